@@ -1,0 +1,35 @@
+/* Rendering a scene to an HDR image, and colour conversion of the result.
+ * Renderers do no I/O. Results do not depend on the thread count.
+ */
+#ifndef ATMOS_RENDER_H
+#define ATMOS_RENDER_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct atmos_render_info {
+    double seconds;          /* wall time of the render */
+    double sun_elevation_deg, sun_azimuth_deg;
+} atmos_render_info;
+
+/* Renders the sky of a scene (Riley §4.1 + §4.2.4). *out gets an image with
+ * count+1 channels: the spectral radiance (W m^-2 sr^-1 nm^-1) at each wavelength of
+ * the scene's set, then coverage alpha (0 outside a fisheye's circle). Reports
+ * progress through ctx and honours cancellation. info may be NULL. */
+ATMOS_API atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene,
+                                        atmos_image **out, atmos_render_info *info);
+
+/* Spectral image (count radiance channels + alpha) -> linear sRGB + alpha (4
+ * channels), scaled so that Y is luminance in cd m^-2. Metadata is copied. */
+ATMOS_API atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral,
+                                           const atmos_wavelengths *wl, atmos_image **out);
+
+/* The wavelength set a scene asks for. */
+ATMOS_API atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_scene *scene,
+                                               atmos_wavelengths *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,44 @@
+/* Solar position from a UTC date-time and a place: the NOAA solar calculator
+ * algorithm (after Meeus, Astronomical Algorithms, 2nd ed., ch. 25), with
+ * atmospheric refraction. Pure functions; thread-safe.
+ */
+#ifndef ATMOS_SUN_H
+#define ATMOS_SUN_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* A UTC instant. Seconds may be fractional. */
+typedef struct atmos_utc_time {
+    int year, month, day;     /* Gregorian calendar */
+    int hour, minute;
+    double second;
+} atmos_utc_time;
+
+typedef struct atmos_sun_position {
+    double elevation_deg;            /* apparent elevation (with refraction unless disabled) */
+    double azimuth_deg;              /* clockwise from north, [0, 360) */
+    double geometric_elevation_deg;  /* without refraction */
+    double declination_deg;
+    double right_ascension_deg;      /* apparent, [0, 360) */
+    double equation_of_time_min;
+    double julian_day;               /* Julian day (UT) of the instant */
+} atmos_sun_position;
+
+/* Parses ISO 8601 "YYYY-MM-DDTHH:MM[:SS[.fff]]" followed by "Z" or "+HH:MM" /
+ * "-HH:MM" (converted to UTC). Returns ATMOS_E_INVALID_ARG with a message for
+ * anything else, including impossible dates (2026-02-30). */
+ATMOS_API atmos_status atmos_parse_utc_time(atmos_context *ctx, const char *text, atmos_utc_time *out);
+
+/* Sun position for latitude (degrees north, [-90, 90]) and longitude (degrees
+ * east, [-180, 180]). refraction: nonzero to include standard atmospheric
+ * refraction in elevation_deg. Errors name the offending value. */
+ATMOS_API atmos_status atmos_sun_position_compute(atmos_context *ctx, const atmos_utc_time *t,
+                                                  double latitude_deg, double longitude_deg,
+                                                  int refraction, atmos_sun_position *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,22 @@
+#!/bin/sh
+# Installs the Debian packages atmos needs to build and test, if any are missing.
+# Safe to run repeatedly: it does nothing when everything is present.
+set -eu
+PKGS="build-essential cmake pkg-config libpng-dev libopenexr-dev libcjson-dev"
+missing=""
+for p in $PKGS; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        missing="$missing $p"
+    fi
+done
+[ -z "$missing" ] && exit 0
+echo "atmos: installing missing Debian packages:$missing" >&2
+SUDO=""
+if [ "$(id -u)" != "0" ]; then
+    if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+        echo "atmos: need root (or sudo) to install:$missing" >&2; exit 1; fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -q --no-install-recommends $missing
