@@ -1,0 +1,31 @@
+/* Shared helpers for the atmos command-line tool. No physics here: subcommands
+ * turn arguments into library calls. */
+#ifndef ATMOS_CLI_H
+#define ATMOS_CLI_H
+
+#include "atmos/atmos.h"
+
+/* Exit statuses of every subcommand. */
+enum { CLI_EXIT_OK = 0, CLI_EXIT_RUNTIME = 1, CLI_EXIT_USAGE = 2 };
+
+/* Parses a finite number; on failure prints "atmos CMD: OPT: expected a number, got 'TEXT'"
+ * to stderr and returns 0. */
+int cli_parse_double(const char *cmd, const char *opt, const char *text, double *out);
+/* Parses an integer in [lo, hi]; prints a message naming OPT and the range on failure. */
+int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, long hi, int *out);
+/* Prints "atmos CMD: message" and "Try 'atmos CMD --help'." to stderr; returns CLI_EXIT_USAGE. */
+int cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Prints "atmos CMD: <ctx error or status string>" to stderr; returns CLI_EXIT_RUNTIME. */
+int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st);
+/* A context for a subcommand: logs warnings and errors to stderr, threads as given (0 = all). */
+atmos_context *cli_context(int threads, int quiet);
+/* Prints a JSON array of n doubles (%.9g) to stdout. */
+void cli_print_json_array(const double *v, int n);
+
+/* Subcommands: each gets argv with argv[0] = subcommand name. */
+int cli_cmd_render(int argc, char **argv);
+int cli_cmd_sky(int argc, char **argv);
+int cli_cmd_sun(int argc, char **argv);
+int cli_cmd_bench(int argc, char **argv);
+
+#endif
