@@ -10,7 +10,8 @@
  *
  * Like NOAA we feed UT where the theory wants dynamical time (TD): the ~1 minute
  * of Delta T moves the sun by ~0.001 degree in longitude, below the method's own
- * error. Positions are geocentric (no parallax: at most 0.0024 degree).
+ * error. Positions are geocentric: we omit the solar parallax, at most
+ * 8.794"/R = 0.0025 degree (Meeus ch. 40).
  */
 #include "core/internal.h"
 
@@ -209,7 +210,7 @@ static atmos_status validate_time(atmos_context *ctx, const atmos_utc_time *t)
 }
 
 /* The NOAA solar calculator's refraction approximation for a standard
- * atmosphere, piecewise in the geometric elevation e (degrees): ~0.57 degree at
+ * atmosphere, piecewise in the geometric elevation e (degrees): 0.48 degree at
  * the horizon, zero above 85 degrees. Returns the correction in degrees to add. */
 static double noaa_refraction_deg(double e)
 {
