@@ -19,6 +19,8 @@ int cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format
 int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st);
 /* A context for a subcommand: logs warnings and errors to stderr, threads as given (0 = all). */
 atmos_context *cli_context(int threads, int quiet);
+/* The same with a progress callback. */
+atmos_context *cli_context_with_progress(int threads, int quiet, atmos_progress_fn fn, void *user);
 /* Prints a JSON array of n doubles (%.9g) to stdout. */
 void cli_print_json_array(const double *v, int n);
 

@@ -1,0 +1,2 @@
+# Empty dependencies file for atmos_asan.
+# This may be replaced when dependencies are built.

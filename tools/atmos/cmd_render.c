@@ -1,0 +1,286 @@
+/* atmos render: a scene file (or the built-in default) to PNG / EXR / PFM. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+static void help(void)
+{
+    printf("Usage: atmos render [SCENE.json] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
+           "Renders a scene file, or the built-in default scene when none is given.\n"
+           "With no output option, writes NAME.png in the current directory (NAME = the scene's name).\n\n"
+           "Outputs:\n"
+           "  -o, --output FILE.png   tone-mapped sRGB PNG (8 or 16 bit, see --png-bits)\n"
+           "      --exr FILE.exr      HDR OpenEXR: linear sRGB + alpha, Y in cd/m^2, scene metadata\n"
+           "      --pfm FILE.pfm      HDR portable float map (linear sRGB, 3 channels)\n"
+           "      --png-bits 8|16     PNG bit depth (default: scene, 8)\n"
+           "      --exr-half          write EXR as 16-bit half floats (default: 32-bit float)\n\n"
+           "Overrides of the scene's settings:\n"
+           "      --width W --height H      image size in pixels\n"
+           "      --spp N                   samples per pixel (1..256)\n"
+           "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
+           "      --altitude M              camera altitude above sea level, metres\n"
+           "      --sun-elevation E         sun elevation, degrees\n"
+           "      --sun-azimuth A           sun azimuth, degrees clockwise from north\n"
+           "      --time T --lat L --lon L  sun from a UTC time (2026-06-21T12:00:00Z) and a place\n"
+           "      --spectral N              N spectral samples in 380-780 nm (default: the paper's rgb)\n"
+           "      --rgb                     the paper's three channels (680, 550, 440 nm)\n"
+           "      --exposure EV|auto        manual exposure (EV100, daylight ~15) or automatic\n"
+           "      --exposure-comp STOPS     compensation added to automatic exposure\n"
+           "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
+           "      --threads N               worker threads (default: all cores)\n"
+           "  -q, --quiet                   no progress bar or messages\n"
+           "  -h, --help                    this help\n\n"
+           "Examples:\n"
+           "  atmos render -o sky.png --exr sky.exr\n"
+           "  atmos render scenes/sunset_fisheye.json --spectral 32 -o sunset.png\n"
+           "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n");
+}
+
+typedef struct {
+    int enabled;
+    double start;
+    int shown;
+} progress_state;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* A progress bar with ETA on stderr, shown only once work has taken over ~1 s. */
+static int progress_bar(void *user, const char *stage, double f)
+{
+    progress_state *p = user;
+    if (!p->enabled) return 0;
+    double t = now_s() - p->start;
+    if (t < 1.0 && f < 1.0) return 0;
+    if (t < 1.0 && !p->shown) return 0;
+    int width = 30, fill = (int)(f * width + 0.5);
+    char bar[64];
+    for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
+    bar[width] = '\0';
+    double eta = f > 0 ? t * (1.0 - f) / f : 0;
+    fprintf(stderr, "\r%s [%s] %3.0f%%  %.1fs elapsed, ETA %.1fs ", stage, bar, 100.0 * f, t, eta);
+    if (f >= 1.0) fputc('\n', stderr);
+    fflush(stderr);
+    p->shown = 1;
+    return 0;
+}
+
+static void default_png_name(const char *scene_name, char *buf, size_t cap)
+{
+    size_t j = 0;
+    for (size_t i = 0; scene_name[i] && j + 5 < cap; i++) {
+        char c = scene_name[i];
+        buf[j++] = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ? c : '_';
+    }
+    if (j == 0) buf[j++] = 'a', buf[j++] = 't', buf[j++] = 'm', buf[j++] = 'o', buf[j++] = 's';
+    snprintf(buf + j, cap - j, ".png");
+}
+
+enum {
+    O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
+    O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS
+};
+
+int cli_cmd_render(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"output", required_argument, 0, 'o'}, {"exr", required_argument, 0, O_EXR},
+        {"pfm", required_argument, 0, O_PFM}, {"png-bits", required_argument, 0, O_PNGBITS},
+        {"exr-half", no_argument, 0, O_EXRHALF}, {"width", required_argument, 0, O_W},
+        {"height", required_argument, 0, O_H}, {"spp", required_argument, 0, O_SPP},
+        {"camera", required_argument, 0, O_CAM}, {"altitude", required_argument, 0, O_ALT},
+        {"sun-elevation", required_argument, 0, O_SEL}, {"sun-azimuth", required_argument, 0, O_SAZ},
+        {"time", required_argument, 0, O_TIME}, {"lat", required_argument, 0, O_LAT},
+        {"lon", required_argument, 0, O_LON}, {"spectral", required_argument, 0, O_SPECTRAL},
+        {"rgb", no_argument, 0, O_RGB}, {"exposure", required_argument, 0, O_EXPOSURE},
+        {"exposure-comp", required_argument, 0, O_EXPCOMP}, {"tone", required_argument, 0, O_TONE},
+        {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},
+        {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+    const char *C = "render";
+    const char *png = NULL, *exr = NULL, *pfm = NULL;
+    const char *time_s = NULL;
+    double lat = NAN, lon = NAN, v;
+    int threads = 0, quiet = 0, c, iv;
+    /* Overrides are collected first and applied after the scene is loaded. */
+    int w = 0, h = 0, spp = 0, png_bits = 0, exr_half = 0, spectral = 0, rgb = 0, cam_type = -1;
+    double alt = NAN, sel = NAN, saz = NAN, ev = NAN, evcomp = NAN;
+    int exposure_auto = 0, tone = -1;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+        switch (c) {
+        case 'o': png = optarg; break;
+        case O_EXR: exr = optarg; break;
+        case O_PFM: pfm = optarg; break;
+        case O_PNGBITS:
+            if (!cli_parse_int(C, "--png-bits", optarg, 8, 16, &png_bits) || (png_bits != 8 && png_bits != 16))
+                return cli_usage_error(C, "--png-bits: must be 8 or 16");
+            break;
+        case O_EXRHALF: exr_half = 1; break;
+        case O_W: if (!cli_parse_int(C, "--width", optarg, 1, ATMOS_SCENE_MAX_DIM, &w)) return CLI_EXIT_USAGE; break;
+        case O_H: if (!cli_parse_int(C, "--height", optarg, 1, ATMOS_SCENE_MAX_DIM, &h)) return CLI_EXIT_USAGE; break;
+        case O_SPP: if (!cli_parse_int(C, "--spp", optarg, 1, 256, &spp)) return CLI_EXIT_USAGE; break;
+        case O_CAM:
+            if (!strcmp(optarg, "pinhole")) cam_type = ATMOS_CAMERA_PINHOLE;
+            else if (!strcmp(optarg, "fisheye")) cam_type = ATMOS_CAMERA_FISHEYE;
+            else if (!strcmp(optarg, "equirect")) cam_type = ATMOS_CAMERA_EQUIRECT;
+            else return cli_usage_error(C, "--camera: expected pinhole, fisheye or equirect, got '%s'", optarg);
+            break;
+        case O_ALT: if (!cli_parse_double(C, "--altitude", optarg, &alt)) return CLI_EXIT_USAGE; break;
+        case O_SEL: if (!cli_parse_double(C, "--sun-elevation", optarg, &sel)) return CLI_EXIT_USAGE; break;
+        case O_SAZ: if (!cli_parse_double(C, "--sun-azimuth", optarg, &saz)) return CLI_EXIT_USAGE; break;
+        case O_TIME: time_s = optarg; break;
+        case O_LAT: if (!cli_parse_double(C, "--lat", optarg, &lat)) return CLI_EXIT_USAGE; break;
+        case O_LON: if (!cli_parse_double(C, "--lon", optarg, &lon)) return CLI_EXIT_USAGE; break;
+        case O_SPECTRAL: if (!cli_parse_int(C, "--spectral", optarg, 1, ATMOS_MAX_WAVELENGTHS, &spectral)) return CLI_EXIT_USAGE; break;
+        case O_RGB: rgb = 1; break;
+        case O_EXPOSURE:
+            if (!strcmp(optarg, "auto")) exposure_auto = 1;
+            else if (!cli_parse_double(C, "--exposure", optarg, &ev)) return CLI_EXIT_USAGE;
+            break;
+        case O_EXPCOMP: if (!cli_parse_double(C, "--exposure-comp", optarg, &evcomp)) return CLI_EXIT_USAGE; break;
+        case O_TONE:
+            if (!strcmp(optarg, "filmic")) tone = ATMOS_TONE_FILMIC;
+            else if (!strcmp(optarg, "reinhard")) tone = ATMOS_TONE_REINHARD;
+            else if (!strcmp(optarg, "clamp")) tone = ATMOS_TONE_CLAMP;
+            else return cli_usage_error(C, "--tone: expected filmic, reinhard or clamp, got '%s'", optarg);
+            break;
+        case O_THREADS: if (!cli_parse_int(C, "--threads", optarg, 1, 1024, &threads)) return CLI_EXIT_USAGE; break;
+        case 'q': quiet = 1; break;
+        case 'h': help(); return CLI_EXIT_OK;
+        default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
+        }
+    }
+    const char *scene_path = NULL;
+    if (optind < argc) scene_path = argv[optind++];
+    if (optind < argc) return cli_usage_error(C, "unexpected argument '%s' (one scene file at most)", argv[optind]);
+    if (spectral && rgb) return cli_usage_error(C, "--spectral and --rgb exclude each other");
+    int use_time = time_s || !isnan(lat) || !isnan(lon);
+    if (use_time && (!time_s || isnan(lat) || isnan(lon)))
+        return cli_usage_error(C, "--time, --lat and --lon go together");
+    if (use_time && (!isnan(sel) || !isnan(saz)))
+        return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
+    if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
+
+    progress_state prog = {!quiet && isatty(2), now_s(), 0};
+    atmos_context *ctx = cli_context_with_progress(threads, quiet, progress_bar, &prog);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+
+    atmos_scene scene;
+    atmos_status st;
+    const char *source = scene_path ? scene_path : "default scene";
+    if (scene_path) {
+        if ((st = atmos_scene_load(ctx, scene_path, &scene)) != ATMOS_OK) goto fail;
+    } else {
+        atmos_scene_defaults(&scene);
+    }
+    if (w) scene.width = w;
+    if (h) scene.height = h;
+    if (spp) scene.samples_per_pixel = spp;
+    if (png_bits) scene.png_bits = png_bits;
+    if (exr_half) scene.exr_half = 1;
+    if (cam_type >= 0 && cam_type != (int)scene.camera.type) {
+        /* A new camera type starts from that type's defaults, keeping the position. */
+        double pos[3] = {scene.camera.position[0], scene.camera.position[1], scene.camera.position[2]};
+        memset(&scene.camera, 0, sizeof scene.camera);
+        scene.camera.type = (atmos_camera_type)cam_type;
+        memcpy(scene.camera.position, pos, sizeof pos);
+    }
+    if (!isnan(alt)) {
+        double dy = alt - scene.camera.position[1];
+        scene.camera.position[1] = alt;
+        int has_look = scene.camera.look_at[0] != 0 || scene.camera.look_at[1] != 0 || scene.camera.look_at[2] != 0;
+        if (has_look) scene.camera.look_at[1] += dy; /* keep the view direction */
+    }
+    if (!isnan(sel) || !isnan(saz)) {
+        scene.sun.from_time = 0;
+        if (!isnan(sel)) scene.sun.elevation_deg = sel;
+        if (!isnan(saz)) scene.sun.azimuth_deg = saz;
+    }
+    if (use_time) {
+        if ((st = atmos_parse_utc_time(ctx, time_s, &scene.sun.time)) != ATMOS_OK) {
+            fprintf(stderr, "atmos render: --time: %s\n", atmos_context_error(ctx));
+            atmos_context_destroy(ctx);
+            return CLI_EXIT_USAGE;
+        }
+        scene.sun.from_time = 1;
+        scene.sun.latitude_deg = lat;
+        scene.sun.longitude_deg = lon;
+    }
+    if (spectral) scene.wavelengths = ATMOS_WAVELENGTHS_SPECTRAL, scene.spectral_samples = spectral;
+    if (rgb) scene.wavelengths = ATMOS_WAVELENGTHS_RGB;
+    if (exposure_auto) scene.tonemap.manual_exposure = 0;
+    if (!isnan(ev)) scene.tonemap.manual_exposure = 1, scene.tonemap.exposure_ev = ev;
+    if (!isnan(evcomp)) {
+        if (scene.tonemap.manual_exposure) {
+            atmos_context_destroy(ctx);
+            return cli_usage_error(C, "--exposure-comp applies to automatic exposure only");
+        }
+        scene.tonemap.exposure_ev = evcomp;
+    }
+    if (tone >= 0) scene.tonemap.curve = (atmos_tone_curve)tone;
+    if ((st = atmos_scene_validate(ctx, &scene, scene_path ? scene_path : "options")) != ATMOS_OK) {
+        fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+        atmos_context_destroy(ctx);
+        return scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+    }
+
+    char default_png[160];
+    if (!png && !exr && !pfm) {
+        default_png_name(scene.name, default_png, sizeof default_png);
+        png = default_png;
+    }
+
+    atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
+    atmos_render_info info;
+    atmos_wavelengths wl;
+    if ((st = atmos_render_sky(ctx, &scene, &spec, &info)) != ATMOS_OK) goto fail;
+    if ((st = atmos_scene_wavelengths(ctx, &scene, &wl)) != ATMOS_OK) goto fail;
+    if ((st = atmos_image_to_srgb(ctx, spec, &wl, &lin)) != ATMOS_OK) goto fail;
+    atmos_image_set_meta(lin, "atmos:source", source);
+    if (exr) {
+        atmos_exr_desc ed = {scene.exr_half, NULL};
+        if ((st = atmos_write_exr(ctx, lin, exr, &ed)) != ATMOS_OK) goto fail;
+    }
+    if (pfm && (st = atmos_write_pfm(ctx, lin, pfm)) != ATMOS_OK) goto fail;
+    if (png) {
+        char buf[64];
+        double scale = atmos_tonemap_scale(lin, &scene.tonemap);
+        snprintf(buf, sizeof buf, "%.6g", scale);
+        atmos_image_set_meta(lin, "atmos:exposure_scale", buf);
+        if ((st = atmos_tonemap(ctx, lin, &scene.tonemap, &disp)) != ATMOS_OK) goto fail;
+        if ((st = atmos_write_png(ctx, disp, png, scene.png_bits ? scene.png_bits : 8)) != ATMOS_OK) goto fail;
+    }
+    if (!quiet) {
+        fprintf(stderr, "atmos render: %s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s\n",
+                source, scene.width, scene.height, info.sun_elevation_deg, info.sun_azimuth_deg, info.seconds);
+        if (png) fprintf(stderr, "  wrote %s\n", png);
+        if (exr) fprintf(stderr, "  wrote %s\n", exr);
+        if (pfm) fprintf(stderr, "  wrote %s\n", pfm);
+    }
+    atmos_image_destroy(spec);
+    atmos_image_destroy(lin);
+    atmos_image_destroy(disp);
+    atmos_context_destroy(ctx);
+    return CLI_EXIT_OK;
+fail:
+    if (prog.shown) fputc('\n', stderr);
+    {
+        int rc = cli_runtime_error(C, ctx, st);
+        atmos_image_destroy(spec);
+        atmos_image_destroy(lin);
+        atmos_image_destroy(disp);
+        atmos_context_destroy(ctx);
+        return rc;
+    }
+}

@@ -1,0 +1,125 @@
+/* atmos sky: the analytic sky model (Riley et al. 2004 §4.1) along one view. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static void help(void)
+{
+    printf("Usage: atmos sky --sun-elevation E [--sun-azimuth A] --view-elevation e --view-azimuth a\n"
+           "                 [--altitude h] [--distance K] [--spectral N] [--albedo R] [--json]\n\n"
+           "Prints, per wavelength, the single-scattered radiance arriving along one view\n"
+           "(Riley et al. 2004 Eq. 15, corrected), the transmittance along it (Eq. 11) and the\n"
+           "sun's attenuated radiance at the observer (Eq. 12 over the disk's solid angle).\n\n"
+           "  --sun-elevation E    sun elevation, degrees above the horizon [-90, 90]\n"
+           "  --sun-azimuth A      sun azimuth, degrees clockwise from north (default 180)\n"
+           "  --view-elevation e   view elevation, degrees [-90, 90]\n"
+           "  --view-azimuth a     view azimuth, degrees clockwise from north\n"
+           "  --altitude h         observer altitude, metres >= 0 (default 0)\n"
+           "  --distance K         path length, metres > 0 (default: to the ground or to space)\n"
+           "  --spectral N         N spectral samples in 380-780 nm (default: rgb = 680, 550, 440 nm)\n"
+           "  --albedo R           ground albedo [0, 1] (default 0.1; used when the view hits the ground)\n"
+           "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
+           "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n\n"
+           "Units: radiance W m^-2 sr^-1 nm^-1. \"inscatter\" is the air's in-scattered radiance only;\n"
+           "\"ground\" is the lit ground's radiance after the air (0 unless the view ends on the\n"
+           "ground); \"sun\" is the radiance of the sun's 0.5 degree disk seen from the observer.\n"
+           "distance_m is null when the path reaches space.\n");
+}
+
+int cli_cmd_sky(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"sun-elevation", required_argument, 0, 'E'}, {"sun-azimuth", required_argument, 0, 'A'},
+        {"view-elevation", required_argument, 0, 'e'}, {"view-azimuth", required_argument, 0, 'a'},
+        {"altitude", required_argument, 0, 'h'},      {"distance", required_argument, 0, 'K'},
+        {"spectral", required_argument, 0, 'n'},      {"albedo", required_argument, 0, 'r'},
+        {"json", no_argument, 0, 'j'},                {"help", no_argument, 0, 'H'},
+        {0, 0, 0, 0}};
+    double sun_el = NAN, sun_az = 180, view_el = NAN, view_az = NAN, alt = 0, dist = INFINITY, albedo = -1;
+    int spectral = 0, json = 0, c;
+    const char *C = "sky";
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        switch (c) {
+        case 'E': if (!cli_parse_double(C, "--sun-elevation", optarg, &sun_el)) return CLI_EXIT_USAGE; break;
+        case 'A': if (!cli_parse_double(C, "--sun-azimuth", optarg, &sun_az)) return CLI_EXIT_USAGE; break;
+        case 'e': if (!cli_parse_double(C, "--view-elevation", optarg, &view_el)) return CLI_EXIT_USAGE; break;
+        case 'a': if (!cli_parse_double(C, "--view-azimuth", optarg, &view_az)) return CLI_EXIT_USAGE; break;
+        case 'h': if (!cli_parse_double(C, "--altitude", optarg, &alt)) return CLI_EXIT_USAGE; break;
+        case 'K': if (!cli_parse_double(C, "--distance", optarg, &dist)) return CLI_EXIT_USAGE; break;
+        case 'r': if (!cli_parse_double(C, "--albedo", optarg, &albedo)) return CLI_EXIT_USAGE; break;
+        case 'n': if (!cli_parse_int(C, "--spectral", optarg, 1, ATMOS_MAX_WAVELENGTHS, &spectral)) return CLI_EXIT_USAGE; break;
+        case 'j': json = 1; break;
+        case 'H': help(); return CLI_EXIT_OK;
+        default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
+        }
+    }
+    if (optind < argc) return cli_usage_error(C, "unexpected argument '%s'", argv[optind]);
+    if (isnan(sun_el)) return cli_usage_error(C, "--sun-elevation is required");
+    if (isnan(view_el)) return cli_usage_error(C, "--view-elevation is required");
+    if (isnan(view_az)) return cli_usage_error(C, "--view-azimuth is required");
+    if (sun_el < -90 || sun_el > 90) return cli_usage_error(C, "--sun-elevation: must be in [-90, 90], got %g", sun_el);
+    if (view_el < -90 || view_el > 90) return cli_usage_error(C, "--view-elevation: must be in [-90, 90], got %g", view_el);
+    if (alt < 0) return cli_usage_error(C, "--altitude: must be >= 0 metres, got %g", alt);
+    if (!(dist > 0)) return cli_usage_error(C, "--distance: must be > 0 metres, got %g", dist);
+    if (albedo != -1 && (albedo < 0 || albedo > 1)) return cli_usage_error(C, "--albedo: must be in [0, 1], got %g", albedo);
+
+    atmos_context *ctx = cli_context(1, 0);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_wavelengths wl;
+    if (spectral) atmos_wavelengths_spectral(spectral, &wl);
+    else atmos_wavelengths_rgb(&wl);
+    atmos_atmosphere_desc ad;
+    atmos_atmosphere_defaults(&ad);
+    if (albedo >= 0) ad.ground_albedo = albedo;
+    atmos_sky *sky = NULL;
+    atmos_status st = atmos_sky_create(ctx, &ad, &wl, &sky);
+    if (st != ATMOS_OK) {
+        int rc = cli_runtime_error(C, ctx, st);
+        atmos_context_destroy(ctx);
+        return rc;
+    }
+    double sun[3], dir[3], eye[3] = {0, alt, 0};
+    atmos_direction_from_angles(sun_el, sun_az, sun);
+    atmos_direction_from_angles(view_el, view_az, dir);
+    double K = atmos_sky_ground_distance(alt, dir);
+    if (dist < K) K = dist;
+    int n = wl.count, hits_ground = !isinf(K) && K == atmos_sky_ground_distance(alt, dir);
+    double ins[ATMOS_MAX_WAVELENGTHS], tr[ATMOS_MAX_WAVELENGTHS], sunr[ATMOS_MAX_WAVELENGTHS],
+        ground[ATMOS_MAX_WAVELENGTHS], lit[ATMOS_MAX_WAVELENGTHS];
+    atmos_sky_inscatter(sky, eye, dir, K, sun, ins);
+    atmos_sky_transmittance(sky, alt, dir, K, tr);
+    atmos_sky_sun_radiance(sky, alt, sun, sunr);
+    atmos_sky_sunlight(sky, 0.0, sun, lit);
+    for (int i = 0; i < n; i++)
+        ground[i] = hits_ground && sun[1] > 0 ? ad.ground_albedo / 3.14159265358979323846 * sun[1] * lit[i] * tr[i] : 0.0;
+    if (json) {
+        printf("{\"wavelengths_nm\": ");
+        cli_print_json_array(wl.nm, n);
+        printf(", \"inscatter\": ");
+        cli_print_json_array(ins, n);
+        printf(", \"transmittance\": ");
+        cli_print_json_array(tr, n);
+        printf(", \"sun\": ");
+        cli_print_json_array(sunr, n);
+        printf(", \"ground\": ");
+        cli_print_json_array(ground, n);
+        if (isinf(K)) printf(", \"distance_m\": null");
+        else printf(", \"distance_m\": %.9g", K);
+        printf(", \"hits_ground\": %s}\n", hits_ground ? "true" : "false");
+    } else {
+        printf("# path: %s", isinf(K) ? "to space" : hits_ground ? "to the ground" : "fixed distance");
+        if (!isinf(K)) printf(", %.6g m", K);
+        printf("\n# radiance in W m^-2 sr^-1 nm^-1\n");
+        printf("%10s %14s %14s %14s %14s\n", "lambda_nm", "inscatter", "transmittance", "sun", "ground");
+        for (int i = 0; i < n; i++)
+            printf("%10.2f %14.6e %14.6e %14.6e %14.6e\n", wl.nm[i], ins[i], tr[i], sunr[i], ground[i]);
+    }
+    atmos_sky_destroy(sky);
+    atmos_context_destroy(ctx);
+    return CLI_EXIT_OK;
+}
