@@ -55,6 +55,8 @@ set(CMAKE_DEPEND_INFO_FILES
   "tests/CMakeFiles/atmos_asan.dir/DependInfo.cmake"
   "tests/CMakeFiles/test_sky.dir/DependInfo.cmake"
   "tests/CMakeFiles/test_sky_asan.dir/DependInfo.cmake"
+  "tests/CMakeFiles/test_sky_batch.dir/DependInfo.cmake"
+  "tests/CMakeFiles/test_sky_batch_asan.dir/DependInfo.cmake"
   "tests/CMakeFiles/test_sunpos.dir/DependInfo.cmake"
   "tests/CMakeFiles/test_sunpos_asan.dir/DependInfo.cmake"
   )

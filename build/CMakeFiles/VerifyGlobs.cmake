@@ -10,6 +10,7 @@ set(OLD_GLOB
   "/work/main/src/core/spectrum.c"
   "/work/main/src/render/camera.c"
   "/work/main/src/render/render_sky.c"
+  "/work/main/src/render/sky_batch.c"
   "/work/main/src/sky/sky.c"
   "/work/main/src/sky/sunpos.c"
   )
@@ -32,6 +33,7 @@ endif()
 file(GLOB NEW_GLOB LIST_DIRECTORIES true "/work/main/tests/unit/test_*.c")
 set(OLD_GLOB
   "/work/main/tests/unit/test_sky.c"
+  "/work/main/tests/unit/test_sky_batch.c"
   "/work/main/tests/unit/test_sunpos.c"
   )
 if(NOT "${NEW_GLOB}" STREQUAL "${OLD_GLOB}")

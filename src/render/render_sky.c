@@ -2,6 +2,9 @@
  * and converts spectral images to linear sRGB. */
 #include "core/internal.h"
 #include "sky/sky_internal.h"
+#include "render/sky_batch.h"
+
+#include <stdlib.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -89,37 +92,89 @@ static double sun_coverage(const sky_job *job, int x, int y)
     return valid ? (double)inside / (S * S) : 0.0;
 }
 
-static void shade_pixel(const sky_job *job, int x, int y, float *px)
+/* Directions of the rays through (x + sx, y + sy) for x in [0, W) into SoA arrays;
+ * w[x] = 1 for a valid ray, 0 outside a fisheye's circle. The equirectangular
+ * camera reads azimuth sines and cosines from a per-sample column table. */
+static void row_rays(const sky_job *job, int y, double sx, double sy, const float *col_sc, float *dx, float *dy,
+                     float *dz, float *w)
 {
-    const int n = job->n;
-    double acc[ATMOS_MAX_WAVELENGTHS] = {0}, L[ATMOS_MAX_WAVELENGTHS];
-    double d[3];
-    int hits = 0;
-    atmos_sky_sample info;
-    /* The disk is drawn separately (antialiased) so the per-sample evaluation hides it. */
-    for (int s = 0; s < job->spp; s++) {
-        double sx = job->spp == 1 ? 0.5 : (s + 0.5) / job->spp;
-        double sy = job->spp == 1 ? 0.5 : radical_inverse2((unsigned)s);
-        if (!atmos_camera_ray(job->cam, x + sx, y + sy, d)) continue;
-        hits++;
-        atmos_sky_radiance(job->sky, job->cam->position, d, job->sun, L, &info);
-        if (info.in_sun_disk)
-            for (int i = 0; i < n; i++) L[i] -= job->sun_radiance[i];
-        for (int i = 0; i < n; i++) acc[i] += L[i];
-    }
-    double inv = 1.0 / job->spp;
-    if (hits && job->sun_visible) {
-        /* Only pixels whose centre is within the disk's radius plus the pixel's
-         * angular footprint get the (antialiased) disk. */
-        double c[3];
-        if (atmos_camera_ray(job->cam, x + 0.5, y + 0.5, c) &&
-            c[0] * job->sun[0] + c[1] * job->sun[1] + c[2] * job->sun[2] >= job->cos_disk_search) {
-            double cov = sun_coverage(job, x, y);
-            for (int i = 0; i < n; i++) acc[i] += cov * job->sun_radiance[i] * job->spp;
+    const atmos_camera *cam = job->cam;
+    const int W = cam->width;
+    if (cam->type == ATMOS_CAMERA_EQUIRECT && col_sc) {
+        double el = (90.0 - ((y + sy) / cam->height) * 180.0) * ATMOS_DEG2RAD;
+        float ce = (float)cos(el), se = (float)sin(el);
+        for (int x = 0; x < W; x++) {
+            dx[x] = ce * col_sc[2 * x];
+            dy[x] = se;
+            dz[x] = -ce * col_sc[2 * x + 1];
+            w[x] = 1.0f;
         }
+        return;
     }
-    for (int i = 0; i < n; i++) px[i] = (float)(acc[i] * inv);
-    px[n] = (float)(hits * inv);
+    if (cam->type == ATMOS_CAMERA_PINHOLE) {
+        const double t = cam->tan_half_fov, H = cam->height;
+        double v = (H - 2.0 * (y + sy)) / H * t;
+        double bx = cam->forward[0] + v * cam->up[0], by = cam->forward[1] + v * cam->up[1],
+               bz = cam->forward[2] + v * cam->up[2];
+        for (int x = 0; x < W; x++) {
+            double u = (2.0 * (x + sx) - W) / H * t;
+            double ox = bx + u * cam->right[0], oy = by + u * cam->right[1], oz = bz + u * cam->right[2];
+            double inv = 1.0 / sqrt(ox * ox + oy * oy + oz * oz);
+            dx[x] = (float)(ox * inv), dy[x] = (float)(oy * inv), dz[x] = (float)(oz * inv);
+            w[x] = 1.0f;
+        }
+        return;
+    }
+    for (int x = 0; x < W; x++) {
+        double d[3];
+        int ok = atmos_camera_ray(cam, x + sx, y + sy, d);
+        dx[x] = (float)d[0], dy[x] = (float)d[1], dz[x] = (float)d[2];
+        w[x] = ok ? 1.0f : 0.0f;
+    }
+}
+
+/* Sample offsets within the pixel: the centre for one sample, else a Hammersley
+ * set (deterministic, identical for every pixel and thread). */
+static void sample_offset(int s, int spp, double *sx, double *sy)
+{
+    *sx = spp == 1 ? 0.5 : (s + 0.5) / spp;
+    *sy = spp == 1 ? 0.5 : radical_inverse2((unsigned)s);
+}
+
+typedef struct {
+    float *dx, *dy, *dz, *w, *acc, *scratch, *hits;
+} row_buffers;
+
+static void shade_row(const sky_job *job, const atmos__sky_batch *batch, const float *col_sc, int y, row_buffers *rb,
+                      float *dst, int C)
+{
+    const int W = job->cam->width, n = job->n, spp = job->spp;
+    memset(rb->acc, 0, sizeof(float) * (size_t)W * n);
+    memset(rb->hits, 0, sizeof(float) * (size_t)W);
+    for (int s = 0; s < spp; s++) {
+        double sx, sy;
+        sample_offset(s, spp, &sx, &sy);
+        row_rays(job, y, sx, sy, col_sc ? col_sc + (size_t)2 * W * s : NULL, rb->dx, rb->dy, rb->dz, rb->w);
+        atmos__sky_batch_eval(batch, W, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, n, rb->scratch);
+        for (int x = 0; x < W; x++) rb->hits[x] += rb->w[x];
+    }
+    const float inv = 1.0f / spp;
+    for (int x = 0; x < W; x++) {
+        float *px = dst + (size_t)x * C;
+        const float *a = rb->acc + (size_t)x * n;
+        for (int i = 0; i < n; i++) px[i] = a[i] * inv;
+        px[n] = rb->hits[x] * inv;
+    }
+    if (!job->sun_visible) return;
+    /* The sun's disk, antialiased by supersampling the few pixels near it. */
+    for (int x = 0; x < W; x++) {
+        double c[3];
+        if (!atmos_camera_ray(job->cam, x + 0.5, y + 0.5, c)) continue;
+        if (c[0] * job->sun[0] + c[1] * job->sun[1] + c[2] * job->sun[2] < job->cos_disk_search) continue;
+        double cov = sun_coverage(job, x, y);
+        float *px = dst + (size_t)x * C;
+        for (int i = 0; i < n; i++) px[i] += (float)(cov * job->sun_radiance[i]);
+    }
 }
 
 atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmos_image **out, atmos_render_info *info)
@@ -159,10 +214,38 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
     const int W = scene->width, H = scene->height, C = img->channels;
     const int band = 8; /* rows per work item: small enough for progress and balance */
     const int nbands = (H + band - 1) / band;
-    int done = 0, cancelled = 0;
+    int done = 0, cancelled = 0, nomem = 0;
     int threads = atmos__threads(ctx);
+    atmos__sky_batch batch;
+    atmos__sky_batch_init(&batch, sky, cam.position[1], job.sun);
+    /* Equirectangular: per-sample tables of the columns' azimuth sines and cosines. */
+    float *col_sc = NULL;
+    if (cam.type == ATMOS_CAMERA_EQUIRECT && (size_t)job.spp * W <= ((size_t)1 << 22)) {
+        col_sc = malloc(sizeof(float) * 2 * (size_t)W * job.spp);
+        if (col_sc)
+            for (int s = 0; s < job.spp; s++) {
+                double sx, sy;
+                sample_offset(s, job.spp, &sx, &sy);
+                for (int x = 0; x < W; x++) {
+                    double az = ((x + sx) / W - 0.5) * 2.0 * ATMOS_PI;
+                    col_sc[(size_t)2 * W * s + 2 * x] = (float)sin(az);
+                    col_sc[(size_t)2 * W * s + 2 * x + 1] = (float)cos(az);
+                }
+            }
+    }
 #pragma omp parallel num_threads(threads)
     {
+        row_buffers rb = {0};
+        size_t per = (size_t)W;
+        float *mem = malloc(sizeof(float) * per * (5 + (size_t)job.n + ATMOS__SKY_BATCH_SCRATCH));
+        if (mem) {
+            rb.dx = mem, rb.dy = mem + per, rb.dz = mem + 2 * per, rb.w = mem + 3 * per, rb.hits = mem + 4 * per;
+            rb.acc = mem + 5 * per;
+            rb.scratch = rb.acc + per * job.n;
+        } else {
+#pragma omp atomic write
+            nomem = 1;
+        }
         /* Bands are handed out dynamically for balance; each pixel's value depends
          * only on its own position, so the image is identical for any thread count. */
 #pragma omp for schedule(dynamic, 1)
@@ -170,9 +253,9 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
             int stop;
 #pragma omp atomic read
             stop = cancelled;
-            if (stop) continue;
+            if (stop || !mem) continue;
             for (int y = b * band; y < H && y < (b + 1) * band; y++)
-                for (int x = 0; x < W; x++) shade_pixel(&job, x, y, img->pixels + ((size_t)y * W + x) * C);
+                shade_row(&job, &batch, col_sc, y, &rb, img->pixels + (size_t)y * W * C, C);
             int d;
 #pragma omp atomic capture
             d = ++done;
@@ -186,6 +269,14 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
                 }
             }
         }
+        free(mem);
+    }
+    free(col_sc);
+    if (!cancelled && !nomem) atmos__progress(ctx, "render sky", 1.0);
+    if (nomem) {
+        atmos_sky_destroy(sky);
+        atmos_image_destroy(img);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for row buffers");
     }
     atmos_sky_destroy(sky);
     if (cancelled) {

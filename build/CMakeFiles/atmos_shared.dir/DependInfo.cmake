@@ -13,6 +13,7 @@ set(CMAKE_DEPENDS_DEPENDENCY_FILES
   "/work/main/src/core/spectrum.c" "CMakeFiles/atmos_shared.dir/src/core/spectrum.c.o" "gcc" "CMakeFiles/atmos_shared.dir/src/core/spectrum.c.o.d"
   "/work/main/src/render/camera.c" "CMakeFiles/atmos_shared.dir/src/render/camera.c.o" "gcc" "CMakeFiles/atmos_shared.dir/src/render/camera.c.o.d"
   "/work/main/src/render/render_sky.c" "CMakeFiles/atmos_shared.dir/src/render/render_sky.c.o" "gcc" "CMakeFiles/atmos_shared.dir/src/render/render_sky.c.o.d"
+  "/work/main/src/render/sky_batch.c" "CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o" "gcc" "CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o.d"
   "/work/main/src/sky/sky.c" "CMakeFiles/atmos_shared.dir/src/sky/sky.c.o" "gcc" "CMakeFiles/atmos_shared.dir/src/sky/sky.c.o.d"
   "/work/main/src/sky/sunpos.c" "CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o" "gcc" "CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o.d"
   )

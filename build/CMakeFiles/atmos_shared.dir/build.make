@@ -139,10 +139,24 @@ CMakeFiles/atmos_shared.dir/src/render/render_sky.c.s: cmake_force
 	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos_shared.dir/src/render/render_sky.c.s"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/src/render/render_sky.c -o CMakeFiles/atmos_shared.dir/src/render/render_sky.c.s
 
+CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o: CMakeFiles/atmos_shared.dir/flags.make
+CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o: /work/main/src/render/sky_batch.c
+CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o: CMakeFiles/atmos_shared.dir/compiler_depend.ts
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building C object CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o -MF CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o.d -o CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o -c /work/main/src/render/sky_batch.c
+
+CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.i: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Preprocessing C source to CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.i"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -E /work/main/src/render/sky_batch.c > CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.i
+
+CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.s: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.s"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/src/render/sky_batch.c -o CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.s
+
 CMakeFiles/atmos_shared.dir/src/sky/sky.c.o: CMakeFiles/atmos_shared.dir/flags.make
 CMakeFiles/atmos_shared.dir/src/sky/sky.c.o: /work/main/src/sky/sky.c
 CMakeFiles/atmos_shared.dir/src/sky/sky.c.o: CMakeFiles/atmos_shared.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building C object CMakeFiles/atmos_shared.dir/src/sky/sky.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Building C object CMakeFiles/atmos_shared.dir/src/sky/sky.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos_shared.dir/src/sky/sky.c.o -MF CMakeFiles/atmos_shared.dir/src/sky/sky.c.o.d -o CMakeFiles/atmos_shared.dir/src/sky/sky.c.o -c /work/main/src/sky/sky.c
 
 CMakeFiles/atmos_shared.dir/src/sky/sky.c.i: cmake_force
@@ -156,7 +170,7 @@ CMakeFiles/atmos_shared.dir/src/sky/sky.c.s: cmake_force
 CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o: CMakeFiles/atmos_shared.dir/flags.make
 CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o: /work/main/src/sky/sunpos.c
 CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o: CMakeFiles/atmos_shared.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Building C object CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_8) "Building C object CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o -MF CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o.d -o CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o -c /work/main/src/sky/sunpos.c
 
 CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.i: cmake_force
@@ -174,6 +188,7 @@ atmos_shared_OBJECTS = \
 "CMakeFiles/atmos_shared.dir/src/core/spectrum.c.o" \
 "CMakeFiles/atmos_shared.dir/src/render/camera.c.o" \
 "CMakeFiles/atmos_shared.dir/src/render/render_sky.c.o" \
+"CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o" \
 "CMakeFiles/atmos_shared.dir/src/sky/sky.c.o" \
 "CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o"
 
@@ -185,6 +200,7 @@ libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/src/core/spectral_data.c.o
 libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/src/core/spectrum.c.o
 libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/src/render/camera.c.o
 libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/src/render/render_sky.c.o
+libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o
 libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/src/sky/sky.c.o
 libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o
 libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/build.make
@@ -194,7 +210,7 @@ libatmos.so.0.1.0: /usr/lib/x86_64-linux-gnu/libpthread.a
 libatmos.so.0.1.0: /usr/lib/x86_64-linux-gnu/libpng16.so
 libatmos.so.0.1.0: /usr/lib/x86_64-linux-gnu/libcjson.so
 libatmos.so.0.1.0: CMakeFiles/atmos_shared.dir/link.txt
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_8) "Linking C shared library libatmos.so"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_9) "Linking C shared library libatmos.so"
 	$(CMAKE_COMMAND) -E cmake_link_script CMakeFiles/atmos_shared.dir/link.txt --verbose=$(VERBOSE)
 	$(CMAKE_COMMAND) -E cmake_symlink_library libatmos.so.0.1.0 libatmos.so.0 libatmos.so
 

@@ -9,6 +9,8 @@ file(REMOVE_RECURSE
   "CMakeFiles/atmos_shared.dir/src/render/camera.c.o.d"
   "CMakeFiles/atmos_shared.dir/src/render/render_sky.c.o"
   "CMakeFiles/atmos_shared.dir/src/render/render_sky.c.o.d"
+  "CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o"
+  "CMakeFiles/atmos_shared.dir/src/render/sky_batch.c.o.d"
   "CMakeFiles/atmos_shared.dir/src/sky/sky.c.o"
   "CMakeFiles/atmos_shared.dir/src/sky/sky.c.o.d"
   "CMakeFiles/atmos_shared.dir/src/sky/sunpos.c.o"

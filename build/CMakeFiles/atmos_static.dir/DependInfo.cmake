@@ -13,6 +13,7 @@ set(CMAKE_DEPENDS_DEPENDENCY_FILES
   "/work/main/src/core/spectrum.c" "CMakeFiles/atmos_static.dir/src/core/spectrum.c.o" "gcc" "CMakeFiles/atmos_static.dir/src/core/spectrum.c.o.d"
   "/work/main/src/render/camera.c" "CMakeFiles/atmos_static.dir/src/render/camera.c.o" "gcc" "CMakeFiles/atmos_static.dir/src/render/camera.c.o.d"
   "/work/main/src/render/render_sky.c" "CMakeFiles/atmos_static.dir/src/render/render_sky.c.o" "gcc" "CMakeFiles/atmos_static.dir/src/render/render_sky.c.o.d"
+  "/work/main/src/render/sky_batch.c" "CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o" "gcc" "CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o.d"
   "/work/main/src/sky/sky.c" "CMakeFiles/atmos_static.dir/src/sky/sky.c.o" "gcc" "CMakeFiles/atmos_static.dir/src/sky/sky.c.o.d"
   "/work/main/src/sky/sunpos.c" "CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o" "gcc" "CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o.d"
   )

@@ -139,10 +139,24 @@ CMakeFiles/atmos_static.dir/src/render/render_sky.c.s: cmake_force
 	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos_static.dir/src/render/render_sky.c.s"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/src/render/render_sky.c -o CMakeFiles/atmos_static.dir/src/render/render_sky.c.s
 
+CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o: CMakeFiles/atmos_static.dir/flags.make
+CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o: /work/main/src/render/sky_batch.c
+CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o: CMakeFiles/atmos_static.dir/compiler_depend.ts
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building C object CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o -MF CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o.d -o CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o -c /work/main/src/render/sky_batch.c
+
+CMakeFiles/atmos_static.dir/src/render/sky_batch.c.i: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Preprocessing C source to CMakeFiles/atmos_static.dir/src/render/sky_batch.c.i"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -E /work/main/src/render/sky_batch.c > CMakeFiles/atmos_static.dir/src/render/sky_batch.c.i
+
+CMakeFiles/atmos_static.dir/src/render/sky_batch.c.s: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos_static.dir/src/render/sky_batch.c.s"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/src/render/sky_batch.c -o CMakeFiles/atmos_static.dir/src/render/sky_batch.c.s
+
 CMakeFiles/atmos_static.dir/src/sky/sky.c.o: CMakeFiles/atmos_static.dir/flags.make
 CMakeFiles/atmos_static.dir/src/sky/sky.c.o: /work/main/src/sky/sky.c
 CMakeFiles/atmos_static.dir/src/sky/sky.c.o: CMakeFiles/atmos_static.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building C object CMakeFiles/atmos_static.dir/src/sky/sky.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Building C object CMakeFiles/atmos_static.dir/src/sky/sky.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos_static.dir/src/sky/sky.c.o -MF CMakeFiles/atmos_static.dir/src/sky/sky.c.o.d -o CMakeFiles/atmos_static.dir/src/sky/sky.c.o -c /work/main/src/sky/sky.c
 
 CMakeFiles/atmos_static.dir/src/sky/sky.c.i: cmake_force
@@ -156,7 +170,7 @@ CMakeFiles/atmos_static.dir/src/sky/sky.c.s: cmake_force
 CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o: CMakeFiles/atmos_static.dir/flags.make
 CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o: /work/main/src/sky/sunpos.c
 CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o: CMakeFiles/atmos_static.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Building C object CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_8) "Building C object CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o -MF CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o.d -o CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o -c /work/main/src/sky/sunpos.c
 
 CMakeFiles/atmos_static.dir/src/sky/sunpos.c.i: cmake_force
@@ -174,6 +188,7 @@ atmos_static_OBJECTS = \
 "CMakeFiles/atmos_static.dir/src/core/spectrum.c.o" \
 "CMakeFiles/atmos_static.dir/src/render/camera.c.o" \
 "CMakeFiles/atmos_static.dir/src/render/render_sky.c.o" \
+"CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o" \
 "CMakeFiles/atmos_static.dir/src/sky/sky.c.o" \
 "CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o"
 
@@ -185,11 +200,12 @@ libatmos_static.a: CMakeFiles/atmos_static.dir/src/core/spectral_data.c.o
 libatmos_static.a: CMakeFiles/atmos_static.dir/src/core/spectrum.c.o
 libatmos_static.a: CMakeFiles/atmos_static.dir/src/render/camera.c.o
 libatmos_static.a: CMakeFiles/atmos_static.dir/src/render/render_sky.c.o
+libatmos_static.a: CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o
 libatmos_static.a: CMakeFiles/atmos_static.dir/src/sky/sky.c.o
 libatmos_static.a: CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o
 libatmos_static.a: CMakeFiles/atmos_static.dir/build.make
 libatmos_static.a: CMakeFiles/atmos_static.dir/link.txt
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_8) "Linking C static library libatmos_static.a"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_9) "Linking C static library libatmos_static.a"
 	$(CMAKE_COMMAND) -P CMakeFiles/atmos_static.dir/cmake_clean_target.cmake
 	$(CMAKE_COMMAND) -E cmake_link_script CMakeFiles/atmos_static.dir/link.txt --verbose=$(VERBOSE)
 

@@ -9,6 +9,8 @@ file(REMOVE_RECURSE
   "CMakeFiles/atmos_static.dir/src/render/camera.c.o.d"
   "CMakeFiles/atmos_static.dir/src/render/render_sky.c.o"
   "CMakeFiles/atmos_static.dir/src/render/render_sky.c.o.d"
+  "CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o"
+  "CMakeFiles/atmos_static.dir/src/render/sky_batch.c.o.d"
   "CMakeFiles/atmos_static.dir/src/sky/sky.c.o"
   "CMakeFiles/atmos_static.dir/src/sky/sky.c.o.d"
   "CMakeFiles/atmos_static.dir/src/sky/sunpos.c.o"

@@ -13,6 +13,7 @@ set(CMAKE_DEPENDS_DEPENDENCY_FILES
   "/work/main/src/core/spectrum.c" "tests/CMakeFiles/atmos_asan.dir/__/src/core/spectrum.c.o" "gcc" "tests/CMakeFiles/atmos_asan.dir/__/src/core/spectrum.c.o.d"
   "/work/main/src/render/camera.c" "tests/CMakeFiles/atmos_asan.dir/__/src/render/camera.c.o" "gcc" "tests/CMakeFiles/atmos_asan.dir/__/src/render/camera.c.o.d"
   "/work/main/src/render/render_sky.c" "tests/CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.o" "gcc" "tests/CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.o.d"
+  "/work/main/src/render/sky_batch.c" "tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o" "gcc" "tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o.d"
   "/work/main/src/sky/sky.c" "tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o" "gcc" "tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o.d"
   "/work/main/src/sky/sunpos.c" "tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o" "gcc" "tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o.d"
   )

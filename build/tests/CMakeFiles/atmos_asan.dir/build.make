@@ -139,10 +139,24 @@ tests/CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.s: cmake_force
 	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.s"
 	cd /work/main/build/tests && /usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/src/render/render_sky.c -o CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.s
 
+tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o: tests/CMakeFiles/atmos_asan.dir/flags.make
+tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o: /work/main/src/render/sky_batch.c
+tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o: tests/CMakeFiles/atmos_asan.dir/compiler_depend.ts
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building C object tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o"
+	cd /work/main/build/tests && /usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o -MF CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o.d -o CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o -c /work/main/src/render/sky_batch.c
+
+tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.i: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Preprocessing C source to CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.i"
+	cd /work/main/build/tests && /usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -E /work/main/src/render/sky_batch.c > CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.i
+
+tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.s: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.s"
+	cd /work/main/build/tests && /usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/src/render/sky_batch.c -o CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.s
+
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o: tests/CMakeFiles/atmos_asan.dir/flags.make
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o: /work/main/src/sky/sky.c
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o: tests/CMakeFiles/atmos_asan.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building C object tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Building C object tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o"
 	cd /work/main/build/tests && /usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o -MF CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o.d -o CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o -c /work/main/src/sky/sky.c
 
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.i: cmake_force
@@ -156,7 +170,7 @@ tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.s: cmake_force
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o: tests/CMakeFiles/atmos_asan.dir/flags.make
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o: /work/main/src/sky/sunpos.c
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o: tests/CMakeFiles/atmos_asan.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Building C object tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_8) "Building C object tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o"
 	cd /work/main/build/tests && /usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o -MF CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o.d -o CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o -c /work/main/src/sky/sunpos.c
 
 tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.i: cmake_force
@@ -174,6 +188,7 @@ atmos_asan_OBJECTS = \
 "CMakeFiles/atmos_asan.dir/__/src/core/spectrum.c.o" \
 "CMakeFiles/atmos_asan.dir/__/src/render/camera.c.o" \
 "CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.o" \
+"CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o" \
 "CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o" \
 "CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o"
 
@@ -185,11 +200,12 @@ tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/__/src/core/spectral_data
 tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/__/src/core/spectrum.c.o
 tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/__/src/render/camera.c.o
 tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.o
+tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o
 tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o
 tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o
 tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/build.make
 tests/libatmos_asan.a: tests/CMakeFiles/atmos_asan.dir/link.txt
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_8) "Linking C static library libatmos_asan.a"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_9) "Linking C static library libatmos_asan.a"
 	cd /work/main/build/tests && $(CMAKE_COMMAND) -P CMakeFiles/atmos_asan.dir/cmake_clean_target.cmake
 	cd /work/main/build/tests && $(CMAKE_COMMAND) -E cmake_link_script CMakeFiles/atmos_asan.dir/link.txt --verbose=$(VERBOSE)
 

@@ -9,6 +9,8 @@ file(REMOVE_RECURSE
   "CMakeFiles/atmos_asan.dir/__/src/render/camera.c.o.d"
   "CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.o"
   "CMakeFiles/atmos_asan.dir/__/src/render/render_sky.c.o.d"
+  "CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o"
+  "CMakeFiles/atmos_asan.dir/__/src/render/sky_batch.c.o.d"
   "CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o"
   "CMakeFiles/atmos_asan.dir/__/src/sky/sky.c.o.d"
   "CMakeFiles/atmos_asan.dir/__/src/sky/sunpos.c.o"

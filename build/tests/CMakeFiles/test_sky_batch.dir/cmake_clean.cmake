@@ -1,0 +1,11 @@
+file(REMOVE_RECURSE
+  "CMakeFiles/test_sky_batch.dir/unit/test_sky_batch.c.o"
+  "CMakeFiles/test_sky_batch.dir/unit/test_sky_batch.c.o.d"
+  "test_sky_batch"
+  "test_sky_batch.pdb"
+)
+
+# Per-language clean rules from dependency scanning.
+foreach(lang C)
+  include(CMakeFiles/test_sky_batch.dir/cmake_clean_${lang}.cmake OPTIONAL)
+endforeach()

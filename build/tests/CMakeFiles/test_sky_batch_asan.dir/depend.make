@@ -1,0 +1,2 @@
+# Empty dependencies file for test_sky_batch_asan.
+# This may be replaced when dependencies are built.

@@ -1,0 +1,107 @@
+/* Fast float evaluation of the analytic sky (see sky_batch.h and src/sky/sky.c). */
+#include "render/sky_batch.h"
+#include "core/internal.h"
+#include "sky/sky_internal.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* exp by range reduction x = n ln2 + r, |r| <= ln2/2, and a degree-6 Taylor
+ * polynomial for e^r (truncation error < 2e-8), 2^n assembled in the exponent
+ * bits. Written without branches or calls so the compiler vectorises loops over it. */
+static inline float expf_fast(float x)
+{
+    x = x < -87.0f ? -87.0f : (x > 88.0f ? 88.0f : x);
+    float t = x * 1.44269504088896341f;
+    float nf = t >= 0 ? (float)(int32_t)(t + 0.5f) : (float)(int32_t)(t - 0.5f);
+    float r = x - nf * 0.693145751953125f;  /* ln2 split: hi exactly representable */
+    r = r - nf * 1.428606765330187045e-06f; /* ln2 lo */
+    float p = 1.0f / 720.0f;
+    p = p * r + 1.0f / 120.0f;
+    p = p * r + 1.0f / 24.0f;
+    p = p * r + 1.0f / 6.0f;
+    p = p * r + 0.5f;
+    p = p * r + 1.0f;
+    p = p * r + 1.0f;
+    union {
+        int32_t i;
+        float f;
+    } s;
+    s.i = ((int32_t)nf + 127) << 23;
+    return p * s.f;
+}
+
+float atmos__expf_fast(float x) { return x < -87.0f ? 0.0f : expf_fast(x); }
+
+void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye_y, const double sun[3])
+{
+    memset(b, 0, sizeof *b);
+    b->n = sky->wl.count;
+    b->gamma = (float)sky->gamma;
+    b->eye_y = (float)eye_y;
+    b->ly = (float)sun[1];
+    for (int k = 0; k < 3; k++) b->sun[k] = (float)sun[k];
+    b->sun_up = sun[1] > 0;
+    double ey = exp(-sky->gamma * eye_y), ground[ATMOS_MAX_WAVELENGTHS];
+    atmos_sky_sunlight(sky, 0.0, sun, ground);
+    for (int i = 0; i < b->n; i++) {
+        double be = sky->beta_sl[i] * ey;
+        b->beta_eye[i] = (float)be;
+        double ts0 = b->sun_up ? be / (sky->gamma * sun[1]) : 0.0;
+        b->ts0[i] = (float)fmin(ts0, 1e30);
+        b->e_ts0[i] = (float)exp(-ts0);
+        b->sun_e[i] = (float)sky->sun_e[i];
+        b->ground[i] = (float)(sky->desc.ground_albedo / ATMOS_PI * fmax(sun[1], 0.0) * ground[i]);
+    }
+}
+
+void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                           const float *weight, float *out, int stride, float *scratch)
+{
+    if (!b->sun_up) return; /* flat earth: no sunlight reaches the air or the ground */
+    float *PE = scratch;               /* P(theta) * weight */
+    float *G = scratch + count;        /* tau_v(K) / beta_eye */
+    float *c = scratch + 2 * count;    /* 1 - p_y / l_y */
+    float *eend = scratch + 3 * count; /* beta(K) / beta_eye */
+    float *gm = scratch + 4 * count;   /* weight if the ray ends on the ground, else 0 */
+    const float gamma = b->gamma, eye_y = b->eye_y, ly = b->ly, inv_ly = 1.0f / b->ly;
+    const float sx = b->sun[0], sy = b->sun[1], sz = b->sun[2];
+    const float k_ray = 3.0f / (16.0f * 3.14159265358979f);
+#pragma omp simd
+    for (int i = 0; i < count; i++) {
+        float py = dy[i];
+        float mu = dx[i] * sx + py * sy + dz[i] * sz;
+        PE[i] = k_ray * (1.0f + mu * mu) * weight[i];
+        int down = py < 0.0f;
+        /* Ground distance K = y / -p_y; up or level rays run to infinity. */
+        float K = down ? eye_y / -py : 0.0f;
+        float z = gamma * py * K; /* <= 0 for ground rays */
+        float e = expf_fast(-z);  /* beta(K)/beta_eye = exp(-gamma p_y K) */
+        float gz = fabsf(z) < 1e-3f ? 1.0f - 0.5f * z + z * z * (1.0f / 6.0f) : (1.0f - e) / z;
+        float Gd = K * gz;
+        /* Upward rays to space: G = 1/(gamma p_y); level rays: unbounded (clamped). */
+        float Gu = py > 1e-20f ? 1.0f / (gamma * py) : 1e20f;
+        Gu = Gu > 1e20f ? 1e20f : Gu;
+        G[i] = down ? Gd : Gu;
+        eend[i] = down ? e : 0.0f;
+        c[i] = 1.0f - py * inv_ly;
+        gm[i] = down ? weight[i] : 0.0f;
+    }
+    (void)ly;
+    for (int k = 0; k < b->n; k++) {
+        const float be = b->beta_eye[k], ts0 = b->ts0[k], a = b->e_ts0[k], E = b->sun_e[k], gr = b->ground[k];
+        float *o = out + k;
+#pragma omp simd
+        for (int i = 0; i < count; i++) {
+            float x = be * G[i];
+            float D = c[i] * x;
+            float bexp = expf_fast(-(x + ts0 * eend[i]));
+            /* e^{-ts0} h(D) = (e^{-ts0} - e^{-(x + tsK)}) / D, by series near D = 0. */
+            float series = a * (1.0f - D * (0.5f - D * (1.0f / 6.0f - D * (1.0f / 24.0f))));
+            float F = fabsf(D) < 1e-2f ? series : (a - bexp) / D;
+            float L = PE[i] * E * x * F + gm[i] * gr * expf_fast(-x);
+            o[(size_t)i * stride] += L;
+        }
+    }
+}
