@@ -45,6 +45,7 @@ endif()
 file(GLOB NEW_GLOB LIST_DIRECTORIES true "/work/main/tools/atmos/*.c")
 set(OLD_GLOB
   "/work/main/tools/atmos/cli.c"
+  "/work/main/tools/atmos/cmd_bench.c"
   "/work/main/tools/atmos/cmd_render.c"
   "/work/main/tools/atmos/cmd_sky.c"
   "/work/main/tools/atmos/cmd_sun.c"

@@ -133,6 +133,42 @@ static void test_eq15_vs_quadrature(void)
     atmos_sky_destroy(sky);
 }
 
+/* Riley et al. 2004 Eq. 15 exactly as printed. It omits the factor
+ * exp(-beta_eye / (gamma p_y)) (docs/models.md), so it must disagree with quadrature;
+ * this guards against anyone "restoring" the printed form. */
+static double eq15_as_printed(double I, double P, double ly, double py, double beta_eye, double K)
+{
+    double a = beta_eye / GAMMA * (1 / ly - 1 / py);
+    return I * P * ly / (py - ly) * (exp(-a * exp(-GAMMA * py * K)) - exp(-a));
+}
+
+static void test_printed_eq15_is_wrong(void)
+{
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_sky *sky = NULL;
+    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
+    double sun[3], dir[3], eye[3] = {0, 0, 0}, L[3];
+    atmos_direction_from_angles(30, 0, sun);
+    atmos_direction_from_angles(60, 90, dir);
+    double K = 20000;
+    atmos_sky_inscatter(sky, eye, dir, K, sun, L);
+    double mu = dir[0] * sun[0] + dir[1] * sun[1] + dir[2] * sun[2];
+    double P = 3.0 / (16 * PI) * (1 + mu * mu);
+    for (int i = 0; i < 3; i++) {
+        double be = atmos_sky_beta_sea_level(sky)[i];
+        quad_ray r = {be, 0, dir[1], sun[1], wl.sun_irradiance[i], P};
+        double ref = quad_inscatter(&r, K);
+        double printed = eq15_as_printed(wl.sun_irradiance[i], P, sun[1], dir[1], be, K);
+        /* The printed form is off by exactly the missing factor ... */
+        CHECK_REL(printed * exp(-be / (GAMMA * dir[1])), ref, 1e-6);
+        /* ... which is several per cent (blue: ~26 %) for a view from sea level. */
+        CHECK(fabs(printed - ref) / ref > 0.05);
+        CHECK_REL(L[i], ref, 1e-6);
+    }
+    atmos_sky_destroy(sky);
+}
+
 static void test_eq11_vs_quadrature(void)
 {
     atmos_wavelengths wl;
@@ -329,6 +365,7 @@ int main(void)
     test_sunlight();
     test_eq11_vs_quadrature();
     test_eq15_vs_quadrature();
+    test_printed_eq15_is_wrong();
     test_physics();
     test_no_nan_sweep();
     test_bad_args();

@@ -83,10 +83,24 @@ CMakeFiles/atmos.dir/tools/atmos/cli.c.s: cmake_force
 	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos.dir/tools/atmos/cli.c.s"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/tools/atmos/cli.c -o CMakeFiles/atmos.dir/tools/atmos/cli.c.s
 
+CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o: CMakeFiles/atmos.dir/flags.make
+CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o: /work/main/tools/atmos/cmd_bench.c
+CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o: CMakeFiles/atmos.dir/compiler_depend.ts
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_2) "Building C object CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o -MF CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o.d -o CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o -c /work/main/tools/atmos/cmd_bench.c
+
+CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.i: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Preprocessing C source to CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.i"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -E /work/main/tools/atmos/cmd_bench.c > CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.i
+
+CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.s: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling C source to assembly CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.s"
+	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -S /work/main/tools/atmos/cmd_bench.c -o CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.s
+
 CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o: CMakeFiles/atmos.dir/flags.make
 CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o: /work/main/tools/atmos/cmd_render.c
 CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o: CMakeFiles/atmos.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_2) "Building C object CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_3) "Building C object CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o -MF CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o.d -o CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o -c /work/main/tools/atmos/cmd_render.c
 
 CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.i: cmake_force
@@ -100,7 +114,7 @@ CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.s: cmake_force
 CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o: CMakeFiles/atmos.dir/flags.make
 CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o: /work/main/tools/atmos/cmd_sky.c
 CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o: CMakeFiles/atmos.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_3) "Building C object CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_4) "Building C object CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o -MF CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o.d -o CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o -c /work/main/tools/atmos/cmd_sky.c
 
 CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.i: cmake_force
@@ -114,7 +128,7 @@ CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.s: cmake_force
 CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o: CMakeFiles/atmos.dir/flags.make
 CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o: /work/main/tools/atmos/cmd_sun.c
 CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o: CMakeFiles/atmos.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_4) "Building C object CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_5) "Building C object CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o -MF CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o.d -o CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o -c /work/main/tools/atmos/cmd_sun.c
 
 CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.i: cmake_force
@@ -128,7 +142,7 @@ CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.s: cmake_force
 CMakeFiles/atmos.dir/tools/atmos/main.c.o: CMakeFiles/atmos.dir/flags.make
 CMakeFiles/atmos.dir/tools/atmos/main.c.o: /work/main/tools/atmos/main.c
 CMakeFiles/atmos.dir/tools/atmos/main.c.o: CMakeFiles/atmos.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_5) "Building C object CMakeFiles/atmos.dir/tools/atmos/main.c.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building C object CMakeFiles/atmos.dir/tools/atmos/main.c.o"
 	/usr/bin/cc $(C_DEFINES) $(C_INCLUDES) $(C_FLAGS) -MD -MT CMakeFiles/atmos.dir/tools/atmos/main.c.o -MF CMakeFiles/atmos.dir/tools/atmos/main.c.o.d -o CMakeFiles/atmos.dir/tools/atmos/main.c.o -c /work/main/tools/atmos/main.c
 
 CMakeFiles/atmos.dir/tools/atmos/main.c.i: cmake_force
@@ -142,6 +156,7 @@ CMakeFiles/atmos.dir/tools/atmos/main.c.s: cmake_force
 # Object files for target atmos
 atmos_OBJECTS = \
 "CMakeFiles/atmos.dir/tools/atmos/cli.c.o" \
+"CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o" \
 "CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o" \
 "CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o" \
 "CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o" \
@@ -151,6 +166,7 @@ atmos_OBJECTS = \
 atmos_EXTERNAL_OBJECTS =
 
 atmos: CMakeFiles/atmos.dir/tools/atmos/cli.c.o
+atmos: CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o
 atmos: CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o
 atmos: CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o
 atmos: CMakeFiles/atmos.dir/tools/atmos/cmd_sun.c.o
@@ -163,7 +179,7 @@ atmos: /usr/lib/x86_64-linux-gnu/libpthread.a
 atmos: /usr/lib/x86_64-linux-gnu/libpng16.so
 atmos: /usr/lib/x86_64-linux-gnu/libOpenEXRCore-3_1.so
 atmos: CMakeFiles/atmos.dir/link.txt
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Linking C executable atmos"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Linking C executable atmos"
 	$(CMAKE_COMMAND) -E cmake_link_script CMakeFiles/atmos.dir/link.txt --verbose=$(VERBOSE)
 
 # Rule to build all files generated by this target.

@@ -1,6 +1,8 @@
 file(REMOVE_RECURSE
   "CMakeFiles/atmos.dir/tools/atmos/cli.c.o"
   "CMakeFiles/atmos.dir/tools/atmos/cli.c.o.d"
+  "CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o"
+  "CMakeFiles/atmos.dir/tools/atmos/cmd_bench.c.o.d"
   "CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o"
   "CMakeFiles/atmos.dir/tools/atmos/cmd_render.c.o.d"
   "CMakeFiles/atmos.dir/tools/atmos/cmd_sky.c.o"
