@@ -100,7 +100,8 @@ static size_t utf8_len(const unsigned char *s, size_t n)
 
 typedef struct scan_result {
     size_t depth;   /* open brackets at the end of the text */
-    int in_string;  /* the text ends inside a string */
+    int in_string;  /* the text ends inside a string... */
+    size_t string_start; /* ...that starts here */
 } scan_result;
 
 /* One pass over the raw text before cJSON parses it, for what cJSON does not
@@ -147,6 +148,7 @@ static atmos_status scan_text(atmos_context *ctx, const char *source, const char
         content = 1;
         if (c == '"') {
             in_string = 1;
+            res->string_start = i;
         } else if (c == '[' || c == '{') {
             if (++depth > ATMOS__SCENE_MAX_DEPTH) {
                 char what[96];
@@ -168,11 +170,14 @@ static atmos_status scan_text(atmos_context *ctx, const char *source, const char
 static atmos_status syntax_error(atmos_context *ctx, const char *source, const char *text, size_t n,
                                  size_t offset, const scan_result *scan)
 {
-    /* Truncated input: cJSON stops at (or just before) the end. */
-    if ((scan->depth > 0 || scan->in_string) && offset + 1 >= n)
+    /* Truncated input: cJSON stops at (or just before) the end, or at the start
+     * of a string that never closes. */
+    if (scan->in_string && offset >= scan->string_start)
         return text_error(ctx, ATMOS_E_FORMAT, source, text, n,
-                          scan->in_string ? "malformed JSON: unexpected end of input inside a string"
-                                          : "malformed JSON: unexpected end of input (unclosed { or [)");
+                          "malformed JSON: unexpected end of input inside a string");
+    if (scan->depth > 0 && offset + 1 >= n)
+        return text_error(ctx, ATMOS_E_FORMAT, source, text, n,
+                          "malformed JSON: unexpected end of input (unclosed { or [)");
     char what[96];
     size_t o = (size_t)snprintf(what, sizeof what, "malformed JSON near '");
     for (size_t i = offset; i < n && i < offset + 24 && text[i] != '\n'; i++) {
@@ -192,7 +197,7 @@ atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, size_t leng
     if (length > ATMOS__SCENE_MAX_BYTES)
         return atmos__error(ctx, ATMOS_E_LIMIT, "%s: input is %zu bytes; scene files are limited to 16 MiB",
                             source, length);
-    scan_result scan = {0, 0};
+    scan_result scan = {0, 0, 0};
     atmos_status st = scan_text(ctx, source, json ? json : "", length, &scan);
     if (st) return st;
 
