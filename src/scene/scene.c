@@ -1,0 +1,315 @@
+/* Scenes: the built-in defaults, reading a scene file, checking the text before
+ * cJSON sees it, and the sun direction of a scene. The JSON tree walk is in
+ * scene_json.c, the value rules in scene_validate.c.
+ */
+#define _POSIX_C_SOURCE 200809L /* fileno, fstat */
+#include "scene/scene_internal.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+void atmos_scene_defaults(atmos_scene *s)
+{
+    if (!s) return;
+    memset(s, 0, sizeof *s);
+    snprintf(s->name, sizeof s->name, "default");
+    s->width = 1280;
+    s->height = 720;
+    s->samples_per_pixel = 1;
+
+    /* A person's eye height, looking a little above the south-south-west horizon:
+     * with the default afternoon sun in the south-west the view shows the bright
+     * aureole, the horizon brightening and the blue gradient at once. */
+    double dir[3];
+    atmos_direction_from_angles(6.0, 200.0, dir);
+    s->camera.type = ATMOS_CAMERA_PINHOLE;
+    s->camera.position[1] = 2.0;
+    for (int i = 0; i < 3; i++) s->camera.look_at[i] = s->camera.position[i] + 1000.0 * dir[i];
+    s->camera.up[1] = 1.0;
+    s->camera.fov_deg = 60.0;
+
+    s->sun.from_time = 0;
+    s->sun.elevation_deg = 10.0;
+    s->sun.azimuth_deg = 225.0;
+    s->sun.refraction = 1;
+
+    atmos_atmosphere_defaults(&s->atmosphere);
+    s->wavelengths = ATMOS_WAVELENGTHS_RGB;
+    s->spectral_samples = ATMOS_SPECTRAL_DEFAULT;
+    s->tonemap.manual_exposure = 0;
+    s->tonemap.exposure_ev = 0.0;
+    s->tonemap.curve = ATMOS_TONE_FILMIC;
+    s->png_bits = 8;
+    s->exr_half = 0;
+}
+
+/* 1-based line and byte column of offset, for messages an editor can jump to. */
+static void line_col(const char *text, size_t offset, size_t *line, size_t *col)
+{
+    size_t l = 1, c = 1;
+    for (size_t i = 0; i < offset; i++) {
+        if (text[i] == '\n') {
+            l++;
+            c = 1;
+        } else {
+            c++;
+        }
+    }
+    *line = l;
+    *col = c;
+}
+
+static atmos_status text_error(atmos_context *ctx, atmos_status status, const char *source,
+                               const char *text, size_t offset, const char *what)
+{
+    size_t line, col;
+    line_col(text, offset, &line, &col);
+    return atmos__error(ctx, status, "%s:%zu:%zu: %s", source, line, col, what);
+}
+
+/* Length of the well-formed UTF-8 sequence at s (Unicode Table 3-7: no overlong
+ * forms, no surrogates, nothing above U+10FFFF), or 0. */
+static size_t utf8_len(const unsigned char *s, size_t n)
+{
+    unsigned c = s[0];
+    size_t len;
+    unsigned lo = 0x80, hi = 0xBF;
+    if (c >= 0xC2 && c <= 0xDF) len = 2;
+    else if (c >= 0xE0 && c <= 0xEF) {
+        len = 3;
+        if (c == 0xE0) lo = 0xA0;
+        if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+        len = 4;
+        if (c == 0xF0) lo = 0x90;
+        if (c == 0xF4) hi = 0x8F;
+    } else {
+        return 0;
+    }
+    if (n < len) return 0;
+    if (s[1] < lo || s[1] > hi) return 0;
+    for (size_t i = 2; i < len; i++)
+        if (s[i] < 0x80 || s[i] > 0xBF) return 0;
+    return len;
+}
+
+typedef struct scan_result {
+    size_t depth;   /* open brackets at the end of the text */
+    int in_string;  /* the text ends inside a string... */
+    size_t string_start; /* ...that starts here */
+} scan_result;
+
+/* One pass over the raw text before cJSON parses it, for what cJSON does not
+ * check or checks too late: invalid UTF-8 (RFC 8259 requires UTF-8), raw control
+ * characters, NUL bytes and "\u0000" (they would silently truncate C strings),
+ * and absurd nesting, which must be refused before cJSON recurses into it. */
+static atmos_status scan_text(atmos_context *ctx, const char *source, const char *text, size_t n,
+                              scan_result *res)
+{
+    const unsigned char *s = (const unsigned char *)text;
+    int in_string = 0, escape = 0, content = 0;
+    size_t depth = 0;
+    for (size_t i = 0; i < n; i++) {
+        unsigned c = s[i];
+        if (c == 0) return text_error(ctx, ATMOS_E_FORMAT, source, text, i, "malformed JSON: NUL byte");
+        if (c >= 0x80) {
+            size_t len = utf8_len(s + i, n - i);
+            if (!len) return text_error(ctx, ATMOS_E_FORMAT, source, text, i, "malformed JSON: invalid UTF-8");
+            /* A byte order mark at the very start is allowed (cJSON skips it). */
+            if (!(i == 0 && len == 3 && c == 0xEF && s[1] == 0xBB && s[2] == 0xBF)) content = 1;
+            i += len - 1;
+            escape = 0;
+            continue;
+        }
+        if (in_string) {
+            if (escape) {
+                escape = 0;
+                if (c == 'u' && n - i > 4 && memcmp(s + i + 1, "0000", 4) == 0)
+                    return text_error(ctx, ATMOS_E_FORMAT, source, text, i - 1,
+                                      "malformed JSON: \\u0000 is not allowed in scene strings");
+            } else if (c == '\\') {
+                escape = 1;
+            } else if (c == '"') {
+                in_string = 0;
+            } else if (c < 0x20) {
+                return text_error(ctx, ATMOS_E_FORMAT, source, text, i,
+                                  "malformed JSON: control character in a string (escape it)");
+            }
+            continue;
+        }
+        if (c == ' ' || c == '\t' || c == '\n' || c == '\r') continue;
+        if (c < 0x20 || c == 0x7F)
+            return text_error(ctx, ATMOS_E_FORMAT, source, text, i, "malformed JSON: control character");
+        content = 1;
+        if (c == '"') {
+            in_string = 1;
+            res->string_start = i;
+        } else if (c == '[' || c == '{') {
+            if (++depth > ATMOS__SCENE_MAX_DEPTH) {
+                char what[96];
+                snprintf(what, sizeof what, "nesting deeper than %d levels", ATMOS__SCENE_MAX_DEPTH);
+                return text_error(ctx, ATMOS_E_LIMIT, source, text, i, what);
+            }
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            depth--;
+        }
+    }
+    if (!content) return atmos__error(ctx, ATMOS_E_FORMAT, "%s: empty input (expected a JSON object)", source);
+    res->depth = depth;
+    res->in_string = in_string;
+    return ATMOS_OK;
+}
+
+/* cJSON reports where it stopped; quote a little of the text there so the
+ * message makes sense without opening the file. */
+static atmos_status syntax_error(atmos_context *ctx, const char *source, const char *text, size_t n,
+                                 size_t offset, const scan_result *scan)
+{
+    /* Truncated input: cJSON stops at (or just before) the end, or at the start
+     * of a string that never closes. */
+    if (scan->in_string && offset >= scan->string_start)
+        return text_error(ctx, ATMOS_E_FORMAT, source, text, n,
+                          "malformed JSON: unexpected end of input inside a string");
+    if (scan->depth > 0 && offset + 1 >= n)
+        return text_error(ctx, ATMOS_E_FORMAT, source, text, n,
+                          "malformed JSON: unexpected end of input (unclosed { or [)");
+    char what[96];
+    size_t o = (size_t)snprintf(what, sizeof what, "malformed JSON near '");
+    for (size_t i = offset; i < n && i < offset + 24 && text[i] != '\n'; i++) {
+        unsigned char c = (unsigned char)text[i];
+        what[o++] = c >= 0x20 && c < 0x7F ? (char)c : '?';
+    }
+    snprintf(what + o, sizeof what - o, "'");
+    return text_error(ctx, ATMOS_E_FORMAT, source, text, offset, what);
+}
+
+atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, size_t length, const char *source,
+                               atmos_scene *out)
+{
+    if (!source) source = "scene";
+    if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: atmos_scene_parse: out is NULL", source);
+    if (!json && length) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: atmos_scene_parse: json is NULL", source);
+    if (length > ATMOS__SCENE_MAX_BYTES)
+        return atmos__error(ctx, ATMOS_E_LIMIT, "%s: input is %zu bytes; scene files are limited to 16 MiB",
+                            source, length);
+    scan_result scan = {0, 0, 0};
+    atmos_status st = scan_text(ctx, source, json ? json : "", length, &scan);
+    if (st) return st;
+
+    /* cJSON is given a terminated private copy: the caller's buffer need not be
+     * terminated, and a reader bug in the (uninstrumented) system cJSON can never
+     * run past our allocation. */
+    char *copy = malloc(length + 1);
+    if (!copy) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", source);
+    memcpy(copy, json, length);
+    copy[length] = '\0';
+    /* return_parse_end instead of cJSON_GetErrorPtr(): the same position, but
+     * not a process-wide global another thread may be overwriting. */
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(copy, length, &end, 0);
+    if (!root) {
+        size_t off = end && end >= copy && end <= copy + length ? (size_t)(end - copy) : 0;
+        st = syntax_error(ctx, source, copy, length, off, &scan);
+        free(copy);
+        return st;
+    }
+    size_t off = end && end >= copy && end <= copy + length ? (size_t)(end - copy) : length;
+    while (off < length && (copy[off] == ' ' || copy[off] == '\t' || copy[off] == '\n' || copy[off] == '\r'))
+        off++;
+    if (off < length) {
+        st = text_error(ctx, ATMOS_E_FORMAT, source, copy, off,
+                        "malformed JSON: unexpected text after the end of the scene");
+    } else {
+        /* Parse into a local so that *out is untouched on failure. */
+        atmos_scene s;
+        atmos_scene_defaults(&s);
+        st = atmos__scene_from_json(ctx, source, root, &s);
+        if (st == ATMOS_OK) *out = s;
+    }
+    cJSON_Delete(root);
+    free(copy);
+    return st;
+}
+
+atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene *out)
+{
+    if (!path || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_load: path or out is NULL");
+    FILE *f = fopen(path, "rb");
+    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* The size is checked before anything is allocated; the read loop below also
+     * stops at the limit, for files that grow or report no size (pipes). */
+    struct stat sb;
+    size_t cap = 4096;
+    if (fstat(fileno(f), &sb) == 0) {
+        if (S_ISDIR(sb.st_mode)) {
+            fclose(f);
+            return atmos__error(ctx, ATMOS_E_IO, "%s: cannot read: %s", path, strerror(EISDIR));
+        }
+        if (S_ISREG(sb.st_mode)) {
+            if ((unsigned long long)sb.st_size > ATMOS__SCENE_MAX_BYTES) {
+                fclose(f);
+                return atmos__error(ctx, ATMOS_E_LIMIT, "%s: file is %lld bytes; scene files are limited to 16 MiB",
+                                    path, (long long)sb.st_size);
+            }
+            cap = (size_t)sb.st_size + 1;
+        }
+    }
+    char *buf = malloc(cap);
+    size_t len = 0;
+    atmos_status st = ATMOS_OK;
+    while (buf) {
+        len += fread(buf + len, 1, cap - len, f);
+        if (ferror(f)) {
+            st = atmos__error(ctx, ATMOS_E_IO, "%s: cannot read: %s", path, strerror(errno));
+            break;
+        }
+        if (len > ATMOS__SCENE_MAX_BYTES) {
+            st = atmos__error(ctx, ATMOS_E_LIMIT, "%s: file is larger than 16 MiB, the limit for scene files", path);
+            break;
+        }
+        if (feof(f)) break;
+        if (len == cap) {
+            size_t ncap = cap * 2 > ATMOS__SCENE_MAX_BYTES + 1 ? ATMOS__SCENE_MAX_BYTES + 1 : cap * 2;
+            char *nb = realloc(buf, ncap);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap = ncap;
+        }
+    }
+    fclose(f);
+    if (!buf) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
+    if (st == ATMOS_OK) st = atmos_scene_parse(ctx, buf, len, path, out);
+    free(buf);
+    return st;
+}
+
+atmos_status atmos_scene_sun_direction(atmos_context *ctx, const atmos_scene *scene, double dir[3],
+                                       double *elevation_deg, double *azimuth_deg)
+{
+    if (!scene || !dir) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_sun_direction: scene or dir is NULL");
+    /* A scene built in code may hold anything; never turn a NaN into a direction. */
+    atmos_status st = atmos__scene_validate_sun(ctx, "scene", &scene->sun);
+    if (st) return st;
+    double e = scene->sun.elevation_deg, a = scene->sun.azimuth_deg;
+    if (scene->sun.from_time) {
+        atmos_sun_position pos;
+        st = atmos_sun_position_compute(ctx, &scene->sun.time, scene->sun.latitude_deg,
+                                        scene->sun.longitude_deg, scene->sun.refraction, &pos);
+        if (st) return st;
+        e = pos.elevation_deg;
+        a = pos.azimuth_deg;
+    }
+    atmos_direction_from_angles(e, a, dir);
+    if (elevation_deg) *elevation_deg = e;
+    if (azimuth_deg) *azimuth_deg = a;
+    return ATMOS_OK;
+}

@@ -1,0 +1,70 @@
+/* Shared between the scene parser (scene_json.c) and the struct validator
+ * (scene_validate.c): the value ranges and the message format, so a value
+ * rejected in a JSON file and the same value set by a CLI override produce the
+ * same message ("SOURCE: /camera/fov_deg: must be in (0, 180) ..., got 270").
+ */
+#ifndef ATMOS_SCENE_INTERNAL_H
+#define ATMOS_SCENE_INTERNAL_H
+
+#include "core/internal.h"
+
+/* Inputs above this are refused before any parsing (ATMOS_E_LIMIT): a real scene
+ * is a few hundred bytes, so this only stops accidents and hostile input. */
+#define ATMOS__SCENE_MAX_BYTES ((size_t)16 << 20)
+/* The scene format needs three levels ({"camera": {"view": {...}}}); "_" keys may
+ * hold annotations of any shape, so allow some room but stop absurd nesting
+ * before cJSON recurses into it. */
+#define ATMOS__SCENE_MAX_DEPTH 64
+/* Camera coordinates are bounded so that differences and norms of positions stay
+ * far from overflow; 1e8 m is well beyond anything an atmosphere renderer needs.
+ * look_at gets ten times more room so that position + 1000 m * direction (the
+ * look_at the parser derives from a view) always stays in range. */
+#define ATMOS__SCENE_MAX_POS 1e8
+#define ATMOS__SCENE_MAX_LOOK 1e9
+
+/* A closed, open or half-open interval. */
+typedef struct atmos__range {
+    double lo, hi;
+    int lo_open, hi_open;
+} atmos__range;
+
+extern const atmos__range atmos__r_dim, atmos__r_spp, atmos__r_altitude, atmos__r_pos, atmos__r_look,
+    atmos__r_fov_pinhole, atmos__r_fov_fisheye, atmos__r_elevation, atmos__r_azimuth,
+    atmos__r_latitude, atmos__r_longitude, atmos__r_beta, atmos__r_scale_height, atmos__r_albedo,
+    atmos__r_sun_diameter, atmos__r_sun_scale, atmos__r_samples, atmos__r_manual_ev,
+    atmos__r_compensation;
+
+/* Reports "SOURCE: PATH: <fmt>" through ctx and returns status. */
+atmos_status atmos__scene_fail(atmos_context *ctx, atmos_status status, const char *source,
+                               const char *path, const char *fmt, ...) ATMOS_PRINTF(5, 6);
+
+/* Formats a double compactly and exactly enough to round-trip ("270", "0.01"). */
+void atmos__scene_fmt_num(char *buf, size_t cap, double v);
+
+/* Checks v against r; on failure reports "PATH: must be in [lo, hi]<extra>, got v".
+ * extra (may be NULL) qualifies the range (" for a pinhole camera"). Non-finite
+ * values get their own message. */
+atmos_status atmos__scene_check_range(atmos_context *ctx, const char *source, const char *path,
+                                      double v, const atmos__range *r, const char *extra);
+
+/* Per-section validators, also run by the parser at the end of each section so
+ * that cross-field rules (look_at vs position, fov by camera type) exist once. */
+atmos_status atmos__scene_validate_camera(atmos_context *ctx, const char *source,
+                                          const atmos_camera_desc *cam);
+atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
+                                       const atmos_scene_sun *sun);
+atmos_status atmos__scene_validate_output(atmos_context *ctx, const char *source,
+                                          const atmos_scene *scene);
+
+/* Fills scene from a parsed JSON document (root), which must be an object. scene
+ * holds the starting values (the defaults); absent keys keep them. */
+struct cJSON;
+atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, const struct cJSON *root,
+                                    atmos_scene *scene);
+
+/* Robust vector helpers (scaled so huge components never overflow). */
+double atmos__scene_norm3(const double v[3]);
+/* Sine of the angle between a and b (0 when parallel); -1 if either is zero. */
+double atmos__scene_sin_angle(const double a[3], const double b[3]);
+
+#endif

@@ -1,0 +1,580 @@
+/* Walks a parsed JSON scene into an atmos_scene, strictly: unknown keys, wrong
+ * types and out-of-range values are errors named by their JSON pointer
+ * ("scene.json: /camera/fov_deg: ..."). Keys are handled in document order and
+ * the first error stops the walk, so the message points at the first problem a
+ * reader meets. Keys starting with "_" are annotations and are skipped.
+ */
+#include "scene/scene_internal.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define PATH_CAP 256
+/* Unknown keys and bad string values are quoted in messages; keep them short so
+ * the path and the reason always fit in the context's message buffer. */
+#define QUOTE_MAX 48
+/* Distance of the look_at point the parser derives from a direction. */
+#define LOOK_DISTANCE_M 1000.0
+
+typedef struct jp {
+    atmos_context *ctx;
+    const char *source;
+} jp;
+
+static const char *type_name(const cJSON *j)
+{
+    if (cJSON_IsNull(j)) return "null";
+    if (cJSON_IsBool(j)) return "a boolean";
+    if (cJSON_IsNumber(j)) return "a number";
+    if (cJSON_IsString(j)) return "a string";
+    if (cJSON_IsArray(j)) return "an array";
+    if (cJSON_IsObject(j)) return "an object";
+    return "an unknown value";
+}
+
+/* Copies at most max bytes of s, escaping what would garble a one-line message,
+ * and never cutting a UTF-8 sequence in half (the input was checked to be valid
+ * UTF-8, so continuation bytes are 10xxxxxx). */
+static void escape_text(char *out, size_t cap, const char *s, size_t max, int pointer)
+{
+    size_t o = 0, i = 0, n = strlen(s);
+    size_t limit = n <= max ? n : max;
+    while (limit < n && ((unsigned char)s[limit] & 0xC0) == 0x80) limit--;
+    for (; i < limit && o + 8 < cap; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (pointer && c == '~') o += (size_t)snprintf(out + o, cap - o, "~0");
+        else if (pointer && c == '/') o += (size_t)snprintf(out + o, cap - o, "~1");
+        else if (!pointer && (c == '"' || c == '\\')) o += (size_t)snprintf(out + o, cap - o, "\\%c", c);
+        else if (c < 0x20 || c == 0x7F) o += (size_t)snprintf(out + o, cap - o, "\\u%04x", c);
+        else out[o++] = (char)c;
+    }
+    if (i < n && o + 4 < cap) o += (size_t)snprintf(out + o, cap - o, "...");
+    out[o < cap ? o : cap - 1] = '\0';
+}
+
+/* parent + "/" + key as a JSON pointer (RFC 6901: "~" -> "~0", "/" -> "~1"). */
+static void child_path(char *out, size_t cap, const char *parent, const char *key)
+{
+    char esc[QUOTE_MAX * 6 + 8];
+    escape_text(esc, sizeof esc, key, QUOTE_MAX, 1);
+    /* Paths are at most three keys deep, so truncation cannot happen in practice;
+     * if it did, only a message would be shortened. */
+    if (snprintf(out, cap, "%s/%s", parent, esc) >= (int)cap) out[cap - 1] = '\0';
+}
+
+static atmos_status type_error(const jp *p, const char *path, const char *expected, const cJSON *j)
+{
+    return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "expected %s, got %s",
+                             expected, type_name(j));
+}
+
+/* Numbers: cJSON turns 1e999 into infinity; JSON has no other non-finite spelling. */
+static atmos_status get_number(const jp *p, const cJSON *j, const char *path, const atmos__range *r,
+                               const char *extra, double *out)
+{
+    if (!cJSON_IsNumber(j)) return type_error(p, path, "a number", j);
+    double v = j->valuedouble;
+    if (!isfinite(v))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "must be a finite number (this one overflows a double)");
+    atmos_status st = r ? atmos__scene_check_range(p->ctx, p->source, path, v, r, extra) : ATMOS_OK;
+    if (st == ATMOS_OK) *out = v;
+    return st;
+}
+
+/* Integers are range-checked before the conversion, which would be undefined
+ * behaviour for values outside int. */
+static atmos_status get_int(const jp *p, const cJSON *j, const char *path, const atmos__range *r, int *out)
+{
+    if (!cJSON_IsNumber(j)) return type_error(p, path, "an integer", j);
+    double v = j->valuedouble;
+    if (!isfinite(v))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "must be a finite number (this one overflows a double)");
+    if (v != floor(v)) {
+        char got[40];
+        atmos__scene_fmt_num(got, sizeof got, v);
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "expected an integer, got %s", got);
+    }
+    atmos_status st = atmos__scene_check_range(p->ctx, p->source, path, v, r, NULL);
+    if (st == ATMOS_OK) *out = (int)v;
+    return st;
+}
+
+static atmos_status get_bool(const jp *p, const cJSON *j, const char *path, int *out)
+{
+    if (!cJSON_IsBool(j)) return type_error(p, path, "true or false", j);
+    *out = cJSON_IsTrue(j) ? 1 : 0;
+    return ATMOS_OK;
+}
+
+static atmos_status get_string(const jp *p, const cJSON *j, const char *path, const char **out)
+{
+    if (!cJSON_IsString(j) || !j->valuestring) return type_error(p, path, "a string", j);
+    *out = j->valuestring;
+    return ATMOS_OK;
+}
+
+/* One of a fixed list of words; the message lists them. */
+static atmos_status get_enum(const jp *p, const cJSON *j, const char *path, const char *const *names,
+                             int n, int *out)
+{
+    const char *s = NULL;
+    atmos_status st = get_string(p, j, path, &s);
+    if (st) return st;
+    for (int i = 0; i < n; i++) {
+        if (strcmp(s, names[i]) == 0) {
+            *out = i;
+            return ATMOS_OK;
+        }
+    }
+    char list[256] = "", got[QUOTE_MAX * 6 + 8];
+    for (int i = 0; i < n; i++) {
+        strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+        strncat(list, names[i], sizeof list - strlen(list) - 1);
+    }
+    escape_text(got, sizeof got, s, QUOTE_MAX, 0);
+    return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "must be one of %s, got \"%s\"",
+                             list, got);
+}
+
+static atmos_status get_vec3(const jp *p, const cJSON *j, const char *path, const atmos__range *const r[3],
+                             double out[3])
+{
+    if (!cJSON_IsArray(j)) return type_error(p, path, "an array of 3 numbers", j);
+    int n = 0;
+    for (const cJSON *e = j->child; e && n < 4; e = e->next) n++;
+    if (n != 3)
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "expected an array of 3 numbers, got %s elements",
+                                 n < 4 ? (n == 0 ? "0" : n == 1 ? "1" : "2") : "more than 3");
+    double v[3];
+    const cJSON *e = j->child;
+    for (int i = 0; i < 3; i++, e = e->next) {
+        char ep[PATH_CAP];
+        snprintf(ep, sizeof ep, "%s/%d", path, i);
+        atmos_status st = get_number(p, e, ep, r[i], NULL, &v[i]);
+        if (st) return st;
+    }
+    memcpy(out, v, sizeof v);
+    return ATMOS_OK;
+}
+
+/* Iterates an object's keys in document order, rejecting unknown and duplicate
+ * keys and skipping "_" annotations. */
+typedef struct obj_iter {
+    const cJSON *next;
+    const char *path;
+    const char *const *keys;
+    int nkeys;
+    unsigned seen;
+} obj_iter;
+
+static atmos_status iter_begin(const jp *p, const cJSON *obj, const char *path, const char *const *keys,
+                               int nkeys, obj_iter *it)
+{
+    if (!cJSON_IsObject(obj)) return type_error(p, path, "an object", obj);
+    it->next = obj->child;
+    it->path = path;
+    it->keys = keys;
+    it->nkeys = nkeys;
+    it->seen = 0;
+    return ATMOS_OK;
+}
+
+/* Sets *idx to the key's index (or -1 at the end), *item and item_path. */
+static atmos_status iter_next(const jp *p, obj_iter *it, int *idx, const cJSON **item, char *item_path)
+{
+    *idx = -1;
+    while (it->next) {
+        const cJSON *c = it->next;
+        it->next = c->next;
+        const char *key = c->string ? c->string : "";
+        child_path(item_path, PATH_CAP, it->path, key);
+        if (key[0] == '_') continue;
+        int k = 0;
+        while (k < it->nkeys && strcmp(key, it->keys[k]) != 0) k++;
+        if (k == it->nkeys) {
+            char list[512] = "";
+            for (int i = 0; i < it->nkeys; i++) {
+                strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+                strncat(list, it->keys[i], sizeof list - strlen(list) - 1);
+            }
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, item_path,
+                                     "unknown key (allowed: %s)", list);
+        }
+        /* cJSON keeps both copies of a repeated key; which one would win is not
+         * something a scene file should depend on. */
+        if (it->seen & (1u << k))
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, item_path, "duplicate key");
+        it->seen |= 1u << k;
+        *idx = k;
+        *item = c;
+        return ATMOS_OK;
+    }
+    return ATMOS_OK;
+}
+
+#define TRY(expr)                              \
+    do {                                       \
+        atmos_status st_ = (expr);             \
+        if (st_ != ATMOS_OK) return st_;       \
+    } while (0)
+
+static atmos_status parse_image(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"width", "height", "samples_per_pixel"};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 3, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) return ATMOS_OK;
+        int *field = k == 0 ? &s->width : k == 1 ? &s->height : &s->samples_per_pixel;
+        TRY(get_int(p, v, ip, k == 2 ? &atmos__r_spp : &atmos__r_dim, field));
+    }
+}
+
+static atmos_status parse_view(const jp *p, const cJSON *j, const char *path, double dir[3])
+{
+    static const char *const keys[] = {"elevation_deg", "azimuth_deg"};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k;
+    double angle[2];
+    TRY(iter_begin(p, j, path, keys, 2, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        TRY(get_number(p, v, ip, k == 0 ? &atmos__r_elevation : &atmos__r_azimuth, NULL, &angle[k]));
+    }
+    /* Both angles: a half-given direction has no obvious meaning. */
+    for (k = 0; k < 2; k++) {
+        if (!(it.seen & (1u << k)))
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                     "missing key \"%s\"", keys[k]);
+    }
+    atmos_direction_from_angles(angle[0], angle[1], dir);
+    return ATMOS_OK;
+}
+
+static atmos_status parse_camera(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"type", "position_m", "look_at_m", "view", "up", "fov_deg"};
+    static const char *const types[] = {"pinhole", "fisheye", "equirect"};
+    static const atmos__range any = {-HUGE_VAL, HUGE_VAL, 0, 0};
+    const atmos__range *pos_r[3] = {&atmos__r_pos, &atmos__r_altitude, &atmos__r_pos};
+    const atmos__range *look_r[3] = {&atmos__r_look, &atmos__r_look, &atmos__r_look};
+    const atmos__range *any_r[3] = {&any, &any, &any};
+    enum { K_TYPE, K_POS, K_LOOK, K_VIEW, K_UP, K_FOV };
+    atmos_camera_desc cam = s->camera;
+    /* The starting view direction, kept so that moving only the position moves
+     * the default look_at with it. */
+    double dir[3] = {cam.look_at[0] - cam.position[0], cam.look_at[1] - cam.position[1],
+                     cam.look_at[2] - cam.position[2]};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, type;
+    TRY(iter_begin(p, j, path, keys, 6, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        switch (k) {
+        case K_TYPE:
+            TRY(get_enum(p, v, ip, types, 3, &type));
+            cam.type = (atmos_camera_type)type;
+            break;
+        case K_POS: TRY(get_vec3(p, v, ip, pos_r, cam.position)); break;
+        case K_LOOK:
+            if (it.seen & (1u << K_VIEW))
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                         "cannot be combined with view (give one of them)");
+            TRY(get_vec3(p, v, ip, look_r, cam.look_at));
+            break;
+        case K_VIEW:
+            if (it.seen & (1u << K_LOOK))
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                         "cannot be combined with look_at_m (give one of them)");
+            TRY(parse_view(p, v, ip, dir));
+            break;
+        case K_UP: TRY(get_vec3(p, v, ip, any_r, cam.up)); break;
+        case K_FOV:
+            /* Its range depends on the type, which may come later in the object. */
+            TRY(get_number(p, v, ip, NULL, NULL, &cam.fov_deg));
+            break;
+        }
+    }
+    int have_look = (it.seen >> K_LOOK) & 1, have_view = (it.seen >> K_VIEW) & 1;
+    if (cam.type == ATMOS_CAMERA_FISHEYE) {
+        /* camera.h: a fisheye defaults to a 180° all-sky view of the zenith. */
+        if (!(it.seen & (1u << K_FOV))) cam.fov_deg = 180.0;
+        if (!have_look && !have_view) {
+            dir[0] = 0.0;
+            dir[1] = 1.0;
+            dir[2] = 0.0;
+        }
+    }
+    if (!have_look) {
+        double n = atmos__scene_norm3(dir);
+        if (n > 0) {
+            for (int i = 0; i < 3; i++) cam.look_at[i] = cam.position[i] + LOOK_DISTANCE_M * dir[i] / n;
+        }
+    }
+    /* Looking straight up or down leaves the default up undefined; north is the
+     * conventional top of a zenith image (camera.h). An explicit up is kept and
+     * validated as given. */
+    if (!(it.seen & (1u << K_UP))) {
+        double d[3] = {cam.look_at[0] - cam.position[0], cam.look_at[1] - cam.position[1],
+                       cam.look_at[2] - cam.position[2]};
+        double y[3] = {0.0, 1.0, 0.0};
+        double sa = atmos__scene_sin_angle(d, y);
+        if (sa >= 0 && sa < 1e-6) {
+            cam.up[0] = 0.0;
+            cam.up[1] = 0.0;
+            cam.up[2] = -1.0;
+        }
+    }
+    TRY(atmos__scene_validate_camera(p->ctx, p->source, &cam));
+    s->camera = cam;
+    return ATMOS_OK;
+}
+
+/* atmos_parse_utc_time reports through a context; a private one keeps its
+ * unprefixed message out of the caller's log so only the JSON-pointer version
+ * is reported. */
+static atmos_status parse_time(const jp *p, const char *text, const char *path, atmos_utc_time *out)
+{
+    atmos_context *tmp = NULL;
+    if (atmos_context_create(NULL, &tmp) != ATMOS_OK)
+        return atmos__scene_fail(p->ctx, ATMOS_E_NOMEM, p->source, path, "out of memory");
+    atmos_status st = atmos_parse_utc_time(tmp, text, out);
+    if (st != ATMOS_OK) {
+        const char *msg = atmos_context_error(tmp);
+        st = atmos__scene_fail(p->ctx, st, p->source, path, "%s", *msg ? msg : "not a valid date-time");
+    }
+    atmos_context_destroy(tmp);
+    return st;
+}
+
+static atmos_status parse_sun(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"elevation_deg", "azimuth_deg", "time", "latitude_deg",
+                                       "longitude_deg", "refraction"};
+    enum { K_ELEV, K_AZIM, K_TIME, K_LAT, K_LON, K_REFR };
+    const unsigned angle_keys = 1u << K_ELEV | 1u << K_AZIM;
+    atmos_scene_sun sun = s->sun;
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    const char *text = NULL;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 6, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        /* Angles and time/place are two ways to say the same thing. */
+        unsigned mine = (1u << k) & angle_keys ? angle_keys : ~angle_keys;
+        if (it.seen & ~mine)
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                     "cannot be combined with %s (give elevation_deg/azimuth_deg or "
+                                     "time/latitude_deg/longitude_deg, not both)",
+                                     mine == angle_keys ? "time/latitude_deg/longitude_deg/refraction"
+                                                        : "elevation_deg/azimuth_deg");
+        switch (k) {
+        case K_ELEV: TRY(get_number(p, v, ip, &atmos__r_elevation, NULL, &sun.elevation_deg)); break;
+        case K_AZIM: TRY(get_number(p, v, ip, &atmos__r_azimuth, NULL, &sun.azimuth_deg)); break;
+        case K_TIME:
+            TRY(get_string(p, v, ip, &text));
+            TRY(parse_time(p, text, ip, &sun.time));
+            break;
+        case K_LAT: TRY(get_number(p, v, ip, &atmos__r_latitude, NULL, &sun.latitude_deg)); break;
+        case K_LON: TRY(get_number(p, v, ip, &atmos__r_longitude, NULL, &sun.longitude_deg)); break;
+        case K_REFR: TRY(get_bool(p, v, ip, &sun.refraction)); break;
+        }
+    }
+    if (it.seen & ~angle_keys) {
+        /* No default place or time: a sun computed for a place the user did not
+         * name would be a silent surprise. */
+        static const int required[] = {K_TIME, K_LAT, K_LON};
+        for (int i = 0; i < 3; i++) {
+            if (!(it.seen & (1u << required[i])))
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                         "missing key \"%s\" (time, latitude_deg and longitude_deg "
+                                         "go together)", keys[required[i]]);
+        }
+        sun.from_time = 1;
+    } else if (it.seen & angle_keys) {
+        sun.from_time = 0;
+    }
+    TRY(atmos__scene_validate_sun(p->ctx, p->source, &sun));
+    s->sun = sun;
+    return ATMOS_OK;
+}
+
+static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"beta_sl_550_per_m", "scale_height_m", "ground_albedo",
+                                       "sun_diameter_deg", "sun_scale", "sun_disk"};
+    atmos_atmosphere_desc *a = &s->atmosphere;
+    double *fields[] = {&a->beta_sl_550, &a->scale_height_m, &a->ground_albedo, &a->sun_diameter_deg,
+                        &a->sun_scale};
+    const atmos__range *ranges[] = {&atmos__r_beta, &atmos__r_scale_height, &atmos__r_albedo,
+                                    &atmos__r_sun_diameter, &atmos__r_sun_scale};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, disk = 1;
+    TRY(iter_begin(p, j, path, keys, 6, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) return ATMOS_OK;
+        if (k < 5) {
+            TRY(get_number(p, v, ip, ranges[k], NULL, fields[k]));
+        } else {
+            TRY(get_bool(p, v, ip, &disk));
+            a->hide_sun_disk = !disk;
+        }
+    }
+}
+
+static atmos_status parse_wavelengths(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"mode", "samples"};
+    static const char *const modes[] = {"rgb", "spectral"};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, mode;
+    TRY(iter_begin(p, j, path, keys, 2, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) return ATMOS_OK;
+        if (k == 0) {
+            TRY(get_enum(p, v, ip, modes, 2, &mode));
+            s->wavelengths = mode == 0 ? ATMOS_WAVELENGTHS_RGB : ATMOS_WAVELENGTHS_SPECTRAL;
+        } else {
+            TRY(get_int(p, v, ip, &atmos__r_samples, &s->spectral_samples));
+        }
+    }
+}
+
+static atmos_status parse_output(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"exposure", "exposure_compensation_ev", "tone_curve", "png_bits",
+                                       "exr_pixel"};
+    static const char *const curves[] = {"filmic", "reinhard", "clamp"};
+    static const char *const pixels[] = {"float", "half"};
+    static const atmos__range int_range = {-2147483648.0, 2147483647.0, 0, 0};
+    enum { K_EXPOSURE, K_COMP, K_CURVE, K_BITS, K_PIXEL };
+    atmos_scene out = *s;
+    obj_iter it;
+    char ip[PATH_CAP], exposure_path[PATH_CAP] = "", comp_path[PATH_CAP] = "";
+    const cJSON *v;
+    int k, e, manual = -1;
+    double ev = 0.0, comp = 0.0;
+    TRY(iter_begin(p, j, path, keys, 5, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        switch (k) {
+        case K_EXPOSURE:
+            if (cJSON_IsString(v) && v->valuestring && strcmp(v->valuestring, "auto") == 0) {
+                manual = 0;
+            } else if (cJSON_IsNumber(v)) {
+                TRY(get_number(p, v, ip, &atmos__r_manual_ev, NULL, &ev));
+                manual = 1;
+            } else if (cJSON_IsString(v)) {
+                char got[QUOTE_MAX * 6 + 8];
+                escape_text(got, sizeof got, v->valuestring ? v->valuestring : "", QUOTE_MAX, 0);
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                         "must be \"auto\" or a number (EV100), got \"%s\"", got);
+            } else {
+                return type_error(p, ip, "\"auto\" or a number (EV100)", v);
+            }
+            snprintf(exposure_path, sizeof exposure_path, "%s", ip);
+            break;
+        case K_COMP:
+            TRY(get_number(p, v, ip, &atmos__r_compensation, NULL, &comp));
+            snprintf(comp_path, sizeof comp_path, "%s", ip);
+            break;
+        case K_CURVE:
+            TRY(get_enum(p, v, ip, curves, 3, &e));
+            out.tonemap.curve = (atmos_tone_curve)e;
+            break;
+        case K_BITS:
+            TRY(get_int(p, v, ip, &int_range, &e));
+            if (e != 8 && e != 16)
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                         "must be 8 or 16, got %d", e);
+            out.png_bits = e;
+            break;
+        case K_PIXEL:
+            TRY(get_enum(p, v, ip, pixels, 2, &e));
+            out.exr_half = e;
+            break;
+        }
+    }
+    /* atmos_tonemap_desc has one exposure_ev: a manual EV100, or the compensation
+     * added to the automatic choice. Both at once would be ambiguous. */
+    if (manual == 1 && comp_path[0])
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, comp_path,
+                                 "only applies with automatic exposure (\"exposure\": \"auto\"), "
+                                 "but %s is a manual EV", exposure_path);
+    if (manual == 1) {
+        out.tonemap.manual_exposure = 1;
+        out.tonemap.exposure_ev = ev;
+    } else if (manual == 0 || comp_path[0]) {
+        /* Compensation alone switches to automatic exposure: that is the only
+         * mode in which it means anything. */
+        out.tonemap.manual_exposure = 0;
+        out.tonemap.exposure_ev = comp;
+    }
+    TRY(atmos__scene_validate_output(p->ctx, p->source, &out));
+    *s = out;
+    return ATMOS_OK;
+}
+
+atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, const cJSON *root,
+                                    atmos_scene *s)
+{
+    static const char *const keys[] = {"name", "image", "camera", "sun", "atmosphere", "wavelengths",
+                                       "output", "renderer"};
+    static const char *const renderers[] = {"sky"};
+    enum { K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER };
+    jp p = {ctx, source};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    const char *name = NULL;
+    int k, renderer;
+    if (!cJSON_IsObject(root)) return type_error(&p, "/", "an object", root);
+    TRY(iter_begin(&p, root, "", keys, 8, &it));
+    for (;;) {
+        TRY(iter_next(&p, &it, &k, &v, ip));
+        if (k < 0) return ATMOS_OK;
+        switch (k) {
+        case K_NAME:
+            TRY(get_string(&p, v, ip, &name));
+            if (strlen(name) >= sizeof s->name)
+                return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, ip,
+                                         "must be at most %d bytes, got %zu", (int)sizeof s->name - 1,
+                                         strlen(name));
+            memcpy(s->name, name, strlen(name) + 1);
+            break;
+        case K_IMAGE: TRY(parse_image(&p, v, ip, s)); break;
+        case K_CAMERA: TRY(parse_camera(&p, v, ip, s)); break;
+        case K_SUN: TRY(parse_sun(&p, v, ip, s)); break;
+        case K_ATMOSPHERE: TRY(parse_atmosphere(&p, v, ip, s)); break;
+        case K_WAVELENGTHS: TRY(parse_wavelengths(&p, v, ip, s)); break;
+        case K_OUTPUT: TRY(parse_output(&p, v, ip, s)); break;
+        case K_RENDERER: TRY(get_enum(&p, v, ip, renderers, 1, &renderer)); break;
+        }
+    }
+}

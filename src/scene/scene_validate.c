@@ -1,0 +1,271 @@
+/* Scene validation: value ranges, cross-field rules and the message format.
+ * The parser uses the same functions, so a JSON file and a scene modified in code
+ * (CLI overrides) are held to identical rules and get identical messages.
+ */
+#include "scene/scene_internal.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The ranges of docs/scene-format.md. */
+const atmos__range atmos__r_dim = {1, ATMOS_SCENE_MAX_DIM, 0, 0};
+const atmos__range atmos__r_spp = {1, 256, 0, 0};
+const atmos__range atmos__r_altitude = {0, 1e6, 0, 0};
+const atmos__range atmos__r_pos = {-ATMOS__SCENE_MAX_POS, ATMOS__SCENE_MAX_POS, 0, 0};
+const atmos__range atmos__r_look = {-ATMOS__SCENE_MAX_LOOK, ATMOS__SCENE_MAX_LOOK, 0, 0};
+const atmos__range atmos__r_fov_pinhole = {0, 180, 1, 1};
+const atmos__range atmos__r_fov_fisheye = {0, 360, 1, 0};
+const atmos__range atmos__r_elevation = {-90, 90, 0, 0};
+const atmos__range atmos__r_azimuth = {0, 360, 0, 1};
+const atmos__range atmos__r_latitude = {-90, 90, 0, 0};
+const atmos__range atmos__r_longitude = {-180, 180, 0, 0};
+const atmos__range atmos__r_beta = {0, 0.01, 1, 0};
+const atmos__range atmos__r_scale_height = {100, 100000, 0, 0};
+const atmos__range atmos__r_albedo = {0, 1, 0, 0};
+const atmos__range atmos__r_sun_diameter = {0, 20, 1, 0};
+const atmos__range atmos__r_sun_scale = {0, 1e6, 0, 0};
+const atmos__range atmos__r_samples = {1, ATMOS_MAX_WAVELENGTHS, 0, 0};
+const atmos__range atmos__r_manual_ev = {-20, 40, 0, 0};
+const atmos__range atmos__r_compensation = {-20, 20, 0, 0};
+
+/* Sines below this count as parallel: the camera basis would be numerically
+ * meaningless (about 0.2 arc seconds). */
+#define PARALLEL_SIN 1e-6
+
+atmos_status atmos__scene_fail(atmos_context *ctx, atmos_status status, const char *source,
+                               const char *path, const char *fmt, ...)
+{
+    char what[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    return atmos__error(ctx, status, "%s: %s: %s", source ? source : "scene", path, what);
+}
+
+void atmos__scene_fmt_num(char *buf, size_t cap, double v)
+{
+    if (isnan(v)) {
+        snprintf(buf, cap, "nan");
+        return;
+    }
+    if (isinf(v)) {
+        snprintf(buf, cap, v < 0 ? "-inf" : "inf");
+        return;
+    }
+    /* 15 digits reads well ("0.1", not "0.10000000000000001"); fall back to 17
+     * when that would hide the difference from a boundary ("got 0.01" for a
+     * value that is actually just above 0.01 would be a baffling message). */
+    snprintf(buf, cap, "%.15g", v);
+    if (strtod(buf, NULL) != v) snprintf(buf, cap, "%.17g", v);
+}
+
+atmos_status atmos__scene_check_range(atmos_context *ctx, const char *source, const char *path,
+                                      double v, const atmos__range *r, const char *extra)
+{
+    char got[40], lo[40], hi[40];
+    atmos__scene_fmt_num(got, sizeof got, v);
+    if (!isfinite(v))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path,
+                                 "must be a finite number, got %s", got);
+    int ok = (r->lo_open ? v > r->lo : v >= r->lo) && (r->hi_open ? v < r->hi : v <= r->hi);
+    if (ok) return ATMOS_OK;
+    atmos__scene_fmt_num(lo, sizeof lo, r->lo);
+    atmos__scene_fmt_num(hi, sizeof hi, r->hi);
+    return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path, "must be in %c%s, %s%c%s, got %s",
+                             r->lo_open ? '(' : '[', lo, hi, r->hi_open ? ')' : ']',
+                             extra ? extra : "", got);
+}
+
+double atmos__scene_norm3(const double v[3])
+{
+    double m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+    if (!(m > 0) || !isfinite(m)) return isfinite(m) ? 0.0 : m;
+    double a = v[0] / m, b = v[1] / m, c = v[2] / m;
+    return m * sqrt(a * a + b * b + c * c);
+}
+
+double atmos__scene_sin_angle(const double a[3], const double b[3])
+{
+    double na = atmos__scene_norm3(a), nb = atmos__scene_norm3(b);
+    if (!(na > 0) || !(nb > 0) || !isfinite(na) || !isfinite(nb)) return -1.0;
+    double u[3] = {a[0] / na, a[1] / na, a[2] / na}, w[3] = {b[0] / nb, b[1] / nb, b[2] / nb};
+    double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
+static atmos_status check_vec(atmos_context *ctx, const char *source, const char *name,
+                              const double v[3], const atmos__range *const r[3])
+{
+    for (int i = 0; i < 3; i++) {
+        char path[64];
+        snprintf(path, sizeof path, "%s/%d", name, i);
+        atmos_status st = atmos__scene_check_range(ctx, source, path, v[i], r[i], NULL);
+        if (st) return st;
+    }
+    return ATMOS_OK;
+}
+
+atmos_status atmos__scene_validate_camera(atmos_context *ctx, const char *source,
+                                          const atmos_camera_desc *cam)
+{
+    static const atmos__range any = {-HUGE_VAL, HUGE_VAL, 0, 0};
+    const atmos__range *pos_r[3] = {&atmos__r_pos, &atmos__r_altitude, &atmos__r_pos};
+    const atmos__range *look_r[3] = {&atmos__r_look, &atmos__r_look, &atmos__r_look};
+    const atmos__range *any_r[3] = {&any, &any, &any};
+    atmos_status st;
+
+    switch (cam->type) {
+    case ATMOS_CAMERA_PINHOLE:
+        st = atmos__scene_check_range(ctx, source, "/camera/fov_deg", cam->fov_deg,
+                                      &atmos__r_fov_pinhole, " for a pinhole camera");
+        break;
+    case ATMOS_CAMERA_FISHEYE:
+        st = atmos__scene_check_range(ctx, source, "/camera/fov_deg", cam->fov_deg,
+                                      &atmos__r_fov_fisheye, " for a fisheye camera");
+        break;
+    case ATMOS_CAMERA_EQUIRECT:
+        /* Ignored by this camera, but a NaN must not hide in a valid scene. */
+        st = atmos__scene_check_range(ctx, source, "/camera/fov_deg", cam->fov_deg, &any, NULL);
+        break;
+    default:
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/type",
+                                 "must be one of pinhole, fisheye, equirect, got %d", (int)cam->type);
+    }
+    if (st) return st;
+    if ((st = check_vec(ctx, source, "/camera/position_m", cam->position, pos_r))) return st;
+    if ((st = check_vec(ctx, source, "/camera/look_at_m", cam->look_at, look_r))) return st;
+    if ((st = check_vec(ctx, source, "/camera/up", cam->up, any_r))) return st;
+
+    /* Equirect cameras ignore look_at and up, but a scene must stay valid if the
+     * type is switched later (CLI override), so the same rules apply to all. */
+    double d[3] = {cam->look_at[0] - cam->position[0], cam->look_at[1] - cam->position[1],
+                   cam->look_at[2] - cam->position[2]};
+    if (!(atmos__scene_norm3(d) > 0))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/look_at_m",
+                                 "must differ from position_m");
+    if (!(atmos__scene_norm3(cam->up) > 0))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/up", "must be nonzero");
+    if (atmos__scene_sin_angle(d, cam->up) < PARALLEL_SIN)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/up",
+                                 "must not be parallel to the view direction");
+    return ATMOS_OK;
+}
+
+static int days_in_month(int year, int month)
+{
+    static const int days[12] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+    int leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    return month == 2 && leap ? 29 : days[month - 1];
+}
+
+atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
+                                       const atmos_scene_sun *sun)
+{
+    atmos_status st;
+    if (!sun->from_time) {
+        if ((st = atmos__scene_check_range(ctx, source, "/sun/elevation_deg", sun->elevation_deg,
+                                           &atmos__r_elevation, NULL)))
+            return st;
+        return atmos__scene_check_range(ctx, source, "/sun/azimuth_deg", sun->azimuth_deg,
+                                        &atmos__r_azimuth, NULL);
+    }
+    const atmos_utc_time *t = &sun->time;
+    /* A leap second may give 60.x seconds. */
+    if (t->year < 1 || t->year > 9999 || t->month < 1 || t->month > 12 || t->day < 1 ||
+        t->day > days_in_month(t->year, t->month) || t->hour < 0 || t->hour > 23 ||
+        t->minute < 0 || t->minute > 59 || !(t->second >= 0 && t->second < 61))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/sun/time",
+                                 "not a valid UTC date-time (%04d-%02d-%02dT%02d:%02d:%06.3f)",
+                                 t->year, t->month, t->day, t->hour, t->minute,
+                                 isfinite(t->second) ? t->second : -1.0);
+    if ((st = atmos__scene_check_range(ctx, source, "/sun/latitude_deg", sun->latitude_deg,
+                                       &atmos__r_latitude, NULL)))
+        return st;
+    return atmos__scene_check_range(ctx, source, "/sun/longitude_deg", sun->longitude_deg,
+                                    &atmos__r_longitude, NULL);
+}
+
+atmos_status atmos__scene_validate_output(atmos_context *ctx, const char *source,
+                                          const atmos_scene *scene)
+{
+    const atmos_tonemap_desc *tm = &scene->tonemap;
+    atmos_status st;
+    /* exposure_ev means a manual EV100 or a compensation; name the JSON key the
+     * value came from. */
+    if (tm->manual_exposure == 1)
+        st = atmos__scene_check_range(ctx, source, "/output/exposure", tm->exposure_ev,
+                                      &atmos__r_manual_ev, NULL);
+    else if (tm->manual_exposure == 0)
+        st = atmos__scene_check_range(ctx, source, "/output/exposure_compensation_ev",
+                                      tm->exposure_ev, &atmos__r_compensation, NULL);
+    else
+        st = atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/output/exposure",
+                               "manual_exposure must be 0 (auto) or 1 (manual), got %d",
+                               tm->manual_exposure);
+    if (st) return st;
+    if (tm->curve != ATMOS_TONE_FILMIC && tm->curve != ATMOS_TONE_REINHARD && tm->curve != ATMOS_TONE_CLAMP)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/output/tone_curve",
+                                 "must be one of filmic, reinhard, clamp, got %d", (int)tm->curve);
+    if (scene->png_bits != 8 && scene->png_bits != 16)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/output/png_bits",
+                                 "must be 8 or 16, got %d", scene->png_bits);
+    return ATMOS_OK;
+}
+
+static atmos_status validate_image(atmos_context *ctx, const char *source, const atmos_scene *s)
+{
+    atmos_status st;
+    if ((st = atmos__scene_check_range(ctx, source, "/image/width", s->width, &atmos__r_dim, NULL))) return st;
+    if ((st = atmos__scene_check_range(ctx, source, "/image/height", s->height, &atmos__r_dim, NULL))) return st;
+    return atmos__scene_check_range(ctx, source, "/image/samples_per_pixel", s->samples_per_pixel,
+                                    &atmos__r_spp, NULL);
+}
+
+static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
+                                        const atmos_atmosphere_desc *a)
+{
+    static const struct {
+        const char *path;
+        size_t offset;
+        const atmos__range *range;
+    } fields[] = {
+        {"/atmosphere/beta_sl_550_per_m", offsetof(atmos_atmosphere_desc, beta_sl_550), &atmos__r_beta},
+        {"/atmosphere/scale_height_m", offsetof(atmos_atmosphere_desc, scale_height_m), &atmos__r_scale_height},
+        {"/atmosphere/ground_albedo", offsetof(atmos_atmosphere_desc, ground_albedo), &atmos__r_albedo},
+        {"/atmosphere/sun_diameter_deg", offsetof(atmos_atmosphere_desc, sun_diameter_deg), &atmos__r_sun_diameter},
+        {"/atmosphere/sun_scale", offsetof(atmos_atmosphere_desc, sun_scale), &atmos__r_sun_scale},
+    };
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) {
+        double v;
+        memcpy(&v, (const char *)a + fields[i].offset, sizeof v);
+        atmos_status st = atmos__scene_check_range(ctx, source, fields[i].path, v, fields[i].range, NULL);
+        if (st) return st;
+    }
+    return ATMOS_OK;
+}
+
+atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, const char *source)
+{
+    if (!scene) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_validate: scene is NULL");
+    atmos_status st;
+    /* The name is copied around as a C string: it must be terminated inside the array. */
+    if (!memchr(scene->name, '\0', sizeof scene->name))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/name",
+                                 "must be at most %d bytes", (int)sizeof scene->name - 1);
+    if ((st = validate_image(ctx, source, scene))) return st;
+    if ((st = atmos__scene_validate_camera(ctx, source, &scene->camera))) return st;
+    if ((st = atmos__scene_validate_sun(ctx, source, &scene->sun))) return st;
+    if ((st = validate_atmosphere(ctx, source, &scene->atmosphere))) return st;
+    if (scene->wavelengths != ATMOS_WAVELENGTHS_RGB && scene->wavelengths != ATMOS_WAVELENGTHS_SPECTRAL)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/wavelengths/mode",
+                                 "must be rgb or spectral, got %d", (int)scene->wavelengths);
+    /* Checked in rgb mode too, so switching the mode later cannot expose a bad count. */
+    if ((st = atmos__scene_check_range(ctx, source, "/wavelengths/samples", scene->spectral_samples,
+                                       &atmos__r_samples, NULL)))
+        return st;
+    return atmos__scene_validate_output(ctx, source, scene);
+}

@@ -1,0 +1,517 @@
+/* Scene files: defaults, a full scene read back value by value, absent keys,
+ * type-dependent defaults, and a table of bad scenes each of which must fail with
+ * the right status and a message naming the right JSON pointer (and range).
+ */
+#define _POSIX_C_SOURCE 200809L /* opendir */
+#include "atmos/atmos.h"
+#include "test.h"
+
+#include <dirent.h>
+
+static atmos_context *ctx;
+
+static atmos_status parse(const char *json, atmos_scene *s)
+{
+    return atmos_scene_parse(ctx, json, strlen(json), "scene.json", s);
+}
+
+static int contains(const char *hay, const char *needle) { return needle == NULL || strstr(hay, needle) != NULL; }
+
+/* |a - b| for 3-vectors, max norm. */
+static double vdiff(const double a[3], const double b[3])
+{
+    double d = 0;
+    for (int i = 0; i < 3; i++) d = fmax(d, fabs(a[i] - b[i]));
+    return d;
+}
+
+static void test_defaults(void)
+{
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    CHECK(strcmp(s.name, "default") == 0);
+    CHECK(s.width == 1280 && s.height == 720 && s.samples_per_pixel == 1);
+    CHECK(s.camera.type == ATMOS_CAMERA_PINHOLE);
+    double pos[3] = {0, 2, 0}, up[3] = {0, 1, 0}, dir[3];
+    CHECK(vdiff(s.camera.position, pos) == 0);
+    CHECK(vdiff(s.camera.up, up) == 0);
+    CHECK_NEAR(s.camera.fov_deg, 60, 0);
+    /* look_at = position + 1000 m towards elevation 6°, azimuth 200° (SSW: x < 0, z < 0 is north so z > 0). */
+    atmos_direction_from_angles(6, 200, dir);
+    double look[3] = {1000 * dir[0], 2 + 1000 * dir[1], 1000 * dir[2]};
+    CHECK(vdiff(s.camera.look_at, look) < 1e-9);
+    CHECK(s.camera.look_at[0] < 0 && s.camera.look_at[2] > 0);
+    CHECK_NEAR(s.camera.look_at[1] - 2, 1000 * sin(6 * 3.14159265358979323846 / 180), 1e-9);
+    CHECK(s.sun.from_time == 0 && s.sun.refraction == 1);
+    CHECK_NEAR(s.sun.elevation_deg, 10, 0);
+    CHECK_NEAR(s.sun.azimuth_deg, 225, 0);
+    CHECK_REL(s.atmosphere.beta_sl_550, 1.35e-5, 1e-12);
+    CHECK_NEAR(s.atmosphere.scale_height_m, 8000, 0);
+    CHECK_NEAR(s.atmosphere.ground_albedo, 0.1, 1e-15);
+    CHECK_NEAR(s.atmosphere.sun_diameter_deg, 0.5, 0);
+    CHECK_NEAR(s.atmosphere.sun_scale, 1, 0);
+    CHECK(s.atmosphere.hide_sun_disk == 0);
+    CHECK(s.wavelengths == ATMOS_WAVELENGTHS_RGB && s.spectral_samples == 16);
+    CHECK(s.tonemap.manual_exposure == 0 && s.tonemap.exposure_ev == 0 && s.tonemap.curve == ATMOS_TONE_FILMIC);
+    CHECK(s.png_bits == 8 && s.exr_half == 0);
+    CHECK_OK(atmos_scene_validate(ctx, &s, "defaults"));
+    /* An empty object is the default scene, bit for bit. */
+    atmos_scene p;
+    CHECK_OK(parse("{}", &p));
+    CHECK(memcmp(&p, &s, sizeof s) == 0);
+}
+
+static const char *full_scene =
+    "{\n"
+    "  \"_comment\": \"every key given\",\n"
+    "  \"name\": \"clear noon sky\",\n"
+    "  \"image\": {\"width\": 1024, \"height\": 512, \"samples_per_pixel\": 4},\n"
+    "  \"camera\": {\"type\": \"pinhole\", \"position_m\": [10, 1500, -20], \"look_at_m\": [110, 1600, -20.5],\n"
+    "             \"up\": [0, 1, 0.25], \"fov_deg\": 75.5, \"_note\": {\"nested\": [1, 2, {\"x\": null}]}},\n"
+    "  \"sun\": {\"elevation_deg\": -4.5, \"azimuth_deg\": 359.75},\n"
+    "  \"atmosphere\": {\"beta_sl_550_per_m\": 2e-5, \"scale_height_m\": 7994, \"ground_albedo\": 0.3,\n"
+    "                 \"sun_diameter_deg\": 0.53, \"sun_scale\": 2.5, \"sun_disk\": false},\n"
+    "  \"wavelengths\": {\"mode\": \"spectral\", \"samples\": 32},\n"
+    "  \"output\": {\"exposure\": 14.5, \"tone_curve\": \"reinhard\", \"png_bits\": 16, \"exr_pixel\": \"half\"},\n"
+    "  \"renderer\": \"sky\"\n"
+    "}\n";
+
+static void test_full_scene(void)
+{
+    atmos_scene s;
+    CHECK_OK(parse(full_scene, &s));
+    CHECK(strcmp(s.name, "clear noon sky") == 0);
+    CHECK(s.width == 1024 && s.height == 512 && s.samples_per_pixel == 4);
+    double pos[3] = {10, 1500, -20}, look[3] = {110, 1600, -20.5}, up[3] = {0, 1, 0.25};
+    CHECK(s.camera.type == ATMOS_CAMERA_PINHOLE);
+    CHECK(vdiff(s.camera.position, pos) == 0);
+    CHECK(vdiff(s.camera.look_at, look) == 0);
+    CHECK(vdiff(s.camera.up, up) == 0);
+    CHECK(s.camera.fov_deg == 75.5);
+    CHECK(s.sun.from_time == 0 && s.sun.elevation_deg == -4.5 && s.sun.azimuth_deg == 359.75);
+    CHECK(s.atmosphere.beta_sl_550 == 2e-5 && s.atmosphere.scale_height_m == 7994);
+    CHECK(s.atmosphere.ground_albedo == 0.3 && s.atmosphere.sun_diameter_deg == 0.53);
+    CHECK(s.atmosphere.sun_scale == 2.5 && s.atmosphere.hide_sun_disk == 1);
+    CHECK(s.wavelengths == ATMOS_WAVELENGTHS_SPECTRAL && s.spectral_samples == 32);
+    CHECK(s.tonemap.manual_exposure == 1 && s.tonemap.exposure_ev == 14.5);
+    CHECK(s.tonemap.curve == ATMOS_TONE_REINHARD);
+    CHECK(s.png_bits == 16 && s.exr_half == 1);
+    CHECK_OK(atmos_scene_validate(ctx, &s, "full"));
+
+    /* The other spellings of the enumerations. */
+    CHECK_OK(parse("{\"output\": {\"exposure\": \"auto\", \"exposure_compensation_ev\": -1.5,"
+                   " \"tone_curve\": \"clamp\", \"png_bits\": 8, \"exr_pixel\": \"float\"},"
+                   " \"wavelengths\": {\"mode\": \"rgb\"}, \"atmosphere\": {\"sun_disk\": true}}", &s));
+    CHECK(s.tonemap.manual_exposure == 0 && s.tonemap.exposure_ev == -1.5 && s.tonemap.curve == ATMOS_TONE_CLAMP);
+    CHECK(s.png_bits == 8 && s.exr_half == 0 && s.wavelengths == ATMOS_WAVELENGTHS_RGB);
+    CHECK(s.atmosphere.hide_sun_disk == 0);
+
+    /* A sun given by time and place; the parse stores the parsed time. */
+    CHECK_OK(parse("{\"sun\": {\"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40,"
+                   " \"longitude_deg\": -105, \"refraction\": false}}", &s));
+    CHECK(s.sun.from_time == 1 && s.sun.refraction == 0);
+    CHECK(s.sun.time.year == 2026 && s.sun.time.month == 6 && s.sun.time.day == 21);
+    CHECK(s.sun.time.hour == 12 && s.sun.time.minute == 0 && s.sun.time.second == 0);
+    CHECK(s.sun.latitude_deg == 40 && s.sun.longitude_deg == -105);
+    CHECK_OK(atmos_scene_validate(ctx, &s, "time"));
+
+    /* Boundaries that are inside their ranges. */
+    CHECK_OK(parse("{\"image\": {\"width\": 16384, \"height\": 1, \"samples_per_pixel\": 256},"
+                   " \"camera\": {\"position_m\": [0, 1000000, 0], \"fov_deg\": 179.999},"
+                   " \"sun\": {\"elevation_deg\": 90, \"azimuth_deg\": 0},"
+                   " \"atmosphere\": {\"beta_sl_550_per_m\": 0.01, \"scale_height_m\": 100, \"ground_albedo\": 1,"
+                   " \"sun_diameter_deg\": 20, \"sun_scale\": 0},"
+                   " \"wavelengths\": {\"samples\": 128}, \"output\": {\"exposure\": -20}}", &s));
+    CHECK(s.width == 16384 && s.camera.position[1] == 1e6 && s.spectral_samples == 128);
+    CHECK_OK(parse("{\"camera\": {\"type\": \"fisheye\", \"fov_deg\": 360}, \"output\": {\"exposure\": 40},"
+                   " \"atmosphere\": {\"sun_scale\": 1e6, \"scale_height_m\": 1e5}}", &s));
+    CHECK(s.camera.fov_deg == 360);
+    CHECK_OK(parse("{\"wavelengths\": {\"samples\": 1}, \"sun\": {\"elevation_deg\": -90},"
+                   " \"output\": {\"exposure_compensation_ev\": 20}, \"name\": \"\"}", &s));
+    CHECK(s.tonemap.manual_exposure == 0 && s.tonemap.exposure_ev == 20 && s.name[0] == '\0');
+    /* A name of exactly 127 bytes (UTF-8 counts bytes) fits. */
+    char json[512], name[128];
+    memset(name, 'n', 127);
+    name[127] = '\0';
+    snprintf(json, sizeof json, "{\"name\": \"%s\"}", name);
+    CHECK_OK(parse(json, &s));
+    CHECK(strcmp(s.name, name) == 0);
+    CHECK_OK(parse("{\"name\": \"\xc3\xa9t\xc3\xa9 \\\"quoted\\\" \\u00e9\"}", &s));
+    CHECK(strcmp(s.name, "\xc3\xa9t\xc3\xa9 \"quoted\" \xc3\xa9") == 0);
+    /* A UTF-8 byte order mark and surrounding whitespace are allowed. */
+    CHECK_OK(parse("\xef\xbb\xbf \r\n\t{\"name\": \"bom\"}\n\n", &s));
+    CHECK(strcmp(s.name, "bom") == 0);
+}
+
+static void test_absent_keys(void)
+{
+    atmos_scene d, s;
+    atmos_scene_defaults(&d);
+
+    CHECK_OK(parse("{\"image\": {\"width\": 100}, \"_x\": [[[]]]}", &s));
+    CHECK(s.width == 100 && s.height == 720 && s.samples_per_pixel == 1);
+    s.width = d.width;
+    CHECK(memcmp(&s, &d, sizeof s) == 0);
+
+    /* Moving only the position keeps the default view direction. */
+    CHECK_OK(parse("{\"camera\": {\"position_m\": [5, 300, 7]}}", &s));
+    double moved[3];
+    for (int i = 0; i < 3; i++) moved[i] = d.camera.look_at[i] - d.camera.position[i] + s.camera.position[i];
+    CHECK(vdiff(s.camera.look_at, moved) < 1e-9);
+    CHECK(s.camera.fov_deg == 60 && s.camera.up[1] == 1);
+
+    /* view gives look_at = position + 1000 m * direction. */
+    CHECK_OK(parse("{\"camera\": {\"view\": {\"elevation_deg\": 30, \"azimuth_deg\": 90}}}", &s));
+    double dir[3];
+    atmos_direction_from_angles(30, 90, dir);
+    double look[3] = {1000 * dir[0], 2 + 1000 * dir[1], 1000 * dir[2]};
+    CHECK(vdiff(s.camera.look_at, look) < 1e-9);
+
+    /* A fisheye without fov or view: 180°, zenith, up = north. */
+    CHECK_OK(parse("{\"camera\": {\"type\": \"fisheye\"}}", &s));
+    double zen[3] = {0, 1002, 0}, north[3] = {0, 0, -1};
+    CHECK(s.camera.type == ATMOS_CAMERA_FISHEYE && s.camera.fov_deg == 180);
+    CHECK(vdiff(s.camera.look_at, zen) < 1e-9);
+    CHECK(vdiff(s.camera.up, north) == 0);
+    /* ...but given values win, whatever the key order. */
+    CHECK_OK(parse("{\"camera\": {\"fov_deg\": 220, \"view\": {\"elevation_deg\": 45, \"azimuth_deg\": 180},"
+                   " \"type\": \"fisheye\"}}", &s));
+    CHECK(s.camera.fov_deg == 220 && s.camera.up[1] == 1 && s.camera.look_at[2] > 0);
+    /* A pinhole looking straight up gets north as up too. */
+    CHECK_OK(parse("{\"camera\": {\"view\": {\"elevation_deg\": 90, \"azimuth_deg\": 0}}}", &s));
+    CHECK(vdiff(s.camera.up, north) == 0);
+    /* Equirect keeps the rest (ignored by that camera, but valid). */
+    CHECK_OK(parse("{\"camera\": {\"type\": \"equirect\"}}", &s));
+    CHECK(s.camera.type == ATMOS_CAMERA_EQUIRECT && vdiff(s.camera.look_at, d.camera.look_at) == 0);
+    /* Only one sun angle: the other keeps its default. */
+    CHECK_OK(parse("{\"sun\": {\"azimuth_deg\": 100}}", &s));
+    CHECK(s.sun.elevation_deg == 10 && s.sun.azimuth_deg == 100 && !s.sun.from_time);
+}
+
+typedef struct bad_case {
+    const char *json;
+    atmos_status status;
+    const char *expect1, *expect2; /* substrings of the message (NULL: none) */
+} bad_case;
+
+static const bad_case bad_cases[] = {
+    /* structure and types */
+    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer)", NULL},
+    {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
+    {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
+    {"{\"a/b~c\": 1}", ATMOS_E_INVALID_ARG, "/a~1b~0c: unknown key", NULL},
+    {"[1, 2]", ATMOS_E_INVALID_ARG, "scene.json: /: expected an object, got an array", NULL},
+    {"{\"image\": 5}", ATMOS_E_INVALID_ARG, "/image: expected an object, got a number", NULL},
+    {"{\"image\": {\"width\": 1.5}}", ATMOS_E_INVALID_ARG, "/image/width: expected an integer, got 1.5", NULL},
+    {"{\"image\": {\"height\": null}}", ATMOS_E_INVALID_ARG, "/image/height: expected an integer, got null", NULL},
+    {"{\"name\": 42}", ATMOS_E_INVALID_ARG, "/name: expected a string, got a number", NULL},
+    {"{\"atmosphere\": {\"sun_disk\": \"yes\"}}", ATMOS_E_INVALID_ARG, "/atmosphere/sun_disk: expected true or false, got a string", NULL},
+    {"{\"camera\": {\"position_m\": [0, 2]}}", ATMOS_E_INVALID_ARG, "/camera/position_m: expected an array of 3 numbers, got 2 elements", NULL},
+    {"{\"camera\": {\"up\": [0, 1, 0, 0]}}", ATMOS_E_INVALID_ARG, "/camera/up: expected an array of 3 numbers", NULL},
+    {"{\"camera\": {\"look_at_m\": [0, 1, \"2\"]}}", ATMOS_E_INVALID_ARG, "/camera/look_at_m/2: expected a number, got a string", NULL},
+    {"{\"camera\": {\"type\": \"ortho\"}}", ATMOS_E_INVALID_ARG, "/camera/type: must be one of pinhole, fisheye, equirect, got \"ortho\"", NULL},
+    {"{\"wavelengths\": {\"mode\": \"hyper\"}}", ATMOS_E_INVALID_ARG, "/wavelengths/mode: must be one of rgb, spectral", NULL},
+    {"{\"output\": {\"tone_curve\": \"aces\"}}", ATMOS_E_INVALID_ARG, "/output/tone_curve: must be one of filmic, reinhard, clamp", NULL},
+    {"{\"output\": {\"exr_pixel\": \"double\"}}", ATMOS_E_INVALID_ARG, "/output/exr_pixel: must be one of float, half", NULL},
+    {"{\"output\": {\"exposure\": \"bright\"}}", ATMOS_E_INVALID_ARG, "/output/exposure: must be \"auto\" or a number", NULL},
+    {"{\"output\": {\"exposure\": true}}", ATMOS_E_INVALID_ARG, "/output/exposure: expected \"auto\" or a number (EV100), got a boolean", NULL},
+    {"{\"renderer\": \"path\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, got \"path\"", NULL},
+    {"{\"image\": {\"width\": 10, \"width\": 20}}", ATMOS_E_INVALID_ARG, "/image/width: duplicate key", NULL},
+    /* ranges, at each side of each boundary that matters */
+    {"{\"image\": {\"width\": 0}}", ATMOS_E_INVALID_ARG, "/image/width: must be in [1, 16384], got 0", NULL},
+    {"{\"image\": {\"height\": 16385}}", ATMOS_E_INVALID_ARG, "/image/height: must be in [1, 16384], got 16385", NULL},
+    {"{\"image\": {\"width\": 1e10}}", ATMOS_E_INVALID_ARG, "/image/width: must be in [1, 16384]", NULL},
+    {"{\"image\": {\"samples_per_pixel\": 257}}", ATMOS_E_INVALID_ARG, "/image/samples_per_pixel: must be in [1, 256], got 257", NULL},
+    {"{\"camera\": {\"fov_deg\": 270}}", ATMOS_E_INVALID_ARG, "scene.json: /camera/fov_deg: must be in (0, 180) for a pinhole camera, got 270", NULL},
+    {"{\"camera\": {\"fov_deg\": 180}}", ATMOS_E_INVALID_ARG, "/camera/fov_deg: must be in (0, 180) for a pinhole camera, got 180", NULL},
+    {"{\"camera\": {\"fov_deg\": 0}}", ATMOS_E_INVALID_ARG, "/camera/fov_deg", "(0, 180)"},
+    {"{\"camera\": {\"fov_deg\": 360.5, \"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/fov_deg: must be in (0, 360] for a fisheye camera, got 360.5", NULL},
+    {"{\"camera\": {\"type\": \"fisheye\", \"fov_deg\": -1}}", ATMOS_E_INVALID_ARG, "/camera/fov_deg", "(0, 360]"},
+    {"{\"camera\": {\"position_m\": [0, -0.5, 0]}}", ATMOS_E_INVALID_ARG, "/camera/position_m/1: must be in [0, 1000000], got -0.5", NULL},
+    {"{\"camera\": {\"position_m\": [0, 1000001, 0]}}", ATMOS_E_INVALID_ARG, "/camera/position_m/1", "[0, 1000000]"},
+    {"{\"camera\": {\"look_at_m\": [0, 2, 0]}}", ATMOS_E_INVALID_ARG, "/camera/look_at_m: must differ from position_m", NULL},
+    {"{\"camera\": {\"look_at_m\": [1, 2, 3], \"view\": {\"elevation_deg\": 1, \"azimuth_deg\": 2}}}", ATMOS_E_INVALID_ARG, "/camera/view: cannot be combined with look_at_m", NULL},
+    {"{\"camera\": {\"view\": {\"elevation_deg\": 1, \"azimuth_deg\": 2}, \"look_at_m\": [1, 2, 3]}}", ATMOS_E_INVALID_ARG, "/camera/look_at_m: cannot be combined with view", NULL},
+    {"{\"camera\": {\"view\": {\"elevation_deg\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view: missing key \"azimuth_deg\"", NULL},
+    {"{\"camera\": {\"view\": {\"elevation_deg\": 90.001, \"azimuth_deg\": 0}}}", ATMOS_E_INVALID_ARG, "/camera/view/elevation_deg: must be in [-90, 90], got 90.001", NULL},
+    {"{\"camera\": {\"up\": [0, 0, 0]}}", ATMOS_E_INVALID_ARG, "/camera/up: must be nonzero", NULL},
+    {"{\"camera\": {\"up\": [0, 1, 0], \"view\": {\"elevation_deg\": 90, \"azimuth_deg\": 0}}}", ATMOS_E_INVALID_ARG, "/camera/up: must not be parallel to the view direction", NULL},
+    {"{\"camera\": {\"type\": \"fisheye\", \"up\": [0, -3, 0]}}", ATMOS_E_INVALID_ARG, "/camera/up: must not be parallel", NULL},
+    {"{\"sun\": {\"elevation_deg\": -90.5}}", ATMOS_E_INVALID_ARG, "/sun/elevation_deg: must be in [-90, 90], got -90.5", NULL},
+    {"{\"sun\": {\"azimuth_deg\": 360}}", ATMOS_E_INVALID_ARG, "/sun/azimuth_deg: must be in [0, 360), got 360", NULL},
+    {"{\"sun\": {\"azimuth_deg\": -0.25}}", ATMOS_E_INVALID_ARG, "/sun/azimuth_deg", "[0, 360)"},
+    {"{\"sun\": {\"elevation_deg\": 10, \"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 1, \"longitude_deg\": 2}}", ATMOS_E_INVALID_ARG, "/sun/time: cannot be combined with elevation_deg/azimuth_deg", NULL},
+    {"{\"sun\": {\"latitude_deg\": 1, \"longitude_deg\": 2, \"time\": \"2026-06-21T12:00:00Z\", \"azimuth_deg\": 10}}", ATMOS_E_INVALID_ARG, "/sun/azimuth_deg: cannot be combined with time", NULL},
+    {"{\"sun\": {\"time\": \"2026-06-21T12:00:00Z\", \"longitude_deg\": 2}}", ATMOS_E_INVALID_ARG, "/sun: missing key \"latitude_deg\"", NULL},
+    {"{\"sun\": {\"time\": 20260621}}", ATMOS_E_INVALID_ARG, "/sun/time: expected a string, got a number", NULL},
+    {"{\"sun\": {\"time\": \"2026-02-30T00:00:00Z\", \"latitude_deg\": 0, \"longitude_deg\": 0}}", ATMOS_E_INVALID_ARG, "scene.json: /sun/time: ", NULL},
+    {"{\"sun\": {\"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 90.5, \"longitude_deg\": 0}}", ATMOS_E_INVALID_ARG, "/sun/latitude_deg: must be in [-90, 90], got 90.5", NULL},
+    {"{\"sun\": {\"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 0, \"longitude_deg\": -180.5}}", ATMOS_E_INVALID_ARG, "/sun/longitude_deg: must be in [-180, 180], got -180.5", NULL},
+    {"{\"sun\": {\"refraction\": 1}}", ATMOS_E_INVALID_ARG, "/sun/refraction: expected true or false", NULL},
+    {"{\"atmosphere\": {\"beta_sl_550_per_m\": 0}}", ATMOS_E_INVALID_ARG, "/atmosphere/beta_sl_550_per_m: must be in (0, 0.01], got 0", NULL},
+    {"{\"atmosphere\": {\"beta_sl_550_per_m\": 0.0100001}}", ATMOS_E_INVALID_ARG, "/atmosphere/beta_sl_550_per_m", "(0, 0.01], got 0.0100001"},
+    {"{\"atmosphere\": {\"scale_height_m\": 99.9}}", ATMOS_E_INVALID_ARG, "/atmosphere/scale_height_m: must be in [100, 100000], got 99.9", NULL},
+    {"{\"atmosphere\": {\"ground_albedo\": 1.01}}", ATMOS_E_INVALID_ARG, "/atmosphere/ground_albedo: must be in [0, 1], got 1.01", NULL},
+    {"{\"atmosphere\": {\"ground_albedo\": -0.01}}", ATMOS_E_INVALID_ARG, "/atmosphere/ground_albedo", "[0, 1]"},
+    {"{\"atmosphere\": {\"sun_diameter_deg\": 0}}", ATMOS_E_INVALID_ARG, "/atmosphere/sun_diameter_deg: must be in (0, 20], got 0", NULL},
+    {"{\"atmosphere\": {\"sun_scale\": 1000001}}", ATMOS_E_INVALID_ARG, "/atmosphere/sun_scale: must be in [0, 1000000]", NULL},
+    {"{\"wavelengths\": {\"samples\": 0}}", ATMOS_E_INVALID_ARG, "/wavelengths/samples: must be in [1, 128], got 0", NULL},
+    {"{\"wavelengths\": {\"samples\": 129}}", ATMOS_E_INVALID_ARG, "/wavelengths/samples", "[1, 128]"},
+    {"{\"output\": {\"exposure\": 40.5}}", ATMOS_E_INVALID_ARG, "/output/exposure: must be in [-20, 40], got 40.5", NULL},
+    {"{\"output\": {\"exposure_compensation_ev\": -20.5}}", ATMOS_E_INVALID_ARG, "/output/exposure_compensation_ev: must be in [-20, 20]", NULL},
+    {"{\"output\": {\"exposure\": 12, \"exposure_compensation_ev\": 1}}", ATMOS_E_INVALID_ARG, "/output/exposure_compensation_ev: only applies with automatic exposure", NULL},
+    {"{\"output\": {\"png_bits\": 12}}", ATMOS_E_INVALID_ARG, "/output/png_bits: must be 8 or 16, got 12", NULL},
+    {"{\"output\": {\"png_bits\": 1e300}}", ATMOS_E_INVALID_ARG, "/output/png_bits", NULL},
+    {"{\"name\": \"nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn\"}", ATMOS_E_INVALID_ARG, "/name: must be at most 127 bytes, got 128", NULL},
+    /* numbers that are not finite doubles */
+    {"{\"camera\": {\"fov_deg\": 1e999}}", ATMOS_E_INVALID_ARG, "/camera/fov_deg: must be a finite number", NULL},
+    {"{\"image\": {\"width\": -1e999}}", ATMOS_E_INVALID_ARG, "/image/width: must be a finite number", NULL},
+    {"{\"camera\": {\"position_m\": [0, 1e400, 0]}}", ATMOS_E_INVALID_ARG, "/camera/position_m/1: must be a finite number", NULL},
+    {"{\"camera\": {\"fov_deg\": NaN}}", ATMOS_E_FORMAT, "scene.json:1:", "malformed JSON"},
+    /* malformed text */
+    {"", ATMOS_E_FORMAT, "scene.json: empty input", NULL},
+    {" \n\t ", ATMOS_E_FORMAT, "empty input", NULL},
+    {"{\"image\": {\"width\": 10,}}", ATMOS_E_FORMAT, "scene.json:1:", "malformed JSON"},
+    {"{\n  \"image\": {\n    \"width\": 10\n  },\n  \"camera\": ]\n}", ATMOS_E_FORMAT, "scene.json:5:", "malformed JSON"},
+    {"{\"image\": {\"width\": 10", ATMOS_E_FORMAT, "unexpected end of input", NULL},
+    {"{\"name\": \"unterminated", ATMOS_E_FORMAT, "unexpected end of input inside a string", NULL},
+    {"{} {}", ATMOS_E_FORMAT, "scene.json:1:4: malformed JSON: unexpected text after the end", NULL},
+    {"{\"name\": \"bad \xff utf8\"}", ATMOS_E_FORMAT, "scene.json:1:15: malformed JSON: invalid UTF-8", NULL},
+    {"{\"name\": \"overlong \xc0\xaf\"}", ATMOS_E_FORMAT, "invalid UTF-8", NULL},
+    {"{\"name\": \"surrogate \xed\xa0\x80\"}", ATMOS_E_FORMAT, "invalid UTF-8", NULL},
+    {"{\"name\": \"tab\there\"}", ATMOS_E_FORMAT, "control character in a string", NULL},
+    {"{\"name\": \"nul \\u0000 escape\"}", ATMOS_E_FORMAT, "\\u0000 is not allowed", NULL},
+    {"{\"_deep\": [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]}", ATMOS_E_LIMIT, "scene.json:1:", "nesting deeper than 64 levels"},
+    {"\"just a string\"", ATMOS_E_INVALID_ARG, "/: expected an object, got a string", NULL},
+    {"{\"image\": {\"width\": 10}} \x01", ATMOS_E_FORMAT, "control character", NULL},
+};
+
+static void test_bad_scenes(void)
+{
+    int n = (int)(sizeof bad_cases / sizeof bad_cases[0]);
+    for (int i = 0; i < n; i++) {
+        const bad_case *c = &bad_cases[i];
+        atmos_scene s, before;
+        memset(&s, 0x5A, sizeof s);
+        before = s;
+        atmos_context_clear_error(ctx);
+        atmos_status st = parse(c->json, &s);
+        const char *msg = atmos_context_error(ctx);
+        CHECK_MSG(st == c->status, "case %d (%s): status %s, expected %s; message: %s", i, c->json,
+                  atmos_status_string(st), atmos_status_string(c->status), msg);
+        CHECK_MSG(contains(msg, c->expect1) && contains(msg, c->expect2),
+                  "case %d (%s): message \"%s\" lacks \"%s\" / \"%s\"", i, c->json, msg, c->expect1,
+                  c->expect2 ? c->expect2 : "");
+        CHECK_MSG(strncmp(msg, "scene.json", 10) == 0, "case %d: message \"%s\" does not start with the source", i, msg);
+        CHECK_MSG(memcmp(&s, &before, sizeof s) == 0, "case %d: output modified on failure", i);
+    }
+    printf("%d bad scenes checked\n", n);
+
+    /* The brief's examples, word for word. */
+    atmos_scene s;
+    CHECK(parse("{\"camera\": {\"fovv_deg\": 50}}", &s) == ATMOS_E_INVALID_ARG);
+    CHECK(strcmp(atmos_context_error(ctx),
+                 "scene.json: /camera/fovv_deg: unknown key (allowed: type, position_m, look_at_m, view, up, fov_deg)") == 0);
+    CHECK(parse("{\"image\": {\"width\": \"1024\"}}", &s) == ATMOS_E_INVALID_ARG);
+    CHECK(strcmp(atmos_context_error(ctx), "scene.json: /image/width: expected an integer, got a string") == 0);
+
+    /* The first error wins: document order. */
+    CHECK(parse("{\"image\": {\"height\": 0, \"width\": 0}, \"bogus\": 1}", &s) == ATMOS_E_INVALID_ARG);
+    CHECK(contains(atmos_context_error(ctx), "/image/height:"));
+    CHECK(parse("{\"bogus\": 1, \"image\": {\"height\": 0}}", &s) == ATMOS_E_INVALID_ARG);
+    CHECK(contains(atmos_context_error(ctx), "/bogus:"));
+
+    /* Text without a terminator, and NUL bytes inside the given length. */
+    const char unterminated[2] = {'{', '}'};
+    CHECK_OK(atmos_scene_parse(ctx, unterminated, 2, "buf", &s));
+    CHECK(atmos_scene_parse(ctx, "{}\0", 3, "buf", &s) == ATMOS_E_FORMAT);
+    CHECK(contains(atmos_context_error(ctx), "buf:1:3: malformed JSON: NUL byte"));
+    CHECK(atmos_scene_parse(ctx, NULL, 0, "buf", &s) == ATMOS_E_FORMAT);
+    CHECK(atmos_scene_parse(ctx, NULL, 5, "buf", &s) == ATMOS_E_INVALID_ARG);
+    CHECK(atmos_scene_parse(ctx, "{}", 2, "buf", NULL) == ATMOS_E_INVALID_ARG);
+    /* A NULL context is allowed: only the status comes back. */
+    CHECK(atmos_scene_parse(NULL, "{\"x\": 1}", 8, NULL, &s) == ATMOS_E_INVALID_ARG);
+}
+
+static void test_limits(void)
+{
+    atmos_scene s;
+    /* Just over 16 MiB: refused before scanning a byte (spaces would otherwise be "empty"). */
+    size_t big = ((size_t)16 << 20) + 1;
+    char *buf = malloc(big);
+    CHECK(buf != NULL);
+    if (!buf) return;
+    memset(buf, ' ', big);
+    CHECK(atmos_scene_parse(ctx, buf, big, "big.json", &s) == ATMOS_E_LIMIT);
+    CHECK(contains(atmos_context_error(ctx), "big.json: input is 16777217 bytes"));
+    /* Exactly 16 MiB is accepted: an object padded with whitespace. */
+    buf[0] = '{';
+    buf[big - 2] = '}';
+    CHECK_OK(atmos_scene_parse(ctx, buf, big - 1, "big.json", &s));
+    /* 10,000 nested arrays: refused without recursing. */
+    size_t depth = 10000;
+    memset(buf, '[', depth);
+    memset(buf + depth, ']', depth);
+    CHECK(atmos_scene_parse(ctx, buf, 2 * depth, "deep.json", &s) == ATMOS_E_LIMIT);
+    CHECK(contains(atmos_context_error(ctx), "deep.json:1:65: nesting deeper than 64 levels"));
+    /* 64 levels are fine (in an annotation) but 65 are not. */
+    for (int levels = 63; levels <= 64; levels++) {
+        char deep[256];
+        int o = snprintf(deep, sizeof deep, "{\"_a\": ");
+        for (int i = 0; i < levels; i++) deep[o++] = '[';
+        for (int i = 0; i < levels; i++) deep[o++] = ']';
+        deep[o++] = '}';
+        deep[o] = '\0';
+        CHECK(parse(deep, &s) == (levels == 63 ? ATMOS_OK : ATMOS_E_LIMIT));
+    }
+    free(buf);
+}
+
+static void test_validate(void)
+{
+    atmos_scene d, s;
+    atmos_scene_defaults(&d);
+    s = d; s.width = 0;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG);
+    CHECK(strcmp(atmos_context_error(ctx), "cli: /image/width: must be in [1, 16384], got 0") == 0);
+    s = d; s.camera.fov_deg = 270;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG);
+    CHECK(strcmp(atmos_context_error(ctx), "cli: /camera/fov_deg: must be in (0, 180) for a pinhole camera, got 270") == 0);
+    s = d; s.camera.type = ATMOS_CAMERA_FISHEYE; s.camera.fov_deg = 270;
+    CHECK_OK(atmos_scene_validate(ctx, &s, "cli"));
+    s = d; s.camera.type = (atmos_camera_type)7;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/camera/type"));
+    s = d; s.camera.position[0] = NAN;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG);
+    CHECK(contains(atmos_context_error(ctx), "cli: /camera/position_m/0: must be a finite number, got nan"));
+    s = d; memcpy(s.camera.look_at, s.camera.position, sizeof s.camera.look_at);
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/camera/look_at_m: must differ"));
+    s = d; s.camera.up[0] = 1e308; s.camera.up[1] = 1e308; s.camera.up[2] = 1e308;
+    CHECK_OK(atmos_scene_validate(ctx, &s, "cli")); /* huge but finite and not parallel: no overflow */
+    s = d; memset(s.name, 'x', sizeof s.name);
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/name: must be at most 127 bytes"));
+    s = d; s.sun.elevation_deg = INFINITY;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/sun/elevation_deg: must be a finite number"));
+    s = d; s.sun.from_time = 1; s.sun.time = (atmos_utc_time){2024, 2, 29, 23, 59, 59.5};
+    CHECK_OK(atmos_scene_validate(ctx, &s, "cli"));
+    s.sun.time.year = 2023;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "cli: /sun/time: not a valid UTC date-time"));
+    s = d; s.sun.from_time = 1; s.sun.time = (atmos_utc_time){2024, 1, 1, 0, 0, 0}; s.sun.longitude_deg = 181;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/sun/longitude_deg: must be in [-180, 180]"));
+    s = d; s.atmosphere.scale_height_m = 0;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/atmosphere/scale_height_m: must be in [100, 100000], got 0"));
+    s = d; s.spectral_samples = 0;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/wavelengths/samples"));
+    s = d; s.wavelengths = (atmos_wavelength_mode)5;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/wavelengths/mode"));
+    s = d; s.tonemap.manual_exposure = 1; s.tonemap.exposure_ev = 39;
+    CHECK_OK(atmos_scene_validate(ctx, &s, "cli"));
+    s.tonemap.manual_exposure = 0;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/output/exposure_compensation_ev: must be in [-20, 20], got 39"));
+    s = d; s.tonemap.curve = (atmos_tone_curve)3;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/output/tone_curve"));
+    s = d; s.png_bits = 12;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/output/png_bits: must be 8 or 16, got 12"));
+    CHECK(atmos_scene_validate(ctx, NULL, "cli") == ATMOS_E_INVALID_ARG);
+}
+
+static void test_load(void)
+{
+    char path[512];
+    atmos_scene s;
+    test_tmp_path(path, sizeof path, "test_scene_full.json");
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs(full_scene, f);
+    fclose(f);
+    CHECK_OK(atmos_scene_load(ctx, path, &s));
+    CHECK(s.width == 1024 && s.camera.fov_deg == 75.5 && strcmp(s.name, "clear noon sky") == 0);
+
+    /* Messages name the file. */
+    f = fopen(path, "wb");
+    fputs("{\n  \"camera\": {\"fov_deg\": 270}\n}\n", f);
+    fclose(f);
+    CHECK(atmos_scene_load(ctx, path, &s) == ATMOS_E_INVALID_ARG);
+    char expect[600];
+    snprintf(expect, sizeof expect, "%s: /camera/fov_deg: must be in (0, 180)", path);
+    CHECK(contains(atmos_context_error(ctx), expect));
+
+    test_tmp_path(path, sizeof path, "does-not-exist/scene.json");
+    CHECK(atmos_scene_load(ctx, path, &s) == ATMOS_E_IO);
+    CHECK(contains(atmos_context_error(ctx), path) && contains(atmos_context_error(ctx), "No such file or directory"));
+    test_tmp_path(path, sizeof path, "");
+    CHECK(atmos_scene_load(ctx, path, &s) == ATMOS_E_IO); /* a directory */
+    CHECK(contains(atmos_context_error(ctx), "Is a directory"));
+    CHECK(atmos_scene_load(ctx, NULL, &s) == ATMOS_E_INVALID_ARG);
+}
+
+static void test_sun_direction(void)
+{
+    atmos_scene s;
+    double dir[3], e = -1, a = -1, ref[3];
+    atmos_scene_defaults(&s);
+    CHECK_OK(atmos_scene_sun_direction(ctx, &s, dir, &e, &a));
+    atmos_direction_from_angles(10, 225, ref);
+    CHECK(vdiff(dir, ref) < 1e-12);
+    CHECK(e == 10 && a == 225);
+    /* South-west and above the horizon: x < 0 (west), z > 0 (south), y > 0. */
+    CHECK(dir[0] < 0 && dir[1] > 0 && dir[2] > 0);
+    CHECK_NEAR(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2], 1, 1e-12);
+    CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 90, \"azimuth_deg\": 0}}", &s));
+    CHECK_OK(atmos_scene_sun_direction(ctx, &s, dir, NULL, NULL));
+    CHECK_NEAR(dir[1], 1, 1e-12);
+    CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 0, \"azimuth_deg\": 90}}", &s));
+    CHECK_OK(atmos_scene_sun_direction(ctx, &s, dir, NULL, NULL));
+    CHECK_NEAR(dir[0], 1, 1e-12); /* due east */
+    s.sun.azimuth_deg = NAN;
+    CHECK(atmos_scene_sun_direction(ctx, &s, dir, NULL, NULL) == ATMOS_E_INVALID_ARG);
+    CHECK(atmos_scene_sun_direction(ctx, NULL, dir, NULL, NULL) == ATMOS_E_INVALID_ARG);
+}
+
+/* Every malformed file kept in tests/crashers/scene must be refused (the replay
+ * test only shows they do not crash). */
+static void test_crashers(void)
+{
+    const char *root = getenv("ATMOS_SOURCE_DIR");
+    if (!root || !*root) {
+        printf("ATMOS_SOURCE_DIR not set: crasher files skipped\n");
+        return;
+    }
+    char dir[512], path[1024];
+    snprintf(dir, sizeof dir, "%s/tests/crashers/scene", root);
+    DIR *d = opendir(dir);
+    CHECK(d != NULL);
+    if (!d) return;
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] == '.') continue;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        atmos_scene s;
+        atmos_status st = atmos_scene_load(ctx, path, &s);
+        CHECK_MSG(st == ATMOS_E_FORMAT || st == ATMOS_E_LIMIT || st == ATMOS_E_INVALID_ARG,
+                  "%s: %s", path, atmos_status_string(st));
+        CHECK_MSG(contains(atmos_context_error(ctx), path), "%s: message \"%s\"", path, atmos_context_error(ctx));
+        n++;
+    }
+    closedir(d);
+    CHECK(n >= 4);
+    printf("%d crasher files refused\n", n);
+}
+
+int main(void)
+{
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    test_defaults();
+    test_full_scene();
+    test_absent_keys();
+    test_bad_scenes();
+    test_limits();
+    test_validate();
+    test_load();
+    test_sun_direction();
+    test_crashers();
+    atmos_context_destroy(ctx);
+    return test_summary("test_scene");
+}
