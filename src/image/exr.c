@@ -61,6 +61,7 @@ static int64_t exr_stream_write(exr_const_context_t ectx, void *user, const void
 }
 
 typedef struct {
+    const char *path; /* final name, for messages */
     const atmos_image *img;
     int half;
     const char *const *names; /* img->channels names, in image order */
@@ -129,7 +130,7 @@ static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *us
     int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) {
         tls_errbuf = saved;
-        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
+        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file %s: %s", job->path, tmp, strerror(errno));
     }
 
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -142,7 +143,7 @@ static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *us
     if (rv == EXR_ERR_SUCCESS)
         rv = exr_initialize_required_attr_simple(ex, part, img->width, img->height, EXR_COMPRESSION_ZIP);
     if (rv != EXR_ERR_SUCCESS) {
-        st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot start file: %s", tmp, exr_message(&eb, rv));
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot start file: %s", job->path, exr_message(&eb, rv));
         goto done;
     }
     /* Names longer than 31 bytes need the "long names" header flag. */
@@ -152,48 +153,54 @@ static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *us
     for (int i = 0; i < img->meta_count; i++)
         if (strlen(img->meta[i].key) > 31) need_long = 1;
     if (need_long && (rv = exr_set_longname_support(ex, 1)) != EXR_ERR_SUCCESS) {
-        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: %s", tmp, exr_message(&eb, rv));
+        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: %s", job->path, exr_message(&eb, rv));
         goto done;
     }
     for (int c = 0; c < img->channels; c++) {
         rv = exr_add_channel(ex, part, job->names[c], job->half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
                              EXR_PERCEPTUALLY_LINEAR, 1, 1);
         if (rv != EXR_ERR_SUCCESS) {
-            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: channel '%s': %s", tmp, job->names[c],
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: channel '%s': %s", job->path, job->names[c],
                               exr_message(&eb, rv));
             goto done;
         }
     }
     for (int i = 0; i < img->meta_count; i++) {
+        const char *key = img->meta[i].key;
+        if (strcmp(key, "type") == 0 || strcmp(key, "name") == 0) {
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: metadata key '%s' is reserved for the EXR part structure",
+                              job->path, key);
+            goto done;
+        }
         eb.msg[0] = '\0';
         rv = exr_attr_set_string(ex, part, img->meta[i].key, img->meta[i].value);
         if (rv != EXR_ERR_SUCCESS) {
             /* Typically the key is one of the standard attributes ("channels", ...). */
             st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: metadata '%s' cannot be stored as a string attribute: %s",
-                              tmp, img->meta[i].key, exr_message(&eb, rv));
+                              job->path, img->meta[i].key, exr_message(&eb, rv));
             goto done;
         }
     }
     rv = exr_write_header(ex);
     if (rv != EXR_ERR_SUCCESS) {
-        st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot write header: %s", tmp, exr_message(&eb, rv));
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot write header: %s", job->path, exr_message(&eb, rv));
         goto done;
     }
-    st = encode_image(ctx, tmp, ex, job, &eb);
+    st = encode_image(ctx, job->path, ex, job, &eb);
 
 done:
     if (ex) {
         /* exr_finish writes the chunk offset table: its failure is a failed write. */
         rv = exr_finish(&ex);
         if (rv != EXR_ERR_SUCCESS && st == ATMOS_OK)
-            st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot finish file: %s", tmp, exr_message(&eb, rv));
+            st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot finish file: %s", job->path, exr_message(&eb, rv));
     }
     /* Data on disk before the rename, so a crash cannot leave an empty file behind
      * the final name. */
     if (st == ATMOS_OK && fsync(fd) != 0)
-        st = atmos__error(ctx, ATMOS_E_IO, "%s: fsync failed: %s", tmp, strerror(errno));
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: fsync failed: %s", job->path, strerror(errno));
     if (close(fd) != 0 && st == ATMOS_OK)
-        st = atmos__error(ctx, ATMOS_E_IO, "%s: close failed: %s", tmp, strerror(errno));
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: close failed: %s", job->path, strerror(errno));
     tls_errbuf = saved;
     return st;
 }
@@ -237,7 +244,7 @@ atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const c
             names[c] = generated[c];
         }
     }
-    exr_write_job job = {img, desc ? desc->half : 0, names};
+    exr_write_job job = {path, img, desc ? desc->half : 0, names};
     atmos_status st = atmos__write_atomic(ctx, path, exr_write_file, &job);
     free(generated);
     free(names);
@@ -357,6 +364,9 @@ static atmos_status read_meta(atmos_context *ctx, const char *path, exr_context_
         const exr_attribute_t *a = NULL;
         if (exr_get_attribute_by_index(ex, 0, EXR_ATTR_LIST_FILE_ORDER, i, &a) != EXR_ERR_SUCCESS || !a) continue;
         if (a->type != EXR_ATTR_STRING || !a->string || !a->name) continue;
+        /* "type" and "name" describe the part's structure (the library writes
+         * "type" itself); they are not image metadata. */
+        if (strcmp(a->name, "type") == 0 || strcmp(a->name, "name") == 0) continue;
         /* EXR strings are counted, not terminated: copy exactly length bytes. */
         int32_t len = a->string->length;
         if (len < 0) continue;
@@ -391,7 +401,9 @@ atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **
      * allocates anything for them. */
     init.max_image_width = ATMOS_IMAGE_MAX_DIM;
     init.max_image_height = ATMOS_IMAGE_MAX_DIM;
-    init.flags = EXR_CONTEXT_FLAG_SILENT_HEADER_PARSE;
+    /* A damaged chunk offset table is an error, not something to guess around: the
+     * library's reconstruction scans the file for plausible chunks instead. */
+    init.flags = EXR_CONTEXT_FLAG_SILENT_HEADER_PARSE | EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
     exr_result_t rv = exr_start_read(&ex, path, &init);
     if (rv != EXR_ERR_SUCCESS) {
         if (rv == EXR_ERR_FILE_ACCESS)

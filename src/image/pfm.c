@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* The header is a few dozen bytes; anything longer than this is not a PFM we accept. */
 #define PFM_MAX_HEADER 256
@@ -37,6 +38,7 @@ static float get32(const unsigned char *b, int little_endian)
 }
 
 typedef struct {
+    const char *path; /* final name, for messages */
     const atmos_image *img;
     int out_channels;
 } pfm_job;
@@ -47,12 +49,12 @@ static atmos_status pfm_write_file(atmos_context *ctx, const char *tmp, void *us
     const atmos_image *img = job->img;
     const int oc = job->out_channels;
     FILE *f = fopen(tmp, "wb");
-    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
+    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file %s: %s", job->path, tmp, strerror(errno));
     size_t row_bytes = (size_t)img->width * (size_t)oc * 4;
     unsigned char *row = malloc(row_bytes);
     if (!row) {
         fclose(f);
-        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", tmp);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", job->path);
     }
     int ok = fprintf(f, "%s\n%d %d\n-1.0\n", oc == 3 ? "PF" : "Pf", img->width, img->height) > 0;
     for (int y = img->height - 1; ok && y >= 0; y--) { /* bottom row first */
@@ -63,9 +65,11 @@ static atmos_status pfm_write_file(atmos_context *ctx, const char *tmp, void *us
         ok = fwrite(row, 1, row_bytes, f) == row_bytes;
     }
     free(row);
-    /* fclose flushes: a full disk shows up here, so check it too. */
+    /* Flush and sync before atmos__write_atomic renames the file into place; a full
+     * disk shows up here, so check every step. */
+    if (ok && (fflush(f) != 0 || fsync(fileno(f)) != 0)) ok = 0;
     if (fclose(f) != 0) ok = 0;
-    if (!ok) return atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", tmp, strerror(errno));
+    if (!ok) return atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", job->path, strerror(errno));
     return ATMOS_OK;
 }
 
@@ -73,7 +77,7 @@ atmos_status atmos_write_pfm(atmos_context *ctx, const atmos_image *img, const c
 {
     if (!img || !img->pixels || !path)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_write_pfm: missing image or path");
-    pfm_job job = {img, 0};
+    pfm_job job = {path, img, 0};
     if (img->channels == 1) job.out_channels = 1;
     else if (img->channels >= 3) job.out_channels = 3;
     else

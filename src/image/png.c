@@ -16,6 +16,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* zlib's deflate cannot compress better than about 1032:1, so a PNG needs at least
  * (raw size / 1032) bytes; with some margin this bounds what a tiny file can make
@@ -52,6 +53,7 @@ static unsigned quantize(float v, unsigned maxv)
 /* ---------------------------------------------------------------- writing ---- */
 
 typedef struct {
+    const char *path; /* final name, for messages */
     const atmos_image *img;
     int bits;
 } png_write_job;
@@ -67,7 +69,7 @@ static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *us
 
     /* All resources acquired before setjmp and not reassigned after it. */
     FILE *f = fopen(tmp, "wb");
-    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
+    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file %s: %s", job->path, tmp, strerror(errno));
     unsigned char *row = malloc(row_bytes);
     png_text *texts = img->meta_count > 0 ? calloc((size_t)img->meta_count, sizeof *texts) : NULL;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, png_error_cb, png_warning_cb);
@@ -77,7 +79,7 @@ static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *us
         free(texts);
         free(row);
         fclose(f);
-        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", tmp);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", job->path);
     }
 
     if (setjmp(png_jmpbuf(png))) {
@@ -85,7 +87,7 @@ static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *us
         free(texts);
         free(row);
         fclose(f);
-        return atmos__error(ctx, ATMOS_E_IO, "%s: PNG write failed: %s", tmp, err.msg);
+        return atmos__error(ctx, ATMOS_E_IO, "%s: PNG write failed: %s", job->path, err.msg);
     }
 
     png_init_io(png, f);
@@ -126,11 +128,12 @@ static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *us
     png_destroy_write_struct(&png, &info);
     free(texts);
     free(row);
-    if (fflush(f) != 0 || ferror(f)) {
+    /* On disk before atmos__write_atomic renames it into place. */
+    if (fflush(f) != 0 || ferror(f) || fsync(fileno(f)) != 0) {
         fclose(f);
-        return atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", tmp, strerror(errno));
+        return atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", job->path, strerror(errno));
     }
-    if (fclose(f) != 0) return atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", tmp, strerror(errno));
+    if (fclose(f) != 0) return atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", job->path, strerror(errno));
     return ATMOS_OK;
 }
 
@@ -152,7 +155,7 @@ atmos_status atmos_write_png(atmos_context *ctx, const atmos_image *display, con
                                 "%s: metadata key '%s': PNG text keys need 1 to 79 bytes and no leading or trailing space",
                                 path, k);
     }
-    png_write_job job = {display, bits};
+    png_write_job job = {path, display, bits};
     return atmos__write_atomic(ctx, path, png_write_file, &job);
 }
 

@@ -287,7 +287,15 @@ static void test_exr_meta(void)
     CHECK(back && (v = atmos_image_get_meta(back, "atmos:renderer")) && strcmp(v, "slice") == 0);
     CHECK(back && (v = atmos_image_get_meta(back, long_key)) && strcmp(v, "long value \xc3\xa9 UTF-8") == 0);
     CHECK(back && (v = atmos_image_get_meta(back, "empty")) && strcmp(v, "") == 0);
+    /* Exactly what was written: no structural attributes ("type") leak in. */
+    CHECK_MSG(back && back->meta_count == 4, "%d metadata entries read back", back ? back->meta_count : -1);
     atmos_image_destroy(back);
+
+    /* "type" and "name" belong to the part structure. */
+    atmos_image *r = make_image(1, 1, 1);
+    CHECK_OK(atmos_image_set_meta(r, "type", "deeptile"));
+    CHECK(atmos_write_exr(ctx, r, path, NULL) == ATMOS_E_INVALID_ARG);
+    atmos_image_destroy(r);
 
     /* A key that is a standard attribute of another type: refused, and the file
      * written before stays intact under the final name. */
@@ -295,6 +303,8 @@ static void test_exr_meta(void)
     CHECK_OK(atmos_image_set_meta(img, "channels", "R,G,B"));
     CHECK(atmos_write_exr(ctx, img, path, NULL) == ATMOS_E_INVALID_ARG);
     CHECK(strstr(atmos_context_error(ctx), "channels") != NULL);
+    /* Messages name the file the caller asked for, not the temporary. */
+    CHECK(strstr(atmos_context_error(ctx), path) != NULL && strstr(atmos_context_error(ctx), ".tmp") == NULL);
     CHECK(file_size(path) == before);
     CHECK_OK(atmos_read_exr(ctx, path, &back));
     atmos_image_destroy(back);
