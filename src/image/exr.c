@@ -1,0 +1,470 @@
+/* OpenEXR reader and writer on OpenEXR's C core API (libOpenEXRCore): no C++.
+ *
+ * Files are single-part scanline images, ZIP compressed (16 lines per chunk),
+ * half or float channels. OpenEXR stores channels sorted by name, so an RGBA image
+ * is stored as A,B,G,R; every channel is mapped by name, never by position. */
+#define _POSIX_C_SOURCE 200809L
+#include "core/internal.h"
+
+#include <openexr.h>
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* The core library reports errors through a callback that may run while it holds
+ * its own context lock, so the callback must not call back into the library (not
+ * even exr_get_user_data). It writes into a per-thread buffer set up around each
+ * public call instead. */
+typedef struct {
+    char msg[512];
+} exr_errbuf;
+static _Thread_local exr_errbuf *tls_errbuf;
+
+static void exr_error_handler(exr_const_context_t ectx, exr_result_t code, const char *msg)
+{
+    (void)ectx;
+    /* Keep the first message: later ones are the generic "unable to ..." wrappers. */
+    if (tls_errbuf && !tls_errbuf->msg[0])
+        snprintf(tls_errbuf->msg, sizeof tls_errbuf->msg, "%s", msg ? msg : exr_get_default_error_message(code));
+}
+
+static const char *exr_message(const exr_errbuf *eb, exr_result_t rv)
+{
+    return eb->msg[0] ? eb->msg : exr_get_default_error_message(rv);
+}
+
+/* ---------------------------------------------------------------- writing ---- */
+
+/* Our own output stream (pwrite on a descriptor we own) so that the data can be
+ * fsync'ed before atmos__write_atomic renames the file into place. */
+static int64_t exr_stream_write(exr_const_context_t ectx, void *user, const void *buf, uint64_t sz, uint64_t offset,
+                                exr_stream_error_func_ptr_t error_cb)
+{
+    int fd = *(const int *)user;
+    const unsigned char *p = buf;
+    uint64_t done = 0;
+    while (done < sz) {
+        ssize_t n = pwrite(fd, p + done, (size_t)(sz - done), (off_t)(offset + done));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            if (error_cb) error_cb(ectx, EXR_ERR_WRITE_IO, "write failed: %s", strerror(errno));
+            return -1;
+        }
+        done += (uint64_t)n;
+    }
+    return (int64_t)done;
+}
+
+typedef struct {
+    const char *path; /* final name, for messages */
+    const atmos_image *img;
+    int half;
+    const char *const *names; /* img->channels names, in image order */
+} exr_write_job;
+
+static atmos_status encode_image(atmos_context *ctx, const char *path, exr_context_t ex, const exr_write_job *job,
+                                 exr_errbuf *eb)
+{
+    const atmos_image *img = job->img;
+    const int nc = img->channels;
+    int32_t lines = 1;
+    exr_result_t rv = exr_get_scanlines_per_chunk(ex, 0, &lines);
+    if (rv != EXR_ERR_SUCCESS || lines < 1)
+        return atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: %s", path, exr_message(eb, rv));
+
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    int initialized = 0;
+    atmos_status st = ATMOS_OK;
+    for (int y = 0; y < img->height && st == ATMOS_OK; y += lines) {
+        exr_chunk_info_t cinfo;
+        rv = exr_write_scanline_chunk_info(ex, 0, y, &cinfo);
+        if (rv == EXR_ERR_SUCCESS)
+            rv = initialized ? exr_encoding_update(ex, 0, &cinfo, &enc) : exr_encoding_initialize(ex, 0, &cinfo, &enc);
+        if (rv != EXR_ERR_SUCCESS) {
+            st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: chunk at line %d: %s", path, y, exr_message(eb, rv));
+            break;
+        }
+        initialized = 1;
+        /* Point each (name-sorted) file channel at its interleaved image channel. */
+        for (int c = 0; c < enc.channel_count; c++) {
+            exr_coding_channel_info_t *ch = &enc.channels[c];
+            int src = -1;
+            for (int k = 0; k < nc; k++)
+                if (strcmp(ch->channel_name, job->names[k]) == 0) src = k;
+            if (src < 0) {
+                st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: unexpected channel '%s'", path, ch->channel_name);
+                break;
+            }
+            ch->user_data_type = EXR_PIXEL_FLOAT;
+            ch->user_bytes_per_element = 4;
+            ch->user_pixel_stride = (int32_t)(nc * 4);
+            ch->user_line_stride = (int32_t)((size_t)img->width * (size_t)nc * 4);
+            ch->encode_from_ptr =
+                (const uint8_t *)(img->pixels + ((size_t)cinfo.start_y * (size_t)img->width) * (size_t)nc + (size_t)src);
+        }
+        if (st != ATMOS_OK) break;
+        rv = exr_encoding_choose_default_routines(ex, 0, &enc);
+        if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ex, 0, &enc);
+        if (rv != EXR_ERR_SUCCESS)
+            st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: encoding line %d: %s", path, y, exr_message(eb, rv));
+    }
+    if (initialized) exr_encoding_destroy(ex, &enc);
+    return st;
+}
+
+static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *user)
+{
+    const exr_write_job *job = user;
+    const atmos_image *img = job->img;
+    exr_errbuf eb = {{0}};
+    exr_errbuf *saved = tls_errbuf;
+    tls_errbuf = &eb;
+
+    atmos_status st = ATMOS_OK;
+    exr_context_t ex = NULL;
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        tls_errbuf = saved;
+        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file %s: %s", job->path, tmp, strerror(errno));
+    }
+
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_error_handler;
+    init.user_data = &fd;
+    init.write_fn = exr_stream_write;
+    exr_result_t rv = exr_start_write(&ex, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
+    int part = 0;
+    if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ex, NULL, EXR_STORAGE_SCANLINE, &part);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_initialize_required_attr_simple(ex, part, img->width, img->height, EXR_COMPRESSION_ZIP);
+    if (rv != EXR_ERR_SUCCESS) {
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot start file: %s", job->path, exr_message(&eb, rv));
+        goto done;
+    }
+    /* Names longer than 31 bytes need the "long names" header flag. */
+    int need_long = 0;
+    for (int c = 0; c < img->channels; c++)
+        if (strlen(job->names[c]) > 31) need_long = 1;
+    for (int i = 0; i < img->meta_count; i++)
+        if (strlen(img->meta[i].key) > 31) need_long = 1;
+    if (need_long && (rv = exr_set_longname_support(ex, 1)) != EXR_ERR_SUCCESS) {
+        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: %s", job->path, exr_message(&eb, rv));
+        goto done;
+    }
+    for (int c = 0; c < img->channels; c++) {
+        rv = exr_add_channel(ex, part, job->names[c], job->half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
+                             EXR_PERCEPTUALLY_LINEAR, 1, 1);
+        if (rv != EXR_ERR_SUCCESS) {
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: channel '%s': %s", job->path, job->names[c],
+                              exr_message(&eb, rv));
+            goto done;
+        }
+    }
+    for (int i = 0; i < img->meta_count; i++) {
+        const char *key = img->meta[i].key;
+        if (strcmp(key, "type") == 0 || strcmp(key, "name") == 0) {
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: metadata key '%s' is reserved for the EXR part structure",
+                              job->path, key);
+            goto done;
+        }
+        eb.msg[0] = '\0';
+        rv = exr_attr_set_string(ex, part, img->meta[i].key, img->meta[i].value);
+        if (rv != EXR_ERR_SUCCESS) {
+            /* Typically the key is one of the standard attributes ("channels", ...). */
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: metadata '%s' cannot be stored as a string attribute: %s",
+                              job->path, img->meta[i].key, exr_message(&eb, rv));
+            goto done;
+        }
+    }
+    rv = exr_write_header(ex);
+    if (rv != EXR_ERR_SUCCESS) {
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot write header: %s", job->path, exr_message(&eb, rv));
+        goto done;
+    }
+    st = encode_image(ctx, job->path, ex, job, &eb);
+
+done:
+    if (ex) {
+        /* exr_finish writes the chunk offset table: its failure is a failed write. */
+        rv = exr_finish(&ex);
+        if (rv != EXR_ERR_SUCCESS && st == ATMOS_OK)
+            st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot finish file: %s", job->path, exr_message(&eb, rv));
+    }
+    /* Data on disk before the rename, so a crash cannot leave an empty file behind
+     * the final name. */
+    if (st == ATMOS_OK && fsync(fd) != 0)
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: fsync failed: %s", job->path, strerror(errno));
+    if (close(fd) != 0 && st == ATMOS_OK)
+        st = atmos__error(ctx, ATMOS_E_IO, "%s: close failed: %s", job->path, strerror(errno));
+    tls_errbuf = saved;
+    return st;
+}
+
+atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const char *path, const atmos_exr_desc *desc)
+{
+    if (!img || !img->pixels || !path)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_write_exr: missing image or path");
+    if (img->channels < 1 || img->channels > ATMOS_IMAGE_MAX_CHANNELS || img->width < 1 || img->height < 1)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: invalid image size", path);
+
+    static const char *const rgba[4] = {"R", "G", "B", "A"};
+    char(*generated)[16] = NULL;
+    const char **names = malloc((size_t)img->channels * sizeof *names);
+    if (!names) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
+    if (img->channels == 3 || img->channels == 4) {
+        for (int c = 0; c < img->channels; c++) names[c] = rgba[c];
+    } else if (desc && desc->channel_names) {
+        for (int c = 0; c < img->channels; c++) {
+            const char *n = desc->channel_names[c];
+            if (!n || !*n || strlen(n) > 255) {
+                free(names);
+                return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: channel %d: name must have 1 to 255 bytes", path, c);
+            }
+            for (int k = 0; k < c; k++) {
+                if (strcmp(names[k], n) == 0) {
+                    free(names);
+                    return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: channel name '%s' is used twice", path, n);
+                }
+            }
+            names[c] = n;
+        }
+    } else {
+        generated = malloc((size_t)img->channels * sizeof *generated);
+        if (!generated) {
+            free(names);
+            return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
+        }
+        for (int c = 0; c < img->channels; c++) {
+            snprintf(generated[c], sizeof generated[c], "C%d", c);
+            names[c] = generated[c];
+        }
+    }
+    exr_write_job job = {path, img, desc ? desc->half : 0, names};
+    atmos_status st = atmos__write_atomic(ctx, path, exr_write_file, &job);
+    free(generated);
+    free(names);
+    return st;
+}
+
+/* ---------------------------------------------------------------- reading ---- */
+
+static atmos_status read_status(exr_result_t rv)
+{
+    switch (rv) {
+    case EXR_ERR_FILE_ACCESS: return ATMOS_E_IO;
+    case EXR_ERR_OUT_OF_MEMORY: return ATMOS_E_NOMEM;
+    default: return ATMOS_E_FORMAT;
+    }
+}
+
+/* Parses "C<n>" with n < count; -1 otherwise. */
+static int generated_index(const char *name, int count)
+{
+    if (name[0] != 'C' || !name[1]) return -1;
+    long v = 0;
+    for (const char *p = name + 1; *p; p++) {
+        if (*p < '0' || *p > '9' || v > ATMOS_IMAGE_MAX_CHANNELS) return -1;
+        v = v * 10 + (*p - '0');
+    }
+    if (name[1] == '0' && name[2]) return -1; /* "C01" is not something we write */
+    return v < count ? (int)v : -1;
+}
+
+/* Chooses the image channel of each file channel (file order is sorted by name):
+ * R,G,B[,A] in that order when the file has exactly those, C0..Cn by number when
+ * it has exactly those, otherwise the file's (alphabetical) order. */
+static void map_channels(const exr_attr_chlist_t *cl, int *dst)
+{
+    const int n = cl->num_channels;
+    static const char *const rgba[4] = {"R", "G", "B", "A"};
+    if (n == 3 || n == 4) {
+        int ok = 1;
+        for (int i = 0; i < n && ok; i++) {
+            int found = -1;
+            for (int k = 0; k < n; k++)
+                if (strcmp(cl->entries[i].name.str, rgba[k]) == 0) found = k;
+            ok = found >= 0;
+            dst[i] = found;
+        }
+        if (ok) return;
+    }
+    int ok = 1;
+    char seen[ATMOS_IMAGE_MAX_CHANNELS] = {0};
+    for (int i = 0; i < n && ok; i++) {
+        int k = generated_index(cl->entries[i].name.str, n);
+        ok = k >= 0 && !seen[k];
+        if (ok) seen[k] = 1;
+        dst[i] = k;
+    }
+    if (ok) return;
+    for (int i = 0; i < n; i++) dst[i] = i;
+}
+
+static atmos_status decode_image(atmos_context *ctx, const char *path, exr_context_t ex, const exr_attr_box2i_t *dw,
+                                 const int *map, atmos_image *img, exr_errbuf *eb)
+{
+    const int nc = img->channels;
+    int32_t lines = 1;
+    exr_result_t rv = exr_get_scanlines_per_chunk(ex, 0, &lines);
+    if (rv != EXR_ERR_SUCCESS || lines < 1)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: OpenEXR: %s", path, exr_message(eb, rv));
+
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    int initialized = 0;
+    atmos_status st = ATMOS_OK;
+    for (int64_t y = dw->min.y; y <= dw->max.y && st == ATMOS_OK; y += lines) {
+        exr_chunk_info_t cinfo;
+        rv = exr_read_scanline_chunk_info(ex, 0, (int)y, &cinfo);
+        if (rv == EXR_ERR_SUCCESS)
+            rv = initialized ? exr_decoding_update(ex, 0, &cinfo, &dec) : exr_decoding_initialize(ex, 0, &cinfo, &dec);
+        if (rv != EXR_ERR_SUCCESS) {
+            st = atmos__error(ctx, read_status(rv), "%s: OpenEXR: chunk at line %lld: %s", path, (long long)y,
+                              exr_message(eb, rv));
+            break;
+        }
+        initialized = 1;
+        /* Trust nothing from the file: the chunk must lie inside the image. */
+        int64_t row0 = (int64_t)cinfo.start_y - dw->min.y;
+        if (row0 < 0 || cinfo.height < 1 || row0 + cinfo.height > img->height || cinfo.width != img->width ||
+            dec.channel_count != nc) {
+            st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: OpenEXR: chunk at line %lld lies outside the data window",
+                              path, (long long)y);
+            break;
+        }
+        for (int c = 0; c < dec.channel_count; c++) {
+            exr_coding_channel_info_t *ch = &dec.channels[c];
+            ch->user_data_type = EXR_PIXEL_FLOAT;
+            ch->user_bytes_per_element = 4;
+            ch->user_pixel_stride = (int32_t)(nc * 4);
+            ch->user_line_stride = (int32_t)((size_t)img->width * (size_t)nc * 4);
+            ch->decode_to_ptr =
+                (uint8_t *)(img->pixels + (size_t)row0 * (size_t)img->width * (size_t)nc + (size_t)map[c]);
+        }
+        rv = exr_decoding_choose_default_routines(ex, 0, &dec);
+        if (rv == EXR_ERR_SUCCESS) rv = exr_decoding_run(ex, 0, &dec);
+        if (rv != EXR_ERR_SUCCESS)
+            st = atmos__error(ctx, read_status(rv), "%s: OpenEXR: cannot decode lines from %lld: %s", path,
+                              (long long)y, exr_message(eb, rv));
+    }
+    if (initialized) exr_decoding_destroy(ex, &dec);
+    return st;
+}
+
+/* Copies every string attribute of the header into img->meta. */
+static atmos_status read_meta(atmos_context *ctx, const char *path, exr_context_t ex, atmos_image *img)
+{
+    int32_t count = 0;
+    if (exr_get_attribute_count(ex, 0, &count) != EXR_ERR_SUCCESS) return ATMOS_OK;
+    for (int32_t i = 0; i < count; i++) {
+        const exr_attribute_t *a = NULL;
+        if (exr_get_attribute_by_index(ex, 0, EXR_ATTR_LIST_FILE_ORDER, i, &a) != EXR_ERR_SUCCESS || !a) continue;
+        if (a->type != EXR_ATTR_STRING || !a->string || !a->name) continue;
+        /* "type" and "name" describe the part's structure (the library writes
+         * "type" itself); they are not image metadata. */
+        if (strcmp(a->name, "type") == 0 || strcmp(a->name, "name") == 0) continue;
+        /* EXR strings are counted, not terminated: copy exactly length bytes. */
+        int32_t len = a->string->length;
+        if (len < 0) continue;
+        char *v = malloc((size_t)len + 1);
+        if (!v) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
+        if (len) memcpy(v, a->string->str, (size_t)len);
+        v[len] = '\0';
+        atmos_status st = atmos_image_set_meta(img, a->name, v);
+        free(v);
+        if (st == ATMOS_E_NOMEM) return atmos__error(ctx, st, "%s: out of memory", path);
+    }
+    return ATMOS_OK;
+}
+
+atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **out)
+{
+    if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_read_exr: out is NULL");
+    *out = NULL;
+    if (!path || !*path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_read_exr: path is empty");
+
+    exr_errbuf eb = {{0}};
+    exr_errbuf *saved = tls_errbuf;
+    tls_errbuf = &eb;
+    atmos_status st = ATMOS_OK;
+    atmos_image *img = NULL;
+    exr_context_t ex = NULL;
+    int *map = NULL;
+
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = exr_error_handler;
+    /* The library rejects larger data windows while parsing the header, before it
+     * allocates anything for them. */
+    init.max_image_width = ATMOS_IMAGE_MAX_DIM;
+    init.max_image_height = ATMOS_IMAGE_MAX_DIM;
+    /* A damaged chunk offset table is an error, not something to guess around: the
+     * library's reconstruction scans the file for plausible chunks instead. */
+    init.flags = EXR_CONTEXT_FLAG_SILENT_HEADER_PARSE | EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    exr_result_t rv = exr_start_read(&ex, path, &init);
+    if (rv != EXR_ERR_SUCCESS) {
+        if (rv == EXR_ERR_FILE_ACCESS)
+            st = atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, exr_message(&eb, rv));
+        else
+            st = atmos__error(ctx, read_status(rv), "%s: not a readable OpenEXR file: %s", path, exr_message(&eb, rv));
+        ex = NULL; /* exr_start_read cleans up after itself on failure */
+        goto done;
+    }
+
+    int parts = 0;
+    exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
+    const exr_attr_chlist_t *cl = NULL;
+    exr_attr_box2i_t dw;
+    if (exr_get_count(ex, &parts) != EXR_ERR_SUCCESS || parts < 1 ||
+        exr_get_storage(ex, 0, &storage) != EXR_ERR_SUCCESS || exr_get_channels(ex, 0, &cl) != EXR_ERR_SUCCESS ||
+        !cl || exr_get_data_window(ex, 0, &dw) != EXR_ERR_SUCCESS) {
+        st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: OpenEXR header lacks parts, channels or data window", path);
+        goto done;
+    }
+    if (storage != EXR_STORAGE_SCANLINE) {
+        st = atmos__error(ctx, ATMOS_E_UNSUPPORTED, "%s: only scanline OpenEXR images are supported (this one is %s)",
+                          path, storage == EXR_STORAGE_TILED ? "tiled" : "deep");
+        goto done;
+    }
+    int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
+    if (w < 1 || h < 1 || cl->num_channels < 1) {
+        st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: OpenEXR image is empty (%lld x %lld, %d channels)", path,
+                          (long long)w, (long long)h, cl->num_channels);
+        goto done;
+    }
+    if (w > ATMOS_IMAGE_MAX_DIM || h > ATMOS_IMAGE_MAX_DIM || cl->num_channels > ATMOS_IMAGE_MAX_CHANNELS) {
+        st = atmos__error(ctx, ATMOS_E_LIMIT, "%s: OpenEXR image %lld x %lld with %d channels exceeds the limits (%d per side, %d channels)",
+                          path, (long long)w, (long long)h, cl->num_channels, ATMOS_IMAGE_MAX_DIM, ATMOS_IMAGE_MAX_CHANNELS);
+        goto done;
+    }
+    for (int c = 0; c < cl->num_channels; c++) {
+        if (cl->entries[c].x_sampling != 1 || cl->entries[c].y_sampling != 1) {
+            st = atmos__error(ctx, ATMOS_E_UNSUPPORTED, "%s: channel '%s' is subsampled; not supported", path,
+                              cl->entries[c].name.str);
+            goto done;
+        }
+    }
+    map = malloc((size_t)cl->num_channels * sizeof *map);
+    if (!map) {
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
+        goto done;
+    }
+    map_channels(cl, map);
+    st = atmos_image_create(ctx, (int)w, (int)h, cl->num_channels, &img);
+    if (st == ATMOS_OK) st = read_meta(ctx, path, ex, img);
+    if (st == ATMOS_OK) st = decode_image(ctx, path, ex, &dw, map, img, &eb);
+
+done:
+    if (ex) exr_finish(&ex);
+    free(map);
+    tls_errbuf = saved;
+    if (st != ATMOS_OK) {
+        atmos_image_destroy(img);
+        return st;
+    }
+    *out = img;
+    return ATMOS_OK;
+}
