@@ -36,6 +36,12 @@ typedef struct atmos_camera {
     double tan_half_fov;                /* pinhole */
 } atmos_camera;
 
+/* Fills *out with a camera of the given type at position with that type's defaults
+ * resolved explicitly: pinhole looks north, level, up = +y, 60° vertical FOV; fisheye
+ * looks at the zenith with north at the top, 180°; equirect (ignores the rest) as pinhole
+ * with fov 180. */
+ATMOS_API void atmos_camera_defaults(atmos_camera_type type, const double position[3], atmos_camera_desc *out);
+
 /* Validates desc and builds the camera for an image of width x height pixels.
  * Errors (ATMOS_E_INVALID_ARG) name the offending field. */
 ATMOS_API atmos_status atmos_camera_init(atmos_context *ctx, const atmos_camera_desc *desc,

@@ -25,6 +25,22 @@ void atmos_direction_to_angles(const double dir[3], double *elevation_deg, doubl
     if (azimuth_deg) *azimuth_deg = a;
 }
 
+void atmos_camera_defaults(atmos_camera_type type, const double position[3], atmos_camera_desc *out)
+{
+    memset(out, 0, sizeof *out);
+    out->type = type;
+    for (int i = 0; i < 3; i++) out->position[i] = out->look_at[i] = position[i];
+    if (type == ATMOS_CAMERA_FISHEYE) {
+        out->look_at[1] += 1.0; /* zenith */
+        out->up[2] = -1.0;      /* north at the top */
+        out->fov_deg = 180.0;
+    } else {
+        out->look_at[2] -= 1.0; /* north, level */
+        out->up[1] = 1.0;
+        out->fov_deg = type == ATMOS_CAMERA_PINHOLE ? 60.0 : 180.0;
+    }
+}
+
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static void cross3(const double a[3], const double b[3], double o[3])
 {

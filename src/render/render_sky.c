@@ -155,14 +155,13 @@ static void shade_row(const sky_job *job, const atmos__sky_batch *batch, const f
         double sx, sy;
         sample_offset(s, spp, &sx, &sy);
         row_rays(job, y, sx, sy, col_sc ? col_sc + (size_t)2 * W * s : NULL, rb->dx, rb->dy, rb->dz, rb->w);
-        atmos__sky_batch_eval(batch, W, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, n, rb->scratch);
+        atmos__sky_batch_eval(batch, W, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
         for (int x = 0; x < W; x++) rb->hits[x] += rb->w[x];
     }
     const float inv = 1.0f / spp;
     for (int x = 0; x < W; x++) {
         float *px = dst + (size_t)x * C;
-        const float *a = rb->acc + (size_t)x * n;
-        for (int i = 0; i < n; i++) px[i] = a[i] * inv;
+        for (int i = 0; i < n; i++) px[i] = rb->acc[(size_t)i * W + x] * inv;
         px[n] = rb->hits[x] * inv;
     }
     if (!job->sun_visible) return;

@@ -56,8 +56,12 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye
     }
 }
 
+/* Built for AVX2 as well as the baseline; the loader picks the best at run time. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx, const float *dy, const float *dz,
-                           const float *weight, float *out, int stride, float *scratch)
+                           const float *weight, float *out, float *scratch)
 {
     if (!b->sun_up) return; /* flat earth: no sunlight reaches the air or the ground */
     float *PE = scratch;               /* P(theta) * weight */
@@ -91,7 +95,7 @@ void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx
     (void)ly;
     for (int k = 0; k < b->n; k++) {
         const float be = b->beta_eye[k], ts0 = b->ts0[k], a = b->e_ts0[k], E = b->sun_e[k], gr = b->ground[k];
-        float *o = out + k;
+        float *o = out + (size_t)k * count;
 #pragma omp simd
         for (int i = 0; i < count; i++) {
             float x = be * G[i];
@@ -101,7 +105,7 @@ void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx
             float series = a * (1.0f - D * (0.5f - D * (1.0f / 6.0f - D * (1.0f / 24.0f))));
             float F = fabsf(D) < 1e-2f ? series : (a - bexp) / D;
             float L = PE[i] * E * x * F + gm[i] * gr * expf_fast(-x);
-            o[(size_t)i * stride] += L;
+            o[i] += L;
         }
     }
 }

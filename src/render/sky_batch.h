@@ -24,10 +24,11 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye
 /* Per-ray scratch the evaluator needs: 6 floats per ray. */
 #define ATMOS__SKY_BATCH_SCRATCH 6
 
-/* Radiance (no sun disk) for count rays with unit directions (dx, dy, dz);
- * out[i*stride + k] += weight[i] * L_k. scratch: count*ATMOS__SKY_BATCH_SCRATCH floats. */
+/* Radiance (no sun disk) for count rays with unit directions (dx, dy, dz), added
+ * wavelength-major: out[k*count + i] += weight[i] * L_k(ray i).
+ * scratch: count*ATMOS__SKY_BATCH_SCRATCH floats. */
 void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx, const float *dy, const float *dz,
-                           const float *weight, float *out, int stride, float *scratch);
+                           const float *weight, float *out, float *scratch);
 
 /* exp(x) for float, vectorisable, relative error < 2e-7 over [-87, 88]; 0 below. */
 float atmos__expf_fast(float x);

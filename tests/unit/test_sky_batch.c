@@ -30,12 +30,12 @@ static void compare(const atmos_wavelengths *wl, double albedo, double eye_y, do
             dx[i] = (float)d[0], dy[i] = (float)d[1], dz[i] = (float)d[2], w[i] = 1;
         }
         memset(out, 0, sizeof out);
-        atmos__sky_batch_eval(&b, N, dx, dy, dz, w, out, wl->count, scratch);
+        atmos__sky_batch_eval(&b, N, dx, dy, dz, w, out, scratch);
         for (int i = 0; i < N; i++) {
             double d[3] = {dx[i], dy[i], dz[i]};
             atmos_sky_radiance(sky, eye, d, sun, L, NULL);
             for (int k = 0; k < wl->count; k++) {
-                double ref = L[k], got = out[i * wl->count + k];
+                double ref = L[k], got = out[k * N + i];
                 /* float evaluation of the same formula: 1e-4 relative, with a floor at
                  * 1e-6 of a typical daylight sky radiance (~0.1 W m^-2 sr^-1 nm^-1) */
                 double err = fabs(got - ref) / fmax(fabs(ref), 1e-7);

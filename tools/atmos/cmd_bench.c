@@ -37,9 +37,7 @@ static int bench_sky(int size, int repeat, int threads)
             scene.width = size;
             scene.height = size;
             double pos[3] = {0, 2, 0};
-            memset(&scene.camera, 0, sizeof scene.camera);
-            scene.camera.type = cams[c].type;
-            memcpy(scene.camera.position, pos, sizeof pos);
+            atmos_camera_defaults(cams[c].type, pos, &scene.camera);
             if (cams[c].type == ATMOS_CAMERA_PINHOLE) {
                 /* looking towards the horizon so the ground and the sun are both in view */
                 atmos_direction_from_angles(5, 225, scene.camera.look_at);

@@ -109,8 +109,8 @@ int cli_cmd_render(int argc, char **argv)
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
     const char *time_s = NULL;
-    double lat = NAN, lon = NAN, v;
-    int threads = 0, quiet = 0, c, iv;
+    double lat = NAN, lon = NAN;
+    int threads = 0, quiet = 0, c;
     /* Overrides are collected first and applied after the scene is loaded. */
     int w = 0, h = 0, spp = 0, png_bits = 0, exr_half = 0, spectral = 0, rgb = 0, cam_type = -1;
     double alt = NAN, sel = NAN, saz = NAN, ev = NAN, evcomp = NAN;
@@ -192,15 +192,12 @@ int cli_cmd_render(int argc, char **argv)
     if (cam_type >= 0 && cam_type != (int)scene.camera.type) {
         /* A new camera type starts from that type's defaults, keeping the position. */
         double pos[3] = {scene.camera.position[0], scene.camera.position[1], scene.camera.position[2]};
-        memset(&scene.camera, 0, sizeof scene.camera);
-        scene.camera.type = (atmos_camera_type)cam_type;
-        memcpy(scene.camera.position, pos, sizeof pos);
+        atmos_camera_defaults((atmos_camera_type)cam_type, pos, &scene.camera);
     }
     if (!isnan(alt)) {
         double dy = alt - scene.camera.position[1];
         scene.camera.position[1] = alt;
-        int has_look = scene.camera.look_at[0] != 0 || scene.camera.look_at[1] != 0 || scene.camera.look_at[2] != 0;
-        if (has_look) scene.camera.look_at[1] += dy; /* keep the view direction */
+        scene.camera.look_at[1] += dy; /* keep the view direction */
     }
     if (!isnan(sel) || !isnan(saz)) {
         scene.sun.from_time = 0;
