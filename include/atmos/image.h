@@ -33,7 +33,8 @@ typedef struct atmos_image {
 ATMOS_API atmos_status atmos_image_create(atmos_context *ctx, int width, int height, int channels,
                                           atmos_image **out);
 ATMOS_API void atmos_image_destroy(atmos_image *img);
-/* Sets (or replaces) a metadata entry. */
+/* Sets (or replaces) a metadata entry; key and value are copied. ATMOS_E_INVALID_ARG
+ * for an empty key or a NULL value. */
 ATMOS_API atmos_status atmos_image_set_meta(atmos_image *img, const char *key, const char *value);
 ATMOS_API const char *atmos_image_get_meta(const atmos_image *img, const char *key);
 
@@ -54,41 +55,58 @@ typedef struct atmos_tonemap_desc {
  * values are linear sRGB scaled so that Y is luminance in cd m^-2 (what the
  * renderers produce):
  *   manual:    1 / (1.2 * 2^EV)  (saturation-based EV100: 1.2*2^EV cd/m^2 maps to 1)
- *   automatic: 0.18 / Lavg * 2^EV, Lavg the log-average luminance of the image's
- *              pixels with alpha > 0 (all pixels if there is no alpha channel).
- * img must have 3 or 4 channels. */
+ *   automatic: 0.18 / Lavg * 2^EV, Lavg = exp(mean(log(1e-4 + Y))) over the image's
+ *              pixels with alpha > 0 (all pixels if there is no alpha channel);
+ *              NaN and negative values count as 0, pixels with infinite Y are
+ *              skipped; with no pixel left the scale is 2^EV.
+ * img must have 3 or 4 channels (otherwise the automatic scale is 2^EV). */
 ATMOS_API double atmos_tonemap_scale(const atmos_image *img, const atmos_tonemap_desc *desc);
 
-/* Linear sRGB (3 or 4 channels; alpha copied) -> display sRGB in [0,1] (tone curve
- * then the sRGB transfer function). *out gets a new image of the same size. */
+/* Linear sRGB (3 or 4 channels; alpha copied, clamped to [0,1]) -> display sRGB in
+ * [0,1]: scale, tone curve per channel, then the sRGB transfer function. NaN and
+ * negative inputs give 0, +Inf gives 1: the output is always finite. *out gets a
+ * new image of the same size carrying a copy of the metadata; the caller destroys
+ * it. Rows are processed on atmos_context_threads(ctx) threads. */
 ATMOS_API atmos_status atmos_tonemap(atmos_context *ctx, const atmos_image *linear,
                                      const atmos_tonemap_desc *desc, atmos_image **out);
 
-/* The sRGB transfer function (IEC 61966-2-1) and its inverse. */
+/* The sRGB transfer function (IEC 61966-2-1) and its inverse. NaN gives 0. */
 ATMOS_API double atmos_srgb_encode(double linear);
 ATMOS_API double atmos_srgb_decode(double encoded);
 
-/* OpenEXR: channels R,G,B[,A] for 3/4-channel images, otherwise named by
- * channel_names (or "C0".."Cn"). half: nonzero for 16-bit half floats, else 32-bit. */
+/* OpenEXR: single-part scanline file, ZIP compression. Channels R,G,B[,A] for
+ * 3/4-channel images, otherwise named by channel_names (distinct, 1..255 bytes) or
+ * "C0".."Cn". half: nonzero for 16-bit half floats, else 32-bit. Every metadata
+ * entry becomes a string attribute; keys that are standard attributes of another
+ * type ("channels", ...) or the structural "type"/"name" give ATMOS_E_INVALID_ARG. */
 typedef struct atmos_exr_desc {
     int half;
     const char *const *channel_names; /* optional, img->channels entries */
 } atmos_exr_desc;
 ATMOS_API atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const char *path,
                                        const atmos_exr_desc *desc);
-/* Reads an EXR written by atmos_write_exr (any channel count, half or float) into a
- * float image; metadata strings are read back into img->meta. */
+/* Reads a scanline EXR (any channel count, half or float) into a float image;
+ * string attributes are read back into img->meta. Channel order: R,G,B[,A] when the
+ * file has exactly those, C0..Cn by number when it has exactly those, otherwise the
+ * file's order (sorted by name, as OpenEXR stores them). Tiled, deep and subsampled
+ * files: ATMOS_E_UNSUPPORTED. Malformed or truncated files: ATMOS_E_FORMAT; sizes
+ * beyond ATMOS_IMAGE_MAX_DIM / _CHANNELS: ATMOS_E_LIMIT or ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **out);
 
 /* PNG from a display-encoded image (values in [0,1], 1/3/4 channels: grey, RGB,
- * RGBA), bits 8 or 16. Metadata as tEXt chunks. */
+ * RGBA), bits 8 or 16; values are clamped (NaN -> 0) and rounded to the nearest
+ * level. Metadata as tEXt chunks (iTXt for non-ASCII values; keys 1..79 bytes). */
 ATMOS_API atmos_status atmos_write_png(atmos_context *ctx, const atmos_image *display, const char *path,
                                        int bits);
-/* Reads a PNG into a float image in [0,1] (for tests and tools). */
+/* Reads a PNG (any bit depth and colour type) into a float image in [0,1] with 1
+ * (grey), 3 (RGB) or 4 (RGBA; also for grey+alpha and palettes with transparency)
+ * channels; text chunks go into img->meta. Malformed files: ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmos_image **out);
 
 /* Portable float map: 3 channels ("PF") or 1 ("Pf"), little-endian, bottom row first
- * as the format requires. Other channel counts: the first three are written. */
+ * as the format requires. 4 or more channels: the first three are written; 2
+ * channels: ATMOS_E_INVALID_ARG. The reader accepts either byte order and ignores
+ * the scale's magnitude; data shorter than the header claims: ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_write_pfm(atmos_context *ctx, const atmos_image *img, const char *path);
 ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **out);
 
