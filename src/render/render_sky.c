@@ -125,6 +125,28 @@ static void row_rays(const sky_job *job, int y, double sx, double sy, const floa
         }
         return;
     }
+    if (cam->type == ATMOS_CAMERA_FISHEYE) {
+        /* Equidistant: angle from the axis proportional to the distance from the centre. */
+        const double S = W < cam->height ? W : cam->height;
+        const float half = (float)(0.5 * cam->fov_deg * ATMOS_DEG2RAD);
+        const float v = (float)((cam->height - 2.0 * (y + sy)) / S);
+        float f[3], r[3], u[3];
+        for (int k = 0; k < 3; k++) f[k] = (float)cam->forward[k], r[k] = (float)cam->right[k], u[k] = (float)cam->up[k];
+        for (int x = 0; x < W; x++) {
+            float uu = (float)((2.0 * (x + sx) - W) / S);
+            float rr = sqrtf(uu * uu + v * v);
+            float th = rr * half;
+            float st = sinf(th), ct = cosf(th);
+            float k1 = rr > 0 ? st / rr : half; /* sin(theta)/r -> half as r -> 0 */
+            float ox = ct * f[0] + k1 * (uu * r[0] + v * u[0]);
+            float oy = ct * f[1] + k1 * (uu * r[1] + v * u[1]);
+            float oz = ct * f[2] + k1 * (uu * r[2] + v * u[2]);
+            float inv = 1.0f / sqrtf(ox * ox + oy * oy + oz * oz);
+            dx[x] = ox * inv, dy[x] = oy * inv, dz[x] = oz * inv;
+            w[x] = rr <= 1.0f ? 1.0f : 0.0f;
+        }
+        return;
+    }
     for (int x = 0; x < W; x++) {
         double d[3];
         int ok = atmos_camera_ray(cam, x + sx, y + sy, d);
@@ -165,11 +187,12 @@ static void shade_row(const sky_job *job, const atmos__sky_batch *batch, const f
         px[n] = rb->hits[x] * inv;
     }
     if (!job->sun_visible) return;
-    /* The sun's disk, antialiased by supersampling the few pixels near it. */
+    /* The sun's disk, antialiased by supersampling the few pixels near it. The
+     * search uses the last sample's rays (within a pixel of the centre). */
+    const float sx = (float)job->sun[0], sy = (float)job->sun[1], sz = (float)job->sun[2];
+    const float cs = (float)job->cos_disk_search;
     for (int x = 0; x < W; x++) {
-        double c[3];
-        if (!atmos_camera_ray(job->cam, x + 0.5, y + 0.5, c)) continue;
-        if (c[0] * job->sun[0] + c[1] * job->sun[1] + c[2] * job->sun[2] < job->cos_disk_search) continue;
+        if (rb->w[x] == 0.0f || rb->dx[x] * sx + rb->dy[x] * sy + rb->dz[x] * sz < cs) continue;
         double cov = sun_coverage(job, x, y);
         float *px = dst + (size_t)x * C;
         for (int i = 0; i < n; i++) px[i] += (float)(cov * job->sun_radiance[i]);
@@ -205,9 +228,12 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
     job.sun_radius = 0.5 * sky->desc.sun_diameter_deg * ATMOS_DEG2RAD;
     atmos_sky_sun_radiance(sky, cam.position[1], job.sun, job.sun_radiance);
     job.sun_visible = !sky->desc.hide_sun_disk && job.sun[1] > 0;
-    double search = job.sun_radius + 1.5 * pixel_footprint(&cam);
+    /* Disk radius plus 2.5 pixel footprints: a sample ray is within one footprint
+     * of the pixel centre, the pixel's far corner within another. */
+    double foot = pixel_footprint(&cam);
     /* The equirect footprint grows towards the poles; search wider there. */
-    if (cam.type == ATMOS_CAMERA_EQUIRECT) search = job.sun_radius + 1.5 * pixel_footprint(&cam) / fmax(1e-3, sqrt(fmax(0.0, 1.0 - job.sun[1] * job.sun[1])));
+    if (cam.type == ATMOS_CAMERA_EQUIRECT) foot /= fmax(1e-3, sqrt(fmax(0.0, 1.0 - job.sun[1] * job.sun[1])));
+    double search = job.sun_radius + 2.5 * foot;
     job.cos_disk_search = search >= ATMOS_PI ? -1.0 : cos(search);
 
     const int W = scene->width, H = scene->height, C = img->channels;
@@ -322,9 +348,10 @@ atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral
     float w[ATMOS_MAX_WAVELENGTHS][3];
     for (int i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) w[i][c] = (float)wl->to_srgb[i][c];
-    size_t npx = (size_t)spectral->width * spectral->height;
+    const long long npx = (long long)spectral->width * spectral->height;
     const int C = spectral->channels;
-    for (size_t p = 0; p < npx; p++) {
+#pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
+    for (long long p = 0; p < npx; p++) {
         const float *s = spectral->pixels + p * C;
         float r = 0, g = 0, b = 0;
         for (int i = 0; i < n; i++) {

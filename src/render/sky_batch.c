@@ -12,9 +12,11 @@
  * bits. Written without branches or calls so the compiler vectorises loops over it. */
 static inline float expf_fast(float x)
 {
-    x = x < -87.0f ? -87.0f : (x > 88.0f ? 88.0f : x);
+    x = x < -87.0f ? -87.0f : x;
+    x = x > 88.0f ? 88.0f : x;
     float t = x * 1.44269504088896341f;
-    float nf = t >= 0 ? (float)(int32_t)(t + 0.5f) : (float)(int32_t)(t - 0.5f);
+    /* round to nearest by the 1.5*2^23 trick: no conversion, no branch */
+    float nf = (t + 12582912.0f) - 12582912.0f;
     float r = x - nf * 0.693145751953125f;  /* ln2 split: hi exactly representable */
     r = r - nf * 1.428606765330187045e-06f; /* ln2 lo */
     float p = 1.0f / 720.0f;
@@ -74,23 +76,27 @@ void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx
     const float k_ray = 3.0f / (16.0f * 3.14159265358979f);
 #pragma omp simd
     for (int i = 0; i < count; i++) {
+        /* Branch-free so that it vectorises: both sides of every select are computed
+         * with safe denominators, then blended. */
         float py = dy[i];
         float mu = dx[i] * sx + py * sy + dz[i] * sz;
         PE[i] = k_ray * (1.0f + mu * mu) * weight[i];
-        int down = py < 0.0f;
-        /* Ground distance K = y / -p_y; up or level rays run to infinity. */
-        float K = down ? eye_y / -py : 0.0f;
-        float z = gamma * py * K; /* <= 0 for ground rays */
+        float down = py < 0.0f ? 1.0f : 0.0f;
+        /* Ground distance K = y / -p_y for descending rays. */
+        float K = down * (eye_y / (py < -1e-30f ? -py : 1e-30f));
+        float z = gamma * py * K; /* <= 0 for ground rays, 0 otherwise */
         float e = expf_fast(-z);  /* beta(K)/beta_eye = exp(-gamma p_y K) */
-        float gz = fabsf(z) < 1e-3f ? 1.0f - 0.5f * z + z * z * (1.0f / 6.0f) : (1.0f - e) / z;
+        float zs = fabsf(z) < 1e-3f ? 1.0f : z;
+        float gz = fabsf(z) < 1e-3f ? 1.0f - 0.5f * z + z * z * (1.0f / 6.0f) : (1.0f - e) / zs;
         float Gd = K * gz;
-        /* Upward rays to space: G = 1/(gamma p_y); level rays: unbounded (clamped). */
-        float Gu = py > 1e-20f ? 1.0f / (gamma * py) : 1e20f;
+        /* Rays to space: G = 1/(gamma p_y); level rays are unbounded (clamped). */
+        float pu = py > 1e-20f ? py : 1e-20f;
+        float Gu = 1.0f / (gamma * pu);
         Gu = Gu > 1e20f ? 1e20f : Gu;
-        G[i] = down ? Gd : Gu;
-        eend[i] = down ? e : 0.0f;
+        G[i] = down > 0.0f ? Gd : Gu;
+        eend[i] = down * e;
         c[i] = 1.0f - py * inv_ly;
-        gm[i] = down ? weight[i] : 0.0f;
+        gm[i] = down * weight[i];
     }
     (void)ly;
     for (int k = 0; k < b->n; k++) {
@@ -103,7 +109,8 @@ void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx
             float bexp = expf_fast(-(x + ts0 * eend[i]));
             /* e^{-ts0} h(D) = (e^{-ts0} - e^{-(x + tsK)}) / D, by series near D = 0. */
             float series = a * (1.0f - D * (0.5f - D * (1.0f / 6.0f - D * (1.0f / 24.0f))));
-            float F = fabsf(D) < 1e-2f ? series : (a - bexp) / D;
+            float Ds = fabsf(D) < 1e-2f ? 1.0f : D;
+            float F = fabsf(D) < 1e-2f ? series : (a - bexp) / Ds;
             float L = PE[i] * E * x * F + gm[i] * gr * expf_fast(-x);
             o[i] += L;
         }
