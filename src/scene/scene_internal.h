@@ -62,6 +62,10 @@ struct cJSON;
 atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, const struct cJSON *root,
                                     atmos_scene *scene);
 
+/* The view direction and up vector atmos_camera_init will use for cam, with
+ * camera.h's zero-means-default rules for look_at and up applied. */
+void atmos__scene_camera_effective(const atmos_camera_desc *cam, double fwd[3], double up[3]);
+
 /* Robust vector helpers (scaled so huge components never overflow). */
 double atmos__scene_norm3(const double v[3]);
 /* Sine of the angle between a and b (0 when parallel); -1 if either is zero. */

@@ -279,7 +279,7 @@ static atmos_status parse_camera(const jp *p, const cJSON *j, const char *path, 
     double dir[3] = {cam.look_at[0] - cam.position[0], cam.look_at[1] - cam.position[1],
                      cam.look_at[2] - cam.position[2]};
     obj_iter it;
-    char ip[PATH_CAP];
+    char ip[PATH_CAP], fov_path[PATH_CAP] = "", look_path[PATH_CAP] = "";
     const cJSON *v;
     int k, type;
     TRY(iter_begin(p, j, path, keys, 6, &it));
@@ -297,6 +297,7 @@ static atmos_status parse_camera(const jp *p, const cJSON *j, const char *path, 
                 return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
                                          "cannot be combined with view (give one of them)");
             TRY(get_vec3(p, v, ip, look_r, cam.look_at));
+            snprintf(look_path, sizeof look_path, "%s", ip);
             break;
         case K_VIEW:
             if (it.seen & (1u << K_LOOK))
@@ -304,14 +305,38 @@ static atmos_status parse_camera(const jp *p, const cJSON *j, const char *path, 
                                          "cannot be combined with look_at_m (give one of them)");
             TRY(parse_view(p, v, ip, dir));
             break;
-        case K_UP: TRY(get_vec3(p, v, ip, any_r, cam.up)); break;
+        case K_UP:
+            TRY(get_vec3(p, v, ip, any_r, cam.up));
+            /* In the struct a zero up means "default"; in a file it is a mistake. */
+            if (cam.up[0] == 0 && cam.up[1] == 0 && cam.up[2] == 0)
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "must be nonzero");
+            break;
         case K_FOV:
             /* Its range depends on the type, which may come later in the object. */
             TRY(get_number(p, v, ip, NULL, NULL, &cam.fov_deg));
+            snprintf(fov_path, sizeof fov_path, "%s", ip);
             break;
         }
     }
     int have_look = (it.seen >> K_LOOK) & 1, have_view = (it.seen >> K_VIEW) & 1;
+    /* A fov of 0 means "the type's default" in the struct, so the validator
+     * accepts it; written in a file it is out of range. */
+    if ((it.seen & (1u << K_FOV)) && cam.fov_deg == 0 && cam.type != ATMOS_CAMERA_EQUIRECT) {
+        int fish = cam.type == ATMOS_CAMERA_FISHEYE;
+        TRY(atmos__scene_check_range(p->ctx, p->source, fov_path, 0.0,
+                                     fish ? &atmos__r_fov_fisheye : &atmos__r_fov_pinhole,
+                                     fish ? " for a fisheye camera" : " for a pinhole camera"));
+    }
+    /* A look_at of exactly [0, 0, 0] would read as "default" in the struct;
+     * store the same direction as another point (1000 m from the origin on the
+     * far side), which is never zero. */
+    if (have_look && cam.look_at[0] == 0 && cam.look_at[1] == 0 && cam.look_at[2] == 0) {
+        double n = atmos__scene_norm3(cam.position);
+        if (!(n > 0))
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, look_path,
+                                     "must differ from position_m");
+        for (int i = 0; i < 3; i++) cam.look_at[i] = -cam.position[i] / n * LOOK_DISTANCE_M;
+    }
     if (cam.type == ATMOS_CAMERA_FISHEYE) {
         /* camera.h: a fisheye defaults to a 180° all-sky view of the zenith. */
         if (!(it.seen & (1u << K_FOV))) cam.fov_deg = 180.0;

@@ -109,6 +109,31 @@ static atmos_status check_vec(atmos_context *ctx, const char *source, const char
     return ATMOS_OK;
 }
 
+static int is_zero3(const double v[3]) { return v[0] == 0 && v[1] == 0 && v[2] == 0; }
+
+void atmos__scene_camera_effective(const atmos_camera_desc *cam, double fwd[3], double up[3])
+{
+    /* camera.h: zero look_at and up mean "default", resolved as atmos_camera_init
+     * resolves them (the CLI relies on this when it switches the camera type). */
+    int fisheye = cam->type == ATMOS_CAMERA_FISHEYE;
+    if (is_zero3(cam->look_at)) {
+        fwd[0] = 0.0;
+        fwd[1] = fisheye ? 1.0 : 0.0;
+        fwd[2] = fisheye ? 0.0 : -1.0;
+    } else {
+        for (int i = 0; i < 3; i++) fwd[i] = cam->look_at[i] - cam->position[i];
+    }
+    if (!is_zero3(cam->up)) {
+        for (int i = 0; i < 3; i++) up[i] = cam->up[i];
+    } else {
+        double n = atmos__scene_norm3(fwd);
+        int vertical = n > 0 && fabs(fwd[1]) > 0.99 * n;
+        up[0] = 0.0;
+        up[1] = fisheye && vertical ? 0.0 : 1.0;
+        up[2] = fisheye && vertical ? -1.0 : 0.0;
+    }
+}
+
 atmos_status atmos__scene_validate_camera(atmos_context *ctx, const char *source,
                                           const atmos_camera_desc *cam)
 {
@@ -116,16 +141,20 @@ atmos_status atmos__scene_validate_camera(atmos_context *ctx, const char *source
     const atmos__range *pos_r[3] = {&atmos__r_pos, &atmos__r_altitude, &atmos__r_pos};
     const atmos__range *look_r[3] = {&atmos__r_look, &atmos__r_look, &atmos__r_look};
     const atmos__range *any_r[3] = {&any, &any, &any};
-    atmos_status st;
+    atmos_status st = ATMOS_OK;
 
+    /* fov_deg 0 means the type's default (camera.h); the parser refuses a 0
+     * written in a file, where it can only be a mistake. */
     switch (cam->type) {
     case ATMOS_CAMERA_PINHOLE:
-        st = atmos__scene_check_range(ctx, source, "/camera/fov_deg", cam->fov_deg,
-                                      &atmos__r_fov_pinhole, " for a pinhole camera");
+        if (cam->fov_deg != 0)
+            st = atmos__scene_check_range(ctx, source, "/camera/fov_deg", cam->fov_deg,
+                                          &atmos__r_fov_pinhole, " for a pinhole camera");
         break;
     case ATMOS_CAMERA_FISHEYE:
-        st = atmos__scene_check_range(ctx, source, "/camera/fov_deg", cam->fov_deg,
-                                      &atmos__r_fov_fisheye, " for a fisheye camera");
+        if (cam->fov_deg != 0)
+            st = atmos__scene_check_range(ctx, source, "/camera/fov_deg", cam->fov_deg,
+                                          &atmos__r_fov_fisheye, " for a fisheye camera");
         break;
     case ATMOS_CAMERA_EQUIRECT:
         /* Ignored by this camera, but a NaN must not hide in a valid scene. */
@@ -142,14 +171,12 @@ atmos_status atmos__scene_validate_camera(atmos_context *ctx, const char *source
 
     /* Equirect cameras ignore look_at and up, but a scene must stay valid if the
      * type is switched later (CLI override), so the same rules apply to all. */
-    double d[3] = {cam->look_at[0] - cam->position[0], cam->look_at[1] - cam->position[1],
-                   cam->look_at[2] - cam->position[2]};
-    if (!(atmos__scene_norm3(d) > 0))
+    double fwd[3], up[3];
+    atmos__scene_camera_effective(cam, fwd, up);
+    if (!(atmos__scene_norm3(fwd) > 0))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/look_at_m",
                                  "must differ from position_m");
-    if (!(atmos__scene_norm3(cam->up) > 0))
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/up", "must be nonzero");
-    if (atmos__scene_sin_angle(d, cam->up) < PARALLEL_SIN)
+    if (atmos__scene_sin_angle(fwd, up) < PARALLEL_SIN)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/up",
                                  "must not be parallel to the view direction");
     return ATMOS_OK;

@@ -183,6 +183,19 @@ static void test_absent_keys(void)
     /* Equirect keeps the rest (ignored by that camera, but valid). */
     CHECK_OK(parse("{\"camera\": {\"type\": \"equirect\"}}", &s));
     CHECK(s.camera.type == ATMOS_CAMERA_EQUIRECT && vdiff(s.camera.look_at, d.camera.look_at) == 0);
+    /* look_at [0, 0, 0] is a real point (it would read as "default" in the
+     * struct): the stored point differs but the direction is the same. */
+    CHECK_OK(parse("{\"camera\": {\"position_m\": [30, 40, 0], \"look_at_m\": [0, 0, 0]}}", &s));
+    CHECK(s.camera.look_at[0] != 0 || s.camera.look_at[1] != 0 || s.camera.look_at[2] != 0);
+    {
+        double want[3] = {-0.6, -0.8, 0}, got[3];
+        double n = 0;
+        for (int i = 0; i < 3; i++) got[i] = s.camera.look_at[i] - s.camera.position[i], n += got[i] * got[i];
+        for (int i = 0; i < 3; i++) got[i] /= sqrt(n);
+        CHECK(vdiff(got, want) < 1e-12);
+    }
+    CHECK(parse("{\"camera\": {\"position_m\": [0, 0, 0], \"look_at_m\": [0, 0, 0]}}", &s) == ATMOS_E_INVALID_ARG);
+    CHECK(contains(atmos_context_error(ctx), "/camera/look_at_m: must differ from position_m"));
     /* Only one sun angle: the other keeps its default. */
     CHECK_OK(parse("{\"sun\": {\"azimuth_deg\": 100}}", &s));
     CHECK(s.sun.elevation_deg == 10 && s.sun.azimuth_deg == 100 && !s.sun.from_time);
@@ -386,6 +399,22 @@ static void test_validate(void)
     CHECK(contains(atmos_context_error(ctx), "cli: /camera/position_m/0: must be a finite number, got nan"));
     s = d; memcpy(s.camera.look_at, s.camera.position, sizeof s.camera.look_at);
     CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/camera/look_at_m: must differ"));
+    /* camera.h: zero look_at, up and fov mean "default" (the CLI zeroes the
+     * camera when it switches the type), for every type. */
+    for (int t = 0; t < 3; t++) {
+        s = d;
+        memset(s.camera.look_at, 0, sizeof s.camera.look_at);
+        memset(s.camera.up, 0, sizeof s.camera.up);
+        s.camera.fov_deg = 0;
+        s.camera.type = (atmos_camera_type)t;
+        CHECK_OK(atmos_scene_validate(ctx, &s, "cli"));
+    }
+    /* ...but a zero up with an explicit vertical pinhole view is what
+     * atmos_camera_init would refuse, so it is refused here too. */
+    s = d; memset(s.camera.up, 0, sizeof s.camera.up); s.camera.look_at[0] = 0; s.camera.look_at[1] = 500; s.camera.look_at[2] = 0;
+    CHECK(atmos_scene_validate(ctx, &s, "cli") == ATMOS_E_INVALID_ARG && contains(atmos_context_error(ctx), "/camera/up: must not be parallel"));
+    s.camera.type = ATMOS_CAMERA_FISHEYE;
+    CHECK_OK(atmos_scene_validate(ctx, &s, "cli"));
     s = d; s.camera.up[0] = 1e308; s.camera.up[1] = 1e308; s.camera.up[2] = 1e308;
     CHECK_OK(atmos_scene_validate(ctx, &s, "cli")); /* huge but finite and not parallel: no overflow */
     s = d; memset(s.name, 'x', sizeof s.name);
