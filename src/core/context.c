@@ -1,4 +1,5 @@
 /* The context object, status strings, error and log plumbing, atomic file writes. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, getpid, isatty, PATH_MAX */
 #include "core/internal.h"
 
 #include <errno.h>

@@ -1,5 +1,6 @@
 /* Renders a scene's sky (Riley et al. 2004 §4.1, §4.2.4) into a spectral image,
  * and converts spectral images to linear sRGB. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, getpid, isatty, PATH_MAX */
 #include "core/internal.h"
 #include "sky/sky_internal.h"
 #include "render/sky_batch.h"

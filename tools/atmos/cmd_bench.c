@@ -1,4 +1,5 @@
 /* atmos bench: speed measurements, one machine-readable line per case. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, getpid, isatty, PATH_MAX */
 #include "cli.h"
 
 #include <stdio.h>

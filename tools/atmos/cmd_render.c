@@ -1,4 +1,5 @@
 /* atmos render: a scene file (or the built-in default) to PNG / EXR / PFM. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, getpid, isatty, PATH_MAX */
 #include "cli.h"
 
 #include <getopt.h>
