@@ -47,6 +47,7 @@ typedef struct {
     int enabled;
     double start;
     int shown;
+    double last_draw;
 } progress_state;
 
 static double now_s(void)
@@ -64,6 +65,8 @@ static int progress_bar(void *user, const char *stage, double f)
     double t = now_s() - p->start;
     if (t < 1.0 && f < 1.0) return 0;
     if (t < 1.0 && !p->shown) return 0;
+    if (f < 1.0 && t - p->last_draw < 0.1) return 0; /* redraw at most ten times a second */
+    p->last_draw = t;
     int width = 30, fill = (int)(f * width + 0.5);
     char bar[64];
     for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
@@ -173,7 +176,7 @@ int cli_cmd_render(int argc, char **argv)
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
 
-    progress_state prog = {!quiet && isatty(2), now_s(), 0};
+    progress_state prog = {!quiet && isatty(2), now_s(), 0, 0.0};
     atmos_context *ctx = cli_context_with_progress(threads, quiet, progress_bar, &prog);
     if (!ctx) return CLI_EXIT_RUNTIME;
 
