@@ -109,5 +109,6 @@ ATMOS_API void atmos_context_clear_error(atmos_context *ctx);
 #include "atmos/image.h"
 #include "atmos/scene.h"
 #include "atmos/render.h"
+#include "atmos/optics.h"
 
 #endif
