@@ -29,6 +29,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -67,7 +68,8 @@ extern double j1(double);
 #define DELTA_RAD 1e-9
 
 typedef struct chunk_result {
-    double *hist; /* NBINS energies by scattering angle, delta transmission excluded */
+    double *hist; /* 2 NBINS: energies by scattering angle (delta transmission excluded),
+                     then the sums of their squares (for the effective sample size) */
     double reflected, transmitted, absorbed, lost, delta;
 } chunk_result;
 
@@ -85,7 +87,7 @@ static long chunk_rays(long rays, int chunk)
 
 static void run_chunk(const job *jb, int chunk, chunk_result *cr)
 {
-    memset(cr->hist, 0, sizeof(double) * NBINS);
+    memset(cr->hist, 0, sizeof(double) * 2 * NBINS);
     cr->reflected = cr->transmitted = cr->absorbed = cr->lost = cr->delta = 0.0;
     atmos__rng rng;
     atmos__rng_seed(&rng, jb->seed ^ (0xD1B54A32D192ED03ull * (uint64_t)(chunk + 1)));
@@ -107,41 +109,75 @@ static void run_chunk(const job *jb, int chunk, chunk_result *cr)
             if (b < 0) b = 0;
             if (b >= NBINS) b = NBINS - 1;
             cr->hist[b] += ray.weight[e];
+            cr->hist[NBINS + b] += ray.weight[e] * ray.weight[e];
         }
     }
 }
 
-/* Kernel standard deviation at theta (degrees). */
-static double kernel_at(double theta, double k0)
+/* The histogram after tracing: energies e[b], squared energies e2[b], their prefix
+ * sums, and the solid angle of each bin. */
+typedef struct binned {
+    const double *e, *omega;
+    const double *c1, *c2; /* c1[b] = sum of e[0..b), c2 likewise for e2; NBINS + 1 entries */
+    double k0;             /* kernel width away from the poles, degrees */
+} binned;
+
+/* Kernel standard deviation at theta (degrees): k0, widened linearly towards the poles
+ * (the solid angle per degree vanishes there), and widened wherever the histogram
+ * holds fewer than MIN_EFFECTIVE_RAYS effective rays (Kish: (sum w)^2 / sum w^2) per
+ * kernel, up to MAX_KERNEL_DEG: a balloon-type adaptive kernel (Terrell & Scott 1992,
+ * Ann. Stat. 20, 1236) that keeps the noise near MIN_EFFECTIVE_RAYS^-1/2 where the
+ * phase function is low (the back hemisphere) while the bright halos keep k0. */
+#define MIN_EFFECTIVE_RAYS 400.0
+#define MAX_KERNEL_DEG 3.0
+#define WINDOW_BINS ((int)(1.0 / BIN_DEG + 0.5)) /* +-1° window for the local ray count */
+
+static double kernel_at(const binned *h, double theta)
 {
     double psi = fmin(theta, 180.0 - theta);
-    if (psi >= POLE_DEG) return k0;
-    return k0 + (POLE_KERNEL_DEG - k0) * (1.0 - psi / POLE_DEG);
+    double sd = h->k0;
+    if (psi < POLE_DEG) sd = h->k0 + (POLE_KERNEL_DEG - h->k0) * (1.0 - psi / POLE_DEG);
+    int b = (int)(theta / BIN_DEG);
+    int lo = b - WINDOW_BINS, hi = b + WINDOW_BINS + 1;
+    if (lo < 0) lo = 0;
+    if (hi > NBINS) hi = NBINS;
+    double s1 = h->c1[hi] - h->c1[lo], s2 = h->c2[hi] - h->c2[lo];
+    double n_eff = s2 > 0.0 ? s1 * s1 / s2 : 0.0;
+    /* A Gaussian of width sd holds about 2.5 sd / 2° of the window's rays. */
+    double need = n_eff > 0.0 ? MIN_EFFECTIVE_RAYS * 2.0 / (2.5 * n_eff) : MAX_KERNEL_DEG;
+    if (need > MAX_KERNEL_DEG) need = MAX_KERNEL_DEG;
+    return sd > need ? sd : need;
 }
 
 /* Energy per steradian at theta from the histogram: the kernel-weighted energy over the
  * kernel-weighted solid angle of the bins (a ratio estimator, which stays unbiased for
  * a constant density even where the kernel is cut by 0° or 180°). */
-static double smoothed_density(const double *hist, const double *omega, double theta, double k0)
+static double smoothed_density(const binned *h, double theta)
 {
-    double sd = kernel_at(theta, k0);
+    double sd = kernel_at(h, theta);
     int lo = (int)floor((theta - 4.0 * sd) / BIN_DEG), hi = (int)ceil((theta + 4.0 * sd) / BIN_DEG);
     if (lo < 0) lo = 0;
     if (hi > NBINS - 1) hi = NBINS - 1;
+    /* Gaussian weights at equally spaced bins by the exact recurrence
+     * g(x + d) = g(x) exp(-(2 x d + d^2) / 2), whose ratio shrinks by exp(-d^2) per
+     * step: three exp() per angle instead of one per bin. */
+    double x0 = ((lo + 0.5) * BIN_DEG - theta) / sd, d = BIN_DEG / sd;
+    double k = exp(-0.5 * x0 * x0), ratio = exp(-(2.0 * x0 * d + d * d) / 2.0), q = exp(-d * d);
     double num = 0.0, den = 0.0;
     for (int b = lo; b <= hi; b++) {
-        double x = ((b + 0.5) * BIN_DEG - theta) / sd;
-        double k = exp(-0.5 * x * x);
-        num += k * hist[b];
-        den += k * omega[b];
+        num += k * h->e[b];
+        den += k * h->omega[b];
+        k *= ratio;
+        ratio *= q;
     }
     return den > 0.0 ? num / den : 0.0;
 }
 
-/* Airy pattern [2 J1(x) / x]^2, x = k a sin(theta), averaged over the grid cell around
- * theta so that rings finer than the grid are replaced by their mean instead of being
- * aliased. Zero beyond 90°, where Fraunhofer's small-angle diffraction does not apply
- * (the pattern is ~(ka)^-3 there anyway). */
+/* Airy pattern [2 J1(x) / x]^2 (Born & Wolf §8.5.2), x = k a sin(theta), averaged over
+ * the grid cell [th0, th1] so that rings finer than the grid are replaced by their mean
+ * instead of being aliased; beyond x = 100 by the ring average 4 / (pi x^3) of the
+ * asymptotic form (J1(x)^2 ~ 2 cos^2(...) / (pi x)). Zero beyond 90°, where Fraunhofer's
+ * small-angle diffraction does not apply (the pattern is ~(ka)^-3 there anyway). */
 static double airy(double x) { return fabs(x) < 1e-8 ? 1.0 : pow(2.0 * j1(x) / x, 2.0); }
 
 static double airy_cell(double ka, double th0, double th1)
@@ -149,12 +185,69 @@ static double airy_cell(double ka, double th0, double th1)
     if (th0 >= 90.0) return 0.0;
     if (th1 > 90.0) th1 = 90.0;
     double x0 = ka * sin(th0 * ATMOS_DEG2RAD), x1 = ka * sin(th1 * ATMOS_DEG2RAD);
+    if (x0 > 100.0) {
+        double x = 0.5 * (x0 + x1);
+        return 4.0 / (ATMOS_PI * x * x * x);
+    }
     int m = (int)ceil(fabs(x1 - x0) / 0.25);
     if (m < 1) return airy(0.5 * (x0 + x1));
-    if (m > 2000) m = 2000;
+    if (m > 512) m = 512;
     double s = 0.0;
     for (int i = 0; i < m; i++) s += airy(x0 + (i + 0.5) * (x1 - x0) / m);
     return s / m;
+}
+
+/* Diffraction by the randomly oriented prism. Each orientation diffracts the light
+ * falling on its shadow, area A(d), like a circular aperture of the same area; the
+ * phase function is the mixture of these Airy patterns weighted by A(d) (the energy
+ * each orientation intercepts). A(d) is tabulated on a Fibonacci lattice of directions
+ * and split into DIFF_SIZES strata of equal intercepted energy, one Airy pattern each.
+ * The spread of A(d) (a factor ~2-4) washes out the rings beyond the first few, as
+ * the hexagonal shape would; the first dark ring of a single circle survives only
+ * softened. Output: per-steradian values (unnormalised) at the grid angles. */
+#define DIFF_DIRS 4096
+#define DIFF_SIZES 24
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void diffraction(const atmos__crystal *c, double k, int n, const double *theta_deg, double *out)
+{
+    static const double golden = 2.39996322972865332; /* pi (3 - sqrt 5) */
+    double areas[DIFF_DIRS], total = 0.0;
+    for (int i = 0; i < DIFF_DIRS; i++) {
+        double z = 1.0 - (2.0 * i + 1.0) / DIFF_DIRS, r = sqrt(fmax(0.0, 1.0 - z * z));
+        double d[3] = {r * cos(golden * i), r * sin(golden * i), z};
+        areas[i] = atmos__crystal_projected_area(c, d);
+    }
+    qsort(areas, DIFF_DIRS, sizeof *areas, cmp_double);
+    for (int i = 0; i < DIFF_DIRS; i++) total += areas[i];
+    double ka[DIFF_SIZES];
+    /* Stratum s holds the directions whose cumulative area falls in [s, s+1) / DIFF_SIZES
+     * of the total; its representative area is its area-weighted mean A2 / A. */
+    double cum = 0.0, sa = 0.0, sa2 = 0.0;
+    int s = 0;
+    for (int i = 0; i < DIFF_DIRS && s < DIFF_SIZES; i++) {
+        sa += areas[i];
+        sa2 += areas[i] * areas[i];
+        cum += areas[i];
+        if (cum >= total * (s + 1) / DIFF_SIZES || i == DIFF_DIRS - 1) {
+            ka[s++] = k * sqrt(sa2 / sa / ATMOS_PI);
+            sa = sa2 = 0.0;
+        }
+    }
+    for (int j = s; j < DIFF_SIZES; j++) ka[j] = ka[s - 1];
+    for (int i = 0; i < n; i++) {
+        double a = i > 0 ? 0.5 * (theta_deg[i - 1] + theta_deg[i]) : theta_deg[0];
+        double b = i + 1 < n ? 0.5 * (theta_deg[i] + theta_deg[i + 1]) : theta_deg[i];
+        double v = 0.0;
+        /* (ka)^2 / (4 pi): the Airy pattern normalised over the sphere (small angles). */
+        for (int j = 0; j < DIFF_SIZES; j++) v += ka[j] * ka[j] / (4.0 * ATMOS_PI) * airy_cell(ka[j], a, b);
+        out[i] = v / DIFF_SIZES;
+    }
 }
 
 static uint64_t hash_double(double v)
@@ -233,39 +326,59 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
     jb.rays = rays;
     const double mean_area = 0.25 * jb.crystal.surface_area; /* Cauchy */
 
-    /* ------------------------------------------------ rays, chunk batches in parallel */
+    /* ------------------------------------------------ rays: chunks in parallel */
     int threads = atmos__threads(ctx);
     if (threads < 1) threads = 1;
     if (threads > CHUNKS) threads = CHUNKS;
-    double *hist = calloc((size_t)NBINS * (size_t)(threads + 2), sizeof(double));
+    /* total (2 NBINS), omega (NBINS), prefix sums (2 (NBINS + 1)), one histogram (2 NBINS)
+     * per chunk (~9 MB): chunks are handed out dynamically (no barrier per batch, so a
+     * thread slowed by other processes does not hold the others up) and merged in
+     * chunk order afterwards. */
+    double *hist = calloc((size_t)NBINS * (size_t)(2 * CHUNKS + 5) + 2, sizeof(double));
     double *airy_tab = malloc(sizeof(double) * (size_t)n_angles);
     if (!hist || !airy_tab) {
         free(hist);
         free(airy_tab);
         return atmos__error(ctx, ATMOS_E_NOMEM, "%s phase: out of memory for histograms", what);
     }
-    double *total = hist, *omega = hist + NBINS, *slots = hist + 2 * (size_t)NBINS;
+    double *total = hist, *omega = hist + 2 * (size_t)NBINS, *c1 = hist + 3 * (size_t)NBINS;
+    double *c2 = c1 + NBINS + 1, *slots = c2 + NBINS + 1;
     chunk_result cr[CHUNKS];
+    for (int c = 0; c < CHUNKS; c++) cr[c].hist = slots + (size_t)c * 2 * NBINS;
+    int done = 0, cancel = 0;
+#pragma omp parallel num_threads(threads)
+    {
+#pragma omp for schedule(dynamic, 1)
+        for (int c = 0; c < CHUNKS; c++) {
+            int stop;
+#pragma omp atomic read
+            stop = cancel;
+            if (stop) continue;
+            run_chunk(&jb, c, &cr[c]);
+            int now;
+#pragma omp atomic capture
+            now = ++done;
+            /* Thread 0 of the team is the calling thread: only it reports. */
+            if (progress && omp_get_thread_num() == 0 && now < CHUNKS && progress(progress_user, (double)now / CHUNKS)) {
+#pragma omp atomic write
+                cancel = 1;
+            }
+        }
+    }
+    if (cancel || (progress && progress(progress_user, 1.0))) {
+        free(hist);
+        free(airy_tab);
+        return atmos__error(ctx, ATMOS_E_CANCELLED, "%s phase at %g nm: cancelled", what, nm);
+    }
+    /* Chunk order, whatever thread ran what: bit-identical for any thread count. */
     double reflected = 0.0, transmitted = 0.0, absorbed = 0.0, lost = 0.0, delta = 0.0;
-    for (int c0 = 0; c0 < CHUNKS; c0 += threads) {
-        int nb = CHUNKS - c0 < threads ? CHUNKS - c0 : threads;
-        for (int j = 0; j < nb; j++) cr[j].hist = slots + (size_t)j * NBINS;
-#pragma omp parallel for num_threads(threads) schedule(static, 1)
-        for (int j = 0; j < nb; j++) run_chunk(&jb, c0 + j, &cr[j]);
-        /* Chunk order, whatever thread ran what. */
-        for (int j = 0; j < nb; j++) {
-            for (int b = 0; b < NBINS; b++) total[b] += cr[j].hist[b];
-            reflected += cr[j].reflected;
-            transmitted += cr[j].transmitted;
-            absorbed += cr[j].absorbed;
-            lost += cr[j].lost;
-            delta += cr[j].delta;
-        }
-        if (progress && progress(progress_user, (double)(c0 + nb) / CHUNKS)) {
-            free(hist);
-            free(airy_tab);
-            return atmos__error(ctx, ATMOS_E_CANCELLED, "%s phase at %g nm: cancelled", what, nm);
-        }
+    for (int c = 0; c < CHUNKS; c++) {
+        for (int bn = 0; bn < 2 * NBINS; bn++) total[bn] += cr[c].hist[bn];
+        reflected += cr[c].reflected;
+        transmitted += cr[c].transmitted;
+        absorbed += cr[c].absorbed;
+        lost += cr[c].lost;
+        delta += cr[c].delta;
     }
     double nr = (double)rays;
     reflected /= nr;
@@ -275,6 +388,11 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
     delta /= nr;
 
     /* ------------------------------------------------ assemble the phase function */
+    for (int b = 0; b < NBINS; b++) {
+        c1[b + 1] = c1[b] + total[b];
+        c2[b + 1] = c2[b] + total[NBINS + b];
+    }
+    binned h = {total, omega, c1, c2, k0};
     for (int b = 0; b < NBINS; b++)
         omega[b] = 2.0 * ATMOS_PI * (cos(b * BIN_DEG * ATMOS_DEG2RAD) - cos((b + 1) * BIN_DEG * ATMOS_DEG2RAD));
     /* Energy that left the crystal through the rays; the lost part (still inside after
@@ -284,12 +402,7 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
     for (int b = 0; b < NBINS; b++) out_energy += total[b];
     out_energy += delta * nr;
 
-    double ka = 2.0 * ATMOS_PI / (nm * 1e-9) * sqrt(mean_area / ATMOS_PI);
-    for (int i = 0; i < n_angles; i++) {
-        double a = i > 0 ? 0.5 * (theta_deg[i - 1] + theta_deg[i]) : theta_deg[0];
-        double b = i + 1 < n_angles ? 0.5 * (theta_deg[i] + theta_deg[i + 1]) : theta_deg[i];
-        airy_tab[i] = airy_cell(ka, a, b);
-    }
+    diffraction(&jb.crystal, 2.0 * ATMOS_PI / (nm * 1e-9), n_angles, theta_deg, airy_tab);
     double airy_norm = atmos__sphere_integral(n_angles, theta_deg, airy_tab);
     if (!(airy_norm > 0.0) || !(out_energy > 0.0)) {
         free(hist);
@@ -302,7 +415,7 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
     double w_geo = 1.0 - absorbed, w_dif = 1.0;
     double f_delta = delta * nr / out_energy;
     for (int i = 0; i < n_angles; i++) {
-        double geo = smoothed_density(total, omega, theta_deg[i], k0) / out_energy;
+        double geo = smoothed_density(&h, theta_deg[i]) / out_energy;
         double dif = airy_tab[i] / airy_norm;
         phase[i] = (w_geo * (geo + f_delta * dif) + w_dif * dif) / (w_geo + w_dif);
     }
