@@ -138,5 +138,7 @@ run "render --camera equirect" 0 render --camera equirect --width 128 --height 6
 # A failing write (directory does not exist) is a runtime error, and leaves nothing.
 run "unwritable output" 1 render --width 8 --height 8 -o "$T/no/such/dir/x.png" -q
 [ -s "$T/err" ] && ok "unwritable output: message" || bad "unwritable output: no message"
+leftover=$(find "$T" -name '*.tmp*' | head -5)
+if [ -z "$leftover" ]; then ok "no temporary files left at the end"; else bad "temporary files left: $leftover"; fi
 
 exit $fail
