@@ -2,8 +2,9 @@
  *
  *  - CIE 1931 2° observer, 1 nm, 360-830 nm. Published facts: ybar(555) = 1 exactly (the
  *    normalisation of V(lambda)); the column sums given as validation metadata of the CIE's
- *    own dataset "CIE 1931 colour-matching functions, 2 degree observer" (CIE_xyz_1931_2deg,
- *    DOI 10.25039/CIE.DS.xvudnb9b, ISO/CIE 11664-1:2019):
+ *    own dataset "CIE 1931 colour-matching functions, 2 degree observer" (CIE_xyz_1931_2deg.csv,
+ *    cie.co.at data tables; ISO/CIE 11664-1:2019), reproduced by the copy in the public
+ *    repository wetadigital/physlight:
  *        sum xbar = 106.865469489595, sum ybar = 106.856917101172, sum zbar = 106.892251278636.
  *  - sRGB (IEC 61966-2-1 / ITU-R BT.709): primaries R (0.64, 0.33), G (0.30, 0.60),
  *    B (0.15, 0.06), white D65 (0.3127, 0.3290). The test derives the RGB->XYZ matrix from
