@@ -24,22 +24,30 @@ static double clamp_mu(double mu) { return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : m
 
 static int g_valid(double g) { return isfinite(g) && g > -1.0 && g < 1.0; }
 
+/* 1 + g^2 - 2 g mu written as a sum of two non-negative terms, (1 - g)^2 + 2g(1 - mu)
+ * for g >= 0 and (1 + g)^2 - 2g(1 + mu) for g < 0: no cancellation as |g| -> 1, where
+ * the naive form rounds to 0 at mu = +-1 (g = 1 - 1e-12 gives Inf instead of ~1e24). */
+static double hg_denominator(double g, double mu)
+{
+    return g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - mu) : (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + mu);
+}
+
 double atmos_phase_hg(double cos_theta, double g)
 {
     if (!g_valid(g) || isnan(cos_theta)) return 0.0;
     double mu = clamp_mu(cos_theta);
-    /* 1 + g^2 - 2 g mu >= (1 - |g|)^2 > 0 for |g| < 1, so no division by zero. */
-    double d = 1.0 + g * g - 2.0 * g * mu;
-    return INV_4PI * (1.0 - g * g) / (d * sqrt(d));
+    /* d >= (1 - |g|)^2 > 0 for |g| < 1, so no division by zero. */
+    double d = hg_denominator(g, mu);
+    return INV_4PI * (1.0 - g) * (1.0 + g) / (d * sqrt(d));
 }
 
 double atmos_phase_cornette_shanks(double cos_theta, double g)
 {
     if (!g_valid(g) || isnan(cos_theta)) return 0.0;
     double mu = clamp_mu(cos_theta);
-    double d = 1.0 + g * g - 2.0 * g * mu;
+    double d = hg_denominator(g, mu);
     /* Nishita Eq. 5 / (4 pi). */
-    return 3.0 * (1.0 - g * g) * (1.0 + mu * mu) / (8.0 * ATMOS_PI * (2.0 + g * g) * d * sqrt(d));
+    return 3.0 * (1.0 - g) * (1.0 + g) * (1.0 + mu * mu) / (8.0 * ATMOS_PI * (2.0 + g * g) * d * sqrt(d));
 }
 
 /* A mixture is valid when it has 1..ATMOS_PHASE_MAX_LOBES lobes of known kinds, finite
