@@ -31,6 +31,7 @@ static const double table3_beta[3] = {5.8e-6, 1.35e-5, 3.31e-5};
 struct atmos_phase_table {
     int n_wl, n_ang;
     const double *theta_deg; /* the shared grid (static storage) */
+    double *sin_theta;       /* sin of the grid angles, computed once per table */
     double *nm;
     double *values; /* n_wl x n_ang, P in sr^-1 */
     double *cdf;    /* n_wl x n_ang, CDF over theta at the grid angles, cdf[0] = 0, last = 1 */
@@ -53,6 +54,7 @@ static const char *kind_name(atmos_particle_kind k)
 void atmos_phase_table_destroy(atmos_phase_table *t)
 {
     if (!t) return;
+    free(t->sin_theta);
     free(t->nm);
     free(t->values);
     free(t->cdf);
@@ -70,16 +72,18 @@ static atmos_phase_table *table_alloc(int n_wl, int n_ang, const double *theta)
     t->n_ang = n_ang;
     t->theta_deg = theta;
     size_t n = (size_t)n_wl * (size_t)n_ang;
+    t->sin_theta = malloc((size_t)n_ang * sizeof *t->sin_theta);
     t->nm = calloc((size_t)n_wl, sizeof *t->nm);
     t->values = calloc(n, sizeof *t->values);
     t->cdf = calloc(n, sizeof *t->cdf);
     t->sigma_ext = calloc((size_t)n_wl, sizeof *t->sigma_ext);
     t->albedo = calloc((size_t)n_wl, sizeof *t->albedo);
     t->g = calloc((size_t)n_wl, sizeof *t->g);
-    if (!t->nm || !t->values || !t->cdf || !t->sigma_ext || !t->albedo || !t->g) {
+    if (!t->sin_theta || !t->nm || !t->values || !t->cdf || !t->sigma_ext || !t->albedo || !t->g) {
         atmos_phase_table_destroy(t);
         return NULL;
     }
+    for (int i = 0; i < n_ang; i++) t->sin_theta[i] = sin(theta[i] * ATMOS_DEG2RAD);
     return t;
 }
 
@@ -263,13 +267,11 @@ static int unpack_payload(atmos_phase_table *t, const double *d, size_t size, co
  * Inside an interval F is then quadratic and is inverted exactly (sample_interval). */
 static int build_cdf(atmos_phase_table *t, int k)
 {
-    const double *th = t->theta_deg, *v = t->values + (size_t)k * t->n_ang;
+    const double *th = t->theta_deg, *sn = t->sin_theta, *v = t->values + (size_t)k * t->n_ang;
     double *c = t->cdf + (size_t)k * t->n_ang;
     c[0] = 0.0;
-    for (int i = 0; i + 1 < t->n_ang; i++) {
-        double a = th[i] * ATMOS_DEG2RAD, b = th[i + 1] * ATMOS_DEG2RAD;
-        c[i + 1] = c[i] + ATMOS_PI * (v[i] * sin(a) + v[i + 1] * sin(b)) * (b - a);
-    }
+    for (int i = 0; i + 1 < t->n_ang; i++)
+        c[i + 1] = c[i] + ATMOS_PI * (v[i] * sn[i] + v[i + 1] * sn[i + 1]) * (th[i + 1] - th[i]) * ATMOS_DEG2RAD;
     double total = c[t->n_ang - 1];
     if (!(total > 0) || !isfinite(total)) return 0;
     for (int i = 1; i < t->n_ang; i++) c[i] /= total;
@@ -527,7 +529,7 @@ double atmos_phase_table_sample(const atmos_phase_table *t, int k, double u)
          * the interval's mass matter); solve f0 x + (f1 - f0) x^2 / (2h) = r, with
          * r = the fraction of the interval's area, r * (f0 + f1) h / 2, using the
          * cancellation-free root x = 2r / (f0 + sqrt(f0^2 + 2 (f1 - f0) r / h)). */
-        double f0 = v[i] * sin(a), f1 = v[i + 1] * sin(b);
+        double f0 = v[i] * t->sin_theta[i], f1 = v[i + 1] * t->sin_theta[i + 1];
         double r = (u - c[i]) / mass * 0.5 * (f0 + f1) * h;
         double disc = f0 * f0 + 2.0 * (f1 - f0) * r / h;
         if (disc < 0) disc = 0;
