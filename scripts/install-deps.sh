@@ -2,7 +2,7 @@
 # Installs the Debian packages atmos needs to build and test, if any are missing.
 # Safe to run repeatedly: it does nothing when everything is present.
 set -eu
-PKGS="build-essential cmake pkg-config libpng-dev libopenexr-dev libcjson-dev"
+PKGS="build-essential cmake pkg-config libpng-dev libopenexr-dev libcjson-dev gnuplot-nox"
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

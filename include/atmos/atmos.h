@@ -110,5 +110,6 @@ ATMOS_API void atmos_context_clear_error(atmos_context *ctx);
 #include "atmos/scene.h"
 #include "atmos/render.h"
 #include "atmos/optics.h"
+#include "atmos/volume.h"
 
 #endif

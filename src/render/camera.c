@@ -65,8 +65,11 @@ atmos_status atmos_camera_init(atmos_context *ctx, const atmos_camera_desc *desc
     if (desc->type != ATMOS_CAMERA_PINHOLE && desc->type != ATMOS_CAMERA_FISHEYE &&
         desc->type != ATMOS_CAMERA_EQUIRECT)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "camera/type: unknown camera type %d", (int)desc->type);
-    if (!finite3(desc->position) || !finite3(desc->look_at) || !finite3(desc->up))
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "camera: position, look_at and up must be finite");
+    if (!finite3(desc->position))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "camera/position_m: must be 3 finite numbers");
+    if (!finite3(desc->look_at))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "camera/look_at_m: must be 3 finite numbers");
+    if (!finite3(desc->up)) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "camera/up: must be 3 finite numbers");
     if (desc->position[1] < 0)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
                             "camera/position_m: altitude (y) must be >= 0 (above the ground), got %g",

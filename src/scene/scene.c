@@ -22,20 +22,20 @@ void atmos_scene_defaults(atmos_scene *s)
     s->height = 720;
     s->samples_per_pixel = 1;
 
-    /* A person's eye height, looking a little above the south-south-west horizon:
-     * with the default afternoon sun in the south-west the view shows the bright
-     * aureole, the horizon brightening and the blue gradient at once. */
+    /* From a 1000 m hill, looking just above the south-south-west horizon: with the
+     * afternoon sun in the south-west the view shows the sun's disk, the blue
+     * gradient, the horizon brightening and the aerial perspective over the plain. */
     double dir[3];
-    atmos_direction_from_angles(6.0, 200.0, dir);
+    atmos_direction_from_angles(1.0, 200.0, dir);
     s->camera.type = ATMOS_CAMERA_PINHOLE;
-    s->camera.position[1] = 2.0;
+    s->camera.position[1] = 1000.0;
     for (int i = 0; i < 3; i++) s->camera.look_at[i] = s->camera.position[i] + 1000.0 * dir[i];
     s->camera.up[1] = 1.0;
     s->camera.fov_deg = 60.0;
 
     s->sun.from_time = 0;
-    s->sun.elevation_deg = 10.0;
-    s->sun.azimuth_deg = 225.0;
+    s->sun.elevation_deg = 22.0;
+    s->sun.azimuth_deg = 235.0;
     s->sun.refraction = 1;
 
     atmos_atmosphere_defaults(&s->atmosphere);

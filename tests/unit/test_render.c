@@ -177,7 +177,9 @@ static void test_cancel_and_progress(void)
     int calls = 0;
     atmos_context_desc d;
     atmos_context_defaults(&d);
-    d.threads = 2;
+    /* One thread: with more, the calling thread (the only one that reports progress)
+     * may get no band at all on a loaded machine, and the render legitimately finishes. */
+    d.threads = 1;
     d.progress = cancel_at_half;
     d.progress_user = &calls;
     atmos_context *ctx = NULL;

@@ -1,4 +1,5 @@
 /* Shared helpers for the atmos subcommands. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, isatty */
 #include "cli.h"
 
 #include <errno.h>
@@ -6,6 +7,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <time.h>
+#include <unistd.h>
 
 int cli_parse_double(const char *cmd, const char *opt, const char *text, double *out)
 {
@@ -84,4 +87,40 @@ void cli_print_json_array(const double *v, int n)
     putchar('[');
     for (int i = 0; i < n; i++) printf("%s%.9g", i ? ", " : "", v[i]);
     putchar(']');
+}
+
+double cli_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+void cli_progress_init(cli_progress *p, int quiet)
+{
+    p->enabled = !quiet && isatty(2);
+    p->start = cli_now_s();
+    p->shown = 0;
+    p->last_draw = 0.0;
+}
+
+int cli_progress_bar(void *user, const char *stage, double f)
+{
+    cli_progress *p = user;
+    if (!p->enabled) return 0;
+    double t = cli_now_s() - p->start;
+    if (t < 1.0 && f < 1.0) return 0;
+    if (t < 1.0 && !p->shown) return 0;
+    if (f < 1.0 && t - p->last_draw < 0.1) return 0; /* redraw at most ten times a second */
+    p->last_draw = t;
+    int width = 30, fill = (int)(f * width + 0.5);
+    char bar[64];
+    for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
+    bar[width] = '\0';
+    double eta = f > 0 ? t * (1.0 - f) / f : 0;
+    fprintf(stderr, "\r%s [%s] %3.0f%%  %.1fs elapsed, ETA %.1fs ", stage, bar, 100.0 * f, t, eta);
+    if (f >= 1.0) fputc('\n', stderr);
+    fflush(stderr);
+    p->shown = 1;
+    return 0;
 }

@@ -21,6 +21,20 @@ int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st);
 atmos_context *cli_context(int threads, int quiet);
 /* The same with a progress callback. */
 atmos_context *cli_context_with_progress(int threads, int quiet, atmos_progress_fn fn, void *user);
+/* A progress bar with ETA on stderr for work that takes over ~1 s, redrawn at most
+ * ten times a second; enabled only when stderr is a terminal and not quiet. Pass
+ * cli_progress_bar with a cli_progress as the context's progress callback; if
+ * p.shown after the work, the bar has already ended its line. */
+typedef struct {
+    int enabled;
+    double start;
+    int shown;
+    double last_draw;
+} cli_progress;
+void cli_progress_init(cli_progress *p, int quiet);
+int cli_progress_bar(void *user, const char *stage, double fraction);
+/* Monotonic clock, seconds. */
+double cli_now_s(void);
 /* Prints a JSON array of n doubles (%.9g) to stdout. */
 void cli_print_json_array(const double *v, int n);
 
@@ -29,5 +43,8 @@ int cli_cmd_render(int argc, char **argv);
 int cli_cmd_sky(int argc, char **argv);
 int cli_cmd_sun(int argc, char **argv);
 int cli_cmd_bench(int argc, char **argv);
+int cli_cmd_phase(int argc, char **argv);
+int cli_cmd_cache(int argc, char **argv);
+int cli_cmd_mie(int argc, char **argv);
 
 #endif

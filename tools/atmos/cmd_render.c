@@ -43,42 +43,6 @@ static void help(void)
            "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n");
 }
 
-typedef struct {
-    int enabled;
-    double start;
-    int shown;
-    double last_draw;
-} progress_state;
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-/* A progress bar with ETA on stderr, shown only once work has taken over ~1 s. */
-static int progress_bar(void *user, const char *stage, double f)
-{
-    progress_state *p = user;
-    if (!p->enabled) return 0;
-    double t = now_s() - p->start;
-    if (t < 1.0 && f < 1.0) return 0;
-    if (t < 1.0 && !p->shown) return 0;
-    if (f < 1.0 && t - p->last_draw < 0.1) return 0; /* redraw at most ten times a second */
-    p->last_draw = t;
-    int width = 30, fill = (int)(f * width + 0.5);
-    char bar[64];
-    for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
-    bar[width] = '\0';
-    double eta = f > 0 ? t * (1.0 - f) / f : 0;
-    fprintf(stderr, "\r%s [%s] %3.0f%%  %.1fs elapsed, ETA %.1fs ", stage, bar, 100.0 * f, t, eta);
-    if (f >= 1.0) fputc('\n', stderr);
-    fflush(stderr);
-    p->shown = 1;
-    return 0;
-}
-
 static void default_png_name(const char *scene_name, char *buf, size_t cap)
 {
     size_t j = 0;
@@ -176,8 +140,9 @@ int cli_cmd_render(int argc, char **argv)
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
 
-    progress_state prog = {!quiet && isatty(2), now_s(), 0, 0.0};
-    atmos_context *ctx = cli_context_with_progress(threads, quiet, progress_bar, &prog);
+    cli_progress prog;
+    cli_progress_init(&prog, quiet);
+    atmos_context *ctx = cli_context_with_progress(threads, quiet, cli_progress_bar, &prog);
     if (!ctx) return CLI_EXIT_RUNTIME;
 
     atmos_scene scene;

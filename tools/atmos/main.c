@@ -15,6 +15,9 @@ static const command commands[] = {
     {"sky", cli_cmd_sky, "query the analytic sky model along one view direction"},
     {"sun", cli_cmd_sun, "solar elevation and azimuth for a UTC time and place"},
     {"bench", cli_cmd_bench, "benchmarks (e.g. 'atmos bench sky')"},
+    {"phase", cli_cmd_phase, "particle phase functions: list presets, print or plot a table"},
+    {"cache", cli_cmd_cache, "the table cache: 'atmos cache path', 'atmos cache clear'"},
+    {"mie", cli_cmd_mie, "Mie efficiencies and amplitudes of one sphere"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

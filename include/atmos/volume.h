@@ -1,0 +1,121 @@
+/* Atmospheric volumes: several particle fields (number densities, m^-3) on one
+ * uniform voxel grid in world space, stored sparsely in bricks, with a coarse
+ * majorant grid for empty-space skipping (Riley et al. 2004 §3.2, Eq. 2-6).
+ *
+ * Life cycle: create -> add fields -> write voxels (set / set_dense) -> finalize.
+ * After atmos_volume_finalize() a volume is immutable: any number of threads may
+ * sample it. Memory limits are checked before allocating (ATMOS_E_LIMIT).
+ */
+#ifndef ATMOS_VOLUME_H
+#define ATMOS_VOLUME_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ATMOS_VOLUME_MAX_FIELDS 8
+#define ATMOS_VOLUME_MAX_DIM 16384          /* voxels along one axis */
+#define ATMOS_VOLUME_DEFAULT_MAX_MEMORY ((uint64_t)8 << 30)
+
+/* Settings for a new volume; zero means default where stated. */
+typedef struct atmos_volume_desc {
+    int dims[3];              /* voxels along x, y, z: 1..ATMOS_VOLUME_MAX_DIM */
+    double voxel_size_m;      /* edge of a (cubic) voxel, metres, > 0 */
+    double origin_m[3];       /* world position of the corner of voxel (0,0,0) */
+    double rotation[9];       /* row-major 3x3 rotation from grid axes to world axes;
+                                 all zero = identity. world = origin + R (index * voxel_size) */
+    uint64_t max_memory;      /* bytes the volume may use; 0 = ATMOS_VOLUME_DEFAULT_MAX_MEMORY */
+} atmos_volume_desc;
+
+typedef struct atmos_volume atmos_volume;
+
+ATMOS_API atmos_status atmos_volume_create(atmos_context *ctx, const atmos_volume_desc *desc, atmos_volume **out);
+ATMOS_API void atmos_volume_destroy(atmos_volume *vol);
+
+/* Adds a field named `name` ("cloud", "rain", "ice", "snow", "graupel", ...) whose
+ * particles are of the optics preset `particle` (atmos_particle_preset(); may equal
+ * name). Returns its index through *index. Before finalize only. */
+ATMOS_API atmos_status atmos_volume_add_field(atmos_context *ctx, atmos_volume *vol, const char *name,
+                                              const char *particle, int *index);
+/* Writes one voxel's number density (m^-3, finite, >= 0). Before finalize only. */
+ATMOS_API atmos_status atmos_volume_set(atmos_context *ctx, atmos_volume *vol, int field, int i, int j, int k,
+                                        float density);
+/* Writes a dense block of nx*ny*nz values (x fastest) times scale, at voxel offset
+ * (i0, j0, k0); zeros leave bricks unallocated. Rejects NaN, Inf and negatives with
+ * a message naming the first bad index. Before finalize only. */
+ATMOS_API atmos_status atmos_volume_set_dense(atmos_context *ctx, atmos_volume *vol, int field, const int offset[3],
+                                              const int size[3], const float *values, float scale);
+/* Builds the majorant grid and statistics; the volume becomes read-only. */
+ATMOS_API atmos_status atmos_volume_finalize(atmos_context *ctx, atmos_volume *vol);
+
+ATMOS_API const atmos_volume_desc *atmos_volume_get_desc(const atmos_volume *vol);
+ATMOS_API int atmos_volume_field_count(const atmos_volume *vol);
+ATMOS_API const char *atmos_volume_field_name(const atmos_volume *vol, int field);
+ATMOS_API const char *atmos_volume_field_particle(const atmos_volume *vol, int field);
+
+typedef struct atmos_volume_field_stats {
+    uint64_t active_voxels;   /* voxels with density > 0 */
+    double min, max;          /* over active voxels (0, 0 if none) */
+    double bounds_m[2][3];    /* world-space AABB of the active voxels */
+} atmos_volume_field_stats;
+ATMOS_API atmos_status atmos_volume_field_stats_get(const atmos_volume *vol, int field, atmos_volume_field_stats *out);
+/* Bytes held (bricks, majorant grid, bookkeeping). */
+ATMOS_API uint64_t atmos_volume_memory(const atmos_volume *vol);
+/* World-space AABB of the whole grid. */
+ATMOS_API void atmos_volume_bounds(const atmos_volume *vol, double lo[3], double hi[3]);
+
+/* Trilinear number density (m^-3) of a field at a world position; 0 outside. */
+ATMOS_API double atmos_volume_sample(const atmos_volume *vol, int field, const double p[3]);
+/* Extinction coefficient (m^-1) at p: sum_i eta_i(p) sigma_ext[i] (Riley Eq. 2-3). */
+ATMOS_API double atmos_volume_extinction(const atmos_volume *vol, const double *sigma_ext, const double p[3]);
+/* Optical depth along p = o + t d, t in [t0, t1] (Riley Eq. 4) with the extinction
+ * above, integrated by DDA over the voxels with empty-space skipping by the majorant
+ * grid; d need not be unit length (t is in units of |d|). */
+ATMOS_API double atmos_volume_optical_depth(const atmos_volume *vol, const double *sigma_ext, const double o[3],
+                                            const double d[3], double t0, double t1);
+
+/* ---------------------------------------------------------------- files */
+
+typedef struct atmos_volume_load_desc {
+    const char *grids;        /* VDB/NanoVDB: comma-separated grid names to load (NULL = "density"
+                                 or all float grids); NetCDF: variables (NULL = all hydrometeors) */
+    const char *field;        /* field/particle name for a single-grid file (NULL = "cloud") */
+    double density_scale;     /* multiplies the file's values to get m^-3; 0 = 1 for VDB/raw,
+                                 mass-based conversion for WRF/CM1 (docs/volumes.md) */
+    int time_index;           /* NetCDF: time step (default 0) */
+    int region[6];            /* NetCDF: i0, i1, j0, j1, k0, k1 sub-region (all 0 = everything) */
+    double voxel_size_m;      /* NetCDF: resampling voxel size (0 = from the grid spacing) */
+    uint64_t max_memory;      /* 0 = default */
+} atmos_volume_load_desc;
+
+/* Loads .vdb (OpenVDB, when built with it), .nvdb (NanoVDB), .nc (WRF or CM1
+ * NetCDF) or .json (raw float32 + JSON sidecar, see docs/volumes.md), chosen by
+ * the file's contents/extension. Malformed files: ATMOS_E_FORMAT naming the file
+ * and the problem; unsupported formats in this build: ATMOS_E_UNSUPPORTED. */
+ATMOS_API atmos_status atmos_volume_load(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                         atmos_volume **out);
+/* Writes every field as raw little-endian float32 (x fastest, one .raw per field
+ * next to the sidecar) and a JSON sidecar at json_path. Atomic per file. */
+ATMOS_API atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol, const char *json_path);
+
+/* ---------------------------------------------------------------- generators */
+
+typedef struct atmos_volume_generate_desc {
+    uint64_t seed;            /* same seed, same volume */
+    double voxel_size_m;      /* 0 = the preset's default */
+    double scale;             /* multiplies the preset's extent (1 = default); 0 = 1 */
+    uint64_t max_memory;      /* 0 = default */
+} atmos_volume_generate_desc;
+
+/* Presets: "cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm"
+ * (docs/volumes.md). Unknown names list the known ones. */
+ATMOS_API atmos_status atmos_volume_generate(atmos_context *ctx, const char *preset,
+                                             const atmos_volume_generate_desc *desc, atmos_volume **out);
+ATMOS_API const char *const *atmos_volume_generator_names(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

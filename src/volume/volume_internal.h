@@ -1,0 +1,19 @@
+/* Internals shared by the volume sources (core, readers, generators). */
+#ifndef ATMOS_VOLUME_INTERNAL_H
+#define ATMOS_VOLUME_INTERNAL_H
+
+#include "atmos/atmos.h"
+
+/* Readers (one per format), dispatched by atmos_volume_load() in volume_io.c.
+ * Each returns a finalized volume or an error naming the file. */
+atmos_status atmos__volume_load_raw_json(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                         atmos_volume **out);
+atmos_status atmos__volume_load_nanovdb(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                        atmos_volume **out);
+atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                       atmos_volume **out);
+/* OpenVDB through the C++ shim (src/volume/openvdb_shim.cpp), when built with it. */
+atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                        atmos_volume **out);
+
+#endif

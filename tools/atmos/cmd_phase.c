@@ -1,0 +1,319 @@
+/* atmos phase: list the particle presets; print, summarise or plot a preset's phase table. */
+#define _POSIX_C_SOURCE 200809L /* mkstemp, popen, fdopen, access */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static void help(void)
+{
+    printf("Usage: atmos phase                      list the particle presets\n"
+           "       atmos phase PRESET [options]     build (or load from the cache) and show its phase table\n\n"
+           "Options:\n"
+           "  --wavelengths rgb|spectral:N   the paper's three channels (default) or N samples in 380-780 nm\n"
+           "  --csv                          print the table: header theta_deg,<nm>,<nm>,... then one row\n"
+           "                                 per tabulated angle, P in 1/sr (integral over the sphere = 1)\n"
+           "  --plot OUT.png                 plot log P against the scattering angle, one curve per\n"
+           "                                 wavelength (needs gnuplot: Debian package gnuplot-nox)\n"
+           "  --no-cache                     neither read nor write the table cache (see 'atmos cache')\n"
+           "  --fast                         preview quality (coarser size integration, fewer rays)\n"
+           "  --threads N                    worker threads (default: all cores)\n"
+           "  -q, --quiet                    no progress bar or warnings\n"
+           "  -h, --help                     this help\n\n"
+           "Without --csv or --plot, prints per wavelength the extinction cross-section, the albedo,\n"
+           "the asymmetry g and P at 0 and 180 degrees.\n\n"
+           "Examples:\n"
+           "  atmos phase rain --plot rain.png\n"
+           "  atmos phase cloud --wavelengths spectral:16 --csv > cloud.csv\n");
+}
+
+/* One line describing a preset, from its resolved description. */
+static void describe(const atmos_particle_desc *p, char *buf, size_t cap)
+{
+    static const char *const sizes[] = {"radius", "lognormal median radius", "gamma mode radius"};
+    const char *sk = (unsigned)p->size.kind < 3 ? sizes[p->size.kind] : "radius";
+    char sigma[48] = "";
+    if (p->sigma_ext_m2 > 0) snprintf(sigma, sizeof sigma, ", sigma_ext %.3g m^2", p->sigma_ext_m2);
+    switch (p->kind) {
+    case ATMOS_PARTICLE_AIR: snprintf(buf, cap, "air molecules: Rayleigh scattering, sigma_ext ~ lambda^-4%s", sigma); break;
+    case ATMOS_PARTICLE_WATER:
+        snprintf(buf, cap, "water spheres (Mie theory), %s %.4g um%s", sk, p->size.r_m * 1e6, sigma);
+        break;
+    case ATMOS_PARTICLE_ICE:
+        snprintf(buf, cap, "hexagonal ice %s, radius %.4g um (ray tracing + diffraction)%s",
+                 p->habit == ATMOS_CRYSTAL_PLATE ? "plates" : "columns", p->size.r_m * 1e6, sigma);
+        break;
+    case ATMOS_PARTICLE_SNOW:
+        snprintf(buf, cap, "irregular (distorted) ice crystals, radius %.4g um%s", p->size.r_m * 1e6, sigma);
+        break;
+    case ATMOS_PARTICLE_ANALYTIC: snprintf(buf, cap, "analytic mixture of %d lobes%s", p->analytic.count, sigma); break;
+    default: snprintf(buf, cap, "particle kind %d", (int)p->kind); break;
+    }
+}
+
+static void known_presets(char *buf, size_t cap)
+{
+    const char *const *names = atmos_particle_preset_names();
+    size_t n = 0;
+    buf[0] = '\0';
+    for (int i = 0; names && names[i] && n < cap; i++) n += (size_t)snprintf(buf + n, cap - n, "%s%s", i ? ", " : "", names[i]);
+}
+
+static int list_presets(void)
+{
+    const char *const *names = atmos_particle_preset_names();
+    atmos_context *ctx = cli_context(1, 0);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    printf("Particle presets (atmos phase PRESET --help for options):\n");
+    for (int i = 0; names && names[i]; i++) {
+        atmos_particle_desc p;
+        char line[256];
+        if (atmos_particle_preset(ctx, names[i], &p) == ATMOS_OK) describe(&p, line, sizeof line);
+        else snprintf(line, sizeof line, "(cannot resolve: %s)", atmos_context_error(ctx));
+        printf("  %-8s %s\n", names[i], line);
+    }
+    atmos_context_destroy(ctx);
+    return CLI_EXIT_OK;
+}
+
+/* Parses rgb | spectral | spectral:N. */
+static int parse_wavelengths(const char *C, const char *text, atmos_wavelengths *wl)
+{
+    if (!strcmp(text, "rgb")) {
+        atmos_wavelengths_rgb(wl);
+        return 1;
+    }
+    int n = ATMOS_SPECTRAL_DEFAULT;
+    if (!strcmp(text, "spectral") ||
+        (!strncmp(text, "spectral:", 9) && cli_parse_int(C, "--wavelengths spectral:N", text + 9, 1, ATMOS_MAX_WAVELENGTHS, &n))) {
+        return atmos_wavelengths_spectral(n, wl) == ATMOS_OK;
+    }
+    if (strncmp(text, "spectral:", 9) != 0)
+        fprintf(stderr, "atmos %s: --wavelengths: expected rgb or spectral:N, got '%s'\n", C, text);
+    return 0;
+}
+
+static void print_csv(const atmos_phase_table *t)
+{
+    const double *theta;
+    int n = atmos_phase_grid(&theta), nw = atmos_phase_table_wavelength_count(t);
+    printf("theta_deg");
+    /* %.10g: 680 prints as "680", a bin centre as "392.5". */
+    for (int k = 0; k < nw; k++) printf(",%.10g", atmos_phase_table_wavelength_nm(t, k));
+    putchar('\n');
+    for (int i = 0; i < n; i++) {
+        printf("%.10g", theta[i]);
+        for (int k = 0; k < nw; k++) printf(",%.9g", atmos_phase_table_values(t, k)[i]);
+        putchar('\n');
+    }
+}
+
+static void print_summary(const char *preset, const atmos_phase_table *t)
+{
+    int nw = atmos_phase_table_wavelength_count(t);
+    printf("phase table '%s'%s: %d wavelengths, P in 1/sr normalised over the sphere\n", preset,
+           atmos_phase_table_from_cache(t) ? " (from the cache)" : "", nw);
+    printf("%10s %14s %8s %9s %14s %14s\n", "nm", "sigma_ext_m2", "albedo", "g", "P(0)", "P(180)");
+    for (int k = 0; k < nw; k++) {
+        const double *v = atmos_phase_table_values(t, k);
+        const double *theta;
+        int n = atmos_phase_grid(&theta);
+        printf("%10.6g %14.6g %8.5f %9.6f %14.6g %14.6g\n", atmos_phase_table_wavelength_nm(t, k),
+               atmos_phase_table_sigma_ext(t, k), atmos_phase_table_albedo(t, k), atmos_phase_table_g(t, k), v[0],
+               v[n - 1]);
+    }
+}
+
+/* ------------------------------------------------------------------ plotting with gnuplot */
+
+static int find_in_path(const char *prog)
+{
+    const char *path = getenv("PATH");
+    if (!path) return 0;
+    char dir[4096];
+    while (*path) {
+        size_t n = strcspn(path, ":");
+        if (n > 0 && n + strlen(prog) + 2 < sizeof dir) {
+            snprintf(dir, sizeof dir, "%.*s/%s", (int)n, path, prog);
+            if (access(dir, X_OK) == 0) return 1;
+        }
+        path += n;
+        if (*path == ':') path++;
+    }
+    return 0;
+}
+
+/* A gnuplot double-quoted string (backslash escapes). */
+static void gp_quote(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"' || *s == '\\') fputc('\\', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+/* Line colour of a wavelength: its CIE 1931 colour in sRGB, brightened. */
+static unsigned wavelength_colour(double nm)
+{
+    double xyz[3], rgb[3];
+    atmos_cie_xyz_cmf(nm, xyz);
+    atmos_xyz_to_srgb(xyz, rgb);
+    double m = 0;
+    for (int c = 0; c < 3; c++) {
+        if (!(rgb[c] > 0)) rgb[c] = 0;
+        if (rgb[c] > m) m = rgb[c];
+    }
+    unsigned out = 0;
+    for (int c = 0; c < 3; c++) {
+        double v = m > 0 ? pow(rgb[c] / m, 1 / 2.2) * 0.85 : 0.4;
+        out = (out << 8) | (unsigned)lround(v * 255);
+    }
+    return out;
+}
+
+static int plot_png(const char *C, const char *preset, const atmos_phase_table *t, const char *out)
+{
+    if (strchr(out, '\n')) return cli_usage_error(C, "--plot: file name contains a newline");
+    if (!find_in_path("gnuplot")) {
+        fprintf(stderr, "atmos %s: --plot needs gnuplot, which is not installed or not on PATH "
+                        "(Debian: apt-get install gnuplot-nox)\n", C);
+        return CLI_EXIT_RUNTIME;
+    }
+    const char *tmpdir = getenv("TMPDIR");
+    char data[4096];
+    snprintf(data, sizeof data, "%s/atmos-phase-XXXXXX", tmpdir && *tmpdir ? tmpdir : "/tmp");
+    int fd = mkstemp(data);
+    FILE *df = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!df) {
+        fprintf(stderr, "atmos %s: cannot create a temporary file: %s\n", C, strerror(errno));
+        if (fd >= 0) close(fd), remove(data);
+        return CLI_EXIT_RUNTIME;
+    }
+    const double *theta;
+    int n = atmos_phase_grid(&theta), nw = atmos_phase_table_wavelength_count(t);
+    for (int i = 0; i < n; i++) {
+        fprintf(df, "%.10g", theta[i]);
+        for (int k = 0; k < nw; k++) {
+            double v = atmos_phase_table_values(t, k)[i];
+            fprintf(df, " %.9g", v > 0 ? v : 1e-300); /* log axis: no zeros */
+        }
+        fputc('\n', df);
+    }
+    int data_ok = fclose(df) == 0;
+    char tmp_png[4200];
+    snprintf(tmp_png, sizeof tmp_png, "%s.tmp%ld", out, (long)getpid());
+    int rc = CLI_EXIT_RUNTIME;
+    FILE *gp = data_ok ? popen("gnuplot", "w") : NULL;
+    if (gp) {
+        fprintf(gp, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1000,640 } "
+                    "else { set terminal png size 1000,640 }\n");
+        fprintf(gp, "set output ");
+        gp_quote(gp, tmp_png);
+        fprintf(gp, "\nset title ");
+        char title[160];
+        snprintf(title, sizeof title, "phase function: %s", preset);
+        gp_quote(gp, title);
+        fprintf(gp, " noenhanced\nset logscale y\nset format y '10^{%%L}'\nset xrange [0:180]\nset xtics 20\n"
+                    "set mxtics 2\nset grid\nset xlabel 'scattering angle (degrees)'\n"
+                    "set ylabel 'P (1/sr), integral over the sphere = 1'\nset key top right\nplot ");
+        for (int k = 0; k < nw; k++) {
+            fprintf(gp, "%s", k ? ", " : "");
+            gp_quote(gp, data);
+            fprintf(gp, " using 1:%d with lines lw 1.5 lc rgb '#%06x' title '%.10g nm'", k + 2,
+                    wavelength_colour(atmos_phase_table_wavelength_nm(t, k)), atmos_phase_table_wavelength_nm(t, k));
+        }
+        fprintf(gp, "\nset output\n");
+        int st = pclose(gp);
+        if (st == 0 && rename(tmp_png, out) == 0) rc = CLI_EXIT_OK;
+        else if (st != 0) fprintf(stderr, "atmos %s: gnuplot failed (status %d)\n", C, st);
+        else fprintf(stderr, "atmos %s: %s: cannot rename into place: %s\n", C, out, strerror(errno));
+    } else {
+        fprintf(stderr, "atmos %s: cannot run gnuplot: %s\n", C, strerror(errno));
+    }
+    if (rc != CLI_EXIT_OK) remove(tmp_png);
+    remove(data);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ the command */
+
+int cli_cmd_phase(int argc, char **argv)
+{
+    const char *C = "phase";
+    const char *preset = NULL, *plot = NULL;
+    int csv = 0, no_cache = 0, fast = 0, threads = 0, quiet = 0;
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(a, "--wavelengths") && i + 1 < argc) {
+            if (!parse_wavelengths(C, argv[++i], &wl)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--plot") && i + 1 < argc) {
+            plot = argv[++i];
+        } else if (!strcmp(a, "--threads") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--csv")) {
+            csv = 1;
+        } else if (!strcmp(a, "--no-cache")) {
+            no_cache = 1;
+        } else if (!strcmp(a, "--fast")) {
+            fast = 1;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            quiet = 1;
+        } else if (a[0] == '-') {
+            return cli_usage_error(C, "unknown or incomplete option '%s'", a);
+        } else if (!preset) {
+            preset = a;
+        } else {
+            return cli_usage_error(C, "unexpected argument '%s' (one preset at a time)", a);
+        }
+    }
+    if (!preset) {
+        if (csv || plot || no_cache || fast) return cli_usage_error(C, "which preset? ('atmos phase' lists them)");
+        return list_presets();
+    }
+    const char *const *names = atmos_particle_preset_names();
+    int known = 0;
+    for (int i = 0; names && names[i]; i++) known |= !strcmp(names[i], preset);
+    if (!known) {
+        char list[256];
+        known_presets(list, sizeof list);
+        return cli_usage_error(C, "unknown preset '%s' (known presets: %s)", preset, list);
+    }
+    if (plot && !*plot) return cli_usage_error(C, "--plot: empty file name");
+
+    cli_progress prog;
+    cli_progress_init(&prog, quiet);
+    atmos_context *ctx = cli_context_with_progress(threads, quiet, cli_progress_bar, &prog);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_particle_desc p;
+    atmos_phase_table *t = NULL;
+    atmos_status st = atmos_particle_preset(ctx, preset, &p);
+    if (st == ATMOS_OK) {
+        if (fast) p.fast = 1;
+        atmos_phase_table_desc td = {no_cache};
+        st = atmos_phase_table_build(ctx, &p, &wl, &td, &t);
+    }
+    if (st != ATMOS_OK) {
+        int rc = cli_runtime_error(C, ctx, st);
+        atmos_context_destroy(ctx);
+        return rc;
+    }
+    int rc = CLI_EXIT_OK;
+    if (csv) print_csv(t);
+    if (plot) rc = plot_png(C, preset, t, plot);
+    if (!csv && !plot) print_summary(preset, t);
+    if (plot && rc == CLI_EXIT_OK && !quiet) fprintf(stderr, "atmos %s: wrote %s\n", C, plot);
+    atmos_phase_table_destroy(t);
+    atmos_context_destroy(ctx);
+    return rc;
+}
