@@ -6,10 +6,10 @@
  *    which for a convex body is a quarter of its surface area (Cauchy's theorem); half
  *    of it is scattered by reflection and refraction (the rays), half by diffraction
  *    (van de Hulst 1957, §8.22; Takano & Liou 1989 J. Atmos. Sci. 46, 3).
- *  - diffraction: Fraunhofer pattern of a circular aperture with the same mean
- *    projected area (the Airy pattern), an approximation to the average over the
- *    hexagonal shadows that differs mainly in the ring structure, which the rendering
- *    never resolves anyway (and which a real size spread washes out).
+ *  - diffraction: each orientation diffracts like a circular aperture of its own
+ *    projected area (Airy pattern), mixed with weights equal to that area (see
+ *    diffraction() below): an approximation to the average over the hexagonal shadows
+ *    that differs mainly in the ring structure.
  *  - delta transmission: rays leaving through a face parallel to the entry face keep the
  *    incident direction exactly; geometric optics gives a delta function at 0°. Like
  *    the diffracted light it is really spread by diffraction at the facet apertures, so
