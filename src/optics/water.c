@@ -1,0 +1,344 @@
+/* Phase function of a polydisperse ensemble of water spheres at one wavelength.
+ *
+ * Size averaging. The single-size phase function of a large drop is full of
+ * interference fringes (period ~ pi/x in angle, ~ 1-3 in x at a fixed angle: the
+ * "ripple" between reflected and refracted rays, whose coarse period in x is
+ * ~ pi/(n-1) ~ 10 and whose finer structure is ~ 1) and narrow resonances. A real
+ * cloud or rain shower averages them away; so must the table. We integrate over the
+ * cross-section-weighted size distribution
+ *     a(r) = n(r) r^2 / <r^2>                                (pdf of r)
+ * because every quantity we need is linear in n(r) pi r^2 Q:
+ *     sigma_ext = pi <r^2> E_a[Q_ext],  sigma_sca = pi <r^2> E_a[Q_sca],
+ *     dsigma_sca/dOmega = <r^2> E_a[(|S1|^2 + |S2|^2) / (2 x^2)],
+ * (BH Eq. 3.16 and 4.61, with k r = x), <r^2> being the number-weighted mean computed
+ * by quadrature of n(r). Sizes are drawn by stratified sampling of a(r): N strata of
+ * equal cross-section weight, one size per stratum at a deterministic jittered
+ * quantile (golden-ratio sequence), so each size carries weight 1/N and the
+ * large drops that dominate the scattering get the samples. Jitter turns what would be
+ * coherent aliasing of the x-ripple into noise that falls as 1/sqrt(N) and as the
+ * strata shrink below the ripple period.
+ *
+ * N is set by the size spread in x (strata at most DX_TARGET wide in x) and capped by a
+ * cost budget (the Mie cost is ~ x * number of distinct |cos theta|): clouds (x < 500)
+ * get ripple-resolving strata; rain (x ~ 1e4 .. 4e4) gets as many sizes as the budget
+ * allows, and the residual fringe noise is then removed by averaging each single-size
+ * intensity over its grid cell in angle (see cell_average): a table value stands for the
+ * cell around its angle, and a drop's fringes finer than the cell carry no information
+ * the grid could hold. Accuracies of the two qualities are in docs/optics.md.
+ *
+ * Threads: sizes are computed in batches by OpenMP threads into per-size slots and
+ * summed by the calling thread in size order, so the result does not depend on the
+ * thread count. Progress is reported between batches from the calling thread.
+ */
+#include "core/internal.h"
+#include "optics/optics_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* Widest stratum in x in normal quality: well below the ripple period (~1-3). */
+#define DX_TARGET 0.25
+/* Cost budget per wavelength, in Mie (series term x distinct angle) units; one unit is
+ * ~3.7 ns on one core of a 2020s x86 machine, so normal quality is ~30 core-seconds
+ * per wavelength at most and fast quality 1/16 of it. */
+#define BUDGET_NORMAL 8.0e9
+#define BUDGET_FAST (BUDGET_NORMAL / 16.0)
+#define MIN_SIZES_NORMAL 32
+#define MIN_SIZES_FAST 12
+#define MAX_SIZES 20000
+/* Tail weight left out at each end of the size range when r_min / r_max are automatic. */
+#define TAIL 0.5e-6
+#define TABLE_N 8193
+#define BATCH 32
+
+/* log of the number density per unit ln r, up to a constant: n(r) r. */
+static double log_density_lnr(const atmos_size_distribution *s, double lnr)
+{
+    switch (s->kind) {
+    case ATMOS_SIZE_LOGNORMAL: {
+        double d = (lnr - log(s->r_m)) / s->sigma;
+        return -0.5 * d * d; /* n(r) ~ exp(-d^2/2) / r, so n(r) r is the Gaussian */
+    }
+    case ATMOS_SIZE_GAMMA: {
+        /* n(r) ~ r^alpha exp(-b r^gamma), b = alpha / (gamma r_m^gamma) (Deirmendjian 1969) */
+        double rr = exp(lnr - log(s->r_m)); /* r / r_m */
+        return (s->alpha + 1.0) * (lnr - log(s->r_m)) - s->alpha / s->gamma * pow(rr, s->gamma);
+    }
+    default:
+        return 0.0;
+    }
+}
+
+static atmos_status check_distribution(atmos_context *ctx, const atmos_size_distribution *s)
+{
+    if (!(s->r_m > 0.0 && s->r_m < 1.0))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "water particle: size.r_m must be in (0, 1) m, got %g", s->r_m);
+    if (s->kind == ATMOS_SIZE_LOGNORMAL && !(s->sigma > 0.0 && s->sigma <= 2.0))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "water particle: lognormal size.sigma must be in (0, 2], got %g",
+                            s->sigma);
+    if (s->kind == ATMOS_SIZE_GAMMA && !(s->alpha > 0.0 && s->alpha <= 1000.0 && s->gamma > 0.0 && s->gamma <= 100.0))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "water particle: gamma size.alpha must be in (0, 1000] and size.gamma in (0, 100], got "
+                            "alpha %g, gamma %g",
+                            s->alpha, s->gamma);
+    if (s->kind != ATMOS_SIZE_MONODISPERSE && s->kind != ATMOS_SIZE_LOGNORMAL && s->kind != ATMOS_SIZE_GAMMA)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "water particle: unknown size distribution kind %d", (int)s->kind);
+    if (!(s->r_min >= 0.0) || !(s->r_max >= 0.0) || (s->r_max > 0.0 && s->r_min >= s->r_max))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "water particle: size.r_min, r_max must be >= 0 with r_min < r_max, got %g, %g", s->r_min,
+                            s->r_max);
+    return ATMOS_OK;
+}
+
+/* A tabulated distribution on a ln r grid: cdf of the cross-section-weighted pdf a(r)
+ * and the number-weighted <r^2>. */
+typedef struct {
+    double lo, hi;            /* ln r range of the table */
+    double cdf[TABLE_N];      /* of a(r), normalised to 1 at hi */
+    double mean_r2;           /* number-weighted <r^2>, m^2 */
+} size_table;
+
+static void build_table(const atmos_size_distribution *s, size_table *t)
+{
+    double c = log(s->r_m);
+    /* the densities are negligible (< e^-40 of their peak) outside this window */
+    double lo = c - 12.0, hi = c + 12.0;
+    if (s->kind == ATMOS_SIZE_LOGNORMAL) lo = c - 9.0 * s->sigma, hi = c + 2.0 * s->sigma * s->sigma + 9.0 * s->sigma;
+    if (s->r_min > 0.0) lo = fmax(lo, log(s->r_min));
+    if (s->r_max > 0.0) hi = fmin(hi, log(s->r_max));
+    if (hi <= lo) hi = lo + 1e-9;
+    const double h = (hi - lo) / (TABLE_N - 1);
+    /* peak of the log-densities to avoid overflow */
+    double pk_a = -INFINITY, pk_n = -INFINITY;
+    for (int i = 0; i < TABLE_N; i++) {
+        double u = lo + i * h, ln = log_density_lnr(s, u);
+        pk_n = fmax(pk_n, ln);
+        pk_a = fmax(pk_a, ln + 2.0 * (u - c));
+    }
+    double sa = 0.0, sn = 0.0, sn2 = 0.0, prev_a = 0.0, prev_n = 0.0, prev_n2 = 0.0;
+    for (int i = 0; i < TABLE_N; i++) {
+        double u = lo + i * h, ln = log_density_lnr(s, u);
+        double fa = exp(ln + 2.0 * (u - c) - pk_a), fn = exp(ln - pk_n), fn2 = fn * exp(2.0 * (u - c));
+        if (i > 0) {
+            sa += 0.5 * h * (fa + prev_a);
+            sn += 0.5 * h * (fn + prev_n);
+            sn2 += 0.5 * h * (fn2 + prev_n2);
+        }
+        t->cdf[i] = sa;
+        prev_a = fa, prev_n = fn, prev_n2 = fn2;
+    }
+    for (int i = 0; i < TABLE_N; i++) t->cdf[i] /= sa;
+    t->lo = lo, t->hi = hi;
+    t->mean_r2 = s->r_m * s->r_m * sn2 / sn;
+}
+
+/* ln r at cross-section quantile q (linear interpolation of the tabulated cdf). */
+static double table_quantile(const size_table *t, double q)
+{
+    int a = 0, b = TABLE_N - 1;
+    while (b - a > 1) {
+        int mid = (a + b) / 2;
+        if (t->cdf[mid] < q) a = mid;
+        else b = mid;
+    }
+    double h = (t->hi - t->lo) / (TABLE_N - 1);
+    double d = t->cdf[b] - t->cdf[a], f = d > 0 ? (q - t->cdf[a]) / d : 0.5;
+    return t->lo + (a + f) * h;
+}
+
+/* Averages |S1|^2 + |S2|^2 over the grid cell of each angle [mid(i-1, i), mid(i, i+1)],
+ * weighting by sin theta, from ns sub-samples per cell; the sub-sample values are
+ * v[i * ns + j]. */
+static void cell_average(int n, int ns, const double *sub_sin, const double *v, double *out)
+{
+    for (int i = 0; i < n; i++) {
+        double s = 0.0, w = 0.0;
+        for (int j = 0; j < ns; j++) {
+            s += v[i * ns + j] * sub_sin[i * ns + j];
+            w += sub_sin[i * ns + j];
+        }
+        out[i] = w > 0.0 ? s / w : v[i * ns + ns / 2];
+    }
+}
+
+/* The angles at which each cell is sampled: ns points evenly inside the cell (the grid
+ * angle itself when ns = 1). Cells at 0 and 180 degrees are one-sided. */
+static void cell_samples(int n, const double *deg, int ns, double *mu, double *sw)
+{
+    for (int i = 0; i < n; i++) {
+        double a = i > 0 ? 0.5 * (deg[i - 1] + deg[i]) : deg[i];
+        double b = i + 1 < n ? 0.5 * (deg[i] + deg[i + 1]) : deg[i];
+        for (int j = 0; j < ns; j++) {
+            double t = ns == 1 ? deg[i] : a + (b - a) * (j + 0.5) / ns;
+            double th = t * ATMOS_DEG2RAD;
+            mu[i * ns + j] = t <= 0.0 ? 1.0 : t >= 180.0 ? -1.0 : cos(th);
+            /* sin weight, but never zero: the end cells average their one-sided half */
+            sw[i * ns + j] = ns == 1 ? 1.0 : fmax(sin(th), 1e-12);
+        }
+    }
+}
+
+atmos_status atmos__water_phase(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
+                                const double *theta_deg, double *phase, atmos__phase_result *res,
+                                atmos__phase_progress progress, void *progress_user)
+{
+    if (!p || !theta_deg || !phase || !res || n_angles < 2)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "water phase: missing argument or fewer than 2 angles (%d)",
+                            n_angles);
+    if (!(nm >= 100.0 && nm <= 100000.0))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "water phase: wavelength must be in [100, 1e5] nm, got %g", nm);
+    for (int i = 0; i < n_angles; i++)
+        if (!(theta_deg[i] >= 0.0 && theta_deg[i] <= 180.0) || (i > 0 && !(theta_deg[i] > theta_deg[i - 1])))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                                "water phase: angles must increase within [0, 180] degrees; theta[%d] = %g", i,
+                                theta_deg[i]);
+    atmos_status st = check_distribution(ctx, &p->size);
+    if (st != ATMOS_OK) return st;
+
+    const atmos_complex m = atmos_refractive_index_water(nm);
+    const double k = 2.0 * ATMOS_PI / (nm * 1e-9);
+    const int mono = p->size.kind == ATMOS_SIZE_MONODISPERSE;
+
+    size_table *tab = mono ? NULL : malloc(sizeof *tab);
+    if (!mono && !tab) return atmos__error(ctx, ATMOS_E_NOMEM, "water phase: out of memory");
+    double q_lo = 0.0, q_hi = 1.0, mean_r2 = p->size.r_m * p->size.r_m;
+    if (!mono) {
+        build_table(&p->size, tab);
+        mean_r2 = tab->mean_r2;
+        if (p->size.r_min <= 0.0) q_lo = TAIL;
+        if (p->size.r_max <= 0.0) q_hi = 1.0 - TAIL;
+    }
+    double r_lo = mono ? p->size.r_m : exp(table_quantile(tab, q_lo));
+    double r_hi = mono ? p->size.r_m : exp(table_quantile(tab, q_hi));
+    if (k * r_hi > 1e5) {
+        free(tab);
+        return atmos__error(ctx, ATMOS_E_LIMIT,
+                            "water phase: drops up to r = %g m at %g nm need size parameter %g > 1e5 (Mie limit); "
+                            "set size.r_max",
+                            r_hi, nm, k * r_hi);
+    }
+
+    /* Sub-samples per cell: two per fringe period (2 pi / x) of the median drop in the
+     * widest cell, at most 2 in normal quality (cost) and 1 in fast quality. */
+    double max_cell = 0.0;
+    for (int i = 0; i + 1 < n_angles; i++) max_cell = fmax(max_cell, theta_deg[i + 1] - theta_deg[i]);
+    /* typical sampled size: the median of the cross-section weight */
+    double x_mean = mono ? k * p->size.r_m : k * exp(table_quantile(tab, 0.5));
+    int ns = (int)ceil(max_cell * ATMOS_DEG2RAD * x_mean / ATMOS_PI);
+    if (ns < 1) ns = 1;
+    if (ns > (p->fast ? 1 : 2)) ns = p->fast ? 1 : 2;
+    if (mono) ns = 1;
+
+    /* Number of sizes: strata DX_TARGET wide in x, within the cost budget. */
+    int n_sizes = 1;
+    if (!mono) {
+        double span = k * (r_hi - r_lo);
+        double want = ceil(span / (p->fast ? 8.0 * DX_TARGET : DX_TARGET));
+        /* theta and 180 - theta share one evaluation only without cell sub-samples */
+        double cost_each = (x_mean + 4.0 * cbrt(x_mean) + 2.0) * (ns == 1 ? 0.5 * n_angles + 1.0 : (double)n_angles * ns);
+        double afford = (p->fast ? BUDGET_FAST : BUDGET_NORMAL) / cost_each;
+        double nmin = p->fast ? MIN_SIZES_FAST : MIN_SIZES_NORMAL;
+        n_sizes = (int)fmin(fmax(fmin(want, afford), nmin), MAX_SIZES);
+    }
+    atmos__log(ctx, ATMOS_LOG_DEBUG,
+               "water phase %g nm: m = %.6f%+.3gi, r %.4g..%.4g m (x %.1f..%.1f), %d sizes, %d sub-angles per cell",
+               nm, m.re, m.im, r_lo, r_hi, k * r_lo, k * r_hi, n_sizes, ns);
+
+    const int nsub = n_angles * ns;
+    const int batch = n_sizes < BATCH ? n_sizes : BATCH;
+    double *mu = malloc((size_t)nsub * sizeof *mu);
+    double *sw = malloc((size_t)nsub * sizeof *sw);
+    double *slot = malloc((size_t)batch * n_angles * sizeof *slot); /* per-size |S|^2/(2x^2) */
+    double *slot_q = malloc((size_t)batch * 3 * sizeof *slot_q);   /* Q_ext, Q_sca, g Q_sca */
+    double *acc = calloc((size_t)n_angles, sizeof *acc);
+    if (!mu || !sw || !slot || !slot_q || !acc) {
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "water phase: out of memory for %d angles", n_angles);
+        goto done;
+    }
+    cell_samples(n_angles, theta_deg, ns, mu, sw);
+
+    double qext_sum = 0.0, qsca_sum = 0.0, gq_sum = 0.0;
+    const double golden = 0.6180339887498949;
+    for (int b0 = 0; b0 < n_sizes && st == ATMOS_OK; b0 += batch) {
+        int nb = n_sizes - b0 < batch ? n_sizes - b0 : batch;
+        int bst = ATMOS_OK;
+#pragma omp parallel num_threads(atmos__threads(ctx)) reduction(max : bst)
+        {
+            bst = ATMOS_OK; /* the private copy of a max reduction starts at INT_MIN */
+            atmos_complex *s1 = malloc((size_t)nsub * sizeof *s1), *s2 = malloc((size_t)nsub * sizeof *s2);
+            double *v = malloc((size_t)nsub * sizeof *v);
+            if (!s1 || !s2 || !v) bst = ATMOS_E_NOMEM;
+#pragma omp for schedule(dynamic, 1)
+            for (int j = 0; j < nb; j++) {
+                if (bst != ATMOS_OK) continue;
+                int i = b0 + j;
+                double r = p->size.r_m;
+                if (!mono) {
+                    /* stratum i of the cross-section weight, jittered by the golden-ratio sequence */
+                    double jit = fmod(0.5 + golden * (i + 1), 1.0);
+                    double q = q_lo + (q_hi - q_lo) * (i + jit) / n_sizes;
+                    r = exp(table_quantile(tab, q));
+                }
+                double x = k * r;
+                atmos_mie_result mr;
+                atmos_status s = atmos_mie(NULL, m, x, nsub, mu, s1, s2, &mr);
+                if (s != ATMOS_OK) {
+                    bst = s;
+                    continue;
+                }
+                double f = 1.0 / (2.0 * x * x);
+                for (int a = 0; a < nsub; a++)
+                    v[a] = f * (s1[a].re * s1[a].re + s1[a].im * s1[a].im + s2[a].re * s2[a].re + s2[a].im * s2[a].im);
+                cell_average(n_angles, ns, sw, v, slot + (size_t)j * n_angles);
+                slot_q[3 * j] = mr.qext;
+                slot_q[3 * j + 1] = mr.qsca;
+                slot_q[3 * j + 2] = mr.g * mr.qsca;
+            }
+            free(s1), free(s2), free(v);
+        }
+        if (bst != ATMOS_OK) {
+            st = atmos__error(ctx, (atmos_status)bst, "water phase: Mie computation failed at %g nm (%s)", nm,
+                              atmos_status_string((atmos_status)bst));
+            break;
+        }
+        /* fixed-order reduction: sizes in index order, independent of threads */
+        for (int j = 0; j < nb; j++) {
+            const double *sv = slot + (size_t)j * n_angles;
+            for (int a = 0; a < n_angles; a++) acc[a] += sv[a];
+            qext_sum += slot_q[3 * j];
+            qsca_sum += slot_q[3 * j + 1];
+            gq_sum += slot_q[3 * j + 2];
+        }
+        if (progress && progress(progress_user, (double)(b0 + nb) / n_sizes)) {
+            st = atmos__error(ctx, ATMOS_E_CANCELLED, "water phase: cancelled at %g nm", nm);
+            break;
+        }
+    }
+    if (st == ATMOS_OK) {
+        /* dsigma/dOmega / sigma_sca = E[|S|^2/(2x^2)] / (pi E[Q_sca]) */
+        double norm = ATMOS_PI * qsca_sum;
+        for (int a = 0; a < n_angles; a++) phase[a] = acc[a] / norm;
+        double integral = atmos__sphere_integral(n_angles, theta_deg, phase);
+        atmos__log(ctx, ATMOS_LOG_DEBUG, "water phase %g nm: integral of P over the sphere before normalising: %.8f",
+                   nm, integral);
+        if (!(integral > 0.0 && isfinite(integral))) {
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                              "water phase: the angle grid does not resolve the phase function at %g nm "
+                              "(integral %g)",
+                              nm, integral);
+        } else {
+            for (int a = 0; a < n_angles; a++) phase[a] /= integral;
+            res->sigma_ext_m2 = ATMOS_PI * mean_r2 * qext_sum / n_sizes;
+            res->albedo = qsca_sum / qext_sum;
+            res->g = gq_sum / qsca_sum;
+        }
+    }
+done:
+    free(tab), free(mu), free(sw), free(slot), free(slot_q), free(acc);
+    return st;
+}
