@@ -164,6 +164,48 @@ ATMOS_API double atmos_phase_table_g(const atmos_phase_table *t, int k);
 /* 1 if the table was read from the disk cache. */
 ATMOS_API int atmos_phase_table_from_cache(const atmos_phase_table *t);
 
+/* ---------------------------------------------------------------- multiple-scattering phase functions */
+
+/* Riley et al. 2004 §4.2.1-4.2.2: Ams_n, the distribution of light directions after n
+ * scattering events of an initially collimated beam (the phase function convolved with
+ * itself n times on the sphere, Eq. 20), and F_n, its forward-hemisphere fraction
+ * (Eq. 23). Built from a phase table by multiplying Legendre coefficients
+ * (convolution of azimuthally symmetric functions on the sphere is a product of their
+ * Legendre coefficients, the Funk-Hecke theorem); see docs/msphase.md. */
+typedef struct atmos_msphase atmos_msphase;
+
+typedef struct atmos_msphase_desc {
+    int max_order;        /* highest n; 0 = until Ams_n is isotropic to isotropy_tol (at most 1000) */
+    double isotropy_tol;  /* max |4 pi Ams_n - 1|; 0 = 1e-6 */
+    int no_cache;         /* nonzero: neither read nor write the disk cache */
+} atmos_msphase_desc;
+
+ATMOS_API atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *table,
+                                           const atmos_msphase_desc *desc, atmos_msphase **out);
+ATMOS_API void atmos_msphase_destroy(atmos_msphase *m);
+
+/* Highest order n tabulated (orders 0..n; Ams_0 is the collimated beam, a delta). */
+ATMOS_API int atmos_msphase_max_order(const atmos_msphase *m);
+ATMOS_API int atmos_msphase_wavelength_count(const atmos_msphase *m);
+/* The output angle grid (degrees, 0..180, finer near 0, never coarser than 0.1°). */
+ATMOS_API int atmos_msphase_grid(const atmos_msphase *m, const double **theta_deg);
+/* Ams_n (sr^-1) at every grid angle for wavelength k, 1 <= n <= max_order. */
+ATMOS_API const double *atmos_msphase_values(const atmos_msphase *m, int k, int n);
+/* Ams at fractional order n >= 1 (linear interpolation between integer orders, and
+ * in angle); orders above max_order are isotropic, 1/(4 pi). */
+ATMOS_API double atmos_msphase_eval(const atmos_msphase *m, int k, double n, double cos_theta);
+/* F_n (Eq. 23) at fractional n >= 0: F_0 = 1, linear interpolation between orders,
+ * 1/2 beyond max_order. */
+ATMOS_API double atmos_msphase_forward(const atmos_msphase *m, int k, double n);
+/* S(n) = sum_{i=1}^{n} ln F_i, linear between integer n (S(0) = 0), so that the exact
+ * light-buffer update of Eq. 24 is prod_{i=a}^{b} F_i = exp(S(b) - S(a - 1)). */
+ATMOS_API double atmos_msphase_log_forward_sum(const atmos_msphase *m, int k, double n);
+/* Legendre coefficient chi_l of the phase function (P = sum (2l+1)/(4 pi) chi_l P_l),
+ * 0 <= l < atmos_msphase_legendre_count(). */
+ATMOS_API int atmos_msphase_legendre_count(const atmos_msphase *m, int k);
+ATMOS_API double atmos_msphase_legendre(const atmos_msphase *m, int k, int l);
+ATMOS_API int atmos_msphase_from_cache(const atmos_msphase *m);
+
 #ifdef __cplusplus
 }
 #endif

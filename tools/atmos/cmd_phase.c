@@ -19,6 +19,11 @@ static void help(void)
            "                                 per tabulated angle, P in 1/sr (integral over the sphere = 1)\n"
            "  --plot OUT.png                 plot log P against the scattering angle, one curve per\n"
            "                                 wavelength (needs gnuplot: Debian package gnuplot-nox)\n"
+           "  --orders                       multiple-scattering phase functions Ams_n (Riley et al. 2004\n"
+           "                                 Eq. 20) instead: --csv prints n,theta_deg,<nm>,... for every\n"
+           "                                 order n >= 1 and angle; --plot draws several orders; the\n"
+           "                                 summary gives the highest order and forward fractions F_n\n"
+           "  --max-order N                  with --orders: stop at order N (default: until isotropic to 1e-6)\n"
            "  --no-cache                     neither read nor write the table cache (see 'atmos cache')\n"
            "  --fast                         preview quality (coarser size integration, fewer rays)\n"
            "  --threads N                    worker threads (default: all cores)\n"
@@ -28,7 +33,8 @@ static void help(void)
            "the asymmetry g and P at 0 and 180 degrees.\n\n"
            "Examples:\n"
            "  atmos phase rain --plot rain.png\n"
-           "  atmos phase cloud --wavelengths spectral:16 --csv > cloud.csv\n");
+           "  atmos phase cloud --wavelengths spectral:16 --csv > cloud.csv\n"
+           "  atmos phase rain --orders --csv > rain_ams.csv\n");
 }
 
 /* One line describing a preset, from its resolved description. */
@@ -177,7 +183,44 @@ static unsigned wavelength_colour(double nm)
     return out;
 }
 
-static int plot_png(const char *C, const char *preset, const atmos_phase_table *t, const char *out)
+/* Curves to plot: n_curves columns over the angles theta[0..n). */
+typedef struct {
+    int n, n_curves;
+    const double *theta;
+    const double *(*column)(const void *src, int curve);
+    void (*label)(const void *src, int curve, char *buf, size_t cap, unsigned *colour);
+    const void *src;
+    const char *ylabel;
+} plot_data;
+
+static const double *table_column(const void *src, int k) { return atmos_phase_table_values(src, k); }
+static void table_label(const void *src, int k, char *buf, size_t cap, unsigned *colour)
+{
+    double nm = atmos_phase_table_wavelength_nm(src, k);
+    snprintf(buf, cap, "%.10g nm", nm);
+    *colour = wavelength_colour(nm);
+}
+
+/* Orders shown by --orders --plot: a few, spread over the tabulated range. */
+static const int plot_orders[] = {1, 2, 3, 5, 10, 20, 50, 100, 200, 500};
+typedef struct {
+    const atmos_msphase *m;
+    int k;
+} orders_src;
+static const double *orders_column(const void *src, int c)
+{
+    const orders_src *o = src;
+    return atmos_msphase_values(o->m, o->k, plot_orders[c]);
+}
+static void orders_label(const void *src, int c, char *buf, size_t cap, unsigned *colour)
+{
+    (void)src;
+    static const unsigned colours[] = {0x1b3a8c, 0x2166ac, 0x4393c3, 0x1a9850, 0x66bd63, 0xa6d96a, 0xfdae61, 0xf46d43, 0xd73027, 0x7f0000};
+    snprintf(buf, cap, "n = %d", plot_orders[c]);
+    *colour = colours[c % 10];
+}
+
+static int plot_png(const char *C, const char *title_text, const plot_data *pd, const char *out)
 {
     if (strchr(out, '\n')) return cli_usage_error(C, "--plot: file name contains a newline");
     if (!find_in_path("gnuplot")) {
@@ -195,12 +238,12 @@ static int plot_png(const char *C, const char *preset, const atmos_phase_table *
         if (fd >= 0) close(fd), remove(data);
         return CLI_EXIT_RUNTIME;
     }
-    const double *theta;
-    int n = atmos_phase_grid(&theta), nw = atmos_phase_table_wavelength_count(t);
+    const double *theta = pd->theta;
+    int n = pd->n, nw = pd->n_curves;
     for (int i = 0; i < n; i++) {
         fprintf(df, "%.10g", theta[i]);
         for (int k = 0; k < nw; k++) {
-            double v = atmos_phase_table_values(t, k)[i];
+            double v = pd->column(pd->src, k)[i];
             fprintf(df, " %.9g", v > 0 ? v : 1e-300); /* log axis: no zeros */
         }
         fputc('\n', df);
@@ -216,17 +259,20 @@ static int plot_png(const char *C, const char *preset, const atmos_phase_table *
         fprintf(gp, "set output ");
         gp_quote(gp, tmp_png);
         fprintf(gp, "\nset title ");
-        char title[160];
-        snprintf(title, sizeof title, "phase function: %s", preset);
-        gp_quote(gp, title);
+        gp_quote(gp, title_text);
         fprintf(gp, " noenhanced\nset logscale y\nset format y '10^{%%L}'\nset xrange [0:180]\nset xtics 20\n"
                     "set mxtics 2\nset grid\nset xlabel 'scattering angle (degrees)'\n"
-                    "set ylabel 'P (1/sr), integral over the sphere = 1'\nset key top right\nplot ");
+                    "set ylabel ");
+        gp_quote(gp, pd->ylabel);
+        fprintf(gp, "\nset key top right\nplot ");
         for (int k = 0; k < nw; k++) {
+            char label[64];
+            unsigned colour = 0;
+            pd->label(pd->src, k, label, sizeof label, &colour);
             fprintf(gp, "%s", k ? ", " : "");
             gp_quote(gp, data);
-            fprintf(gp, " using 1:%d with lines lw 1.5 lc rgb '#%06x' title '%.10g nm'", k + 2,
-                    wavelength_colour(atmos_phase_table_wavelength_nm(t, k)), atmos_phase_table_wavelength_nm(t, k));
+            fprintf(gp, " using 1:%d with lines lw 1.5 lc rgb '#%06x' title ", k + 2, colour);
+            gp_quote(gp, label);
         }
         fprintf(gp, "\nset output\n");
         int st = pclose(gp);
@@ -241,13 +287,43 @@ static int plot_png(const char *C, const char *preset, const atmos_phase_table *
     return rc;
 }
 
+/* Ams_n as CSV: n,theta_deg,<nm>,... for n = 1..max_order (Ams_0 is the collimated
+ * beam, a delta function, and has no table). */
+static void print_orders_csv(const atmos_phase_table *t, const atmos_msphase *m)
+{
+    int nw = atmos_msphase_wavelength_count(m), N = atmos_msphase_max_order(m);
+    const double *grid;
+    int ng = atmos_msphase_grid(m, &grid);
+    printf("n,theta_deg");
+    for (int k = 0; k < nw; k++) printf(",%.10g", atmos_phase_table_wavelength_nm(t, k));
+    putchar('\n');
+    for (int n = 1; n <= N; n++)
+        for (int j = 0; j < ng; j++) {
+            printf("%d,%.10g", n, grid[j]);
+            for (int k = 0; k < nw; k++) printf(",%.9g", atmos_msphase_values(m, k, n)[j]);
+            putchar('\n');
+        }
+}
+
+static void print_orders_summary(const char *preset, const atmos_phase_table *t, const atmos_msphase *m, double secs)
+{
+    int nw = atmos_msphase_wavelength_count(m);
+    printf("multiple-scattering phase functions '%s': orders 1..%d (isotropic beyond), %s in %.3f s\n", preset,
+           atmos_msphase_max_order(m), atmos_msphase_from_cache(m) ? "loaded from the cache" : "built", secs);
+    printf("%10s %10s %10s %10s %10s %10s %12s\n", "nm", "F_1", "F_2", "F_5", "F_10", "F_26", "legendre_l");
+    for (int k = 0; k < nw; k++)
+        printf("%10.10g %10.6f %10.6f %10.6f %10.6f %10.6f %12d\n", atmos_phase_table_wavelength_nm(t, k),
+               atmos_msphase_forward(m, k, 1), atmos_msphase_forward(m, k, 2), atmos_msphase_forward(m, k, 5),
+               atmos_msphase_forward(m, k, 10), atmos_msphase_forward(m, k, 26), atmos_msphase_legendre_count(m, k));
+}
+
 /* ------------------------------------------------------------------ the command */
 
 int cli_cmd_phase(int argc, char **argv)
 {
     const char *C = "phase";
     const char *preset = NULL, *plot = NULL;
-    int csv = 0, no_cache = 0, fast = 0, threads = 0, quiet = 0;
+    int csv = 0, no_cache = 0, fast = 0, threads = 0, quiet = 0, orders = 0, max_order = 0;
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
     for (int i = 1; i < argc; i++) {
@@ -261,6 +337,10 @@ int cli_cmd_phase(int argc, char **argv)
             plot = argv[++i];
         } else if (!strcmp(a, "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--orders")) {
+            orders = 1;
+        } else if (!strcmp(a, "--max-order") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--max-order", argv[++i], 1, 1000, &max_order)) return CLI_EXIT_USAGE;
         } else if (!strcmp(a, "--csv")) {
             csv = 1;
         } else if (!strcmp(a, "--no-cache")) {
@@ -278,7 +358,7 @@ int cli_cmd_phase(int argc, char **argv)
         }
     }
     if (!preset) {
-        if (csv || plot || no_cache || fast) return cli_usage_error(C, "which preset? ('atmos phase' lists them)");
+        if (csv || plot || no_cache || fast || orders) return cli_usage_error(C, "which preset? ('atmos phase' lists them)");
         return list_presets();
     }
     const char *const *names = atmos_particle_preset_names();
@@ -308,10 +388,52 @@ int cli_cmd_phase(int argc, char **argv)
         atmos_context_destroy(ctx);
         return rc;
     }
+    if (max_order && !orders) {
+        atmos_phase_table_destroy(t);
+        atmos_context_destroy(ctx);
+        return cli_usage_error(C, "--max-order goes with --orders");
+    }
     int rc = CLI_EXIT_OK;
-    if (csv) print_csv(t);
-    if (plot) rc = plot_png(C, preset, t, plot);
-    if (!csv && !plot) print_summary(preset, t);
+    char title[160];
+    if (orders) {
+        atmos_msphase *m = NULL;
+        atmos_msphase_desc md = {0};
+        md.max_order = max_order;
+        md.no_cache = no_cache;
+        double t0 = cli_now_s();
+        st = atmos_msphase_build(ctx, t, &md, &m);
+        double secs = cli_now_s() - t0;
+        if (st != ATMOS_OK) {
+            rc = cli_runtime_error(C, ctx, st);
+        } else {
+            if (csv) print_orders_csv(t, m);
+            if (plot) {
+                int nc = 0;
+                while (nc < (int)(sizeof plot_orders / sizeof *plot_orders) && plot_orders[nc] <= atmos_msphase_max_order(m)) nc++;
+                int k = atmos_msphase_wavelength_count(m) / 2;
+                orders_src os = {m, k};
+                const double *grid;
+                int ng = atmos_msphase_grid(m, &grid);
+                snprintf(title, sizeof title, "multiple-scattering phase functions Ams_n: %s, %.10g nm", preset,
+                         atmos_phase_table_wavelength_nm(t, k));
+                plot_data pd = {ng, nc, grid, orders_column, orders_label, &os, "Ams_n (1/sr)"};
+                rc = plot_png(C, title, &pd, plot);
+            }
+            if (!csv && !plot) print_orders_summary(preset, t, m, secs);
+        }
+        atmos_msphase_destroy(m);
+    } else {
+        if (csv) print_csv(t);
+        if (plot) {
+            const double *theta;
+            int n = atmos_phase_grid(&theta);
+            snprintf(title, sizeof title, "phase function: %s", preset);
+            plot_data pd = {n, atmos_phase_table_wavelength_count(t), theta, table_column, table_label, t,
+                            "P (1/sr), integral over the sphere = 1"};
+            rc = plot_png(C, title, &pd, plot);
+        }
+        if (!csv && !plot) print_summary(preset, t);
+    }
     if (plot && rc == CLI_EXIT_OK && !quiet) fprintf(stderr, "atmos %s: wrote %s\n", C, plot);
     atmos_phase_table_destroy(t);
     atmos_context_destroy(ctx);
