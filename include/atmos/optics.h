@@ -206,6 +206,15 @@ ATMOS_API int atmos_msphase_legendre_count(const atmos_msphase *m, int k);
 ATMOS_API double atmos_msphase_legendre(const atmos_msphase *m, int k, int l);
 ATMOS_API int atmos_msphase_from_cache(const atmos_msphase *m);
 
+/* Ams_n of a mixture of particle types (Riley Eq. 6: the phase functions weighted by
+ * each field's share of the scattering coefficient, alpha_i beta_i), exactly: the
+ * mixture's Legendre coefficients are the weighted sums of the components'. All parts
+ * must have the same wavelength count; weights >= 0, not all zero (normalised here).
+ * The cheap alternative of mixing the components' Ams_n linearly is exact only for n = 1;
+ * its error is measured in docs/msphase.md. */
+ATMOS_API atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *parts, const double *weights,
+                                         int count, const atmos_msphase_desc *desc, atmos_msphase **out);
+
 #ifdef __cplusplus
 }
 #endif

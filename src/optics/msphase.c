@@ -329,6 +329,79 @@ static void forward_fractions(const double *chi, int count, int max_order, doubl
     }
 }
 
+/* Ams_1 by the series (when no table is given): like reconstruct's higher orders,
+ * tapered far from the forward direction. */
+static void series_first_order(const double *chi, int count, int ngrid, const double *grid, double *out)
+{
+    for (int j = 0; j < ngrid; j++) {
+        double mu = cos(grid[j] * ATMOS_DEG2RAD), p0 = 1.0, p1 = mu, s = 0;
+        int far = grid[j] >= MS_THETA_C;
+        int lend = far && count > MS_L_SMOOTH ? MS_L_SMOOTH : count;
+        int taper_from = far && count > MS_L_SMOOTH ? MS_L_SMOOTH / 2 : count;
+        for (int l = 0; l < lend; l++) {
+            double pl = l == 0 ? p0 : p1, taper = 1.0;
+            if (l > taper_from) {
+                double t = cos(0.5 * ATMOS_PI * (l - taper_from) / (double)(lend - taper_from));
+                taper = t * t;
+            }
+            s += (2.0 * l + 1) / (4.0 * ATMOS_PI) * taper * chi[l] * pl;
+            if (l > 0) {
+                double nx = ((2.0 * l + 1) * mu * p1 - l * p0) / (l + 1);
+                p0 = p1;
+                p1 = nx;
+            }
+        }
+        out[j] = s;
+    }
+}
+
+/* From the Legendre coefficients in m: the highest order, Ams_n for n >= 2 by the
+ * series, Ams_1 from the tables P (or, when P is NULL, by the series too), F_n and
+ * their log-sums. Frees m on failure. */
+static atmos_status finish_orders(atmos_context *ctx, atmos_msphase *m, const atmos_msphase_desc *dp, int n,
+                                  const double *theta_deg, const double *const *P, int threads)
+{
+    const atmos_msphase_desc d = *dp;
+    const int nwl = m->nwl;
+    int fail = 0;
+    int order = d.max_order;
+    if (order == 0) {
+        for (int k = 0; k < nwl; k++) {
+            int o = isotropic_order(m->chi[k], m->nchi[k], d.isotropy_tol, MS_MAX_ORDER);
+            if (o > order) order = o;
+        }
+    }
+    if (order < 1) order = 1;
+    m->max_order = order;
+    size_t nv = (size_t)nwl * order * m->ngrid;
+    if (nv > ((size_t)1 << 31))
+        fail = 2;
+    else {
+        m->values = malloc(sizeof(double) * nv);
+        m->forward = malloc(sizeof(double) * (size_t)nwl * (order + 1));
+        m->logsum = malloc(sizeof(double) * (size_t)nwl * (order + 1));
+        if (!m->values || !m->forward || !m->logsum) fail = 1;
+    }
+    if (fail) {
+        int ngrid = m->ngrid;
+        atmos_msphase_destroy(m);
+        return atmos__error(ctx, fail == 2 ? ATMOS_E_LIMIT : ATMOS_E_NOMEM, "msphase: %d orders x %d angles x %d wavelengths: %s",
+                            order, ngrid, nwl, fail == 2 ? "table too large" : "out of memory");
+    }
+    for (int k = 0; k < nwl; k++) {
+        double *vk = m->values + (size_t)k * order * m->ngrid;
+        reconstruct(m->chi[k], m->nchi[k], m->truncated[k], order, m->ngrid, m->grid, threads, vk);
+        if (P) first_order(n, theta_deg, P[k], m->ngrid, m->grid, vk);
+        else series_first_order(m->chi[k], m->nchi[k], m->ngrid, m->grid, vk);
+        atmos__progress(ctx, "multiple-scattering phase", 0.5 + 0.5 * (k + 1) / nwl);
+        double *F = m->forward + (size_t)k * (order + 1), *S = m->logsum + (size_t)k * (order + 1);
+        forward_fractions(m->chi[k], m->nchi[k], order, F);
+        S[0] = 0;
+        for (int i = 1; i <= order; i++) S[i] = S[i - 1] + log(fmax(F[i], 1e-300));
+    }
+    return ATMOS_OK;
+}
+
 void atmos_msphase_destroy(atmos_msphase *m)
 {
     if (!m) return;
@@ -376,40 +449,8 @@ atmos_status atmos__msphase_build_arrays(atmos_context *ctx, int nwl, int n, con
         atmos_msphase_destroy(m);
         return atmos__error(ctx, ATMOS_E_CANCELLED, "msphase: cancelled");
     }
-    int order = d.max_order;
-    if (order == 0) {
-        for (int k = 0; k < nwl; k++) {
-            int o = isotropic_order(m->chi[k], m->nchi[k], d.isotropy_tol, MS_MAX_ORDER);
-            if (o > order) order = o;
-        }
-    }
-    if (order < 1) order = 1;
-    m->max_order = order;
-    size_t nv = (size_t)nwl * order * m->ngrid;
-    if (nv > ((size_t)1 << 31))
-        fail = 2;
-    else {
-        m->values = malloc(sizeof(double) * nv);
-        m->forward = malloc(sizeof(double) * (size_t)nwl * (order + 1));
-        m->logsum = malloc(sizeof(double) * (size_t)nwl * (order + 1));
-        if (!m->values || !m->forward || !m->logsum) fail = 1;
-    }
-    if (fail) {
-        int ngrid = m->ngrid;
-        atmos_msphase_destroy(m);
-        return atmos__error(ctx, fail == 2 ? ATMOS_E_LIMIT : ATMOS_E_NOMEM, "msphase: %d orders x %d angles x %d wavelengths: %s",
-                            order, ngrid, nwl, fail == 2 ? "table too large" : "out of memory");
-    }
-    for (int k = 0; k < nwl; k++) {
-        double *vk = m->values + (size_t)k * order * m->ngrid;
-        reconstruct(m->chi[k], m->nchi[k], m->truncated[k], order, m->ngrid, m->grid, threads, vk);
-        first_order(n, theta_deg, P[k], m->ngrid, m->grid, vk);
-        atmos__progress(ctx, "multiple-scattering phase", 0.5 + 0.5 * (k + 1) / nwl);
-        double *F = m->forward + (size_t)k * (order + 1), *S = m->logsum + (size_t)k * (order + 1);
-        forward_fractions(m->chi[k], m->nchi[k], order, F);
-        S[0] = 0;
-        for (int i = 1; i <= order; i++) S[i] = S[i - 1] + log(fmax(F[i], 1e-300));
-    }
+    atmos_status st = finish_orders(ctx, m, &d, n, theta_deg, P, threads);
+    if (st != ATMOS_OK) return st;
     *out = m;
     return ATMOS_OK;
 }
@@ -617,4 +658,72 @@ double atmos_msphase_log_forward_sum(const atmos_msphase *m, int k, double n)
     int n0 = (int)floor(n);
     double w = n - n0;
     return S[n0] * (1 - w) + S[n0 + 1] * w;
+}
+
+atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *parts, const double *weights, int count,
+                               const atmos_msphase_desc *desc, atmos_msphase **out)
+{
+    if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: missing output");
+    *out = NULL;
+    if (!parts || !weights || count < 1)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: need at least one part, got %d", count);
+    double wsum = 0;
+    for (int i = 0; i < count; i++) {
+        if (!parts[i]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: part %d is missing", i);
+        if (!(weights[i] >= 0) || !isfinite(weights[i]))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: weight %d must be finite and >= 0, got %g", i, weights[i]);
+        if (parts[i]->nwl != parts[0]->nwl)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: part %d has %d wavelengths, part 0 has %d", i,
+                                parts[i]->nwl, parts[0]->nwl);
+        wsum += weights[i];
+    }
+    if (!(wsum > 0)) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: the weights are all zero");
+    atmos_msphase_desc d = {0};
+    if (desc) d = *desc;
+    if (d.isotropy_tol == 0) d.isotropy_tol = 1e-6;
+    if (d.max_order < 0 || d.max_order > MS_MAX_ORDER || !(d.isotropy_tol > 0 && d.isotropy_tol < 1))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: max_order must be in [0, %d] and isotropy_tol in (0, 1)",
+                            MS_MAX_ORDER);
+    int nwl = parts[0]->nwl;
+    atmos_msphase *m = calloc(1, sizeof *m);
+    if (!m) return atmos__error(ctx, ATMOS_E_NOMEM, "msphase mix: out of memory");
+    m->nwl = nwl;
+    m->chi = calloc(nwl, sizeof(double *));
+    m->nchi = calloc(nwl, sizeof(int));
+    m->truncated = calloc(nwl, sizeof(int));
+    m->ngrid = build_out_grid(&m->grid);
+    int fail = !m->chi || !m->nchi || !m->truncated || !m->ngrid;
+    for (int k = 0; k < nwl && !fail; k++) {
+        int len = 0;
+        for (int i = 0; i < count; i++) {
+            if (parts[i]->nchi[k] > len) len = parts[i]->nchi[k];
+            m->truncated[k] |= parts[i]->truncated ? parts[i]->truncated[k] : 0;
+        }
+        m->chi[k] = calloc(len, sizeof(double));
+        if (!m->chi[k]) {
+            fail = 1;
+            break;
+        }
+        m->nchi[k] = len;
+        /* Eq. 6 in Legendre space: chi_mix = sum_i w_i chi_i / sum_i w_i. */
+        for (int i = 0; i < count; i++)
+            for (int l = 0; l < parts[i]->nchi[k]; l++) m->chi[k][l] += weights[i] / wsum * parts[i]->chi[k][l];
+    }
+    if (fail) {
+        atmos_msphase_destroy(m);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "msphase mix: out of memory");
+    }
+    if (finish_orders(ctx, m, &d, 0, NULL, NULL, atmos__threads(ctx)) != ATMOS_OK) return atmos_context_error_status(ctx);
+    /* Order 1 mixes linearly (Eq. 6 itself): use the parts' tabulated Ams_1 rather than
+     * the series, exactly as a table built from the mixed phase function would. */
+    for (int k = 0; k < nwl; k++) {
+        double *row = m->values + (size_t)k * m->max_order * m->ngrid;
+        for (int j = 0; j < m->ngrid; j++) row[j] = 0;
+        for (int i = 0; i < count; i++) {
+            const double *src = parts[i]->values + (size_t)k * parts[i]->max_order * parts[i]->ngrid;
+            for (int j = 0; j < m->ngrid; j++) row[j] += weights[i] / wsum * src[j];
+        }
+    }
+    *out = m;
+    return ATMOS_OK;
 }

@@ -82,8 +82,60 @@ static void check_hg(double g)
     free(P);
 }
 
+/* Eq. 6 mixtures: atmos_msphase_mix (Legendre coefficients mixed) against Ams_n built
+ * directly from the mixed, tabulated phase function; and the size of the error made by
+ * mixing the components' Ams_n linearly instead. */
+static void check_mixture(void)
+{
+    const double *theta;
+    int n = atmos_phase_grid(&theta);
+    const double g1 = 0.9, g2 = 0.2, w1 = 0.3, w2 = 0.7;
+    double *a = malloc(sizeof(double) * n), *b = malloc(sizeof(double) * n), *mix = malloc(sizeof(double) * n);
+    for (int i = 0; i < n; i++) {
+        double mu = cos(theta[i] * PI / 180);
+        a[i] = hg(mu, g1), b[i] = hg(mu, g2), mix[i] = w1 * a[i] + w2 * b[i];
+    }
+    atmos_msphase *ma = NULL, *mb = NULL, *mm = NULL, *mx = NULL;
+    const double *pa[1] = {a}, *pb[1] = {b}, *pm[1] = {mix};
+    CHECK_OK(atmos__msphase_build_arrays(NULL, 1, n, theta, pa, NULL, &ma));
+    CHECK_OK(atmos__msphase_build_arrays(NULL, 1, n, theta, pb, NULL, &mb));
+    CHECK_OK(atmos__msphase_build_arrays(NULL, 1, n, theta, pm, NULL, &mm));
+    const atmos_msphase *parts[2] = {ma, mb};
+    const double w[2] = {w1 * 10, w2 * 10}; /* unnormalised on purpose */
+    CHECK_OK(atmos_msphase_mix(NULL, parts, w, 2, NULL, &mx));
+    if (ma && mb && mm && mx) {
+        const double *grid;
+        int ng = atmos_msphase_grid(mx, &grid);
+        const int orders[] = {1, 2, 5, 10};
+        for (int o = 0; o < 4; o++) {
+            int k = orders[o];
+            double max_rel = 0, lin_err = 0;
+            for (int j = 0; j < ng; j++) {
+                double mu = cos(grid[j] * PI / 180);
+                double exact = atmos_msphase_eval(mm, 0, k, mu), got = atmos_msphase_eval(mx, 0, k, mu);
+                /* closed form too: the mixture's chi_l = w1 g1^l + w2 g2^l */
+                max_rel = fmax(max_rel, fabs(got - exact) / exact);
+                double lin = w1 * atmos_msphase_eval(ma, 0, k, mu) + w2 * atmos_msphase_eval(mb, 0, k, mu);
+                lin_err = fmax(lin_err, fabs(lin - exact) / exact);
+            }
+            CHECK_MSG(max_rel < 1e-4, "mixture order %d: %.3g from the directly built table", k, max_rel);
+            CHECK_NEAR(atmos_msphase_forward(mx, 0, k), atmos_msphase_forward(mm, 0, k), 1e-6);
+            printf("mixture 0.3 HG(0.9) + 0.7 HG(0.2), order %d: exact vs direct %.2e; linear mixing of Ams_n errs by %.1f %%\n",
+                   k, max_rel, 100 * lin_err);
+            if (k == 1) CHECK(lin_err < 1e-5);
+            else CHECK(lin_err > 0.01); /* the approximation is not exact beyond n = 1 */
+        }
+    }
+    double bad[2] = {1, -1};
+    atmos_msphase *none = NULL;
+    CHECK(atmos_msphase_mix(NULL, parts, bad, 2, NULL, &none) == ATMOS_E_INVALID_ARG && none == NULL);
+    atmos_msphase_destroy(ma), atmos_msphase_destroy(mb), atmos_msphase_destroy(mm), atmos_msphase_destroy(mx);
+    free(a), free(b), free(mix);
+}
+
 int main(void)
 {
+    check_mixture();
     check_hg(0.0);
     check_hg(0.5);
     check_hg(0.85);
