@@ -36,7 +36,7 @@
 #define MS_L_SMOOTH 4096  /* series length needed away from the forward cone */
 #define MS_THETA_C 1.0    /* degrees: the forward cone where diffraction peaks live */
 /* Bump when the numbers this file produces change: old cache entries are then ignored. */
-#define MS_ALGORITHM_VERSION 1
+#define MS_ALGORITHM_VERSION 2
 
 struct atmos_msphase {
     int nwl, max_order, ngrid;
@@ -455,14 +455,16 @@ atmos_status atmos__msphase_build_arrays(atmos_context *ctx, int nwl, int n, con
     return ATMOS_OK;
 }
 
-/* ---- disk cache: payload = ints (nwl, max_order, ngrid, nchi[k]) then doubles
- * (grid, values, forward, logsum, chi[k]) */
+/* ---- disk cache: payload = ints (nwl, max_order, ngrid, nchi[k]), doubles (grid,
+ * forward, logsum, chi[k]), then the values as floats (7 significant digits are plenty
+ * for a distribution, and half the bytes keep a cached load within a few ms). */
 
 static size_t payload_size(const atmos_msphase *m)
 {
-    size_t nd = (size_t)m->ngrid + (size_t)m->nwl * m->max_order * m->ngrid + 2 * (size_t)m->nwl * (m->max_order + 1);
+    size_t nd = (size_t)m->ngrid + 2 * (size_t)m->nwl * (m->max_order + 1);
     for (int k = 0; k < m->nwl; k++) nd += (size_t)m->nchi[k];
-    return sizeof(int32_t) * (3 + (size_t)m->nwl) + sizeof(double) * nd;
+    return sizeof(int32_t) * (3 + (size_t)m->nwl) + sizeof(double) * nd +
+           sizeof(float) * (size_t)m->nwl * m->max_order * m->ngrid;
 }
 
 static void *serialise(const atmos_msphase *m, size_t *size)
@@ -478,11 +480,15 @@ static void *serialise(const atmos_msphase *m, size_t *size)
     }
 #define PUT(ptr, count) (memcpy(p, (ptr), sizeof(double) * (size_t)(count)), p += sizeof(double) * (size_t)(count))
     PUT(m->grid, m->ngrid);
-    PUT(m->values, (size_t)m->nwl * m->max_order * m->ngrid);
     PUT(m->forward, (size_t)m->nwl * (m->max_order + 1));
     PUT(m->logsum, (size_t)m->nwl * (m->max_order + 1));
     for (int k = 0; k < m->nwl; k++) PUT(m->chi[k], m->nchi[k]);
 #undef PUT
+    size_t nv = (size_t)m->nwl * m->max_order * m->ngrid;
+    for (size_t i = 0; i < nv; i++, p += sizeof(float)) {
+        float v = (float)m->values[i];
+        memcpy(p, &v, sizeof v);
+    }
     return buf;
 }
 
@@ -516,7 +522,6 @@ static atmos_msphase *deserialise(const unsigned char *p, size_t size, int nwl)
     if (!m->grid || !m->values || !m->forward || !m->logsum) goto bad;
 #define GET(ptr, count) (memcpy((ptr), p, sizeof(double) * (size_t)(count)), p += sizeof(double) * (size_t)(count))
     GET(m->grid, m->ngrid);
-    GET(m->values, nv);
     GET(m->forward, nf);
     GET(m->logsum, nf);
     for (int k = 0; k < nwl; k++) {
@@ -525,6 +530,10 @@ static atmos_msphase *deserialise(const unsigned char *p, size_t size, int nwl)
         GET(m->chi[k], m->nchi[k]);
     }
 #undef GET
+    {
+        const float *fv = (const float *)(const void *)p; /* payload buffers come from malloc: aligned */
+        for (size_t i = 0; i < nv; i++) m->values[i] = fv[i];
+    }
     m->from_cache = 1;
     return m;
 bad:
