@@ -33,10 +33,10 @@
 #define MS_MAX_ORDER 1000
 #define MS_CHI_TOL 2e-6
 #define MS_CHUNKS 32
-#define MS_L_SMOOTH 4096  /* series length needed away from the forward cone */
+#define MS_L_SMOOTH 8192  /* series length used away from the forward cone */
 #define MS_THETA_C 1.0    /* degrees: the forward cone where diffraction peaks live */
 /* Bump when the numbers this file produces change: old cache entries are then ignored. */
-#define MS_ALGORITHM_VERSION 2
+#define MS_ALGORITHM_VERSION 5
 
 struct atmos_msphase {
     int nwl, max_order, ngrid;
@@ -246,26 +246,33 @@ static void reconstruct(const double *chi, int count, int truncated, int max_ord
     memset(values, 0, sizeof(double) * (size_t)ngrid * max_order);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int c = 0; c < MS_CHUNKS; c++) {
-        int j0 = (int)((long long)ngrid * c / MS_CHUNKS), j1 = (int)((long long)ngrid * (c + 1) / MS_CHUNKS), nj = j1 - j0;
+        /* Half the chunks cover the forward cone, half the rest, so that no chunk mixes
+         * near angles (full series) with far ones (tapered series). */
+        int jc = 0;
+        while (jc < ngrid && grid[jc] < MS_THETA_C) jc++;
+        const int half = MS_CHUNKS / 2, cc = c < half ? c : c - half;
+        const int lo = c < half ? 0 : jc, span = c < half ? jc : ngrid - jc;
+        int j0 = lo + (int)((long long)span * cc / half), j1 = lo + (int)((long long)span * (cc + 1) / half), nj = j1 - j0;
         if (nj <= 0) continue;
         double *mu = malloc(sizeof(double) * nj), *p0 = malloc(sizeof(double) * nj), *p1 = malloc(sizeof(double) * nj);
         if (mu && p0 && p1) {
             for (int j = 0; j < nj; j++) mu[j] = cos(grid[j0 + j] * ATMOS_DEG2RAD), p0[j] = 1.0, p1[j] = mu[j];
-            /* Far from the forward direction the series is cut at MS_L_SMOOTH with a cos^2
-             * taper over its upper half: a sharp cut would ring (Gibbs) with the forward
-             * peak's large coefficients; the taper blurs by ~1/MS_L_SMOOTH rad (0.014°). */
+            /* Far from the forward direction (theta >= MS_THETA_C) the series is summed with
+             * a Gaussian window exp(-(l/L_g)^2), L_g = MS_L_SMOOTH/4.3 (1e-8 at the cut) when the
+             * series is longer than MS_L_SMOOTH (converged shorter series need no window): the
+             * full series would alias the products of the forward peak's large coefficients
+             * with the table's small high-l floor into noise, a sharp cut would ring, and a
+             * window with a slowly decaying kernel leaks the enormous forward peak into the
+             * degree beyond 1°. The Gaussian kernel blurs by ~2/L_g rad (0.06°) and leaks
+             * nothing measurable. A series cut before its coefficients have decayed
+             * (truncated, not converged) gets the same window near the forward direction,
+             * scaled to its length. */
             int far = grid[j0] >= MS_THETA_C;
             int lend = far && count > MS_L_SMOOTH ? MS_L_SMOOTH : count;
-            /* A series cut before its coefficients have decayed (truncated, not
-             * converged) is tapered over its last quarter for the same reason. */
-            int taper_from = far && count > MS_L_SMOOTH ? MS_L_SMOOTH / 2 : (truncated ? count - count / 4 : count);
+            double lg = far && count > MS_L_SMOOTH ? MS_L_SMOOTH / 4.3 : (truncated ? count / 4.3 : 0.0);
             for (int l = 0; l < lend; l++) {
                 const double *pl = l == 0 ? p0 : p1;
-                double taper = 1.0;
-                if (l > taper_from) {
-                    double t = cos(0.5 * ATMOS_PI * (l - taper_from) / (double)(lend - taper_from));
-                    taper = t * t;
-                }
+                double taper = lg > 0 ? exp(-(l / lg) * (l / lg)) : 1.0;
                 double norm = (2.0 * l + 1) / (4.0 * ATMOS_PI) * taper, cn = chi[l];
                 for (int n = 2; n <= max_order; n++) {
                     cn *= chi[l];
@@ -337,13 +344,9 @@ static void series_first_order(const double *chi, int count, int ngrid, const do
         double mu = cos(grid[j] * ATMOS_DEG2RAD), p0 = 1.0, p1 = mu, s = 0;
         int far = grid[j] >= MS_THETA_C;
         int lend = far && count > MS_L_SMOOTH ? MS_L_SMOOTH : count;
-        int taper_from = far && count > MS_L_SMOOTH ? MS_L_SMOOTH / 2 : count;
+        double lg = far && count > MS_L_SMOOTH ? MS_L_SMOOTH / 4.3 : 0.0; /* the window of reconstruct() */
         for (int l = 0; l < lend; l++) {
-            double pl = l == 0 ? p0 : p1, taper = 1.0;
-            if (l > taper_from) {
-                double t = cos(0.5 * ATMOS_PI * (l - taper_from) / (double)(lend - taper_from));
-                taper = t * t;
-            }
+            double pl = l == 0 ? p0 : p1, taper = lg > 0 ? exp(-(l / lg) * (l / lg)) : 1.0;
             s += (2.0 * l + 1) / (4.0 * ATMOS_PI) * taper * chi[l] * pl;
             if (l > 0) {
                 double nx = ((2.0 * l + 1) * mu * p1 - l * p0) / (l + 1);

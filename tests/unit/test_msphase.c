@@ -83,6 +83,13 @@ static void check_preset(const char *name, atmos_context *ctx)
         worst = fmax(worst, fabs(2 * PI * s - 1));
     }
     CHECK_MSG(worst <= 1e-4, "%s: worst |integral - 1| over %d orders = %.3g", name, N, worst);
+    /* a distribution of directions is never negative (series ringing would show here) */
+    int negative = 0;
+    for (int n = 1; n <= N; n++) {
+        const double *v = atmos_msphase_values(m, 0, n);
+        for (int j = 0; j < ng; j++) negative += v[j] < -1e-9 * v[0];
+    }
+    CHECK_MSG(negative == 0, "%s: %d negative values", name, negative);
     const double *vN = atmos_msphase_values(m, 0, N);
     double iso = 0;
     for (int j = 0; j < ng; j++) iso = fmax(iso, fabs(4 * PI * vN[j] - 1));
