@@ -248,23 +248,38 @@ static atmos_status parse_sidecar(atmos_context *ctx, const char *path, const cJ
     return ATMOS_OK;
 }
 
+static atmos_status check_raw_size(atmos_context *ctx, const char *sidecar, const int n[3], const char *file)
+{
+    uint64_t expect = (uint64_t)n[0] * (uint64_t)n[1] * (uint64_t)n[2] * 4u;
+    struct stat sb;
+    if (stat(file, &sb) != 0)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: raw file %s: cannot stat: %s", sidecar, file, strerror(errno));
+    if (!S_ISREG(sb.st_mode))
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: raw file %s: not a regular file", sidecar, file);
+    if ((uint64_t)sb.st_size != expect)
+        return atmos__error(ctx, ATMOS_E_FORMAT,
+                            "%s: raw file %s has %llu bytes but dims %dx%dx%d of float32 need %llu%s", sidecar, file,
+                            (unsigned long long)sb.st_size, n[0], n[1], n[2], (unsigned long long)expect,
+                            (uint64_t)sb.st_size < expect ? " (truncated)" : "");
+    return ATMOS_OK;
+}
+
+/* Errors from the volume API (which does not know the file) get the path in front;
+ * invalid descriptions read from a file are format errors. */
+static atmos_status prefix_error(atmos_context *ctx, const char *path, atmos_status st)
+{
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", atmos_context_error(ctx));
+    if (!strncmp(msg, path, strlen(path))) return st;
+    return atmos__error(ctx, st == ATMOS_E_INVALID_ARG ? ATMOS_E_FORMAT : st, "%s: %s", path, msg);
+}
+
 /* Streams one raw file into field `fi`, plane by plane. */
 static atmos_status read_raw(atmos_context *ctx, const char *sidecar, atmos_volume *vol, int fi, const raw_field *rf,
                              double extra_scale)
 {
     const int *n = vol->desc.dims;
     uint64_t plane = (uint64_t)n[0] * (uint64_t)n[1];
-    uint64_t expect = plane * (uint64_t)n[2] * 4u;
-    struct stat sb;
-    if (stat(rf->file, &sb) != 0)
-        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: raw file %s: cannot stat: %s", sidecar, rf->file, strerror(errno));
-    if (!S_ISREG(sb.st_mode))
-        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: raw file %s: not a regular file", sidecar, rf->file);
-    if ((uint64_t)sb.st_size != expect)
-        return atmos__error(ctx, ATMOS_E_FORMAT,
-                            "%s: raw file %s has %llu bytes but dims %dx%dx%d of float32 need %llu%s", sidecar,
-                            rf->file, (unsigned long long)sb.st_size, n[0], n[1], n[2], (unsigned long long)expect,
-                            (uint64_t)sb.st_size < expect ? " (truncated)" : "");
     uint64_t buf_bytes = plane * 4u;
     if (!atmos__volume_can_alloc(vol, buf_bytes))
         return atmos__error(ctx, ATMOS_E_LIMIT, "%s: a %llu-byte read buffer exceeds the memory limit", sidecar,
@@ -334,16 +349,13 @@ atmos_status atmos__volume_load_raw_json(atmos_context *ctx, const char *path, c
     double extra = desc && desc->density_scale != 0 ? desc->density_scale : 1.0;
     if (!isfinite(extra) || extra < 0)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: density_scale must be finite and >= 0", path);
+    /* Every raw file must hold exactly the bytes the dims claim: checked before
+     * anything is allocated, so absurd dims never reach an allocation. */
+    for (int g = 0; g < sc.nfields; g++)
+        if ((st = check_raw_size(ctx, path, sc.vd.dims, sc.f[g].file)) != ATMOS_OK) return st;
     sc.vd.max_memory = desc ? desc->max_memory : 0;
     atmos_volume *vol = NULL;
-    if ((st = atmos_volume_create(ctx, &sc.vd, &vol)) != ATMOS_OK) {
-        if (st == ATMOS_E_INVALID_ARG) {
-            char msg[512];
-            snprintf(msg, sizeof msg, "%s", atmos_context_error(ctx));
-            st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: %s", path, msg);
-        }
-        return st;
-    }
+    if ((st = atmos_volume_create(ctx, &sc.vd, &vol)) != ATMOS_OK) return prefix_error(ctx, path, st);
     for (int g = 0; g < sc.nfields && st == ATMOS_OK; g++) {
         int fi;
         st = atmos_volume_add_field(ctx, vol, sc.f[g].name, sc.f[g].particle, &fi);
@@ -352,7 +364,7 @@ atmos_status atmos__volume_load_raw_json(atmos_context *ctx, const char *path, c
     if (st == ATMOS_OK) st = atmos_volume_finalize(ctx, vol);
     if (st != ATMOS_OK) {
         atmos_volume_destroy(vol);
-        return st;
+        return prefix_error(ctx, path, st);
     }
     *out = vol;
     return ATMOS_OK;
@@ -397,6 +409,19 @@ static atmos_status write_field_fn(atmos_context *ctx, const char *tmp, void *us
     return ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", tmp, strerror(errno));
 }
 
+/* cJSON prints 15 significant digits when they round-trip within its epsilon
+ * comparison, which is not bit-exact: print 17 digits ourselves. */
+static cJSON *exact_numbers(const double *v, int n)
+{
+    char buf[32 * 9 + 8];
+    size_t len = 0;
+    buf[len++] = '[';
+    for (int i = 0; i < n; i++)
+        len += (size_t)snprintf(buf + len, sizeof buf - len, "%s%.17g", i ? ", " : "", v[i]);
+    snprintf(buf + len, sizeof buf - len, "]");
+    return cJSON_CreateRaw(buf);
+}
+
 static atmos_status write_text_fn(atmos_context *ctx, const char *tmp, void *user)
 {
     const raw_write_job *j = user;
@@ -423,9 +448,11 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     const atmos_volume_desc *d = &vol->desc;
     double dims[3] = {d->dims[0], d->dims[1], d->dims[2]};
     cJSON_AddItemToObject(root, "dims", cJSON_CreateDoubleArray(dims, 3));
-    cJSON_AddNumberToObject(root, "voxel_size_m", d->voxel_size_m);
-    cJSON_AddItemToObject(root, "origin_m", cJSON_CreateDoubleArray(d->origin_m, 3));
-    if (!vol->identity) cJSON_AddItemToObject(root, "rotation", cJSON_CreateDoubleArray(d->rotation, 9));
+    char num[40];
+    snprintf(num, sizeof num, "%.17g", d->voxel_size_m);
+    cJSON_AddRawToObject(root, "voxel_size_m", num);
+    cJSON_AddItemToObject(root, "origin_m", exact_numbers(d->origin_m, 3));
+    if (!vol->identity) cJSON_AddItemToObject(root, "rotation", exact_numbers(d->rotation, 9));
     cJSON_AddItemToObject(root, "fields", arr = cJSON_CreateArray());
     atmos_status st = ATMOS_OK;
     for (int f = 0; f < vol->nfields && st == ATMOS_OK; f++) {
