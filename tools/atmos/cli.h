@@ -29,5 +29,6 @@ int cli_cmd_render(int argc, char **argv);
 int cli_cmd_sky(int argc, char **argv);
 int cli_cmd_sun(int argc, char **argv);
 int cli_cmd_bench(int argc, char **argv);
+int cli_cmd_volume(int argc, char **argv);
 
 #endif

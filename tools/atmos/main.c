@@ -15,6 +15,7 @@ static const command commands[] = {
     {"sky", cli_cmd_sky, "query the analytic sky model along one view direction"},
     {"sun", cli_cmd_sun, "solar elevation and azimuth for a UTC time and place"},
     {"bench", cli_cmd_bench, "benchmarks (e.g. 'atmos bench sky')"},
+    {"volume", cli_cmd_volume, "inspect, generate and slice cloud volumes"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 
