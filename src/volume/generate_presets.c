@@ -220,7 +220,7 @@ static atmos_status cumulonimbus(gen_job *job, int with_rain)
     atmos__gen_accumulate(&job->grid[1], &anvil, 0, job->threads);
     atmos__gen_balls_free(&anvil);
     uint64_t seed_anvil = gen_next(&job->rng), seed_rain = gen_next(&job->rng);
-    if (with_rain) rain_shaft(job, &job->grid[2], &job->grid[0], base, 2200 * s, 3000 * s, seed_rain);
+    if (with_rain) rain_shaft(job, &job->grid[2], &job->grid[0], base, 2200 * s, 1200 * s, seed_rain);
     /* Split the tower into liquid and ice by height (glaciation), add the anvil. */
     const double yg0 = base + 6000 * s, yg1 = base + 7500 * s;
     gen_grid *cl = &job->grid[0], *ice = &job->grid[1];
