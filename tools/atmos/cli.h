@@ -46,5 +46,6 @@ int cli_cmd_bench(int argc, char **argv);
 int cli_cmd_phase(int argc, char **argv);
 int cli_cmd_cache(int argc, char **argv);
 int cli_cmd_mie(int argc, char **argv);
+int cli_cmd_volume(int argc, char **argv);
 
 #endif

@@ -18,6 +18,7 @@ static const command commands[] = {
     {"phase", cli_cmd_phase, "particle phase functions: list presets, print or plot a table"},
     {"cache", cli_cmd_cache, "the table cache: 'atmos cache path', 'atmos cache clear'"},
     {"mie", cli_cmd_mie, "Mie efficiencies and amplitudes of one sphere"},
+    {"volume", cli_cmd_volume, "inspect, generate and slice cloud volumes"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

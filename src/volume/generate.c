@@ -1,0 +1,121 @@
+/* atmos_volume_generate: preset dispatch, the dense work grids, and turning
+ * fields into a sparse atmos_volume. The presets are in generate_presets.c. */
+#include "volume/generate.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const names[] = {"cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm", NULL};
+
+const char *const *atmos_volume_generator_names(void) { return names; }
+
+atmos_status atmos__gen_grid_init(gen_job *job, const double lo[3], const double hi[3])
+{
+    static const char axis[3] = {'x', 'y', 'z'};
+    uint64_t total = 1;
+    for (int a = 0; a < 3; a++) {
+        double n = ceil((hi[a] - lo[a]) / job->voxel);
+        if (!(n >= 1 && n <= ATMOS_VOLUME_MAX_DIM))
+            return atmos__error(job->ctx, ATMOS_E_INVALID_ARG,
+                                "generate %s: voxel_size_m %g m gives %.0f voxels along %c (allowed 1..%d)", job->preset,
+                                job->voxel, n, axis[a], ATMOS_VOLUME_MAX_DIM);
+        job->dims[a] = (int)n;
+        job->origin[a] = lo[a];
+        total *= (uint64_t)n;
+    }
+    /* The dense work grids (one per field) must fit the memory limit with the result. */
+    uint64_t bytes = total * sizeof(float) * (uint64_t)job->ngrids;
+    if (bytes > job->max_memory)
+        return atmos__error(job->ctx, ATMOS_E_LIMIT,
+                            "generate %s: %dx%dx%d voxels need %llu bytes of work grids, above the %llu-byte limit "
+                            "(use a larger voxel size)",
+                            job->preset, job->dims[0], job->dims[1], job->dims[2], (unsigned long long)bytes,
+                            (unsigned long long)job->max_memory);
+    for (int g = 0; g < job->ngrids; g++) {
+        gen_grid *gr = &job->grid[g];
+        memcpy(gr->n, job->dims, sizeof gr->n);
+        memcpy(gr->origin, job->origin, sizeof gr->origin);
+        gr->voxel = job->voxel;
+        gr->v = calloc((size_t)total, sizeof(float));
+        if (!gr->v) return atmos__error(job->ctx, ATMOS_E_NOMEM, "generate %s: out of memory", job->preset);
+    }
+    return ATMOS_OK;
+}
+
+int atmos__gen_floor_j(const gen_job *job, double y)
+{
+    /* first j whose voxel centre is at or above y */
+    double j = ceil((y - job->origin[1]) / job->voxel - 0.5);
+    return j < 0 ? 0 : (int)j;
+}
+
+/* Builds the volume from the work grids (already converted to m^-3). */
+static atmos_status to_volume(gen_job *job, atmos_volume **out)
+{
+    atmos_volume_desc d = {.voxel_size_m = job->voxel, .max_memory = job->max_memory};
+    memcpy(d.dims, job->dims, sizeof d.dims);
+    memcpy(d.origin_m, job->origin, sizeof d.origin_m);
+    atmos_volume *v = NULL;
+    atmos_status st = atmos_volume_create(job->ctx, &d, &v);
+    int off[3] = {0, 0, 0};
+    for (int g = 0; g < job->ngrids && st == ATMOS_OK; g++) {
+        int idx;
+        st = atmos_volume_add_field(job->ctx, v, job->field_name[g], job->field_name[g], &idx);
+        if (st == ATMOS_OK) st = atmos_volume_set_dense(job->ctx, v, idx, off, job->dims, job->grid[g].v, 1.0f);
+        /* Free each work grid as soon as it is copied to keep the peak low. */
+        free(job->grid[g].v);
+        job->grid[g].v = NULL;
+    }
+    if (st == ATMOS_OK) st = atmos_volume_finalize(job->ctx, v);
+    if (st != ATMOS_OK) {
+        atmos_volume_destroy(v);
+        return st;
+    }
+    *out = v;
+    return ATMOS_OK;
+}
+
+atmos_status atmos_volume_generate(atmos_context *ctx, const char *preset, const atmos_volume_generate_desc *desc,
+                                   atmos_volume **out)
+{
+    if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate: out is NULL");
+    *out = NULL;
+    atmos_volume_generate_desc zero;
+    if (!desc) {
+        memset(&zero, 0, sizeof zero);
+        desc = &zero;
+    }
+    int which = -1;
+    for (int i = 0; preset && names[i]; i++)
+        if (!strcmp(preset, names[i])) which = i;
+    if (which < 0) {
+        char list[256] = "";
+        for (int i = 0; names[i]; i++) {
+            strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+            strncat(list, names[i], sizeof list - strlen(list) - 1);
+        }
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate: unknown preset '%s' (known: %s)",
+                            preset ? preset : "(null)", list);
+    }
+    double scale = desc->scale == 0 ? 1 : desc->scale;
+    if (!isfinite(scale) || scale < 0.05 || scale > 20)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate %s: scale must be in [0.05, 20], got %g", preset, scale);
+    if (desc->voxel_size_m != 0 && !(isfinite(desc->voxel_size_m) && desc->voxel_size_m > 0))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate %s: voxel_size_m must be > 0, got %g", preset,
+                            desc->voxel_size_m);
+    gen_job job;
+    memset(&job, 0, sizeof job);
+    job.ctx = ctx;
+    job.preset = preset;
+    job.scale = scale;
+    job.voxel_override = desc->voxel_size_m;
+    job.max_memory = desc->max_memory ? desc->max_memory : ATMOS_VOLUME_DEFAULT_MAX_MEMORY;
+    job.threads = atmos__threads(ctx);
+    job.rng.s = desc->seed ^ 0xA7305C10D5ull;
+    atmos_status st = atmos__gen_preset(&job, which);
+    if (st == ATMOS_OK) st = to_volume(&job, out);
+    for (int g = 0; g < GEN_MAX_GRIDS; g++) free(job.grid[g].v);
+    atmos__gen_balls_free(&job.balls);
+    return st;
+}

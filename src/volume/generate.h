@@ -1,0 +1,34 @@
+/* Shared state of one atmos_volume_generate() call (generate.c, generate_presets.c). */
+#ifndef ATMOS_GENERATE_H
+#define ATMOS_GENERATE_H
+
+#include "core/internal.h"
+#include "volume/generate_internal.h"
+
+#define GEN_MAX_GRIDS 3
+
+typedef struct {
+    atmos_context *ctx;
+    const char *preset;
+    double scale, voxel_override, voxel;
+    uint64_t max_memory;
+    int threads;
+    gen_rng rng;
+    int ngrids;
+    const char *field_name[GEN_MAX_GRIDS];
+    gen_grid grid[GEN_MAX_GRIDS];
+    int dims[3];
+    double origin[3];
+    gen_balls balls;
+} gen_job;
+
+/* Sets dims/origin from the world box [lo, hi] at job->voxel and allocates the
+ * job->ngrids zeroed work grids after checking sizes and the memory limit. */
+atmos_status atmos__gen_grid_init(gen_job *job, const double lo[3], const double hi[3]);
+/* First grid row j whose voxel centre lies at or above height y. */
+int atmos__gen_floor_j(const gen_job *job, double y);
+/* Fills the job's grids (number densities, m^-3) for preset number `which`
+ * (order of atmos_volume_generator_names()). */
+atmos_status atmos__gen_preset(gen_job *job, int which);
+
+#endif

@@ -1,0 +1,415 @@
+/* The volume object: creation and validation, sparse brick storage, writes, and
+ * finalize (statistics and the majorant grid). Layout: volume_grid.h. */
+#include "volume/volume_grid.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int atmos__volume_can_alloc(const atmos_volume *v, uint64_t bytes)
+{
+    return bytes <= v->desc.max_memory && v->memory <= v->desc.max_memory - bytes;
+}
+
+static atmos_status limit_error(atmos_context *ctx, const atmos_volume *v, const char *what, uint64_t bytes)
+{
+    return atmos__error(ctx, ATMOS_E_LIMIT,
+                        "volume: %s needs %llu bytes but the volume already holds %llu of its %llu-byte limit "
+                        "(max_memory / --max-memory)",
+                        what, (unsigned long long)bytes, (unsigned long long)v->memory,
+                        (unsigned long long)v->desc.max_memory);
+}
+
+static void mat_identity(double r[9])
+{
+    memset(r, 0, 9 * sizeof r[0]);
+    r[0] = r[4] = r[8] = 1;
+}
+
+static atmos_status check_desc(atmos_context *ctx, const atmos_volume_desc *d, atmos_volume_desc *out)
+{
+    *out = *d;
+    static const char axis[3] = {'x', 'y', 'z'};
+    for (int a = 0; a < 3; a++) {
+        if (d->dims[a] < 1 || d->dims[a] > ATMOS_VOLUME_MAX_DIM)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: dims[%d] (%c): must be in 1..%d, got %d", a,
+                                axis[a], ATMOS_VOLUME_MAX_DIM, d->dims[a]);
+        if (!isfinite(d->origin_m[a]))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: origin_m[%d]: must be finite", a);
+    }
+    if (!(isfinite(d->voxel_size_m) && d->voxel_size_m > 0))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: voxel_size_m: must be finite and > 0, got %g",
+                            d->voxel_size_m);
+    int zero = 1;
+    for (int i = 0; i < 9; i++) {
+        if (!isfinite(d->rotation[i]))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: rotation[%d]: must be finite", i);
+        if (d->rotation[i] != 0) zero = 0;
+    }
+    if (zero) {
+        mat_identity(out->rotation);
+    } else {
+        /* A rotation: R R^T = I and det R = +1 (a reflection would flip handedness). */
+        const double *r = d->rotation;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                double s = r[3 * i] * r[3 * j] + r[3 * i + 1] * r[3 * j + 1] + r[3 * i + 2] * r[3 * j + 2];
+                if (fabs(s - (i == j)) > 1e-6)
+                    return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                                        "volume: rotation: not orthonormal (row %d . row %d = %g)", i, j, s);
+            }
+        double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                     r[2] * (r[3] * r[7] - r[4] * r[6]);
+        if (det < 0) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: rotation: determinant is -1 (a reflection)");
+    }
+    if (out->max_memory == 0) out->max_memory = ATMOS_VOLUME_DEFAULT_MAX_MEMORY;
+    return ATMOS_OK;
+}
+
+atmos_status atmos_volume_create(atmos_context *ctx, const atmos_volume_desc *desc, atmos_volume **out)
+{
+    if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: out is NULL");
+    *out = NULL;
+    if (!desc) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: desc is NULL");
+    atmos_volume_desc d;
+    atmos_status st = check_desc(ctx, desc, &d);
+    if (st != ATMOS_OK) return st;
+    if (sizeof(atmos_volume) > d.max_memory)
+        return atmos__error(ctx, ATMOS_E_LIMIT, "volume: max_memory %llu bytes is below the %zu-byte volume header",
+                            (unsigned long long)d.max_memory, sizeof(atmos_volume));
+    atmos_volume *v = calloc(1, sizeof *v);
+    if (!v) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory");
+    v->desc = d;
+    v->memory = sizeof *v;
+    v->nbricks = 1;
+    for (int a = 0; a < 3; a++) {
+        v->nb[a] = (d.dims[a] + VOL_BRICK - 1) / VOL_BRICK;
+        v->nbricks *= (uint64_t)v->nb[a];
+    }
+    v->identity = 1;
+    for (int i = 0; i < 9; i++)
+        if (d.rotation[i] != ((i % 4) == 0 ? 1.0 : 0.0)) v->identity = 0;
+    *out = v;
+    return ATMOS_OK;
+}
+
+void atmos_volume_destroy(atmos_volume *vol)
+{
+    if (!vol) return;
+    for (int f = 0; f < vol->nfields; f++) {
+        vol_field *fl = &vol->field[f];
+        for (uint32_t b = 0; b < fl->count; b++) free(fl->bricks[b]);
+        free(fl->bricks);
+        free(fl->table);
+        free(fl->majorant);
+    }
+    free(vol);
+}
+
+static int valid_name(const char *s)
+{
+    size_t n = s ? strlen(s) : 0;
+    if (n == 0 || n >= VOL_NAME_MAX) return 0;
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)s[i] < 0x20 || s[i] == '"' || s[i] == '\\') return 0;
+    return 1;
+}
+
+atmos_status atmos_volume_add_field(atmos_context *ctx, atmos_volume *vol, const char *name, const char *particle,
+                                    int *index)
+{
+    if (!vol) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: vol is NULL");
+    if (vol->finalized) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: add_field after finalize");
+    if (!valid_name(name))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "volume: field name: must be 1..%d printable characters without quotes", VOL_NAME_MAX - 1);
+    if (!particle) particle = name;
+    if (!valid_name(particle))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field '%s': particle name: must be 1..%d characters",
+                            name, VOL_NAME_MAX - 1);
+    for (int f = 0; f < vol->nfields; f++)
+        if (!strcmp(vol->field[f].name, name))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field '%s' already exists", name);
+    if (vol->nfields >= ATMOS_VOLUME_MAX_FIELDS)
+        return atmos__error(ctx, ATMOS_E_LIMIT, "volume: field '%s': at most %d fields", name, ATMOS_VOLUME_MAX_FIELDS);
+    uint64_t bytes = vol->nbricks * sizeof(uint32_t);
+    if (!atmos__volume_can_alloc(vol, bytes)) return limit_error(ctx, vol, "the brick table of a field", bytes);
+    vol_field *fl = &vol->field[vol->nfields];
+    memset(fl, 0, sizeof *fl);
+    fl->table = calloc((size_t)vol->nbricks, sizeof(uint32_t));
+    if (!fl->table) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory for a %llu-byte brick table",
+                                        (unsigned long long)bytes);
+    vol->memory += bytes;
+    snprintf(fl->name, sizeof fl->name, "%s", name);
+    snprintf(fl->particle, sizeof fl->particle, "%s", particle);
+    if (index) *index = vol->nfields;
+    vol->nfields++;
+    return ATMOS_OK;
+}
+
+/* The brick at brick index b of field fl, allocated (zeroed) if needed. */
+static atmos_status brick_get(atmos_context *ctx, atmos_volume *v, vol_field *fl, uint64_t b, float **out)
+{
+    uint32_t s = fl->table[b];
+    if (s) {
+        *out = fl->bricks[s - 1];
+        return ATMOS_OK;
+    }
+    if (fl->count == fl->cap) {
+        uint32_t ncap = fl->cap ? fl->cap * 2 : 64;
+        if (ncap > UINT32_MAX / 2) ncap = UINT32_MAX / 2;
+        if (fl->count >= ncap) return atmos__error(ctx, ATMOS_E_LIMIT, "volume: field '%s': too many bricks", fl->name);
+        uint64_t extra = (uint64_t)(ncap - fl->cap) * sizeof(float *);
+        if (!atmos__volume_can_alloc(v, extra)) return limit_error(ctx, v, "growing the brick list", extra);
+        float **nb = realloc(fl->bricks, (size_t)ncap * sizeof(float *));
+        if (!nb) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory");
+        fl->bricks = nb;
+        fl->cap = ncap;
+        v->memory += extra;
+    }
+    uint64_t bytes = VOL_BRICK_VOXELS * sizeof(float);
+    if (!atmos__volume_can_alloc(v, bytes)) return limit_error(ctx, v, "another brick", bytes);
+    float *p = calloc(VOL_BRICK_VOXELS, sizeof(float));
+    if (!p) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory");
+    v->memory += bytes;
+    fl->bricks[fl->count++] = p;
+    fl->table[b] = fl->count;
+    *out = p;
+    return ATMOS_OK;
+}
+
+static atmos_status check_field(atmos_context *ctx, const atmos_volume *vol, int field)
+{
+    if (!vol) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: vol is NULL");
+    if (vol->finalized) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: write after finalize");
+    if (field < 0 || field >= vol->nfields)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field index %d out of range (0..%d)", field,
+                            vol->nfields - 1);
+    return ATMOS_OK;
+}
+
+atmos_status atmos_volume_set(atmos_context *ctx, atmos_volume *vol, int field, int i, int j, int k, float density)
+{
+    atmos_status st = check_field(ctx, vol, field);
+    if (st != ATMOS_OK) return st;
+    const int *n = vol->desc.dims;
+    if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2])
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: set: voxel (%d, %d, %d) outside the %dx%dx%d grid", i, j,
+                            k, n[0], n[1], n[2]);
+    if (!isfinite(density) || density < 0)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "volume: field '%s': voxel (%d, %d, %d): density must be finite and >= 0, got %g",
+                            vol->field[field].name, i, j, k, (double)density);
+    vol_field *fl = &vol->field[field];
+    uint64_t b = vol_brick_index(vol, i, j, k);
+    if (density == 0 && !fl->table[b]) return ATMOS_OK;
+    float *p;
+    if ((st = brick_get(ctx, vol, fl, b, &p)) != ATMOS_OK) return st;
+    p[vol_in_brick(i, j, k)] = density;
+    return ATMOS_OK;
+}
+
+atmos_status atmos_volume_set_dense(atmos_context *ctx, atmos_volume *vol, int field, const int offset[3],
+                                    const int size[3], const float *values, float scale)
+{
+    atmos_status st = check_field(ctx, vol, field);
+    if (st != ATMOS_OK) return st;
+    if (!offset || !size || !values) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: set_dense: NULL argument");
+    const int *n = vol->desc.dims;
+    for (int a = 0; a < 3; a++)
+        if (size[a] < 1 || offset[a] < 0 || offset[a] > n[a] - size[a])
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                                "volume: set_dense: block offset[%d] %d + size[%d] %d outside 0..%d", a, offset[a], a,
+                                size[a], n[a]);
+    if (!isfinite(scale) || scale < 0)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: set_dense: scale must be finite and >= 0, got %g",
+                            (double)scale);
+    vol_field *fl = &vol->field[field];
+    const size_t sx = (size_t)size[0], sxy = sx * (size_t)size[1];
+    /* Validate everything first so a rejected block leaves the volume unchanged. */
+    for (int k = 0; k < size[2]; k++)
+        for (int j = 0; j < size[1]; j++)
+            for (int i = 0; i < size[0]; i++) {
+                float x = values[(size_t)k * sxy + (size_t)j * sx + (size_t)i];
+                float y = x * scale;
+                if (!isfinite(x) || x < 0 || !isfinite(y))
+                    return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                                        "volume: field '%s': value at block index (%d, %d, %d) (voxel %d, %d, %d): "
+                                        "density must be finite and >= 0, got %g (scale %g)",
+                                        fl->name, i, j, k, i + offset[0], j + offset[1], k + offset[2], (double)x,
+                                        (double)scale);
+            }
+    /* Brick by brick so that all-zero parts of the block allocate nothing. */
+    int b0[3], b1[3];
+    for (int a = 0; a < 3; a++) {
+        b0[a] = offset[a] >> VOL_BRICK_LOG2;
+        b1[a] = (offset[a] + size[a] - 1) >> VOL_BRICK_LOG2;
+    }
+    for (int bk = b0[2]; bk <= b1[2]; bk++)
+        for (int bj = b0[1]; bj <= b1[1]; bj++)
+            for (int bi = b0[0]; bi <= b1[0]; bi++) {
+                int lo[3] = {bi * VOL_BRICK, bj * VOL_BRICK, bk * VOL_BRICK}, hi[3];
+                for (int a = 0; a < 3; a++) {
+                    hi[a] = lo[a] + VOL_BRICK;
+                    if (lo[a] < offset[a]) lo[a] = offset[a];
+                    if (hi[a] > offset[a] + size[a]) hi[a] = offset[a] + size[a];
+                }
+                uint64_t b = vol_brick_index(vol, lo[0], lo[1], lo[2]);
+                if (!fl->table[b]) {
+                    int any = 0;
+                    for (int k = lo[2]; k < hi[2] && !any; k++)
+                        for (int j = lo[1]; j < hi[1] && !any; j++)
+                            for (int i = lo[0]; i < hi[0]; i++)
+                                if (values[(size_t)(k - offset[2]) * sxy + (size_t)(j - offset[1]) * sx +
+                                           (size_t)(i - offset[0])] * scale != 0) {
+                                    any = 1;
+                                    break;
+                                }
+                    if (!any) continue;
+                }
+                float *p;
+                if ((st = brick_get(ctx, vol, fl, b, &p)) != ATMOS_OK) return st;
+                for (int k = lo[2]; k < hi[2]; k++)
+                    for (int j = lo[1]; j < hi[1]; j++)
+                        for (int i = lo[0]; i < hi[0]; i++)
+                            p[vol_in_brick(i, j, k)] = values[(size_t)(k - offset[2]) * sxy +
+                                                              (size_t)(j - offset[1]) * sx + (size_t)(i - offset[0])] *
+                                                       scale;
+            }
+    return ATMOS_OK;
+}
+
+/* World-space AABB of the index-space box [lo, hi] (corners through the transform). */
+static void index_box_to_world(const atmos_volume *v, const double lo[3], const double hi[3], double out[2][3])
+{
+    for (int a = 0; a < 3; a++) {
+        out[0][a] = INFINITY;
+        out[1][a] = -INFINITY;
+    }
+    const double *r = v->desc.rotation, s = v->desc.voxel_size_m;
+    for (int c = 0; c < 8; c++) {
+        double q[3] = {(c & 1 ? hi[0] : lo[0]) * s, (c & 2 ? hi[1] : lo[1]) * s, (c & 4 ? hi[2] : lo[2]) * s};
+        for (int a = 0; a < 3; a++) {
+            double w = v->desc.origin_m[a] + r[3 * a] * q[0] + r[3 * a + 1] * q[1] + r[3 * a + 2] * q[2];
+            if (w < out[0][a]) out[0][a] = w;
+            if (w > out[1][a]) out[1][a] = w;
+        }
+    }
+}
+
+/* Statistics and majorant of one field. A voxel's value reaches the interpolant in
+ * its own brick's region and, for voxels on a brick face, in the neighbour's region
+ * up to half a voxel across the face (trilinear weights span one voxel spacing). */
+static void finalize_field(atmos_volume *v, vol_field *fl)
+{
+    atmos_volume_field_stats *s = &fl->stats;
+    memset(s, 0, sizeof *s);
+    int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {-1, -1, -1};
+    double mn = INFINITY, mx = 0;
+    for (int bk = 0; bk < v->nb[2]; bk++)
+        for (int bj = 0; bj < v->nb[1]; bj++)
+            for (int bi = 0; bi < v->nb[0]; bi++) {
+                uint64_t b = ((uint64_t)bk * v->nb[1] + bj) * v->nb[0] + bi;
+                if (!fl->table[b]) continue;
+                const float *p = fl->bricks[fl->table[b] - 1];
+                for (int z = 0; z < VOL_BRICK; z++)
+                    for (int y = 0; y < VOL_BRICK; y++)
+                        for (int x = 0; x < VOL_BRICK; x++) {
+                            float val = p[(z * VOL_BRICK + y) * VOL_BRICK + x];
+                            if (!(val > 0)) continue;
+                            int idx[3] = {bi * VOL_BRICK + x, bj * VOL_BRICK + y, bk * VOL_BRICK + z};
+                            int loc[3] = {x, y, z}, cell[3] = {bi, bj, bk};
+                            s->active_voxels++;
+                            if (val < mn) mn = val;
+                            if (val > mx) mx = val;
+                            int c0[3], c1[3];
+                            for (int a = 0; a < 3; a++) {
+                                if (idx[a] < lo[a]) lo[a] = idx[a];
+                                if (idx[a] > hi[a]) hi[a] = idx[a];
+                                c0[a] = (loc[a] == 0 && cell[a] > 0) ? cell[a] - 1 : cell[a];
+                                c1[a] = (loc[a] == VOL_BRICK - 1 && cell[a] + 1 < v->nb[a]) ? cell[a] + 1 : cell[a];
+                            }
+                            for (int ck = c0[2]; ck <= c1[2]; ck++)
+                                for (int cj = c0[1]; cj <= c1[1]; cj++)
+                                    for (int ci = c0[0]; ci <= c1[0]; ci++) {
+                                        float *m = &fl->majorant[((uint64_t)ck * v->nb[1] + cj) * v->nb[0] + ci];
+                                        if (val > *m) *m = val;
+                                    }
+                        }
+            }
+    if (s->active_voxels) {
+        s->min = mn;
+        s->max = mx;
+        double l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0] + 1.0, hi[1] + 1.0, hi[2] + 1.0};
+        index_box_to_world(v, l, h, s->bounds_m);
+    }
+}
+
+atmos_status atmos_volume_finalize(atmos_context *ctx, atmos_volume *vol)
+{
+    if (!vol) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: vol is NULL");
+    if (vol->finalized) return ATMOS_OK;
+    uint64_t bytes = vol->nbricks * sizeof(float) * (uint64_t)vol->nfields;
+    if (!atmos__volume_can_alloc(vol, bytes)) return limit_error(ctx, vol, "the majorant grid", bytes);
+    for (int f = 0; f < vol->nfields; f++) {
+        vol_field *fl = &vol->field[f];
+        fl->majorant = calloc((size_t)vol->nbricks, sizeof(float));
+        if (!fl->majorant) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory for the majorant grid");
+        vol->memory += vol->nbricks * sizeof(float);
+        finalize_field(vol, fl);
+    }
+    vol->finalized = 1;
+    return ATMOS_OK;
+}
+
+const atmos_volume_desc *atmos_volume_get_desc(const atmos_volume *vol) { return vol ? &vol->desc : NULL; }
+int atmos_volume_field_count(const atmos_volume *vol) { return vol ? vol->nfields : 0; }
+
+const char *atmos_volume_field_name(const atmos_volume *vol, int field)
+{
+    return vol && field >= 0 && field < vol->nfields ? vol->field[field].name : NULL;
+}
+
+const char *atmos_volume_field_particle(const atmos_volume *vol, int field)
+{
+    return vol && field >= 0 && field < vol->nfields ? vol->field[field].particle : NULL;
+}
+
+atmos_status atmos_volume_field_stats_get(const atmos_volume *vol, int field, atmos_volume_field_stats *out)
+{
+    if (!vol || !out || field < 0 || field >= vol->nfields) return ATMOS_E_INVALID_ARG;
+    if (!vol->finalized) return ATMOS_E_INVALID_ARG;
+    *out = vol->field[field].stats;
+    return ATMOS_OK;
+}
+
+uint64_t atmos_volume_memory(const atmos_volume *vol) { return vol ? vol->memory : 0; }
+
+void atmos_volume_bounds(const atmos_volume *vol, double lo[3], double hi[3])
+{
+    if (!vol) {
+        for (int a = 0; a < 3; a++) lo[a] = hi[a] = 0;
+        return;
+    }
+    double l[3] = {0, 0, 0}, h[3] = {vol->desc.dims[0], vol->desc.dims[1], vol->desc.dims[2]}, b[2][3];
+    index_box_to_world(vol, l, h, b);
+    for (int a = 0; a < 3; a++) {
+        lo[a] = b[0][a];
+        hi[a] = b[1][a];
+    }
+}
+
+void atmos__volume_world_to_index(const atmos_volume *v, const double p[3], double q[3])
+{
+    const double *r = v->desc.rotation, inv = 1.0 / v->desc.voxel_size_m;
+    double d[3] = {p[0] - v->desc.origin_m[0], p[1] - v->desc.origin_m[1], p[2] - v->desc.origin_m[2]};
+    /* R is orthonormal: its inverse is its transpose. */
+    for (int a = 0; a < 3; a++) q[a] = (r[a] * d[0] + r[3 + a] * d[1] + r[6 + a] * d[2]) * inv;
+}
+
+void atmos__volume_dir_to_index(const atmos_volume *v, const double d[3], double q[3])
+{
+    const double *r = v->desc.rotation, inv = 1.0 / v->desc.voxel_size_m;
+    for (int a = 0; a < 3; a++) q[a] = (r[a] * d[0] + r[3 + a] * d[1] + r[6 + a] * d[2]) * inv;
+}

@@ -1,0 +1,281 @@
+/* atmos volume: inspect, generate and slice volumes. No physics here. */
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *C = "volume";
+
+static void help(void)
+{
+    printf("Usage: atmos volume info FILE [--json] [--max-memory MB]\n"
+           "       atmos volume generate PRESET -o NAME.json [--seed N] [--voxel-size M] [--scale S] [--threads T]\n"
+           "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png\n\n"
+           "  info      fields, dimensions, world-space bounds (metres, after the grid transform), value\n"
+           "            ranges (number densities, m^-3), active voxels and memory of a volume file\n"
+           "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
+           "            {\"fields\": [{\"name\", \"particle\", \"active_voxels\", \"min\", \"max\", \"bounds_m\"}],\n"
+           "             \"dims\", \"voxel_size_m\", \"origin_m\", \"memory_bytes\"}.\n"
+           "  generate  builds a preset cloud volume and writes it as raw float32 files plus a JSON\n"
+           "            sidecar. Presets: ");
+    for (const char *const *n = atmos_volume_generator_names(); *n; n++) printf("%s%s", *n, n[1] ? ", " : "\n");
+    printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
+           "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
+           "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
+           "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image.\n\n"
+           "Exit status: 0 success, 1 runtime error, 2 usage error.\n");
+}
+
+static int load(const char *path, atmos_context *ctx, uint64_t max_memory, atmos_volume **v)
+{
+    atmos_volume_load_desc d;
+    memset(&d, 0, sizeof d);
+    d.max_memory = max_memory;
+    atmos_status st = atmos_volume_load(ctx, path, &d, v);
+    return st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+}
+
+static cJSON *vec3(const double *v) { return cJSON_CreateDoubleArray(v, 3); }
+
+static int cmd_info(int argc, char **argv)
+{
+    const char *file = NULL;
+    int json = 0;
+    double max_mb = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(argv[i], "--json")) {
+            json = 1;
+        } else if (!strcmp(argv[i], "--max-memory") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--max-memory", argv[++i], &max_mb) || max_mb <= 0)
+                return cli_usage_error(C, "--max-memory: expected megabytes > 0");
+        } else if (argv[i][0] == '-') {
+            return cli_usage_error(C, "info: unknown or incomplete option '%s'", argv[i]);
+        } else if (!file) {
+            file = argv[i];
+        } else {
+            return cli_usage_error(C, "info: unexpected argument '%s'", argv[i]);
+        }
+    }
+    if (!file) return cli_usage_error(C, "info: which file?");
+    atmos_context *ctx = cli_context(0, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_volume *v = NULL;
+    int rc = load(file, ctx, (uint64_t)(max_mb * 1048576.0), &v);
+    if (rc != CLI_EXIT_OK) {
+        atmos_context_destroy(ctx);
+        return rc;
+    }
+    const atmos_volume_desc *d = atmos_volume_get_desc(v);
+    double lo[3], hi[3];
+    atmos_volume_bounds(v, lo, hi);
+    if (json) {
+        cJSON *root = cJSON_CreateObject(), *fields = cJSON_CreateArray();
+        cJSON_AddItemToObject(root, "fields", fields);
+        for (int f = 0; f < atmos_volume_field_count(v); f++) {
+            atmos_volume_field_stats s;
+            atmos_volume_field_stats_get(v, f, &s);
+            cJSON *o = cJSON_CreateObject(), *b = cJSON_CreateArray();
+            cJSON_AddStringToObject(o, "name", atmos_volume_field_name(v, f));
+            cJSON_AddStringToObject(o, "particle", atmos_volume_field_particle(v, f));
+            cJSON_AddNumberToObject(o, "active_voxels", (double)s.active_voxels);
+            cJSON_AddNumberToObject(o, "min", s.min);
+            cJSON_AddNumberToObject(o, "max", s.max);
+            if (!s.active_voxels) memset(s.bounds_m, 0, sizeof s.bounds_m);
+            cJSON_AddItemToArray(b, vec3(s.bounds_m[0]));
+            cJSON_AddItemToArray(b, vec3(s.bounds_m[1]));
+            cJSON_AddItemToObject(o, "bounds_m", b);
+            cJSON_AddItemToArray(fields, o);
+        }
+        double dims[3] = {d->dims[0], d->dims[1], d->dims[2]};
+        cJSON_AddItemToObject(root, "dims", cJSON_CreateDoubleArray(dims, 3));
+        cJSON_AddNumberToObject(root, "voxel_size_m", d->voxel_size_m);
+        cJSON_AddItemToObject(root, "origin_m", vec3(d->origin_m));
+        cJSON *gb = cJSON_CreateArray();
+        cJSON_AddItemToArray(gb, vec3(lo));
+        cJSON_AddItemToArray(gb, vec3(hi));
+        cJSON_AddItemToObject(root, "grid_bounds_m", gb);
+        cJSON_AddNumberToObject(root, "memory_bytes", (double)atmos_volume_memory(v));
+        char *text = cJSON_Print(root);
+        if (text) printf("%s\n", text);
+        free(text);
+        cJSON_Delete(root);
+    } else {
+        printf("%s\n  grid %d x %d x %d voxels of %g m, origin (%g, %g, %g) m\n", file, d->dims[0], d->dims[1],
+               d->dims[2], d->voxel_size_m, d->origin_m[0], d->origin_m[1], d->origin_m[2]);
+        printf("  grid bounds (%g, %g, %g) .. (%g, %g, %g) m\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+        printf("  memory %.3f MB\n", atmos_volume_memory(v) / 1048576.0);
+        for (int f = 0; f < atmos_volume_field_count(v); f++) {
+            atmos_volume_field_stats s;
+            atmos_volume_field_stats_get(v, f, &s);
+            printf("  field %-8s particle %-8s active voxels %llu, density %g .. %g m^-3", atmos_volume_field_name(v, f),
+                   atmos_volume_field_particle(v, f), (unsigned long long)s.active_voxels, s.min, s.max);
+            if (s.active_voxels)
+                printf(", bounds (%g, %g, %g) .. (%g, %g, %g) m", s.bounds_m[0][0], s.bounds_m[0][1], s.bounds_m[0][2],
+                       s.bounds_m[1][0], s.bounds_m[1][1], s.bounds_m[1][2]);
+            printf("\n");
+        }
+    }
+    atmos_volume_destroy(v);
+    atmos_context_destroy(ctx);
+    return CLI_EXIT_OK;
+}
+
+static int cmd_generate(int argc, char **argv)
+{
+    const char *preset = NULL, *out = NULL;
+    atmos_volume_generate_desc g;
+    memset(&g, 0, sizeof g);
+    g.seed = 1;
+    int threads = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
+            out = argv[++i];
+        } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
+            char *end = NULL;
+            const char *t = argv[++i];
+            unsigned long long s = strtoull(t, &end, 10);
+            if (!*t || *end || t[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", t);
+            g.seed = s;
+        } else if (!strcmp(argv[i], "--voxel-size") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--voxel-size", argv[++i], &g.voxel_size_m)) return CLI_EXIT_USAGE;
+            if (g.voxel_size_m <= 0) return cli_usage_error(C, "--voxel-size: must be > 0");
+        } else if (!strcmp(argv[i], "--scale") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--scale", argv[++i], &g.scale)) return CLI_EXIT_USAGE;
+            if (g.scale <= 0) return cli_usage_error(C, "--scale: must be > 0");
+        } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
+        } else if (argv[i][0] == '-') {
+            return cli_usage_error(C, "generate: unknown or incomplete option '%s'", argv[i]);
+        } else if (!preset) {
+            preset = argv[i];
+        } else {
+            return cli_usage_error(C, "generate: unexpected argument '%s'", argv[i]);
+        }
+    }
+    if (!preset) return cli_usage_error(C, "generate: which preset?");
+    if (!out) return cli_usage_error(C, "generate: missing -o NAME.json");
+    int known = 0;
+    for (const char *const *n = atmos_volume_generator_names(); *n; n++) known |= !strcmp(*n, preset);
+    if (!known) return cli_usage_error(C, "generate: unknown preset '%s'", preset);
+    atmos_context *ctx = cli_context(threads, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_volume *v = NULL;
+    atmos_status st = atmos_volume_generate(ctx, preset, &g, &v);
+    if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
+    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    atmos_volume_destroy(v);
+    atmos_context_destroy(ctx);
+    return rc;
+}
+
+static int cmd_slice(int argc, char **argv)
+{
+    const char *file = NULL, *out = NULL, *field = NULL;
+    int axis = -1;
+    double at = 0.5;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
+            out = argv[++i];
+        } else if (!strcmp(argv[i], "--field") && i + 1 < argc) {
+            field = argv[++i];
+        } else if (!strcmp(argv[i], "--axis") && i + 1 < argc) {
+            const char *a = argv[++i];
+            if (strlen(a) != 1 || !strchr("xyz", a[0])) return cli_usage_error(C, "--axis: expected x, y or z, got '%s'", a);
+            axis = a[0] - 'x';
+        } else if (!strcmp(argv[i], "--at") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--at", argv[++i], &at)) return CLI_EXIT_USAGE;
+            if (at < 0 || at > 1) return cli_usage_error(C, "--at: expected a fraction in [0, 1], got %g", at);
+        } else if (argv[i][0] == '-') {
+            return cli_usage_error(C, "slice: unknown or incomplete option '%s'", argv[i]);
+        } else if (!file) {
+            file = argv[i];
+        } else {
+            return cli_usage_error(C, "slice: unexpected argument '%s'", argv[i]);
+        }
+    }
+    if (!file) return cli_usage_error(C, "slice: which file?");
+    if (axis < 0) return cli_usage_error(C, "slice: missing --axis x|y|z");
+    if (!out) return cli_usage_error(C, "slice: missing -o SLICE.png");
+    atmos_context *ctx = cli_context(0, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_volume *v = NULL;
+    int rc = load(file, ctx, 0, &v);
+    if (rc != CLI_EXIT_OK) {
+        atmos_context_destroy(ctx);
+        return rc;
+    }
+    int fi = 0;
+    if (field) {
+        fi = -1;
+        for (int f = 0; f < atmos_volume_field_count(v); f++)
+            if (!strcmp(atmos_volume_field_name(v, f), field)) fi = f;
+        if (fi < 0) {
+            fprintf(stderr, "atmos volume: %s: no field '%s'; fields:", file, field);
+            for (int f = 0; f < atmos_volume_field_count(v); f++) fprintf(stderr, " %s", atmos_volume_field_name(v, f));
+            fprintf(stderr, "\n");
+            atmos_volume_destroy(v);
+            atmos_context_destroy(ctx);
+            return CLI_EXIT_RUNTIME;
+        }
+    }
+    const atmos_volume_desc *d = atmos_volume_get_desc(v);
+    /* Image axes: (u right, w up) = (x, y) for a z slice, (x, z) for y, (z, y) for x. */
+    int ua = axis == 0 ? 2 : 0, wa = axis == 1 ? 2 : 1;
+    int width = d->dims[ua], height = d->dims[wa];
+    atmos_image *img = NULL;
+    atmos_status st = atmos_image_create(ctx, width, height, 1, &img);
+    if (st == ATMOS_OK) {
+        double q[3], mx = 0;
+        q[axis] = at * d->dims[axis];
+        if (q[axis] >= d->dims[axis]) q[axis] = d->dims[axis] - 0.5;
+        for (int r = 0; r < height; r++)
+            for (int c = 0; c < width; c++) {
+                q[ua] = c + 0.5;
+                q[wa] = height - 1 - r + 0.5;
+                double p[3];
+                for (int a = 0; a < 3; a++)
+                    p[a] = d->origin_m[a] + d->voxel_size_m * (d->rotation[3 * a] * q[0] + d->rotation[3 * a + 1] * q[1] +
+                                                               d->rotation[3 * a + 2] * q[2]);
+                double val = atmos_volume_sample(v, fi, p);
+                img->pixels[(size_t)r * width + c] = (float)val;
+                if (val > mx) mx = val;
+            }
+        for (size_t n = 0; n < (size_t)width * height; n++) img->pixels[n] = mx > 0 ? (float)(img->pixels[n] / mx) : 0;
+        char buf[64];
+        snprintf(buf, sizeof buf, "%g", mx);
+        atmos_image_set_meta(img, "atmos:slice_max_m-3", buf);
+        st = atmos_write_png(ctx, img, out, 8);
+    }
+    rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    atmos_image_destroy(img);
+    atmos_volume_destroy(v);
+    atmos_context_destroy(ctx);
+    return rc;
+}
+
+int cli_cmd_volume(int argc, char **argv)
+{
+    if (argc < 2) return cli_usage_error(C, "expected a subcommand: info, generate or slice");
+    const char *sub = argv[1];
+    if (!strcmp(sub, "--help") || !strcmp(sub, "-h")) {
+        help();
+        return CLI_EXIT_OK;
+    }
+    if (!strcmp(sub, "info")) return cmd_info(argc - 1, argv + 1);
+    if (!strcmp(sub, "generate")) return cmd_generate(argc - 1, argv + 1);
+    if (!strcmp(sub, "slice")) return cmd_slice(argc - 1, argv + 1);
+    return cli_usage_error(C, "unknown subcommand '%s' (info, generate, slice)", sub);
+}
