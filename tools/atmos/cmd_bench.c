@@ -30,7 +30,7 @@ static void help(void)
            "            bench=optics case=table preset=rain wavelengths=rgb cold_seconds=1.23 cached_seconds=0.0004\n"
            "          and of the multiple-scattering phase functions built from each table:\n"
            "            bench=optics case=msphase preset=rain wavelengths=rgb orders=121 cold_seconds=... cached_seconds=...\n"
-           "          --fast builds preview-quality tables (atmos phase --fast).\n");
+           "          --fast builds preview-quality tables (atmos phase --fast).\n"
            "  volume  [--file FILE] loads FILE (if given; best of R loads) and generates the 'cumulus'\n"
            "          preset, then measures on one thread: trilinear samples per second at random points\n"
            "          and along coherent scanlines inside the active bounds, and optical-depth rays per\n"
@@ -223,6 +223,8 @@ static int bench_optics(int threads, int fast, const char *presets)
     remove_cache_dir(ctx, dir);
     atmos_context_destroy(ctx);
     return rc;
+}
+
 static uint64_t bench_rng = 0x9E3779B97F4A7C15ull;
 static double bench_u01(void)
 {
