@@ -659,6 +659,8 @@ static atmos_status load_source(atmos_context *ctx, const char *path, const sour
             }
             vd.max_memory = desc->max_memory;
             st = atmos_volume_create(ctx, &vd, &vol);
+            /* a grid placement the core refuses (not a rotation, absurd size) is a malformed file */
+            if (st == ATMOS_E_INVALID_ARG) st = ATMOS_E_FORMAT;
         }
     }
     if (st == ATMOS_OK) st = atmos_volume_finalize(ctx, vol);

@@ -137,7 +137,11 @@ atmos_status atmos__reader_name_error(atmos_context *ctx, const char *path, atmo
 {
     if (st == ATMOS_OK || !ctx) return st;
     const char *msg = atmos_context_error(ctx);
-    if (strstr(msg, path)) return st;
+    if (strstr(msg, path)) {
+        char keep[768];
+        snprintf(keep, sizeof keep, "%s", msg);
+        return atmos_context_error_status(ctx) == st ? st : atmos__error(ctx, st, "%s", keep);
+    }
     char copy[768];
     snprintf(copy, sizeof copy, "%s", msg);
     return atmos__error(ctx, st, "%s: %s", path, copy);

@@ -245,6 +245,8 @@ atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, co
     }
     vd.max_memory = desc->max_memory;
     st = atmos_volume_create(ctx, &vd, &vol);
+    /* a grid placement the core refuses (not a rotation, absurd size) is a malformed file */
+    if (st == ATMOS_E_INVALID_ARG) st = ATMOS_E_FORMAT;
     if (st != ATMOS_OK) goto done;
 
     const float scale = desc->density_scale > 0 ? (float)desc->density_scale : 1.0f;
