@@ -12,9 +12,9 @@ static const char *C = "volume";
 
 static void help(void)
 {
-    printf("Usage: atmos volume info FILE [--json] [--max-memory MB]\n"
+    printf("Usage: atmos volume info FILE [--json] [reading options]\n"
            "       atmos volume generate PRESET -o NAME.json [--seed N] [--voxel-size M] [--scale S] [--threads T]\n"
-           "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png\n\n"
+           "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png [reading options]\n\n"
            "  info      fields, dimensions, world-space bounds (metres, after the grid transform), value\n"
            "            ranges (number densities, m^-3), active voxels and memory of a volume file\n"
            "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
@@ -27,16 +27,56 @@ static void help(void)
            "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
            "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image.\n\n"
+           "Reading options (info, slice):\n"
+           "  --grids LIST      VDB/NanoVDB grids or NetCDF variables to read (comma-separated)\n"
+           "  --as NAME         field name for a single-grid file (default cloud)\n"
+           "  --scale S         multiplies the file's values (VDB/raw: to get m^-3)\n"
+           "  --time N          NetCDF time step (default 0)\n"
+           "  --voxel-size M    NetCDF resampling voxel edge in metres (default: the model's DX;\n"
+           "                    WRF cloud layers want a few hundred metres)\n"
+           "  --max-memory MB   refuse volumes that would need more memory\n\n"
            "Exit status: 0 success, 1 runtime error, 2 usage error.\n");
 }
 
-static int load(const char *path, atmos_context *ctx, uint64_t max_memory, atmos_volume **v)
+static int load(const char *path, atmos_context *ctx, const atmos_volume_load_desc *d, atmos_volume **v)
 {
-    atmos_volume_load_desc d;
-    memset(&d, 0, sizeof d);
-    d.max_memory = max_memory;
-    atmos_status st = atmos_volume_load(ctx, path, &d, v);
+    atmos_status st = atmos_volume_load(ctx, path, d, v);
     return st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+}
+
+/* Options of how a file is read, shared by info and slice. Returns 1 if argv[*i] was
+ * one (consuming its value), 0 if not, -1 after a usage error was printed. */
+static int load_option(int argc, char **argv, int *i, atmos_volume_load_desc *d)
+{
+    const char *a = argv[*i];
+    if (*i + 1 >= argc) return 0;
+    if (!strcmp(a, "--grids")) {
+        d->grids = argv[++*i];
+    } else if (!strcmp(a, "--as")) {
+        d->field = argv[++*i];
+    } else if (!strcmp(a, "--time")) {
+        if (!cli_parse_int(C, "--time", argv[++*i], 0, 1000000, &d->time_index)) return -1;
+    } else if (!strcmp(a, "--voxel-size")) {
+        if (!cli_parse_double(C, "--voxel-size", argv[++*i], &d->voxel_size_m) || !(d->voxel_size_m > 0)) {
+            cli_usage_error(C, "--voxel-size: expected metres > 0");
+            return -1;
+        }
+    } else if (!strcmp(a, "--scale")) {
+        if (!cli_parse_double(C, "--scale", argv[++*i], &d->density_scale) || !(d->density_scale > 0)) {
+            cli_usage_error(C, "--scale: expected a factor > 0");
+            return -1;
+        }
+    } else if (!strcmp(a, "--max-memory")) {
+        double mb = 0;
+        if (!cli_parse_double(C, "--max-memory", argv[++*i], &mb) || mb <= 0) {
+            cli_usage_error(C, "--max-memory: expected megabytes > 0");
+            return -1;
+        }
+        d->max_memory = (uint64_t)(mb * 1048576.0);
+    } else {
+        return 0;
+    }
+    return 1;
 }
 
 static cJSON *vec3(const double *v) { return cJSON_CreateDoubleArray(v, 3); }
@@ -44,17 +84,17 @@ static cJSON *vec3(const double *v) { return cJSON_CreateDoubleArray(v, 3); }
 static int cmd_info(int argc, char **argv)
 {
     const char *file = NULL;
-    int json = 0;
-    double max_mb = 0;
+    int json = 0, r;
+    atmos_volume_load_desc ld;
+    memset(&ld, 0, sizeof ld);
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             help();
             return CLI_EXIT_OK;
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
-        } else if (!strcmp(argv[i], "--max-memory") && i + 1 < argc) {
-            if (!cli_parse_double(C, "--max-memory", argv[++i], &max_mb) || max_mb <= 0)
-                return cli_usage_error(C, "--max-memory: expected megabytes > 0");
+        } else if ((r = load_option(argc, argv, &i, &ld)) != 0) {
+            if (r < 0) return CLI_EXIT_USAGE;
         } else if (argv[i][0] == '-') {
             return cli_usage_error(C, "info: unknown or incomplete option '%s'", argv[i]);
         } else if (!file) {
@@ -67,7 +107,7 @@ static int cmd_info(int argc, char **argv)
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
-    int rc = load(file, ctx, (uint64_t)(max_mb * 1048576.0), &v);
+    int rc = load(file, ctx, &ld, &v);
     if (rc != CLI_EXIT_OK) {
         atmos_context_destroy(ctx);
         return rc;
@@ -181,12 +221,16 @@ static int cmd_generate(int argc, char **argv)
 static int cmd_slice(int argc, char **argv)
 {
     const char *file = NULL, *out = NULL, *field = NULL;
-    int axis = -1;
+    int axis = -1, lo;
     double at = 0.5;
+    atmos_volume_load_desc ld;
+    memset(&ld, 0, sizeof ld);
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             help();
             return CLI_EXIT_OK;
+        } else if ((lo = load_option(argc, argv, &i, &ld)) != 0) {
+            if (lo < 0) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
             out = argv[++i];
         } else if (!strcmp(argv[i], "--field") && i + 1 < argc) {
@@ -212,7 +256,7 @@ static int cmd_slice(int argc, char **argv)
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
-    int rc = load(file, ctx, 0, &v);
+    int rc = load(file, ctx, &ld, &v);
     if (rc != CLI_EXIT_OK) {
         atmos_context_destroy(ctx);
         return rc;
