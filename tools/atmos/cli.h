@@ -35,6 +35,10 @@ void cli_progress_init(cli_progress *p, int quiet);
 int cli_progress_bar(void *user, const char *stage, double fraction);
 /* Monotonic clock, seconds. */
 double cli_now_s(void);
+/* Option with a value, as "--name VALUE" or "--name=VALUE": returns 1 if argv[*i] is
+ * that option (advancing *i past a separate value) with *value set (NULL when the value
+ * is missing), else 0. */
+int cli_take_value(int argc, char **argv, int *i, const char *name, const char **value);
 /* Prints a JSON array of n doubles (%.9g) to stdout. */
 void cli_print_json_array(const double *v, int n);
 

@@ -34,21 +34,6 @@ static void mie_usage(FILE *f)
           f);
 }
 
-/* Matches "--name VALUE" and "--name=VALUE" (as in cmd_sun.c). */
-static int take_value(int argc, char **argv, int *i, const char *name, const char **value)
-{
-    const char *a = argv[*i];
-    size_t n = strlen(name);
-    if (strncmp(a, name, n) != 0) return 0;
-    if (a[n] == '=') {
-        *value = a + n + 1;
-        return 1;
-    }
-    if (a[n] != '\0') return 0;
-    *value = *i + 1 < argc ? argv[++*i] : NULL;
-    return 1;
-}
-
 /* Splits "a,b,c" into doubles; returns the count, or -1 after printing a usage error. */
 static int parse_list(const char *opt, const char *text, double *out, int cap)
 {
@@ -94,13 +79,13 @@ int cli_cmd_mie(int argc, char **argv)
             return CLI_EXIT_OK;
         } else if (strcmp(a, "--json") == 0) {
             json = 1;
-        } else if (take_value(argc, argv, &i, "--m", &v)) {
+        } else if (cli_take_value(argc, argv, &i, "--m", &v)) {
             if (!v) return cli_usage_error(MIE_CMD, "--m: missing value");
             m_text = v;
-        } else if (take_value(argc, argv, &i, "--x", &v)) {
+        } else if (cli_take_value(argc, argv, &i, "--x", &v)) {
             if (!v) return cli_usage_error(MIE_CMD, "--x: missing value");
             x_text = v;
-        } else if (take_value(argc, argv, &i, "--angles", &v)) {
+        } else if (cli_take_value(argc, argv, &i, "--angles", &v)) {
             if (!v) return cli_usage_error(MIE_CMD, "--angles: missing value");
             angles_text = v;
         } else if (a[0] == '-') {

@@ -27,22 +27,6 @@ static void sun_usage(FILE *f)
           f);
 }
 
-/* Matches "--name VALUE" and "--name=VALUE". On a match stores the value (or
- * NULL if the value is missing) and advances *i past what was consumed. */
-static int take_value(int argc, char **argv, int *i, const char *name, const char **value)
-{
-    const char *a = argv[*i];
-    size_t n = strlen(name);
-    if (strncmp(a, name, n) != 0) return 0;
-    if (a[n] == '=') {
-        *value = a + n + 1;
-        return 1;
-    }
-    if (a[n] != '\0') return 0;
-    *value = *i + 1 < argc ? argv[++*i] : NULL;
-    return 1;
-}
-
 int cli_cmd_sun(int argc, char **argv)
 {
     const char *time_text = NULL, *lat_text = NULL, *lon_text = NULL;
@@ -58,13 +42,13 @@ int cli_cmd_sun(int argc, char **argv)
             refraction = 0;
         } else if (strcmp(a, "--json") == 0) {
             json = 1;
-        } else if (take_value(argc, argv, &i, "--time", &v)) {
+        } else if (cli_take_value(argc, argv, &i, "--time", &v)) {
             if (!v) return cli_usage_error(SUN_CMD, "--time: missing value");
             time_text = v;
-        } else if (take_value(argc, argv, &i, "--lat", &v)) {
+        } else if (cli_take_value(argc, argv, &i, "--lat", &v)) {
             if (!v) return cli_usage_error(SUN_CMD, "--lat: missing value");
             lat_text = v;
-        } else if (take_value(argc, argv, &i, "--lon", &v)) {
+        } else if (cli_take_value(argc, argv, &i, "--lon", &v)) {
             if (!v) return cli_usage_error(SUN_CMD, "--lon: missing value");
             lon_text = v;
         } else if (a[0] == '-') {
