@@ -57,6 +57,9 @@ ATMOS_API const char *atmos_volume_field_particle(const atmos_volume *vol, int f
 
 typedef struct atmos_volume_field_stats {
     uint64_t active_voxels;   /* voxels with density > 0 */
+    uint64_t file_active_voxels; /* the source file's own count of active voxels, when it has one
+                                    (OpenVDB/NanoVDB: active tiles count as the voxels they cover,
+                                    active zeros included); 0 otherwise */
     double min, max;          /* over active voxels (0, 0 if none) */
     double bounds_m[2][3];    /* world-space AABB of the active voxels */
 } atmos_volume_field_stats;

@@ -551,7 +551,7 @@ static atmos_status load_source(atmos_context *ctx, const char *path, const sour
     atmos_volume *vol = NULL;
     int64_t glo[3] = {0, 0, 0}, ghi[3] = {0, 0, 0};
     double A0[9], t0[3];
-    uint64_t total = 0;
+    uint64_t total = 0, grid_active[64] = {0};
     int gany = 0;
     /* Two passes over the selected grids: measure all (bounding box, voxel
      * count, value check), then create the volume and write. Each grid buffer is
@@ -606,6 +606,7 @@ static atmos_status load_source(atmos_context *ctx, const char *path, const sour
                     }
                     if (w.active > UINT64_MAX - total) total = UINT64_MAX;
                     else total += w.active;
+                    if (si < 64) grid_active[si] = w.active;
                     if (w.any)
                         for (int a = 0; a < 3; a++) {
                             if (!gany || w.lo[a] < glo[a]) glo[a] = w.lo[a];
@@ -619,6 +620,7 @@ static atmos_status load_source(atmos_context *ctx, const char *path, const sour
                 char field[64], particle[64];
                 atmos__reader_field_names(e->name, desc, field, particle);
                 st = atmos_volume_add_field(ctx, vol, field, particle, &w.field);
+                if (st == ATMOS_OK && si < 64) atmos__volume_set_file_active(vol, w.field, grid_active[si]);
                 if (st == ATMOS_OK) {
                     w.ctx = ctx;
                     w.vol = vol;

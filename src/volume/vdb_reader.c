@@ -258,6 +258,7 @@ atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, co
         visit_state vs = {ctx, vol, 0, {lo[0], lo[1], lo[2]}, scale, ATMOS_OK};
         st = atmos_volume_add_field(ctx, vol, field, particle, &vs.field);
         if (st != ATMOS_OK) goto done;
+        atmos__volume_set_file_active(vol, vs.field, gs[s].active_voxels);
         rc = atmos__vdb_visit(f, sel[s], on_block, &vs, msg, sizeof msg);
         if (rc == ATMOS__VDB_E_STOPPED) {
             st = vs.status;

@@ -1,6 +1,7 @@
 /* The volume object: creation and validation, sparse brick storage, writes, and
  * finalize (statistics and the majorant grid). Layout: volume_grid.h. */
 #include "volume/volume_grid.h"
+#include "volume/volume_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -305,6 +306,7 @@ static void finalize_field(atmos_volume *v, vol_field *fl)
 {
     atmos_volume_field_stats *s = &fl->stats;
     memset(s, 0, sizeof *s);
+    s->file_active_voxels = fl->file_active;
     int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {-1, -1, -1};
     double mn = INFINITY, mx = 0;
     for (int bk = 0; bk < v->nb[2]; bk++)
@@ -412,4 +414,12 @@ void atmos__volume_dir_to_index(const atmos_volume *v, const double d[3], double
 {
     const double *r = v->desc.rotation, inv = 1.0 / v->desc.voxel_size_m;
     for (int a = 0; a < 3; a++) q[a] = (r[a] * d[0] + r[3 + a] * d[1] + r[6 + a] * d[2]) * inv;
+}
+
+void atmos__volume_set_file_active(atmos_volume *vol, int field, uint64_t count)
+{
+    if (vol && field >= 0 && field < vol->nfields) {
+        vol->field[field].file_active = count;
+        vol->field[field].stats.file_active_voxels = count;
+    }
 }

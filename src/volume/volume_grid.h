@@ -35,6 +35,7 @@ typedef struct vol_field {
     uint32_t count, cap;  /* occupied bricks, capacity of bricks[] */
     float *majorant;      /* nbricks entries after finalize */
     atmos_volume_field_stats stats;
+    uint64_t file_active;  /* the reader's own active-voxel count, 0 if none */
 } vol_field;
 
 struct atmos_volume {

@@ -16,4 +16,8 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
 atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
                                         atmos_volume **out);
 
+/* Records a reader's own count of active voxels for a field (see
+ * atmos_volume_field_stats.file_active_voxels); call before or after finalize. */
+void atmos__volume_set_file_active(atmos_volume *vol, int field, uint64_t count);
+
 #endif

@@ -239,6 +239,7 @@ static void test_openvdb_real(void)
             CHECK_OK(atmos_volume_field_stats_get(v, 0, &st));
             /* Active voxels holding exactly 0 are not "density > 0". */
             CHECK(st.active_voxels <= 415642 && st.active_voxels > 300000);
+            CHECK_MSG(st.file_active_voxels == 415642, "file active %llu", (unsigned long long)st.file_active_voxels);
             CHECK(st.max <= 1.0 && st.max > 0.5 && st.min > 0);
             /* Bounds: the index box in metres (cell-centred, so half a voxel beyond). */
             CHECK(st.bounds_m[0][0] >= (-66.5) * d->voxel_size_m - 1e-6);

@@ -18,8 +18,10 @@ static void help(void)
            "  info      fields, dimensions, world-space bounds (metres, after the grid transform), value\n"
            "            ranges (number densities, m^-3), active voxels and memory of a volume file\n"
            "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
-           "            {\"fields\": [{\"name\", \"particle\", \"active_voxels\", \"min\", \"max\", \"bounds_m\"}],\n"
-           "             \"dims\", \"voxel_size_m\", \"origin_m\", \"memory_bytes\"}.\n"
+           "            {\"fields\": [{\"name\", \"particle\", \"active_voxels\", \"nonzero_voxels\", \"min\", \"max\",\n"
+           "             \"bounds_m\"}], \"dims\", \"voxel_size_m\", \"origin_m\", \"memory_bytes\"}. active_voxels\n"
+           "            is the file's own count where it has one (OpenVDB, NanoVDB: active tiles count as\n"
+           "            the voxels they cover, active zeros included), else the voxels > 0.\n"
            "  generate  builds a preset cloud volume and writes it as raw float32 files plus a JSON\n"
            "            sidecar. Presets: ");
     for (const char *const *n = atmos_volume_generator_names(); *n; n++) printf("%s%s", *n, n[1] ? ", " : "\n");
@@ -124,7 +126,11 @@ static int cmd_info(int argc, char **argv)
             cJSON *o = cJSON_CreateObject(), *b = cJSON_CreateArray();
             cJSON_AddStringToObject(o, "name", atmos_volume_field_name(v, f));
             cJSON_AddStringToObject(o, "particle", atmos_volume_field_particle(v, f));
-            cJSON_AddNumberToObject(o, "active_voxels", (double)s.active_voxels);
+            /* "active" as the file counts it when it has its own count (OpenVDB/NanoVDB:
+             * tiles as the voxels they cover, active zeros included), else voxels > 0 */
+            cJSON_AddNumberToObject(o, "active_voxels",
+                                    (double)(s.file_active_voxels ? s.file_active_voxels : s.active_voxels));
+            cJSON_AddNumberToObject(o, "nonzero_voxels", (double)s.active_voxels);
             cJSON_AddNumberToObject(o, "min", s.min);
             cJSON_AddNumberToObject(o, "max", s.max);
             if (!s.active_voxels) memset(s.bounds_m, 0, sizeof s.bounds_m);
@@ -154,8 +160,13 @@ static int cmd_info(int argc, char **argv)
         for (int f = 0; f < atmos_volume_field_count(v); f++) {
             atmos_volume_field_stats s;
             atmos_volume_field_stats_get(v, f, &s);
-            printf("  field %-8s particle %-8s active voxels %llu, density %g .. %g m^-3", atmos_volume_field_name(v, f),
-                   atmos_volume_field_particle(v, f), (unsigned long long)s.active_voxels, s.min, s.max);
+            printf("  field %-8s particle %-8s ", atmos_volume_field_name(v, f), atmos_volume_field_particle(v, f));
+            if (s.file_active_voxels)
+                printf("active voxels %llu in the file (tiles counted in full), %llu > 0", (unsigned long long)s.file_active_voxels,
+                       (unsigned long long)s.active_voxels);
+            else
+                printf("active voxels %llu", (unsigned long long)s.active_voxels);
+            printf(", density %g .. %g m^-3", s.min, s.max);
             if (s.active_voxels)
                 printf(", bounds (%g, %g, %g) .. (%g, %g, %g) m", s.bounds_m[0][0], s.bounds_m[0][1], s.bounds_m[0][2],
                        s.bounds_m[1][0], s.bounds_m[1][1], s.bounds_m[1][2]);
