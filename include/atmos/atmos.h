@@ -107,9 +107,9 @@ ATMOS_API void atmos_context_clear_error(atmos_context *ctx);
 #include "atmos/sun.h"
 #include "atmos/sky.h"
 #include "atmos/image.h"
+#include "atmos/optics.h"
 #include "atmos/scene.h"
 #include "atmos/render.h"
-#include "atmos/optics.h"
 #include "atmos/volume.h"
 
 #endif

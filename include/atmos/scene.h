@@ -9,6 +9,7 @@ extern "C" {
 #endif
 
 #define ATMOS_SCENE_MAX_DIM 16384
+#define ATMOS_SCENE_MAX_PARTICLES 8
 
 typedef struct atmos_scene_sun {
     int from_time;             /* 0: use elevation/azimuth; 1: compute from time/latitude/longitude */
@@ -31,6 +32,8 @@ typedef struct atmos_scene {
     atmos_tonemap_desc tonemap;
     int png_bits;                         /* 8 or 16 */
     int exr_half;                         /* nonzero: EXR as half floats */
+    int particle_count;                   /* user-defined particle types ("particles" in the file) */
+    atmos_particle_desc particles[ATMOS_SCENE_MAX_PARTICLES]; /* each named by .name */
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
@@ -48,6 +51,12 @@ ATMOS_API atmos_status atmos_scene_load(atmos_context *ctx, const char *path, at
 /* Checks a scene built or modified in code (CLI overrides) with the same rules
  * and messages as the parser, using source as the message prefix. */
 ATMOS_API atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, const char *source);
+
+/* The particle type called name: a user-defined one of the scene's "particles"
+ * section if there is one by that name, else the optics preset (atmos_particle_preset).
+ * ATMOS_E_INVALID_ARG listing both kinds of names if neither exists. */
+ATMOS_API atmos_status atmos_scene_particle(atmos_context *ctx, const atmos_scene *scene, const char *name,
+                                            atmos_particle_desc *out);
 
 /* The sun's direction (unit vector towards the sun), elevation and azimuth for
  * a scene, computing the solar position when the scene gives a time. */

@@ -566,13 +566,177 @@ static atmos_status parse_output(const jp *p, const cJSON *j, const char *path, 
     return ATMOS_OK;
 }
 
+/* ---- user-defined particle types: "particles": {NAME: {...}, ...} ---- */
+
+static const atmos__range r_radius = {0, 0.01, 1, 0}, r_sigma = {0, 3, 1, 0}, r_alpha = {0, 100, 1, 0},
+                          r_gamma = {0, 10, 1, 0}, r_rbound = {0, 0.01, 0, 0}, r_aspect = {0, 100, 1, 0},
+                          r_distortion = {0, 1.5, 0, 0}, r_rays = {1000, 1e9, 0, 0}, r_g = {-1, 1, 1, 1},
+                          r_weight = {0, 1e6, 0, 0}, r_sigma_ext = {0, 1, 0, 0}, r_unit = {0, 1, 0, 0};
+
+static atmos_status parse_size(const jp *p, const cJSON *j, const char *path, atmos_size_distribution *d)
+{
+    static const char *const keys[] = {"distribution", "radius_m", "sigma", "alpha", "gamma", "r_min_m", "r_max_m"};
+    static const char *const kinds[] = {"mono", "lognormal", "gamma"};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, kind;
+    TRY(iter_begin(p, j, path, keys, 7, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        switch (k) {
+        case 0: TRY(get_enum(p, v, ip, kinds, 3, &kind)); d->kind = (atmos_size_kind)kind; break;
+        case 1: TRY(get_number(p, v, ip, &r_radius, NULL, &d->r_m)); break;
+        case 2: TRY(get_number(p, v, ip, &r_sigma, NULL, &d->sigma)); break;
+        case 3: TRY(get_number(p, v, ip, &r_alpha, NULL, &d->alpha)); break;
+        case 4: TRY(get_number(p, v, ip, &r_gamma, NULL, &d->gamma)); break;
+        case 5: TRY(get_number(p, v, ip, &r_rbound, NULL, &d->r_min)); break;
+        case 6: TRY(get_number(p, v, ip, &r_rbound, NULL, &d->r_max)); break;
+        }
+    }
+    if (d->r_min > 0 && d->r_max > 0 && !(d->r_max > d->r_min))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "r_max_m must exceed r_min_m");
+    return ATMOS_OK;
+}
+
+static atmos_status parse_lobes(const jp *p, const cJSON *j, const char *path, atmos_phase_mixture *m)
+{
+    static const char *const keys[] = {"type", "g", "weight"};
+    static const char *const types[] = {"isotropic", "rayleigh", "hg", "cornette_shanks"};
+    if (!cJSON_IsArray(j)) return type_error(p, path, "an array of lobes", j);
+    memset(m, 0, sizeof *m);
+    int n = 0;
+    for (const cJSON *e = j->child; e; e = e->next, n++) {
+        char ep[PATH_CAP + 16];
+        snprintf(ep, sizeof ep, "%s/%d", path, n);
+        ep[PATH_CAP - 1] = '\0';
+        if (n >= ATMOS_PHASE_MAX_LOBES)
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ep, "at most %d lobes", ATMOS_PHASE_MAX_LOBES);
+        obj_iter it;
+        char ip[PATH_CAP];
+        const cJSON *v;
+        int k, type = -1;
+        m->weight[n] = 1.0;
+        TRY(iter_begin(p, e, ep, keys, 3, &it));
+        for (;;) {
+            TRY(iter_next(p, &it, &k, &v, ip));
+            if (k < 0) break;
+            if (k == 0) TRY(get_enum(p, v, ip, types, 4, &type));
+            else if (k == 1) TRY(get_number(p, v, ip, &r_g, NULL, &m->g[n]));
+            else TRY(get_number(p, v, ip, &r_weight, NULL, &m->weight[n]));
+        }
+        if (type < 0) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ep, "missing key \"type\"");
+        m->kind[n] = (atmos_phase_kind)type;
+    }
+    m->count = n;
+    double w = 0;
+    for (int i = 0; i < n; i++) w += m->weight[i];
+    if (!(w > 0))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs at least one lobe with weight > 0");
+    return ATMOS_OK;
+}
+
+static atmos_status parse_particle(const jp *p, const cJSON *j, const char *path, const char *name,
+                                   atmos_particle_desc *d)
+{
+    static const char *const keys[] = {"preset", "kind", "size", "habit", "aspect_ratio", "distortion", "rays",
+                                       "lobes", "sigma_ext_m2", "albedo"};
+    static const char *const kinds[] = {"air", "water", "ice", "snow", "analytic"};
+    static const char *const habits[] = {"column", "plate"};
+    enum { K_PRESET, K_KIND, K_SIZE, K_HABIT, K_ASPECT, K_DISTORTION, K_RAYS, K_LOBES, K_SIGMA, K_ALBEDO };
+    memset(d, 0, sizeof *d);
+    /* A "preset" is the starting point whatever its place in the object. */
+    const cJSON *pre = cJSON_GetObjectItemCaseSensitive(j, "preset");
+    if (cJSON_IsObject(j) && pre) {
+        char pp[PATH_CAP];
+        child_path(pp, sizeof pp, path, "preset");
+        const char *pname = NULL;
+        TRY(get_string(p, pre, pp, &pname));
+        if (atmos_particle_preset(NULL, pname, d) != ATMOS_OK) {
+            char list[256] = "";
+            const char *const *names = atmos_particle_preset_names();
+            for (int i = 0; names && names[i]; i++) {
+                strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+                strncat(list, names[i], sizeof list - strlen(list) - 1);
+            }
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, pp, "unknown preset (known: %s)", list);
+        }
+    }
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, e, have_kind = pre != NULL;
+    double rays = 0;
+    TRY(iter_begin(p, j, path, keys, 10, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        switch (k) {
+        case K_PRESET: break;
+        case K_KIND: TRY(get_enum(p, v, ip, kinds, 5, &e)); d->kind = (atmos_particle_kind)e; have_kind = 1; break;
+        case K_SIZE: TRY(parse_size(p, v, ip, &d->size)); break;
+        case K_HABIT: TRY(get_enum(p, v, ip, habits, 2, &e)); d->habit = (atmos_crystal_habit)e; break;
+        case K_ASPECT: TRY(get_number(p, v, ip, &r_aspect, NULL, &d->aspect_ratio)); break;
+        case K_DISTORTION: TRY(get_number(p, v, ip, &r_distortion, NULL, &d->distortion)); break;
+        case K_RAYS: TRY(get_number(p, v, ip, &r_rays, NULL, &rays)); d->rays = (long)rays; break;
+        case K_LOBES: TRY(parse_lobes(p, v, ip, &d->analytic)); break;
+        case K_SIGMA: TRY(get_number(p, v, ip, &r_sigma_ext, NULL, &d->sigma_ext_m2)); break;
+        case K_ALBEDO: TRY(get_number(p, v, ip, &r_unit, NULL, &d->albedo)); break;
+        }
+    }
+    if (!have_kind) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"kind\" or \"preset\"");
+    if (d->kind == ATMOS_PARTICLE_WATER && !(d->size.r_m > 0))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "water particles need size.radius_m (the mono radius, lognormal median or gamma mode)");
+    if (d->kind == ATMOS_PARTICLE_WATER && d->size.kind == ATMOS_SIZE_LOGNORMAL && !(d->size.sigma > 0))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "a lognormal size needs size.sigma > 0");
+    if (d->kind == ATMOS_PARTICLE_WATER && d->size.kind == ATMOS_SIZE_GAMMA && !(d->size.alpha > 0 && d->size.gamma > 0))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "a gamma size needs size.alpha and size.gamma > 0");
+    if (d->kind == ATMOS_PARTICLE_ANALYTIC && d->analytic.count < 1)
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "analytic particles need \"lobes\"");
+    snprintf(d->name, sizeof d->name, "%s", name);
+    return ATMOS_OK;
+}
+
+static atmos_status parse_particles(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    if (!cJSON_IsObject(j)) return type_error(p, path, "an object of named particle types", j);
+    int n = 0;
+    for (const cJSON *c = j->child; c; c = c->next) {
+        const char *name = c->string ? c->string : "";
+        char ip[PATH_CAP];
+        child_path(ip, sizeof ip, path, name);
+        if (name[0] == '_') continue;
+        size_t len = strlen(name);
+        int ok = len >= 1 && len < sizeof s->particles[0].name;
+        for (size_t i = 0; ok && i < len; i++) {
+            char ch = name[i];
+            ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '-';
+        }
+        if (!ok)
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                     "a particle name is 1..%d letters, digits, '_' or '-'", (int)sizeof s->particles[0].name - 1);
+        for (int i = 0; i < n; i++)
+            if (!strcmp(s->particles[i].name, name))
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "duplicate key");
+        if (n >= ATMOS_SCENE_MAX_PARTICLES)
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "at most %d particle types",
+                                     ATMOS_SCENE_MAX_PARTICLES);
+        TRY(parse_particle(p, c, ip, name, &s->particles[n]));
+        n++;
+    }
+    s->particle_count = n;
+    return ATMOS_OK;
+}
+
 atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, const cJSON *root,
                                     atmos_scene *s)
 {
     static const char *const keys[] = {"name", "image", "camera", "sun", "atmosphere", "wavelengths",
-                                       "output", "renderer"};
+                                       "output", "renderer", "particles"};
     static const char *const renderers[] = {"sky"};
-    enum { K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER };
+    enum { K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER, K_PARTICLES };
     jp p = {ctx, source};
     obj_iter it;
     char ip[PATH_CAP];
@@ -580,7 +744,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
     const char *name = NULL;
     int k, renderer;
     if (!cJSON_IsObject(root)) return type_error(&p, "/", "an object", root);
-    TRY(iter_begin(&p, root, "", keys, 8, &it));
+    TRY(iter_begin(&p, root, "", keys, 9, &it));
     for (;;) {
         TRY(iter_next(&p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
@@ -600,6 +764,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_WAVELENGTHS: TRY(parse_wavelengths(&p, v, ip, s)); break;
         case K_OUTPUT: TRY(parse_output(&p, v, ip, s)); break;
         case K_RENDERER: TRY(get_enum(&p, v, ip, renderers, 1, &renderer)); break;
+        case K_PARTICLES: TRY(parse_particles(&p, v, ip, s)); break;
         }
     }
 }

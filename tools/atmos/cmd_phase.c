@@ -24,6 +24,8 @@ static void help(void)
            "                                 order n >= 1 and angle; --plot draws several orders; the\n"
            "                                 summary gives the highest order and forward fractions F_n\n"
            "  --max-order N                  with --orders: stop at order N (default: until isotropic to 1e-6)\n"
+           "  --scene FILE                   also look PRESET up among the user-defined particle types of a\n"
+           "                                 scene file (its \"particles\" section, docs/scene-format.md)\n"
            "  --no-cache                     neither read nor write the table cache (see 'atmos cache')\n"
            "  --fast                         preview quality (coarser size integration, fewer rays)\n"
            "  --threads N                    worker threads (default: all cores)\n"
@@ -322,7 +324,7 @@ static void print_orders_summary(const char *preset, const atmos_phase_table *t,
 int cli_cmd_phase(int argc, char **argv)
 {
     const char *C = "phase";
-    const char *preset = NULL, *plot = NULL;
+    const char *preset = NULL, *plot = NULL, *scene_path = NULL;
     int csv = 0, no_cache = 0, fast = 0, threads = 0, quiet = 0, orders = 0, max_order = 0;
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
@@ -337,6 +339,8 @@ int cli_cmd_phase(int argc, char **argv)
             plot = argv[++i];
         } else if (!strcmp(a, "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--scene") && i + 1 < argc) {
+            scene_path = argv[++i];
         } else if (!strcmp(a, "--orders")) {
             orders = 1;
         } else if (!strcmp(a, "--max-order") && i + 1 < argc) {
@@ -364,10 +368,10 @@ int cli_cmd_phase(int argc, char **argv)
     const char *const *names = atmos_particle_preset_names();
     int known = 0;
     for (int i = 0; names && names[i]; i++) known |= !strcmp(names[i], preset);
-    if (!known) {
+    if (!known && !scene_path) {
         char list[256];
         known_presets(list, sizeof list);
-        return cli_usage_error(C, "unknown preset '%s' (known presets: %s)", preset, list);
+        return cli_usage_error(C, "unknown preset '%s' (known presets: %s; user-defined types need --scene)", preset, list);
     }
     if (plot && !*plot) return cli_usage_error(C, "--plot: empty file name");
 
@@ -377,7 +381,15 @@ int cli_cmd_phase(int argc, char **argv)
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_particle_desc p;
     atmos_phase_table *t = NULL;
-    atmos_status st = atmos_particle_preset(ctx, preset, &p);
+    atmos_status st;
+    if (scene_path) {
+        /* User-defined particle types of a scene file ("particles"), or presets. */
+        static atmos_scene scene;
+        st = atmos_scene_load(ctx, scene_path, &scene);
+        if (st == ATMOS_OK) st = atmos_scene_particle(ctx, &scene, preset, &p);
+    } else {
+        st = atmos_particle_preset(ctx, preset, &p);
+    }
     if (st == ATMOS_OK) {
         if (fast) p.fast = 1;
         atmos_phase_table_desc td = {no_cache};
