@@ -209,7 +209,7 @@ typedef struct bad_case {
 
 static const bad_case bad_cases[] = {
     /* structure and types */
-    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer)", NULL},
+    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles)", NULL},
     {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
     {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
     {"{\"a/b~c\": 1}", ATMOS_E_INVALID_ARG, "/a~1b~0c: unknown key", NULL},
