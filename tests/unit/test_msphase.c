@@ -116,7 +116,11 @@ static void check_preset(const char *name, atmos_context *ctx)
     static const double edges[] = {0, 0.05, 0.2, 0.5, 1, 2, 3, 5, 8, 12, 17, 23, 30, 40, 50, 60, 75, 90, 105, 120, 135, 150, 165, 180};
     const int nb = (int)(sizeof edges / sizeof *edges) - 1;
     const int orders[] = {1, 2, 5, 10};
+#if defined(__SANITIZE_ADDRESS__)
+    const long walks = 20000; /* the sanitizer twin: same paths, less work (chi2 scales with the counts) */
+#else
     const long walks = 100000;
+#endif
     for (int o = 0; o < 4; o++) {
         int n = orders[o];
         if (n > N) continue;

@@ -6,6 +6,15 @@
 #include "optics/optics_internal.h"
 #include "test.h"
 
+/* The sanitizer twin checks memory safety on the same code paths with less work:
+ * the rain test skips 550 nm (the colour order needs only 680 and 440) and the cloud
+ * test runs at 550 nm only. */
+#if defined(__SANITIZE_ADDRESS__)
+#define SANITIZED 1
+#else
+#define SANITIZED 0
+#endif
+
 #define PI 3.14159265358979323846
 
 /* Scattering angle (degrees) of minimum deviation after k internal reflections in a
@@ -51,6 +60,7 @@ static void test_rain(atmos_context *ctx)
     const double nms[3] = {680.0, 550.0, 440.0};
     double bow1[3], bow2[3];
     for (int w = 0; w < 3; w++) {
+        if (SANITIZED && w == 1) continue;
         atmos__phase_result r;
         CHECK_OK(atmos__water_phase(ctx, &p, nms[w], NB, th, ph, &r, NULL, NULL));
         double n = atmos_refractive_index_water(nms[w]).re;
@@ -95,6 +105,7 @@ static void test_cloud(atmos_context *ctx)
     double *P = malloc((size_t)n * sizeof *P), *Pc = malloc((size_t)n * sizeof *Pc);
     const double nms[3] = {680.0, 550.0, 440.0};
     for (int w = 0; w < 3; w++) {
+        if (SANITIZED && w != 1) continue;
         atmos__phase_result r;
         CHECK_OK(atmos__water_phase(ctx, &p, nms[w], n, grid, P, &r, NULL, NULL));
         /* g of water clouds in the visible: 0.84 - 0.88 (Hansen & Travis 1974 Fig. 12) */
