@@ -110,6 +110,26 @@ ATMOS_API atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmo
 ATMOS_API atmos_status atmos_write_pfm(atmos_context *ctx, const atmos_image *img, const char *path);
 ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **out);
 
+/* Error statistics of an image against a reference (same size and colour channels;
+ * the 4th channel of RGBA images is coverage and is ignored). rmse, rel_rmse (RMSE over
+ * the reference's mean absolute value) and bias (mean of image - reference) per channel
+ * and over all channels; the worst 16x16 region by RMSE; non-finite samples are counted
+ * and skipped. heatmap (optional): a display-encoded RGB image of the per-pixel relative
+ * difference, black -> red -> yellow -> white at heat_scale. */
+#define ATMOS_IMAGE_DIFF_MAX_CHANNELS 16
+typedef struct atmos_image_diff {
+    int channels;
+    double rmse[ATMOS_IMAGE_DIFF_MAX_CHANNELS], rel_rmse[ATMOS_IMAGE_DIFF_MAX_CHANNELS],
+        bias[ATMOS_IMAGE_DIFF_MAX_CHANNELS];
+    double rmse_all, rel_rmse_all;
+    int worst_x, worst_y, worst_w, worst_h; /* pixels */
+    double worst_rmse;
+    size_t nonfinite;
+    double heat_scale;                      /* relative difference shown as white */
+} atmos_image_diff;
+ATMOS_API atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *image, const atmos_image *reference,
+                                           atmos_image_diff *out, atmos_image **heatmap);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,111 @@
+/* Image comparison: error statistics between an image and a reference, the worst
+ * region, and a heat map of the difference (for `atmos compare` and accuracy reports). */
+#include "core/internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define COMPARE_TILE 16
+
+atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
+                                 atmos_image_diff *out, atmos_image **heatmap)
+{
+    if (heatmap) *heatmap = NULL;
+    if (!a || !ref || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing image");
+    if (a->width != ref->width || a->height != ref->height)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: sizes differ: %dx%d vs %dx%d", a->width, a->height,
+                            ref->width, ref->height);
+    /* Colour channels only: a fourth channel of an RGBA image is coverage, not light. */
+    int ca = a->channels == 4 ? 3 : a->channels, cr = ref->channels == 4 ? 3 : ref->channels;
+    if (ca != cr)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: channel counts differ: %d vs %d", a->channels,
+                            ref->channels);
+    if (ca > ATMOS_IMAGE_DIFF_MAX_CHANNELS)
+        return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "compare: at most %d colour channels, got %d",
+                            ATMOS_IMAGE_DIFF_MAX_CHANNELS, ca);
+    memset(out, 0, sizeof *out);
+    out->channels = ca;
+    const size_t npx = (size_t)a->width * a->height;
+    double se[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0}, sd[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0},
+           sr[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0};
+    size_t bad = 0;
+    for (size_t p = 0; p < npx; p++) {
+        const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
+        for (int c = 0; c < ca; c++) {
+            double va = pa[c], vr = pr[c];
+            if (!isfinite(va) || !isfinite(vr)) {
+                bad++;
+                continue;
+            }
+            double d = va - vr;
+            se[c] += d * d;
+            sd[c] += d;
+            sr[c] += fabs(vr);
+        }
+    }
+    double se_all = 0, sr_all = 0;
+    for (int c = 0; c < ca; c++) {
+        out->rmse[c] = sqrt(se[c] / npx);
+        out->bias[c] = sd[c] / npx;
+        double mean_ref = sr[c] / npx;
+        out->rel_rmse[c] = mean_ref > 0 ? out->rmse[c] / mean_ref : (out->rmse[c] > 0 ? INFINITY : 0.0);
+        se_all += se[c];
+        sr_all += sr[c];
+    }
+    out->rmse_all = sqrt(se_all / (npx * (double)ca));
+    double mean_all = sr_all / (npx * (double)ca);
+    out->rel_rmse_all = mean_all > 0 ? out->rmse_all / mean_all : (out->rmse_all > 0 ? INFINITY : 0.0);
+    out->nonfinite = bad;
+    /* The worst region: the COMPARE_TILE^2 tile with the largest RMSE. */
+    out->worst_rmse = -1;
+    for (int ty = 0; ty < a->height; ty += COMPARE_TILE)
+        for (int tx = 0; tx < a->width; tx += COMPARE_TILE) {
+            double s = 0;
+            int n = 0;
+            for (int y = ty; y < ty + COMPARE_TILE && y < a->height; y++)
+                for (int x = tx; x < tx + COMPARE_TILE && x < a->width; x++) {
+                    const float *pa = a->pixels + ((size_t)y * a->width + x) * a->channels,
+                                *pr = ref->pixels + ((size_t)y * ref->width + x) * ref->channels;
+                    for (int c = 0; c < ca; c++) {
+                        double d = (double)pa[c] - pr[c];
+                        if (isfinite(d)) s += d * d, n++;
+                    }
+                }
+            double r = n ? sqrt(s / n) : 0;
+            if (r > out->worst_rmse) {
+                out->worst_rmse = r;
+                out->worst_x = tx, out->worst_y = ty;
+                out->worst_w = tx + COMPARE_TILE <= a->width ? COMPARE_TILE : a->width - tx;
+                out->worst_h = ty + COMPARE_TILE <= a->height ? COMPARE_TILE : a->height - ty;
+            }
+        }
+    if (!heatmap) return ATMOS_OK;
+    /* Heat map: per pixel the mean absolute difference over the channels relative to the
+     * reference's mean value, 0 black -> red -> yellow -> white at out->heat_scale. */
+    atmos_image *h = NULL;
+    atmos_status st = atmos_image_create(ctx, a->width, a->height, 3, &h);
+    if (st != ATMOS_OK) return st;
+    double scale = 0;
+    for (size_t p = 0; p < npx; p++) {
+        const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
+        double d = 0;
+        for (int c = 0; c < ca; c++) d += fabs((double)pa[c] - pr[c]);
+        d = mean_all > 0 ? d / ca / mean_all : 0;
+        if (!isfinite(d)) d = 0;
+        h->pixels[p * 3] = (float)d;
+        if (d > scale) scale = d;
+    }
+    out->heat_scale = scale;
+    for (size_t p = 0; p < npx; p++) {
+        double t = scale > 0 ? h->pixels[p * 3] / scale : 0;
+        h->pixels[p * 3] = (float)fmin(1.0, 3 * t);
+        h->pixels[p * 3 + 1] = (float)fmin(1.0, fmax(0.0, 3 * t - 1));
+        h->pixels[p * 3 + 2] = (float)fmin(1.0, fmax(0.0, 3 * t - 2));
+    }
+    char buf[64];
+    snprintf(buf, sizeof buf, "%.6g", scale);
+    atmos_image_set_meta(h, "atmos:heat_scale_relative", buf);
+    *heatmap = h;
+    return ATMOS_OK;
+}

@@ -1,0 +1,50 @@
+/* atmos_image_compare against statistics computed by hand on constructed images. */
+#include "atmos/atmos.h"
+#include "test.h"
+
+int main(void)
+{
+    atmos_image *ref = NULL, *img = NULL, *heat = NULL;
+    CHECK_OK(atmos_image_create(NULL, 40, 20, 4, &ref));
+    CHECK_OK(atmos_image_create(NULL, 40, 20, 4, &img));
+    if (!ref || !img) return test_summary("test_compare");
+    /* reference: R = 2, G = 4, B = 6 everywhere; image: R + 1 everywhere (bias 1, rmse 1),
+     * G exact, B off by 3 in one pixel at (33, 17); alpha differs and must be ignored */
+    for (int p = 0; p < 800; p++) {
+        float *r = ref->pixels + p * 4, *a = img->pixels + p * 4;
+        r[0] = 2, r[1] = 4, r[2] = 6, r[3] = 1;
+        a[0] = 3, a[1] = 4, a[2] = 6, a[3] = 0;
+    }
+    img->pixels[(17 * 40 + 33) * 4 + 2] = 9;
+    atmos_image_diff d;
+    CHECK_OK(atmos_image_compare(NULL, img, ref, &d, &heat));
+    CHECK(d.channels == 3);
+    CHECK_NEAR(d.rmse[0], 1.0, 1e-12);
+    CHECK_NEAR(d.bias[0], 1.0, 1e-12);
+    CHECK_NEAR(d.rel_rmse[0], 0.5, 1e-12);
+    CHECK_NEAR(d.rmse[1], 0.0, 0);
+    CHECK_NEAR(d.rmse[2], sqrt(9.0 / 800), 1e-12);
+    CHECK_NEAR(d.bias[2], 3.0 / 800, 1e-12);
+    CHECK_NEAR(d.rmse_all, sqrt((800 + 9.0) / 2400), 1e-12);
+    CHECK_NEAR(d.rel_rmse_all, sqrt((800 + 9.0) / 2400) / 4.0, 1e-12);
+    /* the worst 16x16 tile holds the bad pixel: tile x 32..39 (clipped), y 16..19 */
+    CHECK(d.worst_x == 32 && d.worst_y == 16 && d.worst_w == 8 && d.worst_h == 4);
+    CHECK(heat && heat->channels == 3 && heat->width == 40);
+    if (heat) {
+        const float *hot = heat->pixels + (17 * 40 + 33) * 3, *cold = heat->pixels;
+        CHECK(hot[0] == 1.0f && hot[1] == 1.0f && hot[2] == 1.0f); /* the maximum is white */
+        CHECK(cold[0] < hot[0]);
+    }
+    /* identical images: zero everything */
+    CHECK_OK(atmos_image_compare(NULL, ref, ref, &d, NULL));
+    CHECK(d.rmse_all == 0 && d.bias[0] == 0 && d.rel_rmse_all == 0);
+    /* size mismatch is an error, not a crash */
+    atmos_image *small = NULL;
+    CHECK_OK(atmos_image_create(NULL, 4, 4, 4, &small));
+    CHECK(atmos_image_compare(NULL, small, ref, &d, NULL) == ATMOS_E_INVALID_ARG);
+    atmos_image_destroy(small);
+    atmos_image_destroy(heat);
+    atmos_image_destroy(ref);
+    atmos_image_destroy(img);
+    return test_summary("test_compare");
+}
