@@ -29,6 +29,7 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
     const size_t npx = (size_t)a->width * a->height;
     double se[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0}, sd[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0},
            sr[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0};
+    size_t cnt[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0}; /* finite samples per channel */
     size_t bad = 0;
     for (size_t p = 0; p < npx; p++) {
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
@@ -42,19 +43,24 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
             se[c] += d * d;
             sd[c] += d;
             sr[c] += fabs(vr);
+            cnt[c]++;
         }
     }
-    double se_all = 0, sr_all = 0;
+    /* Means over the finite samples only: a NaN must not count as a perfect match. */
+    double se_all = 0, sr_all = 0, n_all = 0;
     for (int c = 0; c < ca; c++) {
-        out->rmse[c] = sqrt(se[c] / npx);
-        out->bias[c] = sd[c] / npx;
-        double mean_ref = sr[c] / npx;
+        double n = cnt[c] ? (double)cnt[c] : 1.0;
+        out->rmse[c] = sqrt(se[c] / n);
+        out->bias[c] = sd[c] / n;
+        double mean_ref = sr[c] / n;
         out->rel_rmse[c] = mean_ref > 0 ? out->rmse[c] / mean_ref : (out->rmse[c] > 0 ? INFINITY : 0.0);
         se_all += se[c];
         sr_all += sr[c];
+        n_all += (double)cnt[c];
     }
-    out->rmse_all = sqrt(se_all / (npx * (double)ca));
-    double mean_all = sr_all / (npx * (double)ca);
+    if (n_all < 1) n_all = 1;
+    out->rmse_all = sqrt(se_all / n_all);
+    double mean_all = sr_all / n_all;
     out->rel_rmse_all = mean_all > 0 ? out->rmse_all / mean_all : (out->rmse_all > 0 ? INFINITY : 0.0);
     out->nonfinite = bad;
     /* The worst region: the COMPARE_TILE^2 tile with the largest RMSE. */

@@ -36,7 +36,7 @@
 #define MS_L_SMOOTH 8192  /* series length used away from the forward cone */
 #define MS_THETA_C 1.0    /* degrees: the forward cone where diffraction peaks live */
 /* Bump when the numbers this file produces change: old cache entries are then ignored. */
-#define MS_ALGORITHM_VERSION 5
+#define MS_ALGORITHM_VERSION 6
 
 struct atmos_msphase {
     int nwl, max_order, ngrid;
@@ -240,9 +240,10 @@ static int isotropic_order(const double *chi, int count, double tol, int cap)
 
 /* Ams_n = sum_l (2l+1)/(4 pi) chi_l^n P_l(mu) at the output angles for n = 2..max_order,
  * in fixed chunks of angles (each with its own recurrence) processed in parallel. */
-static void reconstruct(const double *chi, int count, int truncated, int max_order, int ngrid, const double *grid,
-                        int threads, double *values)
+static int reconstruct(const double *chi, int count, int truncated, int max_order, int ngrid, const double *grid,
+                       int threads, double *values)
 {
+    int failed = 0;
     memset(values, 0, sizeof(double) * (size_t)ngrid * max_order);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int c = 0; c < MS_CHUNKS; c++) {
@@ -291,8 +292,13 @@ static void reconstruct(const double *chi, int count, int truncated, int max_ord
                 }
             }
         }
+        else {
+#pragma omp atomic write
+            failed = 1;
+        }
         free(mu), free(p0), free(p1);
     }
+    return failed ? -1 : 0;
 }
 
 /* Ams_1 is the phase function itself: interpolate the table (linear in theta, as the
@@ -393,7 +399,10 @@ static atmos_status finish_orders(atmos_context *ctx, atmos_msphase *m, const at
     }
     for (int k = 0; k < nwl; k++) {
         double *vk = m->values + (size_t)k * order * m->ngrid;
-        reconstruct(m->chi[k], m->nchi[k], m->truncated[k], order, m->ngrid, m->grid, threads, vk);
+        if (reconstruct(m->chi[k], m->nchi[k], m->truncated[k], order, m->ngrid, m->grid, threads, vk) != 0) {
+            atmos_msphase_destroy(m);
+            return atmos__error(ctx, ATMOS_E_NOMEM, "msphase: out of memory summing the series");
+        }
         if (P) first_order(n, theta_deg, P[k], m->ngrid, m->grid, vk);
         else series_first_order(m->chi[k], m->nchi[k], m->ngrid, m->grid, vk);
         atmos__progress(ctx, "multiple-scattering phase", 0.5 + 0.5 * (k + 1) / nwl);
@@ -503,6 +512,13 @@ static atmos_msphase *deserialise(const unsigned char *p, size_t size, int nwl)
     if (size < sizeof hdr) return NULL;
     memcpy(hdr, p, sizeof hdr), p += sizeof hdr;
     if (hdr[0] != nwl || hdr[1] < 1 || hdr[1] > MS_MAX_ORDER || hdr[2] < 2 || hdr[2] > 100000) return NULL;
+    {
+        /* The entry must use today's output grid (mixtures index parts by it). */
+        double *g = NULL;
+        int ng = build_out_grid(&g);
+        free(g);
+        if (hdr[2] != ng) return NULL;
+    }
     if ((size_t)(end - p) < sizeof(int32_t) * (size_t)nwl) return NULL;
     atmos_msphase *m = calloc(1, sizeof *m);
     if (!m) return NULL;
@@ -682,6 +698,8 @@ atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *p
     double wsum = 0;
     for (int i = 0; i < count; i++) {
         if (!parts[i]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: part %d is missing", i);
+        if (parts[i]->ngrid != parts[0]->ngrid)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: part %d has a different angle grid", i);
         if (!(weights[i] >= 0) || !isfinite(weights[i]))
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase mix: weight %d must be finite and >= 0, got %g", i, weights[i]);
         if (parts[i]->nwl != parts[0]->nwl)

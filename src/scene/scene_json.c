@@ -568,7 +568,7 @@ static atmos_status parse_output(const jp *p, const cJSON *j, const char *path, 
 
 /* ---- user-defined particle types: "particles": {NAME: {...}, ...} ---- */
 
-static const atmos__range r_radius = {0, 0.01, 1, 0}, r_sigma = {0, 3, 1, 0}, r_alpha = {0, 100, 1, 0},
+static const atmos__range r_radius = {0, 0.01, 1, 0}, r_sigma = {0, 2, 1, 0}, r_alpha = {0, 100, 1, 0},
                           r_gamma = {0, 10, 1, 0}, r_rbound = {0, 0.01, 0, 0}, r_aspect = {0, 100, 1, 0},
                           r_distortion = {0, 1.5, 0, 0}, r_rays = {1000, 1e9, 0, 0}, r_g = {-1, 1, 1, 1},
                           r_weight = {0, 1e6, 0, 0}, r_sigma_ext = {0, 1, 0, 0}, r_unit = {0, 1, 0, 0};
@@ -679,7 +679,12 @@ static atmos_status parse_particle(const jp *p, const cJSON *j, const char *path
         case K_HABIT: TRY(get_enum(p, v, ip, habits, 2, &e)); d->habit = (atmos_crystal_habit)e; break;
         case K_ASPECT: TRY(get_number(p, v, ip, &r_aspect, NULL, &d->aspect_ratio)); break;
         case K_DISTORTION: TRY(get_number(p, v, ip, &r_distortion, NULL, &d->distortion)); break;
-        case K_RAYS: TRY(get_number(p, v, ip, &r_rays, NULL, &rays)); d->rays = (long)rays; break;
+        case K_RAYS:
+            TRY(get_number(p, v, ip, &r_rays, NULL, &rays));
+            if (rays != floor(rays))
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "expected an integer");
+            d->rays = (long)rays;
+            break;
         case K_LOBES: TRY(parse_lobes(p, v, ip, &d->analytic)); break;
         case K_SIGMA: TRY(get_number(p, v, ip, &r_sigma_ext, NULL, &d->sigma_ext_m2)); break;
         case K_ALBEDO: TRY(get_number(p, v, ip, &r_unit, NULL, &d->albedo)); break;

@@ -409,11 +409,14 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
         goto done;
     }
 
-    /* Memory for the source slabs, checked before allocating: one variable at a time
-     * plus rho, heights and one eta field per hydrometeor. */
+    /* Memory for the source slabs, checked before allocating, in the float units the
+     * check takes: two float read buffers and the w-level heights (double) on the
+     * staggered grid; density, mass-level heights and their copy (doubles) and one float
+     * eta field per hydrometeor on the mass grid; with margin for the CM1 path's q_v. */
     const size_t ncol = (size_t)s.nx * (size_t)s.ny;
     const size_t n3 = ncol * (size_t)s.nz, n3s = ncol * (size_t)(s.nz + 1);
-    st = atmos__reader_check_memory(ctx, path, (uint64_t)n3s * (3 + 2 * (uint64_t)nsel) + n3s, desc->max_memory);
+    const uint64_t bytes = (uint64_t)n3s * (4 + 4 + 8) + (uint64_t)n3 * (8 + 8 + 8 + 4 + 4 * (uint64_t)nsel);
+    st = atmos__reader_check_memory(ctx, path, (bytes + 3) / 4, desc->max_memory);
     if (st != ATMOS_OK) goto done;
     buf = malloc(n3s * sizeof *buf);
     float *buf2 = NULL;

@@ -38,6 +38,18 @@ int main(void)
     /* identical images: zero everything */
     CHECK_OK(atmos_image_compare(NULL, ref, ref, &d, NULL));
     CHECK(d.rmse_all == 0 && d.bias[0] == 0 && d.rel_rmse_all == 0);
+    /* non-finite samples are skipped, not counted as perfect matches: image = 2, ref = 1,
+     * half the samples NaN -> rmse over the rest is exactly 1 */
+    atmos_image *x = NULL, *y = NULL;
+    CHECK_OK(atmos_image_create(NULL, 4, 4, 3, &x));
+    CHECK_OK(atmos_image_create(NULL, 4, 4, 3, &y));
+    for (int i = 0; i < 48; i++) x->pixels[i] = i % 2 ? NAN : 2.0f, y->pixels[i] = 1.0f;
+    CHECK_OK(atmos_image_compare(NULL, x, y, &d, NULL));
+    CHECK_NEAR(d.rmse_all, 1.0, 1e-12);
+    CHECK_NEAR(d.bias[0], 1.0, 1e-12);
+    CHECK(d.nonfinite == 24);
+    atmos_image_destroy(x);
+    atmos_image_destroy(y);
     /* size mismatch is an error, not a crash */
     atmos_image *small = NULL;
     CHECK_OK(atmos_image_create(NULL, 4, 4, 4, &small));
