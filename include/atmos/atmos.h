@@ -111,5 +111,6 @@ ATMOS_API void atmos_context_clear_error(atmos_context *ctx);
 #include "atmos/scene.h"
 #include "atmos/render.h"
 #include "atmos/volume.h"
+#include "atmos/slice.h"
 
 #endif

@@ -16,7 +16,8 @@ static void help(void)
 {
     printf("Usage: atmos bench sky [--size N] [--repeat R] [--threads T]\n"
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
-           "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n\n"
+           "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
+           "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--json]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
            "          prints per case the best wall time and megapixels per second:\n"
@@ -35,7 +36,12 @@ static void help(void)
            "          preset, then measures on one thread: trilinear samples per second at random points\n"
            "          and along coherent scanlines inside the active bounds, and optical-depth rays per\n"
            "          second (exact DDA with empty-space skipping) between random points on those bounds:\n"
-           "            bench=volume case=cumulus load_s=1.2 active_voxels=605554 memory_bytes=3774592 ...\n");
+           "            bench=volume case=cumulus load_s=1.2 active_voxels=605554 memory_bytes=3774592 ...\n"
+           "  slice   the half-angle slicing renderer (Riley et al. 2004 Fig. 14: NxN, default 512, 256\n"
+           "          slices) on the generated storm and, with --file, on that volume (the Disney cloud);\n"
+           "          best of R (default 3): ms per frame (light + eye passes + sky; the volume's upload to\n"
+           "          the render grid is reported apart as prepare_ms), fps, ns per sample, breakdown.\n"
+           "          --json prints one JSON object per case.\n");
 }
 
 static double now_s(void)
@@ -337,10 +343,101 @@ static int bench_volume(const char *file, int repeat, int threads)
     return CLI_EXIT_OK;
 }
 
+/* One case of the slice benchmark: the Fig. 14 configuration (size^2, 256 slices) of
+ * the volume seen from a distance of 1.6 times its size, sun 35° high behind-left. */
+static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int repeat, int json)
+{
+    atmos_scene scene;
+    atmos_scene_defaults(&scene);
+    scene.width = scene.height = size;
+    scene.samples_per_pixel = 1;
+    double lo[3], hi[3];
+    atmos_volume_bounds(v, lo, hi);
+    /* place the volume's base at 1500 m, centred above the origin */
+    atmos_slice_settings ss;
+    atmos_slice_defaults(&ss);
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    ss.offset_m[0] = -0.5 * (lo[0] + hi[0]);
+    ss.offset_m[1] = 1500 - lo[1];
+    ss.offset_m[2] = -0.5 * (lo[2] + hi[2]);
+    double cy = 1500 + 0.5 * (hi[1] - lo[1]);
+    double pos[3] = {0, 1500 + 0.3 * (hi[1] - lo[1]), 1.6 * ext};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &scene.camera);
+    scene.camera.look_at[0] = 0, scene.camera.look_at[1] = cy, scene.camera.look_at[2] = 0;
+    scene.camera.fov_deg = 45;
+    scene.sun.from_time = 0;
+    scene.sun.elevation_deg = 35;
+    scene.sun.azimuth_deg = 200;
+    atmos_slice_optics optics;
+    double t0 = now_s();
+    atmos_status st = atmos_slice_optics_build(ctx, &scene, v, &optics);
+    double t_opt = now_s() - t0;
+    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
+    ss.optics = &optics;
+    atmos_slice_timing tm, best_tm;
+    memset(&best_tm, 0, sizeof best_tm);
+    ss.timing = &tm;
+    double best = 1e30;
+    for (int r = 0; r < repeat; r++) {
+        atmos_image *img = NULL;
+        st = atmos_render_slice(ctx, &scene, v, &ss, &img, NULL);
+        atmos_image_destroy(img);
+        if (st != ATMOS_OK) {
+            atmos_slice_optics_free(&optics);
+            return cli_runtime_error("bench", ctx, st);
+        }
+        if (tm.total < best) best = tm.total, best_tm = tm;
+    }
+    atmos_slice_optics_free(&optics);
+    double frame = best_tm.light + best_tm.eye + best_tm.sky; /* the per-frame work; prepare = volume upload */
+    long long samples = best_tm.eye_samples + best_tm.light_samples;
+    double ns = samples > 0 ? 1e9 * (best_tm.light + best_tm.eye) / (double)samples : 0;
+    if (json)
+        printf("{\"bench\":\"slice\",\"case\":\"%s\",\"size\":%d,\"slices\":%d,\"threads\":%d,"
+               "\"ms_per_frame\":%.2f,\"fps\":%.3f,\"ns_per_sample\":%.2f,\"light_ms\":%.2f,\"eye_ms\":%.2f,"
+               "\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"total_ms\":%.2f,\"eye_samples\":%lld,\"light_samples\":%lld,"
+               "\"grid\":[%d,%d,%d],\"optics_s\":%.3f}\n",
+               name, size, ss.slices, atmos_context_threads(ctx), 1e3 * frame, 1.0 / frame, ns, 1e3 * best_tm.light,
+               1e3 * best_tm.eye, 1e3 * best_tm.sky, 1e3 * best_tm.prepare, 1e3 * best_tm.total, best_tm.eye_samples,
+               best_tm.light_samples, best_tm.grid_dims[0], best_tm.grid_dims[1], best_tm.grid_dims[2], t_opt);
+    else
+        printf("bench=slice case=%s size=%dx%d slices=%d threads=%d ms_per_frame=%.2f fps=%.3f ns_per_sample=%.2f "
+               "light_ms=%.2f eye_ms=%.2f sky_ms=%.2f prepare_ms=%.2f total_ms=%.2f eye_samples=%lld light_samples=%lld "
+               "grid=%dx%dx%d optics_s=%.3f\n",
+               name, size, size, ss.slices, atmos_context_threads(ctx), 1e3 * frame, 1.0 / frame, ns, 1e3 * best_tm.light,
+               1e3 * best_tm.eye, 1e3 * best_tm.sky, 1e3 * best_tm.prepare, 1e3 * best_tm.total, best_tm.eye_samples,
+               best_tm.light_samples, best_tm.grid_dims[0], best_tm.grid_dims[1], best_tm.grid_dims[2], t_opt);
+    fflush(stdout);
+    return CLI_EXIT_OK;
+}
+
+static int bench_slice(const char *file, int size, int repeat, int threads, int json)
+{
+    atmos_context *ctx = cli_context(threads, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    int rc = CLI_EXIT_OK;
+    atmos_volume_generate_desc g = {.seed = 1};
+    atmos_volume *v = NULL;
+    atmos_status st = atmos_volume_generate(ctx, "storm", &g, &v);
+    if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
+    else rc = bench_slice_case(ctx, "generated_storm", v, size, repeat, json);
+    atmos_volume_destroy(v);
+    v = NULL;
+    if (rc == CLI_EXIT_OK && file) {
+        st = atmos_volume_load(ctx, file, NULL, &v);
+        const char *base = strrchr(file, '/');
+        if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
+        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, repeat, json);
+        atmos_volume_destroy(v);
+    }
+    atmos_context_destroy(ctx);
+    return rc;
+}
+
 int cli_cmd_bench(int argc, char **argv)
 {
     const char *C = "bench";
-    int size = 1024, repeat = 5, threads = 0, fast = 0;
+    int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0;
     const char *what = NULL, *presets = NULL, *file = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -350,6 +447,9 @@ int cli_cmd_bench(int argc, char **argv)
             if (!cli_parse_int(C, "--size", argv[++i], 16, 8192, &size)) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "--repeat") && i + 1 < argc) {
             if (!cli_parse_int(C, "--repeat", argv[++i], 1, 1000, &repeat)) return CLI_EXIT_USAGE;
+            repeat_set = 1;
+        } else if (!strcmp(argv[i], "--json")) {
+            json = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "--fast")) {
@@ -367,9 +467,10 @@ int cli_cmd_bench(int argc, char **argv)
             return cli_usage_error(C, "unexpected argument '%s'", argv[i]);
         }
     }
-    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume)");
-    if (!strcmp(what, "sky")) return bench_sky(size, repeat, threads);
+    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice)");
+    if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, repeat_set ? repeat : 3, threads, json);
+    if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);
-    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, optics, volume)", what);
+    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, optics, volume, slice)", what);
 }
