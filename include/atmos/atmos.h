@@ -98,6 +98,10 @@ ATMOS_API const char *atmos_context_error(const atmos_context *ctx);
 ATMOS_API atmos_status atmos_context_error_status(const atmos_context *ctx);
 ATMOS_API void atmos_context_clear_error(atmos_context *ctx);
 
+/* Copies the file at src to dst through a temporary file beside dst and a rename, so dst
+ * is never half-written; dst must not exist as anything but a regular file. */
+ATMOS_API atmos_status atmos_copy_file_atomic(atmos_context *ctx, const char *src, const char *dst);
+
 #ifdef __cplusplus
 }
 #endif

@@ -63,7 +63,7 @@ typedef struct atmos_mie_result {
 } atmos_mie_result;
 
 /* Lorenz-Mie scattering by a homogeneous sphere of size parameter x = 2 pi r / lambda
- * (0 < x <= 1e5) and relative refractive index m (MIEV0 convention, m.im <= 0; m.re = 0
+ * (1e-6 <= x <= 1e5) and relative refractive index m (MIEV0 convention, m.im <= 0; m.re = 0
  * and m.im = 0 together mean a perfectly conducting sphere). For n_angles directions
  * with cosines mu[], writes the amplitudes S1, S2 (MIEV0 / Bohren-Huffman convention)
  * to s1, s2 (either may be NULL). Errors: ATMOS_E_INVALID_ARG naming the value. */

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #ifdef _OPENMP
 #include <omp.h>
@@ -148,6 +149,12 @@ int atmos__progress(const atmos_context *ctx, const char *stage, double fraction
 atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user)
 {
     if (!path || !*path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "output path is empty");
+    /* rename() would replace a device, FIFO, directory entry or symlink with our file
+     * (as root, even /dev/full): write only to new or regular files. */
+    struct stat sb;
+    if (lstat(path, &sb) == 0 && !S_ISREG(sb.st_mode))
+        return atmos__error(ctx, ATMOS_E_IO, "%s: exists and is not a regular file (%s); refusing to replace it", path,
+                            S_ISLNK(sb.st_mode) ? "a symbolic link" : S_ISDIR(sb.st_mode) ? "a directory" : "a device or FIFO");
     size_t n = strlen(path);
     char *tmp = malloc(n + 32);
     if (!tmp) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
@@ -161,4 +168,37 @@ atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__wr
     if (st != ATMOS_OK) remove(tmp);
     free(tmp);
     return st;
+}
+
+typedef struct {
+    const char *src;
+    const char *dst;
+} copy_job;
+
+static atmos_status copy_fn(atmos_context *ctx, const char *tmp, void *user)
+{
+    const copy_job *j = user;
+    FILE *in = fopen(j->src, "rb");
+    if (!in) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", j->src, strerror(errno));
+    FILE *out = fopen(tmp, "wb");
+    if (!out) {
+        int e = errno;
+        fclose(in);
+        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file: %s", j->dst, strerror(e));
+    }
+    char buf[65536];
+    size_t n;
+    int ok = 1;
+    while (ok && (n = fread(buf, 1, sizeof buf, in)) > 0) ok = fwrite(buf, 1, n, out) == n;
+    ok = ok && !ferror(in);
+    fclose(in);
+    if (fclose(out) != 0) ok = 0;
+    return ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", j->dst, strerror(errno));
+}
+
+atmos_status atmos_copy_file_atomic(atmos_context *ctx, const char *src, const char *dst)
+{
+    if (!src || !dst) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "copy: missing path");
+    copy_job j = {src, dst};
+    return atmos__write_atomic(ctx, dst, copy_fn, &j);
 }

@@ -188,8 +188,10 @@ static atmos_status mie_amplitudes(atmos_context *ctx, const mie_coef *c, int n_
 atmos_status atmos_mie(atmos_context *ctx, atmos_complex m, double x, int n_angles, const double *mu,
                        atmos_complex *s1, atmos_complex *s2, atmos_mie_result *out)
 {
-    if (!(x > 0.0 && x <= 1e5))
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "mie: size parameter x must be in (0, 1e5], got %g", x);
+    /* Below x ~ 1e-6 the series' first terms lose all their digits to cancellation in
+     * double precision (the Rayleigh limit is then exact to ~1e-12 anyway). */
+    if (!(x >= 1e-6 && x <= 1e5))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "mie: size parameter x must be in [1e-6, 1e5], got %g", x);
     if (!isfinite(m.re) || !isfinite(m.im))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "mie: refractive index must be finite, got %g%+gi", m.re, m.im);
     int perfect = m.re == 0.0 && m.im == 0.0;

@@ -219,7 +219,7 @@ atmos_status atmos__water_phase(atmos_context *ctx, const atmos_particle_desc *p
         free(tab);
         return atmos__error(ctx, ATMOS_E_LIMIT,
                             "water phase: drops up to r = %g m at %g nm need size parameter %g > 1e5 (Mie limit); "
-                            "set size.r_max",
+                            "set size.r_max_m (scene files) / size.r_max",
                             r_hi, nm, k * r_hi);
     }
 

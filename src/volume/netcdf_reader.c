@@ -335,6 +335,30 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
         }
         if (wanted) sel[nsel++] = h;
     }
+    /* Every name asked for must be a hydrometeor this reader knows (by model or field
+     * name): a misspelt one is an error, not silently dropped. */
+    if (desc->grids && *desc->grids) {
+        const char *p = desc->grids;
+        while (*p) {
+            const char *c = strchr(p, ',');
+            size_t len = c ? (size_t)(c - p) : strlen(p);
+            int known = 0;
+            for (int h = 0; h < NHYDRO && len; h++) {
+                const char *name = s.wrf ? hydro[h].wrf : hydro[h].cm1;
+                if ((strlen(name) == len && strncmp(p, name, len) == 0) ||
+                    (strlen(hydro[h].field) == len && strncmp(p, hydro[h].field, len) == 0))
+                    known = 1;
+            }
+            if (!known) {
+                st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: '%.*s' is not a hydrometeor variable (%s, or cloud, rain, "
+                                  "ice, snow, graupel)", path, (int)(len < 64 ? len : 64), p,
+                                  s.wrf ? "QCLOUD, QRAIN, QICE, QSNOW, QGRAUP" : "qc, qr, qi, qs, qg");
+                goto done;
+            }
+            p += len;
+            if (*p == ',') p++;
+        }
+    }
     if (nsel == 0) {
         st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: no hydrometeor variables (%s) %s; variables present: %s", path,
                           s.wrf ? "QCLOUD, QRAIN, QICE, QSNOW, QGRAUP" : "qc, qr, qi, qs, qg",

@@ -486,5 +486,14 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     raw_write_job job = {vol, 0, text};
     st = atmos__write_atomic(ctx, json_path, write_text_fn, &job);
     free(text);
+    if (st != ATMOS_OK) {
+        /* All or nothing: without its sidecar the raw files are orphans. */
+        for (int f = 0; f < vol->nfields; f++) {
+            char rel[PATH_CAP], full[PATH_CAP];
+            int n = snprintf(rel, sizeof rel, "%.*s.%s.raw", (int)stem_len, base, vol->field[f].name);
+            int m = snprintf(full, sizeof full, "%.*s%s", (int)(base - json_path), json_path, rel);
+            if (n > 0 && m > 0 && (size_t)n < sizeof rel && (size_t)m < sizeof full) remove(full);
+        }
+    }
     return st;
 }

@@ -76,7 +76,7 @@ static void test_errors(void)
         {"{\"particles\": {\"x\": {\"kind\": \"water\"}}}", "/particles/x: water particles need size.radius_m"},
         {"{\"particles\": {\"x\": {\"kind\": \"water\", \"size\": {\"distribution\": \"lognormal\", \"radius_m\": 1e-5}}}}",
          "a lognormal size needs size.sigma"},
-        {"{\"particles\": {\"x\": {\"kind\": \"water\", \"size\": {\"radius_m\": 0.5}}}}", "/particles/x/size/radius_m: must be in (0, 0.01]"},
+        {"{\"particles\": {\"x\": {\"kind\": \"water\", \"size\": {\"radius_m\": 0.5}}}}", "/particles/x/size/radius_m: must be in (0, 0.005]"},
         {"{\"particles\": {\"x\": {\"kind\": \"water\", \"size\": {\"radius\": 1e-5}}}}", "/particles/x/size/radius: unknown key"},
         {"{\"particles\": {\"x\": {\"kind\": \"analytic\"}}}", "analytic particles need \"lobes\""},
         {"{\"particles\": {\"x\": {\"kind\": \"analytic\", \"lobes\": [{\"type\": \"hg\", \"g\": 1}]}}}", "/particles/x/lobes/0/g: must be in (-1, 1)"},

@@ -16,7 +16,8 @@ static void help(void)
            "and the worst 16x16 region. --heatmap writes a PNG of the per-pixel relative\n"
            "difference (black, red, yellow, white = the largest). --json prints\n"
            "  {\"rmse\": ..., \"rel_rmse\": ..., \"bias\": [...], \"rmse_per_channel\": [...],\n"
-           "   \"rel_rmse_per_channel\": [...], \"worst_region\": [x, y, w, h], \"worst_rmse\": ...}\n");
+           "   \"rel_rmse_per_channel\": [...], \"worst_region\": [x, y, w, h], \"worst_rmse\": ...,\n"
+           "   \"nonfinite\": N}   (NaN/Inf samples, skipped: statistics are over the finite ones)\n");
 }
 
 static atmos_status read_hdr(atmos_context *ctx, const char *path, atmos_image **out)

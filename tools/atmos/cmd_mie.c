@@ -22,7 +22,7 @@ static void mie_usage(FILE *f)
           "\n"
           "  --m RE,IM       relative refractive index, MIEV0 convention: IM <= 0 absorbs\n"
           "                  (water at 550 nm: 1.334,-1.9e-9); 0,0 = perfectly conducting sphere\n"
-          "  --x X           size parameter 2 pi r / lambda, in (0, 1e5]\n"
+          "  --x X           size parameter 2 pi r / lambda, in [1e-6, 1e5]\n"
           "  --angles LIST   scattering angles in degrees, in [0, 180], comma-separated\n"
           "                  (default 0,30,60,90,120,150,180)\n"
           "  --json          print one JSON object: qext, qsca, qback, g, angles_deg,\n"

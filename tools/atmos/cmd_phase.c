@@ -52,11 +52,18 @@ static void describe(const atmos_particle_desc *p, char *buf, size_t cap)
         snprintf(buf, cap, "water spheres (Mie theory), %s %.4g um%s", sk, p->size.r_m * 1e6, sigma);
         break;
     case ATMOS_PARTICLE_ICE:
-        snprintf(buf, cap, "hexagonal ice %s, radius %.4g um (ray tracing + diffraction)%s",
-                 p->habit == ATMOS_CRYSTAL_PLATE ? "plates" : "columns", p->size.r_m * 1e6, sigma);
+        if (p->size.r_m > 0)
+            snprintf(buf, cap, "hexagonal ice %s, radius %.4g um (ray tracing + diffraction)%s",
+                     p->habit == ATMOS_CRYSTAL_PLATE ? "plates" : "columns", p->size.r_m * 1e6, sigma);
+        else
+            snprintf(buf, cap, "hexagonal ice %s sized by their cross-section (ray tracing + diffraction)%s",
+                     p->habit == ATMOS_CRYSTAL_PLATE ? "plates" : "columns", sigma);
         break;
     case ATMOS_PARTICLE_SNOW:
-        snprintf(buf, cap, "irregular (distorted) ice crystals, radius %.4g um%s", p->size.r_m * 1e6, sigma);
+        if (p->size.r_m > 0)
+            snprintf(buf, cap, "irregular (distorted) ice crystals, radius %.4g um%s", p->size.r_m * 1e6, sigma);
+        else
+            snprintf(buf, cap, "irregular (distorted) ice crystals sized by their cross-section%s", sigma);
         break;
     case ATMOS_PARTICLE_ANALYTIC: snprintf(buf, cap, "analytic mixture of %d lobes%s", p->analytic.count, sigma); break;
     default: snprintf(buf, cap, "particle kind %d", (int)p->kind); break;
@@ -156,14 +163,17 @@ static int find_in_path(const char *prog)
 }
 
 /* A gnuplot double-quoted string (backslash escapes). */
+/* A gnuplot single-quoted string: no escapes and, unlike double quotes, no backquote
+ * command substitution; a quote is written twice; control characters are dropped. */
 static void gp_quote(FILE *f, const char *s)
 {
-    fputc('"', f);
+    fputc('\'', f);
     for (; *s; s++) {
-        if (*s == '"' || *s == '\\') fputc('\\', f);
+        if ((unsigned char)*s < 0x20) continue;
+        if (*s == '\'') fputc('\'', f);
         fputc(*s, f);
     }
-    fputc('"', f);
+    fputc('\'', f);
 }
 
 /* Line colour of a wavelength: its CIE 1931 colour in sRGB, brightened. */
@@ -251,10 +261,16 @@ static int plot_png(const char *C, const char *title_text, const plot_data *pd, 
         fputc('\n', df);
     }
     int data_ok = fclose(df) == 0;
-    char tmp_png[4200];
-    snprintf(tmp_png, sizeof tmp_png, "%s.tmp%ld", out, (long)getpid());
+    /* gnuplot writes into a private temporary file whose name we made (mkstemp: no
+     * characters gnuplot would interpret, e.g. backquotes, which it executes); the PNG is
+     * then copied to the user's path by the library's atomic writer, so a bad output path
+     * gives one clear error and never a partial file. */
+    char tmp_png[4096];
+    snprintf(tmp_png, sizeof tmp_png, "%s/atmos-plot-XXXXXX", tmpdir && *tmpdir ? tmpdir : "/tmp");
+    int pfd = mkstemp(tmp_png);
+    if (pfd >= 0) close(pfd);
     int rc = CLI_EXIT_RUNTIME;
-    FILE *gp = data_ok ? popen("gnuplot", "w") : NULL;
+    FILE *gp = data_ok && pfd >= 0 ? popen("gnuplot", "w") : NULL;
     if (gp) {
         fprintf(gp, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1000,640 } "
                     "else { set terminal png size 1000,640 }\n");
@@ -278,13 +294,19 @@ static int plot_png(const char *C, const char *title_text, const plot_data *pd, 
         }
         fprintf(gp, "\nset output\n");
         int st = pclose(gp);
-        if (st == 0 && rename(tmp_png, out) == 0) rc = CLI_EXIT_OK;
-        else if (st != 0) fprintf(stderr, "atmos %s: gnuplot failed (status %d)\n", C, st);
-        else fprintf(stderr, "atmos %s: %s: cannot rename into place: %s\n", C, out, strerror(errno));
+        if (st != 0) {
+            fprintf(stderr, "atmos %s: gnuplot failed (status %d)\n", C, st);
+        } else {
+            atmos_context *ctx = cli_context(1, 1);
+            atmos_status ws = ctx ? atmos_copy_file_atomic(ctx, tmp_png, out) : ATMOS_E_NOMEM;
+            if (ws == ATMOS_OK) rc = CLI_EXIT_OK;
+            else cli_runtime_error(C, ctx, ws);
+            atmos_context_destroy(ctx);
+        }
     } else {
         fprintf(stderr, "atmos %s: cannot run gnuplot: %s\n", C, strerror(errno));
     }
-    if (rc != CLI_EXIT_OK) remove(tmp_png);
+    if (pfd >= 0) remove(tmp_png);
     remove(data);
     return rc;
 }

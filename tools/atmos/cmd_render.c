@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <signal.h>
 #include <unistd.h>
 
 static void help(void)
@@ -41,6 +42,26 @@ static void help(void)
            "  atmos render -o sky.png --exr sky.exr\n"
            "  atmos render scenes/sunset_fisheye.json --spectral 32 -o sunset.png\n"
            "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n");
+}
+
+/* Temporary names of the outputs (atmos__write_atomic writes PATH.tmpPID): on SIGINT or
+ * SIGTERM they are removed before exiting, so an interrupted run leaves nothing behind. */
+static char tmp_names[3][4200];
+static void on_signal(int sig)
+{
+    for (int i = 0; i < 3; i++)
+        if (tmp_names[i][0]) unlink(tmp_names[i]); /* async-signal-safe */
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+static void protect_outputs(const char *png, const char *exr, const char *pfm)
+{
+    const char *outs[3] = {png, exr, pfm};
+    for (int i = 0; i < 3; i++)
+        if (outs[i]) snprintf(tmp_names[i], sizeof tmp_names[i], "%s.tmp%ld", outs[i], (long)getpid());
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
 }
 
 static void default_png_name(const char *scene_name, char *buf, size_t cap)
@@ -169,6 +190,12 @@ int cli_cmd_render(int argc, char **argv)
         scene.camera.look_at[1] += dy; /* keep the view direction */
     }
     if (!isnan(sel) || !isnan(saz)) {
+        if (scene.sun.from_time) {
+            /* Overriding one angle of a sun placed by time keeps the other one it had. */
+            double dir[3], el = 0, az = 0;
+            if (atmos_scene_sun_direction(ctx, &scene, dir, &el, &az) == ATMOS_OK)
+                scene.sun.elevation_deg = el, scene.sun.azimuth_deg = az;
+        }
         scene.sun.from_time = 0;
         if (!isnan(sel)) scene.sun.elevation_deg = sel;
         if (!isnan(saz)) scene.sun.azimuth_deg = saz;
@@ -207,6 +234,7 @@ int cli_cmd_render(int argc, char **argv)
         png = default_png;
     }
 
+    protect_outputs(png, exr, pfm);
     atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     atmos_render_info info;
     atmos_wavelengths wl;

@@ -19,7 +19,8 @@ static void help(void)
            "            ranges (number densities, m^-3), active voxels and memory of a volume file\n"
            "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
            "            {\"fields\": [{\"name\", \"particle\", \"active_voxels\", \"nonzero_voxels\", \"min\", \"max\",\n"
-           "             \"bounds_m\"}], \"dims\", \"voxel_size_m\", \"origin_m\", \"memory_bytes\"}. active_voxels\n"
+           "             \"bounds_m\"}], \"dims\", \"voxel_size_m\", \"origin_m\", \"grid_bounds_m\", \"memory_bytes\"}.\n"
+           "            active_voxels\n"
            "            is the file's own count where it has one (OpenVDB, NanoVDB: active tiles count as\n"
            "            the voxels they cover, active zeros included), else the voxels > 0.\n"
            "  generate  builds a preset cloud volume and writes it as raw float32 files plus a JSON\n"
@@ -106,7 +107,7 @@ static int cmd_info(int argc, char **argv)
         }
     }
     if (!file) return cli_usage_error(C, "info: which file?");
-    atmos_context *ctx = cli_context(0, 1);
+    atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
     int rc = load(file, ctx, &ld, &v);
@@ -264,7 +265,7 @@ static int cmd_slice(int argc, char **argv)
     if (!file) return cli_usage_error(C, "slice: which file?");
     if (axis < 0) return cli_usage_error(C, "slice: missing --axis x|y|z");
     if (!out) return cli_usage_error(C, "slice: missing -o SLICE.png");
-    atmos_context *ctx = cli_context(0, 1);
+    atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
     int rc = load(file, ctx, &ld, &v);
