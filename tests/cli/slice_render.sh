@@ -1,0 +1,40 @@
+#!/bin/sh
+# atmos render --volume: the slicing renderer through the CLI. A generated cumulus placed in
+# front of the camera must change the image where it stands and leave the sky elsewhere.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/cli_slice.$$
+mkdir -p "$T"
+export XDG_CACHE_HOME="$T/cache"
+fail=0; pass=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
+
+"$A" render -q --width 64 --height 36 --pfm "$T/sky.pfm" || bad "sky render"
+"$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --pfm "$T/cloud.pfm" --threads 2 \
+    && ok || bad "slice render"
+"$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --pfm "$T/cloud1.pfm" --threads 1 \
+    && ok || bad "slice render, 1 thread"
+cmp -s "$T/cloud.pfm" "$T/cloud1.pfm" && ok || bad "1 and 2 threads differ"
+python3 - "$T/sky.pfm" "$T/cloud.pfm" <<'PY' && ok || bad "cloud image check"
+import math, struct, sys
+def pfm(p):
+    d = open(p, "rb").read()
+    parts = d.split(b"\n", 3)
+    w, h = map(int, parts[1].split()); data = parts[3]
+    v = struct.unpack("<%df" % (w * h * 3), data[: w * h * 12])
+    return w, h, v
+w, h, a = pfm(sys.argv[1]); _, _, b = pfm(sys.argv[2])
+assert all(math.isfinite(x) for x in b), "non-finite values"
+px = lambda v, x, y: v[((h - 1 - y) * w + x) * 3:((h - 1 - y) * w + x) * 3 + 3]
+# the cloud stands near the image centre, just above the horizon; the corners are sky
+changed = sum(1 for x in range(24, 40) for y in range(8, 18) if abs(px(a, x, y)[1] - px(b, x, y)[1]) > 0.02 * px(a, x, y)[1])
+same = all(abs(px(a, x, y)[1] - px(b, x, y)[1]) <= 1e-3 * px(a, x, y)[1] for (x, y) in [(1, 1), (62, 1), (1, 34), (62, 34)])
+assert changed > 10, "cloud not visible: %d pixels changed" % changed
+assert same, "corners changed"
+PY
+"$A" render -q --renderer slice -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--renderer slice without --volume should exit 2"
+"$A" render -q --volume generate:nope -o "$T/x.png" 2>/dev/null; [ $? -eq 1 ] && ok || bad "unknown generator should exit 1"
+rm -rf "$T"
+echo "slice_render: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
