@@ -64,4 +64,19 @@ static inline void test_tmp_path(char *buf, size_t cap, const char *name)
     snprintf(buf, cap, "%s/%s", dir && *dir ? dir : "/tmp", name);
 }
 
+/* The whole file at path in a malloc'ed buffer (*n bytes), or NULL. */
+static inline unsigned char *test_slurp(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    *n = 0;
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long sz = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char *buf = malloc(sz > 0 ? (size_t)sz : 1);
+    *n = buf && sz > 0 ? fread(buf, 1, (size_t)sz, f) : 0;
+    fclose(f);
+    return buf;
+}
+
 #endif

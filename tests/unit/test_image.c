@@ -56,19 +56,6 @@ static long file_size(const char *path)
     return stat(path, &sb) == 0 ? (long)sb.st_size : -1;
 }
 
-static unsigned char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long sz = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *buf = malloc(sz > 0 ? (size_t)sz : 1);
-    *n = buf ? fread(buf, 1, (size_t)sz, f) : 0;
-    fclose(f);
-    return buf;
-}
-
 static void spit(const char *path, const void *buf, size_t n)
 {
     FILE *f = fopen(path, "wb");
@@ -423,7 +410,7 @@ static void test_pfm(void)
     for (size_t i = 0; i < 12; i++) img->pixels[i] = (float)i;
     CHECK_OK(atmos_write_pfm(ctx, img, path));
     size_t n = 0;
-    unsigned char *b = slurp(path, &n);
+    unsigned char *b = test_slurp(path, &n);
     const char *hdr = "PF\n2 2\n-1.0\n";
     size_t hl = strlen(hdr);
     CHECK(b && n == hl + 48 && memcmp(b, hdr, hl) == 0);
@@ -501,7 +488,7 @@ static void check_truncations(const char *name, const char *valid, reader_fn rd)
 {
     atmos_context *ctx = new_ctx();
     size_t n = 0;
-    unsigned char *buf = slurp(valid, &n);
+    unsigned char *buf = test_slurp(valid, &n);
     CHECK(buf && n > 0);
     if (!buf) return;
     char path[512];
@@ -814,7 +801,7 @@ static void test_atomic_failure(void)
     spit(path, "old", 3);
     CHECK(atmos__write_atomic(ctx, path, failing_writer, &existed) == ATMOS_E_IO);
     size_t n = 0;
-    unsigned char *b = slurp(path, &n);
+    unsigned char *b = test_slurp(path, &n);
     CHECK(b && n == 3 && memcmp(b, "old", 3) == 0);
     free(b);
     CHECK(!file_exists(tmp));
