@@ -18,7 +18,65 @@ typedef struct atmos_scene_sun {
     atmos_utc_time time;
     double latitude_deg, longitude_deg;
     int refraction;            /* with from_time: include refraction (default 1) */
+    int irradiance_count;      /* 0: the solar spectrum (times atmosphere sun_scale); 1: a flat
+                                  irradiance[0] W m^-2 nm^-1 at every wavelength; 3: per rgb
+                                  channel (680, 550, 440 nm; rgb mode only). Outside the air. */
+    double irradiance[3];
 } atmos_scene_sun;
+
+/* Which renderer draws the scene ("renderer" in the file). */
+typedef enum {
+    ATMOS_RENDERER_SKY = 0,   /* the analytic sky (Riley §4.1, §4.2.4) */
+    ATMOS_RENDERER_SLICE = 1, /* half-angle slicing over the volume (Riley §4.2-§5, slice.h) */
+    ATMOS_RENDERER_PATH = 2   /* Monte Carlo volumetric path tracing over the volume (path.h) */
+} atmos_renderer_kind;
+
+/* What surrounds the volume ("background" in the file). */
+typedef enum {
+    ATMOS_BACKGROUND_SKY = 0,     /* the atmosphere: sky, ground, aerial perspective, sunlight
+                                     attenuated by the air (default) */
+    ATMOS_BACKGROUND_BLACK = 1,   /* vacuum: no air, no ground, radiance 0 behind the volume;
+                                     the sun arrives unattenuated and its disk is not drawn */
+    ATMOS_BACKGROUND_UNIFORM = 2  /* vacuum as BLACK, but radiance background_radiance from
+                                     every direction (lights the volume too) */
+} atmos_background_kind;
+
+#define ATMOS_SCENE_PATH_MAX 1024
+
+/* The volume of a scene ("volume" in the file). source "" = no volume. */
+typedef struct atmos_scene_volume {
+    char source[ATMOS_SCENE_PATH_MAX]; /* a file (.vdb .nvdb .nc .json; relative paths are resolved
+                                          against the scene file's folder by atmos_scene_load) or
+                                          "generate:PRESET" */
+    char grids[256];          /* VDB grid / NetCDF variable names, comma-separated ("" = reader default) */
+    char particle[64];        /* particle type of a single-grid file: a preset or a "particles"
+                                 entry ("" = "cloud") */
+    double density_scale;     /* multiplies the densities (after the reader's unit conversion); 1 */
+    int time_index;           /* NetCDF time step; 0 */
+    double voxel_size_m;      /* NetCDF resampling / generator voxel size; 0 = the source's */
+    uint64_t seed;            /* generators; 1 */
+    double scale;             /* generators: extent factor; 1 */
+    int placed;               /* 1: position_m given; 0: centred 3 widths (>= 4 km) in front of the camera */
+    double position_m[3];     /* world position of the centre of the bottom face of the volume's box */
+} atmos_scene_volume;
+
+/* Settings of the slice renderer ("slice" in the file); mirror atmos_slice_settings. */
+typedef struct atmos_scene_slice {
+    int slices;               /* 256 */
+    int light_size;           /* 256 */
+    double xi;                /* sr^-1; default 0.1/(4 pi); < 0 = none */
+    int eq24;                 /* 1: "update": "eq24"; 0: "eq25" (default) */
+    int low_albedo;           /* 0 */
+    int grid_max_dim;         /* 256 */
+} atmos_scene_slice;
+
+/* Settings of the path tracer ("path" in the file). */
+typedef struct atmos_scene_path {
+    int spp;                  /* samples per pixel; 64 */
+    double time_budget_s;     /* > 0: stop when this much time has passed (after whole passes); 0 = none */
+    uint64_t seed;            /* 1 */
+    int max_depth;            /* scattering events per path; 0 = unlimited (Russian roulette) */
+} atmos_scene_path;
 
 typedef struct atmos_scene {
     char name[128];
@@ -34,6 +92,12 @@ typedef struct atmos_scene {
     int exr_half;                         /* nonzero: EXR as half floats */
     int particle_count;                   /* user-defined particle types ("particles" in the file) */
     atmos_particle_desc particles[ATMOS_SCENE_MAX_PARTICLES]; /* each named by .name */
+    atmos_renderer_kind renderer;
+    atmos_background_kind background;
+    double background_radiance;           /* UNIFORM: W m^-2 sr^-1 nm^-1 at every wavelength */
+    atmos_scene_volume volume;
+    atmos_scene_slice slice;
+    atmos_scene_path path;
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
