@@ -4,6 +4,8 @@
 #ifndef ATMOS_SCENE_H
 #define ATMOS_SCENE_H
 
+#include <stdint.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
