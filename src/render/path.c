@@ -1,0 +1,599 @@
+/* Spectral Monte Carlo volumetric path tracing. See include/atmos/path.h and docs/path.md.
+ *
+ * A camera path carries up to PATH_B wavelengths of the scene's set (all of them in rgb
+ * mode; in spectral mode a uniformly chosen hero and the wavelengths a quarter, half and
+ * three quarters of the set away, each counted with weight N/PATH_B, so every wavelength
+ * is estimated without bias). Its segments:
+ *
+ *   air (outside the volume's occupied box): the analytic sky's transmittance and
+ *       single-scattered in-scatter (sky.c), added along the way;
+ *   the volume's box: free flight by delta tracking (path_medium.c); at a real
+ *       scattering event next-event estimation of the sun's disk (a direction drawn
+ *       uniformly in the disk's cone, the transmittance to it by ratio tracking), then
+ *       Russian roulette and a new direction drawn from the phase function of one of
+ *       the carried wavelengths (one-sample MIS over the wavelengths: the weight of
+ *       wavelength k is p_k / mean_j p_j, never more than PATH_B);
+ *   the ground (y = 0, sky background): Lambertian; the sun's light (shadowed by the
+ *       volume) by next-event estimation, then a cosine-distributed bounce;
+ *   escape: the sky's in-scatter from the escape point to infinity; the sun's disk only
+ *       on a path that has not scattered (after a scattering event the sun is counted
+ *       by next-event estimation alone). A black or uniform background is vacuum: no
+ *       air, no ground, the unattenuated sun, background_radiance from every direction.
+ *
+ * Per pixel, samples are added in their index order into double sums (and sums of
+ * squares, for the variance); the random numbers of sample s of pixel p come from their
+ * own stream. So the image does not depend on the thread count or the schedule.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "render/path_internal.h"
+#include "sky/sky_internal.h"
+
+#include <float.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+void atmos_path_defaults(atmos_path_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->spp = 64;
+    s->seed = 1;
+    s->density_scale = 1.0;
+}
+
+atmos_status atmos_path_optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                     atmos_slice_optics *out)
+{
+    if (!scene || !volume || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "path optics: missing argument");
+    memset(out, 0, sizeof *out);
+    out->owned = 1;
+    atmos_wavelengths wl;
+    atmos_status st = atmos_scene_wavelengths(ctx, scene, &wl);
+    if (st != ATMOS_OK) return st;
+    for (int i = 0; i < atmos_volume_field_count(volume); i++) {
+        atmos_particle_desc pd;
+        if ((st = atmos_scene_particle(ctx, scene, atmos_volume_field_particle(volume, i), &pd)) != ATMOS_OK) goto fail;
+        atmos_phase_table *t = NULL;
+        atmos_phase_table_desc td = {0};
+        if ((st = atmos_phase_table_build(ctx, &pd, &wl, &td, &t)) != ATMOS_OK) goto fail;
+        out->phase[i] = t;
+        out->count = i + 1;
+    }
+    return ATMOS_OK;
+fail:
+    atmos_slice_optics_free(out);
+    return st;
+}
+
+/* ------------------------------------------------------------------ small vector helpers */
+
+static inline double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Orthonormal basis around unit n (Duff et al. 2017). */
+static inline void onb(const double n[3], double t[3], double b[3])
+{
+    double s = n[2] >= 0 ? 1.0 : -1.0;
+    double a = -1.0 / (s + n[2]);
+    double c = n[0] * n[1] * a;
+    t[0] = 1.0 + s * n[0] * n[0] * a, t[1] = s * c, t[2] = -s * n[0];
+    b[0] = c, b[1] = s + n[1] * n[1] * a, b[2] = -n[1];
+}
+
+/* Direction at cos(theta) = mu, azimuth phi around unit axis n. */
+static inline void around(const double n[3], double mu, double phi, double out[3])
+{
+    double t[3], b[3];
+    onb(n, t, b);
+    double st = sqrt(fmax(0.0, 1.0 - mu * mu)), c = cos(phi) * st, s = sin(phi) * st;
+    for (int a = 0; a < 3; a++) out[a] = mu * n[a] + c * t[a] + s * b[a];
+    double l = 1.0 / sqrt(dot3(out, out));
+    for (int a = 0; a < 3; a++) out[a] *= l;
+}
+
+/* ------------------------------------------------------------------ the job */
+
+typedef struct {
+    const path_medium *med; /* NULL: no volume */
+    const path_phase *ph;
+    const atmos_sky *sky;   /* NULL: vacuum */
+    atmos_camera cam;
+    int n;                  /* wavelengths */
+    double sun[3];
+    double cos_sun, sun_omega;
+    int disk_visible;       /* sky background, disk drawn, sun above the horizon */
+    double sun_e[ATMOS_MAX_WAVELENGTHS]; /* extraterrestrial irradiance, W m^-2 nm^-1 */
+    double bg;              /* vacuum: background radiance */
+    double albedo;          /* ground (sky background only) */
+    int max_depth;          /* 0 = unlimited */
+    uint64_t seed;
+} path_job;
+
+typedef struct {
+    long long events, tentative, shadow;
+} path_counts;
+
+/* Sunlight (W m^-2 nm^-1 on a surface facing the sun) at altitude y for the carried wavelengths. */
+static void sunlight(const path_job *J, const path_bundle *b, double y, double *E)
+{
+    if (!J->sky) {
+        for (int i = 0; i < b->m; i++) E[i] = J->sun_e[b->k[i]];
+        return;
+    }
+    const atmos_sky *s = J->sky;
+    const double ly = J->sun[1];
+    if (!(ly > 0)) {
+        for (int i = 0; i < b->m; i++) E[i] = 0;
+        return;
+    }
+    const double ey = exp(-s->gamma * (y > 0 ? y : 0)) / (s->gamma * ly);
+    for (int i = 0; i < b->m; i++) E[i] = J->sun_e[b->k[i]] * exp(-s->beta_sl[b->k[i]] * ey);
+}
+
+/* Sky: in-scatter along p + t d, t in [0, K] (added to L weighted by w) and the
+ * transmittance over it (multiplied into w). */
+static void air_segment(const path_job *J, const path_bundle *b, const double p[3], const double d[3], double K,
+                        double *w, double *L)
+{
+    const atmos_sky *s = J->sky;
+    if (!(K > 0)) return;
+    const double py = d[1], ly = J->sun[1];
+    const double G = atmos__sky_view_depth_factor(s->gamma, py, K);
+    const double e_end = isinf(K) ? (py > 0 ? 0.0 : INFINITY) : exp(-s->gamma * py * K);
+    const double ey = exp(-s->gamma * (p[1] > 0 ? p[1] : 0));
+    const double P = atmos_phase_rayleigh(dot3(d, J->sun));
+    for (int i = 0; i < b->m; i++) {
+        const int k = b->k[i];
+        if (w[i] == 0) continue;
+        L[i] += w[i] * P * J->sun_e[k] * atmos__sky_inscatter_factor(s->gamma, s->beta_sl[k] * ey, G, ly, py, e_end);
+        w[i] *= isinf(G) ? 0.0 : exp(-s->beta_sl[k] * ey * G);
+    }
+}
+
+/* Volume transmittance from world point p along unit d (to the box's far side). */
+static void shadow(const path_job *J, const path_bundle *b, const double p[3], const double d[3], path_rng *r,
+                   double *T, path_counts *cnt)
+{
+    for (int i = 0; i < b->m; i++) T[i] = 1;
+    if (!J->med) return;
+    double q[3], qd[3], t0, t1;
+    atmos__path_to_index(J->med, p, d, q, qd);
+    if (!atmos__path_clip(J->med, q, qd, INFINITY, &t0, &t1)) return;
+    cnt->shadow++;
+    atmos__path_transmittance(J->med, q, qd, t0, t1, b, r, T);
+}
+
+/* A direction in the sun's cone, uniformly (pdf 1 / sun_omega). */
+static void sample_sun(const path_job *J, path_rng *r, double d[3])
+{
+    double mu = 1.0 - path_u(r) * (1.0 - J->cos_sun);
+    around(J->sun, mu, 2.0 * ATMOS_PI * path_u(r), d);
+}
+
+/* Russian roulette on the largest weight; returns 0 to stop. */
+static int roulette(double *w, int m, path_rng *r)
+{
+    double q = 0;
+    for (int i = 0; i < m; i++)
+        if (w[i] > q) q = w[i];
+    if (!(q > 0)) return 0;
+    if (q >= 1) return 1;
+    if (path_u(r) >= q) return 0;
+    for (int i = 0; i < m; i++) w[i] /= q;
+    return 1;
+}
+
+/* One camera path through world ray (o, d); adds the radiance of the carried
+ * wavelengths to L[]. */
+static void trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], path_rng *r,
+                  double *L, path_counts *cnt)
+{
+    const int m = b->m;
+    double w[PATH_B], p[3] = {o[0], o[1], o[2]}, d[3] = {d0[0], d0[1], d0[2]};
+    for (int i = 0; i < m; i++) w[i] = 1, L[i] = 0;
+    int primary = 1, depth = 0;
+    float dens[PATH_F];
+    for (int guard = 0; guard < 1 << 24; guard++) {
+        double K = J->sky ? atmos_sky_ground_distance(p[1], d) : INFINITY;
+        double q[3], qd[3], t0 = 0, t1 = 0;
+        int inbox = 0;
+        if (J->med) {
+            atmos__path_to_index(J->med, p, d, q, qd);
+            inbox = atmos__path_clip(J->med, q, qd, K, &t0, &t1);
+        }
+        if (inbox) {
+            if (J->sky && t0 > 0) air_segment(J, b, p, d, t0, w, L);
+            double t;
+            int ev = atmos__path_free_flight(J->med, q, qd, t0, t1, b, w, r, &t, dens, &cnt->tentative);
+            if (ev < 0) return;
+            if (ev > 0) {
+                /* A real scattering event in the volume. */
+                cnt->events++;
+                for (int a = 0; a < 3; a++) p[a] += t * d[a];
+                const path_medium *M = J->med;
+                const path_phase *P = J->ph;
+                const int nf = M->nf;
+                double ssf[PATH_F][PATH_B], ss[PATH_B];
+                for (int i = 0; i < m; i++) {
+                    ss[i] = 0;
+                    for (int f = 0; f < nf; f++) {
+                        ssf[f][i] = (double)dens[f] * M->sca[f][b->k[i]];
+                        ss[i] += ssf[f][i];
+                    }
+                }
+                /* Next-event estimation of the sun. */
+                double E[PATH_B];
+                sunlight(J, b, p[1], E);
+                int lit = 0;
+                for (int i = 0; i < m; i++) lit |= w[i] * E[i] > 0;
+                if (lit) {
+                    double ds[3], T[PATH_B];
+                    sample_sun(J, r, ds);
+                    path_angle ang;
+                    atmos__path_angle(P, dot3(d, ds), &ang);
+                    double pk[PATH_B];
+                    int any = 0;
+                    for (int i = 0; i < m; i++) {
+                        double s = 0;
+                        if (ss[i] > 0)
+                            for (int f = 0; f < nf; f++)
+                                if (ssf[f][i] > 0) s += ssf[f][i] * atmos__path_phase_eval(P, f, b->k[i], &ang);
+                        pk[i] = ss[i] > 0 ? s / ss[i] : 0;
+                        any |= w[i] * pk[i] * E[i] > 0;
+                    }
+                    if (any) {
+                        shadow(J, b, p, ds, r, T, cnt);
+                        for (int i = 0; i < m; i++) L[i] += w[i] * pk[i] * E[i] * T[i];
+                    }
+                }
+                if (J->max_depth && ++depth >= J->max_depth) return;
+                if (!roulette(w, m, r)) return;
+                /* New direction: wavelength j uniformly among those that scatter, field f in
+                 * proportion to its scattering there, cos(theta) by the table's inverse CDF. */
+                int elig[PATH_B], ne = 0;
+                for (int i = 0; i < m; i++)
+                    if (ss[i] > 0) elig[ne++] = i;
+                if (!ne) return;
+                int j = elig[ne > 1 ? (int)(path_u(r) * ne) % ne : 0];
+                int f = 0;
+                if (nf > 1) {
+                    double u = path_u(r) * ss[j], acc = 0;
+                    for (f = 0; f < nf - 1; f++) {
+                        acc += ssf[f][j];
+                        if (u < acc) break;
+                    }
+                    while (f > 0 && ssf[f][j] <= 0) f--;
+                }
+                double mu = atmos_phase_table_sample(P->t[f], b->k[j], path_u(r));
+                double nd[3];
+                around(d, mu, 2.0 * ATMOS_PI * path_u(r), nd);
+                int chroma = nf > 1 || !P->gray[0];
+                if (chroma && m > 1) {
+                    path_angle ang;
+                    atmos__path_angle(P, mu, &ang);
+                    double pk[PATH_B], mean = 0;
+                    for (int i = 0; i < m; i++) {
+                        double s = 0;
+                        if (ss[i] > 0)
+                            for (int ff = 0; ff < nf; ff++)
+                                if (ssf[ff][i] > 0) s += ssf[ff][i] * atmos__path_phase_eval(P, ff, b->k[i], &ang);
+                        pk[i] = ss[i] > 0 ? s / ss[i] : 0;
+                    }
+                    for (int e = 0; e < ne; e++) mean += pk[elig[e]];
+                    mean /= ne;
+                    if (!(mean > 0)) return;
+                    for (int i = 0; i < m; i++) w[i] *= pk[i] / mean;
+                }
+                memcpy(d, nd, sizeof d);
+                primary = 0;
+                continue;
+            }
+            /* Through the volume: continue from its far side. */
+            for (int a = 0; a < 3; a++) p[a] += t1 * d[a];
+            if (J->sky) K = atmos_sky_ground_distance(p[1], d);
+            if (K <= 1e-9 * (1.0 + fabs(p[1]))) K = 0; /* the box reached the ground */
+        }
+        /* Escape: vacuum, or the air to the ground or to space. */
+        if (!J->sky) {
+            for (int i = 0; i < m; i++) L[i] += w[i] * J->bg;
+            return;
+        }
+        air_segment(J, b, p, d, K, w, L);
+        if (isinf(K)) {
+            if (primary && J->disk_visible && dot3(d, J->sun) >= J->cos_sun) {
+                double E[PATH_B];
+                sunlight(J, b, p[1], E);
+                for (int i = 0; i < m; i++) L[i] += w[i] * E[i] / J->sun_omega;
+            }
+            return;
+        }
+        /* The Lambertian ground. */
+        for (int a = 0; a < 3; a++) p[a] += K * d[a];
+        p[1] = 0;
+        if (!(J->albedo > 0)) return;
+        cnt->events++;
+        double E[PATH_B];
+        sunlight(J, b, 0.0, E);
+        int lit = 0;
+        for (int i = 0; i < m; i++) lit |= w[i] * E[i] > 0;
+        if (lit) {
+            double ds[3], T[PATH_B];
+            sample_sun(J, r, ds);
+            if (ds[1] > 0) {
+                shadow(J, b, p, ds, r, T, cnt);
+                for (int i = 0; i < m; i++) L[i] += w[i] * J->albedo / ATMOS_PI * ds[1] * E[i] * T[i];
+            }
+        }
+        if (J->max_depth && ++depth >= J->max_depth) return;
+        for (int i = 0; i < m; i++) w[i] *= J->albedo;
+        if (!roulette(w, m, r)) return;
+        {
+            /* cosine-distributed about +y */
+            double u1 = path_u(r), phi = 2.0 * ATMOS_PI * path_u(r), st = sqrt(u1);
+            d[0] = st * cos(phi), d[2] = st * sin(phi), d[1] = sqrt(fmax(0.0, 1.0 - u1));
+        }
+        primary = 0;
+    }
+}
+
+/* ------------------------------------------------------------------ the render */
+
+static atmos_status resolve(atmos_context *ctx, const atmos_scene *scene, const atmos_path_settings *in,
+                            atmos_path_settings *s)
+{
+    atmos_path_defaults(s);
+    if (scene->path.spp > 0) s->spp = scene->path.spp;
+    if (scene->path.time_budget_s > 0) s->time_budget_s = scene->path.time_budget_s;
+    if (scene->path.seed) s->seed = scene->path.seed;
+    s->max_depth = scene->path.max_depth;
+    if (in) {
+        if (in->spp) s->spp = in->spp;
+        if (in->time_budget_s) s->time_budget_s = in->time_budget_s;
+        if (in->seed) s->seed = in->seed;
+        if (in->max_depth) s->max_depth = in->max_depth;
+        if (in->density_scale) s->density_scale = in->density_scale;
+        memcpy(s->offset_m, in->offset_m, sizeof s->offset_m);
+        s->optics = in->optics;
+        s->variance = in->variance;
+        s->stats = in->stats;
+    }
+    if (s->spp < 1 || s->spp > ATMOS_PATH_MAX_SPP)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: spp must be in [1, %d], got %d", ATMOS_PATH_MAX_SPP,
+                            s->spp);
+    if (!(s->time_budget_s >= 0) || !isfinite(s->time_budget_s))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: time_budget_s must be >= 0, got %g", s->time_budget_s);
+    if (s->max_depth < 0)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: max_depth must be >= 0, got %d", s->max_depth);
+    if (!(s->density_scale > 0) || !isfinite(s->density_scale))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: density_scale must be > 0, got %g", s->density_scale);
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(s->offset_m[a]))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: offset_m must be finite");
+    return ATMOS_OK;
+}
+
+atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                               const atmos_path_settings *settings, atmos_image **out, atmos_render_info *info)
+{
+    if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: missing scene or output");
+    *out = NULL;
+    if (settings && settings->variance) *settings->variance = NULL;
+    if (volume && !volume->finalized) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: volume is not finalized");
+    const double t_start = now_seconds();
+    atmos_path_settings s;
+    atmos_status st = resolve(ctx, scene, settings, &s);
+    if (st != ATMOS_OK) return st;
+    if ((st = atmos_scene_validate(ctx, scene, "scene")) != ATMOS_OK) return st;
+    atmos_wavelengths wl;
+    if ((st = atmos_scene_wavelengths(ctx, scene, &wl)) != ATMOS_OK) return st;
+    path_job J;
+    memset(&J, 0, sizeof J);
+    if ((st = atmos_camera_init(ctx, &scene->camera, scene->width, scene->height, &J.cam)) != ATMOS_OK) return st;
+    double sun_el = 0, sun_az = 0;
+    if ((st = atmos_scene_sun_direction(ctx, scene, J.sun, &sun_el, &sun_az)) != ATMOS_OK) return st;
+
+    atmos_slice_optics own;
+    memset(&own, 0, sizeof own);
+    path_medium med;
+    path_phase ph;
+    memset(&med, 0, sizeof med);
+    memset(&ph, 0, sizeof ph);
+    atmos_sky *sky = NULL;
+    atmos_image *img = NULL, *var = NULL;
+    double *acc = NULL;
+    const int n = wl.count, W = scene->width, H = scene->height, C = n + 1;
+    const size_t npix = (size_t)W * H;
+    const int NA = 2 * n + 3; /* per pixel: sum and sum of squares per wavelength, hits, sum Y, sum Y^2 */
+    path_counts total = {0, 0, 0};
+    int spp_done = 0;
+    double t_trace = 0, t_prep = 0;
+
+    atmos_atmosphere_desc ad = scene->atmosphere;
+    if ((st = atmos_sky_create(ctx, &ad, &wl, &sky)) != ATMOS_OK) return st;
+    J.n = n;
+    double r = 0.5 * sky->desc.sun_diameter_deg * ATMOS_DEG2RAD;
+    J.cos_sun = cos(r);
+    J.sun_omega = 2.0 * ATMOS_PI * (1.0 - J.cos_sun);
+    for (int k = 0; k < n; k++) J.sun_e[k] = sky->sun_e[k];
+    J.max_depth = s.max_depth;
+    J.seed = s.seed;
+    if (scene->background == ATMOS_BACKGROUND_SKY) {
+        J.albedo = sky->desc.ground_albedo;
+        J.disk_visible = !sky->desc.hide_sun_disk && J.sun[1] > 0;
+    } else {
+        J.bg = scene->background == ATMOS_BACKGROUND_UNIFORM ? scene->background_radiance : 0.0;
+    }
+
+    const double t_prep0 = now_seconds();
+    if (volume && volume->nfields > 0) {
+        const atmos_slice_optics *optics = s.optics;
+        if (!optics) {
+            if ((st = atmos_path_optics_build(ctx, scene, volume, &own)) != ATMOS_OK) goto done;
+            optics = &own;
+        }
+        if (optics->count != volume->nfields) {
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: optics for %d fields, the volume has %d",
+                              optics->count, volume->nfields);
+            goto done;
+        }
+        if ((st = atmos__path_phase_build(ctx, optics, n, &ph)) != ATMOS_OK) goto done;
+        if ((st = atmos__path_medium_build(ctx, volume, s.density_scale, s.offset_m, optics, n, &med)) != ATMOS_OK)
+            goto done;
+        if (!med.empty) J.med = &med, J.ph = &ph;
+    }
+    if (scene->background == ATMOS_BACKGROUND_SKY) J.sky = sky;
+    if ((st = atmos_image_create(ctx, W, H, C, &img)) != ATMOS_OK) goto done;
+    acc = calloc(npix * NA, sizeof(double));
+    if (!acc) {
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the accumulators");
+        goto done;
+    }
+    t_prep = now_seconds() - t_prep0;
+
+    {
+        const int threads = atmos__threads(ctx);
+        /* Passes of S samples per pixel, S from the image size only (never from timing),
+         * so that a pass has enough work to share and the budget is checked often. */
+        int S = (int)(65536 / (npix ? npix : 1));
+        if (S < 1) S = 1;
+        if (S > 256) S = 256;
+        double Ybar[ATMOS_MAX_WAVELENGTHS];
+        for (int k = 0; k < n; k++) Ybar[k] = wl.to_xyz[k][1];
+        const double t0 = now_seconds();
+        int cancelled = 0;
+        while (spp_done < s.spp && !cancelled) {
+            const int s0 = spp_done, s1 = spp_done + S < s.spp ? spp_done + S : s.spp;
+            long long ev = 0, tc = 0, sh = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : ev, tc, sh)
+            for (int y = 0; y < H; y++) {
+                path_counts cnt = {0, 0, 0};
+                for (int x = 0; x < W; x++) {
+                    const size_t pix = (size_t)y * W + x;
+                    double *A = acc + pix * NA;
+                    for (int smp = s0; smp < s1; smp++) {
+                        path_rng rng;
+                        path_rng_seed(&rng, J.seed, pix, (uint64_t)smp);
+                        path_bundle b;
+                        double wgt = 1.0;
+                        if (n <= PATH_B) {
+                            b.m = n;
+                            for (int i = 0; i < n; i++) b.k[i] = i;
+                        } else {
+                            int k0 = (int)(path_u(&rng) * n);
+                            if (k0 >= n) k0 = n - 1;
+                            b.m = PATH_B;
+                            for (int i = 0; i < PATH_B; i++) b.k[i] = (k0 + (i * n) / PATH_B) % n;
+                            wgt = (double)n / PATH_B;
+                        }
+                        double jx = path_u(&rng), jy = path_u(&rng), dir[3];
+                        double L[PATH_B] = {0, 0, 0, 0}, Y = 0;
+                        if (atmos_camera_ray(&J.cam, x + jx, y + jy, dir)) {
+                            trace(&J, &b, J.cam.position, dir, &rng, L, &cnt);
+                            A[2 * n] += 1;
+                        }
+                        for (int i = 0; i < b.m; i++) {
+                            double v = L[i] * wgt;
+                            if (!isfinite(v) || v < 0) v = 0;
+                            A[b.k[i]] += v;
+                            A[n + b.k[i]] += v * v;
+                            Y += Ybar[b.k[i]] * v;
+                        }
+                        A[2 * n + 1] += Y;
+                        A[2 * n + 2] += Y * Y;
+                    }
+                }
+                ev += cnt.events, tc += cnt.tentative, sh += cnt.shadow;
+            }
+            total.events += ev, total.tentative += tc, total.shadow += sh;
+            spp_done = s1;
+            double el = now_seconds() - t0;
+            double frac = (double)spp_done / s.spp;
+            if (s.time_budget_s > 0 && el / s.time_budget_s > frac) frac = el / s.time_budget_s;
+            if (atmos__progress(ctx, "render path", frac)) cancelled = 1;
+            if (s.time_budget_s > 0 && el >= s.time_budget_s) break;
+        }
+        t_trace = now_seconds() - t0;
+        if (cancelled) {
+            st = atmos__error(ctx, ATMOS_E_CANCELLED, "render path: cancelled");
+            goto done;
+        }
+    }
+
+    /* Means, variances of the means, the convergence figure. */
+    {
+        const double N = spp_done;
+        if (s.variance && (st = atmos_image_create(ctx, W, H, C, &var)) != ATMOS_OK) goto done;
+        double rel_sum = 0;
+        long long rel_n = 0;
+        for (size_t pix = 0; pix < npix; pix++) {
+            const double *A = acc + pix * NA;
+            float *px = img->pixels + pix * C;
+            for (int k = 0; k < n; k++) {
+                double mean = A[k] / N;
+                px[k] = (float)mean;
+                if (var) {
+                    double v = N > 1 ? (A[n + k] / N - mean * mean) / (N - 1) : 0;
+                    var->pixels[pix * C + k] = (float)(v > 0 ? v : 0);
+                }
+            }
+            px[n] = (float)(A[2 * n] / N);
+            double my = A[2 * n + 1] / N;
+            if (my > 0 && N > 1) {
+                double vy = (A[2 * n + 2] / N - my * my) / (N - 1);
+                rel_sum += sqrt(vy > 0 ? vy : 0) / my;
+                rel_n++;
+            }
+        }
+        char buf[256];
+        atmos_image_set_meta(img, "atmos:renderer", "path (spectral Monte Carlo volumetric path tracing)");
+        snprintf(buf, sizeof buf, "%d spp, seed %llu, max depth %d, %s", spp_done, (unsigned long long)s.seed,
+                 s.max_depth, scene->background == ATMOS_BACKGROUND_SKY ? "sky" : "vacuum");
+        atmos_image_set_meta(img, "atmos:path", buf);
+        double secs = now_seconds() - t_start;
+        snprintf(buf, sizeof buf, "%.6f", secs);
+        atmos_image_set_meta(img, "atmos:render_seconds", buf);
+        snprintf(buf, sizeof buf, "%.6g", rel_n ? rel_sum / rel_n : 0.0);
+        atmos_image_set_meta(img, "atmos:path_mean_rel_error", buf);
+        if (info) {
+            info->seconds = secs;
+            info->sun_elevation_deg = sun_el;
+            info->sun_azimuth_deg = sun_az;
+        }
+        if (s.stats) {
+            atmos_path_stats *o = s.stats;
+            memset(o, 0, sizeof *o);
+            o->spp = spp_done;
+            o->paths = (long long)spp_done * (long long)npix;
+            o->events = total.events;
+            o->tentative = total.tentative;
+            o->shadow_rays = total.shadow;
+            o->prepare_s = t_prep;
+            o->trace_s = t_trace;
+            o->total_s = secs;
+            o->mean_rel_error = rel_n ? rel_sum / rel_n : 0.0;
+        }
+    }
+    st = ATMOS_OK;
+done:
+    free(acc);
+    atmos__path_medium_free(&med);
+    atmos__path_phase_free(&ph);
+    atmos_sky_destroy(sky);
+    atmos_slice_optics_free(&own);
+    if (st != ATMOS_OK) {
+        atmos_image_destroy(img);
+        atmos_image_destroy(var);
+        return st;
+    }
+    *out = img;
+    if (s.variance) *s.variance = var;
+    else atmos_image_destroy(var);
+    return ATMOS_OK;
+}

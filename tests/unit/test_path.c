@@ -1,0 +1,477 @@
+/* The path tracer against independent references:
+ *  - the adding-doubling solver of path_ad.h (checked first on its own: conservative
+ *    scattering R + T = 1, the single-scattering limit, convergence in the quadrature,
+ *    a published value) for the diffuse reflectance and transmittance of a homogeneous
+ *    HG slab (g = 0.85, tau = 0.5, 2, 8), measured from equirectangular renders by the
+ *    renderer itself (atmos_render_path) above and below a wide thin box volume;
+ *  - analytic single scattering (max_depth 1, and the optically thin limit);
+ *  - Beer-Lambert through a heterogeneous absorber (exact optical depth by
+ *    atmos_volume_optical_depth);
+ * and its invariants: 1 and 2 threads give identical bytes, spectral mode (hero
+ * wavelengths) agrees with rgb mode, no NaN/Inf, an empty scene is the sky.
+ * ATMOS_PATH_LONG=1 runs the slab comparison with 16x the samples (docs/path.md). */
+#include "atmos/atmos.h"
+#include "test.h"
+#include "path_ad.h"
+
+#define PI 3.14159265358979323846
+
+static char cache_dir[1024];
+static int long_run;
+
+static atmos_context *make_ctx(int threads)
+{
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    d.threads = threads;
+    d.cache_dir = cache_dir;
+    d.log = NULL;
+    atmos_context *ctx = NULL;
+    if (atmos_context_create(&d, &ctx) != ATMOS_OK) exit(1);
+    return ctx;
+}
+
+/* ------------------------------------------------------------------ adding-doubling on its own */
+
+static double hg(double mu, double g) { return (1 - g * g) / (4 * PI * pow(1 + g * g - 2 * g * mu, 1.5)); }
+
+static void test_ad(void)
+{
+    static ad_result r, r2;
+    const double taus[3] = {0.5, 2, 8};
+    for (int i = 0; i < 3; i++) {
+        CHECK(ad_slab(taus[i], 1.0, 0.85, 1.0, 32, &r));
+        /* conservative: everything comes out */
+        CHECK_NEAR(r.refl + r.trans + exp(-taus[i]), 1.0, 1e-9);
+        CHECK(ad_slab(taus[i], 1.0, 0.85, 1.0, 48, &r2));
+        /* converged in the quadrature */
+        CHECK_NEAR(r.refl, r2.refl, 2e-5);
+        CHECK_NEAR(r.trans, r2.trans, 2e-5);
+        printf("adding-doubling g=0.85 tau=%g: R=%.6f T=%.6f (N=32), R=%.6f T=%.6f (N=48)\n", taus[i], r.refl, r.trans,
+               r2.refl, r2.trans);
+    }
+    /* absorption lowers both */
+    CHECK(ad_slab(2, 0.9, 0.85, 1.0, 32, &r2));
+    CHECK(ad_slab(2, 1.0, 0.85, 1.0, 32, &r));
+    CHECK(r2.refl < r.refl && r2.trans < r.trans && r2.refl + r2.trans + exp(-2.0) < 0.999);
+    /* single-scattering limit: nadir radiance of a thin layer, a E p(180°) (1 - e^{-2 tau}) / 2 */
+    CHECK(ad_slab(1e-4, 1.0, 0.85, 1.0, 64, &r));
+    CHECK_REL(r.radiance_up[0], hg(-1, 0.85) * 0.5 * (1 - exp(-2e-4)), 1e-3);
+    /* Isotropic scattering: a quadrature direction mu: p = 1/(4 pi), mu0 = 1 */
+    CHECK(ad_slab(1e-4, 1.0, 0.0, 1.0, 16, &r));
+    for (int i = 1; i < r.D; i += 5)
+        CHECK_REL(r.radiance_up[i], 1 / (4 * PI) / (1 + r.mu[i]) * (1 - exp(-1e-4 * (1 + 1 / r.mu[i]))), 1e-3);
+    /* Published: isotropic scattering, albedo 0.8, semi-infinite, normal incidence: total
+     * reflection 0.28525 (Prahl's adding-doubling, iadpython's test suite; equal to
+     * 1 - H(1) sqrt(1 - a) with Chandrasekhar's H-function). */
+    CHECK(ad_slab(1000, 0.8, 0.0, 1.0, 32, &r));
+    CHECK_NEAR(r.refl, 0.28525, 1e-4);
+    printf("adding-doubling isotropic a=0.8 semi-infinite: R=%.5f (published 0.28525)\n", r.refl);
+}
+
+/* ------------------------------------------------------------------ scenes */
+
+typedef struct {
+    atmos_phase_table *t;
+    atmos_slice_optics o;
+} optics;
+
+static void make_optics(atmos_context *ctx, int spectral, double g, double albedo, optics *op)
+{
+    atmos_particle_desc p;
+    memset(&p, 0, sizeof p);
+    snprintf(p.name, sizeof p.name, "hg");
+    p.kind = ATMOS_PARTICLE_ANALYTIC;
+    p.analytic.count = 1;
+    p.analytic.kind[0] = ATMOS_PHASE_HG;
+    p.analytic.g[0] = g;
+    p.analytic.weight[0] = 1;
+    p.sigma_ext_m2 = 1e-9;
+    p.albedo = albedo;
+    atmos_wavelengths wl;
+    if (spectral) atmos_wavelengths_spectral(16, &wl);
+    else atmos_wavelengths_rgb(&wl);
+    atmos_phase_table_desc td = {1};
+    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &op->t));
+    memset(&op->o, 0, sizeof op->o);
+    op->o.count = 1;
+    op->o.phase[0] = op->t;
+}
+
+/* A slab of optical thickness tau (1e-9 m^2 particles), H = 100 m thick, nxz * H wide,
+ * between y = SLAB_Y and SLAB_Y + H, centred on x = z = 0: one voxel thick, uniform, so the
+ * interpolated density is uniform up to the faces. */
+#define SLAB_H 100.0
+#define SLAB_Y 1000.0
+static atmos_volume *slab(atmos_context *ctx, int nxz, double tau)
+{
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    vd.dims[0] = vd.dims[2] = nxz;
+    vd.dims[1] = 1;
+    vd.voxel_size_m = SLAB_H;
+    vd.origin_m[0] = vd.origin_m[2] = -0.5 * nxz * SLAB_H;
+    vd.origin_m[1] = SLAB_Y;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    int f = -1;
+    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
+    float *buf = malloc(sizeof(float) * (size_t)nxz * nxz);
+    for (int i = 0; i < nxz * nxz; i++) buf[i] = (float)(tau / (1e-9 * SLAB_H));
+    int off[3] = {0, 0, 0}, size[3] = {nxz, 1, nxz};
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    free(buf);
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    return v;
+}
+
+static void vacuum_scene(atmos_scene *s, int spectral, double sun_el, double sun_az)
+{
+    atmos_scene_defaults(s);
+    s->wavelengths = spectral ? ATMOS_WAVELENGTHS_SPECTRAL : ATMOS_WAVELENGTHS_RGB;
+    s->spectral_samples = 16;
+    s->background = ATMOS_BACKGROUND_BLACK;
+    s->sun.from_time = 0;
+    s->sun.elevation_deg = sun_el;
+    s->sun.azimuth_deg = sun_az;
+    s->atmosphere.sun_diameter_deg = 0.05;
+}
+
+static atmos_image *render(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v, const optics *op, int spp,
+                           int max_depth, atmos_image **var)
+{
+    atmos_path_settings ps;
+    memset(&ps, 0, sizeof ps);
+    ps.spp = spp;
+    ps.seed = 7;
+    ps.max_depth = max_depth;
+    ps.optics = op ? &op->o : NULL;
+    ps.variance = var;
+    atmos_image *img = NULL;
+    atmos_status st = atmos_render_path(ctx, s, v, &ps, &img, NULL);
+    CHECK_MSG(st == ATMOS_OK, "render path: %s", atmos_context_error(ctx));
+    if (st != ATMOS_OK) exit(1);
+    return img;
+}
+
+static int all_finite(const atmos_image *img)
+{
+    size_t n = (size_t)img->width * img->height * img->channels;
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(img->pixels[i]) || img->pixels[i] < 0) return 0;
+    return 1;
+}
+
+/* Hemispherical flux (per unit sun irradiance E) through an equirectangular image of
+ * the lower (down = 1) or upper half, from the pixels' mean radiance in channel c:
+ * sum over rows of mean * 2 pi * integral over the row of |sin el| cos el d el. */
+static void hemi_flux(const atmos_image *img, const atmos_image *var, int c, int down, double E, double *flux,
+                      double *se)
+{
+    const int W = img->width, H = img->height, C = img->channels;
+    double f = 0, v = 0;
+    for (int y = 0; y < H; y++) {
+        double ea = (90.0 - 180.0 * y / H) * PI / 180, eb = (90.0 - 180.0 * (y + 1) / H) * PI / 180;
+        if (down ? ea > 1e-12 : eb < -1e-12) continue;
+        double wgt = 0.5 * fabs(sin(ea) * sin(ea) - sin(eb) * sin(eb)) * 2 * PI / W / E;
+        for (int x = 0; x < W; x++) {
+            f += wgt * img->pixels[((size_t)y * W + x) * C + c];
+            v += wgt * wgt * var->pixels[((size_t)y * W + x) * C + c];
+        }
+    }
+    *flux = f;
+    *se = sqrt(v);
+}
+
+static double sun_e(atmos_context *ctx, const atmos_scene *s, int k)
+{
+    atmos_wavelengths wl;
+    CHECK_OK(atmos_scene_wavelengths(ctx, s, &wl));
+    return wl.sun_irradiance[k] * (s->atmosphere.sun_scale > 0 ? s->atmosphere.sun_scale : 1.0);
+}
+
+/* ------------------------------------------------------------------ the slab */
+
+static void test_slab(atmos_context *ctx)
+{
+    const double taus[3] = {0.5, 2, 8};
+    const int spp[3] = {1536, 512, 256};
+    optics op;
+    make_optics(ctx, 0, 0.85, 1.0, &op);
+    for (int i = 0; i < 3; i++) {
+        static ad_result ad;
+        CHECK(ad_slab(taus[i], 1.0, 0.85, 1.0, 48, &ad));
+        atmos_volume *v = slab(ctx, 512, taus[i]);
+        atmos_scene s;
+        vacuum_scene(&s, 0, 90, 0);
+        s.width = 4, s.height = 256;
+        double E = sun_e(ctx, &s, 1);
+        for (int side = 0; side < 2; side++) {
+            double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
+            atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
+            atmos_image *var = NULL;
+            atmos_image *img = render(ctx, &s, v, &op, spp[i] * (long_run ? 16 : 1), 0, &var);
+            if (!img || !var) continue;
+            CHECK(all_finite(img));
+            double f, se;
+            hemi_flux(img, var, 1, side == 0, E, &f, &se);
+            double ref = side == 0 ? ad.refl : ad.trans;
+            double z = (f - ref) / se;
+            printf("slab g=0.85 tau=%g %s: path %.5f +- %.5f, adding-doubling %.5f (%+.2f sigma, rel SE %.2f%%)\n",
+                   taus[i], side == 0 ? "R" : "T", f, se, ref, z, 100 * se / ref);
+            CHECK_MSG(fabs(z) < 3.0, "tau %g %s: %.5f vs %.5f (%.2f standard errors)", taus[i], side ? "T" : "R", f, ref, z);
+            CHECK(se < 0.02 * ref); /* the test has teeth */
+            atmos_image_destroy(img);
+            atmos_image_destroy(var);
+        }
+        atmos_volume_destroy(v);
+    }
+    atmos_phase_table_destroy(op.t);
+}
+
+/* ------------------------------------------------------------------ single scattering */
+
+/* Reflected single-scattered radiance of a slab lit at mu0 (azimuth phi0) seen at mu
+ * (looking down, azimuth of the view phi): a E p(Theta) mu0 / (mu0 + mu) (1 - e^{-tau (1/mu0 + 1/mu)}). */
+static void test_single(atmos_context *ctx)
+{
+    optics op;
+    make_optics(ctx, 0, 0.85, 0.8, &op);
+    const double tau = 0.5;
+    atmos_volume *v = slab(ctx, 256, tau);
+    atmos_scene s;
+    vacuum_scene(&s, 0, 40, 200); /* the sun 40° high in the SSW */
+    s.width = s.height = 8;
+    /* a narrow pinhole above the slab looking down 50° below the horizon towards the NNE:
+     * a back-scattering geometry, Theta = 180 - 40 - 50... computed below */
+    double pos[3] = {0, SLAB_Y + SLAB_H + 1, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    double view[3], sun[3], el, az;
+    atmos_direction_from_angles(-50, 20, view);
+    for (int a = 0; a < 3; a++) s.camera.look_at[a] = pos[a] + view[a];
+    s.camera.fov_deg = 0.02;
+    CHECK_OK(atmos_scene_sun_direction(ctx, &s, sun, &el, &az));
+    double E = sun_e(ctx, &s, 1);
+    double mu0 = sin(40 * PI / 180), mu = sin(50 * PI / 180);
+    /* scattering angle between the sunlight's travel (-sun) and the light going to the eye (-view) */
+    double cth = sun[0] * view[0] + sun[1] * view[1] + sun[2] * view[2];
+    double ref = 0.8 * E * hg(cth, 0.85) * mu0 / (mu0 + mu) * (1 - exp(-tau * (1 / mu0 + 1 / mu)));
+    atmos_image *var = NULL;
+    atmos_image *img = render(ctx, &s, v, &op, 256, 1, &var);
+    double m = 0, vv = 0;
+    for (int p = 0; p < 64; p++) m += img->pixels[p * 4 + 1] / 64, vv += var->pixels[p * 4 + 1] / (64.0 * 64.0);
+    printf("single scattering tau=0.5 albedo 0.8 Theta=%.1f deg: path %.6g +- %.2g, analytic %.6g (%+.2f sigma)\n",
+           acos(cth) * 180 / PI, m, sqrt(vv), ref, (m - ref) / sqrt(vv));
+    CHECK(fabs(m - ref) < 3 * sqrt(vv));
+    CHECK(sqrt(vv) < 0.01 * ref);
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_volume_destroy(v);
+
+    /* The optically thin limit with unlimited depth: tau = 1e-2, nadir view, sun at the
+     * zenith: a E p(180°) (1 - e^{-2 tau}) / 2; multiple scattering adds O(tau). */
+    const double tt = 1e-2;
+    v = slab(ctx, 256, tt);
+    vacuum_scene(&s, 0, 90, 0);
+    s.width = s.height = 8;
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = 1, s.camera.look_at[2] = 0; /* (0,0,0) would mean "default" */
+    s.camera.up[0] = 0, s.camera.up[1] = 0, s.camera.up[2] = -1;
+    s.camera.fov_deg = 0.02;
+    ref = 0.8 * E * hg(-1, 0.85) * 0.5 * (1 - exp(-2 * tt));
+    img = render(ctx, &s, v, &op, 4096, 0, &var);
+    m = 0, vv = 0;
+    for (int p = 0; p < 64; p++) m += img->pixels[p * 4 + 1] / 64, vv += var->pixels[p * 4 + 1] / (64.0 * 64.0);
+    printf("thin limit tau=1e-2: path %.6g +- %.2g, single scattering %.6g (rel diff %.2g)\n", m, sqrt(vv), ref,
+           (m - ref) / ref);
+    /* multiple scattering adds about tau of the single-scattered light */
+    CHECK(fabs(m - ref) < 3 * sqrt(vv) + 2 * tt * ref);
+    CHECK(sqrt(vv) < 0.03 * ref);
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+}
+
+/* ------------------------------------------------------------------ Beer-Lambert */
+
+static void test_absorber(atmos_context *ctx)
+{
+    optics op;
+    make_optics(ctx, 0, 0.0, 1e-12, &op);
+    /* heterogeneous: 24^3 voxels of 10 m with a smooth random-looking density */
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    vd.dims[0] = vd.dims[1] = vd.dims[2] = 24;
+    vd.voxel_size_m = 10;
+    vd.origin_m[0] = -120, vd.origin_m[1] = 1000, vd.origin_m[2] = -120;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    int f = -1;
+    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
+    static float buf[24 * 24 * 24];
+    for (int k = 0; k < 24; k++)
+        for (int j = 0; j < 24; j++)
+            for (int i = 0; i < 24; i++)
+                buf[(k * 24 + j) * 24 + i] =
+                    (float)(4e6 * (1.6 + sin(0.7 * i) * cos(0.45 * j + 0.3 * k) + 0.5 * sin(1.3 * k + 0.2 * i)) *
+                            (i > 2 && j > 1 && k > 3 ? 1 : 0.2));
+    int off[3] = {0, 0, 0}, size[3] = {24, 24, 24};
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    atmos_scene s;
+    vacuum_scene(&s, 0, 30, 100);
+    s.background = ATMOS_BACKGROUND_UNIFORM;
+    s.background_radiance = 2.0;
+    s.width = s.height = 8;
+    double pos[3] = {-300, 1050, -250};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = 1130, s.camera.look_at[2] = 0;
+    s.camera.fov_deg = 0.01;
+    atmos_camera cam;
+    CHECK_OK(atmos_camera_init(ctx, &s.camera, 8, 8, &cam));
+    double d[3];
+    atmos_camera_ray(&cam, 4, 4, d);
+    double sig = 1e-9;
+    double tau = atmos_volume_optical_depth(v, &sig, pos, d, 0, 1e4);
+    atmos_image *var = NULL;
+    atmos_image *img = render(ctx, &s, v, &op, 512, 0, &var);
+    double m = 0, vv = 0;
+    for (int p = 0; p < 64; p++) m += img->pixels[p * 4 + 1] / 64, vv += var->pixels[p * 4 + 1] / (64.0 * 64.0);
+    double ref = 2.0 * exp(-tau);
+    printf("Beer-Lambert tau=%.4f: path %.6f +- %.2g, exact %.6f (%+.2f sigma)\n", tau, m, sqrt(vv), ref,
+           (m - ref) / sqrt(vv));
+    CHECK(tau > 0.5 && tau < 3);
+    CHECK(fabs(m - ref) < 3 * sqrt(vv));
+    CHECK(sqrt(vv) < 0.02 * ref);
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+}
+
+/* ------------------------------------------------------------------ invariants */
+
+static void test_threads_and_spectral(void)
+{
+    atmos_context *c1 = make_ctx(1), *c2 = make_ctx(2);
+    optics op;
+    make_optics(c1, 0, 0.85, 0.99, &op);
+    atmos_volume *v = slab(c1, 64, 2);
+    atmos_scene s;
+    vacuum_scene(&s, 0, 35, 150);
+    s.background = ATMOS_BACKGROUND_UNIFORM;
+    s.background_radiance = 0.1;
+    s.width = 24, s.height = 16;
+    double pos[3] = {0, SLAB_Y + 300, 900};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = SLAB_Y + 50, s.camera.look_at[2] = 0;
+    atmos_image *a = render(c1, &s, v, &op, 6, 0, NULL), *b = render(c2, &s, v, &op, 6, 0, NULL);
+    CHECK(a && b && memcmp(a->pixels, b->pixels, sizeof(float) * 24 * 16 * 4) == 0);
+    CHECK(all_finite(a));
+    atmos_image_destroy(a);
+    atmos_image_destroy(b);
+
+    /* Spectral mode: 16 wavelengths, 4 per path; the slab's reflectance is grey, so every
+     * wavelength's reflected radiance over the sun's irradiance matches rgb mode. */
+    optics os;
+    make_optics(c1, 1, 0.85, 0.99, &os);
+    s.background = ATMOS_BACKGROUND_BLACK;
+    s.width = s.height = 8;
+    s.camera.fov_deg = 1;
+    atmos_image *va = NULL, *vb = NULL;
+    a = render(c2, &s, v, &op, 256, 0, &va);
+    vacuum_scene(&s, 1, 35, 150);
+    s.width = s.height = 8;
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = SLAB_Y + 50, s.camera.look_at[2] = 0;
+    s.camera.fov_deg = 1;
+    b = render(c2, &s, v, &os, 512, 0, &vb);
+    double Ea = sun_e(c1, &s, 0);
+    (void)Ea;
+    atmos_scene srgb = s;
+    srgb.wavelengths = ATMOS_WAVELENGTHS_RGB;
+    double ma = 0, sa = 0;
+    for (int p = 0; p < 64; p++) ma += a->pixels[p * 4 + 1] / 64, sa += va->pixels[p * 4 + 1] / 4096.0;
+    ma /= sun_e(c1, &srgb, 1);
+    sa = sqrt(sa) / sun_e(c1, &srgb, 1);
+    int bad = 0;
+    for (int k = 0; k < 16; k += 5) {
+        double mb = 0, sb = 0;
+        for (int p = 0; p < 64; p++) mb += b->pixels[p * 17 + k] / 64, sb += vb->pixels[p * 17 + k] / 4096.0;
+        double e = sun_e(c1, &s, k);
+        mb /= e, sb = sqrt(sb) / e;
+        double z = (mb - ma) / sqrt(sa * sa + sb * sb);
+        printf("spectral k=%d: %.5g +- %.2g vs rgb %.5g +- %.2g (%+.2f sigma)\n", k, mb, sb, ma, sa, z);
+        bad |= fabs(z) > 3.5;
+    }
+    CHECK(!bad);
+    CHECK(all_finite(b));
+    atmos_image_destroy(a);
+    atmos_image_destroy(b);
+    atmos_image_destroy(va);
+    atmos_image_destroy(vb);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+    atmos_phase_table_destroy(os.t);
+    atmos_context_destroy(c1);
+    atmos_context_destroy(c2);
+}
+
+/* No volume and a black ground: the path tracer's sky is atmos_render_sky's (in
+ * expectation; the pixel footprint is sampled by both). */
+static void test_sky_only(atmos_context *ctx)
+{
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.width = 16, s.height = 12;
+    s.samples_per_pixel = 256;
+    s.atmosphere.ground_albedo = 0;
+    s.sun.from_time = 0;
+    s.sun.elevation_deg = 20;
+    s.sun.azimuth_deg = 90;
+    atmos_image *sky = NULL, *var = NULL;
+    CHECK_OK(atmos_render_sky(ctx, &s, &sky, NULL));
+    atmos_image *img = render(ctx, &s, NULL, NULL, 256, 0, &var);
+    int bad = 0;
+    for (int p = 0; p < 16 * 12; p++)
+        for (int c = 0; c < 3; c++) {
+            double a = img->pixels[p * 4 + c], b = sky->pixels[p * 4 + c], se = sqrt(var->pixels[p * 4 + c]);
+            if (fabs(a - b) > 4 * se + 5e-3 * b) {
+                bad++;
+                printf("sky pixel %d channel %d: path %g +- %g, sky %g\n", p, c, a, se, b);
+            }
+        }
+    CHECK_MSG(bad == 0, "%d pixel channels differ from the sky", bad);
+    CHECK(all_finite(img));
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_image_destroy(sky);
+
+    /* bad settings */
+    atmos_path_settings ps;
+    memset(&ps, 0, sizeof ps);
+    ps.spp = ATMOS_PATH_MAX_SPP + 1;
+    atmos_image *o = NULL;
+    CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
+    ps.spp = 1;
+    ps.density_scale = -1;
+    CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
+}
+
+int main(void)
+{
+    test_tmp_path(cache_dir, sizeof cache_dir, "path_cache");
+    const char *lr = getenv("ATMOS_PATH_LONG");
+    long_run = lr && *lr && *lr != '0';
+    setvbuf(stdout, NULL, _IONBF, 0);
+    atmos_context *ctx = make_ctx(0);
+    test_ad();
+    test_sky_only(ctx);
+    test_absorber(ctx);
+    test_single(ctx);
+    test_threads_and_spectral();
+    test_slab(ctx);
+    atmos_context_destroy(ctx);
+    return test_summary("test_path");
+}
