@@ -56,8 +56,10 @@ typedef struct atmos_path_settings {
     double offset_m[3];    /* added to the volume's world position (as atmos_slice_settings) */
     const atmos_slice_optics *optics; /* NULL: built inside the render (only the phase tables
                                          are read; the Ams tables are not needed) */
-    atmos_image **variance; /* optional output: per pixel and channel the variance of the
-                               pixel's mean (same layout as the image; alpha channel 0) */
+    atmos_image **variance; /* optional output: per pixel the variance of the pixel's mean
+                               radiance at each wavelength ((W m^-2 sr^-1 nm^-1)^2), then, in
+                               the place of alpha, the variance of the mean luminance Y
+                               ((cd m^-2)^2, covariances between wavelengths included) */
     atmos_path_stats *stats; /* optional output */
 } atmos_path_settings;
 

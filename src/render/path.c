@@ -545,9 +545,11 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
             }
             px[n] = (float)(A[2 * n] / N);
             double my = A[2 * n + 1] / N;
+            double vy = N > 1 ? (A[2 * n + 2] / N - my * my) / (N - 1) : 0;
+            if (!(vy > 0)) vy = 0;
+            if (var) var->pixels[pix * C + n] = (float)vy;
             if (my > 0 && N > 1) {
-                double vy = (A[2 * n + 2] / N - my * my) / (N - 1);
-                rel_sum += sqrt(vy > 0 ? vy : 0) / my;
+                rel_sum += sqrt(vy) / my;
                 rel_n++;
             }
         }

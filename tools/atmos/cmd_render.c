@@ -24,7 +24,7 @@ static void help(void)
            "      --exr-half          write EXR as 16-bit half floats (default: 32-bit float)\n\n"
            "Overrides of the scene's settings:\n"
            "      --width W --height H      image size in pixels\n"
-           "      --spp N                   samples per pixel (1..256)\n"
+           "      --spp N                   samples per pixel (1..256; path tracer: 1..1000000)\n"
            "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
            "      --altitude M              camera altitude above sea level, metres\n"
            "      --sun-elevation E         sun elevation, degrees\n"
@@ -36,14 +36,19 @@ static void help(void)
            "      --exposure-comp STOPS     compensation added to automatic exposure\n"
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
-           "      --renderer sky|slice      the analytic sky (default), or Riley et al.'s half-angle slicing\n"
-           "                                over a volume (default when --volume is given)\n"
+           "      --renderer sky|slice|path the analytic sky (default), Riley et al.'s half-angle slicing\n"
+           "                                over a volume (default when --volume is given), or spectral\n"
+           "                                Monte Carlo path tracing (the reference; docs/path.md)\n"
            "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
            "      --volume-offset X,Y,Z     metres added to the volume's position (default: moved\n"
            "                                horizontally to 3 widths, at least 4 km, in front of the camera)\n"
            "      --density-scale S         multiplies the volume's densities\n"
            "      --slices N --xi X         slicing planes (default 256); back-scatter term xi (sr^-1)\n"
+           "      --time-budget S           path: stop after the pass during which S seconds have passed\n"
+           "      --seed N                  path: random seed (default 1; same seed, same image)\n"
+           "      --variance FILE.exr       path: per-pixel variance of the mean (per wavelength, and of\n"
+           "                                the luminance Y in channel var_Y)\n"
            "  -q, --quiet                   no progress bar or messages\n"
            "  -h, --help                    this help\n\n"
            "Examples:\n"
@@ -86,7 +91,7 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
     O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VOFFSET,
-    O_DSCALE
+    O_DSCALE, O_TBUDGET, O_SEED, O_VARIANCE
 };
 
 int cli_cmd_render(int argc, char **argv)
@@ -106,6 +111,8 @@ int cli_cmd_render(int argc, char **argv)
         {"renderer", required_argument, 0, O_RENDERER}, {"volume", required_argument, 0, O_VOLUME},
         {"slices", required_argument, 0, O_SLICES}, {"xi", required_argument, 0, O_XI},
         {"volume-offset", required_argument, 0, O_VOFFSET}, {"density-scale", required_argument, 0, O_DSCALE},
+        {"time-budget", required_argument, 0, O_TBUDGET}, {"seed", required_argument, 0, O_SEED},
+        {"variance", required_argument, 0, O_VARIANCE},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -122,6 +129,14 @@ int cli_cmd_render(int argc, char **argv)
     const char *volume_arg = NULL;
     double xi = NAN, dscale = 0, voff[3] = {0, 0, 0};
     int voff_given = 0;
+    /* The path tracer (path.h): --renderer path, --time-budget, --seed, --variance. */
+    int use_path = 0;
+    double tbudget = 0;
+    unsigned long long seed = 0;
+    const char *variance_out = NULL;
+    atmos_image *var_img = NULL;
+    atmos_path_stats pstats;
+    memset(&pstats, 0, sizeof pstats);
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
@@ -136,7 +151,7 @@ int cli_cmd_render(int argc, char **argv)
         case O_EXRHALF: exr_half = 1; break;
         case O_W: if (!cli_parse_int(C, "--width", optarg, 1, ATMOS_SCENE_MAX_DIM, &w)) return CLI_EXIT_USAGE; break;
         case O_H: if (!cli_parse_int(C, "--height", optarg, 1, ATMOS_SCENE_MAX_DIM, &h)) return CLI_EXIT_USAGE; break;
-        case O_SPP: if (!cli_parse_int(C, "--spp", optarg, 1, 256, &spp)) return CLI_EXIT_USAGE; break;
+        case O_SPP: if (!cli_parse_int(C, "--spp", optarg, 1, ATMOS_PATH_MAX_SPP, &spp)) return CLI_EXIT_USAGE; break;
         case O_CAM:
             if (!strcmp(optarg, "pinhole")) cam_type = ATMOS_CAMERA_PINHOLE;
             else if (!strcmp(optarg, "fisheye")) cam_type = ATMOS_CAMERA_FISHEYE;
@@ -164,9 +179,11 @@ int cli_cmd_render(int argc, char **argv)
             break;
         case O_THREADS: if (!cli_parse_int(C, "--threads", optarg, 1, 1024, &threads)) return CLI_EXIT_USAGE; break;
         case O_RENDERER:
+            use_path = 0;
             if (!strcmp(optarg, "sky")) use_slice = 0;
             else if (!strcmp(optarg, "slice")) use_slice = 1;
-            else return cli_usage_error(C, "--renderer: expected sky or slice, got '%s'", optarg);
+            else if (!strcmp(optarg, "path")) use_slice = 0, use_path = 1;
+            else return cli_usage_error(C, "--renderer: expected sky, slice or path, got '%s'", optarg);
             break;
         case O_VOLUME: volume_arg = optarg; break;
         case O_SLICES: if (!cli_parse_int(C, "--slices", optarg, 1, 8192, &slices)) return CLI_EXIT_USAGE; break;
@@ -181,6 +198,17 @@ int cli_cmd_render(int argc, char **argv)
                 return cli_usage_error(C, "--volume-offset: expected X,Y,Z in metres, got '%s'", optarg);
             voff_given = 1;
             break;
+        case O_TBUDGET:
+            if (!cli_parse_double(C, "--time-budget", optarg, &tbudget) || !(tbudget > 0))
+                return cli_usage_error(C, "--time-budget: expected seconds > 0");
+            break;
+        case O_SEED: {
+            char *end = NULL;
+            seed = strtoull(optarg, &end, 10);
+            if (!*optarg || *end || optarg[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", optarg);
+            break;
+        }
+        case O_VARIANCE: variance_out = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
@@ -196,10 +224,14 @@ int cli_cmd_render(int argc, char **argv)
     if (use_time && (!isnan(sel) || !isnan(saz)))
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
-    if (use_slice < 0) use_slice = volume_arg != NULL;
+    if (use_slice < 0) use_slice = volume_arg != NULL && !use_path;
     if (use_slice && !volume_arg) return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
-    if (!use_slice && (volume_arg || slices || !isnan(xi) || dscale > 0))
-        return cli_usage_error(C, "--volume, --slices, --xi and --density-scale go with --renderer slice");
+    if (!use_slice && !use_path && (volume_arg || slices || !isnan(xi) || dscale > 0))
+        return cli_usage_error(C, "--volume, --slices, --xi and --density-scale go with --renderer slice or path");
+    if (use_path && (slices || !isnan(xi))) return cli_usage_error(C, "--slices and --xi go with --renderer slice");
+    if (!use_path && (tbudget > 0 || seed || variance_out))
+        return cli_usage_error(C, "--time-budget, --seed and --variance go with --renderer path");
+    if (!use_path && spp > 256) return cli_usage_error(C, "--spp: must be in [1, 256] for this renderer, got %d", spp);
 
     cli_progress prog;
     cli_progress_init(&prog, quiet);
@@ -216,7 +248,7 @@ int cli_cmd_render(int argc, char **argv)
     }
     if (w) scene.width = w;
     if (h) scene.height = h;
-    if (spp) scene.samples_per_pixel = spp;
+    if (spp && !use_path) scene.samples_per_pixel = spp;
     if (png_bits) scene.png_bits = png_bits;
     if (exr_half) scene.exr_half = 1;
     if (cam_type >= 0 && cam_type != (int)scene.camera.type) {
@@ -278,7 +310,7 @@ int cli_cmd_render(int argc, char **argv)
     atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     atmos_render_info info;
     atmos_wavelengths wl;
-    if (use_slice) {
+    if (use_slice || (use_path && volume_arg)) {
         atmos_volume *vol = NULL;
         if (!strncmp(volume_arg, "generate:", 9)) {
             atmos_volume_generate_desc gd;
@@ -307,9 +339,31 @@ int cli_cmd_render(int argc, char **argv)
             ss.offset_m[0] = scene.camera.position[0] + f[0] / fh * dist - 0.5 * (lo[0] + hi[0]);
             ss.offset_m[2] = scene.camera.position[2] + f[2] / fh * dist - 0.5 * (lo[2] + hi[2]);
         }
-        st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
+        if (use_path) {
+            atmos_path_settings ps;
+            memset(&ps, 0, sizeof ps);
+            ps.spp = spp;
+            ps.time_budget_s = tbudget;
+            ps.seed = seed;
+            ps.density_scale = ss.density_scale;
+            memcpy(ps.offset_m, ss.offset_m, sizeof ps.offset_m);
+            ps.variance = variance_out ? &var_img : NULL;
+            ps.stats = &pstats;
+            st = atmos_render_path(ctx, &scene, vol, &ps, &spec, &info);
+        } else {
+            st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
+        }
         atmos_volume_destroy(vol);
         if (st != ATMOS_OK) goto fail;
+    } else if (use_path) {
+        atmos_path_settings ps;
+        memset(&ps, 0, sizeof ps);
+        ps.spp = spp;
+        ps.time_budget_s = tbudget;
+        ps.seed = seed;
+        ps.variance = variance_out ? &var_img : NULL;
+        ps.stats = &pstats;
+        if ((st = atmos_render_path(ctx, &scene, NULL, &ps, &spec, &info)) != ATMOS_OK) goto fail;
     } else if ((st = atmos_render_sky(ctx, &scene, &spec, &info)) != ATMOS_OK) {
         goto fail;
     }
@@ -321,6 +375,19 @@ int cli_cmd_render(int argc, char **argv)
         if ((st = atmos_write_exr(ctx, lin, exr, &ed)) != ATMOS_OK) goto fail;
     }
     if (pfm && (st = atmos_write_pfm(ctx, lin, pfm)) != ATMOS_OK) goto fail;
+    if (var_img && variance_out) {
+        /* channels: var_<nm>nm per wavelength, then var_Y */
+        static char names[ATMOS_MAX_WAVELENGTHS + 1][24];
+        const char *np[ATMOS_MAX_WAVELENGTHS + 1];
+        for (int k = 0; k < wl.count; k++) {
+            snprintf(names[k], sizeof names[k], "var_%.1fnm", wl.nm[k]);
+            np[k] = names[k];
+        }
+        np[wl.count] = "var_Y";
+        atmos_exr_desc ed = {0, np};
+        atmos_image_set_meta(var_img, "atmos:source", source);
+        if ((st = atmos_write_exr(ctx, var_img, variance_out, &ed)) != ATMOS_OK) goto fail;
+    }
     if (png) {
         char buf[64];
         double scale = atmos_tonemap_scale(lin, &scene.tonemap);
@@ -335,7 +402,12 @@ int cli_cmd_render(int argc, char **argv)
         if (png) fprintf(stderr, "  wrote %s\n", png);
         if (exr) fprintf(stderr, "  wrote %s\n", exr);
         if (pfm) fprintf(stderr, "  wrote %s\n", pfm);
+        if (use_path)
+            fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", pstats.spp,
+                    pstats.events, 100.0 * pstats.mean_rel_error);
+        if (var_img && variance_out) fprintf(stderr, "  wrote %s\n", variance_out);
     }
+    atmos_image_destroy(var_img);
     atmos_image_destroy(spec);
     atmos_image_destroy(lin);
     atmos_image_destroy(disp);
@@ -345,6 +417,7 @@ fail:
     if (prog.shown) fputc('\n', stderr);
     {
         int rc = cli_runtime_error(C, ctx, st);
+        atmos_image_destroy(var_img);
         atmos_image_destroy(spec);
         atmos_image_destroy(lin);
         atmos_image_destroy(disp);
