@@ -17,7 +17,8 @@ static void help(void)
     printf("Usage: atmos bench sky [--size N] [--repeat R] [--threads T]\n"
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
-           "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--json]\n\n"
+           "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--json]\n"
+           "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
            "          prints per case the best wall time and megapixels per second:\n"
@@ -41,7 +42,16 @@ static void help(void)
            "          slices) on the generated storm and, with --file, on that volume (the Disney cloud);\n"
            "          best of R (default 3): ms per frame (light + eye passes + sky; the volume's upload to\n"
            "          the render grid is reported apart as prepare_ms), fps, ns per sample, breakdown.\n"
-           "          --json prints one JSON object per case.\n");
+           "          --json prints one JSON object per case.\n"
+           "  path    the path tracer on FILE (default: the generated cumulus) at NxN (default 256), N\n"
+           "          samples per pixel (default 16), densities times S (default 1e8 m^-3 per unit of a\n"
+           "          VDB file's values, 1 for generated volumes), 'cloud' particles, sun 35° high; once in\n"
+           "          vacuum (black background) and once in the sky. Prints paths/s, real scattering events/s,\n"
+           "          tentative collisions/s, shadow rays/s, and the time to 1 %% noise extrapolated as\n"
+           "          t * (e / 0.01)^2 for two statistics e: the mean over the volume's pixels of the\n"
+           "          per-pixel relative standard error of the luminance (t_1pct_pixel_s) and the relative\n"
+           "          standard error of the volume's mean luminance (t_1pct_mean_s):\n"
+           "            bench=path case=wdas_cloud_sixteenth.vdb background=vacuum size=256x256 spp=16 ...\n");
 }
 
 static double now_s(void)
@@ -411,6 +421,121 @@ static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *
     return CLI_EXIT_OK;
 }
 
+/* One case of the path benchmark (see the help text). */
+static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int spp, double dscale,
+                           int vacuum)
+{
+    atmos_scene scene;
+    atmos_scene_defaults(&scene);
+    scene.width = scene.height = size;
+    scene.background = vacuum ? ATMOS_BACKGROUND_BLACK : ATMOS_BACKGROUND_SKY;
+    double lo[3], hi[3];
+    atmos_volume_bounds(v, lo, hi);
+    atmos_path_settings ps;
+    memset(&ps, 0, sizeof ps);
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    ps.offset_m[0] = -0.5 * (lo[0] + hi[0]);
+    ps.offset_m[1] = 1500 - lo[1];
+    ps.offset_m[2] = -0.5 * (lo[2] + hi[2]);
+    ps.density_scale = dscale;
+    ps.spp = spp;
+    double cy = 1500 + 0.5 * (hi[1] - lo[1]);
+    double pos[3] = {0, 1500 + 0.3 * (hi[1] - lo[1]), 1.6 * ext};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &scene.camera);
+    scene.camera.look_at[0] = 0, scene.camera.look_at[1] = cy, scene.camera.look_at[2] = 0;
+    scene.camera.fov_deg = 45;
+    scene.sun.from_time = 0;
+    scene.sun.elevation_deg = 35;
+    scene.sun.azimuth_deg = 200;
+    atmos_slice_optics optics;
+    double t0 = now_s();
+    atmos_status st = atmos_path_optics_build(ctx, &scene, v, &optics);
+    double t_opt = now_s() - t0;
+    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
+    ps.optics = &optics;
+    atmos_path_stats stats;
+    ps.stats = &stats;
+    atmos_image *img = NULL, *var = NULL;
+    ps.variance = &var;
+    st = atmos_render_path(ctx, &scene, v, &ps, &img, NULL);
+    atmos_slice_optics_free(&optics);
+    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
+    /* The volume's pixels: vacuum, the nonzero ones; sky, those differing from a render
+     * without the volume by more than 3 standard errors. */
+    atmos_wavelengths wl;
+    atmos_scene_wavelengths(ctx, &scene, &wl);
+    const int n = wl.count, C = n + 1;
+    atmos_image *bg = NULL;
+    if (!vacuum) {
+        atmos_path_settings pb = ps;
+        pb.variance = NULL;
+        pb.stats = NULL;
+        pb.optics = NULL;
+        st = atmos_render_path(ctx, &scene, NULL, &pb, &bg, NULL);
+        if (st != ATMOS_OK) {
+            atmos_image_destroy(img);
+            atmos_image_destroy(var);
+            return cli_runtime_error("bench", ctx, st);
+        }
+    }
+    double rel = 0, sumY = 0, sumV = 0;
+    long long cnt = 0;
+    for (int p = 0; p < size * size; p++) {
+        double Y = 0, Yb = 0;
+        for (int k = 0; k < n; k++) {
+            Y += wl.to_xyz[k][1] * img->pixels[(size_t)p * C + k];
+            if (bg) Yb += wl.to_xyz[k][1] * bg->pixels[(size_t)p * C + k];
+        }
+        double vY = var->pixels[(size_t)p * C + n];
+        int covered = vacuum ? Y > 0 : fabs(Y - Yb) > 3 * sqrt(vY) + 1e-3 * Yb;
+        if (!covered || !(Y > 0)) continue;
+        rel += sqrt(vY) / Y;
+        sumY += Y, sumV += vY;
+        cnt++;
+    }
+    rel = cnt ? rel / cnt : 0;
+    double relm = sumY > 0 ? sqrt(sumV) / sumY : 0;
+    const double t = stats.trace_s;
+    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g paths_per_s=%.4g "
+           "events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g events_per_path=%.2f trace_s=%.3f "
+           "prepare_s=%.3f optics_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f t_1pct_pixel_s=%.4g mean_rel_se=%.3g "
+           "t_1pct_mean_s=%.3g\n",
+           name, vacuum ? "vacuum" : "sky", size, size, stats.spp, atmos_context_threads(ctx), dscale,
+           stats.paths / t, stats.events / t, stats.tentative / t, stats.shadow_rays / t,
+           (double)stats.events / (double)stats.paths, t, stats.prepare_s, t_opt, cnt, rel, t * (rel / 0.01) * (rel / 0.01),
+           relm, t * (relm / 0.01) * (relm / 0.01));
+    fflush(stdout);
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_image_destroy(bg);
+    return CLI_EXIT_OK;
+}
+
+static int bench_path(const char *file, int size, int spp, double dscale, int threads)
+{
+    atmos_context *ctx = cli_context(threads, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_volume *v = NULL;
+    atmos_status st;
+    const char *name = "generated_cumulus";
+    if (file) {
+        st = atmos_volume_load(ctx, file, NULL, &v);
+        const char *base = strrchr(file, '/');
+        name = base ? base + 1 : file;
+        if (!(dscale > 0)) dscale = 1e8;
+    } else {
+        atmos_volume_generate_desc g = {.seed = 1};
+        st = atmos_volume_generate(ctx, "cumulus", &g, &v);
+        if (!(dscale > 0)) dscale = 1;
+    }
+    int rc = CLI_EXIT_OK;
+    if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
+    for (int vac = 1; rc == CLI_EXIT_OK && vac >= 0; vac--) rc = bench_path_case(ctx, name, v, size, spp, dscale, vac);
+    atmos_volume_destroy(v);
+    atmos_context_destroy(ctx);
+    return rc;
+}
+
 static int bench_slice(const char *file, int size, int repeat, int threads, int json)
 {
     atmos_context *ctx = cli_context(threads, 1);
@@ -437,7 +562,8 @@ static int bench_slice(const char *file, int size, int repeat, int threads, int 
 int cli_cmd_bench(int argc, char **argv)
 {
     const char *C = "bench";
-    int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0;
+    int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16;
+    double dscale = 0;
     const char *what = NULL, *presets = NULL, *file = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -448,6 +574,11 @@ int cli_cmd_bench(int argc, char **argv)
         } else if (!strcmp(argv[i], "--repeat") && i + 1 < argc) {
             if (!cli_parse_int(C, "--repeat", argv[++i], 1, 1000, &repeat)) return CLI_EXIT_USAGE;
             repeat_set = 1;
+        } else if (!strcmp(argv[i], "--spp") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--spp", argv[++i], 1, ATMOS_PATH_MAX_SPP, &spp)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(argv[i], "--density-scale") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--density-scale", argv[++i], &dscale) || !(dscale > 0))
+                return cli_usage_error(C, "--density-scale: expected a factor > 0");
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
@@ -467,10 +598,11 @@ int cli_cmd_bench(int argc, char **argv)
             return cli_usage_error(C, "unexpected argument '%s'", argv[i]);
         }
     }
-    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice)");
+    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice, path)");
+    if (!strcmp(what, "path")) return bench_path(file, size ? size : 256, spp, dscale, threads);
     if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, repeat_set ? repeat : 3, threads, json);
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);
-    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, optics, volume, slice)", what);
+    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, optics, volume, slice, path)", what);
 }
