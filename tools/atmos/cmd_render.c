@@ -37,13 +37,15 @@ static void help(void)
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
            "      --renderer sky|slice      the analytic sky (default), or Riley et al.'s half-angle slicing\n"
-           "                                over a volume (default when --volume is given)\n"
+           "                                over a volume (default when a volume is given)\n"
            "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
-           "      --volume-offset X,Y,Z     metres added to the volume's position (default: moved\n"
-           "                                horizontally to 3 widths, at least 4 km, in front of the camera)\n"
+           "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
+           "                                (default: 3 widths, at least 4 km, in front of the camera)\n"
            "      --density-scale S         multiplies the volume's densities\n"
-           "      --slices N --xi X         slicing planes (default 256); back-scatter term xi (sr^-1)\n"
+           "      --slices N --xi X         slicing planes (default 256); back-scatter term xi (sr^-1, 0 = none)\n"
+           "      --eq24                    exact light-buffer update (Riley Eq. 24) instead of Eq. 25\n"
+           "      --low-albedo              single scattering with the plain phase function (Riley Fig. 13)\n"
            "  -q, --quiet                   no progress bar or messages\n"
            "  -h, --help                    this help\n\n"
            "Examples:\n"
@@ -85,9 +87,23 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
-    O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VOFFSET,
-    O_DSCALE
+    O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VPOS,
+    O_DSCALE, O_EQ24, O_LOWALB
 };
+
+/* The slice renderer's settings from a scene (the scene's xi 0 means "none"). */
+static void slice_settings(const atmos_scene *s, const double offset[3], atmos_slice_settings *ss)
+{
+    atmos_slice_defaults(ss);
+    ss->slices = s->slice.slices;
+    ss->light_size = s->slice.light_size;
+    ss->xi = s->slice.xi > 0 ? s->slice.xi : -1.0;
+    ss->update = s->slice.eq24 ? ATMOS_SLICE_EQ24 : ATMOS_SLICE_EQ25;
+    ss->low_albedo = s->slice.low_albedo;
+    ss->grid_max_dim = s->slice.grid_max_dim;
+    ss->density_scale = s->volume.density_scale;
+    for (int k = 0; k < 3; k++) ss->offset_m[k] = offset[k];
+}
 
 int cli_cmd_render(int argc, char **argv)
 {
@@ -105,7 +121,8 @@ int cli_cmd_render(int argc, char **argv)
         {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},
         {"renderer", required_argument, 0, O_RENDERER}, {"volume", required_argument, 0, O_VOLUME},
         {"slices", required_argument, 0, O_SLICES}, {"xi", required_argument, 0, O_XI},
-        {"volume-offset", required_argument, 0, O_VOFFSET}, {"density-scale", required_argument, 0, O_DSCALE},
+        {"volume-position", required_argument, 0, O_VPOS}, {"density-scale", required_argument, 0, O_DSCALE},
+        {"eq24", no_argument, 0, O_EQ24}, {"low-albedo", no_argument, 0, O_LOWALB},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -116,12 +133,11 @@ int cli_cmd_render(int argc, char **argv)
     int w = 0, h = 0, spp = 0, png_bits = 0, exr_half = 0, spectral = 0, rgb = 0, cam_type = -1;
     double alt = NAN, sel = NAN, saz = NAN, ev = NAN, evcomp = NAN;
     int exposure_auto = 0, tone = -1;
-    /* The half-angle slicing renderer (Riley et al. 2004 §4.2-§5) over a volume file or
-     * generator; scene files do not describe volumes yet. */
-    int use_slice = -1, slices = 0;
+    /* Volume renderers: these override the scene's "renderer", "volume" and "slice". */
+    int renderer = -1, slices = 0, eq24 = 0, low_albedo = 0;
     const char *volume_arg = NULL;
-    double xi = NAN, dscale = 0, voff[3] = {0, 0, 0};
-    int voff_given = 0;
+    double xi = NAN, dscale = 0, vpos[3] = {0, 0, 0};
+    int vpos_given = 0;
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
@@ -164,23 +180,30 @@ int cli_cmd_render(int argc, char **argv)
             break;
         case O_THREADS: if (!cli_parse_int(C, "--threads", optarg, 1, 1024, &threads)) return CLI_EXIT_USAGE; break;
         case O_RENDERER:
-            if (!strcmp(optarg, "sky")) use_slice = 0;
-            else if (!strcmp(optarg, "slice")) use_slice = 1;
+            if (!strcmp(optarg, "sky")) renderer = ATMOS_RENDERER_SKY;
+            else if (!strcmp(optarg, "slice")) renderer = ATMOS_RENDERER_SLICE;
             else return cli_usage_error(C, "--renderer: expected sky or slice, got '%s'", optarg);
             break;
         case O_VOLUME: volume_arg = optarg; break;
         case O_SLICES: if (!cli_parse_int(C, "--slices", optarg, 1, 8192, &slices)) return CLI_EXIT_USAGE; break;
-        case O_XI: if (!cli_parse_double(C, "--xi", optarg, &xi)) return CLI_EXIT_USAGE; break;
+        case O_XI:
+            if (!cli_parse_double(C, "--xi", optarg, &xi) || !(xi >= 0 && xi <= 100))
+                return cli_usage_error(C, "--xi: expected a value in [0, 100] sr^-1 (0 = no back-scatter term)");
+            break;
+        case O_EQ24: eq24 = 1; break;
+        case O_LOWALB: low_albedo = 1; break;
         case O_DSCALE:
             if (!cli_parse_double(C, "--density-scale", optarg, &dscale) || !(dscale > 0))
                 return cli_usage_error(C, "--density-scale: expected a factor > 0");
             break;
-        case O_VOFFSET:
-            if (sscanf(optarg, "%lf,%lf,%lf", &voff[0], &voff[1], &voff[2]) != 3 || !isfinite(voff[0]) ||
-                !isfinite(voff[1]) || !isfinite(voff[2]))
-                return cli_usage_error(C, "--volume-offset: expected X,Y,Z in metres, got '%s'", optarg);
-            voff_given = 1;
+        case O_VPOS: {
+            char tail;
+            if (sscanf(optarg, "%lf,%lf,%lf%c", &vpos[0], &vpos[1], &vpos[2], &tail) != 3 || !isfinite(vpos[0]) ||
+                !isfinite(vpos[1]) || !isfinite(vpos[2]))
+                return cli_usage_error(C, "--volume-position: expected X,Y,Z in metres, got '%s'", optarg);
+            vpos_given = 1;
             break;
+        }
         case 'q': quiet = 1; break;
         case 'h': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
@@ -196,10 +219,11 @@ int cli_cmd_render(int argc, char **argv)
     if (use_time && (!isnan(sel) || !isnan(saz)))
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
-    if (use_slice < 0) use_slice = volume_arg != NULL;
-    if (use_slice && !volume_arg) return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
-    if (!use_slice && (volume_arg || slices || !isnan(xi) || dscale > 0))
-        return cli_usage_error(C, "--volume, --slices, --xi and --density-scale go with --renderer slice");
+    if (renderer == ATMOS_RENDERER_SKY && (volume_arg || slices || !isnan(xi) || dscale > 0 || vpos_given || eq24 || low_albedo))
+        return cli_usage_error(C, "--volume, --volume-position, --density-scale, --slices, --xi, --eq24 and --low-albedo "
+                                  "go with a volume renderer, not --renderer sky");
+    if (volume_arg && strlen(volume_arg) >= sizeof(((atmos_scene *)0)->volume.source))
+        return cli_usage_error(C, "--volume: the path is too long");
 
     cli_progress prog;
     cli_progress_init(&prog, quiet);
@@ -262,6 +286,24 @@ int cli_cmd_render(int argc, char **argv)
         scene.tonemap.exposure_ev = evcomp;
     }
     if (tone >= 0) scene.tonemap.curve = (atmos_tone_curve)tone;
+    if (volume_arg) {
+        snprintf(scene.volume.source, sizeof scene.volume.source, "%s", volume_arg);
+        if (scene.renderer == ATMOS_RENDERER_SKY) scene.renderer = ATMOS_RENDERER_SLICE;
+    }
+    if (renderer >= 0) scene.renderer = (atmos_renderer_kind)renderer;
+    if (vpos_given) {
+        scene.volume.placed = 1;
+        memcpy(scene.volume.position_m, vpos, sizeof vpos);
+    }
+    if (dscale > 0) scene.volume.density_scale = dscale;
+    if (slices) scene.slice.slices = slices;
+    if (!isnan(xi)) scene.slice.xi = xi;
+    if (eq24) scene.slice.eq24 = 1;
+    if (low_albedo) scene.slice.low_albedo = 1;
+    if (!scene_path && scene.renderer != ATMOS_RENDERER_SKY && !scene.volume.source[0]) {
+        atmos_context_destroy(ctx);
+        return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
+    }
     if ((st = atmos_scene_validate(ctx, &scene, scene_path ? scene_path : "options")) != ATMOS_OK) {
         fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
         atmos_context_destroy(ctx);
@@ -278,35 +320,12 @@ int cli_cmd_render(int argc, char **argv)
     atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     atmos_render_info info;
     atmos_wavelengths wl;
-    if (use_slice) {
+    if (scene.renderer == ATMOS_RENDERER_SLICE) {
         atmos_volume *vol = NULL;
-        if (!strncmp(volume_arg, "generate:", 9)) {
-            atmos_volume_generate_desc gd;
-            memset(&gd, 0, sizeof gd);
-            gd.seed = 1;
-            st = atmos_volume_generate(ctx, volume_arg + 9, &gd, &vol);
-        } else {
-            st = atmos_volume_load(ctx, volume_arg, NULL, &vol);
-        }
-        if (st != ATMOS_OK) goto fail;
+        double offset[3];
+        if ((st = atmos_volume_load_scene(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
         atmos_slice_settings ss;
-        atmos_slice_defaults(&ss);
-        if (slices) ss.slices = slices;
-        if (!isnan(xi)) ss.xi = xi;
-        if (dscale > 0) ss.density_scale = dscale;
-        memcpy(ss.offset_m, voff, sizeof voff);
-        if (!voff_given) {
-            /* Default placement: the volume's centre moved horizontally to three of its
-             * widths (at least 4 km) in front of the camera, at its own altitude. */
-            double lo[3], hi[3], f[3];
-            atmos_volume_bounds(vol, lo, hi);
-            for (int k = 0; k < 3; k++) f[k] = scene.camera.look_at[k] - scene.camera.position[k];
-            double fh = sqrt(f[0] * f[0] + f[2] * f[2]);
-            if (!(fh > 1e-9)) f[0] = 0, f[2] = -1, fh = 1; /* looking straight up or down: north */
-            double width = fmax(hi[0] - lo[0], hi[2] - lo[2]), dist = fmax(3.0 * width, 4000.0);
-            ss.offset_m[0] = scene.camera.position[0] + f[0] / fh * dist - 0.5 * (lo[0] + hi[0]);
-            ss.offset_m[2] = scene.camera.position[2] + f[2] / fh * dist - 0.5 * (lo[2] + hi[2]);
-        }
+        slice_settings(&scene, offset, &ss);
         st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
         atmos_volume_destroy(vol);
         if (st != ATMOS_OK) goto fail;
