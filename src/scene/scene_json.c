@@ -705,7 +705,10 @@ static atmos_status parse_particle(const jp *p, const cJSON *j, const char *path
             break;
         case K_LOBES: TRY(parse_lobes(p, v, ip, &d->analytic)); break;
         case K_SIGMA: TRY(get_number(p, v, ip, &r_sigma_ext, NULL, &d->sigma_ext_m2)); break;
-        case K_ALBEDO: TRY(get_number(p, v, ip, &r_unit, NULL, &d->albedo)); break;
+        case K_ALBEDO:
+            TRY(get_number(p, v, ip, &r_unit, NULL, &d->albedo));
+            d->albedo_set = 1;
+            break;
         }
     }
     if (!have_kind) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"kind\" or \"preset\"");

@@ -329,6 +329,10 @@ int cli_cmd_render(int argc, char **argv)
         st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
         atmos_volume_destroy(vol);
         if (st != ATMOS_OK) goto fail;
+    } else if (scene.renderer == ATMOS_RENDERER_PATH) {
+        fprintf(stderr, "atmos render: %s: the path renderer is not part of this build yet\n", source);
+        atmos_context_destroy(ctx);
+        return CLI_EXIT_RUNTIME;
     } else if ((st = atmos_render_sky(ctx, &scene, &spec, &info)) != ATMOS_OK) {
         goto fail;
     }
