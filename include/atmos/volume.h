@@ -129,6 +129,13 @@ ATMOS_API const char *const *atmos_volume_generator_names(void);
 ATMOS_API atmos_status atmos_volume_load_scene(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
                                                double offset_m[3]);
 
+/* The optical depth of the volume (moved by offset_m) along the ray through each
+ * pixel centre of the scene's camera, with extinction cross-sections sigma_ext[field]
+ * (m^2, densities already scaled): a 1-channel image, for error analyses by depth. */
+ATMOS_API atmos_status atmos_volume_optical_depth_image(atmos_context *ctx, const atmos_scene *scene,
+                                                        const atmos_volume *volume, const double *sigma_ext,
+                                                        const double offset_m[3], atmos_image **out);
+
 #ifdef __cplusplus
 }
 #endif
