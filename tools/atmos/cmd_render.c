@@ -46,6 +46,8 @@ static void help(void)
            "      --slices N --xi X         slicing planes (default 256); back-scatter term xi (sr^-1, 0 = none)\n"
            "      --eq24                    exact light-buffer update (Riley Eq. 24) instead of Eq. 25\n"
            "      --low-albedo              single scattering with the plain phase function (Riley Fig. 13)\n"
+           "      --tau FILE.pfm            also write the volume's optical depth along each pixel's ray\n"
+           "                                (middle wavelength of the set; a key for atmos compare --by)\n"
            "  -q, --quiet                   no progress bar or messages\n"
            "  -h, --help                    this help\n\n"
            "Examples:\n"
@@ -88,8 +90,29 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
     O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VPOS,
-    O_DSCALE, O_EQ24, O_LOWALB
+    O_DSCALE, O_EQ24, O_LOWALB, O_TAU
 };
+
+/* The volume's optical depth along each pixel's ray at the middle wavelength of the
+ * set, as a 1-channel PFM (the optics come from the cache the render just filled). */
+static atmos_status write_tau(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
+                              const double offset[3], const char *path)
+{
+    atmos_slice_optics o;
+    atmos_status st = atmos_slice_optics_build(ctx, scene, vol, &o);
+    if (st != ATMOS_OK) return st;
+    double sigma[ATMOS_VOLUME_MAX_FIELDS] = {0};
+    for (int f = 0; f < o.count; f++) {
+        int k = atmos_phase_table_wavelength_count(o.phase[f]) / 2;
+        sigma[f] = atmos_phase_table_sigma_ext(o.phase[f], k) * scene->volume.density_scale;
+    }
+    atmos_slice_optics_free(&o);
+    atmos_image *img = NULL;
+    if ((st = atmos_volume_optical_depth_image(ctx, scene, vol, sigma, offset, &img)) != ATMOS_OK) return st;
+    st = atmos_write_pfm(ctx, img, path);
+    atmos_image_destroy(img);
+    return st;
+}
 
 /* The slice renderer's settings from a scene (the scene's xi 0 means "none"). */
 static void slice_settings(const atmos_scene *s, const double offset[3], atmos_slice_settings *ss)
@@ -123,6 +146,7 @@ int cli_cmd_render(int argc, char **argv)
         {"slices", required_argument, 0, O_SLICES}, {"xi", required_argument, 0, O_XI},
         {"volume-position", required_argument, 0, O_VPOS}, {"density-scale", required_argument, 0, O_DSCALE},
         {"eq24", no_argument, 0, O_EQ24}, {"low-albedo", no_argument, 0, O_LOWALB},
+        {"tau", required_argument, 0, O_TAU},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -135,7 +159,7 @@ int cli_cmd_render(int argc, char **argv)
     int exposure_auto = 0, tone = -1;
     /* Volume renderers: these override the scene's "renderer", "volume" and "slice". */
     int renderer = -1, slices = 0, eq24 = 0, low_albedo = 0;
-    const char *volume_arg = NULL;
+    const char *volume_arg = NULL, *tau_path = NULL;
     double xi = NAN, dscale = 0, vpos[3] = {0, 0, 0};
     int vpos_given = 0;
     optind = 1;
@@ -191,6 +215,7 @@ int cli_cmd_render(int argc, char **argv)
                 return cli_usage_error(C, "--xi: expected a value in [0, 100] sr^-1 (0 = no back-scatter term)");
             break;
         case O_EQ24: eq24 = 1; break;
+        case O_TAU: tau_path = optarg; break;
         case O_LOWALB: low_albedo = 1; break;
         case O_DSCALE:
             if (!cli_parse_double(C, "--density-scale", optarg, &dscale) || !(dscale > 0))
@@ -219,9 +244,10 @@ int cli_cmd_render(int argc, char **argv)
     if (use_time && (!isnan(sel) || !isnan(saz)))
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
-    if (renderer == ATMOS_RENDERER_SKY && (volume_arg || slices || !isnan(xi) || dscale > 0 || vpos_given || eq24 || low_albedo))
-        return cli_usage_error(C, "--volume, --volume-position, --density-scale, --slices, --xi, --eq24 and --low-albedo "
-                                  "go with a volume renderer, not --renderer sky");
+    if (renderer == ATMOS_RENDERER_SKY &&
+        (volume_arg || slices || !isnan(xi) || dscale > 0 || vpos_given || eq24 || low_albedo || tau_path))
+        return cli_usage_error(C, "--volume, --volume-position, --density-scale, --slices, --xi, --eq24, --low-albedo "
+                                  "and --tau go with a volume renderer, not --renderer sky");
     if (volume_arg && strlen(volume_arg) >= sizeof(((atmos_scene *)0)->volume.source))
         return cli_usage_error(C, "--volume: the path is too long");
 
@@ -300,6 +326,10 @@ int cli_cmd_render(int argc, char **argv)
     if (!isnan(xi)) scene.slice.xi = xi;
     if (eq24) scene.slice.eq24 = 1;
     if (low_albedo) scene.slice.low_albedo = 1;
+    if (tau_path && scene.renderer == ATMOS_RENDERER_SKY) {
+        atmos_context_destroy(ctx);
+        return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
+    }
     if (!scene_path && scene.renderer != ATMOS_RENDERER_SKY && !scene.volume.source[0]) {
         atmos_context_destroy(ctx);
         return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
@@ -327,6 +357,7 @@ int cli_cmd_render(int argc, char **argv)
         atmos_slice_settings ss;
         slice_settings(&scene, offset, &ss);
         st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
+        if (st == ATMOS_OK && tau_path) st = write_tau(ctx, &scene, vol, offset, tau_path);
         atmos_volume_destroy(vol);
         if (st != ATMOS_OK) goto fail;
     } else if (scene.renderer == ATMOS_RENDERER_PATH) {
