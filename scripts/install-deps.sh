@@ -4,7 +4,7 @@
 set -eu
 # Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
 # its headers include, which Debian does not pull in); gnuplot for 'atmos phase --plot'.
-PKGS="build-essential cmake pkg-config libpng-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox"
+PKGS="build-essential cmake pkg-config libpng-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3"
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

@@ -130,6 +130,23 @@ typedef struct atmos_image_diff {
 ATMOS_API atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *image, const atmos_image *reference,
                                            atmos_image_diff *out, atmos_image **heatmap);
 
+/* The same statistics split by a per-pixel key (e.g. the optical depth along each
+ * pixel's ray, or the mean scattering order): pixels whose key (channel 0 of `key`,
+ * same size) lies in [edges[i], edges[i+1]) form bin i. Per bin, over the colour
+ * channels: the pixel count, rel_rmse (RMSE over the reference's mean absolute value
+ * in the bin) and rel_bias (mean difference over the same). Empty bins have count 0
+ * and NaN statistics. edges ascending, 2..ATMOS_IMAGE_BINS_MAX+1 of them. */
+#define ATMOS_IMAGE_BINS_MAX 32
+typedef struct atmos_image_bins {
+    int bins;
+    double edges[ATMOS_IMAGE_BINS_MAX + 1];
+    size_t count[ATMOS_IMAGE_BINS_MAX];
+    double rel_rmse[ATMOS_IMAGE_BINS_MAX], rel_bias[ATMOS_IMAGE_BINS_MAX], mean_reference[ATMOS_IMAGE_BINS_MAX];
+} atmos_image_bins;
+ATMOS_API atmos_status atmos_image_compare_binned(atmos_context *ctx, const atmos_image *image,
+                                                  const atmos_image *reference, const atmos_image *key,
+                                                  const double *edges, int n_edges, atmos_image_bins *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -117,6 +117,7 @@ typedef struct atmos_particle_desc {
     double sigma_ext_m2;            /* extinction cross-section used by renderers; 0 = computed
                                        (presets set Riley Table 2's values) */
     double albedo;                  /* single-scattering albedo used by renderers; 0 = computed */
+    int albedo_set;                 /* nonzero: albedo is used as given, 0 included (a purely absorbing medium) */
     int fast;                       /* nonzero: coarser size integration and fewer rays, for tests
                                        and previews (documented accuracy in docs/optics.md) */
 } atmos_particle_desc;

@@ -220,7 +220,7 @@ atmos_status atmos__cache_store(atmos_context *ctx, const char *key, const void 
         return ATMOS_E_IO;
     }
     store_job job = {key, data, size};
-    atmos_status st = atmos__write_atomic(ctx, path, write_entry, &job);
+    atmos_status st = atmos__write_atomic_unique(ctx, path, write_entry, &job);
     if (st != ATMOS_OK) atmos__log(ctx, ATMOS_LOG_WARN, "cache: %s: not cached (%s)", path, atmos_status_string(st));
     return st;
 }

@@ -3,6 +3,7 @@
 #include "core/internal.h"
 
 #include <errno.h>
+#include <stdatomic.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -146,7 +147,9 @@ int atmos__progress(const atmos_context *ctx, const char *stage, double fraction
     return ctx->desc.progress(ctx->desc.progress_user, stage, fraction);
 }
 
-atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user)
+static atomic_uint write_counter;
+
+static atmos_status write_atomic(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user, int unique)
 {
     if (!path || !*path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "output path is empty");
     /* rename() would replace a device, FIFO, directory entry or symlink with our file
@@ -158,8 +161,13 @@ atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__wr
     size_t n = strlen(path);
     char *tmp = malloc(n + 32);
     if (!tmp) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-    /* Same directory as the target so rename() is atomic; pid makes it unique per process. */
-    snprintf(tmp, n + 32, "%s.tmp%ld", path, (long)getpid());
+    /* Same directory as the target so rename() is atomic; pid makes it unique per
+     * process, and a fixed-width counter per write within it (threads of one process
+     * may store the same cache entry at once). */
+    if (unique)
+        snprintf(tmp, n + 32, "%s.tmp%ld%06u", path, (long)getpid(), atomic_fetch_add(&write_counter, 1u) % 1000000u);
+    else
+        snprintf(tmp, n + 32, "%s.tmp%ld", path, (long)getpid());
     atmos_status st = fn(ctx, tmp, user);
     if (st == ATMOS_OK && rename(tmp, path) != 0) {
         st = atmos__error(ctx, ATMOS_E_IO, "%s: cannot rename temporary file into place: %s", path,
@@ -168,6 +176,16 @@ atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__wr
     if (st != ATMOS_OK) remove(tmp);
     free(tmp);
     return st;
+}
+
+atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user)
+{
+    return write_atomic(ctx, path, fn, user, 0);
+}
+
+atmos_status atmos__write_atomic_unique(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user)
+{
+    return write_atomic(ctx, path, fn, user, 1);
 }
 
 typedef struct {

@@ -25,6 +25,9 @@ int atmos__threads(const atmos_context *ctx);
  * path and returns a status; on failure the temporary is removed. */
 typedef atmos_status (*atmos__write_fn)(atmos_context *ctx, const char *tmp_path, void *user);
 atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user);
+/* The same with a temporary name unique to this write within the process
+ * (PATH.tmpPID + 6-digit counter): for files that several threads may write. */
+atmos_status atmos__write_atomic_unique(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user);
 
 #define ATMOS_PI 3.14159265358979323846
 #define ATMOS_DEG2RAD (ATMOS_PI / 180.0)

@@ -115,3 +115,53 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
     *heatmap = h;
     return ATMOS_OK;
 }
+
+atmos_status atmos_image_compare_binned(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
+                                        const atmos_image *key, const double *edges, int n_edges, atmos_image_bins *out)
+{
+    if (!a || !ref || !key || !edges || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing argument");
+    if (a->width != ref->width || a->height != ref->height || key->width != a->width || key->height != a->height)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: image, reference and key sizes differ (%dx%d, %dx%d, %dx%d)",
+                            a->width, a->height, ref->width, ref->height, key->width, key->height);
+    int ca = a->channels == 4 ? 3 : a->channels, cr = ref->channels == 4 ? 3 : ref->channels;
+    if (ca != cr)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: channel counts differ: %d vs %d", a->channels,
+                            ref->channels);
+    if (n_edges < 2 || n_edges > ATMOS_IMAGE_BINS_MAX + 1)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: 2..%d bin edges, got %d", ATMOS_IMAGE_BINS_MAX + 1,
+                            n_edges);
+    for (int i = 0; i < n_edges; i++)
+        if (isnan(edges[i]) || (i && !(edges[i] > edges[i - 1])))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: bin edges must ascend strictly");
+    memset(out, 0, sizeof *out);
+    out->bins = n_edges - 1;
+    memcpy(out->edges, edges, sizeof(double) * (size_t)n_edges);
+    double se[ATMOS_IMAGE_BINS_MAX] = {0}, sd[ATMOS_IMAGE_BINS_MAX] = {0}, sr[ATMOS_IMAGE_BINS_MAX] = {0};
+    size_t ns[ATMOS_IMAGE_BINS_MAX] = {0};
+    const size_t npx = (size_t)a->width * a->height;
+    for (size_t p = 0; p < npx; p++) {
+        double k = key->pixels[p * key->channels];
+        if (!(k >= edges[0]) || !(k < edges[n_edges - 1])) continue;
+        int b = 0;
+        while (b + 1 < out->bins && k >= edges[b + 1]) b++;
+        const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
+        int counted = 0;
+        for (int c = 0; c < ca; c++) {
+            double va = pa[c], vr = pr[c];
+            if (!isfinite(va) || !isfinite(vr)) continue;
+            se[b] += (va - vr) * (va - vr);
+            sd[b] += va - vr;
+            sr[b] += fabs(vr);
+            ns[b]++;
+            counted = 1;
+        }
+        out->count[b] += (size_t)counted;
+    }
+    for (int b = 0; b < out->bins; b++) {
+        double m = ns[b] ? sr[b] / ns[b] : NAN;
+        out->mean_reference[b] = m;
+        out->rel_rmse[b] = ns[b] && m > 0 ? sqrt(se[b] / ns[b]) / m : NAN;
+        out->rel_bias[b] = ns[b] && m > 0 ? sd[b] / ns[b] / m : NAN;
+    }
+    return ATMOS_OK;
+}

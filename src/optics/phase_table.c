@@ -207,7 +207,9 @@ static char *make_key(const atmos_particle_desc *p, const atmos_wavelengths *wl,
                       p->analytic.weight[i]);
         break;
     }
-    sb_printf(&b, "sigma_ext_m2 %.17g albedo %.17g\nwavelengths %d nm", p->sigma_ext_m2, p->albedo, wl->count);
+    sb_printf(&b, "sigma_ext_m2 %.17g albedo %.17g\n", p->sigma_ext_m2, p->albedo);
+    if (p->albedo_set) sb_printf(&b, "albedo_set 1\n");
+    sb_printf(&b, "wavelengths %d nm", wl->count);
     for (int k = 0; k < wl->count; k++) sb_printf(&b, " %.17g", wl->nm[k]);
     if (b.oom) {
         free(b.s);
@@ -370,7 +372,7 @@ static atmos_status build_one(atmos_context *ctx, const char *who, const atmos_p
     /* Riley Table 2 presets and user settings override the computed values. */
     t->nm[k] = nm;
     t->sigma_ext[k] = p->sigma_ext_m2 > 0 ? p->sigma_ext_m2 : res.sigma_ext_m2;
-    t->albedo[k] = p->albedo > 0 ? p->albedo : res.albedo;
+    t->albedo[k] = p->albedo > 0 || p->albedo_set ? p->albedo : res.albedo;
     if (!isfinite(t->sigma_ext[k]) || t->sigma_ext[k] < 0) t->sigma_ext[k] = 0.0;
     if (!(t->albedo[k] >= 0) || t->albedo[k] > 1) t->albedo[k] = t->albedo[k] > 1 ? 1.0 : 0.0;
 

@@ -19,11 +19,16 @@ atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_scene *scen
 {
     if (scene->wavelengths == ATMOS_WAVELENGTHS_RGB) {
         atmos_wavelengths_rgb(out);
-        return ATMOS_OK;
-    }
-    if (atmos_wavelengths_spectral(scene->spectral_samples, out) != ATMOS_OK)
+    } else if (atmos_wavelengths_spectral(scene->spectral_samples, out) != ATMOS_OK) {
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "wavelengths/samples: must be in [1, %d], got %d",
                             ATMOS_MAX_WAVELENGTHS, scene->spectral_samples);
+    }
+    /* A sun given by its irradiance replaces the solar spectrum; the colour
+     * conversion stays that of the set (to_srgb/to_xyz are unchanged). */
+    if (scene->sun.irradiance_count == 1)
+        for (int i = 0; i < out->count; i++) out->sun_irradiance[i] = scene->sun.irradiance[0];
+    else if (scene->sun.irradiance_count == 3 && out->count == 3)
+        for (int i = 0; i < 3; i++) out->sun_irradiance[i] = scene->sun.irradiance[i];
     return ATMOS_OK;
 }
 
@@ -56,6 +61,8 @@ typedef struct {
     double sun_radiance[ATMOS_MAX_WAVELENGTHS];
     int sun_visible;        /* disk drawn and sun above the horizon */
     double cos_disk_search; /* cos(sun radius + 1.5 pixel footprints) */
+    int vacuum;             /* black or uniform background: no air, no ground, no disk */
+    float background;       /* its radiance at every wavelength */
 } sky_job;
 
 /* An upper bound on the angle one pixel spans, radians. */
@@ -178,7 +185,12 @@ static void shade_row(const sky_job *job, const atmos__sky_batch *batch, const f
         double sx, sy;
         sample_offset(s, spp, &sx, &sy);
         row_rays(job, y, sx, sy, col_sc ? col_sc + (size_t)2 * W * s : NULL, rb->dx, rb->dy, rb->dz, rb->w);
-        atmos__sky_batch_eval(batch, W, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
+        if (job->vacuum) {
+            for (int i = 0; i < n; i++)
+                for (int x = 0; x < W; x++) rb->acc[(size_t)i * W + x] += rb->w[x] * job->background;
+        } else {
+            atmos__sky_batch_eval(batch, W, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
+        }
         for (int x = 0; x < W; x++) rb->hits[x] += rb->w[x];
     }
     const float inv = 1.0f / spp;
@@ -228,7 +240,9 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
     job.spp = scene->samples_per_pixel > 0 ? scene->samples_per_pixel : 1;
     job.sun_radius = 0.5 * sky->desc.sun_diameter_deg * ATMOS_DEG2RAD;
     atmos_sky_sun_radiance(sky, cam.position[1], job.sun, job.sun_radiance);
-    job.sun_visible = !sky->desc.hide_sun_disk && job.sun[1] > 0;
+    job.vacuum = scene->background != ATMOS_BACKGROUND_SKY;
+    job.background = scene->background == ATMOS_BACKGROUND_UNIFORM ? (float)scene->background_radiance : 0.0f;
+    job.sun_visible = !sky->desc.hide_sun_disk && job.sun[1] > 0 && !job.vacuum;
     /* Disk radius plus 2.5 pixel footprints: a sample ray is within one footprint
      * of the pixel centre, the pixel's far corner within another. */
     double foot = pixel_footprint(&cam);

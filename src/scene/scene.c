@@ -301,6 +301,18 @@ atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene 
     if (!buf) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
     if (st == ATMOS_OK) st = atmos_scene_parse(ctx, buf, len, path, out);
     free(buf);
+    /* A relative volume file is relative to the scene file's folder, so scenes can
+     * be rendered from anywhere. */
+    atmos_scene_volume *v = &out->volume;
+    const char *slash = strrchr(path, '/');
+    if (st == ATMOS_OK && v->source[0] && v->source[0] != '/' && strncmp(v->source, "generate:", 9) && slash) {
+        size_t dir = (size_t)(slash - path) + 1, n = strlen(v->source);
+        if (dir + n >= sizeof v->source)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /volume/file: the path is too long once joined to the scene's folder",
+                                path);
+        memmove(v->source + dir, v->source, n + 1);
+        memcpy(v->source, path, dir);
+    }
     return st;
 }
 

@@ -53,6 +53,9 @@ atmos_status atmos__scene_validate_camera(atmos_context *ctx, const char *source
                                           const atmos_camera_desc *cam);
 atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
                                        const atmos_scene_sun *sun);
+/* The renderer, background, sun irradiance, volume, slice and path settings, and
+ * the rules between them (a volume renderer needs a volume, ...). */
+atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *scene);
 atmos_status atmos__scene_validate_output(atmos_context *ctx, const char *source,
                                           const atmos_scene *scene);
 

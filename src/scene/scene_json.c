@@ -388,25 +388,42 @@ static atmos_status parse_time(const jp *p, const char *text, const char *path, 
     return st;
 }
 
+/* "irradiance": W m^-2 nm^-1 outside the air, one number (every wavelength) or three
+ * (the rgb channels, 680, 550, 440 nm). */
+static atmos_status parse_irradiance(const jp *p, const cJSON *j, const char *path, atmos_scene_sun *sun)
+{
+    static const atmos__range r_irr = {0, 1e6, 0, 0};
+    if (cJSON_IsNumber(j)) {
+        TRY(get_number(p, j, path, &r_irr, NULL, &sun->irradiance[0]));
+        sun->irradiance_count = 1;
+        return ATMOS_OK;
+    }
+    if (!cJSON_IsArray(j)) return type_error(p, path, "a number or an array of 3 numbers (W m^-2 nm^-1)", j);
+    const atmos__range *r[3] = {&r_irr, &r_irr, &r_irr};
+    TRY(get_vec3(p, j, path, r, sun->irradiance));
+    sun->irradiance_count = 3;
+    return ATMOS_OK;
+}
+
 static atmos_status parse_sun(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
     static const char *const keys[] = {"elevation_deg", "azimuth_deg", "time", "latitude_deg",
-                                       "longitude_deg", "refraction"};
-    enum { K_ELEV, K_AZIM, K_TIME, K_LAT, K_LON, K_REFR };
-    const unsigned angle_keys = 1u << K_ELEV | 1u << K_AZIM;
+                                       "longitude_deg", "refraction", "irradiance"};
+    enum { K_ELEV, K_AZIM, K_TIME, K_LAT, K_LON, K_REFR, K_IRR };
+    const unsigned angle_keys = 1u << K_ELEV | 1u << K_AZIM, irr_key = 1u << K_IRR;
     atmos_scene_sun sun = s->sun;
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
     const char *text = NULL;
     int k;
-    TRY(iter_begin(p, j, path, keys, 6, &it));
+    TRY(iter_begin(p, j, path, keys, 7, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
         /* Angles and time/place are two ways to say the same thing. */
         unsigned mine = (1u << k) & angle_keys ? angle_keys : ~angle_keys;
-        if (it.seen & ~mine)
+        if (k != K_IRR && (it.seen & ~mine & ~irr_key))
             return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
                                      "cannot be combined with %s (give elevation_deg/azimuth_deg or "
                                      "time/latitude_deg/longitude_deg, not both)",
@@ -422,9 +439,10 @@ static atmos_status parse_sun(const jp *p, const cJSON *j, const char *path, atm
         case K_LAT: TRY(get_number(p, v, ip, &atmos__r_latitude, NULL, &sun.latitude_deg)); break;
         case K_LON: TRY(get_number(p, v, ip, &atmos__r_longitude, NULL, &sun.longitude_deg)); break;
         case K_REFR: TRY(get_bool(p, v, ip, &sun.refraction)); break;
+        case K_IRR: TRY(parse_irradiance(p, v, ip, &sun)); break;
         }
     }
-    if (it.seen & ~angle_keys) {
+    if (it.seen & ~angle_keys & ~irr_key) {
         /* No default place or time: a sun computed for a place the user did not
          * name would be a silent surprise. */
         static const int required[] = {K_TIME, K_LAT, K_LON};
@@ -687,7 +705,10 @@ static atmos_status parse_particle(const jp *p, const cJSON *j, const char *path
             break;
         case K_LOBES: TRY(parse_lobes(p, v, ip, &d->analytic)); break;
         case K_SIGMA: TRY(get_number(p, v, ip, &r_sigma_ext, NULL, &d->sigma_ext_m2)); break;
-        case K_ALBEDO: TRY(get_number(p, v, ip, &r_unit, NULL, &d->albedo)); break;
+        case K_ALBEDO:
+            TRY(get_number(p, v, ip, &r_unit, NULL, &d->albedo));
+            d->albedo_set = 1;
+            break;
         }
     }
     if (!have_kind) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"kind\" or \"preset\"");
@@ -735,13 +756,209 @@ static atmos_status parse_particles(const jp *p, const cJSON *j, const char *pat
     return ATMOS_OK;
 }
 
+/* ---- renderers, background, volume ---- */
+
+static const atmos__range r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0}, r_xi = {0, 100, 0, 0},
+                          r_grid = {8, 2048, 0, 0}, r_path_spp = {1, 1000000, 0, 0},
+                          r_budget = {0, 1e7, 0, 0}, r_seed = {0, 9007199254740992.0, 0, 0},
+                          r_depth = {0, 100000, 0, 0}, r_radiance = {0, 1e6, 0, 0},
+                          r_dscale = {0, 1e30, 1, 0}, r_time_index = {0, 1000000, 0, 0},
+                          r_voxel = {0, 1e5, 0, 0}, r_vscale = {0, 100, 1, 0};
+
+static atmos_status get_u64(const jp *p, const cJSON *j, const char *path, const atmos__range *r, uint64_t *out)
+{
+    double v = 0;
+    TRY(get_number(p, j, path, r, NULL, &v));
+    if (v != floor(v)) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "expected an integer");
+    *out = (uint64_t)v;
+    return ATMOS_OK;
+}
+
+/* Copies a string value into a fixed buffer, refusing one that does not fit. */
+static atmos_status get_text(const jp *p, const cJSON *j, const char *path, char *out, size_t cap)
+{
+    const char *t = NULL;
+    TRY(get_string(p, j, path, &t));
+    if (strlen(t) >= cap)
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "must be at most %d bytes, got %zu",
+                                 (int)cap - 1, strlen(t));
+    if (!t[0]) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "must not be empty");
+    memcpy(out, t, strlen(t) + 1);
+    return ATMOS_OK;
+}
+
+/* "background": "sky" | "black" | {"type": "uniform", "radiance": L} */
+static atmos_status parse_background(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const types[] = {"sky", "black", "uniform"};
+    static const char *const keys[] = {"type", "radiance"};
+    int e = 0;
+    if (cJSON_IsString(j)) {
+        TRY(get_enum(p, j, path, types, 2, &e));
+        s->background = (atmos_background_kind)e;
+        return ATMOS_OK;
+    }
+    if (!cJSON_IsObject(j)) return type_error(p, path, "\"sky\", \"black\" or an object", j);
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, type = -1;
+    double radiance = 0;
+    TRY(iter_begin(p, j, path, keys, 2, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        if (k == 0) TRY(get_enum(p, v, ip, types, 3, &type));
+        else TRY(get_number(p, v, ip, &r_radiance, NULL, &radiance));
+    }
+    if (type < 0) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "missing key \"type\"");
+    if ((it.seen & 2u) && type != ATMOS_BACKGROUND_UNIFORM)
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "\"radiance\" goes with \"type\": \"uniform\" only");
+    if (type == ATMOS_BACKGROUND_UNIFORM && !(it.seen & 2u))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "missing key \"radiance\" (W m^-2 sr^-1 nm^-1)");
+    s->background = (atmos_background_kind)type;
+    s->background_radiance = radiance;
+    return ATMOS_OK;
+}
+
+static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"file", "generate", "grids", "particle", "density_scale", "time_index",
+                                       "voxel_size_m", "seed", "scale", "position_m"};
+    enum { K_FILE, K_GEN, K_GRIDS, K_PARTICLE, K_DSCALE, K_TIME, K_VOXEL, K_SEED, K_SCALE, K_POS };
+    const atmos__range *pos_r[3] = {&atmos__r_pos, &atmos__r_pos, &atmos__r_pos};
+    atmos_scene_volume vol = s->volume;
+    obj_iter it;
+    char ip[PATH_CAP], buf[64];
+    const cJSON *v;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 10, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        switch (k) {
+        case K_FILE:
+        case K_GEN:
+            if (it.seen & (k == K_FILE ? 1u << K_GEN : 1u << K_FILE))
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                         "\"file\" and \"generate\" exclude each other");
+            if (k == K_FILE) {
+                TRY(get_text(p, v, ip, vol.source, sizeof vol.source));
+                if (!strncmp(vol.source, "generate:", 9))
+                    return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                             "use \"generate\": \"%.40s\" for a generated volume", vol.source + 9);
+            } else {
+                TRY(get_text(p, v, ip, buf, sizeof buf));
+                int known = 0;
+                const char *const *names = atmos_volume_generator_names();
+                char list[256] = "";
+                for (int i = 0; names && names[i]; i++) {
+                    known |= !strcmp(names[i], buf);
+                    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
+                    strncat(list, names[i], sizeof list - strlen(list) - 1);
+                }
+                if (!known)
+                    return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                             "unknown generator (known: %s)", list);
+                snprintf(vol.source, sizeof vol.source, "generate:%s", buf);
+            }
+            break;
+        case K_GRIDS:
+            if (cJSON_IsArray(v)) {
+                vol.grids[0] = '\0';
+                int n = 0;
+                for (const cJSON *e = v->child; e; e = e->next, n++) {
+                    char ep[PATH_CAP + 16];
+                    snprintf(ep, sizeof ep, "%s/%d", ip, n);
+                    ep[PATH_CAP - 1] = '\0';
+                    char g[64];
+                    TRY(get_text(p, e, ep, g, sizeof g));
+                    if (strchr(g, ','))
+                        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ep, "a grid name has no ','");
+                    if (strlen(vol.grids) + strlen(g) + 2 > sizeof vol.grids)
+                        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "too many grid names");
+                    if (n) strcat(vol.grids, ",");
+                    strcat(vol.grids, g);
+                }
+                if (n == 0) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "must not be empty");
+            } else {
+                return type_error(p, ip, "an array of grid names", v);
+            }
+            break;
+        case K_PARTICLE: TRY(get_text(p, v, ip, vol.particle, sizeof vol.particle)); break;
+        case K_DSCALE: TRY(get_number(p, v, ip, &r_dscale, NULL, &vol.density_scale)); break;
+        case K_TIME: TRY(get_int(p, v, ip, &r_time_index, &vol.time_index)); break;
+        case K_VOXEL: TRY(get_number(p, v, ip, &r_voxel, NULL, &vol.voxel_size_m)); break;
+        case K_SEED: TRY(get_u64(p, v, ip, &r_seed, &vol.seed)); break;
+        case K_SCALE: TRY(get_number(p, v, ip, &r_vscale, NULL, &vol.scale)); break;
+        case K_POS:
+            TRY(get_vec3(p, v, ip, pos_r, vol.position_m));
+            vol.placed = 1;
+            break;
+        }
+    }
+    if (!(it.seen & (1u << K_FILE | 1u << K_GEN)))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"file\" or \"generate\"");
+    s->volume = vol;
+    return ATMOS_OK;
+}
+
+static atmos_status parse_slice(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"slices", "light_size", "xi", "update", "low_albedo", "grid_max_dim"};
+    static const char *const updates[] = {"eq25", "eq24"};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 6, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) return ATMOS_OK;
+        switch (k) {
+        case 0: TRY(get_int(p, v, ip, &r_slices, &s->slice.slices)); break;
+        case 1: TRY(get_int(p, v, ip, &r_light, &s->slice.light_size)); break;
+        case 2: TRY(get_number(p, v, ip, &r_xi, NULL, &s->slice.xi)); break;
+        case 3: TRY(get_enum(p, v, ip, updates, 2, &s->slice.eq24)); break;
+        case 4: TRY(get_bool(p, v, ip, &s->slice.low_albedo)); break;
+        case 5: TRY(get_int(p, v, ip, &r_grid, &s->slice.grid_max_dim)); break;
+        }
+    }
+}
+
+static atmos_status parse_path(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"spp", "time_budget_s", "seed", "max_depth"};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 4, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) return ATMOS_OK;
+        switch (k) {
+        case 0: TRY(get_int(p, v, ip, &r_path_spp, &s->path.spp)); break;
+        case 1: TRY(get_number(p, v, ip, &r_budget, NULL, &s->path.time_budget_s)); break;
+        case 2: TRY(get_u64(p, v, ip, &r_seed, &s->path.seed)); break;
+        case 3: TRY(get_int(p, v, ip, &r_depth, &s->path.max_depth)); break;
+        }
+    }
+}
+
 atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, const cJSON *root,
                                     atmos_scene *s)
 {
     static const char *const keys[] = {"name", "image", "camera", "sun", "atmosphere", "wavelengths",
-                                       "output", "renderer", "particles"};
-    static const char *const renderers[] = {"sky"};
-    enum { K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER, K_PARTICLES };
+                                       "output", "renderer", "particles", "background", "volume", "slice",
+                                       "path"};
+    static const char *const renderers[] = {"sky", "slice", "path"};
+    enum {
+        K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER, K_PARTICLES,
+        K_BACKGROUND, K_VOLUME, K_SLICE, K_PATH
+    };
     jp p = {ctx, source};
     obj_iter it;
     char ip[PATH_CAP];
@@ -749,10 +966,14 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
     const char *name = NULL;
     int k, renderer;
     if (!cJSON_IsObject(root)) return type_error(&p, "/", "an object", root);
-    TRY(iter_begin(&p, root, "", keys, 9, &it));
+    TRY(iter_begin(&p, root, "", keys, 13, &it));
     for (;;) {
         TRY(iter_next(&p, &it, &k, &v, ip));
-        if (k < 0) return ATMOS_OK;
+        if (k < 0) {
+            /* A volume without a renderer named is drawn by the slice renderer. */
+            if ((it.seen & (1u << K_VOLUME)) && !(it.seen & (1u << K_RENDERER))) s->renderer = ATMOS_RENDERER_SLICE;
+            return atmos__scene_validate_renderer(ctx, source, s);
+        }
         switch (k) {
         case K_NAME:
             TRY(get_string(&p, v, ip, &name));
@@ -768,8 +989,15 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_ATMOSPHERE: TRY(parse_atmosphere(&p, v, ip, s)); break;
         case K_WAVELENGTHS: TRY(parse_wavelengths(&p, v, ip, s)); break;
         case K_OUTPUT: TRY(parse_output(&p, v, ip, s)); break;
-        case K_RENDERER: TRY(get_enum(&p, v, ip, renderers, 1, &renderer)); break;
+        case K_RENDERER:
+            TRY(get_enum(&p, v, ip, renderers, 3, &renderer));
+            s->renderer = (atmos_renderer_kind)renderer;
+            break;
         case K_PARTICLES: TRY(parse_particles(&p, v, ip, s)); break;
+        case K_BACKGROUND: TRY(parse_background(&p, v, ip, s)); break;
+        case K_VOLUME: TRY(parse_volume(&p, v, ip, s)); break;
+        case K_SLICE: TRY(parse_slice(&p, v, ip, s)); break;
+        case K_PATH: TRY(parse_path(&p, v, ip, s)); break;
         }
     }
 }

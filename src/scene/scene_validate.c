@@ -275,6 +275,75 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
     return ATMOS_OK;
 }
 
+atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *s)
+{
+    static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0},
+                              r_xi = {0, 100, 0, 0}, r_grid = {8, 2048, 0, 0}, r_spp = {1, 1000000, 0, 0},
+                              r_budget = {0, 1e7, 0, 0}, r_depth = {0, 100000, 0, 0},
+                              r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0}, r_voxel = {0, 1e5, 0, 0},
+                              r_time_index = {0, 1000000, 0, 0};
+    static const char *const names[] = {"sky", "slice", "path"};
+    atmos_status st;
+    if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_PATH)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice or path, got %d",
+                                 (int)s->renderer);
+    if (s->background < ATMOS_BACKGROUND_SKY || s->background > ATMOS_BACKGROUND_UNIFORM)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/background", "must be sky, black or uniform, got %d",
+                                 (int)s->background);
+    if ((st = atmos__scene_check_range(ctx, source, "/background/radiance", s->background_radiance, &r_radiance, NULL)))
+        return st;
+    const atmos_scene_sun *sun = &s->sun;
+    if (sun->irradiance_count != 0 && sun->irradiance_count != 1 && sun->irradiance_count != 3)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/sun/irradiance",
+                                 "irradiance_count must be 0, 1 or 3, got %d", sun->irradiance_count);
+    for (int i = 0; i < sun->irradiance_count; i++)
+        if ((st = atmos__scene_check_range(ctx, source, "/sun/irradiance", sun->irradiance[i], &r_radiance, NULL)))
+            return st;
+    if (sun->irradiance_count == 3 && s->wavelengths != ATMOS_WAVELENGTHS_RGB)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/sun/irradiance",
+                                 "three values are the rgb channels; in spectral mode give one number");
+    int volume_renderer = s->renderer != ATMOS_RENDERER_SKY;
+    if (!memchr(s->volume.source, '\0', sizeof s->volume.source))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/file", "is not terminated");
+    if (volume_renderer && !s->volume.source[0])
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer",
+                                 "\"%s\" renders a volume: the scene needs \"volume\" (a file or a generator)",
+                                 names[s->renderer]);
+    if (!volume_renderer && s->volume.source[0])
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume",
+                                 "the sky renderer draws no volume (use \"renderer\": \"slice\" or \"path\")");
+    if (s->renderer == ATMOS_RENDERER_SLICE && s->camera.type != ATMOS_CAMERA_PINHOLE)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/type",
+                                 "the slice renderer supports pinhole cameras only");
+    if (!s->volume.placed && s->volume.source[0] && s->camera.type != ATMOS_CAMERA_PINHOLE)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/position_m",
+                                 "is needed with a %s camera (a volume is placed in front of pinhole cameras only)",
+                                 s->camera.type == ATMOS_CAMERA_FISHEYE ? "fisheye" : "equirect");
+    const struct {
+        const char *path;
+        double v;
+        const atmos__range *r;
+    } checks[] = {
+        {"/volume/density_scale", s->volume.density_scale, &r_dscale},
+        {"/volume/scale", s->volume.scale, &r_vscale},
+        {"/volume/voxel_size_m", s->volume.voxel_size_m, &r_voxel},
+        {"/volume/time_index", s->volume.time_index, &r_time_index},
+        {"/volume/position_m/0", s->volume.position_m[0], &atmos__r_pos},
+        {"/volume/position_m/1", s->volume.position_m[1], &atmos__r_pos},
+        {"/volume/position_m/2", s->volume.position_m[2], &atmos__r_pos},
+        {"/slice/slices", s->slice.slices, &r_slices},
+        {"/slice/light_size", s->slice.light_size, &r_light},
+        {"/slice/xi", s->slice.xi, &r_xi},
+        {"/slice/grid_max_dim", s->slice.grid_max_dim, &r_grid},
+        {"/path/spp", s->path.spp, &r_spp},
+        {"/path/time_budget_s", s->path.time_budget_s, &r_budget},
+        {"/path/max_depth", s->path.max_depth, &r_depth},
+    };
+    for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++)
+        if ((st = atmos__scene_check_range(ctx, source, checks[i].path, checks[i].v, checks[i].r, NULL))) return st;
+    return ATMOS_OK;
+}
+
 atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, const char *source)
 {
     if (!scene) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_validate: scene is NULL");
@@ -294,5 +363,6 @@ atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, 
     if ((st = atmos__scene_check_range(ctx, source, "/wavelengths/samples", scene->spectral_samples,
                                        &atmos__r_samples, NULL)))
         return st;
+    if ((st = atmos__scene_validate_renderer(ctx, source, scene))) return st;
     return atmos__scene_validate_output(ctx, source, scene);
 }

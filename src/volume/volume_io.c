@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 typedef enum { FMT_UNKNOWN, FMT_JSON, FMT_NANOVDB, FMT_OPENVDB, FMT_NETCDF } vol_format;
 
@@ -49,6 +50,9 @@ atmos_status atmos_volume_load(atmos_context *ctx, const char *path, const atmos
         memset(&zero, 0, sizeof zero);
         desc = &zero;
     }
+    struct stat sb;
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return atmos__error(ctx, ATMOS_E_IO, "%s: is a directory, not a volume file", path);
     FILE *f = fopen(path, "rb");
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
     unsigned char head[64];

@@ -33,6 +33,26 @@ same = all(abs(px(a, x, y)[1] - px(b, x, y)[1]) <= 1e-3 * px(a, x, y)[1] for (x,
 assert changed > 10, "cloud not visible: %d pixels changed" % changed
 assert same, "corners changed"
 PY
+# --tau: the optical-depth key image, positive where the cloud is; compare --by splits by it
+"$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --eq24 --pfm "$T/eq24.pfm" \
+    --tau "$T/tau.pfm" --threads 2 && ok || bad "render --eq24 --tau"
+"$A" compare "$T/eq24.pfm" "$T/cloud.pfm" --by "$T/tau.pfm" --edges 0,0.001,1,1000 --json > "$T/bins.json" && ok || bad "compare --by"
+python3 - "$T/bins.json" "$T/tau.pfm" <<'PY' && ok || bad "tau image / bins check"
+import json, struct, sys
+j = json.load(open(sys.argv[1]))
+b = j["bins"]
+assert [x["lo"] for x in b] == [0, 0.001, 1], b
+assert b[0]["pixels"] > 0 and b[0]["rel_rmse"] == 0, b[0]   # no volume on the ray: identical
+assert b[1]["pixels"] + b[2]["pixels"] > 10, b
+d = open(sys.argv[2], "rb").read()
+hdr = d.split(b"\n", 3)
+assert hdr[0] == b"Pf", hdr[0]                                  # one channel
+w, h = map(int, hdr[1].split())
+v = struct.unpack("<%df" % (w * h), hdr[3][: w * h * 4])
+assert min(v) == 0 and max(v) > 1, (min(v), max(v))
+PY
+"$A" compare "$T/eq24.pfm" "$T/cloud.pfm" --by "$T/tau.pfm" --edges 1,0 >/dev/null 2>&1; [ $? -eq 2 ] && ok || bad "descending --edges should exit 2"
+"$A" render -q --tau "$T/t.pfm" -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--tau without a volume should exit 2"
 "$A" render -q --renderer slice -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--renderer slice without --volume should exit 2"
 "$A" render -q --volume generate:nope -o "$T/x.png" 2>/dev/null; [ $? -eq 1 ] && ok || bad "unknown generator should exit 1"
 rm -rf "$T"

@@ -2,6 +2,8 @@
 #include "atmos/atmos.h"
 #include "test.h"
 
+#include <math.h>
+
 int main(void)
 {
     atmos_image *ref = NULL, *img = NULL, *heat = NULL;
@@ -58,5 +60,32 @@ int main(void)
     atmos_image_destroy(heat);
     atmos_image_destroy(ref);
     atmos_image_destroy(img);
+    /* Binned by a key: left half key 1 (image = ref * 1.1), right half key 5 (exact),
+     * one pixel with key 100 outside the edges. */
+    {
+        atmos_image *r2 = NULL, *i2 = NULL, *key = NULL;
+        CHECK_OK(atmos_image_create(NULL, 10, 4, 3, &r2));
+        CHECK_OK(atmos_image_create(NULL, 10, 4, 3, &i2));
+        CHECK_OK(atmos_image_create(NULL, 10, 4, 1, &key));
+        for (int p = 0; r2 && i2 && key && p < 40; p++) {
+            int left = p % 10 < 5;
+            for (int c = 0; c < 3; c++) r2->pixels[p * 3 + c] = (float)(c + 1), i2->pixels[p * 3 + c] = (float)((c + 1) * (left ? 1.1 : 1.0));
+            key->pixels[p] = left ? 1.0f : 5.0f;
+        }
+        if (key) key->pixels[39] = 100.0f;
+        double edges[] = {0, 2, 10, 20};
+        atmos_image_bins bins;
+        CHECK_OK(atmos_image_compare_binned(NULL, i2, r2, key, edges, 4, &bins));
+        CHECK(bins.bins == 3 && bins.count[0] == 20 && bins.count[1] == 19 && bins.count[2] == 0);
+        /* left: differences 0.1, 0.2, 0.3 over |ref| 1, 2, 3: rmse sqrt(0.14/3), mean ref 2 */
+        CHECK_REL(bins.rel_rmse[0], sqrt(0.14 / 3) / 2, 1e-5);
+        CHECK_REL(bins.rel_bias[0], 0.2 / 2, 1e-5);
+        CHECK(bins.rel_rmse[1] == 0 && bins.rel_bias[1] == 0 && isnan(bins.rel_rmse[2]));
+        double bad[] = {0, 2, 2};
+        CHECK(atmos_image_compare_binned(NULL, i2, r2, key, bad, 3, &bins) == ATMOS_E_INVALID_ARG);
+        atmos_image_destroy(r2);
+        atmos_image_destroy(i2);
+        atmos_image_destroy(key);
+    }
     return test_summary("test_compare");
 }

@@ -3,6 +3,8 @@
 #include "atmos/atmos.h"
 #include "test.h"
 
+#include <math.h>
+
 static atmos_context *make_ctx(int threads)
 {
     atmos_context_desc d;
@@ -246,8 +248,59 @@ static void test_rgb_vs_spectral_colour(void)
     atmos_context_destroy(ctx);
 }
 
+/* Backgrounds other than the sky are vacuum: exactly the given radiance, no disk;
+ * a sun given by a flat irradiance scales the sky linearly. */
+static void test_background_and_irradiance(void)
+{
+    atmos_context *ctx = make_ctx(2);
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.width = 48, s.height = 32;
+    s.camera.look_at[0] = s.camera.position[0] + 1000 * sin(235 * 3.14159265358979 / 180); /* the sun's azimuth */
+    s.camera.look_at[2] = s.camera.position[2] - 1000 * cos(235 * 3.14159265358979 / 180);
+    s.camera.look_at[1] = s.camera.position[1] + 400;
+    for (int b = 0; b < 2; b++) {
+        s.background = b ? ATMOS_BACKGROUND_UNIFORM : ATMOS_BACKGROUND_BLACK;
+        s.background_radiance = b ? 0.25 : 0.0;
+        atmos_image *img = render(ctx, &s);
+        int bad = 0;
+        for (int i = 0; img && i < s.width * s.height; i++) {
+            const float *px = img->pixels + (size_t)i * img->channels;
+            for (int c = 0; c < 3; c++) bad += px[c] != (b ? 0.25f : 0.0f);
+            bad += px[3] != 1.0f;
+        }
+        CHECK_MSG(img && bad == 0, "background %d: %d values differ", b, bad);
+        atmos_image_destroy(img);
+    }
+    s.background = ATMOS_BACKGROUND_SKY;
+    s.wavelengths = ATMOS_WAVELENGTHS_SPECTRAL;
+    s.spectral_samples = 8;
+    s.sun.irradiance_count = 1;
+    s.sun.irradiance[0] = 1.0;
+    atmos_wavelengths wl;
+    CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
+    for (int i = 0; i < wl.count; i++) CHECK(wl.sun_irradiance[i] == 1.0);
+    atmos_image *a = render(ctx, &s);
+    s.sun.irradiance[0] = 2.0;
+    atmos_image *b2 = render(ctx, &s);
+    double worst = 0;
+    for (size_t i = 0; a && b2 && i < (size_t)s.width * s.height * a->channels; i++)
+        if ((i + 1) % (size_t)a->channels)
+            worst = fmax(worst, fabs(b2->pixels[i] - 2.0 * a->pixels[i]) / fmax(1e-30, 2.0 * a->pixels[i]));
+    CHECK_MSG(worst < 1e-5, "sky radiance is not linear in the sun's irradiance: %g", worst);
+    atmos_image_destroy(a);
+    atmos_image_destroy(b2);
+    s.wavelengths = ATMOS_WAVELENGTHS_RGB;
+    s.sun.irradiance_count = 3;
+    s.sun.irradiance[0] = 1, s.sun.irradiance[1] = 2, s.sun.irradiance[2] = 3;
+    CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
+    CHECK(wl.sun_irradiance[0] == 1 && wl.sun_irradiance[1] == 2 && wl.sun_irradiance[2] == 3);
+    atmos_context_destroy(ctx);
+}
+
 int main(void)
 {
+    test_background_and_irradiance();
     test_matches_model();
     test_threads_identical();
     test_sun_disk_energy();

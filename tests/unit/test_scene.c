@@ -199,6 +199,30 @@ static void test_absent_keys(void)
     /* Only one sun angle: the other keeps its default. */
     CHECK_OK(parse("{\"sun\": {\"azimuth_deg\": 100}}", &s));
     CHECK(s.sun.elevation_deg == 22 && s.sun.azimuth_deg == 100 && !s.sun.from_time);
+
+    /* Renderers, volumes, background, sun irradiance. */
+    CHECK_OK(parse("{}", &s));
+    CHECK(s.renderer == ATMOS_RENDERER_SKY && s.background == ATMOS_BACKGROUND_SKY && !s.volume.source[0]);
+    CHECK(s.slice.slices == 256 && s.path.spp == 64 && s.path.seed == 1 && s.sun.irradiance_count == 0);
+    CHECK_OK(parse("{\"volume\": {\"generate\": \"storm\", \"seed\": 7, \"scale\": 0.5, \"position_m\": [1, 2, 3]}}", &s));
+    CHECK(s.renderer == ATMOS_RENDERER_SLICE); /* a volume alone selects the slice renderer */
+    CHECK(!strcmp(s.volume.source, "generate:storm") && s.volume.seed == 7 && s.volume.scale == 0.5);
+    CHECK(s.volume.placed && s.volume.position_m[0] == 1 && s.volume.position_m[1] == 2 && s.volume.position_m[2] == 3);
+    CHECK_OK(parse("{\"renderer\": \"path\", \"volume\": {\"file\": \"c.vdb\", \"grids\": [\"density\", \"temp\"], "
+                   "\"particle\": \"cloud\", \"density_scale\": 1e8}, \"path\": {\"spp\": 1000, \"time_budget_s\": 30, "
+                   "\"seed\": 42, \"max_depth\": 5}, \"background\": {\"type\": \"uniform\", \"radiance\": 0.25}, "
+                   "\"sun\": {\"elevation_deg\": 30, \"irradiance\": [1, 2, 3]}}", &s));
+    CHECK(s.renderer == ATMOS_RENDERER_PATH && !strcmp(s.volume.source, "c.vdb") && !strcmp(s.volume.grids, "density,temp"));
+    CHECK(!strcmp(s.volume.particle, "cloud") && s.volume.density_scale == 1e8 && !s.volume.placed);
+    CHECK(s.path.spp == 1000 && s.path.time_budget_s == 30 && s.path.seed == 42 && s.path.max_depth == 5);
+    CHECK(s.background == ATMOS_BACKGROUND_UNIFORM && s.background_radiance == 0.25);
+    CHECK(s.sun.irradiance_count == 3 && s.sun.irradiance[2] == 3 && s.sun.elevation_deg == 30);
+    CHECK_OK(parse("{\"sun\": {\"irradiance\": 1.5, \"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40, "
+                   "\"longitude_deg\": 0}, \"background\": \"black\", \"slice\": {\"update\": \"eq24\", \"xi\": 0, "
+                   "\"low_albedo\": true, \"slices\": 64, \"light_size\": 128, \"grid_max_dim\": 64}}", &s));
+    CHECK(s.sun.from_time && s.sun.irradiance_count == 1 && s.sun.irradiance[0] == 1.5 && s.background == ATMOS_BACKGROUND_BLACK);
+    CHECK(s.slice.eq24 == 1 && s.slice.xi == 0 && s.slice.low_albedo == 1 && s.slice.slices == 64 && s.slice.light_size == 128 &&
+          s.slice.grid_max_dim == 64);
 }
 
 typedef struct bad_case {
@@ -209,7 +233,7 @@ typedef struct bad_case {
 
 static const bad_case bad_cases[] = {
     /* structure and types */
-    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles)", NULL},
+    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path)", NULL},
     {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
     {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
     {"{\"a/b~c\": 1}", ATMOS_E_INVALID_ARG, "/a~1b~0c: unknown key", NULL},
@@ -228,7 +252,40 @@ static const bad_case bad_cases[] = {
     {"{\"output\": {\"exr_pixel\": \"double\"}}", ATMOS_E_INVALID_ARG, "/output/exr_pixel: must be one of float, half", NULL},
     {"{\"output\": {\"exposure\": \"bright\"}}", ATMOS_E_INVALID_ARG, "/output/exposure: must be \"auto\" or a number", NULL},
     {"{\"output\": {\"exposure\": true}}", ATMOS_E_INVALID_ARG, "/output/exposure: expected \"auto\" or a number (EV100), got a boolean", NULL},
-    {"{\"renderer\": \"path\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, got \"path\"", NULL},
+    {"{\"renderer\": \"raytrace\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, slice, path, got \"raytrace\"", NULL},
+    /* renderers, background, volume */
+    {"{\"renderer\": \"path\"}", ATMOS_E_INVALID_ARG, "/renderer: \"path\" renders a volume: the scene needs \"volume\"", NULL},
+    {"{\"renderer\": \"sky\", \"volume\": {\"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume: the sky renderer draws no volume", NULL},
+    {"{\"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/type: the slice renderer supports pinhole cameras only", NULL},
+    {"{\"renderer\": \"path\", \"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"equirect\"}}", ATMOS_E_INVALID_ARG, "/volume/position_m: is needed with a equirect camera", NULL},
+    {"{\"volume\": {\"generate\": \"blob\"}}", ATMOS_E_INVALID_ARG, "/volume/generate: unknown generator (known: cumulus,", NULL},
+    {"{\"volume\": {\"file\": \"a.vdb\", \"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume/generate: \"file\" and \"generate\" exclude each other", NULL},
+    {"{\"volume\": {\"file\": \"\"}}", ATMOS_E_INVALID_ARG, "/volume/file: must not be empty", NULL},
+    {"{\"volume\": {\"file\": \"generate:storm\"}}", ATMOS_E_INVALID_ARG, "/volume/file: use \"generate\": \"storm\"", NULL},
+    {"{\"volume\": {\"density_scale\": 2}}", ATMOS_E_INVALID_ARG, "/volume: needs \"file\" or \"generate\"", NULL},
+    {"{\"volume\": {\"generate\": \"storm\", \"density_scale\": 0}}", ATMOS_E_INVALID_ARG, "/volume/density_scale: must be in (0, 1e+30], got 0", NULL},
+    {"{\"volume\": {\"generate\": \"storm\", \"grids\": \"cloud\"}}", ATMOS_E_INVALID_ARG, "/volume/grids: expected an array of grid names, got a string", NULL},
+    {"{\"volume\": {\"generate\": \"storm\", \"grids\": []}}", ATMOS_E_INVALID_ARG, "/volume/grids: must not be empty", NULL},
+    {"{\"volume\": {\"generate\": \"storm\", \"grids\": [\"a,b\"]}}", ATMOS_E_INVALID_ARG, "/volume/grids/0: a grid name has no ','", NULL},
+    {"{\"volume\": {\"generate\": \"storm\", \"seed\": 1.5}}", ATMOS_E_INVALID_ARG, "/volume/seed: expected an integer", NULL},
+    {"{\"volume\": {\"generate\": \"storm\", \"position_m\": [0, 1]}}", ATMOS_E_INVALID_ARG, "/volume/position_m: expected an array of 3 numbers", NULL},
+    {"{\"slice\": {\"slices\": 0}}", ATMOS_E_INVALID_ARG, "/slice/slices: must be in [1, 8192], got 0", NULL},
+    {"{\"slice\": {\"light_size\": 4}}", ATMOS_E_INVALID_ARG, "/slice/light_size: must be in [8, 8192], got 4", NULL},
+    {"{\"slice\": {\"xi\": -1}}", ATMOS_E_INVALID_ARG, "/slice/xi: must be in [0, 100], got -1", NULL},
+    {"{\"slice\": {\"update\": \"eq23\"}}", ATMOS_E_INVALID_ARG, "/slice/update: must be one of eq25, eq24", NULL},
+    {"{\"slice\": {\"low_albedo\": 1}}", ATMOS_E_INVALID_ARG, "/slice/low_albedo: expected true or false", NULL},
+    {"{\"path\": {\"spp\": 0}}", ATMOS_E_INVALID_ARG, "/path/spp: must be in [1, 1000000], got 0", NULL},
+    {"{\"path\": {\"time_budget_s\": -1}}", ATMOS_E_INVALID_ARG, "/path/time_budget_s: must be in [0, 10000000], got -1", NULL},
+    {"{\"path\": {\"seed\": -3}}", ATMOS_E_INVALID_ARG, "/path/seed: must be in [0, ", NULL},
+    {"{\"path\": {\"bounces\": 3}}", ATMOS_E_INVALID_ARG, "/path/bounces: unknown key (allowed: spp, time_budget_s, seed, max_depth)", NULL},
+    {"{\"background\": \"uniform\"}", ATMOS_E_INVALID_ARG, "/background: must be one of sky, black, got \"uniform\"", NULL},
+    {"{\"background\": {\"type\": \"uniform\"}}", ATMOS_E_INVALID_ARG, "/background: missing key \"radiance\"", NULL},
+    {"{\"background\": {\"type\": \"black\", \"radiance\": 1}}", ATMOS_E_INVALID_ARG, "/background: \"radiance\" goes with \"type\": \"uniform\" only", NULL},
+    {"{\"background\": {\"type\": \"uniform\", \"radiance\": -1}}", ATMOS_E_INVALID_ARG, "/background/radiance: must be in [0, 1000000], got -1", NULL},
+    {"{\"background\": 3}", ATMOS_E_INVALID_ARG, "/background: expected \"sky\", \"black\" or an object, got a number", NULL},
+    {"{\"sun\": {\"irradiance\": \"bright\"}}", ATMOS_E_INVALID_ARG, "/sun/irradiance: expected a number or an array of 3 numbers", NULL},
+    {"{\"sun\": {\"irradiance\": -2}}", ATMOS_E_INVALID_ARG, "/sun/irradiance: must be in [0, 1000000], got -2", NULL},
+    {"{\"sun\": {\"irradiance\": [1, 2, 3]}, \"wavelengths\": {\"mode\": \"spectral\"}}", ATMOS_E_INVALID_ARG, "/sun/irradiance: three values are the rgb channels", NULL},
     {"{\"image\": {\"width\": 10, \"width\": 20}}", ATMOS_E_INVALID_ARG, "/image/width: duplicate key", NULL},
     /* ranges, at each side of each boundary that matters */
     {"{\"image\": {\"width\": 0}}", ATMOS_E_INVALID_ARG, "/image/width: must be in [1, 16384], got 0", NULL},

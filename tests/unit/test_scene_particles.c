@@ -61,6 +61,18 @@ static void test_valid(void)
         CHECK_NEAR(atmos_phase_table_albedo(t, 1), 0.95, 1e-12);
     }
     atmos_phase_table_destroy(t);
+    /* "albedo": 0 is a purely absorbing medium, not "computed". */
+    p.albedo = 0;
+    p.albedo_set = 1;
+    t = NULL;
+    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &t));
+    if (t) CHECK(atmos_phase_table_albedo(t, 0) == 0.0 && atmos_phase_table_albedo(t, 2) == 0.0);
+    atmos_phase_table_destroy(t);
+    p.albedo_set = 0;
+    t = NULL;
+    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &t));
+    if (t) CHECK(atmos_phase_table_albedo(t, 0) == 1.0);
+    atmos_phase_table_destroy(t);
 }
 
 static void test_errors(void)

@@ -462,6 +462,71 @@ static void test_crashers(atmos_context *ctx)
     CHECK(n >= 30);
 }
 
+/* A scene's volume: generator, placement by position_m (bottom-face centre) and by
+ * default in front of the camera, and the optical-depth image of a constant box
+ * (tau = sigma eta L along the axis, 0 beside it). */
+static void test_scene_volume(atmos_context *ctx)
+{
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.width = 33, s.height = 33;
+    s.camera.position[0] = 0, s.camera.position[1] = 1000, s.camera.position[2] = 0;
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = 1000, s.camera.look_at[2] = -1000; /* north */
+    s.camera.fov_deg = 10;
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    vd.dims[0] = vd.dims[1] = vd.dims[2] = 20;
+    vd.voxel_size_m = 10;
+    atmos_volume *v = NULL;
+    int f = -1;
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "cloud", &f));
+    static float ones[20 * 20 * 20];
+    for (int i = 0; i < 20 * 20 * 20; i++) ones[i] = 1e8f;
+    int off[3] = {0, 0, 0}, size[3] = {20, 20, 20};
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, ones, 1.0f));
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    /* Box [0,200]^3 moved so its bottom-face centre is at (0, 900, -3000): the camera's
+     * axis at y = 1000 crosses it from z = -3100 to -2900. */
+    double offset[3] = {0 - 100, 900 - 0, -3000 - 100};
+    double sigma[1] = {2e-11}; /* 2e-11 m^2 * 1e8 m^-3 = 2e-3 m^-1; tau = 0.4 over 200 m */
+    atmos_image *img = NULL;
+    CHECK_OK(atmos_volume_optical_depth_image(ctx, &s, v, sigma, offset, &img));
+    if (img) {
+        CHECK_REL(img->pixels[16 * 33 + 16], 0.4, 1e-4);
+        CHECK(img->pixels[0] == 0.0f && img->pixels[33 * 33 - 1] == 0.0f);
+    }
+    atmos_image_destroy(img);
+    atmos_volume_destroy(v);
+
+    snprintf(s.volume.source, sizeof s.volume.source, "generate:cirrus");
+    s.volume.seed = 1, s.volume.scale = 0.3;
+    s.volume.placed = 1;
+    s.volume.position_m[0] = 10, s.volume.position_m[1] = 8000, s.volume.position_m[2] = -20;
+    double o[3], lo[3], hi[3];
+    CHECK_OK(atmos_volume_load_scene(ctx, &s, &v, o));
+    if (v) {
+        atmos_volume_bounds(v, lo, hi);
+        CHECK_NEAR(0.5 * (lo[0] + hi[0]) + o[0], 10, 1e-6);
+        CHECK_NEAR(lo[1] + o[1], 8000, 1e-6);
+        CHECK_NEAR(0.5 * (lo[2] + hi[2]) + o[2], -20, 1e-6);
+    }
+    s.volume.placed = 0;
+    double o2[3];
+    atmos_volume_destroy(v);
+    v = NULL;
+    CHECK_OK(atmos_volume_load_scene(ctx, &s, &v, o2));
+    if (v) {
+        /* In front (north) of the camera, at least 4 km away, at its own altitude. */
+        double cz = 0.5 * (lo[2] + hi[2]) + o2[2], cx = 0.5 * (lo[0] + hi[0]) + o2[0];
+        CHECK(cz <= -4000 + 1e-6 && fabs(cx) < 1e-6 && o2[1] == 0);
+    }
+    atmos_volume_destroy(v);
+    snprintf(s.volume.source, sizeof s.volume.source, "generate:nope");
+    v = NULL;
+    CHECK(atmos_volume_load_scene(ctx, &s, &v, o) == ATMOS_E_INVALID_ARG && v == NULL);
+}
+
 int main(void)
 {
     atmos_context *ctx = NULL;
@@ -473,6 +538,7 @@ int main(void)
     test_limits_and_errors(ctx);
     test_raw_roundtrip(ctx);
     test_crashers(ctx);
+    test_scene_volume(ctx);
     atmos_context_destroy(ctx);
     return test_summary("test_volume");
 }

@@ -165,7 +165,8 @@ static int bench_optics(int threads, int fast, const char *presets)
         atmos_particle_desc p;
         atmos_status st = atmos_particle_preset(ctx, name, &p);
         if (st != ATMOS_OK) {
-            rc = cli_runtime_error("bench", ctx, st);
+            fprintf(stderr, "atmos bench: --presets: %s\n", atmos_context_error(ctx));
+            rc = CLI_EXIT_USAGE;
             break;
         }
         if (fast) p.fast = 1;
@@ -317,6 +318,7 @@ static int bench_volume(const char *file, int repeat, int threads)
 {
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
+    int file_failed = 0;
     if (file) {
         double best = 1e30;
         atmos_volume *v = NULL;
@@ -331,6 +333,7 @@ static int bench_volume(const char *file, int repeat, int threads)
         }
         if (st != ATMOS_OK) {
             printf("bench=volume case=file file=%s skipped=1 reason=\"%s\"\n", file, atmos_context_error(ctx));
+            file_failed = 1;
         } else {
             const char *base = strrchr(file, '/');
             bench_volume_case(base ? base + 1 : file, v, best);
@@ -350,7 +353,7 @@ static int bench_volume(const char *file, int repeat, int threads)
     bench_volume_case("generated_cumulus", v, t);
     atmos_volume_destroy(v);
     atmos_context_destroy(ctx);
-    return CLI_EXIT_OK;
+    return file_failed ? CLI_EXIT_RUNTIME : CLI_EXIT_OK; /* a named file that cannot be read is an error */
 }
 
 /* One case of the slice benchmark: the Fig. 14 configuration (size^2, 256 slices) of

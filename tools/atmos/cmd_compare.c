@@ -3,11 +3,12 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static void help(void)
 {
-    printf("Usage: atmos compare IMAGE REFERENCE [--heatmap OUT.png] [--json]\n\n"
+    printf("Usage: atmos compare IMAGE REFERENCE [--heatmap OUT.png] [--by KEY.pfm [--edges E0,E1,...]] [--json]\n\n"
            "Compares two HDR images of the same size (OpenEXR .exr or portable float map .pfm;\n"
            "the alpha channel of RGBA images is ignored) and prints per channel and overall:\n"
            "  rmse      root-mean-square difference, in the images' units\n"
@@ -17,7 +18,12 @@ static void help(void)
            "difference (black, red, yellow, white = the largest). --json prints\n"
            "  {\"rmse\": ..., \"rel_rmse\": ..., \"bias\": [...], \"rmse_per_channel\": [...],\n"
            "   \"rel_rmse_per_channel\": [...], \"worst_region\": [x, y, w, h], \"worst_rmse\": ...,\n"
-           "   \"nonfinite\": N}   (NaN/Inf samples, skipped: statistics are over the finite ones)\n");
+           "   \"nonfinite\": N}   (NaN/Inf samples, skipped: statistics are over the finite ones)\n\n"
+           "--by KEY splits the statistics by a per-pixel key image of the same size (channel 0),\n"
+           "such as the optical depth written by `atmos render --tau`: pixels with the key in\n"
+           "[E_i, E_i+1) form bin i (default edges 0.01,0.1,0.5,1,2,4,8,16,32,64,1e30). Per bin it\n"
+           "prints the pixel count, rel_rmse and rel_bias (over the reference's mean in the bin);\n"
+           "--json adds \"bins\": [{\"lo\", \"hi\", \"pixels\", \"rel_rmse\", \"rel_bias\"}, ...].\n");
 }
 
 static atmos_status read_hdr(atmos_context *ctx, const char *path, atmos_image **out)
@@ -29,8 +35,9 @@ static atmos_status read_hdr(atmos_context *ctx, const char *path, atmos_image *
 
 int cli_cmd_compare(int argc, char **argv)
 {
-    const char *C = "compare", *files[2] = {NULL, NULL}, *heat = NULL;
-    int json = 0, nf = 0;
+    const char *C = "compare", *files[2] = {NULL, NULL}, *heat = NULL, *by = NULL;
+    int json = 0, nf = 0, n_edges = 11;
+    double edges[ATMOS_IMAGE_BINS_MAX + 1] = {0.01, 0.1, 0.5, 1, 2, 4, 8, 16, 32, 64, 1e30};
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -41,6 +48,23 @@ int cli_cmd_compare(int argc, char **argv)
         } else if (cli_take_value(argc, argv, &i, "--heatmap", &v)) {
             if (!v || !*v) return cli_usage_error(C, "--heatmap: missing file name");
             heat = v;
+        } else if (cli_take_value(argc, argv, &i, "--by", &v)) {
+            if (!v || !*v) return cli_usage_error(C, "--by: missing key image");
+            by = v;
+        } else if (cli_take_value(argc, argv, &i, "--edges", &v)) {
+            if (!v) return cli_usage_error(C, "--edges: missing list");
+            n_edges = 0;
+            const char *q = v;
+            while (*q && n_edges <= ATMOS_IMAGE_BINS_MAX) {
+                char *end = NULL;
+                edges[n_edges] = strtod(q, &end);
+                if (end == q || (*end && *end != ',') || !isfinite(edges[n_edges]) ||
+                    (n_edges && !(edges[n_edges] > edges[n_edges - 1])))
+                    return cli_usage_error(C, "--edges: expected ascending numbers like 0,1,2,4, got '%s'", v);
+                n_edges++;
+                q = *end ? end + 1 : end;
+            }
+            if (*q || n_edges < 2) return cli_usage_error(C, "--edges: 2..%d ascending numbers", ATMOS_IMAGE_BINS_MAX + 1);
         } else if (argv[i][0] == '-') {
             return cli_usage_error(C, "unknown option '%s'", argv[i]);
         } else if (nf < 2) {
@@ -52,11 +76,14 @@ int cli_cmd_compare(int argc, char **argv)
     if (nf < 2) return cli_usage_error(C, "need IMAGE and REFERENCE");
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
-    atmos_image *a = NULL, *b = NULL, *h = NULL;
+    atmos_image *a = NULL, *b = NULL, *h = NULL, *key = NULL;
     atmos_image_diff d;
+    atmos_image_bins bins;
     atmos_status st = read_hdr(ctx, files[0], &a);
     if (st == ATMOS_OK) st = read_hdr(ctx, files[1], &b);
     if (st == ATMOS_OK) st = atmos_image_compare(ctx, a, b, &d, heat ? &h : NULL);
+    if (st == ATMOS_OK && by) st = read_hdr(ctx, by, &key);
+    if (st == ATMOS_OK && by) st = atmos_image_compare_binned(ctx, a, b, key, edges, n_edges, &bins);
     if (st == ATMOS_OK && heat) st = atmos_write_png(ctx, h, heat, 8);
     int rc = CLI_EXIT_OK;
     if (st != ATMOS_OK) {
@@ -68,8 +95,20 @@ int cli_cmd_compare(int argc, char **argv)
         cli_print_json_array(d.rmse, d.channels);
         printf(", \"rel_rmse_per_channel\": ");
         cli_print_json_array(d.rel_rmse, d.channels);
-        printf(", \"worst_region\": [%d, %d, %d, %d], \"worst_rmse\": %.9g, \"nonfinite\": %zu}\n", d.worst_x, d.worst_y,
+        printf(", \"worst_region\": [%d, %d, %d, %d], \"worst_rmse\": %.9g, \"nonfinite\": %zu", d.worst_x, d.worst_y,
                d.worst_w, d.worst_h, d.worst_rmse, d.nonfinite);
+        if (by) {
+            printf(", \"bins\": [");
+            for (int i = 0; i < bins.bins; i++) {
+                /* JSON has no NaN: empty bins say null. */
+                printf("%s{\"lo\": %.9g, \"hi\": %.9g, \"pixels\": %zu, ", i ? ", " : "", bins.edges[i], bins.edges[i + 1],
+                       bins.count[i]);
+                if (isfinite(bins.rel_rmse[i])) printf("\"rel_rmse\": %.9g, \"rel_bias\": %.9g}", bins.rel_rmse[i], bins.rel_bias[i]);
+                else printf("\"rel_rmse\": null, \"rel_bias\": null}");
+            }
+            printf("]");
+        }
+        printf("}\n");
     } else {
         printf("%s vs %s (%dx%d, %d channels)\n", files[0], files[1], a->width, a->height, d.channels);
         printf("%10s %14s %14s %14s\n", "channel", "rmse", "rel_rmse", "bias");
@@ -79,10 +118,17 @@ int cli_cmd_compare(int argc, char **argv)
                d.worst_y + d.worst_h - 1, d.worst_rmse);
         if (d.nonfinite) printf("non-finite samples skipped: %zu\n", d.nonfinite);
         if (heat) printf("heat map: %s (white = %.4g relative difference)\n", heat, d.heat_scale);
+        if (by) {
+            printf("by %s:\n%12s %12s %10s %12s %12s\n", by, "from", "to", "pixels", "rel_rmse", "rel_bias");
+            for (int i = 0; i < bins.bins; i++)
+                printf("%12.4g %12.4g %10zu %12.5g %12.5g\n", bins.edges[i], bins.edges[i + 1], bins.count[i], bins.rel_rmse[i],
+                       bins.rel_bias[i]);
+        }
     }
     atmos_image_destroy(a);
     atmos_image_destroy(b);
     atmos_image_destroy(h);
+    atmos_image_destroy(key);
     atmos_context_destroy(ctx);
     return rc;
 }

@@ -37,18 +37,22 @@ static void help(void)
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
            "      --renderer sky|slice|path the analytic sky (default), Riley et al.'s half-angle slicing\n"
-           "                                over a volume (default when --volume is given), or spectral\n"
-           "                                Monte Carlo path tracing (the reference; docs/path.md)\n"
+           "                                over a volume (default when a volume is given), or spectral\n"
+           "                                Monte Carlo path tracing (the reference, docs/path.md)\n"
            "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
-           "      --volume-offset X,Y,Z     metres added to the volume's position (default: moved\n"
-           "                                horizontally to 3 widths, at least 4 km, in front of the camera)\n"
+           "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
+           "                                (default: 3 widths, at least 4 km, in front of the camera)\n"
            "      --density-scale S         multiplies the volume's densities\n"
-           "      --slices N --xi X         slicing planes (default 256); back-scatter term xi (sr^-1)\n"
+           "      --slices N --xi X         slicing planes (default 256); back-scatter term xi (sr^-1, 0 = none)\n"
+           "      --eq24                    exact light-buffer update (Riley Eq. 24) instead of Eq. 25\n"
+           "      --low-albedo              single scattering with the plain phase function (Riley Fig. 13)\n"
+           "      --tau FILE.pfm            also write the volume's optical depth along each pixel's ray\n"
+           "                                (middle wavelength of the set; a key for atmos compare --by)\n"
            "      --time-budget S           path: stop after the pass during which S seconds have passed\n"
-           "      --seed N                  path: random seed (default 1; same seed, same image)\n"
-           "      --variance FILE.exr       path: per-pixel variance of the mean (per wavelength, and of\n"
-           "                                the luminance Y in channel var_Y)\n"
+           "      --seed N                  path: random seed (default: the scene's, 1; same seed, same image)\n"
+           "      --variance FILE.exr       path: per-pixel variance of the mean (channels var_<nm>nm per\n"
+           "                                wavelength, then var_Y of the luminance)\n"
            "  -q, --quiet                   no progress bar or messages\n"
            "  -h, --help                    this help\n\n"
            "Examples:\n"
@@ -90,9 +94,44 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
-    O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VOFFSET,
-    O_DSCALE, O_TBUDGET, O_SEED, O_VARIANCE
+    O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VPOS,
+    O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE
 };
+
+/* The volume's optical depth along each pixel's ray at the middle wavelength of the
+ * set, as a 1-channel PFM (the optics come from the cache the render just filled). */
+static atmos_status write_tau(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
+                              const double offset[3], const char *path)
+{
+    atmos_slice_optics o;
+    atmos_status st = atmos_slice_optics_build(ctx, scene, vol, &o);
+    if (st != ATMOS_OK) return st;
+    double sigma[ATMOS_VOLUME_MAX_FIELDS] = {0};
+    for (int f = 0; f < o.count; f++) {
+        int k = atmos_phase_table_wavelength_count(o.phase[f]) / 2;
+        sigma[f] = atmos_phase_table_sigma_ext(o.phase[f], k) * scene->volume.density_scale;
+    }
+    atmos_slice_optics_free(&o);
+    atmos_image *img = NULL;
+    if ((st = atmos_volume_optical_depth_image(ctx, scene, vol, sigma, offset, &img)) != ATMOS_OK) return st;
+    st = atmos_write_pfm(ctx, img, path);
+    atmos_image_destroy(img);
+    return st;
+}
+
+/* The slice renderer's settings from a scene (the scene's xi 0 means "none"). */
+static void slice_settings(const atmos_scene *s, const double offset[3], atmos_slice_settings *ss)
+{
+    atmos_slice_defaults(ss);
+    ss->slices = s->slice.slices;
+    ss->light_size = s->slice.light_size;
+    ss->xi = s->slice.xi > 0 ? s->slice.xi : -1.0;
+    ss->update = s->slice.eq24 ? ATMOS_SLICE_EQ24 : ATMOS_SLICE_EQ25;
+    ss->low_albedo = s->slice.low_albedo;
+    ss->grid_max_dim = s->slice.grid_max_dim;
+    ss->density_scale = s->volume.density_scale;
+    for (int k = 0; k < 3; k++) ss->offset_m[k] = offset[k];
+}
 
 int cli_cmd_render(int argc, char **argv)
 {
@@ -110,7 +149,9 @@ int cli_cmd_render(int argc, char **argv)
         {"threads", required_argument, 0, O_THREADS}, {"quiet", no_argument, 0, 'q'},
         {"renderer", required_argument, 0, O_RENDERER}, {"volume", required_argument, 0, O_VOLUME},
         {"slices", required_argument, 0, O_SLICES}, {"xi", required_argument, 0, O_XI},
-        {"volume-offset", required_argument, 0, O_VOFFSET}, {"density-scale", required_argument, 0, O_DSCALE},
+        {"volume-position", required_argument, 0, O_VPOS}, {"density-scale", required_argument, 0, O_DSCALE},
+        {"eq24", no_argument, 0, O_EQ24}, {"low-albedo", no_argument, 0, O_LOWALB},
+        {"tau", required_argument, 0, O_TAU},
         {"time-budget", required_argument, 0, O_TBUDGET}, {"seed", required_argument, 0, O_SEED},
         {"variance", required_argument, 0, O_VARIANCE},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
@@ -123,16 +164,15 @@ int cli_cmd_render(int argc, char **argv)
     int w = 0, h = 0, spp = 0, png_bits = 0, exr_half = 0, spectral = 0, rgb = 0, cam_type = -1;
     double alt = NAN, sel = NAN, saz = NAN, ev = NAN, evcomp = NAN;
     int exposure_auto = 0, tone = -1;
-    /* The half-angle slicing renderer (Riley et al. 2004 §4.2-§5) over a volume file or
-     * generator; scene files do not describe volumes yet. */
-    int use_slice = -1, slices = 0;
-    const char *volume_arg = NULL;
-    double xi = NAN, dscale = 0, voff[3] = {0, 0, 0};
-    int voff_given = 0;
-    /* The path tracer (path.h): --renderer path, --time-budget, --seed, --variance. */
-    int use_path = 0;
+    /* Volume renderers: these override the scene's "renderer", "volume" and "slice". */
+    int renderer = -1, slices = 0, eq24 = 0, low_albedo = 0;
+    const char *volume_arg = NULL, *tau_path = NULL;
+    double xi = NAN, dscale = 0, vpos[3] = {0, 0, 0};
+    int vpos_given = 0;
+    /* The path tracer (path.h): these override the scene's "path". */
     double tbudget = 0;
     unsigned long long seed = 0;
+    int seed_given = 0;
     const char *variance_out = NULL;
     atmos_image *var_img = NULL;
     atmos_path_stats pstats;
@@ -179,33 +219,42 @@ int cli_cmd_render(int argc, char **argv)
             break;
         case O_THREADS: if (!cli_parse_int(C, "--threads", optarg, 1, 1024, &threads)) return CLI_EXIT_USAGE; break;
         case O_RENDERER:
-            use_path = 0;
-            if (!strcmp(optarg, "sky")) use_slice = 0;
-            else if (!strcmp(optarg, "slice")) use_slice = 1;
-            else if (!strcmp(optarg, "path")) use_slice = 0, use_path = 1;
+            if (!strcmp(optarg, "sky")) renderer = ATMOS_RENDERER_SKY;
+            else if (!strcmp(optarg, "slice")) renderer = ATMOS_RENDERER_SLICE;
+            else if (!strcmp(optarg, "path")) renderer = ATMOS_RENDERER_PATH;
             else return cli_usage_error(C, "--renderer: expected sky, slice or path, got '%s'", optarg);
             break;
         case O_VOLUME: volume_arg = optarg; break;
         case O_SLICES: if (!cli_parse_int(C, "--slices", optarg, 1, 8192, &slices)) return CLI_EXIT_USAGE; break;
-        case O_XI: if (!cli_parse_double(C, "--xi", optarg, &xi)) return CLI_EXIT_USAGE; break;
+        case O_XI:
+            if (!cli_parse_double(C, "--xi", optarg, &xi) || !(xi >= 0 && xi <= 100))
+                return cli_usage_error(C, "--xi: expected a value in [0, 100] sr^-1 (0 = no back-scatter term)");
+            break;
+        case O_EQ24: eq24 = 1; break;
+        case O_TAU: tau_path = optarg; break;
+        case O_LOWALB: low_albedo = 1; break;
         case O_DSCALE:
             if (!cli_parse_double(C, "--density-scale", optarg, &dscale) || !(dscale > 0))
                 return cli_usage_error(C, "--density-scale: expected a factor > 0");
             break;
-        case O_VOFFSET:
-            if (sscanf(optarg, "%lf,%lf,%lf", &voff[0], &voff[1], &voff[2]) != 3 || !isfinite(voff[0]) ||
-                !isfinite(voff[1]) || !isfinite(voff[2]))
-                return cli_usage_error(C, "--volume-offset: expected X,Y,Z in metres, got '%s'", optarg);
-            voff_given = 1;
+        case O_VPOS: {
+            char tail;
+            if (sscanf(optarg, "%lf,%lf,%lf%c", &vpos[0], &vpos[1], &vpos[2], &tail) != 3 || !isfinite(vpos[0]) ||
+                !isfinite(vpos[1]) || !isfinite(vpos[2]))
+                return cli_usage_error(C, "--volume-position: expected X,Y,Z in metres, got '%s'", optarg);
+            vpos_given = 1;
             break;
+        }
         case O_TBUDGET:
-            if (!cli_parse_double(C, "--time-budget", optarg, &tbudget) || !(tbudget > 0))
+            if (!cli_parse_double(C, "--time-budget", optarg, &tbudget) || !(tbudget > 0) || !isfinite(tbudget))
                 return cli_usage_error(C, "--time-budget: expected seconds > 0");
             break;
         case O_SEED: {
             char *end = NULL;
             seed = strtoull(optarg, &end, 10);
-            if (!*optarg || *end || optarg[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", optarg);
+            if (!*optarg || *end || optarg[0] == '-')
+                return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", optarg);
+            seed_given = 1;
             break;
         }
         case O_VARIANCE: variance_out = optarg; break;
@@ -224,14 +273,12 @@ int cli_cmd_render(int argc, char **argv)
     if (use_time && (!isnan(sel) || !isnan(saz)))
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
-    if (use_slice < 0) use_slice = volume_arg != NULL && !use_path;
-    if (use_slice && !volume_arg) return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
-    if (!use_slice && !use_path && (volume_arg || slices || !isnan(xi) || dscale > 0))
-        return cli_usage_error(C, "--volume, --slices, --xi and --density-scale go with --renderer slice or path");
-    if (use_path && (slices || !isnan(xi))) return cli_usage_error(C, "--slices and --xi go with --renderer slice");
-    if (!use_path && (tbudget > 0 || seed || variance_out))
-        return cli_usage_error(C, "--time-budget, --seed and --variance go with --renderer path");
-    if (!use_path && spp > 256) return cli_usage_error(C, "--spp: must be in [1, 256] for this renderer, got %d", spp);
+    if (renderer == ATMOS_RENDERER_SKY &&
+        (volume_arg || slices || !isnan(xi) || dscale > 0 || vpos_given || eq24 || low_albedo || tau_path))
+        return cli_usage_error(C, "--volume, --volume-position, --density-scale, --slices, --xi, --eq24, --low-albedo "
+                                  "and --tau go with a volume renderer, not --renderer sky");
+    if (volume_arg && strlen(volume_arg) >= sizeof(((atmos_scene *)0)->volume.source))
+        return cli_usage_error(C, "--volume: the path is too long");
 
     cli_progress prog;
     cli_progress_init(&prog, quiet);
@@ -248,7 +295,6 @@ int cli_cmd_render(int argc, char **argv)
     }
     if (w) scene.width = w;
     if (h) scene.height = h;
-    if (spp && !use_path) scene.samples_per_pixel = spp;
     if (png_bits) scene.png_bits = png_bits;
     if (exr_half) scene.exr_half = 1;
     if (cam_type >= 0 && cam_type != (int)scene.camera.type) {
@@ -294,6 +340,39 @@ int cli_cmd_render(int argc, char **argv)
         scene.tonemap.exposure_ev = evcomp;
     }
     if (tone >= 0) scene.tonemap.curve = (atmos_tone_curve)tone;
+    if (volume_arg) {
+        snprintf(scene.volume.source, sizeof scene.volume.source, "%s", volume_arg);
+        if (scene.renderer == ATMOS_RENDERER_SKY) scene.renderer = ATMOS_RENDERER_SLICE;
+    }
+    if (renderer >= 0) scene.renderer = (atmos_renderer_kind)renderer;
+    if (scene.renderer == ATMOS_RENDERER_PATH) {
+        if (spp) scene.path.spp = spp;
+        if (tbudget > 0) scene.path.time_budget_s = tbudget;
+        if (seed_given) scene.path.seed = seed;
+    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out) {
+        atmos_context_destroy(ctx);
+        return cli_usage_error(C, spp > 256 ? "--spp: must be in [1, 256] for this renderer (1..1000000 with --renderer path)"
+                                            : "--time-budget, --seed and --variance go with --renderer path");
+    } else if (spp) {
+        scene.samples_per_pixel = spp;
+    }
+    if (vpos_given) {
+        scene.volume.placed = 1;
+        memcpy(scene.volume.position_m, vpos, sizeof vpos);
+    }
+    if (dscale > 0) scene.volume.density_scale = dscale;
+    if (slices) scene.slice.slices = slices;
+    if (!isnan(xi)) scene.slice.xi = xi;
+    if (eq24) scene.slice.eq24 = 1;
+    if (low_albedo) scene.slice.low_albedo = 1;
+    if (tau_path && scene.renderer == ATMOS_RENDERER_SKY) {
+        atmos_context_destroy(ctx);
+        return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
+    }
+    if (!scene_path && scene.renderer == ATMOS_RENDERER_SLICE && !scene.volume.source[0]) {
+        atmos_context_destroy(ctx);
+        return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
+    }
     if ((st = atmos_scene_validate(ctx, &scene, scene_path ? scene_path : "options")) != ATMOS_OK) {
         fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
         atmos_context_destroy(ctx);
@@ -310,60 +389,31 @@ int cli_cmd_render(int argc, char **argv)
     atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     atmos_render_info info;
     atmos_wavelengths wl;
-    if (use_slice || (use_path && volume_arg)) {
+    if (scene.renderer == ATMOS_RENDERER_SLICE) {
         atmos_volume *vol = NULL;
-        if (!strncmp(volume_arg, "generate:", 9)) {
-            atmos_volume_generate_desc gd;
-            memset(&gd, 0, sizeof gd);
-            gd.seed = 1;
-            st = atmos_volume_generate(ctx, volume_arg + 9, &gd, &vol);
-        } else {
-            st = atmos_volume_load(ctx, volume_arg, NULL, &vol);
-        }
-        if (st != ATMOS_OK) goto fail;
+        double offset[3];
+        if ((st = atmos_volume_load_scene(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
         atmos_slice_settings ss;
-        atmos_slice_defaults(&ss);
-        if (slices) ss.slices = slices;
-        if (!isnan(xi)) ss.xi = xi;
-        if (dscale > 0) ss.density_scale = dscale;
-        memcpy(ss.offset_m, voff, sizeof voff);
-        if (!voff_given) {
-            /* Default placement: the volume's centre moved horizontally to three of its
-             * widths (at least 4 km) in front of the camera, at its own altitude. */
-            double lo[3], hi[3], f[3];
-            atmos_volume_bounds(vol, lo, hi);
-            for (int k = 0; k < 3; k++) f[k] = scene.camera.look_at[k] - scene.camera.position[k];
-            double fh = sqrt(f[0] * f[0] + f[2] * f[2]);
-            if (!(fh > 1e-9)) f[0] = 0, f[2] = -1, fh = 1; /* looking straight up or down: north */
-            double width = fmax(hi[0] - lo[0], hi[2] - lo[2]), dist = fmax(3.0 * width, 4000.0);
-            ss.offset_m[0] = scene.camera.position[0] + f[0] / fh * dist - 0.5 * (lo[0] + hi[0]);
-            ss.offset_m[2] = scene.camera.position[2] + f[2] / fh * dist - 0.5 * (lo[2] + hi[2]);
-        }
-        if (use_path) {
-            atmos_path_settings ps;
-            memset(&ps, 0, sizeof ps);
-            ps.spp = spp;
-            ps.time_budget_s = tbudget;
-            ps.seed = seed;
-            ps.density_scale = ss.density_scale;
-            memcpy(ps.offset_m, ss.offset_m, sizeof ps.offset_m);
-            ps.variance = variance_out ? &var_img : NULL;
-            ps.stats = &pstats;
-            st = atmos_render_path(ctx, &scene, vol, &ps, &spec, &info);
-        } else {
-            st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
-        }
+        slice_settings(&scene, offset, &ss);
+        st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
+        if (st == ATMOS_OK && tau_path) st = write_tau(ctx, &scene, vol, offset, tau_path);
         atmos_volume_destroy(vol);
         if (st != ATMOS_OK) goto fail;
-    } else if (use_path) {
+    } else if (scene.renderer == ATMOS_RENDERER_PATH) {
+        /* The volume is optional: without one the path tracer renders the sky and the ground. */
+        atmos_volume *vol = NULL;
+        double offset[3] = {0, 0, 0};
+        if (scene.volume.source[0] && (st = atmos_volume_load_scene(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
         atmos_path_settings ps;
-        memset(&ps, 0, sizeof ps);
-        ps.spp = spp;
-        ps.time_budget_s = tbudget;
-        ps.seed = seed;
+        memset(&ps, 0, sizeof ps); /* zero: the scene's "path" settings */
+        ps.density_scale = scene.volume.density_scale;
+        memcpy(ps.offset_m, offset, sizeof offset);
         ps.variance = variance_out ? &var_img : NULL;
         ps.stats = &pstats;
-        if ((st = atmos_render_path(ctx, &scene, NULL, &ps, &spec, &info)) != ATMOS_OK) goto fail;
+        st = atmos_render_path(ctx, &scene, vol, &ps, &spec, &info);
+        if (st == ATMOS_OK && tau_path && vol) st = write_tau(ctx, &scene, vol, offset, tau_path);
+        atmos_volume_destroy(vol);
+        if (st != ATMOS_OK) goto fail;
     } else if ((st = atmos_render_sky(ctx, &scene, &spec, &info)) != ATMOS_OK) {
         goto fail;
     }
@@ -376,7 +426,6 @@ int cli_cmd_render(int argc, char **argv)
     }
     if (pfm && (st = atmos_write_pfm(ctx, lin, pfm)) != ATMOS_OK) goto fail;
     if (var_img && variance_out) {
-        /* channels: var_<nm>nm per wavelength, then var_Y */
         static char names[ATMOS_MAX_WAVELENGTHS + 1][24];
         const char *np[ATMOS_MAX_WAVELENGTHS + 1];
         for (int k = 0; k < wl.count; k++) {
@@ -402,10 +451,10 @@ int cli_cmd_render(int argc, char **argv)
         if (png) fprintf(stderr, "  wrote %s\n", png);
         if (exr) fprintf(stderr, "  wrote %s\n", exr);
         if (pfm) fprintf(stderr, "  wrote %s\n", pfm);
-        if (use_path)
+        if (var_img && variance_out) fprintf(stderr, "  wrote %s\n", variance_out);
+        if (scene.renderer == ATMOS_RENDERER_PATH)
             fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", pstats.spp,
                     pstats.events, 100.0 * pstats.mean_rel_error);
-        if (var_img && variance_out) fprintf(stderr, "  wrote %s\n", variance_out);
     }
     atmos_image_destroy(var_img);
     atmos_image_destroy(spec);

@@ -192,6 +192,7 @@ static int cmd_generate(int argc, char **argv)
             return CLI_EXIT_OK;
         } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
             out = argv[++i];
+            if (!*out) return cli_usage_error(C, "-o: expected a file name");
         } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
             char *end = NULL;
             const char *t = argv[++i];
@@ -245,6 +246,7 @@ static int cmd_slice(int argc, char **argv)
             if (lo < 0) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
             out = argv[++i];
+            if (!*out) return cli_usage_error(C, "-o: expected a file name");
         } else if (!strcmp(argv[i], "--field") && i + 1 < argc) {
             field = argv[++i];
         } else if (!strcmp(argv[i], "--axis") && i + 1 < argc) {
