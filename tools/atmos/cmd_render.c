@@ -287,6 +287,8 @@ int cli_cmd_render(int argc, char **argv)
 
     atmos_scene scene;
     atmos_status st;
+    /* Before any goto fail: the failure path destroys these. */
+    atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     const char *source = scene_path ? scene_path : "default scene";
     if (scene_path) {
         if ((st = atmos_scene_load(ctx, scene_path, &scene)) != ATMOS_OK) goto fail;
@@ -386,7 +388,6 @@ int cli_cmd_render(int argc, char **argv)
     }
 
     protect_outputs(png, exr, pfm);
-    atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     atmos_render_info info;
     atmos_wavelengths wl;
     if (scene.renderer == ATMOS_RENDERER_SLICE) {
