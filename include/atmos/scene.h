@@ -12,6 +12,7 @@ extern "C" {
 
 #define ATMOS_SCENE_MAX_DIM 16384
 #define ATMOS_SCENE_MAX_PARTICLES 8
+#define ATMOS_SCENE_MAX_FRAMES 100000
 
 typedef struct atmos_scene_sun {
     int from_time;             /* 0: use elevation/azimuth; 1: compute from time/latitude/longitude */
@@ -80,6 +81,21 @@ typedef struct atmos_scene_path {
     int max_depth;            /* scattering events per path; 0 = unlimited (Russian roulette) */
 } atmos_scene_path;
 
+/* A sequence of images with the sun moving ("animation" in the file): frame i of N
+ * (0-based) takes the sun at fraction i / (N - 1) of the way from the scene's sun to the
+ * end given here (atmos_scene_animation_frame). With a sun given by time, the time is
+ * interpolated linearly (and the solar position computed for each frame); with a sun
+ * given by angles, the elevation linearly and the azimuth along the shorter arc. */
+typedef struct atmos_scene_animation {
+    int frames;                /* images in the sequence; 0 = a single image (no animation) */
+    int time_end_set;          /* 1: time_end given (a sun given by time) */
+    atmos_utc_time time_end;   /* the last frame's time */
+    int elevation_end_set;     /* 1: elevation_end_deg given (a sun given by angles) */
+    double elevation_end_deg;  /* the last frame's sun elevation, [-90, 90] */
+    int azimuth_end_set;       /* 1: azimuth_end_deg given (a sun given by angles) */
+    double azimuth_end_deg;    /* the last frame's sun azimuth, [0, 360) */
+} atmos_scene_animation;
+
 typedef struct atmos_scene {
     char name[128];
     int width, height;                    /* pixels, 1..ATMOS_SCENE_MAX_DIM */
@@ -100,6 +116,7 @@ typedef struct atmos_scene {
     atmos_scene_volume volume;
     atmos_scene_slice slice;
     atmos_scene_path path;
+    atmos_scene_animation animation;
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
@@ -123,6 +140,13 @@ ATMOS_API atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scen
  * ATMOS_E_INVALID_ARG listing both kinds of names if neither exists. */
 ATMOS_API atmos_status atmos_scene_particle(atmos_context *ctx, const atmos_scene *scene, const char *name,
                                             atmos_particle_desc *out);
+
+/* Frame index (0-based, < the frame count) of the scene's animation: *out is the scene
+ * with the sun moved as atmos_scene_animation describes and no animation left in it.
+ * A scene without an animation has one frame, itself. ATMOS_E_INVALID_ARG for an index
+ * out of range or an animation that does not match the sun (checked as the parser does). */
+ATMOS_API atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *scene, int index,
+                                                   atmos_scene *out);
 
 /* The sun's direction (unit vector towards the sun), elevation and azimuth for
  * a scene, computing the solar position when the scene gives a time. */

@@ -58,6 +58,11 @@ atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
 atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *scene);
 atmos_status atmos__scene_validate_output(atmos_context *ctx, const char *source,
                                           const atmos_scene *scene);
+/* The animation section and its match with the sun (time_end with a sun given by time,
+ * elevation/azimuth ends with a sun given by angles). */
+atmos_status atmos__scene_validate_animation(atmos_context *ctx, const char *source, const atmos_scene *scene);
+/* 1 if t is a real UTC date-time (years 1..9999, a leap second allowed). */
+int atmos__scene_valid_time(const atmos_utc_time *t);
 
 /* Fills scene from a parsed JSON document (root), which must be an object. scene
  * holds the starting values (the defaults); absent keys keep them. */

@@ -948,16 +948,57 @@ static atmos_status parse_path(const jp *p, const cJSON *j, const char *path, at
     }
 }
 
+/* "animation": {"frames": N, "time_end": T} or {"frames": N, "elevation_end_deg": E,
+ * "azimuth_end_deg": A}; whether the end matches the sun is checked once the whole file
+ * is read (the sun may come later). */
+static atmos_status parse_animation(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"frames", "time_end", "elevation_end_deg", "azimuth_end_deg"};
+    static const atmos__range r_frames = {1, ATMOS_SCENE_MAX_FRAMES, 0, 0};
+    atmos_scene_animation a;
+    memset(&a, 0, sizeof a);
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    const char *text = NULL;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 4, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        switch (k) {
+        case 0: TRY(get_int(p, v, ip, &r_frames, &a.frames)); break;
+        case 1:
+            TRY(get_string(p, v, ip, &text));
+            TRY(parse_time(p, text, ip, &a.time_end));
+            a.time_end_set = 1;
+            break;
+        case 2:
+            TRY(get_number(p, v, ip, &atmos__r_elevation, NULL, &a.elevation_end_deg));
+            a.elevation_end_set = 1;
+            break;
+        case 3:
+            TRY(get_number(p, v, ip, &atmos__r_azimuth, NULL, &a.azimuth_end_deg));
+            a.azimuth_end_set = 1;
+            break;
+        }
+    }
+    if (!(it.seen & 1u))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "missing key \"frames\"");
+    s->animation = a;
+    return ATMOS_OK;
+}
+
 atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, const cJSON *root,
                                     atmos_scene *s)
 {
     static const char *const keys[] = {"name", "image", "camera", "sun", "atmosphere", "wavelengths",
                                        "output", "renderer", "particles", "background", "volume", "slice",
-                                       "path"};
+                                       "path", "animation"};
     static const char *const renderers[] = {"sky", "slice", "path"};
     enum {
         K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER, K_PARTICLES,
-        K_BACKGROUND, K_VOLUME, K_SLICE, K_PATH
+        K_BACKGROUND, K_VOLUME, K_SLICE, K_PATH, K_ANIMATION
     };
     jp p = {ctx, source};
     obj_iter it;
@@ -966,13 +1007,14 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
     const char *name = NULL;
     int k, renderer;
     if (!cJSON_IsObject(root)) return type_error(&p, "/", "an object", root);
-    TRY(iter_begin(&p, root, "", keys, 13, &it));
+    TRY(iter_begin(&p, root, "", keys, 14, &it));
     for (;;) {
         TRY(iter_next(&p, &it, &k, &v, ip));
         if (k < 0) {
             /* A volume without a renderer named is drawn by the slice renderer. */
             if ((it.seen & (1u << K_VOLUME)) && !(it.seen & (1u << K_RENDERER))) s->renderer = ATMOS_RENDERER_SLICE;
-            return atmos__scene_validate_renderer(ctx, source, s);
+            TRY(atmos__scene_validate_renderer(ctx, source, s));
+            return atmos__scene_validate_animation(ctx, source, s);
         }
         switch (k) {
         case K_NAME:
@@ -998,6 +1040,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_VOLUME: TRY(parse_volume(&p, v, ip, s)); break;
         case K_SLICE: TRY(parse_slice(&p, v, ip, s)); break;
         case K_PATH: TRY(parse_path(&p, v, ip, s)); break;
+        case K_ANIMATION: TRY(parse_animation(&p, v, ip, s)); break;
         }
     }
 }

@@ -189,6 +189,14 @@ static int days_in_month(int year, int month)
     return month == 2 && leap ? 29 : days[month - 1];
 }
 
+int atmos__scene_valid_time(const atmos_utc_time *t)
+{
+    /* A leap second may give 60.x seconds. */
+    return !(t->year < 1 || t->year > 9999 || t->month < 1 || t->month > 12 || t->day < 1 ||
+             t->day > days_in_month(t->year, t->month) || t->hour < 0 || t->hour > 23 ||
+             t->minute < 0 || t->minute > 59 || !(t->second >= 0 && t->second < 61));
+}
+
 atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
                                        const atmos_scene_sun *sun)
 {
@@ -201,10 +209,7 @@ atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
                                         &atmos__r_azimuth, NULL);
     }
     const atmos_utc_time *t = &sun->time;
-    /* A leap second may give 60.x seconds. */
-    if (t->year < 1 || t->year > 9999 || t->month < 1 || t->month > 12 || t->day < 1 ||
-        t->day > days_in_month(t->year, t->month) || t->hour < 0 || t->hour > 23 ||
-        t->minute < 0 || t->minute > 59 || !(t->second >= 0 && t->second < 61))
+    if (!atmos__scene_valid_time(t))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/sun/time",
                                  "not a valid UTC date-time (%04d-%02d-%02dT%02d:%02d:%06.3f)",
                                  t->year, t->month, t->day, t->hour, t->minute,
@@ -344,6 +349,40 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     return ATMOS_OK;
 }
 
+atmos_status atmos__scene_validate_animation(atmos_context *ctx, const char *source, const atmos_scene *scene)
+{
+    static const atmos__range r_frames = {0, ATMOS_SCENE_MAX_FRAMES, 0, 0};
+    const atmos_scene_animation *a = &scene->animation;
+    atmos_status st;
+    if ((st = atmos__scene_check_range(ctx, source, "/animation/frames", a->frames, &r_frames, NULL))) return st;
+    int angle_end = a->elevation_end_set || a->azimuth_end_set;
+    if (a->time_end_set) {
+        if (!scene->sun.from_time)
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/time_end",
+                                     "needs a sun given by time (\"sun\": {\"time\", \"latitude_deg\", "
+                                     "\"longitude_deg\"}); a sun given by angles moves with elevation_end_deg/azimuth_end_deg");
+        if (!atmos__scene_valid_time(&a->time_end))
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/time_end", "not a valid UTC date-time");
+    }
+    if (angle_end && scene->sun.from_time)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source,
+                                 a->elevation_end_set ? "/animation/elevation_end_deg" : "/animation/azimuth_end_deg",
+                                 "needs a sun given by angles; a sun given by time moves with time_end");
+    if (a->elevation_end_set &&
+        (st = atmos__scene_check_range(ctx, source, "/animation/elevation_end_deg", a->elevation_end_deg,
+                                       &atmos__r_elevation, NULL)))
+        return st;
+    if (a->azimuth_end_set &&
+        (st = atmos__scene_check_range(ctx, source, "/animation/azimuth_end_deg", a->azimuth_end_deg,
+                                       &atmos__r_azimuth, NULL)))
+        return st;
+    if (a->frames > 1 && !a->time_end_set && !angle_end)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation",
+                                 "%d frames need an end: time_end (a sun given by time) or elevation_end_deg/"
+                                 "azimuth_end_deg (a sun given by angles)", a->frames);
+    return ATMOS_OK;
+}
+
 atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, const char *source)
 {
     if (!scene) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_validate: scene is NULL");
@@ -364,5 +403,6 @@ atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, 
                                        &atmos__r_samples, NULL)))
         return st;
     if ((st = atmos__scene_validate_renderer(ctx, source, scene))) return st;
+    if ((st = atmos__scene_validate_animation(ctx, source, scene))) return st;
     return atmos__scene_validate_output(ctx, source, scene);
 }

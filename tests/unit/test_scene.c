@@ -233,7 +233,7 @@ typedef struct bad_case {
 
 static const bad_case bad_cases[] = {
     /* structure and types */
-    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path)", NULL},
+    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path, animation)", NULL},
     {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
     {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
     {"{\"a/b~c\": 1}", ATMOS_E_INVALID_ARG, "/a~1b~0c: unknown key", NULL},
@@ -353,6 +353,19 @@ static const bad_case bad_cases[] = {
     {"{\"name\": \"nul \\u0000 escape\"}", ATMOS_E_FORMAT, "\\u0000 is not allowed", NULL},
     {"{\"_deep\": [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]}", ATMOS_E_LIMIT, "scene.json:1:", "nesting deeper than 64 levels"},
     {"\"just a string\"", ATMOS_E_INVALID_ARG, "/: expected an object, got a string", NULL},
+    /* animation */
+    {"{\"animation\": {\"time_end\": \"2026-06-21T12:00:00Z\"}}", ATMOS_E_INVALID_ARG, "/animation: missing key \"frames\"", NULL},
+    {"{\"animation\": {\"frames\": 0, \"elevation_end_deg\": 3}}", ATMOS_E_INVALID_ARG, "/animation/frames: must be in [1, 100000], got 0", NULL},
+    {"{\"animation\": {\"frames\": 4, \"fps\": 24}}", ATMOS_E_INVALID_ARG, "/animation/fps: unknown key", "time_end"},
+    {"{\"animation\": {\"frames\": 4}}", ATMOS_E_INVALID_ARG, "/animation: 4 frames need an end", NULL},
+    {"{\"animation\": {\"frames\": 4, \"time_end\": \"2026-06-21T12:00:00Z\"}}", ATMOS_E_INVALID_ARG,
+     "/animation/time_end: needs a sun given by time", NULL},
+    {"{\"animation\": {\"frames\": 4, \"time_end\": \"2026-02-30T12:00:00Z\"}, \"sun\": {\"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105}}",
+     ATMOS_E_INVALID_ARG, "/animation/time_end:", NULL},
+    {"{\"sun\": {\"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105}, \"animation\": {\"frames\": 4, \"elevation_end_deg\": 3}}",
+     ATMOS_E_INVALID_ARG, "/animation/elevation_end_deg: needs a sun given by angles", NULL},
+    {"{\"animation\": {\"frames\": 4, \"azimuth_end_deg\": 360}}", ATMOS_E_INVALID_ARG, "/animation/azimuth_end_deg: must be in [0, 360)", NULL},
+    {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": -91}}", ATMOS_E_INVALID_ARG, "/animation/elevation_end_deg: must be in [-90, 90]", NULL},
     {"{\"image\": {\"width\": 10}} \x01", ATMOS_E_FORMAT, "control character", NULL},
 };
 
@@ -555,6 +568,69 @@ static void test_sun_direction(void)
     CHECK(atmos_scene_sun_direction(ctx, NULL, dir, NULL, NULL) == ATMOS_E_INVALID_ARG);
 }
 
+/* "animation": frames interpolate the sun between the scene's and the end. */
+static void test_animation(void)
+{
+    atmos_scene s, f;
+    /* Time: 5 frames from 23:00 to 01:00 the next day (across midnight and a month end). */
+    CHECK_OK(parse("{\"sun\": {\"time\": \"2026-06-30T23:00:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105},"
+                   " \"animation\": {\"frames\": 5, \"time_end\": \"2026-07-01T01:00:00Z\"}}", &s));
+    CHECK(s.animation.frames == 5 && s.animation.time_end_set && !s.animation.elevation_end_set);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 0, &f));
+    CHECK(f.sun.time.day == 30 && f.sun.time.hour == 23 && f.sun.time.minute == 0 && f.animation.frames == 0);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 1, &f));
+    CHECK(f.sun.time.month == 6 && f.sun.time.day == 30 && f.sun.time.hour == 23 && f.sun.time.minute == 30);
+    CHECK_NEAR(f.sun.time.second, 0, 1e-4);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 2, &f));
+    CHECK(f.sun.time.year == 2026 && f.sun.time.month == 7 && f.sun.time.day == 1 && f.sun.time.hour == 0 &&
+          f.sun.time.minute == 0);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 4, &f));
+    CHECK(f.sun.time.month == 7 && f.sun.time.day == 1 && f.sun.time.hour == 1 && f.sun.time.minute == 0 &&
+          f.sun.time.second == 0);
+    CHECK_OK(atmos_scene_validate(ctx, &f, "frame"));
+    CHECK(atmos_scene_animation_frame(ctx, &s, 5, &f) == ATMOS_E_INVALID_ARG);
+    CHECK(atmos_scene_animation_frame(ctx, &s, -1, &f) == ATMOS_E_INVALID_ARG);
+    /* Across a year end, backwards in time. */
+    CHECK_OK(parse("{\"sun\": {\"time\": \"2027-01-01T00:30:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105},"
+                   " \"animation\": {\"frames\": 2, \"time_end\": \"2026-12-31T23:30:00Z\"}}", &s));
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 1, &f));
+    CHECK(f.sun.time.year == 2026 && f.sun.time.month == 12 && f.sun.time.day == 31 && f.sun.time.hour == 23 &&
+          f.sun.time.minute == 30);
+    /* Angles: elevation linearly, azimuth the shorter way (350 -> 30 passes north). */
+    CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 10, \"azimuth_deg\": 350},"
+                   " \"animation\": {\"frames\": 5, \"elevation_end_deg\": -2, \"azimuth_end_deg\": 30}}", &s));
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 1, &f));
+    CHECK_NEAR(f.sun.elevation_deg, 7, 1e-12);
+    CHECK_NEAR(f.sun.azimuth_deg, 0, 1e-9);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 2, &f));
+    CHECK_NEAR(f.sun.azimuth_deg, 10, 1e-9);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 4, &f));
+    CHECK_NEAR(f.sun.elevation_deg, -2, 1e-12);
+    CHECK_NEAR(f.sun.azimuth_deg, 30, 1e-9);
+    /* Only the elevation moves when only it is given. */
+    CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 10, \"azimuth_deg\": 100}, \"animation\": {\"frames\": 3, \"elevation_end_deg\": 0}}", &s));
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 1, &f));
+    CHECK(f.sun.elevation_deg == 5 && f.sun.azimuth_deg == 100);
+    /* No animation: one frame, the scene itself. */
+    atmos_scene_defaults(&s);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 0, &f));
+    CHECK(memcmp(&s, &f, sizeof s) == 0);
+    CHECK(atmos_scene_animation_frame(ctx, &s, 1, &f) == ATMOS_E_INVALID_ARG);
+    /* A one-frame animation needs no end. */
+    CHECK_OK(parse("{\"animation\": {\"frames\": 1}}", &s));
+    /* Validation of scenes changed in code. */
+    atmos_scene_defaults(&s);
+    s.animation.frames = 3;
+    CHECK(atmos_scene_validate(ctx, &s, "code") == ATMOS_E_INVALID_ARG);
+    CHECK(contains(atmos_context_error(ctx), "code: /animation: 3 frames need an end"));
+    s.animation.time_end_set = 1;
+    CHECK(atmos_scene_validate(ctx, &s, "code") == ATMOS_E_INVALID_ARG);
+    CHECK(contains(atmos_context_error(ctx), "/animation/time_end: needs a sun given by time"));
+    s.animation.time_end_set = 0;
+    s.animation.frames = ATMOS_SCENE_MAX_FRAMES + 1;
+    CHECK(atmos_scene_validate(ctx, &s, "code") == ATMOS_E_INVALID_ARG);
+}
+
 /* Every malformed file kept in tests/crashers/scene must be refused (the replay
  * test only shows they do not crash). */
 static void test_crashers(void)
@@ -597,6 +673,7 @@ int main(void)
     test_validate();
     test_load();
     test_sun_direction();
+    test_animation();
     test_crashers();
     atmos_context_destroy(ctx);
     return test_summary("test_scene");

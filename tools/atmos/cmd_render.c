@@ -52,13 +52,22 @@ static void help(void)
            "      --time-budget S           path: stop after the pass during which S seconds have passed\n"
            "      --seed N                  path: random seed (default: the scene's, 1; same seed, same image)\n"
            "      --variance FILE.exr       path: per-pixel variance of the mean (channels var_<nm>nm per\n"
-           "                                wavelength, then var_Y of the luminance)\n"
+           "                                wavelength, then var_Y of the luminance)\n\n"
+           "Animation (the sun moves; the volume and its optics tables are prepared once):\n"
+           "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
+           "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
+           "                                out/sky_0001.png ...; --frames 1: the first frame, as named\n"
+           "      --time-end T              the last frame's UTC time (a sun given by time); frames are\n"
+           "                                spaced evenly in time from the scene's (or --time's) time\n"
+           "      --sun-elevation-end E     the last frame's sun elevation (a sun given by angles)\n"
+           "      --sun-azimuth-end A       the last frame's sun azimuth (the shorter way round)\n"
            "  -q, --quiet                   no progress bar or messages\n"
            "  -h, --help                    this help\n\n"
            "Examples:\n"
            "  atmos render -o sky.png --exr sky.exr\n"
            "  atmos render scenes/sunset_fisheye.json --spectral 32 -o sunset.png\n"
-           "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n");
+           "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n"
+           "  atmos render scenes/fig01_cirrus_sunrise.json --frames 8 --time-end 2026-06-21T12:30:00Z -o out/cirrus.png\n");
 }
 
 /* Temporary names of the outputs (atmos__write_atomic writes PATH.tmpPID): on SIGINT or
@@ -75,10 +84,22 @@ static void on_signal(int sig)
 static void protect_outputs(const char *png, const char *exr, const char *pfm)
 {
     const char *outs[3] = {png, exr, pfm};
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < 3; i++) {
+        tmp_names[i][0] = '\0';
         if (outs[i]) snprintf(tmp_names[i], sizeof tmp_names[i], "%s.tmp%ld", outs[i], (long)getpid());
+    }
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
+}
+
+/* The name of frame `frame` (1-based) of an animation: "_0001" before the extension of
+ * the file name (out/sky.png -> out/sky_0001.png; no extension: appended). digits >= 4. */
+static int frame_name(const char *base, int frame, int digits, char *buf, size_t cap)
+{
+    const char *slash = strrchr(base, '/'), *dot = strrchr(base, '.');
+    size_t stem = dot && dot > (slash ? slash : base) && dot[1] ? (size_t)(dot - base) : strlen(base);
+    int n = snprintf(buf, cap, "%.*s_%0*d%s", (int)stem, base, digits, frame, base + stem);
+    return n > 0 && (size_t)n < cap;
 }
 
 static void default_png_name(const char *scene_name, char *buf, size_t cap)
@@ -95,7 +116,7 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
     O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VPOS,
-    O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE
+    O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE, O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END
 };
 
 /* The volume's optical depth along each pixel's ray at the middle wavelength of the
@@ -154,6 +175,8 @@ int cli_cmd_render(int argc, char **argv)
         {"tau", required_argument, 0, O_TAU},
         {"time-budget", required_argument, 0, O_TBUDGET}, {"seed", required_argument, 0, O_SEED},
         {"variance", required_argument, 0, O_VARIANCE},
+        {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
+        {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -177,6 +200,10 @@ int cli_cmd_render(int argc, char **argv)
     atmos_image *var_img = NULL;
     atmos_path_stats pstats;
     memset(&pstats, 0, sizeof pstats);
+    /* Animation. */
+    int frames = 0;
+    const char *time_end_s = NULL;
+    double sel_end = NAN, saz_end = NAN;
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
@@ -258,6 +285,10 @@ int cli_cmd_render(int argc, char **argv)
             break;
         }
         case O_VARIANCE: variance_out = optarg; break;
+        case O_FRAMES: if (!cli_parse_int(C, "--frames", optarg, 1, ATMOS_SCENE_MAX_FRAMES, &frames)) return CLI_EXIT_USAGE; break;
+        case O_TIME_END: time_end_s = optarg; break;
+        case O_SEL_END: if (!cli_parse_double(C, "--sun-elevation-end", optarg, &sel_end)) return CLI_EXIT_USAGE; break;
+        case O_SAZ_END: if (!cli_parse_double(C, "--sun-azimuth-end", optarg, &saz_end)) return CLI_EXIT_USAGE; break;
         case 'q': quiet = 1; break;
         case 'h': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
@@ -277,6 +308,9 @@ int cli_cmd_render(int argc, char **argv)
         (volume_arg || slices || !isnan(xi) || dscale > 0 || vpos_given || eq24 || low_albedo || tau_path))
         return cli_usage_error(C, "--volume, --volume-position, --density-scale, --slices, --xi, --eq24, --low-albedo "
                                   "and --tau go with a volume renderer, not --renderer sky");
+    if (time_end_s && (!isnan(sel_end) || !isnan(saz_end)))
+        return cli_usage_error(C, "--time-end (a sun given by time) and --sun-elevation-end/--sun-azimuth-end "
+                                  "(a sun given by angles) exclude each other");
     if (volume_arg && strlen(volume_arg) >= sizeof(((atmos_scene *)0)->volume.source))
         return cli_usage_error(C, "--volume: the path is too long");
 
@@ -287,9 +321,13 @@ int cli_cmd_render(int argc, char **argv)
 
     atmos_scene scene;
     atmos_status st;
-    /* Before any goto fail: the failure path destroys these. */
-    atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     const char *source = scene_path ? scene_path : "default scene";
+    /* Released at fail: */
+    atmos_volume *vol = NULL;
+    atmos_slice_optics optics;
+    memset(&optics, 0, sizeof optics);
+    atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
+    int frame = 0, nframes = 1, numbered = 0;
     if (scene_path) {
         if ((st = atmos_scene_load(ctx, scene_path, &scene)) != ATMOS_OK) goto fail;
     } else {
@@ -329,6 +367,25 @@ int cli_cmd_render(int argc, char **argv)
         scene.sun.from_time = 1;
         scene.sun.latitude_deg = lat;
         scene.sun.longitude_deg = lon;
+    }
+    /* A sun switched to the other form on the command line drops the scene's end of the old form. */
+    if (use_time) scene.animation.elevation_end_set = scene.animation.azimuth_end_set = 0;
+    if (!isnan(sel) || !isnan(saz)) scene.animation.time_end_set = 0;
+    if (frames) scene.animation.frames = frames;
+    if (time_end_s) {
+        if ((st = atmos_parse_utc_time(ctx, time_end_s, &scene.animation.time_end)) != ATMOS_OK) {
+            fprintf(stderr, "atmos render: --time-end: %s\n", atmos_context_error(ctx));
+            atmos_context_destroy(ctx);
+            return CLI_EXIT_USAGE;
+        }
+        scene.animation.time_end_set = 1;
+    }
+    if (!isnan(sel_end)) scene.animation.elevation_end_deg = sel_end, scene.animation.elevation_end_set = 1;
+    if (!isnan(saz_end)) scene.animation.azimuth_end_deg = saz_end, scene.animation.azimuth_end_set = 1;
+    if ((time_end_s || !isnan(sel_end) || !isnan(saz_end)) && scene.animation.frames < 2) {
+        atmos_context_destroy(ctx);
+        return cli_usage_error(C, "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N (N >= 2) "
+                                  "or a scene with an \"animation\"");
     }
     if (spectral) scene.wavelengths = ATMOS_WAVELENGTHS_SPECTRAL, scene.spectral_samples = spectral;
     if (rgb) scene.wavelengths = ATMOS_WAVELENGTHS_RGB;
@@ -387,91 +444,141 @@ int cli_cmd_render(int argc, char **argv)
         png = default_png;
     }
 
-    protect_outputs(png, exr, pfm);
+    /* An animation writes numbered files; the volume and the optics tables are built once. */
+    nframes = scene.animation.frames > 1 ? scene.animation.frames : 1;
+    numbered = nframes > 1;
+    int digits = 4;
+    for (int n = nframes; n >= 10000; n /= 10) digits++;
+    double offset[3] = {0, 0, 0};
     atmos_render_info info;
     atmos_wavelengths wl;
-    if (scene.renderer == ATMOS_RENDERER_SLICE) {
-        atmos_volume *vol = NULL;
-        double offset[3];
-        if ((st = atmos_volume_load_scene(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
-        atmos_slice_settings ss;
-        slice_settings(&scene, offset, &ss);
-        st = atmos_render_slice(ctx, &scene, vol, &ss, &spec, &info);
-        if (st == ATMOS_OK && tau_path) st = write_tau(ctx, &scene, vol, offset, tau_path);
-        atmos_volume_destroy(vol);
-        if (st != ATMOS_OK) goto fail;
-    } else if (scene.renderer == ATMOS_RENDERER_PATH) {
-        /* The volume is optional: without one the path tracer renders the sky and the ground. */
-        atmos_volume *vol = NULL;
-        double offset[3] = {0, 0, 0};
-        if (scene.volume.source[0] && (st = atmos_volume_load_scene(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
-        atmos_path_settings ps;
-        memset(&ps, 0, sizeof ps); /* zero: the scene's "path" settings */
-        ps.density_scale = scene.volume.density_scale;
-        memcpy(ps.offset_m, offset, sizeof offset);
-        ps.variance = variance_out ? &var_img : NULL;
-        ps.stats = &pstats;
-        st = atmos_render_path(ctx, &scene, vol, &ps, &spec, &info);
-        if (st == ATMOS_OK && tau_path && vol) st = write_tau(ctx, &scene, vol, offset, tau_path);
-        atmos_volume_destroy(vol);
-        if (st != ATMOS_OK) goto fail;
-    } else if ((st = atmos_render_sky(ctx, &scene, &spec, &info)) != ATMOS_OK) {
-        goto fail;
-    }
+    static char png_i[4200], exr_i[4200], pfm_i[4200], var_i[4200];
     if ((st = atmos_scene_wavelengths(ctx, &scene, &wl)) != ATMOS_OK) goto fail;
-    if ((st = atmos_image_to_srgb(ctx, spec, &wl, &lin)) != ATMOS_OK) goto fail;
-    atmos_image_set_meta(lin, "atmos:source", source);
-    if (exr) {
-        atmos_exr_desc ed = {scene.exr_half, NULL};
-        if ((st = atmos_write_exr(ctx, lin, exr, &ed)) != ATMOS_OK) goto fail;
+    /* The path tracer may render without a volume (sky and ground only). */
+    if (scene.volume.source[0] && scene.renderer != ATMOS_RENDERER_SKY) {
+        if ((st = atmos_volume_load_scene(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
+        if (scene.renderer == ATMOS_RENDERER_SLICE) st = atmos_slice_optics_build(ctx, &scene, vol, &optics);
+        else st = atmos_path_optics_build(ctx, &scene, vol, &optics);
+        if (st != ATMOS_OK) goto fail;
+        if (tau_path && (st = write_tau(ctx, &scene, vol, offset, tau_path)) != ATMOS_OK) goto fail;
     }
-    if (pfm && (st = atmos_write_pfm(ctx, lin, pfm)) != ATMOS_OK) goto fail;
-    if (var_img && variance_out) {
-        static char names[ATMOS_MAX_WAVELENGTHS + 1][24];
-        const char *np[ATMOS_MAX_WAVELENGTHS + 1];
-        for (int k = 0; k < wl.count; k++) {
-            snprintf(names[k], sizeof names[k], "var_%.1fnm", wl.nm[k]);
-            np[k] = names[k];
+    double total_seconds = 0;
+    for (frame = 1; frame <= nframes; frame++) {
+        atmos_scene fs;
+        if ((st = atmos_scene_animation_frame(ctx, &scene, frame - 1, &fs)) != ATMOS_OK) goto fail;
+        const char *o_png = png, *o_exr = exr, *o_pfm = pfm, *o_var = variance_out;
+        if (numbered) {
+            if ((png && !frame_name(png, frame, digits, png_i, sizeof png_i)) ||
+                (exr && !frame_name(exr, frame, digits, exr_i, sizeof exr_i)) ||
+                (pfm && !frame_name(pfm, frame, digits, pfm_i, sizeof pfm_i)) ||
+                (variance_out && !frame_name(variance_out, frame, digits, var_i, sizeof var_i))) {
+                st = ATMOS_E_INVALID_ARG;
+                fprintf(stderr, "atmos render: an output path is too long for numbered frames\n");
+                goto fail_quiet;
+            }
+            o_png = png ? png_i : NULL, o_exr = exr ? exr_i : NULL, o_pfm = pfm ? pfm_i : NULL;
+            o_var = variance_out ? var_i : NULL;
         }
-        np[wl.count] = "var_Y";
-        atmos_exr_desc ed = {0, np};
-        atmos_image_set_meta(var_img, "atmos:source", source);
-        if ((st = atmos_write_exr(ctx, var_img, variance_out, &ed)) != ATMOS_OK) goto fail;
+        protect_outputs(o_png, o_exr, o_pfm);
+        if (scene.renderer == ATMOS_RENDERER_SLICE) {
+            atmos_slice_settings ss;
+            slice_settings(&fs, offset, &ss);
+            ss.optics = &optics;
+            if ((st = atmos_render_slice(ctx, &fs, vol, &ss, &spec, &info)) != ATMOS_OK) goto fail;
+        } else if (scene.renderer == ATMOS_RENDERER_PATH) {
+            atmos_path_settings ps;
+            memset(&ps, 0, sizeof ps); /* zero: the scene's "path" settings */
+            ps.density_scale = fs.volume.density_scale;
+            memcpy(ps.offset_m, offset, sizeof offset);
+            ps.optics = vol ? &optics : NULL;
+            ps.variance = o_var ? &var_img : NULL;
+            ps.stats = &pstats;
+            if ((st = atmos_render_path(ctx, &fs, vol, &ps, &spec, &info)) != ATMOS_OK) goto fail;
+        } else if ((st = atmos_render_sky(ctx, &fs, &spec, &info)) != ATMOS_OK) {
+            goto fail;
+        }
+        if ((st = atmos_image_to_srgb(ctx, spec, &wl, &lin)) != ATMOS_OK) goto fail;
+        atmos_image_set_meta(lin, "atmos:source", source);
+        if (numbered) {
+            char buf[64];
+            snprintf(buf, sizeof buf, "%d/%d", frame, nframes);
+            atmos_image_set_meta(lin, "atmos:frame", buf);
+        }
+        if (o_exr) {
+            atmos_exr_desc ed = {fs.exr_half, NULL};
+            if ((st = atmos_write_exr(ctx, lin, o_exr, &ed)) != ATMOS_OK) goto fail;
+        }
+        if (o_pfm && (st = atmos_write_pfm(ctx, lin, o_pfm)) != ATMOS_OK) goto fail;
+        if (var_img && o_var) {
+            static char names[ATMOS_MAX_WAVELENGTHS + 1][24];
+            const char *np[ATMOS_MAX_WAVELENGTHS + 1];
+            for (int k = 0; k < wl.count; k++) {
+                snprintf(names[k], sizeof names[k], "var_%.1fnm", wl.nm[k]);
+                np[k] = names[k];
+            }
+            np[wl.count] = "var_Y";
+            atmos_exr_desc ed = {0, np};
+            atmos_image_set_meta(var_img, "atmos:source", source);
+            if ((st = atmos_write_exr(ctx, var_img, o_var, &ed)) != ATMOS_OK) goto fail;
+        }
+        if (o_png) {
+            char buf[64];
+            double scale = atmos_tonemap_scale(lin, &fs.tonemap);
+            snprintf(buf, sizeof buf, "%.6g", scale);
+            atmos_image_set_meta(lin, "atmos:exposure_scale", buf);
+            if ((st = atmos_tonemap(ctx, lin, &fs.tonemap, &disp)) != ATMOS_OK) goto fail;
+            if ((st = atmos_write_png(ctx, disp, o_png, fs.png_bits ? fs.png_bits : 8)) != ATMOS_OK) goto fail;
+        }
+        total_seconds += info.seconds;
+        if (!quiet) {
+            if (prog.shown) fputc('\n', stderr), prog.shown = 0;
+            if (numbered) fprintf(stderr, "atmos render: frame %d/%d: ", frame, nframes);
+            else fprintf(stderr, "atmos render: ");
+            fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s\n", source, fs.width,
+                    fs.height, info.sun_elevation_deg, info.sun_azimuth_deg, info.seconds);
+            if (o_png) fprintf(stderr, "  wrote %s\n", o_png);
+            if (o_exr) fprintf(stderr, "  wrote %s\n", o_exr);
+            if (o_pfm) fprintf(stderr, "  wrote %s\n", o_pfm);
+            if (var_img && o_var) fprintf(stderr, "  wrote %s\n", o_var);
+            if (scene.renderer == ATMOS_RENDERER_PATH)
+                fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n",
+                        pstats.spp, pstats.events, 100.0 * pstats.mean_rel_error);
+            if (frame == 1 && tau_path) fprintf(stderr, "  wrote %s\n", tau_path);
+        }
+        atmos_image_destroy(var_img);
+        var_img = NULL;
+        atmos_image_destroy(spec);
+        atmos_image_destroy(lin);
+        atmos_image_destroy(disp);
+        spec = lin = disp = NULL;
     }
-    if (png) {
-        char buf[64];
-        double scale = atmos_tonemap_scale(lin, &scene.tonemap);
-        snprintf(buf, sizeof buf, "%.6g", scale);
-        atmos_image_set_meta(lin, "atmos:exposure_scale", buf);
-        if ((st = atmos_tonemap(ctx, lin, &scene.tonemap, &disp)) != ATMOS_OK) goto fail;
-        if ((st = atmos_write_png(ctx, disp, png, scene.png_bits ? scene.png_bits : 8)) != ATMOS_OK) goto fail;
-    }
-    if (!quiet) {
-        fprintf(stderr, "atmos render: %s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s\n",
-                source, scene.width, scene.height, info.sun_elevation_deg, info.sun_azimuth_deg, info.seconds);
-        if (png) fprintf(stderr, "  wrote %s\n", png);
-        if (exr) fprintf(stderr, "  wrote %s\n", exr);
-        if (pfm) fprintf(stderr, "  wrote %s\n", pfm);
-        if (var_img && variance_out) fprintf(stderr, "  wrote %s\n", variance_out);
-        if (scene.renderer == ATMOS_RENDERER_PATH)
-            fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", pstats.spp,
-                    pstats.events, 100.0 * pstats.mean_rel_error);
-    }
-    atmos_image_destroy(var_img);
-    atmos_image_destroy(spec);
-    atmos_image_destroy(lin);
-    atmos_image_destroy(disp);
+    if (!quiet && nframes > 1)
+        fprintf(stderr, "atmos render: %d frames, %.3f s rendering (volume and optics prepared once)\n", nframes,
+                total_seconds);
+    atmos_slice_optics_free(&optics);
+    atmos_volume_destroy(vol);
     atmos_context_destroy(ctx);
     return CLI_EXIT_OK;
 fail:
     if (prog.shown) fputc('\n', stderr);
+    if (numbered && frame >= 1 && frame <= nframes) fprintf(stderr, "atmos render: frame %d/%d failed\n", frame, nframes);
     {
         int rc = cli_runtime_error(C, ctx, st);
         atmos_image_destroy(var_img);
         atmos_image_destroy(spec);
         atmos_image_destroy(lin);
         atmos_image_destroy(disp);
+        atmos_slice_optics_free(&optics);
+        atmos_volume_destroy(vol);
         atmos_context_destroy(ctx);
         return rc;
     }
+fail_quiet:
+    atmos_image_destroy(spec);
+    atmos_image_destroy(lin);
+    atmos_image_destroy(disp);
+    atmos_slice_optics_free(&optics);
+    atmos_volume_destroy(vol);
+    atmos_context_destroy(ctx);
+    return CLI_EXIT_USAGE;
 }

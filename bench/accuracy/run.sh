@@ -1,0 +1,60 @@
+#!/bin/sh
+# The accuracy report of docs/accuracy.md: the slice renderer (Riley et al. 2004 §4.2-§5)
+# in several variants against the path tracer as reference, on four volumes with the sun
+# behind the viewer and in front of it. Errors are split by the optical depth along each
+# pixel's ray (atmos render --tau, atmos compare --by).
+#
+#   bench/accuracy/run.sh [OUT_DIR]      (default: docs/accuracy)
+#
+# Environment: ATMOS (the binary, default build/atmos), SPP (path samples per pixel,
+# default 1024), CASES (default "cumulus cirrus rain disney"), THREADS.
+# The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
+set -eu
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+A=${ATMOS:-$root/build/atmos}
+OUT=${1:-$root/docs/accuracy}
+SPP=${SPP:-1024}
+CASES=${CASES:-"cumulus cirrus rain disney"}
+TH=${THREADS:+--threads $THREADS}
+mkdir -p "$OUT"
+csv="$OUT/results.csv"
+echo "case,sun,variant,seconds,rel_rmse,bias_rel,bins_json" > "$csv"
+
+# Seconds from atmos render's own timing line ("..., 1.234 s").
+secs() { sed -n 's/.*, \([0-9.]*\) s$/\1/p' "$1" | tail -1; }
+
+for c in $CASES; do
+    scene="$here/$c.json"
+    for sun in behind front; do
+        # The camera looks north in every case: the sun in the south is behind it.
+        if [ "$sun" = behind ]; then az=180; else az=0; fi
+        base="$OUT/${c}_$sun"
+        echo "== $c, sun $sun" >&2
+        "$A" render "$scene" $TH --sun-azimuth $az --renderer path --spp "$SPP" --pfm "$base.path.pfm" \
+            --variance "$base.path.var.pfm" --tau "$base.tau.pfm" -o "$base.path.png" 2> "$base.path.log"
+        echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[]" >> "$csv"
+        for v in eq25 eq25_xi0 eq25_xi4 eq24 low_albedo; do
+            case $v in
+            eq25) opts="" ;;
+            eq25_xi0) opts="--xi 0" ;;
+            eq25_xi4) opts="--xi 0.0318" ;;
+            eq24) opts="--eq24" ;;
+            low_albedo) opts="--low-albedo" ;;
+            esac
+            "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
+            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \
+                --heatmap "$base.$v.diff.png" --json > "$base.$v.json"
+            python3 - "$base.$v.json" "$c" "$sun" "$v" "$(secs "$base.$v.log")" >> "$csv" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+bias = sum(j["bias"]) / len(j["bias"])
+ref_mean = j["rmse"] / j["rel_rmse"] if j["rel_rmse"] > 0 else float("nan")
+bins = [[b["lo"], b["pixels"], b["rel_rmse"], b["rel_bias"]] for b in j["bins"]]
+print("%s,%s,%s,%s,%.5g,%.5g,\"%s\"" % (sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5], j["rel_rmse"],
+                                      bias / ref_mean if ref_mean == ref_mean else float("nan"), json.dumps(bins)))
+PY
+        done
+    done
+done
+echo "wrote $csv" >&2
