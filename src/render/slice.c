@@ -20,6 +20,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -220,28 +221,6 @@ static atmos_status sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
     return ATMOS_OK;
 }
 
-/* Trilinear densities of all fields at grid-frame point (x, y, z). Returns 0 if the
- * point is outside the grid or in an empty occupancy block (dens untouched). */
-static inline int sgrid_sample(const sgrid *g, float x, float y, float z, float *dens)
-{
-    float u = x * g->sc + g->off[0], v = y * g->sc + g->off[1], w = z * g->sc + g->off[2];
-    if (!(u >= 0.0f && v >= 0.0f && w >= 0.0f)) return 0;
-    int i = (int)u, j = (int)v, k = (int)w;
-    if (i > g->c[0] - 2 || j > g->c[1] - 2 || k > g->c[2] - 2) return 0;
-    if (!g->occ[((size_t)(k / SLICE_OCC_B) * g->ob[1] + j / SLICE_OCC_B) * g->ob[0] + i / SLICE_OCC_B]) return 0;
-    float fu = u - i, fv = v - j, fw = w - k;
-    const int nf = g->nf;
-    const size_t sx = (size_t)nf, sy = (size_t)g->c[0] * nf, sz = (size_t)g->c[0] * g->c[1] * nf;
-    const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
-    float w000 = (1 - fu) * (1 - fv) * (1 - fw), w100 = fu * (1 - fv) * (1 - fw), w010 = (1 - fu) * fv * (1 - fw),
-          w110 = fu * fv * (1 - fw), w001 = (1 - fu) * (1 - fv) * fw, w101 = fu * (1 - fv) * fw,
-          w011 = (1 - fu) * fv * fw, w111 = fu * fv * fw;
-    for (int f = 0; f < nf; f++)
-        dens[f] = w000 * p[f] + w100 * p[sx + f] + w010 * p[sy + f] + w110 * p[sx + sy + f] + w001 * p[sz + f] +
-                  w101 * p[sx + sz + f] + w011 * p[sy + sz + f] + w111 * p[sx + sy + sz + f];
-    return 1;
-}
-
 /* ------------------------------------------------------------------ optics tables */
 
 typedef struct {
@@ -412,6 +391,12 @@ static void slice_range(double sa, double sb, double s0, double ds, int nslices,
 
 /* ------------------------------------------------------------------ the render */
 
+/* Pixels x0..x1 of one image row, or texels of one light-buffer row, that a slice
+ * touches (x0 > x1: none). */
+typedef struct {
+    int x0, x1;
+} sspan;
+
 typedef struct {
     int n, nf;
     int W, H, L;                 /* image, light buffer side */
@@ -426,65 +411,95 @@ typedef struct {
     double hl;                   /* h . lt */
     const sgrid *g;
     const stables *t;
-    /* per pixel */
-    float *pdx, *pdy, *pdz, *pinv; /* direction, 1 / (h . d) */
-    int *pk0, *pk1;
-    int *pa;                     /* [pix * nf + f] angle index */
-    float *pw;
-    float *L_eye, *T_eye;        /* [k * npix + pix] */
-    /* per light texel */
+    /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
+     * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
+     * coordinate (texel units, centres at integers) F0 + k dF. */
+    float *pU0[3], *pdU[3], *pF0[2], *pdF[2];
+    float *pdelta;               /* eye-ray length of a slab */
+    float *pinv;                 /* 1 / (h . d) */
+    int *pk0, *pk1;              /* slices the ray crosses inside the box */
+    int *pa;                     /* [pix * nf + f] Ams angle row offset */
+    float *pw;                   /* [pix * nf + f] weight of the next angle */
+    float *L_eye, *T_eye;        /* [c * npix + pix] */
+    /* Per light texel; render-voxel coordinate of texel (a, b) on slice k:
+     * lA + a lEa + b lEb + k lEk. */
     int *lk0, *lk1;
-    float *I, *nsc;              /* light arriving at the current slice: [c * L*L + texel], [texel] */
-    float *I_next, *nsc_next;    /* light leaving it (written by the light pass) */
+    double lA[3], lEa[3], lEb[3], lEk[3];
+    float ldelta;                /* light-ray length of a slab */
+    float *I[2], *nsc[2];        /* light arriving at slice k: I[k & 1] ([c * L*L + texel]), nsc[k & 1] */
+    /* Per slice: the pixels of each row and the texels of each light row whose
+     * samples may fall in occupied blocks ([k * H + y], [k * L + b]). */
+    sspan *espan, *lspan;
 } sjob;
 
-/* Light buffer lookup at grid-frame point (x, y, z): bilinear I per wavelength and n. */
-static inline void light_lookup(const sjob *j, double x, double y, double z, float *I, float *n)
+/* Trilinear densities of all fields at render-voxel coordinate (u, v, w). Returns 0
+ * if the point is outside the grid or in an empty occupancy block (dens untouched). */
+static inline int sgrid_sample_u(const sgrid *g, float u, float v, float w, float *dens)
 {
-    double u = x * j->e1[0] + y * j->e1[1] + z * j->e1[2], v = x * j->e2[0] + y * j->e2[1] + z * j->e2[2];
-    double fu = (u - j->u0) / j->du - 0.5, fv = (v - j->v0) / j->dv - 0.5;
+    if (!(u >= 0.0f && v >= 0.0f && w >= 0.0f)) return 0;
+    int i = (int)u, j = (int)v, k = (int)w;
+    if (i > g->c[0] - 2 || j > g->c[1] - 2 || k > g->c[2] - 2) return 0;
+    if (!g->occ[((size_t)(k / SLICE_OCC_B) * g->ob[1] + j / SLICE_OCC_B) * g->ob[0] + i / SLICE_OCC_B]) return 0;
+    float fu = u - i, fv = v - j, fw = w - k;
+    const int nf = g->nf;
+    const size_t sx = (size_t)nf, sy = (size_t)g->c[0] * nf, sz = (size_t)g->c[0] * g->c[1] * nf;
+    const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
+    float w000 = (1 - fu) * (1 - fv) * (1 - fw), w100 = fu * (1 - fv) * (1 - fw), w010 = (1 - fu) * fv * (1 - fw),
+          w110 = fu * fv * (1 - fw), w001 = (1 - fu) * (1 - fv) * fw, w101 = fu * (1 - fv) * fw,
+          w011 = (1 - fu) * fv * fw, w111 = fu * fv * fw;
+    for (int f = 0; f < nf; f++)
+        dens[f] = w000 * p[f] + w100 * p[sx + f] + w010 * p[sy + f] + w110 * p[sx + sy + f] + w001 * p[sz + f] +
+                  w101 * p[sx + sz + f] + w011 * p[sy + sz + f] + w111 * p[sx + sy + sz + f];
+    return 1;
+}
+
+/* Light buffer lookup at light-buffer coordinate (fu, fv): bilinear I per wavelength and n. */
+static inline void light_lookup(const sjob *j, const float *Ib, const float *nb, float fu, float fv, float *I, float *n)
+{
     const int L = j->L;
-    if (fu < 0) fu = 0;
-    if (fv < 0) fv = 0;
-    if (fu > L - 1) fu = L - 1;
-    if (fv > L - 1) fv = L - 1;
+    const float lim = (float)(L - 1);
+    fu = fu < 0.0f ? 0.0f : (fu > lim ? lim : fu);
+    fv = fv < 0.0f ? 0.0f : (fv > lim ? lim : fv);
     int a = (int)fu, b = (int)fv;
     if (a > L - 2) a = L - 2;
     if (b > L - 2) b = L - 2;
-    if (a < 0) a = 0;
-    if (b < 0) b = 0;
-    float wa = (float)(fu - a), wb = (float)(fv - b);
-    if (L == 1) wa = wb = 0;
-    size_t t00 = (size_t)b * L + a, t10 = t00 + (L > 1), t01 = t00 + (L > 1 ? L : 0), t11 = t01 + (L > 1);
+    float wa = fu - (float)a, wb = fv - (float)b;
+    size_t t00 = (size_t)b * L + a, t10 = t00 + 1, t01 = t00 + L, t11 = t01 + 1;
     float w00 = (1 - wa) * (1 - wb), w10 = wa * (1 - wb), w01 = (1 - wa) * wb, w11 = wa * wb;
     const size_t LL = (size_t)L * L;
     for (int k = 0; k < j->n; k++) {
-        const float *p = j->I + k * LL;
+        const float *p = Ib + k * LL;
         I[k] = w00 * p[t00] + w10 * p[t10] + w01 * p[t01] + w11 * p[t11];
     }
-    *n = w00 * j->nsc[t00] + w10 * j->nsc[t10] + w01 * j->nsc[t01] + w11 * j->nsc[t11];
+    *n = w00 * nb[t00] + w10 * nb[t10] + w01 * nb[t01] + w11 * nb[t11];
 }
 
-/* Eye pass of slice k over image row y (Eq. 26). Returns the samples evaluated. */
-static long long eye_row(const sjob *j, int k, int y)
+/* Eye pass of slice k over pixels x0..x1 of image row y (Eq. 26). Returns the
+ * samples evaluated. */
+static long long eye_span(const sjob *j, int k, int y, int x0, int x1)
 {
-    const int n = j->n, nf = j->nf;
+    const int n = j->n, nf = j->nf, no = j->t->no;
     const size_t npix = (size_t)j->W * j->H;
-    const double sk = j->s0 + (k + 0.5) * j->ds;
+    const float kf = (float)k;
+    const float *Ib = j->I[k & 1], *nb = j->nsc[k & 1];
     float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], nsc;
     long long count = 0;
-    for (int x = 0; x < j->W; x++) {
+    for (int x = x0; x <= x1; x++) {
         size_t p = (size_t)y * j->W + x;
         if (k < j->pk0[p] || k > j->pk1[p]) continue;
-        double t = (sk - j->he) * j->pinv[p];
-        float px = (float)(j->eye[0] + t * j->pdx[p]), py = (float)(j->eye[1] + t * j->pdy[p]),
-              pz = (float)(j->eye[2] + t * j->pdz[p]);
-        if (!sgrid_sample(j->g, px, py, pz, dens)) continue;
+        float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
+              w = j->pU0[2][p] + kf * j->pdU[2][p];
+        if (!sgrid_sample_u(j->g, u, v, w, dens)) continue;
         count++;
-        light_lookup(j, px, py, pz, I, &nsc);
-        const float delta = (float)(j->ds * fabs(j->pinv[p])); /* eye-ray length of the slab */
-        /* One more scattering than the light has had turns it to the eye (Eq. 26). */
+        light_lookup(j, Ib, nb, j->pF0[0][p] + kf * j->pdF[0][p], j->pF0[1][p] + kf * j->pdF[1][p], I, &nsc);
+        const float delta = j->pdelta[p];
+        /* One more scattering than the light has had turns it to the eye (Eq. 26):
+         * Ams at fractional order m, linear between orders (and angles). */
         const float m = j->low_albedo ? 1.0f : nsc + 1.0f;
+        const float mm = m < 1.0f ? 1.0f : (m > (float)no ? (float)no : m);
+        int oi = (int)(mm - 1.0f);
+        if (oi > no - 2) oi = no - 2;
+        const float fo = mm - 1.0f - (float)oi;
         for (int c = 0; c < n; c++) {
             float bext = 0, src = 0;
             for (int f = 0; f < nf; f++) {
@@ -492,8 +507,10 @@ static long long eye_row(const sjob *j, int k, int y)
                 bext += dens[f] * j->t->sig[f][c];
                 float bs = dens[f] * j->t->sca[f][c];
                 if (bs > 0.0f) {
-                    float a = ams_lookup(j->t, f, c, j->pa[p * nf + f], j->pw[p * nf + f], m);
-                    src += bs * (a + j->xi);
+                    const float *q = j->t->ams[f] + ((size_t)c * j->t->ng[f] * no + j->pa[p * nf + f] + oi);
+                    float lo = q[0] + fo * (q[1] - q[0]);
+                    float hi = q[no] + fo * (q[no + 1] - q[no]);
+                    src += bs * (lo + j->pw[p * nf + f] * (hi - lo) + j->xi);
                 }
             }
             if (bext <= 0.0f) continue;
@@ -512,29 +529,37 @@ static long long eye_row(const sjob *j, int k, int y)
     return count;
 }
 
-/* Light pass of slice k over light-buffer row b (Eq. 21, 25 / 24). */
-static long long light_row(const sjob *j, int k, int b)
+/* Light pass of slice k over texels x0..x1 of light row b (Eq. 21, 25 / 24): reads
+ * the light arriving at slice k, writes the light leaving it into the other buffer.
+ * Texels a0..a1 may meet occupied blocks; the others of x0..x1 are copied (texels
+ * outside x0..x1 are equal in both buffers, see render). */
+static long long light_span(const sjob *j, int k, int b, int x0, int x1, int a0, int a1)
 {
     const int n = j->n, nf = j->nf, L = j->L;
     const size_t LL = (size_t)L * L;
-    const double sk = j->s0 + (k + 0.5) * j->ds;
-    const float delta = (float)(j->ds / j->hl); /* light-ray length of the slab */
+    const float delta = j->ldelta;
+    const float *Ic = j->I[k & 1], *nc = j->nsc[k & 1];
+    float *In = j->I[(k + 1) & 1], *nn = j->nsc[(k + 1) & 1];
     float dens[ATMOS_VOLUME_MAX_FIELDS];
     long long count = 0;
-    const double v = j->v0 + (b + 0.5) * j->dv;
-    for (int a = 0; a < L; a++) {
+    double base[3];
+    for (int i = 0; i < 3; i++) base[i] = j->lA[i] + b * j->lEb[i] + k * j->lEk[i];
+    const float bu = (float)base[0], bv = (float)base[1], bw = (float)base[2];
+    const float eu = (float)j->lEa[0], ev = (float)j->lEa[1], ew = (float)j->lEa[2];
+    for (int a = x0; a <= x1; a++) {
         size_t q = (size_t)b * L + a;
-        for (int c = 0; c < n; c++) j->I_next[c * LL + q] = j->I[c * LL + q];
-        j->nsc_next[q] = j->nsc[q];
-        if (k < j->lk0[q] || k > j->lk1[q]) continue;
-        const double u = j->u0 + (a + 0.5) * j->du;
-        double w = (sk - u * dot3(j->h, j->e1) - v * dot3(j->h, j->e2)) / j->hl;
-        float px = (float)(u * j->e1[0] + v * j->e2[0] + w * j->lt[0]);
-        float py = (float)(u * j->e1[1] + v * j->e2[1] + w * j->lt[1]);
-        float pz = (float)(u * j->e1[2] + v * j->e2[2] + w * j->lt[2]);
-        if (!sgrid_sample(j->g, px, py, pz, dens)) continue;
+        const float n0 = nc[q];
+        nn[q] = n0;
+        int upd = a >= a0 && a <= a1 && k >= j->lk0[q] && k <= j->lk1[q];
+        if (upd) {
+            const float af = (float)a;
+            upd = sgrid_sample_u(j->g, bu + af * eu, bv + af * ev, bw + af * ew, dens);
+        }
+        if (!upd) {
+            for (int c = 0; c < n; c++) In[c * LL + q] = Ic[c * LL + q];
+            continue;
+        }
         count++;
-        const float n0 = j->nsc[q];
         float dn = 0;
         for (int c = 0; c < n; c++) {
             float bext = 0, bsca = 0;
@@ -543,7 +568,10 @@ static long long light_row(const sjob *j, int k, int b)
                 bsca += dens[f] * j->t->sca[f][c];
             }
             dn += bsca * delta;
-            if (bext <= 0.0f) continue;
+            if (bext <= 0.0f) {
+                In[c * LL + q] = Ic[c * LL + q];
+                continue;
+            }
             float tau = bext * delta, T = expf(-tau);
             float keep; /* fraction of the scattered light (1 - T) still going forward */
             if (j->low_albedo) {
@@ -564,7 +592,7 @@ static long long light_row(const sjob *j, int k, int b)
                             aF += dens[f] * j->t->sca[f][c] *
                                   order_lerp(j->t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1), idx, 0);
                     aF /= bext;
-                    keep = aF > 0.0f ? expf(msl * logf(aF)) : 0.0f;
+                    keep = aF > 0.0f ? (tau > 1.0f ? expf(msl * logf(aF)) : aF) : 0.0f;
                 } else {
                     /* Eq. 24: prod_{i=n+1}^{n+m} alpha F_i = alpha^m exp(S(n+m) - S(n)); fields
                      * mixed geometrically by their share of beta_sca. */
@@ -578,12 +606,138 @@ static long long light_row(const sjob *j, int k, int b)
                     keep = expf(lnk);
                 }
             }
-            j->I_next[c * LL + q] = j->I[c * LL + q] * (T + (1.0f - T) * keep);
+            In[c * LL + q] = Ic[c * LL + q] * (T + (1.0f - T) * keep);
         }
         /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
-        j->nsc_next[q] = n0 + dn / (float)n;
+        nn[q] = n0 + dn / (float)n;
     }
     return count;
+}
+
+/* Per-slice spans. Every occupied block (a cube of SLICE_OCC_B render voxels, widened
+ * by a small margin for rounding) meets the slices between the planes through its
+ * nearest and farthest corners; a sample of slice k can fall in it only at the pixels
+ * inside the projection of its corners (and the texels inside their orthographic
+ * projection along the light), widened by one pixel. The spans of a row are the union
+ * of those footprints, so the passes visit what the occupied volume covers instead of
+ * the whole image and light buffer. */
+typedef struct {
+    int k0, k1;          /* slices */
+    int ex0, ex1, ey0, ey1; /* pixels (ex0 > ex1: none) */
+    int lx0, lx1, ly0, ly1; /* light texels */
+} sfoot;
+
+static int clampi_d(double v, int lo, int hi)
+{
+    if (!(v > lo)) return lo; /* NaN too */
+    if (v > hi) return hi;
+    return (int)v;
+}
+
+static void block_footprint(const sjob *j, const atmos_camera *cam, const double cf[3], const double cr[3],
+                            const double cu[3], int bi, int bj, int bk, sfoot *o)
+{
+    const sgrid *g = j->g;
+    const double mg = 0.05; /* render voxels: float rounding of the sample positions */
+    double lo[3], hi[3];
+    const int b[3] = {bi, bj, bk};
+    for (int a = 0; a < 3; a++) {
+        double u0 = (double)b[a] * SLICE_OCC_B - mg, u1 = fmin((double)(b[a] + 1) * SLICE_OCC_B, g->c[a] - 1.0) + mg;
+        lo[a] = (u0 - g->off[a]) / g->sc;
+        hi[a] = (u1 - g->off[a]) / g->sc;
+    }
+    double smin = INFINITY, smax = -INFINITY, xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    int behind = 0;
+    const double th = cam->tan_half_fov, W = cam->width, H = cam->height;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        double sv = dot3(p, j->h);
+        smin = fmin(smin, sv), smax = fmax(smax, sv);
+        double uv = dot3(p, j->e1), vv = dot3(p, j->e2);
+        umin = fmin(umin, uv), umax = fmax(umax, uv);
+        vmin = fmin(vmin, vv), vmax = fmax(vmax, vv);
+        double r[3] = {p[0] - j->eye[0], p[1] - j->eye[1], p[2] - j->eye[2]};
+        double z = dot3(r, cf);
+        if (!(z > 1e-6)) {
+            behind++;
+            continue;
+        }
+        /* Image position (pixels; centres at +0.5) as atmos_camera_ray inverts it. */
+        double px = 0.5 * (W + dot3(r, cr) / (z * th) * H), py = 0.5 * (H - dot3(r, cu) / (z * th) * H);
+        xmin = fmin(xmin, px), xmax = fmax(xmax, px);
+        ymin = fmin(ymin, py), ymax = fmax(ymax, py);
+    }
+    slice_range(smin, smax, j->s0, j->ds, j->nslices, &o->k0, &o->k1);
+    if (behind == 8) {
+        o->ex0 = o->ey0 = 1, o->ex1 = o->ey1 = 0; /* rays only go forwards */
+    } else if (behind) {
+        o->ex0 = o->ey0 = 0, o->ex1 = j->W - 1, o->ey1 = j->H - 1; /* straddles the eye: everywhere */
+    } else {
+        o->ex0 = clampi_d(floor(xmin - 0.5) - 1, 0, j->W), o->ex1 = clampi_d(ceil(xmax - 0.5) + 1, -1, j->W - 1);
+        o->ey0 = clampi_d(floor(ymin - 0.5) - 1, 0, j->H), o->ey1 = clampi_d(ceil(ymax - 0.5) + 1, -1, j->H - 1);
+    }
+    /* Texel a's ray is at u = u0 + (a + 0.5) du. */
+    o->lx0 = clampi_d(floor((umin - j->u0) / j->du - 0.5) - 1, 0, j->L);
+    o->lx1 = clampi_d(ceil((umax - j->u0) / j->du - 0.5) + 1, -1, j->L - 1);
+    o->ly0 = clampi_d(floor((vmin - j->v0) / j->dv - 0.5) - 1, 0, j->L);
+    o->ly1 = clampi_d(ceil((vmax - j->v0) / j->dv - 0.5) + 1, -1, j->L - 1);
+}
+
+/* Fills j->espan and j->lspan. Returns 0 if out of memory. */
+static int build_spans(sjob *j, const atmos_camera *cam, const double cf[3], const double cr[3], const double cu[3],
+                       int threads)
+{
+    const sgrid *g = j->g;
+    size_t nb = (size_t)g->ob[0] * g->ob[1] * g->ob[2], nocc = 0;
+    for (size_t i = 0; i < nb; i++) nocc += g->occ[i] != 0;
+    sfoot *fp = malloc(sizeof *fp * (nocc ? nocc : 1));
+    size_t *idx = malloc(sizeof *idx * (nocc ? nocc : 1));
+    if (!fp || !idx) {
+        free(fp), free(idx);
+        return 0;
+    }
+    nocc = 0;
+    for (size_t i = 0; i < nb; i++)
+        if (g->occ[i]) idx[nocc++] = i;
+    const long long no = (long long)nocc;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long i = 0; i < no; i++) {
+        size_t b = idx[i];
+        int bi = (int)(b % (size_t)g->ob[0]), bj = (int)((b / (size_t)g->ob[0]) % (size_t)g->ob[1]),
+            bk = (int)(b / ((size_t)g->ob[0] * g->ob[1]));
+        block_footprint(j, cam, cf, cr, cu, bi, bj, bk, &fp[i]);
+    }
+    free(idx);
+    const int K = j->nslices, H = j->H, L = j->L;
+    /* Each thread owns a contiguous range of slices, so the min/max updates do not race. */
+#pragma omp parallel num_threads(threads)
+    {
+        int nt = omp_get_num_threads(), tid = omp_get_thread_num();
+        int k0 = (int)((long long)K * tid / nt), k1 = (int)((long long)K * (tid + 1) / nt) - 1;
+        for (int k = k0; k <= k1; k++) {
+            for (int y = 0; y < H; y++) j->espan[(size_t)k * H + y] = (sspan){j->W, -1};
+            for (int b = 0; b < L; b++) j->lspan[(size_t)k * L + b] = (sspan){L, -1};
+        }
+        for (size_t i = 0; i < nocc; i++) {
+            const sfoot *f = &fp[i];
+            int a = f->k0 > k0 ? f->k0 : k0, z = f->k1 < k1 ? f->k1 : k1;
+            for (int k = a; k <= z; k++) {
+                for (int y = f->ey0; y <= f->ey1 && f->ex0 <= f->ex1; y++) {
+                    sspan *s = &j->espan[(size_t)k * H + y];
+                    if (f->ex0 < s->x0) s->x0 = f->ex0;
+                    if (f->ex1 > s->x1) s->x1 = f->ex1;
+                }
+                for (int y = f->ly0; y <= f->ly1 && f->lx0 <= f->lx1; y++) {
+                    sspan *s = &j->lspan[(size_t)k * L + y];
+                    if (f->lx0 < s->x0) s->x0 = f->lx0;
+                    if (f->lx1 > s->x1) s->x1 = f->lx1;
+                }
+            }
+        }
+    }
+    free(fp);
+    return 1;
 }
 
 static atmos_status check_settings(atmos_context *ctx, const atmos_slice_settings *in, atmos_slice_settings *s)
@@ -739,31 +893,48 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     j.g = &g;
     j.t = &tab;
     const size_t npix = (size_t)j.W * j.H, LL = (size_t)j.L * j.L;
-    j.pdx = malloc(sizeof(float) * npix * 4);
+    const int K = j.nslices;
+    for (int a = 0; a < 3; a++) {
+        j.pU0[a] = malloc(sizeof(float) * npix);
+        j.pdU[a] = malloc(sizeof(float) * npix);
+    }
+    for (int a = 0; a < 2; a++) {
+        j.pF0[a] = malloc(sizeof(float) * npix);
+        j.pdF[a] = malloc(sizeof(float) * npix);
+    }
+    j.pdelta = malloc(sizeof(float) * npix);
+    j.pinv = malloc(sizeof(float) * npix);
     j.pk0 = malloc(sizeof(int) * npix * 2);
     j.pa = malloc(sizeof(int) * npix * j.nf);
     j.pw = malloc(sizeof(float) * npix * j.nf);
     j.L_eye = calloc(npix * j.n, sizeof(float));
     j.T_eye = malloc(sizeof(float) * npix * j.n);
     j.lk0 = malloc(sizeof(int) * LL * 2);
-    j.I = malloc(sizeof(float) * LL * j.n);
-    j.nsc = calloc(LL, sizeof(float));
-    j.I_next = malloc(sizeof(float) * LL * j.n);
-    j.nsc_next = calloc(LL, sizeof(float));
-    if (!j.pdx || !j.pk0 || !j.pa || !j.pw || !j.L_eye || !j.T_eye || !j.lk0 || !j.I || !j.nsc || !j.I_next ||
-        !j.nsc_next) {
+    for (int a = 0; a < 2; a++) {
+        j.I[a] = malloc(sizeof(float) * LL * j.n);
+        j.nsc[a] = calloc(LL, sizeof(float));
+    }
+    j.espan = malloc(sizeof(sspan) * (size_t)K * j.H);
+    j.lspan = malloc(sizeof(sspan) * (size_t)K * j.L);
+    int nomem = !j.pdelta || !j.pinv || !j.pk0 || !j.pa || !j.pw || !j.L_eye || !j.T_eye || !j.lk0 || !j.espan ||
+                !j.lspan;
+    for (int a = 0; a < 3; a++) nomem |= !j.pU0[a] || !j.pdU[a];
+    for (int a = 0; a < 2; a++) nomem |= !j.pF0[a] || !j.pdF[a] || !j.I[a] || !j.nsc[a];
+    if (nomem) {
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
         goto done;
     }
-    j.pdy = j.pdx + npix, j.pdz = j.pdx + 2 * npix, j.pinv = j.pdx + 3 * npix;
     j.pk1 = j.pk0 + npix;
     j.lk1 = j.lk0 + LL;
     for (size_t i = 0; i < npix * j.n; i++) j.T_eye[i] = 1.0f;
     const int threads = atmos__threads(ctx);
+    const double t_setup0 = now_seconds();
 
     /* Per pixel: ray, slices it crosses inside the box (in front of the eye and of
-     * the ground), and the Ams angle (scattering angle between the sun's light and
-     * the direction to the eye: cos theta = d . sun). */
+     * the ground), its sample on slice k as a linear function of k, and the Ams angle
+     * (scattering angle between the sun's light and the direction to the eye:
+     * cos theta = d . sun). */
+    const double ee1 = dot3(j.eye, j.e1), ee2 = dot3(j.eye, j.e2);
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int y = 0; y < j.H; y++)
         for (int x = 0; x < j.W; x++) {
@@ -771,88 +942,141 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             double dw[3], d[3];
             atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
             TO_GRID(dw, d);
-            j.pdx[p] = (float)d[0], j.pdy[p] = (float)d[1], j.pdz[p] = (float)d[2];
             double hd = dot3(j.h, d);
             j.pk0[p] = 1, j.pk1[p] = 0;
             j.pinv[p] = 0;
+            for (int a = 0; a < 3; a++) j.pU0[a][p] = j.pdU[a][p] = 0;
+            for (int a = 0; a < 2; a++) j.pF0[a][p] = j.pdF[a][p] = 0;
+            j.pdelta[p] = 0;
+            for (int f = 0; f < j.nf; f++) j.pa[p * j.nf + f] = 0, j.pw[p * j.nf + f] = 0;
             double ta, tb;
             int ok = j.btf ? hd <= -SLICE_HD_EPS : hd >= SLICE_HD_EPS;
-            if (ok && ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) {
-                if (ta < 0) ta = 0;
-                double tg = atmos_sky_ground_distance(cam.position[1], dw);
-                if (tb > tg) tb = tg;
-                if (ta < tb) {
-                    double sa = j.he + ta * hd, sb = j.he + tb * hd;
-                    if (sa > sb) {
-                        double q = sa;
-                        sa = sb, sb = q;
-                    }
-                    slice_range(sa, sb, j.s0, j.ds, j.nslices, &j.pk0[p], &j.pk1[p]);
-                    j.pinv[p] = (float)(1.0 / hd);
-                }
+            if (!ok || !ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) continue;
+            if (ta < 0) ta = 0;
+            double tg = atmos_sky_ground_distance(cam.position[1], dw);
+            if (tb > tg) tb = tg;
+            if (!(ta < tb)) continue;
+            double sa = j.he + ta * hd, sb = j.he + tb * hd;
+            if (sa > sb) {
+                double q = sa;
+                sa = sb, sb = q;
             }
+            slice_range(sa, sb, j.s0, j.ds, j.nslices, &j.pk0[p], &j.pk1[p]);
+            if (j.pk0[p] > j.pk1[p]) continue;
+            j.pinv[p] = (float)(1.0 / hd);
+            /* t_k = (s0 + (k + 0.5) ds - h.eye) / (h.d) */
+            const double t0 = (j.s0 + 0.5 * j.ds - j.he) / hd, dt = j.ds / hd;
+            for (int a = 0; a < 3; a++) {
+                j.pU0[a][p] = (float)((j.eye[a] + t0 * d[a]) * g.sc + g.off[a]);
+                j.pdU[a][p] = (float)(dt * d[a] * g.sc);
+            }
+            const double de1 = dot3(d, j.e1), de2 = dot3(d, j.e2);
+            j.pF0[0][p] = (float)((ee1 + t0 * de1 - j.u0) / j.du - 0.5);
+            j.pdF[0][p] = (float)(dt * de1 / j.du);
+            j.pF0[1][p] = (float)((ee2 + t0 * de2 - j.v0) / j.dv - 0.5);
+            j.pdF[1][p] = (float)(dt * de2 / j.dv);
+            j.pdelta[p] = (float)(j.ds * fabs(1.0 / hd));
             double c = dot3(dw, sun_w);
             double th = acos(c > 1 ? 1 : (c < -1 ? -1 : c)) * ATMOS_RAD2DEG;
-            for (int f = 0; f < j.nf; f++) angle_locate(tab.grid[f], tab.ng[f], th, &j.pa[p * j.nf + f], &j.pw[p * j.nf + f]);
+            for (int f = 0; f < j.nf; f++) {
+                int ai;
+                angle_locate(tab.grid[f], tab.ng[f], th, &ai, &j.pw[p * j.nf + f]);
+                j.pa[p * j.nf + f] = ai * tab.no;
+            }
         }
     /* Per light texel: slices its ray crosses inside the box, and the sunlight arriving
-     * there through the air (Eq. 12, at the altitude where the ray enters the box). */
+     * there through the air (Eq. 12, at the altitude where the ray enters the box).
+     * Texel (a, b)'s ray is u e1 + v e2 + w lt; on slice k, w = (s_k - u h.e1 - v h.e2)/h.lt. */
     {
         double cen[3] = {0.5 * (g.box_lo[0] + g.box_hi[0]), 0.5 * (g.box_lo[1] + g.box_hi[1]),
                          0.5 * (g.box_lo[2] + g.box_hi[2])};
         const double *Rm = R;
+        const double he1 = dot3(j.h, j.e1), he2 = dot3(j.h, j.e2);
+        for (int a = 0; a < 3; a++) {
+            double E1 = j.e1[a] - he1 / j.hl * j.lt[a], E2 = j.e2[a] - he2 / j.hl * j.lt[a];
+            j.lA[a] = ((j.u0 + 0.5 * j.du) * E1 + (j.v0 + 0.5 * j.dv) * E2 + (j.s0 + 0.5 * j.ds) / j.hl * j.lt[a]) * g.sc +
+                      g.off[a];
+            j.lEa[a] = j.du * E1 * g.sc;
+            j.lEb[a] = j.dv * E2 * g.sc;
+            j.lEk[a] = j.ds / j.hl * j.lt[a] * g.sc;
+        }
+        j.ldelta = (float)(j.ds / j.hl);
+        /* Texels whose ray misses the box all get the sunlight at the box centre. */
+        double sl_miss[ATMOS_MAX_WAVELENGTHS];
+        {
+            double yw = org[1] + Rm[3] * cen[0] + Rm[4] * cen[1] + Rm[5] * cen[2];
+            atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl_miss);
+        }
 #pragma omp parallel for schedule(static) num_threads(threads)
         for (int b = 0; b < j.L; b++)
             for (int a = 0; a < j.L; a++) {
                 size_t q = (size_t)b * j.L + a;
                 double u = j.u0 + (a + 0.5) * j.du, v = j.v0 + (b + 0.5) * j.dv;
                 double o[3] = {u * j.e1[0] + v * j.e2[0], u * j.e1[1] + v * j.e2[1], u * j.e1[2] + v * j.e2[2]};
-                double ta, tb, entry[3];
-                memcpy(entry, cen, sizeof entry);
+                double ta, tb, sl[ATMOS_MAX_WAVELENGTHS];
                 j.lk0[q] = 1, j.lk1[q] = 0;
                 if (ray_box(o, j.lt, g.box_lo, g.box_hi, &ta, &tb)) {
                     double ho = dot3(j.h, o);
                     slice_range(ho + ta * j.hl, ho + tb * j.hl, j.s0, j.ds, j.nslices, &j.lk0[q], &j.lk1[q]);
+                    double entry[3];
                     for (int i = 0; i < 3; i++) entry[i] = o[i] + ta * j.lt[i];
+                    double yw = org[1] + Rm[3] * entry[0] + Rm[4] * entry[1] + Rm[5] * entry[2];
+                    atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl);
+                } else {
+                    memcpy(sl, sl_miss, sizeof sl);
                 }
-                double yw = org[1] + Rm[3] * entry[0] + Rm[4] * entry[1] + Rm[5] * entry[2];
-                double sl[ATMOS_MAX_WAVELENGTHS];
-                atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl);
-                for (int c = 0; c < j.n; c++) j.I[c * LL + q] = (float)sl[c];
+                for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = j.I[1][c * LL + q] = (float)sl[c];
             }
     }
+    {
+        double cf[3], cr[3], cu[3];
+        TO_GRID(cam.forward, cf);
+        TO_GRID(cam.right, cr);
+        TO_GRID(cam.up, cu);
+        if (!build_spans(&j, &cam, cf, cr, cu, threads)) {
+            st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the spans");
+            goto done;
+        }
+    }
+    const double t_setup = now_seconds() - t_setup0;
     const double t_prep = now_seconds() - t_prep0;
 
-    /* The slices. The eye pass reads the light arriving at slice k while the light
-     * pass writes the light leaving it into the other buffer, so both run in one
-     * parallel loop (one barrier per slice). Rows are interleaved in chunks of 4 with
-     * a static schedule; per-thread CPU time in each pass gives the breakdown. */
+    /* The slices, in one parallel region with one barrier per slice. The eye pass of
+     * slice k reads the light arriving at it (buffer k & 1) while the light pass
+     * writes the light leaving it into the other buffer; each pixel and texel is
+     * written by one work item only, so the image does not depend on the thread
+     * count or the schedule. Only the texels a light span of slice k - 1 or k covers
+     * can differ between the two buffers, so only those are visited. Per-thread CPU
+     * time in each pass gives the breakdown. */
     int cancelled = 0;
-    double cpu_eye = 0, cpu_light = 0, t_slices = 0;
-    const int rows = j.H + j.L;
-    for (int k = 0; k < j.nslices && !cancelled; k++) {
-        long long ce = 0, cl = 0;
-        double ta = now_seconds(), de = 0, dl = 0;
-#pragma omp parallel for schedule(static, 4) num_threads(threads) reduction(+ : ce, cl, de, dl)
-        for (int r = 0; r < rows; r++) {
-            double t0 = now_seconds();
-            if (r < j.H) {
-                ce += eye_row(&j, k, r);
-                de += now_seconds() - t0;
+    double cpu_eye = 0, cpu_light = 0;
+    const double t_sl0 = now_seconds();
+#pragma omp parallel num_threads(threads) reduction(+ : eye_samples, light_samples, cpu_eye, cpu_light)
+    for (int k = 0; k < K; k++) {
+        if (cancelled) break; /* set before the previous barrier: every thread sees the same value */
+        const sspan *es = j.espan + (size_t)k * j.H, *ls = j.lspan + (size_t)k * j.L,
+                    *lp = k > 0 ? j.lspan + (size_t)(k - 1) * j.L : NULL;
+        const int ne = j.H, nl = j.L;
+        double t0 = now_seconds(), tl = -1;
+#pragma omp for schedule(dynamic, 2) nowait
+        for (int r = 0; r < ne + nl; r++) {
+            if (r < ne) {
+                if (es[r].x0 <= es[r].x1) eye_samples += eye_span(&j, k, r, es[r].x0, es[r].x1);
             } else {
-                cl += light_row(&j, k, r - j.H);
-                dl += now_seconds() - t0;
+                if (tl < 0) tl = now_seconds();
+                int b = r - ne, x0 = ls[b].x0, x1 = ls[b].x1;
+                if (lp) x0 = lp[b].x0 < x0 ? lp[b].x0 : x0, x1 = lp[b].x1 > x1 ? lp[b].x1 : x1;
+                if (x0 <= x1) light_samples += light_span(&j, k, b, x0, x1, ls[b].x0, ls[b].x1);
             }
         }
-        t_slices += now_seconds() - ta;
-        cpu_eye += de, cpu_light += dl;
-        eye_samples += ce, light_samples += cl;
-        float *sw = j.I;
-        j.I = j.I_next, j.I_next = sw;
-        sw = j.nsc;
-        j.nsc = j.nsc_next, j.nsc_next = sw;
-        if (atmos__progress(ctx, "render slice", (double)(k + 1) / j.nslices)) cancelled = 1;
+        double t1 = now_seconds();
+        if (tl < 0) cpu_eye += t1 - t0;
+        else cpu_eye += tl - t0, cpu_light += t1 - tl;
+#pragma omp master
+        if (atmos__progress(ctx, "render slice", (double)(k + 1) / K)) cancelled = 1;
+#pragma omp barrier
     }
+    const double t_slices = now_seconds() - t_sl0;
     if (cpu_eye + cpu_light > 0) {
         t_eye = t_slices * cpu_eye / (cpu_eye + cpu_light);
         t_light = t_slices - t_eye;
@@ -903,6 +1127,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         s.timing->prepare = t_prep;
         s.timing->light = t_light;
         s.timing->eye = t_eye;
+        s.timing->setup = t_setup;
     }
 
 finish:
@@ -932,8 +1157,10 @@ finish:
     st = ATMOS_OK;
 done:
 #undef TO_GRID
-    free(j.pdx), free(j.pk0), free(j.pa), free(j.pw), free(j.L_eye), free(j.T_eye), free(j.lk0), free(j.I), free(j.nsc);
-    free(j.I_next), free(j.nsc_next);
+    for (int a = 0; a < 3; a++) free(j.pU0[a]), free(j.pdU[a]);
+    for (int a = 0; a < 2; a++) free(j.pF0[a]), free(j.pdF[a]), free(j.I[a]), free(j.nsc[a]);
+    free(j.pdelta), free(j.pinv), free(j.pk0), free(j.pa), free(j.pw), free(j.L_eye), free(j.T_eye), free(j.lk0);
+    free(j.espan), free(j.lspan);
     atmos_sky_destroy(sky);
     stables_free(&tab);
     sgrid_free(&g);
