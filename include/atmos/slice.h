@@ -71,6 +71,8 @@ typedef struct atmos_slice_settings {
     double offset_m[3];    /* added to the volume's world position (placement in a scene) */
     const atmos_slice_optics *optics; /* NULL = atmos_slice_optics_build inside the render */
     atmos_slice_timing *timing;       /* optional output */
+    int reference;         /* nonzero: the plain scalar passes with libm's exp (slow; the fast
+                              default differs from it by < 1e-5 relative, docs/slice.md) */
 } atmos_slice_settings;
 
 /* Fills *s with the resolved defaults. */

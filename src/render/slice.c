@@ -16,6 +16,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "core/internal.h"
+#include "render/slice_internal.h"
 #include "volume/volume_grid.h"
 
 #include <float.h>
@@ -27,8 +28,6 @@
 #include <string.h>
 #include <time.h>
 
-#define SLICE_OCC_B 4          /* occupancy block edge, render-grid voxels */
-#define SLICE_F_ORDERS 256     /* F_n and S(n) tabulated at integer n = 0..SLICE_F_ORDERS */
 #define SLICE_HD_EPS 0.02      /* rays within ~89° of the slice planes are not sliced */
 #define SLICE_MAX_GRID_BYTES ((uint64_t)2 << 30)
 
@@ -97,21 +96,6 @@ fail:
 }
 
 /* ------------------------------------------------------------------ render grid */
-
-/* The volume box-filtered onto a dense grid (integer factor f native voxels per
- * render voxel), fields interleaved per voxel, with one empty voxel of padding on
- * every side so that the trilinear interpolant falls to zero at the edges, and a
- * coarse occupancy grid (Riley §3.2's majorant idea: blocks that are exactly empty
- * are skipped without interpolating). */
-typedef struct {
-    int nf;
-    int c[3];             /* render voxels per axis, padding included */
-    float *v;             /* c0*c1*c2*nf */
-    int ob[3];
-    unsigned char *occ;   /* ob0*ob1*ob2 */
-    float sc, off[3];     /* u = g * sc + off: grid-frame metres -> render-voxel coordinate */
-    double box_lo[3], box_hi[3]; /* grid-frame metres where the interpolant may be nonzero */
-} sgrid;
 
 static void sgrid_free(sgrid *g)
 {
@@ -223,19 +207,6 @@ static atmos_status sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
 
 /* ------------------------------------------------------------------ optics tables */
 
-typedef struct {
-    int n;                     /* wavelengths */
-    int nf;                    /* fields */
-    float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* sigma_ext, m^2 */
-    float sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* albedo * sigma_ext */
-    int no;                    /* Ams orders tabulated: 1..no */
-    int ng[ATMOS_VOLUME_MAX_FIELDS];
-    const double *grid[ATMOS_VOLUME_MAX_FIELDS];  /* theta, degrees */
-    float *ams[ATMOS_VOLUME_MAX_FIELDS];          /* [(k * ng + a) * no + (order - 1)] */
-    float *F[ATMOS_VOLUME_MAX_FIELDS];            /* [k * (SLICE_F_ORDERS+1) + n]: F_n (Eq. 23) */
-    float *S[ATMOS_VOLUME_MAX_FIELDS];            /* same layout: S(n) = sum_{i<=n} ln F_i */
-} stables;
-
 static void stables_free(stables *t)
 {
     for (int f = 0; f < ATMOS_VOLUME_MAX_FIELDS; f++) free(t->ams[f]), free(t->F[f]), free(t->S[f]);
@@ -308,35 +279,6 @@ static void angle_locate(const double *grid, int ng, double theta_deg, int *a, f
     *w = (float)((theta_deg - grid[lo]) / (grid[lo + 1] - grid[lo]));
 }
 
-/* Ams_m (sr^-1) at fractional order m >= 1 at the pixel's angle (index a, weight wa). */
-static inline float ams_lookup(const stables *t, int f, int k, int a, float wa, float m)
-{
-    const int no = t->no;
-    float mm = m < 1.0f ? 1.0f : (m > (float)no ? (float)no : m);
-    int oi = (int)(mm - 1.0f);
-    if (oi > no - 2) oi = no - 2;
-    float fo = mm - 1.0f - (float)oi;
-    const float *p = t->ams[f] + ((size_t)k * t->ng[f] + a) * no + oi;
-    float lo = p[0] + fo * (p[1] - p[0]);
-    float hi = p[no] + fo * (p[no + 1] - p[no]);
-    return lo + wa * (hi - lo);
-}
-
-/* Linear interpolation in a per-order table at fractional n >= 0; past the last order,
- * F is held (F_n -> 1/2) and S grows by ln F of the last order per order. */
-static inline float order_lerp(const float *tab, float n, int extend)
-{
-    if (!(n > 0.0f)) return tab[0];
-    if (n >= (float)SLICE_F_ORDERS) {
-        if (!extend) return tab[SLICE_F_ORDERS];
-        float slope = tab[SLICE_F_ORDERS] - tab[SLICE_F_ORDERS - 1];
-        return tab[SLICE_F_ORDERS] + slope * (n - (float)SLICE_F_ORDERS);
-    }
-    int i = (int)n;
-    float f = n - (float)i;
-    return tab[i] + f * (tab[i + 1] - tab[i]);
-}
-
 /* ------------------------------------------------------------------ geometry helpers */
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -391,228 +333,6 @@ static void slice_range(double sa, double sb, double s0, double ds, int nslices,
 
 /* ------------------------------------------------------------------ the render */
 
-/* Pixels x0..x1 of one image row, or texels of one light-buffer row, that a slice
- * touches (x0 > x1: none). */
-typedef struct {
-    int x0, x1;
-} sspan;
-
-typedef struct {
-    int n, nf;
-    int W, H, L;                 /* image, light buffer side */
-    int nslices;
-    int btf;                     /* back-to-front */
-    int low_albedo, eq24;
-    float xi;
-    double h[3], lt[3], e1[3], e2[3]; /* half vector, light propagation, light basis */
-    double s0, ds;               /* slice planes s_k = s0 + (k + 0.5) ds along h */
-    double eye[3], he;           /* eye in grid frame, h . eye */
-    double u0, v0, du, dv;       /* light buffer: texel (a, b) centre at u0 + (a+0.5) du, ... */
-    double hl;                   /* h . lt */
-    const sgrid *g;
-    const stables *t;
-    /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
-     * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
-     * coordinate (texel units, centres at integers) F0 + k dF. */
-    float *pU0[3], *pdU[3], *pF0[2], *pdF[2];
-    float *pdelta;               /* eye-ray length of a slab */
-    float *pinv;                 /* 1 / (h . d) */
-    int *pk0, *pk1;              /* slices the ray crosses inside the box */
-    int *pa;                     /* [pix * nf + f] Ams angle row offset */
-    float *pw;                   /* [pix * nf + f] weight of the next angle */
-    float *L_eye, *T_eye;        /* [c * npix + pix] */
-    /* Per light texel; render-voxel coordinate of texel (a, b) on slice k:
-     * lA + a lEa + b lEb + k lEk. */
-    int *lk0, *lk1;
-    double lA[3], lEa[3], lEb[3], lEk[3];
-    float ldelta;                /* light-ray length of a slab */
-    float *I[2], *nsc[2];        /* light arriving at slice k: I[k & 1] ([c * L*L + texel]), nsc[k & 1] */
-    /* Per slice: the pixels of each row and the texels of each light row whose
-     * samples may fall in occupied blocks ([k * H + y], [k * L + b]). */
-    sspan *espan, *lspan;
-} sjob;
-
-/* Trilinear densities of all fields at render-voxel coordinate (u, v, w). Returns 0
- * if the point is outside the grid or in an empty occupancy block (dens untouched). */
-static inline int sgrid_sample_u(const sgrid *g, float u, float v, float w, float *dens)
-{
-    if (!(u >= 0.0f && v >= 0.0f && w >= 0.0f)) return 0;
-    int i = (int)u, j = (int)v, k = (int)w;
-    if (i > g->c[0] - 2 || j > g->c[1] - 2 || k > g->c[2] - 2) return 0;
-    if (!g->occ[((size_t)(k / SLICE_OCC_B) * g->ob[1] + j / SLICE_OCC_B) * g->ob[0] + i / SLICE_OCC_B]) return 0;
-    float fu = u - i, fv = v - j, fw = w - k;
-    const int nf = g->nf;
-    const size_t sx = (size_t)nf, sy = (size_t)g->c[0] * nf, sz = (size_t)g->c[0] * g->c[1] * nf;
-    const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
-    float w000 = (1 - fu) * (1 - fv) * (1 - fw), w100 = fu * (1 - fv) * (1 - fw), w010 = (1 - fu) * fv * (1 - fw),
-          w110 = fu * fv * (1 - fw), w001 = (1 - fu) * (1 - fv) * fw, w101 = fu * (1 - fv) * fw,
-          w011 = (1 - fu) * fv * fw, w111 = fu * fv * fw;
-    for (int f = 0; f < nf; f++)
-        dens[f] = w000 * p[f] + w100 * p[sx + f] + w010 * p[sy + f] + w110 * p[sx + sy + f] + w001 * p[sz + f] +
-                  w101 * p[sx + sz + f] + w011 * p[sy + sz + f] + w111 * p[sx + sy + sz + f];
-    return 1;
-}
-
-/* Light buffer lookup at light-buffer coordinate (fu, fv): bilinear I per wavelength and n. */
-static inline void light_lookup(const sjob *j, const float *Ib, const float *nb, float fu, float fv, float *I, float *n)
-{
-    const int L = j->L;
-    const float lim = (float)(L - 1);
-    fu = fu < 0.0f ? 0.0f : (fu > lim ? lim : fu);
-    fv = fv < 0.0f ? 0.0f : (fv > lim ? lim : fv);
-    int a = (int)fu, b = (int)fv;
-    if (a > L - 2) a = L - 2;
-    if (b > L - 2) b = L - 2;
-    float wa = fu - (float)a, wb = fv - (float)b;
-    size_t t00 = (size_t)b * L + a, t10 = t00 + 1, t01 = t00 + L, t11 = t01 + 1;
-    float w00 = (1 - wa) * (1 - wb), w10 = wa * (1 - wb), w01 = (1 - wa) * wb, w11 = wa * wb;
-    const size_t LL = (size_t)L * L;
-    for (int k = 0; k < j->n; k++) {
-        const float *p = Ib + k * LL;
-        I[k] = w00 * p[t00] + w10 * p[t10] + w01 * p[t01] + w11 * p[t11];
-    }
-    *n = w00 * nb[t00] + w10 * nb[t10] + w01 * nb[t01] + w11 * nb[t11];
-}
-
-/* Eye pass of slice k over pixels x0..x1 of image row y (Eq. 26). Returns the
- * samples evaluated. */
-static long long eye_span(const sjob *j, int k, int y, int x0, int x1)
-{
-    const int n = j->n, nf = j->nf, no = j->t->no;
-    const size_t npix = (size_t)j->W * j->H;
-    const float kf = (float)k;
-    const float *Ib = j->I[k & 1], *nb = j->nsc[k & 1];
-    float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], nsc;
-    long long count = 0;
-    for (int x = x0; x <= x1; x++) {
-        size_t p = (size_t)y * j->W + x;
-        if (k < j->pk0[p] || k > j->pk1[p]) continue;
-        float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
-              w = j->pU0[2][p] + kf * j->pdU[2][p];
-        if (!sgrid_sample_u(j->g, u, v, w, dens)) continue;
-        count++;
-        light_lookup(j, Ib, nb, j->pF0[0][p] + kf * j->pdF[0][p], j->pF0[1][p] + kf * j->pdF[1][p], I, &nsc);
-        const float delta = j->pdelta[p];
-        /* One more scattering than the light has had turns it to the eye (Eq. 26):
-         * Ams at fractional order m, linear between orders (and angles). */
-        const float m = j->low_albedo ? 1.0f : nsc + 1.0f;
-        const float mm = m < 1.0f ? 1.0f : (m > (float)no ? (float)no : m);
-        int oi = (int)(mm - 1.0f);
-        if (oi > no - 2) oi = no - 2;
-        const float fo = mm - 1.0f - (float)oi;
-        for (int c = 0; c < n; c++) {
-            float bext = 0, src = 0;
-            for (int f = 0; f < nf; f++) {
-                if (dens[f] <= 0.0f) continue;
-                bext += dens[f] * j->t->sig[f][c];
-                float bs = dens[f] * j->t->sca[f][c];
-                if (bs > 0.0f) {
-                    const float *q = j->t->ams[f] + ((size_t)c * j->t->ng[f] * no + j->pa[p * nf + f] + oi);
-                    float lo = q[0] + fo * (q[1] - q[0]);
-                    float hi = q[no] + fo * (q[no + 1] - q[no]);
-                    src += bs * (lo + j->pw[p * nf + f] * (hi - lo) + j->xi);
-                }
-            }
-            if (bext <= 0.0f) continue;
-            float tau = bext * delta;
-            float Tslab = expf(-tau);
-            /* beta_sca Delta of Eq. 26, integrated over the slab with its own
-             * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
-            float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
-            float contrib = I[c] * src * len;
-            float *Lp = j->L_eye + c * npix + p, *Tp = j->T_eye + c * npix + p;
-            if (j->btf) *Lp = *Lp * Tslab + contrib; /* back-to-front: over */
-            else *Lp += *Tp * contrib;               /* front-to-back: under */
-            *Tp *= Tslab;
-        }
-    }
-    return count;
-}
-
-/* Light pass of slice k over texels x0..x1 of light row b (Eq. 21, 25 / 24): reads
- * the light arriving at slice k, writes the light leaving it into the other buffer.
- * Texels a0..a1 may meet occupied blocks; the others of x0..x1 are copied (texels
- * outside x0..x1 are equal in both buffers, see render). */
-static long long light_span(const sjob *j, int k, int b, int x0, int x1, int a0, int a1)
-{
-    const int n = j->n, nf = j->nf, L = j->L;
-    const size_t LL = (size_t)L * L;
-    const float delta = j->ldelta;
-    const float *Ic = j->I[k & 1], *nc = j->nsc[k & 1];
-    float *In = j->I[(k + 1) & 1], *nn = j->nsc[(k + 1) & 1];
-    float dens[ATMOS_VOLUME_MAX_FIELDS];
-    long long count = 0;
-    double base[3];
-    for (int i = 0; i < 3; i++) base[i] = j->lA[i] + b * j->lEb[i] + k * j->lEk[i];
-    const float bu = (float)base[0], bv = (float)base[1], bw = (float)base[2];
-    const float eu = (float)j->lEa[0], ev = (float)j->lEa[1], ew = (float)j->lEa[2];
-    for (int a = x0; a <= x1; a++) {
-        size_t q = (size_t)b * L + a;
-        const float n0 = nc[q];
-        nn[q] = n0;
-        int upd = a >= a0 && a <= a1 && k >= j->lk0[q] && k <= j->lk1[q];
-        if (upd) {
-            const float af = (float)a;
-            upd = sgrid_sample_u(j->g, bu + af * eu, bv + af * ev, bw + af * ew, dens);
-        }
-        if (!upd) {
-            for (int c = 0; c < n; c++) In[c * LL + q] = Ic[c * LL + q];
-            continue;
-        }
-        count++;
-        float dn = 0;
-        for (int c = 0; c < n; c++) {
-            float bext = 0, bsca = 0;
-            for (int f = 0; f < nf; f++) {
-                bext += dens[f] * j->t->sig[f][c];
-                bsca += dens[f] * j->t->sca[f][c];
-            }
-            dn += bsca * delta;
-            if (bext <= 0.0f) {
-                In[c * LL + q] = Ic[c * LL + q];
-                continue;
-            }
-            float tau = bext * delta, T = expf(-tau);
-            float keep; /* fraction of the scattered light (1 - T) still going forward */
-            if (j->low_albedo) {
-                keep = 0.0f;
-            } else {
-                /* The number of scatterings in the slab, ceil(beta Delta) in Eq. 24, taken
-                 * continuously as max(1, beta Delta); Eq. 25 raises its worst-case factor to
-                 * the same power (see docs/slice.md). */
-                float msl = tau > 1.0f ? tau : 1.0f;
-                if (bsca <= 0.0f) {
-                    keep = 0.0f;
-                } else if (!j->eq24) {
-                    /* Eq. 25: (alpha F_{floor(n + 1 + beta Delta)})^{beta Delta}. */
-                    float idx = floorf(n0 + 1.0f + tau);
-                    float aF = 0;
-                    for (int f = 0; f < nf; f++)
-                        if (dens[f] > 0.0f)
-                            aF += dens[f] * j->t->sca[f][c] *
-                                  order_lerp(j->t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1), idx, 0);
-                    aF /= bext;
-                    keep = aF > 0.0f ? (tau > 1.0f ? expf(msl * logf(aF)) : aF) : 0.0f;
-                } else {
-                    /* Eq. 24: prod_{i=n+1}^{n+m} alpha F_i = alpha^m exp(S(n+m) - S(n)); fields
-                     * mixed geometrically by their share of beta_sca. */
-                    float lnk = msl * logf(bsca / bext);
-                    for (int f = 0; f < nf; f++) {
-                        float bs = dens[f] * j->t->sca[f][c];
-                        if (bs <= 0.0f) continue;
-                        const float *S = j->t->S[f] + (size_t)c * (SLICE_F_ORDERS + 1);
-                        lnk += bs / bsca * (order_lerp(S, n0 + msl, 1) - order_lerp(S, n0, 1));
-                    }
-                    keep = expf(lnk);
-                }
-            }
-            In[c * LL + q] = Ic[c * LL + q] * (T + (1.0f - T) * keep);
-        }
-        /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
-        nn[q] = n0 + dn / (float)n;
-    }
-    return count;
-}
 
 /* Per-slice spans. Every occupied block (a cube of SLICE_OCC_B render voxels, widened
  * by a small margin for rounding) meets the slices between the planes through its
@@ -749,6 +469,7 @@ static atmos_status check_settings(atmos_context *ctx, const atmos_slice_setting
     if (in->xi != 0) s->xi = in->xi < 0 ? 0 : in->xi;
     s->update = in->update;
     s->low_albedo = in->low_albedo;
+    s->reference = in->reference;
     if (in->grid_max_dim) s->grid_max_dim = in->grid_max_dim;
     if (in->max_order) s->max_order = in->max_order;
     if (in->density_scale != 0) s->density_scale = in->density_scale;
@@ -1048,6 +769,10 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
      * count or the schedule. Only the texels a light span of slice k - 1 or k covers
      * can differ between the two buffers, so only those are visited. Per-thread CPU
      * time in each pass gives the breakdown. */
+    long long (*const eye_pass)(const sjob *, int, int, int, int) =
+        s.reference ? atmos__slice_eye_span_ref : atmos__slice_eye_span;
+    long long (*const light_pass)(const sjob *, int, int, int, int, int, int) =
+        s.reference ? atmos__slice_light_span_ref : atmos__slice_light_span;
     int cancelled = 0;
     double cpu_eye = 0, cpu_light = 0;
     const double t_sl0 = now_seconds();
@@ -1061,12 +786,12 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
 #pragma omp for schedule(dynamic, 2) nowait
         for (int r = 0; r < ne + nl; r++) {
             if (r < ne) {
-                if (es[r].x0 <= es[r].x1) eye_samples += eye_span(&j, k, r, es[r].x0, es[r].x1);
+                if (es[r].x0 <= es[r].x1) eye_samples += eye_pass(&j, k, r, es[r].x0, es[r].x1);
             } else {
                 if (tl < 0) tl = now_seconds();
                 int b = r - ne, x0 = ls[b].x0, x1 = ls[b].x1;
                 if (lp) x0 = lp[b].x0 < x0 ? lp[b].x0 : x0, x1 = lp[b].x1 > x1 ? lp[b].x1 : x1;
-                if (x0 <= x1) light_samples += light_span(&j, k, b, x0, x1, ls[b].x0, ls[b].x1);
+                if (x0 <= x1) light_samples += light_pass(&j, k, b, x0, x1, ls[b].x0, ls[b].x1);
             }
         }
         double t1 = now_seconds();
