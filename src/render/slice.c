@@ -457,6 +457,24 @@ static int build_spans(sjob *j, const atmos_camera *cam, const double cf[3], con
         }
     }
     free(fp);
+    for (int y = 0; y < H; y++) {
+        sspan u = {j->W, -1};
+        for (int k = 0; k < K; k++) {
+            const sspan *e = &j->espan[(size_t)k * H + y];
+            if (e->x0 < u.x0) u.x0 = e->x0;
+            if (e->x1 > u.x1) u.x1 = e->x1;
+        }
+        j->erow[y] = u;
+    }
+    for (int b = 0; b < L; b++) {
+        sspan u = {L, -1};
+        for (int k = 0; k < K; k++) {
+            const sspan *e = &j->lspan[(size_t)k * L + b];
+            if (e->x0 < u.x0) u.x0 = e->x0;
+            if (e->x1 > u.x1) u.x1 = e->x1;
+        }
+        j->lrow[b] = u;
+    }
     return 1;
 }
 
@@ -628,7 +646,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     j.pk0 = malloc(sizeof(int) * npix * 2);
     j.pa = malloc(sizeof(int) * npix * j.nf);
     j.pw = malloc(sizeof(float) * npix * j.nf);
-    j.L_eye = calloc(npix * j.n, sizeof(float));
+    j.L_eye = malloc(sizeof(float) * npix * j.n);
     j.T_eye = malloc(sizeof(float) * npix * j.n);
     j.lk0 = malloc(sizeof(int) * LL * 2);
     for (int a = 0; a < 2; a++) {
@@ -637,8 +655,10 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     }
     j.espan = malloc(sizeof(sspan) * (size_t)K * j.H);
     j.lspan = malloc(sizeof(sspan) * (size_t)K * j.L);
+    j.erow = malloc(sizeof(sspan) * (size_t)j.H);
+    j.lrow = malloc(sizeof(sspan) * (size_t)j.L);
     int nomem = !j.pdelta || !j.pinv || !j.pk0 || !j.pa || !j.pw || !j.L_eye || !j.T_eye || !j.lk0 || !j.espan ||
-                !j.lspan;
+                !j.lspan || !j.erow || !j.lrow;
     for (int a = 0; a < 3; a++) nomem |= !j.pU0[a] || !j.pdU[a];
     for (int a = 0; a < 2; a++) nomem |= !j.pF0[a] || !j.pdF[a] || !j.I[a] || !j.nsc[a];
     if (nomem) {
@@ -647,19 +667,29 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     }
     j.pk1 = j.pk0 + npix;
     j.lk1 = j.lk0 + LL;
-    for (size_t i = 0; i < npix * j.n; i++) j.T_eye[i] = 1.0f;
     const int threads = atmos__threads(ctx);
     const double t_setup0 = now_seconds();
 
+    {
+        double cf[3], cr[3], cu[3];
+        TO_GRID(cam.forward, cf);
+        TO_GRID(cam.right, cr);
+        TO_GRID(cam.up, cu);
+        if (!build_spans(&j, &cam, cf, cr, cu, threads)) {
+            st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the spans");
+            goto done;
+        }
+    }
     /* Per pixel: ray, slices it crosses inside the box (in front of the eye and of
      * the ground), its sample on slice k as a linear function of k, and the Ams angle
      * (scattering angle between the sun's light and the direction to the eye:
      * cos theta = d . sun). */
     const double ee1 = dot3(j.eye, j.e1), ee2 = dot3(j.eye, j.e2);
-#pragma omp parallel for schedule(static) num_threads(threads)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
     for (int y = 0; y < j.H; y++)
-        for (int x = 0; x < j.W; x++) {
+        for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
             size_t p = (size_t)y * j.W + x;
+            for (int c = 0; c < j.n; c++) j.L_eye[c * npix + p] = 0.0f, j.T_eye[c * npix + p] = 1.0f;
             double dw[3], d[3];
             atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
             TO_GRID(dw, d);
@@ -732,6 +762,11 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         for (int b = 0; b < j.L; b++)
             for (int a = 0; a < j.L; a++) {
                 size_t q = (size_t)b * j.L + a;
+                j.lk0[q] = 1, j.lk1[q] = 0;
+                if (a < j.lrow[b].x0 || a > j.lrow[b].x1) { /* never read */
+                    for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = j.I[1][c * LL + q] = (float)sl_miss[c];
+                    continue;
+                }
                 double u = j.u0 + (a + 0.5) * j.du, v = j.v0 + (b + 0.5) * j.dv;
                 double o[3] = {u * j.e1[0] + v * j.e2[0], u * j.e1[1] + v * j.e2[1], u * j.e1[2] + v * j.e2[2]};
                 double ta, tb, sl[ATMOS_MAX_WAVELENGTHS];
@@ -748,16 +783,6 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 }
                 for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = j.I[1][c * LL + q] = (float)sl[c];
             }
-    }
-    {
-        double cf[3], cr[3], cu[3];
-        TO_GRID(cam.forward, cf);
-        TO_GRID(cam.right, cr);
-        TO_GRID(cam.up, cu);
-        if (!build_spans(&j, &cam, cf, cr, cu, threads)) {
-            st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the spans");
-            goto done;
-        }
     }
     const double t_setup = now_seconds() - t_setup0;
     const double t_prep = now_seconds() - t_prep0;
@@ -822,9 +847,9 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                          0.5 * (g.box_lo[2] + g.box_hi[2])};
         const double hc = dot3(j.h, cen);
         const int C = img->channels;
-#pragma omp parallel for schedule(static) num_threads(threads)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
         for (int y = 0; y < j.H; y++)
-            for (int x = 0; x < j.W; x++) {
+            for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
                 size_t p = (size_t)y * j.W + x;
                 int touched = 0;
                 for (int c = 0; c < j.n; c++)
@@ -885,7 +910,7 @@ done:
     for (int a = 0; a < 3; a++) free(j.pU0[a]), free(j.pdU[a]);
     for (int a = 0; a < 2; a++) free(j.pF0[a]), free(j.pdF[a]), free(j.I[a]), free(j.nsc[a]);
     free(j.pdelta), free(j.pinv), free(j.pk0), free(j.pa), free(j.pw), free(j.L_eye), free(j.T_eye), free(j.lk0);
-    free(j.espan), free(j.lspan);
+    free(j.espan), free(j.lspan), free(j.erow), free(j.lrow);
     atmos_sky_destroy(sky);
     stables_free(&tab);
     sgrid_free(&g);

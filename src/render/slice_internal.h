@@ -75,6 +75,9 @@ typedef struct {
     /* Per slice: the pixels of each row and the texels of each light row whose
      * samples may fall in occupied blocks ([k * H + y], [k * L + b]). */
     sspan *espan, *lspan;
+    /* Their union over the slices, per image row and per light row: the only pixels
+     * and texels the render reads or writes (the rest keep the sky / are never read). */
+    sspan *erow, *lrow;
 } sjob;
 
 /* Eye pass of slice k over pixels x0..x1 of image row y (Eq. 26); light pass of slice k
