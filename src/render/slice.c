@@ -466,6 +466,17 @@ static int build_spans(sjob *j, const atmos_camera *cam, const double cf[3], con
         }
         j->erow[y] = u;
     }
+    /* Light spans of slices k - batch..k (the texels a ring slot may hold stale). */
+    for (int b = 0; b < L; b++)
+        for (int k = 0; k < K; k++) {
+            sspan u = {L, -1};
+            for (int q = k - j->batch < 0 ? 0 : k - j->batch; q <= k; q++) {
+                const sspan *e = &j->lspan[(size_t)q * L + b];
+                if (e->x0 < u.x0) u.x0 = e->x0;
+                if (e->x1 > u.x1) u.x1 = e->x1;
+            }
+            j->wspan[(size_t)k * L + b] = u;
+        }
     for (int b = 0; b < L; b++) {
         sspan u = {L, -1};
         for (int k = 0; k < K; k++) {
@@ -649,18 +660,30 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     j.L_eye = malloc(sizeof(float) * npix * j.n);
     j.T_eye = malloc(sizeof(float) * npix * j.n);
     j.lk0 = malloc(sizeof(int) * LL * 2);
-    for (int a = 0; a < 2; a++) {
-        j.I[a] = malloc(sizeof(float) * LL * j.n);
-        j.nsc[a] = calloc(LL, sizeof(float));
+    /* The light ring: B + 1 slots of L^2 (n + 1) floats, B up to 16 within 32 MB. */
+    {
+        size_t slot = sizeof(float) * LL * (size_t)(j.n + 1);
+        size_t fit = ((size_t)32 << 20) / slot;
+        j.batch = fit > 17 ? 16 : (fit > 2 ? (int)fit - 1 : 1);
+        j.ring = malloc(slot * (size_t)(j.batch + 1));
+        j.I = malloc(sizeof(float *) * (size_t)(j.batch + 1));
+        j.nsc = malloc(sizeof(float *) * (size_t)(j.batch + 1));
+        if (j.ring && j.I && j.nsc)
+            for (int q = 0; q <= j.batch; q++) {
+                j.I[q] = j.ring + (size_t)q * LL * (size_t)(j.n + 1);
+                j.nsc[q] = j.I[q] + LL * (size_t)j.n;
+            }
     }
     j.espan = malloc(sizeof(sspan) * (size_t)K * j.H);
     j.lspan = malloc(sizeof(sspan) * (size_t)K * j.L);
+    j.wspan = malloc(sizeof(sspan) * (size_t)K * j.L);
     j.erow = malloc(sizeof(sspan) * (size_t)j.H);
     j.lrow = malloc(sizeof(sspan) * (size_t)j.L);
     int nomem = !j.pdelta || !j.pinv || !j.pk0 || !j.pa || !j.pw || !j.L_eye || !j.T_eye || !j.lk0 || !j.espan ||
-                !j.lspan || !j.erow || !j.lrow;
+                !j.lspan || !j.wspan || !j.erow || !j.lrow;
     for (int a = 0; a < 3; a++) nomem |= !j.pU0[a] || !j.pdU[a];
-    for (int a = 0; a < 2; a++) nomem |= !j.pF0[a] || !j.pdF[a] || !j.I[a] || !j.nsc[a];
+    for (int a = 0; a < 2; a++) nomem |= !j.pF0[a] || !j.pdF[a];
+    nomem |= !j.ring || !j.I || !j.nsc;
     if (nomem) {
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
         goto done;
@@ -764,7 +787,8 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 size_t q = (size_t)b * j.L + a;
                 j.lk0[q] = 1, j.lk1[q] = 0;
                 if (a < j.lrow[b].x0 || a > j.lrow[b].x1) { /* never read */
-                    for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = j.I[1][c * LL + q] = (float)sl_miss[c];
+                    for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = (float)sl_miss[c];
+                    j.nsc[0][q] = 0.0f;
                     continue;
                 }
                 double u = j.u0 + (a + 0.5) * j.du, v = j.v0 + (b + 0.5) * j.dv;
@@ -781,56 +805,77 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 } else {
                     memcpy(sl, sl_miss, sizeof sl);
                 }
-                for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = j.I[1][c * LL + q] = (float)sl[c];
+                for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = (float)sl[c];
+                j.nsc[0][q] = 0.0f;
             }
+    }
+    {
+        const size_t slot = LL * (size_t)(j.n + 1);
+        const int nslot = j.batch + 1;
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (int q = 1; q < nslot; q++) memcpy(j.I[q], j.I[0], sizeof(float) * slot);
     }
     const double t_setup = now_seconds() - t_setup0;
     const double t_prep = now_seconds() - t_prep0;
 
-    /* The slices, in one parallel region with one barrier per slice. The eye pass of
-     * slice k reads the light arriving at it (buffer k & 1) while the light pass
-     * writes the light leaving it into the other buffer; each pixel and texel is
-     * written by one work item only, so the image does not depend on the thread
-     * count or the schedule. Only the texels a light span of slice k - 1 or k covers
-     * can differ between the two buffers, so only those are visited. Per-thread CPU
-     * time in each pass gives the breakdown. */
-    long long (*const eye_pass)(const sjob *, int, int, int, int) =
+    /* The slices, in batches of B (one parallel region, three barriers per batch).
+     * Slot s of the light ring holds the light arriving at slice k0 + s. The light of
+     * a texel on slice k depends only on that texel on slice k - 1, so each light row
+     * runs through the batch on its own (phase A); then each image row runs through
+     * the batch reading slot k - k0 (phase B). Each pixel and texel is written by one
+     * work item only and sees the same sequence of operations as in a slice-by-slice
+     * order, so the image does not depend on the thread count, the schedule or B.
+     * After a batch the ring rotates (the last slot becomes slot 0), so a slot written
+     * for slice k held the light of B + 1 slices earlier: only texels some light span
+     * of slices k - B..k covers can differ, and only those are copied or updated. */
+    long long (*const eye_pass)(const sjob *, int, int, int, int, const float *, const float *) =
         s.reference ? atmos__slice_eye_span_ref : atmos__slice_eye_span;
-    long long (*const light_pass)(const sjob *, int, int, int, int, int, int) =
-        s.reference ? atmos__slice_light_span_ref : atmos__slice_light_span;
+    long long (*const light_pass)(const sjob *, int, int, int, int, int, int, const float *, const float *, float *,
+                                  float *) = s.reference ? atmos__slice_light_span_ref : atmos__slice_light_span;
     int cancelled = 0;
-    double cpu_eye = 0, cpu_light = 0;
+    const int nbatch = j.batch;
     const double t_sl0 = now_seconds();
-#pragma omp parallel num_threads(threads) reduction(+ : eye_samples, light_samples, cpu_eye, cpu_light)
-    for (int k = 0; k < K; k++) {
+#pragma omp parallel num_threads(threads) reduction(+ : eye_samples, light_samples)
+    for (int k0 = 0; k0 < K; k0 += nbatch) {
         if (cancelled) break; /* set before the previous barrier: every thread sees the same value */
-        const sspan *es = j.espan + (size_t)k * j.H, *ls = j.lspan + (size_t)k * j.L,
-                    *lp = k > 0 ? j.lspan + (size_t)(k - 1) * j.L : NULL;
-        const int ne = j.H, nl = j.L;
-        double t0 = now_seconds(), tl = -1;
-#pragma omp for schedule(dynamic, 2) nowait
-        for (int r = 0; r < ne + nl; r++) {
-            if (r < ne) {
-                if (es[r].x0 <= es[r].x1) eye_samples += eye_pass(&j, k, r, es[r].x0, es[r].x1);
-            } else {
-                if (tl < 0) tl = now_seconds();
-                int b = r - ne, x0 = ls[b].x0, x1 = ls[b].x1;
-                if (lp) x0 = lp[b].x0 < x0 ? lp[b].x0 : x0, x1 = lp[b].x1 > x1 ? lp[b].x1 : x1;
-                if (x0 <= x1) light_samples += light_pass(&j, k, b, x0, x1, ls[b].x0, ls[b].x1);
-            }
-        }
-        double t1 = now_seconds();
-        if (tl < 0) cpu_eye += t1 - t0;
-        else cpu_eye += tl - t0, cpu_light += t1 - tl;
+        const int nb = K - k0 < nbatch ? K - k0 : nbatch;
+        double ta = 0;
 #pragma omp master
-        if (atmos__progress(ctx, "render slice", (double)(k + 1) / K)) cancelled = 1;
+        ta = now_seconds();
+#pragma omp for schedule(dynamic, 1)
+        for (int b = 0; b < j.L; b++)
+            for (int q = 0; q < nb; q++) {
+                const int k = k0 + q;
+                const sspan ls = j.lspan[(size_t)k * j.L + b], ws = j.wspan[(size_t)k * j.L + b];
+                if (ws.x0 <= ws.x1)
+                    light_samples += light_pass(&j, k, b, ws.x0, ws.x1, ls.x0, ls.x1, j.I[q], j.nsc[q], j.I[q + 1],
+                                                j.nsc[q + 1]);
+            }
+#pragma omp master
+        {
+            double tb = now_seconds();
+            t_light += tb - ta;
+            ta = tb;
+        }
+#pragma omp for schedule(dynamic, 2)
+        for (int y = 0; y < j.H; y++)
+            for (int q = 0; q < nb; q++) {
+                const int k = k0 + q;
+                const sspan es = j.espan[(size_t)k * j.H + y];
+                if (es.x0 <= es.x1) eye_samples += eye_pass(&j, k, y, es.x0, es.x1, j.I[q], j.nsc[q]);
+            }
+#pragma omp master
+        {
+            t_eye += now_seconds() - ta;
+            float *last = j.I[nb], *lastn = j.nsc[nb];
+            for (int q = nb; q > 0; q--) j.I[q] = j.I[q - 1], j.nsc[q] = j.nsc[q - 1];
+            j.I[0] = last, j.nsc[0] = lastn;
+            if (atmos__progress(ctx, "render slice", (double)(k0 + nb) / K)) cancelled = 1;
+        }
 #pragma omp barrier
     }
     const double t_slices = now_seconds() - t_sl0;
-    if (cpu_eye + cpu_light > 0) {
-        t_eye = t_slices * cpu_eye / (cpu_eye + cpu_light);
-        t_light = t_slices - t_eye;
-    }
+    (void)t_slices;
     if (cancelled) {
         st = atmos__error(ctx, ATMOS_E_CANCELLED, "render slice: cancelled");
         goto done;
@@ -908,9 +953,10 @@ finish:
 done:
 #undef TO_GRID
     for (int a = 0; a < 3; a++) free(j.pU0[a]), free(j.pdU[a]);
-    for (int a = 0; a < 2; a++) free(j.pF0[a]), free(j.pdF[a]), free(j.I[a]), free(j.nsc[a]);
+    for (int a = 0; a < 2; a++) free(j.pF0[a]), free(j.pdF[a]);
+    free(j.ring), free(j.I), free(j.nsc);
     free(j.pdelta), free(j.pinv), free(j.pk0), free(j.pa), free(j.pw), free(j.L_eye), free(j.T_eye), free(j.lk0);
-    free(j.espan), free(j.lspan), free(j.erow), free(j.lrow);
+    free(j.espan), free(j.lspan), free(j.wspan), free(j.erow), free(j.lrow);
     atmos_sky_destroy(sky);
     stables_free(&tab);
     sgrid_free(&g);

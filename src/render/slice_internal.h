@@ -71,10 +71,12 @@ typedef struct {
     int *lk0, *lk1;
     double lA[3], lEa[3], lEb[3], lEk[3];
     float ldelta;                /* light-ray length of a slab */
-    float *I[2], *nsc[2];        /* light arriving at slice k: I[k & 1] ([c * L*L + texel]), nsc[k & 1] */
+    /* The light ring (see render): batch + 1 slots, each I ([c * L*L + texel]) then n. */
+    int batch;
+    float *ring, **I, **nsc;
     /* Per slice: the pixels of each row and the texels of each light row whose
      * samples may fall in occupied blocks ([k * H + y], [k * L + b]). */
-    sspan *espan, *lspan;
+    sspan *espan, *lspan, *wspan; /* wspan: union of the light spans of slices k - batch..k */
     /* Their union over the slices, per image row and per light row: the only pixels
      * and texels the render reads or writes (the rest keep the sky / are never read). */
     sspan *erow, *lrow;
@@ -83,13 +85,16 @@ typedef struct {
 /* Eye pass of slice k over pixels x0..x1 of image row y (Eq. 26); light pass of slice k
  * over texels x0..x1 of light row b (Eq. 21, 25 / 24) where texels a0..a1 may meet
  * occupied blocks (the others of x0..x1 are copied from the arriving buffer). Each
- * returns the samples that fell in occupied blocks. The fast versions process a span
+ * returns the samples that fell in occupied blocks. Ib/nb (Ic/nc) are the light
+ * arriving at slice k, In/nn the light leaving it. The fast versions process a span
  * in chunks of structure-of-arrays samples with vectorisable loops and a polynomial
  * exp; the reference versions are the plain scalar loops with libm's expf/logf
  * (atmos_slice_settings.reference). Both write only their own pixels/texels. */
-long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1);
-long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, int a0, int a1);
-long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1);
-long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x1, int a0, int a1);
+long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb);
+long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, int a0, int a1, const float *Ic,
+                                  const float *nc, float *In, float *nn);
+long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb);
+long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x1, int a0, int a1, const float *Ic,
+                                      const float *nc, float *In, float *nn);
 
 #endif

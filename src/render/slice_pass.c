@@ -71,12 +71,11 @@ static inline void light_lookup(const sjob *j, const float *Ib, const float *nb,
 }
 
 /* Reference eye pass (see slice_internal.h). */
-long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1)
+long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb)
 {
     const int n = j->n, nf = j->nf, no = j->t->no;
     const size_t npix = (size_t)j->W * j->H;
     const float kf = (float)k;
-    const float *Ib = j->I[k & 1], *nb = j->nsc[k & 1];
     float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], nsc;
     long long count = 0;
     for (int x = x0; x <= x1; x++) {
@@ -128,13 +127,12 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1)
  * the light arriving at slice k, writes the light leaving it into the other buffer.
  * Texels a0..a1 may meet occupied blocks; the others of x0..x1 are copied (texels
  * outside x0..x1 are equal in both buffers, see render). */
-long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x1, int a0, int a1)
+long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x1, int a0, int a1, const float *Ic,
+                                      const float *nc, float *In, float *nn)
 {
     const int n = j->n, nf = j->nf, L = j->L;
     const size_t LL = (size_t)L * L;
     const float delta = j->ldelta;
-    const float *Ic = j->I[k & 1], *nc = j->nsc[k & 1];
-    float *In = j->I[(k + 1) & 1], *nn = j->nsc[(k + 1) & 1];
     float dens[ATMOS_VOLUME_MAX_FIELDS];
     long long count = 0;
     double base[3];
@@ -318,14 +316,14 @@ static inline int compact(const sgrid *g, int cnt, const float *u, const float *
 }
 
 SLICE_CLONES
-long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1)
+long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, const float *Ib_, const float *nb_)
 {
     const sgrid *g = j->g;
     const stables *t = j->t;
     const int n = j->n, nf = j->nf, no = t->no, L = j->L;
     const size_t npix = (size_t)j->W * j->H, LL = (size_t)L * L;
     const float kf = (float)k, lim = (float)(L - 1), xi = j->xi, fno = (float)no;
-    const float *restrict Ib = j->I[k & 1], *restrict nb = j->nsc[k & 1];
+    const float *restrict Ib = Ib_, *restrict nb = nb_;
     float u[CH], v[CH], w[CH];
     unsigned char ok[CH];
     int id[CH];
@@ -438,16 +436,17 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1)
 }
 
 SLICE_CLONES
-long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, int a0, int a1)
+long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, int a0, int a1, const float *Ic_,
+                                  const float *nc_, float *In_, float *nn_)
 {
-    if (j->eq24) return atmos__slice_light_span_ref(j, k, b, x0, x1, a0, a1);
+    if (j->eq24) return atmos__slice_light_span_ref(j, k, b, x0, x1, a0, a1, Ic_, nc_, In_, nn_);
     const sgrid *g = j->g;
     const stables *t = j->t;
     const int n = j->n, nf = j->nf, L = j->L;
     const size_t LL = (size_t)L * L;
     const float delta = j->ldelta;
-    const float *restrict Ic = j->I[k & 1], *restrict nc = j->nsc[k & 1];
-    float *restrict In = j->I[(k + 1) & 1], *restrict nn = j->nsc[(k + 1) & 1];
+    const float *restrict Ic = Ic_, *restrict nc = nc_;
+    float *restrict In = In_, *restrict nn = nn_;
     double base[3];
     for (int i = 0; i < 3; i++) base[i] = j->lA[i] + b * j->lEb[i] + k * j->lEk[i];
     const float bu = (float)base[0], bv = (float)base[1], bw = (float)base[2];
