@@ -15,6 +15,7 @@
  * static schedule and the image does not depend on the thread count.
  */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* madvise */
 #include "core/internal.h"
 #include "render/slice_internal.h"
 #include "volume/volume_grid.h"
@@ -27,6 +28,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #define SLICE_HD_EPS 0.02      /* rays within ~89° of the slice planes are not sliced */
 #define SLICE_MAX_GRID_BYTES ((uint64_t)2 << 30)
@@ -36,6 +40,23 @@ static double now_seconds(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Large buffers the passes read at random (render grid, light ring, per-pixel
+ * planes): 2 MB aligned and, on Linux, backed by transparent huge pages where the
+ * system allows it, so that the samples do not pay a page walk per access. Freed
+ * with free(). */
+static void *big_alloc(size_t bytes)
+{
+    const size_t huge = (size_t)2 << 20;
+    if (bytes < huge / 2) return malloc(bytes ? bytes : 1);
+    size_t sz = (bytes + huge - 1) / huge * huge;
+    void *p = NULL;
+    if (posix_memalign(&p, huge, sz) != 0) return NULL;
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    (void)madvise(p, sz, MADV_HUGEPAGE);
+#endif
+    return p;
 }
 
 void atmos_slice_defaults(atmos_slice_settings *s)
@@ -144,7 +165,8 @@ static atmos_status sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
     if (nvox * (uint64_t)nf * sizeof(float) > SLICE_MAX_GRID_BYTES)
         return atmos__error(ctx, ATMOS_E_LIMIT, "slice: render grid %dx%dx%d x %d fields exceeds %llu bytes", g->c[0],
                             g->c[1], g->c[2], nf, (unsigned long long)SLICE_MAX_GRID_BYTES);
-    g->v = calloc(nvox * (uint64_t)nf, sizeof(float));
+    g->v = big_alloc(nvox * (uint64_t)nf * sizeof(float));
+    if (g->v) memset(g->v, 0, nvox * (uint64_t)nf * sizeof(float));
     for (int a = 0; a < 3; a++) g->ob[a] = (g->c[a] - 2) / SLICE_OCC_B + 1;
     g->occ = calloc((size_t)g->ob[0] * g->ob[1] * g->ob[2], 1);
     if (!g->v || !g->occ) {
@@ -644,34 +666,39 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     j.t = &tab;
     const size_t npix = (size_t)j.W * j.H, LL = (size_t)j.L * j.L;
     const int K = j.nslices;
-    for (int a = 0; a < 3; a++) {
-        j.pU0[a] = malloc(sizeof(float) * npix);
-        j.pdU[a] = malloc(sizeof(float) * npix);
+    /* The per-pixel planes in one block; planes are padded by two cache lines so
+     * that the same pixel of different planes does not fall in one cache set. */
+    const size_t pst = npix + 32, nplanes = (size_t)14 + 2 * (size_t)j.nf + 2 * (size_t)j.n;
+    j.pst = pst;
+    j.pixblock = big_alloc(sizeof(float) * pst * nplanes);
+    if (j.pixblock) {
+        float *b = j.pixblock;
+        for (int a = 0; a < 3; a++) j.pU0[a] = b, b += pst, j.pdU[a] = b, b += pst;
+        for (int a = 0; a < 2; a++) j.pF0[a] = b, b += pst, j.pdF[a] = b, b += pst;
+        j.pdelta = b, b += pst;
+        j.pinv = b, b += pst;
+        j.pk0 = (int *)b, j.pk1 = (int *)(b + pst), b += 2 * pst;
+        j.pa = (int *)b, b += pst * j.nf;
+        j.pw = b, b += pst * j.nf;
+        j.L_eye = b, b += pst * j.n;
+        j.T_eye = b;
     }
-    for (int a = 0; a < 2; a++) {
-        j.pF0[a] = malloc(sizeof(float) * npix);
-        j.pdF[a] = malloc(sizeof(float) * npix);
-    }
-    j.pdelta = malloc(sizeof(float) * npix);
-    j.pinv = malloc(sizeof(float) * npix);
-    j.pk0 = malloc(sizeof(int) * npix * 2);
-    j.pa = malloc(sizeof(int) * npix * j.nf);
-    j.pw = malloc(sizeof(float) * npix * j.nf);
-    j.L_eye = malloc(sizeof(float) * npix * j.n);
-    j.T_eye = malloc(sizeof(float) * npix * j.n);
     j.lk0 = malloc(sizeof(int) * LL * 2);
-    /* The light ring: B + 1 slots of L^2 (n + 1) floats, B up to 16 within 32 MB. */
+    /* The light ring: B + 1 slots of L^2 texels of n + 1 floats (I per wavelength, then
+     * n: one cache line serves all of a texel), B up to 16 within 32 MB. Slots are
+     * padded by three cache lines so that they do not alias in the caches. */
+    const size_t slotf = LL * (size_t)(j.n + 1) + 48;
     {
-        size_t slot = sizeof(float) * LL * (size_t)(j.n + 1);
+        size_t slot = sizeof(float) * slotf;
         size_t fit = ((size_t)32 << 20) / slot;
         j.batch = fit > 17 ? 16 : (fit > 2 ? (int)fit - 1 : 1);
-        j.ring = malloc(slot * (size_t)(j.batch + 1));
+        j.ring = big_alloc(slot * (size_t)(j.batch + 1));
         j.I = malloc(sizeof(float *) * (size_t)(j.batch + 1));
         j.nsc = malloc(sizeof(float *) * (size_t)(j.batch + 1));
         if (j.ring && j.I && j.nsc)
             for (int q = 0; q <= j.batch; q++) {
-                j.I[q] = j.ring + (size_t)q * LL * (size_t)(j.n + 1);
-                j.nsc[q] = j.I[q] + LL * (size_t)j.n;
+                j.I[q] = j.ring + (size_t)q * slotf;
+                j.nsc[q] = j.I[q] + j.n;
             }
     }
     j.espan = malloc(sizeof(sspan) * (size_t)K * j.H);
@@ -679,16 +706,13 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     j.wspan = malloc(sizeof(sspan) * (size_t)K * j.L);
     j.erow = malloc(sizeof(sspan) * (size_t)j.H);
     j.lrow = malloc(sizeof(sspan) * (size_t)j.L);
-    int nomem = !j.pdelta || !j.pinv || !j.pk0 || !j.pa || !j.pw || !j.L_eye || !j.T_eye || !j.lk0 || !j.espan ||
+    int nomem = !j.pixblock || !j.lk0 || !j.espan ||
                 !j.lspan || !j.wspan || !j.erow || !j.lrow;
-    for (int a = 0; a < 3; a++) nomem |= !j.pU0[a] || !j.pdU[a];
-    for (int a = 0; a < 2; a++) nomem |= !j.pF0[a] || !j.pdF[a];
     nomem |= !j.ring || !j.I || !j.nsc;
     if (nomem) {
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
         goto done;
     }
-    j.pk1 = j.pk0 + npix;
     j.lk1 = j.lk0 + LL;
     const int threads = atmos__threads(ctx);
     const double t_setup0 = now_seconds();
@@ -712,7 +736,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     for (int y = 0; y < j.H; y++)
         for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
             size_t p = (size_t)y * j.W + x;
-            for (int c = 0; c < j.n; c++) j.L_eye[c * npix + p] = 0.0f, j.T_eye[c * npix + p] = 1.0f;
+            for (int c = 0; c < j.n; c++) j.L_eye[c * j.pst + p] = 0.0f, j.T_eye[c * j.pst + p] = 1.0f;
             double dw[3], d[3];
             atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
             TO_GRID(dw, d);
@@ -787,8 +811,8 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 size_t q = (size_t)b * j.L + a;
                 j.lk0[q] = 1, j.lk1[q] = 0;
                 if (a < j.lrow[b].x0 || a > j.lrow[b].x1) { /* never read */
-                    for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = (float)sl_miss[c];
-                    j.nsc[0][q] = 0.0f;
+                    for (int c = 0; c < j.n; c++) j.I[0][q * (j.n + 1) + c] = (float)sl_miss[c];
+                    j.nsc[0][q * (j.n + 1)] = 0.0f;
                     continue;
                 }
                 double u = j.u0 + (a + 0.5) * j.du, v = j.v0 + (b + 0.5) * j.dv;
@@ -805,15 +829,14 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 } else {
                     memcpy(sl, sl_miss, sizeof sl);
                 }
-                for (int c = 0; c < j.n; c++) j.I[0][c * LL + q] = (float)sl[c];
-                j.nsc[0][q] = 0.0f;
+                for (int c = 0; c < j.n; c++) j.I[0][q * (j.n + 1) + c] = (float)sl[c];
+                j.nsc[0][q * (j.n + 1)] = 0.0f;
             }
     }
     {
-        const size_t slot = LL * (size_t)(j.n + 1);
         const int nslot = j.batch + 1;
 #pragma omp parallel for schedule(static) num_threads(threads)
-        for (int q = 1; q < nslot; q++) memcpy(j.I[q], j.I[0], sizeof(float) * slot);
+        for (int q = 1; q < nslot; q++) memcpy(j.I[q], j.I[0], sizeof(float) * LL * (size_t)(j.n + 1));
     }
     const double t_setup = now_seconds() - t_setup0;
     const double t_prep = now_seconds() - t_prep0;
@@ -898,7 +921,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 size_t p = (size_t)y * j.W + x;
                 int touched = 0;
                 for (int c = 0; c < j.n; c++)
-                    touched |= j.L_eye[c * npix + p] != 0.0f || j.T_eye[c * npix + p] != 1.0f;
+                    touched |= j.L_eye[c * j.pst + p] != 0.0f || j.T_eye[c * j.pst + p] != 1.0f;
                 if (!touched) continue;
                 double dw[3];
                 atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
@@ -911,7 +934,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 atmos_sky_transmittance(sky, cam.position[1], dw, th, Tf);
                 float *px = img->pixels + p * C;
                 for (int c = 0; c < j.n; c++) {
-                    double B = px[c], Lv = j.L_eye[c * npix + p], Tv = j.T_eye[c * npix + p];
+                    double B = px[c], Lv = j.L_eye[c * j.pst + p], Tv = j.T_eye[c * j.pst + p];
                     double r = front[c] + Tf[c] * Lv + Tv * (B - front[c]);
                     px[c] = (float)(isfinite(r) && r > 0 ? r : 0.0);
                 }
@@ -952,10 +975,7 @@ finish:
     st = ATMOS_OK;
 done:
 #undef TO_GRID
-    for (int a = 0; a < 3; a++) free(j.pU0[a]), free(j.pdU[a]);
-    for (int a = 0; a < 2; a++) free(j.pF0[a]), free(j.pdF[a]);
-    free(j.ring), free(j.I), free(j.nsc);
-    free(j.pdelta), free(j.pinv), free(j.pk0), free(j.pa), free(j.pw), free(j.L_eye), free(j.T_eye), free(j.lk0);
+    free(j.pixblock), free(j.ring), free(j.I), free(j.nsc), free(j.lk0);
     free(j.espan), free(j.lspan), free(j.wspan), free(j.erow), free(j.lrow);
     atmos_sky_destroy(sky);
     stables_free(&tab);

@@ -65,13 +65,16 @@ typedef struct {
     int *pk0, *pk1;              /* slices the ray crosses inside the box */
     int *pa;                     /* [pix * nf + f] Ams angle row offset */
     float *pw;                   /* [pix * nf + f] weight of the next angle */
-    float *L_eye, *T_eye;        /* [c * npix + pix] */
+    float *L_eye, *T_eye;        /* [c * pst + pix] (pst: plane stride >= npix) */
+    size_t pst;
+    float *pixblock;             /* owns all the per-pixel planes */
     /* Per light texel; render-voxel coordinate of texel (a, b) on slice k:
      * lA + a lEa + b lEb + k lEk. */
     int *lk0, *lk1;
     double lA[3], lEa[3], lEb[3], lEk[3];
     float ldelta;                /* light-ray length of a slab */
-    /* The light ring (see render): batch + 1 slots, each I ([c * L*L + texel]) then n. */
+    /* The light ring (see render): batch + 1 slots of L*L texels, each I per wavelength
+     * then n ([texel * (n + 1) + c]); nsc[s] = I[s] + n. */
     int batch;
     float *ring, **I, **nsc;
     /* Per slice: the pixels of each row and the texels of each light row whose

@@ -62,9 +62,10 @@ static inline void light_lookup(const sjob *j, const float *Ib, const float *nb,
     float wa = fu - (float)a, wb = fv - (float)b;
     size_t t00 = (size_t)b * L + a, t10 = t00 + 1, t01 = t00 + L, t11 = t01 + 1;
     float w00 = (1 - wa) * (1 - wb), w10 = wa * (1 - wb), w01 = (1 - wa) * wb, w11 = wa * wb;
-    const size_t LL = (size_t)L * L;
+    const size_t ns = (size_t)j->n + 1; /* texels interleave I per wavelength and n */
+    t00 *= ns, t10 *= ns, t01 *= ns, t11 *= ns;
     for (int k = 0; k < j->n; k++) {
-        const float *p = Ib + k * LL;
+        const float *p = Ib + k;
         I[k] = w00 * p[t00] + w10 * p[t10] + w01 * p[t01] + w11 * p[t11];
     }
     *n = w00 * nb[t00] + w10 * nb[t10] + w01 * nb[t01] + w11 * nb[t11];
@@ -74,7 +75,6 @@ static inline void light_lookup(const sjob *j, const float *Ib, const float *nb,
 long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb)
 {
     const int n = j->n, nf = j->nf, no = j->t->no;
-    const size_t npix = (size_t)j->W * j->H;
     const float kf = (float)k;
     float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], nsc;
     long long count = 0;
@@ -114,7 +114,7 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
              * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
             float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
             float contrib = I[c] * src * len;
-            float *Lp = j->L_eye + c * npix + p, *Tp = j->T_eye + c * npix + p;
+            float *Lp = j->L_eye + c * j->pst + p, *Tp = j->T_eye + c * j->pst + p;
             if (j->btf) *Lp = *Lp * Tslab + contrib; /* back-to-front: over */
             else *Lp += *Tp * contrib;               /* front-to-back: under */
             *Tp *= Tslab;
@@ -131,7 +131,7 @@ long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x
                                       const float *nc, float *In, float *nn)
 {
     const int n = j->n, nf = j->nf, L = j->L;
-    const size_t LL = (size_t)L * L;
+    const size_t ns = (size_t)n + 1; /* texels interleave I per wavelength and n */
     const float delta = j->ldelta;
     float dens[ATMOS_VOLUME_MAX_FIELDS];
     long long count = 0;
@@ -141,15 +141,15 @@ long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x
     const float eu = (float)j->lEa[0], ev = (float)j->lEa[1], ew = (float)j->lEa[2];
     for (int a = x0; a <= x1; a++) {
         size_t q = (size_t)b * L + a;
-        const float n0 = nc[q];
-        nn[q] = n0;
+        const float n0 = nc[q * ns];
+        nn[q * ns] = n0;
         int upd = a >= a0 && a <= a1 && k >= j->lk0[q] && k <= j->lk1[q];
         if (upd) {
             const float af = (float)a;
             upd = sgrid_sample_u(j->g, bu + af * eu, bv + af * ev, bw + af * ew, dens);
         }
         if (!upd) {
-            for (int c = 0; c < n; c++) In[c * LL + q] = Ic[c * LL + q];
+            for (int c = 0; c < n; c++) In[q * ns + c] = Ic[q * ns + c];
             continue;
         }
         count++;
@@ -162,7 +162,7 @@ long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x
             }
             dn += bsca * delta;
             if (bext <= 0.0f) {
-                In[c * LL + q] = Ic[c * LL + q];
+                In[q * ns + c] = Ic[q * ns + c];
                 continue;
             }
             float tau = bext * delta, T = expf(-tau);
@@ -199,10 +199,10 @@ long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x
                     keep = expf(lnk);
                 }
             }
-            In[c * LL + q] = Ic[c * LL + q] * (T + (1.0f - T) * keep);
+            In[q * ns + c] = Ic[q * ns + c] * (T + (1.0f - T) * keep);
         }
         /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
-        nn[q] = n0 + dn / (float)n;
+        nn[q * ns] = n0 + dn / (float)n;
     }
     return count;
 }
@@ -291,6 +291,18 @@ static inline void trilinear_soa(const sgrid *g, int m, const int32_t *restrict 
     }
 }
 
+/* live[f]: whether field f is non-zero at any of the m samples. A field that is zero
+ * everywhere in a chunk adds exact zeros to every sum, so its lookups are skipped. */
+static inline void fields_live(int nf, int m, const float *dens, int *live)
+{
+    for (int f = 0; f < nf; f++) {
+        const float *d = dens + f * CH;
+        int any = 0;
+        for (int q = 0; q < m; q++) any |= d[q] != 0.0f;
+        live[f] = any;
+    }
+}
+
 /* The compaction shared by both passes: of the chunk's candidate points (render-voxel
  * coordinates u, v, w; ok[q] = 0 for points already rejected), keeps those in the grid
  * and in an occupied block, as sgrid_sample_u decides. Returns how many; id[] holds
@@ -321,7 +333,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
     const sgrid *g = j->g;
     const stables *t = j->t;
     const int n = j->n, nf = j->nf, no = t->no, L = j->L;
-    const size_t npix = (size_t)j->W * j->H, LL = (size_t)L * L;
+    const int32_t ns = n + 1, LN = L * ns; /* texels interleave I per wavelength and n */
     const float kf = (float)k, lim = (float)(L - 1), xi = j->xi, fno = (float)no;
     const float *restrict Ib = Ib_, *restrict nb = nb_;
     float u[CH], v[CH], w[CH];
@@ -350,6 +362,8 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
         if (!m) continue;
         count += m;
         trilinear_soa(g, m, vox, fu, fv, fw, dens);
+        int live[ATMOS_VOLUME_MAX_FIELDS];
+        fields_live(nf, m, dens, live);
         /* Light buffer (bilinear I and n), the Ams order n + 1 and angle, slab length. */
         float nsc[CH];
         for (int q = 0; q < m; q++) {
@@ -362,9 +376,9 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             ib = ib > L - 2 ? L - 2 : ib;
             float wa = a - (float)ia, wb = b - (float)ib;
             w00[q] = (1 - wa) * (1 - wb), w10[q] = wa * (1 - wb), w01[q] = (1 - wa) * wb, w11[q] = wa * wb;
-            lt[q] = ib * L + ia;
+            lt[q] = (ib * L + ia) * ns;
             const int32_t t00 = lt[q];
-            nsc[q] = w00[q] * nb[t00] + w10[q] * nb[t00 + 1] + w01[q] * nb[t00 + L] + w11[q] * nb[t00 + L + 1];
+            nsc[q] = w00[q] * nb[t00] + w10[q] * nb[t00 + ns] + w01[q] * nb[t00 + LN] + w11[q] * nb[t00 + LN + ns];
             del[q] = j->pdelta[p];
         }
         int32_t oi[CH];
@@ -378,6 +392,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             fo[q] = mm - 1.0f - (float)o;
         }
         for (int f = 0; f < nf; f++) {
+            if (!live[f]) continue;
             const int32_t *restrict pa = j->pa + p0 * nf + f;
             const float *restrict pw = j->pw + p0 * nf + f;
             for (int q = 0; q < m; q++) {
@@ -386,13 +401,14 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             }
         }
         for (int c = 0; c < n; c++) {
-            const float *restrict Iw = Ib + c * LL;
+            const float *restrict Iw = Ib + c;
             for (int q = 0; q < m; q++) {
                 const int32_t t00 = lt[q];
-                Ic[q] = w00[q] * Iw[t00] + w10[q] * Iw[t00 + 1] + w01[q] * Iw[t00 + L] + w11[q] * Iw[t00 + L + 1];
+                Ic[q] = w00[q] * Iw[t00] + w10[q] * Iw[t00 + ns] + w01[q] * Iw[t00 + LN] + w11[q] * Iw[t00 + LN + ns];
                 bext[q] = 0.0f, src[q] = 0.0f;
             }
             for (int f = 0; f < nf; f++) {
+                if (!live[f]) continue;
                 const float sg = t->sig[f][c], sa = t->sca[f][c];
                 const float *restrict A = t->ams[f] + (size_t)c * t->ng[f] * no;
                 const float *restrict d = dens + f * CH;
@@ -417,7 +433,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
                 Tq[q] = be > 0.0f ? T : 1.0f;
                 Cq[q] = be > 0.0f ? contrib : 0.0f;
             }
-            float *restrict Lb = j->L_eye + c * npix + p0, *restrict Tb = j->T_eye + c * npix + p0;
+            float *restrict Lb = j->L_eye + c * j->pst + p0, *restrict Tb = j->T_eye + c * j->pst + p0;
             if (j->btf)
                 for (int q = 0; q < m; q++) {
                     const int x = id[q];
@@ -443,7 +459,7 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
     const sgrid *g = j->g;
     const stables *t = j->t;
     const int n = j->n, nf = j->nf, L = j->L;
-    const size_t LL = (size_t)L * L;
+    const size_t ns = (size_t)n + 1; /* texels interleave I per wavelength and n */
     const float delta = j->ldelta;
     const float *restrict Ic = Ic_, *restrict nc = nc_;
     float *restrict In = In_, *restrict nn = nn_;
@@ -462,8 +478,7 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
         const int cnt = x1 - xs + 1 < CH ? x1 - xs + 1 : CH;
         const size_t q0 = (size_t)b * L + xs;
         /* Light that meets nothing passes unchanged. */
-        for (int c = 0; c < n; c++) memcpy(In + c * LL + q0, Ic + c * LL + q0, sizeof(float) * (size_t)cnt);
-        memcpy(nn + q0, nc + q0, sizeof(float) * (size_t)cnt);
+        memcpy(In + q0 * ns, Ic + q0 * ns, sizeof(float) * (size_t)cnt * ns);
         {
             const int *restrict k0 = j->lk0 + q0, *restrict k1 = j->lk1 + q0;
             for (int q = 0; q < cnt; q++) {
@@ -479,12 +494,15 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
         if (!m) continue;
         count += m;
         trilinear_soa(g, m, vox, fu, fv, fw, dens);
-        for (int q = 0; q < m; q++) n0[q] = nc[q0 + (size_t)id[q]], dn[q] = 0.0f;
+        int live[ATMOS_VOLUME_MAX_FIELDS];
+        fields_live(nf, m, dens, live);
+        for (int q = 0; q < m; q++) n0[q] = nc[(q0 + (size_t)id[q]) * ns], dn[q] = 0.0f;
         float be[CH], bs[CH], aF[CH], tq[CH], kp[CH], lg[CH];
         for (int c = 0; c < n; c++) {
-            const float *restrict Iw = Ic + c * LL + q0;
-            for (int q = 0; q < m; q++) be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[id[q]];
+            const float *restrict Iw = Ic + q0 * ns + c;
+            for (int q = 0; q < m; q++) be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[(size_t)id[q] * ns];
             for (int f = 0; f < nf; f++) {
+                if (!live[f]) continue;
                 const float sg = t->sig[f][c], sa = t->sca[f][c];
                 const float *restrict d = dens + f * CH;
                 for (int q = 0; q < m; q++) be[q] += d[q] * sg, bs[q] += d[q] * sa;
@@ -498,6 +516,7 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
             }
             if (!j->low_albedo)
                 for (int f = 0; f < nf; f++) {
+                    if (!live[f]) continue;
                     const float sa = t->sca[f][c];
                     const float *restrict Ft = t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1);
                     const float *restrict d = dens + f * CH;
@@ -519,11 +538,11 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
                 const float keep = kp[q] > 0.0f && tau > 1.0f ? pw : kp[q];
                 out[q] = be[q] > 0.0f ? Iq[q] * (T + (1.0f - T) * keep) : Iq[q];
             }
-            float *restrict Io = In + c * LL + q0;
-            for (int q = 0; q < m; q++) Io[id[q]] = out[q];
+            float *restrict Io = In + q0 * ns + c;
+            for (int q = 0; q < m; q++) Io[(size_t)id[q] * ns] = out[q];
         }
         /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
-        for (int q = 0; q < m; q++) nn[q0 + (size_t)id[q]] = n0[q] + dn[q] / (float)n;
+        for (int q = 0; q < m; q++) nn[(q0 + (size_t)id[q]) * ns] = n0[q] + dn[q] / (float)n;
     }
     return count;
 }
