@@ -303,6 +303,42 @@ static inline void fields_live(int nf, int m, const float *dens, int *live)
     }
 }
 
+/* Drops the samples at which every field is zero (they change neither the eye nor the
+ * light buffer: their sums are exact zeros). Returns the new count. */
+static inline int drop_empty(int nf, int m, float *dens, int *id)
+{
+    int o = 0;
+    for (int q = 0; q < m; q++) {
+        int any = 0;
+        for (int f = 0; f < nf; f++) any |= dens[f * CH + q] != 0.0f;
+        if (!any) continue;
+        for (int f = 0; f < nf; f++) dens[f * CH + o] = dens[f * CH + q];
+        id[o++] = id[q];
+    }
+    return o;
+}
+
+/* Pads the compacted samples m..mv-1 (mv: m rounded up to 8) with copies of the last,
+ * so that the vector loops run whole vectors only; results of the copies are never
+ * stored. */
+static inline int pad_samples(int m, int *id, int32_t *vox, float *fu, float *fv, float *fw)
+{
+    const int mv = (m + 7) & ~7;
+    for (int q = m; q < mv; q++)
+        id[q] = id[m - 1], vox[q] = vox[m - 1], fu[q] = fu[m - 1], fv[q] = fv[m - 1], fw[q] = fw[m - 1];
+    return mv;
+}
+
+static inline int pad_dens(int nf, int m, float *dens, int *id)
+{
+    const int mv = (m + 7) & ~7;
+    for (int q = m; q < mv; q++) {
+        id[q] = id[m - 1];
+        for (int f = 0; f < nf; f++) dens[f * CH + q] = dens[f * CH + m - 1];
+    }
+    return mv;
+}
+
 /* The compaction shared by both passes: of the chunk's candidate points (render-voxel
  * coordinates u, v, w; ok[q] = 0 for points already rejected), keeps those in the grid
  * and in an occupied block, as sgrid_sample_u decides. Returns how many; id[] holds
@@ -358,15 +394,19 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
                 ok[q] = k >= k0[q] && k <= k1[q];
             }
         }
-        const int m = compact(g, cnt, u, v, w, ok, id, vox, fu, fv, fw);
+        int m = compact(g, cnt, u, v, w, ok, id, vox, fu, fv, fw);
         if (!m) continue;
         count += m;
-        trilinear_soa(g, m, vox, fu, fv, fw, dens);
+        int mv = pad_samples(m, id, vox, fu, fv, fw);
+        trilinear_soa(g, mv, vox, fu, fv, fw, dens);
+        m = drop_empty(nf, m, dens, id);
+        if (!m) continue;
+        mv = pad_dens(nf, m, dens, id);
         int live[ATMOS_VOLUME_MAX_FIELDS];
         fields_live(nf, m, dens, live);
         /* Light buffer (bilinear I and n), the Ams order n + 1 and angle, slab length. */
         float nsc[CH];
-        for (int q = 0; q < m; q++) {
+        for (int q = 0; q < mv; q++) {
             const size_t p = p0 + (size_t)id[q];
             float a = j->pF0[0][p] + kf * j->pdF[0][p], b = j->pF0[1][p] + kf * j->pdF[1][p];
             a = a < 0.0f ? 0.0f : (a > lim ? lim : a);
@@ -382,7 +422,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             del[q] = j->pdelta[p];
         }
         int32_t oi[CH];
-        for (int q = 0; q < m; q++) {
+        for (int q = 0; q < mv; q++) {
             /* One more scattering than the light has had turns it to the eye (Eq. 26). */
             const float mo = j->low_albedo ? 1.0f : nsc[q] + 1.0f;
             const float mm = mo < 1.0f ? 1.0f : (mo > fno ? fno : mo);
@@ -395,14 +435,14 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             if (!live[f]) continue;
             const int32_t *restrict pa = j->pa + p0 * nf + f;
             const float *restrict pw = j->pw + p0 * nf + f;
-            for (int q = 0; q < m; q++) {
+            for (int q = 0; q < mv; q++) {
                 ai[f][q] = pa[id[q] * nf] + oi[q];
                 aw[f][q] = pw[id[q] * nf];
             }
         }
         for (int c = 0; c < n; c++) {
             const float *restrict Iw = Ib + c;
-            for (int q = 0; q < m; q++) {
+            for (int q = 0; q < mv; q++) {
                 const int32_t t00 = lt[q];
                 Ic[q] = w00[q] * Iw[t00] + w10[q] * Iw[t00 + ns] + w01[q] * Iw[t00 + LN] + w11[q] * Iw[t00 + LN + ns];
                 bext[q] = 0.0f, src[q] = 0.0f;
@@ -412,7 +452,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
                 const float sg = t->sig[f][c], sa = t->sca[f][c];
                 const float *restrict A = t->ams[f] + (size_t)c * t->ng[f] * no;
                 const float *restrict d = dens + f * CH;
-                for (int q = 0; q < m; q++) {
+                for (int q = 0; q < mv; q++) {
                     const float dq = d[q] > 0.0f ? d[q] : 0.0f;
                     bext[q] += dq * sg;
                     const float bs = dq * sa;
@@ -423,7 +463,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
                     src[q] += bs > 0.0f ? bs * (val + xi) : 0.0f;
                 }
             }
-            for (int q = 0; q < m; q++) {
+            for (int q = 0; q < mv; q++) {
                 const float be = bext[q], tau = be * del[q];
                 const float T = exp_f(-tau);
                 /* beta_sca Delta of Eq. 26, integrated over the slab with its own
@@ -490,24 +530,28 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
                 ok[q] = a >= a0 && a <= a1 && k >= k0[q] && k <= k1[q];
             }
         }
-        const int m = compact(g, cnt, u, v, w, ok, id, vox, fu, fv, fw);
+        int m = compact(g, cnt, u, v, w, ok, id, vox, fu, fv, fw);
         if (!m) continue;
         count += m;
-        trilinear_soa(g, m, vox, fu, fv, fw, dens);
+        int mv = pad_samples(m, id, vox, fu, fv, fw);
+        trilinear_soa(g, mv, vox, fu, fv, fw, dens);
+        m = drop_empty(nf, m, dens, id);
+        if (!m) continue;
+        mv = pad_dens(nf, m, dens, id);
         int live[ATMOS_VOLUME_MAX_FIELDS];
         fields_live(nf, m, dens, live);
-        for (int q = 0; q < m; q++) n0[q] = nc[(q0 + (size_t)id[q]) * ns], dn[q] = 0.0f;
+        for (int q = 0; q < mv; q++) n0[q] = nc[(q0 + (size_t)id[q]) * ns], dn[q] = 0.0f;
         float be[CH], bs[CH], aF[CH], tq[CH], kp[CH], lg[CH];
         for (int c = 0; c < n; c++) {
             const float *restrict Iw = Ic + q0 * ns + c;
-            for (int q = 0; q < m; q++) be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[(size_t)id[q] * ns];
+            for (int q = 0; q < mv; q++) be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[(size_t)id[q] * ns];
             for (int f = 0; f < nf; f++) {
                 if (!live[f]) continue;
                 const float sg = t->sig[f][c], sa = t->sca[f][c];
                 const float *restrict d = dens + f * CH;
-                for (int q = 0; q < m; q++) be[q] += d[q] * sg, bs[q] += d[q] * sa;
+                for (int q = 0; q < mv; q++) be[q] += d[q] * sg, bs[q] += d[q] * sa;
             }
-            for (int q = 0; q < m; q++) {
+            for (int q = 0; q < mv; q++) {
                 dn[q] += bs[q] * delta;
                 tq[q] = be[q] * delta;
                 /* Eq. 25's order: floor(n + 1 + beta Delta) */
@@ -520,19 +564,19 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
                     const float sa = t->sca[f][c];
                     const float *restrict Ft = t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1);
                     const float *restrict d = dens + f * CH;
-                    for (int q = 0; q < m; q++) {
+                    for (int q = 0; q < mv; q++) {
                         const float fq = Ft[fi[q]], dq = d[q] > 0.0f ? d[q] : 0.0f;
                         aF[q] += dq * sa * fq;
                     }
                 }
-            for (int q = 0; q < m; q++) {
+            for (int q = 0; q < mv; q++) {
                 const float a = aF[q] / be[q];
                 /* keep: the fraction of the scattered light (1 - T) still going forward,
                  * Eq. 25's (alpha F)^{max(1, beta Delta)} (docs/slice.md); 0 in low albedo. */
                 kp[q] = !j->low_albedo && bs[q] > 0.0f && a > 0.0f ? a : 0.0f;
                 lg[q] = log_pos(kp[q]);
             }
-            for (int q = 0; q < m; q++) {
+            for (int q = 0; q < mv; q++) {
                 const float tau = tq[q], T = exp_f(-tau);
                 const float pw = exp_f(tau * lg[q]); /* thick slab: the power */
                 const float keep = kp[q] > 0.0f && tau > 1.0f ? pw : kp[q];
