@@ -43,7 +43,7 @@ ATMOS_API void atmos_slice_optics_free(atmos_slice_optics *o);
 
 /* Time spent in each stage of the last render (seconds) and the work done. */
 typedef struct atmos_slice_timing {
-    double prepare;       /* resampling the volume, tables, per-pixel set-up */
+    double prepare;       /* resampling the volume, tables, per-frame set-up (see setup) */
     double light;         /* light-buffer passes (Eq. 21, 25/24) */
     double eye;           /* eye-buffer passes (Eq. 26) */
     double sky;           /* the sky image and the front/back composite (§5) */
@@ -51,6 +51,8 @@ typedef struct atmos_slice_timing {
     long long eye_samples;   /* eye samples evaluated (non-empty occupancy blocks) */
     long long light_samples; /* light samples evaluated */
     int grid_dims[3];        /* the resampled render grid */
+    double setup;            /* per-frame set-up (part of prepare): per-pixel rays, light texels,
+                                the per-slice spans of pixels and texels to visit */
 } atmos_slice_timing;
 
 /* Settings; zero means default for every field (atmos_slice_defaults shows them). */
@@ -69,6 +71,8 @@ typedef struct atmos_slice_settings {
     double offset_m[3];    /* added to the volume's world position (placement in a scene) */
     const atmos_slice_optics *optics; /* NULL = atmos_slice_optics_build inside the render */
     atmos_slice_timing *timing;       /* optional output */
+    int reference;         /* nonzero: the plain scalar passes with libm's exp (slow; the fast
+                              default differs from it by < 1e-5 relative, docs/slice.md) */
 } atmos_slice_settings;
 
 /* Fills *s with the resolved defaults. */

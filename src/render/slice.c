@@ -15,19 +15,23 @@
  * static schedule and the image does not depend on the thread count.
  */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* madvise */
 #include "core/internal.h"
+#include "render/slice_internal.h"
 #include "volume/volume_grid.h"
 
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
-#define SLICE_OCC_B 4          /* occupancy block edge, render-grid voxels */
-#define SLICE_F_ORDERS 256     /* F_n and S(n) tabulated at integer n = 0..SLICE_F_ORDERS */
 #define SLICE_HD_EPS 0.02      /* rays within ~89° of the slice planes are not sliced */
 #define SLICE_MAX_GRID_BYTES ((uint64_t)2 << 30)
 
@@ -36,6 +40,23 @@ static double now_seconds(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Large buffers the passes read at random (render grid, light ring, per-pixel
+ * planes): 2 MB aligned and, on Linux, backed by transparent huge pages where the
+ * system allows it, so that the samples do not pay a page walk per access. Freed
+ * with free(). */
+static void *big_alloc(size_t bytes)
+{
+    const size_t huge = (size_t)2 << 20;
+    if (bytes < huge / 2) return malloc(bytes ? bytes : 1);
+    size_t sz = (bytes + huge - 1) / huge * huge;
+    void *p = NULL;
+    if (posix_memalign(&p, huge, sz) != 0) return NULL;
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    (void)madvise(p, sz, MADV_HUGEPAGE);
+#endif
+    return p;
 }
 
 void atmos_slice_defaults(atmos_slice_settings *s)
@@ -97,21 +118,6 @@ fail:
 
 /* ------------------------------------------------------------------ render grid */
 
-/* The volume box-filtered onto a dense grid (integer factor f native voxels per
- * render voxel), fields interleaved per voxel, with one empty voxel of padding on
- * every side so that the trilinear interpolant falls to zero at the edges, and a
- * coarse occupancy grid (Riley §3.2's majorant idea: blocks that are exactly empty
- * are skipped without interpolating). */
-typedef struct {
-    int nf;
-    int c[3];             /* render voxels per axis, padding included */
-    float *v;             /* c0*c1*c2*nf */
-    int ob[3];
-    unsigned char *occ;   /* ob0*ob1*ob2 */
-    float sc, off[3];     /* u = g * sc + off: grid-frame metres -> render-voxel coordinate */
-    double box_lo[3], box_hi[3]; /* grid-frame metres where the interpolant may be nonzero */
-} sgrid;
-
 static void sgrid_free(sgrid *g)
 {
     free(g->v);
@@ -159,7 +165,8 @@ static atmos_status sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
     if (nvox * (uint64_t)nf * sizeof(float) > SLICE_MAX_GRID_BYTES)
         return atmos__error(ctx, ATMOS_E_LIMIT, "slice: render grid %dx%dx%d x %d fields exceeds %llu bytes", g->c[0],
                             g->c[1], g->c[2], nf, (unsigned long long)SLICE_MAX_GRID_BYTES);
-    g->v = calloc(nvox * (uint64_t)nf, sizeof(float));
+    g->v = big_alloc(nvox * (uint64_t)nf * sizeof(float));
+    if (g->v) memset(g->v, 0, nvox * (uint64_t)nf * sizeof(float));
     for (int a = 0; a < 3; a++) g->ob[a] = (g->c[a] - 2) / SLICE_OCC_B + 1;
     g->occ = calloc((size_t)g->ob[0] * g->ob[1] * g->ob[2], 1);
     if (!g->v || !g->occ) {
@@ -220,42 +227,7 @@ static atmos_status sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
     return ATMOS_OK;
 }
 
-/* Trilinear densities of all fields at grid-frame point (x, y, z). Returns 0 if the
- * point is outside the grid or in an empty occupancy block (dens untouched). */
-static inline int sgrid_sample(const sgrid *g, float x, float y, float z, float *dens)
-{
-    float u = x * g->sc + g->off[0], v = y * g->sc + g->off[1], w = z * g->sc + g->off[2];
-    if (!(u >= 0.0f && v >= 0.0f && w >= 0.0f)) return 0;
-    int i = (int)u, j = (int)v, k = (int)w;
-    if (i > g->c[0] - 2 || j > g->c[1] - 2 || k > g->c[2] - 2) return 0;
-    if (!g->occ[((size_t)(k / SLICE_OCC_B) * g->ob[1] + j / SLICE_OCC_B) * g->ob[0] + i / SLICE_OCC_B]) return 0;
-    float fu = u - i, fv = v - j, fw = w - k;
-    const int nf = g->nf;
-    const size_t sx = (size_t)nf, sy = (size_t)g->c[0] * nf, sz = (size_t)g->c[0] * g->c[1] * nf;
-    const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
-    float w000 = (1 - fu) * (1 - fv) * (1 - fw), w100 = fu * (1 - fv) * (1 - fw), w010 = (1 - fu) * fv * (1 - fw),
-          w110 = fu * fv * (1 - fw), w001 = (1 - fu) * (1 - fv) * fw, w101 = fu * (1 - fv) * fw,
-          w011 = (1 - fu) * fv * fw, w111 = fu * fv * fw;
-    for (int f = 0; f < nf; f++)
-        dens[f] = w000 * p[f] + w100 * p[sx + f] + w010 * p[sy + f] + w110 * p[sx + sy + f] + w001 * p[sz + f] +
-                  w101 * p[sx + sz + f] + w011 * p[sy + sz + f] + w111 * p[sx + sy + sz + f];
-    return 1;
-}
-
 /* ------------------------------------------------------------------ optics tables */
-
-typedef struct {
-    int n;                     /* wavelengths */
-    int nf;                    /* fields */
-    float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* sigma_ext, m^2 */
-    float sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* albedo * sigma_ext */
-    int no;                    /* Ams orders tabulated: 1..no */
-    int ng[ATMOS_VOLUME_MAX_FIELDS];
-    const double *grid[ATMOS_VOLUME_MAX_FIELDS];  /* theta, degrees */
-    float *ams[ATMOS_VOLUME_MAX_FIELDS];          /* [(k * ng + a) * no + (order - 1)] */
-    float *F[ATMOS_VOLUME_MAX_FIELDS];            /* [k * (SLICE_F_ORDERS+1) + n]: F_n (Eq. 23) */
-    float *S[ATMOS_VOLUME_MAX_FIELDS];            /* same layout: S(n) = sum_{i<=n} ln F_i */
-} stables;
 
 static void stables_free(stables *t)
 {
@@ -329,35 +301,6 @@ static void angle_locate(const double *grid, int ng, double theta_deg, int *a, f
     *w = (float)((theta_deg - grid[lo]) / (grid[lo + 1] - grid[lo]));
 }
 
-/* Ams_m (sr^-1) at fractional order m >= 1 at the pixel's angle (index a, weight wa). */
-static inline float ams_lookup(const stables *t, int f, int k, int a, float wa, float m)
-{
-    const int no = t->no;
-    float mm = m < 1.0f ? 1.0f : (m > (float)no ? (float)no : m);
-    int oi = (int)(mm - 1.0f);
-    if (oi > no - 2) oi = no - 2;
-    float fo = mm - 1.0f - (float)oi;
-    const float *p = t->ams[f] + ((size_t)k * t->ng[f] + a) * no + oi;
-    float lo = p[0] + fo * (p[1] - p[0]);
-    float hi = p[no] + fo * (p[no + 1] - p[no]);
-    return lo + wa * (hi - lo);
-}
-
-/* Linear interpolation in a per-order table at fractional n >= 0; past the last order,
- * F is held (F_n -> 1/2) and S grows by ln F of the last order per order. */
-static inline float order_lerp(const float *tab, float n, int extend)
-{
-    if (!(n > 0.0f)) return tab[0];
-    if (n >= (float)SLICE_F_ORDERS) {
-        if (!extend) return tab[SLICE_F_ORDERS];
-        float slope = tab[SLICE_F_ORDERS] - tab[SLICE_F_ORDERS - 1];
-        return tab[SLICE_F_ORDERS] + slope * (n - (float)SLICE_F_ORDERS);
-    }
-    int i = (int)n;
-    float f = n - (float)i;
-    return tab[i] + f * (tab[i + 1] - tab[i]);
-}
-
 /* ------------------------------------------------------------------ geometry helpers */
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -412,178 +355,160 @@ static void slice_range(double sa, double sb, double s0, double ds, int nslices,
 
 /* ------------------------------------------------------------------ the render */
 
+
+/* Per-slice spans. Every occupied block (a cube of SLICE_OCC_B render voxels, widened
+ * by a small margin for rounding) meets the slices between the planes through its
+ * nearest and farthest corners; a sample of slice k can fall in it only at the pixels
+ * inside the projection of its corners (and the texels inside their orthographic
+ * projection along the light), widened by one pixel. The spans of a row are the union
+ * of those footprints, so the passes visit what the occupied volume covers instead of
+ * the whole image and light buffer. */
 typedef struct {
-    int n, nf;
-    int W, H, L;                 /* image, light buffer side */
-    int nslices;
-    int btf;                     /* back-to-front */
-    int low_albedo, eq24;
-    float xi;
-    double h[3], lt[3], e1[3], e2[3]; /* half vector, light propagation, light basis */
-    double s0, ds;               /* slice planes s_k = s0 + (k + 0.5) ds along h */
-    double eye[3], he;           /* eye in grid frame, h . eye */
-    double u0, v0, du, dv;       /* light buffer: texel (a, b) centre at u0 + (a+0.5) du, ... */
-    double hl;                   /* h . lt */
-    const sgrid *g;
-    const stables *t;
-    /* per pixel */
-    float *pdx, *pdy, *pdz, *pinv; /* direction, 1 / (h . d) */
-    int *pk0, *pk1;
-    int *pa;                     /* [pix * nf + f] angle index */
-    float *pw;
-    float *L_eye, *T_eye;        /* [k * npix + pix] */
-    /* per light texel */
-    int *lk0, *lk1;
-    float *I, *nsc;              /* light arriving at the current slice: [c * L*L + texel], [texel] */
-    float *I_next, *nsc_next;    /* light leaving it (written by the light pass) */
-} sjob;
+    int k0, k1;          /* slices */
+    int ex0, ex1, ey0, ey1; /* pixels (ex0 > ex1: none) */
+    int lx0, lx1, ly0, ly1; /* light texels */
+} sfoot;
 
-/* Light buffer lookup at grid-frame point (x, y, z): bilinear I per wavelength and n. */
-static inline void light_lookup(const sjob *j, double x, double y, double z, float *I, float *n)
+static int clampi_d(double v, int lo, int hi)
 {
-    double u = x * j->e1[0] + y * j->e1[1] + z * j->e1[2], v = x * j->e2[0] + y * j->e2[1] + z * j->e2[2];
-    double fu = (u - j->u0) / j->du - 0.5, fv = (v - j->v0) / j->dv - 0.5;
-    const int L = j->L;
-    if (fu < 0) fu = 0;
-    if (fv < 0) fv = 0;
-    if (fu > L - 1) fu = L - 1;
-    if (fv > L - 1) fv = L - 1;
-    int a = (int)fu, b = (int)fv;
-    if (a > L - 2) a = L - 2;
-    if (b > L - 2) b = L - 2;
-    if (a < 0) a = 0;
-    if (b < 0) b = 0;
-    float wa = (float)(fu - a), wb = (float)(fv - b);
-    if (L == 1) wa = wb = 0;
-    size_t t00 = (size_t)b * L + a, t10 = t00 + (L > 1), t01 = t00 + (L > 1 ? L : 0), t11 = t01 + (L > 1);
-    float w00 = (1 - wa) * (1 - wb), w10 = wa * (1 - wb), w01 = (1 - wa) * wb, w11 = wa * wb;
-    const size_t LL = (size_t)L * L;
-    for (int k = 0; k < j->n; k++) {
-        const float *p = j->I + k * LL;
-        I[k] = w00 * p[t00] + w10 * p[t10] + w01 * p[t01] + w11 * p[t11];
-    }
-    *n = w00 * j->nsc[t00] + w10 * j->nsc[t10] + w01 * j->nsc[t01] + w11 * j->nsc[t11];
+    if (!(v > lo)) return lo; /* NaN too */
+    if (v > hi) return hi;
+    return (int)v;
 }
 
-/* Eye pass of slice k over image row y (Eq. 26). Returns the samples evaluated. */
-static long long eye_row(const sjob *j, int k, int y)
+static void block_footprint(const sjob *j, const atmos_camera *cam, const double cf[3], const double cr[3],
+                            const double cu[3], int bi, int bj, int bk, sfoot *o)
 {
-    const int n = j->n, nf = j->nf;
-    const size_t npix = (size_t)j->W * j->H;
-    const double sk = j->s0 + (k + 0.5) * j->ds;
-    float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], nsc;
-    long long count = 0;
-    for (int x = 0; x < j->W; x++) {
-        size_t p = (size_t)y * j->W + x;
-        if (k < j->pk0[p] || k > j->pk1[p]) continue;
-        double t = (sk - j->he) * j->pinv[p];
-        float px = (float)(j->eye[0] + t * j->pdx[p]), py = (float)(j->eye[1] + t * j->pdy[p]),
-              pz = (float)(j->eye[2] + t * j->pdz[p]);
-        if (!sgrid_sample(j->g, px, py, pz, dens)) continue;
-        count++;
-        light_lookup(j, px, py, pz, I, &nsc);
-        const float delta = (float)(j->ds * fabs(j->pinv[p])); /* eye-ray length of the slab */
-        /* One more scattering than the light has had turns it to the eye (Eq. 26). */
-        const float m = j->low_albedo ? 1.0f : nsc + 1.0f;
-        for (int c = 0; c < n; c++) {
-            float bext = 0, src = 0;
-            for (int f = 0; f < nf; f++) {
-                if (dens[f] <= 0.0f) continue;
-                bext += dens[f] * j->t->sig[f][c];
-                float bs = dens[f] * j->t->sca[f][c];
-                if (bs > 0.0f) {
-                    float a = ams_lookup(j->t, f, c, j->pa[p * nf + f], j->pw[p * nf + f], m);
-                    src += bs * (a + j->xi);
-                }
-            }
-            if (bext <= 0.0f) continue;
-            float tau = bext * delta;
-            float Tslab = expf(-tau);
-            /* beta_sca Delta of Eq. 26, integrated over the slab with its own
-             * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
-            float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
-            float contrib = I[c] * src * len;
-            float *Lp = j->L_eye + c * npix + p, *Tp = j->T_eye + c * npix + p;
-            if (j->btf) *Lp = *Lp * Tslab + contrib; /* back-to-front: over */
-            else *Lp += *Tp * contrib;               /* front-to-back: under */
-            *Tp *= Tslab;
-        }
+    const sgrid *g = j->g;
+    const double mg = 0.05; /* render voxels: float rounding of the sample positions */
+    double lo[3], hi[3];
+    const int b[3] = {bi, bj, bk};
+    for (int a = 0; a < 3; a++) {
+        double u0 = (double)b[a] * SLICE_OCC_B - mg, u1 = fmin((double)(b[a] + 1) * SLICE_OCC_B, g->c[a] - 1.0) + mg;
+        lo[a] = (u0 - g->off[a]) / g->sc;
+        hi[a] = (u1 - g->off[a]) / g->sc;
     }
-    return count;
+    double smin = INFINITY, smax = -INFINITY, xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    int behind = 0;
+    const double th = cam->tan_half_fov, W = cam->width, H = cam->height;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        double sv = dot3(p, j->h);
+        smin = fmin(smin, sv), smax = fmax(smax, sv);
+        double uv = dot3(p, j->e1), vv = dot3(p, j->e2);
+        umin = fmin(umin, uv), umax = fmax(umax, uv);
+        vmin = fmin(vmin, vv), vmax = fmax(vmax, vv);
+        double r[3] = {p[0] - j->eye[0], p[1] - j->eye[1], p[2] - j->eye[2]};
+        double z = dot3(r, cf);
+        if (!(z > 1e-6)) {
+            behind++;
+            continue;
+        }
+        /* Image position (pixels; centres at +0.5) as atmos_camera_ray inverts it. */
+        double px = 0.5 * (W + dot3(r, cr) / (z * th) * H), py = 0.5 * (H - dot3(r, cu) / (z * th) * H);
+        xmin = fmin(xmin, px), xmax = fmax(xmax, px);
+        ymin = fmin(ymin, py), ymax = fmax(ymax, py);
+    }
+    slice_range(smin, smax, j->s0, j->ds, j->nslices, &o->k0, &o->k1);
+    if (behind == 8) {
+        o->ex0 = o->ey0 = 1, o->ex1 = o->ey1 = 0; /* rays only go forwards */
+    } else if (behind) {
+        o->ex0 = o->ey0 = 0, o->ex1 = j->W - 1, o->ey1 = j->H - 1; /* straddles the eye: everywhere */
+    } else {
+        o->ex0 = clampi_d(floor(xmin - 0.5) - 1, 0, j->W), o->ex1 = clampi_d(ceil(xmax - 0.5) + 1, -1, j->W - 1);
+        o->ey0 = clampi_d(floor(ymin - 0.5) - 1, 0, j->H), o->ey1 = clampi_d(ceil(ymax - 0.5) + 1, -1, j->H - 1);
+    }
+    /* Texel a's ray is at u = u0 + (a + 0.5) du. */
+    o->lx0 = clampi_d(floor((umin - j->u0) / j->du - 0.5) - 1, 0, j->L);
+    o->lx1 = clampi_d(ceil((umax - j->u0) / j->du - 0.5) + 1, -1, j->L - 1);
+    o->ly0 = clampi_d(floor((vmin - j->v0) / j->dv - 0.5) - 1, 0, j->L);
+    o->ly1 = clampi_d(ceil((vmax - j->v0) / j->dv - 0.5) + 1, -1, j->L - 1);
 }
 
-/* Light pass of slice k over light-buffer row b (Eq. 21, 25 / 24). */
-static long long light_row(const sjob *j, int k, int b)
+/* Fills j->espan and j->lspan. Returns 0 if out of memory. */
+static int build_spans(sjob *j, const atmos_camera *cam, const double cf[3], const double cr[3], const double cu[3],
+                       int threads)
 {
-    const int n = j->n, nf = j->nf, L = j->L;
-    const size_t LL = (size_t)L * L;
-    const double sk = j->s0 + (k + 0.5) * j->ds;
-    const float delta = (float)(j->ds / j->hl); /* light-ray length of the slab */
-    float dens[ATMOS_VOLUME_MAX_FIELDS];
-    long long count = 0;
-    const double v = j->v0 + (b + 0.5) * j->dv;
-    for (int a = 0; a < L; a++) {
-        size_t q = (size_t)b * L + a;
-        for (int c = 0; c < n; c++) j->I_next[c * LL + q] = j->I[c * LL + q];
-        j->nsc_next[q] = j->nsc[q];
-        if (k < j->lk0[q] || k > j->lk1[q]) continue;
-        const double u = j->u0 + (a + 0.5) * j->du;
-        double w = (sk - u * dot3(j->h, j->e1) - v * dot3(j->h, j->e2)) / j->hl;
-        float px = (float)(u * j->e1[0] + v * j->e2[0] + w * j->lt[0]);
-        float py = (float)(u * j->e1[1] + v * j->e2[1] + w * j->lt[1]);
-        float pz = (float)(u * j->e1[2] + v * j->e2[2] + w * j->lt[2]);
-        if (!sgrid_sample(j->g, px, py, pz, dens)) continue;
-        count++;
-        const float n0 = j->nsc[q];
-        float dn = 0;
-        for (int c = 0; c < n; c++) {
-            float bext = 0, bsca = 0;
-            for (int f = 0; f < nf; f++) {
-                bext += dens[f] * j->t->sig[f][c];
-                bsca += dens[f] * j->t->sca[f][c];
-            }
-            dn += bsca * delta;
-            if (bext <= 0.0f) continue;
-            float tau = bext * delta, T = expf(-tau);
-            float keep; /* fraction of the scattered light (1 - T) still going forward */
-            if (j->low_albedo) {
-                keep = 0.0f;
-            } else {
-                /* The number of scatterings in the slab, ceil(beta Delta) in Eq. 24, taken
-                 * continuously as max(1, beta Delta); Eq. 25 raises its worst-case factor to
-                 * the same power (see docs/slice.md). */
-                float msl = tau > 1.0f ? tau : 1.0f;
-                if (bsca <= 0.0f) {
-                    keep = 0.0f;
-                } else if (!j->eq24) {
-                    /* Eq. 25: (alpha F_{floor(n + 1 + beta Delta)})^{beta Delta}. */
-                    float idx = floorf(n0 + 1.0f + tau);
-                    float aF = 0;
-                    for (int f = 0; f < nf; f++)
-                        if (dens[f] > 0.0f)
-                            aF += dens[f] * j->t->sca[f][c] *
-                                  order_lerp(j->t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1), idx, 0);
-                    aF /= bext;
-                    keep = aF > 0.0f ? expf(msl * logf(aF)) : 0.0f;
-                } else {
-                    /* Eq. 24: prod_{i=n+1}^{n+m} alpha F_i = alpha^m exp(S(n+m) - S(n)); fields
-                     * mixed geometrically by their share of beta_sca. */
-                    float lnk = msl * logf(bsca / bext);
-                    for (int f = 0; f < nf; f++) {
-                        float bs = dens[f] * j->t->sca[f][c];
-                        if (bs <= 0.0f) continue;
-                        const float *S = j->t->S[f] + (size_t)c * (SLICE_F_ORDERS + 1);
-                        lnk += bs / bsca * (order_lerp(S, n0 + msl, 1) - order_lerp(S, n0, 1));
-                    }
-                    keep = expf(lnk);
+    const sgrid *g = j->g;
+    size_t nb = (size_t)g->ob[0] * g->ob[1] * g->ob[2], nocc = 0;
+    for (size_t i = 0; i < nb; i++) nocc += g->occ[i] != 0;
+    sfoot *fp = malloc(sizeof *fp * (nocc ? nocc : 1));
+    size_t *idx = malloc(sizeof *idx * (nocc ? nocc : 1));
+    if (!fp || !idx) {
+        free(fp), free(idx);
+        return 0;
+    }
+    nocc = 0;
+    for (size_t i = 0; i < nb; i++)
+        if (g->occ[i]) idx[nocc++] = i;
+    const long long no = (long long)nocc;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long i = 0; i < no; i++) {
+        size_t b = idx[i];
+        int bi = (int)(b % (size_t)g->ob[0]), bj = (int)((b / (size_t)g->ob[0]) % (size_t)g->ob[1]),
+            bk = (int)(b / ((size_t)g->ob[0] * g->ob[1]));
+        block_footprint(j, cam, cf, cr, cu, bi, bj, bk, &fp[i]);
+    }
+    free(idx);
+    const int K = j->nslices, H = j->H, L = j->L;
+    /* Each thread owns a contiguous range of slices, so the min/max updates do not race. */
+#pragma omp parallel num_threads(threads)
+    {
+        int nt = omp_get_num_threads(), tid = omp_get_thread_num();
+        int k0 = (int)((long long)K * tid / nt), k1 = (int)((long long)K * (tid + 1) / nt) - 1;
+        for (int k = k0; k <= k1; k++) {
+            for (int y = 0; y < H; y++) j->espan[(size_t)k * H + y] = (sspan){j->W, -1};
+            for (int b = 0; b < L; b++) j->lspan[(size_t)k * L + b] = (sspan){L, -1};
+        }
+        for (size_t i = 0; i < nocc; i++) {
+            const sfoot *f = &fp[i];
+            int a = f->k0 > k0 ? f->k0 : k0, z = f->k1 < k1 ? f->k1 : k1;
+            for (int k = a; k <= z; k++) {
+                for (int y = f->ey0; y <= f->ey1 && f->ex0 <= f->ex1; y++) {
+                    sspan *s = &j->espan[(size_t)k * H + y];
+                    if (f->ex0 < s->x0) s->x0 = f->ex0;
+                    if (f->ex1 > s->x1) s->x1 = f->ex1;
+                }
+                for (int y = f->ly0; y <= f->ly1 && f->lx0 <= f->lx1; y++) {
+                    sspan *s = &j->lspan[(size_t)k * L + y];
+                    if (f->lx0 < s->x0) s->x0 = f->lx0;
+                    if (f->lx1 > s->x1) s->x1 = f->lx1;
                 }
             }
-            j->I_next[c * LL + q] = j->I[c * LL + q] * (T + (1.0f - T) * keep);
         }
-        /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
-        j->nsc_next[q] = n0 + dn / (float)n;
     }
-    return count;
+    free(fp);
+    for (int y = 0; y < H; y++) {
+        sspan u = {j->W, -1};
+        for (int k = 0; k < K; k++) {
+            const sspan *e = &j->espan[(size_t)k * H + y];
+            if (e->x0 < u.x0) u.x0 = e->x0;
+            if (e->x1 > u.x1) u.x1 = e->x1;
+        }
+        j->erow[y] = u;
+    }
+    /* Light spans of slices k - batch..k (the texels a ring slot may hold stale). */
+    for (int b = 0; b < L; b++)
+        for (int k = 0; k < K; k++) {
+            sspan u = {L, -1};
+            for (int q = k - j->batch < 0 ? 0 : k - j->batch; q <= k; q++) {
+                const sspan *e = &j->lspan[(size_t)q * L + b];
+                if (e->x0 < u.x0) u.x0 = e->x0;
+                if (e->x1 > u.x1) u.x1 = e->x1;
+            }
+            j->wspan[(size_t)k * L + b] = u;
+        }
+    for (int b = 0; b < L; b++) {
+        sspan u = {L, -1};
+        for (int k = 0; k < K; k++) {
+            const sspan *e = &j->lspan[(size_t)k * L + b];
+            if (e->x0 < u.x0) u.x0 = e->x0;
+            if (e->x1 > u.x1) u.x1 = e->x1;
+        }
+        j->lrow[b] = u;
+    }
+    return 1;
 }
 
 static atmos_status check_settings(atmos_context *ctx, const atmos_slice_settings *in, atmos_slice_settings *s)
@@ -595,6 +520,7 @@ static atmos_status check_settings(atmos_context *ctx, const atmos_slice_setting
     if (in->xi != 0) s->xi = in->xi < 0 ? 0 : in->xi;
     s->update = in->update;
     s->low_albedo = in->low_albedo;
+    s->reference = in->reference;
     if (in->grid_max_dim) s->grid_max_dim = in->grid_max_dim;
     if (in->max_order) s->max_order = in->max_order;
     if (in->density_scale != 0) s->density_scale = in->density_scale;
@@ -739,124 +665,240 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     j.g = &g;
     j.t = &tab;
     const size_t npix = (size_t)j.W * j.H, LL = (size_t)j.L * j.L;
-    j.pdx = malloc(sizeof(float) * npix * 4);
-    j.pk0 = malloc(sizeof(int) * npix * 2);
-    j.pa = malloc(sizeof(int) * npix * j.nf);
-    j.pw = malloc(sizeof(float) * npix * j.nf);
-    j.L_eye = calloc(npix * j.n, sizeof(float));
-    j.T_eye = malloc(sizeof(float) * npix * j.n);
+    const int K = j.nslices;
+    /* The per-pixel planes in one block; planes are padded by two cache lines so
+     * that the same pixel of different planes does not fall in one cache set. */
+    const size_t pst = npix + 32, nplanes = (size_t)14 + 2 * (size_t)j.nf + 2 * (size_t)j.n;
+    j.pst = pst;
+    j.pixblock = big_alloc(sizeof(float) * pst * nplanes);
+    if (j.pixblock) {
+        float *b = j.pixblock;
+        for (int a = 0; a < 3; a++) j.pU0[a] = b, b += pst, j.pdU[a] = b, b += pst;
+        for (int a = 0; a < 2; a++) j.pF0[a] = b, b += pst, j.pdF[a] = b, b += pst;
+        j.pdelta = b, b += pst;
+        j.pinv = b, b += pst;
+        j.pk0 = (int *)b, j.pk1 = (int *)(b + pst), b += 2 * pst;
+        j.pa = (int *)b, b += pst * j.nf;
+        j.pw = b, b += pst * j.nf;
+        j.L_eye = b, b += pst * j.n;
+        j.T_eye = b;
+    }
     j.lk0 = malloc(sizeof(int) * LL * 2);
-    j.I = malloc(sizeof(float) * LL * j.n);
-    j.nsc = calloc(LL, sizeof(float));
-    j.I_next = malloc(sizeof(float) * LL * j.n);
-    j.nsc_next = calloc(LL, sizeof(float));
-    if (!j.pdx || !j.pk0 || !j.pa || !j.pw || !j.L_eye || !j.T_eye || !j.lk0 || !j.I || !j.nsc || !j.I_next ||
-        !j.nsc_next) {
+    /* The light ring: B + 1 slots of L^2 texels of n + 1 floats (I per wavelength, then
+     * n: one cache line serves all of a texel), B up to 16 within 32 MB. Slots are
+     * padded by three cache lines so that they do not alias in the caches. */
+    const size_t slotf = LL * (size_t)(j.n + 1) + 48;
+    {
+        size_t slot = sizeof(float) * slotf;
+        size_t fit = ((size_t)32 << 20) / slot;
+        j.batch = fit > 17 ? 16 : (fit > 2 ? (int)fit - 1 : 1);
+        j.ring = big_alloc(slot * (size_t)(j.batch + 1));
+        j.I = malloc(sizeof(float *) * (size_t)(j.batch + 1));
+        j.nsc = malloc(sizeof(float *) * (size_t)(j.batch + 1));
+        if (j.ring && j.I && j.nsc)
+            for (int q = 0; q <= j.batch; q++) {
+                j.I[q] = j.ring + (size_t)q * slotf;
+                j.nsc[q] = j.I[q] + j.n;
+            }
+    }
+    j.espan = malloc(sizeof(sspan) * (size_t)K * j.H);
+    j.lspan = malloc(sizeof(sspan) * (size_t)K * j.L);
+    j.wspan = malloc(sizeof(sspan) * (size_t)K * j.L);
+    j.erow = malloc(sizeof(sspan) * (size_t)j.H);
+    j.lrow = malloc(sizeof(sspan) * (size_t)j.L);
+    int nomem = !j.pixblock || !j.lk0 || !j.espan ||
+                !j.lspan || !j.wspan || !j.erow || !j.lrow;
+    nomem |= !j.ring || !j.I || !j.nsc;
+    if (nomem) {
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
         goto done;
     }
-    j.pdy = j.pdx + npix, j.pdz = j.pdx + 2 * npix, j.pinv = j.pdx + 3 * npix;
-    j.pk1 = j.pk0 + npix;
     j.lk1 = j.lk0 + LL;
-    for (size_t i = 0; i < npix * j.n; i++) j.T_eye[i] = 1.0f;
     const int threads = atmos__threads(ctx);
+    const double t_setup0 = now_seconds();
 
+    {
+        double cf[3], cr[3], cu[3];
+        TO_GRID(cam.forward, cf);
+        TO_GRID(cam.right, cr);
+        TO_GRID(cam.up, cu);
+        if (!build_spans(&j, &cam, cf, cr, cu, threads)) {
+            st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the spans");
+            goto done;
+        }
+    }
     /* Per pixel: ray, slices it crosses inside the box (in front of the eye and of
-     * the ground), and the Ams angle (scattering angle between the sun's light and
-     * the direction to the eye: cos theta = d . sun). */
-#pragma omp parallel for schedule(static) num_threads(threads)
+     * the ground), its sample on slice k as a linear function of k, and the Ams angle
+     * (scattering angle between the sun's light and the direction to the eye:
+     * cos theta = d . sun). */
+    const double ee1 = dot3(j.eye, j.e1), ee2 = dot3(j.eye, j.e2);
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
     for (int y = 0; y < j.H; y++)
-        for (int x = 0; x < j.W; x++) {
+        for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
             size_t p = (size_t)y * j.W + x;
+            for (int c = 0; c < j.n; c++) j.L_eye[c * j.pst + p] = 0.0f, j.T_eye[c * j.pst + p] = 1.0f;
             double dw[3], d[3];
             atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
             TO_GRID(dw, d);
-            j.pdx[p] = (float)d[0], j.pdy[p] = (float)d[1], j.pdz[p] = (float)d[2];
             double hd = dot3(j.h, d);
             j.pk0[p] = 1, j.pk1[p] = 0;
             j.pinv[p] = 0;
+            for (int a = 0; a < 3; a++) j.pU0[a][p] = j.pdU[a][p] = 0;
+            for (int a = 0; a < 2; a++) j.pF0[a][p] = j.pdF[a][p] = 0;
+            j.pdelta[p] = 0;
+            for (int f = 0; f < j.nf; f++) j.pa[p * j.nf + f] = 0, j.pw[p * j.nf + f] = 0;
             double ta, tb;
             int ok = j.btf ? hd <= -SLICE_HD_EPS : hd >= SLICE_HD_EPS;
-            if (ok && ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) {
-                if (ta < 0) ta = 0;
-                double tg = atmos_sky_ground_distance(cam.position[1], dw);
-                if (tb > tg) tb = tg;
-                if (ta < tb) {
-                    double sa = j.he + ta * hd, sb = j.he + tb * hd;
-                    if (sa > sb) {
-                        double q = sa;
-                        sa = sb, sb = q;
-                    }
-                    slice_range(sa, sb, j.s0, j.ds, j.nslices, &j.pk0[p], &j.pk1[p]);
-                    j.pinv[p] = (float)(1.0 / hd);
-                }
+            if (!ok || !ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) continue;
+            if (ta < 0) ta = 0;
+            double tg = atmos_sky_ground_distance(cam.position[1], dw);
+            if (tb > tg) tb = tg;
+            if (!(ta < tb)) continue;
+            double sa = j.he + ta * hd, sb = j.he + tb * hd;
+            if (sa > sb) {
+                double q = sa;
+                sa = sb, sb = q;
             }
+            slice_range(sa, sb, j.s0, j.ds, j.nslices, &j.pk0[p], &j.pk1[p]);
+            if (j.pk0[p] > j.pk1[p]) continue;
+            j.pinv[p] = (float)(1.0 / hd);
+            /* t_k = (s0 + (k + 0.5) ds - h.eye) / (h.d) */
+            const double t0 = (j.s0 + 0.5 * j.ds - j.he) / hd, dt = j.ds / hd;
+            for (int a = 0; a < 3; a++) {
+                j.pU0[a][p] = (float)((j.eye[a] + t0 * d[a]) * g.sc + g.off[a]);
+                j.pdU[a][p] = (float)(dt * d[a] * g.sc);
+            }
+            const double de1 = dot3(d, j.e1), de2 = dot3(d, j.e2);
+            j.pF0[0][p] = (float)((ee1 + t0 * de1 - j.u0) / j.du - 0.5);
+            j.pdF[0][p] = (float)(dt * de1 / j.du);
+            j.pF0[1][p] = (float)((ee2 + t0 * de2 - j.v0) / j.dv - 0.5);
+            j.pdF[1][p] = (float)(dt * de2 / j.dv);
+            j.pdelta[p] = (float)(j.ds * fabs(1.0 / hd));
             double c = dot3(dw, sun_w);
             double th = acos(c > 1 ? 1 : (c < -1 ? -1 : c)) * ATMOS_RAD2DEG;
-            for (int f = 0; f < j.nf; f++) angle_locate(tab.grid[f], tab.ng[f], th, &j.pa[p * j.nf + f], &j.pw[p * j.nf + f]);
+            for (int f = 0; f < j.nf; f++) {
+                int ai;
+                angle_locate(tab.grid[f], tab.ng[f], th, &ai, &j.pw[p * j.nf + f]);
+                j.pa[p * j.nf + f] = ai * tab.no;
+            }
         }
     /* Per light texel: slices its ray crosses inside the box, and the sunlight arriving
-     * there through the air (Eq. 12, at the altitude where the ray enters the box). */
+     * there through the air (Eq. 12, at the altitude where the ray enters the box).
+     * Texel (a, b)'s ray is u e1 + v e2 + w lt; on slice k, w = (s_k - u h.e1 - v h.e2)/h.lt. */
     {
         double cen[3] = {0.5 * (g.box_lo[0] + g.box_hi[0]), 0.5 * (g.box_lo[1] + g.box_hi[1]),
                          0.5 * (g.box_lo[2] + g.box_hi[2])};
         const double *Rm = R;
+        const double he1 = dot3(j.h, j.e1), he2 = dot3(j.h, j.e2);
+        for (int a = 0; a < 3; a++) {
+            double E1 = j.e1[a] - he1 / j.hl * j.lt[a], E2 = j.e2[a] - he2 / j.hl * j.lt[a];
+            j.lA[a] = ((j.u0 + 0.5 * j.du) * E1 + (j.v0 + 0.5 * j.dv) * E2 + (j.s0 + 0.5 * j.ds) / j.hl * j.lt[a]) * g.sc +
+                      g.off[a];
+            j.lEa[a] = j.du * E1 * g.sc;
+            j.lEb[a] = j.dv * E2 * g.sc;
+            j.lEk[a] = j.ds / j.hl * j.lt[a] * g.sc;
+        }
+        j.ldelta = (float)(j.ds / j.hl);
+        /* Texels whose ray misses the box all get the sunlight at the box centre. */
+        double sl_miss[ATMOS_MAX_WAVELENGTHS];
+        {
+            double yw = org[1] + Rm[3] * cen[0] + Rm[4] * cen[1] + Rm[5] * cen[2];
+            atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl_miss);
+        }
 #pragma omp parallel for schedule(static) num_threads(threads)
         for (int b = 0; b < j.L; b++)
             for (int a = 0; a < j.L; a++) {
                 size_t q = (size_t)b * j.L + a;
+                j.lk0[q] = 1, j.lk1[q] = 0;
+                if (a < j.lrow[b].x0 || a > j.lrow[b].x1) { /* never read */
+                    for (int c = 0; c < j.n; c++) j.I[0][q * (j.n + 1) + c] = (float)sl_miss[c];
+                    j.nsc[0][q * (j.n + 1)] = 0.0f;
+                    continue;
+                }
                 double u = j.u0 + (a + 0.5) * j.du, v = j.v0 + (b + 0.5) * j.dv;
                 double o[3] = {u * j.e1[0] + v * j.e2[0], u * j.e1[1] + v * j.e2[1], u * j.e1[2] + v * j.e2[2]};
-                double ta, tb, entry[3];
-                memcpy(entry, cen, sizeof entry);
+                double ta, tb, sl[ATMOS_MAX_WAVELENGTHS];
                 j.lk0[q] = 1, j.lk1[q] = 0;
                 if (ray_box(o, j.lt, g.box_lo, g.box_hi, &ta, &tb)) {
                     double ho = dot3(j.h, o);
                     slice_range(ho + ta * j.hl, ho + tb * j.hl, j.s0, j.ds, j.nslices, &j.lk0[q], &j.lk1[q]);
+                    double entry[3];
                     for (int i = 0; i < 3; i++) entry[i] = o[i] + ta * j.lt[i];
+                    double yw = org[1] + Rm[3] * entry[0] + Rm[4] * entry[1] + Rm[5] * entry[2];
+                    atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl);
+                } else {
+                    memcpy(sl, sl_miss, sizeof sl);
                 }
-                double yw = org[1] + Rm[3] * entry[0] + Rm[4] * entry[1] + Rm[5] * entry[2];
-                double sl[ATMOS_MAX_WAVELENGTHS];
-                atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl);
-                for (int c = 0; c < j.n; c++) j.I[c * LL + q] = (float)sl[c];
+                for (int c = 0; c < j.n; c++) j.I[0][q * (j.n + 1) + c] = (float)sl[c];
+                j.nsc[0][q * (j.n + 1)] = 0.0f;
             }
     }
+    {
+        const int nslot = j.batch + 1;
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (int q = 1; q < nslot; q++) memcpy(j.I[q], j.I[0], sizeof(float) * LL * (size_t)(j.n + 1));
+    }
+    const double t_setup = now_seconds() - t_setup0;
     const double t_prep = now_seconds() - t_prep0;
 
-    /* The slices. The eye pass reads the light arriving at slice k while the light
-     * pass writes the light leaving it into the other buffer, so both run in one
-     * parallel loop (one barrier per slice). Rows are interleaved in chunks of 4 with
-     * a static schedule; per-thread CPU time in each pass gives the breakdown. */
+    /* The slices, in batches of B (one parallel region, three barriers per batch).
+     * Slot s of the light ring holds the light arriving at slice k0 + s. The light of
+     * a texel on slice k depends only on that texel on slice k - 1, so each light row
+     * runs through the batch on its own (phase A); then each image row runs through
+     * the batch reading slot k - k0 (phase B). Each pixel and texel is written by one
+     * work item only and sees the same sequence of operations as in a slice-by-slice
+     * order, so the image does not depend on the thread count, the schedule or B.
+     * After a batch the ring rotates (the last slot becomes slot 0), so a slot written
+     * for slice k held the light of B + 1 slices earlier: only texels some light span
+     * of slices k - B..k covers can differ, and only those are copied or updated. */
+    long long (*const eye_pass)(const sjob *, int, int, int, int, const float *, const float *) =
+        s.reference ? atmos__slice_eye_span_ref : atmos__slice_eye_span;
+    long long (*const light_pass)(const sjob *, int, int, int, int, int, int, const float *, const float *, float *,
+                                  float *) = s.reference ? atmos__slice_light_span_ref : atmos__slice_light_span;
     int cancelled = 0;
-    double cpu_eye = 0, cpu_light = 0, t_slices = 0;
-    const int rows = j.H + j.L;
-    for (int k = 0; k < j.nslices && !cancelled; k++) {
-        long long ce = 0, cl = 0;
-        double ta = now_seconds(), de = 0, dl = 0;
-#pragma omp parallel for schedule(static, 4) num_threads(threads) reduction(+ : ce, cl, de, dl)
-        for (int r = 0; r < rows; r++) {
-            double t0 = now_seconds();
-            if (r < j.H) {
-                ce += eye_row(&j, k, r);
-                de += now_seconds() - t0;
-            } else {
-                cl += light_row(&j, k, r - j.H);
-                dl += now_seconds() - t0;
+    const int nbatch = j.batch;
+    const double t_sl0 = now_seconds();
+#pragma omp parallel num_threads(threads) reduction(+ : eye_samples, light_samples)
+    for (int k0 = 0; k0 < K; k0 += nbatch) {
+        if (cancelled) break; /* set before the previous barrier: every thread sees the same value */
+        const int nb = K - k0 < nbatch ? K - k0 : nbatch;
+        double ta = 0;
+#pragma omp master
+        ta = now_seconds();
+#pragma omp for schedule(dynamic, 1)
+        for (int b = 0; b < j.L; b++)
+            for (int q = 0; q < nb; q++) {
+                const int k = k0 + q;
+                const sspan ls = j.lspan[(size_t)k * j.L + b], ws = j.wspan[(size_t)k * j.L + b];
+                if (ws.x0 <= ws.x1)
+                    light_samples += light_pass(&j, k, b, ws.x0, ws.x1, ls.x0, ls.x1, j.I[q], j.nsc[q], j.I[q + 1],
+                                                j.nsc[q + 1]);
             }
+#pragma omp master
+        {
+            double tb = now_seconds();
+            t_light += tb - ta;
+            ta = tb;
         }
-        t_slices += now_seconds() - ta;
-        cpu_eye += de, cpu_light += dl;
-        eye_samples += ce, light_samples += cl;
-        float *sw = j.I;
-        j.I = j.I_next, j.I_next = sw;
-        sw = j.nsc;
-        j.nsc = j.nsc_next, j.nsc_next = sw;
-        if (atmos__progress(ctx, "render slice", (double)(k + 1) / j.nslices)) cancelled = 1;
+#pragma omp for schedule(dynamic, 2)
+        for (int y = 0; y < j.H; y++)
+            for (int q = 0; q < nb; q++) {
+                const int k = k0 + q;
+                const sspan es = j.espan[(size_t)k * j.H + y];
+                if (es.x0 <= es.x1) eye_samples += eye_pass(&j, k, y, es.x0, es.x1, j.I[q], j.nsc[q]);
+            }
+#pragma omp master
+        {
+            t_eye += now_seconds() - ta;
+            float *last = j.I[nb], *lastn = j.nsc[nb];
+            for (int q = nb; q > 0; q--) j.I[q] = j.I[q - 1], j.nsc[q] = j.nsc[q - 1];
+            j.I[0] = last, j.nsc[0] = lastn;
+            if (atmos__progress(ctx, "render slice", (double)(k0 + nb) / K)) cancelled = 1;
+        }
+#pragma omp barrier
     }
-    if (cpu_eye + cpu_light > 0) {
-        t_eye = t_slices * cpu_eye / (cpu_eye + cpu_light);
-        t_light = t_slices - t_eye;
-    }
+    const double t_slices = now_seconds() - t_sl0;
+    (void)t_slices;
     if (cancelled) {
         st = atmos__error(ctx, ATMOS_E_CANCELLED, "render slice: cancelled");
         goto done;
@@ -873,13 +915,13 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                          0.5 * (g.box_lo[2] + g.box_hi[2])};
         const double hc = dot3(j.h, cen);
         const int C = img->channels;
-#pragma omp parallel for schedule(static) num_threads(threads)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
         for (int y = 0; y < j.H; y++)
-            for (int x = 0; x < j.W; x++) {
+            for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
                 size_t p = (size_t)y * j.W + x;
                 int touched = 0;
                 for (int c = 0; c < j.n; c++)
-                    touched |= j.L_eye[c * npix + p] != 0.0f || j.T_eye[c * npix + p] != 1.0f;
+                    touched |= j.L_eye[c * j.pst + p] != 0.0f || j.T_eye[c * j.pst + p] != 1.0f;
                 if (!touched) continue;
                 double dw[3];
                 atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
@@ -892,7 +934,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 atmos_sky_transmittance(sky, cam.position[1], dw, th, Tf);
                 float *px = img->pixels + p * C;
                 for (int c = 0; c < j.n; c++) {
-                    double B = px[c], Lv = j.L_eye[c * npix + p], Tv = j.T_eye[c * npix + p];
+                    double B = px[c], Lv = j.L_eye[c * j.pst + p], Tv = j.T_eye[c * j.pst + p];
                     double r = front[c] + Tf[c] * Lv + Tv * (B - front[c]);
                     px[c] = (float)(isfinite(r) && r > 0 ? r : 0.0);
                 }
@@ -903,6 +945,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         s.timing->prepare = t_prep;
         s.timing->light = t_light;
         s.timing->eye = t_eye;
+        s.timing->setup = t_setup;
     }
 
 finish:
@@ -932,8 +975,8 @@ finish:
     st = ATMOS_OK;
 done:
 #undef TO_GRID
-    free(j.pdx), free(j.pk0), free(j.pa), free(j.pw), free(j.L_eye), free(j.T_eye), free(j.lk0), free(j.I), free(j.nsc);
-    free(j.I_next), free(j.nsc_next);
+    free(j.pixblock), free(j.ring), free(j.I), free(j.nsc), free(j.lk0);
+    free(j.espan), free(j.lspan), free(j.wspan), free(j.erow), free(j.lrow);
     atmos_sky_destroy(sky);
     stables_free(&tab);
     sgrid_free(&g);
