@@ -18,6 +18,7 @@
 #define _DEFAULT_SOURCE /* madvise */
 #include "core/internal.h"
 #include "render/slice_internal.h"
+#include "sky/sky_internal.h"
 #include "volume/volume_grid.h"
 
 #include <float.h>
@@ -302,6 +303,16 @@ static void angle_locate(const double *grid, int ng, double theta_deg, int *a, f
 }
 
 /* ------------------------------------------------------------------ geometry helpers */
+
+/* Sunlight arriving at altitude yw: through the air (Eq. 12) with the sky background,
+ * the extraterrestrial irradiance unattenuated in vacuum (black/uniform backgrounds). */
+static void sunlight_at(const atmos_sky *sky, int vacuum, double yw, const double sun[3], int n, double *out)
+{
+    if (vacuum)
+        for (int c = 0; c < n; c++) out[c] = sky->sun_e[c];
+    else
+        atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun, out);
+}
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -598,6 +609,8 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     sjob j;
     memset(&j, 0, sizeof j);
     atmos_sky *sky = NULL;
+    /* Black or uniform background: vacuum around the volume (no air, no ground). */
+    const int vacuum = scene->background != ATMOS_BACKGROUND_SKY;
     long long eye_samples = 0, light_samples = 0;
     double t_light = 0, t_eye = 0;
     if ((st = sgrid_build(ctx, volume, s.density_scale, s.grid_max_dim, &g)) != ATMOS_OK) goto done;
@@ -751,7 +764,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             int ok = j.btf ? hd <= -SLICE_HD_EPS : hd >= SLICE_HD_EPS;
             if (!ok || !ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) continue;
             if (ta < 0) ta = 0;
-            double tg = atmos_sky_ground_distance(cam.position[1], dw);
+            double tg = vacuum ? INFINITY : atmos_sky_ground_distance(cam.position[1], dw);
             if (tb > tg) tb = tg;
             if (!(ta < tb)) continue;
             double sa = j.he + ta * hd, sb = j.he + tb * hd;
@@ -803,7 +816,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         double sl_miss[ATMOS_MAX_WAVELENGTHS];
         {
             double yw = org[1] + Rm[3] * cen[0] + Rm[4] * cen[1] + Rm[5] * cen[2];
-            atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl_miss);
+            sunlight_at(sky, vacuum, yw, sun_w, j.n, sl_miss);
         }
 #pragma omp parallel for schedule(static) num_threads(threads)
         for (int b = 0; b < j.L; b++)
@@ -825,7 +838,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                     double entry[3];
                     for (int i = 0; i < 3; i++) entry[i] = o[i] + ta * j.lt[i];
                     double yw = org[1] + Rm[3] * entry[0] + Rm[4] * entry[1] + Rm[5] * entry[2];
-                    atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun_w, sl);
+                    sunlight_at(sky, vacuum, yw, sun_w, j.n, sl);
                 } else {
                     memcpy(sl, sl_miss, sizeof sl);
                 }
@@ -927,11 +940,15 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
                 double th = j.pinv[p] != 0.0f ? (hc - j.he) * j.pinv[p] : 0.0;
                 if (!(th > 0)) th = 0;
-                double tg = atmos_sky_ground_distance(cam.position[1], dw);
-                if (th > tg) th = tg;
                 double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
-                atmos_sky_inscatter(sky, cam.position, dw, th, sun_w, front);
-                atmos_sky_transmittance(sky, cam.position[1], dw, th, Tf);
+                if (vacuum) { /* no air between the eye and the volume */
+                    for (int c = 0; c < j.n; c++) front[c] = 0.0, Tf[c] = 1.0;
+                } else {
+                    double tg = atmos_sky_ground_distance(cam.position[1], dw);
+                    if (th > tg) th = tg;
+                    atmos_sky_inscatter(sky, cam.position, dw, th, sun_w, front);
+                    atmos_sky_transmittance(sky, cam.position[1], dw, th, Tf);
+                }
                 float *px = img->pixels + p * C;
                 for (int c = 0; c < j.n; c++) {
                     double B = px[c], Lv = j.L_eye[c * j.pst + p], Tv = j.T_eye[c * j.pst + p];

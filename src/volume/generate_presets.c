@@ -12,10 +12,11 @@
  * base itself is a horizontal cut at the condensation level: below it there is no
  * cloud (the refinement's downward-triangle rule keeps balls from growing there).
  *
- * Peak number densities (typical values; the optics presets give the
- * cross-sections): cloud droplets 1e8 m^-3 (100 cm^-3), anvil ice 1e6 m^-3
- * (1000 per litre, a dense anvil), cirrus ice 5e4 m^-3, rain drops 2e3 m^-3
- * (moderate rain of ~1 mm drops).
+ * Peak number densities, chosen so that the extinction with the optics presets'
+ * cross-sections (cloud 6.28e-10, ice 1.82e-6, rain 6.28e-6 m^2; Riley Table 2) is
+ * typical: cloud droplets 1e8 m^-3 (100 cm^-3; 63 km^-1), anvil ice 3e3 m^-3
+ * (5.5 km^-1, a dense anvil), cirrus ice 500 m^-3 (0.9 km^-1), rain drops 2e3 m^-3
+ * (moderate rain of ~1 mm drops; 13 km^-1).
  */
 #include "volume/generate.h"
 
@@ -23,8 +24,8 @@
 #include <string.h>
 
 #define ETA_CLOUD 1e8
-#define ETA_ICE_ANVIL 1e6
-#define ETA_ICE_CIRRUS 5e4
+#define ETA_ICE_ANVIL 3e3
+#define ETA_ICE_CIRRUS 500
 #define ETA_RAIN 2e3
 #define ISO 0.3f
 

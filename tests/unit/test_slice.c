@@ -172,7 +172,10 @@ static void march(atmos_context *ctx, const atmos_scene *s, const atmos_volume *
                 double be = eta * sig;
                 double tl = atmos_volume_optical_depth(v, &sig, p, sun, 0, 1e5);
                 double sl[3];
-                atmos_sky_sunlight(air, p[1], sun, sl);
+                if (s->background != ATMOS_BACKGROUND_SKY) /* vacuum: the sun unattenuated */
+                    for (int c = 0; c < 3; c++) sl[c] = wl.sun_irradiance[c] * s->atmosphere.sun_scale;
+                else
+                    atmos_sky_sunlight(air, p[1], sun, sl);
                 /* exact slab integral of the source with its own attenuation */
                 double Ts = exp(-be * dt);
                 for (int c = 0; c < 3; c++) L[c] += exp(-tau) * sl[c] * exp(-tl) * albedo * P * (1 - Ts);
@@ -184,19 +187,24 @@ static void march(atmos_context *ctx, const atmos_scene *s, const atmos_volume *
             double front[3], Tf[3];
             atmos_sky_inscatter(air, cam.position, d, th, sun, front);
             atmos_sky_transmittance(air, cam.position[1], d, th, Tf);
+            if (s->background != ATMOS_BACKGROUND_SKY)
+                for (int c = 0; c < 3; c++) front[c] = 0, Tf[c] = 1;
             float *px = out->pixels + ((size_t)y * s->width + x) * 4;
             for (int c = 0; c < 3; c++) px[c] = (float)(front[c] + Tf[c] * L[c] + exp(-tau) * (px[c] - front[c]));
         }
     atmos_sky_destroy(air);
 }
 
-static void compare_with_marcher(atmos_context *ctx, float peak, int low_albedo, double tol, const char *what)
+static void compare_with_marcher(atmos_context *ctx, float peak, int low_albedo, int background, double tol,
+                                 const char *what)
 {
     optics op;
     make_optics(ctx, &op);
     atmos_volume *v = blob(ctx, peak);
     atmos_scene s;
     scene_for(&s, 35, 200); /* sun behind-left of the camera: front-to-back */
+    s.background = (atmos_background_kind)background;
+    s.background_radiance = background == ATMOS_BACKGROUND_UNIFORM ? 0.01 : 0.0;
     atmos_slice_settings ss = {0};
     ss.optics = &op.o;
     ss.xi = -1; /* no back-scatter term: pure single scattering in the thin limit */
@@ -224,9 +232,12 @@ static void test_thin_limit(void)
 {
     atmos_context *ctx = make_ctx(2);
     /* peak 1e4 m^-3 * 1e-9 m^2 = 1e-5 m^-1: optical depth ~0.004 through the blob */
-    compare_with_marcher(ctx, 1e4f, 0, 0.02, "thin, Eq. 25");
+    compare_with_marcher(ctx, 1e4f, 0, ATMOS_BACKGROUND_SKY, 0.02, "thin, Eq. 25");
     /* low-albedo mode is plain single scattering at any thickness (peak tau ~ 2) */
-    compare_with_marcher(ctx, 5e6f, 1, 0.03, "low albedo, thick");
+    compare_with_marcher(ctx, 5e6f, 1, ATMOS_BACKGROUND_SKY, 0.03, "low albedo, thick");
+    /* vacuum backgrounds: no air in front, the sun unattenuated */
+    compare_with_marcher(ctx, 1e4f, 0, ATMOS_BACKGROUND_BLACK, 0.02, "thin, black background");
+    compare_with_marcher(ctx, 5e6f, 1, ATMOS_BACKGROUND_UNIFORM, 0.03, "low albedo, uniform background");
     atmos_context_destroy(ctx);
 }
 
