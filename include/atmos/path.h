@@ -60,6 +60,11 @@ typedef struct atmos_path_settings {
                                radiance at each wavelength ((W m^-2 sr^-1 nm^-1)^2), then, in
                                the place of alpha, the variance of the mean luminance Y
                                ((cd m^-2)^2, covariances between wavelengths included) */
+    atmos_image **order;    /* optional output: per pixel (1 channel) the mean number of volume
+                               scattering events of the light reaching the pixel, weighted by
+                               each contribution's luminance (sum of order x Y over sum of Y;
+                               0 where the pixel's mean luminance is 0). Light from the air or
+                               the ground counts the volume events before it only. */
     atmos_path_stats *stats; /* optional output */
 } atmos_path_settings;
 

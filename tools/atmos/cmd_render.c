@@ -53,6 +53,9 @@ static void help(void)
            "      --seed N                  path: random seed (default: the scene's, 1; same seed, same image)\n"
            "      --variance FILE.exr       path: per-pixel variance of the mean (channels var_<nm>nm per\n"
            "                                wavelength, then var_Y of the luminance)\n"
+           "      --order FILE.pfm          path: per-pixel mean number of volume scattering events of the\n"
+           "                                light reaching the pixel, weighted by luminance (1 channel;\n"
+           "                                a key for atmos compare --by)\n"
            "  -q, --quiet                   no progress bar or messages\n"
            "  -h, --help                    this help\n\n"
            "Examples:\n"
@@ -95,7 +98,8 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
     O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VPOS,
-    O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE
+    O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE,
+    O_ORDER
 };
 
 /* The volume's optical depth along each pixel's ray at the middle wavelength of the
@@ -153,7 +157,7 @@ int cli_cmd_render(int argc, char **argv)
         {"eq24", no_argument, 0, O_EQ24}, {"low-albedo", no_argument, 0, O_LOWALB},
         {"tau", required_argument, 0, O_TAU},
         {"time-budget", required_argument, 0, O_TBUDGET}, {"seed", required_argument, 0, O_SEED},
-        {"variance", required_argument, 0, O_VARIANCE},
+        {"variance", required_argument, 0, O_VARIANCE}, {"order", required_argument, 0, O_ORDER},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -173,8 +177,8 @@ int cli_cmd_render(int argc, char **argv)
     double tbudget = 0;
     unsigned long long seed = 0;
     int seed_given = 0;
-    const char *variance_out = NULL;
-    atmos_image *var_img = NULL;
+    const char *variance_out = NULL, *order_out = NULL;
+    atmos_image *var_img = NULL, *order_img = NULL;
     atmos_path_stats pstats;
     memset(&pstats, 0, sizeof pstats);
     optind = 1;
@@ -258,6 +262,7 @@ int cli_cmd_render(int argc, char **argv)
             break;
         }
         case O_VARIANCE: variance_out = optarg; break;
+        case O_ORDER: order_out = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
@@ -351,10 +356,10 @@ int cli_cmd_render(int argc, char **argv)
         if (spp) scene.path.spp = spp;
         if (tbudget > 0) scene.path.time_budget_s = tbudget;
         if (seed_given) scene.path.seed = seed;
-    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out) {
+    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out || order_out) {
         atmos_context_destroy(ctx);
         return cli_usage_error(C, spp > 256 ? "--spp: must be in [1, 256] for this renderer (1..1000000 with --renderer path)"
-                                            : "--time-budget, --seed and --variance go with --renderer path");
+                                            : "--time-budget, --seed, --variance and --order go with --renderer path");
     } else if (spp) {
         scene.samples_per_pixel = spp;
     }
@@ -410,6 +415,7 @@ int cli_cmd_render(int argc, char **argv)
         ps.density_scale = scene.volume.density_scale;
         memcpy(ps.offset_m, offset, sizeof offset);
         ps.variance = variance_out ? &var_img : NULL;
+        ps.order = order_out ? &order_img : NULL;
         ps.stats = &pstats;
         st = atmos_render_path(ctx, &scene, vol, &ps, &spec, &info);
         if (st == ATMOS_OK && tau_path && vol) st = write_tau(ctx, &scene, vol, offset, tau_path);
@@ -438,6 +444,10 @@ int cli_cmd_render(int argc, char **argv)
         atmos_image_set_meta(var_img, "atmos:source", source);
         if ((st = atmos_write_exr(ctx, var_img, variance_out, &ed)) != ATMOS_OK) goto fail;
     }
+    if (order_img && order_out) {
+        atmos_image_set_meta(order_img, "atmos:source", source);
+        if ((st = atmos_write_pfm(ctx, order_img, order_out)) != ATMOS_OK) goto fail;
+    }
     if (png) {
         char buf[64];
         double scale = atmos_tonemap_scale(lin, &scene.tonemap);
@@ -453,11 +463,13 @@ int cli_cmd_render(int argc, char **argv)
         if (exr) fprintf(stderr, "  wrote %s\n", exr);
         if (pfm) fprintf(stderr, "  wrote %s\n", pfm);
         if (var_img && variance_out) fprintf(stderr, "  wrote %s\n", variance_out);
+        if (order_img && order_out) fprintf(stderr, "  wrote %s\n", order_out);
         if (scene.renderer == ATMOS_RENDERER_PATH)
             fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", pstats.spp,
                     pstats.events, 100.0 * pstats.mean_rel_error);
     }
     atmos_image_destroy(var_img);
+    atmos_image_destroy(order_img);
     atmos_image_destroy(spec);
     atmos_image_destroy(lin);
     atmos_image_destroy(disp);
@@ -468,6 +480,7 @@ fail:
     {
         int rc = cli_runtime_error(C, ctx, st);
         atmos_image_destroy(var_img);
+    atmos_image_destroy(order_img);
         atmos_image_destroy(spec);
         atmos_image_destroy(lin);
         atmos_image_destroy(disp);
