@@ -10,14 +10,17 @@
  *   the volume's box: free flight by delta tracking (path_medium.c); at a real
  *       scattering event next-event estimation of the sun's disk (a direction drawn
  *       uniformly in the disk's cone, the transmittance to it by ratio tracking), then
- *       Russian roulette and a new direction drawn from the phase function of one of
- *       the carried wavelengths (one-sample MIS over the wavelengths: the weight of
- *       wavelength k is p_k / mean_j p_j, never more than PATH_B);
+ *       Russian roulette and a new direction drawn from the phase function of the
+ *       path's hero wavelength (multiple importance sampling over whole paths between
+ *       the carried wavelengths: weights never more than PATH_B); a direction that
+ *       lands in the sun's disk counts the sun too, weighted against next-event
+ *       estimation by the balance heuristic;
  *   the ground (y = 0, sky background): Lambertian; the sun's light (shadowed by the
  *       volume) by next-event estimation, then a cosine-distributed bounce;
  *   escape: the sky's in-scatter from the escape point to infinity; the sun's disk only
- *       on a path that has not scattered (after a scattering event the sun is counted
- *       by next-event estimation alone). A black or uniform background is vacuum: no
+ *       on a path that has not scattered (after a volume event the sun is counted by
+ *       the two weighted estimates at the event, after a ground bounce by next-event
+ *       estimation alone). A black or uniform background is vacuum: no
  *       air, no ground, the unattenuated sun, background_radiance from every direction.
  *
  * Per pixel, samples are added in their index order into double sums (and sums of
@@ -192,28 +195,42 @@ static int roulette(double *w, int m, path_rng *r)
 }
 
 /* Phase function of the mixture of fields at a scattering event for every carried
- * wavelength (pk[i] = sum_f ssf[f][i] p_f,k(mu) / ss[i], 0 where nothing scatters), and
- * the density the direction sampler draws from: the mean of pk over the wavelengths that
- * scatter (a wavelength chosen uniformly among them, then a field, then the angle). */
-static double phase_mix(const path_phase *P, const path_bundle *b, int nf, double ssf[][PATH_B], const double *ss,
+ * wavelength: pk[i] = sum_f ssf[f][i] p_f,k(mu) / ss[i], 0 where nothing scatters. */
+static void phase_mix(const path_phase *P, const path_bundle *b, int nf, double ssf[][PATH_B], const double *ss,
                         double mu, double *pk)
 {
     path_angle ang;
     atmos__path_angle(P, mu, &ang);
-    double mean = 0;
-    int ne = 0;
     for (int i = 0; i < b->m; i++) {
         double s = 0;
         if (ss[i] > 0) {
             for (int f = 0; f < nf; f++)
                 if (ssf[f][i] > 0) s += ssf[f][i] * atmos__path_phase_eval(P, f, b->k[i], &ang);
             s /= ss[i];
-            mean += s;
-            ne++;
         }
         pk[i] = s;
     }
-    return ne ? mean / ne : 0.0;
+}
+
+/* Hero wavelengths, multiple importance sampling over whole paths. A path draws every
+ * direction from the phase function of one carried wavelength, its hero h, chosen
+ * uniformly once (Wilkie et al. 2014, "Hero wavelength spectral sampling"); where h does
+ * not scatter, from the first wavelength that does (a fixed rule, so a function of the
+ * path). Wavelength k is then weighted by prod_e p_k(e) / ((1/m) sum_j prod_e pdf_j(e)), the
+ * balance heuristic over the m strategies "hero = j": at most m whatever the path's length.
+ * (Weighting every event separately, p_k / mean_j p_j, compounds over a path: after twenty
+ * events in a droplet cloud, whose phase functions differ between wavelengths by factors of
+ * two in the forward peak and more around the glory and the rainbow, single weights of
+ * hundreds made the fireflies of the first version.) S[j] holds prod_e pdf_j(e),
+ * normalised to mean 1 after every event; the weights w carry the ratio. */
+static double strategies(int m, const double *S, const int *g, const double *pd, double *pj)
+{
+    double D = 0;
+    for (int j = 0; j < m; j++) {
+        if (pj) pj[j] = pd[g[j]];
+        D += S[j] * pd[g[j]];
+    }
+    return D / m;
 }
 
 /* Balance heuristic between the two ways a path finds the sun's disk from a scattering
@@ -236,7 +253,9 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
     const int m = b->m;
     double w[PATH_B], p[3] = {o[0], o[1], o[2]}, d[3] = {d0[0], d0[1], d0[2]};
     for (int i = 0; i < m; i++) w[i] = 1, L[i] = 0, Lo[i] = 0;
-    int primary = 1, depth = 0, order = 0;
+    int primary = 1, depth = 0, order = 0, hero = -1;
+    double S[PATH_B];
+    for (int i = 0; i < m; i++) S[i] = 1;
     float dens[PATH_F];
     for (int guard = 0; guard < 1 << 24; guard++) {
         double K = J->sky ? atmos_sky_ground_distance(p[1], d) : INFINITY;
@@ -269,6 +288,9 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                     }
                     if (ss[i] > 0) elig[ne++] = i;
                 }
+                /* the strategy of each hero here: itself, or the first that scatters */
+                int g[PATH_B];
+                for (int i = 0; i < m; i++) g[i] = ss[i] > 0 ? i : (ne ? elig[0] : i);
                 /* Can the path go on from here (depth limit), and with which probability
                  * does it survive the roulette below: the continuation's share of the
                  * multiple importance sampling of the sun. */
@@ -283,10 +305,13 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 sunlight(J, b, p[1], E);
                 int lit = 0;
                 for (int i = 0; i < m; i++) lit |= w[i] * E[i] > 0;
+                lit = lit && J->sun_omega > 0;
                 if (lit && ne) {
                     double ds[3], T[PATH_B], pk[PATH_B];
                     sample_sun(J, r, ds);
-                    const double pdir = phase_mix(P, b, nf, ssf, ss, dot3(d, ds), pk);
+                    phase_mix(P, b, nf, ssf, ss, dot3(d, ds), pk);
+                    /* the continuation's density of ds given the path so far */
+                    const double pdir = strategies(m, S, g, pk, NULL);
                     int any = 0;
                     for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
                     if (any) {
@@ -301,9 +326,13 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 if (!goes_on) return;
                 depth++;
                 if (!roulette(w, m, r)) return;
-                /* New direction: wavelength j uniformly among those that scatter, field f in
-                 * proportion to its scattering there, cos(theta) by the table's inverse CDF. */
-                int j = elig[ne > 1 ? (int)(path_u(r) * ne) % ne : 0];
+                /* New direction: the hero's strategy (its wavelength or the fallback), a field
+                 * in proportion to its scattering there, cos(theta) by the table's inverse CDF. */
+                if (hero < 0) {
+                    hero = m > 1 ? (int)(path_u(r) * m) : 0;
+                    if (hero >= m) hero = m - 1;
+                }
+                const int j = g[hero];
                 int f = 0;
                 if (nf > 1) {
                     double u = path_u(r) * ss[j], acc = 0;
@@ -317,13 +346,16 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 double nd[3];
                 around(d, mu, 2.0 * ATMOS_PI * path_u(r), nd);
                 const int chroma = nf > 1 || !P->gray[0];
-                const int to_sun = lit && J->sun_omega > 0 && dot3(nd, J->sun) >= J->cos_sun;
+                const int to_sun = lit && dot3(nd, J->sun) >= J->cos_sun;
                 if ((chroma && m > 1) || to_sun) {
-                    double pk[PATH_B];
-                    const double mean = phase_mix(P, b, nf, ssf, ss, mu, pk);
+                    double pk[PATH_B], pj[PATH_B];
+                    phase_mix(P, b, nf, ssf, ss, mu, pk);
+                    const double mean = strategies(m, S, g, pk, pj);
                     if (!(mean > 0)) return;
-                    if (chroma && m > 1)
-                        for (int i = 0; i < m; i++) w[i] *= pk[i] / mean;
+                    for (int i = 0; i < m; i++) {
+                        w[i] *= pk[i] / mean;
+                        S[i] *= pj[i] / mean;
+                    }
                     if (to_sun) {
                         /* The continuation found the sun's disk: its share of the sun's
                          * radiance E / sun_omega, through the volume's transmittance. */
