@@ -202,7 +202,7 @@ static double sun_e(atmos_context *ctx, const atmos_scene *s, int k)
 static void test_slab(atmos_context *ctx)
 {
     const double taus[3] = {0.5, 2, 8};
-    const int spp[3] = {1536, 512, 256};
+    const int spp[3] = {1024, 384, 192};
     optics op;
     make_optics(ctx, 0, 0.85, 1.0, &op);
     for (int i = 0; i < 3; i++) {
@@ -267,14 +267,14 @@ static void test_big_sun(atmos_context *ctx)
         double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
         atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
         atmos_image *var = NULL;
-        atmos_image *img = render(ctx, &s, v, &op, (side == 0 ? 2048 : 512) * (long_run ? 16 : 1), 0, &var);
+        atmos_image *img = render(ctx, &s, v, &op, (side == 0 ? 2048 : 256) * (long_run ? 16 : 1), 0, &var);
         double f, se;
         hemi_flux(img, var, 1, side == 0, E, &f, &se);
         double z = (f - ref[side]) / se;
         printf("slab g=0.9 tau=1 sun 20 deg %s: path %.5f +- %.5f, adding-doubling over the disk %.5f (%+.2f sigma)\n",
                side == 0 ? "R" : "T", f, se, ref[side], z);
         CHECK_MSG(fabs(z) < 3.0, "big sun %s: %.5f vs %.5f (%.2f standard errors)", side ? "T" : "R", f, ref[side], z);
-        CHECK(se < 0.02 * ref[side]);
+        CHECK(se < 0.025 * ref[side]);
         atmos_image_destroy(img);
         atmos_image_destroy(var);
     }
