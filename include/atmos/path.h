@@ -5,8 +5,10 @@
  * volume's majorant grid (spectral tracking: one flight serves every wavelength a path
  * carries), transmittance of shadow rays by ratio tracking on the residual above a
  * per-cell minorant, directions from the tabulated phase functions by their inverse CDF
- * (atmos_phase_table_sample), any number of scattering events ended by Russian roulette,
- * next-event estimation towards the sun's disk at every scattering event. The air is
+ * (atmos_phase_table_sample) of one hero wavelength per path (multiple importance sampling
+ * over the carried wavelengths), any number of scattering events ended by Russian roulette,
+ * the sun's disk found at every scattering event both by next-event estimation and by the
+ * phase-sampled continuation, combined by multiple importance sampling. The air is
  * the analytic sky (sky.h): the medium between the eye and the volume and the light
  * arriving from everywhere a path escapes to; the ground is Lambertian, lit by the sun
  * (shadowed by the volume) and by the paths that leave it. With a black or uniform
