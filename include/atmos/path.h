@@ -5,8 +5,10 @@
  * volume's majorant grid (spectral tracking: one flight serves every wavelength a path
  * carries), transmittance of shadow rays by ratio tracking on the residual above a
  * per-cell minorant, directions from the tabulated phase functions by their inverse CDF
- * (atmos_phase_table_sample), any number of scattering events ended by Russian roulette,
- * next-event estimation towards the sun's disk at every scattering event. The air is
+ * (atmos_phase_table_sample) of one hero wavelength per path (multiple importance sampling
+ * over the carried wavelengths), any number of scattering events ended by Russian roulette,
+ * the sun's disk found at every scattering event both by next-event estimation and by the
+ * phase-sampled continuation, combined by multiple importance sampling. The air is
  * the analytic sky (sky.h): the medium between the eye and the volume and the light
  * arriving from everywhere a path escapes to; the ground is Lambertian, lit by the sun
  * (shadowed by the volume) and by the paths that leave it. With a black or uniform
@@ -60,6 +62,11 @@ typedef struct atmos_path_settings {
                                radiance at each wavelength ((W m^-2 sr^-1 nm^-1)^2), then, in
                                the place of alpha, the variance of the mean luminance Y
                                ((cd m^-2)^2, covariances between wavelengths included) */
+    atmos_image **order;    /* optional output: per pixel (1 channel) the mean number of volume
+                               scattering events of the light reaching the pixel, weighted by
+                               each contribution's luminance (sum of order x Y over sum of Y;
+                               0 where the pixel's mean luminance is 0). Light from the air or
+                               the ground counts the volume events before it only. */
     atmos_path_stats *stats; /* optional output */
 } atmos_path_settings;
 

@@ -10,14 +10,17 @@
  *   the volume's box: free flight by delta tracking (path_medium.c); at a real
  *       scattering event next-event estimation of the sun's disk (a direction drawn
  *       uniformly in the disk's cone, the transmittance to it by ratio tracking), then
- *       Russian roulette and a new direction drawn from the phase function of one of
- *       the carried wavelengths (one-sample MIS over the wavelengths: the weight of
- *       wavelength k is p_k / mean_j p_j, never more than PATH_B);
+ *       Russian roulette and a new direction drawn from the phase function of the
+ *       path's hero wavelength (multiple importance sampling over whole paths between
+ *       the carried wavelengths: weights never more than PATH_B); a direction that
+ *       lands in the sun's disk counts the sun too, weighted against next-event
+ *       estimation by the balance heuristic;
  *   the ground (y = 0, sky background): Lambertian; the sun's light (shadowed by the
  *       volume) by next-event estimation, then a cosine-distributed bounce;
  *   escape: the sky's in-scatter from the escape point to infinity; the sun's disk only
- *       on a path that has not scattered (after a scattering event the sun is counted
- *       by next-event estimation alone). A black or uniform background is vacuum: no
+ *       on a path that has not scattered (after a volume event the sun is counted by
+ *       the two weighted estimates at the event, after a ground bounce by next-event
+ *       estimation alone). A black or uniform background is vacuum: no
  *       air, no ground, the unattenuated sun, background_radiance from every direction.
  *
  * Per pixel, samples are added in their index order into double sums (and sums of
@@ -140,7 +143,7 @@ static void sunlight(const path_job *J, const path_bundle *b, double y, double *
 /* Sky: in-scatter along p + t d, t in [0, K] (added to L weighted by w) and the
  * transmittance over it (multiplied into w). */
 static void air_segment(const path_job *J, const path_bundle *b, const double p[3], const double d[3], double K,
-                        double *w, double *L)
+                        double *w, double *L, double *Lo, int order)
 {
     const atmos_sky *s = J->sky;
     if (!(K > 0)) return;
@@ -152,7 +155,8 @@ static void air_segment(const path_job *J, const path_bundle *b, const double p[
     for (int i = 0; i < b->m; i++) {
         const int k = b->k[i];
         if (w[i] == 0) continue;
-        L[i] += w[i] * P * J->sun_e[k] * atmos__sky_inscatter_factor(s->gamma, s->beta_sl[k] * ey, G, ly, py, e_end);
+        const double c = w[i] * P * J->sun_e[k] * atmos__sky_inscatter_factor(s->gamma, s->beta_sl[k] * ey, G, ly, py, e_end);
+        L[i] += c, Lo[i] += order * c;
         w[i] *= isinf(G) ? 0.0 : exp(-s->beta_sl[k] * ey * G);
     }
 }
@@ -190,15 +194,68 @@ static int roulette(double *w, int m, path_rng *r)
     return 1;
 }
 
+/* Phase function of the mixture of fields at a scattering event for every carried
+ * wavelength: pk[i] = sum_f ssf[f][i] p_f,k(mu) / ss[i], 0 where nothing scatters. */
+static void phase_mix(const path_phase *P, const path_bundle *b, int nf, double ssf[][PATH_B], const double *ss,
+                        double mu, double *pk)
+{
+    path_angle ang;
+    atmos__path_angle(P, mu, &ang);
+    for (int i = 0; i < b->m; i++) {
+        double s = 0;
+        if (ss[i] > 0) {
+            for (int f = 0; f < nf; f++)
+                if (ssf[f][i] > 0) s += ssf[f][i] * atmos__path_phase_eval(P, f, b->k[i], &ang);
+            s /= ss[i];
+        }
+        pk[i] = s;
+    }
+}
+
+/* Hero wavelengths, multiple importance sampling over whole paths. A path draws every
+ * direction from the phase function of one carried wavelength, its hero h, chosen
+ * uniformly once (Wilkie et al. 2014, "Hero wavelength spectral sampling"); where h does
+ * not scatter, from the first wavelength that does (a fixed rule, so a function of the
+ * path). Wavelength k is then weighted by prod_e p_k(e) / ((1/m) sum_j prod_e pdf_j(e)), the
+ * balance heuristic over the m strategies "hero = j": at most m whatever the path's length.
+ * (Weighting every event separately, p_k / mean_j p_j, compounds over a path: after twenty
+ * events in a droplet cloud, whose phase functions differ between wavelengths by factors of
+ * two in the forward peak and more around the glory and the rainbow, single weights of
+ * hundreds made the fireflies of the first version.) S[j] holds prod_e pdf_j(e),
+ * normalised to mean 1 after every event; the weights w carry the ratio. */
+static double strategies(int m, const double *S, const int *g, const double *pd, double *pj)
+{
+    double D = 0;
+    for (int j = 0; j < m; j++) {
+        if (pj) pj[j] = pd[g[j]];
+        D += S[j] * pd[g[j]];
+    }
+    return D / m;
+}
+
+/* Balance heuristic between the two ways a path finds the sun's disk from a scattering
+ * event: next-event estimation (pdf 1 / sun_omega over the cone) and the phase-sampled
+ * continuation (pdf q p_dir: survival probability of the roulette times the direction
+ * sampler's density). Returns the weight of next-event estimation; the continuation
+ * gets 1 minus it. */
+static inline double mis_nee(const path_job *J, double q_pdir)
+{
+    const double pl = 1.0 / J->sun_omega;
+    return q_pdir > 0 ? pl / (pl + q_pdir) : 1.0;
+}
+
 /* One camera path through world ray (o, d); adds the radiance of the carried
- * wavelengths to L[]. */
+ * wavelengths to L[] and, for the scattering-order AOV, each contribution times the
+ * number of volume scattering events before it to Lo[]. */
 static void trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], path_rng *r,
-                  double *L, path_counts *cnt)
+                  double *L, double *Lo, path_counts *cnt)
 {
     const int m = b->m;
     double w[PATH_B], p[3] = {o[0], o[1], o[2]}, d[3] = {d0[0], d0[1], d0[2]};
-    for (int i = 0; i < m; i++) w[i] = 1, L[i] = 0;
-    int primary = 1, depth = 0;
+    for (int i = 0; i < m; i++) w[i] = 1, L[i] = 0, Lo[i] = 0;
+    int primary = 1, depth = 0, order = 0, hero = -1;
+    double S[PATH_B];
+    for (int i = 0; i < m; i++) S[i] = 1;
     float dens[PATH_F];
     for (int guard = 0; guard < 1 << 24; guard++) {
         double K = J->sky ? atmos_sky_ground_distance(p[1], d) : INFINITY;
@@ -209,59 +266,73 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             inbox = atmos__path_clip(J->med, q, qd, K, &t0, &t1);
         }
         if (inbox) {
-            if (J->sky && t0 > 0) air_segment(J, b, p, d, t0, w, L);
+            if (J->sky && t0 > 0) air_segment(J, b, p, d, t0, w, L, Lo, order);
             double t;
             int ev = atmos__path_free_flight(J->med, q, qd, t0, t1, b, w, r, &t, dens, &cnt->tentative);
             if (ev < 0) return;
             if (ev > 0) {
                 /* A real scattering event in the volume. */
                 cnt->events++;
+                order++;
                 for (int a = 0; a < 3; a++) p[a] += t * d[a];
                 const path_medium *M = J->med;
                 const path_phase *P = J->ph;
                 const int nf = M->nf;
                 double ssf[PATH_F][PATH_B], ss[PATH_B];
+                int elig[PATH_B], ne = 0;
                 for (int i = 0; i < m; i++) {
                     ss[i] = 0;
                     for (int f = 0; f < nf; f++) {
                         ssf[f][i] = (double)dens[f] * M->sca[f][b->k[i]];
                         ss[i] += ssf[f][i];
                     }
+                    if (ss[i] > 0) elig[ne++] = i;
                 }
+                /* the strategy of each hero here: itself, or the first that scatters */
+                int g[PATH_B];
+                for (int i = 0; i < m; i++) g[i] = ss[i] > 0 ? i : (ne ? elig[0] : i);
+                /* Can the path go on from here (depth limit), and with which probability
+                 * does it survive the roulette below: the continuation's share of the
+                 * multiple importance sampling of the sun. */
+                const int goes_on = ne > 0 && !(J->max_depth && depth + 1 >= J->max_depth);
+                double q_rr = 0;
+                if (goes_on)
+                    for (int i = 0; i < m; i++)
+                        if (w[i] > q_rr) q_rr = w[i];
+                if (q_rr > 1) q_rr = 1;
                 /* Next-event estimation of the sun. */
                 double E[PATH_B];
                 sunlight(J, b, p[1], E);
                 int lit = 0;
                 for (int i = 0; i < m; i++) lit |= w[i] * E[i] > 0;
-                if (lit) {
-                    double ds[3], T[PATH_B];
+                lit = lit && J->sun_omega > 0;
+                if (lit && ne) {
+                    double ds[3], T[PATH_B], pk[PATH_B];
                     sample_sun(J, r, ds);
-                    path_angle ang;
-                    atmos__path_angle(P, dot3(d, ds), &ang);
-                    double pk[PATH_B];
+                    phase_mix(P, b, nf, ssf, ss, dot3(d, ds), pk);
+                    /* the continuation's density of ds given the path so far */
+                    const double pdir = strategies(m, S, g, pk, NULL);
                     int any = 0;
-                    for (int i = 0; i < m; i++) {
-                        double s = 0;
-                        if (ss[i] > 0)
-                            for (int f = 0; f < nf; f++)
-                                if (ssf[f][i] > 0) s += ssf[f][i] * atmos__path_phase_eval(P, f, b->k[i], &ang);
-                        pk[i] = ss[i] > 0 ? s / ss[i] : 0;
-                        any |= w[i] * pk[i] * E[i] > 0;
-                    }
+                    for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
                     if (any) {
+                        const double wm = mis_nee(J, q_rr * pdir);
                         shadow(J, b, p, ds, r, T, cnt);
-                        for (int i = 0; i < m; i++) L[i] += w[i] * pk[i] * E[i] * T[i];
+                        for (int i = 0; i < m; i++) {
+                            const double c = w[i] * pk[i] * E[i] * T[i] * wm;
+                            L[i] += c, Lo[i] += order * c;
+                        }
                     }
                 }
-                if (J->max_depth && ++depth >= J->max_depth) return;
+                if (!goes_on) return;
+                depth++;
                 if (!roulette(w, m, r)) return;
-                /* New direction: wavelength j uniformly among those that scatter, field f in
-                 * proportion to its scattering there, cos(theta) by the table's inverse CDF. */
-                int elig[PATH_B], ne = 0;
-                for (int i = 0; i < m; i++)
-                    if (ss[i] > 0) elig[ne++] = i;
-                if (!ne) return;
-                int j = elig[ne > 1 ? (int)(path_u(r) * ne) % ne : 0];
+                /* New direction: the hero's strategy (its wavelength or the fallback), a field
+                 * in proportion to its scattering there, cos(theta) by the table's inverse CDF. */
+                if (hero < 0) {
+                    hero = m > 1 ? (int)(path_u(r) * m) : 0;
+                    if (hero >= m) hero = m - 1;
+                }
+                const int j = g[hero];
                 int f = 0;
                 if (nf > 1) {
                     double u = path_u(r) * ss[j], acc = 0;
@@ -274,22 +345,28 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 double mu = atmos_phase_table_sample(P->t[f], b->k[j], path_u(r));
                 double nd[3];
                 around(d, mu, 2.0 * ATMOS_PI * path_u(r), nd);
-                int chroma = nf > 1 || !P->gray[0];
-                if (chroma && m > 1) {
-                    path_angle ang;
-                    atmos__path_angle(P, mu, &ang);
-                    double pk[PATH_B], mean = 0;
-                    for (int i = 0; i < m; i++) {
-                        double s = 0;
-                        if (ss[i] > 0)
-                            for (int ff = 0; ff < nf; ff++)
-                                if (ssf[ff][i] > 0) s += ssf[ff][i] * atmos__path_phase_eval(P, ff, b->k[i], &ang);
-                        pk[i] = ss[i] > 0 ? s / ss[i] : 0;
-                    }
-                    for (int e = 0; e < ne; e++) mean += pk[elig[e]];
-                    mean /= ne;
+                const int chroma = nf > 1 || !P->gray[0];
+                const int to_sun = lit && dot3(nd, J->sun) >= J->cos_sun;
+                if ((chroma && m > 1) || to_sun) {
+                    double pk[PATH_B], pj[PATH_B];
+                    phase_mix(P, b, nf, ssf, ss, mu, pk);
+                    const double mean = strategies(m, S, g, pk, pj);
                     if (!(mean > 0)) return;
-                    for (int i = 0; i < m; i++) w[i] *= pk[i] / mean;
+                    for (int i = 0; i < m; i++) {
+                        w[i] *= pk[i] / mean;
+                        S[i] *= pj[i] / mean;
+                    }
+                    if (to_sun) {
+                        /* The continuation found the sun's disk: its share of the sun's
+                         * radiance E / sun_omega, through the volume's transmittance. */
+                        double T[PATH_B];
+                        const double wm = 1.0 - mis_nee(J, q_rr * mean);
+                        shadow(J, b, p, nd, r, T, cnt);
+                        for (int i = 0; i < m; i++) {
+                            const double c = w[i] * E[i] / J->sun_omega * T[i] * wm;
+                            L[i] += c, Lo[i] += order * c;
+                        }
+                    }
                 }
                 memcpy(d, nd, sizeof d);
                 primary = 0;
@@ -302,10 +379,13 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
         }
         /* Escape: vacuum, or the air to the ground or to space. */
         if (!J->sky) {
-            for (int i = 0; i < m; i++) L[i] += w[i] * J->bg;
+            for (int i = 0; i < m; i++) {
+                const double c = w[i] * J->bg;
+                L[i] += c, Lo[i] += order * c;
+            }
             return;
         }
-        air_segment(J, b, p, d, K, w, L);
+        air_segment(J, b, p, d, K, w, L, Lo, order);
         if (isinf(K)) {
             if (primary && J->disk_visible && dot3(d, J->sun) >= J->cos_sun) {
                 double E[PATH_B];
@@ -328,7 +408,10 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             sample_sun(J, r, ds);
             if (ds[1] > 0) {
                 shadow(J, b, p, ds, r, T, cnt);
-                for (int i = 0; i < m; i++) L[i] += w[i] * J->albedo / ATMOS_PI * ds[1] * E[i] * T[i];
+                for (int i = 0; i < m; i++) {
+                    const double c = w[i] * J->albedo / ATMOS_PI * ds[1] * E[i] * T[i];
+                    L[i] += c, Lo[i] += order * c;
+                }
             }
         }
         if (J->max_depth && ++depth >= J->max_depth) return;
@@ -362,6 +445,7 @@ static atmos_status resolve(atmos_context *ctx, const atmos_scene *scene, const 
         memcpy(s->offset_m, in->offset_m, sizeof s->offset_m);
         s->optics = in->optics;
         s->variance = in->variance;
+        s->order = in->order;
         s->stats = in->stats;
     }
     if (s->spp < 1 || s->spp > ATMOS_PATH_MAX_SPP)
@@ -385,6 +469,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: missing scene or output");
     *out = NULL;
     if (settings && settings->variance) *settings->variance = NULL;
+    if (settings && settings->order) *settings->order = NULL;
     if (volume && !volume->finalized) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: volume is not finalized");
     const double t_start = now_seconds();
     atmos_path_settings s;
@@ -406,11 +491,12 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     memset(&med, 0, sizeof med);
     memset(&ph, 0, sizeof ph);
     atmos_sky *sky = NULL;
-    atmos_image *img = NULL, *var = NULL;
+    atmos_image *img = NULL, *var = NULL, *ord = NULL;
     double *acc = NULL;
     const int n = wl.count, W = scene->width, H = scene->height, C = n + 1;
     const size_t npix = (size_t)W * H;
-    const int NA = 2 * n + 3; /* per pixel: sum and sum of squares per wavelength, hits, sum Y, sum Y^2 */
+    /* per pixel: sum and sum of squares per wavelength, hits, sum Y, sum Y^2, sum order x Y */
+    const int NA = 2 * n + 4;
     path_counts total = {0, 0, 0};
     int spp_done = 0;
     double t_trace = 0, t_prep = 0;
@@ -493,9 +579,9 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
                             wgt = (double)n / PATH_B;
                         }
                         double jx = path_u(&rng), jy = path_u(&rng), dir[3];
-                        double L[PATH_B] = {0, 0, 0, 0}, Y = 0;
+                        double L[PATH_B] = {0, 0, 0, 0}, Lo[PATH_B] = {0, 0, 0, 0}, Y = 0, Yo = 0;
                         if (atmos_camera_ray(&J.cam, x + jx, y + jy, dir)) {
-                            trace(&J, &b, J.cam.position, dir, &rng, L, &cnt);
+                            trace(&J, &b, J.cam.position, dir, &rng, L, Lo, &cnt);
                             A[2 * n] += 1;
                         }
                         for (int i = 0; i < b.m; i++) {
@@ -504,9 +590,11 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
                             A[b.k[i]] += v;
                             A[n + b.k[i]] += v * v;
                             Y += Ybar[b.k[i]] * v;
+                            if (v > 0 && isfinite(Lo[i])) Yo += Ybar[b.k[i]] * Lo[i] * wgt;
                         }
                         A[2 * n + 1] += Y;
                         A[2 * n + 2] += Y * Y;
+                        A[2 * n + 3] += Yo;
                     }
                 }
                 ev += cnt.events, tc += cnt.tentative, sh += cnt.shadow;
@@ -530,6 +618,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     {
         const double N = spp_done;
         if (s.variance && (st = atmos_image_create(ctx, W, H, C, &var)) != ATMOS_OK) goto done;
+        if (s.order && (st = atmos_image_create(ctx, W, H, 1, &ord)) != ATMOS_OK) goto done;
         double rel_sum = 0;
         long long rel_n = 0;
         for (size_t pix = 0; pix < npix; pix++) {
@@ -548,6 +637,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
             double vy = N > 1 ? (A[2 * n + 2] / N - my * my) / (N - 1) : 0;
             if (!(vy > 0)) vy = 0;
             if (var) var->pixels[pix * C + n] = (float)vy;
+            if (ord) ord->pixels[pix] = A[2 * n + 1] > 0 ? (float)(A[2 * n + 3] / A[2 * n + 1]) : 0.0f;
             if (my > 0 && N > 1) {
                 rel_sum += sqrt(vy) / my;
                 rel_n++;
@@ -592,10 +682,13 @@ done:
     if (st != ATMOS_OK) {
         atmos_image_destroy(img);
         atmos_image_destroy(var);
+        atmos_image_destroy(ord);
         return st;
     }
     *out = img;
     if (s.variance) *s.variance = var;
     else atmos_image_destroy(var);
+    if (s.order) *s.order = ord;
+    else atmos_image_destroy(ord);
     return ATMOS_OK;
 }

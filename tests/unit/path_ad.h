@@ -176,15 +176,16 @@ static int ad_slab(double tau, double a, double g, double mu0, int N, ad_result 
         memcpy(res->T, tmp2, DD * sizeof(double));
         free(RT);
     }
-    /* the collimated beam: incident radiance I0 = 1 / (2 pi mu0 eps) for unit irradiance
-     * on a surface normal to it */
-    const double I0 = 1.0 / (2 * PI * mu0 * eps);
+    /* the collimated beam: incident radiance I0 = 1 / (2 pi eps) for unit irradiance on a
+     * surface normal to it (the operators carry the quadrature weights, not the cosines:
+     * checked by the single-scattering limit and by R + T + exp(-tau / mu0) = 1 at mu0 < 1) */
+    const double I0 = 1.0 / (2 * PI * eps);
     double R = 0, Tt = 0;
     for (int i = 0; i < D; i++) {
         res->radiance_up[i] = res->R[i * D] * I0;
         res->radiance_down[i] = res->T[i * D] * I0;
         if (i == 0) continue; /* weight eps: no flux */
-        R += 2 * PI * res->mu[i] * res->w[i] * res->radiance_up[i] * mu0 / mu0;
+        R += 2 * PI * res->mu[i] * res->w[i] * res->radiance_up[i];
         Tt += 2 * PI * res->mu[i] * res->w[i] * res->radiance_down[i];
     }
     /* fluxes per unit incident flux mu0 * E */

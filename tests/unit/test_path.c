@@ -61,6 +61,13 @@ static void test_ad(void)
     CHECK(ad_slab(1e-4, 1.0, 0.0, 1.0, 16, &r));
     for (int i = 1; i < r.D; i += 5)
         CHECK_REL(r.radiance_up[i], 1 / (4 * PI) / (1 + r.mu[i]) * (1 - exp(-1e-4 * (1 + 1 / r.mu[i]))), 1e-3);
+    /* Oblique incidence (mu0 = 0.6): conservation and the single-scattering radiance
+     * a E p mu0 / (mu0 + mu) (1 - e^{-tau (1/mu0 + 1/mu)}) per unit irradiance normal to the beam. */
+    CHECK(ad_slab(1.0, 1.0, 0.9, 0.6, 32, &r));
+    CHECK_NEAR(r.refl + r.trans + exp(-1.0 / 0.6), 1.0, 1e-9);
+    CHECK(ad_slab(1e-4, 1.0, 0.0, 0.6, 16, &r));
+    for (int i = 1; i < r.D; i += 5)
+        CHECK_REL(r.radiance_up[i], 1 / (4 * PI) * 0.6 / (0.6 + r.mu[i]) * (1 - exp(-1e-4 * (1 / 0.6 + 1 / r.mu[i]))), 1e-3);
     /* Published: isotropic scattering, albedo 0.8, semi-infinite, normal incidence: total
      * reflection 0.28525 (Prahl's adding-doubling, iadpython's test suite; equal to
      * 1 - H(1) sqrt(1 - a) with Chandrasekhar's H-function). */
@@ -195,7 +202,7 @@ static double sun_e(atmos_context *ctx, const atmos_scene *s, int k)
 static void test_slab(atmos_context *ctx)
 {
     const double taus[3] = {0.5, 2, 8};
-    const int spp[3] = {1536, 512, 256};
+    const int spp[3] = {1024, 384, 192};
     optics op;
     make_optics(ctx, 0, 0.85, 1.0, &op);
     for (int i = 0; i < 3; i++) {
@@ -226,6 +233,52 @@ static void test_slab(atmos_context *ctx)
         }
         atmos_volume_destroy(v);
     }
+    atmos_phase_table_destroy(op.t);
+}
+
+/* A sun 20 degrees across and a forward-peaked phase function (HG g = 0.9: p(0) = 15 sr^-1
+ * against the cone's 1 / Omega = 10.5 sr^-1), so that the phase-sampled continuation finds
+ * the sun's disk often and the multiple importance sampling between it and next-event
+ * estimation carries a large share of the light (a weight that does not sum to one shows
+ * here as several standard errors). Reference: adding-doubling integrated over the disk,
+ * flux / E = (2 pi / Omega) * integral over mu0 in [cos r, 1] of R(mu0) mu0 (Gauss-Legendre). */
+static void test_big_sun(atmos_context *ctx)
+{
+    const double tau = 1.0, g = 0.9, rad = 10.0 * PI / 180;
+    optics op;
+    make_optics(ctx, 0, g, 1.0, &op);
+    double ref[2] = {0, 0}, x[6], wq[6];
+    ad_gauss01(6, x, wq);
+    for (int i = 0; i < 6; i++) {
+        static ad_result ad;
+        const double mu0 = cos(rad) + (1 - cos(rad)) * x[i];
+        CHECK(ad_slab(tau, 1.0, g, mu0, 48, &ad));
+        ref[0] += wq[i] * (1 - cos(rad)) * ad.refl * mu0; /* ad: fluxes per unit incident flux mu0 E */
+        ref[1] += wq[i] * (1 - cos(rad)) * ad.trans * mu0;
+    }
+    for (int k = 0; k < 2; k++) ref[k] /= 1 - cos(rad); /* 2 pi / Omega */
+    atmos_volume *v = slab(ctx, 512, tau);
+    atmos_scene s;
+    vacuum_scene(&s, 0, 90, 0);
+    s.atmosphere.sun_diameter_deg = 20;
+    s.width = 4, s.height = 128;
+    double E = sun_e(ctx, &s, 1);
+    for (int side = 0; side < 2; side++) {
+        double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
+        atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
+        atmos_image *var = NULL;
+        atmos_image *img = render(ctx, &s, v, &op, (side == 0 ? 2048 : 256) * (long_run ? 16 : 1), 0, &var);
+        double f, se;
+        hemi_flux(img, var, 1, side == 0, E, &f, &se);
+        double z = (f - ref[side]) / se;
+        printf("slab g=0.9 tau=1 sun 20 deg %s: path %.5f +- %.5f, adding-doubling over the disk %.5f (%+.2f sigma)\n",
+               side == 0 ? "R" : "T", f, se, ref[side], z);
+        CHECK_MSG(fabs(z) < 3.0, "big sun %s: %.5f vs %.5f (%.2f standard errors)", side ? "T" : "R", f, ref[side], z);
+        CHECK(se < 0.025 * ref[side]);
+        atmos_image_destroy(img);
+        atmos_image_destroy(var);
+    }
+    atmos_volume_destroy(v);
     atmos_phase_table_destroy(op.t);
 }
 
@@ -291,6 +344,80 @@ static void test_single(atmos_context *ctx)
     atmos_image_destroy(var);
     atmos_volume_destroy(v);
     atmos_phase_table_destroy(op.t);
+}
+
+/* ------------------------------------------------------------------ scattering order AOV */
+
+/* Mean over the image of the order AOV (all pixels see the slab). */
+static double mean_order(atmos_context *ctx, double tau, int spp)
+{
+    optics op;
+    make_optics(ctx, 0, 0.85, 1.0, &op);
+    atmos_volume *v = slab(ctx, 256, tau);
+    atmos_scene s;
+    vacuum_scene(&s, 0, 60, 0);
+    s.width = s.height = 8;
+    double pos[3] = {0, SLAB_Y + SLAB_H + 1, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0.1, s.camera.look_at[1] = 0, s.camera.look_at[2] = 0;
+    s.camera.fov_deg = 10;
+    atmos_path_settings ps;
+    memset(&ps, 0, sizeof ps);
+    ps.spp = spp;
+    ps.seed = 3;
+    ps.optics = &op.o;
+    atmos_image *img = NULL, *ord = NULL;
+    ps.order = &ord;
+    CHECK_OK(atmos_render_path(ctx, &s, v, &ps, &img, NULL));
+    double m = 0, sy = 0;
+    int ok = img && ord && ord->channels == 1 && ord->width == 8 && ord->height == 8;
+    CHECK(ok);
+    for (int p = 0; ok && p < 64; p++) {
+        /* luminance-weighted mean over the image (green channel) */
+        const double y = img->pixels[p * 4 + 1];
+        m += y * ord->pixels[p], sy += y;
+        /* vacuum and a black background: all the light has scattered at least once; a
+         * pixel no path of which scattered is 0 */
+        ok &= isfinite(ord->pixels[p]) && (y > 0 ? ord->pixels[p] >= 1.0f : ord->pixels[p] == 0.0f);
+    }
+    CHECK(ok && sy > 0);
+    m = sy > 0 ? m / sy : 0;
+    atmos_image_destroy(img);
+    atmos_image_destroy(ord);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+    return m;
+}
+
+/* The luminance-weighted mean number of volume scattering events: close to 1 where single
+ * scattering dominates (optically thin), growing with the optical depth; 0 where nothing
+ * scattered (the sky background alone). */
+static void test_order(atmos_context *ctx)
+{
+    const double taus[4] = {0.05, 1, 4, 16};
+    double prev = 0;
+    for (int i = 0; i < 4; i++) {
+        double m = mean_order(ctx, taus[i], 64);
+        printf("order AOV: slab tau=%g seen from above: mean order %.3f\n", taus[i], m);
+        if (i == 0) CHECK(m >= 1.0 && m <= 1.1);
+        else CHECK_MSG(m > prev + 0.5, "tau %g: mean order %.3f, at the thinner slab %.3f", taus[i], m, prev);
+        prev = m;
+    }
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.width = 8, s.height = 6;
+    s.atmosphere.ground_albedo = 0;
+    atmos_path_settings ps;
+    memset(&ps, 0, sizeof ps);
+    ps.spp = 2;
+    atmos_image *img = NULL, *ord = NULL;
+    ps.order = &ord;
+    CHECK_OK(atmos_render_path(ctx, &s, NULL, &ps, &img, NULL));
+    int zero = ord != NULL;
+    for (int p = 0; zero && p < 48; p++) zero &= ord->pixels[p] == 0.0f;
+    CHECK(zero);
+    atmos_image_destroy(img);
+    atmos_image_destroy(ord);
 }
 
 /* ------------------------------------------------------------------ Beer-Lambert */
@@ -470,6 +597,8 @@ int main(void)
     test_sky_only(ctx);
     test_absorber(ctx);
     test_single(ctx);
+    test_big_sun(ctx);
+    test_order(ctx);
     test_threads_and_spectral();
     test_slab(ctx);
     atmos_context_destroy(ctx);

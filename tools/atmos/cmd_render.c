@@ -52,7 +52,10 @@ static void help(void)
            "      --time-budget S           path: stop after the pass during which S seconds have passed\n"
            "      --seed N                  path: random seed (default: the scene's, 1; same seed, same image)\n"
            "      --variance FILE.exr       path: per-pixel variance of the mean (channels var_<nm>nm per\n"
-           "                                wavelength, then var_Y of the luminance)\n\n"
+           "                                wavelength, then var_Y of the luminance)\n"
+           "      --order FILE.pfm          path: per-pixel mean number of volume scattering events of the\n"
+           "                                light reaching the pixel, weighted by luminance (1 channel;\n"
+           "                                a key for atmos compare --by)\n\n"
            "Animation (the sun moves; the volume and its optics tables are prepared once):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
            "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
@@ -116,7 +119,7 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_SPP, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON,
     O_SPECTRAL, O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_SLICES, O_XI, O_VPOS,
-    O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE, O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END
+    O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE, O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER
 };
 
 /* The volume's optical depth along each pixel's ray at the middle wavelength of the
@@ -177,6 +180,7 @@ int cli_cmd_render(int argc, char **argv)
         {"variance", required_argument, 0, O_VARIANCE},
         {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
         {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
+        {"order", required_argument, 0, O_ORDER},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -196,8 +200,8 @@ int cli_cmd_render(int argc, char **argv)
     double tbudget = 0;
     unsigned long long seed = 0;
     int seed_given = 0;
-    const char *variance_out = NULL;
-    atmos_image *var_img = NULL;
+    const char *variance_out = NULL, *order_out = NULL;
+    atmos_image *var_img = NULL, *order_img = NULL;
     atmos_path_stats pstats;
     memset(&pstats, 0, sizeof pstats);
     /* Animation. */
@@ -289,6 +293,7 @@ int cli_cmd_render(int argc, char **argv)
         case O_TIME_END: time_end_s = optarg; break;
         case O_SEL_END: if (!cli_parse_double(C, "--sun-elevation-end", optarg, &sel_end)) return CLI_EXIT_USAGE; break;
         case O_SAZ_END: if (!cli_parse_double(C, "--sun-azimuth-end", optarg, &saz_end)) return CLI_EXIT_USAGE; break;
+        case O_ORDER: order_out = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
@@ -408,10 +413,10 @@ int cli_cmd_render(int argc, char **argv)
         if (spp) scene.path.spp = spp;
         if (tbudget > 0) scene.path.time_budget_s = tbudget;
         if (seed_given) scene.path.seed = seed;
-    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out) {
+    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out || order_out) {
         atmos_context_destroy(ctx);
         return cli_usage_error(C, spp > 256 ? "--spp: must be in [1, 256] for this renderer (1..1000000 with --renderer path)"
-                                            : "--time-budget, --seed and --variance go with --renderer path");
+                                            : "--time-budget, --seed, --variance and --order go with --renderer path");
     } else if (spp) {
         scene.samples_per_pixel = spp;
     }
@@ -452,7 +457,7 @@ int cli_cmd_render(int argc, char **argv)
     double offset[3] = {0, 0, 0};
     atmos_render_info info;
     atmos_wavelengths wl;
-    static char png_i[4200], exr_i[4200], pfm_i[4200], var_i[4200];
+    static char png_i[4200], exr_i[4200], pfm_i[4200], var_i[4200], ord_i[4200];
     if ((st = atmos_scene_wavelengths(ctx, &scene, &wl)) != ATMOS_OK) goto fail;
     /* The path tracer may render without a volume (sky and ground only). */
     if (scene.volume.source[0] && scene.renderer != ATMOS_RENDERER_SKY) {
@@ -466,18 +471,20 @@ int cli_cmd_render(int argc, char **argv)
     for (frame = 1; frame <= nframes; frame++) {
         atmos_scene fs;
         if ((st = atmos_scene_animation_frame(ctx, &scene, frame - 1, &fs)) != ATMOS_OK) goto fail;
-        const char *o_png = png, *o_exr = exr, *o_pfm = pfm, *o_var = variance_out;
+        const char *o_png = png, *o_exr = exr, *o_pfm = pfm, *o_var = variance_out, *o_ord = order_out;
         if (numbered) {
             if ((png && !frame_name(png, frame, digits, png_i, sizeof png_i)) ||
                 (exr && !frame_name(exr, frame, digits, exr_i, sizeof exr_i)) ||
                 (pfm && !frame_name(pfm, frame, digits, pfm_i, sizeof pfm_i)) ||
-                (variance_out && !frame_name(variance_out, frame, digits, var_i, sizeof var_i))) {
+                (variance_out && !frame_name(variance_out, frame, digits, var_i, sizeof var_i)) ||
+                (order_out && !frame_name(order_out, frame, digits, ord_i, sizeof ord_i))) {
                 st = ATMOS_E_INVALID_ARG;
                 fprintf(stderr, "atmos render: an output path is too long for numbered frames\n");
                 goto fail_quiet;
             }
             o_png = png ? png_i : NULL, o_exr = exr ? exr_i : NULL, o_pfm = pfm ? pfm_i : NULL;
             o_var = variance_out ? var_i : NULL;
+            o_ord = order_out ? ord_i : NULL;
         }
         protect_outputs(o_png, o_exr, o_pfm);
         if (scene.renderer == ATMOS_RENDERER_SLICE) {
@@ -492,6 +499,7 @@ int cli_cmd_render(int argc, char **argv)
             memcpy(ps.offset_m, offset, sizeof offset);
             ps.optics = vol ? &optics : NULL;
             ps.variance = o_var ? &var_img : NULL;
+            ps.order = o_ord ? &order_img : NULL;
             ps.stats = &pstats;
             if ((st = atmos_render_path(ctx, &fs, vol, &ps, &spec, &info)) != ATMOS_OK) goto fail;
         } else if ((st = atmos_render_sky(ctx, &fs, &spec, &info)) != ATMOS_OK) {
@@ -521,6 +529,10 @@ int cli_cmd_render(int argc, char **argv)
             atmos_image_set_meta(var_img, "atmos:source", source);
             if ((st = atmos_write_exr(ctx, var_img, o_var, &ed)) != ATMOS_OK) goto fail;
         }
+        if (order_img && o_ord) {
+            atmos_image_set_meta(order_img, "atmos:source", source);
+            if ((st = atmos_write_pfm(ctx, order_img, o_ord)) != ATMOS_OK) goto fail;
+        }
         if (o_png) {
             char buf[64];
             double scale = atmos_tonemap_scale(lin, &fs.tonemap);
@@ -540,13 +552,15 @@ int cli_cmd_render(int argc, char **argv)
             if (o_exr) fprintf(stderr, "  wrote %s\n", o_exr);
             if (o_pfm) fprintf(stderr, "  wrote %s\n", o_pfm);
             if (var_img && o_var) fprintf(stderr, "  wrote %s\n", o_var);
+            if (order_img && o_ord) fprintf(stderr, "  wrote %s\n", o_ord);
             if (scene.renderer == ATMOS_RENDERER_PATH)
                 fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n",
                         pstats.spp, pstats.events, 100.0 * pstats.mean_rel_error);
             if (frame == 1 && tau_path) fprintf(stderr, "  wrote %s\n", tau_path);
         }
         atmos_image_destroy(var_img);
-        var_img = NULL;
+        atmos_image_destroy(order_img);
+        var_img = order_img = NULL;
         atmos_image_destroy(spec);
         atmos_image_destroy(lin);
         atmos_image_destroy(disp);
@@ -565,6 +579,7 @@ fail:
     {
         int rc = cli_runtime_error(C, ctx, st);
         atmos_image_destroy(var_img);
+    atmos_image_destroy(order_img);
         atmos_image_destroy(spec);
         atmos_image_destroy(lin);
         atmos_image_destroy(disp);

@@ -1,0 +1,47 @@
+#!/bin/sh
+# atmos render --renderer path through the CLI: a tiny image of a generated cumulus, the same
+# bytes for 1 and 2 threads, the --variance and --order outputs, --time-budget, bad values.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/cli_path.$$
+mkdir -p "$T"
+export XDG_CACHE_HOME="$T/cache"
+fail=0; pass=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
+P="--renderer path --volume generate:cumulus --width 24 --height 16 --spp 4"
+
+"$A" render -q $P --threads 1 --pfm "$T/a.pfm" && ok || bad "path render, 1 thread"
+"$A" render -q $P --threads 2 --pfm "$T/b.pfm" --variance "$T/var.exr" --order "$T/order.pfm" \
+    && ok || bad "path render, 2 threads, --variance --order"
+cmp -s "$T/a.pfm" "$T/b.pfm" && ok || bad "1 and 2 threads differ"
+[ -s "$T/var.exr" ] && ok || bad "--variance file not written"
+python3 - "$T/b.pfm" "$T/order.pfm" <<'PY' && ok || bad "image / order check"
+import math, struct, sys
+def pfm(p):
+    d = open(p, "rb").read()
+    parts = d.split(b"\n", 3)
+    c = 3 if parts[0] == b"PF" else 1
+    w, h = map(int, parts[1].split())
+    return w, h, c, struct.unpack("<%df" % (w * h * c), parts[3][: w * h * c * 4])
+w, h, c, img = pfm(sys.argv[1])
+assert (w, h, c) == (24, 16, 3), (w, h, c)
+assert all(math.isfinite(x) and x >= 0 for x in img), "bad pixel values"
+w, h, c, o = pfm(sys.argv[2])
+assert (w, h, c) == (24, 16, 1), (w, h, c)
+assert all(math.isfinite(x) and x >= 0 for x in o), "bad order values"
+# the sky pixels carry light that never met the volume (order 0); the cloud's carry more
+assert min(o) == 0 and max(o) >= 1, (min(o), max(o))
+PY
+# --time-budget: stops after the pass in which the budget ran out (here the first)
+"$A" render $P --spp 1000000 --time-budget 0.2 --threads 2 --pfm "$T/t.pfm" 2> "$T/t.log" && ok || bad "--time-budget"
+grep -q "path: [0-9]* spp" "$T/t.log" && ! grep -q "path: 1000000 spp" "$T/t.log" && ok || bad "--time-budget did not stop early"
+# bad values: usage errors exit 2
+for args in "--spp 0" "--spp 1000001" "--time-budget -1" "--seed x" "--threads 0"; do
+    "$A" render -q $P $args -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "'$args' should exit 2"
+done
+"$A" render -q --order "$T/o.pfm" -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--order without --renderer path should exit 2"
+"$A" render -q --variance "$T/v.exr" -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--variance without --renderer path should exit 2"
+rm -rf "$T"
+echo "path_render: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
