@@ -55,6 +55,12 @@ typedef struct atmos_path_settings {
     uint64_t seed;         /* 0 = the scene's (default 1) */
     int max_depth;         /* scattering events per path; 0 = the scene's (0 = unlimited) */
     double density_scale;  /* multiplies the volume's densities; 0 = 1 */
+    double truncate_deg;   /* forward-peak truncation (docs/path.md): the part of every phase
+                              function above its value at theta_c inside the cone theta < theta_c
+                              counts as not scattered. Degrees, (0, 20]; 0 = the scene's (default
+                              0: none, exact); < 0: none whatever the scene says. An
+                              approximation: changes radiances within ~theta_c of the forward
+                              direction (the sun's aureole), removes the droplets' fireflies. */
     double offset_m[3];    /* added to the volume's world position (as atmos_slice_settings) */
     const atmos_slice_optics *optics; /* NULL: built inside the render (only the phase tables
                                          are read; the Ams tables are not needed) */

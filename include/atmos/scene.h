@@ -79,6 +79,7 @@ typedef struct atmos_scene_path {
     double time_budget_s;     /* > 0: stop when this much time has passed (after whole passes); 0 = none */
     uint64_t seed;            /* 1 */
     int max_depth;            /* scattering events per path; 0 = unlimited (Russian roulette) */
+    double truncate_deg;      /* forward-peak truncation angle, degrees, [0, 20]; 0 = none (exact) */
 } atmos_scene_path;
 
 /* A sequence of images with the sun moving ("animation" in the file): frame i of N

@@ -23,6 +23,10 @@
  *       estimation alone). A black or uniform background is vacuum: no
  *       air, no ground, the unattenuated sun, background_radiance from every direction.
  *
+ * With truncate_deg > 0 the volume is the truncated medium of path_phase.c (forward peak
+ * cut at theta_c, that fraction of the scattering counted as unscattered): free flights,
+ * shadow rays, next-event estimation and phase sampling all see sigma_s', sigma_t' and P'.
+ *
  * Per pixel, samples are added in their index order into double sums (and sums of
  * squares, for the variance); the random numbers of sample s of pixel p come from their
  * own stream. So the image does not depend on the thread count or the schedule.
@@ -342,7 +346,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                     }
                     while (f > 0 && ssf[f][j] <= 0) f--;
                 }
-                double mu = atmos_phase_table_sample(P->t[f], b->k[j], path_u(r));
+                double mu = atmos__path_phase_sample(P, f, b->k[j], path_u(r));
                 double nd[3];
                 around(d, mu, 2.0 * ATMOS_PI * path_u(r), nd);
                 const int chroma = nf > 1 || !P->gray[0];
@@ -436,12 +440,14 @@ static atmos_status resolve(atmos_context *ctx, const atmos_scene *scene, const 
     if (scene->path.time_budget_s > 0) s->time_budget_s = scene->path.time_budget_s;
     if (scene->path.seed) s->seed = scene->path.seed;
     s->max_depth = scene->path.max_depth;
+    s->truncate_deg = scene->path.truncate_deg;
     if (in) {
         if (in->spp) s->spp = in->spp;
         if (in->time_budget_s) s->time_budget_s = in->time_budget_s;
         if (in->seed) s->seed = in->seed;
         if (in->max_depth) s->max_depth = in->max_depth;
         if (in->density_scale) s->density_scale = in->density_scale;
+        if (in->truncate_deg) s->truncate_deg = in->truncate_deg < 0 ? 0.0 : in->truncate_deg;
         memcpy(s->offset_m, in->offset_m, sizeof s->offset_m);
         s->optics = in->optics;
         s->variance = in->variance;
@@ -455,6 +461,9 @@ static atmos_status resolve(atmos_context *ctx, const atmos_scene *scene, const 
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: time_budget_s must be >= 0, got %g", s->time_budget_s);
     if (s->max_depth < 0)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: max_depth must be >= 0, got %d", s->max_depth);
+    if (!(s->truncate_deg >= 0 && s->truncate_deg <= 20))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: truncate_deg must be in [0, 20], got %g",
+                            s->truncate_deg);
     if (!(s->density_scale > 0) || !isfinite(s->density_scale))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: density_scale must be > 0, got %g", s->density_scale);
     for (int a = 0; a < 3; a++)
@@ -529,9 +538,10 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
                               optics->count, volume->nfields);
             goto done;
         }
-        if ((st = atmos__path_phase_build(ctx, optics, n, &ph)) != ATMOS_OK) goto done;
+        if ((st = atmos__path_phase_build(ctx, optics, n, s.truncate_deg, &ph)) != ATMOS_OK) goto done;
         if ((st = atmos__path_medium_build(ctx, volume, s.density_scale, s.offset_m, optics, n, &med)) != ATMOS_OK)
             goto done;
+        if (ph.ic) atmos__path_medium_truncate(&med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])ph.trunc);
         if (!med.empty) J.med = &med, J.ph = &ph;
     }
     if (scene->background == ATMOS_BACKGROUND_SKY) J.sky = sky;
@@ -645,8 +655,13 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         }
         char buf[256];
         atmos_image_set_meta(img, "atmos:renderer", "path (spectral Monte Carlo volumetric path tracing)");
-        snprintf(buf, sizeof buf, "%d spp, seed %llu, max depth %d, %s", spp_done, (unsigned long long)s.seed,
-                 s.max_depth, scene->background == ATMOS_BACKGROUND_SKY ? "sky" : "vacuum");
+        if (ph.ic)
+            snprintf(buf, sizeof buf, "%d spp, seed %llu, max depth %d, %s, forward peak truncated at %g deg", spp_done,
+                     (unsigned long long)s.seed, s.max_depth, scene->background == ATMOS_BACKGROUND_SKY ? "sky" : "vacuum",
+                     ph.cut_deg);
+        else
+            snprintf(buf, sizeof buf, "%d spp, seed %llu, max depth %d, %s", spp_done, (unsigned long long)s.seed,
+                     s.max_depth, scene->background == ATMOS_BACKGROUND_SKY ? "sky" : "vacuum");
         atmos_image_set_meta(img, "atmos:path", buf);
         double secs = now_seconds() - t_start;
         snprintf(buf, sizeof buf, "%.6f", secs);

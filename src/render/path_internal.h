@@ -71,6 +71,10 @@ typedef struct {
 atmos_status atmos__path_medium_build(atmos_context *ctx, const atmos_volume *v, double scale, const double offset[3],
                                       const atmos_slice_optics *optics, int nwl, path_medium *m);
 void atmos__path_medium_free(path_medium *m);
+/* Forward-peak truncation of the medium: per field and wavelength the fraction trunc of the
+ * scattering counts as not scattered, sigma_s' = sigma_s (1 - trunc), sigma_t' = sigma_t -
+ * trunc sigma_s (the absorption is unchanged). Majorants and transmittance follow. */
+void atmos__path_medium_truncate(path_medium *m, int nwl, const float trunc[][ATMOS_MAX_WAVELENGTHS]);
 
 /* World point / direction to index space (t stays in metres along a unit world direction). */
 void atmos__path_to_index(const path_medium *m, const double p[3], const double d[3], double q[3], double qd[3]);
@@ -110,9 +114,22 @@ typedef struct {
     float *fv[PATH_F];         /* nwl * ng: f_i = P_i sin(theta_i) / total */
     int gray[PATH_F];          /* same table at every wavelength */
     const atmos_phase_table *t[PATH_F];
+    /* Forward-peak truncation (docs/path.md, "Forward-peak truncation"); ic = 0: none, the
+     * tables above are the exact phase functions and the sampler is the table's own. */
+    int ic;                    /* grid index of the cut angle theta_c */
+    double cut_deg;            /* theta_c (a grid angle) */
+    double *cdf[PATH_F];       /* nwl * ng: CDF over theta of 2 pi f (truncated tables only) */
+    float trunc[PATH_F][ATMOS_MAX_WAVELENGTHS]; /* fraction of the scattering removed (f) */
 } path_phase;
 
-atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_slice_optics *optics, int nwl, path_phase *p);
+/* truncate_deg > 0: the tables are the truncated phase functions P' (P'(theta) =
+ * min(P(theta), P(theta_c)) inside the cone theta < theta_c, P outside, renormalised),
+ * trunc[][] the fractions f removed, and atmos__path_phase_sample draws from them. */
+atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_slice_optics *optics, int nwl,
+                                     double truncate_deg, path_phase *p);
+/* cos(theta) drawn from field f's (truncated) table at wavelength k, matched with
+ * atmos__path_phase_eval; for ic = 0 it is atmos_phase_table_sample. */
+double atmos__path_phase_sample(const path_phase *p, int f, int k, double u);
 void atmos__path_phase_free(path_phase *p);
 
 /* Interval index i and fraction s of theta (from mu = cos theta), and 1/sin(theta) factor. */

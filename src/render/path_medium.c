@@ -112,6 +112,18 @@ atmos_status atmos__path_medium_build(atmos_context *ctx, const atmos_volume *v,
     return ATMOS_OK;
 }
 
+void atmos__path_medium_truncate(path_medium *m, int nwl, const float trunc[][ATMOS_MAX_WAVELENGTHS])
+{
+    for (int f = 0; f < m->nf; f++)
+        for (int k = 0; k < nwl; k++) {
+            const double t = trunc[f][k], sca = m->sca[f][k], se = m->sig[f][k];
+            if (!(t > 0)) continue;
+            double se2 = se - t * sca;
+            m->sca[f][k] = (float)(sca * (1.0 - t));
+            m->sig[f][k] = (float)(se2 > m->sca[f][k] ? se2 : m->sca[f][k]);
+        }
+}
+
 void atmos__path_to_index(const path_medium *m, const double p[3], const double d[3], double q[3], double qd[3])
 {
     const double *r = m->R;

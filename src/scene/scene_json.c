@@ -930,12 +930,13 @@ static atmos_status parse_slice(const jp *p, const cJSON *j, const char *path, a
 
 static atmos_status parse_path(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"spp", "time_budget_s", "seed", "max_depth"};
+    static const char *const keys[] = {"spp", "time_budget_s", "seed", "max_depth", "truncate_deg"};
+    static const atmos__range r_trunc = {0, 20, 0, 0};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 4, &it));
+    TRY(iter_begin(p, j, path, keys, 5, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
@@ -944,6 +945,7 @@ static atmos_status parse_path(const jp *p, const cJSON *j, const char *path, at
         case 1: TRY(get_number(p, v, ip, &r_budget, NULL, &s->path.time_budget_s)); break;
         case 2: TRY(get_u64(p, v, ip, &r_seed, &s->path.seed)); break;
         case 3: TRY(get_int(p, v, ip, &r_depth, &s->path.max_depth)); break;
+        case 4: TRY(get_number(p, v, ip, &r_trunc, NULL, &s->path.truncate_deg)); break;
         }
     }
 }

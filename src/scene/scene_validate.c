@@ -284,7 +284,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
 {
     static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0},
                               r_xi = {0, 100, 0, 0}, r_grid = {8, 2048, 0, 0}, r_spp = {1, 1000000, 0, 0},
-                              r_budget = {0, 1e7, 0, 0}, r_depth = {0, 100000, 0, 0},
+                              r_budget = {0, 1e7, 0, 0}, r_depth = {0, 100000, 0, 0}, r_trunc = {0, 20, 0, 0},
                               r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0}, r_voxel = {0, 1e5, 0, 0},
                               r_time_index = {0, 1000000, 0, 0};
     static const char *const names[] = {"sky", "slice", "path"};
@@ -343,6 +343,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
         {"/path/spp", s->path.spp, &r_spp},
         {"/path/time_budget_s", s->path.time_budget_s, &r_budget},
         {"/path/max_depth", s->path.max_depth, &r_depth},
+        {"/path/truncate_deg", s->path.truncate_deg, &r_trunc},
     };
     for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++)
         if ((st = atmos__scene_check_range(ctx, source, checks[i].path, checks[i].v, checks[i].r, NULL))) return st;

@@ -97,9 +97,10 @@ static int ad_solve(int n, int m, double *A, double *B)
     return 1;
 }
 
-/* Slab of optical thickness tau, single-scattering albedo a, HG asymmetry g, collimated
+/* Slab of optical thickness tau, single-scattering albedo a, phase function the sum of two
+ * HG lobes w1 HG(g1) + (1 - w1) HG(g2) (Legendre moments w1 g1^l + (1 - w1) g2^l), collimated
  * beam at cosine mu0 (0 < mu0 <= 1) on top; N Gauss points per hemisphere (<= 64). */
-static int ad_slab(double tau, double a, double g, double mu0, int N, ad_result *res)
+static int ad_slab2(double tau, double a, double w1, double g1, double g2, double mu0, int N, ad_result *res)
 {
     const double PI = 3.14159265358979323846, eps = 1e-12;
     const int D = N + 1, L = 2 * N; /* Legendre terms kept: 0..L-1 */
@@ -108,10 +109,10 @@ static int ad_slab(double tau, double a, double g, double mu0, int N, ad_result 
     res->mu[0] = mu0, res->w[0] = eps;
     ad_gauss01(N, res->mu + 1, res->w + 1);
     /* delta-M */
-    const double f = pow(g, L);
+    const double f = w1 * pow(g1, L) + (1 - w1) * pow(g2, L);
     const double ts = (1 - a * f) * tau, as = a * (1 - f) / (1 - a * f);
     double chi[2 * AD_MAXN];
-    for (int l = 0; l < L; l++) chi[l] = (pow(g, l) - f) / (1 - f);
+    for (int l = 0; l < L; l++) chi[l] = (w1 * pow(g1, l) + (1 - w1) * pow(g2, l) - f) / (1 - f);
     /* Legendre polynomials at the directions */
     static double P[AD_MAXN][2 * AD_MAXN];
     for (int i = 0; i < D; i++) {
@@ -198,6 +199,12 @@ static int ad_slab(double tau, double a, double g, double mu0, int N, ad_result 
     res->radiance_up[0] = res->R[0] * I0;
     free(Pt), free(Pr), free(A), free(B), free(tmp), free(tmp2), free(E);
     return 1;
+}
+
+/* One HG lobe of asymmetry g. */
+static int ad_slab(double tau, double a, double g, double mu0, int N, ad_result *res)
+{
+    return ad_slab2(tau, a, 1.0, g, 0.0, mu0, N, res);
 }
 
 #endif
