@@ -44,6 +44,9 @@ typedef struct atmos_path_stats {
     double total_s;
     double mean_rel_error;     /* mean over pixels with a nonzero mean of the relative standard
                                   error of the pixel's mean (luminance-weighted over channels) */
+    double truncate_deg;       /* the forward-peak cut used (a grid angle); 0: none */
+    double truncated_min, truncated_max; /* the fraction f of the scattering removed by it, over
+                                            the fields and wavelengths */
 } atmos_path_stats;
 
 /* Settings; zero means "the scene's path section" (scene->path) for spp, time_budget_s,

@@ -508,7 +508,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     const int NA = 2 * n + 4;
     path_counts total = {0, 0, 0};
     int spp_done = 0;
-    double t_trace = 0, t_prep = 0;
+    double t_trace = 0, t_prep = 0, trunc_lo = 0, trunc_hi = 0;
 
     atmos_atmosphere_desc ad = scene->atmosphere;
     if ((st = atmos_sky_create(ctx, &ad, &wl, &sky)) != ATMOS_OK) return st;
@@ -541,7 +541,21 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         if ((st = atmos__path_phase_build(ctx, optics, n, s.truncate_deg, &ph)) != ATMOS_OK) goto done;
         if ((st = atmos__path_medium_build(ctx, volume, s.density_scale, s.offset_m, optics, n, &med)) != ATMOS_OK)
             goto done;
-        if (ph.ic) atmos__path_medium_truncate(&med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])ph.trunc);
+        if (ph.ic) {
+            atmos__path_medium_truncate(&med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])ph.trunc);
+            for (int f = 0; f < ph.nf; f++) {
+                double lo = 1, hi = 0;
+                for (int k = 0; k < n; k++) {
+                    if (ph.trunc[f][k] < lo) lo = ph.trunc[f][k];
+                    if (ph.trunc[f][k] > hi) hi = ph.trunc[f][k];
+                }
+                atmos__log(ctx, ATMOS_LOG_INFO,
+                           "render path: field %d: forward peak truncated at %g deg, scattering fraction removed %.4f-%.4f",
+                           f, ph.cut_deg, lo, hi);
+                if (f == 0 || lo < trunc_lo) trunc_lo = lo;
+                if (hi > trunc_hi) trunc_hi = hi;
+            }
+        }
         if (!med.empty) J.med = &med, J.ph = &ph;
     }
     if (scene->background == ATMOS_BACKGROUND_SKY) J.sky = sky;
@@ -685,6 +699,9 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
             o->trace_s = t_trace;
             o->total_s = secs;
             o->mean_rel_error = rel_n ? rel_sum / rel_n : 0.0;
+            o->truncate_deg = ph.ic ? ph.cut_deg : 0.0;
+            o->truncated_min = trunc_lo;
+            o->truncated_max = trunc_hi;
         }
     }
     st = ATMOS_OK;

@@ -1,6 +1,7 @@
 #!/bin/sh
 # atmos render --renderer path through the CLI: a tiny image of a generated cumulus, the same
-# bytes for 1 and 2 threads, the --variance and --order outputs, --time-budget, bad values.
+# bytes for 1 and 2 threads (also with --truncate), the --variance and --order outputs,
+# --time-budget, bad values.
 set -u
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_path.$$
@@ -15,6 +16,13 @@ P="--renderer path --volume generate:cumulus --width 24 --height 16 --spp 4"
 "$A" render -q $P --threads 2 --pfm "$T/b.pfm" --variance "$T/var.exr" --order "$T/order.pfm" \
     && ok || bad "path render, 2 threads, --variance --order"
 cmp -s "$T/a.pfm" "$T/b.pfm" && ok || bad "1 and 2 threads differ"
+# --truncate: thread-independent too; --truncate 0 is the exact default
+"$A" render -q $P --threads 1 --truncate 3 --pfm "$T/c.pfm" && ok || bad "path render --truncate 3, 1 thread"
+"$A" render -q $P --threads 2 --truncate 3 --pfm "$T/d.pfm" && ok || bad "path render --truncate 3, 2 threads"
+cmp -s "$T/c.pfm" "$T/d.pfm" && ok || bad "--truncate: 1 and 2 threads differ"
+cmp -s "$T/a.pfm" "$T/c.pfm" && bad "--truncate 3 changed nothing" || ok
+"$A" render -q $P --threads 2 --truncate 0 --pfm "$T/e.pfm" && ok || bad "path render --truncate 0"
+cmp -s "$T/a.pfm" "$T/e.pfm" && ok || bad "--truncate 0 differs from the default"
 [ -s "$T/var.exr" ] && ok || bad "--variance file not written"
 python3 - "$T/b.pfm" "$T/order.pfm" <<'PY' && ok || bad "image / order check"
 import math, struct, sys
@@ -37,11 +45,12 @@ PY
 "$A" render $P --spp 1000000 --time-budget 0.2 --threads 2 --pfm "$T/t.pfm" 2> "$T/t.log" && ok || bad "--time-budget"
 grep -q "path: [0-9]* spp" "$T/t.log" && ! grep -q "path: 1000000 spp" "$T/t.log" && ok || bad "--time-budget did not stop early"
 # bad values: usage errors exit 2
-for args in "--spp 0" "--spp 1000001" "--time-budget -1" "--seed x" "--threads 0"; do
+for args in "--spp 0" "--spp 1000001" "--time-budget -1" "--seed x" "--threads 0" "--truncate 21" "--truncate -1"; do
     "$A" render -q $P $args -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "'$args' should exit 2"
 done
 "$A" render -q --order "$T/o.pfm" -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--order without --renderer path should exit 2"
 "$A" render -q --variance "$T/v.exr" -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--variance without --renderer path should exit 2"
+"$A" render -q --truncate 3 -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--truncate without --renderer path should exit 2"
 rm -rf "$T"
 echo "path_render: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

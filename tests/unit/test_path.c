@@ -584,8 +584,23 @@ static void test_threads_and_spectral(void)
     atmos_image *a = render(c1, &s, v, &op, 6, 0, NULL), *b = render(c2, &s, v, &op, 6, 0, NULL);
     CHECK(a && b && memcmp(a->pixels, b->pixels, sizeof(float) * 24 * 16 * 4) == 0);
     CHECK(all_finite(a));
+    /* truncate_deg < 0 is "none" whatever the scene says: the same bytes as the default */
+    s.path.truncate_deg = 5;
+    truncate_deg = -1;
+    atmos_image *tr = render(c2, &s, v, &op, 6, 0, NULL);
+    CHECK(tr && memcmp(a->pixels, tr->pixels, sizeof(float) * 24 * 16 * 4) == 0);
+    atmos_image_destroy(tr);
+    atmos_image_destroy(b);
+    /* the scene's truncation, thread-independent and a different image */
+    truncate_deg = 0;
+    tr = render(c1, &s, v, &op, 6, 0, NULL), b = render(c2, &s, v, &op, 6, 0, NULL);
+    CHECK(tr && b && memcmp(tr->pixels, b->pixels, sizeof(float) * 24 * 16 * 4) == 0);
+    CHECK(memcmp(a->pixels, tr->pixels, sizeof(float) * 24 * 16 * 4) != 0);
+    CHECK(all_finite(tr));
+    s.path.truncate_deg = 0;
     atmos_image_destroy(a);
     atmos_image_destroy(b);
+    atmos_image_destroy(tr);
 
     /* Spectral mode: 16 wavelengths, 4 per path; the slab's reflectance is grey, so every
      * wavelength's reflected radiance over the sun's irradiance matches rgb mode. */
@@ -671,6 +686,9 @@ static void test_sky_only(atmos_context *ctx)
     CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
     ps.spp = 1;
     ps.density_scale = -1;
+    CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
+    ps.density_scale = 0;
+    ps.truncate_deg = 20.5;
     CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
 }
 

@@ -210,11 +210,12 @@ static void test_absent_keys(void)
     CHECK(s.volume.placed && s.volume.position_m[0] == 1 && s.volume.position_m[1] == 2 && s.volume.position_m[2] == 3);
     CHECK_OK(parse("{\"renderer\": \"path\", \"volume\": {\"file\": \"c.vdb\", \"grids\": [\"density\", \"temp\"], "
                    "\"particle\": \"cloud\", \"density_scale\": 1e8}, \"path\": {\"spp\": 1000, \"time_budget_s\": 30, "
-                   "\"seed\": 42, \"max_depth\": 5}, \"background\": {\"type\": \"uniform\", \"radiance\": 0.25}, "
+                   "\"seed\": 42, \"max_depth\": 5, \"truncate_deg\": 3.5}, \"background\": {\"type\": \"uniform\", \"radiance\": 0.25}, "
                    "\"sun\": {\"elevation_deg\": 30, \"irradiance\": [1, 2, 3]}}", &s));
     CHECK(s.renderer == ATMOS_RENDERER_PATH && !strcmp(s.volume.source, "c.vdb") && !strcmp(s.volume.grids, "density,temp"));
     CHECK(!strcmp(s.volume.particle, "cloud") && s.volume.density_scale == 1e8 && !s.volume.placed);
     CHECK(s.path.spp == 1000 && s.path.time_budget_s == 30 && s.path.seed == 42 && s.path.max_depth == 5);
+    CHECK(s.path.truncate_deg == 3.5);
     CHECK(s.background == ATMOS_BACKGROUND_UNIFORM && s.background_radiance == 0.25);
     CHECK(s.sun.irradiance_count == 3 && s.sun.irradiance[2] == 3 && s.sun.elevation_deg == 30);
     CHECK_OK(parse("{\"sun\": {\"irradiance\": 1.5, \"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40, "
@@ -277,7 +278,8 @@ static const bad_case bad_cases[] = {
     {"{\"path\": {\"spp\": 0}}", ATMOS_E_INVALID_ARG, "/path/spp: must be in [1, 1000000], got 0", NULL},
     {"{\"path\": {\"time_budget_s\": -1}}", ATMOS_E_INVALID_ARG, "/path/time_budget_s: must be in [0, 10000000], got -1", NULL},
     {"{\"path\": {\"seed\": -3}}", ATMOS_E_INVALID_ARG, "/path/seed: must be in [0, ", NULL},
-    {"{\"path\": {\"bounces\": 3}}", ATMOS_E_INVALID_ARG, "/path/bounces: unknown key (allowed: spp, time_budget_s, seed, max_depth)", NULL},
+    {"{\"path\": {\"bounces\": 3}}", ATMOS_E_INVALID_ARG, "/path/bounces: unknown key (allowed: spp, time_budget_s, seed, max_depth, truncate_deg)", NULL},
+    {"{\"path\": {\"truncate_deg\": 21}}", ATMOS_E_INVALID_ARG, "/path/truncate_deg: must be in [0, 20], got 21", NULL},
     {"{\"background\": \"uniform\"}", ATMOS_E_INVALID_ARG, "/background: must be one of sky, black, got \"uniform\"", NULL},
     {"{\"background\": {\"type\": \"uniform\"}}", ATMOS_E_INVALID_ARG, "/background: missing key \"radiance\"", NULL},
     {"{\"background\": {\"type\": \"black\", \"radiance\": 1}}", ATMOS_E_INVALID_ARG, "/background: \"radiance\" goes with \"type\": \"uniform\" only", NULL},

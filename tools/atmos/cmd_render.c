@@ -566,6 +566,9 @@ int cli_cmd_render(int argc, char **argv)
             if (scene.renderer == ATMOS_RENDERER_PATH)
                 fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n",
                         pstats.spp, pstats.events, 100.0 * pstats.mean_rel_error);
+            if (scene.renderer == ATMOS_RENDERER_PATH && pstats.truncate_deg > 0)
+                fprintf(stderr, "  path: forward peak truncated at %g deg: %.3f-%.3f of the scattering counted as unscattered\n",
+                        pstats.truncate_deg, pstats.truncated_min, pstats.truncated_max);
             if (frame == 1 && tau_path) fprintf(stderr, "  wrote %s\n", tau_path);
         }
         atmos_image_destroy(var_img);
