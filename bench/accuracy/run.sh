@@ -7,7 +7,8 @@
 #   bench/accuracy/run.sh [OUT_DIR]      (default: docs/accuracy)
 #
 # Environment: ATMOS (the binary, default build/atmos), SPP (path samples per pixel,
-# default 1024), CASES (default "cumulus cirrus rain disney"), THREADS.
+# default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
+# CASES (default "cumulus cirrus rain disney"), THREADS.
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -15,11 +16,14 @@ root=$(cd "$here/../.." && pwd)
 A=${ATMOS:-$root/build/atmos}
 OUT=${1:-$root/docs/accuracy}
 SPP=${SPP:-1024}
+TRUNCATE=${TRUNCATE:-3}
 CASES=${CASES:-"cumulus cirrus rain disney"}
 TH=${THREADS:+--threads $THREADS}
 mkdir -p "$OUT"
 csv="$OUT/results.csv"
-echo "case,sun,variant,seconds,rel_rmse,bias_rel,bins_json" > "$csv"
+# rel_rmse, bias_rel: over the volume's pixels (optical depth >= 0.01), relative to the
+# reference's mean there; tau_bins, order_bins: [bin start, pixels, rel_rmse, rel_bias] per bin
+echo "case,sun,variant,seconds,rel_rmse,bias_rel,tau_bins,order_bins" > "$csv"
 
 # Seconds from atmos render's own timing line ("..., 1.234 s").
 secs() { sed -n 's/.*, \([0-9.]*\) s$/\1/p' "$1" | tail -1; }
@@ -31,9 +35,10 @@ for c in $CASES; do
         if [ "$sun" = behind ]; then az=180; else az=0; fi
         base="$OUT/${c}_$sun"
         echo "== $c, sun $sun" >&2
-        "$A" render "$scene" $TH --sun-azimuth $az --renderer path --spp "$SPP" --pfm "$base.path.pfm" \
-            --variance "$base.path.var.pfm" --tau "$base.tau.pfm" -o "$base.path.png" 2> "$base.path.log"
-        echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[]" >> "$csv"
+        "$A" render "$scene" $TH --sun-azimuth $az --renderer path --spp "$SPP" --truncate "$TRUNCATE" --pfm "$base.path.pfm" \
+            --variance "$base.path.var.exr" --order "$base.order.pfm" --tau "$base.tau.pfm" -o "$base.path.png" \
+            2> "$base.path.log"
+        echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[],[]" >> "$csv"
         for v in eq25 eq25_xi0 eq25_xi4 eq24 low_albedo; do
             case $v in
             eq25) opts="" ;;
@@ -45,14 +50,21 @@ for c in $CASES; do
             "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
             "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \
                 --heatmap "$base.$v.diff.png" --json > "$base.$v.json"
-            python3 - "$base.$v.json" "$c" "$sun" "$v" "$(secs "$base.$v.log")" >> "$csv" <<'PY'
+            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.order.pfm" --edges 0.5,1.5,3,6,12,25,50,1000 \
+                --json > "$base.$v.order.json"
+            # the volume's pixels only (optical depth >= 0.01): the sky and the sun's disk are not the question
+            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,1e30 \
+                --json > "$base.$v.vol.json"
+            python3 - "$base.$v.json" "$base.$v.order.json" "$base.$v.vol.json" "$c" "$sun" "$v" "$(secs "$base.$v.log")" \
+                >> "$csv" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
-bias = sum(j["bias"]) / len(j["bias"])
-ref_mean = j["rmse"] / j["rel_rmse"] if j["rel_rmse"] > 0 else float("nan")
-bins = [[b["lo"], b["pixels"], b["rel_rmse"], b["rel_bias"]] for b in j["bins"]]
-print("%s,%s,%s,%s,%.5g,%.5g,\"%s\"" % (sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5], j["rel_rmse"],
-                                      bias / ref_mean if ref_mean == ref_mean else float("nan"), json.dumps(bins)))
+o = json.load(open(sys.argv[2]))
+v = json.load(open(sys.argv[3]))["bins"][0]
+tb = [[b["lo"], b["pixels"], b["rel_rmse"], b["rel_bias"]] for b in j["bins"]]
+ob = [[b["lo"], b["pixels"], b["rel_rmse"], b["rel_bias"]] for b in o["bins"]]
+print("%s,%s,%s,%s,%.5g,%.5g,\"%s\",\"%s\"" % (sys.argv[4], sys.argv[5], sys.argv[6], sys.argv[7], v["rel_rmse"],
+      v["rel_bias"], json.dumps(tb), json.dumps(ob)))
 PY
         done
     done
