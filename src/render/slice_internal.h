@@ -44,7 +44,8 @@ typedef struct {
 
 typedef struct {
     int n, nf;
-    int W, H, L;                 /* image, light buffer side */
+    int W, H, L;                 /* eye buffer (the image, or smaller: eye_scale), light buffer side */
+    double sx, sy;               /* image pixels per eye-buffer pixel (1 = the image is the eye buffer) */
     int nslices;
     int btf;                     /* back-to-front */
     int low_albedo, eq24;
