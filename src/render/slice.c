@@ -270,7 +270,7 @@ static atmos_status stables_build(atmos_context *ctx, const atmos_slice_optics *
                 /* Orders past the table's last are isotropic (Riley §4.2.1). */
                 const double *vals = ord <= mo ? atmos_msphase_values(m, k, ord) : NULL;
                 for (int a = 0; a < ng; a++)
-                    t->ams[f][((size_t)k * ng + a) * t->no + (ord - 1)] =
+                    t->ams[f][((size_t)a * t->no + (ord - 1)) * n + k] =
                         (float)(vals ? vals[a] : 1.0 / (4.0 * ATMOS_PI));
             }
             for (int i = 0; i <= SLICE_F_ORDERS; i++) {
@@ -282,10 +282,18 @@ static atmos_status stables_build(atmos_context *ctx, const atmos_slice_optics *
     return ATMOS_OK;
 }
 
-/* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. */
+/* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. *a
+ * holds a guess on entry (the neighbouring pixel's index: angles change little from
+ * pixel to pixel), tried with its neighbours before a binary search. */
 static void angle_locate(const double *grid, int ng, double theta_deg, int *a, float *w)
 {
     int lo = 0, hi = ng - 1;
+    for (int g = *a - 1; g <= *a + 1; g++)
+        if (g >= 0 && g < ng - 1 && grid[g] < theta_deg && theta_deg < grid[g + 1]) {
+            *a = g;
+            *w = (float)((theta_deg - grid[g]) / (grid[g + 1] - grid[g]));
+            return;
+        }
     if (theta_deg <= grid[0]) {
         *a = 0, *w = 0;
         return;
@@ -798,7 +806,8 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
      * cos theta = d . sun). */
     const double ee1 = dot3(j.eye, j.e1), ee2 = dot3(j.eye, j.e2);
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-    for (int y = 0; y < j.H; y++)
+    for (int y = 0; y < j.H; y++) {
+        int hint[ATMOS_VOLUME_MAX_FIELDS] = {0};
         for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
             size_t p = (size_t)y * j.W + x;
             for (int c = 0; c < j.n; c++) j.L_eye[c * j.pst + p] = 0.0f, j.T_eye[c * j.pst + p] = 1.0f;
@@ -842,11 +851,11 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             double c = dot3(dw, sun_w);
             double th = acos(c > 1 ? 1 : (c < -1 ? -1 : c)) * ATMOS_RAD2DEG;
             for (int f = 0; f < j.nf; f++) {
-                int ai;
-                angle_locate(tab.grid[f], tab.ng[f], th, &ai, &j.pw[p * j.nf + f]);
-                j.pa[p * j.nf + f] = ai * tab.no;
+                angle_locate(tab.grid[f], tab.ng[f], th, &hint[f], &j.pw[p * j.nf + f]);
+                j.pa[p * j.nf + f] = hint[f] * tab.no * j.n;
             }
         }
+    }
     /* Per light texel: slices its ray crosses inside the box, and the sunlight arriving
      * there through the air (Eq. 12, at the altitude where the ray enters the box).
      * Texel (a, b)'s ray is u e1 + v e2 + w lt; on slice k, w = (s_k - u h.e1 - v h.e2)/h.lt. */
