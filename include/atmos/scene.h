@@ -71,6 +71,7 @@ typedef struct atmos_scene_slice {
     int eq24;                 /* 1: "update": "eq24"; 0: "eq25" (default) */
     int low_albedo;           /* 0 */
     int grid_max_dim;         /* 256 */
+    double eye_scale;         /* 1: eye buffer resolution relative to the image, per axis, (0, 1] */
 } atmos_scene_slice;
 
 /* Settings of the path tracer ("path" in the file). */

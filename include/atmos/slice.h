@@ -53,6 +53,7 @@ typedef struct atmos_slice_timing {
     int grid_dims[3];        /* the resampled render grid */
     double setup;            /* per-frame set-up (part of prepare): per-pixel rays, light texels,
                                 the per-slice spans of pixels and texels to visit */
+    int eye_dims[2];         /* the eye buffer (width, height) */
 } atmos_slice_timing;
 
 /* Settings; zero means default for every field (atmos_slice_defaults shows them). */
@@ -73,6 +74,11 @@ typedef struct atmos_slice_settings {
     atmos_slice_timing *timing;       /* optional output */
     int reference;         /* nonzero: the plain scalar passes with libm's exp (slow; the fast
                               default differs from it by < 1e-5 relative, docs/slice.md) */
+    double eye_scale;      /* eye buffer resolution relative to the image, per axis, in (0, 1];
+                              0 = 1 (the image is the eye buffer). Below 1 the eye passes run on
+                              round(scale * width) x round(scale * height) rays and the volume's
+                              radiance and transparency are upsampled bilinearly before the §5
+                              composite with the full-resolution sky (docs/slice.md) */
 } atmos_slice_settings;
 
 /* Fills *s with the resolved defaults. */

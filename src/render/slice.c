@@ -70,6 +70,7 @@ void atmos_slice_defaults(atmos_slice_settings *s)
     s->grid_max_dim = 256;
     s->max_order = 64;
     s->density_scale = 1.0;
+    s->eye_scale = 1.0;
 }
 
 /* ------------------------------------------------------------------ optics */
@@ -269,7 +270,7 @@ static atmos_status stables_build(atmos_context *ctx, const atmos_slice_optics *
                 /* Orders past the table's last are isotropic (Riley §4.2.1). */
                 const double *vals = ord <= mo ? atmos_msphase_values(m, k, ord) : NULL;
                 for (int a = 0; a < ng; a++)
-                    t->ams[f][((size_t)k * ng + a) * t->no + (ord - 1)] =
+                    t->ams[f][((size_t)a * t->no + (ord - 1)) * n + k] =
                         (float)(vals ? vals[a] : 1.0 / (4.0 * ATMOS_PI));
             }
             for (int i = 0; i <= SLICE_F_ORDERS; i++) {
@@ -281,10 +282,18 @@ static atmos_status stables_build(atmos_context *ctx, const atmos_slice_optics *
     return ATMOS_OK;
 }
 
-/* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. */
+/* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. *a
+ * holds a guess on entry (the neighbouring pixel's index: angles change little from
+ * pixel to pixel), tried with its neighbours before a binary search. */
 static void angle_locate(const double *grid, int ng, double theta_deg, int *a, float *w)
 {
     int lo = 0, hi = ng - 1;
+    for (int g = *a - 1; g <= *a + 1; g++)
+        if (g >= 0 && g < ng - 1 && grid[g] < theta_deg && theta_deg < grid[g + 1]) {
+            *a = g;
+            *w = (float)((theta_deg - grid[g]) / (grid[g + 1] - grid[g]));
+            return;
+        }
     if (theta_deg <= grid[0]) {
         *a = 0, *w = 0;
         return;
@@ -364,6 +373,42 @@ static void slice_range(double sa, double sb, double s0, double ds, int nslices,
     *k0 = (int)a, *k1 = (int)b;
 }
 
+/* §5 composite of one image pixel along direction dw (world): the air from the eye
+ * to the halfway plane at distance th is in front of the volume, the rest (with the
+ * ground and the sun's disk) behind it. px holds the sky image B (= front + T_front *
+ * back) and receives front + T_front * L_vol + T_vol * (B - front). */
+static void composite_pixel(const atmos_sky *sky, int vacuum, const atmos_camera *cam, const double dw[3], double th,
+                            const double sun_w[3], int n, const float *Lv, const float *Tv, float *px)
+{
+    if (!(th > 0)) th = 0;
+    double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
+    if (vacuum) { /* no air between the eye and the volume */
+        for (int c = 0; c < n; c++) front[c] = 0.0, Tf[c] = 1.0;
+    } else {
+        double tg = atmos_sky_ground_distance(cam->position[1], dw);
+        if (th > tg) th = tg;
+        atmos_sky_inscatter(sky, cam->position, dw, th, sun_w, front);
+        atmos_sky_transmittance(sky, cam->position[1], dw, th, Tf);
+    }
+    for (int c = 0; c < n; c++) {
+        double B = px[c], L = Lv[c], T = Tv[c];
+        double r = front[c] + Tf[c] * L + T * (B - front[c]);
+        px[c] = (float)(isfinite(r) && r > 0 ? r : 0.0);
+    }
+}
+
+/* The two eye-buffer pixels (of n) around fractional eye coordinate f (pixel centres at
+ * integers) and the weight of the second; clamped at the edges. */
+static void eye_taps(double f, int n, int t[2], float *w)
+{
+    if (!(f > 0)) f = 0;
+    if (f > n - 1) f = n - 1;
+    int i = (int)f;
+    if (i > n - 2) i = n - 2 < 0 ? 0 : n - 2;
+    t[0] = i, t[1] = i + 1 < n ? i + 1 : i;
+    *w = t[1] == t[0] ? 0.0f : (float)(f - i);
+}
+
 /* ------------------------------------------------------------------ the render */
 
 
@@ -416,8 +461,9 @@ static void block_footprint(const sjob *j, const atmos_camera *cam, const double
             behind++;
             continue;
         }
-        /* Image position (pixels; centres at +0.5) as atmos_camera_ray inverts it. */
-        double px = 0.5 * (W + dot3(r, cr) / (z * th) * H), py = 0.5 * (H - dot3(r, cu) / (z * th) * H);
+        /* Image position (pixels; centres at +0.5) as atmos_camera_ray inverts it, in
+         * eye-buffer pixels. */
+        double px = 0.5 * (W + dot3(r, cr) / (z * th) * H) / j->sx, py = 0.5 * (H - dot3(r, cu) / (z * th) * H) / j->sy;
         xmin = fmin(xmin, px), xmax = fmax(xmax, px);
         ymin = fmin(ymin, py), ymax = fmax(ymax, py);
     }
@@ -535,6 +581,7 @@ static atmos_status check_settings(atmos_context *ctx, const atmos_slice_setting
     if (in->grid_max_dim) s->grid_max_dim = in->grid_max_dim;
     if (in->max_order) s->max_order = in->max_order;
     if (in->density_scale != 0) s->density_scale = in->density_scale;
+    if (in->eye_scale != 0) s->eye_scale = in->eye_scale;
     memcpy(s->offset_m, in->offset_m, sizeof s->offset_m);
     s->optics = in->optics;
     s->timing = in->timing;
@@ -554,6 +601,8 @@ static atmos_status check_settings(atmos_context *ctx, const atmos_slice_setting
     if (!(s->density_scale > 0) || !isfinite(s->density_scale))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "slice/density_scale: must be positive and finite, got %g",
                             s->density_scale);
+    if (!(s->eye_scale > 0 && s->eye_scale <= 1))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "slice/eye_scale: must be in (0, 1], got %g", s->eye_scale);
     for (int i = 0; i < 3; i++)
         if (!isfinite(s->offset_m[i]))
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "slice/offset_m[%d]: must be finite", i);
@@ -663,7 +712,18 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     }
     j.n = wl.count;
     j.nf = volume->nfields;
+    /* The eye buffer: the image, or eye_scale of it per axis (eye pixel x covers image
+     * pixels x sx .. (x + 1) sx; its ray goes through the centre of that area). */
     j.W = cam.width, j.H = cam.height, j.L = s.light_size;
+    j.sx = j.sy = 1.0;
+    if (s.eye_scale < 1.0) {
+        int we = (int)lround(s.eye_scale * cam.width), he = (int)lround(s.eye_scale * cam.height);
+        we = we < 1 ? 1 : we, he = he < 1 ? 1 : he;
+        if (we != j.W || he != j.H) {
+            j.sx = (double)cam.width / we, j.sy = (double)cam.height / he;
+            j.W = we, j.H = he;
+        }
+    }
     j.nslices = s.slices;
     j.s0 = smin;
     j.ds = (smax - smin) / s.slices;
@@ -746,12 +806,13 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
      * cos theta = d . sun). */
     const double ee1 = dot3(j.eye, j.e1), ee2 = dot3(j.eye, j.e2);
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-    for (int y = 0; y < j.H; y++)
+    for (int y = 0; y < j.H; y++) {
+        int hint[ATMOS_VOLUME_MAX_FIELDS] = {0};
         for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
             size_t p = (size_t)y * j.W + x;
             for (int c = 0; c < j.n; c++) j.L_eye[c * j.pst + p] = 0.0f, j.T_eye[c * j.pst + p] = 1.0f;
             double dw[3], d[3];
-            atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
+            atmos_camera_ray(&cam, (x + 0.5) * j.sx, (y + 0.5) * j.sy, dw);
             TO_GRID(dw, d);
             double hd = dot3(j.h, d);
             j.pk0[p] = 1, j.pk1[p] = 0;
@@ -790,11 +851,11 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             double c = dot3(dw, sun_w);
             double th = acos(c > 1 ? 1 : (c < -1 ? -1 : c)) * ATMOS_RAD2DEG;
             for (int f = 0; f < j.nf; f++) {
-                int ai;
-                angle_locate(tab.grid[f], tab.ng[f], th, &ai, &j.pw[p * j.nf + f]);
-                j.pa[p * j.nf + f] = ai * tab.no;
+                angle_locate(tab.grid[f], tab.ng[f], th, &hint[f], &j.pw[p * j.nf + f]);
+                j.pa[p * j.nf + f] = hint[f] * tab.no * j.n;
             }
         }
+    }
     /* Per light texel: slices its ray crosses inside the box, and the sunlight arriving
      * there through the air (Eq. 12, at the altitude where the ray enters the box).
      * Texel (a, b)'s ray is u e1 + v e2 + w lt; on slice k, w = (s_k - u h.e1 - v h.e2)/h.lt. */
@@ -928,34 +989,72 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                          0.5 * (g.box_lo[2] + g.box_hi[2])};
         const double hc = dot3(j.h, cen);
         const int C = img->channels;
+        if (j.sx == 1.0 && j.sy == 1.0) {
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-        for (int y = 0; y < j.H; y++)
-            for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
-                size_t p = (size_t)y * j.W + x;
-                int touched = 0;
-                for (int c = 0; c < j.n; c++)
-                    touched |= j.L_eye[c * j.pst + p] != 0.0f || j.T_eye[c * j.pst + p] != 1.0f;
-                if (!touched) continue;
-                double dw[3];
-                atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
-                double th = j.pinv[p] != 0.0f ? (hc - j.he) * j.pinv[p] : 0.0;
-                if (!(th > 0)) th = 0;
-                double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
-                if (vacuum) { /* no air between the eye and the volume */
-                    for (int c = 0; c < j.n; c++) front[c] = 0.0, Tf[c] = 1.0;
-                } else {
-                    double tg = atmos_sky_ground_distance(cam.position[1], dw);
-                    if (th > tg) th = tg;
-                    atmos_sky_inscatter(sky, cam.position, dw, th, sun_w, front);
-                    atmos_sky_transmittance(sky, cam.position[1], dw, th, Tf);
+            for (int y = 0; y < j.H; y++)
+                for (int x = j.erow[y].x0; x <= j.erow[y].x1; x++) {
+                    size_t p = (size_t)y * j.W + x;
+                    int touched = 0;
+                    for (int c = 0; c < j.n; c++)
+                        touched |= j.L_eye[c * j.pst + p] != 0.0f || j.T_eye[c * j.pst + p] != 1.0f;
+                    if (!touched) continue;
+                    double dw[3];
+                    atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
+                    double th = j.pinv[p] != 0.0f ? (hc - j.he) * j.pinv[p] : 0.0;
+                    float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
+                    for (int c = 0; c < j.n; c++) Lv[c] = j.L_eye[c * j.pst + p], Tv[c] = j.T_eye[c * j.pst + p];
+                    composite_pixel(sky, vacuum, &cam, dw, th, sun_w, j.n, Lv, Tv, img->pixels + p * C);
                 }
-                float *px = img->pixels + p * C;
-                for (int c = 0; c < j.n; c++) {
-                    double B = px[c], Lv = j.L_eye[c * j.pst + p], Tv = j.T_eye[c * j.pst + p];
-                    double r = front[c] + Tf[c] * Lv + Tv * (B - front[c]);
-                    px[c] = (float)(isfinite(r) && r > 0 ? r : 0.0);
+        } else {
+            /* Eye buffer smaller than the image: L_vol and T_vol bilinear between the
+             * four eye pixels around the image pixel's centre (both are premultiplied by
+             * the volume's coverage, so this blurs the silhouette by one eye pixel but
+             * does not tint it). Eye pixels outside their row's union of spans were
+             * never reached (L = 0, T = 1). An image pixel whose four eye pixels are all
+             * untouched keeps the sky image exactly; the halfway plane is met along the
+             * image pixel's own ray. */
+            const int W = cam.width, H = cam.height;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+            for (int y = 0; y < H; y++) {
+                int ey[2];
+                float wy;
+                eye_taps((y + 0.5) / j.sy - 0.5, j.H, ey, &wy);
+                int xa = INT32_MAX, xb = -1;
+                for (int r = 0; r < 2; r++) {
+                    const sspan e = j.erow[ey[r]];
+                    if (e.x0 > e.x1) continue;
+                    int a = (int)floor((e.x0 - 0.5) * j.sx), b = (int)ceil((e.x1 + 1.5) * j.sx);
+                    xa = a < xa ? a : xa, xb = b > xb ? b : xb;
+                }
+                xa = xa < 0 ? 0 : xa, xb = xb > W - 1 ? W - 1 : xb;
+                for (int x = xa; x <= xb; x++) {
+                    int ex[2];
+                    float wx;
+                    eye_taps((x + 0.5) / j.sx - 0.5, j.W, ex, &wx);
+                    const float wt[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+                    float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
+                    for (int c = 0; c < j.n; c++) Lv[c] = 0.0f, Tv[c] = 0.0f;
+                    int touched = 0;
+                    for (int q = 0; q < 4; q++) {
+                        const int tx = ex[q & 1], ty = ey[q >> 1];
+                        const size_t p = (size_t)ty * j.W + tx;
+                        const int in = tx >= j.erow[ty].x0 && tx <= j.erow[ty].x1;
+                        for (int c = 0; c < j.n; c++) {
+                            const float L = in ? j.L_eye[c * j.pst + p] : 0.0f, T = in ? j.T_eye[c * j.pst + p] : 1.0f;
+                            touched |= L != 0.0f || T != 1.0f;
+                            Lv[c] += wt[q] * L, Tv[c] += wt[q] * T;
+                        }
+                    }
+                    if (!touched) continue;
+                    double dw[3], d[3];
+                    atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
+                    TO_GRID(dw, d);
+                    const double hd = dot3(j.h, d);
+                    double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j.he) / hd : 0.0;
+                    composite_pixel(sky, vacuum, &cam, dw, th, sun_w, j.n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
                 }
             }
+        }
         t_sky += now_seconds() - t_c0;
     }
     if (s.timing) {
@@ -969,8 +1068,9 @@ finish:
     {
         char buf[256];
         atmos_image_set_meta(img, "atmos:renderer", "slice (Riley et al. 2004, half-angle slicing)");
-        snprintf(buf, sizeof buf, "%d slices, light buffer %d, xi %g, %s%s", s.slices, s.light_size, s.xi,
-                 s.update == ATMOS_SLICE_EQ24 ? "eq24" : "eq25", s.low_albedo ? ", low albedo" : "");
+        snprintf(buf, sizeof buf, "%d slices, light buffer %d, eye buffer %dx%d, xi %g, %s%s", s.slices, s.light_size,
+                 j.W ? j.W : cam.width, j.H ? j.H : cam.height, s.xi, s.update == ATMOS_SLICE_EQ24 ? "eq24" : "eq25",
+                 s.low_albedo ? ", low albedo" : "");
         atmos_image_set_meta(img, "atmos:slice", buf);
         double secs = now_seconds() - t_start;
         snprintf(buf, sizeof buf, "%.6f", secs);
@@ -986,6 +1086,7 @@ finish:
             s.timing->eye_samples = eye_samples;
             s.timing->light_samples = light_samples;
             memcpy(s.timing->grid_dims, g.c, sizeof g.c);
+            s.timing->eye_dims[0] = j.W, s.timing->eye_dims[1] = j.H;
             if (!g.v) s.timing->prepare = s.timing->light = s.timing->eye = 0;
         }
     }

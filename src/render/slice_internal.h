@@ -31,7 +31,10 @@ typedef struct {
     int no;                    /* Ams orders tabulated: 1..no */
     int ng[ATMOS_VOLUME_MAX_FIELDS];
     const double *grid[ATMOS_VOLUME_MAX_FIELDS];  /* theta, degrees */
-    float *ams[ATMOS_VOLUME_MAX_FIELDS];          /* [(k * ng + a) * no + (order - 1)] */
+    float *ams[ATMOS_VOLUME_MAX_FIELDS];          /* [(a * no + (order - 1)) * n + k]: the wavelengths of
+                                                     an angle and order side by side, so that the
+                                                     bilinear taps of all wavelengths of a sample
+                                                     fall in two cache lines */
     float *F[ATMOS_VOLUME_MAX_FIELDS];            /* [k * (SLICE_F_ORDERS+1) + n]: F_n (Eq. 23) */
     float *S[ATMOS_VOLUME_MAX_FIELDS];            /* same layout: S(n) = sum_{i<=n} ln F_i */
 } stables;
@@ -44,7 +47,8 @@ typedef struct {
 
 typedef struct {
     int n, nf;
-    int W, H, L;                 /* image, light buffer side */
+    int W, H, L;                 /* eye buffer (the image, or smaller: eye_scale), light buffer side */
+    double sx, sy;               /* image pixels per eye-buffer pixel (1 = the image is the eye buffer) */
     int nslices;
     int btf;                     /* back-to-front */
     int low_albedo, eq24;
@@ -63,7 +67,7 @@ typedef struct {
     float *pdelta;               /* eye-ray length of a slab */
     float *pinv;                 /* 1 / (h . d) */
     int *pk0, *pk1;              /* slices the ray crosses inside the box */
-    int *pa;                     /* [pix * nf + f] Ams angle row offset */
+    int *pa;                     /* [pix * nf + f] Ams angle row offset (a * no * n) */
     float *pw;                   /* [pix * nf + f] weight of the next angle */
     float *L_eye, *T_eye;        /* [c * pst + pix] (pst: plane stride >= npix) */
     size_t pst;

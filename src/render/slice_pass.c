@@ -101,9 +101,10 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
                 bext += dens[f] * j->t->sig[f][c];
                 float bs = dens[f] * j->t->sca[f][c];
                 if (bs > 0.0f) {
-                    const float *q = j->t->ams[f] + ((size_t)c * j->t->ng[f] * no + j->pa[p * nf + f] + oi);
-                    float lo = q[0] + fo * (q[1] - q[0]);
-                    float hi = q[no] + fo * (q[no + 1] - q[no]);
+                    const float *q = j->t->ams[f] + ((size_t)j->pa[p * nf + f] + (size_t)oi * n + c);
+                    const size_t an = (size_t)no * n; /* next angle; next order: + n */
+                    float lo = q[0] + fo * (q[n] - q[0]);
+                    float hi = q[an] + fo * (q[an + n] - q[an]);
                     src += bs * (lo + j->pw[p * nf + f] * (hi - lo) + j->xi);
                 }
             }
@@ -370,6 +371,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
     const stables *t = j->t;
     const int n = j->n, nf = j->nf, no = t->no, L = j->L;
     const int32_t ns = n + 1, LN = L * ns; /* texels interleave I per wavelength and n */
+    const int32_t an = no * n;             /* Ams: next angle (next order: + n) */
     const float kf = (float)k, lim = (float)(L - 1), xi = j->xi, fno = (float)no;
     const float *restrict Ib = Ib_, *restrict nb = nb_;
     float u[CH], v[CH], w[CH];
@@ -436,7 +438,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             const int32_t *restrict pa = j->pa + p0 * nf + f;
             const float *restrict pw = j->pw + p0 * nf + f;
             for (int q = 0; q < mv; q++) {
-                ai[f][q] = pa[id[q] * nf] + oi[q];
+                ai[f][q] = pa[id[q] * nf] + oi[q] * n;
                 aw[f][q] = pw[id[q] * nf];
             }
         }
@@ -450,15 +452,15 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             for (int f = 0; f < nf; f++) {
                 if (!live[f]) continue;
                 const float sg = t->sig[f][c], sa = t->sca[f][c];
-                const float *restrict A = t->ams[f] + (size_t)c * t->ng[f] * no;
+                const float *restrict A = t->ams[f] + c; /* next order: + n, next angle: + an */
                 const float *restrict d = dens + f * CH;
                 for (int q = 0; q < mv; q++) {
                     const float dq = d[q] > 0.0f ? d[q] : 0.0f;
                     bext[q] += dq * sg;
                     const float bs = dq * sa;
                     const int32_t ix = ai[f][q];
-                    const float lo = A[ix] + fo[q] * (A[ix + 1] - A[ix]);
-                    const float hi = A[ix + no] + fo[q] * (A[ix + no + 1] - A[ix + no]);
+                    const float lo = A[ix] + fo[q] * (A[ix + n] - A[ix]);
+                    const float hi = A[ix + an] + fo[q] * (A[ix + an + n] - A[ix + an]);
                     const float val = lo + aw[f][q] * (hi - lo);
                     src[q] += bs > 0.0f ? bs * (val + xi) : 0.0f;
                 }

@@ -56,6 +56,7 @@ void atmos_scene_defaults(atmos_scene *s)
     s->slice.light_size = 256;
     s->slice.xi = 0.1 / (4.0 * ATMOS_PI);
     s->slice.grid_max_dim = 256;
+    s->slice.eye_scale = 1.0;
     s->path.spp = 64;
     s->path.seed = 1;
 }

@@ -759,7 +759,7 @@ static atmos_status parse_particles(const jp *p, const cJSON *j, const char *pat
 /* ---- renderers, background, volume ---- */
 
 static const atmos__range r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0}, r_xi = {0, 100, 0, 0},
-                          r_grid = {8, 2048, 0, 0}, r_path_spp = {1, 1000000, 0, 0},
+                          r_grid = {8, 2048, 0, 0}, r_eye_scale = {0, 1, 1, 0}, r_path_spp = {1, 1000000, 0, 0},
                           r_budget = {0, 1e7, 0, 0}, r_seed = {0, 9007199254740992.0, 0, 0},
                           r_depth = {0, 100000, 0, 0}, r_radiance = {0, 1e6, 0, 0},
                           r_dscale = {0, 1e30, 1, 0}, r_time_index = {0, 1000000, 0, 0},
@@ -907,13 +907,13 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
 
 static atmos_status parse_slice(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"slices", "light_size", "xi", "update", "low_albedo", "grid_max_dim"};
+    static const char *const keys[] = {"slices", "light_size", "xi", "update", "low_albedo", "grid_max_dim", "eye_scale"};
     static const char *const updates[] = {"eq25", "eq24"};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 6, &it));
+    TRY(iter_begin(p, j, path, keys, 7, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
@@ -924,6 +924,7 @@ static atmos_status parse_slice(const jp *p, const cJSON *j, const char *path, a
         case 3: TRY(get_enum(p, v, ip, updates, 2, &s->slice.eq24)); break;
         case 4: TRY(get_bool(p, v, ip, &s->slice.low_albedo)); break;
         case 5: TRY(get_int(p, v, ip, &r_grid, &s->slice.grid_max_dim)); break;
+        case 6: TRY(get_number(p, v, ip, &r_eye_scale, NULL, &s->slice.eye_scale)); break;
         }
     }
 }

@@ -283,8 +283,9 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
 atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
     static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0},
-                              r_xi = {0, 100, 0, 0}, r_grid = {8, 2048, 0, 0}, r_spp = {1, 1000000, 0, 0},
-                              r_budget = {0, 1e7, 0, 0}, r_depth = {0, 100000, 0, 0}, r_trunc = {0, 20, 0, 0},
+                              r_xi = {0, 100, 0, 0}, r_grid = {8, 2048, 0, 0}, r_eye_scale = {0, 1, 0, 0},
+                              r_spp = {1, 1000000, 0, 0}, r_budget = {0, 1e7, 0, 0}, r_depth = {0, 100000, 0, 0},
+                              r_trunc = {0, 20, 0, 0},
                               r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0}, r_voxel = {0, 1e5, 0, 0},
                               r_time_index = {0, 1000000, 0, 0};
     static const char *const names[] = {"sky", "slice", "path"};
@@ -340,6 +341,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
         {"/slice/light_size", s->slice.light_size, &r_light},
         {"/slice/xi", s->slice.xi, &r_xi},
         {"/slice/grid_max_dim", s->slice.grid_max_dim, &r_grid},
+        {"/slice/eye_scale", s->slice.eye_scale, &r_eye_scale}, /* 0 (a zeroed struct) = 1; the file needs (0, 1] */
         {"/path/spp", s->path.spp, &r_spp},
         {"/path/time_budget_s", s->path.time_budget_s, &r_budget},
         {"/path/max_depth", s->path.max_depth, &r_depth},

@@ -54,6 +54,13 @@ PY
 "$A" compare "$T/eq24.pfm" "$T/cloud.pfm" --by "$T/tau.pfm" --edges 1,0 >/dev/null 2>&1; [ $? -eq 2 ] && ok || bad "descending --edges should exit 2"
 "$A" render -q --tau "$T/t.pfm" -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--tau without a volume should exit 2"
 "$A" render -q --renderer slice -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--renderer slice without --volume should exit 2"
+# --eye-scale: 1 is the default image exactly; 0.5 renders (1 and 2 threads identical); out of range is a usage error
+"$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --pfm "$T/e1.pfm" --threads 2 \
+    --eye-scale 1 && cmp -s "$T/e1.pfm" "$T/cloud.pfm" && ok || bad "--eye-scale 1 differs from the default"
+"$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --pfm "$T/eh2.pfm" --threads 2 \
+    --eye-scale 0.5 && "$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 \
+    --pfm "$T/eh1.pfm" --threads 1 --eye-scale 0.5 && cmp -s "$T/eh1.pfm" "$T/eh2.pfm" && ok || bad "--eye-scale 0.5"
+"$A" render -q --volume generate:cumulus --eye-scale 1.5 -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--eye-scale 1.5 should exit 2"
 "$A" render -q --volume generate:nope -o "$T/x.png" 2>/dev/null; [ $? -eq 1 ] && ok || bad "unknown generator should exit 1"
 rm -rf "$T"
 echo "slice_render: $pass passed, $fail failed"

@@ -220,10 +220,11 @@ static void test_absent_keys(void)
     CHECK(s.sun.irradiance_count == 3 && s.sun.irradiance[2] == 3 && s.sun.elevation_deg == 30);
     CHECK_OK(parse("{\"sun\": {\"irradiance\": 1.5, \"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40, "
                    "\"longitude_deg\": 0}, \"background\": \"black\", \"slice\": {\"update\": \"eq24\", \"xi\": 0, "
-                   "\"low_albedo\": true, \"slices\": 64, \"light_size\": 128, \"grid_max_dim\": 64}}", &s));
+                   "\"low_albedo\": true, \"slices\": 64, \"light_size\": 128, \"grid_max_dim\": 64, "
+                   "\"eye_scale\": 0.5}}", &s));
     CHECK(s.sun.from_time && s.sun.irradiance_count == 1 && s.sun.irradiance[0] == 1.5 && s.background == ATMOS_BACKGROUND_BLACK);
     CHECK(s.slice.eq24 == 1 && s.slice.xi == 0 && s.slice.low_albedo == 1 && s.slice.slices == 64 && s.slice.light_size == 128 &&
-          s.slice.grid_max_dim == 64);
+          s.slice.grid_max_dim == 64 && s.slice.eye_scale == 0.5);
 }
 
 typedef struct bad_case {
@@ -275,6 +276,8 @@ static const bad_case bad_cases[] = {
     {"{\"slice\": {\"xi\": -1}}", ATMOS_E_INVALID_ARG, "/slice/xi: must be in [0, 100], got -1", NULL},
     {"{\"slice\": {\"update\": \"eq23\"}}", ATMOS_E_INVALID_ARG, "/slice/update: must be one of eq25, eq24", NULL},
     {"{\"slice\": {\"low_albedo\": 1}}", ATMOS_E_INVALID_ARG, "/slice/low_albedo: expected true or false", NULL},
+    {"{\"slice\": {\"eye_scale\": 0}}", ATMOS_E_INVALID_ARG, "/slice/eye_scale: must be in (0, 1], got 0", NULL},
+    {"{\"slice\": {\"eye_scale\": 1.5}}", ATMOS_E_INVALID_ARG, "/slice/eye_scale: must be in (0, 1], got 1.5", NULL},
     {"{\"path\": {\"spp\": 0}}", ATMOS_E_INVALID_ARG, "/path/spp: must be in [1, 1000000], got 0", NULL},
     {"{\"path\": {\"time_budget_s\": -1}}", ATMOS_E_INVALID_ARG, "/path/time_budget_s: must be in [0, 10000000], got -1", NULL},
     {"{\"path\": {\"seed\": -3}}", ATMOS_E_INVALID_ARG, "/path/seed: must be in [0, ", NULL},

@@ -434,6 +434,109 @@ static void test_fast_vs_reference(void)
     atmos_context_destroy(ctx);
 }
 
+/* Eye buffer smaller than the image (eye_scale): scale 1 (or one that rounds to the
+ * image size) is the full-resolution render exactly; 0.5 agrees with it on a smooth
+ * blob within the tolerances below; image pixels farther than two pixels from anything
+ * the full-resolution render touches keep the sky image bit for bit; 1 and 2 threads
+ * give identical images; odd sizes and tiny scales stay finite. */
+static void test_eye_scale(void)
+{
+    optics op;
+    atmos_context *c1 = make_ctx(1), *c2 = make_ctx(2);
+    make_optics(c2, &op);
+    atmos_volume *v = blob(c2, 3e6f);
+    const double suns[][2] = {{35, 200}, {20, 10}};
+    for (int i = 0; i < 2; i++) {
+        atmos_scene s;
+        scene_for(&s, suns[i][0], suns[i][1]);
+        s.width = s.height = 128;
+        const int W = 128, H = 128;
+        atmos_image *sky = NULL;
+        CHECK_OK(atmos_render_sky(c2, &s, &sky, NULL));
+        atmos_slice_settings ss = {0};
+        ss.optics = &op.o;
+        ss.slices = 128;
+        atmos_image *full = render(c2, &s, v, &ss);
+        ss.eye_scale = 1.0;
+        atmos_image *one = render(c2, &s, v, &ss);
+        ss.eye_scale = 0.999; /* rounds to the image size */
+        atmos_image *near1 = render(c2, &s, v, &ss);
+        ss.eye_scale = 0.5;
+        atmos_image *half = render(c2, &s, v, &ss), *half1 = render(c1, &s, v, &ss);
+        if (!full || !one || !near1 || !half || !half1) {
+            CHECK(0);
+        } else {
+            const size_t bytes = sizeof(float) * W * H * 4;
+            CHECK_MSG(memcmp(full->pixels, one->pixels, bytes) == 0, "eye_scale 1 differs from the default");
+            CHECK_MSG(memcmp(full->pixels, near1->pixels, bytes) == 0, "eye_scale 0.999 (64 -> 64) differs");
+            CHECK_MSG(memcmp(half->pixels, half1->pixels, bytes) == 0, "eye_scale 0.5: 1 vs 2 threads differ");
+            CHECK(all_finite(half));
+            /* The volume's effect V = img - sky in both renders. */
+            double ef = 0, eh = 0, dsum = 0, dmax = 0, vmax = 0;
+            static unsigned char near_[128 * 128];
+            memset(near_, 0, sizeof near_);
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++) {
+                    const size_t p = (size_t)y * W + x;
+                    int touched = 0;
+                    for (int c = 0; c < 3; c++) {
+                        double vf = (double)full->pixels[p * 4 + c] - sky->pixels[p * 4 + c];
+                        double vh = (double)half->pixels[p * 4 + c] - sky->pixels[p * 4 + c];
+                        ef += fabs(vf), eh += fabs(vh), dsum += fabs(vh - vf);
+                        dmax = fmax(dmax, fabs(vh - vf)), vmax = fmax(vmax, fabs(vf));
+                        touched |= full->pixels[p * 4 + c] != sky->pixels[p * 4 + c];
+                    }
+                    if (touched)
+                        for (int dy = -2; dy <= 2; dy++)
+                            for (int dx = -2; dx <= 2; dx++)
+                                if (y + dy >= 0 && y + dy < H && x + dx >= 0 && x + dx < W)
+                                    near_[(y + dy) * W + x + dx] = 1;
+                }
+            int sky_kept = 1;
+            for (size_t p = 0; p < (size_t)W * H; p++)
+                if (!near_[p] && memcmp(half->pixels + p * 4, sky->pixels + p * 4, sizeof(float) * 3) != 0) sky_kept = 0;
+            printf("slice eye_scale 0.5 vs 1 (sun %g/%g): volume radiance %+.3f%%, mean |difference| %.2f%% of the "
+                   "mean effect, max %.2f%% of the largest effect\n",
+                   suns[i][0], suns[i][1], 100 * (eh - ef) / ef, 100 * dsum / ef, 100 * dmax / vmax);
+            CHECK_MSG(fabs(eh - ef) <= 0.005 * ef, "eye_scale 0.5: volume radiance %g vs %g", eh, ef);
+            CHECK_MSG(dsum <= 0.01 * ef, "eye_scale 0.5: mean difference %g of the effect", dsum / ef);
+            CHECK_MSG(dmax <= 0.02 * vmax, "eye_scale 0.5: max difference %g of the largest effect", dmax / vmax);
+            CHECK_MSG(sky_kept, "eye_scale 0.5: a pixel away from the volume is not the sky image");
+        }
+        atmos_image_destroy(full), atmos_image_destroy(one), atmos_image_destroy(near1);
+        atmos_image_destroy(half), atmos_image_destroy(half1), atmos_image_destroy(sky);
+    }
+    /* odd sizes, tiny and odd scales, vacuum, back-to-front */
+    atmos_scene s;
+    scene_for(&s, 20, 10);
+    s.width = 67, s.height = 45;
+    s.background = ATMOS_BACKGROUND_BLACK;
+    const double scales[] = {0.37, 0.02, 1e-9};
+    for (int i = 0; i < 3; i++) {
+        atmos_slice_settings ss = {0};
+        ss.optics = &op.o;
+        ss.slices = 32;
+        ss.eye_scale = scales[i];
+        atmos_image *a = render(c2, &s, v, &ss), *b = render(c1, &s, v, &ss);
+        CHECK(a && b && all_finite(a) && memcmp(a->pixels, b->pixels, sizeof(float) * 67 * 45 * 4) == 0);
+        atmos_image_destroy(a), atmos_image_destroy(b);
+    }
+    atmos_image *img = NULL;
+    atmos_slice_settings bad = {0};
+    bad.optics = &op.o;
+    bad.eye_scale = 1.5;
+    CHECK(atmos_render_slice(c2, &s, v, &bad, &img, NULL) == ATMOS_E_INVALID_ARG && img == NULL);
+    CHECK(strstr(atmos_context_error(c2), "eye_scale") != NULL);
+    bad.eye_scale = -0.5;
+    CHECK(atmos_render_slice(c2, &s, v, &bad, &img, NULL) == ATMOS_E_INVALID_ARG);
+    bad.eye_scale = NAN;
+    CHECK(atmos_render_slice(c2, &s, v, &bad, &img, NULL) == ATMOS_E_INVALID_ARG);
+    atmos_volume_destroy(v);
+    free_optics(&op);
+    atmos_context_destroy(c1);
+    atmos_context_destroy(c2);
+}
+
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "cache");
@@ -443,5 +546,6 @@ int main(void)
     test_ftb_btf();
     test_empty_and_errors();
     test_fast_vs_reference();
+    test_eye_scale();
     return test_summary("test_slice");
 }

@@ -17,7 +17,7 @@ static void help(void)
     printf("Usage: atmos bench sky [--size N] [--repeat R] [--threads T]\n"
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
-           "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--json]\n"
+           "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
@@ -43,6 +43,7 @@ static void help(void)
            "          best of R (default 3): ms per frame (per-frame set-up + light + eye passes + sky; the\n"
            "          volume's upload to the render grid and the tables are reported apart in prepare_ms,\n"
            "          which includes setup_ms), fps, ns per sample, breakdown.\n"
+           "          --eye-scale S renders the eye passes on an S-times smaller buffer per axis.\n"
            "          --json prints one JSON object per case.\n"
            "  path    the path tracer on FILE (default: the generated cumulus) at NxN (default 256), N\n"
            "          samples per pixel (default 16), densities times S (default 1e8 m^-3 per unit of a\n"
@@ -359,7 +360,8 @@ static int bench_volume(const char *file, int repeat, int threads)
 
 /* One case of the slice benchmark: the Fig. 14 configuration (size^2, 256 slices) of
  * the volume seen from a distance of 1.6 times its size, sun 35° high behind-left. */
-static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int repeat, int json)
+static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int repeat, double eye_scale,
+                            int json)
 {
     atmos_scene scene;
     atmos_scene_defaults(&scene);
@@ -370,6 +372,7 @@ static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *
     /* place the volume's base at 1500 m, centred above the origin */
     atmos_slice_settings ss;
     atmos_slice_defaults(&ss);
+    ss.eye_scale = eye_scale > 0 ? eye_scale : 1.0;
     double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     ss.offset_m[0] = -0.5 * (lo[0] + hi[0]);
     ss.offset_m[1] = 1500 - lo[1];
@@ -409,18 +412,20 @@ static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *
     long long samples = best_tm.eye_samples + best_tm.light_samples;
     double ns = samples > 0 ? 1e9 * (best_tm.light + best_tm.eye) / (double)samples : 0;
     if (json)
-        printf("{\"bench\":\"slice\",\"case\":\"%s\",\"size\":%d,\"slices\":%d,\"threads\":%d,"
+        printf("{\"bench\":\"slice\",\"case\":\"%s\",\"size\":%d,\"slices\":%d,\"threads\":%d,\"eye\":[%d,%d],"
                "\"ms_per_frame\":%.2f,\"fps\":%.3f,\"ns_per_sample\":%.2f,\"setup_ms\":%.2f,\"light_ms\":%.2f,\"eye_ms\":%.2f,"
                "\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"total_ms\":%.2f,\"eye_samples\":%lld,\"light_samples\":%lld,"
                "\"grid\":[%d,%d,%d],\"optics_s\":%.3f}\n",
-               name, size, ss.slices, atmos_context_threads(ctx), 1e3 * frame, 1.0 / frame, ns, 1e3 * best_tm.setup, 1e3 * best_tm.light,
+               name, size, ss.slices, atmos_context_threads(ctx), best_tm.eye_dims[0], best_tm.eye_dims[1], 1e3 * frame,
+               1.0 / frame, ns, 1e3 * best_tm.setup, 1e3 * best_tm.light,
                1e3 * best_tm.eye, 1e3 * best_tm.sky, 1e3 * best_tm.prepare, 1e3 * best_tm.total, best_tm.eye_samples,
                best_tm.light_samples, best_tm.grid_dims[0], best_tm.grid_dims[1], best_tm.grid_dims[2], t_opt);
     else
-        printf("bench=slice case=%s size=%dx%d slices=%d threads=%d ms_per_frame=%.2f fps=%.3f ns_per_sample=%.2f "
+        printf("bench=slice case=%s size=%dx%d slices=%d threads=%d eye=%dx%d ms_per_frame=%.2f fps=%.3f ns_per_sample=%.2f "
                "setup_ms=%.2f light_ms=%.2f eye_ms=%.2f sky_ms=%.2f prepare_ms=%.2f total_ms=%.2f eye_samples=%lld light_samples=%lld "
                "grid=%dx%dx%d optics_s=%.3f\n",
-               name, size, size, ss.slices, atmos_context_threads(ctx), 1e3 * frame, 1.0 / frame, ns, 1e3 * best_tm.setup, 1e3 * best_tm.light,
+               name, size, size, ss.slices, atmos_context_threads(ctx), best_tm.eye_dims[0], best_tm.eye_dims[1], 1e3 * frame,
+               1.0 / frame, ns, 1e3 * best_tm.setup, 1e3 * best_tm.light,
                1e3 * best_tm.eye, 1e3 * best_tm.sky, 1e3 * best_tm.prepare, 1e3 * best_tm.total, best_tm.eye_samples,
                best_tm.light_samples, best_tm.grid_dims[0], best_tm.grid_dims[1], best_tm.grid_dims[2], t_opt);
     fflush(stdout);
@@ -542,7 +547,7 @@ static int bench_path(const char *file, int size, int spp, double dscale, int th
     return rc;
 }
 
-static int bench_slice(const char *file, int size, int repeat, int threads, int json)
+static int bench_slice(const char *file, int size, int repeat, int threads, double eye_scale, int json)
 {
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
@@ -551,14 +556,14 @@ static int bench_slice(const char *file, int size, int repeat, int threads, int 
     atmos_volume *v = NULL;
     atmos_status st = atmos_volume_generate(ctx, "storm", &g, &v);
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-    else rc = bench_slice_case(ctx, "generated_storm", v, size, repeat, json);
+    else rc = bench_slice_case(ctx, "generated_storm", v, size, repeat, eye_scale, json);
     atmos_volume_destroy(v);
     v = NULL;
     if (rc == CLI_EXIT_OK && file) {
         st = atmos_volume_load(ctx, file, NULL, &v);
         const char *base = strrchr(file, '/');
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, repeat, json);
+        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, repeat, eye_scale, json);
         atmos_volume_destroy(v);
     }
     atmos_context_destroy(ctx);
@@ -569,7 +574,7 @@ int cli_cmd_bench(int argc, char **argv)
 {
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16;
-    double dscale = 0;
+    double dscale = 0, eye_scale = 0;
     const char *what = NULL, *presets = NULL, *file = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -585,6 +590,9 @@ int cli_cmd_bench(int argc, char **argv)
         } else if (!strcmp(argv[i], "--density-scale") && i + 1 < argc) {
             if (!cli_parse_double(C, "--density-scale", argv[++i], &dscale) || !(dscale > 0))
                 return cli_usage_error(C, "--density-scale: expected a factor > 0");
+        } else if (!strcmp(argv[i], "--eye-scale") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--eye-scale", argv[++i], &eye_scale) || !(eye_scale > 0 && eye_scale <= 1))
+                return cli_usage_error(C, "--eye-scale: expected a value in (0, 1]");
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
@@ -606,7 +614,7 @@ int cli_cmd_bench(int argc, char **argv)
     }
     if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice, path)");
     if (!strcmp(what, "path")) return bench_path(file, size ? size : 256, spp, dscale, threads);
-    if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, repeat_set ? repeat : 3, threads, json);
+    if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, repeat_set ? repeat : 3, threads, eye_scale, json);
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);

@@ -47,6 +47,8 @@ static void help(void)
            "      --slices N --xi X         slicing planes (default 256); back-scatter term xi (sr^-1, 0 = none)\n"
            "      --eq24                    exact light-buffer update (Riley Eq. 24) instead of Eq. 25\n"
            "      --low-albedo              single scattering with the plain phase function (Riley Fig. 13)\n"
+           "      --eye-scale S             slice: eye buffer resolution relative to the image, (0, 1] (default 1;\n"
+           "                                0.5 renders the volume on a quarter of the rays, upsampled)\n"
            "      --tau FILE.pfm            also write the volume's optical depth along each pixel's ray\n"
            "                                (middle wavelength of the set; a key for atmos compare --by)\n"
            "      --time-budget S           path: stop after the pass during which S seconds have passed\n"
@@ -126,6 +128,7 @@ enum {
     O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE, O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER,
     O_TRUNCATE
 };
+enum { O_EYESCALE = 512 }; /* slice renderer options added later */
 
 /* The volume's optical depth along each pixel's ray at the middle wavelength of the
  * set, as a 1-channel PFM (the optics come from the cache the render just filled). */
@@ -158,6 +161,7 @@ static void slice_settings(const atmos_scene *s, const double offset[3], atmos_s
     ss->update = s->slice.eq24 ? ATMOS_SLICE_EQ24 : ATMOS_SLICE_EQ25;
     ss->low_albedo = s->slice.low_albedo;
     ss->grid_max_dim = s->slice.grid_max_dim;
+    ss->eye_scale = s->slice.eye_scale;
     ss->density_scale = s->volume.density_scale;
     for (int k = 0; k < 3; k++) ss->offset_m[k] = offset[k];
 }
@@ -180,7 +184,7 @@ int cli_cmd_render(int argc, char **argv)
         {"slices", required_argument, 0, O_SLICES}, {"xi", required_argument, 0, O_XI},
         {"volume-position", required_argument, 0, O_VPOS}, {"density-scale", required_argument, 0, O_DSCALE},
         {"eq24", no_argument, 0, O_EQ24}, {"low-albedo", no_argument, 0, O_LOWALB},
-        {"tau", required_argument, 0, O_TAU},
+        {"tau", required_argument, 0, O_TAU}, {"eye-scale", required_argument, 0, O_EYESCALE},
         {"time-budget", required_argument, 0, O_TBUDGET}, {"seed", required_argument, 0, O_SEED},
         {"variance", required_argument, 0, O_VARIANCE},
         {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
@@ -199,7 +203,7 @@ int cli_cmd_render(int argc, char **argv)
     /* Volume renderers: these override the scene's "renderer", "volume" and "slice". */
     int renderer = -1, slices = 0, eq24 = 0, low_albedo = 0;
     const char *volume_arg = NULL, *tau_path = NULL;
-    double xi = NAN, dscale = 0, vpos[3] = {0, 0, 0};
+    double xi = NAN, dscale = 0, vpos[3] = {0, 0, 0}, eye_scale = 0;
     int vpos_given = 0;
     /* The path tracer (path.h): these override the scene's "path". */
     double tbudget = 0, truncate = NAN;
@@ -267,6 +271,10 @@ int cli_cmd_render(int argc, char **argv)
                 return cli_usage_error(C, "--xi: expected a value in [0, 100] sr^-1 (0 = no back-scatter term)");
             break;
         case O_EQ24: eq24 = 1; break;
+        case O_EYESCALE:
+            if (!cli_parse_double(C, "--eye-scale", optarg, &eye_scale) || !(eye_scale > 0 && eye_scale <= 1))
+                return cli_usage_error(C, "--eye-scale: expected a value in (0, 1] (eye buffer resolution per axis)");
+            break;
         case O_TAU: tau_path = optarg; break;
         case O_LOWALB: low_albedo = 1; break;
         case O_DSCALE:
@@ -319,9 +327,10 @@ int cli_cmd_render(int argc, char **argv)
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (exposure_auto && !isnan(ev)) return cli_usage_error(C, "--exposure given twice");
     if (renderer == ATMOS_RENDERER_SKY &&
-        (volume_arg || slices || !isnan(xi) || dscale > 0 || vpos_given || eq24 || low_albedo || tau_path))
-        return cli_usage_error(C, "--volume, --volume-position, --density-scale, --slices, --xi, --eq24, --low-albedo "
-                                  "and --tau go with a volume renderer, not --renderer sky");
+        (volume_arg || slices || !isnan(xi) || dscale > 0 || vpos_given || eq24 || low_albedo || tau_path ||
+         eye_scale > 0))
+        return cli_usage_error(C, "--volume, --volume-position, --density-scale, --slices, --xi, --eq24, --low-albedo, "
+                                  "--eye-scale and --tau go with a volume renderer, not --renderer sky");
     if (time_end_s && (!isnan(sel_end) || !isnan(saz_end)))
         return cli_usage_error(C, "--time-end (a sun given by time) and --sun-elevation-end/--sun-azimuth-end "
                                   "(a sun given by angles) exclude each other");
@@ -439,6 +448,7 @@ int cli_cmd_render(int argc, char **argv)
     if (!isnan(xi)) scene.slice.xi = xi;
     if (eq24) scene.slice.eq24 = 1;
     if (low_albedo) scene.slice.low_albedo = 1;
+    if (eye_scale > 0) scene.slice.eye_scale = eye_scale;
     if (tau_path && scene.renderer == ATMOS_RENDERER_SKY) {
         atmos_context_destroy(ctx);
         return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
