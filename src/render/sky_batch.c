@@ -7,34 +7,9 @@
 #include <stdint.h>
 #include <string.h>
 
-/* exp by range reduction x = n ln2 + r, |r| <= ln2/2, and a degree-6 Taylor
- * polynomial for e^r (truncation error < 2e-8), 2^n assembled in the exponent
- * bits. Written without branches or calls so the compiler vectorises loops over it. */
-static inline float expf_fast(float x)
-{
-    x = x < -87.0f ? -87.0f : x;
-    x = x > 88.0f ? 88.0f : x;
-    float t = x * 1.44269504088896341f;
-    /* round to nearest by the 1.5*2^23 trick: no conversion, no branch */
-    float nf = (t + 12582912.0f) - 12582912.0f;
-    float r = x - nf * 0.693145751953125f;  /* ln2 split: hi exactly representable */
-    r = r - nf * 1.428606765330187045e-06f; /* ln2 lo */
-    float p = 1.0f / 720.0f;
-    p = p * r + 1.0f / 120.0f;
-    p = p * r + 1.0f / 24.0f;
-    p = p * r + 1.0f / 6.0f;
-    p = p * r + 0.5f;
-    p = p * r + 1.0f;
-    p = p * r + 1.0f;
-    union {
-        int32_t i;
-        float f;
-    } s;
-    s.i = ((int32_t)nf + 127) << 23;
-    return p * s.f;
-}
+#include "core/fastmath.h"
 
-float atmos__expf_fast(float x) { return x < -87.0f ? 0.0f : expf_fast(x); }
+float atmos__expf_fast(float x) { return x < -87.0f ? 0.0f : atmos__expf_poly(x); }
 
 void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye_y, const double sun[3])
 {
@@ -85,7 +60,7 @@ void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx
         /* Ground distance K = y / -p_y for descending rays. */
         float K = down * (eye_y / (py < -1e-30f ? -py : 1e-30f));
         float z = gamma * py * K; /* <= 0 for ground rays, 0 otherwise */
-        float e = expf_fast(-z);  /* beta(K)/beta_eye = exp(-gamma p_y K) */
+        float e = atmos__expf_poly(-z);  /* beta(K)/beta_eye = exp(-gamma p_y K) */
         float zs = fabsf(z) < 1e-3f ? 1.0f : z;
         float gz = fabsf(z) < 1e-3f ? 1.0f - 0.5f * z + z * z * (1.0f / 6.0f) : (1.0f - e) / zs;
         float Gd = K * gz;
@@ -106,12 +81,12 @@ void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx
         for (int i = 0; i < count; i++) {
             float x = be * G[i];
             float D = c[i] * x;
-            float bexp = expf_fast(-(x + ts0 * eend[i]));
+            float bexp = atmos__expf_poly(-(x + ts0 * eend[i]));
             /* e^{-ts0} h(D) = (e^{-ts0} - e^{-(x + tsK)}) / D, by series near D = 0. */
             float series = a * (1.0f - D * (0.5f - D * (1.0f / 6.0f - D * (1.0f / 24.0f))));
             float Ds = fabsf(D) < 1e-2f ? 1.0f : D;
             float F = fabsf(D) < 1e-2f ? series : (a - bexp) / Ds;
-            float L = PE[i] * E * x * F + gm[i] * gr * expf_fast(-x);
+            float L = PE[i] * E * x * F + gm[i] * gr * atmos__expf_poly(-x);
             o[i] += L;
         }
     }

@@ -12,6 +12,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "core/fastmath.h"
+
 /* Linear interpolation in a per-order table at fractional n >= 0; past the last order,
  * F is held (F_n -> 1/2) and S grows by ln F of the last order per order. */
 static inline float order_lerp(const float *tab, float n, int extend)
@@ -218,31 +220,6 @@ long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x
 #define SLICE_CLONES
 #endif
 
-/* e^y by range reduction y = n ln2 + r, |r| <= ln2/2, and a degree-6 Taylor polynomial
- * for e^r (truncation error < 2e-8), 2^n assembled in the exponent bits; y is clamped
- * to [-87, 88] (e^-87 < 2e-38 stands for anything smaller). No branches or calls, so
- * loops over it vectorise. */
-static inline float exp_f(float y)
-{
-    y = y < -87.0f ? -87.0f : (y > 88.0f ? 88.0f : y);
-    float t = y * 1.44269504088896341f;
-    float nf = (t + 12582912.0f) - 12582912.0f; /* round to nearest by the 1.5*2^23 trick */
-    float r = y - nf * 0.693145751953125f;       /* ln2 split: hi exactly representable */
-    r = r - nf * 1.428606765330187045e-06f;
-    float p = 1.0f / 720.0f;
-    p = p * r + 1.0f / 120.0f;
-    p = p * r + 1.0f / 24.0f;
-    p = p * r + 1.0f / 6.0f;
-    p = p * r + 0.5f;
-    p = p * r + 1.0f;
-    p = p * r + 1.0f;
-    union {
-        int32_t i;
-        float f;
-    } s;
-    s.i = (int32_t)(nf + 127.0f) << 23; /* nf + 127 in [1, 254]: exact */
-    return p * s.f;
-}
 
 /* ln x for x > 0: x = 2^e m with m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s),
  * s = (m - 1)/(m + 1), |s| < 0.172, by its series to s^9 (error < 1e-9). Subnormal x
@@ -467,7 +444,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
             }
             for (int q = 0; q < mv; q++) {
                 const float be = bext[q], tau = be * del[q];
-                const float T = exp_f(-tau);
+                const float T = atmos__expf_poly(-tau);
                 /* beta_sca Delta of Eq. 26, integrated over the slab with its own
                  * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
                 const float len = tau < 1e-4f ? del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
@@ -579,8 +556,8 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
                 lg[q] = log_pos(kp[q]);
             }
             for (int q = 0; q < mv; q++) {
-                const float tau = tq[q], T = exp_f(-tau);
-                const float pw = exp_f(tau * lg[q]); /* thick slab: the power */
+                const float tau = tq[q], T = atmos__expf_poly(-tau);
+                const float pw = atmos__expf_poly(tau * lg[q]); /* thick slab: the power */
                 const float keep = kp[q] > 0.0f && tau > 1.0f ? pw : kp[q];
                 out[q] = be[q] > 0.0f ? Iq[q] * (T + (1.0f - T) * keep) : Iq[q];
             }
