@@ -358,33 +358,39 @@ static int bench_volume(const char *file, int repeat, int threads)
     return file_failed ? CLI_EXIT_RUNTIME : CLI_EXIT_OK; /* a named file that cannot be read is an error */
 }
 
+/* The volume benchmarks' view: the volume's base at 1500 m centred above the origin
+ * (offset returned), seen from 1.6 times its size, sun 35° high behind-left. */
+static void bench_view(atmos_scene *scene, const atmos_volume *v, int size, double offset[3])
+{
+    atmos_scene_defaults(scene);
+    scene->width = scene->height = size;
+    scene->samples_per_pixel = 1;
+    double lo[3], hi[3];
+    atmos_volume_bounds(v, lo, hi);
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    offset[0] = -0.5 * (lo[0] + hi[0]);
+    offset[1] = 1500 - lo[1];
+    offset[2] = -0.5 * (lo[2] + hi[2]);
+    double cy = 1500 + 0.5 * (hi[1] - lo[1]);
+    double pos[3] = {0, 1500 + 0.3 * (hi[1] - lo[1]), 1.6 * ext};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &scene->camera);
+    scene->camera.look_at[0] = 0, scene->camera.look_at[1] = cy, scene->camera.look_at[2] = 0;
+    scene->camera.fov_deg = 45;
+    scene->sun.from_time = 0;
+    scene->sun.elevation_deg = 35;
+    scene->sun.azimuth_deg = 200;
+}
+
 /* One case of the slice benchmark: the Fig. 14 configuration (size^2, 256 slices) of
  * the volume seen from a distance of 1.6 times its size, sun 35° high behind-left. */
 static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int repeat, double eye_scale,
                             int json)
 {
     atmos_scene scene;
-    atmos_scene_defaults(&scene);
-    scene.width = scene.height = size;
-    scene.samples_per_pixel = 1;
-    double lo[3], hi[3];
-    atmos_volume_bounds(v, lo, hi);
-    /* place the volume's base at 1500 m, centred above the origin */
     atmos_slice_settings ss;
     atmos_slice_defaults(&ss);
     ss.eye_scale = eye_scale > 0 ? eye_scale : 1.0;
-    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
-    ss.offset_m[0] = -0.5 * (lo[0] + hi[0]);
-    ss.offset_m[1] = 1500 - lo[1];
-    ss.offset_m[2] = -0.5 * (lo[2] + hi[2]);
-    double cy = 1500 + 0.5 * (hi[1] - lo[1]);
-    double pos[3] = {0, 1500 + 0.3 * (hi[1] - lo[1]), 1.6 * ext};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &scene.camera);
-    scene.camera.look_at[0] = 0, scene.camera.look_at[1] = cy, scene.camera.look_at[2] = 0;
-    scene.camera.fov_deg = 45;
-    scene.sun.from_time = 0;
-    scene.sun.elevation_deg = 35;
-    scene.sun.azimuth_deg = 200;
+    bench_view(&scene, v, size, ss.offset_m);
     atmos_slice_optics optics;
     double t0 = now_s();
     atmos_status st = atmos_slice_optics_build(ctx, &scene, v, &optics);
@@ -437,27 +443,12 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
                            int vacuum)
 {
     atmos_scene scene;
-    atmos_scene_defaults(&scene);
-    scene.width = scene.height = size;
-    scene.background = vacuum ? ATMOS_BACKGROUND_BLACK : ATMOS_BACKGROUND_SKY;
-    double lo[3], hi[3];
-    atmos_volume_bounds(v, lo, hi);
     atmos_path_settings ps;
     memset(&ps, 0, sizeof ps);
-    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
-    ps.offset_m[0] = -0.5 * (lo[0] + hi[0]);
-    ps.offset_m[1] = 1500 - lo[1];
-    ps.offset_m[2] = -0.5 * (lo[2] + hi[2]);
+    bench_view(&scene, v, size, ps.offset_m);
+    scene.background = vacuum ? ATMOS_BACKGROUND_BLACK : ATMOS_BACKGROUND_SKY;
     ps.density_scale = dscale;
     ps.spp = spp;
-    double cy = 1500 + 0.5 * (hi[1] - lo[1]);
-    double pos[3] = {0, 1500 + 0.3 * (hi[1] - lo[1]), 1.6 * ext};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &scene.camera);
-    scene.camera.look_at[0] = 0, scene.camera.look_at[1] = cy, scene.camera.look_at[2] = 0;
-    scene.camera.fov_deg = 45;
-    scene.sun.from_time = 0;
-    scene.sun.elevation_deg = 35;
-    scene.sun.azimuth_deg = 200;
     atmos_slice_optics optics;
     double t0 = now_s();
     atmos_status st = atmos_path_optics_build(ctx, &scene, v, &optics);
