@@ -1,7 +1,8 @@
 /* Spectral Monte Carlo volumetric path tracing over a multi-field volume: the reference
  * renderer the fast models are measured against. docs/path.md describes the estimator.
  *
- * Transport inside the volume is unbiased: free flights by delta tracking against the
+ * Transport inside the volume is unbiased (unless truncate_deg is set: the forward-peak
+ * truncation, an approximation, off by default): free flights by delta tracking against the
  * volume's majorant grid (spectral tracking: one flight serves every wavelength a path
  * carries), transmittance of shadow rays by ratio tracking on the residual above a
  * per-cell minorant, directions from the tabulated phase functions by their inverse CDF
