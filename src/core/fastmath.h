@@ -1,0 +1,34 @@
+/* Branch-free float exponential for the renderers' vectorised loops. */
+#ifndef ATMOS_FASTMATH_H
+#define ATMOS_FASTMATH_H
+
+#include <stdint.h>
+
+/* e^x by range reduction x = n ln2 + r, |r| <= ln2/2, and a degree-6 Taylor polynomial
+ * for e^r (truncation error < 2e-8), 2^n assembled in the exponent bits; x is clamped to
+ * [-87, 88] (e^-87 < 2e-38 stands for anything smaller). No branches or calls, so loops
+ * over it vectorise. */
+static inline float atmos__expf_poly(float x)
+{
+    x = x < -87.0f ? -87.0f : x;
+    x = x > 88.0f ? 88.0f : x;
+    float t = x * 1.44269504088896341f;
+    float nf = (t + 12582912.0f) - 12582912.0f; /* round to nearest by the 1.5*2^23 trick */
+    float r = x - nf * 0.693145751953125f;      /* ln2 split: hi exactly representable */
+    r = r - nf * 1.428606765330187045e-06f;     /* ln2 lo */
+    float p = 1.0f / 720.0f;
+    p = p * r + 1.0f / 120.0f;
+    p = p * r + 1.0f / 24.0f;
+    p = p * r + 1.0f / 6.0f;
+    p = p * r + 0.5f;
+    p = p * r + 1.0f;
+    p = p * r + 1.0f;
+    union {
+        int32_t i;
+        float f;
+    } s;
+    s.i = ((int32_t)nf + 127) << 23; /* nf + 127 in [1, 254]: exact */
+    return p * s.f;
+}
+
+#endif
