@@ -33,4 +33,10 @@ atmos_status atmos__write_atomic_unique(atmos_context *ctx, const char *path, at
 #define ATMOS_DEG2RAD (ATMOS_PI / 180.0)
 #define ATMOS_RAD2DEG (180.0 / ATMOS_PI)
 
+/* The phase tables (and, with with_msphase, the Ams_n tables) of every field of a volume
+ * for a scene's wavelength set (src/render/slice.c); used by the slice renderer and the
+ * path tracer. */
+atmos_status atmos__optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                 int with_msphase, atmos_slice_optics *out);
+
 #endif

@@ -59,25 +59,7 @@ void atmos_path_defaults(atmos_path_settings *s)
 atmos_status atmos_path_optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
                                      atmos_slice_optics *out)
 {
-    if (!scene || !volume || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "path optics: missing argument");
-    memset(out, 0, sizeof *out);
-    out->owned = 1;
-    atmos_wavelengths wl;
-    atmos_status st = atmos_scene_wavelengths(ctx, scene, &wl);
-    if (st != ATMOS_OK) return st;
-    for (int i = 0; i < atmos_volume_field_count(volume); i++) {
-        atmos_particle_desc pd;
-        if ((st = atmos_scene_particle(ctx, scene, atmos_volume_field_particle(volume, i), &pd)) != ATMOS_OK) goto fail;
-        atmos_phase_table *t = NULL;
-        atmos_phase_table_desc td = {0};
-        if ((st = atmos_phase_table_build(ctx, &pd, &wl, &td, &t)) != ATMOS_OK) goto fail;
-        out->phase[i] = t;
-        out->count = i + 1;
-    }
-    return ATMOS_OK;
-fail:
-    atmos_slice_optics_free(out);
-    return st;
+    return atmos__optics_build(ctx, scene, volume, 0, out); /* phase tables only */
 }
 
 /* ------------------------------------------------------------------ small vector helpers */

@@ -86,10 +86,10 @@ void atmos_slice_optics_free(atmos_slice_optics *o)
     memset(o, 0, sizeof *o);
 }
 
-atmos_status atmos_slice_optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
-                                      atmos_slice_optics *out)
+atmos_status atmos__optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                 int with_msphase, atmos_slice_optics *out)
 {
-    if (!scene || !volume || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "slice optics: missing argument");
+    if (!scene || !volume || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume optics: missing argument");
     memset(out, 0, sizeof *out);
     out->owned = 1;
     atmos_wavelengths wl;
@@ -105,6 +105,7 @@ atmos_status atmos_slice_optics_build(atmos_context *ctx, const atmos_scene *sce
         if ((st = atmos_phase_table_build(ctx, &pd, &wl, &td, &t)) != ATMOS_OK) goto fail;
         out->phase[i] = t;
         out->count = i + 1;
+        if (!with_msphase) continue;
         atmos_msphase *m = NULL;
         atmos_msphase_desc md = {0};
         md.max_order = 64;
@@ -116,6 +117,12 @@ atmos_status atmos_slice_optics_build(atmos_context *ctx, const atmos_scene *sce
 fail:
     atmos_slice_optics_free(out);
     return st;
+}
+
+atmos_status atmos_slice_optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                      atmos_slice_optics *out)
+{
+    return atmos__optics_build(ctx, scene, volume, 1, out);
 }
 
 /* ------------------------------------------------------------------ render grid */

@@ -151,6 +151,15 @@ static atmos_status write_tau(atmos_context *ctx, const atmos_scene *scene, cons
     return st;
 }
 
+/* A UTC time option; on failure reports it, destroys ctx and returns 0. */
+static int parse_time_option(atmos_context *ctx, const char *option, const char *text, atmos_utc_time *out)
+{
+    if (atmos_parse_utc_time(ctx, text, out) == ATMOS_OK) return 1;
+    fprintf(stderr, "atmos render: %s: %s\n", option, atmos_context_error(ctx));
+    atmos_context_destroy(ctx);
+    return 0;
+}
+
 /* The slice renderer's settings from a scene (the scene's xi 0 means "none"). */
 static void slice_settings(const atmos_scene *s, const double offset[3], atmos_slice_settings *ss)
 {
@@ -382,11 +391,7 @@ int cli_cmd_render(int argc, char **argv)
         if (!isnan(saz)) scene.sun.azimuth_deg = saz;
     }
     if (use_time) {
-        if ((st = atmos_parse_utc_time(ctx, time_s, &scene.sun.time)) != ATMOS_OK) {
-            fprintf(stderr, "atmos render: --time: %s\n", atmos_context_error(ctx));
-            atmos_context_destroy(ctx);
-            return CLI_EXIT_USAGE;
-        }
+        if (!parse_time_option(ctx, "--time", time_s, &scene.sun.time)) return CLI_EXIT_USAGE;
         scene.sun.from_time = 1;
         scene.sun.latitude_deg = lat;
         scene.sun.longitude_deg = lon;
@@ -396,11 +401,7 @@ int cli_cmd_render(int argc, char **argv)
     if (!isnan(sel) || !isnan(saz)) scene.animation.time_end_set = 0;
     if (frames) scene.animation.frames = frames;
     if (time_end_s) {
-        if ((st = atmos_parse_utc_time(ctx, time_end_s, &scene.animation.time_end)) != ATMOS_OK) {
-            fprintf(stderr, "atmos render: --time-end: %s\n", atmos_context_error(ctx));
-            atmos_context_destroy(ctx);
-            return CLI_EXIT_USAGE;
-        }
+        if (!parse_time_option(ctx, "--time-end", time_end_s, &scene.animation.time_end)) return CLI_EXIT_USAGE;
         scene.animation.time_end_set = 1;
     }
     if (!isnan(sel_end)) scene.animation.elevation_end_deg = sel_end, scene.animation.elevation_end_set = 1;
