@@ -78,6 +78,11 @@ typedef struct atmos_path_settings {
                                0 where the pixel's mean luminance is 0). Light from the air or
                                the ground counts the volume events before it only. */
     atmos_path_stats *stats; /* optional output */
+    int no_sky_nee;         /* 1: no next-event estimation toward the sky (the sky is then found
+                               by the phase-sampled continuations alone; same mean, more noise) */
+    int no_forced;          /* 1: camera rays find their single scattering only where their free
+                               flight collides (no forced single scattering; same mean, more noise
+                               in thin media) */
 } atmos_path_settings;
 
 ATMOS_API void atmos_path_defaults(atmos_path_settings *s);

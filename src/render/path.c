@@ -93,6 +93,8 @@ typedef struct {
     const path_medium *med; /* NULL: no volume */
     const path_phase *ph;
     const atmos_sky *sky;   /* NULL: vacuum */
+    const path_env *env;    /* NULL: no next-event estimation of the sky */
+    int forced;             /* camera rays estimate their single scattering by forced_single() */
     atmos_camera cam;
     int n;                  /* wavelengths */
     double sun[3];
@@ -126,24 +128,84 @@ static void sunlight(const path_job *J, const path_bundle *b, double y, double *
     for (int i = 0; i < b->m; i++) E[i] = J->sun_e[b->k[i]] * exp(-s->beta_sl[b->k[i]] * ey);
 }
 
-/* Sky: in-scatter along p + t d, t in [0, K] (added to L weighted by w) and the
- * transmittance over it (multiplied into w). */
-static void air_segment(const path_job *J, const path_bundle *b, const double p[3], const double d[3], double K,
-                        double *w, double *L, double *Lo, int order)
+/* The air's transmittance over p + t d, t in [0, K] (altitude of p: y), multiplied into w. */
+static void air_transmit(const path_job *J, const path_bundle *b, double y, const double d[3], double K, double *w)
 {
     const atmos_sky *s = J->sky;
     if (!(K > 0)) return;
+    const double G = atmos__sky_view_depth_factor(s->gamma, d[1], K);
+    const double ey = exp(-s->gamma * (y > 0 ? y : 0));
+    for (int i = 0; i < b->m; i++) w[i] *= isinf(G) ? 0.0 : exp(-s->beta_sl[b->k[i]] * ey * G);
+}
+
+static void shadow(const path_job *J, const path_bundle *b, const double p[3], const double d[3], path_rng *r,
+                   double *T, path_counts *cnt);
+
+/* Part of a segment lying in the volume's box: the index-space ray and its start there. */
+typedef struct {
+    const double *q, *qd;
+    double t0;
+} air_view;
+
+/* The air's single scattering of sunlight along p + t d, t in [0, K], added to L (times
+ * w[i] wt): the analytic sky's in-scatter (sky.c, exact for its flat exponential
+ * atmosphere), minus the part the volume takes away. That part, the integral of the
+ * in-scatter f(t) (1 - T_view(t) T_sun(t)) with T_view the volume's transmittance from p to
+ * p + t d (view: the segment is inside the box; else 1) and T_sun the volume's
+ * transmittance from there toward the sun, is estimated with one point drawn in proportion
+ * to the air's scattering times its transmittance (of the carried wavelength that scatters
+ * least, so that the others' ratios stay bounded): shadows of the volume on the air, the
+ * light shafts, cost a shadow ray only where the point's way to the sun crosses the box,
+ * and light that nothing shadows is the analytic value without noise. A sample can
+ * therefore be negative in a shadow; its mean is not. */
+static void air_scatter(const path_job *J, const path_bundle *b, const double p[3], const double d[3], double K,
+                        const double *w, double wt, double *L, double *Lo, int order, const air_view *view,
+                        path_rng *r, path_counts *cnt)
+{
+    const atmos_sky *s = J->sky;
+    if (!(K > 0) || !(wt > 0)) return;
     const double py = d[1], ly = J->sun[1];
+    if (!(ly > 0)) return;
     const double G = atmos__sky_view_depth_factor(s->gamma, py, K);
     const double e_end = isinf(K) ? (py > 0 ? 0.0 : INFINITY) : exp(-s->gamma * py * K);
-    const double ey = exp(-s->gamma * (p[1] > 0 ? p[1] : 0));
+    const double y0 = p[1] > 0 ? p[1] : 0;
+    const double ey = exp(-s->gamma * y0);
     const double P = atmos_phase_rayleigh(dot3(d, J->sun));
+    int h = -1;
     for (int i = 0; i < b->m; i++) {
         const int k = b->k[i];
         if (w[i] == 0) continue;
-        const double c = w[i] * P * J->sun_e[k] * atmos__sky_inscatter_factor(s->gamma, s->beta_sl[k] * ey, G, ly, py, e_end);
+        const double c = w[i] * wt * P * J->sun_e[k] * atmos__sky_inscatter_factor(s->gamma, s->beta_sl[k] * ey, G, ly, py, e_end);
         L[i] += c, Lo[i] += order * c;
-        w[i] *= isinf(G) ? 0.0 : exp(-s->beta_sl[k] * ey * G);
+        if (h < 0 || s->beta_sl[k] < s->beta_sl[b->k[h]]) h = i;
+    }
+    if (!J->med || h < 0) return;
+    /* The point: optical depth of wavelength h from p, exponential truncated to [0, tau(K)]. */
+    const double bh = s->beta_sl[b->k[h]] * ey;
+    const double A = isinf(G) ? 1.0 : -expm1(-bh * G);
+    if (!(A > 0)) return;
+    const double Ga = -log1p(-path_u(r) * A) / bh; /* G at the point */
+    const double z = s->gamma * py;
+    double ta = fabs(z * Ga) < 1e-12 ? Ga : -log1p(-z * Ga) / z;
+    if (!(ta >= 0)) return;
+    if (ta > K) ta = K;
+    const double pa[3] = {p[0] + ta * d[0], p[1] + ta * d[1], p[2] + ta * d[2]};
+    double Ts[PATH_B], Tv[PATH_B], E[PATH_B];
+    shadow(J, b, pa, J->sun, r, Ts, cnt);
+    int any = 0, lit = 0;
+    for (int i = 0; i < b->m; i++) any |= Ts[i] < 1, lit |= Ts[i] > 0;
+    if (!any && !view) return; /* nothing in the way to the sun: the analytic value holds */
+    for (int i = 0; i < b->m; i++) Tv[i] = 1;
+    if (view && lit) atmos__path_transmittance(J->med, view->q, view->qd, view->t0, view->t0 + ta, b, r, Tv);
+    sunlight(J, b, pa[1], E);
+    for (int i = 0; i < b->m; i++) {
+        const double occl = 1.0 - Tv[i] * Ts[i];
+        if (w[i] == 0 || occl == 0) continue;
+        const int k = b->k[i];
+        /* f_k / pdf: the scattering and transmittance of k over those of h, times A */
+        const double ratio = s->beta_sl[k] / s->beta_sl[b->k[h]] * exp(-(s->beta_sl[k] - s->beta_sl[b->k[h]]) * ey * Ga) * A;
+        const double c = w[i] * wt * P * E[i] * ratio * occl;
+        L[i] -= c, Lo[i] -= order * c;
     }
 }
 
@@ -180,19 +242,24 @@ static int roulette(double *w, int m, path_rng *r)
     return 1;
 }
 
+/* The scattering at a point of the volume for the carried wavelengths: per field ssf and
+ * in all ss (m^-1). */
+typedef struct {
+    double ssf[PATH_F][PATH_B], ss[PATH_B];
+} path_scatter;
+
 /* Phase function of the mixture of fields at a scattering event for every carried
  * wavelength: pk[i] = sum_f ssf[f][i] p_f,k(mu) / ss[i], 0 where nothing scatters. */
-static void phase_mix(const path_phase *P, const path_bundle *b, int nf, double ssf[][PATH_B], const double *ss,
-                        double mu, double *pk)
+static void phase_mix(const path_phase *P, const path_bundle *b, int nf, const path_scatter *e, double mu, double *pk)
 {
     path_angle ang;
     atmos__path_angle(P, mu, &ang);
     for (int i = 0; i < b->m; i++) {
         double s = 0;
-        if (ss[i] > 0) {
+        if (e->ss[i] > 0) {
             for (int f = 0; f < nf; f++)
-                if (ssf[f][i] > 0) s += ssf[f][i] * atmos__path_phase_eval(P, f, b->k[i], &ang);
-            s /= ss[i];
+                if (e->ssf[f][i] > 0) s += e->ssf[f][i] * atmos__path_phase_eval(P, f, b->k[i], &ang);
+            s /= e->ss[i];
         }
         pk[i] = s;
     }
@@ -230,6 +297,130 @@ static inline double mis_nee(const path_job *J, double q_pdir)
     return q_pdir > 0 ? pl / (pl + q_pdir) : 1.0;
 }
 
+/* The scattering at a point of the volume (densities dens) for the carried wavelengths:
+ * per field ssf and in all ss (m^-1), and for each hero its direction strategy g: itself,
+ * or the first carried wavelength that scatters. Returns how many scatter. */
+static int scatter_at(const path_job *J, const path_bundle *b, const float *dens, path_scatter *e, int *g)
+{
+    const path_medium *M = J->med;
+    int elig[PATH_B], ne = 0;
+    for (int i = 0; i < b->m; i++) {
+        e->ss[i] = 0;
+        for (int f = 0; f < M->nf; f++) {
+            e->ssf[f][i] = (double)dens[f] * M->sca[f][b->k[i]];
+            e->ss[i] += e->ssf[f][i];
+        }
+        if (e->ss[i] > 0) elig[ne++] = i;
+    }
+    for (int i = 0; i < b->m; i++) g[i] = e->ss[i] > 0 ? i : (ne ? elig[0] : i);
+    return ne;
+}
+
+/* Does the sun (sunlight E) light anything the weights w carry? */
+static int sun_lit(const path_job *J, const path_bundle *b, const double *w, const double *E)
+{
+    int lit = 0;
+    for (int i = 0; i < b->m; i++) lit |= w[i] * E[i] > 0;
+    return lit && J->sun_omega > 0;
+}
+
+/* Next-event estimation at a scattering point p of the volume reached along d with weights
+ * w (the path's throughput times the scattering coefficient over the density of the point
+ * sampled, as after a free flight): the sun's disk (E: its light there, NULL when it does
+ * not light the point), a direction drawn uniformly in its cone, the volume's
+ * transmittance to it by ratio tracking; and the sky (J->env), a direction drawn from the
+ * sky's table, the volume's and the air's transmittance to the box's far side, then the
+ * air's light beyond it. Each is weighted against the phase-sampled continuation by the
+ * balance heuristic, whose density there is q (its survival probability) times the
+ * strategies' mean density. */
+static void nee(const path_job *J, const path_bundle *b, const double p[3], const double d[3], const double *w,
+                const path_scatter *e, const double *S, const int *g, double q, const double *E, int order, double *L,
+                double *Lo, path_rng *r, path_counts *cnt)
+{
+    const int m = b->m, nf = J->med->nf;
+    double pk[PATH_B], T[PATH_B];
+    if (E) {
+        double ds[3];
+        sample_sun(J, r, ds);
+        phase_mix(J->ph, b, nf, e, dot3(d, ds), pk);
+        const double pdir = strategies(m, S, g, pk, NULL);
+        int any = 0;
+        for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
+        if (any) {
+            const double wm = mis_nee(J, q * pdir);
+            shadow(J, b, p, ds, r, T, cnt);
+            for (int i = 0; i < m; i++) {
+                const double c = w[i] * pk[i] * E[i] * T[i] * wm;
+                L[i] += c, Lo[i] += order * c;
+            }
+        }
+    }
+    if (J->env) {
+        double de[3];
+        const double pe = atmos__path_env_sample(J->env, path_u(r), path_u(r), path_u(r), de);
+        phase_mix(J->ph, b, nf, e, dot3(d, de), pk);
+        const double pdir = strategies(m, S, g, pk, NULL);
+        int any = 0;
+        for (int i = 0; i < m; i++) any |= w[i] * pk[i] > 0;
+        if (!any || !(pe > 0)) return;
+        const double wm = pe / (pe + q * pdir);
+        const double Kd = atmos_sky_ground_distance(p[1], de);
+        double q2[3], qd2[3], a0, a1, ex = 0, c[PATH_B];
+        for (int i = 0; i < m; i++) T[i] = 1;
+        atmos__path_to_index(J->med, p, de, q2, qd2);
+        if (atmos__path_clip(J->med, q2, qd2, Kd, &a0, &a1)) {
+            cnt->shadow++;
+            atmos__path_transmittance(J->med, q2, qd2, a0, a1, b, r, T);
+            ex = a1;
+        }
+        int on = 0;
+        for (int i = 0; i < m; i++) {
+            c[i] = w[i] * pk[i] * T[i] / pe * wm;
+            on |= c[i] > 0;
+        }
+        if (on && ex < Kd) {
+            air_transmit(J, b, p[1], de, ex, c);
+            const double px[3] = {p[0] + ex * de[0], p[1] + ex * de[1], p[2] + ex * de[2]};
+            air_scatter(J, b, px, de, Kd - ex, c, 1.0, L, Lo, order, NULL, r, cnt);
+        }
+    }
+}
+
+/* Forced single scattering on a camera ray's crossing [t0, t1] of the volume's box (index
+ * space q + t qd, world p + t d): one point drawn in proportion to the majorant, where the
+ * lights are estimated with weights w sigma_s T_view / pdf (T_view by ratio tracking). It
+ * replaces next-event estimation at the first free-flight event of camera paths, so in thin
+ * media every camera ray that crosses the volume estimates its single scattering, instead
+ * of the few that happen to collide. */
+static void forced_single(const path_job *J, const path_bundle *b, const double p[3], const double d[3],
+                          const double q[3], const double qd[3], double t0, double t1, const double *w, double *L,
+                          double *Lo, path_rng *r, path_counts *cnt)
+{
+    double t, pdf;
+    if (!atmos__path_majorant_point(J->med, q, qd, t0, t1, b, path_u(r), &t, &pdf)) return;
+    float dens[PATH_F];
+    atmos__path_density(J->med, q[0] + t * qd[0], q[1] + t * qd[1], q[2] + t * qd[2], dens);
+    path_scatter e;
+    int g[PATH_B];
+    if (!scatter_at(J, b, dens, &e, g)) return;
+    const int m = b->m;
+    double T[PATH_B], c[PATH_B], S[PATH_B], E[PATH_B];
+    atmos__path_transmittance(J->med, q, qd, t0, t, b, r, T);
+    int any = 0;
+    for (int i = 0; i < m; i++) {
+        S[i] = 1;
+        c[i] = w[i] * T[i] * e.ss[i] / pdf;
+        any |= c[i] > 0;
+    }
+    if (!any) return;
+    const double x[3] = {p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]};
+    if (J->sky) air_transmit(J, b, p[1] + t0 * d[1], d, t - t0, c);
+    sunlight(J, b, x[1], E);
+    /* the continuation's share: as if the roulette always let it go on (the first event's
+     * continuations use that too), unless no path goes on after one event */
+    nee(J, b, x, d, c, &e, S, g, J->max_depth == 1 ? 0.0 : 1.0, sun_lit(J, b, c, E) ? E : NULL, 1, L, Lo, r, cnt);
+}
+
 /* One camera path through world ray (o, d); adds the radiance of the carried
  * wavelengths to L[] and, for the scattering-order AOV, each contribution times the
  * number of volume scattering events before it to Lo[]. */
@@ -240,6 +431,9 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
     double w[PATH_B], p[3] = {o[0], o[1], o[2]}, d[3] = {d0[0], d0[1], d0[2]};
     for (int i = 0; i < m; i++) w[i] = 1, L[i] = 0, Lo[i] = 0;
     int primary = 1, depth = 0, order = 0, hero = -1;
+    /* weight of the air's light at the path's escape: after a volume event the
+     * continuation's share against next-event estimation of the sky, else 1 */
+    double esc_wt = 1.0;
     double S[PATH_B];
     for (int i = 0; i < m; i++) S[i] = 1;
     float dens[PATH_F];
@@ -252,31 +446,34 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             inbox = atmos__path_clip(J->med, q, qd, K, &t0, &t1);
         }
         if (inbox) {
-            if (J->sky && t0 > 0) air_segment(J, b, p, d, t0, w, L, Lo, order);
-            double t;
+            if (J->sky && t0 > 0) {
+                air_scatter(J, b, p, d, t0, w, 1.0, L, Lo, order, NULL, r, cnt);
+                air_transmit(J, b, p[1], d, t0, w);
+            }
+            double t, ws[PATH_B];
+            memcpy(ws, w, sizeof ws);
+            if (J->forced && primary) forced_single(J, b, p, d, q, qd, t0, t1, w, L, Lo, r, cnt);
             int ev = atmos__path_free_flight(J->med, q, qd, t0, t1, b, w, r, &t, dens, &cnt->tentative);
+            if (J->sky) {
+                /* The air inside the box: its light (shadowed by the volume) over the whole
+                 * crossing, its transmittance up to where the flight ends. */
+                const double ps[3] = {p[0] + t0 * d[0], p[1] + t0 * d[1], p[2] + t0 * d[2]};
+                const air_view v = {q, qd, t0};
+                air_scatter(J, b, ps, d, t1 - t0, ws, 1.0, L, Lo, order, &v, r, cnt);
+                air_transmit(J, b, ps[1], d, (ev > 0 ? t : t1) - t0, w);
+            }
             if (ev < 0) return;
             if (ev > 0) {
                 /* A real scattering event in the volume. */
                 cnt->events++;
                 order++;
                 for (int a = 0; a < 3; a++) p[a] += t * d[a];
-                const path_medium *M = J->med;
                 const path_phase *P = J->ph;
-                const int nf = M->nf;
-                double ssf[PATH_F][PATH_B], ss[PATH_B];
-                int elig[PATH_B], ne = 0;
-                for (int i = 0; i < m; i++) {
-                    ss[i] = 0;
-                    for (int f = 0; f < nf; f++) {
-                        ssf[f][i] = (double)dens[f] * M->sca[f][b->k[i]];
-                        ss[i] += ssf[f][i];
-                    }
-                    if (ss[i] > 0) elig[ne++] = i;
-                }
-                /* the strategy of each hero here: itself, or the first that scatters */
+                const int nf = J->med->nf;
+                path_scatter ev_s;
                 int g[PATH_B];
-                for (int i = 0; i < m; i++) g[i] = ss[i] > 0 ? i : (ne ? elig[0] : i);
+                const int ne = scatter_at(J, b, dens, &ev_s, g);
+                const double(*ssf)[PATH_B] = ev_s.ssf, *ss = ev_s.ss;
                 /* Can the path go on from here (depth limit), and with which probability
                  * does it survive the roulette below: the continuation's share of the
                  * multiple importance sampling of the sun. */
@@ -286,29 +483,12 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                     for (int i = 0; i < m; i++)
                         if (w[i] > q_rr) q_rr = w[i];
                 if (q_rr > 1) q_rr = 1;
-                /* Next-event estimation of the sun. */
+                const int first = J->forced && primary; /* its lights were estimated by forced_single() */
+                const double q_mis = first ? (J->max_depth == 1 ? 0.0 : 1.0) : q_rr;
                 double E[PATH_B];
                 sunlight(J, b, p[1], E);
-                int lit = 0;
-                for (int i = 0; i < m; i++) lit |= w[i] * E[i] > 0;
-                lit = lit && J->sun_omega > 0;
-                if (lit && ne) {
-                    double ds[3], T[PATH_B], pk[PATH_B];
-                    sample_sun(J, r, ds);
-                    phase_mix(P, b, nf, ssf, ss, dot3(d, ds), pk);
-                    /* the continuation's density of ds given the path so far */
-                    const double pdir = strategies(m, S, g, pk, NULL);
-                    int any = 0;
-                    for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
-                    if (any) {
-                        const double wm = mis_nee(J, q_rr * pdir);
-                        shadow(J, b, p, ds, r, T, cnt);
-                        for (int i = 0; i < m; i++) {
-                            const double c = w[i] * pk[i] * E[i] * T[i] * wm;
-                            L[i] += c, Lo[i] += order * c;
-                        }
-                    }
-                }
+                const int lit = sun_lit(J, b, w, E);
+                if (ne && !first) nee(J, b, p, d, w, &ev_s, S, g, q_mis, lit ? E : NULL, order, L, Lo, r, cnt);
                 if (!goes_on) return;
                 depth++;
                 if (!roulette(w, m, r)) return;
@@ -333,20 +513,25 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 around(d, mu, 2.0 * ATMOS_PI * path_u(r), nd);
                 const int chroma = nf > 1 || !P->gray[0];
                 const int to_sun = lit && dot3(nd, J->sun) >= J->cos_sun;
-                if ((chroma && m > 1) || to_sun) {
+                esc_wt = 1.0;
+                if ((chroma && m > 1) || to_sun || J->env) {
                     double pk[PATH_B], pj[PATH_B];
-                    phase_mix(P, b, nf, ssf, ss, mu, pk);
+                    phase_mix(P, b, nf, &ev_s, mu, pk);
                     const double mean = strategies(m, S, g, pk, pj);
                     if (!(mean > 0)) return;
                     for (int i = 0; i < m; i++) {
                         w[i] *= pk[i] / mean;
                         S[i] *= pj[i] / mean;
                     }
+                    if (J->env) {
+                        const double pe = atmos__path_env_pdf(J->env, nd);
+                        esc_wt = q_mis * mean / (pe + q_mis * mean);
+                    }
                     if (to_sun) {
                         /* The continuation found the sun's disk: its share of the sun's
                          * radiance E / sun_omega, through the volume's transmittance. */
                         double T[PATH_B];
-                        const double wm = 1.0 - mis_nee(J, q_rr * mean);
+                        const double wm = 1.0 - mis_nee(J, q_mis * mean);
                         shadow(J, b, p, nd, r, T, cnt);
                         for (int i = 0; i < m; i++) {
                             const double c = w[i] * E[i] / J->sun_omega * T[i] * wm;
@@ -371,7 +556,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             }
             return;
         }
-        air_segment(J, b, p, d, K, w, L, Lo, order);
+        air_scatter(J, b, p, d, K, w, esc_wt, L, Lo, order, NULL, r, cnt);
         if (isinf(K)) {
             if (primary && J->disk_visible && dot3(d, J->sun) >= J->cos_sun) {
                 double E[PATH_B];
@@ -381,6 +566,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             return;
         }
         /* The Lambertian ground. */
+        air_transmit(J, b, p[1], d, K, w);
         for (int a = 0; a < 3; a++) p[a] += K * d[a];
         p[1] = 0;
         if (!(J->albedo > 0)) return;
@@ -409,6 +595,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             d[0] = st * cos(phi), d[2] = st * sin(phi), d[1] = sqrt(fmax(0.0, 1.0 - u1));
         }
         primary = 0;
+        esc_wt = 1.0;
     }
 }
 
@@ -435,6 +622,8 @@ static atmos_status resolve(atmos_context *ctx, const atmos_scene *scene, const 
         s->variance = in->variance;
         s->order = in->order;
         s->stats = in->stats;
+        s->no_sky_nee = in->no_sky_nee;
+        s->no_forced = in->no_forced;
     }
     if (s->spp < 1 || s->spp > ATMOS_PATH_MAX_SPP)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: spp must be in [1, %d], got %d", ATMOS_PATH_MAX_SPP,
@@ -482,6 +671,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     memset(&med, 0, sizeof med);
     memset(&ph, 0, sizeof ph);
     atmos_sky *sky = NULL;
+    path_env *env = NULL;
     atmos_image *img = NULL, *var = NULL, *ord = NULL;
     double *acc = NULL;
     const int n = wl.count, W = scene->width, H = scene->height, C = n + 1;
@@ -501,6 +691,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     for (int k = 0; k < n; k++) J.sun_e[k] = sky->sun_e[k];
     J.max_depth = s.max_depth;
     J.seed = s.seed;
+    J.forced = !s.no_forced;
     if (scene->background == ATMOS_BACKGROUND_SKY) {
         J.albedo = sky->desc.ground_albedo;
         J.disk_visible = !sky->desc.hide_sun_disk && J.sun[1] > 0;
@@ -541,6 +732,20 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         if (!med.empty) J.med = &med, J.ph = &ph;
     }
     if (scene->background == ATMOS_BACKGROUND_SKY) J.sky = sky;
+    if (J.sky && J.med && !s.no_sky_nee) {
+        /* the sky's light as seen from the middle of the volume's box */
+        double qc[3], yc = med.org[1];
+        for (int a = 0; a < 3; a++) qc[a] = 0.5 * (med.box_lo[a] + med.box_hi[a]);
+        for (int a = 0; a < 3; a++) yc += med.R[3 + a] * qc[a] / med.inv_vs;
+        double Yw[ATMOS_MAX_WAVELENGTHS];
+        for (int k = 0; k < n; k++) Yw[k] = wl.to_xyz[k][1];
+        env = malloc(sizeof *env);
+        if (!env) {
+            st = atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the sky's table");
+            goto done;
+        }
+        if (atmos__path_env_build(sky, J.sun, yc, Yw, env)) J.env = env;
+    }
     if ((st = atmos_image_create(ctx, W, H, C, &img)) != ATMOS_OK) goto done;
     acc = calloc(npix * NA, sizeof(double));
     if (!acc) {
@@ -592,11 +797,11 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
                         }
                         for (int i = 0; i < b.m; i++) {
                             double v = L[i] * wgt;
-                            if (!isfinite(v) || v < 0) v = 0;
+                            if (!isfinite(v)) v = 0; /* may be < 0: the air's shadows (air_scatter) */
                             A[b.k[i]] += v;
                             A[n + b.k[i]] += v * v;
                             Y += Ybar[b.k[i]] * v;
-                            if (v > 0 && isfinite(Lo[i])) Yo += Ybar[b.k[i]] * Lo[i] * wgt;
+                            if (v != 0 && isfinite(Lo[i])) Yo += Ybar[b.k[i]] * Lo[i] * wgt;
                         }
                         A[2 * n + 1] += Y;
                         A[2 * n + 2] += Y * Y;
@@ -689,6 +894,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     st = ATMOS_OK;
 done:
     free(acc);
+    free(env);
     atmos__path_medium_free(&med);
     atmos__path_phase_free(&ph);
     atmos_sky_destroy(sky);

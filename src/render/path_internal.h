@@ -96,6 +96,12 @@ int atmos__path_free_flight(const path_medium *m, const double q[3], const doubl
 void atmos__path_transmittance(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
                                const path_bundle *b, path_rng *r, double *T);
 
+/* A point of [t0, t1] drawn with density proportional to the majorant of the carried
+ * wavelengths (u uniform in [0, 1)): *t and its density *pdf (per metre). 0 if the
+ * majorant is 0 all along. */
+int atmos__path_majorant_point(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
+                               const path_bundle *b, double u, double *t, double *pdf);
+
 /* Scaled densities at an index-space point (0 outside the grid). */
 void atmos__path_density(const path_medium *m, double x, double y, double z, float *dens);
 
@@ -144,5 +150,28 @@ static inline double atmos__path_phase_eval(const path_phase *p, int f, int k, c
     const float *v = p->fv[f] + (size_t)k * p->ng;
     return a->w0 * v[a->i] + a->w1 * v[a->i + 1];
 }
+
+/* ------------------------------------------------------------------ the sky as a light */
+
+/* A sampling distribution of directions for next-event estimation of the sky's light: a
+ * table over (cos of the angle from +y, azimuth), cells of equal solid angle, each holding
+ * the luminance of the analytic sky's single scattering seen from a reference altitude,
+ * mixed with a uniform distribution over the sphere (so that no direction has density 0).
+ * Only the density matters: the radiance itself is always evaluated exactly. */
+#define PATH_ENV_NMU 32
+#define PATH_ENV_NPHI 64
+typedef struct {
+    double cdf[PATH_ENV_NMU * PATH_ENV_NPHI + 1]; /* cumulative over cells, cdf[0] = 0, last 1 */
+    double pdf_cell[PATH_ENV_NMU * PATH_ENV_NPHI]; /* density (sr^-1) of the table part */
+    double uniform;                                 /* weight of the uniform part */
+} path_env;
+
+/* Builds the table for the sky seen from altitude y_ref (weights Y[] per wavelength).
+ * Returns 0 when the sky is dark (sun below the horizon): no next-event estimation. */
+int atmos__path_env_build(const atmos_sky *sky, const double sun[3], double y_ref, const double *Y, path_env *e);
+/* A direction drawn from the distribution; returns its density (sr^-1). */
+double atmos__path_env_sample(const path_env *e, double u0, double u1, double u2, double d[3]);
+/* Density (sr^-1) of unit direction d. */
+double atmos__path_env_pdf(const path_env *e, const double d[3]);
 
 #endif

@@ -263,6 +263,54 @@ static inline double dda_tend(const path_dda *g)
     return t < g->tn[2] ? t : g->tn[2];
 }
 
+/* The majorant of the carried wavelengths in the current cell. */
+static inline double cell_majorant(const path_medium *m, const path_dda *g, const path_bundle *b)
+{
+    const float *mm = m->mm + g->idx * (uint64_t)m->nf * 2;
+    double mu = 0;
+    for (int i = 0; i < b->m; i++) {
+        double s = 0;
+        for (int f = 0; f < m->nf; f++) s += (double)mm[2 * f + 1] * m->sig[f][b->k[i]];
+        if (s > mu) mu = s;
+    }
+    return mu;
+}
+
+int atmos__path_majorant_point(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
+                               const path_bundle *b, double u, double *tout, double *pdf)
+{
+    path_dda g;
+    double total = 0;
+    dda_init(m, q, qd, t0, &g);
+    for (double t = t0;;) {
+        double te = dda_tend(&g);
+        if (te > t1) te = t1;
+        if (te > t) total += cell_majorant(m, &g, b) * (te - t);
+        if (te >= t1) break;
+        t = te;
+        if (!dda_step(m, &g)) break;
+    }
+    if (!(total > 0)) return 0;
+    const double target = u * total;
+    double acc = 0;
+    dda_init(m, q, qd, t0, &g);
+    for (double t = t0;;) {
+        double te = dda_tend(&g);
+        if (te > t1) te = t1;
+        const double mu = te > t ? cell_majorant(m, &g, b) : 0;
+        if (mu > 0 && acc + mu * (te - t) > target) {
+            double x = t + (target - acc) / mu;
+            *tout = x < te ? x : te;
+            *pdf = mu / total;
+            return 1;
+        }
+        acc += mu * (te - t);
+        if (te >= t1 || !dda_step(m, &g)) break;
+        t = te;
+    }
+    return 0; /* rounding: u * total beyond the sum of the second pass */
+}
+
 int atmos__path_free_flight(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
                             const path_bundle *b, double *w, path_rng *r, double *tout, float *dens, long long *tentative)
 {

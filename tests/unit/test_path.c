@@ -151,6 +151,7 @@ static void vacuum_scene(atmos_scene *s, int spectral, double sun_el, double sun
 }
 
 static double truncate_deg; /* atmos_path_settings.truncate_deg of render() */
+static int no_sky_nee, no_forced; /* the same for render() */
 
 static atmos_image *render(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v, const optics *op, int spp,
                            int max_depth, atmos_image **var)
@@ -158,6 +159,8 @@ static atmos_image *render(atmos_context *ctx, const atmos_scene *s, const atmos
     atmos_path_settings ps;
     memset(&ps, 0, sizeof ps);
     ps.truncate_deg = truncate_deg;
+    ps.no_sky_nee = no_sky_nee;
+    ps.no_forced = no_forced;
     ps.spp = spp;
     ps.seed = 7;
     ps.max_depth = max_depth;
@@ -692,6 +695,170 @@ static void test_sky_only(atmos_context *ctx)
     CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
 }
 
+/* ------------------------------------------------------------------ the air around and in the volume */
+
+/* A box of air with a transparent volume in it (densities 1e-6 of a cloud's): the sky seen
+ * through it is the sky without it. Before the air inside the volume's box was counted,
+ * the box showed as a dark rectangle (~2 km of air missing). */
+static void test_air_in_box(atmos_context *ctx)
+{
+    optics op;
+    make_optics(ctx, 0, 0.85, 1.0, &op);
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    vd.dims[0] = vd.dims[1] = vd.dims[2] = 8;
+    vd.voxel_size_m = 250;
+    vd.origin_m[0] = -1000, vd.origin_m[1] = 1000, vd.origin_m[2] = -3000;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    int f = -1;
+    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
+    static float buf[8 * 8 * 8];
+    for (int i = 0; i < 8 * 8 * 8; i++) buf[i] = 1e-6f * (float)(1.0 / (1e-9 * 250));
+    int off[3] = {0, 0, 0}, size[3] = {8, 8, 8};
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.width = 12, s.height = 8;
+    s.atmosphere.ground_albedo = 0;
+    s.sun.from_time = 0;
+    s.sun.elevation_deg = 25;
+    s.sun.azimuth_deg = 120;
+    double pos[3] = {0, 500, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = 2000, s.camera.look_at[2] = -2000;
+    s.camera.fov_deg = 30; /* every pixel looks through the box */
+    atmos_image *sky = NULL, *var = NULL;
+    s.samples_per_pixel = 64;
+    CHECK_OK(atmos_render_sky(ctx, &s, &sky, NULL));
+    atmos_image *img = render(ctx, &s, v, &op, 64, 0, &var);
+    int bad = 0;
+    double worst = 0;
+    for (int p = 0; p < 12 * 8; p++)
+        for (int c = 0; c < 3; c++) {
+            double a = img->pixels[p * 4 + c], b = sky->pixels[p * 4 + c], se = sqrt(var->pixels[p * 4 + c]);
+            if (fabs(a - b) / b > worst) worst = fabs(a - b) / b;
+            if (fabs(a - b) > 4 * se + 2e-3 * b) bad++;
+        }
+    printf("air in a transparent volume's box: largest difference from the sky %.2g (relative)\n", worst);
+    CHECK_MSG(bad == 0, "%d pixel channels differ from the sky", bad);
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_image_destroy(sky);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+}
+
+/* An opaque absorbing slab 500 m above a horizontal ray, the sun at the zenith: the air
+ * under it, from 500 m to 10.5 km along the ray, is in its shadow. Single scattering of
+ * the sun in the air seen along an endless horizontal ray at altitude y is
+ * P(90 deg) E(y) int_0^inf beta T(t) dt = P E; the shadow takes away P E (T(a) - T(b)). */
+static void test_air_shadow(atmos_context *ctx)
+{
+    optics op;
+    make_optics(ctx, 0, 0.0, 1e-12, &op);
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    vd.dims[0] = 20, vd.dims[1] = 1, vd.dims[2] = 100;
+    vd.voxel_size_m = 100;
+    vd.origin_m[0] = -1000, vd.origin_m[1] = 1500, vd.origin_m[2] = -10500;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    int f = -1;
+    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
+    float *buf = malloc(sizeof(float) * 20 * 100);
+    for (int i = 0; i < 20 * 100; i++) buf[i] = (float)(50.0 / (1e-9 * 100)); /* tau 50 across */
+    int off[3] = {0, 0, 0}, size[3] = {20, 1, 100};
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    free(buf);
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.width = s.height = 4;
+    s.atmosphere.ground_albedo = 0;
+    s.sun.from_time = 0;
+    s.sun.elevation_deg = 90;
+    s.sun.azimuth_deg = 0;
+    const double y0 = 1000, pos[3] = {0, y0, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = y0, s.camera.look_at[2] = -1;
+    s.camera.fov_deg = 0.01;
+    atmos_image *var = NULL;
+    atmos_image *img = render(ctx, &s, v, &op, 256, 0, &var);
+    atmos_wavelengths wl;
+    CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
+    atmos_sky *sky = NULL;
+    CHECK_OK(atmos_sky_create(ctx, &s.atmosphere, &wl, &sky));
+    const double up[3] = {0, 1, 0}, dir[3] = {0, 0, -1};
+    double E[ATMOS_MAX_WAVELENGTHS], Ta[ATMOS_MAX_WAVELENGTHS], Tb[ATMOS_MAX_WAVELENGTHS];
+    atmos_sky_sunlight(sky, y0, up, E);
+    atmos_sky_transmittance(sky, y0, dir, 500, Ta);
+    atmos_sky_transmittance(sky, y0, dir, 10500, Tb);
+    const double P = atmos_phase_rayleigh(0.0);
+    for (int c = 0; c < 3; c++) {
+        double m = 0, vv = 0;
+        for (int p = 0; p < 16; p++) m += img->pixels[p * 4 + c] / 16, vv += var->pixels[p * 4 + c] / (16.0 * 16.0);
+        const double open = P * E[c], ref = open * (1 - Ta[c] + Tb[c]);
+        printf("air shadow channel %d: path %.6g +- %.2g, analytic %.6g (%+.2f sigma), unshadowed %.6g\n", c, m,
+               sqrt(vv), ref, (m - ref) / sqrt(vv), open);
+        CHECK(fabs(m - ref) < 4 * sqrt(vv) + 1e-3 * ref);
+        CHECK(open - ref > 10 * sqrt(vv)); /* the shadow is resolved */
+    }
+    atmos_sky_destroy(sky);
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+}
+
+/* A scattering slab in the sky, seen from below: next-event estimation toward the sky and
+ * forced single scattering change the noise, not the mean (each pair of renders within 4
+ * standard errors over the image). */
+static void test_estimators_agree(atmos_context *ctx)
+{
+    optics op;
+    make_optics(ctx, 0, 0.85, 0.99, &op);
+    atmos_volume *v = slab(ctx, 40, 2.0);
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.width = 12, s.height = 8;
+    s.sun.from_time = 0;
+    s.sun.elevation_deg = 35;
+    s.sun.azimuth_deg = 200;
+    double pos[3] = {0, 300, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = 1000, s.camera.look_at[2] = -600;
+    s.camera.fov_deg = 60;
+    /* modes 0-2: all, no sky NEE, no forced; 3-4: single scattering only (max_depth 1), all
+     * and no forced (no sky NEE would miss the sky there: nothing goes on after the event) */
+    double mean[5] = {0}, var[5] = {0};
+    for (int mode = 0; mode < 5; mode++) {
+        no_sky_nee = mode == 1, no_forced = mode == 2 || mode == 4;
+        atmos_image *vi = NULL;
+        atmos_image *img = render(ctx, &s, v, &op, long_run ? 1536 : 96, mode >= 3 ? 1 : 0, &vi);
+        for (int p = 0; p < 96; p++)
+            for (int c = 0; c < 3; c++) {
+                mean[mode] += img->pixels[p * 4 + c] / (96 * 3);
+                var[mode] += vi->pixels[p * 4 + c] / (96.0 * 3 * 96 * 3);
+            }
+        atmos_image_destroy(img);
+        atmos_image_destroy(vi);
+    }
+    no_sky_nee = no_forced = 0;
+    for (int mode = 1; mode < 5; mode++) {
+        if (mode == 3) continue;
+        const int ref = mode == 4 ? 3 : 0;
+        const double z = (mean[mode] - mean[ref]) / sqrt(var[mode] + var[ref]);
+        printf("slab in the sky%s: all estimators %.6g +- %.2g, without %s %.6g +- %.2g (%+.2f sigma)\n",
+               mode == 4 ? ", single scattering" : "", mean[ref], sqrt(var[ref]),
+               mode == 1 ? "sky NEE" : "forced single scattering", mean[mode], sqrt(var[mode]), z);
+        CHECK(fabs(z) < 4);
+    }
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+}
+
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "path_cache");
@@ -701,6 +868,9 @@ int main(void)
     atmos_context *ctx = make_ctx(0);
     test_ad();
     test_sky_only(ctx);
+    test_air_in_box(ctx);
+    test_air_shadow(ctx);
+    test_estimators_agree(ctx);
     test_absorber(ctx);
     test_single(ctx);
     test_big_sun(ctx);

@@ -18,7 +18,8 @@ static void help(void)
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--json]\n"
-           "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n\n"
+           "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
+           "                        [--no-forced] [--no-sky-nee]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
            "          prints per case the best wall time and megapixels per second:\n"
@@ -53,7 +54,9 @@ static void help(void)
            "          t * (e / 0.01)^2 for two statistics e: the mean over the volume's pixels of the\n"
            "          per-pixel relative standard error of the luminance (t_1pct_pixel_s) and the relative\n"
            "          standard error of the volume's mean luminance (t_1pct_mean_s):\n"
-           "            bench=path case=wdas_cloud_sixteenth.vdb background=vacuum size=256x256 spp=16 ...\n");
+           "            bench=path case=wdas_cloud_sixteenth.vdb background=vacuum size=256x256 spp=16 ...\n"
+           "          --no-forced and --no-sky-nee turn off the forced single scattering of camera rays and\n"
+           "          next-event estimation toward the sky (docs/path.md), to measure what they gain.\n");
 }
 
 static double now_s(void)
@@ -440,7 +443,7 @@ static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *
 
 /* One case of the path benchmark (see the help text). */
 static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int spp, double dscale,
-                           int vacuum)
+                           int vacuum, const atmos_path_settings *flags)
 {
     atmos_scene scene;
     atmos_path_settings ps;
@@ -449,6 +452,8 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     scene.background = vacuum ? ATMOS_BACKGROUND_BLACK : ATMOS_BACKGROUND_SKY;
     ps.density_scale = dscale;
     ps.spp = spp;
+    ps.no_forced = flags->no_forced;
+    ps.no_sky_nee = flags->no_sky_nee;
     atmos_slice_optics optics;
     double t0 = now_s();
     atmos_status st = atmos_path_optics_build(ctx, &scene, v, &optics);
@@ -498,12 +503,12 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     rel = cnt ? rel / cnt : 0;
     double relm = sumY > 0 ? sqrt(sumV) / sumY : 0;
     const double t = stats.trace_s;
-    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g paths_per_s=%.4g "
+    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g%s%s paths_per_s=%.4g "
            "events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g events_per_path=%.2f trace_s=%.3f "
            "prepare_s=%.3f optics_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f t_1pct_pixel_s=%.4g mean_rel_se=%.3g "
            "t_1pct_mean_s=%.3g\n",
            name, vacuum ? "vacuum" : "sky", size, size, stats.spp, atmos_context_threads(ctx), dscale,
-           stats.paths / t, stats.events / t, stats.tentative / t, stats.shadow_rays / t,
+           ps.no_forced ? " no_forced=1" : "", ps.no_sky_nee ? " no_sky_nee=1" : "", stats.paths / t, stats.events / t, stats.tentative / t, stats.shadow_rays / t,
            (double)stats.events / (double)stats.paths, t, stats.prepare_s, t_opt, cnt, rel, t * (rel / 0.01) * (rel / 0.01),
            relm, t * (relm / 0.01) * (relm / 0.01));
     fflush(stdout);
@@ -513,7 +518,7 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     return CLI_EXIT_OK;
 }
 
-static int bench_path(const char *file, int size, int spp, double dscale, int threads)
+static int bench_path(const char *file, int size, int spp, double dscale, int threads, const atmos_path_settings *flags)
 {
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
@@ -532,7 +537,7 @@ static int bench_path(const char *file, int size, int spp, double dscale, int th
     }
     int rc = CLI_EXIT_OK;
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-    for (int vac = 1; rc == CLI_EXIT_OK && vac >= 0; vac--) rc = bench_path_case(ctx, name, v, size, spp, dscale, vac);
+    for (int vac = 1; rc == CLI_EXIT_OK && vac >= 0; vac--) rc = bench_path_case(ctx, name, v, size, spp, dscale, vac, flags);
     atmos_volume_destroy(v);
     atmos_context_destroy(ctx);
     return rc;
@@ -567,6 +572,8 @@ int cli_cmd_bench(int argc, char **argv)
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16;
     double dscale = 0, eye_scale = 0;
     const char *what = NULL, *presets = NULL, *file = NULL;
+    atmos_path_settings pflags; /* only no_forced and no_sky_nee are read */
+    memset(&pflags, 0, sizeof pflags);
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             help();
@@ -584,6 +591,10 @@ int cli_cmd_bench(int argc, char **argv)
         } else if (!strcmp(argv[i], "--eye-scale") && i + 1 < argc) {
             if (!cli_parse_double(C, "--eye-scale", argv[++i], &eye_scale) || !(eye_scale > 0 && eye_scale <= 1))
                 return cli_usage_error(C, "--eye-scale: expected a value in (0, 1]");
+        } else if (!strcmp(argv[i], "--no-forced")) {
+            pflags.no_forced = 1;
+        } else if (!strcmp(argv[i], "--no-sky-nee")) {
+            pflags.no_sky_nee = 1;
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
@@ -604,7 +615,7 @@ int cli_cmd_bench(int argc, char **argv)
         }
     }
     if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice, path)");
-    if (!strcmp(what, "path")) return bench_path(file, size ? size : 256, spp, dscale, threads);
+    if (!strcmp(what, "path")) return bench_path(file, size ? size : 256, spp, dscale, threads, &pflags);
     if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, repeat_set ? repeat : 3, threads, eye_scale, json);
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);

@@ -61,7 +61,11 @@ static void help(void)
            "      --truncate DEG            path: cut the phase functions' forward peak at DEG degrees\n"
            "                                (0..20; 0 = exact, the default): the part above P(DEG) inside\n"
            "                                the cone counts as unscattered. Far less noise in droplet\n"
-           "                                clouds; changes light within ~DEG of the forward direction\n\n"
+           "                                clouds; changes light within ~DEG of the forward direction\n"
+           "      --no-sky-nee              path: no next-event estimation toward the sky (same mean,\n"
+           "                                more noise; for comparisons)\n"
+           "      --no-forced               path: no forced single scattering on camera rays (same\n"
+           "                                mean, more noise in thin media; for comparisons)\n\n"
            "Animation (the sun moves; the volume and its optics tables are prepared once):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
            "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
@@ -128,7 +132,7 @@ enum {
     O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE, O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER,
     O_TRUNCATE
 };
-enum { O_EYESCALE = 512 }; /* slice renderer options added later */
+enum { O_EYESCALE = 512, O_NOSKYNEE, O_NOFORCED }; /* slice renderer options added later */
 
 /* The volume's optical depth along each pixel's ray at the middle wavelength of the
  * set, as a 1-channel PFM (the optics come from the cache the render just filled). */
@@ -199,6 +203,7 @@ int cli_cmd_render(int argc, char **argv)
         {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
         {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
         {"order", required_argument, 0, O_ORDER}, {"truncate", required_argument, 0, O_TRUNCATE},
+        {"no-sky-nee", no_argument, 0, O_NOSKYNEE}, {"no-forced", no_argument, 0, O_NOFORCED},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -217,7 +222,7 @@ int cli_cmd_render(int argc, char **argv)
     /* The path tracer (path.h): these override the scene's "path". */
     double tbudget = 0, truncate = NAN;
     unsigned long long seed = 0;
-    int seed_given = 0;
+    int seed_given = 0, no_sky_nee = 0, no_forced = 0;
     const char *variance_out = NULL, *order_out = NULL;
     atmos_image *var_img = NULL, *order_img = NULL;
     atmos_path_stats pstats;
@@ -320,6 +325,8 @@ int cli_cmd_render(int argc, char **argv)
             if (!cli_parse_double(C, "--truncate", optarg, &truncate) || !(truncate >= 0 && truncate <= 20))
                 return cli_usage_error(C, "--truncate: expected degrees in [0, 20]");
             break;
+        case O_NOSKYNEE: no_sky_nee = 1; break;
+        case O_NOFORCED: no_forced = 1; break;
         case 'q': quiet = 1; break;
         case 'h': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
@@ -433,10 +440,10 @@ int cli_cmd_render(int argc, char **argv)
         if (tbudget > 0) scene.path.time_budget_s = tbudget;
         if (seed_given) scene.path.seed = seed;
         if (!isnan(truncate)) scene.path.truncate_deg = truncate;
-    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out || order_out || !isnan(truncate)) {
+    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out || order_out || !isnan(truncate) || no_sky_nee || no_forced) {
         atmos_context_destroy(ctx);
         return cli_usage_error(C, spp > 256 ? "--spp: must be in [1, 256] for this renderer (1..1000000 with --renderer path)"
-                                            : "--time-budget, --seed, --variance, --order and --truncate go with --renderer path");
+                                            : "--time-budget, --seed, --variance, --order, --truncate, --no-sky-nee and --no-forced go with --renderer path");
     } else if (spp) {
         scene.samples_per_pixel = spp;
     }
@@ -522,6 +529,8 @@ int cli_cmd_render(int argc, char **argv)
             ps.variance = o_var ? &var_img : NULL;
             ps.order = o_ord ? &order_img : NULL;
             ps.stats = &pstats;
+            ps.no_sky_nee = no_sky_nee;
+            ps.no_forced = no_forced;
             if ((st = atmos_render_path(ctx, &fs, vol, &ps, &spec, &info)) != ATMOS_OK) goto fail;
         } else if ((st = atmos_render_sky(ctx, &fs, &spec, &info)) != ATMOS_OK) {
             goto fail;
