@@ -364,7 +364,7 @@ static void nee(const path_job *J, const path_bundle *b, const double p[3], cons
         for (int i = 0; i < m; i++) any |= w[i] * pk[i] > 0;
         if (!any || !(pe > 0)) return;
         const double wm = pe / (pe + q * pdir);
-        const double Kd = atmos_sky_ground_distance(p[1], de);
+        const double Kd = J->sky ? atmos_sky_ground_distance(p[1], de) : INFINITY;
         double q2[3], qd2[3], a0, a1, ex = 0, c[PATH_B];
         for (int i = 0; i < m; i++) T[i] = 1;
         atmos__path_to_index(J->med, p, de, q2, qd2);
@@ -378,7 +378,12 @@ static void nee(const path_job *J, const path_bundle *b, const double p[3], cons
             c[i] = w[i] * pk[i] * T[i] / pe * wm;
             on |= c[i] > 0;
         }
-        if (on && ex < Kd) {
+        if (on && !J->sky) { /* a uniform background */
+            for (int i = 0; i < m; i++) {
+                const double v = c[i] * J->bg;
+                L[i] += v, Lo[i] += order * v;
+            }
+        } else if (on && ex < Kd) {
             air_transmit(J, b, p[1], de, ex, c);
             const double px[3] = {p[0] + ex * de[0], p[1] + ex * de[1], p[2] + ex * de[2]};
             air_scatter(J, b, px, de, Kd - ex, c, 1.0, L, Lo, order, NULL, r, cnt);
@@ -551,7 +556,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
         /* Escape: vacuum, or the air to the ground or to space. */
         if (!J->sky) {
             for (int i = 0; i < m; i++) {
-                const double c = w[i] * J->bg;
+                const double c = w[i] * J->bg * esc_wt;
                 L[i] += c, Lo[i] += order * c;
             }
             return;
@@ -746,6 +751,9 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         }
         if (atmos__path_env_build(sky, J.sun, yc, Yw, env)) J.env = env;
     }
+    /* (A uniform background is left to the continuations: next-event estimation with
+     * uniform directions doubled the noise of a slab before one, tests/unit/test_path.c's
+     * history: every escaping path already sees exactly the background.) */
     if ((st = atmos_image_create(ctx, W, H, C, &img)) != ATMOS_OK) goto done;
     acc = calloc(npix * NA, sizeof(double));
     if (!acc) {
