@@ -8,12 +8,14 @@
  * per-cell minorant, directions from the tabulated phase functions by their inverse CDF
  * (atmos_phase_table_sample) of one hero wavelength per path (multiple importance sampling
  * over the carried wavelengths), any number of scattering events ended by Russian roulette,
- * the sun's disk found at every scattering event both by next-event estimation and by the
- * phase-sampled continuation, combined by multiple importance sampling. The air is
- * the analytic sky (sky.h): the medium between the eye and the volume and the light
- * arriving from everywhere a path escapes to; the ground is Lambertian, lit by the sun
- * (shadowed by the volume) and by the paths that leave it. With a black or uniform
- * background the volume floats in vacuum.
+ * the sun's disk and the sky found at every scattering event both by next-event estimation
+ * and by the phase-sampled continuation, combined by multiple importance sampling, and a
+ * camera ray's single scattering estimated at a point forced into its crossing of the
+ * volume. The air is the analytic sky (sky.h): the medium around and inside the volume's
+ * box, its in-scatter shadowed by the volume (light shafts), and the light arriving from
+ * everywhere a path escapes to; the ground is Lambertian, lit by the sun (shadowed by the
+ * volume) and by the paths that leave it. With a black or uniform background the volume
+ * floats in vacuum.
  *
  * Determinism: every (pixel, sample) has its own random stream derived from the seed,
  * so the image is the same bit for bit for any thread count. With a time budget the

@@ -5,16 +5,20 @@
  * three quarters of the set away, each counted with weight N/PATH_B, so every wavelength
  * is estimated without bias). Its segments:
  *
- *   air (outside the volume's occupied box): the analytic sky's transmittance and
- *       single-scattered in-scatter (sky.c), added along the way;
+ *   air (everywhere, inside the volume's occupied box too): the analytic sky's
+ *       transmittance and single-scattered in-scatter (sky.c), minus the volume's shadow
+ *       on it (air_scatter), added along the way;
  *   the volume's box: free flight by delta tracking (path_medium.c); at a real
  *       scattering event next-event estimation of the sun's disk (a direction drawn
- *       uniformly in the disk's cone, the transmittance to it by ratio tracking), then
- *       Russian roulette and a new direction drawn from the phase function of the
- *       path's hero wavelength (multiple importance sampling over whole paths between
- *       the carried wavelengths: weights never more than PATH_B); a direction that
- *       lands in the sun's disk counts the sun too, weighted against next-event
- *       estimation by the balance heuristic;
+ *       uniformly in the disk's cone, the transmittance to it by ratio tracking) and of
+ *       the sky (a direction from path_env.c's table), then Russian roulette and a new
+ *       direction drawn from the phase function of the path's hero wavelength (multiple
+ *       importance sampling over whole paths between the carried wavelengths: weights
+ *       never more than PATH_B); a direction that lands in the sun's disk counts the sun
+ *       too, and the air's light at the path's escape counts, each weighted against its
+ *       next-event estimate by the balance heuristic. A camera ray's crossing of the box
+ *       estimates its single scattering at a point drawn by the majorant
+ *       (forced_single), in place of the next-event estimates at its first event;
  *   the ground (y = 0, sky background): Lambertian; the sun's light (shadowed by the
  *       volume) by next-event estimation, then a cosine-distributed bounce;
  *   escape: the sky's in-scatter from the escape point to infinity; the sun's disk only
