@@ -111,6 +111,26 @@ static void make_optics(atmos_context *ctx, int spectral, double g, double albed
     make_optics2(ctx, spectral, 1.0, g, 0.0, albedo, op);
 }
 
+/* A volume of nx x ny x nz voxels of vs metres with its corner at (ox, oy, oz), one field
+ * "cloud" of particle "hg" with densities buf (x fastest). */
+static atmos_volume *dense_volume(atmos_context *ctx, int nx, int ny, int nz, double vs, double ox, double oy, double oz,
+                                  const float *buf)
+{
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    vd.dims[0] = nx, vd.dims[1] = ny, vd.dims[2] = nz;
+    vd.voxel_size_m = vs;
+    vd.origin_m[0] = ox, vd.origin_m[1] = oy, vd.origin_m[2] = oz;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    int f = -1;
+    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
+    int off[3] = {0, 0, 0}, size[3] = {nx, ny, nz};
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    return v;
+}
+
 /* A slab of optical thickness tau (1e-9 m^2 particles), H = 100 m thick, nxz * H wide,
  * between y = SLAB_Y and SLAB_Y + H, centred on x = z = 0: one voxel thick, uniform, so the
  * interpolated density is uniform up to the faces. */
@@ -118,23 +138,11 @@ static void make_optics(atmos_context *ctx, int spectral, double g, double albed
 #define SLAB_Y 1000.0
 static atmos_volume *slab(atmos_context *ctx, int nxz, double tau)
 {
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = vd.dims[2] = nxz;
-    vd.dims[1] = 1;
-    vd.voxel_size_m = SLAB_H;
-    vd.origin_m[0] = vd.origin_m[2] = -0.5 * nxz * SLAB_H;
-    vd.origin_m[1] = SLAB_Y;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
     float *buf = malloc(sizeof(float) * (size_t)nxz * nxz);
     for (int i = 0; i < nxz * nxz; i++) buf[i] = (float)(tau / (1e-9 * SLAB_H));
-    int off[3] = {0, 0, 0}, size[3] = {nxz, 1, nxz};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    const double o = -0.5 * nxz * SLAB_H;
+    atmos_volume *v = dense_volume(ctx, nxz, 1, nxz, SLAB_H, o, SLAB_Y, o, buf);
     free(buf);
-    CHECK_OK(atmos_volume_finalize(ctx, v));
     return v;
 }
 
@@ -518,15 +526,6 @@ static void test_absorber(atmos_context *ctx)
     optics op;
     make_optics(ctx, 0, 0.0, 1e-12, &op);
     /* heterogeneous: 24^3 voxels of 10 m with a smooth random-looking density */
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = vd.dims[1] = vd.dims[2] = 24;
-    vd.voxel_size_m = 10;
-    vd.origin_m[0] = -120, vd.origin_m[1] = 1000, vd.origin_m[2] = -120;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
     static float buf[24 * 24 * 24];
     for (int k = 0; k < 24; k++)
         for (int j = 0; j < 24; j++)
@@ -534,9 +533,7 @@ static void test_absorber(atmos_context *ctx)
                 buf[(k * 24 + j) * 24 + i] =
                     (float)(4e6 * (1.6 + sin(0.7 * i) * cos(0.45 * j + 0.3 * k) + 0.5 * sin(1.3 * k + 0.2 * i)) *
                             (i > 2 && j > 1 && k > 3 ? 1 : 0.2));
-    int off[3] = {0, 0, 0}, size[3] = {24, 24, 24};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
-    CHECK_OK(atmos_volume_finalize(ctx, v));
+    atmos_volume *v = dense_volume(ctx, 24, 24, 24, 10, -120, 1000, -120, buf);
     atmos_scene s;
     vacuum_scene(&s, 0, 30, 100);
     s.background = ATMOS_BACKGROUND_UNIFORM;
@@ -704,20 +701,9 @@ static void test_air_in_box(atmos_context *ctx)
 {
     optics op;
     make_optics(ctx, 0, 0.85, 1.0, &op);
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = vd.dims[1] = vd.dims[2] = 8;
-    vd.voxel_size_m = 250;
-    vd.origin_m[0] = -1000, vd.origin_m[1] = 1000, vd.origin_m[2] = -3000;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
     static float buf[8 * 8 * 8];
     for (int i = 0; i < 8 * 8 * 8; i++) buf[i] = 1e-6f * (float)(1.0 / (1e-9 * 250));
-    int off[3] = {0, 0, 0}, size[3] = {8, 8, 8};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
-    CHECK_OK(atmos_volume_finalize(ctx, v));
+    atmos_volume *v = dense_volume(ctx, 8, 8, 8, 250, -1000, 1000, -3000, buf);
     atmos_scene s;
     atmos_scene_defaults(&s);
     s.width = 12, s.height = 8;
@@ -758,21 +744,9 @@ static void test_air_shadow(atmos_context *ctx)
 {
     optics op;
     make_optics(ctx, 0, 0.0, 1e-12, &op);
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = 20, vd.dims[1] = 1, vd.dims[2] = 100;
-    vd.voxel_size_m = 100;
-    vd.origin_m[0] = -1000, vd.origin_m[1] = 1500, vd.origin_m[2] = -10500;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
-    float *buf = malloc(sizeof(float) * 20 * 100);
+    static float buf[20 * 100];
     for (int i = 0; i < 20 * 100; i++) buf[i] = (float)(50.0 / (1e-9 * 100)); /* tau 50 across */
-    int off[3] = {0, 0, 0}, size[3] = {20, 1, 100};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
-    free(buf);
-    CHECK_OK(atmos_volume_finalize(ctx, v));
+    atmos_volume *v = dense_volume(ctx, 20, 1, 100, 100, -1000, 1500, -10500, buf);
     atmos_scene s;
     atmos_scene_defaults(&s);
     s.width = s.height = 4;
