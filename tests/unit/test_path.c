@@ -158,6 +158,20 @@ static void vacuum_scene(atmos_scene *s, int spectral, double sun_el, double sun
     s->atmosphere.sun_diameter_deg = 0.05;
 }
 
+/* The sky background, a pinhole camera at pos looking at look. */
+static void sky_scene(atmos_scene *s, int w, int h, double sun_el, double sun_az, const double pos[3],
+                      const double look[3], double fov_deg)
+{
+    atmos_scene_defaults(s);
+    s->width = w, s->height = h;
+    s->sun.from_time = 0;
+    s->sun.elevation_deg = sun_el;
+    s->sun.azimuth_deg = sun_az;
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s->camera);
+    for (int a = 0; a < 3; a++) s->camera.look_at[a] = look[a];
+    s->camera.fov_deg = fov_deg;
+}
+
 static double truncate_deg; /* atmos_path_settings.truncate_deg of render() */
 static int no_sky_nee, no_forced; /* the same for render() */
 
@@ -705,16 +719,9 @@ static void test_air_in_box(atmos_context *ctx)
     for (int i = 0; i < 8 * 8 * 8; i++) buf[i] = 1e-6f * (float)(1.0 / (1e-9 * 250));
     atmos_volume *v = dense_volume(ctx, 8, 8, 8, 250, -1000, 1000, -3000, buf);
     atmos_scene s;
-    atmos_scene_defaults(&s);
-    s.width = 12, s.height = 8;
+    const double pos[3] = {0, 500, 0}, look[3] = {0, 2000, -2000};
+    sky_scene(&s, 12, 8, 25, 120, pos, look, 30); /* every pixel looks through the box */
     s.atmosphere.ground_albedo = 0;
-    s.sun.from_time = 0;
-    s.sun.elevation_deg = 25;
-    s.sun.azimuth_deg = 120;
-    double pos[3] = {0, 500, 0};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
-    s.camera.look_at[0] = 0, s.camera.look_at[1] = 2000, s.camera.look_at[2] = -2000;
-    s.camera.fov_deg = 30; /* every pixel looks through the box */
     atmos_image *sky = NULL, *var = NULL;
     s.samples_per_pixel = 64;
     CHECK_OK(atmos_render_sky(ctx, &s, &sky, NULL));
@@ -748,16 +755,9 @@ static void test_air_shadow(atmos_context *ctx)
     for (int i = 0; i < 20 * 100; i++) buf[i] = (float)(50.0 / (1e-9 * 100)); /* tau 50 across */
     atmos_volume *v = dense_volume(ctx, 20, 1, 100, 100, -1000, 1500, -10500, buf);
     atmos_scene s;
-    atmos_scene_defaults(&s);
-    s.width = s.height = 4;
+    const double y0 = 1000, pos[3] = {0, y0, 0}, look[3] = {0, y0, -1};
+    sky_scene(&s, 4, 4, 90, 0, pos, look, 0.01);
     s.atmosphere.ground_albedo = 0;
-    s.sun.from_time = 0;
-    s.sun.elevation_deg = 90;
-    s.sun.azimuth_deg = 0;
-    const double y0 = 1000, pos[3] = {0, y0, 0};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
-    s.camera.look_at[0] = 0, s.camera.look_at[1] = y0, s.camera.look_at[2] = -1;
-    s.camera.fov_deg = 0.01;
     atmos_image *var = NULL;
     atmos_image *img = render(ctx, &s, v, &op, 256, 0, &var);
     atmos_wavelengths wl;
@@ -795,15 +795,8 @@ static void test_estimators_agree(atmos_context *ctx)
     make_optics(ctx, 0, 0.85, 0.99, &op);
     atmos_volume *v = slab(ctx, 40, 2.0);
     atmos_scene s;
-    atmos_scene_defaults(&s);
-    s.width = 12, s.height = 8;
-    s.sun.from_time = 0;
-    s.sun.elevation_deg = 35;
-    s.sun.azimuth_deg = 200;
-    double pos[3] = {0, 300, 0};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
-    s.camera.look_at[0] = 0, s.camera.look_at[1] = 1000, s.camera.look_at[2] = -600;
-    s.camera.fov_deg = 60;
+    const double pos[3] = {0, 300, 0}, look[3] = {0, 1000, -600};
+    sky_scene(&s, 12, 8, 35, 200, pos, look, 60);
     /* modes 0-2: all, no sky NEE, no forced; 3-4: single scattering only (max_depth 1), all
      * and no forced (no sky NEE would miss the sky there: nothing goes on after the event) */
     double mean[5] = {0}, var[5] = {0};
