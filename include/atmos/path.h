@@ -85,6 +85,9 @@ typedef struct atmos_path_settings {
     int no_forced;          /* 1: camera rays find their single scattering only where their free
                                flight collides (no forced single scattering; same mean, more noise
                                in thin media) */
+    int no_aureole;         /* 1: no aureole estimate (docs/path.md, "Fireflies of droplet clouds";
+                               used where a phase function's forward peak exceeds 100 sr^-1; same
+                               mean, more fireflies) */
 } atmos_path_settings;
 
 ATMOS_API void atmos_path_defaults(atmos_path_settings *s);

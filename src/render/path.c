@@ -99,6 +99,7 @@ typedef struct {
     const atmos_sky *sky;   /* NULL: vacuum */
     const path_env *env;    /* NULL: no next-event estimation of the sky */
     int forced;             /* camera rays estimate their single scattering by forced_single() */
+    int aureole;            /* the aureole estimate (a phase function with a forward peak) */
     atmos_camera cam;
     int n;                  /* wavelengths */
     double sun[3];
@@ -336,10 +337,11 @@ static int sun_lit(const path_job *J, const path_bundle *b, const double *w, con
  * sky's table, the volume's and the air's transmittance to the box's far side, then the
  * air's light beyond it. Each is weighted against the phase-sampled continuation by the
  * balance heuristic, whose density there is q (its survival probability) times the
- * strategies' mean density. */
+ * strategies' mean density; the sun's part is further weighted by hs, the share of the
+ * path's own strategies against the aureole estimate made at the previous event. */
 static void nee(const path_job *J, const path_bundle *b, const double p[3], const double d[3], const double *w,
-                const path_scatter *e, const double *S, const int *g, double q, const double *E, int order, double *L,
-                double *Lo, path_rng *r, path_counts *cnt)
+                const path_scatter *e, const double *S, const int *g, double q, const double *E, double hs, int order,
+                double *L, double *Lo, path_rng *r, path_counts *cnt)
 {
     const int m = b->m, nf = J->med->nf;
     double pk[PATH_B], T[PATH_B];
@@ -351,7 +353,7 @@ static void nee(const path_job *J, const path_bundle *b, const double p[3], cons
         int any = 0;
         for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
         if (any) {
-            const double wm = mis_nee(J, q * pdir);
+            const double wm = mis_nee(J, q * pdir) * hs;
             shadow(J, b, p, ds, r, T, cnt);
             for (int i = 0; i < m; i++) {
                 const double c = w[i] * pk[i] * E[i] * T[i] * wm;
@@ -395,6 +397,85 @@ static void nee(const path_job *J, const path_bundle *b, const double p[3], cons
     }
 }
 
+/* The sun's aureole (docs/path.md, "Fireflies of droplet clouds"). Next-event estimation
+ * at an event x' evaluates the phase function at the angle between the path's direction
+ * and the sun: inside the forward peak (400-900 sr^-1 for cloud droplets against ~0.05
+ * sideways) a path that happens to head within ~2 degrees of the sun collects thousands
+ * of times the usual sunlight, and the continuation draws such directions rarely. So from
+ * each lit event x (incoming direction d) one more estimate of the light (x, x', sun):
+ * a direction a from the phase function of a carried scattering wavelength chosen
+ * uniformly, centred on the sun instead of on d (density pa(a) = the mean over those
+ * wavelengths of p_k(sun . a)), x' by the free flight the path itself would take along a,
+ * at x' next-event estimation of the sun (the whole disk: it stands for both of the path's
+ * ways there). The path reaches the same x' with density q p_dir(a) and counts the sun at
+ * x' times h = q p_dir / (q p_dir + pa) (trace: hprev); this estimate has 1 - h, i.e. the
+ * weight w_k p_k(d . a) / (q p_dir(a) + pa(a)): the balance heuristic between the two.
+ * Used where some phase function has a forward peak (J->aureole). */
+static double aureole_pdf(const path_job *J, const path_bundle *b, const path_scatter *e, const double a[3])
+{
+    double pk[PATH_B], s = 0;
+    int ne = 0;
+    phase_mix(J->ph, b, J->med->nf, e, dot3(a, J->sun), pk);
+    for (int i = 0; i < b->m; i++)
+        if (e->ss[i] > 0) s += pk[i], ne++;
+    return ne ? s / ne : 0.0;
+}
+
+static void aureole(const path_job *J, const path_bundle *b, const double p[3], const double d[3],
+                    const path_scatter *e, const double *w, const double *S, const int *g, double q, int order,
+                    double *L, double *Lo, path_rng *r, path_counts *cnt)
+{
+    const path_medium *M = J->med;
+    const path_phase *P = J->ph;
+    const int m = b->m, nf = M->nf;
+    int elig[PATH_B], ne = 0;
+    for (int i = 0; i < m; i++)
+        if (e->ss[i] > 0) elig[ne++] = i;
+    if (!ne) return;
+    int j = elig[ne > 1 ? (int)(path_u(r) * ne) % ne : 0], f = 0;
+    if (nf > 1) {
+        double u = path_u(r) * e->ss[j], acc = 0;
+        for (f = 0; f < nf - 1; f++) {
+            acc += e->ssf[f][j];
+            if (u < acc) break;
+        }
+        while (f > 0 && e->ssf[f][j] <= 0) f--;
+    }
+    double a[3], pk[PATH_B], wa[PATH_B];
+    around(J->sun, atmos__path_phase_sample(P, f, b->k[j], path_u(r)), 2.0 * ATMOS_PI * path_u(r), a);
+    phase_mix(P, b, nf, e, dot3(d, a), pk);
+    const double den = q * strategies(m, S, g, pk, NULL) + aureole_pdf(J, b, e, a);
+    if (!(den > 0)) return;
+    int any = 0;
+    for (int i = 0; i < m; i++) any |= (wa[i] = w[i] * pk[i] / den) > 0;
+    if (!any) return;
+    /* x': the free flight of the path's own continuation (its probabilities do not depend
+     * on the weights' common scale), with the air's transmittance on the way */
+    double qi[3], qd[3], t0, t1, t;
+    const double K = J->sky ? atmos_sky_ground_distance(p[1], a) : INFINITY;
+    atmos__path_to_index(M, p, a, qi, qd);
+    if (!atmos__path_clip(M, qi, qd, K, &t0, &t1)) return;
+    float dens[PATH_F];
+    if (atmos__path_free_flight(M, qi, qd, t0, t1, b, wa, r, &t, dens, &cnt->tentative) <= 0) return;
+    if (J->sky) air_transmit(J, b, p[1], a, t, wa);
+    path_scatter e2;
+    int g2[PATH_B];
+    if (!scatter_at(J, b, dens, &e2, g2)) return;
+    double x[3], E[PATH_B], ds[3], T[PATH_B];
+    for (int k = 0; k < 3; k++) x[k] = p[k] + t * a[k];
+    sunlight(J, b, x[1], E);
+    sample_sun(J, r, ds);
+    phase_mix(P, b, nf, &e2, dot3(a, ds), pk);
+    any = 0;
+    for (int i = 0; i < m; i++) any |= wa[i] * pk[i] * E[i] > 0;
+    if (!any) return;
+    shadow(J, b, x, ds, r, T, cnt);
+    for (int i = 0; i < m; i++) {
+        const double c = wa[i] * pk[i] * E[i] * T[i];
+        L[i] += c, Lo[i] += (order + 1) * c;
+    }
+}
+
 /* Forced single scattering on a camera ray's crossing [t0, t1] of the volume's box (index
  * space q + t qd, world p + t d): one point drawn in proportion to the majorant, where the
  * lights are estimated with weights w sigma_s T_view / pdf (T_view by ratio tracking). It
@@ -427,7 +508,7 @@ static void forced_single(const path_job *J, const path_bundle *b, const double 
     sunlight(J, b, x[1], E);
     /* the continuation's share: as if the roulette always let it go on (the first event's
      * continuations use that too), unless no path goes on after one event */
-    nee(J, b, x, d, c, &e, S, g, J->max_depth == 1 ? 0.0 : 1.0, sun_lit(J, b, c, E) ? E : NULL, 1, L, Lo, r, cnt);
+    nee(J, b, x, d, c, &e, S, g, J->max_depth == 1 ? 0.0 : 1.0, sun_lit(J, b, c, E) ? E : NULL, 1.0, 1, L, Lo, r, cnt);
 }
 
 /* One camera path through world ray (o, d); adds the radiance of the carried
@@ -443,6 +524,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
     /* weight of the air's light at the path's escape: after a volume event the
      * continuation's share against next-event estimation of the sky, else 1 */
     double esc_wt = 1.0;
+    double hprev = 1; /* the path's share of the sun at its next volume event (aureole) */
     double S[PATH_B];
     for (int i = 0; i < m; i++) S[i] = 1;
     float dens[PATH_F];
@@ -497,8 +579,11 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 double E[PATH_B];
                 sunlight(J, b, p[1], E);
                 const int lit = sun_lit(J, b, w, E);
-                if (ne && !first) nee(J, b, p, d, w, &ev_s, S, g, q_mis, lit ? E : NULL, order, L, Lo, r, cnt);
+                if (ne && !first) nee(J, b, p, d, w, &ev_s, S, g, q_mis, lit ? E : NULL, hprev, order, L, Lo, r, cnt);
                 if (!goes_on) return;
+                /* The sun at the next event through the forward peak: see aureole(). */
+                const int pa_on = J->aureole && lit;
+                if (pa_on) aureole(J, b, p, d, &ev_s, w, S, g, q_rr, order, L, Lo, r, cnt);
                 depth++;
                 if (!roulette(w, m, r)) return;
                 /* New direction: the hero's strategy (its wavelength or the fallback), a field
@@ -523,7 +608,9 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 const int chroma = nf > 1 || !P->gray[0];
                 const int to_sun = lit && dot3(nd, J->sun) >= J->cos_sun;
                 esc_wt = 1.0;
-                if ((chroma && m > 1) || to_sun || J->env) {
+                const double hcur = hprev;
+                hprev = 1;
+                if ((chroma && m > 1) || to_sun || J->env || pa_on) {
                     double pk[PATH_B], pj[PATH_B];
                     phase_mix(P, b, nf, &ev_s, mu, pk);
                     const double mean = strategies(m, S, g, pk, pj);
@@ -531,6 +618,10 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                     for (int i = 0; i < m; i++) {
                         w[i] *= pk[i] / mean;
                         S[i] *= pj[i] / mean;
+                    }
+                    if (pa_on) {
+                        const double c = q_rr * mean;
+                        hprev = c / (c + aureole_pdf(J, b, &ev_s, nd));
                     }
                     if (J->env) {
                         const double pe = atmos__path_env_pdf(J->env, nd);
@@ -540,7 +631,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                         /* The continuation found the sun's disk: its share of the sun's
                          * radiance E / sun_omega, through the volume's transmittance. */
                         double T[PATH_B];
-                        const double wm = 1.0 - mis_nee(J, q_mis * mean);
+                        const double wm = (1.0 - mis_nee(J, q_mis * mean)) * hcur;
                         shadow(J, b, p, nd, r, T, cnt);
                         for (int i = 0; i < m; i++) {
                             const double c = w[i] * E[i] / J->sun_omega * T[i] * wm;
@@ -605,10 +696,15 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
         }
         primary = 0;
         esc_wt = 1.0;
+        hprev = 1;
     }
 }
 
 /* ------------------------------------------------------------------ the render */
+
+/* Forward peak (sr^-1) above which the aureole estimate pays for itself: cloud droplets
+ * have 400-900, HG g = 0.9 15, g = 0.95 62. */
+#define AUREOLE_PEAK 100.0
 
 static atmos_status resolve(atmos_context *ctx, const atmos_scene *scene, const atmos_path_settings *in,
                             atmos_path_settings *s)
@@ -633,6 +729,7 @@ static atmos_status resolve(atmos_context *ctx, const atmos_scene *scene, const 
         s->stats = in->stats;
         s->no_sky_nee = in->no_sky_nee;
         s->no_forced = in->no_forced;
+        s->no_aureole = in->no_aureole;
     }
     if (s->spp < 1 || s->spp > ATMOS_PATH_MAX_SPP)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: spp must be in [1, %d], got %d", ATMOS_PATH_MAX_SPP,
@@ -739,6 +836,15 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
             }
         }
         if (!med.empty) J.med = &med, J.ph = &ph;
+        /* The aureole estimate where a phase function (as used: truncated or not) has a
+         * forward peak of more than AUREOLE_PEAK sr^-1 (cloud droplets: 400-900). */
+        if (J.med && !s.no_aureole) {
+            path_angle ang;
+            atmos__path_angle(&ph, cos(0.05 * ATMOS_DEG2RAD), &ang);
+            for (int f = 0; f < ph.nf; f++)
+                for (int k = 0; k < n; k++)
+                    if (atmos__path_phase_eval(&ph, f, k, &ang) > AUREOLE_PEAK) J.aureole = 1;
+        }
     }
     if (scene->background == ATMOS_BACKGROUND_SKY) J.sky = sky;
     if (J.sky && J.med && !s.no_sky_nee) {

@@ -22,13 +22,15 @@ void atmos__reader_field_names(const char *grid, const atmos_volume_load_desc *d
     const char *user = desc && desc->field && *desc->field ? desc->field : NULL;
     if (strcmp(grid, "density") == 0) {
         snprintf(field, 64, "%s", user ? user : "cloud");
-        snprintf(particle, 64, "%s", user && is_preset_name(user) ? user : "cloud");
+        /* a preset or a scene's own particle (resolved, and refused if unknown, by the
+         * optics build) */
+        snprintf(particle, 64, "%s", user ? user : "cloud");
     } else if (is_preset_name(grid)) {
         snprintf(field, 64, "%s", grid);
         snprintf(particle, 64, "%s", grid);
     } else {
         snprintf(field, 64, "%s", grid);
-        snprintf(particle, 64, "%s", user && is_preset_name(user) ? user : "cloud");
+        snprintf(particle, 64, "%s", user ? user : "cloud");
     }
 }
 

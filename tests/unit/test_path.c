@@ -338,6 +338,54 @@ static double hg2_cone_excess(double w1, double g1, double g2, double tc)
  * total transmittance (diffuse + direct; the truncated medium's direct beam exp(-tau (1 - f))
  * carries the light scattered into the cone) agree within 3 standard errors plus the
  * approximation's allowance; R + T_total = 1 (albedo 1) holds within the noise alone. */
+/* The slab (sun at the zenith, vacuum) with w1 HG(g1) + (1 - w1) HG(g2), its phase function
+ * truncated at tc degrees (0: exact), against the untruncated adding-doubling R and T. */
+static void slab_vs_ad(atmos_context *ctx, double w1, double g1, double g2, double tau, const int spp[2], double tc)
+{
+    truncate_deg = tc;
+    static ad_result ad;
+    CHECK(ad_slab2(tau, 1.0, w1, g1, g2, 1.0, 64, &ad));
+    const double ref[2] = {ad.refl, ad.trans + exp(-tau)};
+    const double f = tc > 0 ? hg2_cone_excess(w1, g1, g2, tc * PI / 180) : 0.0;
+    const double direct = exp(-tau * (1 - f));
+    optics op;
+    make_optics2(ctx, 0, w1, g1, g2, 1.0, &op);
+    atmos_volume *v = slab(ctx, 512, tau);
+    atmos_scene s;
+    vacuum_scene(&s, 0, 90, 0);
+    s.width = 4, s.height = 256;
+    const double E = sun_e(ctx, &s, 1);
+    double val[2], se[2];
+    for (int side = 0; side < 2; side++) {
+        double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
+        atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
+        atmos_image *var = NULL;
+        atmos_image *img = render(ctx, &s, v, &op, spp[side] * (long_run ? 16 : 1), 0, &var);
+        CHECK(all_finite(img));
+        hemi_flux(img, var, 1, side == 0, E, &val[side], &se[side]);
+        if (side == 1) val[1] += direct;
+        /* allowance for the approximation: 1.5 % of R, 0.5 % of T_total (measured: docs/path.md) */
+        const double z = (val[side] - ref[side]) / se[side];
+        const double allow = tc > 0 ? (side == 0 ? 0.015 : 0.005) * ref[side] : 0.0;
+        printf("%s %g deg, %g HG(%g) + %g HG(%g), tau=%g %s: path %.5f +- %.5f, adding-doubling %.5f "
+               "(%+.2f %%, %+.2f sigma; f = %.4f)\n",
+               tc > 0 ? "truncated" : "exact (aureole estimate), cut", tc, w1, g1, 1 - w1, g2, tau,
+               side == 0 ? "R" : "T total", val[side], se[side], ref[side], 100 * (val[side] / ref[side] - 1), z, f);
+        CHECK_MSG(fabs(val[side] - ref[side]) < 3 * se[side] + allow, "%s: %.5f vs %.5f", side ? "T" : "R", val[side],
+                  ref[side]);
+        CHECK(se[side] < 0.02 * ref[side]);
+        atmos_image_destroy(img);
+        atmos_image_destroy(var);
+    }
+    /* energy: nothing is absorbed */
+    const double sum = val[0] + val[1], sse = sqrt(se[0] * se[0] + se[1] * se[1]);
+    printf("  R + T total = %.5f +- %.5f (%+.2f sigma)\n", sum, sse, (sum - 1) / sse);
+    CHECK_MSG(fabs(sum - 1) < 3 * sse, "R + T = %.5f +- %.5f", sum, sse);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+    truncate_deg = 0;
+}
+
 static void test_truncate(atmos_context *ctx)
 {
     static const struct {
@@ -348,51 +396,11 @@ static void test_truncate(atmos_context *ctx)
         {0.5, 0.99, 0.85, 8, {768, 192}},
         {1.0, 0.95, 0.0, 2, {4096, 256}},  /* one HG lobe, g = 0.95 (P(0) = 62 sr^-1) */
     };
-    const double tc = 3.0;
-    truncate_deg = tc;
-    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
-        const double w1 = cases[c].w1, g1 = cases[c].g1, g2 = cases[c].g2, tau = cases[c].tau;
-        static ad_result ad;
-        CHECK(ad_slab2(tau, 1.0, w1, g1, g2, 1.0, 64, &ad));
-        const double ref[2] = {ad.refl, ad.trans + exp(-tau)};
-        const double f = hg2_cone_excess(w1, g1, g2, tc * PI / 180);
-        const double direct = exp(-tau * (1 - f));
-        optics op;
-        make_optics2(ctx, 0, w1, g1, g2, 1.0, &op);
-        atmos_volume *v = slab(ctx, 512, tau);
-        atmos_scene s;
-        vacuum_scene(&s, 0, 90, 0);
-        s.width = 4, s.height = 256;
-        const double E = sun_e(ctx, &s, 1);
-        double val[2], se[2];
-        for (int side = 0; side < 2; side++) {
-            double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
-            atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
-            atmos_image *var = NULL;
-            atmos_image *img = render(ctx, &s, v, &op, cases[c].spp[side] * (long_run ? 16 : 1), 0, &var);
-            CHECK(all_finite(img));
-            hemi_flux(img, var, 1, side == 0, E, &val[side], &se[side]);
-            if (side == 1) val[1] += direct;
-            /* allowance for the approximation: 1.5 % of R, 0.5 % of T_total (measured: docs/path.md) */
-            const double z = (val[side] - ref[side]) / se[side], allow = (side == 0 ? 0.015 : 0.005) * ref[side];
-            printf("truncated %g deg, %g HG(%g) + %g HG(%g), tau=%g %s: path %.5f +- %.5f, adding-doubling %.5f "
-                   "(%+.2f %%, %+.2f sigma; f = %.4f)\n",
-                   tc, w1, g1, 1 - w1, g2, tau, side == 0 ? "R" : "T total", val[side], se[side], ref[side],
-                   100 * (val[side] / ref[side] - 1), z, f);
-            CHECK_MSG(fabs(val[side] - ref[side]) < 3 * se[side] + allow, "truncated %s: %.5f vs %.5f",
-                      side ? "T" : "R", val[side], ref[side]);
-            CHECK(se[side] < 0.02 * ref[side]);
-            atmos_image_destroy(img);
-            atmos_image_destroy(var);
-        }
-        /* energy: nothing is absorbed */
-        const double sum = val[0] + val[1], sse = sqrt(se[0] * se[0] + se[1] * se[1]);
-        printf("  R + T total = %.5f +- %.5f (%+.2f sigma)\n", sum, sse, (sum - 1) / sse);
-        CHECK_MSG(fabs(sum - 1) < 3 * sse, "R + T = %.5f +- %.5f", sum, sse);
-        atmos_volume_destroy(v);
-        atmos_phase_table_destroy(op.t);
-    }
-    truncate_deg = 0;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
+        slab_vs_ad(ctx, cases[c].w1, cases[c].g1, cases[c].g2, cases[c].tau, cases[c].spp, 3.0);
+    /* Exact, with the droplet-like peak: the aureole estimate is on (P(0) > 100 sr^-1) */
+    static const int spp[2] = {2048, 256};
+    slab_vs_ad(ctx, 0.5, 0.99, 0.85, 2, spp, 0.0);
 }
 
 /* ------------------------------------------------------------------ single scattering */
@@ -512,7 +520,10 @@ static void test_order(atmos_context *ctx)
     for (int i = 0; i < 4; i++) {
         double m = mean_order(ctx, taus[i], 64);
         printf("order AOV: slab tau=%g seen from above: mean order %.3f\n", taus[i], m);
-        if (i == 0) CHECK(m >= 1.0 && m <= 1.1);
+        /* tau 0.05: ~1.11 (2048 spp). The light scattered twice within the HG(0.85) forward
+         * peak is ~10 % of the back-scattered single scattering; before the aureole estimate
+         * (path.c) 64 spp mostly missed it (1.06, creeping up to 1.10 at 16384 spp). */
+        if (i == 0) CHECK(m >= 1.0 && m <= 1.2);
         else CHECK_MSG(m > prev + 0.5, "tau %g: mean order %.3f, at the thinner slab %.3f", taus[i], m, prev);
         prev = m;
     }

@@ -19,7 +19,7 @@ static void help(void)
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
-           "                        [--no-forced] [--no-sky-nee]\n\n"
+           "                        [--no-forced] [--no-sky-nee] [--no-aureole]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
            "          prints per case the best wall time and megapixels per second:\n"
@@ -55,8 +55,9 @@ static void help(void)
            "          per-pixel relative standard error of the luminance (t_1pct_pixel_s) and the relative\n"
            "          standard error of the volume's mean luminance (t_1pct_mean_s):\n"
            "            bench=path case=wdas_cloud_sixteenth.vdb background=vacuum size=256x256 spp=16 ...\n"
-           "          --no-forced and --no-sky-nee turn off the forced single scattering of camera rays and\n"
-           "          next-event estimation toward the sky (docs/path.md), to measure what they gain.\n");
+           "          --no-forced, --no-sky-nee and --no-aureole turn off the forced single scattering of\n"
+           "          camera rays, next-event estimation toward the sky and the aureole estimate\n"
+           "          (docs/path.md), to measure what they gain.\n");
 }
 
 static double now_s(void)
@@ -454,6 +455,7 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     ps.spp = spp;
     ps.no_forced = flags->no_forced;
     ps.no_sky_nee = flags->no_sky_nee;
+    ps.no_aureole = flags->no_aureole;
     atmos_slice_optics optics;
     double t0 = now_s();
     atmos_status st = atmos_path_optics_build(ctx, &scene, v, &optics);
@@ -503,12 +505,12 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     rel = cnt ? rel / cnt : 0;
     double relm = sumY > 0 ? sqrt(sumV) / sumY : 0;
     const double t = stats.trace_s;
-    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g%s%s paths_per_s=%.4g "
+    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g%s%s%s paths_per_s=%.4g "
            "events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g events_per_path=%.2f trace_s=%.3f "
            "prepare_s=%.3f optics_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f t_1pct_pixel_s=%.4g mean_rel_se=%.3g "
            "t_1pct_mean_s=%.3g\n",
            name, vacuum ? "vacuum" : "sky", size, size, stats.spp, atmos_context_threads(ctx), dscale,
-           ps.no_forced ? " no_forced=1" : "", ps.no_sky_nee ? " no_sky_nee=1" : "", stats.paths / t, stats.events / t, stats.tentative / t, stats.shadow_rays / t,
+           ps.no_forced ? " no_forced=1" : "", ps.no_sky_nee ? " no_sky_nee=1" : "", ps.no_aureole ? " no_aureole=1" : "", stats.paths / t, stats.events / t, stats.tentative / t, stats.shadow_rays / t,
            (double)stats.events / (double)stats.paths, t, stats.prepare_s, t_opt, cnt, rel, t * (rel / 0.01) * (rel / 0.01),
            relm, t * (relm / 0.01) * (relm / 0.01));
     fflush(stdout);
@@ -572,7 +574,7 @@ int cli_cmd_bench(int argc, char **argv)
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16;
     double dscale = 0, eye_scale = 0;
     const char *what = NULL, *presets = NULL, *file = NULL;
-    atmos_path_settings pflags; /* only no_forced and no_sky_nee are read */
+    atmos_path_settings pflags; /* only the no_* switches are read */
     memset(&pflags, 0, sizeof pflags);
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -595,6 +597,8 @@ int cli_cmd_bench(int argc, char **argv)
             pflags.no_forced = 1;
         } else if (!strcmp(argv[i], "--no-sky-nee")) {
             pflags.no_sky_nee = 1;
+        } else if (!strcmp(argv[i], "--no-aureole")) {
+            pflags.no_aureole = 1;
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {

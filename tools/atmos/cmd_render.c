@@ -65,7 +65,9 @@ static void help(void)
            "      --no-sky-nee              path: no next-event estimation toward the sky (same mean,\n"
            "                                more noise; for comparisons)\n"
            "      --no-forced               path: no forced single scattering on camera rays (same\n"
-           "                                mean, more noise in thin media; for comparisons)\n\n"
+           "                                mean, more noise in thin media; for comparisons)\n"
+           "      --no-aureole              path: no aureole estimate in droplet clouds (same mean,\n"
+           "                                more fireflies; for comparisons)\n\n"
            "Animation (the sun moves; the volume and its optics tables are prepared once):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
            "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
@@ -132,7 +134,7 @@ enum {
     O_DSCALE, O_EQ24, O_LOWALB, O_TAU, O_TBUDGET, O_SEED, O_VARIANCE, O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER,
     O_TRUNCATE
 };
-enum { O_EYESCALE = 512, O_NOSKYNEE, O_NOFORCED }; /* slice renderer options added later */
+enum { O_EYESCALE = 512, O_NOSKYNEE, O_NOFORCED, O_NOAUREOLE }; /* slice renderer options added later */
 
 /* The volume's optical depth along each pixel's ray at the middle wavelength of the
  * set, as a 1-channel PFM (the optics come from the cache the render just filled). */
@@ -204,6 +206,7 @@ int cli_cmd_render(int argc, char **argv)
         {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
         {"order", required_argument, 0, O_ORDER}, {"truncate", required_argument, 0, O_TRUNCATE},
         {"no-sky-nee", no_argument, 0, O_NOSKYNEE}, {"no-forced", no_argument, 0, O_NOFORCED},
+        {"no-aureole", no_argument, 0, O_NOAUREOLE},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     const char *C = "render";
     const char *png = NULL, *exr = NULL, *pfm = NULL;
@@ -222,7 +225,7 @@ int cli_cmd_render(int argc, char **argv)
     /* The path tracer (path.h): these override the scene's "path". */
     double tbudget = 0, truncate = NAN;
     unsigned long long seed = 0;
-    int seed_given = 0, no_sky_nee = 0, no_forced = 0;
+    int seed_given = 0, no_sky_nee = 0, no_forced = 0, no_aureole = 0;
     const char *variance_out = NULL, *order_out = NULL;
     atmos_image *var_img = NULL, *order_img = NULL;
     atmos_path_stats pstats;
@@ -327,6 +330,7 @@ int cli_cmd_render(int argc, char **argv)
             break;
         case O_NOSKYNEE: no_sky_nee = 1; break;
         case O_NOFORCED: no_forced = 1; break;
+        case O_NOAUREOLE: no_aureole = 1; break;
         case 'q': quiet = 1; break;
         case 'h': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
@@ -440,10 +444,10 @@ int cli_cmd_render(int argc, char **argv)
         if (tbudget > 0) scene.path.time_budget_s = tbudget;
         if (seed_given) scene.path.seed = seed;
         if (!isnan(truncate)) scene.path.truncate_deg = truncate;
-    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out || order_out || !isnan(truncate) || no_sky_nee || no_forced) {
+    } else if (spp > 256 || tbudget > 0 || seed_given || variance_out || order_out || !isnan(truncate) || no_sky_nee || no_forced || no_aureole) {
         atmos_context_destroy(ctx);
         return cli_usage_error(C, spp > 256 ? "--spp: must be in [1, 256] for this renderer (1..1000000 with --renderer path)"
-                                            : "--time-budget, --seed, --variance, --order, --truncate, --no-sky-nee and --no-forced go with --renderer path");
+                                            : "--time-budget, --seed, --variance, --order, --truncate and --no-* go with --renderer path");
     } else if (spp) {
         scene.samples_per_pixel = spp;
     }
@@ -531,6 +535,7 @@ int cli_cmd_render(int argc, char **argv)
             ps.stats = &pstats;
             ps.no_sky_nee = no_sky_nee;
             ps.no_forced = no_forced;
+            ps.no_aureole = no_aureole;
             if ((st = atmos_render_path(ctx, &fs, vol, &ps, &spec, &info)) != ATMOS_OK) goto fail;
         } else if ((st = atmos_render_sky(ctx, &fs, &spec, &info)) != ATMOS_OK) {
             goto fail;
