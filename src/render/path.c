@@ -45,6 +45,10 @@
 #include <string.h>
 #include <time.h>
 
+/* Majorant optical depth of a camera ray's crossing of the box up to which it uses forced
+ * single scattering. */
+#define FORCED_TAU_MAX 2.0
+
 static double now_seconds(void)
 {
     struct timespec ts;
@@ -477,22 +481,29 @@ static void aureole(const path_job *J, const path_bundle *b, const double p[3], 
 }
 
 /* Forced single scattering on a camera ray's crossing [t0, t1] of the volume's box (index
- * space q + t qd, world p + t d): one point drawn in proportion to the majorant, where the
+ * space q + t qd, world p + t d): one point drawn by the majorant (half the time as the
+ * first tentative collision forced into the crossing, half uniformly in its optical
+ * depth: atmos__path_majorant_point), where the
  * lights are estimated with weights w sigma_s T_view / pdf (T_view by ratio tracking). It
  * replaces next-event estimation at the first free-flight event of camera paths, so in thin
  * media every camera ray that crosses the volume estimates its single scattering, instead
- * of the few that happen to collide. */
-static void forced_single(const path_job *J, const path_bundle *b, const double p[3], const double d[3],
-                          const double q[3], const double qd[3], double t0, double t1, const double *w, double *L,
-                          double *Lo, path_rng *r, path_counts *cnt)
+ * of the few that happen to collide. Only on crossings whose majorant optical depth is at
+ * most FORCED_TAU_MAX (a function of the ray, so each ray keeps one consistent estimator):
+ * in dense media the free flight's collisions, drawn in proportion to sigma T, are better.
+ * Returns 1 if it made the estimate (the first event's next-event estimates are then
+ * left out). */
+static int forced_single(const path_job *J, const path_bundle *b, const double p[3], const double d[3],
+                         const double q[3], const double qd[3], double t0, double t1, const double *w, double *L,
+                         double *Lo, path_rng *r, path_counts *cnt)
 {
     double t, pdf;
-    if (!atmos__path_majorant_point(J->med, q, qd, t0, t1, b, path_u(r), &t, &pdf)) return;
+    const double u0 = path_u(r), u1 = path_u(r);
+    if (!atmos__path_majorant_point(J->med, q, qd, t0, t1, b, FORCED_TAU_MAX, u0, u1, &t, &pdf)) return 0;
     float dens[PATH_F];
     atmos__path_density(J->med, q[0] + t * qd[0], q[1] + t * qd[1], q[2] + t * qd[2], dens);
     path_scatter e;
     int g[PATH_B];
-    if (!scatter_at(J, b, dens, &e, g)) return;
+    if (!scatter_at(J, b, dens, &e, g)) return 1;
     const int m = b->m;
     double T[PATH_B], c[PATH_B], S[PATH_B], E[PATH_B];
     atmos__path_transmittance(J->med, q, qd, t0, t, b, r, T);
@@ -502,13 +513,14 @@ static void forced_single(const path_job *J, const path_bundle *b, const double 
         c[i] = w[i] * T[i] * e.ss[i] / pdf;
         any |= c[i] > 0;
     }
-    if (!any) return;
+    if (!any) return 1;
     const double x[3] = {p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]};
     if (J->sky) air_transmit(J, b, p[1] + t0 * d[1], d, t - t0, c);
     sunlight(J, b, x[1], E);
     /* the continuation's share: as if the roulette always let it go on (the first event's
      * continuations use that too), unless no path goes on after one event */
     nee(J, b, x, d, c, &e, S, g, J->max_depth == 1 ? 0.0 : 1.0, sun_lit(J, b, c, E) ? E : NULL, 1.0, 1, L, Lo, r, cnt);
+    return 1;
 }
 
 /* One camera path through world ray (o, d); adds the radiance of the carried
@@ -543,7 +555,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             }
             double t, ws[PATH_B];
             memcpy(ws, w, sizeof ws);
-            if (J->forced && primary) forced_single(J, b, p, d, q, qd, t0, t1, w, L, Lo, r, cnt);
+            const int forced = J->forced && primary && forced_single(J, b, p, d, q, qd, t0, t1, w, L, Lo, r, cnt);
             int ev = atmos__path_free_flight(J->med, q, qd, t0, t1, b, w, r, &t, dens, &cnt->tentative);
             if (J->sky) {
                 /* The air inside the box: its light (shadowed by the volume) over the whole
@@ -574,7 +586,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                     for (int i = 0; i < m; i++)
                         if (w[i] > q_rr) q_rr = w[i];
                 if (q_rr > 1) q_rr = 1;
-                const int first = J->forced && primary; /* its lights were estimated by forced_single() */
+                const int first = forced; /* its lights were estimated by forced_single() */
                 const double q_mis = first ? (J->max_depth == 1 ? 0.0 : 1.0) : q_rr;
                 double E[PATH_B];
                 sunlight(J, b, p[1], E);

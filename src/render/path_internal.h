@@ -96,11 +96,14 @@ int atmos__path_free_flight(const path_medium *m, const double q[3], const doubl
 void atmos__path_transmittance(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
                                const path_bundle *b, path_rng *r, double *T);
 
-/* A point of [t0, t1] drawn with density proportional to the majorant of the carried
- * wavelengths (u uniform in [0, 1)): *t and its density *pdf (per metre). 0 if the
- * majorant is 0 all along. */
+/* A point of [t0, t1] for forced single scattering, by the majorant mu of the carried
+ * wavelengths: with u0 < 0.5 the first tentative collision conditioned to lie in [t0, t1]
+ * (density mu e^-tau_mu(t) / (1 - e^-tau_mu(t1)): good in dense media), else uniform in
+ * majorant optical depth (mu / tau_mu(t1): good in thin ones); *pdf is the mixture's
+ * density (per metre), u uniform in [0, 1). 0 if the majorant is 0 all along or its optical
+ * depth over [t0, t1] exceeds tau_max. */
 int atmos__path_majorant_point(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
-                               const path_bundle *b, double u, double *t, double *pdf);
+                               const path_bundle *b, double tau_max, double u0, double u, double *t, double *pdf);
 
 /* Scaled densities at an index-space point (0 outside the grid). */
 void atmos__path_density(const path_medium *m, double x, double y, double z, float *dens);

@@ -277,7 +277,7 @@ static inline double cell_majorant(const path_medium *m, const path_dda *g, cons
 }
 
 int atmos__path_majorant_point(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
-                               const path_bundle *b, double u, double *tout, double *pdf)
+                               const path_bundle *b, double tau_max, double u0, double u, double *tout, double *pdf)
 {
     path_dda g;
     double total = 0;
@@ -290,8 +290,11 @@ int atmos__path_majorant_point(const path_medium *m, const double q[3], const do
         t = te;
         if (!dda_step(m, &g)) break;
     }
-    if (!(total > 0)) return 0;
-    const double target = u * total;
+    if (!(total > 0) || total > tau_max) return 0;
+    /* the majorant optical depth from t0 to the point: the first tentative collision forced
+     * into the crossing, or uniform in optical depth */
+    const double A = -expm1(-total);
+    const double target = u0 < 0.5 ? -log1p(-u * A) : u * total;
     double acc = 0;
     dda_init(m, q, qd, t0, &g);
     for (double t = t0;;) {
@@ -301,14 +304,14 @@ int atmos__path_majorant_point(const path_medium *m, const double q[3], const do
         if (mu > 0 && acc + mu * (te - t) > target) {
             double x = t + (target - acc) / mu;
             *tout = x < te ? x : te;
-            *pdf = mu / total;
+            *pdf = 0.5 * mu * exp(-target) / A + 0.5 * mu / total;
             return 1;
         }
         acc += mu * (te - t);
         if (te >= t1 || !dda_step(m, &g)) break;
         t = te;
     }
-    return 0; /* rounding: u * total beyond the sum of the second pass */
+    return 0; /* rounding: the target beyond the sum of the second pass */
 }
 
 int atmos__path_free_flight(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
