@@ -1,10 +1,12 @@
 #!/bin/sh
-# Installs the Debian packages atmos needs to build and test, if any are missing.
+# Installs the Debian packages atmos needs to build and test, if any are missing; with
+# arguments, those packages instead (scripts/install-bench-deps.sh).
 # Safe to run repeatedly: it does nothing when everything is present.
 set -eu
 # Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
 # its headers include, which Debian does not pull in); gnuplot for 'atmos phase --plot'.
 PKGS="build-essential cmake pkg-config libpng-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3"
+[ $# -gt 0 ] && PKGS="$*"
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
