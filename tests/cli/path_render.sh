@@ -1,6 +1,6 @@
 #!/bin/sh
 # atmos render --renderer path through the CLI: a tiny image of a generated cumulus, the same
-# bytes for 1 and 2 threads (also with --truncate), the --variance and --order outputs,
+# bytes for 1 and 2 threads (also with --truncate and each --no-* switch), the --variance and --order outputs,
 # --time-budget, bad values.
 set -u
 A=${ATMOS_CLI:?ATMOS_CLI not set}
@@ -23,6 +23,14 @@ cmp -s "$T/c.pfm" "$T/d.pfm" && ok || bad "--truncate: 1 and 2 threads differ"
 cmp -s "$T/a.pfm" "$T/c.pfm" && bad "--truncate 3 changed nothing" || ok
 "$A" render -q $P --threads 2 --truncate 0 --pfm "$T/e.pfm" && ok || bad "path render --truncate 0"
 cmp -s "$T/a.pfm" "$T/e.pfm" && ok || bad "--truncate 0 differs from the default"
+# the --no-* switches: each changes the image (another estimator), each stays thread-independent
+for sw in --no-sky-nee --no-forced --no-aureole; do
+    "$A" render -q $P --threads 1 $sw --pfm "$T/s1.pfm" && ok || bad "path render $sw, 1 thread"
+    "$A" render -q $P --threads 2 $sw --pfm "$T/s2.pfm" && ok || bad "path render $sw, 2 threads"
+    cmp -s "$T/s1.pfm" "$T/s2.pfm" && ok || bad "$sw: 1 and 2 threads differ"
+    cmp -s "$T/a.pfm" "$T/s1.pfm" && bad "$sw changed nothing" || ok
+    "$A" render -q $sw -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "$sw without --renderer path should exit 2"
+done
 [ -s "$T/var.exr" ] && ok || bad "--variance file not written"
 python3 - "$T/b.pfm" "$T/order.pfm" <<'PY' && ok || bad "image / order check"
 import math, struct, sys
