@@ -325,6 +325,22 @@ static int scatter_at(const path_job *J, const path_bundle *b, const float *dens
     return ne;
 }
 
+/* A field for a new direction of wavelength j: in proportion to its share of the scattering
+ * there (no random number with one field). */
+static int pick_field(const path_scatter *e, int j, int nf, path_rng *r)
+{
+    int f = 0;
+    if (nf > 1) {
+        double u = path_u(r) * e->ss[j], acc = 0;
+        for (f = 0; f < nf - 1; f++) {
+            acc += e->ssf[f][j];
+            if (u < acc) break;
+        }
+        while (f > 0 && e->ssf[f][j] <= 0) f--;
+    }
+    return f;
+}
+
 /* Does the sun (sunlight E) light anything the weights w carry? */
 static int sun_lit(const path_job *J, const path_bundle *b, const double *w, const double *E)
 {
@@ -343,38 +359,43 @@ static int sun_lit(const path_job *J, const path_bundle *b, const double *w, con
  * balance heuristic, whose density there is q (its survival probability) times the
  * strategies' mean density; the sun's part is further weighted by hs, the share of the
  * path's own strategies against the aureole estimate made at the previous event. */
+static void nee_sun(const path_job *J, const path_bundle *b, const double p[3], const double d[3], const double *w,
+                    const path_scatter *e, const double *S, const int *g, double q, const double *E, double hs,
+                    int order, double *L, double *Lo, path_rng *r, path_counts *cnt)
+{
+    const int m = b->m;
+    double pk[PATH_B], T[PATH_B], ds[3];
+    sample_sun(J, r, ds);
+    phase_mix(J->ph, b, J->med->nf, e, dot3(d, ds), pk);
+    const double pdir = strategies(m, S, g, pk, NULL);
+    int any = 0;
+    for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
+    if (!any) return;
+    const double wm = mis_nee(J, q * pdir) * hs;
+    shadow(J, b, p, ds, r, T, cnt);
+    for (int i = 0; i < m; i++) {
+        const double c = w[i] * pk[i] * E[i] * T[i] * wm;
+        L[i] += c, Lo[i] += order * c;
+    }
+}
+
 static void nee(const path_job *J, const path_bundle *b, const double p[3], const double d[3], const double *w,
                 const path_scatter *e, const double *S, const int *g, double q, const double *E, double hs, int order,
                 double *L, double *Lo, path_rng *r, path_counts *cnt)
 {
-    const int m = b->m, nf = J->med->nf;
+    const int m = b->m;
     double pk[PATH_B], T[PATH_B];
-    if (E) {
-        double ds[3];
-        sample_sun(J, r, ds);
-        phase_mix(J->ph, b, nf, e, dot3(d, ds), pk);
-        const double pdir = strategies(m, S, g, pk, NULL);
-        int any = 0;
-        for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
-        if (any) {
-            const double wm = mis_nee(J, q * pdir) * hs;
-            shadow(J, b, p, ds, r, T, cnt);
-            for (int i = 0; i < m; i++) {
-                const double c = w[i] * pk[i] * E[i] * T[i] * wm;
-                L[i] += c, Lo[i] += order * c;
-            }
-        }
-    }
-    if (J->env) {
+    if (E) nee_sun(J, b, p, d, w, e, S, g, q, E, hs, order, L, Lo, r, cnt);
+    if (J->env) { /* the sky (J->env exists only with the sky background) */
         double de[3];
         const double pe = atmos__path_env_sample(J->env, path_u(r), path_u(r), path_u(r), de);
-        phase_mix(J->ph, b, nf, e, dot3(d, de), pk);
+        phase_mix(J->ph, b, J->med->nf, e, dot3(d, de), pk);
         const double pdir = strategies(m, S, g, pk, NULL);
         int any = 0;
         for (int i = 0; i < m; i++) any |= w[i] * pk[i] > 0;
         if (!any || !(pe > 0)) return;
         const double wm = pe / (pe + q * pdir);
-        const double Kd = J->sky ? atmos_sky_ground_distance(p[1], de) : INFINITY;
+        const double Kd = atmos_sky_ground_distance(p[1], de);
         double q2[3], qd2[3], a0, a1, ex = 0, c[PATH_B];
         for (int i = 0; i < m; i++) T[i] = 1;
         atmos__path_to_index(J->med, p, de, q2, qd2);
@@ -388,12 +409,7 @@ static void nee(const path_job *J, const path_bundle *b, const double p[3], cons
             c[i] = w[i] * pk[i] * T[i] / pe * wm;
             on |= c[i] > 0;
         }
-        if (on && !J->sky) { /* a uniform background */
-            for (int i = 0; i < m; i++) {
-                const double v = c[i] * J->bg;
-                L[i] += v, Lo[i] += order * v;
-            }
-        } else if (on && ex < Kd) {
+        if (on && ex < Kd) {
             air_transmit(J, b, p[1], de, ex, c);
             const double px[3] = {p[0] + ex * de[0], p[1] + ex * de[1], p[2] + ex * de[2]};
             air_scatter(J, b, px, de, Kd - ex, c, 1.0, L, Lo, order, NULL, r, cnt);
@@ -436,15 +452,7 @@ static void aureole(const path_job *J, const path_bundle *b, const double p[3], 
     for (int i = 0; i < m; i++)
         if (e->ss[i] > 0) elig[ne++] = i;
     if (!ne) return;
-    int j = elig[ne > 1 ? (int)(path_u(r) * ne) % ne : 0], f = 0;
-    if (nf > 1) {
-        double u = path_u(r) * e->ss[j], acc = 0;
-        for (f = 0; f < nf - 1; f++) {
-            acc += e->ssf[f][j];
-            if (u < acc) break;
-        }
-        while (f > 0 && e->ssf[f][j] <= 0) f--;
-    }
+    const int j = elig[ne > 1 ? (int)(path_u(r) * ne) % ne : 0], f = pick_field(e, j, nf, r);
     double a[3], pk[PATH_B], wa[PATH_B];
     around(J->sun, atmos__path_phase_sample(P, f, b->k[j], path_u(r)), 2.0 * ATMOS_PI * path_u(r), a);
     phase_mix(P, b, nf, e, dot3(d, a), pk);
@@ -465,19 +473,12 @@ static void aureole(const path_job *J, const path_bundle *b, const double p[3], 
     path_scatter e2;
     int g2[PATH_B];
     if (!scatter_at(J, b, dens, &e2, g2)) return;
-    double x[3], E[PATH_B], ds[3], T[PATH_B];
+    double x[3], E[PATH_B], S2[PATH_B];
     for (int k = 0; k < 3; k++) x[k] = p[k] + t * a[k];
+    for (int i = 0; i < m; i++) S2[i] = 1;
     sunlight(J, b, x[1], E);
-    sample_sun(J, r, ds);
-    phase_mix(P, b, nf, &e2, dot3(a, ds), pk);
-    any = 0;
-    for (int i = 0; i < m; i++) any |= wa[i] * pk[i] * E[i] > 0;
-    if (!any) return;
-    shadow(J, b, x, ds, r, T, cnt);
-    for (int i = 0; i < m; i++) {
-        const double c = wa[i] * pk[i] * E[i] * T[i];
-        L[i] += c, Lo[i] += (order + 1) * c;
-    }
+    /* the whole disk by next-event estimation (q = 0: no continuation shares it) */
+    nee_sun(J, b, x, a, wa, &e2, S2, g2, 0.0, E, 1.0, order + 1, L, Lo, r, cnt);
 }
 
 /* Forced single scattering on a camera ray's crossing [t0, t1] of the volume's box (index
@@ -576,7 +577,6 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 path_scatter ev_s;
                 int g[PATH_B];
                 const int ne = scatter_at(J, b, dens, &ev_s, g);
-                const double(*ssf)[PATH_B] = ev_s.ssf, *ss = ev_s.ss;
                 /* Can the path go on from here (depth limit), and with which probability
                  * does it survive the roulette below: the continuation's share of the
                  * multiple importance sampling of the sun. */
@@ -605,15 +605,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                     if (hero >= m) hero = m - 1;
                 }
                 const int j = g[hero];
-                int f = 0;
-                if (nf > 1) {
-                    double u = path_u(r) * ss[j], acc = 0;
-                    for (f = 0; f < nf - 1; f++) {
-                        acc += ssf[f][j];
-                        if (u < acc) break;
-                    }
-                    while (f > 0 && ssf[f][j] <= 0) f--;
-                }
+                const int f = pick_field(&ev_s, j, nf, r);
                 double mu = atmos__path_phase_sample(P, f, b->k[j], path_u(r));
                 double nd[3];
                 around(d, mu, 2.0 * ATMOS_PI * path_u(r), nd);

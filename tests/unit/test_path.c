@@ -233,6 +233,21 @@ static double sun_e(atmos_context *ctx, const atmos_scene *s, int k)
 
 /* ------------------------------------------------------------------ the slab */
 
+/* The slab seen from just above (side 0) or below (side 1) by an equirectangular camera:
+ * the hemispherical flux of the rendered radiance per unit sun irradiance E, *f +- *se. */
+static void slab_flux(atmos_context *ctx, atmos_scene *s, const atmos_volume *v, const optics *op, int side, int spp,
+                      double E, double *f, double *se)
+{
+    double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s->camera);
+    atmos_image *var = NULL;
+    atmos_image *img = render(ctx, s, v, op, spp * (long_run ? 16 : 1), 0, &var);
+    CHECK(all_finite(img));
+    hemi_flux(img, var, 1, side == 0, E, f, se);
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+}
+
 static void test_slab(atmos_context *ctx)
 {
     const double taus[3] = {0.5, 2, 8};
@@ -248,22 +263,14 @@ static void test_slab(atmos_context *ctx)
         s.width = 4, s.height = 256;
         double E = sun_e(ctx, &s, 1);
         for (int side = 0; side < 2; side++) {
-            double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
-            atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
-            atmos_image *var = NULL;
-            atmos_image *img = render(ctx, &s, v, &op, spp[i] * (long_run ? 16 : 1), 0, &var);
-            if (!img || !var) continue;
-            CHECK(all_finite(img));
             double f, se;
-            hemi_flux(img, var, 1, side == 0, E, &f, &se);
+            slab_flux(ctx, &s, v, &op, side, spp[i], E, &f, &se);
             double ref = side == 0 ? ad.refl : ad.trans;
             double z = (f - ref) / se;
             printf("slab g=0.85 tau=%g %s: path %.5f +- %.5f, adding-doubling %.5f (%+.2f sigma, rel SE %.2f%%)\n",
                    taus[i], side == 0 ? "R" : "T", f, se, ref, z, 100 * se / ref);
             CHECK_MSG(fabs(z) < 3.0, "tau %g %s: %.5f vs %.5f (%.2f standard errors)", taus[i], side ? "T" : "R", f, ref, z);
             CHECK(se < 0.02 * ref); /* the test has teeth */
-            atmos_image_destroy(img);
-            atmos_image_destroy(var);
         }
         atmos_volume_destroy(v);
     }
@@ -298,19 +305,13 @@ static void test_big_sun(atmos_context *ctx)
     s.width = 4, s.height = 128;
     double E = sun_e(ctx, &s, 1);
     for (int side = 0; side < 2; side++) {
-        double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
-        atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
-        atmos_image *var = NULL;
-        atmos_image *img = render(ctx, &s, v, &op, (side == 0 ? 2048 : 256) * (long_run ? 16 : 1), 0, &var);
         double f, se;
-        hemi_flux(img, var, 1, side == 0, E, &f, &se);
+        slab_flux(ctx, &s, v, &op, side, side == 0 ? 2048 : 256, E, &f, &se);
         double z = (f - ref[side]) / se;
         printf("slab g=0.9 tau=1 sun 20 deg %s: path %.5f +- %.5f, adding-doubling over the disk %.5f (%+.2f sigma)\n",
                side == 0 ? "R" : "T", f, se, ref[side], z);
         CHECK_MSG(fabs(z) < 3.0, "big sun %s: %.5f vs %.5f (%.2f standard errors)", side ? "T" : "R", f, ref[side], z);
         CHECK(se < 0.025 * ref[side]);
-        atmos_image_destroy(img);
-        atmos_image_destroy(var);
     }
     atmos_volume_destroy(v);
     atmos_phase_table_destroy(op.t);
@@ -357,12 +358,7 @@ static void slab_vs_ad(atmos_context *ctx, double w1, double g1, double g2, doub
     const double E = sun_e(ctx, &s, 1);
     double val[2], se[2];
     for (int side = 0; side < 2; side++) {
-        double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
-        atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
-        atmos_image *var = NULL;
-        atmos_image *img = render(ctx, &s, v, &op, spp[side] * (long_run ? 16 : 1), 0, &var);
-        CHECK(all_finite(img));
-        hemi_flux(img, var, 1, side == 0, E, &val[side], &se[side]);
+        slab_flux(ctx, &s, v, &op, side, spp[side], E, &val[side], &se[side]);
         if (side == 1) val[1] += direct;
         /* allowance for the approximation: 1.5 % of R, 0.5 % of T_total (measured: docs/path.md) */
         const double z = (val[side] - ref[side]) / se[side];
@@ -374,8 +370,6 @@ static void slab_vs_ad(atmos_context *ctx, double w1, double g1, double g2, doub
         CHECK_MSG(fabs(val[side] - ref[side]) < 3 * se[side] + allow, "%s: %.5f vs %.5f", side ? "T" : "R", val[side],
                   ref[side]);
         CHECK(se[side] < 0.02 * ref[side]);
-        atmos_image_destroy(img);
-        atmos_image_destroy(var);
     }
     /* energy: nothing is absorbed */
     const double sum = val[0] + val[1], sse = sqrt(se[0] * se[0] + se[1] * se[1]);
