@@ -3,14 +3,15 @@
 # (before and after a change that must not change images) can be compared byte for byte:
 #
 #   bench/regress/run.sh BIN OUT_DIR              render every case with BIN into OUT_DIR
-#   bench/regress/run.sh --compare DIR_A DIR_B    per case: identical, or the largest
+#   bench/regress/run.sh --compare DIR_A DIR_B    per PFM: identical, or the largest
 #                                                 relative difference (atmos compare)
 #
 # The cases: the built-in default scene, every scenes/*.json (first frame, at most 320
 # pixels wide), the accuracy cases of bench/accuracy (sun behind and in front; slice
 # renderer in five variants, path tracer at 8 spp exact and truncated with its variance
 # and order images), and a few more settings (spectral, eye_scale 0.5, sky-only path,
-# vacuum backgrounds). Every case writes a PFM (linear sRGB floats) and a PNG.
+# vacuum backgrounds). Every case writes a PFM (linear sRGB floats) and a PNG; only the
+# PFMs are compared (PNG and EXR files carry the render time in their metadata).
 # Scenes whose volume file is missing are skipped (listed). THREADS sets --threads.
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
@@ -20,7 +21,7 @@ if [ "${1:-}" = "--compare" ]; then
     A=$2 B=$3
     BIN=${ATMOS:-$root/build/atmos}
     same=0 diff=0 missing=0
-    for f in "$A"/*.pfm "$A"/*.png "$A"/*.exr; do
+    for f in "$A"/*.pfm; do
         [ -e "$f" ] || continue
         n=$(basename "$f")
         if [ ! -e "$B/$n" ]; then echo "missing  $n"; missing=$((missing + 1)); continue; fi

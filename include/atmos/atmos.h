@@ -112,9 +112,9 @@ ATMOS_API atmos_status atmos_copy_file_atomic(atmos_context *ctx, const char *sr
 #include "atmos/sky.h"
 #include "atmos/image.h"
 #include "atmos/optics.h"
+#include "atmos/volume.h"
 #include "atmos/scene.h"
 #include "atmos/render.h"
-#include "atmos/volume.h"
 #include "atmos/slice.h"
 #include "atmos/path.h"
 

@@ -22,6 +22,8 @@ typedef struct atmos_complex {
 
 /* ---------------------------------------------------------------- analytic phase functions */
 
+/* Riley et al. 2004 Eq. 1: the Rayleigh phase function of air molecules, 3/(16 pi)(1 + mu^2), sr^-1. */
+ATMOS_API double atmos_phase_rayleigh(double cos_theta);
 /* Henyey-Greenstein (Harris 2002 Eq. 4, here normalised over the sphere:
  * (1 - g^2) / (4 pi (1 + g^2 - 2 g mu)^1.5)), g in (-1, 1). */
 ATMOS_API double atmos_phase_hg(double cos_theta, double g);

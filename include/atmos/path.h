@@ -68,7 +68,7 @@ typedef struct atmos_path_settings {
                               approximation: changes radiances within ~theta_c of the forward
                               direction (the sun's aureole), removes the droplets' fireflies. */
     double offset_m[3];    /* added to the volume's world position (as atmos_slice_settings) */
-    const atmos_slice_optics *optics; /* NULL: built inside the render (only the phase tables
+    const atmos_volume_optics *optics; /* NULL: built inside the render (only the phase tables
                                          are read; the Ams tables are not needed) */
     atmos_image **variance; /* optional output: per pixel the variance of the pixel's mean
                                radiance at each wavelength ((W m^-2 sr^-1 nm^-1)^2), then, in
@@ -100,11 +100,6 @@ ATMOS_API void atmos_path_defaults(atmos_path_settings *s);
 ATMOS_API atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
                                          const atmos_path_settings *settings, atmos_image **out,
                                          atmos_render_info *info);
-
-/* Builds only the phase tables of the volume's fields (no Ams tables), enough for the
- * path tracer; free with atmos_slice_optics_free. */
-ATMOS_API atmos_status atmos_path_optics_build(atmos_context *ctx, const atmos_scene *scene,
-                                               const atmos_volume *volume, atmos_slice_optics *out);
 
 #ifdef __cplusplus
 }

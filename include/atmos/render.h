@@ -25,9 +25,12 @@ ATMOS_API atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *s
 ATMOS_API atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral,
                                            const atmos_wavelengths *wl, atmos_image **out);
 
-/* The wavelength set a scene asks for. */
-ATMOS_API atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_scene *scene,
-                                               atmos_wavelengths *out);
+/* The optical depth of the volume (moved by offset_m) along the ray through each pixel
+ * centre of the scene's camera, with extinction cross-sections sigma_ext[field] (m^2,
+ * densities already scaled): a 1-channel image, for error analyses by depth. */
+ATMOS_API atmos_status atmos_render_optical_depth(atmos_context *ctx, const atmos_scene *scene,
+                                                  const atmos_volume *volume, const double *sigma_ext,
+                                                  const double offset_m[3], atmos_image **out);
 
 #ifdef __cplusplus
 }

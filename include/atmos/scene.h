@@ -143,12 +143,48 @@ ATMOS_API atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scen
 ATMOS_API atmos_status atmos_scene_particle(atmos_context *ctx, const atmos_scene *scene, const char *name,
                                             atmos_particle_desc *out);
 
+/* The optics of a scene's volume: for field i, phase[i] (sigma_ext, albedo and P(theta) per
+ * wavelength of the scene's set) and, when built with them, ms[i] (the multiple-scattering
+ * phase functions Ams_n and forward fractions F_n, Riley et al. 2004 Eq. 20-23). */
+typedef struct atmos_volume_optics {
+    int count;
+    const atmos_phase_table *phase[ATMOS_VOLUME_MAX_FIELDS];
+    const atmos_msphase *ms[ATMOS_VOLUME_MAX_FIELDS]; /* NULL when built without them */
+    int owned; /* set by atmos_volume_optics_build: atmos_volume_optics_free destroys the tables */
+} atmos_volume_optics;
+
+/* Builds (or loads from the disk cache) the phase table of every field of the volume, and
+ * with with_msphase its Ams_n tables (64 orders), for the particle type named by
+ * atmos_volume_field_particle() looked up with atmos_scene_particle() (a scene-defined type
+ * or a preset), for the scene's wavelength set. Reports progress through ctx. Free with
+ * atmos_volume_optics_free(). */
+ATMOS_API atmos_status atmos_volume_optics_build(atmos_context *ctx, const atmos_scene *scene,
+                                                 const atmos_volume *volume, int with_msphase,
+                                                 atmos_volume_optics *out);
+/* Destroys the tables if owned; zeroes *o. NULL does nothing. */
+ATMOS_API void atmos_volume_optics_free(atmos_volume_optics *o);
+
+/* Loads or generates the volume a scene names (scene->volume: file, grids, particle, time
+ * index, voxel size; generator, seed, scale) and computes offset_m, the shift that places
+ * it in the world (atmos_scene_volume_offset). The scene's density_scale is not applied
+ * here (the renderers apply it). */
+ATMOS_API atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
+                                               double offset_m[3]);
+/* The shift that places a volume in a scene's world: position_m puts the centre of the
+ * box's bottom face there; without it the box's centre is moved horizontally to three of
+ * its widths (at least 4 km) in front of the scene's camera, at its own altitude. */
+ATMOS_API void atmos_scene_volume_offset(const atmos_scene *scene, const atmos_volume *volume, double offset_m[3]);
+
 /* Frame index (0-based, < the frame count) of the scene's animation: *out is the scene
  * with the sun moved as atmos_scene_animation describes and no animation left in it.
  * A scene without an animation has one frame, itself. ATMOS_E_INVALID_ARG for an index
  * out of range or an animation that does not match the sun (checked as the parser does). */
 ATMOS_API atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *scene, int index,
                                                    atmos_scene *out);
+
+/* The wavelength set a scene asks for. */
+ATMOS_API atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_scene *scene,
+                                               atmos_wavelengths *out);
 
 /* The sun's direction (unit vector towards the sun), elevation and azimuth for
  * a scene, computing the solar position when the scene gives a time. */

@@ -79,9 +79,6 @@ ATMOS_API void atmos_sky_sun_radiance(const atmos_sky *sky, double y, const doub
 /* Solid angle of the sun's disk, sr. */
 ATMOS_API double atmos_sky_sun_solid_angle(const atmos_sky *sky);
 
-/* Riley Eq. 1: Rayleigh phase function, sr^-1 (integrates to 1 over the sphere). */
-ATMOS_API double atmos_phase_rayleigh(double cos_theta);
-
 #ifdef __cplusplus
 }
 #endif

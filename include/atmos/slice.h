@@ -22,25 +22,6 @@ typedef enum {
     ATMOS_SLICE_EQ24 = 1  /* the exact product of F_i, at fractional n (atmos_msphase_log_forward_sum) */
 } atmos_slice_update;
 
-/* Optics of the volume's fields: field i of the volume uses phase[i] (for sigma_ext and
- * albedo per wavelength) and ms[i] (Ams_n, F_n). Borrowed pointers; the tables must
- * have the render's wavelength count. */
-typedef struct atmos_slice_optics {
-    int count;
-    const atmos_phase_table *phase[ATMOS_VOLUME_MAX_FIELDS];
-    const atmos_msphase *ms[ATMOS_VOLUME_MAX_FIELDS];
-    int owned; /* set by atmos_slice_optics_build: atmos_slice_optics_free destroys the tables */
-} atmos_slice_optics;
-
-/* Builds (or loads from the disk cache) the phase table and Ams_n of every field of
- * the volume, the particle type named by atmos_volume_field_particle() looked up with
- * atmos_scene_particle() (a scene-defined type or a preset), for the scene's wavelength
- * set. Reports progress through ctx. Free with atmos_slice_optics_free(). */
-ATMOS_API atmos_status atmos_slice_optics_build(atmos_context *ctx, const atmos_scene *scene,
-                                                const atmos_volume *volume, atmos_slice_optics *out);
-/* Destroys the tables if owned; zeroes *o. NULL does nothing. */
-ATMOS_API void atmos_slice_optics_free(atmos_slice_optics *o);
-
 /* Time spent in each stage of the last render (seconds) and the work done. */
 typedef struct atmos_slice_timing {
     double prepare;       /* resampling the volume, tables, per-frame set-up (see setup) */
@@ -70,7 +51,7 @@ typedef struct atmos_slice_settings {
     int max_order;         /* Ams orders tabulated (higher n use the last); default 64, 1..1000 */
     double density_scale;  /* multiplies the volume's densities; 0 = 1 */
     double offset_m[3];    /* added to the volume's world position (placement in a scene) */
-    const atmos_slice_optics *optics; /* NULL = atmos_slice_optics_build inside the render */
+    const atmos_volume_optics *optics; /* NULL = atmos_volume_optics_build inside the render */
     atmos_slice_timing *timing;       /* optional output */
     int reference;         /* nonzero: the plain scalar passes with libm's exp (slow; the fast
                               default differs from it by < 1e-5 relative, docs/slice.md) */

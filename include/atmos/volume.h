@@ -118,24 +118,6 @@ ATMOS_API atmos_status atmos_volume_generate(atmos_context *ctx, const char *pre
                                              const atmos_volume_generate_desc *desc, atmos_volume **out);
 ATMOS_API const char *const *atmos_volume_generator_names(void);
 
-/* ---------------------------------------------------------------- scenes */
-
-/* Loads or generates the volume a scene names (scene->volume: file, grids, particle,
- * time index, voxel size; generator, seed, scale) and computes offset_m, the shift
- * that places it in the world: position_m puts the centre of the box's bottom face
- * there; without it the box's centre is moved horizontally to three of its widths
- * (at least 4 km) in front of the camera, at its own altitude. The scene's
- * density_scale is not applied here (renderers take it as a setting). */
-ATMOS_API atmos_status atmos_volume_load_scene(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
-                                               double offset_m[3]);
-
-/* The optical depth of the volume (moved by offset_m) along the ray through each
- * pixel centre of the scene's camera, with extinction cross-sections sigma_ext[field]
- * (m^2, densities already scaled): a 1-channel image, for error analyses by depth. */
-ATMOS_API atmos_status atmos_volume_optical_depth_image(atmos_context *ctx, const atmos_scene *scene,
-                                                        const atmos_volume *volume, const double *sigma_ext,
-                                                        const double offset_m[3], atmos_image **out);
-
 #ifdef __cplusplus
 }
 #endif

@@ -17,8 +17,15 @@ atmos_status atmos__error(atmos_context *ctx, atmos_status status, const char *f
 void atmos__log(const atmos_context *ctx, atmos_log_level level, const char *fmt, ...) ATMOS_PRINTF(3, 4);
 /* Reports progress; returns nonzero if the caller asked to cancel. */
 int atmos__progress(const atmos_context *ctx, const char *stage, double fraction);
-/* Thread count to use for ctx (>= 1); 1 when ctx is NULL? No: all cores. */
+/* Thread count to use for ctx (>= 1): the context's setting, all cores when ctx is NULL. */
 int atmos__threads(const atmos_context *ctx);
+/* A large buffer that is read at random (render grids, light buffers, per-pixel planes):
+ * 2 MB aligned and, on Linux, backed by transparent huge pages where the system allows
+ * it, so that samples do not pay a page walk per access. Freed with free(); NULL when
+ * out of memory. */
+void *atmos__big_alloc(size_t bytes);
+/* Monotonic wall-clock time in seconds (for timings and time budgets only). */
+double atmos__now(void);
 
 /* Writes through a temporary file in the same directory and renames on success,
  * so no half-written file ever appears under path. write_fn gets the open temporary
@@ -32,11 +39,5 @@ atmos_status atmos__write_atomic_unique(atmos_context *ctx, const char *path, at
 #define ATMOS_PI 3.14159265358979323846
 #define ATMOS_DEG2RAD (ATMOS_PI / 180.0)
 #define ATMOS_RAD2DEG (180.0 / ATMOS_PI)
-
-/* The phase tables (and, with with_msphase, the Ams_n tables) of every field of a volume
- * for a scene's wavelength set (src/render/slice.c); used by the slice renderer and the
- * path tracer. */
-atmos_status atmos__optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
-                                 int with_msphase, atmos_slice_optics *out);
 
 #endif

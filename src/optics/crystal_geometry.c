@@ -10,6 +10,7 @@
  * energy is accounted for exactly (no Russian roulette noise in the energy balance).
  */
 #include "optics/crystal_internal.h"
+#include "core/vec.h"
 #include "core/internal.h"
 
 #include <math.h>
@@ -43,14 +44,12 @@ void atmos__crystal_init(atmos__crystal *c, double radius, double length)
     for (int k = 0; k < ATMOS_CRYSTAL_FACES; k++) c->surface_area += c->area[k];
 }
 
-static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
 double atmos__crystal_projected_area(const atmos__crystal *c, const double d[3])
 {
     /* For a convex body the lit faces tile the shadow exactly once and so do the
      * unlit ones: the shadow is half the sum over all faces of area |n . d|. */
     double s = 0.0;
-    for (int k = 0; k < ATMOS_CRYSTAL_FACES; k++) s += c->area[k] * fabs(dot3(c->normal[k], d));
+    for (int k = 0; k < ATMOS_CRYSTAL_FACES; k++) s += c->area[k] * fabs(atmos__dot3(c->normal[k], d));
     return 0.5 * s;
 }
 
@@ -80,12 +79,12 @@ static double angle_between(const double a[3], const double b[3])
     double cx = a[1] * b[2] - a[2] * b[1];
     double cy = a[2] * b[0] - a[0] * b[2];
     double cz = a[0] * b[1] - a[1] * b[0];
-    return atan2(sqrt(cx * cx + cy * cy + cz * cz), dot3(a, b));
+    return atan2(sqrt(cx * cx + cy * cy + cz * cz), atmos__dot3(a, b));
 }
 
 static void normalize3(double v[3])
 {
-    double l = sqrt(dot3(v, v));
+    double l = sqrt(atmos__dot3(v, v));
     if (l > 0.0) {
         v[0] /= l;
         v[1] /= l;
@@ -124,7 +123,7 @@ static void refract(const double d[3], const double m[3], double eta, double cos
 
 static void reflect(const double d[3], const double nrm[3], double out[3])
 {
-    double k = 2.0 * dot3(d, nrm);
+    double k = 2.0 * atmos__dot3(d, nrm);
     for (int i = 0; i < 3; i++) out[i] = d[i] - k * nrm[i];
     normalize3(out);
 }
@@ -167,11 +166,11 @@ static void facet_normal(const double n_true[3], const double d[3], int inside, 
     if (tilt > 0.0) {
         for (int attempt = 0; attempt < 8; attempt++) {
             tilted_normal(n_true, tilt, rng, out);
-            double c = dot3(d, out);
+            double c = atmos__dot3(d, out);
             if (inside ? c <= 1e-6 : c >= -1e-6) continue;
             double r[3];
             reflect(d, out, r);
-            double cr = dot3(r, n_true);
+            double cr = atmos__dot3(r, n_true);
             if (inside ? cr >= -1e-9 : cr <= 1e-9) continue;
             double ci = fabs(c), sin_t2 = eta * eta * (1.0 - ci * ci);
             if (sin_t2 < 1.0) {
@@ -179,7 +178,7 @@ static void facet_normal(const double n_true[3], const double d[3], int inside, 
                 double sgn = inside ? -1.0 : 1.0; /* m: unit normal on the incident side */
                 for (int i = 0; i < 3; i++) m[i] = sgn * out[i];
                 refract(d, m, eta, ci, sqrt(1.0 - sin_t2), e);
-                double ce = dot3(e, n_true);
+                double ce = atmos__dot3(e, n_true);
                 if (inside ? ce <= 1e-9 : ce >= -1e-9) continue;
             }
             return;
@@ -219,7 +218,7 @@ void atmos__crystal_trace(const atmos__crystal *c, const atmos__crystal_optics *
     double u = atmos__rng_uniform(rng) * proj;
     int face = -1;
     for (int k = 0; k < ATMOS_CRYSTAL_FACES; k++) {
-        double cn = dot3(c->normal[k], d);
+        double cn = atmos__dot3(c->normal[k], d);
         if (cn >= 0.0) continue;
         face = k;
         u -= c->area[k] * -cn;
@@ -231,7 +230,7 @@ void atmos__crystal_trace(const atmos__crystal *c, const atmos__crystal_optics *
     /* External reflection and refraction into the crystal. */
     double nrm[3], t[3];
     facet_normal(c->normal[face], d, 0, 1.0 / o->n, o->tilt, rng, nrm);
-    double cos_i = -dot3(d, nrm), cos_t;
+    double cos_i = -atmos__dot3(d, nrm), cos_t;
     double R = atmos__fresnel(1.0, o->n, cos_i, &cos_t);
     double r[3];
     reflect(d, nrm, r);
@@ -254,9 +253,9 @@ void atmos__crystal_trace(const atmos__crystal *c, const atmos__crystal_optics *
         int next = -1;
         for (int k = 0; k < ATMOS_CRYSTAL_FACES; k++) {
             if (k == last) continue;
-            double cn = dot3(c->normal[k], t);
+            double cn = atmos__dot3(c->normal[k], t);
             if (cn <= 1e-12) continue;
-            double s = (c->dist[k] - dot3(c->normal[k], p)) / cn;
+            double s = (c->dist[k] - atmos__dot3(c->normal[k], p)) / cn;
             if (s < 0.0) s = 0.0;
             if (s < smin) {
                 smin = s;
@@ -272,7 +271,7 @@ void atmos__crystal_trace(const atmos__crystal *c, const atmos__crystal_optics *
         }
 
         facet_normal(c->normal[next], t, 1, o->n, o->tilt, rng, nrm);
-        cos_i = dot3(t, nrm);
+        cos_i = atmos__dot3(t, nrm);
         R = atmos__fresnel(o->n, 1.0, cos_i, &cos_t);
         if (R < 1.0) {
             double e[3], m[3] = {-nrm[0], -nrm[1], -nrm[2]};

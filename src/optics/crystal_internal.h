@@ -1,5 +1,5 @@
 /* Internal interfaces of the ice / snow crystal ray tracer (crystal_geometry.c) and its
- * driver (crystal.c): the hexagonal prism, a small counter-based-seeded RNG, and the
+ * driver (crystal.c): the hexagonal prism, the seeding of its random streams, and the
  * tracing of one ray through one randomly oriented crystal.
  *
  * Frame: the crystal is fixed (c-axis along z, centred at the origin) and the incident
@@ -11,54 +11,15 @@
 #define ATMOS_CRYSTAL_INTERNAL_H
 
 #include "atmos/atmos.h"
+#include "core/rng.h"
 #include "optics/optics_internal.h"
 
 #include <stdint.h>
 
 /* ---------------------------------------------------------------- random numbers */
 
-/* xoshiro256** (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
- * ACM TOMS 47(4), 2021) seeded through splitmix64 (Steele, Lea & Flood, OOPSLA 2014),
- * as the authors recommend. One stream per (wavelength, chunk): the seed is a hash of
- * both, so results do not depend on which thread runs which chunk. */
-typedef struct atmos__rng {
-    uint64_t s[4];
-} atmos__rng;
-
-static inline uint64_t atmos__splitmix64(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-static inline void atmos__rng_seed(atmos__rng *r, uint64_t seed)
-{
-    for (int i = 0; i < 4; i++) r->s[i] = atmos__splitmix64(&seed);
-}
-
-static inline uint64_t atmos__rng_rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-
-static inline uint64_t atmos__rng_next(atmos__rng *r)
-{
-    uint64_t *s = r->s;
-    uint64_t out = atmos__rng_rotl(s[1] * 5, 7) * 9;
-    uint64_t t = s[1] << 17;
-    s[2] ^= s[0];
-    s[3] ^= s[1];
-    s[1] ^= s[2];
-    s[0] ^= s[3];
-    s[2] ^= t;
-    s[3] = atmos__rng_rotl(s[3], 45);
-    return out;
-}
-
-/* Uniform in [0, 1) with 53 random bits. */
-static inline double atmos__rng_uniform(atmos__rng *r)
-{
-    return (double)(atmos__rng_next(r) >> 11) * 0x1.0p-53;
-}
+/* One atmos__rng stream (core/rng.h) per (wavelength, chunk): the seed is a hash of both, so
+ * results do not depend on which thread runs which chunk. */
 
 /* ---------------------------------------------------------------- the crystal */
 

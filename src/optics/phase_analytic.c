@@ -13,6 +13,7 @@
  * has pdf 0 and samples isotropically.
  */
 #include "core/internal.h"
+#include "core/rng.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -138,17 +139,9 @@ static double sample_hg(double g, double u)
     return clamp_mu(num / (d * d));
 }
 
-/* SplitMix64 (Steele, Lea & Flood 2014): a stream of extra uniforms for the rejection
- * loop, derived from the caller's numbers so sampling stays a pure function of them. */
-static uint64_t splitmix64(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-static double next_uniform(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
+/* A SplitMix64 stream (core/rng.h) of extra uniforms for the rejection loop, derived
+ * from the caller's numbers so sampling stays a pure function of them. */
+static double next_uniform(uint64_t *s) { return atmos__u01(atmos__splitmix64(s)); }
 
 /* Cornette-Shanks by rejection from Henyey-Greenstein with the same g:
  * CS / HG = 3 (1 + mu^2) / (2 (2 + g^2)) <= 3 / (2 + g^2), so a HG candidate is kept with
@@ -206,3 +199,6 @@ double atmos_phase_mixture_sample(const atmos_phase_mixture *p, double u1, doubl
     /* Rounding put target at the very end: the last lobe with weight. */
     return sample_lobe(p->kind[last], p->g[last], 0x1.fffffffffffffp-1, u2);
 }
+
+/* Riley et al. 2004 Eq. 1: the Rayleigh phase function of air molecules, sr^-1. */
+double atmos_phase_rayleigh(double cos_theta) { return 3.0 / (16.0 * ATMOS_PI) * (1.0 + cos_theta * cos_theta); }

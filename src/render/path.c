@@ -37,7 +37,8 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "render/path_internal.h"
-#include "sky/sky_internal.h"
+#include "core/vec.h"
+#include "atmosphere/riley.h"
 
 #include <float.h>
 #include <stdio.h>
@@ -49,13 +50,6 @@
  * single scattering. */
 #define FORCED_TAU_MAX 2.0
 
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 void atmos_path_defaults(atmos_path_settings *s)
 {
     memset(s, 0, sizeof *s);
@@ -64,15 +58,7 @@ void atmos_path_defaults(atmos_path_settings *s)
     s->density_scale = 1.0;
 }
 
-atmos_status atmos_path_optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
-                                     atmos_slice_optics *out)
-{
-    return atmos__optics_build(ctx, scene, volume, 0, out); /* phase tables only */
-}
-
 /* ------------------------------------------------------------------ small vector helpers */
-
-static inline double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* Orthonormal basis around unit n (Duff et al. 2017). */
 static inline void onb(const double n[3], double t[3], double b[3])
@@ -91,7 +77,7 @@ static inline void around(const double n[3], double mu, double phi, double out[3
     onb(n, t, b);
     double st = sqrt(fmax(0.0, 1.0 - mu * mu)), c = cos(phi) * st, s = sin(phi) * st;
     for (int a = 0; a < 3; a++) out[a] = mu * n[a] + c * t[a] + s * b[a];
-    double l = 1.0 / sqrt(dot3(out, out));
+    double l = 1.0 / sqrt(atmos__dot3(out, out));
     for (int a = 0; a < 3; a++) out[a] *= l;
 }
 
@@ -147,7 +133,7 @@ static void air_transmit(const path_job *J, const path_bundle *b, double y, cons
     for (int i = 0; i < b->m; i++) w[i] *= isinf(G) ? 0.0 : exp(-s->beta_sl[b->k[i]] * ey * G);
 }
 
-static void shadow(const path_job *J, const path_bundle *b, const double p[3], const double d[3], path_rng *r,
+static void shadow(const path_job *J, const path_bundle *b, const double p[3], const double d[3], atmos__stream *r,
                    double *T, path_counts *cnt);
 
 /* Part of a segment lying in the volume's box: the index-space ray and its start there. */
@@ -169,7 +155,7 @@ typedef struct {
  * therefore be negative in a shadow; its mean is not. */
 static void air_scatter(const path_job *J, const path_bundle *b, const double p[3], const double d[3], double K,
                         const double *w, double wt, double *L, double *Lo, int order, const air_view *view,
-                        path_rng *r, path_counts *cnt)
+                        atmos__stream *r, path_counts *cnt)
 {
     const atmos_sky *s = J->sky;
     if (!(K > 0) || !(wt > 0)) return;
@@ -179,7 +165,7 @@ static void air_scatter(const path_job *J, const path_bundle *b, const double p[
     const double e_end = isinf(K) ? (py > 0 ? 0.0 : INFINITY) : exp(-s->gamma * py * K);
     const double y0 = p[1] > 0 ? p[1] : 0;
     const double ey = exp(-s->gamma * y0);
-    const double P = atmos_phase_rayleigh(dot3(d, J->sun));
+    const double P = atmos_phase_rayleigh(atmos__dot3(d, J->sun));
     int h = -1;
     for (int i = 0; i < b->m; i++) {
         const int k = b->k[i];
@@ -193,7 +179,7 @@ static void air_scatter(const path_job *J, const path_bundle *b, const double p[
     const double bh = s->beta_sl[b->k[h]] * ey;
     const double A = isinf(G) ? 1.0 : -expm1(-bh * G);
     if (!(A > 0)) return;
-    const double Ga = -log1p(-path_u(r) * A) / bh; /* G at the point */
+    const double Ga = -log1p(-atmos__stream_u(r) * A) / bh; /* G at the point */
     const double z = s->gamma * py;
     double ta = fabs(z * Ga) < 1e-12 ? Ga : -log1p(-z * Ga) / z;
     if (!(ta >= 0)) return;
@@ -219,7 +205,7 @@ static void air_scatter(const path_job *J, const path_bundle *b, const double p[
 }
 
 /* Volume transmittance from world point p along unit d (to the box's far side). */
-static void shadow(const path_job *J, const path_bundle *b, const double p[3], const double d[3], path_rng *r,
+static void shadow(const path_job *J, const path_bundle *b, const double p[3], const double d[3], atmos__stream *r,
                    double *T, path_counts *cnt)
 {
     for (int i = 0; i < b->m; i++) T[i] = 1;
@@ -232,21 +218,21 @@ static void shadow(const path_job *J, const path_bundle *b, const double p[3], c
 }
 
 /* A direction in the sun's cone, uniformly (pdf 1 / sun_omega). */
-static void sample_sun(const path_job *J, path_rng *r, double d[3])
+static void sample_sun(const path_job *J, atmos__stream *r, double d[3])
 {
-    double mu = 1.0 - path_u(r) * (1.0 - J->cos_sun);
-    around(J->sun, mu, 2.0 * ATMOS_PI * path_u(r), d);
+    double mu = 1.0 - atmos__stream_u(r) * (1.0 - J->cos_sun);
+    around(J->sun, mu, 2.0 * ATMOS_PI * atmos__stream_u(r), d);
 }
 
 /* Russian roulette on the largest weight; returns 0 to stop. */
-static int roulette(double *w, int m, path_rng *r)
+static int roulette(double *w, int m, atmos__stream *r)
 {
     double q = 0;
     for (int i = 0; i < m; i++)
         if (w[i] > q) q = w[i];
     if (!(q > 0)) return 0;
     if (q >= 1) return 1;
-    if (path_u(r) >= q) return 0;
+    if (atmos__stream_u(r) >= q) return 0;
     for (int i = 0; i < m; i++) w[i] /= q;
     return 1;
 }
@@ -327,11 +313,11 @@ static int scatter_at(const path_job *J, const path_bundle *b, const float *dens
 
 /* A field for a new direction of wavelength j: in proportion to its share of the scattering
  * there (no random number with one field). */
-static int pick_field(const path_scatter *e, int j, int nf, path_rng *r)
+static int pick_field(const path_scatter *e, int j, int nf, atmos__stream *r)
 {
     int f = 0;
     if (nf > 1) {
-        double u = path_u(r) * e->ss[j], acc = 0;
+        double u = atmos__stream_u(r) * e->ss[j], acc = 0;
         for (f = 0; f < nf - 1; f++) {
             acc += e->ssf[f][j];
             if (u < acc) break;
@@ -361,12 +347,12 @@ static int sun_lit(const path_job *J, const path_bundle *b, const double *w, con
  * path's own strategies against the aureole estimate made at the previous event. */
 static void nee_sun(const path_job *J, const path_bundle *b, const double p[3], const double d[3], const double *w,
                     const path_scatter *e, const double *S, const int *g, double q, const double *E, double hs,
-                    int order, double *L, double *Lo, path_rng *r, path_counts *cnt)
+                    int order, double *L, double *Lo, atmos__stream *r, path_counts *cnt)
 {
     const int m = b->m;
     double pk[PATH_B], T[PATH_B], ds[3];
     sample_sun(J, r, ds);
-    phase_mix(J->ph, b, J->med->nf, e, dot3(d, ds), pk);
+    phase_mix(J->ph, b, J->med->nf, e, atmos__dot3(d, ds), pk);
     const double pdir = strategies(m, S, g, pk, NULL);
     int any = 0;
     for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
@@ -381,15 +367,15 @@ static void nee_sun(const path_job *J, const path_bundle *b, const double p[3], 
 
 static void nee(const path_job *J, const path_bundle *b, const double p[3], const double d[3], const double *w,
                 const path_scatter *e, const double *S, const int *g, double q, const double *E, double hs, int order,
-                double *L, double *Lo, path_rng *r, path_counts *cnt)
+                double *L, double *Lo, atmos__stream *r, path_counts *cnt)
 {
     const int m = b->m;
     double pk[PATH_B], T[PATH_B];
     if (E) nee_sun(J, b, p, d, w, e, S, g, q, E, hs, order, L, Lo, r, cnt);
     if (J->env) { /* the sky (J->env exists only with the sky background) */
         double de[3];
-        const double pe = atmos__path_env_sample(J->env, path_u(r), path_u(r), path_u(r), de);
-        phase_mix(J->ph, b, J->med->nf, e, dot3(d, de), pk);
+        const double pe = atmos__path_env_sample(J->env, atmos__stream_u(r), atmos__stream_u(r), atmos__stream_u(r), de);
+        phase_mix(J->ph, b, J->med->nf, e, atmos__dot3(d, de), pk);
         const double pdir = strategies(m, S, g, pk, NULL);
         int any = 0;
         for (int i = 0; i < m; i++) any |= w[i] * pk[i] > 0;
@@ -435,7 +421,7 @@ static double aureole_pdf(const path_job *J, const path_bundle *b, const path_sc
 {
     double pk[PATH_B], s = 0;
     int ne = 0;
-    phase_mix(J->ph, b, J->med->nf, e, dot3(a, J->sun), pk);
+    phase_mix(J->ph, b, J->med->nf, e, atmos__dot3(a, J->sun), pk);
     for (int i = 0; i < b->m; i++)
         if (e->ss[i] > 0) s += pk[i], ne++;
     return ne ? s / ne : 0.0;
@@ -443,7 +429,7 @@ static double aureole_pdf(const path_job *J, const path_bundle *b, const path_sc
 
 static void aureole(const path_job *J, const path_bundle *b, const double p[3], const double d[3],
                     const path_scatter *e, const double *w, const double *S, const int *g, double q, int order,
-                    double *L, double *Lo, path_rng *r, path_counts *cnt)
+                    double *L, double *Lo, atmos__stream *r, path_counts *cnt)
 {
     const path_medium *M = J->med;
     const path_phase *P = J->ph;
@@ -452,10 +438,10 @@ static void aureole(const path_job *J, const path_bundle *b, const double p[3], 
     for (int i = 0; i < m; i++)
         if (e->ss[i] > 0) elig[ne++] = i;
     if (!ne) return;
-    const int j = elig[ne > 1 ? (int)(path_u(r) * ne) % ne : 0], f = pick_field(e, j, nf, r);
+    const int j = elig[ne > 1 ? (int)(atmos__stream_u(r) * ne) % ne : 0], f = pick_field(e, j, nf, r);
     double a[3], pk[PATH_B], wa[PATH_B];
-    around(J->sun, atmos__path_phase_sample(P, f, b->k[j], path_u(r)), 2.0 * ATMOS_PI * path_u(r), a);
-    phase_mix(P, b, nf, e, dot3(d, a), pk);
+    around(J->sun, atmos__path_phase_sample(P, f, b->k[j], atmos__stream_u(r)), 2.0 * ATMOS_PI * atmos__stream_u(r), a);
+    phase_mix(P, b, nf, e, atmos__dot3(d, a), pk);
     const double den = q * strategies(m, S, g, pk, NULL) + aureole_pdf(J, b, e, a);
     if (!(den > 0)) return;
     int any = 0;
@@ -495,10 +481,10 @@ static void aureole(const path_job *J, const path_bundle *b, const double p[3], 
  * left out). */
 static int forced_single(const path_job *J, const path_bundle *b, const double p[3], const double d[3],
                          const double q[3], const double qd[3], double t0, double t1, const double *w, double *L,
-                         double *Lo, path_rng *r, path_counts *cnt)
+                         double *Lo, atmos__stream *r, path_counts *cnt)
 {
     double t, pdf;
-    const double u0 = path_u(r), u1 = path_u(r);
+    const double u0 = atmos__stream_u(r), u1 = atmos__stream_u(r);
     if (!atmos__path_majorant_point(J->med, q, qd, t0, t1, b, FORCED_TAU_MAX, u0, u1, &t, &pdf)) return 0;
     float dens[PATH_F];
     atmos__path_density(J->med, q[0] + t * qd[0], q[1] + t * qd[1], q[2] + t * qd[2], dens);
@@ -527,7 +513,7 @@ static int forced_single(const path_job *J, const path_bundle *b, const double p
 /* One camera path through world ray (o, d); adds the radiance of the carried
  * wavelengths to L[] and, for the scattering-order AOV, each contribution times the
  * number of volume scattering events before it to Lo[]. */
-static void trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], path_rng *r,
+static void trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], atmos__stream *r,
                   double *L, double *Lo, path_counts *cnt)
 {
     const int m = b->m;
@@ -601,16 +587,16 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 /* New direction: the hero's strategy (its wavelength or the fallback), a field
                  * in proportion to its scattering there, cos(theta) by the table's inverse CDF. */
                 if (hero < 0) {
-                    hero = m > 1 ? (int)(path_u(r) * m) : 0;
+                    hero = m > 1 ? (int)(atmos__stream_u(r) * m) : 0;
                     if (hero >= m) hero = m - 1;
                 }
                 const int j = g[hero];
                 const int f = pick_field(&ev_s, j, nf, r);
-                double mu = atmos__path_phase_sample(P, f, b->k[j], path_u(r));
+                double mu = atmos__path_phase_sample(P, f, b->k[j], atmos__stream_u(r));
                 double nd[3];
-                around(d, mu, 2.0 * ATMOS_PI * path_u(r), nd);
+                around(d, mu, 2.0 * ATMOS_PI * atmos__stream_u(r), nd);
                 const int chroma = nf > 1 || !P->gray[0];
-                const int to_sun = lit && dot3(nd, J->sun) >= J->cos_sun;
+                const int to_sun = lit && atmos__dot3(nd, J->sun) >= J->cos_sun;
                 esc_wt = 1.0;
                 const double hcur = hprev;
                 hprev = 1;
@@ -662,7 +648,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
         }
         air_scatter(J, b, p, d, K, w, esc_wt, L, Lo, order, NULL, r, cnt);
         if (isinf(K)) {
-            if (primary && J->disk_visible && dot3(d, J->sun) >= J->cos_sun) {
+            if (primary && J->disk_visible && atmos__dot3(d, J->sun) >= J->cos_sun) {
                 double E[PATH_B];
                 sunlight(J, b, p[1], E);
                 for (int i = 0; i < m; i++) L[i] += w[i] * E[i] / J->sun_omega;
@@ -695,7 +681,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
         if (!roulette(w, m, r)) return;
         {
             /* cosine-distributed about +y */
-            double u1 = path_u(r), phi = 2.0 * ATMOS_PI * path_u(r), st = sqrt(u1);
+            double u1 = atmos__stream_u(r), phi = 2.0 * ATMOS_PI * atmos__stream_u(r), st = sqrt(u1);
             d[0] = st * cos(phi), d[2] = st * sin(phi), d[1] = sqrt(fmax(0.0, 1.0 - u1));
         }
         primary = 0;
@@ -761,7 +747,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     if (settings && settings->variance) *settings->variance = NULL;
     if (settings && settings->order) *settings->order = NULL;
     if (volume && !volume->finalized) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render path: volume is not finalized");
-    const double t_start = now_seconds();
+    const double t_start = atmos__now();
     atmos_path_settings s;
     atmos_status st = resolve(ctx, scene, settings, &s);
     if (st != ATMOS_OK) return st;
@@ -774,7 +760,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     double sun_el = 0, sun_az = 0;
     if ((st = atmos_scene_sun_direction(ctx, scene, J.sun, &sun_el, &sun_az)) != ATMOS_OK) return st;
 
-    atmos_slice_optics own;
+    atmos_volume_optics own;
     memset(&own, 0, sizeof own);
     path_medium med;
     path_phase ph;
@@ -809,11 +795,11 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         J.bg = scene->background == ATMOS_BACKGROUND_UNIFORM ? scene->background_radiance : 0.0;
     }
 
-    const double t_prep0 = now_seconds();
+    const double t_prep0 = atmos__now();
     if (volume && volume->nfields > 0) {
-        const atmos_slice_optics *optics = s.optics;
+        const atmos_volume_optics *optics = s.optics;
         if (!optics) {
-            if ((st = atmos_path_optics_build(ctx, scene, volume, &own)) != ATMOS_OK) goto done;
+            if ((st = atmos_volume_optics_build(ctx, scene, volume, 0, &own)) != ATMOS_OK) goto done;
             optics = &own;
         }
         if (optics->count != volume->nfields) {
@@ -874,7 +860,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the accumulators");
         goto done;
     }
-    t_prep = now_seconds() - t_prep0;
+    t_prep = atmos__now() - t_prep0;
 
     {
         const int threads = atmos__threads(ctx);
@@ -885,7 +871,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         if (S > 256) S = 256;
         double Ybar[ATMOS_MAX_WAVELENGTHS];
         for (int k = 0; k < n; k++) Ybar[k] = wl.to_xyz[k][1];
-        const double t0 = now_seconds();
+        const double t0 = atmos__now();
         int cancelled = 0;
         while (spp_done < s.spp && !cancelled) {
             const int s0 = spp_done, s1 = spp_done + S < s.spp ? spp_done + S : s.spp;
@@ -897,21 +883,21 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
                     const size_t pix = (size_t)y * W + x;
                     double *A = acc + pix * NA;
                     for (int smp = s0; smp < s1; smp++) {
-                        path_rng rng;
-                        path_rng_seed(&rng, J.seed, pix, (uint64_t)smp);
+                        atmos__stream rng;
+                        atmos__stream_seed(&rng, J.seed, pix, (uint64_t)smp);
                         path_bundle b;
                         double wgt = 1.0;
                         if (n <= PATH_B) {
                             b.m = n;
                             for (int i = 0; i < n; i++) b.k[i] = i;
                         } else {
-                            int k0 = (int)(path_u(&rng) * n);
+                            int k0 = (int)(atmos__stream_u(&rng) * n);
                             if (k0 >= n) k0 = n - 1;
                             b.m = PATH_B;
                             for (int i = 0; i < PATH_B; i++) b.k[i] = (k0 + (i * n) / PATH_B) % n;
                             wgt = (double)n / PATH_B;
                         }
-                        double jx = path_u(&rng), jy = path_u(&rng), dir[3];
+                        double jx = atmos__stream_u(&rng), jy = atmos__stream_u(&rng), dir[3];
                         double L[PATH_B] = {0, 0, 0, 0}, Lo[PATH_B] = {0, 0, 0, 0}, Y = 0, Yo = 0;
                         if (atmos_camera_ray(&J.cam, x + jx, y + jy, dir)) {
                             trace(&J, &b, J.cam.position, dir, &rng, L, Lo, &cnt);
@@ -934,13 +920,13 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
             }
             total.events += ev, total.tentative += tc, total.shadow += sh;
             spp_done = s1;
-            double el = now_seconds() - t0;
+            double el = atmos__now() - t0;
             double frac = (double)spp_done / s.spp;
             if (s.time_budget_s > 0 && el / s.time_budget_s > frac) frac = el / s.time_budget_s;
             if (atmos__progress(ctx, "render path", frac)) cancelled = 1;
             if (s.time_budget_s > 0 && el >= s.time_budget_s) break;
         }
-        t_trace = now_seconds() - t0;
+        t_trace = atmos__now() - t0;
         if (cancelled) {
             st = atmos__error(ctx, ATMOS_E_CANCELLED, "render path: cancelled");
             goto done;
@@ -986,7 +972,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
             snprintf(buf, sizeof buf, "%d spp, seed %llu, max depth %d, %s", spp_done, (unsigned long long)s.seed,
                      s.max_depth, scene->background == ATMOS_BACKGROUND_SKY ? "sky" : "vacuum");
         atmos_image_set_meta(img, "atmos:path", buf);
-        double secs = now_seconds() - t_start;
+        double secs = atmos__now() - t_start;
         snprintf(buf, sizeof buf, "%.6f", secs);
         atmos_image_set_meta(img, "atmos:render_seconds", buf);
         snprintf(buf, sizeof buf, "%.6g", rel_n ? rel_sum / rel_n : 0.0);
@@ -1020,7 +1006,7 @@ done:
     atmos__path_medium_free(&med);
     atmos__path_phase_free(&ph);
     atmos_sky_destroy(sky);
-    atmos_slice_optics_free(&own);
+    atmos_volume_optics_free(&own);
     if (st != ATMOS_OK) {
         atmos_image_destroy(img);
         atmos_image_destroy(var);

@@ -4,7 +4,7 @@
  * of the analytic sky's single scattering (sky.c) seen at its centre from altitude y_ref,
  * to the ground or to space, mixed with a uniform distribution over the sphere. */
 #include "render/path_internal.h"
-#include "sky/sky_internal.h"
+#include "atmosphere/riley.h"
 
 #include <string.h>
 

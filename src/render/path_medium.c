@@ -38,7 +38,7 @@ static float voxel_or_zero(const atmos_volume *v, const vol_field *fl, int i, in
 }
 
 atmos_status atmos__path_medium_build(atmos_context *ctx, const atmos_volume *v, double scale, const double offset[3],
-                                      const atmos_slice_optics *o, int nwl, path_medium *m)
+                                      const atmos_volume_optics *o, int nwl, path_medium *m)
 {
     memset(m, 0, sizeof *m);
     m->v = v;
@@ -315,13 +315,13 @@ int atmos__path_majorant_point(const path_medium *m, const double q[3], const do
 }
 
 int atmos__path_free_flight(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
-                            const path_bundle *b, double *w, path_rng *r, double *tout, float *dens, long long *tentative)
+                            const path_bundle *b, double *w, atmos__stream *r, double *tout, float *dens, long long *tentative)
 {
     const int nf = m->nf, nb = b->m;
     path_dda g;
     dda_init(m, q, qd, t0, &g);
     double t = t0;
-    double tau = -log(1.0 - path_u(r)); /* optical depth (of the majorant) to the next tentative collision */
+    double tau = -log(1.0 - atmos__stream_u(r)); /* optical depth (of the majorant) to the next tentative collision */
     long long tc = 0;
     int res = 0;
     for (;;) {
@@ -360,14 +360,14 @@ int atmos__path_free_flight(const path_medium *m, const double q[3], const doubl
                 goto out;
             }
             const double ps = ns / (ns + nn);
-            if (path_u(r) < ps) {
+            if (atmos__stream_u(r) < ps) {
                 for (int i = 0; i < nb; i++) w[i] *= ss[i] / (mu * ps);
                 *tout = t;
                 res = 1;
                 goto out;
             }
             for (int i = 0; i < nb; i++) w[i] *= sn[i] / (mu * (1.0 - ps));
-            tau = -log(1.0 - path_u(r));
+            tau = -log(1.0 - atmos__stream_u(r));
         }
         if (te >= t1) break;
         t = te;
@@ -379,7 +379,7 @@ out:
 }
 
 void atmos__path_transmittance(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
-                               const path_bundle *b, path_rng *r, double *T)
+                               const path_bundle *b, atmos__stream *r, double *T)
 {
     const int nf = m->nf, nb = b->m;
     double tauc[PATH_B];
@@ -409,7 +409,7 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
             if (mur > 0) {
                 double s = t;
                 for (;;) {
-                    s += -log(1.0 - path_u(r)) / mur;
+                    s += -log(1.0 - atmos__stream_u(r)) / mur;
                     if (s >= te) break;
                     atmos__path_density(m, q[0] + s * qd[0], q[1] + s * qd[1], q[2] + s * qd[2], dens);
                     double tmax = 0;
@@ -430,7 +430,7 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
                 if (tauc[i] < cmin) cmin = tauc[i];
             }
             if (tmax * exp(-cmin) < 1e-2) {
-                if (path_u(r) >= 0.25) {
+                if (atmos__stream_u(r) >= 0.25) {
                     for (int i = 0; i < nb; i++) T[i] = 0;
                     return;
                 }

@@ -36,7 +36,7 @@ void atmos__path_phase_free(path_phase *p)
     memset(p, 0, sizeof *p);
 }
 
-atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_slice_optics *o, int nwl, double truncate_deg,
+atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_volume_optics *o, int nwl, double truncate_deg,
                                      path_phase *p)
 {
     memset(p, 0, sizeof *p);

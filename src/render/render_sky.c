@@ -2,8 +2,8 @@
  * and converts spectral images to linear sRGB. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, getpid, isatty, PATH_MAX */
 #include "core/internal.h"
-#include "sky/sky_internal.h"
-#include "render/sky_batch.h"
+#include "atmosphere/riley.h"
+#include "atmosphere/riley_batch.h"
 
 #include <stdlib.h>
 
@@ -14,30 +14,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_scene *scene, atmos_wavelengths *out)
-{
-    if (scene->wavelengths == ATMOS_WAVELENGTHS_RGB) {
-        atmos_wavelengths_rgb(out);
-    } else if (atmos_wavelengths_spectral(scene->spectral_samples, out) != ATMOS_OK) {
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "wavelengths/samples: must be in [1, %d], got %d",
-                            ATMOS_MAX_WAVELENGTHS, scene->spectral_samples);
-    }
-    /* A sun given by its irradiance replaces the solar spectrum; the colour
-     * conversion stays that of the set (to_srgb/to_xyz are unchanged). */
-    if (scene->sun.irradiance_count == 1)
-        for (int i = 0; i < out->count; i++) out->sun_irradiance[i] = scene->sun.irradiance[0];
-    else if (scene->sun.irradiance_count == 3 && out->count == 3)
-        for (int i = 0; i < 3; i++) out->sun_irradiance[i] = scene->sun.irradiance[i];
-    return ATMOS_OK;
-}
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 /* Van der Corput radical inverse in base 2: the second coordinate of the
  * Hammersley set used for deterministic, thread-independent pixel samples. */
@@ -216,7 +192,7 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
 {
     if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render: missing scene or output");
     *out = NULL;
-    double t0 = now_seconds();
+    double t0 = atmos__now();
     atmos_status st = atmos_scene_validate(ctx, scene, "scene");
     if (st != ATMOS_OK) return st;
     atmos_wavelengths wl;
@@ -323,7 +299,7 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
         atmos_image_destroy(img);
         return atmos__error(ctx, ATMOS_E_CANCELLED, "render: cancelled");
     }
-    double secs = now_seconds() - t0;
+    double secs = atmos__now() - t0;
     char buf[256];
     atmos_image_set_meta(img, "atmos:version", atmos_version());
     atmos_image_set_meta(img, "atmos:scene", scene->name);

@@ -15,10 +15,10 @@
  * static schedule and the image does not depend on the thread count.
  */
 #define _POSIX_C_SOURCE 200809L
-#define _DEFAULT_SOURCE /* madvise */
 #include "core/internal.h"
+#include "core/vec.h"
 #include "render/slice_internal.h"
-#include "sky/sky_internal.h"
+#include "atmosphere/riley.h"
 #include "volume/volume_grid.h"
 
 #include <float.h>
@@ -29,36 +29,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 #define SLICE_HD_EPS 0.02      /* rays within ~89° of the slice planes are not sliced */
-#define SLICE_MAX_GRID_BYTES ((uint64_t)2 << 30)
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-/* Large buffers the passes read at random (render grid, light ring, per-pixel
- * planes): 2 MB aligned and, on Linux, backed by transparent huge pages where the
- * system allows it, so that the samples do not pay a page walk per access. Freed
- * with free(). */
-static void *big_alloc(size_t bytes)
-{
-    const size_t huge = (size_t)2 << 20;
-    if (bytes < huge / 2) return malloc(bytes ? bytes : 1);
-    size_t sz = (bytes + huge - 1) / huge * huge;
-    void *p = NULL;
-    if (posix_memalign(&p, huge, sz) != 0) return NULL;
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    (void)madvise(p, sz, MADV_HUGEPAGE);
-#endif
-    return p;
-}
 
 void atmos_slice_defaults(atmos_slice_settings *s)
 {
@@ -73,251 +45,6 @@ void atmos_slice_defaults(atmos_slice_settings *s)
     s->eye_scale = 1.0;
 }
 
-/* ------------------------------------------------------------------ optics */
-
-void atmos_slice_optics_free(atmos_slice_optics *o)
-{
-    if (!o) return;
-    if (o->owned)
-        for (int i = 0; i < o->count; i++) {
-            atmos_msphase_destroy((atmos_msphase *)o->ms[i]);
-            atmos_phase_table_destroy((atmos_phase_table *)o->phase[i]);
-        }
-    memset(o, 0, sizeof *o);
-}
-
-atmos_status atmos__optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
-                                 int with_msphase, atmos_slice_optics *out)
-{
-    if (!scene || !volume || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume optics: missing argument");
-    memset(out, 0, sizeof *out);
-    out->owned = 1;
-    atmos_wavelengths wl;
-    atmos_status st = atmos_scene_wavelengths(ctx, scene, &wl);
-    if (st != ATMOS_OK) return st;
-    int nf = atmos_volume_field_count(volume);
-    for (int i = 0; i < nf; i++) {
-        atmos_particle_desc pd;
-        const char *name = atmos_volume_field_particle(volume, i);
-        if ((st = atmos_scene_particle(ctx, scene, name, &pd)) != ATMOS_OK) goto fail;
-        atmos_phase_table *t = NULL;
-        atmos_phase_table_desc td = {0};
-        if ((st = atmos_phase_table_build(ctx, &pd, &wl, &td, &t)) != ATMOS_OK) goto fail;
-        out->phase[i] = t;
-        out->count = i + 1;
-        if (!with_msphase) continue;
-        atmos_msphase *m = NULL;
-        atmos_msphase_desc md = {0};
-        md.max_order = 64;
-        if ((st = atmos_msphase_build(ctx, t, &md, &m)) != ATMOS_OK) goto fail;
-        out->ms[i] = m;
-    }
-    out->count = nf;
-    return ATMOS_OK;
-fail:
-    atmos_slice_optics_free(out);
-    return st;
-}
-
-atmos_status atmos_slice_optics_build(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
-                                      atmos_slice_optics *out)
-{
-    return atmos__optics_build(ctx, scene, volume, 1, out);
-}
-
-/* ------------------------------------------------------------------ render grid */
-
-static void sgrid_free(sgrid *g)
-{
-    free(g->v);
-    free(g->occ);
-    memset(g, 0, sizeof *g);
-}
-
-static atmos_status sgrid_build(atmos_context *ctx, const atmos_volume *vol, double scale, int cap, sgrid *g)
-{
-    memset(g, 0, sizeof *g);
-    const int nf = vol->nfields;
-    g->nf = nf;
-    int blo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, bhi[3] = {-1, -1, -1};
-    for (int f = 0; f < nf; f++) {
-        const vol_field *fl = &vol->field[f];
-        if (!fl->table || fl->count == 0) continue;
-        for (uint64_t b = 0; b < vol->nbricks; b++) {
-            if (!fl->table[b]) continue;
-            int bx = (int)(b % (uint64_t)vol->nb[0]);
-            int by = (int)((b / (uint64_t)vol->nb[0]) % (uint64_t)vol->nb[1]);
-            int bz = (int)(b / ((uint64_t)vol->nb[0] * (uint64_t)vol->nb[1]));
-            int bb[3] = {bx, by, bz};
-            for (int a = 0; a < 3; a++) {
-                if (bb[a] < blo[a]) blo[a] = bb[a];
-                if (bb[a] > bhi[a]) bhi[a] = bb[a];
-            }
-        }
-    }
-    if (bhi[0] < 0) return ATMOS_OK; /* empty volume: g->v stays NULL */
-    int lo[3], ext[3], emax = 1;
-    for (int a = 0; a < 3; a++) {
-        lo[a] = blo[a] * VOL_BRICK;
-        int hi = (bhi[a] + 1) * VOL_BRICK;
-        if (hi > vol->desc.dims[a]) hi = vol->desc.dims[a];
-        ext[a] = hi - lo[a];
-        if (ext[a] > emax) emax = ext[a];
-    }
-    int fac = (emax + (cap - 2) - 1) / (cap - 2);
-    if (fac < 1) fac = 1;
-    uint64_t nvox = 1;
-    for (int a = 0; a < 3; a++) {
-        g->c[a] = (ext[a] + fac - 1) / fac + 2;
-        nvox *= (uint64_t)g->c[a];
-    }
-    if (nvox * (uint64_t)nf * sizeof(float) > SLICE_MAX_GRID_BYTES)
-        return atmos__error(ctx, ATMOS_E_LIMIT, "slice: render grid %dx%dx%d x %d fields exceeds %llu bytes", g->c[0],
-                            g->c[1], g->c[2], nf, (unsigned long long)SLICE_MAX_GRID_BYTES);
-    g->v = big_alloc(nvox * (uint64_t)nf * sizeof(float));
-    if (g->v) memset(g->v, 0, nvox * (uint64_t)nf * sizeof(float));
-    for (int a = 0; a < 3; a++) g->ob[a] = (g->c[a] - 2) / SLICE_OCC_B + 1;
-    g->occ = calloc((size_t)g->ob[0] * g->ob[1] * g->ob[2], 1);
-    if (!g->v || !g->occ) {
-        sgrid_free(g);
-        return atmos__error(ctx, ATMOS_E_NOMEM, "slice: out of memory for the render grid");
-    }
-    /* Box filter: every native voxel of every occupied brick adds to its render voxel. */
-    for (int f = 0; f < nf; f++) {
-        const vol_field *fl = &vol->field[f];
-        if (!fl->table) continue;
-        for (uint64_t b = 0; b < vol->nbricks; b++) {
-            uint32_t s = fl->table[b];
-            if (!s) continue;
-            const float *br = fl->bricks[s - 1];
-            int bx = (int)(b % (uint64_t)vol->nb[0]) * VOL_BRICK;
-            int by = (int)((b / (uint64_t)vol->nb[0]) % (uint64_t)vol->nb[1]) * VOL_BRICK;
-            int bz = (int)(b / ((uint64_t)vol->nb[0] * (uint64_t)vol->nb[1])) * VOL_BRICK;
-            for (int k = 0; k < VOL_BRICK; k++)
-                for (int j = 0; j < VOL_BRICK; j++)
-                    for (int i = 0; i < VOL_BRICK; i++) {
-                        float val = br[(k * VOL_BRICK + j) * VOL_BRICK + i];
-                        if (val == 0.0f) continue;
-                        int ci = (bx + i - lo[0]) / fac + 1, cj = (by + j - lo[1]) / fac + 1,
-                            ck = (bz + k - lo[2]) / fac + 1;
-                        if (ci >= g->c[0] - 1 || cj >= g->c[1] - 1 || ck >= g->c[2] - 1) continue;
-                        g->v[(((size_t)ck * g->c[1] + cj) * g->c[0] + ci) * nf + f] += val;
-                    }
-        }
-    }
-    const float norm = (float)(scale / ((double)fac * fac * fac));
-    for (uint64_t p = 0; p < nvox; p++) {
-        int any = 0;
-        for (int f = 0; f < nf; f++) {
-            g->v[p * nf + f] *= norm;
-            any |= g->v[p * nf + f] > 0.0f;
-        }
-        if (!any) continue;
-        int ci = (int)(p % (uint64_t)g->c[0]), cj = (int)((p / (uint64_t)g->c[0]) % (uint64_t)g->c[1]),
-            ck = (int)(p / ((uint64_t)g->c[0] * g->c[1]));
-        /* A sample whose lower corner is i0 reads voxels i0 and i0+1: mark i0 = c-1, c. */
-        for (int dk = -1; dk <= 0; dk++)
-            for (int dj = -1; dj <= 0; dj++)
-                for (int di = -1; di <= 0; di++) {
-                    int a = ci + di, bq = cj + dj, cq = ck + dk;
-                    if (a < 0 || bq < 0 || cq < 0 || a > g->c[0] - 2 || bq > g->c[1] - 2 || cq > g->c[2] - 2) continue;
-                    g->occ[((size_t)(cq / SLICE_OCC_B) * g->ob[1] + bq / SLICE_OCC_B) * g->ob[0] + a / SLICE_OCC_B] = 1;
-                }
-    }
-    /* Render voxel c covers native [lo + (c-1) fac, lo + c fac); its centre is u = c. */
-    const double vs = vol->desc.voxel_size_m;
-    g->sc = (float)(1.0 / (vs * fac));
-    for (int a = 0; a < 3; a++) {
-        g->off[a] = (float)(0.5 - (double)lo[a] / fac);
-        /* u = (q - lo)/fac + 0.5 with q = g/vs; nonzero for u in (0, c-1). */
-        g->box_lo[a] = ((double)lo[a] - 0.5 * fac) * vs;
-        g->box_hi[a] = ((double)lo[a] + (g->c[a] - 1.5) * fac) * vs;
-    }
-    return ATMOS_OK;
-}
-
-/* ------------------------------------------------------------------ optics tables */
-
-static void stables_free(stables *t)
-{
-    for (int f = 0; f < ATMOS_VOLUME_MAX_FIELDS; f++) free(t->ams[f]), free(t->F[f]), free(t->S[f]);
-}
-
-static atmos_status stables_build(atmos_context *ctx, const atmos_slice_optics *o, int n, int max_order, stables *t)
-{
-    memset(t, 0, sizeof *t);
-    t->n = n;
-    t->nf = o->count;
-    t->no = max_order < 2 ? 2 : max_order;
-    for (int f = 0; f < o->count; f++) {
-        if (!o->phase[f] || !o->ms[f]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "slice: optics of field %d missing", f);
-        if (atmos_phase_table_wavelength_count(o->phase[f]) != n || atmos_msphase_wavelength_count(o->ms[f]) != n)
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG,
-                                "slice: optics of field %d have %d wavelengths, the scene %d", f,
-                                atmos_phase_table_wavelength_count(o->phase[f]), n);
-        const atmos_msphase *m = o->ms[f];
-        int mo = atmos_msphase_max_order(m);
-        t->ng[f] = atmos_msphase_grid(m, &t->grid[f]);
-        const int ng = t->ng[f];
-        t->ams[f] = malloc(sizeof(float) * (size_t)n * ng * t->no);
-        t->F[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
-        t->S[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
-        if (!t->ams[f] || !t->F[f] || !t->S[f]) {
-            stables_free(t);
-            return atmos__error(ctx, ATMOS_E_NOMEM, "slice: out of memory for Ams tables");
-        }
-        for (int k = 0; k < n; k++) {
-            double se = atmos_phase_table_sigma_ext(o->phase[f], k), al = atmos_phase_table_albedo(o->phase[f], k);
-            if (!(se >= 0) || !isfinite(se)) se = 0;
-            if (!(al >= 0)) al = 0;
-            if (al > 1) al = 1;
-            t->sig[f][k] = (float)se;
-            t->sca[f][k] = (float)(se * al);
-            for (int ord = 1; ord <= t->no; ord++) {
-                /* Orders past the table's last are isotropic (Riley §4.2.1). */
-                const double *vals = ord <= mo ? atmos_msphase_values(m, k, ord) : NULL;
-                for (int a = 0; a < ng; a++)
-                    t->ams[f][((size_t)a * t->no + (ord - 1)) * n + k] =
-                        (float)(vals ? vals[a] : 1.0 / (4.0 * ATMOS_PI));
-            }
-            for (int i = 0; i <= SLICE_F_ORDERS; i++) {
-                t->F[f][(size_t)k * (SLICE_F_ORDERS + 1) + i] = (float)atmos_msphase_forward(m, k, i);
-                t->S[f][(size_t)k * (SLICE_F_ORDERS + 1) + i] = (float)atmos_msphase_log_forward_sum(m, k, i);
-            }
-        }
-    }
-    return ATMOS_OK;
-}
-
-/* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. *a
- * holds a guess on entry (the neighbouring pixel's index: angles change little from
- * pixel to pixel), tried with its neighbours before a binary search. */
-static void angle_locate(const double *grid, int ng, double theta_deg, int *a, float *w)
-{
-    int lo = 0, hi = ng - 1;
-    for (int g = *a - 1; g <= *a + 1; g++)
-        if (g >= 0 && g < ng - 1 && grid[g] < theta_deg && theta_deg < grid[g + 1]) {
-            *a = g;
-            *w = (float)((theta_deg - grid[g]) / (grid[g + 1] - grid[g]));
-            return;
-        }
-    if (theta_deg <= grid[0]) {
-        *a = 0, *w = 0;
-        return;
-    }
-    if (theta_deg >= grid[ng - 1]) {
-        *a = ng - 2, *w = 1;
-        return;
-    }
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (grid[mid] <= theta_deg) lo = mid;
-        else hi = mid;
-    }
-    *a = lo;
-    *w = (float)((theta_deg - grid[lo]) / (grid[lo + 1] - grid[lo]));
-}
-
 /* ------------------------------------------------------------------ geometry helpers */
 
 /* Sunlight arriving at altitude yw: through the air (Eq. 12) with the sky background,
@@ -328,43 +55,6 @@ static void sunlight_at(const atmos_sky *sky, int vacuum, double yw, const doubl
         for (int c = 0; c < n; c++) out[c] = sky->sun_e[c];
     else
         atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun, out);
-}
-
-static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void normalize3(double a[3])
-{
-    double l = sqrt(dot3(a, a));
-    if (l > 0) a[0] /= l, a[1] /= l, a[2] /= l;
-}
-
-static void cross3(const double a[3], const double b[3], double o[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-/* Slab intersection of o + t d with a box; returns 0 if missed. */
-static int ray_box(const double o[3], const double d[3], const double lo[3], const double hi[3], double *t0, double *t1)
-{
-    double a = -INFINITY, b = INFINITY;
-    for (int i = 0; i < 3; i++) {
-        if (fabs(d[i]) < 1e-300) {
-            if (o[i] < lo[i] || o[i] > hi[i]) return 0;
-            continue;
-        }
-        double ta = (lo[i] - o[i]) / d[i], tb = (hi[i] - o[i]) / d[i];
-        if (ta > tb) {
-            double s = ta;
-            ta = tb, tb = s;
-        }
-        if (ta > a) a = ta;
-        if (tb < b) b = tb;
-    }
-    if (a > b) return 0;
-    *t0 = a, *t1 = b;
-    return 1;
 }
 
 /* Slice indices k whose plane s_k = s0 + (k + 0.5) ds lies in [sa, sb]. */
@@ -457,20 +147,20 @@ static void block_footprint(const sjob *j, const atmos_camera *cam, const double
     const double th = cam->tan_half_fov, W = cam->width, H = cam->height;
     for (int c = 0; c < 8; c++) {
         double p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
-        double sv = dot3(p, j->h);
+        double sv = atmos__dot3(p, j->h);
         smin = fmin(smin, sv), smax = fmax(smax, sv);
-        double uv = dot3(p, j->e1), vv = dot3(p, j->e2);
+        double uv = atmos__dot3(p, j->e1), vv = atmos__dot3(p, j->e2);
         umin = fmin(umin, uv), umax = fmax(umax, uv);
         vmin = fmin(vmin, vv), vmax = fmax(vmax, vv);
         double r[3] = {p[0] - j->eye[0], p[1] - j->eye[1], p[2] - j->eye[2]};
-        double z = dot3(r, cf);
+        double z = atmos__dot3(r, cf);
         if (!(z > 1e-6)) {
             behind++;
             continue;
         }
         /* Image position (pixels; centres at +0.5) as atmos_camera_ray inverts it, in
          * eye-buffer pixels. */
-        double px = 0.5 * (W + dot3(r, cr) / (z * th) * H) / j->sx, py = 0.5 * (H - dot3(r, cu) / (z * th) * H) / j->sy;
+        double px = 0.5 * (W + atmos__dot3(r, cr) / (z * th) * H) / j->sx, py = 0.5 * (H - atmos__dot3(r, cu) / (z * th) * H) / j->sy;
         xmin = fmin(xmin, px), xmax = fmax(xmax, px);
         ymin = fmin(ymin, py), ymax = fmax(ymax, py);
     }
@@ -622,7 +312,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     if (!scene || !volume || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render slice: missing scene, volume or output");
     *out = NULL;
     if (!volume->finalized) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render slice: volume is not finalized");
-    const double t_start = now_seconds();
+    const double t_start = atmos__now();
     atmos_slice_settings s;
     atmos_status st = check_settings(ctx, settings, &s);
     if (st != ATMOS_OK) return st;
@@ -636,28 +326,28 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     double sun_w[3], sun_el = 0, sun_az = 0;
     if ((st = atmos_scene_sun_direction(ctx, scene, sun_w, &sun_el, &sun_az)) != ATMOS_OK) return st;
 
-    atmos_slice_optics own_optics;
+    atmos_volume_optics own_optics;
     memset(&own_optics, 0, sizeof own_optics);
-    const atmos_slice_optics *optics = s.optics;
+    const atmos_volume_optics *optics = s.optics;
     if (!optics) {
-        if ((st = atmos_slice_optics_build(ctx, scene, volume, &own_optics)) != ATMOS_OK) return st;
+        if ((st = atmos_volume_optics_build(ctx, scene, volume, 1, &own_optics)) != ATMOS_OK) return st;
         optics = &own_optics;
     }
     if (optics->count != volume->nfields) {
-        atmos_slice_optics_free(&own_optics);
+        atmos_volume_optics_free(&own_optics);
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render slice: optics for %d fields, the volume has %d",
                             optics->count, volume->nfields);
     }
 
     /* The sky behind everything: exactly atmos_render_sky's image (sun disk included). */
     atmos_image *img = NULL;
-    const double t_sky0 = now_seconds();
+    const double t_sky0 = atmos__now();
     if ((st = atmos_render_sky(ctx, scene, &img, NULL)) != ATMOS_OK) {
-        atmos_slice_optics_free(&own_optics);
+        atmos_volume_optics_free(&own_optics);
         return st;
     }
-    double t_sky = now_seconds() - t_sky0;
-    const double t_prep0 = now_seconds();
+    double t_sky = atmos__now() - t_sky0;
+    const double t_prep0 = atmos__now();
 
     sgrid g;
     stables tab;
@@ -669,9 +359,9 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     const int vacuum = scene->background != ATMOS_BACKGROUND_SKY;
     long long eye_samples = 0, light_samples = 0;
     double t_light = 0, t_eye = 0;
-    if ((st = sgrid_build(ctx, volume, s.density_scale, s.grid_max_dim, &g)) != ATMOS_OK) goto done;
+    if ((st = atmos__sgrid_build(ctx, volume, s.density_scale, s.grid_max_dim, &g)) != ATMOS_OK) goto done;
     if (!g.v) goto finish; /* empty volume: the sky alone */
-    if ((st = stables_build(ctx, optics, wl.count, s.max_order, &tab)) != ATMOS_OK) goto done;
+    if ((st = atmos__stables_build(ctx, optics, wl.count, s.max_order, &tab)) != ATMOS_OK) goto done;
     if ((st = atmos_sky_create(ctx, &scene->atmosphere, &wl, &sky)) != ATMOS_OK) goto done;
 
     /* World <-> grid frame. */
@@ -694,25 +384,25 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
      * light's travel when they are within 90° (front-to-back for the eye), else between
      * the inverted view and the light (back-to-front). The slices always advance along
      * h, away from the sun. */
-    j.btf = dot3(view_g, j.lt) < 0;
+    j.btf = atmos__dot3(view_g, j.lt) < 0;
     for (int a = 0; a < 3; a++) j.h[a] = (j.btf ? -view_g[a] : view_g[a]) + j.lt[a];
-    if (dot3(j.h, j.h) < 1e-20) memcpy(j.h, j.lt, sizeof j.h);
-    normalize3(j.h);
-    j.hl = dot3(j.h, j.lt);
+    if (atmos__dot3(j.h, j.h) < 1e-20) memcpy(j.h, j.lt, sizeof j.h);
+    atmos__normalize3(j.h);
+    j.hl = atmos__dot3(j.h, j.lt);
     if (j.hl < 1e-6) j.hl = 1e-6;
     {
         double ax[3] = {1, 0, 0};
         if (fabs(j.lt[0]) > 0.9) ax[0] = 0, ax[1] = 1;
-        cross3(ax, j.lt, j.e1);
-        normalize3(j.e1);
-        cross3(j.lt, j.e1, j.e2);
+        atmos__cross3(ax, j.lt, j.e1);
+        atmos__normalize3(j.e1);
+        atmos__cross3(j.lt, j.e1, j.e2);
     }
     /* Extents of the box along h (slices) and across the light (light buffer). */
     double smin = INFINITY, smax = -INFINITY, umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
     for (int c = 0; c < 8; c++) {
         double p[3] = {c & 1 ? g.box_hi[0] : g.box_lo[0], c & 2 ? g.box_hi[1] : g.box_lo[1],
                        c & 4 ? g.box_hi[2] : g.box_lo[2]};
-        double sv = dot3(p, j.h), uv = dot3(p, j.e1), vv = dot3(p, j.e2);
+        double sv = atmos__dot3(p, j.h), uv = atmos__dot3(p, j.e1), vv = atmos__dot3(p, j.e2);
         smin = fmin(smin, sv), smax = fmax(smax, sv);
         umin = fmin(umin, uv), umax = fmax(umax, uv);
         vmin = fmin(vmin, vv), vmax = fmax(vmax, vv);
@@ -734,7 +424,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     j.nslices = s.slices;
     j.s0 = smin;
     j.ds = (smax - smin) / s.slices;
-    j.he = dot3(j.h, j.eye);
+    j.he = atmos__dot3(j.h, j.eye);
     j.u0 = umin, j.v0 = vmin;
     j.du = (umax - umin) / j.L, j.dv = (vmax - vmin) / j.L;
     if (!(j.du > 0)) j.du = 1;
@@ -750,7 +440,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
      * that the same pixel of different planes does not fall in one cache set. */
     const size_t pst = npix + 32, nplanes = (size_t)14 + 2 * (size_t)j.nf + 2 * (size_t)j.n;
     j.pst = pst;
-    j.pixblock = big_alloc(sizeof(float) * pst * nplanes);
+    j.pixblock = atmos__big_alloc(sizeof(float) * pst * nplanes);
     if (j.pixblock) {
         float *b = j.pixblock;
         for (int a = 0; a < 3; a++) j.pU0[a] = b, b += pst, j.pdU[a] = b, b += pst;
@@ -772,7 +462,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         size_t slot = sizeof(float) * slotf;
         size_t fit = ((size_t)32 << 20) / slot;
         j.batch = fit > 17 ? 16 : (fit > 2 ? (int)fit - 1 : 1);
-        j.ring = big_alloc(slot * (size_t)(j.batch + 1));
+        j.ring = atmos__big_alloc(slot * (size_t)(j.batch + 1));
         j.I = malloc(sizeof(float *) * (size_t)(j.batch + 1));
         j.nsc = malloc(sizeof(float *) * (size_t)(j.batch + 1));
         if (j.ring && j.I && j.nsc)
@@ -795,7 +485,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     }
     j.lk1 = j.lk0 + LL;
     const int threads = atmos__threads(ctx);
-    const double t_setup0 = now_seconds();
+    const double t_setup0 = atmos__now();
 
     {
         double cf[3], cr[3], cu[3];
@@ -811,7 +501,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
      * the ground), its sample on slice k as a linear function of k, and the Ams angle
      * (scattering angle between the sun's light and the direction to the eye:
      * cos theta = d . sun). */
-    const double ee1 = dot3(j.eye, j.e1), ee2 = dot3(j.eye, j.e2);
+    const double ee1 = atmos__dot3(j.eye, j.e1), ee2 = atmos__dot3(j.eye, j.e2);
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
     for (int y = 0; y < j.H; y++) {
         int hint[ATMOS_VOLUME_MAX_FIELDS] = {0};
@@ -821,7 +511,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             double dw[3], d[3];
             atmos_camera_ray(&cam, (x + 0.5) * j.sx, (y + 0.5) * j.sy, dw);
             TO_GRID(dw, d);
-            double hd = dot3(j.h, d);
+            double hd = atmos__dot3(j.h, d);
             j.pk0[p] = 1, j.pk1[p] = 0;
             j.pinv[p] = 0;
             for (int a = 0; a < 3; a++) j.pU0[a][p] = j.pdU[a][p] = 0;
@@ -830,7 +520,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             for (int f = 0; f < j.nf; f++) j.pa[p * j.nf + f] = 0, j.pw[p * j.nf + f] = 0;
             double ta, tb;
             int ok = j.btf ? hd <= -SLICE_HD_EPS : hd >= SLICE_HD_EPS;
-            if (!ok || !ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) continue;
+            if (!ok || !atmos__ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) continue;
             if (ta < 0) ta = 0;
             double tg = vacuum ? INFINITY : atmos_sky_ground_distance(cam.position[1], dw);
             if (tb > tg) tb = tg;
@@ -849,16 +539,16 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 j.pU0[a][p] = (float)((j.eye[a] + t0 * d[a]) * g.sc + g.off[a]);
                 j.pdU[a][p] = (float)(dt * d[a] * g.sc);
             }
-            const double de1 = dot3(d, j.e1), de2 = dot3(d, j.e2);
+            const double de1 = atmos__dot3(d, j.e1), de2 = atmos__dot3(d, j.e2);
             j.pF0[0][p] = (float)((ee1 + t0 * de1 - j.u0) / j.du - 0.5);
             j.pdF[0][p] = (float)(dt * de1 / j.du);
             j.pF0[1][p] = (float)((ee2 + t0 * de2 - j.v0) / j.dv - 0.5);
             j.pdF[1][p] = (float)(dt * de2 / j.dv);
             j.pdelta[p] = (float)(j.ds * fabs(1.0 / hd));
-            double c = dot3(dw, sun_w);
+            double c = atmos__dot3(dw, sun_w);
             double th = acos(c > 1 ? 1 : (c < -1 ? -1 : c)) * ATMOS_RAD2DEG;
             for (int f = 0; f < j.nf; f++) {
-                angle_locate(tab.grid[f], tab.ng[f], th, &hint[f], &j.pw[p * j.nf + f]);
+                atmos__angle_locate(tab.grid[f], tab.ng[f], th, &hint[f], &j.pw[p * j.nf + f]);
                 j.pa[p * j.nf + f] = hint[f] * tab.no * j.n;
             }
         }
@@ -870,7 +560,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         double cen[3] = {0.5 * (g.box_lo[0] + g.box_hi[0]), 0.5 * (g.box_lo[1] + g.box_hi[1]),
                          0.5 * (g.box_lo[2] + g.box_hi[2])};
         const double *Rm = R;
-        const double he1 = dot3(j.h, j.e1), he2 = dot3(j.h, j.e2);
+        const double he1 = atmos__dot3(j.h, j.e1), he2 = atmos__dot3(j.h, j.e2);
         for (int a = 0; a < 3; a++) {
             double E1 = j.e1[a] - he1 / j.hl * j.lt[a], E2 = j.e2[a] - he2 / j.hl * j.lt[a];
             j.lA[a] = ((j.u0 + 0.5 * j.du) * E1 + (j.v0 + 0.5 * j.dv) * E2 + (j.s0 + 0.5 * j.ds) / j.hl * j.lt[a]) * g.sc +
@@ -900,8 +590,8 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                 double o[3] = {u * j.e1[0] + v * j.e2[0], u * j.e1[1] + v * j.e2[1], u * j.e1[2] + v * j.e2[2]};
                 double ta, tb, sl[ATMOS_MAX_WAVELENGTHS];
                 j.lk0[q] = 1, j.lk1[q] = 0;
-                if (ray_box(o, j.lt, g.box_lo, g.box_hi, &ta, &tb)) {
-                    double ho = dot3(j.h, o);
+                if (atmos__ray_box(o, j.lt, g.box_lo, g.box_hi, &ta, &tb)) {
+                    double ho = atmos__dot3(j.h, o);
                     slice_range(ho + ta * j.hl, ho + tb * j.hl, j.s0, j.ds, j.nslices, &j.lk0[q], &j.lk1[q]);
                     double entry[3];
                     for (int i = 0; i < 3; i++) entry[i] = o[i] + ta * j.lt[i];
@@ -919,8 +609,8 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
 #pragma omp parallel for schedule(static) num_threads(threads)
         for (int q = 1; q < nslot; q++) memcpy(j.I[q], j.I[0], sizeof(float) * LL * (size_t)(j.n + 1));
     }
-    const double t_setup = now_seconds() - t_setup0;
-    const double t_prep = now_seconds() - t_prep0;
+    const double t_setup = atmos__now() - t_setup0;
+    const double t_prep = atmos__now() - t_prep0;
 
     /* The slices, in batches of B (one parallel region, three barriers per batch).
      * Slot s of the light ring holds the light arriving at slice k0 + s. The light of
@@ -938,14 +628,14 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                                   float *) = s.reference ? atmos__slice_light_span_ref : atmos__slice_light_span;
     int cancelled = 0;
     const int nbatch = j.batch;
-    const double t_sl0 = now_seconds();
+    const double t_sl0 = atmos__now();
 #pragma omp parallel num_threads(threads) reduction(+ : eye_samples, light_samples)
     for (int k0 = 0; k0 < K; k0 += nbatch) {
         if (cancelled) break; /* set before the previous barrier: every thread sees the same value */
         const int nb = K - k0 < nbatch ? K - k0 : nbatch;
         double ta = 0;
 #pragma omp master
-        ta = now_seconds();
+        ta = atmos__now();
 #pragma omp for schedule(dynamic, 1)
         for (int b = 0; b < j.L; b++)
             for (int q = 0; q < nb; q++) {
@@ -957,7 +647,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             }
 #pragma omp master
         {
-            double tb = now_seconds();
+            double tb = atmos__now();
             t_light += tb - ta;
             ta = tb;
         }
@@ -970,7 +660,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             }
 #pragma omp master
         {
-            t_eye += now_seconds() - ta;
+            t_eye += atmos__now() - ta;
             float *last = j.I[nb], *lastn = j.nsc[nb];
             for (int q = nb; q > 0; q--) j.I[q] = j.I[q - 1], j.nsc[q] = j.nsc[q - 1];
             j.I[0] = last, j.nsc[0] = lastn;
@@ -978,7 +668,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         }
 #pragma omp barrier
     }
-    const double t_slices = now_seconds() - t_sl0;
+    const double t_slices = atmos__now() - t_sl0;
     (void)t_slices;
     if (cancelled) {
         st = atmos__error(ctx, ATMOS_E_CANCELLED, "render slice: cancelled");
@@ -991,10 +681,10 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
      *   front + T_front * L_vol + T_vol * (B - front).
      * Pixels the volume does not touch keep B exactly. */
     {
-        const double t_c0 = now_seconds();
+        const double t_c0 = atmos__now();
         double cen[3] = {0.5 * (g.box_lo[0] + g.box_hi[0]), 0.5 * (g.box_lo[1] + g.box_hi[1]),
                          0.5 * (g.box_lo[2] + g.box_hi[2])};
-        const double hc = dot3(j.h, cen);
+        const double hc = atmos__dot3(j.h, cen);
         const int C = img->channels;
         if (j.sx == 1.0 && j.sy == 1.0) {
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
@@ -1056,13 +746,13 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                     double dw[3], d[3];
                     atmos_camera_ray(&cam, x + 0.5, y + 0.5, dw);
                     TO_GRID(dw, d);
-                    const double hd = dot3(j.h, d);
+                    const double hd = atmos__dot3(j.h, d);
                     double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j.he) / hd : 0.0;
                     composite_pixel(sky, vacuum, &cam, dw, th, sun_w, j.n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
                 }
             }
         }
-        t_sky += now_seconds() - t_c0;
+        t_sky += atmos__now() - t_c0;
     }
     if (s.timing) {
         s.timing->prepare = t_prep;
@@ -1079,7 +769,7 @@ finish:
                  j.W ? j.W : cam.width, j.H ? j.H : cam.height, s.xi, s.update == ATMOS_SLICE_EQ24 ? "eq24" : "eq25",
                  s.low_albedo ? ", low albedo" : "");
         atmos_image_set_meta(img, "atmos:slice", buf);
-        double secs = now_seconds() - t_start;
+        double secs = atmos__now() - t_start;
         snprintf(buf, sizeof buf, "%.6f", secs);
         atmos_image_set_meta(img, "atmos:render_seconds", buf);
         if (info) {
@@ -1103,9 +793,9 @@ done:
     free(j.pixblock), free(j.ring), free(j.I), free(j.nsc), free(j.lk0);
     free(j.espan), free(j.lspan), free(j.wspan), free(j.erow), free(j.lrow);
     atmos_sky_destroy(sky);
-    stables_free(&tab);
-    sgrid_free(&g);
-    atmos_slice_optics_free(&own_optics);
+    atmos__stables_free(&tab);
+    atmos__sgrid_free(&g);
+    atmos_volume_optics_free(&own_optics);
     if (st != ATMOS_OK) {
         atmos_image_destroy(img);
         return st;

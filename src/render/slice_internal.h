@@ -5,39 +5,8 @@
 
 #include "core/internal.h"
 
-#define SLICE_OCC_B 4          /* occupancy block edge, render-grid voxels */
-#define SLICE_F_ORDERS 256     /* F_n and S(n) tabulated at integer n = 0..SLICE_F_ORDERS */
-
-/* The volume box-filtered onto a dense grid (integer factor f native voxels per
- * render voxel), fields interleaved per voxel, with one empty voxel of padding on
- * every side so that the trilinear interpolant falls to zero at the edges, and a
- * coarse occupancy grid (Riley §3.2's majorant idea: blocks that are exactly empty
- * are skipped without interpolating). */
-typedef struct {
-    int nf;
-    int c[3];             /* render voxels per axis, padding included */
-    float *v;             /* c0*c1*c2*nf */
-    int ob[3];
-    unsigned char *occ;   /* ob0*ob1*ob2 */
-    float sc, off[3];     /* u = g * sc + off: grid-frame metres -> render-voxel coordinate */
-    double box_lo[3], box_hi[3]; /* grid-frame metres where the interpolant may be nonzero */
-} sgrid;
-
-typedef struct {
-    int n;                     /* wavelengths */
-    int nf;                    /* fields */
-    float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* sigma_ext, m^2 */
-    float sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* albedo * sigma_ext */
-    int no;                    /* Ams orders tabulated: 1..no */
-    int ng[ATMOS_VOLUME_MAX_FIELDS];
-    const double *grid[ATMOS_VOLUME_MAX_FIELDS];  /* theta, degrees */
-    float *ams[ATMOS_VOLUME_MAX_FIELDS];          /* [(a * no + (order - 1)) * n + k]: the wavelengths of
-                                                     an angle and order side by side, so that the
-                                                     bilinear taps of all wavelengths of a sample
-                                                     fall in two cache lines */
-    float *F[ATMOS_VOLUME_MAX_FIELDS];            /* [k * (SLICE_F_ORDERS+1) + n]: F_n (Eq. 23) */
-    float *S[ATMOS_VOLUME_MAX_FIELDS];            /* same layout: S(n) = sum_{i<=n} ln F_i */
-} stables;
+#include "render/slice_grid.h"
+#include "render/slice_tables.h"
 
 /* Pixels x0..x1 of one image row, or texels of one light-buffer row, that a slice
  * touches (x0 > x1: none). */

@@ -317,6 +317,23 @@ atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene 
     return st;
 }
 
+atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_scene *scene, atmos_wavelengths *out)
+{
+    if (scene->wavelengths == ATMOS_WAVELENGTHS_RGB) {
+        atmos_wavelengths_rgb(out);
+    } else if (atmos_wavelengths_spectral(scene->spectral_samples, out) != ATMOS_OK) {
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "wavelengths/samples: must be in [1, %d], got %d",
+                            ATMOS_MAX_WAVELENGTHS, scene->spectral_samples);
+    }
+    /* A sun given by its irradiance replaces the solar spectrum; the colour
+     * conversion stays that of the set (to_srgb/to_xyz are unchanged). */
+    if (scene->sun.irradiance_count == 1)
+        for (int i = 0; i < out->count; i++) out->sun_irradiance[i] = scene->sun.irradiance[0];
+    else if (scene->sun.irradiance_count == 3 && out->count == 3)
+        for (int i = 0; i < 3; i++) out->sun_irradiance[i] = scene->sun.irradiance[i];
+    return ATMOS_OK;
+}
+
 atmos_status atmos_scene_sun_direction(atmos_context *ctx, const atmos_scene *scene, double dir[3],
                                        double *elevation_deg, double *azimuth_deg)
 {

@@ -6,6 +6,7 @@
 #define ATMOS_GENERATE_INTERNAL_H
 
 #include "atmos/atmos.h"
+#include "core/rng.h"
 
 #include <stdint.h>
 
@@ -15,15 +16,8 @@ typedef struct {
     uint64_t s;
 } gen_rng;
 
-static inline uint64_t gen_next(gen_rng *r)
-{
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
 /* Uniform in [0, 1). */
-static inline double gen_u01(gen_rng *r) { return (double)(gen_next(r) >> 11) * (1.0 / 9007199254740992.0); }
+static inline double gen_u01(gen_rng *r) { return atmos__u01(atmos__splitmix64(&r->s)); }
 static inline double gen_range(gen_rng *r, double lo, double hi) { return lo + (hi - lo) * gen_u01(r); }
 
 /* A dense scalar work grid in world space: value at voxel centre

@@ -171,7 +171,7 @@ static atmos_status rain_shaft_preset(gen_job *job)
     atmos__gen_accumulate(&job->grid[0], &job->balls, 0, job->threads);
     int fj = atmos__gen_floor_j(job, base);
     if ((st = refine(job, &job->grid[0], 0.075 * w, 2, fj, 1)) != ATMOS_OK) return st;
-    rain_shaft(job, &job->grid[1], &job->grid[0], base, 0.25 * w, 400 * s, gen_next(&job->rng));
+    rain_shaft(job, &job->grid[1], &job->grid[0], base, 0.25 * w, 400 * s, atmos__splitmix64(&job->rng.s));
     cloud_density(job, &job->grid[0], base, 0.8 * w, ETA_CLOUD, fj);
     return ATMOS_OK;
 }
@@ -220,7 +220,7 @@ static atmos_status cumulonimbus(gen_job *job, int with_rain)
     }
     atmos__gen_accumulate(&job->grid[1], &anvil, 0, job->threads);
     atmos__gen_balls_free(&anvil);
-    uint64_t seed_anvil = gen_next(&job->rng), seed_rain = gen_next(&job->rng);
+    uint64_t seed_anvil = atmos__splitmix64(&job->rng.s), seed_rain = atmos__splitmix64(&job->rng.s);
     if (with_rain) rain_shaft(job, &job->grid[2], &job->grid[0], base, 2200 * s, 1200 * s, seed_rain);
     /* Split the tower into liquid and ice by height (glaciation), add the anvil. */
     const double yg0 = base + 6000 * s, yg1 = base + 7500 * s;
@@ -256,7 +256,7 @@ static atmos_status cirrus(gen_job *job)
     double lo[3] = {-half, 8000, -half}, hi[3] = {half, 8000 + 2000 * s, half};
     atmos_status st = atmos__gen_grid_init(job, lo, hi);
     if (st != ATMOS_OK) return st;
-    uint64_t s1 = gen_next(&job->rng), s2 = gen_next(&job->rng), s3 = gen_next(&job->rng), s4 = gen_next(&job->rng);
+    uint64_t s1 = atmos__splitmix64(&job->rng.s), s2 = atmos__splitmix64(&job->rng.s), s3 = atmos__splitmix64(&job->rng.s), s4 = atmos__splitmix64(&job->rng.s);
     gen_grid *g = &job->grid[0];
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < g->n[2]; k++)

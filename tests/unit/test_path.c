@@ -80,7 +80,7 @@ static void test_ad(void)
 
 typedef struct {
     atmos_phase_table *t;
-    atmos_slice_optics o;
+    atmos_volume_optics o;
 } optics;
 
 /* w1 HG(g1) + (1 - w1) HG(g2); w1 = 1: one lobe */

@@ -54,7 +54,7 @@ static atmos_context *make_ctx(void)
 typedef struct {
     atmos_phase_table *t;
     atmos_msphase *m;
-    atmos_slice_optics o;
+    atmos_volume_optics o;
 } optics;
 
 static void build_optics(atmos_context *ctx, const atmos_particle_desc *p, optics *op)

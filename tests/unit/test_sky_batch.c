@@ -1,7 +1,7 @@
 /* The renderer's fast float sky evaluator against the double-precision library
  * functions (which are themselves checked against quadrature in test_sky). */
 #include "atmos/atmos.h"
-#include "render/sky_batch.h"
+#include "atmosphere/riley_batch.h"
 #include "test.h"
 
 static void compare(const atmos_wavelengths *wl, double albedo, double eye_y, double *max_err, int *n_bad)

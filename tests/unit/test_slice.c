@@ -57,7 +57,7 @@ static atmos_volume *blob(atmos_context *ctx, float peak)
 typedef struct {
     atmos_phase_table *t;
     atmos_msphase *m;
-    atmos_slice_optics o;
+    atmos_volume_optics o;
 } optics;
 
 /* An analytic Henyey-Greenstein particle (g = 0.7, sigma_ext 1e-9 m^2, albedo 0.95):

@@ -491,7 +491,7 @@ static void test_scene_volume(atmos_context *ctx)
     double offset[3] = {0 - 100, 900 - 0, -3000 - 100};
     double sigma[1] = {2e-11}; /* 2e-11 m^2 * 1e8 m^-3 = 2e-3 m^-1; tau = 0.4 over 200 m */
     atmos_image *img = NULL;
-    CHECK_OK(atmos_volume_optical_depth_image(ctx, &s, v, sigma, offset, &img));
+    CHECK_OK(atmos_render_optical_depth(ctx, &s, v, sigma, offset, &img));
     if (img) {
         CHECK_REL(img->pixels[16 * 33 + 16], 0.4, 1e-4);
         CHECK(img->pixels[0] == 0.0f && img->pixels[33 * 33 - 1] == 0.0f);
@@ -504,7 +504,7 @@ static void test_scene_volume(atmos_context *ctx)
     s.volume.placed = 1;
     s.volume.position_m[0] = 10, s.volume.position_m[1] = 8000, s.volume.position_m[2] = -20;
     double o[3], lo[3], hi[3];
-    CHECK_OK(atmos_volume_load_scene(ctx, &s, &v, o));
+    CHECK_OK(atmos_scene_load_volume(ctx, &s, &v, o));
     if (v) {
         atmos_volume_bounds(v, lo, hi);
         CHECK_NEAR(0.5 * (lo[0] + hi[0]) + o[0], 10, 1e-6);
@@ -515,7 +515,7 @@ static void test_scene_volume(atmos_context *ctx)
     double o2[3];
     atmos_volume_destroy(v);
     v = NULL;
-    CHECK_OK(atmos_volume_load_scene(ctx, &s, &v, o2));
+    CHECK_OK(atmos_scene_load_volume(ctx, &s, &v, o2));
     if (v) {
         /* In front (north) of the camera, at least 4 km away, at its own altitude. */
         double cz = 0.5 * (lo[2] + hi[2]) + o2[2], cx = 0.5 * (lo[0] + hi[0]) + o2[0];
@@ -524,7 +524,7 @@ static void test_scene_volume(atmos_context *ctx)
     atmos_volume_destroy(v);
     snprintf(s.volume.source, sizeof s.volume.source, "generate:nope");
     v = NULL;
-    CHECK(atmos_volume_load_scene(ctx, &s, &v, o) == ATMOS_E_INVALID_ARG && v == NULL);
+    CHECK(atmos_scene_load_volume(ctx, &s, &v, o) == ATMOS_E_INVALID_ARG && v == NULL);
 }
 
 int main(void)

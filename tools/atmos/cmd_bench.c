@@ -395,9 +395,9 @@ static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *
     atmos_slice_defaults(&ss);
     ss.eye_scale = eye_scale > 0 ? eye_scale : 1.0;
     bench_view(&scene, v, size, ss.offset_m);
-    atmos_slice_optics optics;
+    atmos_volume_optics optics;
     double t0 = now_s();
-    atmos_status st = atmos_slice_optics_build(ctx, &scene, v, &optics);
+    atmos_status st = atmos_volume_optics_build(ctx, &scene, v, 1, &optics);
     double t_opt = now_s() - t0;
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     ss.optics = &optics;
@@ -410,12 +410,12 @@ static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *
         st = atmos_render_slice(ctx, &scene, v, &ss, &img, NULL);
         atmos_image_destroy(img);
         if (st != ATMOS_OK) {
-            atmos_slice_optics_free(&optics);
+            atmos_volume_optics_free(&optics);
             return cli_runtime_error("bench", ctx, st);
         }
         if (tm.total < best) best = tm.total, best_tm = tm;
     }
-    atmos_slice_optics_free(&optics);
+    atmos_volume_optics_free(&optics);
     /* The per-frame work: set-up (rays, light texels, spans), light, eye, sky. The rest of
      * prepare (resampling the volume, tables) is done once per volume in an interactive session. */
     double frame = best_tm.setup + best_tm.light + best_tm.eye + best_tm.sky;
@@ -456,9 +456,9 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     ps.no_forced = flags->no_forced;
     ps.no_sky_nee = flags->no_sky_nee;
     ps.no_aureole = flags->no_aureole;
-    atmos_slice_optics optics;
+    atmos_volume_optics optics;
     double t0 = now_s();
-    atmos_status st = atmos_path_optics_build(ctx, &scene, v, &optics);
+    atmos_status st = atmos_volume_optics_build(ctx, &scene, v, 0, &optics);
     double t_opt = now_s() - t0;
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     ps.optics = &optics;
@@ -467,7 +467,7 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     atmos_image *img = NULL, *var = NULL;
     ps.variance = &var;
     st = atmos_render_path(ctx, &scene, v, &ps, &img, NULL);
-    atmos_slice_optics_free(&optics);
+    atmos_volume_optics_free(&optics);
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     /* The volume's pixels: vacuum, the nonzero ones; sky, those differing from a render
      * without the volume by more than 3 standard errors. */

@@ -141,17 +141,17 @@ enum { O_EYESCALE = 512, O_NOSKYNEE, O_NOFORCED, O_NOAUREOLE }; /* slice rendere
 static atmos_status write_tau(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
                               const double offset[3], const char *path)
 {
-    atmos_slice_optics o;
-    atmos_status st = atmos_slice_optics_build(ctx, scene, vol, &o);
+    atmos_volume_optics o;
+    atmos_status st = atmos_volume_optics_build(ctx, scene, vol, 1, &o);
     if (st != ATMOS_OK) return st;
     double sigma[ATMOS_VOLUME_MAX_FIELDS] = {0};
     for (int f = 0; f < o.count; f++) {
         int k = atmos_phase_table_wavelength_count(o.phase[f]) / 2;
         sigma[f] = atmos_phase_table_sigma_ext(o.phase[f], k) * scene->volume.density_scale;
     }
-    atmos_slice_optics_free(&o);
+    atmos_volume_optics_free(&o);
     atmos_image *img = NULL;
-    if ((st = atmos_volume_optical_depth_image(ctx, scene, vol, sigma, offset, &img)) != ATMOS_OK) return st;
+    if ((st = atmos_render_optical_depth(ctx, scene, vol, sigma, offset, &img)) != ATMOS_OK) return st;
     st = atmos_write_pfm(ctx, img, path);
     atmos_image_destroy(img);
     return st;
@@ -367,7 +367,7 @@ int cli_cmd_render(int argc, char **argv)
     const char *source = scene_path ? scene_path : "default scene";
     /* Released at fail: */
     atmos_volume *vol = NULL;
-    atmos_slice_optics optics;
+    atmos_volume_optics optics;
     memset(&optics, 0, sizeof optics);
     atmos_image *spec = NULL, *lin = NULL, *disp = NULL;
     int frame = 0, nframes = 1, numbered = 0;
@@ -493,9 +493,9 @@ int cli_cmd_render(int argc, char **argv)
     if ((st = atmos_scene_wavelengths(ctx, &scene, &wl)) != ATMOS_OK) goto fail;
     /* The path tracer may render without a volume (sky and ground only). */
     if (scene.volume.source[0] && scene.renderer != ATMOS_RENDERER_SKY) {
-        if ((st = atmos_volume_load_scene(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
-        if (scene.renderer == ATMOS_RENDERER_SLICE) st = atmos_slice_optics_build(ctx, &scene, vol, &optics);
-        else st = atmos_path_optics_build(ctx, &scene, vol, &optics);
+        if ((st = atmos_scene_load_volume(ctx, &scene, &vol, offset)) != ATMOS_OK) goto fail;
+        if (scene.renderer == ATMOS_RENDERER_SLICE) st = atmos_volume_optics_build(ctx, &scene, vol, 1, &optics);
+        else st = atmos_volume_optics_build(ctx, &scene, vol, 0, &optics);
         if (st != ATMOS_OK) goto fail;
         if (tau_path && (st = write_tau(ctx, &scene, vol, offset, tau_path)) != ATMOS_OK) goto fail;
     }
@@ -607,7 +607,7 @@ int cli_cmd_render(int argc, char **argv)
     if (!quiet && nframes > 1)
         fprintf(stderr, "atmos render: %d frames, %.3f s rendering (volume and optics prepared once)\n", nframes,
                 total_seconds);
-    atmos_slice_optics_free(&optics);
+    atmos_volume_optics_free(&optics);
     atmos_volume_destroy(vol);
     atmos_context_destroy(ctx);
     return CLI_EXIT_OK;
@@ -621,7 +621,7 @@ fail:
         atmos_image_destroy(spec);
         atmos_image_destroy(lin);
         atmos_image_destroy(disp);
-        atmos_slice_optics_free(&optics);
+        atmos_volume_optics_free(&optics);
         atmos_volume_destroy(vol);
         atmos_context_destroy(ctx);
         return rc;
@@ -630,7 +630,7 @@ fail_quiet:
     atmos_image_destroy(spec);
     atmos_image_destroy(lin);
     atmos_image_destroy(disp);
-    atmos_slice_optics_free(&optics);
+    atmos_volume_optics_free(&optics);
     atmos_volume_destroy(vol);
     atmos_context_destroy(ctx);
     return CLI_EXIT_USAGE;

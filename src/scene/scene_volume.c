@@ -5,7 +5,7 @@
 #include <math.h>
 #include <string.h>
 
-atmos_status atmos_volume_load_scene(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
+atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
                                      double offset_m[3])
 {
     if (!scene || !out || !offset_m) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "scene volume: missing argument");
@@ -31,8 +31,16 @@ atmos_status atmos_volume_load_scene(atmos_context *ctx, const atmos_scene *scen
         st = atmos_volume_load(ctx, sv->source, &ld, &vol);
     }
     if (st != ATMOS_OK) return st;
+    atmos_scene_volume_offset(scene, vol, offset_m);
+    *out = vol;
+    return ATMOS_OK;
+}
+
+void atmos_scene_volume_offset(const atmos_scene *scene, const atmos_volume *volume, double offset_m[3])
+{
+    const atmos_scene_volume *sv = &scene->volume;
     double lo[3], hi[3];
-    atmos_volume_bounds(vol, lo, hi);
+    atmos_volume_bounds(volume, lo, hi);
     if (sv->placed) {
         /* position_m is where the centre of the box's bottom face goes. */
         offset_m[0] = sv->position_m[0] - 0.5 * (lo[0] + hi[0]);
@@ -51,33 +59,4 @@ atmos_status atmos_volume_load_scene(atmos_context *ctx, const atmos_scene *scen
         offset_m[1] = 0.0;
         offset_m[2] = c->position[2] + f[2] / fh * dist - 0.5 * (lo[2] + hi[2]);
     }
-    *out = vol;
-    return ATMOS_OK;
-}
-
-atmos_status atmos_volume_optical_depth_image(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
-                                              const double *sigma_ext, const double offset_m[3], atmos_image **out)
-{
-    if (!scene || !volume || !sigma_ext || !offset_m || !out)
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "optical depth image: missing argument");
-    *out = NULL;
-    atmos_camera cam;
-    atmos_status st = atmos_camera_init(ctx, &scene->camera, scene->width, scene->height, &cam);
-    if (st != ATMOS_OK) return st;
-    atmos_image *img = NULL;
-    if ((st = atmos_image_create(ctx, scene->width, scene->height, 1, &img)) != ATMOS_OK) return st;
-    const double o[3] = {cam.position[0] - offset_m[0], cam.position[1] - offset_m[1], cam.position[2] - offset_m[2]};
-    const int W = scene->width, H = scene->height;
-    /* Each pixel is written by one iteration: the image is the same on any thread count. */
-#pragma omp parallel for schedule(dynamic, 4) num_threads(atmos__threads(ctx))
-    for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-            double d[3];
-            float tau = 0.0f;
-            if (atmos_camera_ray(&cam, x + 0.5, y + 0.5, d))
-                tau = (float)atmos_volume_optical_depth(volume, sigma_ext, o, d, 0.0, INFINITY);
-            img->pixels[(size_t)y * W + x] = tau;
-        }
-    *out = img;
-    return ATMOS_OK;
 }

@@ -1,7 +1,7 @@
 /* Fast float evaluation of the analytic sky (see sky_batch.h and src/sky/sky.c). */
-#include "render/sky_batch.h"
+#include "atmosphere/riley_batch.h"
 #include "core/internal.h"
-#include "sky/sky_internal.h"
+#include "atmosphere/riley.h"
 
 #include <math.h>
 #include <stdint.h>

@@ -20,7 +20,7 @@
  * exact limits rather than 0/0.
  */
 #include "core/internal.h"
-#include "sky/sky_internal.h"
+#include "atmosphere/riley.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -39,8 +39,6 @@ void atmos_atmosphere_defaults(atmos_atmosphere_desc *d)
     d->sun_diameter_deg = 0.5;
     d->sun_scale = 1.0;
 }
-
-double atmos_phase_rayleigh(double cos_theta) { return 3.0 / (16.0 * ATMOS_PI) * (1.0 + cos_theta * cos_theta); }
 
 double atmos__sky_g(double z)
 {

@@ -1,5 +1,6 @@
 /* Cameras: pinhole, equidistant fisheye, equirectangular. */
 #include "core/internal.h"
+#include "core/vec.h"
 
 #include <math.h>
 #include <string.h>
@@ -41,7 +42,6 @@ void atmos_camera_defaults(atmos_camera_type type, const double position[3], atm
     }
 }
 
-static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static void cross3(const double a[3], const double b[3], double o[3])
 {
     double r[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
@@ -49,7 +49,7 @@ static void cross3(const double a[3], const double b[3], double o[3])
 }
 static double norm3(double v[3])
 {
-    double l = sqrt(dot3(v, v));
+    double l = sqrt(atmos__dot3(v, v));
     if (l > 0) v[0] /= l, v[1] /= l, v[2] /= l;
     return l;
 }
@@ -92,7 +92,7 @@ atmos_status atmos_camera_init(atmos_context *ctx, const atmos_camera_desc *desc
     int has_up = desc->up[0] != 0 || desc->up[1] != 0 || desc->up[2] != 0;
     if (has_up) {
         for (int i = 0; i < 3; i++) up[i] = desc->up[i];
-    } else if (fisheye && fabs(fwd[1]) > 0.99 * sqrt(dot3(fwd, fwd))) {
+    } else if (fisheye && fabs(fwd[1]) > 0.99 * sqrt(atmos__dot3(fwd, fwd))) {
         up[0] = 0, up[1] = 0, up[2] = -1; /* looking up or down: north at the top */
     } else {
         up[0] = 0, up[1] = 1, up[2] = 0;

@@ -1,0 +1,87 @@
+/* The slice renderer's optics tables (slice_tables.h): sigma_ext and albedo per field and
+ * wavelength, Ams_n in a layout the eye pass reads in two cache lines, F_n and S(n). */
+#include "render/slice_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void atmos__stables_free(stables *t)
+{
+    for (int f = 0; f < ATMOS_VOLUME_MAX_FIELDS; f++) free(t->ams[f]), free(t->F[f]), free(t->S[f]);
+}
+
+atmos_status atmos__stables_build(atmos_context *ctx, const atmos_volume_optics *o, int n, int max_order, stables *t)
+{
+    memset(t, 0, sizeof *t);
+    t->n = n;
+    t->nf = o->count;
+    t->no = max_order < 2 ? 2 : max_order;
+    for (int f = 0; f < o->count; f++) {
+        if (!o->phase[f] || !o->ms[f]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "slice: optics of field %d missing", f);
+        if (atmos_phase_table_wavelength_count(o->phase[f]) != n || atmos_msphase_wavelength_count(o->ms[f]) != n)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                                "slice: optics of field %d have %d wavelengths, the scene %d", f,
+                                atmos_phase_table_wavelength_count(o->phase[f]), n);
+        const atmos_msphase *m = o->ms[f];
+        int mo = atmos_msphase_max_order(m);
+        t->ng[f] = atmos_msphase_grid(m, &t->grid[f]);
+        const int ng = t->ng[f];
+        t->ams[f] = malloc(sizeof(float) * (size_t)n * ng * t->no);
+        t->F[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
+        t->S[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
+        if (!t->ams[f] || !t->F[f] || !t->S[f]) {
+            atmos__stables_free(t);
+            return atmos__error(ctx, ATMOS_E_NOMEM, "slice: out of memory for Ams tables");
+        }
+        for (int k = 0; k < n; k++) {
+            double se = atmos_phase_table_sigma_ext(o->phase[f], k), al = atmos_phase_table_albedo(o->phase[f], k);
+            if (!(se >= 0) || !isfinite(se)) se = 0;
+            if (!(al >= 0)) al = 0;
+            if (al > 1) al = 1;
+            t->sig[f][k] = (float)se;
+            t->sca[f][k] = (float)(se * al);
+            for (int ord = 1; ord <= t->no; ord++) {
+                /* Orders past the table's last are isotropic (Riley §4.2.1). */
+                const double *vals = ord <= mo ? atmos_msphase_values(m, k, ord) : NULL;
+                for (int a = 0; a < ng; a++)
+                    t->ams[f][((size_t)a * t->no + (ord - 1)) * n + k] =
+                        (float)(vals ? vals[a] : 1.0 / (4.0 * ATMOS_PI));
+            }
+            for (int i = 0; i <= SLICE_F_ORDERS; i++) {
+                t->F[f][(size_t)k * (SLICE_F_ORDERS + 1) + i] = (float)atmos_msphase_forward(m, k, i);
+                t->S[f][(size_t)k * (SLICE_F_ORDERS + 1) + i] = (float)atmos_msphase_log_forward_sum(m, k, i);
+            }
+        }
+    }
+    return ATMOS_OK;
+}
+
+/* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. *a
+ * holds a guess on entry (the neighbouring pixel's index: angles change little from
+ * pixel to pixel), tried with its neighbours before a binary search. */
+void atmos__angle_locate(const double *grid, int ng, double theta_deg, int *a, float *w)
+{
+    int lo = 0, hi = ng - 1;
+    for (int g = *a - 1; g <= *a + 1; g++)
+        if (g >= 0 && g < ng - 1 && grid[g] < theta_deg && theta_deg < grid[g + 1]) {
+            *a = g;
+            *w = (float)((theta_deg - grid[g]) / (grid[g + 1] - grid[g]));
+            return;
+        }
+    if (theta_deg <= grid[0]) {
+        *a = 0, *w = 0;
+        return;
+    }
+    if (theta_deg >= grid[ng - 1]) {
+        *a = ng - 2, *w = 1;
+        return;
+    }
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (grid[mid] <= theta_deg) lo = mid;
+        else hi = mid;
+    }
+    *a = lo;
+    *w = (float)((theta_deg - grid[lo]) / (grid[lo + 1] - grid[lo]));
+}
