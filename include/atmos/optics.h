@@ -163,6 +163,10 @@ ATMOS_API double atmos_phase_table_sample(const atmos_phase_table *t, int k, dou
 /* Per wavelength: extinction cross-section (m^2), single-scattering albedo, asymmetry g. */
 ATMOS_API double atmos_phase_table_sigma_ext(const atmos_phase_table *t, int k);
 ATMOS_API double atmos_phase_table_albedo(const atmos_phase_table *t, int k);
+/* The extinction and scattering cross-sections (m^2) at wavelength k as renderers use them:
+ * sigma_ext made finite and >= 0, the albedo clamped to [0, 1], sigma_sca = albedo sigma_ext. */
+ATMOS_API void atmos_phase_table_cross_sections(const atmos_phase_table *t, int k, double *sigma_ext,
+                                                double *sigma_sca);
 ATMOS_API double atmos_phase_table_g(const atmos_phase_table *t, int k);
 /* 1 if the table was read from the disk cache. */
 ATMOS_API int atmos_phase_table_from_cache(const atmos_phase_table *t);

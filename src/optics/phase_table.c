@@ -485,6 +485,16 @@ const double *atmos_phase_table_values(const atmos_phase_table *t, int k)
 }
 double atmos_phase_table_sigma_ext(const atmos_phase_table *t, int k) { return wl_ok(t, k) ? t->sigma_ext[k] : 0.0; }
 double atmos_phase_table_albedo(const atmos_phase_table *t, int k) { return wl_ok(t, k) ? t->albedo[k] : 0.0; }
+
+void atmos_phase_table_cross_sections(const atmos_phase_table *t, int k, double *sigma_ext, double *sigma_sca)
+{
+    double se = atmos_phase_table_sigma_ext(t, k), al = atmos_phase_table_albedo(t, k);
+    if (!(se >= 0) || !isfinite(se)) se = 0;
+    if (!(al >= 0)) al = 0;
+    if (al > 1) al = 1;
+    *sigma_ext = se;
+    *sigma_sca = se * al;
+}
 double atmos_phase_table_g(const atmos_phase_table *t, int k) { return wl_ok(t, k) ? t->g[k] : 0.0; }
 int atmos_phase_table_from_cache(const atmos_phase_table *t) { return t ? t->from_cache : 0; }
 

@@ -54,12 +54,10 @@ atmos_status atmos__path_medium_build(atmos_context *ctx, const atmos_volume *v,
     m->inv_vs = 1.0 / v->desc.voxel_size_m;
     for (int f = 0; f < m->nf; f++)
         for (int k = 0; k < nwl; k++) {
-            double se = atmos_phase_table_sigma_ext(o->phase[f], k), al = atmos_phase_table_albedo(o->phase[f], k);
-            if (!(se >= 0) || !isfinite(se)) se = 0;
-            if (!(al >= 0)) al = 0;
-            if (al > 1) al = 1;
+            double se, ss;
+            atmos_phase_table_cross_sections(o->phase[f], k, &se, &ss);
             m->sig[f][k] = (float)se;
-            m->sca[f][k] = (float)(se * al);
+            m->sca[f][k] = (float)ss;
         }
     const uint64_t nc = v->nbricks;
     m->mm = calloc((size_t)nc * m->nf * 2, sizeof(float));

@@ -35,12 +35,10 @@ atmos_status atmos__stables_build(atmos_context *ctx, const atmos_volume_optics 
             return atmos__error(ctx, ATMOS_E_NOMEM, "slice: out of memory for Ams tables");
         }
         for (int k = 0; k < n; k++) {
-            double se = atmos_phase_table_sigma_ext(o->phase[f], k), al = atmos_phase_table_albedo(o->phase[f], k);
-            if (!(se >= 0) || !isfinite(se)) se = 0;
-            if (!(al >= 0)) al = 0;
-            if (al > 1) al = 1;
+            double se, ss;
+            atmos_phase_table_cross_sections(o->phase[f], k, &se, &ss);
             t->sig[f][k] = (float)se;
-            t->sca[f][k] = (float)(se * al);
+            t->sca[f][k] = (float)ss;
             for (int ord = 1; ord <= t->no; ord++) {
                 /* Orders past the table's last are isotropic (Riley §4.2.1). */
                 const double *vals = ord <= mo ? atmos_msphase_values(m, k, ord) : NULL;
