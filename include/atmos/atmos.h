@@ -109,7 +109,7 @@ ATMOS_API atmos_status atmos_copy_file_atomic(atmos_context *ctx, const char *sr
 #include "atmos/spectrum.h"
 #include "atmos/camera.h"
 #include "atmos/sun.h"
-#include "atmos/sky.h"
+#include "atmos/atmosphere.h"
 #include "atmos/image.h"
 #include "atmos/optics.h"
 #include "atmos/volume.h"

@@ -34,16 +34,6 @@ typedef enum {
     ATMOS_RENDERER_PATH = 2   /* Monte Carlo volumetric path tracing over the volume (path.h) */
 } atmos_renderer_kind;
 
-/* What surrounds the volume ("background" in the file). */
-typedef enum {
-    ATMOS_BACKGROUND_SKY = 0,     /* the atmosphere: sky, ground, aerial perspective, sunlight
-                                     attenuated by the air (default) */
-    ATMOS_BACKGROUND_BLACK = 1,   /* vacuum: no air, no ground, radiance 0 behind the volume;
-                                     the sun arrives unattenuated and its disk is not drawn */
-    ATMOS_BACKGROUND_UNIFORM = 2  /* vacuum as BLACK, but radiance background_radiance from
-                                     every direction (lights the volume too) */
-} atmos_background_kind;
-
 #define ATMOS_SCENE_PATH_MAX 1024
 
 /* The volume of a scene ("volume" in the file). source "" = no volume. */
@@ -104,7 +94,10 @@ typedef struct atmos_scene {
     int samples_per_pixel;                /* stratified samples per pixel, 1..256 */
     atmos_camera_desc camera;
     atmos_scene_sun sun;
-    atmos_atmosphere_desc atmosphere;
+    atmos_atmosphere_desc atmosphere;     /* "atmosphere" in the file; "background": "black" or
+                                             {"type": "uniform", "radiance": L} make it a vacuum
+                                             (ATMOS_ATMOSPHERE_VACUUM: no air, no ground, L from
+                                             every direction), "sky" the scene's atmosphere */
     atmos_wavelength_mode wavelengths;
     int spectral_samples;                 /* with spectral mode, 1..ATMOS_MAX_WAVELENGTHS */
     atmos_tonemap_desc tonemap;
@@ -113,8 +106,6 @@ typedef struct atmos_scene {
     int particle_count;                   /* user-defined particle types ("particles" in the file) */
     atmos_particle_desc particles[ATMOS_SCENE_MAX_PARTICLES]; /* each named by .name */
     atmos_renderer_kind renderer;
-    atmos_background_kind background;
-    double background_radiance;           /* UNIFORM: W m^-2 sr^-1 nm^-1 at every wavelength */
     atmos_scene_volume volume;
     atmos_scene_slice slice;
     atmos_scene_path path;

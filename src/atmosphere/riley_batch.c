@@ -1,7 +1,5 @@
-/* Fast float evaluation of the analytic sky (see sky_batch.h and src/sky/sky.c). */
-#include "atmosphere/riley_batch.h"
-#include "core/internal.h"
-#include "atmosphere/riley.h"
+/* Fast float evaluation of Riley's sky (see riley_batch.h and riley.c). */
+#include "atmosphere/atmosphere_internal.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -9,9 +7,7 @@
 
 #include "core/fastmath.h"
 
-float atmos__expf_fast(float x) { return x < -87.0f ? 0.0f : atmos__expf_poly(x); }
-
-void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye_y, const double sun[3])
+void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, double eye_y, const double sun[3])
 {
     memset(b, 0, sizeof *b);
     b->n = sky->wl.count;
@@ -21,7 +17,7 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye
     for (int k = 0; k < 3; k++) b->sun[k] = (float)sun[k];
     b->sun_up = sun[1] > 0;
     double ey = exp(-sky->gamma * eye_y), ground[ATMOS_MAX_WAVELENGTHS];
-    atmos_sky_sunlight(sky, 0.0, sun, ground);
+    atmos__riley_sunlight(sky, 0.0, sun, b->n, NULL, ground);
     for (int i = 0; i < b->n; i++) {
         double be = sky->beta_sl[i] * ey;
         b->beta_eye[i] = (float)be;

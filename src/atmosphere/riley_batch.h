@@ -1,5 +1,5 @@
-/* Fast float evaluation of the analytic sky for many view rays at once (the
- * renderer's inner loop). Same model and closed form as src/sky/sky.c, arranged
+/* Fast float evaluation of Riley's sky for many view rays at once (the renderers'
+ * inner loop, through atmosphere_ops.h). Same model and closed form as riley.c, arranged
  * so that everything depending only on the eye and the sun is computed once and
  * the per-ray work is a few vectorisable exponentials per wavelength. */
 #ifndef ATMOS_SKY_BATCH_H
@@ -19,7 +19,7 @@ typedef struct atmos__sky_batch {
     float ground[ATMOS_MAX_WAVELENGTHS];      /* albedo/pi * l_y * sunlight at y = 0 */
 } atmos__sky_batch;
 
-void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye_y, const double sun[3]);
+void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, double eye_y, const double sun[3]);
 
 /* Per-ray scratch the evaluator needs: 6 floats per ray. */
 #define ATMOS__SKY_BATCH_SCRATCH 6
@@ -29,8 +29,5 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_sky *sky, double eye
  * scratch: count*ATMOS__SKY_BATCH_SCRATCH floats. */
 void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);
-
-/* exp(x) for float, vectorisable, relative error < 2e-7 over [-87, 88]; 0 below. */
-float atmos__expf_fast(float x);
 
 #endif

@@ -38,7 +38,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "render/path_internal.h"
 #include "core/vec.h"
-#include "atmosphere/riley.h"
+#include "atmosphere/atmosphere_ops.h"
 
 #include <float.h>
 #include <stdio.h>
@@ -86,7 +86,7 @@ static inline void around(const double n[3], double mu, double phi, double out[3
 typedef struct {
     const path_medium *med; /* NULL: no volume */
     const path_phase *ph;
-    const atmos_sky *sky;   /* NULL: vacuum */
+    const atmos_atmosphere *atm; /* the air, the ground, the sun and what lies beyond */
     const path_env *env;    /* NULL: no next-event estimation of the sky */
     int forced;             /* camera rays estimate their single scattering by forced_single() */
     int aureole;            /* the aureole estimate (a phase function with a forward peak) */
@@ -94,10 +94,9 @@ typedef struct {
     int n;                  /* wavelengths */
     double sun[3];
     double cos_sun, sun_omega;
-    int disk_visible;       /* sky background, disk drawn, sun above the horizon */
-    double sun_e[ATMOS_MAX_WAVELENGTHS]; /* extraterrestrial irradiance, W m^-2 nm^-1 */
-    double bg;              /* vacuum: background radiance */
-    double albedo;          /* ground (sky background only) */
+    int disk_visible;       /* the sun's disk is drawn */
+    double bg;              /* radiance from beyond the atmosphere (a vacuum's background) */
+    double albedo;          /* the ground's */
     int max_depth;          /* 0 = unlimited */
     uint64_t seed;
 } path_job;
@@ -106,31 +105,20 @@ typedef struct {
     long long events, tentative, shadow;
 } path_counts;
 
-/* Sunlight (W m^-2 nm^-1 on a surface facing the sun) at altitude y for the carried wavelengths. */
-static void sunlight(const path_job *J, const path_bundle *b, double y, double *E)
+/* Sunlight (W m^-2 nm^-1 on a surface facing the sun) at p for the carried wavelengths. */
+static void sunlight(const path_job *J, const path_bundle *b, const double p[3], double *E)
 {
-    if (!J->sky) {
-        for (int i = 0; i < b->m; i++) E[i] = J->sun_e[b->k[i]];
-        return;
-    }
-    const atmos_sky *s = J->sky;
-    const double ly = J->sun[1];
-    if (!(ly > 0)) {
-        for (int i = 0; i < b->m; i++) E[i] = 0;
-        return;
-    }
-    const double ey = exp(-s->gamma * (y > 0 ? y : 0)) / (s->gamma * ly);
-    for (int i = 0; i < b->m; i++) E[i] = J->sun_e[b->k[i]] * exp(-s->beta_sl[b->k[i]] * ey);
+    atmos__atm_sunlight_sub(J->atm, p, J->sun, b->m, b->k, E);
 }
 
-/* The air's transmittance over p + t d, t in [0, K] (altitude of p: y), multiplied into w. */
-static void air_transmit(const path_job *J, const path_bundle *b, double y, const double d[3], double K, double *w)
+/* The air's transmittance over p + t d, t in [0, K], multiplied into w. */
+static void air_transmit(const path_job *J, const path_bundle *b, const double p[3], const double d[3], double K,
+                         double *w)
 {
-    const atmos_sky *s = J->sky;
     if (!(K > 0)) return;
-    const double G = atmos__sky_view_depth_factor(s->gamma, d[1], K);
-    const double ey = exp(-s->gamma * (y > 0 ? y : 0));
-    for (int i = 0; i < b->m; i++) w[i] *= isinf(G) ? 0.0 : exp(-s->beta_sl[b->k[i]] * ey * G);
+    double T[PATH_B];
+    atmos__atm_transmittance_sub(J->atm, p, d, K, b->m, b->k, T);
+    for (int i = 0; i < b->m; i++) w[i] *= T[i];
 }
 
 static void shadow(const path_job *J, const path_bundle *b, const double p[3], const double d[3], atmos__stream *r,
@@ -143,47 +131,30 @@ typedef struct {
 } air_view;
 
 /* The air's single scattering of sunlight along p + t d, t in [0, K], added to L (times
- * w[i] wt): the analytic sky's in-scatter (sky.c, exact for its flat exponential
- * atmosphere), minus the part the volume takes away. That part, the integral of the
- * in-scatter f(t) (1 - T_view(t) T_sun(t)) with T_view the volume's transmittance from p to
- * p + t d (view: the segment is inside the box; else 1) and T_sun the volume's
- * transmittance from there toward the sun, is estimated with one point drawn in proportion
- * to the air's scattering times its transmittance (of the carried wavelength that scatters
- * least, so that the others' ratios stay bounded): shadows of the volume on the air, the
- * light shafts, cost a shadow ray only where the point's way to the sun crosses the box,
- * and light that nothing shadows is the analytic value without noise. A sample can
- * therefore be negative in a shadow; its mean is not. */
+ * w[i] wt): the atmosphere's in-scatter (exact for the closed-form kinds), minus the part
+ * the volume takes away. That part, the integral of the in-scatter f(t) (1 - T_view(t)
+ * T_sun(t)) with T_view the volume's transmittance from p to p + t d (view: the segment is
+ * inside the box; else 1) and T_sun the volume's transmittance from there toward the sun, is
+ * estimated with one point the atmosphere draws in proportion to the air's scattering times
+ * its transmittance (of the carried wavelength that scatters least, so that the others'
+ * ratios stay bounded): shadows of the volume on the air, the light shafts, cost a shadow
+ * ray only where the point's way to the sun crosses the box, and light that nothing
+ * shadows is the analytic value without noise. A sample can therefore be negative in a
+ * shadow; its mean is not. */
 static void air_scatter(const path_job *J, const path_bundle *b, const double p[3], const double d[3], double K,
                         const double *w, double wt, double *L, double *Lo, int order, const air_view *view,
                         atmos__stream *r, path_counts *cnt)
 {
-    const atmos_sky *s = J->sky;
     if (!(K > 0) || !(wt > 0)) return;
-    const double py = d[1], ly = J->sun[1];
-    if (!(ly > 0)) return;
-    const double G = atmos__sky_view_depth_factor(s->gamma, py, K);
-    const double e_end = isinf(K) ? (py > 0 ? 0.0 : INFINITY) : exp(-s->gamma * py * K);
-    const double y0 = p[1] > 0 ? p[1] : 0;
-    const double ey = exp(-s->gamma * y0);
-    const double P = atmos_phase_rayleigh(atmos__dot3(d, J->sun));
-    int h = -1;
+    double f[PATH_B];
+    if (!atmos__atm_inscatter_sub(J->atm, p, d, K, J->sun, b->m, b->k, f)) return;
     for (int i = 0; i < b->m; i++) {
-        const int k = b->k[i];
         if (w[i] == 0) continue;
-        const double c = w[i] * wt * P * J->sun_e[k] * atmos__sky_inscatter_factor(s->gamma, s->beta_sl[k] * ey, G, ly, py, e_end);
+        const double c = w[i] * wt * f[i];
         L[i] += c, Lo[i] += order * c;
-        if (h < 0 || s->beta_sl[k] < s->beta_sl[b->k[h]]) h = i;
     }
-    if (!J->med || h < 0) return;
-    /* The point: optical depth of wavelength h from p, exponential truncated to [0, tau(K)]. */
-    const double bh = s->beta_sl[b->k[h]] * ey;
-    const double A = isinf(G) ? 1.0 : -expm1(-bh * G);
-    if (!(A > 0)) return;
-    const double Ga = -log1p(-atmos__stream_u(r) * A) / bh; /* G at the point */
-    const double z = s->gamma * py;
-    double ta = fabs(z * Ga) < 1e-12 ? Ga : -log1p(-z * Ga) / z;
-    if (!(ta >= 0)) return;
-    if (ta > K) ta = K;
+    double ta, ratio[PATH_B];
+    if (!J->med || !atmos__atm_scatter_point(J->atm, p, d, K, b->m, b->k, w, r, &ta, ratio)) return;
     const double pa[3] = {p[0] + ta * d[0], p[1] + ta * d[1], p[2] + ta * d[2]};
     double Ts[PATH_B], Tv[PATH_B], E[PATH_B];
     shadow(J, b, pa, J->sun, r, Ts, cnt);
@@ -192,14 +163,12 @@ static void air_scatter(const path_job *J, const path_bundle *b, const double p[
     if (!any && !view) return; /* nothing in the way to the sun: the analytic value holds */
     for (int i = 0; i < b->m; i++) Tv[i] = 1;
     if (view && lit) atmos__path_transmittance(J->med, view->q, view->qd, view->t0, view->t0 + ta, b, r, Tv);
-    sunlight(J, b, pa[1], E);
+    sunlight(J, b, pa, E);
+    const double P = atmos_atmosphere_phase(J->atm, pa, atmos__dot3(d, J->sun));
     for (int i = 0; i < b->m; i++) {
         const double occl = 1.0 - Tv[i] * Ts[i];
         if (w[i] == 0 || occl == 0) continue;
-        const int k = b->k[i];
-        /* f_k / pdf: the scattering and transmittance of k over those of h, times A */
-        const double ratio = s->beta_sl[k] / s->beta_sl[b->k[h]] * exp(-(s->beta_sl[k] - s->beta_sl[b->k[h]]) * ey * Ga) * A;
-        const double c = w[i] * wt * P * E[i] * ratio * occl;
+        const double c = w[i] * wt * P * E[i] * ratio[i] * occl;
         L[i] -= c, Lo[i] -= order * c;
     }
 }
@@ -381,7 +350,7 @@ static void nee(const path_job *J, const path_bundle *b, const double p[3], cons
         for (int i = 0; i < m; i++) any |= w[i] * pk[i] > 0;
         if (!any || !(pe > 0)) return;
         const double wm = pe / (pe + q * pdir);
-        const double Kd = atmos_sky_ground_distance(p[1], de);
+        const double Kd = atmos_atmosphere_ground_distance(J->atm, p, de);
         double q2[3], qd2[3], a0, a1, ex = 0, c[PATH_B];
         for (int i = 0; i < m; i++) T[i] = 1;
         atmos__path_to_index(J->med, p, de, q2, qd2);
@@ -396,7 +365,7 @@ static void nee(const path_job *J, const path_bundle *b, const double p[3], cons
             on |= c[i] > 0;
         }
         if (on && ex < Kd) {
-            air_transmit(J, b, p[1], de, ex, c);
+            air_transmit(J, b, p, de, ex, c);
             const double px[3] = {p[0] + ex * de[0], p[1] + ex * de[1], p[2] + ex * de[2]};
             air_scatter(J, b, px, de, Kd - ex, c, 1.0, L, Lo, order, NULL, r, cnt);
         }
@@ -450,19 +419,19 @@ static void aureole(const path_job *J, const path_bundle *b, const double p[3], 
     /* x': the free flight of the path's own continuation (its probabilities do not depend
      * on the weights' common scale), with the air's transmittance on the way */
     double qi[3], qd[3], t0, t1, t;
-    const double K = J->sky ? atmos_sky_ground_distance(p[1], a) : INFINITY;
+    const double K = atmos_atmosphere_ground_distance(J->atm, p, a);
     atmos__path_to_index(M, p, a, qi, qd);
     if (!atmos__path_clip(M, qi, qd, K, &t0, &t1)) return;
     float dens[PATH_F];
     if (atmos__path_free_flight(M, qi, qd, t0, t1, b, wa, r, &t, dens, &cnt->tentative) <= 0) return;
-    if (J->sky) air_transmit(J, b, p[1], a, t, wa);
+    air_transmit(J, b, p, a, t, wa);
     path_scatter e2;
     int g2[PATH_B];
     if (!scatter_at(J, b, dens, &e2, g2)) return;
     double x[3], E[PATH_B], S2[PATH_B];
     for (int k = 0; k < 3; k++) x[k] = p[k] + t * a[k];
     for (int i = 0; i < m; i++) S2[i] = 1;
-    sunlight(J, b, x[1], E);
+    sunlight(J, b, x, E);
     /* the whole disk by next-event estimation (q = 0: no continuation shares it) */
     nee_sun(J, b, x, a, wa, &e2, S2, g2, 0.0, E, 1.0, order + 1, L, Lo, r, cnt);
 }
@@ -502,8 +471,9 @@ static int forced_single(const path_job *J, const path_bundle *b, const double p
     }
     if (!any) return 1;
     const double x[3] = {p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]};
-    if (J->sky) air_transmit(J, b, p[1] + t0 * d[1], d, t - t0, c);
-    sunlight(J, b, x[1], E);
+    const double x0[3] = {p[0] + t0 * d[0], p[1] + t0 * d[1], p[2] + t0 * d[2]};
+    air_transmit(J, b, x0, d, t - t0, c);
+    sunlight(J, b, x, E);
     /* the continuation's share: as if the roulette always let it go on (the first event's
      * continuations use that too), unless no path goes on after one event */
     nee(J, b, x, d, c, &e, S, g, J->max_depth == 1 ? 0.0 : 1.0, sun_lit(J, b, c, E) ? E : NULL, 1.0, 1, L, Lo, r, cnt);
@@ -528,7 +498,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
     for (int i = 0; i < m; i++) S[i] = 1;
     float dens[PATH_F];
     for (int guard = 0; guard < 1 << 24; guard++) {
-        double K = J->sky ? atmos_sky_ground_distance(p[1], d) : INFINITY;
+        double K = atmos_atmosphere_ground_distance(J->atm, p, d);
         double q[3], qd[3], t0 = 0, t1 = 0;
         int inbox = 0;
         if (J->med) {
@@ -536,21 +506,21 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             inbox = atmos__path_clip(J->med, q, qd, K, &t0, &t1);
         }
         if (inbox) {
-            if (J->sky && t0 > 0) {
+            if (t0 > 0) {
                 air_scatter(J, b, p, d, t0, w, 1.0, L, Lo, order, NULL, r, cnt);
-                air_transmit(J, b, p[1], d, t0, w);
+                air_transmit(J, b, p, d, t0, w);
             }
             double t, ws[PATH_B];
             memcpy(ws, w, sizeof ws);
             const int forced = J->forced && primary && forced_single(J, b, p, d, q, qd, t0, t1, w, L, Lo, r, cnt);
             int ev = atmos__path_free_flight(J->med, q, qd, t0, t1, b, w, r, &t, dens, &cnt->tentative);
-            if (J->sky) {
+            {
                 /* The air inside the box: its light (shadowed by the volume) over the whole
                  * crossing, its transmittance up to where the flight ends. */
                 const double ps[3] = {p[0] + t0 * d[0], p[1] + t0 * d[1], p[2] + t0 * d[2]};
                 const air_view v = {q, qd, t0};
                 air_scatter(J, b, ps, d, t1 - t0, ws, 1.0, L, Lo, order, &v, r, cnt);
-                air_transmit(J, b, ps[1], d, (ev > 0 ? t : t1) - t0, w);
+                air_transmit(J, b, ps, d, (ev > 0 ? t : t1) - t0, w);
             }
             if (ev < 0) return;
             if (ev > 0) {
@@ -575,7 +545,7 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
                 const int first = forced; /* its lights were estimated by forced_single() */
                 const double q_mis = first ? (J->max_depth == 1 ? 0.0 : 1.0) : q_rr;
                 double E[PATH_B];
-                sunlight(J, b, p[1], E);
+                sunlight(J, b, p, E);
                 const int lit = sun_lit(J, b, w, E);
                 if (ne && !first) nee(J, b, p, d, w, &ev_s, S, g, q_mis, lit ? E : NULL, hprev, order, L, Lo, r, cnt);
                 if (!goes_on) return;
@@ -635,34 +605,32 @@ static void trace(const path_job *J, const path_bundle *b, const double o[3], co
             }
             /* Through the volume: continue from its far side. */
             for (int a = 0; a < 3; a++) p[a] += t1 * d[a];
-            if (J->sky) K = atmos_sky_ground_distance(p[1], d);
+            K = atmos_atmosphere_ground_distance(J->atm, p, d);
             if (K <= 1e-9 * (1.0 + fabs(p[1]))) K = 0; /* the box reached the ground */
         }
-        /* Escape: vacuum, or the air to the ground or to space. */
-        if (!J->sky) {
-            for (int i = 0; i < m; i++) {
-                const double c = w[i] * J->bg * esc_wt;
-                L[i] += c, Lo[i] += order * c;
-            }
-            return;
-        }
+        /* Escape: the air to the ground or out of the atmosphere, and what lies beyond. */
         air_scatter(J, b, p, d, K, w, esc_wt, L, Lo, order, NULL, r, cnt);
         if (isinf(K)) {
+            if (J->bg != 0)
+                for (int i = 0; i < m; i++) {
+                    const double c = w[i] * J->bg * esc_wt;
+                    L[i] += c, Lo[i] += order * c;
+                }
             if (primary && J->disk_visible && atmos__dot3(d, J->sun) >= J->cos_sun) {
                 double E[PATH_B];
-                sunlight(J, b, p[1], E);
+                sunlight(J, b, p, E);
                 for (int i = 0; i < m; i++) L[i] += w[i] * E[i] / J->sun_omega;
             }
             return;
         }
         /* The Lambertian ground. */
-        air_transmit(J, b, p[1], d, K, w);
+        air_transmit(J, b, p, d, K, w);
         for (int a = 0; a < 3; a++) p[a] += K * d[a];
         p[1] = 0;
         if (!(J->albedo > 0)) return;
         cnt->events++;
         double E[PATH_B];
-        sunlight(J, b, 0.0, E);
+        sunlight(J, b, p, E);
         int lit = 0;
         for (int i = 0; i < m; i++) lit |= w[i] * E[i] > 0;
         if (lit) {
@@ -766,7 +734,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     path_phase ph;
     memset(&med, 0, sizeof med);
     memset(&ph, 0, sizeof ph);
-    atmos_sky *sky = NULL;
+    atmos_atmosphere *atm = NULL;
     path_env *env = NULL;
     atmos_image *img = NULL, *var = NULL, *ord = NULL;
     double *acc = NULL;
@@ -778,22 +746,18 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
     int spp_done = 0;
     double t_trace = 0, t_prep = 0, trunc_lo = 0, trunc_hi = 0;
 
-    atmos_atmosphere_desc ad = scene->atmosphere;
-    if ((st = atmos_sky_create(ctx, &ad, &wl, &sky)) != ATMOS_OK) return st;
+    if ((st = atmos_atmosphere_create(ctx, &scene->atmosphere, &wl, &atm)) != ATMOS_OK) return st;
+    J.atm = atm;
     J.n = n;
-    double r = 0.5 * sky->desc.sun_diameter_deg * ATMOS_DEG2RAD;
+    double r = 0.5 * atmos_atmosphere_get_desc(atm)->sun_diameter_deg * ATMOS_DEG2RAD;
     J.cos_sun = cos(r);
     J.sun_omega = 2.0 * ATMOS_PI * (1.0 - J.cos_sun);
-    for (int k = 0; k < n; k++) J.sun_e[k] = sky->sun_e[k];
     J.max_depth = s.max_depth;
     J.seed = s.seed;
     J.forced = !s.no_forced;
-    if (scene->background == ATMOS_BACKGROUND_SKY) {
-        J.albedo = sky->desc.ground_albedo;
-        J.disk_visible = !sky->desc.hide_sun_disk && J.sun[1] > 0;
-    } else {
-        J.bg = scene->background == ATMOS_BACKGROUND_UNIFORM ? scene->background_radiance : 0.0;
-    }
+    J.albedo = atmos_atmosphere_ground_albedo(atm);
+    J.disk_visible = atmos_atmosphere_sun_disk_visible(atm, J.sun);
+    J.bg = atmos__atm_background(atm);
 
     const double t_prep0 = atmos__now();
     if (volume && volume->nfields > 0) {
@@ -836,12 +800,14 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
                     if (atmos__path_phase_eval(&ph, f, k, &ang) > AUREOLE_PEAK) J.aureole = 1;
         }
     }
-    if (scene->background == ATMOS_BACKGROUND_SKY) J.sky = sky;
-    if (J.sky && J.med && !s.no_sky_nee) {
+    if (J.med && !s.no_sky_nee) {
         /* the sky's light as seen from the middle of the volume's box */
-        double qc[3], yc = med.org[1];
+        double qc[3], pc[3];
         for (int a = 0; a < 3; a++) qc[a] = 0.5 * (med.box_lo[a] + med.box_hi[a]);
-        for (int a = 0; a < 3; a++) yc += med.R[3 + a] * qc[a] / med.inv_vs;
+        for (int a = 0; a < 3; a++) {
+            pc[a] = med.org[a];
+            for (int c = 0; c < 3; c++) pc[a] += med.R[3 * a + c] * qc[c] / med.inv_vs;
+        }
         double Yw[ATMOS_MAX_WAVELENGTHS];
         for (int k = 0; k < n; k++) Yw[k] = wl.to_xyz[k][1];
         env = malloc(sizeof *env);
@@ -849,7 +815,7 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
             st = atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the sky's table");
             goto done;
         }
-        if (atmos__path_env_build(sky, J.sun, yc, Yw, env)) J.env = env;
+        if (atmos__path_env_build(atm, J.sun, pc, Yw, env)) J.env = env;
     }
     /* (A uniform background is left to the continuations: next-event estimation with
      * uniform directions doubled the noise of a slab before one, tests/unit/test_path.c's
@@ -966,11 +932,11 @@ atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, con
         atmos_image_set_meta(img, "atmos:renderer", "path (spectral Monte Carlo volumetric path tracing)");
         if (ph.ic)
             snprintf(buf, sizeof buf, "%d spp, seed %llu, max depth %d, %s, forward peak truncated at %g deg", spp_done,
-                     (unsigned long long)s.seed, s.max_depth, scene->background == ATMOS_BACKGROUND_SKY ? "sky" : "vacuum",
+                     (unsigned long long)s.seed, s.max_depth, atmos_atmosphere_get_kind(atm) == ATMOS_ATMOSPHERE_VACUUM ? "vacuum" : "sky",
                      ph.cut_deg);
         else
             snprintf(buf, sizeof buf, "%d spp, seed %llu, max depth %d, %s", spp_done, (unsigned long long)s.seed,
-                     s.max_depth, scene->background == ATMOS_BACKGROUND_SKY ? "sky" : "vacuum");
+                     s.max_depth, atmos_atmosphere_get_kind(atm) == ATMOS_ATMOSPHERE_VACUUM ? "vacuum" : "sky");
         atmos_image_set_meta(img, "atmos:path", buf);
         double secs = atmos__now() - t_start;
         snprintf(buf, sizeof buf, "%.6f", secs);
@@ -1005,7 +971,7 @@ done:
     free(env);
     atmos__path_medium_free(&med);
     atmos__path_phase_free(&ph);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(atm);
     atmos_volume_optics_free(&own);
     if (st != ATMOS_OK) {
         atmos_image_destroy(img);

@@ -1,10 +1,9 @@
 /* The sky as a light for the path tracer: a direction distribution for next-event
  * estimation toward the sky (path_internal.h). Cells of equal solid angle over
  * (mu = d_y in [-1, 1], phi = atan2(d_z, d_x) in [-pi, pi)), each weighted by the luminance
- * of the analytic sky's single scattering (sky.c) seen at its centre from altitude y_ref,
+ * of the atmosphere's single scattering seen at its centre from the point ref,
  * to the ground or to space, mixed with a uniform distribution over the sphere. */
 #include "render/path_internal.h"
-#include "atmosphere/riley.h"
 
 #include <string.h>
 
@@ -16,19 +15,20 @@
  * seen from above, the sky opposite the sun) from falling far below the phase function's. */
 #define UNIFORM_SHARE 0.15
 
-int atmos__path_env_build(const atmos_sky *sky, const double sun[3], double y_ref, const double *Y, path_env *e)
+int atmos__path_env_build(const atmos_atmosphere *atm, const double sun[3], const double ref[3], const double *Y,
+                          path_env *e)
 {
     memset(e, 0, sizeof *e);
     if (!(sun[1] > 0)) return 0;
-    const int n = sky->wl.count;
-    const double eye[3] = {0, y_ref > 0 ? y_ref : 0, 0};
+    const int n = atmos_atmosphere_wavelengths(atm)->count;
+    const double eye[3] = {ref[0], ref[1] > 0 ? ref[1] : 0, ref[2]};
     double v[ATMOS_MAX_WAVELENGTHS], total = 0;
     for (int i = 0; i < PATH_ENV_NMU; i++) {
         const double mu = -1.0 + (i + 0.5) * DMU, st = sqrt(fmax(0.0, 1.0 - mu * mu));
         for (int j = 0; j < PATH_ENV_NPHI; j++) {
             const double phi = -ATMOS_PI + (j + 0.5) * DPHI;
             const double d[3] = {st * cos(phi), mu, st * sin(phi)};
-            atmos_sky_inscatter(sky, eye, d, atmos_sky_ground_distance(eye[1], d), sun, v);
+            atmos_atmosphere_inscatter(atm, eye, d, atmos_atmosphere_ground_distance(atm, eye, d), sun, v);
             double s = 0;
             for (int k = 0; k < n; k++) s += Y[k] * (v[k] > 0 ? v[k] : 0);
             e->pdf_cell[i * PATH_ENV_NPHI + j] = s;

@@ -18,9 +18,10 @@ typedef struct {
     double uniform;                                 /* weight of the uniform part */
 } path_env;
 
-/* Builds the table for the sky seen from altitude y_ref (weights Y[] per wavelength).
+/* Builds the table for the sky seen from the point ref (weights Y[] per wavelength).
  * Returns 0 when the sky is dark (sun below the horizon): no next-event estimation. */
-int atmos__path_env_build(const atmos_sky *sky, const double sun[3], double y_ref, const double *Y, path_env *e);
+int atmos__path_env_build(const atmos_atmosphere *atm, const double sun[3], const double ref[3], const double *Y,
+                          path_env *e);
 /* A direction drawn from the distribution; returns its density (sr^-1). */
 double atmos__path_env_sample(const path_env *e, double u0, double u1, double u2, double d[3]);
 /* Density (sr^-1) of unit direction d. */

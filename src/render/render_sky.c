@@ -2,8 +2,7 @@
  * and converts spectral images to linear sRGB. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, getpid, isatty, PATH_MAX */
 #include "core/internal.h"
-#include "atmosphere/riley.h"
-#include "atmosphere/riley_batch.h"
+#include "atmosphere/atmosphere_ops.h"
 
 #include <stdlib.h>
 
@@ -28,7 +27,7 @@ static double radical_inverse2(unsigned i)
 }
 
 typedef struct {
-    const atmos_sky *sky;
+    const atmos_atmosphere *atm;
     const atmos_camera *cam;
     double sun[3];
     int spp;
@@ -37,8 +36,6 @@ typedef struct {
     double sun_radiance[ATMOS_MAX_WAVELENGTHS];
     int sun_visible;        /* disk drawn and sun above the horizon */
     double cos_disk_search; /* cos(sun radius + 1.5 pixel footprints) */
-    int vacuum;             /* black or uniform background: no air, no ground, no disk */
-    float background;       /* its radiance at every wavelength */
 } sky_job;
 
 /* An upper bound on the angle one pixel spans, radians. */
@@ -70,7 +67,7 @@ static double sun_coverage(const sky_job *job, int x, int y)
         for (int i = 0; i < S; i++) {
             if (!atmos_camera_ray(job->cam, x + (i + 0.5) / S, y + (j + 0.5) / S, d)) continue;
             valid++;
-            if (atmos_sky_ground_distance(job->cam->position[1], d) < INFINITY) continue;
+            if (atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY) continue;
             if (angle_between(d, job->sun) <= job->sun_radius) inside++;
         }
     return valid ? (double)inside / (S * S) : 0.0;
@@ -151,7 +148,7 @@ typedef struct {
     float *dx, *dy, *dz, *w, *acc, *scratch, *hits;
 } row_buffers;
 
-static void shade_row(const sky_job *job, const atmos__sky_batch *batch, const float *col_sc, int y, row_buffers *rb,
+static void shade_row(const sky_job *job, const atmos__atm_batch *batch, const float *col_sc, int y, row_buffers *rb,
                       float *dst, int C)
 {
     const int W = job->cam->width, n = job->n, spp = job->spp;
@@ -161,12 +158,7 @@ static void shade_row(const sky_job *job, const atmos__sky_batch *batch, const f
         double sx, sy;
         sample_offset(s, spp, &sx, &sy);
         row_rays(job, y, sx, sy, col_sc ? col_sc + (size_t)2 * W * s : NULL, rb->dx, rb->dy, rb->dz, rb->w);
-        if (job->vacuum) {
-            for (int i = 0; i < n; i++)
-                for (int x = 0; x < W; x++) rb->acc[(size_t)i * W + x] += rb->w[x] * job->background;
-        } else {
-            atmos__sky_batch_eval(batch, W, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
-        }
+        atmos__atm_batch_eval(batch, W, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
         for (int x = 0; x < W; x++) rb->hits[x] += rb->w[x];
     }
     const float inv = 1.0f / spp;
@@ -203,22 +195,20 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
     memset(&job, 0, sizeof job);
     double sun_el = 0, sun_az = 0;
     if ((st = atmos_scene_sun_direction(ctx, scene, job.sun, &sun_el, &sun_az)) != ATMOS_OK) return st;
-    atmos_sky *sky = NULL;
-    if ((st = atmos_sky_create(ctx, &scene->atmosphere, &wl, &sky)) != ATMOS_OK) return st;
+    atmos_atmosphere *sky = NULL;
+    if ((st = atmos_atmosphere_create(ctx, &scene->atmosphere, &wl, &sky)) != ATMOS_OK) return st;
     atmos_image *img = NULL;
     if ((st = atmos_image_create(ctx, scene->width, scene->height, wl.count + 1, &img)) != ATMOS_OK) {
-        atmos_sky_destroy(sky);
+        atmos_atmosphere_destroy(sky);
         return st;
     }
-    job.sky = sky;
+    job.atm = sky;
     job.cam = &cam;
     job.n = wl.count;
     job.spp = scene->samples_per_pixel > 0 ? scene->samples_per_pixel : 1;
-    job.sun_radius = 0.5 * sky->desc.sun_diameter_deg * ATMOS_DEG2RAD;
-    atmos_sky_sun_radiance(sky, cam.position[1], job.sun, job.sun_radiance);
-    job.vacuum = scene->background != ATMOS_BACKGROUND_SKY;
-    job.background = scene->background == ATMOS_BACKGROUND_UNIFORM ? (float)scene->background_radiance : 0.0f;
-    job.sun_visible = !sky->desc.hide_sun_disk && job.sun[1] > 0 && !job.vacuum;
+    job.sun_radius = 0.5 * atmos_atmosphere_get_desc(sky)->sun_diameter_deg * ATMOS_DEG2RAD;
+    atmos_atmosphere_sun_radiance(sky, cam.position, job.sun, job.sun_radiance);
+    job.sun_visible = atmos_atmosphere_sun_disk_visible(sky, job.sun);
     /* Disk radius plus 2.5 pixel footprints: a sample ray is within one footprint
      * of the pixel centre, the pixel's far corner within another. */
     double foot = pixel_footprint(&cam);
@@ -232,8 +222,8 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
     const int nbands = (H + band - 1) / band;
     int done = 0, cancelled = 0, nomem = 0;
     int threads = atmos__threads(ctx);
-    atmos__sky_batch batch;
-    atmos__sky_batch_init(&batch, sky, cam.position[1], job.sun);
+    atmos__atm_batch batch;
+    atmos__atm_batch_init(&batch, sky, cam.position, job.sun);
     /* Equirectangular: per-sample tables of the columns' azimuth sines and cosines. */
     float *col_sc = NULL;
     if (cam.type == ATMOS_CAMERA_EQUIRECT && (size_t)job.spp * W <= ((size_t)1 << 22)) {
@@ -253,7 +243,7 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
     {
         row_buffers rb = {0};
         size_t per = (size_t)W;
-        float *mem = malloc(sizeof(float) * per * (5 + (size_t)job.n + ATMOS__SKY_BATCH_SCRATCH));
+        float *mem = malloc(sizeof(float) * per * (5 + (size_t)job.n + ATMOS__ATM_BATCH_SCRATCH));
         if (mem) {
             rb.dx = mem, rb.dy = mem + per, rb.dz = mem + 2 * per, rb.w = mem + 3 * per, rb.hits = mem + 4 * per;
             rb.acc = mem + 5 * per;
@@ -290,11 +280,11 @@ atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmo
     free(col_sc);
     if (!cancelled && !nomem) atmos__progress(ctx, "render sky", 1.0);
     if (nomem) {
-        atmos_sky_destroy(sky);
+        atmos_atmosphere_destroy(sky);
         atmos_image_destroy(img);
         return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for row buffers");
     }
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
     if (cancelled) {
         atmos_image_destroy(img);
         return atmos__error(ctx, ATMOS_E_CANCELLED, "render: cancelled");

@@ -18,7 +18,7 @@
 #include "core/internal.h"
 #include "core/vec.h"
 #include "render/slice_internal.h"
-#include "atmosphere/riley.h"
+#include "atmosphere/atmosphere_ops.h"
 #include "volume/volume_grid.h"
 
 #include <float.h>
@@ -47,14 +47,14 @@ void atmos_slice_defaults(atmos_slice_settings *s)
 
 /* ------------------------------------------------------------------ geometry helpers */
 
-/* Sunlight arriving at altitude yw: through the air (Eq. 12) with the sky background,
- * the extraterrestrial irradiance unattenuated in vacuum (black/uniform backgrounds). */
-static void sunlight_at(const atmos_sky *sky, int vacuum, double yw, const double sun[3], int n, double *out)
+/* Sunlight arriving at the grid-frame point g (Eq. 12 in Riley's air): the world point is
+ * org + R g. */
+static void sunlight_at(const atmos_atmosphere *atm, const double org[3], const double *R, const double g[3],
+                        const double sun[3], double *out)
 {
-    if (vacuum)
-        for (int c = 0; c < n; c++) out[c] = sky->sun_e[c];
-    else
-        atmos_sky_sunlight(sky, yw > 0 ? yw : 0, sun, out);
+    double w[3];
+    for (int a = 0; a < 3; a++) w[a] = org[a] + R[3 * a] * g[0] + R[3 * a + 1] * g[1] + R[3 * a + 2] * g[2];
+    atmos_atmosphere_sunlight(atm, w, sun, out);
 }
 
 /* Slice indices k whose plane s_k = s0 + (k + 0.5) ds lies in [sa, sb]. */
@@ -74,19 +74,15 @@ static void slice_range(double sa, double sb, double s0, double ds, int nslices,
  * to the halfway plane at distance th is in front of the volume, the rest (with the
  * ground and the sun's disk) behind it. px holds the sky image B (= front + T_front *
  * back) and receives front + T_front * L_vol + T_vol * (B - front). */
-static void composite_pixel(const atmos_sky *sky, int vacuum, const atmos_camera *cam, const double dw[3], double th,
+static void composite_pixel(const atmos_atmosphere *atm, const atmos_camera *cam, const double dw[3], double th,
                             const double sun_w[3], int n, const float *Lv, const float *Tv, float *px)
 {
     if (!(th > 0)) th = 0;
     double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
-    if (vacuum) { /* no air between the eye and the volume */
-        for (int c = 0; c < n; c++) front[c] = 0.0, Tf[c] = 1.0;
-    } else {
-        double tg = atmos_sky_ground_distance(cam->position[1], dw);
-        if (th > tg) th = tg;
-        atmos_sky_inscatter(sky, cam->position, dw, th, sun_w, front);
-        atmos_sky_transmittance(sky, cam->position[1], dw, th, Tf);
-    }
+    double tg = atmos_atmosphere_ground_distance(atm, cam->position, dw);
+    if (th > tg) th = tg;
+    atmos_atmosphere_inscatter(atm, cam->position, dw, th, sun_w, front);
+    atmos_atmosphere_transmittance(atm, cam->position, dw, th, Tf);
     for (int c = 0; c < n; c++) {
         double B = px[c], L = Lv[c], T = Tv[c];
         double r = front[c] + Tf[c] * L + T * (B - front[c]);
@@ -354,15 +350,13 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
     memset(&tab, 0, sizeof tab);
     sjob j;
     memset(&j, 0, sizeof j);
-    atmos_sky *sky = NULL;
-    /* Black or uniform background: vacuum around the volume (no air, no ground). */
-    const int vacuum = scene->background != ATMOS_BACKGROUND_SKY;
+    atmos_atmosphere *sky = NULL;
     long long eye_samples = 0, light_samples = 0;
     double t_light = 0, t_eye = 0;
     if ((st = atmos__sgrid_build(ctx, volume, s.density_scale, s.grid_max_dim, &g)) != ATMOS_OK) goto done;
     if (!g.v) goto finish; /* empty volume: the sky alone */
     if ((st = atmos__stables_build(ctx, optics, wl.count, s.max_order, &tab)) != ATMOS_OK) goto done;
-    if ((st = atmos_sky_create(ctx, &scene->atmosphere, &wl, &sky)) != ATMOS_OK) goto done;
+    if ((st = atmos_atmosphere_create(ctx, &scene->atmosphere, &wl, &sky)) != ATMOS_OK) goto done;
 
     /* World <-> grid frame. */
     const double *R = volume->desc.rotation;
@@ -522,7 +516,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
             int ok = j.btf ? hd <= -SLICE_HD_EPS : hd >= SLICE_HD_EPS;
             if (!ok || !atmos__ray_box(j.eye, d, g.box_lo, g.box_hi, &ta, &tb)) continue;
             if (ta < 0) ta = 0;
-            double tg = vacuum ? INFINITY : atmos_sky_ground_distance(cam.position[1], dw);
+            double tg = atmos_atmosphere_ground_distance(sky, cam.position, dw);
             if (tb > tg) tb = tg;
             if (!(ta < tb)) continue;
             double sa = j.he + ta * hd, sb = j.he + tb * hd;
@@ -573,8 +567,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
         /* Texels whose ray misses the box all get the sunlight at the box centre. */
         double sl_miss[ATMOS_MAX_WAVELENGTHS];
         {
-            double yw = org[1] + Rm[3] * cen[0] + Rm[4] * cen[1] + Rm[5] * cen[2];
-            sunlight_at(sky, vacuum, yw, sun_w, j.n, sl_miss);
+            sunlight_at(sky, org, Rm, cen, sun_w, sl_miss);
         }
 #pragma omp parallel for schedule(static) num_threads(threads)
         for (int b = 0; b < j.L; b++)
@@ -595,8 +588,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                     slice_range(ho + ta * j.hl, ho + tb * j.hl, j.s0, j.ds, j.nslices, &j.lk0[q], &j.lk1[q]);
                     double entry[3];
                     for (int i = 0; i < 3; i++) entry[i] = o[i] + ta * j.lt[i];
-                    double yw = org[1] + Rm[3] * entry[0] + Rm[4] * entry[1] + Rm[5] * entry[2];
-                    sunlight_at(sky, vacuum, yw, sun_w, j.n, sl);
+                    sunlight_at(sky, org, Rm, entry, sun_w, sl);
                 } else {
                     memcpy(sl, sl_miss, sizeof sl);
                 }
@@ -700,7 +692,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                     double th = j.pinv[p] != 0.0f ? (hc - j.he) * j.pinv[p] : 0.0;
                     float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
                     for (int c = 0; c < j.n; c++) Lv[c] = j.L_eye[c * j.pst + p], Tv[c] = j.T_eye[c * j.pst + p];
-                    composite_pixel(sky, vacuum, &cam, dw, th, sun_w, j.n, Lv, Tv, img->pixels + p * C);
+                    composite_pixel(sky, &cam, dw, th, sun_w, j.n, Lv, Tv, img->pixels + p * C);
                 }
         } else {
             /* Eye buffer smaller than the image: L_vol and T_vol bilinear between the
@@ -748,7 +740,7 @@ atmos_status atmos_render_slice(atmos_context *ctx, const atmos_scene *scene, co
                     TO_GRID(dw, d);
                     const double hd = atmos__dot3(j.h, d);
                     double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j.he) / hd : 0.0;
-                    composite_pixel(sky, vacuum, &cam, dw, th, sun_w, j.n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
+                    composite_pixel(sky, &cam, dw, th, sun_w, j.n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
                 }
             }
         }
@@ -792,7 +784,7 @@ done:
 #undef TO_GRID
     free(j.pixblock), free(j.ring), free(j.I), free(j.nsc), free(j.lk0);
     free(j.espan), free(j.lspan), free(j.wspan), free(j.erow), free(j.lrow);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
     atmos__stables_free(&tab);
     atmos__sgrid_free(&g);
     atmos_volume_optics_free(&own_optics);

@@ -48,7 +48,6 @@ void atmos_scene_defaults(atmos_scene *s)
     s->exr_half = 0;
 
     s->renderer = ATMOS_RENDERER_SKY;
-    s->background = ATMOS_BACKGROUND_SKY;
     s->volume.density_scale = 1.0;
     s->volume.seed = 1;
     s->volume.scale = 1.0;

@@ -31,7 +31,7 @@ typedef struct atmos__range {
 extern const atmos__range atmos__r_dim, atmos__r_spp, atmos__r_altitude, atmos__r_pos, atmos__r_look,
     atmos__r_fov_pinhole, atmos__r_fov_fisheye, atmos__r_elevation, atmos__r_azimuth,
     atmos__r_latitude, atmos__r_longitude, atmos__r_beta, atmos__r_scale_height, atmos__r_albedo,
-    atmos__r_sun_diameter, atmos__r_sun_scale, atmos__r_samples, atmos__r_manual_ev,
+    atmos__r_sun_diameter, atmos__r_sun_scale, atmos__r_thickness, atmos__r_radiance, atmos__r_samples, atmos__r_manual_ev,
     atmos__r_compensation;
 
 /* Reports "SOURCE: PATH: <fmt>" through ctx and returns status. */

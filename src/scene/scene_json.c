@@ -463,26 +463,32 @@ static atmos_status parse_sun(const jp *p, const cJSON *j, const char *path, atm
 
 static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"beta_sl_550_per_m", "scale_height_m", "ground_albedo",
-                                       "sun_diameter_deg", "sun_scale", "sun_disk"};
+    static const char *const keys[] = {"beta_sl_550_per_m", "scale_height_m", "ground_albedo", "sun_diameter_deg",
+                                       "sun_scale", "thickness_m", "sun_disk", "kind"};
+    static const char *const kinds[] = {"riley", "homogeneous"};
+    static const atmos_atmosphere_kind kind_of[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS};
     atmos_atmosphere_desc *a = &s->atmosphere;
     double *fields[] = {&a->beta_sl_550, &a->scale_height_m, &a->ground_albedo, &a->sun_diameter_deg,
-                        &a->sun_scale};
+                        &a->sun_scale, &a->thickness_m};
     const atmos__range *ranges[] = {&atmos__r_beta, &atmos__r_scale_height, &atmos__r_albedo,
-                                    &atmos__r_sun_diameter, &atmos__r_sun_scale};
+                                    &atmos__r_sun_diameter, &atmos__r_sun_scale, &atmos__r_thickness};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
-    int k, disk = 1;
-    TRY(iter_begin(p, j, path, keys, 6, &it));
+    int k, disk = 1, kind = 0;
+    TRY(iter_begin(p, j, path, keys, 8, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
-        if (k < 5) {
+        if (k < 6) {
             TRY(get_number(p, v, ip, ranges[k], NULL, fields[k]));
-        } else {
+        } else if (k == 6) {
             TRY(get_bool(p, v, ip, &disk));
             a->hide_sun_disk = !disk;
+        } else {
+            TRY(get_enum(p, v, ip, kinds, 2, &kind));
+            /* a vacuum set by "background" stays one */
+            if (a->kind != ATMOS_ATMOSPHERE_VACUUM) a->kind = kind_of[kind];
         }
     }
 }
@@ -761,7 +767,7 @@ static atmos_status parse_particles(const jp *p, const cJSON *j, const char *pat
 static const atmos__range r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0}, r_xi = {0, 100, 0, 0},
                           r_grid = {8, 2048, 0, 0}, r_eye_scale = {0, 1, 1, 0}, r_path_spp = {1, 1000000, 0, 0},
                           r_budget = {0, 1e7, 0, 0}, r_seed = {0, 9007199254740992.0, 0, 0},
-                          r_depth = {0, 100000, 0, 0}, r_radiance = {0, 1e6, 0, 0},
+                          r_depth = {0, 100000, 0, 0},
                           r_dscale = {0, 1e30, 1, 0}, r_time_index = {0, 1000000, 0, 0},
                           r_voxel = {0, 1e5, 0, 0}, r_vscale = {0, 100, 1, 0};
 
@@ -787,39 +793,45 @@ static atmos_status get_text(const jp *p, const cJSON *j, const char *path, char
     return ATMOS_OK;
 }
 
-/* "background": "sky" | "black" | {"type": "uniform", "radiance": L} */
+/* "background": "sky" | "black" | {"type": "uniform", "radiance": L}: "sky" is the scene's
+ * atmosphere (Riley's unless "atmosphere" says otherwise), the others a vacuum. */
 static atmos_status parse_background(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
+    enum { BG_SKY, BG_BLACK, BG_UNIFORM };
     static const char *const types[] = {"sky", "black", "uniform"};
     static const char *const keys[] = {"type", "radiance"};
-    int e = 0;
-    if (cJSON_IsString(j)) {
-        TRY(get_enum(p, j, path, types, 2, &e));
-        s->background = (atmos_background_kind)e;
-        return ATMOS_OK;
-    }
-    if (!cJSON_IsObject(j)) return type_error(p, path, "\"sky\", \"black\" or an object", j);
-    obj_iter it;
-    char ip[PATH_CAP];
-    const cJSON *v;
-    int k, type = -1;
+    int type = -1;
     double radiance = 0;
-    TRY(iter_begin(p, j, path, keys, 2, &it));
-    for (;;) {
-        TRY(iter_next(p, &it, &k, &v, ip));
-        if (k < 0) break;
-        if (k == 0) TRY(get_enum(p, v, ip, types, 3, &type));
-        else TRY(get_number(p, v, ip, &r_radiance, NULL, &radiance));
+    if (cJSON_IsString(j)) {
+        TRY(get_enum(p, j, path, types, 2, &type));
+    } else {
+        if (!cJSON_IsObject(j)) return type_error(p, path, "\"sky\", \"black\" or an object", j);
+        obj_iter it;
+        char ip[PATH_CAP];
+        const cJSON *v;
+        int k;
+        TRY(iter_begin(p, j, path, keys, 2, &it));
+        for (;;) {
+            TRY(iter_next(p, &it, &k, &v, ip));
+            if (k < 0) break;
+            if (k == 0) TRY(get_enum(p, v, ip, types, 3, &type));
+            else TRY(get_number(p, v, ip, &atmos__r_radiance, NULL, &radiance));
+        }
+        if (type < 0) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "missing key \"type\"");
+        if ((it.seen & 2u) && type != BG_UNIFORM)
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                     "\"radiance\" goes with \"type\": \"uniform\" only");
+        if (type == BG_UNIFORM && !(it.seen & 2u))
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                     "missing key \"radiance\" (W m^-2 sr^-1 nm^-1)");
     }
-    if (type < 0) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "missing key \"type\"");
-    if ((it.seen & 2u) && type != ATMOS_BACKGROUND_UNIFORM)
-        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
-                                 "\"radiance\" goes with \"type\": \"uniform\" only");
-    if (type == ATMOS_BACKGROUND_UNIFORM && !(it.seen & 2u))
-        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
-                                 "missing key \"radiance\" (W m^-2 sr^-1 nm^-1)");
-    s->background = (atmos_background_kind)type;
-    s->background_radiance = radiance;
+    atmos_atmosphere_desc *a = &s->atmosphere;
+    if (type == BG_SKY) {
+        if (a->kind == ATMOS_ATMOSPHERE_VACUUM) a->kind = ATMOS_ATMOSPHERE_RILEY;
+    } else {
+        a->kind = ATMOS_ATMOSPHERE_VACUUM;
+    }
+    a->background_radiance = radiance;
     return ATMOS_OK;
 }
 

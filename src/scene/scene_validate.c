@@ -27,6 +27,8 @@ const atmos__range atmos__r_scale_height = {100, 100000, 0, 0};
 const atmos__range atmos__r_albedo = {0, 1, 0, 0};
 const atmos__range atmos__r_sun_diameter = {0, 20, 1, 0};
 const atmos__range atmos__r_sun_scale = {0, 1e6, 0, 0};
+const atmos__range atmos__r_thickness = {1, 1e6, 0, 0};
+const atmos__range atmos__r_radiance = {0, 1e6, 0, 0};
 const atmos__range atmos__r_samples = {1, ATMOS_MAX_WAVELENGTHS, 0, 0};
 const atmos__range atmos__r_manual_ev = {-20, 40, 0, 0};
 const atmos__range atmos__r_compensation = {-20, 20, 0, 0};
@@ -270,7 +272,12 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
         {"/atmosphere/ground_albedo", offsetof(atmos_atmosphere_desc, ground_albedo), &atmos__r_albedo},
         {"/atmosphere/sun_diameter_deg", offsetof(atmos_atmosphere_desc, sun_diameter_deg), &atmos__r_sun_diameter},
         {"/atmosphere/sun_scale", offsetof(atmos_atmosphere_desc, sun_scale), &atmos__r_sun_scale},
+        {"/atmosphere/thickness_m", offsetof(atmos_atmosphere_desc, thickness_m), &atmos__r_thickness},
+        {"/background/radiance", offsetof(atmos_atmosphere_desc, background_radiance), &atmos__r_radiance},
     };
+    if (a->kind != ATMOS_ATMOSPHERE_RILEY && a->kind != ATMOS_ATMOSPHERE_VACUUM && a->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/atmosphere/kind",
+                                 "must be riley, homogeneous or (through \"background\") a vacuum, got %d", (int)a->kind);
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) {
         double v;
         memcpy(&v, (const char *)a + fields[i].offset, sizeof v);
@@ -293,11 +300,6 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_PATH)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice or path, got %d",
                                  (int)s->renderer);
-    if (s->background < ATMOS_BACKGROUND_SKY || s->background > ATMOS_BACKGROUND_UNIFORM)
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/background", "must be sky, black or uniform, got %d",
-                                 (int)s->background);
-    if ((st = atmos__scene_check_range(ctx, source, "/background/radiance", s->background_radiance, &r_radiance, NULL)))
-        return st;
     const atmos_scene_sun *sun = &s->sun;
     if (sun->irradiance_count != 0 && sun->irradiance_count != 1 && sun->irradiance_count != 3)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/sun/irradiance",

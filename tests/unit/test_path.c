@@ -151,18 +151,24 @@ static void vacuum_scene(atmos_scene *s, int spectral, double sun_el, double sun
     atmos_scene_defaults(s);
     s->wavelengths = spectral ? ATMOS_WAVELENGTHS_SPECTRAL : ATMOS_WAVELENGTHS_RGB;
     s->spectral_samples = 16;
-    s->background = ATMOS_BACKGROUND_BLACK;
+    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
     s->sun.from_time = 0;
     s->sun.elevation_deg = sun_el;
     s->sun.azimuth_deg = sun_az;
     s->atmosphere.sun_diameter_deg = 0.05;
 }
 
+/* The kind of atmosphere the air tests run in: each runs in Riley's sky and in a homogeneous
+ * layer, so the path tracer is shown to use only the atmosphere interface. */
+static atmos_atmosphere_kind air_kind = ATMOS_ATMOSPHERE_RILEY;
+
 /* The sky background, a pinhole camera at pos looking at look. */
 static void sky_scene(atmos_scene *s, int w, int h, double sun_el, double sun_az, const double pos[3],
                       const double look[3], double fov_deg)
 {
     atmos_scene_defaults(s);
+    s->atmosphere.kind = air_kind;
+    s->atmosphere.thickness_m = 3000;
     s->width = w, s->height = h;
     s->sun.from_time = 0;
     s->sun.elevation_deg = sun_el;
@@ -555,8 +561,8 @@ static void test_absorber(atmos_context *ctx)
     atmos_volume *v = dense_volume(ctx, 24, 24, 24, 10, -120, 1000, -120, buf);
     atmos_scene s;
     vacuum_scene(&s, 0, 30, 100);
-    s.background = ATMOS_BACKGROUND_UNIFORM;
-    s.background_radiance = 2.0;
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+    s.atmosphere.background_radiance = 2.0;
     s.width = s.height = 8;
     double pos[3] = {-300, 1050, -250};
     atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
@@ -594,8 +600,8 @@ static void test_threads_and_spectral(void)
     atmos_volume *v = slab(c1, 64, 2);
     atmos_scene s;
     vacuum_scene(&s, 0, 35, 150);
-    s.background = ATMOS_BACKGROUND_UNIFORM;
-    s.background_radiance = 0.1;
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+    s.atmosphere.background_radiance = 0.1;
     s.width = 24, s.height = 16;
     double pos[3] = {0, SLAB_Y + 300, 900};
     atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
@@ -625,7 +631,8 @@ static void test_threads_and_spectral(void)
      * wavelength's reflected radiance over the sun's irradiance matches rgb mode. */
     optics os;
     make_optics(c1, 1, 0.85, 0.99, &os);
-    s.background = ATMOS_BACKGROUND_BLACK;
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+    s.atmosphere.background_radiance = 0;
     s.width = s.height = 8;
     s.camera.fov_deg = 1;
     atmos_image *va = NULL, *vb = NULL;
@@ -673,6 +680,8 @@ static void test_sky_only(atmos_context *ctx)
 {
     atmos_scene s;
     atmos_scene_defaults(&s);
+    s.atmosphere.kind = air_kind;
+    s.atmosphere.thickness_m = 3000;
     s.width = 16, s.height = 12;
     s.samples_per_pixel = 256;
     s.atmosphere.ground_albedo = 0;
@@ -767,13 +776,13 @@ static void test_air_shadow(atmos_context *ctx)
     atmos_image *img = render(ctx, &s, v, &op, 256, 0, &var);
     atmos_wavelengths wl;
     CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
-    atmos_sky *sky = NULL;
-    CHECK_OK(atmos_sky_create(ctx, &s.atmosphere, &wl, &sky));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(ctx, &s.atmosphere, &wl, &sky));
     const double up[3] = {0, 1, 0}, dir[3] = {0, 0, -1};
     double E[ATMOS_MAX_WAVELENGTHS], Ta[ATMOS_MAX_WAVELENGTHS], Tb[ATMOS_MAX_WAVELENGTHS];
-    atmos_sky_sunlight(sky, y0, up, E);
-    atmos_sky_transmittance(sky, y0, dir, 500, Ta);
-    atmos_sky_transmittance(sky, y0, dir, 10500, Tb);
+    atmos_atmosphere_sunlight(sky, pos, up, E);
+    atmos_atmosphere_transmittance(sky, pos, dir, 500, Ta);
+    atmos_atmosphere_transmittance(sky, pos, dir, 10500, Tb);
     const double P = atmos_phase_rayleigh(0.0);
     for (int c = 0; c < 3; c++) {
         double m = 0, vv = 0;
@@ -784,7 +793,7 @@ static void test_air_shadow(atmos_context *ctx)
         CHECK(fabs(m - ref) < 4 * sqrt(vv) + 1e-3 * ref);
         CHECK(open - ref > 10 * sqrt(vv)); /* the shadow is resolved */
     }
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
     atmos_image_destroy(img);
     atmos_image_destroy(var);
     atmos_volume_destroy(v);
@@ -839,9 +848,14 @@ int main(void)
     setvbuf(stdout, NULL, _IONBF, 0);
     atmos_context *ctx = make_ctx(0);
     test_ad();
-    test_sky_only(ctx);
-    test_air_in_box(ctx);
-    test_air_shadow(ctx);
+    for (int k = 0; k < 2; k++) {
+        air_kind = k ? ATMOS_ATMOSPHERE_HOMOGENEOUS : ATMOS_ATMOSPHERE_RILEY;
+        printf("-- air: %s\n", k ? "a homogeneous layer 3 km thick" : "Riley's exponential atmosphere");
+        test_sky_only(ctx);
+        test_air_in_box(ctx);
+        test_air_shadow(ctx);
+    }
+    air_kind = ATMOS_ATMOSPHERE_RILEY;
     test_estimators_agree(ctx);
     test_absorber(ctx);
     test_single(ctx);

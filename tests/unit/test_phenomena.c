@@ -116,7 +116,7 @@ static void make_setup(atmos_context *ctx, int front, double fov_deg, double sig
     atmos_scene_defaults(s);
     s->width = W, s->height = H;
     s->samples_per_pixel = 1;
-    s->background = ATMOS_BACKGROUND_BLACK;
+    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
     s->wavelengths = ATMOS_WAVELENGTHS_RGB;
     s->sun.from_time = 0;
     s->sun.elevation_deg = 5;

@@ -24,11 +24,13 @@ static atmos_image *render(atmos_context *ctx, const atmos_scene *s)
     return img;
 }
 
-static void test_matches_model(void)
+static void test_matches_model(atmos_atmosphere_kind kind)
 {
     atmos_context *ctx = make_ctx(2);
     atmos_scene s;
     atmos_scene_defaults(&s);
+    s.atmosphere.kind = kind;
+    s.atmosphere.thickness_m = 2000;
     s.width = 96;
     s.height = 64;
     s.atmosphere.hide_sun_disk = 1;
@@ -49,8 +51,8 @@ static void test_matches_model(void)
             atmos_wavelengths wl;
             atmos_scene_wavelengths(ctx, &s, &wl);
             atmos_atmosphere_desc ad = s.atmosphere;
-            atmos_sky *sky = NULL;
-            CHECK_OK(atmos_sky_create(ctx, &ad, &wl, &sky));
+            atmos_atmosphere *sky = NULL;
+            CHECK_OK(atmos_atmosphere_create(ctx, &ad, &wl, &sky));
             atmos_camera cam;
             CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
             double sun[3];
@@ -67,7 +69,7 @@ static void test_matches_model(void)
                         continue;
                     }
                     if (px[wl.count] != 1.0f) bad_alpha++;
-                    atmos_sky_radiance(sky, cam.position, d, sun, L, NULL);
+                    atmos_atmosphere_radiance(sky, cam.position, d, sun, L, NULL);
                     for (int k = 0; k < wl.count; k++) {
                         double e = fabs(px[k] - L[k]) / fmax(L[k], 1e-6);
                         if (e > max_err) max_err = e;
@@ -77,7 +79,7 @@ static void test_matches_model(void)
             CHECK(bad_alpha == 0);
             if (types[t] == ATMOS_CAMERA_FISHEYE) CHECK(outside > 0);
             else CHECK(outside == 0);
-            atmos_sky_destroy(sky);
+            atmos_atmosphere_destroy(sky);
             atmos_image_destroy(img);
         }
     }
@@ -154,13 +156,14 @@ static void test_sun_disk_energy(void)
             }
         atmos_wavelengths wl;
         atmos_wavelengths_rgb(&wl);
-        atmos_sky *sky = NULL;
-        atmos_sky_create(ctx, &s.atmosphere, &wl, &sky);
+        atmos_atmosphere *sky = NULL;
+        atmos_atmosphere_create(ctx, &s.atmosphere, &wl, &sky);
         double E[3], sdir[3];
+        const double at[3] = {0, 100, 0};
         atmos_direction_from_angles(30, 123, sdir);
-        atmos_sky_sunlight(sky, 100, sdir, E);
+        atmos_atmosphere_sunlight(sky, at, sdir, E);
         for (int k = 0; k < 3; k++) CHECK_REL(flux[k], E[k], 0.01);
-        atmos_sky_destroy(sky);
+        atmos_atmosphere_destroy(sky);
     }
     atmos_image_destroy(a);
     atmos_image_destroy(b);
@@ -260,8 +263,8 @@ static void test_background_and_irradiance(void)
     s.camera.look_at[2] = s.camera.position[2] - 1000 * cos(235 * 3.14159265358979 / 180);
     s.camera.look_at[1] = s.camera.position[1] + 400;
     for (int b = 0; b < 2; b++) {
-        s.background = b ? ATMOS_BACKGROUND_UNIFORM : ATMOS_BACKGROUND_BLACK;
-        s.background_radiance = b ? 0.25 : 0.0;
+        s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+        s.atmosphere.background_radiance = b ? 0.25 : 0.0;
         atmos_image *img = render(ctx, &s);
         int bad = 0;
         for (int i = 0; img && i < s.width * s.height; i++) {
@@ -272,7 +275,8 @@ static void test_background_and_irradiance(void)
         CHECK_MSG(img && bad == 0, "background %d: %d values differ", b, bad);
         atmos_image_destroy(img);
     }
-    s.background = ATMOS_BACKGROUND_SKY;
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_RILEY;
+    s.atmosphere.background_radiance = 0;
     s.wavelengths = ATMOS_WAVELENGTHS_SPECTRAL;
     s.spectral_samples = 8;
     s.sun.irradiance_count = 1;
@@ -301,7 +305,8 @@ static void test_background_and_irradiance(void)
 int main(void)
 {
     test_background_and_irradiance();
-    test_matches_model();
+    test_matches_model(ATMOS_ATMOSPHERE_RILEY);
+    test_matches_model(ATMOS_ATMOSPHERE_HOMOGENEOUS); /* the renderer knows no kind's insides */
     test_threads_identical();
     test_sun_disk_energy();
     test_cancel_and_progress();

@@ -202,7 +202,7 @@ static void test_absent_keys(void)
 
     /* Renderers, volumes, background, sun irradiance. */
     CHECK_OK(parse("{}", &s));
-    CHECK(s.renderer == ATMOS_RENDERER_SKY && s.background == ATMOS_BACKGROUND_SKY && !s.volume.source[0]);
+    CHECK(s.renderer == ATMOS_RENDERER_SKY && s.atmosphere.kind == ATMOS_ATMOSPHERE_RILEY && !s.volume.source[0]);
     CHECK(s.slice.slices == 256 && s.path.spp == 64 && s.path.seed == 1 && s.sun.irradiance_count == 0);
     CHECK_OK(parse("{\"volume\": {\"generate\": \"storm\", \"seed\": 7, \"scale\": 0.5, \"position_m\": [1, 2, 3]}}", &s));
     CHECK(s.renderer == ATMOS_RENDERER_SLICE); /* a volume alone selects the slice renderer */
@@ -216,13 +216,13 @@ static void test_absent_keys(void)
     CHECK(!strcmp(s.volume.particle, "cloud") && s.volume.density_scale == 1e8 && !s.volume.placed);
     CHECK(s.path.spp == 1000 && s.path.time_budget_s == 30 && s.path.seed == 42 && s.path.max_depth == 5);
     CHECK(s.path.truncate_deg == 3.5);
-    CHECK(s.background == ATMOS_BACKGROUND_UNIFORM && s.background_radiance == 0.25);
+    CHECK(s.atmosphere.kind == ATMOS_ATMOSPHERE_VACUUM && s.atmosphere.background_radiance == 0.25);
     CHECK(s.sun.irradiance_count == 3 && s.sun.irradiance[2] == 3 && s.sun.elevation_deg == 30);
     CHECK_OK(parse("{\"sun\": {\"irradiance\": 1.5, \"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40, "
                    "\"longitude_deg\": 0}, \"background\": \"black\", \"slice\": {\"update\": \"eq24\", \"xi\": 0, "
                    "\"low_albedo\": true, \"slices\": 64, \"light_size\": 128, \"grid_max_dim\": 64, "
                    "\"eye_scale\": 0.5}}", &s));
-    CHECK(s.sun.from_time && s.sun.irradiance_count == 1 && s.sun.irradiance[0] == 1.5 && s.background == ATMOS_BACKGROUND_BLACK);
+    CHECK(s.sun.from_time && s.sun.irradiance_count == 1 && s.sun.irradiance[0] == 1.5 && s.atmosphere.kind == ATMOS_ATMOSPHERE_VACUUM && s.atmosphere.background_radiance == 0);
     CHECK(s.slice.eq24 == 1 && s.slice.xi == 0 && s.slice.low_albedo == 1 && s.slice.slices == 64 && s.slice.light_size == 128 &&
           s.slice.grid_max_dim == 64 && s.slice.eye_scale == 0.5);
 }

@@ -5,6 +5,36 @@
 
 #include <math.h>
 
+/* The interface takes points; the flat-earth sky depends on their altitude only. */
+static double ground_at(const atmos_atmosphere *a, double y, const double d[3])
+{
+    const double p[3] = {0, y, 0};
+    return atmos_atmosphere_ground_distance(a, p, d);
+}
+static void transmittance_at(const atmos_atmosphere *a, double y, const double d[3], double K, double *out)
+{
+    const double p[3] = {0, y, 0};
+    atmos_atmosphere_transmittance(a, p, d, K, out);
+}
+static void sunlight_at(const atmos_atmosphere *a, double y, const double sun[3], double *out)
+{
+    const double p[3] = {0, y, 0};
+    atmos_atmosphere_sunlight(a, p, sun, out);
+}
+static void sun_radiance_at(const atmos_atmosphere *a, double y, const double sun[3], double *out)
+{
+    const double p[3] = {0, y, 0};
+    atmos_atmosphere_sun_radiance(a, p, sun, out);
+}
+/* Sea-level scattering coefficients (valid until the next call). */
+static const double *beta_sea_level(const atmos_atmosphere *a)
+{
+    static double b[ATMOS_MAX_WAVELENGTHS];
+    const double p[3] = {0, 0, 0};
+    atmos_atmosphere_scattering(a, p, b, NULL);
+    return b;
+}
+
 #define PI 3.14159265358979323846
 #define GAMMA (1.0 / 8000.0)
 
@@ -75,7 +105,7 @@ static double quad_inscatter(quad_ray *r, double K)
     return s;
 }
 
-static void check_inscatter_grid(atmos_sky *sky, const atmos_wavelengths *wl, double *max_err, int *cases)
+static void check_inscatter_grid(atmos_atmosphere *sky, const atmos_wavelengths *wl, double *max_err, int *cases)
 {
     const double sun_el[] = {-5, 0, 0.001, 0.1, 1, 5, 15, 30, 60, 89.9, 90};
     const double view_el[] = {-90, -45, -10, -1, -0.01, -1e-6, 0, 1e-6, 0.01, 1, 5, 10, 30, 60, 89.999, 90};
@@ -93,11 +123,11 @@ static void check_inscatter_grid(atmos_sky *sky, const atmos_wavelengths *wl, do
                         double sun[3], dir[3], eye[3] = {0, alts[a], 0};
                         atmos_direction_from_angles(sun_el[s], 135.0, sun);
                         atmos_direction_from_angles(ve, 135.0 + daz[z], dir);
-                        double K = fmin(dists[k], atmos_sky_ground_distance(eye[1], dir));
-                        atmos_sky_inscatter(sky, eye, dir, K, sun, out);
+                        double K = fmin(dists[k], ground_at(sky, eye[1], dir));
+                        atmos_atmosphere_inscatter(sky, eye, dir, K, sun, out);
                         double mu = dir[0] * sun[0] + dir[1] * sun[1] + dir[2] * sun[2];
                         for (int i = 0; i < wl->count; i++) {
-                            quad_ray r = {atmos_sky_beta_sea_level(sky)[i], eye[1], dir[1], sun[1],
+                            quad_ray r = {beta_sea_level(sky)[i], eye[1], dir[1], sun[1],
                                           wl->sun_irradiance[i], 3.0 / (16 * PI) * (1 + mu * mu)};
                             double ref = quad_inscatter(&r, K);
                             CHECK_MSG(isfinite(out[i]) && out[i] >= 0, "non-finite or negative in-scatter");
@@ -116,21 +146,21 @@ static void test_eq15_vs_quadrature(void)
 {
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
-    atmos_sky *sky = NULL;
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
     double max_err = 0;
     int cases = 0;
     check_inscatter_grid(sky, &wl, &max_err, &cases);
     printf("Eq. 15 vs quadrature (rgb): %d cases, max relative error %.3e\n", cases, max_err);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 
     atmos_wavelengths_spectral(4, &wl);
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
     max_err = 0;
     cases = 0;
     check_inscatter_grid(sky, &wl, &max_err, &cases);
     printf("Eq. 15 vs quadrature (spectral 4): %d cases, max relative error %.3e\n", cases, max_err);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 }
 
 /* Riley et al. 2004 Eq. 15 exactly as printed. It omits the factor
@@ -146,17 +176,17 @@ static void test_printed_eq15_is_wrong(void)
 {
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
-    atmos_sky *sky = NULL;
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
     double sun[3], dir[3], eye[3] = {0, 0, 0}, L[3];
     atmos_direction_from_angles(30, 0, sun);
     atmos_direction_from_angles(60, 90, dir);
     double K = 20000;
-    atmos_sky_inscatter(sky, eye, dir, K, sun, L);
+    atmos_atmosphere_inscatter(sky, eye, dir, K, sun, L);
     double mu = dir[0] * sun[0] + dir[1] * sun[1] + dir[2] * sun[2];
     double P = 3.0 / (16 * PI) * (1 + mu * mu);
     for (int i = 0; i < 3; i++) {
-        double be = atmos_sky_beta_sea_level(sky)[i];
+        double be = beta_sea_level(sky)[i];
         quad_ray r = {be, 0, dir[1], sun[1], wl.sun_irradiance[i], P};
         double ref = quad_inscatter(&r, K);
         double printed = eq15_as_printed(wl.sun_irradiance[i], P, sun[1], dir[1], be, K);
@@ -166,15 +196,15 @@ static void test_printed_eq15_is_wrong(void)
         CHECK(fabs(printed - ref) / ref > 0.05);
         CHECK_REL(L[i], ref, 1e-6);
     }
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 }
 
 static void test_eq11_vs_quadrature(void)
 {
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
-    atmos_sky *sky = NULL;
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
     const double view_el[] = {-90, -30, -1, -1e-7, 0, 1e-7, 0.5, 10, 45, 90};
     const double alts[] = {0, 2000, 10000, 50000};
     const double dists[] = {1, 100, 5000, 200000};
@@ -184,10 +214,10 @@ static void test_eq11_vs_quadrature(void)
             for (size_t k = 0; k < 4; k++) {
                 double dir[3];
                 atmos_direction_from_angles(view_el[v], 10, dir);
-                double K = fmin(dists[k], atmos_sky_ground_distance(alts[a], dir));
-                atmos_sky_transmittance(sky, alts[a], dir, K, T);
+                double K = fmin(dists[k], ground_at(sky, alts[a], dir));
+                transmittance_at(sky, alts[a], dir, K, T);
                 for (int i = 0; i < 3; i++) {
-                    quad_ray r = {atmos_sky_beta_sea_level(sky)[i], alts[a], dir[1], 1, 1, 1};
+                    quad_ray r = {beta_sea_level(sky)[i], alts[a], dir[1], 1, 1, 1};
                     double ref = exp(-tau_quad(&r, K));
                     double err = fabs(T[i] - ref) / ref;
                     if (err > max_err) max_err = err;
@@ -195,46 +225,46 @@ static void test_eq11_vs_quadrature(void)
                 }
             }
     printf("Eq. 11 vs quadrature: max relative error %.3e\n", max_err);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 }
 
 static void test_table3_and_lambda4(void)
 {
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
-    atmos_sky *sky = NULL;
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
-    const double *b = atmos_sky_beta_sea_level(sky);
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
+    const double *b = beta_sea_level(sky);
     /* Riley et al. 2004, Table 3 */
     CHECK_REL(b[0], 5.8e-6, 1e-12);
     CHECK_REL(b[1], 1.35e-5, 1e-12);
     CHECK_REL(b[2], 3.31e-5, 1e-12);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
     atmos_wavelengths_spectral(16, &wl);
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
-    b = atmos_sky_beta_sea_level(sky);
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
+    b = beta_sea_level(sky);
     for (int i = 0; i < 16; i++) CHECK_REL(b[i] * pow(wl.nm[i], 4), 1.35e-5 * pow(550.0, 4), 1e-12);
     /* Table 3's other entries follow the same law to within 1 % */
     CHECK_REL(1.35e-5 * pow(550.0 / 440.0, 4), 3.31e-5, 0.01);
     CHECK_REL(1.35e-5 * pow(550.0 / 680.0, 4), 5.8e-6, 0.01);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 }
 
 static void test_sunlight(void)
 {
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
-    atmos_sky *sky = NULL;
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
     double s[3], dir[3];
     /* Eq. 12 at the zenith from sea level: exp(-beta_sl H) */
     atmos_direction_from_angles(90, 0, dir);
-    atmos_sky_sunlight(sky, 0, dir, s);
-    for (int i = 0; i < 3; i++) CHECK_REL(s[i], wl.sun_irradiance[i] * exp(-atmos_sky_beta_sea_level(sky)[i] * 8000), 1e-12);
+    sunlight_at(sky, 0, dir, s);
+    for (int i = 0; i < 3; i++) CHECK_REL(s[i], wl.sun_irradiance[i] * exp(-beta_sea_level(sky)[i] * 8000), 1e-12);
     /* Sun on or below the horizon: no direct light, no NaN */
     for (double e = 0; e >= -90; e -= 15) {
         atmos_direction_from_angles(e, 0, dir);
-        atmos_sky_sunlight(sky, 1000, dir, s);
+        sunlight_at(sky, 1000, dir, s);
         for (int i = 0; i < 3; i++) CHECK(s[i] == 0.0);
     }
     /* Integrated Rayleigh phase is 1 (Eq. 1) */
@@ -245,20 +275,20 @@ static void test_sunlight(void)
         sum += atmos_phase_rayleigh(mu) * 2 * PI * 2.0 / n;
     }
     CHECK_NEAR(sum, 1.0, 1e-8);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 }
 
 static void test_physics(void)
 {
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
-    atmos_sky *sky = NULL;
-    CHECK_OK(atmos_sky_create(NULL, NULL, &wl, &sky));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, NULL, &wl, &sky));
     double sun[3], L[3], prev_ratio = 0;
     /* The sun's disk reddens as the sun lowers: red/blue grows monotonically. */
     for (double e = 90; e >= 0.5; e -= 0.5) {
         atmos_direction_from_angles(e, 200, sun);
-        atmos_sky_sun_radiance(sky, 0, sun, L);
+        sun_radiance_at(sky, 0, sun, L);
         double ratio = L[0] / L[2];
         CHECK_MSG(ratio > prev_ratio, "sun red/blue not increasing at elevation %g", e);
         prev_ratio = ratio;
@@ -271,39 +301,39 @@ static void test_physics(void)
         atmos_direction_from_angles(90, 0, zen);
         atmos_direction_from_angles(2, 0, hor);
         double Lz[3], Lh[3];
-        atmos_sky_radiance(sky, eye, zen, sun, Lz, NULL);
-        atmos_sky_radiance(sky, eye, hor, sun, Lh, NULL);
+        atmos_atmosphere_radiance(sky, eye, zen, sun, Lz, NULL);
+        atmos_atmosphere_radiance(sky, eye, hor, sun, Lh, NULL);
         CHECK_MSG(Lz[2] / Lz[0] > Lh[2] / Lh[0], "zenith not bluer than horizon at sun elevation %g", sun_els[k]);
         /* and the daytime sky is blue: blue channel above red at the zenith */
         CHECK(Lz[2] > Lz[0]);
     }
     /* Looking into the sun's disk adds the disk radiance. */
     double eye[3] = {0, 0, 0}, Ls[3];
-    atmos_sky_sample info;
+    atmos_atmosphere_hit info;
     atmos_direction_from_angles(40, 100, sun);
-    atmos_sky_radiance(sky, eye, sun, sun, Ls, &info);
+    atmos_atmosphere_radiance(sky, eye, sun, sun, Ls, &info);
     CHECK(info.in_sun_disk && !info.hits_ground);
-    atmos_sky_sun_radiance(sky, 0, sun, L);
+    sun_radiance_at(sky, 0, sun, L);
     CHECK(Ls[1] > L[1]);
     /* Ground: downward views end on the ground at the right distance. */
     double down[3];
     atmos_direction_from_angles(-30, 0, down);
     double e10[3] = {0, 10000, 0};
-    atmos_sky_radiance(sky, e10, down, sun, Ls, &info);
+    atmos_atmosphere_radiance(sky, e10, down, sun, Ls, &info);
     CHECK(info.hits_ground);
     CHECK_REL(info.distance_m, 20000.0, 1e-12);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 }
 
 static void test_no_nan_sweep(void)
 {
     atmos_wavelengths wl;
     atmos_wavelengths_spectral(32, &wl);
-    atmos_sky *sky = NULL;
+    atmos_atmosphere *sky = NULL;
     atmos_atmosphere_desc ad;
     atmos_atmosphere_defaults(&ad);
     ad.ground_albedo = 0.3;
-    CHECK_OK(atmos_sky_create(NULL, &ad, &wl, &sky));
+    CHECK_OK(atmos_atmosphere_create(NULL, &ad, &wl, &sky));
     double L[ATMOS_MAX_WAVELENGTHS];
     const double alts[] = {0, 2, 10000, 50000, 1e6};
     int bad = 0, n = 0;
@@ -314,7 +344,7 @@ static void test_no_nan_sweep(void)
                     double sun[3], dir[3], eye[3] = {0, alts[a], 0};
                     atmos_direction_from_angles(se, 0, sun);
                     atmos_direction_from_angles(ve, az, dir);
-                    atmos_sky_radiance(sky, eye, dir, sun, L, NULL);
+                    atmos_atmosphere_radiance(sky, eye, dir, sun, L, NULL);
                     for (int i = 0; i < wl.count; i++) {
                         n++;
                         if (!isfinite(L[i]) || L[i] < 0) bad++;
@@ -327,7 +357,7 @@ static void test_no_nan_sweep(void)
             double sun[3], dir[3], eye[3] = {0, alts[a], 0};
             atmos_direction_from_angles(special[k][0], 30, sun);
             atmos_direction_from_angles(special[k][1], 30, dir);
-            atmos_sky_radiance(sky, eye, dir, sun, L, NULL);
+            atmos_atmosphere_radiance(sky, eye, dir, sun, L, NULL);
             for (int i = 0; i < wl.count; i++) {
                 n++;
                 if (!isfinite(L[i]) || L[i] < 0) bad++;
@@ -335,7 +365,7 @@ static void test_no_nan_sweep(void)
         }
     printf("NaN/Inf sweep: %d values, %d bad\n", n, bad);
     CHECK(bad == 0);
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
 }
 
 static void test_bad_args(void)
@@ -347,15 +377,15 @@ static void test_bad_args(void)
     atmos_atmosphere_desc ad;
     atmos_atmosphere_defaults(&ad);
     ad.ground_albedo = 1.5;
-    atmos_sky *sky = NULL;
-    CHECK(atmos_sky_create(ctx, &ad, &wl, &sky) == ATMOS_E_INVALID_ARG);
+    atmos_atmosphere *sky = NULL;
+    CHECK(atmos_atmosphere_create(ctx, &ad, &wl, &sky) == ATMOS_E_INVALID_ARG);
     CHECK(sky == NULL);
     CHECK(strstr(atmos_context_error(ctx), "ground_albedo") != NULL);
     atmos_atmosphere_defaults(&ad);
     ad.scale_height_m = -1;
-    CHECK(atmos_sky_create(ctx, &ad, &wl, &sky) == ATMOS_E_INVALID_ARG);
+    CHECK(atmos_atmosphere_create(ctx, &ad, &wl, &sky) == ATMOS_E_INVALID_ARG);
     CHECK(strstr(atmos_context_error(ctx), "scale_height_m") != NULL);
-    atmos_sky_destroy(NULL); /* must be a no-op */
+    atmos_atmosphere_destroy(NULL); /* must be a no-op */
     atmos_context_destroy(ctx);
 }
 

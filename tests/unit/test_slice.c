@@ -144,8 +144,9 @@ static void march(atmos_context *ctx, const atmos_scene *s, const atmos_volume *
 {
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
-    atmos_sky *air = NULL;
-    CHECK_OK(atmos_sky_create(ctx, &s->atmosphere, &wl, &air));
+    atmos_atmosphere *air = NULL;
+    CHECK_OK(atmos_atmosphere_create(ctx, &s->atmosphere, &wl, &air));
+    const int vacuum = s->atmosphere.kind == ATMOS_ATMOSPHERE_VACUUM;
     atmos_camera cam;
     CHECK_OK(atmos_camera_init(ctx, &s->camera, s->width, s->height, &cam));
     double sun[3], el, az;
@@ -172,10 +173,10 @@ static void march(atmos_context *ctx, const atmos_scene *s, const atmos_volume *
                 double be = eta * sig;
                 double tl = atmos_volume_optical_depth(v, &sig, p, sun, 0, 1e5);
                 double sl[3];
-                if (s->background != ATMOS_BACKGROUND_SKY) /* vacuum: the sun unattenuated */
+                if (vacuum) /* the sun unattenuated */
                     for (int c = 0; c < 3; c++) sl[c] = wl.sun_irradiance[c] * s->atmosphere.sun_scale;
                 else
-                    atmos_sky_sunlight(air, p[1], sun, sl);
+                    atmos_atmosphere_sunlight(air, p, sun, sl);
                 /* exact slab integral of the source with its own attenuation */
                 double Ts = exp(-be * dt);
                 for (int c = 0; c < 3; c++) L[c] += exp(-tau) * sl[c] * exp(-tl) * albedo * P * (1 - Ts);
@@ -185,14 +186,28 @@ static void march(atmos_context *ctx, const atmos_scene *s, const atmos_volume *
             double th = (cen[0] - cam.position[0]) * d[0] + (cen[1] - cam.position[1]) * d[1] +
                         (cen[2] - cam.position[2]) * d[2];
             double front[3], Tf[3];
-            atmos_sky_inscatter(air, cam.position, d, th, sun, front);
-            atmos_sky_transmittance(air, cam.position[1], d, th, Tf);
-            if (s->background != ATMOS_BACKGROUND_SKY)
+            atmos_atmosphere_inscatter(air, cam.position, d, th, sun, front);
+            atmos_atmosphere_transmittance(air, cam.position, d, th, Tf);
+            if (vacuum)
                 for (int c = 0; c < 3; c++) front[c] = 0, Tf[c] = 1;
             float *px = out->pixels + ((size_t)y * s->width + x) * 4;
             for (int c = 0; c < 3; c++) px[c] = (float)(front[c] + Tf[c] * L[c] + exp(-tau) * (px[c] - front[c]));
         }
-    atmos_sky_destroy(air);
+    atmos_atmosphere_destroy(air);
+}
+
+enum { BG_SKY, BG_BLACK, BG_UNIFORM };
+static int homogeneous_air; /* compare_with_marcher: a homogeneous layer instead of Riley's air */
+
+static void compare_with_marcher(atmos_context *ctx, float peak, int low_albedo, int background, double tol,
+                                 const char *what);
+
+/* As compare_with_marcher in a homogeneous layer of air (the renderer knows no kind's insides). */
+static void compare_homogeneous(atmos_context *ctx, double tol)
+{
+    homogeneous_air = 1;
+    compare_with_marcher(ctx, 1e4f, 0, BG_SKY, tol, "thin, homogeneous air");
+    homogeneous_air = 0;
 }
 
 static void compare_with_marcher(atmos_context *ctx, float peak, int low_albedo, int background, double tol,
@@ -203,8 +218,9 @@ static void compare_with_marcher(atmos_context *ctx, float peak, int low_albedo,
     atmos_volume *v = blob(ctx, peak);
     atmos_scene s;
     scene_for(&s, 35, 200); /* sun behind-left of the camera: front-to-back */
-    s.background = (atmos_background_kind)background;
-    s.background_radiance = background == ATMOS_BACKGROUND_UNIFORM ? 0.01 : 0.0;
+    if (background != BG_SKY) s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+    if (homogeneous_air) s.atmosphere.kind = ATMOS_ATMOSPHERE_HOMOGENEOUS, s.atmosphere.thickness_m = 1500;
+    s.atmosphere.background_radiance = background == BG_UNIFORM ? 0.01 : 0.0;
     atmos_slice_settings ss = {0};
     ss.optics = &op.o;
     ss.xi = -1; /* no back-scatter term: pure single scattering in the thin limit */
@@ -232,12 +248,13 @@ static void test_thin_limit(void)
 {
     atmos_context *ctx = make_ctx(2);
     /* peak 1e4 m^-3 * 1e-9 m^2 = 1e-5 m^-1: optical depth ~0.004 through the blob */
-    compare_with_marcher(ctx, 1e4f, 0, ATMOS_BACKGROUND_SKY, 0.02, "thin, Eq. 25");
+    compare_with_marcher(ctx, 1e4f, 0, BG_SKY, 0.02, "thin, Eq. 25");
     /* low-albedo mode is plain single scattering at any thickness (peak tau ~ 2) */
-    compare_with_marcher(ctx, 5e6f, 1, ATMOS_BACKGROUND_SKY, 0.03, "low albedo, thick");
+    compare_with_marcher(ctx, 5e6f, 1, BG_SKY, 0.03, "low albedo, thick");
     /* vacuum backgrounds: no air in front, the sun unattenuated */
-    compare_with_marcher(ctx, 1e4f, 0, ATMOS_BACKGROUND_BLACK, 0.02, "thin, black background");
-    compare_with_marcher(ctx, 5e6f, 1, ATMOS_BACKGROUND_UNIFORM, 0.03, "low albedo, uniform background");
+    compare_with_marcher(ctx, 1e4f, 0, BG_BLACK, 0.02, "thin, black background");
+    compare_with_marcher(ctx, 5e6f, 1, BG_UNIFORM, 0.03, "low albedo, uniform background");
+    compare_homogeneous(ctx, 0.02);
     atmos_context_destroy(ctx);
 }
 
@@ -510,7 +527,7 @@ static void test_eye_scale(void)
     atmos_scene s;
     scene_for(&s, 20, 10);
     s.width = 67, s.height = 45;
-    s.background = ATMOS_BACKGROUND_BLACK;
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
     const double scales[] = {0.37, 0.02, 1e-9};
     for (int i = 0; i < 3; i++) {
         atmos_slice_settings ss = {0};

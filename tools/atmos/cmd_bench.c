@@ -450,7 +450,7 @@ static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v
     atmos_path_settings ps;
     memset(&ps, 0, sizeof ps);
     bench_view(&scene, v, size, ps.offset_m);
-    scene.background = vacuum ? ATMOS_BACKGROUND_BLACK : ATMOS_BACKGROUND_SKY;
+    scene.atmosphere.kind = vacuum ? ATMOS_ATMOSPHERE_VACUUM : ATMOS_ATMOSPHERE_RILEY;
     ps.density_scale = dscale;
     ps.spp = spp;
     ps.no_forced = flags->no_forced;

@@ -76,8 +76,8 @@ int cli_cmd_sky(int argc, char **argv)
     atmos_atmosphere_desc ad;
     atmos_atmosphere_defaults(&ad);
     if (albedo >= 0) ad.ground_albedo = albedo;
-    atmos_sky *sky = NULL;
-    atmos_status st = atmos_sky_create(ctx, &ad, &wl, &sky);
+    atmos_atmosphere *sky = NULL;
+    atmos_status st = atmos_atmosphere_create(ctx, &ad, &wl, &sky);
     if (st != ATMOS_OK) {
         int rc = cli_runtime_error(C, ctx, st);
         atmos_context_destroy(ctx);
@@ -86,15 +86,16 @@ int cli_cmd_sky(int argc, char **argv)
     double sun[3], dir[3], eye[3] = {0, alt, 0};
     atmos_direction_from_angles(sun_el, sun_az, sun);
     atmos_direction_from_angles(view_el, view_az, dir);
-    double K = atmos_sky_ground_distance(alt, dir);
+    const double ground0[3] = {0, 0, 0};
+    double K = atmos_atmosphere_ground_distance(sky, eye, dir);
     if (dist < K) K = dist;
-    int n = wl.count, hits_ground = !isinf(K) && K == atmos_sky_ground_distance(alt, dir);
+    int n = wl.count, hits_ground = !isinf(K) && K == atmos_atmosphere_ground_distance(sky, eye, dir);
     double ins[ATMOS_MAX_WAVELENGTHS], tr[ATMOS_MAX_WAVELENGTHS], sunr[ATMOS_MAX_WAVELENGTHS],
         ground[ATMOS_MAX_WAVELENGTHS], lit[ATMOS_MAX_WAVELENGTHS];
-    atmos_sky_inscatter(sky, eye, dir, K, sun, ins);
-    atmos_sky_transmittance(sky, alt, dir, K, tr);
-    atmos_sky_sun_radiance(sky, alt, sun, sunr);
-    atmos_sky_sunlight(sky, 0.0, sun, lit);
+    atmos_atmosphere_inscatter(sky, eye, dir, K, sun, ins);
+    atmos_atmosphere_transmittance(sky, eye, dir, K, tr);
+    atmos_atmosphere_sun_radiance(sky, eye, sun, sunr);
+    atmos_atmosphere_sunlight(sky, ground0, sun, lit);
     for (int i = 0; i < n; i++)
         ground[i] = hits_ground && sun[1] > 0 ? ad.ground_albedo / 3.14159265358979323846 * sun[1] * lit[i] * tr[i] : 0.0;
     if (json) {
@@ -119,7 +120,7 @@ int cli_cmd_sky(int argc, char **argv)
         for (int i = 0; i < n; i++)
             printf("%10.2f %14.6e %14.6e %14.6e %14.6e\n", wl.nm[i], ins[i], tr[i], sunr[i], ground[i]);
     }
-    atmos_sky_destroy(sky);
+    atmos_atmosphere_destroy(sky);
     atmos_context_destroy(ctx);
     return CLI_EXIT_OK;
 }

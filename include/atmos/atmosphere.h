@@ -1,0 +1,117 @@
+/* The atmosphere: what surrounds the volumes and lights them. One small interface with
+ * several kinds; every renderer asks it the same questions and reads no kind's fields:
+ *
+ *   transmittance along a segment           atmos_atmosphere_transmittance
+ *   sunlight reaching a point               atmos_atmosphere_sunlight
+ *   in-scattered light along a segment      atmos_atmosphere_inscatter   (aerial perspective)
+ *   what a view ray sees                    atmos_atmosphere_radiance    (air, ground, sun's disk)
+ *   where a ray meets the ground            atmos_atmosphere_ground_distance, _ground_albedo
+ *   the air's coefficients and phase        atmos_atmosphere_scattering, _phase
+ *
+ * Kinds:
+ *  - ATMOS_ATMOSPHERE_RILEY: Riley et al. 2004 §4.1 and §4.2.4: a flat earth (y = altitude, the
+ *    ground is y = 0), air of density exp(-y / H) scattering by Rayleigh's law (albedo 1),
+ *    single scattering of collimated sunlight in closed form (Eq. 8-15, Eq. 15 corrected:
+ *    docs/models.md), a Lambertian ground and the sun's disk.
+ *  - ATMOS_ATMOSPHERE_VACUUM: no air and no ground; radiance background_radiance from every
+ *    direction (0: black), the sun unattenuated and its disk not drawn.
+ *  - ATMOS_ATMOSPHERE_HOMOGENEOUS: a layer of air of uniform density from the ground (y = 0)
+ *    to thickness_m, with Riley's coefficients at sea level and the Rayleigh phase function,
+ *    over the same Lambertian ground: every answer in closed form (a test case, and fog).
+ *
+ * Units: positions in metres (world frame, y up), directions unit vectors, radiance in
+ * W m^-2 sr^-1 nm^-1, irradiance in W m^-2 nm^-1, coefficients in m^-1. Every per-wavelength
+ * output has atmos_atmosphere_wavelengths(atm)->count values. An atmosphere is immutable after
+ * creation: any number of threads may query it.
+ */
+#ifndef ATMOS_ATMOSPHERE_H
+#define ATMOS_ATMOSPHERE_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    ATMOS_ATMOSPHERE_RILEY = 0,
+    ATMOS_ATMOSPHERE_VACUUM = 1,
+    ATMOS_ATMOSPHERE_HOMOGENEOUS = 2
+} atmos_atmosphere_kind;
+
+/* Atmosphere settings. atmos_atmosphere_defaults() fills the paper's values; in a
+ * zero-initialised desc, zero means default for every field except ground_albedo. */
+typedef struct atmos_atmosphere_desc {
+    double beta_sl_550;       /* sea-level scattering coefficient at 550 nm, m^-1; default 1.35e-5
+                                 (Riley Table 3); other wavelengths: rgb mode uses Table 3
+                                 scaled by beta_sl_550/1.35e-5, spectral mode the lambda^-4 law */
+    double scale_height_m;    /* RILEY: 1/gamma, default 8000 m (Riley Eq. 9-10) */
+    double ground_albedo;     /* Lambertian ground reflectance in [0, 1]; zero is black ground */
+    double sun_diameter_deg;  /* apparent diameter of the sun's disk, default 0.5 (Riley §4.2.4) */
+    double sun_scale;         /* multiplies the extraterrestrial solar spectrum; default 1 */
+    int hide_sun_disk;        /* nonzero: do not draw the disk (its light still scatters) */
+    atmos_atmosphere_kind kind; /* default RILEY */
+    double background_radiance; /* VACUUM: radiance from every direction, >= 0 */
+    double thickness_m;       /* HOMOGENEOUS: height of the layer's top, m; default 8000 */
+} atmos_atmosphere_desc;
+
+ATMOS_API void atmos_atmosphere_defaults(atmos_atmosphere_desc *desc);
+
+typedef struct atmos_atmosphere atmos_atmosphere;
+
+/* Builds an atmosphere for a wavelength set. Errors name the offending field. */
+ATMOS_API atmos_status atmos_atmosphere_create(atmos_context *ctx, const atmos_atmosphere_desc *desc,
+                                               const atmos_wavelengths *wl, atmos_atmosphere **out);
+ATMOS_API void atmos_atmosphere_destroy(atmos_atmosphere *atm);
+ATMOS_API atmos_atmosphere_kind atmos_atmosphere_get_kind(const atmos_atmosphere *atm);
+ATMOS_API const atmos_wavelengths *atmos_atmosphere_wavelengths(const atmos_atmosphere *atm);
+ATMOS_API const atmos_atmosphere_desc *atmos_atmosphere_get_desc(const atmos_atmosphere *atm);
+
+/* Distance (m) from p along dir to the ground, or INFINITY if the ray never reaches it
+ * (always INFINITY in a vacuum). */
+ATMOS_API double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const double p[3],
+                                                  const double dir[3]);
+/* Reflectance of the (Lambertian) ground; 0 where there is none. */
+ATMOS_API double atmos_atmosphere_ground_albedo(const atmos_atmosphere *atm);
+
+/* Transmittance of the air from p along dir over distance metres (may be INFINITY). */
+ATMOS_API void atmos_atmosphere_transmittance(const atmos_atmosphere *atm, const double p[3], const double dir[3],
+                                              double distance, double *out);
+/* Solar spectral irradiance on a surface facing the sun at p, attenuated by the air (a point
+ * below the ground counts as on it); zero when the sun is on or below the horizon of a flat
+ * earth. */
+ATMOS_API void atmos_atmosphere_sunlight(const atmos_atmosphere *atm, const double p[3], const double sun_dir[3],
+                                         double *out);
+/* Single-scattered radiance of the air arriving at p from the segment p -> p + distance*dir
+ * (distance may be INFINITY). */
+ATMOS_API void atmos_atmosphere_inscatter(const atmos_atmosphere *atm, const double p[3], const double dir[3],
+                                          double distance, const double sun_dir[3], double *out);
+
+/* What a view ray sees: the in-scatter to the ground or to space, the lit ground attenuated
+ * by the air, the background beyond, and the sun's disk (attenuated) if dir falls inside it. */
+typedef struct atmos_atmosphere_hit {
+    double distance_m;   /* length of the air path (INFINITY when it leaves the atmosphere) */
+    int hits_ground;
+    int in_sun_disk;
+} atmos_atmosphere_hit;
+ATMOS_API void atmos_atmosphere_radiance(const atmos_atmosphere *atm, const double p[3], const double dir[3],
+                                         const double sun_dir[3], double *out, atmos_atmosphere_hit *info);
+
+/* Radiance of the sun's disk (uniform) seen from p: attenuated irradiance over the disk's
+ * solid angle. */
+ATMOS_API void atmos_atmosphere_sun_radiance(const atmos_atmosphere *atm, const double p[3], const double sun_dir[3],
+                                             double *out);
+/* Solid angle of the sun's disk, sr. */
+ATMOS_API double atmos_atmosphere_sun_solid_angle(const atmos_atmosphere *atm);
+/* 1 if the sun's disk is drawn for this sun direction (not hidden, above the horizon of a
+ * flat earth, not in a vacuum). */
+ATMOS_API int atmos_atmosphere_sun_disk_visible(const atmos_atmosphere *atm, const double sun_dir[3]);
+
+/* The air's scattering and extinction coefficients (m^-1) at p (either may be NULL). */
+ATMOS_API void atmos_atmosphere_scattering(const atmos_atmosphere *atm, const double p[3], double *scattering,
+                                           double *extinction);
+/* The air's phase function at p, sr^-1 (Rayleigh's for the kinds here). */
+ATMOS_API double atmos_atmosphere_phase(const atmos_atmosphere *atm, const double p[3], double cos_theta);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
