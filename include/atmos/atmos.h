@@ -117,5 +117,6 @@ ATMOS_API atmos_status atmos_copy_file_atomic(atmos_context *ctx, const char *sr
 #include "atmos/render.h"
 #include "atmos/slice.h"
 #include "atmos/path.h"
+#include "atmos/plan.h"
 
 #endif

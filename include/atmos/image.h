@@ -147,6 +147,11 @@ ATMOS_API atmos_status atmos_image_compare_binned(atmos_context *ctx, const atmo
                                                   const atmos_image *reference, const atmos_image *key,
                                                   const double *edges, int n_edges, atmos_image_bins *out);
 
+/* Spectral image (count radiance channels + alpha) -> linear sRGB + alpha (4
+ * channels), scaled so that Y is luminance in cd m^-2. Metadata is copied. */
+ATMOS_API atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral,
+                                           const atmos_wavelengths *wl, atmos_image **out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -52,24 +52,14 @@ typedef struct atmos_path_stats {
                                             the fields and wavelengths */
 } atmos_path_stats;
 
-/* Settings; zero means "the scene's path section" (scene->path) for spp, time_budget_s,
- * seed and max_depth, and the stated default otherwise. atmos_path_defaults shows them. */
+/* What atmos_render_path needs beyond the scene; zero means default for every field. The
+ * tracer's own settings (samples, time budget, seed, depth, truncation, the estimators) are
+ * the scene's "path" section (scene.h, atmos_renderer_settings) and the density scale is the
+ * scene's volume's. */
 typedef struct atmos_path_settings {
-    int spp;               /* samples per pixel, 1..ATMOS_PATH_MAX_SPP (default scene, 64) */
-    double time_budget_s;  /* > 0: stop after the pass during which this much time has passed
-                              (spp is then the upper limit) */
-    uint64_t seed;         /* 0 = the scene's (default 1) */
-    int max_depth;         /* scattering events per path; 0 = the scene's (0 = unlimited) */
-    double density_scale;  /* multiplies the volume's densities; 0 = 1 */
-    double truncate_deg;   /* forward-peak truncation (docs/path.md): the part of every phase
-                              function above its value at theta_c inside the cone theta < theta_c
-                              counts as not scattered. Degrees, (0, 20]; 0 = the scene's (default
-                              0: none, exact); < 0: none whatever the scene says. An
-                              approximation: changes radiances within ~theta_c of the forward
-                              direction (the sun's aureole), removes the droplets' fireflies. */
     double offset_m[3];    /* added to the volume's world position (as atmos_slice_settings) */
     const atmos_volume_optics *optics; /* NULL: built inside the render (only the phase tables
-                                         are read; the Ams tables are not needed) */
+                                          are read; the Ams tables are not needed) */
     atmos_image **variance; /* optional output: per pixel the variance of the pixel's mean
                                radiance at each wavelength ((W m^-2 sr^-1 nm^-1)^2), then, in
                                the place of alpha, the variance of the mean luminance Y
@@ -80,20 +70,13 @@ typedef struct atmos_path_settings {
                                0 where the pixel's mean luminance is 0). Light from the air or
                                the ground counts the volume events before it only. */
     atmos_path_stats *stats; /* optional output */
-    int no_sky_nee;         /* 1: no next-event estimation toward the sky (the sky is then found
-                               by the phase-sampled continuations alone; same mean, more noise) */
-    int no_forced;          /* 1: camera rays find their single scattering only where their free
-                               flight collides (no forced single scattering; same mean, more noise
-                               in thin media) */
-    int no_aureole;         /* 1: no aureole estimate (docs/path.md, "Fireflies of droplet clouds";
-                               used where a phase function's forward peak exceeds 100 sr^-1; same
-                               mean, more fireflies) */
 } atmos_path_settings;
 
 ATMOS_API void atmos_path_defaults(atmos_path_settings *s);
 
-/* Renders the scene (camera of any type, sun, background, wavelengths) with the volume
- * (may be NULL: the sky and the ground alone) by path tracing. *out has the layout of
+/* Renders the scene (camera of any type, sun, atmosphere, wavelengths, "path" settings) with
+ * the volume (may be NULL: the atmosphere and the ground alone) by path tracing: a plan made
+ * and destroyed in one call (include/atmos/plan.h keeps one, and adds samples progressively). *out has the layout of
  * atmos_render_sky: spectral radiance per wavelength (W m^-2 sr^-1 nm^-1), then coverage
  * alpha. settings and info may be NULL. Reports progress through ctx ("render path")
  * and honours cancellation between passes. */

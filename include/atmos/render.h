@@ -20,11 +20,6 @@ typedef struct atmos_render_info {
 ATMOS_API atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene,
                                         atmos_image **out, atmos_render_info *info);
 
-/* Spectral image (count radiance channels + alpha) -> linear sRGB + alpha (4
- * channels), scaled so that Y is luminance in cd m^-2. Metadata is copied. */
-ATMOS_API atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral,
-                                           const atmos_wavelengths *wl, atmos_image **out);
-
 /* The optical depth of the volume (moved by offset_m) along the ray through each pixel
  * centre of the scene's camera, with extinction cross-sections sigma_ext[field] (m^2,
  * densities already scaled): a 1-channel image, for error analyses by depth. */

@@ -53,24 +53,30 @@ typedef struct atmos_scene_volume {
     double position_m[3];     /* world position of the centre of the bottom face of the volume's box */
 } atmos_scene_volume;
 
-/* Settings of the slice renderer ("slice" in the file); mirror atmos_slice_settings. */
+/* Settings of the slice renderer ("slice" in the file). Their ranges, defaults and meaning
+ * are in the table atmos_renderer_settings(ATMOS_RENDERER_SLICE) (docs/scene-format.md). */
 typedef struct atmos_scene_slice {
-    int slices;               /* 256 */
-    int light_size;           /* 256 */
-    double xi;                /* sr^-1; default 0.1/(4 pi); < 0 = none */
-    int eq24;                 /* 1: "update": "eq24"; 0: "eq25" (default) */
+    int slices;               /* sampling planes; 256 */
+    int light_size;           /* light buffer texels per side; 256 */
+    double xi;                /* Riley's back-scatter term xi (Eq. 26), sr^-1; 0.1/(4 pi); 0 = none */
+    int eq24;                 /* "update": 0 = "eq25" (default), 1 = "eq24" */
     int low_albedo;           /* 0 */
     int grid_max_dim;         /* 256 */
-    double eye_scale;         /* 1: eye buffer resolution relative to the image, per axis, (0, 1] */
+    double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1]; 1 */
+    int max_order;            /* Ams orders tabulated; 64 */
 } atmos_scene_slice;
 
-/* Settings of the path tracer ("path" in the file). */
+/* Settings of the path tracer ("path" in the file); the table is
+ * atmos_renderer_settings(ATMOS_RENDERER_PATH). */
 typedef struct atmos_scene_path {
     int spp;                  /* samples per pixel; 64 */
     double time_budget_s;     /* > 0: stop when this much time has passed (after whole passes); 0 = none */
     uint64_t seed;            /* 1 */
     int max_depth;            /* scattering events per path; 0 = unlimited (Russian roulette) */
     double truncate_deg;      /* forward-peak truncation angle, degrees, [0, 20]; 0 = none (exact) */
+    int sky_nee;              /* next-event estimation toward the sky; 1 */
+    int forced;               /* forced single scattering on camera rays; 1 */
+    int aureole;              /* the aureole estimate in droplet clouds; 1 */
 } atmos_scene_path;
 
 /* A sequence of images with the sun moving ("animation" in the file): frame i of N
@@ -182,6 +188,41 @@ ATMOS_API atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_s
 ATMOS_API atmos_status atmos_scene_sun_direction(atmos_context *ctx, const atmos_scene *scene,
                                                  double dir[3], double *elevation_deg,
                                                  double *azimuth_deg);
+
+/* ---------------------------------------------------------------- renderer settings */
+
+/* One setting of a renderer's section of a scene file ("slice", "path"): the table that the
+ * scene parser, the validator, atmos render's options and its --help all read. */
+typedef enum {
+    ATMOS_SETTING_INT = 0,
+    ATMOS_SETTING_REAL = 1,
+    ATMOS_SETTING_BOOL = 2,
+    ATMOS_SETTING_CHOICE = 3,  /* an int holding the index of one of choices[] */
+    ATMOS_SETTING_SEED = 4     /* a uint64_t (JSON numbers up to 2^53) */
+} atmos_setting_type;
+
+typedef struct atmos_setting {
+    const char *key;            /* the key in the scene file's section */
+    const char *flag;           /* atmos render's option without "--" (NULL: none) */
+    atmos_setting_type type;
+    const char *unit;           /* "" when it has none */
+    double min, max;            /* the allowed range (CHOICE and BOOL: unused) */
+    int min_open, max_open;     /* nonzero: the end is excluded */
+    double def;                 /* the default (BOOL 0/1; CHOICE the index) */
+    const char *const *choices; /* CHOICE: the names, NULL-terminated */
+    int flag_sets;              /* BOOL and CHOICE flags take no argument: the value they set */
+    const char *doc;            /* one line */
+    size_t offset;              /* of the value in atmos_scene */
+} atmos_setting;
+
+/* The settings of a renderer's section (count through *count; NULL and 0 for the sky). */
+ATMOS_API const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count);
+/* A setting's value in a scene (as a double: exact for every type), and setting it (the value
+ * is not checked: atmos_scene_validate does that). */
+ATMOS_API double atmos_scene_setting_get(const atmos_scene *scene, const atmos_setting *setting);
+ATMOS_API void atmos_scene_setting_set(atmos_scene *scene, const atmos_setting *setting, double value);
+/* "sky", "slice", "path"; NULL for an unknown kind. */
+ATMOS_API const char *atmos_renderer_name(atmos_renderer_kind renderer);
 
 #ifdef __cplusplus
 }

@@ -1,12 +1,24 @@
-/* Internals of the slice renderer (src/render/slice.c, slice_pass.c): the render grid,
- * the optics tables, the per-frame job and the two passes. Not part of the API. */
+/* Internals of the slice renderer: the plan (slice_plan.c: the render grid, the optics
+ * tables, the buffers and the per-sun light frame kept between frames), the per-frame job
+ * (slice_frame.c), the spans (slice_spans.c), the two passes (slice_pass.c) and the
+ * composite (slice_composite.c). Not part of the API. */
 #ifndef ATMOS_RENDER_SLICE_INTERNAL_H
 #define ATMOS_RENDER_SLICE_INTERNAL_H
 
 #include "core/internal.h"
-
+#include "render/plan_internal.h"
 #include "render/slice_grid.h"
 #include "render/slice_tables.h"
+
+#define SLICE_HD_EPS 0.02 /* rays within ~89 degrees of the slice planes are not sliced */
+
+/* Rotation only, world -> grid frame: o = R^T w (R row-major, grid axes -> world). */
+static inline void atmos__slice_to_grid(const double *R, const double w[3], double o[3])
+{
+    o[0] = R[0] * w[0] + R[3] * w[1] + R[6] * w[2];
+    o[1] = R[1] * w[0] + R[4] * w[1] + R[7] * w[2];
+    o[2] = R[2] * w[0] + R[5] * w[1] + R[8] * w[2];
+}
 
 /* Pixels x0..x1 of one image row, or texels of one light-buffer row, that a slice
  * touches (x0 > x1: none). */
@@ -57,6 +69,59 @@ typedef struct {
      * and texels the render reads or writes (the rest keep the sky / are never read). */
     sspan *erow, *lrow;
 } sjob;
+
+/* The light frame of one sun direction (everything of the light buffer that does not depend
+ * on the camera): the light's travel lt and the buffer's axes e1, e2 in the grid frame, its
+ * extent (texel (a, b) centre at u0 + (a + 0.5) du, v0 + (b + 0.5) dv), and per texel where
+ * its ray crosses the box ([ta, tb], hit) and the sunlight entering there (float, n per
+ * texel; texels that miss get the sunlight at the box's centre). */
+typedef struct {
+    int valid;
+    double sun[3];
+    double lt[3], e1[3], e2[3];
+    double u0, v0, du, dv;
+    double *ta, *tb;
+    unsigned char *hit;
+    float *sl;
+} slight;
+
+struct atmos__slice_plan {
+    sgrid g;                 /* g.v NULL: an empty volume, the sky alone */
+    stables tab;
+    int n, nf, L;
+    int low_albedo, eq24, reference;
+    float xi;
+    double org[3], R[9];     /* world = org + R g */
+    double prepare_s;        /* building the grid and the tables */
+    /* Buffers kept between frames, grown when a frame needs more. */
+    float *pixblock;
+    size_t pix_cap;          /* floats */
+    sspan *spans;
+    size_t span_cap;         /* sspans */
+    int *lk;                 /* 2 L^2 */
+    float *ring, **I, **nsc; /* the light ring: batch + 1 slots */
+    int batch;
+    slight light;
+};
+
+/* Slice indices k whose plane s_k = s0 + (k + 0.5) ds lies in [sa, sb] (k0 > k1: none). */
+void atmos__slice_range(double sa, double sb, double s0, double ds, int nslices, int *k0, int *k1);
+/* Fills the spans of j (espan, lspan, wspan, erow, lrow); 0 if out of memory. cf, cr, cu:
+ * the camera's axes in the grid frame. */
+int atmos__slice_build_spans(sjob *j, const atmos_camera *cam, const double cf[3], const double cr[3],
+                             const double cu[3], int threads);
+/* Restricts the eye spans to the eye-buffer pixels [x0, x1) x [y0, y1). */
+void atmos__slice_clip_spans(sjob *j, int x0, int y0, int x1, int y1);
+/* The §5 composite of the region r of the image img (which holds the sky). */
+void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
+                            const double *R, const atmos__rect *r, atmos_image *img, int threads);
+/* Sets up the per-frame job j of plan sp for the view (geometry, buffers, spans, pixels,
+ * texels); r is the image region to render. */
+atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
+                                      const atmos__view *v, const atmos__rect *r, sjob *j);
+/* The slices, in batches; fills the eye buffer of j. Returns ATMOS_E_CANCELLED when the
+ * progress callback asks to stop. */
+atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp, sjob *j, atmos_slice_timing *tm);
 
 /* Eye pass of slice k over pixels x0..x1 of image row y (Eq. 26); light pass of slice k
  * over texels x0..x1 of light row b (Eq. 21, 25 / 24) where texels a0..a1 may meet

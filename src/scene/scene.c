@@ -51,13 +51,7 @@ void atmos_scene_defaults(atmos_scene *s)
     s->volume.density_scale = 1.0;
     s->volume.seed = 1;
     s->volume.scale = 1.0;
-    s->slice.slices = 256;
-    s->slice.light_size = 256;
-    s->slice.xi = 0.1 / (4.0 * ATMOS_PI);
-    s->slice.grid_max_dim = 256;
-    s->slice.eye_scale = 1.0;
-    s->path.spp = 64;
-    s->path.seed = 1;
+    atmos__settings_defaults(s);
 }
 
 /* 1-based line and byte column of offset, for messages an editor can jump to. */

@@ -74,6 +74,11 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
  * camera.h's zero-means-default rules for look_at and up applied. */
 void atmos__scene_camera_effective(const atmos_camera_desc *cam, double fwd[3], double up[3]);
 
+/* The renderers' settings tables (scene_settings.c): the defaults of every table, and the
+ * range check of every row. */
+void atmos__settings_defaults(atmos_scene *s);
+atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s);
+
 /* Robust vector helpers (scaled so huge components never overflow). */
 double atmos__scene_norm3(const double v[3]);
 /* Sine of the angle between a and b (0 when parallel); -1 if either is zero. */

@@ -764,11 +764,7 @@ static atmos_status parse_particles(const jp *p, const cJSON *j, const char *pat
 
 /* ---- renderers, background, volume ---- */
 
-static const atmos__range r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0}, r_xi = {0, 100, 0, 0},
-                          r_grid = {8, 2048, 0, 0}, r_eye_scale = {0, 1, 1, 0}, r_path_spp = {1, 1000000, 0, 0},
-                          r_budget = {0, 1e7, 0, 0}, r_seed = {0, 9007199254740992.0, 0, 0},
-                          r_depth = {0, 100000, 0, 0},
-                          r_dscale = {0, 1e30, 1, 0}, r_time_index = {0, 1000000, 0, 0},
+static const atmos__range r_seed = {0, 9007199254740992.0, 0, 0}, r_dscale = {0, 1e30, 1, 0}, r_time_index = {0, 1000000, 0, 0},
                           r_voxel = {0, 1e5, 0, 0}, r_vscale = {0, 100, 1, 0};
 
 static atmos_status get_u64(const jp *p, const cJSON *j, const char *path, const atmos__range *r, uint64_t *out)
@@ -917,49 +913,39 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
     return ATMOS_OK;
 }
 
-static atmos_status parse_slice(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+/* A renderer's section ("slice", "path"): every key is a row of its settings table
+ * (atmos_renderer_settings), which gives its type and range. */
+static atmos_status parse_settings(const jp *p, const cJSON *j, const char *path, atmos_renderer_kind r, atmos_scene *s)
 {
-    static const char *const keys[] = {"slices", "light_size", "xi", "update", "low_albedo", "grid_max_dim", "eye_scale"};
-    static const char *const updates[] = {"eq25", "eq24"};
+    int n = 0;
+    const atmos_setting *t = atmos_renderer_settings(r, &n);
+    const char *keys[32];
+    for (int i = 0; i < n && i < 32; i++) keys[i] = t[i].key;
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 7, &it));
+    TRY(iter_begin(p, j, path, keys, n < 32 ? n : 32, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
-        switch (k) {
-        case 0: TRY(get_int(p, v, ip, &r_slices, &s->slice.slices)); break;
-        case 1: TRY(get_int(p, v, ip, &r_light, &s->slice.light_size)); break;
-        case 2: TRY(get_number(p, v, ip, &r_xi, NULL, &s->slice.xi)); break;
-        case 3: TRY(get_enum(p, v, ip, updates, 2, &s->slice.eq24)); break;
-        case 4: TRY(get_bool(p, v, ip, &s->slice.low_albedo)); break;
-        case 5: TRY(get_int(p, v, ip, &r_grid, &s->slice.grid_max_dim)); break;
-        case 6: TRY(get_number(p, v, ip, &r_eye_scale, NULL, &s->slice.eye_scale)); break;
+        const atmos_setting *st = &t[k];
+        const atmos__range range = {st->min, st->max, st->min_open, st->max_open};
+        double value = 0;
+        int x = 0, count = 0;
+        uint64_t u = 0;
+        switch (st->type) {
+        case ATMOS_SETTING_INT: TRY(get_int(p, v, ip, &range, &x)); value = x; break;
+        case ATMOS_SETTING_REAL: TRY(get_number(p, v, ip, &range, NULL, &value)); break;
+        case ATMOS_SETTING_BOOL: TRY(get_bool(p, v, ip, &x)); value = x; break;
+        case ATMOS_SETTING_CHOICE:
+            while (st->choices[count]) count++;
+            TRY(get_enum(p, v, ip, st->choices, count, &x));
+            value = x;
+            break;
+        case ATMOS_SETTING_SEED: TRY(get_u64(p, v, ip, &range, &u)); value = (double)u; break;
         }
-    }
-}
-
-static atmos_status parse_path(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
-{
-    static const char *const keys[] = {"spp", "time_budget_s", "seed", "max_depth", "truncate_deg"};
-    static const atmos__range r_trunc = {0, 20, 0, 0};
-    obj_iter it;
-    char ip[PATH_CAP];
-    const cJSON *v;
-    int k;
-    TRY(iter_begin(p, j, path, keys, 5, &it));
-    for (;;) {
-        TRY(iter_next(p, &it, &k, &v, ip));
-        if (k < 0) return ATMOS_OK;
-        switch (k) {
-        case 0: TRY(get_int(p, v, ip, &r_path_spp, &s->path.spp)); break;
-        case 1: TRY(get_number(p, v, ip, &r_budget, NULL, &s->path.time_budget_s)); break;
-        case 2: TRY(get_u64(p, v, ip, &r_seed, &s->path.seed)); break;
-        case 3: TRY(get_int(p, v, ip, &r_depth, &s->path.max_depth)); break;
-        case 4: TRY(get_number(p, v, ip, &r_trunc, NULL, &s->path.truncate_deg)); break;
-        }
+        atmos_scene_setting_set(s, st, value);
     }
 }
 
@@ -1053,8 +1039,8 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_PARTICLES: TRY(parse_particles(&p, v, ip, s)); break;
         case K_BACKGROUND: TRY(parse_background(&p, v, ip, s)); break;
         case K_VOLUME: TRY(parse_volume(&p, v, ip, s)); break;
-        case K_SLICE: TRY(parse_slice(&p, v, ip, s)); break;
-        case K_PATH: TRY(parse_path(&p, v, ip, s)); break;
+        case K_SLICE: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_SLICE, s)); break;
+        case K_PATH: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_PATH, s)); break;
         case K_ANIMATION: TRY(parse_animation(&p, v, ip, s)); break;
         }
     }

@@ -289,13 +289,8 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
 
 atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
-    static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_slices = {1, 8192, 0, 0}, r_light = {8, 8192, 0, 0},
-                              r_xi = {0, 100, 0, 0}, r_grid = {8, 2048, 0, 0}, r_eye_scale = {0, 1, 0, 0},
-                              r_spp = {1, 1000000, 0, 0}, r_budget = {0, 1e7, 0, 0}, r_depth = {0, 100000, 0, 0},
-                              r_trunc = {0, 20, 0, 0},
-                              r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0}, r_voxel = {0, 1e5, 0, 0},
-                              r_time_index = {0, 1000000, 0, 0};
-    static const char *const names[] = {"sky", "slice", "path"};
+    static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0},
+                              r_voxel = {0, 1e5, 0, 0}, r_time_index = {0, 1000000, 0, 0};
     atmos_status st;
     if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_PATH)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice or path, got %d",
@@ -313,10 +308,11 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     int volume_renderer = s->renderer != ATMOS_RENDERER_SKY;
     if (!memchr(s->volume.source, '\0', sizeof s->volume.source))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/file", "is not terminated");
-    if (volume_renderer && !s->volume.source[0])
+    /* (The path tracer renders the atmosphere and the ground alone when there is no volume.) */
+    if (s->renderer == ATMOS_RENDERER_SLICE && !s->volume.source[0])
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer",
                                  "\"%s\" renders a volume: the scene needs \"volume\" (a file or a generator)",
-                                 names[s->renderer]);
+                                 atmos_renderer_name(s->renderer));
     if (!volume_renderer && s->volume.source[0])
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume",
                                  "the sky renderer draws no volume (use \"renderer\": \"slice\" or \"path\")");
@@ -339,19 +335,10 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
         {"/volume/position_m/0", s->volume.position_m[0], &atmos__r_pos},
         {"/volume/position_m/1", s->volume.position_m[1], &atmos__r_pos},
         {"/volume/position_m/2", s->volume.position_m[2], &atmos__r_pos},
-        {"/slice/slices", s->slice.slices, &r_slices},
-        {"/slice/light_size", s->slice.light_size, &r_light},
-        {"/slice/xi", s->slice.xi, &r_xi},
-        {"/slice/grid_max_dim", s->slice.grid_max_dim, &r_grid},
-        {"/slice/eye_scale", s->slice.eye_scale, &r_eye_scale}, /* 0 (a zeroed struct) = 1; the file needs (0, 1] */
-        {"/path/spp", s->path.spp, &r_spp},
-        {"/path/time_budget_s", s->path.time_budget_s, &r_budget},
-        {"/path/max_depth", s->path.max_depth, &r_depth},
-        {"/path/truncate_deg", s->path.truncate_deg, &r_trunc},
     };
     for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++)
         if ((st = atmos__scene_check_range(ctx, source, checks[i].path, checks[i].v, checks[i].r, NULL))) return st;
-    return ATMOS_OK;
+    return atmos__settings_check(ctx, source, s);
 }
 
 atmos_status atmos__scene_validate_animation(atmos_context *ctx, const char *source, const atmos_scene *scene)

@@ -178,24 +178,25 @@ static void sky_scene(atmos_scene *s, int w, int h, double sun_el, double sun_az
     s->camera.fov_deg = fov_deg;
 }
 
-static double truncate_deg; /* atmos_path_settings.truncate_deg of render() */
-static int no_sky_nee, no_forced; /* the same for render() */
+static double truncate_deg; /* > 0: the scene's path.truncate_deg in render() */
+static int no_sky_nee, no_forced; /* the same for path.sky_nee and path.forced */
 
-static atmos_image *render(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v, const optics *op, int spp,
-                           int max_depth, atmos_image **var)
+static atmos_image *render(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *v, const optics *op,
+                           int spp, int max_depth, atmos_image **var)
 {
+    atmos_scene s = *scene;
+    if (truncate_deg > 0) s.path.truncate_deg = truncate_deg;
+    s.path.sky_nee = !no_sky_nee;
+    s.path.forced = !no_forced;
+    s.path.spp = spp;
+    s.path.seed = 7;
+    s.path.max_depth = max_depth;
     atmos_path_settings ps;
     memset(&ps, 0, sizeof ps);
-    ps.truncate_deg = truncate_deg;
-    ps.no_sky_nee = no_sky_nee;
-    ps.no_forced = no_forced;
-    ps.spp = spp;
-    ps.seed = 7;
-    ps.max_depth = max_depth;
     ps.optics = op ? &op->o : NULL;
     ps.variance = var;
     atmos_image *img = NULL;
-    atmos_status st = atmos_render_path(ctx, s, v, &ps, &img, NULL);
+    atmos_status st = atmos_render_path(ctx, &s, v, &ps, &img, NULL);
     CHECK_MSG(st == ATMOS_OK, "render path: %s", atmos_context_error(ctx));
     if (st != ATMOS_OK) exit(1);
     return img;
@@ -482,10 +483,10 @@ static double mean_order(atmos_context *ctx, double tau, int spp)
     atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
     s.camera.look_at[0] = 0.1, s.camera.look_at[1] = 0, s.camera.look_at[2] = 0;
     s.camera.fov_deg = 10;
+    s.path.spp = spp;
+    s.path.seed = 3;
     atmos_path_settings ps;
     memset(&ps, 0, sizeof ps);
-    ps.spp = spp;
-    ps.seed = 3;
     ps.optics = &op.o;
     atmos_image *img = NULL, *ord = NULL;
     ps.order = &ord;
@@ -531,9 +532,9 @@ static void test_order(atmos_context *ctx)
     atmos_scene_defaults(&s);
     s.width = 8, s.height = 6;
     s.atmosphere.ground_albedo = 0;
+    s.path.spp = 2;
     atmos_path_settings ps;
     memset(&ps, 0, sizeof ps);
-    ps.spp = 2;
     atmos_image *img = NULL, *ord = NULL;
     ps.order = &ord;
     CHECK_OK(atmos_render_path(ctx, &s, NULL, &ps, &img, NULL));
@@ -609,16 +610,11 @@ static void test_threads_and_spectral(void)
     atmos_image *a = render(c1, &s, v, &op, 6, 0, NULL), *b = render(c2, &s, v, &op, 6, 0, NULL);
     CHECK(a && b && memcmp(a->pixels, b->pixels, sizeof(float) * 24 * 16 * 4) == 0);
     CHECK(all_finite(a));
-    /* truncate_deg < 0 is "none" whatever the scene says: the same bytes as the default */
-    s.path.truncate_deg = 5;
-    truncate_deg = -1;
-    atmos_image *tr = render(c2, &s, v, &op, 6, 0, NULL);
-    CHECK(tr && memcmp(a->pixels, tr->pixels, sizeof(float) * 24 * 16 * 4) == 0);
-    atmos_image_destroy(tr);
     atmos_image_destroy(b);
     /* the scene's truncation, thread-independent and a different image */
-    truncate_deg = 0;
-    tr = render(c1, &s, v, &op, 6, 0, NULL), b = render(c2, &s, v, &op, 6, 0, NULL);
+    s.path.truncate_deg = 5;
+    atmos_image *tr = render(c1, &s, v, &op, 6, 0, NULL);
+    b = render(c2, &s, v, &op, 6, 0, NULL);
     CHECK(tr && b && memcmp(tr->pixels, b->pixels, sizeof(float) * 24 * 16 * 4) == 0);
     CHECK(memcmp(a->pixels, tr->pixels, sizeof(float) * 24 * 16 * 4) != 0);
     CHECK(all_finite(tr));
@@ -706,17 +702,20 @@ static void test_sky_only(atmos_context *ctx)
     atmos_image_destroy(var);
     atmos_image_destroy(sky);
 
-    /* bad settings */
+    /* bad settings (the scene's, checked by the scene's rules) */
+    atmos_image *o = NULL;
+    s.path.spp = ATMOS_PATH_MAX_SPP + 1;
+    CHECK(atmos_render_path(ctx, &s, NULL, NULL, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
+    s.path.spp = 1;
+    s.volume.density_scale = -1;
+    CHECK(atmos_render_path(ctx, &s, NULL, NULL, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
+    s.volume.density_scale = 1;
+    s.path.truncate_deg = 20.5;
+    CHECK(atmos_render_path(ctx, &s, NULL, NULL, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
+    s.path.truncate_deg = 0;
     atmos_path_settings ps;
     memset(&ps, 0, sizeof ps);
-    ps.spp = ATMOS_PATH_MAX_SPP + 1;
-    atmos_image *o = NULL;
-    CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
-    ps.spp = 1;
-    ps.density_scale = -1;
-    CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
-    ps.density_scale = 0;
-    ps.truncate_deg = 20.5;
+    ps.offset_m[1] = NAN;
     CHECK(atmos_render_path(ctx, &s, NULL, &ps, &o, NULL) == ATMOS_E_INVALID_ARG && !o);
 }
 

@@ -280,12 +280,13 @@ static double inner_edge(const profile *p, int k, double lo, double pk)
 static atmos_image *render(atmos_context *ctx, const setup *u, const optics *op)
 {
     atmos_slice_settings ss;
-    memset(&ss, 0, sizeof ss);
-    ss.slices = 64;
-    ss.light_size = 64;
+    atmos_slice_defaults(&ss);
     ss.optics = &op->o;
+    atmos_scene s = u->s;
+    s.slice.slices = 64;
+    s.slice.light_size = 64;
     atmos_image *img = NULL;
-    atmos_status st = atmos_render_slice(ctx, &u->s, u->v, &ss, &img, NULL);
+    atmos_status st = atmos_render_slice(ctx, &s, u->v, &ss, &img, NULL);
     CHECK_MSG(st == ATMOS_OK, "render slice: %s", atmos_context_error(ctx));
     return img;
 }

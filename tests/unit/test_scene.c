@@ -256,7 +256,7 @@ static const bad_case bad_cases[] = {
     {"{\"output\": {\"exposure\": true}}", ATMOS_E_INVALID_ARG, "/output/exposure: expected \"auto\" or a number (EV100), got a boolean", NULL},
     {"{\"renderer\": \"raytrace\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, slice, path, got \"raytrace\"", NULL},
     /* renderers, background, volume */
-    {"{\"renderer\": \"path\"}", ATMOS_E_INVALID_ARG, "/renderer: \"path\" renders a volume: the scene needs \"volume\"", NULL},
+    {"{\"renderer\": \"slice\"}", ATMOS_E_INVALID_ARG, "/renderer: \"slice\" renders a volume: the scene needs \"volume\"", NULL},
     {"{\"renderer\": \"sky\", \"volume\": {\"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume: the sky renderer draws no volume", NULL},
     {"{\"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/type: the slice renderer supports pinhole cameras only", NULL},
     {"{\"renderer\": \"path\", \"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"equirect\"}}", ATMOS_E_INVALID_ARG, "/volume/position_m: is needed with a equirect camera", NULL},
@@ -281,7 +281,7 @@ static const bad_case bad_cases[] = {
     {"{\"path\": {\"spp\": 0}}", ATMOS_E_INVALID_ARG, "/path/spp: must be in [1, 1000000], got 0", NULL},
     {"{\"path\": {\"time_budget_s\": -1}}", ATMOS_E_INVALID_ARG, "/path/time_budget_s: must be in [0, 10000000], got -1", NULL},
     {"{\"path\": {\"seed\": -3}}", ATMOS_E_INVALID_ARG, "/path/seed: must be in [0, ", NULL},
-    {"{\"path\": {\"bounces\": 3}}", ATMOS_E_INVALID_ARG, "/path/bounces: unknown key (allowed: spp, time_budget_s, seed, max_depth, truncate_deg)", NULL},
+    {"{\"path\": {\"bounces\": 3}}", ATMOS_E_INVALID_ARG, "/path/bounces: unknown key (allowed: spp, time_budget_s, seed, max_depth, truncate_deg, sky_nee, forced, aureole)", NULL},
     {"{\"path\": {\"truncate_deg\": 21}}", ATMOS_E_INVALID_ARG, "/path/truncate_deg: must be in [0, 20], got 21", NULL},
     {"{\"background\": \"uniform\"}", ATMOS_E_INVALID_ARG, "/background: must be one of sky, black, got \"uniform\"", NULL},
     {"{\"background\": {\"type\": \"uniform\"}}", ATMOS_E_INVALID_ARG, "/background: missing key \"radiance\"", NULL},

@@ -107,11 +107,39 @@ static void scene_for(atmos_scene *s, double sun_el, double sun_az)
     s->wavelengths = ATMOS_WAVELENGTHS_RGB;
 }
 
-static atmos_image *render(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v, atmos_slice_settings *ss)
+/* What these tests vary: the scene's "slice" settings and the density scale (0: the
+ * scene's; xi < 0: none), and the call's optics and reference passes. */
+typedef struct {
+    const atmos_volume_optics *optics;
+    int slices, light_size, eq24, low_albedo, reference;
+    double xi, density_scale, eye_scale;
+} sopts;
+
+static atmos_status render_st(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *v, const sopts *o,
+                              atmos_image **img)
+{
+    atmos_scene s = *scene;
+    atmos_slice_settings ss;
+    atmos_slice_defaults(&ss);
+    s.slice.light_size = 96; /* plenty for a 32^3 volume; keeps the test fast */
+    if (o) {
+        ss.optics = o->optics;
+        ss.reference = o->reference;
+        if (o->slices) s.slice.slices = o->slices;
+        if (o->light_size) s.slice.light_size = o->light_size;
+        if (o->xi != 0) s.slice.xi = o->xi < 0 ? 0 : o->xi;
+        s.slice.eq24 = o->eq24;
+        s.slice.low_albedo = o->low_albedo;
+        if (o->density_scale != 0) s.volume.density_scale = o->density_scale;
+        if (o->eye_scale != 0) s.slice.eye_scale = o->eye_scale;
+    }
+    return atmos_render_slice(ctx, &s, v, &ss, img, NULL);
+}
+
+static atmos_image *render(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v, const sopts *o)
 {
     atmos_image *img = NULL;
-    if (ss && !ss->light_size) ss->light_size = 96; /* plenty for a 32^3 volume; keeps the test fast */
-    atmos_status st = atmos_render_slice(ctx, s, v, ss, &img, NULL);
+    atmos_status st = render_st(ctx, s, v, o, &img);
     CHECK_MSG(st == ATMOS_OK, "render slice: %s", atmos_context_error(ctx));
     return img;
 }
@@ -221,7 +249,7 @@ static void compare_with_marcher(atmos_context *ctx, float peak, int low_albedo,
     if (background != BG_SKY) s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
     if (homogeneous_air) s.atmosphere.kind = ATMOS_ATMOSPHERE_HOMOGENEOUS, s.atmosphere.thickness_m = 1500;
     s.atmosphere.background_radiance = background == BG_UNIFORM ? 0.01 : 0.0;
-    atmos_slice_settings ss = {0};
+    sopts ss = {0};
     ss.optics = &op.o;
     ss.xi = -1; /* no back-scatter term: pure single scattering in the thin limit */
     ss.low_albedo = low_albedo;
@@ -269,11 +297,11 @@ static void test_threads_and_finite(void)
         atmos_scene s;
         scene_for(&s, suns[i][0], suns[i][1]);
         for (int u = 0; u < 2; u++) {
-            atmos_slice_settings ss = {0};
+            sopts ss = {0};
             ss.optics = &op.o;
             ss.slices = 64;
             ss.light_size = 64;
-            ss.update = u ? ATMOS_SLICE_EQ24 : ATMOS_SLICE_EQ25;
+            ss.eq24 = u != 0;
             atmos_image *a = render(c1, &s, v, &ss), *b = render(c2, &s, v, &ss);
             CHECK(a && b && all_finite(a) && all_finite(b));
             if (a && b)
@@ -288,7 +316,7 @@ static void test_threads_and_finite(void)
     scene_for(&s, 0.0, 0.0);
     s.camera.position[2] = -1000;
     s.camera.look_at[2] = -2000;
-    atmos_slice_settings ss = {0};
+    sopts ss = {0};
     ss.optics = &op.o;
     ss.slices = 32;
     ss.density_scale = 1e4;
@@ -312,9 +340,9 @@ static void test_energy_vs_slices(void)
     atmos_image *sky = NULL;
     CHECK_OK(atmos_render_sky(ctx, &s, &sky, NULL));
     for (int u = 0; u < 2; u++) {
-        atmos_slice_settings ss = {0};
+        sopts ss = {0};
         ss.optics = &op.o;
-        ss.update = u ? ATMOS_SLICE_EQ24 : ATMOS_SLICE_EQ25;
+        ss.eq24 = u != 0;
         ss.slices = 64;
         atmos_image *a = render(ctx, &s, v, &ss);
         ss.slices = 256;
@@ -349,7 +377,7 @@ static void test_ftb_btf(void)
         scene_for(&s, el, acos(-caz) * 180 / PI);
         atmos_image *sky = NULL;
         CHECK_OK(atmos_render_sky(ctx, &s, &sky, NULL));
-        atmos_slice_settings ss = {0};
+        sopts ss = {0};
         ss.optics = &op.o;
         atmos_image *a = render(ctx, &s, v, &ss);
         e[i] = volume_energy(a, sky);
@@ -372,7 +400,7 @@ static void test_empty_and_errors(void)
     atmos_volume *v = blob(ctx, 0.0f);
     atmos_scene s;
     scene_for(&s, 35, 200);
-    atmos_slice_settings ss = {0};
+    sopts ss = {0};
     ss.optics = &op.o;
     atmos_image *a = render(ctx, &s, v, &ss), *sky = NULL;
     CHECK_OK(atmos_render_sky(ctx, &s, &sky, NULL));
@@ -382,21 +410,23 @@ static void test_empty_and_errors(void)
 
     atmos_image *img = NULL;
     ss.slices = -3;
-    CHECK(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_E_INVALID_ARG && img == NULL);
-    CHECK(strstr(atmos_context_error(ctx), "slices") != NULL);
+    CHECK(render_st(ctx, &s, v, &ss, &img) == ATMOS_E_INVALID_ARG && img == NULL);
+    CHECK(strstr(atmos_context_error(ctx), "/slice/slices") != NULL);
     ss.slices = 0;
     ss.xi = NAN;
-    CHECK(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_E_INVALID_ARG);
+    CHECK(render_st(ctx, &s, v, &ss, &img) == ATMOS_E_INVALID_ARG);
+    CHECK(strstr(atmos_context_error(ctx), "/slice/xi") != NULL);
     ss.xi = 0;
-    ss.update = (atmos_slice_update)7;
-    CHECK(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_E_INVALID_ARG);
-    ss.update = ATMOS_SLICE_EQ25;
+    ss.eq24 = 7;
+    CHECK(render_st(ctx, &s, v, &ss, &img) == ATMOS_E_INVALID_ARG);
+    ss.eq24 = 0;
     s.camera.type = ATMOS_CAMERA_FISHEYE;
-    CHECK(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_E_UNSUPPORTED);
-    CHECK(atmos_render_slice(ctx, &s, NULL, &ss, &img, NULL) == ATMOS_E_INVALID_ARG);
-    atmos_slice_settings d;
-    atmos_slice_defaults(&d);
-    CHECK(d.slices == 256 && d.light_size == 256 && fabs(d.xi - 0.1 / (4 * PI)) < 1e-12);
+    s.volume.placed = 1;
+    CHECK(render_st(ctx, &s, v, &ss, &img) != ATMOS_OK && img == NULL);
+    CHECK(atmos_render_slice(ctx, &s, NULL, NULL, &img, NULL) == ATMOS_E_INVALID_ARG);
+    atmos_scene d;
+    atmos_scene_defaults(&d);
+    CHECK(d.slice.slices == 256 && d.slice.light_size == 256 && fabs(d.slice.xi - 0.1 / (4 * PI)) < 1e-12);
     atmos_volume_destroy(v);
     free_optics(&op);
     atmos_context_destroy(ctx);
@@ -419,10 +449,10 @@ static void test_fast_vs_reference(void)
             for (int thick = 0; thick < 2; thick++) {
                 atmos_scene s;
                 scene_for(&s, suns[i][0], suns[i][1]);
-                atmos_slice_settings ss = {0};
+                sopts ss = {0};
                 ss.optics = &op.o;
                 ss.slices = thick ? 61 : 64; /* 61: the last batch of slices is partial */
-                ss.update = mode == 1 ? ATMOS_SLICE_EQ24 : ATMOS_SLICE_EQ25;
+                ss.eq24 = mode == 1;
                 ss.low_albedo = mode == 2;
                 ss.density_scale = thick ? 40 : 1;
                 atmos_image *a = render(ctx, &s, v, &ss);
@@ -470,7 +500,7 @@ static void test_eye_scale(void)
         const int W = 128, H = 128;
         atmos_image *sky = NULL;
         CHECK_OK(atmos_render_sky(c2, &s, &sky, NULL));
-        atmos_slice_settings ss = {0};
+        sopts ss = {0};
         ss.optics = &op.o;
         ss.slices = 128;
         atmos_image *full = render(c2, &s, v, &ss);
@@ -530,7 +560,7 @@ static void test_eye_scale(void)
     s.atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
     const double scales[] = {0.37, 0.02, 1e-9};
     for (int i = 0; i < 3; i++) {
-        atmos_slice_settings ss = {0};
+        sopts ss = {0};
         ss.optics = &op.o;
         ss.slices = 32;
         ss.eye_scale = scales[i];
@@ -539,15 +569,15 @@ static void test_eye_scale(void)
         atmos_image_destroy(a), atmos_image_destroy(b);
     }
     atmos_image *img = NULL;
-    atmos_slice_settings bad = {0};
+    sopts bad = {0};
     bad.optics = &op.o;
     bad.eye_scale = 1.5;
-    CHECK(atmos_render_slice(c2, &s, v, &bad, &img, NULL) == ATMOS_E_INVALID_ARG && img == NULL);
+    CHECK(render_st(c2, &s, v, &bad, &img) == ATMOS_E_INVALID_ARG && img == NULL);
     CHECK(strstr(atmos_context_error(c2), "eye_scale") != NULL);
     bad.eye_scale = -0.5;
-    CHECK(atmos_render_slice(c2, &s, v, &bad, &img, NULL) == ATMOS_E_INVALID_ARG);
+    CHECK(render_st(c2, &s, v, &bad, &img) == ATMOS_E_INVALID_ARG);
     bad.eye_scale = NAN;
-    CHECK(atmos_render_slice(c2, &s, v, &bad, &img, NULL) == ATMOS_E_INVALID_ARG);
+    CHECK(render_st(c2, &s, v, &bad, &img) == ATMOS_E_INVALID_ARG);
     atmos_volume_destroy(v);
     free_optics(&op);
     atmos_context_destroy(c1);

@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, getpid, isatty, PATH_MAX */
 #include "cli.h"
 #include "atmos/cache.h"
+#include "bench_render.h"
 
 #include <math.h>
 
@@ -40,10 +41,13 @@ static void help(void)
            "          second (exact DDA with empty-space skipping) between random points on those bounds:\n"
            "            bench=volume case=cumulus load_s=1.2 active_voxels=605554 memory_bytes=3774592 ...\n"
            "  slice   the half-angle slicing renderer (Riley et al. 2004 Fig. 14: NxN, default 512, 256\n"
-           "          slices) on the generated storm and, with --file, on that volume (the Disney cloud);\n"
-           "          best of R (default 3): ms per frame (per-frame set-up + light + eye passes + sky; the\n"
-           "          volume's upload to the render grid and the tables are reported apart in prepare_ms,\n"
-           "          which includes setup_ms), fps, ns per sample, breakdown.\n"
+           "          slices) on the generated storm and, with --file, on that volume (the Disney cloud),\n"
+           "          from one plan as an interactive session renders: 8 R frames (default R 3) with the\n"
+           "          camera orbiting 3 degrees a frame, then with the sun turning 3 degrees a frame, then\n"
+           "          with nothing moving; frames per second of each, end to end (the sky and the\n"
+           "          composite included): fps_camera_moving, fps_sun_moving, fps_static; ms_per_frame\n"
+           "          (sun moving), ns per sample and the breakdown of a frame (setup, light, eye, sky);\n"
+           "          prepare_ms: making the plan (render grid, tables; the optics included).\n"
            "          --eye-scale S renders the eye passes on an S-times smaller buffer per axis.\n"
            "          --json prints one JSON object per case.\n"
            "  path    the path tracer on FILE (default: the generated cumulus) at NxN (default 256), N\n"
@@ -55,16 +59,11 @@ static void help(void)
            "          per-pixel relative standard error of the luminance (t_1pct_pixel_s) and the relative\n"
            "          standard error of the volume's mean luminance (t_1pct_mean_s):\n"
            "            bench=path case=wdas_cloud_sixteenth.vdb background=vacuum size=256x256 spp=16 ...\n"
+           "          and, from the same plan, frames per second of 1-sample frames with the camera moving,\n"
+           "          the sun moving, or nothing moving (each adding one sample per pixel).\n"
            "          --no-forced, --no-sky-nee and --no-aureole turn off the forced single scattering of\n"
            "          camera rays, next-event estimation toward the sky and the aureole estimate\n"
            "          (docs/path.md), to measure what they gain.\n");
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
 static int bench_sky(int size, int repeat, int threads)
@@ -96,10 +95,10 @@ static int bench_sky(int size, int repeat, int threads)
             double best = 1e30;
             for (int r = 0; r < repeat; r++) {
                 atmos_image *spec = NULL, *rgb = NULL;
-                double t0 = now_s();
+                double t0 = cli_now_s();
                 atmos_status st = atmos_render_sky(ctx, &scene, &spec, NULL);
                 if (st == ATMOS_OK) st = atmos_image_to_srgb(ctx, spec, &wl, &rgb);
-                double t = now_s() - t0;
+                double t = cli_now_s() - t0;
                 atmos_image_destroy(spec);
                 atmos_image_destroy(rgb);
                 if (st != ATMOS_OK) {
@@ -138,9 +137,9 @@ static int bench_optics(int threads, int fast, const char *presets)
     double best = 1e30;
     for (int r = 0; r < 3; r++) {
         atmos_mie_result res;
-        double t0 = now_s();
+        double t0 = cli_now_s();
         atmos_status st = atmos_mie(one, m, 1e4, NANG, mu, s1, s2, &res);
-        double t = now_s() - t0;
+        double t = cli_now_s() - t0;
         if (st != ATMOS_OK) {
             int rc = cli_runtime_error("bench", one, st);
             atmos_context_destroy(one);
@@ -182,9 +181,9 @@ static int bench_optics(int threads, int fast, const char *presets)
             else atmos_wavelengths_rgb(&wl);
             atmos_phase_table *t = NULL;
             atmos_phase_table_desc no = {1}, yes = {0};
-            double t0 = now_s();
+            double t0 = cli_now_s();
             st = atmos_phase_table_build(ctx, &p, &wl, &no, &t);
-            double cold = now_s() - t0;
+            double cold = cli_now_s() - t0;
             atmos_phase_table_destroy(t);
             t = NULL;
             /* Fill the cache (untimed), then time the load, best of 3. */
@@ -194,9 +193,9 @@ static int bench_optics(int threads, int fast, const char *presets)
             int hit = 1;
             for (int r = 0; r < 3 && st == ATMOS_OK; r++) {
                 t = NULL;
-                t0 = now_s();
+                t0 = cli_now_s();
                 st = atmos_phase_table_build(ctx, &p, &wl, &yes, &t);
-                double dt = now_s() - t0;
+                double dt = cli_now_s() - t0;
                 if (st == ATMOS_OK) hit &= atmos_phase_table_from_cache(t);
                 atmos_phase_table_destroy(t);
                 if (dt < cached) cached = dt;
@@ -215,9 +214,9 @@ static int bench_optics(int threads, int fast, const char *presets)
             atmos_msphase *ms = NULL;
             atmos_msphase_desc mno = {0}, myes = {0};
             mno.no_cache = 1;
-            t0 = now_s();
+            t0 = cli_now_s();
             if (st == ATMOS_OK) st = atmos_msphase_build(ctx, t, &mno, &ms);
-            double mcold = now_s() - t0;
+            double mcold = cli_now_s() - t0;
             int orders = ms ? atmos_msphase_max_order(ms) : 0;
             atmos_msphase_destroy(ms);
             ms = NULL;
@@ -226,9 +225,9 @@ static int bench_optics(int threads, int fast, const char *presets)
             double mcached = 1e30;
             for (int r = 0; r < 3 && st == ATMOS_OK; r++) {
                 ms = NULL;
-                t0 = now_s();
+                t0 = cli_now_s();
                 st = atmos_msphase_build(ctx, t, &myes, &ms);
-                double dt = now_s() - t0;
+                double dt = cli_now_s() - t0;
                 atmos_msphase_destroy(ms);
                 if (dt < mcached) mcached = dt;
             }
@@ -279,16 +278,16 @@ static void bench_volume_case(const char *name, const atmos_volume *v, double lo
         return;
     }
     const int ns = 2000000, nr = 20000;
-    double sink = 0, t0 = now_s();
+    double sink = 0, t0 = cli_now_s();
     for (int n = 0; n < ns; n++) {
         double p[3] = {lo[0] + (hi[0] - lo[0]) * bench_u01(), lo[1] + (hi[1] - lo[1]) * bench_u01(),
                        lo[2] + (hi[2] - lo[2]) * bench_u01()};
         sink += atmos_volume_sample(v, n % nf, p);
     }
-    double t_rand = now_s() - t0;
+    double t_rand = cli_now_s() - t0;
     double step = atmos_volume_get_desc(v)->voxel_size_m * 0.25;
     int per_line = (int)((hi[0] - lo[0]) / step) + 1;
-    t0 = now_s();
+    t0 = cli_now_s();
     for (int n = 0; n < ns;) {
         double p[3] = {lo[0], lo[1] + (hi[1] - lo[1]) * bench_u01(), lo[2] + (hi[2] - lo[2]) * bench_u01()};
         for (int m = 0; m < per_line && n < ns; m++, n++) {
@@ -296,9 +295,9 @@ static void bench_volume_case(const char *name, const atmos_volume *v, double lo
             sink += atmos_volume_sample(v, 0, p);
         }
     }
-    double t_coh = now_s() - t0;
+    double t_coh = cli_now_s() - t0;
     double tau_sum = 0;
-    t0 = now_s();
+    t0 = cli_now_s();
     for (int n = 0; n < nr; n++) {
         double a[3], b[3], d[3];
         for (int k = 0; k < 3; k++) {
@@ -311,7 +310,7 @@ static void bench_volume_case(const char *name, const atmos_volume *v, double lo
         for (int k = 0; k < 3; k++) d[k] = b[k] - a[k];
         tau_sum += atmos_volume_optical_depth(v, sigma, a, d, 0, 1);
     }
-    double t_od = now_s() - t0;
+    double t_od = cli_now_s() - t0;
     printf("bench=volume case=%s load_s=%.4f active_voxels=%llu memory_bytes=%llu bytes_per_active_voxel=%.2f "
            "random_msamples_per_s=%.2f coherent_msamples_per_s=%.2f od_krays_per_s=%.2f mean_tau=%.3g threads=1%s\n",
            name, load_s, active, (unsigned long long)atmos_volume_memory(v),
@@ -332,9 +331,9 @@ static int bench_volume(const char *file, int repeat, int threads)
         for (int r = 0; r < repeat && st == ATMOS_OK; r++) {
             atmos_volume_destroy(v);
             v = NULL;
-            double t0 = now_s();
+            double t0 = cli_now_s();
             st = atmos_volume_load(ctx, file, NULL, &v);
-            double t = now_s() - t0;
+            double t = cli_now_s() - t0;
             if (t < best) best = t;
         }
         if (st != ATMOS_OK) {
@@ -348,9 +347,9 @@ static int bench_volume(const char *file, int repeat, int threads)
     }
     atmos_volume_generate_desc g = {.seed = 1};
     atmos_volume *v = NULL;
-    double t0 = now_s();
+    double t0 = cli_now_s();
     atmos_status st = atmos_volume_generate(ctx, "cumulus", &g, &v);
-    double t = now_s() - t0;
+    double t = cli_now_s() - t0;
     if (st != ATMOS_OK) {
         int rc = cli_runtime_error("bench", ctx, st);
         atmos_context_destroy(ctx);
@@ -362,168 +361,12 @@ static int bench_volume(const char *file, int repeat, int threads)
     return file_failed ? CLI_EXIT_RUNTIME : CLI_EXIT_OK; /* a named file that cannot be read is an error */
 }
 
-/* The volume benchmarks' view: the volume's base at 1500 m centred above the origin
- * (offset returned), seen from 1.6 times its size, sun 35° high behind-left. */
-static void bench_view(atmos_scene *scene, const atmos_volume *v, int size, double offset[3])
-{
-    atmos_scene_defaults(scene);
-    scene->width = scene->height = size;
-    scene->samples_per_pixel = 1;
-    double lo[3], hi[3];
-    atmos_volume_bounds(v, lo, hi);
-    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
-    offset[0] = -0.5 * (lo[0] + hi[0]);
-    offset[1] = 1500 - lo[1];
-    offset[2] = -0.5 * (lo[2] + hi[2]);
-    double cy = 1500 + 0.5 * (hi[1] - lo[1]);
-    double pos[3] = {0, 1500 + 0.3 * (hi[1] - lo[1]), 1.6 * ext};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &scene->camera);
-    scene->camera.look_at[0] = 0, scene->camera.look_at[1] = cy, scene->camera.look_at[2] = 0;
-    scene->camera.fov_deg = 45;
-    scene->sun.from_time = 0;
-    scene->sun.elevation_deg = 35;
-    scene->sun.azimuth_deg = 200;
-}
-
-/* One case of the slice benchmark: the Fig. 14 configuration (size^2, 256 slices) of
- * the volume seen from a distance of 1.6 times its size, sun 35° high behind-left. */
-static int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int repeat, double eye_scale,
-                            int json)
-{
-    atmos_scene scene;
-    atmos_slice_settings ss;
-    atmos_slice_defaults(&ss);
-    ss.eye_scale = eye_scale > 0 ? eye_scale : 1.0;
-    bench_view(&scene, v, size, ss.offset_m);
-    atmos_volume_optics optics;
-    double t0 = now_s();
-    atmos_status st = atmos_volume_optics_build(ctx, &scene, v, 1, &optics);
-    double t_opt = now_s() - t0;
-    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
-    ss.optics = &optics;
-    atmos_slice_timing tm, best_tm;
-    memset(&best_tm, 0, sizeof best_tm);
-    ss.timing = &tm;
-    double best = 1e30;
-    for (int r = 0; r < repeat; r++) {
-        atmos_image *img = NULL;
-        st = atmos_render_slice(ctx, &scene, v, &ss, &img, NULL);
-        atmos_image_destroy(img);
-        if (st != ATMOS_OK) {
-            atmos_volume_optics_free(&optics);
-            return cli_runtime_error("bench", ctx, st);
-        }
-        if (tm.total < best) best = tm.total, best_tm = tm;
-    }
-    atmos_volume_optics_free(&optics);
-    /* The per-frame work: set-up (rays, light texels, spans), light, eye, sky. The rest of
-     * prepare (resampling the volume, tables) is done once per volume in an interactive session. */
-    double frame = best_tm.setup + best_tm.light + best_tm.eye + best_tm.sky;
-    long long samples = best_tm.eye_samples + best_tm.light_samples;
-    double ns = samples > 0 ? 1e9 * (best_tm.light + best_tm.eye) / (double)samples : 0;
-    if (json)
-        printf("{\"bench\":\"slice\",\"case\":\"%s\",\"size\":%d,\"slices\":%d,\"threads\":%d,\"eye\":[%d,%d],"
-               "\"ms_per_frame\":%.2f,\"fps\":%.3f,\"ns_per_sample\":%.2f,\"setup_ms\":%.2f,\"light_ms\":%.2f,\"eye_ms\":%.2f,"
-               "\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"total_ms\":%.2f,\"eye_samples\":%lld,\"light_samples\":%lld,"
-               "\"grid\":[%d,%d,%d],\"optics_s\":%.3f}\n",
-               name, size, ss.slices, atmos_context_threads(ctx), best_tm.eye_dims[0], best_tm.eye_dims[1], 1e3 * frame,
-               1.0 / frame, ns, 1e3 * best_tm.setup, 1e3 * best_tm.light,
-               1e3 * best_tm.eye, 1e3 * best_tm.sky, 1e3 * best_tm.prepare, 1e3 * best_tm.total, best_tm.eye_samples,
-               best_tm.light_samples, best_tm.grid_dims[0], best_tm.grid_dims[1], best_tm.grid_dims[2], t_opt);
-    else
-        printf("bench=slice case=%s size=%dx%d slices=%d threads=%d eye=%dx%d ms_per_frame=%.2f fps=%.3f ns_per_sample=%.2f "
-               "setup_ms=%.2f light_ms=%.2f eye_ms=%.2f sky_ms=%.2f prepare_ms=%.2f total_ms=%.2f eye_samples=%lld light_samples=%lld "
-               "grid=%dx%dx%d optics_s=%.3f\n",
-               name, size, size, ss.slices, atmos_context_threads(ctx), best_tm.eye_dims[0], best_tm.eye_dims[1], 1e3 * frame,
-               1.0 / frame, ns, 1e3 * best_tm.setup, 1e3 * best_tm.light,
-               1e3 * best_tm.eye, 1e3 * best_tm.sky, 1e3 * best_tm.prepare, 1e3 * best_tm.total, best_tm.eye_samples,
-               best_tm.light_samples, best_tm.grid_dims[0], best_tm.grid_dims[1], best_tm.grid_dims[2], t_opt);
-    fflush(stdout);
-    return CLI_EXIT_OK;
-}
-
-/* One case of the path benchmark (see the help text). */
-static int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int spp, double dscale,
-                           int vacuum, const atmos_path_settings *flags)
-{
-    atmos_scene scene;
-    atmos_path_settings ps;
-    memset(&ps, 0, sizeof ps);
-    bench_view(&scene, v, size, ps.offset_m);
-    scene.atmosphere.kind = vacuum ? ATMOS_ATMOSPHERE_VACUUM : ATMOS_ATMOSPHERE_RILEY;
-    ps.density_scale = dscale;
-    ps.spp = spp;
-    ps.no_forced = flags->no_forced;
-    ps.no_sky_nee = flags->no_sky_nee;
-    ps.no_aureole = flags->no_aureole;
-    atmos_volume_optics optics;
-    double t0 = now_s();
-    atmos_status st = atmos_volume_optics_build(ctx, &scene, v, 0, &optics);
-    double t_opt = now_s() - t0;
-    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
-    ps.optics = &optics;
-    atmos_path_stats stats;
-    ps.stats = &stats;
-    atmos_image *img = NULL, *var = NULL;
-    ps.variance = &var;
-    st = atmos_render_path(ctx, &scene, v, &ps, &img, NULL);
-    atmos_volume_optics_free(&optics);
-    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
-    /* The volume's pixels: vacuum, the nonzero ones; sky, those differing from a render
-     * without the volume by more than 3 standard errors. */
-    atmos_wavelengths wl;
-    atmos_scene_wavelengths(ctx, &scene, &wl);
-    const int n = wl.count, C = n + 1;
-    atmos_image *bg = NULL;
-    if (!vacuum) {
-        atmos_path_settings pb = ps;
-        pb.variance = NULL;
-        pb.stats = NULL;
-        pb.optics = NULL;
-        st = atmos_render_path(ctx, &scene, NULL, &pb, &bg, NULL);
-        if (st != ATMOS_OK) {
-            atmos_image_destroy(img);
-            atmos_image_destroy(var);
-            return cli_runtime_error("bench", ctx, st);
-        }
-    }
-    double rel = 0, sumY = 0, sumV = 0;
-    long long cnt = 0;
-    for (int p = 0; p < size * size; p++) {
-        double Y = 0, Yb = 0;
-        for (int k = 0; k < n; k++) {
-            Y += wl.to_xyz[k][1] * img->pixels[(size_t)p * C + k];
-            if (bg) Yb += wl.to_xyz[k][1] * bg->pixels[(size_t)p * C + k];
-        }
-        double vY = var->pixels[(size_t)p * C + n];
-        int covered = vacuum ? Y > 0 : fabs(Y - Yb) > 3 * sqrt(vY) + 1e-3 * Yb;
-        if (!covered || !(Y > 0)) continue;
-        rel += sqrt(vY) / Y;
-        sumY += Y, sumV += vY;
-        cnt++;
-    }
-    rel = cnt ? rel / cnt : 0;
-    double relm = sumY > 0 ? sqrt(sumV) / sumY : 0;
-    const double t = stats.trace_s;
-    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g%s%s%s paths_per_s=%.4g "
-           "events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g events_per_path=%.2f trace_s=%.3f "
-           "prepare_s=%.3f optics_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f t_1pct_pixel_s=%.4g mean_rel_se=%.3g "
-           "t_1pct_mean_s=%.3g\n",
-           name, vacuum ? "vacuum" : "sky", size, size, stats.spp, atmos_context_threads(ctx), dscale,
-           ps.no_forced ? " no_forced=1" : "", ps.no_sky_nee ? " no_sky_nee=1" : "", ps.no_aureole ? " no_aureole=1" : "", stats.paths / t, stats.events / t, stats.tentative / t, stats.shadow_rays / t,
-           (double)stats.events / (double)stats.paths, t, stats.prepare_s, t_opt, cnt, rel, t * (rel / 0.01) * (rel / 0.01),
-           relm, t * (relm / 0.01) * (relm / 0.01));
-    fflush(stdout);
-    atmos_image_destroy(img);
-    atmos_image_destroy(var);
-    atmos_image_destroy(bg);
-    return CLI_EXIT_OK;
-}
-
-static int bench_path(const char *file, int size, int spp, double dscale, int threads, const atmos_path_settings *flags)
+/* The path tracer's cases: FILE (or the generated cumulus), in vacuum then in the sky. */
+static int bench_path(const char *file, const bench_path_opts *in, int threads)
 {
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
+    bench_path_opts o = *in;
     atmos_volume *v = NULL;
     atmos_status st;
     const char *name = "generated_cumulus";
@@ -531,21 +374,22 @@ static int bench_path(const char *file, int size, int spp, double dscale, int th
         st = atmos_volume_load(ctx, file, NULL, &v);
         const char *base = strrchr(file, '/');
         name = base ? base + 1 : file;
-        if (!(dscale > 0)) dscale = 1e8;
+        if (!(o.density_scale > 0)) o.density_scale = 1e8;
     } else {
         atmos_volume_generate_desc g = {.seed = 1};
         st = atmos_volume_generate(ctx, "cumulus", &g, &v);
-        if (!(dscale > 0)) dscale = 1;
+        if (!(o.density_scale > 0)) o.density_scale = 1;
     }
     int rc = CLI_EXIT_OK;
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-    for (int vac = 1; rc == CLI_EXIT_OK && vac >= 0; vac--) rc = bench_path_case(ctx, name, v, size, spp, dscale, vac, flags);
+    for (int vac = 1; rc == CLI_EXIT_OK && vac >= 0; vac--) rc = bench_path_case(ctx, name, v, &o, vac);
     atmos_volume_destroy(v);
     atmos_context_destroy(ctx);
     return rc;
 }
 
-static int bench_slice(const char *file, int size, int repeat, int threads, double eye_scale, int json)
+/* The slice renderer's cases: the generated storm and, with FILE, that volume. */
+static int bench_slice(const char *file, int size, int frames, int threads, double eye_scale, int json)
 {
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
@@ -554,14 +398,14 @@ static int bench_slice(const char *file, int size, int repeat, int threads, doub
     atmos_volume *v = NULL;
     atmos_status st = atmos_volume_generate(ctx, "storm", &g, &v);
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-    else rc = bench_slice_case(ctx, "generated_storm", v, size, repeat, eye_scale, json);
+    else rc = bench_slice_case(ctx, "generated_storm", v, size, frames, eye_scale, json);
     atmos_volume_destroy(v);
     v = NULL;
     if (rc == CLI_EXIT_OK && file) {
         st = atmos_volume_load(ctx, file, NULL, &v);
         const char *base = strrchr(file, '/');
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, repeat, eye_scale, json);
+        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, frames, eye_scale, json);
         atmos_volume_destroy(v);
     }
     atmos_context_destroy(ctx);
@@ -574,7 +418,7 @@ int cli_cmd_bench(int argc, char **argv)
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16;
     double dscale = 0, eye_scale = 0;
     const char *what = NULL, *presets = NULL, *file = NULL;
-    atmos_path_settings pflags; /* only the no_* switches are read */
+    bench_path_opts pflags;
     memset(&pflags, 0, sizeof pflags);
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -619,8 +463,9 @@ int cli_cmd_bench(int argc, char **argv)
         }
     }
     if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice, path)");
-    if (!strcmp(what, "path")) return bench_path(file, size ? size : 256, spp, dscale, threads, &pflags);
-    if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, repeat_set ? repeat : 3, threads, eye_scale, json);
+    pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale;
+    if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
+    if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, json);
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);

@@ -1,0 +1,132 @@
+/* Plans and frames: build once, render many (as FFTW's plan/execute split).
+ *
+ * A plan holds everything that depends only on a scene, its volume and their optics: the
+ * atmosphere, the volume's placement, its resampled grids and majorants, the phase and Ams
+ * tables, the renderer's buffers. A frame is what may change between two images of an
+ * interactive session: the camera and image size, the sun's direction, the exposure, the
+ * sample budget, the slicing quality. atmos_plan_render renders a frame and redoes only
+ * what the change touches:
+ *
+ *   - nothing changed: the last image is returned (the path tracer goes on adding samples
+ *     while the frame's budget is above what it has);
+ *   - the camera moved: the per-pixel set-up, the sky and the passes;
+ *   - the sun moved: also what depends on the sun alone (the slice renderer's light frame
+ *     and the sunlight entering it, the path tracer's sky-light table);
+ *   - never the volume's grids or the optics tables.
+ *
+ * In half-angle slicing (Riley et al. 2004 §5) the light buffer advances slice by slice in
+ * step with the eye buffer along the half vector between the view and the light, so its
+ * pass is part of every frame whose camera or sun moved.
+ *
+ *   atmos_plan *p;
+ *   atmos_plan_create(ctx, &scene, NULL, NULL, &p);         // loads and places the volume
+ *   atmos_frame f;
+ *   atmos_frame_from_scene(ctx, &scene, &f);
+ *   atmos_image *img;
+ *   atmos_plan_image_create(p, &f, &img);
+ *   for (int i = 0; i < 36; i++) {
+ *       atmos_frame_orbit(&f, p, 10.0);                     // 10 degrees around the volume
+ *       atmos_plan_render(p, &f, NULL, img);
+ *   }
+ *
+ * Thread safety: one render at a time per plan (a plan keeps its buffers and caches); any
+ * number of plans may share a volume and optics. Results do not depend on the thread count.
+ * The context given at creation must outlive the plan; errors and progress go through it.
+ */
+#ifndef ATMOS_PLAN_H
+#define ATMOS_PLAN_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct atmos_plan atmos_plan;
+
+/* Settings of a plan beyond its scene; zero means default for every field. */
+typedef struct atmos_plan_desc {
+    const atmos_volume_optics *optics; /* borrowed; NULL = built from the scene (atmos_volume_optics_build) */
+    int offset_given;      /* nonzero: the volume moves by offset_m; zero: the scene's placement
+                              (atmos_scene_volume_offset) */
+    double offset_m[3];
+    int reference;         /* slice: the plain scalar passes with libm's exp (for checks; slow) */
+} atmos_plan_desc;
+
+/* A frame: what may change between two images of one plan. */
+typedef struct atmos_frame {
+    atmos_camera_desc camera;
+    int width, height;          /* pixels, 1..ATMOS_SCENE_MAX_DIM */
+    double sun_dir[3];          /* unit vector toward the sun, world frame */
+    int samples_per_pixel;      /* sky and slice renderers: stratified samples of the sky, 1..256 */
+    int spp;                    /* path tracer: samples per pixel to reach (progressive), 1..ATMOS_PATH_MAX_SPP */
+    int slices;                 /* slice renderer: sampling planes, 0 = the scene's */
+    double eye_scale;           /* slice renderer: eye buffer scale in (0, 1], 0 = the scene's */
+    atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
+} atmos_frame;
+
+/* A rectangle of pixels [x0, x1) x [y0, y1). */
+typedef struct atmos_region {
+    int x0, y0, x1, y1;
+} atmos_region;
+
+/* Builds a plan for a scene: validates it, creates its atmosphere, loads or generates its
+ * volume when volume is NULL and the scene names one (else uses volume, borrowed: it must
+ * outlive the plan), places it, builds or borrows the optics. desc may be NULL. */
+ATMOS_API atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                         const atmos_plan_desc *desc, atmos_plan **out);
+ATMOS_API void atmos_plan_destroy(atmos_plan *plan);
+
+ATMOS_API atmos_renderer_kind atmos_plan_renderer(const atmos_plan *plan);
+ATMOS_API const atmos_wavelengths *atmos_plan_wavelengths(const atmos_plan *plan);
+ATMOS_API const atmos_atmosphere *atmos_plan_atmosphere(const atmos_plan *plan);
+/* The optics of the plan's volume (NULL without one). */
+ATMOS_API const atmos_volume_optics *atmos_plan_optics(const atmos_plan *plan);
+/* The volume the plan renders (NULL if none) and the shift that places it. */
+ATMOS_API const atmos_volume *atmos_plan_volume(const atmos_plan *plan, double offset_m[3]);
+
+/* The scene's frame: its camera, image size, sun (computed from the time and place when the
+ * scene gives them), samples, slicing and exposure. */
+ATMOS_API atmos_status atmos_frame_from_scene(atmos_context *ctx, const atmos_scene *scene, atmos_frame *out);
+/* Moves the camera by degrees around the vertical axis through the point it looks at (or,
+ * for a plan with a volume, through the volume's centre at the look-at point's height). */
+ATMOS_API void atmos_frame_orbit(atmos_frame *frame, const atmos_plan *plan, double degrees);
+
+/* An image for the plan's frames: width x height, the plan's wavelength count + 1 channels. */
+ATMOS_API atmos_status atmos_plan_image_create(const atmos_plan *plan, const atmos_frame *frame, atmos_image **out);
+
+/* Renders a frame into out (created by atmos_plan_image_create for this frame's size):
+ * spectral radiance per wavelength (W m^-2 sr^-1 nm^-1), then coverage alpha. With a region,
+ * only its pixels are written (the rest of out is left as it was). The path tracer renders
+ * frame->spp samples per pixel, reusing the samples it already has when only the budget
+ * changed; the image is the same whether reached in one call or several. Reports progress
+ * and honours cancellation through the plan's context. info may be NULL. */
+ATMOS_API atmos_status atmos_plan_render(atmos_plan *plan, const atmos_frame *frame, const atmos_region *region,
+                                         atmos_image *out, atmos_render_info *info);
+
+/* Work done by the last render. */
+typedef struct atmos_plan_stats {
+    int reused;                 /* 1: nothing changed, the last image was returned */
+    int sun_changed, camera_changed;
+    atmos_slice_timing slice;   /* slice renderer */
+    atmos_path_stats path;      /* path tracer */
+} atmos_plan_stats;
+ATMOS_API void atmos_plan_get_stats(const atmos_plan *plan, atmos_plan_stats *out);
+
+/* Path tracer: the per-pixel variance of the mean of the last render (per wavelength, then the
+ * luminance's in the place of alpha), and the luminance-weighted mean number of volume
+ * scattering events (1 channel); see atmos_path_settings. New images owned by the caller. */
+ATMOS_API atmos_status atmos_plan_path_variance(const atmos_plan *plan, atmos_image **out);
+ATMOS_API atmos_status atmos_plan_path_order(const atmos_plan *plan, atmos_image **out);
+
+/* Renders a scene as `atmos render` does: the scene's renderer and settings, its volume
+ * (loaded and placed from the scene when volume is NULL), the density scale, the background;
+ * *out as atmos_plan_render's. The CLI, a C program and the Python package give the same
+ * bytes for the same scene. */
+ATMOS_API atmos_status atmos_render_scene(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                          atmos_image **out, atmos_render_info *info);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,372 @@
+/* The path tracer's plan (include/atmos/path.h, docs/path.md): the medium and the phase
+ * tables of the volume (built once), the sky-light table of the last sun, and an
+ * accumulator of the last view to which every render adds samples.
+ *
+ * Per pixel, samples are added in their index order into double sums (and sums of squares,
+ * for the variance); the random numbers of sample s of pixel p come from their own stream.
+ * So a pixel's mean does not depend on the thread count, the schedule, the region or how
+ * many calls it took to reach its sample count. */
+#include "atmosphere/atmosphere_ops.h"
+#include "render/path_trace.h"
+#include "render/plan_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Forward peak (sr^-1) above which the aureole estimate pays for itself: cloud droplets
+ * have 400-900, HG g = 0.9 15, g = 0.95 62. */
+#define AUREOLE_PEAK 100.0
+
+struct atmos__path_plan {
+    path_medium med;
+    path_phase ph;
+    int has_medium;                /* a volume with something in it */
+    int aureole;                   /* the aureole estimate is used */
+    double trunc_lo, trunc_hi;     /* the fraction of the scattering the truncation removed */
+    double prepare_s;
+    /* the sky-light table of env_sun */
+    path_env env;
+    int env_valid, env_on;
+    double env_sun[3];
+    /* the accumulator of view acc_view: per pixel NA doubles (sum and sum of squares per
+     * wavelength, hits, sum Y, sum Y^2, sum order x Y) and its sample count */
+    double *acc;
+    int *count;
+    int NA, W, H;
+    int acc_valid;
+    atmos__view acc_view;
+};
+
+void atmos__path_plan_destroy(atmos__path_plan *pp)
+{
+    if (!pp) return;
+    atmos__path_medium_free(&pp->med);
+    atmos__path_phase_free(&pp->ph);
+    free(pp->acc);
+    free(pp->count);
+    free(pp);
+}
+
+/* The medium and phase tables of the plan's volume, with the forward-peak truncation of the
+ * scene's path settings. */
+static atmos_status build_medium(atmos_plan *p, atmos__path_plan *pp)
+{
+    atmos_context *ctx = p->ctx;
+    const int n = p->wl.count;
+    atmos_status st = atmos__path_phase_build(ctx, p->optics, n, p->scene.path.truncate_deg, &pp->ph);
+    if (st == ATMOS_OK)
+        st = atmos__path_medium_build(ctx, p->volume, p->scene.volume.density_scale, p->offset, p->optics, n, &pp->med);
+    if (st != ATMOS_OK) return st;
+    const path_phase *ph = &pp->ph;
+    if (ph->ic) {
+        atmos__path_medium_truncate(&pp->med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])ph->trunc);
+        for (int f = 0; f < ph->nf; f++) {
+            double lo = 1, hi = 0;
+            for (int k = 0; k < n; k++) {
+                if (ph->trunc[f][k] < lo) lo = ph->trunc[f][k];
+                if (ph->trunc[f][k] > hi) hi = ph->trunc[f][k];
+            }
+            atmos__log(ctx, ATMOS_LOG_INFO,
+                       "render path: field %d: forward peak truncated at %g deg, scattering fraction removed %.4f-%.4f", f,
+                       ph->cut_deg, lo, hi);
+            if (f == 0 || lo < pp->trunc_lo) pp->trunc_lo = lo;
+            if (hi > pp->trunc_hi) pp->trunc_hi = hi;
+        }
+    }
+    pp->has_medium = !pp->med.empty;
+    /* The aureole estimate where a phase function (as used: truncated or not) has a forward
+     * peak of more than AUREOLE_PEAK sr^-1 (cloud droplets: 400-900). */
+    if (pp->has_medium && p->scene.path.aureole) {
+        path_angle ang;
+        atmos__path_angle(ph, cos(0.05 * ATMOS_DEG2RAD), &ang);
+        for (int f = 0; f < ph->nf; f++)
+            for (int k = 0; k < n; k++)
+                if (atmos__path_phase_eval(ph, f, k, &ang) > AUREOLE_PEAK) pp->aureole = 1;
+    }
+    return ATMOS_OK;
+}
+
+atmos_status atmos__path_plan_create(atmos_plan *p, atmos__path_plan **out)
+{
+    const double t0 = atmos__now();
+    atmos__path_plan *pp = calloc(1, sizeof *pp);
+    if (!pp) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render path: out of memory");
+    pp->NA = 2 * p->wl.count + 4;
+    if (p->volume && atmos_volume_field_count(p->volume) > 0) {
+        atmos_status st = build_medium(p, pp);
+        if (st != ATMOS_OK) {
+            atmos__path_plan_destroy(pp);
+            return st;
+        }
+    }
+    pp->prepare_s = atmos__now() - t0;
+    *out = pp;
+    return ATMOS_OK;
+}
+
+/* The sky-light table (next-event estimation toward the sky) for the sun of the view, seen
+ * from the middle of the volume's box; kept until the sun moves. (A uniform background is
+ * left to the continuations: next-event estimation with uniform directions doubled the
+ * noise of a slab before one; every escaping path already sees exactly the background.) */
+static void sky_light(atmos_plan *p, atmos__path_plan *pp, const double sun[3])
+{
+    if (pp->env_valid && !memcmp(pp->env_sun, sun, sizeof pp->env_sun)) return;
+    pp->env_on = 0;
+    if (pp->has_medium && p->scene.path.sky_nee) {
+        const path_medium *med = &pp->med;
+        double qc[3], pc[3], Yw[ATMOS_MAX_WAVELENGTHS];
+        for (int a = 0; a < 3; a++) qc[a] = 0.5 * (med->box_lo[a] + med->box_hi[a]);
+        for (int a = 0; a < 3; a++) {
+            pc[a] = med->org[a];
+            for (int c = 0; c < 3; c++) pc[a] += med->R[3 * a + c] * qc[c] / med->inv_vs;
+        }
+        for (int k = 0; k < p->wl.count; k++) Yw[k] = p->wl.to_xyz[k][1];
+        pp->env_on = atmos__path_env_build(p->atm, sun, pc, Yw, &pp->env);
+    }
+    memcpy(pp->env_sun, sun, sizeof pp->env_sun);
+    pp->env_valid = 1;
+}
+
+/* The job of a view: everything one camera path reads. */
+static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, path_job *J)
+{
+    const atmos_atmosphere *atm = p->atm;
+    memset(J, 0, sizeof *J);
+    J->atm = atm;
+    J->cam = v->cam;
+    memcpy(J->sun, v->sun, sizeof J->sun);
+    J->n = p->wl.count;
+    const double r = 0.5 * atmos_atmosphere_get_desc(atm)->sun_diameter_deg * ATMOS_DEG2RAD;
+    J->cos_sun = cos(r);
+    J->sun_omega = 2.0 * ATMOS_PI * (1.0 - J->cos_sun);
+    J->max_depth = p->scene.path.max_depth;
+    J->seed = p->scene.path.seed;
+    J->forced = p->scene.path.forced;
+    J->albedo = atmos_atmosphere_ground_albedo(atm);
+    J->disk_visible = atmos_atmosphere_sun_disk_visible(atm, J->sun);
+    J->bg = atmos__atm_background(atm);
+    if (pp->has_medium) J->med = &pp->med, J->ph = &pp->ph, J->aureole = pp->aureole;
+    sky_light(p, pp, v->sun);
+    if (pp->env_on) J->env = &pp->env;
+}
+
+/* Samples s0..s1-1 of pixel (x, y) added to its sums A. */
+static void sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, int s1, const double *Ybar, double *A,
+                         path_counts *cnt)
+{
+    const int n = J->n;
+    for (int smp = s0; smp < s1; smp++) {
+        atmos__stream rng;
+        atmos__stream_seed(&rng, J->seed, pix, (uint64_t)smp);
+        /* The carried wavelengths: all of them in rgb mode; in spectral mode a uniformly
+         * chosen hero and the wavelengths a quarter, half and three quarters of the set away,
+         * each counted with weight N / PATH_B. */
+        path_bundle b;
+        double wgt = 1.0;
+        if (n <= PATH_B) {
+            b.m = n;
+            for (int i = 0; i < n; i++) b.k[i] = i;
+        } else {
+            int k0 = (int)(atmos__stream_u(&rng) * n);
+            if (k0 >= n) k0 = n - 1;
+            b.m = PATH_B;
+            for (int i = 0; i < PATH_B; i++) b.k[i] = (k0 + (i * n) / PATH_B) % n;
+            wgt = (double)n / PATH_B;
+        }
+        double jx = atmos__stream_u(&rng), jy = atmos__stream_u(&rng), dir[3];
+        double L[PATH_B] = {0, 0, 0, 0}, Lo[PATH_B] = {0, 0, 0, 0}, Y = 0, Yo = 0;
+        if (atmos_camera_ray(&J->cam, x + jx, y + jy, dir)) {
+            atmos__path_trace(J, &b, J->cam.position, dir, &rng, L, Lo, cnt);
+            A[2 * n] += 1;
+        }
+        for (int i = 0; i < b.m; i++) {
+            double v = L[i] * wgt;
+            if (!isfinite(v)) v = 0; /* may be < 0: the air's shadows (air_scatter) */
+            A[b.k[i]] += v;
+            A[n + b.k[i]] += v * v;
+            Y += Ybar[b.k[i]] * v;
+            if (v != 0 && isfinite(Lo[i])) Yo += Ybar[b.k[i]] * Lo[i] * wgt;
+        }
+        A[2 * n + 1] += Y;
+        A[2 * n + 2] += Y * Y;
+        A[2 * n + 3] += Yo;
+    }
+}
+
+/* Passes of S samples per pixel of r until every pixel has target (or the time budget is
+ * spent), S from the region's size only (never from timing), so that a pass has enough work
+ * to share and the budget is checked often. */
+static atmos_status accumulate(atmos_plan *p, atmos__path_plan *pp, const path_job *J, const atmos__rect *r,
+                               int target, atmos_path_stats *st)
+{
+    atmos_context *ctx = p->ctx;
+    const int threads = atmos__threads(ctx), NA = pp->NA, W = pp->W;
+    const size_t npix = (size_t)(r->x1 - r->x0) * (r->y1 - r->y0);
+    int S = (int)(65536 / (npix ? npix : 1));
+    S = S < 1 ? 1 : (S > 256 ? 256 : S);
+    double Ybar[ATMOS_MAX_WAVELENGTHS];
+    for (int k = 0; k < J->n; k++) Ybar[k] = p->wl.to_xyz[k][1];
+    const double t0 = atmos__now(), budget = p->scene.path.time_budget_s;
+    int lowest = target;
+    for (int y = r->y0; y < r->y1; y++)
+        for (int x = r->x0; x < r->x1; x++)
+            if (pp->count[(size_t)y * W + x] < lowest) lowest = pp->count[(size_t)y * W + x];
+    const int first = lowest;
+    while (lowest < target) {
+        const int s1 = lowest + S < target ? lowest + S : target;
+        long long ev = 0, tc = 0, sh = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : ev, tc, sh)
+        for (int y = r->y0; y < r->y1; y++) {
+            path_counts cnt = {0, 0, 0};
+            for (int x = r->x0; x < r->x1; x++) {
+                const size_t pix = (size_t)y * W + x;
+                if (pp->count[pix] >= s1) continue;
+                sample_pixel(J, x, y, pix, pp->count[pix], s1, Ybar, pp->acc + pix * NA, &cnt);
+                pp->count[pix] = s1;
+            }
+            ev += cnt.events, tc += cnt.tentative, sh += cnt.shadow;
+        }
+        st->events += ev, st->tentative += tc, st->shadow_rays += sh;
+        st->paths += (long long)(s1 - lowest) * (long long)npix;
+        lowest = s1;
+        const double el = atmos__now() - t0;
+        double frac = target > first ? (double)(lowest - first) / (target - first) : 1.0;
+        if (budget > 0 && el / budget > frac) frac = el / budget;
+        if (atmos__progress(ctx, "render path", frac))
+            return atmos__error(ctx, ATMOS_E_CANCELLED, "render path: cancelled");
+        if (budget > 0 && el >= budget) break;
+    }
+    st->spp = lowest;
+    return ATMOS_OK;
+}
+
+/* The means of r into out, and the convergence figure: the mean over pixels with a nonzero
+ * mean of the relative standard error of the pixel's mean luminance. */
+static void resolve(const atmos__path_plan *pp, int n, const atmos__rect *r, atmos_image *out, atmos_path_stats *st)
+{
+    const int NA = pp->NA, C = n + 1, W = pp->W;
+    double rel_sum = 0;
+    long long rel_n = 0;
+    for (int y = r->y0; y < r->y1; y++)
+        for (int x = r->x0; x < r->x1; x++) {
+            const size_t pix = (size_t)y * W + x;
+            const double *A = pp->acc + pix * NA, N = pp->count[pix];
+            float *px = out->pixels + pix * C;
+            for (int k = 0; k < n; k++) px[k] = (float)(A[k] / N);
+            px[n] = (float)(A[2 * n] / N);
+            const double my = A[2 * n + 1] / N;
+            double vy = N > 1 ? (A[2 * n + 2] / N - my * my) / (N - 1) : 0;
+            if (!(vy > 0)) vy = 0;
+            if (my > 0 && N > 1) {
+                rel_sum += sqrt(vy) / my;
+                rel_n++;
+            }
+        }
+    st->mean_rel_error = rel_n ? rel_sum / rel_n : 0.0;
+}
+
+/* Starts the accumulator again for a view (a new camera or sun, a smaller budget). */
+static atmos_status restart(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v)
+{
+    const size_t npix = (size_t)v->cam.width * v->cam.height;
+    if (!pp->acc || pp->W != v->cam.width || pp->H != v->cam.height) {
+        free(pp->acc), free(pp->count);
+        pp->acc = malloc(sizeof(double) * npix * pp->NA);
+        pp->count = malloc(sizeof(int) * npix);
+        pp->acc_valid = 0;
+        if (!pp->acc || !pp->count) {
+            free(pp->acc), free(pp->count);
+            pp->acc = NULL, pp->count = NULL;
+            return atmos__error(p->ctx, ATMOS_E_NOMEM, "render path: out of memory for the accumulators");
+        }
+        pp->W = v->cam.width, pp->H = v->cam.height;
+    }
+    memset(pp->acc, 0, sizeof(double) * npix * pp->NA);
+    memset(pp->count, 0, sizeof(int) * npix);
+    pp->acc_view = *v;
+    pp->acc_valid = 1;
+    return ATMOS_OK;
+}
+
+atmos_status atmos__path_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out,
+                                atmos_path_stats *st)
+{
+    atmos__path_plan *pp = p->path;
+    const double t_start = atmos__now();
+    memset(st, 0, sizeof *st);
+    int over = 0; /* some pixel of r has more samples than the frame asks for */
+    if (pp->acc_valid)
+        for (int y = r->y0; y < r->y1 && !over; y++)
+            for (int x = r->x0; x < r->x1; x++) over |= pp->count[(size_t)y * pp->W + x] > v->spp;
+    const int same = pp->acc_valid && !memcmp(&pp->acc_view.cam, &v->cam, sizeof v->cam) &&
+                     !memcmp(pp->acc_view.sun, v->sun, sizeof v->sun);
+    atmos_status s = ATMOS_OK;
+    if (!same || over) s = restart(p, pp, v);
+    if (s != ATMOS_OK) return s;
+    path_job J;
+    make_job(p, pp, v, &J);
+    const double t0 = atmos__now();
+    st->prepare_s = pp->prepare_s;
+    if ((s = accumulate(p, pp, &J, r, v->spp, st)) != ATMOS_OK) {
+        pp->acc_valid = 0;
+        return s;
+    }
+    st->trace_s = atmos__now() - t0;
+    resolve(pp, p->wl.count, r, out, st);
+    st->truncate_deg = pp->ph.ic ? pp->ph.cut_deg : 0.0;
+    st->truncated_min = pp->trunc_lo, st->truncated_max = pp->trunc_hi;
+    st->total_s = atmos__now() - t_start;
+    return ATMOS_OK;
+}
+
+/* An image of the accumulator: per pixel f(A, N, px) for pixels with samples, 0 elsewhere. */
+static atmos_status aux_image(const atmos_plan *p, int channels, void (*f)(const double *, double, int, float *),
+                              atmos_image **out)
+{
+    const atmos__path_plan *pp = p->path;
+    *out = NULL;
+    if (!pp->acc_valid) return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render path: nothing rendered yet");
+    atmos_status st = atmos_image_create(p->ctx, pp->W, pp->H, channels, out);
+    if (st != ATMOS_OK) return st;
+    for (size_t pix = 0; pix < (size_t)pp->W * pp->H; pix++)
+        if (pp->count[pix] > 0) f(pp->acc + pix * pp->NA, pp->count[pix], p->wl.count, (*out)->pixels + pix * channels);
+    return ATMOS_OK;
+}
+
+/* The variance of the mean per wavelength, then the luminance's. */
+static void pixel_variance(const double *A, double N, int n, float *px)
+{
+    for (int k = 0; k < n; k++) {
+        const double mean = A[k] / N, v = N > 1 ? (A[n + k] / N - mean * mean) / (N - 1) : 0;
+        px[k] = (float)(v > 0 ? v : 0);
+    }
+    const double my = A[2 * n + 1] / N;
+    double vy = N > 1 ? (A[2 * n + 2] / N - my * my) / (N - 1) : 0;
+    if (!(vy > 0)) vy = 0;
+    px[n] = (float)vy;
+}
+
+/* The luminance-weighted mean scattering order. */
+static void pixel_order(const double *A, double N, int n, float *px)
+{
+    (void)N;
+    px[0] = A[2 * n + 1] > 0 ? (float)(A[2 * n + 3] / A[2 * n + 1]) : 0.0f;
+}
+
+atmos_status atmos__path_variance(const atmos_plan *p, atmos_image **out)
+{
+    return aux_image(p, p->wl.count + 1, pixel_variance, out);
+}
+
+atmos_status atmos__path_order(const atmos_plan *p, atmos_image **out) { return aux_image(p, 1, pixel_order, out); }
+
+void atmos__path_describe(const atmos_plan *p, char *buf, size_t cap)
+{
+    const atmos_scene_path *s = &p->scene.path;
+    const char *air = atmos_atmosphere_get_kind(p->atm) == ATMOS_ATMOSPHERE_VACUUM ? "vacuum" : "sky";
+    int n = snprintf(buf, cap, "%d spp, seed %llu, max depth %d, %s", p->stats.path.spp, (unsigned long long)s->seed,
+                     s->max_depth, air);
+    if (p->path->ph.ic && n > 0 && (size_t)n < cap)
+        snprintf(buf + n, cap - (size_t)n, ", forward peak truncated at %g deg", p->path->ph.cut_deg);
+}

@@ -1,0 +1,353 @@
+/* Plans and frames (include/atmos/plan.h): a scene becomes a plan once (the atmosphere, the
+ * volume placed, its optics, each renderer's tables and buffers); a frame becomes a view and
+ * is rendered from the plan, redoing only what changed since the last frame. */
+#include "render/plan_internal.h"
+#include "volume/volume_grid.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------ creation */
+
+/* The scene as the plan checks it: a volume given by the caller stands for the one the scene
+ * would name, and one placed by an explicit offset needs no placement from the scene. */
+static atmos_status check_scene(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                const atmos_plan_desc *d)
+{
+    atmos_scene s = *scene;
+    if (volume && s.renderer != ATMOS_RENDERER_SKY && !s.volume.source[0])
+        snprintf(s.volume.source, sizeof s.volume.source, "(a volume given to the plan)");
+    if (volume && d->offset_given) s.volume.placed = 1;
+    return atmos_scene_validate(ctx, &s, "scene");
+}
+
+static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const atmos_plan_desc *d)
+{
+    atmos_context *ctx = p->ctx;
+    if (p->renderer == ATMOS_RENDERER_SKY) return ATMOS_OK;
+    if (volume) {
+        if (!volume->finalized)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render %s: volume is not finalized",
+                                atmos_renderer_name(p->renderer));
+        p->volume = volume;
+        atmos_scene_volume_offset(&p->scene, volume, p->offset);
+    } else if (p->scene.volume.source[0]) {
+        atmos_status st = atmos_scene_load_volume(ctx, &p->scene, &p->own_volume, p->offset);
+        if (st != ATMOS_OK) return st;
+        p->volume = p->own_volume;
+    }
+    if (d->offset_given) memcpy(p->offset, d->offset_m, sizeof p->offset);
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(p->offset[a])) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the volume's offset must be finite");
+    if (!p->volume) return ATMOS_OK;
+    if (d->optics) {
+        p->optics = d->optics;
+    } else {
+        atmos_status st = atmos_volume_optics_build(ctx, &p->scene, p->volume, p->renderer == ATMOS_RENDERER_SLICE,
+                                                    &p->own_optics);
+        if (st != ATMOS_OK) return st;
+        p->optics = &p->own_optics;
+    }
+    if (p->optics->count != atmos_volume_field_count(p->volume))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: optics for %d fields, the volume has %d", p->optics->count,
+                            atmos_volume_field_count(p->volume));
+    return ATMOS_OK;
+}
+
+atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                               const atmos_plan_desc *desc, atmos_plan **out)
+{
+    if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: missing scene or output");
+    *out = NULL;
+    atmos_plan_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc) d = *desc;
+    atmos_status st = check_scene(ctx, scene, volume, &d);
+    if (st != ATMOS_OK) return st;
+    atmos_plan *p = calloc(1, sizeof *p);
+    if (!p) return atmos__error(ctx, ATMOS_E_NOMEM, "plan: out of memory");
+    p->ctx = ctx;
+    p->scene = *scene;
+    p->renderer = scene->renderer;
+    p->reference = d.reference;
+    if ((st = atmos_scene_wavelengths(ctx, scene, &p->wl)) != ATMOS_OK) goto fail;
+    if ((st = atmos_atmosphere_create(ctx, &scene->atmosphere, &p->wl, &p->atm)) != ATMOS_OK) goto fail;
+    if ((st = plan_volume(p, volume, &d)) != ATMOS_OK) goto fail;
+    if (p->renderer == ATMOS_RENDERER_SLICE && !p->volume) {
+        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the slice renderer needs a volume");
+        goto fail;
+    }
+    if (p->renderer == ATMOS_RENDERER_SLICE) st = atmos__slice_plan_create(p, &p->slice);
+    else if (p->renderer == ATMOS_RENDERER_PATH) st = atmos__path_plan_create(p, &p->path);
+    if (st != ATMOS_OK) goto fail;
+    *out = p;
+    return ATMOS_OK;
+fail:
+    atmos_plan_destroy(p);
+    return st;
+}
+
+void atmos_plan_destroy(atmos_plan *p)
+{
+    if (!p) return;
+    atmos__slice_plan_destroy(p->slice);
+    atmos__path_plan_destroy(p->path);
+    atmos_volume_optics_free(&p->own_optics);
+    atmos_volume_destroy(p->own_volume);
+    atmos_atmosphere_destroy(p->atm);
+    free(p->last_pixels);
+    free(p);
+}
+
+atmos_renderer_kind atmos_plan_renderer(const atmos_plan *p) { return p->renderer; }
+const atmos_wavelengths *atmos_plan_wavelengths(const atmos_plan *p) { return &p->wl; }
+const atmos_atmosphere *atmos_plan_atmosphere(const atmos_plan *p) { return p->atm; }
+
+const atmos_volume_optics *atmos_plan_optics(const atmos_plan *p) { return p->optics; }
+
+const atmos_volume *atmos_plan_volume(const atmos_plan *p, double offset_m[3])
+{
+    if (offset_m) memcpy(offset_m, p->offset, sizeof p->offset);
+    return p->volume;
+}
+
+void atmos_plan_get_stats(const atmos_plan *p, atmos_plan_stats *out) { *out = p->stats; }
+
+/* ------------------------------------------------------------------ frames */
+
+atmos_status atmos_frame_from_scene(atmos_context *ctx, const atmos_scene *scene, atmos_frame *out)
+{
+    if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: missing scene or output");
+    memset(out, 0, sizeof *out);
+    out->camera = scene->camera;
+    out->width = scene->width, out->height = scene->height;
+    out->samples_per_pixel = scene->samples_per_pixel;
+    out->spp = scene->path.spp;
+    out->slices = scene->slice.slices;
+    out->eye_scale = scene->slice.eye_scale;
+    out->tonemap = scene->tonemap;
+    return atmos_scene_sun_direction(ctx, scene, out->sun_dir, NULL, NULL);
+}
+
+/* p rotated by degrees clockwise seen from above (north toward east) about the vertical
+ * axis through c (c NULL: a direction, rotated about the origin). */
+static void orbit_point(double p[3], const double c[3], double degrees)
+{
+    const double a = degrees * ATMOS_DEG2RAD, cs = cos(a), sn = sin(a);
+    const double x = p[0] - (c ? c[0] : 0), z = p[2] - (c ? c[2] : 0);
+    p[0] = (c ? c[0] : 0) + x * cs - z * sn;
+    p[2] = (c ? c[2] : 0) + x * sn + z * cs;
+}
+
+void atmos_frame_orbit(atmos_frame *f, const atmos_plan *plan, double degrees)
+{
+    atmos_camera_desc *c = &f->camera;
+    double pivot[3];
+    memcpy(pivot, c->look_at, sizeof pivot);
+    if (plan && plan->volume) {
+        double lo[3], hi[3];
+        atmos_volume_bounds(plan->volume, lo, hi);
+        for (int a = 0; a < 3; a++) pivot[a] = 0.5 * (lo[a] + hi[a]) + plan->offset[a];
+    }
+    orbit_point(c->position, pivot, degrees);
+    orbit_point(c->look_at, pivot, degrees);
+    orbit_point(c->up, NULL, degrees);
+}
+
+atmos_status atmos_plan_image_create(const atmos_plan *p, const atmos_frame *f, atmos_image **out)
+{
+    if (!p || !f || !out) return atmos__error(p ? p->ctx : NULL, ATMOS_E_INVALID_ARG, "plan image: missing argument");
+    return atmos_image_create(p->ctx, f->width, f->height, p->wl.count + 1, out);
+}
+
+/* The frame for the renderers, with the scene's values where the frame says 0. */
+static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__view *v)
+{
+    atmos_context *ctx = p->ctx;
+    memset(v, 0, sizeof *v);
+    if (f->width < 1 || f->width > ATMOS_SCENE_MAX_DIM || f->height < 1 || f->height > ATMOS_SCENE_MAX_DIM)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: size %dx%d outside 1..%d", f->width, f->height,
+                            ATMOS_SCENE_MAX_DIM);
+    atmos_status st = atmos_camera_init(ctx, &f->camera, f->width, f->height, &v->cam);
+    if (st != ATMOS_OK) return st;
+    const double l = sqrt(f->sun_dir[0] * f->sun_dir[0] + f->sun_dir[1] * f->sun_dir[1] + f->sun_dir[2] * f->sun_dir[2]);
+    if (!(l > 0.5 && l < 2.0)) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: sun_dir must be a unit vector");
+    for (int a = 0; a < 3; a++) v->sun[a] = l == 1.0 ? f->sun_dir[a] : f->sun_dir[a] / l;
+    v->samples_per_pixel = f->samples_per_pixel ? f->samples_per_pixel : p->scene.samples_per_pixel;
+    v->spp = f->spp ? f->spp : p->scene.path.spp;
+    v->slices = f->slices ? f->slices : p->scene.slice.slices;
+    v->eye_scale = f->eye_scale != 0 ? f->eye_scale : p->scene.slice.eye_scale;
+    if (v->samples_per_pixel < 1 || v->samples_per_pixel > 256)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: samples_per_pixel must be in [1, 256], got %d",
+                            v->samples_per_pixel);
+    if (v->spp < 1 || v->spp > ATMOS_PATH_MAX_SPP)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: spp must be in [1, %d], got %d", ATMOS_PATH_MAX_SPP, v->spp);
+    if (v->slices < 1 || v->slices > 8192)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: slices must be in [1, 8192], got %d", v->slices);
+    if (!(v->eye_scale > 0 && v->eye_scale <= 1))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: eye_scale must be in (0, 1], got %g", v->eye_scale);
+    if (p->renderer == ATMOS_RENDERER_SLICE && v->cam.type != ATMOS_CAMERA_PINHOLE)
+        return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "render slice: only pinhole cameras are supported");
+    return ATMOS_OK;
+}
+
+static atmos_status resolve_rect(atmos_context *ctx, const atmos_region *region, int w, int h, atmos__rect *r)
+{
+    *r = (atmos__rect){0, 0, w, h};
+    if (!region) return ATMOS_OK;
+    if (region->x0 < 0 || region->y0 < 0 || region->x1 > w || region->y1 > h || region->x0 >= region->x1 ||
+        region->y0 >= region->y1)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render: region [%d, %d) x [%d, %d) is empty or outside %dx%d",
+                            region->x0, region->x1, region->y0, region->y1, w, h);
+    *r = (atmos__rect){region->x0, region->y0, region->x1, region->y1};
+    return ATMOS_OK;
+}
+
+/* ------------------------------------------------------------------ rendering */
+
+static int same_view(const atmos__view *a, const atmos__view *b)
+{
+    return !memcmp(&a->cam, &b->cam, sizeof a->cam) && !memcmp(a->sun, b->sun, sizeof a->sun) &&
+           a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale;
+}
+
+static int rect_inside(const atmos__rect *a, const atmos__rect *b)
+{
+    return a->x0 >= b->x0 && a->y0 >= b->y0 && a->x1 <= b->x1 && a->y1 <= b->y1;
+}
+
+/* Copies the pixels of r between two images of the frame's size (C channels). */
+static void copy_rect(float *dst, const float *src, int W, int C, const atmos__rect *r)
+{
+    for (int y = r->y0; y < r->y1; y++)
+        memcpy(dst + ((size_t)y * W + r->x0) * C, src + ((size_t)y * W + r->x0) * C,
+               sizeof(float) * (size_t)(r->x1 - r->x0) * C);
+}
+
+/* Keeps the rendered pixels of a sky or slice frame for the next call. */
+static void keep_last(atmos_plan *p, const atmos__view *v, const atmos__rect *r, const atmos_image *out)
+{
+    const size_t need = (size_t)out->width * out->height * out->channels;
+    p->have_last = 0;
+    if (need > p->last_cap) {
+        float *b = realloc(p->last_pixels, sizeof(float) * need);
+        if (!b) return; /* no cache: the next frame is rendered again */
+        p->last_pixels = b, p->last_cap = need;
+    }
+    copy_rect(p->last_pixels, out->pixels, out->width, out->channels, r);
+    p->last_view = *v, p->last_rect = *r, p->have_last = 1;
+}
+
+static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, atmos_image *out)
+{
+    static const char *const names[] = {"sky (analytic single scattering of the atmosphere)",
+                                        "slice (Riley et al. 2004, half-angle slicing)",
+                                        "path (spectral Monte Carlo volumetric path tracing)"};
+    char buf[256];
+    double el = 0, az = 0;
+    atmos_direction_to_angles(v->sun, &el, &az);
+    atmos_image_set_meta(out, "atmos:version", atmos_version());
+    atmos_image_set_meta(out, "atmos:scene", p->scene.name);
+    atmos_image_set_meta(out, "atmos:renderer", names[p->renderer]);
+    snprintf(buf, sizeof buf, "%.6f", el);
+    atmos_image_set_meta(out, "atmos:sun_elevation_deg", buf);
+    snprintf(buf, sizeof buf, "%.6f", az);
+    atmos_image_set_meta(out, "atmos:sun_azimuth_deg", buf);
+    snprintf(buf, sizeof buf, "%s, %d samples", p->wl.mode == ATMOS_WAVELENGTHS_RGB ? "rgb" : "spectral", p->wl.count);
+    atmos_image_set_meta(out, "atmos:wavelengths", buf);
+    snprintf(buf, sizeof buf, "%.6f", seconds);
+    atmos_image_set_meta(out, "atmos:render_seconds", buf);
+    snprintf(buf, sizeof buf, "%d", atmos__threads(p->ctx));
+    atmos_image_set_meta(out, "atmos:threads", buf);
+    if (p->renderer == ATMOS_RENDERER_SLICE) {
+        atmos__slice_describe(p, v, buf, sizeof buf);
+        atmos_image_set_meta(out, "atmos:slice", buf);
+    } else if (p->renderer == ATMOS_RENDERER_PATH) {
+        atmos__path_describe(p, buf, sizeof buf);
+        atmos_image_set_meta(out, "atmos:path", buf);
+        snprintf(buf, sizeof buf, "%.6g", p->stats.path.mean_rel_error);
+        atmos_image_set_meta(out, "atmos:path_mean_rel_error", buf);
+    }
+}
+
+atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_region *region, atmos_image *out,
+                               atmos_render_info *info)
+{
+    if (!p || !f || !out) return atmos__error(p ? p->ctx : NULL, ATMOS_E_INVALID_ARG, "render: missing argument");
+    const double t0 = atmos__now();
+    atmos_context *ctx = p->ctx;
+    atmos__view v;
+    atmos__rect r;
+    atmos_status st = resolve_view(p, f, &v);
+    if (st != ATMOS_OK) return st;
+    if (out->width != f->width || out->height != f->height || out->channels != p->wl.count + 1)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render: the image is %dx%d x %d channels, the frame needs %dx%d x %d",
+                            out->width, out->height, out->channels, f->width, f->height, p->wl.count + 1);
+    if ((st = resolve_rect(ctx, region, f->width, f->height, &r)) != ATMOS_OK) return st;
+    atmos_plan_stats *stats = &p->stats;
+    const atmos_plan_stats prev = *stats;
+    memset(stats, 0, sizeof *stats);
+    stats->camera_changed = !p->have_last || memcmp(&v.cam, &p->last_view.cam, sizeof v.cam) != 0;
+    stats->sun_changed = !p->have_last || memcmp(v.sun, p->last_view.sun, sizeof v.sun) != 0;
+    if (p->renderer != ATMOS_RENDERER_PATH && p->have_last && same_view(&v, &p->last_view) && rect_inside(&r, &p->last_rect)) {
+        copy_rect(out->pixels, p->last_pixels, out->width, out->channels, &r);
+        stats->reused = 1;
+        stats->slice = prev.slice;
+    } else if (p->renderer == ATMOS_RENDERER_SKY) {
+        st = atmos__sky_render(ctx, p->atm, &v, &r, out);
+    } else if (p->renderer == ATMOS_RENDERER_SLICE) {
+        st = atmos__slice_render(p, &v, &r, out, &stats->slice);
+    } else {
+        st = atmos__path_render(p, &v, &r, out, &stats->path);
+    }
+    if (st != ATMOS_OK) {
+        p->have_last = 0;
+        return st;
+    }
+    if (p->renderer != ATMOS_RENDERER_PATH && !stats->reused) keep_last(p, &v, &r, out);
+    else if (p->renderer == ATMOS_RENDERER_PATH) p->last_view = v, p->have_last = 1;
+    const double secs = atmos__now() - t0;
+    set_meta(p, &v, secs, out);
+    if (info) {
+        info->seconds = secs;
+        atmos_direction_to_angles(v.sun, &info->sun_elevation_deg, &info->sun_azimuth_deg);
+    }
+    return ATMOS_OK;
+}
+
+atmos_status atmos_plan_path_variance(const atmos_plan *p, atmos_image **out)
+{
+    if (!p || !out || p->renderer != ATMOS_RENDERER_PATH || !p->path)
+        return atmos__error(p ? p->ctx : NULL, ATMOS_E_INVALID_ARG, "path variance: not a path tracer's plan");
+    return atmos__path_variance(p, out);
+}
+
+atmos_status atmos_plan_path_order(const atmos_plan *p, atmos_image **out)
+{
+    if (!p || !out || p->renderer != ATMOS_RENDERER_PATH || !p->path)
+        return atmos__error(p ? p->ctx : NULL, ATMOS_E_INVALID_ARG, "path order: not a path tracer's plan");
+    return atmos__path_order(p, out);
+}
+
+atmos_status atmos_render_scene(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                atmos_image **out, atmos_render_info *info)
+{
+    if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render scene: missing scene or output");
+    *out = NULL;
+    atmos_plan *p = NULL;
+    atmos_frame f;
+    atmos_image *img = NULL;
+    atmos_status st = atmos_plan_create(ctx, scene, volume, NULL, &p);
+    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, scene, &f);
+    if (st == ATMOS_OK) st = atmos_plan_image_create(p, &f, &img);
+    if (st == ATMOS_OK) st = atmos_plan_render(p, &f, NULL, img, info);
+    atmos_plan_destroy(p);
+    if (st != ATMOS_OK) {
+        atmos_image_destroy(img);
+        return st;
+    }
+    *out = img;
+    return ATMOS_OK;
+}

@@ -1,0 +1,60 @@
+/* The plan (plan.c) and the renderers' parts of it. Data flows one way: a scene makes a plan
+ * (plan.c: the atmosphere, the placed volume, the optics; each renderer's tables and
+ * buffers), a frame makes a view (view.h), and a renderer renders the view from its plan.
+ * Not part of the API. */
+#ifndef ATMOS_RENDER_PLAN_INTERNAL_H
+#define ATMOS_RENDER_PLAN_INTERNAL_H
+
+#include "render/view.h"
+
+typedef struct atmos__slice_plan atmos__slice_plan;
+typedef struct atmos__path_plan atmos__path_plan;
+
+struct atmos_plan {
+    atmos_context *ctx;
+    atmos_renderer_kind renderer;
+    atmos_scene scene;                  /* validated; the renderers read their settings here */
+    atmos_wavelengths wl;
+    atmos_atmosphere *atm;
+    const atmos_volume *volume;         /* NULL: none */
+    atmos_volume *own_volume;           /* loaded by the plan */
+    double offset[3];                   /* the volume's placement */
+    const atmos_volume_optics *optics;  /* NULL without a volume */
+    atmos_volume_optics own_optics;
+    int reference;
+    /* The last frame rendered and its pixels (sky and slice renderers: returned again when
+     * nothing changed). */
+    int have_last;
+    atmos__view last_view;
+    atmos__rect last_rect;
+    float *last_pixels;
+    size_t last_cap;
+    atmos_plan_stats stats;
+    atmos__slice_plan *slice;
+    atmos__path_plan *path;
+};
+
+/* The slice renderer's part (slice_plan.c): the render grid, the optics tables, the buffers
+ * kept between frames, the per-sun light cache. */
+atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out);
+void atmos__slice_plan_destroy(atmos__slice_plan *s);
+/* Renders the view into out over r: the sky, the volume by half-angle slicing, the §5
+ * composite; fills timing. */
+atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out,
+                                 atmos_slice_timing *timing);
+/* The image metadata line of the slice settings used. */
+void atmos__slice_describe(const atmos_plan *p, const atmos__view *v, char *buf, size_t cap);
+
+/* The path tracer's part (path_plan.c): the medium, the phase tables, the sky-light table of
+ * the last sun, the accumulator of the last view. */
+atmos_status atmos__path_plan_create(atmos_plan *p, atmos__path_plan **out);
+void atmos__path_plan_destroy(atmos__path_plan *s);
+/* Adds samples until every pixel of r has v->spp (starting again when the view changed),
+ * then writes the means into out; fills stats. */
+atmos_status atmos__path_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out,
+                                atmos_path_stats *stats);
+atmos_status atmos__path_variance(const atmos_plan *p, atmos_image **out);
+atmos_status atmos__path_order(const atmos_plan *p, atmos_image **out);
+void atmos__path_describe(const atmos_plan *p, char *buf, size_t cap);
+
+#endif

@@ -1,0 +1,280 @@
+/* The sky renderer: what every view ray sees of the atmosphere (Riley et al. 2004 §4.1,
+ * §4.2.4 for Riley's kind), the sun's disk antialiased. Rows are evaluated many rays at a
+ * time in single precision by the atmosphere's batch (atmosphere_ops.h). Each pixel's value
+ * depends only on its own rays (a fixed Hammersley set of sample positions, no random
+ * numbers), so the image is the same for any thread count and any region. */
+#include "atmosphere/atmosphere_ops.h"
+#include "render/view.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* Van der Corput radical inverse in base 2: the second coordinate of the
+ * Hammersley set used for deterministic, thread-independent pixel samples. */
+static double radical_inverse2(unsigned i)
+{
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xAAAAAAAAu) >> 1);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xCCCCCCCCu) >> 2);
+    i = ((i & 0x0F0F0F0Fu) << 4) | ((i & 0xF0F0F0F0u) >> 4);
+    i = ((i & 0x00FF00FFu) << 8) | ((i & 0xFF00FF00u) >> 8);
+    return i * (1.0 / 4294967296.0);
+}
+
+typedef struct {
+    const atmos_atmosphere *atm;
+    const atmos_camera *cam;
+    double sun[3];
+    int spp;
+    int n;
+    double sun_radius;      /* radians */
+    double sun_radiance[ATMOS_MAX_WAVELENGTHS];
+    int sun_visible;        /* disk drawn and sun above the horizon */
+    double cos_disk_search; /* cos(sun radius + 1.5 pixel footprints) */
+} sky_job;
+
+/* An upper bound on the angle one pixel spans, radians. */
+static double pixel_footprint(const atmos_camera *cam)
+{
+    switch (cam->type) {
+    case ATMOS_CAMERA_PINHOLE: return 2.0 * cam->tan_half_fov / cam->height; /* largest at the centre */
+    case ATMOS_CAMERA_FISHEYE: return cam->fov_deg * ATMOS_DEG2RAD / (cam->width < cam->height ? cam->width : cam->height);
+    default: return fmax(2.0 * ATMOS_PI / cam->width, ATMOS_PI / cam->height);
+    }
+}
+
+static double angle_between(const double a[3], const double b[3])
+{
+    double c = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    double cx = a[1] * b[2] - a[2] * b[1], cy = a[2] * b[0] - a[0] * b[2], cz = a[0] * b[1] - a[1] * b[0];
+    return atan2(sqrt(cx * cx + cy * cy + cz * cz), c);
+}
+
+/* Fraction of the pixel (x, y) covered by the sun's disk, by 16x16 supersampling;
+ * called only for pixels near the sun so that the 0.5° disk is antialiased even
+ * when it spans a few pixels. */
+static double sun_coverage(const sky_job *job, int x, int y)
+{
+    const int S = 16;
+    int inside = 0, valid = 0;
+    double d[3];
+    for (int j = 0; j < S; j++)
+        for (int i = 0; i < S; i++) {
+            if (!atmos_camera_ray(job->cam, x + (i + 0.5) / S, y + (j + 0.5) / S, d)) continue;
+            valid++;
+            if (atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY) continue;
+            if (angle_between(d, job->sun) <= job->sun_radius) inside++;
+        }
+    return valid ? (double)inside / (S * S) : 0.0;
+}
+
+/* Directions of the rays through (x + sx, y + sy) for x in [x0, x0 + count) into SoA
+ * arrays (index x - x0); w = 1 for a valid ray, 0 outside a fisheye's circle. The
+ * equirectangular camera reads azimuth sines and cosines from a per-sample column table. */
+static void row_rays(const sky_job *job, int y, int x0, int count, double sx, double sy, const float *col_sc,
+                     float *dx, float *dy, float *dz, float *w)
+{
+    const atmos_camera *cam = job->cam;
+    const int W = cam->width;
+    if (cam->type == ATMOS_CAMERA_EQUIRECT && col_sc) {
+        double el = (90.0 - ((y + sy) / cam->height) * 180.0) * ATMOS_DEG2RAD;
+        float ce = (float)cos(el), se = (float)sin(el);
+        for (int i = 0; i < count; i++) {
+            dx[i] = ce * col_sc[2 * (x0 + i)];
+            dy[i] = se;
+            dz[i] = -ce * col_sc[2 * (x0 + i) + 1];
+            w[i] = 1.0f;
+        }
+        return;
+    }
+    if (cam->type == ATMOS_CAMERA_PINHOLE) {
+        const double t = cam->tan_half_fov, H = cam->height;
+        double v = (H - 2.0 * (y + sy)) / H * t;
+        double bx = cam->forward[0] + v * cam->up[0], by = cam->forward[1] + v * cam->up[1],
+               bz = cam->forward[2] + v * cam->up[2];
+        for (int i = 0; i < count; i++) {
+            double u = (2.0 * (x0 + i + sx) - W) / H * t;
+            double ox = bx + u * cam->right[0], oy = by + u * cam->right[1], oz = bz + u * cam->right[2];
+            double inv = 1.0 / sqrt(ox * ox + oy * oy + oz * oz);
+            dx[i] = (float)(ox * inv), dy[i] = (float)(oy * inv), dz[i] = (float)(oz * inv);
+            w[i] = 1.0f;
+        }
+        return;
+    }
+    if (cam->type == ATMOS_CAMERA_FISHEYE) {
+        /* Equidistant: angle from the axis proportional to the distance from the centre. */
+        const double S = W < cam->height ? W : cam->height;
+        const float half = (float)(0.5 * cam->fov_deg * ATMOS_DEG2RAD);
+        const float v = (float)((cam->height - 2.0 * (y + sy)) / S);
+        float f[3], r[3], u[3];
+        for (int k = 0; k < 3; k++) f[k] = (float)cam->forward[k], r[k] = (float)cam->right[k], u[k] = (float)cam->up[k];
+        for (int i = 0; i < count; i++) {
+            float uu = (float)((2.0 * (x0 + i + sx) - W) / S);
+            float rr = sqrtf(uu * uu + v * v);
+            float th = rr * half;
+            float st = sinf(th), ct = cosf(th);
+            float k1 = rr > 0 ? st / rr : half; /* sin(theta)/r -> half as r -> 0 */
+            float ox = ct * f[0] + k1 * (uu * r[0] + v * u[0]);
+            float oy = ct * f[1] + k1 * (uu * r[1] + v * u[1]);
+            float oz = ct * f[2] + k1 * (uu * r[2] + v * u[2]);
+            float inv = 1.0f / sqrtf(ox * ox + oy * oy + oz * oz);
+            dx[i] = ox * inv, dy[i] = oy * inv, dz[i] = oz * inv;
+            w[i] = rr <= 1.0f ? 1.0f : 0.0f;
+        }
+        return;
+    }
+    for (int i = 0; i < count; i++) {
+        double d[3];
+        int ok = atmos_camera_ray(cam, x0 + i + sx, y + sy, d);
+        dx[i] = (float)d[0], dy[i] = (float)d[1], dz[i] = (float)d[2];
+        w[i] = ok ? 1.0f : 0.0f;
+    }
+}
+
+/* Sample offsets within the pixel: the centre for one sample, else a Hammersley
+ * set (deterministic, identical for every pixel and thread). */
+static void sample_offset(int s, int spp, double *sx, double *sy)
+{
+    *sx = spp == 1 ? 0.5 : (s + 0.5) / spp;
+    *sy = spp == 1 ? 0.5 : radical_inverse2((unsigned)s);
+}
+
+typedef struct {
+    float *dx, *dy, *dz, *w, *acc, *scratch, *hits;
+} row_buffers;
+
+/* Pixels x0 .. x0 + count - 1 of row y into dst (the row's first pixel). */
+static void shade_row(const sky_job *job, const atmos__atm_batch *batch, const float *col_sc, int y, int x0, int count,
+                      row_buffers *rb, float *dst, int C)
+{
+    const int W = job->cam->width, n = job->n, spp = job->spp;
+    memset(rb->acc, 0, sizeof(float) * (size_t)count * n);
+    memset(rb->hits, 0, sizeof(float) * (size_t)count);
+    for (int s = 0; s < spp; s++) {
+        double sx, sy;
+        sample_offset(s, spp, &sx, &sy);
+        row_rays(job, y, x0, count, sx, sy, col_sc ? col_sc + (size_t)2 * W * s : NULL, rb->dx, rb->dy, rb->dz, rb->w);
+        atmos__atm_batch_eval(batch, count, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
+        for (int i = 0; i < count; i++) rb->hits[i] += rb->w[i];
+    }
+    const float inv = 1.0f / spp;
+    for (int i = 0; i < count; i++) {
+        float *px = dst + (size_t)(x0 + i) * C;
+        for (int k = 0; k < n; k++) px[k] = rb->acc[(size_t)k * count + i] * inv;
+        px[n] = rb->hits[i] * inv;
+    }
+    if (!job->sun_visible) return;
+    /* The sun's disk, antialiased by supersampling the few pixels near it. The
+     * search uses the last sample's rays (within a pixel of the centre). */
+    const float sx = (float)job->sun[0], sy = (float)job->sun[1], sz = (float)job->sun[2];
+    const float cs = (float)job->cos_disk_search;
+    for (int i = 0; i < count; i++) {
+        if (rb->w[i] == 0.0f || rb->dx[i] * sx + rb->dy[i] * sy + rb->dz[i] * sz < cs) continue;
+        double cov = sun_coverage(job, x0 + i, y);
+        float *px = dst + (size_t)(x0 + i) * C;
+        for (int k = 0; k < n; k++) px[k] += (float)(cov * job->sun_radiance[k]);
+    }
+}
+
+static void job_init(sky_job *job, const atmos_atmosphere *atm, const atmos__view *v)
+{
+    memset(job, 0, sizeof *job);
+    job->atm = atm;
+    job->cam = &v->cam;
+    memcpy(job->sun, v->sun, sizeof job->sun);
+    job->n = atmos_atmosphere_wavelengths(atm)->count;
+    job->spp = v->samples_per_pixel > 0 ? v->samples_per_pixel : 1;
+    job->sun_radius = 0.5 * atmos_atmosphere_get_desc(atm)->sun_diameter_deg * ATMOS_DEG2RAD;
+    atmos_atmosphere_sun_radiance(atm, v->cam.position, job->sun, job->sun_radiance);
+    job->sun_visible = atmos_atmosphere_sun_disk_visible(atm, job->sun);
+    /* Disk radius plus 2.5 pixel footprints: a sample ray is within one footprint
+     * of the pixel centre, the pixel's far corner within another. */
+    double foot = pixel_footprint(&v->cam);
+    /* The equirect footprint grows towards the poles; search wider there. */
+    if (v->cam.type == ATMOS_CAMERA_EQUIRECT) foot /= fmax(1e-3, sqrt(fmax(0.0, 1.0 - job->sun[1] * job->sun[1])));
+    double search = job->sun_radius + 2.5 * foot;
+    job->cos_disk_search = search >= ATMOS_PI ? -1.0 : cos(search);
+}
+
+/* Equirectangular: per-sample tables of the columns' azimuth sines and cosines (NULL for
+ * other cameras, or when too large: the rays are then computed one by one). */
+static float *column_table(const sky_job *job)
+{
+    const atmos_camera *cam = job->cam;
+    const int W = cam->width;
+    if (cam->type != ATMOS_CAMERA_EQUIRECT || (size_t)job->spp * W > ((size_t)1 << 22)) return NULL;
+    float *col_sc = malloc(sizeof(float) * 2 * (size_t)W * job->spp);
+    if (col_sc)
+        for (int s = 0; s < job->spp; s++) {
+            double sx, sy;
+            sample_offset(s, job->spp, &sx, &sy);
+            for (int x = 0; x < W; x++) {
+                double az = ((x + sx) / W - 0.5) * 2.0 * ATMOS_PI;
+                col_sc[(size_t)2 * W * s + 2 * x] = (float)sin(az);
+                col_sc[(size_t)2 * W * s + 2 * x + 1] = (float)cos(az);
+            }
+        }
+    return col_sc;
+}
+
+atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
+                               const atmos__rect *r, atmos_image *out)
+{
+    sky_job job;
+    job_init(&job, atm, v);
+    const int W = v->cam.width, C = out->channels, count = r->x1 - r->x0;
+    if (count <= 0 || r->y1 <= r->y0) return ATMOS_OK;
+    const int band = 8; /* rows per work item: small enough for progress and balance */
+    const int nbands = (r->y1 - r->y0 + band - 1) / band;
+    int done = 0, cancelled = 0, nomem = 0;
+    atmos__atm_batch batch;
+    atmos__atm_batch_init(&batch, atm, v->cam.position, job.sun);
+    float *col_sc = column_table(&job);
+#pragma omp parallel num_threads(atmos__threads(ctx))
+    {
+        row_buffers rb = {0};
+        const size_t per = (size_t)count;
+        float *mem = malloc(sizeof(float) * per * (5 + (size_t)job.n + ATMOS__ATM_BATCH_SCRATCH));
+        if (mem) {
+            rb.dx = mem, rb.dy = mem + per, rb.dz = mem + 2 * per, rb.w = mem + 3 * per, rb.hits = mem + 4 * per;
+            rb.acc = mem + 5 * per;
+            rb.scratch = rb.acc + per * job.n;
+        } else {
+#pragma omp atomic write
+            nomem = 1;
+        }
+        /* Bands are handed out dynamically for balance; each pixel's value depends
+         * only on its own position, so the image is identical for any thread count. */
+#pragma omp for schedule(dynamic, 1)
+        for (int b = 0; b < nbands; b++) {
+            int stop;
+#pragma omp atomic read
+            stop = cancelled;
+            if (stop || !mem) continue;
+            for (int y = r->y0 + b * band; y < r->y1 && y < r->y0 + (b + 1) * band; y++)
+                shade_row(&job, &batch, col_sc, y, r->x0, count, &rb, out->pixels + (size_t)y * W * C, C);
+            int d;
+#pragma omp atomic capture
+            d = ++done;
+#ifdef _OPENMP
+            if (omp_get_thread_num() == 0)
+#endif
+            {
+                if (atmos__progress(ctx, "render sky", (double)d / nbands)) {
+#pragma omp atomic write
+                    cancelled = 1;
+                }
+            }
+        }
+        free(mem);
+    }
+    free(col_sc);
+    if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for row buffers");
+    if (cancelled) return atmos__error(ctx, ATMOS_E_CANCELLED, "render: cancelled");
+    atmos__progress(ctx, "render sky", 1.0);
+    return ATMOS_OK;
+}

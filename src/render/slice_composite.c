@@ -1,0 +1,124 @@
+/* The §5 composite of the slice renderer (Riley et al. 2004): the volume's radiance and
+ * transparency from the eye buffer over the sky image, with the air in front of the
+ * volume's halfway plane in front of it and the rest behind. */
+#include "atmosphere/atmosphere_ops.h"
+#include "core/vec.h"
+#include "render/slice_internal.h"
+
+#include <math.h>
+#include <stdint.h>
+
+/* §5 composite of one image pixel along direction dw (world): the air from the eye
+ * to the halfway plane at distance th is in front of the volume, the rest (with the
+ * ground and the sun's disk) behind it. px holds the sky image B (= front + T_front *
+ * back) and receives front + T_front * L_vol + T_vol * (B - front). */
+static void composite_pixel(const atmos_atmosphere *atm, const atmos_camera *cam, const double dw[3], double th,
+                            const double sun_w[3], int n, const float *Lv, const float *Tv, float *px)
+{
+    if (!(th > 0)) th = 0;
+    double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
+    double tg = atmos_atmosphere_ground_distance(atm, cam->position, dw);
+    if (th > tg) th = tg;
+    atmos_atmosphere_inscatter(atm, cam->position, dw, th, sun_w, front);
+    atmos_atmosphere_transmittance(atm, cam->position, dw, th, Tf);
+    for (int c = 0; c < n; c++) {
+        double B = px[c], L = Lv[c], T = Tv[c];
+        double r = front[c] + Tf[c] * L + T * (B - front[c]);
+        px[c] = (float)(isfinite(r) && r > 0 ? r : 0.0);
+    }
+}
+
+/* The two eye-buffer pixels (of n) around fractional eye coordinate f (pixel centres at
+ * integers) and the weight of the second; clamped at the edges. */
+static void eye_taps(double f, int n, int t[2], float *w)
+{
+    if (!(f > 0)) f = 0;
+    if (f > n - 1) f = n - 1;
+    int i = (int)f;
+    if (i > n - 2) i = n - 2 < 0 ? 0 : n - 2;
+    t[0] = i, t[1] = i + 1 < n ? i + 1 : i;
+    *w = t[1] == t[0] ? 0.0f : (float)(f - i);
+}
+
+void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
+                            const double *R, const atmos__rect *r, atmos_image *img, int threads)
+{
+    /* §5: air from the eye to the volume's halfway plane is in front of the volume,
+     * the rest (with the ground and the sun's disk, §4.2.4) behind it. With B the sky
+     * image (= front + T_front * back), the pixel is
+     *   front + T_front * L_vol + T_vol * (B - front).
+     * Pixels the volume does not touch keep B exactly. */
+    {
+        const sgrid *g = j->g;
+        double cen[3] = {0.5 * (g->box_lo[0] + g->box_hi[0]), 0.5 * (g->box_lo[1] + g->box_hi[1]),
+                         0.5 * (g->box_lo[2] + g->box_hi[2])};
+        const double hc = atmos__dot3(j->h, cen);
+        const int C = img->channels;
+        if (j->sx == 1.0 && j->sy == 1.0) {
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+            for (int y = 0; y < j->H; y++)
+                for (int x = j->erow[y].x0; x <= j->erow[y].x1; x++) {
+                    size_t p = (size_t)y * j->W + x;
+                    int touched = 0;
+                    for (int c = 0; c < j->n; c++)
+                        touched |= j->L_eye[c * j->pst + p] != 0.0f || j->T_eye[c * j->pst + p] != 1.0f;
+                    if (!touched) continue;
+                    double dw[3];
+                    atmos_camera_ray(cam, x + 0.5, y + 0.5, dw);
+                    double th = j->pinv[p] != 0.0f ? (hc - j->he) * j->pinv[p] : 0.0;
+                    float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
+                    for (int c = 0; c < j->n; c++) Lv[c] = j->L_eye[c * j->pst + p], Tv[c] = j->T_eye[c * j->pst + p];
+                    composite_pixel(atm, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + p * C);
+                }
+        } else {
+            /* Eye buffer smaller than the image: L_vol and T_vol bilinear between the
+             * four eye pixels around the image pixel's centre (both are premultiplied by
+             * the volume's coverage, so this blurs the silhouette by one eye pixel but
+             * does not tint it). Eye pixels outside their row's union of spans were
+             * never reached (L = 0, T = 1). An image pixel whose four eye pixels are all
+             * untouched keeps the sky image exactly; the halfway plane is met along the
+             * image pixel's own ray. */
+            const int W = cam->width;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+            for (int y = r->y0; y < r->y1; y++) {
+                int ey[2];
+                float wy;
+                eye_taps((y + 0.5) / j->sy - 0.5, j->H, ey, &wy);
+                int xa = INT32_MAX, xb = -1;
+                for (int t = 0; t < 2; t++) {
+                    const sspan e = j->erow[ey[t]];
+                    if (e.x0 > e.x1) continue;
+                    int a = (int)floor((e.x0 - 0.5) * j->sx), b = (int)ceil((e.x1 + 1.5) * j->sx);
+                    xa = a < xa ? a : xa, xb = b > xb ? b : xb;
+                }
+                xa = xa < r->x0 ? r->x0 : xa, xb = xb > r->x1 - 1 ? r->x1 - 1 : xb;
+                for (int x = xa; x <= xb; x++) {
+                    int ex[2];
+                    float wx;
+                    eye_taps((x + 0.5) / j->sx - 0.5, j->W, ex, &wx);
+                    const float wt[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+                    float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
+                    for (int c = 0; c < j->n; c++) Lv[c] = 0.0f, Tv[c] = 0.0f;
+                    int touched = 0;
+                    for (int q = 0; q < 4; q++) {
+                        const int tx = ex[q & 1], ty = ey[q >> 1];
+                        const size_t p = (size_t)ty * j->W + tx;
+                        const int in = tx >= j->erow[ty].x0 && tx <= j->erow[ty].x1;
+                        for (int c = 0; c < j->n; c++) {
+                            const float L = in ? j->L_eye[c * j->pst + p] : 0.0f, T = in ? j->T_eye[c * j->pst + p] : 1.0f;
+                            touched |= L != 0.0f || T != 1.0f;
+                            Lv[c] += wt[q] * L, Tv[c] += wt[q] * T;
+                        }
+                    }
+                    if (!touched) continue;
+                    double dw[3], d[3];
+                    atmos_camera_ray(cam, x + 0.5, y + 0.5, dw);
+                    atmos__slice_to_grid(R, dw, d);
+                    const double hd = atmos__dot3(j->h, d);
+                    double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j->he) / hd : 0.0;
+                    composite_pixel(atm, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
+                }
+            }
+        }
+    }
+}

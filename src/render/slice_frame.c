@@ -1,0 +1,392 @@
+/* One frame of the slice renderer (Riley et al. 2004 §4.2-§5; half-angle slicing after
+ * Kniss et al.): the job's geometry, the per-pixel and per-texel set-up, and the slices.
+ *
+ * Everything geometric happens in the volume's grid frame (metres, axes of the voxel grid,
+ * origin at the grid's corner): g = R^T (world - origin - offset). The frame is rigid, so
+ * distances and angles are those of the world.
+ *
+ * Per slice k (planes perpendicular to the half vector h, advancing away from the sun):
+ *  1. eye pass: every pixel's ray meets slice k at one point; the light buffer gives I and n
+ *     there; Eq. 26 is accumulated front-to-back (eye and light within 90 degrees) or
+ *     back-to-front (otherwise);
+ *  2. light pass: every light texel's ray meets slice k at one point; I is attenuated by
+ *     Eq. 25 (or Eq. 24) and n grows by Eq. 21.
+ * Both passes write only their own pixel/texel, so rows are split over threads and the image
+ * does not depend on the thread count. */
+#include "atmosphere/atmosphere_ops.h"
+#include "core/vec.h"
+#include "render/slice_internal.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Sunlight arriving at the grid-frame point g: the world point is org + R g. */
+static void sunlight_at(const atmos_atmosphere *atm, const double org[3], const double *R, const double g[3],
+                        const double sun[3], double *out)
+{
+    double w[3];
+    for (int a = 0; a < 3; a++) w[a] = org[a] + R[3 * a] * g[0] + R[3 * a + 1] * g[1] + R[3 * a + 2] * g[2];
+    atmos_atmosphere_sunlight(atm, w, sun, out);
+}
+
+/* The light frame of the sun direction sun_w (slight), kept until the sun moves: the buffer's
+ * axes and extent across the light, and per texel where its ray crosses the box and the
+ * sunlight entering there (Eq. 12, at the point where the ray enters the box). */
+static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, const double sun_w[3], int threads)
+{
+    slight *lf = &sp->light;
+    const sgrid *g = &sp->g;
+    double sun_g[3];
+    atmos__slice_to_grid(sp->R, sun_w, sun_g);
+    for (int a = 0; a < 3; a++) lf->lt[a] = -sun_g[a];
+    double ax[3] = {1, 0, 0};
+    if (fabs(lf->lt[0]) > 0.9) ax[0] = 0, ax[1] = 1;
+    atmos__cross3(ax, lf->lt, lf->e1);
+    atmos__normalize3(lf->e1);
+    atmos__cross3(lf->lt, lf->e1, lf->e2);
+    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {c & 1 ? g->box_hi[0] : g->box_lo[0], c & 2 ? g->box_hi[1] : g->box_lo[1],
+                       c & 4 ? g->box_hi[2] : g->box_lo[2]};
+        double uv = atmos__dot3(p, lf->e1), vv = atmos__dot3(p, lf->e2);
+        umin = fmin(umin, uv), umax = fmax(umax, uv);
+        vmin = fmin(vmin, vv), vmax = fmax(vmax, vv);
+    }
+    const int L = sp->L, n = sp->n;
+    lf->u0 = umin, lf->v0 = vmin;
+    lf->du = (umax - umin) / L, lf->dv = (vmax - vmin) / L;
+    if (!(lf->du > 0)) lf->du = 1;
+    if (!(lf->dv > 0)) lf->dv = 1;
+    const double cen[3] = {0.5 * (g->box_lo[0] + g->box_hi[0]), 0.5 * (g->box_lo[1] + g->box_hi[1]),
+                           0.5 * (g->box_lo[2] + g->box_hi[2])};
+    double sl_miss[ATMOS_MAX_WAVELENGTHS];
+    sunlight_at(atm, sp->org, sp->R, cen, sun_w, sl_miss);
+    for (int c = 0; c < n; c++) lf->sl[(size_t)L * L * n + c] = (float)sl_miss[c];
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int b = 0; b < L; b++)
+        for (int a = 0; a < L; a++) {
+            const size_t q = (size_t)b * L + a;
+            double u = lf->u0 + (a + 0.5) * lf->du, v = lf->v0 + (b + 0.5) * lf->dv, sl[ATMOS_MAX_WAVELENGTHS];
+            double o[3] = {u * lf->e1[0] + v * lf->e2[0], u * lf->e1[1] + v * lf->e2[1], u * lf->e1[2] + v * lf->e2[2]};
+            lf->hit[q] = (unsigned char)atmos__ray_box(o, lf->lt, g->box_lo, g->box_hi, &lf->ta[q], &lf->tb[q]);
+            if (lf->hit[q]) {
+                double entry[3];
+                for (int i = 0; i < 3; i++) entry[i] = o[i] + lf->ta[q] * lf->lt[i];
+                sunlight_at(atm, sp->org, sp->R, entry, sun_w, sl);
+            } else {
+                memcpy(sl, sl_miss, sizeof sl);
+            }
+            for (int c = 0; c < n; c++) lf->sl[q * n + c] = (float)sl[c];
+        }
+    memcpy(lf->sun, sun_w, sizeof lf->sun);
+    lf->valid = 1;
+}
+
+/* The half vector, the slices and the buffers' sizes of the frame (everything but the
+ * per-pixel and per-texel data). */
+static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob *j)
+{
+    const atmos_camera *cam = &v->cam;
+    const sgrid *g = &sp->g;
+    const slight *lf = &sp->light;
+    double rel[3] = {cam->position[0] - sp->org[0], cam->position[1] - sp->org[1], cam->position[2] - sp->org[2]};
+    atmos__slice_to_grid(sp->R, rel, j->eye);
+    memcpy(j->lt, lf->lt, sizeof j->lt), memcpy(j->e1, lf->e1, sizeof j->e1), memcpy(j->e2, lf->e2, sizeof j->e2);
+    double view_g[3];
+    atmos__slice_to_grid(sp->R, cam->forward, view_g);
+    /* Half-angle slicing (Kniss et al.; Riley §5): h halfway between the view and the
+     * light's travel when they are within 90° (front-to-back for the eye), else between
+     * the inverted view and the light (back-to-front). The slices always advance along
+     * h, away from the sun. */
+    j->btf = atmos__dot3(view_g, j->lt) < 0;
+    for (int a = 0; a < 3; a++) j->h[a] = (j->btf ? -view_g[a] : view_g[a]) + j->lt[a];
+    if (atmos__dot3(j->h, j->h) < 1e-20) memcpy(j->h, j->lt, sizeof j->h);
+    atmos__normalize3(j->h);
+    j->hl = atmos__dot3(j->h, j->lt);
+    if (j->hl < 1e-6) j->hl = 1e-6;
+    double smin = INFINITY, smax = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {c & 1 ? g->box_hi[0] : g->box_lo[0], c & 2 ? g->box_hi[1] : g->box_lo[1],
+                       c & 4 ? g->box_hi[2] : g->box_lo[2]};
+        double sv = atmos__dot3(p, j->h);
+        smin = fmin(smin, sv), smax = fmax(smax, sv);
+    }
+    j->n = sp->n, j->nf = sp->nf;
+    /* The eye buffer: the image, or eye_scale of it per axis (eye pixel x covers image
+     * pixels x sx .. (x + 1) sx; its ray goes through the centre of that area). */
+    j->W = cam->width, j->H = cam->height, j->L = sp->L;
+    j->sx = j->sy = 1.0;
+    if (v->eye_scale < 1.0) {
+        int we = (int)lround(v->eye_scale * cam->width), he = (int)lround(v->eye_scale * cam->height);
+        we = we < 1 ? 1 : we, he = he < 1 ? 1 : he;
+        if (we != j->W || he != j->H) {
+            j->sx = (double)cam->width / we, j->sy = (double)cam->height / he;
+            j->W = we, j->H = he;
+        }
+    }
+    j->nslices = v->slices;
+    j->s0 = smin;
+    j->ds = (smax - smin) / v->slices;
+    j->he = atmos__dot3(j->h, j->eye);
+    j->u0 = lf->u0, j->v0 = lf->v0, j->du = lf->du, j->dv = lf->dv;
+    j->low_albedo = sp->low_albedo;
+    j->eq24 = sp->eq24;
+    j->xi = sp->xi;
+    j->g = g;
+    j->t = &sp->tab;
+}
+
+/* Points the job's per-pixel planes and spans into the plan's buffers, growing them when
+ * this frame needs more. The planes are padded by two cache lines so that the same pixel
+ * of different planes does not fall in one cache set. */
+static int job_buffers(atmos__slice_plan *sp, sjob *j)
+{
+    const size_t npix = (size_t)j->W * j->H, pst = npix + 32, nplanes = (size_t)14 + 2 * (size_t)j->nf + 2 * (size_t)j->n;
+    if (pst * nplanes > sp->pix_cap) {
+        free(sp->pixblock);
+        sp->pix_cap = 0;
+        if (!(sp->pixblock = atmos__big_alloc(sizeof(float) * pst * nplanes))) return 0;
+        sp->pix_cap = pst * nplanes;
+    }
+    const size_t K = (size_t)j->nslices, nspan = K * j->H + 2 * K * j->L + j->H + j->L;
+    if (nspan > sp->span_cap) {
+        free(sp->spans);
+        sp->span_cap = 0;
+        if (!(sp->spans = malloc(sizeof(sspan) * nspan))) return 0;
+        sp->span_cap = nspan;
+    }
+    j->pst = pst;
+    float *b = sp->pixblock;
+    for (int a = 0; a < 3; a++) j->pU0[a] = b, b += pst, j->pdU[a] = b, b += pst;
+    for (int a = 0; a < 2; a++) j->pF0[a] = b, b += pst, j->pdF[a] = b, b += pst;
+    j->pdelta = b, b += pst;
+    j->pinv = b, b += pst;
+    j->pk0 = (int *)b, j->pk1 = (int *)(b + pst), b += 2 * pst;
+    j->pa = (int *)b, b += pst * j->nf;
+    j->pw = b, b += pst * j->nf;
+    j->L_eye = b, b += pst * j->n;
+    j->T_eye = b;
+    j->espan = sp->spans;
+    j->lspan = j->espan + K * j->H;
+    j->wspan = j->lspan + K * j->L;
+    j->erow = j->wspan + K * j->L;
+    j->lrow = j->erow + j->H;
+    j->lk0 = sp->lk, j->lk1 = sp->lk + (size_t)j->L * j->L;
+    j->ring = sp->ring, j->I = sp->I, j->nsc = sp->nsc, j->batch = sp->batch;
+    return 1;
+}
+
+/* Per pixel: ray, slices it crosses inside the box (in front of the eye and of the ground),
+ * its sample on slice k as a linear function of k, and the Ams angle (scattering angle
+ * between the sun's light and the direction to the eye: cos theta = d . sun). */
+static void setup_pixels(const atmos__slice_plan *sp, const atmos_atmosphere *atm, const atmos__view *v, sjob *j,
+                         int threads)
+{
+    const atmos_camera *cam = &v->cam;
+    const sgrid *g = j->g;
+    const stables *tab = j->t;
+    const double ee1 = atmos__dot3(j->eye, j->e1), ee2 = atmos__dot3(j->eye, j->e2);
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    for (int y = 0; y < j->H; y++) {
+        int hint[ATMOS_VOLUME_MAX_FIELDS] = {0};
+        for (int x = j->erow[y].x0; x <= j->erow[y].x1; x++) {
+            size_t p = (size_t)y * j->W + x;
+            for (int c = 0; c < j->n; c++) j->L_eye[c * j->pst + p] = 0.0f, j->T_eye[c * j->pst + p] = 1.0f;
+            double dw[3], d[3];
+            atmos_camera_ray(cam, (x + 0.5) * j->sx, (y + 0.5) * j->sy, dw);
+            atmos__slice_to_grid(sp->R, dw, d);
+            double hd = atmos__dot3(j->h, d);
+            j->pk0[p] = 1, j->pk1[p] = 0;
+            j->pinv[p] = 0;
+            for (int a = 0; a < 3; a++) j->pU0[a][p] = j->pdU[a][p] = 0;
+            for (int a = 0; a < 2; a++) j->pF0[a][p] = j->pdF[a][p] = 0;
+            j->pdelta[p] = 0;
+            for (int f = 0; f < j->nf; f++) j->pa[p * j->nf + f] = 0, j->pw[p * j->nf + f] = 0;
+            double ta, tb;
+            int ok = j->btf ? hd <= -SLICE_HD_EPS : hd >= SLICE_HD_EPS;
+            if (!ok || !atmos__ray_box(j->eye, d, g->box_lo, g->box_hi, &ta, &tb)) continue;
+            if (ta < 0) ta = 0;
+            double tg = atmos_atmosphere_ground_distance(atm, cam->position, dw);
+            if (tb > tg) tb = tg;
+            if (!(ta < tb)) continue;
+            double sa = j->he + ta * hd, sb = j->he + tb * hd;
+            if (sa > sb) {
+                double q = sa;
+                sa = sb, sb = q;
+            }
+            atmos__slice_range(sa, sb, j->s0, j->ds, j->nslices, &j->pk0[p], &j->pk1[p]);
+            if (j->pk0[p] > j->pk1[p]) continue;
+            j->pinv[p] = (float)(1.0 / hd);
+            /* t_k = (s0 + (k + 0.5) ds - h.eye) / (h.d) */
+            const double t0 = (j->s0 + 0.5 * j->ds - j->he) / hd, dt = j->ds / hd;
+            for (int a = 0; a < 3; a++) {
+                j->pU0[a][p] = (float)((j->eye[a] + t0 * d[a]) * g->sc + g->off[a]);
+                j->pdU[a][p] = (float)(dt * d[a] * g->sc);
+            }
+            const double de1 = atmos__dot3(d, j->e1), de2 = atmos__dot3(d, j->e2);
+            j->pF0[0][p] = (float)((ee1 + t0 * de1 - j->u0) / j->du - 0.5);
+            j->pdF[0][p] = (float)(dt * de1 / j->du);
+            j->pF0[1][p] = (float)((ee2 + t0 * de2 - j->v0) / j->dv - 0.5);
+            j->pdF[1][p] = (float)(dt * de2 / j->dv);
+            j->pdelta[p] = (float)(j->ds * fabs(1.0 / hd));
+            double c = atmos__dot3(dw, v->sun);
+            double th = acos(c > 1 ? 1 : (c < -1 ? -1 : c)) * ATMOS_RAD2DEG;
+            for (int f = 0; f < j->nf; f++) {
+                atmos__angle_locate(tab->grid[f], tab->ng[f], th, &hint[f], &j->pw[p * j->nf + f]);
+                j->pa[p * j->nf + f] = hint[f] * tab->no * j->n;
+            }
+        }
+    }
+}
+
+/* Per light texel: the slices its ray crosses inside the box, and the sunlight entering
+ * (from the light frame). Texel (a, b)'s ray is u e1 + v e2 + w lt; on slice k,
+ * w = (s_k - u h.e1 - v h.e2) / h.lt. Every slot of the light ring starts with that light. */
+static void setup_texels(const atmos__slice_plan *sp, sjob *j, int threads)
+{
+    const sgrid *g = j->g;
+    const slight *lf = &sp->light;
+    const double he1 = atmos__dot3(j->h, j->e1), he2 = atmos__dot3(j->h, j->e2);
+    for (int a = 0; a < 3; a++) {
+        double E1 = j->e1[a] - he1 / j->hl * j->lt[a], E2 = j->e2[a] - he2 / j->hl * j->lt[a];
+        j->lA[a] = ((j->u0 + 0.5 * j->du) * E1 + (j->v0 + 0.5 * j->dv) * E2 + (j->s0 + 0.5 * j->ds) / j->hl * j->lt[a]) *
+                       g->sc +
+                   g->off[a];
+        j->lEa[a] = j->du * E1 * g->sc;
+        j->lEb[a] = j->dv * E2 * g->sc;
+        j->lEk[a] = j->ds / j->hl * j->lt[a] * g->sc;
+    }
+    j->ldelta = (float)(j->ds / j->hl);
+    const int L = j->L, n = j->n;
+    const float *sl_miss = lf->sl + (size_t)L * L * n; /* texels never read get the box centre's */
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int b = 0; b < L; b++)
+        for (int a = 0; a < L; a++) {
+            const size_t q = (size_t)b * L + a;
+            const int read = a >= j->lrow[b].x0 && a <= j->lrow[b].x1;
+            const float *sl = read ? lf->sl + q * n : sl_miss;
+            j->lk0[q] = 1, j->lk1[q] = 0;
+            if (read && lf->hit[q]) {
+                double u = j->u0 + (a + 0.5) * j->du, v = j->v0 + (b + 0.5) * j->dv;
+                double o[3] = {u * j->e1[0] + v * j->e2[0], u * j->e1[1] + v * j->e2[1], u * j->e1[2] + v * j->e2[2]};
+                double ho = atmos__dot3(j->h, o);
+                atmos__slice_range(ho + lf->ta[q] * j->hl, ho + lf->tb[q] * j->hl, j->s0, j->ds, j->nslices, &j->lk0[q],
+                                   &j->lk1[q]);
+            }
+            for (int c = 0; c < n; c++) j->I[0][q * (n + 1) + c] = sl[c];
+            j->nsc[0][q * (n + 1)] = 0.0f;
+        }
+    const int nslot = j->batch + 1;
+    const size_t LL = (size_t)L * L;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int q = 1; q < nslot; q++) memcpy(j->I[q], j->I[0], sizeof(float) * LL * (size_t)(n + 1));
+}
+
+/* The eye-buffer pixels that the image region r reads: itself at full resolution, else the
+ * bilinear taps of its pixel centres (slice_composite.c). */
+static void eye_rect(const sjob *j, const atmos__rect *r, int e[4])
+{
+    if (j->sx == 1.0 && j->sy == 1.0) {
+        e[0] = r->x0, e[1] = r->y0, e[2] = r->x1, e[3] = r->y1;
+        return;
+    }
+    const double f[4] = {(r->x0 + 0.5) / j->sx - 0.5, (r->y0 + 0.5) / j->sy - 0.5, (r->x1 - 0.5) / j->sx - 0.5,
+                         (r->y1 - 0.5) / j->sy - 0.5};
+    const int lim[2] = {j->W, j->H};
+    for (int i = 0; i < 4; i++) {
+        int t = (int)floor(f[i]) + (i >= 2 ? 2 : 0);
+        if (t < 0) t = 0;
+        if (t > lim[i & 1]) t = lim[i & 1];
+        e[i] = t;
+    }
+}
+
+atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
+                                      const atmos__view *v, const atmos__rect *r, sjob *j)
+{
+    const int threads = atmos__threads(ctx);
+    memset(j, 0, sizeof *j);
+    if (!sp->light.valid || memcmp(sp->light.sun, v->sun, sizeof v->sun) != 0) light_frame(sp, atm, v->sun, threads);
+    job_geometry(sp, v, j);
+    if (!job_buffers(sp, j)) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
+    double cf[3], cr[3], cu[3];
+    atmos__slice_to_grid(sp->R, v->cam.forward, cf);
+    atmos__slice_to_grid(sp->R, v->cam.right, cr);
+    atmos__slice_to_grid(sp->R, v->cam.up, cu);
+    if (!atmos__slice_build_spans(j, &v->cam, cf, cr, cu, threads))
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the spans");
+    if (r->x0 > 0 || r->y0 > 0 || r->x1 < v->cam.width || r->y1 < v->cam.height) {
+        int e[4];
+        eye_rect(j, r, e);
+        atmos__slice_clip_spans(j, e[0], e[1], e[2], e[3]);
+    }
+    setup_pixels(sp, atm, v, j, threads);
+    setup_texels(sp, j, threads);
+    return ATMOS_OK;
+}
+
+/* The slices, in batches of B (one parallel region, three barriers per batch). Slot s of the
+ * light ring holds the light arriving at slice k0 + s. The light of a texel on slice k
+ * depends only on that texel on slice k - 1, so each light row runs through the batch on
+ * its own (phase A); then each image row runs through the batch reading slot k - k0 (phase
+ * B). Each pixel and texel is written by one work item only and sees the same sequence of
+ * operations as in a slice-by-slice order, so the image does not depend on the thread
+ * count, the schedule or B. After a batch the ring rotates (the last slot becomes slot 0),
+ * so a slot written for slice k held the light of B + 1 slices earlier: only texels some
+ * light span of slices k - B..k covers can differ, and only those are copied or updated. */
+atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp, sjob *j, atmos_slice_timing *tm)
+{
+    long long (*const eye_pass)(const sjob *, int, int, int, int, const float *, const float *) =
+        sp->reference ? atmos__slice_eye_span_ref : atmos__slice_eye_span;
+    long long (*const light_pass)(const sjob *, int, int, int, int, int, int, const float *, const float *, float *,
+                                  float *) = sp->reference ? atmos__slice_light_span_ref : atmos__slice_light_span;
+    const int K = j->nslices, nbatch = j->batch, threads = atmos__threads(ctx);
+    long long eye_samples = 0, light_samples = 0;
+    double t_light = 0, t_eye = 0;
+    int cancelled = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : eye_samples, light_samples)
+    for (int k0 = 0; k0 < K; k0 += nbatch) {
+        if (cancelled) break; /* set before the previous barrier: every thread sees the same value */
+        const int nb = K - k0 < nbatch ? K - k0 : nbatch;
+        double ta = 0;
+#pragma omp master
+        ta = atmos__now();
+#pragma omp for schedule(dynamic, 1)
+        for (int b = 0; b < j->L; b++)
+            for (int q = 0; q < nb; q++) {
+                const int k = k0 + q;
+                const sspan ls = j->lspan[(size_t)k * j->L + b], ws = j->wspan[(size_t)k * j->L + b];
+                if (ws.x0 <= ws.x1)
+                    light_samples += light_pass(j, k, b, ws.x0, ws.x1, ls.x0, ls.x1, j->I[q], j->nsc[q], j->I[q + 1],
+                                                j->nsc[q + 1]);
+            }
+#pragma omp master
+        {
+            double tb = atmos__now();
+            t_light += tb - ta;
+            ta = tb;
+        }
+#pragma omp for schedule(dynamic, 2)
+        for (int y = 0; y < j->H; y++)
+            for (int q = 0; q < nb; q++) {
+                const int k = k0 + q;
+                const sspan es = j->espan[(size_t)k * j->H + y];
+                if (es.x0 <= es.x1) eye_samples += eye_pass(j, k, y, es.x0, es.x1, j->I[q], j->nsc[q]);
+            }
+#pragma omp master
+        {
+            t_eye += atmos__now() - ta;
+            float *last = j->I[nb], *lastn = j->nsc[nb];
+            for (int q = nb; q > 0; q--) j->I[q] = j->I[q - 1], j->nsc[q] = j->nsc[q - 1];
+            j->I[0] = last, j->nsc[0] = lastn;
+            if (atmos__progress(ctx, "render slice", (double)(k0 + nb) / K)) cancelled = 1;
+        }
+#pragma omp barrier
+    }
+    tm->light = t_light, tm->eye = t_eye;
+    tm->eye_samples = eye_samples, tm->light_samples = light_samples;
+    if (cancelled) return atmos__error(ctx, ATMOS_E_CANCELLED, "render slice: cancelled");
+    return ATMOS_OK;
+}

@@ -1,0 +1,124 @@
+/* The slice renderer's plan (Riley et al. 2004 §4.2-§5; include/atmos/slice.h): what every
+ * frame shares (the volume box-filtered onto the render grid, the optics tables, the light
+ * ring, the per-pixel planes and spans grown to the largest frame so far, the light frame of
+ * the last sun), and a frame: the sky, the job, the slices, the §5 composite. */
+#include "atmosphere/atmosphere_ops.h"
+#include "render/slice_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void atmos__slice_plan_destroy(atmos__slice_plan *sp)
+{
+    if (!sp) return;
+    atmos__sgrid_free(&sp->g);
+    atmos__stables_free(&sp->tab);
+    free(sp->pixblock), free(sp->spans), free(sp->lk), free(sp->ring), free(sp->I), free(sp->nsc);
+    free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
+    free(sp);
+}
+
+/* The light ring: B + 1 slots of L^2 texels of n + 1 floats (I per wavelength, then n: one
+ * cache line serves all of a texel), B up to 16 within 32 MB. Slots are padded by three
+ * cache lines so that they do not alias in the caches. Also the texels' slice ranges and the
+ * light frame's per-texel arrays. */
+static int light_buffers(atmos__slice_plan *sp)
+{
+    const size_t LL = (size_t)sp->L * sp->L, slotf = LL * (size_t)(sp->n + 1) + 48, slot = sizeof(float) * slotf;
+    const size_t fit = ((size_t)32 << 20) / slot;
+    sp->batch = fit > 17 ? 16 : (fit > 2 ? (int)fit - 1 : 1);
+    sp->ring = atmos__big_alloc(slot * (size_t)(sp->batch + 1));
+    sp->I = malloc(sizeof(float *) * (size_t)(sp->batch + 1));
+    sp->nsc = malloc(sizeof(float *) * (size_t)(sp->batch + 1));
+    sp->lk = malloc(sizeof(int) * LL * 2);
+    sp->light.ta = malloc(sizeof(double) * LL);
+    sp->light.tb = malloc(sizeof(double) * LL);
+    sp->light.hit = malloc(LL);
+    sp->light.sl = malloc(sizeof(float) * (LL + 1) * (size_t)sp->n);
+    if (!sp->ring || !sp->I || !sp->nsc || !sp->lk || !sp->light.ta || !sp->light.tb || !sp->light.hit || !sp->light.sl)
+        return 0;
+    for (int q = 0; q <= sp->batch; q++) {
+        sp->I[q] = sp->ring + (size_t)q * slotf;
+        sp->nsc[q] = sp->I[q] + sp->n;
+    }
+    return 1;
+}
+
+atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
+{
+    atmos_context *ctx = p->ctx;
+    const atmos_scene_slice *ss = &p->scene.slice;
+    const double t0 = atmos__now();
+    atmos__slice_plan *sp = calloc(1, sizeof *sp);
+    if (!sp) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory");
+    sp->n = p->wl.count;
+    sp->nf = atmos_volume_field_count(p->volume);
+    sp->L = ss->light_size;
+    sp->low_albedo = ss->low_albedo;
+    sp->eq24 = ss->eq24;
+    sp->xi = (float)ss->xi;
+    sp->reference = p->reference;
+    const atmos_volume_desc *vd = atmos_volume_get_desc(p->volume);
+    memcpy(sp->R, vd->rotation, sizeof sp->R);
+    for (int a = 0; a < 3; a++) sp->org[a] = vd->origin_m[a] + p->offset[a];
+    atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, ss->grid_max_dim, &sp->g);
+    if (st == ATMOS_OK && sp->g.v) st = atmos__stables_build(ctx, p->optics, sp->n, ss->max_order, &sp->tab);
+    if (st == ATMOS_OK && sp->g.v && !light_buffers(sp))
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the light buffer");
+    if (st != ATMOS_OK) {
+        atmos__slice_plan_destroy(sp);
+        return st;
+    }
+    sp->prepare_s = atmos__now() - t0;
+    *out = sp;
+    return ATMOS_OK;
+}
+
+/* The eye buffer's size for a view (as job_geometry sets it). */
+static void eye_size(const atmos__view *v, int *w, int *h)
+{
+    *w = v->cam.width, *h = v->cam.height;
+    if (v->eye_scale < 1.0) {
+        int we = (int)lround(v->eye_scale * v->cam.width), he = (int)lround(v->eye_scale * v->cam.height);
+        *w = we < 1 ? 1 : we, *h = he < 1 ? 1 : he;
+    }
+}
+
+void atmos__slice_describe(const atmos_plan *p, const atmos__view *v, char *buf, size_t cap)
+{
+    const atmos_scene_slice *ss = &p->scene.slice;
+    int w, h;
+    eye_size(v, &w, &h);
+    snprintf(buf, cap, "%d slices, light buffer %d, eye buffer %dx%d, xi %g, %s%s", v->slices, ss->light_size, w, h,
+             ss->xi, ss->eq24 ? "eq24" : "eq25", ss->low_albedo ? ", low albedo" : "");
+}
+
+atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out,
+                                 atmos_slice_timing *tm)
+{
+    atmos_context *ctx = p->ctx;
+    atmos__slice_plan *sp = p->slice;
+    const double t_start = atmos__now();
+    memset(tm, 0, sizeof *tm);
+    memcpy(tm->grid_dims, sp->g.c, sizeof sp->g.c);
+    /* The sky behind everything, sun's disk included. */
+    atmos_status st = atmos__sky_render(ctx, p->atm, v, r, out);
+    if (st != ATMOS_OK) return st;
+    tm->sky = atmos__now() - t_start;
+    if (sp->g.v) { /* an empty volume leaves the sky alone */
+        sjob j;
+        const double t_setup = atmos__now();
+        if ((st = atmos__slice_frame_setup(ctx, sp, p->atm, v, r, &j)) != ATMOS_OK) return st;
+        tm->setup = atmos__now() - t_setup;
+        tm->prepare = sp->prepare_s;
+        tm->eye_dims[0] = j.W, tm->eye_dims[1] = j.H;
+        if ((st = atmos__slice_passes(ctx, sp, &j, tm)) != ATMOS_OK) return st;
+        const double t_c0 = atmos__now();
+        atmos__slice_composite(&j, p->atm, &v->cam, v->sun, sp->R, r, out, atmos__threads(ctx));
+        tm->sky += atmos__now() - t_c0;
+    }
+    tm->total = atmos__now() - t_start;
+    return ATMOS_OK;
+}

@@ -1,0 +1,29 @@
+/* A frame resolved for the renderers (plan.c builds it from an atmos_frame): the camera
+ * built for the image, the sun's direction and the frame's budgets with the scene's values
+ * filled in. Renderers take this, never a scene. Not part of the API. */
+#ifndef ATMOS_RENDER_VIEW_H
+#define ATMOS_RENDER_VIEW_H
+
+#include "core/internal.h"
+
+typedef struct atmos__view {
+    atmos_camera cam;          /* width x height pixels */
+    double sun[3];             /* unit vector toward the sun */
+    int samples_per_pixel;     /* stratified samples of the sky, 1..256 */
+    int spp;                   /* path tracer: samples per pixel to reach */
+    int slices;                /* slice renderer: sampling planes */
+    double eye_scale;          /* slice renderer: eye buffer scale, (0, 1] */
+} atmos__view;
+
+/* A region clipped to the image: [x0, x1) x [y0, y1), never empty unless the image is. */
+typedef struct atmos__rect {
+    int x0, y0, x1, y1;
+} atmos__rect;
+
+/* The sky renderer (sky_render.c): what every view ray sees of the atmosphere, the sun's
+ * disk antialiased, over the pixels of r, written into out (width x height x count + 1
+ * channels: radiance per wavelength, coverage alpha). Reports progress as "render sky". */
+atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
+                               const atmos__rect *r, atmos_image *out);
+
+#endif

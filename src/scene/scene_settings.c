@@ -1,0 +1,141 @@
+/* The renderers' settings tables (scene.h, atmos_renderer_settings): the one description of
+ * every setting of a scene file's "slice" and "path" sections. The scene's defaults, the
+ * JSON parser (scene_json.c), the validator (scene_validate.c), atmos render's options and
+ * its --help are all made from these rows, so a setting has one name, one range, one default
+ * and one meaning everywhere. */
+#include "scene/scene_internal.h"
+
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#define SLICE(field) offsetof(atmos_scene, slice.field)
+#define PATH(field) offsetof(atmos_scene, path.field)
+
+static const char *const update_names[] = {"eq25", "eq24", NULL};
+
+static const atmos_setting slice_settings[] = {
+    {"slices", "slices", ATMOS_SETTING_INT, "", 1, 8192, 0, 0, 256, NULL, 0,
+     "sampling planes across the volume", SLICE(slices)},
+    {"light_size", "light-size", ATMOS_SETTING_INT, "texels", 8, 8192, 0, 0, 256, NULL, 0,
+     "light buffer texels per side", SLICE(light_size)},
+    {"xi", "xi", ATMOS_SETTING_REAL, "sr^-1", 0, 100, 0, 0, 0.1 / (4.0 * 3.14159265358979323846), NULL, 0,
+     "Riley's back-scatter term added to Ams (Eq. 26); 0 = none", SLICE(xi)},
+    {"update", "eq24", ATMOS_SETTING_CHOICE, "", 0, 0, 0, 0, 0, update_names, 1,
+     "light-buffer update: eq25 (the paper's) or eq24 (the exact product of F_i; the flag selects it)",
+     SLICE(eq24)},
+    {"low_albedo", "low-albedo", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "single scattering with the plain phase function, light attenuated by T only (Riley Fig. 13)",
+     SLICE(low_albedo)},
+    {"grid_max_dim", "grid-max-dim", ATMOS_SETTING_INT, "voxels", 8, 2048, 0, 0, 256, NULL, 0,
+     "the volume is box-filtered onto a grid of at most this many voxels per axis", SLICE(grid_max_dim)},
+    {"eye_scale", "eye-scale", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 1, NULL, 0,
+     "eye buffer resolution relative to the image, per axis (0.5: a quarter of the rays, upsampled)",
+     SLICE(eye_scale)},
+    {"max_order", "max-order", ATMOS_SETTING_INT, "", 1, 1000, 0, 0, 64, NULL, 0,
+     "orders of Ams tabulated (higher scattering orders use the last)", SLICE(max_order)},
+};
+
+static const atmos_setting path_settings[] = {
+    {"spp", "spp", ATMOS_SETTING_INT, "", 1, 1000000, 0, 0, 64, NULL, 0, "samples per pixel", PATH(spp)},
+    {"time_budget_s", "time-budget", ATMOS_SETTING_REAL, "s", 0, 1e7, 0, 0, 0, NULL, 0,
+     "stop after the pass during which this much time has passed; 0 = none", PATH(time_budget_s)},
+    {"seed", "seed", ATMOS_SETTING_SEED, "", 0, 9007199254740992.0, 0, 0, 1, NULL, 0,
+     "random seed: same seed, same image", PATH(seed)},
+    {"max_depth", "max-depth", ATMOS_SETTING_INT, "", 0, 100000, 0, 0, 0, NULL, 0,
+     "scattering events per path; 0 = unlimited (Russian roulette)", PATH(max_depth)},
+    {"truncate_deg", "truncate", ATMOS_SETTING_REAL, "deg", 0, 20, 0, 0, 0, NULL, 0,
+     "cut every phase function's forward peak at this angle, the part above counting as unscattered "
+     "(less noise in droplet clouds, changes light within it of the forward direction); 0 = exact",
+     PATH(truncate_deg)},
+    {"sky_nee", "no-sky-nee", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "next-event estimation toward the sky (off: same mean, more noise)", PATH(sky_nee)},
+    {"forced", "no-forced", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "forced single scattering on camera rays (off: same mean, more noise in thin media)", PATH(forced)},
+    {"aureole", "no-aureole", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "the aureole estimate in droplet clouds (off: same mean, more fireflies)", PATH(aureole)},
+};
+
+const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)
+{
+    int n = 0;
+    const atmos_setting *t = NULL;
+    if (renderer == ATMOS_RENDERER_SLICE) t = slice_settings, n = (int)(sizeof slice_settings / sizeof *t);
+    if (renderer == ATMOS_RENDERER_PATH) t = path_settings, n = (int)(sizeof path_settings / sizeof *t);
+    if (count) *count = n;
+    return t;
+}
+
+const char *atmos_renderer_name(atmos_renderer_kind renderer)
+{
+    static const char *const names[] = {"sky", "slice", "path"};
+    return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_PATH ? names[renderer] : NULL;
+}
+
+double atmos_scene_setting_get(const atmos_scene *s, const atmos_setting *st)
+{
+    const char *p = (const char *)s + st->offset;
+    switch (st->type) {
+    case ATMOS_SETTING_REAL: {
+        double v;
+        memcpy(&v, p, sizeof v);
+        return v;
+    }
+    case ATMOS_SETTING_SEED: {
+        uint64_t v;
+        memcpy(&v, p, sizeof v);
+        return (double)v;
+    }
+    default: {
+        int v;
+        memcpy(&v, p, sizeof v);
+        return v;
+    }
+    }
+}
+
+void atmos_scene_setting_set(atmos_scene *s, const atmos_setting *st, double v)
+{
+    char *p = (char *)s + st->offset;
+    if (st->type == ATMOS_SETTING_REAL) {
+        memcpy(p, &v, sizeof v);
+    } else if (st->type == ATMOS_SETTING_SEED) {
+        uint64_t u = v > 0 ? (uint64_t)v : 0;
+        memcpy(p, &u, sizeof u);
+    } else {
+        int i = (int)v;
+        memcpy(p, &i, sizeof i);
+    }
+}
+
+void atmos__settings_defaults(atmos_scene *s)
+{
+    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_PATH; r++) {
+        int n;
+        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
+        for (int i = 0; i < n; i++) atmos_scene_setting_set(s, &t[i], t[i].def);
+    }
+}
+
+atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s)
+{
+    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_PATH; r++) {
+        int n;
+        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
+        for (int i = 0; i < n; i++) {
+            char path[96];
+            snprintf(path, sizeof path, "/%s/%s", atmos_renderer_name((atmos_renderer_kind)r), t[i].key);
+            const double v = atmos_scene_setting_get(s, &t[i]);
+            int choices = 0;
+            if (t[i].type == ATMOS_SETTING_CHOICE)
+                while (t[i].choices[choices]) choices++;
+            const atmos__range range = t[i].type == ATMOS_SETTING_BOOL     ? (atmos__range){0, 1, 0, 0}
+                                       : t[i].type == ATMOS_SETTING_CHOICE ? (atmos__range){0, choices - 1, 0, 0}
+                                                                           : (atmos__range){t[i].min, t[i].max,
+                                                                                            t[i].min_open, t[i].max_open};
+            atmos_status st = atmos__scene_check_range(ctx, source, path, v, &range, NULL);
+            if (st != ATMOS_OK) return st;
+        }
+    }
+    return ATMOS_OK;
+}

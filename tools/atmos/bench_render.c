@@ -1,0 +1,208 @@
+/* atmos bench slice and atmos bench path: the volume renderers measured as an interactive
+ * session uses them, one plan kept for many frames, and per frame end to end (the sky and
+ * the composite included): the camera moved every frame, the sun moved every frame, and
+ * nothing moved. One machine-readable line (or JSON object) per case. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_render.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The volume benchmarks' view: the volume's base at 1500 m centred above the origin
+ * (offset returned), seen from 1.6 times its size, sun 35° high behind-left. */
+static void bench_view(atmos_scene *scene, const atmos_volume *v, int size, double offset[3])
+{
+    atmos_scene_defaults(scene);
+    scene->width = scene->height = size;
+    scene->samples_per_pixel = 1;
+    double lo[3], hi[3];
+    atmos_volume_bounds(v, lo, hi);
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    offset[0] = -0.5 * (lo[0] + hi[0]);
+    offset[1] = 1500 - lo[1];
+    offset[2] = -0.5 * (lo[2] + hi[2]);
+    double cy = 1500 + 0.5 * (hi[1] - lo[1]);
+    double pos[3] = {0, 1500 + 0.3 * (hi[1] - lo[1]), 1.6 * ext};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &scene->camera);
+    scene->camera.look_at[0] = 0, scene->camera.look_at[1] = cy, scene->camera.look_at[2] = 0;
+    scene->camera.fov_deg = 45;
+    scene->sun.from_time = 0;
+    scene->sun.elevation_deg = 35;
+    scene->sun.azimuth_deg = 200;
+}
+
+enum { MOVE_CAMERA, MOVE_SUN, MOVE_NOTHING };
+
+/* Frame i of a run: the camera orbits 3° a frame, or the sun turns 3° in azimuth. */
+static void step_frame(const atmos_plan *plan, const atmos_frame *start, int mode, int i, atmos_frame *f)
+{
+    *f = *start;
+    if (mode == MOVE_CAMERA) atmos_frame_orbit(f, plan, 3.0 * i);
+    if (mode == MOVE_SUN) atmos_direction_from_angles(35.0, 200.0 + 3.0 * i, f->sun_dir);
+}
+
+/* Mean seconds per frame over n frames of a mode (after one frame that is not timed), with
+ * the timing of the last frame. */
+static atmos_status run_mode(atmos_plan *plan, const atmos_frame *start, int mode, int n, atmos_image *img,
+                             double *seconds, atmos_plan_stats *last)
+{
+    atmos_frame f;
+    step_frame(plan, start, mode, 0, &f);
+    atmos_status st = atmos_plan_render(plan, &f, NULL, img, NULL);
+    const double t0 = cli_now_s();
+    for (int i = 1; i <= n && st == ATMOS_OK; i++) {
+        step_frame(plan, start, mode, i, &f);
+        if (mode == MOVE_NOTHING) f.spp = start->spp + i; /* the path tracer adds a sample a frame */
+        st = atmos_plan_render(plan, &f, NULL, img, NULL);
+    }
+    *seconds = (cli_now_s() - t0) / n;
+    atmos_plan_get_stats(plan, last);
+    return st;
+}
+
+/* A plan for a scene of the bench view of v (bench_view); its creation time in *prepare_s. */
+static atmos_status bench_plan(atmos_context *ctx, atmos_volume *v, const atmos_scene *scene, atmos_plan **plan,
+                               double *prepare_s)
+{
+    atmos_plan_desc d;
+    memset(&d, 0, sizeof d);
+    d.offset_given = 1;
+    atmos_scene s;
+    bench_view(&s, v, scene->width, d.offset_m);
+    const double t0 = cli_now_s();
+    atmos_status st = atmos_plan_create(ctx, scene, v, &d, plan);
+    *prepare_s = cli_now_s() - t0;
+    return st;
+}
+
+static void print_slice(const char *name, int size, int threads, const double fps[3], const atmos_plan_stats *s,
+                        double prepare_s, int json)
+{
+    const atmos_slice_timing *t = &s->slice;
+    const long long samples = t->eye_samples + t->light_samples;
+    const double ns = samples > 0 ? 1e9 * (t->light + t->eye) / (double)samples : 0;
+    const char *fmt = json ? "{\"bench\":\"slice\",\"case\":\"%s\",\"size\":%d,\"threads\":%d,\"eye\":[%d,%d],"
+                             "\"fps_camera_moving\":%.3f,\"fps_sun_moving\":%.3f,\"fps_static\":%.3f,"
+                             "\"ms_per_frame\":%.2f,\"ns_per_sample\":%.2f,\"setup_ms\":%.2f,\"light_ms\":%.2f,"
+                             "\"eye_ms\":%.2f,\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"eye_samples\":%lld,"
+                             "\"light_samples\":%lld,\"grid\":[%d,%d,%d]}\n"
+                           : "bench=slice case=%s size=%d threads=%d eye=%dx%d fps_camera_moving=%.3f fps_sun_moving=%.3f "
+                             "fps_static=%.3f ms_per_frame=%.2f ns_per_sample=%.2f setup_ms=%.2f light_ms=%.2f eye_ms=%.2f "
+                             "sky_ms=%.2f prepare_ms=%.2f eye_samples=%lld light_samples=%lld grid=%dx%dx%d\n";
+    printf(fmt, name, size, threads, t->eye_dims[0], t->eye_dims[1], fps[MOVE_CAMERA], fps[MOVE_SUN], fps[MOVE_NOTHING],
+           1e3 / fps[MOVE_SUN], ns, 1e3 * t->setup, 1e3 * t->light, 1e3 * t->eye, 1e3 * t->sky, 1e3 * prepare_s,
+           t->eye_samples, t->light_samples, t->grid_dims[0], t->grid_dims[1], t->grid_dims[2]);
+    fflush(stdout);
+}
+
+int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
+                     int json)
+{
+    atmos_scene scene;
+    atmos_plan *plan = NULL;
+    atmos_image *img = NULL;
+    double prepare = 0, sec[3] = {0, 0, 0}, fps[3];
+    atmos_plan_stats stats[3];
+    atmos_frame start;
+    double offset[3];
+    bench_view(&scene, v, size, offset);
+    scene.renderer = ATMOS_RENDERER_SLICE;
+    atmos_status st = bench_plan(ctx, v, &scene, &plan, &prepare);
+    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
+    if (eye_scale > 0) start.eye_scale = eye_scale;
+    if (st == ATMOS_OK) st = atmos_plan_image_create(plan, &start, &img);
+    for (int m = 0; m < 3 && st == ATMOS_OK; m++) st = run_mode(plan, &start, m, frames, img, &sec[m], &stats[m]);
+    atmos_image_destroy(img);
+    atmos_plan_destroy(plan);
+    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
+    for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
+    print_slice(name, size, atmos_context_threads(ctx), fps, &stats[MOVE_SUN], prepare, json);
+    return CLI_EXIT_OK;
+}
+
+/* The volume's pixels and their noise: in vacuum the nonzero ones; in the sky those that
+ * differ from the atmosphere alone (bg) by more than 3 standard errors. rel: the mean
+ * per-pixel relative standard error of the luminance; relm: that of the volume's mean. */
+static long long noise(const atmos_image *img, const atmos_image *var, const atmos_image *bg, const atmos_wavelengths *wl,
+                       double *rel, double *relm)
+{
+    const int n = wl->count, C = n + 1;
+    double r = 0, sumY = 0, sumV = 0;
+    long long cnt = 0;
+    for (size_t p = 0; p < (size_t)img->width * img->height; p++) {
+        double Y = 0, Yb = 0;
+        for (int k = 0; k < n; k++) {
+            Y += wl->to_xyz[k][1] * img->pixels[p * C + k];
+            if (bg) Yb += wl->to_xyz[k][1] * bg->pixels[p * C + k];
+        }
+        const double vY = var->pixels[p * C + n];
+        const int covered = bg ? fabs(Y - Yb) > 3 * sqrt(vY) + 1e-3 * Yb : Y > 0;
+        if (!covered || !(Y > 0)) continue;
+        r += sqrt(vY) / Y;
+        sumY += Y, sumV += vY;
+        cnt++;
+    }
+    *rel = cnt ? r / cnt : 0;
+    *relm = sumY > 0 ? sqrt(sumV) / sumY : 0;
+    return cnt;
+}
+
+/* The atmosphere alone for the path case's scene (the background the volume is told from). */
+static atmos_status path_background(atmos_context *ctx, const atmos_scene *scene, atmos_image **bg)
+{
+    atmos_scene s = *scene;
+    s.volume.source[0] = '\0';
+    return atmos_render_scene(ctx, &s, NULL, bg, NULL);
+}
+
+static void print_path(const char *name, int vacuum, const atmos_scene *s, int threads, const atmos_path_stats *st,
+                       long long cnt, double rel, double relm, const double fps[3])
+{
+    const double t = st->trace_s;
+    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g%s%s%s paths_per_s=%.4g "
+           "events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g events_per_path=%.2f trace_s=%.3f "
+           "prepare_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f t_1pct_pixel_s=%.4g mean_rel_se=%.3g "
+           "t_1pct_mean_s=%.3g fps_camera_moving=%.3f fps_sun_moving=%.3f fps_static=%.3f\n",
+           name, vacuum ? "vacuum" : "sky", s->width, s->height, st->spp, threads, s->volume.density_scale,
+           s->path.forced ? "" : " no_forced=1", s->path.sky_nee ? "" : " no_sky_nee=1",
+           s->path.aureole ? "" : " no_aureole=1", st->paths / t, st->events / t, st->tentative / t,
+           st->shadow_rays / t, (double)st->events / (double)st->paths, t, st->prepare_s, cnt, rel,
+           t * (rel / 0.01) * (rel / 0.01), relm, t * (relm / 0.01) * (relm / 0.01), fps[MOVE_CAMERA], fps[MOVE_SUN],
+           fps[MOVE_NOTHING]);
+    fflush(stdout);
+}
+
+int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v, const bench_path_opts *o, int vacuum)
+{
+    atmos_scene scene;
+    atmos_plan *plan = NULL;
+    atmos_image *img = NULL, *var = NULL, *bg = NULL;
+    double prepare = 0, sec[3] = {0, 0, 0}, fps[3], rel = 0, relm = 0;
+    atmos_plan_stats stats, ms;
+    atmos_frame f;
+    long long cnt = 0;
+    double offset[3];
+    bench_view(&scene, v, o->size, offset);
+    scene.renderer = ATMOS_RENDERER_PATH;
+    scene.atmosphere.kind = vacuum ? ATMOS_ATMOSPHERE_VACUUM : ATMOS_ATMOSPHERE_RILEY;
+    scene.volume.density_scale = o->density_scale;
+    scene.path.spp = o->spp;
+    scene.path.forced = !o->no_forced, scene.path.sky_nee = !o->no_sky_nee, scene.path.aureole = !o->no_aureole;
+    atmos_status st = bench_plan(ctx, v, &scene, &plan, &prepare);
+    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &f);
+    if (st == ATMOS_OK) st = atmos_plan_image_create(plan, &f, &img);
+    if (st == ATMOS_OK) st = atmos_plan_render(plan, &f, NULL, img, NULL);
+    if (st == ATMOS_OK) atmos_plan_get_stats(plan, &stats), st = atmos_plan_path_variance(plan, &var);
+    if (st == ATMOS_OK && !vacuum) st = path_background(ctx, &scene, &bg);
+    if (st == ATMOS_OK) cnt = noise(img, var, bg, atmos_plan_wavelengths(plan), &rel, &relm);
+    f.spp = 1; /* interactive frames: one sample per pixel, the static ones adding one each */
+    for (int m = 0; m < 3 && st == ATMOS_OK; m++) st = run_mode(plan, &f, m, 4, img, &sec[m], &ms);
+    atmos_image_destroy(img), atmos_image_destroy(var), atmos_image_destroy(bg);
+    atmos_plan_destroy(plan);
+    if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
+    for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
+    print_path(name, vacuum, &scene, atmos_context_threads(ctx), &stats.path, cnt, rel, relm, fps);
+    return CLI_EXIT_OK;
+}

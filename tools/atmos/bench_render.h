@@ -1,0 +1,21 @@
+/* The plan-based render benchmarks (bench_render.c) of atmos bench. */
+#ifndef ATMOS_CLI_BENCH_RENDER_H
+#define ATMOS_CLI_BENCH_RENDER_H
+
+#include "cli.h"
+
+/* The slice renderer on v at size^2 (Riley et al. 2004 Fig. 14: 256 slices): frames per mode
+ * (camera moving, sun moving, static), eye_scale > 0 overriding the scene's. */
+int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
+                     int json);
+
+typedef struct {
+    int size, spp;
+    double density_scale;
+    int no_forced, no_sky_nee, no_aureole;
+} bench_path_opts;
+
+/* The path tracer on v, in vacuum or in the sky. */
+int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v, const bench_path_opts *o, int vacuum);
+
+#endif

@@ -1,0 +1,424 @@
+/* atmos render's options (render_opts.h). The fixed options are listed here; one option per
+ * row of the renderers' settings tables is added from atmos_renderer_settings, and --help
+ * prints those rows with their ranges and defaults. */
+#include "render_opts.h"
+
+#include <getopt.h>
+#include <stddef.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum {
+    O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
+    O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_VPOS, O_DSCALE, O_TAU, O_VARIANCE,
+    O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER,
+    O_SETTING = 1024 /* + row index over the tables: a renderer setting */
+};
+
+static const struct option fixed_opts[] = {
+    {"output", required_argument, 0, 'o'}, {"exr", required_argument, 0, O_EXR}, {"pfm", required_argument, 0, O_PFM},
+    {"png-bits", required_argument, 0, O_PNGBITS}, {"exr-half", no_argument, 0, O_EXRHALF},
+    {"width", required_argument, 0, O_W}, {"height", required_argument, 0, O_H},
+    {"camera", required_argument, 0, O_CAM}, {"altitude", required_argument, 0, O_ALT},
+    {"sun-elevation", required_argument, 0, O_SEL}, {"sun-azimuth", required_argument, 0, O_SAZ},
+    {"time", required_argument, 0, O_TIME}, {"lat", required_argument, 0, O_LAT}, {"lon", required_argument, 0, O_LON},
+    {"spectral", required_argument, 0, O_SPECTRAL}, {"rgb", no_argument, 0, O_RGB},
+    {"exposure", required_argument, 0, O_EXPOSURE}, {"exposure-comp", required_argument, 0, O_EXPCOMP},
+    {"tone", required_argument, 0, O_TONE}, {"threads", required_argument, 0, O_THREADS},
+    {"quiet", no_argument, 0, 'q'}, {"renderer", required_argument, 0, O_RENDERER},
+    {"volume", required_argument, 0, O_VOLUME}, {"volume-position", required_argument, 0, O_VPOS},
+    {"density-scale", required_argument, 0, O_DSCALE}, {"tau", required_argument, 0, O_TAU},
+    {"variance", required_argument, 0, O_VARIANCE}, {"order", required_argument, 0, O_ORDER},
+    {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
+    {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
+    {"help", no_argument, 0, 'h'}};
+#define NFIXED ((int)(sizeof fixed_opts / sizeof fixed_opts[0]))
+
+/* Row i of the concatenated settings tables (slice, then path); NULL past the end. */
+static const atmos_setting *table_row(int i, atmos_renderer_kind *r)
+{
+    for (int k = ATMOS_RENDERER_SLICE; k <= ATMOS_RENDERER_PATH; k++) {
+        int n;
+        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)k, &n);
+        if (i < n) {
+            *r = (atmos_renderer_kind)k;
+            return &t[i];
+        }
+        i -= n;
+    }
+    return NULL;
+}
+
+static int takes_value(const atmos_setting *s)
+{
+    return s->type != ATMOS_SETTING_BOOL && s->type != ATMOS_SETTING_CHOICE;
+}
+
+/* The long options: the fixed ones, then one per settings row with a flag. */
+static int build_options(struct option *opts, int cap)
+{
+    int n = 0;
+    for (int i = 0; i < NFIXED && n < cap - 1; i++) opts[n++] = fixed_opts[i];
+    atmos_renderer_kind r = ATMOS_RENDERER_SLICE;
+    const atmos_setting *s;
+    for (int i = 0; (s = table_row(i, &r)) && n < cap - 1; i++)
+        if (s->flag) opts[n++] = (struct option){s->flag, takes_value(s) ? required_argument : no_argument, 0, O_SETTING + i};
+    opts[n] = (struct option){0, 0, 0, 0};
+    return n;
+}
+
+/* A setting's value from the command line, checked against its row's range. */
+static int parse_setting(const atmos_setting *s, const char *text, double *out)
+{
+    char opt[64];
+    snprintf(opt, sizeof opt, "--%s", s->flag);
+    if (!takes_value(s)) {
+        *out = s->flag_sets;
+        return 1;
+    }
+    if (s->type == ATMOS_SETTING_SEED) {
+        char *end = NULL;
+        unsigned long long v = strtoull(text, &end, 10);
+        if (!*text || *end || text[0] == '-' || (double)v > s->max) {
+            cli_usage_error("render", "%s: expected an integer in [0, %.0f], got '%s'", opt, s->max, text);
+            return 0;
+        }
+        *out = (double)v;
+        return 1;
+    }
+    double v;
+    if (!cli_parse_double("render", opt, text, &v)) return 0;
+    const int low = s->min_open ? v <= s->min : v < s->min, high = s->max_open ? v >= s->max : v > s->max;
+    if (low || high || (s->type == ATMOS_SETTING_INT && v != floor(v))) {
+        cli_usage_error("render", "%s: expected %s in %c%g, %g%c%s%s, got '%s'", opt,
+                        s->type == ATMOS_SETTING_INT ? "an integer" : "a value", s->min_open ? '(' : '[', s->min, s->max,
+                        s->max_open ? ')' : ']', s->unit[0] ? " " : "", s->unit, text);
+        return 0;
+    }
+    *out = v;
+    return 1;
+}
+
+static int parse_choice(const char *opt, const char *text, const char *const *names, int n, int *out)
+{
+    for (int i = 0; i < n; i++)
+        if (!strcmp(text, names[i])) return *out = i, 1;
+    char list[128] = "";
+    for (int i = 0; i < n; i++) snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", names[i]);
+    cli_usage_error("render", "%s: expected %s, got '%s'", opt, list, text);
+    return 0;
+}
+
+static void opts_init(render_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->cam_type = o->renderer = o->tone = -1;
+    o->altitude = o->sun_el = o->sun_az = o->lat = o->lon = o->ev = o->ev_comp = NAN;
+    o->sun_el_end = o->sun_az_end = NAN;
+}
+
+/* The options that name files or pick from words. Returns 1, 0 (usage error printed) or -1
+ * (not one of these). */
+static int parse_named(int c, const char *arg, render_opts *o)
+{
+    static const char *const cams[] = {"pinhole", "fisheye", "equirect"}, *const tones[] = {"filmic", "reinhard", "clamp"},
+                             *const renderers[] = {"sky", "slice", "path"};
+    switch (c) {
+    case 'o': o->png = arg; return 1;
+    case O_EXR: o->exr = arg; return 1;
+    case O_PFM: o->pfm = arg; return 1;
+    case O_TAU: o->tau = arg; return 1;
+    case O_VARIANCE: o->variance = arg; return 1;
+    case O_ORDER: o->order = arg; return 1;
+    case O_VOLUME: o->volume = arg; return 1;
+    case O_TIME: o->time = arg; return 1;
+    case O_TIME_END: o->time_end = arg; return 1;
+    case O_EXRHALF: o->exr_half = 1; return 1;
+    case O_RGB: o->rgb = 1; return 1;
+    case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
+    case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
+    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 3, &o->renderer);
+    case O_EXPOSURE:
+        if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
+        return cli_parse_double("render", "--exposure", arg, &o->ev);
+    case O_VPOS: {
+        char tail;
+        double *v = o->volume_pos;
+        if (sscanf(arg, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !isfinite(v[0]) || !isfinite(v[1]) ||
+            !isfinite(v[2])) {
+            cli_usage_error("render", "--volume-position: expected X,Y,Z in metres, got '%s'", arg);
+            return 0;
+        }
+        return o->volume_pos_given = 1, 1;
+    }
+    default: return -1;
+    }
+}
+
+/* The numeric options. Returns 1, 0 (usage error printed) or -1 (not one of these). */
+static int parse_number(int c, const char *arg, render_opts *o)
+{
+    const char *C = "render";
+    switch (c) {
+    case O_PNGBITS:
+        if (!cli_parse_int(C, "--png-bits", arg, 8, 16, &o->png_bits)) return 0;
+        if (o->png_bits != 8 && o->png_bits != 16) return cli_usage_error(C, "--png-bits: must be 8 or 16"), 0;
+        return 1;
+    case O_W: return cli_parse_int(C, "--width", arg, 1, ATMOS_SCENE_MAX_DIM, &o->width);
+    case O_H: return cli_parse_int(C, "--height", arg, 1, ATMOS_SCENE_MAX_DIM, &o->height);
+    case O_SPECTRAL: return cli_parse_int(C, "--spectral", arg, 1, ATMOS_MAX_WAVELENGTHS, &o->spectral);
+    case O_THREADS: return cli_parse_int(C, "--threads", arg, 1, 1024, &o->threads);
+    case O_FRAMES: return cli_parse_int(C, "--frames", arg, 1, ATMOS_SCENE_MAX_FRAMES, &o->frames);
+    case O_ALT: return cli_parse_double(C, "--altitude", arg, &o->altitude);
+    case O_SEL: return cli_parse_double(C, "--sun-elevation", arg, &o->sun_el);
+    case O_SAZ: return cli_parse_double(C, "--sun-azimuth", arg, &o->sun_az);
+    case O_LAT: return cli_parse_double(C, "--lat", arg, &o->lat);
+    case O_LON: return cli_parse_double(C, "--lon", arg, &o->lon);
+    case O_EXPCOMP: return cli_parse_double(C, "--exposure-comp", arg, &o->ev_comp);
+    case O_SEL_END: return cli_parse_double(C, "--sun-elevation-end", arg, &o->sun_el_end);
+    case O_SAZ_END: return cli_parse_double(C, "--sun-azimuth-end", arg, &o->sun_az_end);
+    case O_DSCALE:
+        if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) || !(o->density_scale > 0))
+            return cli_usage_error(C, "--density-scale: expected a factor > 0"), 0;
+        return 1;
+    default: return -1;
+    }
+}
+
+/* Rules between options that hold whatever the scene says. */
+static int check_options(const render_opts *o)
+{
+    const char *C = "render";
+    if (o->spectral && o->rgb) return cli_usage_error(C, "--spectral and --rgb exclude each other");
+    const int use_time = o->time || !isnan(o->lat) || !isnan(o->lon);
+    if (use_time && (!o->time || isnan(o->lat) || isnan(o->lon)))
+        return cli_usage_error(C, "--time, --lat and --lon go together");
+    if (use_time && (!isnan(o->sun_el) || !isnan(o->sun_az)))
+        return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
+    if (o->exposure_auto && !isnan(o->ev)) return cli_usage_error(C, "--exposure given twice");
+    if (o->time_end && (!isnan(o->sun_el_end) || !isnan(o->sun_az_end)))
+        return cli_usage_error(C, "--time-end (a sun given by time) and --sun-elevation-end/--sun-azimuth-end "
+                                  "(a sun given by angles) exclude each other");
+    if (o->volume && strlen(o->volume) >= sizeof(((atmos_scene *)0)->volume.source))
+        return cli_usage_error(C, "--volume: the path is too long");
+    return CLI_EXIT_OK;
+}
+
+int render_opts_parse(int argc, char **argv, render_opts *o)
+{
+    struct option opts[NFIXED + 2 * RENDER_OPTS_MAX_SETTINGS + 1];
+    build_options(opts, (int)(sizeof opts / sizeof opts[0]));
+    opts_init(o);
+    optind = 1;
+    opterr = 0;
+    int c;
+    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+        if (c == 'h') return render_opts_help(), -1;
+        if (c == 'q') {
+            o->quiet = 1;
+            continue;
+        }
+        if (c >= O_SETTING) {
+            atmos_renderer_kind r = ATMOS_RENDERER_SLICE;
+            const atmos_setting *s = table_row(c - O_SETTING, &r);
+            if (o->nset >= RENDER_OPTS_MAX_SETTINGS) return cli_usage_error("render", "too many options");
+            render_setting *rs = &o->set[o->nset];
+            if (!parse_setting(s, optarg, &rs->value)) return CLI_EXIT_USAGE;
+            rs->renderer = r, rs->setting = s, o->nset++;
+            continue;
+        }
+        int done = parse_named(c, optarg, o);
+        if (done < 0) done = parse_number(c, optarg, o);
+        if (done == 0) return CLI_EXIT_USAGE;
+        if (done < 0) return cli_usage_error("render", "unknown or incomplete option '%s'", argv[optind - 1]);
+    }
+    if (optind < argc) o->scene_path = argv[optind++];
+    if (optind < argc) return cli_usage_error("render", "unexpected argument '%s' (one scene file at most)", argv[optind]);
+    return check_options(o);
+}
+
+/* The sun and the animation's end. */
+static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
+{
+    if (!isnan(o->sun_el) || !isnan(o->sun_az)) {
+        if (s->sun.from_time) {
+            /* Overriding one angle of a sun placed by time keeps the other one it had. */
+            double dir[3], el = 0, az = 0;
+            if (atmos_scene_sun_direction(ctx, s, dir, &el, &az) == ATMOS_OK) s->sun.elevation_deg = el, s->sun.azimuth_deg = az;
+        }
+        s->sun.from_time = 0;
+        if (!isnan(o->sun_el)) s->sun.elevation_deg = o->sun_el;
+        if (!isnan(o->sun_az)) s->sun.azimuth_deg = o->sun_az;
+        s->animation.time_end_set = 0; /* a sun switched to angles drops the end of the old form */
+    }
+    if (o->time) {
+        if (atmos_parse_utc_time(ctx, o->time, &s->sun.time) != ATMOS_OK)
+            return cli_usage_error("render", "--time: %s", atmos_context_error(ctx));
+        s->sun.from_time = 1;
+        s->sun.latitude_deg = o->lat, s->sun.longitude_deg = o->lon;
+        s->animation.elevation_end_set = s->animation.azimuth_end_set = 0;
+    }
+    if (o->frames) s->animation.frames = o->frames;
+    if (o->time_end) {
+        if (atmos_parse_utc_time(ctx, o->time_end, &s->animation.time_end) != ATMOS_OK)
+            return cli_usage_error("render", "--time-end: %s", atmos_context_error(ctx));
+        s->animation.time_end_set = 1;
+    }
+    if (!isnan(o->sun_el_end)) s->animation.elevation_end_deg = o->sun_el_end, s->animation.elevation_end_set = 1;
+    if (!isnan(o->sun_az_end)) s->animation.azimuth_end_deg = o->sun_az_end, s->animation.azimuth_end_set = 1;
+    if ((o->time_end || !isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->animation.frames < 2)
+        return cli_usage_error("render", "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N (N >= 2) "
+                                         "or a scene with an \"animation\"");
+    return CLI_EXIT_OK;
+}
+
+/* The image, camera, wavelengths and exposure. */
+static int apply_view(const render_opts *o, atmos_scene *s)
+{
+    if (o->width) s->width = o->width;
+    if (o->height) s->height = o->height;
+    if (o->png_bits) s->png_bits = o->png_bits;
+    if (o->exr_half) s->exr_half = 1;
+    if (o->cam_type >= 0 && o->cam_type != (int)s->camera.type) {
+        /* A new camera type starts from that type's defaults, keeping the position. */
+        double pos[3] = {s->camera.position[0], s->camera.position[1], s->camera.position[2]};
+        atmos_camera_defaults((atmos_camera_type)o->cam_type, pos, &s->camera);
+    }
+    if (!isnan(o->altitude)) {
+        double dy = o->altitude - s->camera.position[1];
+        s->camera.position[1] = o->altitude;
+        s->camera.look_at[1] += dy; /* keep the view direction */
+    }
+    if (o->spectral) s->wavelengths = ATMOS_WAVELENGTHS_SPECTRAL, s->spectral_samples = o->spectral;
+    if (o->rgb) s->wavelengths = ATMOS_WAVELENGTHS_RGB;
+    if (o->exposure_auto) s->tonemap.manual_exposure = 0;
+    if (!isnan(o->ev)) s->tonemap.manual_exposure = 1, s->tonemap.exposure_ev = o->ev;
+    if (!isnan(o->ev_comp)) {
+        if (s->tonemap.manual_exposure) return cli_usage_error("render", "--exposure-comp applies to automatic exposure only");
+        s->tonemap.exposure_ev = o->ev_comp;
+    }
+    if (o->tone >= 0) s->tonemap.curve = (atmos_tone_curve)o->tone;
+    return CLI_EXIT_OK;
+}
+
+/* The renderer, the volume and the renderers' settings. */
+static int apply_renderer(const render_opts *o, atmos_scene *s)
+{
+    const char *C = "render";
+    if (o->volume) {
+        snprintf(s->volume.source, sizeof s->volume.source, "%s", o->volume);
+        if (s->renderer == ATMOS_RENDERER_SKY) s->renderer = ATMOS_RENDERER_SLICE;
+    }
+    if (o->renderer >= 0) s->renderer = (atmos_renderer_kind)o->renderer;
+    const atmos_renderer_kind r = s->renderer;
+    if (r == ATMOS_RENDERER_SKY && (o->volume || o->density_scale > 0 || o->volume_pos_given || o->tau))
+        return cli_usage_error(C, "--volume, --volume-position, --density-scale and --tau go with a volume renderer, "
+                                  "not --renderer sky");
+    if (r != ATMOS_RENDERER_PATH && (o->variance || o->order))
+        return cli_usage_error(C, "--variance and --order go with --renderer path");
+    for (int i = 0; i < o->nset; i++) {
+        const render_setting *rs = &o->set[i];
+        if (rs->renderer == r) {
+            atmos_scene_setting_set(s, rs->setting, rs->value);
+        } else if (rs->setting->offset == offsetof(atmos_scene, path.spp)) {
+            if (rs->value > 256)
+                return cli_usage_error(C, "--spp: must be in [1, 256] for this renderer (1..1000000 with --renderer path)");
+            s->samples_per_pixel = (int)rs->value;
+        } else {
+            return cli_usage_error(C, "--%s goes with --renderer %s", rs->setting->flag, atmos_renderer_name(rs->renderer));
+        }
+    }
+    if (o->volume_pos_given) s->volume.placed = 1, memcpy(s->volume.position_m, o->volume_pos, sizeof o->volume_pos);
+    if (o->density_scale > 0) s->volume.density_scale = o->density_scale;
+    if (o->tau && !s->volume.source[0]) return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
+    if (!o->scene_path && r == ATMOS_RENDERER_SLICE && !s->volume.source[0])
+        return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
+    return CLI_EXIT_OK;
+}
+
+int render_opts_apply(atmos_context *ctx, const render_opts *o, atmos_scene *scene)
+{
+    int rc = apply_view(o, scene);
+    if (rc == CLI_EXIT_OK) rc = apply_sun(ctx, o, scene);
+    if (rc == CLI_EXIT_OK) rc = apply_renderer(o, scene);
+    return rc;
+}
+
+/* One --help line per settings row: flag, argument, doc, range and default. */
+static void help_settings(atmos_renderer_kind r, const char *title)
+{
+    int n;
+    const atmos_setting *t = atmos_renderer_settings(r, &n);
+    printf("%s (the scene's \"%s\" section; docs/scene-format.md):\n", title, atmos_renderer_name(r));
+    for (int i = 0; i < n; i++) {
+        const atmos_setting *s = &t[i];
+        if (!s->flag) continue;
+        char opt[64], range[96] = "";
+        snprintf(opt, sizeof opt, "--%s%s", s->flag, !takes_value(s) ? "" : s->type == ATMOS_SETTING_REAL ? " X" : " N");
+        if (takes_value(s))
+            snprintf(range, sizeof range, " [%s%g, %g%s%s%s], default %g", s->min_open ? "> " : "", s->min, s->max,
+                     s->max_open ? ")" : "", s->unit[0] ? " " : "", s->unit, s->def);
+        printf("      %-24s %s%s\n", opt, s->doc, range);
+    }
+    printf("\n");
+}
+
+void render_opts_help(void)
+{
+    printf("Usage: atmos render [SCENE.json] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
+           "Renders a scene file, or the built-in default scene when none is given.\n"
+           "With no output option, writes NAME.png in the current directory (NAME = the scene's name).\n\n"
+           "Outputs:\n"
+           "  -o, --output FILE.png   tone-mapped sRGB PNG (8 or 16 bit, see --png-bits)\n"
+           "      --exr FILE.exr      HDR OpenEXR: linear sRGB + alpha, Y in cd/m^2, scene metadata\n"
+           "      --pfm FILE.pfm      HDR portable float map (linear sRGB, 3 channels)\n"
+           "      --png-bits 8|16     PNG bit depth (default: scene, 8)\n"
+           "      --exr-half          write EXR as 16-bit half floats (default: 32-bit float)\n"
+           "      --tau FILE.pfm      also write the volume's optical depth along each pixel's ray\n"
+           "                          (middle wavelength of the set; a key for atmos compare --by)\n"
+           "      --variance FILE.exr path: per-pixel variance of the mean (channels var_<nm>nm per\n"
+           "                          wavelength, then var_Y of the luminance)\n"
+           "      --order FILE.pfm    path: per-pixel mean number of volume scattering events of the light\n"
+           "                          reaching the pixel, weighted by luminance (a key for atmos compare --by)\n\n"
+           "Overrides of the scene's settings:\n"
+           "      --width W --height H      image size in pixels\n"
+           "      --spp N                   samples per pixel (1..256; path tracer: 1..1000000)\n"
+           "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
+           "      --altitude M              camera altitude above sea level, metres\n"
+           "      --sun-elevation E         sun elevation, degrees\n"
+           "      --sun-azimuth A           sun azimuth, degrees clockwise from north\n"
+           "      --time T --lat L --lon L  sun from a UTC time (2026-06-21T12:00:00Z) and a place\n"
+           "      --spectral N              N spectral samples in 380-780 nm (default: the paper's rgb)\n"
+           "      --rgb                     the paper's three channels (680, 550, 440 nm)\n"
+           "      --exposure EV|auto        manual exposure (EV100, daylight ~15) or automatic\n"
+           "      --exposure-comp STOPS     compensation added to automatic exposure\n"
+           "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
+           "      --threads N               worker threads (default: all cores)\n"
+           "      --renderer sky|slice|path the atmosphere alone (default), Riley et al.'s half-angle slicing\n"
+           "                                over a volume (default when a volume is given), or spectral\n"
+           "                                Monte Carlo path tracing (the reference, docs/path.md)\n"
+           "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
+           "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
+           "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
+           "                                (default: 3 widths, at least 4 km, in front of the camera)\n"
+           "      --density-scale S         multiplies the volume's densities\n\n");
+    help_settings(ATMOS_RENDERER_SLICE, "Slice renderer");
+    help_settings(ATMOS_RENDERER_PATH, "Path tracer");
+    printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
+           "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
+           "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
+           "                                out/sky_0001.png ...; --frames 1: the first frame, as named\n"
+           "      --time-end T              the last frame's UTC time (a sun given by time); frames are\n"
+           "                                spaced evenly in time from the scene's (or --time's) time\n"
+           "      --sun-elevation-end E     the last frame's sun elevation (a sun given by angles)\n"
+           "      --sun-azimuth-end A       the last frame's sun azimuth (the shorter way round)\n"
+           "  -q, --quiet                   no progress bar or messages\n"
+           "  -h, --help                    this help\n\n"
+           "Examples:\n"
+           "  atmos render -o sky.png --exr sky.exr\n"
+           "  atmos render scenes/sunset_fisheye.json --spectral 32 -o sunset.png\n"
+           "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n"
+           "  atmos render scenes/fig01_cirrus_sunrise.json --frames 8 --time-end 2026-06-21T12:30:00Z -o out/cirrus.png\n");
+}

@@ -1,0 +1,42 @@
+/* atmos render's options: parsed into render_opts, then applied to the scene. The options of
+ * the renderers' settings are made from the library's settings tables
+ * (atmos_renderer_settings), so they have the scene file's names, ranges and meanings. */
+#ifndef ATMOS_CLI_RENDER_OPTS_H
+#define ATMOS_CLI_RENDER_OPTS_H
+
+#include "cli.h"
+
+#define RENDER_OPTS_MAX_SETTINGS 48
+
+/* A renderer setting given on the command line. */
+typedef struct {
+    atmos_renderer_kind renderer;
+    const atmos_setting *setting;
+    double value;
+} render_setting;
+
+typedef struct {
+    const char *scene_path;
+    /* outputs */
+    const char *png, *exr, *pfm, *variance, *order, *tau;
+    int png_bits, exr_half;
+    /* scene overrides (0 / NaN / NULL / -1: not given) */
+    int width, height, spp, spectral, rgb, cam_type, renderer, tone, exposure_auto, frames;
+    double altitude, sun_el, sun_az, lat, lon, ev, ev_comp, sun_el_end, sun_az_end, density_scale;
+    const char *time, *time_end, *volume;
+    double volume_pos[3];
+    int volume_pos_given;
+    render_setting set[RENDER_OPTS_MAX_SETTINGS];
+    int nset;
+    /* the run */
+    int threads, quiet;
+} render_opts;
+
+/* Parses argv; returns CLI_EXIT_OK, CLI_EXIT_USAGE (message printed) or -1 after --help. */
+int render_opts_parse(int argc, char **argv, render_opts *o);
+void render_opts_help(void);
+/* Applies the options to a scene (loaded or the default); returns CLI_EXIT_OK or
+ * CLI_EXIT_USAGE (message printed). ctx receives time-parsing errors. */
+int render_opts_apply(atmos_context *ctx, const render_opts *o, atmos_scene *scene);
+
+#endif
