@@ -1,0 +1,112 @@
+/* The renderers' settings tables (atmos_renderer_settings) are the one description of every
+ * setting: the scene's defaults are the rows' defaults, the parser accepts each row's range
+ * and refuses beyond it naming the key, the validator says the same of a scene set in code,
+ * and atmos render has each row's option (it sets the value the parser would) and lists it
+ * in --help. */
+#define _GNU_SOURCE /* memmem */
+#include "atmos/atmos.h"
+#include "test.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* A scene file with one setting of a renderer's section set to the text value. */
+static atmos_status parse_one(atmos_context *ctx, atmos_renderer_kind r, const char *key, const char *value,
+                              atmos_scene *s)
+{
+    char json[512];
+    snprintf(json, sizeof json, "{\"%s\": {\"%s\": %s}}", atmos_renderer_name(r), key, value);
+    atmos_scene_defaults(s);
+    return atmos_scene_parse(ctx, json, strlen(json), "t.json", s);
+}
+
+static void fmt(char *buf, size_t cap, double v) { snprintf(buf, cap, "%.17g", v); }
+
+static void check_row(atmos_context *ctx, atmos_renderer_kind r, const atmos_setting *st)
+{
+    atmos_scene d, s;
+    atmos_scene_defaults(&d);
+    char path[96], v[64];
+    snprintf(path, sizeof path, "/%s/%s", atmos_renderer_name(r), st->key);
+    CHECK_MSG(atmos_scene_setting_get(&d, st) == st->def, "%s: the scene's default %g is not the row's %g", path,
+              atmos_scene_setting_get(&d, st), st->def);
+    if (st->type == ATMOS_SETTING_BOOL) {
+        CHECK_OK(parse_one(ctx, r, st->key, st->def ? "false" : "true", &s));
+        CHECK(atmos_scene_setting_get(&s, st) == !st->def);
+        CHECK(parse_one(ctx, r, st->key, "1", &s) == ATMOS_E_INVALID_ARG);
+        return;
+    }
+    if (st->type == ATMOS_SETTING_CHOICE) {
+        for (int i = 0; st->choices[i]; i++) {
+            snprintf(v, sizeof v, "\"%s\"", st->choices[i]);
+            CHECK_OK(parse_one(ctx, r, st->key, v, &s));
+            CHECK(atmos_scene_setting_get(&s, st) == i);
+        }
+        CHECK(parse_one(ctx, r, st->key, "\"nope\"", &s) == ATMOS_E_INVALID_ARG);
+        return;
+    }
+    /* the ends of the range (an open end: just inside), then just beyond each */
+    const double span = st->max - st->min, eps = st->type == ATMOS_SETTING_REAL ? 1e-6 * span : 1;
+    const double ends[2] = {st->min_open ? st->min + eps : st->min, st->max_open ? st->max - eps : st->max};
+    for (int e = 0; e < 2; e++) {
+        fmt(v, sizeof v, ends[e]);
+        CHECK_MSG(parse_one(ctx, r, st->key, v, &s) == ATMOS_OK, "%s = %s refused: %s", path, v, atmos_context_error(ctx));
+        CHECK(atmos_scene_setting_get(&s, st) == ends[e]);
+        CHECK_OK(atmos_scene_validate(ctx, &s, "code"));
+        if (st->type == ATMOS_SETTING_SEED) { /* a uint64_t: only a negative number can be out of range */
+            CHECK(parse_one(ctx, r, st->key, "-1", &s) == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), path));
+            continue;
+        }
+        const double beyond = e ? st->max + eps : st->min - eps;
+        fmt(v, sizeof v, st->min_open && !e ? st->min : (st->max_open && e ? st->max : beyond));
+        CHECK_MSG(parse_one(ctx, r, st->key, v, &s) == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), path),
+                  "%s = %s accepted or unnamed (%s)", path, v, atmos_context_error(ctx));
+        atmos_scene_defaults(&s);
+        atmos_scene_setting_set(&s, st, st->min_open && !e ? st->min : (st->max_open && e ? st->max : beyond));
+        CHECK_MSG(atmos_scene_validate(ctx, &s, "code") == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), path),
+                  "%s: the validator accepted %s", path, v);
+    }
+}
+
+/* atmos render's --help names every option of the tables. */
+static void check_help(void)
+{
+    const char *cli = getenv("ATMOS_CLI");
+    if (!cli || !*cli) return;
+    char out[4200], cmd[9000];
+    test_tmp_path(out, sizeof out, "render_help.txt");
+    snprintf(cmd, sizeof cmd, "'%s' render --help > '%s'", cli, out);
+    CHECK(system(cmd) == 0);
+    size_t n = 0;
+    char *text = (char *)test_slurp(out, &n);
+    for (int r = ATMOS_RENDERER_SLICE; text && r <= ATMOS_RENDERER_PATH; r++) {
+        int count;
+        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &count);
+        for (int i = 0; i < count; i++) {
+            char opt[80];
+            snprintf(opt, sizeof opt, "--%s", t[i].flag);
+            CHECK_MSG(t[i].flag && memmem(text, n, opt, strlen(opt)) && memmem(text, n, t[i].doc, strlen(t[i].doc)),
+                      "render --help lacks %s or its doc", opt);
+        }
+    }
+    free(text);
+}
+
+int main(void)
+{
+    atmos_context *ctx = NULL;
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    int total = 0;
+    for (int r = ATMOS_RENDERER_SKY; r <= ATMOS_RENDERER_PATH; r++) {
+        int n = -1;
+        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
+        CHECK(r == ATMOS_RENDERER_SKY ? (!t && n == 0) : (t && n > 0));
+        for (int i = 0; i < n; i++) check_row(ctx, (atmos_renderer_kind)r, &t[i]);
+        total += n;
+    }
+    printf("%d settings checked\n", total);
+    CHECK(atmos_renderer_name((atmos_renderer_kind)9) == NULL);
+    check_help();
+    atmos_context_destroy(ctx);
+    return test_summary("test_settings");
+}
