@@ -127,6 +127,13 @@ double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const doubl
     return y / -dir[1];
 }
 
+void atmos__atm_ground_hit(const atmos_atmosphere *a, double p[3], double n[3])
+{
+    (void)a; /* every kind here has the flat ground y = 0 */
+    p[1] = 0;
+    n[0] = 0, n[1] = 1, n[2] = 0;
+}
+
 int atmos_atmosphere_sun_disk_visible(const atmos_atmosphere *atm, const double sun_dir[3])
 {
     return atm->desc.kind != ATMOS_ATMOSPHERE_VACUUM && !atm->desc.hide_sun_disk && sun_dir[1] > 0;

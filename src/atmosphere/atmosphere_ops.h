@@ -30,6 +30,10 @@ int atmos__atm_inscatter_sub(const atmos_atmosphere *a, const double p[3], const
 int atmos__atm_scatter_point(const atmos_atmosphere *a, const double p[3], const double d[3], double dist, int m,
                              const int *k, const double *w, atmos__stream *rng, double *t, double *ratio);
 
+/* A point that has reached the ground moved onto it exactly (a flat earth: y = 0), and the
+ * ground's outward normal there. */
+void atmos__atm_ground_hit(const atmos_atmosphere *a, double p[3], double n[3]);
+
 /* The extraterrestrial solar irradiance per wavelength of the set (W m^-2 nm^-1) and the
  * cosine of the sun's angular radius. */
 const double *atmos__atm_sun_irradiance(const atmos_atmosphere *a);

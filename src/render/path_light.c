@@ -1,0 +1,281 @@
+/* The light a path tracer's path gathers besides what it finds by itself (path_trace.h):
+ * the sun and the air seen through the volume and the atmosphere, the air's single
+ * scattering along a segment with the volume's shadows on it, next-event estimation of the
+ * sun and the sky, the aureole estimate in droplet clouds, forced single scattering. */
+#include "atmosphere/atmosphere_ops.h"
+#include "core/vec.h"
+#include "render/path_trace.h"
+
+#include <string.h>
+
+/* Majorant optical depth of a camera ray's crossing of the box up to which it uses forced
+ * single scattering. */
+#define FORCED_TAU_MAX 2.0
+
+/* Sunlight (W m^-2 nm^-1 on a surface facing the sun) at p for the carried wavelengths. */
+void atmos__path_sunlight(const path_run *R, const double p[3], double *E)
+{
+    atmos__atm_sunlight_sub(R->J->atm, p, R->J->sun, R->b->m, R->b->k, E);
+}
+
+/* The air's transmittance over p + t d, t in [0, K], multiplied into w. */
+void atmos__path_air_transmit(const path_run *R, const double p[3], const double d[3], double K, double *w)
+{
+    if (!(K > 0)) return;
+    double T[PATH_B];
+    atmos__atm_transmittance_sub(R->J->atm, p, d, K, R->b->m, R->b->k, T);
+    for (int i = 0; i < R->b->m; i++) w[i] *= T[i];
+}
+
+/* Volume transmittance from world point p along unit d (to the box's far side). */
+void atmos__path_shadow(const path_run *R, const double p[3], const double d[3], double *T)
+{
+    for (int i = 0; i < R->b->m; i++) T[i] = 1;
+    if (!R->J->med) return;
+    double q[3], qd[3], t0, t1;
+    atmos__path_to_index(R->J->med, p, d, q, qd);
+    if (!atmos__path_clip(R->J->med, q, qd, INFINITY, &t0, &t1)) return;
+    R->cnt->shadow++;
+    atmos__path_transmittance(R->J->med, q, qd, t0, t1, R->b, R->r, T);
+}
+
+/* A direction in the sun's cone, uniformly (pdf 1 / sun_omega). */
+void atmos__path_sample_sun(const path_run *R, double d[3])
+{
+    double mu = 1.0 - atmos__stream_u(R->r) * (1.0 - R->J->cos_sun);
+    atmos__path_around(R->J->sun, mu, 2.0 * ATMOS_PI * atmos__stream_u(R->r), d);
+}
+
+/* Does the sun (sunlight E) light anything the weights w carry? */
+int atmos__path_sun_lit(const path_run *R, const double *w, const double *E)
+{
+    int lit = 0;
+    for (int i = 0; i < R->b->m; i++) lit |= w[i] * E[i] > 0;
+    return lit && R->J->sun_omega > 0;
+}
+
+/* Balance heuristic between the two ways a path finds the sun's disk from a scattering
+ * event: next-event estimation (pdf 1 / sun_omega over the cone) and the phase-sampled
+ * continuation (pdf q p_dir: survival probability of the roulette times the direction
+ * sampler's density). Returns the weight of next-event estimation; the continuation
+ * gets 1 minus it. */
+double atmos__path_mis_nee(const path_job *J, double q_pdir)
+{
+    const double pl = 1.0 / J->sun_omega;
+    return q_pdir > 0 ? pl / (pl + q_pdir) : 1.0;
+}
+
+/* The air's single scattering of sunlight along p + t d, t in [0, K], added to L (times
+ * w[i] wt): the atmosphere's in-scatter (exact for the closed-form kinds), minus the part
+ * the volume takes away. That part, the integral of the in-scatter f(t) (1 - T_view(t)
+ * T_sun(t)) with T_view the volume's transmittance from p to p + t d (view: the segment is
+ * inside the box; else 1) and T_sun the volume's transmittance from there toward the sun, is
+ * estimated with one point the atmosphere draws in proportion to the air's scattering times
+ * its transmittance (of the carried wavelength that scatters least, so that the others'
+ * ratios stay bounded): shadows of the volume on the air, the light shafts, cost a shadow
+ * ray only where the point's way to the sun crosses the box, and light that nothing
+ * shadows is the analytic value without noise. A sample can therefore be negative in a
+ * shadow; its mean is not. */
+void atmos__path_air_scatter(const path_run *R, const double p[3], const double d[3], double K, const double *w,
+                             double wt, int order, const air_view *view)
+{
+    const path_job *J = R->J;
+    const path_bundle *b = R->b;
+    if (!(K > 0) || !(wt > 0)) return;
+    double f[PATH_B];
+    if (!atmos__atm_inscatter_sub(J->atm, p, d, K, J->sun, b->m, b->k, f)) return;
+    for (int i = 0; i < b->m; i++) {
+        if (w[i] == 0) continue;
+        atmos__path_add(R, i, w[i] * wt * f[i], order);
+    }
+    double ta, ratio[PATH_B];
+    if (!J->med || !atmos__atm_scatter_point(J->atm, p, d, K, b->m, b->k, w, R->r, &ta, ratio)) return;
+    const double pa[3] = {p[0] + ta * d[0], p[1] + ta * d[1], p[2] + ta * d[2]};
+    double Ts[PATH_B], Tv[PATH_B], E[PATH_B];
+    atmos__path_shadow(R, pa, J->sun, Ts);
+    int any = 0, lit = 0;
+    for (int i = 0; i < b->m; i++) any |= Ts[i] < 1, lit |= Ts[i] > 0;
+    if (!any && !view) return; /* nothing in the way to the sun: the analytic value holds */
+    for (int i = 0; i < b->m; i++) Tv[i] = 1;
+    if (view && lit) atmos__path_transmittance(J->med, view->q, view->qd, view->t0, view->t0 + ta, b, R->r, Tv);
+    atmos__path_sunlight(R, pa, E);
+    const double P = atmos_atmosphere_phase(J->atm, pa, atmos__dot3(d, J->sun));
+    for (int i = 0; i < b->m; i++) {
+        const double occl = 1.0 - Tv[i] * Ts[i];
+        if (w[i] == 0 || occl == 0) continue;
+        const double c = w[i] * wt * P * E[i] * ratio[i] * occl;
+        R->L[i] -= c, R->Lo[i] -= order * c;
+    }
+}
+
+/* Next-event estimation at a scattering point p of the volume reached along d with weights
+ * w (the path's throughput times the scattering coefficient over the density of the point
+ * sampled, as after a free flight): the sun's disk (E: its light there, NULL when it does
+ * not light the point), a direction drawn uniformly in its cone, the volume's
+ * transmittance to it by ratio tracking; and the sky (J->env), a direction drawn from the
+ * sky's table, the volume's and the air's transmittance to the box's far side, then the
+ * air's light beyond it. Each is weighted against the phase-sampled continuation by the
+ * balance heuristic, whose density there is q (its survival probability) times the
+ * strategies' mean density; the sun's part is further weighted by hs, the share of the
+ * path's own strategies against the aureole estimate made at the previous event. */
+static void nee_sun(const path_run *R, const path_event *ev, const double *E, double hs)
+{
+    const path_job *J = R->J;
+    const int m = R->b->m;
+    const double *w = ev->w;
+    double pk[PATH_B], T[PATH_B], ds[3];
+    atmos__path_sample_sun(R, ds);
+    atmos__path_phase_mix(J->ph, R->b, J->med->nf, ev->e, atmos__dot3(ev->d, ds), pk);
+    const double pdir = atmos__path_strategies(m, ev->S, ev->g, pk, NULL);
+    int any = 0;
+    for (int i = 0; i < m; i++) any |= w[i] * pk[i] * E[i] > 0;
+    if (!any) return;
+    const double wm = atmos__path_mis_nee(J, ev->q * pdir) * hs;
+    atmos__path_shadow(R, ev->p, ds, T);
+    for (int i = 0; i < m; i++) atmos__path_add(R, i, w[i] * pk[i] * E[i] * T[i] * wm, ev->order);
+}
+
+void atmos__path_nee(const path_run *R, const path_event *ev, const double *E, double hs)
+{
+    const path_job *J = R->J;
+    const path_bundle *b = R->b;
+    const int m = b->m;
+    const double *w = ev->w, *p = ev->p;
+    double pk[PATH_B], T[PATH_B];
+    if (E) nee_sun(R, ev, E, hs);
+    if (J->env) { /* the sky (J->env exists only where the sky has light) */
+        double de[3];
+        const double pe = atmos__path_env_sample(J->env, atmos__stream_u(R->r), atmos__stream_u(R->r),
+                                                 atmos__stream_u(R->r), de);
+        atmos__path_phase_mix(J->ph, b, J->med->nf, ev->e, atmos__dot3(ev->d, de), pk);
+        const double pdir = atmos__path_strategies(m, ev->S, ev->g, pk, NULL);
+        int any = 0;
+        for (int i = 0; i < m; i++) any |= w[i] * pk[i] > 0;
+        if (!any || !(pe > 0)) return;
+        const double wm = pe / (pe + ev->q * pdir);
+        const double Kd = atmos_atmosphere_ground_distance(J->atm, p, de);
+        double q2[3], qd2[3], a0, a1, ex = 0, c[PATH_B];
+        for (int i = 0; i < m; i++) T[i] = 1;
+        atmos__path_to_index(J->med, p, de, q2, qd2);
+        if (atmos__path_clip(J->med, q2, qd2, Kd, &a0, &a1)) {
+            R->cnt->shadow++;
+            atmos__path_transmittance(J->med, q2, qd2, a0, a1, b, R->r, T);
+            ex = a1;
+        }
+        int on = 0;
+        for (int i = 0; i < m; i++) {
+            c[i] = w[i] * pk[i] * T[i] / pe * wm;
+            on |= c[i] > 0;
+        }
+        if (on && ex < Kd) {
+            atmos__path_air_transmit(R, p, de, ex, c);
+            const double px[3] = {p[0] + ex * de[0], p[1] + ex * de[1], p[2] + ex * de[2]};
+            atmos__path_air_scatter(R, px, de, Kd - ex, c, 1.0, ev->order, NULL);
+        }
+    }
+}
+
+/* The sun's aureole (docs/path.md, "Fireflies of droplet clouds"). Next-event estimation
+ * at an event x' evaluates the phase function at the angle between the path's direction
+ * and the sun: inside the forward peak (400-900 sr^-1 for cloud droplets against ~0.05
+ * sideways) a path that happens to head within ~2 degrees of the sun collects thousands
+ * of times the usual sunlight, and the continuation draws such directions rarely. So from
+ * each lit event x (incoming direction d) one more estimate of the light (x, x', sun):
+ * a direction a from the phase function of a carried scattering wavelength chosen
+ * uniformly, centred on the sun instead of on d (density pa(a) = the mean over those
+ * wavelengths of p_k(sun . a)), x' by the free flight the path itself would take along a,
+ * at x' next-event estimation of the sun (the whole disk: it stands for both of the path's
+ * ways there). The path reaches the same x' with density q p_dir(a) and counts the sun at
+ * x' times h = q p_dir / (q p_dir + pa) (trace: hprev); this estimate has 1 - h, i.e. the
+ * weight w_k p_k(d . a) / (q p_dir(a) + pa(a)): the balance heuristic between the two.
+ * Used where some phase function has a forward peak (J->aureole). */
+void atmos__path_aureole(const path_run *R, const path_event *ev)
+{
+    const path_job *J = R->J;
+    const path_bundle *b = R->b;
+    const path_scatter *e = ev->e;
+    const double *p = ev->p, *w = ev->w;
+    atmos__stream *r = R->r;
+    const path_medium *M = J->med;
+    const path_phase *P = J->ph;
+    const int m = b->m, nf = M->nf;
+    int elig[PATH_B], ne = 0;
+    for (int i = 0; i < m; i++)
+        if (e->ss[i] > 0) elig[ne++] = i;
+    if (!ne) return;
+    const int j = elig[ne > 1 ? (int)(atmos__stream_u(r) * ne) % ne : 0], f = atmos__path_pick_field(e, j, nf, r);
+    double a[3], pk[PATH_B], wa[PATH_B];
+    atmos__path_around(J->sun, atmos__path_phase_sample(P, f, b->k[j], atmos__stream_u(r)),
+                       2.0 * ATMOS_PI * atmos__stream_u(r), a);
+    atmos__path_phase_mix(P, b, nf, e, atmos__dot3(ev->d, a), pk);
+    const double den = ev->q * atmos__path_strategies(m, ev->S, ev->g, pk, NULL) + atmos__path_aureole_pdf(J, b, e, a);
+    if (!(den > 0)) return;
+    int any = 0;
+    for (int i = 0; i < m; i++) any |= (wa[i] = w[i] * pk[i] / den) > 0;
+    if (!any) return;
+    /* x': the free flight of the path's own continuation (its probabilities do not depend
+     * on the weights' common scale), with the air's transmittance on the way */
+    double qi[3], qd[3], t0, t1, t;
+    const double K = atmos_atmosphere_ground_distance(J->atm, p, a);
+    atmos__path_to_index(M, p, a, qi, qd);
+    if (!atmos__path_clip(M, qi, qd, K, &t0, &t1)) return;
+    float dens[PATH_F];
+    if (atmos__path_free_flight(M, qi, qd, t0, t1, b, wa, r, &t, dens, &R->cnt->tentative) <= 0) return;
+    atmos__path_air_transmit(R, p, a, t, wa);
+    path_scatter e2;
+    int g2[PATH_B];
+    if (!atmos__path_scatter_at(J, b, dens, &e2, g2)) return;
+    double E[PATH_B], S2[PATH_B];
+    for (int i = 0; i < m; i++) S2[i] = 1;
+    /* the whole disk by next-event estimation (q = 0: no continuation shares it) */
+    path_event at = {{p[0] + t * a[0], p[1] + t * a[1], p[2] + t * a[2]}, {a[0], a[1], a[2]}, wa, &e2, S2, g2, 0.0,
+                     ev->order + 1};
+    atmos__path_sunlight(R, at.p, E);
+    nee_sun(R, &at, E, 1.0);
+}
+
+/* Forced single scattering on a camera ray's crossing [t0, t1] of the volume's box (index
+ * space q + t qd, world p + t d): one point drawn by the majorant (half the time as the
+ * first tentative collision forced into the crossing, half uniformly in its optical
+ * depth: atmos__path_majorant_point), where the
+ * lights are estimated with weights w sigma_s T_view / pdf (T_view by ratio tracking). It
+ * replaces next-event estimation at the first free-flight event of camera paths, so in thin
+ * media every camera ray that crosses the volume estimates its single scattering, instead
+ * of the few that happen to collide. Only on crossings whose majorant optical depth is at
+ * most FORCED_TAU_MAX (a function of the ray, so each ray keeps one consistent estimator):
+ * in dense media the free flight's collisions, drawn in proportion to sigma T, are better.
+ * Returns 1 if it made the estimate (the first event's next-event estimates are then
+ * left out). */
+int atmos__path_forced_single(const path_run *R, const double p[3], const double d[3], const double q[3],
+                              const double qd[3], double t0, double t1, const double *w)
+{
+    const path_job *J = R->J;
+    const path_bundle *b = R->b;
+    double t, pdf;
+    const double u0 = atmos__stream_u(R->r), u1 = atmos__stream_u(R->r);
+    if (!atmos__path_majorant_point(J->med, q, qd, t0, t1, b, FORCED_TAU_MAX, u0, u1, &t, &pdf)) return 0;
+    float dens[PATH_F];
+    atmos__path_density(J->med, q[0] + t * qd[0], q[1] + t * qd[1], q[2] + t * qd[2], dens);
+    path_scatter e;
+    int g[PATH_B];
+    if (!atmos__path_scatter_at(J, b, dens, &e, g)) return 1;
+    const int m = b->m;
+    double T[PATH_B], c[PATH_B], S[PATH_B], E[PATH_B];
+    atmos__path_transmittance(J->med, q, qd, t0, t, b, R->r, T);
+    int any = 0;
+    for (int i = 0; i < m; i++) {
+        S[i] = 1;
+        c[i] = w[i] * T[i] * e.ss[i] / pdf;
+        any |= c[i] > 0;
+    }
+    if (!any) return 1;
+    const double x0[3] = {p[0] + t0 * d[0], p[1] + t0 * d[1], p[2] + t0 * d[2]};
+    atmos__path_air_transmit(R, x0, d, t - t0, c);
+    /* the continuation's share: as if the roulette always let it go on (the first event's
+     * continuations use that too), unless no path goes on after one event */
+    const path_event ev = {{p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]}, {d[0], d[1], d[2]}, c, &e, S, g,
+                           J->max_depth == 1 ? 0.0 : 1.0, 1};
+    atmos__path_sunlight(R, ev.p, E);
+    atmos__path_nee(R, &ev, atmos__path_sun_lit(R, c, E) ? E : NULL, 1.0);
+    return 1;
+}
