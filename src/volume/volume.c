@@ -378,10 +378,16 @@ const char *atmos_volume_field_particle(const atmos_volume *vol, int field)
     return vol && field >= 0 && field < vol->nfields ? vol->field[field].particle : NULL;
 }
 
-atmos_status atmos_volume_field_stats_get(const atmos_volume *vol, int field, atmos_volume_field_stats *out)
+atmos_status atmos_volume_field_stats_get(atmos_context *ctx, const atmos_volume *vol, int field,
+                                          atmos_volume_field_stats *out)
 {
-    if (!vol || !out || field < 0 || field >= vol->nfields) return ATMOS_E_INVALID_ARG;
-    if (!vol->finalized) return ATMOS_E_INVALID_ARG;
+    if (!vol || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field stats: %s is NULL", vol ? "out" : "vol");
+    if (field < 0 || field >= vol->nfields)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field stats: field index %d out of range (0..%d)", field,
+                            vol->nfields - 1);
+    if (!vol->finalized)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field stats of '%s': the volume is not finalized",
+                            vol->field[field].name);
     *out = vol->field[field].stats;
     return ATMOS_OK;
 }
