@@ -47,7 +47,7 @@ ATMOS_API atmos_status atmos_volume_set(atmos_context *ctx, atmos_volume *vol, i
  * a message naming the first bad index. Before finalize only. */
 ATMOS_API atmos_status atmos_volume_set_dense(atmos_context *ctx, atmos_volume *vol, int field, const int offset[3],
                                               const int size[3], const float *values, float scale);
-/* Builds the majorant grid and statistics; the volume becomes read-only. */
+/* Builds the per-brick bounds (majorants) and statistics; the volume becomes read-only. */
 ATMOS_API atmos_status atmos_volume_finalize(atmos_context *ctx, atmos_volume *vol);
 
 ATMOS_API const atmos_volume_desc *atmos_volume_get_desc(const atmos_volume *vol);
