@@ -42,7 +42,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (!vol) fail("no volume on success", NULL);
         for (int f = 0; f < atmos_volume_field_count(vol); f++) {
             atmos_volume_field_stats s;
-            if (atmos_volume_field_stats_get(vol, f, &s) != ATMOS_OK) fail("stats failed", NULL);
+            if (atmos_volume_field_stats_get(ctx, vol, f, &s) != ATMOS_OK) fail("stats failed", NULL);
             if (!isfinite(s.min) || !isfinite(s.max) || s.min < 0 || s.max < s.min) fail("bad statistics", NULL);
         }
     }

@@ -70,7 +70,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (!vol) fail("no volume on success", NULL);
         for (int i = 0; i < atmos_volume_field_count(vol); i++) {
             atmos_volume_field_stats s;
-            if (atmos_volume_field_stats_get(vol, i, &s) != ATMOS_OK) fail("stats failed", NULL);
+            if (atmos_volume_field_stats_get(ctx, vol, i, &s) != ATMOS_OK) fail("stats failed", NULL);
             if (!isfinite(s.min) || !isfinite(s.max) || s.min < 0 || s.max < s.min) fail("bad statistics", NULL);
         }
     }

@@ -47,7 +47,7 @@ ATMOS_API atmos_status atmos_volume_set(atmos_context *ctx, atmos_volume *vol, i
  * a message naming the first bad index. Before finalize only. */
 ATMOS_API atmos_status atmos_volume_set_dense(atmos_context *ctx, atmos_volume *vol, int field, const int offset[3],
                                               const int size[3], const float *values, float scale);
-/* Builds the majorant grid and statistics; the volume becomes read-only. */
+/* Builds the per-brick bounds (majorants) and statistics; the volume becomes read-only. */
 ATMOS_API atmos_status atmos_volume_finalize(atmos_context *ctx, atmos_volume *vol);
 
 ATMOS_API const atmos_volume_desc *atmos_volume_get_desc(const atmos_volume *vol);
@@ -63,7 +63,10 @@ typedef struct atmos_volume_field_stats {
     double min, max;          /* over active voxels (0, 0 if none) */
     double bounds_m[2][3];    /* world-space AABB of the active voxels */
 } atmos_volume_field_stats;
-ATMOS_API atmos_status atmos_volume_field_stats_get(const atmos_volume *vol, int field, atmos_volume_field_stats *out);
+/* Statistics of a field of a finalized volume; a bad argument or a volume that is not
+ * finalized gives ATMOS_E_INVALID_ARG with a message in ctx. */
+ATMOS_API atmos_status atmos_volume_field_stats_get(atmos_context *ctx, const atmos_volume *vol, int field,
+                                                    atmos_volume_field_stats *out);
 /* Bytes held (bricks, majorant grid, bookkeeping). */
 ATMOS_API uint64_t atmos_volume_memory(const atmos_volume *vol);
 /* World-space AABB of the whole grid. */

@@ -1,57 +1,52 @@
-/* The volume as a participating medium for the path tracer: a per-cell (one cell per
- * 8^3 brick of the volume) minorant and majorant of every field's interpolated density,
- * traversed by a 3D DDA; free flights by delta tracking with spectral-tracking weights;
- * transmittance by residual ratio tracking.
+/* The volume as a participating medium for the path tracer: free flights by delta
+ * tracking with spectral-tracking weights, transmittance by residual ratio tracking and
+ * forced points, all over the bricks of the volume walked by the accessor's DDA
+ * (volume/volume_access.h: Amanatides & Woo 1987) against each brick's bounds of the
+ * interpolated density, which the volume built at finalize (volume/volume_range.c).
+ *
+ * This file adds the optics: cross-sections per field and wavelength, their truncation,
+ * and per brick the majorant (and minorant) of the extinction of the carried
+ * wavelengths, sum_f max_f sigma_f,k (sum_f min_f sigma_f,k).
  *
  * Everything runs in the grid's index space (voxel (i,j,k) covers [i, i+1)...), with the
  * ray parameter t in metres along the unit world direction, so extinction coefficients
- * stay in m^-1. The density is the volume's own trilinear interpolant (volume_sample.c's
- * convention: voxel centres at i + 0.5, indices clamped at the faces, zero outside),
- * evaluated here in single precision.
- *
- * Bounds: the interpolant inside cell c is a convex combination of the voxels whose index
- * is in [8c - 1, 8c + 8] (clamped to the grid), so their minimum and maximum bound it
- * everywhere in the cell. The majorant of the extinction at wavelength k is
- * sum_f max_f sigma_f,k, the minorant (control) sum_f min_f sigma_f,k.
+ * stay in m^-1. The density is the volume's trilinear interpolant evaluated in single
+ * precision (the accessor's float sampler) times the density scale.
  */
 #include "render/path_internal.h"
 
-#include <stdlib.h>
+#include <stddef.h>
 #include <string.h>
+
+/* The volume's bounds hold for the exact interpolant; scaled and rounded outwards by a
+ * relative 1e-5 in single precision they also hold for atmos__path_density's float
+ * arithmetic. Computed per brick visit, in this order, so that the bounds (and with
+ * them every free flight) are exactly those of a grid scaled at build time. */
+#define BOUND_UP 1.00001f
+#define BOUND_DN 0.99999f
+
+/* path_medium.h's union: the named fields are the transform's. */
+_Static_assert(offsetof(path_medium, org) == offsetof(path_medium, x.org) &&
+                   offsetof(path_medium, R) == offsetof(path_medium, x.R) &&
+                   offsetof(path_medium, inv_vs) == offsetof(path_medium, x.inv_vs),
+               "path_medium: org, R, inv_vs must alias the transform");
 
 void atmos__path_medium_free(path_medium *m)
 {
     if (!m) return;
-    free(m->mm);
     memset(m, 0, sizeof *m);
-}
-
-static float voxel_or_zero(const atmos_volume *v, const vol_field *fl, int i, int j, int k)
-{
-    if (i < 0) i = 0;
-    if (j < 0) j = 0;
-    if (k < 0) k = 0;
-    if (i > v->desc.dims[0] - 1) i = v->desc.dims[0] - 1;
-    if (j > v->desc.dims[1] - 1) j = v->desc.dims[1] - 1;
-    if (k > v->desc.dims[2] - 1) k = v->desc.dims[2] - 1;
-    return vol_voxel(v, fl, i, j, k);
 }
 
 atmos_status atmos__path_medium_build(atmos_context *ctx, const atmos_volume *v, double scale, const double offset[3],
                                       const atmos_volume_optics *o, int nwl, path_medium *m)
 {
+    (void)ctx;
     memset(m, 0, sizeof *m);
     m->v = v;
     m->nf = v->nfields;
     m->scale = (float)scale;
     m->empty = 1;
-    for (int a = 0; a < 3; a++) {
-        m->n[a] = v->desc.dims[a];
-        m->nb[a] = v->nb[a];
-        m->org[a] = v->desc.origin_m[a] + offset[a];
-    }
-    memcpy(m->R, v->desc.rotation, sizeof m->R);
-    m->inv_vs = 1.0 / v->desc.voxel_size_m;
+    atmos__vol_xform_init(v, offset, &m->x);
     for (int f = 0; f < m->nf; f++)
         for (int k = 0; k < nwl; k++) {
             double se, ss;
@@ -59,52 +54,13 @@ atmos_status atmos__path_medium_build(atmos_context *ctx, const atmos_volume *v,
             m->sig[f][k] = (float)se;
             m->sca[f][k] = (float)ss;
         }
-    const uint64_t nc = v->nbricks;
-    m->mm = calloc((size_t)nc * m->nf * 2, sizeof(float));
-    if (!m->mm) return atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the majorant grid");
-    int clo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, chi[3] = {-1, -1, -1};
-    /* Majorants rounded up (and minorants down) by a relative 1e-5 so that the
-     * single-precision interpolant never leaves [min, max]. */
-    const float up = 1.00001f, dn = 0.99999f;
-    for (int cz = 0; cz < m->nb[2]; cz++)
-        for (int cy = 0; cy < m->nb[1]; cy++)
-            for (int cx = 0; cx < m->nb[0]; cx++) {
-                uint64_t c = ((uint64_t)cz * m->nb[1] + cy) * m->nb[0] + cx;
-                int any = 0;
-                for (int f = 0; f < m->nf; f++) {
-                    const vol_field *fl = &v->field[f];
-                    float mx = fl->majorant ? fl->majorant[c] : 0.0f;
-                    float mn = 0.0f;
-                    if (mx > 0) {
-                        /* minimum over the voxels the cell's interpolant reads; stops at 0 */
-                        mn = INFINITY;
-                        for (int k = cz * VOL_BRICK - 1; k <= cz * VOL_BRICK + VOL_BRICK && mn > 0; k++)
-                            for (int j = cy * VOL_BRICK - 1; j <= cy * VOL_BRICK + VOL_BRICK && mn > 0; j++)
-                                for (int i = cx * VOL_BRICK - 1; i <= cx * VOL_BRICK + VOL_BRICK; i++) {
-                                    float val = voxel_or_zero(v, fl, i, j, k);
-                                    if (val < mn) mn = val;
-                                    if (!(mn > 0)) break;
-                                }
-                        if (!(mn > 0)) mn = 0;
-                        any = 1;
-                    }
-                    m->mm[(c * m->nf + f) * 2] = mn * m->scale * dn;
-                    m->mm[(c * m->nf + f) * 2 + 1] = mx * m->scale * up;
-                }
-                if (any) {
-                    int cc[3] = {cx, cy, cz};
-                    for (int a = 0; a < 3; a++) {
-                        if (cc[a] < clo[a]) clo[a] = cc[a];
-                        if (cc[a] > chi[a]) chi[a] = cc[a];
-                    }
-                }
-            }
-    if (chi[0] >= 0 && scale > 0) {
+    int clo[3], chi[3];
+    if (atmos__vol_range_box(v, clo, chi) && scale > 0) {
         m->empty = 0;
         for (int a = 0; a < 3; a++) {
             m->box_lo[a] = (double)clo[a] * VOL_BRICK;
             double hi = (double)(chi[a] + 1) * VOL_BRICK;
-            m->box_hi[a] = hi < m->n[a] ? hi : m->n[a];
+            m->box_hi[a] = hi < v->desc.dims[a] ? hi : v->desc.dims[a];
         }
     }
     return ATMOS_OK;
@@ -124,12 +80,8 @@ void atmos__path_medium_truncate(path_medium *m, int nwl, const float trunc[][AT
 
 void atmos__path_to_index(const path_medium *m, const double p[3], const double d[3], double q[3], double qd[3])
 {
-    const double *r = m->R;
-    double e[3] = {p[0] - m->org[0], p[1] - m->org[1], p[2] - m->org[2]};
-    for (int a = 0; a < 3; a++) {
-        q[a] = (r[a] * e[0] + r[3 + a] * e[1] + r[6 + a] * e[2]) * m->inv_vs;
-        qd[a] = (r[a] * d[0] + r[3 + a] * d[1] + r[6 + a] * d[2]) * m->inv_vs;
-    }
+    atmos__vol_point_to_index(&m->x, p, q);
+    atmos__vol_dir_to_index(&m->x, d, qd);
 }
 
 int atmos__path_clip(const path_medium *m, const double q[3], const double qd[3], double tmax, double *t0, double *t1)
@@ -155,138 +107,57 @@ int atmos__path_clip(const path_medium *m, const double q[3], const double qd[3]
     return 1;
 }
 
-/* Single-precision trilinear interpolation of every field at index point (x, y, z). */
+/* Scaled densities of every field at index point (x, y, z): the accessor's float sampler. */
 void atmos__path_density(const path_medium *m, double x, double y, double z, float *dens)
 {
     const atmos_volume *v = m->v;
     const int nf = m->nf;
-    if (!(x >= 0 && y >= 0 && z >= 0 && x <= m->n[0] && y <= m->n[1] && z <= m->n[2])) {
+    const double q[3] = {x, y, z};
+    if (!atmos__vol_inside(v, q)) {
         for (int f = 0; f < nf; f++) dens[f] = 0;
         return;
     }
-    float px = (float)x - 0.5f, py = (float)y - 0.5f, pz = (float)z - 0.5f;
-    float fx = floorf(px), fy = floorf(py), fz = floorf(pz);
-    float wx = px - fx, wy = py - fy, wz = pz - fz;
-    int i0 = (int)fx, j0 = (int)fy, k0 = (int)fz, i1 = i0 + 1, j1 = j0 + 1, k1 = k0 + 1;
-    const int nx = m->n[0] - 1, ny = m->n[1] - 1, nz = m->n[2] - 1;
-    if (i0 < 0) i0 = 0;
-    if (j0 < 0) j0 = 0;
-    if (k0 < 0) k0 = 0;
-    if (i1 > nx) i1 = nx;
-    if (j1 > ny) j1 = ny;
-    if (k1 > nz) k1 = nz;
-    if (i0 > nx) i0 = nx;
-    if (j0 > ny) j0 = ny;
-    if (k0 > nz) k0 = nz;
-    const int same = (i0 >> VOL_BRICK_LOG2) == (i1 >> VOL_BRICK_LOG2) && (j0 >> VOL_BRICK_LOG2) == (j1 >> VOL_BRICK_LOG2) &&
-                     (k0 >> VOL_BRICK_LOG2) == (k1 >> VOL_BRICK_LOG2);
-    const uint64_t b = vol_brick_index(v, i0, j0, k0);
+    atmos__vol_corners c;
+    float w[3];
+    atmos__vol_setup_f(v, q, &c, w);
     for (int f = 0; f < nf; f++) {
-        const vol_field *fl = &v->field[f];
-        float c[8];
-        if (same) {
-            uint32_t s = fl->table[b];
-            if (!s) {
-                dens[f] = 0;
-                continue;
-            }
-            const float *p = fl->bricks[s - 1];
-            const int M = VOL_BRICK - 1;
-            const int a0 = i0 & M, a1 = i1 & M, b0 = (j0 & M) * VOL_BRICK, b1 = (j1 & M) * VOL_BRICK,
-                      c0 = (k0 & M) * VOL_BRICK * VOL_BRICK, c1 = (k1 & M) * VOL_BRICK * VOL_BRICK;
-            c[0] = p[c0 + b0 + a0], c[1] = p[c0 + b0 + a1], c[2] = p[c0 + b1 + a0], c[3] = p[c0 + b1 + a1];
-            c[4] = p[c1 + b0 + a0], c[5] = p[c1 + b0 + a1], c[6] = p[c1 + b1 + a0], c[7] = p[c1 + b1 + a1];
-        } else {
-            for (int q = 0; q < 8; q++)
-                c[q] = vol_voxel(v, fl, q & 1 ? i1 : i0, q & 2 ? j1 : j0, q & 4 ? k1 : k0);
-        }
-        float x00 = c[0] + wx * (c[1] - c[0]), x10 = c[2] + wx * (c[3] - c[2]);
-        float x01 = c[4] + wx * (c[5] - c[4]), x11 = c[6] + wx * (c[7] - c[6]);
-        float y0 = x00 + wy * (x10 - x00), y1 = x01 + wy * (x11 - x01);
-        float d = (y0 + wz * (y1 - y0)) * m->scale;
+        const float d = atmos__vol_sample_f(v, f, &c, w) * m->scale;
         dens[f] = d > 0 ? d : 0;
     }
 }
 
-/* 3D DDA over the majorant cells (Amanatides & Woo 1987). */
-typedef struct {
-    int c[3], st[3];
-    double tn[3], dt[3];
-    uint64_t idx;
-    int64_t sidx[3];
-} path_dda;
-
-static void dda_init(const path_medium *m, const double q[3], const double qd[3], double t0, path_dda *g)
+/* The majorant of the carried wavelengths in the DDA's current brick: max over them of
+ * sum_f hi_f sigma_f,k with hi_f the field's scaled upper bound. Fields outer, wavelengths
+ * inner: each bound is computed once, and each wavelength's sum still runs over the fields
+ * in order (the same sums as a wavelength-outer loop). */
+static inline double cell_majorant(const path_medium *m, const atmos__vol_dda *g, const path_bundle *b)
 {
-    for (int a = 0; a < 3; a++) {
-        double x = q[a] + t0 * qd[a];
-        int c = (int)floor(x * (1.0 / VOL_BRICK));
-        if (c < 0) c = 0;
-        if (c > m->nb[a] - 1) c = m->nb[a] - 1;
-        g->c[a] = c;
-        if (qd[a] > 0) {
-            g->st[a] = 1;
-            g->dt[a] = VOL_BRICK / qd[a];
-            g->tn[a] = ((double)(c + 1) * VOL_BRICK - q[a]) / qd[a];
-        } else if (qd[a] < 0) {
-            g->st[a] = -1;
-            g->dt[a] = -VOL_BRICK / qd[a];
-            g->tn[a] = ((double)c * VOL_BRICK - q[a]) / qd[a];
-        } else {
-            g->st[a] = 0;
-            g->dt[a] = INFINITY;
-            g->tn[a] = INFINITY;
-        }
+    if (atmos__vol_dda_empty(m->v, g)) return 0; /* all-zero bounds */
+    const float *rg = atmos__vol_dda_range(m->v, g);
+    double s[PATH_B] = {0};
+    for (int f = 0; f < m->nf; f++) {
+        const float hi = rg[2 * f + 1] * m->scale * BOUND_UP;
+        for (int i = 0; i < b->m; i++) s[i] += (double)hi * m->sig[f][b->k[i]];
     }
-    g->sidx[0] = g->st[0];
-    g->sidx[1] = (int64_t)g->st[1] * m->nb[0];
-    g->sidx[2] = (int64_t)g->st[2] * m->nb[0] * m->nb[1];
-    g->idx = ((uint64_t)g->c[2] * m->nb[1] + g->c[1]) * m->nb[0] + g->c[0];
-}
-
-/* End of the current cell (t) and step to the next; returns 0 when leaving the grid. */
-static inline int dda_step(const path_medium *m, path_dda *g)
-{
-    int a = g->tn[0] < g->tn[1] ? (g->tn[0] < g->tn[2] ? 0 : 2) : (g->tn[1] < g->tn[2] ? 1 : 2);
-    g->c[a] += g->st[a];
-    if (g->c[a] < 0 || g->c[a] >= m->nb[a]) return 0;
-    g->tn[a] += g->dt[a];
-    g->idx += (uint64_t)g->sidx[a];
-    return 1;
-}
-
-static inline double dda_tend(const path_dda *g)
-{
-    double t = g->tn[0] < g->tn[1] ? g->tn[0] : g->tn[1];
-    return t < g->tn[2] ? t : g->tn[2];
-}
-
-/* The majorant of the carried wavelengths in the current cell. */
-static inline double cell_majorant(const path_medium *m, const path_dda *g, const path_bundle *b)
-{
-    const float *mm = m->mm + g->idx * (uint64_t)m->nf * 2;
     double mu = 0;
-    for (int i = 0; i < b->m; i++) {
-        double s = 0;
-        for (int f = 0; f < m->nf; f++) s += (double)mm[2 * f + 1] * m->sig[f][b->k[i]];
-        if (s > mu) mu = s;
-    }
+    for (int i = 0; i < b->m; i++)
+        if (s[i] > mu) mu = s[i];
     return mu;
 }
 
 int atmos__path_majorant_point(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
                                const path_bundle *b, double tau_max, double u0, double u, double *tout, double *pdf)
 {
-    path_dda g;
+    atmos__vol_dda g;
     double total = 0;
-    dda_init(m, q, qd, t0, &g);
+    atmos__vol_dda_init(m->v, q, qd, t0, &g);
     for (double t = t0;;) {
-        double te = dda_tend(&g);
+        double te = atmos__vol_dda_tend(&g);
         if (te > t1) te = t1;
         if (te > t) total += cell_majorant(m, &g, b) * (te - t);
         if (te >= t1) break;
         t = te;
-        if (!dda_step(m, &g)) break;
+        if (!atmos__vol_dda_step(m->v, &g)) break;
     }
     if (!(total > 0) || total > tau_max) return 0;
     /* the majorant optical depth from t0 to the point: the first tentative collision forced
@@ -294,9 +165,9 @@ int atmos__path_majorant_point(const path_medium *m, const double q[3], const do
     const double A = -expm1(-total);
     const double target = u0 < 0.5 ? -log1p(-u * A) : u * total;
     double acc = 0;
-    dda_init(m, q, qd, t0, &g);
+    atmos__vol_dda_init(m->v, q, qd, t0, &g);
     for (double t = t0;;) {
-        double te = dda_tend(&g);
+        double te = atmos__vol_dda_tend(&g);
         if (te > t1) te = t1;
         const double mu = te > t ? cell_majorant(m, &g, b) : 0;
         if (mu > 0 && acc + mu * (te - t) > target) {
@@ -306,7 +177,7 @@ int atmos__path_majorant_point(const path_medium *m, const double q[3], const do
             return 1;
         }
         acc += mu * (te - t);
-        if (te >= t1 || !dda_step(m, &g)) break;
+        if (te >= t1 || !atmos__vol_dda_step(m->v, &g)) break;
         t = te;
     }
     return 0; /* rounding: the target beyond the sum of the second pass */
@@ -316,22 +187,16 @@ int atmos__path_free_flight(const path_medium *m, const double q[3], const doubl
                             const path_bundle *b, double *w, atmos__stream *r, double *tout, float *dens, long long *tentative)
 {
     const int nf = m->nf, nb = b->m;
-    path_dda g;
-    dda_init(m, q, qd, t0, &g);
+    atmos__vol_dda g;
+    atmos__vol_dda_init(m->v, q, qd, t0, &g);
     double t = t0;
     double tau = -log(1.0 - atmos__stream_u(r)); /* optical depth (of the majorant) to the next tentative collision */
     long long tc = 0;
     int res = 0;
     for (;;) {
-        double te = dda_tend(&g);
+        double te = atmos__vol_dda_tend(&g);
         if (te > t1) te = t1;
-        const float *mm = m->mm + g.idx * (uint64_t)nf * 2;
-        double mu = 0;
-        for (int i = 0; i < nb; i++) {
-            double s = 0;
-            for (int f = 0; f < nf; f++) s += (double)mm[2 * f + 1] * m->sig[f][b->k[i]];
-            if (s > mu) mu = s;
-        }
+        const double mu = cell_majorant(m, &g, b);
         while (mu > 0 && te > t) {
             double dtau = mu * (te - t);
             if (tau >= dtau) {
@@ -369,7 +234,7 @@ int atmos__path_free_flight(const path_medium *m, const double q[3], const doubl
         }
         if (te >= t1) break;
         t = te;
-        if (!dda_step(m, &g)) break;
+        if (!atmos__vol_dda_step(m->v, &g)) break;
     }
 out:
     *tentative += tc;
@@ -382,27 +247,32 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
     const int nf = m->nf, nb = b->m;
     double tauc[PATH_B];
     for (int i = 0; i < nb; i++) T[i] = 1, tauc[i] = 0;
-    path_dda g;
-    dda_init(m, q, qd, t0, &g);
+    atmos__vol_dda g;
+    atmos__vol_dda_init(m->v, q, qd, t0, &g);
     double t = t0;
     float dens[PATH_F];
     for (;;) {
-        double te = dda_tend(&g);
+        double te = atmos__vol_dda_tend(&g);
         if (te > t1) te = t1;
-        const float *mm = m->mm + g.idx * (uint64_t)nf * 2;
-        double muc[PATH_B], mur = 0;
+        /* per carried wavelength the control muc = sum_f lo_f sigma_f,k and the residual
+         * sum_f (hi_f - lo_f) sigma_f,k of this brick (fields outer, as in cell_majorant) */
+        double muc[PATH_B] = {0}, res[PATH_B] = {0}, mur = 0;
         int occupied = 0;
-        for (int f = 0; f < nf; f++) occupied |= mm[2 * f + 1] > 0;
-        if (occupied && te > t) {
-            for (int i = 0; i < nb; i++) {
-                double c = 0, rr = 0;
-                for (int f = 0; f < nf; f++) {
-                    c += (double)mm[2 * f] * m->sig[f][b->k[i]];
-                    rr += (double)(mm[2 * f + 1] - mm[2 * f]) * m->sig[f][b->k[i]];
+        if (!atmos__vol_dda_empty(m->v, &g) && te > t) {
+            const float *rg = atmos__vol_dda_range(m->v, &g);
+            for (int f = 0; f < nf; f++) {
+                const float lo = rg[2 * f] * m->scale * BOUND_DN, hi = rg[2 * f + 1] * m->scale * BOUND_UP;
+                occupied |= hi > 0;
+                for (int i = 0; i < nb; i++) {
+                    muc[i] += (double)lo * m->sig[f][b->k[i]];
+                    res[i] += (double)(hi - lo) * m->sig[f][b->k[i]];
                 }
-                muc[i] = c;
-                tauc[i] += c * (te - t);
-                if (rr > mur) mur = rr;
+            }
+        }
+        if (occupied) {
+            for (int i = 0; i < nb; i++) {
+                tauc[i] += muc[i] * (te - t);
+                if (res[i] > mur) mur = res[i];
             }
             if (mur > 0) {
                 double s = t;
@@ -437,7 +307,7 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
         }
         if (te >= t1) break;
         t = te;
-        if (!dda_step(m, &g)) break;
+        if (!atmos__vol_dda_step(m->v, &g)) break;
     }
     for (int i = 0; i < nb; i++) T[i] *= exp(-tauc[i]);
 }

@@ -1,22 +1,27 @@
 /* The volume as a participating medium for the path tracer (path_medium.c): free flights,
- * transmittance and forced points over the volume's majorants. Not part of the API. */
+ * transmittance and forced points over the volume's per-brick bounds. The volume itself is
+ * read through the accessor (volume/volume_access.h); the medium adds the optics. Not
+ * part of the API. */
 #ifndef ATMOS_RENDER_PATH_MEDIUM_H
 #define ATMOS_RENDER_PATH_MEDIUM_H
 
 #include "render/path_common.h"
+#include "volume/volume_access.h"
 
 typedef struct {
     const atmos_volume *v;
     int nf;
-    int n[3];               /* voxels per axis */
-    int nb[3];              /* majorant cells (bricks) per axis */
-    double org[3];          /* world position of the grid corner (origin + offset) */
-    double R[9];            /* grid axes -> world (row-major) */
-    double inv_vs;
+    /* World <-> index: the volume's transform moved by the render's offset. path.c reads
+     * org, R and inv_vs by name (the sky light's reference height), hence the union. */
+    union {
+        atmos__vol_xform x;
+        struct {
+            double org[3], R[9], vs, inv_vs;
+        };
+    };
     float scale;            /* density scale */
-    float *mm;              /* per cell, per field: (min, max) of the scaled interpolated density */
-    double box_lo[3], box_hi[3]; /* index-space box of the occupied cells (ray clipping) */
-    int empty;              /* no occupied cell */
+    double box_lo[3], box_hi[3]; /* index-space box of the bricks with a nonzero bound (ray clipping) */
+    int empty;              /* no such brick */
     float sig[PATH_F][ATMOS_MAX_WAVELENGTHS]; /* extinction cross-section, m^2 */
     float sca[PATH_F][ATMOS_MAX_WAVELENGTHS]; /* scattering cross-section, m^2 */
 } path_medium;

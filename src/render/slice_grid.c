@@ -1,7 +1,9 @@
 /* The slice renderer's render grid (slice_grid.h): the volume box-filtered onto a dense
- * grid with an occupancy grid for empty-space skipping. */
+ * grid with an occupancy grid for empty-space skipping. The volume is read through the
+ * accessor (volume/volume_access.h): its occupied-brick box, "for each occupied brick"
+ * and its transform's voxel size. */
 #include "render/slice_internal.h"
-#include "volume/volume_grid.h"
+#include "volume/volume_access.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -21,23 +23,8 @@ atmos_status atmos__sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
     memset(g, 0, sizeof *g);
     const int nf = vol->nfields;
     g->nf = nf;
-    int blo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, bhi[3] = {-1, -1, -1};
-    for (int f = 0; f < nf; f++) {
-        const vol_field *fl = &vol->field[f];
-        if (!fl->table || fl->count == 0) continue;
-        for (uint64_t b = 0; b < vol->nbricks; b++) {
-            if (!fl->table[b]) continue;
-            int bx = (int)(b % (uint64_t)vol->nb[0]);
-            int by = (int)((b / (uint64_t)vol->nb[0]) % (uint64_t)vol->nb[1]);
-            int bz = (int)(b / ((uint64_t)vol->nb[0] * (uint64_t)vol->nb[1]));
-            int bb[3] = {bx, by, bz};
-            for (int a = 0; a < 3; a++) {
-                if (bb[a] < blo[a]) blo[a] = bb[a];
-                if (bb[a] > bhi[a]) bhi[a] = bb[a];
-            }
-        }
-    }
-    if (bhi[0] < 0) return ATMOS_OK; /* empty volume: g->v stays NULL */
+    int blo[3], bhi[3];
+    if (!atmos__vol_occupied_box(vol, blo, bhi)) return ATMOS_OK; /* empty volume: g->v stays NULL */
     int lo[3], ext[3], emax = 1;
     for (int a = 0; a < 3; a++) {
         lo[a] = blo[a] * VOL_BRICK;
@@ -66,15 +53,10 @@ atmos_status atmos__sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
     }
     /* Box filter: every native voxel of every occupied brick adds to its render voxel. */
     for (int f = 0; f < nf; f++) {
-        const vol_field *fl = &vol->field[f];
-        if (!fl->table) continue;
-        for (uint64_t b = 0; b < vol->nbricks; b++) {
-            uint32_t s = fl->table[b];
-            if (!s) continue;
-            const float *br = fl->bricks[s - 1];
-            int bx = (int)(b % (uint64_t)vol->nb[0]) * VOL_BRICK;
-            int by = (int)((b / (uint64_t)vol->nb[0]) % (uint64_t)vol->nb[1]) * VOL_BRICK;
-            int bz = (int)(b / ((uint64_t)vol->nb[0] * (uint64_t)vol->nb[1])) * VOL_BRICK;
+        atmos__vol_brick_it it = {0};
+        while (atmos__vol_next_brick(vol, f, &it)) {
+            const float *br = it.data;
+            const int bx = it.o[0], by = it.o[1], bz = it.o[2];
             for (int k = 0; k < VOL_BRICK; k++)
                 for (int j = 0; j < VOL_BRICK; j++)
                     for (int i = 0; i < VOL_BRICK; i++) {
@@ -107,7 +89,7 @@ atmos_status atmos__sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
                 }
     }
     /* Render voxel c covers native [lo + (c-1) fac, lo + c fac); its centre is u = c. */
-    const double vs = vol->desc.voxel_size_m;
+    const double vs = atmos__vol_xform_of(vol)->vs;
     g->sc = (float)(1.0 / (vs * fac));
     for (int a = 0; a < 3; a++) {
         g->off[a] = (float)(0.5 - (double)lo[a] / fac);

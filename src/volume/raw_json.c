@@ -13,7 +13,7 @@
  * plane.
  */
 #define _POSIX_C_SOURCE 200809L
-#include "volume/volume_grid.h"
+#include "volume/volume_access.h"
 #include "volume/volume_internal.h"
 
 #include <cjson/cJSON.h>
@@ -278,7 +278,7 @@ static atmos_status prefix_error(atmos_context *ctx, const char *path, atmos_sta
 static atmos_status read_raw(atmos_context *ctx, const char *sidecar, atmos_volume *vol, int fi, const raw_field *rf,
                              double extra_scale)
 {
-    const int *n = vol->desc.dims;
+    const int *n = atmos_volume_get_desc(vol)->dims;
     uint64_t plane = (uint64_t)n[0] * (uint64_t)n[1];
     uint64_t buf_bytes = plane * 4u;
     if (!atmos__volume_can_alloc(vol, buf_bytes))
@@ -382,8 +382,7 @@ static atmos_status write_field_fn(atmos_context *ctx, const char *tmp, void *us
 {
     const raw_write_job *j = user;
     const atmos_volume *v = j->vol;
-    const vol_field *fl = &v->field[j->field];
-    const int *n = v->desc.dims;
+    const int *n = atmos_volume_get_desc(v)->dims;
     FILE *f = fopen(tmp, "wb");
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create: %s", tmp, strerror(errno));
     float *row = malloc((size_t)n[0] * sizeof(float));
@@ -395,7 +394,7 @@ static atmos_status write_field_fn(atmos_context *ctx, const char *tmp, void *us
     for (int k = 0; k < n[2] && ok; k++)
         for (int jj = 0; jj < n[1] && ok; jj++) {
             for (int i = 0; i < n[0]; i++) {
-                row[i] = vol_voxel(v, fl, i, jj, k);
+                row[i] = atmos__vol_voxel(v, j->field, i, jj, k);
                 if (!le) {
                     unsigned char *b = (unsigned char *)&row[i], t;
                     t = b[0], b[0] = b[3], b[3] = t;
@@ -422,6 +421,13 @@ static cJSON *exact_numbers(const double *v, int n)
     return cJSON_CreateRaw(buf);
 }
 
+static int is_identity(const double r[9])
+{
+    for (int i = 0; i < 9; i++)
+        if (r[i] != (i % 4 == 0 ? 1.0 : 0.0)) return 0;
+    return 1;
+}
+
 static atmos_status write_text_fn(atmos_context *ctx, const char *tmp, void *user)
 {
     const raw_write_job *j = user;
@@ -437,7 +443,8 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
 {
     if (!vol || !json_path || !*json_path)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume write_raw: NULL volume or empty path");
-    if (vol->nfields == 0) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: the volume has no fields", json_path);
+    const int nf = atmos_volume_field_count(vol);
+    if (nf == 0) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: the volume has no fields", json_path);
     /* Raw files: <stem>.<field>.raw next to the sidecar, named relative to it. */
     const char *base = strrchr(json_path, '/');
     base = base ? base + 1 : json_path;
@@ -445,19 +452,19 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     if (stem_len > 5 && !strcmp(base + stem_len - 5, ".json")) stem_len -= 5;
     cJSON *root = cJSON_CreateObject(), *arr;
     if (!root) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", json_path);
-    const atmos_volume_desc *d = &vol->desc;
+    const atmos_volume_desc *d = atmos_volume_get_desc(vol);
     double dims[3] = {d->dims[0], d->dims[1], d->dims[2]};
     cJSON_AddItemToObject(root, "dims", cJSON_CreateDoubleArray(dims, 3));
     char num[40];
     snprintf(num, sizeof num, "%.17g", d->voxel_size_m);
     cJSON_AddRawToObject(root, "voxel_size_m", num);
     cJSON_AddItemToObject(root, "origin_m", exact_numbers(d->origin_m, 3));
-    if (!vol->identity) cJSON_AddItemToObject(root, "rotation", exact_numbers(d->rotation, 9));
+    if (!is_identity(d->rotation)) cJSON_AddItemToObject(root, "rotation", exact_numbers(d->rotation, 9));
     cJSON_AddItemToObject(root, "fields", arr = cJSON_CreateArray());
     atmos_status st = ATMOS_OK;
-    for (int f = 0; f < vol->nfields && st == ATMOS_OK; f++) {
+    for (int f = 0; f < nf && st == ATMOS_OK; f++) {
         char rel[PATH_CAP], full[PATH_CAP];
-        int n = snprintf(rel, sizeof rel, "%.*s.%s.raw", (int)stem_len, base, vol->field[f].name);
+        int n = snprintf(rel, sizeof rel, "%.*s.%s.raw", (int)stem_len, base, atmos_volume_field_name(vol, f));
         int m = snprintf(full, sizeof full, "%.*s%s", (int)(base - json_path), json_path, rel);
         if (n < 0 || m < 0 || (size_t)n >= sizeof rel || (size_t)m >= sizeof full) {
             st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: path too long", json_path);
@@ -466,8 +473,8 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
         raw_write_job job = {vol, f, NULL};
         st = atmos__write_atomic(ctx, full, write_field_fn, &job);
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", vol->field[f].name);
-        cJSON_AddStringToObject(o, "particle", vol->field[f].particle);
+        cJSON_AddStringToObject(o, "name", atmos_volume_field_name(vol, f));
+        cJSON_AddStringToObject(o, "particle", atmos_volume_field_particle(vol, f));
         cJSON_AddStringToObject(o, "file", rel);
         cJSON_AddNumberToObject(o, "scale", 1);
         cJSON_AddItemToArray(arr, o);
@@ -488,9 +495,9 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     free(text);
     if (st != ATMOS_OK) {
         /* All or nothing: without its sidecar the raw files are orphans. */
-        for (int f = 0; f < vol->nfields; f++) {
+        for (int f = 0; f < nf; f++) {
             char rel[PATH_CAP], full[PATH_CAP];
-            int n = snprintf(rel, sizeof rel, "%.*s.%s.raw", (int)stem_len, base, vol->field[f].name);
+            int n = snprintf(rel, sizeof rel, "%.*s.%s.raw", (int)stem_len, base, atmos_volume_field_name(vol, f));
             int m = snprintf(full, sizeof full, "%.*s%s", (int)(base - json_path), json_path, rel);
             if (n > 0 && m > 0 && (size_t)n < sizeof rel && (size_t)m < sizeof full) remove(full);
         }

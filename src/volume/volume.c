@@ -1,6 +1,7 @@
-/* The volume object: creation and validation, sparse brick storage, writes, and
- * finalize (statistics and the majorant grid). Layout: volume_grid.h. */
-#include "volume/volume_grid.h"
+/* The volume object: creation and validation, the pooled brick storage, writes, and
+ * finalize (statistics, the per-brick bounds of volume_range.c, the pool fixed).
+ * Layout: volume_grid.h; reading: volume_access.h. */
+#include "volume/volume_access.h"
 #include "volume/volume_internal.h"
 
 #include <math.h>
@@ -76,21 +77,27 @@ atmos_status atmos_volume_create(atmos_context *ctx, const atmos_volume_desc *de
     atmos_volume_desc d;
     atmos_status st = check_desc(ctx, desc, &d);
     if (st != ATMOS_OK) return st;
-    if (sizeof(atmos_volume) > d.max_memory)
-        return atmos__error(ctx, ATMOS_E_LIMIT, "volume: max_memory %llu bytes is below the %zu-byte volume header",
-                            (unsigned long long)d.max_memory, sizeof(atmos_volume));
+    if (sizeof(atmos_volume) + VOL_BRICK_BYTES > d.max_memory)
+        return atmos__error(ctx, ATMOS_E_LIMIT,
+                            "volume: max_memory %llu bytes is below the %llu bytes of the volume header and its zero brick",
+                            (unsigned long long)d.max_memory, (unsigned long long)(sizeof(atmos_volume) + VOL_BRICK_BYTES));
     atmos_volume *v = calloc(1, sizeof *v);
     if (!v) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory");
+    /* The pool starts with brick 0, the zeros every empty table entry addresses. */
+    v->pool = calloc(VOL_BRICK_VOXELS, sizeof(float));
+    if (!v->pool) {
+        free(v);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory");
+    }
+    v->pool_used = v->pool_cap = 1;
     v->desc = d;
-    v->memory = sizeof *v;
+    atmos__vol_xform_init(v, NULL, &v->xform);
+    v->memory = sizeof *v + VOL_BRICK_BYTES;
     v->nbricks = 1;
     for (int a = 0; a < 3; a++) {
         v->nb[a] = (d.dims[a] + VOL_BRICK - 1) / VOL_BRICK;
         v->nbricks *= (uint64_t)v->nb[a];
     }
-    v->identity = 1;
-    for (int i = 0; i < 9; i++)
-        if (d.rotation[i] != ((i % 4) == 0 ? 1.0 : 0.0)) v->identity = 0;
     *out = v;
     return ATMOS_OK;
 }
@@ -98,13 +105,10 @@ atmos_status atmos_volume_create(atmos_context *ctx, const atmos_volume_desc *de
 void atmos_volume_destroy(atmos_volume *vol)
 {
     if (!vol) return;
-    for (int f = 0; f < vol->nfields; f++) {
-        vol_field *fl = &vol->field[f];
-        for (uint32_t b = 0; b < fl->count; b++) free(fl->bricks[b]);
-        free(fl->bricks);
-        free(fl->table);
-        free(fl->majorant);
-    }
+    for (int f = 0; f < vol->nfields; f++) free(vol->field[f].table);
+    free(vol->pool);
+    free(vol->cell);
+    free(vol->range);
     free(vol);
 }
 
@@ -149,34 +153,46 @@ atmos_status atmos_volume_add_field(atmos_context *ctx, atmos_volume *vol, const
     return ATMOS_OK;
 }
 
-/* The brick at brick index b of field fl, allocated (zeroed) if needed. */
+/* Room for one more brick in the pool: doubling (amortised O(1) per brick), but never
+ * past max_memory, so a volume that fits brick by brick also fits the pool. */
+static atmos_status pool_grow(atmos_context *ctx, atmos_volume *v, const vol_field *fl)
+{
+    if (v->pool_cap == UINT32_MAX)
+        return atmos__error(ctx, ATMOS_E_LIMIT, "volume: field '%s': more than %u bricks", fl->name, UINT32_MAX - 1);
+    uint64_t cap = (uint64_t)v->pool_cap * 2;
+    if (cap < 16) cap = 16;
+    if (cap > UINT32_MAX) cap = UINT32_MAX;
+    const uint64_t room = v->memory <= v->desc.max_memory ? (v->desc.max_memory - v->memory) / VOL_BRICK_BYTES : 0;
+    if (cap - v->pool_cap > room) cap = v->pool_cap + room;
+    if (cap == v->pool_cap) return limit_error(ctx, v, "another brick", VOL_BRICK_BYTES);
+    const uint64_t extra = (cap - v->pool_cap) * VOL_BRICK_BYTES;
+#if SIZE_MAX < UINT64_MAX
+    if (cap * VOL_BRICK_BYTES > SIZE_MAX)
+        return atmos__error(ctx, ATMOS_E_NOMEM, "volume: brick pool too large for this machine");
+#endif
+    float *p = realloc(v->pool, (size_t)(cap * VOL_BRICK_BYTES));
+    if (!p) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory for a %llu-byte brick pool",
+                                (unsigned long long)(cap * VOL_BRICK_BYTES));
+    v->pool = p;
+    v->pool_cap = (uint32_t)cap;
+    v->memory += extra;
+    return ATMOS_OK;
+}
+
+/* The brick at brick index b of field fl, taken (zeroed) from the pool if needed. The
+ * pointer is valid until the next brick is taken (the pool may move). */
 static atmos_status brick_get(atmos_context *ctx, atmos_volume *v, vol_field *fl, uint64_t b, float **out)
 {
     uint32_t s = fl->table[b];
-    if (s) {
-        *out = fl->bricks[s - 1];
-        return ATMOS_OK;
+    if (!s) {
+        atmos_status st;
+        if (v->pool_used == v->pool_cap && (st = pool_grow(ctx, v, fl)) != ATMOS_OK) return st;
+        s = v->pool_used++;
+        memset(v->pool + ((size_t)s << VOL_BRICK_VOXELS_LOG2), 0, VOL_BRICK_BYTES);
+        fl->table[b] = s;
+        fl->count++;
     }
-    if (fl->count == fl->cap) {
-        uint32_t ncap = fl->cap ? fl->cap * 2 : 64;
-        if (ncap > UINT32_MAX / 2) ncap = UINT32_MAX / 2;
-        if (fl->count >= ncap) return atmos__error(ctx, ATMOS_E_LIMIT, "volume: field '%s': too many bricks", fl->name);
-        uint64_t extra = (uint64_t)(ncap - fl->cap) * sizeof(float *);
-        if (!atmos__volume_can_alloc(v, extra)) return limit_error(ctx, v, "growing the brick list", extra);
-        float **nb = realloc(fl->bricks, (size_t)ncap * sizeof(float *));
-        if (!nb) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory");
-        fl->bricks = nb;
-        fl->cap = ncap;
-        v->memory += extra;
-    }
-    uint64_t bytes = VOL_BRICK_VOXELS * sizeof(float);
-    if (!atmos__volume_can_alloc(v, bytes)) return limit_error(ctx, v, "another brick", bytes);
-    float *p = calloc(VOL_BRICK_VOXELS, sizeof(float));
-    if (!p) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory");
-    v->memory += bytes;
-    fl->bricks[fl->count++] = p;
-    fl->table[b] = fl->count;
-    *out = p;
+    *out = v->pool + ((size_t)s << VOL_BRICK_VOXELS_LOG2);
     return ATMOS_OK;
 }
 
@@ -288,58 +304,41 @@ static void index_box_to_world(const atmos_volume *v, const double lo[3], const 
         out[0][a] = INFINITY;
         out[1][a] = -INFINITY;
     }
-    const double *r = v->desc.rotation, s = v->desc.voxel_size_m;
     for (int c = 0; c < 8; c++) {
-        double q[3] = {(c & 1 ? hi[0] : lo[0]) * s, (c & 2 ? hi[1] : lo[1]) * s, (c & 4 ? hi[2] : lo[2]) * s};
+        double q[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]}, w[3];
+        atmos__vol_index_to_point(atmos__vol_xform_of(v), q, w);
         for (int a = 0; a < 3; a++) {
-            double w = v->desc.origin_m[a] + r[3 * a] * q[0] + r[3 * a + 1] * q[1] + r[3 * a + 2] * q[2];
-            if (w < out[0][a]) out[0][a] = w;
-            if (w > out[1][a]) out[1][a] = w;
+            if (w[a] < out[0][a]) out[0][a] = w[a];
+            if (w[a] > out[1][a]) out[1][a] = w[a];
         }
     }
 }
 
-/* Statistics and majorant of one field. A voxel's value reaches the interpolant in
- * its own brick's region and, for voxels on a brick face, in the neighbour's region
- * up to half a voxel across the face (trilinear weights span one voxel spacing). */
-static void finalize_field(atmos_volume *v, vol_field *fl)
+/* Statistics of one field: active voxels, their extremes and their world box. */
+static void finalize_field(atmos_volume *v, vol_field *fl, int field)
 {
     atmos_volume_field_stats *s = &fl->stats;
     memset(s, 0, sizeof *s);
     s->file_active_voxels = fl->file_active;
     int lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {-1, -1, -1};
     double mn = INFINITY, mx = 0;
-    for (int bk = 0; bk < v->nb[2]; bk++)
-        for (int bj = 0; bj < v->nb[1]; bj++)
-            for (int bi = 0; bi < v->nb[0]; bi++) {
-                uint64_t b = ((uint64_t)bk * v->nb[1] + bj) * v->nb[0] + bi;
-                if (!fl->table[b]) continue;
-                const float *p = fl->bricks[fl->table[b] - 1];
-                for (int z = 0; z < VOL_BRICK; z++)
-                    for (int y = 0; y < VOL_BRICK; y++)
-                        for (int x = 0; x < VOL_BRICK; x++) {
-                            float val = p[(z * VOL_BRICK + y) * VOL_BRICK + x];
-                            if (!(val > 0)) continue;
-                            int idx[3] = {bi * VOL_BRICK + x, bj * VOL_BRICK + y, bk * VOL_BRICK + z};
-                            int loc[3] = {x, y, z}, cell[3] = {bi, bj, bk};
-                            s->active_voxels++;
-                            if (val < mn) mn = val;
-                            if (val > mx) mx = val;
-                            int c0[3], c1[3];
-                            for (int a = 0; a < 3; a++) {
-                                if (idx[a] < lo[a]) lo[a] = idx[a];
-                                if (idx[a] > hi[a]) hi[a] = idx[a];
-                                c0[a] = (loc[a] == 0 && cell[a] > 0) ? cell[a] - 1 : cell[a];
-                                c1[a] = (loc[a] == VOL_BRICK - 1 && cell[a] + 1 < v->nb[a]) ? cell[a] + 1 : cell[a];
-                            }
-                            for (int ck = c0[2]; ck <= c1[2]; ck++)
-                                for (int cj = c0[1]; cj <= c1[1]; cj++)
-                                    for (int ci = c0[0]; ci <= c1[0]; ci++) {
-                                        float *m = &fl->majorant[((uint64_t)ck * v->nb[1] + cj) * v->nb[0] + ci];
-                                        if (val > *m) *m = val;
-                                    }
-                        }
-            }
+    atmos__vol_brick_it it = {0};
+    while (atmos__vol_next_brick(v, field, &it)) {
+        for (int z = 0; z < VOL_BRICK; z++)
+            for (int y = 0; y < VOL_BRICK; y++)
+                for (int x = 0; x < VOL_BRICK; x++) {
+                    float val = it.data[(z * VOL_BRICK + y) * VOL_BRICK + x];
+                    if (!(val > 0)) continue;
+                    int idx[3] = {it.o[0] + x, it.o[1] + y, it.o[2] + z};
+                    s->active_voxels++;
+                    if (val < mn) mn = val;
+                    if (val > mx) mx = val;
+                    for (int a = 0; a < 3; a++) {
+                        if (idx[a] < lo[a]) lo[a] = idx[a];
+                        if (idx[a] > hi[a]) hi[a] = idx[a];
+                    }
+                }
+    }
     if (s->active_voxels) {
         s->min = mn;
         s->max = mx;
@@ -348,19 +347,25 @@ static void finalize_field(atmos_volume *v, vol_field *fl)
     }
 }
 
+/* The pool is fixed from here on: give back the capacity no brick uses. */
+static void pool_trim(atmos_volume *v)
+{
+    if (v->pool_used == v->pool_cap) return;
+    float *p = realloc(v->pool, (size_t)v->pool_used * VOL_BRICK_BYTES);
+    if (!p) return; /* keeping the larger block is harmless */
+    v->pool = p;
+    v->memory -= (uint64_t)(v->pool_cap - v->pool_used) * VOL_BRICK_BYTES;
+    v->pool_cap = v->pool_used;
+}
+
 atmos_status atmos_volume_finalize(atmos_context *ctx, atmos_volume *vol)
 {
     if (!vol) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: vol is NULL");
     if (vol->finalized) return ATMOS_OK;
-    uint64_t bytes = vol->nbricks * sizeof(float) * (uint64_t)vol->nfields;
-    if (!atmos__volume_can_alloc(vol, bytes)) return limit_error(ctx, vol, "the majorant grid", bytes);
-    for (int f = 0; f < vol->nfields; f++) {
-        vol_field *fl = &vol->field[f];
-        fl->majorant = calloc((size_t)vol->nbricks, sizeof(float));
-        if (!fl->majorant) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory for the majorant grid");
-        vol->memory += vol->nbricks * sizeof(float);
-        finalize_field(vol, fl);
-    }
+    pool_trim(vol);
+    atmos_status st = atmos__volume_build_ranges(ctx, vol);
+    if (st != ATMOS_OK) return st;
+    for (int f = 0; f < vol->nfields; f++) finalize_field(vol, &vol->field[f], f);
     vol->finalized = 1;
     return ATMOS_OK;
 }
@@ -378,10 +383,16 @@ const char *atmos_volume_field_particle(const atmos_volume *vol, int field)
     return vol && field >= 0 && field < vol->nfields ? vol->field[field].particle : NULL;
 }
 
-atmos_status atmos_volume_field_stats_get(const atmos_volume *vol, int field, atmos_volume_field_stats *out)
+atmos_status atmos_volume_field_stats_get(atmos_context *ctx, const atmos_volume *vol, int field,
+                                          atmos_volume_field_stats *out)
 {
-    if (!vol || !out || field < 0 || field >= vol->nfields) return ATMOS_E_INVALID_ARG;
-    if (!vol->finalized) return ATMOS_E_INVALID_ARG;
+    if (!vol || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field stats: %s is NULL", vol ? "out" : "vol");
+    if (field < 0 || field >= vol->nfields)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field stats: field index %d out of range (0..%d)", field,
+                            vol->nfields - 1);
+    if (!vol->finalized)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: field stats of '%s': the volume is not finalized",
+                            vol->field[field].name);
     *out = vol->field[field].stats;
     return ATMOS_OK;
 }
@@ -400,20 +411,6 @@ void atmos_volume_bounds(const atmos_volume *vol, double lo[3], double hi[3])
         lo[a] = b[0][a];
         hi[a] = b[1][a];
     }
-}
-
-void atmos__volume_world_to_index(const atmos_volume *v, const double p[3], double q[3])
-{
-    const double *r = v->desc.rotation, inv = 1.0 / v->desc.voxel_size_m;
-    double d[3] = {p[0] - v->desc.origin_m[0], p[1] - v->desc.origin_m[1], p[2] - v->desc.origin_m[2]};
-    /* R is orthonormal: its inverse is its transpose. */
-    for (int a = 0; a < 3; a++) q[a] = (r[a] * d[0] + r[3 + a] * d[1] + r[6 + a] * d[2]) * inv;
-}
-
-void atmos__volume_dir_to_index(const atmos_volume *v, const double d[3], double q[3])
-{
-    const double *r = v->desc.rotation, inv = 1.0 / v->desc.voxel_size_m;
-    for (int a = 0; a < 3; a++) q[a] = (r[a] * d[0] + r[3 + a] * d[1] + r[6 + a] * d[2]) * inv;
 }
 
 void atmos__volume_set_file_active(atmos_volume *vol, int field, uint64_t count)

@@ -1,18 +1,27 @@
-/* The sparse multi-field grid behind atmos_volume (volume.c builds it,
- * volume_sample.c reads it, raw_json.c and the generators fill it).
+/* The storage behind atmos_volume: volume.c builds it, volume_range.c adds the
+ * per-brick interpolant bounds at finalize, and everything that reads a volume goes
+ * through volume_access.h (transform, trilinear sampler, brick DDA, brick iterator).
  *
- * Storage: the index box is cut into bricks of VOL_BRICK^3 voxels. Each field has
- * its own brick table (one uint32 per brick position: 0 = empty, else 1 + slot in
- * the field's array of brick pointers) so a rain field does not pay for the cloud
- * field's bricks. A brick is VOL_BRICK^3 floats, x fastest. Memory therefore is
- * 4 bytes per brick position per field (the table) + 4 bytes per brick position per
- * field (the majorant grid, after finalize) + 2 KiB per occupied brick.
+ * Bricks: the index box is cut into bricks of VOL_BRICK^3 voxels (x fastest). All
+ * bricks of all fields live in ONE pooled allocation (pool) addressed by 32-bit brick
+ * indices, in the way PNanoVDB addresses a whole grid by 32-bit offsets into one
+ * buffer: brick n is pool[n * VOL_BRICK_VOXELS ...]. Brick 0 is a brick of zeros
+ * that every empty position points at, so "0 = empty" in a brick table is also a valid
+ * address and reading a voxel needs no branch. Indexing by brick rather than by byte
+ * lets 32 bits reach 2^32 bricks (8 TiB) instead of 4 GiB. The pool grows (doubling,
+ * never past max_memory) while the volume is built and is trimmed to its size and
+ * fixed at finalize.
  *
- * Majorant grid: one cell per brick position per field holding the largest density
- * that the trilinear interpolant can take anywhere inside that brick's region of
- * space (the region's voxels plus the one-voxel ring its interpolation reaches).
- * At query time the cell's extinction bound is sum_i sigma_ext[i] * maj_i (Riley
- * Eq. 3), so a cell whose bound is 0 is exactly empty and may be skipped.
+ * Each field has its own brick table (one uint32 per brick position), so a rain field
+ * does not pay for the cloud field's bricks.
+ *
+ * Bounds (after finalize): for every brick position whose region holds a nonzero
+ * voxel of some field, cell[] holds an index r > 0 into range[], where
+ * range[(r * nfields + f) * 2 + {0, 1}] are the minimum and maximum of field f's
+ * voxels over the brick's region (its voxels plus the one-voxel ring the trilinear
+ * interpolation reads, clamped to the grid). Range 0 is all zeros: positions that
+ * nothing reaches. Memory: 4 B per brick position per field (table) + 4 B per brick
+ * position (cell) + 2 KiB per occupied brick + 8 B per field per non-empty region.
  */
 #ifndef ATMOS_VOLUME_GRID_H
 #define ATMOS_VOLUME_GRID_H
@@ -24,16 +33,24 @@
 
 #define VOL_BRICK_LOG2 3
 #define VOL_BRICK (1 << VOL_BRICK_LOG2)
+#define VOL_BRICK_VOXELS_LOG2 (3 * VOL_BRICK_LOG2)
 #define VOL_BRICK_VOXELS (VOL_BRICK * VOL_BRICK * VOL_BRICK)
+#define VOL_BRICK_BYTES ((uint64_t)VOL_BRICK_VOXELS * sizeof(float))
 #define VOL_NAME_MAX 64
+
+/* World <-> index: world = org + R (index * vs). Operations: volume_access.h. */
+typedef struct {
+    double org[3];  /* world position of index point (0, 0, 0), m: origin_m plus a placement offset */
+    double R[9];    /* grid axes -> world axes, row-major; orthonormal, so its inverse is R^T */
+    double vs;      /* voxel edge, m */
+    double inv_vs;  /* 1 / vs, m^-1 */
+} atmos__vol_xform;
 
 typedef struct vol_field {
     char name[VOL_NAME_MAX];
     char particle[VOL_NAME_MAX];
-    uint32_t *table;      /* nbricks entries: 0 empty, else 1 + index into bricks */
-    float **bricks;       /* occupied bricks, VOL_BRICK_VOXELS floats each */
-    uint32_t count, cap;  /* occupied bricks, capacity of bricks[] */
-    float *majorant;      /* nbricks entries after finalize */
+    uint32_t *table;       /* nbricks entries: 0 empty (the zero brick), else a brick index into the pool */
+    uint32_t count;        /* occupied bricks */
     atmos_volume_field_stats stats;
     uint64_t file_active;  /* the reader's own active-voxel count, 0 if none */
 } vol_field;
@@ -45,8 +62,15 @@ struct atmos_volume {
     int nfields;
     vol_field field[ATMOS_VOLUME_MAX_FIELDS];
     int finalized;
-    int identity;             /* rotation is the identity (fast path) */
+    atmos__vol_xform xform;   /* from desc, not moved */
     uint64_t memory;          /* bytes held */
+    float *pool;              /* pool_cap bricks; brick 0 is all zeros */
+    uint32_t pool_used, pool_cap;
+    uint32_t *cell;           /* after finalize: nbricks entries, index into range (0: nothing reaches) */
+    float *range;             /* after finalize: nrange * nfields (min, max) pairs */
+    uint32_t nrange;
+    int occ_lo[3], occ_hi[3]; /* brick box of the occupied bricks of all fields (hi < lo: none) */
+    int rng_lo[3], rng_hi[3]; /* brick box of the positions with a range > 0 (hi < lo: none) */
 };
 
 /* Index of the brick containing voxel (i, j, k) (all in range). */
@@ -62,21 +86,24 @@ static inline int vol_in_brick(int i, int j, int k)
     return ((k & m) * VOL_BRICK + (j & m)) * VOL_BRICK + (i & m);
 }
 
+/* The VOL_BRICK_VOXELS floats of brick n of the pool (n = 0: zeros). */
+static inline const float *vol_brick_data(const atmos_volume *v, uint32_t n)
+{
+    return v->pool + ((size_t)n << VOL_BRICK_VOXELS_LOG2);
+}
+
 /* Density of voxel (i, j, k) of field f; 0 for empty bricks. Indices must be in range. */
 static inline float vol_voxel(const atmos_volume *v, const vol_field *f, int i, int j, int k)
 {
-    uint32_t s = f->table[vol_brick_index(v, i, j, k)];
-    return s ? f->bricks[s - 1][vol_in_brick(i, j, k)] : 0.0f;
+    return vol_brick_data(v, f->table[vol_brick_index(v, i, j, k)])[vol_in_brick(i, j, k)];
 }
 
-/* World -> continuous index coordinates (voxel (i,j,k) covers [i, i+1) etc.). */
-void atmos__volume_world_to_index(const atmos_volume *v, const double p[3], double q[3]);
-/* Direction world -> index space (no translation). */
-void atmos__volume_dir_to_index(const atmos_volume *v, const double d[3], double q[3]);
 /* Optical depth with empty-space skipping on (skip != 0) or off, for tests. */
 double atmos__volume_optical_depth_ex(const atmos_volume *vol, const double *sigma_ext, const double o[3],
                                       const double d[3], double t0, double t1, int skip);
 /* Bytes the volume may still allocate. */
 int atmos__volume_can_alloc(const atmos_volume *v, uint64_t bytes);
+/* Builds cell[], range[] and the two brick boxes (volume_range.c); part of finalize. */
+atmos_status atmos__volume_build_ranges(atmos_context *ctx, atmos_volume *v);
 
 #endif

@@ -1,97 +1,41 @@
 /* Reading a finalized volume: trilinear sampling, extinction (Riley et al. 2004
  * Eq. 2-3) and optical depth (Eq. 4) by a two-level DDA.
  *
- * Interpolation: voxel (i,j,k) holds the density at its centre, index position
- * (i+0.5, j+0.5, k+0.5). Inside the grid box [0,n]^3 the density is the trilinear
- * interpolant of the voxel centres with indices clamped to the grid (so the half
- * voxel next to a face carries the face voxel's value and a uniform grid is
- * uniform up to its faces); outside the box it is 0.
+ * Interpolation: the accessor's double-precision trilinear sampler (volume_access.h:
+ * voxel centres at i + 1/2, indices clamped to the grid, so a uniform grid is uniform
+ * up to its faces; 0 outside the box).
  *
- * Optical depth: the outer DDA walks the majorant cells (one per 8^3 brick) and
- * skips cells whose extinction bound sum_i sigma_i maj_i is 0. Inside an occupied
+ * Optical depth: the outer DDA (the accessor's brick DDA) walks the bricks and skips
+ * those whose extinction bound sum_i sigma_i max_i is 0. Inside an occupied
  * cell the inner DDA cuts the ray at every plane through voxel centres; between two
  * such planes the interpolant is a trilinear polynomial, i.e. a cubic in t along the
  * ray, which Simpson's rule integrates exactly. The result is therefore exact up to
  * floating-point rounding (tests: ~1e-12 relative against fine quadrature). Skipped
  * cells contribute exactly 0, so skipping never changes the result.
  */
-#include "volume/volume_grid.h"
+#include "volume/volume_access.h"
 
 #include <math.h>
-
-/* Trilinear setup at index position q (inside [0,n]^3 after clamping). */
-typedef struct {
-    int i0[3], i1[3];
-    double w[3];
-} vol_lerp;
-
-static void lerp_setup(const atmos_volume *v, const double q[3], vol_lerp *l)
-{
-    for (int a = 0; a < 3; a++) {
-        int n = v->desc.dims[a];
-        double x = q[a] - 0.5;
-        double fl = floor(x);
-        int i = (int)fl;
-        double w = x - fl;
-        int i1 = i + 1;
-        if (i < 0) i = 0;
-        if (i1 > n - 1) i1 = n - 1;
-        if (i > n - 1) i = n - 1;
-        if (i1 < 0) i1 = 0;
-        l->i0[a] = i;
-        l->i1[a] = i1;
-        l->w[a] = w;
-    }
-}
-
-static double lerp_field(const atmos_volume *v, const vol_field *f, const vol_lerp *l)
-{
-    const int *i0 = l->i0, *i1 = l->i1;
-    double c[8];
-    if ((i0[0] >> VOL_BRICK_LOG2) == (i1[0] >> VOL_BRICK_LOG2) && (i0[1] >> VOL_BRICK_LOG2) == (i1[1] >> VOL_BRICK_LOG2) &&
-        (i0[2] >> VOL_BRICK_LOG2) == (i1[2] >> VOL_BRICK_LOG2)) {
-        /* All eight neighbours in one brick: one table look-up. */
-        uint32_t s = f->table[vol_brick_index(v, i0[0], i0[1], i0[2])];
-        if (!s) return 0;
-        const float *p = f->bricks[s - 1];
-        for (int c8 = 0; c8 < 8; c8++)
-            c[c8] = p[vol_in_brick(c8 & 1 ? i1[0] : i0[0], c8 & 2 ? i1[1] : i0[1], c8 & 4 ? i1[2] : i0[2])];
-    } else {
-        for (int c8 = 0; c8 < 8; c8++)
-            c[c8] = vol_voxel(v, f, c8 & 1 ? i1[0] : i0[0], c8 & 2 ? i1[1] : i0[1], c8 & 4 ? i1[2] : i0[2]);
-    }
-    double wx = l->w[0], wy = l->w[1], wz = l->w[2];
-    double x00 = c[0] + wx * (c[1] - c[0]), x10 = c[2] + wx * (c[3] - c[2]);
-    double x01 = c[4] + wx * (c[5] - c[4]), x11 = c[6] + wx * (c[7] - c[6]);
-    double y0 = x00 + wy * (x10 - x00), y1 = x01 + wy * (x11 - x01);
-    return y0 + wz * (y1 - y0);
-}
-
-static int inside_box(const atmos_volume *v, const double q[3])
-{
-    for (int a = 0; a < 3; a++)
-        if (!(q[a] >= 0 && q[a] <= v->desc.dims[a])) return 0;
-    return 1;
-}
 
 double atmos_volume_sample(const atmos_volume *vol, int field, const double p[3])
 {
     if (!vol || !vol->finalized || !p || field < 0 || field >= vol->nfields) return 0;
-    double q[3];
-    atmos__volume_world_to_index(vol, p, q);
-    if (!inside_box(vol, q)) return 0;
-    vol_lerp l;
-    lerp_setup(vol, q, &l);
-    return lerp_field(vol, &vol->field[field], &l);
+    double q[3], w[3];
+    atmos__vol_point_to_index(atmos__vol_xform_of(vol), p, q);
+    if (!atmos__vol_inside(vol, q)) return 0;
+    atmos__vol_corners c;
+    atmos__vol_setup_d(vol, q, &c, w);
+    return atmos__vol_sample_d(vol, field, &c, w);
 }
 
 /* sum_i sigma_i eta_i at index position q, for the fields listed in act[]. */
 static double ext_at(const atmos_volume *v, const double *sigma, const int *act, int nact, const double q[3])
 {
-    vol_lerp l;
-    lerp_setup(v, q, &l);
+    atmos__vol_corners c;
+    double w[3];
+    atmos__vol_setup_d(v, q, &c, w);
     double e = 0;
-    for (int n = 0; n < nact; n++) e += sigma[act[n]] * lerp_field(v, &v->field[act[n]], &l);
+    for (int n = 0; n < nact; n++) e += sigma[act[n]] * atmos__vol_sample_d(v, act[n], &c, w);
     return e;
 }
 
@@ -110,8 +54,8 @@ double atmos_volume_extinction(const atmos_volume *vol, const double *sigma_ext,
     int act[ATMOS_VOLUME_MAX_FIELDS];
     int nact = active_fields(vol, sigma_ext, act);
     double q[3];
-    atmos__volume_world_to_index(vol, p, q);
-    if (!nact || !inside_box(vol, q)) return 0;
+    atmos__vol_point_to_index(atmos__vol_xform_of(vol), p, q);
+    if (!nact || !atmos__vol_inside(vol, q)) return 0;
     return ext_at(vol, sigma_ext, act, nact, q);
 }
 
@@ -190,8 +134,8 @@ double atmos__volume_optical_depth_ex(const atmos_volume *vol, const double *sig
     od_ray r = {.v = vol, .sigma = sigma_ext, .act = act};
     r.nact = active_fields(vol, sigma_ext, act);
     if (!r.nact) return 0;
-    atmos__volume_world_to_index(vol, o, r.o);
-    atmos__volume_dir_to_index(vol, d, r.d);
+    atmos__vol_point_to_index(atmos__vol_xform_of(vol), o, r.o);
+    atmos__vol_dir_to_index(atmos__vol_xform_of(vol), d, r.d);
     /* Clip to the grid box (slab test). */
     double tmin = t0, tmax = t1;
     for (int a = 0; a < 3; a++) {
@@ -211,41 +155,25 @@ double atmos__volume_optical_depth_ex(const atmos_volume *vol, const double *sig
     }
     if (!(tmin < tmax)) return 0;
 
-    /* Outer DDA over the majorant cells (Amanatides & Woo stepping). */
-    int c[3], step[3];
-    double tnext[3];
-    for (int a = 0; a < 3; a++) {
-        double x = r.o[a] + tmin * r.d[a];
-        c[a] = (int)floor(x / VOL_BRICK);
-        if (c[a] < 0) c[a] = 0;
-        if (c[a] > vol->nb[a] - 1) c[a] = vol->nb[a] - 1;
-        step[a] = r.d[a] > 0 ? 1 : (r.d[a] < 0 ? -1 : 0);
-        tnext[a] = step[a] ? ((double)(c[a] + (step[a] > 0)) * VOL_BRICK - r.o[a]) / r.d[a] : INFINITY;
-    }
-    double tau = 0, t = tmin;
-    while (t < tmax) {
-        double te = tmax;
-        for (int a = 0; a < 3; a++)
-            if (tnext[a] < te) te = tnext[a];
+    /* Outer DDA over the bricks (Amanatides & Woo 1987); a brick whose extinction bound
+     * is 0 contributes exactly 0 and is skipped. */
+    atmos__vol_dda g;
+    atmos__vol_dda_init(vol, r.o, r.d, tmin, &g);
+    double tau = 0;
+    for (double t = tmin;;) {
+        double te = atmos__vol_dda_tend(&g);
+        if (te > tmax) te = tmax;
         if (te > t) {
             double m = 1;
             if (skip) {
-                uint64_t b = ((uint64_t)c[2] * vol->nb[1] + c[1]) * vol->nb[0] + c[0];
+                const float *rg = atmos__vol_dda_range(vol, &g);
                 m = 0;
-                for (int n = 0; n < r.nact; n++) m += sigma_ext[act[n]] * vol->field[act[n]].majorant[b];
+                for (int n = 0; n < r.nact; n++) m += sigma_ext[act[n]] * rg[2 * act[n] + 1];
             }
             if (m > 0) tau += integrate_cell(&r, t, te);
             t = te;
         }
-        if (te >= tmax) break;
-        int out = 0;
-        for (int a = 0; a < 3; a++)
-            if (tnext[a] <= te) {
-                c[a] += step[a];
-                if (c[a] < 0 || c[a] >= vol->nb[a]) out = 1;
-                tnext[a] = ((double)(c[a] + (step[a] > 0)) * VOL_BRICK - r.o[a]) / r.d[a];
-            }
-        if (out) break;
+        if (te >= tmax || !atmos__vol_dda_step(vol, &g)) break;
     }
     return tau * dlen;
 }

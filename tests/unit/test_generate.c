@@ -186,8 +186,8 @@ static void test_anvil(atmos_context *ctx)
     int fc = field_index(v, "cloud"), fi = field_index(v, "ice");
     CHECK(fc >= 0 && fi >= 0);
     atmos_volume_field_stats sc, si;
-    atmos_volume_field_stats_get(v, fc, &sc);
-    atmos_volume_field_stats_get(v, fi, &si);
+    atmos_volume_field_stats_get(ctx, v, fc, &sc);
+    atmos_volume_field_stats_get(ctx, v, fi, &si);
     /* Tower width: cloud at mid-height of the liquid tower. Anvil: ice in the top
      * fifth of the ice field. */
     double ymid = 0.5 * (sc.bounds_m[0][1] + sc.bounds_m[1][1]);
@@ -212,8 +212,8 @@ static void test_rain(atmos_context *ctx)
         int fc = field_index(v, "cloud"), fr = field_index(v, "rain");
         CHECK(fc >= 0 && fr >= 0);
         atmos_volume_field_stats sc, sr;
-        atmos_volume_field_stats_get(v, fc, &sc);
-        atmos_volume_field_stats_get(v, fr, &sr);
+        atmos_volume_field_stats_get(ctx, v, fc, &sc);
+        atmos_volume_field_stats_get(ctx, v, fr, &sr);
         /* Most rain lies below the cloud base and it reaches the ground (y = 0). */
         long below = 0, total = 0;
         const int *n = v->desc.dims;
@@ -243,7 +243,7 @@ static void test_presets_and_errors(atmos_context *ctx)
         if (!v) continue;
         for (int f = 0; f < atmos_volume_field_count(v); f++) {
             atmos_volume_field_stats s;
-            atmos_volume_field_stats_get(v, f, &s);
+            atmos_volume_field_stats_get(ctx, v, f, &s);
             CHECK_MSG(s.active_voxels > 0 && isfinite(s.max) && s.max > 0, "%s: field %s empty", names[n],
                       atmos_volume_field_name(v, f));
         }

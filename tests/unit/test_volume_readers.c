@@ -108,7 +108,7 @@ static void check_fixture_volume(const atmos_volume *v, const double A[9], const
     vdb_world(A, t, 8, 1, 1, w);
     CHECK_NEAR(atmos_volume_sample(v, f, w), 0.0, 0);
     atmos_volume_field_stats st;
-    CHECK_OK(atmos_volume_field_stats_get(v, f, &st));
+    CHECK_OK(atmos_volume_field_stats_get(ctx, v, f, &st));
     CHECK_MSG(st.active_voxels == 24 + 512, "%s: %llu active", what, (unsigned long long)st.active_voxels);
     CHECK_NEAR(st.min, 1, 1e-6);
     CHECK_NEAR(st.max, fixture_value(1, 2, 1), 1e-4);
@@ -236,7 +236,7 @@ static void test_openvdb_real(void)
             CHECK(d->dims[0] == 126 && d->dims[1] == 86 && d->dims[2] == 154);
             CHECK_NEAR(d->voxel_size_m, 10.0 / 3.0, 1e-4);
             atmos_volume_field_stats st;
-            CHECK_OK(atmos_volume_field_stats_get(v, 0, &st));
+            CHECK_OK(atmos_volume_field_stats_get(ctx, v, 0, &st));
             /* Active voxels holding exactly 0 are not "density > 0". */
             CHECK(st.active_voxels <= 415642 && st.active_voxels > 300000);
             CHECK_MSG(st.file_active_voxels == 415642, "file active %llu", (unsigned long long)st.file_active_voxels);
@@ -261,7 +261,7 @@ static void test_openvdb_real(void)
         CHECK_OK(atmos__volume_load_openvdb(ctx, p, NULL, &v));
         if (v) {
             atmos_volume_field_stats st;
-            CHECK_OK(atmos_volume_field_stats_get(v, 0, &st));
+            CHECK_OK(atmos_volume_field_stats_get(ctx, v, 0, &st));
             CHECK_MSG(st.active_voxels == 19660, "dragon active %llu", (unsigned long long)st.active_voxels);
             CHECK(st.min > 0 && st.max <= 1.0);
             const atmos_volume_desc *d = atmos_volume_get_desc(v);

@@ -257,14 +257,14 @@ static double bench_u01(void)
 }
 
 /* One line of volume figures: memory, sampling and optical-depth throughput. */
-static void bench_volume_case(const char *name, const atmos_volume *v, double load_s)
+static void bench_volume_case(atmos_context *ctx, const char *name, const atmos_volume *v, double load_s)
 {
     int nf = atmos_volume_field_count(v);
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, sigma[ATMOS_VOLUME_MAX_FIELDS];
     unsigned long long active = 0;
     for (int f = 0; f < nf; f++) {
         atmos_volume_field_stats s;
-        atmos_volume_field_stats_get(v, f, &s);
+        atmos_volume_field_stats_get(ctx, v, f, &s);
         active += s.active_voxels;
         sigma[f] = s.max > 0 ? 0.05 / s.max : 0; /* ~0.05 optical depth per voxel-metre at the peak */
         if (!s.active_voxels) continue;
@@ -341,7 +341,7 @@ static int bench_volume(const char *file, int repeat, int threads)
             file_failed = 1;
         } else {
             const char *base = strrchr(file, '/');
-            bench_volume_case(base ? base + 1 : file, v, best);
+            bench_volume_case(ctx, base ? base + 1 : file, v, best);
         }
         atmos_volume_destroy(v);
     }
@@ -355,7 +355,7 @@ static int bench_volume(const char *file, int repeat, int threads)
         atmos_context_destroy(ctx);
         return rc;
     }
-    bench_volume_case("generated_cumulus", v, t);
+    bench_volume_case(ctx, "generated_cumulus", v, t);
     atmos_volume_destroy(v);
     atmos_context_destroy(ctx);
     return file_failed ? CLI_EXIT_RUNTIME : CLI_EXIT_OK; /* a named file that cannot be read is an error */

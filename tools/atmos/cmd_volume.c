@@ -123,7 +123,7 @@ static int cmd_info(int argc, char **argv)
         cJSON_AddItemToObject(root, "fields", fields);
         for (int f = 0; f < atmos_volume_field_count(v); f++) {
             atmos_volume_field_stats s;
-            atmos_volume_field_stats_get(v, f, &s);
+            atmos_volume_field_stats_get(ctx, v, f, &s);
             cJSON *o = cJSON_CreateObject(), *b = cJSON_CreateArray();
             cJSON_AddStringToObject(o, "name", atmos_volume_field_name(v, f));
             cJSON_AddStringToObject(o, "particle", atmos_volume_field_particle(v, f));
@@ -160,7 +160,7 @@ static int cmd_info(int argc, char **argv)
         printf("  memory %.3f MB\n", atmos_volume_memory(v) / 1048576.0);
         for (int f = 0; f < atmos_volume_field_count(v); f++) {
             atmos_volume_field_stats s;
-            atmos_volume_field_stats_get(v, f, &s);
+            atmos_volume_field_stats_get(ctx, v, f, &s);
             printf("  field %-8s particle %-8s ", atmos_volume_field_name(v, f), atmos_volume_field_particle(v, f));
             if (s.file_active_voxels)
                 printf("active voxels %llu in the file (tiles counted in full), %llu > 0", (unsigned long long)s.file_active_voxels,
