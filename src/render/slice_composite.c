@@ -41,7 +41,7 @@ static void eye_taps(double f, int n, int t[2], float *w)
 }
 
 void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
-                            const double *R, const atmos__rect *r, atmos_image *img, int threads)
+                            const atmos__vol_xform *xf, const atmos__rect *r, atmos_image *img, int threads)
 {
     /* §5: air from the eye to the volume's halfway plane is in front of the volume,
      * the rest (with the ground and the sun's disk, §4.2.4) behind it. With B the sky
@@ -113,7 +113,7 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     if (!touched) continue;
                     double dw[3], d[3];
                     atmos_camera_ray(cam, x + 0.5, y + 0.5, dw);
-                    atmos__slice_to_grid(R, dw, d);
+                    atmos__vol_dir_to_frame(xf, dw, d);
                     const double hd = atmos__dot3(j->h, d);
                     double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j->he) / hd : 0.0;
                     composite_pixel(atm, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);

@@ -22,12 +22,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Sunlight arriving at the grid-frame point g: the world point is org + R g. */
-static void sunlight_at(const atmos_atmosphere *atm, const double org[3], const double *R, const double g[3],
-                        const double sun[3], double *out)
+/* Sunlight arriving at the grid-frame point g. */
+static void sunlight_at(const atmos_atmosphere *atm, const atmos__vol_xform *x, const double g[3], const double sun[3],
+                        double *out)
 {
     double w[3];
-    for (int a = 0; a < 3; a++) w[a] = org[a] + R[3 * a] * g[0] + R[3 * a + 1] * g[1] + R[3 * a + 2] * g[2];
+    atmos__vol_frame_to_point(x, g, w);
     atmos_atmosphere_sunlight(atm, w, sun, out);
 }
 
@@ -39,7 +39,7 @@ static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, cons
     slight *lf = &sp->light;
     const sgrid *g = &sp->g;
     double sun_g[3];
-    atmos__slice_to_grid(sp->R, sun_w, sun_g);
+    atmos__vol_dir_to_frame(&sp->x, sun_w, sun_g);
     for (int a = 0; a < 3; a++) lf->lt[a] = -sun_g[a];
     double ax[3] = {1, 0, 0};
     if (fabs(lf->lt[0]) > 0.9) ax[0] = 0, ax[1] = 1;
@@ -62,7 +62,7 @@ static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, cons
     const double cen[3] = {0.5 * (g->box_lo[0] + g->box_hi[0]), 0.5 * (g->box_lo[1] + g->box_hi[1]),
                            0.5 * (g->box_lo[2] + g->box_hi[2])};
     double sl_miss[ATMOS_MAX_WAVELENGTHS];
-    sunlight_at(atm, sp->org, sp->R, cen, sun_w, sl_miss);
+    sunlight_at(atm, &sp->x, cen, sun_w, sl_miss);
     for (int c = 0; c < n; c++) lf->sl[(size_t)L * L * n + c] = (float)sl_miss[c];
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int b = 0; b < L; b++)
@@ -74,7 +74,7 @@ static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, cons
             if (lf->hit[q]) {
                 double entry[3];
                 for (int i = 0; i < 3; i++) entry[i] = o[i] + lf->ta[q] * lf->lt[i];
-                sunlight_at(atm, sp->org, sp->R, entry, sun_w, sl);
+                sunlight_at(atm, &sp->x, entry, sun_w, sl);
             } else {
                 memcpy(sl, sl_miss, sizeof sl);
             }
@@ -91,11 +91,11 @@ static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob
     const atmos_camera *cam = &v->cam;
     const sgrid *g = &sp->g;
     const slight *lf = &sp->light;
-    double rel[3] = {cam->position[0] - sp->org[0], cam->position[1] - sp->org[1], cam->position[2] - sp->org[2]};
-    atmos__slice_to_grid(sp->R, rel, j->eye);
+    double rel[3] = {cam->position[0] - sp->x.org[0], cam->position[1] - sp->x.org[1], cam->position[2] - sp->x.org[2]};
+    atmos__vol_dir_to_frame(&sp->x, rel, j->eye);
     memcpy(j->lt, lf->lt, sizeof j->lt), memcpy(j->e1, lf->e1, sizeof j->e1), memcpy(j->e2, lf->e2, sizeof j->e2);
     double view_g[3];
-    atmos__slice_to_grid(sp->R, cam->forward, view_g);
+    atmos__vol_dir_to_frame(&sp->x, cam->forward, view_g);
     /* Half-angle slicing (Kniss et al.; Riley §5): h halfway between the view and the
      * light's travel when they are within 90° (front-to-back for the eye), else between
      * the inverted view and the light (back-to-front). The slices always advance along
@@ -196,7 +196,7 @@ static void setup_pixels(const atmos__slice_plan *sp, const atmos_atmosphere *at
             for (int c = 0; c < j->n; c++) j->L_eye[c * j->pst + p] = 0.0f, j->T_eye[c * j->pst + p] = 1.0f;
             double dw[3], d[3];
             atmos_camera_ray(cam, (x + 0.5) * j->sx, (y + 0.5) * j->sy, dw);
-            atmos__slice_to_grid(sp->R, dw, d);
+            atmos__vol_dir_to_frame(&sp->x, dw, d);
             double hd = atmos__dot3(j->h, d);
             j->pk0[p] = 1, j->pk1[p] = 0;
             j->pinv[p] = 0;
@@ -312,9 +312,9 @@ atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp,
     job_geometry(sp, v, j);
     if (!job_buffers(sp, j)) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
     double cf[3], cr[3], cu[3];
-    atmos__slice_to_grid(sp->R, v->cam.forward, cf);
-    atmos__slice_to_grid(sp->R, v->cam.right, cr);
-    atmos__slice_to_grid(sp->R, v->cam.up, cu);
+    atmos__vol_dir_to_frame(&sp->x, v->cam.forward, cf);
+    atmos__vol_dir_to_frame(&sp->x, v->cam.right, cr);
+    atmos__vol_dir_to_frame(&sp->x, v->cam.up, cu);
     if (!atmos__slice_build_spans(j, &v->cam, cf, cr, cu, threads))
         return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the spans");
     if (r->x0 > 0 || r->y0 > 0 || r->x1 < v->cam.width || r->y1 < v->cam.height) {

@@ -10,15 +10,9 @@
 #include "render/slice_grid.h"
 #include "render/slice_tables.h"
 
-#define SLICE_HD_EPS 0.02 /* rays within ~89 degrees of the slice planes are not sliced */
+#include "volume/volume_access.h"
 
-/* Rotation only, world -> grid frame: o = R^T w (R row-major, grid axes -> world). */
-static inline void atmos__slice_to_grid(const double *R, const double w[3], double o[3])
-{
-    o[0] = R[0] * w[0] + R[3] * w[1] + R[6] * w[2];
-    o[1] = R[1] * w[0] + R[4] * w[1] + R[7] * w[2];
-    o[2] = R[2] * w[0] + R[5] * w[1] + R[8] * w[2];
-}
+#define SLICE_HD_EPS 0.02 /* rays within ~89 degrees of the slice planes are not sliced */
 
 /* Pixels x0..x1 of one image row, or texels of one light-buffer row, that a slice
  * touches (x0 > x1: none). */
@@ -91,7 +85,7 @@ struct atmos__slice_plan {
     int n, nf, L;
     int low_albedo, eq24, reference;
     float xi;
-    double org[3], R[9];     /* world = org + R g */
+    atmos__vol_xform x;      /* the volume's transform, placed: world = org + R g in the grid frame */
     double prepare_s;        /* building the grid and the tables */
     /* Buffers kept between frames, grown when a frame needs more. */
     float *pixblock;
@@ -114,7 +108,7 @@ int atmos__slice_build_spans(sjob *j, const atmos_camera *cam, const double cf[3
 void atmos__slice_clip_spans(sjob *j, int x0, int y0, int x1, int y1);
 /* The §5 composite of the region r of the image img (which holds the sky). */
 void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
-                            const double *R, const atmos__rect *r, atmos_image *img, int threads);
+                            const atmos__vol_xform *xf, const atmos__rect *r, atmos_image *img, int threads);
 /* Sets up the per-frame job j of plan sp for the view (geometry, buffers, spans, pixels,
  * texels); r is the image region to render. */
 atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,

@@ -60,9 +60,7 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     sp->eq24 = ss->eq24;
     sp->xi = (float)ss->xi;
     sp->reference = p->reference;
-    const atmos_volume_desc *vd = atmos_volume_get_desc(p->volume);
-    memcpy(sp->R, vd->rotation, sizeof sp->R);
-    for (int a = 0; a < 3; a++) sp->org[a] = vd->origin_m[a] + p->offset[a];
+    atmos__vol_xform_init(p->volume, p->offset, &sp->x);
     atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, ss->grid_max_dim, &sp->g);
     if (st == ATMOS_OK && sp->g.v) st = atmos__stables_build(ctx, p->optics, sp->n, ss->max_order, &sp->tab);
     if (st == ATMOS_OK && sp->g.v && !light_buffers(sp))
@@ -116,7 +114,7 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         tm->eye_dims[0] = j.W, tm->eye_dims[1] = j.H;
         if ((st = atmos__slice_passes(ctx, sp, &j, tm)) != ATMOS_OK) return st;
         const double t_c0 = atmos__now();
-        atmos__slice_composite(&j, p->atm, &v->cam, v->sun, sp->R, r, out, atmos__threads(ctx));
+        atmos__slice_composite(&j, p->atm, &v->cam, v->sun, &sp->x, r, out, atmos__threads(ctx));
         tm->sky += atmos__now() - t_c0;
     }
     tm->total = atmos__now() - t_start;

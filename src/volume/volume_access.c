@@ -12,11 +12,16 @@ void atmos__vol_xform_init(const atmos_volume *v, const double offset[3], atmos_
     x->inv_vs = 1.0 / v->desc.voxel_size_m;
 }
 
-void atmos__vol_index_to_point(const atmos__vol_xform *x, const double q[3], double p[3])
+void atmos__vol_frame_to_point(const atmos__vol_xform *x, const double g[3], double p[3])
 {
     const double *r = x->R;
+    for (int a = 0; a < 3; a++) p[a] = x->org[a] + r[3 * a] * g[0] + r[3 * a + 1] * g[1] + r[3 * a + 2] * g[2];
+}
+
+void atmos__vol_index_to_point(const atmos__vol_xform *x, const double q[3], double p[3])
+{
     const double s[3] = {q[0] * x->vs, q[1] * x->vs, q[2] * x->vs};
-    for (int a = 0; a < 3; a++) p[a] = x->org[a] + r[3 * a] * s[0] + r[3 * a + 1] * s[1] + r[3 * a + 2] * s[2];
+    atmos__vol_frame_to_point(x, s, p);
 }
 
 void atmos__vol_index_to_dir(const atmos__vol_xform *x, const double qd[3], double d[3])

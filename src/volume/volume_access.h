@@ -73,6 +73,8 @@ ATMOS__VOL_INLINE void atmos__vol_dir_to_index(const atmos__vol_xform *x, const 
     for (int a = 0; a < 3; a++) qd[a] *= x->inv_vs;
 }
 
+/* Grid-frame point (metres along the grid's axes from its corner) -> world: org + R g. */
+void atmos__vol_frame_to_point(const atmos__vol_xform *x, const double g[3], double p[3]);
 /* Index point -> world: org + R (q vs). */
 void atmos__vol_index_to_point(const atmos__vol_xform *x, const double q[3], double p[3]);
 /* Index-space direction -> world: R (qd vs). */
