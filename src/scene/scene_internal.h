@@ -74,8 +74,8 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
  * camera.h's zero-means-default rules for look_at and up applied. */
 void atmos__scene_camera_effective(const atmos_camera_desc *cam, double fwd[3], double up[3]);
 
-/* The renderers' settings tables (scene_settings.c): the defaults of every table, and the
- * range check of every row. */
+/* The defaults of every row of the renderers' settings tables (scene_settings.c), and the
+ * range check of every row (scene_validate.c). */
 void atmos__settings_defaults(atmos_scene *s);
 atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s);
 

@@ -6,7 +6,6 @@
 #include "scene/scene_internal.h"
 
 #include <stddef.h>
-#include <stdio.h>
 #include <string.h>
 
 #define SLICE(field) offsetof(atmos_scene, slice.field)
@@ -115,27 +114,4 @@ void atmos__settings_defaults(atmos_scene *s)
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
         for (int i = 0; i < n; i++) atmos_scene_setting_set(s, &t[i], t[i].def);
     }
-}
-
-atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s)
-{
-    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_PATH; r++) {
-        int n;
-        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
-        for (int i = 0; i < n; i++) {
-            char path[96];
-            snprintf(path, sizeof path, "/%s/%s", atmos_renderer_name((atmos_renderer_kind)r), t[i].key);
-            const double v = atmos_scene_setting_get(s, &t[i]);
-            int choices = 0;
-            if (t[i].type == ATMOS_SETTING_CHOICE)
-                while (t[i].choices[choices]) choices++;
-            const atmos__range range = t[i].type == ATMOS_SETTING_BOOL     ? (atmos__range){0, 1, 0, 0}
-                                       : t[i].type == ATMOS_SETTING_CHOICE ? (atmos__range){0, choices - 1, 0, 0}
-                                                                           : (atmos__range){t[i].min, t[i].max,
-                                                                                            t[i].min_open, t[i].max_open};
-            atmos_status st = atmos__scene_check_range(ctx, source, path, v, &range, NULL);
-            if (st != ATMOS_OK) return st;
-        }
-    }
-    return ATMOS_OK;
 }

@@ -287,6 +287,30 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
     return ATMOS_OK;
 }
 
+/* Every row of the renderers' settings tables within its range (atmos_renderer_settings). */
+atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s)
+{
+    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_PATH; r++) {
+        int n;
+        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
+        for (int i = 0; i < n; i++) {
+            char path[96];
+            snprintf(path, sizeof path, "/%s/%s", atmos_renderer_name((atmos_renderer_kind)r), t[i].key);
+            const double v = atmos_scene_setting_get(s, &t[i]);
+            int choices = 0;
+            if (t[i].type == ATMOS_SETTING_CHOICE)
+                while (t[i].choices[choices]) choices++;
+            const atmos__range range = t[i].type == ATMOS_SETTING_BOOL     ? (atmos__range){0, 1, 0, 0}
+                                       : t[i].type == ATMOS_SETTING_CHOICE ? (atmos__range){0, choices - 1, 0, 0}
+                                                                           : (atmos__range){t[i].min, t[i].max,
+                                                                                            t[i].min_open, t[i].max_open};
+            atmos_status st = atmos__scene_check_range(ctx, source, path, v, &range, NULL);
+            if (st != ATMOS_OK) return st;
+        }
+    }
+    return ATMOS_OK;
+}
+
 atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
     static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0},

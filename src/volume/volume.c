@@ -9,20 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-int atmos__volume_can_alloc(const atmos_volume *v, uint64_t bytes)
-{
-    return bytes <= v->desc.max_memory && v->memory <= v->desc.max_memory - bytes;
-}
-
-static atmos_status limit_error(atmos_context *ctx, const atmos_volume *v, const char *what, uint64_t bytes)
-{
-    return atmos__error(ctx, ATMOS_E_LIMIT,
-                        "volume: %s needs %llu bytes but the volume already holds %llu of its %llu-byte limit "
-                        "(max_memory / --max-memory)",
-                        what, (unsigned long long)bytes, (unsigned long long)v->memory,
-                        (unsigned long long)v->desc.max_memory);
-}
-
 static void mat_identity(double r[9])
 {
     memset(r, 0, 9 * sizeof r[0]);
@@ -139,7 +125,7 @@ atmos_status atmos_volume_add_field(atmos_context *ctx, atmos_volume *vol, const
     if (vol->nfields >= ATMOS_VOLUME_MAX_FIELDS)
         return atmos__error(ctx, ATMOS_E_LIMIT, "volume: field '%s': at most %d fields", name, ATMOS_VOLUME_MAX_FIELDS);
     uint64_t bytes = vol->nbricks * sizeof(uint32_t);
-    if (!atmos__volume_can_alloc(vol, bytes)) return limit_error(ctx, vol, "the brick table of a field", bytes);
+    if (!atmos__volume_can_alloc(vol, bytes)) return atmos__volume_limit_error(ctx, vol, "the brick table of a field", bytes);
     vol_field *fl = &vol->field[vol->nfields];
     memset(fl, 0, sizeof *fl);
     fl->table = calloc((size_t)vol->nbricks, sizeof(uint32_t));
@@ -164,7 +150,7 @@ static atmos_status pool_grow(atmos_context *ctx, atmos_volume *v, const vol_fie
     if (cap > UINT32_MAX) cap = UINT32_MAX;
     const uint64_t room = v->memory <= v->desc.max_memory ? (v->desc.max_memory - v->memory) / VOL_BRICK_BYTES : 0;
     if (cap - v->pool_cap > room) cap = v->pool_cap + room;
-    if (cap == v->pool_cap) return limit_error(ctx, v, "another brick", VOL_BRICK_BYTES);
+    if (cap == v->pool_cap) return atmos__volume_limit_error(ctx, v, "another brick", VOL_BRICK_BYTES);
     const uint64_t extra = (cap - v->pool_cap) * VOL_BRICK_BYTES;
 #if SIZE_MAX < UINT64_MAX
     if (cap * VOL_BRICK_BYTES > SIZE_MAX)

@@ -103,6 +103,8 @@ double atmos__volume_optical_depth_ex(const atmos_volume *vol, const double *sig
                                       const double d[3], double t0, double t1, int skip);
 /* Bytes the volume may still allocate. */
 int atmos__volume_can_alloc(const atmos_volume *v, uint64_t bytes);
+/* ATMOS_E_LIMIT: "volume: WHAT needs BYTES bytes but the volume already holds ..." */
+atmos_status atmos__volume_limit_error(atmos_context *ctx, const atmos_volume *v, const char *what, uint64_t bytes);
 /* Builds cell[], range[] and the two brick boxes (volume_range.c); part of finalize. */
 atmos_status atmos__volume_build_ranges(atmos_context *ctx, atmos_volume *v);
 

@@ -101,14 +101,6 @@ static uint64_t mark_reached(atmos_volume *v)
     return marked;
 }
 
-static atmos_status limit(atmos_context *ctx, const atmos_volume *v, uint64_t bytes)
-{
-    return atmos__error(ctx, ATMOS_E_LIMIT,
-                        "volume: the per-brick bounds need %llu bytes but the volume already holds %llu of its "
-                        "%llu-byte limit (max_memory / --max-memory)",
-                        (unsigned long long)bytes, (unsigned long long)v->memory, (unsigned long long)v->desc.max_memory);
-}
-
 atmos_status atmos__volume_build_ranges(atmos_context *ctx, atmos_volume *v)
 {
     const size_t nf = (size_t)v->nfields, pair = 2 * nf * sizeof(float);
@@ -116,14 +108,14 @@ atmos_status atmos__volume_build_ranges(atmos_context *ctx, atmos_volume *v)
     free(v->range);
     v->cell = NULL, v->range = NULL;
     uint64_t bytes = v->nbricks * sizeof(uint32_t);
-    if (!atmos__volume_can_alloc(v, bytes)) return limit(ctx, v, bytes);
+    if (!atmos__volume_can_alloc(v, bytes)) return atmos__volume_limit_error(ctx, v, "the index of per-brick bounds", bytes);
     v->cell = calloc((size_t)v->nbricks, sizeof(uint32_t));
     if (!v->cell) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory for the per-brick bounds");
     v->memory += bytes;
     const uint64_t marked = mark_reached(v);
     if (marked >= UINT32_MAX) return atmos__error(ctx, ATMOS_E_LIMIT, "volume: too many bricks for 32-bit bounds");
     uint64_t rbytes = (marked + 1) * pair;
-    if (!atmos__volume_can_alloc(v, rbytes)) return limit(ctx, v, rbytes);
+    if (!atmos__volume_can_alloc(v, rbytes)) return atmos__volume_limit_error(ctx, v, "the table of per-brick bounds", rbytes);
     v->range = calloc((size_t)(marked + 1), pair ? pair : 1);
     if (!v->range) return atmos__error(ctx, ATMOS_E_NOMEM, "volume: out of memory for the per-brick bounds");
     v->memory += rbytes;

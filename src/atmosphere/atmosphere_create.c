@@ -1,0 +1,139 @@
+/* The atmosphere object (include/atmos/atmosphere.h): its settings, creation, and what every
+ * kind shares (the wavelengths' coefficients, the sun, the flat ground). The questions are
+ * asked in atmosphere_ask.c. */
+#include "atmosphere/atmosphere_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Riley et al. 2004, Table 3: sea-level scattering coefficients, m^-1. */
+static const double table3_nm[3] = {680.0, 550.0, 440.0};
+static const double table3_beta[3] = {5.8e-6, 1.35e-5, 3.31e-5};
+
+void atmos_atmosphere_defaults(atmos_atmosphere_desc *d)
+{
+    memset(d, 0, sizeof *d);
+    d->beta_sl_550 = ATMOS_SKY_BETA_SL_550;
+    d->scale_height_m = 8000.0;
+    d->ground_albedo = 0.1;
+    d->sun_diameter_deg = 0.5;
+    d->sun_scale = 1.0;
+    d->kind = ATMOS_ATMOSPHERE_RILEY;
+    d->thickness_m = 8000.0;
+}
+
+/* Zero means default for every field except ground_albedo (and the vacuum's radiance). */
+static void resolve(const atmos_atmosphere_desc *in, atmos_atmosphere_desc *d)
+{
+    atmos_atmosphere_defaults(d);
+    if (!in) return;
+    *d = *in;
+    if (d->beta_sl_550 == 0) d->beta_sl_550 = ATMOS_SKY_BETA_SL_550;
+    if (d->scale_height_m == 0) d->scale_height_m = 8000.0;
+    if (d->sun_diameter_deg == 0) d->sun_diameter_deg = 0.5;
+    if (d->sun_scale == 0) d->sun_scale = 1.0;
+    if (d->thickness_m == 0) d->thickness_m = 8000.0;
+}
+
+static atmos_status check(atmos_context *ctx, const atmos_atmosphere_desc *d, const atmos_wavelengths *wl)
+{
+    if (d->kind != ATMOS_ATMOSPHERE_RILEY && d->kind != ATMOS_ATMOSPHERE_VACUUM && d->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/kind: unknown kind %d", (int)d->kind);
+    if (!(d->beta_sl_550 > 0 && d->beta_sl_550 <= 0.01))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/beta_sl_550_per_m: must be in (0, 0.01], got %g",
+                            d->beta_sl_550);
+    if (!(d->scale_height_m >= 100 && d->scale_height_m <= 100000))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/scale_height_m: must be in [100, 100000], got %g",
+                            d->scale_height_m);
+    if (!(d->ground_albedo >= 0 && d->ground_albedo <= 1))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/ground_albedo: must be in [0, 1], got %g",
+                            d->ground_albedo);
+    if (!(d->sun_diameter_deg > 0 && d->sun_diameter_deg <= 20))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/sun_diameter_deg: must be in (0, 20], got %g",
+                            d->sun_diameter_deg);
+    if (!(d->sun_scale >= 0 && d->sun_scale <= 1e6))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/sun_scale: must be in [0, 1e6], got %g", d->sun_scale);
+    if (!(d->background_radiance >= 0 && d->background_radiance <= 1e6))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/background_radiance: must be in [0, 1e6], got %g",
+                            d->background_radiance);
+    if (!(d->thickness_m >= 1 && d->thickness_m <= 1e6))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/thickness_m: must be in [1, 1e6], got %g",
+                            d->thickness_m);
+    if (wl->count < 1 || wl->count > ATMOS_MAX_WAVELENGTHS)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere: wavelength set has %d samples (allowed 1..%d)",
+                            wl->count, ATMOS_MAX_WAVELENGTHS);
+    return ATMOS_OK;
+}
+
+atmos_status atmos_atmosphere_create(atmos_context *ctx, const atmos_atmosphere_desc *desc,
+                                     const atmos_wavelengths *wl, atmos_atmosphere **out)
+{
+    if (!out || !wl) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere: missing argument");
+    *out = NULL;
+    atmos_atmosphere_desc d;
+    resolve(desc, &d);
+    atmos_status st = check(ctx, &d, wl);
+    if (st != ATMOS_OK) return st;
+    atmos_atmosphere *a = calloc(1, sizeof *a);
+    if (!a) return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory");
+    a->desc = d;
+    a->wl = *wl;
+    a->gamma = 1.0 / d.scale_height_m;
+    const double scale = d.beta_sl_550 / ATMOS_SKY_BETA_SL_550;
+    for (int i = 0; i < wl->count; i++) {
+        double b = ATMOS_SKY_BETA_SL_550 * pow(550.0 / wl->nm[i], 4.0);
+        if (wl->mode == ATMOS_WAVELENGTHS_RGB) {
+            /* The paper's own channel values where the wavelength is one of Table 3's. */
+            for (int k = 0; k < 3; k++)
+                if (fabs(wl->nm[i] - table3_nm[k]) < 1e-9) b = table3_beta[k];
+        }
+        a->beta_sl[i] = d.kind == ATMOS_ATMOSPHERE_VACUUM ? 0.0 : b * scale;
+        a->sun_e[i] = wl->sun_irradiance[i] * d.sun_scale;
+    }
+    const double r = 0.5 * d.sun_diameter_deg * ATMOS_DEG2RAD;
+    a->cos_sun_radius = cos(r);
+    a->sun_solid_angle = 2.0 * ATMOS_PI * (1.0 - cos(r));
+    *out = a;
+    return ATMOS_OK;
+}
+
+void atmos_atmosphere_destroy(atmos_atmosphere *atm) { free(atm); }
+atmos_atmosphere_kind atmos_atmosphere_get_kind(const atmos_atmosphere *atm) { return atm->desc.kind; }
+const atmos_wavelengths *atmos_atmosphere_wavelengths(const atmos_atmosphere *atm) { return &atm->wl; }
+const atmos_atmosphere_desc *atmos_atmosphere_get_desc(const atmos_atmosphere *atm) { return &atm->desc; }
+double atmos_atmosphere_sun_solid_angle(const atmos_atmosphere *atm) { return atm->sun_solid_angle; }
+const double *atmos__atm_sun_irradiance(const atmos_atmosphere *a) { return a->sun_e; }
+double atmos__atm_cos_sun_radius(const atmos_atmosphere *a) { return a->cos_sun_radius; }
+
+double atmos__atm_background(const atmos_atmosphere *a)
+{
+    return a->desc.kind == ATMOS_ATMOSPHERE_VACUUM ? a->desc.background_radiance : 0.0;
+}
+
+double atmos_atmosphere_ground_albedo(const atmos_atmosphere *atm)
+{
+    return atm->desc.kind == ATMOS_ATMOSPHERE_VACUUM ? 0.0 : atm->desc.ground_albedo;
+}
+
+/* The ground is the plane y = 0 of a flat earth; a point on or below it looking down is on it. */
+double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const double p[3], const double dir[3])
+{
+    if (atm->desc.kind == ATMOS_ATMOSPHERE_VACUUM) return INFINITY;
+    const double y = p[1];
+    if (y <= 0) return dir[1] < 0 ? 0.0 : (y < 0 ? 0.0 : INFINITY);
+    if (dir[1] >= 0) return INFINITY;
+    return y / -dir[1];
+}
+
+void atmos__atm_ground_hit(const atmos_atmosphere *a, double p[3], double n[3])
+{
+    (void)a; /* every kind here has the flat ground y = 0 */
+    p[1] = 0;
+    n[0] = 0, n[1] = 1, n[2] = 0;
+}
+
+int atmos_atmosphere_sun_disk_visible(const atmos_atmosphere *atm, const double sun_dir[3])
+{
+    return atm->desc.kind != ATMOS_ATMOSPHERE_VACUUM && !atm->desc.hide_sun_disk && sun_dir[1] > 0;
+}
