@@ -330,24 +330,3 @@ atmos_status atmos_plan_path_order(const atmos_plan *p, atmos_image **out)
         return atmos__error(p ? p->ctx : NULL, ATMOS_E_INVALID_ARG, "path order: not a path tracer's plan");
     return atmos__path_order(p, out);
 }
-
-atmos_status atmos_render_scene(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
-                                atmos_image **out, atmos_render_info *info)
-{
-    if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render scene: missing scene or output");
-    *out = NULL;
-    atmos_plan *p = NULL;
-    atmos_frame f;
-    atmos_image *img = NULL;
-    atmos_status st = atmos_plan_create(ctx, scene, volume, NULL, &p);
-    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, scene, &f);
-    if (st == ATMOS_OK) st = atmos_plan_image_create(p, &f, &img);
-    if (st == ATMOS_OK) st = atmos_plan_render(p, &f, NULL, img, info);
-    atmos_plan_destroy(p);
-    if (st != ATMOS_OK) {
-        atmos_image_destroy(img);
-        return st;
-    }
-    *out = img;
-    return ATMOS_OK;
-}

@@ -1,5 +1,5 @@
-/* The one-call renderers (render.h, slice.h, path.h): a plan made for one frame of the scene
- * and destroyed. A caller rendering many frames keeps the plan (plan.h). */
+/* The one-call renderers (atmos_render_scene in plan.h; render.h, slice.h, path.h): a plan made
+ * for one frame of the scene and destroyed. A caller rendering many frames keeps the plan. */
 #include "render/plan_internal.h"
 
 #include <string.h>
@@ -25,6 +25,14 @@ static atmos_status render_once(atmos_context *ctx, const atmos_scene *scene, co
     if (keep) *keep = p;
     else atmos_plan_destroy(p);
     return ATMOS_OK;
+}
+
+atmos_status atmos_render_scene(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
+                                atmos_image **out, atmos_render_info *info)
+{
+    if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render scene: missing scene or output");
+    *out = NULL;
+    return render_once(ctx, scene, volume, NULL, out, info, NULL);
 }
 
 atmos_status atmos_render_sky(atmos_context *ctx, const atmos_scene *scene, atmos_image **out, atmos_render_info *info)
