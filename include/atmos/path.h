@@ -11,11 +11,11 @@
  * the sun's disk and the sky found at every scattering event both by next-event estimation
  * and by the phase-sampled continuation, combined by multiple importance sampling, and a
  * camera ray's single scattering estimated at a point forced into its crossing of the
- * volume. The air is the analytic sky (sky.h): the medium around and inside the volume's
- * box, its in-scatter shadowed by the volume (light shafts), and the light arriving from
- * everywhere a path escapes to; the ground is Lambertian, lit by the sun (shadowed by the
- * volume) and by the paths that leave it. With a black or uniform background the volume
- * floats in vacuum.
+ * volume. The air is the scene's atmosphere (atmosphere.h): the medium around and inside
+ * the volume's box, its in-scatter shadowed by the volume (light shafts), and the light
+ * arriving from everywhere a path escapes to; the ground is Lambertian, lit by the sun
+ * (shadowed by the volume) and by the paths that leave it. In a vacuum (a black or uniform
+ * background) the volume floats in empty space.
  *
  * Determinism: every (pixel, sample) has its own random stream derived from the seed,
  * so the image is the same bit for bit for any thread count. With a time budget the

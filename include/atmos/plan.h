@@ -26,7 +26,7 @@
  *   atmos_plan_image_create(p, &f, &img);
  *   for (int i = 0; i < 36; i++) {
  *       atmos_frame_orbit(&f, p, 10.0);                     // 10 degrees around the volume
- *       atmos_plan_render(p, &f, NULL, img);
+ *       atmos_plan_render(p, &f, NULL, img, NULL);
  *   }
  *
  * Thread safety: one render at a time per plan (a plan keeps its buffers and caches); any
@@ -120,9 +120,10 @@ ATMOS_API atmos_status atmos_plan_path_variance(const atmos_plan *plan, atmos_im
 ATMOS_API atmos_status atmos_plan_path_order(const atmos_plan *plan, atmos_image **out);
 
 /* Renders a scene as `atmos render` does: the scene's renderer and settings, its volume
- * (loaded and placed from the scene when volume is NULL), the density scale, the background;
- * *out as atmos_plan_render's. The CLI, a C program and the Python package give the same
- * bytes for the same scene. */
+ * (loaded and placed from the scene when volume is NULL), the density scale, the atmosphere;
+ * *out as atmos_plan_render's. The CLI and a C program (and, through this call, any binding)
+ * give the same bytes for the same scene. One image: the scene's own sun; the frames of an
+ * animation are atmos_scene_animation_frame's scenes, or frames of one plan. */
 ATMOS_API atmos_status atmos_render_scene(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
                                           atmos_image **out, atmos_render_info *info);
 

@@ -215,20 +215,20 @@ static atmos_status accumulate(atmos_plan *p, atmos__path_plan *pp, const path_j
     const int first = lowest;
     while (lowest < target) {
         const int s1 = lowest + S < target ? lowest + S : target;
-        long long ev = 0, tc = 0, sh = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : ev, tc, sh)
+        long long ev = 0, tc = 0, sh = 0, paths = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : ev, tc, sh, paths)
         for (int y = r->y0; y < r->y1; y++) {
             path_counts cnt = {0, 0, 0};
             for (int x = r->x0; x < r->x1; x++) {
                 const size_t pix = (size_t)y * W + x;
                 if (pp->count[pix] >= s1) continue;
                 sample_pixel(J, x, y, pix, pp->count[pix], s1, Ybar, pp->acc + pix * NA, &cnt);
+                paths += s1 - pp->count[pix];
                 pp->count[pix] = s1;
             }
             ev += cnt.events, tc += cnt.tentative, sh += cnt.shadow;
         }
-        st->events += ev, st->tentative += tc, st->shadow_rays += sh;
-        st->paths += (long long)(s1 - lowest) * (long long)npix;
+        st->events += ev, st->tentative += tc, st->shadow_rays += sh, st->paths += paths;
         lowest = s1;
         const double el = atmos__now() - t0;
         double frac = target > first ? (double)(lowest - first) / (target - first) : 1.0;

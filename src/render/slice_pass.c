@@ -1,5 +1,5 @@
 /* The eye and light passes of the slice renderer (Riley et al. 2004 Eq. 21, 24-26; see
- * slice.c and docs/slice.md): a scalar reference version of each, and a fast version
+ * slice_frame.c and docs/slice.md): a scalar reference version of each, and a fast version
  * that processes a span in chunks of structure-of-arrays samples so that the compiler
  * vectorises the interpolation, the optics and the exponentials (built for AVX2 as
  * well as the baseline, chosen at run time). Both compute the same quantities in the

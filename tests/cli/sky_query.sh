@@ -53,6 +53,10 @@ q nadir --sun-elevation 45 --view-elevation -90 --view-azimuth 0 --altitude 3000
 q nadir_ground --sun-elevation 45 --view-elevation -90 --view-azimuth 0
 q tiny_up --sun-elevation 45 --view-elevation 1e-9 --view-azimuth 0
 q tiny_down --sun-elevation 45 --view-elevation -1e-9 --view-azimuth 0 --altitude 100
+# The homogeneous layer (docs/models.md): 1 km of uniform air seen 10 deg up from the ground.
+q layer --sun-elevation 30 --view-elevation 10 --view-azimuth 90 --atmosphere homogeneous --thickness 1000
+"$cli" sky --sun-elevation 30 --view-elevation 10 --view-azimuth 90 --atmosphere fog >/dev/null 2>&1
+[ $? -eq 2 ] && ok "--atmosphere fog is a usage error" || bad "--atmosphere fog should exit 2"
 
 python3 - "$T" "$src" <<'EOF' || fail=1
 import csv, json, math, sys
@@ -88,7 +92,7 @@ def load(name):
 
 names = ["zenith45", "spectral8", "horiz1000", "down10k", "sun5", "sun20", "sun60", "level", "level_high",
          "at_sun", "at_sun_level", "at_sun_spectral", "sun_horizon", "sun_below", "nadir", "nadir_ground",
-         "tiny_up", "tiny_down"]
+         "tiny_up", "tiny_down", "layer"]
 R = {n: load(n) for n in names}
 if any(v is None for v in R.values()): sys.exit(1)
 
@@ -111,6 +115,21 @@ check(all(a < b for a, b in zip(wl, wl[1:])), "--spectral 8: increasing")
 for w, t in zip(wl, s8["transmittance"]):
     want = math.exp(-1.35e-5 * (550.0 / w) ** 4 * H)
     check(rel(t, want) < 1e-6, "spectral zenith transmittance at %g nm: %r vs lambda^-4 law %r" % (w, t, want))
+
+# The layer: transmittance exp(-beta L) over the L = 1000 / sin 10 deg inside it; the sun's
+# light at the ground exp(-beta 1000 / sin 30 deg); in-scatter P E0 beta int_0^L e^{-beta c s} ds
+# with c = 1 - sin 10 / sin 30, E0 from the sun's radiance and transmittance.
+ly = R["layer"]
+L = 1000 / math.sin(math.radians(10))
+for c in range(3):
+    check(rel(ly["transmittance"][c], math.exp(-BETA[c] * L)) < 1e-9,
+          "layer transmittance %d nm = exp(-beta * 1000 / sin 10)" % ly["wavelengths_nm"][c])
+    E0 = ly["sun"][c] * OMEGA / math.exp(-BETA[c] * 1000 / 0.5)
+    mu = math.cos(math.radians(30)) * math.cos(math.radians(10)) * math.cos(math.radians(90 - 180)) + 0.5 * math.sin(math.radians(10))
+    P = 3 / (16 * math.pi) * (1 + mu * mu)
+    cc = 1 - math.sin(math.radians(10)) / 0.5
+    want = P * E0 * BETA[c] * math.exp(-BETA[c] * 1000 / 0.5) * (1 - math.exp(-BETA[c] * cc * L)) / (BETA[c] * cc)
+    check(rel(ly["inscatter"][c], want) < 1e-6, "layer in-scatter %d nm: %r vs closed form %r" % (ly["wavelengths_nm"][c], ly["inscatter"][c], want))
 
 h = R["horiz1000"]
 check(h["distance_m"] == 1000 and h["hits_ground"] is False, "--distance 1000: path of 1000 m, not ground")

@@ -157,18 +157,27 @@ static atmos_status path_background(atmos_context *ctx, const atmos_scene *scene
     return atmos_render_scene(ctx, &s, NULL, bg, NULL);
 }
 
+/* A path case's figures: text (key=value) or one JSON object. prepare_s: making the plan
+ * (medium, phase tables, optics). */
 static void print_path(const char *name, int vacuum, const atmos_scene *s, int threads, const atmos_path_stats *st,
-                       long long cnt, double rel, double relm, const double fps[3])
+                       double prepare_s, long long cnt, double rel, double relm, const double fps[3], int json)
 {
     const double t = st->trace_s;
-    printf("bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g%s%s%s paths_per_s=%.4g "
-           "events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g events_per_path=%.2f trace_s=%.3f "
-           "prepare_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f t_1pct_pixel_s=%.4g mean_rel_se=%.3g "
-           "t_1pct_mean_s=%.3g fps_camera_moving=%.3f fps_sun_moving=%.3f fps_static=%.3f\n",
-           name, vacuum ? "vacuum" : "sky", s->width, s->height, st->spp, threads, s->volume.density_scale,
-           s->path.forced ? "" : " no_forced=1", s->path.sky_nee ? "" : " no_sky_nee=1",
-           s->path.aureole ? "" : " no_aureole=1", st->paths / t, st->events / t, st->tentative / t,
-           st->shadow_rays / t, (double)st->events / (double)st->paths, t, st->prepare_s, cnt, rel,
+    const char *fmt =
+        json ? "{\"bench\":\"path\",\"case\":\"%s\",\"background\":\"%s\",\"size\":[%d,%d],\"spp\":%d,\"threads\":%d,"
+               "\"density_scale\":%g,\"forced\":%d,\"sky_nee\":%d,\"aureole\":%d,\"paths_per_s\":%.4g,\"events_per_s\":%.4g,"
+               "\"tentative_per_s\":%.4g,\"shadow_rays_per_s\":%.4g,\"events_per_path\":%.2f,\"trace_s\":%.3f,"
+               "\"prepare_s\":%.3f,\"covered_pixels\":%lld,\"pixel_rel_se\":%.4f,\"t_1pct_pixel_s\":%.4g,"
+               "\"mean_rel_se\":%.3g,\"t_1pct_mean_s\":%.3g,\"fps_camera_moving\":%.3f,\"fps_sun_moving\":%.3f,"
+               "\"fps_static\":%.3f}\n"
+             : "bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g forced=%d sky_nee=%d "
+               "aureole=%d paths_per_s=%.4g events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g "
+               "events_per_path=%.2f trace_s=%.3f prepare_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f "
+               "t_1pct_pixel_s=%.4g mean_rel_se=%.3g t_1pct_mean_s=%.3g fps_camera_moving=%.3f fps_sun_moving=%.3f "
+               "fps_static=%.3f\n";
+    printf(fmt, name, vacuum ? "vacuum" : "sky", s->width, s->height, st->spp, threads, s->volume.density_scale,
+           s->path.forced, s->path.sky_nee, s->path.aureole, st->paths / t, st->events / t, st->tentative / t,
+           st->shadow_rays / t, (double)st->events / (double)st->paths, t, prepare_s, cnt, rel,
            t * (rel / 0.01) * (rel / 0.01), relm, t * (relm / 0.01) * (relm / 0.01), fps[MOVE_CAMERA], fps[MOVE_SUN],
            fps[MOVE_NOTHING]);
     fflush(stdout);
@@ -203,6 +212,6 @@ int bench_path_case(atmos_context *ctx, const char *name, atmos_volume *v, const
     atmos_plan_destroy(plan);
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
-    print_path(name, vacuum, &scene, atmos_context_threads(ctx), &stats.path, cnt, rel, relm, fps);
+    print_path(name, vacuum, &scene, atmos_context_threads(ctx), &stats.path, prepare, cnt, rel, relm, fps, o->json);
     return CLI_EXIT_OK;
 }

@@ -13,6 +13,7 @@ typedef struct {
     int size, spp;
     double density_scale;
     int no_forced, no_sky_nee, no_aureole;
+    int json;
 } bench_path_opts;
 
 /* The path tracer on v, in vacuum or in the sky. */

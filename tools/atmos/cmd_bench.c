@@ -20,7 +20,7 @@ static void help(void)
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
-           "                        [--no-forced] [--no-sky-nee] [--no-aureole]\n\n"
+           "                        [--no-forced] [--no-sky-nee] [--no-aureole] [--json]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
            "          prints per case the best wall time and megapixels per second:\n"
@@ -463,7 +463,7 @@ int cli_cmd_bench(int argc, char **argv)
         }
     }
     if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice, path)");
-    pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale;
+    pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale, pflags.json = json;
     if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
     if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, json);
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);

@@ -1,4 +1,4 @@
-/* atmos sky: the analytic sky model (Riley et al. 2004 §4.1) along one view. */
+/* atmos sky: the atmosphere (Riley et al. 2004 §4.1 by default) along one view. */
 #include "cli.h"
 
 #include <getopt.h>
@@ -9,7 +9,8 @@
 static void help(void)
 {
     printf("Usage: atmos sky --sun-elevation E [--sun-azimuth A] --view-elevation e --view-azimuth a\n"
-           "                 [--altitude h] [--distance K] [--spectral N] [--albedo R] [--json]\n\n"
+           "                 [--altitude h] [--distance K] [--spectral N] [--albedo R]\n"
+           "                 [--atmosphere riley|homogeneous] [--thickness M] [--json]\n\n"
            "Prints, per wavelength, the single-scattered radiance arriving along one view\n"
            "(Riley et al. 2004 Eq. 15, corrected), the transmittance along it (Eq. 11) and the\n"
            "sun's attenuated radiance at the observer (Eq. 12 over the disk's solid angle).\n\n"
@@ -21,6 +22,9 @@ static void help(void)
            "  --distance K         path length, metres > 0 (default: to the ground or to space)\n"
            "  --spectral N         N spectral samples in 380-780 nm (default: rgb = 680, 550, 440 nm)\n"
            "  --albedo R           ground albedo [0, 1] (default 0.1; used when the view hits the ground)\n"
+           "  --atmosphere KIND    riley (the exponential atmosphere, default) or homogeneous (a uniform\n"
+           "                       layer from the ground to --thickness; docs/models.md)\n"
+           "  --thickness M        the homogeneous layer's top, metres (default 8000)\n"
            "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
            "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n\n"
            "Units: radiance W m^-2 sr^-1 nm^-1. \"inscatter\" is the air's in-scattered radiance only;\n"
@@ -37,8 +41,10 @@ int cli_cmd_sky(int argc, char **argv)
         {"altitude", required_argument, 0, 'h'},      {"distance", required_argument, 0, 'K'},
         {"spectral", required_argument, 0, 'n'},      {"albedo", required_argument, 0, 'r'},
         {"json", no_argument, 0, 'j'},                {"help", no_argument, 0, 'H'},
+        {"atmosphere", required_argument, 0, 'k'},    {"thickness", required_argument, 0, 't'},
         {0, 0, 0, 0}};
-    double sun_el = NAN, sun_az = 180, view_el = NAN, view_az = NAN, alt = 0, dist = INFINITY, albedo = -1;
+    double sun_el = NAN, sun_az = 180, view_el = NAN, view_az = NAN, alt = 0, dist = INFINITY, albedo = -1, top = 0;
+    atmos_atmosphere_kind kind = ATMOS_ATMOSPHERE_RILEY;
     int spectral = 0, json = 0, c;
     const char *C = "sky";
     optind = 1;
@@ -54,6 +60,15 @@ int cli_cmd_sky(int argc, char **argv)
         case 'r': if (!cli_parse_double(C, "--albedo", optarg, &albedo)) return CLI_EXIT_USAGE; break;
         case 'n': if (!cli_parse_int(C, "--spectral", optarg, 1, ATMOS_MAX_WAVELENGTHS, &spectral)) return CLI_EXIT_USAGE; break;
         case 'j': json = 1; break;
+        case 'k':
+            if (!strcmp(optarg, "riley")) kind = ATMOS_ATMOSPHERE_RILEY;
+            else if (!strcmp(optarg, "homogeneous")) kind = ATMOS_ATMOSPHERE_HOMOGENEOUS;
+            else return cli_usage_error(C, "--atmosphere: expected riley or homogeneous, got '%s'", optarg);
+            break;
+        case 't':
+            if (!cli_parse_double(C, "--thickness", optarg, &top) || !(top >= 1 && top <= 1e6))
+                return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]");
+            break;
         case 'H': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
         }
@@ -76,6 +91,8 @@ int cli_cmd_sky(int argc, char **argv)
     atmos_atmosphere_desc ad;
     atmos_atmosphere_defaults(&ad);
     if (albedo >= 0) ad.ground_albedo = albedo;
+    ad.kind = kind;
+    if (top > 0) ad.thickness_m = top;
     atmos_atmosphere *sky = NULL;
     atmos_status st = atmos_atmosphere_create(ctx, &ad, &wl, &sky);
     if (st != ATMOS_OK) {

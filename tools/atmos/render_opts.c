@@ -13,7 +13,7 @@
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
     O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_VPOS, O_DSCALE, O_TAU, O_VARIANCE,
-    O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER,
+    O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS,
     O_SETTING = 1024 /* + row index over the tables: a renderer setting */
 };
 
@@ -33,6 +33,7 @@ static const struct option fixed_opts[] = {
     {"variance", required_argument, 0, O_VARIANCE}, {"order", required_argument, 0, O_ORDER},
     {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
     {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
+    {"atmosphere", required_argument, 0, O_ATMOSPHERE}, {"thickness", required_argument, 0, O_THICKNESS},
     {"help", no_argument, 0, 'h'}};
 #define NFIXED ((int)(sizeof fixed_opts / sizeof fixed_opts[0]))
 
@@ -114,7 +115,7 @@ static int parse_choice(const char *opt, const char *text, const char *const *na
 static void opts_init(render_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->cam_type = o->renderer = o->tone = -1;
+    o->cam_type = o->renderer = o->tone = o->air = -1;
     o->altitude = o->sun_el = o->sun_az = o->lat = o->lon = o->ev = o->ev_comp = NAN;
     o->sun_el_end = o->sun_az_end = NAN;
 }
@@ -124,7 +125,7 @@ static void opts_init(render_opts *o)
 static int parse_named(int c, const char *arg, render_opts *o)
 {
     static const char *const cams[] = {"pinhole", "fisheye", "equirect"}, *const tones[] = {"filmic", "reinhard", "clamp"},
-                             *const renderers[] = {"sky", "slice", "path"};
+                             *const renderers[] = {"sky", "slice", "path"}, *const airs[] = {"riley", "homogeneous"};
     switch (c) {
     case 'o': o->png = arg; return 1;
     case O_EXR: o->exr = arg; return 1;
@@ -140,6 +141,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
     case O_RENDERER: return parse_choice("--renderer", arg, renderers, 3, &o->renderer);
+    case O_ATMOSPHERE: return parse_choice("--atmosphere", arg, airs, 2, &o->air);
     case O_EXPOSURE:
         if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
         return cli_parse_double("render", "--exposure", arg, &o->ev);
@@ -179,6 +181,10 @@ static int parse_number(int c, const char *arg, render_opts *o)
     case O_EXPCOMP: return cli_parse_double(C, "--exposure-comp", arg, &o->ev_comp);
     case O_SEL_END: return cli_parse_double(C, "--sun-elevation-end", arg, &o->sun_el_end);
     case O_SAZ_END: return cli_parse_double(C, "--sun-azimuth-end", arg, &o->sun_az_end);
+    case O_THICKNESS:
+        if (!cli_parse_double(C, "--thickness", arg, &o->thickness) || !(o->thickness >= 1 && o->thickness <= 1e6))
+            return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]"), 0;
+        return 1;
     case O_DSCALE:
         if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) || !(o->density_scale > 0))
             return cli_usage_error(C, "--density-scale: expected a factor > 0"), 0;
@@ -300,6 +306,10 @@ static int apply_view(const render_opts *o, atmos_scene *s)
         s->tonemap.exposure_ev = o->ev_comp;
     }
     if (o->tone >= 0) s->tonemap.curve = (atmos_tone_curve)o->tone;
+    /* the kind of air (a vacuum background stays a vacuum) */
+    if (o->air >= 0 && s->atmosphere.kind != ATMOS_ATMOSPHERE_VACUUM)
+        s->atmosphere.kind = o->air ? ATMOS_ATMOSPHERE_HOMOGENEOUS : ATMOS_ATMOSPHERE_RILEY;
+    if (o->thickness > 0) s->atmosphere.thickness_m = o->thickness;
     return CLI_EXIT_OK;
 }
 
@@ -346,6 +356,14 @@ int render_opts_apply(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     return rc;
 }
 
+/* A number for --help: integers in full (2^53, not 9.0072e+15), others as %g. */
+static const char *num(char *buf, size_t cap, double v)
+{
+    if (v == floor(v) && fabs(v) < 1e17) snprintf(buf, cap, "%.0f", v);
+    else snprintf(buf, cap, "%g", v);
+    return buf;
+}
+
 /* One --help line per settings row: flag, argument, doc, range and default. */
 static void help_settings(atmos_renderer_kind r, const char *title)
 {
@@ -355,11 +373,12 @@ static void help_settings(atmos_renderer_kind r, const char *title)
     for (int i = 0; i < n; i++) {
         const atmos_setting *s = &t[i];
         if (!s->flag) continue;
-        char opt[64], range[96] = "";
+        char opt[64], range[128] = "", a[32], b[32], c[32];
         snprintf(opt, sizeof opt, "--%s%s", s->flag, !takes_value(s) ? "" : s->type == ATMOS_SETTING_REAL ? " X" : " N");
         if (takes_value(s))
-            snprintf(range, sizeof range, " [%s%g, %g%s%s%s], default %g", s->min_open ? "> " : "", s->min, s->max,
-                     s->max_open ? ")" : "", s->unit[0] ? " " : "", s->unit, s->def);
+            snprintf(range, sizeof range, " [%s%s, %s%s%s%s], default %s", s->min_open ? "> " : "", num(a, sizeof a, s->min),
+                     num(b, sizeof b, s->max), s->max_open ? ")" : "", s->unit[0] ? " " : "", s->unit,
+                     num(c, sizeof c, s->def));
         printf("      %-24s %s%s\n", opt, s->doc, range);
     }
     printf("\n");
@@ -384,7 +403,8 @@ void render_opts_help(void)
            "                          reaching the pixel, weighted by luminance (a key for atmos compare --by)\n\n"
            "Overrides of the scene's settings:\n"
            "      --width W --height H      image size in pixels\n"
-           "      --spp N                   samples per pixel (1..256; path tracer: 1..1000000)\n"
+           "      --spp N                   sky and slice renderers: stratified samples of the sky per pixel\n"
+           "                                (1..256); path tracer: its samples per pixel (below)\n"
            "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
            "      --altitude M              camera altitude above sea level, metres\n"
            "      --sun-elevation E         sun elevation, degrees\n"
@@ -403,7 +423,10 @@ void render_opts_help(void)
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
            "                                (default: 3 widths, at least 4 km, in front of the camera)\n"
-           "      --density-scale S         multiplies the volume's densities\n\n");
+           "      --density-scale S         multiplies the volume's densities\n"
+           "      --atmosphere riley|homogeneous   the air: Riley et al.'s exponential atmosphere (default)\n"
+           "                                or a uniform layer from the ground to --thickness (docs/models.md)\n"
+           "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");
     help_settings(ATMOS_RENDERER_SLICE, "Slice renderer");
     help_settings(ATMOS_RENDERER_PATH, "Path tracer");
     printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"

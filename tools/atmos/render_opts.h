@@ -21,8 +21,8 @@ typedef struct {
     const char *png, *exr, *pfm, *variance, *order, *tau;
     int png_bits, exr_half;
     /* scene overrides (0 / NaN / NULL / -1: not given) */
-    int width, height, spp, spectral, rgb, cam_type, renderer, tone, exposure_auto, frames;
-    double altitude, sun_el, sun_az, lat, lon, ev, ev_comp, sun_el_end, sun_az_end, density_scale;
+    int width, height, spp, spectral, rgb, cam_type, renderer, tone, exposure_auto, frames, air;
+    double altitude, sun_el, sun_az, lat, lon, ev, ev_comp, sun_el_end, sun_az_end, density_scale, thickness;
     const char *time, *time_end, *volume;
     double volume_pos[3];
     int volume_pos_given;
