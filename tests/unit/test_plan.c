@@ -260,8 +260,8 @@ static void test_bad_frames(atmos_context *ctx, const atmos_volume *v)
     CHECK(atmos_plan_render(p, &g, NULL, img, NULL) != ATMOS_OK);
     g = f, g.camera.fov_deg = 270;
     CHECK(atmos_plan_render(p, &g, NULL, img, NULL) == ATMOS_E_INVALID_ARG);
-    atmos_image *none = NULL;
-    CHECK(atmos_plan_path_variance(p, &none) == ATMOS_E_INVALID_ARG && !none);
+    atmos_image *no_var = NULL;
+    CHECK(atmos_plan_path_variance(p, &no_var) == ATMOS_E_INVALID_ARG && !no_var);
     atmos_image_destroy(img);
     atmos_image_destroy(small);
     atmos_plan_destroy(p);
