@@ -16,6 +16,7 @@
  * precisely its west and north edges, since z grows southward.
  */
 #include "core/internal.h"
+#include "volume/netcdf_classic.h"
 #include "volume/reader_common.h"
 #include "volume/volume_internal.h"
 
@@ -235,38 +236,25 @@ static double column_at(const float *v, const double *zm, int nz, size_t stride,
 }
 
 /* Classic-format files (CDF-1/2/5) are read by offset: a truncated one yields
- * zeros past the end instead of an error. The data alone needs at least this many
- * bytes (header and padding not counted), so a shorter file is truncated. */
+ * zeros past the end instead of an error. The header says where every variable's
+ * data starts and how many records there are, so a file shorter than the end of
+ * its data is truncated (netcdf_classic.c). */
 static atmos_status check_classic_size(const src *s)
 {
-    int fmt, nv, unlim = -1;
+    int fmt;
     if (nc_inq_format(s->nc, &fmt) != NC_NOERR) return ATMOS_OK;
     if (fmt != NC_FORMAT_CLASSIC && fmt != NC_FORMAT_64BIT_OFFSET && fmt != NC_FORMAT_CDF5) return ATMOS_OK;
-    if (nc_inq_nvars(s->nc, &nv) != NC_NOERR) return ATMOS_OK;
-    nc_inq_unlimdim(s->nc, &unlim);
-    double need = 0;
-    for (int v = 0; v < nv; v++) {
-        int nd, dims[NC_MAX_VAR_DIMS];
-        nc_type type;
-        size_t tsize;
-        if (nc_inq_var(s->nc, v, NULL, &type, &nd, dims, NULL) != NC_NOERR) continue;
-        if (nc_inq_type(s->nc, type, NULL, &tsize) != NC_NOERR) continue;
-        double n = (double)tsize;
-        for (int d = 0; d < nd; d++) {
-            size_t len;
-            if (nc_inq_dimlen(s->nc, dims[d], &len) != NC_NOERR) len = 0;
-            n *= (double)len; /* the record dimension's length is the record count */
-        }
-        need += n;
-    }
     FILE *f = fopen(s->path, "rb");
     if (!f) return ATMOS_OK;
-    double have = 0;
-    if (fseek(f, 0, SEEK_END) == 0) have = (double)ftell(f);
+    uint64_t need = 0, have = 0;
+    int rc = atmos__netcdf_classic_data_end(f, &need, &have);
     fclose(f);
-    if (have < need)
-        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %.0f bytes, the file has %.0f",
-                            s->path, need, have);
+    if (rc == 1)
+        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated inside the NetCDF header (%llu bytes)", s->path,
+                            (unsigned long long)have);
+    if (rc == 0 && have < need)
+        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %llu bytes, the file has %llu",
+                            s->path, (unsigned long long)need, (unsigned long long)have);
     return ATMOS_OK;
 }
 
