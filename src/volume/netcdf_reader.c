@@ -172,9 +172,17 @@ static atmos_status get_dim(const src *s, const char *name, size_t *len)
     return rc == NC_NOERR ? ATMOS_OK : nc_fail(s, rc, name);
 }
 
+/* A numeric attribute holding one value (nc_get_att_double copies all of an
+ * attribute's values, so the length is checked first). */
 static atmos_status get_att_double(const src *s, int var, const char *name, double *v)
 {
-    int rc = nc_get_att_double(s->nc, var, name, v);
+    nc_type type;
+    size_t len = 0;
+    int rc = nc_inq_att(s->nc, var, name, &type, &len);
+    if (rc == NC_NOERR && type != NC_CHAR && type != NC_STRING && len != 1)
+        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: attribute %s has %zu values, expected one", s->path, name,
+                            len);
+    if (rc == NC_NOERR) rc = nc_get_att_double(s->nc, var, name, v);
     if (rc != NC_NOERR)
         return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: attribute %s missing or not numeric", s->path, name);
     if (!isfinite(*v) || !(*v > 0))
