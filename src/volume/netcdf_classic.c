@@ -180,20 +180,19 @@ static int parse(reader *r, uint64_t *end)
     r->pos = 4;
     r->cdf5 = magic[3] == 5;
     r->off8 = magic[3] != 1;
-    uint64_t numrecs, ndims = 0, nvars = 0, *dim_len = NULL;
+    uint64_t numrecs = 0, ndims = 0, nvars = 0, *dim_len = NULL;
     var_extent *vars = NULL;
-    int rc = -1;
+    int rc = 0;
     if (read_nonneg(r, &numrecs) || read_dims(r, &dim_len, &ndims) || skip_attributes(r) ||
         read_list_head(r, TAG_VARIABLE, 20, &nvars))
-        goto done;
-    if (numrecs == (r->cdf5 ? UINT64_MAX : 0xFFFFFFFFu)) numrecs = 0; /* streaming: records unknown */
-    vars = malloc((size_t)(nvars ? nvars : 1) * sizeof *vars);
-    if (!vars) goto done;
-    for (uint64_t i = 0; i < nvars; i++)
-        if (read_var(r, dim_len, ndims, &vars[i])) goto done;
-    *end = data_end(vars, nvars, numrecs);
-    rc = 0;
-done:
+        rc = -1;
+    if (rc == 0) {
+        if (numrecs == (r->cdf5 ? UINT64_MAX : 0xFFFFFFFFu)) numrecs = 0; /* streaming: records unknown */
+        vars = malloc((size_t)(nvars ? nvars : 1) * sizeof *vars);
+        if (!vars) rc = -1;
+    }
+    for (uint64_t i = 0; i < nvars && rc == 0; i++) rc = read_var(r, dim_len, ndims, &vars[i]);
+    if (rc == 0) *end = data_end(vars, nvars, numrecs);
     free(dim_len);
     free(vars);
     return rc;
