@@ -257,12 +257,12 @@ static uint64_t hash_double(double v)
     return atmos__splitmix64(&u);
 }
 
-atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
-                                     const double *theta_deg, double *phase, atmos__phase_result *res,
-                                     atmos__phase_progress progress, void *progress_user,
-                                     atmos__crystal_stats *stats)
+/* ------------------------------------------------------------ the phase function */
+
+/* Rejects settings and grids the computation cannot use. */
+static atmos_status check_args(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
+                               const double *theta_deg, const double *phase)
 {
-    /* ------------------------------------------------ arguments and resolved parameters */
     if (!p || !theta_deg || !phase || n_angles < 2)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "crystal phase: missing particle, grid or output (n_angles %d)",
                             n_angles);
@@ -292,7 +292,15 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
         if (!(theta_deg[i] >= 0.0 && theta_deg[i] <= 180.0) || (i && !(theta_deg[i] > theta_deg[i - 1])))
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s phase: angle grid must increase within [0, 180] (index %d)",
                                 what, i);
+    return ATMOS_OK;
+}
 
+/* The crystal, its optics and the ray budget, resolved from the particle's settings
+ * and defaults; st gets the resolved parameters (radius, length, index, tilt, rays,
+ * kernel). */
+static atmos_status setup_job(atmos_context *ctx, const atmos_particle_desc *p, double nm, const char *what, job *jb,
+                              atmos__crystal_stats *st)
+{
     double aspect = p->aspect_ratio > 0.0 ? p->aspect_ratio : (p->habit == ATMOS_CRYSTAL_PLATE ? 0.2 : 2.0);
     /* Surface area S = 3 sqrt(3) R^2 (two hexagons) + 6 R L (six rectangles), L = 2 R aspect. */
     double s_per_r2 = 3.0 * sqrt(3.0) + 12.0 * aspect;
@@ -308,43 +316,42 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
                             : snow ? (p->fast ? DEFAULT_RAYS_SNOW_FAST : DEFAULT_RAYS_SNOW)
                                    : (p->fast ? DEFAULT_RAYS_ICE_FAST : DEFAULT_RAYS_ICE);
     if (rays < CHUNKS) rays = CHUNKS;
-    double k0 = snow ? KERNEL_DEG_SNOW : p->fast ? KERNEL_DEG_ICE_FAST : KERNEL_DEG_ICE;
 
     atmos_complex m = atmos_refractive_index_ice(nm);
     if (!(m.re > 1.0 && m.re < 3.0 && m.im <= 0.0 && isfinite(m.im)))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s phase: refractive index %g%+gi at %g nm unusable", what, m.re,
                             m.im, nm);
 
-    job jb;
-    atmos__crystal_init(&jb.crystal, radius, 2.0 * radius * aspect);
-    jb.optics.n = m.re;
-    jb.optics.alpha = 4.0 * ATMOS_PI * -m.im / (nm * 1e-9);
-    jb.optics.tilt = tilt;
-    jb.optics.max_hits = MAX_HITS;
-    jb.optics.cutoff = ENERGY_CUTOFF;
-    jb.seed = hash_double(nm) ^ ((uint64_t)p->kind << 56);
-    jb.rays = rays;
-    const double mean_area = 0.25 * jb.crystal.surface_area; /* Cauchy */
+    atmos__crystal_init(&jb->crystal, radius, 2.0 * radius * aspect);
+    jb->optics.n = m.re;
+    jb->optics.alpha = 4.0 * ATMOS_PI * -m.im / (nm * 1e-9);
+    jb->optics.tilt = tilt;
+    jb->optics.max_hits = MAX_HITS;
+    jb->optics.cutoff = ENERGY_CUTOFF;
+    jb->seed = hash_double(nm) ^ ((uint64_t)p->kind << 56);
+    jb->rays = rays;
 
-    /* ------------------------------------------------ rays: chunks in parallel */
+    memset(st, 0, sizeof *st);
+    st->radius_m = radius;
+    st->length_m = jb->crystal.length;
+    st->mean_projected_area_m2 = 0.25 * jb->crystal.surface_area; /* Cauchy */
+    st->n_real = m.re;
+    st->k_imag = -m.im;
+    st->tilt_rad = tilt;
+    st->rays = rays;
+    st->kernel_deg = snow ? KERNEL_DEG_SNOW : p->fast ? KERNEL_DEG_ICE_FAST : KERNEL_DEG_ICE;
+    return ATMOS_OK;
+}
+
+/* Traces the chunks in parallel into cr[]. Chunks are handed out dynamically (no
+ * barrier per batch, so a thread slowed by other processes does not hold the others
+ * up) and merged in chunk order afterwards. Returns nonzero if progress cancelled. */
+static int trace_chunks(atmos_context *ctx, const job *jb, chunk_result *cr, atmos__phase_progress progress,
+                        void *progress_user)
+{
     int threads = atmos__threads(ctx);
     if (threads < 1) threads = 1;
     if (threads > CHUNKS) threads = CHUNKS;
-    /* total (2 NBINS), omega (NBINS), prefix sums (2 (NBINS + 1)), one histogram (2 NBINS)
-     * per chunk (~9 MB): chunks are handed out dynamically (no barrier per batch, so a
-     * thread slowed by other processes does not hold the others up) and merged in
-     * chunk order afterwards. */
-    double *hist = calloc((size_t)NBINS * (size_t)(2 * CHUNKS + 5) + 2, sizeof(double));
-    double *airy_tab = malloc(sizeof(double) * (size_t)n_angles);
-    if (!hist || !airy_tab) {
-        free(hist);
-        free(airy_tab);
-        return atmos__error(ctx, ATMOS_E_NOMEM, "%s phase: out of memory for histograms", what);
-    }
-    double *total = hist, *omega = hist + 2 * (size_t)NBINS, *c1 = hist + 3 * (size_t)NBINS;
-    double *c2 = c1 + NBINS + 1, *slots = c2 + NBINS + 1;
-    chunk_result cr[CHUNKS];
-    for (int c = 0; c < CHUNKS; c++) cr[c].hist = slots + (size_t)c * 2 * NBINS;
     int done = 0, cancel = 0;
 #pragma omp parallel num_threads(threads)
     {
@@ -354,7 +361,7 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
 #pragma omp atomic read
             stop = cancel;
             if (stop) continue;
-            run_chunk(&jb, c, &cr[c]);
+            run_chunk(jb, c, &cr[c]);
             int now;
 #pragma omp atomic capture
             now = ++done;
@@ -365,12 +372,13 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
             }
         }
     }
-    if (cancel || (progress && progress(progress_user, 1.0))) {
-        free(hist);
-        free(airy_tab);
-        return atmos__error(ctx, ATMOS_E_CANCELLED, "%s phase at %g nm: cancelled", what, nm);
-    }
-    /* Chunk order, whatever thread ran what: bit-identical for any thread count. */
+    return cancel || (progress && progress(progress_user, 1.0));
+}
+
+/* Adds the chunks' histograms into total (2 NBINS) and their energies, per ray, into
+ * st, in chunk order whatever thread ran what: bit-identical for any thread count. */
+static void merge_chunks(const chunk_result *cr, double *total, atmos__crystal_stats *st)
+{
     double reflected = 0.0, transmitted = 0.0, absorbed = 0.0, lost = 0.0, delta = 0.0;
     for (int c = 0; c < CHUNKS; c++) {
         for (int bn = 0; bn < 2 * NBINS; bn++) total[bn] += cr[c].hist[bn];
@@ -380,40 +388,73 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
         lost += cr[c].lost;
         delta += cr[c].delta;
     }
-    double nr = (double)rays;
-    reflected /= nr;
-    transmitted /= nr;
-    absorbed /= nr;
-    lost /= nr;
-    delta /= nr;
+    double nr = (double)st->rays;
+    st->reflected = reflected / nr;
+    st->transmitted = transmitted / nr;
+    st->absorbed = absorbed / nr;
+    st->lost = lost / nr;
+    st->delta_transmitted = delta / nr;
+}
 
-    /* ------------------------------------------------ assemble the phase function */
+/* Work memory: total (2 NBINS), omega (NBINS), prefix sums (2 (NBINS + 1)), one
+ * histogram (2 NBINS) per chunk (~9 MB), and one value per grid angle. */
+typedef struct work {
+    double *mem, *airy;
+    double *total, *omega, *c1, *c2;
+    chunk_result cr[CHUNKS];
+} work;
+
+static int work_alloc(work *w, int n_angles)
+{
+    w->mem = calloc((size_t)NBINS * (size_t)(2 * CHUNKS + 5) + 2, sizeof(double));
+    w->airy = malloc(sizeof(double) * (size_t)n_angles);
+    if (!w->mem || !w->airy) return -1;
+    w->total = w->mem;
+    w->omega = w->mem + 2 * (size_t)NBINS;
+    w->c1 = w->mem + 3 * (size_t)NBINS;
+    w->c2 = w->c1 + NBINS + 1;
+    double *slots = w->c2 + NBINS + 1;
+    for (int c = 0; c < CHUNKS; c++) w->cr[c].hist = slots + (size_t)c * 2 * NBINS;
+    return 0;
+}
+
+static void work_free(work *w)
+{
+    free(w->mem);
+    free(w->airy);
+}
+
+/* The phase function on the grid from the merged histogram and the diffraction
+ * pattern, normalised on the grid; *g its asymmetry parameter. */
+static atmos_status assemble_phase(atmos_context *ctx, const job *jb, const atmos__crystal_stats *st, double nm,
+                                   const char *what, int n_angles, const double *theta_deg, double *phase, work *w,
+                                   double *g)
+{
+    double *total = w->total, *omega = w->omega, *c1 = w->c1, *c2 = w->c2, *airy_tab = w->airy;
     for (int b = 0; b < NBINS; b++) {
         c1[b + 1] = c1[b] + total[b];
         c2[b + 1] = c2[b] + total[NBINS + b];
     }
-    binned h = {total, omega, c1, c2, k0};
+    binned h = {total, omega, c1, c2, st->kernel_deg};
     for (int b = 0; b < NBINS; b++)
         omega[b] = 2.0 * ATMOS_PI * (cos(b * BIN_DEG * ATMOS_DEG2RAD) - cos((b + 1) * BIN_DEG * ATMOS_DEG2RAD));
     /* Energy that left the crystal through the rays; the lost part (still inside after
      * MAX_HITS interactions, typically < 1e-3) is given the same angular distribution
      * as the rest by normalising with what left. */
+    const double nr = (double)st->rays;
     double out_energy = 0.0;
     for (int b = 0; b < NBINS; b++) out_energy += total[b];
-    out_energy += delta * nr;
+    out_energy += st->delta_transmitted * nr;
 
-    diffraction(&jb.crystal, 2.0 * ATMOS_PI / (nm * 1e-9), n_angles, theta_deg, airy_tab);
+    diffraction(&jb->crystal, 2.0 * ATMOS_PI / (nm * 1e-9), n_angles, theta_deg, airy_tab);
     double airy_norm = atmos__sphere_integral(n_angles, theta_deg, airy_tab);
-    if (!(airy_norm > 0.0) || !(out_energy > 0.0)) {
-        free(hist);
-        free(airy_tab);
+    if (!(airy_norm > 0.0) || !(out_energy > 0.0))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
                             "%s phase at %g nm: no scattered energy (grid too coarse for the diffraction peak?)", what,
                             nm);
-    }
     /* Scattering cross-sections in units of <A>: diffraction 1, rays 1 - absorbed. */
-    double w_geo = 1.0 - absorbed, w_dif = 1.0;
-    double f_delta = delta * nr / out_energy;
+    double w_geo = 1.0 - st->absorbed, w_dif = 1.0;
+    double f_delta = st->delta_transmitted * nr / out_energy;
     for (int i = 0; i < n_angles; i++) {
         double geo = smoothed_density(&h, theta_deg[i]) / out_energy;
         double dif = airy_tab[i] / airy_norm;
@@ -426,35 +467,49 @@ atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_de
         phase[i] /= norm;
         airy_tab[i] = phase[i] * cos(theta_deg[i] * ATMOS_DEG2RAD);
     }
-    double g = atmos__sphere_integral(n_angles, theta_deg, airy_tab);
+    *g = atmos__sphere_integral(n_angles, theta_deg, airy_tab);
+    return ATMOS_OK;
+}
 
+atmos_status atmos__crystal_phase_ex(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
+                                     const double *theta_deg, double *phase, atmos__phase_result *res,
+                                     atmos__phase_progress progress, void *progress_user,
+                                     atmos__crystal_stats *stats)
+{
+    atmos_status s = check_args(ctx, p, nm, n_angles, theta_deg, phase);
+    if (s != ATMOS_OK) return s;
+    const char *what = p->kind == ATMOS_PARTICLE_ICE ? "ice" : "snow";
+    job jb;
+    atmos__crystal_stats st;
+    if ((s = setup_job(ctx, p, nm, what, &jb, &st)) != ATMOS_OK) return s;
+    work w;
+    if (work_alloc(&w, n_angles) != 0) {
+        work_free(&w);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "%s phase: out of memory for histograms", what);
+    }
+    double g = 0.0;
+    if (trace_chunks(ctx, &jb, w.cr, progress, progress_user)) {
+        s = atmos__error(ctx, ATMOS_E_CANCELLED, "%s phase at %g nm: cancelled", what, nm);
+    } else {
+        merge_chunks(w.cr, w.total, &st);
+        s = assemble_phase(ctx, &jb, &st, nm, what, n_angles, theta_deg, phase, &w, &g);
+    }
+    work_free(&w);
+    if (s != ATMOS_OK) return s;
     if (res) {
-        res->sigma_ext_m2 = 2.0 * mean_area;
+        /* Scattering cross-sections in units of <A>: diffraction 1, rays 1 - absorbed,
+         * of the extinction 2 <A>. */
+        const double w_geo = 1.0 - st.absorbed, w_dif = 1.0;
+        res->sigma_ext_m2 = 2.0 * st.mean_projected_area_m2;
         res->albedo = (w_geo + w_dif) / 2.0;
         res->g = g;
     }
-    if (stats) {
-        stats->radius_m = radius;
-        stats->length_m = jb.crystal.length;
-        stats->mean_projected_area_m2 = mean_area;
-        stats->n_real = m.re;
-        stats->k_imag = -m.im;
-        stats->tilt_rad = tilt;
-        stats->rays = rays;
-        stats->reflected = reflected;
-        stats->transmitted = transmitted;
-        stats->absorbed = absorbed;
-        stats->lost = lost;
-        stats->delta_transmitted = delta;
-        stats->kernel_deg = k0;
-    }
+    if (stats) *stats = st;
     atmos__log(ctx, ATMOS_LOG_DEBUG,
                "%s phase at %g nm: R %.3g um, L %.3g um, n %.5f, %ld rays: reflected %.4f, transmitted %.4f "
                "(delta %.4f), absorbed %.2e, lost %.2e; g %.4f",
-               what, nm, radius * 1e6, jb.crystal.length * 1e6, m.re, rays, reflected, transmitted, delta, absorbed,
-               lost, g);
-    free(hist);
-    free(airy_tab);
+               what, nm, st.radius_m * 1e6, st.length_m * 1e6, st.n_real, st.rays, st.reflected, st.transmitted,
+               st.delta_transmitted, st.absorbed, st.lost, g);
     return ATMOS_OK;
 }
 

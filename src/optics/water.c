@@ -183,9 +183,8 @@ static void cell_samples(int n, const double *deg, int ns, double *mu, double *s
     }
 }
 
-atmos_status atmos__water_phase(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
-                                const double *theta_deg, double *phase, atmos__phase_result *res,
-                                atmos__phase_progress progress, void *progress_user)
+static atmos_status check_args(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
+                               const double *theta_deg, const double *phase, const atmos__phase_result *res)
 {
     if (!p || !theta_deg || !phase || !res || n_angles < 2)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "water phase: missing argument or fewer than 2 angles (%d)",
@@ -197,46 +196,38 @@ atmos_status atmos__water_phase(atmos_context *ctx, const atmos_particle_desc *p
             return atmos__error(ctx, ATMOS_E_INVALID_ARG,
                                 "water phase: angles must increase within [0, 180] degrees; theta[%d] = %g", i,
                                 theta_deg[i]);
-    atmos_status st = check_distribution(ctx, &p->size);
-    if (st != ATMOS_OK) return st;
+    return check_distribution(ctx, &p->size);
+}
 
-    const atmos_complex m = atmos_refractive_index_water(nm);
-    const double k = 2.0 * ATMOS_PI / (nm * 1e-9);
-    const int mono = p->size.kind == ATMOS_SIZE_MONODISPERSE;
+/* How one wavelength samples the drop sizes and the angles. */
+typedef struct {
+    atmos_complex m;   /* refractive index */
+    double k;          /* wavenumber, 1/m */
+    int mono;          /* one size: p->size.r_m */
+    size_table *tab;   /* the distribution (NULL when mono) */
+    double q_lo, q_hi; /* range of cross-section quantiles sampled */
+    double mean_r2;    /* number-weighted <r^2>, m^2 */
+    int ns;            /* sub-samples per angle cell */
+    int n_sizes;       /* sizes, one per stratum */
+} size_plan;
 
-    size_table *tab = mono ? NULL : malloc(sizeof *tab);
-    if (!mono && !tab) return atmos__error(ctx, ATMOS_E_NOMEM, "water phase: out of memory");
-    double q_lo = 0.0, q_hi = 1.0, mean_r2 = p->size.r_m * p->size.r_m;
-    if (!mono) {
-        build_table(&p->size, tab);
-        mean_r2 = tab->mean_r2;
-        if (p->size.r_min <= 0.0) q_lo = TAIL;
-        if (p->size.r_max <= 0.0) q_hi = 1.0 - TAIL;
-    }
-    double r_lo = mono ? p->size.r_m : exp(table_quantile(tab, q_lo));
-    double r_hi = mono ? p->size.r_m : exp(table_quantile(tab, q_hi));
-    if (k * r_hi > 1e5) {
-        free(tab);
-        return atmos__error(ctx, ATMOS_E_LIMIT,
-                            "water phase: drops up to r = %g m at %g nm need size parameter %g > 1e5 (Mie limit); "
-                            "set size.r_max_m (scene files) / size.r_max",
-                            r_hi, nm, k * r_hi);
-    }
-
-    /* Sub-samples per cell: two per fringe period (2 pi / x) of the median drop in the
-     * widest cell, at most 2 in normal quality (cost) and 1 in fast quality. */
+/* Sub-samples per cell: two per fringe period (2 pi / x) of the median drop in the
+ * widest cell, at most 2 in normal quality (cost) and 1 in fast quality. Number of
+ * sizes: strata DX_TARGET wide in x, within the cost budget. */
+static void plan_counts(const atmos_particle_desc *p, int n_angles, const double *theta_deg, double r_lo, double r_hi,
+                        size_plan *sp)
+{
+    const double k = sp->k;
     double max_cell = 0.0;
     for (int i = 0; i + 1 < n_angles; i++) max_cell = fmax(max_cell, theta_deg[i + 1] - theta_deg[i]);
     /* typical sampled size: the median of the cross-section weight */
-    double x_mean = mono ? k * p->size.r_m : k * exp(table_quantile(tab, 0.5));
+    double x_mean = sp->mono ? k * p->size.r_m : k * exp(table_quantile(sp->tab, 0.5));
     int ns = (int)ceil(max_cell * ATMOS_DEG2RAD * x_mean / ATMOS_PI);
     if (ns < 1) ns = 1;
     if (ns > (p->fast ? 1 : 2)) ns = p->fast ? 1 : 2;
-    if (mono) ns = 1;
-
-    /* Number of sizes: strata DX_TARGET wide in x, within the cost budget. */
+    if (sp->mono) ns = 1;
     int n_sizes = 1;
-    if (!mono) {
+    if (!sp->mono) {
         double span = k * (r_hi - r_lo);
         double want = ceil(span / (p->fast ? 8.0 * DX_TARGET : DX_TARGET));
         /* theta and 180 - theta share one evaluation only without cell sub-samples */
@@ -245,100 +236,189 @@ atmos_status atmos__water_phase(atmos_context *ctx, const atmos_particle_desc *p
         double nmin = p->fast ? MIN_SIZES_FAST : MIN_SIZES_NORMAL;
         n_sizes = (int)fmin(fmax(fmin(want, afford), nmin), MAX_SIZES);
     }
+    sp->ns = ns;
+    sp->n_sizes = n_sizes;
+}
+
+/* The size range (refused beyond the Mie limit) and the sample counts. sp->tab is
+ * allocated here and freed by the caller whatever this returns. */
+static atmos_status plan_sizes(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
+                               const double *theta_deg, size_plan *sp)
+{
+    sp->m = atmos_refractive_index_water(nm);
+    sp->k = 2.0 * ATMOS_PI / (nm * 1e-9);
+    sp->mono = p->size.kind == ATMOS_SIZE_MONODISPERSE;
+    sp->tab = sp->mono ? NULL : malloc(sizeof *sp->tab);
+    if (!sp->mono && !sp->tab) return atmos__error(ctx, ATMOS_E_NOMEM, "water phase: out of memory");
+    const double k = sp->k;
+    sp->q_lo = 0.0, sp->q_hi = 1.0, sp->mean_r2 = p->size.r_m * p->size.r_m;
+    if (!sp->mono) {
+        build_table(&p->size, sp->tab);
+        sp->mean_r2 = sp->tab->mean_r2;
+        if (p->size.r_min <= 0.0) sp->q_lo = TAIL;
+        if (p->size.r_max <= 0.0) sp->q_hi = 1.0 - TAIL;
+    }
+    double r_lo = sp->mono ? p->size.r_m : exp(table_quantile(sp->tab, sp->q_lo));
+    double r_hi = sp->mono ? p->size.r_m : exp(table_quantile(sp->tab, sp->q_hi));
+    if (k * r_hi > 1e5)
+        return atmos__error(ctx, ATMOS_E_LIMIT,
+                            "water phase: drops up to r = %g m at %g nm need size parameter %g > 1e5 (Mie limit); "
+                            "set size.r_max_m (scene files) / size.r_max",
+                            r_hi, nm, k * r_hi);
+    plan_counts(p, n_angles, theta_deg, r_lo, r_hi, sp);
     atmos__log(ctx, ATMOS_LOG_DEBUG,
                "water phase %g nm: m = %.6f%+.3gi, r %.4g..%.4g m (x %.1f..%.1f), %d sizes, %d sub-angles per cell",
-               nm, m.re, m.im, r_lo, r_hi, k * r_lo, k * r_hi, n_sizes, ns);
+               nm, sp->m.re, sp->m.im, r_lo, r_hi, k * r_lo, k * r_hi, sp->n_sizes, sp->ns);
+    return ATMOS_OK;
+}
 
-    const int nsub = n_angles * ns;
-    const int batch = n_sizes < BATCH ? n_sizes : BATCH;
-    double *mu = malloc((size_t)nsub * sizeof *mu);
-    double *sw = malloc((size_t)nsub * sizeof *sw);
-    double *slot = malloc((size_t)batch * n_angles * sizeof *slot); /* per-size |S|^2/(2x^2) */
-    double *slot_q = malloc((size_t)batch * 3 * sizeof *slot_q);   /* Q_ext, Q_sca, g Q_sca */
-    double *acc = calloc((size_t)n_angles, sizeof *acc);
-    if (!mu || !sw || !slot || !slot_q || !acc) {
-        st = atmos__error(ctx, ATMOS_E_NOMEM, "water phase: out of memory for %d angles", n_angles);
-        goto done;
-    }
-    cell_samples(n_angles, theta_deg, ns, mu, sw);
-
-    double qext_sum = 0.0, qsca_sum = 0.0, gq_sum = 0.0;
+/* Radius of size i: stratum i of the cross-section weight, jittered by the
+ * golden-ratio sequence. */
+static double size_radius(const atmos_particle_desc *p, const size_plan *sp, int i)
+{
     const double golden = 0.6180339887498949;
-    for (int b0 = 0; b0 < n_sizes && st == ATMOS_OK; b0 += batch) {
-        int nb = n_sizes - b0 < batch ? n_sizes - b0 : batch;
-        int bst = ATMOS_OK;
+    if (sp->mono) return p->size.r_m;
+    double jit = fmod(0.5 + golden * (i + 1), 1.0);
+    double q = sp->q_lo + (sp->q_hi - sp->q_lo) * (i + jit) / sp->n_sizes;
+    return exp(table_quantile(sp->tab, q));
+}
+
+/* Buffers: the sub-sample angles and weights, per-size slots of one batch, the sums. */
+typedef struct {
+    int n_angles, nsub, batch;
+    double *mu, *sw;   /* cos theta and sin weight of each sub-sample (nsub) */
+    double *slot;      /* per size: cell-averaged |S|^2/(2x^2) (batch x n_angles) */
+    double *slot_q;    /* per size: Q_ext, Q_sca, g Q_sca (batch x 3) */
+    double *acc;       /* sum over sizes of the slots (n_angles) */
+    double qext_sum, qsca_sum, gq_sum;
+} water_work;
+
+static int work_alloc(water_work *w, int n_angles, const size_plan *sp)
+{
+    memset(w, 0, sizeof *w);
+    w->n_angles = n_angles;
+    w->nsub = n_angles * sp->ns;
+    w->batch = sp->n_sizes < BATCH ? sp->n_sizes : BATCH;
+    w->mu = malloc((size_t)w->nsub * sizeof *w->mu);
+    w->sw = malloc((size_t)w->nsub * sizeof *w->sw);
+    w->slot = malloc((size_t)w->batch * n_angles * sizeof *w->slot);
+    w->slot_q = malloc((size_t)w->batch * 3 * sizeof *w->slot_q);
+    w->acc = calloc((size_t)n_angles, sizeof *w->acc);
+    return w->mu && w->sw && w->slot && w->slot_q && w->acc ? 0 : -1;
+}
+
+static void work_free(water_work *w)
+{
+    free(w->mu), free(w->sw), free(w->slot), free(w->slot_q), free(w->acc);
+}
+
+/* Sizes b0 .. b0 + nb - 1 by Mie theory, in parallel, each into its slot. Returns
+ * the worst status of any size. */
+static atmos_status mie_batch(atmos_context *ctx, const atmos_particle_desc *p, const size_plan *sp, int b0, int nb,
+                              water_work *w)
+{
+    const int nsub = w->nsub, n_angles = w->n_angles;
+    int bst = ATMOS_OK;
 #pragma omp parallel num_threads(atmos__threads(ctx)) reduction(max : bst)
-        {
-            bst = ATMOS_OK; /* the private copy of a max reduction starts at INT_MIN */
-            atmos_complex *s1 = malloc((size_t)nsub * sizeof *s1), *s2 = malloc((size_t)nsub * sizeof *s2);
-            double *v = malloc((size_t)nsub * sizeof *v);
-            if (!s1 || !s2 || !v) bst = ATMOS_E_NOMEM;
+    {
+        bst = ATMOS_OK; /* the private copy of a max reduction starts at INT_MIN */
+        atmos_complex *s1 = malloc((size_t)nsub * sizeof *s1), *s2 = malloc((size_t)nsub * sizeof *s2);
+        double *v = malloc((size_t)nsub * sizeof *v);
+        if (!s1 || !s2 || !v) bst = ATMOS_E_NOMEM;
 #pragma omp for schedule(dynamic, 1)
-            for (int j = 0; j < nb; j++) {
-                if (bst != ATMOS_OK) continue;
-                int i = b0 + j;
-                double r = p->size.r_m;
-                if (!mono) {
-                    /* stratum i of the cross-section weight, jittered by the golden-ratio sequence */
-                    double jit = fmod(0.5 + golden * (i + 1), 1.0);
-                    double q = q_lo + (q_hi - q_lo) * (i + jit) / n_sizes;
-                    r = exp(table_quantile(tab, q));
-                }
-                double x = k * r;
-                atmos_mie_result mr;
-                atmos_status s = atmos_mie(NULL, m, x, nsub, mu, s1, s2, &mr);
-                if (s != ATMOS_OK) {
-                    bst = s;
-                    continue;
-                }
-                double f = 1.0 / (2.0 * x * x);
-                for (int a = 0; a < nsub; a++)
-                    v[a] = f * (s1[a].re * s1[a].re + s1[a].im * s1[a].im + s2[a].re * s2[a].re + s2[a].im * s2[a].im);
-                cell_average(n_angles, ns, sw, v, slot + (size_t)j * n_angles);
-                slot_q[3 * j] = mr.qext;
-                slot_q[3 * j + 1] = mr.qsca;
-                slot_q[3 * j + 2] = mr.g * mr.qsca;
-            }
-            free(s1), free(s2), free(v);
-        }
-        if (bst != ATMOS_OK) {
-            st = atmos__error(ctx, (atmos_status)bst, "water phase: Mie computation failed at %g nm (%s)", nm,
-                              atmos_status_string((atmos_status)bst));
-            break;
-        }
-        /* fixed-order reduction: sizes in index order, independent of threads */
         for (int j = 0; j < nb; j++) {
-            const double *sv = slot + (size_t)j * n_angles;
-            for (int a = 0; a < n_angles; a++) acc[a] += sv[a];
-            qext_sum += slot_q[3 * j];
-            qsca_sum += slot_q[3 * j + 1];
-            gq_sum += slot_q[3 * j + 2];
+            if (bst != ATMOS_OK) continue;
+            double x = sp->k * size_radius(p, sp, b0 + j);
+            atmos_mie_result mr;
+            atmos_status s = atmos_mie(NULL, sp->m, x, nsub, w->mu, s1, s2, &mr);
+            if (s != ATMOS_OK) {
+                bst = s;
+                continue;
+            }
+            double f = 1.0 / (2.0 * x * x);
+            for (int a = 0; a < nsub; a++)
+                v[a] = f * (s1[a].re * s1[a].re + s1[a].im * s1[a].im + s2[a].re * s2[a].re + s2[a].im * s2[a].im);
+            cell_average(n_angles, sp->ns, w->sw, v, w->slot + (size_t)j * n_angles);
+            w->slot_q[3 * j] = mr.qext;
+            w->slot_q[3 * j + 1] = mr.qsca;
+            w->slot_q[3 * j + 2] = mr.g * mr.qsca;
         }
-        if (progress && progress(progress_user, (double)(b0 + nb) / n_sizes)) {
-            st = atmos__error(ctx, ATMOS_E_CANCELLED, "water phase: cancelled at %g nm", nm);
-            break;
-        }
+        free(s1), free(s2), free(v);
     }
+    return (atmos_status)bst;
+}
+
+/* Adds a batch's slots to the sums: sizes in index order, independent of threads. */
+static void accumulate(water_work *w, int nb)
+{
+    for (int j = 0; j < nb; j++) {
+        const double *sv = w->slot + (size_t)j * w->n_angles;
+        for (int a = 0; a < w->n_angles; a++) w->acc[a] += sv[a];
+        w->qext_sum += w->slot_q[3 * j];
+        w->qsca_sum += w->slot_q[3 * j + 1];
+        w->gq_sum += w->slot_q[3 * j + 2];
+    }
+}
+
+/* All sizes, batch by batch, with progress (and cancellation) between batches. */
+static atmos_status sum_sizes(atmos_context *ctx, const atmos_particle_desc *p, double nm, const size_plan *sp,
+                              water_work *w, atmos__phase_progress progress, void *progress_user)
+{
+    for (int b0 = 0; b0 < sp->n_sizes; b0 += w->batch) {
+        int nb = sp->n_sizes - b0 < w->batch ? sp->n_sizes - b0 : w->batch;
+        atmos_status bst = mie_batch(ctx, p, sp, b0, nb, w);
+        if (bst != ATMOS_OK)
+            return atmos__error(ctx, bst, "water phase: Mie computation failed at %g nm (%s)", nm,
+                                atmos_status_string(bst));
+        accumulate(w, nb);
+        if (progress && progress(progress_user, (double)(b0 + nb) / sp->n_sizes))
+            return atmos__error(ctx, ATMOS_E_CANCELLED, "water phase: cancelled at %g nm", nm);
+    }
+    return ATMOS_OK;
+}
+
+/* The phase function from the sums, normalised on the grid, and the cross-sections:
+ * dsigma/dOmega / sigma_sca = E[|S|^2/(2x^2)] / (pi E[Q_sca]). */
+static atmos_status finish(atmos_context *ctx, double nm, const double *theta_deg, const size_plan *sp,
+                           const water_work *w, double *phase, atmos__phase_result *res)
+{
+    const int n_angles = w->n_angles;
+    double norm = ATMOS_PI * w->qsca_sum;
+    for (int a = 0; a < n_angles; a++) phase[a] = w->acc[a] / norm;
+    double integral = atmos__sphere_integral(n_angles, theta_deg, phase);
+    atmos__log(ctx, ATMOS_LOG_DEBUG, "water phase %g nm: integral of P over the sphere before normalising: %.8f", nm,
+               integral);
+    if (!(integral > 0.0 && isfinite(integral)))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "water phase: the angle grid does not resolve the phase function at %g nm "
+                            "(integral %g)",
+                            nm, integral);
+    for (int a = 0; a < n_angles; a++) phase[a] /= integral;
+    res->sigma_ext_m2 = ATMOS_PI * sp->mean_r2 * w->qext_sum / sp->n_sizes;
+    res->albedo = w->qsca_sum / w->qext_sum;
+    res->g = w->gq_sum / w->qsca_sum;
+    return ATMOS_OK;
+}
+
+atmos_status atmos__water_phase(atmos_context *ctx, const atmos_particle_desc *p, double nm, int n_angles,
+                                const double *theta_deg, double *phase, atmos__phase_result *res,
+                                atmos__phase_progress progress, void *progress_user)
+{
+    atmos_status st = check_args(ctx, p, nm, n_angles, theta_deg, phase, res);
+    if (st != ATMOS_OK) return st;
+    size_plan sp;
+    memset(&sp, 0, sizeof sp);
+    water_work w;
+    memset(&w, 0, sizeof w);
+    st = plan_sizes(ctx, p, nm, n_angles, theta_deg, &sp);
+    if (st == ATMOS_OK && work_alloc(&w, n_angles, &sp) != 0)
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "water phase: out of memory for %d angles", n_angles);
     if (st == ATMOS_OK) {
-        /* dsigma/dOmega / sigma_sca = E[|S|^2/(2x^2)] / (pi E[Q_sca]) */
-        double norm = ATMOS_PI * qsca_sum;
-        for (int a = 0; a < n_angles; a++) phase[a] = acc[a] / norm;
-        double integral = atmos__sphere_integral(n_angles, theta_deg, phase);
-        atmos__log(ctx, ATMOS_LOG_DEBUG, "water phase %g nm: integral of P over the sphere before normalising: %.8f",
-                   nm, integral);
-        if (!(integral > 0.0 && isfinite(integral))) {
-            st = atmos__error(ctx, ATMOS_E_INVALID_ARG,
-                              "water phase: the angle grid does not resolve the phase function at %g nm "
-                              "(integral %g)",
-                              nm, integral);
-        } else {
-            for (int a = 0; a < n_angles; a++) phase[a] /= integral;
-            res->sigma_ext_m2 = ATMOS_PI * mean_r2 * qext_sum / n_sizes;
-            res->albedo = qsca_sum / qext_sum;
-            res->g = gq_sum / qsca_sum;
-        }
+        cell_samples(n_angles, theta_deg, sp.ns, w.mu, w.sw);
+        st = sum_sizes(ctx, p, nm, &sp, &w, progress, progress_user);
     }
-done:
-    free(tab), free(mu), free(sw), free(slot), free(slot_q), free(acc);
+    if (st == ATMOS_OK) st = finish(ctx, nm, theta_deg, &sp, &w, phase, res);
+    work_free(&w);
+    free(sp.tab);
     return st;
 }

@@ -114,120 +114,129 @@ static const char *codec_name(unsigned c)
     return c == 0 ? "none" : c == 1 ? "zip" : c == 2 ? "blosc" : "unknown";
 }
 
+/* The grids listed so far, in file order. */
+typedef struct {
+    grid_entry *g;
+    int n, cap;
+} grid_list;
+
+/* Checks the 16-byte segment header at off; *gcount is its number of grids. */
+static atmos_status segment_header(atmos_context *ctx, const char *path, const source *s, uint64_t off, int listed,
+                                   unsigned *gcount)
+{
+    unsigned char h[NVDB_HEADER_SIZE];
+    if (src_read(s, off, h, sizeof h) != 0)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated NanoVDB segment header at byte %llu", path,
+                            (unsigned long long)off);
+    const uint64_t magic = rd_u64(h);
+    const uint32_t version = rd_u32(h + 8);
+    const unsigned codec = (unsigned)h[14] | (unsigned)h[15] << 8;
+    *gcount = (unsigned)h[12] | (unsigned)h[13] << 8;
+    if (magic != PNANOVDB_MAGIC_NUMBER)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: not a NanoVDB file (bad magic number at byte %llu)", path,
+                            (unsigned long long)off);
+    if ((version >> 21) != PNANOVDB_MAJOR_VERSION_NUMBER)
+        return atmos__error(ctx, ATMOS_E_UNSUPPORTED,
+                            "%s: NanoVDB file format version %u.%u; this reader handles major version %u", path,
+                            version >> 21, (version >> 10) & 0x7ffu, (unsigned)PNANOVDB_MAJOR_VERSION_NUMBER);
+    if (codec != NVDB_CODEC_NONE)
+        return atmos__error(ctx, ATMOS_E_UNSUPPORTED,
+                            "%s: %s-compressed NanoVDB file; atmos reads uncompressed .nvdb only (re-save it "
+                            "with codec NONE, e.g. nanovdb_convert without -z/-b)",
+                            path, codec_name(codec));
+    if (*gcount == 0 || (unsigned)listed + *gcount > NVDB_MAX_GRIDS)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: segment at byte %llu declares %u grids", path,
+                            (unsigned long long)off, *gcount);
+    return ATMOS_OK;
+}
+
+/* Reads one grid's metadata and name at *off (advanced past them) into a new entry. */
+static atmos_status grid_metadata(atmos_context *ctx, const char *path, const source *s, uint64_t *off,
+                                  grid_list *l)
+{
+    unsigned char m[NVDB_META_SIZE];
+    if (src_read(s, *off, m, sizeof m) != 0)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated grid metadata (grid %d)", path, l->n);
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 4;
+        grid_entry *ng = realloc(l->g, (size_t)cap * sizeof *ng);
+        if (!ng) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
+        l->g = ng;
+        l->cap = cap;
+    }
+    grid_entry *e = &l->g[l->n];
+    memset(e, 0, sizeof *e);
+    e->grid_size = rd_u64(m);
+    e->file_size = rd_u64(m + 8);
+    e->grid_type = rd_u32(m + 32);
+    const uint32_t name_size = rd_u32(m + 136);
+    e->codec = (uint16_t)(m[168] | m[169] << 8);
+    *off += NVDB_META_SIZE;
+    if (name_size == 0 || name_size > NVDB_MAX_NAME)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: grid %d: implausible name length %u", path, l->n, name_size);
+    char name[NVDB_MAX_NAME];
+    if (src_read(s, *off, name, name_size) != 0)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated grid name (grid %d)", path, l->n);
+    name[name_size - 1] = '\0';
+    /* Longer names than NanoVDB's own 256-byte limit are cut, not trusted. */
+    size_t nl = strnlen(name, sizeof e->name - 1);
+    memcpy(e->name, name, nl);
+    e->name[nl] = '\0';
+    *off += name_size;
+    l->n++;
+    return ATMOS_OK;
+}
+
+/* The buffers of grids first.. follow all of the segment's metadata, in order, from
+ * *off (advanced past them). */
+static atmos_status place_buffers(atmos_context *ctx, const char *path, const source *s, uint64_t *off,
+                                  grid_list *l, int first)
+{
+    for (int i = first; i < l->n; i++) {
+        grid_entry *e = &l->g[i];
+        if (e->file_size != e->grid_size)
+            return atmos__error(ctx, ATMOS_E_FORMAT,
+                                "%s: grid '%s': stored size %llu differs from its size %llu in an uncompressed file",
+                                path, e->name, (unsigned long long)e->file_size, (unsigned long long)e->grid_size);
+        if (e->file_size > s->size - *off)
+            return atmos__error(ctx, ATMOS_E_FORMAT,
+                                "%s: grid '%s': truncated (needs %llu bytes at byte %llu, the file has %llu)", path,
+                                e->name, (unsigned long long)e->file_size, (unsigned long long)*off,
+                                (unsigned long long)s->size);
+        e->offset = *off;
+        *off += e->file_size;
+    }
+    return ATMOS_OK;
+}
+
+/* One segment at *off: header, metadata, buffers. */
+static atmos_status list_segment(atmos_context *ctx, const char *path, const source *s, uint64_t *off, grid_list *l)
+{
+    unsigned gcount = 0;
+    atmos_status st = segment_header(ctx, path, s, *off, l->n, &gcount);
+    if (st != ATMOS_OK) return st;
+    *off += NVDB_HEADER_SIZE;
+    const int first = l->n;
+    for (unsigned i = 0; i < gcount; i++)
+        if ((st = grid_metadata(ctx, path, s, off, l)) != ATMOS_OK) return st;
+    return place_buffers(ctx, path, s, off, l, first);
+}
+
 /* Lists the grids of every segment. */
 static atmos_status list_file(atmos_context *ctx, const char *path, const source *s, grid_entry **out, int *count)
 {
-    *out = NULL;
-    *count = 0;
-    grid_entry *g = NULL;
-    int n = 0, cap = 0;
+    grid_list l = {NULL, 0, 0};
     uint64_t off = 0;
     atmos_status st = ATMOS_OK;
-    while (off < s->size) {
-        unsigned char h[NVDB_HEADER_SIZE];
-        if (src_read(s, off, h, sizeof h) != 0) {
-            st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated NanoVDB segment header at byte %llu", path,
-                              (unsigned long long)off);
-            goto fail;
-        }
-        const uint64_t magic = rd_u64(h);
-        const uint32_t version = rd_u32(h + 8);
-        const unsigned gcount = (unsigned)h[12] | (unsigned)h[13] << 8;
-        const unsigned codec = (unsigned)h[14] | (unsigned)h[15] << 8;
-        if (magic != PNANOVDB_MAGIC_NUMBER) {
-            st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: not a NanoVDB file (bad magic number at byte %llu)", path,
-                              (unsigned long long)off);
-            goto fail;
-        }
-        if ((version >> 21) != PNANOVDB_MAJOR_VERSION_NUMBER) {
-            st = atmos__error(ctx, ATMOS_E_UNSUPPORTED,
-                              "%s: NanoVDB file format version %u.%u; this reader handles major version %u", path,
-                              version >> 21, (version >> 10) & 0x7ffu, (unsigned)PNANOVDB_MAJOR_VERSION_NUMBER);
-            goto fail;
-        }
-        if (codec != NVDB_CODEC_NONE) {
-            st = atmos__error(ctx, ATMOS_E_UNSUPPORTED,
-                              "%s: %s-compressed NanoVDB file; atmos reads uncompressed .nvdb only (re-save it "
-                              "with codec NONE, e.g. nanovdb_convert without -z/-b)",
-                              path, codec_name(codec));
-            goto fail;
-        }
-        if (gcount == 0 || (unsigned)n + gcount > NVDB_MAX_GRIDS) {
-            st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: segment at byte %llu declares %u grids", path,
-                              (unsigned long long)off, gcount);
-            goto fail;
-        }
-        off += NVDB_HEADER_SIZE;
-        int first = n;
-        for (unsigned i = 0; i < gcount; i++) {
-            unsigned char m[NVDB_META_SIZE];
-            if (src_read(s, off, m, sizeof m) != 0) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated grid metadata (grid %d)", path, n);
-                goto fail;
-            }
-            if (n == cap) {
-                cap = cap ? 2 * cap : 4;
-                grid_entry *ng = realloc(g, (size_t)cap * sizeof *g);
-                if (!ng) {
-                    st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-                    goto fail;
-                }
-                g = ng;
-            }
-            grid_entry *e = &g[n];
-            memset(e, 0, sizeof *e);
-            e->grid_size = rd_u64(m);
-            e->file_size = rd_u64(m + 8);
-            e->grid_type = rd_u32(m + 32);
-            const uint32_t name_size = rd_u32(m + 136);
-            e->codec = (uint16_t)(m[168] | m[169] << 8);
-            off += NVDB_META_SIZE;
-            if (name_size == 0 || name_size > NVDB_MAX_NAME) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: grid %d: implausible name length %u", path, n, name_size);
-                goto fail;
-            }
-            char name[NVDB_MAX_NAME];
-            if (src_read(s, off, name, name_size) != 0) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated grid name (grid %d)", path, n);
-                goto fail;
-            }
-            name[name_size - 1] = '\0';
-            /* Longer names than NanoVDB's own 256-byte limit are cut, not trusted. */
-            size_t nl = strnlen(name, sizeof e->name - 1);
-            memcpy(e->name, name, nl);
-            e->name[nl] = '\0';
-            off += name_size;
-            n++;
-        }
-        /* The buffers follow all of the segment's metadata, in order. */
-        for (int i = first; i < n; i++) {
-            if (g[i].file_size != g[i].grid_size) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT,
-                                  "%s: grid '%s': stored size %llu differs from its size %llu in an uncompressed file",
-                                  path, g[i].name, (unsigned long long)g[i].file_size,
-                                  (unsigned long long)g[i].grid_size);
-                goto fail;
-            }
-            if (g[i].file_size > s->size - off) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT,
-                                  "%s: grid '%s': truncated (needs %llu bytes at byte %llu, the file has %llu)", path,
-                                  g[i].name, (unsigned long long)g[i].file_size, (unsigned long long)off,
-                                  (unsigned long long)s->size);
-                goto fail;
-            }
-            g[i].offset = off;
-            off += g[i].file_size;
-        }
+    while (off < s->size && st == ATMOS_OK) st = list_segment(ctx, path, s, &off, &l);
+    if (st == ATMOS_OK && l.n == 0) st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: empty file, no NanoVDB grids", path);
+    if (st != ATMOS_OK) {
+        free(l.g);
+        l.g = NULL;
+        l.n = 0;
     }
-    if (n == 0) {
-        st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: empty file, no NanoVDB grids", path);
-        goto fail;
-    }
-    *out = g;
-    *count = n;
-    return ATMOS_OK;
-fail:
-    free(g);
+    *out = l.g;
+    *count = l.n;
     return st;
 }
 
@@ -498,178 +507,220 @@ static void list_names(const grid_entry *g, int n, char *buf, size_t cap)
     }
 }
 
-static atmos_status load_source(atmos_context *ctx, const char *path, const source *s,
-                                const atmos_volume_load_desc *desc, atmos_volume **out)
-{
-    grid_entry *g = NULL;
-    int ng = 0;
-    atmos_status st = list_file(ctx, path, s, &g, &ng);
-    if (st != ATMOS_OK) return st;
+/* ------------------------------------------------------------ the reader */
 
-    /* Which grids: the list asked for, else "density", else every float grid. */
-    int sel[ATMOS_VOLUME_MAX_FIELDS], nsel = 0;
+/* One load: the file's grids, the selection, what pass 1 measured, the volume.
+ * Two passes over the selected grids: measure all (bounding box, voxel count, value
+ * check), then create the volume and write. Each grid buffer is read again in pass 2
+ * rather than all being held at once. */
+typedef struct {
+    atmos_context *ctx;
+    const char *path;
+    const source *s;
+    const atmos_volume_load_desc *desc;
+    grid_entry *g;
+    int ng;
+    int sel[ATMOS_VOLUME_MAX_FIELDS], nsel;
+    /* pass 1 */
+    double A0[9], t0[3];            /* the first grid's transform, which all must share */
+    uint64_t total, grid_active[64]; /* active voxels: all grids, each grid */
+    int64_t glo[3], ghi[3];         /* inclusive index box of all grids' active values */
+    int gany;
+    atmos_volume *vol;
+} nvdb_load;
+
+/* Which grids: the list asked for, else "density", else every float grid. */
+static atmos_status choose_grids(nvdb_load *L)
+{
     char present[512];
-    list_names(g, ng, present, sizeof present);
-    if (desc->grids && *desc->grids) {
-        const char *p = desc->grids;
+    list_names(L->g, L->ng, present, sizeof present);
+    L->nsel = 0;
+    if (L->desc->grids && *L->desc->grids) {
+        const char *p = L->desc->grids;
         while (*p) {
             const char *c = strchr(p, ',');
             size_t len = c ? (size_t)(c - p) : strlen(p);
             if (len) {
-                int i = select_grid(g, ng, p, len);
-                if (i < 0) {
-                    st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: grid '%.*s' not found; grids present: %s", path,
-                                      (int)len, p, present);
-                    goto done;
-                }
-                if (nsel == ATMOS_VOLUME_MAX_FIELDS) {
-                    st = atmos__error(ctx, ATMOS_E_LIMIT, "%s: more than %d grids requested", path,
-                                      ATMOS_VOLUME_MAX_FIELDS);
-                    goto done;
-                }
-                sel[nsel++] = i;
+                int i = select_grid(L->g, L->ng, p, len);
+                if (i < 0)
+                    return atmos__error(L->ctx, ATMOS_E_FORMAT, "%s: grid '%.*s' not found; grids present: %s",
+                                        L->path, (int)len, p, present);
+                if (L->nsel == ATMOS_VOLUME_MAX_FIELDS)
+                    return atmos__error(L->ctx, ATMOS_E_LIMIT, "%s: more than %d grids requested", L->path,
+                                        ATMOS_VOLUME_MAX_FIELDS);
+                L->sel[L->nsel++] = i;
             }
             p += len;
             if (*p == ',') p++;
         }
     } else {
-        int i = select_grid(g, ng, "density", 7);
-        if (i >= 0 && g[i].grid_type == PNANOVDB_GRID_TYPE_FLOAT) {
-            sel[nsel++] = i;
+        int i = select_grid(L->g, L->ng, "density", 7);
+        if (i >= 0 && L->g[i].grid_type == PNANOVDB_GRID_TYPE_FLOAT) {
+            L->sel[L->nsel++] = i;
         } else {
-            for (i = 0; i < ng && nsel < ATMOS_VOLUME_MAX_FIELDS; i++)
-                if (g[i].grid_type == PNANOVDB_GRID_TYPE_FLOAT) sel[nsel++] = i;
+            for (i = 0; i < L->ng && L->nsel < ATMOS_VOLUME_MAX_FIELDS; i++)
+                if (L->g[i].grid_type == PNANOVDB_GRID_TYPE_FLOAT) L->sel[L->nsel++] = i;
         }
     }
-    if (nsel == 0) {
-        st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: no float grid to load; grids present: %s", path, present);
-        goto done;
-    }
+    if (L->nsel == 0)
+        return atmos__error(L->ctx, ATMOS_E_FORMAT, "%s: no float grid to load; grids present: %s", L->path, present);
+    return ATMOS_OK;
+}
 
-    const uint64_t limit = desc->max_memory ? desc->max_memory : ATMOS_VOLUME_DEFAULT_MAX_MEMORY;
-    const float scale = desc->density_scale > 0 ? (float)desc->density_scale : 1.0f;
-    atmos_volume *vol = NULL;
-    int64_t glo[3] = {0, 0, 0}, ghi[3] = {0, 0, 0};
-    double A0[9], t0[3];
-    uint64_t total = 0, grid_active[64] = {0};
-    int gany = 0;
-    /* Two passes over the selected grids: measure all (bounding box, voxel
-     * count, value check), then create the volume and write. Each grid buffer is
-     * read again in pass 2 rather than all being held at once. */
-    for (int pass = 1; pass <= 2 && st == ATMOS_OK; pass++) {
-        for (int si = 0; si < nsel && st == ATMOS_OK; si++) {
-            const grid_entry *e = &g[sel[si]];
-            /* Reading the buffer is itself an allocation the file asks for. */
-            if (e->file_size > limit) {
-                st = atmos__error(ctx, ATMOS_E_LIMIT, "%s: grid '%s' is %llu bytes, over the memory limit", path,
-                                  e->name, (unsigned long long)e->file_size);
-                break;
-            }
-            walk w;
-            memset(&w, 0, sizeof w);
-            w.size = e->file_size;
-            /* Whole 8-byte words so PNanoVDB's 64-bit reads stay aligned. */
-            uint64_t words = (w.size + 7) / 8;
-            uint64_t *mem = calloc((size_t)(words ? words : 1), 8);
-            if (!mem) {
-                st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory reading grid '%s'", path, e->name);
-                break;
-            }
-            if (src_read(s, e->offset, mem, w.size) != 0) {
-                free(mem);
-                st = atmos__error(ctx, ATMOS_E_IO, "%s: cannot read grid '%s': %s", path, e->name, strerror(errno));
-                break;
-            }
-            w.buf = pnanovdb_make_buf((uint32_t *)mem, words * 2);
-            pnanovdb_root_handle_t root;
-            uint32_t tiles = 0;
-            double A[9], t[3];
-            st = load_grid(ctx, path, e, &w, &root, &tiles, A, t);
-            if (st == ATMOS_OK && pass == 1) {
-                if (walk_root(&w, 1, root, tiles)) {
-                    st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: grid '%s': corrupt tree: %s", path, e->name,
-                                      w.why ? w.why : "invalid node");
-                } else if (w.bad) {
-                    st = atmos__error(ctx, ATMOS_E_FORMAT,
-                                      "%s: grid '%s': value %g at index (%lld, %lld, %lld) is %s; densities must be "
-                                      "finite and >= 0",
-                                      path, e->name, w.bad_value, (long long)w.bad_ijk[0], (long long)w.bad_ijk[1],
-                                      (long long)w.bad_ijk[2], w.bad_value < 0 ? "negative" : "not finite");
-                } else if (si > 0 && (memcmp(A, A0, sizeof A) != 0 || memcmp(t, t0, sizeof t) != 0)) {
-                    st = atmos__error(ctx, ATMOS_E_UNSUPPORTED,
-                                      "%s: grids '%s' and '%s' have different transforms; load them separately", path,
-                                      g[sel[0]].name, e->name);
-                } else {
-                    if (si == 0) {
-                        memcpy(A0, A, sizeof A);
-                        memcpy(t0, t, sizeof t);
-                    }
-                    if (w.active > UINT64_MAX - total) total = UINT64_MAX;
-                    else total += w.active;
-                    if (si < 64) grid_active[si] = w.active;
-                    if (w.any)
-                        for (int a = 0; a < 3; a++) {
-                            if (!gany || w.lo[a] < glo[a]) glo[a] = w.lo[a];
-                            if (!gany || w.hi[a] > ghi[a]) ghi[a] = w.hi[a];
-                        }
-                    gany |= w.any;
-                    atmos__log(ctx, ATMOS_LOG_INFO, "%s: grid '%s': %llu active voxels (tiles counted in full)", path,
-                               e->name, (unsigned long long)w.active);
-                }
-            } else if (st == ATMOS_OK) {
-                char field[64], particle[64];
-                atmos__reader_field_names(e->name, desc, field, particle);
-                st = atmos_volume_add_field(ctx, vol, field, particle, &w.field);
-                if (st == ATMOS_OK && si < 64) atmos__volume_set_file_active(vol, w.field, grid_active[si]);
-                if (st == ATMOS_OK) {
-                    w.ctx = ctx;
-                    w.vol = vol;
-                    w.scale = scale;
-                    memcpy(w.lo, glo, sizeof glo);
-                    if (walk_root(&w, 2, root, tiles))
-                        st = w.status != ATMOS_OK ? w.status
-                                                  : atmos__error(ctx, ATMOS_E_FORMAT, "%s: grid '%s': corrupt tree",
-                                                                 path, e->name);
-                }
-            }
-            for (int l = 0; l < 3; l++) free(w.seen[l]);
-            free(mem);
-        }
-        if (pass == 1 && st == ATMOS_OK) {
-            st = atmos__reader_check_memory(ctx, path, total, desc->max_memory);
-            if (st != ATMOS_OK) break;
-            atmos_volume_desc vd;
-            memset(&vd, 0, sizeof vd);
-            for (int a = 0; a < 3; a++) {
-                int64_t n = gany ? ghi[a] - glo[a] + 1 : 1;
-                if (n > ATMOS_VOLUME_MAX_DIM) {
-                    st = atmos__error(ctx, ATMOS_E_LIMIT, "%s: the grids span %lld voxels along axis %d (limit %d)",
-                                      path, (long long)n, a, ATMOS_VOLUME_MAX_DIM);
-                    break;
-                }
-                vd.dims[a] = (int)n;
-            }
-            if (st != ATMOS_OK) break;
-            if (!gany)
-                atmos__log(ctx, ATMOS_LOG_WARN, "%s: the selected grids have no active voxels; the volume is empty",
-                           path);
-            const int imin[3] = {(int)glo[0], (int)glo[1], (int)glo[2]};
-            char why[256];
-            if (atmos__reader_placement(A0, t0, imin, &vd, why, sizeof why) != 0) {
-                st = atmos__error(ctx, ATMOS_E_UNSUPPORTED, "%s: grid '%s': %s", path, g[sel[0]].name, why);
-                break;
-            }
-            vd.max_memory = desc->max_memory;
-            st = atmos_volume_create(ctx, &vd, &vol);
-            /* a grid placement the core refuses (not a rotation, absurd size) is a malformed file */
-            if (st == ATMOS_E_INVALID_ARG) st = ATMOS_E_FORMAT;
-        }
+/* One selected grid's buffer, read and checked: the walk over it, its root and its
+ * transform. grid_release frees it whatever grid_open returned. */
+typedef struct {
+    walk w;
+    uint64_t *mem;
+    pnanovdb_root_handle_t root;
+    uint32_t tiles;
+    double A[9], t[3];
+} grid_buf;
+
+static atmos_status grid_open(const nvdb_load *L, const grid_entry *e, grid_buf *b)
+{
+    memset(b, 0, sizeof *b);
+    const uint64_t limit = L->desc->max_memory ? L->desc->max_memory : ATMOS_VOLUME_DEFAULT_MAX_MEMORY;
+    /* Reading the buffer is itself an allocation the file asks for. */
+    if (e->file_size > limit)
+        return atmos__error(L->ctx, ATMOS_E_LIMIT, "%s: grid '%s' is %llu bytes, over the memory limit", L->path,
+                            e->name, (unsigned long long)e->file_size);
+    b->w.size = e->file_size;
+    /* Whole 8-byte words so PNanoVDB's 64-bit reads stay aligned. */
+    const uint64_t words = (b->w.size + 7) / 8;
+    b->mem = calloc((size_t)(words ? words : 1), 8);
+    if (!b->mem)
+        return atmos__error(L->ctx, ATMOS_E_NOMEM, "%s: out of memory reading grid '%s'", L->path, e->name);
+    if (src_read(L->s, e->offset, b->mem, b->w.size) != 0)
+        return atmos__error(L->ctx, ATMOS_E_IO, "%s: cannot read grid '%s': %s", L->path, e->name, strerror(errno));
+    b->w.buf = pnanovdb_make_buf((uint32_t *)b->mem, words * 2);
+    return load_grid(L->ctx, L->path, e, &b->w, &b->root, &b->tiles, b->A, b->t);
+}
+
+static void grid_release(grid_buf *b)
+{
+    for (int l = 0; l < 3; l++) free(b->w.seen[l]);
+    free(b->mem);
+}
+
+/* Pass 1 over selected grid si: checks its tree, values and transform, and adds its
+ * active voxels and index box to the totals. */
+static atmos_status measure_grid(nvdb_load *L, int si, grid_buf *b)
+{
+    const grid_entry *e = &L->g[L->sel[si]];
+    walk *w = &b->w;
+    if (walk_root(w, 1, b->root, b->tiles))
+        return atmos__error(L->ctx, ATMOS_E_FORMAT, "%s: grid '%s': corrupt tree: %s", L->path, e->name,
+                            w->why ? w->why : "invalid node");
+    if (w->bad)
+        return atmos__error(L->ctx, ATMOS_E_FORMAT,
+                            "%s: grid '%s': value %g at index (%lld, %lld, %lld) is %s; densities must be "
+                            "finite and >= 0",
+                            L->path, e->name, w->bad_value, (long long)w->bad_ijk[0], (long long)w->bad_ijk[1],
+                            (long long)w->bad_ijk[2], w->bad_value < 0 ? "negative" : "not finite");
+    if (si > 0 && (memcmp(b->A, L->A0, sizeof b->A) != 0 || memcmp(b->t, L->t0, sizeof b->t) != 0))
+        return atmos__error(L->ctx, ATMOS_E_UNSUPPORTED,
+                            "%s: grids '%s' and '%s' have different transforms; load them separately", L->path,
+                            L->g[L->sel[0]].name, e->name);
+    if (si == 0) {
+        memcpy(L->A0, b->A, sizeof b->A);
+        memcpy(L->t0, b->t, sizeof b->t);
     }
-    if (st == ATMOS_OK) st = atmos_volume_finalize(ctx, vol);
-    if (st != ATMOS_OK) atmos_volume_destroy(vol);
-    else *out = vol;
-done:
-    free(g);
+    if (w->active > UINT64_MAX - L->total) L->total = UINT64_MAX;
+    else L->total += w->active;
+    if (si < 64) L->grid_active[si] = w->active;
+    if (w->any)
+        for (int a = 0; a < 3; a++) {
+            if (!L->gany || w->lo[a] < L->glo[a]) L->glo[a] = w->lo[a];
+            if (!L->gany || w->hi[a] > L->ghi[a]) L->ghi[a] = w->hi[a];
+        }
+    L->gany |= w->any;
+    atmos__log(L->ctx, ATMOS_LOG_INFO, "%s: grid '%s': %llu active voxels (tiles counted in full)", L->path, e->name,
+               (unsigned long long)w->active);
+    return ATMOS_OK;
+}
+
+/* After pass 1: the memory check, then the volume spanning all grids' index box,
+ * placed by their shared transform. */
+static atmos_status create_volume(nvdb_load *L)
+{
+    atmos_status st = atmos__reader_check_memory(L->ctx, L->path, L->total, L->desc->max_memory);
+    if (st != ATMOS_OK) return st;
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    for (int a = 0; a < 3; a++) {
+        int64_t n = L->gany ? L->ghi[a] - L->glo[a] + 1 : 1;
+        if (n > ATMOS_VOLUME_MAX_DIM)
+            return atmos__error(L->ctx, ATMOS_E_LIMIT, "%s: the grids span %lld voxels along axis %d (limit %d)",
+                                L->path, (long long)n, a, ATMOS_VOLUME_MAX_DIM);
+        vd.dims[a] = (int)n;
+    }
+    if (!L->gany)
+        atmos__log(L->ctx, ATMOS_LOG_WARN, "%s: the selected grids have no active voxels; the volume is empty",
+                   L->path);
+    const int imin[3] = {(int)L->glo[0], (int)L->glo[1], (int)L->glo[2]};
+    char why[256];
+    if (atmos__reader_placement(L->A0, L->t0, imin, &vd, why, sizeof why) != 0)
+        return atmos__error(L->ctx, ATMOS_E_UNSUPPORTED, "%s: grid '%s': %s", L->path, L->g[L->sel[0]].name, why);
+    vd.max_memory = L->desc->max_memory;
+    st = atmos_volume_create(L->ctx, &vd, &L->vol);
+    /* a grid placement the core refuses (not a rotation, absurd size) is a malformed file */
+    return st == ATMOS_E_INVALID_ARG ? ATMOS_E_FORMAT : st;
+}
+
+/* Pass 2 over selected grid si: adds its field and writes its values. */
+static atmos_status write_grid(nvdb_load *L, int si, grid_buf *b)
+{
+    const grid_entry *e = &L->g[L->sel[si]];
+    walk *w = &b->w;
+    char field[64], particle[64];
+    atmos__reader_field_names(e->name, L->desc, field, particle);
+    atmos_status st = atmos_volume_add_field(L->ctx, L->vol, field, particle, &w->field);
+    if (st != ATMOS_OK) return st;
+    if (si < 64) atmos__volume_set_file_active(L->vol, w->field, L->grid_active[si]);
+    w->ctx = L->ctx;
+    w->vol = L->vol;
+    w->scale = L->desc->density_scale > 0 ? (float)L->desc->density_scale : 1.0f;
+    memcpy(w->lo, L->glo, sizeof L->glo);
+    if (walk_root(w, 2, b->root, b->tiles))
+        return w->status != ATMOS_OK
+                   ? w->status
+                   : atmos__error(L->ctx, ATMOS_E_FORMAT, "%s: grid '%s': corrupt tree", L->path, e->name);
+    return ATMOS_OK;
+}
+
+/* One pass over the selected grids, each read, used and released in turn. */
+static atmos_status run_pass(nvdb_load *L, int pass)
+{
+    for (int si = 0; si < L->nsel; si++) {
+        grid_buf b;
+        atmos_status st = grid_open(L, &L->g[L->sel[si]], &b);
+        if (st == ATMOS_OK) st = pass == 1 ? measure_grid(L, si, &b) : write_grid(L, si, &b);
+        grid_release(&b);
+        if (st != ATMOS_OK) return st;
+    }
+    return ATMOS_OK;
+}
+
+static atmos_status load_source(atmos_context *ctx, const char *path, const source *s,
+                                const atmos_volume_load_desc *desc, atmos_volume **out)
+{
+    nvdb_load L;
+    memset(&L, 0, sizeof L);
+    L.ctx = ctx;
+    L.path = path;
+    L.s = s;
+    L.desc = desc;
+    atmos_status st = list_file(ctx, path, s, &L.g, &L.ng);
+    if (st != ATMOS_OK) return st;
+    st = choose_grids(&L);
+    if (st == ATMOS_OK) st = run_pass(&L, 1);
+    if (st == ATMOS_OK) st = create_volume(&L);
+    if (st == ATMOS_OK) st = run_pass(&L, 2);
+    if (st == ATMOS_OK) st = atmos_volume_finalize(ctx, L.vol);
+    if (st != ATMOS_OK) atmos_volume_destroy(L.vol);
+    else *out = L.vol;
+    free(L.g);
     return atmos__reader_name_error(ctx, path, st);
 }
 

@@ -16,6 +16,7 @@
  * precisely its west and north edges, since z grows southward.
  */
 #include "core/internal.h"
+#include "volume/netcdf_classic.h"
 #include "volume/reader_common.h"
 #include "volume/volume_internal.h"
 
@@ -171,9 +172,17 @@ static atmos_status get_dim(const src *s, const char *name, size_t *len)
     return rc == NC_NOERR ? ATMOS_OK : nc_fail(s, rc, name);
 }
 
+/* A numeric attribute holding one value (nc_get_att_double copies all of an
+ * attribute's values, so the length is checked first). */
 static atmos_status get_att_double(const src *s, int var, const char *name, double *v)
 {
-    int rc = nc_get_att_double(s->nc, var, name, v);
+    nc_type type;
+    size_t len = 0;
+    int rc = nc_inq_att(s->nc, var, name, &type, &len);
+    if (rc == NC_NOERR && type != NC_CHAR && type != NC_STRING && len != 1)
+        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: attribute %s has %zu values, expected one", s->path, name,
+                            len);
+    if (rc == NC_NOERR) rc = nc_get_att_double(s->nc, var, name, v);
     if (rc != NC_NOERR)
         return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: attribute %s missing or not numeric", s->path, name);
     if (!isfinite(*v) || !(*v > 0))
@@ -235,42 +244,592 @@ static double column_at(const float *v, const double *zm, int nz, size_t stride,
 }
 
 /* Classic-format files (CDF-1/2/5) are read by offset: a truncated one yields
- * zeros past the end instead of an error. The data alone needs at least this many
- * bytes (header and padding not counted), so a shorter file is truncated. */
+ * zeros past the end instead of an error. The header says where every variable's
+ * data starts and how many records there are, so a file shorter than the end of
+ * its data is truncated (netcdf_classic.c). */
 static atmos_status check_classic_size(const src *s)
 {
-    int fmt, nv, unlim = -1;
+    int fmt;
     if (nc_inq_format(s->nc, &fmt) != NC_NOERR) return ATMOS_OK;
     if (fmt != NC_FORMAT_CLASSIC && fmt != NC_FORMAT_64BIT_OFFSET && fmt != NC_FORMAT_CDF5) return ATMOS_OK;
-    if (nc_inq_nvars(s->nc, &nv) != NC_NOERR) return ATMOS_OK;
-    nc_inq_unlimdim(s->nc, &unlim);
-    double need = 0;
-    for (int v = 0; v < nv; v++) {
-        int nd, dims[NC_MAX_VAR_DIMS];
-        nc_type type;
-        size_t tsize;
-        if (nc_inq_var(s->nc, v, NULL, &type, &nd, dims, NULL) != NC_NOERR) continue;
-        if (nc_inq_type(s->nc, type, NULL, &tsize) != NC_NOERR) continue;
-        double n = (double)tsize;
-        for (int d = 0; d < nd; d++) {
-            size_t len;
-            if (nc_inq_dimlen(s->nc, dims[d], &len) != NC_NOERR) len = 0;
-            n *= (double)len; /* the record dimension's length is the record count */
-        }
-        need += n;
-    }
     FILE *f = fopen(s->path, "rb");
     if (!f) return ATMOS_OK;
-    double have = 0;
-    if (fseek(f, 0, SEEK_END) == 0) have = (double)ftell(f);
+    uint64_t need = 0, have = 0;
+    int rc = atmos__netcdf_classic_data_end(f, &need, &have);
     fclose(f);
-    if (have < need)
-        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %.0f bytes, the file has %.0f",
-                            s->path, need, have);
+    if (rc == 1)
+        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated inside the NetCDF header (%llu bytes)", s->path,
+                            (unsigned long long)have);
+    if (rc == 0 && have < need)
+        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %llu bytes, the file has %llu",
+                            s->path, (unsigned long long)need, (unsigned long long)have);
+    return ATMOS_OK;
+}
+
+/* ------------------------------------------------------------ loader state */
+
+/* Everything one load holds. Each step below fills part of it and returns a status;
+ * loader_free releases all of it, whichever step failed. */
+typedef struct {
+    src s;
+    int opened;                           /* s.nc is open */
+    const atmos_volume_load_desc *desc;
+    char present[1024];                   /* the file's variables, for messages */
+    int sel[NHYDRO], nsel;                /* hydrometeors to load (indices into hydro[]) */
+    int use_rho;                          /* CM1: density from rho, else from prs and th */
+    double dx, dy;                        /* horizontal grid spacing, m */
+    size_t ncol, n3, n3s;                 /* columns, mass points, staggered (w) points */
+    float *buf, *buf2;                    /* read buffers (n3s floats; buf2 for WRF only) */
+    float *qv;                            /* CM1 water vapour, when the file has it */
+    double *rho;                          /* dry-air density at the mass points, kg/m^3 */
+    double *zw, *zm;                      /* heights (m) of the w-levels (n3s), mass levels (n3) */
+    double *zh;                           /* CM1: heights of the region's mass levels (nz + 1) */
+    double *xc, *yc;                      /* column centres, m (one allocation, xc first) */
+    float *eta;                           /* number densities, m^-3: nsel fields of n3 */
+    double *zmt;                          /* zm transposed: each column's levels contiguous */
+    float *colv;                          /* one output column */
+    double zlo;                           /* bottom of the output grid, m */
+    atmos_volume_desc vd;                 /* the output grid */
+    atmos_volume *vol;
+} loader;
+
+static void loader_free(loader *L)
+{
+    if (L->opened) nc_close(L->s.nc);
+    free(L->buf);
+    free(L->buf2);
+    free(L->qv);
+    free(L->rho);
+    free(L->zw);
+    free(L->zm);
+    free(L->zh);
+    free(L->xc);
+    free(L->eta);
+    free(L->zmt);
+    free(L->colv);
+    atmos_volume_destroy(L->vol);
+    L->vol = NULL;
+}
+
+static atmos_status out_of_memory(const loader *L)
+{
+    return atmos__error(L->s.ctx, ATMOS_E_NOMEM, "%s: out of memory", L->s.path);
+}
+
+static const char *model_var(const loader *L, int h) { return L->s.wrf ? hydro[h].wrf : hydro[h].cm1; }
+
+static const char *model_hydro_list(const loader *L)
+{
+    return L->s.wrf ? "QCLOUD, QRAIN, QICE, QSNOW, QGRAUP" : "qc, qr, qi, qs, qg";
+}
+
+/* ------------------------------------------------------------ opening, identifying */
+
+/* Opens the file; a file that exists but libnetcdf cannot read is a format error. */
+static atmos_status open_file(loader *L)
+{
+    int rc = nc_open(L->s.path, NC_NOWRITE, &L->s.nc);
+    if (rc != NC_NOERR) {
+        FILE *f = fopen(L->s.path, "rb");
+        if (!f) return atmos__error(L->s.ctx, ATMOS_E_IO, "%s: cannot open: %s", L->s.path, nc_strerror(rc));
+        fclose(f);
+        return atmos__error(L->s.ctx, ATMOS_E_FORMAT, "%s: not a readable NetCDF file: %s", L->s.path,
+                            nc_strerror(rc));
+    }
+    L->opened = 1;
+    return ATMOS_OK;
+}
+
+/* WRF or CM1, from the variables each model always writes. */
+static atmos_status identify_model(loader *L)
+{
+    src *s = &L->s;
+    list_vars(s, L->present, sizeof L->present);
+    atmos_status st = check_classic_size(s);
+    if (st != ATMOS_OK) return st;
+    s->wrf = has_var(s, "PH") || has_var(s, "QCLOUD") || has_var(s, "QVAPOR");
+    int cm1 = has_var(s, "qc") || has_var(s, "rho") || has_var(s, "prs");
+    if (!s->wrf && !cm1)
+        return atmos__error(s->ctx, ATMOS_E_FORMAT,
+                            "%s: neither WRF (QCLOUD, P, PB, T, PH, PHB, ...) nor CM1 (qc, rho or prs/th, ...) output; "
+                            "variables present: %s",
+                            s->path, L->present);
+    return ATMOS_OK;
+}
+
+/* ------------------------------------------------------------ choosing variables */
+
+/* Whether the list item p[0..len) names hydrometeor h, by the model's variable name
+ * or by the atmos field name. */
+static int names_hydro(const loader *L, int h, const char *p, size_t len)
+{
+    const char *name = model_var(L, h);
+    return (strlen(name) == len && strncmp(p, name, len) == 0) ||
+           (strlen(hydro[h].field) == len && strncmp(p, hydro[h].field, len) == 0);
+}
+
+/* Whether the comma-separated list asks for hydrometeor h. */
+static int list_asks_for(const loader *L, const char *list, int h)
+{
+    int wanted = 0;
+    const char *p = list;
+    while (*p) {
+        const char *c = strchr(p, ',');
+        size_t len = c ? (size_t)(c - p) : strlen(p);
+        if (names_hydro(L, h, p, len)) wanted = 1;
+        p += len;
+        if (*p == ',') p++;
+    }
+    return wanted;
+}
+
+/* Every name asked for must be a hydrometeor this reader knows (by model or field
+ * name): a misspelt one is an error, not silently dropped. */
+static atmos_status check_list_names(const loader *L, const char *list)
+{
+    const char *p = list;
+    while (*p) {
+        const char *c = strchr(p, ',');
+        size_t len = c ? (size_t)(c - p) : strlen(p);
+        int known = 0;
+        for (int h = 0; h < NHYDRO && len; h++)
+            if (names_hydro(L, h, p, len)) known = 1;
+        if (!known)
+            return atmos__error(L->s.ctx, ATMOS_E_INVALID_ARG,
+                                "%s: '%.*s' is not a hydrometeor variable (%s, or cloud, rain, ice, snow, graupel)",
+                                L->s.path, (int)(len < 64 ? len : 64), p, model_hydro_list(L));
+        p += len;
+        if (*p == ',') p++;
+    }
+    return ATMOS_OK;
+}
+
+/* Which hydrometeors: those asked for (desc->grids, by model or field name), else all
+ * present. */
+static atmos_status choose_hydrometeors(loader *L)
+{
+    const char *list = L->desc->grids && *L->desc->grids ? L->desc->grids : NULL;
+    L->nsel = 0;
+    for (int h = 0; h < NHYDRO; h++) {
+        int wanted;
+        if (list) {
+            wanted = list_asks_for(L, list, h);
+            if (wanted && !has_var(&L->s, model_var(L, h)))
+                return atmos__error(L->s.ctx, ATMOS_E_FORMAT, "%s: variable %s (%s) not found; variables present: %s",
+                                    L->s.path, model_var(L, h), hydro[h].field, L->present);
+        } else {
+            wanted = has_var(&L->s, model_var(L, h));
+        }
+        if (wanted) L->sel[L->nsel++] = h;
+    }
+    if (list) {
+        atmos_status st = check_list_names(L, list);
+        if (st != ATMOS_OK) return st;
+    }
+    if (L->nsel == 0)
+        return atmos__error(L->s.ctx, ATMOS_E_FORMAT, "%s: no hydrometeor variables (%s) %s; variables present: %s",
+                            L->s.path, model_hydro_list(L), list ? "match the requested list" : "found", L->present);
+    return ATMOS_OK;
+}
+
+/* The variables the air density and the heights need. */
+static atmos_status check_density_vars(loader *L)
+{
+    static const char *const need_wrf[] = {"P", "PB", "T", "QVAPOR", "PH", "PHB"};
+    const src *s = &L->s;
+    L->use_rho = !s->wrf && has_var(s, "rho");
+    if (s->wrf) {
+        for (int i = 0; i < 6; i++)
+            if (!has_var(s, need_wrf[i]))
+                return atmos__error(s->ctx, ATMOS_E_FORMAT,
+                                    "%s: WRF variable %s not found (needed for air density and heights: P, PB, T, "
+                                    "QVAPOR, PH, PHB); variables present: %s",
+                                    s->path, need_wrf[i], L->present);
+    } else if (!L->use_rho && !(has_var(s, "prs") && has_var(s, "th"))) {
+        return atmos__error(s->ctx, ATMOS_E_FORMAT,
+                            "%s: CM1 output needs rho, or prs and th, for the air density; variables present: %s",
+                            s->path, L->present);
+    }
+    return ATMOS_OK;
+}
+
+/* ------------------------------------------------------------ dimensions and region */
+
+/* CM1 names its dimensions ni/nj/nk, or after the coordinates xh/yh/zh. */
+static atmos_status get_dim_either(const src *s, const char *a, const char *b, size_t *len)
+{
+    atmos_status st = get_dim(s, a, len);
+    return st == ATMOS_OK ? st : get_dim(s, b, len);
+}
+
+/* Full extents of the mass grid, and WRF's spacing (CM1's comes from its coordinates). */
+static atmos_status read_extents(loader *L)
+{
+    src *s = &L->s;
+    atmos_status st;
+    if (s->wrf) {
+        if ((st = get_dim(s, "west_east", &s->dim_len[0])) || (st = get_dim(s, "south_north", &s->dim_len[1])) ||
+            (st = get_dim(s, "bottom_top", &s->dim_len[2])))
+            return st;
+        if ((st = get_att_double(s, NC_GLOBAL, "DX", &L->dx)) || (st = get_att_double(s, NC_GLOBAL, "DY", &L->dy)))
+            return st;
+    } else {
+        if ((st = get_dim_either(s, "ni", "xh", &s->dim_len[0])) || (st = get_dim_either(s, "nj", "yh", &s->dim_len[1])) ||
+            (st = get_dim_either(s, "nk", "zh", &s->dim_len[2])))
+            return st;
+        L->dx = L->dy = 0; /* from xh, yh once read */
+    }
+    /* A first CM1 name that failed left a message behind. */
+    if (s->ctx) atmos_context_clear_error(s->ctx);
+    for (int a = 0; a < 3; a++)
+        if (s->dim_len[a] < 1 || s->dim_len[a] > 100000)
+            return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: grid dimension %d has %zu points", s->path, a,
+                                s->dim_len[a]);
+    return ATMOS_OK;
+}
+
+/* Sub-region [i0, i1) x [j0, j1) x [k0, k1) of mass points (0 ends mean "to the end")
+ * and the time step. A WRF region may start above the lowest level: its heights come
+ * from the staggered levels bounding the chosen ones. */
+static atmos_status choose_region(loader *L)
+{
+    src *s = &L->s;
+    const int *r = L->desc->region;
+    int lo[3] = {r[0], r[2], r[4]}, hi[3] = {r[1], r[3], r[5]};
+    for (int a = 0; a < 3; a++) {
+        if (hi[a] == 0) hi[a] = (int)s->dim_len[a];
+        if (lo[a] < 0 || hi[a] > (int)s->dim_len[a] || lo[a] >= hi[a])
+            return atmos__error(s->ctx, ATMOS_E_INVALID_ARG, "%s: region [%d, %d) along %s is outside 0..%zu", s->path,
+                                lo[a], hi[a], a == 0 ? "x" : a == 1 ? "y" : "z", s->dim_len[a]);
+    }
+    s->i0 = lo[0];
+    s->j0 = lo[1];
+    s->k0 = lo[2];
+    s->nx = hi[0] - lo[0];
+    s->ny = hi[1] - lo[1];
+    s->nz = hi[2] - lo[2];
+    s->t = L->desc->time_index;
+    if (s->t < 0) return atmos__error(s->ctx, ATMOS_E_INVALID_ARG, "%s: negative time index %d", s->path, s->t);
+    L->ncol = (size_t)s->nx * (size_t)s->ny;
+    L->n3 = L->ncol * (size_t)s->nz;
+    L->n3s = L->ncol * (size_t)(s->nz + 1);
+    return ATMOS_OK;
+}
+
+/* Memory for the source slabs, checked before allocating, in the float units the
+ * check takes: two float read buffers and the w-level heights (double) on the
+ * staggered grid; density, mass-level heights and their copy (doubles) and one float
+ * eta field per hydrometeor on the mass grid; with margin for the CM1 path's q_v. */
+static atmos_status allocate_slabs(loader *L)
+{
+    const uint64_t bytes =
+        (uint64_t)L->n3s * (4 + 4 + 8) + (uint64_t)L->n3 * (8 + 8 + 8 + 4 + 4 * (uint64_t)L->nsel);
+    atmos_status st = atmos__reader_check_memory(L->s.ctx, L->s.path, (bytes + 3) / 4, L->desc->max_memory);
+    if (st != ATMOS_OK) return st;
+    const size_t nxy = (size_t)(L->s.nx > L->s.ny ? L->s.nx : L->s.ny);
+    L->buf = malloc(L->n3s * sizeof *L->buf);
+    L->rho = malloc(L->n3 * sizeof *L->rho);
+    L->zw = malloc(L->n3s * sizeof *L->zw);
+    L->zm = malloc(L->n3 * sizeof *L->zm);
+    L->eta = malloc(L->n3 * (size_t)L->nsel * sizeof *L->eta);
+    L->xc = malloc(nxy * 2 * sizeof *L->xc);
+    if (!L->buf || !L->rho || !L->zw || !L->zm || !L->eta || !L->xc) return out_of_memory(L);
+    L->yc = L->xc + nxy;
+    return ATMOS_OK;
+}
+
+/* ------------------------------------------------------------ heights and air density */
+
+/* WRF: z = (PH + PHB) / g on the staggered levels (geopotential = g z); mass levels
+ * halfway between. */
+static atmos_status wrf_heights(loader *L)
+{
+    const src *s = &L->s;
+    const size_t ncol = L->ncol;
+    atmos_status st;
+    if ((st = read_var(s, "PH", 1, L->buf)) || (st = read_var(s, "PHB", 1, L->buf2))) return st;
+    for (size_t i = 0; i < L->n3s; i++) L->zw[i] = ((double)L->buf[i] + L->buf2[i]) / GRAV;
+    for (size_t k = 0; k < (size_t)s->nz; k++)
+        for (size_t c = 0; c < ncol; c++) {
+            L->zm[k * ncol + c] = 0.5 * (L->zw[k * ncol + c] + L->zw[(k + 1) * ncol + c]);
+            if (!(L->zw[(k + 1) * ncol + c] > L->zw[k * ncol + c]))
+                return atmos__error(s->ctx, ATMOS_E_FORMAT,
+                                    "%s: heights from PH+PHB do not increase upward (column %zu, level %zu)", s->path,
+                                    c, k + (size_t)s->k0);
+        }
+    return ATMOS_OK;
+}
+
+/* WRF: p = P + PB; theta = T + 300 K; T = theta (p/p0)^(R_d/c_p);
+ * rho = p / (R_d T_v), T_v = T (1 + 0.61 q_v). */
+static atmos_status wrf_density(loader *L)
+{
+    const src *s = &L->s;
+    float *buf = L->buf, *buf2 = L->buf2;
+    double *rho = L->rho;
+    atmos_status st;
+    if ((st = read_var(s, "P", 0, buf)) || (st = read_var(s, "PB", 0, buf2))) return st;
+    for (size_t i = 0; i < L->n3; i++) rho[i] = (double)buf[i] + buf2[i]; /* p for now */
+    if ((st = read_var(s, "T", 0, buf)) || (st = read_var(s, "QVAPOR", 0, buf2))) return st;
+    for (size_t i = 0; i < L->n3; i++) {
+        double p = rho[i], theta = (double)buf[i] + 300.0, qv = buf2[i] > 0 ? buf2[i] : 0.0;
+        double T = theta * pow(p / P0, RD / CP);
+        rho[i] = p / (RD * T * (1.0 + 0.61 * qv));
+        if (!(p > 0) || !(theta > 0) || !isfinite(rho[i]))
+            return atmos__error(s->ctx, ATMOS_E_FORMAT,
+                                "%s: non-physical pressure %g Pa or potential temperature %g K", s->path, p, theta);
+    }
+    return ATMOS_OK;
+}
+
+static atmos_status wrf_columns(loader *L)
+{
+    L->buf2 = malloc(L->n3s * sizeof *L->buf2);
+    if (!L->buf2) return out_of_memory(L);
+    atmos_status st = wrf_heights(L);
+    if (st == ATMOS_OK) st = wrf_density(L);
+    if (st != ATMOS_OK) return st;
+    for (int i = 0; i < L->s.nx; i++) L->xc[i] = (i + 0.5) * L->dx;
+    for (int j = 0; j < L->s.ny; j++) L->yc[j] = (j + 0.5) * L->dy;
+    return ATMOS_OK;
+}
+
+/* CM1: coordinates xh, yh, zh, the spacing from them, and the heights. CM1 has no
+ * terrain here (zh above ground); the column spans from the ground (or half a layer
+ * below the region's first level) to half a layer above its last. */
+static atmos_status cm1_heights(loader *L)
+{
+    const src *s = &L->s;
+    const size_t ncol = L->ncol;
+    L->zh = malloc(((size_t)s->nz + 1) * sizeof *L->zh);
+    if (!L->zh) return out_of_memory(L);
+    double *zh = L->zh, *xc = L->xc, *yc = L->yc;
+    atmos_status st = read_coord(s, "zh", (size_t)s->k0, (size_t)s->nz, zh);
+    if (!st) st = read_coord(s, "xh", (size_t)s->i0, (size_t)s->nx, xc);
+    if (!st) st = read_coord(s, "yh", (size_t)s->j0, (size_t)s->ny, yc);
+    if (st) return st;
+    L->dx = s->nx > 1 ? (xc[s->nx - 1] - xc[0]) / (s->nx - 1) : 1000.0;
+    L->dy = s->ny > 1 ? (yc[s->ny - 1] - yc[0]) / (s->ny - 1) : L->dx;
+    if (s->nx == 1) L->dx = L->dy;
+    for (int k = 0; k < s->nz; k++)
+        for (size_t c = 0; c < ncol; c++) L->zm[(size_t)k * ncol + c] = zh[k];
+    for (int k = 0; k <= s->nz; k++) {
+        double z = k == 0 ? (s->k0 == 0 ? 0.0 : zh[0] - 0.5 * (s->nz > 1 ? zh[1] - zh[0] : zh[0]))
+                   : k == s->nz ? zh[s->nz - 1] + 0.5 * (s->nz > 1 ? zh[s->nz - 1] - zh[s->nz - 2] : zh[0])
+                                : 0.5 * (zh[k - 1] + zh[k]);
+        for (size_t c = 0; c < ncol; c++) L->zw[(size_t)k * ncol + c] = z;
+    }
+    return ATMOS_OK;
+}
+
+/* CM1: rho itself, or from prs, th and (when present) qv as for WRF. */
+static atmos_status cm1_density(loader *L)
+{
+    const src *s = &L->s;
+    double *rho = L->rho;
+    atmos_status st;
+    if (L->use_rho) {
+        if ((st = read_var(s, "rho", 0, L->buf))) return st;
+        for (size_t i = 0; i < L->n3; i++) rho[i] = L->buf[i];
+    } else {
+        if ((st = read_var(s, "prs", 0, L->buf))) return st;
+        for (size_t i = 0; i < L->n3; i++) rho[i] = L->buf[i];
+        if ((st = read_var(s, "th", 0, L->buf))) return st;
+        if (has_var(s, "qv")) {
+            L->qv = malloc(L->n3 * sizeof *L->qv);
+            if (!L->qv) return out_of_memory(L);
+            if ((st = read_var(s, "qv", 0, L->qv))) return st;
+        }
+        const float *qv = L->qv;
+        for (size_t i = 0; i < L->n3; i++) {
+            double p = rho[i], th = L->buf[i], q = qv && qv[i] > 0 ? qv[i] : 0.0;
+            double T = th * pow(p / P0, RD / CP);
+            rho[i] = p / (RD * T * (1.0 + 0.61 * q));
+        }
+    }
+    for (size_t i = 0; i < L->n3; i++)
+        if (!(rho[i] > 0) || !isfinite(rho[i]))
+            return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: non-physical air density %g kg/m^3", s->path, rho[i]);
+    return ATMOS_OK;
+}
+
+/* Heights (m) of the w-levels and mass levels of each column, and the air density. */
+static atmos_status read_columns(loader *L)
+{
+    if (L->s.wrf) return wrf_columns(L);
+    atmos_status st = cm1_heights(L);
+    return st == ATMOS_OK ? cm1_density(L) : st;
+}
+
+/* ------------------------------------------------------------ mixing ratio to number density */
+
+/* eta = q rho / m_p (or q * density_scale) at the mass points of hydrometeor sel[si].
+ * Mixing ratios slightly below zero are normal in model output (advection
+ * undershoots; the WRF test file has none, but many runs do), so they are clamped to
+ * 0 and counted in a warning. */
+static atmos_status number_density(loader *L, int si)
+{
+    const int h = L->sel[si];
+    const char *name = model_var(L, h);
+    atmos_status st = read_var(&L->s, name, 0, L->buf);
+    if (st != ATMOS_OK) return st;
+    const double conv = L->desc->density_scale > 0 ? L->desc->density_scale : 0.0;
+    const double mp = particle_mass(h);
+    float *eta = L->eta + (size_t)si * L->n3;
+    size_t neg = 0;
+    double qmax = 0;
+    for (size_t i = 0; i < L->n3; i++) {
+        double q = L->buf[i];
+        if (q < 0) {
+            neg++;
+            q = 0;
+        }
+        if (q > 1.0)
+            return atmos__error(L->s.ctx, ATMOS_E_FORMAT, "%s: %s = %g kg/kg is not a mixing ratio", L->s.path, name,
+                                q);
+        if (q > qmax) qmax = q;
+        eta[i] = (float)(conv > 0 ? q * conv : q * L->rho[i] / mp);
+    }
+    if (neg)
+        atmos__log(L->s.ctx, ATMOS_LOG_WARN, "%s: %s: %zu negative mixing ratios set to 0", L->s.path, name, neg);
+    atmos__log(L->s.ctx, ATMOS_LOG_INFO, "%s: %s -> field %s (particle %s, mean mass %.3g kg): max q %.3g kg/kg",
+               L->s.path, name, hydro[h].field, hydro[h].particle, mp, qmax);
+    return ATMOS_OK;
+}
+
+/* ------------------------------------------------------------ the voxel grid */
+
+/* The uniform output grid: from the lowest ground to the highest model top, voxels of
+ * desc->voxel_size_m or by default the horizontal grid spacing (on coarse grids that
+ * flattens the vertical structure, hence the warning). */
+static atmos_status output_grid(loader *L)
+{
+    const src *s = &L->s;
+    const size_t top = (size_t)s->nz * L->ncol;
+    double zlo = INFINITY, zhi = -INFINITY, layer = INFINITY;
+    for (size_t c = 0; c < L->ncol; c++) {
+        if (L->zw[c] < zlo) zlo = L->zw[c];
+        if (L->zw[top + c] > zhi) zhi = L->zw[top + c];
+        double th = (L->zw[top + c] - L->zw[c]) / s->nz;
+        if (th < layer) layer = th;
+    }
+    const double dx = L->dx, dy = L->dy;
+    double vs = L->desc->voxel_size_m > 0 ? L->desc->voxel_size_m : fmin(dx, dy);
+    if ((zhi - zlo) / vs < 8)
+        atmos__log(s->ctx, ATMOS_LOG_WARN,
+                   "%s: a voxel of %g m leaves only %.1f voxels over the model's %.0f m depth (thinnest mean layer "
+                   "%.0f m); choose a smaller voxel size",
+                   s->path, vs, (zhi - zlo) / vs, zhi - zlo, layer);
+    if (!(vs > 0) || !isfinite(vs))
+        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: cannot derive a voxel size (dx %g, dy %g)", s->path, dx, dy);
+    const double extent[3] = {s->nx * dx, zhi - zlo, s->ny * dy};
+    atmos_volume_desc *vd = &L->vd;
+    memset(vd, 0, sizeof *vd);
+    for (int a = 0; a < 3; a++) {
+        double n = ceil(extent[a] / vs - 1e-9);
+        if (n < 1) n = 1;
+        if (n > ATMOS_VOLUME_MAX_DIM)
+            return atmos__error(s->ctx, ATMOS_E_LIMIT,
+                                "%s: %.0f voxels of %g m along %s exceed the limit of %d; choose a larger voxel size "
+                                "or a smaller region",
+                                s->path, n, vs, a == 0 ? "x" : a == 1 ? "y" : "z", ATMOS_VOLUME_MAX_DIM);
+        vd->dims[a] = (int)n;
+    }
+    vd->voxel_size_m = vs;
+    vd->origin_m[0] = s->wrf ? 0.0 : L->xc[0] - 0.5 * dx;
+    vd->origin_m[1] = zlo;
+    vd->origin_m[2] = 0.0;
+    vd->max_memory = L->desc->max_memory;
+    L->zlo = zlo;
+    return atmos_volume_create(s->ctx, vd, &L->vol);
+}
+
+/* Buffers of the resampling: one output column, and the mass-level heights column by
+ * column for the per-column search. */
+static atmos_status resample_buffers(loader *L)
+{
+    const int nz = L->s.nz;
+    L->colv = malloc((size_t)L->vd.dims[1] * sizeof *L->colv);
+    L->zmt = malloc(L->n3 * sizeof *L->zmt);
+    if (!L->colv || !L->zmt) return out_of_memory(L);
+    for (size_t c = 0; c < L->ncol; c++)
+        for (int k = 0; k < nz; k++) L->zmt[c * (size_t)nz + k] = L->zm[(size_t)k * L->ncol + c];
+    return ATMOS_OK;
+}
+
+/* Clamps a fractional column index f to [0, n - 1]: the two columns bracketing it
+ * and the weight of the second. */
+static void bracket(double f, int n, int *a, int *b, double *w)
+{
+    if (f < 0) f = 0;
+    if (f > n - 1) f = n - 1;
+    *a = (int)floor(f);
+    *b = *a + 1 < n ? *a + 1 : *a;
+    *w = f - *a;
+}
+
+/* One output column (voxels I, *, K) of field values e at the mass points: bilinear
+ * between mass-point columns (cell centres at (i + 0.5) dx), linear in height within
+ * each. Returns whether any value is > 0. */
+static int resample_column(const loader *L, const float *e, int I, int K)
+{
+    const src *s = &L->s;
+    const double vs = L->vd.voxel_size_m;
+    int ia, ib, ja, jb;
+    double wx, wy;
+    bracket(((I + 0.5) * vs) / L->dx - 0.5, s->nx, &ia, &ib, &wx);
+    /* z grows southward: K = 0 is the region's north edge. */
+    bracket((s->ny * L->dy - (K + 0.5) * vs) / L->dy - 0.5, s->ny, &ja, &jb, &wy);
+    const int ci[4] = {ia, ib, ia, ib}, cj[4] = {ja, ja, jb, jb};
+    const double cw[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+    int nonzero = 0;
+    for (int J = 0; J < L->vd.dims[1]; J++) {
+        double y = L->zlo + (J + 0.5) * vs, v = 0;
+        for (int c = 0; c < 4; c++) {
+            if (cw[c] == 0) continue;
+            size_t col = (size_t)ci[c] + (size_t)s->nx * (size_t)cj[c];
+            double zcol[2] = {L->zw[col], L->zw[(size_t)s->nz * L->ncol + col]};
+            v += cw[c] * column_at(e + col, L->zmt + col * (size_t)s->nz, s->nz, L->ncol, zcol, y);
+        }
+        L->colv[J] = (float)v;
+        if (v > 0) nonzero = 1;
+    }
+    return nonzero;
+}
+
+/* Adds hydrometeor sel[si] as a field and writes its non-empty columns. */
+static atmos_status resample_field(loader *L, int si)
+{
+    const int h = L->sel[si];
+    int field;
+    atmos_status st = atmos_volume_add_field(L->s.ctx, L->vol, hydro[h].field, hydro[h].particle, &field);
+    if (st != ATMOS_OK) return st;
+    const float *e = L->eta + (size_t)si * L->n3;
+    for (int I = 0; I < L->vd.dims[0]; I++)
+        for (int K = 0; K < L->vd.dims[2]; K++) {
+            if (!resample_column(L, e, I, K)) continue;
+            const int off[3] = {I, 0, K}, size[3] = {1, L->vd.dims[1], 1};
+            if ((st = atmos_volume_set_dense(L->s.ctx, L->vol, field, off, size, L->colv, 1.0f))) return st;
+        }
     return ATMOS_OK;
 }
 
 /* ------------------------------------------------------------ the reader */
+
+static atmos_status load(loader *L)
+{
+    atmos_status st;
+    if ((st = open_file(L)) || (st = identify_model(L)) || (st = choose_hydrometeors(L)) ||
+        (st = check_density_vars(L)) || (st = read_extents(L)) || (st = choose_region(L)) ||
+        (st = allocate_slabs(L)) || (st = read_columns(L)))
+        return st;
+    for (int si = 0; si < L->nsel; si++)
+        if ((st = number_density(L, si))) return st;
+    if ((st = output_grid(L)) || (st = resample_buffers(L))) return st;
+    for (int si = 0; si < L->nsel; si++)
+        if ((st = resample_field(L, si))) return st;
+    return atmos_volume_finalize(L->s.ctx, L->vol);
+}
 
 atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
                                        atmos_volume **out)
@@ -278,427 +837,18 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
     static const atmos_volume_load_desc zero_desc;
     if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "netcdf: path and out are required");
     *out = NULL;
-    if (!desc) desc = &zero_desc;
-    src s;
-    memset(&s, 0, sizeof s);
-    s.ctx = ctx;
-    s.path = path;
-    int rc = nc_open(path, NC_NOWRITE, &s.nc);
-    if (rc != NC_NOERR) {
-        FILE *f = fopen(path, "rb");
-        if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, nc_strerror(rc));
-        fclose(f);
-        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: not a readable NetCDF file: %s", path, nc_strerror(rc));
+    loader L;
+    memset(&L, 0, sizeof L);
+    L.s.ctx = ctx;
+    L.s.path = path;
+    L.desc = desc ? desc : &zero_desc;
+    atmos_status st = load(&L);
+    if (st == ATMOS_OK) {
+        *out = L.vol;
+        L.vol = NULL;
     }
-    atmos_status st = ATMOS_OK;
-    float *buf = NULL, *eta = NULL, *colv = NULL;
-    double *zw = NULL, *zm = NULL, *zmt = NULL, *rho = NULL, *xc = NULL, *yc = NULL;
-    atmos_volume *vol = NULL;
-    char present[1024];
-    list_vars(&s, present, sizeof present);
-    if ((st = check_classic_size(&s))) goto done;
-
-    s.wrf = has_var(&s, "PH") || has_var(&s, "QCLOUD") || has_var(&s, "QVAPOR");
-    int cm1 = has_var(&s, "qc") || has_var(&s, "rho") || has_var(&s, "prs");
-    if (!s.wrf && !cm1) {
-        st = atmos__error(ctx, ATMOS_E_FORMAT,
-                          "%s: neither WRF (QCLOUD, P, PB, T, PH, PHB, ...) nor CM1 (qc, rho or prs/th, ...) output; "
-                          "variables present: %s",
-                          path, present);
-        goto done;
-    }
-
-    /* Which hydrometeors: those asked for (desc->grids, by model or field name), else all present. */
-    int sel[NHYDRO], nsel = 0;
-    for (int h = 0; h < NHYDRO; h++) {
-        const char *name = s.wrf ? hydro[h].wrf : hydro[h].cm1;
-        int wanted;
-        if (desc->grids && *desc->grids) {
-            wanted = 0;
-            const char *p = desc->grids;
-            while (*p) {
-                const char *c = strchr(p, ',');
-                size_t len = c ? (size_t)(c - p) : strlen(p);
-                if ((strlen(name) == len && strncmp(p, name, len) == 0) ||
-                    (strlen(hydro[h].field) == len && strncmp(p, hydro[h].field, len) == 0))
-                    wanted = 1;
-                p += len;
-                if (*p == ',') p++;
-            }
-            if (wanted && !has_var(&s, name)) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: variable %s (%s) not found; variables present: %s", path,
-                                  name, hydro[h].field, present);
-                goto done;
-            }
-        } else {
-            wanted = has_var(&s, name);
-        }
-        if (wanted) sel[nsel++] = h;
-    }
-    /* Every name asked for must be a hydrometeor this reader knows (by model or field
-     * name): a misspelt one is an error, not silently dropped. */
-    if (desc->grids && *desc->grids) {
-        const char *p = desc->grids;
-        while (*p) {
-            const char *c = strchr(p, ',');
-            size_t len = c ? (size_t)(c - p) : strlen(p);
-            int known = 0;
-            for (int h = 0; h < NHYDRO && len; h++) {
-                const char *name = s.wrf ? hydro[h].wrf : hydro[h].cm1;
-                if ((strlen(name) == len && strncmp(p, name, len) == 0) ||
-                    (strlen(hydro[h].field) == len && strncmp(p, hydro[h].field, len) == 0))
-                    known = 1;
-            }
-            if (!known) {
-                st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: '%.*s' is not a hydrometeor variable (%s, or cloud, rain, "
-                                  "ice, snow, graupel)", path, (int)(len < 64 ? len : 64), p,
-                                  s.wrf ? "QCLOUD, QRAIN, QICE, QSNOW, QGRAUP" : "qc, qr, qi, qs, qg");
-                goto done;
-            }
-            p += len;
-            if (*p == ',') p++;
-        }
-    }
-    if (nsel == 0) {
-        st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: no hydrometeor variables (%s) %s; variables present: %s", path,
-                          s.wrf ? "QCLOUD, QRAIN, QICE, QSNOW, QGRAUP" : "qc, qr, qi, qs, qg",
-                          desc->grids && *desc->grids ? "match the requested list" : "found", present);
-        goto done;
-    }
-    /* The variables the density and heights need. */
-    const char *need_wrf[] = {"P", "PB", "T", "QVAPOR", "PH", "PHB"};
-    int use_rho = !s.wrf && has_var(&s, "rho");
-    if (s.wrf) {
-        for (int i = 0; i < 6; i++)
-            if (!has_var(&s, need_wrf[i])) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT,
-                                  "%s: WRF variable %s not found (needed for air density and heights: P, PB, T, QVAPOR, "
-                                  "PH, PHB); variables present: %s",
-                                  path, need_wrf[i], present);
-                goto done;
-            }
-    } else if (!use_rho && !(has_var(&s, "prs") && has_var(&s, "th"))) {
-        st = atmos__error(ctx, ATMOS_E_FORMAT,
-                          "%s: CM1 output needs rho, or prs and th, for the air density; variables present: %s", path,
-                          present);
-        goto done;
-    }
-
-    /* Extents and spacing. */
-    double dx, dy;
-    if (s.wrf) {
-        if ((st = get_dim(&s, "west_east", &s.dim_len[0])) || (st = get_dim(&s, "south_north", &s.dim_len[1])) ||
-            (st = get_dim(&s, "bottom_top", &s.dim_len[2])))
-            goto done;
-        if ((st = get_att_double(&s, NC_GLOBAL, "DX", &dx)) || (st = get_att_double(&s, NC_GLOBAL, "DY", &dy)))
-            goto done;
-    } else {
-        if ((st = get_dim(&s, "ni", &s.dim_len[0])) != ATMOS_OK && (st = get_dim(&s, "xh", &s.dim_len[0])) != ATMOS_OK)
-            goto done;
-        if ((st = get_dim(&s, "nj", &s.dim_len[1])) != ATMOS_OK && (st = get_dim(&s, "yh", &s.dim_len[1])) != ATMOS_OK)
-            goto done;
-        if ((st = get_dim(&s, "nk", &s.dim_len[2])) != ATMOS_OK && (st = get_dim(&s, "zh", &s.dim_len[2])) != ATMOS_OK)
-            goto done;
-        dx = dy = 0; /* from xh, yh below */
-    }
-    if (ctx) atmos_context_clear_error(ctx);
-    for (int a = 0; a < 3; a++)
-        if (s.dim_len[a] < 1 || s.dim_len[a] > 100000) {
-            st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: grid dimension %d has %zu points", path, a, s.dim_len[a]);
-            goto done;
-        }
-    /* Sub-region [i0, i1) x [j0, j1) x [k0, k1) of mass points; 0 ends mean "to the end". */
-    const int *r = desc->region;
-    int lo[3] = {r[0], r[2], r[4]}, hi[3] = {r[1], r[3], r[5]};
-    for (int a = 0; a < 3; a++) {
-        if (hi[a] == 0) hi[a] = (int)s.dim_len[a];
-        if (lo[a] < 0 || hi[a] > (int)s.dim_len[a] || lo[a] >= hi[a]) {
-            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: region [%d, %d) along %s is outside 0..%zu", path, lo[a],
-                              hi[a], a == 0 ? "x" : a == 1 ? "y" : "z", s.dim_len[a]);
-            goto done;
-        }
-    }
-    if (s.wrf && (lo[2] != 0 && hi[2] != (int)s.dim_len[2])) {
-        /* Allowed: heights come from the staggered levels bounding the chosen ones. */
-    }
-    s.i0 = lo[0];
-    s.j0 = lo[1];
-    s.k0 = lo[2];
-    s.nx = hi[0] - lo[0];
-    s.ny = hi[1] - lo[1];
-    s.nz = hi[2] - lo[2];
-    s.t = desc->time_index;
-    if (s.t < 0) {
-        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: negative time index %d", path, s.t);
-        goto done;
-    }
-
-    /* Memory for the source slabs, checked before allocating, in the float units the
-     * check takes: two float read buffers and the w-level heights (double) on the
-     * staggered grid; density, mass-level heights and their copy (doubles) and one float
-     * eta field per hydrometeor on the mass grid; with margin for the CM1 path's q_v. */
-    const size_t ncol = (size_t)s.nx * (size_t)s.ny;
-    const size_t n3 = ncol * (size_t)s.nz, n3s = ncol * (size_t)(s.nz + 1);
-    const uint64_t bytes = (uint64_t)n3s * (4 + 4 + 8) + (uint64_t)n3 * (8 + 8 + 8 + 4 + 4 * (uint64_t)nsel);
-    st = atmos__reader_check_memory(ctx, path, (bytes + 3) / 4, desc->max_memory);
-    if (st != ATMOS_OK) goto done;
-    buf = malloc(n3s * sizeof *buf);
-    float *buf2 = NULL;
-    rho = malloc(n3 * sizeof *rho);
-    zw = malloc(n3s * sizeof *zw);
-    zm = malloc(n3 * sizeof *zm);
-    eta = malloc(n3 * (size_t)nsel * sizeof *eta);
-    xc = malloc((size_t)(s.nx > s.ny ? s.nx : s.ny) * 2 * sizeof *xc);
-    if (!buf || !rho || !zw || !zm || !eta || !xc) {
-        st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-        goto done;
-    }
-    yc = xc + (s.nx > s.ny ? s.nx : s.ny);
-
-    /* Heights (m) of the w-levels and mass levels of each column, and air density. */
-    if (s.wrf) {
-        buf2 = malloc(n3s * sizeof *buf2);
-        if (!buf2) {
-            st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-            goto done;
-        }
-        /* z = (PH + PHB) / g on the staggered levels (WRF: geopotential = g z). */
-        if ((st = read_var(&s, "PH", 1, buf)) || (st = read_var(&s, "PHB", 1, buf2))) {
-            free(buf2);
-            goto done;
-        }
-        for (size_t i = 0; i < n3s; i++) zw[i] = ((double)buf[i] + buf2[i]) / GRAV;
-        for (size_t k = 0; k < (size_t)s.nz; k++)
-            for (size_t c = 0; c < ncol; c++) {
-                zm[k * ncol + c] = 0.5 * (zw[k * ncol + c] + zw[(k + 1) * ncol + c]);
-                if (!(zw[(k + 1) * ncol + c] > zw[k * ncol + c])) {
-                    free(buf2);
-                    st = atmos__error(ctx, ATMOS_E_FORMAT,
-                                      "%s: heights from PH+PHB do not increase upward (column %zu, level %zu)", path, c,
-                                      k + (size_t)s.k0);
-                    goto done;
-                }
-            }
-        /* p = P + PB; theta = T + 300 K; T = theta (p/p0)^(R_d/c_p);
-         * rho = p / (R_d T_v), T_v = T (1 + 0.61 q_v). */
-        if ((st = read_var(&s, "P", 0, buf)) || (st = read_var(&s, "PB", 0, buf2))) {
-            free(buf2);
-            goto done;
-        }
-        for (size_t i = 0; i < n3; i++) rho[i] = (double)buf[i] + buf2[i]; /* p for now */
-        if ((st = read_var(&s, "T", 0, buf)) || (st = read_var(&s, "QVAPOR", 0, buf2))) {
-            free(buf2);
-            goto done;
-        }
-        for (size_t i = 0; i < n3; i++) {
-            double p = rho[i], theta = (double)buf[i] + 300.0, qv = buf2[i] > 0 ? buf2[i] : 0.0;
-            double T = theta * pow(p / P0, RD / CP);
-            rho[i] = p / (RD * T * (1.0 + 0.61 * qv));
-            if (!(p > 0) || !(theta > 0) || !isfinite(rho[i])) {
-                free(buf2);
-                st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: non-physical pressure %g Pa or potential temperature %g K",
-                                  path, p, theta);
-                goto done;
-            }
-        }
-        free(buf2);
-        for (int i = 0; i < s.nx; i++) xc[i] = (i + 0.5) * dx;
-        for (int j = 0; j < s.ny; j++) yc[j] = (j + 0.5) * dy;
-    } else {
-        double *zh = malloc(((size_t)s.nz + 1) * sizeof *zh);
-        if (!zh) {
-            st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-            goto done;
-        }
-        st = read_coord(&s, "zh", (size_t)s.k0, (size_t)s.nz, zh);
-        if (!st) st = read_coord(&s, "xh", (size_t)s.i0, (size_t)s.nx, xc);
-        if (!st) st = read_coord(&s, "yh", (size_t)s.j0, (size_t)s.ny, yc);
-        if (st) {
-            free(zh);
-            goto done;
-        }
-        dx = s.nx > 1 ? (xc[s.nx - 1] - xc[0]) / (s.nx - 1) : 1000.0;
-        dy = s.ny > 1 ? (yc[s.ny - 1] - yc[0]) / (s.ny - 1) : dx;
-        if (s.nx == 1) dx = dy;
-        /* CM1 has no terrain here (zh above ground); the column spans from the
-         * ground (or half a layer below the region's first level) to half a layer
-         * above its last. */
-        for (int k = 0; k < s.nz; k++)
-            for (size_t c = 0; c < ncol; c++) zm[(size_t)k * ncol + c] = zh[k];
-        for (int k = 0; k <= s.nz; k++) {
-            double z = k == 0 ? (s.k0 == 0 ? 0.0 : zh[0] - 0.5 * (s.nz > 1 ? zh[1] - zh[0] : zh[0]))
-                       : k == s.nz ? zh[s.nz - 1] + 0.5 * (s.nz > 1 ? zh[s.nz - 1] - zh[s.nz - 2] : zh[0])
-                                   : 0.5 * (zh[k - 1] + zh[k]);
-            for (size_t c = 0; c < ncol; c++) zw[(size_t)k * ncol + c] = z;
-        }
-        free(zh);
-        if (use_rho) {
-            if ((st = read_var(&s, "rho", 0, buf))) goto done;
-            for (size_t i = 0; i < n3; i++) rho[i] = buf[i];
-        } else {
-            if ((st = read_var(&s, "prs", 0, buf))) goto done;
-            for (size_t i = 0; i < n3; i++) rho[i] = buf[i];
-            if ((st = read_var(&s, "th", 0, buf))) goto done;
-            int qv_ok = has_var(&s, "qv");
-            float *qv = qv_ok ? malloc(n3 * sizeof *qv) : NULL;
-            if (qv_ok && (!qv || (st = read_var(&s, "qv", 0, qv)))) {
-                free(qv);
-                if (!st) st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-                goto done;
-            }
-            for (size_t i = 0; i < n3; i++) {
-                double p = rho[i], th = buf[i], q = qv && qv[i] > 0 ? qv[i] : 0.0;
-                double T = th * pow(p / P0, RD / CP);
-                rho[i] = p / (RD * T * (1.0 + 0.61 * q));
-            }
-            free(qv);
-        }
-        for (size_t i = 0; i < n3; i++)
-            if (!(rho[i] > 0) || !isfinite(rho[i])) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: non-physical air density %g kg/m^3", path, rho[i]);
-                goto done;
-            }
-    }
-
-    /* Number densities at the mass points. Mixing ratios slightly below zero are
-     * normal in model output (advection undershoots; the WRF test file has none,
-     * but many runs do), so they are clamped to 0 and counted in a warning. */
-    for (int si = 0; si < nsel; si++) {
-        const int h = sel[si];
-        const char *name = s.wrf ? hydro[h].wrf : hydro[h].cm1;
-        if ((st = read_var(&s, name, 0, buf))) goto done;
-        const double conv = desc->density_scale > 0 ? desc->density_scale : 0.0;
-        const double mp = particle_mass(h);
-        size_t neg = 0;
-        double qmax = 0;
-        for (size_t i = 0; i < n3; i++) {
-            double q = buf[i];
-            if (q < 0) {
-                neg++;
-                q = 0;
-            }
-            if (q > 1.0) {
-                st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: %s = %g kg/kg is not a mixing ratio", path, name, q);
-                goto done;
-            }
-            if (q > qmax) qmax = q;
-            eta[(size_t)si * n3 + i] = (float)(conv > 0 ? q * conv : q * rho[i] / mp);
-        }
-        if (neg)
-            atmos__log(ctx, ATMOS_LOG_WARN, "%s: %s: %zu negative mixing ratios set to 0", path, name, neg);
-        atmos__log(ctx, ATMOS_LOG_INFO, "%s: %s -> field %s (particle %s, mean mass %.3g kg): max q %.3g kg/kg", path,
-                   name, hydro[h].field, hydro[h].particle, mp, qmax);
-    }
-
-    /* The uniform output grid. */
-    double zlo = INFINITY, zhi = -INFINITY, layer = INFINITY;
-    for (size_t c = 0; c < ncol; c++) {
-        if (zw[c] < zlo) zlo = zw[c];
-        if (zw[(size_t)s.nz * ncol + c] > zhi) zhi = zw[(size_t)s.nz * ncol + c];
-        double th = (zw[(size_t)s.nz * ncol + c] - zw[c]) / s.nz;
-        if (th < layer) layer = th;
-    }
-    /* Default voxel: the horizontal grid spacing. On coarse grids that flattens the
-     * vertical structure, hence the warning. */
-    double vs = desc->voxel_size_m > 0 ? desc->voxel_size_m : fmin(dx, dy);
-    if ((zhi - zlo) / vs < 8)
-        atmos__log(ctx, ATMOS_LOG_WARN,
-                   "%s: a voxel of %g m leaves only %.1f voxels over the model's %.0f m depth (thinnest mean layer "
-                   "%.0f m); choose a smaller voxel size",
-                   path, vs, (zhi - zlo) / vs, zhi - zlo, layer);
-    if (!(vs > 0) || !isfinite(vs)) {
-        st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: cannot derive a voxel size (dx %g, dy %g)", path, dx, dy);
-        goto done;
-    }
-    const double extent[3] = {s.nx * dx, zhi - zlo, s.ny * dy};
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    for (int a = 0; a < 3; a++) {
-        double n = ceil(extent[a] / vs - 1e-9);
-        if (n < 1) n = 1;
-        if (n > ATMOS_VOLUME_MAX_DIM) {
-            st = atmos__error(ctx, ATMOS_E_LIMIT,
-                              "%s: %.0f voxels of %g m along %s exceed the limit of %d; choose a larger voxel size or "
-                              "a smaller region",
-                              path, n, vs, a == 0 ? "x" : a == 1 ? "y" : "z", ATMOS_VOLUME_MAX_DIM);
-            goto done;
-        }
-        vd.dims[a] = (int)n;
-    }
-    vd.voxel_size_m = vs;
-    vd.origin_m[0] = s.wrf ? 0.0 : xc[0] - 0.5 * dx;
-    vd.origin_m[1] = zlo;
-    vd.origin_m[2] = 0.0;
-    vd.max_memory = desc->max_memory;
-    if ((st = atmos_volume_create(ctx, &vd, &vol))) goto done;
-
-    colv = malloc((size_t)vd.dims[1] * sizeof *colv);
-    /* Mass-level heights column by column, for the per-column search. */
-    zmt = malloc(n3 * sizeof *zmt);
-    if (!colv || !zmt) {
-        st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-        goto done;
-    }
-    for (int si = 0; si < nsel; si++) {
-        const int h = sel[si];
-        int field;
-        if ((st = atmos_volume_add_field(ctx, vol, hydro[h].field, hydro[h].particle, &field))) goto done;
-        const float *e = eta + (size_t)si * n3;
-        for (int I = 0; I < vd.dims[0]; I++) {
-            /* Bilinear between mass-point columns (cell centres at (i + 0.5) dx). */
-            double fx = ((I + 0.5) * vs) / dx - 0.5;
-            if (fx < 0) fx = 0;
-            if (fx > s.nx - 1) fx = s.nx - 1;
-            int ia = (int)floor(fx), ib = ia + 1 < s.nx ? ia + 1 : ia;
-            double wx = fx - ia;
-            for (int K = 0; K < vd.dims[2]; K++) {
-                /* z grows southward: K = 0 is the region's north edge. */
-                double fy = (s.ny * dy - (K + 0.5) * vs) / dy - 0.5;
-                if (fy < 0) fy = 0;
-                if (fy > s.ny - 1) fy = s.ny - 1;
-                int ja = (int)floor(fy), jb = ja + 1 < s.ny ? ja + 1 : ja;
-                double wy = fy - ja;
-                const int ci[4] = {ia, ib, ia, ib}, cj[4] = {ja, ja, jb, jb};
-                const double cw[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
-                int nonzero = 0;
-                if (I == 0 && K == 0 && si == 0)
-                    for (size_t c = 0; c < ncol; c++)
-                        for (int k = 0; k < s.nz; k++) zmt[c * (size_t)s.nz + k] = zm[(size_t)k * ncol + c];
-                for (int J = 0; J < vd.dims[1]; J++) {
-                    double y = zlo + (J + 0.5) * vs, v = 0;
-                    for (int c = 0; c < 4; c++) {
-                        if (cw[c] == 0) continue;
-                        size_t col = (size_t)ci[c] + (size_t)s.nx * (size_t)cj[c];
-                        double zcol[2] = {zw[col], zw[(size_t)s.nz * ncol + col]};
-                        v += cw[c] * column_at(e + col, zmt + col * (size_t)s.nz, s.nz, ncol, zcol, y);
-                    }
-                    colv[J] = (float)v;
-                    if (v > 0) nonzero = 1;
-                }
-                if (!nonzero) continue;
-                const int off[3] = {I, 0, K}, size[3] = {1, vd.dims[1], 1};
-                if ((st = atmos_volume_set_dense(ctx, vol, field, off, size, colv, 1.0f))) goto done;
-            }
-        }
-    }
-    st = atmos_volume_finalize(ctx, vol);
-
-done:
-    nc_close(s.nc);
-    free(buf);
-    free(rho);
-    free(zw);
-    free(zm);
-    free(zmt);
-    free(eta);
-    free(xc);
-    free(colv);
-    if (st != ATMOS_OK) {
-        atmos_volume_destroy(vol);
-        return atmos__reader_name_error(ctx, path, st);
-    }
-    *out = vol;
-    return ATMOS_OK;
+    loader_free(&L);
+    return st == ATMOS_OK ? ATMOS_OK : atmos__reader_name_error(ctx, path, st);
 }
 
 #endif /* ATMOS_HAVE_NETCDF */

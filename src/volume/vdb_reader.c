@@ -139,145 +139,161 @@ static atmos_status select_grids(atmos_context *ctx, const char *path, const atm
     return ATMOS_OK;
 }
 
-atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
-                                        atmos_volume **out)
-{
-    static const atmos_volume_load_desc zero_desc;
-    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "openvdb: path and out are required");
-    *out = NULL;
-    if (!desc) desc = &zero_desc;
-    char msg[MSG_CAP];
-    atmos__vdb *f = NULL;
-    int rc = atmos__vdb_open(path, &f, msg, sizeof msg);
-    if (rc != ATMOS__VDB_OK) return atmos__error(ctx, shim_status(rc), "%s: %s", path, msg);
-
-    atmos_status st;
-    atmos_volume *vol = NULL;
-    int sel[ATMOS_VOLUME_MAX_FIELDS], nsel = 0;
+/* One load: the open file, the selected grids and their measurements, the index box
+ * they span, the volume. atmos__volume_load_openvdb closes the file and, on
+ * failure, destroys the volume, whichever step failed. */
+typedef struct {
+    atmos_context *ctx;
+    const char *path;
+    const atmos_volume_load_desc *desc;
+    atmos__vdb *f;
+    int sel[ATMOS_VOLUME_MAX_FIELDS], nsel;
     atmos__vdb_grid_stats gs[ATMOS_VOLUME_MAX_FIELDS];
-    st = select_grids(ctx, path, f, desc->grids, sel, &nsel);
-    if (st != ATMOS_OK) goto done;
+    int lo[3], hi[3], any; /* inclusive index box of all grids' active values */
+    uint64_t total;        /* active voxels of all grids */
+    atmos_volume *vol;
+    char msg[MSG_CAP];     /* the shim's last message */
+} vdb_load;
 
-    int lo[3] = {0, 0, 0}, hi[3] = {-1, -1, -1}, any = 0;
-    uint64_t total = 0;
-    for (int s = 0; s < nsel; s++) {
-        atmos__vdb_grid_info info;
-        atmos__vdb_get_grid_info(f, sel[s], &info);
-        rc = atmos__vdb_load_grid(f, sel[s], &gs[s], msg, sizeof msg);
-        if (rc != ATMOS__VDB_OK) {
-            st = atmos__error(ctx, shim_status(rc), "%s: %s", path, msg);
-            goto done;
-        }
-        /* Real fog volumes (the Disney cloud, dragon.vdb) hold no negative or
-         * non-finite values, so any such value marks a broken or non-density
-         * grid (an SDF, say): refuse rather than guess. */
-        if (gs[s].bad_values) {
-            st = atmos__error(ctx, ATMOS_E_FORMAT,
-                              "%s: grid '%s': value %g at index (%d, %d, %d) is %s (%llu bad values); densities "
-                              "must be finite and >= 0 (is this a level set rather than a fog volume?)",
-                              path, info.name, gs[s].bad_value, gs[s].bad_ijk[0], gs[s].bad_ijk[1], gs[s].bad_ijk[2],
-                              gs[s].bad_value < 0 ? "negative" : "not finite", (unsigned long long)gs[s].bad_values);
-            goto done;
-        }
-        if (!gs[s].linear) {
-            st = atmos__error(ctx, ATMOS_E_UNSUPPORTED,
-                              "%s: grid '%s' has a non-linear transform (%s, e.g. a frustum): atmos needs a linear "
-                              "(scale, rotation, translation) transform; resample the grid first",
-                              path, info.name, gs[s].map_type);
-            goto done;
-        }
-        if (s > 0 && memcmp(gs[s].mat, gs[0].mat, sizeof gs[0].mat) != 0) {
-            atmos__vdb_grid_info first;
-            atmos__vdb_get_grid_info(f, sel[0], &first);
-            st = atmos__error(ctx, ATMOS_E_UNSUPPORTED,
-                              "%s: grids '%s' and '%s' have different transforms; atmos puts all fields on one "
-                              "grid: load them separately or resample",
-                              path, first.name, info.name);
-            goto done;
-        }
-        total += gs[s].active_voxels;
-        if (gs[s].empty) continue;
-        for (int a = 0; a < 3; a++) {
-            if (!any || gs[s].bbox_min[a] < lo[a]) lo[a] = gs[s].bbox_min[a];
-            if (!any || gs[s].bbox_max[a] > hi[a]) hi[a] = gs[s].bbox_max[a];
-        }
-        any = 1;
-        atmos__log(ctx, ATMOS_LOG_INFO,
-                   "%s: grid '%s': %llu active voxels (%llu in leaves, %llu active tiles), index box [%d %d %d]..[%d "
-                   "%d %d], values %g..%g%s",
-                   path, info.name, (unsigned long long)gs[s].active_voxels, (unsigned long long)gs[s].leaf_voxels,
-                   (unsigned long long)gs[s].active_tiles, gs[s].bbox_min[0], gs[s].bbox_min[1], gs[s].bbox_min[2],
-                   gs[s].bbox_max[0], gs[s].bbox_max[1], gs[s].bbox_max[2], gs[s].min, gs[s].max,
-                   gs[s].compressed ? ", compressed" : "");
-    }
-    if (!any) {
-        atmos__log(ctx, ATMOS_LOG_WARN, "%s: the selected grids have no active voxels; the volume is empty", path);
-        lo[0] = lo[1] = lo[2] = 0;
-        hi[0] = hi[1] = hi[2] = 0;
-    }
-    st = atmos__reader_check_memory(ctx, path, total, desc->max_memory);
-    if (st != ATMOS_OK) goto done;
+static atmos_status shim_error(vdb_load *L, int rc)
+{
+    return atmos__error(L->ctx, shim_status(rc), "%s: %s", L->path, L->msg);
+}
 
+/* Loads selected grid s and checks its values and its transform against the first. */
+static atmos_status measure_grid(vdb_load *L, int s)
+{
+    atmos__vdb_grid_stats *gs = &L->gs[s];
+    atmos__vdb_grid_info info;
+    atmos__vdb_get_grid_info(L->f, L->sel[s], &info);
+    int rc = atmos__vdb_load_grid(L->f, L->sel[s], gs, L->msg, sizeof L->msg);
+    if (rc != ATMOS__VDB_OK) return shim_error(L, rc);
+    /* Real fog volumes (the Disney cloud, dragon.vdb) hold no negative or non-finite
+     * values, so any such value marks a broken or non-density grid (an SDF, say):
+     * refuse rather than guess. */
+    if (gs->bad_values)
+        return atmos__error(L->ctx, ATMOS_E_FORMAT,
+                            "%s: grid '%s': value %g at index (%d, %d, %d) is %s (%llu bad values); densities "
+                            "must be finite and >= 0 (is this a level set rather than a fog volume?)",
+                            L->path, info.name, gs->bad_value, gs->bad_ijk[0], gs->bad_ijk[1], gs->bad_ijk[2],
+                            gs->bad_value < 0 ? "negative" : "not finite", (unsigned long long)gs->bad_values);
+    if (!gs->linear)
+        return atmos__error(L->ctx, ATMOS_E_UNSUPPORTED,
+                            "%s: grid '%s' has a non-linear transform (%s, e.g. a frustum): atmos needs a linear "
+                            "(scale, rotation, translation) transform; resample the grid first",
+                            L->path, info.name, gs->map_type);
+    if (s > 0 && memcmp(gs->mat, L->gs[0].mat, sizeof gs->mat) != 0) {
+        atmos__vdb_grid_info first;
+        atmos__vdb_get_grid_info(L->f, L->sel[0], &first);
+        return atmos__error(L->ctx, ATMOS_E_UNSUPPORTED,
+                            "%s: grids '%s' and '%s' have different transforms; atmos puts all fields on one "
+                            "grid: load them separately or resample",
+                            L->path, first.name, info.name);
+    }
+    L->total += gs->active_voxels;
+    if (gs->empty) return ATMOS_OK;
+    for (int a = 0; a < 3; a++) {
+        if (!L->any || gs->bbox_min[a] < L->lo[a]) L->lo[a] = gs->bbox_min[a];
+        if (!L->any || gs->bbox_max[a] > L->hi[a]) L->hi[a] = gs->bbox_max[a];
+    }
+    L->any = 1;
+    atmos__log(L->ctx, ATMOS_LOG_INFO,
+               "%s: grid '%s': %llu active voxels (%llu in leaves, %llu active tiles), index box [%d %d %d]..[%d "
+               "%d %d], values %g..%g%s",
+               L->path, info.name, (unsigned long long)gs->active_voxels, (unsigned long long)gs->leaf_voxels,
+               (unsigned long long)gs->active_tiles, gs->bbox_min[0], gs->bbox_min[1], gs->bbox_min[2],
+               gs->bbox_max[0], gs->bbox_max[1], gs->bbox_max[2], gs->min, gs->max,
+               gs->compressed ? ", compressed" : "");
+    return ATMOS_OK;
+}
+
+/* The memory check, then the volume spanning the grids' index box, placed by their
+ * shared transform. */
+static atmos_status create_volume(vdb_load *L)
+{
+    if (!L->any) {
+        atmos__log(L->ctx, ATMOS_LOG_WARN, "%s: the selected grids have no active voxels; the volume is empty",
+                   L->path);
+        L->lo[0] = L->lo[1] = L->lo[2] = 0;
+        L->hi[0] = L->hi[1] = L->hi[2] = 0;
+    }
+    atmos_status st = atmos__reader_check_memory(L->ctx, L->path, L->total, L->desc->max_memory);
+    if (st != ATMOS_OK) return st;
     atmos_volume_desc vd;
     memset(&vd, 0, sizeof vd);
     for (int a = 0; a < 3; a++) {
-        int64_t n = (int64_t)hi[a] - lo[a] + 1;
-        if (n > ATMOS_VOLUME_MAX_DIM) {
-            st = atmos__error(ctx, ATMOS_E_LIMIT, "%s: the grids span %lld voxels along axis %d (limit %d)", path,
-                              (long long)n, a, ATMOS_VOLUME_MAX_DIM);
-            goto done;
-        }
+        int64_t n = (int64_t)L->hi[a] - L->lo[a] + 1;
+        if (n > ATMOS_VOLUME_MAX_DIM)
+            return atmos__error(L->ctx, ATMOS_E_LIMIT, "%s: the grids span %lld voxels along axis %d (limit %d)",
+                                L->path, (long long)n, a, ATMOS_VOLUME_MAX_DIM);
         vd.dims[a] = (int)n;
     }
     /* OpenVDB maps row vectors: world = [i j k 1] * M; atmos's A is column-major
      * in that sense, so A = M3^T and the translation is M's last row. */
     double A[9], t[3];
     for (int r = 0; r < 3; r++) {
-        for (int c = 0; c < 3; c++) A[3 * r + c] = gs[0].mat[c][r];
-        t[r] = gs[0].mat[3][r];
+        for (int c = 0; c < 3; c++) A[3 * r + c] = L->gs[0].mat[c][r];
+        t[r] = L->gs[0].mat[3][r];
     }
     char why[256];
-    if (atmos__reader_placement(A, t, lo, &vd, why, sizeof why) != 0) {
+    if (atmos__reader_placement(A, t, L->lo, &vd, why, sizeof why) != 0) {
         atmos__vdb_grid_info info;
-        atmos__vdb_get_grid_info(f, sel[0], &info);
-        st = atmos__error(ctx, ATMOS_E_UNSUPPORTED, "%s: grid '%s': %s", path, info.name, why);
-        goto done;
+        atmos__vdb_get_grid_info(L->f, L->sel[0], &info);
+        return atmos__error(L->ctx, ATMOS_E_UNSUPPORTED, "%s: grid '%s': %s", L->path, info.name, why);
     }
-    vd.max_memory = desc->max_memory;
-    st = atmos_volume_create(ctx, &vd, &vol);
+    vd.max_memory = L->desc->max_memory;
+    st = atmos_volume_create(L->ctx, &vd, &L->vol);
     /* a grid placement the core refuses (not a rotation, absurd size) is a malformed file */
-    if (st == ATMOS_E_INVALID_ARG) st = ATMOS_E_FORMAT;
-    if (st != ATMOS_OK) goto done;
+    return st == ATMOS_E_INVALID_ARG ? ATMOS_E_FORMAT : st;
+}
 
-    const float scale = desc->density_scale > 0 ? (float)desc->density_scale : 1.0f;
-    for (int s = 0; s < nsel; s++) {
-        atmos__vdb_grid_info info;
-        atmos__vdb_get_grid_info(f, sel[s], &info);
-        char field[64], particle[64];
-        atmos__reader_field_names(info.name, desc, field, particle);
-        visit_state vs = {ctx, vol, 0, {lo[0], lo[1], lo[2]}, scale, ATMOS_OK};
-        st = atmos_volume_add_field(ctx, vol, field, particle, &vs.field);
-        if (st != ATMOS_OK) goto done;
-        atmos__volume_set_file_active(vol, vs.field, gs[s].active_voxels);
-        rc = atmos__vdb_visit(f, sel[s], on_block, &vs, msg, sizeof msg);
-        if (rc == ATMOS__VDB_E_STOPPED) {
-            st = vs.status;
-            goto done;
-        }
-        if (rc != ATMOS__VDB_OK) {
-            st = atmos__error(ctx, shim_status(rc), "%s: %s", path, msg);
-            goto done;
-        }
-    }
-    st = atmos_volume_finalize(ctx, vol);
+/* Adds selected grid s as a field and copies its leaves and active tiles. */
+static atmos_status write_grid(vdb_load *L, int s)
+{
+    atmos__vdb_grid_info info;
+    atmos__vdb_get_grid_info(L->f, L->sel[s], &info);
+    char field[64], particle[64];
+    atmos__reader_field_names(info.name, L->desc, field, particle);
+    const float scale = L->desc->density_scale > 0 ? (float)L->desc->density_scale : 1.0f;
+    visit_state vs = {L->ctx, L->vol, 0, {L->lo[0], L->lo[1], L->lo[2]}, scale, ATMOS_OK};
+    atmos_status st = atmos_volume_add_field(L->ctx, L->vol, field, particle, &vs.field);
+    if (st != ATMOS_OK) return st;
+    atmos__volume_set_file_active(L->vol, vs.field, L->gs[s].active_voxels);
+    int rc = atmos__vdb_visit(L->f, L->sel[s], on_block, &vs, L->msg, sizeof L->msg);
+    if (rc == ATMOS__VDB_E_STOPPED) return vs.status;
+    return rc == ATMOS__VDB_OK ? ATMOS_OK : shim_error(L, rc);
+}
 
-done:
-    atmos__vdb_close(f);
+static atmos_status load(vdb_load *L)
+{
+    int rc = atmos__vdb_open(L->path, &L->f, L->msg, sizeof L->msg);
+    if (rc != ATMOS__VDB_OK) return shim_error(L, rc);
+    atmos_status st = select_grids(L->ctx, L->path, L->f, L->desc->grids, L->sel, &L->nsel);
+    for (int s = 0; s < L->nsel && st == ATMOS_OK; s++) st = measure_grid(L, s);
+    if (st == ATMOS_OK) st = create_volume(L);
+    for (int s = 0; s < L->nsel && st == ATMOS_OK; s++) st = write_grid(L, s);
+    return st == ATMOS_OK ? atmos_volume_finalize(L->ctx, L->vol) : st;
+}
+
+atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                        atmos_volume **out)
+{
+    static const atmos_volume_load_desc zero_desc;
+    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "openvdb: path and out are required");
+    *out = NULL;
+    vdb_load L;
+    memset(&L, 0, sizeof L);
+    L.ctx = ctx;
+    L.path = path;
+    L.desc = desc ? desc : &zero_desc;
+    L.hi[0] = L.hi[1] = L.hi[2] = -1;
+    atmos_status st = load(&L);
+    if (L.f) atmos__vdb_close(L.f);
     if (st != ATMOS_OK) {
-        atmos_volume_destroy(vol);
+        atmos_volume_destroy(L.vol);
         return atmos__reader_name_error(ctx, path, st);
     }
-    *out = vol;
+    *out = L.vol;
     return ATMOS_OK;
 }
 
