@@ -63,7 +63,6 @@ static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, cons
                            0.5 * (g->box_lo[2] + g->box_hi[2])};
     double sl_miss[ATMOS_MAX_WAVELENGTHS];
     sunlight_at(atm, &sp->x, cen, sun_w, sl_miss);
-    for (int c = 0; c < n; c++) lf->sl[(size_t)L * L * n + c] = (float)sl_miss[c];
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int b = 0; b < L; b++)
         for (int a = 0; a < L; a++) {
@@ -243,7 +242,9 @@ static void setup_pixels(const atmos__slice_plan *sp, const atmos_atmosphere *at
 
 /* Per light texel: the slices its ray crosses inside the box, and the sunlight entering
  * (from the light frame). Texel (a, b)'s ray is u e1 + v e2 + w lt; on slice k,
- * w = (s_k - u h.e1 - v h.e2) / h.lt. Every slot of the light ring starts with that light. */
+ * w = (s_k - u h.e1 - v h.e2) / h.lt. Every slot of the light ring starts with that light.
+ * Only the texels of each row's union of light spans (lrow) are set: the passes read and
+ * write no other (the spans are widened by a texel for the bilinear taps, slice_spans.c). */
 static void setup_texels(const atmos__slice_plan *sp, sjob *j, int threads)
 {
     const sgrid *g = j->g;
@@ -259,29 +260,27 @@ static void setup_texels(const atmos__slice_plan *sp, sjob *j, int threads)
         j->lEk[a] = j->ds / j->hl * j->lt[a] * g->sc;
     }
     j->ldelta = (float)(j->ds / j->hl);
-    const int L = j->L, n = j->n;
-    const float *sl_miss = lf->sl + (size_t)L * L * n; /* texels never read get the box centre's */
+    const int L = j->L, n = j->n, nslot = j->batch + 1;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (int b = 0; b < L; b++)
-        for (int a = 0; a < L; a++) {
+    for (int b = 0; b < L; b++) {
+        const sspan row = j->lrow[b];
+        for (int a = row.x0; a <= row.x1; a++) {
             const size_t q = (size_t)b * L + a;
-            const int read = a >= j->lrow[b].x0 && a <= j->lrow[b].x1;
-            const float *sl = read ? lf->sl + q * n : sl_miss;
             j->lk0[q] = 1, j->lk1[q] = 0;
-            if (read && lf->hit[q]) {
+            if (lf->hit[q]) {
                 double u = j->u0 + (a + 0.5) * j->du, v = j->v0 + (b + 0.5) * j->dv;
                 double o[3] = {u * j->e1[0] + v * j->e2[0], u * j->e1[1] + v * j->e2[1], u * j->e1[2] + v * j->e2[2]};
                 double ho = atmos__dot3(j->h, o);
                 atmos__slice_range(ho + lf->ta[q] * j->hl, ho + lf->tb[q] * j->hl, j->s0, j->ds, j->nslices, &j->lk0[q],
                                    &j->lk1[q]);
             }
-            for (int c = 0; c < n; c++) j->I[0][q * (n + 1) + c] = sl[c];
+            for (int c = 0; c < n; c++) j->I[0][q * (n + 1) + c] = lf->sl[q * n + c];
             j->nsc[0][q * (n + 1)] = 0.0f;
         }
-    const int nslot = j->batch + 1;
-    const size_t LL = (size_t)L * L;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int q = 1; q < nslot; q++) memcpy(j->I[q], j->I[0], sizeof(float) * LL * (size_t)(n + 1));
+        if (row.x0 > row.x1) continue;
+        const size_t first = ((size_t)b * L + row.x0) * (n + 1), len = (size_t)(row.x1 - row.x0 + 1) * (n + 1);
+        for (int s = 1; s < nslot; s++) memcpy(j->I[s] + first, j->I[0] + first, sizeof(float) * len);
+    }
 }
 
 /* The eye-buffer pixels that the image region r reads: itself at full resolution, else the

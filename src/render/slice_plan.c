@@ -36,7 +36,7 @@ static int light_buffers(atmos__slice_plan *sp)
     sp->light.ta = malloc(sizeof(double) * LL);
     sp->light.tb = malloc(sizeof(double) * LL);
     sp->light.hit = malloc(LL);
-    sp->light.sl = malloc(sizeof(float) * (LL + 1) * (size_t)sp->n);
+    sp->light.sl = malloc(sizeof(float) * LL * (size_t)sp->n);
     if (!sp->ring || !sp->I || !sp->nsc || !sp->lk || !sp->light.ta || !sp->light.tb || !sp->light.hit || !sp->light.sl)
         return 0;
     for (int q = 0; q <= sp->batch; q++) {
