@@ -187,6 +187,10 @@ typedef struct atmos_msphase_desc {
     int no_cache;         /* nonzero: neither read nor write the disk cache */
 } atmos_msphase_desc;
 
+/* Builds (or loads from the disk cache) Ams_n and F_n of a phase table. On failure *out is
+ * NULL and the status says why (with a message in ctx). A built object is immutable: any
+ * number of threads may read it. The accessors below return 0 (or NULL) for a NULL object
+ * or an index out of range. */
 ATMOS_API atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *table,
                                            const atmos_msphase_desc *desc, atmos_msphase **out);
 ATMOS_API void atmos_msphase_destroy(atmos_msphase *m);
@@ -218,7 +222,8 @@ ATMOS_API int atmos_msphase_from_cache(const atmos_msphase *m);
  * mixture's Legendre coefficients are the weighted sums of the components'. All parts
  * must have the same wavelength count; weights >= 0, not all zero (normalised here).
  * The cheap alternative of mixing the components' Ams_n linearly is exact only for n = 1;
- * its error is measured in docs/msphase.md. */
+ * its error is measured in docs/msphase.md. On failure *out is NULL and the status is the
+ * error's (ATMOS_E_NOMEM when the tables cannot be allocated), with or without a context. */
 ATMOS_API atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *parts, const double *weights,
                                          int count, const atmos_msphase_desc *desc, atmos_msphase **out);
 

@@ -366,7 +366,7 @@ static void series_first_order(const double *chi, int count, int ngrid, const do
 
 /* From the Legendre coefficients in m: the highest order, Ams_n for n >= 2 by the
  * series, Ams_1 from the tables P (or, when P is NULL, by the series too), F_n and
- * their log-sums. Frees m on failure. */
+ * their log-sums. Frees m on failure and returns the error (with its message). */
 static atmos_status finish_orders(atmos_context *ctx, atmos_msphase *m, const atmos_msphase_desc *dp, int n,
                                   const double *theta_deg, const double *const *P, int threads)
 {
@@ -563,6 +563,7 @@ bad:
 atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *table, const atmos_msphase_desc *desc,
                                  atmos_msphase **out)
 {
+    if (out) *out = NULL;
     if (!table || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase: missing table or output");
     int nwl = atmos_phase_table_wavelength_count(table);
     const double *theta;
@@ -606,24 +607,27 @@ atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *ta
     return st;
 }
 
-int atmos_msphase_max_order(const atmos_msphase *m) { return m->max_order; }
-int atmos_msphase_wavelength_count(const atmos_msphase *m) { return m->nwl; }
+/* Accessors: a NULL object or an index out of range gives 0 (or NULL), never a crash. */
+static int wl_ok(const atmos_msphase *m, int k) { return m && k >= 0 && k < m->nwl; }
+
+int atmos_msphase_max_order(const atmos_msphase *m) { return m ? m->max_order : 0; }
+int atmos_msphase_wavelength_count(const atmos_msphase *m) { return m ? m->nwl : 0; }
 int atmos_msphase_grid(const atmos_msphase *m, const double **theta_deg)
 {
-    if (theta_deg) *theta_deg = m->grid;
-    return m->ngrid;
+    if (theta_deg) *theta_deg = m ? m->grid : NULL;
+    return m ? m->ngrid : 0;
 }
-int atmos_msphase_from_cache(const atmos_msphase *m) { return m->from_cache; }
-int atmos_msphase_legendre_count(const atmos_msphase *m, int k) { return k >= 0 && k < m->nwl ? m->nchi[k] : 0; }
+int atmos_msphase_from_cache(const atmos_msphase *m) { return m ? m->from_cache : 0; }
+int atmos_msphase_legendre_count(const atmos_msphase *m, int k) { return wl_ok(m, k) ? m->nchi[k] : 0; }
 double atmos_msphase_legendre(const atmos_msphase *m, int k, int l)
 {
-    if (k < 0 || k >= m->nwl || l < 0 || l >= m->nchi[k]) return 0.0;
+    if (!wl_ok(m, k) || l < 0 || l >= m->nchi[k]) return 0.0;
     return m->chi[k][l];
 }
 
 const double *atmos_msphase_values(const atmos_msphase *m, int k, int n)
 {
-    if (k < 0 || k >= m->nwl || n < 1 || n > m->max_order) return NULL;
+    if (!wl_ok(m, k) || n < 1 || n > m->max_order) return NULL;
     return m->values + ((size_t)k * m->max_order + (n - 1)) * m->ngrid;
 }
 
@@ -654,7 +658,7 @@ static double eval_order(const atmos_msphase *m, int k, int n, int i, double f)
 
 double atmos_msphase_eval(const atmos_msphase *m, int k, double n, double cos_theta)
 {
-    if (k < 0 || k >= m->nwl) return 0.0;
+    if (!wl_ok(m, k)) return 0.0;
     if (!(n >= 1)) n = 1;
     if (cos_theta > 1) cos_theta = 1;
     if (cos_theta < -1) cos_theta = -1;
@@ -669,7 +673,7 @@ double atmos_msphase_eval(const atmos_msphase *m, int k, double n, double cos_th
 
 double atmos_msphase_forward(const atmos_msphase *m, int k, double n)
 {
-    if (k < 0 || k >= m->nwl) return 0.0;
+    if (!wl_ok(m, k)) return 0.0;
     if (!(n > 0)) return 1.0;
     if (n >= m->max_order) return n >= m->max_order + 1 ? 0.5 : m->forward[(size_t)k * (m->max_order + 1) + m->max_order] * (m->max_order + 1 - n) + 0.5 * (n - m->max_order);
     const double *F = m->forward + (size_t)k * (m->max_order + 1);
@@ -680,7 +684,7 @@ double atmos_msphase_forward(const atmos_msphase *m, int k, double n)
 
 double atmos_msphase_log_forward_sum(const atmos_msphase *m, int k, double n)
 {
-    if (k < 0 || k >= m->nwl || !(n > 0)) return 0.0;
+    if (!wl_ok(m, k) || !(n > 0)) return 0.0;
     const double *S = m->logsum + (size_t)k * (m->max_order + 1);
     if (n >= m->max_order) return S[m->max_order] + (n - m->max_order) * log(0.5);
     int n0 = (int)floor(n);
@@ -743,7 +747,10 @@ atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *p
         atmos_msphase_destroy(m);
         return atmos__error(ctx, ATMOS_E_NOMEM, "msphase mix: out of memory");
     }
-    if (finish_orders(ctx, m, &d, 0, NULL, NULL, atmos__threads(ctx)) != ATMOS_OK) return atmos_context_error_status(ctx);
+    /* finish_orders has freed m and reported the error; return its status, not the
+     * context's (there may be no context to hold it). */
+    atmos_status st = finish_orders(ctx, m, &d, 0, NULL, NULL, atmos__threads(ctx));
+    if (st != ATMOS_OK) return st;
     /* Order 1 mixes linearly (Eq. 6 itself): use the parts' tabulated Ams_1 rather than
      * the series, exactly as a table built from the mixed phase function would. */
     for (int k = 0; k < nwl; k++) {

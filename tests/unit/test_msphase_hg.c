@@ -1,11 +1,23 @@
 /* Multiple-scattering phase functions against an analytic case: the Henyey-Greenstein
  * function has Legendre coefficients chi_l = g^l, so convolving it n times with itself
  * gives Henyey-Greenstein with g^n, and its forward fraction has a closed form. */
+#define _POSIX_C_SOURCE 200809L /* setrlimit, sysconf */
 #include "atmos/atmos.h"
 #include "optics/optics_internal.h"
 #include "test.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #define PI 3.14159265358979323846
+
+#if defined(__SANITIZE_ADDRESS__)
+/* check_mix_failure: under the sanitizer an allocation above 16 MB fails (returns NULL)
+ * instead of being refused through an address-space limit, which the sanitizer's own
+ * mappings make unusable. Nothing else in this test allocates that much. */
+const char *__asan_default_options(void);
+const char *__asan_default_options(void) { return "allocator_may_return_null=1:max_allocation_size_mb=16"; }
+#endif
 
 static double hg(double mu, double g) { return (1 - g * g) / (4 * PI * pow(1 + g * g - 2 * g * mu, 1.5)); }
 
@@ -133,8 +145,95 @@ static void check_mixture(void)
     free(a), free(b), free(mix);
 }
 
+static atmos_msphase *hg_msphase(double g, int max_order)
+{
+    const double *theta;
+    int n = atmos_phase_grid(&theta);
+    double *P = malloc(sizeof(double) * n);
+    if (!P) return NULL;
+    for (int i = 0; i < n; i++) P[i] = hg(cos(theta[i] * PI / 180), g);
+    const double *Ps[1] = {P};
+    atmos_msphase *m = NULL;
+    atmos_msphase_desc d = {0};
+    d.max_order = max_order;
+    CHECK_OK(atmos__msphase_build_arrays(NULL, 1, n, theta, Ps, &d, &m));
+    free(P);
+    return m;
+}
+
+/* The accessors on a NULL object: 0 or NULL, no crash (issue: they dereferenced it). */
+static void check_null(void)
+{
+    const double *g = (const double *)&g;
+    CHECK(atmos_msphase_max_order(NULL) == 0 && atmos_msphase_wavelength_count(NULL) == 0);
+    CHECK(atmos_msphase_grid(NULL, &g) == 0 && g == NULL && atmos_msphase_grid(NULL, NULL) == 0);
+    CHECK(atmos_msphase_from_cache(NULL) == 0 && atmos_msphase_legendre_count(NULL, 0) == 0);
+    CHECK(atmos_msphase_legendre(NULL, 0, 0) == 0 && atmos_msphase_values(NULL, 0, 1) == NULL);
+    CHECK(atmos_msphase_eval(NULL, 0, 1, 0.5) == 0 && atmos_msphase_forward(NULL, 0, 1) == 0);
+    CHECK(atmos_msphase_log_forward_sum(NULL, 0, 1) == 0);
+    atmos_msphase_destroy(NULL);
+    atmos_msphase *out = (atmos_msphase *)&g;
+    CHECK(atmos_msphase_build(NULL, NULL, NULL, &out) == ATMOS_E_INVALID_ARG && out == NULL);
+}
+
+/* A mix whose tables cannot be allocated fails with ATMOS_E_NOMEM and *out = NULL, with or
+ * without a context (issue: without one it returned ATMOS_OK and no object). Order 1000 on
+ * the Ams grid is 22 MB of values; the address space is limited to 8 MB more than in use
+ * (the sanitizer build instead fails allocations above 16 MB, see the top of this file). */
+static void check_mix_failure(void)
+{
+    atmos_msphase *a = hg_msphase(0.5, 0), *b = hg_msphase(-0.2, 0);
+    if (!a || !b) {
+        atmos_msphase_destroy(a), atmos_msphase_destroy(b);
+        return;
+    }
+    atmos_context *ctx = NULL;
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    const atmos_msphase *parts[2] = {a, b};
+    const double w[2] = {1, 1};
+    atmos_msphase_desc d = {0};
+    d.max_order = 1000;
+    atmos_msphase *out1 = a, *out2 = a;
+    atmos_status s1, s2;
+#if !defined(__SANITIZE_ADDRESS__)
+    struct rlimit old, lim;
+    long pages = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%ld", &pages) != 1) pages = 0;
+        fclose(f);
+    }
+    if (pages <= 0 || getrlimit(RLIMIT_AS, &old) != 0) {
+        printf("mix failure: no /proc/self/statm or RLIMIT_AS here; skipped\n");
+        atmos_context_destroy(ctx), atmos_msphase_destroy(a), atmos_msphase_destroy(b);
+        return;
+    }
+    lim = old;
+    lim.rlim_cur = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + ((rlim_t)8 << 20);
+    if (old.rlim_cur != RLIM_INFINITY && old.rlim_cur < lim.rlim_cur) lim.rlim_cur = old.rlim_cur;
+    setrlimit(RLIMIT_AS, &lim);
+#endif
+    s1 = atmos_msphase_mix(NULL, parts, w, 2, &d, &out1);
+    s2 = atmos_msphase_mix(ctx, parts, w, 2, &d, &out2);
+#if !defined(__SANITIZE_ADDRESS__)
+    setrlimit(RLIMIT_AS, &old);
+#endif
+    CHECK_MSG(s1 == ATMOS_E_NOMEM && out1 == NULL, "mix without a context: %s, out %p", atmos_status_string(s1), (void *)out1);
+    CHECK_MSG(s2 == ATMOS_E_NOMEM && out2 == NULL, "mix with a context: %s, out %p", atmos_status_string(s2), (void *)out2);
+    CHECK_MSG(strstr(atmos_context_error(ctx), "out of memory") != NULL, "message: %s", atmos_context_error(ctx));
+    atmos_msphase_destroy(out1 == a ? NULL : out1), atmos_msphase_destroy(out2 == a ? NULL : out2);
+    /* and with the memory there, the same mix works */
+    d.max_order = 8;
+    CHECK_OK(atmos_msphase_mix(NULL, parts, w, 2, &d, &out1));
+    CHECK(out1 && atmos_msphase_max_order(out1) == 8);
+    atmos_msphase_destroy(out1);
+    atmos_context_destroy(ctx), atmos_msphase_destroy(a), atmos_msphase_destroy(b);
+}
+
 int main(void)
 {
+    check_null();
+    check_mix_failure();
     check_mixture();
     check_hg(0.0);
     check_hg(0.5);
