@@ -6,6 +6,7 @@
 #include "optics/optics_internal.h"
 #include "test.h"
 
+#include <stdint.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -145,6 +146,15 @@ static void check_mixture(void)
     free(a), free(b), free(mix);
 }
 
+static uint64_t rng_state = 99;
+static double uniform(void)
+{
+    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+}
+
 static atmos_msphase *hg_msphase(double g, int max_order)
 {
     const double *theta;
@@ -159,6 +169,73 @@ static atmos_msphase *hg_msphase(double g, int max_order)
     CHECK_OK(atmos__msphase_build_arrays(NULL, 1, n, theta, Ps, &d, &m));
     free(P);
     return m;
+}
+
+/* atmos_msphase_eval as it read its grid before the angle-table reader: a bisection of the
+ * whole grid, linear in degrees, then linear between orders. The reference for check_eval. */
+static double old_eval(const atmos_msphase *m, double n, double mu)
+{
+    const double *grid;
+    const int ng = atmos_msphase_grid(m, &grid), N = atmos_msphase_max_order(m);
+    if (!(n >= 1)) n = 1;
+    if (mu > 1) mu = 1;
+    if (mu < -1) mu = -1;
+    double t = acos(mu) * (180.0 / PI), f;
+    int lo = 0, hi = ng - 1;
+    if (!(t > 0)) t = 0;
+    if (t >= 180.0) {
+        f = 1.0;
+        lo = ng - 2;
+    } else {
+        while (hi - lo > 1) {
+            int mid = (lo + hi) / 2;
+            if (grid[mid] <= t) lo = mid;
+            else hi = mid;
+        }
+        f = (t - grid[lo]) / (grid[lo + 1] - grid[lo]);
+    }
+    if (n >= N + 1) return 1.0 / (4.0 * PI);
+    const int n0 = (int)floor(n);
+    const double w = n - n0;
+    const double *v0 = atmos_msphase_values(m, 0, n0), *v1 = n0 + 1 <= N ? atmos_msphase_values(m, 0, n0 + 1) : NULL;
+    const double a = v0[lo] * (1 - f) + v0[lo + 1] * f;
+    const double b = v1 ? v1[lo] * (1 - f) + v1[lo + 1] * f : 1.0 / (4.0 * PI);
+    return w > 0 ? a * (1 - w) + b * w : a;
+}
+
+/* Ams lookups through the angle-table reader give the former lookups' numbers bit for bit:
+ * at every grid angle, one ulp beside it, between grid angles, at random and at the ends. */
+static void check_eval(void)
+{
+    atmos_msphase *m = hg_msphase(0.7, 6);
+    if (!m) return;
+    const double *grid;
+    const int ng = atmos_msphase_grid(m, &grid);
+    const double orders[] = {1, 2.5, 6, 6.75, 9, 0.2};
+    long bad = 0, count = 0;
+    for (int q = 0; q < 4 * ng + 100000; q++) {
+        double th;
+        if (q < 4 * ng) {
+            th = grid[q / 4] * PI / 180;
+            if (q % 4 == 1) th = nextafter(th, 0);
+            if (q % 4 == 2) th = nextafter(th, 4);
+            if (q % 4 == 3 && q / 4 + 1 < ng) th = 0.5 * (grid[q / 4] + grid[q / 4 + 1]) * PI / 180;
+        } else {
+            th = q % 2 ? PI * uniform() : 0.05 * uniform();
+        }
+        for (int o = 0; o < 6; o++) {
+            const double a = atmos_msphase_eval(m, 0, orders[o], cos(th)), b = old_eval(m, orders[o], cos(th));
+            bad += memcmp(&a, &b, sizeof a) != 0;
+            count++;
+        }
+    }
+    const double ends[] = {1, -1, 1.5, -3, NAN};
+    for (int e = 0; e < 5; e++) {
+        const double a = atmos_msphase_eval(m, 0, 2, ends[e]), b = old_eval(m, 2, ends[e]);
+        bad += memcmp(&a, &b, sizeof a) != 0;
+    }
+    CHECK_MSG(bad == 0, "atmos_msphase_eval: %ld of %ld lookups differ from the former reader", bad, count);
+    atmos_msphase_destroy(m);
 }
 
 /* The accessors on a NULL object: 0 or NULL, no crash (issue: they dereferenced it). */
@@ -233,6 +310,7 @@ static void check_mix_failure(void)
 int main(void)
 {
     check_null();
+    check_eval();
     check_mix_failure();
     check_mixture();
     check_hg(0.0);
