@@ -154,12 +154,24 @@ ATMOS_API void atmos_phase_table_destroy(atmos_phase_table *t);
 
 ATMOS_API int atmos_phase_table_wavelength_count(const atmos_phase_table *t);
 ATMOS_API double atmos_phase_table_wavelength_nm(const atmos_phase_table *t, int k);
-/* Tabulated P (sr^-1) at every grid angle for wavelength k. */
+/* Tabulated P (sr^-1) at every grid angle for wavelength k (for plotting and export: the
+ * values themselves, without interpolation). */
 ATMOS_API const double *atmos_phase_table_values(const atmos_phase_table *t, int k);
-/* P at any angle (linear interpolation in theta). */
+/* The phase function at any angle, sr^-1, as the density atmos_phase_table_sample draws
+ * from: f(theta) / sin(theta), with f the piecewise-linear interpolant in theta of
+ * f_i = P_i sin(theta_i) / F and F = 2 pi int P sin(theta) dtheta by the trapezoid rule, so
+ * that it integrates to 1 over the sphere exactly (to rounding) and pdf = eval. Between grid
+ * angles it differs from P interpolated linearly in theta by O(h^2) relative (h the grid step;
+ * docs/phase-tables.md); at theta = 0 and 180° it is the finite limit (in the first and last
+ * interval f is linear from 0 at the pole). cos_theta is clamped to [-1, 1]; NaN or a bad k
+ * give 0. */
 ATMOS_API double atmos_phase_table_eval(const atmos_phase_table *t, int k, double cos_theta);
-/* Importance sampling by the inverse CDF: cos(theta) from a uniform u in [0, 1). */
+/* Importance sampling by the inverse CDF of that density: cos(theta) from a uniform u in
+ * [0, 1) (clamped into it); azimuth is uniform, the caller's to draw. */
 ATMOS_API double atmos_phase_table_sample(const atmos_phase_table *t, int k, double u);
+/* pdf in sr^-1 of the direction with this cos(theta) as atmos_phase_table_sample draws it:
+ * equal to atmos_phase_table_eval. */
+ATMOS_API double atmos_phase_table_pdf(const atmos_phase_table *t, int k, double cos_theta);
 /* Per wavelength: extinction cross-section (m^2), single-scattering albedo, asymmetry g. */
 ATMOS_API double atmos_phase_table_sigma_ext(const atmos_phase_table *t, int k);
 ATMOS_API double atmos_phase_table_albedo(const atmos_phase_table *t, int k);

@@ -139,4 +139,11 @@ static inline int atmos__angle_cdf_find(const double *c, int n, double *u)
  * there from f0 to f1 (any common scale): the exact inverse of its quadratic integral. */
 double atmos__angle_invert(const atmos__angle_grid *g, const double *c, int i, double u, double f0, double f1);
 
+/* ---------------------------------------------------------------- phase tables */
+
+/* The normalised f_i of a phase table's wavelength k on atmos__phase_angle_grid() (NULL
+ * for a bad k) and, in *total, the trapezoid integral 2 pi int P sin(theta) dtheta they
+ * were divided by (in radians, interval by interval, as f_i's users sum it). */
+const double *atmos__phase_table_density(const atmos_phase_table *t, int k, double *total);
+
 #endif

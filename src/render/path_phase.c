@@ -1,10 +1,12 @@
-/* Tabulated phase functions for the path tracer: evaluation that matches the inverse-CDF
- * sampler of phase_table.c exactly, in single precision, and forward-peak truncation.
+/* Tabulated phase functions for the path tracer: the tables' own matched density and
+ * sampler (atmos_phase_table_eval / _sample / _pdf, angle_table.h), kept in single precision
+ * for evaluation, and forward-peak truncation.
  *
  * atmos_phase_table_sample draws theta with density 2 pi f(theta), f the piecewise-linear
- * interpolant of f_i = P(theta_i) sin(theta_i) / F; over solid angle that is
- * f(theta) / sin(theta), which atmos__path_phase_eval computes from fv = (float)f_i with
- * the interval and weights of atmos__angle_density_weights (angle_table.h). Evaluating this function (rather than P interpolated
+ * interpolant of the table's f_i = P(theta_i) sin(theta_i) / F; over solid angle that is
+ * f(theta) / sin(theta), which is what atmos_phase_table_eval returns and what
+ * atmos__path_phase_eval computes from fv = (float)f_i with the same interval and weights
+ * (atmos__angle_density_weights). Evaluating this function (rather than P interpolated
  * linearly) for next-event estimation and for the spectral weights makes the phase function
  * that is sampled and the one that is evaluated the same, so a phase-sampled direction has
  * weight exactly 1.
@@ -42,8 +44,8 @@ static int cut_index(const atmos__angle_grid *g, double truncate_deg)
 }
 
 /* fv = P' sin(theta) / (its integral) for the table v clipped at v[ic] inside the cone;
- * returns the fraction of the scattering removed. total is the table's own integral,
- * summed the same way as kept here. */
+ * returns the fraction of the scattering removed. total is the table's own integral
+ * (atmos__phase_table_density), summed the same way as kept here. */
 static float truncate_table(const atmos__angle_grid *g, int ic, const double *v, double total, float *fv)
 {
     const int ng = g->n;
@@ -107,15 +109,11 @@ atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_volume_opti
         for (int k = 0; k < nwl; k++) {
             const double *v = atmos_phase_table_values(t, k);
             if (k > 0 && memcmp(v, v0, sizeof(double) * (size_t)ng) != 0) p->gray[f] = 0;
-            const atmos__angle_grid *g = p->grid;
-            double total = 0;
-            for (int i = 0; i + 1 < ng; i++)
-                total += ATMOS_PI * (v[i] * g->sin[i] + v[i + 1] * g->sin[i + 1]) * (g->rad[i + 1] - g->rad[i]);
-            if (!(total > 0) || !isfinite(total)) total = 1;
+            double total;
+            const double *d = atmos__phase_table_density(t, k, &total);
             float *fv = p->fv[f] + (size_t)k * ng;
             if (!p->ic) {
-                for (int i = 0; i < ng; i++) fv[i] = (float)(v[i] * g->sin[i] / total);
-                fv[0] = 0.0f; /* sin 0 */
+                for (int i = 0; i < ng; i++) fv[i] = (float)d[i];
                 continue;
             }
             p->trunc[f][k] = truncate_table(p->grid, p->ic, v, total, fv);

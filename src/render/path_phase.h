@@ -8,14 +8,15 @@
 #include "render/path_common.h"
 
 /* For every field and wavelength the density atmos_phase_table_sample draws from
- * (angle_table.h), as f_i in single precision so that evaluating all fields and wavelengths
- * of a scattering event reads few cache lines; evaluation (next-event estimation, spectral
- * weights) and sampling use the same function, so phase sampling has weight 1. */
+ * (atmos_phase_table_eval, angle_table.h), as f_i in single precision so that evaluating
+ * all fields and wavelengths of a scattering event reads few cache lines; evaluation (next-
+ * event estimation, spectral weights) and sampling use the same function, so phase sampling
+ * has weight 1. */
 typedef struct {
     int nf, nwl;
     int ng;                        /* grid angles */
     const atmos__angle_grid *grid; /* atmos__phase_angle_grid() */
-    float *fv[PATH_F];             /* nwl * n: f_i = P_i sin(theta_i) / total, or truncated */
+    float *fv[PATH_F];             /* nwl * n: f_i (atmos__phase_table_density), or truncated */
     int gray[PATH_F];              /* same table at every wavelength */
     const atmos_phase_table *t[PATH_F];
     /* Forward-peak truncation (docs/path.md, "Forward-peak truncation"); ic = 0: none, the

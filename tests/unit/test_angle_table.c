@@ -2,9 +2,12 @@
  * linear scan for the interval of an angle, on the library's two grids and on a random grid
  * with angles on and one ulp beside the lookup's bin edges; the slice renderer's per-pixel
  * lookup (atmos__angle_locate) against its former implementation, a hinted bisection, kept
- * here as the reference; the weights of the sampled density. */
+ * here as the reference; the weights of the sampled density; the path tracer's copies of a
+ * table's density (exact single-precision copies, and the truncated tables' sampler against
+ * their evaluation). */
 #include "atmos/atmos.h"
 #include "optics/angle_table.h"
+#include "render/path_phase.h"
 #include "render/slice_tables.h"
 #include "test.h"
 
@@ -262,6 +265,90 @@ static void check_weights(void)
     printf("density weights: isotropic table reads back as 1 to %.2g\n", worst);
 }
 
+/* ---- the path tracer's copies: untruncated, f_i in single precision exactly; truncated,
+ * a density (integral 1) that its sampler draws (CDF at a sampled angle = u). */
+static double path_integral(const path_phase *p, int f, int k, double lo_rad, double hi_rad)
+{
+    const atmos__angle_grid *g = p->grid;
+    double s = 0;
+    for (int i = 0; i + 1 < g->n; i++) {
+        double a = fmax(g->rad[i], lo_rad), b = fmin(g->rad[i + 1], hi_rad);
+        if (!(b > a)) continue;
+        /* the density times sin is linear in theta inside an interval: two Gauss points are exact */
+        const double c = 0.5 * (a + b), r = 0.5 * (b - a) / sqrt(3.0);
+        path_angle w1, w2;
+        atmos__path_angle(p, cos(c - r), &w1);
+        atmos__path_angle(p, cos(c + r), &w2);
+        s += 0.5 * (b - a) * (atmos__path_phase_eval(p, f, k, &w1) * sin(c - r) + atmos__path_phase_eval(p, f, k, &w2) * sin(c + r));
+    }
+    return 2 * PI * s;
+}
+
+static void check_path_phase(void)
+{
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_particle_desc pd;
+    memset(&pd, 0, sizeof pd);
+    snprintf(pd.name, sizeof pd.name, "hg");
+    pd.kind = ATMOS_PARTICLE_ANALYTIC;
+    pd.analytic.count = 2;
+    pd.analytic.kind[0] = ATMOS_PHASE_HG, pd.analytic.g[0] = 0.98, pd.analytic.weight[0] = 0.7;
+    pd.analytic.kind[1] = ATMOS_PHASE_HG, pd.analytic.g[1] = 0.3, pd.analytic.weight[1] = 0.3;
+    atmos_phase_table *t = NULL;
+    atmos_phase_table_desc td = {1};
+    CHECK_OK(atmos_phase_table_build(NULL, &pd, &wl, &td, &t));
+    if (!t) return;
+    atmos_volume_optics o;
+    memset(&o, 0, sizeof o);
+    o.count = 1;
+    o.phase[0] = t;
+    path_phase p;
+    CHECK_OK(atmos__path_phase_build(NULL, &o, 3, 0, &p));
+    const int n = p.ng;
+    long bad = 0;
+    for (int k = 0; k < 3; k++) {
+        const double *d = atmos__phase_table_density(t, k, NULL);
+        for (int i = 0; i < n; i++) bad += p.fv[0][(size_t)k * n + i] != (float)d[i];
+    }
+    CHECK_MSG(bad == 0, "%ld single-precision densities are not the table's", bad);
+    double worst = 0;
+    for (int q = 0; q < 20000; q++) {
+        double mu = q % 2 ? 2 * uniform() - 1 : cos(0.1 * uniform());
+        path_angle a;
+        atmos__path_angle(&p, mu, &a);
+        double e = atmos_phase_table_eval(t, 1, mu), r = fabs(atmos__path_phase_eval(&p, 0, 1, &a) - e) / e;
+        if (r > worst) worst = r;
+    }
+    CHECK_MSG(worst < 1e-6, "path evaluation vs atmos_phase_table_eval: %g", worst);
+    CHECK(atmos__path_phase_sample(&p, 0, 1, 0.3) == atmos_phase_table_sample(t, 1, 0.3));
+    atmos__path_phase_free(&p);
+
+    /* truncated at 3°: the fraction removed, a normalised density, and its sampler */
+    CHECK_OK(atmos__path_phase_build(NULL, &o, 3, 3.0, &p));
+    CHECK(p.ic > 0 && fabs(p.cut_deg - 3.0) < 1e-9);
+    CHECK_MSG(p.trunc[0][1] > 0.3 && p.trunc[0][1] < 0.7, "truncated fraction %g", p.trunc[0][1]);
+    CHECK_NEAR(path_integral(&p, 0, 1, 0, PI), 1.0, 1e-6);
+    double werr = 0;
+    for (int q = 0; q < 500; q++) {
+        const double u = (q + 0.5) / 500;
+        const double th = acos(atmos__path_phase_sample(&p, 0, 1, u));
+        werr = fmax(werr, fabs(path_integral(&p, 0, 1, 0, th) - u));
+    }
+    CHECK_MSG(werr < 1e-6, "truncated sampler vs its density: CDF at a sample differs from u by %g", werr);
+    /* below the cut the truncated density is flat in P (P(theta_c)), above it the table's */
+    path_angle a0, a1, a2;
+    atmos__path_angle(&p, cos(0.5 * PI / 180), &a0);
+    atmos__path_angle(&p, cos(2.9 * PI / 180), &a1);
+    atmos__path_angle(&p, cos(20 * PI / 180), &a2);
+    CHECK_REL(atmos__path_phase_eval(&p, 0, 1, &a0), atmos__path_phase_eval(&p, 0, 1, &a1), 1e-3);
+    CHECK_REL(atmos__path_phase_eval(&p, 0, 1, &a2) * (1 - p.trunc[0][1]), atmos_phase_table_eval(t, 1, cos(20 * PI / 180)), 1e-6);
+    printf("path phase: exact copies, eval within %.2g of the table's; truncated at 3 deg removes %.4f, sampler within %.2g\n",
+           worst, p.trunc[0][1], werr);
+    atmos__path_phase_free(&p);
+    atmos_phase_table_destroy(t);
+}
+
 int main(void)
 {
     check_grids();
@@ -269,5 +356,6 @@ int main(void)
     if (g) check_random_grid(g);
     free(g);
     check_weights();
+    check_path_phase();
     return test_summary("test_angle_table");
 }
