@@ -210,7 +210,9 @@ ATMOS_API void atmos_msphase_destroy(atmos_msphase *m);
 /* Highest order n tabulated (orders 0..n; Ams_0 is the collimated beam, a delta). */
 ATMOS_API int atmos_msphase_max_order(const atmos_msphase *m);
 ATMOS_API int atmos_msphase_wavelength_count(const atmos_msphase *m);
-/* The output angle grid (degrees, 0..180, finer near 0, never coarser than 0.1°). */
+/* The output angle grid (degrees, 0..180, finer near 0, never coarser than 0.1°; not the
+ * phase tables' grid, see docs/msphase.md). *theta_deg points to static storage, the same
+ * for every object. */
 ATMOS_API int atmos_msphase_grid(const atmos_msphase *m, const double **theta_deg);
 /* Ams_n (sr^-1) at every grid angle for wavelength k, 1 <= n <= max_order. */
 ATMOS_API const double *atmos_msphase_values(const atmos_msphase *m, int k, int n);

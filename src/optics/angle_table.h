@@ -104,13 +104,14 @@ static inline int atmos__angle_lerp(const atmos__angle_grid *g, double theta_deg
 
 /* ---------------------------------------------------------------- the sampled density
  *
- * A tabulated phase function is sampled (atmos__angle_sample) with the density over theta
- * 2 pi f(theta), where f is the piecewise-linear interpolant in theta of f_i = P_i sin(theta_i)
- * normalised so that 2 pi int f dtheta = 1 by the trapezoid rule, the rule that normalises
- * the table. Over solid angle that density is f(theta) / sin(theta): evaluating it (rather
- * than P interpolated linearly) makes the evaluated and the sampled phase function the same,
- * so pdf = eval and a phase-sampled direction has weight exactly 1. The two differ by the
- * interpolation error only (relative O(h^2), far below 1e-4 on the grids here). */
+ * A tabulated phase function is sampled (atmos__angle_cdf_find, atmos__angle_invert) with
+ * the density over theta 2 pi f(theta), where f is the piecewise-linear interpolant in theta
+ * of f_i = P_i sin(theta_i) / F, F = 2 pi int P sin(theta) dtheta by the trapezoid rule (the
+ * rule that normalises the table), so that 2 pi int f dtheta = 1. Over solid angle that
+ * density is f(theta) / sin(theta): evaluating it (rather than P interpolated linearly)
+ * makes the evaluated and the sampled phase function the same, so pdf = eval and a
+ * phase-sampled direction has weight exactly 1. The two differ by the interpolation error
+ * only (relative O(h^2), far below 1e-4 on the grids here). */
 
 /* Where cos(theta) falls and how f_i, f_{i+1} make the density there:
  * p = w0 f_i + w1 f_{i+1} (sr^-1 for f normalised as above). */
@@ -141,9 +142,10 @@ double atmos__angle_invert(const atmos__angle_grid *g, const double *c, int i, d
 
 /* ---------------------------------------------------------------- phase tables */
 
-/* The normalised f_i of a phase table's wavelength k on atmos__phase_angle_grid() (NULL
- * for a bad k) and, in *total, the trapezoid integral 2 pi int P sin(theta) dtheta they
- * were divided by (in radians, interval by interval, as f_i's users sum it). */
-const double *atmos__phase_table_density(const atmos_phase_table *t, int k, double *total);
+/* F of a phase table's wavelength k (0 for a bad k): its sampled density has
+ * f_i = P_i sin(theta_i) / F on atmos__phase_angle_grid(), P_i = atmos_phase_table_values.
+ * F is the trapezoid integral 2 pi int P sin(theta) dtheta summed in radians interval by
+ * interval, sum_i pi (P_i sin_i + P_i+1 sin_i+1) (rad_i+1 - rad_i), 1 to rounding. */
+double atmos__phase_table_total(const atmos_phase_table *t, int k);
 
 #endif

@@ -13,12 +13,11 @@
  * phase table's grid, with the table linearly interpolated in theta (atmos_phase_table_eval
  * interpolates P sin(theta) instead, to match its sampler; the two readings differ by
  * O(h^2), far below the series' tolerance) and enough nodes per interval for the highest
- * l needed; the series is
- * cut where |chi_l| stays below 2e-6 for 256 consecutive l (forward diffraction peaks of
- * drops of size parameter x have coefficients up to l ~ 2x; beyond, the piecewise-linear
- * table has a floor of ~1e-7 coefficients, which matter only for Ams_1, taken from the
- * table: squared, they are below 1e-12). Everything is summed in a fixed order,
- * so results do not depend on the thread count.
+ * l needed; the series is cut where |chi_l| stays below 2e-6 for 256 consecutive l
+ * (forward diffraction peaks of drops of size parameter x have coefficients up to l ~ 2x;
+ * beyond, the piecewise-linear table has a floor of ~1e-7 coefficients, which matter only
+ * for Ams_1, taken from the table: squared, they are below 1e-12). Everything is summed in
+ * a fixed order, so results do not depend on the thread count.
  *
  * Tables are read through angle_table.h: the phase table on its grid (Ams_1), Ams_n on the
  * output grid of phase_grid.c (atmos_msphase_eval, and the slice renderer per pixel).
@@ -96,9 +95,8 @@ static double forward_width(int n, const double *theta_deg, const double *P)
 }
 
 /* Gauss nodes of 2 pi P(theta) sin(theta) dtheta over the grid intervals [i0, i1), with
- * P linear in theta inside an interval and enough nodes per
- * interval for P_L's oscillation (period 2 pi / L). Appends to mu/f; returns the count
- * (or, with mu == NULL, only counts). */
+ * P linear in theta inside an interval and enough nodes per interval for P_L's oscillation
+ * (period 2 pi / L). Appends to mu/f; returns the count (or, with mu == NULL, only counts). */
 static int make_nodes(int i0, int i1, const double *theta_deg, const double *P, int L, double *mu, double *f)
 {
     double gx[64], gw[64];

@@ -37,8 +37,7 @@ struct atmos_phase_table {
     double *nm;
     double *values;  /* n_wl x n_ang, P in sr^-1 */
     double *cdf;     /* n_wl x n_ang, CDF over theta at the grid angles, cdf[0] = 0, last = 1 */
-    double *density; /* n_wl x n_ang, f_i = P_i sin(theta_i) / total (angle_table.h) */
-    double *total;   /* n_wl: the trapezoid integral 2 pi int P sin(theta) dtheta of f */
+    double *total;   /* n_wl: F, the normaliser of the sampled density (angle_table.h) */
     double *sigma_ext, *albedo, *g;
     int from_cache;
 };
@@ -61,7 +60,6 @@ void atmos_phase_table_destroy(atmos_phase_table *t)
     free(t->nm);
     free(t->values);
     free(t->cdf);
-    free(t->density);
     free(t->total);
     free(t->sigma_ext);
     free(t->albedo);
@@ -81,12 +79,11 @@ static atmos_phase_table *table_alloc(int n_wl, const atmos__angle_grid *grid)
     t->nm = calloc((size_t)n_wl, sizeof *t->nm);
     t->values = calloc(n, sizeof *t->values);
     t->cdf = calloc(n, sizeof *t->cdf);
-    t->density = calloc(n, sizeof *t->density);
     t->total = calloc((size_t)n_wl, sizeof *t->total);
     t->sigma_ext = calloc((size_t)n_wl, sizeof *t->sigma_ext);
     t->albedo = calloc((size_t)n_wl, sizeof *t->albedo);
     t->g = calloc((size_t)n_wl, sizeof *t->g);
-    if (!t->nm || !t->values || !t->cdf || !t->density || !t->total || !t->sigma_ext || !t->albedo || !t->g) {
+    if (!t->nm || !t->values || !t->cdf || !t->total || !t->sigma_ext || !t->albedo || !t->g) {
         atmos_phase_table_destroy(t);
         return NULL;
     }
@@ -273,12 +270,12 @@ static int unpack_payload(atmos_phase_table *t, const double *d, size_t size, co
  * piecewise linear between grid angles: the same trapezoid rule that normalises the
  * table (atmos__sphere_integral), so the CDF ends at exactly the normalised total.
  * Inside an interval F is then quadratic and is inverted exactly (atmos__angle_invert).
- * The density f_i = P_i sin(theta_i) / total that atmos_phase_table_eval reads is that
- * same function; total is summed in radians interval by interval, the sum the path
- * tracer's single-precision copies of f_i have always been divided by (path_phase.c),
- * so that those copies stay what they were. The CDF's own sum (degree steps converted
- * per interval) differs from it in the last bits only; it is kept so that sampled
- * directions stay what they were too. */
+ * atmos_phase_table_eval reads that same function through g_i = P_i sin(theta_i) / F; F
+ * (t->total) is summed in radians interval by interval, the sum the path tracer's
+ * single-precision copies of g_i have always been divided by (path_phase.c), so that those
+ * copies stay what they were. The CDF's own sum (degree steps converted per interval)
+ * differs from it in the last bits only; it is kept so that sampled directions stay what
+ * they were too. */
 static int build_cdf(atmos_phase_table *t, int k)
 {
     const atmos__angle_grid *gr = t->grid;
@@ -296,8 +293,6 @@ static int build_cdf(atmos_phase_table *t, int k)
     for (int i = 0; i + 1 < t->n_ang; i++)
         ft += ATMOS_PI * (v[i] * sn[i] + v[i + 1] * sn[i + 1]) * (gr->rad[i + 1] - gr->rad[i]);
     if (!(ft > 0) || !isfinite(ft)) return 0;
-    double *f = t->density + (size_t)k * t->n_ang;
-    for (int i = 0; i < t->n_ang; i++) f[i] = v[i] * sn[i] / ft;
     t->total[k] = ft;
     return 1;
 }
@@ -520,12 +515,7 @@ void atmos_phase_table_cross_sections(const atmos_phase_table *t, int k, double 
 double atmos_phase_table_g(const atmos_phase_table *t, int k) { return wl_ok(t, k) ? t->g[k] : 0.0; }
 int atmos_phase_table_from_cache(const atmos_phase_table *t) { return t ? t->from_cache : 0; }
 
-const double *atmos__phase_table_density(const atmos_phase_table *t, int k, double *total)
-{
-    if (!wl_ok(t, k)) return NULL;
-    if (total) *total = t->total[k];
-    return t->density + (size_t)k * t->n_ang;
-}
+double atmos__phase_table_total(const atmos_phase_table *t, int k) { return wl_ok(t, k) ? t->total[k] : 0.0; }
 
 /* The density atmos_phase_table_sample draws from, per steradian (angle_table.h). */
 double atmos_phase_table_eval(const atmos_phase_table *t, int k, double cos_theta)
@@ -533,8 +523,8 @@ double atmos_phase_table_eval(const atmos_phase_table *t, int k, double cos_thet
     if (!wl_ok(t, k) || isnan(cos_theta)) return 0.0;
     atmos__angle_weights a;
     atmos__angle_density_weights(t->grid, cos_theta, &a);
-    const double *f = t->density + (size_t)k * t->n_ang;
-    return a.w0 * f[a.i] + a.w1 * f[a.i + 1];
+    const double *v = t->values + (size_t)k * t->n_ang, *sn = t->grid->sin;
+    return (a.w0 * (v[a.i] * sn[a.i]) + a.w1 * (v[a.i + 1] * sn[a.i + 1])) / t->total[k];
 }
 
 double atmos_phase_table_pdf(const atmos_phase_table *t, int k, double cos_theta)

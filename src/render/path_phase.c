@@ -5,11 +5,11 @@
  * atmos_phase_table_sample draws theta with density 2 pi f(theta), f the piecewise-linear
  * interpolant of the table's f_i = P(theta_i) sin(theta_i) / F; over solid angle that is
  * f(theta) / sin(theta), which is what atmos_phase_table_eval returns and what
- * atmos__path_phase_eval computes from fv = (float)f_i with the same interval and weights
- * (atmos__angle_density_weights). Evaluating this function (rather than P interpolated
- * linearly) for next-event estimation and for the spectral weights makes the phase function
- * that is sampled and the one that is evaluated the same, so a phase-sampled direction has
- * weight exactly 1.
+ * atmos__path_phase_eval computes from fv = (float)f_i (F = atmos__phase_table_total) with
+ * the same interval and weights (atmos__angle_density_weights). Evaluating this function
+ * (rather than P interpolated linearly) for next-event estimation and for the spectral
+ * weights makes the phase function that is sampled and the one that is evaluated the same,
+ * so a phase-sampled direction has weight exactly 1.
  *
  * Forward-peak truncation (the delta-M idea of Wiscombe 1977, J. Atmos. Sci. 34, 1408, in
  * the form of Potter 1970, J. Atmos. Sci. 27, 617: the peak is cut off at an angle rather
@@ -45,7 +45,7 @@ static int cut_index(const atmos__angle_grid *g, double truncate_deg)
 
 /* fv = P' sin(theta) / (its integral) for the table v clipped at v[ic] inside the cone;
  * returns the fraction of the scattering removed. total is the table's own integral
- * (atmos__phase_table_density), summed the same way as kept here. */
+ * (atmos__phase_table_total), summed the same way as kept here. */
 static float truncate_table(const atmos__angle_grid *g, int ic, const double *v, double total, float *fv)
 {
     const int ng = g->n;
@@ -109,11 +109,10 @@ atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_volume_opti
         for (int k = 0; k < nwl; k++) {
             const double *v = atmos_phase_table_values(t, k);
             if (k > 0 && memcmp(v, v0, sizeof(double) * (size_t)ng) != 0) p->gray[f] = 0;
-            double total;
-            const double *d = atmos__phase_table_density(t, k, &total);
+            const double total = atmos__phase_table_total(t, k);
             float *fv = p->fv[f] + (size_t)k * ng;
             if (!p->ic) {
-                for (int i = 0; i < ng; i++) fv[i] = (float)d[i];
+                for (int i = 0; i < ng; i++) fv[i] = (float)(v[i] * p->grid->sin[i] / total);
                 continue;
             }
             p->trunc[f][k] = truncate_table(p->grid, p->ic, v, total, fv);

@@ -16,7 +16,7 @@ typedef struct {
     int nf, nwl;
     int ng;                        /* grid angles */
     const atmos__angle_grid *grid; /* atmos__phase_angle_grid() */
-    float *fv[PATH_F];             /* nwl * n: f_i (atmos__phase_table_density), or truncated */
+    float *fv[PATH_F];             /* nwl * n: f_i = P_i sin(theta_i) / F, or truncated */
     int gray[PATH_F];              /* same table at every wavelength */
     const atmos_phase_table *t[PATH_F];
     /* Forward-peak truncation (docs/path.md, "Forward-peak truncation"); ic = 0: none, the
