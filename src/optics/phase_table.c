@@ -278,21 +278,19 @@ static int unpack_payload(atmos_phase_table *t, const double *d, size_t size, co
  * they were too. */
 static int build_cdf(atmos_phase_table *t, int k)
 {
-    const atmos__angle_grid *gr = t->grid;
-    const double *th = t->theta_deg, *sn = gr->sin, *v = t->values + (size_t)k * t->n_ang;
+    const double *th = t->theta_deg, *rad = t->grid->rad, *sn = t->grid->sin, *v = t->values + (size_t)k * t->n_ang;
     double *c = t->cdf + (size_t)k * t->n_ang;
+    double ft = 0;
     c[0] = 0.0;
-    for (int i = 0; i + 1 < t->n_ang; i++)
-        c[i + 1] = c[i] + ATMOS_PI * (v[i] * sn[i] + v[i + 1] * sn[i + 1]) * (th[i + 1] - th[i]) * ATMOS_DEG2RAD;
+    for (int i = 0; i + 1 < t->n_ang; i++) {
+        const double a = ATMOS_PI * (v[i] * sn[i] + v[i + 1] * sn[i + 1]);
+        c[i + 1] = c[i] + a * (th[i + 1] - th[i]) * ATMOS_DEG2RAD;
+        ft += a * (rad[i + 1] - rad[i]);
+    }
     double total = c[t->n_ang - 1];
-    if (!(total > 0) || !isfinite(total)) return 0;
+    if (!(total > 0) || !isfinite(total) || !(ft > 0) || !isfinite(ft)) return 0;
     for (int i = 1; i < t->n_ang; i++) c[i] /= total;
     c[t->n_ang - 1] = 1.0;
-
-    double ft = 0;
-    for (int i = 0; i + 1 < t->n_ang; i++)
-        ft += ATMOS_PI * (v[i] * sn[i] + v[i + 1] * sn[i + 1]) * (gr->rad[i + 1] - gr->rad[i]);
-    if (!(ft > 0) || !isfinite(ft)) return 0;
     t->total[k] = ft;
     return 1;
 }
