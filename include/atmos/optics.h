@@ -154,12 +154,24 @@ ATMOS_API void atmos_phase_table_destroy(atmos_phase_table *t);
 
 ATMOS_API int atmos_phase_table_wavelength_count(const atmos_phase_table *t);
 ATMOS_API double atmos_phase_table_wavelength_nm(const atmos_phase_table *t, int k);
-/* Tabulated P (sr^-1) at every grid angle for wavelength k. */
+/* Tabulated P (sr^-1) at every grid angle for wavelength k (for plotting and export: the
+ * values themselves, without interpolation). */
 ATMOS_API const double *atmos_phase_table_values(const atmos_phase_table *t, int k);
-/* P at any angle (linear interpolation in theta). */
+/* The phase function at any angle, sr^-1, as the density atmos_phase_table_sample draws
+ * from: f(theta) / sin(theta), with f the piecewise-linear interpolant in theta of
+ * f_i = P_i sin(theta_i) / F and F = 2 pi int P sin(theta) dtheta by the trapezoid rule, so
+ * that it integrates to 1 over the sphere exactly (to rounding) and pdf = eval. Between grid
+ * angles it differs from P interpolated linearly in theta by O(h^2) relative (h the grid step;
+ * docs/phase-tables.md); at theta = 0 and 180° it is the finite limit (in the first and last
+ * interval f is linear from 0 at the pole). cos_theta is clamped to [-1, 1]; NaN or a bad k
+ * give 0. */
 ATMOS_API double atmos_phase_table_eval(const atmos_phase_table *t, int k, double cos_theta);
-/* Importance sampling by the inverse CDF: cos(theta) from a uniform u in [0, 1). */
+/* Importance sampling by the inverse CDF of that density: cos(theta) from a uniform u in
+ * [0, 1) (clamped into it); azimuth is uniform, the caller's to draw. */
 ATMOS_API double atmos_phase_table_sample(const atmos_phase_table *t, int k, double u);
+/* pdf in sr^-1 of the direction with this cos(theta) as atmos_phase_table_sample draws it:
+ * equal to atmos_phase_table_eval. */
+ATMOS_API double atmos_phase_table_pdf(const atmos_phase_table *t, int k, double cos_theta);
 /* Per wavelength: extinction cross-section (m^2), single-scattering albedo, asymmetry g. */
 ATMOS_API double atmos_phase_table_sigma_ext(const atmos_phase_table *t, int k);
 ATMOS_API double atmos_phase_table_albedo(const atmos_phase_table *t, int k);
@@ -187,6 +199,10 @@ typedef struct atmos_msphase_desc {
     int no_cache;         /* nonzero: neither read nor write the disk cache */
 } atmos_msphase_desc;
 
+/* Builds (or loads from the disk cache) Ams_n and F_n of a phase table. On failure *out is
+ * NULL and the status says why (with a message in ctx). A built object is immutable: any
+ * number of threads may read it. The accessors below return 0 (or NULL) for a NULL object
+ * or an index out of range. */
 ATMOS_API atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *table,
                                            const atmos_msphase_desc *desc, atmos_msphase **out);
 ATMOS_API void atmos_msphase_destroy(atmos_msphase *m);
@@ -194,7 +210,9 @@ ATMOS_API void atmos_msphase_destroy(atmos_msphase *m);
 /* Highest order n tabulated (orders 0..n; Ams_0 is the collimated beam, a delta). */
 ATMOS_API int atmos_msphase_max_order(const atmos_msphase *m);
 ATMOS_API int atmos_msphase_wavelength_count(const atmos_msphase *m);
-/* The output angle grid (degrees, 0..180, finer near 0, never coarser than 0.1°). */
+/* The output angle grid (degrees, 0..180, finer near 0, never coarser than 0.1°; not the
+ * phase tables' grid, see docs/msphase.md). *theta_deg points to static storage, the same
+ * for every object. */
 ATMOS_API int atmos_msphase_grid(const atmos_msphase *m, const double **theta_deg);
 /* Ams_n (sr^-1) at every grid angle for wavelength k, 1 <= n <= max_order. */
 ATMOS_API const double *atmos_msphase_values(const atmos_msphase *m, int k, int n);
@@ -218,7 +236,8 @@ ATMOS_API int atmos_msphase_from_cache(const atmos_msphase *m);
  * mixture's Legendre coefficients are the weighted sums of the components'. All parts
  * must have the same wavelength count; weights >= 0, not all zero (normalised here).
  * The cheap alternative of mixing the components' Ams_n linearly is exact only for n = 1;
- * its error is measured in docs/msphase.md. */
+ * its error is measured in docs/msphase.md. On failure *out is NULL and the status is the
+ * error's (ATMOS_E_NOMEM when the tables cannot be allocated), with or without a context. */
 ATMOS_API atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *parts, const double *weights,
                                          int count, const atmos_msphase_desc *desc, atmos_msphase **out);
 

@@ -10,15 +10,20 @@
  *     F_n = 1/2 + 1/2 sum_{l odd} chi_l^n (P_{l-1}(0) - P_{l+1}(0)).
  *
  * chi_l is computed by Gauss-Legendre quadrature in theta over every interval of the
- * phase table's grid, with the table linearly interpolated in theta (as the table itself
- * is evaluated) and enough nodes per interval for the highest l needed; the series is
- * cut where |chi_l| stays below 2e-6 for 256 consecutive l (forward diffraction peaks of
- * drops of size parameter x have coefficients up to l ~ 2x; beyond, the piecewise-linear
- * table has a floor of ~1e-7 coefficients, which matter only for Ams_1, taken from the
- * table: squared, they are below 1e-12). Everything is summed in a fixed order,
- * so results do not depend on the thread count.
+ * phase table's grid, with the table linearly interpolated in theta (atmos_phase_table_eval
+ * interpolates P sin(theta) instead, to match its sampler; the two readings differ by
+ * O(h^2), far below the series' tolerance) and enough nodes per interval for the highest
+ * l needed; the series is cut where |chi_l| stays below 2e-6 for 256 consecutive l
+ * (forward diffraction peaks of drops of size parameter x have coefficients up to l ~ 2x;
+ * beyond, the piecewise-linear table has a floor of ~1e-7 coefficients, which matter only
+ * for Ams_1, taken from the table: squared, they are below 1e-12). Everything is summed in
+ * a fixed order, so results do not depend on the thread count.
+ *
+ * Tables are read through angle_table.h: the phase table on its grid (Ams_1), Ams_n on the
+ * output grid of phase_grid.c (atmos_msphase_eval, and the slice renderer per pixel).
  */
 #include "core/internal.h"
+#include "optics/angle_table.h"
 #include "optics/optics_internal.h"
 #include "core/cache.h"
 
@@ -40,7 +45,8 @@
 
 struct atmos_msphase {
     int nwl, max_order, ngrid;
-    double *grid;        /* output angles, degrees */
+    const atmos__angle_grid *ag; /* the output grid, atmos__msphase_angle_grid() */
+    const double *grid;  /* its angles, degrees */
     double *values;      /* [k][n-1][j], n = 1..max_order */
     double *forward;     /* [k][n], n = 0..max_order */
     double *logsum;      /* [k][n], n = 0..max_order: sum_{i=1}^{n} ln F_i */
@@ -50,28 +56,12 @@ struct atmos_msphase {
     int from_cache;
 };
 
-/* Output grid: 0.001° near the forward direction (a 1 mm drop's diffraction peak is
- * ~0.013° wide and widens only as sqrt(n)), 0.1° at most anywhere. */
-static const struct {
-    double from, to, step;
-} out_segments[] = {{0.0, 0.1, 0.0005}, {0.1, 0.5, 0.001}, {0.5, 2.0, 0.01}, {2.0, 20.0, 0.05}, {20.0, 180.0, 0.1}};
-
-static int build_out_grid(double **grid)
+/* The output grid (phase_grid.c; why it is not the phase tables' grid is said there). */
+static void use_out_grid(atmos_msphase *m)
 {
-    int n = 0;
-    for (size_t s = 0; s < sizeof out_segments / sizeof *out_segments; s++)
-        n += (int)lround((out_segments[s].to - out_segments[s].from) / out_segments[s].step);
-    n += 1;
-    double *g = malloc(sizeof(double) * n);
-    if (!g) return 0;
-    int i = 0;
-    for (size_t s = 0; s < sizeof out_segments / sizeof *out_segments; s++) {
-        int steps = (int)lround((out_segments[s].to - out_segments[s].from) / out_segments[s].step);
-        for (int k = 0; k < steps; k++) g[i++] = out_segments[s].from + k * out_segments[s].step;
-    }
-    g[i++] = 180.0;
-    *grid = g;
-    return n;
+    m->ag = atmos__msphase_angle_grid();
+    m->grid = m->ag->deg;
+    m->ngrid = m->ag->n;
 }
 
 /* Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_m; m <= 64). */
@@ -105,9 +95,8 @@ static double forward_width(int n, const double *theta_deg, const double *P)
 }
 
 /* Gauss nodes of 2 pi P(theta) sin(theta) dtheta over the grid intervals [i0, i1), with
- * P linear in theta inside an interval (as tables are evaluated) and enough nodes per
- * interval for P_L's oscillation (period 2 pi / L). Appends to mu/f; returns the count
- * (or, with mu == NULL, only counts). */
+ * P linear in theta inside an interval and enough nodes per interval for P_L's oscillation
+ * (period 2 pi / L). Appends to mu/f; returns the count (or, with mu == NULL, only counts). */
 static int make_nodes(int i0, int i1, const double *theta_deg, const double *P, int L, double *mu, double *f)
 {
     double gx[64], gw[64];
@@ -302,15 +291,12 @@ static int reconstruct(const double *chi, int count, int truncated, int max_orde
 }
 
 /* Ams_1 is the phase function itself: interpolate the table (linear in theta, as the
- * table is evaluated) onto the output grid, renormalised on that grid. */
-static void first_order(int n, const double *theta_deg, const double *P, int ngrid, const double *grid, double *out)
+ * Legendre coefficients read it) onto the output grid, renormalised on that grid. */
+static void first_order(const atmos__angle_grid *pg, const double *P, int ngrid, const double *grid, double *out)
 {
-    int i = 0;
     for (int j = 0; j < ngrid; j++) {
-        while (i + 2 < n && theta_deg[i + 1] <= grid[j]) i++;
-        double s = (grid[j] - theta_deg[i]) / (theta_deg[i + 1] - theta_deg[i]);
-        if (s < 0) s = 0;
-        if (s > 1) s = 1;
+        double s;
+        const int i = atmos__angle_lerp(pg, grid[j], &s);
         out[j] = P[i] * (1 - s) + P[i + 1] * s;
     }
     double integral = 0;
@@ -365,10 +351,10 @@ static void series_first_order(const double *chi, int count, int ngrid, const do
 }
 
 /* From the Legendre coefficients in m: the highest order, Ams_n for n >= 2 by the
- * series, Ams_1 from the tables P (or, when P is NULL, by the series too), F_n and
- * their log-sums. Frees m on failure. */
-static atmos_status finish_orders(atmos_context *ctx, atmos_msphase *m, const atmos_msphase_desc *dp, int n,
-                                  const double *theta_deg, const double *const *P, int threads)
+ * series, Ams_1 from the tables P on the grid pg (or, when P is NULL, by the series too),
+ * F_n and their log-sums. Frees m on failure and returns the error (with its message). */
+static atmos_status finish_orders(atmos_context *ctx, atmos_msphase *m, const atmos_msphase_desc *dp,
+                                  const atmos__angle_grid *pg, const double *const *P, int threads)
 {
     const atmos_msphase_desc d = *dp;
     const int nwl = m->nwl;
@@ -403,7 +389,7 @@ static atmos_status finish_orders(atmos_context *ctx, atmos_msphase *m, const at
             atmos_msphase_destroy(m);
             return atmos__error(ctx, ATMOS_E_NOMEM, "msphase: out of memory summing the series");
         }
-        if (P) first_order(n, theta_deg, P[k], m->ngrid, m->grid, vk);
+        if (P) first_order(pg, P[k], m->ngrid, m->grid, vk);
         else series_first_order(m->chi[k], m->nchi[k], m->ngrid, m->grid, vk);
         atmos__progress(ctx, "multiple-scattering phase", 0.5 + 0.5 * (k + 1) / nwl);
         double *F = m->forward + (size_t)k * (order + 1), *S = m->logsum + (size_t)k * (order + 1);
@@ -419,7 +405,7 @@ void atmos_msphase_destroy(atmos_msphase *m)
     if (!m) return;
     if (m->chi)
         for (int k = 0; k < m->nwl; k++) free(m->chi[k]);
-    free(m->chi), free(m->nchi), free(m->truncated), free(m->grid), free(m->values), free(m->forward), free(m->logsum);
+    free(m->chi), free(m->nchi), free(m->truncated), free(m->values), free(m->forward), free(m->logsum);
     free(m);
 }
 
@@ -427,6 +413,9 @@ atmos_status atmos__msphase_build_arrays(atmos_context *ctx, int nwl, int n, con
                                          const double *const *P, const atmos_msphase_desc *desc, atmos_msphase **out)
 {
     *out = NULL;
+    const atmos__angle_grid *pg = atmos__phase_angle_grid();
+    if (theta_deg != pg->deg || n != pg->n)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase: the phase functions must be on atmos_phase_grid()");
     atmos_msphase_desc d = {0};
     if (desc) d = *desc;
     if (d.isotropy_tol == 0) d.isotropy_tol = 1e-6;
@@ -440,8 +429,8 @@ atmos_status atmos__msphase_build_arrays(atmos_context *ctx, int nwl, int n, con
     m->chi = calloc(nwl, sizeof(double *));
     m->nchi = calloc(nwl, sizeof(int));
     m->truncated = calloc(nwl, sizeof(int));
-    m->ngrid = build_out_grid(&m->grid);
-    if (!m->chi || !m->nchi || !m->truncated || !m->ngrid) {
+    use_out_grid(m);
+    if (!m->chi || !m->nchi || !m->truncated) {
         atmos_msphase_destroy(m);
         return atmos__error(ctx, ATMOS_E_NOMEM, "msphase: out of memory");
     }
@@ -461,7 +450,7 @@ atmos_status atmos__msphase_build_arrays(atmos_context *ctx, int nwl, int n, con
         atmos_msphase_destroy(m);
         return atmos__error(ctx, ATMOS_E_CANCELLED, "msphase: cancelled");
     }
-    atmos_status st = finish_orders(ctx, m, &d, n, theta_deg, P, threads);
+    atmos_status st = finish_orders(ctx, m, &d, pg, P, threads);
     if (st != ATMOS_OK) return st;
     *out = m;
     return ATMOS_OK;
@@ -512,17 +501,13 @@ static atmos_msphase *deserialise(const unsigned char *p, size_t size, int nwl)
     if (size < sizeof hdr) return NULL;
     memcpy(hdr, p, sizeof hdr), p += sizeof hdr;
     if (hdr[0] != nwl || hdr[1] < 1 || hdr[1] > MS_MAX_ORDER || hdr[2] < 2 || hdr[2] > 100000) return NULL;
-    {
-        /* The entry must use today's output grid (mixtures index parts by it). */
-        double *g = NULL;
-        int ng = build_out_grid(&g);
-        free(g);
-        if (hdr[2] != ng) return NULL;
-    }
+    /* The entry must use today's output grid (mixtures index parts by it; checked below). */
+    if (hdr[2] != atmos__msphase_angle_grid()->n) return NULL;
     if ((size_t)(end - p) < sizeof(int32_t) * (size_t)nwl) return NULL;
     atmos_msphase *m = calloc(1, sizeof *m);
     if (!m) return NULL;
-    m->nwl = nwl, m->max_order = hdr[1], m->ngrid = hdr[2];
+    m->nwl = nwl, m->max_order = hdr[1];
+    use_out_grid(m);
     m->nchi = calloc(nwl, sizeof(int));
     m->chi = calloc(nwl, sizeof(double *));
     if (!m->nchi || !m->chi) goto bad;
@@ -534,13 +519,13 @@ static atmos_msphase *deserialise(const unsigned char *p, size_t size, int nwl)
     }
     if (payload_size(m) != size) goto bad;
     size_t nv = (size_t)nwl * m->max_order * m->ngrid, nf = (size_t)nwl * (m->max_order + 1);
-    m->grid = malloc(sizeof(double) * m->ngrid);
     m->values = malloc(sizeof(double) * nv);
     m->forward = malloc(sizeof(double) * nf);
     m->logsum = malloc(sizeof(double) * nf);
-    if (!m->grid || !m->values || !m->forward || !m->logsum) goto bad;
+    if (!m->values || !m->forward || !m->logsum) goto bad;
+    if (memcmp(p, m->grid, sizeof(double) * (size_t)m->ngrid) != 0) goto bad;
+    p += sizeof(double) * (size_t)m->ngrid;
 #define GET(ptr, count) (memcpy((ptr), p, sizeof(double) * (size_t)(count)), p += sizeof(double) * (size_t)(count))
-    GET(m->grid, m->ngrid);
     GET(m->forward, nf);
     GET(m->logsum, nf);
     for (int k = 0; k < nwl; k++) {
@@ -563,6 +548,7 @@ bad:
 atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *table, const atmos_msphase_desc *desc,
                                  atmos_msphase **out)
 {
+    if (out) *out = NULL;
     if (!table || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "msphase: missing table or output");
     int nwl = atmos_phase_table_wavelength_count(table);
     const double *theta;
@@ -606,43 +592,28 @@ atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *ta
     return st;
 }
 
-int atmos_msphase_max_order(const atmos_msphase *m) { return m->max_order; }
-int atmos_msphase_wavelength_count(const atmos_msphase *m) { return m->nwl; }
+/* Accessors: a NULL object or an index out of range gives 0 (or NULL), never a crash. */
+static int wl_ok(const atmos_msphase *m, int k) { return m && k >= 0 && k < m->nwl; }
+
+int atmos_msphase_max_order(const atmos_msphase *m) { return m ? m->max_order : 0; }
+int atmos_msphase_wavelength_count(const atmos_msphase *m) { return m ? m->nwl : 0; }
 int atmos_msphase_grid(const atmos_msphase *m, const double **theta_deg)
 {
-    if (theta_deg) *theta_deg = m->grid;
-    return m->ngrid;
+    if (theta_deg) *theta_deg = m ? m->grid : NULL;
+    return m ? m->ngrid : 0;
 }
-int atmos_msphase_from_cache(const atmos_msphase *m) { return m->from_cache; }
-int atmos_msphase_legendre_count(const atmos_msphase *m, int k) { return k >= 0 && k < m->nwl ? m->nchi[k] : 0; }
+int atmos_msphase_from_cache(const atmos_msphase *m) { return m ? m->from_cache : 0; }
+int atmos_msphase_legendre_count(const atmos_msphase *m, int k) { return wl_ok(m, k) ? m->nchi[k] : 0; }
 double atmos_msphase_legendre(const atmos_msphase *m, int k, int l)
 {
-    if (k < 0 || k >= m->nwl || l < 0 || l >= m->nchi[k]) return 0.0;
+    if (!wl_ok(m, k) || l < 0 || l >= m->nchi[k]) return 0.0;
     return m->chi[k][l];
 }
 
 const double *atmos_msphase_values(const atmos_msphase *m, int k, int n)
 {
-    if (k < 0 || k >= m->nwl || n < 1 || n > m->max_order) return NULL;
+    if (!wl_ok(m, k) || n < 1 || n > m->max_order) return NULL;
     return m->values + ((size_t)k * m->max_order + (n - 1)) * m->ngrid;
-}
-
-/* Index i with grid[i] <= t < grid[i+1] and the fraction; the grid is piecewise uniform. */
-static int locate(const atmos_msphase *m, double t, double *frac)
-{
-    int lo = 0, hi = m->ngrid - 1;
-    if (!(t > 0)) t = 0;
-    if (t >= 180.0) {
-        *frac = 1.0;
-        return m->ngrid - 2;
-    }
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (m->grid[mid] <= t) lo = mid;
-        else hi = mid;
-    }
-    *frac = (t - m->grid[lo]) / (m->grid[lo + 1] - m->grid[lo]);
-    return lo;
 }
 
 static double eval_order(const atmos_msphase *m, int k, int n, int i, double f)
@@ -654,12 +625,12 @@ static double eval_order(const atmos_msphase *m, int k, int n, int i, double f)
 
 double atmos_msphase_eval(const atmos_msphase *m, int k, double n, double cos_theta)
 {
-    if (k < 0 || k >= m->nwl) return 0.0;
+    if (!wl_ok(m, k)) return 0.0;
     if (!(n >= 1)) n = 1;
     if (cos_theta > 1) cos_theta = 1;
     if (cos_theta < -1) cos_theta = -1;
     double f;
-    int i = locate(m, acos(cos_theta) * ATMOS_RAD2DEG, &f);
+    const int i = atmos__angle_lerp(m->ag, acos(cos_theta) * ATMOS_RAD2DEG, &f);
     if (n >= m->max_order + 1) return 1.0 / (4.0 * ATMOS_PI);
     int n0 = (int)floor(n);
     double w = n - n0;
@@ -669,7 +640,7 @@ double atmos_msphase_eval(const atmos_msphase *m, int k, double n, double cos_th
 
 double atmos_msphase_forward(const atmos_msphase *m, int k, double n)
 {
-    if (k < 0 || k >= m->nwl) return 0.0;
+    if (!wl_ok(m, k)) return 0.0;
     if (!(n > 0)) return 1.0;
     if (n >= m->max_order) return n >= m->max_order + 1 ? 0.5 : m->forward[(size_t)k * (m->max_order + 1) + m->max_order] * (m->max_order + 1 - n) + 0.5 * (n - m->max_order);
     const double *F = m->forward + (size_t)k * (m->max_order + 1);
@@ -680,7 +651,7 @@ double atmos_msphase_forward(const atmos_msphase *m, int k, double n)
 
 double atmos_msphase_log_forward_sum(const atmos_msphase *m, int k, double n)
 {
-    if (k < 0 || k >= m->nwl || !(n > 0)) return 0.0;
+    if (!wl_ok(m, k) || !(n > 0)) return 0.0;
     const double *S = m->logsum + (size_t)k * (m->max_order + 1);
     if (n >= m->max_order) return S[m->max_order] + (n - m->max_order) * log(0.5);
     int n0 = (int)floor(n);
@@ -721,8 +692,8 @@ atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *p
     m->chi = calloc(nwl, sizeof(double *));
     m->nchi = calloc(nwl, sizeof(int));
     m->truncated = calloc(nwl, sizeof(int));
-    m->ngrid = build_out_grid(&m->grid);
-    int fail = !m->chi || !m->nchi || !m->truncated || !m->ngrid;
+    use_out_grid(m);
+    int fail = !m->chi || !m->nchi || !m->truncated;
     for (int k = 0; k < nwl && !fail; k++) {
         int len = 0;
         for (int i = 0; i < count; i++) {
@@ -743,7 +714,10 @@ atmos_status atmos_msphase_mix(atmos_context *ctx, const atmos_msphase *const *p
         atmos_msphase_destroy(m);
         return atmos__error(ctx, ATMOS_E_NOMEM, "msphase mix: out of memory");
     }
-    if (finish_orders(ctx, m, &d, 0, NULL, NULL, atmos__threads(ctx)) != ATMOS_OK) return atmos_context_error_status(ctx);
+    /* finish_orders has freed m and reported the error; return its status, not the
+     * context's (there may be no context to hold it). */
+    atmos_status st = finish_orders(ctx, m, &d, NULL, NULL, atmos__threads(ctx));
+    if (st != ATMOS_OK) return st;
     /* Order 1 mixes linearly (Eq. 6 itself): use the parts' tabulated Ams_1 rather than
      * the series, exactly as a table built from the mixed phase function would. */
     for (int k = 0; k < nwl; k++) {

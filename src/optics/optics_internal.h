@@ -35,9 +35,9 @@ atmos_status atmos__crystal_phase(atmos_context *ctx, const atmos_particle_desc 
  * trapezoid rule in theta with the sin(theta) weight: 2 pi int f sin(theta) dtheta. */
 double atmos__sphere_integral(int n, const double *theta_deg, const double *f);
 
-/* Ams_n from phase functions tabulated on an arbitrary theta grid (one array per
- * wavelength): the core of atmos_msphase_build, also used by tests with analytic
- * phase functions. */
+/* Ams_n from phase functions tabulated on the grid of atmos_phase_grid() (n and theta_deg
+ * as it returns them; another grid is ATMOS_E_INVALID_ARG), one array per wavelength: the
+ * core of atmos_msphase_build, also used by tests with analytic phase functions. */
 atmos_status atmos__msphase_build_arrays(atmos_context *ctx, int nwl, int n, const double *theta_deg,
                                          const double *const *P, const atmos_msphase_desc *desc,
                                          atmos_msphase **out);

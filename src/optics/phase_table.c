@@ -1,10 +1,12 @@
 /* Phase tables: a particle type's phase function P^lambda(theta) at every wavelength of a
  * set on the shared angular grid (atmos_phase_grid), normalised, with extinction
- * cross-section, albedo and asymmetry, an inverse-CDF sampler, and the disk cache
- * (DESIGN.md §7). Format and conventions: docs/phase-tables.md.
+ * cross-section, albedo and asymmetry, an inverse-CDF sampler and the density it draws from
+ * (eval = pdf, angle_table.h), and the disk cache (DESIGN.md §7). Format and conventions:
+ * docs/phase-tables.md.
  */
 #include "core/cache.h"
 #include "core/internal.h"
+#include "optics/angle_table.h"
 #include "optics/optics_internal.h"
 
 #include <math.h>
@@ -30,11 +32,12 @@ static const double table3_beta[3] = {5.8e-6, 1.35e-5, 3.31e-5};
 
 struct atmos_phase_table {
     int n_wl, n_ang;
-    const double *theta_deg; /* the shared grid (static storage) */
-    double *sin_theta;       /* sin of the grid angles, computed once per table */
+    const atmos__angle_grid *grid; /* atmos__phase_angle_grid() */
+    const double *theta_deg;       /* grid->deg */
     double *nm;
-    double *values; /* n_wl x n_ang, P in sr^-1 */
-    double *cdf;    /* n_wl x n_ang, CDF over theta at the grid angles, cdf[0] = 0, last = 1 */
+    double *values;  /* n_wl x n_ang, P in sr^-1 */
+    double *cdf;     /* n_wl x n_ang, CDF over theta at the grid angles, cdf[0] = 0, last = 1 */
+    double *total;   /* n_wl: F, the normaliser of the sampled density (angle_table.h) */
     double *sigma_ext, *albedo, *g;
     int from_cache;
 };
@@ -54,36 +57,36 @@ static const char *kind_name(atmos_particle_kind k)
 void atmos_phase_table_destroy(atmos_phase_table *t)
 {
     if (!t) return;
-    free(t->sin_theta);
     free(t->nm);
     free(t->values);
     free(t->cdf);
+    free(t->total);
     free(t->sigma_ext);
     free(t->albedo);
     free(t->g);
     free(t);
 }
 
-static atmos_phase_table *table_alloc(int n_wl, int n_ang, const double *theta)
+static atmos_phase_table *table_alloc(int n_wl, const atmos__angle_grid *grid)
 {
     atmos_phase_table *t = calloc(1, sizeof *t);
     if (!t) return NULL;
     t->n_wl = n_wl;
-    t->n_ang = n_ang;
-    t->theta_deg = theta;
-    size_t n = (size_t)n_wl * (size_t)n_ang;
-    t->sin_theta = malloc((size_t)n_ang * sizeof *t->sin_theta);
+    t->n_ang = grid->n;
+    t->grid = grid;
+    t->theta_deg = grid->deg;
+    size_t n = (size_t)n_wl * (size_t)grid->n;
     t->nm = calloc((size_t)n_wl, sizeof *t->nm);
     t->values = calloc(n, sizeof *t->values);
     t->cdf = calloc(n, sizeof *t->cdf);
+    t->total = calloc((size_t)n_wl, sizeof *t->total);
     t->sigma_ext = calloc((size_t)n_wl, sizeof *t->sigma_ext);
     t->albedo = calloc((size_t)n_wl, sizeof *t->albedo);
     t->g = calloc((size_t)n_wl, sizeof *t->g);
-    if (!t->sin_theta || !t->nm || !t->values || !t->cdf || !t->sigma_ext || !t->albedo || !t->g) {
+    if (!t->nm || !t->values || !t->cdf || !t->total || !t->sigma_ext || !t->albedo || !t->g) {
         atmos_phase_table_destroy(t);
         return NULL;
     }
-    for (int i = 0; i < n_ang; i++) t->sin_theta[i] = sin(theta[i] * ATMOS_DEG2RAD);
     return t;
 }
 
@@ -266,18 +269,29 @@ static int unpack_payload(atmos_phase_table *t, const double *d, size_t size, co
 /* The sampling density over theta is f(theta) = 2 pi P(theta) sin(theta) taken as
  * piecewise linear between grid angles: the same trapezoid rule that normalises the
  * table (atmos__sphere_integral), so the CDF ends at exactly the normalised total.
- * Inside an interval F is then quadratic and is inverted exactly (sample_interval). */
+ * Inside an interval F is then quadratic and is inverted exactly (atmos__angle_invert).
+ * atmos_phase_table_eval reads that same function through g_i = P_i sin(theta_i) / F; F
+ * (t->total) is summed in radians interval by interval, the sum the path tracer's
+ * single-precision copies of g_i have always been divided by (path_phase.c), so that those
+ * copies stay what they were. The CDF's own sum (degree steps converted per interval)
+ * differs from it in the last bits only; it is kept so that sampled directions stay what
+ * they were too. */
 static int build_cdf(atmos_phase_table *t, int k)
 {
-    const double *th = t->theta_deg, *sn = t->sin_theta, *v = t->values + (size_t)k * t->n_ang;
+    const double *th = t->theta_deg, *rad = t->grid->rad, *sn = t->grid->sin, *v = t->values + (size_t)k * t->n_ang;
     double *c = t->cdf + (size_t)k * t->n_ang;
+    double ft = 0;
     c[0] = 0.0;
-    for (int i = 0; i + 1 < t->n_ang; i++)
-        c[i + 1] = c[i] + ATMOS_PI * (v[i] * sn[i] + v[i + 1] * sn[i + 1]) * (th[i + 1] - th[i]) * ATMOS_DEG2RAD;
+    for (int i = 0; i + 1 < t->n_ang; i++) {
+        const double a = ATMOS_PI * (v[i] * sn[i] + v[i + 1] * sn[i + 1]);
+        c[i + 1] = c[i] + a * (th[i + 1] - th[i]) * ATMOS_DEG2RAD;
+        ft += a * (rad[i + 1] - rad[i]);
+    }
     double total = c[t->n_ang - 1];
-    if (!(total > 0) || !isfinite(total)) return 0;
+    if (!(total > 0) || !isfinite(total) || !(ft > 0) || !isfinite(ft)) return 0;
     for (int i = 1; i < t->n_ang; i++) c[i] /= total;
     c[t->n_ang - 1] = 1.0;
+    t->total[k] = ft;
     return 1;
 }
 
@@ -411,9 +425,10 @@ atmos_status atmos_phase_table_build(atmos_context *ctx, const atmos_particle_de
     atmos_status st = check_inputs(ctx, who, particle, wl);
     if (st != ATMOS_OK) return st;
 
-    const double *theta;
-    int n_ang = atmos_phase_grid(&theta);
-    atmos_phase_table *t = table_alloc(wl->count, n_ang, theta);
+    const atmos__angle_grid *grid = atmos__phase_angle_grid();
+    const double *theta = grid->deg;
+    const int n_ang = grid->n;
+    atmos_phase_table *t = table_alloc(wl->count, grid);
     if (!t) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", who);
 
     int use_cache = !(desc && desc->no_cache);
@@ -498,58 +513,28 @@ void atmos_phase_table_cross_sections(const atmos_phase_table *t, int k, double 
 double atmos_phase_table_g(const atmos_phase_table *t, int k) { return wl_ok(t, k) ? t->g[k] : 0.0; }
 int atmos_phase_table_from_cache(const atmos_phase_table *t) { return t ? t->from_cache : 0; }
 
-/* Index i with theta[i] <= x < theta[i + 1] (x inside [theta[0], theta[n-1]]). */
-static int find_interval(const double *a, int n, double x)
-{
-    int lo = 0, hi = n - 1;
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (a[mid] <= x) lo = mid;
-        else hi = mid;
-    }
-    return lo;
-}
+double atmos__phase_table_total(const atmos_phase_table *t, int k) { return wl_ok(t, k) ? t->total[k] : 0.0; }
 
+/* The density atmos_phase_table_sample draws from, per steradian (angle_table.h). */
 double atmos_phase_table_eval(const atmos_phase_table *t, int k, double cos_theta)
 {
     if (!wl_ok(t, k) || isnan(cos_theta)) return 0.0;
-    double mu = cos_theta < -1 ? -1 : cos_theta > 1 ? 1 : cos_theta;
-    double th = acos(mu) * ATMOS_RAD2DEG;
-    const double *v = t->values + (size_t)k * t->n_ang;
-    int i = find_interval(t->theta_deg, t->n_ang, th);
-    double h = t->theta_deg[i + 1] - t->theta_deg[i];
-    double s = h > 0 ? (th - t->theta_deg[i]) / h : 0.0;
-    if (s < 0) s = 0;
-    if (s > 1) s = 1;
-    return v[i] + s * (v[i + 1] - v[i]);
+    atmos__angle_weights a;
+    atmos__angle_density_weights(t->grid, cos_theta, &a);
+    const double *v = t->values + (size_t)k * t->n_ang, *sn = t->grid->sin;
+    return (a.w0 * (v[a.i] * sn[a.i]) + a.w1 * (v[a.i + 1] * sn[a.i + 1])) / t->total[k];
+}
+
+double atmos_phase_table_pdf(const atmos_phase_table *t, int k, double cos_theta)
+{
+    return atmos_phase_table_eval(t, k, cos_theta);
 }
 
 double atmos_phase_table_sample(const atmos_phase_table *t, int k, double u)
 {
     if (!wl_ok(t, k)) return 1.0;
-    if (!(u >= 0)) u = 0;
-    if (u >= 1) u = 0x1.fffffffffffffp-1;
-    const double *c = t->cdf + (size_t)k * t->n_ang, *v = t->values + (size_t)k * t->n_ang;
-    /* First interval whose upper CDF exceeds u: never one of zero probability. */
-    int i = find_interval(c, t->n_ang, u);
-    while (i + 1 < t->n_ang - 1 && c[i + 1] <= u) i++;
-    double a = t->theta_deg[i] * ATMOS_DEG2RAD, b = t->theta_deg[i + 1] * ATMOS_DEG2RAD, h = b - a;
-    double mass = c[i + 1] - c[i];
-    double x = 0.0; /* offset into [a, b] */
-    if (mass > 0 && h > 0) {
-        /* f is linear on [a, b] from f0 to f1 (units irrelevant: only their ratio and
-         * the interval's mass matter); solve f0 x + (f1 - f0) x^2 / (2h) = r, with
-         * r = the fraction of the interval's area, r * (f0 + f1) h / 2, using the
-         * cancellation-free root x = 2r / (f0 + sqrt(f0^2 + 2 (f1 - f0) r / h)). */
-        double f0 = v[i] * t->sin_theta[i], f1 = v[i + 1] * t->sin_theta[i + 1];
-        double r = (u - c[i]) / mass * 0.5 * (f0 + f1) * h;
-        double disc = f0 * f0 + 2.0 * (f1 - f0) * r / h;
-        if (disc < 0) disc = 0;
-        double den = f0 + sqrt(disc);
-        x = den > 0 ? 2.0 * r / den : 0.0;
-        if (x < 0) x = 0;
-        if (x > h) x = h;
-    }
-    double mu = cos(a + x);
-    return mu < -1 ? -1 : mu > 1 ? 1 : mu;
+    const double *c = t->cdf + (size_t)k * t->n_ang, *v = t->values + (size_t)k * t->n_ang, *sn = t->grid->sin;
+    const int i = atmos__angle_cdf_find(c, t->n_ang, &u);
+    /* f in the units of the CDF's sum (only the ratio f1 / f0 and the interval's mass matter) */
+    return atmos__angle_invert(t->grid, c, i, u, v[i] * sn[i], v[i + 1] * sn[i + 1]);
 }

@@ -1,28 +1,29 @@
-/* The tabulated phase functions for the path tracer (path_phase.c): matched sampling and
- * evaluation, forward-peak truncation. Not part of the API. */
+/* The tabulated phase functions for the path tracer (path_phase.c): single-precision copies
+ * of the tables' sampled densities for evaluation, forward-peak truncation. Not part of the
+ * API. */
 #ifndef ATMOS_RENDER_PATH_PHASE_H
 #define ATMOS_RENDER_PATH_PHASE_H
 
+#include "optics/angle_table.h"
 #include "render/path_common.h"
 
-/* For every field and wavelength the sampling density of atmos_phase_table_sample, which is
- * piecewise linear in 2 pi P(theta) sin(theta) between grid angles (phase_table.c), so
- * that evaluation (next-event estimation, spectral weights) and sampling use exactly the
- * same function and phase sampling has weight 1. */
+/* For every field and wavelength the density atmos_phase_table_sample draws from
+ * (atmos_phase_table_eval, angle_table.h), as f_i in single precision so that evaluating
+ * all fields and wavelengths of a scattering event reads few cache lines; evaluation (next-
+ * event estimation, spectral weights) and sampling use the same function, so phase sampling
+ * has weight 1. */
 typedef struct {
     int nf, nwl;
-    int ng;
-    const double *theta;       /* degrees, the shared grid */
-    double *th_rad;            /* radians */
-    unsigned short *lut;       /* PHASE_LUT + 2 entries: first interval of each 0.05° bin */
-    float *fv[PATH_F];         /* nwl * ng: f_i = P_i sin(theta_i) / total */
-    int gray[PATH_F];          /* same table at every wavelength */
+    int ng;                        /* grid angles */
+    const atmos__angle_grid *grid; /* atmos__phase_angle_grid() */
+    float *fv[PATH_F];             /* nwl * n: f_i = P_i sin(theta_i) / F, or truncated */
+    int gray[PATH_F];              /* same table at every wavelength */
     const atmos_phase_table *t[PATH_F];
     /* Forward-peak truncation (docs/path.md, "Forward-peak truncation"); ic = 0: none, the
      * tables above are the exact phase functions and the sampler is the table's own. */
-    int ic;                    /* grid index of the cut angle theta_c */
-    double cut_deg;            /* theta_c (a grid angle) */
-    double *cdf[PATH_F];       /* nwl * ng: CDF over theta of 2 pi f (truncated tables only) */
+    int ic;                        /* grid index of the cut angle theta_c */
+    double cut_deg;                /* theta_c (a grid angle) */
+    double *cdf[PATH_F];           /* nwl * n: CDF over theta of 2 pi f (truncated tables only) */
     float trunc[PATH_F][ATMOS_MAX_WAVELENGTHS]; /* fraction of the scattering removed (f) */
 } path_phase;
 
@@ -36,13 +37,13 @@ atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_volume_opti
 double atmos__path_phase_sample(const path_phase *p, int f, int k, double u);
 void atmos__path_phase_free(path_phase *p);
 
-/* Interval index i and fraction s of theta (from mu = cos theta), and 1/sin(theta) factor. */
-typedef struct {
-    int i;
-    double s;
-    double w0, w1; /* p = w0 * f_i + w1 * f_{i+1}, see path_phase.c */
-} path_angle;
-void atmos__path_angle(const path_phase *p, double mu, path_angle *a);
+/* The interval of theta (from mu = cos theta) and the weights of f_i, f_{i+1} there: one
+ * lookup serves every field and wavelength of a scattering event. */
+typedef atmos__angle_weights path_angle;
+static inline void atmos__path_angle(const path_phase *p, double mu, path_angle *a)
+{
+    atmos__angle_density_weights(p->grid, mu, a);
+}
 static inline double atmos__path_phase_eval(const path_phase *p, int f, int k, const path_angle *a)
 {
     const float *v = p->fv[f] + (size_t)k * p->ng;

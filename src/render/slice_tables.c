@@ -1,5 +1,6 @@
 /* The slice renderer's optics tables (slice_tables.h): sigma_ext and albedo per field and
  * wavelength, Ams_n in a layout the eye pass reads in two cache lines, F_n and S(n). */
+#include "optics/angle_table.h"
 #include "render/slice_internal.h"
 
 #include <math.h>
@@ -57,10 +58,11 @@ atmos_status atmos__stables_build(atmos_context *ctx, const atmos_volume_optics 
 
 /* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. *a
  * holds a guess on entry (the neighbouring pixel's index: angles change little from
- * pixel to pixel), tried with its neighbours before a binary search. */
+ * pixel to pixel), tried with its neighbours before the angle-table reader. The result
+ * does not depend on the guess: a is the one interval with grid[a] <= theta < grid[a+1]
+ * ((0, 0) at or below the first angle, (ng - 2, 1) at or above the last, (0, NaN) for NaN). */
 void atmos__angle_locate(const double *grid, int ng, double theta_deg, int *a, float *w)
 {
-    int lo = 0, hi = ng - 1;
     for (int g = *a - 1; g <= *a + 1; g++)
         if (g >= 0 && g < ng - 1 && grid[g] < theta_deg && theta_deg < grid[g + 1]) {
             *a = g;
@@ -75,11 +77,10 @@ void atmos__angle_locate(const double *grid, int ng, double theta_deg, int *a, f
         *a = ng - 2, *w = 1;
         return;
     }
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (grid[mid] <= theta_deg) lo = mid;
-        else hi = mid;
-    }
+    /* The grids the renderer is given are the library's (the Ams grid); any other is
+     * searched whole by the same bisection. */
+    const atmos__angle_grid *known = atmos__angle_grid_known(grid, ng);
+    const int lo = known ? atmos__angle_find(known, theta_deg) : atmos__angle_search(grid, 0, ng - 1, theta_deg);
     *a = lo;
     *w = (float)((theta_deg - grid[lo]) / (grid[lo + 1] - grid[lo]));
 }

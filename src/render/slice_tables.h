@@ -28,7 +28,7 @@ void atmos__stables_free(stables *t);
 
 /* Index a and weight w (of grid point a+1) of angle theta on an increasing grid. *a
  * holds a guess on entry (the neighbouring pixel's index), tried with its neighbours
- * before a binary search. */
+ * before the angle-table reader (optics/angle_table.h); the result does not depend on it. */
 void atmos__angle_locate(const double *grid, int ng, double theta_deg, int *a, float *w);
 
 #endif

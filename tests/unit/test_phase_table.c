@@ -207,6 +207,8 @@ static void test_air(void)
     /* Outside the table: NULL / 0, never a crash. */
     CHECK(atmos_phase_table_values(t, 3) == NULL && atmos_phase_table_values(t, -1) == NULL);
     CHECK(atmos_phase_table_eval(t, 5, 0.5) == 0 && atmos_phase_table_wavelength_count(NULL) == 0);
+    CHECK(atmos_phase_table_pdf(t, -1, 0.5) == 0 && atmos_phase_table_pdf(NULL, 0, 0.5) == 0);
+    CHECK(atmos_phase_table_sample(NULL, 0, 0.5) == 1.0 && atmos_phase_table_sample(t, 3, 0.5) == 1.0);
     atmos_phase_table_destroy(t);
 
     /* Spectral: the lambda^-4 law between the channels. */
@@ -260,25 +262,39 @@ static void test_analytic(void)
     }
     CHECK(table_chi2(t, 0, 300000) < 1);
 
-    /* Interpolation: exact at grid angles, linear in theta between them, clamped |mu| > 1. */
+    /* Evaluation between and at grid angles: the sampled density, f(theta) / sin(theta) with
+     * f linear in theta through f_i = P_i sin(theta_i) (the table is normalised, so f's own
+     * normaliser is 1 to rounding): the grid values back at grid angles, O(h^2) from P
+     * interpolated linearly in theta between them, the finite limits at the poles, clamped
+     * |mu| > 1. */
     const double *v = atmos_phase_table_values(t, 2);
-    double worst = 0;
-    for (int i = 0; i < n; i++) {
-        if (th[i] < 1.0) continue; /* acos(cos(theta)) loses digits at tiny theta */
-        double e = fabs(atmos_phase_table_eval(t, 2, cos(th[i] * PI / 180)) - v[i]) / v[i];
-        if (e > worst) worst = e;
-        if (i + 1 < n) {
-            double mid = 0.5 * (th[i] + th[i + 1]);
-            double em = fabs(atmos_phase_table_eval(t, 2, cos(mid * PI / 180)) - 0.5 * (v[i] + v[i + 1])) / v[i];
-            if (em > worst) worst = em;
+    double worst = 0, worst_mid = 0, worst_lin = 0;
+    for (int i = 0; i + 1 < n; i++) {
+        const double a = th[i] * PI / 180, b = th[i + 1] * PI / 180, mid = 0.5 * (a + b);
+        if (th[i] >= 1.0) { /* acos(cos(theta)) loses digits at tiny theta */
+            double e = fabs(atmos_phase_table_eval(t, 2, cos(a)) - v[i]) / v[i];
+            if (e > worst) worst = e;
         }
+        if (i > 0 && i + 2 < n) {
+            double want = 0.5 * (v[i] * sin(a) + v[i + 1] * sin(b)) / sin(mid);
+            double e = fabs(atmos_phase_table_eval(t, 2, cos(mid)) - want) / want;
+            if (e > worst_mid) worst_mid = e;
+        }
+        double el = fabs(atmos_phase_table_eval(t, 2, cos(mid)) - 0.5 * (v[i] + v[i + 1])) / v[i];
+        if (el > worst_lin) worst_lin = el;
     }
-    CHECK_MSG(worst < 1e-7, "eval interpolation: max rel err %g", worst);
-    CHECK(atmos_phase_table_eval(t, 2, 1.0) == v[0]);
-    CHECK(atmos_phase_table_eval(t, 2, 1.5) == v[0]);
-    CHECK(atmos_phase_table_eval(t, 2, -1.0) == v[n - 1]);
-    CHECK(atmos_phase_table_eval(t, 2, -7.0) == v[n - 1]);
-    CHECK(atmos_phase_table_eval(t, 2, NAN) == 0);
+    CHECK_MSG(worst < 1e-9, "eval at grid angles: max rel err %g", worst);
+    CHECK_MSG(worst_mid < 1e-9, "eval between grid angles: max rel err %g", worst_mid);
+    CHECK_MSG(worst_lin < 1e-4, "eval vs P linear in theta: max rel difference %g", worst_lin);
+    printf("analytic table: eval vs P interpolated linearly in theta: %.2g at most\n", worst_lin);
+    const double h = th[1] * PI / 180, hn = (180 - th[n - 2]) * PI / 180;
+    CHECK_REL(atmos_phase_table_eval(t, 2, 1.0), v[1] * sin(h) / h, 1e-12);
+    CHECK(atmos_phase_table_eval(t, 2, 1.5) == atmos_phase_table_eval(t, 2, 1.0));
+    CHECK_REL(atmos_phase_table_eval(t, 2, cos(1e-6)), atmos_phase_table_eval(t, 2, 1.0), 1e-9);
+    CHECK_REL(atmos_phase_table_eval(t, 2, -1.0), v[n - 2] * sin(th[n - 2] * PI / 180) / hn, 1e-9);
+    CHECK(atmos_phase_table_eval(t, 2, -7.0) == atmos_phase_table_eval(t, 2, -1.0));
+    CHECK_REL(atmos_phase_table_eval(t, 2, cos(PI - 1e-5)), atmos_phase_table_eval(t, 2, -1.0), 1e-9);
+    CHECK(atmos_phase_table_eval(t, 2, NAN) == 0 && atmos_phase_table_pdf(t, 2, NAN) == 0);
     for (int i = 0; i < 8; i++) {
         double mu = atmos_phase_table_sample(t, 2, (double[]){0, 1e-300, 0.5, 1 - 1e-16, 1, -1, 2, NAN}[i]);
         CHECK(mu >= -1 && mu <= 1);
@@ -304,6 +320,118 @@ static void test_analytic(void)
     none.count = 0;
     p = analytic(0.5);
     CHECK(atmos_phase_table_build(ctx, &p, &none, &td, &t) == ATMOS_E_INVALID_ARG && t == NULL);
+    atmos_context_destroy(ctx);
+}
+
+/* ---- the eval / sample / pdf triple */
+
+/* 2 pi int eval(cos theta) sin(theta) dtheta over [a, b] (radians) inside one grid interval,
+ * where eval times sin is linear in theta: two Gauss points are exact. */
+static double mass_in(const atmos_phase_table *t, int k, double a, double b)
+{
+    const double c = 0.5 * (a + b), r = 0.5 * (b - a) / sqrt(3.0);
+    return PI * (b - a) * (atmos_phase_table_eval(t, k, cos(c - r)) * sin(c - r) + atmos_phase_table_eval(t, k, cos(c + r)) * sin(c + r));
+}
+
+/* The probability of [0, theta] under eval, interval by interval; cum[i] = up to grid angle i. */
+static double mass_to(const atmos_phase_table *t, int k, const double *cum, const double *th, int n, double theta)
+{
+    int i = 0;
+    while (i + 2 < n && th[i + 1] * PI / 180 <= theta) i++;
+    return cum[i] + mass_in(t, k, th[i] * PI / 180, theta);
+}
+
+/* Chi-square of samples against eval in bins given by their edges (degrees); expected counts
+ * are exact integrals of eval. Returns chi2 / (dof + 5 sqrt(2 dof)). */
+static double binned_chi2(const atmos_phase_table *t, int k, const double *cum, const double *th, int n,
+                          const double *edges, int nb, long samples)
+{
+    long *counts = calloc((size_t)nb, sizeof *counts);
+    if (!counts) return 1e9;
+    for (long q = 0; q < samples; q++) {
+        const double x = acos(atmos_phase_table_sample(t, k, uniform())) * 180 / PI;
+        int b = 0;
+        while (b + 1 < nb && x >= edges[b + 1]) b++;
+        counts[b]++;
+    }
+    double chi2 = 0;
+    for (int b = 0; b < nb; b++) {
+        double e = samples * (mass_to(t, k, cum, th, n, edges[b + 1] * PI / 180) - mass_to(t, k, cum, th, n, edges[b] * PI / 180));
+        chi2 += (counts[b] - e) * (counts[b] - e) / e;
+    }
+    free(counts);
+    const double thr = (nb - 1) + 5 * sqrt(2.0 * (nb - 1));
+    if (chi2 > thr) fprintf(stderr, "binned chi2 %.1f over %d bins, threshold %.1f\n", chi2, nb, thr);
+    return chi2 / thr;
+}
+
+/* eval is the density sample draws from, per steradian, and pdf is eval: pdf = eval bit for
+ * bit; eval integrates to 1 over the sphere to rounding; the probability eval gives to
+ * [0, theta(u)] is u for a sampled theta(u) (the sampler inverts eval's own CDF); a
+ * histogram of samples fine in the forward peak matches eval. */
+static void check_triple(const char *name, const atmos_phase_table *t, int k, int chi2_forward)
+{
+    const double *th;
+    const int n = atmos_phase_grid(&th);
+    int same = 1;
+    for (int q = 0; q < 100000; q++) {
+        double mu = q < n ? cos(th[q] * PI / 180) : q % 3 ? 2 * uniform() - 1 : cos(0.02 * uniform());
+        same &= atmos_phase_table_pdf(t, k, mu) == atmos_phase_table_eval(t, k, mu);
+    }
+    CHECK_MSG(same, "%s: pdf differs from eval", name);
+
+    double *cum = malloc(sizeof(double) * (size_t)n);
+    if (!cum) return;
+    cum[0] = 0;
+    for (int i = 0; i + 1 < n; i++) cum[i + 1] = cum[i] + mass_in(t, k, th[i] * PI / 180, th[i + 1] * PI / 180);
+    CHECK_MSG(fabs(cum[n - 1] - 1) < 1e-12, "%s: eval integrates to 1 + %.3g over the sphere", name, cum[n - 1] - 1);
+
+    double worst = 0;
+    for (int q = 0; q <= 4000; q++) {
+        const double u = q == 0 ? 0 : q == 4000 ? 1 - 1e-16 : q == 1 ? 1e-12 : (q - 0.5) / 4000 + 1e-4 * uniform();
+        const double theta = acos(atmos_phase_table_sample(t, k, u));
+        const double e = fabs(mass_to(t, k, cum, th, n, theta) - u);
+        if (e > worst) worst = e;
+    }
+    CHECK_MSG(worst < 1e-10, "%s: probability of [0, sample(u)] differs from u by %.3g", name, worst);
+
+    if (chi2_forward) {
+        /* 40 bins of 0.05° in the peak, 36 of 5° beyond 2° */
+        double edges[77];
+        int nb = 0;
+        for (int b = 0; b < 40; b++) edges[nb++] = 0.05 * b;
+        for (int b = 0; b < 36; b++) edges[nb++] = b == 0 ? 2.0 : 5.0 * b;
+        edges[nb] = 180;
+        CHECK(binned_chi2(t, k, cum, th, n, edges, nb, 400000) < 1);
+    }
+    printf("%s: pdf = eval, integral 1 %+.2g, CDF at samples within %.2g of u\n", name, cum[n - 1] - 1, worst);
+    free(cum);
+}
+
+static void test_triple(void)
+{
+    atmos_context *ctx = make_ctx(cache_dir, NULL);
+    atmos_phase_table_desc td = {1};
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_phase_table *t = NULL;
+    atmos_particle_desc p = air();
+    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &t));
+    if (t) check_triple("air", t, 1, 0);
+    atmos_phase_table_destroy(t);
+    p = analytic(0.9);
+    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &t));
+    if (t) check_triple("mixture", t, 2, 1);
+    atmos_phase_table_destroy(t);
+    /* a sharp forward peak, 1.4° wide at half maximum */
+    p = analytic(0.9);
+    p.analytic.count = 1;
+    p.analytic.kind[0] = ATMOS_PHASE_HG;
+    p.analytic.g[0] = 0.995;
+    p.analytic.weight[0] = 1;
+    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &t));
+    if (t) check_triple("HG 0.995", t, 0, 1);
+    atmos_phase_table_destroy(t);
     atmos_context_destroy(ctx);
 }
 
@@ -504,6 +632,7 @@ int main(void)
     test_tmp_path(cache_dir, sizeof cache_dir, "phase-cache");
     test_air();
     test_analytic();
+    test_triple();
     test_cache();
     test_progress_and_cancel();
     return test_summary("test_phase_table");
