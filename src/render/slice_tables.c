@@ -28,7 +28,8 @@ atmos_status atmos__stables_build(atmos_context *ctx, const atmos_volume_optics 
         int mo = atmos_msphase_max_order(m);
         t->ng[f] = atmos_msphase_grid(m, &t->grid[f]);
         const int ng = t->ng[f];
-        t->ams[f] = malloc(sizeof(float) * (size_t)n * ng * t->no);
+        /* + 4: the RGB eye pass reads four floats where the last row's three end */
+        t->ams[f] = calloc((size_t)n * ng * t->no + 4, sizeof(float));
         t->F[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
         t->S[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
         if (!t->ams[f] || !t->F[f] || !t->S[f]) {

@@ -1,0 +1,204 @@
+/* The reference eye and light passes of the slice renderer (Riley et al. 2004 Eq. 21, 24-26;
+ * see slice_frame.c and docs/slice.md): plain scalar code with libm's exp, one sample at a
+ * time. slice_pass.c holds the fast versions, which compute the same quantities in the same
+ * order; the reference decides what they must give. */
+#include "render/slice_internal.h"
+
+#include <math.h>
+
+/* Linear interpolation in a per-order table at fractional n >= 0; past the last order,
+ * F is held (F_n -> 1/2) and S grows by ln F of the last order per order. */
+static inline float order_lerp(const float *tab, float n, int extend)
+{
+    if (!(n > 0.0f)) return tab[0];
+    if (n >= (float)SLICE_F_ORDERS) {
+        if (!extend) return tab[SLICE_F_ORDERS];
+        float slope = tab[SLICE_F_ORDERS] - tab[SLICE_F_ORDERS - 1];
+        return tab[SLICE_F_ORDERS] + slope * (n - (float)SLICE_F_ORDERS);
+    }
+    int i = (int)n;
+    float f = n - (float)i;
+    return tab[i] + f * (tab[i + 1] - tab[i]);
+}
+
+
+/* Trilinear densities of all fields at render-voxel coordinate (u, v, w). Returns 0
+ * if the point is outside the grid or in an empty occupancy block (dens untouched). */
+static inline int sgrid_sample_u(const sgrid *g, float u, float v, float w, float *dens)
+{
+    if (!(u >= 0.0f && v >= 0.0f && w >= 0.0f)) return 0;
+    int i = (int)u, j = (int)v, k = (int)w;
+    if (i > g->c[0] - 2 || j > g->c[1] - 2 || k > g->c[2] - 2) return 0;
+    if (!g->occ[((size_t)(k / SLICE_OCC_B) * g->ob[1] + j / SLICE_OCC_B) * g->ob[0] + i / SLICE_OCC_B]) return 0;
+    float fu = u - i, fv = v - j, fw = w - k;
+    const int nf = g->nf;
+    const size_t sx = (size_t)nf, sy = (size_t)g->c[0] * nf, sz = (size_t)g->c[0] * g->c[1] * nf;
+    const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
+    float w000 = (1 - fu) * (1 - fv) * (1 - fw), w100 = fu * (1 - fv) * (1 - fw), w010 = (1 - fu) * fv * (1 - fw),
+          w110 = fu * fv * (1 - fw), w001 = (1 - fu) * (1 - fv) * fw, w101 = fu * (1 - fv) * fw,
+          w011 = (1 - fu) * fv * fw, w111 = fu * fv * fw;
+    for (int f = 0; f < nf; f++)
+        dens[f] = w000 * p[f] + w100 * p[sx + f] + w010 * p[sy + f] + w110 * p[sx + sy + f] + w001 * p[sz + f] +
+                  w101 * p[sx + sz + f] + w011 * p[sy + sz + f] + w111 * p[sx + sy + sz + f];
+    return 1;
+}
+
+/* Light buffer lookup at light-buffer coordinate (fu, fv): bilinear I per wavelength and n. */
+static inline void light_lookup(const sjob *j, const float *Ib, const float *nb, float fu, float fv, float *I, float *n)
+{
+    const int L = j->L;
+    const float lim = (float)(L - 1);
+    fu = fu < 0.0f ? 0.0f : (fu > lim ? lim : fu);
+    fv = fv < 0.0f ? 0.0f : (fv > lim ? lim : fv);
+    int a = (int)fu, b = (int)fv;
+    if (a > L - 2) a = L - 2;
+    if (b > L - 2) b = L - 2;
+    float wa = fu - (float)a, wb = fv - (float)b;
+    size_t t00 = (size_t)b * L + a, t10 = t00 + 1, t01 = t00 + L, t11 = t01 + 1;
+    float w00 = (1 - wa) * (1 - wb), w10 = wa * (1 - wb), w01 = (1 - wa) * wb, w11 = wa * wb;
+    const size_t ns = (size_t)j->n + 1; /* texels interleave I per wavelength and n */
+    t00 *= ns, t10 *= ns, t01 *= ns, t11 *= ns;
+    for (int k = 0; k < j->n; k++) {
+        const float *p = Ib + k;
+        I[k] = w00 * p[t00] + w10 * p[t10] + w01 * p[t01] + w11 * p[t11];
+    }
+    *n = w00 * nb[t00] + w10 * nb[t10] + w01 * nb[t01] + w11 * nb[t11];
+}
+
+/* Reference eye pass (see slice_internal.h). */
+long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb)
+{
+    const int n = j->n, nf = j->nf, no = j->t->no;
+    const float kf = (float)k;
+    float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], nsc;
+    long long count = 0;
+    for (int x = x0; x <= x1; x++) {
+        size_t p = (size_t)y * j->W + x;
+        if (k < j->pk0[p] || k > j->pk1[p]) continue;
+        float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
+              w = j->pU0[2][p] + kf * j->pdU[2][p];
+        if (!sgrid_sample_u(j->g, u, v, w, dens)) continue;
+        count++;
+        light_lookup(j, Ib, nb, j->pF0[0][p] + kf * j->pdF[0][p], j->pF0[1][p] + kf * j->pdF[1][p], I, &nsc);
+        const float delta = j->pdelta[p];
+        /* One more scattering than the light has had turns it to the eye (Eq. 26):
+         * Ams at fractional order m, linear between orders (and angles). */
+        const float m = j->low_albedo ? 1.0f : nsc + 1.0f;
+        const float mm = m < 1.0f ? 1.0f : (m > (float)no ? (float)no : m);
+        int oi = (int)(mm - 1.0f);
+        if (oi > no - 2) oi = no - 2;
+        const float fo = mm - 1.0f - (float)oi;
+        for (int c = 0; c < n; c++) {
+            float bext = 0, src = 0;
+            for (int f = 0; f < nf; f++) {
+                if (dens[f] <= 0.0f) continue;
+                bext += dens[f] * j->t->sig[f][c];
+                float bs = dens[f] * j->t->sca[f][c];
+                if (bs > 0.0f) {
+                    const float *q = j->t->ams[f] + ((size_t)j->pa[p * nf + f] + (size_t)oi * n + c);
+                    const size_t an = (size_t)no * n; /* next angle; next order: + n */
+                    float lo = q[0] + fo * (q[n] - q[0]);
+                    float hi = q[an] + fo * (q[an + n] - q[an]);
+                    src += bs * (lo + j->pw[p * nf + f] * (hi - lo) + j->xi);
+                }
+            }
+            if (bext <= 0.0f) continue;
+            float tau = bext * delta;
+            float Tslab = expf(-tau);
+            /* beta_sca Delta of Eq. 26, integrated over the slab with its own
+             * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
+            float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
+            float contrib = I[c] * src * len;
+            float *Lp = j->L_eye + c * j->pst + p, *Tp = j->T_eye + c * j->pst + p;
+            if (j->btf) *Lp = *Lp * Tslab + contrib; /* back-to-front: over */
+            else *Lp += *Tp * contrib;               /* front-to-back: under */
+            *Tp *= Tslab;
+        }
+    }
+    return count;
+}
+
+/* Reference light pass of slice k over texels x0..x1 of light row b: reads
+ * the light arriving at slice k, writes the light leaving it into the other buffer.
+ * Texels a0..a1 may meet occupied blocks; the others of x0..x1 are copied (texels
+ * outside x0..x1 are equal in both buffers, see render). */
+long long atmos__slice_light_span_ref(const sjob *j, int k, int b, int x0, int x1, int a0, int a1, const float *Ic,
+                                      const float *nc, float *In, float *nn)
+{
+    const int n = j->n, nf = j->nf, L = j->L;
+    const size_t ns = (size_t)n + 1; /* texels interleave I per wavelength and n */
+    const float delta = j->ldelta;
+    float dens[ATMOS_VOLUME_MAX_FIELDS];
+    long long count = 0;
+    double base[3];
+    for (int i = 0; i < 3; i++) base[i] = j->lA[i] + b * j->lEb[i] + k * j->lEk[i];
+    const float bu = (float)base[0], bv = (float)base[1], bw = (float)base[2];
+    const float eu = (float)j->lEa[0], ev = (float)j->lEa[1], ew = (float)j->lEa[2];
+    for (int a = x0; a <= x1; a++) {
+        size_t q = (size_t)b * L + a;
+        const float n0 = nc[q * ns];
+        nn[q * ns] = n0;
+        int upd = a >= a0 && a <= a1 && k >= j->lk0[q] && k <= j->lk1[q];
+        if (upd) {
+            const float af = (float)a;
+            upd = sgrid_sample_u(j->g, bu + af * eu, bv + af * ev, bw + af * ew, dens);
+        }
+        if (!upd) {
+            for (int c = 0; c < n; c++) In[q * ns + c] = Ic[q * ns + c];
+            continue;
+        }
+        count++;
+        float dn = 0;
+        for (int c = 0; c < n; c++) {
+            float bext = 0, bsca = 0;
+            for (int f = 0; f < nf; f++) {
+                bext += dens[f] * j->t->sig[f][c];
+                bsca += dens[f] * j->t->sca[f][c];
+            }
+            dn += bsca * delta;
+            if (bext <= 0.0f) {
+                In[q * ns + c] = Ic[q * ns + c];
+                continue;
+            }
+            float tau = bext * delta, T = expf(-tau);
+            float keep; /* fraction of the scattered light (1 - T) still going forward */
+            if (j->low_albedo) {
+                keep = 0.0f;
+            } else {
+                /* The number of scatterings in the slab, ceil(beta Delta) in Eq. 24, taken
+                 * continuously as max(1, beta Delta); Eq. 25 raises its worst-case factor to
+                 * the same power (see docs/slice.md). */
+                float msl = tau > 1.0f ? tau : 1.0f;
+                if (bsca <= 0.0f) {
+                    keep = 0.0f;
+                } else if (!j->eq24) {
+                    /* Eq. 25: (alpha F_{floor(n + 1 + beta Delta)})^{beta Delta}. */
+                    float idx = floorf(n0 + 1.0f + tau);
+                    float aF = 0;
+                    for (int f = 0; f < nf; f++)
+                        if (dens[f] > 0.0f)
+                            aF += dens[f] * j->t->sca[f][c] *
+                                  order_lerp(j->t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1), idx, 0);
+                    aF /= bext;
+                    keep = aF > 0.0f ? (tau > 1.0f ? expf(msl * logf(aF)) : aF) : 0.0f;
+                } else {
+                    /* Eq. 24: prod_{i=n+1}^{n+m} alpha F_i = alpha^m exp(S(n+m) - S(n)); fields
+                     * mixed geometrically by their share of beta_sca. */
+                    float lnk = msl * logf(bsca / bext);
+                    for (int f = 0; f < nf; f++) {
+                        float bs = dens[f] * j->t->sca[f][c];
+                        if (bs <= 0.0f) continue;
+                        const float *S = j->t->S[f] + (size_t)c * (SLICE_F_ORDERS + 1);
+                        lnk += bs / bsca * (order_lerp(S, n0 + msl, 1) - order_lerp(S, n0, 1));
+                    }
+                    keep = expf(lnk);
+                }
+            }
+            In[q * ns + c] = Ic[q * ns + c] * (T + (1.0f - T) * keep);
+        }
+        /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
+        nn[q * ns] = n0 + dn / (float)n;
+    }
+    return count;
+}
+
