@@ -352,7 +352,7 @@ atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp
         double ta = 0;
 #pragma omp master
         ta = atmos__now();
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(dynamic, 4)
         for (int b = 0; b < j->L; b++)
             for (int q = 0; q < nb; q++) {
                 const int k = k0 + q;

@@ -46,7 +46,7 @@ atmos_status atmos__sgrid_build(atmos_context *ctx, const atmos_volume *vol, dou
     g->v = atmos__big_alloc(nvox * (uint64_t)nf * sizeof(float));
     if (g->v) memset(g->v, 0, nvox * (uint64_t)nf * sizeof(float));
     for (int a = 0; a < 3; a++) g->ob[a] = (g->c[a] - 2) / SLICE_OCC_B + 1;
-    g->occ = calloc((size_t)g->ob[0] * g->ob[1] * g->ob[2], 1);
+    g->occ = calloc((size_t)g->ob[0] * g->ob[1] * g->ob[2], sizeof *g->occ);
     if (!g->v || !g->occ) {
         atmos__sgrid_free(g);
         return atmos__error(ctx, ATMOS_E_NOMEM, "slice: out of memory for the render grid");

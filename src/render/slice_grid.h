@@ -4,6 +4,8 @@
 
 #include "core/internal.h"
 
+#include <stdint.h>
+
 #define SLICE_OCC_B 4          /* occupancy block edge, render-grid voxels */
 
 /* The volume box-filtered onto a dense grid (integer factor f native voxels per
@@ -16,7 +18,7 @@ typedef struct {
     int c[3];             /* render voxels per axis, padding included */
     float *v;             /* c0*c1*c2*nf */
     int ob[3];
-    unsigned char *occ;   /* ob0*ob1*ob2 */
+    int32_t *occ;         /* ob0*ob1*ob2, 1 = occupied (32-bit: the passes gather it) */
     float sc, off[3];     /* u = g * sc + off: grid-frame metres -> render-voxel coordinate */
     double box_lo[3], box_hi[3]; /* grid-frame metres where the interpolant may be nonzero */
 } sgrid;

@@ -20,12 +20,19 @@
 #else
 #define SLICE_CLONES
 #endif
+/* The helpers below are inlined into each clone (a helper left out of line would be
+ * compiled for the baseline only). */
+#if defined(__GNUC__)
+#define SLICE_INLINE static inline __attribute__((always_inline))
+#else
+#define SLICE_INLINE static inline
+#endif
 
 
 /* ln x for x > 0: x = 2^e m with m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s),
  * s = (m - 1)/(m + 1), |s| < 0.172, by its series to s^9 (error < 1e-9). Subnormal x
  * are taken as FLT_MIN. Branch-free for vectorisation. */
-static inline float log_pos(float x)
+SLICE_INLINE float log_pos(float x)
 {
     x = x < 1.17549435e-38f ? 1.17549435e-38f : x;
     union {
@@ -50,7 +57,7 @@ static inline float log_pos(float x)
 /* Trilinear densities of the compacted samples: vox[q] is the grid index of the lower
  * corner (times nf), (fu, fv, fw) the fractions. SoA out: dens[f * CH + q]. The grid
  * holds at most 2 GB, so 32-bit indices suffice. */
-static inline void trilinear_soa(const sgrid *g, int m, const int32_t *restrict vox, const float *restrict fu,
+SLICE_INLINE void trilinear_soa(const sgrid *g, int m, const int32_t *restrict vox, const float *restrict fu,
                                  const float *restrict fv, const float *restrict fw, float *restrict dens)
 {
     const int nf = g->nf;
@@ -72,7 +79,7 @@ static inline void trilinear_soa(const sgrid *g, int m, const int32_t *restrict 
 
 /* live[f]: whether field f is non-zero at any of the m samples. A field that is zero
  * everywhere in a chunk adds exact zeros to every sum, so its lookups are skipped. */
-static inline void fields_live(int nf, int m, const float *dens, int *live)
+SLICE_INLINE void fields_live(int nf, int m, const float *dens, int *live)
 {
     for (int f = 0; f < nf; f++) {
         const float *d = dens + f * CH;
@@ -84,7 +91,7 @@ static inline void fields_live(int nf, int m, const float *dens, int *live)
 
 /* Drops the samples at which every field is zero (they change neither the eye nor the
  * light buffer: their sums are exact zeros). Returns the new count. */
-static inline int drop_empty(int nf, int m, float *dens, int *id)
+SLICE_INLINE int drop_empty(int nf, int m, float *dens, int *id)
 {
     int o = 0;
     for (int q = 0; q < m; q++) {
@@ -100,7 +107,7 @@ static inline int drop_empty(int nf, int m, float *dens, int *id)
 /* Pads the compacted samples m..mv-1 (mv: m rounded up to 8) with copies of the last,
  * so that the vector loops run whole vectors only; results of the copies are never
  * stored. */
-static inline int pad_samples(int m, int *id, int32_t *vox, float *fu, float *fv, float *fw)
+SLICE_INLINE int pad_samples(int m, int *id, int32_t *vox, float *fu, float *fv, float *fw)
 {
     const int mv = (m + 7) & ~7;
     for (int q = m; q < mv; q++)
@@ -108,7 +115,7 @@ static inline int pad_samples(int m, int *id, int32_t *vox, float *fu, float *fv
     return mv;
 }
 
-static inline int pad_dens(int nf, int m, float *dens, int *id)
+SLICE_INLINE int pad_dens(int nf, int m, float *dens, int *id)
 {
     const int mv = (m + 7) & ~7;
     for (int q = m; q < mv; q++) {
@@ -121,29 +128,32 @@ static inline int pad_dens(int nf, int m, float *dens, int *id)
 /* The compaction shared by both passes: of the chunk's candidate points (render-voxel
  * coordinates u, v, w; ok[q] = 0 for points already rejected), keeps those in the grid
  * and in an occupied block, as the reference's trilinear lookup decides. Returns how many;
- * id[] holds their chunk positions. Branch-free: every point is written at position m and
- * m advances only for the kept ones (rejected points' indices are clamped to voxel 0 so
- * that the occupancy read stays inside the grid). */
-static inline int compact(const sgrid *g, int cnt, const float *u, const float *v, const float *w,
-                          const unsigned char *ok, int *id, int32_t *vox, float *fu, float *fv, float *fw)
+ * id[] holds their chunk positions. The tests, lower corners and fractions run as one
+ * vector loop over all points (rejected ones clamped to voxel 0, so that the occupancy
+ * gather stays inside the grid); a branch-free scalar loop then packs the kept ones. */
+SLICE_INLINE int compact(const sgrid *g, int cnt, const float *restrict u, const float *restrict v,
+                          const float *restrict w, const unsigned char *restrict ok, int *restrict id,
+                          int32_t *restrict vox, float *restrict fu, float *restrict fv, float *restrict fw)
 {
-    const int c0 = g->c[0], c1 = g->c[1], c2 = g->c[2], ob0 = g->ob[0], ob1 = g->ob[1];
-    const int nf = g->nf;
-    const unsigned char *occ = g->occ;
-    int m = 0;
+    const int c0 = g->c[0], c1 = g->c[1], ob0 = g->ob[0], ob1 = g->ob[1], nf = g->nf;
+    const float u1 = (float)(c0 - 1), v1 = (float)(c1 - 1), w1 = (float)(g->c[2] - 1);
+    const int32_t *restrict occ = g->occ;
+    int32_t keep[CH], vx[CH];
+    float a[CH], b[CH], c[CH];
     for (int q = 0; q < cnt; q++) {
         const float uq = u[q], vq = v[q], wq = w[q];
-        int in = (ok[q] != 0) & (uq >= 0.0f) & (vq >= 0.0f) & (wq >= 0.0f);
-        int i = in ? (int)uq : 0, jj = in ? (int)vq : 0, kk = in ? (int)wq : 0;
-        in &= (i <= c0 - 2) & (jj <= c1 - 2) & (kk <= c2 - 2);
-        i = in ? i : 0, jj = in ? jj : 0, kk = in ? kk : 0;
-        const unsigned ob = ((unsigned)kk / SLICE_OCC_B * (unsigned)ob1 + (unsigned)jj / SLICE_OCC_B) * (unsigned)ob0 +
-                            (unsigned)i / SLICE_OCC_B;
-        in &= occ[ob] != 0;
-        id[m] = q;
-        vox[m] = ((kk * c1 + jj) * c0 + i) * nf;
-        fu[m] = uq - (float)i, fv[m] = vq - (float)jj, fw[m] = wq - (float)kk;
-        m += in;
+        /* 0 <= floor(x) <= c - 2, i.e. 0 <= x < c - 1 (NaN fails) */
+        const int in = (ok[q] != 0) & (uq >= 0.0f) & (vq >= 0.0f) & (wq >= 0.0f) & (uq < u1) & (vq < v1) & (wq < w1);
+        const int i = in ? (int)uq : 0, jj = in ? (int)vq : 0, kk = in ? (int)wq : 0;
+        const int32_t ob = (kk / SLICE_OCC_B * ob1 + jj / SLICE_OCC_B) * ob0 + i / SLICE_OCC_B;
+        keep[q] = in & (occ[ob] != 0);
+        vx[q] = ((kk * c1 + jj) * c0 + i) * nf;
+        a[q] = uq - (float)i, b[q] = vq - (float)jj, c[q] = wq - (float)kk;
+    }
+    int m = 0;
+    for (int q = 0; q < cnt; q++) {
+        id[m] = q, vox[m] = vx[q], fu[m] = a[q], fv[m] = b[q], fw[m] = c[q];
+        m += keep[q];
     }
     return m;
 }
@@ -160,9 +170,29 @@ typedef struct {
     int live[ATMOS_VOLUME_MAX_FIELDS];
 } echunk;
 
-/* The chunk's samples on slice k that meet occupied blocks of the grid and a non-zero
- * density, with their densities. Returns the number of samples looked up (e->m: kept). */
-static inline int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e)
+/* Of a chunk's cnt candidate points (render-voxel coordinates u, v, w; ok[q] = 0 for
+ * points already rejected), the ones that meet occupied blocks and a non-zero density, with
+ * their densities; lim: how many entries past the chunk's first the per-point arrays hold
+ * (the padded lanes of a contiguous chunk read up to e->mv). Returns the number of points
+ * looked up in the grid (e->m: kept). */
+SLICE_INLINE int chunk_lookup(const sgrid *g, int cnt, const float *u, const float *v, const float *w,
+                               const unsigned char *ok, size_t lim, echunk *e)
+{
+    e->m = compact(g, cnt, u, v, w, ok, e->id, e->vox, e->fu, e->fv, e->fw);
+    const int looked = e->m;
+    if (!e->m) return 0;
+    e->mv = pad_samples(e->m, e->id, e->vox, e->fu, e->fv, e->fw);
+    trilinear_soa(g, e->mv, e->vox, e->fu, e->fv, e->fw, e->dens);
+    e->m = drop_empty(g->nf, e->m, e->dens, e->id);
+    if (!e->m) return looked;
+    e->mv = pad_dens(g->nf, e->m, e->dens, e->id);
+    fields_live(g->nf, e->m, e->dens, e->live);
+    e->contig = e->id[e->m - 1] == e->m - 1 && (size_t)e->mv <= lim; /* ids increase from 0 */
+    return looked;
+}
+
+/* The chunk of pixels p0.. (cnt of them) on slice k: chunk_lookup of their samples. */
+SLICE_INLINE int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e)
 {
     const float kf = (float)k;
     float u[CH], v[CH], w[CH];
@@ -176,23 +206,12 @@ static inline int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *
         w[q] = W0[q] + kf * dW[q];
         ok[q] = k >= k0[q] && k <= k1[q];
     }
-    e->m = compact(j->g, cnt, u, v, w, ok, e->id, e->vox, e->fu, e->fv, e->fw);
-    const int looked = e->m;
-    if (!e->m) return 0;
-    e->mv = pad_samples(e->m, e->id, e->vox, e->fu, e->fv, e->fw);
-    trilinear_soa(j->g, e->mv, e->vox, e->fu, e->fv, e->fw, e->dens);
-    e->m = drop_empty(j->nf, e->m, e->dens, e->id);
-    if (!e->m) return looked;
-    e->mv = pad_dens(j->nf, e->m, e->dens, e->id);
-    fields_live(j->nf, e->m, e->dens, e->live);
-    /* ids increase from 0; the padded lanes read pixels past the last (never written) */
-    e->contig = e->id[e->m - 1] == e->m - 1 && p0 + (size_t)e->mv <= (size_t)j->W * j->H;
-    return looked;
+    return chunk_lookup(j->g, cnt, u, v, w, ok, (size_t)j->W * j->H - p0, e);
 }
 
 /* The samples' light-buffer texel (lt, the row-major offset of the lower-left one) and
  * bilinear weights, and their slab lengths. */
-static inline void eye_texels(const sjob *j, int k, size_t p0, echunk *e)
+SLICE_INLINE void eye_texels(const sjob *j, int k, size_t p0, echunk *e)
 {
     const int L = j->L;
     const int32_t ns = j->n + 1;
@@ -214,7 +233,7 @@ static inline void eye_texels(const sjob *j, int k, size_t p0, echunk *e)
 }
 
 /* Bilinear light-buffer value at the samples: component c of the texels ([texel + c]). */
-static inline void eye_bilinear(const echunk *e, const float *restrict B, int32_t ns, int32_t LN, float *restrict out)
+SLICE_INLINE void eye_bilinear(const echunk *e, const float *restrict B, int32_t ns, int32_t LN, float *restrict out)
 {
     for (int q = 0; q < e->mv; q++) {
         const int32_t t00 = e->lt[q];
@@ -224,7 +243,7 @@ static inline void eye_bilinear(const echunk *e, const float *restrict B, int32_
 
 /* The Ams order (one more scattering than the light has had turns it to the eye, Eq. 26)
  * and each live field's Ams row and angle weight. */
-static inline void eye_orders(const sjob *j, size_t p0, echunk *e)
+SLICE_INLINE void eye_orders(const sjob *j, size_t p0, echunk *e)
 {
     const int n = j->n, nf = j->nf, no = j->t->no;
     const float fno = (float)no;
@@ -249,7 +268,7 @@ static inline void eye_orders(const sjob *j, size_t p0, echunk *e)
 }
 
 /* Extinction and source (sum over fields of beta_sca (Ams + xi)) of wavelength c. */
-static inline void eye_optics(const sjob *j, const echunk *e, int c, float *restrict bext, float *restrict src)
+SLICE_INLINE void eye_optics(const sjob *j, const echunk *e, int c, float *restrict bext, float *restrict src)
 {
     const stables *t = j->t;
     const int n = j->n;
@@ -276,7 +295,7 @@ static inline void eye_optics(const sjob *j, const echunk *e, int c, float *rest
 
 /* Eq. 26 for wavelength c: the slab's transmittance and in-scattered light, composited
  * into the eye buffer over (back to front) or under (front to back). */
-static inline void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
+SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
                              const float *restrict bext, const float *restrict src)
 {
     float Tq[CH], Cq[CH];
@@ -315,7 +334,7 @@ static inline void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, c
  * Ams tables are read by whole-vector loads rather than one gathered lane per wavelength.
  * Lane c computes what eye_bilinear and eye_optics compute for wavelength c, with the same
  * operations in the same order (the same bits). Out: [q * 4 + c], lane 3 of the light: n. */
-static inline void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float *restrict I4)
+SLICE_INLINE void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float *restrict I4)
 {
     const int32_t LN = j->L * 4;
     for (int q = 0; q < e->mv; q++) {
@@ -329,7 +348,7 @@ static inline void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, floa
     }
 }
 
-static inline void eye_rgb_optics(const sjob *j, const echunk *e, float *restrict be4, float *restrict src4)
+SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float *restrict be4, float *restrict src4)
 {
     const stables *t = j->t;
     const int32_t an = t->no * 3;
@@ -363,7 +382,7 @@ static inline void eye_rgb_optics(const sjob *j, const echunk *e, float *restric
 }
 
 /* The light, the optics and the blend of an RGB chunk. */
-static inline void eye_rgb(const sjob *j, size_t p0, echunk *e, const float *Ib)
+SLICE_INLINE void eye_rgb(const sjob *j, size_t p0, echunk *e, const float *Ib)
 {
     float I4[4 * CH], be4[4 * CH], src4[4 * CH], Ic[CH], bext[CH], src[CH];
     eye_rgb_light(j, e, Ib, I4);
@@ -409,102 +428,97 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
     return count;
 }
 
+/* The light of wavelength c leaving the chunk's samples (Eq. 25; the light pass's
+ * per-wavelength part): I' = I (T + (1 - T) keep). Accumulates beta_sca Delta into dn. */
+SLICE_INLINE void light_wavelength(const sjob *j, int c, const echunk *e, const float *restrict Iw,
+                                    const float *restrict n0, float *restrict dn, float *restrict Io)
+{
+    const stables *t = j->t;
+    const size_t ns = (size_t)j->n + 1;
+    const float delta = j->ldelta;
+    const int contig = e->contig;
+    float be[CH], bs[CH], aF[CH], tq[CH], kp[CH], lg[CH], Iq[CH], out[CH];
+    int32_t fi[CH];
+    for (int q = 0; q < e->mv; q++)
+        be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[(size_t)(contig ? q : e->id[q]) * ns];
+    for (int f = 0; f < j->nf; f++) {
+        if (!e->live[f]) continue;
+        const float sg = t->sig[f][c], sa = t->sca[f][c];
+        const float *restrict d = e->dens + f * CH;
+        for (int q = 0; q < e->mv; q++) be[q] += d[q] * sg, bs[q] += d[q] * sa;
+    }
+    for (int q = 0; q < e->mv; q++) {
+        dn[q] += bs[q] * delta;
+        tq[q] = be[q] * delta;
+        /* Eq. 25's order: floor(n + 1 + beta Delta) */
+        const float idx = floorf(n0[q] + 1.0f + tq[q]);
+        fi[q] = !(idx > 0.0f) ? 0 : (idx >= (float)SLICE_F_ORDERS ? SLICE_F_ORDERS : (int)idx);
+    }
+    if (!j->low_albedo)
+        for (int f = 0; f < j->nf; f++) {
+            if (!e->live[f]) continue;
+            const float sa = t->sca[f][c];
+            const float *restrict Ft = t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1);
+            const float *restrict d = e->dens + f * CH;
+            for (int q = 0; q < e->mv; q++) {
+                const float fq = Ft[fi[q]], dq = d[q] > 0.0f ? d[q] : 0.0f;
+                aF[q] += dq * sa * fq;
+            }
+        }
+    for (int q = 0; q < e->mv; q++) {
+        const float a = aF[q] / be[q];
+        /* keep: the fraction of the scattered light (1 - T) still going forward,
+         * Eq. 25's (alpha F)^{max(1, beta Delta)} (docs/slice.md); 0 in low albedo. */
+        kp[q] = !j->low_albedo && bs[q] > 0.0f && a > 0.0f ? a : 0.0f;
+        lg[q] = log_pos(kp[q]);
+    }
+    for (int q = 0; q < e->mv; q++) {
+        const float tau = tq[q], T = atmos__expf_poly(-tau);
+        const float pw = atmos__expf_poly(tau * lg[q]); /* thick slab: the power */
+        const float keep = kp[q] > 0.0f && tau > 1.0f ? pw : kp[q];
+        out[q] = be[q] > 0.0f ? Iq[q] * (T + (1.0f - T) * keep) : Iq[q];
+    }
+    for (int q = 0; q < e->m; q++) Io[(size_t)(contig ? q : e->id[q]) * ns] = out[q];
+}
+
 SLICE_CLONES
 long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, int a0, int a1, const float *Ic_,
                                   const float *nc_, float *In_, float *nn_)
 {
     if (j->eq24) return atmos__slice_light_span_ref(j, k, b, x0, x1, a0, a1, Ic_, nc_, In_, nn_);
-    const sgrid *g = j->g;
-    const stables *t = j->t;
-    const int n = j->n, nf = j->nf, L = j->L;
+    const int n = j->n, L = j->L;
     const size_t ns = (size_t)n + 1; /* texels interleave I per wavelength and n */
-    const float delta = j->ldelta;
     const float *restrict Ic = Ic_, *restrict nc = nc_;
     float *restrict In = In_, *restrict nn = nn_;
     double base[3];
     for (int i = 0; i < 3; i++) base[i] = j->lA[i] + b * j->lEb[i] + k * j->lEk[i];
     const float bu = (float)base[0], bv = (float)base[1], bw = (float)base[2];
     const float eu = (float)j->lEa[0], ev = (float)j->lEa[1], ew = (float)j->lEa[2];
-    float u[CH], v[CH], w[CH];
+    float u[CH], v[CH], w[CH], n0[CH], dn[CH];
     unsigned char ok[CH];
-    int id[CH];
-    int32_t vox[CH], fi[CH];
-    float fu[CH], fv[CH], fw[CH], dens[ATMOS_VOLUME_MAX_FIELDS * CH];
-    float n0[CH], dn[CH], Iq[CH], out[CH];
+    echunk e;
     long long count = 0;
     for (int xs = x0; xs <= x1; xs += CH) {
         const int cnt = x1 - xs + 1 < CH ? x1 - xs + 1 : CH;
         const size_t q0 = (size_t)b * L + xs;
         /* Light that meets nothing passes unchanged. */
         memcpy(In + q0 * ns, Ic + q0 * ns, sizeof(float) * (size_t)cnt * ns);
-        {
-            const int *restrict k0 = j->lk0 + q0, *restrict k1 = j->lk1 + q0;
-            for (int q = 0; q < cnt; q++) {
-                const int a = xs + q;
-                const float af = (float)a;
-                u[q] = bu + af * eu;
-                v[q] = bv + af * ev;
-                w[q] = bw + af * ew;
-                ok[q] = a >= a0 && a <= a1 && k >= k0[q] && k <= k1[q];
-            }
+        const int *restrict k0 = j->lk0 + q0, *restrict k1 = j->lk1 + q0;
+        for (int q = 0; q < cnt; q++) {
+            const int a = xs + q;
+            const float af = (float)a;
+            u[q] = bu + af * eu;
+            v[q] = bv + af * ev;
+            w[q] = bw + af * ew;
+            ok[q] = a >= a0 && a <= a1 && k >= k0[q] && k <= k1[q];
         }
-        int m = compact(g, cnt, u, v, w, ok, id, vox, fu, fv, fw);
-        if (!m) continue;
-        count += m;
-        int mv = pad_samples(m, id, vox, fu, fv, fw);
-        trilinear_soa(g, mv, vox, fu, fv, fw, dens);
-        m = drop_empty(nf, m, dens, id);
-        if (!m) continue;
-        mv = pad_dens(nf, m, dens, id);
-        int live[ATMOS_VOLUME_MAX_FIELDS];
-        fields_live(nf, m, dens, live);
-        for (int q = 0; q < mv; q++) n0[q] = nc[(q0 + (size_t)id[q]) * ns], dn[q] = 0.0f;
-        float be[CH], bs[CH], aF[CH], tq[CH], kp[CH], lg[CH];
-        for (int c = 0; c < n; c++) {
-            const float *restrict Iw = Ic + q0 * ns + c;
-            for (int q = 0; q < mv; q++) be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[(size_t)id[q] * ns];
-            for (int f = 0; f < nf; f++) {
-                if (!live[f]) continue;
-                const float sg = t->sig[f][c], sa = t->sca[f][c];
-                const float *restrict d = dens + f * CH;
-                for (int q = 0; q < mv; q++) be[q] += d[q] * sg, bs[q] += d[q] * sa;
-            }
-            for (int q = 0; q < mv; q++) {
-                dn[q] += bs[q] * delta;
-                tq[q] = be[q] * delta;
-                /* Eq. 25's order: floor(n + 1 + beta Delta) */
-                const float idx = floorf(n0[q] + 1.0f + tq[q]);
-                fi[q] = !(idx > 0.0f) ? 0 : (idx >= (float)SLICE_F_ORDERS ? SLICE_F_ORDERS : (int)idx);
-            }
-            if (!j->low_albedo)
-                for (int f = 0; f < nf; f++) {
-                    if (!live[f]) continue;
-                    const float sa = t->sca[f][c];
-                    const float *restrict Ft = t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1);
-                    const float *restrict d = dens + f * CH;
-                    for (int q = 0; q < mv; q++) {
-                        const float fq = Ft[fi[q]], dq = d[q] > 0.0f ? d[q] : 0.0f;
-                        aF[q] += dq * sa * fq;
-                    }
-                }
-            for (int q = 0; q < mv; q++) {
-                const float a = aF[q] / be[q];
-                /* keep: the fraction of the scattered light (1 - T) still going forward,
-                 * Eq. 25's (alpha F)^{max(1, beta Delta)} (docs/slice.md); 0 in low albedo. */
-                kp[q] = !j->low_albedo && bs[q] > 0.0f && a > 0.0f ? a : 0.0f;
-                lg[q] = log_pos(kp[q]);
-            }
-            for (int q = 0; q < mv; q++) {
-                const float tau = tq[q], T = atmos__expf_poly(-tau);
-                const float pw = atmos__expf_poly(tau * lg[q]); /* thick slab: the power */
-                const float keep = kp[q] > 0.0f && tau > 1.0f ? pw : kp[q];
-                out[q] = be[q] > 0.0f ? Iq[q] * (T + (1.0f - T) * keep) : Iq[q];
-            }
-            float *restrict Io = In + q0 * ns + c;
-            for (int q = 0; q < m; q++) Io[(size_t)id[q] * ns] = out[q];
-        }
+        count += chunk_lookup(j->g, cnt, u, v, w, ok, (size_t)L * L - q0, &e);
+        if (!e.m) continue;
+        const int contig = e.contig;
+        for (int q = 0; q < e.mv; q++) n0[q] = nc[(q0 + (size_t)(contig ? q : e.id[q])) * ns], dn[q] = 0.0f;
+        for (int c = 0; c < n; c++) light_wavelength(j, c, &e, Ic + q0 * ns + c, n0, dn, In + q0 * ns + c);
         /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
-        for (int q = 0; q < m; q++) nn[(q0 + (size_t)id[q]) * ns] = n0[q] + dn[q] / (float)n;
+        for (int q = 0; q < e.m; q++) nn[(q0 + (size_t)(contig ? q : e.id[q])) * ns] = n0[q] + dn[q] / (float)n;
     }
     return count;
 }
