@@ -89,17 +89,24 @@ SLICE_INLINE void fields_live(int nf, int m, const float *dens, int *live)
     }
 }
 
-/* Drops the samples at which every field is zero (they change neither the eye nor the
- * light buffer: their sums are exact zeros). Returns the new count. */
+/* Samples at which every field is zero change neither the eye nor the light buffer (their
+ * sums are exact zeros, their transmittance exactly 1), so they may be kept or dropped
+ * without changing a bit: when more than a quarter of the m samples are empty they are
+ * dropped (branch-free packing), otherwise kept (computing them costs less than packing).
+ * Returns the new count (0: all empty). */
 SLICE_INLINE int drop_empty(int nf, int m, float *dens, int *id)
 {
+    int nz[CH], live = 0;
+    for (int q = 0; q < m; q++) nz[q] = 0;
+    for (int f = 0; f < nf; f++)
+        for (int q = 0; q < m; q++) nz[q] |= dens[f * CH + q] != 0.0f;
+    for (int q = 0; q < m; q++) live += nz[q];
+    if (live == 0 || 4 * live >= 3 * m) return live ? m : 0;
     int o = 0;
     for (int q = 0; q < m; q++) {
-        int any = 0;
-        for (int f = 0; f < nf; f++) any |= dens[f * CH + q] != 0.0f;
-        if (!any) continue;
         for (int f = 0; f < nf; f++) dens[f * CH + o] = dens[f * CH + q];
-        id[o++] = id[q];
+        id[o] = id[q];
+        o += nz[q];
     }
     return o;
 }
@@ -333,65 +340,78 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
  * wavelengths at orders o and o + 1 are six consecutive floats, so the light buffer and the
  * Ams tables are read by whole-vector loads rather than one gathered lane per wavelength.
  * Lane c computes what eye_bilinear and eye_optics compute for wavelength c, with the same
- * operations in the same order (the same bits). Out: [q * 4 + c], lane 3 of the light: n. */
-SLICE_INLINE void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float *restrict I4)
+ * operations in the same order (the same bits); four samples' vectors are transposed into
+ * the per-wavelength arrays. I3[c]: the light of wavelength c (c = 3: n, also in nsc). */
+SLICE_INLINE void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float (*restrict I3)[CH])
 {
     const int32_t LN = j->L * 4;
-    for (int q = 0; q < e->mv; q++) {
-        const float *p = Ib + e->lt[q];
-        __m128 r = _mm_mul_ps(_mm_set1_ps(e->w00[q]), _mm_loadu_ps(p));
-        r = _mm_add_ps(r, _mm_mul_ps(_mm_set1_ps(e->w10[q]), _mm_loadu_ps(p + 4)));
-        r = _mm_add_ps(r, _mm_mul_ps(_mm_set1_ps(e->w01[q]), _mm_loadu_ps(p + LN)));
-        r = _mm_add_ps(r, _mm_mul_ps(_mm_set1_ps(e->w11[q]), _mm_loadu_ps(p + LN + 4)));
-        _mm_storeu_ps(I4 + 4 * q, r);
-        e->nsc[q] = I4[4 * q + 3];
+    for (int q0 = 0; q0 < e->mv; q0 += 4) {
+        __m128 r[4];
+        for (int i = 0; i < 4; i++) {
+            const int q = q0 + i;
+            const float *p = Ib + e->lt[q];
+            __m128 v = _mm_mul_ps(_mm_set1_ps(e->w00[q]), _mm_loadu_ps(p));
+            v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(e->w10[q]), _mm_loadu_ps(p + 4)));
+            v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(e->w01[q]), _mm_loadu_ps(p + LN)));
+            r[i] = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(e->w11[q]), _mm_loadu_ps(p + LN + 4)));
+        }
+        _MM_TRANSPOSE4_PS(r[0], r[1], r[2], r[3]);
+        for (int c = 0; c < 3; c++) _mm_storeu_ps(I3[c] + q0, r[c]);
+        _mm_storeu_ps(e->nsc + q0, r[3]);
     }
 }
 
-SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float *restrict be4, float *restrict src4)
+/* One sample's extinction and source vectors (lane c: wavelength c) over the live fields. */
+SLICE_INLINE void eye_rgb_sample(const sjob *j, const echunk *e, int q, const __m128 *sg, const __m128 *sa,
+                                 __m128 *bext, __m128 *src)
 {
     const stables *t = j->t;
     const int32_t an = t->no * 3;
-    const __m128 xi = _mm_set1_ps(j->xi), zero = _mm_setzero_ps();
+    const __m128 xi = _mm_set1_ps(j->xi), zero = _mm_setzero_ps(), fo = _mm_set1_ps(e->fo[q]);
+    __m128 be = zero, sr = zero;
+    for (int f = 0; f < j->nf; f++) {
+        if (!e->live[f]) continue;
+        const float d = e->dens[f * CH + q];
+        const __m128 dq = _mm_set1_ps(d > 0.0f ? d : 0.0f);
+        be = _mm_add_ps(be, _mm_mul_ps(dq, sg[f]));
+        const __m128 bs = _mm_mul_ps(dq, sa[f]);
+        const float *A = t->ams[f] + e->ai[f][q];
+        const __m128 l0 = _mm_loadu_ps(A), l1 = _mm_loadu_ps(A + 3);
+        const __m128 h0 = _mm_loadu_ps(A + an), h1 = _mm_loadu_ps(A + an + 3);
+        const __m128 lo = _mm_add_ps(l0, _mm_mul_ps(fo, _mm_sub_ps(l1, l0)));
+        const __m128 hi = _mm_add_ps(h0, _mm_mul_ps(fo, _mm_sub_ps(h1, h0)));
+        const __m128 val = _mm_add_ps(lo, _mm_mul_ps(_mm_set1_ps(e->aw[f][q]), _mm_sub_ps(hi, lo)));
+        const __m128 s = _mm_mul_ps(bs, _mm_add_ps(val, xi));
+        sr = _mm_add_ps(sr, _mm_and_ps(_mm_cmpgt_ps(bs, zero), s));
+    }
+    *bext = be, *src = sr;
+}
+
+SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float (*restrict be3)[CH], float (*restrict src3)[CH])
+{
+    const stables *t = j->t;
     __m128 sg[ATMOS_VOLUME_MAX_FIELDS], sa[ATMOS_VOLUME_MAX_FIELDS];
     for (int f = 0; f < j->nf; f++) {
         sg[f] = _mm_setr_ps(t->sig[f][0], t->sig[f][1], t->sig[f][2], 0.0f);
         sa[f] = _mm_setr_ps(t->sca[f][0], t->sca[f][1], t->sca[f][2], 0.0f);
     }
-    for (int q = 0; q < e->mv; q++) {
-        __m128 be = zero, src = zero;
-        const __m128 fo = _mm_set1_ps(e->fo[q]);
-        for (int f = 0; f < j->nf; f++) {
-            if (!e->live[f]) continue;
-            const float d = e->dens[f * CH + q];
-            const __m128 dq = _mm_set1_ps(d > 0.0f ? d : 0.0f);
-            be = _mm_add_ps(be, _mm_mul_ps(dq, sg[f]));
-            const __m128 bs = _mm_mul_ps(dq, sa[f]);
-            const float *A = t->ams[f] + e->ai[f][q];
-            const __m128 l0 = _mm_loadu_ps(A), l1 = _mm_loadu_ps(A + 3);
-            const __m128 h0 = _mm_loadu_ps(A + an), h1 = _mm_loadu_ps(A + an + 3);
-            const __m128 lo = _mm_add_ps(l0, _mm_mul_ps(fo, _mm_sub_ps(l1, l0)));
-            const __m128 hi = _mm_add_ps(h0, _mm_mul_ps(fo, _mm_sub_ps(h1, h0)));
-            const __m128 val = _mm_add_ps(lo, _mm_mul_ps(_mm_set1_ps(e->aw[f][q]), _mm_sub_ps(hi, lo)));
-            const __m128 s = _mm_mul_ps(bs, _mm_add_ps(val, xi));
-            src = _mm_add_ps(src, _mm_and_ps(_mm_cmpgt_ps(bs, zero), s));
-        }
-        _mm_storeu_ps(be4 + 4 * q, be);
-        _mm_storeu_ps(src4 + 4 * q, src);
+    for (int q0 = 0; q0 < e->mv; q0 += 4) {
+        __m128 be[4], sr[4];
+        for (int i = 0; i < 4; i++) eye_rgb_sample(j, e, q0 + i, sg, sa, &be[i], &sr[i]);
+        _MM_TRANSPOSE4_PS(be[0], be[1], be[2], be[3]);
+        _MM_TRANSPOSE4_PS(sr[0], sr[1], sr[2], sr[3]);
+        for (int c = 0; c < 3; c++) _mm_storeu_ps(be3[c] + q0, be[c]), _mm_storeu_ps(src3[c] + q0, sr[c]);
     }
 }
 
 /* The light, the optics and the blend of an RGB chunk. */
 SLICE_INLINE void eye_rgb(const sjob *j, size_t p0, echunk *e, const float *Ib)
 {
-    float I4[4 * CH], be4[4 * CH], src4[4 * CH], Ic[CH], bext[CH], src[CH];
-    eye_rgb_light(j, e, Ib, I4);
+    float I3[4][CH], be3[3][CH], src3[3][CH];
+    eye_rgb_light(j, e, Ib, I3);
     eye_orders(j, p0, e);
-    eye_rgb_optics(j, e, be4, src4);
-    for (int c = 0; c < 3; c++) {
-        for (int q = 0; q < e->mv; q++) Ic[q] = I4[4 * q + c], bext[q] = be4[4 * q + c], src[q] = src4[4 * q + c];
-        eye_blend(j, p0, e, c, Ic, bext, src);
-    }
+    eye_rgb_optics(j, e, be3, src3);
+    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c]);
 }
 #else
 #define SLICE_RGB 0
