@@ -157,10 +157,27 @@ SLICE_INLINE int compact(const sgrid *g, int cnt, const float *restrict u, const
         vx[q] = ((kk * c1 + jj) * c0 + i) * nf;
         a[q] = uq - (float)i, b[q] = vq - (float)jj, c[q] = wq - (float)kk;
     }
+    for (int q = cnt; q < ((cnt + 7) & ~7); q++) keep[q] = 0;
+    /* Points come in runs (a span's ends, empty blocks), so groups of eight that are all
+     * rejected are skipped and groups all kept are copied whole. */
     int m = 0;
-    for (int q = 0; q < cnt; q++) {
-        id[m] = q, vox[m] = vx[q], fu[m] = a[q], fv[m] = b[q], fw[m] = c[q];
-        m += keep[q];
+    for (int g0 = 0; g0 < cnt; g0 += 8) {
+        int any = 0, all = 1;
+        for (int q = g0; q < g0 + 8; q++) any |= keep[q], all &= keep[q];
+        if (!any) continue;
+        if (all) {
+            for (int i = 0; i < 8; i++) {
+                const int q = g0 + i;
+                id[m + i] = q, vox[m + i] = vx[q], fu[m + i] = a[q], fv[m + i] = b[q], fw[m + i] = c[q];
+            }
+            m += 8;
+            continue;
+        }
+        const int g1 = g0 + 8 < cnt ? g0 + 8 : cnt;
+        for (int q = g0; q < g1; q++) {
+            id[m] = q, vox[m] = vx[q], fu[m] = a[q], fv[m] = b[q], fw[m] = c[q];
+            m += keep[q];
+        }
     }
     return m;
 }
