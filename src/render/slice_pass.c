@@ -139,7 +139,7 @@ SLICE_INLINE int pad_dens(int nf, int m, float *dens, int *id)
  * vector loop over all points (rejected ones clamped to voxel 0, so that the occupancy
  * gather stays inside the grid); a branch-free scalar loop then packs the kept ones. */
 SLICE_INLINE int compact(const sgrid *g, int cnt, const float *restrict u, const float *restrict v,
-                          const float *restrict w, const unsigned char *restrict ok, int *restrict id,
+                          const float *restrict w, const int32_t *restrict ok, int *restrict id,
                           int32_t *restrict vox, float *restrict fu, float *restrict fv, float *restrict fw)
 {
     const int c0 = g->c[0], c1 = g->c[1], ob0 = g->ob[0], ob1 = g->ob[1], nf = g->nf;
@@ -150,7 +150,7 @@ SLICE_INLINE int compact(const sgrid *g, int cnt, const float *restrict u, const
     for (int q = 0; q < cnt; q++) {
         const float uq = u[q], vq = v[q], wq = w[q];
         /* 0 <= floor(x) <= c - 2, i.e. 0 <= x < c - 1 (NaN fails) */
-        const int in = (ok[q] != 0) & (uq >= 0.0f) & (vq >= 0.0f) & (wq >= 0.0f) & (uq < u1) & (vq < v1) & (wq < w1);
+        const int in = ok[q] & (uq >= 0.0f) & (vq >= 0.0f) & (wq >= 0.0f) & (uq < u1) & (vq < v1) & (wq < w1);
         const int i = in ? (int)uq : 0, jj = in ? (int)vq : 0, kk = in ? (int)wq : 0;
         const int32_t ob = (kk / SLICE_OCC_B * ob1 + jj / SLICE_OCC_B) * ob0 + i / SLICE_OCC_B;
         keep[q] = in & (occ[ob] != 0);
@@ -162,10 +162,10 @@ SLICE_INLINE int compact(const sgrid *g, int cnt, const float *restrict u, const
      * rejected are skipped and groups all kept are copied whole. */
     int m = 0;
     for (int g0 = 0; g0 < cnt; g0 += 8) {
-        int any = 0, all = 1;
-        for (int q = g0; q < g0 + 8; q++) any |= keep[q], all &= keep[q];
-        if (!any) continue;
-        if (all) {
+        const int32_t *kq = keep + g0;
+        const int kept = (kq[0] + kq[1]) + (kq[2] + kq[3]) + ((kq[4] + kq[5]) + (kq[6] + kq[7]));
+        if (!kept) continue;
+        if (kept == 8) {
             for (int i = 0; i < 8; i++) {
                 const int q = g0 + i;
                 id[m + i] = q, vox[m + i] = vx[q], fu[m + i] = a[q], fv[m + i] = b[q], fw[m + i] = c[q];
@@ -200,7 +200,7 @@ typedef struct {
  * (the padded lanes of a contiguous chunk read up to e->mv). Returns the number of points
  * looked up in the grid (e->m: kept). */
 SLICE_INLINE int chunk_lookup(const sgrid *g, int cnt, const float *u, const float *v, const float *w,
-                               const unsigned char *ok, size_t lim, echunk *e)
+                               const int32_t *ok, size_t lim, echunk *e)
 {
     e->m = compact(g, cnt, u, v, w, ok, e->id, e->vox, e->fu, e->fv, e->fw);
     const int looked = e->m;
@@ -220,7 +220,7 @@ SLICE_INLINE int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e
 {
     const float kf = (float)k;
     float u[CH], v[CH], w[CH];
-    unsigned char ok[CH];
+    int32_t ok[CH];
     const float *restrict U0 = j->pU0[0] + p0, *restrict V0 = j->pU0[1] + p0, *restrict W0 = j->pU0[2] + p0;
     const float *restrict dU = j->pdU[0] + p0, *restrict dV = j->pdU[1] + p0, *restrict dW = j->pdU[2] + p0;
     const int *restrict k0 = j->pk0 + p0, *restrict k1 = j->pk1 + p0;
@@ -334,17 +334,21 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
         Cq[q] = be > 0.0f ? contrib : 0.0f;
     }
     float *restrict Lb = j->L_eye + c * j->pst + p0, *restrict Tb = j->T_eye + c * j->pst + p0;
-    const int contig = e->contig;
-    if (j->btf)
-        for (int q = 0; q < e->m; q++) {
-            const int x = contig ? q : e->id[q];
-            Lb[x] = Lb[x] * Tq[q] + Cq[q]; /* back-to-front: over */
+    const int m = e->m;
+    if (e->contig && j->btf)
+        for (int q = 0; q < m; q++) Lb[q] = Lb[q] * Tq[q] + Cq[q], Tb[q] *= Tq[q]; /* back-to-front: over */
+    else if (e->contig)
+        for (int q = 0; q < m; q++) Lb[q] += Tb[q] * Cq[q], Tb[q] *= Tq[q]; /* front-to-back: under */
+    else if (j->btf)
+        for (int q = 0; q < m; q++) {
+            const int x = e->id[q];
+            Lb[x] = Lb[x] * Tq[q] + Cq[q];
             Tb[x] *= Tq[q];
         }
     else
-        for (int q = 0; q < e->m; q++) {
-            const int x = contig ? q : e->id[q];
-            Lb[x] += Tb[x] * Cq[q]; /* front-to-back: under */
+        for (int q = 0; q < m; q++) {
+            const int x = e->id[q];
+            Lb[x] += Tb[x] * Cq[q];
             Tb[x] *= Tq[q];
         }
 }
@@ -532,7 +536,7 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
     const float bu = (float)base[0], bv = (float)base[1], bw = (float)base[2];
     const float eu = (float)j->lEa[0], ev = (float)j->lEa[1], ew = (float)j->lEa[2];
     float u[CH], v[CH], w[CH], n0[CH], dn[CH];
-    unsigned char ok[CH];
+    int32_t ok[CH];
     echunk e;
     long long count = 0;
     for (int xs = x0; xs <= x1; xs += CH) {
