@@ -185,8 +185,8 @@ SLICE_INLINE int compact(const sgrid *g, int cnt, const float *restrict u, const
 /* One chunk of eye samples (pixels x of one row on one slice) as structure of arrays. */
 typedef struct {
     int m, mv;  /* samples, and that count padded to whole vectors */
-    int contig; /* the samples are pixels 0..m-1 of the chunk (id[q] = q): their per-pixel
-                   data is read and written without indices (loops unswitched on it) */
+    int contig; /* the samples are points 0..m-1 of the chunk (id[q] = q): their per-point
+                   data is read and written without indices (see lane) */
     int id[CH];
     int32_t vox[CH], lt[CH], oi[CH], ai[ATMOS_VOLUME_MAX_FIELDS][CH];
     float fu[CH], fv[CH], fw[CH], dens[ATMOS_VOLUME_MAX_FIELDS * CH];
@@ -196,11 +196,9 @@ typedef struct {
 
 /* Of a chunk's cnt candidate points (render-voxel coordinates u, v, w; ok[q] = 0 for
  * points already rejected), the ones that meet occupied blocks and a non-zero density, with
- * their densities; lim: how many entries past the chunk's first the per-point arrays hold
- * (the padded lanes of a contiguous chunk read up to e->mv). Returns the number of points
- * looked up in the grid (e->m: kept). */
+ * their densities. Returns the number of points looked up in the grid (e->m: kept). */
 SLICE_INLINE int chunk_lookup(const sgrid *g, int cnt, const float *u, const float *v, const float *w,
-                               const int32_t *ok, size_t lim, echunk *e)
+                               const int32_t *ok, echunk *e)
 {
     e->m = compact(g, cnt, u, v, w, ok, e->id, e->vox, e->fu, e->fv, e->fw);
     const int looked = e->m;
@@ -211,9 +209,14 @@ SLICE_INLINE int chunk_lookup(const sgrid *g, int cnt, const float *u, const flo
     if (!e->m) return looked;
     e->mv = pad_dens(g->nf, e->m, e->dens, e->id);
     fields_live(g->nf, e->m, e->dens, e->live);
-    e->contig = e->id[e->m - 1] == e->m - 1 && (size_t)e->mv <= lim; /* ids increase from 0 */
+    e->contig = e->id[e->m - 1] == e->m - 1; /* ids increase from 0 */
     return looked;
 }
+
+/* The chunk point of sample q: id[q], which for a contiguous chunk is q itself, or for its
+ * padded lanes (q >= m) the last sample's, as pad_samples made them (so a computed index
+ * lets the loops read the per-point arrays without the indirection). */
+SLICE_INLINE int lane(const echunk *e, int q) { return e->contig ? (q < e->m ? q : e->m - 1) : e->id[q]; }
 
 /* The chunk of pixels p0.. (cnt of them) on slice k: chunk_lookup of their samples. */
 SLICE_INLINE int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e)
@@ -230,7 +233,7 @@ SLICE_INLINE int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e
         w[q] = W0[q] + kf * dW[q];
         ok[q] = k >= k0[q] && k <= k1[q];
     }
-    return chunk_lookup(j->g, cnt, u, v, w, ok, (size_t)j->W * j->H - p0, e);
+    return chunk_lookup(j->g, cnt, u, v, w, ok, e);
 }
 
 /* The samples' light-buffer texel (lt, the row-major offset of the lower-left one) and
@@ -240,9 +243,8 @@ SLICE_INLINE void eye_texels(const sjob *j, int k, size_t p0, echunk *e)
     const int L = j->L;
     const int32_t ns = j->n + 1;
     const float kf = (float)k, lim = (float)(L - 1);
-    const int contig = e->contig;
     for (int q = 0; q < e->mv; q++) {
-        const size_t p = p0 + (size_t)(contig ? q : e->id[q]);
+        const size_t p = p0 + (size_t)lane(e, q);
         float a = j->pF0[0][p] + kf * j->pdF[0][p], b = j->pF0[1][p] + kf * j->pdF[1][p];
         a = a < 0.0f ? 0.0f : (a > lim ? lim : a);
         b = b < 0.0f ? 0.0f : (b > lim ? lim : b);
@@ -284,7 +286,7 @@ SLICE_INLINE void eye_orders(const sjob *j, size_t p0, echunk *e)
         const int32_t *restrict pa = j->pa + p0 * nf + f;
         const float *restrict pw = j->pw + p0 * nf + f;
         for (int q = 0; q < e->mv; q++) {
-            const int x = e->contig ? q : e->id[q];
+            const int x = lane(e, q);
             e->ai[f][q] = pa[x * nf] + e->oi[q] * n;
             e->aw[f][q] = pw[x * nf];
         }
@@ -477,11 +479,10 @@ SLICE_INLINE void light_wavelength(const sjob *j, int c, const echunk *e, const 
     const stables *t = j->t;
     const size_t ns = (size_t)j->n + 1;
     const float delta = j->ldelta;
-    const int contig = e->contig;
     float be[CH], bs[CH], aF[CH], tq[CH], kp[CH], lg[CH], Iq[CH], out[CH];
     int32_t fi[CH];
     for (int q = 0; q < e->mv; q++)
-        be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[(size_t)(contig ? q : e->id[q]) * ns];
+        be[q] = 0.0f, bs[q] = 0.0f, aF[q] = 0.0f, Iq[q] = Iw[(size_t)lane(e, q) * ns];
     for (int f = 0; f < j->nf; f++) {
         if (!e->live[f]) continue;
         const float sg = t->sig[f][c], sa = t->sca[f][c];
@@ -519,7 +520,7 @@ SLICE_INLINE void light_wavelength(const sjob *j, int c, const echunk *e, const 
         const float keep = kp[q] > 0.0f && tau > 1.0f ? pw : kp[q];
         out[q] = be[q] > 0.0f ? Iq[q] * (T + (1.0f - T) * keep) : Iq[q];
     }
-    for (int q = 0; q < e->m; q++) Io[(size_t)(contig ? q : e->id[q]) * ns] = out[q];
+    for (int q = 0; q < e->m; q++) Io[(size_t)lane(e, q) * ns] = out[q];
 }
 
 SLICE_CLONES
@@ -553,13 +554,12 @@ long long atmos__slice_light_span(const sjob *j, int k, int b, int x0, int x1, i
             w[q] = bw + af * ew;
             ok[q] = a >= a0 && a <= a1 && k >= k0[q] && k <= k1[q];
         }
-        count += chunk_lookup(j->g, cnt, u, v, w, ok, (size_t)L * L - q0, &e);
+        count += chunk_lookup(j->g, cnt, u, v, w, ok, &e);
         if (!e.m) continue;
-        const int contig = e.contig;
-        for (int q = 0; q < e.mv; q++) n0[q] = nc[(q0 + (size_t)(contig ? q : e.id[q])) * ns], dn[q] = 0.0f;
+        for (int q = 0; q < e.mv; q++) n0[q] = nc[(q0 + (size_t)lane(&e, q)) * ns], dn[q] = 0.0f;
         for (int c = 0; c < n; c++) light_wavelength(j, c, &e, Ic + q0 * ns + c, n0, dn, In + q0 * ns + c);
         /* Eq. 21: n grows by alpha beta_ext Delta = beta_sca Delta (mean over wavelengths). */
-        for (int q = 0; q < e.m; q++) nn[(q0 + (size_t)(contig ? q : e.id[q])) * ns] = n0[q] + dn[q] / (float)n;
+        for (int q = 0; q < e.m; q++) nn[(q0 + (size_t)lane(&e, q)) * ns] = n0[q] + dn[q] / (float)n;
     }
     return count;
 }
