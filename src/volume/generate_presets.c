@@ -18,7 +18,7 @@
  * (5.5 km^-1, a dense anvil), cirrus ice 500 m^-3 (0.9 km^-1), rain drops 2e3 m^-3
  * (moderate rain of ~1 mm drops; 13 km^-1).
  */
-#include "volume/generate.h"
+#include "volume/generate_job.h"
 
 #include <math.h>
 #include <string.h>

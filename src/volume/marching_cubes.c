@@ -11,7 +11,7 @@
  * connection, so the surface has no cracks. Triangle orientation does not matter
  * here: normals come from the field gradient.
  */
-#include "volume/generate_internal.h"
+#include "volume/generator.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -11,7 +11,7 @@
  * n_y = -0.25) so that bases stay flat and tops grow upward.
  */
 #include "core/internal.h"
-#include "volume/generate_internal.h"
+#include "volume/generator.h"
 
 #include <math.h>
 #include <stdlib.h>

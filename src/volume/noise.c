@@ -2,7 +2,7 @@
  * values on the integer lattice (a hash of the lattice point and the seed),
  * interpolated with the quintic fade 6t^5 - 15t^4 + 10t^3 so the sum of octaves
  * has continuous first and second derivatives. */
-#include "volume/generate_internal.h"
+#include "volume/generator.h"
 
 #include <math.h>
 

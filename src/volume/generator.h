@@ -2,8 +2,8 @@
  * noise.c). All randomness comes from one explicitly seeded generator and all
  * parallel loops write disjoint voxels in a fixed order, so a preset gives the same
  * voxels for a seed whatever the thread count. */
-#ifndef ATMOS_GENERATE_INTERNAL_H
-#define ATMOS_GENERATE_INTERNAL_H
+#ifndef ATMOS_GENERATOR_H
+#define ATMOS_GENERATOR_H
 
 #include "atmos/atmos.h"
 #include "core/rng.h"

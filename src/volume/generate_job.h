@@ -1,9 +1,9 @@
-/* Shared state of one atmos_volume_generate() call (generate.c, generate_presets.c). */
-#ifndef ATMOS_GENERATE_H
-#define ATMOS_GENERATE_H
+/* Shared state of one atmos_volume_generate() call (generate.c, generate_grid.c, generate_presets.c). */
+#ifndef ATMOS_GENERATE_JOB_H
+#define ATMOS_GENERATE_JOB_H
 
 #include "core/internal.h"
-#include "volume/generate_internal.h"
+#include "volume/generator.h"
 
 #define GEN_MAX_GRIDS 3
 
