@@ -9,6 +9,7 @@
 #include <openexr.h>
 
 #include <errno.h>
+#include <math.h>
 #include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -117,6 +118,56 @@ static atmos_status encode_image(atmos_context *ctx, const char *path, exr_conte
     return st;
 }
 
+/* A metadata value that is a number as a whole ("12.5", "-3", "2.2e9"): 1 for an integer
+ * that fits 32 bits (*iv), 2 for another finite number (*dv), 0 for text. */
+static int meta_number(const char *v, int32_t *iv, double *dv)
+{
+    if (!*v || strlen(v) > 40 || v[0] == ' ' || v[0] == '\t' || v[0] == '\n') return 0;
+    char *end = NULL;
+    errno = 0;
+    double d = strtod(v, &end);
+    if (*end || errno || !isfinite(d)) return 0;
+    if (v[0] == '+' || (v[0] == '0' && v[1] >= '0' && v[1] <= '9')) return 0; /* "007", "+1": keep the text */
+    if (!strpbrk(v, ".eExXnNiI") && d >= -2147483648.0 && d <= 2147483647.0) {
+        *iv = (int32_t)d;
+        return 1;
+    }
+    if (strpbrk(v, "xXnNiI")) return 0; /* hex floats, nan, inf: text */
+    *dv = d;
+    return 2;
+}
+
+/* The header's attributes: the standard "chromaticities" (linear sRGB / Rec. 709
+ * primaries, D65 white) and the image's metadata, numbers as int or double attributes
+ * and everything else as strings. */
+static atmos_status write_attributes(atmos_context *ctx, const char *path, exr_context_t ex, int part,
+                                     const atmos_image *img, exr_errbuf *eb)
+{
+    exr_result_t rv;
+    if (!atmos_image_get_meta(img, "chromaticities")) {
+        const exr_attr_chromaticities_t rec709 = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+        if ((rv = exr_attr_set_chromaticities(ex, part, "chromaticities", &rec709)) != EXR_ERR_SUCCESS)
+            return atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: chromaticities: %s", path, exr_message(eb, rv));
+    }
+    for (int i = 0; i < img->meta_count; i++) {
+        const char *key = img->meta[i].key, *val = img->meta[i].value;
+        if (strcmp(key, "type") == 0 || strcmp(key, "name") == 0)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: metadata key '%s' is reserved for the EXR part structure",
+                                path, key);
+        eb->msg[0] = '\0';
+        int32_t iv = 0;
+        double dv = 0;
+        const int kind = meta_number(val, &iv, &dv);
+        rv = kind == 1 ? exr_attr_set_int(ex, part, key, iv)
+             : kind == 2 ? exr_attr_set_double(ex, part, key, dv)
+                         : exr_attr_set_string(ex, part, key, val);
+        if (rv != EXR_ERR_SUCCESS) /* typically a standard attribute of another type ("channels", ...) */
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: metadata '%s' cannot be stored as %s attribute: %s",
+                                path, key, kind == 1 ? "an int" : kind == 2 ? "a double" : "a string", exr_message(eb, rv));
+    }
+    return ATMOS_OK;
+}
+
 static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *user)
 {
     const exr_write_job *job = user;
@@ -165,22 +216,7 @@ static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *us
             goto done;
         }
     }
-    for (int i = 0; i < img->meta_count; i++) {
-        const char *key = img->meta[i].key;
-        if (strcmp(key, "type") == 0 || strcmp(key, "name") == 0) {
-            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: metadata key '%s' is reserved for the EXR part structure",
-                              job->path, key);
-            goto done;
-        }
-        eb.msg[0] = '\0';
-        rv = exr_attr_set_string(ex, part, img->meta[i].key, img->meta[i].value);
-        if (rv != EXR_ERR_SUCCESS) {
-            /* Typically the key is one of the standard attributes ("channels", ...). */
-            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: OpenEXR: metadata '%s' cannot be stored as a string attribute: %s",
-                              job->path, img->meta[i].key, exr_message(&eb, rv));
-            goto done;
-        }
-    }
+    if ((st = write_attributes(ctx, job->path, ex, part, img, &eb)) != ATMOS_OK) goto done;
     rv = exr_write_header(ex);
     if (rv != EXR_ERR_SUCCESS) {
         st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot write header: %s", job->path, exr_message(&eb, rv));
@@ -205,6 +241,36 @@ done:
     return st;
 }
 
+/* Half floats end at 65504: a finite value beyond that would be stored as infinity.
+ * Such values are clamped to +-65504 in a copy (*out; NULL when none is out of range),
+ * with a warning that counts them. Infinities and NaN are stored as they are. */
+#define EXR_HALF_MAX 65504.0f
+static atmos_status clamp_to_half(atmos_context *ctx, const atmos_image *img, const char *path, atmos_image **out)
+{
+    *out = NULL;
+    const size_t n = (size_t)img->width * (size_t)img->height * (size_t)img->channels;
+    size_t over = 0;
+    float peak = 0;
+    for (size_t i = 0; i < n; i++) {
+        const float v = fabsf(img->pixels[i]);
+        if (v > EXR_HALF_MAX && isfinite(v)) over++, peak = v > peak ? v : peak;
+    }
+    if (!over) return ATMOS_OK;
+    atmos_status st = atmos_image_create(ctx, img->width, img->height, img->channels, out);
+    if (st != ATMOS_OK) return st;
+    for (size_t i = 0; i < n; i++) {
+        const float v = img->pixels[i];
+        (*out)->pixels[i] = !isfinite(v) ? v : v > EXR_HALF_MAX ? EXR_HALF_MAX : v < -EXR_HALF_MAX ? -EXR_HALF_MAX : v;
+    }
+    for (int i = 0; i < img->meta_count && st == ATMOS_OK; i++)
+        st = atmos_image_set_meta(*out, img->meta[i].key, img->meta[i].value);
+    if (st != ATMOS_OK) return atmos__error(ctx, st, "%s: out of memory", path);
+    atmos__log(ctx, ATMOS_LOG_WARN,
+               "%s: %zu sample%s beyond the largest half float (up to %.4g) clamped to 65504; "
+               "32-bit float output keeps them", path, over, over == 1 ? "" : "s", (double)peak);
+    return ATMOS_OK;
+}
+
 atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const char *path, const atmos_exr_desc *desc)
 {
     if (!img || !img->pixels || !path)
@@ -216,9 +282,7 @@ atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const c
     char(*generated)[16] = NULL;
     const char **names = malloc((size_t)img->channels * sizeof *names);
     if (!names) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-    if (img->channels == 3 || img->channels == 4) {
-        for (int c = 0; c < img->channels; c++) names[c] = rgba[c];
-    } else if (desc && desc->channel_names) {
+    if (desc && desc->channel_names) {
         for (int c = 0; c < img->channels; c++) {
             const char *n = desc->channel_names[c];
             if (!n || !*n || strlen(n) > 255) {
@@ -233,6 +297,8 @@ atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const c
             }
             names[c] = n;
         }
+    } else if (img->channels == 3 || img->channels == 4) {
+        for (int c = 0; c < img->channels; c++) names[c] = rgba[c];
     } else {
         generated = malloc((size_t)img->channels * sizeof *generated);
         if (!generated) {
@@ -245,7 +311,11 @@ atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const c
         }
     }
     exr_write_job job = {path, img, desc ? desc->half : 0, names};
-    atmos_status st = atmos__write_atomic(ctx, path, exr_write_file, &job);
+    atmos_image *clamped = NULL;
+    atmos_status st = job.half ? clamp_to_half(ctx, img, path, &clamped) : ATMOS_OK;
+    if (clamped) job.img = clamped;
+    if (st == ATMOS_OK) st = atmos__write_atomic(ctx, path, exr_write_file, &job);
+    atmos_image_destroy(clamped);
     free(generated);
     free(names);
     return st;
@@ -363,7 +433,23 @@ static atmos_status read_meta(atmos_context *ctx, const char *path, exr_context_
     for (int32_t i = 0; i < count; i++) {
         const exr_attribute_t *a = NULL;
         if (exr_get_attribute_by_index(ex, 0, EXR_ATTR_LIST_FILE_ORDER, i, &a) != EXR_ERR_SUCCESS || !a) continue;
-        if (a->type != EXR_ATTR_STRING || !a->string || !a->name) continue;
+        if (!a->name) continue;
+        if (a->type == EXR_ATTR_INT || a->type == EXR_ATTR_DOUBLE) {
+            /* numbers (as the writer stores numeric metadata) come back as their text */
+            char num[40];
+            if (a->type == EXR_ATTR_INT) {
+                snprintf(num, sizeof num, "%d", (int)a->i);
+            } else {
+                for (int p = 15; p <= 17; p++) {
+                    snprintf(num, sizeof num, "%.*g", p, a->d);
+                    if (strtod(num, NULL) == a->d) break;
+                }
+            }
+            if (atmos_image_set_meta(img, a->name, num) == ATMOS_E_NOMEM)
+                return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
+            continue;
+        }
+        if (a->type != EXR_ATTR_STRING || !a->string) continue;
         /* "type" and "name" describe the part's structure (the library writes
          * "type" itself); they are not image metadata. */
         if (strcmp(a->name, "type") == 0 || strcmp(a->name, "name") == 0) continue;

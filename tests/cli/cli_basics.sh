@@ -135,8 +135,10 @@ run "render --camera fisheye" 0 render --camera fisheye --width 64 --height 64 -
 run "render --camera equirect" 0 render --camera equirect --width 128 --height 64 -o "$T/eq.png" --exr "$T/eq.exr" -q
 [ -s "$T/eq.png" ] && [ -s "$T/eq.exr" ] && ok "equirect PNG and EXR written" || bad "equirect outputs missing"
 
-# A failing write (directory does not exist) is a runtime error, and leaves nothing.
-run "unwritable output" 1 render --width 8 --height 8 -o "$T/no/such/dir/x.png" -q
+# A failing write (a folder that cannot be made: its parent is a file) is a runtime error,
+# and leaves nothing.
+: > "$T/a_file"
+run "unwritable output" 1 render --width 8 --height 8 -o "$T/a_file/dir/x.png" -q
 [ -s "$T/err" ] && ok "unwritable output: message" || bad "unwritable output: no message"
 leftover=$(find "$T" -name '*.tmp*' | head -5)
 if [ -z "$leftover" ]; then ok "no temporary files left at the end"; else bad "temporary files left: $leftover"; fi

@@ -1,6 +1,7 @@
 /* Shared helpers for the atmos subcommands. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, isatty */
 #include "cli.h"
+#include "outputs.h"
 
 #include <errno.h>
 #include <math.h>
@@ -52,7 +53,9 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
 int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st)
 {
     const char *msg = ctx ? atmos_context_error(ctx) : "";
-    fprintf(stderr, "atmos %s: %s\n", cmd, msg && *msg ? msg : atmos_status_string(st));
+    char buf[2048];
+    cli_outputs_final_names(msg && *msg ? msg : atmos_status_string(st), buf, sizeof buf);
+    fprintf(stderr, "atmos %s: %s\n", cmd, buf);
     return CLI_EXIT_RUNTIME;
 }
 
@@ -61,7 +64,9 @@ static void log_stderr(void *user, atmos_log_level level, const char *msg)
     (void)user;
     /* Errors are printed by the subcommand with its own prefix; log the rest. */
     if (level == ATMOS_LOG_ERROR) return;
-    fprintf(stderr, "atmos: %s: %s\n", level == ATMOS_LOG_WARN ? "warning" : "info", msg);
+    char buf[2048];
+    cli_outputs_final_names(msg, buf, sizeof buf);
+    fprintf(stderr, "atmos: %s: %s\n", level == ATMOS_LOG_WARN ? "warning" : "info", buf);
 }
 
 atmos_context *cli_context(int threads, int quiet) { return cli_context_with_progress(threads, quiet, NULL, NULL); }

@@ -1,5 +1,6 @@
 /* atmos compare: error statistics of an HDR image against a reference. */
 #include "cli.h"
+#include "outputs.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -74,6 +75,13 @@ int cli_cmd_compare(int argc, char **argv)
         }
     }
     if (nf < 2) return cli_usage_error(C, "need IMAGE and REFERENCE");
+    if (heat) { /* the heat map must not replace an image it compares */
+        if (cli_file_kind_of(heat) != CLI_FILE_PNG) return cli_usage_error(C, "--heatmap %s: expected a .png file name", heat);
+        cli_outputs out = {0};
+        cli_outputs_add(&out, "--heatmap", heat);
+        const char *inputs[3] = {files[0], files[1], by};
+        if (cli_outputs_check(C, &out, inputs, 3) != CLI_EXIT_OK) return CLI_EXIT_USAGE;
+    }
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_image *a = NULL, *b = NULL, *h = NULL, *key = NULL;

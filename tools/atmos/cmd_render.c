@@ -1,36 +1,16 @@
 /* atmos render: a scene file (or the built-in default) to PNG / EXR / PFM. The options
  * (render_opts.c) become a scene; the scene becomes one plan; every frame of its animation
  * is rendered from that plan (atmos_plan_render, the same call atmos_render_scene makes). */
-#define _POSIX_C_SOURCE 200809L /* getpid */
+#include "outputs.h"
 #include "render_opts.h"
 
-#include <signal.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-/* Temporary names of the outputs (atmos__write_atomic writes PATH.tmpPID): on SIGINT or
- * SIGTERM they are removed before exiting, so an interrupted run leaves nothing behind. */
-static char tmp_names[3][4200];
-static void on_signal(int sig)
-{
-    for (int i = 0; i < 3; i++)
-        if (tmp_names[i][0]) unlink(tmp_names[i]); /* async-signal-safe */
-    signal(sig, SIG_DFL);
-    raise(sig);
-}
-
-static void protect_outputs(const char *png, const char *exr, const char *pfm)
-{
-    const char *outs[3] = {png, exr, pfm};
-    for (int i = 0; i < 3; i++) {
-        tmp_names[i][0] = '\0';
-        if (outs[i]) snprintf(tmp_names[i], sizeof tmp_names[i], "%s.tmp%ld", outs[i], (long)getpid());
-    }
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
-}
+/* The options that name files, in the order of frame_files' names. */
+static const char *const out_option[6] = {"-o", "--exr", "--pfm", "--variance", "--order", "--tau"};
 
 /* The name of frame `frame` (1-based) of an animation: "_0001" before the extension of
  * the file name (out/sky.png -> out/sky_0001.png; no extension: appended). digits >= 4. */
@@ -53,25 +33,47 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
     snprintf(buf + j, cap - j, ".png");
 }
 
-/* The output files of one frame: the option's names, numbered in an animation. */
+/* The output files of one frame: the options' names, numbered in an animation (the
+ * optical depth image, made once, goes with the first frame). out: -o's file, of the
+ * format its extension names. */
 typedef struct {
-    const char *png, *exr, *pfm, *var, *ord;
-    char buf[5][4200];
+    const char *out, *exr, *pfm, *var, *ord, *tau;
+    char buf[5][CLI_OUTPUT_PATH_MAX];
 } frame_files;
 
 static int name_frame_files(const render_opts *o, const char *png, int frame, int nframes, frame_files *ff)
 {
-    const char *base[5] = {png, o->exr, o->pfm, o->variance, o->order};
-    const char **dst[5] = {&ff->png, &ff->exr, &ff->pfm, &ff->var, &ff->ord};
+    const char *base[6] = {png, o->exr, o->pfm, o->variance, o->order, frame == 1 ? o->tau : NULL};
+    const char **dst[6] = {&ff->out, &ff->exr, &ff->pfm, &ff->var, &ff->ord, &ff->tau};
     int digits = 4;
     for (int n = nframes; n >= 10000; n /= 10) digits++;
-    for (int i = 0; i < 5; i++) {
+    for (int i = 0; i < 6; i++) {
         *dst[i] = base[i];
-        if (!base[i] || nframes < 2) continue;
+        if (!base[i] || nframes < 2 || i == 5) continue;
         if (!frame_name(base[i], frame, digits, ff->buf[i], sizeof ff->buf[i])) return 0;
         *dst[i] = ff->buf[i];
     }
     return 1;
+}
+
+/* The outputs of frame `frame` named (ff), checked and staged (set): w gets the staging
+ * names the writers write, renamed onto ff's names when the frame is done. Returns
+ * CLI_EXIT_OK or the exit status (message printed). */
+static int stage_frame(const render_opts *o, const char *png, int frame, int nframes, frame_files *ff, cli_outputs *set,
+                       frame_files *w)
+{
+    if (!name_frame_files(o, png, frame, nframes, ff)) {
+        fprintf(stderr, "atmos render: an output path is too long for numbered frames\n");
+        return CLI_EXIT_USAGE;
+    }
+    const char *names[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
+    const char **dst[6] = {&w->out, &w->exr, &w->pfm, &w->var, &w->ord, &w->tau};
+    int idx[6];
+    set->n = 0;
+    for (int i = 0; i < 6; i++) idx[i] = cli_outputs_add(set, out_option[i], names[i]);
+    if (cli_outputs_prepare("render", set) != 0) return CLI_EXIT_RUNTIME;
+    for (int i = 0; i < 6; i++) *dst[i] = idx[i] < 0 ? NULL : cli_outputs_stage(set, idx[i]);
+    return CLI_EXIT_OK;
 }
 
 /* The volume's optical depth along each pixel's ray at the middle wavelength of the set,
@@ -92,8 +94,16 @@ static atmos_status write_tau(atmos_context *ctx, const atmos_scene *scene, cons
     return st;
 }
 
-/* The path tracer's variance (channels var_<nm>nm, then var_Y) and order images. */
-static atmos_status write_path_aux(atmos_context *ctx, const atmos_plan *plan, const frame_files *ff, const char *source)
+/* The render's metadata (lin's) on an image of the same frame. */
+static void copy_meta(atmos_image *img, const atmos_image *lin)
+{
+    for (int i = 0; i < lin->meta_count; i++)
+        if (strcmp(lin->meta[i].key, "atmos:units")) atmos_image_set_meta(img, lin->meta[i].key, lin->meta[i].value);
+}
+
+/* The path tracer's variance (channels var_<nm>nm, then var_Y) and order images, with the
+ * render's metadata (lin's). */
+static atmos_status write_path_aux(atmos_context *ctx, const atmos_plan *plan, const frame_files *ff, const atmos_image *lin)
 {
     const atmos_wavelengths *wl = atmos_plan_wavelengths(plan);
     atmos_image *img = NULL;
@@ -107,40 +117,68 @@ static atmos_status write_path_aux(atmos_context *ctx, const atmos_plan *plan, c
         }
         np[wl->count] = "var_Y";
         atmos_exr_desc ed = {0, np};
-        atmos_image_set_meta(img, "atmos:source", source);
+        copy_meta(img, lin);
+        atmos_image_set_meta(img, "atmos:units", "variance of the mean of each channel: the channel's units squared");
         st = atmos_write_exr(ctx, img, ff->var, &ed);
         atmos_image_destroy(img);
         img = NULL;
     }
     if (st == ATMOS_OK && ff->ord && (st = atmos_plan_path_order(plan, &img)) == ATMOS_OK) {
-        atmos_image_set_meta(img, "atmos:source", source);
         st = atmos_write_pfm(ctx, img, ff->ord);
         atmos_image_destroy(img);
     }
     return st;
 }
 
-/* The outputs of a rendered frame: linear sRGB to EXR and PFM, tone-mapped to PNG. */
-static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, const atmos_scene *fs,
-                                  const atmos_image *spec, const frame_files *ff, const char *source, const char *frame)
+/* One exposure over an animation: the automatic exposure of the first frame, kept as the
+ * manual exposure of the others (unless --exposure-per-frame). */
+typedef struct {
+    int lock, locked;
+    double ev;
+} exposure_lock;
+
+/* The tone-mapped image of a frame, with the exposure the animation keeps. */
+static atmos_status tone_map(atmos_context *ctx, atmos_image *lin, const atmos_scene *fs, exposure_lock *xl,
+                             atmos_image **disp)
+{
+    atmos_tonemap_desc td = fs->tonemap;
+    if (xl->locked && !td.manual_exposure) td.manual_exposure = 1, td.exposure_ev = xl->ev;
+    const double scale = atmos_tonemap_scale(lin, &td);
+    char buf[64];
+    snprintf(buf, sizeof buf, "%.6g", scale);
+    atmos_image_set_meta(lin, "atmos:exposure_scale", buf);
+    if (xl->lock && !xl->locked && !fs->tonemap.manual_exposure && scale > 0 && isfinite(scale)) {
+        xl->ev = log2(1.0 / (1.2 * scale)); /* the manual EV whose scale 1 / (1.2 * 2^EV) this is */
+        xl->locked = 1;
+    }
+    if (xl->locked && !fs->tonemap.manual_exposure) atmos_image_set_meta(lin, "atmos:exposure", "locked at frame 1");
+    return atmos_tonemap(ctx, lin, &td, disp);
+}
+
+/* The outputs of a rendered frame (w: the files to write): linear sRGB to EXR and PFM,
+ * tone-mapped to PNG; -o's file in the format its extension names. */
+static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, const atmos_scene *fs, const atmos_image *spec,
+                                  const frame_files *w, cli_file_kind out_kind, const char *source, const char *frame,
+                                  exposure_lock *xl)
 {
     atmos_image *lin = NULL, *disp = NULL;
     atmos_status st = atmos_image_to_srgb(ctx, spec, atmos_plan_wavelengths(plan), &lin);
     if (st != ATMOS_OK) return st;
     atmos_image_set_meta(lin, "atmos:source", source);
     if (frame) atmos_image_set_meta(lin, "atmos:frame", frame);
-    if (ff->exr) {
-        atmos_exr_desc ed = {fs->exr_half, NULL};
-        st = atmos_write_exr(ctx, lin, ff->exr, &ed);
-    }
-    if (st == ATMOS_OK && ff->pfm) st = atmos_write_pfm(ctx, lin, ff->pfm);
-    if (st == ATMOS_OK && atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH) st = write_path_aux(ctx, plan, ff, source);
-    if (st == ATMOS_OK && ff->png) {
-        char buf[64];
-        snprintf(buf, sizeof buf, "%.6g", atmos_tonemap_scale(lin, &fs->tonemap));
-        atmos_image_set_meta(lin, "atmos:exposure_scale", buf);
-        st = atmos_tonemap(ctx, lin, &fs->tonemap, &disp);
-        if (st == ATMOS_OK) st = atmos_write_png(ctx, disp, ff->png, fs->png_bits ? fs->png_bits : 8);
+    const atmos_wavelengths *wl = atmos_plan_wavelengths(plan);
+    char nm[ATMOS_MAX_WAVELENGTHS * 8 + 8] = "";
+    for (int k = 0; k < wl->count; k++) snprintf(nm + strlen(nm), sizeof nm - strlen(nm), "%s%.1f", k ? " " : "", wl->nm[k]);
+    atmos_image_set_meta(lin, "atmos:wavelengths_nm", nm);
+    atmos_exr_desc ed = {fs->exr_half, NULL};
+    if (w->exr) st = atmos_write_exr(ctx, lin, w->exr, &ed);
+    if (st == ATMOS_OK && w->pfm) st = atmos_write_pfm(ctx, lin, w->pfm);
+    if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_EXR) st = atmos_write_exr(ctx, lin, w->out, &ed);
+    if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_PFM) st = atmos_write_pfm(ctx, lin, w->out);
+    if (st == ATMOS_OK && atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH) st = write_path_aux(ctx, plan, w, lin);
+    if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_PNG) {
+        st = tone_map(ctx, lin, fs, xl, &disp);
+        if (st == ATMOS_OK) st = atmos_write_png(ctx, disp, w->out, fs->png_bits ? fs->png_bits : 8);
     }
     atmos_image_destroy(lin);
     atmos_image_destroy(disp);
@@ -148,14 +186,14 @@ static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, co
 }
 
 static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const frame_files *ff, const char *source,
-                         const atmos_render_info *info, int frame, int nframes, const char *tau)
+                         const atmos_render_info *info, int frame, int nframes)
 {
     if (nframes > 1) fprintf(stderr, "atmos render: frame %d/%d: ", frame, nframes);
     else fprintf(stderr, "atmos render: ");
     fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s\n", source, fs->width, fs->height,
             info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
-    const char *files[5] = {ff->png, ff->exr, ff->pfm, ff->var, ff->ord};
-    for (int i = 0; i < 5; i++)
+    const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
+    for (int i = 0; i < 6; i++)
         if (files[i]) fprintf(stderr, "  wrote %s\n", files[i]);
     if (atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH) {
         atmos_plan_stats ps;
@@ -166,47 +204,83 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
             fprintf(stderr, "  path: forward peak truncated at %g deg: %.3f-%.3f of the scattering counted as unscattered\n",
                     ps.path.truncate_deg, ps.path.truncated_min, ps.path.truncated_max);
     }
-    if (frame == 1 && tau) fprintf(stderr, "  wrote %s\n", tau);
 }
 
-/* Every frame of the scene's animation from the one plan. Returns a status; *failed_frame
- * names the frame that failed (0: before any). */
+/* The staged outputs of one frame: what they are named and what the writers write. */
+typedef struct {
+    frame_files ff, w;
+    cli_outputs set;
+} frame_outputs;
+
+/* Every frame of the scene's animation from the one plan; frame 1's outputs are staged
+ * already (fo), the others are staged here, and each frame's are renamed into place once
+ * all of them are written. Returns a status; *failed_frame names the frame that failed. */
 static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const atmos_scene *scene, const render_opts *o,
-                                  const char *png, const char *source, cli_progress *prog, int *failed_frame)
+                                  const char *png, const char *source, cli_progress *prog, frame_outputs *fo,
+                                  int *failed_frame)
 {
     const int nframes = scene->animation.frames > 1 ? scene->animation.frames : 1;
+    const cli_file_kind out_kind = png ? cli_file_kind_of(png) : CLI_FILE_OTHER;
+    exposure_lock xl = {nframes > 1 && !o->exposure_per_frame, 0, 0};
     atmos_image *spec = NULL;
     atmos_status st = ATMOS_OK;
     double total = 0;
     for (int frame = 1; frame <= nframes && st == ATMOS_OK; frame++) {
         *failed_frame = frame;
-        static frame_files ff;
         atmos_scene fs;
         atmos_frame f;
         atmos_render_info info;
         char label[64];
         snprintf(label, sizeof label, "%d/%d", frame, nframes);
-        if ((st = atmos_scene_animation_frame(ctx, scene, frame - 1, &fs)) != ATMOS_OK) break;
-        if (!name_frame_files(o, png, frame, nframes, &ff)) {
-            fprintf(stderr, "atmos render: an output path is too long for numbered frames\n");
-            return ATMOS_E_INVALID_ARG;
+        if (frame > 1 && stage_frame(o, png, frame, nframes, &fo->ff, &fo->set, &fo->w) != CLI_EXIT_OK) {
+            st = ATMOS_E_IO;
+            break;
         }
-        protect_outputs(ff.png, ff.exr, ff.pfm);
+        if ((st = atmos_scene_animation_frame(ctx, scene, frame - 1, &fs)) != ATMOS_OK) break;
         if ((st = atmos_frame_from_scene(ctx, &fs, &f)) != ATMOS_OK) break;
         if (!spec && (st = atmos_plan_image_create(plan, &f, &spec)) != ATMOS_OK) break;
         if ((st = atmos_plan_render(plan, &f, NULL, spec, &info)) != ATMOS_OK) break;
-        if ((st = write_outputs(ctx, plan, &fs, spec, &ff, source, nframes > 1 ? label : NULL)) != ATMOS_OK) break;
+        st = write_outputs(ctx, plan, &fs, spec, &fo->w, out_kind, source, nframes > 1 ? label : NULL, &xl);
+        if (st != ATMOS_OK) break;
+        if (cli_outputs_commit("render", &fo->set) != 0) {
+            st = ATMOS_E_IO;
+            break;
+        }
         total += info.seconds;
         if (!o->quiet) {
             if (prog->shown) fputc('\n', stderr), prog->shown = 0;
-            report_frame(plan, &fs, &ff, source, &info, frame, nframes, o->tau);
+            report_frame(plan, &fs, &fo->ff, source, &info, frame, nframes);
         }
     }
+    cli_outputs_discard(&fo->set);
     atmos_image_destroy(spec);
     if (st == ATMOS_OK && !o->quiet && nframes > 1)
-        fprintf(stderr, "atmos render: %d frames, %.3f s rendering (one plan: the volume and its optics made once)\n",
-                nframes, total);
+        fprintf(stderr, "atmos render: %d frames, %.3f s rendering (one plan: the volume and its optics made once)%s\n",
+                nframes, total, xl.locked ? "; exposure locked at frame 1's" : "");
     return st;
+}
+
+/* Each output's extension names the format written, no two outputs are the same file and
+ * none is an input (the scene file, the volume file). CLI_EXIT_OK or CLI_EXIT_USAGE. */
+static int check_outputs(const render_opts *o, const atmos_scene *scene, const char *png)
+{
+    const char *names[6] = {png, o->exr, o->pfm, o->variance, o->order, o->tau};
+    static const cli_file_kind want[6] = {CLI_FILE_OTHER, CLI_FILE_EXR, CLI_FILE_PFM, CLI_FILE_EXR, CLI_FILE_PFM, CLI_FILE_PFM};
+    static const char *const ext[4] = {"", ".png", ".exr", ".pfm"};
+    cli_outputs set = {0};
+    for (int i = 0; i < 6; i++) {
+        if (!names[i]) continue;
+        const cli_file_kind k = cli_file_kind_of(names[i]);
+        if (i == 0 && k == CLI_FILE_OTHER)
+            return cli_usage_error("render", "-o %s: the extension names no format atmos writes (.png, .exr or .pfm)",
+                                   names[i]);
+        if (i > 0 && k != want[i])
+            return cli_usage_error("render", "%s %s: expected a %s file name", out_option[i], names[i], ext[want[i]]);
+        cli_outputs_add(&set, out_option[i], names[i]);
+    }
+    const char *vol = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) ? scene->volume.source : NULL;
+    const char *inputs[2] = {o->scene_path, vol};
+    return cli_outputs_check("render", &set, inputs, 2);
 }
 
 /* The scene: the file or the default, the options applied, validated. Returns CLI_EXIT_OK
@@ -249,16 +323,25 @@ int cli_cmd_render(int argc, char **argv)
         default_png_name(scene.name, default_png, sizeof default_png);
         png = default_png;
     }
+    const int nframes = scene.animation.frames > 1 ? scene.animation.frames : 1;
+    /* Every output checked, its folder made and its staging file created before any work. */
+    static frame_outputs fo;
+    if ((rc = check_outputs(&o, &scene, png)) != CLI_EXIT_OK ||
+        (rc = stage_frame(&o, png, 1, nframes, &fo.ff, &fo.set, &fo.w)) != CLI_EXIT_OK) {
+        atmos_context_destroy(ctx);
+        return rc;
+    }
     atmos_plan *plan = NULL;
     int failed = 0;
     atmos_status st = atmos_plan_create(ctx, &scene, NULL, NULL, &plan);
-    if (st == ATMOS_OK && o.tau) st = write_tau(ctx, &scene, plan, o.tau);
-    if (st == ATMOS_OK) st = render_frames(ctx, plan, &scene, &o, png, source, &prog, &failed);
+    if (st == ATMOS_OK && fo.w.tau) st = write_tau(ctx, &scene, plan, fo.w.tau);
+    if (st == ATMOS_OK) st = render_frames(ctx, plan, &scene, &o, png, source, &prog, &fo, &failed);
+    cli_outputs_discard(&fo.set);
     if (st != ATMOS_OK) {
         if (prog.shown) fputc('\n', stderr);
-        const int nframes = scene.animation.frames > 1 ? scene.animation.frames : 1;
         if (nframes > 1 && failed >= 1) fprintf(stderr, "atmos render: frame %d/%d failed\n", failed, nframes);
-        rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
+        if (st == ATMOS_E_IO && !atmos_context_error(ctx)[0]) rc = CLI_EXIT_RUNTIME; /* an output's message printed */
+        else rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
     }
     atmos_plan_destroy(plan);
     atmos_context_destroy(ctx);

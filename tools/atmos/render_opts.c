@@ -13,7 +13,7 @@
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
     O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_VPOS, O_DSCALE, O_TAU, O_VARIANCE,
-    O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS,
+    O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS, O_EXP_PER_FRAME,
     O_SETTING = 1024 /* + row index over the tables: a renderer setting */
 };
 
@@ -34,6 +34,7 @@ static const struct option fixed_opts[] = {
     {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
     {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
     {"atmosphere", required_argument, 0, O_ATMOSPHERE}, {"thickness", required_argument, 0, O_THICKNESS},
+    {"exposure-per-frame", no_argument, 0, O_EXP_PER_FRAME},
     {"help", no_argument, 0, 'h'}};
 #define NFIXED ((int)(sizeof fixed_opts / sizeof fixed_opts[0]))
 
@@ -137,6 +138,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_TIME: o->time = arg; return 1;
     case O_TIME_END: o->time_end = arg; return 1;
     case O_EXRHALF: o->exr_half = 1; return 1;
+    case O_EXP_PER_FRAME: o->exposure_per_frame = 1; return 1;
     case O_RGB: o->rgb = 1; return 1;
     case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
@@ -389,12 +391,18 @@ void render_opts_help(void)
     printf("Usage: atmos render [SCENE.json] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
            "Renders a scene file, or the built-in default scene when none is given.\n"
            "With no output option, writes NAME.png in the current directory (NAME = the scene's name).\n\n"
-           "Outputs:\n"
-           "  -o, --output FILE.png   tone-mapped sRGB PNG (8 or 16 bit, see --png-bits)\n"
+           "Outputs (the format is the extension's; folders are created; every output is checked\n"
+           "before rendering and all are written or none: two options naming the same file, or\n"
+           "an output that is an input, are refused):\n"
+           "  -o, --output FILE       .png: tone-mapped sRGB PNG (8 or 16 bit, see --png-bits);\n"
+           "                          .exr or .pfm: the HDR image, as --exr / --pfm write it\n"
            "      --exr FILE.exr      HDR OpenEXR: linear sRGB + alpha, Y in cd/m^2, scene metadata\n"
+           "                          (numbers as numbers) and the chromaticities (Rec. 709, D65)\n"
            "      --pfm FILE.pfm      HDR portable float map (linear sRGB, 3 channels)\n"
            "      --png-bits 8|16     PNG bit depth (default: scene, 8)\n"
-           "      --exr-half          write EXR as 16-bit half floats (default: 32-bit float)\n"
+           "      --exr-half          write EXR as 16-bit half floats (default: 32-bit float); values\n"
+           "                          beyond the largest half (65504, e.g. the sun's disc) are clamped\n"
+           "                          to 65504 with a warning\n"
            "      --tau FILE.pfm      also write the volume's optical depth along each pixel's ray\n"
            "                          (middle wavelength of the set; a key for atmos compare --by)\n"
            "      --variance FILE.exr path: per-pixel variance of the mean (channels var_<nm>nm per\n"
@@ -414,6 +422,8 @@ void render_opts_help(void)
            "      --rgb                     the paper's three channels (680, 550, 440 nm)\n"
            "      --exposure EV|auto        manual exposure (EV100, daylight ~15) or automatic\n"
            "      --exposure-comp STOPS     compensation added to automatic exposure\n"
+           "      --exposure-per-frame      animations: automatic exposure chosen for each frame; by\n"
+           "                                default the first frame's is kept for all (a locked exposure)\n"
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
            "      --renderer sky|slice|path the atmosphere alone (default), Riley et al.'s half-angle slicing\n"
@@ -433,6 +443,8 @@ void render_opts_help(void)
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
            "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
            "                                out/sky_0001.png ...; --frames 1: the first frame, as named\n"
+           "                                (automatic exposure: the first frame's for all frames,\n"
+           "                                see --exposure-per-frame)\n"
            "      --time-end T              the last frame's UTC time (a sun given by time); frames are\n"
            "                                spaced evenly in time from the scene's (or --time's) time\n"
            "      --sun-elevation-end E     the last frame's sun elevation (a sun given by angles)\n"

@@ -20,6 +20,7 @@ typedef struct {
     /* outputs */
     const char *png, *exr, *pfm, *variance, *order, *tau;
     int png_bits, exr_half;
+    int exposure_per_frame; /* an animation's automatic exposure chosen per frame, not locked */
     /* scene overrides (0 / NaN / NULL / -1: not given) */
     int width, height, spp, spectral, rgb, cam_type, renderer, tone, exposure_auto, frames, air;
     double altitude, sun_el, sun_az, lat, lon, ev, ev_comp, sun_el_end, sun_az_end, density_scale, thickness;

@@ -1,0 +1,187 @@
+#!/bin/sh
+# atmos render's outputs are what their names say and are written all or none: the format
+# by the extension, half-float EXRs without overflow, the variance EXR's channel names, the
+# EXR header (render metadata, chromaticities, numbers as numbers), folders created, every
+# output checked before rendering, no output written twice or over an input, no temporary
+# left by SIGTERM, and one exposure over an animation.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/cli_outputs.$$
+mkdir -p "$T"
+export XDG_CACHE_HOME="$T/cache"
+fail=0; pass=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
+S="--width 32 --height 16"
+# A path-traced cloud of analytic particles (no optical table to build).
+cat > "$T/path.json" <<'EOF'
+{
+  "image": {"width": 24, "height": 16},
+  "sun": {"elevation_deg": 22, "azimuth_deg": 235},
+  "particles": {"cloud": {"kind": "analytic", "lobes": [{"type": "hg", "g": 0.8}], "sigma_ext_m2": 6.28e-10}},
+  "renderer": "path",
+  "volume": {"generate": "cumulus"},
+  "path": {"spp": 2}
+}
+EOF
+P="$T/path.json"
+
+# The header of an EXR as lines "name type value" (string, int, double, chromaticities,
+# and the channel list as "channels chlist A,B,G,R").
+exr_header() {
+    python3 - "$1" <<'PY'
+import struct, sys
+b = open(sys.argv[1], "rb").read()
+assert b[:4] == b"\x76\x2f\x31\x01", "not an EXR"
+i = 8
+while b[i] != 0:
+    j = b.index(b"\0", i); name = b[i:j].decode()
+    k = b.index(b"\0", j + 1); typ = b[j + 1:k].decode()
+    n = struct.unpack("<i", b[k + 1:k + 5])[0]; v = b[k + 5:k + 5 + n]; i = k + 5 + n
+    if typ == "string": v = v.decode()
+    elif typ == "int": v = struct.unpack("<i", v)[0]
+    elif typ == "double": v = repr(struct.unpack("<d", v)[0])
+    elif typ == "chromaticities": v = ",".join("%.4f" % x for x in struct.unpack("<8f", v))
+    elif typ == "chlist":
+        names, p = [], 0
+        while v[p] != 0:
+            e = v.index(b"\0", p); names.append(v[p:e].decode()); p = e + 1 + 16
+        v = ",".join(names)
+    else: v = "-"
+    print(name, typ, v)
+PY
+}
+
+# 1. The writer by the extension; other extensions refused before rendering.
+"$A" render -q $S -o "$T/o.exr" && ok || bad "-o x.exr"
+[ "$(head -c 4 "$T/o.exr" | od -An -tx1 | tr -d ' ')" = "762f3101" ] && ok || bad "-o x.exr did not write an OpenEXR file"
+"$A" render -q $S -o "$T/o.PFM" && ok || bad "-o x.PFM"
+[ "$(head -c 3 "$T/o.PFM" | od -An -c | tr -d ' ')" = 'PF\n' ] && ok || bad "-o x.PFM did not write a PFM"
+"$A" render -q $S -o "$T/o.png" && [ "$(head -c 4 "$T/o.png" | od -An -c | tr -d ' ')" = "211PNG" ] && ok || bad "-o x.png"
+for name in o.jpg o.tiff noext; do
+    "$A" render -q $S -o "$T/$name" 2>"$T/err"; rc=$?
+    [ $rc -eq 2 ] && [ ! -e "$T/$name" ] && grep -q "extension" "$T/err" && ok || bad "-o $name: rc $rc, $(cat "$T/err")"
+done
+"$A" render -q $S --exr "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && [ ! -e "$T/x.png" ] && ok || bad "--exr x.png should exit 2"
+"$A" render -q $S --pfm "$T/x.exr" 2>/dev/null; [ $? -eq 2 ] && [ ! -e "$T/x.exr" ] && ok || bad "--pfm x.exr should exit 2"
+
+# 2. Half floats: the sun (~1e9 cd/m^2 in the float file) is clamped to 65504 with a
+# warning, not stored as infinity.
+"$A" render $S --exr "$T/f.exr" 2>/dev/null && "$A" render $S --exr "$T/h.exr" --exr-half 2>"$T/herr" && ok || bad "--exr-half"
+grep -q "clamped to 65504" "$T/herr" && ok || bad "--exr-half: no warning about clamping ($(cat "$T/herr"))"
+out=$("$A" compare "$T/h.exr" "$T/f.exr" --json 2>&1)
+echo "$out" | grep -q '"nonfinite": 0}' && ok || bad "--exr-half wrote non-finite values: $out"
+
+# 3 and 4. The variance EXR (rgb): named channels and the render's metadata; every EXR
+# carries the chromaticities and numbers as numbers.
+"$A" render -q $P --rgb --exr "$T/p.exr" --variance "$T/v.exr" && ok || bad "path render --variance"
+exr_header "$T/v.exr" > "$T/vh" || bad "variance EXR unreadable"
+grep -q "^channels chlist var_440.0nm,var_550.0nm,var_680.0nm,var_Y$" "$T/vh" && ok || bad "variance channels: $(grep chlist "$T/vh")"
+for key in "atmos:scene string" "atmos:renderer string path" "atmos:sun_elevation_deg double 22.0" \
+    "atmos:sun_azimuth_deg double 235.0" "atmos:threads int" "atmos:version string" "atmos:wavelengths_nm string 680.0 550.0 440.0"; do
+    grep -q "^$key" "$T/vh" && ok || bad "variance EXR lacks '$key'"
+done
+for f in o.exr f.exr h.exr p.exr v.exr; do
+    exr_header "$T/$f" > "$T/hdr"
+    grep -q "^chromaticities chromaticities 0.6400,0.3300,0.3000,0.6000,0.1500,0.0600,0.3127,0.3290$" "$T/hdr" \
+        && ok || bad "$f: no Rec. 709 / D65 chromaticities"
+done
+exr_header "$T/p.exr" > "$T/hdr"
+grep -q "^atmos:path_mean_rel_error double" "$T/hdr" && ok || bad "p.exr: error figure not a double"
+grep -q "^atmos:render_seconds double" "$T/hdr" && ok || bad "p.exr: render time not a double"
+
+# 5. Missing folders are created; an output that cannot be written fails the command
+# before rendering, and no other output is written or replaced.
+"$A" render -q $S -o "$T/new/sub/a.png" --exr "$T/new/b.exr" && [ -s "$T/new/sub/a.png" ] && [ -s "$T/new/b.exr" ] \
+    && ok || bad "outputs in missing folders"
+: > "$T/plain"
+cp "$T/f.exr" "$T/keep.exr"
+t0=$(date +%s)
+"$A" render -q $P --spp 20000 --exr "$T/keep.exr" --pfm "$T/plain/x.pfm" 2>"$T/err"; rc=$?
+t1=$(date +%s)
+[ $rc -eq 1 ] && grep -q "plain" "$T/err" && ok || bad "an unwritable output: rc $rc, $(cat "$T/err")"
+[ $((t1 - t0)) -le 5 ] && ok || bad "an unwritable output was found after $((t1 - t0)) s of rendering"
+cmp -s "$T/keep.exr" "$T/f.exr" && ok || bad "the other output was replaced though the command failed"
+mkdir "$T/adir.pfm"
+"$A" render -q $S --pfm "$T/adir.pfm" --exr "$T/keep.exr" 2>/dev/null; [ $? -ne 0 ] && cmp -s "$T/keep.exr" "$T/f.exr" \
+    && ok || bad "an output that is a folder"
+
+# 6. No output twice, none over an input.
+"$A" render -q $S -o "$T/d.pfm" --pfm "$T/../$(basename "$T")/./d.pfm" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q "same file" "$T/err" && [ ! -e "$T/d.pfm" ] && ok || bad "the same PFM twice: rc $rc"
+"$A" render -q $P --pfm "$T/d.pfm" --tau "$T/d.pfm" 2>/dev/null; [ $? -eq 2 ] && [ ! -e "$T/d.pfm" ] && ok || bad "--pfm X --tau X"
+"$A" render -q $S -o "$T/d.exr" --exr "$T/d.exr" 2>/dev/null; [ $? -eq 2 ] && ok || bad "-o X.exr --exr X.exr"
+ln -s "$T/f.exr" "$T/link.exr"
+"$A" render -q $S --exr "$T/link.exr" -o "$T/f.exr" 2>/dev/null; [ $? -eq 2 ] && ok || bad "an output and a link to it"
+cp "$T/f.exr" "$T/ref.exr"
+"$A" render -q $S --pfm "$T/a.pfm" && ok || bad "render a.pfm"
+cp "$T/a.pfm" "$T/a0.pfm"
+ln -s a.pfm "$T/heat.png"
+"$A" compare "$T/f.exr" "$T/a.pfm" --heatmap "$T/heat.png" >/dev/null 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && cmp -s "$T/a.pfm" "$T/a0.pfm" && ok || bad "compare --heatmap over its reference: rc $rc, $(cat "$T/err")"
+"$A" compare "$T/f.exr" "$T/a.pfm" --heatmap "$T/a.pfm" >/dev/null 2>&1; [ $? -eq 2 ] && cmp -s "$T/a.pfm" "$T/a0.pfm" \
+    && ok || bad "compare A B --heatmap B"
+cp "$T/f.exr" "$T/f2.exr"
+"$A" compare "$T/f.exr" "$T/f2.exr" --heatmap "$T/fine.png" >/dev/null && [ -s "$T/fine.png" ] && ok || bad "compare --heatmap"
+
+# 7. SIGTERM while the outputs are written leaves no temporary and no partial output.
+mkdir "$T/sig"
+"$A" render -q $P --width 512 --height 512 --spp 1 --spectral 16 \
+    --variance "$T/sig/v.exr" --order "$T/sig/o.pfm" --tau "$T/sig/t.pfm" --pfm "$T/sig/p.pfm" 2>/dev/null &
+pid=$!
+n=0
+while [ -z "$(ls "$T/sig" | grep tmp)" ] && [ $n -lt 1200 ] && kill -0 $pid 2>/dev/null; do sleep 0.02; n=$((n + 1)); done
+kill -TERM $pid 2>/dev/null
+wait $pid; rc=$?
+[ $rc -ne 0 ] && ok || bad "a terminated run should fail (rc $rc)"
+[ -z "$(ls "$T/sig")" ] && ok || bad "SIGTERM left: $(ls "$T/sig")"
+
+# 8. One exposure over an animation: the sun setting from 12 to -1 degrees makes each
+# frame darker than the one before (mean display value of the PNGs); per frame on request.
+"$A" render -q --width 48 --height 27 --frames 5 --sun-elevation 12 --sun-elevation-end -1 -o "$T/an/s.png" \
+    && ok || bad "animation"
+"$A" render -q --width 48 --height 27 --frames 5 --sun-elevation 12 --sun-elevation-end -1 -o "$T/pf/s.png" \
+    --exposure-per-frame && ok || bad "animation --exposure-per-frame"
+"$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/one.png" && ok || bad "single render"
+python3 - "$T/an" "$T/pf" "$T/one.png" <<'PY' && ok || bad "exposure over the animation"
+import os, struct, sys, zlib
+def mean(path):
+    b = open(path, "rb").read()
+    w, h, depth, ctype = struct.unpack(">IIBB", b[16:26])
+    assert depth == 8 and ctype in (2, 6)
+    i, data = 8, b""
+    while i < len(b):
+        n = struct.unpack(">I", b[i:i + 4])[0]
+        if b[i + 4:i + 8] == b"IDAT": data += b[i + 8:i + 8 + n]
+        i += 12 + n
+    raw, bpp = zlib.decompress(data), 3 if ctype == 2 else 4
+    stride, prev, tot, p = w * bpp, bytearray(w * bpp), 0, 0
+    for _ in range(h):
+        f, line = raw[p], bytearray(raw[p + 1:p + 1 + stride]); p += 1 + stride
+        for x in range(stride):
+            a = line[x - bpp] if x >= bpp else 0
+            c = prev[x - bpp] if x >= bpp else 0
+            up = prev[x]
+            if f == 1: line[x] = (line[x] + a) & 255
+            elif f == 2: line[x] = (line[x] + up) & 255
+            elif f == 3: line[x] = (line[x] + (a + up) // 2) & 255
+            elif f == 4:
+                pa, pb, pc = abs(up - c), abs(a - c), abs(a + up - 2 * c)
+                line[x] = (line[x] + (a if pa <= pb and pa <= pc else up if pb <= pc else c)) & 255
+        prev = line
+        tot += sum(line[x] for x in range(stride) if x % bpp < 3)
+    return tot / (w * h * 3)
+locked = [mean(os.path.join(sys.argv[1], "s_%04d.png" % k)) for k in range(1, 6)]
+free = [mean(os.path.join(sys.argv[2], "s_%04d.png" % k)) for k in range(1, 6)]
+print("locked", ["%.1f" % m for m in locked], "per frame", ["%.1f" % m for m in free])
+assert all(b < a for a, b in zip(locked, locked[1:])), "not darker frame by frame"
+# The scene's mean luminance falls to a fifth from frame 1 (12 deg) to frame 4 (2.25 deg):
+# with one exposure the display falls clearly too (per-frame exposure keeps it at ~0.94).
+assert locked[3] < 0.75 * locked[0], "frame 4 is nearly as bright as frame 1: re-exposed"
+assert mean(sys.argv[3]) == locked[0] == free[0], "the first frame is not exposed as a single render"
+assert free[3] > 1.5 * locked[3], "--exposure-per-frame does not re-expose"
+PY
+
+rm -rf "$T"
+echo "render_outputs: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]

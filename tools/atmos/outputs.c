@@ -1,0 +1,256 @@
+/* Output files written all or none (outputs.h). */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include "outputs.h"
+
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+cli_file_kind cli_file_kind_of(const char *path)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash)) return CLI_FILE_OTHER;
+    if (!strcasecmp(dot, ".png")) return CLI_FILE_PNG;
+    if (!strcasecmp(dot, ".exr")) return CLI_FILE_EXR;
+    if (!strcasecmp(dot, ".pfm")) return CLI_FILE_PFM;
+    return CLI_FILE_OTHER;
+}
+
+/* ------------------------------------------------ temporaries removed on signals ---- */
+
+/* Every staging file and the writer's temporary next to it (STAGE.tmpPID, as the
+ * library's atomic writes name them). A slot is filled before its flag is set, so the
+ * handler reads only whole names; unlink is async-signal-safe. */
+#define SLOTS (2 * CLI_OUTPUTS_MAX)
+static char slot_name[SLOTS][CLI_OUTPUT_PATH_MAX + 64];
+static volatile sig_atomic_t slot_used[SLOTS];
+
+static void on_signal(int sig)
+{
+    for (int i = 0; i < SLOTS; i++)
+        if (slot_used[i]) unlink(slot_name[i]);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+static void register_stage(int i, const char *stage)
+{
+    static int installed;
+    if (!installed) {
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_signal;
+        sigemptyset(&sa.sa_mask);
+        sigaction(SIGINT, &sa, NULL);
+        sigaction(SIGTERM, &sa, NULL);
+        installed = 1;
+    }
+    slot_used[2 * i] = slot_used[2 * i + 1] = 0;
+    snprintf(slot_name[2 * i], sizeof slot_name[0], "%s", stage);
+    snprintf(slot_name[2 * i + 1], sizeof slot_name[0], "%s.tmp%ld", stage, (long)getpid());
+    slot_used[2 * i] = slot_used[2 * i + 1] = 1;
+}
+
+static void unregister_stage(int i) { slot_used[2 * i] = slot_used[2 * i + 1] = 0; }
+
+/* ------------------------------------------------------------------ the set ---- */
+
+int cli_outputs_add(cli_outputs *set, const char *option, const char *path)
+{
+    if (!path || set->n >= CLI_OUTPUTS_MAX) return -1;
+    cli_output *o = &set->f[set->n];
+    o->option = option, o->path = path, o->stage[0] = '\0';
+    return set->n++;
+}
+
+const char *cli_outputs_stage(const cli_outputs *set, int i) { return set->f[i].stage; }
+
+/* The path made absolute with '.', '..' and repeated '/' removed; the folder part resolved
+ * by realpath when it exists (symbolic links followed). 0 when it does not fit. */
+static int normalise(const char *path, char *out, size_t cap)
+{
+    char abs[2 * CLI_OUTPUT_PATH_MAX + 2], joined[sizeof abs + CLI_OUTPUT_PATH_MAX], cwd[CLI_OUTPUT_PATH_MAX];
+    if (path[0] == '/') {
+        snprintf(abs, sizeof abs, "%s", path);
+    } else {
+        if (!getcwd(cwd, sizeof cwd)) return 0;
+        snprintf(abs, sizeof abs, "%s/%s", cwd, path);
+    }
+    char *slash = strrchr(abs, '/');
+    *slash = '\0';
+    char *real = realpath(abs[0] ? abs : "/", NULL);
+    *slash = '/';
+    if (real) snprintf(joined, sizeof joined, "%s/%s", real, slash + 1);
+    else snprintf(joined, sizeof joined, "%s", abs);
+    free(real);
+    path = joined;
+    /* lexical clean-up, component by component */
+    size_t len = 0;
+    for (const char *p = path; *p;) {
+        while (*p == '/') p++;
+        const char *e = strchr(p, '/');
+        size_t n = e ? (size_t)(e - p) : strlen(p);
+        if (n == 0) break;
+        if (n == 2 && p[0] == '.' && p[1] == '.') {
+            while (len > 0 && out[len - 1] != '/') len--;
+            if (len > 0) len--;
+        } else if (!(n == 1 && p[0] == '.')) {
+            if (len + 1 + n + 1 > cap) return 0;
+            out[len++] = '/';
+            memcpy(out + len, p, n);
+            len += n;
+        }
+        p += n;
+    }
+    if (len == 0) out[len++] = '/';
+    out[len] = '\0';
+    return 1;
+}
+
+/* Whether a and b name the same file: equal normalised paths, or both existing with the
+ * same device and inode (hard links, symbolic links). */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino) return 1;
+    char na[CLI_OUTPUT_PATH_MAX + 2], nb[CLI_OUTPUT_PATH_MAX + 2];
+    return normalise(a, na, sizeof na) && normalise(b, nb, sizeof nb) && !strcmp(na, nb);
+}
+
+int cli_outputs_check(const char *cmd, const cli_outputs *set, const char *const *inputs, int ninputs)
+{
+    for (int i = 0; i < set->n; i++) {
+        const cli_output *o = &set->f[i];
+        if (!o->path[0]) return fprintf(stderr, "atmos %s: %s: empty file name\n", cmd, o->option), 2;
+        if (strlen(o->path) >= CLI_OUTPUT_PATH_MAX)
+            return fprintf(stderr, "atmos %s: %s: the path is too long\n", cmd, o->option), 2;
+        for (int k = 0; k < i; k++)
+            if (same_file(o->path, set->f[k].path)) {
+                fprintf(stderr, "atmos %s: %s %s and %s %s name the same file: one would overwrite the other\n", cmd,
+                        set->f[k].option, set->f[k].path, o->option, o->path);
+                return 2;
+            }
+        for (int k = 0; k < ninputs; k++)
+            if (inputs[k] && same_file(o->path, inputs[k])) {
+                fprintf(stderr, "atmos %s: %s %s is the input file %s: refusing to overwrite an input\n", cmd,
+                        o->option, o->path, inputs[k]);
+                return 2;
+            }
+    }
+    return 0;
+}
+
+/* mkdir -p of the folder part of path. 0 or errno, with the failing folder in bad. */
+static int make_parents(const char *path, char *bad, size_t cap)
+{
+    char dir[CLI_OUTPUT_PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    if (!slash || slash == path) return 0;
+    snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    for (char *p = dir + 1;; p++) {
+        if (*p != '/' && *p) continue;
+        const char c = *p;
+        *p = '\0';
+        struct stat sb;
+        if (stat(dir, &sb) != 0 && mkdir(dir, 0777) != 0 && errno != EEXIST) {
+            snprintf(bad, cap, "%s", dir);
+            return errno;
+        }
+        if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
+            snprintf(bad, cap, "%s", dir);
+            return ENOTDIR;
+        }
+        if (!c) return 0;
+        *p = c;
+    }
+}
+
+int cli_outputs_prepare(const char *cmd, cli_outputs *set)
+{
+    for (int i = 0; i < set->n; i++) {
+        cli_output *o = &set->f[i];
+        char bad[CLI_OUTPUT_PATH_MAX];
+        int e = make_parents(o->path, bad, sizeof bad);
+        struct stat sb;
+        const char *why = NULL;
+        if (e) {
+            fprintf(stderr, "atmos %s: %s %s: cannot create the folder %s: %s\n", cmd, o->option, o->path, bad, strerror(e));
+        } else if (lstat(o->path, &sb) == 0 && !S_ISREG(sb.st_mode)) {
+            why = S_ISLNK(sb.st_mode) ? "a symbolic link" : S_ISDIR(sb.st_mode) ? "a folder" : "a device or FIFO";
+            fprintf(stderr, "atmos %s: %s %s: exists and is %s; refusing to replace it\n", cmd, o->option, o->path, why);
+            e = 1;
+        } else {
+            snprintf(o->stage, sizeof o->stage, "%s.tmp%ld", o->path, (long)getpid());
+            register_stage(i, o->stage);
+            errno = 0;
+            FILE *f = fopen(o->stage, "wb");
+            if (!f || fclose(f) != 0) {
+                e = errno ? errno : EIO;
+                fprintf(stderr, "atmos %s: %s %s: cannot write there: %s\n", cmd, o->option, o->path, strerror(e));
+            }
+        }
+        if (e) {
+            cli_outputs_discard(set);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int cli_outputs_commit(const char *cmd, cli_outputs *set)
+{
+    for (int i = 0; i < set->n; i++) {
+        struct stat sb;
+        if (stat(set->f[i].stage, &sb) != 0 || sb.st_size == 0) {
+            fprintf(stderr, "atmos %s: %s %s was not written\n", cmd, set->f[i].option, set->f[i].path);
+            cli_outputs_discard(set);
+            return 1;
+        }
+    }
+    for (int i = 0; i < set->n; i++) {
+        cli_output *o = &set->f[i];
+        if (rename(o->stage, o->path) != 0) {
+            fprintf(stderr, "atmos %s: %s: cannot rename %s into place: %s\n", cmd, o->path, o->stage, strerror(errno));
+            cli_outputs_discard(set);
+            return 1;
+        }
+        unregister_stage(i);
+        o->stage[0] = '\0';
+    }
+    return 0;
+}
+
+void cli_outputs_discard(cli_outputs *set)
+{
+    for (int i = 0; i < set->n; i++) {
+        cli_output *o = &set->f[i];
+        if (!o->stage[0]) continue;
+        unlink(o->stage);
+        unlink(slot_name[2 * i + 1]);
+        unregister_stage(i);
+        o->stage[0] = '\0';
+    }
+}
+
+void cli_outputs_final_names(const char *msg, char *out, size_t cap)
+{
+    char suffix[32];
+    const int n = snprintf(suffix, sizeof suffix, ".tmp%ld", (long)getpid());
+    size_t len = 0;
+    if (!cap) return;
+    for (const char *p = msg; *p && len + 1 < cap;) {
+        const char *q = strstr(p, suffix);
+        const size_t k = q ? (size_t)(q - p) : strlen(p);
+        const size_t take = k < cap - 1 - len ? k : cap - 1 - len;
+        memcpy(out + len, p, take);
+        len += take;
+        if (!q) break;
+        p = q + n;
+    }
+    out[len] = '\0';
+}

@@ -1,0 +1,57 @@
+/* The output files of a command, written all or none.
+ *
+ * Before any work: each name's extension says its format, no two outputs are the same
+ * file and no output is one of the command's input files (cli_outputs_check). Then, still
+ * before the work, the missing parent folders are created and an empty staging file is
+ * made next to each output (cli_outputs_prepare): a folder or file that cannot be
+ * written fails the command before anything is rendered. The writers write the staging
+ * files; cli_outputs_commit renames them all onto the final names at the end, and any
+ * failure removes them (cli_outputs_discard) so that no output is replaced. SIGINT and
+ * SIGTERM remove the staging files and the writers' temporaries before the process
+ * ends by the signal. */
+#ifndef ATMOS_CLI_OUTPUTS_H
+#define ATMOS_CLI_OUTPUTS_H
+
+#include <stddef.h>
+
+typedef enum { CLI_FILE_OTHER = 0, CLI_FILE_PNG, CLI_FILE_EXR, CLI_FILE_PFM } cli_file_kind;
+
+/* The format a file name's extension names (case-insensitive .png, .exr, .pfm). */
+cli_file_kind cli_file_kind_of(const char *path);
+
+#define CLI_OUTPUTS_MAX 8
+#define CLI_OUTPUT_PATH_MAX 4096
+
+typedef struct {
+    const char *option; /* the option that named it, for messages ("-o", "--exr") */
+    const char *path;   /* the final name */
+    char stage[CLI_OUTPUT_PATH_MAX + 32]; /* written here, renamed to path by commit */
+} cli_output;
+
+typedef struct {
+    int n;
+    cli_output f[CLI_OUTPUTS_MAX];
+} cli_outputs;
+
+/* Adds an output (path NULL: nothing); returns its index or -1 when path is NULL. */
+int cli_outputs_add(cli_outputs *set, const char *option, const char *path);
+/* The name a writer should write output i to (its staging file). */
+const char *cli_outputs_stage(const cli_outputs *set, int i);
+
+/* No output twice (the same file after normalising the path, or the same existing file
+ * by device and inode) and no output that is one of inputs[0..ninputs) (NULL entries
+ * skipped). Returns 0 (CLI_EXIT_OK) or 2 (CLI_EXIT_USAGE) with a message on stderr. */
+int cli_outputs_check(const char *cmd, const cli_outputs *set, const char *const *inputs, int ninputs);
+/* Creates missing parent folders, refuses outputs that exist and are not regular files,
+ * and creates the staging files. Returns 0 or 1 (CLI_EXIT_RUNTIME) with a message on
+ * stderr; on failure no staging file is left. */
+int cli_outputs_prepare(const char *cmd, cli_outputs *set);
+/* Renames every staging file onto its final name. Returns 0 or 1 (message printed). */
+int cli_outputs_commit(const char *cmd, cli_outputs *set);
+/* Removes the staging files (and the writers' temporaries next to them). */
+void cli_outputs_discard(cli_outputs *set);
+/* A message with the staging suffix (".tmpPID") taken out of the names it holds, so
+ * that the library's messages about a staging file name the output. */
+void cli_outputs_final_names(const char *msg, char *out, size_t cap);
+
+#endif
