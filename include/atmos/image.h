@@ -74,11 +74,17 @@ ATMOS_API atmos_status atmos_tonemap(atmos_context *ctx, const atmos_image *line
 ATMOS_API double atmos_srgb_encode(double linear);
 ATMOS_API double atmos_srgb_decode(double encoded);
 
-/* OpenEXR: single-part scanline file, ZIP compression. Channels R,G,B[,A] for
- * 3/4-channel images, otherwise named by channel_names (distinct, 1..255 bytes) or
- * "C0".."Cn". half: nonzero for 16-bit half floats, else 32-bit. Every metadata
- * entry becomes a string attribute; keys that are standard attributes of another
- * type ("channels", ...) or the structural "type"/"name" give ATMOS_E_INVALID_ARG. */
+/* OpenEXR: single-part scanline file, ZIP compression. Channels named by
+ * channel_names when given (distinct, 1..255 bytes), else R,G,B[,A] for 3/4-channel
+ * images and "C0".."Cn" otherwise. half: nonzero for 16-bit half floats, else 32-bit;
+ * finite values beyond the largest half (+-65504) are written as +-65504, with a
+ * warning (ATMOS_LOG_WARN) that counts them, instead of becoming infinite (infinities
+ * and NaN are stored as they are). Every file carries the standard "chromaticities"
+ * attribute of linear sRGB (Rec. 709 primaries, D65 white) unless the metadata has that
+ * key. Every metadata entry becomes an attribute: a value that is a decimal number as a
+ * whole an int (integers that fit 32 bits, without a leading zero or '+') or a double
+ * attribute, anything else a string; keys that are standard attributes of another type
+ * ("channels", ...) or the structural "type"/"name" give ATMOS_E_INVALID_ARG. */
 typedef struct atmos_exr_desc {
     int half;
     const char *const *channel_names; /* optional, img->channels entries */
@@ -86,7 +92,8 @@ typedef struct atmos_exr_desc {
 ATMOS_API atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const char *path,
                                        const atmos_exr_desc *desc);
 /* Reads a scanline EXR (any channel count, half or float) into a float image;
- * string attributes are read back into img->meta. Channel order: R,G,B[,A] when the
+ * string, int and double attributes are read back into img->meta (numbers as text:
+ * %d, or the shortest %g that gives the double back). Channel order: R,G,B[,A] when the
  * file has exactly those, C0..Cn by number when it has exactly those, otherwise the
  * file's order (sorted by name, as OpenEXR stores them). Tiled, deep and subsampled
  * files: ATMOS_E_UNSUPPORTED. Malformed or truncated files: ATMOS_E_FORMAT; sizes
