@@ -106,6 +106,17 @@ mkdir "$T/adir.pfm"
 "$A" render -q $S --pfm "$T/adir.pfm" --exr "$T/keep.exr" 2>/dev/null; [ $? -ne 0 ] && cmp -s "$T/keep.exr" "$T/f.exr" \
     && ok || bad "an output that is a folder"
 
+# A write that fails after rendering (a file size limit: the small half-float EXR fits, the
+# PFM does not) replaces none of the outputs and leaves no temporary.
+mkdir -p "$T/fs"
+"$A" render -q --width 128 --height 128 --exr "$T/fs/keep.exr" --exr-half && cp "$T/fs/keep.exr" "$T/fs/keep0.exr" \
+    && ok || bad "render keep.exr"
+sh -c 'trap "" XFSZ; ulimit -f 100; exec "$@"' sh "$A" render -q --width 128 --height 128 --sun-elevation 40 \
+    --exr "$T/fs/keep.exr" --exr-half --pfm "$T/fs/new.pfm" 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] && grep -q "new.pfm" "$T/err" && ok || bad "a failed write: rc $rc, $(cat "$T/err")"
+cmp -s "$T/fs/keep.exr" "$T/fs/keep0.exr" && ok || bad "the EXR was replaced though the PFM failed"
+[ "$(ls "$T/fs")" = "$(printf 'keep.exr\nkeep0.exr')" ] && ok || bad "a failed write left: $(ls "$T/fs")"
+
 # 6. No output twice, none over an input.
 "$A" render -q $S -o "$T/d.pfm" --pfm "$T/../$(basename "$T")/./d.pfm" 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q "same file" "$T/err" && [ ! -e "$T/d.pfm" ] && ok || bad "the same PFM twice: rc $rc"
