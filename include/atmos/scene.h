@@ -45,11 +45,14 @@ typedef struct atmos_scene_volume {
     char particle[64];        /* particle type of a single-grid file: a preset or a "particles"
                                  entry ("" = "cloud") */
     double density_scale;     /* multiplies the densities (after the reader's unit conversion); 1 */
+    atmos_density_unit density_unit; /* files: what the values are (ATMOS_DENSITY_AUTO: the format's own) */
     int time_index;           /* NetCDF time step; 0 */
-    double voxel_size_m;      /* NetCDF resampling / generator voxel size; 0 = the source's */
+    double voxel_size_m;      /* NetCDF resampling / generator voxel size / other files: the voxel
+                                 edge replacing the file's; 0 = the source's */
     uint64_t seed;            /* generators; 1 */
-    double scale;             /* generators: extent factor; 1 */
-    int placed;               /* 1: position_m given; 0: centred 3 widths (>= 4 km) in front of the camera */
+    double scale;             /* generators: extent factor; VDB/NanoVDB/raw files: multiplies their
+                                 lengths (0.01 for centimetres); 1 */
+    int placed;               /* 1: position_m given; 0: atmos_scene_volume_offset's default */
     double position_m[3];     /* world position of the centre of the bottom face of the volume's box */
 } atmos_scene_volume;
 
@@ -116,6 +119,8 @@ typedef struct atmos_scene {
     atmos_scene_slice slice;
     atmos_scene_path path;
     atmos_scene_animation animation;
+    int camera_given;                     /* the scene file has a "camera" (a volume scene without
+                                             one is framed by atmos_scene_frame_volume) */
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
@@ -169,8 +174,19 @@ ATMOS_API atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_s
                                                double offset_m[3]);
 /* The shift that places a volume in a scene's world: position_m puts the centre of the
  * box's bottom face there; without it the box's centre is moved horizontally to three of
- * its widths (at least 4 km) in front of the scene's camera, at its own altitude. */
+ * its widths (at least 4 km) in front of the scene's camera, at its own altitude -- except
+ * for an OpenVDB/NanoVDB file (an artist's volume in its own local frame), whose box's base
+ * goes to ATMOS_SCENE_CLOUD_BASE_M above the ground. */
 ATMOS_API void atmos_scene_volume_offset(const atmos_scene *scene, const atmos_volume *volume, double offset_m[3]);
+#define ATMOS_SCENE_CLOUD_BASE_M 1500.0
+
+/* Points the scene's pinhole camera at a volume placed by offset_m so that its whole box is
+ * in view: looking at the box's centre along the camera's heading at view_elevation_deg
+ * (the view direction's elevation; negative: looking down), from the nearest distance that keeps the box's eight
+ * corners inside the field of view (with a 10 % margin), the camera at least 2 m above the
+ * ground. Other camera types and fields (up, fov) are kept. */
+ATMOS_API void atmos_scene_frame_volume(atmos_scene *scene, const atmos_volume *volume, const double offset_m[3],
+                                        double view_elevation_deg);
 
 /* Frame index (0-based, < the frame count) of the scene's animation: *out is the scene
  * with the sun moved as atmos_scene_animation describes and no animation left in it.

@@ -3,6 +3,7 @@
  * is rendered from that plan (atmos_plan_render, the same call atmos_render_scene makes). */
 #define _POSIX_C_SOURCE 200809L /* getpid */
 #include "render_opts.h"
+#include "render_scene.h"
 
 #include <signal.h>
 #include <stdio.h>
@@ -152,8 +153,8 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
 {
     if (nframes > 1) fprintf(stderr, "atmos render: frame %d/%d: ", frame, nframes);
     else fprintf(stderr, "atmos render: ");
-    fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s\n", source, fs->width, fs->height,
-            info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
+    fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source, fs->width,
+            fs->height, info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
     const char *files[5] = {ff->png, ff->exr, ff->pfm, ff->var, ff->ord};
     for (int i = 0; i < 5; i++)
         if (files[i]) fprintf(stderr, "  wrote %s\n", files[i]);
@@ -209,25 +210,6 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const at
     return st;
 }
 
-/* The scene: the file or the default, the options applied, validated. Returns CLI_EXIT_OK
- * or the exit status of the failure (message printed). */
-static int make_scene(atmos_context *ctx, const render_opts *o, atmos_scene *scene)
-{
-    atmos_status st;
-    if (o->scene_path) {
-        if ((st = atmos_scene_load(ctx, o->scene_path, scene)) != ATMOS_OK) return cli_runtime_error("render", ctx, st);
-    } else {
-        atmos_scene_defaults(scene);
-    }
-    int rc = render_opts_apply(ctx, o, scene);
-    if (rc != CLI_EXIT_OK) return rc;
-    if ((st = atmos_scene_validate(ctx, scene, o->scene_path ? o->scene_path : "options")) != ATMOS_OK) {
-        fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
-        return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
-    }
-    return CLI_EXIT_OK;
-}
-
 int cli_cmd_render(int argc, char **argv)
 {
     render_opts o;
@@ -239,7 +221,9 @@ int cli_cmd_render(int argc, char **argv)
     atmos_context *ctx = cli_context_with_progress(o.threads, o.quiet, cli_progress_bar, &prog);
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_scene scene;
-    if ((rc = make_scene(ctx, &o, &scene)) != CLI_EXIT_OK) {
+    atmos_volume *volume = NULL; /* loaded here when framed (render_scene.c), else by the plan */
+    if ((rc = render_scene_make(ctx, &o, &scene, &volume)) != CLI_EXIT_OK) {
+        atmos_volume_destroy(volume);
         atmos_context_destroy(ctx);
         return rc;
     }
@@ -251,9 +235,15 @@ int cli_cmd_render(int argc, char **argv)
     }
     atmos_plan *plan = NULL;
     int failed = 0;
-    atmos_status st = atmos_plan_create(ctx, &scene, NULL, NULL, &plan);
+    const double t0 = cli_now_s();
+    atmos_status st = atmos_plan_create(ctx, &scene, volume, NULL, &plan);
+    const double t_plan = cli_now_s() - t0;
     if (st == ATMOS_OK && o.tau) st = write_tau(ctx, &scene, plan, o.tau);
     if (st == ATMOS_OK) st = render_frames(ctx, plan, &scene, &o, png, source, &prog, &failed);
+    if (st == ATMOS_OK && !o.quiet)
+        fprintf(stderr, "atmos render: %.3f s in all: %.3f s for the plan (volume, optics tables), %.3f s rendering and "
+                        "writing\n",
+                cli_now_s() - t0, t_plan, cli_now_s() - t0 - t_plan);
     if (st != ATMOS_OK) {
         if (prog.shown) fputc('\n', stderr);
         const int nframes = scene.animation.frames > 1 ? scene.animation.frames : 1;
@@ -261,6 +251,7 @@ int cli_cmd_render(int argc, char **argv)
         rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
     }
     atmos_plan_destroy(plan);
+    atmos_volume_destroy(volume);
     atmos_context_destroy(ctx);
     return rc;
 }

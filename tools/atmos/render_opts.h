@@ -26,6 +26,13 @@ typedef struct {
     const char *time, *time_end, *volume;
     double volume_pos[3];
     int volume_pos_given;
+    /* the volume file (NULL / -1 / 0: not given) */
+    const char *grids, *particle;
+    int time_index, density_unit;
+    double voxel_size, volume_scale;
+    /* the camera (NaN / 0: not given) */
+    double fov, view_el, view_az, position[3], look_at[3];
+    int position_given, look_at_given;
     render_setting set[RENDER_OPTS_MAX_SETTINGS];
     int nset;
     /* the run */
@@ -38,5 +45,8 @@ void render_opts_help(void);
 /* Applies the options to a scene (loaded or the default); returns CLI_EXIT_OK or
  * CLI_EXIT_USAGE (message printed). ctx receives time-parsing errors. */
 int render_opts_apply(atmos_context *ctx, const render_opts *o, atmos_scene *scene);
+/* Nonzero when the options place the camera themselves (--position, --look-at, --altitude,
+ * --camera): a volume file is then not framed by default. */
+int render_opts_camera_given(const render_opts *o);
 
 #endif
