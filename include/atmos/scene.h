@@ -135,6 +135,18 @@ ATMOS_API atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, s
 /* Reads a file (at most 16 MiB) and parses it. */
 ATMOS_API atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene *out);
 
+/* The same with keys set from outside the text (atmos render -D, as Mitsuba's): each of the
+ * count overrides is "PATH=VALUE", PATH a JSON pointer ("/camera/fov_deg") or a dotted path
+ * ("camera.fov_deg", "camera.position_m.1"), VALUE JSON text ("35", "[0, 900, 0]",
+ * "\"path\"") or a bare word that is not JSON, taken as a string (renderer=path).
+ * Objects on the path are made as needed; array items are replaced (or appended at the
+ * array's size). Each value is then read with the rules and messages of the file's. The
+ * load's path "-" reads standard input (relative volume paths: from the current folder). */
+ATMOS_API atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t length, const char *source,
+                                              const char *const *overrides, int count, atmos_scene *out);
+ATMOS_API atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const char *const *overrides,
+                                             int count, atmos_scene *out);
+
 /* Checks a scene built or modified in code (CLI overrides) with the same rules
  * and messages as the parser, using source as the message prefix. */
 ATMOS_API atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, const char *source);

@@ -230,7 +230,8 @@ int cli_cmd_render(int argc, char **argv)
     const char *source = o.scene_path ? o.scene_path : "default scene", *png = o.png;
     char default_png[160];
     if (!o.png && !o.exr && !o.pfm) {
-        default_png_name(scene.name, default_png, sizeof default_png);
+        char stem[128];
+        default_png_name(render_scene_output_name(&o, &scene, stem, sizeof stem), default_png, sizeof default_png);
         png = default_png;
     }
     atmos_plan *plan = NULL;

@@ -40,7 +40,7 @@ static const struct option fixed_opts[] = {
     {"voxel-size", required_argument, 0, O_VOXEL}, {"volume-scale", required_argument, 0, O_VSCALE},
     {"fov", required_argument, 0, O_FOV}, {"view-elevation", required_argument, 0, O_VIEW_EL},
     {"view-azimuth", required_argument, 0, O_VIEW_AZ}, {"position", required_argument, 0, O_POSITION},
-    {"look-at", required_argument, 0, O_LOOKAT},
+    {"look-at", required_argument, 0, O_LOOKAT}, {"define", required_argument, 0, 'D'},
     {"help", no_argument, 0, 'h'}};
 #define NFIXED ((int)(sizeof fixed_opts / sizeof fixed_opts[0]))
 
@@ -265,8 +265,14 @@ int render_opts_parse(int argc, char **argv, render_opts *o)
     optind = 1;
     opterr = 0;
     int c;
-    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:qhD:", opts, NULL)) != -1) {
         if (c == 'h') return render_opts_help(), -1;
+        if (c == 'D') {
+            if (o->ndefines >= RENDER_OPTS_MAX_DEFINES) return cli_usage_error("render", "too many -D options");
+            if (!strchr(optarg, '=')) return cli_usage_error("render", "-D: expected KEY=VALUE, got '%s'", optarg);
+            o->defines[o->ndefines++] = optarg;
+            continue;
+        }
         if (c == 'q') {
             o->quiet = 1;
             continue;
@@ -488,9 +494,11 @@ static void help_settings(atmos_renderer_kind r, const char *title)
 
 void render_opts_help(void)
 {
-    printf("Usage: atmos render [SCENE.json] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
-           "Renders a scene file, or the built-in default scene when none is given.\n"
-           "With no output option, writes NAME.png in the current directory (NAME = the scene's name).\n\n"
+    printf("Usage: atmos render [SCENE.json|-] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
+           "Renders a scene file ('-': read from standard input), or the built-in default scene when none\n"
+           "is given. With no output option, writes NAME.png in the current directory (NAME = the scene\n"
+           "file's name without its extension; the scene's \"name\" for the default scene or standard input).\n"
+           "A volume file is rendered with --volume FILE (not as the scene).\n\n"
            "Outputs:\n"
            "  -o, --output FILE.png   tone-mapped sRGB PNG (8 or 16 bit, see --png-bits)\n"
            "      --exr FILE.exr      HDR OpenEXR: linear sRGB + alpha, Y in cd/m^2, scene metadata\n"
@@ -509,6 +517,14 @@ void render_opts_help(void)
            "                                (1..256); path tracer: its samples per pixel (below)\n"
            "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
            "      --altitude M              camera altitude above sea level, metres\n"
+           "      --position X,Y,Z          camera position, metres (x east, y up, z south); keeps the view\n"
+           "                                direction unless --look-at is given\n"
+           "      --look-at X,Y,Z           the point the camera looks at, metres\n"
+           "      --view-elevation E        the view direction's elevation, degrees (negative: down)\n"
+           "      --view-azimuth A          the view direction's azimuth, degrees clockwise from north\n"
+           "      --fov DEG                 field of view: pinhole vertical, fisheye across the circle\n"
+           "                                (a volume file with no camera given is framed: placed, and the\n"
+           "                                camera pointed at it from where the whole box shows)\n"
            "      --sun-elevation E         sun elevation, degrees\n"
            "      --sun-azimuth A           sun azimuth, degrees clockwise from north\n"
            "      --time T --lat L --lon L  sun from a UTC time (2026-06-21T12:00:00Z) and a place\n"
@@ -526,6 +542,20 @@ void render_opts_help(void)
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
            "                                (default: 3 widths, at least 4 km, in front of the camera)\n"
            "      --density-scale S         multiplies the volume's densities\n"
+           "      --density-unit U          what a volume file's values are: per_m3 (particles per m^3), g_m3\n"
+           "                                (water content, by the particle's mean mass), fraction (0..1, 1 =\n"
+           "                                1e8 m^-3, a cumulus), auto (default: VDB fraction, raw per_m3,\n"
+           "                                NetCDF its mixing ratios)\n"
+           "      --voxel-size M            NetCDF: the resampling voxel (default: the model's mean layer depth,\n"
+           "                                or DX if finer); VDB/raw: the voxel edge replacing the file's\n"
+           "      --volume-scale S          generators: extent factor; VDB/raw files: multiplies their lengths\n"
+           "                                (0.01: a file in centimetres)\n"
+           "      --grids LIST              VDB grids or NetCDF variables to load (comma-separated)\n"
+           "      --particle NAME           particle type of a single-grid file (default cloud)\n"
+           "      --time-index N            NetCDF time step (default 0)\n"
+           "  -D, --define PATH=VALUE      sets a scene key before the scene is read, as if in the file:\n"
+           "                                PATH dotted (camera.fov_deg) or a JSON pointer (/camera/fov_deg),\n"
+           "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable\n"
            "      --atmosphere riley|homogeneous   the air: Riley et al.'s exponential atmosphere (default)\n"
            "                                or a uniform layer from the ground to --thickness (docs/models.md)\n"
            "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");
@@ -545,5 +575,8 @@ void render_opts_help(void)
            "  atmos render -o sky.png --exr sky.exr\n"
            "  atmos render scenes/sunset_fisheye.json --spectral 32 -o sunset.png\n"
            "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n"
+           "  atmos render --volume wdas_cloud_sixteenth.vdb --renderer path --spp 64\n"
+           "  atmos render --volume wrfout_d01.nc --time-index 6 --grids QCLOUD,QICE --view-elevation -45\n"
+           "  atmos render scenes/fig06_halo_cirrus.json -D camera.fov_deg=30 -D renderer=path\n"
            "  atmos render scenes/fig01_cirrus_sunrise.json --frames 8 --time-end 2026-06-21T12:30:00Z -o out/cirrus.png\n");
 }

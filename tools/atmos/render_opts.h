@@ -7,6 +7,7 @@
 #include "cli.h"
 
 #define RENDER_OPTS_MAX_SETTINGS 48
+#define RENDER_OPTS_MAX_DEFINES 64
 
 /* A renderer setting given on the command line. */
 typedef struct {
@@ -33,6 +34,9 @@ typedef struct {
     /* the camera (NaN / 0: not given) */
     double fov, view_el, view_az, position[3], look_at[3];
     int position_given, look_at_given;
+    /* -D PATH=VALUE: scene keys set before the scene is read */
+    const char *defines[RENDER_OPTS_MAX_DEFINES];
+    int ndefines;
     render_setting set[RENDER_OPTS_MAX_SETTINGS];
     int nset;
     /* the run */

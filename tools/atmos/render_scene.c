@@ -68,14 +68,21 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     atmos_status st;
     *volume = NULL;
     if (o->scene_path) {
-        if (looks_like_volume(o->scene_path)) {
+        if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
             fprintf(stderr,
                     "atmos render: %s is a volume file, not a scene: render it with\n"
                     "  atmos render --volume %s\n",
                     o->scene_path, o->scene_path);
             return CLI_EXIT_USAGE;
         }
-        if ((st = atmos_scene_load(ctx, o->scene_path, scene)) != ATMOS_OK) return cli_runtime_error("render", ctx, st);
+        if ((st = atmos_scene_load_with(ctx, o->scene_path, o->defines, o->ndefines, scene)) != ATMOS_OK)
+            return cli_runtime_error("render", ctx, st);
+    } else if (o->ndefines) {
+        /* the built-in default scene is the parse of an empty one */
+        if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", o->defines, o->ndefines, scene)) != ATMOS_OK) {
+            fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+            return CLI_EXIT_USAGE;
+        }
     } else {
         atmos_scene_defaults(scene);
     }
@@ -91,4 +98,15 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         if ((st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK) return cli_runtime_error("render", ctx, st);
     }
     return CLI_EXIT_OK;
+}
+
+const char *render_scene_output_name(const render_opts *o, const atmos_scene *scene, char *buf, size_t cap)
+{
+    const char *p = o->scene_path;
+    if (!p || !strcmp(p, "-")) return scene->name;
+    const char *base = strrchr(p, '/') ? strrchr(p, '/') + 1 : p, *dot = strrchr(base, '.');
+    size_t n = dot && dot > base ? (size_t)(dot - base) : strlen(base);
+    if (n == 0) return scene->name;
+    snprintf(buf, cap, "%.*s", (int)(n < cap ? n : cap - 1), base);
+    return buf;
 }
