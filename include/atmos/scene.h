@@ -52,6 +52,7 @@ typedef struct atmos_scene_volume {
     uint64_t seed;            /* generators; 1 */
     double scale;             /* generators: extent factor; VDB/NanoVDB/raw files: multiplies their
                                  lengths (0.01 for centimetres); 1 */
+    double subgrid_detail;    /* NetCDF: artists' sub-grid detail amplitude, 0 = off (atmos_volume_load_desc) */
     int placed;               /* 1: position_m given; 0: atmos_scene_volume_offset's default */
     double position_m[3];     /* world position of the centre of the bottom face of the volume's box */
 } atmos_scene_volume;

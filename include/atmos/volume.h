@@ -122,6 +122,11 @@ typedef struct atmos_volume_load_desc {
     double length_scale;      /* VDB/NanoVDB/raw: multiplies every length of the file (voxel size and
                                  origin; 0.01 for a file in centimetres), after voxel_size_m; 0 = 1.
                                  NetCDF: must be 0 or 1 (its lengths are metres) */
+    double subgrid_detail;    /* NetCDF, for artists: 0 = off (the model's fields, smoothly
+                                 reconstructed); (0, 1]: each voxel times 1 + a (2 n - 1), n a
+                                 fractal noise in [0, 1] at scales from half the model's grid
+                                 spacing down to the voxel: a texture the model does not hold
+                                 (logged as such). Other formats: must be 0 */
 } atmos_volume_load_desc;
 
 /* Loads .vdb (OpenVDB, when built with it), .nvdb (NanoVDB), .nc (WRF or CM1

@@ -30,6 +30,7 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         ld.voxel_size_m = sv->voxel_size_m;
         ld.density_unit = sv->density_unit;
         ld.length_scale = sv->scale > 0 ? sv->scale : 1.0;
+        ld.subgrid_detail = sv->subgrid_detail;
         st = atmos_volume_load(ctx, sv->source, &ld, &vol);
     }
     if (st != ATMOS_OK) return st;

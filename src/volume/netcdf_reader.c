@@ -16,6 +16,7 @@
  * precisely its west and north edges, since z grows southward.
  */
 #include "core/internal.h"
+#include "volume/generator.h"
 #include "volume/netcdf_classic.h"
 #include "volume/reader_common.h"
 #include "volume/volume_internal.h"
@@ -839,6 +840,26 @@ static int resample_column(const loader *L, const float *e, int I, int K)
     return nonzero;
 }
 
+/* Artists' sub-grid detail (desc->subgrid_detail = a > 0): the column's values times
+ * 1 + a (2 n - 1), n a fractal value noise in [0, 1] (mean 1/2: the factor's mean is 1) whose
+ * largest features are half the model's grid spacing and whose octaves reach the voxel. One
+ * noise for all fields (the same texture in cloud and rain), fixed seed: the same volume
+ * every time. */
+static void add_detail(const loader *L, int I, int K)
+{
+    const double a = L->desc->subgrid_detail, vs = L->vd.voxel_size_m;
+    const double cell = 0.5 * fmin(L->dx, L->dy);
+    int octaves = 1;
+    while (octaves < 6 && cell / (1 << octaves) > vs) octaves++;
+    for (int J = 0; J < L->vd.dims[1]; J++) {
+        if (!(L->colv[J] > 0)) continue;
+        const double n = atmos__gen_fbm3(0x5EED, (I + 0.5) * vs / cell, (J + 0.5) * vs / cell, (K + 0.5) * vs / cell,
+                                         octaves, 0.5);
+        const double f = 1 + a * (2 * n - 1);
+        L->colv[J] = (float)(L->colv[J] * (f > 0 ? f : 0));
+    }
+}
+
 /* Adds hydrometeor sel[si] as a field and writes its non-empty columns. */
 static atmos_status resample_field(loader *L, int si)
 {
@@ -857,6 +878,7 @@ static atmos_status resample_field(loader *L, int si)
     for (int I = 0; I < L->vd.dims[0]; I++)
         for (int K = 0; K < L->vd.dims[2]; K++) {
             if (!resample_column(L, e, I, K)) continue;
+            if (L->desc->subgrid_detail > 0) add_detail(L, I, K);
             const int off[3] = {I, 0, K}, size[3] = {1, L->vd.dims[1], 1};
             if ((st = atmos_volume_set_dense(L->s.ctx, L->vol, field, off, size, L->colv, 1.0f))) return st;
         }
@@ -875,6 +897,11 @@ static atmos_status load(loader *L)
     for (int si = 0; si < L->nsel; si++)
         if ((st = number_density(L, si))) return st;
     if ((st = output_grid(L)) || (st = resample_buffers(L))) return st;
+    if (L->desc->subgrid_detail > 0)
+        atmos__log(L->s.ctx, ATMOS_LOG_WARN,
+                   "%s: sub-grid detail added (amplitude %g): an artistic texture below the model's %.0f m grid, "
+                   "not model data",
+                   L->s.path, L->desc->subgrid_detail, fmin(L->dx, L->dy));
     for (int si = 0; si < L->nsel; si++)
         if ((st = resample_field(L, si))) return st;
     return atmos_volume_finalize(L->s.ctx, L->vol);

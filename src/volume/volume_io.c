@@ -68,12 +68,20 @@ static atmos_status load_format(atmos_context *ctx, const char *path, vol_format
     atmos_status st;
     if (!(d.length_scale >= 0 && d.length_scale <= 1e6) || !(d.voxel_size_m >= 0 && d.voxel_size_m <= 1e6))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: voxel size and length scale must be in [0, 1e6]", path);
+    if (!(d.subgrid_detail >= 0 && d.subgrid_detail <= 1))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: sub-grid detail must be in [0, 1], got %g", path,
+                            d.subgrid_detail);
     if (fmt == FMT_NETCDF) {
         if ((st = check_netcdf_units(ctx, path, &d)) != ATMOS_OK) return st;
         st = atmos__volume_load_netcdf(ctx, path, &d, out);
         if (st == ATMOS_OK) atmos__volume_set_source_format(*out, format_names[fmt]);
         return st;
     }
+    if (d.subgrid_detail != 0)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "%s: sub-grid detail applies to a NetCDF model's fields only (a VDB or raw volume has "
+                            "its own detail)",
+                            path);
     double factor = 1.0;
     const atmos_density_unit own = fmt == FMT_JSON ? ATMOS_DENSITY_PER_M3 : ATMOS_DENSITY_FRACTION;
     if ((st = atmos__volume_unit_factor(ctx, path, d.density_unit, own, d.field, &factor)) != ATMOS_OK) return st;

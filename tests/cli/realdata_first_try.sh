@@ -43,7 +43,7 @@ printf ' BDV\0\0\0\0' > "$T/cloud_no_extension"
 
 # 3. the time of the plan (tables) is reported, and progress lines go to a log
 ATMOS_PROGRESS_INTERVAL=0 "$A" render --width 16 --height 9 -o "$T/sky.png" 2> "$T/log.txt" && ok || bad "sky render"
-grep -q "s for the plan (volume, optics tables)" "$T/log.txt" && ok || bad "no plan time: $(cat "$T/log.txt")"
+grep -q "s for the scene, the volume and the optics tables" "$T/log.txt" && ok || bad "no plan time: $(cat "$T/log.txt")"
 grep -q "^atmos: render sky: .* %, .* s elapsed" "$T/log.txt" && ok || bad "no progress line off a terminal"
 
 # 4. the Disney cloud: a cloud at a cloud's altitude, framed by the default camera

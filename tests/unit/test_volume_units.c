@@ -1,8 +1,8 @@
 /* What a volume file's values and lengths are, and where it goes: density units (number
  * density, water content, 0..1 fraction), voxel size and length scale applied to files,
  * the scene keys a kind of volume would ignore refused, an artist's volume placed at a
- * cloud's altitude and framed by the camera, and the WRF resampling's smoothness (no
- * slope jump at the model's columns). */
+ * cloud's altitude and framed by the camera, the WRF resampling's smoothness (no slope
+ * jump at the model's columns) and its optional sub-grid detail for artists. */
 #define _POSIX_C_SOURCE 200809L
 #include "atmos/atmos.h"
 #include "test.h"
@@ -82,6 +82,10 @@ static void test_units(const char *json)
     v = NULL;
     CHECK(atmos_volume_load(ctx, json, &d, &v) == ATMOS_E_INVALID_ARG && !v);
     CHECK(strstr(atmos_context_error(ctx), "glory_droplets") != NULL);
+    /* sub-grid detail is for model fields: refused for a raw (or VDB) file */
+    memset(&d, 0, sizeof d);
+    d.subgrid_detail = 0.5;
+    CHECK(atmos_volume_load(ctx, json, &d, &v) == ATMOS_E_INVALID_ARG && !v);
 }
 
 /* Lengths: voxel_size_m replaces the file's voxel (origin scaled alike), length_scale
@@ -250,6 +254,56 @@ static void write_wrf(const char *path)
     NC_OK(nc_close(nc));
 }
 
+/* The sum and the largest relative change of field 0 between two volumes on one grid, at
+ * every voxel centre. */
+static void compare_fields(const atmos_volume *a, const atmos_volume *b, double *sum_a, double *sum_b, double *change,
+                           int *negative)
+{
+    const atmos_volume_desc *d = atmos_volume_get_desc(a);
+    *sum_a = *sum_b = *change = 0;
+    *negative = 0;
+    for (int k = 0; k < d->dims[2]; k++)
+        for (int j = 0; j < d->dims[1]; j++)
+            for (int i = 0; i < d->dims[0]; i++) {
+                const double q[3] = {d->origin_m[0] + (i + 0.5) * d->voxel_size_m,
+                                     d->origin_m[1] + (j + 0.5) * d->voxel_size_m,
+                                     d->origin_m[2] + (k + 0.5) * d->voxel_size_m};
+                const double x = atmos_volume_sample(a, 0, q), y = atmos_volume_sample(b, 0, q);
+                *sum_a += x, *sum_b += y;
+                *negative += y < 0;
+                if (x > 0) *change = fmax(*change, fabs(y / x - 1));
+            }
+}
+
+/* Artists' sub-grid detail: off by default; on, a texture that keeps the field's mean
+ * (within the noise's sampling) and its sign, the same every time, refused for VDB/raw. */
+static void test_wrf_detail(const char *path)
+{
+    atmos_volume_load_desc d;
+    memset(&d, 0, sizeof d);
+    d.voxel_size_m = 125;
+    atmos_volume *plain = NULL, *art = NULL, *art2 = NULL;
+    CHECK_OK(atmos_volume_load(ctx, path, &d, &plain));
+    d.subgrid_detail = 0.6;
+    CHECK_OK(atmos_volume_load(ctx, path, &d, &art));
+    CHECK_OK(atmos_volume_load(ctx, path, &d, &art2));
+    if (plain && art && art2) {
+        double sa, sb, change, s2, c2;
+        int neg, neg2;
+        compare_fields(plain, art, &sa, &sb, &change, &neg);
+        CHECK_MSG(change > 0.1 && change <= 0.6 + 1e-6, "detail changed voxels by up to %.3f", change);
+        CHECK_MSG(fabs(sb / sa - 1) < 0.1, "detail moved the mean by %.3f", sb / sa - 1);
+        CHECK(neg == 0);
+        compare_fields(art, art2, &s2, &sb, &c2, &neg2);
+        CHECK_MSG(c2 == 0, "detail differs between two loads (%g)", c2);
+        printf("test_volume_units: sub-grid detail 0.6: voxels changed by up to %.2f, mean by %+.3f\n", change,
+               sb / sa - 1);
+    }
+    atmos_volume_destroy(plain);
+    atmos_volume_destroy(art);
+    atmos_volume_destroy(art2);
+}
+
 /* Along a row, at 200 m voxels, column i's centre is voxel 5 i + 2. The second difference
  * of the resampled field there (its slope's change across the column) must be of the size
  * of those of its neighbours: bilinear interpolation is straight between columns (second
@@ -296,6 +350,7 @@ static void test_wrf_smooth(void)
     CHECK_OK(atmos_volume_load(ctx, p, &d, &v));
     if (v) CHECK_MSG(atmos_volume_get_desc(v)->dims[1] >= 3, "%d voxels tall", atmos_volume_get_desc(v)->dims[1]);
     atmos_volume_destroy(v);
+    test_wrf_detail(p);
     /* the units of other formats do not apply to a model's mixing ratios */
     d.density_unit = ATMOS_DENSITY_FRACTION;
     v = NULL;

@@ -220,6 +220,7 @@ int cli_cmd_render(int argc, char **argv)
     cli_progress_init(&prog, o.quiet);
     atmos_context *ctx = cli_context_with_progress(o.threads, o.quiet, cli_progress_bar, &prog);
     if (!ctx) return CLI_EXIT_RUNTIME;
+    const double t0 = cli_now_s();
     atmos_scene scene;
     atmos_volume *volume = NULL; /* loaded here when framed (render_scene.c), else by the plan */
     if ((rc = render_scene_make(ctx, &o, &scene, &volume)) != CLI_EXIT_OK) {
@@ -236,14 +237,13 @@ int cli_cmd_render(int argc, char **argv)
     }
     atmos_plan *plan = NULL;
     int failed = 0;
-    const double t0 = cli_now_s();
     atmos_status st = atmos_plan_create(ctx, &scene, volume, NULL, &plan);
     const double t_plan = cli_now_s() - t0;
     if (st == ATMOS_OK && o.tau) st = write_tau(ctx, &scene, plan, o.tau);
     if (st == ATMOS_OK) st = render_frames(ctx, plan, &scene, &o, png, source, &prog, &failed);
     if (st == ATMOS_OK && !o.quiet)
-        fprintf(stderr, "atmos render: %.3f s in all: %.3f s for the plan (volume, optics tables), %.3f s rendering and "
-                        "writing\n",
+        fprintf(stderr, "atmos render: %.3f s in all: %.3f s for the scene, the volume and the optics tables, %.3f s "
+                        "rendering and writing\n",
                 cli_now_s() - t0, t_plan, cli_now_s() - t0 - t_plan);
     if (st != ATMOS_OK) {
         if (prog.shown) fputc('\n', stderr);

@@ -14,7 +14,7 @@ enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
     O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_VPOS, O_DSCALE, O_TAU, O_VARIANCE,
     O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS, O_GRIDS, O_PARTICLE, O_TINDEX,
-    O_DUNIT, O_VOXEL, O_VSCALE, O_FOV, O_VIEW_EL, O_VIEW_AZ, O_POSITION, O_LOOKAT,
+    O_DUNIT, O_VOXEL, O_VSCALE, O_FOV, O_VIEW_EL, O_VIEW_AZ, O_POSITION, O_LOOKAT, O_DETAIL,
     O_SETTING = 1024 /* + row index over the tables: a renderer setting */
 };
 
@@ -41,6 +41,7 @@ static const struct option fixed_opts[] = {
     {"fov", required_argument, 0, O_FOV}, {"view-elevation", required_argument, 0, O_VIEW_EL},
     {"view-azimuth", required_argument, 0, O_VIEW_AZ}, {"position", required_argument, 0, O_POSITION},
     {"look-at", required_argument, 0, O_LOOKAT}, {"define", required_argument, 0, 'D'},
+    {"subgrid-detail", required_argument, 0, O_DETAIL},
     {"help", no_argument, 0, 'h'}};
 #define NFIXED ((int)(sizeof fixed_opts / sizeof fixed_opts[0]))
 
@@ -215,6 +216,11 @@ static int parse_number(int c, const char *arg, render_opts *o)
             !(o->volume_scale > 0 && o->volume_scale <= 100))
             return cli_usage_error(C, "--volume-scale: expected a factor in (0, 100]"), 0;
         return 1;
+    case O_DETAIL:
+        if (!cli_parse_double(C, "--subgrid-detail", arg, &o->subgrid_detail) ||
+            !(o->subgrid_detail > 0 && o->subgrid_detail <= 1))
+            return cli_usage_error(C, "--subgrid-detail: expected an amplitude in (0, 1]"), 0;
+        return 1;
     case O_FOV:
         if (!cli_parse_double(C, "--fov", arg, &o->fov) || !(o->fov > 0 && o->fov <= 360))
             return cli_usage_error(C, "--fov: expected degrees in (0, 360]"), 0;
@@ -367,20 +373,21 @@ int render_opts_camera_given(const render_opts *o)
 static int apply_volume_file(const render_opts *o, atmos_scene *s)
 {
     const char *C = "render";
-    const int given = o->grids || o->particle || o->time_index >= 0 || o->density_unit >= 0;
+    const int given = o->grids || o->particle || o->time_index >= 0 || o->density_unit >= 0 || o->subgrid_detail > 0;
     if (!given && !(o->voxel_size > 0) && !(o->volume_scale > 0)) return CLI_EXIT_OK;
     if (!s->volume.source[0])
         return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit, --voxel-size and --volume-scale "
                                   "need a volume (--volume or a scene with one)");
     if (given && !strncmp(s->volume.source, "generate:", 9))
-        return cli_usage_error(C, "--grids, --particle, --time-index and --density-unit apply to a volume file, "
-                                  "not to a generated volume");
+        return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit and --subgrid-detail apply to a "
+                                  "volume file, not to a generated volume");
     if (o->grids) snprintf(s->volume.grids, sizeof s->volume.grids, "%s", o->grids);
     if (o->particle) snprintf(s->volume.particle, sizeof s->volume.particle, "%s", o->particle);
     if (o->time_index >= 0) s->volume.time_index = o->time_index;
     if (o->density_unit >= 0) s->volume.density_unit = (atmos_density_unit)o->density_unit;
     if (o->voxel_size > 0) s->volume.voxel_size_m = o->voxel_size;
     if (o->volume_scale > 0) s->volume.scale = o->volume_scale;
+    if (o->subgrid_detail > 0) s->volume.subgrid_detail = o->subgrid_detail;
     return CLI_EXIT_OK;
 }
 
@@ -430,7 +437,7 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
     const atmos_renderer_kind r = s->renderer;
     if (r == ATMOS_RENDERER_SKY && (o->volume || o->density_scale > 0 || o->volume_pos_given || o->tau || o->grids ||
                                     o->particle || o->time_index >= 0 || o->density_unit >= 0 || o->voxel_size > 0 ||
-                                    o->volume_scale > 0))
+                                    o->volume_scale > 0 || o->subgrid_detail > 0))
         return cli_usage_error(C, "--volume, --volume-position, --density-scale, --tau and the volume file's options "
                                   "go with a volume renderer, not --renderer sky");
     if (r != ATMOS_RENDERER_PATH && (o->variance || o->order))
@@ -554,6 +561,8 @@ void render_opts_help(void)
            "      --grids LIST              VDB grids or NetCDF variables to load (comma-separated)\n"
            "      --particle NAME           particle type of a single-grid file (default cloud)\n"
            "      --time-index N            NetCDF time step (default 0)\n"
+           "      --subgrid-detail A        NetCDF, for artists: a fractal texture below the model's grid,\n"
+           "                                amplitude A in (0, 1] (not model data; default off)\n"
            "  -D, --define PATH=VALUE      sets a scene key before the scene is read, as if in the file:\n"
            "                                PATH dotted (camera.fov_deg) or a JSON pointer (/camera/fov_deg),\n"
            "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable\n"

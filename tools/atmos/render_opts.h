@@ -30,7 +30,7 @@ typedef struct {
     /* the volume file (NULL / -1 / 0: not given) */
     const char *grids, *particle;
     int time_index, density_unit;
-    double voxel_size, volume_scale;
+    double voxel_size, volume_scale, subgrid_detail;
     /* the camera (NaN / 0: not given) */
     double fov, view_el, view_az, position[3], look_at[3];
     int position_given, look_at_given;
