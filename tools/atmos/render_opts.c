@@ -569,6 +569,10 @@ void render_opts_help(void)
            "      --atmosphere riley|homogeneous   the air: Riley et al.'s exponential atmosphere (default)\n"
            "                                or a uniform layer from the ground to --thickness (docs/models.md)\n"
            "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");
+    printf("One rule for every renderer: an option of another renderer than the one rendering is refused\n"
+           "(exit 2, naming the renderer it goes with); --spp is the one option all renderers share. A scene\n"
+           "file may keep a \"slice\" and a \"path\" section (for --renderer to switch between them); only the\n"
+           "rendering renderer's is used.\n\n");
     help_settings(ATMOS_RENDERER_SLICE, "Slice renderer");
     help_settings(ATMOS_RENDERER_PATH, "Path tracer");
     printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
