@@ -51,6 +51,11 @@ static atmos_status check_netcdf_units(atmos_context *ctx, const char *path, con
                             "%s: a NetCDF model's hydrometeors are mass mixing ratios, converted by the reader: "
                             "density unit %s does not apply (use density_scale)",
                             path, atmos__density_unit_name(d->density_unit));
+    if (d->field && d->field[0])
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "%s: a NetCDF model's hydrometeors have their own particle types (QCLOUD cloud, QRAIN rain, "
+                            "QICE ice, QSNOW snow, QGRAUP snow): particle \"%s\" does not apply (choose them with grids)",
+                            path, d->field);
     if (d->length_scale != 0 && d->length_scale != 1)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
                             "%s: a NetCDF model's lengths are metres: a length scale does not apply "

@@ -355,6 +355,13 @@ static void test_wrf_smooth(void)
     d.density_unit = ATMOS_DENSITY_FRACTION;
     v = NULL;
     CHECK(atmos_volume_load(ctx, p, &d, &v) == ATMOS_E_INVALID_ARG && !v);
+    /* nor a particle type for a single grid, nor a length scale */
+    memset(&d, 0, sizeof d);
+    d.field = "rain";
+    CHECK(atmos_volume_load(ctx, p, &d, &v) == ATMOS_E_INVALID_ARG && !v);
+    memset(&d, 0, sizeof d);
+    d.length_scale = 0.01;
+    CHECK(atmos_volume_load(ctx, p, &d, &v) == ATMOS_E_INVALID_ARG && !v);
 }
 #endif
 

@@ -559,7 +559,7 @@ void render_opts_help(void)
            "      --volume-scale S          generators: extent factor; VDB/raw files: multiplies their lengths\n"
            "                                (0.01: a file in centimetres)\n"
            "      --grids LIST              VDB grids or NetCDF variables to load (comma-separated)\n"
-           "      --particle NAME           particle type of a single-grid file (default cloud)\n"
+           "      --particle NAME           particle type of a single-grid VDB/raw file (default cloud)\n"
            "      --time-index N            NetCDF time step (default 0)\n"
            "      --subgrid-detail A        NetCDF, for artists: a fractal texture below the model's grid,\n"
            "                                amplitude A in (0, 1] (not model data; default off)\n"
