@@ -180,7 +180,8 @@ ATMOS_API atmos_status atmos_volume_optics_build(atmos_context *ctx, const atmos
 ATMOS_API void atmos_volume_optics_free(atmos_volume_optics *o);
 
 /* Loads or generates the volume a scene names (scene->volume: file, grids, particle, time
- * index, voxel size; generator, seed, scale) and computes offset_m, the shift that places
+ * index, voxel size, density unit, length scale, sub-grid detail; generator, seed, scale)
+ * and computes offset_m, the shift that places
  * it in the world (atmos_scene_volume_offset). The scene's density_scale is not applied
  * here (the renderers apply it). */
 ATMOS_API atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
