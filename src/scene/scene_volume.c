@@ -34,6 +34,15 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         st = atmos_volume_load(ctx, sv->source, &ld, &vol);
     }
     if (st != ATMOS_OK) return st;
+    /* A scene written when VDB values were read as particles per m^3 scaled them by ~1e8;
+     * read as a 0..1 fraction (1 = 1e8 m^-3) they would be that much denser again. */
+    const char *fmt = atmos_volume_source_format(vol);
+    if (sv->density_unit == ATMOS_DENSITY_AUTO && sv->density_scale >= 1e3 &&
+        (!strcmp(fmt, "openvdb") || !strcmp(fmt, "nanovdb")))
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "%s: read as a 0..1 density (1 = %g m^-3) and then scaled by %g: for values in particles per m^3 "
+                   "give \"density_unit\": \"per_m3\" (--density-unit per_m3)",
+                   sv->source, ATMOS_DENSITY_FRACTION_PER_M3, sv->density_scale);
     atmos_scene_volume_offset(scene, vol, offset_m);
     *out = vol;
     return ATMOS_OK;

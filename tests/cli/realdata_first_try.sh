@@ -52,6 +52,10 @@ if [ -f "$DATA/wdas_cloud_sixteenth.vdb" ]; then
         --tau "$T/disney_tau.pfm" -o "$T/disney.png" && ok || bad "Disney cloud render"
     c=$(coverage "$T/disney_tau.pfm" 1)
     at_least "$c" 0.03 && ok || bad "Disney cloud: only $c of the pixels have tau > 1"
+    # an old scene's density scale on a fraction is a warning naming the unit to give
+    "$A" render --volume "$DATA/wdas_cloud_sixteenth.vdb" --density-scale 1e8 --width 16 --height 9 --slices 16 \
+        -o "$T/d8.png" 2> "$T/err.txt" && grep -q "density_unit.*per_m3" "$T/err.txt" && ok \
+        || bad "no warning for --density-scale 1e8 on a 0..1 VDB"
     # --voxel-size applies to a VDB file (the file's 3.33 m voxel replaced)
     "$A" volume info "$DATA/wdas_cloud_sixteenth.vdb" --voxel-size 25 | grep -q "voxels of 25 m" && ok \
         || bad "volume info --voxel-size 25 on a VDB"
