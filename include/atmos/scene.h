@@ -45,11 +45,15 @@ typedef struct atmos_scene_volume {
     char particle[64];        /* particle type of a single-grid file: a preset or a "particles"
                                  entry ("" = "cloud") */
     double density_scale;     /* multiplies the densities (after the reader's unit conversion); 1 */
+    atmos_density_unit density_unit; /* files: what the values are (ATMOS_DENSITY_AUTO: the format's own) */
     int time_index;           /* NetCDF time step; 0 */
-    double voxel_size_m;      /* NetCDF resampling / generator voxel size; 0 = the source's */
+    double voxel_size_m;      /* NetCDF resampling / generator voxel size / other files: the voxel
+                                 edge replacing the file's; 0 = the source's */
     uint64_t seed;            /* generators; 1 */
-    double scale;             /* generators: extent factor; 1 */
-    int placed;               /* 1: position_m given; 0: centred 3 widths (>= 4 km) in front of the camera */
+    double scale;             /* generators: extent factor; VDB/NanoVDB/raw files: multiplies their
+                                 lengths (0.01 for centimetres); 1 */
+    double subgrid_detail;    /* NetCDF: artists' sub-grid detail amplitude, 0 = off (atmos_volume_load_desc) */
+    int placed;               /* 1: position_m given; 0: atmos_scene_volume_offset's default */
     double position_m[3];     /* world position of the centre of the bottom face of the volume's box */
 } atmos_scene_volume;
 
@@ -116,6 +120,8 @@ typedef struct atmos_scene {
     atmos_scene_slice slice;
     atmos_scene_path path;
     atmos_scene_animation animation;
+    int camera_given;                     /* the scene file has a "camera" (a volume scene without
+                                             one is framed by atmos_scene_frame_volume) */
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
@@ -129,6 +135,18 @@ ATMOS_API atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, s
                                          const char *source, atmos_scene *out);
 /* Reads a file (at most 16 MiB) and parses it. */
 ATMOS_API atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene *out);
+
+/* The same with keys set from outside the text (atmos render -D, as Mitsuba's): each of the
+ * count overrides is "PATH=VALUE", PATH a JSON pointer ("/camera/fov_deg") or a dotted path
+ * ("camera.fov_deg", "camera.position_m.1"), VALUE JSON text ("35", "[0, 900, 0]",
+ * "\"path\"") or a bare word that is not JSON, taken as a string (renderer=path).
+ * Objects on the path are made as needed; array items are replaced (or appended at the
+ * array's size). Each value is then read with the rules and messages of the file's. The
+ * load's path "-" reads standard input (relative volume paths: from the current folder). */
+ATMOS_API atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t length, const char *source,
+                                              const char *const *overrides, int count, atmos_scene *out);
+ATMOS_API atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const char *const *overrides,
+                                             int count, atmos_scene *out);
 
 /* Checks a scene built or modified in code (CLI overrides) with the same rules
  * and messages as the parser, using source as the message prefix. */
@@ -162,15 +180,27 @@ ATMOS_API atmos_status atmos_volume_optics_build(atmos_context *ctx, const atmos
 ATMOS_API void atmos_volume_optics_free(atmos_volume_optics *o);
 
 /* Loads or generates the volume a scene names (scene->volume: file, grids, particle, time
- * index, voxel size; generator, seed, scale) and computes offset_m, the shift that places
+ * index, voxel size, density unit, length scale, sub-grid detail; generator, seed, scale)
+ * and computes offset_m, the shift that places
  * it in the world (atmos_scene_volume_offset). The scene's density_scale is not applied
  * here (the renderers apply it). */
 ATMOS_API atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
                                                double offset_m[3]);
 /* The shift that places a volume in a scene's world: position_m puts the centre of the
  * box's bottom face there; without it the box's centre is moved horizontally to three of
- * its widths (at least 4 km) in front of the scene's camera, at its own altitude. */
+ * its widths (at least 4 km) in front of the scene's camera, at its own altitude -- except
+ * for an OpenVDB/NanoVDB file (an artist's volume in its own local frame), whose box's base
+ * goes to ATMOS_SCENE_CLOUD_BASE_M above the ground. */
 ATMOS_API void atmos_scene_volume_offset(const atmos_scene *scene, const atmos_volume *volume, double offset_m[3]);
+#define ATMOS_SCENE_CLOUD_BASE_M 1500.0
+
+/* Points the scene's pinhole camera at a volume placed by offset_m so that its whole box is
+ * in view: looking at the box's centre along the camera's heading at view_elevation_deg
+ * (the view direction's elevation; negative: looking down), from the nearest distance that keeps the box's eight
+ * corners inside the field of view (with a 10 % margin), the camera at least 2 m above the
+ * ground. Other camera types and fields (up, fov) are kept. */
+ATMOS_API void atmos_scene_frame_volume(atmos_scene *scene, const atmos_volume *volume, const double offset_m[3],
+                                        double view_elevation_deg);
 
 /* Frame index (0-based, < the frame count) of the scene's animation: *out is the scene
  * with the sun moved as atmos_scene_animation describes and no animation left in it.

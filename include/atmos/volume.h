@@ -84,6 +84,28 @@ ATMOS_API double atmos_volume_optical_depth(const atmos_volume *vol, const doubl
 
 /* ---------------------------------------------------------------- files */
 
+/* What a file's values are (atmos_volume_load_desc.density_unit; "density_unit" in a scene). */
+typedef enum atmos_density_unit {
+    ATMOS_DENSITY_AUTO = 0,     /* the format's own: OpenVDB/NanoVDB FRACTION, raw JSON PER_M3,
+                                   NetCDF the model's mass mixing ratios (docs/volumes.md) */
+    ATMOS_DENSITY_PER_M3 = 1,   /* number density, particles per m^3 */
+    ATMOS_DENSITY_G_M3 = 2,     /* water content, g of water or ice per m^3 of air, turned into a
+                                   number density by the particle type's mean mass (cloud, rain,
+                                   ice, snow, graupel; ATMOS_DENSITY_G_M3_MASS lists them) */
+    ATMOS_DENSITY_FRACTION = 3  /* a dimensionless 0..1 "density" (artist fog volumes): 1 is
+                                   ATMOS_DENSITY_FRACTION_PER_M3 particles per m^3 */
+} atmos_density_unit;
+
+/* A fraction of 1 is 1e8 particles per m^3 (100 per cm^3, a cumulus's droplet concentration,
+ * the generated cumulus's peak): with the "cloud" droplet preset an extinction of 63 km^-1 (a
+ * mean free path of 16 m), so a cloud a few hundred metres across is optically thick. */
+#define ATMOS_DENSITY_FRACTION_PER_M3 1e8
+
+/* Mean mass (kg) of one particle of a hydrometeor type ("cloud", "rain", "ice", "snow",
+ * "graupel"), the assumption that turns a water content into a number density; 0 for
+ * other names. */
+ATMOS_API double atmos_particle_mean_mass(const char *particle);
+
 typedef struct atmos_volume_load_desc {
     const char *grids;        /* VDB/NanoVDB: comma-separated grid names to load (NULL = "density"
                                  or all float grids); NetCDF: variables (NULL = all hydrometeors) */
@@ -92,8 +114,19 @@ typedef struct atmos_volume_load_desc {
                                  mass-based conversion for WRF/CM1 (docs/volumes.md) */
     int time_index;           /* NetCDF: time step (default 0) */
     int region[6];            /* NetCDF: i0, i1, j0, j1, k0, k1 sub-region (all 0 = everything) */
-    double voxel_size_m;      /* NetCDF: resampling voxel size (0 = from the grid spacing) */
+    double voxel_size_m;      /* NetCDF: resampling voxel size (0 = from the model levels and
+                                 grid spacing); other formats: the voxel edge in metres, replacing
+                                 the file's (its origin scaled by the same factor); 0 = the file's */
     uint64_t max_memory;      /* 0 = default */
+    atmos_density_unit density_unit; /* what the values are; AUTO = the format's own */
+    double length_scale;      /* VDB/NanoVDB/raw: multiplies every length of the file (voxel size and
+                                 origin; 0.01 for a file in centimetres), after voxel_size_m; 0 = 1.
+                                 NetCDF: must be 0 or 1 (its lengths are metres) */
+    double subgrid_detail;    /* NetCDF, for artists: 0 = off (the model's fields, smoothly
+                                 reconstructed); (0, 1]: each voxel times 1 + a (2 n - 1), n a
+                                 fractal noise in [0, 1] at scales from half the model's grid
+                                 spacing down to the voxel: a texture the model does not hold
+                                 (logged as such). Other formats: must be 0 */
 } atmos_volume_load_desc;
 
 /* Loads .vdb (OpenVDB, when built with it), .nvdb (NanoVDB), .nc (WRF or CM1
@@ -102,6 +135,9 @@ typedef struct atmos_volume_load_desc {
  * and the problem; unsupported formats in this build: ATMOS_E_UNSUPPORTED. */
 ATMOS_API atmos_status atmos_volume_load(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
                                          atmos_volume **out);
+/* The kind of file a volume was loaded from: "openvdb", "nanovdb", "netcdf", "raw", or ""
+ * (generated or built in code). */
+ATMOS_API const char *atmos_volume_source_format(const atmos_volume *vol);
 /* Writes every field as raw little-endian float32 (x fastest, one .raw per field
  * next to the sidecar) and a JSON sidecar at json_path. Atomic per file. */
 ATMOS_API atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol, const char *json_path);

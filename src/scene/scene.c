@@ -197,6 +197,12 @@ static atmos_status syntax_error(atmos_context *ctx, const char *source, const c
 atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, size_t length, const char *source,
                                atmos_scene *out)
 {
+    return atmos_scene_parse_with(ctx, json, length, source, NULL, 0, out);
+}
+
+atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t length, const char *source,
+                                    const char *const *overrides, int count, atmos_scene *out)
+{
     if (!source) source = "scene";
     if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: atmos_scene_parse: out is NULL", source);
     if (!json && length) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: atmos_scene_parse: json is NULL", source);
@@ -234,7 +240,10 @@ atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, size_t leng
         /* Parse into a local so that *out is untouched on failure. */
         atmos_scene s;
         atmos_scene_defaults(&s);
-        st = atmos__scene_from_json(ctx, source, root, &s);
+        if (count > 0 && !cJSON_IsObject(root))
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: a scene must be a JSON object", source);
+        else st = atmos__scene_apply_overrides(ctx, source, root, overrides, count);
+        if (st == ATMOS_OK) st = atmos__scene_from_json(ctx, source, root, &s);
         if (st == ATMOS_OK) *out = s;
     }
     cJSON_Delete(root);
@@ -244,8 +253,16 @@ atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, size_t leng
 
 atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene *out)
 {
+    return atmos_scene_load_with(ctx, path, NULL, 0, out);
+}
+
+atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const char *const *overrides, int count,
+                                   atmos_scene *out)
+{
     if (!path || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_load: path or out is NULL");
-    FILE *f = fopen(path, "rb");
+    const int in = !strcmp(path, "-");
+    FILE *f = in ? stdin : fopen(path, "rb");
+    if (in) path = "standard input";
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
     /* The size is checked before anything is allocated; the read loop below also
      * stops at the limit, for files that grow or report no size (pipes). */
@@ -253,12 +270,12 @@ atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene 
     size_t cap = 4096;
     if (fstat(fileno(f), &sb) == 0) {
         if (S_ISDIR(sb.st_mode)) {
-            fclose(f);
+            if (!in) fclose(f);
             return atmos__error(ctx, ATMOS_E_IO, "%s: cannot read: %s", path, strerror(EISDIR));
         }
         if (S_ISREG(sb.st_mode)) {
             if ((unsigned long long)sb.st_size > ATMOS__SCENE_MAX_BYTES) {
-                fclose(f);
+                if (!in) fclose(f);
                 return atmos__error(ctx, ATMOS_E_LIMIT, "%s: file is %lld bytes; scene files are limited to 16 MiB",
                                     path, (long long)sb.st_size);
             }
@@ -291,14 +308,14 @@ atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene 
             cap = ncap;
         }
     }
-    fclose(f);
+    if (!in) fclose(f);
     if (!buf) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-    if (st == ATMOS_OK) st = atmos_scene_parse(ctx, buf, len, path, out);
+    if (st == ATMOS_OK) st = atmos_scene_parse_with(ctx, buf, len, path, overrides, count, out);
     free(buf);
     /* A relative volume file is relative to the scene file's folder, so scenes can
      * be rendered from anywhere. */
     atmos_scene_volume *v = &out->volume;
-    const char *slash = strrchr(path, '/');
+    const char *slash = in ? NULL : strrchr(path, '/'); /* from standard input: the current folder */
     if (st == ATMOS_OK && v->source[0] && v->source[0] != '/' && strncmp(v->source, "generate:", 9) && slash) {
         size_t dir = (size_t)(slash - path) + 1, n = strlen(v->source);
         if (dir + n >= sizeof v->source)

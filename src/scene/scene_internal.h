@@ -70,6 +70,10 @@ struct cJSON;
 atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, const struct cJSON *root,
                                     atmos_scene *scene);
 
+/* Sets each "PATH=VALUE" of overrides in root (scene_override.c; atmos_scene_parse_with). */
+atmos_status atmos__scene_apply_overrides(atmos_context *ctx, const char *source, struct cJSON *root,
+                                          const char *const *overrides, int count);
+
 /* The view direction and up vector atmos_camera_init will use for cam, with
  * camera.h's zero-means-default rules for look_at and up applied. */
 void atmos__scene_camera_effective(const atmos_camera_desc *cam, double fwd[3], double up[3]);

@@ -833,20 +833,28 @@ static atmos_status parse_background(const jp *p, const cJSON *j, const char *pa
 
 static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"file", "generate", "grids", "particle", "density_scale", "time_index",
-                                       "voxel_size_m", "seed", "scale", "position_m"};
-    enum { K_FILE, K_GEN, K_GRIDS, K_PARTICLE, K_DSCALE, K_TIME, K_VOXEL, K_SEED, K_SCALE, K_POS };
+    static const char *const keys[] = {"file",  "generate", "grids", "particle",   "density_scale", "time_index",
+                                       "voxel_size_m", "seed", "scale", "position_m", "density_unit", "subgrid_detail"};
+    static const char *const units[] = {"auto", "per_m3", "g_m3", "fraction"};
+    enum { K_FILE, K_GEN, K_GRIDS, K_PARTICLE, K_DSCALE, K_TIME, K_VOXEL, K_SEED, K_SCALE, K_POS, K_UNIT, K_DETAIL };
+    static const atmos__range r_detail = {0, 1, 0, 0};
     const atmos__range *pos_r[3] = {&atmos__r_pos, &atmos__r_pos, &atmos__r_pos};
     atmos_scene_volume vol = s->volume;
     obj_iter it;
     char ip[PATH_CAP], buf[64];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 10, &it));
+    TRY(iter_begin(p, j, path, keys, 12, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
         switch (k) {
+        case K_UNIT: {
+            int u = 0;
+            TRY(get_enum(p, v, ip, units, 4, &u));
+            vol.density_unit = (atmos_density_unit)u;
+            break;
+        }
         case K_FILE:
         case K_GEN:
             if (it.seen & (k == K_FILE ? 1u << K_GEN : 1u << K_FILE))
@@ -897,6 +905,7 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
             break;
         case K_PARTICLE: TRY(get_text(p, v, ip, vol.particle, sizeof vol.particle)); break;
         case K_DSCALE: TRY(get_number(p, v, ip, &r_dscale, NULL, &vol.density_scale)); break;
+        case K_DETAIL: TRY(get_number(p, v, ip, &r_detail, NULL, &vol.subgrid_detail)); break;
         case K_TIME: TRY(get_int(p, v, ip, &r_time_index, &vol.time_index)); break;
         case K_VOXEL: TRY(get_number(p, v, ip, &r_voxel, NULL, &vol.voxel_size_m)); break;
         case K_SEED: TRY(get_u64(p, v, ip, &r_seed, &vol.seed)); break;
@@ -909,6 +918,15 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
     }
     if (!(it.seen & (1u << K_FILE | 1u << K_GEN)))
         return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"file\" or \"generate\"");
+    /* The keys one kind of volume would ignore are refused with it. */
+    static const int file_only[] = {K_GRIDS, K_TIME, K_UNIT, K_DETAIL}, gen_only[] = {K_SEED};
+    const int is_file = (it.seen & (1u << K_FILE)) != 0;
+    const int *bad = is_file ? gen_only : file_only, nbad = is_file ? 1 : 4;
+    for (int i = 0; i < nbad; i++)
+        if (it.seen & (1u << bad[i]))
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                     "\"%s\" applies to %s, not to a %s volume", keys[bad[i]],
+                                     is_file ? "generated volumes" : "volume files", is_file ? "file" : "generated");
     s->volume = vol;
     return ATMOS_OK;
 }
@@ -1027,7 +1045,10 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
             memcpy(s->name, name, strlen(name) + 1);
             break;
         case K_IMAGE: TRY(parse_image(&p, v, ip, s)); break;
-        case K_CAMERA: TRY(parse_camera(&p, v, ip, s)); break;
+        case K_CAMERA:
+            TRY(parse_camera(&p, v, ip, s));
+            s->camera_given = 1;
+            break;
         case K_SUN: TRY(parse_sun(&p, v, ip, s)); break;
         case K_ATMOSPHERE: TRY(parse_atmosphere(&p, v, ip, s)); break;
         case K_WAVELENGTHS: TRY(parse_wavelengths(&p, v, ip, s)); break;

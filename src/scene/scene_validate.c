@@ -314,8 +314,11 @@ atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const
 atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
     static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0},
-                              r_voxel = {0, 1e5, 0, 0}, r_time_index = {0, 1000000, 0, 0};
+                              r_voxel = {0, 1e5, 0, 0}, r_time_index = {0, 1000000, 0, 0}, r_detail = {0, 1, 0, 0};
     atmos_status st;
+    if (s->volume.density_unit < ATMOS_DENSITY_AUTO || s->volume.density_unit > ATMOS_DENSITY_FRACTION)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/density_unit",
+                                 "must be auto, per_m3, g_m3 or fraction, got %d", (int)s->volume.density_unit);
     if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_PATH)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice or path, got %d",
                                  (int)s->renderer);
@@ -356,6 +359,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
         {"/volume/scale", s->volume.scale, &r_vscale},
         {"/volume/voxel_size_m", s->volume.voxel_size_m, &r_voxel},
         {"/volume/time_index", s->volume.time_index, &r_time_index},
+        {"/volume/subgrid_detail", s->volume.subgrid_detail, &r_detail},
         {"/volume/position_m/0", s->volume.position_m[0], &atmos__r_pos},
         {"/volume/position_m/1", s->volume.position_m[1], &atmos__r_pos},
         {"/volume/position_m/2", s->volume.position_m[2], &atmos__r_pos},

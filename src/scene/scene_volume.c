@@ -28,9 +28,21 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         ld.field = sv->particle[0] ? sv->particle : NULL;
         ld.time_index = sv->time_index;
         ld.voxel_size_m = sv->voxel_size_m;
+        ld.density_unit = sv->density_unit;
+        ld.length_scale = sv->scale > 0 ? sv->scale : 1.0;
+        ld.subgrid_detail = sv->subgrid_detail;
         st = atmos_volume_load(ctx, sv->source, &ld, &vol);
     }
     if (st != ATMOS_OK) return st;
+    /* A scene written when VDB values were read as particles per m^3 scaled them by ~1e8;
+     * read as a 0..1 fraction (1 = 1e8 m^-3) they would be that much denser again. */
+    const char *fmt = atmos_volume_source_format(vol);
+    if (sv->density_unit == ATMOS_DENSITY_AUTO && sv->density_scale >= 1e3 &&
+        (!strcmp(fmt, "openvdb") || !strcmp(fmt, "nanovdb")))
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "%s: read as a 0..1 density (1 = %g m^-3) and then scaled by %g: for values in particles per m^3 "
+                   "give \"density_unit\": \"per_m3\" (--density-unit per_m3)",
+                   sv->source, ATMOS_DENSITY_FRACTION_PER_M3, sv->density_scale);
     atmos_scene_volume_offset(scene, vol, offset_m);
     *out = vol;
     return ATMOS_OK;
@@ -58,5 +70,52 @@ void atmos_scene_volume_offset(const atmos_scene *scene, const atmos_volume *vol
         offset_m[0] = c->position[0] + f[0] / fh * dist - 0.5 * (lo[0] + hi[0]);
         offset_m[1] = 0.0;
         offset_m[2] = c->position[2] + f[2] / fh * dist - 0.5 * (lo[2] + hi[2]);
+        /* An artist's volume has its own local frame (often centred on the origin, half
+         * below it): its base goes to a cloud's altitude. */
+        const char *fmt = atmos_volume_source_format(volume);
+        if (!strcmp(fmt, "openvdb") || !strcmp(fmt, "nanovdb")) offset_m[1] = ATMOS_SCENE_CLOUD_BASE_M - lo[1];
     }
+}
+
+/* The camera distance along -f from the box's centre that keeps every corner inside the
+ * pinhole's half-angles (tan_h horizontal, tan_v vertical). */
+static double framing_distance(const double lo[3], const double hi[3], const double f[3], const double r[3],
+                               const double u[3], double tan_h, double tan_v)
+{
+    double d = 0;
+    for (int n = 0; n < 8; n++) {
+        double q[3];
+        for (int a = 0; a < 3; a++) q[a] = ((n >> a) & 1 ? hi[a] : lo[a]) - 0.5 * (lo[a] + hi[a]);
+        double qf = q[0] * f[0] + q[1] * f[1] + q[2] * f[2], qr = q[0] * r[0] + q[1] * r[1] + q[2] * r[2],
+               qu = q[0] * u[0] + q[1] * u[1] + q[2] * u[2];
+        d = fmax(d, qf + fabs(qr) / tan_h);
+        d = fmax(d, qf + fabs(qu) / tan_v);
+    }
+    return d;
+}
+
+void atmos_scene_frame_volume(atmos_scene *scene, const atmos_volume *volume, const double offset_m[3],
+                              double view_elevation_deg)
+{
+    if (!scene || !volume || !offset_m || scene->camera.type != ATMOS_CAMERA_PINHOLE) return;
+    atmos_camera_desc *c = &scene->camera;
+    double lo[3], hi[3], ctr[3];
+    atmos_volume_bounds(volume, lo, hi);
+    for (int a = 0; a < 3; a++) lo[a] += offset_m[a], hi[a] += offset_m[a], ctr[a] = 0.5 * (lo[a] + hi[a]);
+    /* The view direction: the camera's heading at the view elevation (negative: down). */
+    double h[3] = {c->look_at[0] - c->position[0], 0, c->look_at[2] - c->position[2]};
+    double hn = sqrt(h[0] * h[0] + h[2] * h[2]);
+    if (!(hn > 1e-9)) h[0] = 0, h[2] = -1, hn = 1;
+    const double el = view_elevation_deg * ATMOS_DEG2RAD;
+    double f[3] = {cos(el) * h[0] / hn, sin(el), cos(el) * h[2] / hn};
+    double r[3] = {-f[2], 0, f[0]}, rn = sqrt(r[0] * r[0] + r[2] * r[2]);
+    for (int a = 0; a < 3; a++) r[a] /= rn;
+    double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    const double aspect = scene->height > 0 ? (double)scene->width / scene->height : 1.0;
+    const double tan_v = tan(0.5 * c->fov_deg * ATMOS_DEG2RAD), tan_h = tan_v * aspect;
+    const double d = 1.1 * framing_distance(lo, hi, f, r, u, tan_h, tan_v);
+    for (int a = 0; a < 3; a++) c->position[a] = ctr[a] - d * f[a];
+    if (c->position[1] < 2.0) c->position[1] = 2.0; /* above the ground, still looking at the centre */
+    memcpy(c->look_at, ctr, sizeof ctr);
+    c->up[0] = 0, c->up[1] = 1, c->up[2] = 0;
 }

@@ -16,6 +16,7 @@
  * precisely its west and north edges, since z grows southward.
  */
 #include "core/internal.h"
+#include "volume/generator.h"
 #include "volume/netcdf_classic.h"
 #include "volume/reader_common.h"
 #include "volume/volume_internal.h"
@@ -224,25 +225,6 @@ static atmos_status read_coord(const src *s, const char *name, size_t start, siz
     return ATMOS_OK;
 }
 
-/* Value at height y in one column: heights zm[0..nz) at mass levels (increasing),
- * valid between ztop_bottom[0] (ground) and [1] (model top); 0 outside. Linear
- * between mass levels, constant from the ground to the first level and from the
- * last level to the top. */
-static double column_at(const float *v, const double *zm, int nz, size_t stride, const double lim[2], double y)
-{
-    if (y < lim[0] || y > lim[1]) return 0.0;
-    if (y <= zm[0]) return v[0];
-    if (y >= zm[nz - 1]) return v[(size_t)(nz - 1) * stride];
-    int lo = 0, hi = nz - 1;
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (zm[mid] <= y) lo = mid;
-        else hi = mid;
-    }
-    double f = (y - zm[lo]) / (zm[hi] - zm[lo]);
-    return (1 - f) * v[(size_t)lo * stride] + f * v[(size_t)hi * stride];
-}
-
 /* Classic-format files (CDF-1/2/5) are read by offset: a truncated one yields
  * zeros past the end instead of an error. The header says where every variable's
  * data starts and how many records there are, so a file shorter than the end of
@@ -288,6 +270,8 @@ typedef struct {
     float *eta;                           /* number densities, m^-3: nsel fields of n3 */
     double *zmt;                          /* zm transposed: each column's levels contiguous */
     float *colv;                          /* one output column */
+    double *acc;                          /* the same, accumulated in double */
+    unsigned char *wet;                   /* per model column: any value > 0 in the field */
     double zlo;                           /* bottom of the output grid, m */
     atmos_volume_desc vd;                 /* the output grid */
     atmos_volume *vol;
@@ -307,6 +291,8 @@ static void loader_free(loader *L)
     free(L->eta);
     free(L->zmt);
     free(L->colv);
+    free(L->acc);
+    free(L->wet);
     atmos_volume_destroy(L->vol);
     L->vol = NULL;
 }
@@ -699,9 +685,21 @@ static atmos_status number_density(loader *L, int si)
 
 /* ------------------------------------------------------------ the voxel grid */
 
+/* The default voxel: the model's vertical resolution (its mean layer depth) unless the
+ * horizontal spacing is finer, but no smaller than keeps the grid within DEFAULT_VOXELS
+ * voxels (a coarse model over a wide domain: the vertical resolution then gives way). */
+#define DEFAULT_VOXELS 8388608.0
+static double default_voxel(const loader *L, double depth)
+{
+    const src *s = &L->s;
+    double vs = fmin(fmin(L->dx, L->dy), depth / s->nz);
+    const double budget = cbrt(s->nx * L->dx * s->ny * L->dy * depth / DEFAULT_VOXELS);
+    return fmax(vs, budget);
+}
+
 /* The uniform output grid: from the lowest ground to the highest model top, voxels of
- * desc->voxel_size_m or by default the horizontal grid spacing (on coarse grids that
- * flattens the vertical structure, hence the warning). */
+ * desc->voxel_size_m or by default_voxel (a voxel too large for the model's depth
+ * flattens its vertical structure, hence the warning). */
 static atmos_status output_grid(loader *L)
 {
     const src *s = &L->s;
@@ -714,7 +712,7 @@ static atmos_status output_grid(loader *L)
         if (th < layer) layer = th;
     }
     const double dx = L->dx, dy = L->dy;
-    double vs = L->desc->voxel_size_m > 0 ? L->desc->voxel_size_m : fmin(dx, dy);
+    double vs = L->desc->voxel_size_m > 0 ? L->desc->voxel_size_m : default_voxel(L, zhi - zlo);
     if ((zhi - zlo) / vs < 8)
         atmos__log(s->ctx, ATMOS_LOG_WARN,
                    "%s: a voxel of %g m leaves only %.1f voxels over the model's %.0f m depth (thinnest mean layer "
@@ -750,51 +748,116 @@ static atmos_status resample_buffers(loader *L)
 {
     const int nz = L->s.nz;
     L->colv = malloc((size_t)L->vd.dims[1] * sizeof *L->colv);
+    L->acc = malloc((size_t)L->vd.dims[1] * sizeof *L->acc);
+    L->wet = malloc(L->ncol);
     L->zmt = malloc(L->n3 * sizeof *L->zmt);
-    if (!L->colv || !L->zmt) return out_of_memory(L);
+    if (!L->colv || !L->acc || !L->wet || !L->zmt) return out_of_memory(L);
     for (size_t c = 0; c < L->ncol; c++)
         for (int k = 0; k < nz; k++) L->zmt[c * (size_t)nz + k] = L->zm[(size_t)k * L->ncol + c];
     return ATMOS_OK;
 }
 
-/* Clamps a fractional column index f to [0, n - 1]: the two columns bracketing it
- * and the weight of the second. */
-static void bracket(double f, int n, int *a, int *b, double *w)
+/* Adds w times model column col (values v[k * ncol], k over its mass levels) at the
+ * output voxels' heights to L->acc: linear between mass levels, constant from the ground
+ * to the first level and from the last level to the model top, 0 below the ground and
+ * above the top. The heights grow with J, so the level pair is found by one walk up. */
+static void add_column(const loader *L, const float *v, size_t col, double w)
+{
+    const int nz = L->s.nz;
+    const size_t stride = L->ncol;
+    const double *zm = L->zmt + col * (size_t)nz;
+    const double ground = L->zw[col], top = L->zw[(size_t)nz * L->ncol + col], vs = L->vd.voxel_size_m;
+    int lo = 0;
+    for (int J = 0; J < L->vd.dims[1]; J++) {
+        const double y = L->zlo + (J + 0.5) * vs;
+        if (y < ground) continue;
+        if (y > top) break;
+        double val;
+        if (y <= zm[0]) {
+            val = v[0];
+        } else if (y >= zm[nz - 1]) {
+            val = v[(size_t)(nz - 1) * stride];
+        } else {
+            while (lo + 2 < nz && zm[lo + 1] <= y) lo++;
+            const double f = (y - zm[lo]) / (zm[lo + 1] - zm[lo]);
+            val = (1 - f) * v[(size_t)lo * stride] + f * v[(size_t)(lo + 1) * stride];
+        }
+        L->acc[J] += w * val;
+    }
+}
+
+/* The four columns and Catmull-Rom weights at fractional column index f (clamped to
+ * [0, n - 1]; columns past the edges repeat the edge's). The cubic passes through the
+ * columns' values and its slope is continuous across them (C1): a smooth field, not the
+ * pyramids of bilinear interpolation, whose slope jumps at every column. */
+static void cubic_taps(double f, int n, int idx[4], double w[4])
 {
     if (f < 0) f = 0;
     if (f > n - 1) f = n - 1;
-    *a = (int)floor(f);
-    *b = *a + 1 < n ? *a + 1 : *a;
-    *w = f - *a;
+    int a = (int)floor(f);
+    if (a > n - 2) a = n - 2 > 0 ? n - 2 : 0;
+    const double t = f - a, t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5 * (-t + 2 * t2 - t3);
+    w[1] = 0.5 * (2 - 5 * t2 + 3 * t3);
+    w[2] = 0.5 * (t + 4 * t2 - 3 * t3);
+    w[3] = 0.5 * (t3 - t2);
+    for (int k = 0; k < 4; k++) {
+        int i = a - 1 + k;
+        idx[k] = i < 0 ? 0 : i > n - 1 ? n - 1 : i;
+    }
 }
 
-/* One output column (voxels I, *, K) of field values e at the mass points: bilinear
- * between mass-point columns (cell centres at (i + 0.5) dx), linear in height within
- * each. Returns whether any value is > 0. */
+/* One output column (voxels I, *, K) of field values e at the mass points: each model
+ * column interpolated linearly in height at its own (terrain-following) levels, then the
+ * 4 x 4 nearest columns (cell centres at (i + 0.5) dx) combined by bicubic Catmull-Rom
+ * weights; the cubic's small overshoots below zero are cut at zero. Returns whether any
+ * value is > 0. */
 static int resample_column(const loader *L, const float *e, int I, int K)
 {
     const src *s = &L->s;
     const double vs = L->vd.voxel_size_m;
-    int ia, ib, ja, jb;
-    double wx, wy;
-    bracket(((I + 0.5) * vs) / L->dx - 0.5, s->nx, &ia, &ib, &wx);
+    int ix[4], jy[4];
+    double wx[4], wy[4];
+    cubic_taps(((I + 0.5) * vs) / L->dx - 0.5, s->nx, ix, wx);
     /* z grows southward: K = 0 is the region's north edge. */
-    bracket((s->ny * L->dy - (K + 0.5) * vs) / L->dy - 0.5, s->ny, &ja, &jb, &wy);
-    const int ci[4] = {ia, ib, ia, ib}, cj[4] = {ja, ja, jb, jb};
-    const double cw[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+    cubic_taps((s->ny * L->dy - (K + 0.5) * vs) / L->dy - 0.5, s->ny, jy, wy);
+    const int nJ = L->vd.dims[1];
+    int any = 0;
+    for (int J = 0; J < nJ; J++) L->acc[J] = 0;
+    for (int c = 0; c < 16; c++) {
+        const double cw = wx[c & 3] * wy[c >> 2];
+        const size_t col = (size_t)ix[c & 3] + (size_t)s->nx * (size_t)jy[c >> 2];
+        if (cw == 0 || !L->wet[col]) continue;
+        add_column(L, e + col, col, cw);
+        any = 1;
+    }
     int nonzero = 0;
-    for (int J = 0; J < L->vd.dims[1]; J++) {
-        double y = L->zlo + (J + 0.5) * vs, v = 0;
-        for (int c = 0; c < 4; c++) {
-            if (cw[c] == 0) continue;
-            size_t col = (size_t)ci[c] + (size_t)s->nx * (size_t)cj[c];
-            double zcol[2] = {L->zw[col], L->zw[(size_t)s->nz * L->ncol + col]};
-            v += cw[c] * column_at(e + col, L->zmt + col * (size_t)s->nz, s->nz, L->ncol, zcol, y);
-        }
+    for (int J = 0; J < nJ; J++) {
+        const double v = any && L->acc[J] > 0 ? L->acc[J] : 0.0;
         L->colv[J] = (float)v;
         if (v > 0) nonzero = 1;
     }
     return nonzero;
+}
+
+/* Artists' sub-grid detail (desc->subgrid_detail = a > 0): the column's values times
+ * 1 + a (2 n - 1), n a fractal value noise in [0, 1] (mean 1/2: the factor's mean is 1) whose
+ * largest features are half the model's grid spacing and whose octaves reach the voxel. One
+ * noise for all fields (the same texture in cloud and rain), fixed seed: the same volume
+ * every time. */
+static void add_detail(const loader *L, int I, int K)
+{
+    const double a = L->desc->subgrid_detail, vs = L->vd.voxel_size_m;
+    const double cell = 0.5 * fmin(L->dx, L->dy);
+    int octaves = 1;
+    while (octaves < 6 && cell / (1 << octaves) > vs) octaves++;
+    for (int J = 0; J < L->vd.dims[1]; J++) {
+        if (!(L->colv[J] > 0)) continue;
+        const double n = atmos__gen_fbm3(0x5EED, (I + 0.5) * vs / cell, (J + 0.5) * vs / cell, (K + 0.5) * vs / cell,
+                                         octaves, 0.5);
+        const double f = 1 + a * (2 * n - 1);
+        L->colv[J] = (float)(L->colv[J] * (f > 0 ? f : 0));
+    }
 }
 
 /* Adds hydrometeor sel[si] as a field and writes its non-empty columns. */
@@ -805,9 +868,17 @@ static atmos_status resample_field(loader *L, int si)
     atmos_status st = atmos_volume_add_field(L->s.ctx, L->vol, hydro[h].field, hydro[h].particle, &field);
     if (st != ATMOS_OK) return st;
     const float *e = L->eta + (size_t)si * L->n3;
+    int wet = 0;
+    for (size_t c = 0; c < L->ncol; c++) {
+        L->wet[c] = 0;
+        for (int k = 0; k < L->s.nz && !L->wet[c]; k++) L->wet[c] = e[(size_t)k * L->ncol + c] > 0;
+        wet |= L->wet[c];
+    }
+    if (!wet) return ATMOS_OK; /* a dry field: no column to write */
     for (int I = 0; I < L->vd.dims[0]; I++)
         for (int K = 0; K < L->vd.dims[2]; K++) {
             if (!resample_column(L, e, I, K)) continue;
+            if (L->desc->subgrid_detail > 0) add_detail(L, I, K);
             const int off[3] = {I, 0, K}, size[3] = {1, L->vd.dims[1], 1};
             if ((st = atmos_volume_set_dense(L->s.ctx, L->vol, field, off, size, L->colv, 1.0f))) return st;
         }
@@ -826,6 +897,11 @@ static atmos_status load(loader *L)
     for (int si = 0; si < L->nsel; si++)
         if ((st = number_density(L, si))) return st;
     if ((st = output_grid(L)) || (st = resample_buffers(L))) return st;
+    if (L->desc->subgrid_detail > 0)
+        atmos__log(L->s.ctx, ATMOS_LOG_WARN,
+                   "%s: sub-grid detail added (amplitude %g): an artistic texture below the model's %.0f m grid, "
+                   "not model data",
+                   L->s.path, L->desc->subgrid_detail, fmin(L->dx, L->dy));
     for (int si = 0; si < L->nsel; si++)
         if ((st = resample_field(L, si))) return st;
     return atmos_volume_finalize(L->s.ctx, L->vol);

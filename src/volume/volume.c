@@ -406,3 +406,22 @@ void atmos__volume_set_file_active(atmos_volume *vol, int field, uint64_t count)
         vol->field[field].stats.file_active_voxels = count;
     }
 }
+
+void atmos__volume_rescale(atmos_volume *vol, double factor)
+{
+    if (!vol || !(factor > 0) || factor == 1.0) return;
+    vol->desc.voxel_size_m *= factor;
+    for (int a = 0; a < 3; a++) vol->desc.origin_m[a] *= factor;
+    atmos__vol_xform_init(vol, NULL, &vol->xform);
+    /* A field's box is origin + R (index * voxel size): linear in both, so it scales too. */
+    for (int f = 0; f < vol->nfields; f++)
+        for (int c = 0; c < 2; c++)
+            for (int a = 0; a < 3; a++) vol->field[f].stats.bounds_m[c][a] *= factor;
+}
+
+void atmos__volume_set_source_format(atmos_volume *vol, const char *format)
+{
+    if (vol) snprintf(vol->source_format, sizeof vol->source_format, "%s", format ? format : "");
+}
+
+const char *atmos_volume_source_format(const atmos_volume *vol) { return vol ? vol->source_format : ""; }

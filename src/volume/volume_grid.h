@@ -71,6 +71,7 @@ struct atmos_volume {
     uint32_t nrange;
     int occ_lo[3], occ_hi[3]; /* brick box of the occupied bricks of all fields (hi < lo: none) */
     int rng_lo[3], rng_hi[3]; /* brick box of the positions with a range > 0 (hi < lo: none) */
+    char source_format[16];   /* atmos_volume_source_format */
 };
 
 /* Index of the brick containing voxel (i, j, k) (all in range). */

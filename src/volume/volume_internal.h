@@ -20,4 +20,10 @@ atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, co
  * atmos_volume_field_stats.file_active_voxels); call before or after finalize. */
 void atmos__volume_set_file_active(atmos_volume *vol, int field, uint64_t count);
 
+/* Multiplies every length of a finalized volume (voxel size, origin, the fields' boxes) by
+ * factor > 0: a unit conversion of the file's lengths. */
+void atmos__volume_rescale(atmos_volume *vol, double factor);
+/* Records the kind of file the volume came from (atmos_volume_source_format). */
+void atmos__volume_set_source_format(atmos_volume *vol, const char *format);
+
 #endif

@@ -105,14 +105,31 @@ double cli_now_s(void)
 void cli_progress_init(cli_progress *p, int quiet)
 {
     p->enabled = !quiet && isatty(2);
+    p->log = !quiet && !p->enabled;
     p->start = cli_now_s();
     p->shown = 0;
     p->last_draw = 0.0;
+    p->last_log = 0.0;
+    const char *iv = getenv("ATMOS_PROGRESS_INTERVAL");
+    char *end = NULL;
+    p->interval = iv && *iv ? strtod(iv, &end) : 5.0;
+    if (!(p->interval >= 0) || (end && *end)) p->interval = 5.0;
+}
+
+/* Off a terminal: a line every interval seconds, the first after one interval. */
+static void progress_log(cli_progress *p, const char *stage, double f)
+{
+    double t = cli_now_s() - p->start;
+    if (t < p->interval || (p->last_log > 0 && t - p->last_log < p->interval)) return;
+    p->last_log = t > 0 ? t : 1e-9;
+    fprintf(stderr, "atmos: %s: %.0f %%, %.1f s elapsed\n", stage, 100.0 * f, t);
+    fflush(stderr);
 }
 
 int cli_progress_bar(void *user, const char *stage, double f)
 {
     cli_progress *p = user;
+    if (p->log) progress_log(p, stage, f);
     if (!p->enabled) return 0;
     double t = cli_now_s() - p->start;
     if (t < 1.0 && f < 1.0) return 0;

@@ -3,6 +3,7 @@
  * is rendered from that plan (atmos_plan_render, the same call atmos_render_scene makes). */
 #include "outputs.h"
 #include "render_opts.h"
+#include "render_scene.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -190,7 +191,7 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
 {
     if (nframes > 1) fprintf(stderr, "atmos render: frame %d/%d: ", frame, nframes);
     else fprintf(stderr, "atmos render: ");
-    fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s\n", source, fs->width, fs->height,
+    fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source, fs->width, fs->height,
             info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
     for (int i = 0; i < 6; i++)
@@ -283,25 +284,6 @@ static int check_outputs(const render_opts *o, const atmos_scene *scene, const c
     return cli_outputs_check("render", &set, inputs, 2);
 }
 
-/* The scene: the file or the default, the options applied, validated. Returns CLI_EXIT_OK
- * or the exit status of the failure (message printed). */
-static int make_scene(atmos_context *ctx, const render_opts *o, atmos_scene *scene)
-{
-    atmos_status st;
-    if (o->scene_path) {
-        if ((st = atmos_scene_load(ctx, o->scene_path, scene)) != ATMOS_OK) return cli_runtime_error("render", ctx, st);
-    } else {
-        atmos_scene_defaults(scene);
-    }
-    int rc = render_opts_apply(ctx, o, scene);
-    if (rc != CLI_EXIT_OK) return rc;
-    if ((st = atmos_scene_validate(ctx, scene, o->scene_path ? o->scene_path : "options")) != ATMOS_OK) {
-        fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
-        return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
-    }
-    return CLI_EXIT_OK;
-}
-
 int cli_cmd_render(int argc, char **argv)
 {
     render_opts o;
@@ -312,15 +294,19 @@ int cli_cmd_render(int argc, char **argv)
     cli_progress_init(&prog, o.quiet);
     atmos_context *ctx = cli_context_with_progress(o.threads, o.quiet, cli_progress_bar, &prog);
     if (!ctx) return CLI_EXIT_RUNTIME;
+    const double t0 = cli_now_s();
     atmos_scene scene;
-    if ((rc = make_scene(ctx, &o, &scene)) != CLI_EXIT_OK) {
+    atmos_volume *volume = NULL; /* loaded here when framed (render_scene.c), else by the plan */
+    if ((rc = render_scene_make(ctx, &o, &scene, &volume)) != CLI_EXIT_OK) {
+        atmos_volume_destroy(volume);
         atmos_context_destroy(ctx);
         return rc;
     }
     const char *source = o.scene_path ? o.scene_path : "default scene", *png = o.png;
     char default_png[160];
     if (!o.png && !o.exr && !o.pfm) {
-        default_png_name(scene.name, default_png, sizeof default_png);
+        char stem[128];
+        default_png_name(render_scene_output_name(&o, &scene, stem, sizeof stem), default_png, sizeof default_png);
         png = default_png;
     }
     const int nframes = scene.animation.frames > 1 ? scene.animation.frames : 1;
@@ -328,15 +314,21 @@ int cli_cmd_render(int argc, char **argv)
     static frame_outputs fo;
     if ((rc = check_outputs(&o, &scene, png)) != CLI_EXIT_OK ||
         (rc = stage_frame(&o, png, 1, nframes, &fo.ff, &fo.set, &fo.w)) != CLI_EXIT_OK) {
+        atmos_volume_destroy(volume);
         atmos_context_destroy(ctx);
         return rc;
     }
     atmos_plan *plan = NULL;
     int failed = 0;
-    atmos_status st = atmos_plan_create(ctx, &scene, NULL, NULL, &plan);
+    atmos_status st = atmos_plan_create(ctx, &scene, volume, NULL, &plan);
+    const double t_plan = cli_now_s() - t0;
     if (st == ATMOS_OK && fo.w.tau) st = write_tau(ctx, &scene, plan, fo.w.tau);
     if (st == ATMOS_OK) st = render_frames(ctx, plan, &scene, &o, png, source, &prog, &fo, &failed);
     cli_outputs_discard(&fo.set);
+    if (st == ATMOS_OK && !o.quiet)
+        fprintf(stderr, "atmos render: %.3f s in all: %.3f s for the scene, the volume and the optics tables, %.3f s "
+                        "rendering and writing\n",
+                cli_now_s() - t0, t_plan, cli_now_s() - t0 - t_plan);
     if (st != ATMOS_OK) {
         if (prog.shown) fputc('\n', stderr);
         if (nframes > 1 && failed >= 1) fprintf(stderr, "atmos render: frame %d/%d failed\n", failed, nframes);
@@ -344,6 +336,7 @@ int cli_cmd_render(int argc, char **argv)
         else rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
     }
     atmos_plan_destroy(plan);
+    atmos_volume_destroy(volume);
     atmos_context_destroy(ctx);
     return rc;
 }

@@ -33,10 +33,15 @@ static void help(void)
            "Reading options (info, slice):\n"
            "  --grids LIST      VDB/NanoVDB grids or NetCDF variables to read (comma-separated)\n"
            "  --as NAME         field name for a single-grid file (default cloud)\n"
-           "  --scale S         multiplies the file's values (VDB/raw: to get m^-3)\n"
+           "  --scale S         multiplies the file's values (after the density unit's conversion)\n"
+           "  --density-unit U  what a VDB/raw file's values are: per_m3, g_m3 (water content, by the\n"
+           "                    particle's mean mass), fraction (0..1, 1 = 1e8 m^-3) or auto (default:\n"
+           "                    VDB fraction, raw per_m3; NetCDF: its mixing ratios, auto only)\n"
+           "  --length-scale F  multiplies a VDB/raw file's lengths (0.01: a file in centimetres)\n"
            "  --time N          NetCDF time step (default 0)\n"
-           "  --voxel-size M    NetCDF resampling voxel edge in metres (default: the model's DX;\n"
-           "                    WRF cloud layers want a few hundred metres)\n"
+           "  --voxel-size M    NetCDF: resampling voxel edge in metres (default: the model's mean layer\n"
+           "                    depth or DX if finer, at most 8.4 M voxels); VDB/raw: the voxel edge\n"
+           "                    replacing the file's (its origin scaled with it)\n"
            "  --max-memory MB   refuse volumes that would need more memory\n\n"
            "Exit status: 0 success, 1 runtime error, 2 usage error.\n");
 }
@@ -67,6 +72,22 @@ static int load_option(int argc, char **argv, int *i, atmos_volume_load_desc *d)
     } else if (!strcmp(a, "--scale")) {
         if (!cli_parse_double(C, "--scale", argv[++*i], &d->density_scale) || !(d->density_scale > 0)) {
             cli_usage_error(C, "--scale: expected a factor > 0");
+            return -1;
+        }
+    } else if (!strcmp(a, "--density-unit")) {
+        static const char *const units[] = {"auto", "per_m3", "g_m3", "fraction"};
+        const char *u = argv[++*i];
+        int k = 0;
+        while (k < 4 && strcmp(u, units[k])) k++;
+        if (k == 4) {
+            cli_usage_error(C, "--density-unit: expected auto, per_m3, g_m3 or fraction, got '%s'", u);
+            return -1;
+        }
+        d->density_unit = (atmos_density_unit)k;
+    } else if (!strcmp(a, "--length-scale")) {
+        if (!cli_parse_double(C, "--length-scale", argv[++*i], &d->length_scale) ||
+            !(d->length_scale > 0 && d->length_scale <= 1e6)) {
+            cli_usage_error(C, "--length-scale: expected a factor in (0, 1e6]");
             return -1;
         }
     } else if (!strcmp(a, "--max-memory")) {

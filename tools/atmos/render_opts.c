@@ -13,7 +13,8 @@
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
     O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_VPOS, O_DSCALE, O_TAU, O_VARIANCE,
-    O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS, O_EXP_PER_FRAME,
+    O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS, O_GRIDS, O_PARTICLE, O_TINDEX,
+    O_DUNIT, O_VOXEL, O_VSCALE, O_FOV, O_VIEW_EL, O_VIEW_AZ, O_POSITION, O_LOOKAT, O_DETAIL, O_EXP_PER_FRAME,
     O_SETTING = 1024 /* + row index over the tables: a renderer setting */
 };
 
@@ -34,6 +35,13 @@ static const struct option fixed_opts[] = {
     {"frames", required_argument, 0, O_FRAMES}, {"time-end", required_argument, 0, O_TIME_END},
     {"sun-elevation-end", required_argument, 0, O_SEL_END}, {"sun-azimuth-end", required_argument, 0, O_SAZ_END},
     {"atmosphere", required_argument, 0, O_ATMOSPHERE}, {"thickness", required_argument, 0, O_THICKNESS},
+    {"grids", required_argument, 0, O_GRIDS}, {"particle", required_argument, 0, O_PARTICLE},
+    {"time-index", required_argument, 0, O_TINDEX}, {"density-unit", required_argument, 0, O_DUNIT},
+    {"voxel-size", required_argument, 0, O_VOXEL}, {"volume-scale", required_argument, 0, O_VSCALE},
+    {"fov", required_argument, 0, O_FOV}, {"view-elevation", required_argument, 0, O_VIEW_EL},
+    {"view-azimuth", required_argument, 0, O_VIEW_AZ}, {"position", required_argument, 0, O_POSITION},
+    {"look-at", required_argument, 0, O_LOOKAT}, {"define", required_argument, 0, 'D'},
+    {"subgrid-detail", required_argument, 0, O_DETAIL},
     {"exposure-per-frame", no_argument, 0, O_EXP_PER_FRAME},
     {"help", no_argument, 0, 'h'}};
 #define NFIXED ((int)(sizeof fixed_opts / sizeof fixed_opts[0]))
@@ -119,6 +127,20 @@ static void opts_init(render_opts *o)
     o->cam_type = o->renderer = o->tone = o->air = -1;
     o->altitude = o->sun_el = o->sun_az = o->lat = o->lon = o->ev = o->ev_comp = NAN;
     o->sun_el_end = o->sun_az_end = NAN;
+    o->time_index = o->density_unit = -1;
+    o->fov = o->view_el = o->view_az = NAN;
+}
+
+/* X,Y,Z in metres. */
+static int parse_vec3(const char *opt, const char *arg, double v[3], int *given)
+{
+    char tail;
+    if (sscanf(arg, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !isfinite(v[0]) || !isfinite(v[1]) ||
+        !isfinite(v[2])) {
+        cli_usage_error("render", "%s: expected X,Y,Z in metres, got '%s'", opt, arg);
+        return 0;
+    }
+    return *given = 1, 1;
 }
 
 /* The options that name files or pick from words. Returns 1, 0 (usage error printed) or -1
@@ -147,15 +169,14 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_EXPOSURE:
         if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
         return cli_parse_double("render", "--exposure", arg, &o->ev);
-    case O_VPOS: {
-        char tail;
-        double *v = o->volume_pos;
-        if (sscanf(arg, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !isfinite(v[0]) || !isfinite(v[1]) ||
-            !isfinite(v[2])) {
-            cli_usage_error("render", "--volume-position: expected X,Y,Z in metres, got '%s'", arg);
-            return 0;
-        }
-        return o->volume_pos_given = 1, 1;
+    case O_VPOS: return parse_vec3("--volume-position", arg, o->volume_pos, &o->volume_pos_given);
+    case O_POSITION: return parse_vec3("--position", arg, o->position, &o->position_given);
+    case O_LOOKAT: return parse_vec3("--look-at", arg, o->look_at, &o->look_at_given);
+    case O_GRIDS: o->grids = arg; return 1;
+    case O_PARTICLE: o->particle = arg; return 1;
+    case O_DUNIT: {
+        static const char *const units[] = {"auto", "per_m3", "g_m3", "fraction"};
+        return parse_choice("--density-unit", arg, units, 4, &o->density_unit);
     }
     default: return -1;
     }
@@ -187,6 +208,30 @@ static int parse_number(int c, const char *arg, render_opts *o)
         if (!cli_parse_double(C, "--thickness", arg, &o->thickness) || !(o->thickness >= 1 && o->thickness <= 1e6))
             return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]"), 0;
         return 1;
+    case O_TINDEX: return cli_parse_int(C, "--time-index", arg, 0, 1000000, &o->time_index);
+    case O_VOXEL:
+        if (!cli_parse_double(C, "--voxel-size", arg, &o->voxel_size) || !(o->voxel_size > 0 && o->voxel_size <= 1e5))
+            return cli_usage_error(C, "--voxel-size: expected metres in (0, 100000]"), 0;
+        return 1;
+    case O_VSCALE:
+        if (!cli_parse_double(C, "--volume-scale", arg, &o->volume_scale) ||
+            !(o->volume_scale > 0 && o->volume_scale <= 100))
+            return cli_usage_error(C, "--volume-scale: expected a factor in (0, 100]"), 0;
+        return 1;
+    case O_DETAIL:
+        if (!cli_parse_double(C, "--subgrid-detail", arg, &o->subgrid_detail) ||
+            !(o->subgrid_detail > 0 && o->subgrid_detail <= 1))
+            return cli_usage_error(C, "--subgrid-detail: expected an amplitude in (0, 1]"), 0;
+        return 1;
+    case O_FOV:
+        if (!cli_parse_double(C, "--fov", arg, &o->fov) || !(o->fov > 0 && o->fov <= 360))
+            return cli_usage_error(C, "--fov: expected degrees in (0, 360]"), 0;
+        return 1;
+    case O_VIEW_EL:
+        if (!cli_parse_double(C, "--view-elevation", arg, &o->view_el) || !(fabs(o->view_el) < 90))
+            return cli_usage_error(C, "--view-elevation: expected degrees in (-90, 90)"), 0;
+        return 1;
+    case O_VIEW_AZ: return cli_parse_double(C, "--view-azimuth", arg, &o->view_az);
     case O_DSCALE:
         if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) || !(o->density_scale > 0))
             return cli_usage_error(C, "--density-scale: expected a factor > 0"), 0;
@@ -211,6 +256,12 @@ static int check_options(const render_opts *o)
                                   "(a sun given by angles) exclude each other");
     if (o->volume && strlen(o->volume) >= sizeof(((atmos_scene *)0)->volume.source))
         return cli_usage_error(C, "--volume: the path is too long");
+    if (o->grids && strlen(o->grids) >= sizeof(((atmos_scene *)0)->volume.grids))
+        return cli_usage_error(C, "--grids: the list is too long");
+    if (o->particle && (!o->particle[0] || strlen(o->particle) >= sizeof(((atmos_scene *)0)->volume.particle)))
+        return cli_usage_error(C, "--particle: expected a particle type's name");
+    if (o->look_at_given && (!isnan(o->view_el) || !isnan(o->view_az)))
+        return cli_usage_error(C, "--look-at and --view-elevation/--view-azimuth exclude each other");
     return CLI_EXIT_OK;
 }
 
@@ -222,8 +273,14 @@ int render_opts_parse(int argc, char **argv, render_opts *o)
     optind = 1;
     opterr = 0;
     int c;
-    while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:qhD:", opts, NULL)) != -1) {
         if (c == 'h') return render_opts_help(), -1;
+        if (c == 'D') {
+            if (o->ndefines >= RENDER_OPTS_MAX_DEFINES) return cli_usage_error("render", "too many -D options");
+            if (!strchr(optarg, '=')) return cli_usage_error("render", "-D: expected KEY=VALUE, got '%s'", optarg);
+            o->defines[o->ndefines++] = optarg;
+            continue;
+        }
         if (c == 'q') {
             o->quiet = 1;
             continue;
@@ -282,6 +339,60 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
     return CLI_EXIT_OK;
 }
 
+/* --position, --look-at, --fov, --view-elevation/--view-azimuth. A new position keeps the
+ * view direction unless --look-at is given too; the view angles turn the camera where it is. */
+static void apply_camera(const render_opts *o, atmos_camera_desc *c)
+{
+    double d[3], len = 0;
+    for (int a = 0; a < 3; a++) d[a] = c->look_at[a] - c->position[a], len += d[a] * d[a];
+    len = sqrt(len);
+    if (o->position_given) {
+        memcpy(c->position, o->position, sizeof o->position);
+        for (int a = 0; a < 3; a++) c->look_at[a] = c->position[a] + d[a];
+    }
+    if (o->look_at_given) memcpy(c->look_at, o->look_at, sizeof o->look_at);
+    if (!isnan(o->view_el) || !isnan(o->view_az)) {
+        double el = 0, az = 0;
+        if (len > 0) {
+            el = asin(fmax(-1.0, fmin(1.0, d[1] / len))) * 57.295779513082321;
+            az = atan2(d[0], -d[2]) * 57.295779513082321; /* clockwise from north (-z), east +x */
+        }
+        if (!isnan(o->view_el)) el = o->view_el;
+        if (!isnan(o->view_az)) az = o->view_az;
+        double dir[3];
+        atmos_direction_from_angles(el, az, dir);
+        for (int a = 0; a < 3; a++) c->look_at[a] = c->position[a] + 1000.0 * dir[a];
+    }
+    if (!isnan(o->fov)) c->fov_deg = o->fov;
+}
+
+int render_opts_camera_given(const render_opts *o)
+{
+    return o->position_given || o->look_at_given || !isnan(o->altitude) || o->cam_type > 0;
+}
+
+/* The volume file's options: refused with a generated volume, which has none of them. */
+static int apply_volume_file(const render_opts *o, atmos_scene *s)
+{
+    const char *C = "render";
+    const int given = o->grids || o->particle || o->time_index >= 0 || o->density_unit >= 0 || o->subgrid_detail > 0;
+    if (!given && !(o->voxel_size > 0) && !(o->volume_scale > 0)) return CLI_EXIT_OK;
+    if (!s->volume.source[0])
+        return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit, --voxel-size and --volume-scale "
+                                  "need a volume (--volume or a scene with one)");
+    if (given && !strncmp(s->volume.source, "generate:", 9))
+        return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit and --subgrid-detail apply to a "
+                                  "volume file, not to a generated volume");
+    if (o->grids) snprintf(s->volume.grids, sizeof s->volume.grids, "%s", o->grids);
+    if (o->particle) snprintf(s->volume.particle, sizeof s->volume.particle, "%s", o->particle);
+    if (o->time_index >= 0) s->volume.time_index = o->time_index;
+    if (o->density_unit >= 0) s->volume.density_unit = (atmos_density_unit)o->density_unit;
+    if (o->voxel_size > 0) s->volume.voxel_size_m = o->voxel_size;
+    if (o->volume_scale > 0) s->volume.scale = o->volume_scale;
+    if (o->subgrid_detail > 0) s->volume.subgrid_detail = o->subgrid_detail;
+    return CLI_EXIT_OK;
+}
+
 /* The image, camera, wavelengths and exposure. */
 static int apply_view(const render_opts *o, atmos_scene *s)
 {
@@ -299,6 +410,7 @@ static int apply_view(const render_opts *o, atmos_scene *s)
         s->camera.position[1] = o->altitude;
         s->camera.look_at[1] += dy; /* keep the view direction */
     }
+    apply_camera(o, &s->camera);
     if (o->spectral) s->wavelengths = ATMOS_WAVELENGTHS_SPECTRAL, s->spectral_samples = o->spectral;
     if (o->rgb) s->wavelengths = ATMOS_WAVELENGTHS_RGB;
     if (o->exposure_auto) s->tonemap.manual_exposure = 0;
@@ -325,9 +437,11 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
     }
     if (o->renderer >= 0) s->renderer = (atmos_renderer_kind)o->renderer;
     const atmos_renderer_kind r = s->renderer;
-    if (r == ATMOS_RENDERER_SKY && (o->volume || o->density_scale > 0 || o->volume_pos_given || o->tau))
-        return cli_usage_error(C, "--volume, --volume-position, --density-scale and --tau go with a volume renderer, "
-                                  "not --renderer sky");
+    if (r == ATMOS_RENDERER_SKY && (o->volume || o->density_scale > 0 || o->volume_pos_given || o->tau || o->grids ||
+                                    o->particle || o->time_index >= 0 || o->density_unit >= 0 || o->voxel_size > 0 ||
+                                    o->volume_scale > 0 || o->subgrid_detail > 0))
+        return cli_usage_error(C, "--volume, --volume-position, --density-scale, --tau and the volume file's options "
+                                  "go with a volume renderer, not --renderer sky");
     if (r != ATMOS_RENDERER_PATH && (o->variance || o->order))
         return cli_usage_error(C, "--variance and --order go with --renderer path");
     for (int i = 0; i < o->nset; i++) {
@@ -342,6 +456,7 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
             return cli_usage_error(C, "--%s goes with --renderer %s", rs->setting->flag, atmos_renderer_name(rs->renderer));
         }
     }
+    if (apply_volume_file(o, s) != CLI_EXIT_OK) return CLI_EXIT_USAGE;
     if (o->volume_pos_given) s->volume.placed = 1, memcpy(s->volume.position_m, o->volume_pos, sizeof o->volume_pos);
     if (o->density_scale > 0) s->volume.density_scale = o->density_scale;
     if (o->tau && !s->volume.source[0]) return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
@@ -388,9 +503,11 @@ static void help_settings(atmos_renderer_kind r, const char *title)
 
 void render_opts_help(void)
 {
-    printf("Usage: atmos render [SCENE.json] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
-           "Renders a scene file, or the built-in default scene when none is given.\n"
-           "With no output option, writes NAME.png in the current directory (NAME = the scene's name).\n\n"
+    printf("Usage: atmos render [SCENE.json|-] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
+           "Renders a scene file ('-': read from standard input), or the built-in default scene when none\n"
+           "is given. With no output option, writes NAME.png in the current directory (NAME = the scene\n"
+           "file's name without its extension; the scene's \"name\" for the default scene or standard input).\n"
+           "A volume file is rendered with --volume FILE (not as the scene).\n\n"
            "Outputs (the format is the extension's; folders are created; every output is checked\n"
            "before rendering and all are written or none: two options naming the same file, or\n"
            "an output that is an input, are refused):\n"
@@ -415,6 +532,14 @@ void render_opts_help(void)
            "                                (1..256); path tracer: its samples per pixel (below)\n"
            "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
            "      --altitude M              camera altitude above sea level, metres\n"
+           "      --position X,Y,Z          camera position, metres (x east, y up, z south); keeps the view\n"
+           "                                direction unless --look-at is given\n"
+           "      --look-at X,Y,Z           the point the camera looks at, metres\n"
+           "      --view-elevation E        the view direction's elevation, degrees (negative: down)\n"
+           "      --view-azimuth A          the view direction's azimuth, degrees clockwise from north\n"
+           "      --fov DEG                 field of view: pinhole vertical, fisheye across the circle\n"
+           "                                (a volume file with no camera given is framed: placed, and the\n"
+           "                                camera pointed at it from where the whole box shows)\n"
            "      --sun-elevation E         sun elevation, degrees\n"
            "      --sun-azimuth A           sun azimuth, degrees clockwise from north\n"
            "      --time T --lat L --lon L  sun from a UTC time (2026-06-21T12:00:00Z) and a place\n"
@@ -432,11 +557,32 @@ void render_opts_help(void)
            "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
-           "                                (default: 3 widths, at least 4 km, in front of the camera)\n"
+           "                                (default: 3 widths, at least 4 km, in front of the camera; a\n"
+           "                                VDB/NanoVDB file's base at 1500 m, a cloud's)\n"
            "      --density-scale S         multiplies the volume's densities\n"
+           "      --density-unit U          what a volume file's values are: per_m3 (particles per m^3), g_m3\n"
+           "                                (water content, by the particle's mean mass), fraction (0..1, 1 =\n"
+           "                                1e8 m^-3, a cumulus), auto (default: VDB fraction, raw per_m3,\n"
+           "                                NetCDF its mixing ratios)\n"
+           "      --voxel-size M            NetCDF: the resampling voxel (default: the model's mean layer depth,\n"
+           "                                or DX if finer); VDB/raw: the voxel edge replacing the file's\n"
+           "      --volume-scale S          generators: extent factor; VDB/raw files: multiplies their lengths\n"
+           "                                (0.01: a file in centimetres)\n"
+           "      --grids LIST              VDB grids or NetCDF variables to load (comma-separated)\n"
+           "      --particle NAME           particle type of a single-grid VDB/raw file (default cloud)\n"
+           "      --time-index N            NetCDF time step (default 0)\n"
+           "      --subgrid-detail A        NetCDF, for artists: a fractal texture below the model's grid,\n"
+           "                                amplitude A in (0, 1] (not model data; default off)\n"
+           "  -D, --define PATH=VALUE      sets a scene key before the scene is read, as if in the file:\n"
+           "                                PATH dotted (camera.fov_deg) or a JSON pointer (/camera/fov_deg),\n"
+           "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable\n"
            "      --atmosphere riley|homogeneous   the air: Riley et al.'s exponential atmosphere (default)\n"
            "                                or a uniform layer from the ground to --thickness (docs/models.md)\n"
            "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");
+    printf("One rule for every renderer: an option of another renderer than the one rendering is refused\n"
+           "(exit 2, naming the renderer it goes with); --spp is the one option all renderers share. A scene\n"
+           "file may keep a \"slice\" and a \"path\" section (for --renderer to switch between them); only the\n"
+           "rendering renderer's is used.\n\n");
     help_settings(ATMOS_RENDERER_SLICE, "Slice renderer");
     help_settings(ATMOS_RENDERER_PATH, "Path tracer");
     printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
@@ -455,5 +601,8 @@ void render_opts_help(void)
            "  atmos render -o sky.png --exr sky.exr\n"
            "  atmos render scenes/sunset_fisheye.json --spectral 32 -o sunset.png\n"
            "  atmos render --camera equirect --width 2048 --height 1024 --exr env.exr\n"
+           "  atmos render --volume wdas_cloud_sixteenth.vdb --renderer path --spp 64\n"
+           "  atmos render --volume wrfout_d01.nc --time-index 6 --grids QCLOUD,QICE --view-elevation -45\n"
+           "  atmos render scenes/fig06_halo_cirrus.json -D camera.fov_deg=30 -D renderer=path\n"
            "  atmos render scenes/fig01_cirrus_sunrise.json --frames 8 --time-end 2026-06-21T12:30:00Z -o out/cirrus.png\n");
 }

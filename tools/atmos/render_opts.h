@@ -7,6 +7,7 @@
 #include "cli.h"
 
 #define RENDER_OPTS_MAX_SETTINGS 48
+#define RENDER_OPTS_MAX_DEFINES 64
 
 /* A renderer setting given on the command line. */
 typedef struct {
@@ -27,6 +28,16 @@ typedef struct {
     const char *time, *time_end, *volume;
     double volume_pos[3];
     int volume_pos_given;
+    /* the volume file (NULL / -1 / 0: not given) */
+    const char *grids, *particle;
+    int time_index, density_unit;
+    double voxel_size, volume_scale, subgrid_detail;
+    /* the camera (NaN / 0: not given) */
+    double fov, view_el, view_az, position[3], look_at[3];
+    int position_given, look_at_given;
+    /* -D PATH=VALUE: scene keys set before the scene is read */
+    const char *defines[RENDER_OPTS_MAX_DEFINES];
+    int ndefines;
     render_setting set[RENDER_OPTS_MAX_SETTINGS];
     int nset;
     /* the run */
@@ -39,5 +50,8 @@ void render_opts_help(void);
 /* Applies the options to a scene (loaded or the default); returns CLI_EXIT_OK or
  * CLI_EXIT_USAGE (message printed). ctx receives time-parsing errors. */
 int render_opts_apply(atmos_context *ctx, const render_opts *o, atmos_scene *scene);
+/* Nonzero when the options place the camera themselves (--position, --look-at, --altitude,
+ * --camera): a volume file is then not framed by default. */
+int render_opts_camera_given(const render_opts *o);
 
 #endif

@@ -1,0 +1,118 @@
+/* Scene keys set from outside the file (atmos render -D PATH=VALUE, as Mitsuba's -D): each
+ * override sets one value in the parsed JSON tree before the tree is read, so the value
+ * meets the same rules and messages as one written in the file. */
+#include "scene/scene_internal.h"
+
+#include <cjson/cJSON.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define OV_TOKEN_MAX 128
+
+/* The next path token from *p (JSON pointer: up to '/', "~1" = '/', "~0" = '~'; dotted: up
+ * to '.'), copied to tok. Returns 0 at the end, -1 for a token too long or empty. */
+static int next_token(const char **p, int pointer, char *tok)
+{
+    const char *s = *p;
+    if (!*s) return 0;
+    size_t n = 0;
+    while (*s && *s != (pointer ? '/' : '.')) {
+        char c = *s++;
+        if (pointer && c == '~' && (*s == '0' || *s == '1')) c = *s++ == '0' ? '~' : '/';
+        if (n + 1 >= OV_TOKEN_MAX) return -1;
+        tok[n++] = c;
+    }
+    tok[n] = '\0';
+    if (*s) s++;
+    *p = s;
+    return n ? 1 : -1;
+}
+
+/* An array index token: digits only, at most the array's size (the size appends). */
+static int array_index(const char *tok, int size)
+{
+    if (!*tok) return -1;
+    long v = 0;
+    for (const char *c = tok; *c; c++) {
+        if (*c < '0' || *c > '9' || v > 100000) return -1;
+        v = v * 10 + (*c - '0');
+    }
+    return v <= size ? (int)v : -1;
+}
+
+/* Puts value (owned: consumed on success and on failure) at key or index tok of node. */
+static int put(cJSON *node, const char *tok, cJSON *value)
+{
+    int done = 0;
+    if (cJSON_IsObject(node)) {
+        if (cJSON_GetObjectItemCaseSensitive(node, tok)) done = cJSON_ReplaceItemInObjectCaseSensitive(node, tok, value);
+        else done = cJSON_AddItemToObject(node, tok, value);
+    } else {
+        const int n = cJSON_GetArraySize(node), i = array_index(tok, n);
+        if (i == n) done = cJSON_AddItemToArray(node, value);
+        else if (i >= 0) done = cJSON_ReplaceItemInArray(node, i, value);
+    }
+    if (!done) cJSON_Delete(value);
+    return done;
+}
+
+/* The child of node at tok, created as an object if node is an object without it. */
+static cJSON *child(cJSON *node, const char *tok)
+{
+    if (cJSON_IsObject(node)) {
+        cJSON *c = cJSON_GetObjectItemCaseSensitive(node, tok);
+        if (!c) {
+            c = cJSON_CreateObject();
+            if (c && !cJSON_AddItemToObject(node, tok, c)) cJSON_Delete(c), c = NULL;
+        }
+        return c;
+    }
+    int i = array_index(tok, cJSON_GetArraySize(node) - 1);
+    return i < 0 ? NULL : cJSON_GetArrayItem(node, i);
+}
+
+static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *root, const char *ov)
+{
+    const char *eq = strchr(ov, '=');
+    if (!eq || eq == ov)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%.200s': expected PATH=VALUE", source, ov);
+    size_t plen = (size_t)(eq - ov);
+    char path[1024], tok[OV_TOKEN_MAX];
+    if (plen >= sizeof path)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%.60s...': the path is too long", source, ov);
+    memcpy(path, ov, plen);
+    path[plen] = '\0';
+    /* The value: JSON text, or a bare word (not JSON) taken as a string. */
+    cJSON *value = cJSON_Parse(eq + 1);
+    if (!value) value = cJSON_CreateString(eq + 1);
+    if (!value) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", source);
+    const int pointer = path[0] == '/';
+    const char *p = pointer ? path + 1 : path;
+    cJSON *node = root;
+    int r;
+    while ((r = next_token(&p, pointer, tok)) > 0) {
+        if (!cJSON_IsObject(node) && !cJSON_IsArray(node)) break;
+        if (!*p) {
+            if (put(node, tok, value)) return ATMOS_OK;
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%s': cannot set '%s' there", source, path, tok);
+        }
+        node = child(node, tok);
+        if (!node) break;
+    }
+    cJSON_Delete(value);
+    return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                        "%s: override '%s': not a path into the scene (JSON pointer /a/b/0 or dotted a.b.0, "
+                        "through objects and arrays)",
+                        source, path);
+}
+
+atmos_status atmos__scene_apply_overrides(atmos_context *ctx, const char *source, struct cJSON *root,
+                                          const char *const *overrides, int count)
+{
+    for (int i = 0; i < count; i++) {
+        if (!overrides || !overrides[i]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override %d is NULL", source, i);
+        atmos_status st = apply_one(ctx, source, root, overrides[i]);
+        if (st != ATMOS_OK) return st;
+    }
+    return ATMOS_OK;
+}

@@ -1,0 +1,47 @@
+/* Scene keys set from outside the file (atmos_scene_parse_with, atmos render -D): dotted
+ * paths and JSON pointers, values as JSON or bare words, objects made on the way, array
+ * items replaced, and every value read with the file's rules. */
+#include "atmos/atmos.h"
+#include "test.h"
+
+#include <string.h>
+
+static atmos_context *ctx;
+
+static atmos_status parse(const char *json, const char *const *ov, int n, atmos_scene *s)
+{
+    return atmos_scene_parse_with(ctx, json, strlen(json), "t.json", ov, n, s);
+}
+
+int main(void)
+{
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    atmos_scene s;
+    /* dotted and pointer paths, numbers, arrays, a bare word; objects made as needed */
+    const char *a[] = {"camera.fov_deg=35", "/image/width=64", "name=plain word", "camera.position_m=[1, 900, 2]",
+                       "camera.position_m.1=950"};
+    CHECK_OK(parse("{\"image\": {\"height\": 32}}", a, 5, &s));
+    CHECK(s.camera.fov_deg == 35 && s.width == 64 && s.height == 32 && !strcmp(s.name, "plain word"));
+    CHECK(s.camera.position[0] == 1 && s.camera.position[1] == 950 && s.camera.position[2] == 2);
+    CHECK(s.camera_given);
+    /* a later override wins over an earlier one and over the file */
+    const char *b[] = {"image.width=10", "image.width=20"};
+    CHECK_OK(parse("{\"image\": {\"width\": 5}}", b, 2, &s));
+    CHECK(s.width == 20);
+    /* "~1" is "/" in a pointer token: the key "a/b" (unknown), named back as "/a~1b" */
+    const char *c[] = {"/a~1b=1"};
+    CHECK(parse("{}", c, 1, &s) == ATMOS_E_INVALID_ARG);
+    CHECK(strstr(atmos_context_error(ctx), "/a~1b: unknown key") != NULL);
+    /* the file's rules and JSON pointers in the messages */
+    const char *d[] = {"camera.fov_deg=500"};
+    CHECK(parse("{}", d, 1, &s) == ATMOS_E_INVALID_ARG);
+    CHECK(strstr(atmos_context_error(ctx), "/camera/fov_deg") != NULL);
+    /* paths that lead nowhere: through a number, past an array's end, an empty token */
+    const char *e[] = {"image.width.x=1", "camera.position_m.7=1", "camera..fov_deg=1", "=1", "nothing"};
+    for (int i = 0; i < 5; i++) CHECK_MSG(parse("{}", &e[i], 1, &s) == ATMOS_E_INVALID_ARG, "override %s", e[i]);
+    /* no overrides: the plain parse */
+    CHECK_OK(parse("{\"name\": \"x\"}", NULL, 0, &s));
+    CHECK(!strcmp(s.name, "x") && !s.camera_given);
+    atmos_context_destroy(ctx);
+    return test_summary("test_scene_override");
+}

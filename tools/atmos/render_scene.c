@@ -1,0 +1,112 @@
+/* atmos render's scene: the scene file (or the default), the options applied, validated,
+ * and a volume file without a camera framed: the volume loaded here, placed, and the
+ * camera pointed at it (atmos_scene_frame_volume). */
+#include "render_scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static int ends_with(const char *s, const char *ext)
+{
+    size_t n = strlen(s), m = strlen(ext);
+    if (n < m) return 0;
+    for (size_t i = 0; i < m; i++) {
+        char c = s[n - m + i];
+        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
+        if (c != ext[i]) return 0;
+    }
+    return 1;
+}
+
+/* A volume file given where a scene goes: by its extension or its first bytes (OpenVDB,
+ * NanoVDB, NetCDF classic, HDF5). */
+static int looks_like_volume(const char *path)
+{
+    static const char *const exts[] = {".vdb", ".nvdb", ".nc", ".nc4", ".cdf", ".raw"};
+    for (size_t i = 0; i < sizeof exts / sizeof exts[0]; i++)
+        if (ends_with(path, exts[i])) return 1;
+    unsigned char b[8] = {0};
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    size_t n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    if (n >= 4 && b[0] == 0x20 && b[1] == 0x42 && b[2] == 0x44 && b[3] == 0x56) return 1;
+    if (n >= 7 && !memcmp(b, "NanoVDB", 7)) return 1;
+    if (n >= 4 && !memcmp(b, "CDF", 3)) return 1;
+    return n >= 8 && !memcmp(b, "\x89HDF\r\n\x1a\n", 8);
+}
+
+/* A volume file with no camera given: loaded and placed here, the camera framing it. */
+static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
+{
+    double off[3], lo[3], hi[3];
+    atmos_status st = atmos_scene_load_volume(ctx, scene, volume, off);
+    if (st != ATMOS_OK) return st;
+    atmos_volume_bounds(*volume, lo, hi);
+    /* The placement made explicit, so that the plan puts the volume where it was framed. */
+    scene->volume.placed = 1;
+    scene->volume.position_m[0] = off[0] + 0.5 * (lo[0] + hi[0]);
+    scene->volume.position_m[1] = off[1] + lo[1];
+    scene->volume.position_m[2] = off[2] + 0.5 * (lo[2] + hi[2]);
+    /* A model domain is wide and flat: seen from above; a cloud from its own height. */
+    const int model = !strcmp(atmos_volume_source_format(*volume), "netcdf");
+    const double el = !isnan(o->view_el) ? o->view_el : model ? -30.0 : 0.0;
+    atmos_scene_frame_volume(scene, *volume, off, el);
+    if (!o->quiet) {
+        const double *p = scene->camera.position, *l = scene->camera.look_at;
+        fprintf(stderr,
+                "atmos render: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
+                "looking at (%.0f, %.0f, %.0f) m\n",
+                hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
+    }
+    return ATMOS_OK;
+}
+
+int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
+{
+    atmos_status st;
+    *volume = NULL;
+    if (o->scene_path) {
+        if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
+            fprintf(stderr,
+                    "atmos render: %s is a volume file, not a scene: render it with\n"
+                    "  atmos render --volume %s\n",
+                    o->scene_path, o->scene_path);
+            return CLI_EXIT_USAGE;
+        }
+        if ((st = atmos_scene_load_with(ctx, o->scene_path, o->defines, o->ndefines, scene)) != ATMOS_OK)
+            return cli_runtime_error("render", ctx, st);
+    } else if (o->ndefines) {
+        /* the built-in default scene is the parse of an empty one */
+        if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", o->defines, o->ndefines, scene)) != ATMOS_OK) {
+            fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+            return CLI_EXIT_USAGE;
+        }
+    } else {
+        atmos_scene_defaults(scene);
+    }
+    int rc = render_opts_apply(ctx, o, scene);
+    if (rc != CLI_EXIT_OK) return rc;
+    if ((st = atmos_scene_validate(ctx, scene, o->scene_path ? o->scene_path : "options")) != ATMOS_OK) {
+        fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+        return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+    }
+    const int file = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) != 0;
+    if (file && scene->renderer != ATMOS_RENDERER_SKY && !scene->camera_given && !render_opts_camera_given(o) &&
+        scene->camera.type == ATMOS_CAMERA_PINHOLE) {
+        if ((st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK) return cli_runtime_error("render", ctx, st);
+    }
+    return CLI_EXIT_OK;
+}
+
+const char *render_scene_output_name(const render_opts *o, const atmos_scene *scene, char *buf, size_t cap)
+{
+    const char *p = o->scene_path;
+    if (!p || !strcmp(p, "-")) return scene->name;
+    const char *base = strrchr(p, '/') ? strrchr(p, '/') + 1 : p, *dot = strrchr(base, '.');
+    size_t n = dot && dot > base ? (size_t)(dot - base) : strlen(base);
+    if (n == 0) return scene->name;
+    snprintf(buf, cap, "%.*s", (int)(n < cap ? n : cap - 1), base);
+    return buf;
+}

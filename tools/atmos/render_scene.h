@@ -1,0 +1,21 @@
+/* atmos render's scene from its options (render_scene.c). */
+#ifndef ATMOS_CLI_RENDER_SCENE_H
+#define ATMOS_CLI_RENDER_SCENE_H
+
+#include "render_opts.h"
+
+#include <stddef.h>
+
+/* The scene: the file (a volume file there is refused with a hint to --volume) or the
+ * default, the options applied, validated. A volume file with no camera in the scene or
+ * the options is loaded into *volume (else NULL; the caller destroys it), placed, and the
+ * camera framed on it. Returns CLI_EXIT_OK or the exit status of the failure (message
+ * printed). */
+int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume);
+
+/* The name of the default output (NAME.png when no output is given): the scene file's name
+ * without its folder and extension (as pbrt and Mitsuba do), or the scene's "name" for the
+ * default scene and a scene from standard input. Returns buf or scene->name. */
+const char *render_scene_output_name(const render_opts *o, const atmos_scene *scene, char *buf, size_t cap);
+
+#endif
