@@ -4,7 +4,8 @@
  *    the paths the limit stopped are counted (an alarm fails the test if a render hangs);
  *  - voxel sizes outside the documented range are refused;
  *  - the default depth limit's bias on a conservative slab of optical depth 1000
- *    (R + T against 1, measured from equirectangular renders above and below it);
+ *    (R + T against 1, measured from equirectangular renders above and below it, and the
+ *    light lost against renders of the same samples with a 10 times higher limit);
  *  - the time budget stops a render inside a pass (wall time), and the image is then that
  *    of the whole passes completed: the same bytes as a render of that many samples
  *    without a budget, for 1 and 2 threads;
@@ -305,41 +306,62 @@ static void hemi_flux(const atmos_image *img, const atmos_image *var, int c, int
     *se = sqrt(vv);
 }
 
-/* The default depth limit on a conservative slab of optical depth 1000 (g = 0.85, sun 60
- * degrees high): R + T must be 1; what the limit loses is 1 - (R + T). */
-static void test_depth_bias(void)
+/* R and T (per unit irradiance, channel G) of the conservative slab v (sun 60 degrees high),
+ * from equirectangular renders just above and below it, with max_depth depth (0: the
+ * default limit); the paths stopped by the default limit are added to *cut. */
+static void slab_rt(atmos_context *ctx, const atmos_volume *v, const optics *op, int depth, int spp, double *F,
+                    double *se, long long *cut, long long *paths)
 {
-    atmos_context *ctx = make_ctx(0, NULL);
-    optics op;
-    make_optics(ctx, 0.85, 1.0, &op);
-    atmos_volume *v = slab(ctx, 400, 1000);
     atmos_scene s;
-    down_scene(&s, 32, 16, 8);
-    s.sun.elevation_deg = 60;
+    down_scene(&s, 32, 16, spp);
     atmos_wavelengths wl;
     CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
     const double E = wl.sun_irradiance[1] * sin(60 * PI / 180);
-    double F[2], se[2];
-    long long cut = 0, paths = 0;
-    const double t0 = now_s();
+    s.path.max_depth = depth;
     for (int side = 0; side < 2; side++) {
         const double pos[3] = {0, side == 0 ? SLAB_Y + SLAB_H + 0.05 : SLAB_Y - 0.05, 0};
         atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
         atmos_image *var = NULL;
         atmos_path_stats st;
-        atmos_image *img = render(ctx, &s, v, &op, &var, &st);
+        atmos_image *img = render(ctx, &s, v, op, &var, &st);
         hemi_flux(img, var, 1, side == 0, E, &F[side], &se[side]);
-        cut += st.cut_paths, paths += st.paths;
+        *cut += st.cut_paths, *paths += st.paths;
         atmos_image_destroy(img), atmos_image_destroy(var);
     }
-    const double sum = F[0] + F[1], e = sqrt(se[0] * se[0] + se[1] * se[1]);
-    printf("  tau 1000 conservative slab: R %.4f +- %.4f, T %.4f +- %.4f, R + T %.4f +- %.4f (lost %.2f %%), %lld of %lld "
-           "paths stopped at the depth limit, %.1f s\n",
-           F[0], se[0], F[1], se[1], sum, e, 100 * (1 - sum), cut, paths, now_s() - t0);
-    /* the limit loses light (the paths through the slab take ~1e5 events), but not much */
-    CHECK_MSG(cut > 0, "no path met the depth limit at tau 1000");
-    CHECK_MSG(sum < 1 + 3 * e && sum > 0.95, "R + T = %g +- %g", sum, e);
-    atmos_volume_destroy(v);
+}
+
+/* The default depth limit (10000 events) on a conservative slab (g = 0.85) of optical depth
+ * 1000: R + T must be 1. The light the limit loses is measured against renders of the same
+ * samples with max_depth 100000 (the same paths up to the limit, so the difference has little
+ * noise): the paths through the slab need ~1e5 events. ATMOS_PATH_LONG=1: 16x the samples. */
+static void test_depth_bias(int long_run)
+{
+    atmos_context *ctx = make_ctx(0, NULL);
+    optics op;
+    make_optics(ctx, 0.85, 1.0, &op);
+    const double taus[2] = {1000, 100};
+    for (int i = 0; i < (long_run ? 2 : 1); i++) {
+        atmos_volume *v = slab(ctx, 400, taus[i]);
+        const int spp = long_run ? 64 : 4;
+        double F[2], se[2], G[2], sg[2];
+        long long cut = 0, paths = 0, cut2 = 0, paths2 = 0;
+        const double t0 = now_s();
+        slab_rt(ctx, v, &op, 0, spp, F, se, &cut, &paths);
+        const double t1 = now_s();
+        slab_rt(ctx, v, &op, 100000, spp, G, sg, &cut2, &paths2);
+        const double sum = F[0] + F[1], e = sqrt(se[0] * se[0] + se[1] * se[1]), sum2 = G[0] + G[1];
+        printf("  tau %g conservative slab, %d spp: default limit R %.4f +- %.4f, T %.4f +- %.4f, R + T %.4f +- %.4f "
+               "(%lld of %lld paths stopped, %.1f s); max_depth 100000: R + T %.4f (%.1f s); lost to the limit "
+               "%.3f %%\n",
+               taus[i], spp, F[0], se[0], F[1], se[1], sum, e, cut, paths, t1 - t0, sum2, now_s() - t1,
+               100 * (sum2 - sum));
+        if (i == 0) {
+            CHECK_MSG(cut > 0, "no path met the depth limit at tau 1000");
+            CHECK_MSG(sum < 1 + 3 * e && sum > 0.9, "R + T = %g +- %g", sum, e);
+            CHECK_MSG(sum2 - sum >= 0 && sum2 - sum < 0.03, "the limit lost %g of the light", sum2 - sum);
+        }
+        atmos_volume_destroy(v);
+    }
     atmos_phase_table_destroy(op.t);
     atmos_context_destroy(ctx);
 }
@@ -479,6 +501,7 @@ int main(void)
     test_budget_whole_passes();
     test_budget_in_pass();
     test_huge_tau();
-    test_depth_bias();
+    const char *lr = getenv("ATMOS_PATH_LONG");
+    test_depth_bias(lr && *lr && *lr != '0');
     return test_summary("test_path_walk");
 }

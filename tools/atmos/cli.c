@@ -103,12 +103,21 @@ void cli_progress_init(cli_progress *p, int quiet)
     p->start = cli_now_s();
     p->shown = 0;
     p->last_draw = 0.0;
+    p->log = !quiet && !p->enabled;
+    p->last_log = 0.0;
 }
 
 int cli_progress_bar(void *user, const char *stage, double f)
 {
     cli_progress *p = user;
-    if (!p->enabled) return 0;
+    if (!p->enabled) {
+        const double t = cli_now_s() - p->start;
+        if (p->log && f < 1.0 && t - p->last_log >= 5.0) {
+            p->last_log = t;
+            fprintf(stderr, "atmos: %s: %.0f %% after %.0f s\n", stage, 100.0 * f, t);
+        }
+        return 0;
+    }
     double t = cli_now_s() - p->start;
     if (t < 1.0 && f < 1.0) return 0;
     if (t < 1.0 && !p->shown) return 0;

@@ -22,14 +22,17 @@ atmos_context *cli_context(int threads, int quiet);
 /* The same with a progress callback. */
 atmos_context *cli_context_with_progress(int threads, int quiet, atmos_progress_fn fn, void *user);
 /* A progress bar with ETA on stderr for work that takes over ~1 s, redrawn at most
- * ten times a second; enabled only when stderr is a terminal and not quiet. Pass
- * cli_progress_bar with a cli_progress as the context's progress callback; if
- * p.shown after the work, the bar has already ended its line. */
+ * ten times a second; enabled only when stderr is a terminal and not quiet. When stderr is
+ * not a terminal (and not quiet), a log line every 5 s instead. Pass cli_progress_bar with a
+ * cli_progress as the context's progress callback; if p.shown after the work, the bar has
+ * already ended its line. */
 typedef struct {
     int enabled;
     double start;
     int shown;
     double last_draw;
+    int log;         /* not a terminal: log lines */
+    double last_log;
 } cli_progress;
 void cli_progress_init(cli_progress *p, int quiet);
 int cli_progress_bar(void *user, const char *stage, double fraction);
