@@ -310,7 +310,7 @@ static void hemi_flux(const atmos_image *img, const atmos_image *var, int c, int
  * from equirectangular renders just above and below it, with max_depth depth (0: the
  * default limit); the paths stopped by the default limit are added to *cut. */
 static void slab_rt(atmos_context *ctx, const atmos_volume *v, const optics *op, int depth, int spp, double *F,
-                    double *se, long long *cut, long long *paths)
+                    double *se, long long *cut, long long *paths, long long *events)
 {
     atmos_scene s;
     down_scene(&s, 32, 16, spp);
@@ -325,7 +325,7 @@ static void slab_rt(atmos_context *ctx, const atmos_volume *v, const optics *op,
         atmos_path_stats st;
         atmos_image *img = render(ctx, &s, v, op, &var, &st);
         hemi_flux(img, var, 1, side == 0, E, &F[side], &se[side]);
-        *cut += st.cut_paths, *paths += st.paths;
+        *cut += st.cut_paths, *paths += st.paths, *events += st.events;
         atmos_image_destroy(img), atmos_image_destroy(var);
     }
 }
@@ -339,26 +339,27 @@ static void test_depth_bias(int long_run)
     atmos_context *ctx = make_ctx(0, NULL);
     optics op;
     make_optics(ctx, 0.85, 1.0, &op);
-    const double taus[2] = {1000, 100};
-    for (int i = 0; i < (long_run ? 2 : 1); i++) {
+    const double taus[3] = {1000, 100, 3000};
+    for (int i = 0; i < (long_run ? 3 : 1); i++) {
         atmos_volume *v = slab(ctx, 400, taus[i]);
-        const int spp = long_run ? 64 : 4;
+        const int spp = long_run ? (taus[i] > 1000 ? 8 : 64) : 4;
         double F[2], se[2], G[2], sg[2];
-        long long cut = 0, paths = 0, cut2 = 0, paths2 = 0;
+        long long cut = 0, paths = 0, ev = 0, cut2 = 0, paths2 = 0, ev2 = 0;
         const double t0 = now_s();
-        slab_rt(ctx, v, &op, 0, spp, F, se, &cut, &paths);
+        slab_rt(ctx, v, &op, 0, spp, F, se, &cut, &paths, &ev);
         const double t1 = now_s();
-        slab_rt(ctx, v, &op, 100000, spp, G, sg, &cut2, &paths2);
+        slab_rt(ctx, v, &op, 100000, spp, G, sg, &cut2, &paths2, &ev2);
+        const double t2 = now_s();
         const double sum = F[0] + F[1], e = sqrt(se[0] * se[0] + se[1] * se[1]), sum2 = G[0] + G[1];
-        printf("  tau %g conservative slab, %d spp: default limit R %.4f +- %.4f, T %.4f +- %.4f, R + T %.4f +- %.4f "
-               "(%lld of %lld paths stopped, %.1f s); max_depth 100000: R + T %.4f (%.1f s); lost to the limit "
-               "%.3f %%\n",
-               taus[i], spp, F[0], se[0], F[1], se[1], sum, e, cut, paths, t1 - t0, sum2, now_s() - t1,
-               100 * (sum2 - sum));
+        printf("  tau %g conservative slab, %d spp: default limit R %.4f +- %.4f, T %.4f +- %.4f, R + T %.4f +- %.4f, "
+               "%lld of %lld paths stopped, %.1f events and %.3f ms per path; max_depth 100000: R + T %.4f, %.1f events "
+               "and %.3f ms per path; lost to the default limit %.3f %%\n",
+               taus[i], spp, F[0], se[0], F[1], se[1], sum, e, cut, paths, (double)ev / paths, 1e3 * (t1 - t0) / paths,
+               sum2, (double)ev2 / paths2, 1e3 * (t2 - t1) / paths2, 100 * (sum2 - sum));
         if (i == 0) {
             CHECK_MSG(cut > 0, "no path met the depth limit at tau 1000");
             CHECK_MSG(sum < 1 + 3 * e && sum > 0.9, "R + T = %g +- %g", sum, e);
-            CHECK_MSG(sum2 - sum >= 0 && sum2 - sum < 0.03, "the limit lost %g of the light", sum2 - sum);
+            CHECK_MSG(sum2 - sum >= 0 && sum2 - sum < 0.06, "the limit lost %g of the light", sum2 - sum);
         }
         atmos_volume_destroy(v);
     }
