@@ -34,7 +34,7 @@ struct atmos__path_plan {
     int env_valid, env_on;
     double env_sun[3];
     /* the accumulator of view acc_view: per pixel NA doubles (sum and sum of squares per
-     * wavelength, hits, sum Y, sum Y^2, sum order x Y, samples that scattered in the volume)
+     * wavelength, hits, sum Y, sum Y^2, sum order x Y, samples whose path met the volume)
      * and its sample count */
     double *acc;
     int *count;
