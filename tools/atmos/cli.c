@@ -114,7 +114,7 @@ int cli_progress_bar(void *user, const char *stage, double f)
         const double t = cli_now_s() - p->start;
         if (p->log && f < 1.0 && t - p->last_log >= 5.0) {
             p->last_log = t;
-            fprintf(stderr, "atmos: %s: %.0f %% after %.0f s\n", stage, 100.0 * f, t);
+            fprintf(stderr, "atmos: %s: %d %% after %.0f s\n", stage, (int)(100.0 * f), t);
         }
         return 0;
     }
