@@ -37,7 +37,7 @@ extern "C" {
 
 /* Work done and time spent by a render. */
 typedef struct atmos_path_stats {
-    int spp;                   /* samples per pixel taken (whole passes) */
+    int spp;                   /* samples per pixel taken (the lowest count of the pixels) */
     long long paths;           /* camera paths traced */
     long long events;          /* real scattering events (volume and ground) */
     long long tentative;       /* tentative collisions of free-flight sampling (real + null) */
@@ -50,6 +50,18 @@ typedef struct atmos_path_stats {
     double truncate_deg;       /* the forward-peak cut used (a grid angle); 0: none */
     double truncated_min, truncated_max; /* the fraction f of the scattering removed by it, over
                                             the fields and wavelengths */
+    /* The noise of the volume's pixels (those where some sample scattered in the volume): the
+     * relative standard error of the pixel's mean luminance, its mean, median and 90th
+     * percentile over them (pixels with a nonzero mean and 2 or more samples). */
+    long long volume_pixels;
+    double volume_rel_error_mean, volume_rel_error_median, volume_rel_error_p90;
+    long long cut_paths;       /* paths stopped by the default depth limit (scene max_depth 0:
+                                  10000 scattering events; their further light is lost) */
+    long long walks_ended;     /* free flights and shadow rays that took more than 4096 steps
+                                  and ended at the Russian roulette that bounds their cost */
+    int budget_cut;            /* the time budget stopped the render inside a pass (a pass it
+                                  cut is discarded; the first pass's samples are kept) */
+    long long empty_pixels;    /* pixels without a sample (a budget spent in the first pass) */
 } atmos_path_stats;
 
 /* What atmos_render_path needs beyond the scene; zero means default for every field. The
@@ -78,8 +90,9 @@ ATMOS_API void atmos_path_defaults(atmos_path_settings *s);
  * the volume (may be NULL: the atmosphere and the ground alone) by path tracing: a plan made
  * and destroyed in one call (include/atmos/plan.h keeps one, and adds samples progressively). *out has the layout of
  * atmos_render_sky: spectral radiance per wavelength (W m^-2 sr^-1 nm^-1), then coverage
- * alpha. settings and info may be NULL. Reports progress through ctx ("render path")
- * and honours cancellation between passes. */
+ * alpha. settings and info may be NULL. Reports progress through ctx ("render path", from
+ * the calling thread, about four times a second) and honours cancellation and the time
+ * budget before every sample. */
 ATMOS_API atmos_status atmos_render_path(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
                                          const atmos_path_settings *settings, atmos_image **out,
                                          atmos_render_info *info);

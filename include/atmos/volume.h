@@ -17,12 +17,15 @@ extern "C" {
 
 #define ATMOS_VOLUME_MAX_FIELDS 8
 #define ATMOS_VOLUME_MAX_DIM 16384          /* voxels along one axis */
+#define ATMOS_VOLUME_MIN_VOXEL_M 1e-6      /* voxel edge, metres: the supported range */
+#define ATMOS_VOLUME_MAX_VOXEL_M 1e5       /* (100 km) */
 #define ATMOS_VOLUME_DEFAULT_MAX_MEMORY ((uint64_t)8 << 30)
 
 /* Settings for a new volume; zero means default where stated. */
 typedef struct atmos_volume_desc {
     int dims[3];              /* voxels along x, y, z: 1..ATMOS_VOLUME_MAX_DIM */
-    double voxel_size_m;      /* edge of a (cubic) voxel, metres, > 0 */
+    double voxel_size_m;      /* edge of a (cubic) voxel, metres, in [ATMOS_VOLUME_MIN_VOXEL_M,
+                                 ATMOS_VOLUME_MAX_VOXEL_M] */
     double origin_m[3];       /* world position of the corner of voxel (0,0,0) */
     double rotation[9];       /* row-major 3x3 rotation from grid axes to world axes;
                                  all zero = identity. world = origin + R (index * voxel_size) */

@@ -64,6 +64,7 @@ typedef struct {
     double esc_wt;       /* the weight of the air's light at the path's escape: after a volume event
                             the continuation's share against next-event estimation of the sky */
     double hprev;        /* the path's share of the sun at its next volume event (aureole) */
+    int met;             /* the camera ray's forced estimate was made */
 } path_state;
 
 /* After a volume event: the new direction, drawn with the hero's strategy (its wavelength or
@@ -137,7 +138,9 @@ static int volume_event(const path_run *R, path_state *s, double t, const float 
     /* Can the path go on from here (depth limit), and with which probability does it survive
      * the roulette below: the continuation's share of the multiple importance sampling of
      * the sun. */
-    const int goes_on = ne > 0 && !(J->max_depth && s->depth + 1 >= J->max_depth);
+    const int at_limit = J->max_depth && s->depth + 1 >= J->max_depth;
+    const int goes_on = ne > 0 && !at_limit;
+    if (ne > 0 && at_limit && J->depth_default) R->cnt->cut++;
     double q_rr = 0;
     if (goes_on)
         for (int i = 0; i < m; i++)
@@ -177,6 +180,7 @@ static int cross_volume(const path_run *R, path_state *s, const double q[3], con
     float dens[PATH_F];
     memcpy(ws, s->w, sizeof ws);
     const int forced = J->forced && s->primary && atmos__path_forced_single(R, s->p, s->d, q, qd, t0, t1, s->w);
+    s->met |= forced;
     const int ev = atmos__path_free_flight(J->med, q, qd, t0, t1, R->b, s->w, R->r, &t, dens, &R->cnt->tentative);
     /* The air inside the box: its light (shadowed by the volume) over the whole crossing,
      * its transmittance up to where the flight ends. */
@@ -216,7 +220,10 @@ static int ground(const path_run *R, path_state *s, double K)
             for (int i = 0; i < m; i++) atmos__path_add(R, i, s->w[i] * J->albedo / ATMOS_PI * cs * E[i] * T[i], s->order);
         }
     }
-    if (J->max_depth && ++s->depth >= J->max_depth) return 0;
+    if (J->max_depth && ++s->depth >= J->max_depth) {
+        if (J->depth_default) R->cnt->cut++;
+        return 0;
+    }
     for (int i = 0; i < m; i++) s->w[i] *= J->albedo;
     if (!roulette(s->w, m, R->r)) return 0;
     /* cosine-distributed about n, in a frame that is the world's axes for n = +y */
@@ -250,8 +257,8 @@ static void escape(const path_run *R, const path_state *s)
     }
 }
 
-void atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], atmos__stream *r,
-                       double *L, double *Lo, path_counts *cnt)
+int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], atmos__stream *r,
+                      double *L, double *Lo, path_counts *cnt)
 {
     const path_run R = {J, b, r, cnt, L, Lo};
     path_state s = {.primary = 1, .hero = -1, .esc_wt = 1.0, .hprev = 1};
@@ -265,7 +272,7 @@ void atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3
             atmos__path_to_index(J->med, s.p, s.d, q, qd);
             if (atmos__path_clip(J->med, q, qd, K, &t0, &t1)) {
                 const int c = cross_volume(&R, &s, q, qd, t0, t1);
-                if (c < 0) return;
+                if (c < 0) return s.order > 0 || s.met;
                 if (c > 0) continue;
                 /* through the volume: on from its far side */
                 K = atmos_atmosphere_ground_distance(J->atm, s.p, s.d);
@@ -275,8 +282,9 @@ void atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3
         atmos__path_air_scatter(&R, s.p, s.d, K, s.w, s.esc_wt, s.order, NULL);
         if (isinf(K)) {
             escape(&R, &s);
-            return;
+            return s.order > 0 || s.met;
         }
-        if (!ground(&R, &s, K)) return;
+        if (!ground(&R, &s, K)) return s.order > 0 || s.met;
     }
+    return s.order > 0 || s.met;
 }

@@ -183,6 +183,34 @@ int atmos__path_majorant_point(const path_medium *m, const double q[3], const do
     return 0; /* rounding: the target beyond the sum of the second pass */
 }
 
+/* Every PATH_WALK_RR steps of one walk (tentative collisions of a free flight, steps of a
+ * ratio-tracked shadow ray) the walk plays Russian roulette: it goes on with probability 1/2
+ * and doubled weights, else ends (weights 0). Unbiased; it bounds the expected steps of a
+ * walk that would otherwise take ~ its majorant optical depth in steps, which in an optically
+ * huge medium (a density scale of 1e12, voxels of 1e20 m) is more than a render can take, or
+ * never ends when the steps fall below the position's precision. In the media of the
+ * gallery a walk never takes that many steps (no image changes). *res = -2 when it ends. */
+static _Thread_local long long walks_ended; /* walks ended so, for atmos__path_walks_ended */
+
+static int walk_roulette(double *w, int nb, atmos__stream *r, int *res)
+{
+    if (atmos__stream_u(r) < 0.5) {
+        for (int i = 0; i < nb; i++) w[i] *= 2;
+        return 1;
+    }
+    for (int i = 0; i < nb; i++) w[i] = 0;
+    *res = -2;
+    walks_ended++;
+    return 0;
+}
+
+long long atmos__path_walks_ended(void)
+{
+    const long long n = walks_ended;
+    walks_ended = 0;
+    return n;
+}
+
 int atmos__path_free_flight(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
                             const path_bundle *b, double *w, atmos__stream *r, double *tout, float *dens, long long *tentative)
 {
@@ -230,6 +258,7 @@ int atmos__path_free_flight(const path_medium *m, const double q[3], const doubl
                 goto out;
             }
             for (int i = 0; i < nb; i++) w[i] *= sn[i] / (mu * (1.0 - ps));
+            if ((tc & (PATH_WALK_RR - 1)) == 0 && !walk_roulette(w, nb, r, &res)) goto out;
             tau = -log(1.0 - atmos__stream_u(r));
         }
         if (te >= t1) break;
@@ -241,10 +270,11 @@ out:
     return res;
 }
 
-void atmos__path_transmittance(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
-                               const path_bundle *b, atmos__stream *r, double *T)
+int atmos__path_transmittance(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
+                              const path_bundle *b, atmos__stream *r, double *T)
 {
     const int nf = m->nf, nb = b->m;
+    long long steps = 0;
     double tauc[PATH_B];
     for (int i = 0; i < nb; i++) T[i] = 1, tauc[i] = 0;
     atmos__vol_dda g;
@@ -279,6 +309,8 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
                 for (;;) {
                     s += -log(1.0 - atmos__stream_u(r)) / mur;
                     if (s >= te) break;
+                    int dead = 0;
+                    if ((++steps & (PATH_WALK_RR - 1)) == 0 && !walk_roulette(T, nb, r, &dead)) return 1;
                     atmos__path_density(m, q[0] + s * qd[0], q[1] + s * qd[1], q[2] + s * qd[2], dens);
                     double tmax = 0;
                     for (int i = 0; i < nb; i++) {
@@ -288,7 +320,7 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
                         T[i] *= fac < 0 ? 0 : (fac > 1 ? 1 : fac);
                         if (T[i] > tmax) tmax = T[i];
                     }
-                    if (!(tmax > 0)) return;
+                    if (!(tmax > 0)) return 0;
                 }
             }
             /* Russian roulette once the transmittance is certainly small. */
@@ -300,7 +332,7 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
             if (tmax * exp(-cmin) < 1e-2) {
                 if (atmos__stream_u(r) >= 0.25) {
                     for (int i = 0; i < nb; i++) T[i] = 0;
-                    return;
+                    return 0;
                 }
                 for (int i = 0; i < nb; i++) T[i] *= 4;
             }
@@ -310,4 +342,5 @@ void atmos__path_transmittance(const path_medium *m, const double q[3], const do
         if (!atmos__vol_dda_step(m->v, &g)) break;
     }
     for (int i = 0; i < nb; i++) T[i] *= exp(-tauc[i]);
+    return 0;
 }

@@ -40,18 +40,26 @@ void atmos__path_to_index(const path_medium *m, const double p[3], const double 
  * 0 if none. */
 int atmos__path_clip(const path_medium *m, const double q[3], const double qd[3], double tmax, double *t0, double *t1);
 
+/* Steps of one walk (free flight or shadow ray) between its Russian roulettes (a power of
+ * two; path_medium.c). */
+#define PATH_WALK_RR 4096
+/* The walks the calling thread ended at that roulette since the last call. */
+long long atmos__path_walks_ended(void);
+
 /* Free flight by delta tracking with spectral tracking weights (Kutz et al. 2017,
  * "Spectral and decomposition tracking", the history-aware average probabilities) from
  * t0 to t1 (inside the box). Returns 1 at a real scattering event (*t, dens[] = the
- * scaled field densities there), 0 when the ray leaves at t1, -1 when every weight is 0.
+ * scaled field densities there), 0 when the ray leaves at t1, -1 when every weight is 0,
+ * -2 when the walk ended at its roulette (every PATH_WALK_RR tentative collisions).
  * w[] (per carried wavelength) is updated. *tentative counts tentative collisions. */
 int atmos__path_free_flight(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
                             const path_bundle *b, double *w, atmos__stream *r, double *t, float *dens, long long *tentative);
 
 /* Transmittance from t0 to t1 by ratio tracking on the residual above each cell's
  * minorant (the minorant's part is exact: exp(-sigma_c * length)), with Russian roulette
- * when it gets small. Writes T[] per carried wavelength. */
-void atmos__path_transmittance(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
+ * when it gets small and every PATH_WALK_RR steps. Writes T[] per carried wavelength;
+ * returns 1 when the walk ended at the latter (T = 0). */
+int atmos__path_transmittance(const path_medium *m, const double q[3], const double qd[3], double t0, double t1,
                                const path_bundle *b, atmos__stream *r, double *T);
 
 /* A point of [t0, t1] for forced single scattering, by the majorant mu of the carried

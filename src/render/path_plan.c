@@ -10,9 +10,13 @@
 #include "render/path_trace.h"
 #include "render/plan_internal.h"
 
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /* Forward peak (sr^-1) above which the aureole estimate pays for itself: cloud droplets
  * have 400-900, HG g = 0.9 15, g = 0.95 62. */
@@ -30,7 +34,8 @@ struct atmos__path_plan {
     int env_valid, env_on;
     double env_sun[3];
     /* the accumulator of view acc_view: per pixel NA doubles (sum and sum of squares per
-     * wavelength, hits, sum Y, sum Y^2, sum order x Y) and its sample count */
+     * wavelength, hits, sum Y, sum Y^2, sum order x Y, samples whose path met the volume)
+     * and its sample count */
     double *acc;
     int *count;
     int NA, W, H;
@@ -92,7 +97,7 @@ atmos_status atmos__path_plan_create(atmos_plan *p, atmos__path_plan **out)
     const double t0 = atmos__now();
     atmos__path_plan *pp = calloc(1, sizeof *pp);
     if (!pp) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render path: out of memory");
-    pp->NA = 2 * p->wl.count + 4;
+    pp->NA = 2 * p->wl.count + 5;
     if (p->volume && atmos_volume_field_count(p->volume) > 0) {
         atmos_status st = build_medium(p, pp);
         if (st != ATMOS_OK) {
@@ -140,7 +145,8 @@ static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, 
     const double r = 0.5 * atmos_atmosphere_get_desc(atm)->sun_diameter_deg * ATMOS_DEG2RAD;
     J->cos_sun = cos(r);
     J->sun_omega = 2.0 * ATMOS_PI * (1.0 - J->cos_sun);
-    J->max_depth = p->scene.path.max_depth;
+    J->max_depth = p->scene.path.max_depth ? p->scene.path.max_depth : PATH_DEFAULT_DEPTH;
+    J->depth_default = !p->scene.path.max_depth;
     J->seed = p->scene.path.seed;
     J->forced = p->scene.path.forced;
     J->albedo = atmos_atmosphere_ground_albedo(atm);
@@ -151,12 +157,48 @@ static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, 
     if (pp->env_on) J->env = &pp->env;
 }
 
-/* Samples s0..s1-1 of pixel (x, y) added to its sums A. */
-static void sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, int s1, const double *Ybar, double *A,
-                         path_counts *cnt)
+/* The clock of a render's passes: the time budget, checked before every sample, and the
+ * progress reports (by the calling thread, at most every REPORT_S seconds). */
+#define REPORT_S 0.25
+typedef struct {
+    atmos_context *ctx;
+    double start, deadline, budget, next_report;
+    long long total;   /* samples this call is to take */
+    atomic_llong done; /* samples taken so far */
+    atomic_int stop;   /* 1: the budget is spent, 2: cancelled */
+} path_clock;
+
+/* Before a sample: 0 to take it, 1 to stop (budget spent or cancelled). */
+static int clock_tick(path_clock *c)
+{
+    if (atomic_load_explicit(&c->stop, memory_order_relaxed)) return 1;
+    const double now = atmos__now();
+    if (now >= c->deadline) {
+        atomic_store(&c->stop, 1);
+        return 1;
+    }
+#ifdef _OPENMP
+    if (omp_get_thread_num() != 0) return 0;
+#endif
+    if (now < c->next_report) return 0;
+    c->next_report = now + REPORT_S;
+    double f = c->total > 0 ? (double)atomic_load_explicit(&c->done, memory_order_relaxed) / (double)c->total : 1.0;
+    if (c->budget > 0 && (now - c->start) / c->budget > f) f = (now - c->start) / c->budget;
+    if (atmos__progress(c->ctx, "render path", f < 1 ? f : 0.999)) {
+        atomic_store(&c->stop, 2);
+        return 1;
+    }
+    return 0;
+}
+
+/* Samples s0..s1-1 of pixel (x, y) added to its sums A, while the clock lets; returns the
+ * pixel's sample count reached. */
+static int sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, int s1, const double *Ybar, double *A,
+                        path_counts *cnt, path_clock *clk)
 {
     const int n = J->n;
-    for (int smp = s0; smp < s1; smp++) {
+    int smp = s0;
+    for (; smp < s1 && !clock_tick(clk); smp++) {
         atmos__stream rng;
         atmos__stream_seed(&rng, J->seed, pix, (uint64_t)smp);
         /* The carried wavelengths: all of them in rgb mode; in spectral mode a uniformly
@@ -177,7 +219,7 @@ static void sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, in
         double jx = atmos__stream_u(&rng), jy = atmos__stream_u(&rng), dir[3];
         double L[PATH_B] = {0, 0, 0, 0}, Lo[PATH_B] = {0, 0, 0, 0}, Y = 0, Yo = 0;
         if (atmos_camera_ray(&J->cam, x + jx, y + jy, dir)) {
-            atmos__path_trace(J, &b, J->cam.position, dir, &rng, L, Lo, cnt);
+            if (atmos__path_trace(J, &b, J->cam.position, dir, &rng, L, Lo, cnt) > 0) A[2 * n + 4] += 1;
             A[2 * n] += 1;
         }
         for (int i = 0; i < b.m; i++) {
@@ -192,67 +234,167 @@ static void sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, in
         A[2 * n + 2] += Y * Y;
         A[2 * n + 3] += Yo;
     }
+    atomic_fetch_add_explicit(&clk->done, smp - s0, memory_order_relaxed);
+    return smp;
 }
 
-/* Passes of S samples per pixel of r until every pixel has target (or the time budget is
- * spent), S from the region's size only (never from timing), so that a pass has enough work
- * to share and the budget is checked often. */
+/* One pass: every pixel of r brought to s1 samples (fewer where the clock stopped it). */
+static void pass(atmos__path_plan *pp, const path_job *J, const atmos__rect *r, int s1, int threads, const double *Ybar,
+                 path_clock *clk, atmos_path_stats *st)
+{
+    const int NA = pp->NA, W = pp->W;
+    long long ev = 0, tc = 0, sh = 0, cut = 0, ended = 0, paths = 0;
+    atmos__path_walks_ended(); /* the calling thread's count starts at 0 */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : ev, tc, sh, cut, ended, paths)
+    for (int y = r->y0; y < r->y1; y++) {
+        path_counts cnt = {0, 0, 0, 0, 0};
+        for (int x = r->x0; x < r->x1; x++) {
+            const size_t pix = (size_t)y * W + x;
+            if (pp->count[pix] >= s1) continue;
+            const int got = sample_pixel(J, x, y, pix, pp->count[pix], s1, Ybar, pp->acc + pix * NA, &cnt, clk);
+            paths += got - pp->count[pix];
+            pp->count[pix] = got;
+        }
+        ev += cnt.events, tc += cnt.tentative, sh += cnt.shadow, cut += cnt.cut;
+        ended += atmos__path_walks_ended();
+    }
+    st->events += ev, st->tentative += tc, st->shadow_rays += sh, st->paths += paths, st->cut_paths += cut;
+    st->walks_ended += ended;
+}
+
+/* The accumulator's rows of r (sums and counts): saved before a pass that may be cut by the
+ * budget, restored when it is. */
+typedef struct {
+    double *acc;
+    int *count;
+} path_saved;
+
+static void save_rows(const atmos__path_plan *pp, const atmos__rect *r, path_saved *sv, int restore)
+{
+    const size_t first = (size_t)r->y0 * pp->W, n = (size_t)(r->y1 - r->y0) * pp->W;
+    if (restore) {
+        memcpy(pp->acc + first * pp->NA, sv->acc, sizeof(double) * n * pp->NA);
+        memcpy(pp->count + first, sv->count, sizeof(int) * n);
+    } else {
+        memcpy(sv->acc, pp->acc + first * pp->NA, sizeof(double) * n * pp->NA);
+        memcpy(sv->count, pp->count + first, sizeof(int) * n);
+    }
+}
+
+/* The lowest sample count of r's pixels (at most cap) and how many pixels have none. */
+static int lowest_count(const atmos__path_plan *pp, const atmos__rect *r, int cap, long long *empty)
+{
+    int lowest = cap;
+    *empty = 0;
+    for (int y = r->y0; y < r->y1; y++)
+        for (int x = r->x0; x < r->x1; x++) {
+            const int c = pp->count[(size_t)y * pp->W + x];
+            if (c < lowest) lowest = c;
+            *empty += c == 0;
+        }
+    return lowest;
+}
+
+/* Passes of S samples per pixel of r until every pixel has target, S from the region's size
+ * only. The time budget is checked before every sample: a pass it cuts is discarded (every
+ * pixel keeps the samples of the whole passes before it, so the image is that of the passes
+ * completed, whatever the thread count), except a first pass, whose samples are kept (pixels
+ * it did not reach stay empty: st->empty_pixels). With a budget the passes start at one
+ * sample per pixel and double while a pass takes less than 1/16 of the budget (up to S), so a
+ * discarded pass costs little. (A pixel's sums depend on its sample count only, not on how the
+ * samples were grouped into passes.) */
 static atmos_status accumulate(atmos_plan *p, atmos__path_plan *pp, const path_job *J, const atmos__rect *r,
                                int target, atmos_path_stats *st)
 {
     atmos_context *ctx = p->ctx;
-    const int threads = atmos__threads(ctx), NA = pp->NA, W = pp->W;
+    const int threads = atmos__threads(ctx);
     const size_t npix = (size_t)(r->x1 - r->x0) * (r->y1 - r->y0);
     int S = (int)(65536 / (npix ? npix : 1));
     S = S < 1 ? 1 : (S > 256 ? 256 : S);
     double Ybar[ATMOS_MAX_WAVELENGTHS];
     for (int k = 0; k < J->n; k++) Ybar[k] = p->wl.to_xyz[k][1];
-    const double t0 = atmos__now(), budget = p->scene.path.time_budget_s;
-    int lowest = target;
+    path_clock clk = {.ctx = ctx, .start = atmos__now(), .budget = p->scene.path.time_budget_s};
+    clk.deadline = clk.budget > 0 ? clk.start + clk.budget : INFINITY;
+    clk.next_report = clk.start + REPORT_S;
+    atomic_init(&clk.done, 0);
+    atomic_init(&clk.stop, 0);
+    long long empty = 0;
+    int lowest = lowest_count(pp, r, target, &empty);
     for (int y = r->y0; y < r->y1; y++)
-        for (int x = r->x0; x < r->x1; x++)
-            if (pp->count[(size_t)y * W + x] < lowest) lowest = pp->count[(size_t)y * W + x];
-    const int first = lowest;
-    while (lowest < target) {
-        const int s1 = lowest + S < target ? lowest + S : target;
-        long long ev = 0, tc = 0, sh = 0, paths = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : ev, tc, sh, paths)
-        for (int y = r->y0; y < r->y1; y++) {
-            path_counts cnt = {0, 0, 0};
-            for (int x = r->x0; x < r->x1; x++) {
-                const size_t pix = (size_t)y * W + x;
-                if (pp->count[pix] >= s1) continue;
-                sample_pixel(J, x, y, pix, pp->count[pix], s1, Ybar, pp->acc + pix * NA, &cnt);
-                paths += s1 - pp->count[pix];
-                pp->count[pix] = s1;
-            }
-            ev += cnt.events, tc += cnt.tentative, sh += cnt.shadow;
+        for (int x = r->x0; x < r->x1; x++) {
+            const int c = pp->count[(size_t)y * pp->W + x];
+            clk.total += c < target ? target - c : 0;
         }
-        st->events += ev, st->tentative += tc, st->shadow_rays += sh, st->paths += paths;
-        lowest = s1;
-        const double el = atmos__now() - t0;
-        double frac = target > first ? (double)(lowest - first) / (target - first) : 1.0;
-        if (budget > 0 && el / budget > frac) frac = el / budget;
-        if (atmos__progress(ctx, "render path", frac))
-            return atmos__error(ctx, ATMOS_E_CANCELLED, "render path: cancelled");
-        if (budget > 0 && el >= budget) break;
+    path_saved sv = {NULL, NULL};
+    const size_t nrow = (size_t)(r->y1 - r->y0) * pp->W;
+    if (clk.budget > 0 && lowest < target) {
+        sv.acc = malloc(sizeof(double) * nrow * pp->NA);
+        sv.count = malloc(sizeof(int) * nrow);
+        if (!sv.acc || !sv.count) {
+            free(sv.acc), free(sv.count);
+            return atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the time budget's copy");
+        }
     }
-    st->spp = lowest;
-    return ATMOS_OK;
+    atmos_status status = ATMOS_OK;
+    int step = clk.budget > 0 ? 1 : S; /* with a budget: passes of 1, 2, 4 ... samples up to S */
+    while (lowest < target) {
+        const int s1 = lowest + step < target ? lowest + step : target;
+        const int undo = sv.acc && lowest > 0;
+        if (undo) save_rows(pp, r, &sv, 0);
+        const double tp = atmos__now();
+        pass(pp, J, r, s1, threads, Ybar, &clk, st);
+        if (step < S && 16.0 * (atmos__now() - tp) < clk.budget) step = 2 * step < S ? 2 * step : S;
+        const int stop = atomic_load(&clk.stop);
+        if (stop == 2) {
+            status = atmos__error(ctx, ATMOS_E_CANCELLED, "render path: cancelled");
+            break;
+        }
+        if (stop == 1) {
+            st->budget_cut = 1;
+            if (undo) save_rows(pp, r, &sv, 1);
+            break;
+        }
+        lowest = s1;
+        const double el = atmos__now() - clk.start;
+        double frac = (double)atomic_load(&clk.done) / (double)(clk.total ? clk.total : 1);
+        if (clk.budget > 0 && el / clk.budget > frac) frac = el / clk.budget;
+        if (atmos__progress(ctx, "render path", frac)) {
+            status = atmos__error(ctx, ATMOS_E_CANCELLED, "render path: cancelled");
+            break;
+        }
+        if (clk.budget > 0 && el >= clk.budget) break;
+    }
+    free(sv.acc), free(sv.count);
+    st->spp = lowest_count(pp, r, target, &empty);
+    st->empty_pixels = empty;
+    return status;
 }
 
-/* The means of r into out, and the convergence figure: the mean over pixels with a nonzero
- * mean of the relative standard error of the pixel's mean luminance. */
+/* Ascending doubles, for qsort. */
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The means of r into out, and the convergence figures: the mean over pixels with a nonzero
+ * mean of the relative standard error of the pixel's mean luminance, and over the volume's
+ * pixels (some sample scattered in the volume) its mean, median and 90th percentile. */
 static void resolve(const atmos__path_plan *pp, int n, const atmos__rect *r, atmos_image *out, atmos_path_stats *st)
 {
     const int NA = pp->NA, C = n + 1, W = pp->W;
-    double rel_sum = 0;
-    long long rel_n = 0;
+    double rel_sum = 0, vol_sum = 0;
+    long long rel_n = 0, vol_n = 0;
+    double *vol = malloc(sizeof(double) * (size_t)(r->x1 - r->x0) * (size_t)(r->y1 - r->y0));
     for (int y = r->y0; y < r->y1; y++)
         for (int x = r->x0; x < r->x1; x++) {
             const size_t pix = (size_t)y * W + x;
             const double *A = pp->acc + pix * NA, N = pp->count[pix];
             float *px = out->pixels + pix * C;
+            if (!(N > 0)) {
+                for (int k = 0; k <= n; k++) px[k] = 0;
+                continue;
+            }
             for (int k = 0; k < n; k++) px[k] = (float)(A[k] / N);
             px[n] = (float)(A[2 * n] / N);
             const double my = A[2 * n + 1] / N;
@@ -261,9 +403,47 @@ static void resolve(const atmos__path_plan *pp, int n, const atmos__rect *r, atm
             if (my > 0 && N > 1) {
                 rel_sum += sqrt(vy) / my;
                 rel_n++;
+                if (A[2 * n + 4] > 0) {
+                    vol_sum += sqrt(vy) / my;
+                    if (vol) vol[vol_n] = sqrt(vy) / my;
+                    vol_n++;
+                }
             }
         }
     st->mean_rel_error = rel_n ? rel_sum / rel_n : 0.0;
+    st->volume_pixels = vol_n;
+    st->volume_rel_error_mean = vol_n ? vol_sum / vol_n : 0.0;
+    st->volume_rel_error_median = st->volume_rel_error_p90 = 0;
+    if (vol && vol_n) {
+        qsort(vol, (size_t)vol_n, sizeof *vol, cmp_double);
+        st->volume_rel_error_median = vol[(vol_n - 1) / 2];
+        if (!(vol_n & 1)) st->volume_rel_error_median = 0.5 * (vol[(vol_n - 1) / 2] + vol[vol_n / 2]);
+        st->volume_rel_error_p90 = vol[(size_t)ceil(0.9 * (double)vol_n) - 1];
+    }
+    free(vol);
+}
+
+/* Warnings for what the render could not do: paths cut by the default depth limit, pixels
+ * the time budget left without a sample. */
+static void report(atmos_context *ctx, const atmos_path_stats *st)
+{
+    if (st->cut_paths > 0)
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "render path: %lld of %lld paths (%.3g %%) reached the default limit of %d scattering events and "
+                   "were stopped, their further light lost (an optically very thick volume: a conservative slab of "
+                   "optical depth 1000 loses about 4 %% of the light this way); path.max_depth sets the limit",
+                   st->cut_paths, st->paths, 100.0 * (double)st->cut_paths / (double)(st->paths ? st->paths : 1),
+                   PATH_DEFAULT_DEPTH);
+    if (st->walks_ended > 0)
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "render path: %lld free flights or shadow rays took more than %d steps and ended at their Russian "
+                   "roulette (unbiased, but the light through such parts is noisy and mostly lost at these sample "
+                   "counts): the volume is optically huge within its %d-voxel bricks (a density scale far too large?)",
+                   st->walks_ended, PATH_WALK_RR, VOL_BRICK);
+    if (st->empty_pixels > 0)
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "render path: the time budget ran out in the first pass: %lld pixels have no sample (black, alpha 0)",
+                   st->empty_pixels);
 }
 
 /* Starts the accumulator again for a view (a new camera or sun, a smaller budget). */
@@ -314,6 +494,7 @@ atmos_status atmos__path_render(atmos_plan *p, const atmos__view *v, const atmos
     }
     st->trace_s = atmos__now() - t0;
     resolve(pp, p->wl.count, r, out, st);
+    report(p->ctx, st);
     st->truncate_deg = pp->ph.ic ? pp->ph.cut_deg : 0.0;
     st->truncated_min = pp->trunc_lo, st->truncated_max = pp->trunc_hi;
     st->total_s = atmos__now() - t_start;

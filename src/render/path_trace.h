@@ -21,12 +21,19 @@ typedef struct {
     int disk_visible;       /* the sun's disk is drawn */
     double bg;              /* radiance from beyond the atmosphere (a vacuum's background) */
     double albedo;          /* the ground's */
-    int max_depth;          /* 0 = unlimited */
+    int max_depth;          /* scattering events per path (the scene's, else PATH_DEFAULT_DEPTH) */
+    int depth_default;      /* max_depth is the default: a path stopped by it counts as cut */
     uint64_t seed;
 } path_job;
 
+/* The depth limit when the scene sets none: it bounds the walk in optically huge media (a
+ * path there takes ~ tau^2 events to leave; docs/path.md, "Optically huge media"). */
+#define PATH_DEFAULT_DEPTH 10000
+
 typedef struct {
     long long events, tentative, shadow;
+    long long cut;   /* paths stopped by the default depth limit */
+    long long ended; /* walks ended at their roulette (path_medium.h, PATH_WALK_RR) */
 } path_counts;
 
 /* What every estimate along one camera path shares: the job, the carried wavelengths, the
@@ -123,8 +130,9 @@ int atmos__path_forced_single(const path_run *R, const double p[3], const double
 
 /* One camera path through world ray (o, d); adds the radiance of the carried wavelengths to
  * L[] and, for the scattering-order image, each contribution times the number of volume
- * scattering events before it to Lo[]. */
-void atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d[3], atmos__stream *r,
+ * scattering events before it to Lo[]. Returns 1 when the path met the volume (a scattering
+ * event, or the camera ray's forced single-scattering estimate), else 0. */
+int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d[3], atmos__stream *r,
                        double *L, double *Lo, path_counts *cnt);
 
 #endif

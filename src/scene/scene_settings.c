@@ -38,11 +38,11 @@ static const atmos_setting slice_settings[] = {
 static const atmos_setting path_settings[] = {
     {"spp", "spp", ATMOS_SETTING_INT, "", 1, 1000000, 0, 0, 64, NULL, 0, "samples per pixel", PATH(spp)},
     {"time_budget_s", "time-budget", ATMOS_SETTING_REAL, "s", 0, 1e7, 0, 0, 0, NULL, 0,
-     "stop after the pass during which this much time has passed; 0 = none", PATH(time_budget_s)},
+     "stop when this much time has passed (a pass it cuts is discarded); 0 = none", PATH(time_budget_s)},
     {"seed", "seed", ATMOS_SETTING_SEED, "", 0, 9007199254740992.0, 0, 0, 1, NULL, 0,
      "random seed: same seed, same image", PATH(seed)},
     {"max_depth", "max-depth", ATMOS_SETTING_INT, "", 0, 100000, 0, 0, 0, NULL, 0,
-     "scattering events per path; 0 = unlimited (Russian roulette)", PATH(max_depth)},
+     "scattering events per path; 0 = the default limit of 10000", PATH(max_depth)},
     {"truncate_deg", "truncate", ATMOS_SETTING_REAL, "deg", 0, 20, 0, 0, 0, NULL, 0,
      "cut every phase function's forward peak at this angle, the part above counting as unscattered "
      "(less noise in droplet clouds, changes light within it of the forward direction); 0 = exact",

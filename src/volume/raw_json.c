@@ -221,6 +221,9 @@ static atmos_status parse_sidecar(atmos_context *ctx, const char *path, const cJ
         return st;
     if (!(sc->vd.voxel_size_m > 0))
         return atmos__error(ctx, ATMOS_E_FORMAT, "%s: voxel_size_m: must be > 0", path);
+    if (sc->vd.voxel_size_m < ATMOS_VOLUME_MIN_VOXEL_M || sc->vd.voxel_size_m > ATMOS_VOLUME_MAX_VOXEL_M)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: voxel_size_m: voxel size %g m is outside the supported %g..%g m",
+                            path, sc->vd.voxel_size_m, ATMOS_VOLUME_MIN_VOXEL_M, ATMOS_VOLUME_MAX_VOXEL_M);
     if (single) {
         sc->nfields = 1;
         if ((st = parse_field(ctx, path, root, "top level", 1, &sc->f[0])) != ATMOS_OK) return st;

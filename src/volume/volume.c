@@ -29,6 +29,13 @@ static atmos_status check_desc(atmos_context *ctx, const atmos_volume_desc *d, a
     if (!(isfinite(d->voxel_size_m) && d->voxel_size_m > 0))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "volume: voxel_size_m: must be finite and > 0, got %g",
                             d->voxel_size_m);
+    /* A micrometre to 100 km: beyond, the renderers' walks in metres lose the voxel to the
+     * precision of the positions (a path tracer's free flight stops advancing). */
+    if (d->voxel_size_m < ATMOS_VOLUME_MIN_VOXEL_M || d->voxel_size_m > ATMOS_VOLUME_MAX_VOXEL_M)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "volume: voxel size %g m is outside the supported %g..%g m (a unit mix-up? the voxel size "
+                            "is in metres)",
+                            d->voxel_size_m, ATMOS_VOLUME_MIN_VOXEL_M, ATMOS_VOLUME_MAX_VOXEL_M);
     int zero = 1;
     for (int i = 0; i < 9; i++) {
         if (!isfinite(d->rotation[i]))

@@ -49,7 +49,7 @@ assert all(math.isfinite(x) and x >= 0 for x in o), "bad order values"
 # the sky pixels carry light that never met the volume (order 0); the cloud's carry more
 assert min(o) == 0 and max(o) >= 1, (min(o), max(o))
 PY
-# --time-budget: stops after the pass in which the budget ran out (here the first)
+# --time-budget: stops when the budget runs out (tests/cli/path_run.sh: inside a pass)
 "$A" render $P --spp 1000000 --time-budget 0.2 --threads 2 --pfm "$T/t.pfm" 2> "$T/t.log" && ok || bad "--time-budget"
 grep -q "path: [0-9]* spp" "$T/t.log" && ! grep -q "path: 1000000 spp" "$T/t.log" && ok || bad "--time-budget did not stop early"
 # bad values: usage errors exit 2

@@ -169,17 +169,20 @@ static void print_path(const char *name, int vacuum, const atmos_scene *s, int t
                "\"tentative_per_s\":%.4g,\"shadow_rays_per_s\":%.4g,\"events_per_path\":%.2f,\"trace_s\":%.3f,"
                "\"prepare_s\":%.3f,\"covered_pixels\":%lld,\"pixel_rel_se\":%.4f,\"t_1pct_pixel_s\":%.4g,"
                "\"mean_rel_se\":%.3g,\"t_1pct_mean_s\":%.3g,\"fps_camera_moving\":%.3f,\"fps_sun_moving\":%.3f,"
-               "\"fps_static\":%.3f}\n"
+               "\"fps_static\":%.3f,\"volume_pixels\":%lld,\"volume_rel_se_mean\":%.4f,\"volume_rel_se_median\":%.4f,"
+               "\"volume_rel_se_p90\":%.4f,\"cut_paths\":%lld}\n"
              : "bench=path case=%s background=%s size=%dx%d spp=%d threads=%d density_scale=%g forced=%d sky_nee=%d "
                "aureole=%d paths_per_s=%.4g events_per_s=%.4g tentative_per_s=%.4g shadow_rays_per_s=%.4g "
                "events_per_path=%.2f trace_s=%.3f prepare_s=%.3f covered_pixels=%lld pixel_rel_se=%.4f "
                "t_1pct_pixel_s=%.4g mean_rel_se=%.3g t_1pct_mean_s=%.3g fps_camera_moving=%.3f fps_sun_moving=%.3f "
-               "fps_static=%.3f\n";
+               "fps_static=%.3f volume_pixels=%lld volume_rel_se_mean=%.4f volume_rel_se_median=%.4f "
+               "volume_rel_se_p90=%.4f cut_paths=%lld\n";
     printf(fmt, name, vacuum ? "vacuum" : "sky", s->width, s->height, st->spp, threads, s->volume.density_scale,
            s->path.forced, s->path.sky_nee, s->path.aureole, st->paths / t, st->events / t, st->tentative / t,
            st->shadow_rays / t, (double)st->events / (double)st->paths, t, prepare_s, cnt, rel,
            t * (rel / 0.01) * (rel / 0.01), relm, t * (relm / 0.01) * (relm / 0.01), fps[MOVE_CAMERA], fps[MOVE_SUN],
-           fps[MOVE_NOTHING]);
+           fps[MOVE_NOTHING], st->volume_pixels, st->volume_rel_error_mean, st->volume_rel_error_median,
+           st->volume_rel_error_p90, st->cut_paths);
     fflush(stdout);
 }
 

@@ -199,8 +199,16 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     if (atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH) {
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
-        fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", ps.path.spp,
-                ps.path.events, 100.0 * ps.path.mean_rel_error);
+        const atmos_path_stats *q = &ps.path;
+        if (q->volume_pixels > 0)
+            fprintf(stderr,
+                    "  path: %d spp, %lld scattering events; relative standard error over the volume's %lld pixels: "
+                    "mean %.2f %%, median %.2f %%, 90th percentile %.2f %% (over all pixels: mean %.2f %%)\n",
+                    q->spp, q->events, q->volume_pixels, 100.0 * q->volume_rel_error_mean,
+                    100.0 * q->volume_rel_error_median, 100.0 * q->volume_rel_error_p90, 100.0 * q->mean_rel_error);
+        else
+            fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", q->spp,
+                    q->events, 100.0 * q->mean_rel_error);
         if (ps.path.truncate_deg > 0)
             fprintf(stderr, "  path: forward peak truncated at %g deg: %.3f-%.3f of the scattering counted as unscattered\n",
                     ps.path.truncate_deg, ps.path.truncated_min, ps.path.truncated_max);

@@ -1,0 +1,69 @@
+#!/bin/sh
+# atmos render --renderer path finishes on time and says how noisy it is: a render whose
+# passes are far longer than its --time-budget (the generated cumulus at density scale 1e6,
+# once minutes for a few pixels) stops within the budget and, off a terminal, logs its
+# progress; the final report gives the noise over the volume's pixels (mean, median, 90th
+# percentile) and atmos bench path --json carries them; absurd voxel sizes are refused.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/cli_path_run.$$
+mkdir -p "$T"
+export XDG_CACHE_HOME="$T/cache"
+fail=0; pass=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
+
+# the render's own time (the first report line ends in ", X s"), without the table builds
+render_s() { sed -n 's/^atmos render: .*, \([0-9.]*\) s$/\1/p' "$1" | head -n 1; }
+
+# A budget inside a pass: 6 s on passes that would take minutes; stderr is a file, so
+# progress comes as log lines (one every 5 s).
+"$A" render --renderer path --volume generate:cumulus --density-scale 1e6 --width 64 --height 48 --spp 100000 \
+    --time-budget 6 --threads 2 --pfm "$T/b.pfm" 2> "$T/b.log" && ok || bad "render with --time-budget 6"
+s=$(render_s "$T/b.log")
+python3 -c "import sys; sys.exit(0 if 0 < float('$s') < 7.5 else 1)" 2>/dev/null && ok \
+    || { bad "--time-budget 6 took ${s:-?} s"; cat "$T/b.log" >&2; }
+grep -q "^atmos: render path: [0-9]* %, [0-9.]* s elapsed$" "$T/b.log" && ok || bad "no progress log line off a terminal"
+grep -q "path: [0-9]* spp" "$T/b.log" && ok || bad "no sample count reported"
+
+# The noise over the volume's pixels: in the sky the air's many quiet pixels dilute the mean
+# over all pixels, the volume's figure is larger.
+"$A" render --renderer path --volume generate:cumulus --width 32 --height 24 --spp 8 --threads 2 \
+    --pfm "$T/n.pfm" 2> "$T/n.log" && ok || bad "noise render"
+line=$(grep "over the volume's" "$T/n.log")
+[ -n "$line" ] && ok || { bad "no noise figure over the volume's pixels"; cat "$T/n.log" >&2; }
+echo "$line" | python3 -c "
+import re, sys
+l = sys.stdin.read()
+m = re.search(r\"volume's (\d+) pixels: mean ([\d.]+) %, median ([\d.]+) %, 90th percentile ([\d.]+) % \(over all pixels: mean ([\d.]+) %\)\", l)
+n, mean, med, p90, allp = int(m.group(1)), *map(float, m.group(2, 3, 4, 5))
+assert 0 < n < 32 * 24, n
+assert med <= p90 and mean > allp, (mean, med, p90, allp)
+" && ok || bad "noise figures: $line"
+
+# atmos bench path --json: the same figures
+"$A" bench path --size 16 --spp 2 --threads 2 --json > "$T/bench.json" 2> /dev/null && ok || bad "bench path --json"
+python3 - "$T/bench.json" <<'PY' && ok || bad "bench path --json lacks the volume's noise figures"
+import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
+assert len(rows) == 2
+for r in rows:
+    for k in ("volume_pixels", "volume_rel_se_mean", "volume_rel_se_median", "volume_rel_se_p90", "cut_paths"):
+        assert k in r, k
+    assert r["volume_pixels"] > 0 and r["volume_rel_se_median"] <= r["volume_rel_se_p90"]
+PY
+
+# Voxel sizes outside 1e-6..1e5 m are refused, naming the voxel size (a raw sidecar here).
+printf '\000\000\200\077' > "$T/v.raw"
+for vs in 1e20 1e-9; do
+    printf '{"file": "v.raw", "dims": [1, 1, 1], "voxel_size_m": %s}\n' "$vs" > "$T/v.json"
+    "$A" volume info "$T/v.json" > /dev/null 2> "$T/v.log"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "voxel size" "$T/v.log" && ok || bad "voxel size $vs: exit $rc, $(cat "$T/v.log")"
+done
+printf '{"file": "v.raw", "dims": [1, 1, 1], "voxel_size_m": 1e5}\n' > "$T/v.json"
+"$A" volume info "$T/v.json" > /dev/null 2>&1 && ok || bad "voxel size 1e5 refused"
+
+rm -rf "$T"
+echo "path_run: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
