@@ -144,7 +144,8 @@ void atmos__path_air_scatter(const path_run *R, const double p[3], const double 
     const int span = J->med && (view || sun_shadow_span(J->med, p, d, J->sun, K, &s0, &s1));
     const double p0[3] = {p[0] + s0 * d[0], p[1] + s0 * d[1], p[2] + s0 * d[2]};
     for (int i = 0; i < m; i++) fs[i] = 0;
-    if (span) { /* the analytic in-scatter of the span, seen through the air from p */
+    if (view) memcpy(fs, f, sizeof fs); /* the span is the whole segment */
+    else if (span) { /* the analytic in-scatter of the span, seen through the air from p */
         atmos__atm_inscatter_sub(J->atm, p0, d, s1 - s0, J->sun, m, b->k, fs);
         atmos__path_air_transmit(R, p, d, s0, fs);
     }
