@@ -254,7 +254,8 @@ void atmos__path_nee(const path_run *R, const path_event *ev, const double *E, d
  * ways there). The path reaches the same x' with density q p_dir(a) and counts the sun at
  * x' times h = q p_dir / (q p_dir + pa) (trace: hprev); this estimate has 1 - h, i.e. the
  * weight w_k p_k(d . a) / (q p_dir(a) + pa(a)): the balance heuristic between the two.
- * Used where some phase function has a forward peak (J->aureole). */
+ * Used where some phase function has a forward peak, or had one before truncation
+ * (J->aureole: path_plan.c). */
 void atmos__path_aureole(const path_run *R, const path_event *ev)
 {
     const path_job *J = R->J;

@@ -189,7 +189,7 @@ static void sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, in
         }
         for (int i = 0; i < b.m; i++) {
             double v = L[i] * wgt;
-            if (!isfinite(v)) v = 0; /* may be < 0: the air's shadows (air_scatter) */
+            if (!isfinite(v)) v = 0; /* a non-finite sample counts 0 (every estimate is >= 0) */
             A[b.k[i]] += v;
             A[n + b.k[i]] += v * v;
             Y += Ybar[b.k[i]] * v;
