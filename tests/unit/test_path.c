@@ -896,13 +896,14 @@ static void test_air_shadow(atmos_context *ctx)
 }
 
 /* A camera inside a dense cloud (a 1 km cube, optical depth 20 across, albedo 0.99) in the
- * sky, looking up, the sun 40 degrees high. The light is faint there, so the air's
- * in-scatter along the rays (almost all of it in the cloud's shadow) is a large part of
- * it: every sample of it must be >= 0 (the first estimator, the analytic value minus a
+ * sky, looking up, the sun 40 degrees high. Little sunlight is scattered once toward the
+ * camera there, so at single scattering the air's in-scatter along the rays (almost all of
+ * it in the cloud's shadow) is a large part of the light: every sample of it must be >= 0 (the first estimator, the analytic value minus a
  * one-point estimate of the shadowed part, gave negative pixels in all three channels at
- * 1 spp, and at single scattering half of them still at 64 spp), and over many samples
- * every pixel's mean is >= 0 within its noise and equals, over the image, that of the
- * renderer without next-event estimation of the sky and forced single scattering. */
+ * 1 spp here; in the generated cumulus at single scattering, half of them at 64 spp), and
+ * over many samples every pixel's mean is >= 0 within its noise and equals, over the image,
+ * that of the renderer without next-event estimation of the sky and forced single
+ * scattering. */
 static void test_air_inside(atmos_context *ctx)
 {
     optics op;
