@@ -65,47 +65,113 @@ double atmos__path_mis_nee(const path_job *J, double q_pdir)
     return q_pdir > 0 ? pl / (pl + q_pdir) : 1.0;
 }
 
+/* The part [*a, *b] of the segment p + t d, t in [0, K], whose points see the sun through
+ * the volume's box: the t for which some s >= 0 puts p + t d + s sun in the box. In index
+ * space (q + t qd, sun qs) each axis bounds s from below and above by lines in t (or t
+ * alone where qs is 0 on that axis); s exists where every lower bound is below every upper
+ * one, an interval of t (the box is convex). Returns 0 when no point of the segment does. */
+static int sun_shadow_span(const path_medium *M, const double p[3], const double d[3], const double sun[3], double K,
+                           double *a, double *b)
+{
+    double q[3], qd[3], q2[3], qs[3];
+    atmos__path_to_index(M, p, d, q, qd);
+    atmos__path_to_index(M, p, sun, q2, qs);
+    double lo[4][2] = {{0, 0}}, hi[3][2]; /* bounds on s: c0 + c1 t; s >= 0 is the first lower one */
+    int nl = 1, nh = 0;
+    double t0 = 0, t1 = K;
+    for (int x = 0; x < 3; x++) {
+        const double l = M->box_lo[x] - q[x], h = M->box_hi[x] - q[x]; /* l <= t qd + s qs <= h */
+        if (qs[x] == 0) {
+            if (qd[x] == 0) {
+                if (l > 0 || h < 0) return 0;
+                continue;
+            }
+            double ta = l / qd[x], tb = h / qd[x];
+            if (ta > tb) {
+                const double c = ta;
+                ta = tb, tb = c;
+            }
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+            continue;
+        }
+        const double lo0 = (qs[x] > 0 ? l : h) / qs[x], hi0 = (qs[x] > 0 ? h : l) / qs[x], c1 = -qd[x] / qs[x];
+        lo[nl][0] = lo0, lo[nl][1] = c1, nl++;
+        hi[nh][0] = hi0, hi[nh][1] = c1, nh++;
+    }
+    for (int i = 0; i < nl; i++)
+        for (int j = 0; j < nh; j++) { /* lo_i(t) <= hi_j(t): e0 + e1 t <= 0 */
+            const double e0 = lo[i][0] - hi[j][0], e1 = lo[i][1] - hi[j][1];
+            if (e1 == 0) {
+                if (e0 > 0) return 0;
+            } else if (e1 > 0) {
+                if (-e0 / e1 < t1) t1 = -e0 / e1;
+            } else if (-e0 / e1 > t0) {
+                t0 = -e0 / e1;
+            }
+        }
+    if (!(t0 < t1)) return 0;
+    *a = t0, *b = t1;
+    return 1;
+}
+
 /* The air's single scattering of sunlight along p + t d, t in [0, K], added to L (times
- * w[i] wt): the atmosphere's in-scatter (exact for the closed-form kinds), minus the part
- * the volume takes away. That part, the integral of the in-scatter f(t) (1 - T_view(t)
- * T_sun(t)) with T_view the volume's transmittance from p to p + t d (view: the segment is
- * inside the box; else 1) and T_sun the volume's transmittance from there toward the sun, is
- * estimated with one point the atmosphere draws in proportion to the air's scattering times
- * its transmittance (of the carried wavelength that scatters least, so that the others'
- * ratios stay bounded): shadows of the volume on the air, the light shafts, cost a shadow
- * ray only where the point's way to the sun crosses the box, and light that nothing
- * shadows is the analytic value without noise. A sample can therefore be negative in a
- * shadow; its mean is not. */
+ * w[i] wt), with the volume's shadows on it: the integral of the in-scatter f(t) T_view(t)
+ * T_sun(t), T_view the volume's transmittance from p to p + t d (view: the segment is inside
+ * the box; else 1) and T_sun the volume's transmittance from there toward the sun.
+ *  - Outside the box, only the part [s0, s1] of the segment whose way to the sun crosses the
+ *    box can be shadowed (sun_shadow_span): the rest is the atmosphere's analytic in-scatter
+ *    (exact for the closed-form kinds) without noise, the part by one point that the
+ *    atmosphere draws on it in proportion to the air's scattering times its transmittance
+ *    (of the carried wavelength that scatters least, so that the others' ratios stay
+ *    bounded) times T_sun there.
+ *  - Inside the box the whole segment is estimated so, times T_view too.
+ * Every sample is >= 0. (The first version added the analytic value of the whole segment and
+ * subtracted f (1 - T_view T_sun) / pdf at one point drawn over all of it: unbiased too, but
+ * where nearly everything is shadowed, as inside a cloud, a sample was the analytic value
+ * minus its one-point estimate, negative about half the time: pixels with little other
+ * light came out negative at low sample counts, and a ray to space beside a cloud
+ * subtracted the whole sky's in-scatter at a point in the cloud's shadow.) */
 void atmos__path_air_scatter(const path_run *R, const double p[3], const double d[3], double K, const double *w,
                              double wt, int order, const air_view *view)
 {
     const path_job *J = R->J;
     const path_bundle *b = R->b;
+    const int m = b->m;
     if (!(K > 0) || !(wt > 0)) return;
-    double f[PATH_B];
-    if (!atmos__atm_inscatter_sub(J->atm, p, d, K, J->sun, b->m, b->k, f)) return;
-    for (int i = 0; i < b->m; i++) {
+    double f[PATH_B], fs[PATH_B], s0 = 0, s1 = K;
+    if (!atmos__atm_inscatter_sub(J->atm, p, d, K, J->sun, m, b->k, f)) return;
+    const int span = J->med && (view || sun_shadow_span(J->med, p, d, J->sun, K, &s0, &s1));
+    const double p0[3] = {p[0] + s0 * d[0], p[1] + s0 * d[1], p[2] + s0 * d[2]};
+    for (int i = 0; i < m; i++) fs[i] = 0;
+    if (view) memcpy(fs, f, sizeof fs); /* the span is the whole segment */
+    else if (span) { /* the analytic in-scatter of the span, seen through the air from p */
+        atmos__atm_inscatter_sub(J->atm, p0, d, s1 - s0, J->sun, m, b->k, fs);
+        atmos__path_air_transmit(R, p, d, s0, fs);
+    }
+    for (int i = 0; i < m; i++) {
         if (w[i] == 0) continue;
-        atmos__path_add(R, i, w[i] * wt * f[i], order);
+        const double rest = f[i] - fs[i];
+        if (rest > 0) atmos__path_add(R, i, w[i] * wt * rest, order);
     }
     double ta, ratio[PATH_B];
-    if (!J->med || !atmos__atm_scatter_point(J->atm, p, d, K, b->m, b->k, w, R->r, &ta, ratio)) return;
+    if (!span || !atmos__atm_scatter_point(J->atm, p0, d, s1 - s0, m, b->k, w, R->r, &ta, ratio)) return;
+    atmos__path_air_transmit(R, p, d, s0, ratio); /* the point's ratio counts the air from p0 on */
+    ta += s0;
     const double pa[3] = {p[0] + ta * d[0], p[1] + ta * d[1], p[2] + ta * d[2]};
-    double Ts[PATH_B], Tv[PATH_B], E[PATH_B];
-    atmos__path_shadow(R, pa, J->sun, Ts);
-    int any = 0, lit = 0;
-    for (int i = 0; i < b->m; i++) any |= Ts[i] < 1, lit |= Ts[i] > 0;
-    if (!any && !view) return; /* nothing in the way to the sun: the analytic value holds */
-    for (int i = 0; i < b->m; i++) Tv[i] = 1;
-    if (view && lit) atmos__path_transmittance(J->med, view->q, view->qd, view->t0, view->t0 + ta, b, R->r, Tv);
+    double T[PATH_B], Tv[PATH_B], E[PATH_B];
+    atmos__path_shadow(R, pa, J->sun, T);
+    int lit = 0;
+    for (int i = 0; i < m; i++) lit |= w[i] != 0 && T[i] > 0;
+    if (!lit) return;
+    if (view) {
+        atmos__path_transmittance(J->med, view->q, view->qd, view->t0, view->t0 + ta, b, R->r, Tv);
+        for (int i = 0; i < m; i++) T[i] *= Tv[i];
+    }
     atmos__path_sunlight(R, pa, E);
     const double P = atmos_atmosphere_phase(J->atm, pa, atmos__dot3(d, J->sun));
-    for (int i = 0; i < b->m; i++) {
-        const double occl = 1.0 - Tv[i] * Ts[i];
-        if (w[i] == 0 || occl == 0) continue;
-        const double c = w[i] * wt * P * E[i] * ratio[i] * occl;
-        R->L[i] -= c, R->Lo[i] -= order * c;
-    }
+    for (int i = 0; i < m; i++)
+        if (w[i] != 0 && T[i] > 0) atmos__path_add(R, i, w[i] * wt * P * E[i] * ratio[i] * T[i], order);
 }
 
 /* Next-event estimation at a scattering point p of the volume reached along d with weights
@@ -188,7 +254,8 @@ void atmos__path_nee(const path_run *R, const path_event *ev, const double *E, d
  * ways there). The path reaches the same x' with density q p_dir(a) and counts the sun at
  * x' times h = q p_dir / (q p_dir + pa) (trace: hprev); this estimate has 1 - h, i.e. the
  * weight w_k p_k(d . a) / (q p_dir(a) + pa(a)): the balance heuristic between the two.
- * Used where some phase function has a forward peak (J->aureole). */
+ * Used where some phase function has a forward peak, or had one before truncation
+ * (J->aureole: path_plan.c). */
 void atmos__path_aureole(const path_run *R, const path_event *ev)
 {
     const path_job *J = R->J;
