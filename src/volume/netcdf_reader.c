@@ -18,6 +18,7 @@
 #include "core/internal.h"
 #include "volume/netcdf_classic.h"
 #include "volume/reader_common.h"
+#include "volume/reader_fence.h"
 #include "volume/volume_internal.h"
 
 #include <math.h>
@@ -608,6 +609,12 @@ static atmos_status cm1_heights(loader *L)
     if (!st) st = read_coord(s, "xh", (size_t)s->i0, (size_t)s->nx, xc);
     if (!st) st = read_coord(s, "yh", (size_t)s->j0, (size_t)s->ny, yc);
     if (st) return st;
+    /* CM1's zh is the height of the scalar levels above the ground: positive, increasing. */
+    for (int k = 0; k < s->nz; k++)
+        if (!(zh[k] >= 0) || (k > 0 && !(zh[k] > zh[k - 1])))
+            return atmos__error(s->ctx, ATMOS_E_FORMAT,
+                                "%s: zh[%d] = %g m%s: CM1 heights above the ground must be >= 0 and increase upward",
+                                s->path, s->k0 + k, zh[k], zh[k] >= 0 ? " (not above the level below)" : "");
     L->dx = s->nx > 1 ? (xc[s->nx - 1] - xc[0]) / (s->nx - 1) : 1000.0;
     L->dy = s->ny > 1 ? (yc[s->ny - 1] - yc[0]) / (s->ny - 1) : L->dx;
     if (s->nx == 1) L->dx = L->dy;
@@ -831,12 +838,11 @@ static atmos_status load(loader *L)
     return atmos_volume_finalize(L->s.ctx, L->vol);
 }
 
-atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
-                                       atmos_volume **out)
+/* The load itself, run in the fence's child process. */
+static atmos_status load_direct(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                atmos_volume **out)
 {
     static const atmos_volume_load_desc zero_desc;
-    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "netcdf: path and out are required");
-    *out = NULL;
     loader L;
     memset(&L, 0, sizeof L);
     L.s.ctx = ctx;
@@ -849,6 +855,15 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
     }
     loader_free(&L);
     return st == ATMOS_OK ? ATMOS_OK : atmos__reader_name_error(ctx, path, st);
+}
+
+/* libnetcdf and libhdf5 parse the file behind the fence (reader_fence.h): a damaged
+ * netCDF-4 file can make libhdf5 free an invalid pointer. */
+atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                       atmos_volume **out)
+{
+    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "netcdf: path and out are required");
+    return atmos__reader_fenced(ctx, path, desc, "NetCDF/HDF5", load_direct, out);
 }
 
 #endif /* ATMOS_HAVE_NETCDF */

@@ -94,14 +94,10 @@ extern "C" int atmos__vdb_open(const char *path, atmos__vdb **out, char *msg, si
         }
         // Grid types come from the metadata only, so listing does not read voxels.
         openvdb::GridPtrVecPtr metas = f->file->readAllGridMetadata();
+        // Both lists follow the file's descriptor map, so they match by position (grids
+        // with the same name have unique names like "cloud[1]" but the same getName()).
         f->types.assign(f->names.size(), std::string());
-        for (const auto &g : *metas) {
-            for (size_t i = 0; i < f->names.size(); i++)
-                if (f->names[i] == g->getName() && f->types[i].empty()) {
-                    f->types[i] = g->valueType();
-                    break;
-                }
-        }
+        for (size_t i = 0; i < f->names.size() && i < metas->size(); i++) f->types[i] = (*metas)[i]->valueType();
         f->grids.resize(f->names.size());
         *out = f;
         return ATMOS__VDB_OK;

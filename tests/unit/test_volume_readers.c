@@ -208,6 +208,69 @@ static void test_openvdb_fixtures(void)
     atmos_volume_load_desc tiny = {.max_memory = 1000};
     check_status(atmos__volume_load_openvdb, p, &tiny, ATMOS_E_LIMIT, "memory limit");
     check_status(atmos__volume_load_openvdb, "/nonexistent/x.vdb", NULL, ATMOS_E_IO, "cannot open");
+    /* Two float grids of the same name: both load (OpenVDB names the second "cloud[1]"). */
+    fixture(p, sizeof p, "dup_names.vdb");
+    v = NULL;
+    CHECK_OK(atmos__volume_load_openvdb(ctx, p, NULL, &v));
+    if (v) {
+        CHECK_MSG(atmos_volume_field_count(v) == 2, "%d fields", atmos_volume_field_count(v));
+        atmos_volume_destroy(v);
+    }
+}
+
+/* Writes the first n bytes of buf to path, with byte `flip` (if < n) set to `value`. */
+static void write_mutant(const char *path, const unsigned char *buf, size_t n, size_t flip, unsigned char value)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return;
+    fwrite(buf, 1, n, f);
+    if (flip < n) {
+        fseek(f, (long)flip, SEEK_SET);
+        fputc(value, f);
+    }
+    fclose(f);
+}
+
+/* Damaged copies of the fixtures: every cut (a truncated file) must be refused, naming the
+ * file; a flipped byte must give a volume or an error naming the file, never a crash of
+ * this process (the library reads behind the fence). */
+static void test_openvdb_damaged(void)
+{
+    const char *names[] = {"small.vdb", "small_blosc.vdb", "small_zip.vdb"};
+    int cuts = 0, flips = 0, flips_ok = 0;
+    for (int n = 0; n < 3; n++) {
+        char p[1024], q[1024];
+        fixture(p, sizeof p, names[n]);
+        size_t size;
+        unsigned char *buf = test_slurp(p, &size);
+        CHECK_MSG(buf != NULL, "cannot read %s", p);
+        if (!buf) continue;
+        test_tmp_path(q, sizeof q, "damaged.vdb");
+        const size_t stride = size / 97 + 1;
+        for (size_t cut = 0; cut < size; cut += stride, cuts++) {
+            write_mutant(q, buf, cut, SIZE_MAX, 0);
+            atmos_volume *v = NULL;
+            atmos_status st = atmos__volume_load_openvdb(ctx, q, NULL, &v);
+            CHECK_MSG(st != ATMOS_OK, "%s cut to %zu bytes of %zu loaded", names[n], cut, size);
+            if (st != ATMOS_OK) CHECK_MSG(strstr(atmos_context_error(ctx), q), "%s", atmos_context_error(ctx));
+            atmos_volume_destroy(v);
+        }
+        if (n == 0) {
+            /* the header's own message for a cut inside the grid */
+            write_mutant(q, buf, size / 2, SIZE_MAX, 0);
+            check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "truncated");
+        }
+        for (size_t at = 7; n > 0 && at < size; at += size / 40 + 1, flips++) {
+            write_mutant(q, buf, size, at, (unsigned char)(buf[at] ^ 0xb5));
+            atmos_volume *v = NULL;
+            atmos_status st = atmos__volume_load_openvdb(ctx, q, NULL, &v);
+            if (st == ATMOS_OK) flips_ok++;
+            else CHECK_MSG(strstr(atmos_context_error(ctx), q), "%s", atmos_context_error(ctx));
+            atmos_volume_destroy(v);
+        }
+        free(buf);
+    }
+    printf("damaged OpenVDB fixtures: %d cuts refused, %d flipped bytes (%d loaded)\n", cuts, flips, flips_ok);
 }
 
 /* The real files: counts from the file via the shim, placement and values via the reader. */
@@ -337,6 +400,10 @@ static void test_nanovdb(void)
     fixture(p, sizeof p, "small.nvdb");
     atmos_volume_load_desc tiny = {.max_memory = 2000};
     check_status(atmos__volume_load_nanovdb, p, &tiny, ATMOS_E_LIMIT, NULL);
+    /* A quantized grid: refused, saying quantized grids are the reason. */
+    fixture(p, sizeof p, "fp16.nvdb");
+    check_status(atmos__volume_load_nanovdb, p, NULL, ATMOS_E_UNSUPPORTED, "quantized Fp16");
+    fixture(p, sizeof p, "small.nvdb");
 
     /* Modified copies: compressed codec, truncation, every single-byte corruption
      * of the header and a sweep of corruptions through the grid (no crash, and a
@@ -431,6 +498,7 @@ int main(void)
     CHECK_OK(atmos_context_create(NULL, &ctx));
 #ifdef ATMOS_HAVE_OPENVDB
     test_openvdb_fixtures();
+    test_openvdb_damaged();
     test_openvdb_real();
 #else
     skip("OpenVDB reader not built");
