@@ -248,23 +248,31 @@ static double column_at(const float *v, const double *zm, int nz, size_t stride,
  * zeros past the end instead of an error. The header says where every variable's
  * data starts and how many records there are, so a file shorter than the end of
  * its data is truncated (netcdf_classic.c). */
+static atmos_status classic_truncation(atmos_context *ctx, const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return ATMOS_OK;
+    unsigned char magic[4] = {0};
+    uint64_t need = 0, have = 0;
+    int rc = -1;
+    if (fread(magic, 1, 4, f) == 4 && magic[0] == 'C' && magic[1] == 'D' && magic[2] == 'F')
+        rc = atmos__netcdf_classic_data_end(f, &need, &have);
+    fclose(f);
+    if (rc == 1)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated inside the NetCDF header (%llu bytes)", path,
+                            (unsigned long long)have);
+    if (rc == 0 && have < need)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %llu bytes, the file has %llu",
+                            path, (unsigned long long)need, (unsigned long long)have);
+    return ATMOS_OK;
+}
+
 static atmos_status check_classic_size(const src *s)
 {
     int fmt;
     if (nc_inq_format(s->nc, &fmt) != NC_NOERR) return ATMOS_OK;
     if (fmt != NC_FORMAT_CLASSIC && fmt != NC_FORMAT_64BIT_OFFSET && fmt != NC_FORMAT_CDF5) return ATMOS_OK;
-    FILE *f = fopen(s->path, "rb");
-    if (!f) return ATMOS_OK;
-    uint64_t need = 0, have = 0;
-    int rc = atmos__netcdf_classic_data_end(f, &need, &have);
-    fclose(f);
-    if (rc == 1)
-        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated inside the NetCDF header (%llu bytes)", s->path,
-                            (unsigned long long)have);
-    if (rc == 0 && have < need)
-        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %llu bytes, the file has %llu",
-                            s->path, (unsigned long long)need, (unsigned long long)have);
-    return ATMOS_OK;
+    return classic_truncation(s->ctx, s->path);
 }
 
 /* ------------------------------------------------------------ loader state */
@@ -863,6 +871,11 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
                                        atmos_volume **out)
 {
     if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "netcdf: path and out are required");
+    *out = NULL;
+    /* atmos's own check of a classic file's size needs no library: done here, it spares a
+     * truncated file the child process */
+    atmos_status st = classic_truncation(ctx, path);
+    if (st != ATMOS_OK) return st;
     return atmos__reader_fenced(ctx, path, desc, "NetCDF/HDF5", load_direct, out);
 }
 

@@ -256,11 +256,22 @@ static void test_openvdb_damaged(void)
             atmos_volume_destroy(v);
         }
         if (n == 0) {
-            /* the header's own message for a cut inside the grid */
+            /* the header's own message for a cut inside the grid, and for the crashers */
             write_mutant(q, buf, size / 2, SIZE_MAX, 0);
             check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "truncated");
+            const char *src = getenv("ATMOS_SOURCE_DIR");
+            snprintf(q, sizeof q, "%s/tests/crashers/volume/truncated_uncompressed.vdb", src && *src ? src : ".");
+            check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "truncated: grid 'density' ends at");
+            snprintf(q, sizeof q, "%s/tests/crashers/volume/dragon_creator_length.vdb", src && *src ? src : ".");
+            check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "grids claimed");
+            test_tmp_path(q, sizeof q, "damaged.vdb");
         }
-        for (size_t at = 7; n > 0 && at < size; at += size / 40 + 1, flips++) {
+#ifdef __SANITIZE_ADDRESS__
+        const size_t flip_stride = size / 10 + 1; /* a fork of a sanitized process is slow */
+#else
+        const size_t flip_stride = size / 40 + 1;
+#endif
+        for (size_t at = 7; n > 0 && at < size; at += flip_stride, flips++) {
             write_mutant(q, buf, size, at, (unsigned char)(buf[at] ^ 0xb5));
             atmos_volume *v = NULL;
             atmos_status st = atmos__volume_load_openvdb(ctx, q, NULL, &v);
@@ -427,6 +438,13 @@ static void test_nanovdb(void)
     check_status(atmos__volume_load_nanovdb, q, NULL, ATMOS_E_FORMAT, "truncated");
     spit(q, b, 10);
     check_status(atmos__volume_load_nanovdb, q, NULL, ATMOS_E_FORMAT, NULL);
+    /* every cut of the file is refused */
+    for (size_t cut = 0; cut < n; cut += n / 89 + 1) {
+        spit(q, b, cut);
+        atmos_volume *tv = NULL;
+        CHECK_MSG(atmos__volume_load_nanovdb(ctx, q, NULL, &tv) != ATMOS_OK, "small.nvdb cut to %zu bytes loaded", cut);
+        atmos_volume_destroy(tv);
+    }
     int unclean = 0, loaded = 0;
     /* A small limit keeps mutants that spread voxels far apart cheap to refuse. */
     atmos_volume_load_desc small_mem = {.max_memory = 16u << 20};
