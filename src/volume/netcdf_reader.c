@@ -704,6 +704,11 @@ static atmos_status number_density(loader *L, int si)
                                 q);
         if (q > qmax) qmax = q;
         eta[i] = (float)(conv > 0 ? q * conv : q * L->rho[i] / mp);
+        if (!isfinite(eta[i]))
+            return atmos__error(L->s.ctx, ATMOS_E_FORMAT,
+                                "%s: %s = %g kg/kg at point %zu gives a number density of %g m^-3 (air density %g "
+                                "kg/m^3): not a float; is the air density (rho, or prs and th) right?",
+                                L->s.path, name, q, i, conv > 0 ? q * conv : q * L->rho[i] / mp, L->rho[i]);
     }
     if (neg)
         atmos__log(L->s.ctx, ATMOS_LOG_WARN, "%s: %s: %zu negative mixing ratios set to 0", L->s.path, name, neg);
