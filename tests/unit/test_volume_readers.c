@@ -265,6 +265,20 @@ static void test_openvdb_damaged(void)
             snprintf(q, sizeof q, "%s/tests/crashers/volume/dragon_creator_length.vdb", src && *src ? src : ".");
             check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "grids claimed");
             test_tmp_path(q, sizeof q, "damaged.vdb");
+            /* a tree that disagrees with the count OpenVDB wrote next to it (here the count is
+             * changed, as a damaged mask would change the tree) */
+            unsigned char *c = malloc(size);
+            size_t at = SIZE_MAX;
+            for (size_t i = 0; c && i + 16 + 17 + 8 <= size && at == SIZE_MAX; i++)
+                if (memcmp(buf + i, "file_voxel_count", 16) == 0) at = i + 16 + 4 + 5 + 4; /* type "int64", size 8 */
+            CHECK_MSG(at != SIZE_MAX, "no file_voxel_count in %s", names[n]);
+            if (c && at != SIZE_MAX) {
+                memcpy(c, buf, size);
+                c[at] ^= 1;
+                write_mutant(q, c, size, SIZE_MAX, 0);
+                check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "the file's own count says");
+            }
+            free(c);
         }
 #ifdef __SANITIZE_ADDRESS__
         const size_t flip_stride = size / 10 + 1; /* a fork of a sanitized process is slow */
