@@ -214,6 +214,7 @@ static void test_openvdb_fixtures(void)
     CHECK_OK(atmos__volume_load_openvdb(ctx, p, NULL, &v));
     if (v) {
         CHECK_MSG(atmos_volume_field_count(v) == 2, "%d fields", atmos_volume_field_count(v));
+        CHECK(field_index(v, "cloud[0]") >= 0 && field_index(v, "cloud[1]") >= 0);
         atmos_volume_destroy(v);
     }
 }
