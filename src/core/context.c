@@ -105,6 +105,13 @@ void atmos_context_clear_error(atmos_context *ctx)
     ctx->error_status = ATMOS_OK;
 }
 
+void atmos__context_redirect_log(atmos_context *ctx, atmos_log_fn fn, void *user)
+{
+    if (!ctx) return;
+    ctx->desc.log = fn;
+    ctx->desc.log_user = user;
+}
+
 int atmos__threads(const atmos_context *ctx)
 {
     if (ctx && ctx->desc.threads > 0) return ctx->desc.threads;

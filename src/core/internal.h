@@ -15,6 +15,9 @@
  * write `return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));` */
 atmos_status atmos__error(atmos_context *ctx, atmos_status status, const char *fmt, ...) ATMOS_PRINTF(3, 4);
 void atmos__log(const atmos_context *ctx, atmos_log_level level, const char *fmt, ...) ATMOS_PRINTF(3, 4);
+/* Sends ctx's log messages to fn instead of the user's callback (a reader's child process
+ * forwards them to its parent, volume/reader_fence.c); the level filter stays. */
+void atmos__context_redirect_log(atmos_context *ctx, atmos_log_fn fn, void *user);
 /* Reports progress; returns nonzero if the caller asked to cancel. */
 int atmos__progress(const atmos_context *ctx, const char *stage, double fraction);
 /* Thread count to use for ctx (>= 1): the context's setting, all cores when ctx is NULL. */

@@ -496,12 +496,26 @@ static int select_grid(const grid_entry *g, int n, const char *name, size_t len)
     return -1;
 }
 
+/* " (quantized Fp16)" and the like for a grid atmos does not read; "" for a float grid. */
+static const char *type_note(uint32_t type)
+{
+    switch (type) {
+    case PNANOVDB_GRID_TYPE_FLOAT: return "";
+    case PNANOVDB_GRID_TYPE_FP4: return " (quantized Fp4)";
+    case PNANOVDB_GRID_TYPE_FP8: return " (quantized Fp8)";
+    case PNANOVDB_GRID_TYPE_FP16: return " (quantized Fp16)";
+    case PNANOVDB_GRID_TYPE_FPN: return " (quantized FpN)";
+    default: return " (not float)";
+    }
+}
+
 static void list_names(const grid_entry *g, int n, char *buf, size_t cap)
 {
     size_t len = 0;
     buf[0] = '\0';
     for (int i = 0; i < n && len + 1 < cap; i++) {
-        int wr = snprintf(buf + len, cap - len, "%s%s", i ? ", " : "", g[i].name[0] ? g[i].name : "(unnamed)");
+        int wr = snprintf(buf + len, cap - len, "%s%s%s", i ? ", " : "", g[i].name[0] ? g[i].name : "(unnamed)",
+                          type_note(g[i].grid_type));
         if (wr < 0) break;
         len += (size_t)wr;
     }
@@ -562,8 +576,15 @@ static atmos_status choose_grids(nvdb_load *L)
                 if (L->g[i].grid_type == PNANOVDB_GRID_TYPE_FLOAT) L->sel[L->nsel++] = i;
         }
     }
+    int quantized = 0;
+    for (int i = 0; i < L->ng; i++)
+        quantized |= L->g[i].grid_type >= PNANOVDB_GRID_TYPE_FP4 && L->g[i].grid_type <= PNANOVDB_GRID_TYPE_FPN;
     if (L->nsel == 0)
-        return atmos__error(L->ctx, ATMOS_E_FORMAT, "%s: no float grid to load; grids present: %s", L->path, present);
+        return atmos__error(L->ctx, quantized ? ATMOS_E_UNSUPPORTED : ATMOS_E_FORMAT,
+                            "%s: no float grid to load; grids present: %s%s", L->path, present,
+                            quantized ? "; atmos reads 32-bit float grids only, not quantized ones: write the grid "
+                                        "as float (without Fp4/Fp8/Fp16/FpN quantization)"
+                                      : "");
     return ATMOS_OK;
 }
 

@@ -19,6 +19,7 @@
 #include "volume/generator.h"
 #include "volume/netcdf_classic.h"
 #include "volume/reader_common.h"
+#include "volume/reader_fence.h"
 #include "volume/volume_internal.h"
 
 #include <math.h>
@@ -229,23 +230,31 @@ static atmos_status read_coord(const src *s, const char *name, size_t start, siz
  * zeros past the end instead of an error. The header says where every variable's
  * data starts and how many records there are, so a file shorter than the end of
  * its data is truncated (netcdf_classic.c). */
+static atmos_status classic_truncation(atmos_context *ctx, const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return ATMOS_OK;
+    unsigned char magic[4] = {0};
+    uint64_t need = 0, have = 0;
+    int rc = -1;
+    if (fread(magic, 1, 4, f) == 4 && magic[0] == 'C' && magic[1] == 'D' && magic[2] == 'F')
+        rc = atmos__netcdf_classic_data_end(f, &need, &have);
+    fclose(f);
+    if (rc == 1)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated inside the NetCDF header (%llu bytes)", path,
+                            (unsigned long long)have);
+    if (rc == 0 && have < need)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %llu bytes, the file has %llu",
+                            path, (unsigned long long)need, (unsigned long long)have);
+    return ATMOS_OK;
+}
+
 static atmos_status check_classic_size(const src *s)
 {
     int fmt;
     if (nc_inq_format(s->nc, &fmt) != NC_NOERR) return ATMOS_OK;
     if (fmt != NC_FORMAT_CLASSIC && fmt != NC_FORMAT_64BIT_OFFSET && fmt != NC_FORMAT_CDF5) return ATMOS_OK;
-    FILE *f = fopen(s->path, "rb");
-    if (!f) return ATMOS_OK;
-    uint64_t need = 0, have = 0;
-    int rc = atmos__netcdf_classic_data_end(f, &need, &have);
-    fclose(f);
-    if (rc == 1)
-        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated inside the NetCDF header (%llu bytes)", s->path,
-                            (unsigned long long)have);
-    if (rc == 0 && have < need)
-        return atmos__error(s->ctx, ATMOS_E_FORMAT, "%s: truncated: the variables need at least %llu bytes, the file has %llu",
-                            s->path, (unsigned long long)need, (unsigned long long)have);
-    return ATMOS_OK;
+    return classic_truncation(s->ctx, s->path);
 }
 
 /* ------------------------------------------------------------ loader state */
@@ -594,6 +603,12 @@ static atmos_status cm1_heights(loader *L)
     if (!st) st = read_coord(s, "xh", (size_t)s->i0, (size_t)s->nx, xc);
     if (!st) st = read_coord(s, "yh", (size_t)s->j0, (size_t)s->ny, yc);
     if (st) return st;
+    /* CM1's zh is the height of the scalar levels above the ground: positive, increasing. */
+    for (int k = 0; k < s->nz; k++)
+        if (!(zh[k] >= 0) || (k > 0 && !(zh[k] > zh[k - 1])))
+            return atmos__error(s->ctx, ATMOS_E_FORMAT,
+                                "%s: zh[%d] = %g m%s: CM1 heights above the ground must be >= 0 and increase upward",
+                                s->path, s->k0 + k, zh[k], zh[k] >= 0 ? " (not above the level below)" : "");
     L->dx = s->nx > 1 ? (xc[s->nx - 1] - xc[0]) / (s->nx - 1) : 1000.0;
     L->dy = s->ny > 1 ? (yc[s->ny - 1] - yc[0]) / (s->ny - 1) : L->dx;
     if (s->nx == 1) L->dx = L->dy;
@@ -675,6 +690,11 @@ static atmos_status number_density(loader *L, int si)
                                 q);
         if (q > qmax) qmax = q;
         eta[i] = (float)(conv > 0 ? q * conv : q * L->rho[i] / mp);
+        if (!isfinite(eta[i]))
+            return atmos__error(L->s.ctx, ATMOS_E_FORMAT,
+                                "%s: %s = %g kg/kg at point %zu gives a number density of %g m^-3 (air density %g "
+                                "kg/m^3): not a float; is the air density (rho, or prs and th) right?",
+                                L->s.path, name, q, i, conv > 0 ? q * conv : q * L->rho[i] / mp, L->rho[i]);
     }
     if (neg)
         atmos__log(L->s.ctx, ATMOS_LOG_WARN, "%s: %s: %zu negative mixing ratios set to 0", L->s.path, name, neg);
@@ -907,12 +927,11 @@ static atmos_status load(loader *L)
     return atmos_volume_finalize(L->s.ctx, L->vol);
 }
 
-atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
-                                       atmos_volume **out)
+/* The load itself, run in the fence's child process. */
+static atmos_status load_direct(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                atmos_volume **out)
 {
     static const atmos_volume_load_desc zero_desc;
-    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "netcdf: path and out are required");
-    *out = NULL;
     loader L;
     memset(&L, 0, sizeof L);
     L.s.ctx = ctx;
@@ -925,6 +944,20 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
     }
     loader_free(&L);
     return st == ATMOS_OK ? ATMOS_OK : atmos__reader_name_error(ctx, path, st);
+}
+
+/* libnetcdf and libhdf5 parse the file behind the fence (reader_fence.h): a damaged
+ * netCDF-4 file can make libhdf5 free an invalid pointer. */
+atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                       atmos_volume **out)
+{
+    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "netcdf: path and out are required");
+    *out = NULL;
+    /* atmos's own check of a classic file's size needs no library: done here, it spares a
+     * truncated file the child process */
+    atmos_status st = classic_truncation(ctx, path);
+    if (st != ATMOS_OK) return st;
+    return atmos__reader_fenced(ctx, path, desc, "NetCDF/HDF5", load_direct, out);
 }
 
 #endif /* ATMOS_HAVE_NETCDF */

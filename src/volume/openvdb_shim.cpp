@@ -66,6 +66,32 @@ int from_exception(char *msg, size_t cap, const char *what_doing)
     }
 }
 
+// Compares the loaded tree with the file_voxel_count and file_bbox_min/max metadata the
+// library wrote with the grid (absent in files from other writers: nothing to compare).
+const char *stats_disagree(const openvdb::GridBase &grid, const atmos__vdb_grid_stats &st)
+{
+    static thread_local char why[160];
+    auto count = grid.getMetadata<openvdb::Int64Metadata>("file_voxel_count");
+    if (count && (uint64_t)count->value() != st.active_voxels) {
+        std::snprintf(why, sizeof why, "%llu active voxels, the file's own count says %lld",
+                      (unsigned long long)st.active_voxels, (long long)count->value());
+        return why;
+    }
+    auto lo = grid.getMetadata<openvdb::Vec3IMetadata>("file_bbox_min");
+    auto hi = grid.getMetadata<openvdb::Vec3IMetadata>("file_bbox_max");
+    if (lo && hi && !st.empty) {
+        for (int a = 0; a < 3; a++)
+            if (lo->value()[a] != st.bbox_min[a] || hi->value()[a] != st.bbox_max[a]) {
+                std::snprintf(why, sizeof why, "active voxels span [%d %d %d]..[%d %d %d], the file's own box is "
+                              "[%d %d %d]..[%d %d %d]", st.bbox_min[0], st.bbox_min[1], st.bbox_min[2],
+                              st.bbox_max[0], st.bbox_max[1], st.bbox_max[2], lo->value()[0], lo->value()[1],
+                              lo->value()[2], hi->value()[0], hi->value()[1], hi->value()[2]);
+                return why;
+            }
+    }
+    return nullptr;
+}
+
 } // namespace
 
 extern "C" const char *atmos__vdb_library_version(void) { return OPENVDB_LIBRARY_VERSION_STRING; }
@@ -94,14 +120,10 @@ extern "C" int atmos__vdb_open(const char *path, atmos__vdb **out, char *msg, si
         }
         // Grid types come from the metadata only, so listing does not read voxels.
         openvdb::GridPtrVecPtr metas = f->file->readAllGridMetadata();
+        // Both lists follow the file's descriptor map, so they match by position (grids
+        // with the same name have unique names like "cloud[1]" but the same getName()).
         f->types.assign(f->names.size(), std::string());
-        for (const auto &g : *metas) {
-            for (size_t i = 0; i < f->names.size(); i++)
-                if (f->names[i] == g->getName() && f->types[i].empty()) {
-                    f->types[i] = g->valueType();
-                    break;
-                }
-        }
+        for (size_t i = 0; i < f->names.size() && i < metas->size(); i++) f->types[i] = (*metas)[i]->valueType();
         f->grids.resize(f->names.size());
         *out = f;
         return ATMOS__VDB_OK;
@@ -191,6 +213,12 @@ extern "C" int atmos__vdb_load_grid(atmos__vdb *f, int index, atmos__vdb_grid_st
         if (comp) {
             const std::string s = comp->str();
             st->compressed = s.find("zip") != std::string::npos || s.find("blosc") != std::string::npos;
+        }
+        // OpenVDB records each grid's active voxel count and bounding box as metadata when it
+        // writes the file: a tree that disagrees was damaged (a flipped mask bit, say).
+        if (const char *why = stats_disagree(*grid, *st)) {
+            set_msg(msg, cap, "grid '" + f->names[index] + "': " + why + ": damaged file");
+            return ATMOS__VDB_E_FORMAT;
         }
         f->grids[index] = grid;
         return ATMOS__VDB_OK;

@@ -6,6 +6,7 @@
 #include "volume/reader_common.h"
 #include "volume/volume_internal.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +27,8 @@ atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, co
 #else
 
 #include "volume/openvdb_shim.h"
+#include "volume/reader_fence.h"
+#include "volume/vdb_header.h"
 
 #define MSG_CAP 512
 
@@ -275,12 +278,11 @@ static atmos_status load(vdb_load *L)
     return st == ATMOS_OK ? atmos_volume_finalize(L->ctx, L->vol) : st;
 }
 
-atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
-                                        atmos_volume **out)
+/* The load itself, run in the fence's child process. */
+static atmos_status load_direct(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                atmos_volume **out)
 {
     static const atmos_volume_load_desc zero_desc;
-    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "openvdb: path and out are required");
-    *out = NULL;
     vdb_load L;
     memset(&L, 0, sizeof L);
     L.ctx = ctx;
@@ -295,6 +297,24 @@ atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, co
     }
     *out = L.vol;
     return ATMOS_OK;
+}
+
+/* The file's own structure is checked first (no library involved): a truncated or damaged
+ * header is refused here with what is wrong. The library then reads the file behind the
+ * fence (reader_fence.h), so a crash or a runaway in it becomes an error naming the file. */
+atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                        atmos_volume **out)
+{
+    if (!out || !path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "openvdb: path and out are required");
+    *out = NULL;
+    FILE *probe = fopen(path, "rb");
+    if (!probe) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
+    fclose(probe);
+    char why[MSG_CAP];
+    int ngrids = 0;
+    if (atmos__vdb_check_header(path, &ngrids, why, sizeof why) != 0)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: %s", path, why);
+    return atmos__reader_fenced(ctx, path, desc, "OpenVDB", load_direct, out);
 }
 
 #endif /* ATMOS_HAVE_OPENVDB */

@@ -39,5 +39,15 @@ set +e
 "$A" volume info "$ATMOS_SOURCE_DIR/tests/crashers/volume/truncated_raw.json" 2> "$T/err.txt"; [ $? -eq 1 ] || fail "crasher exit"
 grep -q "truncated" "$T/err.txt" || fail "crasher message"
 "$A" volume slice "$T/rs.json" --axis z --field snow -o "$T/s.png" 2>/dev/null; [ $? -eq 1 ] || fail "missing field exit"
+# damaged OpenVDB files: refused with exit 1 and a message naming the file (when the reader is built)
+C="$ATMOS_SOURCE_DIR/tests/crashers/volume"
+"$A" volume info "$C/truncated_uncompressed.vdb" 2> "$T/err.txt"; rc=$?
+if ! grep -q "cannot read OpenVDB files" "$T/err.txt"; then
+    [ $rc -eq 1 ] || fail "truncated vdb exit $rc"
+    grep -q "truncated_uncompressed.vdb: truncated: grid 'density' ends at byte" "$T/err.txt" || fail "truncated vdb message"
+    "$A" volume info "$C/dragon_blosc_overflow.vdb" 2> "$T/err.txt"; rc=$?
+    [ $rc -eq 1 ] || fail "damaged vdb exit $rc (the library's crash must not reach the command)"
+    grep -q "dragon_blosc_overflow.vdb: " "$T/err.txt" || fail "damaged vdb message"
+fi
 set -e
 echo "volume.sh: ok"

@@ -100,6 +100,16 @@ int main(int argc, char **argv)
             openvdb::BBoxd(openvdb::Vec3d(0, 0, 0), openvdb::Vec3d(10, 10, 10)), 0.5, 10.0, 1.0));
         write_vdb(dir + "/frustum.vdb", openvdb::GridPtrVec{fr}, openvdb::io::COMPRESS_NONE);
 
+        // Two float grids with the same name (OpenVDB gives them unique names in the file).
+        auto c1 = openvdb::FloatGrid::create(0.0f), c2 = openvdb::FloatGrid::create(0.0f);
+        c1->setName("cloud");
+        c2->setName("cloud");
+        c1->setTransform(xf);
+        c2->setTransform(xf);
+        c1->tree().setValue(openvdb::Coord(0, 0, 0), 1.0f);
+        c2->tree().setValue(openvdb::Coord(1, 0, 0), 2.0f);
+        write_vdb(dir + "/dup_names.vdb", openvdb::GridPtrVec{c1, c2}, openvdb::io::COMPRESS_NONE);
+
         // NanoVDB: the same density, alone and with a second grid; rotated.
         nanovdb::io::writeGrid(dir + "/small.nvdb", nanovdb::openToNanoVDB(*density));
         std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
@@ -109,6 +119,8 @@ int main(int argc, char **argv)
         nanovdb::io::writeGrid(dir + "/rotated.nvdb", nanovdb::openToNanoVDB(*rot));
         nanovdb::io::writeGrid(dir + "/nonuniform.nvdb", nanovdb::openToNanoVDB(*nonuni));
         nanovdb::io::writeGrid(dir + "/negative.nvdb", nanovdb::openToNanoVDB(*neg));
+        nanovdb::io::writeGrid(dir + "/fp16.nvdb",
+                               nanovdb::openToNanoVDB<nanovdb::HostBuffer, openvdb::FloatTree, nanovdb::Fp16>(*density));
     } catch (const std::exception &e) {
         std::fprintf(stderr, "make_vdb_fixtures: %s\n", e.what());
         return 1;

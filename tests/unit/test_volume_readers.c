@@ -208,6 +208,95 @@ static void test_openvdb_fixtures(void)
     atmos_volume_load_desc tiny = {.max_memory = 1000};
     check_status(atmos__volume_load_openvdb, p, &tiny, ATMOS_E_LIMIT, "memory limit");
     check_status(atmos__volume_load_openvdb, "/nonexistent/x.vdb", NULL, ATMOS_E_IO, "cannot open");
+    /* Two float grids of the same name: both load (OpenVDB names the second "cloud[1]"). */
+    fixture(p, sizeof p, "dup_names.vdb");
+    v = NULL;
+    CHECK_OK(atmos__volume_load_openvdb(ctx, p, NULL, &v));
+    if (v) {
+        CHECK_MSG(atmos_volume_field_count(v) == 2, "%d fields", atmos_volume_field_count(v));
+        CHECK(field_index(v, "cloud[0]") >= 0 && field_index(v, "cloud[1]") >= 0);
+        atmos_volume_destroy(v);
+    }
+}
+
+/* Writes the first n bytes of buf to path, with byte `flip` (if < n) set to `value`. */
+static void write_mutant(const char *path, const unsigned char *buf, size_t n, size_t flip, unsigned char value)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return;
+    fwrite(buf, 1, n, f);
+    if (flip < n) {
+        fseek(f, (long)flip, SEEK_SET);
+        fputc(value, f);
+    }
+    fclose(f);
+}
+
+/* Damaged copies of the fixtures: every cut (a truncated file) must be refused, naming the
+ * file; a flipped byte must give a volume or an error naming the file, never a crash of
+ * this process (the library reads behind the fence). */
+static void test_openvdb_damaged(void)
+{
+    const char *names[] = {"small.vdb", "small_blosc.vdb", "small_zip.vdb"};
+    int cuts = 0, flips = 0, flips_ok = 0;
+    for (int n = 0; n < 3; n++) {
+        char p[1024], q[1024];
+        fixture(p, sizeof p, names[n]);
+        size_t size;
+        unsigned char *buf = test_slurp(p, &size);
+        CHECK_MSG(buf != NULL, "cannot read %s", p);
+        if (!buf) continue;
+        test_tmp_path(q, sizeof q, "damaged.vdb");
+        const size_t stride = size / 97 + 1;
+        for (size_t cut = 0; cut < size; cut += stride, cuts++) {
+            write_mutant(q, buf, cut, SIZE_MAX, 0);
+            atmos_volume *v = NULL;
+            atmos_status st = atmos__volume_load_openvdb(ctx, q, NULL, &v);
+            CHECK_MSG(st != ATMOS_OK, "%s cut to %zu bytes of %zu loaded", names[n], cut, size);
+            if (st != ATMOS_OK) CHECK_MSG(strstr(atmos_context_error(ctx), q), "%s", atmos_context_error(ctx));
+            atmos_volume_destroy(v);
+        }
+        if (n == 0) {
+            /* the header's own message for a cut inside the grid, and for the crashers */
+            write_mutant(q, buf, size / 2, SIZE_MAX, 0);
+            check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "truncated");
+            const char *src = getenv("ATMOS_SOURCE_DIR");
+            snprintf(q, sizeof q, "%s/tests/crashers/volume/truncated_uncompressed.vdb", src && *src ? src : ".");
+            check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "truncated: grid 'density' ends at");
+            snprintf(q, sizeof q, "%s/tests/crashers/volume/dragon_creator_length.vdb", src && *src ? src : ".");
+            check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "grids claimed");
+            test_tmp_path(q, sizeof q, "damaged.vdb");
+            /* a tree that disagrees with the count OpenVDB wrote next to it (here the count is
+             * changed, as a damaged mask would change the tree) */
+            unsigned char *c = malloc(size);
+            size_t at = SIZE_MAX;
+            for (size_t i = 0; c && i + 16 + 17 + 8 <= size && at == SIZE_MAX; i++)
+                if (memcmp(buf + i, "file_voxel_count", 16) == 0) at = i + 16 + 4 + 5 + 4; /* type "int64", size 8 */
+            CHECK_MSG(at != SIZE_MAX, "no file_voxel_count in %s", names[n]);
+            if (c && at != SIZE_MAX) {
+                memcpy(c, buf, size);
+                c[at] ^= 1;
+                write_mutant(q, c, size, SIZE_MAX, 0);
+                check_status(atmos__volume_load_openvdb, q, NULL, ATMOS_E_FORMAT, "the file's own count says");
+            }
+            free(c);
+        }
+#ifdef __SANITIZE_ADDRESS__
+        const size_t flip_stride = size / 10 + 1; /* a fork of a sanitized process is slow */
+#else
+        const size_t flip_stride = size / 40 + 1;
+#endif
+        for (size_t at = 7; n > 0 && at < size; at += flip_stride, flips++) {
+            write_mutant(q, buf, size, at, (unsigned char)(buf[at] ^ 0xb5));
+            atmos_volume *v = NULL;
+            atmos_status st = atmos__volume_load_openvdb(ctx, q, NULL, &v);
+            if (st == ATMOS_OK) flips_ok++;
+            else CHECK_MSG(strstr(atmos_context_error(ctx), q), "%s", atmos_context_error(ctx));
+            atmos_volume_destroy(v);
+        }
+        free(buf);
+    }
+    printf("damaged OpenVDB fixtures: %d cuts refused, %d flipped bytes (%d loaded)\n", cuts, flips, flips_ok);
 }
 
 /* The real files: counts from the file via the shim, placement and values via the reader. */
@@ -337,6 +426,10 @@ static void test_nanovdb(void)
     fixture(p, sizeof p, "small.nvdb");
     atmos_volume_load_desc tiny = {.max_memory = 2000};
     check_status(atmos__volume_load_nanovdb, p, &tiny, ATMOS_E_LIMIT, NULL);
+    /* A quantized grid: refused, saying quantized grids are the reason. */
+    fixture(p, sizeof p, "fp16.nvdb");
+    check_status(atmos__volume_load_nanovdb, p, NULL, ATMOS_E_UNSUPPORTED, "quantized Fp16");
+    fixture(p, sizeof p, "small.nvdb");
 
     /* Modified copies: compressed codec, truncation, every single-byte corruption
      * of the header and a sweep of corruptions through the grid (no crash, and a
@@ -360,6 +453,13 @@ static void test_nanovdb(void)
     check_status(atmos__volume_load_nanovdb, q, NULL, ATMOS_E_FORMAT, "truncated");
     spit(q, b, 10);
     check_status(atmos__volume_load_nanovdb, q, NULL, ATMOS_E_FORMAT, NULL);
+    /* every cut of the file is refused */
+    for (size_t cut = 0; cut < n; cut += n / 89 + 1) {
+        spit(q, b, cut);
+        atmos_volume *tv = NULL;
+        CHECK_MSG(atmos__volume_load_nanovdb(ctx, q, NULL, &tv) != ATMOS_OK, "small.nvdb cut to %zu bytes loaded", cut);
+        atmos_volume_destroy(tv);
+    }
     int unclean = 0, loaded = 0;
     /* A small limit keeps mutants that spread voxels far apart cheap to refuse. */
     atmos_volume_load_desc small_mem = {.max_memory = 16u << 20};
@@ -431,6 +531,7 @@ int main(void)
     CHECK_OK(atmos_context_create(NULL, &ctx));
 #ifdef ATMOS_HAVE_OPENVDB
     test_openvdb_fixtures();
+    test_openvdb_damaged();
     test_openvdb_real();
 #else
     skip("OpenVDB reader not built");
