@@ -16,6 +16,7 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, dou
     b->ly = (float)sun[1];
     for (int k = 0; k < 3; k++) b->sun[k] = (float)sun[k];
     b->sun_up = sun[1] > 0;
+    b->high = sky->gamma * eye_y > ATMOS__RILEY_HIGH_EYE;
     double ey = exp(-sky->gamma * eye_y), ground[ATMOS_MAX_WAVELENGTHS];
     atmos__riley_sunlight(sky, 0.0, sun, b->n, NULL, ground);
     for (int i = 0; i < b->n; i++) {
