@@ -184,8 +184,9 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
                             v->samples_per_pixel);
     if (v->spp < 1 || v->spp > ATMOS_PATH_MAX_SPP)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: spp must be in [1, %d], got %d", ATMOS_PATH_MAX_SPP, v->spp);
-    if (v->slices < 1 || v->slices > 8192)
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: slices must be in [1, 8192], got %d", v->slices);
+    if (v->slices < 0 || v->slices > 8192)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: slices must be in [0, 8192] (0: chosen from the volume), got %d",
+                            v->slices);
     if (!(v->eye_scale > 0 && v->eye_scale <= 1))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: eye_scale must be in (0, 1], got %g", v->eye_scale);
     if (p->renderer == ATMOS_RENDERER_SLICE && v->cam.type != ATMOS_CAMERA_PINHOLE)
