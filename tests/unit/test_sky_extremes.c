@@ -1,5 +1,6 @@
 /* Riley's sky at the edges of its valid ranges: an eye far above the air (up to 1e4
- * scale heights) and a sun disk of 1e-6 degrees. Both gave NaN images with exit status 0;
+ * scale heights), a sun disk of 1e-6 degrees (both gave NaN images with exit status 0), a
+ * sun grazing the horizon over a thin atmosphere (negative radiance);
  * here they are checked against physics that does not depend on the evaluator. */
 #include "atmos/atmos.h"
 #include "test.h"
@@ -120,6 +121,34 @@ static void test_tiny_sun(atmos_context *ctx)
     atmos_image_destroy(img);
 }
 
+/* The sun 0.001 degrees above the horizon through a 375 m scale height: the sun's optical
+ * depth at the eye, ~165 at 440 nm, underflows e^{-ts0} in float, and the in-scatter
+ * difference (e^{-ts0} - e^{-(tau_v + tau_s)}) came out a tiny negative in every pixel. */
+static void test_grazing_sun(atmos_context *ctx)
+{
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.atmosphere.scale_height_m = 375.0;
+    s.atmosphere.beta_sl_550 = 3.18e-6;
+    s.atmosphere.ground_albedo = 0.6;
+    s.sun.elevation_deg = 0.001;
+    s.sun.azimuth_deg = 112.5;
+    s.width = 16, s.height = 12;
+    const double pos[3] = {0, 4.9, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    atmos_direction_from_angles(-77.8, 146.3, s.camera.look_at);
+    for (int k = 0; k < 3; k++) s.camera.look_at[k] += pos[k];
+    atmos_image *img = NULL;
+    atmos_status st = atmos_render_sky(ctx, &s, &img, NULL);
+    CHECK_MSG(st == ATMOS_OK, "grazing sun render failed: %s", atmos_context_error(ctx));
+    if (!img) return;
+    int neg = 0;
+    for (int i = 0; i < img->channels * img->width * img->height; i++) neg += !(img->pixels[i] >= 0.0f);
+    printf("sun at 0.001 degrees, 375 m scale height: %d negative or non-finite values\n", neg);
+    CHECK(neg == 0);
+    atmos_image_destroy(img);
+}
+
 int main(void)
 {
     atmos_context *ctx = make_ctx();
@@ -129,6 +158,7 @@ int main(void)
     test_column_transmittance(8000.0, 700000.0);
     test_column_transmittance(100.0, 1e6);
     test_tiny_sun(ctx);
+    test_grazing_sun(ctx);
     atmos_context_destroy(ctx);
     return test_summary("test_sky_extremes");
 }
