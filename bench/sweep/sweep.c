@@ -9,9 +9,10 @@
  * parser refuses, or whose volume exceeds a stated limit, is counted as "refused": a
  * failure of the sweep's own generator in --short mode, reported only in the full sweep.
  *
- *   atmos_sweep [--count N] [--first I] [--seed S] [--short] [--limit SECONDS] [-v]
+ *   atmos_sweep [--count N] [--first I] [--seed S] [--short] [--limit SECONDS] [-v] [--print]
  *
- * Scene i is made from (seed, i) alone: `--first I --count 1` replays it, -v prints its JSON.
+ * Scene i is made from (seed, i) alone: `--first I --count 1` replays it, -v prints its JSON,
+ * --print prints the scenes' JSON without rendering them.
  * --short keeps to the ranges that work today (the test in `make test`); the full ranges
  * are those of docs/scene-format.md. One line per failing scene, then counts by kind;
  * exit status 1 if any scene failed. */
@@ -274,8 +275,9 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--limit") && i + 1 < argc) limit = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--short")) full = 0;
         else if (!strcmp(argv[i], "-v")) verbose = 1;
+        else if (!strcmp(argv[i], "--print")) verbose = 2;
         else {
-            fprintf(stderr, "usage: atmos_sweep [--count N] [--first I] [--seed S] [--short] [--limit SECONDS] [-v]\n");
+            fprintf(stderr, "usage: atmos_sweep [--count N] [--first I] [--seed S] [--short] [--limit SECONDS] [-v] [--print]\n");
             return 2;
         }
     }
@@ -286,6 +288,10 @@ int main(int argc, char **argv)
         scene_text t;
         result res;
         make_scene(seed, i, full, &t);
+        if (verbose == 2) { /* --print: the scenes' JSON, nothing rendered */
+            printf("scene %d %s\n%s", i, rnames[t.renderer], t.json);
+            continue;
+        }
         run_child(&t, limit, &res);
         counts[res.kind][t.renderer]++;
         if ((i - first + 1) % 50 == 0) fprintf(stderr, "sweep: %d of %d scenes\n", i - first + 1, count);
