@@ -38,13 +38,15 @@ typedef struct {
     uint64_t s;
 } rng;
 
-static uint64_t next_u64(rng *r)
+static uint64_t mix64(uint64_t z)
 {
-    uint64_t z = (r->s += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return z ^ (z >> 31);
 }
+/* SplitMix64; each scene's stream starts at a hash of (seed, index), so that the streams
+ * of neighbouring scenes do not overlap. */
+static uint64_t next_u64(rng *r) { return mix64(r->s += 0x9e3779b97f4a7c15ull); }
 static double uni(rng *r) { return (next_u64(r) >> 11) * (1.0 / 9007199254740992.0); }
 static double range(rng *r, double a, double b) { return a + (b - a) * uni(r); }
 static double log_range(rng *r, double a, double b) { return exp(range(r, log(a), log(b))); }
@@ -133,7 +135,7 @@ static void make_volume(rng *r, int full, int pinhole, scene_text *t)
 
 static void make_scene(uint64_t seed, int index, int full, scene_text *t)
 {
-    rng r = {seed * 0x100000001b3ull + (uint64_t)index * 0x9e3779b97f4a7c15ull};
+    rng r = {mix64(mix64(seed) ^ mix64((uint64_t)index + 0x632be59bd9b4e019ull))};
     memset(t, 0, sizeof *t);
     t->renderer = pick(&r, 3);
     const int cam = make_view(&r, full, t->renderer, t);
