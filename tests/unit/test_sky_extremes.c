@@ -1,6 +1,7 @@
 /* Riley's sky at the edges of its valid ranges: an eye far above the air (up to 1e4
  * scale heights), a sun disk of 1e-6 degrees (both gave NaN images with exit status 0), a
- * sun grazing the horizon over a thin atmosphere (negative radiance);
+ * sun grazing the horizon over a thin atmosphere (negative radiance) or a thick homogeneous
+ * layer (NaN);
  * here they are checked against physics that does not depend on the evaluator. */
 #include "atmos/atmos.h"
 #include "test.h"
@@ -149,6 +150,33 @@ static void test_grazing_sun(atmos_context *ctx)
     atmos_image_destroy(img);
 }
 
+/* A thick homogeneous layer (optical depth 35) with the sun 0.001 degrees high, seen from
+ * inside it: along steep upward views the sun's depth at the segment's start underflows
+ * while the in-scatter integral overflows; every upward pixel was NaN (found by the sweep,
+ * scene 915). */
+static void test_thick_layer(atmos_context *ctx)
+{
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_HOMOGENEOUS;
+    s.atmosphere.thickness_m = 157000.0;
+    s.atmosphere.beta_sl_550 = 2.2e-4;
+    s.sun.elevation_deg = 0.001;
+    s.sun.azimuth_deg = 103.0;
+    s.width = 32, s.height = 16;
+    const double pos[3] = {0, 49600.0, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_EQUIRECT, pos, &s.camera);
+    atmos_image *img = NULL;
+    atmos_status st = atmos_render_sky(ctx, &s, &img, NULL);
+    CHECK_MSG(st == ATMOS_OK, "thick layer render failed: %s", atmos_context_error(ctx));
+    if (!img) return;
+    int bad = 0;
+    for (int i = 0; i < img->channels * img->width * img->height; i++) bad += !(img->pixels[i] >= 0.0f && isfinite(img->pixels[i]));
+    printf("homogeneous layer of optical depth 35, sun at 0.001 degrees: %d negative or non-finite values\n", bad);
+    CHECK(bad == 0);
+    atmos_image_destroy(img);
+}
+
 int main(void)
 {
     atmos_context *ctx = make_ctx();
@@ -159,6 +187,7 @@ int main(void)
     test_column_transmittance(100.0, 1e6);
     test_tiny_sun(ctx);
     test_grazing_sun(ctx);
+    test_thick_layer(ctx);
     atmos_context_destroy(ctx);
     return test_summary("test_sky_extremes");
 }
