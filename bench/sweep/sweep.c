@@ -138,7 +138,9 @@ static void make_scene(uint64_t seed, int index, int full, scene_text *t)
     rng r = {mix64(mix64(seed) ^ mix64((uint64_t)index + 0x632be59bd9b4e019ull))};
     memset(t, 0, sizeof *t);
     t->renderer = pick(&r, 3);
-    const int cam = make_view(&r, full, t->renderer, t);
+    /* --short: the sky and the slice renderer take camera, sun and atmosphere from the full
+     * ranges (they pass the full sweep); the path tracer and the volumes keep to the short ones. */
+    const int cam = make_view(&r, full || t->renderer != 2, t->renderer, t);
     if (t->renderer > 0 && (t->renderer == 1 || pick(&r, 4) != 0)) make_volume(&r, full, cam == 0, t);
     if (t->renderer == 1) {
         t->budget_s = 10.0;
