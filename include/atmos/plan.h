@@ -100,7 +100,9 @@ ATMOS_API atmos_status atmos_plan_image_create(const atmos_plan *plan, const atm
  * only its pixels are written (the rest of out is left as it was). The path tracer renders
  * frame->spp samples per pixel, reusing the samples it already has when only the budget
  * changed; the image is the same whether reached in one call or several. Reports progress
- * and honours cancellation through the plan's context. info may be NULL. */
+ * and honours cancellation through the plan's context. info may be NULL. A frame whose
+ * image would hold a NaN or an infinity (a renderer bug: no valid scene may give one) fails
+ * with ATMOS_E_UNSUPPORTED and a message counting them, rather than being returned. */
 ATMOS_API atmos_status atmos_plan_render(atmos_plan *plan, const atmos_frame *frame, const atmos_region *region,
                                          atmos_image *out, atmos_render_info *info);
 

@@ -60,7 +60,8 @@ typedef struct atmos_scene_volume {
 /* Settings of the slice renderer ("slice" in the file). Their ranges, defaults and meaning
  * are in the table atmos_renderer_settings(ATMOS_RENDERER_SLICE) (docs/scene-format.md). */
 typedef struct atmos_scene_slice {
-    int slices;               /* sampling planes; 256 */
+    int slices;               /* sampling planes; 0 (default) = chosen from the volume's shape:
+                                 256, more (up to 2048) for wide, flat volumes (docs/slice.md) */
     int light_size;           /* light buffer texels per side; 256 */
     double xi;                /* Riley's back-scatter term xi (Eq. 26), sr^-1; 0.1/(4 pi); 0 = none */
     int eq24;                 /* "update": 0 = "eq25" (default), 1 = "eq24" */

@@ -173,7 +173,11 @@ void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx
                            const float *weight, float *out, float *scratch)
 {
     switch (b->kind) {
-    case ATMOS_ATMOSPHERE_RILEY: atmos__sky_batch_eval(&b->riley, count, dx, dy, dz, weight, out, scratch); return;
+    case ATMOS_ATMOSPHERE_RILEY:
+        /* An eye above ~50 scale heights is outside the float closed form's range. */
+        if (b->riley.high) batch_generic(b, count, dx, dy, dz, weight, out);
+        else atmos__sky_batch_eval(&b->riley, count, dx, dy, dz, weight, out, scratch);
+        return;
     case ATMOS_ATMOSPHERE_VACUUM: {
         const int n = b->atm->wl.count;
         for (int k = 0; k < n; k++)

@@ -93,7 +93,11 @@ atmos_status atmos_atmosphere_create(atmos_context *ctx, const atmos_atmosphere_
     }
     const double r = 0.5 * d.sun_diameter_deg * ATMOS_DEG2RAD;
     a->cos_sun_radius = cos(r);
-    a->sun_solid_angle = 2.0 * ATMOS_PI * (1.0 - cos(r));
+    /* 2 pi (1 - cos r), which cancels to 0 for a disk below ~1e-8 rad (a valid
+     * sun_diameter_deg of 1e-6) and is then divided by; 4 pi sin^2(r/2) is the same
+     * solid angle without the cancellation. The first form is kept for r >= 1e-3 rad,
+     * where it is exact to ~1e-10, so that the images of such suns stay as they were. */
+    a->sun_solid_angle = r < 1e-3 ? 4.0 * ATMOS_PI * sin(0.5 * r) * sin(0.5 * r) : 2.0 * ATMOS_PI * (1.0 - cos(r));
     *out = a;
     return ATMOS_OK;
 }

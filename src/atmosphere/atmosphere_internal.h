@@ -23,6 +23,10 @@ struct atmos_atmosphere {
 #define ATMOS__WL(k, i) ((k) ? (k)[i] : (i))
 
 /* Riley et al. 2004 §4.1 (riley.c). y is the altitude of the point (>= 0). */
+/* gamma y above which an eye's descending rays are evaluated from their low end (riley.c) and
+ * the renderers' float batch hands Riley's sky to the double-precision functions: at 50 scale
+ * heights beta_eye ~ 1e-27 m^-1 is still a normal float, e^{gamma y} ~ 5e21 far from overflow. */
+#define ATMOS__RILEY_HIGH_EYE 50.0
 /* (1 - e^-z)/z, exact limit 1 at z = 0. */
 double atmos__sky_g(double z);
 /* tau_v(K) / beta_eye = K g(gamma p_y K); INFINITY for unbounded depth. */

@@ -66,9 +66,17 @@ int atmos__homog_inscatter(const atmos_atmosphere *a, double y, const double d[3
     for (int i = 0; i < m; i++) {
         const int j = ATMOS__WL(k, i);
         const double b = a->beta_sl[j];
+        const double es = b * (a->desc.thickness_m - ya) / ly; /* sun's optical depth at the segment's start */
+        if (c < 0 && -b * c * S > 700.0) {
+            /* A view much steeper than a low sun: the start's e^{-es} underflows while
+             * the integral's e^{-b c S} overflows (0 * inf). Written from the segment's end,
+             * where the integrand peaks: e^{-(es + b c S)} S g(-b c S). */
+            out[i] = P * a->sun_e[j] * b * exp(-(es + b * c * S)) * S * atmos__sky_g(-b * c * S);
+            continue;
+        }
         /* S g(b c S) = integral of e^{-b c s} over [0, S]; S infinite only for a level ray (c = 1) */
         const double integral = isinf(S) ? 1.0 / (b * c) : S * atmos__sky_g(b * c * S);
-        out[i] = P * a->sun_e[j] * b * exp(-b * (a->desc.thickness_m - ya) / ly) * integral;
+        out[i] = P * a->sun_e[j] * b * exp(-es) * integral;
     }
     return 1;
 }

@@ -63,9 +63,29 @@ double atmos__sky_inscatter_factor(double gamma, double beta_eye, double G, doub
     return x * exp(-(x + tsK)) * h_fn(-D);
 }
 
+/* An eye far above the air (gamma y > ATMOS__RILEY_HIGH_EYE): beta_eye = beta_sl e^{-gamma y}
+ * underflows and G = K g(-gamma y) overflows, and their product, the optical depth, becomes
+ * 0 * inf. A descending segment's optical depth written from its low end y_end = y + p_y K,
+ *   tau_v(K) = beta_sl e^{-gamma y_end} K g(-gamma p_y K),
+ * has neither. Returns the wavelength-independent part tau_v / beta_sl (0 if the segment
+ * does not descend or is unbounded), used only for such eyes so that the images of any
+ * lower eye stay as they were. */
+static int high_descent(const atmos_atmosphere *a, double y, double py, double dist, double *depth)
+{
+    if (!(a->gamma * y > ATMOS__RILEY_HIGH_EYE) || !(py < 0) || !(dist > 0) || isinf(dist)) return 0;
+    const double y_end = fmax(y + py * dist, 0.0);
+    *depth = exp(-a->gamma * y_end) * dist * atmos__sky_g(-a->gamma * py * dist);
+    return 1;
+}
+
 void atmos__riley_transmittance(const atmos_atmosphere *a, double y, const double d[3], double dist, int m,
                                 const int *k, double *out)
 {
+    double depth;
+    if (high_descent(a, y, d[1], dist, &depth)) {
+        for (int i = 0; i < m; i++) out[i] = exp(-a->beta_sl[ATMOS__WL(k, i)] * depth);
+        return;
+    }
     const double G = atmos__sky_view_depth_factor(a->gamma, d[1], dist);
     const double ey = exp(-a->gamma * y);
     for (int i = 0; i < m; i++) out[i] = isinf(G) ? 0.0 : exp(-a->beta_sl[ATMOS__WL(k, i)] * ey * G);
@@ -90,10 +110,21 @@ int atmos__riley_inscatter(const atmos_atmosphere *a, double y, const double d[3
         for (int i = 0; i < m; i++) out[i] = 0.0;
         return 0;
     }
+    const double P = atmos_phase_rayleigh(d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2]);
+    double depth;
+    if (high_descent(a, y, py, dist, &depth)) {
+        /* p_y < 0 < l_y, so D = (1 - p_y/l_y) tau_v > 0: tau_v e^{-tau_s(0)} h(D). */
+        const double c = 1.0 - py / ly, ey = exp(-a->gamma * y);
+        for (int i = 0; i < m; i++) {
+            const int j = ATMOS__WL(k, i);
+            const double x = a->beta_sl[j] * depth, ts0 = a->beta_sl[j] * ey / (a->gamma * ly);
+            out[i] = P * a->sun_e[j] * x * exp(-ts0) * atmos__sky_g(c * x);
+        }
+        return 1;
+    }
     const double G = atmos__sky_view_depth_factor(a->gamma, py, dist);
     const double e_end = isinf(dist) ? (py > 0 ? 0.0 : INFINITY) : exp(-a->gamma * py * dist);
     const double ey = exp(-a->gamma * y);
-    const double P = atmos_phase_rayleigh(d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2]);
     for (int i = 0; i < m; i++) {
         const int j = ATMOS__WL(k, i);
         out[i] = P * a->sun_e[j] * atmos__sky_inscatter_factor(a->gamma, a->beta_sl[j] * ey, G, ly, py, e_end);

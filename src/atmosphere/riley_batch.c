@@ -16,6 +16,7 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, dou
     b->ly = (float)sun[1];
     for (int k = 0; k < 3; k++) b->sun[k] = (float)sun[k];
     b->sun_up = sun[1] > 0;
+    b->high = sky->gamma * eye_y > ATMOS__RILEY_HIGH_EYE;
     double ey = exp(-sky->gamma * eye_y), ground[ATMOS_MAX_WAVELENGTHS];
     atmos__riley_sunlight(sky, 0.0, sun, b->n, NULL, ground);
     for (int i = 0; i < b->n; i++) {
@@ -82,6 +83,10 @@ void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx
             float series = a * (1.0f - D * (0.5f - D * (1.0f / 6.0f - D * (1.0f / 24.0f))));
             float Ds = fabsf(D) < 1e-2f ? 1.0f : D;
             float F = fabsf(D) < 1e-2f ? series : (a - bexp) / Ds;
+            /* F >= 0 exactly; in float a = e^{-ts0} underflows to 0 for ts0 > ~104 while the
+             * polynomial's clamp leaves bexp at e^-87, which made F, and the radiance, a
+             * tiny negative (a NaN stays a NaN for the image check). */
+            F = F < 0.0f ? 0.0f : F;
             float L = PE[i] * E * x * F + gm[i] * gr * atmos__expf_poly(-x);
             o[i] += L;
         }

@@ -10,6 +10,8 @@
 typedef struct atmos__sky_batch {
     int n;                 /* wavelengths */
     int sun_up;            /* l_y > 0: otherwise the flat-earth sky is black */
+    int high;              /* gamma eye_y > ATMOS__RILEY_HIGH_EYE: beta_eye and e^{gamma eye_y}
+                              leave float's range; the caller evaluates in double instead */
     float gamma, eye_y, ly;
     float sun[3];
     float beta_eye[ATMOS_MAX_WAVELENGTHS];    /* Eq. 13 */
@@ -24,7 +26,7 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, dou
 /* Per-ray scratch the evaluator needs: 6 floats per ray. */
 #define ATMOS__SKY_BATCH_SCRATCH 6
 
-/* Radiance (no sun disk) for count rays with unit directions (dx, dy, dz), added
+/* Radiance (no sun disk) for count rays (b->high must be 0) with unit directions (dx, dy, dz), added
  * wavelength-major: out[k*count + i] += weight[i] * L_k(ray i).
  * scratch: count*ATMOS__SKY_BATCH_SCRATCH floats. */
 void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx, const float *dy, const float *dz,

@@ -14,6 +14,10 @@ static inline float atmos__expf_poly(float x)
     x = x > 88.0f ? 88.0f : x;
     float t = x * 1.44269504088896341f;
     float nf = (t + 12582912.0f) - 12582912.0f; /* round to nearest by the 1.5*2^23 trick */
+    /* nf is in [-126, 127] for any number; a NaN argument (which the clamps above let
+     * through) becomes -126 here so that the conversion and shift below stay defined,
+     * while p, and so the result, stays NaN for the caller's checks to see. */
+    nf = nf > -126.0f ? nf : -126.0f;
     float r = x - nf * 0.693145751953125f;      /* ln2 split: hi exactly representable */
     r = r - nf * 1.428606765330187045e-06f;     /* ln2 lo */
     float p = 1.0f / 720.0f;
@@ -27,7 +31,7 @@ static inline float atmos__expf_poly(float x)
         int32_t i;
         float f;
     } s;
-    s.i = ((int32_t)nf + 127) << 23; /* nf + 127 in [1, 254]: exact */
+    s.i = (int32_t)((uint32_t)((int32_t)nf + 127) << 23); /* nf + 127 in [1, 254]: exact */
     return p * s.f;
 }
 

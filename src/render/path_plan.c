@@ -151,7 +151,7 @@ static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, 
     J->n = p->wl.count;
     const double r = 0.5 * atmos_atmosphere_get_desc(atm)->sun_diameter_deg * ATMOS_DEG2RAD;
     J->cos_sun = cos(r);
-    J->sun_omega = 2.0 * ATMOS_PI * (1.0 - J->cos_sun);
+    J->sun_omega = atmos_atmosphere_sun_solid_angle(atm); /* > 0 even where cos_sun rounds to 1 */
     J->max_depth = p->scene.path.max_depth ? p->scene.path.max_depth : PATH_DEFAULT_DEPTH;
     J->depth_default = !p->scene.path.max_depth;
     J->seed = p->scene.path.seed;

@@ -184,8 +184,9 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
                             v->samples_per_pixel);
     if (v->spp < 1 || v->spp > ATMOS_PATH_MAX_SPP)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: spp must be in [1, %d], got %d", ATMOS_PATH_MAX_SPP, v->spp);
-    if (v->slices < 1 || v->slices > 8192)
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: slices must be in [1, 8192], got %d", v->slices);
+    if (v->slices < 0 || v->slices > 8192)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: slices must be in [0, 8192] (0: chosen from the volume), got %d",
+                            v->slices);
     if (!(v->eye_scale > 0 && v->eye_scale <= 1))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: eye_scale must be in (0, 1], got %g", v->eye_scale);
     if (p->renderer == ATMOS_RENDERER_SLICE && v->cam.type != ATMOS_CAMERA_PINHOLE)
@@ -224,6 +225,25 @@ static void copy_rect(float *dst, const float *src, int W, int C, const atmos__r
     for (int y = r->y0; y < r->y1; y++)
         memcpy(dst + ((size_t)y * W + r->x0) * C, src + ((size_t)y * W + r->x0) * C,
                sizeof(float) * (size_t)(r->x1 - r->x0) * C);
+}
+
+/* No valid scene may give a NaN or an infinity (DESIGN §5): a renderer that does has a
+ * bug, and an image holding one is refused here, whatever the renderer, rather than
+ * written with exit status 0. */
+static atmos_status check_finite(atmos_context *ctx, const atmos_image *out, const atmos__rect *r)
+{
+    const int W = out->width, C = out->channels;
+    size_t bad = 0, fx = 0, fy = 0;
+    for (int y = r->y0; y < r->y1; y++) {
+        const float *row = out->pixels + ((size_t)y * W + r->x0) * C;
+        for (size_t i = 0; i < (size_t)(r->x1 - r->x0) * C; i++)
+            if (!isfinite(row[i]) && bad++ == 0) fx = r->x0 + i / C, fy = y;
+    }
+    if (!bad) return ATMOS_OK;
+    return atmos__error(ctx, ATMOS_E_UNSUPPORTED,
+                        "render: %zu of %zu pixel values are NaN or infinite (the first at pixel %zu, %zu): a "
+                        "renderer bug for this scene; the image is not written, please report the scene",
+                        bad, (size_t)(r->y1 - r->y0) * (size_t)(r->x1 - r->x0) * C, fx, fy);
 }
 
 /* Keeps the rendered pixels of a sky or slice frame for the next call. */
@@ -302,6 +322,7 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
     } else {
         st = atmos__path_render(p, &v, &r, out, &stats->path);
     }
+    if (st == ATMOS_OK && !stats->reused) st = check_finite(ctx, out, &r);
     if (st != ATMOS_OK) {
         p->have_last = 0;
         return st;

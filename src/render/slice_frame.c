@@ -83,9 +83,33 @@ static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, cons
     lf->valid = 1;
 }
 
+/* The slice count when the scene leaves it to the renderer ("slices": 0, the default;
+ * docs/slice.md, "Slice count"). A ray through a thin layer meets only the planes of the
+ * layer's own thickness along h, so a wide, flat volume sampled by a count fixed for the
+ * whole extent gets a few samples per ray, that count changing from pixel to pixel in
+ * diagonal bands. The planes are therefore spaced so that the box's thinnest extent
+ * measured along h, min_a E_a / |h_a|, holds SLICE_AUTO_ACROSS of them, with at least
+ * SLICE_AUTO_MIN slices (compact volumes keep that count) and at most SLICE_AUTO_MAX
+ * (*needed then tells how many the rule asked for). */
+#define SLICE_AUTO_MIN 256
+#define SLICE_AUTO_MAX 2048
+#define SLICE_AUTO_ACROSS 64.0
+static int auto_slices(const sgrid *g, const double h[3], double extent, int *needed)
+{
+    double k = 0; /* max_a |h_a| / E_a: the inverse of the thinnest extent along h */
+    for (int a = 0; a < 3; a++) {
+        const double E = g->box_hi[a] - g->box_lo[a];
+        if (E > 0) k = fmax(k, fabs(h[a]) / E);
+    }
+    const double want = ceil(SLICE_AUTO_ACROSS * extent * k);
+    *needed = want > 1e9 ? 1000000000 : (int)want;
+    if (*needed <= SLICE_AUTO_MIN) return SLICE_AUTO_MIN;
+    return *needed < SLICE_AUTO_MAX ? *needed : SLICE_AUTO_MAX;
+}
+
 /* The half vector, the slices and the buffers' sizes of the frame (everything but the
  * per-pixel and per-texel data). */
-static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob *j)
+static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob *j, int *needed)
 {
     const atmos_camera *cam = &v->cam;
     const sgrid *g = &sp->g;
@@ -125,9 +149,9 @@ static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob
             j->W = we, j->H = he;
         }
     }
-    j->nslices = v->slices;
+    j->nslices = v->slices > 0 ? v->slices : auto_slices(g, j->h, smax - smin, needed);
     j->s0 = smin;
-    j->ds = (smax - smin) / v->slices;
+    j->ds = (smax - smin) / j->nslices;
     j->he = atmos__dot3(j->h, j->eye);
     j->u0 = lf->u0, j->v0 = lf->v0, j->du = lf->du, j->dv = lf->dv;
     j->low_albedo = sp->low_albedo;
@@ -308,7 +332,14 @@ atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp,
     const int threads = atmos__threads(ctx);
     memset(j, 0, sizeof *j);
     if (!sp->light.valid || memcmp(sp->light.sun, v->sun, sizeof v->sun) != 0) light_frame(sp, atm, v->sun, threads);
-    job_geometry(sp, v, j);
+    int needed = 0;
+    job_geometry(sp, v, j, &needed);
+    if (needed > j->nslices)
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "render slice: this view of the volume would need %d slices to sample its thinnest extent "
+                   "without banding; using %d (set \"slices\" / --slices to choose)",
+                   needed, j->nslices);
+    sp->slices_used = j->nslices;
     if (!job_buffers(sp, j)) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
     double cf[3], cr[3], cu[3];
     atmos__vol_dir_to_frame(&sp->x, v->cam.forward, cf);

@@ -87,6 +87,7 @@ struct atmos__slice_plan {
     float xi;
     atmos__vol_xform x;      /* the volume's transform, placed: world = org + R g in the grid frame */
     double prepare_s;        /* building the grid and the tables */
+    int slices_used;         /* the last frame's slice count (the rule's when "slices" is 0) */
     /* Buffers kept between frames, grown when a frame needs more. */
     float *pixblock;
     size_t pix_cap;          /* floats */

@@ -89,7 +89,9 @@ void atmos__slice_describe(const atmos_plan *p, const atmos__view *v, char *buf,
     const atmos_scene_slice *ss = &p->scene.slice;
     int w, h;
     eye_size(v, &w, &h);
-    snprintf(buf, cap, "%d slices, light buffer %d, eye buffer %dx%d, xi %g, %s%s", v->slices, ss->light_size, w, h,
+    const int slices = v->slices > 0 ? v->slices : p->slice->slices_used;
+    snprintf(buf, cap, "%d slices%s, light buffer %d, eye buffer %dx%d, xi %g, %s%s", slices,
+             v->slices > 0 ? "" : " (chosen)", ss->light_size, w, h,
              ss->xi, ss->eq24 ? "eq24" : "eq25", ss->low_albedo ? ", low albedo" : "");
 }
 

@@ -14,8 +14,8 @@
 static const char *const update_names[] = {"eq25", "eq24", NULL};
 
 static const atmos_setting slice_settings[] = {
-    {"slices", "slices", ATMOS_SETTING_INT, "", 1, 8192, 0, 0, 256, NULL, 0,
-     "sampling planes across the volume", SLICE(slices)},
+    {"slices", "slices", ATMOS_SETTING_INT, "", 0, 8192, 0, 0, 0, NULL, 0,
+     "sampling planes across the volume; 0 = chosen from the volume's shape (256 to 2048)", SLICE(slices)},
     {"light_size", "light-size", ATMOS_SETTING_INT, "texels", 8, 8192, 0, 0, 256, NULL, 0,
      "light buffer texels per side", SLICE(light_size)},
     {"xi", "xi", ATMOS_SETTING_REAL, "sr^-1", 0, 100, 0, 0, 0.1 / (4.0 * 3.14159265358979323846), NULL, 0,

@@ -203,7 +203,7 @@ static void test_absent_keys(void)
     /* Renderers, volumes, background, sun irradiance. */
     CHECK_OK(parse("{}", &s));
     CHECK(s.renderer == ATMOS_RENDERER_SKY && s.atmosphere.kind == ATMOS_ATMOSPHERE_RILEY && !s.volume.source[0]);
-    CHECK(s.slice.slices == 256 && s.path.spp == 64 && s.path.seed == 1 && s.sun.irradiance_count == 0);
+    CHECK(s.slice.slices == 0 && s.path.spp == 64 && s.path.seed == 1 && s.sun.irradiance_count == 0);
     CHECK_OK(parse("{\"volume\": {\"generate\": \"storm\", \"seed\": 7, \"scale\": 0.5, \"position_m\": [1, 2, 3]}}", &s));
     CHECK(s.renderer == ATMOS_RENDERER_SLICE); /* a volume alone selects the slice renderer */
     CHECK(!strcmp(s.volume.source, "generate:storm") && s.volume.seed == 7 && s.volume.scale == 0.5);
@@ -271,7 +271,7 @@ static const bad_case bad_cases[] = {
     {"{\"volume\": {\"generate\": \"storm\", \"grids\": [\"a,b\"]}}", ATMOS_E_INVALID_ARG, "/volume/grids/0: a grid name has no ','", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"seed\": 1.5}}", ATMOS_E_INVALID_ARG, "/volume/seed: expected an integer", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"position_m\": [0, 1]}}", ATMOS_E_INVALID_ARG, "/volume/position_m: expected an array of 3 numbers", NULL},
-    {"{\"slice\": {\"slices\": 0}}", ATMOS_E_INVALID_ARG, "/slice/slices: must be in [1, 8192], got 0", NULL},
+    {"{\"slice\": {\"slices\": -1}}", ATMOS_E_INVALID_ARG, "/slice/slices: must be in [0, 8192], got -1", NULL},
     {"{\"slice\": {\"light_size\": 4}}", ATMOS_E_INVALID_ARG, "/slice/light_size: must be in [8, 8192], got 4", NULL},
     {"{\"slice\": {\"xi\": -1}}", ATMOS_E_INVALID_ARG, "/slice/xi: must be in [0, 100], got -1", NULL},
     {"{\"slice\": {\"update\": \"eq23\"}}", ATMOS_E_INVALID_ARG, "/slice/update: must be one of eq25, eq24", NULL},

@@ -426,7 +426,7 @@ static void test_empty_and_errors(void)
     CHECK(atmos_render_slice(ctx, &s, NULL, NULL, &img, NULL) == ATMOS_E_INVALID_ARG);
     atmos_scene d;
     atmos_scene_defaults(&d);
-    CHECK(d.slice.slices == 256 && d.slice.light_size == 256 && fabs(d.slice.xi - 0.1 / (4 * PI)) < 1e-12);
+    CHECK(d.slice.slices == 0 && d.slice.light_size == 256 && fabs(d.slice.xi - 0.1 / (4 * PI)) < 1e-12);
     atmos_volume_destroy(v);
     free_optics(&op);
     atmos_context_destroy(ctx);
