@@ -13,8 +13,8 @@ fail=0; pass=0
 ok() { pass=$((pass + 1)); }
 bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
 
-# the render's own time (the first report line ends in ", X s"), without the table builds
-render_s() { sed -n 's/^atmos render: .*, \([0-9.]*\) s$/\1/p' "$1" | head -n 1; }
+# the render's own time (the first report line ends in ", X s rendering"), without the table builds
+render_s() { sed -n 's/^atmos render: .*, \([0-9.]*\) s rendering$/\1/p' "$1" | head -n 1; }
 
 # A budget inside a pass: 6 s on passes that would take minutes; stderr is a file, so
 # progress comes as log lines (one every 5 s).
