@@ -266,6 +266,8 @@ int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3]
     memcpy(s.d, d0, sizeof s.d);
     for (int i = 0; i < b->m; i++) s.w[i] = 1, L[i] = 0, Lo[i] = 0, s.S[i] = 1;
     for (int guard = 0; guard < 1 << 24; guard++) {
+        /* a path of thousands of events in an optically huge medium can outlast the budget */
+        if ((guard & 15) == 15 && J->deadline < INFINITY && atmos__now() >= J->deadline) return PATH_ABANDONED;
         double K = atmos_atmosphere_ground_distance(J->atm, s.p, s.d);
         double q[3], qd[3], t0 = 0, t1 = 0;
         if (J->med) {

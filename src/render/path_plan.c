@@ -145,6 +145,7 @@ static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, 
 {
     const atmos_atmosphere *atm = p->atm;
     memset(J, 0, sizeof *J);
+    J->deadline = INFINITY;
     J->atm = atm;
     J->cam = v->cam;
     memcpy(J->sun, v->sun, sizeof J->sun);
@@ -226,7 +227,12 @@ static int sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, int
         double jx = atmos__stream_u(&rng), jy = atmos__stream_u(&rng), dir[3];
         double L[PATH_B] = {0, 0, 0, 0}, Lo[PATH_B] = {0, 0, 0, 0}, Y = 0, Yo = 0;
         if (atmos_camera_ray(&J->cam, x + jx, y + jy, dir)) {
-            if (atmos__path_trace(J, &b, J->cam.position, dir, &rng, L, Lo, cnt) > 0) A[2 * n + 4] += 1;
+            const int met = atmos__path_trace(J, &b, J->cam.position, dir, &rng, L, Lo, cnt);
+            if (met == PATH_ABANDONED) {
+                atomic_store(&clk->stop, 1);
+                break;
+            }
+            if (met > 0) A[2 * n + 4] += 1;
             A[2 * n] += 1;
         }
         for (int i = 0; i < b.m; i++) {
@@ -344,12 +350,14 @@ static atmos_status accumulate(atmos_plan *p, atmos__path_plan *pp, const path_j
     }
     atmos_status status = ATMOS_OK;
     int step = clk.budget > 0 ? 1 : S; /* with a budget: passes of 1, 2, 4 ... samples up to S */
+    path_job Jb = *J; /* with the budget's deadline, past which a path is abandoned */
+    Jb.deadline = clk.deadline;
     while (lowest < target) {
         const int s1 = lowest + step < target ? lowest + step : target;
         const int undo = sv.acc && lowest > 0;
         if (undo) save_rows(pp, r, &sv, 0);
         const double tp = atmos__now();
-        pass(pp, J, r, s1, threads, Ybar, &clk, st);
+        pass(pp, &Jb, r, s1, threads, Ybar, &clk, st);
         if (step < S && 16.0 * (atmos__now() - tp) < clk.budget) step = 2 * step < S ? 2 * step : S;
         const int stop = atomic_load(&clk.stop);
         if (stop == 2) {

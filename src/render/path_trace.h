@@ -23,6 +23,7 @@ typedef struct {
     double albedo;          /* the ground's */
     int max_depth;          /* scattering events per path (the scene's, else PATH_DEFAULT_DEPTH) */
     int depth_default;      /* max_depth is the default: a path stopped by it counts as cut */
+    double deadline;        /* atmos__now() past which a path is abandoned (the time budget); INFINITY: none */
     uint64_t seed;
 } path_job;
 
@@ -132,6 +133,9 @@ int atmos__path_forced_single(const path_run *R, const double p[3], const double
  * L[] and, for the scattering-order image, each contribution times the number of volume
  * scattering events before it to Lo[]. Returns 1 when the path met the volume (a scattering
  * event, or the camera ray's forced single-scattering estimate), else 0. */
+/* atmos__path_trace's result for a path abandoned at the job's deadline (its sample is not
+ * counted: the pass it belongs to is cut). */
+#define PATH_ABANDONED (-1)
 int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d[3], atmos__stream *r,
                        double *L, double *Lo, path_counts *cnt);
 

@@ -53,6 +53,28 @@ for r in rows:
     assert r["volume_pixels"] > 0 and r["volume_rel_se_median"] <= r["volume_rel_se_p90"]
 PY
 
+# A single path that outlasts the budget (a camera under a rain shaft of optical depth in the
+# millions, paths of thousands of events each of long walks; seconds per path) is abandoned at
+# the deadline: the render ends near its budget, not after its longest path (15 s before).
+cat > "$T/long.json" <<'JSON'
+{"image": {"width": 16, "height": 12, "samples_per_pixel": 1},
+ "camera": {"type": "equirect", "position_m": [-5953.6219744415648, 13.710115345816162, 5026.646176666618]},
+ "sun": {"elevation_deg": -14.585043855712811, "azimuth_deg": 207.4115460471096},
+ "atmosphere": {"kind": "riley", "scale_height_m": 67257.401662335935, "beta_sl_550_per_m": 1.2017748696823234e-09,
+                "ground_albedo": 0.22123431345868116, "sun_diameter_deg": 0.00040070294075110041,
+                "thickness_m": 102292.23768252868},
+ "background": "black",
+ "wavelengths": {"mode": "spectral", "samples": 4},
+ "volume": {"generate": "rain_shaft", "density_scale": 71460663.272414625, "scale": 18.75186476761688, "seed": 29,
+            "voxel_size_m": 795.19312773420427, "position_m": [518.56998484100177, 1013.7912071135919, -2800.3390559747882]},
+ "particles": {"rain": {"kind": "analytic", "lobes": [{"type": "hg", "g": 0.88, "weight": 1}], "sigma_ext_m2": 6e-6}},
+ "renderer": "path", "path": {"spp": 2, "time_budget_s": 0.5, "seed": 18}}
+JSON
+"$A" render "$T/long.json" --threads 2 --pfm "$T/long.pfm" 2> "$T/long.log" && ok || bad "render of a path longer than its budget"
+s=$(render_s "$T/long.log")
+python3 -c "import sys; sys.exit(0 if 0 < float('$s') < 3.0 else 1)" 2>/dev/null && ok \
+    || { bad "a 0.5 s budget with paths longer than it took ${s:-?} s"; cat "$T/long.log" >&2; }
+
 # Voxel sizes outside 1e-6..1e5 m are refused, naming the voxel size (a raw sidecar here).
 printf '\000\000\200\077' > "$T/v.raw"
 for vs in 1e20 1e-9; do
