@@ -276,22 +276,24 @@ static int generated_index(const char *name, int count)
 }
 
 /* Chooses the image channel of each file channel (file order is sorted by name):
- * R,G,B[,A] in that order when the file has exactly those, C0..Cn by number when
- * it has exactly those, otherwise the file's (alphabetical) order. */
+ * R,G,B first in that order when the file has all three, then A if present, then the
+ * other channels in the file's (alphabetical) order; C0..Cn by number when the file
+ * has exactly those; otherwise the file's order. */
 static void map_channels(const exr_attr_chlist_t *cl, int *dst)
 {
     const int n = cl->num_channels;
     static const char *const rgba[4] = {"R", "G", "B", "A"};
-    if (n == 3 || n == 4) {
-        int ok = 1;
-        for (int i = 0; i < n && ok; i++) {
-            int found = -1;
-            for (int k = 0; k < n; k++)
-                if (strcmp(cl->entries[i].name.str, rgba[k]) == 0) found = k;
-            ok = found >= 0;
-            dst[i] = found;
-        }
-        if (ok) return;
+    int rgb_at[4] = {-1, -1, -1, -1};
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 4; k++)
+            if (strcmp(cl->entries[i].name.str, rgba[k]) == 0) rgb_at[k] = i;
+    if (rgb_at[0] >= 0 && rgb_at[1] >= 0 && rgb_at[2] >= 0) {
+        int next = 0;
+        for (int k = 0; k < 4; k++)
+            if (rgb_at[k] >= 0) dst[rgb_at[k]] = next++;
+        for (int i = 0; i < n; i++)
+            if (i != rgb_at[0] && i != rgb_at[1] && i != rgb_at[2] && i != rgb_at[3]) dst[i] = next++;
+        return;
     }
     int ok = 1;
     char seen[ATMOS_IMAGE_MAX_CHANNELS] = {0};
@@ -303,6 +305,22 @@ static void map_channels(const exr_attr_chlist_t *cl, int *dst)
     }
     if (ok) return;
     for (int i = 0; i < n; i++) dst[i] = i;
+}
+
+/* UINT channels were decoded as their 32-bit integers into the float slots: convert
+ * them to the floats they stand for (exact up to 2^24). */
+static void convert_uint_channels(const exr_attr_chlist_t *cl, const int *map, atmos_image *img)
+{
+    const size_t npx = (size_t)img->width * (size_t)img->height;
+    for (int i = 0; i < cl->num_channels; i++) {
+        if (cl->entries[i].pixel_type != EXR_PIXEL_UINT) continue;
+        float *px = img->pixels + map[i];
+        for (size_t p = 0; p < npx; p++, px += img->channels) {
+            uint32_t u;
+            memcpy(&u, px, sizeof u);
+            *px = (float)u;
+        }
+    }
 }
 
 static atmos_status decode_image(atmos_context *ctx, const char *path, exr_context_t ex, const exr_attr_box2i_t *dw,
@@ -338,7 +356,9 @@ static atmos_status decode_image(atmos_context *ctx, const char *path, exr_conte
         }
         for (int c = 0; c < dec.channel_count; c++) {
             exr_coding_channel_info_t *ch = &dec.channels[c];
-            ch->user_data_type = EXR_PIXEL_FLOAT;
+            /* A UINT channel is decoded as integers (a float destination would get its
+             * raw bits) and converted once the whole image is in. */
+            ch->user_data_type = ch->data_type == EXR_PIXEL_UINT ? EXR_PIXEL_UINT : EXR_PIXEL_FLOAT;
             ch->user_bytes_per_element = 4;
             ch->user_pixel_stride = (int32_t)(nc * 4);
             ch->user_line_stride = (int32_t)((size_t)img->width * (size_t)nc * 4);
@@ -381,8 +401,32 @@ static atmos_status read_meta(atmos_context *ctx, const char *path, exr_context_
     return ATMOS_OK;
 }
 
+/* The channel names in image order, in one allocation: the pointer array, then the strings. */
+static char **channel_names(const exr_attr_chlist_t *cl, const int *map)
+{
+    const int n = cl->num_channels;
+    size_t bytes = sizeof(char *) * (size_t)n;
+    for (int i = 0; i < n; i++) bytes += strlen(cl->entries[i].name.str) + 1;
+    char **names = malloc(bytes);
+    if (!names) return NULL;
+    char *s = (char *)(names + n);
+    for (int i = 0; i < n; i++) {
+        size_t len = strlen(cl->entries[i].name.str) + 1;
+        memcpy(s, cl->entries[i].name.str, len);
+        names[map[i]] = s;
+        s += len;
+    }
+    return names;
+}
+
 atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **out)
 {
+    return atmos_read_exr_named(ctx, path, out, NULL);
+}
+
+atmos_status atmos_read_exr_named(atmos_context *ctx, const char *path, atmos_image **out, char ***names)
+{
+    if (names) *names = NULL;
     if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_read_exr: out is NULL");
     *out = NULL;
     if (!path || !*path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_read_exr: path is empty");
@@ -456,6 +500,9 @@ atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **
     st = atmos_image_create(ctx, (int)w, (int)h, cl->num_channels, &img);
     if (st == ATMOS_OK) st = read_meta(ctx, path, ex, img);
     if (st == ATMOS_OK) st = decode_image(ctx, path, ex, &dw, map, img, &eb);
+    if (st == ATMOS_OK) convert_uint_channels(cl, map, img);
+    if (st == ATMOS_OK && names && !(*names = channel_names(cl, map)))
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
 
 done:
     if (ex) exr_finish(&ex);
