@@ -88,8 +88,9 @@ ATMOS_API atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *im
 /* Reads a scanline EXR (any channel count; half, float or unsigned-int channels, the
  * last converted to their values as floats, exact up to 2^24) into a float image;
  * string attributes are read back into img->meta. Channel order, by name: when the
- * file has R, G and B, those first in that order, then A if present, then the others
- * in the file's order (sorted by name, as OpenEXR stores them); C0..Cn by number when
+ * file has R, G and B (or only one layer has "<layer>.R", ".G", ".B"), those first in
+ * that order, then their A if present, then the others in the file's order (sorted by
+ * name, as OpenEXR stores them); C0..Cn by number when
  * the file has exactly those; otherwise the file's order. Tiled, deep and subsampled
  * files: ATMOS_E_UNSUPPORTED. Malformed or truncated files: ATMOS_E_FORMAT; sizes
  * beyond ATMOS_IMAGE_MAX_DIM / _CHANNELS: ATMOS_E_LIMIT or ATMOS_E_FORMAT. */
@@ -131,9 +132,10 @@ typedef struct atmos_channel_match {
     int count;
     int image[ATMOS_IMAGE_DIFF_MAX_CHANNELS], reference[ATMOS_IMAGE_DIFF_MAX_CHANNELS];
 } atmos_channel_match;
-/* Pairs channels by name ("A" is coverage and never compared): R,G,B when both images
- * have all three; otherwise every other channel when both have the same set of names
- * (in the image's order); otherwise the only channel of each when both have one.
+/* Pairs channels by name ("A" and "<layer>.A" are coverage and never compared): R,G,B
+ * when both images have all three (plain, or one layer's "<layer>.R", ...: the only layer
+ * with all three); otherwise every other channel when both have the same set of names (in
+ * the image's order); otherwise the only channel of each when both have one.
  * Anything else is ATMOS_E_INVALID_ARG with both name lists in the message; more than
  * ATMOS_IMAGE_DIFF_MAX_CHANNELS pairs is ATMOS_E_UNSUPPORTED. */
 ATMOS_API atmos_status atmos_image_match_channels(atmos_context *ctx, const char *const *image_names, int image_count,

@@ -2,11 +2,10 @@
  * a comparison must never pair B with R because one file lists its channels in another
  * order, nor compare different quantities because two images have as many channels. */
 #include "core/internal.h"
+#include "image/channel_names.h"
 
 #include <stdio.h>
 #include <string.h>
-
-static int is_alpha(const char *name) { return strcmp(name, "A") == 0; }
 
 static int find(const char *const *names, int count, const char *name)
 {
@@ -20,7 +19,7 @@ static int light_channels(const char *const *names, int count, int *idx)
 {
     int n = 0;
     for (int i = 0; i < count; i++)
-        if (!is_alpha(names[i])) idx[n++] = i;
+        if (!atmos__is_alpha_channel(names[i])) idx[n++] = i;
     return n;
 }
 
@@ -55,12 +54,10 @@ atmos_status atmos_image_match_channels(atmos_context *ctx, const char *const *n
     for (int i = 0; i < cr; i++)
         if (!nr[i]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing channel names");
     memset(out, 0, sizeof *out);
-    static const char *const rgb[3] = {"R", "G", "B"};
-    int ok = 1;
-    for (int c = 0; c < 3; c++) ok = ok && find(na, ca, rgb[c]) >= 0 && find(nr, cr, rgb[c]) >= 0;
-    if (ok) {
+    int rgb_a[4], rgb_r[4];
+    if (atmos__rgb_channels(na, ca, rgb_a) && atmos__rgb_channels(nr, cr, rgb_r)) {
         out->count = 3;
-        for (int c = 0; c < 3; c++) out->image[c] = find(na, ca, rgb[c]), out->reference[c] = find(nr, cr, rgb[c]);
+        for (int c = 0; c < 3; c++) out->image[c] = rgb_a[c], out->reference[c] = rgb_r[c];
         return ATMOS_OK;
     }
     int la[ATMOS_IMAGE_MAX_CHANNELS], lr[ATMOS_IMAGE_MAX_CHANNELS];
@@ -69,7 +66,7 @@ atmos_status atmos_image_match_channels(atmos_context *ctx, const char *const *n
     int same = 1;
     for (int i = 0; i < n && same; i++) {
         int j = find(nr, cr, na[la[i]]);
-        same = j >= 0 && !is_alpha(nr[j]);
+        same = j >= 0 && !atmos__is_alpha_channel(nr[j]);
         if (same && i < ATMOS_IMAGE_DIFF_MAX_CHANNELS) out->image[i] = la[i], out->reference[i] = j;
     }
     if (!same) {

@@ -5,6 +5,7 @@
  * is stored as A,B,G,R; every channel is mapped by name, never by position. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/internal.h"
+#include "image/channel_names.h"
 
 #include <openexr.h>
 
@@ -276,23 +277,23 @@ static int generated_index(const char *name, int count)
 }
 
 /* Chooses the image channel of each file channel (file order is sorted by name):
- * R,G,B first in that order when the file has all three, then A if present, then the
- * other channels in the file's (alphabetical) order; C0..Cn by number when the file
- * has exactly those; otherwise the file's order. */
+ * R,G,B first in that order when the file has all three (plain, or the only layer's
+ * "<layer>.R", ...), then that alpha if present, then the other channels in the file's
+ * (alphabetical) order; C0..Cn by number when the file has exactly those; otherwise the
+ * file's order. */
 static void map_channels(const exr_attr_chlist_t *cl, int *dst)
 {
     const int n = cl->num_channels;
-    static const char *const rgba[4] = {"R", "G", "B", "A"};
-    int rgb_at[4] = {-1, -1, -1, -1};
-    for (int i = 0; i < n; i++)
-        for (int k = 0; k < 4; k++)
-            if (strcmp(cl->entries[i].name.str, rgba[k]) == 0) rgb_at[k] = i;
-    if (rgb_at[0] >= 0 && rgb_at[1] >= 0 && rgb_at[2] >= 0) {
+    const char *names[ATMOS_IMAGE_MAX_CHANNELS];
+    for (int i = 0; i < n; i++) names[i] = cl->entries[i].name.str;
+    int rgba[4];
+    if (atmos__rgb_channels(names, n, rgba)) {
         int next = 0;
+        for (int i = 0; i < n; i++) dst[i] = -1;
         for (int k = 0; k < 4; k++)
-            if (rgb_at[k] >= 0) dst[rgb_at[k]] = next++;
+            if (rgba[k] >= 0) dst[rgba[k]] = next++;
         for (int i = 0; i < n; i++)
-            if (i != rgb_at[0] && i != rgb_at[1] && i != rgb_at[2] && i != rgb_at[3]) dst[i] = next++;
+            if (dst[i] < 0) dst[i] = next++;
         return;
     }
     int ok = 1;

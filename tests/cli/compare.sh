@@ -50,6 +50,11 @@ $EXR "$T/rgbz.exr" 2 2 Z:float:9 G:float:8,11,2,5 B:half:9,12,3,6 R:float:7,10,1
 out=$("$A" compare "$T/rgbz.exr" "$T/ref.pfm" --json) || bad "compare R,G,B,Z EXR"
 echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] == 0 and d["channels"] == ["R","G","B"], d' \
     && ok || bad "R,G,B,Z EXR against the same RGB: $out"
+# One layer's channels (as multi-layer files name them) pair with plain R,G,B.
+$EXR "$T/layer.exr" 2 2 view.A:half:1 view.B:half:9,12,3,6 view.G:float:8,11,2,5 view.R:float:7,10,1,4 || bad "write layer.exr"
+out=$("$A" compare "$T/layer.exr" "$T/ref.pfm" --json) || bad "compare layered EXR"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] == 0 and d["channels"] == ["view.R","view.G","view.B"], d' \
+    && ok || bad "layered EXR against the same RGB: $out"
 # UINT channels are compared by value, not as float bit patterns.
 $EXR "$T/uint.exr" 2 2 R:uint:7,10,1,4 G:uint:8,11,2,5 B:uint:9,12,3,6 || bad "write uint.exr"
 out=$("$A" compare "$T/uint.exr" "$T/ref.pfm" --json) || bad "compare UINT EXR"

@@ -169,6 +169,11 @@ static void pairing(void)
     check_pairs(rgba, 4, c3, 3, 0, NULL, NULL);
     check_pairs(xy, 2, xz, 2, 0, NULL, NULL);
     check_pairs(rgba, 4, y, 1, 0, NULL, NULL);
+    /* One layer's colour pairs with plain R,G,B; two layers' colour is ambiguous. */
+    static const char *const layer[5] = {"view.A", "view.B", "view.G", "view.R", "depth.Z"},
+                             *const two[6] = {"a.B", "a.G", "a.R", "b.B", "b.G", "b.R"};
+    check_pairs(layer, 5, bgr, 3, 3, (const int[]){3, 2, 1}, (const int[]){2, 1, 0});
+    check_pairs(two, 6, bgr, 3, 0, NULL, NULL);
     /* Compared through the pairing, an image and the same pixels in B,G,R order agree. */
     atmos_image *a = NULL, *b = NULL;
     CHECK_OK(atmos_image_create(NULL, 4, 4, 4, &a));
