@@ -92,7 +92,9 @@ ATMOS_API atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *im
  * that order, then their A if present, then the others in the file's order (sorted by
  * name, as OpenEXR stores them); C0..Cn by number when
  * the file has exactly those; otherwise the file's order. Tiled, deep and subsampled
- * files: ATMOS_E_UNSUPPORTED. Malformed or truncated files: ATMOS_E_FORMAT; sizes
+ * files: ATMOS_E_UNSUPPORTED. Malformed or truncated files: ATMOS_E_FORMAT, found before
+ * the image is allocated when the chunk table or a chunk cannot hold what the header
+ * claims (a chunk may not expand beyond what its compression allows); sizes
  * beyond ATMOS_IMAGE_MAX_DIM / _CHANNELS: ATMOS_E_LIMIT or ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **out);
 /* The same, and *names (if names is not NULL) gets the channel names in image order:
@@ -112,8 +114,10 @@ ATMOS_API atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmo
 
 /* Portable float map: 3 channels ("PF") or 1 ("Pf"), little-endian, bottom row first
  * as the format requires. 4 or more channels: the first three are written; 2
- * channels: ATMOS_E_INVALID_ARG. The reader accepts either byte order and ignores
- * the scale's magnitude; data shorter than the header claims: ATMOS_E_FORMAT. */
+ * channels: ATMOS_E_INVALID_ARG. The reader accepts either byte order, ignores the
+ * scale's magnitude and takes a CRLF pair after the scale as the header's end (unless
+ * the file's size says the data start at the LF); data shorter than the header claims:
+ * ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_write_pfm(atmos_context *ctx, const atmos_image *img, const char *path);
 ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **out);
 

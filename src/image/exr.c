@@ -376,6 +376,54 @@ static atmos_status decode_image(atmos_context *ctx, const char *path, exr_conte
     return st;
 }
 
+/* The most a chunk's data can grow when decompressed: raw data not at all; RLE at most
+ * 127 bytes from 2; zlib (ZIP, ZIPS) at most ~1032 times, PXR24 (zlib of 24-bit floats)
+ * 4/3 of that; B44 32 bytes from 3. PIZ's Huffman runs and DWA's zlib'd run lengths have
+ * no small bound: 0, not checked. */
+static uint64_t max_expansion(exr_compression_t c)
+{
+    switch (c) {
+    case EXR_COMPRESSION_NONE: return 1;
+    case EXR_COMPRESSION_RLE: return 64;
+    case EXR_COMPRESSION_ZIPS:
+    case EXR_COMPRESSION_ZIP: return 1100;
+    case EXR_COMPRESSION_PXR24: return 1500;
+    case EXR_COMPRESSION_B44:
+    case EXR_COMPRESSION_B44A: return 16;
+    default: return 0;
+    }
+}
+
+/* Every chunk's place and sizes, before the image is allocated: a few hundred bytes that
+ * claim a 65536 x 65536 image are refused here, not after gigabytes were asked for. The
+ * library checks the offset table and each chunk against the file's size; the data of a
+ * chunk must be able to expand to what the header says it holds. */
+static atmos_status check_chunks(atmos_context *ctx, const char *path, exr_context_t ex, const exr_attr_box2i_t *dw,
+                                 exr_errbuf *eb)
+{
+    int32_t lines = 1;
+    exr_compression_t comp = EXR_COMPRESSION_LAST_TYPE;
+    exr_result_t rv = exr_get_scanlines_per_chunk(ex, 0, &lines);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_get_compression(ex, 0, &comp);
+    if (rv != EXR_ERR_SUCCESS || lines < 1)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: OpenEXR: %s", path, exr_message(eb, rv));
+    const uint64_t grow = max_expansion(comp);
+    for (int64_t y = dw->min.y; y <= dw->max.y; y += lines) {
+        exr_chunk_info_t ci;
+        rv = exr_read_scanline_chunk_info(ex, 0, (int)y, &ci);
+        if (rv != EXR_ERR_SUCCESS)
+            return atmos__error(ctx, read_status(rv), "%s: OpenEXR: chunk at line %lld: %s", path, (long long)y,
+                                exr_message(eb, rv));
+        if (grow && ci.unpacked_size / grow > ci.packed_size)
+            return atmos__error(ctx, ATMOS_E_FORMAT,
+                                "%s: OpenEXR: chunk at line %lld holds %llu bytes but claims %llu decompressed: more "
+                                "than its compression can give (truncated or damaged file)",
+                                path, (long long)y, (unsigned long long)ci.packed_size,
+                                (unsigned long long)ci.unpacked_size);
+    }
+    return ATMOS_OK;
+}
+
 /* Copies every string attribute of the header into img->meta. */
 static atmos_status read_meta(atmos_context *ctx, const char *path, exr_context_t ex, atmos_image *img)
 {
@@ -492,6 +540,8 @@ atmos_status atmos_read_exr_named(atmos_context *ctx, const char *path, atmos_im
             goto done;
         }
     }
+    st = check_chunks(ctx, path, ex, &dw, &eb);
+    if (st != ATMOS_OK) goto done;
     map = malloc((size_t)cl->num_channels * sizeof *map);
     if (!map) {
         st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);

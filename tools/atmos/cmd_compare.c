@@ -70,6 +70,18 @@ static void json_numbers(const double *v, int n)
     putchar(']');
 }
 
+/* A channel name as a JSON string (EXR names may hold any byte but NUL). */
+static void json_string(const char *s)
+{
+    putchar('"');
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\') printf("\\%c", *p);
+        else if (*p < 0x20 || *p == 0x7f) printf("\\u%04x", *p);
+        else putchar(*p);
+    }
+    putchar('"');
+}
+
 static void print_json(const atmos_image_diff *d, const char *const *names, const atmos_channel_match *m,
                        const atmos_image_bins *bins)
 {
@@ -82,7 +94,10 @@ static void print_json(const atmos_image_diff *d, const char *const *names, cons
     printf(", \"rel_rmse_per_channel\": ");
     json_numbers(d->rel_rmse, d->channels);
     printf(", \"channels\": [");
-    for (int c = 0; c < m->count; c++) printf("%s\"%s\"", c ? ", " : "", names[m->image[c]]);
+    for (int c = 0; c < m->count; c++) {
+        if (c) printf(", ");
+        json_string(names[m->image[c]]);
+    }
     printf("], \"worst_region\": [%d, %d, %d, %d], \"worst_rmse\": ", d->worst_x, d->worst_y, d->worst_w, d->worst_h);
     json_number(d->worst_rmse);
     printf(", \"nonfinite\": %zu, \"nonfinite_image\": %zu, \"nonfinite_reference\": %zu", d->nonfinite,
