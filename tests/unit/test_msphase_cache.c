@@ -97,17 +97,23 @@ static int damage_entry(const char *path, damage how)
     int32_t hdr[4];
     memcpy(hdr, p, sizeof hdr); /* nwl = 1: nwl, max_order, ngrid, nchi[0] */
     size_t nv = (size_t)hdr[1] * (size_t)hdr[2];
-    float *v = (float *)(void *)(p + size - 4 * nv); /* payload offsets are multiples of 4 */
+    unsigned char *v = p + size - 4 * nv; /* the floats (the file's bytes: unaligned) */
     unsigned char *fwd = p + 16 + 8 * (size_t)hdr[2];
     unsigned char *chi = fwd + 8 * 2 * (size_t)(hdr[1] + 1);
     double x;
+    float fv;
     switch (how) {
     case VALUES_TIMES_10:
-        for (size_t i = 0; i < nv; i++) v[i] *= 10;
-        break;
-    case VALUE_NAN: v[nv / 2] = (float)NAN; break;
     case VALUES_NEGATIVE:
-        for (size_t i = 0; i < nv; i++) v[i] = -v[i];
+        for (size_t i = 0; i < nv; i++) {
+            memcpy(&fv, v + 4 * i, 4);
+            fv = how == VALUES_NEGATIVE ? -fv : 10 * fv;
+            memcpy(v + 4 * i, &fv, 4);
+        }
+        break;
+    case VALUE_NAN:
+        fv = (float)NAN;
+        memcpy(v + 4 * (nv / 2), &fv, 4);
         break;
     case FORWARD_CHANGED:
         memcpy(&x, fwd + 8, 8);
