@@ -561,8 +561,17 @@ bad:
 static const char *implausible(const atmos_msphase *m)
 {
     const int no = m->max_order, ng = m->ngrid;
-    double *F = malloc(sizeof(double) * (size_t)(no + 1));
+    /* Trapezoid weights of 2 pi int f sin(theta) dtheta on the grid, over the sphere (wt)
+     * and over the intervals of the forward hemisphere (wf), computed once. */
+    double *F = malloc(sizeof(double) * ((size_t)(no + 1) + 2 * (size_t)ng)), *wt = F + no + 1, *wf = wt + ng;
     if (!F) return NULL; /* cannot check: trust the checksum, as before */
+    for (int j = 0; j < ng; j++) wt[j] = wf[j] = 0;
+    for (int j = 0; j + 1 < ng; j++) {
+        double a = m->grid[j] * ATMOS_DEG2RAD, b = m->grid[j + 1] * ATMOS_DEG2RAD;
+        double wa = ATMOS_PI * sin(a) * (b - a), wb = ATMOS_PI * sin(b) * (b - a);
+        wt[j] += wa, wt[j + 1] += wb;
+        if (m->grid[j + 1] <= 90) wf[j] += wa, wf[j + 1] += wb;
+    }
     const char *why = NULL;
     for (int k = 0; k < m->nwl && !why; k++) {
         const double *chi = m->chi[k], *Fk = m->forward + (size_t)k * (no + 1), *Sk = m->logsum + (size_t)k * (no + 1);
@@ -585,12 +594,9 @@ static const char *implausible(const atmos_msphase *m)
                     why = "a value is not finite";
                     break;
                 }
-                lo = fmin(lo, v[j]), hi = fmax(hi, v[j]);
-                if (j + 1 == ng) break;
-                double a = m->grid[j] * ATMOS_DEG2RAD, b = m->grid[j + 1] * ATMOS_DEG2RAD;
-                double piece = ATMOS_PI * (v[j] * sin(a) + v[j + 1] * sin(b)) * (b - a);
-                total += piece;
-                if (m->grid[j + 1] <= 90) fwd += piece;
+                if (v[j] < lo) lo = v[j];
+                if (v[j] > hi) hi = v[j];
+                total += v[j] * wt[j], fwd += v[j] * wf[j];
             }
             if (!why && !(hi > 0 && lo >= -MS_CHECK_NEG * hi)) why = "a distribution is negative";
             else if (!why && !(fabs(total - 1) <= MS_CHECK_NORM)) why = "a distribution does not integrate to 1";
