@@ -378,8 +378,10 @@ static atmos_status decode_image(atmos_context *ctx, const char *path, exr_conte
 
 /* The most a chunk's data can grow when decompressed: raw data not at all; RLE at most
  * 127 bytes from 2; zlib (ZIP, ZIPS) at most ~1032 times, PXR24 (zlib of 24-bit floats)
- * 4/3 of that; B44 32 bytes from 3. PIZ's Huffman runs and DWA's zlib'd run lengths have
- * no small bound: 0, not checked. */
+ * 4/3 of that; B44 32 bytes from 3. PIZ (Huffman codes with runs of up to 255 values)
+ * and DWA (run lengths of zeros, Huffman or zlib coded, then 8x8 blocks from one DC
+ * value) have no tight bound: generous ones, far above what either can reach in
+ * practice but enough to refuse a few bytes that claim gigabytes. 0: not checked. */
 static uint64_t max_expansion(exr_compression_t c)
 {
     switch (c) {
@@ -390,6 +392,9 @@ static uint64_t max_expansion(exr_compression_t c)
     case EXR_COMPRESSION_PXR24: return 1500;
     case EXR_COMPRESSION_B44:
     case EXR_COMPRESSION_B44A: return 16;
+    case EXR_COMPRESSION_PIZ: return (uint64_t)1 << 16;
+    case EXR_COMPRESSION_DWAA:
+    case EXR_COMPRESSION_DWAB: return (uint64_t)1 << 22;
     default: return 0;
     }
 }
