@@ -91,14 +91,23 @@ typedef struct atmos_exr_desc {
 } atmos_exr_desc;
 ATMOS_API atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const char *path,
                                        const atmos_exr_desc *desc);
-/* Reads a scanline EXR (any channel count, half or float) into a float image;
- * string, int and double attributes are read back into img->meta (numbers as text:
- * %d, or the shortest %g that gives the double back). Channel order: R,G,B[,A] when the
- * file has exactly those, C0..Cn by number when it has exactly those, otherwise the
- * file's order (sorted by name, as OpenEXR stores them). Tiled, deep and subsampled
- * files: ATMOS_E_UNSUPPORTED. Malformed or truncated files: ATMOS_E_FORMAT; sizes
+/* Reads a scanline EXR (any channel count; half, float or unsigned-int channels, the
+ * last converted to their values as floats, exact up to 2^24) into a float image;
+ * string, int and double attributes are read back into img->meta (numbers as text: %d,
+ * or the shortest %g that gives the double back). Channel order, by name: when the
+ * file has R, G and B (or only one layer has "<layer>.R", ".G", ".B"), those first in
+ * that order, then their A if present, then the others in the file's order (sorted by
+ * name, as OpenEXR stores them); C0..Cn by number when
+ * the file has exactly those; otherwise the file's order. Tiled, deep and subsampled
+ * files: ATMOS_E_UNSUPPORTED. Malformed or truncated files: ATMOS_E_FORMAT, found before
+ * the image is allocated when the chunk table or a chunk cannot hold what the header
+ * claims (a chunk may not expand beyond what its compression allows); sizes
  * beyond ATMOS_IMAGE_MAX_DIM / _CHANNELS: ATMOS_E_LIMIT or ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **out);
+/* The same, and *names (if names is not NULL) gets the channel names in image order:
+ * img->channels strings in one allocation that the caller frees with free(*names). */
+ATMOS_API atmos_status atmos_read_exr_named(atmos_context *ctx, const char *path, atmos_image **out,
+                                            char ***names);
 
 /* PNG from a display-encoded image (values in [0,1], 1/3/4 channels: grey, RGB,
  * RGBA), bits 8 or 16; values are clamped (NaN -> 0) and rounded to the nearest
@@ -112,8 +121,10 @@ ATMOS_API atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmo
 
 /* Portable float map: 3 channels ("PF") or 1 ("Pf"), little-endian, bottom row first
  * as the format requires. 4 or more channels: the first three are written; 2
- * channels: ATMOS_E_INVALID_ARG. The reader accepts either byte order and ignores
- * the scale's magnitude; data shorter than the header claims: ATMOS_E_FORMAT. */
+ * channels: ATMOS_E_INVALID_ARG. The reader accepts either byte order, ignores the
+ * scale's magnitude and takes a CRLF pair after the scale as the header's end (unless
+ * the file's size says the data start at the LF); data shorter than the header claims:
+ * ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_write_pfm(atmos_context *ctx, const atmos_image *img, const char *path);
 ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **out);
 
@@ -121,9 +132,26 @@ ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmo
  * the 4th channel of RGBA images is coverage and is ignored). rmse, rel_rmse (RMSE over
  * the reference's mean absolute value) and bias (mean of image - reference) per channel
  * and over all channels; the worst 16x16 region by RMSE; non-finite samples are counted
- * and skipped. heatmap (optional): a display-encoded RGB image of the per-pixel relative
+ * (in total and per image) and skipped, and statistics with no finite sample are NaN.
+ * A caller that uses the result as a test must treat nonfinite > 0 as a failure.
+ * heatmap (optional): a display-encoded RGB image of the per-pixel relative
  * difference, black -> red -> yellow -> white at heat_scale. */
 #define ATMOS_IMAGE_DIFF_MAX_CHANNELS 16
+/* Which channels to compare: pair c is channel image[c] of the image against channel
+ * reference[c] of the reference. */
+typedef struct atmos_channel_match {
+    int count;
+    int image[ATMOS_IMAGE_DIFF_MAX_CHANNELS], reference[ATMOS_IMAGE_DIFF_MAX_CHANNELS];
+} atmos_channel_match;
+/* Pairs channels by name ("A" and "<layer>.A" are coverage and never compared): R,G,B
+ * when both images have all three (plain, or one layer's "<layer>.R", ...: the only layer
+ * with all three); otherwise every other channel when both have the same set of names (in
+ * the image's order); otherwise the only channel of each when both have one.
+ * Anything else is ATMOS_E_INVALID_ARG with both name lists in the message; more than
+ * ATMOS_IMAGE_DIFF_MAX_CHANNELS pairs is ATMOS_E_UNSUPPORTED. */
+ATMOS_API atmos_status atmos_image_match_channels(atmos_context *ctx, const char *const *image_names, int image_count,
+                                                  const char *const *reference_names, int reference_count,
+                                                  atmos_channel_match *out);
 typedef struct atmos_image_diff {
     int channels;
     double rmse[ATMOS_IMAGE_DIFF_MAX_CHANNELS], rel_rmse[ATMOS_IMAGE_DIFF_MAX_CHANNELS],
@@ -131,11 +159,16 @@ typedef struct atmos_image_diff {
     double rmse_all, rel_rmse_all;
     int worst_x, worst_y, worst_w, worst_h; /* pixels */
     double worst_rmse;
-    size_t nonfinite;
+    size_t nonfinite;                       /* compared samples skipped: either value NaN or infinite */
     double heat_scale;                      /* relative difference shown as white */
+    size_t nonfinite_image, nonfinite_reference; /* of those, the non-finite values in each image */
 } atmos_image_diff;
 ATMOS_API atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *image, const atmos_image *reference,
                                            atmos_image_diff *out, atmos_image **heatmap);
+/* The same over the channel pairs of `match` (from atmos_image_match_channels). */
+ATMOS_API atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *image,
+                                                   const atmos_image *reference, const atmos_channel_match *match,
+                                                   atmos_image_diff *out, atmos_image **heatmap);
 
 /* The same statistics split by a per-pixel key (e.g. the optical depth along each
  * pixel's ray, or the mean scattering order): pixels whose key (channel 0 of `key`,
@@ -153,6 +186,10 @@ typedef struct atmos_image_bins {
 ATMOS_API atmos_status atmos_image_compare_binned(atmos_context *ctx, const atmos_image *image,
                                                   const atmos_image *reference, const atmos_image *key,
                                                   const double *edges, int n_edges, atmos_image_bins *out);
+ATMOS_API atmos_status atmos_image_compare_binned_matched(atmos_context *ctx, const atmos_image *image,
+                                                          const atmos_image *reference, const atmos_channel_match *match,
+                                                          const atmos_image *key, const double *edges, int n_edges,
+                                                          atmos_image_bins *out);
 
 /* Spectral image (count radiance channels + alpha) -> linear sRGB + alpha (4
  * channels), scaled so that Y is luminance in cd m^-2. Metadata is copied. */

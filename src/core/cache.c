@@ -6,11 +6,13 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
+#include <unistd.h>
 
 static const unsigned char magic[8] = {'A', 'T', 'M', 'O', 'S', 'C', 'A', 0x1a};
 #define HEADER_SIZE 32u
@@ -92,6 +94,32 @@ static int reject(atmos_context *ctx, FILE *f, const char *path, const char *why
     return 0;
 }
 
+/* Opens an entry for reading, or NULL (a miss). The descriptor is opened without
+ * blocking and checked before anything is read: a FIFO in place of an entry would
+ * block fopen until a writer appears, and a device or directory is not an entry. Such
+ * a name is removed (a directory only if empty) so that the rebuilt entry can take it. */
+static FILE *open_entry(atmos_context *ctx, const char *path)
+{
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+        if (errno != ENOENT) atmos__log(ctx, ATMOS_LOG_WARN, "cache: %s: cannot open: %s", path, strerror(errno));
+        return NULL; /* a missing entry is the normal cold case: silent */
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        reject(ctx, NULL, path, "not a regular file");
+        return NULL;
+    }
+    int fl = fcntl(fd, F_GETFL);
+    FILE *f = fl == -1 || fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) == -1 ? NULL : fdopen(fd, "rb");
+    if (!f) {
+        atmos__log(ctx, ATMOS_LOG_WARN, "cache: %s: cannot open: %s", path, strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
 int atmos__cache_load(atmos_context *ctx, const char *key, void **data, size_t *size)
 {
     *data = NULL;
@@ -100,14 +128,10 @@ int atmos__cache_load(atmos_context *ctx, const char *key, void **data, size_t *
     size_t key_len = strlen(key);
     if (key_len == 0 || key_len > ATMOS__CACHE_MAX_KEY || !atmos__cache_entry_path(ctx, key, path, sizeof path))
         return 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        if (errno != ENOENT)
-            atmos__log(ctx, ATMOS_LOG_WARN, "cache: %s: cannot open: %s", path, strerror(errno));
-        return 0; /* a missing entry is the normal cold case: silent */
-    }
+    FILE *f = open_entry(ctx, path);
+    if (!f) return 0;
     struct stat st;
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) return reject(ctx, f, path, "not a regular file");
+    if (fstat(fileno(f), &st) != 0) return reject(ctx, f, path, "cannot stat");
     uint64_t file_size = (uint64_t)st.st_size;
 
     unsigned char h[HEADER_SIZE];

@@ -8,15 +8,11 @@
 
 #define COMPARE_TILE 16
 
-atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
-                                 atmos_image_diff *out, atmos_image **heatmap)
+/* The old positional rule: the colour channels in order, a 4th channel of an RGBA
+ * image being coverage, not light. */
+static atmos_status positional_match(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
+                                     atmos_channel_match *m)
 {
-    if (heatmap) *heatmap = NULL;
-    if (!a || !ref || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing image");
-    if (a->width != ref->width || a->height != ref->height)
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: sizes differ: %dx%d vs %dx%d", a->width, a->height,
-                            ref->width, ref->height);
-    /* Colour channels only: a fourth channel of an RGBA image is coverage, not light. */
     int ca = a->channels == 4 ? 3 : a->channels, cr = ref->channels == 4 ? 3 : ref->channels;
     if (ca != cr)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: channel counts differ: %d vs %d", a->channels,
@@ -24,19 +20,60 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
     if (ca > ATMOS_IMAGE_DIFF_MAX_CHANNELS)
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "compare: at most %d colour channels, got %d",
                             ATMOS_IMAGE_DIFF_MAX_CHANNELS, ca);
+    m->count = ca;
+    for (int c = 0; c < ca; c++) m->image[c] = m->reference[c] = c;
+    return ATMOS_OK;
+}
+
+static atmos_status check_match(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
+                                const atmos_channel_match *m)
+{
+    if (!m || m->count < 1 || m->count > ATMOS_IMAGE_DIFF_MAX_CHANNELS)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: 1..%d channels to compare", ATMOS_IMAGE_DIFF_MAX_CHANNELS);
+    for (int c = 0; c < m->count; c++)
+        if (m->image[c] < 0 || m->image[c] >= a->channels || m->reference[c] < 0 || m->reference[c] >= ref->channels)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: channel pair %d is out of range", c);
+    return ATMOS_OK;
+}
+
+atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
+                                 atmos_image_diff *out, atmos_image **heatmap)
+{
+    if (heatmap) *heatmap = NULL;
+    if (!a || !ref || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing image");
+    atmos_channel_match m;
+    atmos_status st = positional_match(ctx, a, ref, &m);
+    if (st != ATMOS_OK) return st;
+    return atmos_image_compare_matched(ctx, a, ref, &m, out, heatmap);
+}
+
+atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
+                                         const atmos_channel_match *m, atmos_image_diff *out, atmos_image **heatmap)
+{
+    if (heatmap) *heatmap = NULL;
+    if (!a || !ref || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing image");
+    if (a->width != ref->width || a->height != ref->height)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: sizes differ: %dx%d vs %dx%d", a->width, a->height,
+                            ref->width, ref->height);
+    atmos_status st = check_match(ctx, a, ref, m);
+    if (st != ATMOS_OK) return st;
+    const int ca = m->count;
+    const int *ia = m->image, *ir = m->reference;
     memset(out, 0, sizeof *out);
     out->channels = ca;
     const size_t npx = (size_t)a->width * a->height;
     double se[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0}, sd[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0},
            sr[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0};
     size_t cnt[ATMOS_IMAGE_DIFF_MAX_CHANNELS] = {0}; /* finite samples per channel */
-    size_t bad = 0;
+    size_t bad = 0, bad_a = 0, bad_r = 0;
     for (size_t p = 0; p < npx; p++) {
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
         for (int c = 0; c < ca; c++) {
-            double va = pa[c], vr = pr[c];
+            double va = pa[ia[c]], vr = pr[ir[c]];
             if (!isfinite(va) || !isfinite(vr)) {
                 bad++;
+                bad_a += !isfinite(va);
+                bad_r += !isfinite(vr);
                 continue;
             }
             double d = va - vr;
@@ -46,23 +83,26 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
             cnt[c]++;
         }
     }
-    /* Means over the finite samples only: a NaN must not count as a perfect match. */
+    /* Means over the finite samples only: a NaN must not count as a perfect match, and a
+     * channel with no finite sample has NaN statistics, not zeros. */
     double se_all = 0, sr_all = 0, n_all = 0;
     for (int c = 0; c < ca; c++) {
-        double n = cnt[c] ? (double)cnt[c] : 1.0;
+        double n = cnt[c] ? (double)cnt[c] : NAN;
         out->rmse[c] = sqrt(se[c] / n);
         out->bias[c] = sd[c] / n;
         double mean_ref = sr[c] / n;
-        out->rel_rmse[c] = mean_ref > 0 ? out->rmse[c] / mean_ref : (out->rmse[c] > 0 ? INFINITY : 0.0);
+        out->rel_rmse[c] = !cnt[c] ? NAN : mean_ref > 0 ? out->rmse[c] / mean_ref : (out->rmse[c] > 0 ? INFINITY : 0.0);
         se_all += se[c];
         sr_all += sr[c];
         n_all += (double)cnt[c];
     }
-    if (n_all < 1) n_all = 1;
+    if (n_all < 1) n_all = NAN;
     out->rmse_all = sqrt(se_all / n_all);
     double mean_all = sr_all / n_all;
-    out->rel_rmse_all = mean_all > 0 ? out->rmse_all / mean_all : (out->rmse_all > 0 ? INFINITY : 0.0);
+    out->rel_rmse_all = !(n_all >= 1) ? NAN : mean_all > 0 ? out->rmse_all / mean_all : (out->rmse_all > 0 ? INFINITY : 0.0);
     out->nonfinite = bad;
+    out->nonfinite_image = bad_a;
+    out->nonfinite_reference = bad_r;
     /* The worst region: the COMPARE_TILE^2 tile with the largest RMSE. */
     out->worst_rmse = -1;
     for (int ty = 0; ty < a->height; ty += COMPARE_TILE)
@@ -74,7 +114,7 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
                     const float *pa = a->pixels + ((size_t)y * a->width + x) * a->channels,
                                 *pr = ref->pixels + ((size_t)y * ref->width + x) * ref->channels;
                     for (int c = 0; c < ca; c++) {
-                        double d = (double)pa[c] - pr[c];
+                        double d = (double)pa[ia[c]] - pr[ir[c]];
                         if (isfinite(d)) s += d * d, n++;
                     }
                 }
@@ -90,13 +130,13 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
     /* Heat map: per pixel the mean absolute difference over the channels relative to the
      * reference's mean value, 0 black -> red -> yellow -> white at out->heat_scale. */
     atmos_image *h = NULL;
-    atmos_status st = atmos_image_create(ctx, a->width, a->height, 3, &h);
+    st = atmos_image_create(ctx, a->width, a->height, 3, &h);
     if (st != ATMOS_OK) return st;
     double scale = 0;
     for (size_t p = 0; p < npx; p++) {
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
         double d = 0;
-        for (int c = 0; c < ca; c++) d += fabs((double)pa[c] - pr[c]);
+        for (int c = 0; c < ca; c++) d += fabs((double)pa[ia[c]] - pr[ir[c]]);
         d = mean_all > 0 ? d / ca / mean_all : 0;
         if (!isfinite(d)) d = 0;
         h->pixels[p * 3] = (float)d;
@@ -120,13 +160,24 @@ atmos_status atmos_image_compare_binned(atmos_context *ctx, const atmos_image *a
                                         const atmos_image *key, const double *edges, int n_edges, atmos_image_bins *out)
 {
     if (!a || !ref || !key || !edges || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing argument");
+    atmos_channel_match m;
+    atmos_status st = positional_match(ctx, a, ref, &m);
+    if (st != ATMOS_OK) return st;
+    return atmos_image_compare_binned_matched(ctx, a, ref, &m, key, edges, n_edges, out);
+}
+
+atmos_status atmos_image_compare_binned_matched(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
+                                                const atmos_channel_match *m, const atmos_image *key,
+                                                const double *edges, int n_edges, atmos_image_bins *out)
+{
+    if (!a || !ref || !key || !edges || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: missing argument");
     if (a->width != ref->width || a->height != ref->height || key->width != a->width || key->height != a->height)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: image, reference and key sizes differ (%dx%d, %dx%d, %dx%d)",
                             a->width, a->height, ref->width, ref->height, key->width, key->height);
-    int ca = a->channels == 4 ? 3 : a->channels, cr = ref->channels == 4 ? 3 : ref->channels;
-    if (ca != cr)
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: channel counts differ: %d vs %d", a->channels,
-                            ref->channels);
+    atmos_status st = check_match(ctx, a, ref, m);
+    if (st != ATMOS_OK) return st;
+    const int ca = m->count;
+    const int *ia = m->image, *ir = m->reference;
     if (n_edges < 2 || n_edges > ATMOS_IMAGE_BINS_MAX + 1)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "compare: 2..%d bin edges, got %d", ATMOS_IMAGE_BINS_MAX + 1,
                             n_edges);
@@ -147,7 +198,7 @@ atmos_status atmos_image_compare_binned(atmos_context *ctx, const atmos_image *a
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
         int counted = 0;
         for (int c = 0; c < ca; c++) {
-            double va = pa[c], vr = pr[c];
+            double va = pa[ia[c]], vr = pr[ir[c]];
             if (!isfinite(va) || !isfinite(vr)) continue;
             se[b] += (va - vr) * (va - vr);
             sd[b] += va - vr;
@@ -158,10 +209,10 @@ atmos_status atmos_image_compare_binned(atmos_context *ctx, const atmos_image *a
         out->count[b] += (size_t)counted;
     }
     for (int b = 0; b < out->bins; b++) {
-        double m = ns[b] ? sr[b] / ns[b] : NAN;
-        out->mean_reference[b] = m;
-        out->rel_rmse[b] = ns[b] && m > 0 ? sqrt(se[b] / ns[b]) / m : NAN;
-        out->rel_bias[b] = ns[b] && m > 0 ? sd[b] / ns[b] / m : NAN;
+        double mr = ns[b] ? sr[b] / ns[b] : NAN;
+        out->mean_reference[b] = mr;
+        out->rel_rmse[b] = ns[b] && mr > 0 ? sqrt(se[b] / ns[b]) / mr : NAN;
+        out->rel_bias[b] = ns[b] && mr > 0 ? sd[b] / ns[b] / mr : NAN;
     }
     return ATMOS_OK;
 }

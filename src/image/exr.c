@@ -5,6 +5,7 @@
  * is stored as A,B,G,R; every channel is mapped by name, never by position. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/internal.h"
+#include "image/channel_names.h"
 
 #include <openexr.h>
 
@@ -346,22 +347,24 @@ static int generated_index(const char *name, int count)
 }
 
 /* Chooses the image channel of each file channel (file order is sorted by name):
- * R,G,B[,A] in that order when the file has exactly those, C0..Cn by number when
- * it has exactly those, otherwise the file's (alphabetical) order. */
+ * R,G,B first in that order when the file has all three (plain, or the only layer's
+ * "<layer>.R", ...), then that alpha if present, then the other channels in the file's
+ * (alphabetical) order; C0..Cn by number when the file has exactly those; otherwise the
+ * file's order. */
 static void map_channels(const exr_attr_chlist_t *cl, int *dst)
 {
     const int n = cl->num_channels;
-    static const char *const rgba[4] = {"R", "G", "B", "A"};
-    if (n == 3 || n == 4) {
-        int ok = 1;
-        for (int i = 0; i < n && ok; i++) {
-            int found = -1;
-            for (int k = 0; k < n; k++)
-                if (strcmp(cl->entries[i].name.str, rgba[k]) == 0) found = k;
-            ok = found >= 0;
-            dst[i] = found;
-        }
-        if (ok) return;
+    const char *names[ATMOS_IMAGE_MAX_CHANNELS];
+    for (int i = 0; i < n; i++) names[i] = cl->entries[i].name.str;
+    int rgba[4];
+    if (atmos__rgb_channels(names, n, rgba)) {
+        int next = 0;
+        for (int i = 0; i < n; i++) dst[i] = -1;
+        for (int k = 0; k < 4; k++)
+            if (rgba[k] >= 0) dst[rgba[k]] = next++;
+        for (int i = 0; i < n; i++)
+            if (dst[i] < 0) dst[i] = next++;
+        return;
     }
     int ok = 1;
     char seen[ATMOS_IMAGE_MAX_CHANNELS] = {0};
@@ -373,6 +376,22 @@ static void map_channels(const exr_attr_chlist_t *cl, int *dst)
     }
     if (ok) return;
     for (int i = 0; i < n; i++) dst[i] = i;
+}
+
+/* UINT channels were decoded as their 32-bit integers into the float slots: convert
+ * them to the floats they stand for (exact up to 2^24). */
+static void convert_uint_channels(const exr_attr_chlist_t *cl, const int *map, atmos_image *img)
+{
+    const size_t npx = (size_t)img->width * (size_t)img->height;
+    for (int i = 0; i < cl->num_channels; i++) {
+        if (cl->entries[i].pixel_type != EXR_PIXEL_UINT) continue;
+        float *px = img->pixels + map[i];
+        for (size_t p = 0; p < npx; p++, px += img->channels) {
+            uint32_t u;
+            memcpy(&u, px, sizeof u);
+            *px = (float)u;
+        }
+    }
 }
 
 static atmos_status decode_image(atmos_context *ctx, const char *path, exr_context_t ex, const exr_attr_box2i_t *dw,
@@ -408,7 +427,9 @@ static atmos_status decode_image(atmos_context *ctx, const char *path, exr_conte
         }
         for (int c = 0; c < dec.channel_count; c++) {
             exr_coding_channel_info_t *ch = &dec.channels[c];
-            ch->user_data_type = EXR_PIXEL_FLOAT;
+            /* A UINT channel is decoded as integers (a float destination would get its
+             * raw bits) and converted once the whole image is in. */
+            ch->user_data_type = ch->data_type == EXR_PIXEL_UINT ? EXR_PIXEL_UINT : EXR_PIXEL_FLOAT;
             ch->user_bytes_per_element = 4;
             ch->user_pixel_stride = (int32_t)(nc * 4);
             ch->user_line_stride = (int32_t)((size_t)img->width * (size_t)nc * 4);
@@ -423,6 +444,59 @@ static atmos_status decode_image(atmos_context *ctx, const char *path, exr_conte
     }
     if (initialized) exr_decoding_destroy(ex, &dec);
     return st;
+}
+
+/* The most a chunk's data can grow when decompressed: raw data not at all; RLE at most
+ * 127 bytes from 2; zlib (ZIP, ZIPS) at most ~1032 times, PXR24 (zlib of 24-bit floats)
+ * 4/3 of that; B44 32 bytes from 3. PIZ (Huffman codes with runs of up to 255 values)
+ * and DWA (run lengths of zeros, Huffman or zlib coded, then 8x8 blocks from one DC
+ * value) have no tight bound: generous ones, far above what either can reach in
+ * practice but enough to refuse a few bytes that claim gigabytes. 0: not checked. */
+static uint64_t max_expansion(exr_compression_t c)
+{
+    switch (c) {
+    case EXR_COMPRESSION_NONE: return 1;
+    case EXR_COMPRESSION_RLE: return 64;
+    case EXR_COMPRESSION_ZIPS:
+    case EXR_COMPRESSION_ZIP: return 1100;
+    case EXR_COMPRESSION_PXR24: return 1500;
+    case EXR_COMPRESSION_B44:
+    case EXR_COMPRESSION_B44A: return 16;
+    case EXR_COMPRESSION_PIZ: return (uint64_t)1 << 16;
+    case EXR_COMPRESSION_DWAA:
+    case EXR_COMPRESSION_DWAB: return (uint64_t)1 << 22;
+    default: return 0;
+    }
+}
+
+/* Every chunk's place and sizes, before the image is allocated: a few hundred bytes that
+ * claim a 65536 x 65536 image are refused here, not after gigabytes were asked for. The
+ * library checks the offset table and each chunk against the file's size; the data of a
+ * chunk must be able to expand to what the header says it holds. */
+static atmos_status check_chunks(atmos_context *ctx, const char *path, exr_context_t ex, const exr_attr_box2i_t *dw,
+                                 exr_errbuf *eb)
+{
+    int32_t lines = 1;
+    exr_compression_t comp = EXR_COMPRESSION_LAST_TYPE;
+    exr_result_t rv = exr_get_scanlines_per_chunk(ex, 0, &lines);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_get_compression(ex, 0, &comp);
+    if (rv != EXR_ERR_SUCCESS || lines < 1)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: OpenEXR: %s", path, exr_message(eb, rv));
+    const uint64_t grow = max_expansion(comp);
+    for (int64_t y = dw->min.y; y <= dw->max.y; y += lines) {
+        exr_chunk_info_t ci;
+        rv = exr_read_scanline_chunk_info(ex, 0, (int)y, &ci);
+        if (rv != EXR_ERR_SUCCESS)
+            return atmos__error(ctx, read_status(rv), "%s: OpenEXR: chunk at line %lld: %s", path, (long long)y,
+                                exr_message(eb, rv));
+        if (grow && ci.unpacked_size / grow > ci.packed_size)
+            return atmos__error(ctx, ATMOS_E_FORMAT,
+                                "%s: OpenEXR: chunk at line %lld holds %llu bytes but claims %llu decompressed: more "
+                                "than its compression can give (truncated or damaged file)",
+                                path, (long long)y, (unsigned long long)ci.packed_size,
+                                (unsigned long long)ci.unpacked_size);
+    }
+    return ATMOS_OK;
 }
 
 /* Copies every string attribute of the header into img->meta. */
@@ -467,8 +541,32 @@ static atmos_status read_meta(atmos_context *ctx, const char *path, exr_context_
     return ATMOS_OK;
 }
 
+/* The channel names in image order, in one allocation: the pointer array, then the strings. */
+static char **channel_names(const exr_attr_chlist_t *cl, const int *map)
+{
+    const int n = cl->num_channels;
+    size_t bytes = sizeof(char *) * (size_t)n;
+    for (int i = 0; i < n; i++) bytes += strlen(cl->entries[i].name.str) + 1;
+    char **names = malloc(bytes);
+    if (!names) return NULL;
+    char *s = (char *)(names + n);
+    for (int i = 0; i < n; i++) {
+        size_t len = strlen(cl->entries[i].name.str) + 1;
+        memcpy(s, cl->entries[i].name.str, len);
+        names[map[i]] = s;
+        s += len;
+    }
+    return names;
+}
+
 atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **out)
 {
+    return atmos_read_exr_named(ctx, path, out, NULL);
+}
+
+atmos_status atmos_read_exr_named(atmos_context *ctx, const char *path, atmos_image **out, char ***names)
+{
+    if (names) *names = NULL;
     if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_read_exr: out is NULL");
     *out = NULL;
     if (!path || !*path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_read_exr: path is empty");
@@ -533,6 +631,8 @@ atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **
             goto done;
         }
     }
+    st = check_chunks(ctx, path, ex, &dw, &eb);
+    if (st != ATMOS_OK) goto done;
     map = malloc((size_t)cl->num_channels * sizeof *map);
     if (!map) {
         st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
@@ -542,6 +642,9 @@ atmos_status atmos_read_exr(atmos_context *ctx, const char *path, atmos_image **
     st = atmos_image_create(ctx, (int)w, (int)h, cl->num_channels, &img);
     if (st == ATMOS_OK) st = read_meta(ctx, path, ex, img);
     if (st == ATMOS_OK) st = decode_image(ctx, path, ex, &dw, map, img, &eb);
+    if (st == ATMOS_OK) convert_uint_channels(cl, map, img);
+    if (st == ATMOS_OK && names && !(*names = channel_names(cl, map)))
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
 
 done:
     if (ex) exr_finish(&ex);

@@ -1,8 +1,9 @@
 /* Portable float map (PFM) reader and writer.
  *
  * Format: "PF" (RGB) or "Pf" (grey), width, height, a scale whose sign gives the
- * byte order (negative = little-endian), one whitespace byte, then width*height*c
- * 32-bit IEEE floats, rows from the BOTTOM of the image to the top. */
+ * byte order (negative = little-endian), one whitespace byte (the reader also takes
+ * a CRLF pair there), then width*height*c 32-bit IEEE floats, rows from the BOTTOM of
+ * the image to the top. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/internal.h"
 
@@ -160,7 +161,6 @@ atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **
                           path, scale_text);
         goto done;
     }
-    pos++; /* the single whitespace byte that ends the header */
     int little = scale < 0;
 
     if (w < 1 || h < 1) {
@@ -180,6 +180,14 @@ atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **
         st = atmos__error(ctx, ATMOS_E_IO, "%s: cannot stat: %s", path, strerror(errno));
         goto done;
     }
+    /* One whitespace byte ends the header. A header written with CRLF line ends has
+     * two ("\r\n"): taking only the '\r' would shift every float by a byte. The "\r\n"
+     * counts as one terminator unless the file's size says the data start at the '\n'. */
+    uint64_t data_bytes = (uint64_t)row_bytes * (uint64_t)h;
+    if (hdr[pos] == '\r' && pos + 1 < len && hdr[pos + 1] == '\n' && sb.st_size >= 0 &&
+        (uint64_t)sb.st_size != (uint64_t)pos + 1 + data_bytes)
+        pos++;
+    pos++;
     if (sb.st_size < 0 || (uint64_t)sb.st_size < (uint64_t)pos ||
         ((uint64_t)sb.st_size - (uint64_t)pos) / (uint64_t)row_bytes < (uint64_t)h) {
         st = atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated PFM: %ld x %ld x %d floats need %llu bytes of data, file has %llu",

@@ -545,6 +545,68 @@ bad:
     return NULL;
 }
 
+/* Value checks of an entry read from the cache: the checksum only proves that the bytes
+ * are those written, not that they are a multiple-scattering table (an entry written by a
+ * broken build, or forged with a recomputed checksum, passes it). NULL when the entry is
+ * plausible, else what is wrong. The forward fractions and their log-sums are recomputed
+ * from the Legendre coefficients (they must agree to rounding); each Ams_n must be finite,
+ * at most slightly negative (the series' ringing), integrate to 1 over the sphere and to
+ * F_n over the forward hemisphere. Correct tables (water drops, ice crystals, HG) are
+ * within 3e-5 of both and never below -1e-9 of their maximum; the tolerances are wide
+ * so that only numbers that are not such a table fail. */
+#define MS_CHECK_CHI0 1e-3   /* |chi_0 - 1|: the phase function's normalisation */
+#define MS_CHECK_NORM 0.02   /* |2 pi int Ams_n - 1| on the output grid */
+#define MS_CHECK_FWD 0.02    /* |2 pi int_fwd Ams_n - F_n| */
+#define MS_CHECK_NEG 0.01    /* lowest value over the largest */
+static const char *implausible(const atmos_msphase *m)
+{
+    const int no = m->max_order, ng = m->ngrid;
+    /* Trapezoid weights of 2 pi int f sin(theta) dtheta on the grid, over the sphere (wt)
+     * and over the intervals of the forward hemisphere (wf), computed once. */
+    double *F = malloc(sizeof(double) * ((size_t)(no + 1) + 2 * (size_t)ng)), *wt = F + no + 1, *wf = wt + ng;
+    if (!F) return NULL; /* cannot check: trust the checksum, as before */
+    for (int j = 0; j < ng; j++) wt[j] = wf[j] = 0;
+    for (int j = 0; j + 1 < ng; j++) {
+        double a = m->grid[j] * ATMOS_DEG2RAD, b = m->grid[j + 1] * ATMOS_DEG2RAD;
+        double wa = ATMOS_PI * sin(a) * (b - a), wb = ATMOS_PI * sin(b) * (b - a);
+        wt[j] += wa, wt[j + 1] += wb;
+        if (m->grid[j + 1] <= 90) wf[j] += wa, wf[j + 1] += wb;
+    }
+    const char *why = NULL;
+    for (int k = 0; k < m->nwl && !why; k++) {
+        const double *chi = m->chi[k], *Fk = m->forward + (size_t)k * (no + 1), *Sk = m->logsum + (size_t)k * (no + 1);
+        if (!(fabs(chi[0] - 1) <= MS_CHECK_CHI0)) why = "chi_0 is not 1 (the phase function is not normalised)";
+        for (int l = 1; l < m->nchi[k] && !why; l++)
+            if (!(fabs(chi[l]) <= 1 + 1e-9)) why = "a Legendre coefficient lies outside [-1, 1]";
+        if (why) break;
+        forward_fractions(chi, m->nchi[k], no, F);
+        double sum = 0;
+        for (int n = 0; n <= no && !why; n++) {
+            if (n) sum += log(fmax(F[n], 1e-300));
+            if (!(fabs(Fk[n] - F[n]) <= 1e-12) || !(fabs(Sk[n] - sum) <= 1e-9 * (1 + fabs(sum))))
+                why = "the forward fractions disagree with the Legendre coefficients";
+        }
+        for (int n = 1; n <= no && !why; n++) {
+            const double *v = m->values + ((size_t)k * no + (size_t)(n - 1)) * ng;
+            double lo = 0, hi = 0, total = 0, fwd = 0;
+            for (int j = 0; j < ng; j++) {
+                if (!isfinite(v[j])) {
+                    why = "a value is not finite";
+                    break;
+                }
+                if (v[j] < lo) lo = v[j];
+                if (v[j] > hi) hi = v[j];
+                total += v[j] * wt[j], fwd += v[j] * wf[j];
+            }
+            if (!why && !(hi > 0 && lo >= -MS_CHECK_NEG * hi)) why = "a distribution is negative";
+            else if (!why && !(fabs(total - 1) <= MS_CHECK_NORM)) why = "a distribution does not integrate to 1";
+            else if (!why && !(fabs(fwd - F[n]) <= MS_CHECK_FWD)) why = "a distribution's forward part is not F_n";
+        }
+    }
+    free(F);
+    return why;
+}
+
 atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *table, const atmos_msphase_desc *desc,
                                  atmos_msphase **out)
 {
@@ -575,11 +637,18 @@ atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *ta
         if (atmos__cache_load(ctx, key, &data, &size)) {
             atmos_msphase *m = deserialise(data, size, nwl);
             free(data);
-            if (m) {
+            const int shaped = m != NULL;
+            const char *why = shaped ? implausible(m) : "an unexpected shape";
+            if (!why) {
                 *out = m;
                 return ATMOS_OK;
             }
-            atmos__log(ctx, ATMOS_LOG_WARN, "msphase: cached entry has an unexpected shape; rebuilding");
+            atmos_msphase_destroy(m);
+            char path[4096];
+            if (!atmos__cache_entry_path(ctx, key, path, sizeof path)) snprintf(path, sizeof path, "(entry)");
+            atmos__log(ctx, ATMOS_LOG_WARN, "cache: %s: multiple-scattering entry has %s%s; ignoring it and rebuilding",
+                       path, shaped ? "values out of range: " : "", why);
+            remove(path);
         }
     }
     atmos_status st = atmos__msphase_build_arrays(ctx, nwl, n, theta, P, &d, out);

@@ -20,6 +20,50 @@ python3 -c 'import sys; assert open(sys.argv[1],"rb").read(8) == b"\x89PNG\r\n\x
 "$A" compare "$T/small.pfm" "$T/a.pfm" 2>/dev/null; [ $? -eq 1 ] && ok || bad "size mismatch should exit 1"
 "$A" compare "$T/a.pfm" 2>/dev/null; [ $? -eq 2 ] && ok || bad "one file should exit 2"
 "$A" compare "$T/nope.exr" "$T/a.pfm" 2>/dev/null; [ $? -eq 1 ] && ok || bad "missing file should exit 1"
+
+# A comparison is a test oracle: broken images must fail it loudly.
+S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
+EXR="python3 $S/tests/tools/write_exr.py"
+# pfm FILE HEADER_LINE_END VALUE...: a 2 x 2 RGB PFM (12 values, little-endian, bottom row
+# first as the format stores it; the EXRs below list the top row first)
+pfm() {
+    python3 -c 'import struct,sys; e=sys.argv[2].encode().decode("unicode_escape").encode()
+v=[float(x) for x in sys.argv[3:]]
+open(sys.argv[1],"wb").write(b"PF"+e+b"2 2"+e+b"-1.0"+e+struct.pack("<12f",*v))' "$@"
+}
+V="1 2 3 4 5 6 7 8 9 10 11 12"
+pfm "$T/ref.pfm" '\n' $V
+pfm "$T/nan.pfm" '\n' nan nan nan nan nan nan nan nan nan nan nan nan
+out=$("$A" compare "$T/nan.pfm" "$T/ref.pfm" --json 2>"$T/err"); rc=$?
+[ $rc -eq 1 ] && ok || bad "all-NaN image against its reference: exit $rc, expected 1 ($out)"
+grep -q "12 compared samples are NaN or infinite (12 in" "$T/err" && ok || bad "all-NaN: no count in the error: $(cat "$T/err")"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] is None and d["nonfinite_image"] == 12 and d["nonfinite_reference"] == 0, d' \
+    && ok || bad "all-NaN: statistics $out"
+"$A" compare "$T/ref.pfm" "$T/nan.pfm" >/dev/null 2>&1; [ $? -eq 1 ] && ok || bad "NaN reference should exit 1"
+# A CRLF header reads the same pixels as an LF one.
+pfm "$T/crlf.pfm" '\r\n' $V
+out=$("$A" compare "$T/crlf.pfm" "$T/ref.pfm" --json) || bad "compare CRLF PFM"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] == 0, d' && ok || bad "CRLF PFM differs: $out"
+# EXR channels are paired by name: R,G,B plus a depth channel Z (stored B,G,R,Z), and R,G,B
+# given in another order, both equal the reference.
+$EXR "$T/rgbz.exr" 2 2 Z:float:9 G:float:8,11,2,5 B:half:9,12,3,6 R:float:7,10,1,4 || bad "write rgbz.exr"
+out=$("$A" compare "$T/rgbz.exr" "$T/ref.pfm" --json) || bad "compare R,G,B,Z EXR"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] == 0 and d["channels"] == ["R","G","B"], d' \
+    && ok || bad "R,G,B,Z EXR against the same RGB: $out"
+# One layer's channels (as multi-layer files name them) pair with plain R,G,B.
+$EXR "$T/layer.exr" 2 2 view.A:half:1 view.B:half:9,12,3,6 view.G:float:8,11,2,5 view.R:float:7,10,1,4 || bad "write layer.exr"
+out=$("$A" compare "$T/layer.exr" "$T/ref.pfm" --json) || bad "compare layered EXR"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] == 0 and d["channels"] == ["view.R","view.G","view.B"], d' \
+    && ok || bad "layered EXR against the same RGB: $out"
+# UINT channels are compared by value, not as float bit patterns.
+$EXR "$T/uint.exr" 2 2 R:uint:7,10,1,4 G:uint:8,11,2,5 B:uint:9,12,3,6 || bad "write uint.exr"
+out=$("$A" compare "$T/uint.exr" "$T/ref.pfm" --json) || bad "compare UINT EXR"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] == 0, d' && ok || bad "UINT EXR against the same values: $out"
+# Channels that do not pair by name are an error, not a positional guess.
+$EXR "$T/xyz.exr" 2 2 X:float:1 Y:float:2 Z:float:3 || bad "write xyz.exr"
+"$A" compare "$T/xyz.exr" "$T/ref.pfm" >/dev/null 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] && grep -q "do not pair by name" "$T/err" && ok || bad "X,Y,Z against R,G,B: exit $rc, $(cat "$T/err")"
+
 rm -rf "$T"
 echo "compare: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -49,7 +49,14 @@ int main(void)
     CHECK_OK(atmos_image_compare(NULL, x, y, &d, NULL));
     CHECK_NEAR(d.rmse_all, 1.0, 1e-12);
     CHECK_NEAR(d.bias[0], 1.0, 1e-12);
-    CHECK(d.nonfinite == 24);
+    CHECK(d.nonfinite == 24 && d.nonfinite_image == 24 && d.nonfinite_reference == 0);
+    /* An all-NaN image has no finite sample: its statistics are NaN, not a perfect 0,
+     * and every sample is counted against the image, none against the reference. */
+    for (int i = 0; i < 48; i++) x->pixels[i] = NAN;
+    y->pixels[5] = INFINITY;
+    CHECK_OK(atmos_image_compare(NULL, x, y, &d, NULL));
+    CHECK(isnan(d.rmse_all) && isnan(d.rel_rmse_all) && isnan(d.rmse[0]) && isnan(d.bias[2]));
+    CHECK(d.nonfinite == 48 && d.nonfinite_image == 48 && d.nonfinite_reference == 1);
     atmos_image_destroy(x);
     atmos_image_destroy(y);
     /* size mismatch is an error, not a crash */

@@ -10,8 +10,11 @@
 static void help(void)
 {
     printf("Usage: atmos compare IMAGE REFERENCE [--heatmap OUT.png] [--by KEY.pfm [--edges E0,E1,...]] [--json]\n\n"
-           "Compares two HDR images of the same size (OpenEXR .exr or portable float map .pfm;\n"
-           "the alpha channel of RGBA images is ignored) and prints per channel and overall:\n"
+           "Compares two HDR images of the same size (OpenEXR .exr or portable float map .pfm)\n"
+           "channel by channel, paired by name: R,G,B when both have them, otherwise the same\n"
+           "set of names in both, otherwise the only channel of each (a PFM's are R,G,B or Y;\n"
+           "alpha, A, is never compared; anything else is an error). It prints per channel and\n"
+           "overall:\n"
            "  rmse      root-mean-square difference, in the images' units\n"
            "  rel_rmse  rmse divided by the reference's mean absolute value\n"
            "  bias      mean of IMAGE - REFERENCE\n"
@@ -19,8 +22,11 @@ static void help(void)
            "images read) of the per-pixel relative difference (black, red, yellow, white = the\n"
            "largest). --json prints\n"
            "  {\"rmse\": ..., \"rel_rmse\": ..., \"bias\": [...], \"rmse_per_channel\": [...],\n"
-           "   \"rel_rmse_per_channel\": [...], \"worst_region\": [x, y, w, h], \"worst_rmse\": ...,\n"
-           "   \"nonfinite\": N}   (NaN/Inf samples, skipped: statistics are over the finite ones)\n\n"
+           "   \"rel_rmse_per_channel\": [...], \"channels\": [names], \"worst_region\": [x, y, w, h],\n"
+           "   \"worst_rmse\": ..., \"nonfinite\": N, \"nonfinite_image\": N1, \"nonfinite_reference\": N2}\n"
+           "(numbers without a finite value are null). NaN or infinite samples in either image\n"
+           "fail the comparison: the statistics over the finite ones are printed, then an error\n"
+           "with the counts, and the exit status is 1.\n\n"
            "--by KEY splits the statistics by a per-pixel key image of the same size (channel 0),\n"
            "such as the optical depth written by `atmos render --tau`: pixels with the key in\n"
            "[E_i, E_i+1) form bin i (default edges 0.01,0.1,0.5,1,2,4,8,16,32,64,1e30). Per bin it\n"
@@ -28,11 +34,108 @@ static void help(void)
            "--json adds \"bins\": [{\"lo\", \"hi\", \"pixels\", \"rel_rmse\", \"rel_bias\"}, ...].\n");
 }
 
-static atmos_status read_hdr(atmos_context *ctx, const char *path, atmos_image **out)
+/* An image and its channel names (EXR: from the file; PFM: R,G,B or Y). */
+typedef struct {
+    atmos_image *img;
+    char **owned; /* the EXR reader's names, freed with free() */
+    const char *const *names;
+} named_image;
+
+static atmos_status read_hdr(atmos_context *ctx, const char *path, named_image *out)
 {
+    static const char *const rgb[3] = {"R", "G", "B"}, *const grey[1] = {"Y"};
     size_t n = strlen(path);
-    if (n >= 4 && !strcmp(path + n - 4, ".pfm")) return atmos_read_pfm(ctx, path, out);
-    return atmos_read_exr(ctx, path, out);
+    if (n >= 4 && !strcmp(path + n - 4, ".pfm")) {
+        atmos_status st = atmos_read_pfm(ctx, path, &out->img);
+        if (st == ATMOS_OK) out->names = out->img->channels == 3 ? rgb : grey;
+        return st;
+    }
+    atmos_status st = atmos_read_exr_named(ctx, path, &out->img, &out->owned);
+    out->names = (const char *const *)out->owned;
+    return st;
+}
+
+/* JSON has no NaN or infinity: such numbers are null. */
+static void json_number(double v)
+{
+    if (isfinite(v)) printf("%.9g", v);
+    else printf("null");
+}
+
+static void json_numbers(const double *v, int n)
+{
+    putchar('[');
+    for (int i = 0; i < n; i++) {
+        if (i) printf(", ");
+        json_number(v[i]);
+    }
+    putchar(']');
+}
+
+/* A channel name as a JSON string (EXR names may hold any byte but NUL). */
+static void json_string(const char *s)
+{
+    putchar('"');
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\') printf("\\%c", *p);
+        else if (*p < 0x20 || *p == 0x7f) printf("\\u%04x", *p);
+        else putchar(*p);
+    }
+    putchar('"');
+}
+
+static void print_json(const atmos_image_diff *d, const char *const *names, const atmos_channel_match *m,
+                       const atmos_image_bins *bins)
+{
+    printf("{\"rmse\": ");
+    json_number(d->rmse_all);
+    printf(", \"rel_rmse\": %.9g, \"bias\": ", isfinite(d->rel_rmse_all) ? d->rel_rmse_all : -1.0);
+    json_numbers(d->bias, d->channels);
+    printf(", \"rmse_per_channel\": ");
+    json_numbers(d->rmse, d->channels);
+    printf(", \"rel_rmse_per_channel\": ");
+    json_numbers(d->rel_rmse, d->channels);
+    printf(", \"channels\": [");
+    for (int c = 0; c < m->count; c++) {
+        if (c) printf(", ");
+        json_string(names[m->image[c]]);
+    }
+    printf("], \"worst_region\": [%d, %d, %d, %d], \"worst_rmse\": ", d->worst_x, d->worst_y, d->worst_w, d->worst_h);
+    json_number(d->worst_rmse);
+    printf(", \"nonfinite\": %zu, \"nonfinite_image\": %zu, \"nonfinite_reference\": %zu", d->nonfinite,
+           d->nonfinite_image, d->nonfinite_reference);
+    if (bins) {
+        printf(", \"bins\": [");
+        for (int i = 0; i < bins->bins; i++) {
+            /* Empty bins say null. */
+            printf("%s{\"lo\": %.9g, \"hi\": %.9g, \"pixels\": %zu, ", i ? ", " : "", bins->edges[i], bins->edges[i + 1],
+                   bins->count[i]);
+            if (isfinite(bins->rel_rmse[i])) printf("\"rel_rmse\": %.9g, \"rel_bias\": %.9g}", bins->rel_rmse[i], bins->rel_bias[i]);
+            else printf("\"rel_rmse\": null, \"rel_bias\": null}");
+        }
+        printf("]");
+    }
+    printf("}\n");
+}
+
+static void print_text(const char *const *files, const atmos_image *a, const atmos_image_diff *d,
+                       const char *const *names, const atmos_channel_match *m, const char *heat, const char *by,
+                       const atmos_image_bins *bins)
+{
+    printf("%s vs %s (%dx%d, %d channels)\n", files[0], files[1], a->width, a->height, d->channels);
+    printf("%10s %14s %14s %14s\n", "channel", "rmse", "rel_rmse", "bias");
+    for (int c = 0; c < d->channels; c++)
+        printf("%10s %14.6g %14.6g %14.6g\n", names[m->image[c]], d->rmse[c], d->rel_rmse[c], d->bias[c]);
+    printf("%10s %14.6g %14.6g\n", "all", d->rmse_all, d->rel_rmse_all);
+    printf("worst region: x %d..%d, y %d..%d, rmse %.6g\n", d->worst_x, d->worst_x + d->worst_w - 1, d->worst_y,
+           d->worst_y + d->worst_h - 1, d->worst_rmse);
+    if (heat) printf("heat map: %s (white = %.4g relative difference)\n", heat, d->heat_scale);
+    if (bins) {
+        printf("by %s:\n%12s %12s %10s %12s %12s\n", by, "from", "to", "pixels", "rel_rmse", "rel_bias");
+        for (int i = 0; i < bins->bins; i++)
+            printf("%12.4g %12.4g %10zu %12.5g %12.5g\n", bins->edges[i], bins->edges[i + 1], bins->count[i],
+                   bins->rel_rmse[i], bins->rel_bias[i]);
+    }
 }
 
 int cli_cmd_compare(int argc, char **argv)
@@ -85,59 +188,37 @@ int cli_cmd_compare(int argc, char **argv)
     }
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
-    atmos_image *a = NULL, *b = NULL, *h = NULL, *key = NULL;
+    named_image a = {0}, b = {0}, key = {0};
+    atmos_image *h = NULL;
     atmos_image_diff d;
     atmos_image_bins bins;
+    atmos_channel_match m;
     atmos_status st = read_hdr(ctx, files[0], &a);
     if (st == ATMOS_OK) st = read_hdr(ctx, files[1], &b);
-    if (st == ATMOS_OK) st = atmos_image_compare(ctx, a, b, &d, heat ? &h : NULL);
+    if (st == ATMOS_OK) st = atmos_image_match_channels(ctx, a.names, a.img->channels, b.names, b.img->channels, &m);
+    if (st == ATMOS_OK) st = atmos_image_compare_matched(ctx, a.img, b.img, &m, &d, heat ? &h : NULL);
     if (st == ATMOS_OK && by) st = read_hdr(ctx, by, &key);
-    if (st == ATMOS_OK && by) st = atmos_image_compare_binned(ctx, a, b, key, edges, n_edges, &bins);
+    if (st == ATMOS_OK && by) st = atmos_image_compare_binned_matched(ctx, a.img, b.img, &m, key.img, edges, n_edges, &bins);
     if (st == ATMOS_OK && heat) st = atmos_write_png(ctx, h, heat, 8);
     int rc = CLI_EXIT_OK;
     if (st != ATMOS_OK) {
         rc = cli_runtime_error(C, ctx, st);
-    } else if (json) {
-        printf("{\"rmse\": %.9g, \"rel_rmse\": %.9g, \"bias\": ", d.rmse_all, isfinite(d.rel_rmse_all) ? d.rel_rmse_all : -1.0);
-        cli_print_json_array(d.bias, d.channels);
-        printf(", \"rmse_per_channel\": ");
-        cli_print_json_array(d.rmse, d.channels);
-        printf(", \"rel_rmse_per_channel\": ");
-        cli_print_json_array(d.rel_rmse, d.channels);
-        printf(", \"worst_region\": [%d, %d, %d, %d], \"worst_rmse\": %.9g, \"nonfinite\": %zu", d.worst_x, d.worst_y,
-               d.worst_w, d.worst_h, d.worst_rmse, d.nonfinite);
-        if (by) {
-            printf(", \"bins\": [");
-            for (int i = 0; i < bins.bins; i++) {
-                /* JSON has no NaN: empty bins say null. */
-                printf("%s{\"lo\": %.9g, \"hi\": %.9g, \"pixels\": %zu, ", i ? ", " : "", bins.edges[i], bins.edges[i + 1],
-                       bins.count[i]);
-                if (isfinite(bins.rel_rmse[i])) printf("\"rel_rmse\": %.9g, \"rel_bias\": %.9g}", bins.rel_rmse[i], bins.rel_bias[i]);
-                else printf("\"rel_rmse\": null, \"rel_bias\": null}");
-            }
-            printf("]");
-        }
-        printf("}\n");
     } else {
-        printf("%s vs %s (%dx%d, %d channels)\n", files[0], files[1], a->width, a->height, d.channels);
-        printf("%10s %14s %14s %14s\n", "channel", "rmse", "rel_rmse", "bias");
-        for (int c = 0; c < d.channels; c++) printf("%10d %14.6g %14.6g %14.6g\n", c, d.rmse[c], d.rel_rmse[c], d.bias[c]);
-        printf("%10s %14.6g %14.6g\n", "all", d.rmse_all, d.rel_rmse_all);
-        printf("worst region: x %d..%d, y %d..%d, rmse %.6g\n", d.worst_x, d.worst_x + d.worst_w - 1, d.worst_y,
-               d.worst_y + d.worst_h - 1, d.worst_rmse);
-        if (d.nonfinite) printf("non-finite samples skipped: %zu\n", d.nonfinite);
-        if (heat) printf("heat map: %s (white = %.4g relative difference)\n", heat, d.heat_scale);
-        if (by) {
-            printf("by %s:\n%12s %12s %10s %12s %12s\n", by, "from", "to", "pixels", "rel_rmse", "rel_bias");
-            for (int i = 0; i < bins.bins; i++)
-                printf("%12.4g %12.4g %10zu %12.5g %12.5g\n", bins.edges[i], bins.edges[i + 1], bins.count[i], bins.rel_rmse[i],
-                       bins.rel_bias[i]);
+        if (json) print_json(&d, a.names, &m, by ? &bins : NULL);
+        else print_text(files, a.img, &d, a.names, &m, heat, by, by ? &bins : NULL);
+        /* A comparison is a test: a NaN or infinity in either image fails it, whatever
+         * the statistics over the finite samples say. */
+        if (d.nonfinite) {
+            fprintf(stderr, "atmos %s: %zu compared samples are NaN or infinite (%zu in %s, %zu in %s): the comparison fails\n",
+                    C, d.nonfinite, d.nonfinite_image, files[0], d.nonfinite_reference, files[1]);
+            rc = CLI_EXIT_RUNTIME;
         }
     }
-    atmos_image_destroy(a);
-    atmos_image_destroy(b);
+    atmos_image_destroy(a.img);
+    atmos_image_destroy(b.img);
     atmos_image_destroy(h);
-    atmos_image_destroy(key);
+    atmos_image_destroy(key.img);
+    free(a.owned), free(b.owned), free(key.owned);
     atmos_context_destroy(ctx);
     return rc;
 }
