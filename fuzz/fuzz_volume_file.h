@@ -19,50 +19,50 @@
 typedef atmos_status (*fuzz_volume_loader)(atmos_context *, const char *, const atmos_volume_load_desc *,
                                            atmos_volume **);
 
-static char path[512];
-static const char *target_name;
+static char fuzz_path[512];
+static const char *fuzz_target_name;
 
-static void fail(const char *what, const char *msg)
+static void fuzz_fail(const char *what, const char *msg)
 {
-    fprintf(stderr, "%s: %s (message: %s)\n", target_name, what, msg ? msg : "");
+    fprintf(stderr, "%s: %s (message: %s)\n", fuzz_target_name, what, msg ? msg : "");
     abort();
 }
 
-static void setup(const char *file_name)
+static void fuzz_setup(const char *file_name)
 {
     const char *t = getenv("TMPDIR");
     char dir[256];
     snprintf(dir, sizeof dir, "%s/atmos-fuzz-XXXXXX", t && *t ? t : "/tmp");
-    if (!mkdtemp(dir)) fail("cannot create a temporary directory", dir);
-    snprintf(path, sizeof path, "%s/%s", dir, file_name);
+    if (!mkdtemp(dir)) fuzz_fail("cannot create a temporary directory", dir);
+    snprintf(fuzz_path, sizeof fuzz_path, "%s/%s", dir, file_name);
 }
 
 /* One input through loader, written as file_name; name is the target's, for messages. */
 static int fuzz_volume_file(const uint8_t *data, size_t size, const char *name, const char *file_name,
                             fuzz_volume_loader loader)
 {
-    target_name = name;
-    if (!path[0]) setup(file_name);
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(data, 1, size, f) != size || fclose(f) != 0) fail("cannot write the input", path);
+    fuzz_target_name = name;
+    if (!fuzz_path[0]) fuzz_setup(file_name);
+    FILE *f = fopen(fuzz_path, "wb");
+    if (!f || fwrite(data, 1, size, f) != size || fclose(f) != 0) fuzz_fail("cannot write the input", fuzz_path);
     atmos_context *ctx = NULL;
     if (atmos_context_create(NULL, &ctx) != ATMOS_OK) return 0;
     atmos_volume_load_desc desc = {.max_memory = 64u << 20};
     atmos_volume *vol = NULL;
-    atmos_status st = loader(ctx, path, &desc, &vol);
+    atmos_status st = loader(ctx, fuzz_path, &desc, &vol);
     const char *msg = atmos_context_error(ctx);
     if (st != ATMOS_OK) {
         if (st != ATMOS_E_FORMAT && st != ATMOS_E_UNSUPPORTED && st != ATMOS_E_LIMIT && st != ATMOS_E_NOMEM &&
             st != ATMOS_E_IO)
-            fail("unexpected status", msg);
-        if (!strstr(msg, path)) fail("message does not name the input", msg);
-        if (vol) fail("volume returned on failure", msg);
+            fuzz_fail("unexpected status", msg);
+        if (!strstr(msg, fuzz_path)) fuzz_fail("message does not name the input", msg);
+        if (vol) fuzz_fail("volume returned on failure", msg);
     } else {
-        if (!vol) fail("no volume on success", NULL);
+        if (!vol) fuzz_fail("no volume on success", NULL);
         for (int i = 0; i < atmos_volume_field_count(vol); i++) {
             atmos_volume_field_stats s;
-            if (atmos_volume_field_stats_get(ctx, vol, i, &s) != ATMOS_OK) fail("stats failed", NULL);
-            if (!isfinite(s.min) || !isfinite(s.max) || s.min < 0 || s.max < s.min) fail("bad statistics", NULL);
+            if (atmos_volume_field_stats_get(ctx, vol, i, &s) != ATMOS_OK) fuzz_fail("stats failed", NULL);
+            if (!isfinite(s.min) || !isfinite(s.max) || s.min < 0 || s.max < s.min) fuzz_fail("bad statistics", NULL);
         }
     }
     atmos_volume_destroy(vol);
