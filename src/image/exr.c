@@ -69,6 +69,18 @@ typedef struct {
     const char *const *names; /* img->channels names, in image order */
 } exr_write_job;
 
+/* OpenEXR's default compressor keeps a chunk whose compressed data are exactly as long as
+ * the raw data, and readers take a chunk of the raw size as stored raw: such a chunk is
+ * stored raw here (the raw bytes are what any reader then decodes). */
+static _Thread_local exr_result_t (*tls_compress)(exr_encode_pipeline_t *);
+static exr_result_t compress_unless_raw_sized(exr_encode_pipeline_t *e)
+{
+    const exr_result_t rv = tls_compress(e);
+    if (rv == EXR_ERR_SUCCESS && e->compressed_bytes == e->packed_bytes && e->compressed_buffer != e->packed_buffer)
+        memcpy(e->compressed_buffer, e->packed_buffer, e->packed_bytes);
+    return rv;
+}
+
 static atmos_status encode_image(atmos_context *ctx, const char *path, exr_context_t ex, const exr_write_job *job,
                                  exr_errbuf *eb)
 {
@@ -111,6 +123,10 @@ static atmos_status encode_image(atmos_context *ctx, const char *path, exr_conte
         }
         if (st != ATMOS_OK) break;
         rv = exr_encoding_choose_default_routines(ex, 0, &enc);
+        if (rv == EXR_ERR_SUCCESS && enc.compress_fn) {
+            tls_compress = enc.compress_fn;
+            enc.compress_fn = compress_unless_raw_sized;
+        }
         if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ex, 0, &enc);
         if (rv != EXR_ERR_SUCCESS)
             st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: encoding line %d: %s", path, y, exr_message(eb, rv));

@@ -6,6 +6,8 @@
 #include "test.h"
 
 #include <openexr.h>
+#include <stdint.h>
+#include <string.h>
 
 static int warnings;
 static char last_warning[512];
@@ -128,6 +130,25 @@ static void test_header(atmos_context *ctx, const char *path)
     atmos_image_destroy(img);
 }
 
+/* A chunk whose ZIP data come out exactly as long as the raw data is read back right: a
+ * reader takes a chunk of the raw size as stored raw (a 3x2 one-channel image of these bit
+ * patterns compresses to exactly its 24 bytes). */
+static void test_raw_sized_chunk(atmos_context *ctx, const char *path)
+{
+    static const uint32_t bits[6] = {0, 1, 2, 7, 1000, 16777216};
+    atmos_image *img = NULL, *back = NULL;
+    if (atmos_image_create(ctx, 3, 2, 1, &img) != ATMOS_OK) exit(2);
+    memcpy(img->pixels, bits, sizeof bits);
+    static const char *const names[1] = {"Y"};
+    atmos_exr_desc d = {0, names};
+    CHECK_OK(atmos_write_exr(ctx, img, path, &d));
+    CHECK_OK(atmos_read_exr(ctx, path, &back));
+    int wrong = 0;
+    for (int i = 0; back && i < 6; i++) wrong += memcmp(&back->pixels[i], &bits[i], 4) != 0;
+    CHECK_MSG(back && !wrong, "%d of 6 values of a raw-sized chunk read back wrong", wrong);
+    atmos_image_destroy(img), atmos_image_destroy(back);
+}
+
 int main(void)
 {
     atmos_context *ctx = new_ctx();
@@ -136,6 +157,7 @@ int main(void)
     test_names(ctx, path);
     test_half(ctx, path);
     test_header(ctx, path);
+    test_raw_sized_chunk(ctx, path);
     remove(path);
     atmos_context_destroy(ctx);
     return test_summary("test_exr_write");
