@@ -8,6 +8,7 @@
 #include "atmos/cache.h"
 #include "core/cache.h"
 #include "test.h"
+#include "test_optics.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -170,14 +171,7 @@ int main(void)
     CHECK_OK(atmos_cache_clear(ctx, NULL));
 
     atmos_particle_desc p;
-    memset(&p, 0, sizeof p);
-    snprintf(p.name, sizeof p.name, "test-hg");
-    p.kind = ATMOS_PARTICLE_ANALYTIC;
-    p.analytic.count = 1;
-    p.analytic.kind[0] = ATMOS_PHASE_HG;
-    p.analytic.g[0] = 0.7;
-    p.analytic.weight[0] = 1;
-    p.sigma_ext_m2 = 1e-9;
+    test_hg_particle(&p, "test-hg", 0.7, 0.0);
     atmos_wavelengths wl;
     atmos_wavelengths_spectral(1, &wl);
     atmos_phase_table *t = NULL;

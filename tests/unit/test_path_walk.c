@@ -15,6 +15,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "atmos/atmos.h"
 #include "test.h"
+#include "test_optics.h"
 
 #include <signal.h>
 #include <time.h>
@@ -64,31 +65,12 @@ static atmos_context *make_ctx(int threads, progress_log *prog)
     return ctx;
 }
 
-typedef struct {
-    atmos_phase_table *t;
-    atmos_volume_optics o;
-} optics;
+typedef test_optics optics;
 
 /* One HG particle "hg" of extinction cross-section 1e-9 m^2. */
 static void make_optics(atmos_context *ctx, double g, double albedo, optics *op)
 {
-    atmos_particle_desc p;
-    memset(&p, 0, sizeof p);
-    snprintf(p.name, sizeof p.name, "hg");
-    p.kind = ATMOS_PARTICLE_ANALYTIC;
-    p.analytic.count = 1;
-    p.analytic.kind[0] = ATMOS_PHASE_HG;
-    p.analytic.g[0] = g;
-    p.analytic.weight[0] = 1;
-    p.sigma_ext_m2 = 1e-9;
-    p.albedo = albedo;
-    atmos_wavelengths wl;
-    atmos_wavelengths_rgb(&wl);
-    atmos_phase_table_desc td = {1};
-    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &op->t));
-    memset(&op->o, 0, sizeof op->o);
-    op->o.count = 1;
-    op->o.phase[0] = op->t;
+    test_hg_optics(ctx, "hg", g, albedo, 0, op);
 }
 
 /* A slab of optical thickness tau, H = 100 m thick between y = SLAB_Y and SLAB_Y + H, nxz * H

@@ -6,6 +6,7 @@
  * honoured (and still band, which the test also checks so that it can fail). */
 #include "atmos/atmos.h"
 #include "test.h"
+#include "test_optics.h"
 
 #define NX 256
 #define NY 3
@@ -36,35 +37,12 @@ static atmos_volume *slab(atmos_context *ctx, double density, int nx, int ny)
     return v;
 }
 
-typedef struct {
-    atmos_phase_table *t;
-    atmos_msphase *m;
-    atmos_volume_optics o;
-} optics;
+typedef test_optics optics;
 
 /* Henyey-Greenstein g = 0.7, sigma_ext 1e-9 m^2, albedo 0.95: quick to build. */
 static void make_optics(atmos_context *ctx, optics *op)
 {
-    atmos_particle_desc p;
-    memset(&p, 0, sizeof p);
-    snprintf(p.name, sizeof p.name, "hg07");
-    p.kind = ATMOS_PARTICLE_ANALYTIC;
-    p.analytic.count = 1;
-    p.analytic.kind[0] = ATMOS_PHASE_HG;
-    p.analytic.g[0] = 0.7;
-    p.analytic.weight[0] = 1;
-    p.sigma_ext_m2 = 1e-9;
-    p.albedo = 0.95;
-    atmos_wavelengths wl;
-    atmos_wavelengths_rgb(&wl);
-    atmos_phase_table_desc td = {1};
-    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &op->t));
-    atmos_msphase_desc md = {64, 0, 1};
-    CHECK_OK(atmos_msphase_build(ctx, op->t, &md, &op->m));
-    memset(&op->o, 0, sizeof op->o);
-    op->o.count = 1;
-    op->o.phase[0] = op->t;
-    op->o.ms[0] = op->m;
+    test_hg_optics(ctx, "hg07", 0.7, 0.95, 1, op);
 }
 
 /* slices 0: the renderer's choice. The camera looks down at about 37 degrees from 25 km. */
