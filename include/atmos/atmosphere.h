@@ -18,6 +18,13 @@
  *  - ATMOS_ATMOSPHERE_HOMOGENEOUS: a layer of air of uniform density from the ground (y = 0)
  *    to thickness_m, with Riley's coefficients at sea level and the Rayleigh phase function,
  *    over the same Lambertian ground: every answer in closed form (a test case, and fog).
+ *  - ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL: the Earth's atmosphere over a
+ *    spherical planet (docs/sky.md): air molecules (Rayleigh with the refractive index's
+ *    dispersion and the King factor), aerosols (Mie over a size distribution), ozone
+ *    absorption, a Lambertian ground. The planet's centre is at (0, -planet_radius_m, 0), so
+ *    the ground under the origin is y = 0 and y is the altitude there. DOBASHI is Dobashi et
+ *    al. 2002 §5's look-up tables (single scattering and an ambient term); SPHERICAL is the
+ *    production sky with all orders of scattering.
  *
  * Units: positions in metres (world frame, y up), directions unit vectors, radiance in
  * W m^-2 sr^-1 nm^-1, irradiance in W m^-2 nm^-1, coefficients in m^-1. Every per-wavelength
@@ -34,8 +41,20 @@ extern "C" {
 typedef enum {
     ATMOS_ATMOSPHERE_RILEY = 0,
     ATMOS_ATMOSPHERE_VACUUM = 1,
-    ATMOS_ATMOSPHERE_HOMOGENEOUS = 2
+    ATMOS_ATMOSPHERE_HOMOGENEOUS = 2,
+    ATMOS_ATMOSPHERE_DOBASHI = 3,
+    ATMOS_ATMOSPHERE_SPHERICAL = 4
 } atmos_atmosphere_kind;
+
+/* Aerosol types of the spherical kinds (docs/sky.md gives their size distributions,
+ * refractive indices and sources). */
+typedef enum {
+    ATMOS_AEROSOL_CONTINENTAL = 0,
+    ATMOS_AEROSOL_MARITIME = 1,
+    ATMOS_AEROSOL_URBAN = 2,
+    ATMOS_AEROSOL_DESERT = 3,
+    ATMOS_AEROSOL_NONE = 4
+} atmos_aerosol_type;
 
 /* Atmosphere settings. atmos_atmosphere_defaults() fills the paper's values; in a
  * zero-initialised desc, zero means default for every field except ground_albedo. */
@@ -51,6 +70,18 @@ typedef struct atmos_atmosphere_desc {
     atmos_atmosphere_kind kind; /* default RILEY */
     double background_radiance; /* VACUUM: radiance from every direction, >= 0 */
     double thickness_m;       /* HOMOGENEOUS: height of the layer's top, m; default 8000 */
+    /* DOBASHI and SPHERICAL (ground_albedo, sun_* as above): */
+    double planet_radius_m;   /* default 6360e3 */
+    double top_m;             /* height of the top of the atmosphere, m; default 100e3 (>= 60e3) */
+    double rayleigh_scale_height_m; /* default 7994 (Dobashi et al. 2002 Appendix A.1) */
+    atmos_aerosol_type aerosol;     /* default CONTINENTAL */
+    double aerosol_scale_height_m;  /* default 1200 (Dobashi et al. 2002 Appendix A.1) */
+    double visibility_km;     /* meteorological range at the ground (Koschmieder, 2 % contrast,
+                                 550 nm): sets the aerosol amount; default 40 */
+    double turbidity;         /* if > 0, replaces visibility_km: Linke's turbidity at 550 nm,
+                                 (tau_air + tau_aerosol) / tau_air over the vertical */
+    double ozone_du;          /* ozone column in Dobson units; default 300 */
+    int no_ozone;             /* nonzero: no ozone (ozone_du ignored) */
 } atmos_atmosphere_desc;
 
 ATMOS_API void atmos_atmosphere_defaults(atmos_atmosphere_desc *desc);

@@ -3,6 +3,7 @@
  * tagged set: a switch is cheaper than a call through a pointer in the renderers' inner
  * loops and keeps every kind's answers side by side. */
 #include "atmosphere/atmosphere_internal.h"
+#include "atmosphere/planet_solver.h"
 
 #include <math.h>
 #include <string.h>
@@ -13,6 +14,10 @@ static double altitude(const double p[3]) { return p[1] > 0 ? p[1] : 0.0; }
 void atmos__atm_transmittance_sub(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
                                   int m, const int *k, double *out)
 {
+    if (a->solver) {
+        a->solver->transmittance(a, p, d, dist, m, k, out);
+        return;
+    }
     switch (a->desc.kind) {
     case ATMOS_ATMOSPHERE_RILEY: atmos__riley_transmittance(a, altitude(p), d, dist, m, k, out); return;
     case ATMOS_ATMOSPHERE_HOMOGENEOUS: atmos__homog_transmittance(a, altitude(p), d, dist, m, k, out); return;
@@ -24,6 +29,10 @@ void atmos__atm_transmittance_sub(const atmos_atmosphere *a, const double p[3], 
 void atmos__atm_sunlight_sub(const atmos_atmosphere *a, const double p[3], const double sun[3], int m, const int *k,
                              double *out)
 {
+    if (a->solver) {
+        a->solver->sunlight(a, p, sun, m, k, out);
+        return;
+    }
     switch (a->desc.kind) {
     case ATMOS_ATMOSPHERE_RILEY: atmos__riley_sunlight(a, altitude(p), sun, m, k, out); return;
     case ATMOS_ATMOSPHERE_HOMOGENEOUS: atmos__homog_sunlight(a, altitude(p), sun, m, k, out); return;
@@ -35,6 +44,7 @@ void atmos__atm_sunlight_sub(const atmos_atmosphere *a, const double p[3], const
 int atmos__atm_inscatter_sub(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
                              const double sun[3], int m, const int *k, double *out)
 {
+    if (a->solver) return a->solver->inscatter(a, p, d, dist, sun, m, k, out);
     switch (a->desc.kind) {
     case ATMOS_ATMOSPHERE_RILEY: return atmos__riley_inscatter(a, altitude(p), d, dist, sun, m, k, out);
     case ATMOS_ATMOSPHERE_HOMOGENEOUS: return atmos__homog_inscatter(a, altitude(p), d, dist, sun, m, k, out);
@@ -47,6 +57,7 @@ int atmos__atm_inscatter_sub(const atmos_atmosphere *a, const double p[3], const
 int atmos__atm_scatter_point(const atmos_atmosphere *a, const double p[3], const double d[3], double dist, int m,
                              const int *k, const double *w, atmos__stream *rng, double *t, double *ratio)
 {
+    if (a->solver) return 0; /* the spherical kinds: no shadow estimate in the air yet */
     switch (a->desc.kind) {
     case ATMOS_ATMOSPHERE_RILEY: return atmos__riley_scatter_point(a, altitude(p), d, dist, m, k, w, rng, t, ratio);
     case ATMOS_ATMOSPHERE_HOMOGENEOUS:
@@ -82,6 +93,19 @@ void atmos_atmosphere_sun_radiance(const atmos_atmosphere *atm, const double p[3
 void atmos_atmosphere_scattering(const atmos_atmosphere *atm, const double p[3], double *scattering,
                                  double *extinction)
 {
+    if (atm->planet) {
+        const atmos__planet *pl = atm->planet;
+        const double h = atmos__planet_altitude(pl, p);
+        for (int i = 0; i < atm->wl.count; i++) {
+            const int on = h <= pl->r_top - pl->r_ground;
+            const double s = on ? pl->rayleigh[i] * atmos__planet_rho_rayleigh(pl, h) +
+                                      pl->mie_sca[i] * atmos__planet_rho_mie(pl, h)
+                                : 0.0;
+            if (scattering) scattering[i] = s;
+            if (extinction) extinction[i] = atmos__planet_extinction(pl, h, i);
+        }
+        return;
+    }
     const double y = altitude(p);
     double f = 0.0;
     if (atm->desc.kind == ATMOS_ATMOSPHERE_RILEY) f = exp(-atm->gamma * y);
@@ -92,16 +116,42 @@ void atmos_atmosphere_scattering(const atmos_atmosphere *atm, const double p[3],
     }
 }
 
+/* A spherical kind's mixture is a function of the wavelength; this answer is its first's. */
 double atmos_atmosphere_phase(const atmos_atmosphere *atm, const double p[3], double cos_theta)
 {
-    (void)atm, (void)p;
+    if (atm->planet) return atmos__planet_phase(atm->planet, atmos__planet_altitude(atm->planet, p), 0, cos_theta);
     return atmos_phase_rayleigh(cos_theta);
+}
+
+/* A spherical kind's view ray: its solver's radiance and the sun's disk where the planet
+ * does not hide it. */
+static void planet_radiance(const atmos_atmosphere *atm, const double p[3], const double dir[3],
+                            const double sun_dir[3], int disk, double *out, atmos_atmosphere_hit *info)
+{
+    atmos_atmosphere_hit h;
+    if (atm->solver->radiance) atm->solver->radiance(atm, p, dir, sun_dir, out, &h);
+    else atmos__planet_radiance_generic(atm, p, dir, sun_dir, out, &h);
+    h.in_sun_disk = 0;
+    if (disk && !h.hits_ground && !atm->desc.hide_sun_disk) {
+        const double mu = dir[0] * sun_dir[0] + dir[1] * sun_dir[1] + dir[2] * sun_dir[2];
+        if (mu >= atm->cos_sun_radius) {
+            double sun[ATMOS_MAX_WAVELENGTHS];
+            h.in_sun_disk = 1;
+            atmos_atmosphere_sun_radiance(atm, p, sun_dir, sun);
+            for (int i = 0; i < atm->wl.count; i++) out[i] += sun[i];
+        }
+    }
+    if (info) *info = h;
 }
 
 /* What a view ray sees; the sun's disk only with disk. */
 static void radiance(const atmos_atmosphere *atm, const double p[3], const double dir[3], const double sun_dir[3],
                      int disk, double *out, atmos_atmosphere_hit *info)
 {
+    if (atm->solver) {
+        planet_radiance(atm, p, dir, sun_dir, disk, out, info);
+        return;
+    }
     const int n = atm->wl.count;
     const double K = atmos_atmosphere_ground_distance(atm, p, dir);
     const int ground = !isinf(K);
@@ -152,6 +202,13 @@ void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const
     memcpy(b->sun, sun, sizeof b->sun);
     b->background = (float)atmos__atm_background(a);
     if (a->desc.kind == ATMOS_ATMOSPHERE_RILEY) atmos__sky_batch_init(&b->riley, a, eye[1], sun);
+    if (a->solver && a->solver->batch_init) a->solver->batch_init(b);
+}
+
+void atmos__atm_batch_release(atmos__atm_batch *b)
+{
+    if (b->atm && b->atm->solver && b->atm->solver->batch_release) b->atm->solver->batch_release(b);
+    b->state = NULL;
 }
 
 /* Any kind: the double-precision radiance of each ray without the sun's disk. */
@@ -184,6 +241,9 @@ void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx
             for (int i = 0; i < count; i++) out[(size_t)k * count + i] += weight[i] * b->background;
         return;
     }
-    default: batch_generic(b, count, dx, dy, dz, weight, out);
+    default:
+        if (b->atm->solver && b->atm->solver->batch_eval)
+            b->atm->solver->batch_eval(b, count, dx, dy, dz, weight, out, scratch);
+        else batch_generic(b, count, dx, dy, dz, weight, out);
     }
 }

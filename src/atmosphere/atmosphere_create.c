@@ -2,6 +2,7 @@
  * kind shares (the wavelengths' coefficients, the sun, the flat ground). The questions are
  * asked in atmosphere_ask.c. */
 #include "atmosphere/atmosphere_internal.h"
+#include "atmosphere/planet_solver.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -21,6 +22,18 @@ void atmos_atmosphere_defaults(atmos_atmosphere_desc *d)
     d->sun_scale = 1.0;
     d->kind = ATMOS_ATMOSPHERE_RILEY;
     d->thickness_m = 8000.0;
+    d->planet_radius_m = 6360e3;
+    d->top_m = 100e3;
+    d->rayleigh_scale_height_m = 7994.0;
+    d->aerosol = ATMOS_AEROSOL_CONTINENTAL;
+    d->aerosol_scale_height_m = 1200.0;
+    d->visibility_km = 40.0;
+    d->ozone_du = 300.0;
+}
+
+static int planet_kind(atmos_atmosphere_kind k)
+{
+    return k == ATMOS_ATMOSPHERE_DOBASHI || k == ATMOS_ATMOSPHERE_SPHERICAL;
 }
 
 /* Zero means default for every field except ground_albedo (and the vacuum's radiance). */
@@ -34,11 +47,47 @@ static void resolve(const atmos_atmosphere_desc *in, atmos_atmosphere_desc *d)
     if (d->sun_diameter_deg == 0) d->sun_diameter_deg = 0.5;
     if (d->sun_scale == 0) d->sun_scale = 1.0;
     if (d->thickness_m == 0) d->thickness_m = 8000.0;
+    if (d->planet_radius_m == 0) d->planet_radius_m = 6360e3;
+    if (d->top_m == 0) d->top_m = 100e3;
+    if (d->rayleigh_scale_height_m == 0) d->rayleigh_scale_height_m = 7994.0;
+    if (d->aerosol_scale_height_m == 0) d->aerosol_scale_height_m = 1200.0;
+    if (d->visibility_km == 0) d->visibility_km = 40.0;
+    if (d->ozone_du == 0) d->ozone_du = 300.0;
+}
+
+/* The spherical kinds' settings. */
+static atmos_status check_planet(atmos_context *ctx, const atmos_atmosphere_desc *d)
+{
+    if (!(d->planet_radius_m >= 1e3 && d->planet_radius_m <= 1e8))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/planet_radius_m: must be in [1e3, 1e8], got %g",
+                            d->planet_radius_m);
+    if (!(d->top_m >= 60e3 && d->top_m <= 1e6))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/top_m: must be in [60e3, 1e6], got %g", d->top_m);
+    if (!(d->rayleigh_scale_height_m >= 100 && d->rayleigh_scale_height_m <= 100000))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "atmosphere/rayleigh_scale_height_m: must be in [100, 100000], got %g",
+                            d->rayleigh_scale_height_m);
+    if (!(d->aerosol_scale_height_m >= 100 && d->aerosol_scale_height_m <= 100000))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "atmosphere/aerosol_scale_height_m: must be in [100, 100000], got %g",
+                            d->aerosol_scale_height_m);
+    if ((int)d->aerosol < 0 || d->aerosol > ATMOS_AEROSOL_NONE)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/aerosol: unknown type %d", (int)d->aerosol);
+    if (!(d->visibility_km >= 0.5 && d->visibility_km <= 1000))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/visibility_km: must be in [0.5, 1000], got %g",
+                            d->visibility_km);
+    if (!(d->turbidity == 0 || (d->turbidity >= 1 && d->turbidity <= 50)))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/turbidity: must be 0 (unset) or in [1, 50], got %g",
+                            d->turbidity);
+    if (!(d->ozone_du >= 0 && d->ozone_du <= 1000))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/ozone_du: must be in [0, 1000], got %g", d->ozone_du);
+    return ATMOS_OK;
 }
 
 static atmos_status check(atmos_context *ctx, const atmos_atmosphere_desc *d, const atmos_wavelengths *wl)
 {
-    if (d->kind != ATMOS_ATMOSPHERE_RILEY && d->kind != ATMOS_ATMOSPHERE_VACUUM && d->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS)
+    if (d->kind != ATMOS_ATMOSPHERE_RILEY && d->kind != ATMOS_ATMOSPHERE_VACUUM &&
+        d->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS && !planet_kind(d->kind))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/kind: unknown kind %d", (int)d->kind);
     if (!(d->beta_sl_550 > 0 && d->beta_sl_550 <= 0.01))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/beta_sl_550_per_m: must be in (0, 0.01], got %g",
@@ -63,7 +112,18 @@ static atmos_status check(atmos_context *ctx, const atmos_atmosphere_desc *d, co
     if (wl->count < 1 || wl->count > ATMOS_MAX_WAVELENGTHS)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere: wavelength set has %d samples (allowed 1..%d)",
                             wl->count, ATMOS_MAX_WAVELENGTHS);
-    return ATMOS_OK;
+    return planet_kind(d->kind) ? check_planet(ctx, d) : ATMOS_OK;
+}
+
+/* The planet and its solver's tables for the spherical kinds. */
+static atmos_status create_planet(atmos_context *ctx, atmos_atmosphere *a)
+{
+    a->planet = calloc(1, sizeof *a->planet);
+    if (!a->planet) return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory");
+    atmos_status st = atmos__planet_init(ctx, a->planet, &a->desc, &a->wl);
+    if (st != ATMOS_OK) return st;
+    a->solver = a->desc.kind == ATMOS_ATMOSPHERE_DOBASHI ? &atmos__dobashi_solver : &atmos__spherical_solver;
+    return a->solver->create ? a->solver->create(ctx, a) : ATMOS_OK;
 }
 
 atmos_status atmos_atmosphere_create(atmos_context *ctx, const atmos_atmosphere_desc *desc,
@@ -98,11 +158,21 @@ atmos_status atmos_atmosphere_create(atmos_context *ctx, const atmos_atmosphere_
      * solid angle without the cancellation. The first form is kept for r >= 1e-3 rad,
      * where it is exact to ~1e-10, so that the images of such suns stay as they were. */
     a->sun_solid_angle = r < 1e-3 ? 4.0 * ATMOS_PI * sin(0.5 * r) * sin(0.5 * r) : 2.0 * ATMOS_PI * (1.0 - cos(r));
+    if (planet_kind(d.kind) && (st = create_planet(ctx, a)) != ATMOS_OK) {
+        atmos_atmosphere_destroy(a);
+        return st;
+    }
     *out = a;
     return ATMOS_OK;
 }
 
-void atmos_atmosphere_destroy(atmos_atmosphere *atm) { free(atm); }
+void atmos_atmosphere_destroy(atmos_atmosphere *atm)
+{
+    if (!atm) return;
+    if (atm->solver && atm->solver->destroy && atm->model) atm->solver->destroy(atm->model);
+    free(atm->planet);
+    free(atm);
+}
 atmos_atmosphere_kind atmos_atmosphere_get_kind(const atmos_atmosphere *atm) { return atm->desc.kind; }
 const atmos_wavelengths *atmos_atmosphere_wavelengths(const atmos_atmosphere *atm) { return &atm->wl; }
 const atmos_atmosphere_desc *atmos_atmosphere_get_desc(const atmos_atmosphere *atm) { return &atm->desc; }
@@ -124,6 +194,7 @@ double atmos_atmosphere_ground_albedo(const atmos_atmosphere *atm)
 double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const double p[3], const double dir[3])
 {
     if (atm->desc.kind == ATMOS_ATMOSPHERE_VACUUM) return INFINITY;
+    if (atm->planet) return atmos__planet_ground_distance(atm->planet, p, dir);
     const double y = p[1];
     if (y <= 0) return dir[1] < 0 ? 0.0 : (y < 0 ? 0.0 : INFINITY);
     if (dir[1] >= 0) return INFINITY;
@@ -132,12 +203,17 @@ double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const doubl
 
 void atmos__atm_ground_hit(const atmos_atmosphere *a, double p[3], double n[3])
 {
-    (void)a; /* every kind here has the flat ground y = 0 */
-    p[1] = 0;
+    if (a->planet) {
+        atmos__planet_ground_point(a->planet, p, n);
+        return;
+    }
+    p[1] = 0; /* the flat ground y = 0 */
     n[0] = 0, n[1] = 1, n[2] = 0;
 }
 
 int atmos_atmosphere_sun_disk_visible(const atmos_atmosphere *atm, const double sun_dir[3])
 {
+    /* a spherical kind's disk is hidden ray by ray where the planet is in the way */
+    if (atm->planet) return !atm->desc.hide_sun_disk;
     return atm->desc.kind != ATMOS_ATMOSPHERE_VACUUM && !atm->desc.hide_sun_disk && sun_dir[1] > 0;
 }

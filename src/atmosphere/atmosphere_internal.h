@@ -17,6 +17,10 @@ struct atmos_atmosphere {
     double cos_sun_radius;
     double sun_solid_angle;
     double gamma;                            /* RILEY: 1 / scale height, m^-1 */
+    /* DOBASHI, SPHERICAL (NULL otherwise): the planet, its solver and the solver's tables */
+    struct atmos__planet *planet;
+    const struct atmos__planet_solver *solver;
+    void *model;
 };
 
 /* Wavelength i of a subset: k[i], or i itself when k is NULL (the whole set). */

@@ -51,9 +51,12 @@ typedef struct atmos__atm_batch {
     double eye[3], sun[3];
     float background;
     atmos__sky_batch riley;
+    void *state;           /* a spherical kind's per-eye tables (its solver's batch_init) */
 } atmos__atm_batch;
 #define ATMOS__ATM_BATCH_SCRATCH ATMOS__SKY_BATCH_SCRATCH
 void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3]);
+/* Frees what atmos__atm_batch_init allocated (a spherical kind's per-eye tables). */
+void atmos__atm_batch_release(atmos__atm_batch *b);
 void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);
 

@@ -273,6 +273,7 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
         free(mem);
     }
     free(col_sc);
+    atmos__atm_batch_release(&batch);
     if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for row buffers");
     if (cancelled) return atmos__error(ctx, ATMOS_E_CANCELLED, "render: cancelled");
     atmos__progress(ctx, "render sky", 1.0);

@@ -461,34 +461,50 @@ static atmos_status parse_sun(const jp *p, const cJSON *j, const char *path, atm
     return ATMOS_OK;
 }
 
+/* "model" (or its older name "kind") picks the atmosphere's kind; the spherical models'
+ * settings are read for any model and used by those. */
 static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
     static const char *const keys[] = {"beta_sl_550_per_m", "scale_height_m", "ground_albedo", "sun_diameter_deg",
-                                       "sun_scale", "thickness_m", "sun_disk", "kind"};
-    static const char *const kinds[] = {"riley", "homogeneous"};
-    static const atmos_atmosphere_kind kind_of[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS};
+                                       "sun_scale", "thickness_m", "planet_radius_m", "top_m",
+                                       "rayleigh_scale_height_m", "aerosol_scale_height_m", "visibility_km",
+                                       "turbidity", "ozone_du", "sun_disk", "ozone", "kind", "model", "aerosol"};
+    enum { NUM = 13, K_DISK = 13, K_OZONE, K_KIND, K_MODEL, K_AEROSOL, NKEYS };
+    static const char *const kinds[] = {"riley", "homogeneous", "dobashi", "spherical"};
+    static const atmos_atmosphere_kind kind_of[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS,
+                                                    ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL};
+    static const char *const aerosols[] = {"continental", "maritime", "urban", "desert", "none"};
     atmos_atmosphere_desc *a = &s->atmosphere;
-    double *fields[] = {&a->beta_sl_550, &a->scale_height_m, &a->ground_albedo, &a->sun_diameter_deg,
-                        &a->sun_scale, &a->thickness_m};
-    const atmos__range *ranges[] = {&atmos__r_beta, &atmos__r_scale_height, &atmos__r_albedo,
-                                    &atmos__r_sun_diameter, &atmos__r_sun_scale, &atmos__r_thickness};
+    double *fields[NUM] = {&a->beta_sl_550, &a->scale_height_m, &a->ground_albedo, &a->sun_diameter_deg,
+                           &a->sun_scale, &a->thickness_m, &a->planet_radius_m, &a->top_m,
+                           &a->rayleigh_scale_height_m, &a->aerosol_scale_height_m, &a->visibility_km,
+                           &a->turbidity, &a->ozone_du};
+    const atmos__range *ranges[NUM] = {&atmos__r_beta, &atmos__r_scale_height, &atmos__r_albedo,
+                                       &atmos__r_sun_diameter, &atmos__r_sun_scale, &atmos__r_thickness,
+                                       &atmos__r_planet_radius, &atmos__r_top, &atmos__r_scale_height,
+                                       &atmos__r_scale_height, &atmos__r_visibility, &atmos__r_turbidity,
+                                       &atmos__r_ozone};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
-    int k, disk = 1, kind = 0;
-    TRY(iter_begin(p, j, path, keys, 8, &it));
+    int k, flag = 1, e = 0;
+    TRY(iter_begin(p, j, path, keys, NKEYS, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
-        if (k < 6) {
+        if (k < NUM) {
             TRY(get_number(p, v, ip, ranges[k], NULL, fields[k]));
-        } else if (k == 6) {
-            TRY(get_bool(p, v, ip, &disk));
-            a->hide_sun_disk = !disk;
+        } else if (k == K_DISK || k == K_OZONE) {
+            TRY(get_bool(p, v, ip, &flag));
+            if (k == K_DISK) a->hide_sun_disk = !flag;
+            else a->no_ozone = !flag;
+        } else if (k == K_AEROSOL) {
+            TRY(get_enum(p, v, ip, aerosols, 5, &e));
+            a->aerosol = (atmos_aerosol_type)e;
         } else {
-            TRY(get_enum(p, v, ip, kinds, 2, &kind));
+            TRY(get_enum(p, v, ip, kinds, 4, &e));
             /* a vacuum set by "background" stays one */
-            if (a->kind != ATMOS_ATMOSPHERE_VACUUM) a->kind = kind_of[kind];
+            if (a->kind != ATMOS_ATMOSPHERE_VACUUM) a->kind = kind_of[e];
         }
     }
 }

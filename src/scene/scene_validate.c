@@ -13,7 +13,7 @@
 /* The ranges of docs/scene-format.md. */
 const atmos__range atmos__r_dim = {1, ATMOS_SCENE_MAX_DIM, 0, 0};
 const atmos__range atmos__r_spp = {1, 256, 0, 0};
-const atmos__range atmos__r_altitude = {0, 1e6, 0, 0};
+const atmos__range atmos__r_altitude = {0, 1e8, 0, 0};
 const atmos__range atmos__r_pos = {-ATMOS__SCENE_MAX_POS, ATMOS__SCENE_MAX_POS, 0, 0};
 const atmos__range atmos__r_look = {-ATMOS__SCENE_MAX_LOOK, ATMOS__SCENE_MAX_LOOK, 0, 0};
 const atmos__range atmos__r_fov_pinhole = {0, 180, 1, 1};
@@ -32,6 +32,11 @@ const atmos__range atmos__r_radiance = {0, 1e6, 0, 0};
 const atmos__range atmos__r_samples = {1, ATMOS_MAX_WAVELENGTHS, 0, 0};
 const atmos__range atmos__r_manual_ev = {-20, 40, 0, 0};
 const atmos__range atmos__r_compensation = {-20, 20, 0, 0};
+const atmos__range atmos__r_planet_radius = {1e3, 1e8, 0, 0};
+const atmos__range atmos__r_top = {60e3, 1e6, 0, 0};
+const atmos__range atmos__r_visibility = {0.5, 1000, 0, 0};
+const atmos__range atmos__r_turbidity = {1, 50, 0, 0};
+const atmos__range atmos__r_ozone = {0, 1000, 0, 0};
 
 /* Sines below this count as parallel: the camera basis would be numerically
  * meaningless (about 0.2 arc seconds). */
@@ -274,10 +279,26 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
         {"/atmosphere/sun_scale", offsetof(atmos_atmosphere_desc, sun_scale), &atmos__r_sun_scale},
         {"/atmosphere/thickness_m", offsetof(atmos_atmosphere_desc, thickness_m), &atmos__r_thickness},
         {"/background/radiance", offsetof(atmos_atmosphere_desc, background_radiance), &atmos__r_radiance},
+        {"/atmosphere/planet_radius_m", offsetof(atmos_atmosphere_desc, planet_radius_m), &atmos__r_planet_radius},
+        {"/atmosphere/top_m", offsetof(atmos_atmosphere_desc, top_m), &atmos__r_top},
+        {"/atmosphere/rayleigh_scale_height_m", offsetof(atmos_atmosphere_desc, rayleigh_scale_height_m),
+         &atmos__r_scale_height},
+        {"/atmosphere/aerosol_scale_height_m", offsetof(atmos_atmosphere_desc, aerosol_scale_height_m),
+         &atmos__r_scale_height},
+        {"/atmosphere/visibility_km", offsetof(atmos_atmosphere_desc, visibility_km), &atmos__r_visibility},
+        {"/atmosphere/ozone_du", offsetof(atmos_atmosphere_desc, ozone_du), &atmos__r_ozone},
     };
-    if (a->kind != ATMOS_ATMOSPHERE_RILEY && a->kind != ATMOS_ATMOSPHERE_VACUUM && a->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS)
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/atmosphere/kind",
-                                 "must be riley, homogeneous or (through \"background\") a vacuum, got %d", (int)a->kind);
+    if (a->kind != ATMOS_ATMOSPHERE_RILEY && a->kind != ATMOS_ATMOSPHERE_VACUUM && a->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS &&
+        a->kind != ATMOS_ATMOSPHERE_DOBASHI && a->kind != ATMOS_ATMOSPHERE_SPHERICAL)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/atmosphere/model",
+                                 "must be riley, dobashi, spherical, homogeneous or (through \"background\") a vacuum, "
+                                 "got %d",
+                                 (int)a->kind);
+    if (a->turbidity != 0) {
+        atmos_status st = atmos__scene_check_range(ctx, source, "/atmosphere/turbidity", a->turbidity,
+                                                   &atmos__r_turbidity, NULL);
+        if (st) return st;
+    }
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) {
         double v;
         memcpy(&v, (const char *)a + fields[i].offset, sizeof v);

@@ -22,8 +22,10 @@ static void help(void)
            "  --distance K         path length, metres > 0 (default: to the ground or to space)\n"
            "  --spectral N         N spectral samples in 380-780 nm (default: rgb = 680, 550, 440 nm)\n"
            "  --albedo R           ground albedo [0, 1] (default 0.1; used when the view hits the ground)\n"
-           "  --atmosphere KIND    riley (the exponential atmosphere, default) or homogeneous (a uniform\n"
-           "                       layer from the ground to --thickness; docs/models.md)\n"
+           "  --model NAME         riley (the flat exponential atmosphere, default), homogeneous (a uniform\n"
+           "                       layer from the ground to --thickness; docs/models.md), dobashi or\n"
+           "                       spherical (the Earth's atmosphere over a spherical planet; docs/sky.md)\n"
+           "  --atmosphere NAME    the same as --model\n"
            "  --thickness M        the homogeneous layer's top, metres (default 8000)\n"
            "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
            "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n\n"
@@ -42,6 +44,7 @@ int cli_cmd_sky(int argc, char **argv)
         {"spectral", required_argument, 0, 'n'},      {"albedo", required_argument, 0, 'r'},
         {"json", no_argument, 0, 'j'},                {"help", no_argument, 0, 'H'},
         {"atmosphere", required_argument, 0, 'k'},    {"thickness", required_argument, 0, 't'},
+        {"model", required_argument, 0, 'k'},
         {0, 0, 0, 0}};
     double sun_el = NAN, sun_az = 180, view_el = NAN, view_az = NAN, alt = 0, dist = INFINITY, albedo = -1, top = 0;
     atmos_atmosphere_kind kind = ATMOS_ATMOSPHERE_RILEY;
@@ -63,7 +66,11 @@ int cli_cmd_sky(int argc, char **argv)
         case 'k':
             if (!strcmp(optarg, "riley")) kind = ATMOS_ATMOSPHERE_RILEY;
             else if (!strcmp(optarg, "homogeneous")) kind = ATMOS_ATMOSPHERE_HOMOGENEOUS;
-            else return cli_usage_error(C, "--atmosphere: expected riley or homogeneous, got '%s'", optarg);
+            else if (!strcmp(optarg, "dobashi")) kind = ATMOS_ATMOSPHERE_DOBASHI;
+            else if (!strcmp(optarg, "spherical")) kind = ATMOS_ATMOSPHERE_SPHERICAL;
+            else
+                return cli_usage_error(C, "--model: expected riley, homogeneous, dobashi or spherical, got '%s'",
+                                       optarg);
             break;
         case 't':
             if (!cli_parse_double(C, "--thickness", optarg, &top) || !(top >= 1 && top <= 1e6))
@@ -115,6 +122,12 @@ int cli_cmd_sky(int argc, char **argv)
     atmos_atmosphere_sunlight(sky, ground0, sun, lit);
     for (int i = 0; i < n; i++)
         ground[i] = hits_ground && sun[1] > 0 ? ad.ground_albedo / 3.14159265358979323846 * sun[1] * lit[i] * tr[i] : 0.0;
+    if (kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL) {
+        /* a round ground: what the view ray sees there beyond the air's own light */
+        double all[ATMOS_MAX_WAVELENGTHS];
+        atmos_atmosphere_radiance(sky, eye, dir, sun, all, NULL);
+        for (int i = 0; i < n; i++) ground[i] = hits_ground ? fmax(all[i] - ins[i], 0.0) : 0.0;
+    }
     if (json) {
         printf("{\"wavelengths_nm\": ");
         cli_print_json_array(wl.nm, n);

@@ -1,0 +1,110 @@
+/* The Earth's atmosphere over a spherical planet: one description (densities, coefficients,
+ * phase functions, geometry) shared by its solvers (Dobashi's tables, the production sky,
+ * the Monte Carlo reference). Internal to src/atmosphere/.
+ *
+ * Frame: the planet's centre is at (0, -r_ground, 0); y is the altitude above the point of
+ * the ground under the origin. Altitudes and distances in metres, coefficients in m^-1,
+ * per-wavelength arrays indexed like the atmosphere's wavelength set. */
+#ifndef ATMOS_PLANET_H
+#define ATMOS_PLANET_H
+
+#include "core/internal.h"
+#include "core/rng.h"
+
+#include <math.h>
+
+/* Cosine grid of the tabulated aerosol phase function: uniform in the scattering angle. */
+#define ATMOS__PLANET_PHASE_N 721
+
+typedef struct atmos__planet {
+    double r_ground, r_top;               /* radii of the ground and the top of the air */
+    int n;                                /* wavelengths */
+    double rayleigh[ATMOS_MAX_WAVELENGTHS]; /* air molecules' scattering at the ground */
+    double h_rayleigh;                    /* their scale height */
+    double mie_sca[ATMOS_MAX_WAVELENGTHS];  /* aerosols' scattering at the ground */
+    double mie_ext[ATMOS_MAX_WAVELENGTHS];  /* aerosols' extinction at the ground */
+    double h_mie;
+    double ozone[ATMOS_MAX_WAVELENGTHS];  /* ozone absorption at the peak of its profile */
+    double ozone_centre, ozone_half_width; /* tent profile: 1 at centre, 0 beyond +- half width */
+    double albedo;                        /* the ground's Lambertian reflectance */
+    /* the aerosols' phase function per wavelength, sr^-1, at scattering angles
+     * theta_j = j * 180 / (N - 1) degrees, and its cumulative distribution over theta for
+     * sampling (cdf[k][0] = 0, cdf[k][N-1] = 1) */
+    float mie_phase[ATMOS_MAX_WAVELENGTHS][ATMOS__PLANET_PHASE_N];
+    float mie_cdf[ATMOS_MAX_WAVELENGTHS][ATMOS__PLANET_PHASE_N];
+    double mie_g[ATMOS_MAX_WAVELENGTHS];  /* asymmetry parameter */
+} atmos__planet;
+
+/* Fills the description from a resolved atmosphere desc (planet.c, planet_optics.c). */
+atmos_status atmos__planet_init(atmos_context *ctx, atmos__planet *pl, const atmos_atmosphere_desc *d,
+                                const atmos_wavelengths *wl);
+
+/* ------------------------------------------------------------------ profiles */
+static inline double atmos__planet_rho_rayleigh(const atmos__planet *pl, double h)
+{
+    return exp(-(h > 0 ? h : 0) / pl->h_rayleigh);
+}
+static inline double atmos__planet_rho_mie(const atmos__planet *pl, double h)
+{
+    return exp(-(h > 0 ? h : 0) / pl->h_mie);
+}
+static inline double atmos__planet_rho_ozone(const atmos__planet *pl, double h)
+{
+    const double x = 1.0 - fabs(h - pl->ozone_centre) / pl->ozone_half_width;
+    return x > 0 ? x : 0.0;
+}
+/* Extinction at altitude h for wavelength k (above the top: 0). */
+static inline double atmos__planet_extinction(const atmos__planet *pl, double h, int k)
+{
+    if (h > pl->r_top - pl->r_ground) return 0.0;
+    return pl->rayleigh[k] * atmos__planet_rho_rayleigh(pl, h) + pl->mie_ext[k] * atmos__planet_rho_mie(pl, h) +
+           pl->ozone[k] * atmos__planet_rho_ozone(pl, h);
+}
+
+/* ------------------------------------------------------------------ phase functions */
+/* The aerosols' phase function (sr^-1) at cos_theta for wavelength k, interpolated. */
+double atmos__planet_mie_phase(const atmos__planet *pl, int k, double cos_theta);
+/* A cos_theta drawn from it with the uniform number u. */
+double atmos__planet_mie_sample(const atmos__planet *pl, int k, double u);
+/* The mixture at altitude h: (rayleigh_sca * P_R + mie_sca * P_M) / (rayleigh_sca + mie_sca). */
+double atmos__planet_phase(const atmos__planet *pl, double h, int k, double cos_theta);
+
+/* ------------------------------------------------------------------ geometry */
+/* Distance from the centre, altitude, and the cosine of the zenith angle of d at p. */
+double atmos__planet_radius(const atmos__planet *pl, const double p[3]);
+double atmos__planet_altitude(const atmos__planet *pl, const double p[3]);
+double atmos__planet_mu(const atmos__planet *pl, const double p[3], const double d[3]);
+/* The nearest t >= 0 where p + t d meets the sphere of radius r about the centre, or
+ * INFINITY. From inside the sphere this is the exit. */
+double atmos__planet_sphere_hit(const atmos__planet *pl, const double p[3], const double d[3], double r);
+/* Distance to the ground along d (INFINITY if missed); a point at or below the ground
+ * looking down is on it (0). */
+double atmos__planet_ground_distance(const atmos__planet *pl, const double p[3], const double d[3]);
+/* The part [*t0, *t1] of the segment [0, dist] inside the atmosphere (below r_top and
+ * above the ground); 0 if none. */
+int atmos__planet_clip(const atmos__planet *pl, const double p[3], const double d[3], double dist, double *t0,
+                       double *t1);
+/* Moves p onto the ground along the local vertical; n: the outward normal there. */
+void atmos__planet_ground_point(const atmos__planet *pl, double p[3], double n[3]);
+/* Distance to the ground and to the top along the direction of cosine mu from altitude h:
+ * the standard (r, mu) parametrization of the spherical kinds' tables. */
+double atmos__planet_dist_top(const atmos__planet *pl, double r, double mu);
+double atmos__planet_dist_ground(const atmos__planet *pl, double r, double mu); /* INFINITY: misses */
+
+/* ------------------------------------------------------------------ numerics */
+/* Optical depth per wavelength (subset k[0..m-1], k NULL: all) of the segment p + t d,
+ * t in [0, dist] (dist may be INFINITY), by quadrature fine enough for a reference (the
+ * solvers' tables are built with it; planet.c documents the accuracy). */
+void atmos__planet_optical_depth(const atmos__planet *pl, const double p[3], const double d[3], double dist, int m,
+                                 const int *k, double *out);
+/* Transmittance of the sunlight (direction sun) reaching p: exp(-depth to the top), 0 where
+ * the planet hides the sun's centre. */
+void atmos__planet_sun_transmittance(const atmos__planet *pl, const double p[3], const double sun[3], int m,
+                                     const int *k, double *out);
+/* Single scattering (per unit solar irradiance) of the segment p + t d, t in [0, dist]:
+ * the integral of sigma_s P T(p, x) T_sun(x) by brute-force quadrature, with the planet's
+ * shadow. A slow second method for tests and the tables. */
+void atmos__planet_single_scatter(const atmos__planet *pl, const double p[3], const double d[3], double dist,
+                                  const double sun[3], int m, const int *k, double *out);
+
+#endif

@@ -1,0 +1,56 @@
+/* The solvers of the spherical kinds (DOBASHI, SPHERICAL): each answers the atmosphere's
+ * questions over the same planet description (planet.h) with its own tables. The shared
+ * answers (geometry, coefficients, phase, the sun's disk, the dispatch) are planet_ask.c's.
+ * Every function gets the atmosphere (a->planet, a->model, a->sun_e, a->wl) and the subset
+ * convention of atmosphere_ops.h (k NULL: wavelengths 0..m-1). */
+#ifndef ATMOS_PLANET_SOLVER_H
+#define ATMOS_PLANET_SOLVER_H
+
+#include "atmosphere/atmosphere_internal.h"
+#include "atmosphere/planet.h"
+
+typedef struct atmos__planet_solver {
+    const char *name;
+    /* builds a->model (its tables) from a->planet; NULL: no tables */
+    atmos_status (*create)(atmos_context *ctx, atmos_atmosphere *a);
+    void (*destroy)(void *model);
+    void (*transmittance)(const atmos_atmosphere *a, const double p[3], const double d[3], double dist, int m,
+                          const int *k, double *out);
+    /* extraterrestrial irradiance times the sun's transmittance to p (0 in the planet's shadow) */
+    void (*sunlight)(const atmos_atmosphere *a, const double p[3], const double sun[3], int m, const int *k,
+                     double *out);
+    /* radiance scattered by the air of the segment toward p (every order the solver has);
+     * returns 0 when it is 0 at every wavelength */
+    int (*inscatter)(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
+                     const double sun[3], int m, const int *k, double *out);
+    /* what the view ray sees without the sun's disk: the air to the ground or to space and
+     * the lit ground (all wavelengths); NULL: planet_ask.c's from the three above */
+    void (*radiance)(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
+                     double *out, atmos_atmosphere_hit *info);
+    /* many rays from one eye (atmosphere_ops.h); NULL: one by one through radiance */
+    void (*batch_init)(atmos__atm_batch *b);
+    void (*batch_eval)(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                       const float *weight, float *out, float *scratch);
+    void (*batch_release)(atmos__atm_batch *b);
+} atmos__planet_solver;
+
+/* The solvers: dobashi.c, spherical.c; planet_numeric.c's brute-force quadrature (single
+ * scattering, a test reference). */
+extern const atmos__planet_solver atmos__dobashi_solver;
+extern const atmos__planet_solver atmos__spherical_solver;
+extern const atmos__planet_solver atmos__numeric_solver;
+
+/* The numeric solver's functions, for other solvers to fall back on. */
+void atmos__numeric_transmittance(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
+                                  int m, const int *k, double *out);
+void atmos__numeric_sunlight(const atmos_atmosphere *a, const double p[3], const double sun[3], int m, const int *k,
+                             double *out);
+int atmos__numeric_inscatter(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
+                             const double sun[3], int m, const int *k, double *out);
+
+/* planet_ask.c: the radiance of a view ray from the solver's three answers (in-scatter to
+ * the ground or space, plus the ground lit by the attenuated sun), without the disk. */
+void atmos__planet_radiance_generic(const atmos_atmosphere *a, const double p[3], const double d[3],
+                                    const double sun[3], double *out, atmos_atmosphere_hit *info);
+
+#endif
