@@ -142,6 +142,18 @@ ATMOS_API void atmos_atmosphere_scattering(const atmos_atmosphere *atm, const do
 /* The air's phase function at p, sr^-1 (Rayleigh's for the kinds here). */
 ATMOS_API double atmos_atmosphere_phase(const atmos_atmosphere *atm, const double p[3], double cos_theta);
 
+/* Ground truth for the spherical kinds (DOBASHI and SPHERICAL describe the same air; the
+ * reference ignores their tables): what the view ray sees without the sun's disk, by Monte
+ * Carlo random walks through the air with every order of scattering, the ozone's
+ * absorption and the ground's reflections; `paths` walks per wavelength, the same result for
+ * the same seed on any thread count. max_order > 0 keeps only the light scattered at most
+ * that many times (1: single scattering), 0 keeps all. std_error (may be NULL) receives each
+ * wavelength's standard error. ATMOS_E_INVALID_ARG for another kind. */
+ATMOS_API atmos_status atmos_atmosphere_reference_radiance(const atmos_atmosphere *atm, const double p[3],
+                                                           const double dir[3], const double sun_dir[3], long paths,
+                                                           unsigned long long seed, int max_order, double *out,
+                                                           double *std_error);
+
 #ifdef __cplusplus
 }
 #endif

@@ -91,6 +91,13 @@ void atmos__planet_ground_point(const atmos__planet *pl, double p[3], double n[3
 double atmos__planet_dist_top(const atmos__planet *pl, double r, double mu);
 double atmos__planet_dist_ground(const atmos__planet *pl, double r, double mu); /* INFINITY: misses */
 
+/* ------------------------------------------------------------------ the ground */
+/* The ground's Lambertian reflectance at the ground point g for wavelength k (uniform, or
+ * from a map) and the radiance it emits there (the night side's lights), W m^-2 sr^-1
+ * nm^-1 (planet_surface.c). */
+double atmos__planet_ground_albedo(const atmos__planet *pl, const double g[3], int k);
+double atmos__planet_ground_emission(const atmos__planet *pl, const double g[3], int k);
+
 /* ------------------------------------------------------------------ numerics */
 /* Optical depth per wavelength (subset k[0..m-1], k NULL: all) of the segment p + t d,
  * t in [0, dist] (dist may be INFINITY), by quadrature fine enough for a reference (the

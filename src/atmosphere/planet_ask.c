@@ -13,15 +13,16 @@ void atmos__planet_radiance_generic(const atmos_atmosphere *a, const double p[3]
     const int ground = K < INFINITY;
     if (!a->solver->inscatter(a, p, d, K, sun, n, NULL, out))
         for (int i = 0; i < n; i++) out[i] = 0.0;
-    if (ground && pl->albedo > 0) {
+    if (ground) {
         double g[3] = {p[0] + K * d[0], p[1] + K * d[1], p[2] + K * d[2]}, nrm[3];
         atmos__planet_ground_point(pl, g, nrm);
-        const double cs = atmos__dot3(nrm, sun);
-        if (cs > 0) {
-            double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
-            a->solver->sunlight(a, g, sun, n, NULL, E);
-            a->solver->transmittance(a, p, d, K, n, NULL, T);
-            for (int i = 0; i < n; i++) out[i] += pl->albedo / ATMOS_PI * cs * E[i] * T[i];
+        const double cs = fmax(atmos__dot3(nrm, sun), 0.0);
+        double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+        a->solver->transmittance(a, p, d, K, n, NULL, T);
+        if (cs > 0) a->solver->sunlight(a, g, sun, n, NULL, E);
+        for (int i = 0; i < n; i++) {
+            const double lit = cs > 0 ? atmos__planet_ground_albedo(pl, g, i) / ATMOS_PI * cs * E[i] : 0.0;
+            out[i] += (lit + atmos__planet_ground_emission(pl, g, i)) * T[i];
         }
     }
     if (info) {
