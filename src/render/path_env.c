@@ -19,7 +19,7 @@ int atmos__path_env_build(const atmos_atmosphere *atm, const double sun[3], cons
                           path_env *e)
 {
     memset(e, 0, sizeof *e);
-    if (!(sun[1] > 0)) return 0;
+    /* (a flat earth's sky is dark once the sun has set; a round one's is not: the cells say) */
     const int n = atmos_atmosphere_wavelengths(atm)->count;
     const double eye[3] = {ref[0], ref[1] > 0 ? ref[1] : 0, ref[2]};
     double v[ATMOS_MAX_WAVELENGTHS], total = 0;
