@@ -157,9 +157,9 @@ void atmos__planet_single_scatter(const atmos__planet *pl, const double p[3], co
         const double x[3] = {p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]};
         const double h = atmos__planet_altitude(pl, x);
         atmos__planet_sun_transmittance(pl, x, sun, m, k, Ts);
-        const double pr = atmos_phase_rayleigh(nu);
         for (int i = 0; i < m; i++) {
             const int kk = k ? k[i] : i;
+            const double pr = atmos__planet_rayleigh_phase(pl, kk, nu);
             const double ext = atmos__planet_extinction(pl, h, kk) * dt;
             const double Tv = exp(-(tau[i] + 0.5 * ext));
             const double sca = pl->rayleigh[kk] * atmos__planet_rho_rayleigh(pl, h) * pr +
