@@ -129,11 +129,17 @@ void atmos__planet_sun_transmittance(const atmos__planet *pl, const double p[3],
                                      const int *k, double *out)
 {
     double q[3] = {p[0], p[1], p[2]};
+    int on_ground = 0;
     if (atmos__planet_radius(pl, q) < pl->r_ground) {
         double n[3];
         atmos__planet_ground_point(pl, q, n);
+        on_ground = 1;
     }
-    if (atmos__planet_ground_distance(pl, q, sun) < INFINITY) {
+    /* a point moved onto the ground may land a rounding error below it, where the ground
+     * test would hide every sun: there the horizon decides */
+    const int hidden = on_ground ? atmos__planet_mu(pl, q, sun) < 0
+                                 : atmos__planet_ground_distance(pl, q, sun) < INFINITY;
+    if (hidden) {
         for (int i = 0; i < m; i++) out[i] = 0.0;
         return;
     }

@@ -254,6 +254,38 @@ static void test_phase_sampling(void)
     CHECK_NEAR(mean, pl.mie_g[0], 0.004);
 }
 
+/* The planet's quadrature: the vertical optical depth of all three constituents against
+ * their columns in closed form; the sun seen from points on and just below the ground. */
+static void test_planet_numerics(void)
+{
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_atmosphere_desc d;
+    defaults(&d, ATMOS_AEROSOL_URBAN);
+    d.visibility_km = 10;
+    static atmos__planet pl;
+    make_planet(&pl, &d, &wl);
+    double tau[ATMOS_MAX_WAVELENGTHS];
+    vertical_depth(&pl, tau);
+    const double top = pl.r_top - pl.r_ground;
+    for (int k = 0; k < 3; k++) {
+        const double exact = pl.rayleigh[k] * pl.h_rayleigh * -expm1(-top / pl.h_rayleigh) +
+                             pl.mie_ext[k] * pl.h_mie * -expm1(-top / pl.h_mie) + pl.ozone[k] * pl.ozone_half_width;
+        CHECK_REL(tau[k], exact, 1e-6);
+    }
+    /* the sun overhead of points on or just below the ground, anywhere on the planet */
+    int hidden = 0;
+    for (int i = 0; i < 200; i++) {
+        const double a = 0.031 * i, r = pl.r_ground - (i % 4) * 0.37;
+        const double p[3] = {r * sin(a), r * cos(a) - pl.r_ground, 0};
+        const double up[3] = {sin(a), cos(a), 0};
+        double T[ATMOS_MAX_WAVELENGTHS];
+        atmos__planet_sun_transmittance(&pl, p, up, 3, NULL, T);
+        if (!(T[1] > 0.5 * exp(-tau[1]))) hidden++;
+    }
+    CHECK_MSG(hidden == 0, "%d of 200 ground points see no sun overhead", hidden);
+}
+
 static void timing(void)
 {
     atmos_wavelengths wl;
@@ -281,6 +313,7 @@ int main(void)
     test_aerosols();
     test_amount();
     test_phase_sampling();
+    test_planet_numerics();
     timing();
     return test_summary("test_planet_optics");
 }
