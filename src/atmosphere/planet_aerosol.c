@@ -6,7 +6,8 @@
  * visible wavelength), the hygroscopic ones (water-soluble, sea salt) grown to 80 % relative
  * humidity (mode radius as OPAC tabulates it there, refractive index by volume mixing with
  * water); the mixtures are OPAC's number densities (Table 4). Optics by the library's Mie
- * solver over each distribution (Simpson's rule in ln r), cached on disk. */
+ * solver over each distribution (Simpson's rule in ln r; wavelengths on OpenMP threads),
+ * cached on disk. */
 #include "atmosphere/planet_optics.h"
 
 #include "core/cache.h"
@@ -185,13 +186,25 @@ atmos_status atmos__aerosol_optics(atmos_context *ctx, atmos_aerosol_type type, 
     if (key && cache_get(ctx, key, n, ext, sca, g, phase)) return ATMOS_OK;
     double mu[NP];
     for (int j = 0; j < NP; j++) mu[j] = cos(j * ATMOS_PI / (NP - 1));
-    atmos_complex *s = phase ? malloc(2 * NP * sizeof *s) : NULL;
-    if (phase && !s) return atmos__error(ctx, ATMOS_E_NOMEM, "aerosol optics: out of memory");
+    /* wavelengths in parallel, each summed in a fixed order: the result does not depend on
+     * the thread count */
     atmos_status st = ATMOS_OK;
-    for (int k = 0; k < n && st == ATMOS_OK; k++)
-        st = mixture_optics(ctx, &mixtures[type], nm[k], mu, s, s ? s + NP : NULL, &ext[k], &sca[k], g ? &g[k] : NULL,
-                            phase ? phase[k] : NULL);
-    free(s);
+#pragma omp parallel num_threads(atmos__threads(ctx))
+    {
+        atmos_complex *s = phase ? malloc(2 * NP * sizeof *s) : NULL;
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < n; k++) {
+            atmos_status e = phase && !s ? ATMOS_E_NOMEM
+                                         : mixture_optics(ctx, &mixtures[type], nm[k], mu, s, s ? s + NP : NULL,
+                                                          &ext[k], &sca[k], g ? &g[k] : NULL, phase ? phase[k] : NULL);
+            if (e != ATMOS_OK) {
+#pragma omp critical(atmos_aerosol_status)
+                st = e;
+            }
+        }
+        free(s);
+    }
+    if (st == ATMOS_E_NOMEM) return atmos__error(ctx, st, "aerosol optics: out of memory");
     if (st == ATMOS_OK && key) cache_put(ctx, key, n, ext, sca, g, phase);
     return st;
 }
