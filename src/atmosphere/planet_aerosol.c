@@ -57,7 +57,9 @@ static const mixture mixtures[4] = {
     [ATMOS_AEROSOL_DESERT] = {4, {WASO, MINM, MIAM, MICM}, {2000.0, 269.5, 30.5, 0.142}},
 };
 
-#define NQ 32 /* Simpson intervals in ln r per component */
+#define NQ 32      /* Simpson intervals in ln r per component for the phase function */
+#define NF_MIN 96   /* at least this many for the cross-sections */
+#define NF_MAX 4096 /* and at most this many */
 #define NP ATMOS__PLANET_PHASE_N
 
 /* The component's refractive index at wavelength nm (MIEV0 sign: im <= 0). */
@@ -73,32 +75,57 @@ static atmos_complex comp_index(const component *c, double nm)
     return m;
 }
 
+/* Simpson's weight of node i of n intervals of width h. */
+static double simpson(int i, int n, double h) { return (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * h / 3.0; }
+
 /* Adds one component's cross-sections (m^2 per particle times its number) and
- * differential scattering (m^2 sr^-1) at wavelength nm to the sums. */
+ * differential scattering (m^2 sr^-1) at wavelength nm to the sums. The cross-sections
+ * resolve the interference ripple of Q_ext (period ~ pi / (m - 1) in x): steps in ln r of
+ * at most 0.5 / x at the mode, without angles (cheap); the phase function, smooth after the
+ * size average, takes NQ steps and is scaled to the fine scattering cross-section. */
 static atmos_status add_component(atmos_context *ctx, const component *c, double number, double nm,
                                   const double *mu, atmos_complex *s1, atmos_complex *s2, double *ext, double *sca,
                                   double *gsca, double *dsca)
 {
     const double s = log(c->sigma_g), lm = log(c->r_mod_um * 1e-6);
-    const double lo = fmax(lm - 4.0 * s, log(0.005e-6 * c->growth)), hi = fmin(lm + 4.0 * s, log(c->r_max_um * 1e-6));
-    const double h = (hi - lo) / NQ, lam = nm * 1e-9, k = 2.0 * ATMOS_PI / lam;
+    const double lam = nm * 1e-9, k = 2.0 * ATMOS_PI / lam;
+    /* the integrand n(ln r) pi r^2 Q peaks at ln r_m + 2 s^2 where Q is ~2 (x > 1) and up to
+     * ln r_m + 6 s^2 where Q ~ x^4 (x < 1): integrate 5 s beyond the peak, within OPAC's
+     * radius limits */
+    const double peak = fmax(lm + 2.0 * s * s, fmin(lm + 6.0 * s * s, log(1.0 / k)));
+    const double lo = fmax(lm - 4.0 * s, log(0.005e-6 * c->growth)), hi = fmin(peak + 5.0 * s, log(c->r_max_um * 1e-6));
+    const double step = fmin((hi - lo) / NF_MIN, 0.5 / (k * exp(lm)));
+    int nf = 2 * (int)ceil(0.5 * (hi - lo) / step);
+    if (nf > NF_MAX) nf = NF_MAX;
     const atmos_complex m = comp_index(c, nm);
-    for (int i = 0; i <= NQ; i++) {
-        const double lr = lo + i * h, r = exp(lr), z = (lr - lm) / s;
-        const double wq = (i == 0 || i == NQ) ? 1.0 : (i % 2 ? 4.0 : 2.0);
-        const double w = number * wq * h / 3.0 * exp(-0.5 * z * z) / (sqrt(2.0 * ATMOS_PI) * s);
-        atmos_mie_result res;
-        atmos_status st = atmos_mie(ctx, m, k * r, mu ? NP : 0, mu, s1, s2, &res);
-        if (st != ATMOS_OK) return st;
-        const double area = ATMOS_PI * r * r;
-        *ext += w * area * res.qext;
-        *sca += w * area * res.qsca;
-        *gsca += w * area * res.qsca * res.g;
-        if (dsca)
+    double sca_fine = 0;
+    for (int pass = 0; pass < (dsca ? 2 : 1); pass++) {
+        const int n = pass == 0 ? nf : NQ;
+        const double h = (hi - lo) / n;
+        double d[NP], sca_coarse = 0;
+        if (pass) memset(d, 0, sizeof d);
+        for (int i = 0; i <= n; i++) {
+            const double lr = lo + i * h, r = exp(lr), z = (lr - lm) / s;
+            const double w = number * simpson(i, n, h) * exp(-0.5 * z * z) / (sqrt(2.0 * ATMOS_PI) * s);
+            atmos_mie_result res;
+            atmos_status st = atmos_mie(ctx, m, k * r, pass ? NP : 0, pass ? mu : NULL, s1, s2, &res);
+            if (st != ATMOS_OK) return st;
+            const double area = ATMOS_PI * r * r;
+            if (pass == 0) {
+                *ext += w * area * res.qext;
+                sca_fine += w * area * res.qsca;
+                *gsca += w * area * res.qsca * res.g;
+                continue;
+            }
+            sca_coarse += w * area * res.qsca;
             for (int j = 0; j < NP; j++)
-                dsca[j] += w * 0.5 * (s1[j].re * s1[j].re + s1[j].im * s1[j].im + s2[j].re * s2[j].re +
-                                      s2[j].im * s2[j].im) / (k * k);
+                d[j] += w * 0.5 * (s1[j].re * s1[j].re + s1[j].im * s1[j].im + s2[j].re * s2[j].re +
+                                   s2[j].im * s2[j].im) / (k * k);
+        }
+        if (pass && sca_coarse > 0)
+            for (int j = 0; j < NP; j++) dsca[j] += d[j] * sca_fine / sca_coarse;
     }
+    *sca += sca_fine;
     return ATMOS_OK;
 }
 
@@ -127,7 +154,7 @@ static size_t payload_size(int n) { return (size_t)n * (3 * sizeof(double) + NP 
 
 static char *cache_key(atmos_aerosol_type type, int n, const double *nm, char *buf, size_t cap)
 {
-    int len = snprintf(buf, cap, "planet-aerosol v1 opac80 type=%d nq=%d np=%d n=%d", (int)type, NQ, NP, n);
+    int len = snprintf(buf, cap, "planet-aerosol v3 opac80 type=%d nq=%d nf=%d-%d np=%d n=%d", (int)type, NQ, NF_MIN, NF_MAX, NP, n);
     for (int k = 0; k < n && len > 0 && (size_t)len < cap; k++) len += snprintf(buf + len, cap - len, " %.17g", nm[k]);
     return len > 0 && (size_t)len < cap ? buf : NULL;
 }

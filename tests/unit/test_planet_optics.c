@@ -298,12 +298,6 @@ static void timing(void)
     make_planet(&pl, &d, &wl);
     timespec_get(&b, TIME_UTC);
     printf("planet init (desert, rgb, no cache): %.3f s\n", (double)(b.tv_sec - a.tv_sec) + 1e-9 * (double)(b.tv_nsec - a.tv_nsec));
-    CHECK_OK(atmos_wavelengths_spectral(40, &wl));
-    timespec_get(&a, TIME_UTC);
-    make_planet(&pl, &d, &wl);
-    timespec_get(&b, TIME_UTC);
-    printf("planet init (desert, 40 samples, no cache): %.3f s\n",
-           (double)(b.tv_sec - a.tv_sec) + 1e-9 * (double)(b.tv_nsec - a.tv_nsec));
 }
 
 int main(void)
