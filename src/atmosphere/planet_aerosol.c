@@ -149,7 +149,8 @@ static atmos_status mixture_optics(atmos_context *ctx, const mixture *mx, double
     return ATMOS_OK;
 }
 
-/* Cache payload: per wavelength ext, sca, g (doubles), then the phase tables (floats). */
+/* Cache payload: per wavelength ext, sca, g (doubles), then the phase tables (floats). The
+ * key's version (v3) must change whenever the components, mixtures or quadrature do. */
 static size_t payload_size(int n) { return (size_t)n * (3 * sizeof(double) + NP * sizeof(float)); }
 
 static char *cache_key(atmos_aerosol_type type, int n, const double *nm, char *buf, size_t cap)
