@@ -129,11 +129,17 @@ void atmos__planet_sun_transmittance(const atmos__planet *pl, const double p[3],
                                      const int *k, double *out)
 {
     double q[3] = {p[0], p[1], p[2]};
+    int on_ground = 0;
     if (atmos__planet_radius(pl, q) < pl->r_ground) {
         double n[3];
         atmos__planet_ground_point(pl, q, n);
+        on_ground = 1;
     }
-    if (atmos__planet_ground_distance(pl, q, sun) < INFINITY) {
+    /* a point moved onto the ground may land a rounding error below it, where the ground
+     * test would hide every sun: there the horizon decides */
+    const int hidden = on_ground ? atmos__planet_mu(pl, q, sun) < 0
+                                 : atmos__planet_ground_distance(pl, q, sun) < INFINITY;
+    if (hidden) {
         for (int i = 0; i < m; i++) out[i] = 0.0;
         return;
     }
@@ -157,9 +163,9 @@ void atmos__planet_single_scatter(const atmos__planet *pl, const double p[3], co
         const double x[3] = {p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]};
         const double h = atmos__planet_altitude(pl, x);
         atmos__planet_sun_transmittance(pl, x, sun, m, k, Ts);
-        const double pr = atmos_phase_rayleigh(nu);
         for (int i = 0; i < m; i++) {
             const int kk = k ? k[i] : i;
+            const double pr = atmos__planet_rayleigh_phase(pl, kk, nu);
             const double ext = atmos__planet_extinction(pl, h, kk) * dt;
             const double Tv = exp(-(tau[i] + 0.5 * ext));
             const double sca = pl->rayleigh[kk] * atmos__planet_rho_rayleigh(pl, h) * pr +

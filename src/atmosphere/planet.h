@@ -20,6 +20,8 @@ typedef struct atmos__planet {
     double r_ground, r_top;               /* radii of the ground and the top of the air */
     int n;                                /* wavelengths */
     double rayleigh[ATMOS_MAX_WAVELENGTHS]; /* air molecules' scattering at the ground */
+    double rayleigh_gamma[ATMOS_MAX_WAVELENGTHS]; /* their phase function's depolarization
+                                          term gamma = rho / (2 - rho) (0: pure Rayleigh) */
     double h_rayleigh;                    /* their scale height */
     double mie_sca[ATMOS_MAX_WAVELENGTHS];  /* aerosols' scattering at the ground */
     double mie_ext[ATMOS_MAX_WAVELENGTHS];  /* aerosols' extinction at the ground */
@@ -62,9 +64,18 @@ static inline double atmos__planet_extinction(const atmos__planet *pl, double h,
 }
 
 /* ------------------------------------------------------------------ phase functions */
-/* The aerosols' phase function (sr^-1) at cos_theta for wavelength k, interpolated. */
+/* The air molecules' phase function with depolarization (Chandrasekhar 1950 §18):
+ * 3 / (16 pi) (1 + 3 gamma + (1 - gamma) cos^2) / (1 + 2 gamma), sr^-1. */
+static inline double atmos__planet_rayleigh_phase(const atmos__planet *pl, int k, double cos_theta)
+{
+    const double g = pl->rayleigh_gamma[k];
+    return 3.0 / (16.0 * ATMOS_PI) * (1.0 + 3.0 * g + (1.0 - g) * cos_theta * cos_theta) / (1.0 + 2.0 * g);
+}
+/* The aerosols' phase function (sr^-1) at cos_theta for wavelength k: P sin(theta)
+ * interpolated linearly in theta between the table's angles, over sin(theta); it integrates
+ * to one over the sphere. */
 double atmos__planet_mie_phase(const atmos__planet *pl, int k, double cos_theta);
-/* A cos_theta drawn from it with the uniform number u. */
+/* A cos_theta drawn from exactly that density with the uniform number u (pdf = eval). */
 double atmos__planet_mie_sample(const atmos__planet *pl, int k, double u);
 /* The mixture at altitude h: (rayleigh_sca * P_R + mie_sca * P_M) / (rayleigh_sca + mie_sca). */
 double atmos__planet_phase(const atmos__planet *pl, double h, int k, double cos_theta);
