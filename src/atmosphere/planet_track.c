@@ -22,7 +22,9 @@
  * majorant chosen then (the standard restart argument of delta tracking with piecewise
  * majorants). The estimators are therefore exact, whatever the segmentation: it affects
  * only the cost (the number of tentative collisions, about the majorant's optical depth)
- * and, for ratio tracking, the variance. */
+ * and, for ratio tracking, the variance. Ratio tracking plays a Russian roulette once its
+ * estimate falls below 0.01 (kept with probability T / 0.01, then 0.01): a shadow ray through
+ * an optically thick path stops after a few optical depths instead of running to the end. */
 #include "atmosphere/planet_track.h"
 
 #include "core/vec.h"
@@ -32,6 +34,8 @@
 #define RISE_MIN 2000.0
 #define DROP_MIN 1000.0
 #define DROP_FRAC 0.3
+/* Transmittance below which ratio tracking plays a Russian roulette (survivors take it). */
+#define RATIO_RR 0.01
 /* Tentative collisions per call beyond which a flight or a shadow ray is abandoned (never
  * reached by the Earth's air: a vertical ray meets ~2, a horizontal one from the ground at
  * 400 nm ~40). */
@@ -137,6 +141,11 @@ static double track(const atmos__planet *pl, const double p[3], const double d[3
         if (ratio) {
             T *= f < 1 ? 1.0 - f : 0.0;
             if (!(T > 0)) return 0.0;
+            if (T < RATIO_RR) {
+                /* Russian roulette: deep shadow rays stop early, unbiased */
+                if (atmos__stream_u(r) * RATIO_RR >= T) return 0.0;
+                T = RATIO_RR;
+            }
         } else if (atmos__stream_u(r) < f) {
             return t;
         }
