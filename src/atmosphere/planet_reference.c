@@ -3,12 +3,13 @@
  * planet description only, never a solver's tables), one wavelength per walk.
  *
  * A walk starts at the eye (moved to where the view ray enters the air when it is outside)
- * and repeats: a free flight by delta tracking of the extinction (planet_track.c) to the
- * first real collision, the ground, or the top;
+ * and repeats: the sunlight scattered once toward the walk by the air of its segment to the
+ * ground or the top (one importance-sampled point, its transmittances by quadrature,
+ * planet_segment.c: the walk's next-event estimation of the sun, made along the segment rather
+ * than at a collision), then a free flight by delta tracking of the extinction
+ * (planet_track.c) to the first real collision, the ground, or the top;
  *  - in the air: the weight is multiplied by the single-scattering albedo there
- *    (sigma_s / sigma_t: aerosol and ozone absorption), the sun is estimated (next-event
- *    estimation: the mixture's phase function times the sun's irradiance times the ratio-
- *    tracked transmittance to the top, 0 in the planet's shadow), and a new direction is
+ *    (sigma_s / sigma_t: aerosol and ozone absorption) and a new direction is
  *    drawn from the Rayleigh / aerosol mixture (a component in proportion to its
  *    scattering, Rayleigh's 3/(16 pi)(1 + cos^2) by exact inversion of its cubic CDF, the
  *    aerosols' from their tabulated CDF);
@@ -61,25 +62,18 @@ static double rayleigh_sample(double u)
     return mu > 1 ? 1 : (mu < -1 ? -1 : mu);
 }
 
-/* A scattering in the air at p (reached along d with weight *w). Adds the sun's estimate to
- * *L; returns 0 when the walk ends here. */
-static int air_event(const atmos_atmosphere *a, const double p[3], double d[3], const double sun[3], int k, int last,
-                     double *w, double *L, atmos__stream *r)
+/* A scattering in the air at p (reached along d with weight *w; the sunlight scattered here
+ * is counted along the segment, by atmos__planet_segment_sun). Returns 0 when the walk ends. */
+static int air_event(const atmos_atmosphere *a, const double p[3], double d[3], int k, int last, double *w,
+                     atmos__stream *r)
 {
     const atmos__planet *pl = a->planet;
     const double h = atmos__planet_altitude(pl, p);
     const double sR = pl->rayleigh[k] * atmos__planet_rho_rayleigh(pl, h);
     const double sM = pl->mie_sca[k] * atmos__planet_rho_mie(pl, h);
     const double ext = atmos__planet_extinction(pl, h, k);
-    if (!(ext > 0) || !(sR + sM > 0)) return 0;
+    if (last || !(ext > 0) || !(sR + sM > 0)) return 0;
     *w *= fmin((sR + sM) / ext, 1.0);
-    const double Ts = atmos__planet_sun_track(pl, p, sun, k, r);
-    if (Ts > 0) {
-        const double nu = atmos__dot3(d, sun);
-        const double P = (sR * atmos_phase_rayleigh(nu) + sM * atmos__planet_mie_phase(pl, k, nu)) / (sR + sM);
-        *L += *w * P * a->sun_e[k] * Ts;
-    }
-    if (last) return 0;
     const double mu = atmos__stream_u(r) * (sR + sM) < sR ? rayleigh_sample(atmos__stream_u(r))
                                                           : atmos__planet_mie_sample(pl, k, atmos__stream_u(r));
     const double dir[3] = {d[0], d[1], d[2]};
@@ -102,8 +96,8 @@ static int ground_event(const atmos_atmosphere *a, double p[3], double d[3], con
     if (!(alb > 0)) return 0;
     const double cs = atmos__dot3(n, sun);
     if (cs > 0) {
-        const double Ts = atmos__planet_ratio_track(pl, p, sun, atmos__planet_exit_top(pl, p, sun), k, r);
-        *L += *w * alb / ATMOS_PI * cs * a->sun_e[k] * Ts;
+        *L += *w * alb / ATMOS_PI * cs * a->sun_e[k] *
+              exp(-atmos__planet_depth1(pl, p, sun, 0.0, atmos__planet_exit_top(pl, p, sun), k));
     }
     if (last) return 0;
     *w *= alb;
@@ -137,10 +131,11 @@ double atmos__atm_reference_walk(const atmos_atmosphere *a, const double eye[3],
         const int last = max_order > 0 && order >= max_order;
         const double K = atmos__planet_hit_ground(pl, p, d);
         const double tex = K < INFINITY ? K : atmos__planet_exit_top(pl, p, d);
+        L += w * a->sun_e[k] * atmos__planet_segment_sun(pl, p, d, tex, sun, k, r);
         const double t = atmos__planet_free_flight(pl, p, d, tex, k, r);
         for (int i = 0; i < 3; i++) p[i] += t * d[i];
         int go;
-        if (t < tex) go = air_event(a, p, d, sun, k, last, &w, &L, r);
+        if (t < tex) go = air_event(a, p, d, k, last, &w, r);
         else if (K < INFINITY) go = ground_event(a, p, d, sun, k, last, &w, &L, r);
         else go = 0;
         if (!go || !(w > 0)) break;

@@ -23,7 +23,7 @@
  * majorants). The estimators are therefore exact, whatever the segmentation: it affects
  * only the cost (the number of tentative collisions, about the majorant's optical depth)
  * and, for ratio tracking, the variance. Ratio tracking plays a Russian roulette once its
- * estimate falls below 0.01 (kept with probability T / 0.01, then 0.01): a shadow ray through
+ * estimate falls below 1e-6 (kept with probability T / 1e-6, then 1e-6): a shadow ray through
  * an optically thick path stops after a few optical depths instead of running to the end. */
 #include "atmosphere/planet_track.h"
 
@@ -35,7 +35,7 @@
 #define DROP_MIN 1000.0
 #define DROP_FRAC 0.3
 /* Transmittance below which ratio tracking plays a Russian roulette (survivors take it). */
-#define RATIO_RR 0.01
+#define RATIO_RR 1e-6
 /* Tentative collisions per call beyond which a flight or a shadow ray is abandoned (never
  * reached by the Earth's air: a vertical ray meets ~2, a horizontal one from the ground at
  * 400 nm ~40). */

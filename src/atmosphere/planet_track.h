@@ -26,4 +26,18 @@ double atmos__planet_ratio_track(const atmos__planet *pl, const double p[3], con
 double atmos__planet_sun_track(const atmos__planet *pl, const double p[3], const double sun[3], int k,
                                atmos__stream *r);
 
+/* An unbiased estimate of the sunlight scattered once toward p by the air of the segment
+ * p + t d, t in [0, tmax], at wavelength k, per unit extraterrestrial irradiance: the
+ * integral of sigma_s(t) P(t) T(p, t) T_sun(t) dt, from one point drawn from a density fitted
+ * to the integrand, its transmittances by ratio tracking (planet_segment.c). */
+double atmos__planet_segment_sun(const atmos__planet *pl, const double p[3], const double d[3], double tmax,
+                                 const double sun[3], int k, atmos__stream *r);
+
+/* The optical depth of p + t d, t in [t0, t1] (inside the air) at wavelength k by quadrature
+ * on pieces cut by altitude, and the transmittance of the sunlight reaching p with it (0 where
+ * the planet hides the sun's centre) (planet_segment.c). */
+double atmos__planet_depth1(const atmos__planet *pl, const double p[3], const double d[3], double t0, double t1,
+                            int k);
+double atmos__planet_sun_depth_transmittance(const atmos__planet *pl, const double p[3], const double sun[3], int k);
+
 #endif

@@ -132,7 +132,7 @@ static void test_energy(atmos_atmosphere *a)
         }
         rim /= ATMOS_PI * Rt * Rt;
         /* the scattered part: points stratified in z = n.sun, uniform in azimuth */
-        const int N = 250000;
+        const int N = 120000;
         double s = 0, s2 = 0, prev = 0;
         for (int i = 0; i < N; i++) {
             atmos__stream r;
@@ -190,6 +190,20 @@ static double vertical_depth(const atmos__planet *pl, int k, double h0, double h
     return tau + pl->ozone[k] * oz;
 }
 
+/* planet.c's quadrature of the optical depth over 400 equal pieces of [t0, t1]. */
+static double fine_depth(const atmos__planet *pl, const double p[3], const double d[3], double t0, double t1, int k)
+{
+    double sum = 0;
+    for (int i = 0; i < 400; i++) {
+        const double a = t0 + (t1 - t0) * i / 400, b = t0 + (t1 - t0) * (i + 1) / 400;
+        const double q[3] = {p[0] + a * d[0], p[1] + a * d[1], p[2] + a * d[2]};
+        double tau;
+        atmos__planet_optical_depth(pl, q, d, b - a, 1, &k, &tau);
+        sum += tau;
+    }
+    return sum;
+}
+
 /* Free flights and ratio tracking follow the extinction whatever scatters: their escape
  * probability and their mean are the transmittance. Ozone made 30 times stronger to weigh. */
 static void test_beer_lambert(atmos_atmosphere *a)
@@ -220,6 +234,37 @@ static void test_beer_lambert(atmos_atmosphere *a)
                    k, seg[s].h0, seg[s].h1, T, pe, se_e, mr, se_r);
             CHECK(fabs(pe - T) <= 4.5 * se_e + 1e-9);
             CHECK(fabs(mr - T) <= 4.5 * se_r + 1e-6 * T);
+        }
+        /* the walk's transmittances: atmos__planet_depth1 against the closed form on vertical
+         * paths and planet.c's quadrature over 400 pieces on slant ones (from the ground at
+         * 2 deg, 300 km and to the top; through the limb from 400 km, tangent 5 km above the
+         * ground) */
+        for (size_t s = 0; s < sizeof seg / sizeof seg[0]; s++) {
+            const double p[3] = {0, seg[s].h0, 0}, ref = vertical_depth(pl, k, seg[s].h0, seg[s].h1);
+            const double got = atmos__planet_depth1(pl, p, up, 0.0, seg[s].h1 - seg[s].h0, k);
+            printf("depth1 k %d, vertical %g-%g m: %.9f, closed form %.9f\n", k, seg[s].h0, seg[s].h1, got, ref);
+            CHECK(fabs(got - ref) <= 1e-6 * ref);
+        }
+        {
+            const double R = pl->r_ground, rp = R + 5e3, H = R + 400e3;
+            const double pe[3] = {0, 400e3, 0}, s0[3] = {0, 0, 0};
+            double dl[3], ds[3], ref1, ref2, ref3;
+            const double c = rp / H; /* limb: cos of the angle below the horizontal */
+            dl[0] = c, dl[1] = -sqrt(1 - c * c), dl[2] = 0;
+            dir_from(2, 30, ds);
+            double t0, t1;
+            atmos__planet_clip(pl, pe, dl, INFINITY, &t0, &t1);
+            ref1 = fine_depth(pl, pe, dl, t0, t1, k);
+            ref2 = fine_depth(pl, s0, ds, 0.0, 300e3, k);
+            ref3 = fine_depth(pl, s0, ds, 0.0, atmos__planet_exit_top(pl, s0, ds), k);
+            const double g1 = atmos__planet_depth1(pl, pe, dl, t0, t1, k);
+            const double g2 = atmos__planet_depth1(pl, s0, ds, 0.0, 300e3, k);
+            const double g3 = atmos__planet_depth1(pl, s0, ds, 0.0, atmos__planet_exit_top(pl, s0, ds), k);
+            printf("depth1 k %d: limb %.9f (quadrature %.9f), 2 deg 300 km %.9f (%.9f), to the top %.9f (%.9f)\n", k,
+                   g1, ref1, g2, ref2, g3, ref3);
+            CHECK(fabs(g1 - ref1) <= 1e-6 * ref1);
+            CHECK(fabs(g2 - ref2) <= 1e-6 * ref2);
+            CHECK(fabs(g3 - ref3) <= 1e-6 * ref3);
         }
         /* a slant path from the ground at 2 degrees, 300 km: against the quadrature */
         const double p[3] = {0, 0, 0};
@@ -302,7 +347,7 @@ static void test_published(atmos_atmosphere *a)
     pl->mie_ext[k] = pl->mie_sca[k] = pl->ozone[k] = 0;
     static const double table[][2] = {{2.5, 0.795}, {62.5, 0.368}, {92.5, 0.174}};
     const double Rg = pl->r_ground, Rt = pl->r_top, sun[3] = {0, 0, 1};
-    const int N = 8000;
+    const int N = 4000;
     for (int j = 0; j < 3; j++) {
         const double al = table[j][0] * ATMOS_DEG2RAD;
         const double o[3] = {sin(al), 0, cos(al)}, e1[3] = {cos(al), 0, -sin(al)}, e2[3] = {0, 1, 0};
