@@ -95,7 +95,9 @@ static void test_ozone(void)
     }
     CHECK(peak * 1e4 > 4.6e-21 && peak * 1e4 < 5.4e-21);
     CHECK(at > 585 && at < 615);
-    /* tiny in the blue gap near 380 nm, small in the red */
+    /* the Huggins-Chappuis minimum: 3.4e-24 cm^2 at 381.8 nm at 296 K (Axson et al. 2011,
+     * Atmos. Chem. Phys. Discuss. 11, 21655); the table's 233 K values are lower there */
+    CHECK(atmos__ozone_cross_section(381.8) * 1e4 > 1.5e-24 && atmos__ozone_cross_section(381.8) * 1e4 < 5e-24);
     CHECK(atmos__ozone_cross_section(380) * 1e4 < 5e-23);
     CHECK(atmos__ozone_cross_section(700) < 0.3 * peak);
     /* the bin mean of the linear interpolant between two table points (595 and 605 nm) */
