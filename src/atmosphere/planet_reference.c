@@ -76,6 +76,10 @@ static int air_event(const atmos_atmosphere *a, const double p[3], double d[3], 
     *w *= fmin((sR + sM) / ext, 1.0);
     const double mu = atmos__stream_u(r) * (sR + sM) < sR ? rayleigh_sample(atmos__stream_u(r))
                                                           : atmos__planet_mie_sample(pl, k, atmos__stream_u(r));
+    /* drawn from the mixture with Rayleigh's own phase function; the air's is depolarized
+     * (planet.h): the weight is the ratio of the two mixtures (within ~3 % of 1) */
+    const double PM = atmos__planet_mie_phase(pl, k, mu);
+    *w *= (sR * atmos__planet_rayleigh_phase(pl, k, mu) + sM * PM) / (sR * atmos_phase_rayleigh(mu) + sM * PM);
     const double dir[3] = {d[0], d[1], d[2]};
     around(dir, mu, 2.0 * ATMOS_PI * atmos__stream_u(r), d);
     return 1;

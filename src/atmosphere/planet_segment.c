@@ -126,7 +126,7 @@ double atmos__planet_segment_sun(const atmos__planet *pl, const double p[3], con
                                  const double sun[3], int k, atmos__stream *r)
 {
     if (!(tmax > 0) || !isfinite(tmax)) return 0.0;
-    const double nu = atmos__dot3(d, sun), PR = atmos_phase_rayleigh(nu), PM = atmos__planet_mie_phase(pl, k, nu);
+    const double nu = atmos__dot3(d, sun), PR = atmos__planet_rayleigh_phase(pl, k, nu), PM = atmos__planet_mie_phase(pl, k, nu);
     const double dt = tmax / SEG_N;
     seg_cell cell[SEG_N];
     double cdf[SEG_N + 1], tau = 0, e0, e1;
