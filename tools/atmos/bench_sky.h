@@ -36,6 +36,8 @@ typedef struct {
     const char *out;         /* output directory (NULL: tables on stdout only) */
     double map_range;        /* the error maps saturate at +- this relative error */
     double floor;            /* relative errors are divided by max(ref, floor * block max) */
+    int nalt, nsun;          /* > 0: these observer altitudes (m) and sun elevations (deg) */
+    double alt_m[8], sun_deg[8];
 } acc_opts;
 
 /* Everything a run measured, for the report. */

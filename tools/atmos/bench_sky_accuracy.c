@@ -3,6 +3,7 @@
  * to 36 000 km and suns from the zenith to 10 degrees below the horizon
  * (docs/sky-accuracy.md). This file builds the grid and measures; bench_sky_report.c
  * writes the tables, CSV files and error maps. */
+#define _POSIX_C_SOURCE 200809L /* strtok_r */
 #include "bench_sky.h"
 
 #include <math.h>
@@ -37,6 +38,8 @@ static void help(void)
            "                   (default 0: one batch)\n"
            "  --max-paths N    cap on the walks per wavelength of one view (default 64 x --paths)\n"
            "  --models LIST    comma-separated models (default riley,dobashi,spherical)\n"
+           "  --altitudes LIST observer altitudes in km instead of the grid's (up to 8; e.g. 0,36000)\n"
+           "  --suns LIST      sun elevations in degrees instead of the grid's (up to 8; e.g. 10,-6)\n"
            "  --spectral N     N wavelengths in 380-780 nm (default rgb: 680, 550, 440 nm)\n"
            "  --seed S         the reference's seed (default 1); the same seed gives the same figures\n"
            "  --threads T      views computed in parallel (default: all cores); figures do not depend on T\n"
@@ -94,13 +97,13 @@ static void acc_grid(acc_run *r, const acc_opts *o, double R, double top)
 {
     static const double alt_full[] = {0, 10e3, 100e3, 1000e3, 36000e3}, alt_quick[] = {0, 36000e3};
     static const double sun_full[] = {90, 45, 10, 2, -2, -6, -10}, sun_quick[] = {45, -6};
-    r->nalt = o->quick ? 2 : 5;
-    r->nsun = o->quick ? 2 : 7;
+    r->nalt = o->nalt ? o->nalt : o->quick ? 2 : 5;
+    r->nsun = o->nsun ? o->nsun : o->quick ? 2 : 7;
     for (int a = 0; a < r->nalt; a++) {
-        r->alt_m[a] = o->quick ? alt_quick[a] : alt_full[a];
+        r->alt_m[a] = o->nalt ? o->alt_m[a] : o->quick ? alt_quick[a] : alt_full[a];
         r->nview[a] = acc_views(r->alt_m[a], R, top, o->quick, r->view[a]);
     }
-    for (int s = 0; s < r->nsun; s++) r->sun_deg[s] = o->quick ? sun_quick[s] : sun_full[s];
+    for (int s = 0; s < r->nsun; s++) r->sun_deg[s] = o->nsun ? o->sun_deg[s] : o->quick ? sun_quick[s] : sun_full[s];
 }
 
 size_t acc_index(const acc_run *r, int a, int s, int v)
@@ -172,7 +175,9 @@ static atmos_status acc_measure(acc_run *r, const acc_opts *o, const atmos_atmos
                                 atmos_atmosphere *const *models)
 {
     const int total = r->nalt * r->nsun * ACC_MAX_VIEWS, n = r->wl.count;
-    int failed = 0, nt = o->threads;
+    int failed = 0, nt = o->threads, views = 0, done = 0;
+    for (int a = 0; a < r->nalt; a++) views += r->nview[a] * r->nsun;
+    const double t0 = cli_now_s();
 #ifdef _OPENMP
     if (nt <= 0) nt = omp_get_max_threads();
 #endif
@@ -198,6 +203,11 @@ static atmos_status acc_measure(acc_run *r, const acc_opts *o, const atmos_atmos
             }
             atmos_atmosphere_radiance(models[m], p, d, sun, r->mod[m] + i, NULL);
         }
+        int now;
+#pragma omp atomic capture
+        now = ++done;
+        if (!o->quick && now * 10 / views != (now - 1) * 10 / views)
+            fprintf(stderr, "atmos bench sky-accuracy: %d of %d views, %.0f s\n", now, views, cli_now_s() - t0);
     }
     return failed ? ATMOS_E_INVALID_ARG : ATMOS_OK;
 }
@@ -275,6 +285,22 @@ static int parse_models(const char *list, int use[ACC_MODELS])
     return 1;
 }
 
+/* A comma-separated list of at most 8 numbers in [lo, hi], times scale. */
+static int parse_list(const char *text, double lo, double hi, double scale, double *out, int *n)
+{
+    char buf[256];
+    if (!*text || strlen(text) >= sizeof buf) return 0;
+    snprintf(buf, sizeof buf, "%s", text);
+    *n = 0;
+    for (char *save = NULL, *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        char *end;
+        const double v = strtod(t, &end);
+        if (*end || end == t || !(v >= lo && v <= hi) || *n >= 8) return 0;
+        out[(*n)++] = v * scale;
+    }
+    return *n > 0;
+}
+
 static int parse_opts(int argc, char **argv, acc_opts *o)
 {
     const char *C = "bench sky-accuracy";
@@ -303,6 +329,12 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
         } else if (!strcmp(a, "--models")) {
             if (!parse_models(val, o->use))
                 return cli_usage_error(C, "--models: expected a list of riley, dobashi, spherical, got '%s'", val);
+        } else if (!strcmp(a, "--altitudes")) {
+            if (!parse_list(val, 0, 100000, 1e3, o->alt_m, &o->nalt))
+                return cli_usage_error(C, "--altitudes: expected up to 8 altitudes in km in [0, 100000], got '%s'", val);
+        } else if (!strcmp(a, "--suns")) {
+            if (!parse_list(val, -90, 90, 1, o->sun_deg, &o->nsun))
+                return cli_usage_error(C, "--suns: expected up to 8 sun elevations in [-90, 90] degrees, got '%s'", val);
         } else if (!strcmp(a, "--spectral")) {
             if (!cli_parse_int(C, a, val, 1, ATMOS_MAX_WAVELENGTHS, &spectral)) return CLI_EXIT_USAGE;
         } else if (!strcmp(a, "--seed")) {
