@@ -82,10 +82,9 @@ static void tau_quad(const atmos_atmosphere *a, const double p[3], const double 
 /* Vertical paths over the documented profiles: air molecules exp(-h / 7994 m), aerosols
  * exp(-h / 1200 m) (Dobashi et al. 2002 Appendix A.1), in closed form:
  * tau = beta(0) H (exp(-h0 / H) - exp(-h1 / H)) per component. */
-static void test_vertical(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_vertical(const atmos_atmosphere *air, const atmos_atmosphere *aer, const atmos_wavelengths *wl)
 {
     const double HR = 7994, HM = 1200, up[3] = {0, 1, 0};
-    atmos_atmosphere *air = make(kind, 0, 0, wl), *aer = make(kind, 1, 0, wl);
     for (int k = 0; k < wl->count; k++) {
         const double b = ext_at(air, 0, k);
         CHECK(b > 0);
@@ -103,15 +102,13 @@ static void test_vertical(atmos_atmosphere_kind kind, const atmos_wavelengths *w
         const double tau = br * HR * (1 - exp(-TOP / HR)) + bm * HM * (1 - exp(-TOP / HM));
         CHECK_REL(tau_of(aer, p0, up, INFINITY, k), tau, 5e-3);
     }
-    atmos_atmosphere_destroy(air);
-    atmos_atmosphere_destroy(aer);
 }
 
 /* Ozone: its vertical optical depth (with minus without) is proportional to the column,
  * and largest in the Chappuis band (peak near 600 nm) of rgb's three wavelengths. */
-static void test_ozone(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_ozone(const atmos_atmosphere *none, const atmos_atmosphere *o300, const atmos_atmosphere *o600,
+                       const atmos_wavelengths *wl)
 {
-    atmos_atmosphere *none = make(kind, 1, 0, wl), *o300 = make(kind, 1, 300, wl), *o600 = make(kind, 1, 600, wl);
     const double p0[3] = {0, 0, 0}, up[3] = {0, 1, 0};
     double d300[ATMOS_MAX_WAVELENGTHS];
     for (int k = 0; k < wl->count; k++) {
@@ -121,15 +118,11 @@ static void test_ozone(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
         CHECK_REL(tau_of(o600, p0, up, INFINITY, k) - t0, 2 * d300[k], 1e-2);
     }
     CHECK(d300[1] > d300[0] && d300[1] > d300[2]); /* 550 nm above 680 and 440 nm */
-    atmos_atmosphere_destroy(none);
-    atmos_atmosphere_destroy(o300);
-    atmos_atmosphere_destroy(o600);
 }
 
 /* Slanted, grazing, finite and from-space paths against the quadrature (all constituents). */
-static void test_slant(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_slant(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 {
-    atmos_atmosphere *a = make(kind, 1, 300, wl);
     static const struct {
         double h, el, dist;
     } paths[] = {{0, 30, INFINITY},   {0, 10, INFINITY},    {0, 2, INFINITY},         {0, 0, INFINITY},
@@ -146,7 +139,6 @@ static void test_slant(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
                       k, t, q[k]);
         }
     }
-    atmos_atmosphere_destroy(a);
 }
 
 static void sunlight(const atmos_atmosphere *a, double h, double el, double *E)
@@ -157,9 +149,8 @@ static void sunlight(const atmos_atmosphere *a, double h, double el, double *E)
     atmos_atmosphere_sunlight(a, p, s, E);
 }
 
-static void test_sunlight(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_sunlight(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 {
-    atmos_atmosphere *a = make(kind, 1, 300, wl);
     const int n = wl->count;
     double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
     /* in the planet's shadow: on the ground after sunset, at 10 km at midnight, and from
@@ -197,7 +188,6 @@ static void test_sunlight(atmos_atmosphere_kind kind, const atmos_wavelengths *w
         CHECK_MSG(r < ratio, "sun %g: blue/red %g not below %g", els[i], r, ratio);
         ratio = r;
     }
-    atmos_atmosphere_destroy(a);
 }
 
 static int finite_nonneg(const double *L, int n)
@@ -223,9 +213,8 @@ static int close_rel(const double *a, const double *b, int n, double tol)
 }
 
 /* The horizon: approaching it from above and from below the radiance converges. */
-static void test_horizon(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_horizon(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 {
-    atmos_atmosphere *a = make(kind, 1, 300, wl);
     const int n = wl->count;
     for (int ih = 0; ih < 2; ih++) {
         const double h = ih ? 10e3 : 0, p[3] = {0, h, 0}, dip = acos(R / (R + h)) / DEG;
@@ -239,7 +228,6 @@ static void test_horizon(atmos_atmosphere_kind kind, const atmos_wavelengths *wl
             }
         }
     }
-    atmos_atmosphere_destroy(a);
 }
 
 /* The point where the ray x - s d (s > 0, backward from x) is at radius r. */
@@ -253,9 +241,8 @@ static void back_to(const double x[3], const double d[3], double r, double out[3
 
 /* Crossing the top: the same ray seen from 0.5 km below the top, 50 km above it and from
  * 36 000 km gives the same radiance. */
-static void test_top_crossing(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_top_crossing(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 {
-    atmos_atmosphere *a = make(kind, 1, 300, wl);
     const int n = wl->count;
     static const struct {
         double h, el; /* a point of the ray and its elevation there */
@@ -277,13 +264,11 @@ static void test_top_crossing(atmos_atmosphere_kind kind, const atmos_wavelength
             CHECK_MSG(close_rel(Lin, Lout, n, 2e-2), "ray %zu sun %d: inside %g, outside %g", i, sun, Lin[1], Lout[1]);
             CHECK_MSG(close_rel(Lfar, Lout, n, 1e-2), "ray %zu sun %d: far %g, outside %g", i, sun, Lfar[1], Lout[1]);
         }
-    atmos_atmosphere_destroy(a);
 }
 
 /* Views mirrored about the vertical plane of the sun and the observer see the same. */
-static void test_mirror(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_mirror(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 {
-    atmos_atmosphere *a = make(kind, 1, 300, wl);
     const int n = wl->count;
     static const double hs[] = {0, 10e3, 1000e3}, suns[] = {10, -4}, els[] = {30, 3, -20, -60}, daz[] = {30, 90, 150};
     for (int ih = 0; ih < 3; ih++)
@@ -297,14 +282,12 @@ static void test_mirror(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
                     CHECK_MSG(close_rel(L1, L2, n, 1e-3), "h %g sun %g el %g daz %g: %g vs %g", hs[ih], suns[is],
                               els[ie], daz[ia], L1[1], L2[1]);
                 }
-    atmos_atmosphere_destroy(a);
 }
 
 /* Finite, non-negative radiance everywhere: observers from the ground to 36 000 km, the sun
  * from the zenith to 30 degrees below the horizon, views from the zenith to the nadir. */
-static void test_grid(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
+static void test_grid(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 {
-    atmos_atmosphere *a = make(kind, 1, 300, wl);
     const int n = wl->count;
     static const double hs[] = {0, 10e3, 100e3, 1000e3, 36000e3}, suns[] = {90, 10, -6, -30};
     static const double els[] = {-90, -60, -30, -10, -3, -1, 0, 1, 10, 45, 90}, azs[] = {0, 90, 180};
@@ -325,7 +308,6 @@ static void test_grid(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
                 }
     CHECK_MSG(bad == 0, "%d views with negative or non-finite radiance", bad);
     CHECK_MSG(lit > 200, "only %d of 660 views lit", lit);
-    atmos_atmosphere_destroy(a);
 }
 
 int main(void)
@@ -334,14 +316,22 @@ int main(void)
     atmos_wavelengths_rgb(&wl);
     const atmos_atmosphere_kind kinds[] = {ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL};
     for (int i = 0; i < 2; i++) {
-        test_vertical(kinds[i], &wl);
-        test_ozone(kinds[i], &wl);
-        test_slant(kinds[i], &wl);
-        test_sunlight(kinds[i], &wl);
-        test_horizon(kinds[i], &wl);
-        test_top_crossing(kinds[i], &wl);
-        test_mirror(kinds[i], &wl);
-        test_grid(kinds[i], &wl);
+        /* air molecules only; with aerosols; the defaults (300 DU of ozone); 600 DU */
+        atmos_atmosphere *air = make(kinds[i], 0, 0, &wl), *aer = make(kinds[i], 1, 0, &wl);
+        atmos_atmosphere *a = make(kinds[i], 1, 300, &wl), *o600 = make(kinds[i], 1, 600, &wl);
+        if (!air || !aer || !a || !o600) return test_summary("test_sky_physics");
+        test_vertical(air, aer, &wl);
+        test_ozone(aer, a, o600, &wl);
+        test_slant(a, &wl);
+        test_sunlight(a, &wl);
+        test_horizon(a, &wl);
+        test_top_crossing(a, &wl);
+        test_mirror(a, &wl);
+        test_grid(a, &wl);
+        atmos_atmosphere_destroy(air);
+        atmos_atmosphere_destroy(aer);
+        atmos_atmosphere_destroy(a);
+        atmos_atmosphere_destroy(o600);
     }
     return test_summary("test_sky_physics");
 }
