@@ -240,11 +240,30 @@ double acc_rel_errors(const acc_run *r, const acc_opts *o, int m, int a, int s, 
     return rel_error(acc_luminance(&r->wl, M), acc_luminance(&r->wl, L), o->floor * block_max(r, a, s, -1));
 }
 
+/* The reference's relative standard error of Y over block (a, s): RMS and max over its
+ * views (the same for every model). */
+static void block_se(const acc_run *r, const acc_opts *o, int a, int s, acc_stats *st)
+{
+    const double ymax = block_max(r, a, s, -1);
+    st->se_rms_y = st->se_max_y = 0;
+    for (int v = 0; v < r->nview[a]; v++) {
+        const size_t i = acc_index(r, a, s, v);
+        double vy = 0;
+        for (int k = 0; k < r->wl.count; k++) vy += pow(r->wl.to_xyz[k][1] * r->se[i + (size_t)k], 2);
+        const double y = acc_luminance(&r->wl, r->ref + i), den = fmax(y, o->floor * ymax);
+        const double rse = den > 0 ? sqrt(vy) / den : 0.0;
+        st->se_rms_y += rse * rse;
+        st->se_max_y = fmax(st->se_max_y, rse);
+    }
+    if (r->nview[a]) st->se_rms_y = sqrt(st->se_rms_y / r->nview[a]);
+}
+
 static void acc_block_stats(const acc_run *r, const acc_opts *o, int m, int a, int s, acc_stats *st)
 {
     const int n = r->wl.count;
     memset(st, 0, sizeof *st);
-    double e[ATMOS_MAX_WAVELENGTHS], ymax = block_max(r, a, s, -1);
+    block_se(r, o, a, s, st);
+    double e[ATMOS_MAX_WAVELENGTHS];
     for (int v = 0; v < r->nview[a]; v++) {
         const size_t i = acc_index(r, a, s, v);
         if (isnan(r->mod[m][i])) continue;
@@ -256,15 +275,9 @@ static void acc_block_stats(const acc_run *r, const acc_opts *o, int m, int a, i
             st->rms[k] += e[k] * e[k];
             if (fabs(e[k]) > fabs(st->worst[k])) st->worst[k] = e[k];
         }
-        double vy = 0;
-        for (int k = 0; k < n; k++) vy += r->wl.to_xyz[k][1] * r->wl.to_xyz[k][1] * r->se[i + (size_t)k] * r->se[i + (size_t)k];
-        const double y = acc_luminance(&r->wl, r->ref + i), rse = sqrt(vy) / fmax(y, o->floor * ymax);
-        st->se_rms_y += rse * rse;
-        st->se_max_y = fmax(st->se_max_y, rse);
     }
     if (!st->views) return;
     st->rms_y = sqrt(st->rms_y / st->views);
-    st->se_rms_y = sqrt(st->se_rms_y / st->views);
     for (int k = 0; k < n; k++) st->rms[k] = sqrt(st->rms[k] / st->views);
 }
 

@@ -43,7 +43,7 @@ static void table_summary(FILE *f, const acc_run *r, const acc_opts *o)
             for (int m = 0; m < ACC_MODELS; m++) {
                 if (!o->use[m]) continue;
                 const acc_stats *st = &r->stats[m][a][s];
-                if (st->views) any = st;
+                any = st; /* the reference's figures: the same in every model's stats */
                 pct(f, st->views ? st->rms_y : NAN, 0);
                 pct(f, st->views ? st->worst_y : NAN, 1);
             }
