@@ -24,7 +24,8 @@ static void help(void)
 {
     printf("Usage: atmos bench sky-accuracy [--quick] [--paths N] [--target-se X] [--max-paths N]\n"
            "                                [--models riley,dobashi,spherical] [--spectral N] [--seed S]\n"
-           "                                [--threads T] [--out DIR] [--map-range X] [--floor X]\n\n"
+           "                                [--threads T] [--out DIR] [--map-range X] [--floor X]\n"
+           "                                [--altitudes LIST] [--suns LIST]\n\n"
            "Compares each model's view radiance (atmos_atmosphere_radiance, the sun's disk hidden) with\n"
            "the reference (atmos_atmosphere_reference_radiance: Monte Carlo walks, all orders) on a fixed\n"
            "grid: observers at 0, 10, 100, 1000 and 36 000 km above the ground, suns at 90, 45, 10, 2,\n"
