@@ -129,32 +129,38 @@ static unsigned long long mix64(unsigned long long x)
     return x ^ (x >> 31);
 }
 
-/* The reference along one view: batches of o->paths walks (each its own seed) until the
- * relative standard error of Y reaches o->target_se or the walks reach o->max_paths; the
- * batches' mean and the standard error of that mean. */
-static atmos_status reference_view(const atmos_atmosphere *ref, const acc_opts *o, const atmos_wavelengths *wl,
+/* The reference along one view: adds batches of o->paths walks (batch b with its own seed)
+ * to the view's running estimate (L, se: the batches' mean and the standard error of that
+ * mean over *used walks) until the standard error of Y is at most o->target_se times
+ * max(Y, y_floor) or the walks would pass o->max_paths; first_only: one batch. */
+static atmos_status reference_more(const atmos_atmosphere *ref, const acc_opts *o, const atmos_wavelengths *wl,
                                    const double p[3], const double d[3], const double sun[3],
-                                   unsigned long long seed, double *L, double *se, long *used)
+                                   unsigned long long seed, double y_floor, int first_only, double *L, double *se,
+                                   long *used)
 {
     const int n = wl->count;
-    double sum[ATMOS_MAX_WAVELENGTHS] = {0}, var[ATMOS_MAX_WAVELENGTHS] = {0};
+    int batches = (int)(*used / o->paths);
+    double sum[ATMOS_MAX_WAVELENGTHS], var[ATMOS_MAX_WAVELENGTHS];
     double b[ATMOS_MAX_WAVELENGTHS], bse[ATMOS_MAX_WAVELENGTHS];
-    int batches = 0;
+    for (int k = 0; k < n; k++) sum[k] = L[k] * batches, var[k] = se[k] * batches * se[k] * batches;
     for (;;) {
+        if (batches > 0) {
+            double vy = 0;
+            for (int k = 0; k < n; k++) vy += wl->to_xyz[k][1] * wl->to_xyz[k][1] * se[k] * se[k];
+            const double y = acc_luminance(wl, L);
+            if (first_only || !(o->target_se > 0) || sqrt(vy) <= o->target_se * fmax(fabs(y), y_floor) ||
+                (long)(batches + 1) * o->paths > o->max_paths)
+                break;
+        }
         atmos_status st =
             atmos_atmosphere_reference_radiance(ref, p, d, sun, o->paths, mix64(seed + (unsigned)batches), 0, b, bse);
         if (st != ATMOS_OK) return st;
         batches++;
-        for (int k = 0; k < n; k++) sum[k] += b[k], var[k] += bse[k] * bse[k];
-        double vy = 0;
         for (int k = 0; k < n; k++) {
+            sum[k] += b[k], var[k] += bse[k] * bse[k];
             L[k] = sum[k] / batches;
             se[k] = sqrt(var[k]) / batches;
-            vy += wl->to_xyz[k][1] * wl->to_xyz[k][1] * se[k] * se[k];
         }
-        const double y = acc_luminance(wl, L);
-        if (!(o->target_se > 0) || sqrt(vy) <= o->target_se * fabs(y) || (long)(batches + 1) * o->paths > o->max_paths)
-            break;
     }
     *used = (long)batches * o->paths;
     return ATMOS_OK;
@@ -170,28 +176,36 @@ static void view_geometry(const acc_run *r, int a, int s, int v, double p[3], do
     atmos_direction_from_angles(90.0 - w->zenith_deg, 180.0 + w->dazimuth_deg, d);
 }
 
-/* Every view of the grid: the reference and each model (NAN where a model is n/a: Riley's
- * flat earth from 36 000 km). */
-static atmos_status acc_measure(acc_run *r, const acc_opts *o, const atmos_atmosphere *ref,
-                                atmos_atmosphere *const *models)
+static int omp_threads(const acc_opts *o)
 {
-    const int total = r->nalt * r->nsun * ACC_MAX_VIEWS, n = r->wl.count;
-    int failed = 0, nt = o->threads, views = 0, done = 0;
-    for (int a = 0; a < r->nalt; a++) views += r->nview[a] * r->nsun;
-    const double t0 = cli_now_s();
+    int nt = o->threads;
 #ifdef _OPENMP
     if (nt <= 0) nt = omp_get_max_threads();
 #endif
-    if (nt <= 0) nt = 1;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+    return nt > 0 ? nt : 1;
+}
+
+static unsigned long long view_seed(const acc_opts *o, int t)
+{
+    return o->seed * 0x100000001ull + (unsigned long long)t * 977u;
+}
+
+/* Every view of the grid: one batch of the reference and each model (NAN where a model is
+ * n/a: Riley's flat earth from 36 000 km). */
+static atmos_status measure_first(acc_run *r, const acc_opts *o, const atmos_atmosphere *ref,
+                                  atmos_atmosphere *const *models)
+{
+    const int total = r->nalt * r->nsun * ACC_MAX_VIEWS, n = r->wl.count;
+    int failed = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(o))
     for (int t = 0; t < total; t++) {
         const int a = t / (r->nsun * ACC_MAX_VIEWS), s = t / ACC_MAX_VIEWS % r->nsun, v = t % ACC_MAX_VIEWS;
         if (v >= r->nview[a]) continue;
         double p[3], sun[3], d[3];
         view_geometry(r, a, s, v, p, sun, d);
         const size_t i = acc_index(r, a, s, v);
-        if (reference_view(ref, o, &r->wl, p, d, sun, o->seed * 0x100000001ull + (unsigned long long)t * 977u,
-                           r->ref + i, r->se + i, r->paths_used + i / (size_t)n) != ATMOS_OK) {
+        if (reference_more(ref, o, &r->wl, p, d, sun, view_seed(o, t), 0, 1, r->ref + i, r->se + i,
+                           r->paths_used + i / (size_t)n) != ATMOS_OK) {
 #pragma omp atomic write
             failed = 1;
             continue;
@@ -204,11 +218,42 @@ static atmos_status acc_measure(acc_run *r, const acc_opts *o, const atmos_atmos
             }
             atmos_atmosphere_radiance(models[m], p, d, sun, r->mod[m] + i, NULL);
         }
+    }
+    return failed ? ATMOS_E_INVALID_ARG : ATMOS_OK;
+}
+
+/* With a target standard error: more batches for each view until its standard error of Y
+ * is at most the target times max(Y, floor x the block's largest Y after the first batch),
+ * the denominator of its relative errors (views far darker than their block stop early). */
+static atmos_status measure_refine(acc_run *r, const acc_opts *o, const atmos_atmosphere *ref)
+{
+    if (!(o->target_se > 0)) return ATMOS_OK;
+    const int total = r->nalt * r->nsun * ACC_MAX_VIEWS, n = r->wl.count;
+    double ymax[8][8] = {{0}};
+    int failed = 0, views = 0, done = 0;
+    for (int a = 0; a < r->nalt; a++)
+        for (int s = 0; s < r->nsun; s++)
+            for (int v = 0; v < r->nview[a]; v++, views++)
+                ymax[a][s] = fmax(ymax[a][s], acc_luminance(&r->wl, r->ref + acc_index(r, a, s, v)));
+    const double t0 = cli_now_s();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(o))
+    for (int t = 0; t < total; t++) {
+        const int a = t / (r->nsun * ACC_MAX_VIEWS), s = t / ACC_MAX_VIEWS % r->nsun, v = t % ACC_MAX_VIEWS;
+        if (v >= r->nview[a]) continue;
+        double p[3], sun[3], d[3];
+        view_geometry(r, a, s, v, p, sun, d);
+        const size_t i = acc_index(r, a, s, v);
+        if (reference_more(ref, o, &r->wl, p, d, sun, view_seed(o, t), o->floor * ymax[a][s], 0, r->ref + i,
+                           r->se + i, r->paths_used + i / (size_t)n) != ATMOS_OK) {
+#pragma omp atomic write
+            failed = 1;
+        }
         int now;
 #pragma omp atomic capture
         now = ++done;
         if (!o->quick && now * 10 / views != (now - 1) * 10 / views)
-            fprintf(stderr, "atmos bench sky-accuracy: %d of %d views, %.0f s\n", now, views, cli_now_s() - t0);
+            fprintf(stderr, "atmos bench sky-accuracy: %d of %d views refined, %.0f s\n", now, views,
+                    cli_now_s() - t0);
     }
     return failed ? ATMOS_E_INVALID_ARG : ATMOS_OK;
 }
@@ -430,7 +475,8 @@ int bench_sky_accuracy_main(int argc, char **argv)
         st = acc_alloc(r);
     }
     const double t0 = cli_now_s();
-    if (st == ATMOS_OK) st = acc_measure(r, &o, ref, models);
+    if (st == ATMOS_OK) st = measure_first(r, &o, ref, models);
+    if (st == ATMOS_OK) st = measure_refine(r, &o, ref);
     if (st == ATMOS_OK) {
         r->seconds = cli_now_s() - t0;
         for (int m = 0; m < ACC_MODELS; m++)
