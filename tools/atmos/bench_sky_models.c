@@ -66,8 +66,8 @@ static void view_scene(atmos_scene *sc, atmos_atmosphere_kind kind, int space, i
     }
 }
 
-/* Best wall time of `frames` frames of one plan, the sun turning 0.01 degree a frame (so
- * every frame is rendered, not reused). */
+/* Best wall time of `frames` frames of one plan, the camera moving 1 m east a frame (so
+ * every frame is rendered, not reused; the sun stays, as in a walk or a flight). */
 static atmos_status time_frames(atmos_context *ctx, const atmos_scene *sc, int frames, double *best)
 {
     atmos_plan *p = NULL;
@@ -77,8 +77,10 @@ static atmos_status time_frames(atmos_context *ctx, const atmos_scene *sc, int f
     if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, sc, &f);
     if (st == ATMOS_OK) st = atmos_plan_image_create(p, &f, &img);
     *best = 1e30;
+    atmos_direction_from_angles(30.0, 180.0, f.sun_dir);
     for (int i = 0; i < frames && st == ATMOS_OK; i++) {
-        atmos_direction_from_angles(30.0 + 0.01 * i, 180.0, f.sun_dir);
+        f.camera.position[0] += 1.0;
+        f.camera.look_at[0] += 1.0;
         const double t0 = cli_now_s();
         st = atmos_plan_render(p, &f, NULL, img, NULL);
         const double t = cli_now_s() - t0;
@@ -89,25 +91,35 @@ static atmos_status time_frames(atmos_context *ctx, const atmos_scene *sc, int f
     return st;
 }
 
-/* One view of one model: a 12x8 probe, then the largest of 45x30, 90x60, 180x120, 360x240
- * and 720x480 whose estimated time for `repeat` frames fits budget_s (slow models are
- * measured smaller). */
+/* One view of one model. A frame costs a fixed part (tables that depend on the camera or
+ * the sun) plus a part per pixel. Starting from frames of 1x1 and 12x8 pixels (best of 2),
+ * the image grows through 45x30, 90x60, 180x120, 360x240 to 720x480 while the cost the last
+ * two sizes predict for the next one (fixed + per pixel) fits budget_s for `repeat` frames;
+ * the last size is measured with `repeat` frames when they fit (slow models: smaller). */
 static atmos_status bench_view(atmos_context *ctx, const char *name, atmos_atmosphere_kind kind, int space,
                                int repeat, double budget_s)
 {
     static const int divs[] = {60, 16, 8, 4, 2, 1};
     atmos_scene sc;
-    double t;
-    int i = 0;
+    double t_prev, t;
+    view_scene(&sc, kind, space, 1, 1);
+    atmos_status st = time_frames(ctx, &sc, 2, &t_prev);
+    double px_prev = 1, px = (double)(FULL_W / divs[0]) * (FULL_H / divs[0]);
     view_scene(&sc, kind, space, FULL_W / divs[0], FULL_H / divs[0]);
-    atmos_status st = time_frames(ctx, &sc, 1, &t);
-    while (st == ATMOS_OK && i < 5 && t * (double)(divs[i] * divs[i]) / (divs[i + 1] * divs[i + 1]) * repeat <= budget_s) {
+    if (st == ATMOS_OK) st = time_frames(ctx, &sc, 2, &t);
+    int i = 0;
+    while (st == ATMOS_OK && i < 5) {
+        const double per_px = fmax((t - t_prev) / (px - px_prev), 0.0), fixed = fmax(t - per_px * px, 0.0);
+        const double px_next = (double)(FULL_W / divs[i + 1]) * (FULL_H / divs[i + 1]);
+        if ((fixed + per_px * px_next) * (repeat > 2 ? repeat : 2) > budget_s) break;
         i++;
         view_scene(&sc, kind, space, FULL_W / divs[i], FULL_H / divs[i]);
-        st = time_frames(ctx, &sc, repeat, &t);
+        t_prev = t, px_prev = px, px = px_next;
+        st = time_frames(ctx, &sc, 2, &t);
     }
+    if (st == ATMOS_OK && repeat > 2 && t * repeat <= budget_s) st = time_frames(ctx, &sc, repeat, &t);
     if (st != ATMOS_OK) return st;
-    const double px = (double)sc.width * sc.height, scale = (double)FULL_W * FULL_H / px;
+    const double scale = (double)FULL_W * FULL_H / px;
     const int threads = atmos_context_threads(ctx);
     printf("bench=sky case=%s model=%s wavelengths=rgb size=%dx%d threads=%d seconds=%.5f ns_per_pixel=%.1f",
            space ? "space" : "ground", name, sc.width, sc.height, threads, t, t * threads * 1e9 / px);
