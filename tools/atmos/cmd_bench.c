@@ -3,6 +3,7 @@
 #include "cli.h"
 #include "atmos/cache.h"
 #include "bench_render.h"
+#include "bench_sky.h"
 
 #include <math.h>
 
@@ -15,7 +16,8 @@
 
 static void help(void)
 {
-    printf("Usage: atmos bench sky [--size N] [--repeat R] [--threads T]\n"
+    printf("Usage: atmos bench sky [--size N] [--repeat R] [--threads T] [--models LIST] [--budget S]\n"
+           "       atmos bench sky-accuracy [--quick] [--paths N] ... (atmos bench sky-accuracy --help)\n"
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--json]\n"
@@ -26,6 +28,20 @@ static void help(void)
            "          prints per case the best wall time and megapixels per second:\n"
            "            bench=sky camera=pinhole wavelengths=rgb size=1024x1024 threads=2 seconds=0.0401 mpix_per_s=26.1\n"
            "          The time covers rendering the spectral image and converting it to linear sRGB.\n"
+           "          Then per atmosphere model (--models, default riley,dobashi,spherical): the time to\n"
+           "          create it at rgb (its tables) in an empty private cache and again (best of 2; the\n"
+           "          same when the model keeps no cache):\n"
+           "            bench=sky case=precompute model=spherical wavelengths=rgb threads=2 precompute_seconds=0.41 cached_seconds=0.01\n"
+           "          and the sky renderer's cost per frame of one plan (the camera moving 1 m a frame,\n"
+           "          the sun fixed; best of R) at 720x480, from 2 m above the ground toward the horizon\n"
+           "          (90 degree field) and from 36 000 km at the whole Earth (20 degree field), with\n"
+           "          frames per second for the latter; ns_per_pixel = seconds x threads / pixels:\n"
+           "            bench=sky case=space model=spherical wavelengths=rgb size=720x480 threads=2 seconds=0.0123 ns_per_pixel=71.2 fps=81.3\n"
+           "          The image grows from 1x1 and 12x8 through 45x30 ... 720x480 while the time the last\n"
+           "          two sizes predict (a fixed part per frame plus a part per pixel) fits --budget S\n"
+           "          seconds per case (default 2); a model too slow for 720x480 is reported at the last\n"
+           "          size with extrapolated=1 (fps scaled to 720x480). A larger --budget gives longer,\n"
+           "          steadier runs.\n"
            "  optics  Mie scattering at x = 10000, m = 1.33 - 1e-8i, 1801 angles on one thread (best of 3):\n"
            "            bench=optics case=mie x=10000 angles=1801 threads=1 seconds=0.0123\n"
            "          then, per preset (default rain, cloud, ice, snow; --presets to choose) and wavelength\n"
@@ -70,7 +86,7 @@ static void help(void)
            "          (docs/path.md), to measure what they gain.\n");
 }
 
-static int bench_sky(int size, int repeat, int threads)
+static int bench_sky(int size, int repeat, int threads, const char *models, double budget)
 {
     static const struct {
         const char *name;
@@ -118,7 +134,7 @@ static int bench_sky(int size, int repeat, int threads)
             fflush(stdout);
         }
     atmos_context_destroy(ctx);
-    return CLI_EXIT_OK;
+    return bench_sky_models(threads, repeat, budget, models);
 }
 
 /* Removes the private cache directory of bench_optics (only our entries are in it). */
@@ -420,12 +436,29 @@ static int bench_slice(const char *file, int size, int frames, int threads, doub
     return rc;
 }
 
+/* A comma-separated list of riley, dobashi, spherical. */
+static int model_list_ok(const char *list)
+{
+    static const char *const names[] = {"riley", "dobashi", "spherical"};
+    if (!*list) return 0;
+    for (const char *t = list; *t;) {
+        const size_t len = strcspn(t, ",");
+        int found = 0;
+        for (int m = 0; m < 3; m++) found |= len == strlen(names[m]) && !strncmp(t, names[m], len);
+        if (!found) return 0;
+        t += len;
+        if (*t == ',' && !*++t) return 0;
+    }
+    return 1;
+}
+
 int cli_cmd_bench(int argc, char **argv)
 {
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16;
-    double dscale = 0, eye_scale = 0;
-    const char *what = NULL, *presets = NULL, *file = NULL;
+    double dscale = 0, eye_scale = 0, budget = 2;
+    const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL;
+    if (argc > 1 && !strcmp(argv[1], "sky-accuracy")) return bench_sky_accuracy_main(argc - 1, argv + 1);
     bench_path_opts pflags;
     memset(&pflags, 0, sizeof pflags);
     for (int i = 1; i < argc; i++) {
@@ -460,6 +493,13 @@ int cli_cmd_bench(int argc, char **argv)
         } else if (!strcmp(argv[i], "--presets") && i + 1 < argc) {
             presets = argv[++i];
             if (!*presets || strlen(presets) >= 256) return cli_usage_error(C, "--presets: expected a list like rain,cloud");
+        } else if (!strcmp(argv[i], "--models") && i + 1 < argc) {
+            models = argv[++i];
+            if (!model_list_ok(models))
+                return cli_usage_error(C, "--models: expected a list of riley, dobashi, spherical, got '%s'", models);
+        } else if (!strcmp(argv[i], "--budget") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--budget", argv[++i], &budget) || !(budget > 0))
+                return cli_usage_error(C, "--budget: expected seconds > 0");
         } else if (!strcmp(argv[i], "--file") && i + 1 < argc) {
             file = argv[++i];
         } else if (argv[i][0] == '-') {
@@ -470,12 +510,12 @@ int cli_cmd_bench(int argc, char **argv)
             return cli_usage_error(C, "unexpected argument '%s'", argv[i]);
         }
     }
-    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, optics, volume, slice, path)");
+    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, sky-accuracy, optics, volume, slice, path)");
     pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale, pflags.json = json;
     if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
     if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, json);
-    if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);
+    if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads, models, budget);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);
-    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, optics, volume, slice, path)", what);
+    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, sky-accuracy, optics, volume, slice, path)", what);
 }
