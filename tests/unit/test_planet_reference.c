@@ -483,6 +483,16 @@ int main(void)
         double L[3];
         const double p[3] = {0, 0, 0}, d[3] = {0, 1, 0};
         CHECK(atmos_atmosphere_reference_radiance(a, p, d, d, 0, 1, 0, L, NULL) == ATMOS_E_INVALID_ARG);
+        const double zero[3] = {0, 0, 0}, bad[3] = {0, NAN, 0};
+        CHECK(atmos_atmosphere_reference_radiance(a, p, zero, d, 10, 1, 0, L, NULL) == ATMOS_E_INVALID_ARG);
+        CHECK(atmos_atmosphere_reference_radiance(a, p, d, zero, 10, 1, 0, L, NULL) == ATMOS_E_INVALID_ARG);
+        CHECK(atmos_atmosphere_reference_radiance(a, bad, d, d, 10, 1, 0, L, NULL) == ATMOS_E_INVALID_ARG);
+        /* an eye under the ground sees from the ground point above it */
+        const double under[3] = {0, -50, 0}, ground[3] = {0, 0, 0};
+        double Lu[3], Lg[3];
+        CHECK_OK(atmos_atmosphere_reference_radiance(a, under, d, d, 200, 5, 0, Lu, NULL));
+        CHECK_OK(atmos_atmosphere_reference_radiance(a, ground, d, d, 200, 5, 0, Lg, NULL));
+        CHECK(fabs(Lu[1] - Lg[1]) <= 1e-9 * Lg[1]);
     }
     atmos_atmosphere_destroy(a);
     a = make_atm(ctx, 1.0);
