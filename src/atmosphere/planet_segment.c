@@ -46,10 +46,10 @@ static void make_cell(double g0, double g1, double dt, seg_cell *c)
 }
 
 /* The column of an exponential profile (scale height H, 1 at the ground) from radius r to
- * space along a direction of zenith cosine mu, approximately: rising, the Chapman function's
- * approximation ch = c / ((c - 1) mu + 1), c = sqrt(pi r / (2 H)) (exact at mu = 0 and 1 to
- * first order); sinking, the whole grazing path through the perigee less the part behind the
- * point. Only the sampling density uses it. */
+ * space along a direction of zenith cosine mu, approximately: rising, the Chapman function
+ * ch(x, mu) interpolated as c / ((c - 1) mu + 1), c = sqrt(pi x / 2), x = r / H (1 at the
+ * zenith, the large-x horizontal value sqrt(pi x / 2) at mu = 0); sinking, the whole grazing
+ * path through the perigee less the part behind the point. Only the sampling density uses it. */
 static double column(double R, double r, double mu, double H)
 {
     const double c = sqrt(ATMOS_PI * r / (2.0 * H)), rho = exp(-(r - R) / H);
