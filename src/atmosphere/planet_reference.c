@@ -158,6 +158,9 @@ atmos_status atmos_atmosphere_reference_radiance(const atmos_atmosphere *atm, co
     if (!atm || !atm->planet || !p || !dir || !sun_dir || !out || paths < 1) return ATMOS_E_INVALID_ARG;
     const int n = atm->wl.count;
     double sun[3] = {sun_dir[0], sun_dir[1], sun_dir[2]};
+    const double ls = atmos__dot3(sun, sun), ld = atmos__dot3(dir, dir);
+    if (!(ls > 0) || !(ld > 0) || !isfinite(ls) || !isfinite(ld) || !isfinite(p[0] + p[1] + p[2]))
+        return ATMOS_E_INVALID_ARG;
     atmos__normalize3(sun);
     double *sums = calloc((size_t)n * NBLOCK * 2, sizeof(double));
     if (!sums) return ATMOS_E_NOMEM;

@@ -11,7 +11,7 @@
  *
  * q is a mixture: 80 % a piecewise log-linear density over SEG_N equal cells fitted to the
  * integrand at the cells' ends — sigma_s P, the view's transmittance by the trapezoid rule,
- * the planet's shadow exactly (0 in the shadow; the sun's transmittance itself is left out) —
+ * the planet's shadow exactly, the sun's transmittance from an approximate Chapman function —
  * so that the steep decay of the air along a horizontal ray is followed within a cell; 20 %
  * uniform over the segment (a defence where the fit is poor). Unlike next-event
  * estimation at the walk's collisions, every segment contributes — in thin air most flights
@@ -45,8 +45,23 @@ static void make_cell(double g0, double g1, double dt, seg_cell *c)
     }
 }
 
-/* The sca-weighted view transmittance estimate at the segment's points (no ratio tracking):
- * the integrand's fit at t_j = j dt. */
+/* The column of an exponential profile (scale height H, 1 at the ground) from radius r to
+ * space along a direction of zenith cosine mu, approximately: rising, the Chapman function
+ * ch(x, mu) interpolated as c / ((c - 1) mu + 1), c = sqrt(pi x / 2), x = r / H (1 at the
+ * zenith, the large-x horizontal value sqrt(pi x / 2) at mu = 0); sinking, the whole grazing
+ * path through the perigee less the part behind the point. Only the sampling density uses it. */
+static double column(double R, double r, double mu, double H)
+{
+    const double c = sqrt(ATMOS_PI * r / (2.0 * H)), rho = exp(-(r - R) / H);
+    const double up = rho * H * c / ((c - 1.0) * fabs(mu) + 1.0);
+    if (mu >= 0) return up;
+    const double rp = r * sqrt(fmax(0.0, 1.0 - mu * mu));
+    return fmax(2.0 * exp(-(rp - R) / H) * H * sqrt(ATMOS_PI * rp / (2.0 * H)) - up, 0.0);
+}
+
+/* The integrand's fit at a point t of the segment, without the view's transmittance: the
+ * scattering toward the eye times an approximate transmittance of the sunlight (0 in the
+ * planet's shadow); *ext: the extinction there. */
 static double fit_at(const atmos__planet *pl, const double p[3], const double d[3], const double sun[3], double t, int k,
                      double PR, double PM, double *ext)
 {
@@ -54,7 +69,12 @@ static double fit_at(const atmos__planet *pl, const double p[3], const double d[
     const double h = atmos__planet_altitude(pl, x);
     *ext = atmos__planet_extinction(pl, h, k);
     if (atmos__planet_hit_ground(pl, x, sun) < INFINITY) return 0.0;
-    return pl->rayleigh[k] * atmos__planet_rho_rayleigh(pl, h) * PR + pl->mie_sca[k] * atmos__planet_rho_mie(pl, h) * PM;
+    const double r = h + pl->r_ground, mu = atmos__planet_mu(pl, x, sun);
+    const double tau = pl->rayleigh[k] * column(pl->r_ground, r, mu, pl->h_rayleigh) +
+                       pl->mie_ext[k] * column(pl->r_ground, r, mu, pl->h_mie);
+    return (pl->rayleigh[k] * atmos__planet_rho_rayleigh(pl, h) * PR +
+            pl->mie_sca[k] * atmos__planet_rho_mie(pl, h) * PM) *
+           exp(-fmin(tau, 700.0));
 }
 
 /* Altitude steps (m above the lowest point of a monotone branch) at which the optical depth's
