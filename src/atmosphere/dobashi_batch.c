@@ -12,9 +12,9 @@
  * which are applied per pixel so that the aerosols' forward peak stays sharp) and the view
  * transmittance T. Eq. 12's ground term I_sun r g_l(0, theta_g) cos theta_g T / pi is
  * evaluated per pixel at the ray's ground point (the terminator is sharp; the albedo and
- * the emission are read there). Where the table is not smooth (a cell whose corners'
- * in-scatter differ by more than ROUGH: the terminator on the ground and in the air, the
- * shadowed limb) the pixel's ray is marched exactly instead (dobashi_eval.c). */
+ * the emission are read there). Where the table is not smooth enough (mark_rough: the
+ * terminator on the ground and in the air, the shadowed limb) the pixel's ray is marched
+ * exactly instead (dobashi_eval.c). */
 #include "atmosphere/dobashi.h"
 
 #include "core/vec.h"
@@ -24,7 +24,8 @@
 
 #define NM 64   /* rows per block */
 #define NPHI 17 /* azimuth cosines */
-#define ROUGH 1.15 /* largest ratio of a cell's corners interpolated */
+#define ROUGH 3.0f /* largest ratio of a cell's corners interpolated */
+#define TOL 0.02f  /* largest relative error at a cell's centre */
 
 typedef struct {
     int n, outside;
@@ -76,10 +77,24 @@ static void entry(const atmos_atmosphere *a, const double eye[3], const double s
     }
 }
 
-/* Marks the cells whose corners' S_r + S_m differ by more than ROUGH at some wavelength. */
-static void mark_rough(dob_eye *e)
+/* The direction of zenith cosine mu and azimuth cosine c. */
+static void direction(const dob_eye *e, double mu, double c, double d[3])
+{
+    const double st = sqrt(fmax(1.0 - mu * mu, 0.0)), s = sqrt(fmax(1.0 - c * c, 0.0));
+    for (int k = 0; k < 3; k++) d[k] = mu * e->up[k] + st * (c * e->e1[k] + s * e->e2[k]);
+}
+
+/* Marks the cells that bilinear interpolation misses: the ray through the cell's centre,
+ * marched exactly, differs from the corners' mean by more than TOL (of the table's largest
+ * value / 1000 at least) at some wavelength, or the corners differ by more than a factor
+ * ROUGH (a terminator or a shadow's edge inside the cell). */
+static void mark_rough(dob_eye *e, const atmos_atmosphere *a, const double eye[3], const double sun[3])
 {
     const int n = e->n, n3 = 3 * n;
+    float top[ATMOS_MAX_WAVELENGTHS] = {0};
+    for (size_t c = 0; c < (size_t)2 * NM * NPHI; c++)
+        for (int k = 0; k < n; k++) top[k] = fmaxf(top[k], e->tab[c * n3 + 3 * k] + e->tab[c * n3 + 3 * k + 1]);
+#pragma omp parallel for schedule(dynamic, 1)
     for (int bi = 0; bi < 2 * NM; bi++)
         for (int j = 0; j < NPHI; j++) {
             unsigned char x = 0;
@@ -87,13 +102,27 @@ static void mark_rough(dob_eye *e)
                 const float *c[4];
                 c[0] = e->tab + ((size_t)bi * NPHI + j) * n3, c[1] = c[0] + n3;
                 c[2] = c[0] + (size_t)NPHI * n3, c[3] = c[2] + n3;
+                float mean[ATMOS_MAX_WAVELENGTHS], mid[3 * ATMOS_MAX_WAVELENGTHS];
                 for (int k = 0; k < n && !x; k++) {
                     float lo = INFINITY, hi = 0;
+                    mean[k] = 0;
                     for (int q = 0; q < 4; q++) {
                         const float v = c[q][3 * k] + c[q][3 * k + 1];
-                        lo = fminf(lo, v), hi = fmaxf(hi, v);
+                        lo = fminf(lo, v), hi = fmaxf(hi, v), mean[k] += 0.25f * v;
                     }
-                    x = hi > ROUGH * lo;
+                    x = hi > ROUGH * lo && hi > 1e-3f * top[k];
+                }
+                if (!x) {
+                    const int block = bi / NM, i = bi % NM;
+                    const double xr = (i + 0.5) / (NM - 1), mu = block == 0 ? e->mu_h - (e->mu_h + 1.0) * xr * xr
+                                                                           : e->mu_h + (e->mu_hi - e->mu_h) * xr * xr;
+                    double d[3];
+                    direction(e, mu, -1.0 + 2.0 * (j + 0.5) / (NPHI - 1), d);
+                    entry(a, eye, sun, d, mid);
+                    for (int k = 0; k < n && !x; k++) {
+                        const float v = mid[3 * k] + mid[3 * k + 1];
+                        x = fabsf(v - mean[k]) > TOL * fmaxf(v, 1e-3f * top[k]);
+                    }
                 }
             }
             e->exact[(size_t)bi * NPHI + j] = x;
@@ -127,15 +156,14 @@ void atmos__dobashi_batch_init(atmos__atm_batch *b)
 #pragma omp parallel for schedule(dynamic, 1)
     for (int bi = 0; bi < 2 * NM; bi++) {
         const int block = bi / NM, i = bi % NM;
-        const double mu = row_mu(e, block, i), st = sqrt(fmax(1.0 - mu * mu, 0.0));
+        const double mu = row_mu(e, block, i);
         for (int j = 0; j < NPHI; j++) {
-            const double c = -1.0 + 2.0 * j / (NPHI - 1), s = sqrt(fmax(1.0 - c * c, 0.0));
             double d[3];
-            for (int k = 0; k < 3; k++) d[k] = mu * e->up[k] + st * (c * e->e1[k] + s * e->e2[k]);
+            direction(e, mu, -1.0 + 2.0 * j / (NPHI - 1), d);
             entry(a, b->eye, b->sun, d, e->tab + (size_t)bi * row + (size_t)j * 3 * e->n);
         }
     }
-    mark_rough(e);
+    mark_rough(e, a, b->eye, b->sun);
     b->state = e;
 }
 
