@@ -35,6 +35,8 @@ typedef struct atmos__dobashi {
     int spheres;                /* sample spheres in use (h_sphere[0] = 0, the last at the top) */
     double h_sphere[ATMOS__DOB_SPHERES];
     double mu_split[ATMOS__DOB_SPHERES]; /* cosine below which the ray reaches sphere s - 1 */
+    int sphere_row[ATMOS__DOB_SPHERES];  /* the sphere's row of the height grid */
+    double sphere_mh[ATMOS__DOB_SPHERES]; /* the horizon's cosine there */
     float *gl;     /* [NH][NS][n]: -ln g_l */
     float *plane;  /* [NH][NV][n][3]: dI_r, dI_m, dg_v */
     float *sphere; /* [SPHERES][3 ranges][NSV][n][3] */

@@ -184,9 +184,10 @@ static int lookup(const dob_eye *e, double mu, double c, float *v)
     const int n4 = 3 * e->n;
     int block;
     double x;
-    if (mu >= e->mu_h) block = 1, x = sqrt(fmin((mu - e->mu_h) / (e->mu_hi - e->mu_h), 1.0));
-    else block = 0, x = sqrt(fmin((e->mu_h - mu) / (e->mu_h + 1.0), 1.0));
-    const double xr = x * (NM - 1), xc = 0.5 * (fmin(fmax(c, -1.0), 1.0) + 1.0) * (NPHI - 1);
+    if (mu >= e->mu_h) block = 1, x = (mu - e->mu_h) / (e->mu_hi - e->mu_h);
+    else block = 0, x = (e->mu_h - mu) / (e->mu_h + 1.0);
+    c = c < -1.0 ? -1.0 : (c > 1.0 ? 1.0 : c);
+    const double xr = sqrt(x < 1.0 ? x : 1.0) * (NM - 1), xc = 0.5 * (c + 1.0) * (NPHI - 1);
     int i = (int)xr, j = (int)xc;
     if (i > NM - 2) i = NM - 2;
     if (j > NPHI - 2) j = NPHI - 2;
@@ -224,6 +225,11 @@ void atmos__dobashi_batch_eval(const atmos__atm_batch *b, int count, const float
             continue;
         }
         const double fr = atmos_phase_rayleigh(nu);
+        /* the aerosols' phase table (dobashi_tables.c) at sin(alpha / 2) */
+        const double hu = 0.5 * (1.0 - nu), u = sqrt(hu < 0 ? 0 : (hu > 1 ? 1 : hu)) * (ATMOS__DOB_PHASE_N - 1);
+        int ju = (int)u;
+        if (ju > ATMOS__DOB_PHASE_N - 2) ju = ATMOS__DOB_PHASE_N - 2;
+        const float fu = (float)(u - ju);
         double g[3] = {0, 0, 0}, cs = 0;
         if (ground) { /* the ground point, its sun cosine and g_l(0, theta_g) */
             const double bq = atmos__dot3(e->q, d);
@@ -234,7 +240,8 @@ void atmos__dobashi_batch_eval(const atmos__atm_batch *b, int count, const float
         }
         for (int k = 0; k < n; k++) {
             const float *w = v + 3 * k;
-            double L = a->sun_e[k] * (fr * w[0] + atmos__dobashi_mie_phase(m, k, nu) * w[1] +
+            const float *ph = m->mie + (size_t)k * ATMOS__DOB_PHASE_N + ju;
+            double L = a->sun_e[k] * (fr * w[0] + (ph[0] + fu * (ph[1] - ph[0])) * w[1] +
                                       m->ambient * (1.0 - w[2]));
             if (ground) {
                 const double lit = cs > 0 ? atmos__planet_ground_albedo(a->planet, g, k) / ATMOS_PI * cs * gl[k] : 0;

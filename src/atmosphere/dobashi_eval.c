@@ -22,25 +22,36 @@ static double row_coord(const atmos__dobashi *m, double h, int *i0)
     return x - i;
 }
 
-/* g_l at height h (clamped to the air) and sun cosine mu_s, all wavelengths. */
-static void gl_at(const atmos__dobashi *m, const atmos__planet *pl, double h, double mu_s, double *out)
+/* g_l between rows i and i + 1 (weight fh) at sun cosine mu_s, the horizon's cosine mh. */
+static void gl_rows(const atmos__dobashi *m, int i, double fh, double mh, double mu_s, double *out)
 {
     const int n = m->n;
-    h = fmin(fmax(h, 0.0), m->top);
-    const double mh = horizon_mu(pl, pl->r_ground + h);
     if (mu_s < mh) {
         for (int k = 0; k < n; k++) out[k] = 0.0;
         return;
     }
-    int i, j;
-    const double fh = row_coord(m, h, &i);
-    const double x = sqrt(fmin((mu_s - mh) / (1.0 - mh), 1.0)) * (ATMOS__DOB_NS - 1);
-    j = (int)x;
+    const double y = (mu_s - mh) / (1.0 - mh);
+    const double x = sqrt(y < 1.0 ? y : 1.0) * (ATMOS__DOB_NS - 1);
+    int j = (int)x;
     if (j > ATMOS__DOB_NS - 2) j = ATMOS__DOB_NS - 2;
     const double fs = x - j;
-    const float *a = m->gl + ((size_t)i * ATMOS__DOB_NS + j) * n, *b = a + (size_t)ATMOS__DOB_NS * n;
+    const float *a = m->gl + ((size_t)i * ATMOS__DOB_NS + j) * n;
+    if (fh == 0) {
+        for (int k = 0; k < n; k++) out[k] = exp(-((1 - fs) * a[k] + fs * a[n + k]));
+        return;
+    }
+    const float *b = a + (size_t)ATMOS__DOB_NS * n;
     for (int k = 0; k < n; k++)
         out[k] = exp(-((1 - fh) * ((1 - fs) * a[k] + fs * a[n + k]) + fh * ((1 - fs) * b[k] + fs * b[n + k])));
+}
+
+/* g_l at height h (clamped to the air) and sun cosine mu_s, all wavelengths. */
+static void gl_at(const atmos__dobashi *m, const atmos__planet *pl, double h, double mu_s, double *out)
+{
+    h = fmin(fmax(h, 0.0), m->top);
+    int i;
+    const double fh = row_coord(m, h, &i);
+    gl_rows(m, i, fh, horizon_mu(pl, pl->r_ground + h), mu_s, out);
 }
 
 void atmos__dobashi_gl(const atmos__dobashi *m, const atmos__planet *pl, const double p[3], const double sun[3],
@@ -162,7 +173,7 @@ static int march_spheres(const atmos__dobashi *m, const atmos__planet *pl, const
         const double r = pl->r_ground + m->h_sphere[s];
         const double f = e + 1 < ne && te[e + 1] > dist ? (dist - te[e]) / (te[e + 1] - te[e]) : 1.0;
         sphere_at(m, s, re[e], mue[e], v);
-        gl_at(m, pl, m->h_sphere[s], (qs + te[e] * ds) / r, g);
+        gl_rows(m, m->sphere_row[s], 0.0, m->sphere_mh[s], (qs + te[e] * ds) / r, g);
         add_piece(m->n, v, g, f, sr, sm, T);
     }
     return e;

@@ -150,8 +150,11 @@ atmos__dobashi *atmos__dobashi_build(const atmos__planet *pl, double dt, int nsp
     /* spheres on rows of the height grid: all, or fewer spread over it */
     const int every = nspheres > 1 && nspheres < S ? (S - 1) / (nspheres - 1) : 1;
     m->spheres = (S - 1) / every + 1;
-    for (int s = 0; s < m->spheres; s++)
-        m->h_sphere[s] = row_height(m->top, s * every * ((ATMOS__DOB_NH - 1) / (S - 1)));
+    for (int s = 0; s < m->spheres; s++) {
+        m->sphere_row[s] = s * every * ((ATMOS__DOB_NH - 1) / (S - 1));
+        m->h_sphere[s] = row_height(m->top, m->sphere_row[s]);
+        m->sphere_mh[s] = horizon_mu(pl, m->h_sphere[s]);
+    }
     for (int s = 0; s < m->spheres; s++) {
         const double r = pl->r_ground + m->h_sphere[s], rd = s > 0 ? pl->r_ground + m->h_sphere[s - 1] : r;
         m->mu_split[s] = -sqrt(fmax(1.0 - (rd / r) * (rd / r), 0.0));
