@@ -213,6 +213,28 @@ static void test_batch(const atmos_atmosphere *a)
     CHECK_MSG(worst < 0.03, "batch worst %g", worst);
 }
 
+/* The ambient term adds dobashi_ambient E_sun (1 - T) to the in-scatter of any segment, T
+ * the segment's transmittance; out of range values are refused. */
+static void test_ambient(const atmos_wavelengths *wl, const atmos_atmosphere *a0)
+{
+    atmos_atmosphere_desc ad = *atmos_atmosphere_get_desc(a0);
+    ad.dobashi_ambient = 0.02;
+    atmos_atmosphere *a = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, &ad, wl, &a));
+    if (!a) return;
+    const double eye[3] = {0, 2000, 0}, d[3] = {0.6, 0.0, 0.8}, sun[3] = {0, 0.5, sqrt(0.75)};
+    double with[3], without[3], T[3];
+    atmos_atmosphere_inscatter(a, eye, d, 50e3, sun, with);
+    atmos_atmosphere_inscatter(a0, eye, d, 50e3, sun, without);
+    atmos_atmosphere_transmittance(a, eye, d, 50e3, T);
+    const double *E = atmos__atm_sun_irradiance(a);
+    for (int k = 0; k < 3; k++) CHECK_REL(with[k] - without[k], 0.02 * E[k] * (1.0 - T[k]), 1e-9);
+    atmos_atmosphere_destroy(a);
+    ad.dobashi_ambient = 1.5;
+    a = NULL;
+    CHECK(atmos_atmosphere_create(NULL, &ad, wl, &a) == ATMOS_E_INVALID_ARG && !a);
+}
+
 int main(void)
 {
     atmos_wavelengths wl;
@@ -224,6 +246,7 @@ int main(void)
     test_single_scattering(a);
     test_convergence(a);
     test_batch(a);
+    test_ambient(&wl, a);
     atmos_atmosphere_destroy(a);
     return test_summary("test_dobashi");
 }
