@@ -233,6 +233,13 @@ static void test_ambient(const atmos_wavelengths *wl, const atmos_atmosphere *a0
     ad.dobashi_ambient = 1.5;
     a = NULL;
     CHECK(atmos_atmosphere_create(NULL, &ad, wl, &a) == ATMOS_E_INVALID_ARG && !a);
+    /* the scene key */
+    static const char ok[] = "{\"atmosphere\": {\"model\": \"dobashi\", \"dobashi_ambient\": 0.05}}";
+    static const char bad[] = "{\"atmosphere\": {\"model\": \"dobashi\", \"dobashi_ambient\": -1}}";
+    atmos_scene sc;
+    CHECK_OK(atmos_scene_parse(NULL, ok, strlen(ok), "t", &sc));
+    CHECK(sc.atmosphere.dobashi_ambient == 0.05 && sc.atmosphere.kind == ATMOS_ATMOSPHERE_DOBASHI);
+    CHECK(atmos_scene_parse(NULL, bad, strlen(bad), "t", &sc) == ATMOS_E_INVALID_ARG);
 }
 
 int main(void)
