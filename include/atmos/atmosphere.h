@@ -82,6 +82,11 @@ typedef struct atmos_atmosphere_desc {
                                  (tau_air + tau_aerosol) / tau_air over the vertical */
     double ozone_du;          /* ozone column in Dobson units; default 300 */
     int no_ozone;             /* nonzero: no ozone (ozone_du ignored) */
+    double dobashi_ambient;   /* DOBASHI: the ambient term I_a standing for multiple scattering
+                                 (Dobashi et al. 2002 §3): an isotropic radiance per unit
+                                 extraterrestrial irradiance, sr^-1, that the air along a view
+                                 ray adds as I_a E_sun (1 - T_view); default 0 (single
+                                 scattering only), in [0, 1] */
 } atmos_atmosphere_desc;
 
 ATMOS_API void atmos_atmosphere_defaults(atmos_atmosphere_desc *desc);

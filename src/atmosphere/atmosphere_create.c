@@ -81,6 +81,9 @@ static atmos_status check_planet(atmos_context *ctx, const atmos_atmosphere_desc
                             d->turbidity);
     if (!(d->ozone_du >= 0 && d->ozone_du <= 1000))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/ozone_du: must be in [0, 1000], got %g", d->ozone_du);
+    if (!(d->dobashi_ambient >= 0 && d->dobashi_ambient <= 1))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/dobashi_ambient: must be in [0, 1], got %g",
+                            d->dobashi_ambient);
     return ATMOS_OK;
 }
 

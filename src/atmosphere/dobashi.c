@@ -1,10 +1,61 @@
-/* Dobashi et al. 2002 §5: the sky over a spherical earth from look-up tables.
- * PROVISIONAL: answers by the numeric solver until the tables land. */
-#include "atmosphere/planet_solver.h"
+/* Dobashi et al. 2002 §5: the solver table of ATMOS_ATMOSPHERE_DOBASHI (planet_solver.h)
+ * over the look-up tables of dobashi.h. Every answer is Eq. 12 or a part of it: the view
+ * transmittance is the product of the dg_v, the sunlight I_sun g_l, the in-scatter the sum
+ * over the sub-segments (single scattering) plus the ambient term. */
+#include "atmosphere/dobashi.h"
+
+#include <stdlib.h>
+
+static atmos_status dob_create(atmos_context *ctx, atmos_atmosphere *a)
+{
+    atmos__dobashi *m = atmos__dobashi_build(a->planet, 0.0, 0);
+    if (!m) return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory for Dobashi's tables");
+    m->ambient = a->desc.dobashi_ambient;
+    a->model = m;
+    return ATMOS_OK;
+}
+
+static void dob_transmittance(const atmos_atmosphere *a, const double p[3], const double d[3], double dist, int cnt,
+                              const int *k, double *out)
+{
+    double sr[ATMOS_MAX_WAVELENGTHS], sm[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    atmos__dobashi_march(a->model, a->planet, p, d, dist, d, sr, sm, T);
+    for (int i = 0; i < cnt; i++) out[i] = T[ATMOS__WL(k, i)];
+}
+
+static void dob_sunlight(const atmos_atmosphere *a, const double p[3], const double sun[3], int cnt, const int *k,
+                         double *out)
+{
+    atmos__dobashi_gl(a->model, a->planet, p, sun, cnt, k, out);
+    for (int i = 0; i < cnt; i++) out[i] *= a->sun_e[ATMOS__WL(k, i)];
+}
+
+static int dob_inscatter(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
+                         const double sun[3], int cnt, const int *k, double *out)
+{
+    const atmos__dobashi *m = a->model;
+    double sr[ATMOS_MAX_WAVELENGTHS], sm[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    atmos__dobashi_march(m, a->planet, p, d, dist, sun, sr, sm, T);
+    const double nu = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2], fr = atmos_phase_rayleigh(nu);
+    int any = 0;
+    for (int i = 0; i < cnt; i++) {
+        const int kk = ATMOS__WL(k, i);
+        out[i] = a->sun_e[kk] * (fr * sr[kk] + atmos__planet_mie_phase(a->planet, kk, nu) * sm[kk] +
+                                 m->ambient * (1.0 - T[kk]));
+        any |= out[i] > 0;
+    }
+    return any;
+}
 
 const atmos__planet_solver atmos__dobashi_solver = {
     .name = "dobashi",
-    .transmittance = atmos__numeric_transmittance,
-    .sunlight = atmos__numeric_sunlight,
-    .inscatter = atmos__numeric_inscatter,
+    .create = dob_create,
+    .destroy = atmos__dobashi_free,
+    .transmittance = dob_transmittance,
+    .sunlight = dob_sunlight,
+    .inscatter = dob_inscatter,
+    .radiance = atmos__dobashi_radiance,
+    .batch_init = atmos__dobashi_batch_init,
+    .batch_eval = atmos__dobashi_batch_eval,
+    .batch_release = atmos__dobashi_batch_release,
 };

@@ -33,7 +33,7 @@ extern const atmos__range atmos__r_dim, atmos__r_spp, atmos__r_altitude, atmos__
     atmos__r_latitude, atmos__r_longitude, atmos__r_beta, atmos__r_scale_height, atmos__r_albedo,
     atmos__r_sun_diameter, atmos__r_sun_scale, atmos__r_thickness, atmos__r_radiance, atmos__r_samples, atmos__r_manual_ev,
     atmos__r_compensation, atmos__r_planet_radius, atmos__r_top, atmos__r_visibility, atmos__r_turbidity,
-    atmos__r_ozone;
+    atmos__r_ozone, atmos__r_dobashi_ambient;
 
 /* Reports "SOURCE: PATH: <fmt>" through ctx and returns status. */
 atmos_status atmos__scene_fail(atmos_context *ctx, atmos_status status, const char *source,

@@ -468,8 +468,9 @@ static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *pa
     static const char *const keys[] = {"beta_sl_550_per_m", "scale_height_m", "ground_albedo", "sun_diameter_deg",
                                        "sun_scale", "thickness_m", "planet_radius_m", "top_m",
                                        "rayleigh_scale_height_m", "aerosol_scale_height_m", "visibility_km",
-                                       "turbidity", "ozone_du", "sun_disk", "ozone", "kind", "model", "aerosol"};
-    enum { NUM = 13, K_DISK = 13, K_OZONE, K_KIND, K_MODEL, K_AEROSOL, NKEYS };
+                                       "turbidity", "ozone_du", "dobashi_ambient", "sun_disk", "ozone", "kind",
+                                       "model", "aerosol"};
+    enum { NUM = 14, K_DISK = 14, K_OZONE, K_KIND, K_MODEL, K_AEROSOL, NKEYS };
     static const char *const kinds[] = {"riley", "homogeneous", "dobashi", "spherical"};
     static const atmos_atmosphere_kind kind_of[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS,
                                                     ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL};
@@ -478,12 +479,12 @@ static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *pa
     double *fields[NUM] = {&a->beta_sl_550, &a->scale_height_m, &a->ground_albedo, &a->sun_diameter_deg,
                            &a->sun_scale, &a->thickness_m, &a->planet_radius_m, &a->top_m,
                            &a->rayleigh_scale_height_m, &a->aerosol_scale_height_m, &a->visibility_km,
-                           &a->turbidity, &a->ozone_du};
+                           &a->turbidity, &a->ozone_du, &a->dobashi_ambient};
     const atmos__range *ranges[NUM] = {&atmos__r_beta, &atmos__r_scale_height, &atmos__r_albedo,
                                        &atmos__r_sun_diameter, &atmos__r_sun_scale, &atmos__r_thickness,
                                        &atmos__r_planet_radius, &atmos__r_top, &atmos__r_scale_height,
                                        &atmos__r_scale_height, &atmos__r_visibility, &atmos__r_turbidity,
-                                       &atmos__r_ozone};
+                                       &atmos__r_ozone, &atmos__r_dobashi_ambient};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;

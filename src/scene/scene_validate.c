@@ -37,6 +37,7 @@ const atmos__range atmos__r_top = {60e3, 1e6, 0, 0};
 const atmos__range atmos__r_visibility = {0.5, 1000, 0, 0};
 const atmos__range atmos__r_turbidity = {1, 50, 0, 0};
 const atmos__range atmos__r_ozone = {0, 1000, 0, 0};
+const atmos__range atmos__r_dobashi_ambient = {0, 1, 0, 0};
 
 /* Sines below this count as parallel: the camera basis would be numerically
  * meaningless (about 0.2 arc seconds). */
@@ -287,6 +288,7 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
          &atmos__r_scale_height},
         {"/atmosphere/visibility_km", offsetof(atmos_atmosphere_desc, visibility_km), &atmos__r_visibility},
         {"/atmosphere/ozone_du", offsetof(atmos_atmosphere_desc, ozone_du), &atmos__r_ozone},
+        {"/atmosphere/dobashi_ambient", offsetof(atmos_atmosphere_desc, dobashi_ambient), &atmos__r_dobashi_ambient},
     };
     if (a->kind != ATMOS_ATMOSPHERE_RILEY && a->kind != ATMOS_ATMOSPHERE_VACUUM && a->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS &&
         a->kind != ATMOS_ATMOSPHERE_DOBASHI && a->kind != ATMOS_ATMOSPHERE_SPHERICAL)
