@@ -22,6 +22,11 @@
 /* Steps of the march per monotone piece of a ray (the piece going down to the ray's lowest
  * point and the piece rising from it): the one-ray answers and the tables. */
 #define ATMOS__SPH_STEPS 40
+/* The sky-view table (spherical_batch.c): rows per side of the horizon, azimuths over
+ * [0, pi]; row j of a side at x = (j / (ROWS - 1))^2 (1e-7 at j = 0), azimuth i at
+ * pi i / (AZ - 1). */
+#define ATMOS__SPH_SV_ROWS 48
+#define ATMOS__SPH_SV_AZ 32
 #define ATMOS__SPH_STEPS_TABLE 20
 
 typedef struct atmos__sph_model {

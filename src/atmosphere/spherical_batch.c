@@ -19,9 +19,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NV 48  /* rows per half */
-#define NA 32  /* azimuths over [0, pi] */
-#define NPH 256 /* the Mie phase over x = sqrt((1 - nu) / 2) = sin(theta / 2) */
+#define NV ATMOS__SPH_SV_ROWS
+#define NA ATMOS__SPH_SV_AZ
+#define NPH 1024 /* the Mie phase over x = sqrt((1 - nu) / 2) = sin(theta / 2) */
 #define PLANE (2 * NV * NA)
 
 typedef struct sv_state {
