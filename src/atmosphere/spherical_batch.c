@@ -29,8 +29,9 @@ typedef struct sv_state {
     double up[3], e1[3], e2[3];
     float fup[3], fe1[3], fe2[3], fsun[3];
     float muh;
-    float *tab;  /* [n][3][2 NV][NA]: channel 0 Rayleigh, 1 Mie (no phase), 2 the rest; rows
-                    0..NV-1 above the horizon, NV..2NV-1 below, row 0 / NV at the horizon */
+    float *tab;  /* [2 NV][NA][n][3]: channel 0 Rayleigh, 1 Mie (no phase), 2 the rest; rows
+                    0..NV-1 above the horizon, NV..2NV-1 below, row 0 / NV at the horizon;
+                    a node's 3n values together, for the look-up's four corners */
     float *mie;  /* [n][NPH] */
 } sv_state;
 
@@ -94,11 +95,11 @@ static void fill_node(const atmos_atmosphere *a, sv_state *s, const double eye[3
         const double g[3] = {q[0] + K * d[0], q[1] + K * d[1], q[2] + K * d[2]};
         atmos__sph_ground(pl, a->model, g, sun, a->sun_e, n, NULL, G);
     }
+    float *t = s->tab + ((size_t)row * NA + col) * 3 * n;
     for (int k = 0; k < n; k++) {
-        float *t = s->tab + (size_t)k * 3 * PLANE + (size_t)row * NA + col;
-        t[0] = (float)(sm.sr[k] * a->sun_e[k]);
-        t[PLANE] = (float)(sm.sm[k] * a->sun_e[k]);
-        t[2 * PLANE] = (float)(sm.ms[k] * a->sun_e[k] + sm.t[k] * G[k]);
+        t[3 * k] = (float)(sm.sr[k] * a->sun_e[k]);
+        t[3 * k + 1] = (float)(sm.sm[k] * a->sun_e[k]);
+        t[3 * k + 2] = (float)(sm.ms[k] * a->sun_e[k] + sm.t[k] * G[k]);
     }
 }
 
@@ -201,23 +202,23 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
         iy = iy > NV - 2 ? NV - 2 : iy;
         ix = ix > NA - 2 ? NA - 2 : ix;
         const float ay = fy - iy, ax = fx - ix;
-        const size_t base = (size_t)(iy + (lower ? NV : 0)) * NA + ix;
+        const int S = 3 * n;
+        const float *t00 = s->tab + ((size_t)(iy + (lower ? NV : 0)) * NA + ix) * S;
+        const float *t01 = t00 + S, *t10 = t00 + (size_t)NA * S, *t11 = t10 + S;
         const float w00 = (1 - ay) * (1 - ax), w01 = (1 - ay) * ax, w10 = ay * (1 - ax), w11 = ay * ax;
         float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
         int ip = (int)fp;
         ip = ip > NPH - 2 ? NPH - 2 : ip;
-        const float ap = fp - ip, pr = kr * (1.0f + nu * nu);
+        const float ap = fp - ip, pr = kr * (1.0f + nu * nu), wi = weight[i];
         for (int k = 0; k < n; k++) {
-            const float *t = s->tab + (size_t)k * 3 * PLANE + base;
             const float *mp = s->mie + k * NPH + ip;
             const float pm = mp[0] + ap * (mp[1] - mp[0]);
-            float L = 0;
-            for (int c = 0; c < 3; c++) {
-                const float *tc = t + (size_t)c * PLANE;
-                const float v = w00 * tc[0] + w01 * tc[1] + w10 * tc[NA] + w11 * tc[NA + 1];
-                L += (c == 0 ? pr : (c == 1 ? pm : 1.0f)) * v;
-            }
-            out[(size_t)k * count + i] += weight[i] * L;
+            const int j = 3 * k;
+            const float vr = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
+            const float vm = w00 * t00[j + 1] + w01 * t01[j + 1] + w10 * t10[j + 1] + w11 * t11[j + 1];
+            const float vg = w00 * t00[j + 2] + w01 * t01[j + 2] + w10 * t10[j + 2] + w11 * t11[j + 2];
+            const float L = pr * vr + pm * vm + vg;
+            out[(size_t)k * count + i] += wi * L;
         }
     }
 }

@@ -15,7 +15,7 @@
 
 static void help(void)
 {
-    printf("Usage: atmos bench sky [--size N] [--repeat R] [--threads T]\n"
+    printf("Usage: atmos bench sky [--size N] [--repeat R] [--threads T] [--model NAME]\n"
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--json]\n"
@@ -26,6 +26,10 @@ static void help(void)
            "          prints per case the best wall time and megapixels per second:\n"
            "            bench=sky camera=pinhole wavelengths=rgb size=1024x1024 threads=2 seconds=0.0401 mpix_per_s=26.1\n"
            "          The time covers rendering the spectral image and converting it to linear sRGB.\n"
+           "          --model riley (default), homogeneous, dobashi or spherical; the spherical kinds\n"
+           "          first print their tables' build without a cache and their load from a private\n"
+           "          cache directory (yours is not touched), per wavelength set:\n"
+           "            bench=sky model=spherical wavelengths=rgb threads=2 precompute_seconds=0.4 cached_seconds=0.001\n"
            "  optics  Mie scattering at x = 10000, m = 1.33 - 1e-8i, 1801 angles on one thread (best of 3):\n"
            "            bench=optics case=mie x=10000 angles=1801 threads=1 seconds=0.0123\n"
            "          then, per preset (default rain, cloud, ice, snow; --presets to choose) and wavelength\n"
@@ -70,7 +74,52 @@ static void help(void)
            "          (docs/path.md), to measure what they gain.\n");
 }
 
-static int bench_sky(int size, int repeat, int threads)
+static void remove_cache_dir(atmos_context *ctx, const char *dir);
+
+/* A spherical kind's tables: built cold, then loaded from a private cache directory. */
+static int bench_precompute(atmos_atmosphere_kind kind, const char *name, int threads)
+{
+    const char *tmp = getenv("TMPDIR");
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/atmos-bench-cache-%ld", tmp && *tmp ? tmp : "/tmp", (long)getpid());
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    if (threads > 0) d.threads = threads;
+    d.cache_dir = dir;
+    d.log_level = ATMOS_LOG_ERROR;
+    atmos_context *ctx = NULL;
+    if (atmos_context_create(&d, &ctx) != ATMOS_OK) return CLI_EXIT_RUNTIME;
+    atmos_atmosphere_desc ad;
+    atmos_atmosphere_defaults(&ad);
+    ad.kind = kind;
+    for (int spectral = 0; spectral < 2; spectral++) {
+        atmos_wavelengths wl;
+        if (spectral) atmos_wavelengths_spectral(16, &wl);
+        else atmos_wavelengths_rgb(&wl);
+        double t[2];
+        for (int pass = 0; pass < 2; pass++) {
+            atmos_atmosphere *a = NULL;
+            const double t0 = cli_now_s();
+            atmos_status st = atmos_atmosphere_create(ctx, &ad, &wl, &a);
+            t[pass] = cli_now_s() - t0;
+            atmos_atmosphere_destroy(a);
+            if (st != ATMOS_OK) {
+                int rc = cli_runtime_error("bench", ctx, st);
+                remove_cache_dir(ctx, dir);
+                atmos_context_destroy(ctx);
+                return rc;
+            }
+        }
+        printf("bench=sky model=%s wavelengths=%s threads=%d precompute_seconds=%.4f cached_seconds=%.4f\n", name,
+               spectral ? "spectral16" : "rgb", atmos_context_threads(ctx), t[0], t[1]);
+        fflush(stdout);
+    }
+    remove_cache_dir(ctx, dir);
+    atmos_context_destroy(ctx);
+    return CLI_EXIT_OK;
+}
+
+static int bench_sky(int size, int repeat, int threads, atmos_atmosphere_kind kind)
 {
     static const struct {
         const char *name;
@@ -82,6 +131,7 @@ static int bench_sky(int size, int repeat, int threads)
         for (int spectral = 0; spectral < 2; spectral++) {
             atmos_scene scene;
             atmos_scene_defaults(&scene);
+            scene.atmosphere.kind = kind;
             scene.width = size;
             scene.height = size;
             double pos[3] = {0, 2, 0};
@@ -425,7 +475,8 @@ int cli_cmd_bench(int argc, char **argv)
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16;
     double dscale = 0, eye_scale = 0;
-    const char *what = NULL, *presets = NULL, *file = NULL;
+    const char *what = NULL, *presets = NULL, *file = NULL, *model = "riley";
+    atmos_atmosphere_kind kind = ATMOS_ATMOSPHERE_RILEY;
     bench_path_opts pflags;
     memset(&pflags, 0, sizeof pflags);
     for (int i = 1; i < argc; i++) {
@@ -455,6 +506,13 @@ int cli_cmd_bench(int argc, char **argv)
             json = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(argv[i], "--model") && i + 1 < argc) {
+            model = argv[++i];
+            if (!strcmp(model, "riley")) kind = ATMOS_ATMOSPHERE_RILEY;
+            else if (!strcmp(model, "homogeneous")) kind = ATMOS_ATMOSPHERE_HOMOGENEOUS;
+            else if (!strcmp(model, "dobashi")) kind = ATMOS_ATMOSPHERE_DOBASHI;
+            else if (!strcmp(model, "spherical")) kind = ATMOS_ATMOSPHERE_SPHERICAL;
+            else return cli_usage_error(C, "--model: expected riley, homogeneous, dobashi or spherical, got '%s'", model);
         } else if (!strcmp(argv[i], "--fast")) {
             fast = 1;
         } else if (!strcmp(argv[i], "--presets") && i + 1 < argc) {
@@ -474,7 +532,13 @@ int cli_cmd_bench(int argc, char **argv)
     pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale, pflags.json = json;
     if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
     if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, json);
-    if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads);
+    if (!strcmp(what, "sky")) {
+        if (kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL) {
+            int rc = bench_precompute(kind, model, threads);
+            if (rc != CLI_EXIT_OK) return rc;
+        }
+        return bench_sky(size ? size : 1024, repeat, threads, kind);
+    }
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);
     return cli_usage_error(C, "unknown benchmark '%s' (available: sky, optics, volume, slice, path)", what);
