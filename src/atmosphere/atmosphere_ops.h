@@ -42,6 +42,13 @@ double atmos__atm_cos_sun_radius(const atmos_atmosphere *a);
  * planet, whose sun's disk is counted apart), per wavelength (the same at every one). */
 double atmos__atm_background(const atmos_atmosphere *a);
 
+/* One random walk of the Monte Carlo reference of the spherical kinds
+ * (atmos_atmosphere_reference_radiance, planet_reference.c): an unbiased estimate of the
+ * radiance at wavelength k of the set seen from eye along dir, without the sun's disk, with
+ * at most max_order scatterings (0: all), drawing from r. 0 for the other kinds. */
+double atmos__atm_reference_walk(const atmos_atmosphere *a, const double eye[3], const double dir[3],
+                                 const double sun[3], int k, int max_order, atmos__stream *r);
+
 /* Radiance (without the sun's disk) of many view rays from one eye, in single precision: the
  * renderers' inner loop. atmos__atm_batch_eval adds weight[i] * L_k(ray i) to
  * out[k * count + i]; scratch holds count * ATMOS__ATM_BATCH_SCRATCH floats. */

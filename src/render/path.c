@@ -26,6 +26,9 @@
  *       scattered (after a volume event the sun is counted by the two weighted estimates at
  *       the event, after a ground bounce by next-event estimation alone).
  *
+ * Without a volume, over a planet (the DOBASHI and SPHERICAL kinds), a path is instead the
+ * atmosphere's own Monte Carlo reference (trace_reference): the reference sky.
+ *
  * With truncate_deg > 0 the volume is the truncated medium of path_phase.c (forward peak
  * cut at theta_c, that fraction of the scattering counted as unscattered): free flights,
  * shadow rays, next-event estimation and phase sampling all see sigma_s', sigma_t' and P'.
@@ -257,6 +260,22 @@ static void escape(const path_run *R, const path_state *s)
     }
 }
 
+/* A planet's air without a volume: the atmosphere's Monte Carlo reference (every order of
+ * scattering; atmos__atm_reference_walk), one walk per carried wavelength, at most the
+ * scene's max_depth scatterings, and the sun's disk on the camera ray as escape() adds it. */
+static void trace_reference(const path_run *R, const double o[3], const double d[3])
+{
+    const path_job *J = R->J;
+    const int max_order = J->depth_default ? 0 : J->max_depth;
+    for (int i = 0; i < R->b->m; i++)
+        R->L[i] = atmos__atm_reference_walk(J->atm, o, d, J->sun, R->b->k[i], max_order, R->r);
+    if (J->disk_visible && atmos__dot3(d, J->sun) >= J->cos_sun && isinf(atmos_atmosphere_ground_distance(J->atm, o, d))) {
+        double E[PATH_B];
+        atmos__path_sunlight(R, o, E);
+        for (int i = 0; i < R->b->m; i++) R->L[i] += E[i] / J->sun_omega;
+    }
+}
+
 int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], atmos__stream *r,
                       double *L, double *Lo, path_counts *cnt)
 {
@@ -265,6 +284,10 @@ int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3]
     memcpy(s.p, o, sizeof s.p);
     memcpy(s.d, d0, sizeof s.d);
     for (int i = 0; i < b->m; i++) s.w[i] = 1, L[i] = 0, Lo[i] = 0, s.S[i] = 1;
+    if (J->reference) {
+        trace_reference(&R, o, d0);
+        return 0;
+    }
     for (int guard = 0; guard < 1 << 24; guard++) {
         /* a path of thousands of events in an optically huge medium can outlast the budget */
         if ((guard & 15) == 15 && J->deadline < INFINITY && atmos__now() >= J->deadline) return PATH_ABANDONED;

@@ -161,6 +161,8 @@ static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, 
     J->disk_visible = atmos_atmosphere_sun_disk_visible(atm, J->sun);
     J->bg = atmos__atm_background(atm);
     if (pp->has_medium) J->med = &pp->med, J->ph = &pp->ph, J->aureole = pp->aureole;
+    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(atm);
+    J->reference = !pp->has_medium && (kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL);
     sky_light(p, pp, v->sun);
     if (pp->env_on) J->env = &pp->env;
 }

@@ -24,6 +24,7 @@ typedef struct {
     int max_depth;          /* scattering events per path (the scene's, else PATH_DEFAULT_DEPTH) */
     int depth_default;      /* max_depth is the default: a path stopped by it counts as cut */
     double deadline;        /* atmos__now() past which a path is abandoned (the time budget); INFINITY: none */
+    int reference;          /* no volume, a planet's air: every path is the atmosphere's Monte Carlo reference */
     uint64_t seed;
 } path_job;
 

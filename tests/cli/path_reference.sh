@@ -1,0 +1,41 @@
+#!/bin/sh
+# atmos render --renderer path over a planet without a volume: the Monte Carlo reference sky
+# (docs/sky.md, "The reference"). The same bytes on 1 and 2 threads; finite, lit sky and ground;
+# all orders of scattering bring more light than the first alone (--max-depth 1).
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/cli_path_reference.$$
+mkdir -p "$T"
+export XDG_CACHE_HOME="$T/cache"
+fail=0; pass=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
+cat > "$T/s.json" <<'JSON'
+{"name": "reference sky", "image": {"width": 16, "height": 8},
+ "camera": {"type": "equirect", "position_m": [0, 100, 0]},
+ "sun": {"elevation_deg": 20.0, "azimuth_deg": 180.0},
+ "atmosphere": {"model": "spherical", "ground_albedo": 0.3},
+ "renderer": "path", "path": {"spp": 8}}
+JSON
+"$A" render -q "$T/s.json" --threads 1 --pfm "$T/a.pfm" && ok || bad "render, 1 thread"
+"$A" render -q "$T/s.json" --threads 2 --pfm "$T/b.pfm" && ok || bad "render, 2 threads"
+cmp -s "$T/a.pfm" "$T/b.pfm" && ok || bad "1 and 2 threads differ"
+"$A" render -q "$T/s.json" --threads 2 --max-depth 1 --pfm "$T/c.pfm" && ok || bad "render --max-depth 1"
+python3 - "$T/a.pfm" "$T/c.pfm" <<'PY' && ok || bad "image check"
+import math, struct, sys
+def pfm(p):
+    d = open(p, "rb").read()
+    parts = d.split(b"\n", 3)
+    w, h = map(int, parts[1].split())
+    return w, h, struct.unpack("<%df" % (w * h * 3), parts[3][: w * h * 12])
+w, h, a = pfm(sys.argv[1])
+_, _, c = pfm(sys.argv[2])
+assert (w, h) == (16, 8)
+assert all(math.isfinite(x) and x >= 0 for x in a + c), "bad pixel values"
+# PFM rows run bottom to top: rows 0-3 look down (the ground), 4-7 up (the sky)
+ground = sum(a[: w * 4 * 3]); sky = sum(a[w * 4 * 3:])
+assert ground > 0 and sky > 0, (ground, sky)
+assert sum(a) > 1.05 * sum(c), (sum(a), sum(c))
+PY
+echo "path_reference: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
