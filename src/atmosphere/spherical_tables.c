@@ -196,8 +196,10 @@ static void psi_entry(const atmos__planet *pl, const atmos__sph_model *m, double
                         for (int k = 0; k < n; k++) lo_g[k] *= albedo[k] / ATMOS_PI * cs;
                     }
                 }
+                const double nu = d[0] * sun[0] + d[1] * sun[1], pr = atmos_phase_rayleigh(nu);
                 for (int k = 0; k < n; k++) {
-                    L2[k] += wmu * pu * (pu * (s.sr[k] + s.sm[k]) + s.t[k] * lo_g[k]);
+                    const double first = pr * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k];
+                    L2[k] += wmu * pu * (first + s.t[k] * lo_g[k]);
                     F[k] += wmu * pu * s.f[k];
                 }
             }
