@@ -6,11 +6,14 @@
  *   x_mu = (d - d_min) / (d_max - d_min), d the distance to the top, d_min = Rt - r,
  *   d_max = rho + H. Depth (not T) is stored: it is smooth where T underflows.
  * Psi_ms(r, mu_s): Hillaire 2020 §5.5-5.6: at each point, light of the second order
- *   L_2nd = int_sphere L'(x, -w) p_u dw with L' the isotropically (p_u = 1 / 4 pi) scattered
- *   sunlight along the ray plus the sunlit Lambertian ground at its end, and
+ *   L_2nd = int_sphere L'(x, -w) p_u dw (p_u = 1 / 4 pi) with L' the sunlight scattered once
+ *   along the ray plus the sunlit Lambertian ground at its end, and
  *   f_ms = int_sphere L_f(x, -w) p_u dw with L_f = int sigma_s T dt; all higher orders
- *   follow as the geometric series Psi_ms = L_2nd / (1 - f_ms). Rows in x = sqrt(h / top),
- *   columns in mu_s = x' |x'|, x' in [-1, 1] (dense near the horizon, where twilight lives).
+ *   follow as the geometric series Psi_ms = L_2nd / (1 - f_ms). Unlike Hillaire, L' uses
+ *   the real phase functions (Rayleigh, the aerosols' table) at the angle to the sun: the
+ *   isotropic one put 20-55 % too much higher-order light in the zenith (docs/sky.md).
+ *   Rows in x = sqrt(h / top), columns in mu_s = x' |x'|, x' in [-1, 1] (dense near the
+ *   horizon, where twilight lives).
  * E_sky(mu_s): the irradiance of the ground by the sky (single scattering with the real
  *   phase functions plus Psi_ms), mu_s mapped like Psi's. */
 #include "atmosphere/spherical.h"
