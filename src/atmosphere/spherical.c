@@ -1,10 +1,162 @@
-/* The production sky over a spherical earth with all orders of scattering.
- * PROVISIONAL: answers by the numeric solver (single scattering) until the tables land. */
-#include "atmosphere/planet_solver.h"
+/* The production sky over a spherical earth with all orders of scattering (Hillaire 2020):
+ * the solver table of the SPHERICAL kind over the tables and the march of spherical.h,
+ * the tables cached on disk (src/core/cache.h) under a key naming the whole planet
+ * description. docs/sky.md, "The production sky". */
+#include "atmosphere/spherical.h"
+
+#include "core/cache.h"
+#include "core/vec.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Bumped whenever the tables' content or layout changes. */
+#define SPH_TABLE_VERSION 1
+
+static void sph_destroy(void *model)
+{
+    atmos__sph_model *m = model;
+    if (!m) return;
+    free(m->block);
+    free(m);
+}
+
+static void cache_key(const atmos__planet *pl, const atmos__sph_model *m, char *key, size_t cap)
+{
+    snprintf(key, cap, "spherical-sky v%d tau %dx%d psi %dx%d esky %d steps %d floats %zu planet %016llx",
+             SPH_TABLE_VERSION, ATMOS__SPH_T_R, ATMOS__SPH_T_MU, ATMOS__SPH_M_R, ATMOS__SPH_M_MU, ATMOS__SPH_E_MU,
+             ATMOS__SPH_STEPS_TABLE, m->block_floats, (unsigned long long)atmos__cache_checksum(pl, sizeof *pl));
+}
+
+static atmos_status sph_create(atmos_context *ctx, atmos_atmosphere *a)
+{
+    const atmos__planet *pl = a->planet;
+    atmos__sph_model *m = calloc(1, sizeof *m);
+    if (!m) return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory");
+    m->n = pl->n;
+    m->R = pl->r_ground, m->Rt = pl->r_top, m->H = sqrt(m->Rt * m->Rt - m->R * m->R);
+    const size_t nt = (size_t)ATMOS__SPH_T_R * ATMOS__SPH_T_MU, nm = (size_t)ATMOS__SPH_M_R * ATMOS__SPH_M_MU;
+    const size_t ne = 2 * (size_t)ATMOS__SPH_E_MU;
+    m->block_floats = (size_t)m->n * (nt + 2 * nm + ne);
+    m->block = calloc(m->block_floats, sizeof(float));
+    if (!m->block) {
+        free(m);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory");
+    }
+    m->tau = m->block;
+    m->psi = m->tau + (size_t)m->n * nt;
+    m->fms = m->psi + (size_t)m->n * nm;
+    m->esky = m->fms + (size_t)m->n * nm;
+    a->model = m;
+    char key[256];
+    cache_key(pl, m, key, sizeof key);
+    void *data = NULL;
+    size_t size = 0;
+    if (ctx && atmos__cache_load(ctx, key, &data, &size)) {
+        if (size == m->block_floats * sizeof(float)) {
+            memcpy(m->block, data, size);
+            free(data);
+            return ATMOS_OK;
+        }
+        free(data);
+    }
+    atmos_status st = atmos__sph_build(ctx, pl, m);
+    if (st == ATMOS_OK && ctx) atmos__cache_store(ctx, key, m->block, m->block_floats * sizeof(float));
+    return st;
+}
+
+/* Optical depth of q + t d, t in [t0, t1], by composite Gauss-Legendre over each monotone
+ * piece in s, t = t_low +- L s^2 (as the march). */
+static void segment_depth(const atmos__planet *pl, const double q[3], const double d[3], double t0, double t1, int m,
+                          const int *k, double *out)
+{
+    static const double gx[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+    static const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
+    enum { P = 16 };
+    for (int i = 0; i < m; i++) out[i] = 0.0;
+    double tc = -atmos__dot3(q, d);
+    tc = tc < t0 ? t0 : (tc > t1 ? t1 : tc);
+    const double len[2] = {tc - t0, t1 - tc};
+    for (int side = 0; side < 2; side++) {
+        const double L = len[side], sg = side ? 1.0 : -1.0;
+        if (!(L > 0)) continue;
+        for (int p = 0; p < P; p++)
+            for (int g = 0; g < 4; g++) {
+                const double s = (p + 0.5 + 0.5 * gx[g]) / P, w = gw[g] / P * L * s, t = tc + sg * L * s * s;
+                const double x[3] = {q[0] + t * d[0], q[1] + t * d[1], q[2] + t * d[2]};
+                const double h = sqrt(atmos__dot3(x, x)) - pl->r_ground;
+                for (int i = 0; i < m; i++) out[i] += w * atmos__planet_extinction(pl, h, ATMOS__WL(k, i));
+            }
+    }
+}
+
+static void sph_transmittance(const atmos_atmosphere *a, const double p[3], const double d[3], double dist, int m,
+                              const int *k, double *out)
+{
+    const atmos__planet *pl = a->planet;
+    double t0, t1;
+    if (!atmos__planet_clip(pl, p, d, dist, &t0, &t1)) {
+        for (int i = 0; i < m; i++) out[i] = 1.0;
+        return;
+    }
+    const double q[3] = {p[0], p[1] + pl->r_ground, p[2]};
+    segment_depth(pl, q, d, t0, t1, m, k, out);
+    for (int i = 0; i < m; i++) out[i] = exp(-out[i]);
+}
+
+static void sph_sunlight(const atmos_atmosphere *a, const double p[3], const double sun[3], int m, const int *k,
+                         double *out)
+{
+    const atmos__planet *pl = a->planet;
+    const atmos__sph_model *md = a->model;
+    double q[3] = {p[0], p[1] + pl->r_ground, p[2]};
+    double r = sqrt(atmos__dot3(q, q));
+    if (r > pl->r_top) { /* from space: where the sunward ray enters the air, if it does */
+        const double t = atmos__planet_sphere_hit(pl, p, sun, pl->r_top);
+        if (t < INFINITY && atmos__dot3(q, sun) < 0)
+            for (int i = 0; i < 3; i++) q[i] += t * sun[i];
+        r = sqrt(atmos__dot3(q, q));
+    }
+    atmos__sph_sun_t(md, r, r > 0 ? atmos__dot3(q, sun) / r : 1.0, m, k, out);
+    for (int i = 0; i < m; i++) out[i] *= a->sun_e[ATMOS__WL(k, i)];
+}
+
+static int sph_inscatter(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
+                         const double sun[3], int m, const int *k, double *out)
+{
+    const atmos__planet *pl = a->planet;
+    double t0, t1;
+    for (int i = 0; i < m; i++) out[i] = 0.0;
+    if (!atmos__planet_clip(pl, p, d, dist, &t0, &t1)) return 0;
+    const double q[3] = {p[0], p[1] + pl->r_ground, p[2]};
+    atmos__sph_sums s;
+    atmos__sph_march(pl, a->model, q, d, t0, t1, sun, ATMOS__SPH_STEPS, 1, m, k, &s);
+    const double nu = atmos__dot3(d, sun), pr = atmos_phase_rayleigh(nu);
+    int any = 0;
+    for (int i = 0; i < m; i++) {
+        const int kk = ATMOS__WL(k, i);
+        out[i] = (pr * s.sr[i] + atmos__planet_mie_phase(pl, kk, nu) * s.sm[i] + s.ms[i]) * a->sun_e[kk];
+        any |= out[i] > 0;
+    }
+    return any;
+}
+
+static void sph_radiance(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
+                         double *out, atmos_atmosphere_hit *info)
+{
+    atmos__sph_radiance(a, p, d, sun, ATMOS__SPH_STEPS, out, info);
+}
 
 const atmos__planet_solver atmos__spherical_solver = {
     .name = "spherical",
-    .transmittance = atmos__numeric_transmittance,
-    .sunlight = atmos__numeric_sunlight,
-    .inscatter = atmos__numeric_inscatter,
+    .create = sph_create,
+    .destroy = sph_destroy,
+    .transmittance = sph_transmittance,
+    .sunlight = sph_sunlight,
+    .inscatter = sph_inscatter,
+    .radiance = sph_radiance,
+    .batch_init = atmos__sph_batch_init,
+    .batch_eval = atmos__sph_batch_eval,
+    .batch_release = atmos__sph_batch_release,
 };

@@ -1,0 +1,88 @@
+/* The production sky's tables (after Hillaire 2020, "A Scalable and Production Ready Sky and
+ * Atmosphere Rendering Technique", EGSR): the optical depth to the top of the atmosphere
+ * tau(r, mu), the multiple-scattering term Psi_ms(r, mu_s) (all orders >= 2 under his
+ * isotropic approximation with the series 1 / (1 - f_ms)), the sky's irradiance of the
+ * ground E_sky(mu_s), and the ray march that answers the solver's questions with them
+ * (docs/sky.md, "The production sky"). Internal to src/atmosphere/.
+ *
+ * Frame of the functions here: positions relative to the planet's centre (q = p + (0, R, 0)),
+ * all quantities per unit extraterrestrial irradiance unless stated. */
+#ifndef ATMOS_SPHERICAL_H
+#define ATMOS_SPHERICAL_H
+
+#include "atmosphere/planet_solver.h"
+
+/* Table sizes: tau over (r, mu) with Bruneton's 2017 mapping, Psi_ms over (sqrt altitude,
+ * mu_s), E_sky over mu_s. */
+#define ATMOS__SPH_T_R 64
+#define ATMOS__SPH_T_MU 256
+#define ATMOS__SPH_M_R 24
+#define ATMOS__SPH_M_MU 32
+#define ATMOS__SPH_E_MU 64
+/* Steps of the march per monotone piece of a ray (the piece going down to the ray's lowest
+ * point and the piece rising from it): the one-ray answers and the tables. */
+#define ATMOS__SPH_STEPS 40
+/* The sky-view table (spherical_batch.c): rows per side of the horizon, azimuths over
+ * [0, pi]; row j of a side at x = (j / (ROWS - 1))^2 (1e-7 at j = 0), azimuth i at
+ * pi i / (AZ - 1). */
+#define ATMOS__SPH_SV_ROWS 48
+#define ATMOS__SPH_SV_AZ 32
+#define ATMOS__SPH_STEPS_TABLE 20
+
+typedef struct atmos__sph_model {
+    int n;                  /* wavelengths */
+    double R, Rt, H;        /* ground and top radii, H = sqrt(Rt^2 - R^2) */
+    float *tau;             /* [n][T_R][T_MU] optical depth to the top (rays above the horizon) */
+    float *psi;             /* [n][M_R][M_MU] Psi_ms, sr^-1 per unit irradiance and scattering */
+    float *fms;             /* [n][M_R][M_MU] f_ms: the share of isotropic light scattered again */
+    float *esky;            /* [n][E_MU] the sky's irradiance of the ground, per unit irradiance */
+    float *block;           /* one allocation holding the four (the cache's payload) */
+    size_t block_floats;
+    double build_seconds;   /* 0 when loaded from the cache */
+} atmos__sph_model;
+
+/* What a march along a segment gathers, per wavelength of the subset (phase functions left
+ * out: along one ray the scattering angle is constant):
+ *   sr = int sigma_R T T_sun dt, sm = int sigma_M,sca T T_sun dt,
+ *   ms = int sigma_s T Psi_ms dt, f = int sigma_s T dt, t = T over the whole segment. */
+typedef struct atmos__sph_sums {
+    double sr[ATMOS_MAX_WAVELENGTHS], sm[ATMOS_MAX_WAVELENGTHS], ms[ATMOS_MAX_WAVELENGTHS];
+    double f[ATMOS_MAX_WAVELENGTHS], t[ATMOS_MAX_WAVELENGTHS];
+} atmos__sph_sums;
+
+/* ------------------------------------------------------------------ tables (spherical_tables.c) */
+/* Builds the tables of the planet (threads over rows). */
+atmos_status atmos__sph_build(atmos_context *ctx, const atmos__planet *pl, atmos__sph_model *m);
+/* Optical depth to the top from radius r along cosine mu (rays that miss the ground), per
+ * wavelength of the subset. */
+void atmos__sph_tau_top(const atmos__sph_model *m, double r, double mu, int cnt, const int *k, double *out);
+/* Transmittance of the sunlight at radius r with the sun at cosine mu_s (0 in the planet's
+ * shadow, the sun's centre behind the ground). */
+void atmos__sph_sun_t(const atmos__sph_model *m, double r, double mu_s, int cnt, const int *k, double *out);
+void atmos__sph_psi(const atmos__sph_model *m, double r, double mu_s, int cnt, const int *k, double *out);
+void atmos__sph_esky(const atmos__sph_model *m, double mu_s, int cnt, const int *k, double *out);
+/* f_ms at (r, mu_s) of wavelength k (a diagnostic of the multiple-scattering table). */
+double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k);
+
+/* ------------------------------------------------------------------ the march (spherical_march.c) */
+/* Marches q + t d, t in [t0, t1] (inside the air), sun direction sun; use_ms: add the
+ * Psi_ms term (the tables must hold it). steps per monotone piece. */
+void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const double q[3], const double d[3],
+                      double t0, double t1, const double sun[3], int steps, int use_ms, int cnt, const int *k,
+                      atmos__sph_sums *s);
+/* Radiance per unit irradiance reflected by the ground point g (centre frame, on the
+ * sphere) lit by the sun and the sky, plus its emission divided by the irradiance. */
+void atmos__sph_ground(const atmos__planet *pl, const atmos__sph_model *m, const double g[3], const double sun[3],
+                       const double *sun_e, int cnt, const int *k, double *out);
+/* The radiance of the view ray from p (world frame) without the sun's disk, all
+ * wavelengths, in W m^-2 sr^-1 nm^-1; steps per piece. */
+void atmos__sph_radiance(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
+                         int steps, double *out, atmos_atmosphere_hit *info);
+
+/* ------------------------------------------------------------------ per eye (spherical_batch.c) */
+void atmos__sph_batch_init(atmos__atm_batch *b);
+void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                           const float *weight, float *out, float *scratch);
+void atmos__sph_batch_release(atmos__atm_batch *b);
+
+#endif

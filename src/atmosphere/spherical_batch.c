@@ -1,0 +1,224 @@
+/* The production sky's per-eye table (spherical.h): Hillaire's sky-view look-up table, the
+ * sky renderer's inner loop. For an eye inside the air, batch_init marches a grid of view
+ * directions (the one-ray path's march, so the table equals it at its nodes) and keeps,
+ * per wavelength, the Rayleigh and Mie single scattering without their phase functions
+ * and the rest (higher orders, the lit ground seen through the air); batch_eval
+ * interpolates them and applies the phase functions of the ray's scattering angle, so
+ * the sun's aureole is as sharp as the phase table, not the grid.
+ *
+ * Grid: the view zenith's cosine mu on each side of the horizon mu_h = -sqrt(1 - (R/r)^2)
+ * apart (the ground's edge is never blurred), in v = sqrt(x), x = |mu - mu_h| / (1 -+ mu_h):
+ * rows crowd at the horizon; the azimuth from the sun's vertical plane over [0, pi] (the
+ * sky of a uniform ground is symmetric about it). An eye above the top of the air (where
+ * the grid would waste itself on empty space) gets the one-ray march per ray. */
+#include "atmosphere/spherical.h"
+
+#include "core/vec.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NV ATMOS__SPH_SV_ROWS
+#define NA ATMOS__SPH_SV_AZ
+#define NPH 1024 /* the Mie phase over x = sqrt((1 - nu) / 2) = sin(theta / 2) */
+#define PLANE (2 * NV * NA)
+
+typedef struct sv_state {
+    int march, n;
+    double up[3], e1[3], e2[3];
+    float fup[3], fe1[3], fe2[3], fsun[3];
+    float muh;
+    float *tab;  /* [2 NV][NA][n][3]: channel 0 Rayleigh, 1 Mie (no phase), 2 the rest; rows
+                    0..NV-1 above the horizon, NV..2NV-1 below, row 0 / NV at the horizon;
+                    a node's 3n values together, for the look-up's four corners */
+    float *mie;  /* [n][NPH] */
+} sv_state;
+
+static double node_mu(double muh, int row)
+{
+    const int lower = row >= NV;
+    const double v = (double)(lower ? row - NV : row) / (NV - 1);
+    const double x = fmax(v * v, 1e-7);
+    return lower ? muh - x * (1.0 + muh) : muh + x * (1.0 - muh);
+}
+
+static void node_dir(const sv_state *s, int row, int col, double d[3])
+{
+    const double mu = node_mu(s->muh, row), sn = sqrt(fmax(0.0, 1.0 - mu * mu));
+    const double phi = ATMOS_PI * col / (NA - 1), c = cos(phi), si = sin(phi);
+    for (int i = 0; i < 3; i++) d[i] = mu * s->up[i] + sn * (c * s->e1[i] + si * s->e2[i]);
+}
+
+static void frame(sv_state *s, const atmos__planet *pl, const double eye[3], const double sun[3])
+{
+    const double q[3] = {eye[0], eye[1] + pl->r_ground, eye[2]};
+    const double r = sqrt(atmos__dot3(q, q));
+    for (int i = 0; i < 3; i++) s->up[i] = r > 0 ? q[i] / r : (i == 1);
+    const double su = atmos__dot3(sun, s->up);
+    double h[3] = {sun[0] - su * s->up[0], sun[1] - su * s->up[1], sun[2] - su * s->up[2]};
+    double hl = sqrt(atmos__dot3(h, h));
+    if (hl < 1e-9) { /* the sun at the zenith or nadir: any horizontal axis */
+        const double ax[3] = {fabs(s->up[0]) < 0.9 ? 1.0 : 0.0, fabs(s->up[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+        const double a = atmos__dot3(ax, s->up);
+        for (int i = 0; i < 3; i++) h[i] = ax[i] - a * s->up[i];
+        hl = sqrt(atmos__dot3(h, h));
+    }
+    for (int i = 0; i < 3; i++) s->e1[i] = h[i] / hl;
+    atmos__cross3(s->up, s->e1, s->e2);
+    for (int i = 0; i < 3; i++) {
+        s->fup[i] = (float)s->up[i], s->fe1[i] = (float)s->e1[i], s->fe2[i] = (float)s->e2[i];
+        s->fsun[i] = (float)sun[i];
+    }
+    const double rr = pl->r_ground / fmax(r, pl->r_ground);
+    s->muh = (float)-sqrt(fmax(0.0, 1.0 - rr * rr));
+}
+
+static void fill_node(const atmos_atmosphere *a, sv_state *s, const double eye[3], const double sun[3], int row,
+                      int col)
+{
+    const atmos__planet *pl = a->planet;
+    const int n = s->n;
+    double d[3];
+    node_dir(s, row, col, d);
+    const double K = atmos__planet_ground_distance(pl, eye, d);
+    const double q[3] = {eye[0], eye[1] + pl->r_ground, eye[2]};
+    double t0, t1, G[ATMOS_MAX_WAVELENGTHS] = {0};
+    atmos__sph_sums sm;
+    if (atmos__planet_clip(pl, eye, d, K, &t0, &t1))
+        atmos__sph_march(pl, a->model, q, d, t0, t1, sun, ATMOS__SPH_STEPS, 1, n, NULL, &sm);
+    else {
+        memset(&sm, 0, sizeof sm);
+        for (int k = 0; k < n; k++) sm.t[k] = 1.0;
+    }
+    if (K < INFINITY) {
+        const double g[3] = {q[0] + K * d[0], q[1] + K * d[1], q[2] + K * d[2]};
+        atmos__sph_ground(pl, a->model, g, sun, a->sun_e, n, NULL, G);
+    }
+    float *t = s->tab + ((size_t)row * NA + col) * 3 * n;
+    for (int k = 0; k < n; k++) {
+        t[3 * k] = (float)(sm.sr[k] * a->sun_e[k]);
+        t[3 * k + 1] = (float)(sm.sm[k] * a->sun_e[k]);
+        t[3 * k + 2] = (float)(sm.ms[k] * a->sun_e[k] + sm.t[k] * G[k]);
+    }
+}
+
+void atmos__sph_batch_init(atmos__atm_batch *b)
+{
+    const atmos_atmosphere *a = b->atm;
+    const atmos__planet *pl = a->planet;
+    sv_state *s = calloc(1, sizeof *s);
+    if (!s) return; /* batch_eval falls back on the march */
+    s->n = a->wl.count;
+    s->march = atmos__planet_altitude(pl, b->eye) >= pl->r_top - pl->r_ground;
+    b->state = s;
+    if (s->march) return;
+    frame(s, pl, b->eye, b->sun);
+    s->tab = malloc(sizeof(float) * ((size_t)s->n * 3 * PLANE + (size_t)s->n * NPH));
+    if (!s->tab) {
+        s->march = 1;
+        return;
+    }
+    s->mie = s->tab + (size_t)s->n * 3 * PLANE;
+    for (int k = 0; k < s->n; k++)
+        for (int j = 0; j < NPH; j++) {
+            const double x = (double)j / (NPH - 1);
+            s->mie[k * NPH + j] = (float)atmos__planet_mie_phase(pl, k, 1.0 - 2.0 * x * x);
+        }
+#pragma omp parallel for schedule(dynamic)
+    for (int e = 0; e < 2 * NV * NA; e++) fill_node(a, s, b->eye, b->sun, e / NA, e % NA);
+}
+
+void atmos__sph_batch_release(atmos__atm_batch *b)
+{
+    sv_state *s = b->state;
+    if (s) free(s->tab);
+    free(s);
+    b->state = NULL;
+}
+
+/* atan(y / x) for 0 <= y <= x by Abramowitz & Stegun 4.4.49 (|error| <= 2e-8). */
+static inline float atan_unit(float z)
+{
+    const float z2 = z * z;
+    float p = 0.0028662257f;
+    p = p * z2 - 0.0161657367f;
+    p = p * z2 + 0.0429096138f;
+    p = p * z2 - 0.0752896400f;
+    p = p * z2 + 0.1065626393f;
+    p = p * z2 - 0.1420889944f;
+    p = p * z2 + 0.1999355085f;
+    p = p * z2 - 0.3333314528f;
+    return z * (1.0f + p * z2);
+}
+
+/* The azimuth in [0, pi] of (x, y) with y >= 0. */
+static inline float azimuth(float x, float y)
+{
+    const float ax = fabsf(x);
+    const int swap = y > ax;
+    const float num = swap ? ax : y, den = swap ? y : ax;
+    float a = den > 0 ? atan_unit(num / den) : 0.0f;
+    a = swap ? 1.57079632679f - a : a;
+    return x < 0 ? 3.14159265359f - a : a;
+}
+
+static void eval_march(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                       const float *weight, float *out)
+{
+    const int n = b->atm->wl.count;
+    for (int i = 0; i < count; i++) {
+        if (weight[i] == 0.0f) continue;
+        double d[3] = {dx[i], dy[i], dz[i]}, L[ATMOS_MAX_WAVELENGTHS];
+        const double l = sqrt(atmos__dot3(d, d));
+        for (int c = 0; c < 3; c++) d[c] /= l;
+        atmos__sph_radiance(b->atm, b->eye, d, b->sun, ATMOS__SPH_STEPS, L, NULL);
+        for (int k = 0; k < n; k++) out[(size_t)k * count + i] += weight[i] * (float)L[k];
+    }
+}
+
+void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                           const float *weight, float *out, float *scratch)
+{
+    (void)scratch;
+    const sv_state *s = b->state;
+    if (!s || s->march) {
+        eval_march(b, count, dx, dy, dz, weight, out);
+        return;
+    }
+    const int n = s->n;
+    const float muh = s->muh, kr = 3.0f / (16.0f * 3.14159265359f);
+    for (int i = 0; i < count; i++) {
+        const float x = dx[i], y = dy[i], z = dz[i];
+        const float mu = x * s->fup[0] + y * s->fup[1] + z * s->fup[2];
+        const float h1 = x * s->fe1[0] + y * s->fe1[1] + z * s->fe1[2];
+        const float h2 = fabsf(x * s->fe2[0] + y * s->fe2[1] + z * s->fe2[2]);
+        const float nu = x * s->fsun[0] + y * s->fsun[1] + z * s->fsun[2];
+        const int lower = mu < muh;
+        float xv = lower ? (muh - mu) / (1.0f + muh) : (mu - muh) / (1.0f - muh);
+        xv = xv < 0 ? 0 : (xv > 1 ? 1 : xv);
+        float fy = sqrtf(xv) * (NV - 1), fx = azimuth(h1, h2) * ((NA - 1) / 3.14159265359f);
+        int iy = (int)fy, ix = (int)fx;
+        iy = iy > NV - 2 ? NV - 2 : iy;
+        ix = ix > NA - 2 ? NA - 2 : ix;
+        const float ay = fy - iy, ax = fx - ix;
+        const int S = 3 * n;
+        const float *t00 = s->tab + ((size_t)(iy + (lower ? NV : 0)) * NA + ix) * S;
+        const float *t01 = t00 + S, *t10 = t00 + (size_t)NA * S, *t11 = t10 + S;
+        const float w00 = (1 - ay) * (1 - ax), w01 = (1 - ay) * ax, w10 = ay * (1 - ax), w11 = ay * ax;
+        float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
+        int ip = (int)fp;
+        ip = ip > NPH - 2 ? NPH - 2 : ip;
+        const float ap = fp - ip, pr = kr * (1.0f + nu * nu), wi = weight[i];
+        for (int k = 0; k < n; k++) {
+            const float *mp = s->mie + k * NPH + ip;
+            const float pm = mp[0] + ap * (mp[1] - mp[0]);
+            const int j = 3 * k;
+            const float vr = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
+            const float vm = w00 * t00[j + 1] + w01 * t01[j + 1] + w10 * t10[j + 1] + w11 * t11[j + 1];
+            const float vg = w00 * t00[j + 2] + w01 * t01[j + 2] + w10 * t10[j + 2] + w11 * t11[j + 2];
+            const float L = pr * vr + pm * vm + vg;
+            out[(size_t)k * count + i] += wi * L;
+        }
+    }
+}

@@ -1,0 +1,117 @@
+/* The production sky's ray march (spherical.h): single scattering with the sunlight's
+ * transmittance from the tau table, the higher orders from Psi_ms, the view transmittance
+ * accumulated step by step; the lit ground; the radiance of a view ray.
+ *
+ * Steps: each segment is split at its lowest point (closest to the planet's centre) into
+ * monotone pieces; on each, t = t_low +- L s^2 with s at the midpoints of `steps` equal
+ * parts of [0, 1], so that samples crowd where the air is densest (a horizontal ray from
+ * the ground climbs only h ~ t^2 / 2R). Each sample stands for its step with the source
+ * constant over it and the step's own attenuation integrated exactly (Hillaire 2020 §5.3's
+ * energy-conserving form), so optically thick steps (grazing blue rays) lose nothing. */
+#include "atmosphere/spherical.h"
+
+#include "core/vec.h"
+
+#include <math.h>
+#include <string.h>
+
+static void sample_point(const atmos__planet *pl, const atmos__sph_model *m, const double q[3], const double d[3],
+                         double t, double w, const double sun[3], int use_ms, int cnt, const int *k, double *tr,
+                         atmos__sph_sums *s)
+{
+    const double x[3] = {q[0] + t * d[0], q[1] + t * d[1], q[2] + t * d[2]};
+    const double r = sqrt(atmos__dot3(x, x)), h = r - pl->r_ground;
+    if (h > pl->r_top - pl->r_ground) return;
+    const double mus = atmos__dot3(x, sun) / r;
+    const double rr = atmos__planet_rho_rayleigh(pl, h), rm = atmos__planet_rho_mie(pl, h);
+    const double ro = atmos__planet_rho_ozone(pl, h);
+    double ts[ATMOS_MAX_WAVELENGTHS], psi[ATMOS_MAX_WAVELENGTHS];
+    atmos__sph_sun_t(m, r, mus, cnt, k, ts);
+    if (use_ms) atmos__sph_psi(m, r, mus, cnt, k, psi);
+    for (int i = 0; i < cnt; i++) {
+        const int kk = ATMOS__WL(k, i);
+        const double sr = pl->rayleigh[kk] * rr, sm = pl->mie_sca[kk] * rm;
+        const double st = (pl->rayleigh[kk] * rr + pl->mie_ext[kk] * rm + pl->ozone[kk] * ro) * w;
+        /* the step's own attenuation integrated exactly: int_0^w e^{-sigma_t t} dt */
+        const double es = exp(-st), Tw = tr[i] * (st > 1e-7 ? (1.0 - es) / st : 1.0 - 0.5 * st) * w;
+        s->sr[i] += sr * Tw * ts[i];
+        s->sm[i] += sm * Tw * ts[i];
+        s->f[i] += (sr + sm) * Tw;
+        if (use_ms) s->ms[i] += (sr + sm) * Tw * psi[i];
+        tr[i] *= es;
+    }
+}
+
+void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const double q[3], const double d[3],
+                      double t0, double t1, const double sun[3], int steps, int use_ms, int cnt, const int *k,
+                      atmos__sph_sums *s)
+{
+    double tr[ATMOS_MAX_WAVELENGTHS];
+    memset(s, 0, sizeof *s);
+    for (int i = 0; i < cnt; i++) tr[i] = 1.0;
+    if (t1 > t0) {
+        double tc = -atmos__dot3(q, d);
+        tc = tc < t0 ? t0 : (tc > t1 ? t1 : tc);
+        const double la = tc - t0, lb = t1 - tc;
+        if (la > 0) /* toward the lowest point: s from 1 down to 0 */
+            for (int j = 0; j < steps; j++) {
+                const double u = 1.0 - (j + 0.5) / steps;
+                sample_point(pl, m, q, d, tc - la * u * u, 2.0 * la * u / steps, sun, use_ms, cnt, k, tr, s);
+            }
+        if (lb > 0)
+            for (int j = 0; j < steps; j++) {
+                const double u = (j + 0.5) / steps;
+                sample_point(pl, m, q, d, tc + lb * u * u, 2.0 * lb * u / steps, sun, use_ms, cnt, k, tr, s);
+            }
+    }
+    for (int i = 0; i < cnt; i++) s->t[i] = tr[i];
+}
+
+void atmos__sph_ground(const atmos__planet *pl, const atmos__sph_model *m, const double g[3], const double sun[3],
+                       const double *sun_e, int cnt, const int *k, double *out)
+{
+    const double r = sqrt(atmos__dot3(g, g));
+    const double n[3] = {g[0] / r, g[1] / r, g[2] / r};
+    const double gw[3] = {n[0] * pl->r_ground, n[1] * pl->r_ground - pl->r_ground, n[2] * pl->r_ground};
+    const double cs = atmos__dot3(n, sun);
+    double ts[ATMOS_MAX_WAVELENGTHS], es[ATMOS_MAX_WAVELENGTHS];
+    atmos__sph_sun_t(m, pl->r_ground, cs, cnt, k, ts);
+    atmos__sph_esky(m, cs, cnt, k, es);
+    for (int i = 0; i < cnt; i++) {
+        const int kk = ATMOS__WL(k, i);
+        const double e = (cs > 0 ? cs * ts[i] : 0.0) + es[i];
+        out[i] = atmos__planet_ground_albedo(pl, gw, kk) / ATMOS_PI * e * sun_e[kk] +
+                 atmos__planet_ground_emission(pl, gw, kk);
+    }
+}
+
+void atmos__sph_radiance(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
+                         int steps, double *out, atmos_atmosphere_hit *info)
+{
+    const atmos__planet *pl = a->planet;
+    const atmos__sph_model *m = a->model;
+    const int n = a->wl.count;
+    const double K = atmos__planet_ground_distance(pl, p, d);
+    const double q[3] = {p[0], p[1] + pl->r_ground, p[2]};
+    double t0, t1;
+    atmos__sph_sums s;
+    if (atmos__planet_clip(pl, p, d, K, &t0, &t1)) {
+        atmos__sph_march(pl, m, q, d, t0, t1, sun, steps, 1, n, NULL, &s);
+        const double nu = atmos__dot3(d, sun), pr = atmos_phase_rayleigh(nu);
+        for (int i = 0; i < n; i++)
+            out[i] = (pr * s.sr[i] + atmos__planet_mie_phase(pl, i, nu) * s.sm[i] + s.ms[i]) * a->sun_e[i];
+    } else {
+        for (int i = 0; i < n; i++) out[i] = 0.0, s.t[i] = 1.0;
+    }
+    if (K < INFINITY) {
+        const double g[3] = {q[0] + K * d[0], q[1] + K * d[1], q[2] + K * d[2]};
+        double G[ATMOS_MAX_WAVELENGTHS];
+        atmos__sph_ground(pl, m, g, sun, a->sun_e, n, NULL, G);
+        for (int i = 0; i < n; i++) out[i] += s.t[i] * G[i];
+    }
+    if (info) {
+        info->distance_m = K;
+        info->hits_ground = K < INFINITY;
+        info->in_sun_disk = 0;
+    }
+}
