@@ -36,11 +36,11 @@ static int dob_inscatter(const atmos_atmosphere *a, const double p[3], const dou
     const atmos__dobashi *m = a->model;
     double sr[ATMOS_MAX_WAVELENGTHS], sm[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
     atmos__dobashi_march(m, a->planet, p, d, dist, sun, sr, sm, T);
-    const double nu = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2], fr = atmos_phase_rayleigh(nu);
+    const double nu = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2];
     int any = 0;
     for (int i = 0; i < cnt; i++) {
         const int kk = ATMOS__WL(k, i);
-        out[i] = a->sun_e[kk] * (fr * sr[kk] + atmos__planet_mie_phase(a->planet, kk, nu) * sm[kk] +
+        out[i] = a->sun_e[kk] * (atmos__planet_rayleigh_phase(a->planet, kk, nu) * sr[kk] + atmos__planet_mie_phase(a->planet, kk, nu) * sm[kk] +
                                  m->ambient * (1.0 - T[kk]));
         any |= out[i] > 0;
     }

@@ -224,7 +224,6 @@ void atmos__dobashi_batch_eval(const atmos__atm_batch *b, int count, const float
             for (int k = 0; k < n; k++) out[(size_t)k * count + i] += weight[i] * (float)L[k];
             continue;
         }
-        const double fr = atmos_phase_rayleigh(nu);
         /* the aerosols' phase table (dobashi_tables.c) at sin(alpha / 2) */
         const double hu = 0.5 * (1.0 - nu), u = sqrt(hu < 0 ? 0 : (hu > 1 ? 1 : hu)) * (ATMOS__DOB_PHASE_N - 1);
         int ju = (int)u;
@@ -241,7 +240,7 @@ void atmos__dobashi_batch_eval(const atmos__atm_batch *b, int count, const float
         for (int k = 0; k < n; k++) {
             const float *w = v + 3 * k;
             const float *ph = m->mie + (size_t)k * ATMOS__DOB_PHASE_N + ju;
-            double L = a->sun_e[k] * (fr * w[0] + (ph[0] + fu * (ph[1] - ph[0])) * w[1] +
+            double L = a->sun_e[k] * (atmos__planet_rayleigh_phase(a->planet, k, nu) * w[0] + (ph[0] + fu * (ph[1] - ph[0])) * w[1] +
                                       m->ambient * (1.0 - w[2]));
             if (ground) {
                 const double lit = cs > 0 ? atmos__planet_ground_albedo(a->planet, g, k) / ATMOS_PI * cs * gl[k] : 0;

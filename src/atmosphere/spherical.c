@@ -132,11 +132,11 @@ static int sph_inscatter(const atmos_atmosphere *a, const double p[3], const dou
     const double q[3] = {p[0], p[1] + pl->r_ground, p[2]};
     atmos__sph_sums s;
     atmos__sph_march(pl, a->model, q, d, t0, t1, sun, ATMOS__SPH_STEPS, 1, m, k, &s);
-    const double nu = atmos__dot3(d, sun), pr = atmos_phase_rayleigh(nu);
+    const double nu = atmos__dot3(d, sun);
     int any = 0;
     for (int i = 0; i < m; i++) {
         const int kk = ATMOS__WL(k, i);
-        out[i] = (pr * s.sr[i] + atmos__planet_mie_phase(pl, kk, nu) * s.sm[i] + s.ms[i]) * a->sun_e[kk];
+        out[i] = (atmos__planet_rayleigh_phase(pl, kk, nu) * s.sr[i] + atmos__planet_mie_phase(pl, kk, nu) * s.sm[i] + s.ms[i]) * a->sun_e[kk];
         any |= out[i] > 0;
     }
     return any;

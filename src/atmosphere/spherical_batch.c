@@ -188,6 +188,13 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
     }
     const int n = s->n;
     const float muh = s->muh, kr = 3.0f / (16.0f * 3.14159265359f);
+    /* the air's depolarized Rayleigh phase function (planet.h): kr (ra + rb nu^2) */
+    float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS];
+    for (int k = 0; k < n; k++) {
+        const double g = b->atm->planet->rayleigh_gamma[k];
+        ra[k] = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
+        rb[k] = (float)((1.0 - g) / (1.0 + 2.0 * g));
+    }
     for (int i = 0; i < count; i++) {
         const float x = dx[i], y = dy[i], z = dz[i];
         const float mu = x * s->fup[0] + y * s->fup[1] + z * s->fup[2];
@@ -209,7 +216,7 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
         float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
         int ip = (int)fp;
         ip = ip > NPH - 2 ? NPH - 2 : ip;
-        const float ap = fp - ip, pr = kr * (1.0f + nu * nu), wi = weight[i];
+        const float ap = fp - ip, nu2 = nu * nu, wi = weight[i];
         for (int k = 0; k < n; k++) {
             const float *mp = s->mie + k * NPH + ip;
             const float pm = mp[0] + ap * (mp[1] - mp[0]);
@@ -217,7 +224,7 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
             const float vr = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
             const float vm = w00 * t00[j + 1] + w01 * t01[j + 1] + w10 * t10[j + 1] + w11 * t11[j + 1];
             const float vg = w00 * t00[j + 2] + w01 * t01[j + 2] + w10 * t10[j + 2] + w11 * t11[j + 2];
-            const float L = pr * vr + pm * vm + vg;
+            const float L = kr * (ra[k] + rb[k] * nu2) * vr + pm * vm + vg;
             out[(size_t)k * count + i] += wi * L;
         }
     }

@@ -97,9 +97,9 @@ void atmos__sph_radiance(const atmos_atmosphere *a, const double p[3], const dou
     atmos__sph_sums s;
     if (atmos__planet_clip(pl, p, d, K, &t0, &t1)) {
         atmos__sph_march(pl, m, q, d, t0, t1, sun, steps, 1, n, NULL, &s);
-        const double nu = atmos__dot3(d, sun), pr = atmos_phase_rayleigh(nu);
+        const double nu = atmos__dot3(d, sun);
         for (int i = 0; i < n; i++)
-            out[i] = (pr * s.sr[i] + atmos__planet_mie_phase(pl, i, nu) * s.sm[i] + s.ms[i]) * a->sun_e[i];
+            out[i] = (atmos__planet_rayleigh_phase(pl, i, nu) * s.sr[i] + atmos__planet_mie_phase(pl, i, nu) * s.sm[i] + s.ms[i]) * a->sun_e[i];
     } else {
         for (int i = 0; i < n; i++) out[i] = 0.0, s.t[i] = 1.0;
     }

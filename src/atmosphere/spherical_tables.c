@@ -199,9 +199,9 @@ static void psi_entry(const atmos__planet *pl, const atmos__sph_model *m, double
                         for (int k = 0; k < n; k++) lo_g[k] *= albedo[k] / ATMOS_PI * cs;
                     }
                 }
-                const double nu = d[0] * sun[0] + d[1] * sun[1], pr = atmos_phase_rayleigh(nu);
+                const double nu = d[0] * sun[0] + d[1] * sun[1];
                 for (int k = 0; k < n; k++) {
-                    const double first = pr * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k];
+                    const double first = atmos__planet_rayleigh_phase(pl, k, nu) * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k];
                     L2[k] += wmu * pu * (first + s.t[k] * lo_g[k]);
                     F[k] += wmu * pu * s.f[k];
                 }
@@ -254,9 +254,8 @@ static void esky_entry(const atmos__planet *pl, const atmos__sph_model *m, doubl
             atmos__sph_sums s;
             atmos__sph_march(pl, m, q, d, 0.0, atmos__planet_dist_top(pl, m->R, mu), sun, ATMOS__SPH_STEPS_TABLE, 1,
                              n, NULL, &s);
-            const double pr = atmos_phase_rayleigh(nu);
             for (int k = 0; k < n; k++)
-                out[k] += w * (pr * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k] + s.ms[k]);
+                out[k] += w * (atmos__planet_rayleigh_phase(pl, k, nu) * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k] + s.ms[k]);
         }
     }
 }

