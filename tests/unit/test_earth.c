@@ -1,7 +1,8 @@
 /* The Earth from space (docs/sky.md): the ground's maps looked up at known latitudes and
  * longitudes (synthetic maps whose halves differ), the night lights only on the night side,
  * the cloud spheres' attenuation against exp(-tau) in closed form, the brightness to
- * optical depth mapping against the two-stream reflectance it inverts. */
+ * optical depth mapping against the two-stream reflectance it inverts; the scene keys: files
+ * relative to the scene's folder, missing files refused, a world file placing a cloud image. */
 #include "atmos/atmos.h"
 #include "atmosphere/atmosphere_internal.h"
 #include "atmosphere/planet_clouds.h"
@@ -186,8 +187,64 @@ static void test_cloud_attenuation(void)
     atmos_image_destroy(night);
 }
 
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) exit(2);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void test_scene_keys(void)
+{
+    char scene[512], map[512], jgw[512];
+    test_tmp_path(scene, sizeof scene, "earth.json");
+    test_tmp_path(map, sizeof map, "earth_clouds.png");
+    test_tmp_path(jgw, sizeof jgw, "earth_clouds.jgw");
+    remove(map);
+    write_text(scene, "{\"atmosphere\": {\"model\": \"spherical\", \"latitude_deg\": 27, \"longitude_deg\": -117,"
+                      " \"clouds\": {\"image\": \"earth_clouds.png\", \"world_file\": \"earth_clouds.jgw\"}}}");
+    atmos_scene sc;
+    atmos_context *ctx = NULL;
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    /* the image is missing: refused when the scene is read, naming the key */
+    CHECK(atmos_scene_load(ctx, scene, &sc) == ATMOS_E_IO);
+    CHECK(strstr(atmos_context_error(ctx), "clouds/image") != NULL);
+    /* a 10 x 20 image, pixels 0.5 x 0.25 degrees, the top-left one centred at 119.75 W, 29.875 N:
+     * it spans 120..115 W and 25..30 N */
+    atmos_image *img = make_map(10, 20, 1, grey_cloud);
+    CHECK_OK(atmos_write_png(NULL, img, map, 8));
+    atmos_image_destroy(img);
+    CHECK(atmos_scene_load(ctx, scene, &sc) == ATMOS_E_IO); /* the world file is missing */
+    write_text(jgw, "0.5\n0\n0\n-0.25\n-119.75\n29.875\n");
+    CHECK_OK(atmos_scene_load(ctx, scene, &sc));
+    CHECK(strcmp(sc.earth.cloud_image, map) == 0); /* resolved against the scene's folder */
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_atmosphere *a = NULL;
+    CHECK_OK(atmos_scene_atmosphere_create(ctx, &sc, &wl, &a));
+    if (a && a->planet->clouds) {
+        const atmos__clouds *cl = a->planet->clouds;
+        CHECK_NEAR(cl->lon_w, -120, 1e-12);
+        CHECK_NEAR(cl->lon_e, -115, 1e-12);
+        CHECK_NEAR(cl->lat_s, 25, 1e-12);
+        CHECK_NEAR(cl->lat_n, 30, 1e-12);
+        /* clouds over the origin (27 N 117 W), none at 10 degrees of arc west (outside) */
+        CHECK(atmos__clouds_column_tau(cl, 27, -117) > 1);
+        CHECK(atmos__clouds_column_tau(cl, 27, -127) == 0);
+    }
+    CHECK(a && a->planet->clouds);
+    atmos_atmosphere_destroy(a);
+    /* a world file with a rotation is refused */
+    write_text(jgw, "0.5\n0.1\n0\n-0.25\n-119.75\n29.875\n");
+    a = NULL;
+    CHECK(atmos_scene_atmosphere_create(ctx, &sc, &wl, &a) == ATMOS_E_FORMAT && !a);
+    atmos_context_destroy(ctx);
+}
+
 int main(void)
 {
+    test_scene_keys();
     test_map_lookup();
     test_night_lights();
     test_brightness_mapping();
