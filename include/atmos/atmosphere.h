@@ -174,6 +174,11 @@ ATMOS_API int atmos_atmosphere_sun_disk_visible(const atmos_atmosphere *atm, con
 /* The air's scattering and extinction coefficients (m^-1) at p (either may be NULL). */
 ATMOS_API void atmos_atmosphere_scattering(const atmos_atmosphere *atm, const double p[3], double *scattering,
                                            double *extinction);
+/* The clouds' extinction (m^-1, grey) at p: a spherical kind's cloud layer at uniform density
+ * along the vertical, its column optical depth from the cloud image (docs/sky.md); 0 outside
+ * the layer, outside the image, and for an atmosphere without clouds. What the cloud spheres
+ * draw, as a field that a volume can sample (atmos_scene_cloud_volume). */
+ATMOS_API double atmos_atmosphere_cloud_extinction(const atmos_atmosphere *atm, const double p[3]);
 /* The air's phase function at p, sr^-1 (Rayleigh's for the kinds here). */
 ATMOS_API double atmos_atmosphere_phase(const atmos_atmosphere *atm, const double p[3], double cos_theta);
 

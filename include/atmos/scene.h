@@ -156,6 +156,13 @@ ATMOS_API atmos_status atmos_scene_load(atmos_context *ctx, const char *path, at
  * (a world file sets the cloud image's extent). */
 ATMOS_API atmos_status atmos_scene_atmosphere_create(atmos_context *ctx, const atmos_scene *scene,
                                                      const atmos_wavelengths *wl, atmos_atmosphere **out);
+/* The clouds of the scene's spherical atmosphere as a volume (field "cloud", particle "cloud"):
+ * a box of the world frame 2 half_width_m wide in x and z around (centre_xz[0], centre_xz[1]),
+ * from the cloud layer's base (where the curved layer is lowest in the box) to its top, of
+ * voxel_size_m voxels whose densities give the layer's extinction (docs/sky.md). The ground
+ * truth for the cloud spheres with the slice renderer and the path tracer. */
+ATMOS_API atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *scene, const double centre_xz[2],
+                                                double half_width_m, double voxel_size_m, atmos_volume **out);
 
 /* The same with keys set from outside the text (atmos render -D, as Mitsuba's): each of the
  * count overrides is "PATH=VALUE", PATH a JSON pointer ("/camera/fov_deg") or a dotted path

@@ -129,6 +129,7 @@ static atmos_status create_planet(atmos_context *ctx, atmos_atmosphere *a)
     if (!a->planet) return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory");
     atmos_status st = atmos__planet_init(ctx, a->planet, &a->desc, &a->wl);
     if (st == ATMOS_OK) st = atmos__planet_surface_create(ctx, a->planet, &a->desc, &a->wl);
+    if (st == ATMOS_OK && a->desc.clouds.image) atmos__clouds_resolve(&a->desc.clouds);
     if (st == ATMOS_OK) st = atmos__planet_clouds_create(ctx, a->planet, &a->desc);
     /* the planet keeps its own copies: the caller's images may go */
     a->desc.ground_map = a->desc.night_map = a->desc.clouds.image = NULL;

@@ -117,6 +117,8 @@ atmos_status atmos__planet_surface_create(atmos_context *ctx, atmos__planet *pl,
 void atmos__planet_surface_release(atmos__planet *pl);
 atmos_status atmos__planet_clouds_create(atmos_context *ctx, atmos__planet *pl, const atmos_atmosphere_desc *d);
 void atmos__planet_clouds_release(atmos__planet *pl);
+/* Fills the cloud settings' defaults (zero means default; planet_clouds.c). */
+void atmos__clouds_resolve(atmos_cloud_desc *c);
 
 /* ------------------------------------------------------------------ numerics */
 /* Optical depth per wavelength (subset k[0..m-1], k NULL: all) of the segment p + t d,

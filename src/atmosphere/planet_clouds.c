@@ -62,8 +62,7 @@ static atmos_status check(atmos_context *ctx, const atmos_cloud_desc *c, double 
     return ATMOS_OK;
 }
 
-/* Zero means default. */
-static void resolve(atmos_cloud_desc *c)
+void atmos__clouds_resolve(atmos_cloud_desc *c)
 {
     if (c->lon_west_deg == 0 && c->lon_east_deg == 0 && c->lat_south_deg == 0 && c->lat_north_deg == 0)
         c->lon_west_deg = -180, c->lon_east_deg = 180, c->lat_south_deg = -90, c->lat_north_deg = 90;
@@ -78,7 +77,7 @@ atmos_status atmos__planet_clouds_create(atmos_context *ctx, atmos__planet *pl, 
     pl->clouds = NULL;
     if (!d->clouds.image) return ATMOS_OK;
     atmos_cloud_desc c = d->clouds;
-    resolve(&c);
+    atmos__clouds_resolve(&c);
     atmos_status st = check(ctx, &c, pl->r_top - pl->r_ground);
     if (st != ATMOS_OK) return st;
     const atmos_image *img = c.image;
@@ -160,4 +159,16 @@ double atmos__clouds_sun_attenuation(const atmos__planet *pl, const double x[3],
         depth += atmos__clouds_crossing_tau(pl, j, y, sun);
     }
     return exp(-depth);
+}
+
+double atmos_atmosphere_cloud_extinction(const atmos_atmosphere *atm, const double p[3])
+{
+    const atmos__planet *pl = atm ? atm->planet : NULL;
+    if (!pl || !pl->clouds) return 0.0;
+    const atmos__clouds *cl = pl->clouds;
+    const double h = atmos__planet_altitude(pl, p);
+    if (h < cl->base || h > cl->top) return 0.0;
+    double lat, lon;
+    atmos__planet_latlon(pl, p, &lat, &lon);
+    return atmos__clouds_column_tau(cl, lat, lon) * cl->sigma_per_tau;
 }

@@ -202,6 +202,7 @@ static void test_scene_keys(void)
     test_tmp_path(map, sizeof map, "earth_clouds.png");
     test_tmp_path(jgw, sizeof jgw, "earth_clouds.jgw");
     remove(map);
+    remove(jgw);
     write_text(scene, "{\"atmosphere\": {\"model\": \"spherical\", \"latitude_deg\": 27, \"longitude_deg\": -117,"
                       " \"clouds\": {\"image\": \"earth_clouds.png\", \"world_file\": \"earth_clouds.jgw\"}}}");
     atmos_scene sc;
@@ -234,6 +235,31 @@ static void test_scene_keys(void)
         CHECK(atmos__clouds_column_tau(cl, 27, -127) == 0);
     }
     CHECK(a && a->planet->clouds);
+    /* the same clouds as a volume: its vertical column's optical depth over the origin is the
+     * cloud spheres' (-ln G of the sunlight from the zenith at the ground) */
+    atmos_volume *v = NULL;
+    const double centre[2] = {0, 0};
+    CHECK_OK(atmos_scene_cloud_volume(ctx, &sc, centre, 5000, 500, &v));
+    if (v && a) {
+        atmos_particle_desc pd;
+        CHECK_OK(atmos_particle_preset(NULL, "cloud", &pd));
+        const atmos_volume_desc *vd = atmos_volume_get_desc(v);
+        CHECK(vd->dims[0] == 20 && vd->dims[2] == 20);
+        double col = 0;
+        for (int j = 0; j < vd->dims[1]; j++) {
+            const double p[3] = {250, vd->origin_m[1] + (j + 0.5) * 500, 250};
+            col += atmos_volume_sample(v, 0, p) * pd.sigma_ext_m2 * 500;
+        }
+        double sun[3], g[3] = {250, 0, 250};
+        atmos_direction_from_angles(90, 0, sun);
+        const double spheres = -log(atmos__clouds_sun_attenuation(a->planet, g, sun, -1));
+        CHECK(spheres > 1);
+        CHECK_REL(col, spheres, 1e-3);
+        /* outside the layer's heights: nothing */
+        const double below[3] = {250, 1000, 250};
+        CHECK(atmos_volume_sample(v, 0, below) == 0);
+    }
+    atmos_volume_destroy(v);
     atmos_atmosphere_destroy(a);
     /* a world file with a rotation is refused */
     write_text(jgw, "0.5\n0.1\n0\n-0.25\n-119.75\n29.875\n");
