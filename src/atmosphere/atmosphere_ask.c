@@ -140,7 +140,9 @@ static void planet_radiance(const atmos_atmosphere *atm, const double p[3], cons
             double sun[ATMOS_MAX_WAVELENGTHS];
             h.in_sun_disk = 1;
             atmos_atmosphere_sun_radiance(atm, p, sun_dir, sun);
-            for (int i = 0; i < atm->wl.count; i++) out[i] += sun[i];
+            const double tc =
+                atm->planet->clouds ? atmos__clouds_view_transmittance(atm->planet, p, dir, INFINITY) : 1.0;
+            for (int i = 0; i < atm->wl.count; i++) out[i] += sun[i] * tc;
         }
     }
     if (info) *info = h;

@@ -35,6 +35,9 @@ double atmos__clouds_sun_attenuation(const atmos__planet *pl, const double x[3],
 void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const double sun[3], int w, int h,
                                        float *out);
 
+/* The clouds' transmittance along p + t d, t in [0, dist] (the sun's disk behind them). */
+double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[3], const double d[3], double dist);
+
 /* A view ray through the air and the cloud spheres (planet_clouds_render.c): the solver's
  * in-scatter and transmittance on the segments between the eye, the spheres and the
  * ground; each crossing scatters the sunlight reaching it (times G) and attenuates what

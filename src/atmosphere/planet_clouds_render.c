@@ -160,3 +160,15 @@ void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const dou
         }
     }
 }
+
+double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[3], const double d[3], double dist)
+{
+    crossing c[MAX_CROSSINGS];
+    const int nc = find_crossings(pl, p, d, dist, c);
+    double tau = 0.0;
+    for (int j = 0; j < nc; j++) {
+        const double x[3] = {p[0] + c[j].t * d[0], p[1] + c[j].t * d[1], p[2] + c[j].t * d[2]};
+        tau += atmos__clouds_crossing_tau(pl, c[j].sphere, x, d);
+    }
+    return exp(-tau);
+}

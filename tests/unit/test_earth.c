@@ -176,6 +176,14 @@ static void test_cloud_attenuation(void)
     atmos_atmosphere_radiance(clear, eye, down, sun, L0, NULL);
     /* (the air's transmittance is integrated in two pieces with the cloud: 1e-4) */
     for (int k = 0; k < 3; k++) CHECK_REL(L[k], L0[k] * exp(-tau), 1e-4);
+    /* the sun's disk seen from the ground straight up through the cloud: dimmed by exp(-tau)
+     * (the cloud's own light, ~E/pi, is ~1/200 of the dimmed disk's: 2 %) */
+    const double ground[3] = {0, 1, 0}, up[3] = {0, 1, 0};
+    atmos_direction_from_angles(90, 0, sun);
+    double Ls[3], Lsun[3];
+    atmos_atmosphere_sun_radiance(a, ground, sun, Lsun);
+    atmos_atmosphere_radiance(a, ground, up, sun, Ls, NULL);
+    for (int k = 0; k < 3; k++) CHECK_REL(Ls[k], Lsun[k] * exp(-tau), 0.02);
     atmos_atmosphere_destroy(a);
     atmos_atmosphere_destroy(clear);
     /* five spheres carry the same column: the ground's shadow is the same */
