@@ -3,9 +3,9 @@
 # arguments, those packages instead (scripts/install-bench-deps.sh).
 # Safe to run repeatedly: it does nothing when everything is present.
 set -eu
-# Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
+# Images: libpng, libjpeg (maps of the Earth), OpenEXR. Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
 # its headers include, which Debian does not pull in); gnuplot for 'atmos phase --plot'.
-PKGS="build-essential cmake pkg-config libpng-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3"
+PKGS="build-essential cmake pkg-config libpng-dev libjpeg-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3"
 [ $# -gt 0 ] && PKGS="$*"
 missing=""
 for p in $PKGS; do

@@ -56,6 +56,29 @@ typedef enum {
     ATMOS_AEROSOL_NONE = 4
 } atmos_aerosol_type;
 
+struct atmos_image;
+
+/* Clouds of the spherical kinds from a satellite image (Dobashi et al. 2002 §5.4; docs/sky.md,
+ * "The Earth from space"): a layer between base_m and top_m of uniform density along the
+ * vertical, drawn as `spheres` concentric cloud spheres; the column's optical depth comes from
+ * the image's brightness. */
+typedef struct atmos_cloud_desc {
+    const struct atmos_image *image; /* NULL: no clouds. Brightness, sRGB-encoded in [0,1] (grey,
+                                         or the mean of R, G, B); equirectangular over the extent
+                                         below, north up */
+    double lon_west_deg, lon_east_deg;  /* the image's outer pixel edges; all four 0: the whole */
+    double lat_south_deg, lat_north_deg; /* globe (-180..180, -90..90) */
+    double base_m, top_m;       /* heights of the layer, m; default 2000 and 8000 */
+    int spheres;                /* cloud spheres, 1..64; default 5 */
+    double threshold;           /* linear brightness of cloud-free pixels (no cloud at or below
+                                   it); default 0.04 */
+    double max_optical_depth;   /* cap of the column's optical depth; default 100 */
+    double g;                   /* Henyey-Greenstein asymmetry of the clouds' single scattering;
+                                   default 0 */
+    int single_scattering;      /* nonzero: the sunlight scattered once only (Dobashi's model);
+                                   0: also the diffuse source mu_s E (1 - G) / pi (docs/sky.md) */
+} atmos_cloud_desc;
+
 /* Atmosphere settings. atmos_atmosphere_defaults() fills the paper's values; in a
  * zero-initialised desc, zero means default for every field except ground_albedo. */
 typedef struct atmos_atmosphere_desc {
@@ -87,6 +110,18 @@ typedef struct atmos_atmosphere_desc {
                                  extraterrestrial irradiance, sr^-1, that the air along a view
                                  ray adds as I_a E_sun (1 - T_view); default 0 (single
                                  scattering only), in [0, 1] */
+    /* DOBASHI and SPHERICAL: the Earth's surface and clouds from maps (docs/sky.md, "The Earth
+     * from space"). The maps are equirectangular: longitude -180..180 left to right, latitude
+     * 90..-90 top to bottom, values sRGB-encoded in [0,1]. The atmosphere keeps compact copies
+     * (8 bits per channel): the images may be destroyed after atmos_atmosphere_create. */
+    double latitude_deg, longitude_deg; /* where the ground under the origin is; there x points
+                                           east, y up, z south (atmos_direction_from_angles) */
+    const struct atmos_image *ground_map; /* the ground's reflectance (1 or 3 channels); NULL:
+                                             the uniform ground_albedo */
+    const struct atmos_image *night_map;  /* lights on the night side (1 or 3 channels); NULL: none */
+    double night_radiance;    /* radiance of a white night_map pixel, W m^-2 sr^-1 nm^-1;
+                                 default 5e-6 (a bright city in VIIRS's day/night band) */
+    atmos_cloud_desc clouds;
 } atmos_atmosphere_desc;
 
 ATMOS_API void atmos_atmosphere_defaults(atmos_atmosphere_desc *desc);
@@ -144,6 +179,11 @@ ATMOS_API int atmos_atmosphere_sun_disk_visible(const atmos_atmosphere *atm, con
 /* The air's scattering and extinction coefficients (m^-1) at p (either may be NULL). */
 ATMOS_API void atmos_atmosphere_scattering(const atmos_atmosphere *atm, const double p[3], double *scattering,
                                            double *extinction);
+/* The clouds' extinction (m^-1, grey) at p: a spherical kind's cloud layer at uniform density
+ * along the vertical, its column optical depth from the cloud image (docs/sky.md); 0 outside
+ * the layer, outside the image, and for an atmosphere without clouds. What the cloud spheres
+ * draw, as a field that a volume can sample (atmos_scene_cloud_volume). */
+ATMOS_API double atmos_atmosphere_cloud_extinction(const atmos_atmosphere *atm, const double p[3]);
 /* The air's phase function at p, sr^-1 (Rayleigh's for the kinds here). */
 ATMOS_API double atmos_atmosphere_phase(const atmos_atmosphere *atm, const double p[3], double cos_theta);
 

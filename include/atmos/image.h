@@ -119,6 +119,15 @@ ATMOS_API atmos_status atmos_write_png(atmos_context *ctx, const atmos_image *di
  * channels; text chunks go into img->meta. Malformed files: ATMOS_E_FORMAT. */
 ATMOS_API atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmos_image **out);
 
+/* Reads a baseline or progressive JPEG (libjpeg) into a float image in [0,1], the file's
+ * 8-bit values / 255 unchanged (sRGB-encoded for ordinary photographs): 1 channel for
+ * greyscale files, 3 (RGB) for colour ones; CMYK files are refused. A malformed or
+ * truncated file (libjpeg's warnings included) gives ATMOS_E_FORMAT, never a partial
+ * image. atmos_read_jpeg_scaled decodes at 1/reduce of the size (reduce 1, 2, 4 or 8,
+ * libjpeg's DCT scaling; each side rounded up): large maps at a fraction of the memory. */
+ATMOS_API atmos_status atmos_read_jpeg(atmos_context *ctx, const char *path, atmos_image **out);
+ATMOS_API atmos_status atmos_read_jpeg_scaled(atmos_context *ctx, const char *path, int reduce, atmos_image **out);
+
 /* Portable float map: 3 channels ("PF") or 1 ("Pf"), little-endian, bottom row first
  * as the format requires. 4 or more channels: the first three are written; 2
  * channels: ATMOS_E_INVALID_ARG. The reader accepts either byte order, ignores the

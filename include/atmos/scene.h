@@ -99,6 +99,20 @@ typedef struct atmos_scene_animation {
     double azimuth_end_deg;    /* the last frame's sun azimuth, [0, 360) */
 } atmos_scene_animation;
 
+/* The Earth's maps and clouds of a spherical atmosphere ("atmosphere" keys "ground_map",
+ * "night_lights", "map_reduce", "clouds": {"image", "world_file", ...}); relative paths are
+ * resolved against the scene file's folder by atmos_scene_load, which also checks that the
+ * files can be read. The images are read when the atmosphere is made
+ * (atmos_scene_atmosphere_create); the other settings are in atmos_atmosphere_desc. */
+typedef struct atmos_scene_earth {
+    char ground_map[ATMOS_SCENE_PATH_MAX];   /* JPEG or PNG; "" none */
+    char night_lights[ATMOS_SCENE_PATH_MAX]; /* JPEG or PNG; "" none */
+    char cloud_image[ATMOS_SCENE_PATH_MAX];  /* JPEG or PNG; "" no clouds */
+    char cloud_world_file[ATMOS_SCENE_PATH_MAX]; /* ESRI world file placing cloud_image
+                                                    (longitude, latitude of pixel centres); "" */
+    int map_reduce;                          /* JPEG maps decoded at 1/map_reduce: 1, 2, 4, 8 */
+} atmos_scene_earth;
+
 typedef struct atmos_scene {
     char name[128];
     int width, height;                    /* pixels, 1..ATMOS_SCENE_MAX_DIM */
@@ -123,6 +137,7 @@ typedef struct atmos_scene {
     atmos_scene_animation animation;
     int camera_given;                     /* the scene file has a "camera" (a volume scene without
                                              one is framed by atmos_scene_frame_volume) */
+    atmos_scene_earth earth;              /* the spherical atmosphere's maps and clouds */
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
@@ -136,6 +151,18 @@ ATMOS_API atmos_status atmos_scene_parse(atmos_context *ctx, const char *json, s
                                          const char *source, atmos_scene *out);
 /* Reads a file (at most 16 MiB) and parses it. */
 ATMOS_API atmos_status atmos_scene_load(atmos_context *ctx, const char *path, atmos_scene *out);
+/* The scene's atmosphere for a wavelength set: atmos_atmosphere_create with the maps and
+ * the cloud image of scene->earth read (JPEG or PNG, by the file's first bytes) and placed
+ * (a world file sets the cloud image's extent). */
+ATMOS_API atmos_status atmos_scene_atmosphere_create(atmos_context *ctx, const atmos_scene *scene,
+                                                     const atmos_wavelengths *wl, atmos_atmosphere **out);
+/* The clouds of the scene's spherical atmosphere as a volume (field "cloud", particle "cloud"):
+ * a box of the world frame 2 half_width_m wide in x and z around (centre_xz[0], centre_xz[1]),
+ * from the cloud layer's base (where the curved layer is lowest in the box) to its top, of
+ * voxel_size_m voxels whose densities give the layer's extinction (docs/sky.md). The ground
+ * truth for the cloud spheres with the slice renderer and the path tracer. */
+ATMOS_API atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *scene, const double centre_xz[2],
+                                                double half_width_m, double voxel_size_m, atmos_volume **out);
 
 /* The same with keys set from outside the text (atmos render -D, as Mitsuba's): each of the
  * count overrides is "PATH=VALUE", PATH a JSON pointer ("/camera/fov_deg") or a dotted path

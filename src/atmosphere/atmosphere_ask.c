@@ -3,6 +3,7 @@
  * tagged set: a switch is cheaper than a call through a pointer in the renderers' inner
  * loops and keeps every kind's answers side by side. */
 #include "atmosphere/atmosphere_internal.h"
+#include "atmosphere/planet_clouds.h"
 #include "atmosphere/planet_solver.h"
 
 #include <math.h>
@@ -129,7 +130,8 @@ static void planet_radiance(const atmos_atmosphere *atm, const double p[3], cons
                             const double sun_dir[3], int disk, double *out, atmos_atmosphere_hit *info)
 {
     atmos_atmosphere_hit h;
-    if (atm->solver->radiance) atm->solver->radiance(atm, p, dir, sun_dir, out, &h);
+    if (atm->planet->clouds) atmos__planet_radiance_clouds(atm, p, dir, sun_dir, out, &h);
+    else if (atm->solver->radiance) atm->solver->radiance(atm, p, dir, sun_dir, out, &h);
     else atmos__planet_radiance_generic(atm, p, dir, sun_dir, out, &h);
     h.in_sun_disk = 0;
     if (disk && !h.hits_ground && !atm->desc.hide_sun_disk) {
@@ -138,7 +140,9 @@ static void planet_radiance(const atmos_atmosphere *atm, const double p[3], cons
             double sun[ATMOS_MAX_WAVELENGTHS];
             h.in_sun_disk = 1;
             atmos_atmosphere_sun_radiance(atm, p, sun_dir, sun);
-            for (int i = 0; i < atm->wl.count; i++) out[i] += sun[i];
+            const double tc =
+                atm->planet->clouds ? atmos__clouds_view_transmittance(atm->planet, p, dir, INFINITY) : 1.0;
+            for (int i = 0; i < atm->wl.count; i++) out[i] += sun[i] * tc;
         }
     }
     if (info) *info = h;
@@ -242,7 +246,8 @@ void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx
         return;
     }
     default:
-        if (b->atm->solver && b->atm->solver->batch_eval)
+        /* clouds: ray by ray through the cloud spheres (planet_clouds_render.c) */
+        if (b->atm->solver && b->atm->solver->batch_eval && !b->atm->planet->clouds)
             b->atm->solver->batch_eval(b, count, dx, dy, dz, weight, out, scratch);
         else batch_generic(b, count, dx, dy, dz, weight, out);
     }

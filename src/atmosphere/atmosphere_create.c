@@ -84,6 +84,13 @@ static atmos_status check_planet(atmos_context *ctx, const atmos_atmosphere_desc
     if (!(d->dobashi_ambient >= 0 && d->dobashi_ambient <= 1))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/dobashi_ambient: must be in [0, 1], got %g",
                             d->dobashi_ambient);
+    if (!(fabs(d->latitude_deg) <= 90 && fabs(d->longitude_deg) <= 360))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "atmosphere/latitude_deg, longitude_deg: must be in [-90, 90] and [-360, 360], got %g, %g",
+                            d->latitude_deg, d->longitude_deg);
+    if (!(d->night_radiance >= 0 && d->night_radiance <= 1e3))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere/night_radiance: must be in [0, 1e3], got %g",
+                            d->night_radiance);
     return ATMOS_OK;
 }
 
@@ -124,6 +131,11 @@ static atmos_status create_planet(atmos_context *ctx, atmos_atmosphere *a)
     a->planet = calloc(1, sizeof *a->planet);
     if (!a->planet) return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory");
     atmos_status st = atmos__planet_init(ctx, a->planet, &a->desc, &a->wl);
+    if (st == ATMOS_OK) st = atmos__planet_surface_create(ctx, a->planet, &a->desc, &a->wl);
+    if (st == ATMOS_OK && a->desc.clouds.image) atmos__clouds_resolve(&a->desc.clouds);
+    if (st == ATMOS_OK) st = atmos__planet_clouds_create(ctx, a->planet, &a->desc);
+    /* the planet keeps its own copies: the caller's images may go */
+    a->desc.ground_map = a->desc.night_map = a->desc.clouds.image = NULL;
     if (st != ATMOS_OK) return st;
     a->solver = a->desc.kind == ATMOS_ATMOSPHERE_DOBASHI ? &atmos__dobashi_solver : &atmos__spherical_solver;
     return a->solver->create ? a->solver->create(ctx, a) : ATMOS_OK;
@@ -173,6 +185,8 @@ void atmos_atmosphere_destroy(atmos_atmosphere *atm)
 {
     if (!atm) return;
     if (atm->solver && atm->solver->destroy && atm->model) atm->solver->destroy(atm->model);
+    atmos__planet_surface_release(atm->planet);
+    atmos__planet_clouds_release(atm->planet);
     free(atm->planet);
     free(atm);
 }

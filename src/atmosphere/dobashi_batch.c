@@ -244,7 +244,7 @@ void atmos__dobashi_batch_eval(const atmos__atm_batch *b, int count, const float
                                       m->ambient * (1.0 - w[2]));
             if (ground) {
                 const double lit = cs > 0 ? atmos__planet_ground_albedo(a->planet, g, k) / ATMOS_PI * cs * gl[k] : 0;
-                L += (lit * a->sun_e[k] + atmos__planet_ground_emission(a->planet, g, k)) * w[2];
+                L += (lit * a->sun_e[k] + atmos__planet_ground_lights(a->planet, g, sun, k)) * w[2];
             }
             out[(size_t)k * count + i] += weight[i] * (float)L;
         }

@@ -236,7 +236,7 @@ void atmos__dobashi_radiance(const atmos_atmosphere *a, const double p[3], const
         gl_at(m, pl, 0.0, cs, gl);
         for (int k = 0; k < m->n; k++) {
             const double lit = cs > 0 ? atmos__planet_ground_albedo(pl, g, k) / ATMOS_PI * cs * gl[k] * a->sun_e[k] : 0;
-            out[k] += (lit + atmos__planet_ground_emission(pl, g, k)) * T[k];
+            out[k] += (lit + atmos__planet_ground_lights(pl, g, sun, k)) * T[k];
         }
     }
     if (info) {

@@ -35,6 +35,12 @@ typedef struct atmos__planet {
     float mie_phase[ATMOS_MAX_WAVELENGTHS][ATMOS__PLANET_PHASE_N];
     float mie_cdf[ATMOS_MAX_WAVELENGTHS][ATMOS__PLANET_PHASE_N];
     double mie_g[ATMOS_MAX_WAVELENGTHS];  /* asymmetry parameter */
+    /* the geographic frame (planet_surface.c): the Earth-centred axes (x to latitude 0,
+     * longitude 0; y to longitude 90 E; z north) of the world's x (east at the origin),
+     * y (up there) and -z (north there) */
+    double geo_east[3], geo_up[3], geo_north[3];
+    struct atmos__surface *surface;       /* the ground's maps; NULL: uniform, no lights */
+    struct atmos__clouds *clouds;         /* the cloud spheres (planet_clouds.c); NULL: none */
 } atmos__planet;
 
 /* Fills the description from a resolved atmosphere desc (planet.c, planet_optics.c). */
@@ -104,10 +110,27 @@ double atmos__planet_dist_ground(const atmos__planet *pl, double r, double mu); 
 
 /* ------------------------------------------------------------------ the ground */
 /* The ground's Lambertian reflectance at the ground point g for wavelength k (uniform, or
- * from a map) and the radiance it emits there (the night side's lights), W m^-2 sr^-1
- * nm^-1 (planet_surface.c). */
+ * from a map) and the radiance its night map gives there at full night, W m^-2 sr^-1 nm^-1
+ * (planet_surface.c); every solver and the reference draw the lights through
+ * atmos__planet_ground_lights, which fades them by the sun's elevation. */
 double atmos__planet_ground_albedo(const atmos__planet *pl, const double g[3], int k);
 double atmos__planet_ground_emission(const atmos__planet *pl, const double g[3], int k);
+/* The night lights at g as the sun (direction sun) sees them: the emission times the night
+ * factor, 1 where the sun is 12 degrees or more below g's horizon, 0 where it is above it,
+ * smooth between (twilight). The solvers' radiance uses this one. */
+double atmos__planet_ground_lights(const atmos__planet *pl, const double g[3], const double sun[3], int k);
+/* Latitude and longitude (degrees; longitude in [-180, 180]) of the direction of x from the
+ * planet's centre. */
+void atmos__planet_latlon(const atmos__planet *pl, const double x[3], double *lat_deg, double *lon_deg);
+/* Builds the geographic frame and the maps of d (planet_surface.c) and the cloud spheres
+ * (planet_clouds.c) into pl; the release functions free them (NULL-safe). */
+atmos_status atmos__planet_surface_create(atmos_context *ctx, atmos__planet *pl, const atmos_atmosphere_desc *d,
+                                          const atmos_wavelengths *wl);
+void atmos__planet_surface_release(atmos__planet *pl);
+atmos_status atmos__planet_clouds_create(atmos_context *ctx, atmos__planet *pl, const atmos_atmosphere_desc *d);
+void atmos__planet_clouds_release(atmos__planet *pl);
+/* Fills the cloud settings' defaults (zero means default; planet_clouds.c). */
+void atmos__clouds_resolve(atmos_cloud_desc *c);
 
 /* ------------------------------------------------------------------ numerics */
 /* Optical depth per wavelength (subset k[0..m-1], k NULL: all) of the segment p + t d,

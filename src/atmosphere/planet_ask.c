@@ -22,7 +22,7 @@ void atmos__planet_radiance_generic(const atmos_atmosphere *a, const double p[3]
         if (cs > 0) a->solver->sunlight(a, g, sun, n, NULL, E);
         for (int i = 0; i < n; i++) {
             const double lit = cs > 0 ? atmos__planet_ground_albedo(pl, g, i) / ATMOS_PI * cs * E[i] : 0.0;
-            out[i] += (lit + atmos__planet_ground_emission(pl, g, i)) * T[i];
+            out[i] += (lit + atmos__planet_ground_lights(pl, g, sun, i)) * T[i];
         }
     }
     if (info) {

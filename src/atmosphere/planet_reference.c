@@ -95,7 +95,7 @@ static int ground_event(const atmos_atmosphere *a, double p[3], double d[3], con
     atmos__planet_ground_point(pl, p, n);
     /* a hair above the ground, so that the walk leaves it cleanly */
     for (int i = 0; i < 3; i++) p[i] += 1e-6 * n[i];
-    *L += *w * atmos__planet_ground_emission(pl, p, k);
+    *L += *w * atmos__planet_ground_lights(pl, p, sun, k);
     const double alb = atmos__planet_ground_albedo(pl, p, k);
     if (!(alb > 0)) return 0;
     const double cs = atmos__dot3(n, sun);

@@ -81,7 +81,7 @@ void atmos__sph_ground(const atmos__planet *pl, const atmos__sph_model *m, const
         const int kk = ATMOS__WL(k, i);
         const double e = (cs > 0 ? cs * ts[i] : 0.0) + es[i];
         out[i] = atmos__planet_ground_albedo(pl, gw, kk) / ATMOS_PI * e * sun_e[kk] +
-                 atmos__planet_ground_emission(pl, gw, kk);
+                 atmos__planet_ground_lights(pl, gw, sun, kk);
     }
 }
 

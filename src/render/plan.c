@@ -73,7 +73,7 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
     p->renderer = scene->renderer;
     p->reference = d.reference;
     if ((st = atmos_scene_wavelengths(ctx, scene, &p->wl)) != ATMOS_OK) goto fail;
-    if ((st = atmos_atmosphere_create(ctx, &scene->atmosphere, &p->wl, &p->atm)) != ATMOS_OK) goto fail;
+    if ((st = atmos_scene_atmosphere_create(ctx, scene, &p->wl, &p->atm)) != ATMOS_OK) goto fail;
     if ((st = plan_volume(p, volume, &d)) != ATMOS_OK) goto fail;
     if (p->renderer == ATMOS_RENDERER_SLICE && !p->volume) {
         st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the slice renderer needs a volume");

@@ -324,6 +324,7 @@ atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const c
         memmove(v->source + dir, v->source, n + 1);
         memcpy(v->source, path, dir);
     }
+    if (st == ATMOS_OK) st = atmos__scene_earth_paths(ctx, path, slash ? (size_t)(slash - path) + 1 : 0, &out->earth);
     return st;
 }
 

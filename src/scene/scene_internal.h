@@ -89,4 +89,9 @@ double atmos__scene_norm3(const double v[3]);
 /* Sine of the angle between a and b (0 when parallel); -1 if either is zero. */
 double atmos__scene_sin_angle(const double a[3], const double b[3]);
 
+/* scene_earth.c: the Earth's map and cloud files of a scene loaded from `path`, made
+ * relative to its folder (the first dir bytes of path; 0: the current folder) and checked
+ * to be readable. */
+atmos_status atmos__scene_earth_paths(atmos_context *ctx, const char *path, size_t dir, atmos_scene_earth *e);
+
 #endif

@@ -461,6 +461,61 @@ static atmos_status parse_sun(const jp *p, const cJSON *j, const char *path, atm
     return ATMOS_OK;
 }
 
+static atmos_status get_text(const jp *p, const cJSON *j, const char *path, char *out, size_t cap);
+
+/* "clouds" of a spherical atmosphere: the satellite image, where it lies, the layer. */
+static atmos_status parse_clouds(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"lon_west_deg", "lon_east_deg", "lat_south_deg", "lat_north_deg", "base_m",
+                                       "top_m", "threshold", "max_optical_depth", "g", "image", "world_file",
+                                       "spheres", "single_scattering"};
+    enum { NUM = 9, K_IMAGE = 9, K_WORLD, K_SPHERES, K_SINGLE, NKEYS };
+    static const atmos__range lon = {-360, 360, 0, 0}, lat = {-90, 90, 0, 0}, height = {0, 1e6, 0, 0},
+                              unit = {0, 1, 0, 1}, tau = {0, 1e4, 1, 0}, g = {-1, 1, 1, 1}, spheres = {1, 64, 0, 0};
+    atmos_cloud_desc *c = &s->atmosphere.clouds;
+    double *fields[NUM] = {&c->lon_west_deg, &c->lon_east_deg, &c->lat_south_deg, &c->lat_north_deg, &c->base_m,
+                           &c->top_m, &c->threshold, &c->max_optical_depth, &c->g};
+    const atmos__range *ranges[NUM] = {&lon, &lon, &lat, &lat, &height, &height, &unit, &tau, &g};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k;
+    TRY(iter_begin(p, j, path, keys, NKEYS, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        if (k < NUM) TRY(get_number(p, v, ip, ranges[k], NULL, fields[k]));
+        else if (k == K_IMAGE) TRY(get_text(p, v, ip, s->earth.cloud_image, sizeof s->earth.cloud_image));
+        else if (k == K_WORLD) TRY(get_text(p, v, ip, s->earth.cloud_world_file, sizeof s->earth.cloud_world_file));
+        else if (k == K_SPHERES) TRY(get_int(p, v, ip, &spheres, &c->spheres));
+        else TRY(get_bool(p, v, ip, &c->single_scattering));
+    }
+    if (!(it.seen & (1u << K_IMAGE)))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "missing key \"image\"");
+    return ATMOS_OK;
+}
+
+/* The spherical atmosphere's Earth: where the origin is, the maps, the clouds. */
+static atmos_status parse_earth_key(const jp *p, int k, const cJSON *v, const char *ip, atmos_scene *s)
+{
+    static const atmos__range reduce = {1, 8, 0, 0}, night = {0, 1e3, 0, 0};
+    atmos_atmosphere_desc *a = &s->atmosphere;
+    switch (k) {
+    case 0: return get_number(p, v, ip, &atmos__r_latitude, NULL, &a->latitude_deg);
+    case 1: return get_number(p, v, ip, &atmos__r_longitude, NULL, &a->longitude_deg);
+    case 2: return get_number(p, v, ip, &night, NULL, &a->night_radiance);
+    case 3: return get_text(p, v, ip, s->earth.ground_map, sizeof s->earth.ground_map);
+    case 4: return get_text(p, v, ip, s->earth.night_lights, sizeof s->earth.night_lights);
+    case 5: {
+        TRY(get_int(p, v, ip, &reduce, &s->earth.map_reduce));
+        if (s->earth.map_reduce & (s->earth.map_reduce - 1))
+            return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "must be 1, 2, 4 or 8");
+        return ATMOS_OK;
+    }
+    default: return parse_clouds(p, v, ip, s);
+    }
+}
+
 /* "model" (or its older name "kind") picks the atmosphere's kind; the spherical models'
  * settings are read for any model and used by those. */
 static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
@@ -469,8 +524,9 @@ static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *pa
                                        "sun_scale", "thickness_m", "planet_radius_m", "top_m",
                                        "rayleigh_scale_height_m", "aerosol_scale_height_m", "visibility_km",
                                        "turbidity", "ozone_du", "dobashi_ambient", "sun_disk", "ozone", "kind",
-                                       "model", "aerosol"};
-    enum { NUM = 14, K_DISK = 14, K_OZONE, K_KIND, K_MODEL, K_AEROSOL, NKEYS };
+                                       "model", "aerosol", "latitude_deg", "longitude_deg", "night_radiance",
+                                       "ground_map", "night_lights", "map_reduce", "clouds"};
+    enum { NUM = 14, K_DISK = 14, K_OZONE, K_KIND, K_MODEL, K_AEROSOL, K_EARTH, NKEYS = K_EARTH + 7 };
     static const char *const kinds[] = {"riley", "homogeneous", "dobashi", "spherical"};
     static const atmos_atmosphere_kind kind_of[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS,
                                                     ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL};
@@ -495,6 +551,8 @@ static atmos_status parse_atmosphere(const jp *p, const cJSON *j, const char *pa
         if (k < 0) return ATMOS_OK;
         if (k < NUM) {
             TRY(get_number(p, v, ip, ranges[k], NULL, fields[k]));
+        } else if (k >= K_EARTH) {
+            TRY(parse_earth_key(p, k - K_EARTH, v, ip, s));
         } else if (k == K_DISK || k == K_OZONE) {
             TRY(get_bool(p, v, ip, &flag));
             if (k == K_DISK) a->hide_sun_disk = !flag;

@@ -14,7 +14,8 @@ static void help(void)
 {
     printf("Usage: atmos volume info FILE [--json] [reading options]\n"
            "       atmos volume generate PRESET -o NAME.json [--seed N] [--voxel-size M] [--scale S] [--threads T]\n"
-           "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png [reading options]\n\n"
+           "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png [reading options]\n"
+           "       atmos volume clouds SCENE.json -o NAME.json [--centre X,Z] [--half-width M] [--voxel-size M]\n\n"
            "  info      fields, dimensions, world-space bounds (metres, after the grid transform), value\n"
            "            ranges (number densities, m^-3), active voxels and memory of a volume file\n"
            "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
@@ -29,7 +30,12 @@ static void help(void)
     printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
            "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
-           "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image.\n\n"
+           "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image.\n"
+           "  clouds    the cloud layer of SCENE's spherical atmosphere (\"clouds\" from a satellite image) as\n"
+           "            a raw + JSON volume of \"cloud\" particles with the same optical depths, in the\n"
+           "            world frame (x east, y up, z south at the scene's latitude/longitude): a box\n"
+           "            2 M wide around (X, Z) (default 0,0; half width 20000 m) from the layer's base to\n"
+           "            its top, voxels of --voxel-size metres (default 500).\n\n"
            "Reading options (info, slice):\n"
            "  --grids LIST      VDB/NanoVDB grids or NetCDF variables to read (comma-separated)\n"
            "  --as NAME         field name for a single-grid file (default cloud)\n"
@@ -345,9 +351,58 @@ static int cmd_slice(int argc, char **argv)
     return rc;
 }
 
+static int cmd_clouds(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out = NULL;
+    double centre[2] = {0, 0}, half = 20000, voxel = 500;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
+            out = argv[++i];
+            if (!*out) return cli_usage_error(C, "-o: expected a file name");
+        } else if (!strcmp(argv[i], "--centre") && i + 1 < argc) {
+            char *end = NULL;
+            const char *t = argv[++i];
+            centre[0] = strtod(t, &end);
+            if (end == t || *end != ',') return cli_usage_error(C, "--centre: expected X,Z in metres, got '%s'", t);
+            const char *t2 = end + 1;
+            centre[1] = strtod(t2, &end);
+            if (end == t2 || *end || !isfinite(centre[0]) || !isfinite(centre[1]))
+                return cli_usage_error(C, "--centre: expected X,Z in metres, got '%s'", t);
+        } else if (!strcmp(argv[i], "--half-width") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--half-width", argv[++i], &half)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(argv[i], "--voxel-size") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--voxel-size", argv[++i], &voxel)) return CLI_EXIT_USAGE;
+        } else if (argv[i][0] == '-') {
+            return cli_usage_error(C, "clouds: unknown or incomplete option '%s'", argv[i]);
+        } else if (!scene_path) {
+            scene_path = argv[i];
+        } else {
+            return cli_usage_error(C, "clouds: unexpected argument '%s'", argv[i]);
+        }
+    }
+    if (!scene_path) return cli_usage_error(C, "clouds: which scene?");
+    if (!out) return cli_usage_error(C, "clouds: missing -o NAME.json");
+    if (!(half > 0 && voxel > 0)) return cli_usage_error(C, "clouds: --half-width and --voxel-size must be > 0");
+    atmos_context *ctx = cli_context(0, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_scene *sc = malloc(sizeof *sc);
+    atmos_volume *v = NULL;
+    atmos_status st = sc ? atmos_scene_load(ctx, scene_path, sc) : ATMOS_E_NOMEM;
+    if (st == ATMOS_OK) st = atmos_scene_cloud_volume(ctx, sc, centre, half, voxel, &v);
+    if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
+    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    atmos_volume_destroy(v);
+    free(sc);
+    atmos_context_destroy(ctx);
+    return rc;
+}
+
 int cli_cmd_volume(int argc, char **argv)
 {
-    if (argc < 2) return cli_usage_error(C, "expected a subcommand: info, generate or slice");
+    if (argc < 2) return cli_usage_error(C, "expected a subcommand: info, generate, slice or clouds");
     const char *sub = argv[1];
     if (!strcmp(sub, "--help") || !strcmp(sub, "-h")) {
         help();
@@ -356,5 +411,6 @@ int cli_cmd_volume(int argc, char **argv)
     if (!strcmp(sub, "info")) return cmd_info(argc - 1, argv + 1);
     if (!strcmp(sub, "generate")) return cmd_generate(argc - 1, argv + 1);
     if (!strcmp(sub, "slice")) return cmd_slice(argc - 1, argv + 1);
-    return cli_usage_error(C, "unknown subcommand '%s' (info, generate, slice)", sub);
+    if (!strcmp(sub, "clouds")) return cmd_clouds(argc - 1, argv + 1);
+    return cli_usage_error(C, "unknown subcommand '%s' (info, generate, slice, clouds)", sub);
 }

@@ -1,0 +1,48 @@
+/* The cloud spheres of the spherical kinds (planet_clouds.c, planet_clouds_render.c):
+ * internal to src/atmosphere/. */
+#ifndef ATMOS_PLANET_CLOUDS_H
+#define ATMOS_PLANET_CLOUDS_H
+
+#include "atmosphere/planet_solver.h"
+
+#define ATMOS__CLOUDS_MAX 64
+
+typedef struct atmos__clouds {
+    int m;                       /* spheres */
+    double base, top, dh;        /* the layer's heights and one shell's thickness, m */
+    double r[ATMOS__CLOUDS_MAX]; /* radii of the spheres, lowest first */
+    double mu_min[ATMOS__CLOUDS_MAX];
+    double sigma_per_tau;        /* the layer's extinction per unit column optical depth, m^-1 */
+    int w, h, global;            /* the optical depth image and whether it spans 360 degrees */
+    double lon_w, lon_e, lat_s, lat_n;
+    float *tau;                  /* column optical depth per pixel, row 0 north */
+    double g;                    /* Henyey-Greenstein asymmetry of single scattering */
+    int single;                  /* nonzero: no diffuse source */
+} atmos__clouds;
+
+/* Column optical depth of a pixel of linear brightness b (planet_clouds.c's mapping). */
+double atmos__clouds_tau_from_brightness(double b, double threshold, double max_tau);
+/* Column optical depth at (lat, lon), bilinear; 0 outside the image. */
+double atmos__clouds_column_tau(const atmos__clouds *cl, double lat, double lon);
+/* Optical depth of shell i crossed at x (on sphere i) in direction d. */
+double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x[3], const double d[3]);
+/* G: the transmittance of the cloud spheres above sphere `below` (-1: all of them, for the
+ * ground) to the sunlight reaching x; the attenuation texture of sphere i is
+ * G(x on sphere i, sun, i). */
+double atmos__clouds_sun_attenuation(const atmos__planet *pl, const double x[3], const double sun[3], int below);
+/* Tabulates G_i over an equirectangular w x h grid of sphere i's points (row 0 north,
+ * longitudes -180..180) for one sun direction: the attenuation texture. */
+void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const double sun[3], int w, int h,
+                                       float *out);
+
+/* The clouds' transmittance along p + t d, t in [0, dist] (the sun's disk behind them). */
+double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[3], const double d[3], double dist);
+
+/* A view ray through the air and the cloud spheres (planet_clouds_render.c): the solver's
+ * in-scatter and transmittance on the segments between the eye, the spheres and the
+ * ground; each crossing scatters the sunlight reaching it (times G) and attenuates what
+ * lies behind it; the ground is shadowed by G of all spheres. Without the sun's disk. */
+void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3], const double d[3],
+                                   const double sun[3], double *out, atmos_atmosphere_hit *info);
+
+#endif

@@ -1,0 +1,174 @@
+/* A view ray of a spherical kind through the cloud spheres (planet_clouds.h; Dobashi et al.
+ * 2002 §5.4): the air before, between and behind the spheres from the solver's in-scatter
+ * and transmittance, each sphere's crossing as a thin layer, the ground under them.
+ *
+ * A crossing of sphere i at x with shell optical depth tau (planet_clouds.c) lets through
+ * t = exp(-tau) of the light behind it and adds (1 - t) J, J the source of the shell:
+ *   J = E(x) [ G_i(x) P_HG(cos) + mu_s (1 - G_i(x) exp(-tau_i / (2 mu_s))) / pi ]
+ * E(x) the sunlight the solver gives at x (the air's attenuation and the planet's shadow),
+ * G_i the attenuation texture (the spheres above i), cos = d . sun the cosine of the
+ * scattering angle, mu_s the sun's cosine to the vertical at x. The second term is the
+ * diffuse light (the clouds' multiple scattering, which Dobashi's single scattering leaves
+ * out): the sunlight taken from the direct beam above the middle of the shell becomes
+ * isotropic light of radiance mu_s E / pi per unit lost (a thick cloud's top looks like a
+ * white Lambertian surface); single_scattering leaves it out. The air under a cloud is lit
+ * as if the cloud were not there (its shadow in the air is not drawn); the ground's
+ * sunlight is multiplied by G of all spheres. */
+#include "atmosphere/planet_clouds.h"
+
+#include "core/vec.h"
+
+#define MAX_CROSSINGS (2 * ATMOS__CLOUDS_MAX)
+/* stop walking once the clouds pass less than this */
+#define OPAQUE 1e-4
+
+typedef struct {
+    double t;
+    int sphere;
+} crossing;
+
+/* The crossings of the spheres with the ray in (0, tmax), nearest first. */
+static int find_crossings(const atmos__planet *pl, const double p[3], const double d[3], double tmax,
+                          crossing *c)
+{
+    const atmos__clouds *cl = pl->clouds;
+    const double o[3] = {p[0], p[1] + pl->r_ground, p[2]};
+    const double b = atmos__dot3(o, d), oo = atmos__dot3(o, o);
+    int n = 0;
+    for (int i = 0; i < cl->m; i++) {
+        const double disc = b * b - (oo - cl->r[i] * cl->r[i]);
+        if (disc <= 0) continue;
+        const double s = sqrt(disc), ts[2] = {-b - s, -b + s};
+        for (int j = 0; j < 2; j++) {
+            if (!(ts[j] > 0 && ts[j] < tmax)) continue;
+            int k = n++;
+            while (k > 0 && c[k - 1].t > ts[j]) c[k] = c[k - 1], k--;
+            c[k].t = ts[j], c[k].sphere = i;
+        }
+    }
+    return n;
+}
+
+static double hg(double g, double cos_theta)
+{
+    const double q = 1.0 + g * g - 2.0 * g * cos_theta;
+    return (1.0 - g * g) / (4.0 * ATMOS_PI * q * sqrt(q));
+}
+
+/* Adds the crossing's light (times the transmittance w in front of it) to out; returns
+ * the crossing's transmittance. */
+static double crossing_light(const atmos_atmosphere *a, const double x[3], const double d[3], const double sun[3],
+                             int i, const double *w, double *out)
+{
+    const atmos__planet *pl = a->planet;
+    const atmos__clouds *cl = pl->clouds;
+    const double tau = atmos__clouds_crossing_tau(pl, i, x, d);
+    if (tau <= 0) return 1.0;
+    const double t = exp(-tau);
+    const int n = a->wl.count;
+    double E[ATMOS_MAX_WAVELENGTHS];
+    a->solver->sunlight(a, x, sun, n, NULL, E);
+    int lit = 0;
+    for (int k = 0; k < n; k++) lit |= E[k] > 0;
+    if (!lit) return t;
+    const double G = atmos__clouds_sun_attenuation(pl, x, sun, i);
+    double J = G * hg(cl->g, atmos__dot3(d, sun));
+    const double mus = atmos__planet_mu(pl, x, sun);
+    if (!cl->single && mus > 0) {
+        const double own = atmos__clouds_crossing_tau(pl, i, x, sun); /* the whole shell along the sun */
+        J += mus * (1.0 - G * exp(-0.5 * own)) / ATMOS_PI;
+    }
+    for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];
+    return t;
+}
+
+/* The ground at distance K: lit by the sunlight through the air and the clouds, and its
+ * lights; times w. */
+static void ground_light(const atmos_atmosphere *a, const double p[3], const double d[3], double K,
+                         const double sun[3], const double *w, double *out)
+{
+    const atmos__planet *pl = a->planet;
+    const int n = a->wl.count;
+    double g[3] = {p[0] + K * d[0], p[1] + K * d[1], p[2] + K * d[2]}, nrm[3];
+    atmos__planet_ground_point(pl, g, nrm);
+    const double cs = fmax(atmos__dot3(nrm, sun), 0.0);
+    double E[ATMOS_MAX_WAVELENGTHS];
+    double G = 0.0;
+    if (cs > 0) {
+        a->solver->sunlight(a, g, sun, n, NULL, E);
+        G = atmos__clouds_sun_attenuation(pl, g, sun, -1);
+    }
+    for (int k = 0; k < n; k++) {
+        const double lit = cs > 0 ? atmos__planet_ground_albedo(pl, g, k) / ATMOS_PI * cs * E[k] * G : 0.0;
+        out[k] += w[k] * (lit + atmos__planet_ground_lights(pl, g, sun, k));
+    }
+}
+
+void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3], const double d[3],
+                                   const double sun[3], double *out, atmos_atmosphere_hit *info)
+{
+    const atmos__planet *pl = a->planet;
+    const int n = a->wl.count;
+    const double K = atmos__planet_ground_distance(pl, p, d);
+    crossing c[MAX_CROSSINGS];
+    const int nc = find_crossings(pl, p, d, K, c);
+    double w[ATMOS_MAX_WAVELENGTHS], S[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    for (int k = 0; k < n; k++) out[k] = 0.0, w[k] = 1.0;
+    double x[3] = {p[0], p[1], p[2]}, t_prev = 0.0, clouds = 1.0;
+    int opaque = 0;
+    for (int j = 0; j <= nc && !opaque; j++) {
+        const double t_end = j < nc ? c[j].t : K, seg = t_end - t_prev;
+        /* the air of the segment, seen through everything in front of it */
+        if (seg > 0 && a->solver->inscatter(a, x, d, seg, sun, n, NULL, S))
+            for (int k = 0; k < n; k++) out[k] += w[k] * S[k];
+        if (seg > 0 && (j < nc || K < INFINITY)) {
+            a->solver->transmittance(a, x, d, seg, n, NULL, T);
+            for (int k = 0; k < n; k++) w[k] *= T[k];
+        }
+        if (j == nc) {
+            if (K < INFINITY) ground_light(a, p, d, K, sun, w, out);
+            break;
+        }
+        for (int i = 0; i < 3; i++) x[i] = p[i] + t_end * d[i];
+        const double tc = crossing_light(a, x, d, sun, c[j].sphere, w, out);
+        clouds *= tc;
+        for (int k = 0; k < n; k++) w[k] *= tc;
+        opaque = clouds < OPAQUE;
+        t_prev = t_end;
+    }
+    if (info) {
+        info->distance_m = K;
+        info->hits_ground = K < INFINITY;
+        info->in_sun_disk = 0;
+    }
+}
+
+void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const double sun[3], int w, int h,
+                                       float *out)
+{
+    const double r = pl->clouds->r[i];
+    for (int y = 0; y < h; y++) {
+        const double lat = (90.0 - (y + 0.5) * 180.0 / h) * ATMOS_DEG2RAD;
+        for (int xx = 0; xx < w; xx++) {
+            const double lon = (-180.0 + (xx + 0.5) * 360.0 / w) * ATMOS_DEG2RAD;
+            /* the Earth-centred direction, then the world's axes (east, up, -north) */
+            const double q[3] = {cos(lat) * cos(lon), cos(lat) * sin(lon), sin(lat)};
+            const double e = atmos__dot3(q, pl->geo_east), u = atmos__dot3(q, pl->geo_up),
+                         no = atmos__dot3(q, pl->geo_north);
+            const double x[3] = {r * e, r * u - pl->r_ground, -r * no};
+            out[(size_t)y * (size_t)w + (size_t)xx] = (float)atmos__clouds_sun_attenuation(pl, x, sun, i);
+        }
+    }
+}
+
+double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[3], const double d[3], double dist)
+{
+    crossing c[MAX_CROSSINGS];
+    const int nc = find_crossings(pl, p, d, dist, c);
+    double tau = 0.0;
+    for (int j = 0; j < nc; j++) {
+        const double x[3] = {p[0] + c[j].t * d[0], p[1] + c[j].t * d[1], p[2] + c[j].t * d[2]};
+        tau += atmos__clouds_crossing_tau(pl, c[j].sphere, x, d);
+    }
+    return exp(-tau);
+}
