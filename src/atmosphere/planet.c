@@ -1,6 +1,6 @@
-/* The spherical planet's geometry and numerics (planet.h): ray-sphere distances, the
- * optical depth of a segment and brute-force single scattering, the slow but simple
- * second method that the solvers' tables are built and tested with. */
+/* The spherical planet's geometry and numerics (planet.h): ray-sphere distances and the
+ * optical depth of a segment by quadrature, with which the solvers' tables are built and
+ * tested (brute-force single scattering: planet_numeric.c). */
 #include "atmosphere/planet.h"
 
 #include "core/vec.h"
@@ -145,33 +145,4 @@ void atmos__planet_sun_transmittance(const atmos__planet *pl, const double p[3],
     }
     atmos__planet_optical_depth(pl, q, sun, INFINITY, m, k, out);
     for (int i = 0; i < m; i++) out[i] = exp(-out[i]);
-}
-
-/* Midpoint rule over SSN steps with the view transmittance accumulated step by step. */
-#define SSN 512
-void atmos__planet_single_scatter(const atmos__planet *pl, const double p[3], const double d[3], double dist,
-                                  const double sun[3], int m, const int *k, double *out)
-{
-    for (int i = 0; i < m; i++) out[i] = 0.0;
-    double t0, t1;
-    if (!atmos__planet_clip(pl, p, d, dist, &t0, &t1)) return;
-    double tau[ATMOS_MAX_WAVELENGTHS], Ts[ATMOS_MAX_WAVELENGTHS];
-    atmos__planet_optical_depth(pl, p, d, t0, m, k, tau);
-    const double dt = (t1 - t0) / SSN, nu = atmos__dot3(d, sun);
-    for (int s = 0; s < SSN; s++) {
-        const double t = t0 + (s + 0.5) * dt;
-        const double x[3] = {p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]};
-        const double h = atmos__planet_altitude(pl, x);
-        atmos__planet_sun_transmittance(pl, x, sun, m, k, Ts);
-        for (int i = 0; i < m; i++) {
-            const int kk = k ? k[i] : i;
-            const double pr = atmos__planet_rayleigh_phase(pl, kk, nu);
-            const double ext = atmos__planet_extinction(pl, h, kk) * dt;
-            const double Tv = exp(-(tau[i] + 0.5 * ext));
-            const double sca = pl->rayleigh[kk] * atmos__planet_rho_rayleigh(pl, h) * pr +
-                               pl->mie_sca[kk] * atmos__planet_rho_mie(pl, h) * atmos__planet_mie_phase(pl, kk, nu);
-            out[i] += sca * Tv * Ts[i] * dt;
-            tau[i] += ext;
-        }
-    }
 }

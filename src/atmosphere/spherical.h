@@ -53,6 +53,7 @@ typedef struct atmos__sph_sums {
 /* ------------------------------------------------------------------ tables (spherical_tables.c) */
 /* Builds the tables of the planet (threads over rows). */
 atmos_status atmos__sph_build(atmos_context *ctx, const atmos__planet *pl, atmos__sph_model *m);
+/* ---- look-ups (spherical_lookup.c) */
 /* Optical depth to the top from radius r along cosine mu (rays that miss the ground), per
  * wavelength of the subset. */
 void atmos__sph_tau_top(const atmos__sph_model *m, double r, double mu, int cnt, const int *k, double *out);
@@ -63,6 +64,11 @@ void atmos__sph_psi(const atmos__sph_model *m, double r, double mu_s, int cnt, c
 void atmos__sph_esky(const atmos__sph_model *m, double mu_s, int cnt, const int *k, double *out);
 /* f_ms at (r, mu_s) of wavelength k (a diagnostic of the multiple-scattering table). */
 double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k);
+/* The mappings' inverses the build needs (spherical_lookup.c): the (r, mu) of a depth-table
+ * node, the mu_s of a column coordinate; and a clamp. */
+void atmos__sph_tau_node(const atmos__sph_model *m, double xr, double xm, double *r, double *mu);
+double atmos__sph_x_to_mus(double x);
+double atmos__sph_clampd(double x, double lo, double hi);
 
 /* ------------------------------------------------------------------ the march (spherical_march.c) */
 /* Marches q + t d, t in [t0, t1] (inside the air), sun direction sun; use_ms: add the

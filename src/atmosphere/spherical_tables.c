@@ -28,97 +28,6 @@
 #define MM ATMOS__SPH_M_MU
 #define EM ATMOS__SPH_E_MU
 
-/* ------------------------------------------------------------------ mappings */
-
-static double clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
-
-/* Bruneton's (x_r, x_mu) of (r, mu) and back. */
-static void tau_coords(const atmos__sph_model *m, double r, double mu, double *xr, double *xm)
-{
-    r = clampd(r, m->R, m->Rt);
-    const double rho = sqrt(fmax(r * r - m->R * m->R, 0.0));
-    const double disc = r * r * (mu * mu - 1.0) + m->Rt * m->Rt;
-    const double d = fmax(0.0, -r * mu + sqrt(fmax(disc, 0.0)));
-    const double dmin = m->Rt - r, dmax = rho + m->H;
-    *xr = rho / m->H;
-    *xm = dmax > dmin ? clampd((d - dmin) / (dmax - dmin), 0.0, 1.0) : 0.0;
-}
-
-static void tau_node(const atmos__sph_model *m, double xr, double xm, double *r, double *mu)
-{
-    const double rho = m->H * xr;
-    *r = sqrt(rho * rho + m->R * m->R);
-    const double dmin = m->Rt - *r, dmax = rho + m->H, d = dmin + xm * (dmax - dmin);
-    *mu = d <= 0 ? 1.0 : clampd((m->H * m->H - rho * rho - d * d) / (2.0 * *r * d), -1.0, 1.0);
-}
-
-static double mus_to_x(double mus) { return 0.5 * (1.0 + copysign(sqrt(fabs(clampd(mus, -1, 1))), mus)); }
-static double x_to_mus(double x)
-{
-    const double s = 2.0 * x - 1.0;
-    return s * fabs(s);
-}
-static double alt_to_x(const atmos__sph_model *m, double r)
-{
-    return sqrt(clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0));
-}
-
-/* Bilinear look-up in a [n][ny][nx] table at fractional coordinates u (x) and v (y) in [0, 1]. */
-static void bilinear(const float *tab, int ny, int nx, double u, double v, int cnt, const int *k, double *out)
-{
-    const double fx = clampd(u, 0, 1) * (nx - 1), fy = clampd(v, 0, 1) * (ny - 1);
-    int ix = (int)fx, iy = (int)fy;
-    if (ix > nx - 2) ix = nx - 2;
-    if (iy > ny - 2) iy = ny - 2;
-    const double ax = fx - ix, ay = fy - iy;
-    for (int i = 0; i < cnt; i++) {
-        const float *t = tab + (size_t)ATMOS__WL(k, i) * nx * ny + (size_t)iy * nx + ix;
-        out[i] = (1 - ay) * ((1 - ax) * t[0] + ax * t[1]) + ay * ((1 - ax) * t[nx] + ax * t[nx + 1]);
-    }
-}
-
-void atmos__sph_tau_top(const atmos__sph_model *m, double r, double mu, int cnt, const int *k, double *out)
-{
-    double xr, xm;
-    tau_coords(m, r, mu, &xr, &xm);
-    bilinear(m->tau, TR, TM, xm, xr, cnt, k, out);
-}
-
-void atmos__sph_sun_t(const atmos__sph_model *m, double r, double mu_s, int cnt, const int *k, double *out)
-{
-    if (r < m->R) r = m->R;
-    const double q = m->R / r;
-    if (mu_s < 0 && mu_s * mu_s >= 1.0 - q * q) { /* the ground hides the sun's centre */
-        for (int i = 0; i < cnt; i++) out[i] = 0.0;
-        return;
-    }
-    if (r >= m->Rt) {
-        for (int i = 0; i < cnt; i++) out[i] = 1.0;
-        return;
-    }
-    atmos__sph_tau_top(m, r, mu_s, cnt, k, out);
-    for (int i = 0; i < cnt; i++) out[i] = exp(-out[i]);
-}
-
-void atmos__sph_psi(const atmos__sph_model *m, double r, double mu_s, int cnt, const int *k, double *out)
-{
-    bilinear(m->psi, MR, MM, mus_to_x(mu_s), alt_to_x(m, r), cnt, k, out);
-}
-
-double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k)
-{
-    double v;
-    bilinear(m->fms, MR, MM, mus_to_x(mu_s), alt_to_x(m, r), 1, &k, &v);
-    return v;
-}
-
-void atmos__sph_esky(const atmos__sph_model *m, double mu_s, int cnt, const int *k, double *out)
-{
-    bilinear(m->esky, 2, EM, mus_to_x(mu_s), 0.0, cnt, k, out);
-}
-
-/* ------------------------------------------------------------------ build */
-
 /* Optical depth from (0, r, 0) along (sqrt(1 - mu^2), mu, 0) to the top (a ray that misses
  * the ground): composite 4-point Gauss-Legendre in s over each monotone piece, t = t_low
  * +- L s^2 (points crowd where the ray is lowest and the air densest). */
@@ -127,7 +36,7 @@ static void depth_to_top(const atmos__planet *pl, double r, double mu, double *o
     static const double gx[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
     static const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
     enum { P = 12 };
-    const double dist = atmos__planet_dist_top(pl, r, mu), tc = clampd(-r * mu, 0.0, dist);
+    const double dist = atmos__planet_dist_top(pl, r, mu), tc = atmos__sph_clampd(-r * mu, 0.0, dist);
     const double len[2] = {tc, dist - tc};
     for (int i = 0; i < pl->n; i++) out[i] = 0.0;
     for (int side = 0; side < 2; side++) {
@@ -150,7 +59,7 @@ static void build_tau(const atmos__planet *pl, atmos__sph_model *m)
         double tau[ATMOS_MAX_WAVELENGTHS];
         for (int i = 0; i < TM; i++) {
             double r, mu;
-            tau_node(m, (double)j / (TR - 1), (double)i / (TM - 1), &r, &mu);
+            atmos__sph_tau_node(m, (double)j / (TR - 1), (double)i / (TM - 1), &r, &mu);
             depth_to_top(pl, r, mu, tau);
             for (int k = 0; k < m->n; k++) m->tau[((size_t)k * TR + j) * TM + i] = (float)tau[k];
         }
@@ -220,7 +129,7 @@ static void build_psi(const atmos__planet *pl, atmos__sph_model *m, const double
     for (int e = 0; e < MR * MM; e++) {
         const int j = e / MM, i = e % MM;
         const double x = (double)j / (MR - 1);
-        const double r = m->R + (m->Rt - m->R) * x * x, mus = x_to_mus((double)i / (MM - 1));
+        const double r = m->R + (m->Rt - m->R) * x * x, mus = atmos__sph_x_to_mus((double)i / (MM - 1));
         double psi[ATMOS_MAX_WAVELENGTHS], f[ATMOS_MAX_WAVELENGTHS];
         psi_entry(pl, m, r, mus, albedo, psi, f);
         for (int k = 0; k < m->n; k++) {
@@ -265,7 +174,7 @@ static void build_esky(const atmos__planet *pl, atmos__sph_model *m)
 #pragma omp parallel for schedule(dynamic)
     for (int i = 0; i < EM; i++) {
         double e[ATMOS_MAX_WAVELENGTHS];
-        esky_entry(pl, m, x_to_mus((double)i / (EM - 1)), e);
+        esky_entry(pl, m, atmos__sph_x_to_mus((double)i / (EM - 1)), e);
         for (int k = 0; k < m->n; k++) {
             m->esky[(size_t)k * 2 * EM + i] = (float)e[k];
             m->esky[(size_t)k * 2 * EM + EM + i] = (float)e[k];

@@ -61,6 +61,8 @@ size_t acc_index(const acc_run *r, int a, int s, int v);
 /* Relative errors of one view for one model: per wavelength (out[k]) and of Y (return). */
 double acc_rel_errors(const acc_run *r, const acc_opts *o, int m, int a, int s, int v, double *out);
 double acc_luminance(const atmos_wavelengths *wl, const double *L);
+/* The largest reference value of block (a, s) at wavelength k (k = -1: of Y). */
+double acc_block_max(const acc_run *r, int a, int s, int k);
 
 /* The report: Markdown tables on stdout (and table.md), results.csv, summary.csv and the
  * error maps (error_map_MODEL.png) in o->out. */

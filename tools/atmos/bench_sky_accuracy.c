@@ -14,7 +14,6 @@
 #include <omp.h>
 #endif
 
-const char *const acc_model_names[ACC_MODELS] = {"riley", "dobashi", "spherical"};
 static const atmos_atmosphere_kind acc_kinds[ACC_MODELS] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_DOBASHI,
                                                             ATMOS_ATMOSPHERE_SPHERICAL};
 
@@ -105,18 +104,6 @@ static void acc_grid(acc_run *r, const acc_opts *o, double R, double top)
         r->nview[a] = acc_views(r->alt_m[a], R, top, o->quick, r->view[a]);
     }
     for (int s = 0; s < r->nsun; s++) r->sun_deg[s] = o->nsun ? o->sun_deg[s] : o->quick ? sun_quick[s] : sun_full[s];
-}
-
-size_t acc_index(const acc_run *r, int a, int s, int v)
-{
-    return (((size_t)a * (size_t)r->nsun + (size_t)s) * ACC_MAX_VIEWS + (size_t)v) * (size_t)r->wl.count;
-}
-
-double acc_luminance(const atmos_wavelengths *wl, const double *L)
-{
-    double y = 0;
-    for (int k = 0; k < wl->count; k++) y += wl->to_xyz[k][1] * L[k];
-    return y;
 }
 
 /* ------------------------------------------------------------------ measuring */
@@ -260,37 +247,11 @@ static atmos_status measure_refine(acc_run *r, const acc_opts *o, const atmos_at
 
 /* ------------------------------------------------------------------ statistics */
 
-/* The largest reference value of block (a, s) at wavelength k (k = -1: of Y). */
-static double block_max(const acc_run *r, int a, int s, int k)
-{
-    double mx = 0;
-    for (int v = 0; v < r->nview[a]; v++) {
-        const double *L = r->ref + acc_index(r, a, s, v);
-        mx = fmax(mx, k < 0 ? acc_luminance(&r->wl, L) : L[k]);
-    }
-    return mx;
-}
-
-static double rel_error(double model, double ref, double floor_value)
-{
-    const double den = fmax(ref, floor_value);
-    if (den > 0) return (model - ref) / den;
-    return model == ref ? 0.0 : INFINITY;
-}
-
-double acc_rel_errors(const acc_run *r, const acc_opts *o, int m, int a, int s, int v, double *out)
-{
-    const size_t i = acc_index(r, a, s, v);
-    const double *L = r->ref + i, *M = r->mod[m] + i;
-    for (int k = 0; k < r->wl.count; k++) out[k] = rel_error(M[k], L[k], o->floor * block_max(r, a, s, k));
-    return rel_error(acc_luminance(&r->wl, M), acc_luminance(&r->wl, L), o->floor * block_max(r, a, s, -1));
-}
-
 /* The reference's relative standard error of Y over block (a, s): RMS and max over its
  * views (the same for every model). */
 static void block_se(const acc_run *r, const acc_opts *o, int a, int s, acc_stats *st)
 {
-    const double ymax = block_max(r, a, s, -1);
+    const double ymax = acc_block_max(r, a, s, -1);
     st->se_rms_y = st->se_max_y = 0;
     for (int v = 0; v < r->nview[a]; v++) {
         const size_t i = acc_index(r, a, s, v);
