@@ -187,6 +187,16 @@ ATMOS_API double atmos_atmosphere_cloud_extinction(const atmos_atmosphere *atm, 
 /* The air's phase function at p, sr^-1 (Rayleigh's for the kinds here). */
 ATMOS_API double atmos_atmosphere_phase(const atmos_atmosphere *atm, const double p[3], double cos_theta);
 
+/* The look-up tables of a spherical kind, to print or plot: names (NULL-terminated; an empty
+ * list for kinds without tables) and one table as an image with one channel per wavelength
+ * of the set, its metadata "atmos:table" (the name) and "atmos:axes" (what x and y are).
+ * SPHERICAL: "transmittance", "multiple_scattering", "f_ms", "sky_irradiance"; DOBASHI:
+ * "sun_attenuation", "plane_rayleigh", "plane_mie", "plane_attenuation" (docs/sky.md).
+ * ATMOS_E_INVALID_ARG for an unknown name, listing the known ones. */
+ATMOS_API const char *const *atmos_atmosphere_table_names(const atmos_atmosphere *atm);
+ATMOS_API atmos_status atmos_atmosphere_table(atmos_context *ctx, const atmos_atmosphere *atm, const char *name,
+                                              struct atmos_image **out);
+
 /* Ground truth for the spherical kinds (DOBASHI and SPHERICAL describe the same air; the
  * reference ignores their tables): what the view ray sees without the sun's disk, by Monte
  * Carlo random walks through the air with every order of scattering, the ozone's

@@ -47,7 +47,27 @@ static int dob_inscatter(const atmos_atmosphere *a, const double p[3], const dou
     return any;
 }
 
+/* The tables as images (atmos_atmosphere_table); grids as dobashi_tables.c lays them out. */
+static const char *const dob_table_names[] = {"sun_attenuation", "plane_rayleigh", "plane_mie",
+                                              "plane_attenuation", NULL};
+
+static atmos_status dob_table(atmos_context *ctx, const atmos_atmosphere *a, int i, atmos_image **out)
+{
+    const atmos__dobashi *m = a->model;
+    const int n = m->n;
+    if (i == 0)
+        return atmos__planet_table_image(ctx, m->gl, ATMOS__DOB_NS, ATMOS__DOB_NH, n, (size_t)n,
+                                         (size_t)ATMOS__DOB_NS * n, 1, 1, dob_table_names[0],
+                                         "x: the sun's cosine at the point; y: height (dobashi_tables.c); g_l",
+                                         out);
+    return atmos__planet_table_image(ctx, m->plane + (i - 1), ATMOS__DOB_NV, ATMOS__DOB_NH, n, (size_t)n * 3,
+                                     (size_t)ATMOS__DOB_NV * n * 3, 3, 0, dob_table_names[i],
+                                     "x: the view's cosine; y: height (dobashi_tables.c); one sub-segment", out);
+}
+
 const atmos__planet_solver atmos__dobashi_solver = {
+    .table_names = dob_table_names,
+    .table = dob_table,
     .name = "dobashi",
     .create = dob_create,
     .destroy = atmos__dobashi_free,

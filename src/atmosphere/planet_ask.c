@@ -4,6 +4,54 @@
 
 #include "core/vec.h"
 
+#include <string.h>
+
+const char *const *atmos_atmosphere_table_names(const atmos_atmosphere *atm)
+{
+    static const char *const none[] = {NULL};
+    return atm && atm->solver && atm->solver->table_names ? atm->solver->table_names : none;
+}
+
+atmos_status atmos_atmosphere_table(atmos_context *ctx, const atmos_atmosphere *atm, const char *name,
+                                    atmos_image **out)
+{
+    if (!atm || !name || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere table: missing argument");
+    *out = NULL;
+    const char *const *names = atmos_atmosphere_table_names(atm);
+    char known[256] = "";
+    for (int i = 0; names[i]; i++) {
+        if (!strcmp(names[i], name)) return atm->solver->table(ctx, atm, i, out);
+        if (strlen(known) + strlen(names[i]) + 3 < sizeof known) {
+            if (i) strcat(known, ", ");
+            strcat(known, names[i]);
+        }
+    }
+    return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere table '%s' unknown; this model's tables: %s", name,
+                        known[0] ? known : "none (only the spherical models keep tables)");
+}
+
+atmos_status atmos__planet_table_image(atmos_context *ctx, const float *src, int w, int h, int n, size_t xs,
+                                       size_t ys, size_t ks, int neg_exp, const char *name, const char *axes,
+                                       atmos_image **out)
+{
+    atmos_status st = atmos_image_create(ctx, w, h, n, out);
+    if (st != ATMOS_OK) return st;
+    atmos_image *img = *out;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int k = 0; k < n; k++) {
+                const float v = src[(size_t)k * ks + (size_t)y * ys + (size_t)x * xs];
+                img->pixels[((size_t)y * w + x) * n + k] = neg_exp ? expf(-v) : v;
+            }
+    if ((st = atmos_image_set_meta(img, "atmos:table", name)) == ATMOS_OK)
+        st = atmos_image_set_meta(img, "atmos:axes", axes);
+    if (st != ATMOS_OK) {
+        atmos_image_destroy(img);
+        *out = NULL;
+    }
+    return st;
+}
+
 void atmos__planet_radiance_generic(const atmos_atmosphere *a, const double p[3], const double d[3],
                                     const double sun[3], double *out, atmos_atmosphere_hit *info)
 {

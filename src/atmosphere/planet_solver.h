@@ -32,7 +32,18 @@ typedef struct atmos__planet_solver {
     void (*batch_eval)(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                        const float *weight, float *out, float *scratch);
     void (*batch_release)(atmos__atm_batch *b);
+    /* the solver's look-up tables by name (atmos_atmosphere_table; NULL-terminated names, a
+     * function making table i as an image with one channel per wavelength) */
+    const char *const *table_names;
+    atmos_status (*table)(atmos_context *ctx, const atmos_atmosphere *a, int i, atmos_image **out);
 } atmos__planet_solver;
+
+/* An image of w x h pixels and n channels whose pixel (x, y), channel k is
+ * src[k * ks + y * ys + x * xs] (times scale; exp(-value) when neg_exp), with the metadata
+ * atmos:table = name and atmos:axes = axes (planet_ask.c). */
+atmos_status atmos__planet_table_image(atmos_context *ctx, const float *src, int w, int h, int n, size_t xs,
+                                       size_t ys, size_t ks, int neg_exp, const char *name, const char *axes,
+                                       atmos_image **out);
 
 /* The solvers: dobashi.c, spherical.c; planet_numeric.c's brute-force quadrature (single
  * scattering, a test reference). */

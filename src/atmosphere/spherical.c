@@ -148,7 +148,37 @@ static void sph_radiance(const atmos_atmosphere *a, const double p[3], const dou
     atmos__sph_radiance(a, p, d, sun, ATMOS__SPH_STEPS, out, info);
 }
 
+/* The tables as images (atmos_atmosphere_table): rows and columns as spherical_lookup.c
+ * maps them. */
+static const char *const sph_table_names[] = {"transmittance", "multiple_scattering", "f_ms", "sky_irradiance",
+                                              NULL};
+
+static atmos_status sph_table(atmos_context *ctx, const atmos_atmosphere *a, int i, atmos_image **out)
+{
+    const atmos__sph_model *m = a->model;
+    const int n = m->n;
+    switch (i) {
+    case 0:
+        return atmos__planet_table_image(ctx, m->tau, ATMOS__SPH_T_MU, ATMOS__SPH_T_R, n, 1, ATMOS__SPH_T_MU,
+                                         (size_t)ATMOS__SPH_T_R * ATMOS__SPH_T_MU, 1, sph_table_names[i],
+                                         "x: (d - d_min) / (d_max - d_min) of the distance d to the top; "
+                                         "y: rho / H (Bruneton 2017); exp(-depth to the top)",
+                                         out);
+    case 1:
+    case 2:
+        return atmos__planet_table_image(ctx, i == 1 ? m->psi : m->fms, ATMOS__SPH_M_MU, ATMOS__SPH_M_R, n, 1,
+                                         ATMOS__SPH_M_MU, (size_t)ATMOS__SPH_M_R * ATMOS__SPH_M_MU, 0,
+                                         sph_table_names[i],
+                                         "x: mu_s = x'|x'|, x' in [-1, 1]; y: sqrt(altitude / top)", out);
+    default:
+        return atmos__planet_table_image(ctx, m->esky, ATMOS__SPH_E_MU, 1, n, 1, 0, ATMOS__SPH_E_MU, 0,
+                                         sph_table_names[i], "x: mu_s = x'|x'|, x' in [-1, 1] (the ground)", out);
+    }
+}
+
 const atmos__planet_solver atmos__spherical_solver = {
+    .table_names = sph_table_names,
+    .table = sph_table,
     .name = "spherical",
     .create = sph_create,
     .destroy = sph_destroy,

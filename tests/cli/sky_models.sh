@@ -122,4 +122,15 @@ EOF
 for f in "$T"/acc/*.png; do
     head -c 8 "$f" | od -An -c | grep -q 'P   N   G' && ok "$(basename "$f") is a PNG" || bad "$(basename "$f") is not a PNG"
 done
+# the look-up tables: listed, written, refused by name
+"$cli" sky --model spherical --table list >"$T/tables.txt" 2>&1 && grep -qx transmittance "$T/tables.txt" &&
+    grep -qx multiple_scattering "$T/tables.txt" && ok "sky --table list names the spherical tables" ||
+    bad "sky --table list: $(cat "$T/tables.txt")"
+"$cli" sky --model dobashi --table sun_attenuation -o "$T/gl.png" >/dev/null 2>&1 &&
+    head -c 8 "$T/gl.png" | od -An -c | grep -q 'P   N   G' && ok "sky --table sun_attenuation -o x.png writes a PNG" ||
+    bad "sky --table sun_attenuation -o x.png"
+"$cli" sky --model spherical --table nope -o "$T/x.exr" >/dev/null 2>"$T/nope.err"
+st=$?
+[ $st -ne 0 ] && grep -q "transmittance" "$T/nope.err" && [ ! -e "$T/x.exr" ] && ok "an unknown table is refused, naming the known ones" ||
+    bad "unknown table: exit $st, $(cat "$T/nope.err")"
 exit $fail

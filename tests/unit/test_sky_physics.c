@@ -314,6 +314,38 @@ static void test_grid(const atmos_atmosphere *a, const atmos_wavelengths *wl)
     CHECK_MSG(lit > 200, "only %d of 660 views lit", lit);
 }
 
+/* The tables as images (atmos_atmosphere_table): each kind lists some, each is finite and
+ * as wide as a wavelength set; the production sky's transmittance at its first node (the
+ * ground, straight up) is the interface's vertical transmittance; Dobashi's sun attenuation
+ * lies in [0, 1]; an unknown name is refused. */
+static void test_tables(const atmos_atmosphere *a, const atmos_wavelengths *wl)
+{
+    const char *const *names = atmos_atmosphere_table_names(a);
+    CHECK(names[0] != NULL);
+    for (int i = 0; names[i]; i++) {
+        atmos_image *t = NULL;
+        CHECK_OK(atmos_atmosphere_table(NULL, a, names[i], &t));
+        if (!t) continue;
+        CHECK(t->channels == wl->count && t->width > 0 && t->height > 0);
+        int bad = 0;
+        for (size_t j = 0; j < (size_t)t->width * t->height * t->channels; j++) bad += !isfinite(t->pixels[j]);
+        CHECK_MSG(bad == 0, "table %s: %d values not finite", names[i], bad);
+        if (!strcmp(names[i], "transmittance")) {
+            const double p[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+            double T[ATMOS_MAX_WAVELENGTHS];
+            atmos_atmosphere_transmittance(a, p, up, INFINITY, T);
+            for (int k = 0; k < wl->count; k++) CHECK_REL(t->pixels[k], T[k], 2e-3);
+        }
+        if (!strcmp(names[i], "sun_attenuation"))
+            for (size_t j = 0; j < (size_t)t->width * t->height * t->channels; j++)
+                bad += !(t->pixels[j] >= 0 && t->pixels[j] <= 1);
+        CHECK_MSG(bad == 0, "table %s: values out of range", names[i]);
+        atmos_image_destroy(t);
+    }
+    atmos_image *t = NULL;
+    CHECK(atmos_atmosphere_table(NULL, a, "no such table", &t) == ATMOS_E_INVALID_ARG && t == NULL);
+}
+
 int main(void)
 {
     atmos_wavelengths wl;
@@ -332,6 +364,7 @@ int main(void)
         test_top_crossing(a, &wl);
         test_mirror(a, &wl);
         test_grid(a, &wl);
+        test_tables(a, &wl);
         atmos_atmosphere_destroy(air);
         atmos_atmosphere_destroy(aer);
         atmos_atmosphere_destroy(a);

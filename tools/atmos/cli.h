@@ -38,6 +38,8 @@ typedef struct {
 } cli_progress;
 void cli_progress_init(cli_progress *p, int quiet);
 int cli_progress_bar(void *user, const char *stage, double fraction);
+/* atmos sky --table NAME [-o FILE] (sky_tables.c): "list" prints the model's tables. */
+int cli_sky_table(const char *C, atmos_context *ctx, const atmos_atmosphere *atm, const char *name, const char *out);
 /* Monotonic clock, seconds. */
 double cli_now_s(void);
 /* Option with a value, as "--name VALUE" or "--name=VALUE": returns 1 if argv[*i] is

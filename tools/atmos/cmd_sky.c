@@ -27,12 +27,35 @@ static void help(void)
            "                       spherical (the Earth's atmosphere over a spherical planet; docs/sky.md)\n"
            "  --atmosphere NAME    the same as --model\n"
            "  --thickness M        the homogeneous layer's top, metres (default 8000)\n"
+           "  --table NAME -o FILE instead of a view: write the model's look-up table NAME (dobashi,\n"
+           "                       spherical) as FILE.exr (every wavelength), .pfm (the first three)\n"
+           "                       or .png (a plot, each channel scaled to its maximum); --table list\n"
+           "                       prints the names\n"
            "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
            "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n\n"
            "Units: radiance W m^-2 sr^-1 nm^-1. \"inscatter\" is the air's in-scattered radiance only;\n"
            "\"ground\" is the lit ground's radiance after the air (0 unless the view ends on the\n"
            "ground); \"sun\" is the radiance of the sun's 0.5 degree disk seen from the observer.\n"
            "distance_m is null when the path reaches space.\n");
+}
+
+/* --table: the model's tables, no view. */
+static int sky_table(const char *C, atmos_atmosphere_kind kind, int spectral, const char *table, const char *out)
+{
+    atmos_context *ctx = cli_context(0, 0);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_wavelengths wl;
+    if (spectral) atmos_wavelengths_spectral(spectral, &wl);
+    else atmos_wavelengths_rgb(&wl);
+    atmos_atmosphere_desc ad;
+    atmos_atmosphere_defaults(&ad);
+    ad.kind = kind;
+    atmos_atmosphere *atm = NULL;
+    atmos_status st = atmos_atmosphere_create(ctx, &ad, &wl, &atm);
+    int rc = st == ATMOS_OK ? cli_sky_table(C, ctx, atm, table, out) : cli_runtime_error(C, ctx, st);
+    atmos_atmosphere_destroy(atm);
+    atmos_context_destroy(ctx);
+    return rc;
 }
 
 int cli_cmd_sky(int argc, char **argv)
@@ -44,15 +67,16 @@ int cli_cmd_sky(int argc, char **argv)
         {"spectral", required_argument, 0, 'n'},      {"albedo", required_argument, 0, 'r'},
         {"json", no_argument, 0, 'j'},                {"help", no_argument, 0, 'H'},
         {"atmosphere", required_argument, 0, 'k'},    {"thickness", required_argument, 0, 't'},
-        {"model", required_argument, 0, 'k'},
+        {"model", required_argument, 0, 'k'},         {"table", required_argument, 0, 'L'},
+        {"output", required_argument, 0, 'o'},
         {0, 0, 0, 0}};
     double sun_el = NAN, sun_az = 180, view_el = NAN, view_az = NAN, alt = 0, dist = INFINITY, albedo = -1, top = 0;
     atmos_atmosphere_kind kind = ATMOS_ATMOSPHERE_RILEY;
     int spectral = 0, json = 0, c;
-    const char *C = "sky";
+    const char *C = "sky", *table = NULL, *out = NULL;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:", opts, NULL)) != -1) {
         switch (c) {
         case 'E': if (!cli_parse_double(C, "--sun-elevation", optarg, &sun_el)) return CLI_EXIT_USAGE; break;
         case 'A': if (!cli_parse_double(C, "--sun-azimuth", optarg, &sun_az)) return CLI_EXIT_USAGE; break;
@@ -63,6 +87,8 @@ int cli_cmd_sky(int argc, char **argv)
         case 'r': if (!cli_parse_double(C, "--albedo", optarg, &albedo)) return CLI_EXIT_USAGE; break;
         case 'n': if (!cli_parse_int(C, "--spectral", optarg, 1, ATMOS_MAX_WAVELENGTHS, &spectral)) return CLI_EXIT_USAGE; break;
         case 'j': json = 1; break;
+        case 'L': table = optarg; break;
+        case 'o': out = optarg; break;
         case 'k':
             if (!strcmp(optarg, "riley")) kind = ATMOS_ATMOSPHERE_RILEY;
             else if (!strcmp(optarg, "homogeneous")) kind = ATMOS_ATMOSPHERE_HOMOGENEOUS;
@@ -81,6 +107,7 @@ int cli_cmd_sky(int argc, char **argv)
         }
     }
     if (optind < argc) return cli_usage_error(C, "unexpected argument '%s'", argv[optind]);
+    if (table) return sky_table(C, kind, spectral, table, out);
     if (isnan(sun_el)) return cli_usage_error(C, "--sun-elevation is required");
     if (isnan(view_el)) return cli_usage_error(C, "--view-elevation is required");
     if (isnan(view_az)) return cli_usage_error(C, "--view-azimuth is required");
