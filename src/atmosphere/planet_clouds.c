@@ -120,6 +120,19 @@ void atmos__planet_clouds_release(atmos__planet *pl)
     pl->clouds = NULL;
 }
 
+/* A regional image's clouds fade out over its outer CLOUD_FADE of the shorter side
+ * (smoothstep of the distance to the nearest edge, in pixels): its clouds end where the
+ * image ends, and a straight cliff of cloud along the frame is the one thing sure to be
+ * wrong. */
+#define CLOUD_FADE 0.05
+static double edge_fade(const atmos__clouds *cl, double u, double v)
+{
+    const double d = fmin(fmin(u + 0.5, cl->w - 0.5 - u), fmin(v + 0.5, cl->h - 0.5 - v));
+    const double margin = fmax(2.0, CLOUD_FADE * (cl->w < cl->h ? cl->w : cl->h));
+    const double x = fmin(fmax(d / margin, 0.0), 1.0);
+    return x * x * (3.0 - 2.0 * x);
+}
+
 double atmos__clouds_column_tau(const atmos__clouds *cl, double lat, double lon)
 {
     if (cl->global) lon = lon - 360.0 * floor((lon - cl->lon_w) / 360.0);
@@ -127,14 +140,21 @@ double atmos__clouds_column_tau(const atmos__clouds *cl, double lat, double lon)
     if (lat < cl->lat_s || lat > cl->lat_n || lon < cl->lon_w || lon > cl->lon_e) return 0.0;
     double u = (lon - cl->lon_w) / (cl->lon_e - cl->lon_w) * cl->w - 0.5;
     double v = (cl->lat_n - lat) / (cl->lat_n - cl->lat_s) * cl->h - 0.5;
+    const double fade = cl->global ? 1.0 : edge_fade(cl, u, v);
     u = fmin(fmax(u, 0.0), cl->w - 1.0), v = fmin(fmax(v, 0.0), cl->h - 1.0);
     const int x0 = (int)u, y0 = (int)v;
     const int x1 = x0 + 1 < cl->w ? x0 + 1 : x0, y1 = y0 + 1 < cl->h ? y0 + 1 : y0;
     const double au = u - x0, av = v - y0;
     const float *t = cl->tau;
     const size_t W = (size_t)cl->w;
-    return (1 - av) * ((1 - au) * t[y0 * W + x0] + au * t[y0 * W + x1]) +
-           av * ((1 - au) * t[y1 * W + x0] + au * t[y1 * W + x1]);
+    const double tau = (1 - av) * ((1 - au) * t[y0 * W + x0] + au * t[y0 * W + x1]) +
+                       av * ((1 - au) * t[y1 * W + x0] + au * t[y1 * W + x1]);
+    if (fade >= 1.0) return tau;
+    /* faded in reflectance, R = k tau / (1 + k tau) as atmos__clouds_tau_from_brightness
+     * inverts it, so that a thick cloud thins out over the margin instead of staying opaque
+     * to its last pixel */
+    const double k = 0.5 * (1.0 - CLOUD_G_INVERSION), R = fade * k * tau / (1.0 + k * tau);
+    return R / (k * (1.0 - R));
 }
 
 double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x[3], const double d[3])

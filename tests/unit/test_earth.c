@@ -278,8 +278,38 @@ static void test_scene_keys(void)
     atmos_context_destroy(ctx);
 }
 
+/* A regional cloud image (10 x 20 degrees, 100 x 200 pixels, uniform grey) fades to no
+ * cloud at its edges over 5 % of its shorter side (5 pixels; in reflectance: half way in,
+ * half the reflectance, 0.41 of the optical depth for this grey), untouched inside. */
+static void test_regional_edges(void)
+{
+    atmos_image *img = make_map(100, 200, 1, grey_cloud);
+    atmos_atmosphere_desc d;
+    atmos_atmosphere_defaults(&d);
+    d.kind = ATMOS_ATMOSPHERE_SPHERICAL;
+    d.clouds.image = img;
+    d.clouds.lon_west_deg = 0, d.clouds.lon_east_deg = 10, d.clouds.lat_south_deg = 0, d.clouds.lat_north_deg = 20;
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_atmosphere *a = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, &d, &wl, &a));
+    if (a) {
+        const atmos__clouds *cl = a->planet->clouds;
+        const double inner = atmos__clouds_column_tau(cl, 10, 5);
+        CHECK(inner > 1);
+        CHECK_NEAR(atmos__clouds_column_tau(cl, 10, 0.5), inner, 1e-9 * inner);  /* 5 pixels in */
+        CHECK(atmos__clouds_column_tau(cl, 10, 0.001) < 0.01 * inner);            /* at the edge */
+        const double half = atmos__clouds_column_tau(cl, 10, 0.25);               /* 2.5 pixels in */
+        CHECK(half > 0.3 * inner && half < 0.7 * inner);
+        CHECK(atmos__clouds_column_tau(cl, 19.999, 5) < 0.01 * inner);
+    }
+    atmos_atmosphere_destroy(a);
+    atmos_image_destroy(img);
+}
+
 int main(void)
 {
+    test_regional_edges();
     test_scene_keys();
     test_map_lookup();
     test_night_lights();
