@@ -40,19 +40,7 @@ typedef struct {
 
 static void frame(dob_eye *e, const double sun[3])
 {
-    const double r = sqrt(e->qq);
-    for (int i = 0; i < 3; i++) e->up[i] = r > 0 ? e->q[i] / r : (i == 1);
-    e->mu_s = atmos__dot3(e->up, sun);
-    double t[3] = {sun[0] - e->mu_s * e->up[0], sun[1] - e->mu_s * e->up[1], sun[2] - e->mu_s * e->up[2]};
-    double len = sqrt(atmos__dot3(t, t));
-    if (len < 1e-9) { /* the sun at the zenith or nadir: any horizontal axis */
-        const double a[3] = {fabs(e->up[0]) < 0.9 ? 1.0 : 0.0, fabs(e->up[0]) < 0.9 ? 0.0 : 1.0, 0.0};
-        const double c = atmos__dot3(a, e->up);
-        for (int i = 0; i < 3; i++) t[i] = a[i] - c * e->up[i];
-        len = sqrt(atmos__dot3(t, t));
-    }
-    for (int i = 0; i < 3; i++) e->e1[i] = t[i] / len;
-    atmos__cross3(e->up, e->e1, e->e2);
+    e->mu_s = atmos__planet_sun_frame(e->q, sun, e->up, e->e1, e->e2);
 }
 
 static double row_mu(const dob_eye *e, int block, int i)

@@ -84,6 +84,24 @@ void atmos__planet_ground_point(const atmos__planet *pl, double p[3], double n[3
     p[1] -= pl->r_ground;
 }
 
+double atmos__planet_sun_frame(const double q[3], const double sun[3], double up[3], double e1[3], double e2[3])
+{
+    const double r = sqrt(atmos__dot3(q, q));
+    for (int i = 0; i < 3; i++) up[i] = r > 0 ? q[i] / r : (i == 1);
+    const double mu_s = atmos__dot3(up, sun);
+    double t[3] = {sun[0] - mu_s * up[0], sun[1] - mu_s * up[1], sun[2] - mu_s * up[2]};
+    double len = sqrt(atmos__dot3(t, t));
+    if (len < 1e-9) { /* the sun at the zenith or nadir: any horizontal axis */
+        const double a[3] = {fabs(up[0]) < 0.9 ? 1.0 : 0.0, fabs(up[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+        const double c = atmos__dot3(a, up);
+        for (int i = 0; i < 3; i++) t[i] = a[i] - c * up[i];
+        len = sqrt(atmos__dot3(t, t));
+    }
+    for (int i = 0; i < 3; i++) e1[i] = t[i] / len;
+    atmos__cross3(up, e1, e2);
+    return mu_s;
+}
+
 double atmos__planet_dist_top(const atmos__planet *pl, double r, double mu)
 {
     const double disc = r * r * (mu * mu - 1.0) + pl->r_top * pl->r_top;

@@ -101,6 +101,10 @@ double atmos__planet_ground_distance(const atmos__planet *pl, const double p[3],
  * above the ground); 0 if none. */
 int atmos__planet_clip(const atmos__planet *pl, const double p[3], const double d[3], double dist, double *t0,
                        double *t1);
+/* The local frame at q (a position from the planet's centre): up, e1 horizontal toward the
+ * sun (any horizontal axis with the sun at the zenith or nadir), e2 = up x e1; returns the
+ * sun's zenith cosine there. The per-eye tables of the solvers are laid out in it. */
+double atmos__planet_sun_frame(const double q[3], const double sun[3], double up[3], double e1[3], double e2[3]);
 /* Moves p onto the ground along the local vertical; n: the outward normal there. */
 void atmos__planet_ground_point(const atmos__planet *pl, double p[3], double n[3]);
 /* Distance to the ground and to the top along the direction of cosine mu from altitude h:

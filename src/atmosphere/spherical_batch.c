@@ -53,19 +53,8 @@ static void node_dir(const sv_state *s, int row, int col, double d[3])
 static void frame(sv_state *s, const atmos__planet *pl, const double eye[3], const double sun[3])
 {
     const double q[3] = {eye[0], eye[1] + pl->r_ground, eye[2]};
+    atmos__planet_sun_frame(q, sun, s->up, s->e1, s->e2);
     const double r = sqrt(atmos__dot3(q, q));
-    for (int i = 0; i < 3; i++) s->up[i] = r > 0 ? q[i] / r : (i == 1);
-    const double su = atmos__dot3(sun, s->up);
-    double h[3] = {sun[0] - su * s->up[0], sun[1] - su * s->up[1], sun[2] - su * s->up[2]};
-    double hl = sqrt(atmos__dot3(h, h));
-    if (hl < 1e-9) { /* the sun at the zenith or nadir: any horizontal axis */
-        const double ax[3] = {fabs(s->up[0]) < 0.9 ? 1.0 : 0.0, fabs(s->up[0]) < 0.9 ? 0.0 : 1.0, 0.0};
-        const double a = atmos__dot3(ax, s->up);
-        for (int i = 0; i < 3; i++) h[i] = ax[i] - a * s->up[i];
-        hl = sqrt(atmos__dot3(h, h));
-    }
-    for (int i = 0; i < 3; i++) s->e1[i] = h[i] / hl;
-    atmos__cross3(s->up, s->e1, s->e2);
     for (int i = 0; i < 3; i++) {
         s->fup[i] = (float)s->up[i], s->fe1[i] = (float)s->e1[i], s->fe2[i] = (float)s->e2[i];
         s->fsun[i] = (float)sun[i];

@@ -177,6 +177,17 @@ static unsigned long long view_seed(const acc_opts *o, int t)
     return o->seed * 0x100000001ull + (unsigned long long)t * 977u;
 }
 
+/* Grid point t of the parallel loops: its indices and geometry; 0 past the altitude's views. */
+static int grid_point(const acc_run *r, int t, int *a, int *s, double p[3], double sun[3], double d[3], size_t *i)
+{
+    *a = t / (r->nsun * ACC_MAX_VIEWS), *s = t / ACC_MAX_VIEWS % r->nsun;
+    const int v = t % ACC_MAX_VIEWS;
+    if (v >= r->nview[*a]) return 0;
+    view_geometry(r, *a, *s, v, p, sun, d);
+    *i = acc_index(r, *a, *s, v);
+    return 1;
+}
+
 /* Every view of the grid: one batch of the reference and each model (NAN where a model is
  * n/a: Riley's flat earth from 36 000 km). */
 static atmos_status measure_first(acc_run *r, const acc_opts *o, const atmos_atmosphere *ref,
@@ -186,11 +197,10 @@ static atmos_status measure_first(acc_run *r, const acc_opts *o, const atmos_atm
     int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(o))
     for (int t = 0; t < total; t++) {
-        const int a = t / (r->nsun * ACC_MAX_VIEWS), s = t / ACC_MAX_VIEWS % r->nsun, v = t % ACC_MAX_VIEWS;
-        if (v >= r->nview[a]) continue;
+        int a, s;
         double p[3], sun[3], d[3];
-        view_geometry(r, a, s, v, p, sun, d);
-        const size_t i = acc_index(r, a, s, v);
+        size_t i;
+        if (!grid_point(r, t, &a, &s, p, sun, d, &i)) continue;
         if (reference_more(ref, o, &r->wl, p, d, sun, view_seed(o, t), 0, 1, r->ref + i, r->se + i,
                            r->paths_used + i / (size_t)n) != ATMOS_OK) {
 #pragma omp atomic write
@@ -219,17 +229,17 @@ static atmos_status measure_refine(acc_run *r, const acc_opts *o, const atmos_at
     double ymax[8][8] = {{0}};
     int failed = 0, views = 0, done = 0;
     for (int a = 0; a < r->nalt; a++)
-        for (int s = 0; s < r->nsun; s++)
-            for (int v = 0; v < r->nview[a]; v++, views++)
-                ymax[a][s] = fmax(ymax[a][s], acc_luminance(&r->wl, r->ref + acc_index(r, a, s, v)));
+        for (int s = 0; s < r->nsun; s++) {
+            ymax[a][s] = acc_block_max(r, a, s, -1);
+            views += r->nview[a];
+        }
     const double t0 = cli_now_s();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(o))
     for (int t = 0; t < total; t++) {
-        const int a = t / (r->nsun * ACC_MAX_VIEWS), s = t / ACC_MAX_VIEWS % r->nsun, v = t % ACC_MAX_VIEWS;
-        if (v >= r->nview[a]) continue;
+        int a, s;
         double p[3], sun[3], d[3];
-        view_geometry(r, a, s, v, p, sun, d);
-        const size_t i = acc_index(r, a, s, v);
+        size_t i;
+        if (!grid_point(r, t, &a, &s, p, sun, d, &i)) continue;
         if (reference_more(ref, o, &r->wl, p, d, sun, view_seed(o, t), o->floor * ymax[a][s], 0, r->ref + i,
                            r->se + i, r->paths_used + i / (size_t)n) != ATMOS_OK) {
 #pragma omp atomic write

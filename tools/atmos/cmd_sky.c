@@ -39,20 +39,42 @@ static void help(void)
            "distance_m is null when the path reaches space.\n");
 }
 
+/* The context and the atmosphere of the options; on failure the exit code in *rc and
+ * nothing to free. */
+static atmos_atmosphere *make_sky(const char *C, atmos_atmosphere_kind kind, int spectral, double albedo, double top,
+                                  atmos_context **ctx, atmos_wavelengths *wl, int *rc)
+{
+    *ctx = cli_context(1, 0);
+    if (!*ctx) {
+        *rc = CLI_EXIT_RUNTIME;
+        return NULL;
+    }
+    if (spectral) atmos_wavelengths_spectral(spectral, wl);
+    else atmos_wavelengths_rgb(wl);
+    atmos_atmosphere_desc ad;
+    atmos_atmosphere_defaults(&ad);
+    if (albedo >= 0) ad.ground_albedo = albedo;
+    ad.kind = kind;
+    if (top > 0) ad.thickness_m = top;
+    atmos_atmosphere *sky = NULL;
+    atmos_status st = atmos_atmosphere_create(*ctx, &ad, wl, &sky);
+    if (st != ATMOS_OK) {
+        *rc = cli_runtime_error(C, *ctx, st);
+        atmos_context_destroy(*ctx);
+        *ctx = NULL;
+    }
+    return sky;
+}
+
 /* --table: the model's tables, no view. */
 static int sky_table(const char *C, atmos_atmosphere_kind kind, int spectral, const char *table, const char *out)
 {
-    atmos_context *ctx = cli_context(0, 0);
-    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_context *ctx;
     atmos_wavelengths wl;
-    if (spectral) atmos_wavelengths_spectral(spectral, &wl);
-    else atmos_wavelengths_rgb(&wl);
-    atmos_atmosphere_desc ad;
-    atmos_atmosphere_defaults(&ad);
-    ad.kind = kind;
-    atmos_atmosphere *atm = NULL;
-    atmos_status st = atmos_atmosphere_create(ctx, &ad, &wl, &atm);
-    int rc = st == ATMOS_OK ? cli_sky_table(C, ctx, atm, table, out) : cli_runtime_error(C, ctx, st);
+    int rc;
+    atmos_atmosphere *atm = make_sky(C, kind, spectral, -1, 0, &ctx, &wl, &rc);
+    if (!atm) return rc;
+    rc = cli_sky_table(C, ctx, atm, table, out);
     atmos_atmosphere_destroy(atm);
     atmos_context_destroy(ctx);
     return rc;
@@ -117,23 +139,11 @@ int cli_cmd_sky(int argc, char **argv)
     if (!(dist > 0)) return cli_usage_error(C, "--distance: must be > 0 metres, got %g", dist);
     if (albedo != -1 && (albedo < 0 || albedo > 1)) return cli_usage_error(C, "--albedo: must be in [0, 1], got %g", albedo);
 
-    atmos_context *ctx = cli_context(1, 0);
-    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_context *ctx;
     atmos_wavelengths wl;
-    if (spectral) atmos_wavelengths_spectral(spectral, &wl);
-    else atmos_wavelengths_rgb(&wl);
-    atmos_atmosphere_desc ad;
-    atmos_atmosphere_defaults(&ad);
-    if (albedo >= 0) ad.ground_albedo = albedo;
-    ad.kind = kind;
-    if (top > 0) ad.thickness_m = top;
-    atmos_atmosphere *sky = NULL;
-    atmos_status st = atmos_atmosphere_create(ctx, &ad, &wl, &sky);
-    if (st != ATMOS_OK) {
-        int rc = cli_runtime_error(C, ctx, st);
-        atmos_context_destroy(ctx);
-        return rc;
-    }
+    int rc;
+    atmos_atmosphere *sky = make_sky(C, kind, spectral, albedo, top, &ctx, &wl, &rc);
+    if (!sky) return rc;
     double sun[3], dir[3], eye[3] = {0, alt, 0};
     atmos_direction_from_angles(sun_el, sun_az, sun);
     atmos_direction_from_angles(view_el, view_az, dir);
@@ -147,13 +157,14 @@ int cli_cmd_sky(int argc, char **argv)
     atmos_atmosphere_transmittance(sky, eye, dir, K, tr);
     atmos_atmosphere_sun_radiance(sky, eye, sun, sunr);
     atmos_atmosphere_sunlight(sky, ground0, sun, lit);
-    for (int i = 0; i < n; i++)
-        ground[i] = hits_ground && sun[1] > 0 ? ad.ground_albedo / 3.14159265358979323846 * sun[1] * lit[i] * tr[i] : 0.0;
     if (kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL) {
         /* a round ground: what the view ray sees there beyond the air's own light */
         double all[ATMOS_MAX_WAVELENGTHS];
         atmos_atmosphere_radiance(sky, eye, dir, sun, all, NULL);
         for (int i = 0; i < n; i++) ground[i] = hits_ground ? fmax(all[i] - ins[i], 0.0) : 0.0;
+    } else {
+        const double albedo_pi = atmos_atmosphere_ground_albedo(sky) / 3.14159265358979323846;
+        for (int i = 0; i < n; i++) ground[i] = hits_ground && sun[1] > 0 ? albedo_pi * sun[1] * lit[i] * tr[i] : 0.0;
     }
     if (json) {
         printf("{\"wavelengths_nm\": ");
