@@ -181,53 +181,75 @@ static double row_coord(const atmos__sph_space *s, double p2, int *disk)
     return sqrt(fmin(1.0, h / (s->Rt - s->R))) * (NL - 1);
 }
 
-void atmos__sph_space_eval(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int count, const float *dx, const float *dy, const float *dz,
-                           const float *weight, float *out)
+/* One ray's look-up (d a unit vector toward the air, b = q . d, p2 its impact parameter
+ * squared): the table's logarithms interpolated into l[NC n]; returns 1 on the disk. */
+static int ray_logs(const atmos__sph_space *s, const double d[3], double p2, float *l)
 {
-    const atmos__planet *pl = a->planet;
+    const int S = NC * s->n;
+    int disk;
+    const double fy = row_coord(s, p2, &disk);
+    const double phi = atan2(fabs(atmos__dot3(d, s->e2)), atmos__dot3(d, s->e1));
+    const int lim = (disk ? NG : NL) - 2;
+    int iy = (int)fy;
+    iy = iy > lim ? lim : iy;
+    const int row = iy + (disk ? 0 : NG);
+    const double fx0 = phi_col(s->phit[row], phi) * (NA - 1), fx1 = phi_col(s->phit[row + 1], phi) * (NA - 1);
+    int ix0 = (int)fx0, ix1 = (int)fx1;
+    ix0 = ix0 > NA - 2 ? NA - 2 : ix0;
+    ix1 = ix1 > NA - 2 ? NA - 2 : ix1;
+    const float ay = (float)(fy - iy), ax0 = (float)(fx0 - ix0), ax1 = (float)(fx1 - ix1);
+    const float *t00 = s->tab + ((size_t)row * NA + ix0) * S, *t01 = t00 + S;
+    const float *t10 = s->tab + ((size_t)(row + 1) * NA + ix1) * S, *t11 = t10 + S;
+    const float w00 = (1 - ay) * (1 - ax0), w01 = (1 - ay) * ax0, w10 = ay * (1 - ax1), w11 = ay * ax1;
+    for (int j = 0; j < S; j++) l[j] = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
+    return disk;
+}
+
+/* Rays i0 .. i0 + m - 1 (m <= BLK): the look-ups of the rays that meet the air and their
+ * ground, the exponentials in one loop (which vectorises), then the phase functions. */
+#define BLK 16
+static void eval_block(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int i0, int m,
+                       int count, const float *dx, const float *dy, const float *dz, const float *weight, float *out)
+{
     const int n = s->n, S = NC * n;
-    const double Rt2 = s->Rt * s->Rt, R2 = s->R * s->R;
     const float kr = 3.0f / (16.0f * 3.14159265359f);
-    for (int i = 0; i < count; i++) {
+    float lv[BLK * NC * ATMOS_MAX_WAVELENGTHS], G[BLK * ATMOS_MAX_WAVELENGTHS], nu2[BLK], ap[BLK];
+    int ip[BLK], idx[BLK], disk[BLK], h = 0;
+    for (int i = i0; i < i0 + m; i++) {
         if (weight[i] == 0.0f) continue;
         double d[3] = {dx[i], dy[i], dz[i]};
         const double l = sqrt(atmos__dot3(d, d));
         for (int c = 0; c < 3; c++) d[c] /= l;
         const double b = atmos__dot3(s->q, d), p2 = s->qq - b * b;
-        if (b >= 0 || p2 >= Rt2) continue; /* misses the air */
-        int disk;
-        const double fy = row_coord(s, p2, &disk);
-        const double phi = atan2(fabs(atmos__dot3(d, s->e2)), atmos__dot3(d, s->e1));
-        const int lim = (disk ? NG : NL) - 2;
-        int iy = (int)fy;
-        iy = iy > lim ? lim : iy;
-        const int row = iy + (disk ? 0 : NG);
-        const double fx0 = phi_col(s->phit[row], phi) * (NA - 1), fx1 = phi_col(s->phit[row + 1], phi) * (NA - 1);
-        int ix0 = (int)fx0, ix1 = (int)fx1;
-        ix0 = ix0 > NA - 2 ? NA - 2 : ix0;
-        ix1 = ix1 > NA - 2 ? NA - 2 : ix1;
-        const float ay = (float)(fy - iy), ax0 = (float)(fx0 - ix0), ax1 = (float)(fx1 - ix1);
-        const float *t00 = s->tab + ((size_t)row * NA + ix0) * S, *t01 = t00 + S;
-        const float *t10 = s->tab + ((size_t)(row + 1) * NA + ix1) * S, *t11 = t10 + S;
-        const float w00 = (1 - ay) * (1 - ax0), w01 = (1 - ay) * ax0, w10 = ay * (1 - ax1), w11 = ay * ax1;
-        double G[ATMOS_MAX_WAVELENGTHS] = {0};
-        if (disk) {
-            const double K = -b - sqrt(fmax(0.0, b * b - (s->qq - R2)));
+        if (b >= 0 || p2 >= s->Rt * s->Rt) continue; /* misses the air */
+        idx[h] = i;
+        disk[h] = ray_logs(s, d, p2, lv + h * S);
+        if (disk[h]) {
+            const double K = -b - sqrt(fmax(0.0, b * b - (s->qq - s->R * s->R)));
             const double g[3] = {s->q[0] + K * d[0], s->q[1] + K * d[1], s->q[2] + K * d[2]};
-            atmos__sph_ground(pl, a->model, g, sun, a->sun_e, n, NULL, G);
+            double Gd[ATMOS_MAX_WAVELENGTHS];
+            atmos__sph_ground(a->planet, a->model, g, sun, a->sun_e, n, NULL, Gd);
+            for (int k = 0; k < n; k++) G[h * n + k] = (float)Gd[k];
         }
-        const float nu = (float)atmos__dot3(d, sun), nu2 = nu * nu, wi = weight[i];
-        float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
-        int ip = (int)fp;
-        ip = ip > NPH - 2 ? NPH - 2 : ip;
-        const float ap = fp - ip;
-        float v[NC * ATMOS_MAX_WAVELENGTHS];
-        for (int j = 0; j < S; j++) v[j] = atmos__expf_fast(w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j]);
-        for (int k = 0; k < n; k++) {
-            const float *mp = s->mie + k * NPH + ip, *vk = v + NC * k;
-            const float pm = mp[0] + ap * (mp[1] - mp[0]);
-            const float L = kr * (s->ra[k] + s->rb[k] * nu2) * vk[0] + pm * vk[1] + vk[2] + (disk ? vk[3] * (float)G[k] : 0.0f);
-            out[(size_t)k * count + i] += wi * L;
-        }
+        const float nu = (float)atmos__dot3(d, sun);
+        const float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
+        ip[h] = (int)fp < NPH - 2 ? (int)fp : NPH - 2;
+        ap[h] = fp - ip[h], nu2[h] = nu * nu;
+        h++;
     }
+    for (int j = 0; j < h * S; j++) lv[j] = atmos__expf_fast(lv[j]);
+    for (int r = 0; r < h; r++)
+        for (int k = 0; k < n; k++) {
+            const float *mp = s->mie + k * NPH + ip[r], *v = lv + r * S + NC * k;
+            const float pm = mp[0] + ap[r] * (mp[1] - mp[0]);
+            const float L = kr * (s->ra[k] + s->rb[k] * nu2[r]) * v[0] + pm * v[1] + v[2] + (disk[r] ? v[3] * G[r * n + k] : 0.0f);
+            out[(size_t)k * count + idx[r]] += weight[idx[r]] * L;
+        }
+}
+
+void atmos__sph_space_eval(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int count,
+                           const float *dx, const float *dy, const float *dz, const float *weight, float *out)
+{
+    for (int i0 = 0; i0 < count; i0 += BLK)
+        eval_block(s, a, sun, i0, count - i0 < BLK ? count - i0 : BLK, count, dx, dy, dz, weight, out);
 }
