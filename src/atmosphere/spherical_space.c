@@ -82,7 +82,7 @@ static double row_phit(const atmos__sph_space *s, int row, double mu_s)
 static double col_phi(double t, double x)
 {
     const double xt = t / ATMOS_PI;
-    if (x <= xt) {
+    if (x < xt || xt >= 1.0) {
         const double s = 1.0 - x / xt;
         return t - t * (A * s + (1.0 - A) * s * s);
     }

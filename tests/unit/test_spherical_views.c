@@ -20,7 +20,7 @@
 #include <omp.h>
 #endif
 
-enum { NMAX = 12000 };
+enum { NMAX = 13000 };
 static float dx[NMAX], dy[NMAX], dz[NMAX], w[NMAX], out[3 * NMAX], out2[3 * NMAX];
 static float scratch[NMAX * ATMOS__ATM_BATCH_SCRATCH];
 static double ref[NMAX];
@@ -81,7 +81,8 @@ static double compare(const atmos_atmosphere *a, const double eye[3], const doub
     }
     for (int i = 0; i < n; i++) {
         const double got[3] = {out[i], out[stride + i], out[2 * stride + i]};
-        const double e = fabs(lum(got) - ref[i]) / fmax(ref[i], 1e-3 * top);
+        double e = fabs(lum(got) - ref[i]) / fmax(ref[i], 1e-3 * top);
+        if (!isfinite(e)) e = INFINITY;
         *s2 += e * e, (*cnt)++;
         if (e > worst) worst = e, *at = i;
     }
@@ -90,7 +91,7 @@ static double compare(const atmos_atmosphere *a, const double eye[3], const doub
 
 /* Rays from an eye at altitude alt above the origin: impact parameters uniform over the
  * disk and beyond the air, and crowded over the disk's edge and the limb; azimuths off the
- * table's nodes. Returns the count; *miss0: the first of the rays that miss the air. */
+ * table's nodes and in the sun's vertical plane (the sun lies in the x = 0 plane). Returns the count; *miss0: the first of the rays that miss the air. */
 static int space_rays(const atmos__planet *pl, double alt, int *miss0)
 {
     const double r = pl->r_ground + alt, R = pl->r_ground, Rt = pl->r_top;
@@ -104,8 +105,8 @@ static int space_rays(const atmos__planet *pl, double alt, int *miss0)
             else p = R + (Rt - R) * pow((i - 89.5) / 100.0, 2);      /* the limb */
             if (pass && i == 0) *miss0 = n;
             const double st = p / r, ct = sqrt(1 - st * st);
-            for (int j = 0; j < 60; j++) {
-                const double ps = 2 * ATMOS_PI * (j + 0.37) / 60;
+            for (int j = 0; j < 62; j++) { /* the last two in the sun's vertical plane */
+                const double ps = j < 60 ? 2 * ATMOS_PI * (j + 0.37) / 60 : ATMOS_PI * (j == 60 ? 0.5 : 1.5);
                 dx[n] = (float)(st * cos(ps)), dy[n] = (float)-ct, dz[n] = (float)(st * sin(ps)), w[n] = 1;
                 n++;
             }
@@ -129,7 +130,7 @@ static void from_space(const atmos_atmosphere *a)
             for (int i = miss0; i < n; i++) CHECK(out[i] == 0 && out[n + i] == 0 && out[2 * n + i] == 0);
             const double worst = compare(a, eye, sun, miss0, n, &s2, &cnt, &at);
             printf("space: eye %.0f km, sun %.1f deg: worst %.3f %% (p row %d, azimuth %d: %.4g vs %.4g)\n",
-                   alts[ia] / 1e3, els[is], 100 * worst, at / 60, at % 60,
+                   alts[ia] / 1e3, els[is], 100 * worst, at / 62, at % 62,
                    0.2126 * out[at] + 0.7152 * out[n + at] + 0.0722 * out[2 * n + at], ref[at]);
             all_worst = fmax(all_worst, worst);
 #ifdef _OPENMP
