@@ -104,6 +104,7 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
     s->n = a->wl.count;
     s->march = atmos__planet_altitude(pl, b->eye) >= pl->r_top - pl->r_ground;
     b->state = s;
+    if (pl->clouds) return; /* rays through cloud spheres are answered one by one (atmosphere_ask.c) */
     if (s->march) {
         s->space = atmos__sph_space_create(a, b->eye, b->sun);
         return;
