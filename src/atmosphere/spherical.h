@@ -30,7 +30,7 @@
 #define ATMOS__SPH_STEPS_TABLE 20
 /* Steps of the march per piece for the per-eye tables' nodes: the sky-view table's and the
  * table of an eye above the air (spherical_space.c). */
-#define ATMOS__SPH_STEPS_SKYVIEW 30
+#define ATMOS__SPH_STEPS_SKYVIEW 20
 #define ATMOS__SPH_STEPS_SPACE 20
 /* The table of an eye above the air (spherical_space.c): rows over the disk and over the
  * limb, azimuths over [0, pi]. */

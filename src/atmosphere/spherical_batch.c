@@ -176,47 +176,51 @@ static void eval_march(const atmos__atm_batch *b, int count, const float *dx, co
     }
 }
 
-/* Rays i0 .. i0 + m - 1 (m <= BLK): the table's logarithms interpolated for the block,
- * exponentiated in one loop (which vectorises), then the phase functions applied. */
+/* Rays i0 .. i0 + m - 1 (m <= BLK) in four loops: the table coordinates and the phase
+ * table's of every ray (vectorises), the look-ups of the table's logarithms, their
+ * exponentials (vectorises), the phase functions applied. */
 #define BLK 16
 static void eval_block(const sv_state *s, const float *ra, const float *rb, int i0, int m, int count,
                        const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
     const int n = s->n, S = 3 * n;
     const float muh = s->muh, kr = 3.0f / (16.0f * 3.14159265359f);
-    float lv[BLK * 3 * ATMOS_MAX_WAVELENGTHS], nu2[BLK], ap[BLK];
-    int ip[BLK];
-    for (int p = 0; p < m; p++) {
-        const int i = i0 + p;
+    float lv[BLK * 3 * ATMOS_MAX_WAVELENGTHS], fy[BLK], fx[BLK], fp[BLK], nu2[BLK];
+    int low[BLK];
+    for (int p = 0; p < BLK; p++) {
+        const int i = i0 + (p < m ? p : 0);
         const float x = dx[i], y = dy[i], z = dz[i];
         const float mu = x * s->fup[0] + y * s->fup[1] + z * s->fup[2];
         const float h1 = x * s->fe1[0] + y * s->fe1[1] + z * s->fe1[2];
         const float h2 = fabsf(x * s->fe2[0] + y * s->fe2[1] + z * s->fe2[2]);
         const float nu = x * s->fsun[0] + y * s->fsun[1] + z * s->fsun[2];
-        const int lower = mu < muh;
-        float xv = lower ? (muh - mu) / (1.0f + muh) : (mu - muh) / (1.0f - muh);
+        low[p] = mu < muh;
+        float xv = low[p] ? (muh - mu) / (1.0f + muh) : (mu - muh) / (1.0f - muh);
         xv = xv < 0 ? 0 : (xv > 1 ? 1 : xv);
-        float fy = sqrtf(xv) * (NV - 1), fx = azimuth(h1, h2) * ((NA - 1) / 3.14159265359f);
-        int iy = (int)fy, ix = (int)fx;
+        fy[p] = sqrtf(xv) * (NV - 1), fx[p] = azimuth(h1, h2) * ((NA - 1) / 3.14159265359f);
+        const float c = 0.5f * (1.0f - nu);
+        fp[p] = sqrtf(c > 0 ? c : 0) * (NPH - 1), nu2[p] = nu * nu;
+    }
+    for (int p = 0; p < m; p++) {
+        int iy = (int)fy[p], ix = (int)fx[p];
         iy = iy > NV - 2 ? NV - 2 : iy;
         ix = ix > NA - 2 ? NA - 2 : ix;
-        const float ay = fy - iy, ax = fx - ix;
-        const float *t00 = s->tab + ((size_t)(iy + (lower ? NV : 0)) * NA + ix) * S;
+        const float ay = fy[p] - iy, ax = fx[p] - ix;
+        const float *t00 = s->tab + ((size_t)(iy + (low[p] ? NV : 0)) * NA + ix) * S;
         const float *t01 = t00 + S, *t10 = t00 + (size_t)NA * S, *t11 = t10 + S;
         const float w00 = (1 - ay) * (1 - ax), w01 = (1 - ay) * ax, w10 = ay * (1 - ax), w11 = ay * ax;
         float *l = lv + p * S;
         for (int j = 0; j < S; j++) l[j] = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
-        float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
-        ip[p] = (int)fp;
-        ip[p] = ip[p] > NPH - 2 ? NPH - 2 : ip[p];
-        ap[p] = fp - ip[p], nu2[p] = nu * nu;
     }
     for (int j = 0; j < m * S; j++) lv[j] = atmos__expf_fast(lv[j]);
     for (int p = 0; p < m; p++) {
         const float *v = lv + p * S;
+        int ip = (int)fp[p];
+        ip = ip > NPH - 2 ? NPH - 2 : ip;
+        const float ap = fp[p] - ip;
         for (int k = 0; k < n; k++) {
-            const float *mp = s->mie + k * NPH + ip[p];
-            const float pm = mp[0] + ap[p] * (mp[1] - mp[0]);
+            const float *mp = s->mie + k * NPH + ip;
+            const float pm = mp[0] + ap * (mp[1] - mp[0]);
             const float L = kr * (ra[k] + rb[k] * nu2[p]) * v[3 * k] + pm * v[3 * k + 1] + v[3 * k + 2];
             out[(size_t)k * count + i0 + p] += weight[i0 + p] * L;
         }

@@ -182,8 +182,8 @@ static void from_air(const atmos_atmosphere *a)
             all_worst = fmax(all_worst, worst);
         }
     printf("sky-view table vs one ray: worst %.3f %%, rms %.3f %%\n", 100 * all_worst, 100 * sqrt(s2 / cnt));
-    /* (15.7 % and 0.47 %, the worst from 10 km in the twilight; the table of 48 x 32 nodes
-     * interpolated linearly, 40 steps a piece, gave 18.1 % and 0.71 %) */
+    /* (15.7 % and 0.50 %, the worst from 10 km in the twilight; the table of 48 x 32 nodes
+     * of 40 steps a piece, interpolated linearly, gave 18.1 % and 0.71 %) */
     CHECK(all_worst < 0.2);
     CHECK(sqrt(s2 / cnt) < 0.006);
 }
