@@ -35,7 +35,7 @@
 /* The table of an eye above the air (spherical_space.c): rows over the disk and over the
  * limb, azimuths over [0, pi]. */
 #define ATMOS__SPH_SP_DISK 48
-#define ATMOS__SPH_SP_LIMB 48
+#define ATMOS__SPH_SP_LIMB 32
 #define ATMOS__SPH_SP_AZ 64
 
 typedef struct atmos__sph_model {

@@ -146,7 +146,7 @@ static void from_space(const atmos_atmosphere *a)
 #endif
         }
     printf("space table vs one ray: worst %.3f %%, rms %.3f %%\n", 100 * all_worst, 100 * sqrt(s2 / cnt));
-    /* (12.5 % and 0.61 %: the worst where the air's light falls off across the terminator,
+    /* (12.5 % and 0.66 %: the worst where the air's light falls off across the terminator,
      * whose logarithm is curved on the scale of a cell; a blurred limb, a lit night side or
      * a ground seen through the table's cells gives errors of order one) */
     CHECK(all_worst < 0.2);
