@@ -1,10 +1,12 @@
 /* The production sky's per-eye table (spherical.h): Hillaire's sky-view look-up table, the
  * sky renderer's inner loop. For an eye inside the air, batch_init marches a grid of view
- * directions (the one-ray path's march, so the table equals it at its nodes) and keeps,
- * per wavelength, the Rayleigh and Mie single scattering without their phase functions
- * and the rest (higher orders, the lit ground seen through the air); batch_eval
- * interpolates them and applies the phase functions of the ray's scattering angle, so
- * the sun's aureole is as sharp as the phase table, not the grid.
+ * directions (the one-ray path's march with ATMOS__SPH_STEPS_SKYVIEW steps, so the table
+ * equals it at its nodes) and keeps, per wavelength, the logarithms of the Rayleigh and Mie
+ * single scattering without their phase functions and of the rest (higher orders, the lit
+ * ground seen through the air); batch_eval interpolates the logarithms (the light's
+ * exponential fall-offs toward the twilight and the horizon stay smooth), exponentiates and
+ * applies the phase functions of the ray's scattering angle, so the sun's aureole is as
+ * sharp as the phase table, not the grid.
  *
  * Grid: the view zenith's cosine mu on each side of the horizon mu_h = -sqrt(1 - (R/r)^2)
  * apart (the ground's edge is never blurred), in v = sqrt(x), x = |mu - mu_h| / (1 -+ mu_h):

@@ -4,20 +4,25 @@
  * coordinates about the axis from the eye to the planet's centre:
  *  - the ray's impact parameter p (its closest distance to the centre), in two blocks split
  *    at the ground's radius R (the disk's edge is never blurred):
- *      the disk, p < R: v = sqrt(u), u = sqrt(1 - (p / R)^2) the cosine of the zenith angle
- *        where the ray meets the ground, so rows crowd at the disk's edge, where the air's
- *        path grows as 1 / u;
- *      the limb, R <= p < R_top: v = sqrt((p - R) / (R_top - R)), rows crowd at the bottom
- *        of the limb, where the air is densest;
+ *      the disk, p < R: p = R sin z, z = pi / 2 (1 - (AD v + (1 - AD) v^2)) the zenith angle
+ *        where the ray meets the ground, v uniform over the rows: rows crowd at the disk's
+ *        edge, where the air's path grows as 1 / cos z, and stay a few degrees of z apart at
+ *        its centre;
+ *      the limb, R <= p < R_top: p - R = (R_top - R) v^2, rows crowd at the bottom of the
+ *        limb, where the air is densest;
  *  - the azimuth of the ray about that axis from the sun's side, over [0, pi] (the planet's
- *    light is symmetric about the plane through the eye, the centre and the sun).
- * Per node and wavelength the table keeps the air's light as the march gives it (Rayleigh and
- * Mie single scattering without their phase functions, the higher orders) and the view
- * transmittance to the ground. Per pixel: the ray's node coordinates, the phase functions
- * of its own scattering angle, and on the disk the ground at the ray's own ground point
- * (the maps' albedo and night lights, the sun and the sky there: atmos__sph_ground) seen
- * through the interpolated transmittance, so the maps and the terminator on the ground stay
- * as sharp as the per-ray answer. Rays that miss the air cost a dot product. */
+ *    light is symmetric about the plane through the eye, the centre and the sun), the columns
+ *    of each row crowded where the sun sets at the row's reference point (the air's light
+ *    falls off steeply across the terminator).
+ * Per node and wavelength the table keeps the logarithms of the air's light as the march
+ * gives it (Rayleigh and Mie single scattering without their phase functions, the higher
+ * orders) and of the view transmittance to the ground: interpolated as logarithms, the
+ * exponential fall-offs (the limb's brightness with height, the twilight) stay smooth.
+ * Per pixel: the ray's node coordinates, the phase functions of its own scattering angle, and
+ * on the disk the ground at the ray's own ground point (the maps' albedo and night lights,
+ * the sun and the sky there: atmos__sph_ground) seen through the interpolated transmittance,
+ * so the maps and the terminator on the ground stay as sharp as the per-ray answer. Rays that
+ * miss the air cost a dot product. */
 #include "atmosphere/spherical.h"
 
 #include "core/fastmath.h"
@@ -47,9 +52,7 @@ struct atmos__sph_space {
     float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS]; /* Rayleigh: kr (ra + rb nu^2) */
 };
 
-#ifndef AD
-#define AD 0.3
-#endif
+#define AD 0.3 /* the disk's rows: the linear share of their mapping (above) */
 /* The impact parameter of row `row`. */
 static double row_p(const atmos__sph_space *s, int row)
 {
