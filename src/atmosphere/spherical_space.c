@@ -38,6 +38,7 @@
 #define NC 4 /* channels: Rayleigh, Mie (no phase), the higher orders, the view transmittance */
 #define TINY 1e-30 /* the values are kept as logarithms, at least log(TINY) */
 #define NPH 1024 /* the Mie phase over sin(theta / 2), as the ground's table */
+#define NCS 2048 /* the ground's irradiance over the sun's cosine there, in [-1, 1] */
 
 struct atmos__sph_space {
     int n;
@@ -49,6 +50,8 @@ struct atmos__sph_space {
     double phit[NG + NL];        /* per row: the azimuth where the sun sets at the row's
                                     reference point (its columns crowd there) */
     float *mie;                  /* [n][NPH] */
+    float *gi;                   /* [n][NCS]: the ground's irradiance by the sun and the sky
+                                    over pi, times the sun's, as atmos__sph_ground has it */
     float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS]; /* Rayleigh: kr (ra + rb nu^2) */
 };
 
@@ -144,12 +147,21 @@ atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const doubl
     s->R = pl->r_ground, s->Rt = pl->r_top;
     const double mu_s = atmos__planet_sun_frame(s->q, sun, s->up, s->e1, s->e2);
     for (int row = 0; row < NG + NL; row++) s->phit[row] = row_phit(s, row, mu_s);
-    s->tab = malloc(sizeof(float) * ((size_t)(NG + NL) * NA * NC * s->n + (size_t)s->n * NPH));
+    s->tab = malloc(sizeof(float) * ((size_t)(NG + NL) * NA * NC * s->n + (size_t)s->n * (NPH + NCS)));
     if (!s->tab) {
         free(s);
         return NULL;
     }
     s->mie = s->tab + (size_t)(NG + NL) * NA * NC * s->n;
+    s->gi = s->mie + (size_t)s->n * NPH;
+    for (int j = 0; j < NCS; j++) { /* (cos T_sun + E_sky) E / pi, as atmos__sph_ground */
+        const double cs = -1.0 + 2.0 * j / (NCS - 1);
+        double ts[ATMOS_MAX_WAVELENGTHS], es[ATMOS_MAX_WAVELENGTHS];
+        atmos__sph_sun_t(a->model, pl->r_ground, cs, s->n, NULL, ts);
+        atmos__sph_esky(a->model, cs, s->n, NULL, es);
+        for (int k = 0; k < s->n; k++)
+            s->gi[k * NCS + j] = (float)(((cs > 0 ? cs * ts[k] : 0.0) + es[k]) / ATMOS_PI * a->sun_e[k]);
+    }
     for (int k = 0; k < s->n; k++) {
         const double g = pl->rayleigh_gamma[k];
         s->ra[k] = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
@@ -208,6 +220,28 @@ static int ray_logs(const atmos__sph_space *s, const double d[3], double p2, flo
     return disk;
 }
 
+/* The light of the ground where the ray d (b = q . d) meets it: its albedo and night lights
+ * there, its irradiance from the table over the sun's cosine (atmos__sph_ground's). */
+static void ground(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], const double d[3],
+                   double b, float *G)
+{
+    const atmos__planet *pl = a->planet;
+    const double K = -b - sqrt(fmax(0.0, b * b - (s->qq - s->R * s->R)));
+    double nr[3] = {s->q[0] + K * d[0], s->q[1] + K * d[1], s->q[2] + K * d[2]};
+    const double l = sqrt(atmos__dot3(nr, nr));
+    for (int c = 0; c < 3; c++) nr[c] /= l;
+    const double gw[3] = {nr[0] * s->R, nr[1] * s->R - s->R, nr[2] * s->R}; /* world frame */
+    const double u = (atmos__dot3(nr, sun) + 1.0) * 0.5 * (NCS - 1);
+    int j = (int)u;
+    j = j < 0 ? 0 : (j > NCS - 2 ? NCS - 2 : j);
+    const float f = (float)(u - j);
+    for (int k = 0; k < s->n; k++) {
+        const float *e = s->gi + k * NCS + j;
+        G[k] = (float)atmos__planet_ground_albedo(pl, gw, k) * (e[0] + f * (e[1] - e[0])) +
+               (float)atmos__planet_ground_lights(pl, gw, sun, k);
+    }
+}
+
 /* Rays i0 .. i0 + m - 1 (m <= BLK): the look-ups of the rays that meet the air and their
  * ground, the exponentials in one loop (which vectorises), then the phase functions. */
 #define BLK 16
@@ -227,13 +261,7 @@ static void eval_block(const atmos__sph_space *s, const atmos_atmosphere *a, con
         if (b >= 0 || p2 >= s->Rt * s->Rt) continue; /* misses the air */
         idx[h] = i;
         disk[h] = ray_logs(s, d, p2, lv + h * S);
-        if (disk[h]) {
-            const double K = -b - sqrt(fmax(0.0, b * b - (s->qq - s->R * s->R)));
-            const double g[3] = {s->q[0] + K * d[0], s->q[1] + K * d[1], s->q[2] + K * d[2]};
-            double Gd[ATMOS_MAX_WAVELENGTHS];
-            atmos__sph_ground(a->planet, a->model, g, sun, a->sun_e, n, NULL, Gd);
-            for (int k = 0; k < n; k++) G[h * n + k] = (float)Gd[k];
-        }
+        if (disk[h]) ground(s, a, sun, d, b, G + h * n);
         const float nu = (float)atmos__dot3(d, sun);
         const float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
         ip[h] = (int)fp < NPH - 2 ? (int)fp : NPH - 2;
