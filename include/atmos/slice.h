@@ -31,6 +31,10 @@ typedef struct atmos_slice_timing {
                                 of pixels and texels to visit (and, when the sun moved, the light
                                 frame) */
     int eye_dims[2];         /* the eye buffer (width, height) */
+    double aerial;           /* the air in front of the volume (aerial perspective) in the
+                                composite, its per-frame table included; part of sky */
+    double sunlight;         /* the sunlight entering the light buffer, when the sun moved;
+                                part of setup */
 } atmos_slice_timing;
 
 /* What atmos_render_slice needs beyond the scene; zero means default for every field. The

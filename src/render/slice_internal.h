@@ -88,6 +88,7 @@ struct atmos__slice_plan {
     atmos__vol_xform x;      /* the volume's transform, placed: world = org + R g in the grid frame */
     double prepare_s;        /* building the grid and the tables */
     int slices_used;         /* the last frame's slice count (the rule's when "slices" is 0) */
+    double sunlight_s;       /* the last frame's time on the sunlight of the light frame (0: kept) */
     /* Buffers kept between frames, grown when a frame needs more. */
     float *pixblock;
     size_t pix_cap;          /* floats */

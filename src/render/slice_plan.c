@@ -117,7 +117,9 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         if ((st = atmos__slice_passes(ctx, sp, &j, tm)) != ATMOS_OK) return st;
         const double t_c0 = atmos__now();
         atmos__slice_composite(&j, p->atm, &v->cam, v->sun, &sp->x, r, out, atmos__threads(ctx));
-        tm->sky += atmos__now() - t_c0;
+        tm->aerial = atmos__now() - t_c0;
+        tm->sky += tm->aerial;
+        tm->sunlight = sp->sunlight_s;
     }
     tm->total = atmos__now() - t_start;
     return ATMOS_OK;

@@ -9,6 +9,12 @@
 int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
                      int json);
 
+/* The aerial-perspective case: the slice renderer on v under each atmosphere model of the
+ * comma-separated list (riley, dobashi, spherical; NULL: riley,spherical), frames frames with
+ * the camera moving and with the sun moving; the frame's time and the atmosphere's shares. */
+int bench_slice_aerial(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, const char *models,
+                       int json);
+
 typedef struct {
     int size, spp;
     double density_scale;
