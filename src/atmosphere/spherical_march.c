@@ -115,3 +115,25 @@ void atmos__sph_radiance(const atmos_atmosphere *a, const double p[3], const dou
         info->in_sun_disk = 0;
     }
 }
+
+void atmos__sph_march_cumulative(const atmos__planet *pl, const atmos__sph_model *m, const double q[3],
+                                 const double d[3], double t0, double t1, int nd, const double *tj,
+                                 const double sun[3], int steps, int use_ms, int cnt, const int *k, double *out)
+{
+    double tr[ATMOS_MAX_WAVELENGTHS];
+    atmos__sph_sums s;
+    memset(&s, 0, sizeof s);
+    for (int i = 0; i < cnt; i++) tr[i] = 1.0;
+    double a = t0;
+    for (int j = 0; j < nd; j++) {
+        const double b = tj[j] < t1 ? tj[j] : t1;
+        if (b > a) { /* the slice's part in the air, in equal steps at their midpoints */
+            const double w = (b - a) / steps;
+            for (int st = 0; st < steps; st++)
+                sample_point(pl, m, q, d, a + (st + 0.5) * w, w, sun, use_ms, cnt, k, tr, &s);
+            a = b;
+        }
+        double *o = out + (size_t)j * cnt * 4;
+        for (int i = 0; i < cnt; i++) o[4 * i] = s.sr[i], o[4 * i + 1] = s.sm[i], o[4 * i + 2] = s.ms[i], o[4 * i + 3] = tr[i];
+    }
+}

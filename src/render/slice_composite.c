@@ -7,20 +7,24 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 /* §5 composite of one image pixel along direction dw (world): the air from the eye
  * to the halfway plane at distance th is in front of the volume, the rest (with the
  * ground and the sun's disk) behind it. px holds the sky image B (= front + T_front *
  * back) and receives front + T_front * L_vol + T_vol * (B - front). */
-static void composite_pixel(const atmos_atmosphere *atm, const atmos_camera *cam, const double dw[3], double th,
-                            const double sun_w[3], int n, const float *Lv, const float *Tv, float *px)
+static void composite_pixel(const atmos_atmosphere *atm, const atmos__aerial *ap, const atmos_camera *cam,
+                            const double dw[3], double th, const double sun_w[3], int n, const float *Lv,
+                            const float *Tv, float *px)
 {
     if (!(th > 0)) th = 0;
     double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
     double tg = atmos_atmosphere_ground_distance(atm, cam->position, dw);
     if (th > tg) th = tg;
-    atmos_atmosphere_inscatter(atm, cam->position, dw, th, sun_w, front);
-    atmos_atmosphere_transmittance(atm, cam->position, dw, th, Tf);
+    if (!ap || !atmos__aerial_eval(ap, dw, th, front, Tf)) {
+        atmos_atmosphere_inscatter(atm, cam->position, dw, th, sun_w, front);
+        atmos_atmosphere_transmittance(atm, cam->position, dw, th, Tf);
+    }
     for (int c = 0; c < n; c++) {
         double B = px[c], L = Lv[c], T = Tv[c];
         double r = front[c] + Tf[c] * L + T * (B - front[c]);
@@ -40,9 +44,60 @@ static void eye_taps(double f, int n, int t[2], float *w)
     *w = t[1] == t[0] ? 0.0f : (float)(f - i);
 }
 
-void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
-                            const atmos__vol_xform *xf, const atmos__rect *r, atmos_image *img, int threads)
+/* The aerial-perspective volume's distance slices (atmosphere_ops.h). */
+#define AP_SLICES 32
+
+/* The image pixels [x0, x1] x [y0, y1] that the composite may visit (the eye spans' union,
+ * and at a reduced eye buffer the image pixels whose bilinear taps reach it); 0: none. */
+static int visited_rect(const sjob *j, const atmos__rect *r, int e[4])
 {
+    int ex0 = INT32_MAX, ex1 = -1, ey0 = INT32_MAX, ey1 = -1;
+    for (int y = 0; y < j->H; y++) {
+        const sspan s = j->erow[y];
+        if (s.x0 > s.x1) continue;
+        ex0 = s.x0 < ex0 ? s.x0 : ex0, ex1 = s.x1 > ex1 ? s.x1 : ex1;
+        ey0 = y < ey0 ? y : ey0, ey1 = y;
+    }
+    if (ex1 < 0) return 0;
+    e[0] = (int)floor((ex0 - 1) * j->sx), e[2] = (int)ceil((ex1 + 2) * j->sx);
+    e[1] = (int)floor((ey0 - 1) * j->sy), e[3] = (int)ceil((ey1 + 2) * j->sy);
+    e[0] = e[0] < r->x0 ? r->x0 : e[0], e[1] = e[1] < r->y0 ? r->y0 : e[1];
+    e[2] = e[2] > r->x1 - 1 ? r->x1 - 1 : e[2], e[3] = e[3] > r->y1 - 1 ? r->y1 - 1 : e[3];
+    return e[0] <= e[2] && e[1] <= e[3];
+}
+
+/* The frame's aerial-perspective volume over the visited pixels' frustum and the distances
+ * to the volume's box (a kind whose answers are closed forms is asked directly: NULL). */
+static const atmos__aerial *frame_aerial(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam,
+                                         const double sun_w[3], const atmos__rect *r, atmos__aerial *ap, int threads)
+{
+    int e[4];
+    if (!ap || !atmos__aerial_wanted(atm) || cam->type != ATMOS_CAMERA_PINHOLE || !visited_rect(j, r, e)) return NULL;
+    atmos__aerial_grid g;
+    memcpy(g.eye, cam->position, sizeof g.eye), memcpy(g.sun, sun_w, sizeof g.sun);
+    memcpy(g.fwd, cam->forward, sizeof g.fwd), memcpy(g.right, cam->right, sizeof g.right);
+    memcpy(g.up, cam->up, sizeof g.up);
+    const double W = cam->width, H = cam->height, tn = cam->tan_half_fov;
+    g.u0 = (2.0 * e[0] - W) / H * tn, g.u1 = (2.0 * (e[2] + 1) - W) / H * tn;
+    g.v0 = (H - 2.0 * (e[3] + 1)) / H * tn, g.v1 = (H - 2.0 * e[1]) / H * tn;
+    const sgrid *b = j->g;
+    double far = 0;
+    for (int c = 0; c < 8; c++) {
+        const double p[3] = {c & 1 ? b->box_hi[0] : b->box_lo[0], c & 2 ? b->box_hi[1] : b->box_lo[1],
+                             c & 4 ? b->box_hi[2] : b->box_lo[2]};
+        const double dd[3] = {p[0] - j->eye[0], p[1] - j->eye[1], p[2] - j->eye[2]};
+        far = fmax(far, sqrt(atmos__dot3(dd, dd)));
+    }
+    g.tmax = 1.01 * far;
+    g.nu = atmos__aerial_nodes(g.u1 - g.u0, g.tmax), g.nv = atmos__aerial_nodes(g.v1 - g.v0, g.tmax), g.nd = AP_SLICES;
+    return atmos__aerial_build(ap, atm, &g, threads) ? ap : NULL;
+}
+
+void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
+                            const atmos__vol_xform *xf, const atmos__rect *r, atmos__aerial *aerial, atmos_image *img,
+                            int threads)
+{
+    const atmos__aerial *ap = frame_aerial(j, atm, cam, sun_w, r, aerial, threads);
     /* §5: air from the eye to the volume's halfway plane is in front of the volume,
      * the rest (with the ground and the sun's disk, §4.2.4) behind it. With B the sky
      * image (= front + T_front * back), the pixel is
@@ -68,7 +123,7 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     double th = j->pinv[p] != 0.0f ? (hc - j->he) * j->pinv[p] : 0.0;
                     float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
                     for (int c = 0; c < j->n; c++) Lv[c] = j->L_eye[c * j->pst + p], Tv[c] = j->T_eye[c * j->pst + p];
-                    composite_pixel(atm, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + p * C);
+                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + p * C);
                 }
         } else {
             /* Eye buffer smaller than the image: L_vol and T_vol bilinear between the
@@ -116,7 +171,7 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     atmos__vol_dir_to_frame(xf, dw, d);
                     const double hd = atmos__dot3(j->h, d);
                     double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j->he) / hd : 0.0;
-                    composite_pixel(atm, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
+                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
                 }
             }
         }
