@@ -46,7 +46,9 @@ typedef struct atmos_slice_settings {
     const atmos_volume_optics *optics; /* NULL = built from the scene inside the render */
     atmos_slice_timing *timing;       /* optional output */
     int reference;         /* nonzero: the plain scalar passes with libm's exp (slow; the fast
-                              default differs from it by < 1e-5 relative, docs/slice.md) */
+                              default differs from it by < 1e-5 relative, docs/slice.md), and
+                              the air in front of the volume asked of the atmosphere per pixel
+                              instead of the aerial-perspective volume (the spherical kinds) */
 } atmos_slice_settings;
 
 /* Fills *s with the defaults (all zero). */

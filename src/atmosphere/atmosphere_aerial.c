@@ -21,7 +21,7 @@
 #include <string.h>
 
 #define AP_TAU_MAX 80.0 /* optical depths are kept up to this (transmittance e^-80 ~ 2e-35) */
-#define AP_NPH 1024     /* the aerosols' phase function over sin(theta / 2) */
+#define AP_NPH 4096     /* the aerosols' phase function over sin(theta / 2) */
 
 int atmos__aerial_wanted(const atmos_atmosphere *a) { return a->solver != NULL; }
 
@@ -44,16 +44,18 @@ static void node_dir(const atmos__aerial_grid *g, int iu, int iv, double d[3])
     atmos__normalize3(d);
 }
 
-/* Any kind: the in-scatter and transmittance from the eye to each slice distance. */
+/* Any kind: the in-scatter and transmittance from the eye to each slice distance (to the
+ * ground, tg, where the ray meets it first: the segments renderers ask about end there). */
 static void node_generic(const atmos_atmosphere *a, const atmos__aerial_grid *g, const double d[3], const double *t,
-                         float *out)
+                         double tg, float *out)
 {
     const int n = a->wl.count;
     for (int j = 0; j < g->nd; j++) {
         double S[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
-        if (t[j] > 0) {
-            atmos__atm_inscatter_sub(a, g->eye, d, t[j], g->sun, n, NULL, S);
-            atmos__atm_transmittance_sub(a, g->eye, d, t[j], n, NULL, T);
+        const double tj = t[j] < tg ? t[j] : tg;
+        if (tj > 0) {
+            atmos__atm_inscatter_sub(a, g->eye, d, tj, g->sun, n, NULL, S);
+            atmos__atm_transmittance_sub(a, g->eye, d, tj, n, NULL, T);
         } else {
             for (int k = 0; k < n; k++) S[k] = 0.0, T[k] = 1.0;
         }
@@ -113,10 +115,11 @@ int atmos__aerial_build(atmos__aerial *ap, const atmos_atmosphere *a, const atmo
     for (int e = 0; e < nodes; e++) {
         double d[3];
         node_dir(&ap->g, e % g->nu, e / g->nu, d);
-        ap->ground[e] = (float)atmos_atmosphere_ground_distance(a, g->eye, d);
+        const double tg = atmos_atmosphere_ground_distance(a, g->eye, d);
+        ap->ground[e] = (float)tg;
         float *o = ap->tab + (size_t)e * node;
         if (ap->split) a->solver->aerial(a, g->eye, d, g->sun, nd, t, o);
-        else node_generic(a, &ap->g, d, t, o);
+        else node_generic(a, &ap->g, d, t, tg, o);
     }
     return 1;
 }

@@ -117,7 +117,9 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         tm->eye_dims[0] = j.W, tm->eye_dims[1] = j.H;
         if ((st = atmos__slice_passes(ctx, sp, &j, tm)) != ATMOS_OK) return st;
         const double t_c0 = atmos__now();
-        atmos__slice_composite(&j, p->atm, &v->cam, v->sun, &sp->x, r, &sp->aerial, out, atmos__threads(ctx));
+        /* the reference passes ask the atmosphere per pixel: the check of the aerial volume */
+        atmos__slice_composite(&j, p->atm, &v->cam, v->sun, &sp->x, r, sp->reference ? NULL : &sp->aerial, out,
+                               atmos__threads(ctx));
         tm->aerial = atmos__now() - t_c0;
         tm->sky += tm->aerial;
         tm->sunlight = sp->sunlight_s;
