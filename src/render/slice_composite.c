@@ -47,47 +47,46 @@ static void eye_taps(double f, int n, int t[2], float *w)
 /* The aerial-perspective volume's distance slices (atmosphere_ops.h). */
 #define AP_SLICES 32
 
-/* The image pixels [x0, x1] x [y0, y1] that the composite may visit (the eye spans' union,
- * and at a reduced eye buffer the image pixels whose bilinear taps reach it); 0: none. */
-static int visited_rect(const sjob *j, const atmos__rect *r, int e[4])
-{
-    int ex0 = INT32_MAX, ex1 = -1, ey0 = INT32_MAX, ey1 = -1;
-    for (int y = 0; y < j->H; y++) {
-        const sspan s = j->erow[y];
-        if (s.x0 > s.x1) continue;
-        ex0 = s.x0 < ex0 ? s.x0 : ex0, ex1 = s.x1 > ex1 ? s.x1 : ex1;
-        ey0 = y < ey0 ? y : ey0, ey1 = y;
-    }
-    if (ex1 < 0) return 0;
-    e[0] = (int)floor((ex0 - 1) * j->sx), e[2] = (int)ceil((ex1 + 2) * j->sx);
-    e[1] = (int)floor((ey0 - 1) * j->sy), e[3] = (int)ceil((ey1 + 2) * j->sy);
-    e[0] = e[0] < r->x0 ? r->x0 : e[0], e[1] = e[1] < r->y0 ? r->y0 : e[1];
-    e[2] = e[2] > r->x1 - 1 ? r->x1 - 1 : e[2], e[3] = e[3] > r->y1 - 1 ? r->y1 - 1 : e[3];
-    return e[0] <= e[2] && e[1] <= e[3];
-}
-
-/* The frame's aerial-perspective volume over the visited pixels' frustum and the distances
- * to the volume's box (a kind whose answers are closed forms is asked directly: NULL). */
+/* The frame's aerial-perspective volume (a kind whose answers are closed forms is asked
+ * directly: NULL): over the directions of the volume's box as the camera sees it (its
+ * corners projected, widened by the bilinear taps of a reduced eye buffer and cut to the
+ * image; the whole image when the eye is in front of no corner), out to the box's farthest
+ * corner. It depends on neither the region rendered nor the thread count. */
 static const atmos__aerial *frame_aerial(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam,
-                                         const double sun_w[3], const atmos__rect *r, atmos__aerial *ap, int threads)
+                                         const double sun_w[3], const atmos__vol_xform *xf, atmos__aerial *ap,
+                                         int threads)
 {
-    int e[4];
-    if (!ap || !atmos__aerial_wanted(atm) || cam->type != ATMOS_CAMERA_PINHOLE || !visited_rect(j, r, e)) return NULL;
+    if (!ap || !atmos__aerial_wanted(atm) || cam->type != ATMOS_CAMERA_PINHOLE) return NULL;
     atmos__aerial_grid g;
     memcpy(g.eye, cam->position, sizeof g.eye), memcpy(g.sun, sun_w, sizeof g.sun);
     memcpy(g.fwd, cam->forward, sizeof g.fwd), memcpy(g.right, cam->right, sizeof g.right);
     memcpy(g.up, cam->up, sizeof g.up);
+    double f[3], rt[3], up[3];
+    atmos__vol_dir_to_frame(xf, cam->forward, f);
+    atmos__vol_dir_to_frame(xf, cam->right, rt);
+    atmos__vol_dir_to_frame(xf, cam->up, up);
     const double W = cam->width, H = cam->height, tn = cam->tan_half_fov;
-    g.u0 = (2.0 * e[0] - W) / H * tn, g.u1 = (2.0 * (e[2] + 1) - W) / H * tn;
-    g.v0 = (H - 2.0 * (e[3] + 1)) / H * tn, g.v1 = (H - 2.0 * e[1]) / H * tn;
+    const double ui[2] = {-W / H * tn, W / H * tn}, vi[2] = {-tn, tn};
     const sgrid *b = j->g;
-    double far = 0;
+    double far = 0, u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    int behind = 0;
     for (int c = 0; c < 8; c++) {
-        const double p[3] = {c & 1 ? b->box_hi[0] : b->box_lo[0], c & 2 ? b->box_hi[1] : b->box_lo[1],
-                             c & 4 ? b->box_hi[2] : b->box_lo[2]};
-        const double dd[3] = {p[0] - j->eye[0], p[1] - j->eye[1], p[2] - j->eye[2]};
+        const double dd[3] = {(c & 1 ? b->box_hi[0] : b->box_lo[0]) - j->eye[0],
+                              (c & 2 ? b->box_hi[1] : b->box_lo[1]) - j->eye[1],
+                              (c & 4 ? b->box_hi[2] : b->box_lo[2]) - j->eye[2]};
         far = fmax(far, sqrt(atmos__dot3(dd, dd)));
+        const double z = atmos__dot3(dd, f);
+        if (!(z > 0)) {
+            behind = 1;
+            continue;
+        }
+        const double u = atmos__dot3(dd, rt) / z, v = atmos__dot3(dd, up) / z;
+        u0 = fmin(u0, u), u1 = fmax(u1, u), v0 = fmin(v0, v), v1 = fmax(v1, v);
     }
+    const double m = (2.0 * fmax(j->sx, j->sy) + 1.0) * 2.0 * tn / H; /* the taps' reach, in u and v */
+    g.u0 = behind ? ui[0] : fmax(u0 - m, ui[0]), g.u1 = behind ? ui[1] : fmin(u1 + m, ui[1]);
+    g.v0 = behind ? vi[0] : fmax(v0 - m, vi[0]), g.v1 = behind ? vi[1] : fmin(v1 + m, vi[1]);
+    if (!(g.u1 > g.u0 && g.v1 > g.v0)) return NULL; /* the box is out of view */
     g.tmax = 1.01 * far;
     g.nu = atmos__aerial_nodes(g.u1 - g.u0, g.tmax), g.nv = atmos__aerial_nodes(g.v1 - g.v0, g.tmax), g.nd = AP_SLICES;
     return atmos__aerial_build(ap, atm, &g, threads) ? ap : NULL;
@@ -97,7 +96,7 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                             const atmos__vol_xform *xf, const atmos__rect *r, atmos__aerial *aerial, atmos_image *img,
                             int threads)
 {
-    const atmos__aerial *ap = frame_aerial(j, atm, cam, sun_w, r, aerial, threads);
+    const atmos__aerial *ap = frame_aerial(j, atm, cam, sun_w, xf, aerial, threads);
     /* §5: air from the eye to the volume's halfway plane is in front of the volume,
      * the rest (with the ground and the sun's disk, §4.2.4) behind it. With B the sky
      * image (= front + T_front * back), the pixel is
