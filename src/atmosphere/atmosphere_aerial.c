@@ -25,10 +25,43 @@
 
 int atmos__aerial_wanted(const atmos_atmosphere *a) { return a->solver != NULL; }
 
-int atmos__aerial_nodes(double span, double tmax)
+/* Node count along one axis of the frustum: the spread of the rays' vertical component
+ * (dy) and of their direction (angle, radians) across it, at 9 points along the axis for each
+ * of 3 lines across the other axis. */
+static int axis_nodes(const atmos__aerial_grid *g, const double vert[3], int along_u)
 {
-    const double n = ceil(span * tmax / ATMOS__AERIAL_NODE_SPACING_M) + 1;
-    return n < ATMOS__AERIAL_MIN_NODES ? ATMOS__AERIAL_MIN_NODES : (n > ATMOS__AERIAL_MAX_NODES ? ATMOS__AERIAL_MAX_NODES : (int)n);
+    double dy = 0, ang = 0;
+    for (int l = 0; l < 3; l++) {
+        double lo = INFINITY, hi = -INFINITY, first[3] = {0, 0, 0}, last[3] = {0, 0, 0};
+        for (int i = 0; i < 9; i++) {
+            const double a = i / 8.0, b = l / 2.0;
+            const double u = g->u0 + (g->u1 - g->u0) * (along_u ? a : b), v = g->v0 + (g->v1 - g->v0) * (along_u ? b : a);
+            double d[3];
+            for (int c = 0; c < 3; c++) d[c] = g->fwd[c] + u * g->right[c] + v * g->up[c];
+            atmos__normalize3(d);
+            const double y = atmos__dot3(d, vert);
+            lo = fmin(lo, y), hi = fmax(hi, y);
+            if (i == 0) memcpy(first, d, sizeof first);
+            memcpy(last, d, sizeof last);
+        }
+        dy = fmax(dy, hi - lo);
+        ang = fmax(ang, acos(fmin(1.0, fmax(-1.0, atmos__dot3(first, last)))));
+    }
+    const double n = fmax(ceil(dy * g->tmax / ATMOS__AERIAL_NODE_SPACING_M),
+                          ceil(ang * g->tmax / ATMOS__AERIAL_NODE_SPACING_ACROSS_M)) + 1;
+    return n < ATMOS__AERIAL_MIN_NODES ? ATMOS__AERIAL_MIN_NODES
+                                       : (n > ATMOS__AERIAL_MAX_NODES ? ATMOS__AERIAL_MAX_NODES : (int)n);
+}
+
+void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g)
+{
+    double vert[3] = {0, 1, 0}; /* the local vertical at the eye (a flat earth's y) */
+    if (a->planet) {
+        vert[0] = g->eye[0], vert[1] = g->eye[1] + a->planet->r_ground, vert[2] = g->eye[2];
+        atmos__normalize3(vert);
+    }
+    g->nu = axis_nodes(g, vert, 1);
+    g->nv = axis_nodes(g, vert, 0);
 }
 
 static double slice_t(const atmos__aerial_grid *g, int j)

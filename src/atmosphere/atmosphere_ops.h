@@ -76,6 +76,7 @@ void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx
  * docs/sky.md, "Aerial perspective"). The answers approximate atmos_atmosphere_inscatter
  * and atmos_atmosphere_transmittance of the segment eye -> eye + t d. */
 #define ATMOS__AERIAL_MAX_SLICES 128
+#define ATMOS__AERIAL_SLICES 64 /* what the renderers ask for (test_aerial's accuracy) */
 typedef struct atmos__aerial_grid {
     double eye[3], sun[3];
     double fwd[3], right[3], up[3];
@@ -96,14 +97,17 @@ typedef struct atmos__aerial {
     float *mie;            /* split: the aerosols' phase function over sin(theta / 2) */
     const atmos_atmosphere *mie_atm; /* the atmosphere it was made for */
 } atmos__aerial;
-/* Nodes across a frustum of `span` in plane coordinates (u1 - u0) for distances up to tmax:
- * neighbouring node rays at most ATMOS__AERIAL_NODE_SPACING_M apart at tmax (the air's
- * density changes with height, so this spacing bounds the interpolation's error: 300 m keeps
- * it within ~0.5 % in test_aerial), between ATMOS__AERIAL_MIN_NODES and _MAX_NODES. */
+/* Sets g->nu and g->nv from g's frustum and tmax: the air's density changes with height, so
+ * neighbouring node rays are at most ATMOS__AERIAL_NODE_SPACING_M apart vertically (the local
+ * vertical at the eye) at tmax, and at most ATMOS__AERIAL_NODE_SPACING_ACROSS_M apart at all
+ * (what changes across the view at one height: the sun's angle over the curved ground, the
+ * ground's distance); between ATMOS__AERIAL_MIN_NODES and _MAX_NODES per axis. test_aerial
+ * measures the error this leaves (< 1 %). */
 #define ATMOS__AERIAL_NODE_SPACING_M 300.0
+#define ATMOS__AERIAL_NODE_SPACING_ACROSS_M 3000.0
 #define ATMOS__AERIAL_MIN_NODES 4
 #define ATMOS__AERIAL_MAX_NODES 64
-int atmos__aerial_nodes(double span, double tmax);
+void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g);
 /* 1 when the kind's direct answers are costly enough for a renderer to ask the volume instead
  * (the planet kinds); Riley's, the homogeneous layer's and a vacuum's are closed forms. */
 int atmos__aerial_wanted(const atmos_atmosphere *a);

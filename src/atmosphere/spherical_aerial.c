@@ -7,7 +7,7 @@
 #include <stdlib.h>
 
 /* Steps of the march per slice. */
-#define SPH_AERIAL_STEPS 2
+#define SPH_AERIAL_STEPS 1
 
 void atmos__sph_aerial(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3], int nd,
                        const double *t, float *out)

@@ -44,9 +44,6 @@ static void eye_taps(double f, int n, int t[2], float *w)
     *w = t[1] == t[0] ? 0.0f : (float)(f - i);
 }
 
-/* The aerial-perspective volume's distance slices (atmosphere_ops.h). */
-#define AP_SLICES 32
-
 /* The frame's aerial-perspective volume (a kind whose answers are closed forms is asked
  * directly: NULL): over the directions of the volume's box as the camera sees it (its
  * corners projected, widened by the bilinear taps of a reduced eye buffer and cut to the
@@ -88,7 +85,8 @@ static const atmos__aerial *frame_aerial(const sjob *j, const atmos_atmosphere *
     g.v0 = behind ? vi[0] : fmax(v0 - m, vi[0]), g.v1 = behind ? vi[1] : fmin(v1 + m, vi[1]);
     if (!(g.u1 > g.u0 && g.v1 > g.v0)) return NULL; /* the box is out of view */
     g.tmax = 1.01 * far;
-    g.nu = atmos__aerial_nodes(g.u1 - g.u0, g.tmax), g.nv = atmos__aerial_nodes(g.v1 - g.v0, g.tmax), g.nd = AP_SLICES;
+    g.nd = ATMOS__AERIAL_SLICES;
+    atmos__aerial_nodes(atm, &g);
     return atmos__aerial_build(ap, atm, &g, threads) ? ap : NULL;
 }
 

@@ -43,7 +43,7 @@ static double lum(const double *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.07
 
 /* A frustum from eye (altitude y) centred on (el, az) degrees, +-tu across, +-tv up. */
 static void frustum(atmos__aerial_grid *g, double y, double el, double az, double tu, double tv, double sun_el,
-                    double sun_az, int nu, int nv, int nd, double tmax)
+                    double sun_az, int nu, int nv, int nd, double tmax, double roll_deg)
 {
     memset(g, 0, sizeof *g);
     g->eye[1] = y;
@@ -53,6 +53,11 @@ static void frustum(atmos__aerial_grid *g, double y, double el, double az, doubl
     atmos__cross3(g->fwd, wup, g->right);
     atmos__normalize3(g->right);
     atmos__cross3(g->right, g->fwd, g->up);
+    const double cr = cos(roll_deg * 0.017453292519943295), sr = sin(roll_deg * 0.017453292519943295);
+    for (int c = 0; c < 3; c++) {
+        const double r = g->right[c], u = g->up[c];
+        g->right[c] = cr * r + sr * u, g->up[c] = cr * u - sr * r;
+    }
     g->u0 = -tu, g->u1 = tu, g->v0 = -tv, g->v1 = tv;
     g->nu = nu, g->nv = nv, g->nd = nd, g->tmax = tmax;
 }
@@ -103,8 +108,8 @@ static errs compare(const char *name, const atmos_atmosphere *a, const atmos__ae
         }
     }
     e.s_rms = sqrt(e.s_rms);
-    printf("%s: %d pairs (%.0f %% from the volume), in-scatter worst %.3f %% rms %.3f %%, transmittance worst "
-           "%.3f %%\n", name, count, 100 * e.answered, 100 * e.s_worst, 100 * e.s_rms, 100 * e.t_worst);
+    printf("%s (%dx%d nodes): %d pairs (%.0f %% from the volume), in-scatter worst %.3f %% rms %.3f %%, transmittance worst "
+           "%.3f %%\n", name, g->nu, g->nv, count, 100 * e.answered, 100 * e.s_worst, 100 * e.s_rms, 100 * e.t_worst);
     atmos__aerial_free(&ap);
     return e;
 }
@@ -112,11 +117,12 @@ static errs compare(const char *name, const atmos_atmosphere *a, const atmos__ae
 /* The production sky's fast path, the grid's nodes by atmos__aerial_nodes (as the slice
  * renderer makes them): within 1 % at worst, in-scatter and transmittance. */
 static void spherical_case(const atmos_atmosphere *a, const char *name, double y, double el, double az, double tu,
-                           double tv, double sun_el, double sun_az, double tmax, int count, int near_sun)
+                           double tv, double sun_el, double sun_az, double tmax, int count, int near_sun,
+                           double roll)
 {
     atmos__aerial_grid g;
-    frustum(&g, y, el, az, tu, tv, sun_el, sun_az, atmos__aerial_nodes(2 * tu, tmax), atmos__aerial_nodes(2 * tv, tmax),
-            32, tmax);
+    frustum(&g, y, el, az, tu, tv, sun_el, sun_az, 2, 2, ATMOS__AERIAL_SLICES, tmax, roll);
+    atmos__aerial_nodes(a, &g);
     const errs e = compare(name, a, &g, count, near_sun);
     CHECK(e.s_worst < 0.01 && e.t_worst < 0.01);
     CHECK(e.s_rms < 0.002);
@@ -126,13 +132,18 @@ static void spherical_case(const atmos_atmosphere *a, const char *name, double y
 static void spherical_cases(const atmos_atmosphere *a)
 {
     /* 1500 m up, a 30-degree sun in the frame's corner, the ground in its lower part */
-    spherical_case(a, "spherical, sun 30 deg, 62-degree view, 20 km", 1500, 10, 150, 0.6, 0.6, 30, 180, 20e3, 400, 0);
+    spherical_case(a, "spherical, sun 30 deg, 62-degree view, 20 km", 1500, 10, 150, 0.6, 0.6, 30, 180, 20e3, 400, 0, 0);
+    /* the same with the camera rolled 30 degrees (the image's axes no longer level) */
+    spherical_case(a, "spherical, sun 30 deg, rolled 30 deg, 20 km", 1500, 10, 150, 0.6, 0.6, 30, 180, 20e3, 400, 0, 30);
     /* 2 m up, a 3-degree sun in view, the horizon across the frame */
-    spherical_case(a, "spherical, sun 3 deg in view, horizon, 30 km", 2, 2, 200, 0.3, 0.15, 3, 200, 30e3, 400, 1);
+    spherical_case(a, "spherical, sun 3 deg in view, horizon, 30 km", 2, 2, 200, 0.3, 0.15, 3, 200, 30e3, 400, 1, 0);
     /* the sun just below the horizon (the air in front lit from below the frame) */
-    spherical_case(a, "spherical, sun -2 deg, 15 km", 300, 5, 100, 0.4, 0.3, -2, 90, 15e3, 300, 0);
+    spherical_case(a, "spherical, sun -2 deg, 15 km", 300, 5, 100, 0.4, 0.3, -2, 90, 15e3, 300, 0, 0);
     /* a cloud 1-3 km away in a 45-degree view */
-    spherical_case(a, "spherical, 45-degree view, 3 km", 1500, 8, 0, 0.41, 0.41, 35, 200, 3000, 400, 0);
+    spherical_case(a, "spherical, 45-degree view, 3 km", 1500, 8, 0, 0.41, 0.41, 35, 200, 3000, 400, 0, 0);
+    /* a storm's distance, looking down 20 degrees from 6 km */
+    spherical_case(a, "spherical, 45-degree view 20 deg down from 6 km, 40 km", 6000, -20, 300, 0.41, 0.41, 15, 30, 40e3,
+                   400, 0, 0);
 }
 
 /* The generic path: Riley's closed form and the homogeneous layer. */
@@ -140,13 +151,13 @@ static void generic_cases(void)
 {
     atmos_atmosphere *r = make(ATMOS_ATMOSPHERE_RILEY);
     atmos__aerial_grid g;
-    frustum(&g, 1500, 10, 150, 0.6, 0.6, 30, 180, atmos__aerial_nodes(1.2, 20e3), atmos__aerial_nodes(1.2, 20e3), 32,
-            20e3);
+    frustum(&g, 1500, 10, 150, 0.6, 0.6, 30, 180, 2, 2, ATMOS__AERIAL_SLICES, 20e3, 0);
+    atmos__aerial_nodes(r, &g);
     errs e = compare("riley (generic), 20 km", r, &g, 300, 0);
     CHECK(e.s_worst < 0.01 && e.t_worst < 0.01);
     atmos_atmosphere_destroy(r);
     atmos_atmosphere *h = make(ATMOS_ATMOSPHERE_HOMOGENEOUS);
-    frustum(&g, 1000, 0, 30, 0.5, 0.3, 20, 60, 12, 8, 16, 1500); /* inside the layer throughout */
+    frustum(&g, 1000, 0, 30, 0.5, 0.3, 20, 60, 12, 8, 16, 1500, 0); /* inside the layer throughout */
     e = compare("homogeneous (generic), 1.5 km", h, &g, 300, 0);
     CHECK(e.s_worst < 0.01);
     CHECK(e.t_worst < 1e-5); /* optical depth linear in distance: exact but for float storage */
@@ -157,7 +168,7 @@ static void generic_cases(void)
 static void edges_and_threads(const atmos_atmosphere *a)
 {
     atmos__aerial_grid g;
-    frustum(&g, 1500, 10, 150, 0.3, 0.3, 30, 180, 9, 7, 12, 5000);
+    frustum(&g, 1500, 10, 150, 0.3, 0.3, 30, 180, 9, 7, 12, 5000, 0);
     atmos__aerial p1, p2;
     memset(&p1, 0, sizeof p1), memset(&p2, 0, sizeof p2);
     CHECK(atmos__aerial_build(&p1, a, &g, 1));
