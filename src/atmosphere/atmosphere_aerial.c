@@ -10,7 +10,9 @@
  * table, not the grid); any other kind answers from its in-scatter and transmittance at each
  * slice distance (the phase function then at the node's angle). Queries interpolate the
  * in-scatter and the optical depth trilinearly: bilinear over the frustum's plane
- * coordinates, linear in distance between the two slices around t. */
+ * coordinates, linear in distance between the two slices around t. The slices may start at a
+ * distance tmin > 0 (a volume's near side): the air in front of it is then marched as one
+ * segment, as the one-ray answer does. */
 #include "atmosphere/atmosphere_internal.h"
 #include "atmosphere/planet_solver.h"
 
@@ -55,9 +57,10 @@ static int axis_nodes(const atmos__aerial_grid *g, const double vert[3], int alo
 
 void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g)
 {
-    double vert[3] = {0, 1, 0}; /* the local vertical at the eye (a flat earth's y) */
+    double vert[3] = {0, 1, 0}; /* the local vertical where the view's centre ends (a flat earth's y) */
     if (a->planet) {
-        vert[0] = g->eye[0], vert[1] = g->eye[1] + a->planet->r_ground, vert[2] = g->eye[2];
+        for (int c = 0; c < 3; c++) vert[c] = g->eye[c] + g->tmax * g->fwd[c];
+        vert[1] += a->planet->r_ground;
         atmos__normalize3(vert);
     }
     g->nu = axis_nodes(g, vert, 1);
@@ -66,8 +69,8 @@ void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g)
 
 static double slice_t(const atmos__aerial_grid *g, int j)
 {
-    const double x = (double)j / (g->nd - 1);
-    return g->tmax * x * x;
+    const double x = (double)j / (g->nd - 1), f = g->crowd_far ? 1.0 - (1.0 - x) * (1.0 - x) : x * x;
+    return g->tmin + (g->tmax - g->tmin) * f;
 }
 
 static void node_dir(const atmos__aerial_grid *g, int iu, int iv, double d[3])
@@ -121,7 +124,7 @@ static int mie_table(atmos__aerial *ap, const atmos_atmosphere *a)
 
 int atmos__aerial_build(atmos__aerial *ap, const atmos_atmosphere *a, const atmos__aerial_grid *g, int threads)
 {
-    if (g->nu < 2 || g->nv < 2 || g->nd < 2 || !(g->tmax > 0)) return 0;
+    if (g->nu < 2 || g->nv < 2 || g->nd < 2 || !(g->tmin >= 0 && g->tmax > g->tmin)) return 0;
     const int n = a->wl.count;
     const size_t node = (size_t)g->nd * n * 4, need = node * g->nu * g->nv;
     if (need > ap->cap) {
@@ -181,7 +184,7 @@ int atmos__aerial_eval(const atmos__aerial *ap, const double d[3], double t, dou
 {
     const atmos__aerial_grid *g = &ap->g;
     const double c = atmos__dot3(d, g->fwd);
-    if (!ap->tab || !(c > 0) || !(t >= 0) || t > g->tmax) return 0;
+    if (!ap->tab || !(c > 0) || !(t >= g->tmin) || t > g->tmax) return 0;
     const double u = atmos__dot3(d, g->right) / c, v = atmos__dot3(d, g->up) / c;
     int iu, iv, j;
     double wu, wv, wt;
@@ -192,7 +195,8 @@ int atmos__aerial_eval(const atmos__aerial *ap, const double d[3], double t, dou
      * the air's up to t: the query is the atmosphere's to answer */
     const float *gd = ap->ground + (size_t)iv * g->nu + iu;
     if (!(t <= gd[0] && t <= gd[1] && t <= gd[g->nu] && t <= gd[g->nu + 1])) return 0;
-    j = (int)((g->nd - 1) * sqrt(t / g->tmax));
+    const double f = (t - g->tmin) / (g->tmax - g->tmin);
+    j = (int)((g->nd - 1) * (g->crowd_far ? 1.0 - sqrt(fmax(0.0, 1.0 - f)) : sqrt(f)));
     if (j > g->nd - 2) j = g->nd - 2;
     const double ta = slice_t(g, j), tb = slice_t(g, j + 1);
     const int n = ap->n;

@@ -71,7 +71,9 @@ void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx
  * sun, the in-scattered radiance and the transmittance of the air from the eye to distance t
  * along direction d, on a grid over the directions d = fwd + u right + v up of a pinhole
  * frustum (u in [u0, u1], v in [v0, v1], nu x nv nodes; fwd, right, up orthonormal) times nd
- * distances t_j = tmax (j / (nd - 1))^2 (crowded near the eye), each node direction built by
+ * distances t_j = tmin + (tmax - tmin) f(j / (nd - 1)), f(x) = x^2 (crowded near the eye, or
+ * near tmin: the near side of what the renderer draws; 0 for all distances) or, crowd_far,
+ * 1 - (1 - x)^2 (crowded at tmax: views down into the air from above), each node direction built by
  * one pass along its ray, interpolated per query (what is exact and what interpolated:
  * docs/sky.md, "Aerial perspective"). The answers approximate atmos_atmosphere_inscatter
  * and atmos_atmosphere_transmittance of the segment eye -> eye + t d. */
@@ -82,7 +84,8 @@ typedef struct atmos__aerial_grid {
     double fwd[3], right[3], up[3];
     double u0, u1, v0, v1;
     int nu, nv, nd;        /* >= 2 each; nd at most ATMOS__AERIAL_MAX_SLICES */
-    double tmax;           /* m, > 0 */
+    double tmin, tmax;     /* m, 0 <= tmin < tmax */
+    int crowd_far;
 } atmos__aerial_grid;
 typedef struct atmos__aerial {
     atmos__aerial_grid g;
@@ -99,7 +102,7 @@ typedef struct atmos__aerial {
 } atmos__aerial;
 /* Sets g->nu and g->nv from g's frustum and tmax: the air's density changes with height, so
  * neighbouring node rays are at most ATMOS__AERIAL_NODE_SPACING_M apart vertically (the local
- * vertical at the eye) at tmax, and at most ATMOS__AERIAL_NODE_SPACING_ACROSS_M apart at all
+ * vertical where the frustum's axis reaches tmax) at tmax, and at most ATMOS__AERIAL_NODE_SPACING_ACROSS_M apart at all
  * (what changes across the view at one height: the sun's angle over the curved ground, the
  * ground's distance); between ATMOS__AERIAL_MIN_NODES and _MAX_NODES per axis. test_aerial
  * measures the error this leaves (< 1 %). */

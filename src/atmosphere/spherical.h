@@ -79,8 +79,9 @@ void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const 
 /* The march's running sums from t0 to each distance tj[0] < tj[1] < ... < tj[nd-1] along
  * q + t d ([t0, t1] inside the air; the sums stop at t1): out[(j * cnt + i) * 4 + 0..3] = sr,
  * sm, ms, t of atmos__sph_sums for wavelength i from t0 to tj[j]. One pass: each slice
- * [tj[j-1], tj[j]] (from t0 for j = 0) in `steps` equal steps, sampled at their midpoints
- * (the aerial-perspective volume, spherical_aerial.c). */
+ * [tj[j-1], tj[j]] (from t0 for j = 0) in at least `steps` equal steps, more where the ray
+ * climbs or descends (at most 150 m of height a step), sampled at their midpoints (the
+ * aerial-perspective volume, spherical_aerial.c). */
 void atmos__sph_march_cumulative(const atmos__planet *pl, const atmos__sph_model *m, const double q[3],
                                  const double d[3], double t0, double t1, int nd, const double *tj,
                                  const double sun[3], int steps, int use_ms, int cnt, const int *k, double *out);

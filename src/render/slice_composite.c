@@ -47,14 +47,16 @@ static void eye_taps(double f, int n, int t[2], float *w)
 /* The frame's aerial-perspective volume (a kind whose answers are closed forms is asked
  * directly: NULL): over the directions of the volume's box as the camera sees it (its
  * corners projected, widened by the bilinear taps of a reduced eye buffer and cut to the
- * image; the whole image when the eye is in front of no corner), out to the box's farthest
- * corner. It depends on neither the region rendered nor the thread count. */
+ * image; the whole image when the eye is in front of no corner), from the box's nearest point
+ * to its farthest corner (slices crowded at the near end, or at the far end when the eye is
+ * above the box). It depends on neither the region rendered nor the thread count. */
 static const atmos__aerial *frame_aerial(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam,
                                          const double sun_w[3], const atmos__vol_xform *xf, atmos__aerial *ap,
                                          int threads)
 {
     if (!ap || !atmos__aerial_wanted(atm) || cam->type != ATMOS_CAMERA_PINHOLE) return NULL;
     atmos__aerial_grid g;
+    memset(&g, 0, sizeof g);
     memcpy(g.eye, cam->position, sizeof g.eye), memcpy(g.sun, sun_w, sizeof g.sun);
     memcpy(g.fwd, cam->forward, sizeof g.fwd), memcpy(g.right, cam->right, sizeof g.right);
     memcpy(g.up, cam->up, sizeof g.up);
@@ -84,7 +86,23 @@ static const atmos__aerial *frame_aerial(const sjob *j, const atmos_atmosphere *
     g.u0 = behind ? ui[0] : fmax(u0 - m, ui[0]), g.u1 = behind ? ui[1] : fmin(u1 + m, ui[1]);
     g.v0 = behind ? vi[0] : fmax(v0 - m, vi[0]), g.v1 = behind ? vi[1] : fmin(v1 + m, vi[1]);
     if (!(g.u1 > g.u0 && g.v1 > g.v0)) return NULL; /* the box is out of view */
-    g.tmax = 1.01 * far;
+    double near2 = 0; /* the box's nearest point (0: the eye is inside) */
+    for (int a = 0; a < 3; a++) {
+        const double e = j->eye[a] < b->box_lo[a] ? b->box_lo[a] - j->eye[a] : (j->eye[a] > b->box_hi[a] ? j->eye[a] - b->box_hi[a] : 0);
+        near2 += e * e;
+    }
+    g.tmin = fmax(0.0, sqrt(near2) - 1.0);
+    g.tmax = far + 0.01 * (far - g.tmin) + 1.0;
+    /* looking down at the box from above it, the air thickens with distance: slices crowd far */
+    double top = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        const double p[3] = {c & 1 ? b->box_hi[0] : b->box_lo[0], c & 2 ? b->box_hi[1] : b->box_lo[1],
+                             c & 4 ? b->box_hi[2] : b->box_lo[2]};
+        double w[3];
+        atmos__vol_frame_to_point(xf, p, w);
+        top = fmax(top, w[1]);
+    }
+    g.crowd_far = cam->position[1] > top;
     g.nd = ATMOS__AERIAL_SLICES;
     atmos__aerial_nodes(atm, &g);
     return atmos__aerial_build(ap, atm, &g, threads) ? ap : NULL;
