@@ -65,6 +65,13 @@ void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g)
     }
     g->nu = axis_nodes(g, vert, 1);
     g->nv = axis_nodes(g, vert, 0);
+    /* many wavelengths: fewer nodes, so that the table stays within its budget */
+    const double per_node = (double)g->nd * a->wl.count * 4 * sizeof(float);
+    const double f = sqrt(ATMOS__AERIAL_MAX_BYTES / (per_node * g->nu * g->nv));
+    if (f < 1) {
+        g->nu = (int)(g->nu * f), g->nv = (int)(g->nv * f);
+        g->nu = g->nu < 2 ? 2 : g->nu, g->nv = g->nv < 2 ? 2 : g->nv;
+    }
 }
 
 static double slice_t(const atmos__aerial_grid *g, int j)

@@ -104,8 +104,10 @@ typedef struct atmos__aerial {
  * neighbouring node rays are at most ATMOS__AERIAL_NODE_SPACING_M apart vertically (the local
  * vertical where the frustum's axis reaches tmax) at tmax, and at most ATMOS__AERIAL_NODE_SPACING_ACROSS_M apart at all
  * (what changes across the view at one height: the sun's angle over the curved ground, the
- * ground's distance); between ATMOS__AERIAL_MIN_NODES and _MAX_NODES per axis. test_aerial
- * measures the error this leaves (< 1 %). */
+ * ground's distance); between ATMOS__AERIAL_MIN_NODES and _MAX_NODES per axis, and fewer
+ * (both axes scaled alike) where the table would pass ATMOS__AERIAL_MAX_BYTES (many
+ * wavelengths). test_aerial measures the error this leaves (< 1 % at rgb). */
+#define ATMOS__AERIAL_MAX_BYTES (48.0 * 1024 * 1024)
 #define ATMOS__AERIAL_NODE_SPACING_M 300.0
 #define ATMOS__AERIAL_NODE_SPACING_ACROSS_M 3000.0
 #define ATMOS__AERIAL_MIN_NODES 4

@@ -172,6 +172,25 @@ static void spherical_cases(const atmos_atmosphere *a)
                    400, 0, 0);
 }
 
+/* Many wavelengths: the node count keeps the table within its budget. */
+static void budget(void)
+{
+    atmos_atmosphere_desc ad;
+    atmos_atmosphere_defaults(&ad);
+    ad.kind = ATMOS_ATMOSPHERE_RILEY;
+    atmos_wavelengths wl;
+    atmos_wavelengths_spectral(ATMOS_MAX_WAVELENGTHS, &wl);
+    atmos_atmosphere *a = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, &ad, &wl, &a));
+    atmos__aerial_grid g;
+    frustum(&g, 1500, 10, 150, 0.6, 0.6, 30, 180, 2, 2, ATMOS__AERIAL_SLICES, 40e3, 30);
+    atmos__aerial_nodes(a, &g);
+    const double bytes = (double)g.nu * g.nv * g.nd * wl.count * 4 * sizeof(float);
+    printf("%d wavelengths: %dx%d nodes, %.1f MB\n", wl.count, g.nu, g.nv, bytes / 1048576);
+    CHECK(bytes <= ATMOS__AERIAL_MAX_BYTES && g.nu >= 2 && g.nv >= 2);
+    atmos_atmosphere_destroy(a);
+}
+
 /* The generic path: Riley's closed form and the homogeneous layer. */
 static void generic_cases(void)
 {
@@ -354,6 +373,7 @@ int main(void)
     from_space(a);
     edges_and_threads(a);
     generic_cases();
+    budget();
     atmos_context_desc cd;
     atmos_context_defaults(&cd);
     cd.threads = 2;
