@@ -50,7 +50,8 @@ typedef struct atmos_plan_desc {
     int offset_given;      /* nonzero: the volume moves by offset_m; zero: the scene's placement
                               (atmos_scene_volume_offset) */
     double offset_m[3];
-    int reference;         /* slice: the plain scalar passes with libm's exp (for checks; slow) */
+    int reference;         /* slice: the plain scalar passes with libm's exp and the air in front
+                              of the volume asked per pixel (for checks; slow) */
 } atmos_plan_desc;
 
 /* A frame: what may change between two images of one plan. */

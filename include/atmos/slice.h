@@ -31,6 +31,10 @@ typedef struct atmos_slice_timing {
                                 of pixels and texels to visit (and, when the sun moved, the light
                                 frame) */
     int eye_dims[2];         /* the eye buffer (width, height) */
+    double aerial;           /* the air in front of the volume (aerial perspective) in the
+                                composite, its per-frame table included; part of sky */
+    double sunlight;         /* the sunlight entering the light buffer, when the sun moved;
+                                part of setup */
 } atmos_slice_timing;
 
 /* What atmos_render_slice needs beyond the scene; zero means default for every field. The
@@ -42,7 +46,9 @@ typedef struct atmos_slice_settings {
     const atmos_volume_optics *optics; /* NULL = built from the scene inside the render */
     atmos_slice_timing *timing;       /* optional output */
     int reference;         /* nonzero: the plain scalar passes with libm's exp (slow; the fast
-                              default differs from it by < 1e-5 relative, docs/slice.md) */
+                              default differs from it by < 1e-5 relative, docs/slice.md), and
+                              the air in front of the volume asked of the atmosphere per pixel
+                              instead of the aerial-perspective volume (the spherical kinds) */
 } atmos_slice_settings;
 
 /* Fills *s with the defaults (all zero). */

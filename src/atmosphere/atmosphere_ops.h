@@ -67,4 +67,63 @@ void atmos__atm_batch_release(atmos__atm_batch *b);
 void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);
 
+/* The aerial-perspective volume (atmosphere_aerial.c; Hillaire 2020 §5.5): for one eye and
+ * sun, the in-scattered radiance and the transmittance of the air from the eye to distance t
+ * along direction d, on a grid over the directions d = fwd + u right + v up of a pinhole
+ * frustum (u in [u0, u1], v in [v0, v1], nu x nv nodes; fwd, right, up orthonormal) times nd
+ * distances t_j = tmin + (tmax - tmin) f(j / (nd - 1)), f(x) = x^2 (crowded near the eye, or
+ * near tmin: the near side of what the renderer draws; 0 for all distances) or, crowd_far,
+ * 1 - (1 - x)^2 (crowded at tmax: views down into the air from above), each node direction built by
+ * one pass along its ray, interpolated per query (what is exact and what interpolated:
+ * docs/sky.md, "Aerial perspective"). The answers approximate atmos_atmosphere_inscatter
+ * and atmos_atmosphere_transmittance of the segment eye -> eye + t d. */
+#define ATMOS__AERIAL_MAX_SLICES 128
+#define ATMOS__AERIAL_SLICES 64 /* what the renderers ask for (test_aerial's accuracy) */
+typedef struct atmos__aerial_grid {
+    double eye[3], sun[3];
+    double fwd[3], right[3], up[3];
+    double u0, u1, v0, v1;
+    int nu, nv, nd;        /* >= 2 each; nd at most ATMOS__AERIAL_MAX_SLICES */
+    double tmin, tmax;     /* m, 0 <= tmin < tmax */
+    int crowd_far;
+} atmos__aerial_grid;
+typedef struct atmos__aerial {
+    atmos__aerial_grid g;
+    const atmos_atmosphere *atm;
+    int n, split;          /* split: Rayleigh and aerosol single scattering kept apart, their
+                              phase functions applied per query (a planet kind's fast path) */
+    float *tab;            /* [v][u][slice][wavelength][4]: Rayleigh, aerosols (no phase),
+                              the rest of the in-scatter, optical depth */
+    size_t cap;
+    float *ground;         /* [v][u]: each node ray's distance to the ground (INFINITY: none) */
+    size_t gcap;
+    float *mie;            /* split: the aerosols' phase function over sin(theta / 2) */
+    const atmos_atmosphere *mie_atm; /* the atmosphere it was made for */
+} atmos__aerial;
+/* Sets g->nu and g->nv from g's frustum and tmax: the air's density changes with height, so
+ * neighbouring node rays are at most ATMOS__AERIAL_NODE_SPACING_M apart vertically (the local
+ * vertical where the frustum's axis reaches tmax) at tmax, and at most ATMOS__AERIAL_NODE_SPACING_ACROSS_M apart at all
+ * (what changes across the view at one height: the sun's angle over the curved ground, the
+ * ground's distance); between ATMOS__AERIAL_MIN_NODES and _MAX_NODES per axis, and fewer
+ * (both axes scaled alike) where the table would pass ATMOS__AERIAL_MAX_BYTES (many
+ * wavelengths). test_aerial measures the error this leaves (< 1 % at rgb). */
+#define ATMOS__AERIAL_MAX_BYTES (48.0 * 1024 * 1024)
+#define ATMOS__AERIAL_NODE_SPACING_M 300.0
+#define ATMOS__AERIAL_NODE_SPACING_ACROSS_M 3000.0
+#define ATMOS__AERIAL_MIN_NODES 4
+#define ATMOS__AERIAL_MAX_NODES 64
+void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g);
+/* 1 when the kind's direct answers are costly enough for a renderer to ask the volume instead
+ * (the planet kinds); Riley's, the homogeneous layer's and a vacuum's are closed forms. */
+int atmos__aerial_wanted(const atmos_atmosphere *a);
+/* (Re)builds ap (its storage kept from the last build, grown when needed) for the grid g on
+ * `threads` threads; the result does not depend on the thread count. 0: out of memory or a
+ * degenerate grid. */
+int atmos__aerial_build(atmos__aerial *ap, const atmos_atmosphere *a, const atmos__aerial_grid *g, int threads);
+/* The in-scatter and the transmittance (all wavelengths) for unit direction d and distance t;
+ * 0 (outputs untouched) when (d, t) lies outside the grid: ask the atmosphere then. */
+int atmos__aerial_eval(const atmos__aerial *ap, const double d[3], double t, double *inscatter,
+                       double *transmittance);
+void atmos__aerial_free(atmos__aerial *ap);
+
 #endif

@@ -32,6 +32,13 @@ typedef struct atmos__planet_solver {
     void (*batch_eval)(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                        const float *weight, float *out, float *scratch);
     void (*batch_release)(atmos__atm_batch *b);
+    /* the aerial-perspective volume's node (atmosphere_aerial.c): along d from p, at each
+     * distance t[0] < ... < t[nd-1], per wavelength of the set: the Rayleigh and the aerosol
+     * single scattering without their phase functions, the rest of the in-scatter (phase
+     * included) in W m^-2 sr^-1 nm^-1, and the optical depth (at most 80), in
+     * out[(j * n + k) * 4 + 0..3]; NULL: the volume asks inscatter and transmittance */
+    void (*aerial)(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3], int nd,
+                   const double *t, float *out);
     /* the solver's look-up tables by name (atmos_atmosphere_table; NULL-terminated names, a
      * function making table i as an image with one channel per wavelength) */
     const char *const *table_names;

@@ -189,4 +189,5 @@ const atmos__planet_solver atmos__spherical_solver = {
     .batch_init = atmos__sph_batch_init,
     .batch_eval = atmos__sph_batch_eval,
     .batch_release = atmos__sph_batch_release,
+    .aerial = atmos__sph_aerial,
 };

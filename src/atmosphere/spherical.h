@@ -85,6 +85,15 @@ double atmos__sph_clampd(double x, double lo, double hi);
 void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const double q[3], const double d[3],
                       double t0, double t1, const double sun[3], int steps, int use_ms, int cnt, const int *k,
                       atmos__sph_sums *s);
+/* The march's running sums from t0 to each distance tj[0] < tj[1] < ... < tj[nd-1] along
+ * q + t d ([t0, t1] inside the air; the sums stop at t1): out[(j * cnt + i) * 4 + 0..3] = sr,
+ * sm, ms, t of atmos__sph_sums for wavelength i from t0 to tj[j]. One pass: each slice
+ * [tj[j-1], tj[j]] (from t0 for j = 0) in at least `steps` equal steps, more where the ray
+ * climbs or descends (at most 150 m of height a step), sampled at their midpoints (the
+ * aerial-perspective volume, spherical_aerial.c). */
+void atmos__sph_march_cumulative(const atmos__planet *pl, const atmos__sph_model *m, const double q[3],
+                                 const double d[3], double t0, double t1, int nd, const double *tj,
+                                 const double sun[3], int steps, int use_ms, int cnt, const int *k, double *out);
 /* Radiance per unit irradiance reflected by the ground point g (centre frame, on the
  * sphere) lit by the sun and the sky, plus its emission divided by the irradiance. */
 void atmos__sph_ground(const atmos__planet *pl, const atmos__sph_model *m, const double g[3], const double sun[3],
@@ -93,6 +102,10 @@ void atmos__sph_ground(const atmos__planet *pl, const atmos__sph_model *m, const
  * wavelengths, in W m^-2 sr^-1 nm^-1; steps per piece. */
 void atmos__sph_radiance(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
                          int steps, double *out, atmos_atmosphere_hit *info);
+
+/* The aerial-perspective volume's node (planet_solver.h's `aerial`; spherical_aerial.c). */
+void atmos__sph_aerial(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3], int nd,
+                       const double *t, float *out);
 
 /* ------------------------------------------------------------------ per eye (spherical_batch.c) */
 void atmos__sph_batch_init(atmos__atm_batch *b);

@@ -115,3 +115,38 @@ void atmos__sph_radiance(const atmos_atmosphere *a, const double p[3], const dou
         info->in_sun_disk = 0;
     }
 }
+
+/* The cumulative march's steps: at most this change of height per step (the aerosols' scale
+ * height is 1200 m). */
+#define SPH_CUMULATIVE_CLIMB_M 150.0
+
+void atmos__sph_march_cumulative(const atmos__planet *pl, const atmos__sph_model *m, const double q[3],
+                                 const double d[3], double t0, double t1, int nd, const double *tj,
+                                 const double sun[3], int steps, int use_ms, int cnt, const int *k, double *out)
+{
+    double tr[ATMOS_MAX_WAVELENGTHS];
+    atmos__sph_sums s;
+    memset(&s, 0, sizeof s);
+    for (int i = 0; i < cnt; i++) tr[i] = 1.0;
+    double a = t0;
+    const double tc = -atmos__dot3(q, d); /* the ray's lowest point */
+    for (int j = 0; j < nd; j++) {
+        const double b = tj[j] < t1 ? tj[j] : t1;
+        if (b > a) { /* the slice's part in the air, in equal steps at their midpoints */
+            double ra = 0, rb = 0, rc = 0;
+            for (int c = 0; c < 3; c++) {
+                const double xa = q[c] + a * d[c], xb = q[c] + b * d[c], xc = q[c] + tc * d[c];
+                ra += xa * xa, rb += xb * xb, rc += xc * xc;
+            }
+            ra = sqrt(ra), rb = sqrt(rb), rc = tc > a && tc < b ? sqrt(rc) : fmin(ra, rb);
+            const double climb = fmax(ra, rb) - rc; /* the most the height changes over the slice */
+            const int n = steps > (int)ceil(climb / SPH_CUMULATIVE_CLIMB_M) ? steps : (int)ceil(climb / SPH_CUMULATIVE_CLIMB_M);
+            const double w = (b - a) / n;
+            for (int st = 0; st < n; st++)
+                sample_point(pl, m, q, d, a + (st + 0.5) * w, w, sun, use_ms, cnt, k, tr, &s);
+            a = b;
+        }
+        double *o = out + (size_t)j * cnt * 4;
+        for (int i = 0; i < cnt; i++) o[4 * i] = s.sr[i], o[4 * i + 1] = s.sm[i], o[4 * i + 2] = s.ms[i], o[4 * i + 3] = tr[i];
+    }
+}

@@ -7,20 +7,24 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 /* §5 composite of one image pixel along direction dw (world): the air from the eye
  * to the halfway plane at distance th is in front of the volume, the rest (with the
  * ground and the sun's disk) behind it. px holds the sky image B (= front + T_front *
  * back) and receives front + T_front * L_vol + T_vol * (B - front). */
-static void composite_pixel(const atmos_atmosphere *atm, const atmos_camera *cam, const double dw[3], double th,
-                            const double sun_w[3], int n, const float *Lv, const float *Tv, float *px)
+static void composite_pixel(const atmos_atmosphere *atm, const atmos__aerial *ap, const atmos_camera *cam,
+                            const double dw[3], double th, const double sun_w[3], int n, const float *Lv,
+                            const float *Tv, float *px)
 {
     if (!(th > 0)) th = 0;
     double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
     double tg = atmos_atmosphere_ground_distance(atm, cam->position, dw);
     if (th > tg) th = tg;
-    atmos_atmosphere_inscatter(atm, cam->position, dw, th, sun_w, front);
-    atmos_atmosphere_transmittance(atm, cam->position, dw, th, Tf);
+    if (!ap || !atmos__aerial_eval(ap, dw, th, front, Tf)) {
+        atmos_atmosphere_inscatter(atm, cam->position, dw, th, sun_w, front);
+        atmos_atmosphere_transmittance(atm, cam->position, dw, th, Tf);
+    }
     for (int c = 0; c < n; c++) {
         double B = px[c], L = Lv[c], T = Tv[c];
         double r = front[c] + Tf[c] * L + T * (B - front[c]);
@@ -40,9 +44,75 @@ static void eye_taps(double f, int n, int t[2], float *w)
     *w = t[1] == t[0] ? 0.0f : (float)(f - i);
 }
 
-void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
-                            const atmos__vol_xform *xf, const atmos__rect *r, atmos_image *img, int threads)
+/* The frame's aerial-perspective volume (a kind whose answers are closed forms is asked
+ * directly: NULL): over the directions of the volume's box as the camera sees it (its
+ * corners projected, widened by the bilinear taps of a reduced eye buffer and cut to the
+ * image; the whole image when the eye is in front of no corner), from the box's nearest point
+ * to its farthest corner (slices crowded at the near end, or at the far end when the eye is
+ * above the box). It depends on neither the region rendered nor the thread count. */
+static const atmos__aerial *frame_aerial(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam,
+                                         const double sun_w[3], const atmos__vol_xform *xf, atmos__aerial *ap,
+                                         int threads)
 {
+    if (!ap || !atmos__aerial_wanted(atm) || cam->type != ATMOS_CAMERA_PINHOLE) return NULL;
+    atmos__aerial_grid g;
+    memset(&g, 0, sizeof g);
+    memcpy(g.eye, cam->position, sizeof g.eye), memcpy(g.sun, sun_w, sizeof g.sun);
+    memcpy(g.fwd, cam->forward, sizeof g.fwd), memcpy(g.right, cam->right, sizeof g.right);
+    memcpy(g.up, cam->up, sizeof g.up);
+    double f[3], rt[3], up[3];
+    atmos__vol_dir_to_frame(xf, cam->forward, f);
+    atmos__vol_dir_to_frame(xf, cam->right, rt);
+    atmos__vol_dir_to_frame(xf, cam->up, up);
+    const double W = cam->width, H = cam->height, tn = cam->tan_half_fov;
+    const double ui[2] = {-W / H * tn, W / H * tn}, vi[2] = {-tn, tn};
+    const sgrid *b = j->g;
+    double far = 0, u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    int behind = 0;
+    for (int c = 0; c < 8; c++) {
+        const double dd[3] = {(c & 1 ? b->box_hi[0] : b->box_lo[0]) - j->eye[0],
+                              (c & 2 ? b->box_hi[1] : b->box_lo[1]) - j->eye[1],
+                              (c & 4 ? b->box_hi[2] : b->box_lo[2]) - j->eye[2]};
+        far = fmax(far, sqrt(atmos__dot3(dd, dd)));
+        const double z = atmos__dot3(dd, f);
+        if (!(z > 0)) {
+            behind = 1;
+            continue;
+        }
+        const double u = atmos__dot3(dd, rt) / z, v = atmos__dot3(dd, up) / z;
+        u0 = fmin(u0, u), u1 = fmax(u1, u), v0 = fmin(v0, v), v1 = fmax(v1, v);
+    }
+    const double m = (2.0 * fmax(j->sx, j->sy) + 1.0) * 2.0 * tn / H; /* the taps' reach, in u and v */
+    g.u0 = behind ? ui[0] : fmax(u0 - m, ui[0]), g.u1 = behind ? ui[1] : fmin(u1 + m, ui[1]);
+    g.v0 = behind ? vi[0] : fmax(v0 - m, vi[0]), g.v1 = behind ? vi[1] : fmin(v1 + m, vi[1]);
+    if (!(g.u1 > g.u0 && g.v1 > g.v0)) return NULL; /* the box is out of view */
+    double near2 = 0; /* the box's nearest point (0: the eye is inside) */
+    for (int a = 0; a < 3; a++) {
+        const double e = j->eye[a] < b->box_lo[a] ? b->box_lo[a] - j->eye[a] : (j->eye[a] > b->box_hi[a] ? j->eye[a] - b->box_hi[a] : 0);
+        near2 += e * e;
+    }
+    g.tmin = fmax(0.0, sqrt(near2) - 1.0);
+    g.tmax = far + 0.01 * (far - g.tmin) + 1.0;
+    /* looking down at the box from above it, the air thickens with distance: slices crowd far */
+    double top = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        const double p[3] = {c & 1 ? b->box_hi[0] : b->box_lo[0], c & 2 ? b->box_hi[1] : b->box_lo[1],
+                             c & 4 ? b->box_hi[2] : b->box_lo[2]};
+        double w[3];
+        atmos__vol_frame_to_point(xf, p, w);
+        top = fmax(top, w[1]);
+    }
+    g.crowd_far = cam->position[1] > top;
+    g.nd = ATMOS__AERIAL_SLICES;
+    atmos__aerial_nodes(atm, &g);
+    return atmos__aerial_build(ap, atm, &g, threads) ? ap : NULL;
+}
+
+void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
+                            const atmos__vol_xform *xf, const atmos__rect *r, atmos__aerial *aerial, atmos_image *img,
+                            int threads)
+{
+    const atmos__aerial *ap = frame_aerial(j, atm, cam, sun_w, xf, aerial, threads);
     /* §5: air from the eye to the volume's halfway plane is in front of the volume,
      * the rest (with the ground and the sun's disk, §4.2.4) behind it. With B the sky
      * image (= front + T_front * back), the pixel is
@@ -68,7 +138,7 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     double th = j->pinv[p] != 0.0f ? (hc - j->he) * j->pinv[p] : 0.0;
                     float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
                     for (int c = 0; c < j->n; c++) Lv[c] = j->L_eye[c * j->pst + p], Tv[c] = j->T_eye[c * j->pst + p];
-                    composite_pixel(atm, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + p * C);
+                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + p * C);
                 }
         } else {
             /* Eye buffer smaller than the image: L_vol and T_vol bilinear between the
@@ -116,7 +186,7 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     atmos__vol_dir_to_frame(xf, dw, d);
                     const double hd = atmos__dot3(j->h, d);
                     double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j->he) / hd : 0.0;
-                    composite_pixel(atm, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
+                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
                 }
             }
         }

@@ -5,6 +5,7 @@
 #ifndef ATMOS_RENDER_SLICE_INTERNAL_H
 #define ATMOS_RENDER_SLICE_INTERNAL_H
 
+#include "atmosphere/atmosphere_ops.h"
 #include "core/internal.h"
 #include "render/plan_internal.h"
 #include "render/slice_grid.h"
@@ -88,6 +89,8 @@ struct atmos__slice_plan {
     atmos__vol_xform x;      /* the volume's transform, placed: world = org + R g in the grid frame */
     double prepare_s;        /* building the grid and the tables */
     int slices_used;         /* the last frame's slice count (the rule's when "slices" is 0) */
+    atmos__aerial aerial;    /* the last frame's aerial-perspective volume (its storage kept) */
+    double sunlight_s;       /* the last frame's time on the sunlight of the light frame (0: kept) */
     /* Buffers kept between frames, grown when a frame needs more. */
     float *pixblock;
     size_t pix_cap;          /* floats */
@@ -107,9 +110,12 @@ int atmos__slice_build_spans(sjob *j, const atmos_camera *cam, const double cf[3
                              const double cu[3], int threads);
 /* Restricts the eye spans to the eye-buffer pixels [x0, x1) x [y0, y1). */
 void atmos__slice_clip_spans(sjob *j, int x0, int y0, int x1, int y1);
-/* The §5 composite of the region r of the image img (which holds the sky). */
+/* The §5 composite of the region r of the image img (which holds the sky); the air in front
+ * of the volume from the aerial-perspective volume kept in `aerial` (rebuilt for the frame)
+ * when the atmosphere's kind wants one, else asked of the atmosphere per pixel. */
 void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const atmos_camera *cam, const double sun_w[3],
-                            const atmos__vol_xform *xf, const atmos__rect *r, atmos_image *img, int threads);
+                            const atmos__vol_xform *xf, const atmos__rect *r, atmos__aerial *aerial, atmos_image *img,
+                            int threads);
 /* Sets up the per-frame job j of plan sp for the view (geometry, buffers, spans, pixels,
  * texels); r is the image region to render. */
 atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,

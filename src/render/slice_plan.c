@@ -17,6 +17,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     atmos__stables_free(&sp->tab);
     free(sp->pixblock), free(sp->spans), free(sp->lk), free(sp->ring), free(sp->I), free(sp->nsc);
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
+    atmos__aerial_free(&sp->aerial);
     free(sp);
 }
 
@@ -116,8 +117,12 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         tm->eye_dims[0] = j.W, tm->eye_dims[1] = j.H;
         if ((st = atmos__slice_passes(ctx, sp, &j, tm)) != ATMOS_OK) return st;
         const double t_c0 = atmos__now();
-        atmos__slice_composite(&j, p->atm, &v->cam, v->sun, &sp->x, r, out, atmos__threads(ctx));
-        tm->sky += atmos__now() - t_c0;
+        /* the reference passes ask the atmosphere per pixel: the check of the aerial volume */
+        atmos__slice_composite(&j, p->atm, &v->cam, v->sun, &sp->x, r, sp->reference ? NULL : &sp->aerial, out,
+                               atmos__threads(ctx));
+        tm->aerial = atmos__now() - t_c0;
+        tm->sky += tm->aerial;
+        tm->sunlight = sp->sunlight_s;
     }
     tm->total = atmos__now() - t_start;
     return ATMOS_OK;

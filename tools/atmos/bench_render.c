@@ -122,6 +122,135 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     return CLI_EXIT_OK;
 }
 
+/* The aerial-perspective case (atmos bench slice --aerial): the bench view of v (densities
+ * times density_scale, so that the cloud is seen) rendered by slicing under each atmosphere
+ * model of the list, 1 + frames frames of one plan (the first
+ * not timed), the camera orbiting 3 degrees a frame (motion=camera) or the sun turning 3
+ * degrees a frame (motion=sun). Per frame on average: the whole frame, the sky image, the air
+ * in front of the volume (the composite's aerial perspective, its table included) and the
+ * sunlight entering the light buffer; aerial_share = (aerial + sunlight) / frame,
+ * atmosphere_share = (sky + aerial + sunlight) / frame; and the first frame against the
+ * reference passes' (frame_difference). */
+static const struct {
+    const char *name;
+    atmos_atmosphere_kind kind;
+} aerial_models[] = {{"riley", ATMOS_ATMOSPHERE_RILEY}, {"dobashi", ATMOS_ATMOSPHERE_DOBASHI},
+                     {"spherical", ATMOS_ATMOSPHERE_SPHERICAL}};
+
+static int in_list(const char *list, const char *name)
+{
+    const size_t n = strlen(name);
+    for (const char *t = list; *t; t += *t == ',') {
+        const size_t len = strcspn(t, ",");
+        if (len == n && !strncmp(t, name, n)) return 1;
+        t += len;
+    }
+    return 0;
+}
+
+static atmos_status aerial_run(atmos_plan *plan, const atmos_frame *start, int mode, int frames, atmos_image *img,
+                               double ms[4])
+{
+    atmos_frame f;
+    atmos_plan_stats s;
+    step_frame(plan, start, mode, 0, &f);
+    atmos_status st = atmos_plan_render(plan, &f, NULL, img, NULL);
+    for (int k = 0; k < 4; k++) ms[k] = 0;
+    for (int i = 1; i <= frames && st == ATMOS_OK; i++) {
+        step_frame(plan, start, mode, i, &f);
+        const double t0 = cli_now_s();
+        st = atmos_plan_render(plan, &f, NULL, img, NULL);
+        ms[0] += 1e3 * (cli_now_s() - t0) / frames;
+        atmos_plan_get_stats(plan, &s);
+        ms[1] += 1e3 * (s.slice.sky - s.slice.aerial) / frames;
+        ms[2] += 1e3 * s.slice.aerial / frames;
+        ms[3] += 1e3 * s.slice.sunlight / frames;
+    }
+    return st;
+}
+
+/* The frame f of the scene's plan (fast) against a plan with the reference passes, which ask
+ * the atmosphere per pixel for the air in front of the volume: over the pixel values the
+ * volume changes (those that differ from the sky renderer's image), the RMS and the largest
+ * relative difference. */
+static atmos_status frame_difference(atmos_context *ctx, atmos_volume *v, const atmos_scene *scene,
+                                     const atmos_frame *f, double *rms, double *worst)
+{
+    atmos_plan_desc d;
+    memset(&d, 0, sizeof d);
+    d.offset_given = 1;
+    atmos_scene tmp;
+    bench_view(&tmp, v, scene->width, d.offset_m);
+    atmos_image *img[3] = {NULL, NULL, NULL};
+    atmos_status st = ATMOS_OK;
+    for (int r = 0; r < 3 && st == ATMOS_OK; r++) {
+        atmos_scene s = *scene;
+        if (r == 2) s.renderer = ATMOS_RENDERER_SKY;
+        atmos_plan *p = NULL;
+        d.reference = r == 1;
+        st = atmos_plan_create(ctx, &s, r == 2 ? NULL : v, &d, &p);
+        if (st == ATMOS_OK) st = atmos_plan_image_create(p, f, &img[r]);
+        if (st == ATMOS_OK) st = atmos_plan_render(p, f, NULL, img[r], NULL);
+        atmos_plan_destroy(p);
+    }
+    double sum2 = 0;
+    long cnt = 0;
+    *worst = 0;
+    for (size_t i = 0; st == ATMOS_OK && i < (size_t)img[0]->width * img[0]->height * img[0]->channels; i++) {
+        if ((int)(i % img[0]->channels) == img[0]->channels - 1) continue; /* alpha */
+        const double a = img[0]->pixels[i], b = img[1]->pixels[i], k = img[2]->pixels[i];
+        if (!(fabs(b - k) > 1e-6 * k) || !(b > 0)) continue;
+        const double e = fabs(a - b) / b;
+        sum2 += e * e, cnt++;
+        *worst = fmax(*worst, e);
+    }
+    *rms = cnt ? sqrt(sum2 / cnt) : 0;
+    for (int r = 0; r < 3; r++) atmos_image_destroy(img[r]);
+    return st;
+}
+
+int bench_slice_aerial(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, const char *models,
+                       double density_scale, int json)
+{
+    for (size_t m = 0; m < sizeof aerial_models / sizeof aerial_models[0]; m++) {
+        if (!in_list(models ? models : "riley,spherical", aerial_models[m].name)) continue;
+        atmos_scene scene;
+        atmos_plan *plan = NULL;
+        atmos_image *img = NULL;
+        atmos_frame start;
+        double offset[3], prepare = 0, ms[2][4];
+        bench_view(&scene, v, size, offset);
+        scene.renderer = ATMOS_RENDERER_SLICE;
+        scene.atmosphere.kind = aerial_models[m].kind;
+        scene.volume.density_scale = density_scale;
+        atmos_status st = bench_plan(ctx, v, &scene, &plan, &prepare);
+        if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
+        if (st == ATMOS_OK) st = atmos_plan_image_create(plan, &start, &img);
+        for (int mode = 0; mode < 2 && st == ATMOS_OK; mode++)
+            st = aerial_run(plan, &start, mode == 0 ? MOVE_CAMERA : MOVE_SUN, frames, img, ms[mode]);
+        atmos_image_destroy(img);
+        atmos_plan_destroy(plan);
+        double rms = 0, worst = 0;
+        if (st == ATMOS_OK) st = frame_difference(ctx, v, &scene, &start, &rms, &worst);
+        if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
+        for (int mode = 0; mode < 2; mode++) {
+            const double *t = ms[mode];
+            const char *fmt =
+                json ? "{\"bench\":\"slice\",\"case\":\"aerial\",\"volume\":\"%s\",\"model\":\"%s\","
+                       "\"motion\":\"%s\",\"size\":%d,\"threads\":%d,\"frames\":%d,\"ms_per_frame\":%.2f,"
+                       "\"sky_ms\":%.2f,\"aerial_ms\":%.2f,\"sunlight_ms\":%.2f,\"aerial_share\":%.4f,"
+                       "\"atmosphere_share\":%.4f,\"frame_rms_rel\":%.2e,\"frame_max_rel\":%.2e}\n"
+                     : "bench=slice case=aerial volume=%s model=%s motion=%s size=%d threads=%d frames=%d "
+                       "ms_per_frame=%.2f sky_ms=%.2f aerial_ms=%.2f sunlight_ms=%.2f aerial_share=%.4f "
+                       "atmosphere_share=%.4f frame_rms_rel=%.2e frame_max_rel=%.2e\n";
+            printf(fmt, name, aerial_models[m].name, mode == 0 ? "camera" : "sun", size, atmos_context_threads(ctx),
+                   frames, t[0], t[1], t[2], t[3], (t[2] + t[3]) / t[0], (t[1] + t[2] + t[3]) / t[0], rms, worst);
+        }
+        fflush(stdout);
+    }
+    return CLI_EXIT_OK;
+}
+
 /* The volume's pixels and their noise: in vacuum the nonzero ones; in the sky those that
  * differ from the atmosphere alone (bg) by more than 3 standard errors. rel: the mean
  * per-pixel relative standard error of the luminance; relm: that of the volume's mean. */

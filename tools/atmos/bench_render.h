@@ -9,6 +9,13 @@
 int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
                      int json);
 
+/* The aerial-perspective case: the slice renderer on v (densities times density_scale) under
+ * each atmosphere model of the comma-separated list (riley, dobashi, spherical; NULL:
+ * riley,spherical), frames frames with the camera moving and with the sun moving; the frame's
+ * time, the atmosphere's shares, the first frame against the per-pixel air's. */
+int bench_slice_aerial(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, const char *models,
+                       double density_scale, int json);
+
 typedef struct {
     int size, spp;
     double density_scale;
