@@ -184,7 +184,6 @@ static void build_esky(const atmos__planet *pl, atmos__sph_model *m)
 
 atmos_status atmos__sph_build(atmos_context *ctx, const atmos__planet *pl, atmos__sph_model *m)
 {
-    (void)ctx;
     const double t0 = atmos__now();
     /* the multiple-scattering table sees a uniform ground: the albedo under the origin */
     const double g0[3] = {0, 0, 0};
@@ -193,6 +192,13 @@ atmos_status atmos__sph_build(atmos_context *ctx, const atmos__planet *pl, atmos
     build_tau(pl, m);
     build_psi(pl, m, albedo);
     build_esky(pl, m);
+    /* the higher orders with their angular dependence: fixed-point iterations from Psi_ms,
+     * the sky's irradiance of the ground renewed after each (spherical_ms.c) */
+    for (int it = 0; it < ATMOS__SPH_J_ITER; it++) {
+        const atmos_status st = atmos__sph_build_j(pl, m, albedo);
+        if (st != ATMOS_OK) return atmos__error(ctx, st, "atmosphere: out of memory");
+        build_esky(pl, m);
+    }
     m->build_seconds = atmos__now() - t0;
     return ATMOS_OK;
 }
