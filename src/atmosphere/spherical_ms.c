@@ -28,8 +28,9 @@
  * in s (the aureole of the incoming single scattering is resolved), psi' by midpoints over
  * [0, pi], folded (the light is symmetric in psi'). The phase weights of each view node,
  * normalised so that a uniform field gathers exactly (energy), depend only on the two
- * grids and are computed once per build. Threads over (r, mu_s) nodes: the result does not
- * depend on their number. */
+ * grids and are computed once per build. The table holds the logarithm, interpolated
+ * quadrilinearly (JFLOOR below). Threads over (r, mu_s) nodes: the result does not depend on
+ * their number. */
 #include "atmosphere/spherical.h"
 
 #include <math.h>
@@ -45,6 +46,11 @@
 #define QP 12  /* its psi' nodes over [0, pi] */
 #define QN (QG * QP)
 #define JV (JG * JP)
+/* The table holds log(j + JFLOOR) and is interpolated in it: in twilight j falls by ~3.6
+ * times per degree of the sun's depression (the sky's irradiance of the ground between
+ * 5.2 and 6.4 degrees below), which linear interpolation over a node spacing of a degree
+ * overestimates by a quarter. */
+#define JFLOOR 1e-20
 
 /* ------------------------------------------------------------------ mappings */
 static double x_to_gamma(double x) { return ATMOS_PI * (GA * x + (1.0 - GA) * x * x); }
@@ -105,6 +111,7 @@ void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, co
             jr[i] += w * t[2 * kk], jm[i] += w * t[2 * kk + 1];
         }
     }
+    for (int i = 0; i < cnt; i++) jr[i] = exp(jr[i]) - JFLOOR, jm[i] = exp(jm[i]) - JFLOOR;
 }
 
 /* ------------------------------------------------------------------ build */
@@ -123,7 +130,7 @@ static void quad_nodes(j_quad *qd)
     static const double gw[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
                                  0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
     for (int a = 0; a < QG; a++) { /* two panels of 8 points in s over [0, 1] */
-        const double s = 0.25 * (2 * (a / 8) + 1 + gx[a % 8]), ws = 0.25 * gw[a % 8];
+        const double s = (0.5 * (1 + gx[a % 8]) + a / 8) / (QG / 8), ws = 0.5 * gw[a % 8] / (QG / 8);
         const double g = ATMOS_PI * s * s, dg = 2.0 * ATMOS_PI * s * ws;
         for (int b = 0; b < QP; b++) {
             const int q = a * QP + b;
@@ -207,8 +214,8 @@ static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_qu
                 const double l = L[(size_t)q * n + k];
                 a += wr[q] * l, b += wm[q] * l;
             }
-            out[((size_t)v * n + k) * 2] = (float)a;
-            out[((size_t)v * n + k) * 2 + 1] = (float)b;
+            out[((size_t)v * n + k) * 2] = (float)log(a + JFLOOR);
+            out[((size_t)v * n + k) * 2 + 1] = (float)log(b + JFLOOR);
         }
     free(L);
     return 0;
