@@ -24,9 +24,10 @@
  *          a = 0.3 (nodes 2.8 degrees apart at the sun, 16 at the anti-sun);
  *   psi    the azimuth of the view about the sun's direction, 0 on the zenith's side,
  *          x = (1 - cos psi) / 2 (the light is symmetric about the sun's vertical plane).
- * The gather integrates over the same sun-centred frame: gamma' = pi s^2 by Gauss-Legendre
- * in s (the aureole of the incoming single scattering is resolved), psi' by midpoints over
- * [0, pi], folded (the light is symmetric in psi'). The phase weights of each view node,
+ * The gather integrates over the same sun-centred frame: gamma' mapped like gamma from s, by
+ * three 8-point Gauss-Legendre panels in s (the aureole of the incoming single scattering is
+ * resolved, and a view's phase lobe far from the sun still meets nodes 9 degrees apart), psi'
+ * by 16 midpoints over [0, pi], folded (the light is symmetric in psi'). The phase weights of each view node,
  * normalised so that a uniform field gathers exactly (energy), depend only on the two
  * grids and are computed once per build. The table holds the logarithm, interpolated
  * quadrilinearly (JFLOOR below). Threads over (r, mu_s) nodes: the result does not depend on
@@ -42,8 +43,8 @@
 #define JG ATMOS__SPH_J_G
 #define JP ATMOS__SPH_J_P
 #define GA 0.3 /* gamma's linear share */
-#define QG 16  /* the gather's gamma' nodes */
-#define QP 12  /* its psi' nodes over [0, pi] */
+#define QG 24  /* the gather's gamma' nodes */
+#define QP 16  /* its psi' nodes over [0, pi] */
 #define QN (QG * QP)
 #define JV (JG * JP)
 /* The table holds log(j + JFLOOR) and is interpolated in it: in twilight j falls by ~3.6
@@ -129,9 +130,9 @@ static void quad_nodes(j_quad *qd)
                                  0.7966664774136267,  0.9602898564975363};
     static const double gw[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
                                  0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
-    for (int a = 0; a < QG; a++) { /* two panels of 8 points in s over [0, 1] */
+    for (int a = 0; a < QG; a++) { /* QG / 8 panels of 8 points in s over [0, 1] */
         const double s = (0.5 * (1 + gx[a % 8]) + a / 8) / (QG / 8), ws = 0.5 * gw[a % 8] / (QG / 8);
-        const double g = ATMOS_PI * s * s, dg = 2.0 * ATMOS_PI * s * ws;
+        const double g = x_to_gamma(s), dg = ATMOS_PI * (GA + 2.0 * (1.0 - GA) * s) * ws;
         for (int b = 0; b < QP; b++) {
             const int q = a * QP + b;
             qd->g[q] = g, qd->p[q] = (b + 0.5) * ATMOS_PI / QP;
