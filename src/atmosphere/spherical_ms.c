@@ -19,7 +19,9 @@
  *
  * Parametrization (sun-centred; J is smooth away from the sun and peaked toward it):
  *   rows   x_r = sqrt(h / top) (dense near the ground, where the aerosols are);
- *   mu_s   x = (1 + sign(mu_s) sqrt|mu_s|) / 2 (dense near the horizon: twilight);
+ *   mu_s   x = (y + sqrt(0.3)) / (1 + sqrt(0.3)), y = sign(mu_s) sqrt|mu_s| (dense near the
+ *          horizon: twilight), clamped below mu_s = -0.3 (17.5 degrees down: the sun is
+ *          below the horizon of every point of the air, J is night's);
  *   gamma  the angle between the view and the sun, gamma = pi (a x + (1 - a) x^2),
  *          a = 0.3 (nodes 2.8 degrees apart at the sun, 16 at the anti-sun);
  *   psi    the azimuth of the view about the sun's direction, 0 on the zenith's side,
@@ -43,6 +45,7 @@
 #define JG ATMOS__SPH_J_G
 #define JP ATMOS__SPH_J_P
 #define GA 0.3 /* gamma's linear share */
+#define XS 0.5477225575051661 /* sqrt(0.3): the columns' lowest sun, mu_s = -0.3 */
 #define QG 24  /* the gather's gamma' nodes */
 #define QP 16  /* its psi' nodes over [0, pi] */
 #define QN (QG * QP)
@@ -62,7 +65,13 @@ static double gamma_to_x(double g)
 }
 static double mus_x(double mus)
 {
-    return 0.5 * (1.0 + copysign(sqrt(fabs(atmos__sph_clampd(mus, -1, 1))), mus));
+    const double x = copysign(sqrt(fabs(atmos__sph_clampd(mus, -1, 1))), mus);
+    return atmos__sph_clampd((x + XS) / (1.0 + XS), 0.0, 1.0);
+}
+static double x_mus(double x)
+{
+    const double y = -XS + (1.0 + XS) * x;
+    return y * fabs(y);
 }
 
 /* The direction of (gamma, psi) about the sun sun = (ss, ms, 0) at a point on the y axis:
@@ -198,7 +207,7 @@ static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_qu
 {
     const int n = m->n;
     const double x = (double)ir / (JR - 1), r = m->R + (m->Rt - m->R) * x * x;
-    const double xs = 2.0 * is / (JS - 1) - 1.0, ms = xs * fabs(xs), ss = sqrt(fmax(0.0, 1.0 - ms * ms));
+    const double ms = x_mus((double)is / (JS - 1)), ss = sqrt(fmax(0.0, 1.0 - ms * ms));
     const double sun[3] = {ss, ms, 0};
     double *L = malloc(sizeof(double) * QN * (size_t)n);
     if (!L) return 1;
