@@ -20,8 +20,9 @@
  * Parametrization (sun-centred; J is smooth away from the sun and peaked toward it):
  *   rows   x_r = sqrt(h / top) (dense near the ground, where the aerosols are);
  *   mu_s   x = (y + sqrt(0.3)) / (1 + sqrt(0.3)), y = sign(mu_s) sqrt|mu_s| (dense near the
- *          horizon: twilight), clamped below mu_s = -0.3 (17.5 degrees down: the sun is
- *          below the horizon of every point of the air, J is night's);
+ *          horizon: twilight), down to mu_s = -0.3 (17.5 degrees down: the sun is below the
+ *          horizon of every point of the air); below, the lowest column times
+ *          e^(-60 (-0.3 - mu_s)), a steep fade standing for the night's darkening;
  *   gamma  the angle between the view and the sun, gamma = pi (a x + (1 - a) x^2),
  *          a = 0.3 (nodes 2.8 degrees apart at the sun, 16 at the anti-sun);
  *   psi    the azimuth of the view about the sun's direction, 0 on the zenith's side,
@@ -46,6 +47,7 @@
 #define JP ATMOS__SPH_J_P
 #define GA 0.3 /* gamma's linear share */
 #define XS 0.5477225575051661 /* sqrt(0.3): the columns' lowest sun, mu_s = -0.3 */
+#define JFADE 60.0 /* J's decay per unit of mu_s below the lowest column (e^-6 at -0.4) */
 #define QG 24  /* the gather's gamma' nodes */
 #define QP 16  /* its psi' nodes over [0, pi] */
 #define QN (QG * QP)
@@ -121,7 +123,10 @@ void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, co
             jr[i] += w * t[2 * kk], jm[i] += w * t[2 * kk + 1];
         }
     }
-    for (int i = 0; i < cnt; i++) jr[i] = exp(jr[i]) - JFLOOR, jm[i] = exp(jm[i]) - JFLOOR;
+    /* below the lowest column a steep fade, not the column's light: the night side keeps
+     * its darkness (the night lights stay the brightest thing there) */
+    const double fade = mus < -XS * XS ? exp(-JFADE * (-XS * XS - mus)) : 1.0;
+    for (int i = 0; i < cnt; i++) jr[i] = (exp(jr[i]) - JFLOOR) * fade, jm[i] = (exp(jm[i]) - JFLOOR) * fade;
 }
 
 /* ------------------------------------------------------------------ build */
