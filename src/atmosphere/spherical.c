@@ -12,7 +12,7 @@
 #include <string.h>
 
 /* Bumped whenever the tables' content or layout changes. */
-#define SPH_TABLE_VERSION 1
+#define SPH_TABLE_VERSION 2
 
 static void sph_destroy(void *model)
 {
@@ -24,8 +24,10 @@ static void sph_destroy(void *model)
 
 static void cache_key(const atmos__planet *pl, const atmos__sph_model *m, char *key, size_t cap)
 {
-    snprintf(key, cap, "spherical-sky v%d tau %dx%d psi %dx%d esky %d steps %d floats %zu planet %016llx",
+    snprintf(key, cap,
+             "spherical-sky v%d tau %dx%d psi %dx%d esky %d j %dx%dx%dx%d it %d steps %d floats %zu planet %016llx",
              SPH_TABLE_VERSION, ATMOS__SPH_T_R, ATMOS__SPH_T_MU, ATMOS__SPH_M_R, ATMOS__SPH_M_MU, ATMOS__SPH_E_MU,
+             ATMOS__SPH_J_R, ATMOS__SPH_J_MUS, ATMOS__SPH_J_G, ATMOS__SPH_J_P, ATMOS__SPH_J_ITER,
              ATMOS__SPH_STEPS_TABLE, m->block_floats, (unsigned long long)atmos__cache_checksum(pl, sizeof *pl));
 }
 
@@ -38,7 +40,8 @@ static atmos_status sph_create(atmos_context *ctx, atmos_atmosphere *a)
     m->R = pl->r_ground, m->Rt = pl->r_top, m->H = sqrt(m->Rt * m->Rt - m->R * m->R);
     const size_t nt = (size_t)ATMOS__SPH_T_R * ATMOS__SPH_T_MU, nm = (size_t)ATMOS__SPH_M_R * ATMOS__SPH_M_MU;
     const size_t ne = 2 * (size_t)ATMOS__SPH_E_MU;
-    m->block_floats = (size_t)m->n * (nt + 2 * nm + ne);
+    const size_t nj = 2 * (size_t)ATMOS__SPH_J_R * ATMOS__SPH_J_MUS * ATMOS__SPH_J_G * ATMOS__SPH_J_P;
+    m->block_floats = (size_t)m->n * (nt + 2 * nm + ne + nj);
     m->block = calloc(m->block_floats, sizeof(float));
     if (!m->block) {
         free(m);
@@ -48,8 +51,9 @@ static atmos_status sph_create(atmos_context *ctx, atmos_atmosphere *a)
     m->psi = m->tau + (size_t)m->n * nt;
     m->fms = m->psi + (size_t)m->n * nm;
     m->esky = m->fms + (size_t)m->n * nm;
+    m->jms = m->esky + (size_t)m->n * ne;
     a->model = m;
-    char key[256];
+    char key[320];
     cache_key(pl, m, key, sizeof key);
     void *data = NULL;
     size_t size = 0;
@@ -57,6 +61,7 @@ static atmos_status sph_create(atmos_context *ctx, atmos_atmosphere *a)
         if (size == m->block_floats * sizeof(float)) {
             memcpy(m->block, data, size);
             free(data);
+            m->use_j = 1;
             return ATMOS_OK;
         }
         free(data);

@@ -19,6 +19,14 @@
 #define ATMOS__SPH_M_R 24
 #define ATMOS__SPH_M_MU 32
 #define ATMOS__SPH_E_MU 64
+/* The higher orders' scattering density J_ms (spherical_ms.c): rows in sqrt(altitude / top),
+ * sun cosines, angles from the sun, azimuths about it; the fixed-point iterations that
+ * build it from Psi_ms. */
+#define ATMOS__SPH_J_R 16
+#define ATMOS__SPH_J_MUS 32
+#define ATMOS__SPH_J_G 20
+#define ATMOS__SPH_J_P 10
+#define ATMOS__SPH_J_ITER 2
 /* Steps of the march per monotone piece of a ray (the piece going down to the ray's lowest
  * point and the piece rising from it): the one-ray answers and the tables. */
 #define ATMOS__SPH_STEPS 40
@@ -45,6 +53,9 @@ typedef struct atmos__sph_model {
     float *psi;             /* [n][M_R][M_MU] Psi_ms, sr^-1 per unit irradiance and scattering */
     float *fms;             /* [n][M_R][M_MU] f_ms: the share of isotropic light scattered again */
     float *esky;            /* [n][E_MU] the sky's irradiance of the ground, per unit irradiance */
+    float *jms;             /* [J_R][J_MUS][J_G][J_P][n][2] J_ms per unit scattering coefficient of
+                               the air molecules and of the aerosols, sr^-1 per unit irradiance */
+    int use_j;              /* the march takes the higher orders from jms (else from Psi_ms) */
     float *block;           /* one allocation holding the four (the cache's payload) */
     size_t block_floats;
     double build_seconds;   /* 0 when loaded from the cache */
@@ -53,7 +64,9 @@ typedef struct atmos__sph_model {
 /* What a march along a segment gathers, per wavelength of the subset (phase functions left
  * out: along one ray the scattering angle is constant):
  *   sr = int sigma_R T T_sun dt, sm = int sigma_M,sca T T_sun dt,
- *   ms = int sigma_s T Psi_ms dt, f = int sigma_s T dt, t = T over the whole segment. */
+ *   ms = int (sigma_R j_R + sigma_M j_M) T dt (the higher orders, phase included; from
+ *   Psi_ms, ms = int sigma_s T Psi_ms dt, while the J table is being built),
+ *   f = int sigma_s T dt, t = T over the whole segment. */
 typedef struct atmos__sph_sums {
     double sr[ATMOS_MAX_WAVELENGTHS], sm[ATMOS_MAX_WAVELENGTHS], ms[ATMOS_MAX_WAVELENGTHS];
     double f[ATMOS_MAX_WAVELENGTHS], t[ATMOS_MAX_WAVELENGTHS];
@@ -71,6 +84,21 @@ void atmos__sph_tau_top(const atmos__sph_model *m, double r, double mu, int cnt,
 void atmos__sph_sun_t(const atmos__sph_model *m, double r, double mu_s, int cnt, const int *k, double *out);
 void atmos__sph_psi(const atmos__sph_model *m, double r, double mu_s, int cnt, const int *k, double *out);
 void atmos__sph_esky(const atmos__sph_model *m, double mu_s, int cnt, const int *k, double *out);
+/* J_ms at radius r for a view of zenith cosine mu, the sun at cosine mu_s, the view at the
+ * angle g (atmos__sph_j_gamma of the cosine nu between view and sun, once per ray) from it:
+ * jr, jm per unit scattering coefficient of the air molecules and the aerosols
+ * (spherical_ms.c). */
+typedef struct atmos__sph_jg {
+    int i;
+    double a, cg, sg;
+} atmos__sph_jg;
+void atmos__sph_j_gamma(double nu, atmos__sph_jg *g);
+void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, const atmos__sph_jg *g, int cnt,
+                  const int *k, double *jr, double *jm);
+/* Builds jms by one fixed-point iteration over the field marched with the current higher
+ * orders (Psi_ms, or jms of the iteration before) and sets use_j; albedo: the uniform
+ * ground's. */
+atmos_status atmos__sph_build_j(const atmos__planet *pl, atmos__sph_model *m, const double *albedo);
 /* f_ms at (r, mu_s) of wavelength k (a diagnostic of the multiple-scattering table). */
 double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k);
 /* The mappings' inverses the build needs (spherical_lookup.c): the (r, mu) of a depth-table
@@ -81,7 +109,8 @@ double atmos__sph_clampd(double x, double lo, double hi);
 
 /* ------------------------------------------------------------------ the march (spherical_march.c) */
 /* Marches q + t d, t in [t0, t1] (inside the air), sun direction sun; use_ms: add the
- * Psi_ms term (the tables must hold it). steps per monotone piece. */
+ * higher orders (J_ms, or Psi_ms before J is built; the tables must hold it). steps per
+ * monotone piece. */
 void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const double q[3], const double d[3],
                       double t0, double t1, const double sun[3], int steps, int use_ms, int cnt, const int *k,
                       atmos__sph_sums *s);

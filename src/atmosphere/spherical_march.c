@@ -16,8 +16,8 @@
 #include <string.h>
 
 static void sample_point(const atmos__planet *pl, const atmos__sph_model *m, const double q[3], const double d[3],
-                         double t, double w, const double sun[3], int use_ms, int cnt, const int *k, double *tr,
-                         atmos__sph_sums *s)
+                         double t, double w, const double sun[3], const atmos__sph_jg *jg, int use_ms, int cnt,
+                         const int *k, double *tr, atmos__sph_sums *s)
 {
     const double x[3] = {q[0] + t * d[0], q[1] + t * d[1], q[2] + t * d[2]};
     const double r = sqrt(atmos__dot3(x, x)), h = r - pl->r_ground;
@@ -25,9 +25,11 @@ static void sample_point(const atmos__planet *pl, const atmos__sph_model *m, con
     const double mus = atmos__dot3(x, sun) / r;
     const double rr = atmos__planet_rho_rayleigh(pl, h), rm = atmos__planet_rho_mie(pl, h);
     const double ro = atmos__planet_rho_ozone(pl, h);
-    double ts[ATMOS_MAX_WAVELENGTHS], psi[ATMOS_MAX_WAVELENGTHS];
+    double ts[ATMOS_MAX_WAVELENGTHS], psi[ATMOS_MAX_WAVELENGTHS], jm[ATMOS_MAX_WAVELENGTHS];
     atmos__sph_sun_t(m, r, mus, cnt, k, ts);
-    if (use_ms) atmos__sph_psi(m, r, mus, cnt, k, psi);
+    const int use_j = use_ms && m->use_j;
+    if (use_j) atmos__sph_j(m, r, atmos__dot3(x, d) / r, mus, jg, cnt, k, psi, jm);
+    else if (use_ms) atmos__sph_psi(m, r, mus, cnt, k, psi);
     for (int i = 0; i < cnt; i++) {
         const int kk = ATMOS__WL(k, i);
         const double sr = pl->rayleigh[kk] * rr, sm = pl->mie_sca[kk] * rm;
@@ -37,7 +39,8 @@ static void sample_point(const atmos__planet *pl, const atmos__sph_model *m, con
         s->sr[i] += sr * Tw * ts[i];
         s->sm[i] += sm * Tw * ts[i];
         s->f[i] += (sr + sm) * Tw;
-        if (use_ms) s->ms[i] += (sr + sm) * Tw * psi[i];
+        if (use_j) s->ms[i] += (sr * psi[i] + sm * jm[i]) * Tw;
+        else if (use_ms) s->ms[i] += (sr + sm) * Tw * psi[i];
         tr[i] *= es;
     }
 }
@@ -50,18 +53,20 @@ void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const 
     memset(s, 0, sizeof *s);
     for (int i = 0; i < cnt; i++) tr[i] = 1.0;
     if (t1 > t0) {
+        atmos__sph_jg jg = {0, 0.0, 1.0, 0.0};
+        if (use_ms && m->use_j) atmos__sph_j_gamma(atmos__dot3(d, sun), &jg);
         double tc = -atmos__dot3(q, d);
         tc = tc < t0 ? t0 : (tc > t1 ? t1 : tc);
         const double la = tc - t0, lb = t1 - tc;
         if (la > 0) /* toward the lowest point: s from 1 down to 0 */
             for (int j = 0; j < steps; j++) {
                 const double u = 1.0 - (j + 0.5) / steps;
-                sample_point(pl, m, q, d, tc - la * u * u, 2.0 * la * u / steps, sun, use_ms, cnt, k, tr, s);
+                sample_point(pl, m, q, d, tc - la * u * u, 2.0 * la * u / steps, sun, &jg, use_ms, cnt, k, tr, s);
             }
         if (lb > 0)
             for (int j = 0; j < steps; j++) {
                 const double u = (j + 0.5) / steps;
-                sample_point(pl, m, q, d, tc + lb * u * u, 2.0 * lb * u / steps, sun, use_ms, cnt, k, tr, s);
+                sample_point(pl, m, q, d, tc + lb * u * u, 2.0 * lb * u / steps, sun, &jg, use_ms, cnt, k, tr, s);
             }
     }
     for (int i = 0; i < cnt; i++) s->t[i] = tr[i];

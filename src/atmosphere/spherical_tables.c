@@ -139,7 +139,9 @@ static void build_psi(const atmos__planet *pl, atmos__sph_model *m, const double
     }
 }
 
-/* E_sky at one mu_s: the upper hemisphere by Gauss-Legendre in mu on [0, 1] times
+/* E_sky at one mu_s: the upper hemisphere by Gauss-Legendre in u = sqrt(mu) (two panels;
+ * nodes crowd at the horizon, where the twilight sky's light is: 8 points in mu put E_sky
+ * 25 % above the integral of the sky's own radiance with the sun 6 degrees below) times
  * azimuth midpoints over [0, pi], radiance (with the real phase functions) times mu. */
 #define EMU 8
 #define EPHI 16
@@ -153,15 +155,16 @@ static void esky_entry(const atmos__planet *pl, const atmos__sph_model *m, doubl
     const int n = m->n;
     const double q[3] = {0, m->R, 0}, sun[3] = {sqrt(fmax(0.0, 1 - mus * mus)), mus, 0};
     for (int k = 0; k < n; k++) out[k] = 0.0;
-    for (int a = 0; a < EMU; a++) {
-        const double mu = 0.5 + 0.5 * gx[a], w = 0.5 * gw[a] * 2.0 * ATMOS_PI / EPHI * mu;
+    for (int a = 0; a < 2 * EMU; a++) { /* two panels in u, mu = u^2 (the horizon, twilight's light) */
+        const double u = 0.5 * (0.5 * (1.0 + gx[a % EMU]) + a / EMU), mu = u * u;
+        const double w = 0.25 * gw[a % EMU] * 2.0 * u * 2.0 * ATMOS_PI / EPHI * mu;
         const double sn = sqrt(fmax(0.0, 1 - mu * mu));
         for (int b = 0; b < EPHI; b++) {
             const double phi = (b + 0.5) * ATMOS_PI / EPHI;
             const double d[3] = {sn * cos(phi), mu, sn * sin(phi)};
             const double nu = d[0] * sun[0] + d[1] * sun[1];
             atmos__sph_sums s;
-            atmos__sph_march(pl, m, q, d, 0.0, atmos__planet_dist_top(pl, m->R, mu), sun, ATMOS__SPH_STEPS_TABLE, 1,
+            atmos__sph_march(pl, m, q, d, 0.0, atmos__planet_dist_top(pl, m->R, mu), sun, ATMOS__SPH_STEPS, 1,
                              n, NULL, &s);
             for (int k = 0; k < n; k++)
                 out[k] += w * (atmos__planet_rayleigh_phase(pl, k, nu) * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k] + s.ms[k]);
@@ -184,7 +187,6 @@ static void build_esky(const atmos__planet *pl, atmos__sph_model *m)
 
 atmos_status atmos__sph_build(atmos_context *ctx, const atmos__planet *pl, atmos__sph_model *m)
 {
-    (void)ctx;
     const double t0 = atmos__now();
     /* the multiple-scattering table sees a uniform ground: the albedo under the origin */
     const double g0[3] = {0, 0, 0};
@@ -193,6 +195,13 @@ atmos_status atmos__sph_build(atmos_context *ctx, const atmos__planet *pl, atmos
     build_tau(pl, m);
     build_psi(pl, m, albedo);
     build_esky(pl, m);
+    /* the higher orders with their angular dependence: fixed-point iterations from Psi_ms,
+     * the sky's irradiance of the ground renewed after each (spherical_ms.c) */
+    for (int it = 0; it < ATMOS__SPH_J_ITER; it++) {
+        const atmos_status st = atmos__sph_build_j(pl, m, albedo);
+        if (st != ATMOS_OK) return atmos__error(ctx, st, "atmosphere: out of memory");
+        build_esky(pl, m);
+    }
     m->build_seconds = atmos__now() - t0;
     return ATMOS_OK;
 }

@@ -242,9 +242,10 @@ static void energy(void)
         }
     for (int k = 0; k < 3; k++) printf("white ground, sun at zenith: up/in flux at the top, wavelength %d: %.4f\n", k,
                                        up[k] / e[k]);
-    /* Hillaire's isotropic series lets the ground-air interreflections of a white ground
-     * escape (docs/sky.md): the budget may fall short, never above */
-    for (int k = 0; k < 3; k++) CHECK(up[k] / e[k] > 0.85 && up[k] / e[k] < 1.005);
+    /* J_ms's two iterations from Psi_ms truncate the ground-air interreflections of a
+     * white ground (docs/sky.md: 0.96 / 0.96 / 0.95; Psi_ms alone gave 0.97 / 0.95 / 0.90):
+     * the budget may fall a little short, never above */
+    for (int k = 0; k < 3; k++) CHECK(up[k] / e[k] > 0.93 && up[k] / e[k] < 1.005);
     atmos_atmosphere_destroy(a);
 }
 

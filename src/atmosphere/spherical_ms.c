@@ -1,0 +1,259 @@
+/* The production sky's scattering density of the higher orders with its angular dependence
+ * (spherical.h): J_ms(r, mu_s, gamma, psi), the light of orders >= 2 scattered at a point
+ * toward the eye, per unit scattering coefficient of each kind of particle and per unit
+ * solar irradiance, so that the march adds sigma_R j_R + sigma_M j_M per step (docs/sky.md,
+ * "The production sky").
+ *
+ * The density is the phase-weighted gather of the light arriving at the point,
+ *   j_type(x, w) = int_sphere p_type(w . w') L(x, w') dw',
+ * where L(x, w') is everything seen from x along w' but the sun's disk: the single
+ * scattering along the ray, the higher orders along it, the lit ground at its end (a
+ * Lambertian ground of the tables' uniform albedo lit by the sun and by E_sky). Summed over
+ * the orders this is the fixed point J = G(L(J)) (Bruneton & Neyret 2008, Bruneton 2017's
+ * scattering density, summed over orders instead of order by order). It is reached by
+ * iteration from Hillaire's isotropic Psi_ms: iteration 1 gathers the field marched with
+ * Psi_ms (the second order and the last scattering of every order exact in angle, the
+ * orders >= 3 arriving as Psi makes them), iteration n the field marched with J of
+ * iteration n - 1; each iteration shrinks the error of the incoming higher orders by the
+ * share of light scattered again (f_ms, <= 0.3 here).
+ *
+ * Parametrization (sun-centred; J is smooth away from the sun and peaked toward it):
+ *   rows   x_r = sqrt(h / top) (dense near the ground, where the aerosols are);
+ *   mu_s   x = (y + sqrt(0.3)) / (1 + sqrt(0.3)), y = sign(mu_s) sqrt|mu_s| (dense near the
+ *          horizon: twilight), down to mu_s = -0.3 (17.5 degrees down: the sun is below the
+ *          horizon of every point of the air); below, the lowest column times
+ *          e^(-60 (-0.3 - mu_s)), a steep fade standing for the night's darkening;
+ *   gamma  the angle between the view and the sun, gamma = pi (a x + (1 - a) x^2),
+ *          a = 0.3 (nodes 2.8 degrees apart at the sun, 16 at the anti-sun);
+ *   psi    the azimuth of the view about the sun's direction, 0 on the zenith's side,
+ *          x = (1 - cos psi) / 2 (the light is symmetric about the sun's vertical plane).
+ * The gather integrates over the same sun-centred frame: gamma' mapped like gamma from s, by
+ * three 8-point Gauss-Legendre panels in s (the aureole of the incoming single scattering is
+ * resolved, and a view's phase lobe far from the sun still meets nodes 9 degrees apart), psi'
+ * by 16 midpoints over [0, pi], folded (the light is symmetric in psi'). The phase weights of each view node,
+ * normalised so that a uniform field gathers exactly (energy), depend only on the two
+ * grids and are computed once per build. The table holds the logarithm, interpolated
+ * quadrilinearly (JFLOOR below). Threads over (r, mu_s) nodes: the result does not depend on
+ * their number. */
+#include "atmosphere/spherical.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define JR ATMOS__SPH_J_R
+#define JS ATMOS__SPH_J_MUS
+#define JG ATMOS__SPH_J_G
+#define JP ATMOS__SPH_J_P
+#define GA 0.3 /* gamma's linear share */
+#define XS 0.5477225575051661 /* sqrt(0.3): the columns' lowest sun, mu_s = -0.3 */
+#define JFADE 60.0 /* J's decay per unit of mu_s below the lowest column (e^-6 at -0.4) */
+#define QG 24  /* the gather's gamma' nodes */
+#define QP 16  /* its psi' nodes over [0, pi] */
+#define QN (QG * QP)
+#define JV (JG * JP)
+/* The table holds log(j + JFLOOR) and is interpolated in it: in twilight j falls by ~3.6
+ * times per degree of the sun's depression (the sky's irradiance of the ground between
+ * 5.2 and 6.4 degrees below), which linear interpolation over a node spacing of a degree
+ * overestimates by a quarter. */
+#define JFLOOR 1e-20
+
+/* ------------------------------------------------------------------ mappings */
+static double x_to_gamma(double x) { return ATMOS_PI * (GA * x + (1.0 - GA) * x * x); }
+static double gamma_to_x(double g)
+{
+    const double u = atmos__sph_clampd(g / ATMOS_PI, 0.0, 1.0);
+    return (-GA + sqrt(GA * GA + 4.0 * (1.0 - GA) * u)) / (2.0 * (1.0 - GA));
+}
+static double mus_x(double mus)
+{
+    const double x = copysign(sqrt(fabs(atmos__sph_clampd(mus, -1, 1))), mus);
+    return atmos__sph_clampd((x + XS) / (1.0 + XS), 0.0, 1.0);
+}
+static double x_mus(double x)
+{
+    const double y = -XS + (1.0 + XS) * x;
+    return y * fabs(y);
+}
+
+/* The direction of (gamma, psi) about the sun sun = (ss, ms, 0) at a point on the y axis:
+ * cos g sun + sin g (cos psi a + sin psi b), a = (-ms, ss, 0) toward the zenith, b = z. */
+static void sun_dir(double ss, double ms, double g, double psi, double d[3])
+{
+    const double cg = cos(g), sg = sin(g), cp = cos(psi), sp = sin(psi);
+    d[0] = cg * ss - sg * cp * ms;
+    d[1] = cg * ms + sg * cp * ss;
+    d[2] = sg * sp;
+}
+
+/* ------------------------------------------------------------------ look-up */
+void atmos__sph_j_gamma(double nu, atmos__sph_jg *g)
+{
+    const double gm = acos(atmos__sph_clampd(nu, -1.0, 1.0));
+    const double f = gamma_to_x(gm) * (JG - 1);
+    int i = (int)f;
+    if (i > JG - 2) i = JG - 2;
+    g->i = i, g->a = f - i;
+    g->cg = nu, g->sg = sin(gm);
+}
+
+void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, const atmos__sph_jg *g, int cnt,
+                  const int *k, double *jr, double *jm)
+{
+    const int n = m->n;
+    const double xr = sqrt(atmos__sph_clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0)) * (JR - 1);
+    const double xs = mus_x(mus) * (JS - 1);
+    const double den = g->sg * sqrt(fmax(0.0, 1.0 - mus * mus));
+    const double cp = den > 1e-9 ? atmos__sph_clampd((mu - mus * g->cg) / den, -1.0, 1.0) : 1.0;
+    const double xp = 0.5 * (1.0 - cp) * (JP - 1);
+    int ir = (int)xr, is = (int)xs, ip = (int)xp;
+    if (ir > JR - 2) ir = JR - 2;
+    if (is > JS - 2) is = JS - 2;
+    if (ip > JP - 2) ip = JP - 2;
+    const double ar = xr - ir, as = xs - is, ap = xp - ip, ag = g->a;
+    for (int i = 0; i < cnt; i++) jr[i] = jm[i] = 0.0;
+    for (int c = 0; c < 16; c++) {
+        const int br = c & 1, bs = (c >> 1) & 1, bg = (c >> 2) & 1, bp = (c >> 3) & 1;
+        const double w = (br ? ar : 1 - ar) * (bs ? as : 1 - as) * (bg ? ag : 1 - ag) * (bp ? ap : 1 - ap);
+        if (w == 0.0) continue;
+        const size_t node = (((size_t)(ir + br) * JS + is + bs) * JG + g->i + bg) * JP + ip + bp;
+        const float *t = m->jms + node * 2 * (size_t)n;
+        for (int i = 0; i < cnt; i++) {
+            const int kk = ATMOS__WL(k, i);
+            jr[i] += w * t[2 * kk], jm[i] += w * t[2 * kk + 1];
+        }
+    }
+    /* below the lowest column a steep fade, not the column's light: the night side keeps
+     * its darkness (the night lights stay the brightest thing there) */
+    const double fade = mus < -XS * XS ? exp(-JFADE * (-XS * XS - mus)) : 1.0;
+    for (int i = 0; i < cnt; i++) jr[i] = (exp(jr[i]) - JFLOOR) * fade, jm[i] = (exp(jm[i]) - JFLOOR) * fade;
+}
+
+/* ------------------------------------------------------------------ build */
+/* The gather's nodes (gamma', psi', solid angle) and the normalised phase weights
+ * w[k][type][v][q] of view node v and incoming node q (psi' folded with -psi'). */
+typedef struct j_quad {
+    double g[QN], p[QN], dw[QN];
+    float *w; /* [n][2][JV][QN] */
+} j_quad;
+
+static void quad_nodes(j_quad *qd)
+{
+    static const double gx[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+                                 -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
+                                 0.7966664774136267,  0.9602898564975363};
+    static const double gw[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
+                                 0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+    for (int a = 0; a < QG; a++) { /* QG / 8 panels of 8 points in s over [0, 1] */
+        const double s = (0.5 * (1 + gx[a % 8]) + a / 8) / (QG / 8), ws = 0.5 * gw[a % 8] / (QG / 8);
+        const double g = x_to_gamma(s), dg = ATMOS_PI * (GA + 2.0 * (1.0 - GA) * s) * ws;
+        for (int b = 0; b < QP; b++) {
+            const int q = a * QP + b;
+            qd->g[q] = g, qd->p[q] = (b + 0.5) * ATMOS_PI / QP;
+            qd->dw[q] = sin(g) * dg * ATMOS_PI / QP;
+        }
+    }
+}
+
+static void quad_weights(const atmos__planet *pl, j_quad *qd)
+{
+    const int n = pl->n;
+    for (int v = 0; v < JV; v++) {
+        const double gv = x_to_gamma((double)(v / JP) / (JG - 1));
+        const double cpv = 1.0 - 2.0 * (double)(v % JP) / (JP - 1), spv = sqrt(fmax(0.0, 1.0 - cpv * cpv));
+        const double dv[3] = {cos(gv), sin(gv) * cpv, sin(gv) * spv}; /* in (sun, a, b) */
+        for (int k = 0; k < n; k++) {
+            double sum[2] = {0, 0};
+            float *wr = qd->w + (((size_t)k * 2 + 0) * JV + v) * QN, *wm = wr + (size_t)JV * QN;
+            for (int q = 0; q < QN; q++) {
+                const double cg = cos(qd->g[q]), sg = sin(qd->g[q]), cp = cos(qd->p[q]), sp = sin(qd->p[q]);
+                const double c1 = dv[0] * cg + dv[1] * sg * cp + dv[2] * sg * sp;
+                const double c2 = dv[0] * cg + dv[1] * sg * cp - dv[2] * sg * sp;
+                const double pr = atmos__planet_rayleigh_phase(pl, k, c1) + atmos__planet_rayleigh_phase(pl, k, c2);
+                const double pm = atmos__planet_mie_phase(pl, k, c1) + atmos__planet_mie_phase(pl, k, c2);
+                wr[q] = (float)(pr * qd->dw[q]), wm[q] = (float)(pm * qd->dw[q]);
+                sum[0] += wr[q], sum[1] += wm[q];
+            }
+            for (int q = 0; q < QN; q++) {
+                wr[q] = (float)(wr[q] / sum[0]);
+                wm[q] = (float)(wm[q] / sum[1]);
+            }
+        }
+    }
+}
+
+/* The light seen from (0, r, 0) along d without the sun's disk, per unit irradiance. */
+static void incoming(const atmos__planet *pl, const atmos__sph_model *m, double r, const double d[3],
+                     const double sun[3], const double *albedo, double *L)
+{
+    const int n = m->n;
+    const double q[3] = {0, r, 0}, mu = d[1];
+    const double dg = atmos__planet_dist_ground(pl, r, mu);
+    const double t1 = dg < INFINITY ? dg : atmos__planet_dist_top(pl, r, mu);
+    atmos__sph_sums s;
+    atmos__sph_march(pl, m, q, d, 0.0, t1, sun, ATMOS__SPH_STEPS_TABLE, 1, n, NULL, &s);
+    const double nu = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2];
+    double G[ATMOS_MAX_WAVELENGTHS] = {0};
+    if (dg < INFINITY) {
+        const double g[3] = {t1 * d[0], r + t1 * d[1], t1 * d[2]};
+        const double cs = (g[0] * sun[0] + g[1] * sun[1]) / sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        double ts[ATMOS_MAX_WAVELENGTHS], es[ATMOS_MAX_WAVELENGTHS];
+        atmos__sph_sun_t(m, m->R, cs, n, NULL, ts);
+        atmos__sph_esky(m, cs, n, NULL, es);
+        for (int k = 0; k < n; k++) G[k] = albedo[k] / ATMOS_PI * ((cs > 0 ? cs * ts[k] : 0.0) + es[k]);
+    }
+    for (int k = 0; k < n; k++)
+        L[k] = atmos__planet_rayleigh_phase(pl, k, nu) * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k] +
+               s.ms[k] + s.t[k] * G[k];
+}
+
+static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_quad *qd, int ir, int is,
+                  const double *albedo, float *out)
+{
+    const int n = m->n;
+    const double x = (double)ir / (JR - 1), r = m->R + (m->Rt - m->R) * x * x;
+    const double ms = x_mus((double)is / (JS - 1)), ss = sqrt(fmax(0.0, 1.0 - ms * ms));
+    const double sun[3] = {ss, ms, 0};
+    double *L = malloc(sizeof(double) * QN * (size_t)n);
+    if (!L) return 1;
+    for (int q = 0; q < QN; q++) {
+        double d[3];
+        sun_dir(ss, ms, qd->g[q], qd->p[q], d);
+        incoming(pl, m, r, d, sun, albedo, L + (size_t)q * n);
+    }
+    for (int v = 0; v < JV; v++)
+        for (int k = 0; k < n; k++) {
+            const float *wr = qd->w + (((size_t)k * 2 + 0) * JV + v) * QN, *wm = wr + (size_t)JV * QN;
+            double a = 0.0, b = 0.0;
+            for (int q = 0; q < QN; q++) {
+                const double l = L[(size_t)q * n + k];
+                a += wr[q] * l, b += wm[q] * l;
+            }
+            out[((size_t)v * n + k) * 2] = (float)log(a + JFLOOR);
+            out[((size_t)v * n + k) * 2 + 1] = (float)log(b + JFLOOR);
+        }
+    free(L);
+    return 0;
+}
+
+atmos_status atmos__sph_build_j(const atmos__planet *pl, atmos__sph_model *m, const double *albedo)
+{
+    const int n = m->n;
+    const size_t per = (size_t)JV * 2 * n, total = (size_t)JR * JS * per;
+    j_quad qd;
+    quad_nodes(&qd);
+    qd.w = malloc(sizeof(float) * (size_t)n * 2 * JV * QN);
+    float *next = malloc(sizeof(float) * total);
+    if (!qd.w || !next) {
+        free(qd.w), free(next);
+        return ATMOS_E_NOMEM;
+    }
+    quad_weights(pl, &qd);
+    int fail = 0;
+#pragma omp parallel for schedule(dynamic) reduction(| : fail)
+    for (int e = 0; e < JR * JS; e++) fail |= j_node(pl, m, &qd, e / JS, e % JS, albedo, next + (size_t)e * per);
+    if (!fail) memcpy(m->jms, next, sizeof(float) * total);
+    m->use_j = !fail;
+    free(qd.w), free(next);
+    return fail ? ATMOS_E_NOMEM : ATMOS_OK;
+}
