@@ -30,7 +30,7 @@ int atmos__aerial_wanted(const atmos_atmosphere *a) { return a->solver != NULL; 
 /* Node count along one axis of the frustum: the spread of the rays' vertical component
  * (dy) and of their direction (angle, radians) across it, at 9 points along the axis for each
  * of 3 lines across the other axis. */
-static int axis_nodes(const atmos__aerial_grid *g, const double vert[3], int along_u)
+static int axis_nodes(const atmos__aerial_grid *g, const double vert[3], int along_u, double across_m)
 {
     double dy = 0, ang = 0;
     for (int l = 0; l < 3; l++) {
@@ -50,7 +50,7 @@ static int axis_nodes(const atmos__aerial_grid *g, const double vert[3], int alo
         ang = fmax(ang, acos(fmin(1.0, fmax(-1.0, atmos__dot3(first, last)))));
     }
     const double n = fmax(ceil(dy * g->tmax / ATMOS__AERIAL_NODE_SPACING_M),
-                          ceil(ang * g->tmax / ATMOS__AERIAL_NODE_SPACING_ACROSS_M)) + 1;
+                          ceil(ang * g->tmax / across_m)) + 1;
     return n < ATMOS__AERIAL_MIN_NODES ? ATMOS__AERIAL_MIN_NODES
                                        : (n > ATMOS__AERIAL_MAX_NODES ? ATMOS__AERIAL_MAX_NODES : (int)n);
 }
@@ -63,8 +63,13 @@ void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g)
         vert[1] += a->planet->r_ground;
         atmos__normalize3(vert);
     }
-    g->nu = axis_nodes(g, vert, 1);
-    g->nv = axis_nodes(g, vert, 0);
+    /* a low sun: the light of the higher orders changes fast across the view (the twilight
+     * sky's light falls off steeply away from the sun's azimuth), so the nodes across halve */
+    const double sun_el = atmos__dot3(g->sun, vert);
+    const double across = sun_el < ATMOS__AERIAL_LOW_SUN ? 0.5 * ATMOS__AERIAL_NODE_SPACING_ACROSS_M
+                                                         : ATMOS__AERIAL_NODE_SPACING_ACROSS_M;
+    g->nu = axis_nodes(g, vert, 1, across);
+    g->nv = axis_nodes(g, vert, 0, across);
     /* many wavelengths: fewer nodes, so that the table stays within its budget */
     const double per_node = (double)g->nd * a->wl.count * 4 * sizeof(float);
     const double f = sqrt(ATMOS__AERIAL_MAX_BYTES / (per_node * g->nu * g->nv));

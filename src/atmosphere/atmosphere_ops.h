@@ -106,10 +106,14 @@ typedef struct atmos__aerial {
  * (what changes across the view at one height: the sun's angle over the curved ground, the
  * ground's distance); between ATMOS__AERIAL_MIN_NODES and _MAX_NODES per axis, and fewer
  * (both axes scaled alike) where the table would pass ATMOS__AERIAL_MAX_BYTES (many
- * wavelengths). test_aerial measures the error this leaves (< 1 % at rgb). */
+ * wavelengths); with the sun below ATMOS__AERIAL_LOW_SUN at the far end's vertical the spacing
+ * across halves (the higher orders' light changes fastest across a twilight view). test_aerial
+ * measures the error this leaves (< 1 % at rgb). */
 #define ATMOS__AERIAL_MAX_BYTES (48.0 * 1024 * 1024)
 #define ATMOS__AERIAL_NODE_SPACING_M 300.0
 #define ATMOS__AERIAL_NODE_SPACING_ACROSS_M 3000.0
+/* the sine of the sun's elevation below which the nodes across are twice as dense (5 degrees) */
+#define ATMOS__AERIAL_LOW_SUN 0.0872
 #define ATMOS__AERIAL_MIN_NODES 4
 #define ATMOS__AERIAL_MAX_NODES 64
 void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g);

@@ -1,5 +1,5 @@
 /* The production sky's ray march (spherical.h): single scattering with the sunlight's
- * transmittance from the tau table, the higher orders from Psi_ms, the view transmittance
+ * transmittance from the tau table, the higher orders from J_ms (or Psi_ms), the view transmittance
  * accumulated step by step; the lit ground; the radiance of a view ray.
  *
  * Steps: each segment is split at its lowest point (closest to the planet's centre) into
@@ -133,6 +133,8 @@ void atmos__sph_march_cumulative(const atmos__planet *pl, const atmos__sph_model
     atmos__sph_sums s;
     memset(&s, 0, sizeof s);
     for (int i = 0; i < cnt; i++) tr[i] = 1.0;
+    atmos__sph_jg jg = {0, 0.0, 1.0, 0.0};
+    if (use_ms && m->use_j) atmos__sph_j_gamma(atmos__dot3(d, sun), &jg);
     double a = t0;
     const double tc = -atmos__dot3(q, d); /* the ray's lowest point */
     for (int j = 0; j < nd; j++) {
@@ -148,7 +150,7 @@ void atmos__sph_march_cumulative(const atmos__planet *pl, const atmos__sph_model
             const int n = steps > (int)ceil(climb / SPH_CUMULATIVE_CLIMB_M) ? steps : (int)ceil(climb / SPH_CUMULATIVE_CLIMB_M);
             const double w = (b - a) / n;
             for (int st = 0; st < n; st++)
-                sample_point(pl, m, q, d, a + (st + 0.5) * w, w, sun, use_ms, cnt, k, tr, &s);
+                sample_point(pl, m, q, d, a + (st + 0.5) * w, w, sun, &jg, use_ms, cnt, k, tr, &s);
             a = b;
         }
         double *o = out + (size_t)j * cnt * 4;
