@@ -137,17 +137,6 @@ static const struct {
 } aerial_models[] = {{"riley", ATMOS_ATMOSPHERE_RILEY}, {"dobashi", ATMOS_ATMOSPHERE_DOBASHI},
                      {"spherical", ATMOS_ATMOSPHERE_SPHERICAL}};
 
-static int in_list(const char *list, const char *name)
-{
-    const size_t n = strlen(name);
-    for (const char *t = list; *t; t += *t == ',') {
-        const size_t len = strcspn(t, ",");
-        if (len == n && !strncmp(t, name, n)) return 1;
-        t += len;
-    }
-    return 0;
-}
-
 static atmos_status aerial_run(atmos_plan *plan, const atmos_frame *start, int mode, int frames, atmos_image *img,
                                double ms[4])
 {
@@ -213,7 +202,7 @@ int bench_slice_aerial(atmos_context *ctx, const char *name, atmos_volume *v, in
                        double density_scale, int json)
 {
     for (size_t m = 0; m < sizeof aerial_models / sizeof aerial_models[0]; m++) {
-        if (!in_list(models ? models : "riley,spherical", aerial_models[m].name)) continue;
+        if (!cli_list_has(models ? models : "riley,spherical", aerial_models[m].name)) continue;
         atmos_scene scene;
         atmos_plan *plan = NULL;
         atmos_image *img = NULL;

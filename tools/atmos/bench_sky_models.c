@@ -135,17 +135,6 @@ static atmos_status bench_view(atmos_context *ctx, const char *name, atmos_atmos
     return ATMOS_OK;
 }
 
-static int list_has(const char *list, const char *name)
-{
-    const size_t n = strlen(name);
-    for (const char *t = list; *t; t += *t == ',') {
-        const size_t len = strcspn(t, ",");
-        if (len == n && !strncmp(t, name, n)) return 1;
-        t += len;
-    }
-    return 0;
-}
-
 int bench_sky_models(int threads, int repeat, double budget_s, const char *models)
 {
     const char *tmp = getenv("TMPDIR");
@@ -160,7 +149,7 @@ int bench_sky_models(int threads, int repeat, double budget_s, const char *model
     if (atmos_context_create(&cd, &ctx) != ATMOS_OK) return CLI_EXIT_RUNTIME;
     atmos_status st = ATMOS_OK;
     for (size_t m = 0; m < sizeof kinds / sizeof kinds[0] && st == ATMOS_OK; m++) {
-        if (models && !list_has(models, kinds[m].name)) continue;
+        if (models && !cli_list_has(models, kinds[m].name)) continue;
         double cold = 0, cached = 0;
         st = bench_precompute(ctx, kinds[m].kind, &cold, &cached);
         if (st != ATMOS_OK) break;

@@ -161,3 +161,14 @@ int cli_take_value(int argc, char **argv, int *i, const char *name, const char *
     *value = *i + 1 < argc ? argv[++*i] : NULL;
     return 1;
 }
+
+int cli_list_has(const char *list, const char *name)
+{
+    const size_t n = strlen(name);
+    for (const char *t = list; *t; t += *t == ',') {
+        const size_t len = strcspn(t, ",");
+        if (len == n && !strncmp(t, name, n)) return 1;
+        t += len;
+    }
+    return 0;
+}

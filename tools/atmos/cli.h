@@ -46,6 +46,8 @@ double cli_now_s(void);
  * that option (advancing *i past a separate value) with *value set (NULL when the value
  * is missing), else 0. */
 int cli_take_value(int argc, char **argv, int *i, const char *name, const char **value);
+/* 1 when name is one of the comma-separated names of list. */
+int cli_list_has(const char *list, const char *name);
 /* Prints a JSON array of n doubles (%.9g) to stdout. */
 void cli_print_json_array(const double *v, int n);
 
