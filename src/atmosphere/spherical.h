@@ -27,6 +27,13 @@
 #define ATMOS__SPH_J_G 20
 #define ATMOS__SPH_J_P 10
 #define ATMOS__SPH_J_ITER 2
+/* gamma's linear share in its mapping gamma = pi (a x + (1 - a) x^2) */
+#define ATMOS__SPH_J_GA 0.3
+/* The table holds log(j + ATMOS__SPH_J_FLOOR) and is interpolated in it: in twilight j falls by ~3.6
+ * times per degree of the sun's depression (the sky's irradiance of the ground between
+ * 5.2 and 6.4 degrees below), which linear interpolation over a node spacing of a degree
+ * overestimates by a quarter. */
+#define ATMOS__SPH_J_FLOOR 1e-20
 /* Steps of the march per monotone piece of a ray (the piece going down to the ray's lowest
  * point and the piece rising from it): the one-ray answers and the tables. */
 #define ATMOS__SPH_STEPS 40
@@ -93,6 +100,10 @@ typedef struct atmos__sph_jg {
     double a, cg, sg;
 } atmos__sph_jg;
 void atmos__sph_j_gamma(double nu, atmos__sph_jg *g);
+/* J_ms's coordinate mappings (spherical_jlookup.c): gamma of a column coordinate in [0, 1],
+ * mu_s of a sun-column coordinate in [0, 1]. */
+double atmos__sph_j_x_to_gamma(double x);
+double atmos__sph_j_x_mus(double x);
 void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, const atmos__sph_jg *g, int cnt,
                   const int *k, double *jr, double *jm);
 /* Builds jms by one fixed-point iteration over the field marched with the current higher

@@ -33,8 +33,9 @@
  * by 16 midpoints over [0, pi], folded (the light is symmetric in psi'). The phase weights of each view node,
  * normalised so that a uniform field gathers exactly (energy), depend only on the two
  * grids and are computed once per build. The table holds the logarithm, interpolated
- * quadrilinearly (JFLOOR below). Threads over (r, mu_s) nodes: the result does not depend on
- * their number. */
+ * quadrilinearly (ATMOS__SPH_J_FLOOR; the look-up and the mappings are in
+ * spherical_jlookup.c). Threads over (r, mu_s) nodes: the result does not depend on their
+ * number. */
 #include "atmosphere/spherical.h"
 
 #include <math.h>
@@ -45,37 +46,14 @@
 #define JS ATMOS__SPH_J_MUS
 #define JG ATMOS__SPH_J_G
 #define JP ATMOS__SPH_J_P
-#define GA 0.3 /* gamma's linear share */
-#define XS 0.5477225575051661 /* sqrt(0.3): the columns' lowest sun, mu_s = -0.3 */
-#define JFADE 60.0 /* J's decay per unit of mu_s below the lowest column (e^-6 at -0.4) */
+#define GA ATMOS__SPH_J_GA
 #define QG 24  /* the gather's gamma' nodes */
 #define QP 16  /* its psi' nodes over [0, pi] */
 #define QN (QG * QP)
 #define JV (JG * JP)
-/* The table holds log(j + JFLOOR) and is interpolated in it: in twilight j falls by ~3.6
- * times per degree of the sun's depression (the sky's irradiance of the ground between
- * 5.2 and 6.4 degrees below), which linear interpolation over a node spacing of a degree
- * overestimates by a quarter. */
-#define JFLOOR 1e-20
+#define JFLOOR ATMOS__SPH_J_FLOOR
 
-/* ------------------------------------------------------------------ mappings */
-static double x_to_gamma(double x) { return ATMOS_PI * (GA * x + (1.0 - GA) * x * x); }
-static double gamma_to_x(double g)
-{
-    const double u = atmos__sph_clampd(g / ATMOS_PI, 0.0, 1.0);
-    return (-GA + sqrt(GA * GA + 4.0 * (1.0 - GA) * u)) / (2.0 * (1.0 - GA));
-}
-static double mus_x(double mus)
-{
-    const double x = copysign(sqrt(fabs(atmos__sph_clampd(mus, -1, 1))), mus);
-    return atmos__sph_clampd((x + XS) / (1.0 + XS), 0.0, 1.0);
-}
-static double x_mus(double x)
-{
-    const double y = -XS + (1.0 + XS) * x;
-    return y * fabs(y);
-}
-
+/* ------------------------------------------------------------------ the gather's frame */
 /* The direction of (gamma, psi) about the sun sun = (ss, ms, 0) at a point on the y axis:
  * cos g sun + sin g (cos psi a + sin psi b), a = (-ms, ss, 0) toward the zenith, b = z. */
 static void sun_dir(double ss, double ms, double g, double psi, double d[3])
@@ -84,49 +62,6 @@ static void sun_dir(double ss, double ms, double g, double psi, double d[3])
     d[0] = cg * ss - sg * cp * ms;
     d[1] = cg * ms + sg * cp * ss;
     d[2] = sg * sp;
-}
-
-/* ------------------------------------------------------------------ look-up */
-void atmos__sph_j_gamma(double nu, atmos__sph_jg *g)
-{
-    const double gm = acos(atmos__sph_clampd(nu, -1.0, 1.0));
-    const double f = gamma_to_x(gm) * (JG - 1);
-    int i = (int)f;
-    if (i > JG - 2) i = JG - 2;
-    g->i = i, g->a = f - i;
-    g->cg = nu, g->sg = sin(gm);
-}
-
-void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, const atmos__sph_jg *g, int cnt,
-                  const int *k, double *jr, double *jm)
-{
-    const int n = m->n;
-    const double xr = sqrt(atmos__sph_clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0)) * (JR - 1);
-    const double xs = mus_x(mus) * (JS - 1);
-    const double den = g->sg * sqrt(fmax(0.0, 1.0 - mus * mus));
-    const double cp = den > 1e-9 ? atmos__sph_clampd((mu - mus * g->cg) / den, -1.0, 1.0) : 1.0;
-    const double xp = 0.5 * (1.0 - cp) * (JP - 1);
-    int ir = (int)xr, is = (int)xs, ip = (int)xp;
-    if (ir > JR - 2) ir = JR - 2;
-    if (is > JS - 2) is = JS - 2;
-    if (ip > JP - 2) ip = JP - 2;
-    const double ar = xr - ir, as = xs - is, ap = xp - ip, ag = g->a;
-    for (int i = 0; i < cnt; i++) jr[i] = jm[i] = 0.0;
-    for (int c = 0; c < 16; c++) {
-        const int br = c & 1, bs = (c >> 1) & 1, bg = (c >> 2) & 1, bp = (c >> 3) & 1;
-        const double w = (br ? ar : 1 - ar) * (bs ? as : 1 - as) * (bg ? ag : 1 - ag) * (bp ? ap : 1 - ap);
-        if (w == 0.0) continue;
-        const size_t node = (((size_t)(ir + br) * JS + is + bs) * JG + g->i + bg) * JP + ip + bp;
-        const float *t = m->jms + node * 2 * (size_t)n;
-        for (int i = 0; i < cnt; i++) {
-            const int kk = ATMOS__WL(k, i);
-            jr[i] += w * t[2 * kk], jm[i] += w * t[2 * kk + 1];
-        }
-    }
-    /* below the lowest column a steep fade, not the column's light: the night side keeps
-     * its darkness (the night lights stay the brightest thing there) */
-    const double fade = mus < -XS * XS ? exp(-JFADE * (-XS * XS - mus)) : 1.0;
-    for (int i = 0; i < cnt; i++) jr[i] = (exp(jr[i]) - JFLOOR) * fade, jm[i] = (exp(jm[i]) - JFLOOR) * fade;
 }
 
 /* ------------------------------------------------------------------ build */
@@ -146,7 +81,7 @@ static void quad_nodes(j_quad *qd)
                                  0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
     for (int a = 0; a < QG; a++) { /* QG / 8 panels of 8 points in s over [0, 1] */
         const double s = (0.5 * (1 + gx[a % 8]) + a / 8) / (QG / 8), ws = 0.5 * gw[a % 8] / (QG / 8);
-        const double g = x_to_gamma(s), dg = ATMOS_PI * (GA + 2.0 * (1.0 - GA) * s) * ws;
+        const double g = atmos__sph_j_x_to_gamma(s), dg = ATMOS_PI * (GA + 2.0 * (1.0 - GA) * s) * ws;
         for (int b = 0; b < QP; b++) {
             const int q = a * QP + b;
             qd->g[q] = g, qd->p[q] = (b + 0.5) * ATMOS_PI / QP;
@@ -159,7 +94,7 @@ static void quad_weights(const atmos__planet *pl, j_quad *qd)
 {
     const int n = pl->n;
     for (int v = 0; v < JV; v++) {
-        const double gv = x_to_gamma((double)(v / JP) / (JG - 1));
+        const double gv = atmos__sph_j_x_to_gamma((double)(v / JP) / (JG - 1));
         const double cpv = 1.0 - 2.0 * (double)(v % JP) / (JP - 1), spv = sqrt(fmax(0.0, 1.0 - cpv * cpv));
         const double dv[3] = {cos(gv), sin(gv) * cpv, sin(gv) * spv}; /* in (sun, a, b) */
         for (int k = 0; k < n; k++) {
@@ -212,7 +147,7 @@ static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_qu
 {
     const int n = m->n;
     const double x = (double)ir / (JR - 1), r = m->R + (m->Rt - m->R) * x * x;
-    const double ms = x_mus((double)is / (JS - 1)), ss = sqrt(fmax(0.0, 1.0 - ms * ms));
+    const double ms = atmos__sph_j_x_mus((double)is / (JS - 1)), ss = sqrt(fmax(0.0, 1.0 - ms * ms));
     const double sun[3] = {ss, ms, 0};
     double *L = malloc(sizeof(double) * QN * (size_t)n);
     if (!L) return 1;

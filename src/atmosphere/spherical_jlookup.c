@@ -1,0 +1,78 @@
+/* The look-up of the production sky's scattering density of the higher orders J_ms
+ * (spherical.h; built by spherical_ms.c, whose header states the parametrization): the
+ * mappings of its coordinates, and the quadrilinear interpolation of its logarithm that the
+ * march reads at every step. */
+#include "atmosphere/spherical.h"
+
+#include <math.h>
+
+#define JR ATMOS__SPH_J_R
+#define JS ATMOS__SPH_J_MUS
+#define JG ATMOS__SPH_J_G
+#define JP ATMOS__SPH_J_P
+#define GA ATMOS__SPH_J_GA
+#define XS 0.5477225575051661 /* sqrt(0.3): the columns' lowest sun, mu_s = -0.3 */
+#define JFADE 60.0 /* J's decay per unit of mu_s below the lowest column (e^-6 at -0.4) */
+#define JFLOOR ATMOS__SPH_J_FLOOR
+
+/* ------------------------------------------------------------------ mappings */
+double atmos__sph_j_x_to_gamma(double x) { return ATMOS_PI * (GA * x + (1.0 - GA) * x * x); }
+static double gamma_to_x(double g)
+{
+    const double u = atmos__sph_clampd(g / ATMOS_PI, 0.0, 1.0);
+    return (-GA + sqrt(GA * GA + 4.0 * (1.0 - GA) * u)) / (2.0 * (1.0 - GA));
+}
+static double mus_x(double mus)
+{
+    const double x = copysign(sqrt(fabs(atmos__sph_clampd(mus, -1, 1))), mus);
+    return atmos__sph_clampd((x + XS) / (1.0 + XS), 0.0, 1.0);
+}
+double atmos__sph_j_x_mus(double x)
+{
+    const double y = -XS + (1.0 + XS) * x;
+    return y * fabs(y);
+}
+
+/* ------------------------------------------------------------------ look-up */
+void atmos__sph_j_gamma(double nu, atmos__sph_jg *g)
+{
+    const double gm = acos(atmos__sph_clampd(nu, -1.0, 1.0));
+    const double f = gamma_to_x(gm) * (JG - 1);
+    int i = (int)f;
+    if (i > JG - 2) i = JG - 2;
+    g->i = i, g->a = f - i;
+    g->cg = nu, g->sg = sin(gm);
+}
+
+void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, const atmos__sph_jg *g, int cnt,
+                  const int *k, double *jr, double *jm)
+{
+    const int n = m->n;
+    const double xr = sqrt(atmos__sph_clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0)) * (JR - 1);
+    const double xs = mus_x(mus) * (JS - 1);
+    const double den = g->sg * sqrt(fmax(0.0, 1.0 - mus * mus));
+    const double cp = den > 1e-9 ? atmos__sph_clampd((mu - mus * g->cg) / den, -1.0, 1.0) : 1.0;
+    const double xp = 0.5 * (1.0 - cp) * (JP - 1);
+    int ir = (int)xr, is = (int)xs, ip = (int)xp;
+    if (ir > JR - 2) ir = JR - 2;
+    if (is > JS - 2) is = JS - 2;
+    if (ip > JP - 2) ip = JP - 2;
+    const double ar = xr - ir, as = xs - is, ap = xp - ip, ag = g->a;
+    for (int i = 0; i < cnt; i++) jr[i] = jm[i] = 0.0;
+    for (int c = 0; c < 16; c++) {
+        const int br = c & 1, bs = (c >> 1) & 1, bg = (c >> 2) & 1, bp = (c >> 3) & 1;
+        const double w = (br ? ar : 1 - ar) * (bs ? as : 1 - as) * (bg ? ag : 1 - ag) * (bp ? ap : 1 - ap);
+        if (w == 0.0) continue;
+        const size_t node = (((size_t)(ir + br) * JS + is + bs) * JG + g->i + bg) * JP + ip + bp;
+        const float *t = m->jms + node * 2 * (size_t)n;
+        for (int i = 0; i < cnt; i++) {
+            const int kk = ATMOS__WL(k, i);
+            jr[i] += w * t[2 * kk], jm[i] += w * t[2 * kk + 1];
+        }
+    }
+    /* below the lowest column a steep fade, not the column's light: the night side keeps
+     * its darkness (the night lights stay the brightest thing there) */
+    const double fade = mus < -XS * XS ? exp(-JFADE * (-XS * XS - mus)) : 1.0;
+    for (int i = 0; i < cnt; i++) jr[i] = (exp(jr[i]) - JFLOOR) * fade, jm[i] = (exp(jm[i]) - JFLOOR) * fade;
+}
+
