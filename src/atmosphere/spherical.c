@@ -7,6 +7,7 @@
 #include "core/cache.h"
 #include "core/vec.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -156,7 +157,31 @@ static void sph_radiance(const atmos_atmosphere *a, const double p[3], const dou
 /* The tables as images (atmos_atmosphere_table): rows and columns as spherical_lookup.c
  * maps them. */
 static const char *const sph_table_names[] = {"transmittance", "multiple_scattering", "f_ms", "sky_irradiance",
-                                              NULL};
+                                              "higher_orders_air", "higher_orders_aerosols", NULL};
+
+/* An image of J_ms's part (0 air molecules, 1 aerosols): x over (gamma, psi) with psi
+ * fastest, y over (altitude row, sun column) with the sun column fastest; the table's
+ * logarithms turned back into values. */
+static atmos_status j_table(atmos_context *ctx, const atmos__sph_model *m, int part, const char *name,
+                            atmos_image **out)
+{
+    const int n = m->n, w = ATMOS__SPH_J_G * ATMOS__SPH_J_P, h = ATMOS__SPH_J_R * ATMOS__SPH_J_MUS;
+    if (!m->use_j) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmosphere table '%s': not built", name);
+    float *v = malloc(sizeof(float) * (size_t)w * h * n);
+    if (!v) return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere table '%s': out of memory", name);
+    for (size_t e = 0; e < (size_t)w * h; e++)
+        for (int k = 0; k < n; k++)
+            v[(size_t)k * w * h + e] = (float)(exp(m->jms[(e * n + k) * 2 + part]) - ATMOS__SPH_J_FLOOR);
+    const atmos_status st = atmos__planet_table_image(
+        ctx, v, w, h, n, 1, (size_t)w, (size_t)w * h, 0, name,
+        "x: gamma node * J_P + psi node (gamma, the angle from the sun, = pi (0.3 u + 0.7 u^2), u = node / "
+        "(J_G - 1); psi, the azimuth about the sun, (1 - cos psi) / 2 = node / (J_P - 1)); y: altitude row * "
+        "J_MUS + sun column (rows sqrt(altitude / top); columns y|y|, y in [-sqrt 0.3, 1]); "
+        "sr^-1 per unit irradiance and scattering coefficient",
+        out);
+    free(v);
+    return st;
+}
 
 static atmos_status sph_table(atmos_context *ctx, const atmos_atmosphere *a, int i, atmos_image **out)
 {
@@ -175,6 +200,9 @@ static atmos_status sph_table(atmos_context *ctx, const atmos_atmosphere *a, int
                                          ATMOS__SPH_M_MU, (size_t)ATMOS__SPH_M_R * ATMOS__SPH_M_MU, 0,
                                          sph_table_names[i],
                                          "x: mu_s = x'|x'|, x' in [-1, 1]; y: sqrt(altitude / top)", out);
+    case 4:
+    case 5:
+        return j_table(ctx, m, i - 4, sph_table_names[i], out);
     default:
         return atmos__planet_table_image(ctx, m->esky, ATMOS__SPH_E_MU, 1, n, 1, 0, ATMOS__SPH_E_MU, 0,
                                          sph_table_names[i], "x: mu_s = x'|x'|, x' in [-1, 1] (the ground)", out);
