@@ -125,11 +125,7 @@ static int mie_table(atmos__aerial *ap, const atmos_atmosphere *a)
     float *m = realloc(ap->mie, sizeof(float) * (size_t)a->wl.count * AP_NPH);
     if (!m) return 0;
     ap->mie = m;
-    for (int k = 0; k < a->wl.count; k++)
-        for (int j = 0; j < AP_NPH; j++) {
-            const double x = (double)j / (AP_NPH - 1);
-            m[k * AP_NPH + j] = (float)atmos__planet_mie_phase(a->planet, k, 1.0 - 2.0 * x * x);
-        }
+    atmos__planet_mie_phase_table(a->planet, a->wl.count, AP_NPH, m);
     ap->mie_atm = a;
     return 1;
 }

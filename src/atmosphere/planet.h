@@ -77,10 +77,21 @@ static inline double atmos__planet_rayleigh_phase(const atmos__planet *pl, int k
     const double g = pl->rayleigh_gamma[k];
     return 3.0 / (16.0 * ATMOS_PI) * (1.0 + 3.0 * g + (1.0 - g) * cos_theta * cos_theta) / (1.0 + 2.0 * g);
 }
+/* The same as kr (a + b cos^2), kr = 3 / (16 pi): the coefficients a and b of wavelength k
+ * (for loops that apply it to many rays). */
+static inline void atmos__planet_rayleigh_ab(const atmos__planet *pl, int k, float *a, float *b)
+{
+    const double g = pl->rayleigh_gamma[k];
+    *a = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
+    *b = (float)((1.0 - g) / (1.0 + 2.0 * g));
+}
 /* The aerosols' phase function (sr^-1) at cos_theta for wavelength k: P sin(theta)
  * interpolated linearly in theta between the table's angles, over sin(theta); it integrates
  * to one over the sphere. */
 double atmos__planet_mie_phase(const atmos__planet *pl, int k, double cos_theta);
+/* That phase function tabulated for look-ups: out[k * steps + j] at sin(theta / 2) =
+ * j / (steps - 1), for the n wavelengths (steps >= 2). */
+void atmos__planet_mie_phase_table(const atmos__planet *pl, int n, int steps, float *out);
 /* A cos_theta drawn from exactly that density with the uniform number u (pdf = eval). */
 double atmos__planet_mie_sample(const atmos__planet *pl, int k, double u);
 /* The mixture at altitude h: (rayleigh_sca * P_R + mie_sca * P_M) / (rayleigh_sca + mie_sca). */

@@ -63,3 +63,12 @@ double atmos__planet_phase(const atmos__planet *pl, double h, int k, double cos_
     if (!(r + m > 0)) return pr;
     return (r * pr + m * atmos__planet_mie_phase(pl, k, cos_theta)) / (r + m);
 }
+
+void atmos__planet_mie_phase_table(const atmos__planet *pl, int n, int steps, float *out)
+{
+    for (int k = 0; k < n; k++)
+        for (int j = 0; j < steps; j++) {
+            const double x = (double)j / (steps - 1);
+            out[(size_t)k * steps + j] = (float)atmos__planet_mie_phase(pl, k, 1.0 - 2.0 * x * x);
+        }
+}

@@ -134,6 +134,10 @@ void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const 
 void atmos__sph_march_cumulative(const atmos__planet *pl, const atmos__sph_model *m, const double q[3],
                                  const double d[3], double t0, double t1, int nd, const double *tj,
                                  const double sun[3], int steps, int use_ms, int cnt, const int *k, double *out);
+/* The ground's irradiance per unit solar irradiance with the sun at cosine cs there:
+ * cs T_sun (lit side only) + E_sky. */
+void atmos__sph_ground_irradiance(const atmos__planet *pl, const atmos__sph_model *m, double cs, int cnt,
+                                  const int *k, double *out);
 /* Radiance per unit irradiance reflected by the ground point g (centre frame, on the
  * sphere) lit by the sun and the sky, plus its emission divided by the irradiance. */
 void atmos__sph_ground(const atmos__planet *pl, const atmos__sph_model *m, const double g[3], const double sun[3],

@@ -118,11 +118,7 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
         return;
     }
     s->mie = s->tab + (size_t)s->n * 3 * PLANE;
-    for (int k = 0; k < s->n; k++)
-        for (int j = 0; j < NPH; j++) {
-            const double x = (double)j / (NPH - 1);
-            s->mie[k * NPH + j] = (float)atmos__planet_mie_phase(pl, k, 1.0 - 2.0 * x * x);
-        }
+    atmos__planet_mie_phase_table(pl, s->n, NPH, s->mie);
 #pragma omp parallel for schedule(dynamic)
     for (int e = 0; e < 2 * NV * NA; e++) fill_node(a, s, b->eye, b->sun, e / NA, e % NA);
 }
@@ -244,11 +240,7 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
     }
     /* the air's depolarized Rayleigh phase function (planet.h): kr (ra + rb nu^2) */
     float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS];
-    for (int k = 0; k < s->n; k++) {
-        const double g = b->atm->planet->rayleigh_gamma[k];
-        ra[k] = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
-        rb[k] = (float)((1.0 - g) / (1.0 + 2.0 * g));
-    }
+    for (int k = 0; k < s->n; k++) atmos__planet_rayleigh_ab(b->atm->planet, k, &ra[k], &rb[k]);
     for (int i0 = 0; i0 < count; i0 += BLK)
         eval_block(s, ra, rb, i0, count - i0 < BLK ? count - i0 : BLK, count, dx, dy, dz, weight, out);
 }

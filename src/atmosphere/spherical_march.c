@@ -72,20 +72,26 @@ void atmos__sph_march(const atmos__planet *pl, const atmos__sph_model *m, const 
     for (int i = 0; i < cnt; i++) s->t[i] = tr[i];
 }
 
+void atmos__sph_ground_irradiance(const atmos__planet *pl, const atmos__sph_model *m, double cs, int cnt,
+                                  const int *k, double *out)
+{
+    double ts[ATMOS_MAX_WAVELENGTHS];
+    atmos__sph_sun_t(m, pl->r_ground, cs, cnt, k, ts);
+    atmos__sph_esky(m, cs, cnt, k, out);
+    for (int i = 0; i < cnt; i++) out[i] += cs > 0 ? cs * ts[i] : 0.0;
+}
+
 void atmos__sph_ground(const atmos__planet *pl, const atmos__sph_model *m, const double g[3], const double sun[3],
                        const double *sun_e, int cnt, const int *k, double *out)
 {
     const double r = sqrt(atmos__dot3(g, g));
     const double n[3] = {g[0] / r, g[1] / r, g[2] / r};
     const double gw[3] = {n[0] * pl->r_ground, n[1] * pl->r_ground - pl->r_ground, n[2] * pl->r_ground};
-    const double cs = atmos__dot3(n, sun);
-    double ts[ATMOS_MAX_WAVELENGTHS], es[ATMOS_MAX_WAVELENGTHS];
-    atmos__sph_sun_t(m, pl->r_ground, cs, cnt, k, ts);
-    atmos__sph_esky(m, cs, cnt, k, es);
+    double e[ATMOS_MAX_WAVELENGTHS];
+    atmos__sph_ground_irradiance(pl, m, atmos__dot3(n, sun), cnt, k, e);
     for (int i = 0; i < cnt; i++) {
         const int kk = ATMOS__WL(k, i);
-        const double e = (cs > 0 ? cs * ts[i] : 0.0) + es[i];
-        out[i] = atmos__planet_ground_albedo(pl, gw, kk) / ATMOS_PI * e * sun_e[kk] +
+        out[i] = atmos__planet_ground_albedo(pl, gw, kk) / ATMOS_PI * e[i] * sun_e[kk] +
                  atmos__planet_ground_lights(pl, gw, sun, kk);
     }
 }

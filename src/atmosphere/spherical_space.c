@@ -156,21 +156,12 @@ atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const doubl
     s->gi = s->mie + (size_t)s->n * NPH;
     for (int j = 0; j < NCS; j++) { /* (cos T_sun + E_sky) E / pi, as atmos__sph_ground */
         const double cs = -1.0 + 2.0 * j / (NCS - 1);
-        double ts[ATMOS_MAX_WAVELENGTHS], es[ATMOS_MAX_WAVELENGTHS];
-        atmos__sph_sun_t(a->model, pl->r_ground, cs, s->n, NULL, ts);
-        atmos__sph_esky(a->model, cs, s->n, NULL, es);
-        for (int k = 0; k < s->n; k++)
-            s->gi[k * NCS + j] = (float)(((cs > 0 ? cs * ts[k] : 0.0) + es[k]) / ATMOS_PI * a->sun_e[k]);
+        double e[ATMOS_MAX_WAVELENGTHS];
+        atmos__sph_ground_irradiance(pl, a->model, cs, s->n, NULL, e);
+        for (int k = 0; k < s->n; k++) s->gi[k * NCS + j] = (float)(e[k] / ATMOS_PI * a->sun_e[k]);
     }
-    for (int k = 0; k < s->n; k++) {
-        const double g = pl->rayleigh_gamma[k];
-        s->ra[k] = (float)((1.0 + 3.0 * g) / (1.0 + 2.0 * g));
-        s->rb[k] = (float)((1.0 - g) / (1.0 + 2.0 * g));
-        for (int j = 0; j < NPH; j++) {
-            const double x = (double)j / (NPH - 1);
-            s->mie[k * NPH + j] = (float)atmos__planet_mie_phase(pl, k, 1.0 - 2.0 * x * x);
-        }
-    }
+    for (int k = 0; k < s->n; k++) atmos__planet_rayleigh_ab(pl, k, &s->ra[k], &s->rb[k]);
+    atmos__planet_mie_phase_table(pl, s->n, NPH, s->mie);
 #pragma omp parallel for schedule(dynamic)
     for (int e = 0; e < (NG + NL) * NA; e++) fill_node(a, s, eye, sun, e / NA, e % NA);
     return s;
