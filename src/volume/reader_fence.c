@@ -139,10 +139,19 @@ static void child_main(int fd, atmos_context *ctx, const char *path, const atmos
 
 /* ------------------------------------------------------------ parent */
 
+/* A child asleep with no CPU time spent and nothing sent for this long is stuck: a lock that
+ * another thread of the parent held at the fork (an allocator's, a library's) stays locked in
+ * the child forever. It is killed and started again, up to FENCE_ATTEMPTS times in all. */
+#define FENCE_STALL_S 3.0
+#define FENCE_ATTEMPTS 3
+
 typedef struct {
     int fd;
-    double deadline; /* CLOCK_MONOTONIC seconds */
-    int timed_out;
+    pid_t pid;
+    double deadline;      /* CLOCK_MONOTONIC seconds */
+    double progress_at;   /* when the child last sent bytes or spent CPU time */
+    long long cpu_ticks;  /* its CPU time then, clock ticks; -1 unknown */
+    int timed_out, stalled;
 } in_pipe;
 
 static double now_s(void)
@@ -152,7 +161,40 @@ static double now_s(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* Reads n bytes; -1 on end of pipe, error or deadline. */
+/* The child's CPU time (user + system, clock ticks) if it is asleep ('S'), -1 if it is
+ * running, in the kernel's disk wait, gone, or /proc cannot tell. */
+static long long asleep_cpu_ticks(pid_t pid)
+{
+    char name[64], line[1024];
+    snprintf(name, sizeof name, "/proc/%ld/stat", (long)pid);
+    FILE *f = fopen(name, "r");
+    if (!f) return -1;
+    size_t n = fread(line, 1, sizeof line - 1, f);
+    fclose(f);
+    line[n] = '\0';
+    const char *c = strrchr(line, ')'); /* the command name may hold spaces and parentheses */
+    char state;
+    unsigned long long utime, stime;
+    if (!c || sscanf(c + 1, " %c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &state, &utime, &stime) != 3)
+        return -1;
+    return state == 'S' ? (long long)(utime + stime) : -1;
+}
+
+/* Called while no bytes arrive: has the child been asleep, spending no CPU time, for
+ * FENCE_STALL_S seconds? */
+static int child_stalled(in_pipe *p)
+{
+    const long long ticks = asleep_cpu_ticks(p->pid);
+    const double t = now_s();
+    if (ticks < 0 || ticks != p->cpu_ticks) {
+        p->cpu_ticks = ticks;
+        p->progress_at = t;
+        return 0;
+    }
+    return t - p->progress_at >= FENCE_STALL_S;
+}
+
+/* Reads n bytes; -1 on end of pipe, error, deadline or a stalled child. */
 static int read_all(in_pipe *p, void *buf, size_t n)
 {
     char *q = buf;
@@ -163,15 +205,22 @@ static int read_all(in_pipe *p, void *buf, size_t n)
             return -1;
         }
         struct pollfd pfd = {p->fd, POLLIN, 0};
-        int pr = poll(&pfd, 1, left > 1e6 ? 1000000000 : (int)(left * 1000) + 1);
+        int pr = poll(&pfd, 1, left > 0.5 ? 500 : (int)(left * 1000) + 1);
         if (pr < 0 && errno == EINTR) continue;
         if (pr < 0) return -1;
-        if (pr == 0) continue;
+        if (pr == 0) {
+            if (child_stalled(p)) {
+                p->stalled = 1;
+                return -1;
+            }
+            continue;
+        }
         ssize_t r = read(p->fd, q, n);
         if (r < 0 && errno == EINTR) continue;
         if (r <= 0) return -1;
         q += r;
         n -= (size_t)r;
+        p->progress_at = now_s();
     }
     return 0;
 }
@@ -257,6 +306,10 @@ static atmos_status receive(atmos_context *ctx, in_pipe *p, atmos_volume **out, 
 static atmos_status child_failure(atmos_context *ctx, const char *path, const char *library, int wstatus,
                                   const in_pipe *p, const fence_limits *l)
 {
+    if (p->stalled)
+        return atmos__error(ctx, ATMOS_E_LIMIT, "%s: the %s library stopped making progress reading the file (asleep, "
+                            "no CPU time for %.0f s) in %d attempts; stopped", path, library, FENCE_STALL_S,
+                            FENCE_ATTEMPTS);
     if (p->timed_out)
         return atmos__error(ctx, ATMOS_E_LIMIT, "%s: the %s library did not finish reading the file in %u s; stopped",
                             path, library, l->wall_s);
@@ -274,12 +327,12 @@ static atmos_status child_failure(atmos_context *ctx, const char *path, const ch
                         "status %d): the file is damaged", path, library, WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1);
 }
 
-atmos_status atmos__reader_fenced(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
-                                  const char *library, atmos__reader_fn load, atmos_volume **out)
+/* One child: fork, load there, receive here. *p tells how it ended. */
+static atmos_status fence_attempt(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                  atmos__reader_fn load, const fence_limits *l, in_pipe *p, int *ws, int *reported,
+                                  atmos_volume **out)
 {
-    *out = NULL;
-    fence_limits l;
-    limits_for(path, desc, &l);
+    *p = (in_pipe){-1, -1, 0, 0, -1, 0, 0};
     int fds[2];
     if (pipe(fds) != 0)
         return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create a pipe for the reader: %s", path, strerror(errno));
@@ -292,16 +345,37 @@ atmos_status atmos__reader_fenced(atmos_context *ctx, const char *path, const at
     }
     if (pid == 0) {
         close(fds[0]);
-        child_main(fds[1], ctx, path, desc, load, &l);
+        child_main(fds[1], ctx, path, desc, load, l);
     }
     close(fds[1]);
-    in_pipe p = {fds[0], now_s() + l.wall_s, 0};
-    int reported = 0;
-    atmos_status st = receive(ctx, &p, out, &reported);
+    const double t = now_s();
+    *p = (in_pipe){fds[0], pid, t + l->wall_s, t, -1, 0, 0};
+    atmos_status st = receive(ctx, p, out, reported);
     close(fds[0]);
-    if (p.timed_out) kill(pid, SIGKILL);
-    int ws = 0;
-    while (waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
+    if (p->timed_out || p->stalled) kill(pid, SIGKILL);
+    while (waitpid(pid, ws, 0) < 0 && errno == EINTR) {
+    }
+    return st;
+}
+
+atmos_status atmos__reader_fenced(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
+                                  const char *library, atmos__reader_fn load, atmos_volume **out)
+{
+    *out = NULL;
+    fence_limits l;
+    limits_for(path, desc, &l);
+    in_pipe p;
+    int ws = 0, reported = 0;
+    atmos_status st = ATMOS_E_IO;
+    for (int attempt = 1; attempt <= FENCE_ATTEMPTS; attempt++) {
+        atmos_volume_destroy(*out);
+        *out = NULL;
+        ws = reported = 0;
+        st = fence_attempt(ctx, path, desc, load, &l, &p, &ws, &reported, out);
+        if (!p.stalled || attempt == FENCE_ATTEMPTS) break;
+        atmos__log(ctx, ATMOS_LOG_WARN, "%s: the %s reader process stopped making progress (asleep, no CPU time "
+                   "for %.0f s); starting it again (attempt %d of %d)", path, library, FENCE_STALL_S, attempt + 1,
+                   FENCE_ATTEMPTS);
     }
     if (st != ATMOS_OK) {
         atmos_volume_destroy(*out);

@@ -20,7 +20,9 @@ typedef atmos_status (*atmos__reader_fn)(atmos_context *ctx, const char *path, c
 /* Runs load(ctx, path, desc, out) in a child process. `library` names the parser in
  * messages ("OpenVDB"). Limits: address space 2 x max_memory + 256 MiB + 16 MiB per CPU
  * beyond what the process already maps; CPU time 60 s + 1 s per 20 MB of file; wall time
- * 4 x the CPU limit. Log messages of the child reach ctx's log callback. */
+ * 4 x the CPU limit. A child asleep with no CPU time spent and nothing sent for 3 s (stuck on
+ * a lock another thread held at the fork) is killed and started again, 3 attempts in all.
+ * Log messages of the child reach ctx's log callback. */
 atmos_status atmos__reader_fenced(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
                                   const char *library, atmos__reader_fn load, atmos_volume **out);
 

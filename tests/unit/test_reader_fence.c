@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 static atmos_context *ctx;
 
@@ -58,17 +59,50 @@ static atmos_status load_ok(atmos_context *c, const char *path, const atmos_volu
     return st;
 }
 
-static int warned;
+static int warned, restarted;
 static void on_log(void *user, atmos_log_level level, const char *msg)
 {
     (void)user;
     if (level == ATMOS_LOG_WARN && strstr(msg, "from the child")) warned++;
+    if (level == ATMOS_LOG_WARN && strstr(msg, "stopped making progress")) restarted++;
 }
 
 static atmos_status load_ok_warn(atmos_context *c, const char *path, const atmos_volume_load_desc *d,
                                  atmos_volume **out)
 {
     atmos__log(c, ATMOS_LOG_WARN, "a warning from the child");
+    return load_ok(c, path, d, out);
+}
+
+/* Sleeps forever in the child (as a child stuck on a lock held at the fork does) unless the
+ * marker file `path` exists; creates it first, so a second child loads normally. */
+static atmos_status load_stuck_once(atmos_context *c, const char *path, const atmos_volume_load_desc *d,
+                                    atmos_volume **out)
+{
+    FILE *f = fopen(path, "r");
+    if (f) {
+        fclose(f);
+        return load_ok(c, path, d, out);
+    }
+    f = fopen(path, "w");
+    if (f) fclose(f);
+    for (;;) pause();
+    return ATMOS_E_IO; /* not reached */
+}
+
+static atmos_status load_stuck(atmos_context *c, const char *path, const atmos_volume_load_desc *d, atmos_volume **out)
+{
+    (void)c, (void)path, (void)d, (void)out;
+    for (;;) pause();
+    return ATMOS_E_IO; /* not reached */
+}
+
+/* Works for 4.5 s of CPU time without a word: busy, not stuck. */
+static atmos_status load_busy(atmos_context *c, const char *path, const atmos_volume_load_desc *d, atmos_volume **out)
+{
+    clock_t t0 = clock();
+    volatile double x = 0;
+    while ((double)(clock() - t0) / CLOCKS_PER_SEC < 4.5) x += 1e-9;
     return load_ok(c, path, d, out);
 }
 
@@ -131,6 +165,34 @@ int main(void)
         CHECK(a.active_voxels == b.active_voxels && a.max == b.max);
     }
     atmos_volume_destroy(v);
+    v = NULL;
+
+    /* A child stuck asleep (a lock held at the fork) is started again; a busy one is not. */
+    char marker[1024];
+    const char *tmp = getenv("ATMOS_TEST_TMP");
+    snprintf(marker, sizeof marker, "%s/stuck-once.marker", tmp && *tmp ? tmp : ".");
+    remove(marker);
+    t0 = now_s();
+    st = atmos__reader_fenced(ctx, marker, NULL, "TestLib", load_stuck_once, &v);
+    CHECK_MSG(st == ATMOS_OK && v, "%s", atmos_context_error(ctx));
+    CHECK_MSG(restarted == 1, "%d restarts", restarted);
+    CHECK_MSG(now_s() - t0 < 30, "stuck once took %.1f s", now_s() - t0);
+    if (v) CHECK(atmos_volume_field_count(v) == 2);
+    atmos_volume_destroy(v);
+    v = NULL;
+    remove(marker);
+    restarted = 0;
+    st = atmos__reader_fenced(ctx, "busy.vdb", NULL, "TestLib", load_busy, &v);
+    CHECK_MSG(st == ATMOS_OK && v && restarted == 0, "%s, %d restarts", atmos_context_error(ctx), restarted);
+    atmos_volume_destroy(v);
+    v = NULL;
+    t0 = now_s();
+    st = atmos__reader_fenced(ctx, "stuck.vdb", NULL, "TestLib", load_stuck, &v);
+    CHECK_MSG(st == ATMOS_E_LIMIT && !v && strstr(atmos_context_error(ctx), "stuck.vdb") &&
+                  strstr(atmos_context_error(ctx), "stopped making progress"),
+              "%s", atmos_context_error(ctx));
+    CHECK_MSG(restarted == 2 && now_s() - t0 < 40, "%d restarts, %.1f s", restarted, now_s() - t0);
+    printf("stuck: %s (%.1f s)\n", atmos_context_error(ctx), now_s() - t0);
     atmos_volume_destroy(ref);
     atmos_context_destroy(ctx);
     return test_summary("test_reader_fence");
