@@ -13,7 +13,7 @@
 #include <string.h>
 
 /* Bumped whenever the tables' content or layout changes. */
-#define SPH_TABLE_VERSION 2
+#define SPH_TABLE_VERSION 3
 
 static void sph_destroy(void *model)
 {

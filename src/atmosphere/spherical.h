@@ -116,7 +116,7 @@ double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k);
  * node, the mu_s of a column coordinate; and a clamp. */
 void atmos__sph_tau_node(const atmos__sph_model *m, double xr, double xm, double *r, double *mu);
 double atmos__sph_x_to_mus(double x);
-double atmos__sph_clampd(double x, double lo, double hi);
+static inline double atmos__sph_clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
 /* ------------------------------------------------------------------ the march (spherical_march.c) */
 /* Marches q + t d, t in [t0, t1] (inside the air), sun direction sun; use_ms: add the

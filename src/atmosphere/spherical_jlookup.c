@@ -58,21 +58,23 @@ void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, co
     if (is > JS - 2) is = JS - 2;
     if (ip > JP - 2) ip = JP - 2;
     const double ar = xr - ir, as = xs - is, ap = xp - ip, ag = g->a;
-    for (int i = 0; i < cnt; i++) jr[i] = jm[i] = 0.0;
+    const double wr[2] = {1 - ar, ar}, ws[2] = {1 - as, as}, wg[2] = {1 - ag, ag}, wp[2] = {1 - ap, ap};
+    double acc[2 * ATMOS_MAX_WAVELENGTHS];
+    for (int i = 0; i < 2 * cnt; i++) acc[i] = 0.0;
     for (int c = 0; c < 16; c++) {
         const int br = c & 1, bs = (c >> 1) & 1, bg = (c >> 2) & 1, bp = (c >> 3) & 1;
-        const double w = (br ? ar : 1 - ar) * (bs ? as : 1 - as) * (bg ? ag : 1 - ag) * (bp ? ap : 1 - ap);
+        const double w = wr[br] * ws[bs] * wg[bg] * wp[bp];
         if (w == 0.0) continue;
         const size_t node = (((size_t)(ir + br) * JS + is + bs) * JG + g->i + bg) * JP + ip + bp;
         const float *t = m->jms + node * 2 * (size_t)n;
-        for (int i = 0; i < cnt; i++) {
-            const int kk = ATMOS__WL(k, i);
-            jr[i] += w * t[2 * kk], jm[i] += w * t[2 * kk + 1];
-        }
+        if (!k) /* all wavelengths: one contiguous run of (air, aerosols) pairs */
+            for (int i = 0; i < 2 * cnt; i++) acc[i] += w * t[i];
+        else
+            for (int i = 0; i < cnt; i++) acc[2 * i] += w * t[2 * k[i]], acc[2 * i + 1] += w * t[2 * k[i] + 1];
     }
     /* below the lowest column a steep fade, not the column's light: the night side keeps
      * its darkness (the night lights stay the brightest thing there) */
     const double fade = mus < -XS * XS ? exp(-JFADE * (-XS * XS - mus)) : 1.0;
-    for (int i = 0; i < cnt; i++) jr[i] = (exp(jr[i]) - JFLOOR) * fade, jm[i] = (exp(jm[i]) - JFLOOR) * fade;
+    for (int i = 0; i < cnt; i++) jr[i] = (exp(acc[2 * i]) - JFLOOR) * fade, jm[i] = (exp(acc[2 * i + 1]) - JFLOOR) * fade;
 }
 

@@ -14,8 +14,6 @@
 
 /* ------------------------------------------------------------------ mappings */
 
-double atmos__sph_clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
-
 /* Bruneton's (x_r, x_mu) of (r, mu) and back. */
 static void tau_coords(const atmos__sph_model *m, double r, double mu, double *xr, double *xm)
 {

@@ -149,21 +149,22 @@ static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_qu
     const double x = (double)ir / (JR - 1), r = m->R + (m->Rt - m->R) * x * x;
     const double ms = atmos__sph_j_x_mus((double)is / (JS - 1)), ss = sqrt(fmax(0.0, 1.0 - ms * ms));
     const double sun[3] = {ss, ms, 0};
-    double *L = malloc(sizeof(double) * QN * (size_t)n);
+    double l[ATMOS_MAX_WAVELENGTHS];
+    float *L = malloc(sizeof(float) * QN * (size_t)n); /* [n][QN]: each wavelength's run contiguous */
     if (!L) return 1;
     for (int q = 0; q < QN; q++) {
         double d[3];
         sun_dir(ss, ms, qd->g[q], qd->p[q], d);
-        incoming(pl, m, r, d, sun, albedo, L + (size_t)q * n);
+        incoming(pl, m, r, d, sun, albedo, l);
+        for (int k = 0; k < n; k++) L[(size_t)k * QN + q] = (float)l[k];
     }
     for (int v = 0; v < JV; v++)
         for (int k = 0; k < n; k++) {
             const float *wr = qd->w + (((size_t)k * 2 + 0) * JV + v) * QN, *wm = wr + (size_t)JV * QN;
-            double a = 0.0, b = 0.0;
-            for (int q = 0; q < QN; q++) {
-                const double l = L[(size_t)q * n + k];
-                a += wr[q] * l, b += wm[q] * l;
-            }
+            const float *lk = L + (size_t)k * QN;
+            float a = 0.0f, b = 0.0f;
+#pragma omp simd reduction(+ : a, b)
+            for (int q = 0; q < QN; q++) a += wr[q] * lk[q], b += wm[q] * lk[q];
             out[((size_t)v * n + k) * 2] = (float)log(a + JFLOOR);
             out[((size_t)v * n + k) * 2 + 1] = (float)log(b + JFLOOR);
         }
