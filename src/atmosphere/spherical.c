@@ -13,7 +13,7 @@
 #include <string.h>
 
 /* Bumped whenever the tables' content or layout changes. */
-#define SPH_TABLE_VERSION 3
+#define SPH_TABLE_VERSION 4
 
 static void sph_destroy(void *model)
 {

@@ -42,7 +42,7 @@
  * pi i / (AZ - 1). */
 #define ATMOS__SPH_SV_ROWS 48
 #define ATMOS__SPH_SV_AZ 16
-#define ATMOS__SPH_STEPS_TABLE 20
+#define ATMOS__SPH_STEPS_TABLE 12
 /* Steps of the march per piece for the per-eye tables' nodes: the sky-view table's and the
  * table of an eye above the air (spherical_space.c). */
 #define ATMOS__SPH_STEPS_SKYVIEW 20

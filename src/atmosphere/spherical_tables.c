@@ -164,8 +164,8 @@ static void esky_entry(const atmos__planet *pl, const atmos__sph_model *m, doubl
             const double d[3] = {sn * cos(phi), mu, sn * sin(phi)};
             const double nu = d[0] * sun[0] + d[1] * sun[1];
             atmos__sph_sums s;
-            atmos__sph_march(pl, m, q, d, 0.0, atmos__planet_dist_top(pl, m->R, mu), sun, ATMOS__SPH_STEPS, 1,
-                             n, NULL, &s);
+            atmos__sph_march(pl, m, q, d, 0.0, atmos__planet_dist_top(pl, m->R, mu), sun, ATMOS__SPH_STEPS_SKYVIEW,
+                             1, n, NULL, &s);
             for (int k = 0; k < n; k++)
                 out[k] += w * (atmos__planet_rayleigh_phase(pl, k, nu) * s.sr[k] + atmos__planet_mie_phase(pl, k, nu) * s.sm[k] + s.ms[k]);
         }
