@@ -58,19 +58,24 @@ void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, co
     if (is > JS - 2) is = JS - 2;
     if (ip > JP - 2) ip = JP - 2;
     const double ar = xr - ir, as = xs - is, ap = xp - ip, ag = g->a;
-    const double wr[2] = {1 - ar, ar}, ws[2] = {1 - as, as}, wg[2] = {1 - ag, ag}, wp[2] = {1 - ap, ap};
+    const double wr[2] = {1 - ar, ar}, ws[2] = {1 - as, as}, wg[2] = {1 - ag, ag};
+    /* the table's strides; the two psi nodes of a corner are adjacent */
+    const size_t sp = 2 * (size_t)n, sg = JP * sp, ss = JG * sg, sr = JS * ss;
+    const float *base = m->jms + (size_t)ir * sr + (size_t)is * ss + (size_t)g->i * sg + (size_t)ip * sp;
     double acc[2 * ATMOS_MAX_WAVELENGTHS];
     for (int i = 0; i < 2 * cnt; i++) acc[i] = 0.0;
-    for (int c = 0; c < 16; c++) {
-        const int br = c & 1, bs = (c >> 1) & 1, bg = (c >> 2) & 1, bp = (c >> 3) & 1;
-        const double w = wr[br] * ws[bs] * wg[bg] * wp[bp];
-        if (w == 0.0) continue;
-        const size_t node = (((size_t)(ir + br) * JS + is + bs) * JG + g->i + bg) * JP + ip + bp;
-        const float *t = m->jms + node * 2 * (size_t)n;
+    for (int c = 0; c < 8; c++) { /* the (r, mu_s, gamma) corners, each with its two psi nodes */
+        const int br = c & 1, bs = (c >> 1) & 1, bg = (c >> 2) & 1;
+        const double w = wr[br] * ws[bs] * wg[bg], w0 = w * (1 - ap), w1 = w * ap;
+        const float *t = base + br * sr + bs * ss + bg * sg;
         if (!k) /* all wavelengths: one contiguous run of (air, aerosols) pairs */
-            for (int i = 0; i < 2 * cnt; i++) acc[i] += w * t[i];
+            for (int i = 0; i < 2 * cnt; i++) acc[i] += w0 * t[i] + w1 * t[i + sp];
         else
-            for (int i = 0; i < cnt; i++) acc[2 * i] += w * t[2 * k[i]], acc[2 * i + 1] += w * t[2 * k[i] + 1];
+            for (int i = 0; i < cnt; i++)
+                for (int part = 0; part < 2; part++) {
+                    const size_t o = 2 * (size_t)k[i] + part;
+                    acc[2 * i + part] += w0 * t[o] + w1 * t[o + sp];
+                }
     }
     /* below the lowest column a steep fade, not the column's light: the night side keeps
      * its darkness (the night lights stay the brightest thing there) */
