@@ -12,7 +12,8 @@
  * |grad phi| / phi), bounds it by phi (the streaming limit). At a face to vacuum the Marshak
  * condition (no diffuse light coming in: phi/4 - D/2 dphi/dn = 0 with n inward) gives the
  * outgoing flux phi_b / 2 at the face; with the face value reached from the cell's centre
- * over h/2 that is phi a / ((2 a + 1)) per area, a = 2 D / h.
+ * over h/2 that is phi a / ((2 a + 1)) per area, a = 2 D / h. Light coming in through the
+ * face (the partial current J_in: the sky, the ground) makes it (phi - 4 J_in) a / (2 a + 1).
  *
  * Cell-centred finite volumes (harmonic mean of D at a face), red-black successive
  * over-relaxation (each colour's update reads only the other colour: the result does not
@@ -106,8 +107,9 @@ static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, co
                 for (int f = 0; f < 6; f++) {
                     if (nb[f] == -2) continue;
                     if (nb[f] == -1) {
-                        const double a = 2.0 * Di / h;
-                        diag += a / ((2.0 * a + 1.0) * h);
+                        const double a = 2.0 * Di / h, b = a / ((2.0 * a + 1.0) * h);
+                        diag += b;
+                        if (m->jin) sum += b * 4.0 * m->jin[f * n + w];
                     } else {
                         const double Dn = D[nb[f]], c = 2.0 * Di * Dn / (Di + Dn) * ih2;
                         diag += c;
@@ -181,7 +183,35 @@ void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__
                 for (int f = 0; f < 6; f++) {
                     if (nb[f] != -1) continue;
                     const double a = 2.0 * cell_D(m, phi, i, j, k, w, limiter) / h;
-                    out[f] += phi[cell * n + w] * a / (2.0 * a + 1.0) * h * h;
+                    const double in4 = m->jin ? 4.0 * m->jin[f * n + w] : 0.0;
+                    out[f] += (phi[cell * n + w] - in4) * a / (2.0 * a + 1.0) * h * h;
+                }
+            }
+}
+
+void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, float *J,
+                        int threads)
+{
+    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2], limiter = o ? o->limiter : 0;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int k = 0; k < cz; k++)
+        for (int j = 0; j < cy; j++)
+            for (int i = 0; i < cx; i++) {
+                const size_t cell = ((size_t)k * cy + j) * cx + i;
+                long long nb[6];
+                neighbours(m, i, j, k, nb);
+                for (int w = 0; w < n; w++) {
+                    const double D = cell_D(m, phi, i, j, k, w, limiter), p = phi[cell * n + w];
+                    for (int a = 0; a < 3; a++) {
+                        /* a missing neighbour: the face value of the Marshak condition is
+                         * not known here; the one-sided difference of the other side */
+                        const long long lo = nb[2 * a], hi = nb[2 * a + 1];
+                        double d = 0;
+                        if (lo >= 0 && hi >= 0) d = (phi[(size_t)hi * n + w] - phi[(size_t)lo * n + w]) / (2 * m->h);
+                        else if (hi >= 0) d = (phi[(size_t)hi * n + w] - p) / m->h;
+                        else if (lo >= 0) d = (p - phi[(size_t)lo * n + w]) / m->h;
+                        J[(cell * n + w) * 3 + a] = (float)(-D * d);
+                    }
                 }
             }
 }

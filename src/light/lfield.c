@@ -1,4 +1,4 @@
-/* The light-field container (lfield.h): its cells, their values, the trilinear read. */
+/* The light-field container (lfield.h): its cells and their values. */
 #include "light/lfield.h"
 
 #include <stdlib.h>
@@ -10,7 +10,8 @@ int atmos__lfield_alloc(atmos__lfield *f, int kind, int cx, int cy, int cz, int 
     const size_t cnt = (size_t)cx * cy * cz * n;
     f->L = calloc(cnt, sizeof(float));
     f->phi = calloc(cnt, sizeof(float));
-    if (!f->L || !f->phi) {
+    f->J = calloc(cnt * 3, sizeof(float));
+    if (!f->L || !f->phi || !f->J) {
         atmos__lfield_free(f);
         return 0;
     }
@@ -21,7 +22,7 @@ int atmos__lfield_alloc(atmos__lfield *f, int kind, int cx, int cy, int cz, int 
 
 void atmos__lfield_free(atmos__lfield *f)
 {
-    free(f->L), free(f->phi);
+    free(f->L), free(f->phi), free(f->J);
     memset(f, 0, sizeof *f);
 }
 

@@ -33,6 +33,9 @@ typedef struct {
     float *sig_t;    /* extinction, m^-1 */
     float *sig_s;    /* scattering, m^-1 */
     float *g;        /* asymmetry parameter <cos theta> of the scattering */
+    float *jin;      /* [face * n + w] or NULL: the diffuse light coming in through each non-periodic
+                        face (-x, +x, -y, +y, -z, +z) from outside, the inward partial current
+                        (irradiance), W m^-2 nm^-1: the sky and the ground as boundary sources */
 } atmos__lmedium;
 
 /* The field: cell (i, j, k) stands for the s^3 host voxels i s .. i s + s - 1 (host-voxel
@@ -42,6 +45,8 @@ typedef struct {
     int c[3], n; /* cells per axis, wavelengths */
     int s;       /* host voxels per cell edge */
     float *L;    /* [cell * n + w]: mean radiance of the diffuse light, W m^-2 sr^-1 nm^-1 */
+    float *J;    /* [(cell * n + w) * 3 + axis]: its net flux (first moment), W m^-2 nm^-1, in the
+                    grid's frame: the radiance toward unit direction d is L + 3/(4 pi) J . d */
     float *phi;  /* [cell * n + w]: its fluence (4 pi L), the solver's unknown (its warm start) */
     /* what it was computed for */
     int valid;
@@ -59,9 +64,8 @@ void atmos__lmedium_free(atmos__lmedium *m);
 int atmos__lfield_alloc(atmos__lfield *f, int kind, int cx, int cy, int cz, int n, int s);
 void atmos__lfield_free(atmos__lfield *f);
 
-/* Trilinear value at host-voxel coordinate (u, v, w) (clamped to the outer cells' centres):
- * out[w] per wavelength. */
-/* (atmos__lfield_sample) Cell index and weight of the next cell along one axis for host coordinate u. */
+/* Trilinear value at host-voxel coordinate (u, v, w) (clamped to the outer cells' centres)
+ * of an array of m floats per cell (L: n, J: 3 n): out[m]. */
 static inline void atmos__lfield_axis(float u, int s, int c, int *i, float *w)
 {
     float x = (u - 0.5f * (float)(s - 1)) / (float)s;
@@ -72,21 +76,21 @@ static inline void atmos__lfield_axis(float u, int s, int c, int *i, float *w)
     *i = a, *w = c > 1 ? x - (float)a : 0.0f;
 }
 
-static inline void atmos__lfield_sample(const atmos__lfield *f, float u, float v, float w, float *out)
+static inline void atmos__lfield_sample(const atmos__lfield *f, const float *arr, int m, float u, float v, float w,
+                                        float *out)
 {
     int i, j, k;
     float a, b, c;
     atmos__lfield_axis(u, f->s, f->c[0], &i, &a);
     atmos__lfield_axis(v, f->s, f->c[1], &j, &b);
     atmos__lfield_axis(w, f->s, f->c[2], &k, &c);
-    const int n = f->n;
-    const size_t sx = f->c[0] > 1 ? (size_t)n : 0, sy = f->c[1] > 1 ? (size_t)f->c[0] * n : 0,
-                 sz = f->c[2] > 1 ? (size_t)f->c[0] * f->c[1] * n : 0;
-    const float *p = f->L + (((size_t)k * f->c[1] + j) * f->c[0] + i) * n;
+    const size_t sx = f->c[0] > 1 ? (size_t)m : 0, sy = f->c[1] > 1 ? (size_t)f->c[0] * m : 0,
+                 sz = f->c[2] > 1 ? (size_t)f->c[0] * f->c[1] * m : 0;
+    const float *p = arr + (((size_t)k * f->c[1] + j) * f->c[0] + i) * m;
     const float w000 = (1 - a) * (1 - b) * (1 - c), w100 = a * (1 - b) * (1 - c), w010 = (1 - a) * b * (1 - c),
                 w110 = a * b * (1 - c), w001 = (1 - a) * (1 - b) * c, w101 = a * (1 - b) * c, w011 = (1 - a) * b * c,
                 w111 = a * b * c;
-    for (int q = 0; q < n; q++)
+    for (int q = 0; q < m; q++)
         out[q] = w000 * p[q] + w100 * p[sx + q] + w010 * p[sy + q] + w110 * p[sx + sy + q] + w001 * p[sz + q] +
                  w101 * p[sx + sz + q] + w011 * p[sy + sz + q] + w111 * p[sx + sy + sz + q];
 }
@@ -118,9 +122,12 @@ typedef struct {
 int atmos__lfield_diffuse(const atmos__lmedium *m, const float *Q, float *phi, const atmos__ldiffusion_opts *o,
                           int threads);
 
-/* Power per unit area of the face area leaving through each of the six faces (-x, +x, -y,
- * +y, -z, +z), summed over the face's cells, of wavelength w: out[6], W nm^-1 (times h^2). */
+/* The net power leaving through each of the six faces (-x, +x, -y,
+ * +y, -z, +z), (outgoing minus the incoming jin), summed over the face's cells, of wavelength w: out[6], W nm^-1. */
 void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, int w,
                         double out[6]);
+/* The net flux J = -D grad phi of the solution (central differences), [(cell * n + w) * 3 + a]. */
+void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, float *J,
+                        int threads);
 
 #endif

@@ -23,6 +23,6 @@ int atmos__lmedium_alloc(atmos__lmedium *m, int cx, int cy, int cz, int n, doubl
 
 void atmos__lmedium_free(atmos__lmedium *m)
 {
-    free(m->sig_t), free(m->sig_s), free(m->g);
+    free(m->sig_t), free(m->sig_s), free(m->g), free(m->jin);
     memset(m, 0, sizeof *m);
 }

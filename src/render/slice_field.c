@@ -78,10 +78,44 @@ atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *s
     const size_t cells = (size_t)cx * cy * cz;
     sp->fdens = malloc(sizeof(float) * cells * (size_t)sp->nf);
     if (!sp->fdens || !atmos__lmedium_alloc(&sp->fmed, cx, cy, cz, sp->n, s / (double)g->sc) ||
+        !(sp->fmed.jin = calloc((size_t)6 * sp->n, sizeof(float))) ||
         !atmos__lfield_alloc(&sp->field, ATMOS__LFIELD_DIFFUSION, cx, cy, cz, sp->n, s))
         return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
     field_medium(sp, s);
     return ATMOS_OK;
+}
+
+/* The sky's and the ground's light coming in through each face of the field's box: the
+ * inward partial current J_in = int L(d) max(0, d . n) dOmega over the directions d looking
+ * out through the face (normal n), L what a view ray from the box's centre cw sees
+ * (atmos_atmosphere_radiance: the sky, the lit ground; the sun's disk left out, the sun is
+ * the forward beam's), on SKY_NMU x SKY_NPHI cells of equal solid angle. */
+#define SKY_NMU 16
+#define SKY_NPHI 32
+static void field_sky(atmos__slice_plan *sp, const atmos_atmosphere *atm, const double cw[3], const double sun_w[3])
+{
+    const int n = sp->n;
+    float *jin = sp->fmed.jin;
+    for (int i = 0; i < 6 * n; i++) jin[i] = 0.0f;
+    const double dom = 4.0 * 3.14159265358979323846 / (SKY_NMU * SKY_NPHI);
+    double acc[6 * ATMOS_MAX_WAVELENGTHS] = {0};
+    for (int a = 0; a < SKY_NMU; a++)
+        for (int b = 0; b < SKY_NPHI; b++) {
+            const double mu = -1.0 + 2.0 * (a + 0.5) / SKY_NMU, sn = sqrt(1.0 - mu * mu),
+                         ph = 2.0 * 3.14159265358979323846 * (b + 0.5) / SKY_NPHI;
+            const double d[3] = {sn * cos(ph), mu, sn * sin(ph)};
+            double L[ATMOS_MAX_WAVELENGTHS], df[3];
+            atmos_atmosphere_hit info;
+            atmos_atmosphere_radiance(atm, cw, d, sun_w, L, &info);
+            if (info.in_sun_disk) continue;
+            atmos__vol_dir_to_frame(&sp->x, d, df);
+            for (int f = 0; f < 6; f++) {
+                const double c = (f & 1 ? 1.0 : -1.0) * df[f / 2];
+                if (c > 0)
+                    for (int w = 0; w < n; w++) acc[f * n + w] += L[w] * c * dom;
+            }
+        }
+    for (int i = 0; i < 6 * n; i++) jin[i] = (float)acc[i];
 }
 
 atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
@@ -103,13 +137,16 @@ atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp
     atmos__vol_frame_to_point(&sp->x, cen, cw);
     atmos_atmosphere_sunlight(atm, cw, sun_w, sl);
     atmos__lfield_sun_source(&sp->fmed, lt, sl, field_keep, sp, Q, NULL, threads);
+    field_sky(sp, atm, cw, sun_w);
     const double t1 = atmos__now();
     atmos__ldiffusion_opts o = {0};
+    o.limiter = 1; /* measured better than without (docs/lightfield.md) */
     fl->sweeps = atmos__lfield_diffuse(&sp->fmed, Q, fl->phi, &o, threads);
     free(Q);
     if (fl->sweeps < 0) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffusion solve");
     const float inv4pi = (float)(1.0 / (4.0 * 3.14159265358979323846));
     for (size_t i = 0; i < cnt; i++) fl->L[i] = fl->phi[i] * inv4pi;
+    atmos__lfield_flux(&sp->fmed, fl->phi, &o, fl->J, threads);
     memcpy(fl->sun, sun_w, sizeof fl->sun);
     fl->valid = 1;
     fl->source_s = t1 - t0;

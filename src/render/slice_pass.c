@@ -319,9 +319,9 @@ SLICE_INLINE void eye_optics(const sjob *j, const echunk *e, int c, float *restr
     }
 }
 
-/* The diffuse light field at the samples of slice k ([q * n + c]), read at the points
- * eye_samples computed. */
-SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict Lf)
+/* The diffuse light field at the samples of slice k, read at the points eye_samples
+ * computed: L and A ([q * n + c], atmos__slice_field_at). */
+SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict Lf, float *restrict Af)
 {
     const float kf = (float)k;
     const int n = j->n;
@@ -329,27 +329,28 @@ SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, fl
         const size_t p = p0 + (size_t)lane(e, q);
         const float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
                     w = j->pU0[2][p] + kf * j->pdU[2][p];
-        atmos__lfield_sample(j->field, u, v, w, Lf + (size_t)q * n);
+        atmos__slice_field_at(j->field, j->eu, u, v, w, Lf + (size_t)q * n, Af + (size_t)q * n);
     }
 }
 
-/* Wavelength c of the diffuse field scattered toward the eye with an isotropic phase
- * function: ds[q] = beta_sca L_d (NULL without a field). */
-SLICE_INLINE float *eye_field_src(const sjob *j, const echunk *e, int c, const float *Lf, float *restrict ds)
+/* Wavelength c of the diffuse field scattered toward the eye: ds[q] = sum over the fields of
+ * beta_sca (L + g A), not below 0 (NULL without a field). */
+SLICE_INLINE float *eye_field_src(const sjob *j, const echunk *e, int c, const float *Lf, const float *Af,
+                                  float *restrict ds)
 {
     if (!j->field) return NULL;
     const int n = j->n;
     for (int q = 0; q < e->mv; q++) ds[q] = 0.0f;
     for (int f = 0; f < j->nf; f++) {
         if (!e->live[f]) continue;
-        const float sa = j->t->sca[f][c];
+        const float sa = j->t->sca[f][c], g = j->fg[f][c];
         const float *restrict d = e->dens + f * CH;
         for (int q = 0; q < e->mv; q++) {
             const float bs = (d[q] > 0.0f ? d[q] : 0.0f) * sa;
-            ds[q] += bs > 0.0f ? bs : 0.0f;
+            ds[q] += bs > 0.0f ? bs * (Lf[(size_t)q * n + c] + g * Af[(size_t)q * n + c]) : 0.0f;
         }
     }
-    for (int q = 0; q < e->mv; q++) ds[q] *= Lf[(size_t)q * n + c];
+    for (int q = 0; q < e->mv; q++) ds[q] = ds[q] > 0.0f ? ds[q] : 0.0f;
     return ds;
 }
 
@@ -465,12 +466,12 @@ SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float (*restric
 /* The light, the optics and the blend of an RGB chunk. */
 SLICE_INLINE void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib)
 {
-    float I3[4][CH], be3[3][CH], src3[3][CH], Lf[3 * CH], ds[CH];
+    float I3[4][CH], be3[3][CH], src3[3][CH], Lf[3 * CH], Af[3 * CH], ds[CH];
     eye_rgb_light(j, e, Ib, I3);
     eye_orders(j, p0, e);
     eye_rgb_optics(j, e, be3, src3);
-    if (j->field) eye_field(j, k, p0, e, Lf);
-    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], eye_field_src(j, e, c, Lf, ds));
+    if (j->field) eye_field(j, k, p0, e, Lf, Af);
+    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], eye_field_src(j, e, c, Lf, Af, ds));
 }
 #else
 #define SLICE_RGB 0
@@ -483,7 +484,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
     const int32_t ns = n + 1, LN = j->L * ns; /* texels interleave I per wavelength and n */
     echunk e;
     float Ic[CH], bext[CH], src[CH], ds[CH];
-    float Lf[CH * ATMOS_MAX_WAVELENGTHS]; /* the diffuse field at the samples, [q * n + c] */
+    float Lf[CH * ATMOS_MAX_WAVELENGTHS], Af[CH * ATMOS_MAX_WAVELENGTHS]; /* the diffuse field at the samples */
     long long count = 0;
     for (int xs = x0; xs <= x1; xs += CH) {
         const int cnt = x1 - xs + 1 < CH ? x1 - xs + 1 : CH;
@@ -499,11 +500,11 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
 #endif
         eye_bilinear(&e, nb, ns, LN, e.nsc);
         eye_orders(j, p0, &e);
-        if (j->field) eye_field(j, k, p0, &e, Lf);
+        if (j->field) eye_field(j, k, p0, &e, Lf, Af);
         for (int c = 0; c < n; c++) {
             eye_bilinear(&e, Ib + c, ns, LN, Ic);
             eye_optics(j, &e, c, bext, src);
-            eye_blend(j, p0, &e, c, Ic, bext, src, eye_field_src(j, &e, c, Lf, ds));
+            eye_blend(j, p0, &e, c, Ic, bext, src, eye_field_src(j, &e, c, Lf, Af, ds));
         }
     }
     return count;

@@ -119,6 +119,8 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
             const int kept = sp->field.valid && memcmp(sp->field.sun, v->sun, sizeof v->sun) == 0;
             if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun)) != ATMOS_OK) return st;
             j.field = &sp->field;
+            j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->fg;
+            for (int a = 0; a < 3; a++) j.eu[a] = (float)(j.eye[a] * sp->g.sc + sp->g.off[a]);
             if (!kept) tm->field = sp->field.build_s, tm->field_sweeps = sp->field.sweeps;
         }
         tm->setup = atmos__now() - t_setup;

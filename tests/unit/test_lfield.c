@@ -148,11 +148,11 @@ static void check_sample(void)
     CHECK(atmos__lfield_alloc(&f, ATMOS__LFIELD_DIFFUSION, 3, 2, 2, 1, 4));
     for (int c = 0; c < 12; c++) f.L[c] = (float)(c % 3); /* value = cell index along x */
     float v;
-    atmos__lfield_sample(&f, 1.5f, 1.5f, 1.5f, &v); /* centre of cell 0: (4 - 1)/2 */
+    atmos__lfield_sample(&f, f.L, 1, 1.5f, 1.5f, 1.5f, &v); /* centre of cell 0: (4 - 1)/2 */
     CHECK_NEAR(v, 0.0, 1e-6);
-    atmos__lfield_sample(&f, 7.5f, 3.0f, 0.0f, &v);
+    atmos__lfield_sample(&f, f.L, 1, 7.5f, 3.0f, 0.0f, &v);
     CHECK_NEAR(v, 1.5, 1e-6);
-    atmos__lfield_sample(&f, 100.0f, -5.0f, 9.0f, &v);
+    atmos__lfield_sample(&f, f.L, 1, 100.0f, -5.0f, 9.0f, &v);
     CHECK_NEAR(v, 2.0, 1e-6);
     atmos__lfield_free(&f);
 }
