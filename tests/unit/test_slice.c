@@ -274,12 +274,13 @@ static void test_threads_and_finite(void)
     for (int i = 0; i < 5; i++) {
         atmos_scene s;
         scene_for(&s, suns[i][0], suns[i][1]);
-        for (int u = 0; u < 2; u++) {
+        for (int u = 0; u < 3; u++) { /* eq25, eq24, eq25 with the diffuse light field */
             sopts ss = {0};
             ss.optics = &op.o;
             ss.slices = 64;
             ss.light_size = 64;
-            ss.eq24 = u != 0;
+            ss.eq24 = u == 1;
+            ss.diffuse = u == 2;
             atmos_image *a = render(c1, &s, v, &ss), *b = render(c2, &s, v, &ss);
             CHECK(a && b && all_finite(a) && all_finite(b));
             if (a && b)
