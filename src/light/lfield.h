@@ -47,6 +47,8 @@ typedef struct {
     float *L;    /* [cell * n + w]: mean radiance of the diffuse light, W m^-2 sr^-1 nm^-1 */
     float *J;    /* [(cell * n + w) * 3 + axis]: its net flux (first moment), W m^-2 nm^-1, in the
                     grid's frame: the radiance toward unit direction d is L + 3/(4 pi) J . d */
+    float *LA;   /* [cell * 2 n + w]: L, then [cell * 2 n + n + w]: A = 3/(4 pi) J . d toward one
+                    eye (d from the cell's centre; the renderer's per-frame view of the field) */
     float *phi;  /* [cell * n + w]: its fluence (4 pi L), the solver's unknown (its warm start) */
     /* what it was computed for */
     int valid;
@@ -55,6 +57,10 @@ typedef struct {
     int sweeps;
     double build_s, source_s, solve_s;
 } atmos__lfield;
+
+/* Fills f->LA for an eye at host-voxel coordinate eye (grid and host axes aligned, the host's
+ * voxels cubes). */
+void atmos__lfield_toward(atmos__lfield *f, const double eye[3], int threads);
 
 size_t atmos__lmedium_cells(const atmos__lmedium *m);
 int atmos__lmedium_alloc(atmos__lmedium *m, int cx, int cy, int cz, int n, double h);

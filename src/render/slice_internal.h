@@ -14,8 +14,6 @@
 
 #include "volume/volume_access.h"
 
-#include <math.h>
-
 #define SLICE_HD_EPS 0.02 /* rays within ~89 degrees of the slice planes are not sliced */
 
 /* Pixels x0..x1 of one image row, or texels of one light-buffer row, that a slice
@@ -40,7 +38,6 @@ typedef struct {
     const sgrid *g;
     const stables *t;
     const atmos__lfield *field;  /* the diffuse light field, or NULL */
-    float eu[3];                 /* the eye in render-voxel coordinates (the field's anisotropy) */
     const float (*fg)[ATMOS_MAX_WAVELENGTHS]; /* the fields' asymmetry g per wavelength */
     /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
      * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
@@ -122,20 +119,16 @@ atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *s
 atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
                                        const double sun_w[3]);
 
-/* The diffuse field at render-voxel point (u, v, w) for the eye e (render voxels): per
- * wavelength its mean radiance L[c] and A[c] = 3/(4 pi) J . d, d the unit direction to the
- * eye; a medium of asymmetry g scatters L + g A toward the eye (Eddington's two terms). */
-static inline void atmos__slice_field_at(const atmos__lfield *f, const float e[3], float u, float v, float w,
-                                         float *L, float *A)
+/* The diffuse field at render-voxel point (u, v, w), toward the frame's eye: per wavelength
+ * its mean radiance L[c] and A[c] = 3/(4 pi) J . d, d the unit direction to the eye (from the
+ * field's cells, atmos__lfield_toward); a medium of asymmetry g scatters L + g A toward the eye
+ * (Eddington's two terms). */
+static inline void atmos__slice_field_at(const atmos__lfield *f, float u, float v, float w, float *L, float *A)
 {
-    float J[3 * ATMOS_MAX_WAVELENGTHS];
+    float o[2 * ATMOS_MAX_WAVELENGTHS];
     const int n = f->n;
-    atmos__lfield_sample(f, f->L, n, u, v, w, L);
-    atmos__lfield_sample(f, f->J, 3 * n, u, v, w, J);
-    float dx = e[0] - u, dy = e[1] - v, dz = e[2] - w;
-    const float r = sqrtf(dx * dx + dy * dy + dz * dz), s = r > 0.0f ? 0.238732415f / r : 0.0f; /* 3/(4 pi) */
-    dx *= s, dy *= s, dz *= s;
-    for (int c = 0; c < n; c++) A[c] = J[3 * c] * dx + J[3 * c + 1] * dy + J[3 * c + 2] * dz;
+    atmos__lfield_sample(f, f->LA, 2 * n, u, v, w, o);
+    for (int c = 0; c < n; c++) L[c] = o[c], A[c] = o[n + c];
 }
 
 /* Slice indices k whose plane s_k = s0 + (k + 0.5) ds lies in [sa, sb] (k0 > k1: none). */

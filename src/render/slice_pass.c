@@ -329,7 +329,7 @@ SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, fl
         const size_t p = p0 + (size_t)lane(e, q);
         const float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
                     w = j->pU0[2][p] + kf * j->pdU[2][p];
-        atmos__slice_field_at(j->field, j->eu, u, v, w, Lf + (size_t)q * n, Af + (size_t)q * n);
+        atmos__slice_field_at(j->field, u, v, w, Lf + (size_t)q * n, Af + (size_t)q * n);
     }
 }
 

@@ -73,7 +73,7 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
         if (oi > no - 2) oi = no - 2;
         const float fo = mm - 1.0f - (float)oi;
         float Ld[ATMOS_MAX_WAVELENGTHS], Ad[ATMOS_MAX_WAVELENGTHS];
-        if (j->field) atmos__slice_field_at(j->field, j->eu, u, v, w, Ld, Ad);
+        if (j->field) atmos__slice_field_at(j->field, u, v, w, Ld, Ad);
         for (int c = 0; c < n; c++) {
             float bext = 0, src = 0, dsrc = 0;
             for (int f = 0; f < nf; f++) {

@@ -120,7 +120,9 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
             if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun)) != ATMOS_OK) return st;
             j.field = &sp->field;
             j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->fg;
-            for (int a = 0; a < 3; a++) j.eu[a] = (float)(j.eye[a] * sp->g.sc + sp->g.off[a]);
+            double eu[3]; /* the eye in render-voxel coordinates */
+            for (int a = 0; a < 3; a++) eu[a] = j.eye[a] * sp->g.sc + sp->g.off[a];
+            atmos__lfield_toward(&sp->field, eu, atmos__threads(ctx));
             if (!kept) tm->field = sp->field.build_s, tm->field_sweeps = sp->field.sweeps;
         }
         tm->setup = atmos__now() - t_setup;
