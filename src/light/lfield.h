@@ -3,7 +3,8 @@
  * every solver: a plan product made once per sun direction (and sky) and reused by the eye
  * passes of every frame until the sun moves.
  *
- *   lfield.c      the container: the grid, its cells' values, the trilinear read
+ *   lfield.c      the container: the grid, its cells' values, the field turned toward an eye
+ *                 (the trilinear read is inline below)
  *   lmedium.c     the medium on the field's grid (extinction, scattering, asymmetry per cell)
  *   sun_source.c  the sunlight a forward-lobe model (Riley et al. 2004 Eq. 24/25) drops at
  *                 each scattering: the source of the diffuse field
