@@ -55,10 +55,10 @@ static void slab_model(double tau, double g, double th_deg, int nz, int limiter,
 }
 
 /* Reflected and transmitted flux of the slab against adding-doubling. The model's flux
- * errors, measured (64 cells, g 0.85; R, T model vs adding-doubling):
- *   tau 1:  R 0.025 / 0.042, T 0.975 / 0.958 (sun 0);  R 0.062 / 0.165, T 0.938 / 0.835 (60)
- *   tau 4:  R 0.164 / 0.191, T 0.838 / 0.809;           R 0.384 / 0.416, T 0.620 / 0.584
- *   tau 16: R 0.631 / 0.557, T 0.382 / 0.443;           R 0.772 / 0.697, T 0.242 / 0.303
+ * errors, measured (64 cells, g 0.85; R, T model / adding-doubling; docs/lightfield.md):
+ *   tau 1:  R 0.027 / 0.042, T 0.974 / 0.958 (sun 0);  R 0.069 / 0.165, T 0.932 / 0.835 (60)
+ *   tau 4:  R 0.179 / 0.191, T 0.823 / 0.809;           R 0.391 / 0.416, T 0.612 / 0.584
+ *   tau 16: R 0.606 / 0.557, T 0.407 / 0.443;           R 0.720 / 0.697, T 0.294 / 0.303
  * The dropped light enters the diffusion as an isotropic source although it was scattered
  * backward (too little reflection of thin slabs at low sun), and the diffusion reflects a
  * little too much of thick ones. The checks hold these (the issue's goal, 3 %, is not met):
