@@ -8,7 +8,8 @@
 #
 # Environment: ATMOS (the binary, default build/atmos), SPP (path samples per pixel,
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
-# CASES (default "cumulus cirrus rain disney"), THREADS.
+# CASES (default "cumulus cirrus rain disney"), VARIANTS (default all of the slice variants
+# below), THREADS.
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -18,6 +19,7 @@ OUT=${1:-$root/docs/accuracy}
 SPP=${SPP:-1024}
 TRUNCATE=${TRUNCATE:-3}
 CASES=${CASES:-"cumulus cirrus rain disney"}
+VARIANTS=${VARIANTS:-"eq25 eq25_xi0 eq25_xi4 eq24 low_albedo diffuse diffuse_xi0"}
 TH=${THREADS:+--threads $THREADS}
 mkdir -p "$OUT"
 csv="$OUT/results.csv"
@@ -39,13 +41,15 @@ for c in $CASES; do
             --variance "$base.path.var.exr" --order "$base.order.pfm" --tau "$base.tau.pfm" -o "$base.path.png" \
             2> "$base.path.log"
         echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[],[]" >> "$csv"
-        for v in eq25 eq25_xi0 eq25_xi4 eq24 low_albedo; do
+        for v in $VARIANTS; do
             case $v in
             eq25) opts="" ;;
             eq25_xi0) opts="--xi 0" ;;
             eq25_xi4) opts="--xi 0.0318" ;;
             eq24) opts="--eq24" ;;
             low_albedo) opts="--low-albedo" ;;
+            diffuse) opts="--diffuse" ;;
+            diffuse_xi0) opts="--diffuse --xi 0" ;;
             esac
             "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
             "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \

@@ -69,6 +69,7 @@ typedef struct atmos_scene_slice {
     int grid_max_dim;         /* 256 */
     double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1]; 1 */
     int max_order;            /* Ams orders tabulated; 64 */
+    int diffuse;              /* 1: add the diffuse light field (the light Eq. 24/25 drop, by diffusion) */
 } atmos_scene_slice;
 
 /* Settings of the path tracer ("path" in the file); the table is

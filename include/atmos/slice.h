@@ -35,6 +35,9 @@ typedef struct atmos_slice_timing {
                                 composite, its per-frame table included; part of sky */
     double sunlight;         /* the sunlight entering the light buffer, when the sun moved;
                                 part of setup */
+    double field;            /* the diffuse light field ("diffuse"), when the sun moved: its source
+                                and its diffusion solve; part of setup */
+    int field_sweeps;        /* that solve's sweeps (0: kept from the last frame) */
 } atmos_slice_timing;
 
 /* What atmos_render_slice needs beyond the scene; zero means default for every field. The

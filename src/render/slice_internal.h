@@ -7,6 +7,7 @@
 
 #include "atmosphere/atmosphere_ops.h"
 #include "core/internal.h"
+#include "light/lfield.h"
 #include "render/plan_internal.h"
 #include "render/slice_grid.h"
 #include "render/slice_tables.h"
@@ -36,6 +37,8 @@ typedef struct {
     double hl;                   /* h . lt */
     const sgrid *g;
     const stables *t;
+    const atmos__lfield *field;  /* the diffuse light field, or NULL */
+    const float (*fg)[ATMOS_MAX_WAVELENGTHS]; /* the fields' asymmetry g per wavelength */
     /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
      * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
      * coordinate (texel units, centres at integers) F0 + k dF. */
@@ -100,7 +103,33 @@ struct atmos__slice_plan {
     float *ring, **I, **nsc; /* the light ring: batch + 1 slots */
     int batch;
     slight light;
+    /* The diffuse light field (slice_field.c; "diffuse"): the medium on its grid, each
+     * cell's mean density of each field ([cell * nf + f]), the fields' asymmetry g. */
+    int diffuse;
+    atmos__lmedium fmed;
+    float *fdens;
+    float fg[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    atmos__lfield field;
 };
+
+/* The diffuse light field: its medium built from the render grid and the optics (once per
+ * plan), and the field brought up to date for the sun direction sun_w (a solve when the sun
+ * moved, warm-started from the last one). */
+atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *sp, const atmos_volume_optics *o);
+atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
+                                       const double sun_w[3]);
+
+/* The diffuse field at render-voxel point (u, v, w), toward the frame's eye: per wavelength
+ * its mean radiance L[c] and A[c] = 3/(4 pi) J . d, d the unit direction to the eye (from the
+ * field's cells, atmos__lfield_toward); a medium of asymmetry g scatters L + g A toward the eye
+ * (Eddington's two terms). */
+static inline void atmos__slice_field_at(const atmos__lfield *f, float u, float v, float w, float *L, float *A)
+{
+    float o[2 * ATMOS_MAX_WAVELENGTHS];
+    const int n = f->n;
+    atmos__lfield_sample(f, f->LA, 2 * n, u, v, w, o);
+    for (int c = 0; c < n; c++) L[c] = o[c], A[c] = o[n + c];
+}
 
 /* Slice indices k whose plane s_k = s0 + (k + 0.5) ds lies in [sa, sb] (k0 > k1: none). */
 void atmos__slice_range(double sa, double sb, double s0, double ds, int nslices, int *k0, int *k1);

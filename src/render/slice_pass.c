@@ -319,10 +319,46 @@ SLICE_INLINE void eye_optics(const sjob *j, const echunk *e, int c, float *restr
     }
 }
 
+/* The diffuse light field at the samples of slice k, read at the points eye_samples
+ * computed: L and A ([q * n + c], atmos__slice_field_at). */
+SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict Lf, float *restrict Af)
+{
+    const float kf = (float)k;
+    const int n = j->n;
+    for (int q = 0; q < e->mv; q++) {
+        const size_t p = p0 + (size_t)lane(e, q);
+        const float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
+                    w = j->pU0[2][p] + kf * j->pdU[2][p];
+        atmos__slice_field_at(j->field, u, v, w, Lf + (size_t)q * n, Af + (size_t)q * n);
+    }
+}
+
+/* Wavelength c of the diffuse field scattered toward the eye: ds[q] = sum over the fields of
+ * beta_sca (L + g A), not below 0 (NULL without a field). */
+SLICE_INLINE float *eye_field_src(const sjob *j, const echunk *e, int c, const float *Lf, const float *Af,
+                                  float *restrict ds)
+{
+    if (!j->field) return NULL;
+    const int n = j->n;
+    for (int q = 0; q < e->mv; q++) ds[q] = 0.0f;
+    for (int f = 0; f < j->nf; f++) {
+        if (!e->live[f]) continue;
+        const float sa = j->t->sca[f][c], g = j->fg[f][c];
+        const float *restrict d = e->dens + f * CH;
+        for (int q = 0; q < e->mv; q++) {
+            const float bs = (d[q] > 0.0f ? d[q] : 0.0f) * sa;
+            ds[q] += bs > 0.0f ? bs * (Lf[(size_t)q * n + c] + g * Af[(size_t)q * n + c]) : 0.0f;
+        }
+    }
+    for (int q = 0; q < e->mv; q++) ds[q] = ds[q] > 0.0f ? ds[q] : 0.0f;
+    return ds;
+}
+
 /* Eq. 26 for wavelength c: the slab's transmittance and in-scattered light, composited
- * into the eye buffer over (back to front) or under (front to back). */
+ * into the eye buffer over (back to front) or under (front to back); ds (or NULL): the
+ * diffuse field's in-scattering added to the beam's. */
 SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
-                             const float *restrict bext, const float *restrict src)
+                             const float *restrict bext, const float *restrict src, const float *restrict ds)
 {
     float Tq[CH], Cq[CH];
     for (int q = 0; q < e->mv; q++) {
@@ -331,7 +367,7 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
         /* beta_sca Delta of Eq. 26, integrated over the slab with its own attenuation:
          * (1 - T)/beta_ext (-> Delta when thin). */
         const float len = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
-        const float contrib = Ic[q] * src[q] * len;
+        const float contrib = (ds ? Ic[q] * src[q] + ds[q] : Ic[q] * src[q]) * len;
         Tq[q] = be > 0.0f ? T : 1.0f;
         Cq[q] = be > 0.0f ? contrib : 0.0f;
     }
@@ -428,13 +464,14 @@ SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float (*restric
 }
 
 /* The light, the optics and the blend of an RGB chunk. */
-SLICE_INLINE void eye_rgb(const sjob *j, size_t p0, echunk *e, const float *Ib)
+SLICE_INLINE void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib)
 {
-    float I3[4][CH], be3[3][CH], src3[3][CH];
+    float I3[4][CH], be3[3][CH], src3[3][CH], Lf[3 * CH], Af[3 * CH], ds[CH];
     eye_rgb_light(j, e, Ib, I3);
     eye_orders(j, p0, e);
     eye_rgb_optics(j, e, be3, src3);
-    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c]);
+    if (j->field) eye_field(j, k, p0, e, Lf, Af);
+    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], eye_field_src(j, e, c, Lf, Af, ds));
 }
 #else
 #define SLICE_RGB 0
@@ -446,7 +483,8 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
     const int n = j->n;
     const int32_t ns = n + 1, LN = j->L * ns; /* texels interleave I per wavelength and n */
     echunk e;
-    float Ic[CH], bext[CH], src[CH];
+    float Ic[CH], bext[CH], src[CH], ds[CH];
+    float Lf[CH * ATMOS_MAX_WAVELENGTHS], Af[CH * ATMOS_MAX_WAVELENGTHS]; /* the diffuse field at the samples */
     long long count = 0;
     for (int xs = x0; xs <= x1; xs += CH) {
         const int cnt = x1 - xs + 1 < CH ? x1 - xs + 1 : CH;
@@ -456,16 +494,17 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
         eye_texels(j, k, p0, &e);
 #if SLICE_RGB
         if (n == 3) {
-            eye_rgb(j, p0, &e, Ib);
+            eye_rgb(j, k, p0, &e, Ib);
             continue;
         }
 #endif
         eye_bilinear(&e, nb, ns, LN, e.nsc);
         eye_orders(j, p0, &e);
+        if (j->field) eye_field(j, k, p0, &e, Lf, Af);
         for (int c = 0; c < n; c++) {
             eye_bilinear(&e, Ib + c, ns, LN, Ic);
             eye_optics(j, &e, c, bext, src);
-            eye_blend(j, p0, &e, c, Ic, bext, src);
+            eye_blend(j, p0, &e, c, Ic, bext, src, eye_field_src(j, &e, c, Lf, Af, ds));
         }
     }
     return count;

@@ -6,22 +6,6 @@
 
 #include <math.h>
 
-/* Linear interpolation in a per-order table at fractional n >= 0; past the last order,
- * F is held (F_n -> 1/2) and S grows by ln F of the last order per order. */
-static inline float order_lerp(const float *tab, float n, int extend)
-{
-    if (!(n > 0.0f)) return tab[0];
-    if (n >= (float)SLICE_F_ORDERS) {
-        if (!extend) return tab[SLICE_F_ORDERS];
-        float slope = tab[SLICE_F_ORDERS] - tab[SLICE_F_ORDERS - 1];
-        return tab[SLICE_F_ORDERS] + slope * (n - (float)SLICE_F_ORDERS);
-    }
-    int i = (int)n;
-    float f = n - (float)i;
-    return tab[i] + f * (tab[i + 1] - tab[i]);
-}
-
-
 /* Trilinear densities of all fields at render-voxel coordinate (u, v, w). Returns 0
  * if the point is outside the grid or in an empty occupancy block (dens untouched). */
 static inline int sgrid_sample_u(const sgrid *g, float u, float v, float w, float *dens)
@@ -88,13 +72,16 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
         int oi = (int)(mm - 1.0f);
         if (oi > no - 2) oi = no - 2;
         const float fo = mm - 1.0f - (float)oi;
+        float Ld[ATMOS_MAX_WAVELENGTHS], Ad[ATMOS_MAX_WAVELENGTHS];
+        if (j->field) atmos__slice_field_at(j->field, u, v, w, Ld, Ad);
         for (int c = 0; c < n; c++) {
-            float bext = 0, src = 0;
+            float bext = 0, src = 0, dsrc = 0;
             for (int f = 0; f < nf; f++) {
                 if (dens[f] <= 0.0f) continue;
                 bext += dens[f] * j->t->sig[f][c];
                 float bs = dens[f] * j->t->sca[f][c];
                 if (bs > 0.0f) {
+                    if (j->field) dsrc += bs * (Ld[c] + j->fg[f][c] * Ad[c]);
                     const float *q = j->t->ams[f] + ((size_t)j->pa[p * nf + f] + (size_t)oi * n + c);
                     const size_t an = (size_t)no * n; /* next angle; next order: + n */
                     float lo = q[0] + fo * (q[n] - q[0]);
@@ -108,7 +95,8 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
             /* beta_sca Delta of Eq. 26, integrated over the slab with its own
              * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
             float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
-            float contrib = I[c] * src * len;
+            /* the diffuse field scattered toward the eye: beta_sca (L + g A), not below 0 */
+            float contrib = (j->field ? I[c] * src + (dsrc > 0.0f ? dsrc : 0.0f) : I[c] * src) * len;
             float *Lp = j->L_eye + c * j->pst + p, *Tp = j->T_eye + c * j->pst + p;
             if (j->btf) *Lp = *Lp * Tslab + contrib; /* back-to-front: over */
             else *Lp += *Tp * contrib;               /* front-to-back: under */

@@ -18,6 +18,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     free(sp->pixblock), free(sp->spans), free(sp->lk), free(sp->ring), free(sp->I), free(sp->nsc);
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
     atmos__aerial_free(&sp->aerial);
+    atmos__lmedium_free(&sp->fmed), atmos__lfield_free(&sp->field), free(sp->fdens);
     free(sp);
 }
 
@@ -60,12 +61,14 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     sp->low_albedo = ss->low_albedo;
     sp->eq24 = ss->eq24;
     sp->xi = (float)ss->xi;
+    sp->diffuse = ss->diffuse && !ss->low_albedo;
     sp->reference = p->reference;
     atmos__vol_xform_init(p->volume, p->offset, &sp->x);
     atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, ss->grid_max_dim, &sp->g);
     if (st == ATMOS_OK && sp->g.v) st = atmos__stables_build(ctx, p->optics, sp->n, ss->max_order, &sp->tab);
     if (st == ATMOS_OK && sp->g.v && !light_buffers(sp))
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the light buffer");
+    if (st == ATMOS_OK && sp->g.v && sp->diffuse) st = atmos__slice_field_prepare(ctx, sp, p->optics);
     if (st != ATMOS_OK) {
         atmos__slice_plan_destroy(sp);
         return st;
@@ -93,7 +96,7 @@ void atmos__slice_describe(const atmos_plan *p, const atmos__view *v, char *buf,
     const int slices = v->slices > 0 ? v->slices : p->slice->slices_used;
     snprintf(buf, cap, "%d slices%s, light buffer %d, eye buffer %dx%d, xi %g, %s%s", slices,
              v->slices > 0 ? "" : " (chosen)", ss->light_size, w, h,
-             ss->xi, ss->eq24 ? "eq24" : "eq25", ss->low_albedo ? ", low albedo" : "");
+             ss->xi, ss->eq24 ? "eq24" : "eq25", ss->low_albedo ? ", low albedo" : (ss->diffuse ? ", diffuse field" : ""));
 }
 
 atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out,
@@ -112,6 +115,16 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         sjob j;
         const double t_setup = atmos__now();
         if ((st = atmos__slice_frame_setup(ctx, sp, p->atm, v, r, &j)) != ATMOS_OK) return st;
+        if (sp->diffuse) {
+            const int kept = sp->field.valid && memcmp(sp->field.sun, v->sun, sizeof v->sun) == 0;
+            if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun)) != ATMOS_OK) return st;
+            j.field = &sp->field;
+            j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->fg;
+            double eu[3]; /* the eye in render-voxel coordinates */
+            for (int a = 0; a < 3; a++) eu[a] = j.eye[a] * sp->g.sc + sp->g.off[a];
+            atmos__lfield_toward(&sp->field, eu, atmos__threads(ctx));
+            if (!kept) tm->field = sp->field.build_s, tm->field_sweeps = sp->field.sweeps;
+        }
         tm->setup = atmos__now() - t_setup;
         tm->prepare = sp->prepare_s;
         tm->eye_dims[0] = j.W, tm->eye_dims[1] = j.H;

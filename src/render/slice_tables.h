@@ -31,4 +31,19 @@ void atmos__stables_free(stables *t);
  * before the angle-table reader (optics/angle_table.h); the result does not depend on it. */
 void atmos__angle_locate(const double *grid, int ng, double theta_deg, int *a, float *w);
 
+/* Linear interpolation in a per-order table at fractional n >= 0; past the last order,
+ * F is held (F_n -> 1/2) and S grows by ln F of the last order per order. */
+static inline float order_lerp(const float *tab, float n, int extend)
+{
+    if (!(n > 0.0f)) return tab[0];
+    if (n >= (float)SLICE_F_ORDERS) {
+        if (!extend) return tab[SLICE_F_ORDERS];
+        float slope = tab[SLICE_F_ORDERS] - tab[SLICE_F_ORDERS - 1];
+        return tab[SLICE_F_ORDERS] + slope * (n - (float)SLICE_F_ORDERS);
+    }
+    int i = (int)n;
+    float f = n - (float)i;
+    return tab[i] + f * (tab[i + 1] - tab[i]);
+}
+
 #endif

@@ -88,7 +88,7 @@ static void scene_for(atmos_scene *s, double sun_el, double sun_az)
  * scene's; xi < 0: none), and the call's optics and reference passes. */
 typedef struct {
     const atmos_volume_optics *optics;
-    int slices, light_size, eq24, low_albedo, reference;
+    int slices, light_size, eq24, low_albedo, reference, diffuse;
     double xi, density_scale, eye_scale;
 } sopts;
 
@@ -107,6 +107,7 @@ static atmos_status render_st(atmos_context *ctx, const atmos_scene *scene, cons
         if (o->xi != 0) s.slice.xi = o->xi < 0 ? 0 : o->xi;
         s.slice.eq24 = o->eq24;
         s.slice.low_albedo = o->low_albedo;
+        s.slice.diffuse = o->diffuse;
         if (o->density_scale != 0) s.volume.density_scale = o->density_scale;
         if (o->eye_scale != 0) s.slice.eye_scale = o->eye_scale;
     }
@@ -273,12 +274,13 @@ static void test_threads_and_finite(void)
     for (int i = 0; i < 5; i++) {
         atmos_scene s;
         scene_for(&s, suns[i][0], suns[i][1]);
-        for (int u = 0; u < 2; u++) {
+        for (int u = 0; u < 3; u++) { /* eq25, eq24, eq25 with the diffuse light field */
             sopts ss = {0};
             ss.optics = &op.o;
             ss.slices = 64;
             ss.light_size = 64;
-            ss.eq24 = u != 0;
+            ss.eq24 = u == 1;
+            ss.diffuse = u == 2;
             atmos_image *a = render(c1, &s, v, &ss), *b = render(c2, &s, v, &ss);
             CHECK(a && b && all_finite(a) && all_finite(b));
             if (a && b)
@@ -411,8 +413,8 @@ static void test_empty_and_errors(void)
 
 /* The fast passes (SoA chunks, polynomial exp/log) against the reference scalar passes
  * (libm expf/logf), thin and optically thick (slabs with beta Delta > 1, where Eq. 25
- * raises alpha F to a power), both compositing orders, Eq. 25, Eq. 24, low albedo:
- * every pixel within 1e-5 of the image maximum. */
+ * raises alpha F to a power), both compositing orders, Eq. 25, Eq. 24, low albedo, Eq. 25
+ * with the diffuse light field: every pixel within 1e-5 of the image maximum. */
 static void test_fast_vs_reference(void)
 {
     optics op;
@@ -422,11 +424,12 @@ static void test_fast_vs_reference(void)
     const double suns[][2] = {{35, 200}, {20, 10}};
     double worst = 0;
     for (int i = 0; i < 2; i++)
-        for (int mode = 0; mode < 3; mode++)
+        for (int mode = 0; mode < 4; mode++)
             for (int thick = 0; thick < 2; thick++) {
                 atmos_scene s;
                 scene_for(&s, suns[i][0], suns[i][1]);
                 sopts ss = {0};
+                ss.diffuse = mode == 3;
                 ss.optics = &op.o;
                 ss.slices = thick ? 61 : 64; /* 61: the last batch of slices is partial */
                 ss.eq24 = mode == 1;

@@ -78,7 +78,7 @@ static atmos_status bench_plan(atmos_context *ctx, atmos_volume *v, const atmos_
 }
 
 static void print_slice(const char *name, int size, int threads, const double fps[3], const atmos_plan_stats *s,
-                        double prepare_s, int json)
+                        double prepare_s, int diffuse, int json)
 {
     const atmos_slice_timing *t = &s->slice;
     const long long samples = t->eye_samples + t->light_samples;
@@ -87,18 +87,21 @@ static void print_slice(const char *name, int size, int threads, const double fp
                              "\"fps_camera_moving\":%.3f,\"fps_sun_moving\":%.3f,\"fps_static\":%.3f,"
                              "\"ms_per_frame\":%.2f,\"ns_per_sample\":%.2f,\"setup_ms\":%.2f,\"light_ms\":%.2f,"
                              "\"eye_ms\":%.2f,\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"eye_samples\":%lld,"
-                             "\"light_samples\":%lld,\"grid\":[%d,%d,%d]}\n"
+                             "\"light_samples\":%lld,\"grid\":[%d,%d,%d],\"diffuse\":%d,\"field_ms\":%.2f,"
+                             "\"field_sweeps\":%d}\n"
                            : "bench=slice case=%s size=%d threads=%d eye=%dx%d fps_camera_moving=%.3f fps_sun_moving=%.3f "
                              "fps_static=%.3f ms_per_frame=%.2f ns_per_sample=%.2f setup_ms=%.2f light_ms=%.2f eye_ms=%.2f "
-                             "sky_ms=%.2f prepare_ms=%.2f eye_samples=%lld light_samples=%lld grid=%dx%dx%d\n";
+                             "sky_ms=%.2f prepare_ms=%.2f eye_samples=%lld light_samples=%lld grid=%dx%dx%d diffuse=%d "
+                             "field_ms=%.2f field_sweeps=%d\n";
     printf(fmt, name, size, threads, t->eye_dims[0], t->eye_dims[1], fps[MOVE_CAMERA], fps[MOVE_SUN], fps[MOVE_NOTHING],
            1e3 / fps[MOVE_SUN], ns, 1e3 * t->setup, 1e3 * t->light, 1e3 * t->eye, 1e3 * t->sky, 1e3 * prepare_s,
-           t->eye_samples, t->light_samples, t->grid_dims[0], t->grid_dims[1], t->grid_dims[2]);
+           t->eye_samples, t->light_samples, t->grid_dims[0], t->grid_dims[1], t->grid_dims[2], diffuse, 1e3 * t->field,
+           t->field_sweeps);
     fflush(stdout);
 }
 
 int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
-                     int json)
+                     int diffuse, int json)
 {
     atmos_scene scene;
     atmos_plan *plan = NULL;
@@ -109,6 +112,7 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     double offset[3];
     bench_view(&scene, v, size, offset);
     scene.renderer = ATMOS_RENDERER_SLICE;
+    scene.slice.diffuse = diffuse;
     atmos_status st = bench_plan(ctx, v, &scene, &plan, &prepare);
     if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
     if (eye_scale > 0) start.eye_scale = eye_scale;
@@ -118,7 +122,7 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     atmos_plan_destroy(plan);
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
-    print_slice(name, size, atmos_context_threads(ctx), fps, &stats[MOVE_SUN], prepare, json);
+    print_slice(name, size, atmos_context_threads(ctx), fps, &stats[MOVE_SUN], prepare, diffuse, json);
     return CLI_EXIT_OK;
 }
 

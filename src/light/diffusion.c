@@ -1,0 +1,217 @@
+/* The diffuse light of all orders by a diffusion solve on the light field's grid (lfield.h,
+ * atmos__lfield_diffuse).
+ *
+ * With the forward beam taken apart (sun_source.c), the rest of the light is diffuse. Its
+ * fluence phi obeys the diffusion approximation of radiative transfer (e.g. Ishimaru 1978,
+ * ch. 9; Stam 1995 "Multiple scattering as a diffusion process"):
+ *     -div(D grad phi) + sig_a phi = Q,   D = 1 / (3 sig_tr),   sig_tr = sig_t - g sig_s,
+ * sig_tr being the similarity-scaled (delta-Eddington, Joseph et al. 1976) extinction, which
+ * carries the anisotropy of scattering into an isotropic transport. Where the medium is thin
+ * D grows without bound and the flux |D grad phi| may exceed phi (faster than light); the
+ * flux limiter of Levermore & Pomraning 1981 in its "sum" form, D = 1 / (3 sig_tr +
+ * |grad phi| / phi), bounds it by phi (the streaming limit). At a face to vacuum the Marshak
+ * condition (no diffuse light coming in: phi/4 - D/2 dphi/dn = 0 with n inward) gives the
+ * outgoing flux phi_b / 2 at the face; with the face value reached from the cell's centre
+ * over h/2 that is phi a / ((2 a + 1)) per area, a = 2 D / h. Light coming in through the
+ * face (the partial current J_in: the sky, the ground) makes it (phi - 4 J_in) a / (2 a + 1).
+ *
+ * Cell-centred finite volumes (harmonic mean of D at a face), red-black successive
+ * over-relaxation (each colour's update reads only the other colour: the result does not
+ * depend on the thread count), the diffusion coefficient lagged and refreshed every few
+ * sweeps when the limiter is on. phi holds the previous solution (the warm start). */
+#include "light/lfield.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define DIFF_OMEGA 1.8    /* over-relaxation */
+#define DIFF_REFRESH 4    /* sweeps between refreshes of the flux-limited D */
+
+
+/* The diffusion coefficient of cell (i, j, k), wavelength w. */
+static double cell_D(const atmos__lmedium *m, const float *phi, int i, int j, int k, int w, int limiter)
+{
+    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    const size_t cell = ((size_t)k * cy + j) * cx + i;
+    double str = m->sig_t[cell * n + w] - m->g[cell * n + w] * m->sig_s[cell * n + w];
+    double den = 3.0 * (str > 0 ? str : 0);
+    if (limiter) {
+        const int ix[3] = {i, j, k};
+        const size_t st[3] = {1, (size_t)cx, (size_t)cx * cy};
+        const double p = phi[cell * n + w];
+        double g2 = 0;
+        for (int a = 0; a < 3; a++) {
+            const int c = m->c[a];
+            if (c < 2) continue;
+            int lo = ix[a] - 1, hi = ix[a] + 1;
+            double span = 2.0;
+            if (m->periodic[a]) {
+                lo = (lo + c) % c, hi = hi % c;
+            } else {
+                if (lo < 0) lo = ix[a], span = 1.0;
+                if (hi >= c) hi = ix[a], span -= 1.0;
+            }
+            const double d = (phi[(cell + (size_t)(hi - ix[a]) * st[a]) * n + w] -
+                              phi[(cell - (size_t)(ix[a] - lo) * st[a]) * n + w]) / (span * m->h);
+            g2 += d * d;
+        }
+        if (p > 0) den += sqrt(g2) / p;
+    }
+    /* D at most the grid's largest extent: a void's coupling stays finite without the limiter */
+    const int big = cx > cy ? (cx > cz ? cx : cz) : (cy > cz ? cy : cz);
+    const double dmin = 1.0 / (big * m->h);
+    return 1.0 / (den > dmin ? den : dmin);
+}
+
+static void refresh_D(const atmos__lmedium *m, const float *phi, int w, int limiter, float *D)
+{
+    const int cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    for (int k = 0; k < cz; k++)
+        for (int j = 0; j < cy; j++)
+            for (int i = 0; i < cx; i++)
+                D[((size_t)k * cy + j) * cx + i] = (float)cell_D(m, phi, i, j, k, w, limiter);
+}
+
+/* The six neighbours of a cell: offsets, -1: a vacuum face, -2: none (a periodic axis of one
+ * cell, which is its own neighbour: no exchange). */
+static void neighbours(const atmos__lmedium *m, int i, int j, int k, long long nb[6])
+{
+    const int ix[3] = {i, j, k};
+    const long long st[3] = {1, m->c[0], (long long)m->c[0] * m->c[1]};
+    const long long cell = ((long long)k * m->c[1] + j) * m->c[0] + i;
+    for (int a = 0; a < 3; a++) {
+        const int c = m->c[a];
+        for (int s = 0; s < 2; s++) {
+            int x = ix[a] + (s ? 1 : -1);
+            if (m->periodic[a]) x = (x + c) % c;
+            nb[2 * a + s] = x < 0 || x >= c ? -1 : (x == ix[a] ? -2 : cell + (long long)(x - ix[a]) * st[a]);
+        }
+    }
+}
+
+/* One colour's half-sweep of wavelength w; returns the largest change. */
+static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, const float *D, int w, int colour)
+{
+    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    const double h = m->h, ih2 = 1.0 / (h * h);
+    double big = 0;
+    for (int k = 0; k < cz; k++)
+        for (int j = 0; j < cy; j++)
+            for (int i = (j + k + colour) & 1; i < cx; i += 2) {
+                const size_t cell = ((size_t)k * cy + j) * cx + i;
+                long long nb[6];
+                neighbours(m, i, j, k, nb);
+                const double Di = D[cell];
+                double diag = m->sig_t[cell * n + w] - m->sig_s[cell * n + w], sum = Q[cell * n + w];
+                diag = diag > 0 ? diag : 0;
+                for (int f = 0; f < 6; f++) {
+                    if (nb[f] == -2) continue;
+                    if (nb[f] == -1) {
+                        const double a = 2.0 * Di / h, b = a / ((2.0 * a + 1.0) * h);
+                        diag += b;
+                        if (m->jin) sum += b * 4.0 * m->jin[f * n + w];
+                    } else {
+                        const double Dn = D[nb[f]], c = 2.0 * Di * Dn / (Di + Dn) * ih2;
+                        diag += c;
+                        sum += c * phi[(size_t)nb[f] * n + w];
+                    }
+                }
+                if (!(diag > 0)) continue;
+                const double old = phi[cell * n + w];
+                double v = old + DIFF_OMEGA * (sum / diag - old);
+                v = v > 0 ? v : 0;
+                phi[cell * n + w] = (float)v;
+                const double d = fabs(v - old);
+                big = d > big ? d : big;
+            }
+    return big;
+}
+
+/* The solve of wavelength w; returns its sweeps (-1: out of memory). */
+static int solve_one(const atmos__lmedium *m, const float *Q, float *phi, int w, int maxs, double tol, int limiter)
+{
+    const int n = m->n;
+    const size_t cells = atmos__lmedium_cells(m);
+    float *D = malloc(sizeof(float) * cells);
+    if (!D) return -1;
+    int s = 0;
+    for (; s < maxs; s++) {
+        if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, phi, w, limiter, D);
+        double ch = half_sweep(m, Q, phi, D, w, 0);
+        double ch1 = half_sweep(m, Q, phi, D, w, 1);
+        ch = ch1 > ch ? ch1 : ch;
+        double top = 0;
+        for (size_t c = 0; c < cells; c++) top = phi[c * n + w] > top ? phi[c * n + w] : top;
+        if (!(top > 0) || ch <= tol * top) {
+            s++;
+            break;
+        }
+    }
+    free(D);
+    return s;
+}
+
+int atmos__lfield_diffuse(const atmos__lmedium *m, const float *Q, float *phi, const atmos__ldiffusion_opts *o,
+                          int threads)
+{
+    const int n = m->n, maxs = o && o->max_sweeps > 0 ? o->max_sweeps : 2000, limiter = o ? o->limiter : 0;
+    const double tol = o && o->tol > 0 ? o->tol : 1e-4;
+    int most = 0, fail = 0;
+    /* the wavelengths in parallel, each solved by one thread: no barrier per sweep (which
+     * costs a time slice whenever the machine is busy), the same result for any thread count */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(max : most) reduction(| : fail)
+    for (int w = 0; w < n; w++) {
+        const int s = solve_one(m, Q, phi, w, maxs, tol, limiter);
+        if (s < 0) fail = 1;
+        most = s > most ? s : most;
+    }
+    return fail ? -1 : most;
+}
+
+void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, int w,
+                        double out[6])
+{
+    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2], limiter = o ? o->limiter : 0;
+    const double h = m->h;
+    for (int f = 0; f < 6; f++) out[f] = 0;
+    for (int k = 0; k < cz; k++)
+        for (int j = 0; j < cy; j++)
+            for (int i = 0; i < cx; i++) {
+                long long nb[6];
+                neighbours(m, i, j, k, nb);
+                const size_t cell = ((size_t)k * cy + j) * cx + i;
+                for (int f = 0; f < 6; f++) {
+                    if (nb[f] != -1) continue;
+                    const double a = 2.0 * cell_D(m, phi, i, j, k, w, limiter) / h;
+                    const double in4 = m->jin ? 4.0 * m->jin[f * n + w] : 0.0;
+                    out[f] += (phi[cell * n + w] - in4) * a / (2.0 * a + 1.0) * h * h;
+                }
+            }
+}
+
+void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, float *J,
+                        int threads)
+{
+    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2], limiter = o ? o->limiter : 0;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int k = 0; k < cz; k++)
+        for (int j = 0; j < cy; j++)
+            for (int i = 0; i < cx; i++) {
+                const size_t cell = ((size_t)k * cy + j) * cx + i;
+                long long nb[6];
+                neighbours(m, i, j, k, nb);
+                for (int w = 0; w < n; w++) {
+                    const double D = cell_D(m, phi, i, j, k, w, limiter), p = phi[cell * n + w];
+                    for (int a = 0; a < 3; a++) {
+                        /* a missing neighbour: the face value of the Marshak condition is
+                         * not known here; the one-sided difference of the other side */
+                        const long long lo = nb[2 * a], hi = nb[2 * a + 1];
+                        double d = 0;
+                        if (lo >= 0 && hi >= 0) d = (phi[(size_t)hi * n + w] - phi[(size_t)lo * n + w]) / (2 * m->h);
+                        else if (hi >= 0) d = (phi[(size_t)hi * n + w] - p) / m->h;
+                        else if (lo >= 0) d = (p - phi[(size_t)lo * n + w]) / m->h;
+                        J[(cell * n + w) * 3 + a] = (float)(-D * d);
+                    }
+                }
+            }
+}

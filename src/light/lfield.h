@@ -1,0 +1,140 @@
+/* Light fields (DESIGN.md §13): a grid over a volume holding, per cell and wavelength, light
+ * that a renderer's eye pass reads instead of computing it per sample. One container for
+ * every solver: a plan product made once per sun direction (and sky) and reused by the eye
+ * passes of every frame until the sun moves.
+ *
+ *   lfield.c      the container: the grid, its cells' values, the field turned toward an eye
+ *                 (the trilinear read is inline below)
+ *   lmedium.c     the medium on the field's grid (extinction, scattering, asymmetry per cell)
+ *   sun_source.c  the sunlight a forward-lobe model (Riley et al. 2004 Eq. 24/25) drops at
+ *                 each scattering: the source of the diffuse field
+ *   diffusion.c   the diffuse light of all orders by a (flux-limited) diffusion solve
+ *
+ * Kinds: ATMOS__LFIELD_DIFFUSION (docs/lightfield.md). Nishita et al. 1996's reference
+ * patterns would fill the same cells with the radiance of orders 2 and 3 (a later kind).
+ * Not part of the API. */
+#ifndef ATMOS_LIGHT_LFIELD_H
+#define ATMOS_LIGHT_LFIELD_H
+
+#include "core/internal.h"
+
+#include <stddef.h>
+
+typedef enum {
+    ATMOS__LFIELD_NONE = 0,
+    ATMOS__LFIELD_DIFFUSION = 1, /* mean radiance of the diffuse light, isotropic */
+} atmos__lfield_kind;
+
+/* The medium on the field's grid: cell (i, j, k) is the box [i h, (i + 1) h) x ... in the
+ * field's frame (metres from the grid's corner); per cell and wavelength ([cell * n + w]). */
+typedef struct {
+    int c[3], n;     /* cells per axis, wavelengths */
+    double h;        /* cell edge, m */
+    int periodic[3]; /* 1: the axis wraps around (a horizontally infinite layer); 0: vacuum beyond */
+    float *sig_t;    /* extinction, m^-1 */
+    float *sig_s;    /* scattering, m^-1 */
+    float *g;        /* asymmetry parameter <cos theta> of the scattering */
+    float *jin;      /* [face * n + w] or NULL: the diffuse light coming in through each non-periodic
+                        face (-x, +x, -y, +y, -z, +z) from outside, the inward partial current
+                        (irradiance), W m^-2 nm^-1: the sky and the ground as boundary sources */
+} atmos__lmedium;
+
+/* The field: cell (i, j, k) stands for the s^3 host voxels i s .. i s + s - 1 (host-voxel
+ * centres at integer coordinates), its value at the centre of those, (i + (s - 1)/2 ...). */
+typedef struct {
+    int kind;
+    int c[3], n; /* cells per axis, wavelengths */
+    int s;       /* host voxels per cell edge */
+    float *L;    /* [cell * n + w]: mean radiance of the diffuse light, W m^-2 sr^-1 nm^-1 */
+    float *J;    /* [(cell * n + w) * 3 + axis]: its net flux (first moment), W m^-2 nm^-1, in the
+                    grid's frame: the radiance toward unit direction d is L + 3/(4 pi) J . d */
+    float *LA;   /* [cell * 2 n + w]: L, then [cell * 2 n + n + w]: A = 3/(4 pi) J . d toward one
+                    eye (d from the cell's centre; the renderer's per-frame view of the field) */
+    float *phi;  /* [cell * n + w]: its fluence (4 pi L), the solver's unknown (its warm start) */
+    /* what it was computed for */
+    int valid;
+    double sun[3];
+    /* the last solve */
+    int sweeps;
+    double build_s, source_s, solve_s;
+} atmos__lfield;
+
+/* Fills f->LA for an eye at host-voxel coordinate eye (grid and host axes aligned, the host's
+ * voxels cubes). */
+void atmos__lfield_toward(atmos__lfield *f, const double eye[3], int threads);
+
+size_t atmos__lmedium_cells(const atmos__lmedium *m);
+int atmos__lmedium_alloc(atmos__lmedium *m, int cx, int cy, int cz, int n, double h);
+void atmos__lmedium_free(atmos__lmedium *m);
+
+/* Allocates a field of cells cx x cy x cz (s host voxels each) for n wavelengths, zero. */
+int atmos__lfield_alloc(atmos__lfield *f, int kind, int cx, int cy, int cz, int n, int s);
+void atmos__lfield_free(atmos__lfield *f);
+
+/* Trilinear value at host-voxel coordinate (u, v, w) (clamped to the outer cells' centres)
+ * of an array of m floats per cell (L: n, J: 3 n): out[m]. */
+static inline void atmos__lfield_axis(float u, int s, int c, int *i, float *w)
+{
+    float x = (u - 0.5f * (float)(s - 1)) / (float)s;
+    const float lim = (float)(c - 1);
+    x = x < 0.0f ? 0.0f : (x > lim ? lim : x);
+    int a = (int)x;
+    if (a > c - 2) a = c - 2 < 0 ? 0 : c - 2;
+    *i = a, *w = c > 1 ? x - (float)a : 0.0f;
+}
+
+static inline void atmos__lfield_sample(const atmos__lfield *f, const float *arr, int m, float u, float v, float w,
+                                        float *out)
+{
+    int i, j, k;
+    float a, b, c;
+    atmos__lfield_axis(u, f->s, f->c[0], &i, &a);
+    atmos__lfield_axis(v, f->s, f->c[1], &j, &b);
+    atmos__lfield_axis(w, f->s, f->c[2], &k, &c);
+    const size_t sx = f->c[0] > 1 ? (size_t)m : 0, sy = f->c[1] > 1 ? (size_t)f->c[0] * m : 0,
+                 sz = f->c[2] > 1 ? (size_t)f->c[0] * f->c[1] * m : 0;
+    const float *p = arr + (((size_t)k * f->c[1] + j) * f->c[0] + i) * m;
+    const float w000 = (1 - a) * (1 - b) * (1 - c), w100 = a * (1 - b) * (1 - c), w010 = (1 - a) * b * (1 - c),
+                w110 = a * b * (1 - c), w001 = (1 - a) * (1 - b) * c, w101 = a * (1 - b) * c, w011 = (1 - a) * b * c,
+                w111 = a * b * c;
+    for (int q = 0; q < m; q++)
+        out[q] = w000 * p[q] + w100 * p[sx + q] + w010 * p[sy + q] + w110 * p[sx + sy + q] + w001 * p[sz + q] +
+                 w101 * p[sx + sz + q] + w011 * p[sy + sz + q] + w111 * p[sx + sy + sz + q];
+}
+
+/* The forward-lobe model's kept fraction: the share F of the light scattered at cell `cell`
+ * (wavelength w) that stays in the forward beam when the light has been scattered n times
+ * before (Riley's F_{n+1}, Eq. 23; 0: all of it leaves the beam). */
+typedef float (*atmos__lkeep_fn)(const void *user, size_t cell, int w, float n);
+
+/* The source of the diffuse field (sun_source.c): per cell and wavelength the power per unit
+ * volume, W m^-3 nm^-1, that the forward beam loses to scattering out of its lobe,
+ * sig_s (1 - F) I, where I is the forward beam arriving at the cell's centre from the sun
+ * (travel direction lt, a unit vector in the field's frame; sun[w] its irradiance where it
+ * enters the grid) attenuated by sig_t - sig_s F along the way, the scattering count growing
+ * by sig_s ds (mean over wavelengths, Riley's Eq. 21). Ibeam (may be NULL) gets I. */
+void atmos__lfield_sun_source(const atmos__lmedium *m, const double lt[3], const double *sun, atmos__lkeep_fn keep,
+                              const void *user, float *Q, float *Ibeam, int threads);
+
+typedef struct {
+    int max_sweeps; /* 0: 2000 */
+    double tol;     /* largest change of a sweep over the largest fluence; 0: 1e-4 */
+    int limiter;    /* 1: flux-limited diffusion coefficient (Levermore-Pomraning sum limiter) */
+} atmos__ldiffusion_opts;
+
+/* Solves -div(D grad phi) + sig_a phi = Q on the medium's grid (diffusion.c), D =
+ * 1/(3 sig_tr [+ |grad phi|/phi]), sig_tr = sig_t - g sig_s (the delta-Eddington /
+ * similarity-scaled transport extinction), vacuum (Marshak) boundaries on the non-periodic
+ * faces; phi holds the warm start on entry. Returns the sweeps used. */
+int atmos__lfield_diffuse(const atmos__lmedium *m, const float *Q, float *phi, const atmos__ldiffusion_opts *o,
+                          int threads);
+
+/* The net power leaving through each of the six faces (-x, +x, -y,
+ * +y, -z, +z), (outgoing minus the incoming jin), summed over the face's cells, of wavelength w: out[6], W nm^-1. */
+void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, int w,
+                        double out[6]);
+/* The net flux J = -D grad phi of the solution (central differences), [(cell * n + w) * 3 + a]. */
+void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, float *J,
+                        int threads);
+
+#endif

