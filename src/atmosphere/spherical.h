@@ -113,10 +113,9 @@ atmos_status atmos__sph_build_j(const atmos__planet *pl, atmos__sph_model *m, co
 /* f_ms at (r, mu_s) of wavelength k (a diagnostic of the multiple-scattering table). */
 double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k);
 /* The mappings' inverses the build needs (spherical_lookup.c): the (r, mu) of a depth-table
- * node, the mu_s of a column coordinate; and a clamp. */
+ * node, the mu_s of a column coordinate (the clamp is atmos__clampd, core/vec.h). */
 void atmos__sph_tau_node(const atmos__sph_model *m, double xr, double xm, double *r, double *mu);
 double atmos__sph_x_to_mus(double x);
-static inline double atmos__sph_clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
 /* ------------------------------------------------------------------ the march (spherical_march.c) */
 /* Marches q + t d, t in [t0, t1] (inside the air), sun direction sun; use_ms: add the

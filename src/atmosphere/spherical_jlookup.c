@@ -3,6 +3,7 @@
  * mappings of its coordinates, and the quadrilinear interpolation of its logarithm that the
  * march reads at every step. */
 #include "atmosphere/spherical.h"
+#include "core/vec.h"
 
 #include <math.h>
 
@@ -19,13 +20,13 @@
 double atmos__sph_j_x_to_gamma(double x) { return ATMOS_PI * (GA * x + (1.0 - GA) * x * x); }
 static double gamma_to_x(double g)
 {
-    const double u = atmos__sph_clampd(g / ATMOS_PI, 0.0, 1.0);
+    const double u = atmos__clampd(g / ATMOS_PI, 0.0, 1.0);
     return (-GA + sqrt(GA * GA + 4.0 * (1.0 - GA) * u)) / (2.0 * (1.0 - GA));
 }
 static double mus_x(double mus)
 {
-    const double x = copysign(sqrt(fabs(atmos__sph_clampd(mus, -1, 1))), mus);
-    return atmos__sph_clampd((x + XS) / (1.0 + XS), 0.0, 1.0);
+    const double x = copysign(sqrt(fabs(atmos__clampd(mus, -1, 1))), mus);
+    return atmos__clampd((x + XS) / (1.0 + XS), 0.0, 1.0);
 }
 double atmos__sph_j_x_mus(double x)
 {
@@ -36,7 +37,7 @@ double atmos__sph_j_x_mus(double x)
 /* ------------------------------------------------------------------ look-up */
 void atmos__sph_j_gamma(double nu, atmos__sph_jg *g)
 {
-    const double gm = acos(atmos__sph_clampd(nu, -1.0, 1.0));
+    const double gm = acos(atmos__clampd(nu, -1.0, 1.0));
     const double f = gamma_to_x(gm) * (JG - 1);
     int i = (int)f;
     if (i > JG - 2) i = JG - 2;
@@ -48,10 +49,10 @@ void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, co
                   const int *k, double *jr, double *jm)
 {
     const int n = m->n;
-    const double xr = sqrt(atmos__sph_clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0)) * (JR - 1);
+    const double xr = sqrt(atmos__clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0)) * (JR - 1);
     const double xs = mus_x(mus) * (JS - 1);
     const double den = g->sg * sqrt(fmax(0.0, 1.0 - mus * mus));
-    const double cp = den > 1e-9 ? atmos__sph_clampd((mu - mus * g->cg) / den, -1.0, 1.0) : 1.0;
+    const double cp = den > 1e-9 ? atmos__clampd((mu - mus * g->cg) / den, -1.0, 1.0) : 1.0;
     const double xp = 0.5 * (1.0 - cp) * (JP - 1);
     int ir = (int)xr, is = (int)xs, ip = (int)xp;
     if (ir > JR - 2) ir = JR - 2;

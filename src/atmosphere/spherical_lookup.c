@@ -1,6 +1,7 @@
 /* The production sky's tables' parametrizations and look-ups (spherical.h; what each table
  * holds and how it is built: spherical_tables.c). */
 #include "atmosphere/spherical.h"
+#include "core/vec.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -17,13 +18,13 @@
 /* Bruneton's (x_r, x_mu) of (r, mu) and back. */
 static void tau_coords(const atmos__sph_model *m, double r, double mu, double *xr, double *xm)
 {
-    r = atmos__sph_clampd(r, m->R, m->Rt);
+    r = atmos__clampd(r, m->R, m->Rt);
     const double rho = sqrt(fmax(r * r - m->R * m->R, 0.0));
     const double disc = r * r * (mu * mu - 1.0) + m->Rt * m->Rt;
     const double d = fmax(0.0, -r * mu + sqrt(fmax(disc, 0.0)));
     const double dmin = m->Rt - r, dmax = rho + m->H;
     *xr = rho / m->H;
-    *xm = dmax > dmin ? atmos__sph_clampd((d - dmin) / (dmax - dmin), 0.0, 1.0) : 0.0;
+    *xm = dmax > dmin ? atmos__clampd((d - dmin) / (dmax - dmin), 0.0, 1.0) : 0.0;
 }
 
 void atmos__sph_tau_node(const atmos__sph_model *m, double xr, double xm, double *r, double *mu)
@@ -31,12 +32,12 @@ void atmos__sph_tau_node(const atmos__sph_model *m, double xr, double xm, double
     const double rho = m->H * xr;
     *r = sqrt(rho * rho + m->R * m->R);
     const double dmin = m->Rt - *r, dmax = rho + m->H, d = dmin + xm * (dmax - dmin);
-    *mu = d <= 0 ? 1.0 : atmos__sph_clampd((m->H * m->H - rho * rho - d * d) / (2.0 * *r * d), -1.0, 1.0);
+    *mu = d <= 0 ? 1.0 : atmos__clampd((m->H * m->H - rho * rho - d * d) / (2.0 * *r * d), -1.0, 1.0);
 }
 
 static double mus_to_x(double mus)
 {
-    return 0.5 * (1.0 + copysign(sqrt(fabs(atmos__sph_clampd(mus, -1, 1))), mus));
+    return 0.5 * (1.0 + copysign(sqrt(fabs(atmos__clampd(mus, -1, 1))), mus));
 }
 double atmos__sph_x_to_mus(double x)
 {
@@ -45,13 +46,13 @@ double atmos__sph_x_to_mus(double x)
 }
 static double alt_to_x(const atmos__sph_model *m, double r)
 {
-    return sqrt(atmos__sph_clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0));
+    return sqrt(atmos__clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0));
 }
 
 /* Bilinear look-up in a [n][ny][nx] table at fractional coordinates u (x) and v (y) in [0, 1]. */
 static void bilinear(const float *tab, int ny, int nx, double u, double v, int cnt, const int *k, double *out)
 {
-    const double fx = atmos__sph_clampd(u, 0, 1) * (nx - 1), fy = atmos__sph_clampd(v, 0, 1) * (ny - 1);
+    const double fx = atmos__clampd(u, 0, 1) * (nx - 1), fy = atmos__clampd(v, 0, 1) * (ny - 1);
     int ix = (int)fx, iy = (int)fy;
     if (ix > nx - 2) ix = nx - 2;
     if (iy > ny - 2) iy = ny - 2;
@@ -102,7 +103,7 @@ double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k)
  * columns' 1.2 degrees there put it up to 25 % high. */
 void atmos__sph_esky(const atmos__sph_model *m, double mu_s, int cnt, const int *k, double *out)
 {
-    const double f = atmos__sph_clampd(mus_to_x(mu_s), 0, 1) * (EM - 1);
+    const double f = atmos__clampd(mus_to_x(mu_s), 0, 1) * (EM - 1);
     int i = (int)f;
     if (i > EM - 2) i = EM - 2;
     const double a = f - i;

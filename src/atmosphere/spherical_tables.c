@@ -17,6 +17,7 @@
  * E_sky(mu_s): the irradiance of the ground by the sky (single scattering with the real
  *   phase functions plus Psi_ms), mu_s mapped like Psi's. */
 #include "atmosphere/spherical.h"
+#include "core/vec.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -36,7 +37,7 @@ static void depth_to_top(const atmos__planet *pl, double r, double mu, double *o
     static const double gx[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
     static const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
     enum { P = 12 };
-    const double dist = atmos__planet_dist_top(pl, r, mu), tc = atmos__sph_clampd(-r * mu, 0.0, dist);
+    const double dist = atmos__planet_dist_top(pl, r, mu), tc = atmos__clampd(-r * mu, 0.0, dist);
     const double len[2] = {tc, dist - tc};
     for (int i = 0; i < pl->n; i++) out[i] = 0.0;
     for (int side = 0; side < 2; side++) {

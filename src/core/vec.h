@@ -1,8 +1,12 @@
-/* Small 3-vector helpers shared by the renderers and the geometry code. */
+/* Small 3-vector and scalar helpers shared by the renderers, the geometry code and the
+ * atmosphere's tables. */
 #ifndef ATMOS_CORE_VEC_H
 #define ATMOS_CORE_VEC_H
 
 #include <math.h>
+
+/* x limited to [lo, hi]. */
+static inline double atmos__clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
 static inline double atmos__dot3(const double a[3], const double b[3])
 {
