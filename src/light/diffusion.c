@@ -28,50 +28,6 @@
 #define DIFF_REFRESH 4    /* sweeps between refreshes of the flux-limited D */
 
 
-/* The diffusion coefficient of cell (i, j, k), wavelength w. */
-static double cell_D(const atmos__lmedium *m, const float *phi, int i, int j, int k, int w, int limiter)
-{
-    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
-    const size_t cell = ((size_t)k * cy + j) * cx + i;
-    double str = m->sig_t[cell * n + w] - m->g[cell * n + w] * m->sig_s[cell * n + w];
-    double den = 3.0 * (str > 0 ? str : 0);
-    if (limiter) {
-        const int ix[3] = {i, j, k};
-        const size_t st[3] = {1, (size_t)cx, (size_t)cx * cy};
-        const double p = phi[cell * n + w];
-        double g2 = 0;
-        for (int a = 0; a < 3; a++) {
-            const int c = m->c[a];
-            if (c < 2) continue;
-            int lo = ix[a] - 1, hi = ix[a] + 1;
-            double span = 2.0;
-            if (m->periodic[a]) {
-                lo = (lo + c) % c, hi = hi % c;
-            } else {
-                if (lo < 0) lo = ix[a], span = 1.0;
-                if (hi >= c) hi = ix[a], span -= 1.0;
-            }
-            const double d = (phi[(cell + (size_t)(hi - ix[a]) * st[a]) * n + w] -
-                              phi[(cell - (size_t)(ix[a] - lo) * st[a]) * n + w]) / (span * m->h);
-            g2 += d * d;
-        }
-        if (p > 0) den += sqrt(g2) / p;
-    }
-    /* D at most the grid's largest extent: a void's coupling stays finite without the limiter */
-    const int big = cx > cy ? (cx > cz ? cx : cz) : (cy > cz ? cy : cz);
-    const double dmin = 1.0 / (big * m->h);
-    return 1.0 / (den > dmin ? den : dmin);
-}
-
-static void refresh_D(const atmos__lmedium *m, const float *phi, int w, int limiter, float *D)
-{
-    const int cx = m->c[0], cy = m->c[1], cz = m->c[2];
-    for (int k = 0; k < cz; k++)
-        for (int j = 0; j < cy; j++)
-            for (int i = 0; i < cx; i++)
-                D[((size_t)k * cy + j) * cx + i] = (float)cell_D(m, phi, i, j, k, w, limiter);
-}
-
 /* The six neighbours of a cell: offsets, -1: a vacuum face, -2: none (a periodic axis of one
  * cell, which is its own neighbour: no exchange). */
 static void neighbours(const atmos__lmedium *m, int i, int j, int k, long long nb[6])
@@ -89,12 +45,62 @@ static void neighbours(const atmos__lmedium *m, int i, int j, int k, long long n
     }
 }
 
-/* One colour's half-sweep of wavelength w; returns the largest change. */
-static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, const float *D, int w, int colour)
+/* d phi / d axis a at a cell of wavelength w: the central difference, one-sided where a
+ * neighbour is missing (the face value of the Marshak condition is not known here), 0 with
+ * neither. */
+static double cell_grad(const atmos__lmedium *m, const float *phi, const long long nb[6], size_t cell, int w, int a)
+{
+    const int n = m->n;
+    const long long lo = nb[2 * a], hi = nb[2 * a + 1];
+    if (lo >= 0 && hi >= 0) return (phi[(size_t)hi * n + w] - phi[(size_t)lo * n + w]) / (2 * m->h);
+    if (hi >= 0) return (phi[(size_t)hi * n + w] - phi[cell * n + w]) / m->h;
+    if (lo >= 0) return (phi[cell * n + w] - phi[(size_t)lo * n + w]) / m->h;
+    return 0.0;
+}
+
+/* The diffusion coefficient of a cell (its neighbours nb), wavelength w. */
+static double cell_D(const atmos__lmedium *m, const float *phi, const long long nb[6], size_t cell, int w,
+                     int limiter)
+{
+    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    double str = m->sig_t[cell * n + w] - m->g[cell * n + w] * m->sig_s[cell * n + w];
+    double den = 3.0 * (str > 0 ? str : 0);
+    if (limiter) {
+        const double p = phi[cell * n + w];
+        double g2 = 0;
+        for (int a = 0; a < 3; a++) {
+            const double d = cell_grad(m, phi, nb, cell, w, a);
+            g2 += d * d;
+        }
+        if (p > 0) den += sqrt(g2) / p;
+    }
+    /* D at most the grid's largest extent: a void's coupling stays finite without the limiter */
+    const int big = cx > cy ? (cx > cz ? cx : cz) : (cy > cz ? cy : cz);
+    const double dmin = 1.0 / (big * m->h);
+    return 1.0 / (den > dmin ? den : dmin);
+}
+
+static void refresh_D(const atmos__lmedium *m, const float *phi, int w, int limiter, float *D)
+{
+    const int cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    for (int k = 0; k < cz; k++)
+        for (int j = 0; j < cy; j++)
+            for (int i = 0; i < cx; i++) {
+                long long nb[6];
+                neighbours(m, i, j, k, nb);
+                const size_t cell = ((size_t)k * cy + j) * cx + i;
+                D[cell] = (float)cell_D(m, phi, nb, cell, w, limiter);
+            }
+}
+
+/* One colour's half-sweep of wavelength w; returns the largest change, *top the largest value
+ * of the colour's cells. */
+static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, const float *D, int w, int colour,
+                         double *top)
 {
     const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
     const double h = m->h, ih2 = 1.0 / (h * h);
-    double big = 0;
+    double big = 0, most = 0;
     for (int k = 0; k < cz; k++)
         for (int j = 0; j < cy; j++)
             for (int i = (j + k + colour) & 1; i < cx; i += 2) {
@@ -116,32 +122,36 @@ static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, co
                         sum += c * phi[(size_t)nb[f] * n + w];
                     }
                 }
-                if (!(diag > 0)) continue;
                 const double old = phi[cell * n + w];
+                if (!(diag > 0)) {
+                    most = old > most ? old : most;
+                    continue;
+                }
                 double v = old + DIFF_OMEGA * (sum / diag - old);
                 v = v > 0 ? v : 0;
                 phi[cell * n + w] = (float)v;
-                const double d = fabs(v - old);
+                const double d = fabs(v - old), vf = phi[cell * n + w];
                 big = d > big ? d : big;
+                most = vf > most ? vf : most;
             }
+    *top = most;
     return big;
 }
 
 /* The solve of wavelength w; returns its sweeps (-1: out of memory). */
 static int solve_one(const atmos__lmedium *m, const float *Q, float *phi, int w, int maxs, double tol, int limiter)
 {
-    const int n = m->n;
     const size_t cells = atmos__lmedium_cells(m);
     float *D = malloc(sizeof(float) * cells);
     if (!D) return -1;
     int s = 0;
     for (; s < maxs; s++) {
         if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, phi, w, limiter, D);
-        double ch = half_sweep(m, Q, phi, D, w, 0);
-        double ch1 = half_sweep(m, Q, phi, D, w, 1);
+        double top0, top1;
+        double ch = half_sweep(m, Q, phi, D, w, 0, &top0);
+        const double ch1 = half_sweep(m, Q, phi, D, w, 1, &top1);
         ch = ch1 > ch ? ch1 : ch;
-        double top = 0;
-        for (size_t c = 0; c < cells; c++) top = phi[c * n + w] > top ? phi[c * n + w] : top;
+        const double top = top1 > top0 ? top1 : top0;
         if (!(top > 0) || ch <= tol * top) {
             s++;
             break;
@@ -182,7 +192,7 @@ void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__
                 const size_t cell = ((size_t)k * cy + j) * cx + i;
                 for (int f = 0; f < 6; f++) {
                     if (nb[f] != -1) continue;
-                    const double a = 2.0 * cell_D(m, phi, i, j, k, w, limiter) / h;
+                    const double a = 2.0 * cell_D(m, phi, nb, cell, w, limiter) / h;
                     const double in4 = m->jin ? 4.0 * m->jin[f * n + w] : 0.0;
                     out[f] += (phi[cell * n + w] - in4) * a / (2.0 * a + 1.0) * h * h;
                 }
@@ -201,15 +211,9 @@ void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__
                 long long nb[6];
                 neighbours(m, i, j, k, nb);
                 for (int w = 0; w < n; w++) {
-                    const double D = cell_D(m, phi, i, j, k, w, limiter), p = phi[cell * n + w];
+                    const double D = cell_D(m, phi, nb, cell, w, limiter);
                     for (int a = 0; a < 3; a++) {
-                        /* a missing neighbour: the face value of the Marshak condition is
-                         * not known here; the one-sided difference of the other side */
-                        const long long lo = nb[2 * a], hi = nb[2 * a + 1];
-                        double d = 0;
-                        if (lo >= 0 && hi >= 0) d = (phi[(size_t)hi * n + w] - phi[(size_t)lo * n + w]) / (2 * m->h);
-                        else if (hi >= 0) d = (phi[(size_t)hi * n + w] - p) / m->h;
-                        else if (lo >= 0) d = (p - phi[(size_t)lo * n + w]) / m->h;
+                        const double d = cell_grad(m, phi, nb, cell, w, a);
                         J[(cell * n + w) * 3 + a] = (float)(-D * d);
                     }
                 }

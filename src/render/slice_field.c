@@ -119,9 +119,10 @@ static void field_sky(atmos__slice_plan *sp, const atmos_atmosphere *atm, const 
 }
 
 atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
-                                       const double sun_w[3])
+                                       const double sun_w[3], int *built)
 {
     atmos__lfield *fl = &sp->field;
+    *built = 0;
     if (fl->valid && memcmp(fl->sun, sun_w, sizeof fl->sun) == 0) return ATMOS_OK;
     const double t0 = atmos__now();
     const int threads = atmos__threads(ctx), n = sp->n;
@@ -149,6 +150,7 @@ atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp
     atmos__lfield_flux(&sp->fmed, fl->phi, &o, fl->J, threads);
     memcpy(fl->sun, sun_w, sizeof fl->sun);
     fl->valid = 1;
+    *built = 1;
     fl->source_s = t1 - t0;
     fl->solve_s = atmos__now() - t1;
     fl->build_s = atmos__now() - t0;

@@ -114,10 +114,10 @@ struct atmos__slice_plan {
 
 /* The diffuse light field: its medium built from the render grid and the optics (once per
  * plan), and the field brought up to date for the sun direction sun_w (a solve when the sun
- * moved, warm-started from the last one). */
+ * moved, warm-started from the last one; *built: 1 if it solved, 0 if it kept the field). */
 atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *sp, const atmos_volume_optics *o);
 atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
-                                       const double sun_w[3]);
+                                       const double sun_w[3], int *built);
 
 /* The diffuse field at render-voxel point (u, v, w), toward the frame's eye: per wavelength
  * its mean radiance L[c] and A[c] = 3/(4 pi) J . d, d the unit direction to the eye (from the

@@ -116,14 +116,14 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         const double t_setup = atmos__now();
         if ((st = atmos__slice_frame_setup(ctx, sp, p->atm, v, r, &j)) != ATMOS_OK) return st;
         if (sp->diffuse) {
-            const int kept = sp->field.valid && memcmp(sp->field.sun, v->sun, sizeof v->sun) == 0;
-            if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun)) != ATMOS_OK) return st;
+            int built;
+            if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun, &built)) != ATMOS_OK) return st;
             j.field = &sp->field;
             j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->fg;
             double eu[3]; /* the eye in render-voxel coordinates */
             for (int a = 0; a < 3; a++) eu[a] = j.eye[a] * sp->g.sc + sp->g.off[a];
             atmos__lfield_toward(&sp->field, eu, atmos__threads(ctx));
-            if (!kept) tm->field = sp->field.build_s, tm->field_sweeps = sp->field.sweeps;
+            if (built) tm->field = sp->field.build_s, tm->field_sweeps = sp->field.sweeps;
         }
         tm->setup = atmos__now() - t_setup;
         tm->prepare = sp->prepare_s;
