@@ -209,6 +209,18 @@ void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const
     if (a->solver && a->solver->batch_init) a->solver->batch_init(b);
 }
 
+int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3])
+{
+    if (b->atm == a && a->solver && a->solver->batch_keep && a->solver->batch_keep(b, eye, sun)) {
+        memcpy(b->eye, eye, sizeof b->eye);
+        memcpy(b->sun, sun, sizeof b->sun);
+        return 1;
+    }
+    if (b->atm) atmos__atm_batch_release(b);
+    atmos__atm_batch_init(b, a, eye, sun);
+    return 0;
+}
+
 void atmos__atm_batch_release(atmos__atm_batch *b)
 {
     if (b->atm && b->atm->solver && b->atm->solver->batch_release) b->atm->solver->batch_release(b);

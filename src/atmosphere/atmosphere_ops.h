@@ -64,6 +64,10 @@ typedef struct atmos__atm_batch {
 void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3]);
 /* Frees what atmos__atm_batch_init allocated (a spherical kind's per-eye tables). */
 void atmos__atm_batch_release(atmos__atm_batch *b);
+/* b (zeroed, or initialised before) made to answer for atmosphere a, eye and sun: its per-eye
+ * tables kept when they answer for them as they are (returns 1), else built again (0). The
+ * rays' values are those of atmos__atm_batch_init's either way. */
+int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3]);
 void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);
 

@@ -32,6 +32,9 @@ typedef struct atmos__planet_solver {
     void (*batch_eval)(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                        const float *weight, float *out, float *scratch);
     void (*batch_release)(atmos__atm_batch *b);
+    /* whether b's per-eye tables answer for a new eye and sun as they are (turned toward
+     * them); NULL: never */
+    int (*batch_keep)(atmos__atm_batch *b, const double eye[3], const double sun[3]);
     /* the aerial-perspective volume's node (atmosphere_aerial.c): along d from p, at each
      * distance t[0] < ... < t[nd-1], per wavelength of the set: the Rayleigh and the aerosol
      * single scattering without their phase functions, the rest of the in-scatter (phase

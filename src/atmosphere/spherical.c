@@ -222,5 +222,6 @@ const atmos__planet_solver atmos__spherical_solver = {
     .batch_init = atmos__sph_batch_init,
     .batch_eval = atmos__sph_batch_eval,
     .batch_release = atmos__sph_batch_release,
+    .batch_keep = atmos__sph_batch_keep,
     .aerial = atmos__sph_aerial,
 };

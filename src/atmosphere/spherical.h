@@ -155,6 +155,9 @@ void atmos__sph_batch_init(atmos__atm_batch *b);
 void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);
 void atmos__sph_batch_release(atmos__atm_batch *b);
+/* Whether b's table answers for a new eye and sun (the same quanta; spherical_batch.c), and
+ * if so turns it to them. */
+int atmos__sph_batch_keep(atmos__atm_batch *b, const double eye[3], const double sun[3]);
 /* An eye above the top of the air (spherical_space.c): its table (NULL when out of memory),
  * the radiance of many view rays added to out as batch_eval does, and the release. */
 typedef struct atmos__sph_space atmos__sph_space;

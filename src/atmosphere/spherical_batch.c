@@ -12,7 +12,14 @@
  * apart (the ground's edge is never blurred), in v = sqrt(x), x = |mu - mu_h| / (1 -+ mu_h):
  * rows crowd at the horizon; the azimuth from the sun's vertical plane over [0, pi] (the
  * sky of a uniform ground is symmetric about it). An eye above the top of the air (where
- * this grid would waste itself on empty space) gets its own table (spherical_space.c). */
+ * this grid would waste itself on empty space) gets its own table (spherical_space.c).
+ *
+ * Over a uniform ground (no maps, no cloud spheres) the table depends on the eye's altitude h
+ * and the sun's zenith cosine mu_s there alone: it is built for their quantised values (h on
+ * h_q = HS (exp(k DH) - 1): steps of 1 m near the ground, 11 m at 100 km; mu_s in steps of
+ * 1e-5) and kept while the eye and the sun stay in the same quantum (batch_keep), so an eye
+ * flying level reuses it, and a frame's image is the same whatever frames came before it.
+ * The horizon's row follows the true altitude. */
 #include "atmosphere/spherical.h"
 
 #include "core/fastmath.h"
@@ -27,9 +34,14 @@
 #define NPH 1024 /* the Mie phase over x = sqrt((1 - nu) / 2) = sin(theta / 2) */
 #define PLANE (2 * NV * NA)
 #define TINY 1e-30 /* the values are kept as logarithms, at least log(TINY) */
+#define KEEP_HS 10000.0 /* the altitude's quantum: HS DH near the ground (m) */
+#define KEEP_DH 1e-4
+#define KEEP_DMU 1e-5 /* the sun's zenith cosine's quantum */
 
 typedef struct sv_state {
     int march, n;
+    int keyed;    /* built for the quantised altitude and sun (key) */
+    long key[2];
     atmos__sph_space *space; /* the eye above the air; NULL (march per ray) if out of memory */
     double up[3], e1[3], e2[3];
     float fup[3], fe1[3], fe2[3], fsun[3];
@@ -97,6 +109,37 @@ static void fill_node(const atmos_atmosphere *a, sv_state *s, const double eye[3
     }
 }
 
+/* The quantised altitude and sun's zenith cosine of an eye (key) and an eye and a sun with
+ * those values (eye_q, sun_q); 0 when the table depends on more (the ground's maps, cloud
+ * spheres) or the quantised eye would leave the air. */
+static int sv_key(const atmos__planet *pl, const double eye[3], const double sun[3], long key[2], double eye_q[3],
+                  double sun_q[3])
+{
+    const double q[3] = {eye[0], eye[1] + pl->r_ground, eye[2]};
+    const double r = sqrt(atmos__dot3(q, q));
+    if (pl->surface || pl->clouds || !(r > 0)) return 0;
+    const double mu = atmos__clampd(atmos__dot3(q, sun) / r, -1.0, 1.0);
+    key[0] = lround(log1p(fmax(r - pl->r_ground, 0.0) / KEEP_HS) / KEEP_DH);
+    key[1] = lround(mu / KEEP_DMU);
+    const double hq = KEEP_HS * expm1((double)key[0] * KEEP_DH);
+    const double mq = atmos__clampd((double)key[1] * KEEP_DMU, -1.0, 1.0);
+    if (hq >= pl->r_top - pl->r_ground) return 0;
+    eye_q[0] = 0.0, eye_q[1] = hq, eye_q[2] = 0.0;
+    sun_q[0] = sqrt(fmax(0.0, 1.0 - mq * mq)), sun_q[1] = mq, sun_q[2] = 0.0;
+    return 1;
+}
+
+int atmos__sph_batch_keep(atmos__atm_batch *b, const double eye[3], const double sun[3])
+{
+    sv_state *s = b->state;
+    long key[2];
+    double eq[3], sq[3];
+    if (!s || !s->tab || !s->keyed || !sv_key(b->atm->planet, eye, sun, key, eq, sq)) return 0;
+    if (key[0] != s->key[0] || key[1] != s->key[1]) return 0;
+    frame(s, b->atm->planet, eye, sun);
+    return 1;
+}
+
 void atmos__sph_batch_init(atmos__atm_batch *b)
 {
     const atmos_atmosphere *a = b->atm;
@@ -111,7 +154,10 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
         s->space = atmos__sph_space_create(a, b->eye, b->sun);
         return;
     }
-    frame(s, pl, b->eye, b->sun);
+    double eye[3], sun[3];
+    s->keyed = sv_key(pl, b->eye, b->sun, s->key, eye, sun);
+    if (!s->keyed) memcpy(eye, b->eye, sizeof eye), memcpy(sun, b->sun, sizeof sun);
+    frame(s, pl, eye, sun);
     s->tab = malloc(sizeof(float) * ((size_t)s->n * 3 * PLANE + (size_t)s->n * NPH));
     if (!s->tab) {
         s->march = 1;
@@ -120,7 +166,8 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
     s->mie = s->tab + (size_t)s->n * 3 * PLANE;
     atmos__planet_mie_phase_table(pl, s->n, NPH, s->mie);
 #pragma omp parallel for schedule(dynamic)
-    for (int e = 0; e < 2 * NV * NA; e++) fill_node(a, s, b->eye, b->sun, e / NA, e % NA);
+    for (int e = 0; e < 2 * NV * NA; e++) fill_node(a, s, eye, sun, e / NA, e % NA);
+    frame(s, pl, b->eye, b->sun);
 }
 
 void atmos__sph_batch_release(atmos__atm_batch *b)

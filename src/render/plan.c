@@ -79,6 +79,7 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
         st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the slice renderer needs a volume");
         goto fail;
     }
+    if (p->renderer != ATMOS_RENDERER_PATH) p->sky_keep = atmos__sky_keep_create(); /* NULL: per frame */
     if (p->renderer == ATMOS_RENDERER_SLICE) st = atmos__slice_plan_create(p, &p->slice);
     else if (p->renderer == ATMOS_RENDERER_PATH) st = atmos__path_plan_create(p, &p->path);
     if (st != ATMOS_OK) goto fail;
@@ -94,6 +95,7 @@ void atmos_plan_destroy(atmos_plan *p)
     if (!p) return;
     atmos__slice_plan_destroy(p->slice);
     atmos__path_plan_destroy(p->path);
+    atmos__sky_keep_destroy(p->sky_keep);
     atmos_volume_optics_free(&p->own_optics);
     atmos_volume_destroy(p->own_volume);
     atmos_atmosphere_destroy(p->atm);
@@ -316,7 +318,7 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
         stats->reused = 1;
         stats->slice = prev.slice;
     } else if (p->renderer == ATMOS_RENDERER_SKY) {
-        st = atmos__sky_render(ctx, p->atm, &v, &r, out);
+        st = atmos__sky_render(ctx, p->atm, &v, &r, out, p->sky_keep);
     } else if (p->renderer == ATMOS_RENDERER_SLICE) {
         st = atmos__slice_render(p, &v, &r, out, &stats->slice);
     } else {

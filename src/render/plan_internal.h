@@ -30,6 +30,7 @@ struct atmos_plan {
     float *last_pixels;
     size_t last_cap;
     atmos_plan_stats stats;
+    atmos__sky_keep *sky_keep;          /* the sky's per-eye tables (sky and slice renderers) */
     atmos__slice_plan *slice;
     atmos__path_plan *path;
 };

@@ -221,8 +221,20 @@ static float *column_table(const sky_job *job)
     return col_sc;
 }
 
+struct atmos__sky_keep {
+    atmos__atm_batch batch; /* zeroed until the first frame */
+};
+
+atmos__sky_keep *atmos__sky_keep_create(void) { return calloc(1, sizeof(atmos__sky_keep)); }
+
+void atmos__sky_keep_destroy(atmos__sky_keep *k)
+{
+    if (k) atmos__atm_batch_release(&k->batch);
+    free(k);
+}
+
 atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
-                               const atmos__rect *r, atmos_image *out)
+                               const atmos__rect *r, atmos_image *out, atmos__sky_keep *keep)
 {
     sky_job job;
     job_init(&job, atm, v);
@@ -231,8 +243,10 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
     const int band = 8; /* rows per work item: small enough for progress and balance */
     const int nbands = (r->y1 - r->y0 + band - 1) / band;
     int done = 0, cancelled = 0, nomem = 0;
-    atmos__atm_batch batch;
-    atmos__atm_batch_init(&batch, atm, v->cam.position, job.sun);
+    atmos__atm_batch own, *bp = keep ? &keep->batch : &own;
+    if (keep) atmos__atm_batch_update(bp, atm, v->cam.position, job.sun);
+    else atmos__atm_batch_init(bp, atm, v->cam.position, job.sun);
+    const atmos__atm_batch *batch = bp;
     float *col_sc = column_table(&job);
 #pragma omp parallel num_threads(atmos__threads(ctx))
     {
@@ -256,7 +270,7 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
             stop = cancelled;
             if (stop || !mem) continue;
             for (int y = r->y0 + b * band; y < r->y1 && y < r->y0 + (b + 1) * band; y++)
-                shade_row(&job, &batch, col_sc, y, r->x0, count, &rb, out->pixels + (size_t)y * W * C, C);
+                shade_row(&job, batch, col_sc, y, r->x0, count, &rb, out->pixels + (size_t)y * W * C, C);
             int d;
 #pragma omp atomic capture
             d = ++done;
@@ -273,7 +287,7 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
         free(mem);
     }
     free(col_sc);
-    atmos__atm_batch_release(&batch);
+    if (!keep) atmos__atm_batch_release(&own);
     if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for row buffers");
     if (cancelled) return atmos__error(ctx, ATMOS_E_CANCELLED, "render: cancelled");
     atmos__progress(ctx, "render sky", 1.0);

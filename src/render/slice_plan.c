@@ -108,7 +108,7 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
     memset(tm, 0, sizeof *tm);
     memcpy(tm->grid_dims, sp->g.c, sizeof sp->g.c);
     /* The sky behind everything, sun's disk included. */
-    atmos_status st = atmos__sky_render(ctx, p->atm, v, r, out);
+    atmos_status st = atmos__sky_render(ctx, p->atm, v, r, out, p->sky_keep);
     if (st != ATMOS_OK) return st;
     tm->sky = atmos__now() - t_start;
     if (sp->g.v) { /* an empty volume leaves the sky alone */

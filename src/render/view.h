@@ -20,10 +20,17 @@ typedef struct atmos__rect {
     int x0, y0, x1, y1;
 } atmos__rect;
 
+/* What the sky renderer keeps between the frames of one plan: the atmosphere's per-eye
+ * tables, built again only when the eye or the sun moved enough to change them. */
+typedef struct atmos__sky_keep atmos__sky_keep;
+atmos__sky_keep *atmos__sky_keep_create(void);
+void atmos__sky_keep_destroy(atmos__sky_keep *k);
+
 /* The sky renderer (sky_render.c): what every view ray sees of the atmosphere, the sun's
  * disk antialiased, over the pixels of r, written into out (width x height x count + 1
- * channels: radiance per wavelength, coverage alpha). Reports progress as "render sky". */
+ * channels: radiance per wavelength, coverage alpha). Reports progress as "render sky".
+ * keep: the plan's (NULL: the per-eye tables are built for this frame alone). */
 atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
-                               const atmos__rect *r, atmos_image *out);
+                               const atmos__rect *r, atmos_image *out, atmos__sky_keep *keep);
 
 #endif
