@@ -31,6 +31,12 @@ typedef struct atmos_sun_position {
  * anything else, including impossible dates (2026-02-30). */
 ATMOS_API atmos_status atmos_parse_utc_time(atmos_context *ctx, const char *text, atmos_utc_time *out);
 
+/* Seconds since the start of Julian day number 0's civil date (an instant's place on one
+ * clock, for differences and sums: doubles hold whole seconds of any year 1..9999 exactly)
+ * and the instant of such a count. */
+ATMOS_API double atmos_utc_time_seconds(const atmos_utc_time *t);
+ATMOS_API void atmos_utc_time_from_seconds(double seconds, atmos_utc_time *out);
+
 /* Sun position for latitude (degrees north, [-90, 90]) and longitude (degrees
  * east, [-180, 180]). refraction: nonzero to include standard atmospheric
  * refraction in elevation_deg. Errors name the offending value. */

@@ -390,48 +390,6 @@ atmos_status atmos_scene_particle(atmos_context *ctx, const atmos_scene *scene, 
                         name, list);
 }
 
-/* Julian day number (the day starting at noon UT on the given civil date's noon) of a
- * Gregorian date (Meeus, Astronomical Algorithms, ch. 7), and its inverse. */
-static long julian_day_number(int y, int m, int d)
-{
-    if (m <= 2) y -= 1, m += 12;
-    long a = y / 100, b = 2 - a + a / 4;
-    return (long)floor(365.25 * (y + 4716)) + (long)floor(30.6001 * (m + 1)) + d + b - 1524;
-}
-
-static void civil_from_julian_day_number(long z, int *y, int *m, int *d)
-{
-    long alpha = (long)floor((z - 1867216.25) / 36524.25);
-    long a = z + 1 + alpha - alpha / 4, b = a + 1524;
-    long c = (long)floor((b - 122.1) / 365.25), dd = (long)floor(365.25 * c);
-    long e = (long)floor((b - dd) / 30.6001);
-    *d = (int)(b - dd - (long)floor(30.6001 * e));
-    *m = (int)(e < 14 ? e - 1 : e - 13);
-    *y = (int)(*m > 2 ? c - 4716 : c - 4715);
-}
-
-/* Seconds since the start of Julian day number 0's civil date, and back. Doubles hold
- * whole seconds of any year 1..9999 exactly and leave ~1e-5 s for fractions. */
-static double utc_to_seconds(const atmos_utc_time *t)
-{
-    return (double)julian_day_number(t->year, t->month, t->day) * 86400.0 + t->hour * 3600.0 + t->minute * 60.0 +
-           t->second;
-}
-
-static void utc_from_seconds(double s, atmos_utc_time *t)
-{
-    double day = floor(s / 86400.0), sod = s - day * 86400.0;
-    if (sod < 0) sod = 0;
-    civil_from_julian_day_number((long)day, &t->year, &t->month, &t->day);
-    t->hour = (int)(sod / 3600.0);
-    if (t->hour > 23) t->hour = 23;
-    sod -= t->hour * 3600.0;
-    t->minute = (int)(sod / 60.0);
-    if (t->minute > 59) t->minute = 59;
-    t->second = sod - t->minute * 60.0;
-    if (t->second < 0) t->second = 0;
-}
-
 atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *scene, int index, atmos_scene *out)
 {
     if (!scene || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_animation_frame: scene or out is NULL");
@@ -446,8 +404,8 @@ atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *
     if (n > 1) {
         double f = (double)index / (n - 1);
         if (s.sun.from_time && a->time_end_set) {
-            double t0 = utc_to_seconds(&s.sun.time), t1 = utc_to_seconds(&a->time_end);
-            utc_from_seconds(index == n - 1 ? t1 : t0 + f * (t1 - t0), &s.sun.time);
+            double t0 = atmos_utc_time_seconds(&s.sun.time), t1 = atmos_utc_time_seconds(&a->time_end);
+            atmos_utc_time_from_seconds(index == n - 1 ? t1 : t0 + f * (t1 - t0), &s.sun.time);
         } else if (!s.sun.from_time) {
             if (a->elevation_end_set)
                 s.sun.elevation_deg += f * (a->elevation_end_deg - s.sun.elevation_deg);

@@ -20,6 +20,7 @@ static const command commands[] = {
     {"mie", cli_cmd_mie, "Mie efficiencies and amplitudes of one sphere"},
     {"volume", cli_cmd_volume, "inspect, generate and slice cloud volumes"},
     {"compare", cli_cmd_compare, "error statistics of an HDR image against a reference"},
+    {"view", cli_cmd_view, "the interactive viewer: fly around a scene, move the sun (SDL2 window)"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

@@ -1,0 +1,84 @@
+#!/bin/sh
+# atmos view (tools/view/, docs/viewer.md): the help lists every key; a headless scripted
+# run records N frames (PNG + frames.csv with the documented columns); under Xvfb the
+# window opens and closes cleanly, keys pushed through the window's event queue move the
+# sun and the camera by the documented amounts (I: 20 degrees a second, W: the flight
+# speed, a tap = 1/30 s), F12 saves EXR + PNG + a scene whose offline render (atmos render)
+# has the same pixels; bad input is a usage error, not a crash.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/view.$$
+rm -rf "$T"
+mkdir -p "$T" || exit 1
+trap 'rm -rf "$T"' EXIT
+export XDG_CACHE_HOME="$T/cache"
+fail=0
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+
+"$A" view --help >"$T/help.txt" 2>&1 || bad "view --help exits 0"
+for k in W S A D E Q Left Right Up Down I K J L '\[' '\]' Z X = - O R V H F12 P Esc; do
+    grep -q "^  $k " "$T/help.txt" || bad "help lists key $k"
+done
+ok "help lists the keys"
+
+# headless, scripted (an orbit: the default scene pans in place)
+"$A" view --headless --frames 3 --size 64x36 --record "$T/rec" >"$T/out.txt" 2>&1 || { bad "headless run"; cat "$T/out.txt" >&2; }
+python3 - "$T/rec" <<'PY' && ok "headless record: 3 frames, csv columns" || bad "headless record"
+import csv, os, sys
+d = sys.argv[1]
+rows = list(csv.DictReader(open(os.path.join(d, "frames.csv"))))
+assert len(rows) == 3, rows
+for i, r in enumerate(rows):
+    assert int(r["frame"]) == i and float(r["ms"]) > 0 and r["renderer"] == "sky" and r["impostor_updates"] == "0", r
+    assert os.path.getsize(os.path.join(d, "frame_%05d.png" % i)) > 100
+yaw = [float(r["yaw_deg"]) for r in rows]
+assert abs((yaw[1] - yaw[0]) % 360 - 120) < 1e-6 and abs((yaw[2] - yaw[1]) % 360 - 120) < 1e-6, yaw
+PY
+
+# bad input: usage errors with a message
+"$A" view --headless >/dev/null 2>"$T/e1.txt"; [ $? -eq 2 ] && grep -q "needs --frames" "$T/e1.txt" && ok "--headless alone refused" || bad "--headless alone"
+"$A" view --frames 2 --headless --press Nope >/dev/null 2>"$T/e2.txt"; [ $? -eq 2 ] && grep -q "unknown key" "$T/e2.txt" && ok "unknown key refused" || bad "unknown key"
+printf '{"keys": [{"t": 0, "position_m": [0, 1]}]}' >"$T/bad.json"
+"$A" view --frames 2 --headless --script "$T/bad.json" >/dev/null 2>"$T/e3.txt"; [ $? -eq 2 ] && grep -q "keys\[0\]" "$T/e3.txt" && ok "bad script refused" || bad "bad script"
+
+if ! command -v xvfb-run >/dev/null 2>&1; then
+    bad "xvfb-run is missing (scripts/install-deps.sh installs xvfb and xauth)"
+    exit 1
+fi
+cd "$T" || exit 1
+xvfb-run -a "$A" view --frames 3 --size 96x54 --record "$T/win" --press I,W,F12 --save-base "$T/shot" >"$T/xout.txt" 2>&1
+st=$?
+[ $st -eq 0 ] && ok "window opens, renders 3 frames, closes (exit 0)" || { bad "xvfb run: exit $st"; cat "$T/xout.txt" >&2; }
+python3 - "$T/win/frames.csv" <<'PY' && ok "keys move the sun and the camera as documented" || bad "keys"
+import csv, math, sys
+r = list(csv.DictReader(open(sys.argv[1])))
+assert len(r) == 3, r
+f = lambda i, k: float(r[i][k])
+assert abs(f(1, "sun_elevation_deg") - f(0, "sun_elevation_deg") - 20.0 / 30) < 1e-3, r   # I: 20 deg/s, a tap
+assert f(2, "sun_elevation_deg") == f(1, "sun_elevation_deg")
+d = math.dist([f(1, "x_m"), f(1, "y_m"), f(1, "z_m")], [f(0, "x_m"), f(0, "y_m"), f(0, "z_m")])
+assert abs(d - 100.0 / 30) < 1e-2, d    # W: the default scene's 100 m/s (a tenth of 1 km), a tap
+PY
+if [ -f "$T/shot_001.json" ] && [ -f "$T/shot_001.exr" ] && [ -f "$T/shot_001.png" ]; then
+    ok "F12 saved EXR, PNG and JSON"
+    "$A" render "$T/shot_001.json" --exr "$T/off.exr" -o "$T/off.png" >/dev/null 2>&1 || bad "offline render of the saved scene"
+    "$A" compare "$T/shot_001.exr" "$T/off.exr" --json >"$T/cmp.json" 2>&1 || bad "compare"
+    python3 - "$T/cmp.json" "$T/shot_001.png" "$T/off.png" <<'PY' && ok "saved frame = offline render (EXR and PNG pixels)" || bad "saved frame differs from the offline render"
+import json, struct, sys, zlib
+c = json.load(open(sys.argv[1]))
+assert c["rmse"] == 0 and c["nonfinite"] == 0, c
+def pixels(p):
+    d = open(p, "rb").read(); i = 8; idat = b""
+    while i < len(d):
+        n, = struct.unpack(">I", d[i:i + 4]); t = d[i + 4:i + 8]
+        if t == b"IDAT": idat += d[i + 8:i + 8 + n]
+        if t == b"IHDR": hdr = d[i + 8:i + 8 + n]
+        i += 12 + n
+    return hdr, zlib.decompress(idat)
+assert pixels(sys.argv[2]) == pixels(sys.argv[3])
+PY
+else
+    bad "F12 saved EXR, PNG and JSON"
+fi
+exit $fail

@@ -1,0 +1,161 @@
+/* atmos view: the interactive viewer. A scene becomes a plan per renderer; every frame the
+ * viewer's state (camera, sun, exposure, renderer) becomes an atmos_frame rendered from the
+ * kept plan, and the image is shown in an SDL2 window (or, headless, only recorded).
+ *
+ * The state and what the keys do to it (view_state.c, view_keys.c) know nothing of SDL, so
+ * that the tests can drive them; the window (view_window.c), the flight script
+ * (view_script.c), the recording and the saved views (view_record.c) and the loop
+ * (view_cmd.c) are the rest. */
+#ifndef ATMOS_VIEW_H
+#define ATMOS_VIEW_H
+
+#include "cli.h"
+
+#include <stdio.h>
+
+/* What a key or a script does to the state. */
+typedef enum {
+    VA_NONE = 0,
+    VA_FORWARD, VA_BACK, VA_LEFT, VA_RIGHT, VA_UP, VA_DOWN,         /* flight (held) */
+    VA_LOOK_LEFT, VA_LOOK_RIGHT, VA_LOOK_UP, VA_LOOK_DOWN,          /* turning (held) */
+    VA_SUN_UP, VA_SUN_DOWN, VA_SUN_LEFT, VA_SUN_RIGHT,              /* the sun (held) */
+    VA_TIME_BACK, VA_TIME_FORWARD,                                  /* date and time (pressed) */
+    VA_ZOOM_IN, VA_ZOOM_OUT, VA_EXPOSURE_UP, VA_EXPOSURE_DOWN,      /* pressed */
+    VA_ORBIT, VA_RENDERER, VA_SPECTRAL, VA_OVERLAY, VA_SAVE, VA_QUIT, /* pressed */
+    VA_COUNT
+} view_action;
+
+/* The viewer's state: what a frame is made of. */
+typedef struct view_state {
+    double pos[3];          /* the camera, m (world frame, y up) */
+    double yaw_deg;         /* the view's azimuth, clockwise from north (-z) */
+    double pitch_deg;       /* the view's elevation, [-89, 89] */
+    double fov_deg;         /* vertical field of view, [5, 120] */
+    double speed;           /* flight speed, m/s (scaled by the scene's size) */
+    int orbit;              /* 1: moving turns the camera about target at its distance */
+    double target[3];       /* the orbit's centre: the volume's centre, or the point looked at */
+    double sun_el, sun_az;  /* degrees */
+    int sun_from_time;      /* the sun follows the date and time (NOAA) */
+    atmos_utc_time time;
+    double lat, lon;
+    double ev;              /* exposure compensation (automatic) or EV100 (manual), stops */
+    int manual_exposure;
+    atmos_renderer_kind renderer;
+    int has_volume;
+    int spectral;           /* nonzero: the scene's spectral samples, else rgb */
+    int overlay;            /* the on-screen text shown */
+    int quit, save;         /* requests for the loop */
+    unsigned changes;       /* VIEW_CHANGED_* since the loop last cleared them */
+} view_state;
+
+enum { VIEW_CHANGED_CAMERA = 1, VIEW_CHANGED_SUN = 2, VIEW_CHANGED_PLAN = 4, VIEW_CHANGED_LOOK = 8 };
+
+/* ---- view_state.c */
+/* The state of a scene's own frame (f from atmos_frame_from_scene; target: the orbit's
+ * centre, NULL for the point the camera looks at). */
+void view_state_init(view_state *s, const atmos_scene *sc, const atmos_frame *f, const double *target);
+/* One action over dt seconds (held actions) or once (pressed ones); fast / slow: the
+ * speed modifiers (x10, x0.1). */
+void view_state_apply(view_state *s, view_action a, double dt, int fast, int slow);
+/* Mouse motion of (dx, dy) pixels: turns the view (or, orbiting, moves about the target). */
+void view_state_look(view_state *s, double dx, double dy);
+/* Scroll: the field of view narrows (clicks > 0) or widens. */
+void view_state_zoom(view_state *s, double clicks);
+/* The frame of the state: camera, sun, exposure (f holds the rest: size, budgets). */
+void view_state_frame(const view_state *s, atmos_frame *f);
+/* The view direction of the state (unit). */
+void view_state_forward(const view_state *s, double d[3]);
+/* The sun's direction from its angles or (sun_from_time) from the date, time and place. */
+void view_state_sun(view_state *s);
+
+/* ---- view_keys.c: the key table (SDL key codes, no SDL here) */
+typedef struct view_key {
+    int sym;                /* SDL_Keycode */
+    view_action action;
+    const char *key, *what; /* for --help */
+} view_key;
+/* The table, ending with sym 0. */
+const view_key *view_keys(void);
+/* The action of an SDL key code (VA_NONE if none). */
+view_action view_key_action(int sym);
+/* 1 for the actions that act while their key is held. */
+int view_action_held(view_action a);
+/* Prints the keys and the mouse to f (the help's "Keys" section). */
+void view_keys_help(FILE *f);
+/* An action by its name in a script ("forward", "sun_up", ...; VA_NONE if unknown). */
+view_action view_action_named(const char *name);
+
+/* ---- view_script.c: a flight (keyframes of camera and sun), or an orbit */
+typedef struct view_key_frame {
+    double t;               /* seconds */
+    double pos[3], look_at[3];
+    int has_sun;
+    double sun_el, sun_az;
+    view_action press;      /* a key pressed at t (VA_NONE: none) */
+} view_key_frame;
+typedef struct view_script {
+    int n;
+    view_key_frame *k;
+    double fps;             /* frames per second of the flight's clock; 24 */
+} view_script;
+/* The whole of a text file (a new string; NULL when it cannot be read). */
+char *view_read_text(const char *path);
+/* Reads a flight file: {"fps": 24, "keys": [{"t": 0, "position_m": [..], "look_at_m": [..],
+ * "sun": {"elevation_deg": e, "azimuth_deg": a}, "press": "sun_up"}, ...]}. Returns 0 or an
+ * exit status with a message. */
+int view_script_load(const char *path, view_script *out);
+void view_script_free(view_script *s);
+/* The state at time t of the script (camera and sun interpolated between keyframes; keys
+ * pressed in (t_prev, t] applied); an empty script orbits the target once in `frames`. */
+void view_script_step(const view_script *s, view_state *st, double t_prev, double t, int frame, int frames);
+
+/* ---- view_record.c */
+typedef struct view_recorder {
+    const char *dir;        /* NULL: no recording */
+    FILE *csv;
+    int frames;
+} view_recorder;
+int view_record_open(view_recorder *r, const char *dir);
+/* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv. */
+int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms,
+                      const char *renderer, int impostor_updates, const view_state *s);
+int view_record_close(view_recorder *r);
+/* Saves the current view: BASE.exr (linear sRGB), BASE.png (what is shown), BASE.json (the
+ * scene that renders the same image with `atmos render BASE.json`). scene_json: the text of
+ * the scene file the viewer opened ("{}" for none). */
+int view_save(atmos_context *ctx, const char *base, const char *scene_json, const atmos_scene *sc,
+              const view_state *s, const atmos_image *lin, const atmos_image *disp);
+/* The scene of the state as JSON (a new string; NULL when out of memory): the scene file's
+ * text with the camera, sun, size, renderer and exposure of the state. */
+char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_state *s);
+
+/* ---- view_window.c (SDL2) */
+typedef struct view_window view_window;
+/* Opens a window of w x h; NULL with a message when no display can be opened. */
+view_window *view_window_open(int w, int h, const char *title);
+void view_window_close(view_window *win);
+/* Shows a display-sRGB image (3 or 4 channels, [0, 1]) scaled to the window, with the
+ * overlay's lines on top (NULL: none). Returns 0 or -1. */
+int view_window_present(view_window *win, const atmos_image *disp, const char *const *lines, int nlines);
+/* Polls the window's events into the state (held keys act over dt). */
+void view_window_events(view_window *win, view_state *s, double dt);
+/* Pushes a key press and release of the SDL key code sym into the window's queue (the tests'
+ * and the scripts' keys go through the same path as a user's). */
+void view_window_push_key(view_window *win, int sym);
+
+/* ---- view_cmd.c, view_loop.c */
+typedef struct view_opts {
+    int width, height, frames, headless;
+    const char *script, *record, *save_base, *press;
+    int passed;          /* arguments left for atmos render's parser */
+    char **pass;
+} view_opts;
+/* The SDL key codes of comma-separated key names (as --help prints them, any case) into
+ * codes; returns the count, or -1 for an unknown name or more than cap (view_keys.c). */
+int view_key_codes(const char *list, int *codes, int cap);
+/* Opens the window (unless headless) and runs frames until quit or o->frames; text: the
+ * scene file's JSON ("{}" for none). Returns an exit status. */
+int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atmos_volume *vol, const char *text);
+
+
+#endif

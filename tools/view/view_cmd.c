@@ -1,0 +1,118 @@
+/* atmos view [SCENE] [options]: the interactive viewer's command and its loop (view.h).
+ *
+ * Interactive by design: each renderer keeps one plan, and a frame is rendered from it with
+ * only what changed (the slice renderer's light when the sun moves, the sky's tables when
+ * the eye moves far enough, the path tracer's samples when anything moves). While the
+ * camera or the sun moves, the slice renderer draws its eye buffer at half resolution and
+ * the path tracer one sample per pixel; when nothing moves the slice renderer draws the
+ * scene's own quality and the path tracer adds a sample per pixel each frame up to the
+ * scene's budget. A saved frame (F12, P) is always rendered at the scene's quality. */
+#include "render_opts.h"
+#include "render_scene.h"
+#include "view.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+
+static void help(void)
+{
+    printf("Usage: atmos view [SCENE.json] [--volume FILE|generate:PRESET] [--size WxH] [--script FLIGHT.json]\n"
+           "                  [--frames N] [--record DIR] [--headless] [--press KEYS] [--save-base BASE]\n"
+           "                  [atmos render's scene options]\n\n"
+           "Opens a window on a scene (or the built-in default; a volume with --volume) and renders it\n"
+           "with atmos's renderers on the CPU as you fly around it, move the sun or scrub the time of\n"
+           "day. The renderers keep their plans: a frame recomputes only what changed. While the\n"
+           "camera or the sun moves the slice renderer draws at half resolution and the path tracer\n"
+           "one sample per pixel; when still, the full quality, and the path tracer keeps adding\n"
+           "samples up to the scene's budget (\"path\": {\"spp\": N}).\n\n"
+           "Options:\n"
+           "  --size WxH         the rendered frame's size (default 960x540; the window scales it)\n"
+           "  --script FILE      play a flight: {\"fps\": 24, \"keys\": [{\"t\": 0, \"position_m\": [x, y, z],\n"
+           "                     \"look_at_m\": [x, y, z], \"sun\": {\"elevation_deg\": e, \"azimuth_deg\": a},\n"
+           "                     \"press\": \"NAME\"}, ...]} (camera and sun interpolated; \"press\" acts at t)\n"
+           "  --frames N         play N frames (of the script, or an orbit about the volume) and exit\n"
+           "  --record DIR       write every frame as DIR/frame_NNNNN.png and DIR/frames.csv (frame, ms =\n"
+           "                     the frame's wall time including presentation, renderer, impostor_updates,\n"
+           "                     camera, sun)\n"
+           "  --headless         no window (with --frames: render and record only)\n"
+           "  --press KEYS       press these keys (names as below, comma-separated) at the first frame,\n"
+           "                     through the window's event queue as a user's keys\n"
+           "  --save-base BASE   where F12/P saves: BASE_NNN.exr, .png, .json (default view_NNN in the\n"
+           "                     current folder); the .json renders the same frame with atmos render\n"
+           "  --help             this text\n"
+           "Scene options are atmos render's (atmos render --help): --renderer, --volume, --sun-elevation,\n"
+           "--time, --spp, -D KEY=VALUE, --threads, ...\n\n");
+    view_keys_help(stdout);
+}
+
+/* Takes the viewer's own options out of argv; the rest goes to atmos render's parser. */
+static int parse(int argc, char **argv, view_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->width = 960, o->height = 540;
+    o->pass = calloc((size_t)argc + 1, sizeof *o->pass);
+    if (!o->pass) return CLI_EXIT_RUNTIME;
+    o->pass[o->passed++] = argv[0];
+    for (int i = 1; i < argc; i++) {
+        const char *v = NULL;
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return help(), -1;
+        if (!strcmp(argv[i], "--headless")) o->headless = 1;
+        else if (cli_take_value(argc, argv, &i, "--size", &v)) {
+            if (!v || sscanf(v, "%dx%d", &o->width, &o->height) != 2 || o->width < 1 || o->height < 1 ||
+                o->width > 8192 || o->height > 8192)
+                return cli_usage_error("view", "--size: expected WxH in 1..8192, got '%s'", v ? v : "");
+        } else if (cli_take_value(argc, argv, &i, "--frames", &v)) {
+            if (!v || !cli_parse_int("view", "--frames", v, 1, 10000000, &o->frames)) return CLI_EXIT_USAGE;
+        } else if (cli_take_value(argc, argv, &i, "--script", &v)) {
+            if (!(o->script = v)) return cli_usage_error("view", "--script needs a file");
+        } else if (cli_take_value(argc, argv, &i, "--record", &v)) {
+            if (!(o->record = v)) return cli_usage_error("view", "--record needs a folder");
+        } else if (cli_take_value(argc, argv, &i, "--press", &v)) {
+            if (!(o->press = v)) return cli_usage_error("view", "--press needs key names");
+        } else if (cli_take_value(argc, argv, &i, "--save-base", &v)) {
+            if (!(o->save_base = v)) return cli_usage_error("view", "--save-base needs a name");
+        } else {
+            o->pass[o->passed++] = argv[i];
+        }
+    }
+    if (o->headless && !o->frames) return cli_usage_error("view", "--headless needs --frames N");
+    return CLI_EXIT_OK;
+}
+
+int cli_cmd_view(int argc, char **argv)
+{
+    view_opts vo;
+    int rc = parse(argc, argv, &vo);
+    render_opts ro;
+    if (rc == CLI_EXIT_OK) {
+        rc = render_opts_parse(vo.passed, vo.pass, &ro);
+        if (rc == -1) rc = CLI_EXIT_OK, vo.frames = -1; /* atmos render's --help was shown */
+    }
+    if (rc != CLI_EXIT_OK || vo.frames < 0) {
+        free(vo.pass);
+        return rc == -1 ? CLI_EXIT_OK : rc;
+    }
+    int codes[16];
+    if (vo.press && view_key_codes(vo.press, codes, 16) < 0) {
+        free(vo.pass);
+        return cli_usage_error("view", "--press: unknown key in '%s' (atmos view --help lists the keys)", vo.press);
+    }
+    atmos_context *ctx = cli_context(ro.threads, ro.quiet);
+    atmos_scene sc;
+    atmos_volume *vol = NULL;
+    char *text = NULL;
+    if (!ctx) rc = CLI_EXIT_RUNTIME;
+    if (rc == CLI_EXIT_OK) rc = render_scene_make(ctx, &ro, &sc, &vol);
+    if (rc == CLI_EXIT_OK && ro.scene_path && strcmp(ro.scene_path, "-")) text = view_read_text(ro.scene_path);
+    if (rc == CLI_EXIT_OK) {
+        sc.width = vo.width, sc.height = vo.height;
+        rc = view_loop(ctx, &vo, &sc, vol, text ? text : "{}");
+    }
+    free(text);
+    atmos_volume_destroy(vol);
+    atmos_context_destroy(ctx);
+    free(vo.pass);
+    return rc;
+}

@@ -1,0 +1,194 @@
+/* The viewer's loop (view.h, view_cmd.c): the plans, one frame after another, the display,
+ * the overlay, the recording and the saved views. */
+#include "view.h"
+
+#include <SDL2/SDL_keycode.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+
+typedef struct loop {
+    atmos_context *ctx;
+    atmos_scene *sc;             /* the scene; renderer and wavelengths follow the state */
+    const atmos_volume *vol;
+    atmos_plan *plan[3];         /* per renderer kind, made when first used */
+    int spectral;                /* the wavelengths the plans were made for */
+    atmos_image *img, *lin, *disp;
+    double log_scale;            /* the exposure's smoothed log scale (automatic exposure) */
+    int have_scale, spp, saves;
+} loop;
+
+static void drop_plans(loop *L)
+{
+    for (int k = 0; k < 3; k++) atmos_plan_destroy(L->plan[k]), L->plan[k] = NULL;
+    atmos_image_destroy(L->img), L->img = NULL;
+}
+
+static atmos_status get_plan(loop *L, const view_state *s, atmos_plan **out)
+{
+    if (s->spectral != L->spectral) drop_plans(L), L->spectral = s->spectral;
+    const int k = (int)s->renderer;
+    if (!L->plan[k]) {
+        atmos_scene sc = *L->sc;
+        sc.renderer = s->renderer;
+        sc.wavelengths = s->spectral ? ATMOS_WAVELENGTHS_SPECTRAL : ATMOS_WAVELENGTHS_RGB;
+        fprintf(stderr, "atmos view: preparing the %s renderer...\n", atmos_renderer_name(s->renderer));
+        atmos_status st = atmos_plan_create(L->ctx, &sc, L->vol, NULL, &L->plan[k]);
+        if (st != ATMOS_OK) return st;
+        atmos_image_destroy(L->img), L->img = NULL;
+    }
+    *out = L->plan[k];
+    return ATMOS_OK;
+}
+
+/* The display image of L->img: linear sRGB, then the tone map with the exposure held as a
+ * manual EV (so that a saved scene reproduces it): automatic exposure adapts smoothly
+ * (a third of the way in log a frame) unless `snap`. */
+static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int snap, double *ev_used)
+{
+    atmos_image_destroy(L->lin), L->lin = NULL;
+    atmos_image_destroy(L->disp), L->disp = NULL;
+    atmos_status st = atmos_image_to_srgb(L->ctx, L->img, atmos_plan_wavelengths(p), &L->lin);
+    if (st != ATMOS_OK) return st;
+    atmos_tonemap_desc td;
+    memset(&td, 0, sizeof td);
+    td.curve = L->sc->tonemap.curve;
+    td.manual_exposure = s->manual_exposure;
+    td.exposure_ev = s->ev;
+    if (!s->manual_exposure) {
+        const double ls = log(fmax(atmos_tonemap_scale(L->lin, &td), 1e-30));
+        L->log_scale = (!L->have_scale || snap) ? ls : L->log_scale + (ls - L->log_scale) / 3.0;
+        L->have_scale = 1;
+        /* manual: scale = 1 / (1.2 2^EV) */
+        td.manual_exposure = 1;
+        td.exposure_ev = -log2(1.2 * exp(L->log_scale));
+    }
+    *ev_used = td.exposure_ev;
+    return atmos_tonemap(L->ctx, L->lin, &td, &L->disp);
+}
+
+/* Renders the state's frame; preview: the reduced quality of a moving view. */
+static atmos_status render(loop *L, view_state *s, int preview, atmos_plan **pp)
+{
+    atmos_plan *p;
+    atmos_status st = get_plan(L, s, &p);
+    if (st != ATMOS_OK) return st;
+    atmos_frame f;
+    if ((st = atmos_frame_from_scene(L->ctx, L->sc, &f)) != ATMOS_OK) return st;
+    view_state_frame(s, &f);
+    if (s->renderer == ATMOS_RENDERER_SLICE && preview) f.eye_scale = 0.5 * (f.eye_scale > 0 ? f.eye_scale : 1.0);
+    if (s->renderer == ATMOS_RENDERER_PATH) {
+        const int full = L->sc->path.spp > 0 ? L->sc->path.spp : 64;
+        L->spp = preview ? 1 : (L->spp < full ? L->spp + 1 : full);
+        f.spp = L->spp;
+    }
+    if (!L->img && (st = atmos_plan_image_create(p, &f, &L->img)) != ATMOS_OK) return st;
+    *pp = p;
+    return atmos_plan_render(p, &f, NULL, L->img, NULL);
+}
+
+static int save(loop *L, const view_opts *o, view_state *s, const char *text)
+{
+    atmos_plan *p;
+    const int keep_spp = L->spp;
+    L->spp = 1 << 30; /* the scene's full budget */
+    double ev;
+    atmos_status st = render(L, s, 0, &p);
+    if (st == ATMOS_OK) st = display(L, p, s, 0, &ev);
+    L->spp = keep_spp;
+    if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
+    view_state saved = *s;
+    saved.manual_exposure = 1, saved.ev = ev;
+    char base[4096];
+    snprintf(base, sizeof base, "%s_%03d", o->save_base ? o->save_base : "view", ++L->saves);
+    return view_save(L->ctx, base, text, L->sc, &saved, L->lin, L->disp);
+}
+
+static void overlay(const view_state *s, double ms, char lines[4][160])
+{
+    snprintf(lines[0], 160, "%s  %.1f ms  %.1f fps", atmos_renderer_name(s->renderer), ms, ms > 0 ? 1000.0 / ms : 0.0);
+    if (s->sun_from_time)
+        snprintf(lines[1], 160, "sun %.1f / %.1f deg  %04d-%02d-%02d %02d:%02d UTC", s->sun_el, s->sun_az, s->time.year,
+                 s->time.month, s->time.day, s->time.hour, s->time.minute);
+    else snprintf(lines[1], 160, "sun elevation %.1f azimuth %.1f deg", s->sun_el, s->sun_az);
+    snprintf(lines[2], 160, "camera %.0f %.0f %.0f m  heading %.0f pitch %.0f  fov %.0f%s", s->pos[0], s->pos[1],
+             s->pos[2], s->yaw_deg, s->pitch_deg, s->fov_deg, s->orbit ? "  orbit" : "");
+    snprintf(lines[3], 160, "%s  EV %+.1f  H: hide  Esc: quit", s->spectral ? "spectral" : "rgb", s->ev);
+}
+
+/* The orbit's centre: the middle of the volume's box where the plan placed it. */
+static int volume_centre(const atmos_plan *p, double c[3])
+{
+    double off[3], lo[3], hi[3];
+    const atmos_volume *v = atmos_plan_volume(p, off);
+    if (!v) return 0;
+    atmos_volume_bounds(v, lo, hi);
+    for (int i = 0; i < 3; i++) c[i] = 0.5 * (lo[i] + hi[i]) + off[i];
+    return 1;
+}
+
+static int start(loop *L, const view_opts *o, view_state *s, view_script *script)
+{
+    atmos_frame f;
+    atmos_status st = atmos_frame_from_scene(L->ctx, L->sc, &f);
+    view_state_init(s, L->sc, &f, NULL);
+    atmos_plan *p = NULL;
+    if (st == ATMOS_OK) st = get_plan(L, s, &p);
+    if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
+    double c[3];
+    if (volume_centre(p, c)) view_state_init(s, L->sc, &f, c);
+    if (o->script) return view_script_load(o->script, script);
+    return CLI_EXIT_OK;
+}
+
+int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atmos_volume *vol, const char *text)
+{
+    loop L;
+    memset(&L, 0, sizeof L);
+    L.ctx = ctx, L.sc = sc, L.vol = vol, L.spectral = sc->wavelengths == ATMOS_WAVELENGTHS_SPECTRAL;
+    view_state s;
+    view_script script = {0};
+    view_recorder rec = {0};
+    view_window *win = NULL;
+    int rc = start(&L, o, &s, &script);
+    if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record);
+    if (rc == CLI_EXIT_OK && !o->headless && !(win = view_window_open(o->width, o->height, "atmos view")))
+        rc = CLI_EXIT_RUNTIME;
+    const int scripted = o->frames > 0 || o->script;
+    double last_ms = 0.0;
+    for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!o->frames || i < o->frames); i++) {
+        const double t0 = cli_now_s();
+        if (scripted) view_script_step(&script, &s, (i - 1) / script.fps, i / (script.fps > 0 ? script.fps : 24), i, o->frames);
+        if (win && i == 1 && o->press) {
+            int codes[16];
+            const int n = view_key_codes(o->press, codes, 16);
+            for (int k = 0; k < n; k++) view_window_push_key(win, codes[k]);
+        }
+        if (win) view_window_events(win, &s, last_ms > 0 ? last_ms / 1000.0 : 1.0 / 30.0);
+        const int moving = (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && i > 0 && !scripted;
+        s.changes = 0;
+        atmos_plan *p = NULL;
+        double ev;
+        atmos_status st = render(&L, &s, moving, &p);
+        if (st == ATMOS_OK) st = display(&L, p, &s, i == 0 || scripted, &ev);
+        if (st != ATMOS_OK) {
+            rc = cli_runtime_error("view", ctx, st);
+            break;
+        }
+        char lines[4][160];
+        const char *lp[4] = {lines[0], lines[1], lines[2], lines[3]};
+        overlay(&s, last_ms, lines);
+        if (win && view_window_present(win, L.disp, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
+        last_ms = 1000.0 * (cli_now_s() - t0);
+        if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), 0, &s);
+        if (rc == CLI_EXIT_OK && s.save) rc = save(&L, o, &s, text), s.save = 0;
+    }
+    if (view_record_close(&rec) != CLI_EXIT_OK && rc == CLI_EXIT_OK) rc = CLI_EXIT_RUNTIME;
+    view_window_close(win);
+    view_script_free(&script);
+    drop_plans(&L);
+    atmos_image_destroy(L.lin);
+    atmos_image_destroy(L.disp);
+    return rc;
+}

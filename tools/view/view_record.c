@@ -1,0 +1,151 @@
+/* Recording a flight and saving a view (view.h). A saved view is the frame's linear EXR,
+ * the PNG as shown, and a scene file that renders the same image offline: the scene file
+ * the viewer opened, edited with cJSON to hold the viewer's camera, sun, size, renderer and
+ * exposure (and the volume's resolved path), so every other setting stays as written. */
+#include "view.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+int view_record_open(view_recorder *r, const char *dir)
+{
+    memset(r, 0, sizeof *r);
+    if (!dir) return CLI_EXIT_OK;
+    r->dir = dir;
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "atmos view: --record %s: %s\n", dir, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    char path[4096];
+    snprintf(path, sizeof path, "%s/frames.csv", dir);
+    if (!(r->csv = fopen(path, "w"))) {
+        fprintf(stderr, "atmos view: --record: cannot write %s: %s\n", path, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    fprintf(r->csv, "frame,ms,renderer,impostor_updates,x_m,y_m,z_m,yaw_deg,pitch_deg,sun_elevation_deg,sun_azimuth_deg\n");
+    return CLI_EXIT_OK;
+}
+
+int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms, const char *renderer,
+                      int impostor_updates, const view_state *s)
+{
+    if (!r->dir) return CLI_EXIT_OK;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/frame_%05d.png", r->dir, r->frames);
+    atmos_status st = atmos_write_png(ctx, disp, path, 8);
+    if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
+    fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.4f,%.4f\n", r->frames, ms, renderer, impostor_updates,
+            s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, s->sun_el, s->sun_az);
+    r->frames++;
+    return CLI_EXIT_OK;
+}
+
+int view_record_close(view_recorder *r)
+{
+    int rc = CLI_EXIT_OK;
+    if (r->csv && fclose(r->csv) != 0) {
+        fprintf(stderr, "atmos view: --record: writing frames.csv failed\n");
+        rc = CLI_EXIT_RUNTIME;
+    }
+    r->csv = NULL;
+    return rc;
+}
+
+static cJSON *object(cJSON *root, const char *name)
+{
+    cJSON *o = cJSON_GetObjectItemCaseSensitive(root, name);
+    if (!cJSON_IsObject(o)) {
+        cJSON_DeleteItemFromObjectCaseSensitive(root, name);
+        o = cJSON_AddObjectToObject(root, name);
+    }
+    return o;
+}
+
+static void set(cJSON *o, const char *name, cJSON *v)
+{
+    if (!o || !v) {
+        cJSON_Delete(v);
+        return;
+    }
+    if (cJSON_HasObjectItem(o, name)) cJSON_ReplaceItemInObjectCaseSensitive(o, name, v);
+    else cJSON_AddItemToObject(o, name, v);
+}
+
+static void clear(cJSON *o, const char *const *names, int n)
+{
+    for (int i = 0; i < n; i++) cJSON_DeleteItemFromObjectCaseSensitive(o, names[i]);
+}
+
+char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_state *s)
+{
+    cJSON *root = cJSON_Parse(scene_json && *scene_json ? scene_json : "{}");
+    if (!root || !cJSON_IsObject(root)) {
+        cJSON_Delete(root);
+        root = cJSON_CreateObject();
+    }
+    atmos_frame f;
+    memset(&f, 0, sizeof f);
+    view_state_frame(s, &f);
+    cJSON *img = object(root, "image");
+    set(img, "width", cJSON_CreateNumber(sc->width));
+    set(img, "height", cJSON_CreateNumber(sc->height));
+    cJSON *cam = object(root, "camera");
+    static const char *const cam_keys[] = {"view", "position_m", "look_at_m", "up", "fov_deg", "type"};
+    clear(cam, cam_keys, 6);
+    set(cam, "type", cJSON_CreateString("pinhole"));
+    set(cam, "position_m", cJSON_CreateDoubleArray(f.camera.position, 3));
+    set(cam, "look_at_m", cJSON_CreateDoubleArray(f.camera.look_at, 3));
+    set(cam, "fov_deg", cJSON_CreateNumber(f.camera.fov_deg));
+    cJSON *sun = object(root, "sun");
+    static const char *const sun_keys[] = {"elevation_deg", "azimuth_deg", "time", "latitude_deg", "longitude_deg"};
+    clear(sun, sun_keys, 5);
+    set(sun, "elevation_deg", cJSON_CreateNumber(s->sun_el));
+    set(sun, "azimuth_deg", cJSON_CreateNumber(s->sun_az));
+    set(root, "renderer", cJSON_CreateString(atmos_renderer_name(s->renderer)));
+    cJSON *out = object(root, "output");
+    static const char *const out_keys[] = {"exposure", "exposure_compensation_ev"};
+    clear(out, out_keys, 2);
+    if (s->manual_exposure) set(out, "exposure", cJSON_CreateNumber(s->ev));
+    else set(out, "exposure_compensation_ev", cJSON_CreateNumber(s->ev));
+    cJSON *wl = object(root, "wavelengths");
+    set(wl, "mode", cJSON_CreateString(s->spectral ? "spectral" : "rgb"));
+    cJSON_DeleteItemFromObjectCaseSensitive(root, "animation");
+    if (sc->volume.source[0]) {
+        cJSON *vol = object(root, "volume");
+        const int gen = !strncmp(sc->volume.source, "generate:", 9);
+        static const char *const src_keys[] = {"file", "generate"};
+        clear(vol, src_keys, 2);
+        set(vol, gen ? "generate" : "file", cJSON_CreateString(gen ? sc->volume.source + 9 : sc->volume.source));
+    }
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    return text;
+}
+
+int view_save(atmos_context *ctx, const char *base, const char *scene_json, const atmos_scene *sc,
+              const view_state *s, const atmos_image *lin, const atmos_image *disp)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s.exr", base);
+    atmos_status st = atmos_write_exr(ctx, lin, path, NULL);
+    if (st == ATMOS_OK) {
+        snprintf(path, sizeof path, "%s.png", base);
+        st = atmos_write_png(ctx, disp, path, 8);
+    }
+    if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
+    char *text = view_scene_json(scene_json, sc, s);
+    snprintf(path, sizeof path, "%s.json", base);
+    FILE *f = text ? fopen(path, "w") : NULL;
+    const int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    if ((f && fclose(f) != 0) || !ok) {
+        fprintf(stderr, "atmos view: cannot write %s\n", path);
+        free(text);
+        return CLI_EXIT_RUNTIME;
+    }
+    free(text);
+    fprintf(stderr, "atmos view: saved %s.exr, %s.png and %s.json\n", base, base, base);
+    return CLI_EXIT_OK;
+}
