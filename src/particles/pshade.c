@@ -1,0 +1,156 @@
+/* Harris's multiple forward scattering on the CPU (pcloud.h, atmos__pcloud_shade). The
+ * light buffer is an orthographic view from the sun over the particles' box: per texel and
+ * wavelength the share of the sunlight still travelling (trans) and the scattering optical
+ * depth met (taus). Harris reads the frame buffer back at each particle's centre before
+ * splatting it; here the buffer is an array and the read is bilinear. */
+#include "particles/pcloud.h"
+#include "core/internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SQRT_2PI 2.5066282746310002
+
+typedef struct lframe {
+    double e1[3], e2[3], L[3];
+    double u0, v0, texel;
+    int res;
+    float prof[ATMOS__PCLOUD_PROF + 1];
+} lframe;
+
+typedef struct order_key {
+    double d;
+    int i;
+} order_key;
+
+static int by_depth(const void *a, const void *b)
+{
+    const order_key *x = a, *y = b;
+    return x->d < y->d ? -1 : (x->d > y->d ? 1 : (x->i > y->i) - (x->i < y->i));
+}
+
+static double dot(const double *a, const float x, const float y, const float z) { return a[0] * x + a[1] * y + a[2] * z; }
+
+static void make_frame(const atmos__pcloud *pc, const double sun[3], int res, lframe *f)
+{
+    memcpy(f->L, sun, sizeof f->L);
+    const double a[3] = {fabs(sun[0]) < 0.9 ? 1.0 : 0.0, fabs(sun[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    const double c = a[0] * sun[0] + a[1] * sun[1] + a[2] * sun[2];
+    double t[3] = {a[0] - c * sun[0], a[1] - c * sun[1], a[2] - c * sun[2]};
+    const double l = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    for (int i = 0; i < 3; i++) f->e1[i] = t[i] / l;
+    f->e2[0] = sun[1] * f->e1[2] - sun[2] * f->e1[1];
+    f->e2[1] = sun[2] * f->e1[0] - sun[0] * f->e1[2];
+    f->e2[2] = sun[0] * f->e1[1] - sun[1] * f->e1[0];
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, smin = INFINITY;
+    for (int p = 0; p < pc->n; p++) {
+        const double u = dot(f->e1, pc->x[p], pc->y[p], pc->z[p]), v = dot(f->e2, pc->x[p], pc->y[p], pc->z[p]);
+        const double r = ATMOS__PCLOUD_CUT * pc->s[p];
+        lo[0] = fmin(lo[0], u - r), hi[0] = fmax(hi[0], u + r);
+        lo[1] = fmin(lo[1], v - r), hi[1] = fmax(hi[1], v + r);
+        smin = fmin(smin, pc->s[p]);
+    }
+    const double ext = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    /* texels of half the smallest width, 64..1024 per side */
+    f->res = res > 0 ? res : (int)fmin(1024.0, fmax(64.0, ceil(ext / (0.5 * smin))));
+    f->texel = ext / f->res;
+    f->u0 = lo[0], f->v0 = lo[1];
+    atmos__pcloud_profile(f->prof);
+}
+
+/* Bilinear read of buffer b at texel coordinates (x, y). */
+static double read_at(const float *b, int res, double x, double y)
+{
+    x = fmin(fmax(x - 0.5, 0.0), res - 1.001), y = fmin(fmax(y - 0.5, 0.0), res - 1.001);
+    const int i = (int)x, j = (int)y;
+    const double ax = x - i, ay = y - j;
+    const float *r0 = b + (size_t)j * res + i, *r1 = r0 + res;
+    return (1 - ay) * ((1 - ax) * r0[0] + ax * r0[1]) + ay * ((1 - ax) * r1[0] + ax * r1[1]);
+}
+
+/* The splat of particle p into the light buffer at texel coordinates (x, y). */
+static void splat(const atmos__pcloud *pc, int p, const lframe *f, double tc, double aF, double a, double x, double y,
+                  float *trans, float *taus)
+{
+    const int res = f->res;
+    const double s = pc->s[p], k2 = f->texel * f->texel / (s * s), rt = ATMOS__PCLOUD_CUT * s / f->texel;
+    const int i0 = (int)fmax(0.0, floor(x - rt)), i1 = (int)fmin(res - 1.0, ceil(x + rt));
+    const int j0 = (int)fmax(0.0, floor(y - rt)), j1 = (int)fmin(res - 1.0, ceil(y + rt));
+    for (int j = j0; j <= j1; j++)
+        for (int i = i0; i <= i1; i++) {
+            const double dx = i + 0.5 - x, dy = j + 0.5 - y, b2 = dx * dx + dy * dy;
+            if (b2 > rt * rt) continue;
+            const double tau = tc * atmos__pcloud_column(f->prof, (float)(b2 * k2)), T = exp(-tau);
+            const size_t t = (size_t)j * res + i;
+            trans[t] *= (float)(T + (1.0 - T) * aF);
+            taus[t] += (float)(a * tau);
+        }
+}
+
+/* The light pass of wavelength k. The particles go in groups of depths within half the
+ * first one's width; a group splats the front halves of its blobs (optical depth tc / 2),
+ * reads the light at its particles' centres, then splats the back halves: particles side by
+ * side shade each other's centres as the halves of a slab do. */
+static void pass(const atmos__pcloud *pc, const atmos__poptics *o, const lframe *f, const order_key *ord, int k,
+                 float *trans, float *taus, float *light, float *ns)
+{
+    const int res = f->res, nw = o->nw;
+    for (size_t t = 0; t < (size_t)res * res; t++) trans[t] = 1.0f, taus[t] = 0.0f;
+    for (int q0 = 0, q1; q0 < pc->n; q0 = q1) {
+        const double dmax = ord[q0].d + 0.5 * pc->s[ord[q0].i];
+        for (q1 = q0 + 1; q1 < pc->n && ord[q1].d < dmax; q1++) {}
+        for (int phase = 0; phase < 3; phase++)
+            for (int q = q0; q < q1; q++) {
+                const int p = ord[q].i, fi = pc->field[p];
+                const double x = (dot(f->e1, pc->x[p], pc->y[p], pc->z[p]) - f->u0) / f->texel;
+                const double y = (dot(f->e2, pc->x[p], pc->y[p], pc->z[p]) - f->v0) / f->texel;
+                const double a = o->albedo[fi][k], tc = o->sigma_ext[fi][k] * pc->n0[p] * pc->s[p] * SQRT_2PI;
+                const size_t at = (size_t)p * nw + k;
+                if (phase == 1) {
+                    light[at] = (float)read_at(trans, res, x, y);
+                    ns[at] = (float)read_at(taus, res, x, y);
+                    continue;
+                }
+                const double n = phase ? ns[at] : read_at(taus, res, x, y);
+                const double F = o->ms[fi] ? atmos_msphase_forward(o->ms[fi], k, n + 1.0) : 0.0;
+                splat(pc, p, f, 0.5 * tc, a * F, a, x, y, trans, taus);
+            }
+    }
+}
+
+atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
+                                 const double sun[3], int res, float *light, float *order)
+{
+    if (pc->n == 0) return ATMOS_OK;
+    lframe f;
+    make_frame(pc, sun, res, &f);
+    order_key *ord = malloc(sizeof *ord * (size_t)pc->n);
+    float *ns = malloc(sizeof(float) * (size_t)pc->n * o->nw);
+    if (!ord || !ns) {
+        free(ord), free(ns);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the light pass");
+    }
+    for (int p = 0; p < pc->n; p++) ord[p].d = -dot(sun, pc->x[p], pc->y[p], pc->z[p]), ord[p].i = p;
+    qsort(ord, (size_t)pc->n, sizeof *ord, by_depth);
+    int nomem = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
+    for (int k = 0; k < o->nw; k++) {
+        float *buf = malloc(sizeof(float) * 2 * (size_t)f.res * f.res);
+        if (!buf) {
+#pragma omp atomic write
+            nomem = 1;
+            continue;
+        }
+        pass(pc, o, &f, ord, k, buf, buf + (size_t)f.res * f.res, light, ns);
+        free(buf);
+    }
+    for (int p = 0; p < pc->n && order; p++) {
+        double m = 0;
+        for (int k = 0; k < o->nw; k++) m += ns[(size_t)p * o->nw + k];
+        order[p] = (float)(m / o->nw);
+    }
+    free(ord), free(ns);
+    if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the light buffer");
+    return ATMOS_OK;
+}

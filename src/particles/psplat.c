@@ -1,0 +1,142 @@
+/* The particles' eye pass (pcloud.h, atmos__pcloud_splat): Harris's back-to-front splatting
+ * on the CPU. The particles are sorted far to near, binned into tiles of the image, and each
+ * tile composites its own list in that order, so a tile's pixels see every particle in the
+ * same order whatever thread draws it. */
+#include "particles/pcloud.h"
+#include "core/fastmath.h"
+#include "core/internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TILE 32
+#define SQRT_2PI 2.5066282746310002
+
+typedef struct sp {
+    double c[3], s, z;       /* centre, width, depth along the camera's axis */
+    int bb[4];               /* pixel box [x0, x1) x [y0, y1) */
+    float col[ATMOS_MAX_WAVELENGTHS], tc[ATMOS_MAX_WAVELENGTHS]; /* colour and central depth */
+} sp;
+
+typedef struct far_key {
+    double z;
+    int i;
+} far_key;
+
+static int far_first(const void *a, const void *b)
+{
+    const far_key *x = a, *y = b;
+    return x->z > y->z ? -1 : (x->z < y->z ? 1 : (x->i > y->i) - (x->i < y->i));
+}
+
+/* The splat of particle p as seen by cam; 0 when it is not drawn. */
+static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const float *light, const float *order,
+                   const double sun[3], const double *sun_e, const atmos_camera *cam, const int rect[4], sp *out)
+{
+    const double c[3] = {pc->x[p], pc->y[p], pc->z[p]}, s = pc->s[p], r = ATMOS__PCLOUD_CUT * s;
+    double rel[3], X = 0, Y = 0, Z = 0;
+    for (int i = 0; i < 3; i++) rel[i] = c[i] - cam->position[i];
+    for (int i = 0; i < 3; i++) X += rel[i] * cam->right[i], Y += rel[i] * cam->up[i], Z += rel[i] * cam->forward[i];
+    if (Z <= r) return 0; /* behind the eye, or the eye inside the splat */
+    const double W = cam->width, H = cam->height, t = cam->tan_half_fov, f = H / (2.0 * t);
+    const double px = 0.5 * W + f * X / Z, py = 0.5 * H - f * Y / Z;
+    /* the sphere's outline on the image lies within r f / sqrt(Z^2 - r^2) of the centre's image,
+     * stretched toward the edges: bound it by the projection of its box */
+    const double rp = f * r / sqrt(Z * Z - r * r) * (1.0 + (fabs(X) + fabs(Y) + r) / Z);
+    out->bb[0] = (int)fmax(rect[0], floor(px - rp)), out->bb[1] = (int)fmin(rect[2], ceil(px + rp));
+    out->bb[2] = (int)fmax(rect[1], floor(py - rp)), out->bb[3] = (int)fmin(rect[3], ceil(py + rp));
+    if (out->bb[0] >= out->bb[1] || out->bb[2] >= out->bb[3]) return 0;
+    memcpy(out->c, c, sizeof out->c);
+    out->s = s, out->z = Z;
+    const double d = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
+    /* scattering angle: the sunlight travels along -sun, the eye is at -rel from the centre */
+    const double mu = (sun[0] * rel[0] + sun[1] * rel[1] + sun[2] * rel[2]) / d;
+    const int fi = pc->field[p];
+    for (int k = 0; k < o->nw; k++) {
+        const double ph = o->ms[fi] ? atmos_msphase_eval(o->ms[fi], k, order[p] + 1.0, mu) : 1.0 / (4.0 * ATMOS_PI);
+        out->col[k] = (float)(o->albedo[fi][k] * ph * sun_e[k] * light[(size_t)p * o->nw + k]);
+        out->tc[k] = (float)(o->sigma_ext[fi][k] * pc->n0[p] * s * SQRT_2PI);
+    }
+    return 1;
+}
+
+/* Composites splat q over the pixels of its box inside tile (tx, ty). */
+static void draw(const sp *q, int nw, const atmos_camera *cam, const float *prof, int tx, int ty, atmos_image *img)
+{
+    const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
+    const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
+    const double W = cam->width, H = cam->height, t = cam->tan_half_fov, k2 = 1.0 / (q->s * q->s);
+    const double rc2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT * q->s * q->s;
+    double rel[3];
+    for (int i = 0; i < 3; i++) rel[i] = q->c[i] - cam->position[i];
+    const double rr = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
+    const int C = img->channels;
+    for (int y = y0; y < y1; y++) {
+        const double v = (H - 2.0 * (y + 0.5)) / H * t;
+        for (int x = x0; x < x1; x++) {
+            const double u = (2.0 * (x + 0.5) - W) / H * t;
+            double d[3], dd = 0, rd = 0;
+            for (int i = 0; i < 3; i++) d[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i], dd += d[i] * d[i];
+            for (int i = 0; i < 3; i++) rd += rel[i] * d[i];
+            const double b2 = rr - rd * rd / dd;
+            if (b2 > rc2) continue;
+            const float g = atmos__pcloud_column(prof, (float)(b2 * k2));
+            float *px = img->pixels + ((size_t)y * cam->width + x) * C, tm = 0;
+            for (int k = 0; k < nw; k++) {
+                const float T = atmos__expf_fast(-q->tc[k] * g);
+                px[k] = px[k] * T + q->col[k] * (1.0f - T);
+                tm += T;
+            }
+            px[nw] = 1.0f - (1.0f - px[nw]) * tm / nw;
+        }
+    }
+}
+
+atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
+                                 const float *light, const float *order, const double sun[3], const double *sun_e,
+                                 const atmos_camera *cam, const int rect[4], atmos_image *img, int *drawn)
+{
+    if (drawn) *drawn = 0;
+    if (cam->type != ATMOS_CAMERA_PINHOLE)
+        return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "particles: the splat renderer draws pinhole cameras only");
+    const int ntx = (rect[2] - rect[0] + TILE - 1) / TILE, nty = (rect[3] - rect[1] + TILE - 1) / TILE;
+    sp *s = malloc(sizeof *s * (size_t)(pc->n ? pc->n : 1));
+    far_key *ord = malloc(sizeof *ord * (size_t)(pc->n ? pc->n : 1));
+    int *cnt = calloc((size_t)ntx * nty + 1, sizeof(int));
+    int n = 0;
+    float prof[ATMOS__PCLOUD_PROF + 1];
+    atmos__pcloud_profile(prof);
+    if (!s || !ord || !cnt) goto nomem;
+    for (int p = 0; p < pc->n; p++)
+        if (prepare(pc, p, o, light, order, sun, sun_e, cam, rect, &s[n])) ord[n].z = s[n].z, ord[n].i = n, n++;
+    qsort(ord, (size_t)n, sizeof *ord, far_first);
+    /* tile lists: counts, offsets, then the splats in far-to-near order */
+    for (int q = 0; q < n; q++) {
+        const sp *a = &s[ord[q].i];
+        for (int ty = (a->bb[2] - rect[1]) / TILE; ty <= (a->bb[3] - 1 - rect[1]) / TILE; ty++)
+            for (int tx = (a->bb[0] - rect[0]) / TILE; tx <= (a->bb[1] - 1 - rect[0]) / TILE; tx++) cnt[ty * ntx + tx + 1]++;
+    }
+    for (int t = 0; t < ntx * nty; t++) cnt[t + 1] += cnt[t];
+    int *list = malloc(sizeof(int) * (size_t)(cnt[ntx * nty] ? cnt[ntx * nty] : 1)), *fill = calloc((size_t)ntx * nty, sizeof(int));
+    if (!list || !fill) {
+        free(list), free(fill);
+        goto nomem;
+    }
+    for (int q = 0; q < n; q++) {
+        const sp *a = &s[ord[q].i];
+        for (int ty = (a->bb[2] - rect[1]) / TILE; ty <= (a->bb[3] - 1 - rect[1]) / TILE; ty++)
+            for (int tx = (a->bb[0] - rect[0]) / TILE; tx <= (a->bb[1] - 1 - rect[0]) / TILE; tx++)
+                list[cnt[ty * ntx + tx] + fill[ty * ntx + tx]++] = ord[q].i;
+    }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
+    for (int t = 0; t < ntx * nty; t++)
+        for (int q = cnt[t]; q < cnt[t + 1]; q++)
+            draw(&s[list[q]], o->nw, cam, prof, rect[0] + (t % ntx) * TILE, rect[1] + (t / ntx) * TILE, img);
+    free(list), free(fill), free(s), free(ord), free(cnt);
+    if (drawn) *drawn = n;
+    return ATMOS_OK;
+nomem:
+    free(s), free(ord), free(cnt);
+    return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the splats");
+}

@@ -1,0 +1,185 @@
+/* Particle clouds (src/particles/): conversion from a volume and back (a uniform box's
+ * density and mass kept), Harris's light pass against Beer-Lambert through a uniform slab
+ * (no forward share) and against the forward share's closed form, the eye pass of one thin
+ * particle against the single-scattering integral, and the images' independence of the
+ * thread count. */
+#include "atmos/atmos.h"
+#include "particles/pcloud.h"
+#include "test.h"
+
+#include <math.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* A box of nx x ny x nz voxels of 50 m at density rho (one "cloud" field). */
+static atmos_volume *box(int nx, int ny, int nz, float rho)
+{
+    atmos_volume_desc d;
+    memset(&d, 0, sizeof d);
+    d.dims[0] = nx, d.dims[1] = ny, d.dims[2] = nz;
+    d.voxel_size_m = 50;
+    atmos_volume *v = NULL;
+    int f;
+    CHECK_OK(atmos_volume_create(NULL, &d, &v));
+    CHECK_OK(atmos_volume_add_field(NULL, v, "cloud", "cloud", &f));
+    float *vals = malloc(sizeof(float) * (size_t)nx * ny * nz);
+    for (int i = 0; i < nx * ny * nz; i++) vals[i] = rho;
+    const int off[3] = {0, 0, 0};
+    CHECK_OK(atmos_volume_set_dense(NULL, v, f, off, d.dims, vals, 1.0f));
+    CHECK_OK(atmos_volume_finalize(NULL, v));
+    free(vals);
+    return v;
+}
+
+static void convert(void)
+{
+    atmos_volume *v = box(24, 24, 24, 1e8f);
+    const double off[3] = {0, 0, 0};
+    atmos__pcloud pc;
+    CHECK_OK(atmos__pcloud_from_volume(NULL, v, off, 100.0, 0, &pc));
+    CHECK(pc.n == 12 * 12 * 12);
+    CHECK(pc.nfields == 1 && !strcmp(pc.field_name[0], "cloud"));
+    atmos_volume *g = NULL;
+    CHECK_OK(atmos__pcloud_to_volume(NULL, &pc, 25.0, &g));
+    /* the middle of the box: the lattice of Gaussians sums to the density */
+    const double mid[3] = {600, 600, 600};
+    const double inner = g ? atmos_volume_sample(g, 0, mid) : 0;
+    printf("convert: %d particles, density at the centre %.5g (box 1e8)\n", pc.n, inner);
+    CHECK_REL(inner, 1e8, 5e-3);
+    const double corner[3] = {250, 250, 250}; /* the ripple of the cut lattice: 1 % */
+    CHECK_REL(g ? atmos_volume_sample(g, 0, corner) : 0, 1e8, 1.5e-2);
+    /* the mass: the sum over the grid (cut at 3 s, the particles keep their cells' mass) */
+    double mass = 0;
+    for (double z = 12.5; z < 1500; z += 25)
+        for (double y = 12.5; y < 1500; y += 25)
+            for (double x = 12.5; x < 1500; x += 25) {
+                const double p[3] = {x - 150, y - 150, z - 150};
+                mass += atmos_volume_sample(g, 0, p) * 25.0 * 25.0 * 25.0;
+            }
+    const double want = 1e8 * 1200.0 * 1200.0 * 1200.0;
+    printf("convert: mass %.6g of %.6g\n", mass, want);
+    CHECK_REL(mass, want, 3e-3);
+    atmos_volume_destroy(g);
+    atmos_volume_destroy(v);
+    atmos__pcloud_free(&pc);
+}
+
+/* The light pass with no forward share against the optical depth toward the sun from each
+ * particle's centre through the particles' own density grid (atmos__pcloud_to_volume, then
+ * the volume's DDA: a second method): a uniform slab with the sun overhead and a
+ * generated cumulus with the sun at 35 degrees. Returns |tau - tau_ref| / (tau_ref
+ * + 0.1) over the particles: its rms (printed with the worst). */
+static double light_vs_grid(atmos_volume *v, double h, const double sun[3], double sigma, const char *what)
+{
+    const double off[3] = {0, 0, 0};
+    atmos__pcloud pc;
+    CHECK_OK(atmos__pcloud_from_volume(NULL, v, off, h, 0, &pc));
+    atmos_volume *g = NULL;
+    CHECK_OK(atmos__pcloud_to_volume(NULL, &pc, 0.25 * h, &g));
+    atmos__poptics o;
+    memset(&o, 0, sizeof o);
+    o.nw = 1;
+    o.sigma_ext[0][0] = sigma, o.albedo[0][0] = 0.9;
+    float *light = malloc(sizeof(float) * (size_t)pc.n), *order = malloc(sizeof(float) * (size_t)pc.n);
+    CHECK_OK(atmos__pcloud_shade(NULL, &pc, &o, sun, 0, light, order));
+    double worst = 0, worst_n = 0, mean = 0, rms = 0;
+    for (int p = 0; p < pc.n && g; p++) {
+        const double c[3] = {pc.x[p], pc.y[p], pc.z[p]};
+        const double ref = atmos_volume_optical_depth(g, &sigma, c, sun, 0, 1e5);
+        const double got = -log(light[p]);
+        worst = fmax(worst, fabs(got - ref) / (ref + 0.1));
+        worst_n = fmax(worst_n, fabs(order[p] - 0.9 * ref) / (0.9 * ref + 0.1));
+        mean += got - ref;
+        rms += (got - ref) * (got - ref) / ((ref + 0.1) * (ref + 0.1));
+    }
+    rms = sqrt(rms / pc.n);
+    printf("light pass, %s: %d particles, |tau - tau_grid| / (tau_grid + 0.1): rms %.4f, worst %.4f; of the "
+           "scattering count: worst %.4f; mean tau - tau_grid %.4f\n", what, pc.n, rms, worst, worst_n, mean / pc.n);
+    CHECK(worst_n < 1.2 * worst + 1e-3);
+    free(light), free(order);
+    atmos_volume_destroy(g);
+    atmos__pcloud_free(&pc);
+    return rms;
+}
+
+static void light_pass(void)
+{
+    atmos_volume *v = box(40, 20, 40, 1e8f);
+    const double up[3] = {0, 1, 0};
+    CHECK(light_vs_grid(v, 100.0, up, 2e-11, "slab") < 0.02);
+    atmos_volume_destroy(v);
+    atmos_volume_generate_desc gd;
+    memset(&gd, 0, sizeof gd);
+    gd.seed = 3, gd.voxel_size_m = 100;
+    CHECK_OK(atmos_volume_generate(NULL, "cumulus", &gd, &v));
+    double sun[3];
+    atmos_direction_from_angles(35, 120, sun);
+    CHECK(light_vs_grid(v, 100.0, sun, 2e-11, "cumulus") < 0.05);
+    atmos_volume_destroy(v);
+}
+
+/* One thin particle seen face on, isotropic scattering, against the single-scattering
+ * integral a/(4 pi) E (1 - exp(-tau)) on the ray through its centre; and the same bytes
+ * on 1 and 2 threads for a cloud of them. */
+static void eye_pass(void)
+{
+    atmos__pcloud pc;
+    memset(&pc, 0, sizeof pc);
+    pc.nfields = 1;
+    CHECK_OK(atmos__pcloud_add(&pc, 0, 0, -1000, 20, 1e9, 0));
+    atmos__poptics o;
+    memset(&o, 0, sizeof o);
+    o.nw = 1;
+    o.sigma_ext[0][0] = 1e-12, o.albedo[0][0] = 0.9;
+    const float light[1] = {0.8f}, order[1] = {0.0f};
+    const double sun[3] = {0, 1, 0}, sun_e[1] = {1.5};
+    atmos_camera_desc cd;
+    const double pos[3] = {0, 0, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &cd);
+    cd.fov_deg = 10;
+    atmos_camera cam;
+    CHECK_OK(atmos_camera_init(NULL, &cd, 65, 65, &cam));
+    atmos_image *img = NULL;
+    CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img));
+    const int rect[4] = {0, 0, 65, 65};
+    int drawn = 0;
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, light, order, sun, sun_e, &cam, rect, img, &drawn));
+    CHECK(drawn == 1);
+    const double tau = 1e-12 * 1e9 * 20 * sqrt(2 * 3.141592653589793) * erf(3 / sqrt(2.0));
+    const double want = 0.9 / (4 * 3.141592653589793) * 1.5 * 0.8 * (1 - exp(-tau));
+    printf("eye pass: centre %.6g, single scattering %.6g (tau %.4f)\n", img->pixels[(32 * 65 + 32) * 2], want, tau);
+    CHECK_REL(img->pixels[(32 * 65 + 32) * 2], want, 1e-3);
+    CHECK_NEAR(img->pixels[(32 * 65 + 32) * 2 + 1], 1 - exp(-tau), 1e-4);
+    CHECK(img->pixels[0] == 0.0f); /* the corner is beyond 3 s */
+    /* many overlapping particles, 1 thread against 2 */
+    for (int i = 0; i < 300; i++)
+        CHECK_OK(atmos__pcloud_add(&pc, 30 * sin(i * 1.3), 30 * cos(i * 0.7), -900 - 0.5 * i, 5 + i % 7, 1e9, 0));
+    float *lt = malloc(sizeof(float) * (size_t)pc.n), *od = calloc((size_t)pc.n, sizeof(float));
+    for (int i = 0; i < pc.n; i++) lt[i] = 0.5f + 0.001f * i;
+    atmos_image *img2 = NULL;
+    CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img2));
+#ifdef _OPENMP
+    omp_set_num_threads(1);
+#endif
+    memset(img->pixels, 0, sizeof(float) * 65 * 65 * 2);
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, lt, od, sun, sun_e, &cam, rect, img, NULL));
+#ifdef _OPENMP
+    omp_set_num_threads(2);
+#endif
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, lt, od, sun, sun_e, &cam, rect, img2, NULL));
+    CHECK(memcmp(img->pixels, img2->pixels, sizeof(float) * 65 * 65 * 2) == 0);
+    free(lt), free(od);
+    atmos_image_destroy(img);
+    atmos_image_destroy(img2);
+    atmos__pcloud_free(&pc);
+}
+
+int main(void)
+{
+    convert();
+    light_pass();
+    eye_pass();
+    return test_summary("test_particles");
+}
