@@ -87,15 +87,17 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
 
 /* ---- psplat.c: the eye pass (§2.2.2, Eq. 9) */
 /* Composites the particles over img (width x height, nw + 1 channels: radiance per
- * wavelength, then coverage) back to front, within [x0, x1) x [y0, y1): a particle adds
- * a Ams_{n+1}(theta) E_sun I_p (1 - T) and leaves T = exp(-tau(b)) of what is behind it,
- * b the pixel ray's distance from its centre (Harris's Gaussian splat, exactly), theta the
- * scattering angle toward the eye. light, order: atmos__pcloud_shade's; sun_e: the
- * sunlight outside the cloud per wavelength (W m^-2 nm^-1). Pinhole cameras; particles
- * whose splat holds the eye are left out. Threads over tiles of 32 x 32 pixels (the image
- * does not depend on the thread count). *drawn: the particles drawn (may be NULL). */
-atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
-                                 const float *light, const float *order, const double sun[3], const double *sun_e,
-                                 const atmos_camera *cam, const int rect[4], atmos_image *img, int *drawn);
+ * wavelength, then coverage) back to front, within rect [x0, y0, x1, y1): a particle adds
+ * a sum_j Ams_{n_j+1}(theta_j) E_j I_pj (1 - T) and leaves T = exp(-tau(b)) of what is behind
+ * it, b the pixel ray's distance from its centre (Harris's splat, exactly), over the lights
+ * j (toward dir[j], irradiance e[j] outside the cloud; light[j], order[j] their
+ * atmos__pcloud_shade), theta_j the scattering angle from light j toward the eye. Pinhole
+ * cameras; particles whose splat holds the eye are left out. Threads over tiles of 32 x 32
+ * pixels (the image does not depend on the thread count). *drawn: the particles drawn (may
+ * be NULL). */
+atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o, int nlights,
+                                        const float *const *light, const float *const *order, const double (*dir)[3],
+                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const atmos_camera *cam,
+                                        const int rect[4], atmos_image *img, int *drawn);
 
 #endif

@@ -30,9 +30,17 @@ static int far_first(const void *a, const void *b)
     return x->z > y->z ? -1 : (x->z < y->z ? 1 : (x->i > y->i) - (x->i < y->i));
 }
 
+/* The lights of a frame (atmos__pcloud_splat_lights' arguments). */
+typedef struct lights {
+    int n;
+    const float *const *light, *const *order;
+    const double (*dir)[3];
+    const double (*e)[ATMOS_MAX_WAVELENGTHS];
+} lights;
+
 /* The splat of particle p as seen by cam; 0 when it is not drawn. */
-static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const float *light, const float *order,
-                   const double sun[3], const double *sun_e, const atmos_camera *cam, const int rect[4], sp *out)
+static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const lights *L, const atmos_camera *cam,
+                   const int rect[4], sp *out)
 {
     const double c[3] = {pc->x[p], pc->y[p], pc->z[p]}, s = pc->s[p], r = ATMOS__PCLOUD_CUT * s;
     double rel[3], X = 0, Y = 0, Z = 0;
@@ -50,12 +58,16 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
     memcpy(out->c, c, sizeof out->c);
     out->s = s, out->z = Z;
     const double d = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
-    /* scattering angle: the sunlight travels along -sun, the eye is at -rel from the centre */
-    const double mu = (sun[0] * rel[0] + sun[1] * rel[1] + sun[2] * rel[2]) / d;
     const int fi = pc->field[p];
     for (int k = 0; k < o->nw; k++) {
-        const double ph = o->ms[fi] ? atmos_msphase_eval(o->ms[fi], k, order[p] + 1.0, mu) : 1.0 / (4.0 * ATMOS_PI);
-        out->col[k] = (float)(o->albedo[fi][k] * ph * sun_e[k] * light[(size_t)p * o->nw + k]);
+        double sum = 0;
+        for (int j = 0; j < L->n; j++) {
+            /* scattering angle: the light travels along -dir, the eye is at -rel from the centre */
+            const double mu = (L->dir[j][0] * rel[0] + L->dir[j][1] * rel[1] + L->dir[j][2] * rel[2]) / d;
+            const double ph = o->ms[fi] ? atmos_msphase_eval(o->ms[fi], k, L->order[j][p] + 1.0, mu) : 1.0 / (4.0 * ATMOS_PI);
+            sum += ph * L->e[j][k] * L->light[j][(size_t)p * o->nw + k];
+        }
+        out->col[k] = (float)(o->albedo[fi][k] * sum);
         out->tc[k] = (float)(o->sigma_ext[fi][k] * pc->n0[p] * s * SQRT_2PI);
     }
     return 1;
@@ -93,10 +105,12 @@ static void draw(const sp *q, int nw, const atmos_camera *cam, const float *prof
     }
 }
 
-atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
-                                 const float *light, const float *order, const double sun[3], const double *sun_e,
-                                 const atmos_camera *cam, const int rect[4], atmos_image *img, int *drawn)
+atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o, int nlights,
+                                        const float *const *light, const float *const *order, const double (*dir)[3],
+                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const atmos_camera *cam,
+                                        const int rect[4], atmos_image *img, int *drawn)
 {
+    const lights L = {nlights, light, order, dir, e};
     if (drawn) *drawn = 0;
     if (cam->type != ATMOS_CAMERA_PINHOLE)
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "particles: the splat renderer draws pinhole cameras only");
@@ -109,7 +123,7 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
     atmos__pcloud_profile(prof);
     if (!s || !ord || !cnt) goto nomem;
     for (int p = 0; p < pc->n; p++)
-        if (prepare(pc, p, o, light, order, sun, sun_e, cam, rect, &s[n])) ord[n].z = s[n].z, ord[n].i = n, n++;
+        if (prepare(pc, p, o, &L, cam, rect, &s[n])) ord[n].z = s[n].z, ord[n].i = n, n++;
     qsort(ord, (size_t)n, sizeof *ord, far_first);
     /* tile lists: counts, offsets, then the splats in far-to-near order */
     for (int q = 0; q < n; q++) {

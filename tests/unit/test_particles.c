@@ -134,7 +134,8 @@ static void eye_pass(void)
     o.nw = 1;
     o.sigma_ext[0][0] = 1e-12, o.albedo[0][0] = 0.9;
     const float light[1] = {0.8f}, order[1] = {0.0f};
-    const double sun[3] = {0, 1, 0}, sun_e[1] = {1.5};
+    const float *lp[1] = {light}, *op[1] = {order};
+    const double sun[1][3] = {{0, 1, 0}}, sun_e[1][ATMOS_MAX_WAVELENGTHS] = {{1.5}};
     atmos_camera_desc cd;
     const double pos[3] = {0, 0, 0};
     atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &cd);
@@ -145,7 +146,7 @@ static void eye_pass(void)
     CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img));
     const int rect[4] = {0, 0, 65, 65};
     int drawn = 0;
-    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, light, order, sun, sun_e, &cam, rect, img, &drawn));
+    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, lp, op, sun, sun_e, &cam, rect, img, &drawn));
     CHECK(drawn == 1);
     const double tau = 1e-12 * 1e9 * 20 * sqrt(2 * 3.141592653589793) * erf(3 / sqrt(2.0));
     const double want = 0.9 / (4 * 3.141592653589793) * 1.5 * 0.8 * (1 - exp(-tau));
@@ -158,17 +159,18 @@ static void eye_pass(void)
         CHECK_OK(atmos__pcloud_add(&pc, 30 * sin(i * 1.3), 30 * cos(i * 0.7), -900 - 0.5 * i, 5 + i % 7, 1e9, 0));
     float *lt = malloc(sizeof(float) * (size_t)pc.n), *od = calloc((size_t)pc.n, sizeof(float));
     for (int i = 0; i < pc.n; i++) lt[i] = 0.5f + 0.001f * i;
+    const float *ltp[1] = {lt}, *odp[1] = {od};
     atmos_image *img2 = NULL;
     CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img2));
 #ifdef _OPENMP
     omp_set_num_threads(1);
 #endif
     memset(img->pixels, 0, sizeof(float) * 65 * 65 * 2);
-    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, lt, od, sun, sun_e, &cam, rect, img, NULL));
+    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, &cam, rect, img, NULL));
 #ifdef _OPENMP
     omp_set_num_threads(2);
 #endif
-    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, lt, od, sun, sun_e, &cam, rect, img2, NULL));
+    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, &cam, rect, img2, NULL));
     CHECK(memcmp(img->pixels, img2->pixels, sizeof(float) * 65 * 65 * 2) == 0);
     free(lt), free(od);
     atmos_image_destroy(img);
