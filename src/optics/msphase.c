@@ -652,6 +652,12 @@ atmos_status atmos_msphase_build(atmos_context *ctx, const atmos_phase_table *ta
         }
     }
     atmos_status st = atmos__msphase_build_arrays(ctx, nwl, n, theta, P, &d, out);
+    if (st == ATMOS_OK) {
+        /* the values as the cache keeps them (floats), so that a table built here and one
+         * loaded from the cache answer with the same bits */
+        const size_t nv = (size_t)(*out)->nwl * (*out)->max_order * (*out)->ngrid;
+        for (size_t i = 0; i < nv; i++) (*out)->values[i] = (double)(float)(*out)->values[i];
+    }
     if (st == ATMOS_OK && !d.no_cache) {
         size_t size = 0;
         void *data = serialise(*out, &size);
