@@ -31,8 +31,11 @@ typedef struct atmos_scene_sun {
 typedef enum {
     ATMOS_RENDERER_SKY = 0,   /* the analytic sky (Riley §4.1, §4.2.4) */
     ATMOS_RENDERER_SLICE = 1, /* half-angle slicing over the volume (Riley §4.2-§5, slice.h) */
-    ATMOS_RENDERER_PATH = 2   /* Monte Carlo volumetric path tracing over the volume (path.h) */
+    ATMOS_RENDERER_PATH = 2,  /* Monte Carlo volumetric path tracing over the volume (path.h) */
+    ATMOS_RENDERER_HARRIS = 3 /* Harris 2002: the volume as particles, multiple forward scattering, splats */
 } atmos_renderer_kind;
+/* The last renderer kind (loops over the kinds end here). */
+#define ATMOS_RENDERER_LAST ATMOS_RENDERER_HARRIS
 
 #define ATMOS_SCENE_PATH_MAX 1024
 
@@ -85,6 +88,16 @@ typedef struct atmos_scene_path {
     int aureole;              /* the aureole estimate in droplet clouds; 1 */
 } atmos_scene_path;
 
+/* Settings of Harris's particle renderer ("harris" in the file); the table is
+ * atmos_renderer_settings(ATMOS_RENDERER_HARRIS) (docs/particles.md). */
+typedef struct atmos_scene_harris {
+    double spacing_m;         /* particles one per cell of this edge; 0 = the volume's voxel, coarser
+                                 until at most max_particles */
+    int max_particles;        /* 50000 */
+    int sky_lights;           /* sky lights besides the sun (Harris §2.3.1); 6 */
+    int light_size;           /* light buffer texels per side; 0 = from the particles' size (<= 1024) */
+} atmos_scene_harris;
+
 /* A sequence of images with the sun moving ("animation" in the file): frame i of N
  * (0-based) takes the sun at fraction i / (N - 1) of the way from the scene's sun to the
  * end given here (atmos_scene_animation_frame). With a sun given by time, the time is
@@ -135,6 +148,7 @@ typedef struct atmos_scene {
     atmos_scene_volume volume;
     atmos_scene_slice slice;
     atmos_scene_path path;
+    atmos_scene_harris harris;
     atmos_scene_animation animation;
     int camera_given;                     /* the scene file has a "camera" (a volume scene without
                                              one is framed by atmos_scene_frame_volume) */
@@ -280,7 +294,7 @@ ATMOS_API const atmos_setting *atmos_renderer_settings(atmos_renderer_kind rende
  * is not checked: atmos_scene_validate does that). */
 ATMOS_API double atmos_scene_setting_get(const atmos_scene *scene, const atmos_setting *setting);
 ATMOS_API void atmos_scene_setting_set(atmos_scene *scene, const atmos_setting *setting, double value);
-/* "sky", "slice", "path"; NULL for an unknown kind. */
+/* "sky", "slice", "path", "harris"; NULL for an unknown kind. */
 ATMOS_API const char *atmos_renderer_name(atmos_renderer_kind renderer);
 
 #ifdef __cplusplus

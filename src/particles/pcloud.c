@@ -44,12 +44,3 @@ void atmos__pcloud_bounds(const atmos__pcloud *pc, double lo[3], double hi[3])
         for (int a = 0; a < 3; a++) lo[a] = fmin(lo[a], c[a] - r), hi[a] = fmax(hi[a], c[a] + r);
     }
 }
-
-void atmos__pcloud_profile(float tab[ATMOS__PCLOUD_PROF + 1])
-{
-    const double c2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT;
-    for (int i = 0; i <= ATMOS__PCLOUD_PROF; i++) {
-        const double u = c2 * i / ATMOS__PCLOUD_PROF;
-        tab[i] = (float)(exp(-0.5 * u) * erf(sqrt(fmax(0.0, 0.5 * (c2 - u)))));
-    }
-}

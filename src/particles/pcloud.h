@@ -12,6 +12,9 @@
 #define ATMOS_PCLOUD_H
 
 #include "atmos/atmos.h"
+#include "core/fastmath.h"
+
+#include <math.h>
 
 #include <stdint.h>
 
@@ -19,17 +22,18 @@
  * the peak there). */
 #define ATMOS__PCLOUD_CUT 3.0
 
-/* The column of a particle cut at CUT widths, at distance b from its centre, relative to
- * tc = sigma_ext n0 s sqrt(2 pi): exp(-u / 2) erf(sqrt((CUT^2 - u) / 2)), u = b^2 / s^2
- * (1 at the centre but for the cut, 0 beyond it), tabulated over u in [0, CUT^2]. */
-#define ATMOS__PCLOUD_PROF 512
-void atmos__pcloud_profile(float tab[ATMOS__PCLOUD_PROF + 1]);
-static inline float atmos__pcloud_column(const float *tab, float u)
+/* The column of a particle cut at CUT = 3 widths, at distance b from its centre, relative to
+ * tc = sigma_ext n0 s sqrt(2 pi): exp(-u / 2) erf(sqrt((9 - u) / 2)), u = b^2 / s^2 (0 beyond
+ * the cut). With Abramowitz & Stegun 7.1.26 for erf (|error| <= 1.5e-7), erf(z) = 1 - P(t)
+ * exp(-z^2), t = 1 / (1 + 0.3275911 z), and exp(-u / 2) exp(-z^2) = exp(-4.5): one exponential,
+ * no branch (the loops over texels and pixels vectorise). */
+static inline float atmos__pcloud_column(float u)
 {
-    const float x = u * (float)(ATMOS__PCLOUD_PROF / (ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT));
-    if (!(x < ATMOS__PCLOUD_PROF)) return 0.0f;
-    const int i = (int)x;
-    return tab[i] + (x - (float)i) * (tab[i + 1] - tab[i]);
+    u = u < 9.0f ? u : 9.0f;
+    const float z = sqrtf(0.5f * (9.0f - u)), t = 1.0f / (1.0f + 0.3275911f * z);
+    const float P = t * (0.254829592f + t * (-0.284496736f + t * (1.421413741f + t * (-1.453152027f + t * 1.061405429f))));
+    const float c = atmos__expf_poly(-0.5f * u) - 0.011108996538242306f * P; /* exp(-4.5) */
+    return c > 0.0f ? c : 0.0f;
 }
 
 typedef struct atmos__pcloud {
@@ -81,9 +85,9 @@ typedef struct atmos__poptics {
  * a texel leaves T + (1 - T) a F_{n+1} of the light, T = exp(-tau) (Eq. 25 for a thin slab),
  * F_{n+1} the forward fraction at the particle's scattering count. One thread per
  * wavelength (the result does not depend on the thread count). res: the buffer's texels per
- * side (0: from the particles' size, at most 1024). */
+ * side (0: texels of texel_scale x 0.7 of the smallest particle's width, at most 1024). */
 atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
-                                 const double sun[3], int res, float *light, float *order);
+                                 const double sun[3], int res, double texel_scale, float *light, float *order);
 
 /* ---- psplat.c: the eye pass (§2.2.2, Eq. 9) */
 /* Composites the particles over img (width x height, nw + 1 channels: radiance per
@@ -91,13 +95,17 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
  * a sum_j Ams_{n_j+1}(theta_j) E_j I_pj (1 - T) and leaves T = exp(-tau(b)) of what is behind
  * it, b the pixel ray's distance from its centre (Harris's splat, exactly), over the lights
  * j (toward dir[j], irradiance e[j] outside the cloud; light[j], order[j] their
- * atmos__pcloud_shade), theta_j the scattering angle from light j toward the eye. Pinhole
+ * atmos__pcloud_shade), theta_j the scattering angle from light j toward the eye. air_t,
+ * air_l (NULL: no air): the transmittance and the in-scattered radiance of the air from the
+ * eye to each particle [p * nw + k]; the particle's colour is seen as air_l + air_t colour
+ * (exact for an opaque particle; the air behind a translucent one is in what it covers). Pinhole
  * cameras; particles whose splat holds the eye are left out. Threads over tiles of 32 x 32
  * pixels (the image does not depend on the thread count). *drawn: the particles drawn (may
  * be NULL). */
 atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o, int nlights,
                                         const float *const *light, const float *const *order, const double (*dir)[3],
-                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const atmos_camera *cam,
-                                        const int rect[4], atmos_image *img, int *drawn);
+                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const float *air_t,
+                                        const float *air_l, const atmos_camera *cam, const int rect[4],
+                                        atmos_image *img, int *drawn);
 
 #endif

@@ -4,6 +4,7 @@
  * depth met (taus). Harris reads the frame buffer back at each particle's centre before
  * splatting it; here the buffer is an array and the read is bilinear. */
 #include "particles/pcloud.h"
+#include "core/fastmath.h"
 #include "core/internal.h"
 
 #include <math.h>
@@ -16,7 +17,6 @@ typedef struct lframe {
     double e1[3], e2[3], L[3];
     double u0, v0, texel;
     int res;
-    float prof[ATMOS__PCLOUD_PROF + 1];
 } lframe;
 
 typedef struct order_key {
@@ -32,7 +32,7 @@ static int by_depth(const void *a, const void *b)
 
 static double dot(const double *a, const float x, const float y, const float z) { return a[0] * x + a[1] * y + a[2] * z; }
 
-static void make_frame(const atmos__pcloud *pc, const double sun[3], int res, lframe *f)
+static void make_frame(const atmos__pcloud *pc, const double sun[3], int res, double texel_scale, lframe *f)
 {
     memcpy(f->L, sun, sizeof f->L);
     const double a[3] = {fabs(sun[0]) < 0.9 ? 1.0 : 0.0, fabs(sun[0]) < 0.9 ? 0.0 : 1.0, 0.0};
@@ -52,11 +52,10 @@ static void make_frame(const atmos__pcloud *pc, const double sun[3], int res, lf
         smin = fmin(smin, pc->s[p]);
     }
     const double ext = fmax(hi[0] - lo[0], hi[1] - lo[1]);
-    /* texels of half the smallest width, 64..1024 per side */
-    f->res = res > 0 ? res : (int)fmin(1024.0, fmax(64.0, ceil(ext / (0.5 * smin))));
+    /* texels of 0.7 the smallest width (times texel_scale), 32..1024 per side */
+    f->res = res > 0 ? res : (int)fmin(1024.0, fmax(32.0, ceil(ext / (0.7 * texel_scale * smin))));
     f->texel = ext / f->res;
     f->u0 = lo[0], f->v0 = lo[1];
-    atmos__pcloud_profile(f->prof);
 }
 
 /* Bilinear read of buffer b at texel coordinates (x, y). */
@@ -69,23 +68,28 @@ static double read_at(const float *b, int res, double x, double y)
     return (1 - ay) * ((1 - ax) * r0[0] + ax * r0[1]) + ay * ((1 - ax) * r1[0] + ax * r1[1]);
 }
 
-/* The splat of particle p into the light buffer at texel coordinates (x, y). */
-static void splat(const atmos__pcloud *pc, int p, const lframe *f, double tc, double aF, double a, double x, double y,
+/* The splat of particle p into the light buffer at texel coordinates (x, y): row by row
+ * over the texels within the cut (a loop the compiler vectorises). */
+static void splat(const atmos__pcloud *pc, int p, const lframe *f, float tc, float aF, float a, float x, float y,
                   float *trans, float *taus)
 {
     const int res = f->res;
-    const double s = pc->s[p], k2 = f->texel * f->texel / (s * s), rt = ATMOS__PCLOUD_CUT * s / f->texel;
-    const int i0 = (int)fmax(0.0, floor(x - rt)), i1 = (int)fmin(res - 1.0, ceil(x + rt));
-    const int j0 = (int)fmax(0.0, floor(y - rt)), j1 = (int)fmin(res - 1.0, ceil(y + rt));
-    for (int j = j0; j <= j1; j++)
+    const float s = pc->s[p], k2 = (float)(f->texel * f->texel) / (s * s), rt = (float)(ATMOS__PCLOUD_CUT * s / f->texel);
+    const int j0 = (int)fmaxf(0.0f, floorf(y - rt)), j1 = (int)fminf(res - 1.0f, ceilf(y + rt));
+    for (int j = j0; j <= j1; j++) {
+        const float dy = (float)j + 0.5f - y, rem = rt * rt - dy * dy;
+        if (rem < 0) continue;
+        const float w = sqrtf(rem);
+        const int i0 = (int)fmaxf(0.0f, ceilf(x - 0.5f - w)), i1 = (int)fminf(res - 1.0f, floorf(x - 0.5f + w));
+        float *tr = trans + (size_t)j * res, *ts = taus + (size_t)j * res;
         for (int i = i0; i <= i1; i++) {
-            const double dx = i + 0.5 - x, dy = j + 0.5 - y, b2 = dx * dx + dy * dy;
-            if (b2 > rt * rt) continue;
-            const double tau = tc * atmos__pcloud_column(f->prof, (float)(b2 * k2)), T = exp(-tau);
-            const size_t t = (size_t)j * res + i;
-            trans[t] *= (float)(T + (1.0 - T) * aF);
-            taus[t] += (float)(a * tau);
+            const float dx = (float)i + 0.5f - x;
+            const float tau = tc * atmos__pcloud_column((dx * dx + dy * dy) * k2);
+            const float T = atmos__expf_poly(-tau); /* tau <= a particle's column: far above -87 */
+            tr[i] *= T + (1.0f - T) * aF;
+            ts[i] += a * tau;
         }
+    }
 }
 
 /* The light pass of wavelength k. The particles go in groups of depths within half the
@@ -114,17 +118,17 @@ static void pass(const atmos__pcloud *pc, const atmos__poptics *o, const lframe 
                 }
                 const double n = phase ? ns[at] : read_at(taus, res, x, y);
                 const double F = o->ms[fi] ? atmos_msphase_forward(o->ms[fi], k, n + 1.0) : 0.0;
-                splat(pc, p, f, 0.5 * tc, a * F, a, x, y, trans, taus);
+                splat(pc, p, f, (float)(0.5 * tc), (float)(a * F), (float)a, (float)x, (float)y, trans, taus);
             }
     }
 }
 
 atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
-                                 const double sun[3], int res, float *light, float *order)
+                                 const double sun[3], int res, double texel_scale, float *light, float *order)
 {
     if (pc->n == 0) return ATMOS_OK;
     lframe f;
-    make_frame(pc, sun, res, &f);
+    make_frame(pc, sun, res, texel_scale > 0 ? texel_scale : 1.0, &f);
     order_key *ord = malloc(sizeof *ord * (size_t)pc->n);
     float *ns = malloc(sizeof(float) * (size_t)pc->n * o->nw);
     if (!ord || !ns) {

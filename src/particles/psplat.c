@@ -36,6 +36,7 @@ typedef struct lights {
     const float *const *light, *const *order;
     const double (*dir)[3];
     const double (*e)[ATMOS_MAX_WAVELENGTHS];
+    const float *air_t, *air_l;
 } lights;
 
 /* The splat of particle p as seen by cam; 0 when it is not drawn. */
@@ -68,13 +69,17 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
             sum += ph * L->e[j][k] * L->light[j][(size_t)p * o->nw + k];
         }
         out->col[k] = (float)(o->albedo[fi][k] * sum);
+        if (L->air_t) { /* seen through the air: L_air + T_air colour (an opaque particle exactly) */
+            const size_t at = (size_t)p * o->nw + k;
+            out->col[k] = L->air_l[at] + L->air_t[at] * out->col[k];
+        }
         out->tc[k] = (float)(o->sigma_ext[fi][k] * pc->n0[p] * s * SQRT_2PI);
     }
     return 1;
 }
 
 /* Composites splat q over the pixels of its box inside tile (tx, ty). */
-static void draw(const sp *q, int nw, const atmos_camera *cam, const float *prof, int tx, int ty, atmos_image *img)
+static void draw(const sp *q, int nw, const atmos_camera *cam, int tx, int ty, atmos_image *img)
 {
     const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
     const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
@@ -93,7 +98,7 @@ static void draw(const sp *q, int nw, const atmos_camera *cam, const float *prof
             for (int i = 0; i < 3; i++) rd += rel[i] * d[i];
             const double b2 = rr - rd * rd / dd;
             if (b2 > rc2) continue;
-            const float g = atmos__pcloud_column(prof, (float)(b2 * k2));
+            const float g = atmos__pcloud_column((float)(b2 * k2));
             float *px = img->pixels + ((size_t)y * cam->width + x) * C, tm = 0;
             for (int k = 0; k < nw; k++) {
                 const float T = atmos__expf_fast(-q->tc[k] * g);
@@ -107,10 +112,11 @@ static void draw(const sp *q, int nw, const atmos_camera *cam, const float *prof
 
 atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o, int nlights,
                                         const float *const *light, const float *const *order, const double (*dir)[3],
-                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const atmos_camera *cam,
-                                        const int rect[4], atmos_image *img, int *drawn)
+                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const float *air_t,
+                                        const float *air_l, const atmos_camera *cam, const int rect[4],
+                                        atmos_image *img, int *drawn)
 {
-    const lights L = {nlights, light, order, dir, e};
+    const lights L = {nlights, light, order, dir, e, air_t, air_l};
     if (drawn) *drawn = 0;
     if (cam->type != ATMOS_CAMERA_PINHOLE)
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "particles: the splat renderer draws pinhole cameras only");
@@ -119,8 +125,6 @@ atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud 
     far_key *ord = malloc(sizeof *ord * (size_t)(pc->n ? pc->n : 1));
     int *cnt = calloc((size_t)ntx * nty + 1, sizeof(int));
     int n = 0;
-    float prof[ATMOS__PCLOUD_PROF + 1];
-    atmos__pcloud_profile(prof);
     if (!s || !ord || !cnt) goto nomem;
     for (int p = 0; p < pc->n; p++)
         if (prepare(pc, p, o, &L, cam, rect, &s[n])) ord[n].z = s[n].z, ord[n].i = n, n++;
@@ -146,7 +150,7 @@ atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
     for (int t = 0; t < ntx * nty; t++)
         for (int q = cnt[t]; q < cnt[t + 1]; q++)
-            draw(&s[list[q]], o->nw, cam, prof, rect[0] + (t % ntx) * TILE, rect[1] + (t / ntx) * TILE, img);
+            draw(&s[list[q]], o->nw, cam, rect[0] + (t % ntx) * TILE, rect[1] + (t / ntx) * TILE, img);
     free(list), free(fill), free(s), free(ord), free(cnt);
     if (drawn) *drawn = n;
     return ATMOS_OK;

@@ -45,7 +45,8 @@ static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const
     if (d->optics) {
         p->optics = d->optics;
     } else {
-        atmos_status st = atmos_volume_optics_build(ctx, &p->scene, p->volume, p->renderer == ATMOS_RENDERER_SLICE,
+        atmos_status st = atmos_volume_optics_build(ctx, &p->scene, p->volume, p->renderer == ATMOS_RENDERER_SLICE ||
+                                                                                 p->renderer == ATMOS_RENDERER_HARRIS,
                                                     &p->own_optics);
         if (st != ATMOS_OK) return st;
         p->optics = &p->own_optics;
@@ -75,13 +76,14 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
     if ((st = atmos_scene_wavelengths(ctx, scene, &p->wl)) != ATMOS_OK) goto fail;
     if ((st = atmos_scene_atmosphere_create(ctx, scene, &p->wl, &p->atm)) != ATMOS_OK) goto fail;
     if ((st = plan_volume(p, volume, &d)) != ATMOS_OK) goto fail;
-    if (p->renderer == ATMOS_RENDERER_SLICE && !p->volume) {
-        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the slice renderer needs a volume");
+    if ((p->renderer == ATMOS_RENDERER_SLICE || p->renderer == ATMOS_RENDERER_HARRIS) && !p->volume) {
+        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the %s renderer needs a volume", atmos_renderer_name(p->renderer));
         goto fail;
     }
     if (p->renderer != ATMOS_RENDERER_PATH) p->sky_keep = atmos__sky_keep_create(); /* NULL: per frame */
     if (p->renderer == ATMOS_RENDERER_SLICE) st = atmos__slice_plan_create(p, &p->slice);
     else if (p->renderer == ATMOS_RENDERER_PATH) st = atmos__path_plan_create(p, &p->path);
+    else if (p->renderer == ATMOS_RENDERER_HARRIS) st = atmos__harris_plan_create(p, &p->harris);
     if (st != ATMOS_OK) goto fail;
     *out = p;
     return ATMOS_OK;
@@ -95,6 +97,7 @@ void atmos_plan_destroy(atmos_plan *p)
     if (!p) return;
     atmos__slice_plan_destroy(p->slice);
     atmos__path_plan_destroy(p->path);
+    atmos__harris_plan_destroy(p->harris);
     atmos__sky_keep_destroy(p->sky_keep);
     atmos_volume_optics_free(&p->own_optics);
     atmos_volume_destroy(p->own_volume);
@@ -266,7 +269,8 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
 {
     static const char *const names[] = {"sky (analytic single scattering of the atmosphere)",
                                         "slice (Riley et al. 2004, half-angle slicing)",
-                                        "path (spectral Monte Carlo volumetric path tracing)"};
+                                        "path (spectral Monte Carlo volumetric path tracing)",
+                                        "harris (Harris 2002, particle clouds: multiple forward scattering, splats)"};
     char buf[256];
     double el = 0, az = 0;
     atmos_direction_to_angles(v->sun, &el, &az);
@@ -291,6 +295,9 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
         atmos_image_set_meta(out, "atmos:path", buf);
         snprintf(buf, sizeof buf, "%.6g", p->stats.path.mean_rel_error);
         atmos_image_set_meta(out, "atmos:path_mean_rel_error", buf);
+    } else if (p->renderer == ATMOS_RENDERER_HARRIS) {
+        atmos__harris_describe(p, buf, sizeof buf);
+        atmos_image_set_meta(out, "atmos:harris", buf);
     }
 }
 
@@ -321,6 +328,8 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
         st = atmos__sky_render(ctx, p->atm, &v, &r, out, p->sky_keep);
     } else if (p->renderer == ATMOS_RENDERER_SLICE) {
         st = atmos__slice_render(p, &v, &r, out, &stats->slice);
+    } else if (p->renderer == ATMOS_RENDERER_HARRIS) {
+        st = atmos__harris_render(p, &v, &r, out);
     } else {
         st = atmos__path_render(p, &v, &r, out, &stats->path);
     }

@@ -9,6 +9,7 @@
 
 typedef struct atmos__slice_plan atmos__slice_plan;
 typedef struct atmos__path_plan atmos__path_plan;
+typedef struct atmos__harris_plan atmos__harris_plan;
 
 struct atmos_plan {
     atmos_context *ctx;
@@ -33,6 +34,7 @@ struct atmos_plan {
     atmos__sky_keep *sky_keep;          /* the sky's per-eye tables (sky and slice renderers) */
     atmos__slice_plan *slice;
     atmos__path_plan *path;
+    atmos__harris_plan *harris;
 };
 
 /* The slice renderer's part (slice_plan.c): the render grid, the optics tables, the buffers
@@ -57,5 +59,13 @@ atmos_status atmos__path_render(atmos_plan *p, const atmos__view *v, const atmos
 atmos_status atmos__path_variance(const atmos_plan *p, atmos_image **out);
 atmos_status atmos__path_order(const atmos_plan *p, atmos_image **out);
 void atmos__path_describe(const atmos_plan *p, char *buf, size_t cap);
+
+/* Harris's particle renderer (harris_render.c): the volume's particles, their light from the
+ * sun and the sky lights (kept until the sun moves). */
+atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out);
+void atmos__harris_plan_destroy(atmos__harris_plan *h);
+/* The sky, then the particles splatted over it, over the pixels of r. */
+atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);
+void atmos__harris_describe(const atmos_plan *p, char *buf, size_t cap);
 
 #endif

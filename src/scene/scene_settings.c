@@ -1,5 +1,5 @@
 /* The renderers' settings tables (scene.h, atmos_renderer_settings): the one description of
- * every setting of a scene file's "slice" and "path" sections. The scene's defaults, the
+ * every setting of a scene file's renderer sections ("slice", "path", "harris"). The scene's defaults, the
  * JSON parser (scene_json.c), the validator (scene_validate.c), atmos render's options and
  * its --help are all made from these rows, so a setting has one name, one range, one default
  * and one meaning everywhere. */
@@ -10,6 +10,7 @@
 
 #define SLICE(field) offsetof(atmos_scene, slice.field)
 #define PATH(field) offsetof(atmos_scene, path.field)
+#define HARRIS(field) offsetof(atmos_scene, harris.field)
 
 static const char *const update_names[] = {"eq25", "eq24", NULL};
 
@@ -59,20 +60,35 @@ static const atmos_setting path_settings[] = {
      "the aureole estimate in droplet clouds (off: same mean, more fireflies)", PATH(aureole)},
 };
 
+static const atmos_setting harris_settings[] = {
+    {"spacing_m", "spacing", ATMOS_SETTING_REAL, "m", 0, 1e5, 0, 0, 0, NULL, 0,
+     "one particle per cell of this edge; 0 = the volume's voxel, coarser until at most max_particles",
+     HARRIS(spacing_m)},
+    {"max_particles", "max-particles", ATMOS_SETTING_INT, "", 1, 20000000, 0, 0, 50000, NULL, 0,
+     "the most particles made from the volume (with spacing 0)", HARRIS(max_particles)},
+    {"sky_lights", "sky-lights", ATMOS_SETTING_INT, "", 0, 16, 0, 0, 6, NULL, 0,
+     "sky lights besides the sun: the zenith and directions 30 degrees high (Harris 2002 §2.3.1); 0 = the sun alone",
+     HARRIS(sky_lights)},
+    {"light_size", "harris-light-size", ATMOS_SETTING_INT, "texels", 0, 4096, 0, 0, 0, NULL, 0,
+     "light buffer texels per side; 0 = 0.7 of the smallest particle's width a texel, at most 1024",
+     HARRIS(light_size)},
+};
+
 const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)
 {
     int n = 0;
     const atmos_setting *t = NULL;
     if (renderer == ATMOS_RENDERER_SLICE) t = slice_settings, n = (int)(sizeof slice_settings / sizeof *t);
     if (renderer == ATMOS_RENDERER_PATH) t = path_settings, n = (int)(sizeof path_settings / sizeof *t);
+    if (renderer == ATMOS_RENDERER_HARRIS) t = harris_settings, n = (int)(sizeof harris_settings / sizeof *t);
     if (count) *count = n;
     return t;
 }
 
 const char *atmos_renderer_name(atmos_renderer_kind renderer)
 {
-    static const char *const names[] = {"sky", "slice", "path"};
-    return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_PATH ? names[renderer] : NULL;
+    static const char *const names[] = {"sky", "slice", "path", "harris"};
+    return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_LAST ? names[renderer] : NULL;
 }
 
 double atmos_scene_setting_get(const atmos_scene *s, const atmos_setting *st)
@@ -113,7 +129,7 @@ void atmos_scene_setting_set(atmos_scene *s, const atmos_setting *st, double v)
 
 void atmos__settings_defaults(atmos_scene *s)
 {
-    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_PATH; r++) {
+    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_LAST; r++) {
         int n;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
         for (int i = 0; i < n; i++) atmos_scene_setting_set(s, &t[i], t[i].def);

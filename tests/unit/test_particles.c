@@ -83,7 +83,7 @@ static double light_vs_grid(atmos_volume *v, double h, const double sun[3], doub
     o.nw = 1;
     o.sigma_ext[0][0] = sigma, o.albedo[0][0] = 0.9;
     float *light = malloc(sizeof(float) * (size_t)pc.n), *order = malloc(sizeof(float) * (size_t)pc.n);
-    CHECK_OK(atmos__pcloud_shade(NULL, &pc, &o, sun, 0, light, order));
+    CHECK_OK(atmos__pcloud_shade(NULL, &pc, &o, sun, 0, 1.0, light, order));
     double worst = 0, worst_n = 0, mean = 0, rms = 0;
     for (int p = 0; p < pc.n && g; p++) {
         const double c[3] = {pc.x[p], pc.y[p], pc.z[p]};
@@ -146,7 +146,7 @@ static void eye_pass(void)
     CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img));
     const int rect[4] = {0, 0, 65, 65};
     int drawn = 0;
-    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, lp, op, sun, sun_e, &cam, rect, img, &drawn));
+    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, lp, op, sun, sun_e, NULL, NULL, &cam, rect, img, &drawn));
     CHECK(drawn == 1);
     const double tau = 1e-12 * 1e9 * 20 * sqrt(2 * 3.141592653589793) * erf(3 / sqrt(2.0));
     const double want = 0.9 / (4 * 3.141592653589793) * 1.5 * 0.8 * (1 - exp(-tau));
@@ -166,11 +166,11 @@ static void eye_pass(void)
     omp_set_num_threads(1);
 #endif
     memset(img->pixels, 0, sizeof(float) * 65 * 65 * 2);
-    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, &cam, rect, img, NULL));
+    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, NULL, NULL, &cam, rect, img, NULL));
 #ifdef _OPENMP
     omp_set_num_threads(2);
 #endif
-    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, &cam, rect, img2, NULL));
+    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, NULL, NULL, &cam, rect, img2, NULL));
     CHECK(memcmp(img->pixels, img2->pixels, sizeof(float) * 65 * 65 * 2) == 0);
     free(lt), free(od);
     atmos_image_destroy(img);

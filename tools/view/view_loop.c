@@ -12,7 +12,7 @@ typedef struct loop {
     atmos_context *ctx;
     atmos_scene *sc;             /* the scene; renderer and wavelengths follow the state */
     const atmos_volume *vol;
-    atmos_plan *plan[3];         /* per renderer kind, made when first used */
+    atmos_plan *plan[ATMOS_RENDERER_LAST + 1]; /* per renderer kind, made when first used */
     int spectral;                /* the wavelengths the plans were made for */
     atmos_image *img, *lin, *disp;
     double log_scale;            /* the exposure's smoothed log scale (automatic exposure) */
@@ -21,7 +21,7 @@ typedef struct loop {
 
 static void drop_plans(loop *L)
 {
-    for (int k = 0; k < 3; k++) atmos_plan_destroy(L->plan[k]), L->plan[k] = NULL;
+    for (int k = 0; k <= ATMOS_RENDERER_LAST; k++) atmos_plan_destroy(L->plan[k]), L->plan[k] = NULL;
     atmos_image_destroy(L->img), L->img = NULL;
 }
 

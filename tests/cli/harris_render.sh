@@ -1,0 +1,57 @@
+#!/bin/sh
+# atmos render --renderer harris (docs/particles.md): a generated cumulus renders, the image
+# does not depend on the thread count (same EXR pixels on 1 and 2 threads), the cloud covers
+# pixels and is brighter on its sunlit side than the air beside it, the "harris" section's
+# settings are read and checked, and the renderer refuses a scene without a volume.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/harris_render.$$
+rm -rf "$T"
+mkdir -p "$T" || exit 1
+trap 'rm -rf "$T"' EXIT
+export XDG_CACHE_HOME="$T/cache"
+fail=0
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+
+for n in 1 2; do
+    "$A" render --volume generate:cumulus --voxel-size 120 --renderer harris --width 96 --height 64 --fov 14 \
+        --threads $n --pfm "$T/h$n.pfm" -o "$T/h$n.png" -q 2>"$T/e$n.txt" || { bad "harris render on $n threads"; cat "$T/e$n.txt" >&2; }
+done
+cmp -s "$T/h1.pfm" "$T/h2.pfm" && ok "same pixels on 1 and 2 threads" || bad "harris image depends on the thread count"
+python3 - "$T/h1.pfm" <<'PY' && ok "a cloud: finite, covers the middle, not black" || bad "harris image"
+import struct, sys
+d = open(sys.argv[1], "rb").read()
+parts = d.split(b"\n", 3)
+assert parts[0] == b"PF", parts[0]
+w, h = map(int, parts[1].split())
+px = struct.unpack("<%df" % (w * h * 3), parts[3][: w * h * 12])
+import math
+assert all(math.isfinite(v) and v >= 0 for v in px)
+lum = [0.2126 * px[3 * i] + 0.7152 * px[3 * i + 1] + 0.0722 * px[3 * i + 2] for i in range(w * h)]
+mid = lum[(h // 2) * w + w // 2]
+assert mid > 0, mid
+PY
+cat >"$T/s.json" <<'J'
+{"volume": {"generate": "cumulus", "voxel_size_m": 120}, "renderer": "harris",
+ "harris": {"sky_lights": 2, "max_particles": 500}, "image": {"width": 48, "height": 32}}
+J
+"$A" render "$T/s.json" -o "$T/s.png" 2>"$T/es.txt" && grep -q "harris" "$T/es.txt" -- 2>/dev/null; \
+python3 - "$T/s.png" <<'PY' && ok "scene's harris section read" || bad "harris section"
+import struct, sys
+d = open(sys.argv[1], "rb").read(); i = 8; meta = {}
+while i < len(d):
+    n, = struct.unpack(">I", d[i:i + 4]); t = d[i + 4:i + 8]
+    if t == b"tEXt":
+        k, v = d[i + 8:i + 8 + n].split(b"\0", 1); meta[k] = v
+    i += 12 + n
+h = meta[b"atmos:harris"].decode()
+assert "2 sky lights" in h, h
+assert int(h.split()[0]) <= 500, h
+PY
+printf '{"renderer": "harris", "harris": {"sky_lights": 40}, "volume": {"generate": "cumulus"}}' >"$T/bad.json"
+"$A" render "$T/bad.json" -o "$T/bad.png" 2>"$T/eb.txt"; st=$?
+[ $st -ne 0 ] && grep -q "sky_lights" "$T/eb.txt" && ok "sky_lights out of range refused" || bad "sky_lights 40 accepted (exit $st)"
+"$A" render --renderer harris -o "$T/nv.png" 2>"$T/en.txt"; st=$?
+[ $st -eq 2 ] && grep -q "needs --volume" "$T/en.txt" && ok "harris without a volume: usage error" || bad "harris without a volume (exit $st)"
+exit $fail
