@@ -113,6 +113,7 @@ typedef struct atmos_plan_stats {
     int sun_changed, camera_changed;
     atmos_slice_timing slice;   /* slice renderer */
     atmos_path_stats path;      /* path tracer */
+    int impostor_updates;       /* Harris's renderer: impostors made again this frame */
 } atmos_plan_stats;
 ATMOS_API void atmos_plan_get_stats(const atmos_plan *plan, atmos_plan_stats *out);
 

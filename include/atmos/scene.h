@@ -96,6 +96,9 @@ typedef struct atmos_scene_harris {
     int max_particles;        /* 50000 */
     int sky_lights;           /* sky lights besides the sun (Harris §2.3.1); 6 */
     int light_size;           /* light buffer texels per side; 0 = from the particles' size (<= 1024) */
+    int impostors;            /* 1: clouds drawn from dynamically generated impostors (Harris §3) */
+    double impostor_tolerance_deg; /* the translation error that makes an impostor again; 0.15 */
+    int impostor_max_res;     /* an impostor's texels per side at most; 512 */
 } atmos_scene_harris;
 
 /* A sequence of images with the sun moving ("animation" in the file): frame i of N
@@ -222,6 +225,14 @@ ATMOS_API atmos_status atmos_volume_optics_build(atmos_context *ctx, const atmos
 /* Destroys the tables if owned; zeroes *o. NULL does nothing. */
 ATMOS_API void atmos_volume_optics_free(atmos_volume_optics *o);
 
+/* Every generator a scene's "volume": {"generate": NAME} may name (NULL-terminated): the
+ * volume generators (atmos_volume_generator_names) and the particle clouds' ("harris_cumulus",
+ * "harris_field": Harris 2002's ellipsoid clusters, docs/particles.md), and the volume of one:
+ * a particle cloud's is its particles summed on a grid (so every renderer draws the same cloud;
+ * Harris's renderer takes the particles themselves). */
+ATMOS_API const char *const *atmos_scene_generator_names(void);
+ATMOS_API atmos_status atmos_scene_generate_volume(atmos_context *ctx, const char *preset,
+                                                   const atmos_volume_generate_desc *desc, atmos_volume **out);
 /* Loads or generates the volume a scene names (scene->volume: file, grids, particle, time
  * index, voxel size, density unit, length scale, sub-grid detail; generator, seed, scale)
  * and computes offset_m, the shift that places

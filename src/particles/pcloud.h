@@ -36,6 +36,14 @@ static inline float atmos__pcloud_column(float u)
     return c > 0.0f ? c : 0.0f;
 }
 
+/* The peak n0 of a particle of width s holding the particles of a cell of edge h at mean
+ * density mean: mean h^3 / (0.9707 (2 pi)^(3/2) s^3), 0.9707 = P(chi^2_3 <= 9) = erf(3 / sqrt 2)
+ * - sqrt(18 / pi) exp(-4.5), the share of a 3-D Gaussian's mass within the cut. */
+static inline double atmos__pcloud_peak(double mean, double h, double s)
+{
+    return mean * h * h * h / (0.9707091134651118 * 15.749609945722419 * s * s * s);
+}
+
 typedef struct atmos__pcloud {
     int n, cap;
     float *x, *y, *z;     /* centres, m (world) */
@@ -67,6 +75,32 @@ atmos_status atmos__pcloud_from_volume(atmos_context *ctx, const atmos_volume *v
  * particle type): the same cloud for the path tracer and the slice renderer. */
 atmos_status atmos__pcloud_to_volume(atmos_context *ctx, const atmos__pcloud *pc, double voxel_m, atmos_volume **out);
 
+/* ---- pgenerate.c: particle clouds made as Harris's notes describe them (§1.1.1): clusters
+ * of ellipsoids filled with particles */
+/* The presets ("harris_cumulus": one fair-weather cumulus; "harris_field": a field of 120 of
+ * them over 30 x 30 km), NULL-terminated. */
+const char *const *atmos__pcloud_generator_names(void);
+/* Makes a preset's particles (one "cloud" field of droplets; world positions as a generated
+ * volume's: about x = z = 0, the bases at 1.5 km times scale); same seed, same particles. scale multiplies the extent (0:
+ * 1). *voxel_m: the grid spacing for atmos__pcloud_to_volume (half the finest particle spacing,
+ * at most 640 voxels across: a field's grid blurs its smallest clouds). */
+atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint64_t seed, double scale,
+                                    atmos__pcloud *out, double *voxel_m);
+
+/* ---- pcluster.c: the clouds of a particle set (what Harris's impostors are made of) */
+typedef struct atmos__pclusters {
+    int n;                /* clouds */
+    int *start;           /* [n + 1]: cloud c's particles are idx[start[c] .. start[c + 1]) */
+    int *idx;             /* particle indices, cloud by cloud, ascending within each */
+    double (*centre)[3];  /* the middle of each cloud's box */
+    double *radius;       /* the sphere about it that holds every splat of the cloud */
+} atmos__pclusters;
+/* Groups the particles into clouds: two particles whose splats (CUT s) overlap or come
+ * within link metres belong to one cloud (connected components; clouds numbered by their
+ * lowest particle). */
+atmos_status atmos__pcloud_cluster(atmos_context *ctx, const atmos__pcloud *pc, double link, atmos__pclusters *out);
+void atmos__pclusters_free(atmos__pclusters *c);
+
 /* ---- pshade.c: Harris's multiple forward scattering (§2.2.1, Eq. 8) */
 /* What the light pass and the eye pass need of each particle type, per wavelength. */
 typedef struct atmos__poptics {
@@ -84,28 +118,72 @@ typedef struct atmos__poptics {
  * splatted nearest-first, with Riley's forward share: a particle of optical depth tau along
  * a texel leaves T + (1 - T) a F_{n+1} of the light, T = exp(-tau) (Eq. 25 for a thin slab),
  * F_{n+1} the forward fraction at the particle's scattering count. One thread per
- * wavelength (the result does not depend on the thread count). res: the buffer's texels per
+ * wavelength (the result does not depend on the thread count). Only the particles idx[0..nidx)
+ * (idx NULL: all) are lit and shade each other: a cloud at a time, each with a buffer fitted
+ * to it. res: the buffer's texels per
  * side (0: texels of texel_scale x 0.7 of the smallest particle's width, at most 1024). */
-atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
-                                 const double sun[3], int res, double texel_scale, float *light, float *order);
+atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, const int *idx, int nidx,
+                                 const atmos__poptics *o, const double sun[3], int res, double texel_scale, float *light,
+                                 float *order);
 
 /* ---- psplat.c: the eye pass (§2.2.2, Eq. 9) */
-/* Composites the particles over img (width x height, nw + 1 channels: radiance per
- * wavelength, then coverage) back to front, within rect [x0, y0, x1, y1): a particle adds
- * a sum_j Ams_{n_j+1}(theta_j) E_j I_pj (1 - T) and leaves T = exp(-tau(b)) of what is behind
- * it, b the pixel ray's distance from its centre (Harris's splat, exactly), over the lights
- * j (toward dir[j], irradiance e[j] outside the cloud; light[j], order[j] their
- * atmos__pcloud_shade), theta_j the scattering angle from light j toward the eye. air_t,
- * air_l (NULL: no air): the transmittance and the in-scattered radiance of the air from the
- * eye to each particle [p * nw + k]; the particle's colour is seen as air_l + air_t colour
- * (exact for an opaque particle; the air behind a translucent one is in what it covers). Pinhole
- * cameras; particles whose splat holds the eye are left out. Threads over tiles of 32 x 32
- * pixels (the image does not depend on the thread count). *drawn: the particles drawn (may
- * be NULL). */
-atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o, int nlights,
-                                        const float *const *light, const float *const *order, const double (*dir)[3],
-                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const float *air_t,
-                                        const float *air_l, const atmos_camera *cam, const int rect[4],
-                                        atmos_image *img, int *drawn);
+/* The lights of a frame: n lights toward dir[j] with irradiance e[j] outside the cloud, their
+ * light passes (light[j], order[j]: atmos__pcloud_shade's), and the air from the eye to each
+ * particle (air_t: transmittance, air_l: in-scattered radiance, [p * nw + k]; NULL: none). */
+typedef struct atmos__plights {
+    int n;
+    const float *const *light, *const *order;
+    const double (*dir)[3];
+    const double (*e)[ATMOS_MAX_WAVELENGTHS];
+    const float *air_t, *air_l;
+} atmos__plights;
+/* Composites the particles idx[0..nidx) (idx NULL: all) over img (width x height, nw + 1
+ * channels: radiance per wavelength, then coverage) back to front, within rect [x0, y0, x1,
+ * y1): a particle adds a sum_j Ams_{n_j+1}(theta_j) E_j I_pj (1 - T) and leaves T =
+ * exp(-tau(b)) of what is behind it, b the pixel ray's distance from its centre (Harris's
+ * splat, exactly), theta_j the scattering angle from light j toward the eye; seen through the
+ * air its colour is air_l + air_t colour (exact for an opaque particle; the air behind a
+ * translucent one is in what it covers). Pinhole cameras; particles whose splat holds the
+ * eye are left out. Threads over tiles of 32 x 32 pixels (the image does not depend on the
+ * thread count). *drawn: the particles drawn (may be NULL). */
+atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
+                                 const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
+                                 const int rect[4], atmos_image *img, int *drawn);
+
+/* ---- pimpostor.c: Harris's dynamically generated impostors (§3) */
+/* One cloud's impostor: its particles splatted into a res x res image (nw + 1 channels:
+ * colour, coverage) by a camera at `view` fitted to the cloud's sphere. */
+typedef struct atmos__pimpostor {
+    int valid, res;
+    double view[3];
+    atmos_camera cam;
+    atmos_image *img;
+} atmos__pimpostor;
+/* The texels a cloud of radius r needs seen from distance d by a frame of focal length f
+ * pixels: its projected diameter 2 r f / d (Schaufler's resolution, Harris Eq. 11), rounded
+ * up to a multiple of 8, in [8, max_res]. */
+int atmos__pimpostor_res(double r, double d, double f, int max_res);
+/* Whether im still serves the eye e for the cloud (centre c, radius r): the eye outside the
+ * sphere, the angle at the centre between im's view and e within tol radians (Harris's
+ * translation error), and im's texels at least what the view needs (the resolution error). */
+int atmos__pimpostor_serves(const atmos__pimpostor *im, const double c[3], double r, const double e[3], double tol,
+                            double f, int max_res);
+/* Makes im for the eye e: the particles idx[0..nidx) splatted by a camera at e looking at c
+ * whose field just holds the sphere of radius r. */
+atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
+                                   const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
+                                   const double c[3], double r, const double e[3], int res);
+/* Draws im over img seen by cam within rect: each pixel's ray meets the impostor's plane
+ * (through c, facing im's view), the texture is read there (bilinear), and the pixel becomes
+ * pixel (1 - coverage) + colour. */
+void atmos__pimpostor_draw(atmos_context *ctx, const atmos__pimpostor *im, const double c[3], double r,
+                           const atmos_camera *cam, const int rect[4], atmos_image *img);
+void atmos__pimpostor_free(atmos__pimpostor *im);
+/* Harris §3.1, the head in the clouds: the particles idx[0..nidx) splatted into an image of
+ * 1/factor of cam's pixels per axis (the same view), then laid over img within rect, read
+ * bilinearly: pixel (1 - coverage) + colour. */
+atmos_status atmos__pimpostor_screen(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
+                                     const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
+                                     int factor, const int rect[4], atmos_image *img);
 
 #endif

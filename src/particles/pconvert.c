@@ -7,12 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define TWO_PI_32 15.749609945722419 /* (2 pi)^(3/2) */
 #define S_OVER_H 0.6
-/* The share of a 3-D Gaussian's mass within ATMOS__PCLOUD_CUT = 3 widths of its centre,
- * P(chi^2_3 <= 9) = erf(3 / sqrt 2) - sqrt(18 / pi) exp(-4.5): the particles are cut there,
- * so their peak is raised by its inverse to keep each cell's mass. */
-#define CUT_MASS 0.9707091134651118
 
 typedef struct vframe {
     int dims[3];
@@ -62,7 +57,7 @@ static long sweep(const atmos_volume *vol, const vframe *f, int field, int m, do
                 if (!(mean > thr)) continue;
                 count++;
                 if (pc && atmos__pcloud_add(pc, cen[0] / sum + off[0], cen[1] / sum + off[1], cen[2] / sum + off[2], s,
-                                            mean * h * h * h / (CUT_MASS * TWO_PI_32 * s * s * s), field) != ATMOS_OK)
+                                            atmos__pcloud_peak(mean, h, s), field) != ATMOS_OK)
                     return -1;
             }
     return count;

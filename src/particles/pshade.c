@@ -32,7 +32,8 @@ static int by_depth(const void *a, const void *b)
 
 static double dot(const double *a, const float x, const float y, const float z) { return a[0] * x + a[1] * y + a[2] * z; }
 
-static void make_frame(const atmos__pcloud *pc, const double sun[3], int res, double texel_scale, lframe *f)
+static void make_frame(const atmos__pcloud *pc, const int *idx, int n, const double sun[3], int res, double texel_scale,
+                       lframe *f)
 {
     memcpy(f->L, sun, sizeof f->L);
     const double a[3] = {fabs(sun[0]) < 0.9 ? 1.0 : 0.0, fabs(sun[0]) < 0.9 ? 0.0 : 1.0, 0.0};
@@ -44,7 +45,8 @@ static void make_frame(const atmos__pcloud *pc, const double sun[3], int res, do
     f->e2[1] = sun[2] * f->e1[0] - sun[0] * f->e1[2];
     f->e2[2] = sun[0] * f->e1[1] - sun[1] * f->e1[0];
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, smin = INFINITY;
-    for (int p = 0; p < pc->n; p++) {
+    for (int q = 0; q < n; q++) {
+        const int p = idx ? idx[q] : q;
         const double u = dot(f->e1, pc->x[p], pc->y[p], pc->z[p]), v = dot(f->e2, pc->x[p], pc->y[p], pc->z[p]);
         const double r = ATMOS__PCLOUD_CUT * pc->s[p];
         lo[0] = fmin(lo[0], u - r), hi[0] = fmax(hi[0], u + r);
@@ -96,14 +98,14 @@ static void splat(const atmos__pcloud *pc, int p, const lframe *f, float tc, flo
  * first one's width; a group splats the front halves of its blobs (optical depth tc / 2),
  * reads the light at its particles' centres, then splats the back halves: particles side by
  * side shade each other's centres as the halves of a slab do. */
-static void pass(const atmos__pcloud *pc, const atmos__poptics *o, const lframe *f, const order_key *ord, int k,
+static void pass(const atmos__pcloud *pc, int n, const atmos__poptics *o, const lframe *f, const order_key *ord, int k,
                  float *trans, float *taus, float *light, float *ns)
 {
     const int res = f->res, nw = o->nw;
     for (size_t t = 0; t < (size_t)res * res; t++) trans[t] = 1.0f, taus[t] = 0.0f;
-    for (int q0 = 0, q1; q0 < pc->n; q0 = q1) {
+    for (int q0 = 0, q1; q0 < n; q0 = q1) {
         const double dmax = ord[q0].d + 0.5 * pc->s[ord[q0].i];
-        for (q1 = q0 + 1; q1 < pc->n && ord[q1].d < dmax; q1++) {}
+        for (q1 = q0 + 1; q1 < n && ord[q1].d < dmax; q1++) {}
         for (int phase = 0; phase < 3; phase++)
             for (int q = q0; q < q1; q++) {
                 const int p = ord[q].i, fi = pc->field[p];
@@ -116,27 +118,32 @@ static void pass(const atmos__pcloud *pc, const atmos__poptics *o, const lframe 
                     ns[at] = (float)read_at(taus, res, x, y);
                     continue;
                 }
-                const double n = phase ? ns[at] : read_at(taus, res, x, y);
-                const double F = o->ms[fi] ? atmos_msphase_forward(o->ms[fi], k, n + 1.0) : 0.0;
+                const double sc = phase ? ns[at] : read_at(taus, res, x, y);
+                const double F = o->ms[fi] ? atmos_msphase_forward(o->ms[fi], k, sc + 1.0) : 0.0;
                 splat(pc, p, f, (float)(0.5 * tc), (float)(a * F), (float)a, (float)x, (float)y, trans, taus);
             }
     }
 }
 
-atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
-                                 const double sun[3], int res, double texel_scale, float *light, float *order)
+atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, const int *idx, int nidx,
+                                 const atmos__poptics *o, const double sun[3], int res, double texel_scale, float *light,
+                                 float *order)
 {
-    if (pc->n == 0) return ATMOS_OK;
+    const int n = idx ? nidx : pc->n;
+    if (n == 0) return ATMOS_OK;
     lframe f;
-    make_frame(pc, sun, res, texel_scale > 0 ? texel_scale : 1.0, &f);
-    order_key *ord = malloc(sizeof *ord * (size_t)pc->n);
+    make_frame(pc, idx, n, sun, res, texel_scale > 0 ? texel_scale : 1.0, &f);
+    order_key *ord = malloc(sizeof *ord * (size_t)n);
     float *ns = malloc(sizeof(float) * (size_t)pc->n * o->nw);
     if (!ord || !ns) {
         free(ord), free(ns);
         return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the light pass");
     }
-    for (int p = 0; p < pc->n; p++) ord[p].d = -dot(sun, pc->x[p], pc->y[p], pc->z[p]), ord[p].i = p;
-    qsort(ord, (size_t)pc->n, sizeof *ord, by_depth);
+    for (int q = 0; q < n; q++) {
+        const int p = idx ? idx[q] : q;
+        ord[q].d = -dot(sun, pc->x[p], pc->y[p], pc->z[p]), ord[q].i = p;
+    }
+    qsort(ord, (size_t)n, sizeof *ord, by_depth);
     int nomem = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
     for (int k = 0; k < o->nw; k++) {
@@ -146,10 +153,11 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
             nomem = 1;
             continue;
         }
-        pass(pc, o, &f, ord, k, buf, buf + (size_t)f.res * f.res, light, ns);
+        pass(pc, n, o, &f, ord, k, buf, buf + (size_t)f.res * f.res, light, ns);
         free(buf);
     }
-    for (int p = 0; p < pc->n && order; p++) {
+    for (int q = 0; q < n && order; q++) {
+        const int p = idx ? idx[q] : q;
         double m = 0;
         for (int k = 0; k < o->nw; k++) m += ns[(size_t)p * o->nw + k];
         order[p] = (float)(m / o->nw);

@@ -30,17 +30,8 @@ static int far_first(const void *a, const void *b)
     return x->z > y->z ? -1 : (x->z < y->z ? 1 : (x->i > y->i) - (x->i < y->i));
 }
 
-/* The lights of a frame (atmos__pcloud_splat_lights' arguments). */
-typedef struct lights {
-    int n;
-    const float *const *light, *const *order;
-    const double (*dir)[3];
-    const double (*e)[ATMOS_MAX_WAVELENGTHS];
-    const float *air_t, *air_l;
-} lights;
-
 /* The splat of particle p as seen by cam; 0 when it is not drawn. */
-static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const lights *L, const atmos_camera *cam,
+static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const atmos__plights *L, const atmos_camera *cam,
                    const int rect[4], sp *out)
 {
     const double c[3] = {pc->x[p], pc->y[p], pc->z[p]}, s = pc->s[p], r = ATMOS__PCLOUD_CUT * s;
@@ -110,13 +101,10 @@ static void draw(const sp *q, int nw, const atmos_camera *cam, int tx, int ty, a
     }
 }
 
-atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o, int nlights,
-                                        const float *const *light, const float *const *order, const double (*dir)[3],
-                                        const double (*e)[ATMOS_MAX_WAVELENGTHS], const float *air_t,
-                                        const float *air_l, const atmos_camera *cam, const int rect[4],
-                                        atmos_image *img, int *drawn)
+atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
+                                 const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
+                                 const int rect[4], atmos_image *img, int *drawn)
 {
-    const lights L = {nlights, light, order, dir, e, air_t, air_l};
     if (drawn) *drawn = 0;
     if (cam->type != ATMOS_CAMERA_PINHOLE)
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "particles: the splat renderer draws pinhole cameras only");
@@ -126,8 +114,9 @@ atmos_status atmos__pcloud_splat_lights(atmos_context *ctx, const atmos__pcloud 
     int *cnt = calloc((size_t)ntx * nty + 1, sizeof(int));
     int n = 0;
     if (!s || !ord || !cnt) goto nomem;
-    for (int p = 0; p < pc->n; p++)
-        if (prepare(pc, p, o, &L, cam, rect, &s[n])) ord[n].z = s[n].z, ord[n].i = n, n++;
+    const int count = idx ? nidx : pc->n;
+    for (int q = 0; q < count; q++)
+        if (prepare(pc, idx ? idx[q] : q, o, L, cam, rect, &s[n])) ord[n].z = s[n].z, ord[n].i = n, n++;
     qsort(ord, (size_t)n, sizeof *ord, far_first);
     /* tile lists: counts, offsets, then the splats in far-to-near order */
     for (int q = 0; q < n; q++) {

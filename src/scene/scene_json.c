@@ -943,7 +943,7 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
             } else {
                 TRY(get_text(p, v, ip, buf, sizeof buf));
                 int known = 0;
-                const char *const *names = atmos_volume_generator_names();
+                const char *const *names = atmos_scene_generator_names();
                 char list[256] = "";
                 for (int i = 0; names && names[i]; i++) {
                     known |= !strcmp(names[i], buf);

@@ -72,6 +72,15 @@ static const atmos_setting harris_settings[] = {
     {"light_size", "harris-light-size", ATMOS_SETTING_INT, "texels", 0, 4096, 0, 0, 0, NULL, 0,
      "light buffer texels per side; 0 = 0.7 of the smallest particle's width a texel, at most 1024",
      HARRIS(light_size)},
+    {"impostors", "no-impostors", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "draw each cloud from an impostor made again when the eye has moved round it (Harris 2002 §3); off: every "
+     "particle every frame",
+     HARRIS(impostors)},
+    {"impostor_tolerance_deg", "impostor-tolerance", ATMOS_SETTING_REAL, "deg", 0, 10, 0, 0, 0.15, NULL, 0,
+     "the angle the eye may move round a cloud before its impostor is made again (Harris: 0.15 imperceptible, up to 1)",
+     HARRIS(impostor_tolerance_deg)},
+    {"impostor_max_res", "impostor-max-res", ATMOS_SETTING_INT, "texels", 16, 4096, 0, 0, 512, NULL, 0,
+     "an impostor's texels per side at most", HARRIS(impostor_max_res)},
 };
 
 const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)

@@ -1,9 +1,37 @@
 /* The volume a scene names ("volume" in a scene file): loading or generating it and
  * placing it in the world. */
 #include "core/internal.h"
+#include "particles/pcloud.h"
 
 #include <math.h>
 #include <string.h>
+
+const char *const *atmos_scene_generator_names(void)
+{
+    static const char *all[32];
+    if (!all[0]) { /* the volume generators, then the particle clouds' (written once, the same each time) */
+        int n = 0;
+        for (const char *const *v = atmos_volume_generator_names(); *v && n < 24; v++) all[n++] = *v;
+        for (const char *const *v = atmos__pcloud_generator_names(); *v && n < 31; v++) all[n++] = *v;
+    }
+    return all;
+}
+
+atmos_status atmos_scene_generate_volume(atmos_context *ctx, const char *preset, const atmos_volume_generate_desc *desc,
+                                         atmos_volume **out)
+{
+    for (const char *const *v = atmos__pcloud_generator_names(); *v; v++)
+        if (preset && !strcmp(*v, preset)) {
+            atmos__pcloud pc;
+            double voxel;
+            atmos_status st = atmos__pcloud_generate(ctx, preset, desc ? desc->seed : 1, desc ? desc->scale : 1, &pc, &voxel);
+            if (st == ATMOS_OK)
+                st = atmos__pcloud_to_volume(ctx, &pc, desc && desc->voxel_size_m > 0 ? desc->voxel_size_m : voxel, out);
+            atmos__pcloud_free(&pc);
+            return st;
+        }
+    return atmos_volume_generate(ctx, preset, desc, out);
+}
 
 atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scene, atmos_volume **out,
                                      double offset_m[3])
@@ -20,7 +48,7 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         gd.seed = sv->seed;
         gd.voxel_size_m = sv->voxel_size_m;
         gd.scale = sv->scale > 0 ? sv->scale : 1.0;
-        st = atmos_volume_generate(ctx, sv->source + 9, &gd, &vol);
+        st = atmos_scene_generate_volume(ctx, sv->source + 9, &gd, &vol);
     } else {
         atmos_volume_load_desc ld;
         memset(&ld, 0, sizeof ld);

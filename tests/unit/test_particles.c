@@ -83,7 +83,7 @@ static double light_vs_grid(atmos_volume *v, double h, const double sun[3], doub
     o.nw = 1;
     o.sigma_ext[0][0] = sigma, o.albedo[0][0] = 0.9;
     float *light = malloc(sizeof(float) * (size_t)pc.n), *order = malloc(sizeof(float) * (size_t)pc.n);
-    CHECK_OK(atmos__pcloud_shade(NULL, &pc, &o, sun, 0, 1.0, light, order));
+    CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun, 0, 1.0, light, order));
     double worst = 0, worst_n = 0, mean = 0, rms = 0;
     for (int p = 0; p < pc.n && g; p++) {
         const double c[3] = {pc.x[p], pc.y[p], pc.z[p]};
@@ -146,7 +146,8 @@ static void eye_pass(void)
     CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img));
     const int rect[4] = {0, 0, 65, 65};
     int drawn = 0;
-    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, lp, op, sun, sun_e, NULL, NULL, &cam, rect, img, &drawn));
+    const atmos__plights L1 = {1, lp, op, sun, sun_e, NULL, NULL};
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L1, NULL, 0, &cam, rect, img, &drawn));
     CHECK(drawn == 1);
     const double tau = 1e-12 * 1e9 * 20 * sqrt(2 * 3.141592653589793) * erf(3 / sqrt(2.0));
     const double want = 0.9 / (4 * 3.141592653589793) * 1.5 * 0.8 * (1 - exp(-tau));
@@ -160,17 +161,18 @@ static void eye_pass(void)
     float *lt = malloc(sizeof(float) * (size_t)pc.n), *od = calloc((size_t)pc.n, sizeof(float));
     for (int i = 0; i < pc.n; i++) lt[i] = 0.5f + 0.001f * i;
     const float *ltp[1] = {lt}, *odp[1] = {od};
+    const atmos__plights L2 = {1, ltp, odp, sun, sun_e, NULL, NULL};
     atmos_image *img2 = NULL;
     CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img2));
 #ifdef _OPENMP
     omp_set_num_threads(1);
 #endif
     memset(img->pixels, 0, sizeof(float) * 65 * 65 * 2);
-    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, NULL, NULL, &cam, rect, img, NULL));
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L2, NULL, 0, &cam, rect, img, NULL));
 #ifdef _OPENMP
     omp_set_num_threads(2);
 #endif
-    CHECK_OK(atmos__pcloud_splat_lights(NULL, &pc, &o, 1, ltp, odp, sun, sun_e, NULL, NULL, &cam, rect, img2, NULL));
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L2, NULL, 0, &cam, rect, img2, NULL));
     CHECK(memcmp(img->pixels, img2->pixels, sizeof(float) * 65 * 65 * 2) == 0);
     free(lt), free(od);
     atmos_image_destroy(img);
@@ -178,9 +180,138 @@ static void eye_pass(void)
     atmos__pcloud_free(&pc);
 }
 
+/* A small cloud of particles about c. */
+static void blob(atmos__pcloud *pc, const double c[3], int n, double spread)
+{
+    for (int i = 0; i < n; i++)
+        CHECK_OK(atmos__pcloud_add(pc, c[0] + spread * sin(i * 1.7), c[1] + spread * cos(i * 0.9),
+                                   c[2] + spread * sin(i * 0.37 + 1), 40 + 10 * (i % 3), 4e8, 0));
+}
+
+static double rel_rms(const atmos_image *a, const atmos_image *b)
+{
+    double d2 = 0, r2 = 0;
+    for (size_t i = 0; i < (size_t)a->width * a->height * a->channels; i++)
+        d2 += (a->pixels[i] - b->pixels[i]) * (a->pixels[i] - b->pixels[i]), r2 += b->pixels[i] * b->pixels[i];
+    return sqrt(d2 / r2);
+}
+
+/* Clouds found as connected particles; an impostor drawn from where it was made matches the
+ * particles splatted directly (within its resampling), drifts as the eye moves round the
+ * cloud, and stops serving beyond the tolerance angle, inside the cloud or when too coarse. */
+static void impostors(void)
+{
+    atmos__pcloud pc;
+    memset(&pc, 0, sizeof pc);
+    pc.nfields = 1;
+    const double c1[3] = {0, 2000, -6000}, c2[3] = {3000, 2000, -6000};
+    blob(&pc, c1, 200, 300), blob(&pc, c2, 150, 250);
+    atmos__pclusters cl;
+    CHECK_OK(atmos__pcloud_cluster(NULL, &pc, 0, &cl));
+    CHECK(cl.n == 2);
+    CHECK(cl.n == 2 && cl.start[1] == 200 && cl.idx[0] == 0 && cl.idx[200] == 200);
+    atmos__poptics o;
+    memset(&o, 0, sizeof o);
+    o.nw = 1, o.sigma_ext[0][0] = 1e-11, o.albedo[0][0] = 0.9;
+    float *light = malloc(sizeof(float) * (size_t)pc.n), *order = malloc(sizeof(float) * (size_t)pc.n);
+    double sun[1][3];
+    atmos_direction_from_angles(40, 100, sun[0]);
+    CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun[0], 0, 1.0, light, order));
+    const float *lp[1] = {light}, *op[1] = {order};
+    const double e1[1][ATMOS_MAX_WAVELENGTHS] = {{1.0}};
+    const atmos__plights L = {1, lp, op, sun, e1, NULL, NULL};
+    atmos_camera_desc cd;
+    const double eye[3] = {0, 1800, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, eye, &cd);
+    memcpy(cd.look_at, c1, sizeof cd.look_at);
+    cd.fov_deg = 20;
+    atmos_camera cam;
+    CHECK_OK(atmos_camera_init(NULL, &cd, 160, 160, &cam));
+    atmos_image *direct = NULL, *imp = NULL;
+    CHECK_OK(atmos_image_create(NULL, 160, 160, 2, &direct));
+    CHECK_OK(atmos_image_create(NULL, 160, 160, 2, &imp));
+    const int rect[4] = {0, 0, 160, 160}, *idx = cl.idx + cl.start[0], nidx = cl.start[1] - cl.start[0];
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L, idx, nidx, &cam, rect, direct, NULL));
+    const double f = 160 / (2 * tan(10 * 3.141592653589793 / 180));
+    atmos__pimpostor im;
+    memset(&im, 0, sizeof im);
+    const int res = atmos__pimpostor_res(cl.radius[0], 6000, f, 512);
+    CHECK_OK(atmos__pimpostor_make(NULL, &im, &pc, &o, &L, idx, nidx, cl.centre[0], cl.radius[0], eye, res));
+    atmos__pimpostor_draw(NULL, &im, cl.centre[0], cl.radius[0], &cam, rect, imp);
+    const double e0 = rel_rms(imp, direct);
+    /* the eye 0.5 degree round the cloud: the stale impostor against the direct splats */
+    double eye2[3];
+    const double ang = 0.5 * 3.141592653589793 / 180;
+    eye2[0] = c1[0] + (eye[0] - c1[0]) * cos(ang) + (eye[2] - c1[2]) * sin(ang), eye2[1] = eye[1];
+    eye2[2] = c1[2] - (eye[0] - c1[0]) * sin(ang) + (eye[2] - c1[2]) * cos(ang);
+    memcpy(cd.position, eye2, sizeof cd.position);
+    CHECK_OK(atmos_camera_init(NULL, &cd, 160, 160, &cam));
+    memset(direct->pixels, 0, sizeof(float) * 160 * 160 * 2), memset(imp->pixels, 0, sizeof(float) * 160 * 160 * 2);
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L, idx, nidx, &cam, rect, direct, NULL));
+    atmos__pimpostor_draw(NULL, &im, cl.centre[0], cl.radius[0], &cam, rect, imp);
+    const double e05 = rel_rms(imp, direct);
+    printf("impostor: %d texels, rel rms against the splats %.4f where made, %.4f 0.5 degree round\n", res, e0, e05);
+    CHECK(e0 < 0.03);
+    CHECK(e05 > e0);
+    CHECK(atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], eye, 0.15 * 3.141592653589793 / 180, f, 512));
+    CHECK(!atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], eye2, 0.15 * 3.141592653589793 / 180, f, 512));
+    CHECK(atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], eye2, 1.0 * 3.141592653589793 / 180, f, 512));
+    const double near[3] = {c1[0], c1[1], c1[2] + 2 * cl.radius[0]}, inside[3] = {c1[0], c1[1], c1[2] + 10};
+    CHECK(!atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], near, 0.1, f, 512)); /* too coarse */
+    CHECK(!atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], inside, 3.0, f, 512));
+    atmos__pimpostor_free(&im);
+    atmos_image_destroy(direct), atmos_image_destroy(imp);
+    free(light), free(order);
+    atmos__pclusters_free(&cl);
+    atmos__pcloud_free(&pc);
+}
+
+/* The generated particle clouds: the same particles for a seed, a field of 120 separate
+ * clouds (as the impostors need them), and their grid through the scene's generator (the
+ * cloud every renderer sees) holding their mass. */
+static void generated(void)
+{
+    atmos__pcloud a, b;
+    double va, vb;
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, &a, &va));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, &b, &vb));
+    CHECK(a.n == b.n && a.n > 50000 && va == vb);
+    CHECK(a.n == b.n && !memcmp(a.x, b.x, sizeof(float) * (size_t)a.n) && !memcmp(a.n0, b.n0, sizeof(float) * (size_t)a.n));
+    atmos__pclusters cl;
+    CHECK_OK(atmos__pcloud_cluster(NULL, &a, 0, &cl));
+    printf("harris_field: %d particles, %d clouds, grid voxel %.1f m\n", a.n, cl.n, va);
+    CHECK(cl.n == 120);
+    atmos__pclusters_free(&cl);
+    atmos__pcloud_free(&b);
+    atmos_volume_generate_desc gd;
+    memset(&gd, 0, sizeof gd);
+    gd.seed = 2;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_scene_generate_volume(NULL, "harris_cumulus", &gd, &v));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_cumulus", 2, 1.0, &b, &vb));
+    double mass = 0, want = 0, lo[3], hi[3];
+    for (int p = 0; p < b.n; p++) want += b.n0[p] * 0.9707091134651118 * 15.749609945722419 * pow(b.s[p], 3);
+    atmos_volume_bounds(v, lo, hi);
+    for (double z = lo[2] + 0.5 * vb; z < hi[2]; z += vb)
+        for (double y = lo[1] + 0.5 * vb; y < hi[1]; y += vb)
+            for (double x = lo[0] + 0.5 * vb; x < hi[0]; x += vb) {
+                const double p[3] = {x, y, z};
+                mass += atmos_volume_sample(v, 0, p) * vb * vb * vb;
+            }
+    printf("harris_cumulus: %d particles, grid mass %.5g of %.5g\n", b.n, mass, want);
+    CHECK_REL(mass, want, 0.02);
+    int known = 0;
+    for (const char *const *n = atmos_scene_generator_names(); *n; n++) known += !strcmp(*n, "harris_field") + !strcmp(*n, "cumulus");
+    CHECK(known == 2);
+    atmos_volume_destroy(v);
+    atmos__pcloud_free(&a), atmos__pcloud_free(&b);
+}
+
 int main(void)
 {
     convert();
+    generated();
+    impostors();
     light_pass();
     eye_pass();
     return test_summary("test_particles");

@@ -26,7 +26,7 @@ static void help(void)
            "            the voxels they cover, active zeros included), else the voxels > 0.\n"
            "  generate  builds a preset cloud volume and writes it as raw float32 files plus a JSON\n"
            "            sidecar. Presets: ");
-    for (const char *const *n = atmos_volume_generator_names(); *n; n++) printf("%s%s", *n, n[1] ? ", " : "\n");
+    for (const char *const *n = atmos_scene_generator_names(); *n; n++) printf("%s%s", *n, n[1] ? ", " : "\n");
     printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
            "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
@@ -245,12 +245,12 @@ static int cmd_generate(int argc, char **argv)
     if (!preset) return cli_usage_error(C, "generate: which preset?");
     if (!out) return cli_usage_error(C, "generate: missing -o NAME.json");
     int known = 0;
-    for (const char *const *n = atmos_volume_generator_names(); *n; n++) known |= !strcmp(*n, preset);
+    for (const char *const *n = atmos_scene_generator_names(); *n; n++) known |= !strcmp(*n, preset);
     if (!known) return cli_usage_error(C, "generate: unknown preset '%s'", preset);
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
-    atmos_status st = atmos_volume_generate(ctx, preset, &g, &v);
+    atmos_status st = atmos_scene_generate_volume(ctx, preset, &g, &v);
     if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
     int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
     atmos_volume_destroy(v);

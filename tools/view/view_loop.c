@@ -17,6 +17,7 @@ typedef struct loop {
     atmos_image *img, *lin, *disp;
     double log_scale;            /* the exposure's smoothed log scale (automatic exposure) */
     int have_scale, spp, saves;
+    int impostor_updates;        /* the last frame's */
 } loop;
 
 static void drop_plans(loop *L)
@@ -85,7 +86,11 @@ static atmos_status render(loop *L, view_state *s, int preview, atmos_plan **pp)
     }
     if (!L->img && (st = atmos_plan_image_create(p, &f, &L->img)) != ATMOS_OK) return st;
     *pp = p;
-    return atmos_plan_render(p, &f, NULL, L->img, NULL);
+    st = atmos_plan_render(p, &f, NULL, L->img, NULL);
+    atmos_plan_stats ps;
+    atmos_plan_get_stats(p, &ps);
+    L->impostor_updates = ps.impostor_updates;
+    return st;
 }
 
 static int save(loop *L, const view_opts *o, view_state *s, const char *text)
@@ -181,7 +186,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         overlay(&s, last_ms, lines);
         if (win && view_window_present(win, L.disp, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
         last_ms = 1000.0 * (cli_now_s() - t0);
-        if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), 0, &s);
+        if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates, &s);
         if (rc == CLI_EXIT_OK && s.save) rc = save(&L, o, &s, text), s.save = 0;
     }
     if (view_record_close(&rec) != CLI_EXIT_OK && rc == CLI_EXIT_OK) rc = CLI_EXIT_RUNTIME;

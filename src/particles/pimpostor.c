@@ -1,0 +1,169 @@
+/* Harris 2002 §3's dynamically generated impostors (pcloud.h): a cloud drawn once into a
+ * texture from the eye, shown on a plane through its centre facing where it was made from,
+ * made again when the eye has moved too far round it (the translation error) or too near to
+ * it (the resolution error). */
+#include "particles/pcloud.h"
+#include "core/internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int atmos__pimpostor_res(double r, double d, double f, int max_res)
+{
+    const double px = d > r ? 2.0 * r * f / d : max_res;
+    int res = 8 * (int)ceil(fmax(px, 8.0) / 8.0);
+    return res < max_res ? res : max_res;
+}
+
+int atmos__pimpostor_serves(const atmos__pimpostor *im, const double c[3], double r, const double e[3], double tol,
+                            double f, int max_res)
+{
+    if (!im->valid) return 0;
+    double a[3], b[3], la = 0, lb = 0, ab = 0;
+    for (int i = 0; i < 3; i++) a[i] = im->view[i] - c[i], b[i] = e[i] - c[i];
+    for (int i = 0; i < 3; i++) la += a[i] * a[i], lb += b[i] * b[i], ab += a[i] * b[i];
+    if (lb <= r * r) return 0; /* the eye inside the cloud's sphere */
+    const double cosang = ab / sqrt(la * lb);
+    if (cosang < cos(tol)) return 0;
+    return atmos__pimpostor_res(r, sqrt(lb), f, max_res) <= im->res;
+}
+
+atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
+                                   const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
+                                   const double c[3], double r, const double e[3], int res)
+{
+    double d = 0;
+    for (int i = 0; i < 3; i++) d += (c[i] - e[i]) * (c[i] - e[i]);
+    d = sqrt(d);
+    if (!(d > r)) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "particles: an impostor seen from inside its cloud");
+    atmos_camera_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.type = ATMOS_CAMERA_PINHOLE;
+    memcpy(cd.position, e, sizeof cd.position), memcpy(cd.look_at, c, sizeof cd.look_at);
+    const double fwd_y = (c[1] - e[1]) / d;
+    cd.up[0] = 0, cd.up[1] = fabs(fwd_y) > 0.99 ? 0 : 1, cd.up[2] = fabs(fwd_y) > 0.99 ? -1 : 0;
+    cd.fov_deg = 2.0 * asin(r / d) * 180.0 / ATMOS_PI;
+    atmos_status st = atmos_camera_init(ctx, &cd, res, res, &im->cam);
+    if (st == ATMOS_OK && (!im->img || im->img->width != res)) {
+        atmos_image_destroy(im->img), im->img = NULL;
+        st = atmos_image_create(ctx, res, res, o->nw + 1, &im->img);
+    }
+    if (st != ATMOS_OK) return st;
+    memset(im->img->pixels, 0, sizeof(float) * (size_t)res * res * (o->nw + 1));
+    const int rect[4] = {0, 0, res, res};
+    if ((st = atmos__pcloud_splat(ctx, pc, o, L, idx, nidx, &im->cam, rect, im->img, NULL)) != ATMOS_OK) return st;
+    memcpy(im->view, e, sizeof im->view);
+    im->res = res, im->valid = 1;
+    return ATMOS_OK;
+}
+
+/* The impostor's texel coordinates of the world point w (0 when behind its camera). */
+static int to_texel(const atmos__pimpostor *im, const double w[3], double *tx, double *ty)
+{
+    const atmos_camera *k = &im->cam;
+    double X = 0, Y = 0, Z = 0;
+    for (int i = 0; i < 3; i++) {
+        const double rel = w[i] - k->position[i];
+        X += rel * k->right[i], Y += rel * k->up[i], Z += rel * k->forward[i];
+    }
+    if (!(Z > 0)) return 0;
+    const double f = k->height / (2.0 * k->tan_half_fov);
+    *tx = 0.5 * k->width + f * X / Z - 0.5, *ty = 0.5 * k->height - f * Y / Z - 0.5;
+    return 1;
+}
+
+/* Pixel row y of the frame: the impostor over [x0, x1). */
+static void draw_row(const atmos__pimpostor *im, const double c[3], const double nrm[3], const atmos_camera *cam, int y,
+                     int x0, int x1, atmos_image *img)
+{
+    const int C = img->channels, nw = C - 1, R = im->res;
+    const double W = cam->width, H = cam->height, t = cam->tan_half_fov, v = (H - 2.0 * (y + 0.5)) / H * t;
+    double ce = 0, dn;
+    for (int i = 0; i < 3; i++) ce += (c[i] - cam->position[i]) * nrm[i];
+    for (int x = x0; x < x1; x++) {
+        const double u = (2.0 * (x + 0.5) - W) / H * t;
+        double d[3], w[3], tx, ty;
+        dn = 0;
+        for (int i = 0; i < 3; i++) d[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i], dn += d[i] * nrm[i];
+        if (!(fabs(dn) > 1e-12) || ce / dn <= 0) continue;
+        for (int i = 0; i < 3; i++) w[i] = cam->position[i] + ce / dn * d[i];
+        if (!to_texel(im, w, &tx, &ty) || tx < -0.5 || ty < -0.5 || tx > R - 0.5 || ty > R - 0.5) continue;
+        tx = fmin(fmax(tx, 0.0), R - 1.001), ty = fmin(fmax(ty, 0.0), R - 1.001);
+        const int i0 = (int)tx, j0 = (int)ty;
+        const double ax = tx - i0, ay = ty - j0;
+        const float *t00 = im->img->pixels + ((size_t)j0 * R + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)R * C,
+                    *t11 = t10 + C;
+        float *px = img->pixels + ((size_t)y * cam->width + x) * C;
+        float tex[ATMOS_MAX_WAVELENGTHS + 1];
+        for (int k = 0; k < C; k++)
+            tex[k] = (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
+        const float keep = 1.0f - tex[nw];
+        for (int k = 0; k < nw; k++) px[k] = px[k] * keep + tex[k];
+        px[nw] = 1.0f - (1.0f - px[nw]) * keep;
+    }
+}
+
+void atmos__pimpostor_draw(atmos_context *ctx, const atmos__pimpostor *im, const double c[3], double r,
+                           const atmos_camera *cam, const int rect[4], atmos_image *img)
+{
+    double nrm[3], l = 0, X = 0, Y = 0, Z = 0;
+    for (int i = 0; i < 3; i++) nrm[i] = im->view[i] - c[i], l += nrm[i] * nrm[i];
+    for (int i = 0; i < 3; i++) nrm[i] /= sqrt(l);
+    for (int i = 0; i < 3; i++) {
+        const double rel = c[i] - cam->position[i];
+        X += rel * cam->right[i], Y += rel * cam->up[i], Z += rel * cam->forward[i];
+    }
+    if (!(Z > r)) return; /* the caller splats clouds near or behind the eye */
+    const double W = cam->width, H = cam->height, f = H / (2.0 * cam->tan_half_fov);
+    const double px = 0.5 * W + f * X / Z, py = 0.5 * H - f * Y / Z;
+    const double rp = f * r / sqrt(Z * Z - r * r) * (1.0 + (fabs(X) + fabs(Y) + r) / Z);
+    const int x0 = (int)fmax(rect[0], floor(px - rp)), x1 = (int)fmin(rect[2], ceil(px + rp));
+    const int y0 = (int)fmax(rect[1], floor(py - rp)), y1 = (int)fmin(rect[3], ceil(py + rp));
+#pragma omp parallel for schedule(dynamic, 8) num_threads(atmos__threads(ctx))
+    for (int y = y0; y < y1; y++) draw_row(im, c, nrm, cam, y, x0, x1, img);
+}
+
+atmos_status atmos__pimpostor_screen(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
+                                     const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
+                                     int factor, const int rect[4], atmos_image *img)
+{
+    const int w = (cam->width + factor - 1) / factor, h = (cam->height + factor - 1) / factor, C = img->channels;
+    atmos_camera small = *cam;
+    small.width = w, small.height = h;
+    /* the same field of view over the rounded-up size: the small image covers the frame */
+    small.tan_half_fov = cam->tan_half_fov * (double)h * factor / cam->height;
+    atmos_image *lo = NULL;
+    atmos_status st = atmos_image_create(ctx, w, h, C, &lo);
+    if (st != ATMOS_OK) return st;
+    memset(lo->pixels, 0, sizeof(float) * (size_t)w * h * C);
+    const int all[4] = {0, 0, w, h};
+    st = atmos__pcloud_splat(ctx, pc, o, L, idx, nidx, &small, all, lo, NULL);
+    if (st == ATMOS_OK) {
+#pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
+        for (int y = rect[1]; y < rect[3]; y++)
+            for (int x = rect[0]; x < rect[2]; x++) {
+                const double tx = fmin(fmax((x + 0.5) / factor - 0.5, 0.0), w - 1.001);
+                const double ty = fmin(fmax((y + 0.5) / factor - 0.5, 0.0), h - 1.001);
+                const int i0 = (int)tx, j0 = (int)ty;
+                const double ax = tx - i0, ay = ty - j0;
+                const float *t00 = lo->pixels + ((size_t)j0 * w + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)w * C,
+                            *t11 = t10 + C;
+                float *px = img->pixels + ((size_t)y * cam->width + x) * C;
+                const float cov = (float)((1 - ay) * ((1 - ax) * t00[C - 1] + ax * t01[C - 1]) +
+                                          ay * ((1 - ax) * t10[C - 1] + ax * t11[C - 1]));
+                for (int k = 0; k < C - 1; k++)
+                    px[k] = px[k] * (1.0f - cov) +
+                            (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
+                px[C - 1] = 1.0f - (1.0f - px[C - 1]) * (1.0f - cov);
+            }
+    }
+    atmos_image_destroy(lo);
+    return st;
+}
+
+void atmos__pimpostor_free(atmos__pimpostor *im)
+{
+    atmos_image_destroy(im->img);
+    memset(im, 0, sizeof *im);
+}

@@ -1,0 +1,135 @@
+/* Harris's particle renderer: a frame (docs/particles.md). The sky renderer draws the
+ * background; the clouds go far to near, each drawn from its impostor (Harris §3: made again
+ * when the eye has moved round it by more than the tolerance angle or come so near that its
+ * texels are too coarse) or, with impostors off or the eye within its sphere, splatted
+ * particle by particle over the image. */
+#include "render/harris_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The frame's aerial-perspective volume over the whole image, from the particles' nearest
+ * to their farthest point (NULL: the kind's answers are closed forms, asked per particle). */
+static const atmos__aerial *frame_aerial(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v)
+{
+    const atmos_camera *cam = &v->cam;
+    if (!atmos__aerial_wanted(p->atm) || cam->type != ATMOS_CAMERA_PINHOLE) return NULL;
+    double lo[3], hi[3], near2 = 0, far = 0;
+    atmos__pcloud_bounds(&h->pc, lo, hi);
+    for (int a = 0; a < 3; a++) {
+        const double e = cam->position[a] < lo[a] ? lo[a] - cam->position[a] : (cam->position[a] > hi[a] ? cam->position[a] - hi[a] : 0);
+        const double f = fmax(fabs(lo[a] - cam->position[a]), fabs(hi[a] - cam->position[a]));
+        near2 += e * e, far += f * f;
+    }
+    atmos__aerial_grid g;
+    memset(&g, 0, sizeof g);
+    memcpy(g.eye, cam->position, sizeof g.eye), memcpy(g.sun, v->sun, sizeof g.sun);
+    memcpy(g.fwd, cam->forward, sizeof g.fwd), memcpy(g.right, cam->right, sizeof g.right);
+    memcpy(g.up, cam->up, sizeof g.up);
+    const double tn = cam->tan_half_fov, asp = (double)cam->width / cam->height;
+    g.u0 = -asp * tn, g.u1 = asp * tn, g.v0 = -tn, g.v1 = tn;
+    g.tmin = fmax(0.0, sqrt(near2) - 1.0), g.tmax = sqrt(far) + 1.0;
+    g.crowd_far = cam->position[1] > hi[1];
+    g.nd = ATMOS__AERIAL_SLICES;
+    atmos__aerial_nodes(p->atm, &g);
+    return atmos__aerial_build(&h->aerial, p->atm, &g, atmos__threads(p->ctx)) ? &h->aerial : NULL;
+}
+
+/* The air from the eye to the centres of particles idx[0..n) (ap: the frame's volume, or
+ * NULL: ask the atmosphere). */
+static void air(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
+                const int *idx, int n)
+{
+    const int nw = h->o.nw;
+#pragma omp parallel for schedule(dynamic, 256) num_threads(atmos__threads(p->ctx))
+    for (int q = 0; q < n; q++) {
+        const int i = idx[q];
+        double d[3] = {h->pc.x[i] - v->cam.position[0], h->pc.y[i] - v->cam.position[1], h->pc.z[i] - v->cam.position[2]};
+        const double t = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; a++) d[a] /= t > 0 ? t : 1.0;
+        double L[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+        if (!ap || !atmos__aerial_eval(ap, d, t, L, T)) {
+            atmos_atmosphere_inscatter(p->atm, v->cam.position, d, t, v->sun, L);
+            atmos_atmosphere_transmittance(p->atm, v->cam.position, d, t, T);
+        }
+        for (int k = 0; k < nw; k++) h->air_l[(size_t)i * nw + k] = (float)L[k], h->air_t[(size_t)i * nw + k] = (float)T[k];
+    }
+}
+
+typedef struct far_cloud {
+    double d;
+    int k;
+} far_cloud;
+
+static int far_first(const void *a, const void *b)
+{
+    const far_cloud *x = a, *y = b;
+    return x->d > y->d ? -1 : (x->d < y->d ? 1 : (x->k > y->k) - (x->k < y->k));
+}
+
+/* Cloud k: its impostor (made again when it no longer serves) or its particles. */
+static atmos_status cloud(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
+                          int k, const int rect[4], atmos_image *out)
+{
+    const atmos_scene_harris *hs = &p->scene.harris;
+    const atmos__pclusters *c = &h->clouds;
+    const int *idx = c->idx + c->start[k], n = c->start[k + 1] - c->start[k];
+    const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
+                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
+    const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
+    double d2 = 0;
+    for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
+    const double margin = 1.05 * c->radius[k]; /* an impostor's plane needs the eye well outside */
+    if (!hs->impostors || v->cam.type != ATMOS_CAMERA_PINHOLE) {
+        air(p, h, v, ap, idx, n);
+        int drawn = 0;
+        atmos_status st = atmos__pcloud_splat(p->ctx, &h->pc, &h->o, &L, idx, n, &v->cam, rect, out, &drawn);
+        h->drawn += drawn, h->direct++;
+        return st;
+    }
+    if (d2 <= margin * margin) { /* the head in the cloud (§3.1): a screen-sized impostor at 1/4 resolution */
+        air(p, h, v, ap, idx, n);
+        h->direct++, h->updates++;
+        return atmos__pimpostor_screen(p->ctx, &h->pc, &h->o, &L, idx, n, &v->cam, 4, rect, out);
+    }
+    atmos__pimpostor *im = &h->imp[k];
+    const double tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
+    if (!atmos__pimpostor_serves(im, c->centre[k], c->radius[k], e, tol, f, hs->impostor_max_res)) {
+        air(p, h, v, ap, idx, n);
+        const int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, hs->impostor_max_res);
+        atmos_status st = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, &L, idx, n, c->centre[k], c->radius[k], e, res);
+        if (st != ATMOS_OK) return st;
+        h->updates++;
+    }
+    atmos__pimpostor_draw(p->ctx, im, c->centre[k], c->radius[k], &v->cam, rect, out);
+    return ATMOS_OK;
+}
+
+atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
+{
+    atmos__harris_plan *h = p->harris;
+    atmos_status st = atmos__sky_render(p->ctx, p->atm, v, r, out, p->sky_keep);
+    if (st != ATMOS_OK) return st;
+    if (!h->have_sun || memcmp(h->sun, v->sun, sizeof h->sun) != 0) {
+        const double t0 = atmos__now();
+        if ((st = atmos__harris_lights(p, h, v->sun)) != ATMOS_OK) return st;
+        h->shade_s = atmos__now() - t0;
+    }
+    const int rect[4] = {r->x0, r->y0, r->x1, r->y1};
+    const atmos__aerial *ap = frame_aerial(p, h, v);
+    const int nc = h->clouds.n;
+    far_cloud *ord = malloc(sizeof *ord * (size_t)(nc ? nc : 1));
+    if (!ord) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    for (int k = 0; k < nc; k++) {
+        double d2 = 0;
+        for (int a = 0; a < 3; a++) d2 += (v->cam.position[a] - h->clouds.centre[k][a]) * (v->cam.position[a] - h->clouds.centre[k][a]);
+        ord[k].d = d2, ord[k].k = k;
+    }
+    qsort(ord, (size_t)nc, sizeof *ord, far_first);
+    h->drawn = h->updates = h->direct = 0;
+    for (int q = 0; q < nc && st == ATMOS_OK; q++) st = cloud(p, h, v, ap, ord[q].k, rect, out);
+    free(ord);
+    p->stats.impostor_updates = h->updates;
+    return st;
+}

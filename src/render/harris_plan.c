@@ -1,0 +1,150 @@
+/* Harris 2002's particle-cloud renderer ("renderer": "harris", docs/particles.md), the plan's
+ * part: the plan's volume becomes a particle cloud once (src/particles/), grouped into clouds
+ * for the impostors; the light passes run when the sun moves (the sun and, as Harris §2.3.1
+ * lights clouds at sunset with several coloured lights, sky lights from directions over the
+ * upper hemisphere whose colour the atmosphere gives). */
+#include "render/harris_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The sky lights' directions: sky_lights directions at 30 degrees elevation evenly in
+ * azimuth (the first toward the sun's azimuth) and one at the zenith, each standing for an
+ * equal share of the upper hemisphere. */
+static void sky_dirs(int n, const double sun[3], double (*d)[3])
+{
+    if (n <= 0) return;
+    double el, az;
+    atmos_direction_to_angles(sun, &el, &az);
+    d[0][0] = 0, d[0][1] = 1, d[0][2] = 0;
+    for (int i = 1; i < n; i++) atmos_direction_from_angles(30.0, fmod(az + 360.0 * (i - 1) / (n - 1), 360.0), d[i]);
+}
+
+atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const double sun[3])
+{
+    double lo[3], hi[3], c[3];
+    atmos__pcloud_bounds(&h->pc, lo, hi);
+    for (int a = 0; a < 3; a++) c[a] = 0.5 * (lo[a] + hi[a]);
+    memcpy(h->dir[0], sun, sizeof h->dir[0]);
+    atmos_atmosphere_sunlight(p->atm, c, sun, h->e[0]);
+    const int sky = p->scene.harris.sky_lights;
+    h->nlights = 1 + sky;
+    sky_dirs(sky, sun, h->dir + 1);
+    for (int j = 1; j < h->nlights; j++) {
+        atmos_atmosphere_hit info;
+        atmos_atmosphere_radiance(p->atm, c, h->dir[j], sun, h->e[j], &info);
+        for (int k = 0; k < h->o.nw; k++) h->e[j][k] *= 2.0 * ATMOS_PI / sky; /* radiance x its share of the sky */
+    }
+    /* each light and each cloud on its own (clouds do not shade one another, as in Harris's
+     * passes), the pairs on the threads; the result does not depend on the count */
+    atmos_status st = ATMOS_OK;
+    const atmos__pclusters *cl = &h->clouds;
+    const int pairs = h->nlights * cl->n;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
+    for (int q = 0; q < pairs; q++) {
+        const int j = q / cl->n, k = q % cl->n;
+        /* the sky's light is soft: its buffers have texels three times as wide */
+        const atmos_status sj = atmos__pcloud_shade(p->ctx, &h->pc, cl->idx + cl->start[k], cl->start[k + 1] - cl->start[k],
+                                                    &h->o, h->dir[j], p->scene.harris.light_size, j ? 3.0 : 1.0,
+                                                    h->light[j], h->order[j]);
+        if (sj != ATMOS_OK) {
+#pragma omp critical
+            st = sj;
+        }
+    }
+    if (st != ATMOS_OK) return st;
+    memcpy(h->sun, sun, sizeof h->sun);
+    h->have_sun = 1;
+    for (int k = 0; k < h->clouds.n; k++) h->imp[k].valid = 0; /* lit anew */
+    return ATMOS_OK;
+}
+
+static atmos_status optics(atmos_plan *p, atmos__harris_plan *h)
+{
+    h->o.nw = p->wl.count;
+    for (int f = 0; f < p->optics->count; f++) {
+        for (int k = 0; k < h->o.nw; k++) {
+            h->o.sigma_ext[f][k] = atmos_phase_table_sigma_ext(p->optics->phase[f], k);
+            h->o.albedo[f][k] = atmos_phase_table_albedo(p->optics->phase[f], k);
+        }
+        h->o.ms[f] = p->optics->ms[f];
+        if (!h->o.ms[f])
+            return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render harris: the optics need their Ams tables");
+    }
+    return ATMOS_OK;
+}
+
+/* The particles: a particle cloud's own (the scene's "generate": "harris_..."), or the
+ * volume's made into particles. */
+static atmos_status particles(atmos_plan *p, atmos__harris_plan *h)
+{
+    const atmos_scene_volume *sv = &p->scene.volume;
+    const atmos_scene_harris *hs = &p->scene.harris;
+    for (const char *const *g = atmos__pcloud_generator_names(); *g; g++)
+        if (!strncmp(sv->source, "generate:", 9) && !strcmp(sv->source + 9, *g)) {
+            double voxel;
+            atmos_status st = atmos__pcloud_generate(p->ctx, *g, sv->seed, sv->scale > 0 ? sv->scale : 1.0, &h->pc, &voxel);
+            if (st != ATMOS_OK) return st;
+            /* the grid the plan placed starts at the particles' box (atmos__pcloud_to_volume) */
+            double lo[3], hi[3];
+            atmos__pcloud_bounds(&h->pc, lo, hi);
+            for (int i = 0; i < h->pc.n; i++) {
+                h->pc.x[i] += (float)(p->offset[0] - lo[0] + atmos_volume_get_desc(p->volume)->origin_m[0]);
+                h->pc.y[i] += (float)(p->offset[1] - lo[1] + atmos_volume_get_desc(p->volume)->origin_m[1]);
+                h->pc.z[i] += (float)(p->offset[2] - lo[2] + atmos_volume_get_desc(p->volume)->origin_m[2]);
+            }
+            return ATMOS_OK;
+        }
+    return atmos__pcloud_from_volume(p->ctx, p->volume, p->offset, hs->spacing_m, hs->max_particles, &h->pc);
+}
+
+atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
+{
+    *out = NULL;
+    atmos__harris_plan *h = calloc(1, sizeof *h);
+    if (!h) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    const atmos_scene_harris *hs = &p->scene.harris;
+    atmos_status st = optics(p, h);
+    if (st == ATMOS_OK) st = particles(p, h);
+    for (int i = 0; i < h->pc.n && st == ATMOS_OK; i++) h->pc.n0[i] *= (float)p->scene.volume.density_scale;
+    if (st == ATMOS_OK) st = atmos__pcloud_cluster(p->ctx, &h->pc, 0.0, &h->clouds);
+    if (st == ATMOS_OK && !(h->imp = calloc((size_t)(h->clouds.n ? h->clouds.n : 1), sizeof *h->imp)))
+        st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    h->air_t = malloc(sizeof(float) * (size_t)(h->pc.n ? h->pc.n : 1) * h->o.nw);
+    h->air_l = malloc(sizeof(float) * (size_t)(h->pc.n ? h->pc.n : 1) * h->o.nw);
+    if (!h->air_t || !h->air_l) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    for (int j = 0; j <= hs->sky_lights && st == ATMOS_OK; j++) {
+        h->light[j] = malloc(sizeof(float) * (size_t)(h->pc.n ? h->pc.n : 1) * h->o.nw);
+        h->order[j] = malloc(sizeof(float) * (size_t)(h->pc.n ? h->pc.n : 1));
+        if (!h->light[j] || !h->order[j]) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    }
+    if (st != ATMOS_OK) {
+        atmos__harris_plan_destroy(h);
+        return st;
+    }
+    atmos__log(p->ctx, ATMOS_LOG_INFO, "render harris: %d particles in %d clouds", h->pc.n, h->clouds.n);
+    *out = h;
+    return ATMOS_OK;
+}
+
+void atmos__harris_plan_destroy(atmos__harris_plan *h)
+{
+    if (!h) return;
+    for (int k = 0; h->imp && k < h->clouds.n; k++) atmos__pimpostor_free(&h->imp[k]);
+    free(h->imp);
+    atmos__pclusters_free(&h->clouds);
+    atmos__pcloud_free(&h->pc);
+    for (int j = 0; j < ATMOS__HARRIS_MAX_LIGHTS; j++) free(h->light[j]), free(h->order[j]);
+    free(h->air_t), free(h->air_l);
+    atmos__aerial_free(&h->aerial);
+    free(h);
+}
+
+void atmos__harris_describe(const atmos_plan *p, char *buf, size_t cap)
+{
+    const atmos__harris_plan *h = p->harris;
+    snprintf(buf, cap, "%d particles in %d clouds (%d splatted, %d clouds direct), %d sky lights, light passes %.3f s, "
+             "%d impostor updates", h->pc.n, h->clouds.n, h->drawn, h->direct, h->nlights - 1, h->shade_s, h->updates);
+}
