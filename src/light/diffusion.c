@@ -15,6 +15,13 @@
  * over h/2 that is phi a / ((2 a + 1)) per area, a = 2 D / h. Light coming in through the
  * face (the partial current J_in: the sky, the ground) makes it (phi - 4 J_in) a / (2 a + 1).
  *
+ * An anisotropic source (the light the forward beam drops goes mostly back toward the sun)
+ * enters through its first moment Q1 = int q(w) w dw: the P1 equations div J + sig_a phi = Q,
+ * grad phi / 3 + sig_tr J = Q1 give J = -D grad phi + 3 D Q1 and
+ *     -div(D grad phi) + sig_a phi = Q - div(3 D Q1)
+ * (e.g. Ishimaru 1978, §9-2). At a vacuum face the Marshak condition with this J adds
+ * 3 D Q1 . n / (2 a + 1) to the outgoing net flux.
+ *
  * Cell-centred finite volumes (harmonic mean of D at a face), red-black successive
  * over-relaxation (each colour's update reads only the other colour: the result does not
  * depend on the thread count), the diffusion coefficient lagged and refreshed every few
@@ -80,23 +87,29 @@ static double cell_D(const atmos__lmedium *m, const float *phi, const long long 
     return 1.0 / (den > dmin ? den : dmin);
 }
 
-static void refresh_D(const atmos__lmedium *m, const float *phi, int w, int limiter, float *D)
+/* The lagged coefficients of wavelength w: D per cell and, with a first moment of the
+ * source, the flux it drives, P = 3 D Q1 ([cell * 3 + axis]). */
+static void refresh_D(const atmos__lmedium *m, const atmos__lsource *q, const float *phi, int w, int limiter, float *D,
+                      float *P)
 {
-    const int cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
     for (int k = 0; k < cz; k++)
         for (int j = 0; j < cy; j++)
             for (int i = 0; i < cx; i++) {
                 long long nb[6];
                 neighbours(m, i, j, k, nb);
                 const size_t cell = ((size_t)k * cy + j) * cx + i;
-                D[cell] = (float)cell_D(m, phi, nb, cell, w, limiter);
+                const double d = cell_D(m, phi, nb, cell, w, limiter);
+                D[cell] = (float)d;
+                if (P)
+                    for (int a = 0; a < 3; a++) P[cell * 3 + a] = (float)(3.0 * d * q->Q1[(cell * n + w) * 3 + a]);
             }
 }
 
 /* One colour's half-sweep of wavelength w; returns the largest change, *top the largest value
  * of the colour's cells. */
-static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, const float *D, int w, int colour,
-                         double *top)
+static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, const float *D, const float *P, int w,
+                         int colour, double *top)
 {
     const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
     const double h = m->h, ih2 = 1.0 / (h * h);
@@ -112,14 +125,17 @@ static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, co
                 diag = diag > 0 ? diag : 0;
                 for (int f = 0; f < 6; f++) {
                     if (nb[f] == -2) continue;
+                    const double sg = f & 1 ? 1.0 : -1.0; /* the face's outward normal along axis f / 2 */
                     if (nb[f] == -1) {
                         const double a = 2.0 * Di / h, b = a / ((2.0 * a + 1.0) * h);
                         diag += b;
                         if (m->jin) sum += b * 4.0 * m->jin[f * n + w];
+                        if (P) sum -= sg * P[cell * 3 + f / 2] / ((2.0 * a + 1.0) * h);
                     } else {
                         const double Dn = D[nb[f]], c = 2.0 * Di * Dn / (Di + Dn) * ih2;
                         diag += c;
                         sum += c * phi[(size_t)nb[f] * n + w];
+                        if (P) sum -= sg * 0.5 * (P[cell * 3 + f / 2] + P[(size_t)nb[f] * 3 + f / 2]) / h;
                     }
                 }
                 const double old = phi[cell * n + w];
@@ -139,17 +155,21 @@ static double half_sweep(const atmos__lmedium *m, const float *Q, float *phi, co
 }
 
 /* The solve of wavelength w; returns its sweeps (-1: out of memory). */
-static int solve_one(const atmos__lmedium *m, const float *Q, float *phi, int w, int maxs, double tol, int limiter)
+static int solve_one(const atmos__lmedium *m, const atmos__lsource *q, float *phi, int w, int maxs, double tol,
+                     int limiter)
 {
     const size_t cells = atmos__lmedium_cells(m);
-    float *D = malloc(sizeof(float) * cells);
-    if (!D) return -1;
+    float *D = malloc(sizeof(float) * cells), *P = q->Q1 ? malloc(sizeof(float) * cells * 3) : NULL;
+    if (!D || (q->Q1 && !P)) {
+        free(D), free(P);
+        return -1;
+    }
     int s = 0;
     for (; s < maxs; s++) {
-        if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, phi, w, limiter, D);
+        if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, q, phi, w, limiter, D, P);
         double top0, top1;
-        double ch = half_sweep(m, Q, phi, D, w, 0, &top0);
-        const double ch1 = half_sweep(m, Q, phi, D, w, 1, &top1);
+        double ch = half_sweep(m, q->Q, phi, D, P, w, 0, &top0);
+        const double ch1 = half_sweep(m, q->Q, phi, D, P, w, 1, &top1);
         ch = ch1 > ch ? ch1 : ch;
         const double top = top1 > top0 ? top1 : top0;
         if (!(top > 0) || ch <= tol * top) {
@@ -157,11 +177,11 @@ static int solve_one(const atmos__lmedium *m, const float *Q, float *phi, int w,
             break;
         }
     }
-    free(D);
+    free(D), free(P);
     return s;
 }
 
-int atmos__lfield_diffuse(const atmos__lmedium *m, const float *Q, float *phi, const atmos__ldiffusion_opts *o,
+int atmos__lfield_diffuse(const atmos__lmedium *m, const atmos__lsource *q, float *phi, const atmos__ldiffusion_opts *o,
                           int threads)
 {
     const int n = m->n, maxs = o && o->max_sweeps > 0 ? o->max_sweeps : 2000, limiter = o ? o->limiter : 0;
@@ -171,15 +191,15 @@ int atmos__lfield_diffuse(const atmos__lmedium *m, const float *Q, float *phi, c
      * costs a time slice whenever the machine is busy), the same result for any thread count */
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(max : most) reduction(| : fail)
     for (int w = 0; w < n; w++) {
-        const int s = solve_one(m, Q, phi, w, maxs, tol, limiter);
+        const int s = solve_one(m, q, phi, w, maxs, tol, limiter);
         if (s < 0) fail = 1;
         most = s > most ? s : most;
     }
     return fail ? -1 : most;
 }
 
-void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, int w,
-                        double out[6])
+void atmos__lfield_leak(const atmos__lmedium *m, const atmos__lsource *q, const float *phi,
+                        const atmos__ldiffusion_opts *o, int w, double out[6])
 {
     const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2], limiter = o ? o->limiter : 0;
     const double h = m->h;
@@ -190,17 +210,18 @@ void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__
                 long long nb[6];
                 neighbours(m, i, j, k, nb);
                 const size_t cell = ((size_t)k * cy + j) * cx + i;
+                const double D = cell_D(m, phi, nb, cell, w, limiter), a = 2.0 * D / h;
                 for (int f = 0; f < 6; f++) {
                     if (nb[f] != -1) continue;
-                    const double a = 2.0 * cell_D(m, phi, nb, cell, w, limiter) / h;
                     const double in4 = m->jin ? 4.0 * m->jin[f * n + w] : 0.0;
-                    out[f] += (phi[cell * n + w] - in4) * a / (2.0 * a + 1.0) * h * h;
+                    const double src = q->Q1 ? (f & 1 ? 3.0 : -3.0) * D * q->Q1[(cell * n + w) * 3 + f / 2] : 0.0;
+                    out[f] += ((phi[cell * n + w] - in4) * a + src) / (2.0 * a + 1.0) * h * h;
                 }
             }
 }
 
-void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, float *J,
-                        int threads)
+void atmos__lfield_flux(const atmos__lmedium *m, const atmos__lsource *q, const float *phi,
+                        const atmos__ldiffusion_opts *o, float *J, int threads)
 {
     const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2], limiter = o ? o->limiter : 0;
 #pragma omp parallel for schedule(static) num_threads(threads)
@@ -214,7 +235,8 @@ void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__
                     const double D = cell_D(m, phi, nb, cell, w, limiter);
                     for (int a = 0; a < 3; a++) {
                         const double d = cell_grad(m, phi, nb, cell, w, a);
-                        J[(cell * n + w) * 3 + a] = (float)(-D * d);
+                        const double src = q->Q1 ? 3.0 * D * q->Q1[(cell * n + w) * 3 + a] : 0.0;
+                        J[(cell * n + w) * 3 + a] = (float)(-D * d + src);
                     }
                 }
             }

@@ -104,17 +104,27 @@ static inline void atmos__lfield_sample(const atmos__lfield *f, const float *arr
 
 /* The forward-lobe model's kept fraction: the share F of the light scattered at cell `cell`
  * (wavelength w) that stays in the forward beam when the light has been scattered n times
- * before (Riley's F_{n+1}, Eq. 23; 0: all of it leaves the beam). */
-typedef float (*atmos__lkeep_fn)(const void *user, size_t cell, int w, float n);
+ * before (Riley's F_{n+1}, Eq. 23; 0: all of it leaves the beam), and in *mu the mean cosine,
+ * to the beam's direction of travel, of the dropped rest 1 - F (the diffuse source's
+ * direction; 0: isotropic). */
+typedef float (*atmos__lkeep_fn)(const void *user, size_t cell, int w, float n, float *mu);
 
 /* The source of the diffuse field (sun_source.c): per cell and wavelength the power per unit
  * volume, W m^-3 nm^-1, that the forward beam loses to scattering out of its lobe,
- * sig_s (1 - F) I, where I is the forward beam arriving at the cell's centre from the sun
+ * Q = sig_s (1 - F) I, where I is the forward beam arriving at the cell's centre from the sun
  * (travel direction lt, a unit vector in the field's frame; sun[w] its irradiance where it
  * enters the grid) attenuated by sig_t - sig_s F along the way, the scattering count growing
- * by sig_s ds (mean over wavelengths, Riley's Eq. 21). Ibeam (may be NULL) gets I. */
+ * by sig_s ds (mean over wavelengths, Riley's Eq. 21). Q1 (may be NULL) gets the source's
+ * first moment, [(cell * n + w) * 3 + axis] = Q mu lt (W m^-3 nm^-1): the dropped light's net
+ * direction. Ibeam (may be NULL) gets I. */
 void atmos__lfield_sun_source(const atmos__lmedium *m, const double lt[3], const double *sun, atmos__lkeep_fn keep,
-                              const void *user, float *Q, float *Ibeam, int threads);
+                              const void *user, float *Q, float *Q1, float *Ibeam, int threads);
+
+/* A source of the diffuse field: per cell and wavelength its power per unit volume Q
+ * ([cell * n + w]) and its first moment Q1 ([(cell * n + w) * 3 + axis], NULL: isotropic). */
+typedef struct {
+    const float *Q, *Q1;
+} atmos__lsource;
 
 typedef struct {
     int max_sweeps; /* 0: 2000 */
@@ -122,19 +132,20 @@ typedef struct {
     int limiter;    /* 1: flux-limited diffusion coefficient (Levermore-Pomraning sum limiter) */
 } atmos__ldiffusion_opts;
 
-/* Solves -div(D grad phi) + sig_a phi = Q on the medium's grid (diffusion.c), D =
+/* Solves -div(D grad phi) + sig_a phi = Q - div(3 D Q1) on the medium's grid (diffusion.c), D =
  * 1/(3 sig_tr [+ |grad phi|/phi]), sig_tr = sig_t - g sig_s (the delta-Eddington /
  * similarity-scaled transport extinction), vacuum (Marshak) boundaries on the non-periodic
  * faces; phi holds the warm start on entry. Returns the sweeps used. */
-int atmos__lfield_diffuse(const atmos__lmedium *m, const float *Q, float *phi, const atmos__ldiffusion_opts *o,
+int atmos__lfield_diffuse(const atmos__lmedium *m, const atmos__lsource *q, float *phi, const atmos__ldiffusion_opts *o,
                           int threads);
 
-/* The net power leaving through each of the six faces (-x, +x, -y,
- * +y, -z, +z), (outgoing minus the incoming jin), summed over the face's cells, of wavelength w: out[6], W nm^-1. */
-void atmos__lfield_leak(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, int w,
-                        double out[6]);
-/* The net flux J = -D grad phi of the solution (central differences), [(cell * n + w) * 3 + a]. */
-void atmos__lfield_flux(const atmos__lmedium *m, const float *phi, const atmos__ldiffusion_opts *o, float *J,
-                        int threads);
+/* The net power leaving through each of the six faces (-x, +x, -y, +y, -z, +z), (outgoing
+ * minus the incoming jin), summed over the face's cells, of wavelength w: out[6], W nm^-1. */
+void atmos__lfield_leak(const atmos__lmedium *m, const atmos__lsource *q, const float *phi,
+                        const atmos__ldiffusion_opts *o, int w, double out[6]);
+/* The net flux J = -D grad phi + 3 D Q1 of the solution (central differences),
+ * [(cell * n + w) * 3 + a]. */
+void atmos__lfield_flux(const atmos__lmedium *m, const atmos__lsource *q, const float *phi,
+                        const atmos__ldiffusion_opts *o, float *J, int threads);
 
 #endif

@@ -7,7 +7,9 @@
  * scattered sideways and back. That light does not leave a conservative cloud: it is the
  * source of the diffuse field. The beam is marched here on the field's own grid, from each
  * cell's centre back toward the sun in steps of h/2 (the cell of each step's midpoint), then
- * integrated forward so that the scattering count n grows from where the light entered. */
+ * integrated forward so that the scattering count n grows from where the light entered.
+ * The dropped light goes back (the forward model keeps the forward hemisphere): its first
+ * moment, Q times the mean cosine of the dropped part along the beam, tells the diffusion so. */
 #include "light/lfield.h"
 
 #include <math.h>
@@ -44,7 +46,7 @@ static int beam_cells(const atmos__lmedium *m, const double lt[3], int i, int j,
 }
 
 void atmos__lfield_sun_source(const atmos__lmedium *m, const double lt[3], const double *sun, atmos__lkeep_fn keep,
-                              const void *user, float *Q, float *Ibeam, int threads)
+                              const void *user, float *Q, float *Q1, float *Ibeam, int threads)
 {
     const int n = m->n;
     const size_t cells = atmos__lmedium_cells(m);
@@ -70,7 +72,8 @@ void atmos__lfield_sun_source(const atmos__lmedium *m, const double lt[3], const
                 double dn = 0;
                 for (int w = 0; w < n; w++) {
                     const double st = m->sig_t[q * n + w], ss = m->sig_s[q * n + w];
-                    const double F = ss > 0 ? keep(user, q, w, (float)nsc + 1.0f) : 0.0;
+                    float mu;
+                    const double F = ss > 0 ? keep(user, q, w, (float)nsc + 1.0f, &mu) : 0.0;
                     I[w] *= exp(-(st - ss * F) * len);
                     dn += ss * len;
                 }
@@ -78,11 +81,16 @@ void atmos__lfield_sun_source(const atmos__lmedium *m, const double lt[3], const
             }
             for (int w = 0; w < n; w++) {
                 const double ss = m->sig_s[cell * n + w];
-                const double F = ss > 0 ? keep(user, cell, w, (float)nsc + 1.0f) : 0.0;
-                Q[cell * n + w] = (float)(ss * (1.0 - F) * I[w] * sun[w]);
+                float mu = 0.0f;
+                const double F = ss > 0 ? keep(user, cell, w, (float)nsc + 1.0f, &mu) : 0.0;
+                const double q = ss * (1.0 - F) * I[w] * sun[w];
+                Q[cell * n + w] = (float)q;
+                if (Q1)
+                    for (int a = 0; a < 3; a++) Q1[(cell * n + w) * 3 + a] = (float)(q * mu * lt[a]);
                 if (Ibeam) Ibeam[cell * n + w] = (float)(I[w] * sun[w]);
             }
         }
         free(path);
     }
 }
+

@@ -13,19 +13,33 @@
 
 #define FIELD_CELLS_MAX 40 /* the field's grid has at most about this many cells per axis */
 
-/* Riley's kept share F_{n+1} at a cell: the fields' F tables mixed by their scattering. */
-static float field_keep(const void *user, size_t cell, int w, float n)
+/* Riley's kept share F_{n+1} at a cell: the fields' F tables mixed by their scattering; *mu
+ * the mean cosine of the dropped rest. The beam keeps F as if it went straight on (first
+ * moment F); a scattering by a phase function of asymmetry g gives the light the moment g, so
+ * the dropped rest carries g - F: mu = (g - F)/(1 - F), backward where F > g (the first
+ * orders), forward where F -> 1/2 < g (deep inside). It is held between the mean cosine of the
+ * backward hemisphere of Ams_{n+1} (the part the forward model drops) and 1. The fields' mu
+ * are mixed by what each drops. Measured against the mean cosine of the backward hemisphere
+ * alone and an isotropic source in docs/lightfield.md. */
+static float field_keep(const void *user, size_t cell, int w, float n, float *mu)
 {
     const atmos__slice_plan *sp = user;
     const int nf = sp->nf;
     const float *d = sp->fdens + cell * (size_t)nf;
-    float num = 0, den = 0;
+    float num = 0, den = 0, mnum = 0, mden = 0;
     for (int f = 0; f < nf; f++) {
         const float bs = d[f] * sp->tab.sca[f][w];
         if (!(bs > 0.0f)) continue;
-        num += bs * order_lerp(sp->tab.F[f] + (size_t)w * (SLICE_F_ORDERS + 1), n, 0);
+        const size_t row = (size_t)w * (SLICE_F_ORDERS + 1);
+        const float F = order_lerp(sp->tab.F[f] + row, n, 0), drop = bs * (1.0f - F);
+        num += bs * F;
         den += bs;
+        if (!(drop > 0.0f)) continue;
+        const float lo = order_lerp(sp->tab.B[f] + row, n, 0), m = (sp->fg[f][w] - F) / (1.0f - F);
+        mnum += drop * (m < lo ? lo : (m > 1.0f ? 1.0f : m));
+        mden += drop;
     }
+    *mu = mden > 0.0f ? mnum / mden : 0.0f;
     return den > 0.0f ? num / den : 0.0f;
 }
 
@@ -128,7 +142,7 @@ atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp
     const int threads = atmos__threads(ctx), n = sp->n;
     const sgrid *g = &sp->g;
     const size_t cnt = atmos__lmedium_cells(&sp->fmed) * (size_t)n;
-    float *Q = malloc(sizeof(float) * cnt);
+    float *Q = malloc(sizeof(float) * cnt * 4), *Q1 = Q + cnt;
     if (!Q) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
     double sun_g[3], lt[3], sl[ATMOS_MAX_WAVELENGTHS], cen[3], cw[3];
     atmos__vol_dir_to_frame(&sp->x, sun_w, sun_g);
@@ -137,17 +151,21 @@ atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp
      * differ by the air's attenuation across the box) */
     atmos__vol_frame_to_point(&sp->x, cen, cw);
     atmos_atmosphere_sunlight(atm, cw, sun_w, sl);
-    atmos__lfield_sun_source(&sp->fmed, lt, sl, field_keep, sp, Q, NULL, threads);
+    atmos__lfield_sun_source(&sp->fmed, lt, sl, field_keep, sp, Q, Q1, NULL, threads);
+    const atmos__lsource src = {Q, Q1};
     field_sky(sp, atm, cw, sun_w);
     const double t1 = atmos__now();
     atmos__ldiffusion_opts o = {0};
     o.limiter = 1; /* measured better than without (docs/lightfield.md) */
-    fl->sweeps = atmos__lfield_diffuse(&sp->fmed, Q, fl->phi, &o, threads);
-    free(Q);
-    if (fl->sweeps < 0) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffusion solve");
+    fl->sweeps = atmos__lfield_diffuse(&sp->fmed, &src, fl->phi, &o, threads);
+    if (fl->sweeps < 0) {
+        free(Q);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffusion solve");
+    }
     const float inv4pi = (float)(1.0 / (4.0 * 3.14159265358979323846));
+    atmos__lfield_flux(&sp->fmed, &src, fl->phi, &o, fl->J, threads);
     for (size_t i = 0; i < cnt; i++) fl->L[i] = fl->phi[i] * inv4pi;
-    atmos__lfield_flux(&sp->fmed, fl->phi, &o, fl->J, threads);
+    free(Q);
     memcpy(fl->sun, sun_w, sizeof fl->sun);
     fl->valid = 1;
     *built = 1;

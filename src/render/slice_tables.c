@@ -1,5 +1,6 @@
 /* The slice renderer's optics tables (slice_tables.h): sigma_ext and albedo per field and
- * wavelength, Ams_n in a layout the eye pass reads in two cache lines, F_n and S(n). */
+ * wavelength, Ams_n in a layout the eye pass reads in two cache lines, F_n, S(n) and the
+ * backward hemisphere's mean cosine. */
 #include "optics/angle_table.h"
 #include "render/slice_internal.h"
 
@@ -9,7 +10,25 @@
 
 void atmos__stables_free(stables *t)
 {
-    for (int f = 0; f < ATMOS_VOLUME_MAX_FIELDS; f++) free(t->ams[f]), free(t->F[f]), free(t->S[f]);
+    for (int f = 0; f < ATMOS_VOLUME_MAX_FIELDS; f++) free(t->ams[f]), free(t->F[f]), free(t->S[f]), free(t->B[f]);
+}
+
+/* The mean cosine of a phase function (values p on the angle grid th, degrees) over the
+ * backward hemisphere, int p mu dOmega / int p dOmega over theta > 90 degrees (trapezoids in
+ * theta, the interval across 90 degrees cut there). */
+static double back_mean_cosine(const double *th, const double *p, int ng)
+{
+    double num = 0, den = 0;
+    for (int a = 0; a + 1 < ng; a++) {
+        if (th[a + 1] <= 90.0) continue;
+        const double t0 = th[a] > 90.0 ? th[a] : 90.0, t1 = th[a + 1];
+        const double p0 = p[a] + (p[a + 1] - p[a]) * (t0 - th[a]) / (th[a + 1] - th[a]), p1 = p[a + 1];
+        const double s0 = sin(t0 * ATMOS_DEG2RAD), s1 = sin(t1 * ATMOS_DEG2RAD), dt = (t1 - t0) * ATMOS_DEG2RAD;
+        const double c0 = cos(t0 * ATMOS_DEG2RAD), c1 = cos(t1 * ATMOS_DEG2RAD);
+        den += 0.5 * dt * (p0 * s0 + p1 * s1);
+        num += 0.5 * dt * (p0 * s0 * c0 + p1 * s1 * c1);
+    }
+    return den > 0 ? num / den : -0.5;
 }
 
 atmos_status atmos__stables_build(atmos_context *ctx, const atmos_volume_optics *o, int n, int max_order, stables *t)
@@ -32,7 +51,8 @@ atmos_status atmos__stables_build(atmos_context *ctx, const atmos_volume_optics 
         t->ams[f] = calloc((size_t)n * ng * t->no + 4, sizeof(float));
         t->F[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
         t->S[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
-        if (!t->ams[f] || !t->F[f] || !t->S[f]) {
+        t->B[f] = malloc(sizeof(float) * (size_t)n * (SLICE_F_ORDERS + 1));
+        if (!t->ams[f] || !t->F[f] || !t->S[f] || !t->B[f]) {
             atmos__stables_free(t);
             return atmos__error(ctx, ATMOS_E_NOMEM, "slice: out of memory for Ams tables");
         }
@@ -51,6 +71,8 @@ atmos_status atmos__stables_build(atmos_context *ctx, const atmos_volume_optics 
             for (int i = 0; i <= SLICE_F_ORDERS; i++) {
                 t->F[f][(size_t)k * (SLICE_F_ORDERS + 1) + i] = (float)atmos_msphase_forward(m, k, i);
                 t->S[f][(size_t)k * (SLICE_F_ORDERS + 1) + i] = (float)atmos_msphase_log_forward_sum(m, k, i);
+                const double *v = i >= 1 && i <= mo ? atmos_msphase_values(m, k, i) : NULL;
+                t->B[f][(size_t)k * (SLICE_F_ORDERS + 1) + i] = (float)(v ? back_mean_cosine(t->grid[f], v, ng) : -0.5);
             }
         }
     }

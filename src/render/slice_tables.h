@@ -20,6 +20,9 @@ typedef struct {
                                                      fall in two cache lines */
     float *F[ATMOS_VOLUME_MAX_FIELDS];            /* [k * (SLICE_F_ORDERS+1) + n]: F_n (Eq. 23) */
     float *S[ATMOS_VOLUME_MAX_FIELDS];            /* same layout: S(n) = sum_{i<=n} ln F_i */
+    float *B[ATMOS_VOLUME_MAX_FIELDS];            /* same layout: the mean cosine of Ams_n over the
+                                                     backward hemisphere, the part 1 - F_n that the
+                                                     forward model drops (-1/2 where isotropic) */
 } stables;
 
 /* The tables of the volume's optics for n wavelengths, Ams orders 1..max_order. */

@@ -11,7 +11,14 @@
 
 typedef struct {
     double g;
+    int split; /* KEEP_ISO, KEEP_RILEY or KEEP_DE below */
 } hg_keep;
+
+enum {
+    KEEP_ISO,   /* Riley's F_n, the dropped light an isotropic source */
+    KEEP_RILEY, /* Riley's F_n, the dropped light with its first moment (as slice_field.c) */
+    KEEP_DE     /* delta-Eddington's split: f = g^2 kept, the rest of mean cosine g / (1 + g) */
+};
 
 /* forward-hemisphere fraction of HG(g): Ams_n of HG is HG(g^n), so F_n = fwd(g^n) */
 static double hg_forward(double g)
@@ -20,16 +27,33 @@ static double hg_forward(double g)
     return (1 + g) / (2 * g) - (1 - g * g) / (2 * g * sqrt(1 + g * g));
 }
 
-static float keep_hg(const void *user, size_t cell, int w, float n)
+/* mean cosine of HG(g) over the backward hemisphere (midpoint rule in mu) */
+static double hg_back_mu(double g)
+{
+    double num = 0, den = 0;
+    for (int i = 0; i < 400; i++) {
+        const double mu = -1.0 + (i + 0.5) / 400.0, p = (1 - g * g) / pow(1 + g * g - 2 * g * mu, 1.5);
+        num += p * mu, den += p;
+    }
+    return num / den;
+}
+
+static float keep_hg(const void *user, size_t cell, int w, float n, float *mu)
 {
     (void)cell, (void)w;
     const hg_keep *k = user;
-    return (float)hg_forward(pow(k->g, n));
+    if (k->split == KEEP_DE) {
+        *mu = (float)(k->g / (1 + k->g));
+        return (float)(k->g * k->g);
+    }
+    const double F = hg_forward(pow(k->g, n)), lo = hg_back_mu(pow(k->g, n)), m = (k->g - F) / (1 - F);
+    *mu = k->split == KEEP_RILEY ? (float)(m < lo ? lo : (m > 1 ? 1 : m)) : 0.0f;
+    return (float)F;
 }
 
 /* A slab of optical depth tau, 1 x 1 x nz cells (periodic across), sun at zenith angle th;
  * reflected and transmitted fluxes relative to the incident one. */
-static void slab_model(double tau, double g, double th_deg, int nz, int limiter, double *R, double *T)
+static void slab_model(double tau, double g, double th_deg, int nz, int limiter, int split, double *R, double *T)
 {
     atmos__lmedium m;
     const double h = 1.0, st = tau / (nz * h), mu0 = cos(th_deg * PI / 180);
@@ -37,34 +61,34 @@ static void slab_model(double tau, double g, double th_deg, int nz, int limiter,
     m.periodic[0] = m.periodic[1] = 1;
     for (int k = 0; k < nz; k++) m.sig_t[k] = (float)st, m.sig_s[k] = (float)st, m.g[k] = (float)g;
     const double lt[3] = {sin(th_deg * PI / 180), 0, -mu0}; /* the light travels down (-z) */
-    float *Q = calloc(nz, sizeof(float)), *Ib = calloc(nz, sizeof(float)), *phi = calloc(nz, sizeof(float));
+    float *Q = calloc(nz, sizeof(float)), *Q1 = calloc(nz * 3, sizeof(float)), *Ib = calloc(nz, sizeof(float)),
+          *phi = calloc(nz, sizeof(float));
     const double sun = 1.0;
-    hg_keep hk = {g};
-    atmos__lfield_sun_source(&m, lt, &sun, keep_hg, &hk, Q, Ib, 1);
+    hg_keep hk = {g, split};
+    atmos__lfield_sun_source(&m, lt, &sun, keep_hg, &hk, Q, Q1, Ib, 1);
+    const atmos__lsource src = {Q, split == KEEP_ISO ? NULL : Q1};
     atmos__ldiffusion_opts o = {.limiter = limiter, .tol = 1e-7, .max_sweeps = 20000};
-    atmos__lfield_diffuse(&m, Q, phi, &o, 1);
+    atmos__lfield_diffuse(&m, &src, phi, &o, 1);
     double leak[6];
-    atmos__lfield_leak(&m, phi, &o, 0, leak);
+    atmos__lfield_leak(&m, &src, phi, &o, 0, leak);
     /* the beam leaving the bottom: the last cell's, attenuated over the half cell below */
-    const double F = hg_forward(pow(g, st * nz * h / mu0 + 1.0));
+    const double F = split == KEEP_DE ? g * g : hg_forward(pow(g, st * nz * h / mu0 + 1.0));
     const double Ibot = Ib[0] * exp(-st * (1 - F) * 0.5 * h / mu0);
     *R = leak[5] / (h * h) / mu0;
     *T = (mu0 * Ibot + leak[4] / (h * h)) / mu0;
-    free(Q), free(Ib), free(phi);
+    free(Q), free(Q1), free(Ib), free(phi);
     atmos__lmedium_free(&m);
 }
 
-/* Reflected and transmitted flux of the slab against adding-doubling. The model's flux
- * errors, measured (64 cells, g 0.85; R, T model / adding-doubling; docs/lightfield.md):
- *   tau 1:  R 0.027 / 0.042, T 0.974 / 0.958 (sun 0);  R 0.069 / 0.165, T 0.932 / 0.835 (60)
- *   tau 4:  R 0.179 / 0.191, T 0.823 / 0.809;           R 0.391 / 0.416, T 0.612 / 0.584
- *   tau 16: R 0.606 / 0.557, T 0.407 / 0.443;           R 0.720 / 0.697, T 0.294 / 0.303
- * The dropped light enters the diffusion as an isotropic source although it was scattered
- * backward (too little reflection of thin slabs at low sun), and the diffusion reflects a
- * little too much of thick ones. The checks hold these (the issue's goal, 3 %, is not met):
- * energy is conserved (R + T = 1 in a conservative slab, to the discretisation), each flux
- * within 0.11 of adding-doubling and closer to it than the forward model alone (no
- * reflection at all, only the beam transmitted). */
+/* Reflected and transmitted flux of the slab against adding-doubling (64 cells, g 0.85; the
+ * figures in docs/lightfield.md). Energy is conserved in every split (R + T = 1 in a
+ * conservative slab, to the discretisation). The diffusion solve itself, fed delta-Eddington's
+ * split with the source's first moment, is within 0.03 (of the incident flux) of
+ * adding-doubling in all six slabs: the check of the anisotropic source term. Riley's split
+ * with the first moment (the slice renderer's) is within 0.03 with the sun at the zenith and
+ * in the thick slab, but its collimated forward lobe reflects too little of a low sun in thin
+ * slabs (0.09 against 0.16 at tau 1, 60 degrees): within 0.08 there, and nearer to
+ * adding-doubling than the isotropic source in the thick slab and the thin one with a high sun. */
 static void check_slab(void)
 {
     const double taus[3] = {1, 4, 16}, ths[2] = {0, 60}, g = 0.85;
@@ -74,17 +98,22 @@ static void check_slab(void)
             const double mu0 = cos(ths[b] * PI / 180);
             CHECK(ad_slab(taus[a], 1.0, g, mu0, 32, &r));
             const double Rad = r.refl, Tad = r.trans + exp(-taus[a] / mu0);
-            double R, T, Rl, Tl;
-            slab_model(taus[a], g, ths[b], 64, 0, &R, &T);
-            slab_model(taus[a], g, ths[b], 64, 1, &Rl, &Tl);
-            printf("tau %4.0f sun %2.0f: R %.4f T %.4f (sum %.4f) | limited R %.4f T %.4f | adding-doubling R %.4f "
-                   "T %.4f\n",
-                   taus[a], ths[b], R, T, R + T, Rl, Tl, Rad, Tad);
+            double R, T, Ri, Ti, Rd, Td;
+            slab_model(taus[a], g, ths[b], 64, 1, KEEP_RILEY, &R, &T);
+            slab_model(taus[a], g, ths[b], 64, 1, KEEP_ISO, &Ri, &Ti);
+            slab_model(taus[a], g, ths[b], 64, 1, KEEP_DE, &Rd, &Td);
+            printf("tau %4.0f sun %2.0f: R %.4f T %.4f (sum %.4f) | isotropic source R %.4f T %.4f | delta-Eddington R "
+                   "%.4f T %.4f | adding-doubling R %.4f T %.4f\n",
+                   taus[a], ths[b], R, T, R + T, Ri, Ti, Rd, Td, Rad, Tad);
             CHECK_NEAR(R + T, 1.0, 0.02);
-            CHECK_NEAR(Rl + Tl, 1.0, 0.02);
-            CHECK_NEAR(R, Rad, 0.11);
-            CHECK_NEAR(T, Tad, 0.11);
-            CHECK(fabs(R - Rad) < Rad); /* the forward model alone reflects nothing */
+            CHECK_NEAR(Ri + Ti, 1.0, 0.02);
+            CHECK_NEAR(Rd + Td, 1.0, 0.02);
+            CHECK_NEAR(Rd, Rad, 0.03);
+            CHECK_NEAR(Td, Tad, 0.03);
+            const double tol = ths[b] == 0 || taus[a] > 10 ? 0.03 : 0.08;
+            CHECK_NEAR(R, Rad, tol);
+            CHECK_NEAR(T, Tad, tol);
+            if (taus[a] > 10 || ths[b] == 0) CHECK(fabs(R - Rad) <= fabs(Ri - Rad) + 0.01);
         }
 }
 
@@ -108,20 +137,22 @@ static void check_closed_cloud(void)
                 }
             }
     const size_t cnt = (size_t)N * N * N * 2;
-    float *Q = calloc(cnt, sizeof(float)), *phi = calloc(cnt, sizeof(float)), *phi2 = calloc(cnt, sizeof(float));
+    float *Q = calloc(cnt, sizeof(float)), *Q1 = calloc(cnt * 3, sizeof(float)), *phi = calloc(cnt, sizeof(float)),
+          *phi2 = calloc(cnt, sizeof(float));
     const double sun[2] = {1, 2}, lt1[3] = {0.6, 0, -0.8}, lt0[3] = {0, 0, -1};
-    hg_keep hk = {0.85};
+    hg_keep hk = {0.85, KEEP_RILEY};
+    const atmos__lsource src = {Q, Q1};
     atmos__ldiffusion_opts o = {.tol = 1e-6, .max_sweeps = 20000};
     for (int lim = 0; lim < 2; lim++) {
         o.limiter = lim;
-        atmos__lfield_sun_source(&m, lt1, sun, keep_hg, &hk, Q, NULL, 2);
+        atmos__lfield_sun_source(&m, lt1, sun, keep_hg, &hk, Q, Q1, NULL, 2);
         memset(phi, 0, sizeof(float) * cnt);
-        const int sweeps = atmos__lfield_diffuse(&m, Q, phi, &o, 2);
+        const int sweeps = atmos__lfield_diffuse(&m, &src, phi, &o, 2);
         CHECK(sweeps > 0 && sweeps < 20000);
         for (int w = 0; w < 2; w++) {
             double in = 0, leak[6], out = 0;
             for (size_t c = 0; c < (size_t)N * N * N; c++) in += Q[c * 2 + w] * 1000.0;
-            atmos__lfield_leak(&m, phi, &o, w, leak);
+            atmos__lfield_leak(&m, &src, phi, &o, w, leak);
             for (int f = 0; f < 6; f++) out += leak[f];
             printf("closed cloud, limiter %d, g %.2f: dropped %.6g W, leaving %.6g W (%d sweeps)\n", lim,
                    w ? 0.85 : 0.5, in, out, sweeps);
@@ -129,15 +160,15 @@ static void check_closed_cloud(void)
             CHECK_REL(out, in, lim ? 0.03 : 0.01);
         }
         /* warm start from another sun's field, one thread: the same field to the tolerance */
-        atmos__lfield_sun_source(&m, lt0, sun, keep_hg, &hk, Q, NULL, 1);
-        atmos__lfield_diffuse(&m, Q, phi2, &o, 1);
-        atmos__lfield_sun_source(&m, lt1, sun, keep_hg, &hk, Q, NULL, 1);
-        atmos__lfield_diffuse(&m, Q, phi2, &o, 1);
+        atmos__lfield_sun_source(&m, lt0, sun, keep_hg, &hk, Q, Q1, NULL, 1);
+        atmos__lfield_diffuse(&m, &src, phi2, &o, 1);
+        atmos__lfield_sun_source(&m, lt1, sun, keep_hg, &hk, Q, Q1, NULL, 1);
+        atmos__lfield_diffuse(&m, &src, phi2, &o, 1);
         double top = 0, diff = 0;
         for (size_t c = 0; c < cnt; c++) top = fmax(top, phi[c]), diff = fmax(diff, fabs(phi[c] - phi2[c]));
         CHECK(diff <= 2e-3 * top);
     }
-    free(Q), free(phi), free(phi2);
+    free(Q), free(Q1), free(phi), free(phi2);
     atmos__lmedium_free(&m);
 }
 

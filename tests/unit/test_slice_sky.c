@@ -1,0 +1,133 @@
+/* Sky light alone (the sun off) on a thin cloud: the slice renderer with the diffuse light
+ * field against the path tracer. The sky is uniform (a vacuum atmosphere with a background
+ * radiance from every direction) and the sun's irradiance is zero, so the forward model's
+ * light buffer is dark and all the cloud's light is the sky's, which reaches it only through
+ * the field's boundary sources and diffusion. Without the field the cloud is a dark
+ * absorber in front of the sky; with it, it scatters the sky's light as the path tracer
+ * does. Albedo 0.9, so that the cloud is not simply as bright as the sky (a conservative
+ * cloud in a uniform sky is). Measured (256 paths per pixel): with the field bias +1.9 %,
+ * relative RMS 0.045; without it -35 % and 0.49. Small sizes (a 32^3 blob, 32 x 32 pixels)
+ * keep it fast. */
+#include "atmos/atmos.h"
+#include "test.h"
+#include "test_optics.h"
+
+#define N 32
+#define VOX 20.0
+#define W 32
+#define SKY 0.2 /* the sky's radiance, W m^-2 sr^-1 nm^-1 */
+
+static char cache_dir[1024];
+
+/* A Gaussian blob of peak density peak (m^-3), 640 m across, 1000 m north of the camera. */
+static atmos_volume *blob(atmos_context *ctx, float peak)
+{
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    vd.dims[0] = vd.dims[1] = vd.dims[2] = N;
+    vd.voxel_size_m = VOX;
+    vd.origin_m[0] = -N * VOX / 2, vd.origin_m[1] = 1500 - N * VOX / 2, vd.origin_m[2] = -1000 - N * VOX / 2;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    int f = -1;
+    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "cloud", &f));
+    static float buf[N * N * N];
+    for (int k = 0; k < N; k++)
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                const double x = (i + 0.5 - N / 2.0) / (N / 2.0), y = (j + 0.5 - N / 2.0) / (N / 2.0),
+                             z = (k + 0.5 - N / 2.0) / (N / 2.0), r2 = x * x + y * y + z * z;
+                buf[(k * N + j) * N + i] = r2 < 0.8 ? (float)(peak * exp(-4 * r2) * (0.8 - r2) / 0.8) : 0.0f;
+            }
+    int off[3] = {0, 0, 0}, size[3] = {N, N, N};
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    return v;
+}
+
+static void scene_for(atmos_scene *s)
+{
+    atmos_scene_defaults(s);
+    s->width = s->height = W;
+    double pos[3] = {0, 1500, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s->camera);
+    s->camera.look_at[0] = 0, s->camera.look_at[1] = 1500, s->camera.look_at[2] = -1000;
+    s->camera.fov_deg = 45;
+    s->sun.from_time = 0;
+    s->sun.elevation_deg = 40, s->sun.azimuth_deg = 150;
+    s->sun.irradiance_count = 1, s->sun.irradiance[0] = 0.0; /* the sun off */
+    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+    s->atmosphere.background_radiance = SKY;
+    s->wavelengths = ATMOS_WAVELENGTHS_RGB;
+}
+
+static atmos_image *slice(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *v,
+                          const atmos_volume_optics *o, int diffuse)
+{
+    atmos_scene s = *scene;
+    atmos_slice_settings ss;
+    atmos_slice_defaults(&ss);
+    ss.optics = o;
+    s.slice.light_size = 96;
+    s.slice.xi = 0; /* no ambient term: the sky's light is the field's alone */
+    s.slice.diffuse = diffuse;
+    atmos_image *img = NULL;
+    CHECK_MSG(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_OK, "slice: %s", atmos_context_error(ctx));
+    return img;
+}
+
+/* Over the cloud's pixels (where the path tracer's image differs from the sky by more than
+ * 1 %): the relative bias of img against ref and its relative RMS difference. */
+static void cloud_error(const atmos_image *img, const atmos_image *ref, const atmos_image *dark, double *bias,
+                        double *rms, int *pixels)
+{
+    double sd = 0, sr = 0, s2 = 0;
+    int cnt = 0;
+    for (int p = 0; p < W * W; p++) {
+        const double r = ref->pixels[p * 4 + 1], m = img->pixels[p * 4 + 1], d = dark->pixels[p * 4 + 1];
+        if (fabs(d - SKY) < 0.01 * SKY) continue; /* the cloud's pixels: where it dims the sky */
+        sd += m - r, sr += r, s2 += (m - r) * (m - r) / (r * r), cnt++;
+    }
+    *bias = cnt ? sd / sr : 0, *rms = cnt ? sqrt(s2 / cnt) : 0, *pixels = cnt;
+}
+
+int main(void)
+{
+    test_tmp_path(cache_dir, sizeof cache_dir, "cache");
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    d.threads = 2;
+    d.cache_dir = cache_dir;
+    d.log = NULL;
+    atmos_context *ctx = NULL;
+    if (atmos_context_create(&d, &ctx) != ATMOS_OK) return 1;
+    test_optics op;
+    test_hg_optics(ctx, "hg085", 0.85, 0.9, 1, &op);
+    /* peak 1.5e7 m^-3: optical depth ~2.7 through the centre, ~0.5 near the rim */
+    atmos_volume *v = blob(ctx, 1.5e7f);
+    atmos_scene s;
+    scene_for(&s);
+    s.samples_per_pixel = 1;
+    s.path.spp = 256;
+    atmos_path_settings ps;
+    atmos_path_defaults(&ps);
+    ps.optics = &op.o;
+    atmos_image *ref = NULL;
+    CHECK_OK(atmos_render_path(ctx, &s, v, &ps, &ref, NULL));
+    atmos_image *with = slice(ctx, &s, v, &op.o, 1), *without = slice(ctx, &s, v, &op.o, 0);
+    double bw, rw, bo, ro;
+    int nw, no;
+    cloud_error(with, ref, without, &bw, &rw, &nw);
+    cloud_error(without, ref, without, &bo, &ro, &no);
+    printf("sky alone, %d cloud pixels: with the field bias %+.2f %% rms %.3f; without bias %+.2f %% rms %.3f\n", nw,
+           100 * bw, rw, 100 * bo, ro);
+    CHECK(nw > 100);
+    CHECK(bo < -0.15); /* without the field the cloud is far too dark */
+    CHECK(fabs(bw) < 0.05);
+    CHECK(rw < 0.08);
+    atmos_image_destroy(ref), atmos_image_destroy(with), atmos_image_destroy(without);
+    atmos_volume_destroy(v);
+    test_optics_free(&op);
+    atmos_context_destroy(ctx);
+    return test_summary("test_slice_sky");
+}
