@@ -1,6 +1,7 @@
 #!/bin/sh
 # The accuracy report of docs/accuracy.md: the slice renderer (Riley et al. 2004 §4.2-§5)
-# in several variants against the path tracer as reference, on four volumes with the sun
+# in several variants, and Harris's particle renderer (harris: the sun and six sky lights;
+# harris_sun: the sun alone), against the path tracer as reference, on four volumes with the sun
 # behind the viewer and in front of it. Errors are split by the optical depth along each
 # pixel's ray (atmos render --tau, atmos compare --by).
 #
@@ -8,8 +9,8 @@
 #
 # Environment: ATMOS (the binary, default build/atmos), SPP (path samples per pixel,
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
-# CASES (default "cumulus cirrus rain disney"), VARIANTS (default all of the slice variants
-# below), THREADS.
+# CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
+# VARIANTS (default all of the slice variants below), THREADS.
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -50,6 +51,8 @@ for c in $CASES; do
             low_albedo) opts="--low-albedo" ;;
             diffuse) opts="--diffuse" ;;
             diffuse_xi0) opts="--diffuse --xi 0" ;;
+            harris) opts="--renderer harris" ;;
+            harris_sun) opts="--renderer harris --sky-lights 0" ;;
             esac
             "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
             "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \
