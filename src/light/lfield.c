@@ -24,7 +24,7 @@ int atmos__lfield_alloc(atmos__lfield *f, int kind, int cx, int cy, int cz, int 
 
 void atmos__lfield_free(atmos__lfield *f)
 {
-    free(f->L), free(f->phi), free(f->J), free(f->LA);
+    free(f->L), free(f->phi), free(f->J), free(f->LA), free(f->part);
     memset(f, 0, sizeof *f);
 }
 
