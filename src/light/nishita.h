@@ -30,6 +30,9 @@ typedef struct {
     double lt[3];            /* the sunlight's direction of travel (unit) */
     double ev[3];            /* the scattered light's direction of travel toward the eye (unit) */
     const double *sun;       /* the sunlight's irradiance entering the grid, per wavelength */
+    const float *E;          /* [cell * n + w] or NULL: the sunlight reaching each cell (a finer grid's
+                                mean over the cell weighted by the scattering); NULL: at the cell's centre,
+                                marched on the field's grid */
     const float *phase;      /* ATMOS__NISHITA_PHASE_N values of the patterns' phase function, sr^-1 */
     const double *sky;       /* [element * n + w]: I_l of Eq. 7 (the element's radiance integrated with the
                                 phase toward ev, W m^-2 sr^-1 nm^-1); NULL: no sky light */

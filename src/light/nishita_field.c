@@ -158,7 +158,8 @@ int atmos__nishita_solve(const atmos__nishita_in *in, int s, atmos__lfield *f, a
     st->pattern_s = atmos__now() - t0;
     if (ok) {
         t0 = atmos__now();
-        atmos__lfield_sun_source(m, in->lt, in->sun, no_keep, NULL, Q, Ec, in->threads);
+        if (in->E) memcpy(Ec, in->E, sizeof(float) * cells * n);
+        else atmos__lfield_sun_source(m, in->lt, in->sun, no_keep, NULL, Q, Ec, in->threads);
         const double to_sun[3] = {-in->lt[0], -in->lt[1], -in->lt[2]};
         if (t) ok = atmos__nishita_sky_attenuation(m, to_sun, t, in->threads);
         st->sky_s = atmos__now() - t0;

@@ -28,24 +28,6 @@ static double beam_spread(const float *ph)
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* Sub-voxels per edge of the cell at offset o: P's own cell and its neighbours finely, the
- * cells whose cone (seen from P) meets the beam spread around the sun's or the eye's
- * direction by 4, the rest by 2. */
-static int subdivision(const int o[3], const double lt[3], const double ev[3], double tb_deg)
-{
-    int a = abs(o[0]);
-    if (abs(o[1]) > a) a = abs(o[1]);
-    if (abs(o[2]) > a) a = abs(o[2]);
-    if (a == 0) return SELF_SUB;
-    if (a == 1) return 6;
-    const double len = sqrt((double)o[0] * o[0] + (double)o[1] * o[1] + (double)o[2] * o[2]);
-    const double u[3] = {-o[0] / len, -o[1] / len, -o[2] / len};
-    const double half = asin(fmin(1.0, 0.87 / len)) * 180.0 / PI;
-    const double a1 = acos(fmax(-1.0, fmin(1.0, dot3(lt, u)))) * 180.0 / PI;
-    const double a2 = acos(fmax(-1.0, fmin(1.0, dot3(u, ev)))) * 180.0 / PI;
-    return a1 < tb_deg + half || a2 < tb_deg + half ? 4 : 2;
-}
-
 /* int over the cell at offset o (cells; P's centre at the origin) of p(din . u) p(u . dout) /
  * |x|^2 dV, u the direction of x -> P (sign -1) or P -> x (sign +1), on m^3 sub-voxels; the
  * weighted mean |x| in *r. */
@@ -141,23 +123,110 @@ static int max_abs(const int o[3])
     return abs(o[2]) > a ? abs(o[2]) : a;
 }
 
-/* Order 2: one path per cell of the sample space. */
+/* Directions of travel u into P with their solid angles, a partition of the sphere: cones of
+ * CONE_DEG around the sunlight's direction and around the eye's (rings finer toward the axis:
+ * the beam spread of a droplet's phase function is a few degrees), the rest on a Fibonacci
+ * lattice. */
+#define CONE_DEG 15.0
+#define CONE_RINGS 60
+#define CONE_AZ 48
+#define LATTICE 16000
+typedef struct {
+    double u[3], dw;
+} dirw;
+
+static void basis(const double a[3], double e1[3], double e2[3])
+{
+    const double t[3] = {fabs(a[0]) < 0.9 ? 1.0 : 0.0, fabs(a[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    e1[0] = a[1] * t[2] - a[2] * t[1], e1[1] = a[2] * t[0] - a[0] * t[2], e1[2] = a[0] * t[1] - a[1] * t[0];
+    const double l = sqrt(dot3(e1, e1));
+    for (int i = 0; i < 3; i++) e1[i] /= l;
+    e2[0] = a[1] * e1[2] - a[2] * e1[1], e2[1] = a[2] * e1[0] - a[0] * e1[2], e2[2] = a[0] * e1[1] - a[1] * e1[0];
+}
+
+/* The cone's directions around axis a (skip: inside the cone around axis b, if b). */
+static int cone(const double a[3], const double *b, dirw *d)
+{
+    double e1[3], e2[3];
+    basis(a, e1, e2);
+    const double tc = CONE_DEG * PI / 180, cc = cos(tc);
+    int n = 0;
+    for (int i = 0; i < CONE_RINGS; i++) {
+        const double t0 = tc * (double)i * i / (CONE_RINGS * CONE_RINGS), t1 = tc * (double)(i + 1) * (i + 1) / (CONE_RINGS * CONE_RINGS);
+        const double tm = 0.5 * (t0 + t1), dw = (cos(t0) - cos(t1)) * 2 * PI / CONE_AZ;
+        for (int j = 0; j < CONE_AZ; j++) {
+            const double ph = 2 * PI * (j + 0.5) / CONE_AZ, s = sin(tm);
+            dirw *q = d + n;
+            for (int k = 0; k < 3; k++) q->u[k] = cos(tm) * a[k] + s * (cos(ph) * e1[k] + sin(ph) * e2[k]);
+            if (b && dot3(q->u, b) >= cc) continue;
+            q->dw = dw, n++;
+        }
+    }
+    return n;
+}
+
+static int direction_set(const double lt[3], const double ev[3], dirw *d)
+{
+    int n = cone(lt, NULL, d);
+    n += cone(ev, lt, d + n);
+    double used = 0;
+    for (int i = 0; i < n; i++) used += d[i].dw;
+    const int n0 = n;
+    const double cc = cos(CONE_DEG * PI / 180), ga = PI * (3.0 - sqrt(5.0));
+    for (int i = 0; i < LATTICE; i++) {
+        const double z = 1.0 - (2.0 * i + 1.0) / LATTICE, r = sqrt(1.0 - z * z), ph = ga * i;
+        dirw *q = d + n;
+        q->u[0] = r * cos(ph), q->u[1] = z, q->u[2] = r * sin(ph);
+        if (dot3(q->u, lt) >= cc || dot3(q->u, ev) >= cc) continue;
+        n++;
+    }
+    for (int i = n0; i < n; i++) d[i].dw = (4 * PI - used) / (n - n0);
+    return n;
+}
+
+/* Order 2: the phase-weighted form factor of every cell of the sample space, integrated in
+ * directions (the set above) and exactly along each direction: from P's centre back along
+ * the light's path, each cell crossed gets p(theta1) p(theta2) dOmega times the length
+ * crossed (cells; dV / r^2 = dOmega dr), and its weighted mean distance. */
+static void form_factors(const atmos__nishita_in *in, const dirw *d, int nd, int R, double *w, double *wr)
+{
+    const int side = 2 * R + 1;
+    for (int e = 0; e < nd; e++) {
+        const double *u = d[e].u;
+        const double k = d[e].dw * atmos__nishita_phase(in->phase, dot3(in->lt, u)) *
+                         atmos__nishita_phase(in->phase, dot3(u, in->ev));
+        const double v[3] = {-u[0], -u[1], -u[2]};
+        int c[3] = {0, 0, 0};
+        double t = 0, tn[3], dtn[3];
+        for (int a = 0; a < 3; a++) {
+            dtn[a] = v[a] != 0 ? 1.0 / fabs(v[a]) : 1e300;
+            tn[a] = v[a] != 0 ? 0.5 / fabs(v[a]) : 1e300;
+        }
+        for (;;) {
+            const int a = tn[0] < tn[1] ? (tn[0] < tn[2] ? 0 : 2) : (tn[1] < tn[2] ? 1 : 2);
+            const double t1 = tn[a];
+            const size_t i = ((size_t)(c[2] + R) * side + (c[1] + R)) * side + (c[0] + R);
+            w[i] += k * (t1 - t), wr[i] += k * (t1 - t) * 0.5 * (t + t1);
+            t = t1, tn[a] += dtn[a];
+            c[a] += v[a] > 0 ? 1 : -1;
+            if (abs(c[a]) > R) break;
+        }
+    }
+}
+
 static int pattern2(const atmos__nishita_in *in, double st, double ss, atmos__nishita_pattern *p)
 {
     const int R = in->radius2, side = 2 * R + 1, N = side * side * side;
     const double h = in->m->h;
-    float *c = malloc(sizeof(float) * N), *w = malloc(sizeof(float) * N), *r = malloc(sizeof(float) * N);
-    int ok = c && w && r;
+    float *c = malloc(sizeof(float) * N);
+    double *w = calloc((size_t)N, sizeof(double)), *wr = calloc((size_t)N, sizeof(double));
+    dirw *d = malloc(sizeof(dirw) * (2 * CONE_RINGS * CONE_AZ + LATTICE));
+    int ok = c && w && wr && d;
     if (ok) {
-#pragma omp parallel for schedule(dynamic, 16) num_threads(in->threads)
+        form_factors(in, d, direction_set(in->lt, in->ev, d), R, w, wr);
         for (int i = 0; i < N; i++) {
-            int o[3];
-            double rr;
-            decode(i, R, o);
-            const int m = subdivision(o, in->lt, in->ev, p->theta_b_deg);
-            w[i] = (float)cell_integral(in->phase, o, m, -1, in->lt, in->ev, &rr);
-            r[i] = (float)rr;
-            c[i] = (float)(w[i] * h * ss * exp(-st * rr * h));
+            wr[i] = w[i] > 0 ? wr[i] / w[i] : 0;
+            c[i] = (float)(w[i] * h * ss * exp(-st * wr[i] * h));
         }
         int *keep = NULL;
         const int n = select_paths(c, N, in->ratio, &keep, &p->kept2);
@@ -169,31 +238,68 @@ static int pattern2(const atmos__nishita_in *in, double st, double ss, atmos__ni
             int o[3];
             decode(keep[e], R, o);
             for (int a = 0; a < 3; a++) p->o2[3 * e + a] = (int16_t)o[a];
-            p->w2[e] = w[keep[e]], p->r2[e] = r[keep[e]];
+            p->w2[e] = (float)w[keep[e]], p->r2[e] = (float)wr[keep[e]];
             if (max_abs(o) > p->box2) p->box2 = max_abs(o);
         }
         p->n2 = ok ? n : 0;
         free(keep);
     }
-    free(c), free(w), free(r);
+    free(c), free(w), free(wr), free(d);
     return ok;
 }
 
 /* The order-3 sample space's shared factors: the unit directions and lengths of the offsets,
  * the legs inside one cell (sub-voxels: S(din, dout) = int p p / r^2 dV over the cell). */
+#define SMOOTH_LEVELS 24  /* leg lengths 1 .. 24 cells */
+#define SMOOTH_N 721      /* theta = 0, 0.25, ..., 180 degrees */
 typedef struct {
     const atmos__nishita_in *in;
     int R, N;
+    float *smooth;  /* [level * SMOOTH_N + i]: the phase averaged over the cone a cell subtends at the
+                       leg's length (level + 1 cells): a leg between two cells' centres stands for
+                       every direction between their volumes, and a droplet's forward peak is
+                       narrower than that cone */
     double *S_kj; /* [q]: first and second scattering in one cell, then on toward P from offset q */
     double *S_jP; /* [q]: from offset q into P's cell, scattered there once more, then to P */
     double S00, K0, rself;
 } space3;
 
+/* The phase averaged over a cap of angular radius alpha around the direction at theta_i. */
+static void smooth_table(const float *ph, double alpha, float *out)
+{
+    enum { RINGS = 12, AZ = 16 };
+    const double ca = cos(alpha);
+    for (int i = 0; i < SMOOTH_N; i++) {
+        const double th = i * 0.25 * PI / 180, a[3] = {sin(th), 0, cos(th)};
+        double e1[3] = {cos(th), 0, -sin(th)}, e2[3] = {0, 1, 0}, acc = 0;
+        for (int r = 0; r < RINGS; r++) {
+            const double c = 1.0 - (r + 0.5) / RINGS * (1.0 - ca), sn = sqrt(fmax(0.0, 1.0 - c * c));
+            for (int z = 0; z < AZ; z++) {
+                const double phi = 2 * PI * (z + 0.5) / AZ;
+                acc += atmos__nishita_phase(ph, c * a[2] + sn * (cos(phi) * e1[2] + sin(phi) * e2[2]));
+            }
+        }
+        out[i] = (float)(acc / (RINGS * AZ));
+    }
+}
+
+/* The smoothed phase for a leg of length len (cells) at cos(theta) mu. */
+static double leg_phase(const space3 *s, double len, double mu)
+{
+    int l = (int)(len + 0.5) - 1;
+    l = l < 0 ? 0 : (l >= SMOOTH_LEVELS ? SMOOTH_LEVELS - 1 : l);
+    mu = mu > 1.0 ? 1.0 : (mu < -1.0 ? -1.0 : mu);
+    const double x = acos(mu) * (720.0 / PI);
+    int i = (int)x;
+    if (i > SMOOTH_N - 2) i = SMOOTH_N - 2;
+    const float *t = s->smooth + (size_t)l * SMOOTH_N;
+    return t[i] + (x - i) * (t[i + 1] - t[i]);
+}
+
 /* Weight (cells^-2 times the phase functions) and leg lengths of the path with its second
  * scattering at offset index jj from P and its first at offset index kk from that. */
 static double path3(const space3 *s, int jj, int kk, double *l1, double *l2)
 {
-    const float *ph = s->in->phase;
     int j[3], d[3];
     decode(jj, s->R, j), decode(kk, s->R, d);
     const double lj = sqrt((double)j[0] * j[0] + (double)j[1] * j[1] + (double)j[2] * j[2]);
@@ -205,16 +311,16 @@ static double path3(const space3 *s, int jj, int kk, double *l1, double *l2)
     const double b[3] = {lj > 0 ? -j[0] / lj : 0, lj > 0 ? -j[1] / lj : 0, lj > 0 ? -j[2] / lj : 0};
     if (ld == 0) { /* k in j's cell */
         *l1 = s->rself, *l2 = lj;
-        return s->S_kj[jj] * atmos__nishita_phase(ph, dot3(b, s->in->ev)) / (lj * lj);
+        return s->S_kj[jj] * leg_phase(s, lj, dot3(b, s->in->ev)) / (lj * lj);
     }
     const double a[3] = {-d[0] / ld, -d[1] / ld, -d[2] / ld};
-    const double pa = atmos__nishita_phase(ph, dot3(s->in->lt, a)) / (ld * ld);
+    const double pa = leg_phase(s, ld, dot3(s->in->lt, a)) / (ld * ld);
     if (lj == 0) { /* j in P's cell: its leg to P inside the cell */
         *l1 = ld, *l2 = s->rself;
         return pa * s->S_jP[kk];
     }
     *l1 = ld, *l2 = lj;
-    return pa * atmos__nishita_phase(ph, dot3(a, b)) * atmos__nishita_phase(ph, dot3(b, s->in->ev)) / (lj * lj);
+    return pa * leg_phase(s, ld < lj ? ld : lj, dot3(a, b)) * leg_phase(s, lj, dot3(b, s->in->ev)) / (lj * lj);
 }
 
 static int space3_init(const atmos__nishita_in *in, space3 *s)
@@ -223,7 +329,10 @@ static int space3_init(const atmos__nishita_in *in, space3 *s)
     s->in = in, s->R = R, s->N = side * side * side;
     s->S_kj = calloc((size_t)s->N, sizeof(double));
     s->S_jP = calloc((size_t)s->N, sizeof(double));
-    if (!s->S_kj || !s->S_jP) return 0;
+    s->smooth = malloc(sizeof(float) * SMOOTH_LEVELS * SMOOTH_N);
+    if (!s->S_kj || !s->S_jP || !s->smooth) return 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(in->threads)
+    for (int l = 0; l < SMOOTH_LEVELS; l++) smooth_table(in->phase, atan(0.62 / (l + 1)), s->smooth + (size_t)l * SMOOTH_N);
     const int z[3] = {0, 0, 0};
     s->S00 = cell_integral(in->phase, z, SELF_SUB, 1, in->lt, in->ev, &s->rself);
     s->K0 = 0;
@@ -287,7 +396,7 @@ static int pattern3(const atmos__nishita_in *in, double st, double ss, atmos__ni
         p->space3 = NN;
         free(keep);
     }
-    free(c), free(s.S_kj), free(s.S_jP);
+    free(c), free(s.S_kj), free(s.S_jP), free(s.smooth);
     return ok;
 }
 

@@ -75,12 +75,13 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
     if ((st = atmos_scene_wavelengths(ctx, scene, &p->wl)) != ATMOS_OK) goto fail;
     if ((st = atmos_scene_atmosphere_create(ctx, scene, &p->wl, &p->atm)) != ATMOS_OK) goto fail;
     if ((st = plan_volume(p, volume, &d)) != ATMOS_OK) goto fail;
-    if (p->renderer == ATMOS_RENDERER_SLICE && !p->volume) {
-        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the slice renderer needs a volume");
+    if ((p->renderer == ATMOS_RENDERER_SLICE || p->renderer == ATMOS_RENDERER_NISHITA) && !p->volume) {
+        st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the %s renderer needs a volume", atmos_renderer_name(p->renderer));
         goto fail;
     }
     if (p->renderer == ATMOS_RENDERER_SLICE) st = atmos__slice_plan_create(p, &p->slice);
     else if (p->renderer == ATMOS_RENDERER_PATH) st = atmos__path_plan_create(p, &p->path);
+    else if (p->renderer == ATMOS_RENDERER_NISHITA) st = atmos__nishita_plan_create(p, &p->nishita);
     if (st != ATMOS_OK) goto fail;
     *out = p;
     return ATMOS_OK;
@@ -94,6 +95,7 @@ void atmos_plan_destroy(atmos_plan *p)
     if (!p) return;
     atmos__slice_plan_destroy(p->slice);
     atmos__path_plan_destroy(p->path);
+    atmos__nishita_plan_destroy(p->nishita);
     atmos_volume_optics_free(&p->own_optics);
     atmos_volume_destroy(p->own_volume);
     atmos_atmosphere_destroy(p->atm);
@@ -264,7 +266,8 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
 {
     static const char *const names[] = {"sky (analytic single scattering of the atmosphere)",
                                         "slice (Riley et al. 2004, half-angle slicing)",
-                                        "path (spectral Monte Carlo volumetric path tracing)"};
+                                        "path (spectral Monte Carlo volumetric path tracing)",
+                                        "nishita (Nishita et al. 1996, orders 1-3 and sky light by a light field)"};
     char buf[256];
     double el = 0, az = 0;
     atmos_direction_to_angles(v->sun, &el, &az);
@@ -289,6 +292,9 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
         atmos_image_set_meta(out, "atmos:path", buf);
         snprintf(buf, sizeof buf, "%.6g", p->stats.path.mean_rel_error);
         atmos_image_set_meta(out, "atmos:path_mean_rel_error", buf);
+    } else if (p->renderer == ATMOS_RENDERER_NISHITA) {
+        atmos__nishita_describe(p, buf, sizeof buf);
+        atmos_image_set_meta(out, "atmos:nishita", buf);
     }
 }
 
@@ -319,6 +325,8 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
         st = atmos__sky_render(ctx, p->atm, &v, &r, out);
     } else if (p->renderer == ATMOS_RENDERER_SLICE) {
         st = atmos__slice_render(p, &v, &r, out, &stats->slice);
+    } else if (p->renderer == ATMOS_RENDERER_NISHITA) {
+        st = atmos__nishita_render(p, &v, &r, out);
     } else {
         st = atmos__path_render(p, &v, &r, out, &stats->path);
     }

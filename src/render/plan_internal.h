@@ -9,6 +9,7 @@
 
 typedef struct atmos__slice_plan atmos__slice_plan;
 typedef struct atmos__path_plan atmos__path_plan;
+typedef struct atmos__nishita_plan atmos__nishita_plan;
 
 struct atmos_plan {
     atmos_context *ctx;
@@ -32,6 +33,7 @@ struct atmos_plan {
     atmos_plan_stats stats;
     atmos__slice_plan *slice;
     atmos__path_plan *path;
+    atmos__nishita_plan *nishita;
 };
 
 /* The slice renderer's part (slice_plan.c): the render grid, the optics tables, the buffers
@@ -56,5 +58,14 @@ atmos_status atmos__path_render(atmos_plan *p, const atmos__view *v, const atmos
 atmos_status atmos__path_variance(const atmos_plan *p, atmos_image **out);
 atmos_status atmos__path_order(const atmos_plan *p, atmos_image **out);
 void atmos__path_describe(const atmos_plan *p, char *buf, size_t cap);
+
+/* The Nishita renderer's part (nishita_plan.c): the render grid, the optics, the sunlight's
+ * attenuation per voxel and the light field, each kept until the sun (or the eye's direction)
+ * changes. */
+atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out);
+void atmos__nishita_plan_destroy(atmos__nishita_plan *s);
+/* The sky, then the volume by eye rays over it, over the pixels of r (nishita_render.c). */
+atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);
+void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap);
 
 #endif

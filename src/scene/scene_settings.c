@@ -10,6 +10,7 @@
 
 #define SLICE(field) offsetof(atmos_scene, slice.field)
 #define PATH(field) offsetof(atmos_scene, path.field)
+#define NISHITA(field) offsetof(atmos_scene, nishita.field)
 
 static const char *const update_names[] = {"eq25", "eq24", NULL};
 
@@ -59,20 +60,37 @@ static const atmos_setting path_settings[] = {
      "the aureole estimate in droplet clouds (off: same mean, more fireflies)", PATH(aureole)},
 };
 
+static const atmos_setting nishita_settings[] = {
+    {"orders", "nishita-orders", ATMOS_SETTING_INT, "", 1, 3, 0, 0, 3, NULL, 0,
+     "highest scattering order of the sunlight (1: single scattering; 2, 3: by reference patterns)",
+     NISHITA(orders)},
+    {"ratio", "nishita-ratio", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 0.8, NULL, 0,
+     "the share r of the sample space's contribution the reference patterns keep", NISHITA(ratio)},
+    {"paths", "nishita-paths", ATMOS_SETTING_INT, "", 1, 100000, 0, 0, 256, NULL, 0,
+     "order-3 paths computed per cell (n1, chosen at random among the pattern's)", NISHITA(paths)},
+    {"cells", "nishita-cells", ATMOS_SETTING_INT, "", 4, 96, 0, 0, 32, NULL, 0,
+     "the light field's grid: at most this many cells per axis", NISHITA(cells)},
+    {"sky", "no-nishita-sky", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "the sky's and the ground's light through sky elements (off: the sunlight alone)", NISHITA(sky)},
+    {"step_pct", "nishita-step", ATMOS_SETTING_INT, "%", 5, 400, 0, 0, 50, NULL, 0,
+     "eye-ray step, per cent of a render voxel", NISHITA(step_scale_pct)},
+};
+
 const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)
 {
     int n = 0;
     const atmos_setting *t = NULL;
     if (renderer == ATMOS_RENDERER_SLICE) t = slice_settings, n = (int)(sizeof slice_settings / sizeof *t);
     if (renderer == ATMOS_RENDERER_PATH) t = path_settings, n = (int)(sizeof path_settings / sizeof *t);
+    if (renderer == ATMOS_RENDERER_NISHITA) t = nishita_settings, n = (int)(sizeof nishita_settings / sizeof *t);
     if (count) *count = n;
     return t;
 }
 
 const char *atmos_renderer_name(atmos_renderer_kind renderer)
 {
-    static const char *const names[] = {"sky", "slice", "path"};
-    return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_PATH ? names[renderer] : NULL;
+    static const char *const names[] = {"sky", "slice", "path", "nishita"};
+    return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_NISHITA ? names[renderer] : NULL;
 }
 
 double atmos_scene_setting_get(const atmos_scene *s, const atmos_setting *st)
@@ -113,7 +131,7 @@ void atmos_scene_setting_set(atmos_scene *s, const atmos_setting *st, double v)
 
 void atmos__settings_defaults(atmos_scene *s)
 {
-    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_PATH; r++) {
+    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_NISHITA; r++) {
         int n;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
         for (int i = 0; i < n; i++) atmos_scene_setting_set(s, &t[i], t[i].def);

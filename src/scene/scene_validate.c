@@ -313,7 +313,7 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
 /* Every row of the renderers' settings tables within its range (atmos_renderer_settings). */
 atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
-    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_PATH; r++) {
+    for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_NISHITA; r++) {
         int n;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
         for (int i = 0; i < n; i++) {
@@ -342,8 +342,8 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     if (s->volume.density_unit < ATMOS_DENSITY_AUTO || s->volume.density_unit > ATMOS_DENSITY_FRACTION)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/density_unit",
                                  "must be auto, per_m3, g_m3 or fraction, got %d", (int)s->volume.density_unit);
-    if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_PATH)
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice or path, got %d",
+    if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_NISHITA)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice, path or nishita, got %d",
                                  (int)s->renderer);
     const atmos_scene_sun *sun = &s->sun;
     if (sun->irradiance_count != 0 && sun->irradiance_count != 1 && sun->irradiance_count != 3)
@@ -359,7 +359,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     if (!memchr(s->volume.source, '\0', sizeof s->volume.source))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/file", "is not terminated");
     /* (The path tracer renders the atmosphere and the ground alone when there is no volume.) */
-    if (s->renderer == ATMOS_RENDERER_SLICE && !s->volume.source[0])
+    if ((s->renderer == ATMOS_RENDERER_SLICE || s->renderer == ATMOS_RENDERER_NISHITA) && !s->volume.source[0])
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer",
                                  "\"%s\" renders a volume: the scene needs \"volume\" (a file or a generator)",
                                  atmos_renderer_name(s->renderer));

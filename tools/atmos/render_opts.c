@@ -49,7 +49,7 @@ static const struct option fixed_opts[] = {
 /* Row i of the concatenated settings tables (slice, then path); NULL past the end. */
 static const atmos_setting *table_row(int i, atmos_renderer_kind *r)
 {
-    for (int k = ATMOS_RENDERER_SLICE; k <= ATMOS_RENDERER_PATH; k++) {
+    for (int k = ATMOS_RENDERER_SLICE; k <= ATMOS_RENDERER_NISHITA; k++) {
         int n;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)k, &n);
         if (i < n) {
@@ -148,7 +148,7 @@ static int parse_vec3(const char *opt, const char *arg, double v[3], int *given)
 static int parse_named(int c, const char *arg, render_opts *o)
 {
     static const char *const cams[] = {"pinhole", "fisheye", "equirect"}, *const tones[] = {"filmic", "reinhard", "clamp"},
-                             *const renderers[] = {"sky", "slice", "path"}, *const airs[] = {"riley", "homogeneous"};
+                             *const renderers[] = {"sky", "slice", "path", "nishita"}, *const airs[] = {"riley", "homogeneous"};
     switch (c) {
     case 'o': o->png = arg; return 1;
     case O_EXR: o->exr = arg; return 1;
@@ -164,7 +164,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_RGB: o->rgb = 1; return 1;
     case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
-    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 3, &o->renderer);
+    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 4, &o->renderer);
     case O_ATMOSPHERE: return parse_choice("--atmosphere", arg, airs, 2, &o->air);
     case O_EXPOSURE:
         if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
@@ -460,8 +460,8 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
     if (o->volume_pos_given) s->volume.placed = 1, memcpy(s->volume.position_m, o->volume_pos, sizeof o->volume_pos);
     if (o->density_scale > 0) s->volume.density_scale = o->density_scale;
     if (o->tau && !s->volume.source[0]) return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
-    if (!o->scene_path && r == ATMOS_RENDERER_SLICE && !s->volume.source[0])
-        return cli_usage_error(C, "--renderer slice needs --volume FILE or --volume generate:PRESET");
+    if (!o->scene_path && (r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_NISHITA) && !s->volume.source[0])
+        return cli_usage_error(C, "--renderer %s needs --volume FILE or --volume generate:PRESET", atmos_renderer_name(r));
     return CLI_EXIT_OK;
 }
 
@@ -551,9 +551,11 @@ void render_opts_help(void)
            "                                default the first frame's is kept for all (a locked exposure)\n"
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
-           "      --renderer sky|slice|path the atmosphere alone (default), Riley et al.'s half-angle slicing\n"
-           "                                over a volume (default when a volume is given), or spectral\n"
-           "                                Monte Carlo path tracing (the reference, docs/path.md)\n"
+           "      --renderer sky|slice|path|nishita   the atmosphere alone (default), Riley et al.'s\n"
+           "                                half-angle slicing over a volume (default when a volume is\n"
+           "                                given), spectral Monte Carlo path tracing (the reference,\n"
+           "                                docs/path.md), or Nishita et al. 1996's ray marching with\n"
+           "                                orders 2-3 and sky light from a light field (docs/lightfield.md)\n"
            "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
@@ -585,6 +587,7 @@ void render_opts_help(void)
            "rendering renderer's is used.\n\n");
     help_settings(ATMOS_RENDERER_SLICE, "Slice renderer");
     help_settings(ATMOS_RENDERER_PATH, "Path tracer");
+    help_settings(ATMOS_RENDERER_NISHITA, "Nishita renderer (Nishita et al. 1996: orders 2-3 and sky light by a light field)");
     printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
            "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
