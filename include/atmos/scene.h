@@ -90,7 +90,7 @@ typedef struct atmos_scene_path {
  * atmos_renderer_settings(ATMOS_RENDERER_NISHITA) (docs/lightfield.md, "Nishita 1996"). */
 typedef struct atmos_scene_nishita {
     int orders;               /* highest scattering order of the sunlight: 1, 2 or 3; 3 */
-    double ratio;             /* the share r of the sample space's contribution the patterns keep; 0.8 */
+    double ratio;             /* the share r of the sample space's contribution the patterns keep; 0.95 */
     int paths;                /* n1: order-3 paths computed per cell; 256 */
     int cells;                /* the light field's grid: at most this many cells per axis; 32 */
     int sky;                  /* the sky's and the ground's light through sky elements; 1 */

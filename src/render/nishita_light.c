@@ -171,7 +171,7 @@ atmos_status atmos__nishita_field_update(atmos_plan *p, const double sun_w[3], c
     if (!ok) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the light field");
     memcpy(np->field_sun, sun_w, sizeof np->field_sun), memcpy(np->field_ev, ev, sizeof np->field_ev);
     np->field_valid = 1;
-    atmos__log(p->ctx, ATMOS_LOG_WARN,
+    atmos__log(p->ctx, ATMOS_LOG_INFO,
                "render nishita: field %dx%dx%d cells of %d voxels; patterns: order 2 %d paths (%.0f %%, half-size %d), "
                "order 3 %d of %lld (%.0f %%, half-size %d), beam spread %.1f deg, %.3f s; sky %.3f s; cells %.3f s",
                np->med.c[0], np->med.c[1], np->med.c[2], np->s, np->stats.n2, 100 * np->stats.kept2, np->stats.box2,

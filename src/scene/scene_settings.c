@@ -64,7 +64,7 @@ static const atmos_setting nishita_settings[] = {
     {"orders", "nishita-orders", ATMOS_SETTING_INT, "", 1, 3, 0, 0, 3, NULL, 0,
      "highest scattering order of the sunlight (1: single scattering; 2, 3: by reference patterns)",
      NISHITA(orders)},
-    {"ratio", "nishita-ratio", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 0.8, NULL, 0,
+    {"ratio", "nishita-ratio", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 0.95, NULL, 0,
      "the share r of the sample space's contribution the reference patterns keep", NISHITA(ratio)},
     {"paths", "nishita-paths", ATMOS_SETTING_INT, "", 1, 100000, 0, 0, 256, NULL, 0,
      "order-3 paths computed per cell (n1, chosen at random among the pattern's)", NISHITA(paths)},
