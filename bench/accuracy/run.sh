@@ -9,7 +9,7 @@
 # Environment: ATMOS (the binary, default build/atmos), SPP (path samples per pixel,
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
 # CASES (default "cumulus cirrus rain disney"), VARIANTS (default all of the slice variants
-# below), THREADS.
+# below; "nishita": the Nishita renderer, not in the default list), THREADS.
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -50,6 +50,7 @@ for c in $CASES; do
             low_albedo) opts="--low-albedo" ;;
             diffuse) opts="--diffuse" ;;
             diffuse_xi0) opts="--diffuse --xi 0" ;;
+            nishita) opts="--renderer nishita" ;;
             esac
             "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
             "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \

@@ -55,11 +55,18 @@ typedef struct {
 
 /* A reference pattern (nishita_pattern.c). Order 2: entry e of o2 is a cell offset o (from the
  * cell P receiving, o = the first scattering's cell) with w2 = the phase-weighted form factor
- * int p(theta1) p(theta2) / r^2 dV / h over the cell (sub-voxels) and r2 the mean distance
- * (cells). Order 3: offsets j (second scattering) and k (first), w3 = p p p / (r1^2 r2^2) times
- * the cells' volumes / h^2, r3 the two legs' lengths. Sorted by contribution, largest first. */
+ * int p(theta1) p(theta2) / r^2 dV / h over the cell (integrated over directions, exactly along
+ * each) and r2 its weighted mean distance (cells). Order 3: offsets j (second scattering) and k
+ * (first), w3 = p p p / (r1^2 r2^2) times the cells' volumes / h^2 (the phases averaged over the
+ * cone a cell subtends; a leg inside one cell over its sub-voxels), r3 the two legs' lengths.
+ * Sorted by contribution, largest first. */
+#define ATMOS__NISHITA_SELF_N 49 /* optical depths of a cell's edge 10^(-3 + i / 8) */
 typedef struct {
     int n2, n3;
+    /* P's own cell, for order 2: int p p exp(-sig_t r) dV / r^2 / h over the cell at the cell
+     * optical depths tau = sig_t h of ATMOS__NISHITA_SELF_N (exact along each direction: in a
+     * dense cell the light scattered once reaches P from within a mean free path) */
+    float self2[ATMOS__NISHITA_SELF_N];
     int16_t *o2; /* 3 per entry */
     float *w2, *r2;
     int16_t *o3; /* 6 per entry: j, k */
@@ -74,6 +81,15 @@ typedef struct {
  * sig_s (m^-1, cell edge h). Returns 0 when out of memory. */
 int atmos__nishita_pattern_build(const atmos__nishita_in *in, double sig_t, double sig_s, atmos__nishita_pattern *p);
 void atmos__nishita_pattern_free(atmos__nishita_pattern *p);
+
+/* Order 2's weight of P's own cell at cell optical depth tau (log-linear in tau). */
+static inline double atmos__nishita_self2(const atmos__nishita_pattern *p, double tau)
+{
+    double x = (log10(tau > 1e-3 ? tau : 1e-3) + 3.0) * 8.0;
+    if (x > ATMOS__NISHITA_SELF_N - 1.001) x = ATMOS__NISHITA_SELF_N - 1.001;
+    const int i = (int)x;
+    return p->self2[i] + (x - i) * (p->self2[i + 1] - p->self2[i]);
+}
 
 /* The patterns' phase function at cos(theta) (linear in theta). */
 static inline double atmos__nishita_phase(const float *ph, double mu)

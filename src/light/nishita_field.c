@@ -68,10 +68,12 @@ static void order2(const job *J, const int P[3], size_t cp, double *out)
         const int q[3] = {P[0] + o[0], P[1] + o[1], P[2] + o[2]};
         size_t c;
         if (!cell_of(m, q, &c) || !(m->sig_s[c * n] > 0)) continue;
-        if (o[0] == 0 && o[1] == 0 && o[2] == 0)
-            for (int w = 0; w < n; w++) tau[w] = m->sig_t[cp * n + w] * p->r2[e] * m->h;
-        else
-            tau_line(m, q, P, tau);
+        if (o[0] == 0 && o[1] == 0 && o[2] == 0) { /* the cell itself: attenuated exactly along each direction */
+            for (int w = 0; w < n; w++)
+                out[w] += atmos__nishita_self2(p, m->sig_t[cp * n + w] * m->h) * m->h * m->sig_s[c * n + w] * J->E[c * n + w];
+            continue;
+        }
+        tau_line(m, q, P, tau);
         const double k = p->w2[e] * m->h;
         for (int w = 0; w < n; w++) out[w] += k * m->sig_s[c * n + w] * J->E[c * n + w] * exp(-tau[w]);
     }

@@ -188,8 +188,9 @@ static int direction_set(const double lt[3], const double ev[3], dirw *d)
  * directions (the set above) and exactly along each direction: from P's centre back along
  * the light's path, each cell crossed gets p(theta1) p(theta2) dOmega times the length
  * crossed (cells; dV / r^2 = dOmega dr), and its weighted mean distance. */
-static void form_factors(const atmos__nishita_in *in, const dirw *d, int nd, int R, double *w, double *wr)
+static void form_factors(const atmos__nishita_in *in, const dirw *d, int nd, int R, double *w, double *wr, float *self)
 {
+    double acc[ATMOS__NISHITA_SELF_N] = {0};
     const int side = 2 * R + 1;
     for (int e = 0; e < nd; e++) {
         const double *u = d[e].u;
@@ -206,12 +207,18 @@ static void form_factors(const atmos__nishita_in *in, const dirw *d, int nd, int
             const int a = tn[0] < tn[1] ? (tn[0] < tn[2] ? 0 : 2) : (tn[1] < tn[2] ? 1 : 2);
             const double t1 = tn[a];
             const size_t i = ((size_t)(c[2] + R) * side + (c[1] + R)) * side + (c[0] + R);
+            if (t == 0)
+                for (int q = 0; q < ATMOS__NISHITA_SELF_N; q++) {
+                    const double tau = pow(10.0, -3.0 + q / 8.0);
+                    acc[q] += k * -expm1(-tau * t1) / tau;
+                }
             w[i] += k * (t1 - t), wr[i] += k * (t1 - t) * 0.5 * (t + t1);
             t = t1, tn[a] += dtn[a];
             c[a] += v[a] > 0 ? 1 : -1;
             if (abs(c[a]) > R) break;
         }
     }
+    for (int q = 0; q < ATMOS__NISHITA_SELF_N; q++) self[q] = (float)acc[q];
 }
 
 static int pattern2(const atmos__nishita_in *in, double st, double ss, atmos__nishita_pattern *p)
@@ -223,7 +230,7 @@ static int pattern2(const atmos__nishita_in *in, double st, double ss, atmos__ni
     dirw *d = malloc(sizeof(dirw) * (2 * CONE_RINGS * CONE_AZ + LATTICE));
     int ok = c && w && wr && d;
     if (ok) {
-        form_factors(in, d, direction_set(in->lt, in->ev, d), R, w, wr);
+        form_factors(in, d, direction_set(in->lt, in->ev, d), R, w, wr, p->self2);
         for (int i = 0; i < N; i++) {
             wr[i] = w[i] > 0 ? wr[i] / w[i] : 0;
             c[i] = (float)(w[i] * h * ss * exp(-st * wr[i] * h));

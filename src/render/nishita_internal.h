@@ -19,7 +19,6 @@
 
 struct atmos__nishita_plan {
     int nf, n;
-    const atmos_volume *vol;
     sgrid g;                 /* the volume box-filtered onto the render grid (slice_grid.c) */
     atmos__vol_xform x;      /* the volume's placement */
     float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* extinction cross-section, m^2 */

@@ -54,7 +54,6 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     atmos__nishita_plan *np = calloc(1, sizeof *np);
     if (!np) return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory");
     np->nf = atmos_volume_field_count(p->volume), np->n = p->wl.count;
-    np->vol = p->volume;
     atmos__vol_xform_init(p->volume, p->offset, &np->x);
     for (int f = 0; f < np->nf; f++) {
         np->phase[f] = p->optics->phase[f];
