@@ -27,7 +27,10 @@ struct atmos__nishita_plan {
     float *col;              /* per render voxel and field: the column density toward the sun, m */
     double col_sun[3];       /* the sun (grid frame) col was made for */
     int col_valid;
-    atmos__lmedium med;      /* the light field's medium: cells of s render voxels */
+    atmos__lmedium med;      /* the light field's medium: cells of s render voxels, forward peak truncated */
+    double trunc[ATMOS_MAX_WAVELENGTHS]; /* the share of the scattering in the forward peak (above the
+                                            phase's value at TRUNC_DEG), counted as not scattered by
+                                            the orders 2-3 */
     float *fdens;            /* per cell and field: the mean density */
     int s;
     atmos__lfield field;
@@ -36,6 +39,10 @@ struct atmos__nishita_plan {
     atmos__nishita_stats stats;
     double col_s;            /* the last sweep's time */
 };
+
+/* The forward-peak truncation of the orders 2-3 (nishita_light.c): trunc[] from the fields'
+ * mean phase function, the field's medium scaled (sig_s (1 - f), sig_t - f sig_s). */
+void atmos__nishita_truncate(atmos__nishita_plan *np);
 
 /* The sunlight's column densities for the sun sun_g (grid frame), unless already made. */
 void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int threads);

@@ -13,8 +13,10 @@
 
 #define SKY_NMU 64   /* sky directions: SKY_NMU x SKY_NPHI cells of equal solid angle */
 #define SKY_NPHI 128
-#define SKY_SUB 8    /* cells within SKY_PEAK_DEG of the forward direction: the phase averaged on SKY_SUB^2 points */
-#define SKY_PEAK_DEG 12.0
+#define SKY_SUB 8    /* cells within SKY_NEAR_DEG of the forward direction: the phase averaged on SKY_SUB^2 points */
+#define SKY_NEAR_DEG 20.0
+#define SKY_PEAK_DEG 4.0 /* the cone around the forward direction integrated apart */
+#define TRUNC_DEG 3.0    /* the orders 2-3: the phase's forward peak cut here (as the path tracer's --truncate) */
 
 /* The medium's phase function at wavelength w and cos(theta) mu: the fields' mixed by their
  * share of the scattering in the mean cell (mix[f]: the fields' mean densities). */
@@ -28,6 +30,74 @@ static double mixed_phase(const atmos__nishita_plan *np, const double *mix, int 
     return den > 0 ? num / den : 1.0 / (4.0 * ATMOS_PI);
 }
 
+/* The patterns' phase table: at theta_i = i / 10 degrees the mean of the phase over the
+ * directions of theta_i +- 0.05 degrees (weighted by solid angle), so that a forward peak
+ * narrower than the table's step (ice crystals, raindrops: hundredths of a degree) keeps its
+ * integral instead of being sampled at its top. */
+static void pattern_phase(const atmos__nishita_plan *np, const double *mix, int w, float *ph)
+{
+    enum { SUB = 64 };
+    for (int i = 0; i < ATMOS__NISHITA_PHASE_N; i++) {
+        const double a = fmax(0.0, (i - 0.5) * 0.1), b = fmin(180.0, (i + 0.5) * 0.1);
+        double num = 0, den = 0;
+        for (int k = 0; k < SUB; k++) {
+            const double t = (a + (b - a) * (k + 0.5) / SUB) * ATMOS_DEG2RAD, s = sin(t);
+            num += s * mixed_phase(np, mix, w, cos(t)), den += s;
+        }
+        ph[i] = (float)(num / den);
+    }
+    /* truncated: min(P, P(TRUNC_DEG)), renormalised (the peak's share counts as not scattered) */
+    const int ic = (int)(TRUNC_DEG * 10 + 0.5);
+    for (int i = 0; i < ic; i++) ph[i] = ph[i] < ph[ic] ? ph[i] : ph[ic];
+    const double f = np->trunc[w];
+    for (int i = 0; i < ATMOS__NISHITA_PHASE_N; i++) ph[i] = (float)(ph[i] / (1 - f));
+}
+
+/* The fields' mean densities over the cells that hold any. */
+static void mean_mix(const atmos__nishita_plan *np, double *mix);
+
+/* The share of the scattering above the phase's value at TRUNC_DEG inside that cone. */
+static double peak_share(const atmos__nishita_plan *np, const double *mix, int w)
+{
+    enum { STEPS = 4096 };
+    const double dt = TRUNC_DEG * ATMOS_DEG2RAD / STEPS, pc = mixed_phase(np, mix, w, cos(TRUNC_DEG * ATMOS_DEG2RAD));
+    double f = 0;
+    for (int k = 0; k < STEPS; k++) {
+        const double t = (k + 0.5) * dt;
+        f += fmax(0.0, mixed_phase(np, mix, w, cos(t)) - pc) * 2 * ATMOS_PI * sin(t) * dt;
+    }
+    return fmin(f, 0.99);
+}
+
+void atmos__nishita_truncate(atmos__nishita_plan *np)
+{
+    double mix[ATMOS_VOLUME_MAX_FIELDS];
+    mean_mix(np, mix);
+    atmos__lmedium *m = &np->med;
+    const int n = np->n;
+    for (int w = 0; w < n; w++) np->trunc[w] = peak_share(np, mix, w);
+    for (size_t c = 0; c < atmos__lmedium_cells(m); c++)
+        for (int w = 0; w < n; w++) {
+            const double f = np->trunc[w], ss = m->sig_s[c * n + w];
+            m->sig_t[c * n + w] = (float)(m->sig_t[c * n + w] - f * ss), m->sig_s[c * n + w] = (float)(ss * (1 - f));
+        }
+}
+
+/* The phase integrated over the cone of SKY_PEAK_DEG around the forward direction, per
+ * wavelength (fine steps in theta: the peak's integral, however narrow). */
+static void peak_integral(const atmos__nishita_plan *np, const double *mix, double *out)
+{
+    enum { STEPS = 4096 };
+    const double dt = SKY_PEAK_DEG * ATMOS_DEG2RAD / STEPS;
+    for (int w = 0; w < np->n; w++) {
+        out[w] = 0;
+        for (int k = 0; k < STEPS; k++) {
+            const double t = (k + 0.5) * dt;
+            out[w] += mixed_phase(np, mix, w, cos(t)) * 2 * ATMOS_PI * sin(t) * dt;
+        }
+    }
+}
+
 /* The mean of the phase over sky cell (a, b) toward the eye direction ev (grid frame), per
  * wavelength: the cell's centre, or SKY_SUB^2 points near the forward peak. */
 static void cell_phase(const atmos__nishita_plan *np, const double *mix, int a, int b, const double ev[3],
@@ -38,7 +108,7 @@ static void cell_phase(const atmos__nishita_plan *np, const double *mix, int a, 
     const double mu = -1.0 + 2.0 * (a + 0.5) / SKY_NMU, ph = 2.0 * ATMOS_PI * (b + 0.5) / SKY_NPHI;
     dir[0] = sqrt(1 - mu * mu) * cos(ph), dir[1] = mu, dir[2] = sqrt(1 - mu * mu) * sin(ph);
     atmos__vol_dir_to_frame(&np->x, dir, dg);
-    const int m = -atmos__dot3(dg, ev) > cos(SKY_PEAK_DEG * ATMOS_DEG2RAD) ? SKY_SUB : 1;
+    const int m = -atmos__dot3(dg, ev) > cos(SKY_NEAR_DEG * ATMOS_DEG2RAD) ? SKY_SUB : 1;
     for (int w = 0; w < n; w++) out[w] = 0;
     for (int i = 0; i < m; i++)
         for (int j = 0; j < m; j++) {
@@ -72,6 +142,7 @@ static void sky_elements(const atmos__nishita_plan *np, const atmos_atmosphere *
             atmos_atmosphere_radiance(atm, cw, d, sun_w, L, &info);
             if (info.in_sun_disk) continue;
             atmos__vol_dir_to_frame(&np->x, d, dg);
+            if (-atmos__dot3(dg, ev) > cos(SKY_PEAK_DEG * ATMOS_DEG2RAD)) continue; /* the peak's cone, below */
             const int l = atmos__nishita_sky_element(dg, sun_g);
             cell_phase(np, mix, a, b, ev, P);
             for (int w = 0; w < n; w++) row[((size_t)a * E + l) * n + w] += L[w] * P[w] * dom;
@@ -79,6 +150,19 @@ static void sky_elements(const atmos__nishita_plan *np, const atmos_atmosphere *
     for (int a = 0; a < SKY_NMU; a++)
         for (int i = 0; i < E * n; i++) I[i] += row[(size_t)a * E * n + i];
     free(row);
+    /* the cone around the forward direction: the sky straight behind the volume (seen from the
+     * eye) times the phase's integral over the cone */
+    double back_g[3], back_w[3], L[ATMOS_MAX_WAVELENGTHS], pk[ATMOS_MAX_WAVELENGTHS];
+    for (int k = 0; k < 3; k++) back_g[k] = -ev[k];
+    atmos__vol_index_to_dir(&np->x, back_g, back_w);
+    const double lb = sqrt(atmos__dot3(back_w, back_w));
+    for (int k = 0; k < 3; k++) back_w[k] /= lb;
+    atmos_atmosphere_hit info;
+    atmos_atmosphere_radiance(atm, cw, back_w, sun_w, L, &info);
+    if (info.in_sun_disk) return; /* the sun behind the volume: its disk is the sunlight's */
+    peak_integral(np, mix, pk);
+    const int l = atmos__nishita_sky_element(back_g, sun_g);
+    for (int w = 0; w < n; w++) I[l * n + w] += L[w] * pk[w];
 }
 
 /* The fields' mean densities over the cells that hold any. */
@@ -115,11 +199,14 @@ static void cell_sunlight(const atmos__nishita_plan *np, const double *sl, float
                     const size_t v = (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
                     for (int w = 0; w < n; w++) {
                         double b = 0, tau = 0;
-                        for (int f = 0; f < nf; f++) b += g->v[v + f] * np->sca[f][w], tau += np->col[v + f] * np->sig[f][w];
+                        for (int f = 0; f < nf; f++)
+                            b += g->v[v + f] * np->sca[f][w],
+                                tau += np->col[v + f] * (np->sig[f][w] - np->trunc[w] * np->sca[f][w]);
                         num[w] += b * exp(-tau), den[w] += b;
                     }
                 }
         for (int w = 0; w < n; w++) E[cell * n + w] = (float)(den[w] > 0 ? sl[w] * num[w] / den[w] : 0.0);
+
     }
 }
 
@@ -149,9 +236,13 @@ atmos_status atmos__nishita_field_update(atmos_plan *p, const double sun_w[3], c
         free(ph), free(sky), free(E);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the light field");
     }
-    for (int i = 0; i < ATMOS__NISHITA_PHASE_N; i++) ph[i] = (float)mixed_phase(np, mix, n / 2, cos(i * 0.1 * ATMOS_DEG2RAD));
+    pattern_phase(np, mix, n / 2, ph);
     const double t0 = atmos__now();
     if (p->scene.nishita.sky) sky_elements(np, p->atm, cw, sun_w, sun_g, ev, mix, sky, threads);
+    /* the eye pass multiplies the field by the truncated scattering sig_s (1 - f); the sky's
+     * light is scattered with the whole phase function */
+    for (int e = 0; e < ATMOS__NISHITA_ELEMENTS; e++)
+        for (int w = 0; w < n; w++) sky[e * n + w] /= 1 - np->trunc[w];
     const double tsky = atmos__now() - t0;
     const atmos_scene_nishita *ns = &p->scene.nishita;
     atmos__nishita_in in = {0};

@@ -78,7 +78,7 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
         if (!np->col || !np->fdens || !atmos__lmedium_alloc(&np->med, cx, cy, cz, np->n, np->s / (double)g->sc))
             st = atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the light field");
         else
-            cell_medium(np);
+            cell_medium(np), atmos__nishita_truncate(np);
     }
     if (st != ATMOS_OK) {
         atmos__nishita_plan_destroy(np);

@@ -86,7 +86,8 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
                 s1 += dens[f] * np->sca[f][w] * pf[f][w];
                 tau += col[f] * np->sig[f][w];
             }
-            double S = s1 * J->E[w] * exp(-tau) + (J->use_field ? ss * (Lf[w] > 0 ? Lf[w] : 0) : 0);
+            /* the field's radiance is per unit truncated scattering, sig_s (1 - f) */
+            double S = s1 * J->E[w] * exp(-tau) + (J->use_field ? ss * (1 - np->trunc[w]) * (Lf[w] > 0 ? Lf[w] : 0) : 0);
             const double a = st > 0 ? -expm1(-st * dt) : 0;
             L[w] += st > 0 ? T[w] * S / st * a : 0;
             if (w == n / 2) wsum += T[w] * a, tsum += t * T[w] * a;
