@@ -10,7 +10,8 @@
 # Environment: ATMOS (the binary, default build/atmos), SPP (path samples per pixel,
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
 # CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
-# VARIANTS (default all of the slice variants below), THREADS.
+# VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer, "harris",
+# "harris_sun": Harris's, not in the default list), THREADS.
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -51,6 +52,7 @@ for c in $CASES; do
             low_albedo) opts="--low-albedo" ;;
             diffuse) opts="--diffuse" ;;
             diffuse_xi0) opts="--diffuse --xi 0" ;;
+            nishita) opts="--renderer nishita" ;;
             harris) opts="--renderer harris" ;;
             harris_sun) opts="--renderer harris --sky-lights 0" ;;
             esac

@@ -32,7 +32,8 @@ typedef enum {
     ATMOS_RENDERER_SKY = 0,   /* the analytic sky (Riley §4.1, §4.2.4) */
     ATMOS_RENDERER_SLICE = 1, /* half-angle slicing over the volume (Riley §4.2-§5, slice.h) */
     ATMOS_RENDERER_PATH = 2,  /* Monte Carlo volumetric path tracing over the volume (path.h) */
-    ATMOS_RENDERER_HARRIS = 3 /* Harris 2002: the volume as particles, multiple forward scattering, splats */
+    ATMOS_RENDERER_NISHITA = 3, /* Nishita et al. 1996: ray marching with a light field of orders 2-3 and sky light */
+    ATMOS_RENDERER_HARRIS = 4  /* Harris 2002: the volume as particles, multiple forward scattering, splats */
 } atmos_renderer_kind;
 /* The last renderer kind (loops over the kinds end here). */
 #define ATMOS_RENDERER_LAST ATMOS_RENDERER_HARRIS
@@ -87,6 +88,17 @@ typedef struct atmos_scene_path {
     int forced;               /* forced single scattering on camera rays; 1 */
     int aureole;              /* the aureole estimate in droplet clouds; 1 */
 } atmos_scene_path;
+
+/* Settings of the Nishita renderer ("nishita" in the file); the table is
+ * atmos_renderer_settings(ATMOS_RENDERER_NISHITA) (docs/lightfield.md, "Nishita 1996"). */
+typedef struct atmos_scene_nishita {
+    int orders;               /* highest scattering order of the sunlight: 1, 2 or 3; 3 */
+    double ratio;             /* the share r of the sample space's contribution the patterns keep; 0.95 */
+    int paths;                /* n1: order-3 paths computed per cell; 256 */
+    int cells;                /* the light field's grid: at most this many cells per axis; 32 */
+    int sky;                  /* the sky's and the ground's light through sky elements; 1 */
+    int step_scale_pct;       /* eye-ray step, per cent of a render voxel; 50 */
+} atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is
  * atmos_renderer_settings(ATMOS_RENDERER_HARRIS) (docs/particles.md). */
@@ -151,6 +163,7 @@ typedef struct atmos_scene {
     atmos_scene_volume volume;
     atmos_scene_slice slice;
     atmos_scene_path path;
+    atmos_scene_nishita nishita;
     atmos_scene_harris harris;
     atmos_scene_animation animation;
     int camera_given;                     /* the scene file has a "camera" (a volume scene without
@@ -305,7 +318,7 @@ ATMOS_API const atmos_setting *atmos_renderer_settings(atmos_renderer_kind rende
  * is not checked: atmos_scene_validate does that). */
 ATMOS_API double atmos_scene_setting_get(const atmos_scene *scene, const atmos_setting *setting);
 ATMOS_API void atmos_scene_setting_set(atmos_scene *scene, const atmos_setting *setting, double value);
-/* "sky", "slice", "path", "harris"; NULL for an unknown kind. */
+/* "sky", "slice", "path", "nishita", "harris"; NULL for an unknown kind. */
 ATMOS_API const char *atmos_renderer_name(atmos_renderer_kind renderer);
 
 #ifdef __cplusplus

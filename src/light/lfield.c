@@ -24,7 +24,7 @@ int atmos__lfield_alloc(atmos__lfield *f, int kind, int cx, int cy, int cz, int 
 
 void atmos__lfield_free(atmos__lfield *f)
 {
-    free(f->L), free(f->phi), free(f->J), free(f->LA);
+    free(f->L), free(f->phi), free(f->J), free(f->LA), free(f->part);
     memset(f, 0, sizeof *f);
 }
 
@@ -48,4 +48,11 @@ void atmos__lfield_toward(atmos__lfield *f, const double eye[3], int threads)
                     o[n + w] = (float)(s * (J[0] * d[0] + J[1] * d[1] + J[2] * d[2]));
                 }
             }
+}
+
+float atmos__lkeep_none(const void *user, size_t cell, int w, float n, float *mu)
+{
+    (void)user, (void)cell, (void)w, (void)n;
+    if (mu) *mu = 0.0f;
+    return 0.0f;
 }

@@ -10,8 +10,10 @@
  *                 each scattering: the source of the diffuse field
  *   diffusion.c   the diffuse light of all orders by a (flux-limited) diffusion solve
  *
- * Kinds: ATMOS__LFIELD_DIFFUSION (docs/lightfield.md). Nishita et al. 1996's reference
- * patterns would fill the same cells with the radiance of orders 2 and 3 (a later kind).
+ *   nishita_pattern.c, nishita_field.c, nishita_sky.c  Nishita et al. 1996's reference
+ *                 patterns and sky elements (nishita.h)
+ *
+ * Kinds: ATMOS__LFIELD_DIFFUSION, ATMOS__LFIELD_NISHITA (docs/lightfield.md).
  * Not part of the API. */
 #ifndef ATMOS_LIGHT_LFIELD_H
 #define ATMOS_LIGHT_LFIELD_H
@@ -23,6 +25,7 @@
 typedef enum {
     ATMOS__LFIELD_NONE = 0,
     ATMOS__LFIELD_DIFFUSION = 1, /* mean radiance of the diffuse light, isotropic */
+    ATMOS__LFIELD_NISHITA = 2,   /* Nishita et al. 1996: orders 2, 3 and sky light toward one eye direction */
 } atmos__lfield_kind;
 
 /* The medium on the field's grid: cell (i, j, k) is the box [i h, (i + 1) h) x ... in the
@@ -51,6 +54,10 @@ typedef struct {
     float *LA;   /* [cell * 2 n + w]: L, then [cell * 2 n + n + w]: A = 3/(4 pi) J . d toward one
                     eye (d from the cell's centre; the renderer's per-frame view of the field) */
     float *phi;  /* [cell * n + w]: its fluence (4 pi L), the solver's unknown (its warm start) */
+    float *part; /* ATMOS__LFIELD_NISHITA: [(cell * n + w) * 4 + q], q = 0 the sunlight at the cell's
+                    centre (W m^-2 nm^-1), 1 order 2, 2 order 3, 3 sky and ground light scattered
+                    once (q = 1..3: radiance per unit scattering coefficient toward the eye,
+                    W m^-2 sr^-1 nm^-1; L holds their sum). NULL for other kinds. */
     /* what it was computed for */
     int valid;
     double sun[3];
@@ -108,6 +115,8 @@ static inline void atmos__lfield_sample(const atmos__lfield *f, const float *arr
  * to the beam's direction of travel, of the dropped rest 1 - F (the diffuse source's
  * direction; 0: isotropic). */
 typedef float (*atmos__lkeep_fn)(const void *user, size_t cell, int w, float n, float *mu);
+/* The beam that keeps nothing (plain attenuation: F = 0, the dropped light isotropic). */
+float atmos__lkeep_none(const void *user, size_t cell, int w, float n, float *mu);
 
 /* The source of the diffuse field (sun_source.c): per cell and wavelength the power per unit
  * volume, W m^-3 nm^-1, that the forward beam loses to scattering out of its lobe,

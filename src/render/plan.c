@@ -76,13 +76,15 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
     if ((st = atmos_scene_wavelengths(ctx, scene, &p->wl)) != ATMOS_OK) goto fail;
     if ((st = atmos_scene_atmosphere_create(ctx, scene, &p->wl, &p->atm)) != ATMOS_OK) goto fail;
     if ((st = plan_volume(p, volume, &d)) != ATMOS_OK) goto fail;
-    if ((p->renderer == ATMOS_RENDERER_SLICE || p->renderer == ATMOS_RENDERER_HARRIS) && !p->volume) {
+    if ((p->renderer == ATMOS_RENDERER_SLICE || p->renderer == ATMOS_RENDERER_NISHITA || p->renderer == ATMOS_RENDERER_HARRIS) &&
+        !p->volume) {
         st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: the %s renderer needs a volume", atmos_renderer_name(p->renderer));
         goto fail;
     }
     if (p->renderer != ATMOS_RENDERER_PATH) p->sky_keep = atmos__sky_keep_create(); /* NULL: per frame */
     if (p->renderer == ATMOS_RENDERER_SLICE) st = atmos__slice_plan_create(p, &p->slice);
     else if (p->renderer == ATMOS_RENDERER_PATH) st = atmos__path_plan_create(p, &p->path);
+    else if (p->renderer == ATMOS_RENDERER_NISHITA) st = atmos__nishita_plan_create(p, &p->nishita);
     else if (p->renderer == ATMOS_RENDERER_HARRIS) st = atmos__harris_plan_create(p, &p->harris);
     if (st != ATMOS_OK) goto fail;
     *out = p;
@@ -97,6 +99,7 @@ void atmos_plan_destroy(atmos_plan *p)
     if (!p) return;
     atmos__slice_plan_destroy(p->slice);
     atmos__path_plan_destroy(p->path);
+    atmos__nishita_plan_destroy(p->nishita);
     atmos__harris_plan_destroy(p->harris);
     atmos__sky_keep_destroy(p->sky_keep);
     atmos_volume_optics_free(&p->own_optics);
@@ -270,6 +273,7 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
     static const char *const names[] = {"sky (analytic single scattering of the atmosphere)",
                                         "slice (Riley et al. 2004, half-angle slicing)",
                                         "path (spectral Monte Carlo volumetric path tracing)",
+                                        "nishita (Nishita et al. 1996, orders 1-3 and sky light by a light field)",
                                         "harris (Harris 2002, particle clouds: multiple forward scattering, splats)"};
     char buf[256];
     double el = 0, az = 0;
@@ -295,6 +299,9 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
         atmos_image_set_meta(out, "atmos:path", buf);
         snprintf(buf, sizeof buf, "%.6g", p->stats.path.mean_rel_error);
         atmos_image_set_meta(out, "atmos:path_mean_rel_error", buf);
+    } else if (p->renderer == ATMOS_RENDERER_NISHITA) {
+        atmos__nishita_describe(p, buf, sizeof buf);
+        atmos_image_set_meta(out, "atmos:nishita", buf);
     } else if (p->renderer == ATMOS_RENDERER_HARRIS) {
         atmos__harris_describe(p, buf, sizeof buf);
         atmos_image_set_meta(out, "atmos:harris", buf);
@@ -328,6 +335,8 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
         st = atmos__sky_render(ctx, p->atm, &v, &r, out, p->sky_keep);
     } else if (p->renderer == ATMOS_RENDERER_SLICE) {
         st = atmos__slice_render(p, &v, &r, out, &stats->slice);
+    } else if (p->renderer == ATMOS_RENDERER_NISHITA) {
+        st = atmos__nishita_render(p, &v, &r, out);
     } else if (p->renderer == ATMOS_RENDERER_HARRIS) {
         st = atmos__harris_render(p, &v, &r, out);
     } else {

@@ -9,6 +9,7 @@
 
 typedef struct atmos__slice_plan atmos__slice_plan;
 typedef struct atmos__path_plan atmos__path_plan;
+typedef struct atmos__nishita_plan atmos__nishita_plan;
 typedef struct atmos__harris_plan atmos__harris_plan;
 
 struct atmos_plan {
@@ -34,6 +35,7 @@ struct atmos_plan {
     atmos__sky_keep *sky_keep;          /* the sky's per-eye tables (sky and slice renderers) */
     atmos__slice_plan *slice;
     atmos__path_plan *path;
+    atmos__nishita_plan *nishita;
     atmos__harris_plan *harris;
 };
 
@@ -59,6 +61,15 @@ atmos_status atmos__path_render(atmos_plan *p, const atmos__view *v, const atmos
 atmos_status atmos__path_variance(const atmos_plan *p, atmos_image **out);
 atmos_status atmos__path_order(const atmos_plan *p, atmos_image **out);
 void atmos__path_describe(const atmos_plan *p, char *buf, size_t cap);
+
+/* The Nishita renderer's part (nishita_plan.c): the render grid, the optics, the sunlight's
+ * attenuation per voxel and the light field, each kept until the sun (or the eye's direction)
+ * changes. */
+atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out);
+void atmos__nishita_plan_destroy(atmos__nishita_plan *s);
+/* The sky, then the volume by eye rays over it, over the pixels of r (nishita_render.c). */
+atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);
+void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap);
 
 /* Harris's particle renderer (harris_render.c): the volume's particles, their light from the
  * sun and the sky lights (kept until the sun moves). */

@@ -1088,11 +1088,11 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
 {
     static const char *const keys[] = {"name", "image", "camera", "sun", "atmosphere", "wavelengths",
                                        "output", "renderer", "particles", "background", "volume", "slice",
-                                       "path", "animation", "harris"};
-    static const char *const renderers[] = {"sky", "slice", "path", "harris"};
+                                       "path", "animation", "nishita", "harris"};
+    static const char *const renderers[] = {"sky", "slice", "path", "nishita", "harris"};
     enum {
         K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER, K_PARTICLES,
-        K_BACKGROUND, K_VOLUME, K_SLICE, K_PATH, K_ANIMATION, K_HARRIS
+        K_BACKGROUND, K_VOLUME, K_SLICE, K_PATH, K_ANIMATION, K_NISHITA, K_HARRIS
     };
     jp p = {ctx, source};
     obj_iter it;
@@ -1101,7 +1101,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
     const char *name = NULL;
     int k, renderer;
     if (!cJSON_IsObject(root)) return type_error(&p, "/", "an object", root);
-    TRY(iter_begin(&p, root, "", keys, 15, &it));
+    TRY(iter_begin(&p, root, "", keys, 16, &it));
     for (;;) {
         TRY(iter_next(&p, &it, &k, &v, ip));
         if (k < 0) {
@@ -1129,7 +1129,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_WAVELENGTHS: TRY(parse_wavelengths(&p, v, ip, s)); break;
         case K_OUTPUT: TRY(parse_output(&p, v, ip, s)); break;
         case K_RENDERER:
-            TRY(get_enum(&p, v, ip, renderers, 4, &renderer));
+            TRY(get_enum(&p, v, ip, renderers, 5, &renderer));
             s->renderer = (atmos_renderer_kind)renderer;
             break;
         case K_PARTICLES: TRY(parse_particles(&p, v, ip, s)); break;
@@ -1138,6 +1138,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_SLICE: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_SLICE, s)); break;
         case K_PATH: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_PATH, s)); break;
         case K_ANIMATION: TRY(parse_animation(&p, v, ip, s)); break;
+        case K_NISHITA: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_NISHITA, s)); break;
         case K_HARRIS: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_HARRIS, s)); break;
         }
     }

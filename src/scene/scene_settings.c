@@ -10,6 +10,7 @@
 
 #define SLICE(field) offsetof(atmos_scene, slice.field)
 #define PATH(field) offsetof(atmos_scene, path.field)
+#define NISHITA(field) offsetof(atmos_scene, nishita.field)
 #define HARRIS(field) offsetof(atmos_scene, harris.field)
 
 static const char *const update_names[] = {"eq25", "eq24", NULL};
@@ -60,6 +61,22 @@ static const atmos_setting path_settings[] = {
      "the aureole estimate in droplet clouds (off: same mean, more fireflies)", PATH(aureole)},
 };
 
+static const atmos_setting nishita_settings[] = {
+    {"orders", "nishita-orders", ATMOS_SETTING_INT, "", 1, 3, 0, 0, 3, NULL, 0,
+     "highest scattering order of the sunlight (1: single scattering; 2, 3: by reference patterns)",
+     NISHITA(orders)},
+    {"ratio", "nishita-ratio", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 0.95, NULL, 0,
+     "the share r of the sample space's contribution the reference patterns keep", NISHITA(ratio)},
+    {"paths", "nishita-paths", ATMOS_SETTING_INT, "", 1, 100000, 0, 0, 256, NULL, 0,
+     "order-3 paths computed per cell (n1, chosen at random among the pattern's)", NISHITA(paths)},
+    {"cells", "nishita-cells", ATMOS_SETTING_INT, "", 4, 96, 0, 0, 32, NULL, 0,
+     "the light field's grid: at most this many cells per axis", NISHITA(cells)},
+    {"sky", "no-nishita-sky", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "the sky's and the ground's light through sky elements (off: the sunlight alone)", NISHITA(sky)},
+    {"step_pct", "nishita-step", ATMOS_SETTING_INT, "%", 5, 400, 0, 0, 50, NULL, 0,
+     "eye-ray step, per cent of a render voxel", NISHITA(step_scale_pct)},
+};
+
 static const atmos_setting harris_settings[] = {
     {"spacing_m", "spacing", ATMOS_SETTING_REAL, "m", 0, 1e5, 0, 0, 0, NULL, 0,
      "one particle per cell of this edge; 0 = the volume's voxel, coarser until at most max_particles",
@@ -89,6 +106,7 @@ const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *
     const atmos_setting *t = NULL;
     if (renderer == ATMOS_RENDERER_SLICE) t = slice_settings, n = (int)(sizeof slice_settings / sizeof *t);
     if (renderer == ATMOS_RENDERER_PATH) t = path_settings, n = (int)(sizeof path_settings / sizeof *t);
+    if (renderer == ATMOS_RENDERER_NISHITA) t = nishita_settings, n = (int)(sizeof nishita_settings / sizeof *t);
     if (renderer == ATMOS_RENDERER_HARRIS) t = harris_settings, n = (int)(sizeof harris_settings / sizeof *t);
     if (count) *count = n;
     return t;
@@ -96,7 +114,7 @@ const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *
 
 const char *atmos_renderer_name(atmos_renderer_kind renderer)
 {
-    static const char *const names[] = {"sky", "slice", "path", "harris"};
+    static const char *const names[] = {"sky", "slice", "path", "nishita", "harris"};
     return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_LAST ? names[renderer] : NULL;
 }
 

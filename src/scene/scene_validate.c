@@ -343,7 +343,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/density_unit",
                                  "must be auto, per_m3, g_m3 or fraction, got %d", (int)s->volume.density_unit);
     if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_LAST)
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice, path or harris, got %d",
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice, path, nishita or harris, got %d",
                                  (int)s->renderer);
     const atmos_scene_sun *sun = &s->sun;
     if (sun->irradiance_count != 0 && sun->irradiance_count != 1 && sun->irradiance_count != 3)
@@ -359,7 +359,8 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     if (!memchr(s->volume.source, '\0', sizeof s->volume.source))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/file", "is not terminated");
     /* (The path tracer renders the atmosphere and the ground alone when there is no volume.) */
-    if ((s->renderer == ATMOS_RENDERER_SLICE || s->renderer == ATMOS_RENDERER_HARRIS) && !s->volume.source[0])
+    if ((s->renderer == ATMOS_RENDERER_SLICE || s->renderer == ATMOS_RENDERER_NISHITA || s->renderer == ATMOS_RENDERER_HARRIS) &&
+        !s->volume.source[0])
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer",
                                  "\"%s\" renders a volume: the scene needs \"volume\" (a file or a generator)",
                                  atmos_renderer_name(s->renderer));

@@ -235,7 +235,7 @@ typedef struct bad_case {
 
 static const bad_case bad_cases[] = {
     /* structure and types */
-    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path, animation, harris)", NULL},
+    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path, animation, nishita, harris)", NULL},
     {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
     {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
     {"{\"a/b~c\": 1}", ATMOS_E_INVALID_ARG, "/a~1b~0c: unknown key", NULL},
@@ -254,7 +254,7 @@ static const bad_case bad_cases[] = {
     {"{\"output\": {\"exr_pixel\": \"double\"}}", ATMOS_E_INVALID_ARG, "/output/exr_pixel: must be one of float, half", NULL},
     {"{\"output\": {\"exposure\": \"bright\"}}", ATMOS_E_INVALID_ARG, "/output/exposure: must be \"auto\" or a number", NULL},
     {"{\"output\": {\"exposure\": true}}", ATMOS_E_INVALID_ARG, "/output/exposure: expected \"auto\" or a number (EV100), got a boolean", NULL},
-    {"{\"renderer\": \"raytrace\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, slice, path, harris, got \"raytrace\"", NULL},
+    {"{\"renderer\": \"raytrace\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, slice, path, nishita, harris, got \"raytrace\"", NULL},
     /* renderers, background, volume */
     {"{\"renderer\": \"slice\"}", ATMOS_E_INVALID_ARG, "/renderer: \"slice\" renders a volume: the scene needs \"volume\"", NULL},
     {"{\"renderer\": \"sky\", \"volume\": {\"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume: the sky renderer draws no volume", NULL},

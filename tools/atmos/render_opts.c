@@ -148,7 +148,7 @@ static int parse_vec3(const char *opt, const char *arg, double v[3], int *given)
 static int parse_named(int c, const char *arg, render_opts *o)
 {
     static const char *const cams[] = {"pinhole", "fisheye", "equirect"}, *const tones[] = {"filmic", "reinhard", "clamp"},
-                             *const renderers[] = {"sky", "slice", "path", "harris"}, *const airs[] = {"riley", "homogeneous"};
+                             *const renderers[] = {"sky", "slice", "path", "nishita", "harris"}, *const airs[] = {"riley", "homogeneous"};
     switch (c) {
     case 'o': o->png = arg; return 1;
     case O_EXR: o->exr = arg; return 1;
@@ -164,7 +164,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_RGB: o->rgb = 1; return 1;
     case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
-    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 4, &o->renderer);
+    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 5, &o->renderer);
     case O_ATMOSPHERE: return parse_choice("--atmosphere", arg, airs, 2, &o->air);
     case O_EXPOSURE:
         if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
@@ -460,7 +460,8 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
     if (o->volume_pos_given) s->volume.placed = 1, memcpy(s->volume.position_m, o->volume_pos, sizeof o->volume_pos);
     if (o->density_scale > 0) s->volume.density_scale = o->density_scale;
     if (o->tau && !s->volume.source[0]) return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
-    if (!o->scene_path && (r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_HARRIS) && !s->volume.source[0])
+    if (!o->scene_path && (r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_NISHITA || r == ATMOS_RENDERER_HARRIS) &&
+        !s->volume.source[0])
         return cli_usage_error(C, "--renderer %s needs --volume FILE or --volume generate:PRESET", atmos_renderer_name(r));
     return CLI_EXIT_OK;
 }
@@ -551,10 +552,12 @@ void render_opts_help(void)
            "                                default the first frame's is kept for all (a locked exposure)\n"
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
-           "      --renderer sky|slice|path|harris   the atmosphere alone (default), Riley et al.'s half-angle\n"
-           "                                slicing over a volume (default when a volume is given), spectral\n"
-           "                                Monte Carlo path tracing (the reference, docs/path.md), or Harris's\n"
-           "                                particle clouds (the volume as particles, docs/particles.md)\n"
+           "      --renderer sky|slice|path|nishita|harris   the atmosphere alone (default), Riley et\n"
+           "                                al.'s half-angle slicing over a volume (default when a volume is\n"
+           "                                given), spectral Monte Carlo path tracing (the reference,\n"
+           "                                docs/path.md), Nishita et al. 1996's ray marching with orders 2-3\n"
+           "                                and sky light from a light field (docs/lightfield.md), or\n"
+           "                                Harris's particle clouds (the volume as particles, docs/particles.md)\n"
            "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
@@ -586,6 +589,7 @@ void render_opts_help(void)
            "rendering renderer's is used.\n\n");
     help_settings(ATMOS_RENDERER_SLICE, "Slice renderer");
     help_settings(ATMOS_RENDERER_PATH, "Path tracer");
+    help_settings(ATMOS_RENDERER_NISHITA, "Nishita renderer (Nishita et al. 1996: orders 2-3 and sky light by a light field)");
     help_settings(ATMOS_RENDERER_HARRIS, "Harris's particle renderer");
     printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"

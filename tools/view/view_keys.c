@@ -30,7 +30,7 @@ static const view_key keys[] = {
     {SDLK_MINUS, VA_EXPOSURE_DOWN, "-", "darker by half a stop"},
     {SDLK_KP_MINUS, VA_EXPOSURE_DOWN, "Keypad -", "darker"},
     {SDLK_o, VA_ORBIT, "O", "orbit the volume / fly freely"},
-    {SDLK_r, VA_RENDERER, "R", "next renderer: slice, harris (particles), path (progressive), sky"},
+    {SDLK_r, VA_RENDERER, "R", "next renderer: slice, harris (particles), nishita, path (progressive), sky"},
     {SDLK_v, VA_SPECTRAL, "V", "rgb / spectral wavelengths"},
     {SDLK_h, VA_OVERLAY, "H", "overlay on / off"},
     {SDLK_F12, VA_SAVE, "F12", "save the frame: EXR, PNG and the scene JSON that renders it"},

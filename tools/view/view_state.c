@@ -136,9 +136,10 @@ void view_state_apply(view_state *s, view_action a, double dt, int fast, int slo
     case VA_EXPOSURE_DOWN: s->ev -= s->manual_exposure ? -0.5 : 0.5; s->changes |= VIEW_CHANGED_LOOK; break;
     case VA_ORBIT: s->orbit = !s->orbit; break;
     case VA_RENDERER: {
-        /* slice -> harris -> path -> sky -> slice with a volume; sky alone without */
-        const atmos_renderer_kind next = s->renderer == ATMOS_RENDERER_SLICE    ? ATMOS_RENDERER_HARRIS
-                                         : s->renderer == ATMOS_RENDERER_HARRIS ? ATMOS_RENDERER_PATH
+        /* slice -> harris -> nishita -> path -> sky -> slice with a volume; sky alone without */
+        const atmos_renderer_kind next = s->renderer == ATMOS_RENDERER_SLICE     ? ATMOS_RENDERER_HARRIS
+                                         : s->renderer == ATMOS_RENDERER_HARRIS  ? ATMOS_RENDERER_NISHITA
+                                         : s->renderer == ATMOS_RENDERER_NISHITA ? ATMOS_RENDERER_PATH
                                          : s->renderer == ATMOS_RENDERER_PATH   ? ATMOS_RENDERER_SKY
                                                                                 : ATMOS_RENDERER_SLICE;
         if (s->has_volume || next == ATMOS_RENDERER_SKY) s->renderer = s->has_volume ? next : ATMOS_RENDERER_SKY;

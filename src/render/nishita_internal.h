@@ -1,0 +1,53 @@
+/* The Nishita renderer ("renderer": "nishita"; Nishita, Dobashi & Nakamae 1996): eye rays
+ * marched through the volume, the first order of the sunlight computed at every sample with
+ * the fields' own phase functions and the sunlight's attenuation stored per render voxel, the
+ * orders 2 and 3 and the sky's light interpolated from a light field (src/light/nishita.h).
+ *
+ *   nishita_plan.c    the render grid, the optics, the sunlight's attenuation per voxel (one
+ *                     sweep across the grid per sun direction), the light field per sun and
+ *                     eye direction, its sky elements
+ *   nishita_render.c  the eye rays and the composite over the sky
+ *
+ * Not part of the API. */
+#ifndef ATMOS_RENDER_NISHITA_INTERNAL_H
+#define ATMOS_RENDER_NISHITA_INTERNAL_H
+
+#include "light/nishita.h"
+#include "render/plan_internal.h"
+#include "render/slice_grid.h"
+#include "volume/volume_access.h"
+
+struct atmos__nishita_plan {
+    int nf, n;
+    sgrid g;                 /* the volume box-filtered onto the render grid (slice_grid.c) */
+    atmos__vol_xform x;      /* the volume's placement */
+    float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* extinction cross-section, m^2 */
+    float sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* scattering cross-section, m^2 */
+    const atmos_phase_table *phase[ATMOS_VOLUME_MAX_FIELDS];
+    float *col;              /* per render voxel and field: the column density toward the sun, m */
+    double col_sun[3];       /* the sun (grid frame) col was made for */
+    int col_valid;
+    atmos__lmedium med;      /* the light field's medium: cells of s render voxels, forward peak truncated */
+    double trunc[ATMOS_MAX_WAVELENGTHS]; /* the share of the scattering in the forward peak (above the
+                                            phase's value at TRUNC_DEG), counted as not scattered by
+                                            the orders 2-3 */
+    float *fdens;            /* per cell and field: the mean density */
+    int s;
+    atmos__lfield field;
+    double field_sun[3], field_ev[3];
+    int field_valid;
+    atmos__nishita_stats stats;
+    double col_s;            /* the last sweep's time */
+};
+
+/* The forward-peak truncation of the orders 2-3 (nishita_light.c): trunc[] from the fields'
+ * mean phase function, the field's medium scaled (sig_s (1 - f), sig_t - f sig_s). */
+void atmos__nishita_truncate(atmos__nishita_plan *np);
+
+/* The sunlight's column densities for the sun sun_g (grid frame), unless already made. */
+void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int threads);
+/* The light field for the sun sun_w (world) and the eye at eye_w, unless made for the same
+ * sun and eye direction. */
+atmos_status atmos__nishita_field_update(atmos_plan *p, const double sun_w[3], const double eye_w[3]);
+
+#endif

@@ -1,0 +1,148 @@
+/* The Nishita renderer's plan (nishita_internal.h): the render grid and the optics once, the
+ * sunlight's attenuation per render voxel once per sun direction, the light field of orders 2
+ * and 3 and of the sky once per sun and eye direction (Nishita et al. 1996 §3.4 step 2:
+ * "the attenuation ratio for the sunlight at each voxel is stored"). */
+#include "atmosphere/atmosphere_ops.h"
+#include "core/vec.h"
+#include "render/nishita_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GRID_CAP 256 /* render voxels per axis at most */
+
+void atmos__nishita_plan_destroy(atmos__nishita_plan *s)
+{
+    if (!s) return;
+    atmos__sgrid_free(&s->g);
+    free(s->col), free(s->fdens);
+    atmos__lmedium_free(&s->med);
+    atmos__lfield_free(&s->field);
+    free(s);
+}
+
+/* The mean density of each field over the s^3 render voxels of every cell, and the cells'
+ * extinction and scattering per wavelength. */
+static void cell_medium(atmos__nishita_plan *np)
+{
+    const sgrid *g = &np->g;
+    atmos__lmedium *m = &np->med;
+    const int nf = np->nf, n = np->n, s = np->s;
+    for (size_t cell = 0; cell < atmos__lmedium_cells(m); cell++) {
+        const int I = (int)(cell % (size_t)m->c[0]), J = (int)(cell / (size_t)m->c[0] % (size_t)m->c[1]),
+                  K = (int)(cell / ((size_t)m->c[0] * m->c[1]));
+        double sum[ATMOS_VOLUME_MAX_FIELDS] = {0};
+        int cnt = 0;
+        for (int k = K * s; k < (K + 1) * s && k < g->c[2]; k++)
+            for (int j = J * s; j < (J + 1) * s && j < g->c[1]; j++)
+                for (int i = I * s; i < (I + 1) * s && i < g->c[0]; i++, cnt++)
+                    for (int f = 0; f < nf; f++) sum[f] += g->v[(((size_t)k * g->c[1] + j) * g->c[0] + i) * nf + f];
+        float *d = np->fdens + cell * nf;
+        for (int f = 0; f < nf; f++) d[f] = cnt ? (float)(sum[f] / cnt) : 0.0f;
+        for (int w = 0; w < n; w++) {
+            double st = 0, ss = 0;
+            for (int f = 0; f < nf; f++) st += d[f] * np->sig[f][w], ss += d[f] * np->sca[f][w];
+            m->sig_t[cell * n + w] = (float)st, m->sig_s[cell * n + w] = (float)ss;
+        }
+    }
+}
+
+atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out)
+{
+    atmos_context *ctx = p->ctx;
+    atmos__nishita_plan *np = calloc(1, sizeof *np);
+    if (!np) return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory");
+    np->nf = atmos_volume_field_count(p->volume), np->n = p->wl.count;
+    atmos__vol_xform_init(p->volume, p->offset, &np->x);
+    for (int f = 0; f < np->nf; f++) {
+        np->phase[f] = p->optics->phase[f];
+        for (int w = 0; w < np->n; w++) {
+            double se, ss;
+            atmos_phase_table_cross_sections(np->phase[f], w, &se, &ss);
+            np->sig[f][w] = (float)se, np->sca[f][w] = (float)ss;
+        }
+    }
+    atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, GRID_CAP, &np->g);
+    if (st == ATMOS_OK && np->g.v) {
+        const sgrid *g = &np->g;
+        int big = g->c[0] > g->c[1] ? g->c[0] : g->c[1];
+        big = big > g->c[2] ? big : g->c[2];
+        const int cap = p->scene.nishita.cells > 0 ? p->scene.nishita.cells : 32;
+        np->s = (big + cap - 1) / cap;
+        const int cx = (g->c[0] + np->s - 1) / np->s, cy = (g->c[1] + np->s - 1) / np->s,
+                  cz = (g->c[2] + np->s - 1) / np->s;
+        const size_t vox = (size_t)g->c[0] * g->c[1] * g->c[2];
+        np->col = malloc(sizeof(float) * vox * np->nf);
+        np->fdens = malloc(sizeof(float) * (size_t)cx * cy * cz * np->nf);
+        if (!np->col || !np->fdens || !atmos__lmedium_alloc(&np->med, cx, cy, cz, np->n, np->s / (double)g->sc))
+            st = atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the light field");
+        else
+            cell_medium(np), atmos__nishita_truncate(np);
+    }
+    if (st != ATMOS_OK) {
+        atmos__nishita_plan_destroy(np);
+        return st;
+    }
+    *out = np;
+    return ATMOS_OK;
+}
+
+/* Bilinear value of plane array a (nx x ny, m floats per point, member f) at (x, y); 0 outside. */
+static float plane_at(const float *a, int nx, int ny, int m, int f, double x, double y)
+{
+    if (!(x >= 0 && y >= 0 && x <= nx - 1 && y <= ny - 1)) return 0.0f;
+    int i = (int)x, j = (int)y;
+    if (i > nx - 2) i = nx - 2 < 0 ? 0 : nx - 2;
+    if (j > ny - 2) j = ny - 2 < 0 ? 0 : ny - 2;
+    const double u = x - i, v = y - j;
+    const int i1 = i + 1 < nx ? i + 1 : i, j1 = j + 1 < ny ? j + 1 : j;
+    return (float)((1 - u) * (1 - v) * a[((size_t)j * nx + i) * m + f] + u * (1 - v) * a[((size_t)j * nx + i1) * m + f] +
+                   (1 - u) * v * a[((size_t)j1 * nx + i) * m + f] + u * v * a[((size_t)j1 * nx + i1) * m + f]);
+}
+
+/* The column density toward the sun at every render voxel, by one sweep across the grid
+ * along the axis nearest to the sun's direction: a voxel's column is the column one plane
+ * nearer the sun (bilinear there) plus the trapezoid of the densities over the step between
+ * them. Planes one after another, the rows of a plane in parallel. */
+void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int threads)
+{
+    if (np->col_valid && !memcmp(np->col_sun, sun_g, sizeof np->col_sun)) return;
+    const double t0 = atmos__now();
+    const sgrid *g = &np->g;
+    const int nf = np->nf;
+    int a = 0;
+    for (int q = 1; q < 3; q++)
+        if (fabs(sun_g[q]) > fabs(sun_g[a])) a = q;
+    const int b = (a + 1) % 3, c = (a + 2) % 3, na = g->c[a], nb = g->c[b], nc = g->c[c];
+    const double db = sun_g[b] / fabs(sun_g[a]), dc = sun_g[c] / fabs(sun_g[a]);
+    const double len = 1.0 / fabs(sun_g[a]) / g->sc; /* metres per plane along the sun */
+    const int step = sun_g[a] > 0 ? -1 : 1;           /* from the sun's side */
+    size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf};
+    float *plane = malloc(sizeof(float) * (size_t)nb * nc * nf * 4);
+    if (!plane) return;
+    float *pc = plane, *pd = plane + (size_t)nb * nc * nf, *qc = pd + (size_t)nb * nc * nf,
+          *qd = qc + (size_t)nb * nc * nf; /* previous: columns, densities; current: same */
+    memset(plane, 0, sizeof(float) * (size_t)nb * nc * nf * 2);
+    for (int ia = step > 0 ? 0 : na - 1; ia >= 0 && ia < na; ia += step) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (int jc = 0; jc < nc; jc++)
+            for (int jb = 0; jb < nb; jb++) {
+                const size_t v = ia * str[a] + jb * str[b] + jc * str[c], e = ((size_t)jc * nb + jb) * nf;
+                for (int f = 0; f < nf; f++) {
+                    const float d = g->v[v + f];
+                    const float up = plane_at(pd, nb, nc, nf, f, jb + db, jc + dc);
+                    qd[e + f] = d;
+                    qc[e + f] = plane_at(pc, nb, nc, nf, f, jb + db, jc + dc) + (float)(0.5 * len * (d + up));
+                    np->col[v + f] = qc[e + f];
+                }
+            }
+        float *t = pc;
+        pc = qc, qc = t;
+        t = pd, pd = qd, qd = t;
+    }
+    free(plane);
+    memcpy(np->col_sun, sun_g, sizeof np->col_sun);
+    np->col_valid = 1;
+    np->col_s = atmos__now() - t0;
+}

@@ -1,0 +1,157 @@
+/* The Nishita renderer's eye rays (nishita_internal.h; Nishita et al. 1996 §3.4 step 3, Eq. 1):
+ * per pixel a ray through the volume's box in steps of a fraction of a render voxel; at each
+ * sample the first order exactly (the fields' own phase functions at the ray's angle to the
+ * sun, the sunlight attenuated by the column density stored per render voxel) and the
+ * light field's orders 2-3 and sky light (per unit scattering coefficient) interpolated and
+ * multiplied by the sample's scattering coefficient; the sky behind attenuated by the volume
+ * and the air in front of the volume added as the slice renderer's composite does. */
+#include "atmosphere/atmosphere_ops.h"
+#include "core/vec.h"
+#include "render/nishita_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    const atmos__nishita_plan *np;
+    const atmos_atmosphere *atm;
+    const atmos_camera *cam;
+    double sun_w[3], eye_g[3];
+    double E[ATMOS_MAX_WAVELENGTHS]; /* the sunlight at the box's centre */
+    double dt;                       /* step, m */
+    int use_field;
+} rjob;
+
+/* Trilinear value of m floats per voxel of a render-grid array at render-voxel coordinate
+ * (u, v, w) (voxel centres at integers; clamped into the grid). */
+static void grid_at(const sgrid *g, const float *arr, int m, double u, double v, double w, float *out)
+{
+    const double x[3] = {u, v, w};
+    int i[3];
+    double f[3];
+    for (int a = 0; a < 3; a++) {
+        double y = x[a] < 0 ? 0 : (x[a] > g->c[a] - 1 ? g->c[a] - 1 : x[a]);
+        i[a] = (int)y;
+        if (i[a] > g->c[a] - 2) i[a] = g->c[a] - 2;
+        f[a] = y - i[a];
+    }
+    const size_t sx = (size_t)m, sy = (size_t)g->c[0] * m, sz = (size_t)g->c[0] * g->c[1] * m;
+    const float *p = arr + (((size_t)i[2] * g->c[1] + i[1]) * g->c[0] + i[0]) * m;
+    for (int q = 0; q < m; q++) {
+        const double a00 = p[q] + f[0] * (p[sx + q] - p[q]), a10 = p[sy + q] + f[0] * (p[sx + sy + q] - p[sy + q]),
+                     a01 = p[sz + q] + f[0] * (p[sx + sz + q] - p[sz + q]),
+                     a11 = p[sy + sz + q] + f[0] * (p[sx + sy + sz + q] - p[sy + sz + q]);
+        const double b0 = a00 + f[1] * (a10 - a00), b1 = a01 + f[1] * (a11 - a01);
+        out[q] = (float)(b0 + f[2] * (b1 - b0));
+    }
+}
+
+/* The volume's radiance L and transmittance T along direction d (world) from the eye, and the
+ * distance th of its light's centre (the transmittance-weighted mean). 0 if the ray misses. */
+static int march(const rjob *J, const double dw[3], double *L, double *T, double *th)
+{
+    const atmos__nishita_plan *np = J->np;
+    const sgrid *g = &np->g;
+    const int n = np->n, nf = np->nf;
+    double dg[3], t0, t1;
+    atmos__vol_dir_to_frame(&np->x, dw, dg);
+    if (!atmos__ray_box(J->eye_g, dg, g->box_lo, g->box_hi, &t0, &t1) || !(t1 > t0)) return 0;
+    if (t0 < 0) t0 = 0;
+    double pf[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    const double mu = atmos__dot3(dw, J->sun_w); /* cos of the angle between the sunlight's and the ray's travel */
+    for (int f = 0; f < nf; f++)
+        for (int w = 0; w < n; w++) pf[f][w] = atmos_phase_table_eval(np->phase[f], w, mu);
+    for (int w = 0; w < n; w++) L[w] = 0, T[w] = 1;
+    const int steps = (int)ceil((t1 - t0) / J->dt);
+    const double dt = (t1 - t0) / steps;
+    double wsum = 0, tsum = 0;
+    for (int s = 0; s < steps; s++) {
+        const double t = t0 + (s + 0.5) * dt;
+        double u[3];
+        for (int a = 0; a < 3; a++) u[a] = (J->eye_g[a] + t * dg[a]) * g->sc + g->off[a];
+        float dens[ATMOS_VOLUME_MAX_FIELDS], col[ATMOS_VOLUME_MAX_FIELDS], Lf[ATMOS_MAX_WAVELENGTHS];
+        grid_at(g, g->v, nf, u[0], u[1], u[2], dens);
+        float any = 0;
+        for (int f = 0; f < nf; f++) any += dens[f];
+        if (!(any > 0)) continue;
+        grid_at(g, np->col, nf, u[0], u[1], u[2], col);
+        if (J->use_field) atmos__lfield_sample(&np->field, np->field.L, n, (float)u[0], (float)u[1], (float)u[2], Lf);
+        double Tmax = 0;
+        for (int w = 0; w < n; w++) {
+            double st = 0, ss = 0, s1 = 0, tau = 0;
+            for (int f = 0; f < nf; f++) {
+                st += dens[f] * np->sig[f][w], ss += dens[f] * np->sca[f][w];
+                s1 += dens[f] * np->sca[f][w] * pf[f][w];
+                tau += col[f] * np->sig[f][w];
+            }
+            /* the field's radiance is per unit truncated scattering, sig_s (1 - f) */
+            double S = s1 * J->E[w] * exp(-tau) + (J->use_field ? ss * (1 - np->trunc[w]) * (Lf[w] > 0 ? Lf[w] : 0) : 0);
+            const double a = st > 0 ? -expm1(-st * dt) : 0;
+            L[w] += st > 0 ? T[w] * S / st * a : 0;
+            if (w == n / 2) wsum += T[w] * a, tsum += t * T[w] * a;
+            T[w] *= 1 - a;
+            Tmax = T[w] > Tmax ? T[w] : Tmax;
+        }
+        if (Tmax < 1e-5) break;
+    }
+    *th = wsum > 0 ? tsum / wsum : 0.5 * (t0 + t1);
+    return 1;
+}
+
+/* Pixel (x, y): the volume over the sky image's value px (B = front + T_front back): front +
+ * T_front L + T (B - front), the air's part "front" in front of the volume's light. */
+static void shade(const rjob *J, int x, int y, float *px)
+{
+    double d[3], L[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS], th;
+    const int n = J->np->n;
+    if (!atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d) || !march(J, d, L, T, &th)) return;
+    double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
+    const double tg = atmos_atmosphere_ground_distance(J->atm, J->cam->position, d);
+    if (th > tg) th = tg;
+    atmos_atmosphere_inscatter(J->atm, J->cam->position, d, th, J->sun_w, front);
+    atmos_atmosphere_transmittance(J->atm, J->cam->position, d, th, Tf);
+    for (int c = 0; c < n; c++) {
+        const double r = front[c] + Tf[c] * L[c] + T[c] * (px[c] - front[c]);
+        px[c] = (float)(isfinite(r) && r > 0 ? r : 0.0);
+    }
+}
+
+atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
+{
+    atmos__nishita_plan *np = p->nishita;
+    atmos_status st = atmos__sky_render(p->ctx, p->atm, v, r, out, p->sky_keep);
+    if (st != ATMOS_OK || !np->g.v) return st;
+    const int threads = atmos__threads(p->ctx);
+    double sun_g[3], rel[3], cen[3], cw[3];
+    atmos__vol_dir_to_frame(&np->x, v->sun, sun_g);
+    atmos__nishita_columns(np, sun_g, threads);
+    if (!np->col_valid) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the sunlight");
+    const int use_field = p->scene.nishita.orders > 1 || p->scene.nishita.sky;
+    if (use_field && (st = atmos__nishita_field_update(p, v->sun, v->cam.position)) != ATMOS_OK) return st;
+    rjob J;
+    memset(&J, 0, sizeof J);
+    J.np = np, J.atm = p->atm, J.cam = &v->cam, J.use_field = use_field;
+    memcpy(J.sun_w, v->sun, sizeof J.sun_w);
+    for (int a = 0; a < 3; a++) rel[a] = v->cam.position[a] - np->x.org[a], cen[a] = 0.5 * (np->g.box_lo[a] + np->g.box_hi[a]);
+    atmos__vol_dir_to_frame(&np->x, rel, J.eye_g);
+    atmos__vol_frame_to_point(&np->x, cen, cw);
+    atmos_atmosphere_sunlight(p->atm, cw, v->sun, J.E);
+    J.dt = p->scene.nishita.step_scale_pct / 100.0 / np->g.sc;
+    const int W = out->width, C = out->channels;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int y = r->y0; y < r->y1; y++)
+        for (int x = r->x0; x < r->x1; x++) shade(&J, x, y, out->pixels + ((size_t)y * W + x) * C);
+    return ATMOS_OK;
+}
+
+void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap)
+{
+    const atmos__nishita_plan *np = p->nishita;
+    const atmos_scene_nishita *s = &p->scene.nishita;
+    snprintf(buf, cap, "orders 1-%d, ratio %g, %d order-3 paths per cell, sky %s; field %dx%dx%d cells of %d voxels; "
+             "patterns: order 2 %d paths, order 3 %d of %lld",
+             s->orders, s->ratio, s->paths, s->sky ? "on" : "off", np->med.c[0], np->med.c[1], np->med.c[2], np->s,
+             np->stats.n2, np->stats.n3, np->stats.n3_space);
+}
