@@ -10,16 +10,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The sky lights' directions: sky_lights directions at 30 degrees elevation evenly in
- * azimuth (the first toward the sun's azimuth) and one at the zenith, each standing for an
- * equal share of the upper hemisphere. */
+/* The sky lights' directions: one at the zenith and sky_lights - 1 at 30 degrees elevation
+ * evenly in azimuth, half a step off the sun's azimuth (so that none looks at the sun), each
+ * standing for an equal share of the upper hemisphere. */
 static void sky_dirs(int n, const double sun[3], double (*d)[3])
 {
     if (n <= 0) return;
     double el, az;
     atmos_direction_to_angles(sun, &el, &az);
     d[0][0] = 0, d[0][1] = 1, d[0][2] = 0;
-    for (int i = 1; i < n; i++) atmos_direction_from_angles(30.0, fmod(az + 360.0 * (i - 1) / (n - 1), 360.0), d[i]);
+    for (int i = 1; i < n; i++) atmos_direction_from_angles(30.0, fmod(az + 360.0 * (i - 0.5) / (n - 1), 360.0), d[i]);
 }
 
 atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const double sun[3])
@@ -35,6 +35,11 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
     for (int j = 1; j < h->nlights; j++) {
         atmos_atmosphere_hit info;
         atmos_atmosphere_radiance(p->atm, c, h->dir[j], sun, h->e[j], &info);
+        if (info.in_sun_disk) { /* the sun is the first light: its disk is not the sky's */
+            double disk[ATMOS_MAX_WAVELENGTHS];
+            atmos_atmosphere_sun_radiance(p->atm, c, sun, disk);
+            for (int k = 0; k < h->o.nw; k++) h->e[j][k] = fmax(0.0, h->e[j][k] - disk[k]);
+        }
         for (int k = 0; k < h->o.nw; k++) h->e[j][k] *= 2.0 * ATMOS_PI / sky; /* radiance x its share of the sky */
     }
     /* each light and each cloud on its own (clouds do not shade one another, as in Harris's
