@@ -68,41 +68,85 @@ static int far_first(const void *a, const void *b)
     return x->d > y->d ? -1 : (x->d < y->d ? 1 : (x->k > y->k) - (x->k < y->k));
 }
 
-/* Cloud k: its impostor (made again when it no longer serves) or its particles. */
-static atmos_status cloud(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
-                          int k, const int rect[4], atmos_image *out)
+/* Whether the sphere (c, r) meets cam's view: inside all four side planes of the frustum
+ * within r (and not wholly behind the eye). */
+static int visible(const atmos_camera *cam, const double c[3], double r)
+{
+    double X = 0, Y = 0, Z = 0;
+    for (int i = 0; i < 3; i++) {
+        const double rel = c[i] - cam->position[i];
+        X += rel * cam->right[i], Y += rel * cam->up[i], Z += rel * cam->forward[i];
+    }
+    const double th = cam->tan_half_fov, tw = th * cam->width / cam->height;
+    return Z > -r && fabs(X) - Z * tw <= r * sqrt(1 + tw * tw) && fabs(Y) - Z * th <= r * sqrt(1 + th * th);
+}
+
+/* How cloud k is drawn this frame: 0 not at all (out of view), 1 its particles, 2 a screen-sized
+ * impostor (the eye inside it), 3 its impostor as it is, 4 its impostor made again. */
+static int mode(const atmos_plan *p, const atmos__harris_plan *h, const atmos__view *v, int k)
 {
     const atmos_scene_harris *hs = &p->scene.harris;
     const atmos__pclusters *c = &h->clouds;
-    const int *idx = c->idx + c->start[k], n = c->start[k + 1] - c->start[k];
-    const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
-                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
+    if (!visible(&v->cam, c->centre[k], c->radius[k])) return 0;
+    if (!hs->impostors || v->cam.type != ATMOS_CAMERA_PINHOLE) return 1;
     const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
     double d2 = 0;
     for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
     const double margin = 1.05 * c->radius[k]; /* an impostor's plane needs the eye well outside */
-    if (!hs->impostors || v->cam.type != ATMOS_CAMERA_PINHOLE) {
+    if (d2 <= margin * margin) return 2;
+    const double tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
+    return atmos__pimpostor_serves(&h->imp[k], c->centre[k], c->radius[k], e, tol, f, hs->impostor_max_res) ? 3 : 4;
+}
+
+/* Makes the impostors of the clouds list[0..n) again, the clouds on the threads (each one's
+ * splats on one: the result does not depend on the thread count). */
+static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
+                           const int *list, int n)
+{
+    const atmos__pclusters *c = &h->clouds;
+    const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
+                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
+    const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
+    for (int q = 0; q < n; q++) air(p, h, v, ap, c->idx + c->start[list[q]], c->start[list[q] + 1] - c->start[list[q]]);
+    atmos_status st = ATMOS_OK;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
+    for (int q = 0; q < n; q++) {
+        const int k = list[q], *idx = c->idx + c->start[k], m = c->start[k + 1] - c->start[k];
+        double d2 = 0;
+        for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
+        const int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
+        const atmos_status sk = atmos__pimpostor_make(p->ctx, &h->imp[k], &h->pc, &h->o, &L, idx, m, c->centre[k],
+                                                      c->radius[k], e, res);
+        if (sk != ATMOS_OK) {
+#pragma omp critical
+            st = sk;
+        }
+    }
+    h->updates += n;
+    return st;
+}
+
+/* Cloud k drawn over the frame as mode() says (its impostor made already). */
+static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
+                         int k, int how, const int rect[4], atmos_image *out)
+{
+    const atmos__pclusters *c = &h->clouds;
+    const int *idx = c->idx + c->start[k], n = c->start[k + 1] - c->start[k];
+    const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
+                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
+    if (how == 1) {
         air(p, h, v, ap, idx, n);
         int drawn = 0;
         atmos_status st = atmos__pcloud_splat(p->ctx, &h->pc, &h->o, &L, idx, n, &v->cam, rect, out, &drawn);
         h->drawn += drawn, h->direct++;
         return st;
     }
-    if (d2 <= margin * margin) { /* the head in the cloud (§3.1): a screen-sized impostor at 1/4 resolution */
+    if (how == 2) { /* the head in the cloud (§3.1): a screen-sized impostor at 1/4 resolution */
         air(p, h, v, ap, idx, n);
         h->direct++, h->updates++;
         return atmos__pimpostor_screen(p->ctx, &h->pc, &h->o, &L, idx, n, &v->cam, 4, rect, out);
     }
-    atmos__pimpostor *im = &h->imp[k];
-    const double tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
-    if (!atmos__pimpostor_serves(im, c->centre[k], c->radius[k], e, tol, f, hs->impostor_max_res)) {
-        air(p, h, v, ap, idx, n);
-        const int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, hs->impostor_max_res);
-        atmos_status st = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, &L, idx, n, c->centre[k], c->radius[k], e, res);
-        if (st != ATMOS_OK) return st;
-        h->updates++;
-    }
-    atmos__pimpostor_draw(p->ctx, im, c->centre[k], c->radius[k], &v->cam, rect, out);
+    atmos__pimpostor_draw(p->ctx, &h->imp[k], c->centre[k], c->radius[k], &v->cam, rect, out);
     return ATMOS_OK;
 }
 
@@ -128,7 +172,15 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     }
     qsort(ord, (size_t)nc, sizeof *ord, far_first);
     h->drawn = h->updates = h->direct = 0;
-    for (int q = 0; q < nc && st == ATMOS_OK; q++) st = cloud(p, h, v, ap, ord[q].k, rect, out);
+    const size_t cap = nc > 0 ? (size_t)nc : 1;
+    int *how = malloc(sizeof(int) * 2 * cap), *stale = how ? how + cap : NULL, nstale = 0;
+    if (!how) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    for (int k = 0; k < nc && how; k++)
+        if ((how[k] = mode(p, h, v, k)) == 4) stale[nstale++] = k;
+    if (st == ATMOS_OK) st = remake(p, h, v, ap, stale, nstale);
+    for (int q = 0; q < nc && st == ATMOS_OK; q++)
+        if (how[ord[q].k]) st = draw(p, h, v, ap, ord[q].k, how[ord[q].k], rect, out);
+    free(how);
     free(ord);
     p->stats.impostor_updates = h->updates;
     return st;

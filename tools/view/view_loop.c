@@ -43,6 +43,24 @@ static atmos_status get_plan(loop *L, const view_state *s, atmos_plan **out)
     return ATMOS_OK;
 }
 
+/* The automatic exposure's scale (atmos_tonemap_scale) of every 4th pixel of every 4th row:
+ * the log average of a frame changes little, and the serial sum over every pixel of a
+ * 1280 x 720 frame took a tenth of its time. */
+static double exposure_scale(const atmos_image *lin, const atmos_tonemap_desc *td)
+{
+    const int step = lin->width * lin->height > 65536 ? 4 : 1, w = (lin->width + step - 1) / step,
+              h = (lin->height + step - 1) / step, C = lin->channels;
+    atmos_image *sub = NULL;
+    if (step == 1 || atmos_image_create(NULL, w, h, C, &sub) != ATMOS_OK) return atmos_tonemap_scale(lin, td);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            memcpy(sub->pixels + ((size_t)y * w + x) * C, lin->pixels + ((size_t)y * step * lin->width + x * step) * C,
+                   sizeof(float) * C);
+    const double scale = atmos_tonemap_scale(sub, td);
+    atmos_image_destroy(sub);
+    return scale;
+}
+
 /* The display image of L->img: linear sRGB, then the tone map with the exposure held as a
  * manual EV (so that a saved scene reproduces it): automatic exposure adapts smoothly
  * (a third of the way in log a frame) unless `snap`. */
@@ -58,7 +76,7 @@ static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int sna
     td.manual_exposure = s->manual_exposure;
     td.exposure_ev = s->ev;
     if (!s->manual_exposure) {
-        const double ls = log(fmax(atmos_tonemap_scale(L->lin, &td), 1e-30));
+        const double ls = log(fmax(exposure_scale(L->lin, &td), 1e-30));
         L->log_scale = (!L->have_scale || snap) ? ls : L->log_scale + (ls - L->log_scale) / 3.0;
         L->have_scale = 1;
         /* manual: scale = 1 / (1.2 2^EV) */
