@@ -29,6 +29,13 @@ int atmos__threads(const atmos_context *ctx);
 void *atmos__big_alloc(size_t bytes);
 /* Monotonic wall-clock time in seconds (for timings and time budgets only). */
 double atmos__now(void);
+/* Indices sorted by a key (keysort.c): ascending, or descending with desc; ties by ascending
+ * index, a total order, so the result does not depend on the sort's algorithm. */
+typedef struct atmos__keyed {
+    double key;
+    int index;
+} atmos__keyed;
+void atmos__keyed_sort(atmos__keyed *a, size_t n, int desc);
 
 /* Writes through a temporary file in the same directory and renames on success,
  * so no half-written file ever appears under path. write_fn gets the open temporary

@@ -19,17 +19,6 @@ typedef struct lframe {
     int res;
 } lframe;
 
-typedef struct order_key {
-    double d;
-    int i;
-} order_key;
-
-static int by_depth(const void *a, const void *b)
-{
-    const order_key *x = a, *y = b;
-    return x->d < y->d ? -1 : (x->d > y->d ? 1 : (x->i > y->i) - (x->i < y->i));
-}
-
 static double dot(const double *a, const float x, const float y, const float z) { return a[0] * x + a[1] * y + a[2] * z; }
 
 static void make_frame(const atmos__pcloud *pc, const int *idx, int n, const double sun[3], int res, double texel_scale,
@@ -98,17 +87,17 @@ static void splat(const atmos__pcloud *pc, int p, const lframe *f, float tc, flo
  * first one's width; a group splats the front halves of its blobs (optical depth tc / 2),
  * reads the light at its particles' centres, then splats the back halves: particles side by
  * side shade each other's centres as the halves of a slab do. */
-static void pass(const atmos__pcloud *pc, int n, const atmos__poptics *o, const lframe *f, const order_key *ord, int k,
+static void pass(const atmos__pcloud *pc, int n, const atmos__poptics *o, const lframe *f, const atmos__keyed *ord, int k,
                  float *trans, float *taus, float *light, float *ns)
 {
     const int res = f->res, nw = o->nw;
     for (size_t t = 0; t < (size_t)res * res; t++) trans[t] = 1.0f, taus[t] = 0.0f;
     for (int q0 = 0, q1; q0 < n; q0 = q1) {
-        const double dmax = ord[q0].d + 0.5 * pc->s[ord[q0].i];
-        for (q1 = q0 + 1; q1 < n && ord[q1].d < dmax; q1++) {}
+        const double dmax = ord[q0].key + 0.5 * pc->s[ord[q0].index];
+        for (q1 = q0 + 1; q1 < n && ord[q1].key < dmax; q1++) {}
         for (int phase = 0; phase < 3; phase++)
             for (int q = q0; q < q1; q++) {
-                const int p = ord[q].i, fi = pc->field[p];
+                const int p = ord[q].index, fi = pc->field[p];
                 const double x = (dot(f->e1, pc->x[p], pc->y[p], pc->z[p]) - f->u0) / f->texel;
                 const double y = (dot(f->e2, pc->x[p], pc->y[p], pc->z[p]) - f->v0) / f->texel;
                 const double a = o->albedo[fi][k], tc = o->sigma_ext[fi][k] * pc->n0[p] * pc->s[p] * SQRT_2PI;
@@ -133,7 +122,7 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
     if (n == 0) return ATMOS_OK;
     lframe f;
     make_frame(pc, idx, n, sun, res, texel_scale > 0 ? texel_scale : 1.0, &f);
-    order_key *ord = malloc(sizeof *ord * (size_t)n);
+    atmos__keyed *ord = malloc(sizeof *ord * (size_t)n);
     float *ns = malloc(sizeof(float) * (size_t)pc->n * o->nw);
     if (!ord || !ns) {
         free(ord), free(ns);
@@ -141,9 +130,9 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
     }
     for (int q = 0; q < n; q++) {
         const int p = idx ? idx[q] : q;
-        ord[q].d = -dot(sun, pc->x[p], pc->y[p], pc->z[p]), ord[q].i = p;
+        ord[q].key = -dot(sun, pc->x[p], pc->y[p], pc->z[p]), ord[q].index = p;
     }
-    qsort(ord, (size_t)n, sizeof *ord, by_depth);
+    atmos__keyed_sort(ord, (size_t)n, 0);
     int nomem = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
     for (int k = 0; k < o->nw; k++) {

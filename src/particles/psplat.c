@@ -19,17 +19,6 @@ typedef struct sp {
     float col[ATMOS_MAX_WAVELENGTHS], tc[ATMOS_MAX_WAVELENGTHS]; /* colour and central depth */
 } sp;
 
-typedef struct far_key {
-    double z;
-    int i;
-} far_key;
-
-static int far_first(const void *a, const void *b)
-{
-    const far_key *x = a, *y = b;
-    return x->z > y->z ? -1 : (x->z < y->z ? 1 : (x->i > y->i) - (x->i < y->i));
-}
-
 /* The splat of particle p as seen by cam; 0 when it is not drawn. */
 static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const atmos__plights *L, const atmos_camera *cam,
                    const int rect[4], sp *out)
@@ -110,17 +99,17 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "particles: the splat renderer draws pinhole cameras only");
     const int ntx = (rect[2] - rect[0] + TILE - 1) / TILE, nty = (rect[3] - rect[1] + TILE - 1) / TILE;
     sp *s = malloc(sizeof *s * (size_t)(pc->n ? pc->n : 1));
-    far_key *ord = malloc(sizeof *ord * (size_t)(pc->n ? pc->n : 1));
+    atmos__keyed *ord = malloc(sizeof *ord * (size_t)(pc->n ? pc->n : 1));
     int *cnt = calloc((size_t)ntx * nty + 1, sizeof(int));
     int n = 0;
     if (!s || !ord || !cnt) goto nomem;
     const int count = idx ? nidx : pc->n;
     for (int q = 0; q < count; q++)
-        if (prepare(pc, idx ? idx[q] : q, o, L, cam, rect, &s[n])) ord[n].z = s[n].z, ord[n].i = n, n++;
-    qsort(ord, (size_t)n, sizeof *ord, far_first);
+        if (prepare(pc, idx ? idx[q] : q, o, L, cam, rect, &s[n])) ord[n].key = s[n].z, ord[n].index = n, n++;
+    atmos__keyed_sort(ord, (size_t)n, 1);
     /* tile lists: counts, offsets, then the splats in far-to-near order */
     for (int q = 0; q < n; q++) {
-        const sp *a = &s[ord[q].i];
+        const sp *a = &s[ord[q].index];
         for (int ty = (a->bb[2] - rect[1]) / TILE; ty <= (a->bb[3] - 1 - rect[1]) / TILE; ty++)
             for (int tx = (a->bb[0] - rect[0]) / TILE; tx <= (a->bb[1] - 1 - rect[0]) / TILE; tx++) cnt[ty * ntx + tx + 1]++;
     }
@@ -131,10 +120,10 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
         goto nomem;
     }
     for (int q = 0; q < n; q++) {
-        const sp *a = &s[ord[q].i];
+        const sp *a = &s[ord[q].index];
         for (int ty = (a->bb[2] - rect[1]) / TILE; ty <= (a->bb[3] - 1 - rect[1]) / TILE; ty++)
             for (int tx = (a->bb[0] - rect[0]) / TILE; tx <= (a->bb[1] - 1 - rect[0]) / TILE; tx++)
-                list[cnt[ty * ntx + tx] + fill[ty * ntx + tx]++] = ord[q].i;
+                list[cnt[ty * ntx + tx] + fill[ty * ntx + tx]++] = ord[q].index;
     }
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
     for (int t = 0; t < ntx * nty; t++)

@@ -57,17 +57,6 @@ static void air(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v
     }
 }
 
-typedef struct far_cloud {
-    double d;
-    int k;
-} far_cloud;
-
-static int far_first(const void *a, const void *b)
-{
-    const far_cloud *x = a, *y = b;
-    return x->d > y->d ? -1 : (x->d < y->d ? 1 : (x->k > y->k) - (x->k < y->k));
-}
-
 /* Whether the sphere (c, r) meets cam's view: inside all four side planes of the frustum
  * within r (and not wholly behind the eye). */
 static int visible(const atmos_camera *cam, const double c[3], double r)
@@ -163,14 +152,14 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     const int rect[4] = {r->x0, r->y0, r->x1, r->y1};
     const atmos__aerial *ap = frame_aerial(p, h, v);
     const int nc = h->clouds.n;
-    far_cloud *ord = malloc(sizeof *ord * (size_t)(nc ? nc : 1));
+    atmos__keyed *ord = malloc(sizeof *ord * (size_t)(nc ? nc : 1));
     if (!ord) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     for (int k = 0; k < nc; k++) {
         double d2 = 0;
         for (int a = 0; a < 3; a++) d2 += (v->cam.position[a] - h->clouds.centre[k][a]) * (v->cam.position[a] - h->clouds.centre[k][a]);
-        ord[k].d = d2, ord[k].k = k;
+        ord[k].key = d2, ord[k].index = k;
     }
-    qsort(ord, (size_t)nc, sizeof *ord, far_first);
+    atmos__keyed_sort(ord, (size_t)nc, 1);
     h->drawn = h->updates = h->direct = 0;
     const size_t cap = nc > 0 ? (size_t)nc : 1;
     int *how = malloc(sizeof(int) * 2 * cap), *stale = how ? how + cap : NULL, nstale = 0;
@@ -179,7 +168,7 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
         if ((how[k] = mode(p, h, v, k)) == 4) stale[nstale++] = k;
     if (st == ATMOS_OK) st = remake(p, h, v, ap, stale, nstale);
     for (int q = 0; q < nc && st == ATMOS_OK; q++)
-        if (how[ord[q].k]) st = draw(p, h, v, ap, ord[q].k, how[ord[q].k], rect, out);
+        if (how[ord[q].index]) st = draw(p, h, v, ap, ord[q].index, how[ord[q].index], rect, out);
     free(how);
     free(ord);
     p->stats.impostor_updates = h->updates;
