@@ -127,6 +127,11 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
                                  float *order);
 
 /* ---- psplat.c: the eye pass (§2.2.2, Eq. 9) */
+/* The pixels of rect [x0, y0, x1, y1) that the sphere (c, r) may cover seen by the pinhole cam:
+ * bb[4] = [x0, x1) x [y0, y1); *Z its centre's depth along the view. 0 when the sphere holds the
+ * eye, lies behind it or misses rect. */
+int atmos__pcloud_screen_box(const atmos_camera *cam, const double c[3], double r, const int rect[4], int bb[4],
+                             double *Z);
 /* The lights of a frame: n lights toward dir[j] with irradiance e[j] outside the cloud, their
  * light passes (light[j], order[j]: atmos__pcloud_shade's), and the air from the eye to each
  * particle (air_t: transmittance, air_l: in-scattered radiance, [p * nw + k]; NULL: none). */

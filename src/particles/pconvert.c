@@ -82,10 +82,10 @@ atmos_status atmos__pcloud_from_volume(atmos_context *ctx, const atmos_volume *v
         snprintf(out->particle[fi], sizeof out->particle[fi], "%s", atmos_volume_field_particle(vol, fi));
     }
     int m = h > 0 ? (int)fmax(1.0, floor(h / f.vs + 0.5)) : 1;
-    for (;;) {
+    while (!(h > 0)) { /* coarser cells until the particles fit */
         long total = 0;
         for (int fi = 0; fi < nf; fi++) total += sweep(vol, &f, fi, m, thr[fi], offset, NULL);
-        if (total <= max_particles || h > 0) break;
+        if (total <= max_particles) break;
         m++;
     }
     for (int fi = 0; fi < nf; fi++)

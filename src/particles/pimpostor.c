@@ -73,11 +73,27 @@ static int to_texel(const atmos__pimpostor *im, const double w[3], double *tx, d
     return 1;
 }
 
+/* Lays texel coordinates (tx, ty) of the w x h texture tex (C channels: colour, coverage),
+ * read bilinearly, over pixel px: px (1 - coverage) + colour. */
+static void over(const float *tex, int w, int h, int C, double tx, double ty, float *px)
+{
+    tx = fmin(fmax(tx, 0.0), w - 1.001), ty = fmin(fmax(ty, 0.0), h - 1.001);
+    const int i0 = (int)tx, j0 = (int)ty;
+    const double ax = tx - i0, ay = ty - j0;
+    const float *t00 = tex + ((size_t)j0 * w + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)w * C, *t11 = t10 + C;
+    float v[ATMOS_MAX_WAVELENGTHS + 1] = {0};
+    for (int k = 0; k < C; k++)
+        v[k] = (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
+    const float keep = 1.0f - v[C - 1];
+    for (int k = 0; k < C - 1; k++) px[k] = px[k] * keep + v[k];
+    px[C - 1] = 1.0f - (1.0f - px[C - 1]) * keep;
+}
+
 /* Pixel row y of the frame: the impostor over [x0, x1). */
 static void draw_row(const atmos__pimpostor *im, const double c[3], const double nrm[3], const atmos_camera *cam, int y,
                      int x0, int x1, atmos_image *img)
 {
-    const int C = img->channels, nw = C - 1, R = im->res;
+    const int C = img->channels, R = im->res;
     const double W = cam->width, H = cam->height, t = cam->tan_half_fov, v = (H - 2.0 * (y + 0.5)) / H * t;
     double ce = 0, dn;
     for (int i = 0; i < 3; i++) ce += (c[i] - cam->position[i]) * nrm[i];
@@ -89,39 +105,21 @@ static void draw_row(const atmos__pimpostor *im, const double c[3], const double
         if (!(fabs(dn) > 1e-12) || ce / dn <= 0) continue;
         for (int i = 0; i < 3; i++) w[i] = cam->position[i] + ce / dn * d[i];
         if (!to_texel(im, w, &tx, &ty) || tx < -0.5 || ty < -0.5 || tx > R - 0.5 || ty > R - 0.5) continue;
-        tx = fmin(fmax(tx, 0.0), R - 1.001), ty = fmin(fmax(ty, 0.0), R - 1.001);
-        const int i0 = (int)tx, j0 = (int)ty;
-        const double ax = tx - i0, ay = ty - j0;
-        const float *t00 = im->img->pixels + ((size_t)j0 * R + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)R * C,
-                    *t11 = t10 + C;
-        float *px = img->pixels + ((size_t)y * cam->width + x) * C;
-        float tex[ATMOS_MAX_WAVELENGTHS + 1];
-        for (int k = 0; k < C; k++)
-            tex[k] = (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
-        const float keep = 1.0f - tex[nw];
-        for (int k = 0; k < nw; k++) px[k] = px[k] * keep + tex[k];
-        px[nw] = 1.0f - (1.0f - px[nw]) * keep;
+        over(im->img->pixels, R, R, C, tx, ty, img->pixels + ((size_t)y * cam->width + x) * C);
     }
 }
 
 void atmos__pimpostor_draw(atmos_context *ctx, const atmos__pimpostor *im, const double c[3], double r,
                            const atmos_camera *cam, const int rect[4], atmos_image *img)
 {
-    double nrm[3], l = 0, X = 0, Y = 0, Z = 0;
+    double nrm[3], l = 0, Z;
+    int bb[4];
+    /* (the caller splats clouds near or behind the eye) */
+    if (!atmos__pcloud_screen_box(cam, c, r, rect, bb, &Z)) return;
     for (int i = 0; i < 3; i++) nrm[i] = im->view[i] - c[i], l += nrm[i] * nrm[i];
     for (int i = 0; i < 3; i++) nrm[i] /= sqrt(l);
-    for (int i = 0; i < 3; i++) {
-        const double rel = c[i] - cam->position[i];
-        X += rel * cam->right[i], Y += rel * cam->up[i], Z += rel * cam->forward[i];
-    }
-    if (!(Z > r)) return; /* the caller splats clouds near or behind the eye */
-    const double W = cam->width, H = cam->height, f = H / (2.0 * cam->tan_half_fov);
-    const double px = 0.5 * W + f * X / Z, py = 0.5 * H - f * Y / Z;
-    const double rp = f * r / sqrt(Z * Z - r * r) * (1.0 + (fabs(X) + fabs(Y) + r) / Z);
-    const int x0 = (int)fmax(rect[0], floor(px - rp)), x1 = (int)fmin(rect[2], ceil(px + rp));
-    const int y0 = (int)fmax(rect[1], floor(py - rp)), y1 = (int)fmin(rect[3], ceil(py + rp));
 #pragma omp parallel for schedule(dynamic, 8) num_threads(atmos__threads(ctx))
-    for (int y = y0; y < y1; y++) draw_row(im, c, nrm, cam, y, x0, x1, img);
+    for (int y = bb[2]; y < bb[3]; y++) draw_row(im, c, nrm, cam, y, bb[0], bb[1], img);
 }
 
 atmos_status atmos__pimpostor_screen(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
@@ -142,21 +140,9 @@ atmos_status atmos__pimpostor_screen(atmos_context *ctx, const atmos__pcloud *pc
     if (st == ATMOS_OK) {
 #pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
         for (int y = rect[1]; y < rect[3]; y++)
-            for (int x = rect[0]; x < rect[2]; x++) {
-                const double tx = fmin(fmax((x + 0.5) / factor - 0.5, 0.0), w - 1.001);
-                const double ty = fmin(fmax((y + 0.5) / factor - 0.5, 0.0), h - 1.001);
-                const int i0 = (int)tx, j0 = (int)ty;
-                const double ax = tx - i0, ay = ty - j0;
-                const float *t00 = lo->pixels + ((size_t)j0 * w + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)w * C,
-                            *t11 = t10 + C;
-                float *px = img->pixels + ((size_t)y * cam->width + x) * C;
-                const float cov = (float)((1 - ay) * ((1 - ax) * t00[C - 1] + ax * t01[C - 1]) +
-                                          ay * ((1 - ax) * t10[C - 1] + ax * t11[C - 1]));
-                for (int k = 0; k < C - 1; k++)
-                    px[k] = px[k] * (1.0f - cov) +
-                            (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
-                px[C - 1] = 1.0f - (1.0f - px[C - 1]) * (1.0f - cov);
-            }
+            for (int x = rect[0]; x < rect[2]; x++)
+                over(lo->pixels, w, h, C, (x + 0.5) / factor - 0.5, (y + 0.5) / factor - 0.5,
+                     img->pixels + ((size_t)y * cam->width + x) * C);
     }
     atmos_image_destroy(lo);
     return st;

@@ -19,23 +19,34 @@ typedef struct sp {
     float col[ATMOS_MAX_WAVELENGTHS], tc[ATMOS_MAX_WAVELENGTHS]; /* colour and central depth */
 } sp;
 
-/* The splat of particle p as seen by cam; 0 when it is not drawn. */
-static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const atmos__plights *L, const atmos_camera *cam,
-                   const int rect[4], sp *out)
+int atmos__pcloud_screen_box(const atmos_camera *cam, const double c[3], double r, const int rect[4], int bb[4],
+                             double *Zout)
 {
-    const double c[3] = {pc->x[p], pc->y[p], pc->z[p]}, s = pc->s[p], r = ATMOS__PCLOUD_CUT * s;
-    double rel[3], X = 0, Y = 0, Z = 0;
-    for (int i = 0; i < 3; i++) rel[i] = c[i] - cam->position[i];
-    for (int i = 0; i < 3; i++) X += rel[i] * cam->right[i], Y += rel[i] * cam->up[i], Z += rel[i] * cam->forward[i];
-    if (Z <= r) return 0; /* behind the eye, or the eye inside the splat */
-    const double W = cam->width, H = cam->height, t = cam->tan_half_fov, f = H / (2.0 * t);
+    double X = 0, Y = 0, Z = 0;
+    for (int i = 0; i < 3; i++) {
+        const double rel = c[i] - cam->position[i];
+        X += rel * cam->right[i], Y += rel * cam->up[i], Z += rel * cam->forward[i];
+    }
+    if (Z <= r) return 0; /* behind the eye, or the eye inside the sphere */
+    const double W = cam->width, H = cam->height, f = H / (2.0 * cam->tan_half_fov);
     const double px = 0.5 * W + f * X / Z, py = 0.5 * H - f * Y / Z;
     /* the sphere's outline on the image lies within r f / sqrt(Z^2 - r^2) of the centre's image,
      * stretched toward the edges: bound it by the projection of its box */
     const double rp = f * r / sqrt(Z * Z - r * r) * (1.0 + (fabs(X) + fabs(Y) + r) / Z);
-    out->bb[0] = (int)fmax(rect[0], floor(px - rp)), out->bb[1] = (int)fmin(rect[2], ceil(px + rp));
-    out->bb[2] = (int)fmax(rect[1], floor(py - rp)), out->bb[3] = (int)fmin(rect[3], ceil(py + rp));
-    if (out->bb[0] >= out->bb[1] || out->bb[2] >= out->bb[3]) return 0;
+    bb[0] = (int)fmax(rect[0], floor(px - rp)), bb[1] = (int)fmin(rect[2], ceil(px + rp));
+    bb[2] = (int)fmax(rect[1], floor(py - rp)), bb[3] = (int)fmin(rect[3], ceil(py + rp));
+    *Zout = Z;
+    return bb[0] < bb[1] && bb[2] < bb[3];
+}
+
+/* The splat of particle p as seen by cam; 0 when it is not drawn. */
+static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const atmos__plights *L, const atmos_camera *cam,
+                   const int rect[4], sp *out)
+{
+    const double c[3] = {pc->x[p], pc->y[p], pc->z[p]}, s = pc->s[p];
+    double rel[3], Z;
+    if (!atmos__pcloud_screen_box(cam, c, ATMOS__PCLOUD_CUT * s, rect, out->bb, &Z)) return 0;
+    for (int i = 0; i < 3; i++) rel[i] = c[i] - cam->position[i];
     memcpy(out->c, c, sizeof out->c);
     out->s = s, out->z = Z;
     const double d = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);

@@ -95,11 +95,10 @@ static atmos_status particles(atmos_plan *p, atmos__harris_plan *h)
             /* the grid the plan placed starts at the particles' box (atmos__pcloud_to_volume) */
             double lo[3], hi[3];
             atmos__pcloud_bounds(&h->pc, lo, hi);
-            for (int i = 0; i < h->pc.n; i++) {
-                h->pc.x[i] += (float)(p->offset[0] - lo[0] + atmos_volume_get_desc(p->volume)->origin_m[0]);
-                h->pc.y[i] += (float)(p->offset[1] - lo[1] + atmos_volume_get_desc(p->volume)->origin_m[1]);
-                h->pc.z[i] += (float)(p->offset[2] - lo[2] + atmos_volume_get_desc(p->volume)->origin_m[2]);
-            }
+            const double *org = atmos_volume_get_desc(p->volume)->origin_m;
+            const float sx = (float)(p->offset[0] - lo[0] + org[0]), sy = (float)(p->offset[1] - lo[1] + org[1]),
+                        sz = (float)(p->offset[2] - lo[2] + org[2]);
+            for (int i = 0; i < h->pc.n; i++) h->pc.x[i] += sx, h->pc.y[i] += sy, h->pc.z[i] += sz;
             return ATMOS_OK;
         }
     return atmos__pcloud_from_volume(p->ctx, p->volume, p->offset, hs->spacing_m, hs->max_particles, &h->pc);
