@@ -4,11 +4,14 @@
 #   make test   install missing packages, build, run the whole test suite (ctest),
 #               including an AddressSanitizer + UndefinedBehaviorSanitizer build
 #               of the unit tests. WERROR=ON turns warnings into errors (CI does).
+#   make install PREFIX=DIR   build, then install the library, headers, pkg-config file,
+#               CMake package, CLI, man pages and docs under DIR (default /usr/local;
+#               DESTDIR=... stages it, docs/install.md)
 JOBS     ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD    ?= build
 WERROR   ?= OFF
 
-.PHONY: all deps build run test bench clean
+.PHONY: all deps build run test bench install clean
 all: build
 
 deps:
@@ -32,6 +35,10 @@ run: build
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+PREFIX   ?= /usr/local
+install: build
+	DESTDIR=$(DESTDIR) cmake --install $(BUILD) --prefix $(PREFIX)
 
 bench: build
 	./$(BUILD)/atmos bench sky

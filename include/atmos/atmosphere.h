@@ -34,6 +34,9 @@
 #ifndef ATMOS_ATMOSPHERE_H
 #define ATMOS_ATMOSPHERE_H
 
+#include "atmos/base.h"
+#include "atmos/spectrum.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

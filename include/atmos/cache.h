@@ -8,7 +8,7 @@
 #ifndef ATMOS_CACHE_H
 #define ATMOS_CACHE_H
 
-#include "atmos/atmos.h"
+#include "atmos/base.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -6,6 +6,8 @@
 #ifndef ATMOS_CAMERA_H
 #define ATMOS_CAMERA_H
 
+#include "atmos/base.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

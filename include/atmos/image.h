@@ -9,6 +9,9 @@
 #ifndef ATMOS_IMAGE_H
 #define ATMOS_IMAGE_H
 
+#include "atmos/base.h"
+#include "atmos/spectrum.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

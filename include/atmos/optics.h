@@ -12,6 +12,9 @@
 #ifndef ATMOS_OPTICS_H
 #define ATMOS_OPTICS_H
 
+#include "atmos/base.h"
+#include "atmos/spectrum.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -27,6 +27,8 @@
 #ifndef ATMOS_PATH_H
 #define ATMOS_PATH_H
 
+#include "atmos/base.h"
+#include "atmos/render.h"
 #include <stdint.h>
 
 #ifdef __cplusplus

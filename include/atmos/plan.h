@@ -36,6 +36,9 @@
 #ifndef ATMOS_PLAN_H
 #define ATMOS_PLAN_H
 
+#include "atmos/base.h"
+#include "atmos/slice.h"
+#include "atmos/path.h"
 #include <stdint.h>
 
 #ifdef __cplusplus

@@ -4,6 +4,9 @@
 #ifndef ATMOS_RENDER_H
 #define ATMOS_RENDER_H
 
+#include "atmos/base.h"
+#include "atmos/scene.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

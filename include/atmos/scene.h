@@ -4,6 +4,14 @@
 #ifndef ATMOS_SCENE_H
 #define ATMOS_SCENE_H
 
+#include "atmos/base.h"
+#include "atmos/spectrum.h"
+#include "atmos/camera.h"
+#include "atmos/sun.h"
+#include "atmos/atmosphere.h"
+#include "atmos/image.h"
+#include "atmos/optics.h"
+#include "atmos/volume.h"
 #include <stdint.h>
 
 #ifdef __cplusplus

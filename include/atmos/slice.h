@@ -12,6 +12,9 @@
 #ifndef ATMOS_SLICE_H
 #define ATMOS_SLICE_H
 
+#include "atmos/base.h"
+#include "atmos/render.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -6,6 +6,8 @@
 #ifndef ATMOS_SPECTRUM_H
 #define ATMOS_SPECTRUM_H
 
+#include "atmos/base.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -5,6 +5,8 @@
 #ifndef ATMOS_SUN_H
 #define ATMOS_SUN_H
 
+#include "atmos/base.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -9,6 +9,7 @@
 #ifndef ATMOS_VOLUME_H
 #define ATMOS_VOLUME_H
 
+#include "atmos/base.h"
 #include <stdint.h>
 
 #ifdef __cplusplus

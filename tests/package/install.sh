@@ -1,0 +1,97 @@
+#!/bin/sh
+# atmos as a user installs and uses it (docs/install.md): `cmake --install` into a fresh
+# prefix, then against the installed files only:
+#  - the files a package has: headers, libatmos.so with its SONAME, libatmos.a, atmos.pc,
+#    the CMake package, the CLI, a man page for the CLI and for every command its --help lists;
+#  - every public header compiles on its own, in C11 and C++11 (-Wall -Wextra -pedantic -Werror);
+#  - a C++ program calls the library (the headers' extern "C");
+#  - the examples build through pkg-config (shared, and one static) and through find_package
+#    (atmos::atmos, atmos::atmos_static), run, and the static and shared builds write the
+#    same bytes.
+# Run by ctest with ATMOS_BUILD_DIR (the build tree), ATMOS_SOURCE_DIR, CC, CXX.
+set -u
+build=${ATMOS_BUILD_DIR:?ATMOS_BUILD_DIR must name the build tree}
+src=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR must name the source tree}
+CC=${CC:-cc} CXX=${CXX:-c++}
+T=${ATMOS_TEST_TMP:-/tmp}/install.$$
+rm -rf "$T"
+mkdir -p "$T" || exit 1
+trap 'rm -rf "$T"' EXIT
+fail=0
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+check() { name=$1; shift; if "$@" >"$T/log" 2>&1; then ok "$name"; else bad "$name"; sed 's/^/  /' "$T/log" >&2; fi; }
+
+P=$T/prefix
+check "cmake --install into a new prefix" cmake --install "$build" --prefix "$P"
+libdir=$(dirname "$(find "$P" -name libatmos.so -print | head -n 1)")
+[ -n "$libdir" ] && [ -d "$libdir" ] || { bad "no libatmos.so installed"; exit 1; }
+for f in "$P/include/atmos/atmos.h" "$libdir/libatmos.a" "$libdir/pkgconfig/atmos.pc" \
+         "$libdir/cmake/atmos/atmos-config.cmake" "$libdir/cmake/atmos/atmos-config-version.cmake" \
+         "$P/bin/atmos" "$P/share/man/man1/atmos.1" "$P/share/doc/atmos/README.md"; do
+    [ -s "$f" ] && ok "installed ${f#"$P"/}" || bad "missing ${f#"$P"/}"
+done
+soname=$(objdump -p "$libdir/libatmos.so" 2>/dev/null | awk '$1 == "SONAME" {print $2}')
+[ "$soname" = libatmos.so.0 ] && ok "SONAME libatmos.so.0" || bad "SONAME is '$soname', expected libatmos.so.0"
+"$P/bin/atmos" --version >"$T/v" 2>&1 && grep -q "^atmos [0-9]" "$T/v" && ok "installed atmos --version" || bad "installed atmos --version"
+"$P/bin/atmos" --help | awk '/^Commands:/ {c = 1; next} c && /^  [a-z]+  / {print $1} c && /^$/ {exit}' >"$T/cmds"
+[ -s "$T/cmds" ] || bad "no commands in atmos --help"
+while read -r c; do
+    m=$P/share/man/man1/atmos-$c.1
+    [ -s "$m" ] && grep -q "^\.SH DESCRIPTION" "$m" && ok "man page atmos-$c.1" || bad "no man page for 'atmos $c'"
+done <"$T/cmds"
+
+# Every public header alone, as C and as C++.
+for h in "$P"/include/atmos/*.h; do
+    b=$(basename "$h")
+    printf '#include <atmos/%s>\n' "$b" >"$T/one.c"
+    check "$b alone in C11" "$CC" -std=c11 -Wall -Wextra -pedantic -Werror -I"$P/include" -c "$T/one.c" -o "$T/one.o"
+    cp "$T/one.c" "$T/one.cpp"
+    check "$b alone in C++11" "$CXX" -std=c++11 -Wall -Wextra -pedantic -Werror -I"$P/include" -c "$T/one.cpp" -o "$T/one.o"
+done
+cat >"$T/cxx.cpp" <<'CXX'
+#include <atmos/atmos.h>
+#include <cstdio>
+#include <cstring>
+int main() { std::printf("%s %s\n", atmos_version(), atmos_status_string(ATMOS_E_IO)); return std::strlen(atmos_version()) ? 0 : 1; }
+CXX
+check "a C++ program links the library" "$CXX" -std=c++11 -Wall -Wextra -Werror -I"$P/include" "$T/cxx.cpp" -L"$libdir" -latmos -o "$T/cxx"
+check "the C++ program runs" env LD_LIBRARY_PATH="$libdir" "$T/cxx"
+
+# The examples through pkg-config.
+export PKG_CONFIG_PATH="$libdir/pkgconfig" XDG_CACHE_HOME="$T/cache"
+mkdir -p "$T/pc"
+for e in orbit sky slice_volume mie_phase; do
+    # shellcheck disable=SC2046
+    check "examples/$e.c through pkg-config" "$CC" -std=c11 -Wall -Wextra -Werror "$src/examples/$e.c" \
+        $(pkg-config --cflags --libs atmos) -lm -o "$T/pc/$e"
+done
+static_libs=$(pkg-config --static --libs atmos | sed 's/-latmos /-Wl,-Bstatic -latmos -Wl,-Bdynamic /')
+# shellcheck disable=SC2046,SC2086
+check "examples/sky.c statically through pkg-config --static" "$CC" -std=c11 -Wall -Wextra -Werror \
+    "$src/examples/sky.c" $(pkg-config --cflags atmos) $static_libs -o "$T/pc/sky_static"
+objdump -p "$T/pc/sky_static" 2>/dev/null | grep -q "NEEDED.*libatmos" && bad "the static sky needs libatmos.so" || ok "the static sky does not need libatmos.so"
+# The examples through find_package, as their own CMake project.
+check "examples/ configured with find_package(atmos)" cmake -S "$src/examples" -B "$T/cm" -DCMAKE_PREFIX_PATH="$P" \
+    -DCMAKE_C_COMPILER="$CC" -DCMAKE_BUILD_TYPE=Release
+check "examples/ built with atmos::atmos and atmos::atmos_static" cmake --build "$T/cm"
+
+# Run them (small sizes).
+cd "$T" || exit 1
+export LD_LIBRARY_PATH="$libdir"
+check "pkg-config sky runs" "$T/pc/sky" --size 24 16 --out "$T/sky_pc"
+check "pkg-config static sky runs" "$T/pc/sky_static" --size 24 16 --out "$T/sky_pc_static"
+check "find_package sky runs" "$T/cm/sky" --size 24 16 --out "$T/sky_cm"
+check "find_package static sky runs" "$T/cm/sky_static" --size 24 16 --out "$T/sky_cm_static"
+for a in sky_pc_static sky_cm sky_cm_static; do
+    cmp -s "$T/sky_pc.pfm" "$T/$a.pfm" && ok "$a.pfm equals the shared pkg-config build's" || bad "$a.pfm differs"
+done
+check "find_package mie_phase runs" "$T/cm/mie_phase" --fast --preset rain
+grep -q "^138," "$T/log" && ok "mie_phase prints the table" || bad "mie_phase printed no 138-degree row"
+check "find_package orbit runs" "$T/cm/orbit" --size 24 --frames 2 --out "$T"
+[ -s "$T/orbit_01.png" ] && ok "orbit wrote its frames" || bad "orbit wrote no orbit_01.png"
+check "pkg-config slice_volume runs" "$T/pc/slice_volume" --size 32 20 -o "$T/slice.png"
+[ -s "$T/slice.png" ] && ok "slice_volume wrote its image" || bad "slice_volume wrote no image"
+"$T/cm/sky" --size 0 5 >/dev/null 2>&1; [ $? -eq 2 ] && ok "bad --size is a usage error" || bad "sky --size 0 5 did not exit 2"
+
+exit $fail
