@@ -94,4 +94,17 @@ check "pkg-config slice_volume runs" "$T/pc/slice_volume" --size 32 20 -o "$T/sl
 [ -s "$T/slice.png" ] && ok "slice_volume wrote its image" || bad "slice_volume wrote no image"
 "$T/cm/sky" --size 0 5 >/dev/null 2>&1; [ $? -eq 2 ] && ok "bad --size is a usage error" || bad "sky --size 0 5 did not exit 2"
 
+# The Python package installed by pip against the installed library (a copy of python/, so the
+# checkout stays clean; --target: the system's site-packages are left alone).
+py=${ATMOS_PYTHON:-python3}
+if "$py" -c "import setuptools, cffi, numpy, pip" 2>/dev/null; then
+    cp -r "$src/python" "$T/pysrc" && rm -f "$T"/pysrc/atmos/_native*.so
+    check "pip install ./python against the installed atmos" "$py" -m pip install --no-build-isolation --no-index \
+        --no-deps --target "$T/site" "$T/pysrc"
+    check "the pip-installed package imports and renders" env PYTHONPATH="$T/site" LD_LIBRARY_PATH= "$py" -c \
+        "import atmos, numpy; a = numpy.asarray(atmos.render(width=8, height=6)); assert a.shape == (6, 8, 4), a.shape"
+else
+    bad "no Python with cffi, NumPy, pip and setuptools (scripts/install-deps.sh installs them)"
+fi
+
 exit $fail

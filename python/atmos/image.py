@@ -1,0 +1,68 @@
+"""Images: an atmos image seen by NumPy without a copy."""
+import numpy as np
+
+from atmos._core import check, context, ffi, lib
+
+
+class Image:
+    """An image the library made: ``height x width`` pixels of ``channels`` float32 values,
+    row-major, top row first. ``numpy.asarray(image)`` is a ``(height, width, channels)``
+    float32 view of the library's own buffer (no copy; the array keeps the image alive).
+
+    Rendered images hold linear sRGB (Rec. 709 primaries, D65; Y in cd/m^2) and coverage alpha:
+    channels 0-2 are what ``atmos render --pfm`` writes. ``meta`` holds the image's metadata
+    (scene, renderer, sun, camera) as a dict. ``close()`` (or ``with``) frees it at once."""
+
+    def __init__(self, ptr, meta=None):
+        self._ptr = ffi.gc(ptr, lib.atmos_image_destroy)
+        self.meta = dict(meta or {})
+
+    @property
+    def shape(self):
+        p = self._live()
+        return (p.height, p.width, p.channels)
+
+    def _live(self):
+        if self._ptr is None:
+            raise ValueError("atmos.Image: the image was closed")
+        return self._ptr
+
+    @property
+    def __array_interface__(self):
+        p = self._live()
+        return {
+            "shape": (p.height, p.width, p.channels),
+            "typestr": "<f4",
+            "data": (int(ffi.cast("uintptr_t", p.pixels)), False),
+            "version": 3,
+        }
+
+    def numpy(self) -> np.ndarray:
+        """The pixels as a ``(height, width, channels)`` float32 array sharing this image's memory."""
+        return np.asarray(self)
+
+    def write_exr(self, path: str) -> None:
+        """Writes the image as OpenEXR (linear, atomically)."""
+        check(lib.atmos_write_exr(context(), self._live(), str(path).encode(), ffi.NULL))
+
+    def write_pfm(self, path: str) -> None:
+        """Writes the first three channels as a portable float map (atomically)."""
+        check(lib.atmos_write_pfm(context(), self._live(), str(path).encode()))
+
+    def close(self) -> None:
+        """Frees the pixels now. Arrays made from the image must not be used afterwards."""
+        if self._ptr is not None:
+            ffi.release(self._ptr)
+            self._ptr = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __repr__(self):
+        if self._ptr is None:
+            return "<atmos.Image closed>"
+        h, w, c = self.shape
+        return f"<atmos.Image {w}x{h}, {c} channels, float32>"

@@ -1,0 +1,126 @@
+"""Rendering: one call for one image, a plan for many frames of one scene."""
+from atmos._core import check, context, ffi, lib
+from atmos.image import Image
+from atmos.scene import Scene
+
+
+def _to_srgb(ctx, spectral, wl):
+    out = ffi.new("atmos_image **")
+    check(lib.atmos_image_to_srgb(ctx, spectral, wl, out), ctx)
+    return out[0]
+
+
+def _info(info):
+    return {"seconds": info.seconds, "sun_elevation_deg": info.sun_elevation_deg,
+            "sun_azimuth_deg": info.sun_azimuth_deg}
+
+
+def render(scene: Scene | None = None, volume=None, **kw) -> Image:
+    """Renders a scene as `atmos render` does (its renderer, settings, volume, atmosphere) and
+    returns linear sRGB + alpha as an Image (``numpy.asarray`` gives ``(H, W, 4)`` float32,
+    channels 0-2 equal to what ``atmos render --pfm`` writes). Keywords override the scene
+    (``Scene.with_``). ``volume``: an ``atmos.Volume`` drawn instead of the scene's own, where
+    its origin puts it (see ``Plan``); name a renderer for it here (``renderer="path"``), as a
+    scene without a volume of its own cannot name a volume renderer. The GIL is released while the library renders."""
+    scene = scene or Scene.default()
+    if volume is not None:
+        scene = _scene_for_volume(scene)
+    if kw:
+        scene = scene.with_(**kw)
+    if volume is not None:
+        with Plan(scene, volume) as plan:
+            return plan.render()
+    ctx = context()
+    s = scene._struct()
+    spec = ffi.new("atmos_image **")
+    info = ffi.new("atmos_render_info *")
+    check(lib.atmos_render_scene(ctx, s, ffi.NULL, spec, info), ctx)
+    spec_img = ffi.gc(spec[0], lib.atmos_image_destroy)
+    wl = ffi.new("atmos_wavelengths *")
+    check(lib.atmos_scene_wavelengths(ctx, s, wl), ctx)
+    rgb = _to_srgb(ctx, spec_img, wl)
+    ffi.release(spec_img)
+    return Image(rgb, _info(info))
+
+
+def _scene_for_volume(scene: Scene) -> Scene:
+    """A scene that renders a volume given in code: one without a "volume" of its own is given
+    a stand-in source (never read: the given volume is used), so that it is validated, and
+    drawn by default, as a scene with a volume."""
+    if ffi.string(scene._struct().volume.source):
+        return scene
+    return scene.with_(volume__generate="cumulus")
+
+
+class Plan:
+    """A plan: the scene's atmosphere, volume, optics and renderer state made once; each
+    ``render(camera=..., sun=...)`` does only the work its changes need (a moved sun does not
+    resample the volume; the path tracer adds samples while nothing moves). ``volume``: an
+    ``atmos.Volume`` drawn instead of the scene's own, at the place its origin gives (not
+    moved by the scene's placement rules); the scene's "volume" settings (particle, density
+    scale) still apply, and a scene without one renders it with the slice renderer unless it
+    names another.
+
+    >>> with atmos.Plan(scene) as plan:
+    ...     for az in range(0, 360, 10):
+    ...         img = plan.render(sun=(20, az))
+    """
+
+    def __init__(self, scene: Scene, volume=None):
+        ctx = context()
+        desc = ffi.NULL
+        if volume is not None:
+            scene = _scene_for_volume(scene)
+            desc = ffi.new("atmos_plan_desc *")
+            desc.offset_given = 1  # the volume stays where its origin puts it
+        self._scene = scene._struct()
+        self._volume = volume  # borrowed by the plan: kept alive with it
+        p = ffi.new("atmos_plan **")
+        check(lib.atmos_plan_create(ctx, self._scene, volume._ptr if volume is not None else ffi.NULL, desc, p), ctx)
+        self._ptr = ffi.gc(p[0], lib.atmos_plan_destroy)
+        self._frame = ffi.new("atmos_frame *")
+        check(lib.atmos_frame_from_scene(ctx, self._scene, self._frame), ctx)
+
+    def render(self, camera: dict | None = None, sun=None, size=None, spp=None) -> Image:
+        """Renders a frame. camera: {"position_m": [x, y, z], "look_at_m": [...], "fov_deg": f}
+        (any subset); sun: (elevation_deg, azimuth_deg); size: (width, height); spp: the path
+        tracer's samples per pixel. What is not given stays as in the last frame."""
+        if self._ptr is None:
+            raise ValueError("atmos.Plan: the plan was closed")
+        f = self._frame
+        if camera:
+            for key, field in (("position_m", "position"), ("look_at_m", "look_at"), ("up", "up")):
+                if key in camera:
+                    setattr(f.camera, field, [float(v) for v in camera[key]])
+            if "fov_deg" in camera:
+                f.camera.fov_deg = float(camera["fov_deg"])
+        if sun is not None:
+            lib.atmos_direction_from_angles(float(sun[0]), float(sun[1]), f.sun_dir)
+        if size is not None:
+            f.width, f.height = int(size[0]), int(size[1])
+        if spp is not None:
+            f.spp = int(spp)
+        ctx = context()
+        img = ffi.new("atmos_image **")
+        check(lib.atmos_plan_image_create(self._ptr, f, img), ctx)
+        spec = ffi.gc(img[0], lib.atmos_image_destroy)
+        info = ffi.new("atmos_render_info *")
+        check(lib.atmos_plan_render(self._ptr, f, ffi.NULL, spec, info), ctx)
+        rgb = _to_srgb(ctx, spec, lib.atmos_plan_wavelengths(self._ptr))
+        ffi.release(spec)
+        return Image(rgb, _info(info))
+
+    def close(self) -> None:
+        """Frees the plan now."""
+        if self._ptr is not None:
+            ffi.release(self._ptr)
+            self._ptr = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __repr__(self):
+        return "<atmos.Plan closed>" if self._ptr is None else f"<atmos.Plan {self._frame.width}x{self._frame.height}>"

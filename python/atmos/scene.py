@@ -1,0 +1,92 @@
+"""Scenes: a scene file, a dict or the built-in default, with overrides as the CLI's -D."""
+import json
+import os
+
+from atmos._core import check, context, ffi, lib
+
+# Keyword arguments with a name of their own (as the CLI's options); any other keyword is a
+# path into the scene with "__" between keys: camera__fov_deg=35 is -D camera.fov_deg=35.
+_SHORT = {
+    "width": "image.width",
+    "height": "image.height",
+    "spp": "path.spp",
+    "renderer": "renderer",
+    "sun_elevation_deg": "sun.elevation_deg",
+    "sun_azimuth_deg": "sun.azimuth_deg",
+    "samples_per_pixel": "image.samples_per_pixel",
+}
+
+
+def _override(key: str, value) -> str:
+    path = _SHORT.get(key, key.replace("__", "."))
+    return f"{path}={json.dumps(value)}"
+
+
+class Scene:
+    """A scene as atmos reads it: a JSON document (docs/scene-format.md) from a file, a dict
+    or the built-in default, plus overrides. It is parsed and validated by the library, so
+    a bad key or value raises AtmosError naming it, as the CLI does.
+
+    >>> s = atmos.Scene.load("scenes/fig11_cumulus_dawn.json")
+    >>> s2 = s.with_(width=320, height=200, camera__fov_deg=35)
+    """
+
+    def __init__(self, text: str = "{}", path: str | None = None, overrides=(), source: str = "scene"):
+        self._text = text
+        self._path = path
+        self._overrides = tuple(overrides)
+        self._source = source
+        self._struct()  # validate now: errors belong to the line that made the scene
+
+    @classmethod
+    def default(cls) -> "Scene":
+        """The built-in default scene (what `atmos render` renders without a scene file)."""
+        return cls("{}", source="default")
+
+    @classmethod
+    def load(cls, path) -> "Scene":
+        """Reads a scene file; relative volume paths are taken from the file's folder."""
+        path = os.fspath(path)
+        return cls(path=path, source=path)
+
+    @classmethod
+    def from_dict(cls, d: dict, source: str = "dict") -> "Scene":
+        """A scene from a dict with the scene file's keys."""
+        return cls(json.dumps(d), source=source)
+
+    @classmethod
+    def from_json(cls, text: str, source: str = "json") -> "Scene":
+        return cls(text, source=source)
+
+    def with_(self, **kw) -> "Scene":
+        """A copy with keys overridden: width, height, spp, renderer, sun_elevation_deg,
+        sun_azimuth_deg, samples_per_pixel by name; any other key as a path with "__"
+        between its parts (camera__position_m=[0, 900, 0])."""
+        extra = tuple(_override(k, v) for k, v in kw.items())
+        return Scene(self._text, self._path, self._overrides + extra, self._source)
+
+    def _struct(self):
+        """The validated C scene (a new atmos_scene each call)."""
+        ctx = context()
+        out = ffi.new("atmos_scene *")
+        keep = [ffi.new("char[]", o.encode()) for o in self._overrides]
+        arr = ffi.new("const char *[]", keep) if keep else ffi.NULL
+        if self._path is not None:
+            st = lib.atmos_scene_load_with(ctx, self._path.encode(), arr, len(keep), out)
+        else:
+            raw = self._text.encode()
+            st = lib.atmos_scene_parse_with(ctx, raw, len(raw), self._source.encode(), arr, len(keep), out)
+        check(st, ctx)
+        return out
+
+    @property
+    def size(self):
+        """(width, height) in pixels."""
+        s = self._struct()
+        return (s.width, s.height)
+
+    def __repr__(self):
+        where = self._path or self._source
+        extra = f", {len(self._overrides)} override(s)" if self._overrides else ""
+        w, h = self.size
+        return f"<atmos.Scene {where!r} {w}x{h}{extra}>"

@@ -1,0 +1,205 @@
+"""The Python package against the CLI, published values and its own promises (docs/python.md).
+
+Run by ctest (python.pytest) with PYTHONPATH=python, ATMOS_CLI = the atmos binary and
+ATMOS_SOURCE_DIR = the checkout."""
+import os
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import atmos
+
+CLI = os.environ.get("ATMOS_CLI", "atmos")
+SRC = os.environ.get("ATMOS_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def read_pfm(path):
+    """A colour PFM read independently of the library: header "PF", size, scale (< 0: little
+    endian), rows bottom to top."""
+    with open(path, "rb") as f:
+        assert f.readline().strip() == b"PF"
+        w, h = map(int, f.readline().split())
+        scale = float(f.readline())
+        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
+    return data.reshape(h, w, 3)[::-1]
+
+
+def test_version_is_the_cli_version():
+    out = subprocess.run([CLI, "--version"], capture_output=True, text=True, check=True).stdout
+    assert out.split()[1] == atmos.version() == atmos.__version__
+
+
+def test_render_equals_the_cli_pfm(tmp_path):
+    img = atmos.render(atmos.Scene.default(), width=64, height=48)
+    a = np.asarray(img)
+    assert a.shape == (48, 64, 4) and a.dtype == np.float32
+    pfm = tmp_path / "cli.pfm"
+    subprocess.run([CLI, "render", "--width", "64", "--height", "48", "--pfm", str(pfm), "-o", str(tmp_path / "c.png")],
+                   check=True, capture_output=True)
+    cli = read_pfm(pfm)
+    assert np.array_equal(a[..., :3], cli), f"max difference {np.abs(a[..., :3] - cli).max()}"
+    assert np.all(a[..., :3] > 0)
+
+
+def test_image_is_a_view_without_copy():
+    img = atmos.render(width=8, height=6)
+    a, b = np.asarray(img), np.asarray(img)
+    assert np.shares_memory(a, b)
+    a[0, 0, 0] = -1.0
+    assert np.asarray(img)[0, 0, 0] == -1.0
+    assert "8x6" in repr(img)
+    with img:
+        pass
+    assert "closed" in repr(img)
+    with pytest.raises(ValueError):
+        np.asarray(img)
+
+
+def test_scene_load_dict_and_overrides():
+    s = atmos.Scene.load(os.path.join(SRC, "scenes", "fig11_cumulus_dawn.json"))
+    assert s.with_(width=32, height=20).size == (32, 20)
+    assert s.with_(image__width=40).size[0] == 40
+    d = atmos.Scene.from_dict({"image": {"width": 12, "height": 10}, "sun": {"elevation_deg": 45, "azimuth_deg": 90}})
+    assert d.size == (12, 10)
+
+
+def test_errors_are_exceptions_with_status_and_message(tmp_path):
+    with pytest.raises(atmos.AtmosError) as e:
+        atmos.Scene.from_dict({"image": {"width": -3}})
+    assert e.value.status == 1 and "/image/width" in e.value.message
+    with pytest.raises(atmos.AtmosError) as e:
+        atmos.Scene.load(tmp_path / "missing.json")
+    assert e.value.status == 3  # ATMOS_E_IO
+    with pytest.raises(atmos.AtmosError) as e:
+        atmos.Scene.from_dict({"camera": {"fov_deg": 270}})
+    assert "fov_deg" in e.value.message
+    bad = np.ones((2, 2, 2), dtype=np.float32)
+    bad[1, 0, 1] = -5
+    with pytest.raises(atmos.AtmosError) as e:
+        atmos.Volume.from_array(bad, 10.0)
+    assert e.value.status == 1
+    with pytest.raises(atmos.AtmosError):
+        atmos.phase_table("no-such-particle")
+
+
+def test_volume_round_trip_and_render():
+    rng = np.random.default_rng(7)
+    a = (rng.random((6, 5, 4)) * 2e8).astype(np.float32)
+    a[a < 5e7] = 0
+    v = atmos.Volume.from_array({"cloud": a, "rain": (a * 1e-5, "rain")}, 25.0, origin_m=(-50, 1000, -2000))
+    assert v.shape == (6, 5, 4) and v.fields == {"cloud": "cloud", "rain": "rain"}
+    assert np.array_equal(v.to_array("cloud"), a)
+    assert np.allclose(v.to_array(1), (a * 1e-5).astype(np.float32), rtol=1e-6)
+    # A dense box seen against a black background covers the pixels of its silhouette only.
+    box = atmos.Volume.from_array(np.full((8, 8, 8), 3e8, dtype=np.float32), 25.0, origin_m=(-100, 900, -1100))
+    scene = atmos.Scene.from_dict({"image": {"width": 32, "height": 32}, "background": "black",
+                                   "camera": {"position_m": [0, 1000, 0], "look_at_m": [0, 1000, -1000], "fov_deg": 20},
+                                   "sun": {"elevation_deg": 30, "azimuth_deg": 180}})
+    for renderer in ("slice", "path"):
+        img = np.asarray(atmos.render(scene, volume=box, renderer=renderer, spp=4))
+        lum = img[..., :3].sum(axis=-1)
+        assert lum[16, 16] > 0, renderer
+        assert lum[1, 1] == 0, renderer  # black background, outside the box's silhouette
+
+
+def test_mie_against_rayleigh_limit_and_extinction_paradox():
+    m = complex(1.5, 0.0)
+    x = 0.01
+    r = atmos.mie(m, x)
+    k = (m * m - 1) / (m * m + 2)
+    assert r["qsca"] == pytest.approx(8 / 3 * x**4 * abs(k) ** 2, rel=1e-3)  # Bohren & Huffman Eq. 5.8
+    big = atmos.mie(atmos.refractive_index("water", 550), 2000.0)
+    assert big["qext"] == pytest.approx(2.0, abs=0.02)
+    amp = atmos.mie(m, 3.0, cos_theta=np.array([[1.0, 0.0], [-0.5, -1.0]]))
+    assert amp["s1"].shape == (2, 2) and amp["s1"][0, 0] == pytest.approx(amp["s2"][0, 0])  # S1 = S2 forward
+
+
+def test_phase_table_is_normalised():
+    t = atmos.phase_table("cloud", fast=True)
+    th = np.radians(t["theta_deg"])
+    for k in range(len(t["nm"])):
+        p = t["phase"][k]
+        f = 2 * np.pi * p * np.sin(th)
+        norm = np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(th))
+        g = np.sum(0.5 * ((f * np.cos(th))[1:] + (f * np.cos(th))[:-1]) * np.diff(th))
+        assert norm == pytest.approx(1.0, abs=2e-3)
+        assert g == pytest.approx(t["g"][k], abs=2e-3)
+
+
+def test_sky_radiance_is_vectorised_and_symmetric_about_the_sun():
+    scene = atmos.Scene.from_dict({"sun": {"elevation_deg": 30, "azimuth_deg": 120}})
+    az = np.array([[120 - 40, 120 + 40], [120 - 90, 120 + 90]])
+    L = atmos.sky_radiance(scene, atmos.directions(np.full(az.shape, 20.0), az))
+    assert L.shape == (2, 2, 3)
+    assert np.allclose(L[:, 0], L[:, 1], rtol=1e-9)
+    assert np.all(L > 0)
+    with pytest.raises(ValueError):
+        atmos.sky_radiance(scene, np.zeros((1, 3)))
+
+
+def test_plan_frames_equal_one_call_renders():
+    base = atmos.Scene.load(os.path.join(SRC, "scenes", "fig11_cumulus_dawn.json")).with_(width=40, height=24)
+    with atmos.Plan(base) as plan:
+        moved = np.asarray(plan.render(sun=(25, 200))).copy()
+        again = np.asarray(plan.render(sun=(25, 200)))
+    one = np.asarray(atmos.render(base.with_(sun__elevation_deg=25, sun__azimuth_deg=200)))
+    assert np.array_equal(moved, again)
+    assert np.array_equal(moved, one)
+
+
+def test_gil_is_released_while_rendering():
+    scene = atmos.Scene.load(os.path.join(SRC, "scenes", "fig11_cumulus_dawn.json")).with_(width=160, height=90)
+    atmos.render(scene)  # tables cached
+    count, done = [0], threading.Event()
+
+    def spin():
+        while not done.is_set():
+            count[0] += 1
+
+    t = threading.Thread(target=spin)
+    t.start()
+    before = count[0]
+    atmos.render(scene)
+    during = count[0] - before
+    done.set()
+    t.join()
+    assert during > 1000, f"the other thread ran {during} steps during the render"
+
+
+def test_two_threads_render_concurrently_and_agree():
+    scene = atmos.Scene.default().with_(width=48, height=32)
+    ref = np.asarray(atmos.render(scene)).copy()
+    out, errors = [None, None], []
+
+    def work(i):
+        try:
+            out[i] = np.asarray(atmos.render(scene)).copy()
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    ts = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert not errors
+    assert np.array_equal(out[0], ref) and np.array_equal(out[1], ref)
+
+
+def rss_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def test_no_leak_over_1000_renders():
+    scene = atmos.Scene.default().with_(width=16, height=12)
+    for _ in range(50):
+        atmos.render(scene)
+    before = rss_bytes()
+    for _ in range(1000):
+        img = atmos.render(scene)
+        np.asarray(img).sum()
+    grown = rss_bytes() - before
+    assert grown < 8 << 20, f"resident memory grew by {grown / 2**20:.1f} MiB over 1000 renders"
