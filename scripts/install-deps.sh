@@ -7,8 +7,8 @@ set -eu
 # its headers include, which Debian does not pull in); gnuplot for 'atmos phase --plot'; SDL2, SDL2_ttf
 # and the DejaVu fonts for 'atmos view', Xvfb (and xauth for xvfb-run) for its tests.
 # help2man writes the man pages from the CLI's help text; the Python package needs cffi, NumPy and
-# Python's headers, its tests pytest and pip.
-PKGS="build-essential cmake pkg-config libpng-dev libjpeg-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3 libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth help2man python3-dev python3-cffi python3-numpy python3-pytest python3-pip"
+# Python's headers, its tests pytest and pip; atmos render --mpi Open MPI.
+PKGS="build-essential cmake pkg-config libpng-dev libjpeg-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3 libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth help2man python3-dev python3-cffi python3-numpy python3-pytest python3-pip libopenmpi-dev openmpi-bin"
 [ $# -gt 0 ] && PKGS="$*"
 missing=""
 for p in $PKGS; do

@@ -3,6 +3,7 @@
  * is rendered from that plan (atmos_plan_render, the same call atmos_render_scene makes). */
 #include "outputs.h"
 #include "render_opts.h"
+#include "dist.h"
 #include "render_scene.h"
 
 #include <math.h>
@@ -186,17 +187,21 @@ static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, co
     return st;
 }
 
+/* ranks: 0 rendered here alone; r > 0 by rank r (--mpi); -1 by all ranks together. The path
+ * tracer's statistics are those of this process's plan, so only for a frame it rendered alone. */
 static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const frame_files *ff, const char *source,
-                         const atmos_render_info *info, int frame, int nframes)
+                         const atmos_render_info *info, int frame, int nframes, int ranks)
 {
     if (nframes > 1) fprintf(stderr, "atmos render: frame %d/%d: ", frame, nframes);
     else fprintf(stderr, "atmos render: ");
     fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source, fs->width, fs->height,
             info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
+    if (ranks > 0) fprintf(stderr, "  rendered by rank %d\n", ranks);
+    if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
     for (int i = 0; i < 6; i++)
         if (files[i]) fprintf(stderr, "  wrote %s\n", files[i]);
-    if (atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH) {
+    if (atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH && ranks == 0) {
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
         const atmos_path_stats *q = &ps.path;
@@ -226,7 +231,7 @@ typedef struct {
  * all of them are written. Returns a status; *failed_frame names the frame that failed. */
 static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const atmos_scene *scene, const render_opts *o,
                                   const char *png, const char *source, cli_progress *prog, frame_outputs *fo,
-                                  int *failed_frame)
+                                  int *failed_frame, const cli_dist *d)
 {
     const int nframes = scene->animation.frames > 1 ? scene->animation.frames : 1;
     const cli_file_kind out_kind = png ? cli_file_kind_of(png) : CLI_FILE_OTHER;
@@ -241,14 +246,25 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const at
         atmos_render_info info;
         char label[64];
         snprintf(label, sizeof label, "%d/%d", frame, nframes);
-        if (frame > 1 && stage_frame(o, png, frame, nframes, &fo->ff, &fo->set, &fo->w) != CLI_EXIT_OK) {
+        /* --mpi: an animation's frame is rendered by its owner and written by rank 0; a single
+         * image is rendered by all ranks. */
+        const int owner = nframes > 1 ? cli_dist_frame_owner(d, frame) : -1;
+        if (d->rank != 0 && owner >= 0 && owner != d->rank) continue;
+        if (frame > 1 && d->rank == 0 && stage_frame(o, png, frame, nframes, &fo->ff, &fo->set, &fo->w) != CLI_EXIT_OK) {
             st = ATMOS_E_IO;
             break;
         }
         if ((st = atmos_scene_animation_frame(ctx, scene, frame - 1, &fs)) != ATMOS_OK) break;
         if ((st = atmos_frame_from_scene(ctx, &fs, &f)) != ATMOS_OK) break;
         if (!spec && (st = atmos_plan_image_create(plan, &f, &spec)) != ATMOS_OK) break;
-        if ((st = atmos_plan_render(plan, &f, NULL, spec, &info)) != ATMOS_OK) break;
+        if (owner < 0) st = cli_dist_render(d, plan, &f, spec, &info);
+        else if (owner == d->rank) st = atmos_plan_render(plan, &f, NULL, spec, &info);
+        else st = cli_dist_recv(d, owner, spec, &info);
+        if (d->rank != 0) {
+            if (owner >= 0) st = cli_dist_send(d, spec, st, &info);
+            continue;
+        }
+        if (st != ATMOS_OK) break;
         st = write_outputs(ctx, plan, &fs, spec, &fo->w, out_kind, source, nframes > 1 ? label : NULL, &xl);
         if (st != ATMOS_OK) break;
         if (cli_outputs_commit("render", &fo->set) != 0) {
@@ -258,7 +274,7 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const at
         total += info.seconds;
         if (!o->quiet) {
             if (prog->shown) fputc('\n', stderr), prog->shown = 0;
-            report_frame(plan, &fs, &fo->ff, source, &info, frame, nframes);
+            report_frame(plan, &fs, &fo->ff, source, &info, frame, nframes, owner > 0 ? owner : (d->size > 1 ? -1 : 0));
         }
     }
     cli_outputs_discard(&fo->set);
@@ -292,59 +308,78 @@ static int check_outputs(const render_opts *o, const atmos_scene *scene, const c
     return cli_outputs_check("render", &set, inputs, 2);
 }
 
+/* The render after the scene is made: outputs checked and staged (rank 0), the plan, the
+ * frames. Returns the exit status; *stuck is set when rank 0 stops an animation that other
+ * ranks are still rendering (they may be waiting for it: the job must be ended). */
+static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume *volume,
+                      cli_progress *prog, const cli_dist *d, double t0, int *stuck)
+{
+    const char *source = o->scene_path ? o->scene_path : "default scene", *png = o->png;
+    char default_png[160];
+    if (!o->png && !o->exr && !o->pfm) {
+        char stem[128];
+        default_png_name(render_scene_output_name(o, scene, stem, sizeof stem), default_png, sizeof default_png);
+        png = default_png;
+    }
+    const int nframes = scene->animation.frames > 1 ? scene->animation.frames : 1;
+    /* Every output checked, its folder made and its staging file created before any work. */
+    static frame_outputs fo;
+    int rc = CLI_EXIT_OK;
+    if (d->rank == 0) {
+        rc = check_outputs(o, scene, png);
+        if (rc == CLI_EXIT_OK) rc = stage_frame(o, png, 1, nframes, &fo.ff, &fo.set, &fo.w);
+    }
+    if ((rc = cli_dist_max(d, rc)) != CLI_EXIT_OK) return cli_outputs_discard(&fo.set), rc;
+    atmos_plan *plan = NULL;
+    int failed = 0;
+    atmos_status st = atmos_plan_create(ctx, scene, volume, NULL, &plan);
+    if (d->size > 1 && (atmos_status)cli_dist_max(d, (int)st) != ATMOS_OK && st == ATMOS_OK) st = ATMOS_E_CANCELLED;
+    const double t_plan = cli_now_s() - t0;
+    if (st == ATMOS_OK && d->rank == 0 && fo.w.tau) st = write_tau(ctx, scene, plan, fo.w.tau);
+    if (st == ATMOS_OK) {
+        st = render_frames(ctx, plan, scene, o, png, source, prog, &fo, &failed, d);
+        *stuck = st != ATMOS_OK && d->rank == 0 && d->size > 1 && nframes > 1;
+    }
+    cli_outputs_discard(&fo.set);
+    if (st == ATMOS_OK && !o->quiet)
+        fprintf(stderr, "atmos render: %.3f s in all: %.3f s for the scene, the volume and the optics tables, %.3f s "
+                        "rendering and writing\n",
+                cli_now_s() - t0, t_plan, cli_now_s() - t0 - t_plan);
+    if (st != ATMOS_OK && st != ATMOS_E_CANCELLED) {
+        if (prog->shown) fputc('\n', stderr);
+        if (d->size > 1) fprintf(stderr, "atmos render: rank %d of %d:\n", d->rank, d->size);
+        if (nframes > 1 && failed >= 1) fprintf(stderr, "atmos render: frame %d/%d failed\n", failed, nframes);
+        if (st == ATMOS_E_IO && !atmos_context_error(ctx)[0]) rc = CLI_EXIT_RUNTIME; /* an output's message printed */
+        else rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
+    } else if (st == ATMOS_E_CANCELLED)
+        rc = CLI_EXIT_RUNTIME; /* another rank failed and said why */
+    atmos_plan_destroy(plan);
+    return rc;
+}
+
 int cli_cmd_render(int argc, char **argv)
 {
     render_opts o;
     int rc = render_opts_parse(argc, argv, &o);
     if (rc < 0) return CLI_EXIT_OK; /* --help */
     if (rc != CLI_EXIT_OK) return rc;
+    cli_dist d;
+    if ((rc = cli_dist_start(o.mpi, &d)) != CLI_EXIT_OK) return rc;
+    if (d.rank != 0) o.quiet = 1; /* rank 0 reports; the others speak only of their failures */
     cli_progress prog;
     cli_progress_init(&prog, o.quiet);
     atmos_context *ctx = cli_context_with_progress(o.threads, o.quiet, cli_progress_bar, &prog);
-    if (!ctx) return CLI_EXIT_RUNTIME;
     const double t0 = cli_now_s();
     atmos_scene scene;
     atmos_volume *volume = NULL; /* loaded here when framed (render_scene.c), else by the plan */
-    if ((rc = render_scene_make(ctx, &o, &scene, &volume)) != CLI_EXIT_OK) {
-        atmos_volume_destroy(volume);
-        atmos_context_destroy(ctx);
-        return rc;
-    }
-    const char *source = o.scene_path ? o.scene_path : "default scene", *png = o.png;
-    char default_png[160];
-    if (!o.png && !o.exr && !o.pfm) {
-        char stem[128];
-        default_png_name(render_scene_output_name(&o, &scene, stem, sizeof stem), default_png, sizeof default_png);
-        png = default_png;
-    }
-    const int nframes = scene.animation.frames > 1 ? scene.animation.frames : 1;
-    /* Every output checked, its folder made and its staging file created before any work. */
-    static frame_outputs fo;
-    if ((rc = check_outputs(&o, &scene, png)) != CLI_EXIT_OK ||
-        (rc = stage_frame(&o, png, 1, nframes, &fo.ff, &fo.set, &fo.w)) != CLI_EXIT_OK) {
-        atmos_volume_destroy(volume);
-        atmos_context_destroy(ctx);
-        return rc;
-    }
-    atmos_plan *plan = NULL;
-    int failed = 0;
-    atmos_status st = atmos_plan_create(ctx, &scene, volume, NULL, &plan);
-    const double t_plan = cli_now_s() - t0;
-    if (st == ATMOS_OK && fo.w.tau) st = write_tau(ctx, &scene, plan, fo.w.tau);
-    if (st == ATMOS_OK) st = render_frames(ctx, plan, &scene, &o, png, source, &prog, &fo, &failed);
-    cli_outputs_discard(&fo.set);
-    if (st == ATMOS_OK && !o.quiet)
-        fprintf(stderr, "atmos render: %.3f s in all: %.3f s for the scene, the volume and the optics tables, %.3f s "
-                        "rendering and writing\n",
-                cli_now_s() - t0, t_plan, cli_now_s() - t0 - t_plan);
-    if (st != ATMOS_OK) {
-        if (prog.shown) fputc('\n', stderr);
-        if (nframes > 1 && failed >= 1) fprintf(stderr, "atmos render: frame %d/%d failed\n", failed, nframes);
-        if (st == ATMOS_E_IO && !atmos_context_error(ctx)[0]) rc = CLI_EXIT_RUNTIME; /* an output's message printed */
-        else rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
-    }
-    atmos_plan_destroy(plan);
+    rc = ctx ? render_scene_make(ctx, &o, &scene, &volume) : CLI_EXIT_RUNTIME;
+    int stuck = 0;
+    if ((rc = cli_dist_max(&d, rc)) == CLI_EXIT_OK) rc = render_run(ctx, &o, &scene, volume, &prog, &d, t0, &stuck);
     atmos_volume_destroy(volume);
     atmos_context_destroy(ctx);
+    /* Rank 0 stopped with other ranks still rendering frames for it: the whole job ends (its
+     * outputs were discarded above). A rank that failed told rank 0, and waits for that. */
+    if (stuck) cli_dist_abort(&d, rc);
+    cli_dist_stop(&d);
     return rc;
 }

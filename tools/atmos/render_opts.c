@@ -14,7 +14,7 @@ enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
     O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_VPOS, O_DSCALE, O_TAU, O_VARIANCE,
     O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS, O_GRIDS, O_PARTICLE, O_TINDEX,
-    O_DUNIT, O_VOXEL, O_VSCALE, O_FOV, O_VIEW_EL, O_VIEW_AZ, O_POSITION, O_LOOKAT, O_DETAIL, O_EXP_PER_FRAME,
+    O_DUNIT, O_VOXEL, O_VSCALE, O_FOV, O_VIEW_EL, O_VIEW_AZ, O_POSITION, O_LOOKAT, O_DETAIL, O_EXP_PER_FRAME, O_MPI,
     O_SETTING = 1024 /* + row index over the tables: a renderer setting */
 };
 
@@ -28,7 +28,7 @@ static const struct option fixed_opts[] = {
     {"spectral", required_argument, 0, O_SPECTRAL}, {"rgb", no_argument, 0, O_RGB},
     {"exposure", required_argument, 0, O_EXPOSURE}, {"exposure-comp", required_argument, 0, O_EXPCOMP},
     {"tone", required_argument, 0, O_TONE}, {"threads", required_argument, 0, O_THREADS},
-    {"quiet", no_argument, 0, 'q'}, {"renderer", required_argument, 0, O_RENDERER},
+    {"quiet", no_argument, 0, 'q'}, {"renderer", required_argument, 0, O_RENDERER}, {"mpi", no_argument, 0, O_MPI},
     {"volume", required_argument, 0, O_VOLUME}, {"volume-position", required_argument, 0, O_VPOS},
     {"density-scale", required_argument, 0, O_DSCALE}, {"tau", required_argument, 0, O_TAU},
     {"variance", required_argument, 0, O_VARIANCE}, {"order", required_argument, 0, O_ORDER},
@@ -161,6 +161,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_TIME_END: o->time_end = arg; return 1;
     case O_EXRHALF: o->exr_half = 1; return 1;
     case O_EXP_PER_FRAME: o->exposure_per_frame = 1; return 1;
+    case O_MPI: o->mpi = 1; return 1;
     case O_RGB: o->rgb = 1; return 1;
     case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
@@ -251,6 +252,8 @@ static int check_options(const render_opts *o)
     if (use_time && (!isnan(o->sun_el) || !isnan(o->sun_az)))
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (o->exposure_auto && !isnan(o->ev)) return cli_usage_error(C, "--exposure given twice");
+    if (o->mpi && (o->variance || o->order))
+        return cli_usage_error(C, "--variance and --order are not written with --mpi (each rank holds its own samples)");
     if (o->time_end && (!isnan(o->sun_el_end) || !isnan(o->sun_az_end)))
         return cli_usage_error(C, "--time-end (a sun given by time) and --sun-elevation-end/--sun-azimuth-end "
                                   "(a sun given by angles) exclude each other");
@@ -552,6 +555,11 @@ void render_opts_help(void)
            "                                default the first frame's is kept for all (a locked exposure)\n"
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
+           "      --mpi                     share the work between the ranks of an MPI job (mpirun -np N\n"
+           "                                atmos render ... --mpi): an animation's frames go round the\n"
+           "                                ranks, a single image's bands of rows are split between them;\n"
+           "                                rank 0 writes every output, the same bytes as one process\n"
+           "                                (docs/cluster.md; not with --variance or --order)\n"
            "      --renderer sky|slice|path|nishita|harris   the atmosphere alone (default), Riley et\n"
            "                                al.'s half-angle slicing over a volume (default when a volume is\n"
            "                                given), spectral Monte Carlo path tracing (the reference,\n"

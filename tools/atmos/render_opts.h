@@ -42,6 +42,7 @@ typedef struct {
     int nset;
     /* the run */
     int threads, quiet;
+    int mpi; /* --mpi: the work shared by the ranks of an MPI job (tools/atmos/dist.h) */
 } render_opts;
 
 /* Parses argv; returns CLI_EXIT_OK, CLI_EXIT_USAGE (message printed) or -1 after --help. */

@@ -1,0 +1,145 @@
+/* cli_dist over MPI (Open MPI from Debian): frames and bands of rows between the ranks of
+ * MPI_COMM_WORLD, every image gathered at rank 0. Messages carry the sender's status, so a
+ * rank that fails tells rank 0, which reports it and ends the job (cmd_render.c). */
+#include "dist.h"
+#include "cli.h"
+
+#include <mpi.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { TAG_HEAD = 1, TAG_DATA = 2 };
+/* Floats per message: MPI counts are ints. */
+#define CHUNK ((size_t)1 << 28)
+
+int cli_dist_start(int want, cli_dist *d)
+{
+    d->rank = 0, d->size = 1, d->active = 0;
+    if (!want) return CLI_EXIT_OK;
+    int provided = 0;
+    if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+        return cli_usage_error("render", "--mpi: MPI could not be started");
+    MPI_Comm_rank(MPI_COMM_WORLD, &d->rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &d->size);
+    d->active = 1;
+    return CLI_EXIT_OK;
+}
+
+void cli_dist_stop(const cli_dist *d)
+{
+    if (d->active) MPI_Finalize();
+}
+
+void cli_dist_abort(const cli_dist *d, int rc)
+{
+    if (d->active && d->size > 1) MPI_Abort(MPI_COMM_WORLD, rc ? rc : 1);
+}
+
+int cli_dist_max(const cli_dist *d, int v)
+{
+    int out = v;
+    if (d->active) MPI_Allreduce(&v, &out, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    return out;
+}
+
+int cli_dist_frame_owner(const cli_dist *d, int frame)
+{
+    return (frame - 1) % d->size;
+}
+
+/* n floats to or from a rank, in messages of at most CHUNK. */
+static void send_floats(const float *p, size_t n, int to)
+{
+    for (size_t i = 0; i < n; i += CHUNK)
+        MPI_Send(p + i, (int)(n - i < CHUNK ? n - i : CHUNK), MPI_FLOAT, to, TAG_DATA, MPI_COMM_WORLD);
+}
+
+static void recv_floats(float *p, size_t n, int from)
+{
+    for (size_t i = 0; i < n; i += CHUNK)
+        MPI_Recv(p + i, (int)(n - i < CHUNK ? n - i : CHUNK), MPI_FLOAT, from, TAG_DATA, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+}
+
+/* The rows of rank r's bands, in order, copied between the image and a packed buffer
+ * (to_img: buffer -> image). Returns the floats copied. */
+static size_t copy_bands(atmos_image *img, float *buf, int r, int size, int to_img)
+{
+    const size_t row = (size_t)img->width * img->channels;
+    size_t q = 0;
+    for (int y0 = r * CLI_DIST_BAND_ROWS; y0 < img->height; y0 += size * CLI_DIST_BAND_ROWS) {
+        const int y1 = y0 + CLI_DIST_BAND_ROWS < img->height ? y0 + CLI_DIST_BAND_ROWS : img->height;
+        float *px = img->pixels + (size_t)y0 * row;
+        const size_t n = (size_t)(y1 - y0) * row;
+        if (buf) memcpy(to_img ? px : buf + q, to_img ? buf + q : px, n * sizeof(float));
+        q += n;
+    }
+    return q;
+}
+
+/* This rank's bands rendered as regions of the frame. */
+static atmos_status render_bands(const cli_dist *d, atmos_plan *plan, const atmos_frame *f, atmos_image *img,
+                                 atmos_render_info *info)
+{
+    atmos_status st = ATMOS_OK;
+    double seconds = 0;
+    for (int y0 = d->rank * CLI_DIST_BAND_ROWS; y0 < img->height && st == ATMOS_OK; y0 += d->size * CLI_DIST_BAND_ROWS) {
+        atmos_region rg = {0, y0, img->width, y0 + CLI_DIST_BAND_ROWS < img->height ? y0 + CLI_DIST_BAND_ROWS : img->height};
+        st = atmos_plan_render(plan, f, &rg, img, info);
+        seconds += info->seconds;
+    }
+    info->seconds = seconds;
+    return st;
+}
+
+atmos_status cli_dist_render(const cli_dist *d, atmos_plan *plan, const atmos_frame *f, atmos_image *img,
+                             atmos_render_info *info)
+{
+    if (!d->active || d->size == 1) return atmos_plan_render(plan, f, NULL, img, info);
+    memset(info, 0, sizeof *info);
+    atmos_status st = render_bands(d, plan, f, img, info);
+    st = (atmos_status)cli_dist_max(d, (int)st);
+    if (st != ATMOS_OK) return st;
+    if (d->rank != 0) {
+        const size_t n = copy_bands(img, NULL, d->rank, d->size, 0);
+        float *buf = malloc(n * sizeof(float) + 1);
+        int ok = buf != NULL;
+        MPI_Send(&ok, 1, MPI_INT, 0, TAG_HEAD, MPI_COMM_WORLD);
+        if (ok) copy_bands(img, buf, d->rank, d->size, 0), send_floats(buf, n, 0);
+        free(buf);
+        return ok ? ATMOS_OK : ATMOS_E_NOMEM;
+    }
+    atmos_status worst = ATMOS_OK;
+    for (int r = 1; r < d->size; r++) {
+        int ok = 0;
+        MPI_Recv(&ok, 1, MPI_INT, r, TAG_HEAD, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        if (!ok) { worst = ATMOS_E_NOMEM; continue; }
+        const size_t n = copy_bands(img, NULL, r, d->size, 1);
+        float *buf = malloc(n * sizeof(float) + 1);
+        if (!buf) return ATMOS_E_NOMEM; /* the sender blocks: the caller ends the job */
+        recv_floats(buf, n, r);
+        copy_bands(img, buf, r, d->size, 1);
+        free(buf);
+    }
+    return worst;
+}
+
+atmos_status cli_dist_send(const cli_dist *d, const atmos_image *img, atmos_status st, const atmos_render_info *info)
+{
+    double head[4] = {(double)st, info ? info->seconds : 0, info ? info->sun_elevation_deg : 0,
+                      info ? info->sun_azimuth_deg : 0};
+    MPI_Send(head, 4, MPI_DOUBLE, 0, TAG_HEAD, MPI_COMM_WORLD);
+    if (st == ATMOS_OK) send_floats(img->pixels, (size_t)img->width * img->height * img->channels, 0);
+    (void)d;
+    return st;
+}
+
+atmos_status cli_dist_recv(const cli_dist *d, int from, atmos_image *img, atmos_render_info *info)
+{
+    double head[4];
+    MPI_Recv(head, 4, MPI_DOUBLE, from, TAG_HEAD, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    const atmos_status st = (atmos_status)head[0];
+    info->seconds = head[1], info->sun_elevation_deg = head[2], info->sun_azimuth_deg = head[3];
+    if (st == ATMOS_OK) recv_floats(img->pixels, (size_t)img->width * img->height * img->channels, from);
+    (void)d;
+    return st;
+}
