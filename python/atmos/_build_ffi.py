@@ -32,7 +32,11 @@ typedef struct atmos_wavelengths { int count; double nm[...]; ...; } atmos_wavel
 void atmos_wavelengths_rgb(atmos_wavelengths *out);
 atmos_status atmos_wavelengths_spectral(int n, atmos_wavelengths *out);
 
-typedef struct atmos_image { int width, height, channels; float *pixels; ...; } atmos_image;
+typedef struct atmos_image_meta { char *key; char *value; } atmos_image_meta;
+typedef struct atmos_image { int width, height, channels; float *pixels; int meta_count; atmos_image_meta *meta; ...; }
+    atmos_image;
+atmos_status atmos_read_exr_named(atmos_context *ctx, const char *path, atmos_image **out, char ***names);
+void free(void *ptr);
 void atmos_image_destroy(atmos_image *img);
 const char *atmos_image_get_meta(const atmos_image *img, const char *key);
 atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral, const atmos_wavelengths *wl,
@@ -120,6 +124,7 @@ void atmos_py_volume_dense(const atmos_volume *vol, int field, float *out);
 # more than the work they do.
 SOURCE = r"""
 #include <atmos/atmos.h>
+#include <stdlib.h>
 
 /* A particle preset, with its fast (coarser) optics if asked. */
 static atmos_status atmos_py_particle_fast(atmos_context *ctx, const char *name, int fast, atmos_particle_desc *out)

@@ -11,11 +11,16 @@ class Image:
 
     Rendered images hold linear sRGB (Rec. 709 primaries, D65; Y in cd/m^2) and coverage alpha:
     channels 0-2 are what ``atmos render --pfm`` writes. ``meta`` holds the image's metadata
-    (scene, renderer, sun, camera) as a dict. ``close()`` (or ``with``) frees it at once."""
+    (scene, renderer, sun, camera: the library's atmos:* keys, and the render's time) as a
+    dict of strings; ``channels`` names the channels. ``close()`` (or ``with``) frees it at once."""
 
-    def __init__(self, ptr, meta=None):
+    def __init__(self, ptr, meta=None, channels=None):
         self._ptr = ffi.gc(ptr, lib.atmos_image_destroy)
-        self.meta = dict(meta or {})
+        self.meta = {ffi.string(ptr.meta[i].key).decode(errors="replace"): ffi.string(ptr.meta[i].value).decode(errors="replace")
+                     for i in range(ptr.meta_count)}
+        self.meta.update(meta or {})
+        self.channels = list(channels) if channels else (["R", "G", "B", "A"][: ptr.channels] if ptr.channels in (3, 4)
+                                                         else [f"C{i}" for i in range(ptr.channels)])
 
     @property
     def shape(self):
@@ -66,3 +71,17 @@ class Image:
             return "<atmos.Image closed>"
         h, w, c = self.shape
         return f"<atmos.Image {w}x{h}, {c} channels, float32>"
+
+
+def read_exr(path) -> Image:
+    """Reads an OpenEXR file (any channel count: an ``atmos render --exr-layers`` file's
+    R, G, B, A, tau.Y, ...), with its channel names in ``channels`` and its attributes in
+    ``meta``."""
+    ctx = context()
+    out = ffi.new("atmos_image **")
+    names = ffi.new("char ***")
+    check(lib.atmos_read_exr_named(ctx, str(path).encode(), out, names), ctx)
+    n = out[0].channels
+    chans = [ffi.string(names[0][i]).decode() for i in range(n)]
+    lib.free(names[0])
+    return Image(out[0], channels=chans)

@@ -285,6 +285,12 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
     atmos_image_set_meta(out, "atmos:sun_elevation_deg", buf);
     snprintf(buf, sizeof buf, "%.6f", az);
     atmos_image_set_meta(out, "atmos:sun_azimuth_deg", buf);
+    static const char *const cams[] = {"pinhole", "fisheye", "equirect"};
+    const atmos_camera *c = &v->cam;
+    snprintf(buf, sizeof buf, "%s at (%.3f, %.3f, %.3f) m, forward (%.6f, %.6f, %.6f), up (%.6f, %.6f, %.6f), fov %.4f deg",
+             cams[(unsigned)c->type < 3u ? (int)c->type : 0], c->position[0], c->position[1], c->position[2], c->forward[0], c->forward[1],
+             c->forward[2], c->up[0], c->up[1], c->up[2], c->fov_deg);
+    atmos_image_set_meta(out, "atmos:camera", buf);
     snprintf(buf, sizeof buf, "%s, %d samples", p->wl.mode == ATMOS_WAVELENGTHS_RGB ? "rgb" : "spectral", p->wl.count);
     atmos_image_set_meta(out, "atmos:wavelengths", buf);
     snprintf(buf, sizeof buf, "%.6f", seconds);

@@ -203,3 +203,25 @@ def test_no_leak_over_1000_renders():
         np.asarray(img).sum()
     grown = rss_bytes() - before
     assert grown < 8 << 20, f"resident memory grew by {grown / 2**20:.1f} MiB over 1000 renders"
+
+
+def test_cli_exr_layers_and_metadata(tmp_path):
+    """atmos render --exr-layers: one EXR with the image, the optical depth and the
+    transmittance, and the metadata that says how it was made."""
+    scene = os.path.join(SRC, "scenes", "fig11_cumulus_dawn.json")
+    exr, tau, pfm = tmp_path / "l.exr", tmp_path / "tau.pfm", tmp_path / "l.pfm"
+    subprocess.run([CLI, "render", scene, "--width", "40", "--height", "24", "-q", "--exr", str(exr), "--pfm", str(pfm),
+                    "--tau", str(tau), "--exr-layers", "tau,transmittance"], check=True, capture_output=True)
+    img = atmos.read_exr(exr)
+    assert img.channels == ["R", "G", "B", "A", "tau.Y", "transmittance.Y"]
+    a = np.asarray(img)
+    assert np.array_equal(a[..., :3], read_pfm(pfm))
+    t = np.frombuffer(open(tau, "rb").read().split(b"\n", 3)[3], dtype="<f4").reshape(24, 40)[::-1]
+    assert np.array_equal(a[..., 4], t) and t.max() > 1
+    assert np.allclose(a[..., 5], np.exp(-t), rtol=1e-6, atol=0)
+    assert img.meta["atmos:scene_json"] == open(scene).read()
+    assert img.meta["atmos:command"].startswith("atmos render ") and "--exr-layers" in img.meta["atmos:command"]
+    assert img.meta["atmos:camera"].startswith("pinhole at (")
+    bad = subprocess.run([CLI, "render", scene, "--width", "8", "--height", "6", "--exr", str(exr), "--exr-layers", "nope"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "nope" in bad.stderr

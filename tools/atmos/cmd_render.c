@@ -4,6 +4,7 @@
 #include "outputs.h"
 #include "render_opts.h"
 #include "dist.h"
+#include "render_layers.h"
 #include "render_scene.h"
 
 #include <math.h>
@@ -82,15 +83,8 @@ static int stage_frame(const render_opts *o, const char *png, int frame, int nfr
  * as a 1-channel PFM. */
 static atmos_status write_tau(atmos_context *ctx, const atmos_scene *scene, const atmos_plan *plan, const char *path)
 {
-    double offset[3], sigma[ATMOS_VOLUME_MAX_FIELDS] = {0};
-    const atmos_volume *vol = atmos_plan_volume(plan, offset);
-    const atmos_volume_optics *o = atmos_plan_optics(plan);
-    for (int f = 0; o && f < o->count; f++) {
-        int k = atmos_phase_table_wavelength_count(o->phase[f]) / 2;
-        sigma[f] = atmos_phase_table_sigma_ext(o->phase[f], k) * scene->volume.density_scale;
-    }
     atmos_image *img = NULL;
-    atmos_status st = atmos_render_optical_depth(ctx, scene, vol, sigma, offset, &img);
+    atmos_status st = render_layers_tau(ctx, scene, plan, &img);
     if (st == ATMOS_OK) st = atmos_write_pfm(ctx, img, path);
     atmos_image_destroy(img);
     return st;
@@ -159,21 +153,36 @@ static atmos_status tone_map(atmos_context *ctx, atmos_image *lin, const atmos_s
 
 /* The outputs of a rendered frame (w: the files to write): linear sRGB to EXR and PFM,
  * tone-mapped to PNG; -o's file in the format its extension names. */
+/* The --exr file: lin, with the --exr-layers appended when asked. */
+static atmos_status write_exr_layers(atmos_context *ctx, const atmos_plan *plan, const atmos_scene *fs, const atmos_image *lin,
+                                     const char *path, atmos_exr_desc *ed, int layers)
+{
+    if (!layers) return atmos_write_exr(ctx, lin, path, ed);
+    atmos_image *all = NULL;
+    atmos_status st = render_layers_build(ctx, plan, fs, lin, layers, &all, &ed->channel_names);
+    if (st == ATMOS_OK) st = atmos_write_exr(ctx, all, path, ed);
+    ed->channel_names = NULL;
+    atmos_image_destroy(all);
+    return st;
+}
+
 static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, const atmos_scene *fs, const atmos_image *spec,
                                   const frame_files *w, cli_file_kind out_kind, const char *source, const char *frame,
-                                  exposure_lock *xl)
+                                  exposure_lock *xl, const render_opts *o)
 {
     atmos_image *lin = NULL, *disp = NULL;
     atmos_status st = atmos_image_to_srgb(ctx, spec, atmos_plan_wavelengths(plan), &lin);
     if (st != ATMOS_OK) return st;
     atmos_image_set_meta(lin, "atmos:source", source);
+    if (o->command) atmos_image_set_meta(lin, "atmos:command", o->command);
+    if (o->scene_text) atmos_image_set_meta(lin, "atmos:scene_json", o->scene_text);
     if (frame) atmos_image_set_meta(lin, "atmos:frame", frame);
     const atmos_wavelengths *wl = atmos_plan_wavelengths(plan);
     char nm[ATMOS_MAX_WAVELENGTHS * 8 + 8] = "";
     for (int k = 0; k < wl->count; k++) snprintf(nm + strlen(nm), sizeof nm - strlen(nm), "%s%.1f", k ? " " : "", wl->nm[k]);
     atmos_image_set_meta(lin, "atmos:wavelengths_nm", nm);
     atmos_exr_desc ed = {fs->exr_half, NULL};
-    if (w->exr) st = atmos_write_exr(ctx, lin, w->exr, &ed);
+    if (w->exr) st = write_exr_layers(ctx, plan, fs, lin, w->exr, &ed, o->exr_layers);
     if (st == ATMOS_OK && w->pfm) st = atmos_write_pfm(ctx, lin, w->pfm);
     if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_EXR) st = atmos_write_exr(ctx, lin, w->out, &ed);
     if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_PFM) st = atmos_write_pfm(ctx, lin, w->out);
@@ -265,7 +274,7 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const at
             continue;
         }
         if (st != ATMOS_OK) break;
-        st = write_outputs(ctx, plan, &fs, spec, &fo->w, out_kind, source, nframes > 1 ? label : NULL, &xl);
+        st = write_outputs(ctx, plan, &fs, spec, &fo->w, out_kind, source, nframes > 1 ? label : NULL, &xl, o);
         if (st != ATMOS_OK) break;
         if (cli_outputs_commit("render", &fo->set) != 0) {
             st = ATMOS_E_IO;
@@ -361,10 +370,10 @@ int cli_cmd_render(int argc, char **argv)
 {
     render_opts o;
     int rc = render_opts_parse(argc, argv, &o);
-    if (rc < 0) return CLI_EXIT_OK; /* --help */
-    if (rc != CLI_EXIT_OK) return rc;
+    if (rc != CLI_EXIT_OK) return render_opts_free(&o), rc < 0 ? CLI_EXIT_OK /* --help */ : rc;
     cli_dist d;
-    if ((rc = cli_dist_start(o.mpi, &d)) != CLI_EXIT_OK) return rc;
+    if ((rc = cli_dist_start(o.mpi, &d)) != CLI_EXIT_OK) return render_opts_free(&o), rc;
+    o.scene_text = render_scene_text(o.scene_path);
     if (d.rank != 0) o.quiet = 1; /* rank 0 reports; the others speak only of their failures */
     cli_progress prog;
     cli_progress_init(&prog, o.quiet);
@@ -381,5 +390,6 @@ int cli_cmd_render(int argc, char **argv)
      * outputs were discarded above). A rank that failed told rank 0, and waits for that. */
     if (stuck) cli_dist_abort(&d, rc);
     cli_dist_stop(&d);
+    render_opts_free(&o);
     return rc;
 }

@@ -2,6 +2,7 @@
  * row of the renderers' settings tables is added from atmos_renderer_settings, and --help
  * prints those rows with their ranges and defaults. */
 #include "render_opts.h"
+#include "render_layers.h"
 
 #include <getopt.h>
 #include <stddef.h>
@@ -14,13 +15,14 @@ enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
     O_RGB, O_EXPOSURE, O_EXPCOMP, O_TONE, O_THREADS, O_RENDERER, O_VOLUME, O_VPOS, O_DSCALE, O_TAU, O_VARIANCE,
     O_FRAMES, O_TIME_END, O_SEL_END, O_SAZ_END, O_ORDER, O_ATMOSPHERE, O_THICKNESS, O_GRIDS, O_PARTICLE, O_TINDEX,
-    O_DUNIT, O_VOXEL, O_VSCALE, O_FOV, O_VIEW_EL, O_VIEW_AZ, O_POSITION, O_LOOKAT, O_DETAIL, O_EXP_PER_FRAME, O_MPI,
+    O_DUNIT, O_VOXEL, O_VSCALE, O_FOV, O_VIEW_EL, O_VIEW_AZ, O_POSITION, O_LOOKAT, O_DETAIL, O_EXP_PER_FRAME, O_MPI, O_LAYERS,
     O_SETTING = 1024 /* + row index over the tables: a renderer setting */
 };
 
 static const struct option fixed_opts[] = {
     {"output", required_argument, 0, 'o'}, {"exr", required_argument, 0, O_EXR}, {"pfm", required_argument, 0, O_PFM},
     {"png-bits", required_argument, 0, O_PNGBITS}, {"exr-half", no_argument, 0, O_EXRHALF},
+    {"exr-layers", required_argument, 0, O_LAYERS},
     {"width", required_argument, 0, O_W}, {"height", required_argument, 0, O_H},
     {"camera", required_argument, 0, O_CAM}, {"altitude", required_argument, 0, O_ALT},
     {"sun-elevation", required_argument, 0, O_SEL}, {"sun-azimuth", required_argument, 0, O_SAZ},
@@ -162,6 +164,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_EXRHALF: o->exr_half = 1; return 1;
     case O_EXP_PER_FRAME: o->exposure_per_frame = 1; return 1;
     case O_MPI: o->mpi = 1; return 1;
+    case O_LAYERS: return render_layers_parse(arg, &o->exr_layers);
     case O_RGB: o->rgb = 1; return 1;
     case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
@@ -252,8 +255,10 @@ static int check_options(const render_opts *o)
     if (use_time && (!isnan(o->sun_el) || !isnan(o->sun_az)))
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (o->exposure_auto && !isnan(o->ev)) return cli_usage_error(C, "--exposure given twice");
-    if (o->mpi && (o->variance || o->order))
-        return cli_usage_error(C, "--variance and --order are not written with --mpi (each rank holds its own samples)");
+    if (o->mpi && (o->variance || o->order || (o->exr_layers & (RENDER_LAYER_ORDER | RENDER_LAYER_VARIANCE))))
+        return cli_usage_error(C, "--variance, --order and the order and variance layers are not written with --mpi "
+                                  "(each rank holds its own samples)");
+    if (o->exr_layers && !o->exr) return cli_usage_error(C, "--exr-layers: they go in the --exr file; give one");
     if (o->time_end && (!isnan(o->sun_el_end) || !isnan(o->sun_az_end)))
         return cli_usage_error(C, "--time-end (a sun given by time) and --sun-elevation-end/--sun-azimuth-end "
                                   "(a sun given by angles) exclude each other");
@@ -266,6 +271,37 @@ static int check_options(const render_opts *o)
     if (o->look_at_given && (!isnan(o->view_el) || !isnan(o->view_az)))
         return cli_usage_error(C, "--look-at and --view-elevation/--view-azimuth exclude each other");
     return CLI_EXIT_OK;
+}
+
+/* argv as one line, each argument in single quotes when it has more than letters, digits
+ * and -_./=,:+ (a line a shell runs again). */
+static char *command_line(int argc, char **argv)
+{
+    size_t cap = 16;
+    for (int i = 0; i < argc; i++) cap += 4 * strlen(argv[i]) + 3;
+    char *s = malloc(cap), *q = s;
+    if (!s) return NULL;
+    q += sprintf(q, "atmos");
+    for (int i = 0; i < argc; i++) {
+        const int plain = argv[i][0] && strspn(argv[i], "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                         "0123456789-_./=,:+") == strlen(argv[i]);
+        *q++ = ' ';
+        if (!plain) *q++ = '\'';
+        for (const char *a = argv[i]; *a; a++) {
+            if (!plain && *a == '\'') q += sprintf(q, "'\\''");
+            else *q++ = *a;
+        }
+        if (!plain) *q++ = '\'';
+    }
+    *q = 0;
+    return s;
+}
+
+void render_opts_free(render_opts *o)
+{
+    free(o->command);
+    free(o->scene_text);
+    o->command = o->scene_text = NULL;
 }
 
 int render_opts_parse(int argc, char **argv, render_opts *o)
@@ -304,6 +340,7 @@ int render_opts_parse(int argc, char **argv, render_opts *o)
     }
     if (optind < argc) o->scene_path = argv[optind++];
     if (optind < argc) return cli_usage_error("render", "unexpected argument '%s' (one scene file at most)", argv[optind]);
+    o->command = command_line(argc, argv);
     return check_options(o);
 }
 
@@ -524,6 +561,10 @@ void render_opts_help(void)
            "      --exr-half          write EXR as 16-bit half floats (default: 32-bit float); values\n"
            "                          beyond the largest half (65504, e.g. the sun's disc) are clamped\n"
            "                          to 65504 with a warning\n"
+           "      --exr-layers LIST   more layers in the --exr file beside R,G,B,A (comma-separated):\n"
+           "                          tau (tau.Y, the volume's optical depth along the pixel's ray),\n"
+           "                          transmittance (transmittance.Y = exp(-tau)), and with the path\n"
+           "                          tracer order (order.Y) and variance (variance.<nm>nm, variance.Y)\n"
            "      --tau FILE.pfm      also write the volume's optical depth along each pixel's ray\n"
            "                          (middle wavelength of the set; a key for atmos compare --by)\n"
            "      --variance FILE.exr path: per-pixel variance of the mean (channels var_<nm>nm per\n"

@@ -21,6 +21,9 @@ typedef struct {
     /* outputs */
     const char *png, *exr, *pfm, *variance, *order, *tau;
     int png_bits, exr_half;
+    int exr_layers;         /* --exr-layers: RENDER_LAYER_* (render_layers.h) in the --exr file */
+    char *command;          /* the command line, for the outputs' metadata (render_opts_free) */
+    char *scene_text;       /* the scene file's text (at most 1 MiB), for the same; NULL: none */
     int exposure_per_frame; /* an animation's automatic exposure chosen per frame, not locked */
     /* scene overrides (0 / NaN / NULL / -1: not given) */
     int width, height, spp, spectral, rgb, cam_type, renderer, tone, exposure_auto, frames, air;
@@ -45,8 +48,10 @@ typedef struct {
     int mpi; /* --mpi: the work shared by the ranks of an MPI job (tools/atmos/dist.h) */
 } render_opts;
 
-/* Parses argv; returns CLI_EXIT_OK, CLI_EXIT_USAGE (message printed) or -1 after --help. */
+/* Parses argv; returns CLI_EXIT_OK, CLI_EXIT_USAGE (message printed) or -1 after --help.
+ * render_opts_free releases what it allocated (either way). */
 int render_opts_parse(int argc, char **argv, render_opts *o);
+void render_opts_free(render_opts *o);
 void render_opts_help(void);
 /* Applies the options to a scene (loaded or the default); returns CLI_EXIT_OK or
  * CLI_EXIT_USAGE (message printed). ctx receives time-parsing errors. */

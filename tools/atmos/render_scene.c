@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static int ends_with(const char *s, const char *ext)
@@ -109,4 +110,17 @@ const char *render_scene_output_name(const render_opts *o, const atmos_scene *sc
     if (n == 0) return scene->name;
     snprintf(buf, cap, "%.*s", (int)(n < cap ? n : cap - 1), base);
     return buf;
+}
+
+char *render_scene_text(const char *path)
+{
+    if (!path || !strcmp(path, "-")) return NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    char *text = malloc((1 << 20) + 1);
+    size_t n = text ? fread(text, 1, (1 << 20) + 1, f) : 0;
+    fclose(f);
+    if (!text || n > (1 << 20) || memchr(text, 0, n)) return free(text), NULL;
+    text[n] = 0;
+    return text;
 }

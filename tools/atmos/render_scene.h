@@ -18,4 +18,9 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
  * default scene and a scene from standard input. Returns buf or scene->name. */
 const char *render_scene_output_name(const render_opts *o, const atmos_scene *scene, char *buf, size_t cap);
 
+/* The scene file's text for the outputs' metadata (atmos:scene_json): NULL for the default
+ * scene, standard input, a file over 1 MiB or one that cannot be read (the scene's own
+ * reading reports that). The caller frees it. */
+char *render_scene_text(const char *path);
+
 #endif
