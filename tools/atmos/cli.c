@@ -95,6 +95,32 @@ void cli_print_json_array(const double *v, int n)
     putchar(']');
 }
 
+char *cli_read_text(const char *path, size_t max)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    int bad = 0;
+    for (;;) {
+        if (n + 4096 + 1 > cap) {
+            cap = 2 * cap + 8192;
+            char *nb = realloc(buf, cap);
+            if (!nb) { bad = 1; break; }
+            buf = nb;
+        }
+        const size_t r = fread(buf + n, 1, 4096, f);
+        n += r;
+        if (n > max) { bad = 1; break; }
+        if (r < 4096) break;
+    }
+    bad = bad || ferror(f) || !buf || memchr(buf, 0, n);
+    fclose(f);
+    if (bad) return free(buf), NULL;
+    buf[n] = '\0';
+    return buf;
+}
+
 double cli_now_s(void)
 {
     struct timespec ts;

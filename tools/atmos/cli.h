@@ -42,6 +42,10 @@ int cli_progress_bar(void *user, const char *stage, double fraction);
 int cli_sky_table(const char *C, atmos_context *ctx, const atmos_atmosphere *atm, const char *name, const char *out);
 /* Monotonic clock, seconds. */
 double cli_now_s(void);
+/* The whole of a text file as a new string; NULL when it cannot be read, is longer than max
+ * bytes or holds a NUL byte. */
+char *cli_read_text(const char *path, size_t max);
+#define CLI_TEXT_MAX ((size_t)16 << 20)
 /* Option with a value, as "--name VALUE" or "--name=VALUE": returns 1 if argv[*i] is
  * that option (advancing *i past a separate value) with *value set (NULL when the value
  * is missing), else 0. */

@@ -114,13 +114,5 @@ const char *render_scene_output_name(const render_opts *o, const atmos_scene *sc
 
 char *render_scene_text(const char *path)
 {
-    if (!path || !strcmp(path, "-")) return NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    char *text = malloc((1 << 20) + 1);
-    size_t n = text ? fread(text, 1, (1 << 20) + 1, f) : 0;
-    fclose(f);
-    if (!text || n > (1 << 20) || memchr(text, 0, n)) return free(text), NULL;
-    text[n] = 0;
-    return text;
+    return path && strcmp(path, "-") ? cli_read_text(path, (size_t)1 << 20) : NULL;
 }

@@ -98,8 +98,6 @@ typedef struct view_script {
     view_key_frame *k;
     double fps;             /* frames per second of the flight's clock; 24 */
 } view_script;
-/* The whole of a text file (a new string; NULL when it cannot be read). */
-char *view_read_text(const char *path);
 /* Reads a flight file: {"fps": 24, "keys": [{"t": 0, "position_m": [..], "look_at_m": [..],
  * "sun": {"elevation_deg": e, "azimuth_deg": a}, "press": "sun_up"}, ...]}. Returns 0 or an
  * exit status with a message. */

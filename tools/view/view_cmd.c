@@ -92,11 +92,13 @@ int cli_cmd_view(int argc, char **argv)
     }
     if (rc != CLI_EXIT_OK || vo.frames < 0) {
         free(vo.pass);
+        render_opts_free(&ro);
         return rc == -1 ? CLI_EXIT_OK : rc;
     }
     int codes[16];
     if (vo.press && view_key_codes(vo.press, codes, 16) < 0) {
         free(vo.pass);
+        render_opts_free(&ro);
         return cli_usage_error("view", "--press: unknown key in '%s' (atmos view --help lists the keys)", vo.press);
     }
     atmos_context *ctx = cli_context(ro.threads, ro.quiet);
@@ -105,7 +107,7 @@ int cli_cmd_view(int argc, char **argv)
     char *text = NULL;
     if (!ctx) rc = CLI_EXIT_RUNTIME;
     if (rc == CLI_EXIT_OK) rc = render_scene_make(ctx, &ro, &sc, &vol);
-    if (rc == CLI_EXIT_OK && ro.scene_path && strcmp(ro.scene_path, "-")) text = view_read_text(ro.scene_path);
+    if (rc == CLI_EXIT_OK && ro.scene_path && strcmp(ro.scene_path, "-")) text = cli_read_text(ro.scene_path, CLI_TEXT_MAX);
     if (rc == CLI_EXIT_OK) {
         sc.width = vo.width, sc.height = vo.height;
         rc = view_loop(ctx, &vo, &sc, vol, text ? text : "{}");
@@ -114,5 +116,6 @@ int cli_cmd_view(int argc, char **argv)
     atmos_volume_destroy(vol);
     atmos_context_destroy(ctx);
     free(vo.pass);
+    render_opts_free(&ro);
     return rc;
 }

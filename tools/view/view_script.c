@@ -7,33 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-char *view_read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    char *buf = NULL;
-    size_t n = 0, cap = 0;
-    for (;;) {
-        if (n + 4096 + 1 > cap) {
-            cap = 2 * cap + 8192;
-            char *nb = realloc(buf, cap);
-            if (!nb) break;
-            buf = nb;
-        }
-        const size_t r = fread(buf + n, 1, 4096, f);
-        n += r;
-        if (r < 4096) break;
-    }
-    const int bad = ferror(f) || !buf;
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return NULL;
-    }
-    buf[n] = '\0';
-    return buf;
-}
-
 static int vec3(const cJSON *o, const char *name, double v[3])
 {
     const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, name);
@@ -74,7 +47,7 @@ int view_script_load(const char *path, view_script *out)
 {
     memset(out, 0, sizeof *out);
     out->fps = 24;
-    char *text = view_read_text(path);
+    char *text = cli_read_text(path, CLI_TEXT_MAX);
     if (!text) {
         fprintf(stderr, "atmos view: --script %s: cannot read it\n", path);
         return CLI_EXIT_RUNTIME;
