@@ -3,10 +3,10 @@
 # arguments, those packages instead (scripts/install-bench-deps.sh).
 # Safe to run repeatedly: it does nothing when everything is present.
 set -eu
-# Images: libpng, libjpeg (maps of the Earth), OpenEXR. Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
+# Images: libpng, libjpeg (maps of the Earth), OpenEXR. Meshes: tinyobjloader (OBJ files). Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
 # its headers include, which Debian does not pull in); gnuplot for 'atmos phase --plot'; SDL2, SDL2_ttf
 # and the DejaVu fonts for 'atmos view', Xvfb (and xauth for xvfb-run) for its tests.
-PKGS="build-essential cmake pkg-config libpng-dev libjpeg-dev libopenexr-dev libcjson-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3 libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth"
+PKGS="build-essential cmake pkg-config libpng-dev libjpeg-dev libopenexr-dev libcjson-dev libtinyobjloader-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3 libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth"
 [ $# -gt 0 ] && PKGS="$*"
 missing=""
 for p in $PKGS; do

@@ -118,5 +118,6 @@ ATMOS_API atmos_status atmos_copy_file_atomic(atmos_context *ctx, const char *sr
 #include "atmos/slice.h"
 #include "atmos/path.h"
 #include "atmos/plan.h"
+#include "atmos/mesh.h"
 
 #endif
