@@ -1,0 +1,86 @@
+/* Dobashi, Yamamoto and Nishita 2002 §4's light beams ("renderer": "beams", docs/beams.md):
+ * point lights and spotlights in a uniform fog, the shadows of meshes in the air by shadow
+ * maps, sampling planes facing the view with a pre-integrated scattering table and
+ * sub-planes. The plan's part (beams_plan.c), the table (beams_table.c), the shadow maps
+ * (beams_shadow.c) and the frame (beams_render.c). Not part of the API. */
+#ifndef ATMOS_RENDER_BEAMS_INTERNAL_H
+#define ATMOS_RENDER_BEAMS_INTERNAL_H
+
+#include "render/plan_internal.h"
+
+/* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
+ * substitution of Sun et al. 2005). For a ray passing at distance v from the light, with u
+ * the signed distance along the ray from Q (the ray's point nearest the light) and
+ * theta = atan(u / v), the light scattered toward the eye between u_a and u_b per unit
+ * intensity is
+ *     exp(-sigma_t t_Q) / v * (W(theta_b, x) - W(theta_a, x)),  x = sigma_t v,
+ *     W(theta, x) = sigma_s * int_{-pi/2}^{theta} p(-sin th) exp(-x tan(pi/4 + th/2)) dth,
+ * t_Q the distance from the eye to Q and p the phase function: two look-ups for any
+ * interval, whatever its length (Dobashi's q(u, v) is a difference of W at a fixed
+ * interval). Tabulated over nt angles in [-pi/2, pi/2] and nx values of x = x_max w^2,
+ * w in [0, 1] (finer near the light); linear in theta, cubic in w. */
+typedef struct atmos__beams_table {
+    int nt, nx;
+    double x_max;
+    double *w;               /* nx rows of nt values */
+} atmos__beams_table;
+
+atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, double g, double x_max,
+                                      atmos__beams_table *out);
+void atmos__beams_table_free(atmos__beams_table *t);
+
+/* The four rows and their weights for one x (a ray and a light): W at any theta is then
+ * atmos__beams_table_at. */
+typedef struct atmos__beams_column {
+    const double *row[4];
+    double wt[4];
+} atmos__beams_column;
+void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__beams_column *c);
+double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double theta);
+
+/* A depth map seen from a light through one frustum: the distance along fwd of the nearest
+ * surface through each of n x n texels spanning [-tan_half, tan_half]^2 of the image plane. */
+typedef struct atmos__beams_face {
+    double right[3], up[3], fwd[3];
+    double tan_half;
+    int n;
+    float *depth;
+} atmos__beams_face;
+
+typedef struct atmos__beams_light {
+    atmos_light_type type;
+    double pos[3], axis[3];
+    double cos_inner, cos_outer; /* spot: full within cos_inner, zero beyond cos_outer */
+    double range;
+    double I[ATMOS_MAX_WAVELENGTHS]; /* spectral intensity on the axis, W sr^-1 nm^-1 */
+    double I_max;                /* the largest of I */
+    int nfaces;                  /* 0: no shadow casters; 1: a spot's frustum; 6: a cube map */
+    atmos__beams_face face[6];
+} atmos__beams_light;
+
+/* The light's shadow maps of the meshes, size texels a side (beams_shadow.c). */
+atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l, atmos_mesh *const *mesh, int nmesh,
+                                       int size);
+void atmos__beams_shadow_free(atmos__beams_light *l);
+/* H: the share of the light reaching p past the meshes, in [0, 1] (2x2 filtered). */
+double atmos__beams_visibility(const atmos__beams_light *l, const double p[3]);
+/* The spot's smooth falloff at p (1 for a point light): a smoothstep in the cosine of the
+ * angle from the axis between cos_outer and cos_inner. */
+double atmos__beams_falloff(const atmos__beams_light *l, const double p[3]);
+
+struct atmos__beams_plan {
+    int nmesh;
+    atmos_mesh **mesh;
+    double (*albedo)[ATMOS_MAX_WAVELENGTHS]; /* per mesh */
+    int nlights;
+    atmos__beams_light *lights;
+    double sigma_t, sigma_s;                 /* 0 without fog */
+    atmos__beams_table table;
+    /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
+    int centre_planes, centre_subplanes;
+};
+
+/* The light sources' spectra (beams_plan.c): the intensity at wavelength nm of a light. */
+double atmos__beams_spectrum(const atmos_scene_light *l, const atmos_wavelengths *wl, int k);
+
+#endif
