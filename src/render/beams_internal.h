@@ -45,6 +45,11 @@ typedef struct atmos__beams_face {
     double tan_half;
     int n;
     float *depth;
+    /* per tile of TILE x TILE texels, the least and the greatest depth of the tile and the
+     * texels around it (what a filtered look-up in it may read): nearer than the least is
+     * lit, farther than the greatest is in shadow, without reading the map */
+    int tiles;
+    float *tile_min, *tile_max;
 } atmos__beams_face;
 
 typedef struct atmos__beams_light {
@@ -67,6 +72,20 @@ double atmos__beams_visibility(const atmos__beams_light *l, const double p[3]);
 /* The spot's smooth falloff at p (1 for a point light): a smoothstep in the cosine of the
  * angle from the axis between cos_outer and cos_inner. */
 double atmos__beams_falloff(const atmos__beams_light *l, const double p[3]);
+
+/* One ray's view of one light, for the sub-planes: the point o + t d relative to the light,
+ * its depth along the spot's axis and its coordinates in each shadow face, all linear in t
+ * (set once per ray; a sample then costs a few multiply-adds and at most one square root). */
+typedef struct atmos__beams_ray {
+    const atmos__beams_light *l;
+    double ww0, wd;          /* |w(0)|^2 and w(0).d: |w(t)|^2 = ww0 + 2 t wd + t^2 */
+    double w0[3], d[3];      /* w(t) = w0 + t d */
+    double a0, a1;           /* the depth along the axis: a0 + t a1 */
+    double f0[6][3], f1[6][3]; /* per face: (right, up, fwd) coordinates a0 + t a1 */
+} atmos__beams_ray;
+void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r);
+/* The spot's falloff times the visibility H at o + t d (as the two functions above). */
+double atmos__beams_ray_light(const atmos__beams_ray *r, double t);
 
 struct atmos__beams_plan {
     int nmesh;

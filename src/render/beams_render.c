@@ -42,7 +42,7 @@ static int first_hit(const atmos__beams_plan *b, const double o[3], const double
 {
     int any = 0;
     for (int m = 0; m < b->nmesh; m++) {
-        atmos_mesh_hit h;
+        atmos_mesh_hit h = {0, 0, {0, 0, 0}};
         if (atmos_mesh_intersect(b->mesh[m], o, d, tmin, tmax, hit ? &h : NULL)) {
             if (!hit) return 1;
             *hit = h, *which = m, tmax = h.t, any = 1;
@@ -139,6 +139,8 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
         for (int k = 0; k < J->nw; k++) L[k] += l->I[k] * S;
         return;
     }
+    atmos__beams_ray ray;
+    atmos__beams_ray_init(l, J->eye, d, &ray);
     double sum = 0;
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
@@ -147,12 +149,7 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
         const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
         double h = 0;
-        for (int s = 0; s < m; s++) {
-            const double t = ta + (s + 0.5) * step;
-            const double P[3] = {J->eye[0] + t * d[0], J->eye[1] + t * d[1], J->eye[2] + t * d[2]};
-            const double fall = atmos__beams_falloff(l, P);
-            if (fall > 0) h += fall * atmos__beams_visibility(l, P);
-        }
+        for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + 0.5) * step);
         sum += h / m * fl;
         if (centre) J->centre_subplanes += m;
     }
@@ -164,7 +161,7 @@ static void pixel(job *J, int x, int y, float *px, double *f)
     const atmos__beams_plan *b = J->b;
     double d[3], L[ATMOS_MAX_WAVELENGTHS];
     atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
-    atmos_mesh_hit h;
+    atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
     const int hit = first_hit(b, J->eye, d, 0, INFINITY, &h, &m);
     const double T = hit ? h.t : INFINITY;

@@ -12,11 +12,15 @@
 #include <string.h>
 
 #define NEAR_M 1e-3
+#define TILE 8
 #define SPOT_FRUSTUM_MAX_DEG 60.0
 
 void atmos__beams_shadow_free(atmos__beams_light *l)
 {
-    for (int f = 0; f < l->nfaces; f++) free(l->face[f].depth), l->face[f].depth = NULL;
+    for (int f = 0; f < l->nfaces; f++) {
+        free(l->face[f].depth), free(l->face[f].tile_min);
+        l->face[f].depth = l->face[f].tile_min = l->face[f].tile_max = NULL;
+    }
     l->nfaces = 0;
 }
 
@@ -82,6 +86,22 @@ static void clip_draw(atmos__beams_face *F, const double in[3][3])
     }
 }
 
+/* The tiles' bounds (atmos__beams_face), each over its texels and a ring of one around. */
+static void tile_bounds(atmos__beams_face *F)
+{
+    const int n = F->n, T = F->tiles;
+    for (int ty = 0; ty < T; ty++)
+        for (int tx = 0; tx < T; tx++) {
+            float lo = INFINITY, hi = 0;
+            for (int y = ty * TILE - 1; y <= (ty + 1) * TILE; y++)
+                for (int x = tx * TILE - 1; x <= (tx + 1) * TILE; x++) {
+                    const float z = F->depth[(size_t)(y < 0 ? 0 : y >= n ? n - 1 : y) * n + (x < 0 ? 0 : x >= n ? n - 1 : x)];
+                    lo = fminf(lo, z), hi = fmaxf(hi, z);
+                }
+            F->tile_min[ty * T + tx] = lo, F->tile_max[ty * T + tx] = hi;
+        }
+}
+
 static void raster_face(atmos__beams_face *F, const double pos[3], atmos_mesh *const *mesh, int nmesh)
 {
     for (size_t i = 0; i < (size_t)F->n * F->n; i++) F->depth[i] = INFINITY;
@@ -96,6 +116,7 @@ static void raster_face(atmos__beams_face *F, const double pos[3], atmos_mesh *c
             if (v[0][2] < NEAR_M && v[1][2] < NEAR_M && v[2][2] < NEAR_M) continue;
             clip_draw(F, v);
         }
+    tile_bounds(F);
 }
 
 atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l, atmos_mesh *const *mesh, int nmesh,
@@ -113,10 +134,12 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
             d[f / 2] = f % 2 ? -1 : 1;
             set_face(F, d, 1.0);
         }
-        F->n = size;
+        F->n = size, F->tiles = (size + TILE - 1) / TILE;
         F->depth = malloc(sizeof(float) * (size_t)size * size);
-        if (!F->depth) {
-            l->nfaces = f;
+        F->tile_min = malloc(sizeof(float) * 2 * (size_t)F->tiles * F->tiles);
+        F->tile_max = F->tile_min ? F->tile_min + (size_t)F->tiles * F->tiles : NULL;
+        if (!F->depth || !F->tile_min) {
+            l->nfaces = f + 1;
             atmos__beams_shadow_free(l);
             return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d shadow map", size, size);
         }
@@ -127,34 +150,76 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     return ATMOS_OK;
 }
 
+/* H at the point (x, y, z) of face F's frame: the four nearest comparisons, blended. */
+static double lookup(const atmos__beams_face *F, double x, double y, double z)
+{
+    if (z <= NEAR_M) return 1;
+    const int n = F->n;
+    const double k = 0.5 * n / (z * F->tan_half);
+    const double fx = 0.5 * n + x * k - 0.5, fy = 0.5 * n + y * k - 0.5;
+    if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
+    const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1; /* floor: fx, fy > -1 */
+    const int tile = (y0 < 0 ? 0 : y0 / TILE) * F->tiles + (x0 < 0 ? 0 : x0 / TILE);
+    if (z < F->tile_min[tile]) return 1;
+    if (z >= F->tile_max[tile]) return 0;
+    const double ax = fx - x0, ay = fy - y0;
+    const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
+    const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
+    const float *ra = F->depth + (size_t)ya * n, *rb = F->depth + (size_t)yb * n;
+    const double top = (1 - ax) * (z < ra[xa]) + ax * (z < ra[xb]), bottom = (1 - ax) * (z < rb[xa]) + ax * (z < rb[xb]);
+    return (1 - ay) * top + ay * bottom;
+}
+
+/* The cube face of w's largest component. */
+static int cube_face(const double w[3])
+{
+    const double ax = fabs(w[0]), ay = fabs(w[1]), az = fabs(w[2]);
+    const int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
+    return 2 * a + (w[a] < 0);
+}
+
 double atmos__beams_visibility(const atmos__beams_light *l, const double p[3])
 {
     if (!l->nfaces) return 1;
     const double d[3] = {p[0] - l->pos[0], p[1] - l->pos[1], p[2] - l->pos[2]};
-    int f = 0;
-    if (l->nfaces == 6) { /* the cube face of the largest component */
-        const double ax = fabs(d[0]), ay = fabs(d[1]), az = fabs(d[2]);
-        const int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
-        f = 2 * a + (d[a] < 0);
+    const atmos__beams_face *F = &l->face[l->nfaces == 6 ? cube_face(d) : 0];
+    return lookup(F, atmos__dot3(d, F->right), atmos__dot3(d, F->up), atmos__dot3(d, F->fwd));
+}
+
+void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r)
+{
+    r->l = l;
+    for (int a = 0; a < 3; a++) r->w0[a] = o[a] - l->pos[a], r->d[a] = d[a];
+    r->ww0 = atmos__dot3(r->w0, r->w0), r->wd = atmos__dot3(r->w0, d);
+    r->a0 = atmos__dot3(r->w0, l->axis), r->a1 = atmos__dot3(d, l->axis);
+    for (int f = 0; f < l->nfaces; f++) {
+        const atmos__beams_face *F = &l->face[f];
+        r->f0[f][0] = atmos__dot3(r->w0, F->right), r->f1[f][0] = atmos__dot3(d, F->right);
+        r->f0[f][1] = atmos__dot3(r->w0, F->up), r->f1[f][1] = atmos__dot3(d, F->up);
+        r->f0[f][2] = atmos__dot3(r->w0, F->fwd), r->f1[f][2] = atmos__dot3(d, F->fwd);
     }
-    const atmos__beams_face *F = &l->face[f];
-    const double z = atmos__dot3(d, F->fwd);
-    if (z <= NEAR_M) return 1;
-    const int n = F->n;
-    const double fx = (0.5 + 0.5 * atmos__dot3(d, F->right) / (z * F->tan_half)) * n - 0.5;
-    const double fy = (0.5 + 0.5 * atmos__dot3(d, F->up) / (z * F->tan_half)) * n - 0.5;
-    if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
-    const int x0 = (int)floor(fx), y0 = (int)floor(fy);
-    const double ax = fx - x0, ay = fy - y0;
-    double h = 0;
-    for (int j = 0; j < 2; j++)
-        for (int i = 0; i < 2; i++) {
-            const int x = x0 + i < 0 ? 0 : x0 + i > n - 1 ? n - 1 : x0 + i;
-            const int y = y0 + j < 0 ? 0 : y0 + j > n - 1 ? n - 1 : y0 + j;
-            const double wgt = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
-            h += (z < F->depth[(size_t)y * n + x]) * wgt;
+}
+
+double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
+{
+    const atmos__beams_light *l = r->l;
+    double fall = 1;
+    if (l->type == ATMOS_LIGHT_SPOT) {
+        const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
+        if (z <= 0 || z * z <= l->cos_outer * l->cos_outer * w2) return 0;
+        if (z * z < l->cos_inner * l->cos_inner * w2) {
+            const double s = (z / sqrt(w2) - l->cos_outer) / (l->cos_inner - l->cos_outer);
+            fall = s * s * (3 - 2 * s);
         }
-    return h;
+    }
+    if (!l->nfaces) return fall;
+    int f = 0;
+    if (l->nfaces == 6) {
+        const double w[3] = {r->w0[0] + t * r->d[0], r->w0[1] + t * r->d[1], r->w0[2] + t * r->d[2]};
+        f = cube_face(w);
+    }
+    return fall * lookup(&l->face[f], r->f0[f][0] + t * r->f1[f][0], r->f0[f][1] + t * r->f1[f][1],
+                         r->f0[f][2] + t * r->f1[f][2]);
 }
 
 double atmos__beams_falloff(const atmos__beams_light *l, const double p[3])
