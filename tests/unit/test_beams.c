@@ -273,6 +273,69 @@ static void test_threads(void)
     atmos_image_destroy(img[1]);
 }
 
+/* The Fig. 4 scene file, smaller: the picture has what the figure has. And objects from OBJ
+ * files named relative to the scene's folder: a good one renders, a broken one is an error
+ * naming the file. */
+static void test_scene_files(void)
+{
+    const char *src = getenv("ATMOS_SOURCE_DIR");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/dobashi_fig04_spotlight.json", src && *src ? src : ".");
+    atmos_scene s;
+    CHECK_OK(atmos_scene_load(ctx, path, &s));
+    s.width = 60, s.height = 90;
+    atmos_image *img = render(ctx, &s);
+    if (img) {
+        atmos_camera cam;
+        CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
+        /* the pixels looking at the sphere's lit top, through its shadow below, at the lit floor */
+        const double top[3] = {0, 9.4, 0}, under[3] = {0, 4, 0}, floor_lit[3] = {5.5, 0, 0}, floor_dark[3] = {0, 0, 0};
+        const double *pts[4] = {top, under, floor_lit, floor_dark};
+        double val[4];
+        for (int i = 0; i < 4; i++) {
+            double d[3], best = -1;
+            int bx = 0, by = 0;
+            for (int y = 0; y < s.height; y++)
+                for (int x = 0; x < s.width; x++) { /* the pixel whose ray passes nearest the point */
+                    atmos_camera_ray(&cam, x + 0.5, y + 0.5, d);
+                    double w[3], t = 0;
+                    for (int k = 0; k < 3; k++) w[k] = pts[i][k] - s.camera.position[k], t += w[k] * d[k];
+                    double e = 0;
+                    for (int k = 0; k < 3; k++) e += (w[k] - t * d[k]) * (w[k] - t * d[k]);
+                    if (best < 0 || e < best) best = e, bx = x, by = y;
+                }
+            val[i] = img->pixels[((size_t)by * s.width + bx) * img->channels + 1];
+        }
+        printf("fig04: sphere top %.4g, the air below it %.4g, lit floor %.4g, its shadow %.4g\n", val[0], val[1], val[2],
+               val[3]);
+        CHECK(val[0] > 2 * val[1] && val[2] > 3 * val[3] && val[1] > 0);
+        atmos_image_destroy(img);
+    }
+    char obj[1024], scene[1024];
+    test_tmp_path(obj, sizeof obj, "tri.obj");
+    FILE *f = fopen(obj, "wb");
+    if (f) fputs("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 3 2\n", f), fclose(f);
+    const char *text = "{\"renderer\": \"beams\", \"image\": {\"width\": 16, \"height\": 12}, \"background\": \"black\","
+                       " \"camera\": {\"position_m\": [0, 3, 6], \"look_at_m\": [0, 0, 0]},"
+                       " \"fog\": {\"extinction_per_m\": 0.1}, \"lights\": [{\"position_m\": [0, 4, 0]}],"
+                       " \"objects\": [{\"mesh\": \"%s\", \"scale\": 2}]}";
+    for (int broken = 0; broken < 2; broken++) {
+        test_tmp_path(scene, sizeof scene, broken ? "broken_scene.json" : "obj_scene.json");
+        f = fopen(scene, "wb");
+        if (f) fprintf(f, text, broken ? "nothing_here.obj" : "tri.obj"), fclose(f);
+        CHECK_OK(atmos_scene_load(ctx, scene, &s));
+        atmos_image *im = NULL;
+        const atmos_status st = atmos_render_scene(ctx, &s, NULL, &im, NULL);
+        if (broken)
+            CHECK_MSG(st == ATMOS_E_IO && strstr(atmos_context_error(ctx), "nothing_here.obj"), "broken OBJ: %s",
+                      atmos_context_error(ctx));
+        else
+            CHECK_MSG(st == ATMOS_OK && im && im->pixels[((size_t)6 * 16 + 8) * im->channels + 1] > 0, "OBJ scene: %s",
+                      atmos_context_error(ctx));
+        atmos_image_destroy(im);
+    }
+}
+
 static void test_spectrum(void)
 {
     atmos_scene_light l;
@@ -292,6 +355,7 @@ int main(void)
     test_airlight();
     test_shadow();
     test_threads();
+    test_scene_files();
     atmos_context_destroy(ctx);
     return test_summary("test_beams");
 }
