@@ -118,6 +118,8 @@ atmos_status atmos__mesh_bvh_build(atmos_context *ctx, atmos_mesh *m)
     b->nnodes = 1;
     make_node(&B, 0, 0, n, 0);
     free(B.centroid), free(B.box);
+    node *fit = realloc(b->nodes, sizeof(node) * (size_t)b->nnodes); /* room for 2n nodes was the worst case */
+    if (fit) b->nodes = fit, b->cap = b->nnodes;
     m->bvh = b;
     return ATMOS_OK;
 }
