@@ -1,7 +1,7 @@
 /* atmos bench beams: the beam renderer's frame rate (Dobashi et al. 2002 §4, docs/beams.md)
  * on the Fig. 4 scene (a sphere under a spotlight, 300x450) and on variants of it: without
- * sub-planes, with two and four lights (the spot copied around the first), and at twice the
- * size. Each case makes one plan (objects, shadow maps, the scattering table) and renders
+ * sub-planes (at the scene's plane spacing, 0.3 m and 0.1 m), with a coarser epsilon, with two
+ * and four lights (the spot copied around the first), and at twice the size. Each case makes one plan (objects, shadow maps, the scattering table) and renders
  * frames with the camera moving round the sphere (a degree a frame): what an interactive
  * session pays per frame. */
 #include "bench_beams.h"
@@ -13,6 +13,7 @@
 typedef struct beams_case {
     const char *name;
     int lights, scale, subplanes;
+    double spacing_m, epsilon; /* 0: the scene's */
 } beams_case;
 
 static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_case *c, int frames, int threads)
@@ -20,6 +21,8 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     atmos_scene s = *base;
     s.width *= c->scale, s.height *= c->scale;
     if (!c->subplanes) s.beams.max_subplanes = 1;
+    if (c->spacing_m > 0) s.beams.plane_spacing_m = c->spacing_m;
+    if (c->epsilon > 0) s.beams.epsilon = c->epsilon;
     for (int i = 1; i < c->lights && i < ATMOS_SCENE_MAX_LIGHTS; i++) { /* copies of the first, round it */
         s.lights[i] = s.lights[0];
         s.lights[i].position_m[0] += 6 * cos(2 * 3.14159265358979 * i / c->lights);
@@ -45,10 +48,10 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     int rc = CLI_EXIT_OK;
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
     else
-        printf("bench=beams scene=%s size=%dx%d lights=%d subplanes=%s threads=%d frames=%d plan_seconds=%.3f "
-               "frame_ms=%.1f best_ms=%.1f fps=%.1f\n",
-               c->name, s.width, s.height, s.light_count, c->subplanes ? "on" : "off", threads, frames, plan_s,
-               1e3 * total / frames, 1e3 * best, frames / total);
+        printf("bench=beams scene=%s size=%dx%d lights=%d subplanes=%s plane_spacing_m=%g epsilon=%g threads=%d frames=%d "
+               "plan_seconds=%.3f frame_ms=%.1f best_ms=%.1f fps=%.1f\n",
+               c->name, s.width, s.height, s.light_count, c->subplanes ? "on" : "off", s.beams.plane_spacing_m,
+               s.beams.epsilon, threads, frames, plan_s, 1e3 * total / frames, 1e3 * best, frames / total);
     fflush(stdout);
     atmos_image_destroy(img);
     atmos_plan_destroy(plan);
@@ -66,9 +69,14 @@ int bench_beams(const char *file, int frames, int threads)
         st = ATMOS_E_INVALID_ARG, fprintf(stderr, "atmos bench: %s: not a beams scene\n", path);
     int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error("bench", ctx, st);
     static const beams_case cases[] = {
-        {"dobashi_fig04", 1, 1, 1},           {"dobashi_fig04_no_subplanes", 1, 1, 0},
-        {"dobashi_fig04_2_lights", 2, 1, 1},  {"dobashi_fig04_4_lights", 4, 1, 1},
-        {"dobashi_fig04_double_size", 1, 2, 1},
+        {"dobashi_fig04", 1, 1, 1, 0, 0},
+        {"dobashi_fig04_no_subplanes", 1, 1, 0, 0, 0},
+        {"dobashi_fig04_no_subplanes_0.3m", 1, 1, 0, 0.3, 0},
+        {"dobashi_fig04_no_subplanes_0.1m", 1, 1, 0, 0.1, 0},
+        {"dobashi_fig04_epsilon_0.03", 1, 1, 1, 0, 0.03},
+        {"dobashi_fig04_2_lights", 2, 1, 1, 0, 0},
+        {"dobashi_fig04_4_lights", 4, 1, 1, 0, 0},
+        {"dobashi_fig04_double_size", 1, 2, 1, 0, 0},
     };
     const int used = atmos_context_threads(ctx);
     for (size_t i = 0; rc == CLI_EXIT_OK && i < sizeof cases / sizeof *cases; i++)

@@ -5,8 +5,8 @@
 #include "cli.h"
 
 /* Frames per second of the scene file (NULL: scenes/dobashi_fig04_spotlight.json from the
- * current folder) and its variants (no sub-planes, 2 and 4 lights, twice the size), frames
- * frames each with the camera moving. */
+ * current folder) and its variants (no sub-planes at three plane spacings, a coarser epsilon,
+ * 2 and 4 lights, twice the size), frames frames each with the camera moving. */
 int bench_beams(const char *file, int frames, int threads);
 
 #endif

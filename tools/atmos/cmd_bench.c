@@ -109,10 +109,11 @@ static void help(void)
            "          (docs/path.md), to measure what they gain.\n"
            "  beams   the beam renderer (docs/beams.md) on SCENE (default scenes/dobashi_fig04_spotlight.json,\n"
            "          from the current folder: Dobashi et al. 2002 Fig. 4 at 300x450) and its variants: no\n"
-           "          sub-planes, 2 and 4 lights, twice the size. One plan per case, then 4 R frames (default\n"
+           "          sub-planes (planes at the scene's spacing, 0.3 m, 0.1 m), epsilon 0.03, 2 and 4 lights,\n"
+           "          twice the size. One plan per case, then 4 R frames (default\n"
            "          20) with the camera moving a degree round the scene a frame; one line per case:\n"
-           "            bench=beams scene=dobashi_fig04 size=300x450 lights=1 subplanes=on threads=2 frames=20\n"
-           "            plan_seconds=0.05 frame_ms=40.1 best_ms=38.0 fps=24.9\n");
+           "            bench=beams scene=dobashi_fig04 size=300x450 lights=1 subplanes=on plane_spacing_m=1.2\n"
+           "            epsilon=0.01 threads=2 frames=20 plan_seconds=0.05 frame_ms=40.1 best_ms=38.0 fps=24.9\n");
 }
 
 static int bench_sky(int size, int repeat, int threads, const char *models, double budget)
