@@ -47,8 +47,12 @@ typedef struct atmos__beams_face {
     float *depth;
     /* per tile of TILE x TILE texels, the least and the greatest depth of the tile and the
      * texels around it (what a filtered look-up in it may read): nearer than the least is
-     * lit, farther than the greatest is in shadow, without reading the map */
-    int tiles;
+     * lit, farther than the greatest is in shadow, without reading the map; then the same
+     * over 2x2, 4x4, ... tiles up to the whole map (level k at offset level_at[k], level_n[k]
+     * cells a side) */
+    int tiles, levels;
+    int level_n[24];
+    size_t level_at[24];
     float *tile_min, *tile_max;
 } atmos__beams_face;
 
@@ -86,6 +90,12 @@ typedef struct atmos__beams_ray {
 void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r);
 /* The spot's falloff times the visibility H at o + t d (as the two functions above). */
 double atmos__beams_ray_light(const atmos__beams_ray *r, double t);
+/* What is the same all along [ta, tb] of the ray: 1 if H is (*h: 0 or 1; the segment nearer
+ * or farther than every depth of the shadow map's tiles it crosses), and then *full = 1 if the
+ * falloff is 1 too (the segment inside the spot's inner cone); 0 when H may vary. */
+int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full);
+/* The spot's falloff alone at o + t d (1 for a point light). */
+double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t);
 
 struct atmos__beams_plan {
     int nmesh;

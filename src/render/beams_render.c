@@ -10,7 +10,10 @@
  *     between the planes, m_k of them where f_l could add more than epsilon of the pixel's
  *     unshadowed airlight (Dobashi §4.2.2's criterion, per pixel: m_k = ceil(f_l,k /
  *     (epsilon sum_k f_l,k)) up to max_subplanes), at the midpoints of m_k equal parts;
- *   - the interval adds I f_h f_l (Eq. 6).
+ *   - the interval adds I f_h f_l (Eq. 6); an interval along which H cannot change (clear of
+ *     every depth the shadow map's tiles there hold, or beyond them all) samples the falloff
+ *     alone, or nothing when it is in shadow or inside the inner cone: the value its samples
+ *     would all have.
  * Rows go to the threads; each pixel depends on nothing but its own ray, so the image does
  * not depend on the thread count. */
 #include "render/beams_internal.h"
@@ -148,8 +151,17 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
         const double need = ceil(fl / (J->epsilon * S));
         const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
-        double h = 0;
-        for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + 0.5) * step);
+        double h = 0, same = 0;
+        int full = 0;
+        const int uniform = m > 1 && atmos__beams_ray_uniform(&ray, ta, f[2 * k + 2], &same, &full);
+        if (uniform && (full || same == 0)) { /* what every sample would say */
+            sum += same * fl;
+            continue;
+        }
+        if (uniform) /* lit all along: the falloff alone varies */
+            for (int s = 0; s < m; s++) h += atmos__beams_ray_falloff(&ray, ta + (s + 0.5) * step);
+        else
+            for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + 0.5) * step);
         sum += h / m * fl;
         if (centre) J->centre_subplanes += m;
     }

@@ -86,7 +86,8 @@ static void clip_draw(atmos__beams_face *F, const double in[3][3])
     }
 }
 
-/* The tiles' bounds (atmos__beams_face), each over its texels and a ring of one around. */
+/* The tiles' bounds (atmos__beams_face), each over its texels and a ring of one around, then
+ * each coarser level's cells over their 2x2 children. */
 static void tile_bounds(atmos__beams_face *F)
 {
     const int n = F->n, T = F->tiles;
@@ -100,6 +101,33 @@ static void tile_bounds(atmos__beams_face *F)
                 }
             F->tile_min[ty * T + tx] = lo, F->tile_max[ty * T + tx] = hi;
         }
+    for (int k = 1; k < F->levels; k++) {
+        const int m = F->level_n[k], c = F->level_n[k - 1];
+        const float *cmin = F->tile_min + F->level_at[k - 1], *cmax = F->tile_max + F->level_at[k - 1];
+        for (int j = 0; j < m; j++)
+            for (int i = 0; i < m; i++) {
+                float lo = INFINITY, hi = 0;
+                for (int y = 2 * j; y < 2 * j + 2 && y < c; y++)
+                    for (int x = 2 * i; x < 2 * i + 2 && x < c; x++)
+                        lo = fminf(lo, cmin[y * c + x]), hi = fmaxf(hi, cmax[y * c + x]);
+                F->tile_min[F->level_at[k] + (size_t)j * m + i] = lo, F->tile_max[F->level_at[k] + (size_t)j * m + i] = hi;
+            }
+    }
+}
+
+/* The levels' sizes and offsets; the cells of all levels. */
+static size_t plan_levels(atmos__beams_face *F)
+{
+    size_t at = 0;
+    int m = F->tiles, k = 0;
+    for (;;) {
+        F->level_n[k] = m, F->level_at[k] = at;
+        at += (size_t)m * m, k++;
+        if (m == 1) break;
+        m = (m + 1) / 2;
+    }
+    F->levels = k;
+    return at;
 }
 
 static void raster_face(atmos__beams_face *F, const double pos[3], atmos_mesh *const *mesh, int nmesh)
@@ -135,9 +163,10 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
             set_face(F, d, 1.0);
         }
         F->n = size, F->tiles = (size + TILE - 1) / TILE;
+        const size_t cells = plan_levels(F);
         F->depth = malloc(sizeof(float) * (size_t)size * size);
-        F->tile_min = malloc(sizeof(float) * 2 * (size_t)F->tiles * F->tiles);
-        F->tile_max = F->tile_min ? F->tile_min + (size_t)F->tiles * F->tiles : NULL;
+        F->tile_min = malloc(sizeof(float) * 2 * cells);
+        F->tile_max = F->tile_min ? F->tile_min + cells : NULL;
         if (!F->depth || !F->tile_min) {
             l->nfaces = f + 1;
             atmos__beams_shadow_free(l);
@@ -200,19 +229,72 @@ void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const
     }
 }
 
+/* Face f's texel coordinates and depth of the ray at t (0 if behind the near plane). */
+static int project(const atmos__beams_ray *r, int f, double t, double *fx, double *fy, double *z)
+{
+    const atmos__beams_face *F = &r->l->face[f];
+    *z = r->f0[f][2] + t * r->f1[f][2];
+    if (*z <= NEAR_M) return 0;
+    const double k = 0.5 * F->n / (*z * F->tan_half);
+    *fx = 0.5 * F->n + (r->f0[f][0] + t * r->f1[f][0]) * k - 0.5;
+    *fy = 0.5 * F->n + (r->f0[f][1] + t * r->f1[f][1]) * k - 0.5;
+    return *fx > -1 && *fx < F->n && *fy > -1 && *fy < F->n;
+}
+
+static int inside_inner(const atmos__beams_ray *r, double t)
+{
+    const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
+    return z > 0 && z * z >= r->l->cos_inner * r->l->cos_inner * w2;
+}
+
+int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full)
+{
+    const atmos__beams_light *l = r->l;
+    *full = l->type != ATMOS_LIGHT_SPOT || (inside_inner(r, ta) && inside_inner(r, tb)); /* the cone is convex */
+    *h = 1;
+    if (!l->nfaces) return 1;
+    int f = 0;
+    if (l->nfaces == 6) { /* both ends in one face's pyramid: so is the segment */
+        const double wa[3] = {r->w0[0] + ta * r->d[0], r->w0[1] + ta * r->d[1], r->w0[2] + ta * r->d[2]};
+        const double wb[3] = {r->w0[0] + tb * r->d[0], r->w0[1] + tb * r->d[1], r->w0[2] + tb * r->d[2]};
+        if ((f = cube_face(wa)) != cube_face(wb)) return 0;
+    }
+    double xa, ya, za, xb, yb, zb; /* depth is linear along the segment, its image a straight line */
+    if (!project(r, f, ta, &xa, &ya, &za) || !project(r, f, tb, &xb, &yb, &zb)) return 0;
+    const atmos__beams_face *F = &l->face[f];
+    const int x0 = (int)(fmin(xa, xb) + 1) - 1, x1 = (int)(fmax(xa, xb) + 1) - 1;
+    const int y0 = (int)(fmin(ya, yb) + 1) - 1, y1 = (int)(fmax(ya, yb) + 1) - 1;
+    const int tx0 = x0 < 0 ? 0 : x0 / TILE, tx1 = x1 < 0 ? 0 : x1 / TILE, ty0 = y0 < 0 ? 0 : y0 / TILE,
+              ty1 = y1 < 0 ? 0 : y1 / TILE;
+    int k = 0; /* the finest level where the tiles' box spans at most 2 x 2 cells */
+    while (k + 1 < F->levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
+    const float *cmin = F->tile_min + F->level_at[k], *cmax = F->tile_max + F->level_at[k];
+    const int m = F->level_n[k];
+    float lo = INFINITY, hi = 0;
+    for (int ty = ty0 >> k; ty <= ty1 >> k; ty++)
+        for (int tx = tx0 >> k; tx <= tx1 >> k; tx++)
+            lo = fminf(lo, cmin[ty * m + tx]), hi = fmaxf(hi, cmax[ty * m + tx]);
+    if (fmax(za, zb) < lo) return 1;
+    if (fmin(za, zb) >= hi) return *h = 0, 1;
+    return 0;
+}
+
+double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
+{
+    const atmos__beams_light *l = r->l;
+    if (l->type != ATMOS_LIGHT_SPOT) return 1;
+    const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
+    if (z <= 0 || z * z <= l->cos_outer * l->cos_outer * w2) return 0;
+    if (z * z >= l->cos_inner * l->cos_inner * w2) return 1;
+    const double s = (z / sqrt(w2) - l->cos_outer) / (l->cos_inner - l->cos_outer);
+    return s * s * (3 - 2 * s);
+}
+
 double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
-    double fall = 1;
-    if (l->type == ATMOS_LIGHT_SPOT) {
-        const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
-        if (z <= 0 || z * z <= l->cos_outer * l->cos_outer * w2) return 0;
-        if (z * z < l->cos_inner * l->cos_inner * w2) {
-            const double s = (z / sqrt(w2) - l->cos_outer) / (l->cos_inner - l->cos_outer);
-            fall = s * s * (3 - 2 * s);
-        }
-    }
-    if (!l->nfaces) return fall;
+    const double fall = atmos__beams_ray_falloff(r, t);
+    if (!l->nfaces || fall == 0) return fall;
     int f = 0;
     if (l->nfaces == 6) {
         const double w[3] = {r->w0[0] + t * r->d[0], r->w0[1] + t * r->d[1], r->w0[2] + t * r->d[2]};
