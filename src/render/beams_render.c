@@ -19,6 +19,9 @@
 #include "render/beams_internal.h"
 #include "core/vec.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -216,21 +219,43 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.cx = v->cam.width / 2, J.cy = v->cam.height / 2;
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
-    const int W = out->width, C = out->channels;
-    int failed = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
-    for (int y = r->y0; y < r->y1; y++) {
+    const int W = out->width, C = out->channels, rows = r->y1 - r->y0;
+    int failed = 0, cancelled = 0, done = 0;
+#pragma omp parallel num_threads(atmos__threads(p->ctx))
+    {
         double *f = malloc(sizeof(double) * (2 * MAX_INTERVALS + 2));
         if (!f) {
 #pragma omp atomic write
             failed = 1;
-            continue;
         }
-        for (int x = r->x0; x < r->x1; x++) pixel(&J, x, y, out->pixels + ((size_t)y * W + x) * C, f);
+        /* rows handed out dynamically; a pixel depends on its own ray alone, so the image is
+         * the same for any thread count */
+#pragma omp for schedule(dynamic, 1)
+        for (int y = r->y0; y < r->y1; y++) {
+            int stop;
+#pragma omp atomic read
+            stop = cancelled;
+            if (stop || !f) continue;
+            for (int x = r->x0; x < r->x1; x++) pixel(&J, x, y, out->pixels + ((size_t)y * W + x) * C, f);
+            int d;
+#pragma omp atomic capture
+            d = ++done;
+#ifdef _OPENMP
+            if (omp_get_thread_num() == 0)
+#endif
+            {
+                if (atmos__progress(p->ctx, "render beams", (double)d / rows)) {
+#pragma omp atomic write
+                    cancelled = 1;
+                }
+            }
+        }
         free(f);
     }
     free(J.z_lo);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
+    if (cancelled) return atmos__error(p->ctx, ATMOS_E_CANCELLED, "render beams: cancelled");
+    atmos__progress(p->ctx, "render beams", 1.0);
     return ATMOS_OK;
 }

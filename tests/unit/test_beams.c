@@ -336,6 +336,34 @@ static void test_scene_files(void)
     }
 }
 
+/* A progress callback that asks to stop once the beams are being drawn. */
+static int stop_beams(void *user, const char *stage, double fraction)
+{
+    (void)fraction;
+    if (strcmp(stage, "render beams")) return 0;
+    ++*(int *)user;
+    return 1;
+}
+
+static void test_cancel(void)
+{
+    atmos_scene s;
+    base_scene(&s, 32, 24);
+    s.lights[0].position_m[2] = -20;
+    atmos_context_desc d;
+    memset(&d, 0, sizeof d);
+    int calls = 0;
+    d.progress = stop_beams, d.progress_user = &calls;
+    d.threads = 1; /* progress comes from the calling thread: with one, from the first row on */
+    atmos_context *c = NULL;
+    CHECK_OK(atmos_context_create(&d, &c));
+    atmos_image *img = NULL;
+    const atmos_status st = atmos_render_scene(c, &s, NULL, &img, NULL);
+    CHECK_MSG(st == ATMOS_E_CANCELLED && calls >= 1 && !img, "%s, %d calls: %s", atmos_status_string(st), calls, atmos_context_error(c));
+    atmos_image_destroy(img);
+    atmos_context_destroy(c);
+}
+
 static void test_spectrum(void)
 {
     atmos_scene_light l;
@@ -356,6 +384,7 @@ int main(void)
     test_shadow();
     test_threads();
     test_scene_files();
+    test_cancel();
     atmos_context_destroy(ctx);
     return test_summary("test_beams");
 }
