@@ -198,8 +198,8 @@ int atmos_mesh_intersect(const atmos_mesh *m, const double o[3], const double d[
         const double t0 = box_entry(&b->nodes[n->first], o, inv, tmin, tmax);
         const double t1 = box_entry(&b->nodes[n->first + 1], o, inv, tmin, tmax);
         const int near = t0 <= t1 ? n->first : n->first + 1, far = near == n->first ? n->first + 1 : n->first;
-        if (fmax(t0, t1) < INFINITY) stack[sp++] = far;
-        if (fmin(t0, t1) < INFINITY) stack[sp++] = near;
+        if (atmos__maxd(t0, t1) < INFINITY) stack[sp++] = far;
+        if (atmos__mind(t0, t1) < INFINITY) stack[sp++] = near;
     }
     if (best < 0) return 0;
     if (hit) {

@@ -118,10 +118,10 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     const double Lp[3] = {l->pos[0] - J->eye[0], l->pos[1] - J->eye[1], l->pos[2] - J->eye[2]};
     const double tQ = atmos__dot3(Lp, d);
     const double q[3] = {Lp[0] - tQ * d[0], Lp[1] - tQ * d[1], Lp[2] - tQ * d[2]};
-    const double v = fmax(sqrt(atmos__dot3(q, q)), 1e-6 * R);
+    const double v = atmos__maxd(sqrt(atmos__dot3(q, q)), 1e-6 * R);
     if (v >= R) return;
     const double hh = sqrt(R * R - v * v);
-    double t0 = fmax(0, tQ - hh), t1 = fmin(T, tQ + hh);
+    double t0 = atmos__maxd(0, tQ - hh), t1 = atmos__mind(T, tQ + hh);
     if (!(t0 < t1) || !clip_cone(l, J->eye, d, &t0, &t1)) return;
     atmos__beams_column col;
     atmos__beams_table_column(&b->table, sig * v, &col);
@@ -131,10 +131,10 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     long j = (long)floor((t0 * cosf - zl) / dz) + 1;
     int n = 0;
     while (a < t1) {
-        double e = n == MAX_INTERVALS - 1 ? t1 : fmin(t1, (zl + j * dz) / cosf);
-        if (e <= a) e = fmin(t1, a + 1e-9 * (1 + a)); /* a plane at a itself */
+        double e = n == MAX_INTERVALS - 1 ? t1 : atmos__mind(t1, (zl + j * dz) / cosf);
+        if (e <= a) e = atmos__mind(t1, a + 1e-9 * (1 + a)); /* a plane at a itself */
         const double We = atmos__beams_table_at(&b->table, &col, atan2(e - tQ, v));
-        f[2 * n] = a, f[2 * n + 1] = fmax(0, We - Wa) * scale;
+        f[2 * n] = a, f[2 * n + 1] = atmos__maxd(0, We - Wa) * scale;
         S += f[2 * n + 1];
         a = e, Wa = We, j++, n++;
     }

@@ -262,8 +262,8 @@ int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, do
     double xa, ya, za, xb, yb, zb; /* depth is linear along the segment, its image a straight line */
     if (!project(r, f, ta, &xa, &ya, &za) || !project(r, f, tb, &xb, &yb, &zb)) return 0;
     const atmos__beams_face *F = &l->face[f];
-    const int x0 = (int)(fmin(xa, xb) + 1) - 1, x1 = (int)(fmax(xa, xb) + 1) - 1;
-    const int y0 = (int)(fmin(ya, yb) + 1) - 1, y1 = (int)(fmax(ya, yb) + 1) - 1;
+    const int x0 = (int)(atmos__mind(xa, xb) + 1) - 1, x1 = (int)(atmos__maxd(xa, xb) + 1) - 1;
+    const int y0 = (int)(atmos__mind(ya, yb) + 1) - 1, y1 = (int)(atmos__maxd(ya, yb) + 1) - 1;
     const int tx0 = x0 < 0 ? 0 : x0 / TILE, tx1 = x1 < 0 ? 0 : x1 / TILE, ty0 = y0 < 0 ? 0 : y0 / TILE,
               ty1 = y1 < 0 ? 0 : y1 / TILE;
     int k = 0; /* the finest level where the tiles' box spans at most 2 x 2 cells */
@@ -273,9 +273,9 @@ int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, do
     float lo = INFINITY, hi = 0;
     for (int ty = ty0 >> k; ty <= ty1 >> k; ty++)
         for (int tx = tx0 >> k; tx <= tx1 >> k; tx++)
-            lo = fminf(lo, cmin[ty * m + tx]), hi = fmaxf(hi, cmax[ty * m + tx]);
-    if (fmax(za, zb) < lo) return 1;
-    if (fmin(za, zb) >= hi) return *h = 0, 1;
+            lo = cmin[ty * m + tx] < lo ? cmin[ty * m + tx] : lo, hi = cmax[ty * m + tx] > hi ? cmax[ty * m + tx] : hi;
+    if (atmos__maxd(za, zb) < lo) return 1;
+    if (atmos__mind(za, zb) >= hi) return *h = 0, 1;
     return 0;
 }
 

@@ -2,8 +2,8 @@
  * on the Fig. 4 scene (a sphere under a spotlight, 300x450) and on variants of it: without
  * sub-planes (at the scene's plane spacing, 0.3 m and 0.1 m), with a coarser epsilon, with two
  * and four lights (the spot copied around the first), and at twice the size. Each case makes one plan (objects, shadow maps, the scattering table) and renders
- * frames with the camera moving round the sphere (a degree a frame): what an interactive
- * session pays per frame. */
+ * frames with the camera moving round the sphere (a degree a frame): what interactive use
+ * pays per frame. */
 #include "bench_beams.h"
 
 #include <math.h>
