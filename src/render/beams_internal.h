@@ -19,6 +19,9 @@
  * interval, whatever its length (Dobashi's q(u, v) is a difference of W at a fixed
  * interval). Tabulated over nt angles in [-pi/2, pi/2] and nx values of x = x_max w^2,
  * w in [0, 1] (finer near the light); linear in theta, cubic in w. */
+/* The fog's reach from a light, in optical depths: beyond, exp(-50) of the light is left. */
+#define ATMOS__BEAMS_MAX_OPTICAL_RANGE 50.0
+
 typedef struct atmos__beams_table {
     int nt, nx;
     double x_max;

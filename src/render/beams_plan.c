@@ -98,9 +98,10 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
         range = fmax(range, b->lights[i].range);
         st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->mesh, b->nmesh, s->beams.shadow_size);
     }
-    if (st == ATMOS_OK && s->fog.enabled) {
+    if (st == ATMOS_OK && s->fog.enabled) { /* x = sigma_t v reaches sigma_t times the largest reach */
         b->sigma_t = s->fog.extinction_per_m, b->sigma_s = s->fog.scattering_per_m;
-        st = atmos__beams_table_build(p->ctx, b->sigma_t, b->sigma_s, s->fog.g, b->sigma_t * range, &b->table);
+        st = atmos__beams_table_build(p->ctx, b->sigma_t, b->sigma_s, s->fog.g,
+                                      fmin(b->sigma_t * range, ATMOS__BEAMS_MAX_OPTICAL_RANGE), &b->table);
     }
     if (st != ATMOS_OK) {
         atmos__beams_plan_destroy(b);

@@ -28,8 +28,6 @@
 
 /* Intervals per light along one ray at most: planes closer than 2 range / this are spread. */
 #define MAX_INTERVALS 4096
-/* The fog's reach from a light, in optical depths: beyond, exp(-50) of the light is left. */
-#define MAX_OPTICAL_RANGE 50.0
 
 typedef struct job {
     const atmos__beams_plan *b;
@@ -197,7 +195,7 @@ static atmos_status planes(atmos_plan *p, job *J)
     J->dz = J->z_lo + b->nlights, J->reach = J->dz + b->nlights;
     for (int i = 0; i < b->nlights; i++) {
         const atmos__beams_light *l = &b->lights[i];
-        const double R = b->sigma_t > 0 ? fmin(l->range, MAX_OPTICAL_RANGE / b->sigma_t) : l->range;
+        const double R = b->sigma_t > 0 ? fmin(l->range, ATMOS__BEAMS_MAX_OPTICAL_RANGE / b->sigma_t) : l->range;
         const double Lp[3] = {l->pos[0] - J->eye[0], l->pos[1] - J->eye[1], l->pos[2] - J->eye[2]};
         const double given = p->scene.beams.plane_spacing_m;
         J->reach[i] = R;
