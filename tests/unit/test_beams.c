@@ -336,6 +336,42 @@ static void test_scene_files(void)
     }
 }
 
+/* Valid scenes at the ends of the ranges render, with finite pixels (the plan refuses a NaN or
+ * an infinity), and nothing negative. */
+static void test_extremes(void)
+{
+    for (int c = 0; c < 8; c++) {
+        atmos_scene s;
+        base_scene(&s, 16, 12);
+        s.camera.position[0] = 0, s.camera.position[1] = 2, s.camera.position[2] = 10;
+        s.camera.look_at[1] = 2;
+        atmos_scene_light *l = &s.lights[0];
+        l->position_m[1] = 4;
+        s.object_count = 1;
+        atmos_scene_object *o = &s.objects[0];
+        memset(o, 0, sizeof *o);
+        snprintf(o->mesh, sizeof o->mesh, "builtin:sphere");
+        o->position_m[1] = 2, o->scale[0] = o->scale[1] = o->scale[2] = 1, o->albedo[0] = o->albedo[1] = o->albedo[2] = 1;
+        switch (c) {
+        case 0: l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 0, l->edge_deg = 0; break; /* a beam of no width */
+        case 1: l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 89, l->edge_deg = 1; break; /* a half space: cube map */
+        case 2: memcpy(l->position_m, s.camera.position, sizeof l->position_m); break; /* at the eye */
+        case 3: l->position_m[1] = 2; break;                                           /* inside the sphere */
+        case 4: s.fog.extinction_per_m = s.fog.scattering_per_m = 10, l->range_m = 1e6; break;
+        case 5: s.fog.extinction_per_m = s.fog.scattering_per_m = 1e-9, l->range_m = 1e6; break;
+        case 6: s.fog.g = 0.999, l->intensity_w_sr = 1e9; break;
+        case 7: s.fog.enabled = 0; break; /* no fog: the lit sphere alone */
+        }
+        atmos_image *img = NULL;
+        const atmos_status st = atmos_render_scene(ctx, &s, NULL, &img, NULL);
+        CHECK_MSG(st == ATMOS_OK, "extreme case %d: %s", c, atmos_context_error(ctx));
+        int negative = 0;
+        for (size_t i = 0; img && i < (size_t)s.width * s.height * img->channels; i++) negative += img->pixels[i] < 0;
+        CHECK_MSG(negative == 0, "extreme case %d: %d negative values", c, negative);
+        atmos_image_destroy(img);
+    }
+}
+
 /* A progress callback that asks to stop once the beams are being drawn. */
 static int stop_beams(void *user, const char *stage, double fraction)
 {
@@ -385,6 +421,7 @@ int main(void)
     test_threads();
     test_scene_files();
     test_cancel();
+    test_extremes();
     atmos_context_destroy(ctx);
     return test_summary("test_beams");
 }
