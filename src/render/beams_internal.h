@@ -17,8 +17,9 @@
  *     W(theta, x) = sigma_s * int_{-pi/2}^{theta} p(-sin th) exp(-x tan(pi/4 + th/2)) dth,
  * t_Q the distance from the eye to Q and p the phase function: two look-ups for any
  * interval, whatever its length (Dobashi's q(u, v) is a difference of W at a fixed
- * interval). Tabulated over nt angles in [-pi/2, pi/2] and nx values of x = x_max w^2,
- * w in [0, 1] (finer near the light); linear in theta, cubic in w. */
+ * interval). Tabulated over nt values of s = u / (|u| + v) = sin-like in [-1, 1] (theta
+ * without an arctangent per look-up: tan theta = s / (1 - |s|)) and nx values of
+ * x = x_max w^2, w in [0, 1] (finer near the light); linear in s, cubic in w. */
 /* The fog's reach from a light, in optical depths: beyond, exp(-50) of the light is left. */
 #define ATMOS__BEAMS_MAX_OPTICAL_RANGE 50.0
 
@@ -39,7 +40,9 @@ typedef struct atmos__beams_column {
     double wt[4];
 } atmos__beams_column;
 void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__beams_column *c);
-double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double theta);
+double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s);
+/* The table's coordinate of the point u along a ray passing at v from the light. */
+static inline double atmos__beams_table_s(double u, double v) { return u / ((u < 0 ? -u : u) + v); }
 
 /* A depth map seen from a light through one frustum: the distance along fwd of the nearest
  * surface through each of n x n texels spanning [-tan_half, tan_half]^2 of the image plane. */

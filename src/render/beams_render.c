@@ -125,13 +125,13 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     atmos__beams_table_column(&b->table, sig * v, &col);
     const double scale = exp(-sig * tQ) / v, cosf = atmos__dot3(d, J->fwd), dz = J->dz[i], zl = J->z_lo[i];
     /* the intervals between the planes crossing [t0, t1], and their f_l */
-    double a = t0, Wa = atmos__beams_table_at(&b->table, &col, atan2(t0 - tQ, v)), S = 0;
+    double a = t0, Wa = atmos__beams_table_at(&b->table, &col, atmos__beams_table_s(t0 - tQ, v)), S = 0;
     long j = (long)floor((t0 * cosf - zl) / dz) + 1;
     int n = 0;
     while (a < t1) {
         double e = n == MAX_INTERVALS - 1 ? t1 : atmos__mind(t1, (zl + j * dz) / cosf);
         if (e <= a) e = atmos__mind(t1, a + 1e-9 * (1 + a)); /* a plane at a itself */
-        const double We = atmos__beams_table_at(&b->table, &col, atan2(e - tQ, v));
+        const double We = atmos__beams_table_at(&b->table, &col, atmos__beams_table_s(e - tQ, v));
         f[2 * n] = a, f[2 * n + 1] = atmos__maxd(0, We - Wa) * scale;
         S += f[2 * n + 1];
         a = e, Wa = We, j++, n++;

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define TABLE_THETA 2048
+#define TABLE_S 2049 /* odd: s = 0 (theta = 0) is a node */
 #define TABLE_X 512
 
 void atmos__beams_table_free(atmos__beams_table *t)
@@ -26,21 +26,25 @@ static double hg(double g, double mu)
     return (1 - g * g) / (4 * ATMOS_PI * d * sqrt(d));
 }
 
+/* The angle of the table's coordinate s = u / (|u| + v): tan(theta) = u / v = s / (1 - |s|). */
+static double theta_of(double s) { return atan2(s, 1 - fabs(s)); }
+
 atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, double g, double x_max,
                                       atmos__beams_table *t)
 {
     memset(t, 0, sizeof *t);
-    const int nt = TABLE_THETA, nx = TABLE_X, ns = 2 * nt - 1; /* the cells' ends and midpoints */
+    const int nt = TABLE_S, nx = TABLE_X, ns = 2 * nt - 1; /* the cells' ends and their angular midpoints */
     t->nt = nt, t->nx = nx, t->x_max = x_max > 0 ? x_max : 1e-9;
     t->w = malloc(sizeof(double) * (size_t)nt * nx);
-    double *ph = malloc(sizeof(double) * ns), *tn = malloc(sizeof(double) * ns);
-    if (!t->w || !ph || !tn) {
-        free(ph), free(tn), atmos__beams_table_free(t);
+    double *ph = malloc(sizeof(double) * ns), *tn = malloc(sizeof(double) * ns), *h = malloc(sizeof(double) * nt);
+    if (!t->w || !ph || !tn || !h) {
+        free(ph), free(tn), free(h), atmos__beams_table_free(t);
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the scattering table");
     }
-    const double h = ATMOS_PI / (nt - 1);
     for (int i = 0; i < ns; i++) {
-        const double th = -0.5 * ATMOS_PI + 0.5 * h * i;
+        const double a = theta_of(-1 + 2.0 * (i / 2) / (nt - 1)), b = theta_of(-1 + 2.0 * ((i + 1) / 2) / (nt - 1));
+        const double th = 0.5 * (a + b); /* a node, or the middle of a cell in angle */
+        if (i % 2 == 0) h[i / 2] = i + 2 < ns ? theta_of(-1 + 2.0 * (i / 2 + 1) / (nt - 1)) - a : 0;
         ph[i] = sigma_s * hg(g, -sin(th));
         tn[i] = i == ns - 1 ? INFINITY : tan(0.25 * ATMOS_PI + 0.5 * th); /* (1 + sin th) / cos th */
     }
@@ -53,12 +57,12 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
         for (int i = 0; i + 1 < nt; i++) {
             const double fm = ph[2 * i + 1] * exp(-x * tn[2 * i + 1]);
             const double f1 = x > 0 ? (isinf(tn[2 * i + 2]) ? 0 : ph[2 * i + 2] * exp(-x * tn[2 * i + 2])) : ph[2 * i + 2];
-            acc += h / 6 * (f0 + 4 * fm + f1);
+            acc += h[i] / 6 * (f0 + 4 * fm + f1);
             row[i + 1] = acc;
             f0 = f1;
         }
     }
-    free(ph), free(tn);
+    free(ph), free(tn), free(h);
     return ATMOS_OK;
 }
 
@@ -77,9 +81,9 @@ void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__bea
     for (int k = 0; k < 4; k++) c->row[k] = t->w + (size_t)(j0 + k) * t->nt;
 }
 
-double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double theta)
+double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s)
 {
-    const double f = atmos__clampd((theta + 0.5 * ATMOS_PI) * ((t->nt - 1) / ATMOS_PI), 0, t->nt - 1);
+    const double f = atmos__clampd((s + 1) * (0.5 * (t->nt - 1)), 0, t->nt - 1);
     int i = (int)f;
     if (i > t->nt - 2) i = t->nt - 2;
     const double a = f - i;
