@@ -17,7 +17,7 @@
  *     W(theta, x) = sigma_s * int_{-pi/2}^{theta} p(-sin th) exp(-x tan(pi/4 + th/2)) dth,
  * t_Q the distance from the eye to Q and p the phase function: two look-ups for any
  * interval, whatever its length (Dobashi's q(u, v) is a difference of W at a fixed
- * interval). Tabulated over nt values of s = u / (|u| + v) = sin-like in [-1, 1] (theta
+ * interval). Tabulated over nt values of s = u / (|u| + v) in [-1, 1] (theta
  * without an arctangent per look-up: tan theta = s / (1 - |s|)) and nx values of
  * x = x_max w^2, w in [0, 1] (finer near the light); linear in s, cubic in w. */
 /* The fog's reach from a light, in optical depths: beyond, exp(-50) of the light is left. */

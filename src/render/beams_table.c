@@ -1,8 +1,9 @@
 /* The beam renderer's pre-integrated scattering table W(theta, x) (beams_internal.h): one
  * table for the fog, whatever the light, since the light's intensity and the visibility stay
- * outside it (Dobashi et al. 2002 Eq. 6: f_h times f_l). Each row is a cumulative integral
- * over theta by Simpson's rule per cell; the phase function and the tangent depend on theta
- * alone and are evaluated once per angle. */
+ * outside it (Dobashi et al. 2002 Eq. 6: f_h times f_l). Its nodes are even in s = u / (|u| + v)
+ * (so a look-up needs no arctangent); each row is a cumulative integral over theta by
+ * Simpson's rule per cell (the cell's ends and its middle in angle); the phase function and
+ * the tangent depend on theta alone and are evaluated once per angle. */
 #include "render/beams_internal.h"
 #include "core/vec.h"
 
