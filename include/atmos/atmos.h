@@ -29,5 +29,6 @@
 #include "atmos/slice.h"
 #include "atmos/path.h"
 #include "atmos/plan.h"
+#include "atmos/mesh.h"
 
 #endif

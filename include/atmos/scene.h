@@ -41,10 +41,12 @@ typedef enum {
     ATMOS_RENDERER_SLICE = 1, /* half-angle slicing over the volume (Riley §4.2-§5, slice.h) */
     ATMOS_RENDERER_PATH = 2,  /* Monte Carlo volumetric path tracing over the volume (path.h) */
     ATMOS_RENDERER_NISHITA = 3, /* Nishita et al. 1996: ray marching with a light field of orders 2-3 and sky light */
-    ATMOS_RENDERER_HARRIS = 4  /* Harris 2002: the volume as particles, multiple forward scattering, splats */
+    ATMOS_RENDERER_HARRIS = 4,  /* Harris 2002: the volume as particles, multiple forward scattering, splats */
+    ATMOS_RENDERER_BEAMS = 5   /* Dobashi et al. 2002 §4: light beams of point lights and spotlights in fog, with
+                                  the shadows of meshes, by sampling planes and a pre-integrated table */
 } atmos_renderer_kind;
 /* The last renderer kind (loops over the kinds end here). */
-#define ATMOS_RENDERER_LAST ATMOS_RENDERER_HARRIS
+#define ATMOS_RENDERER_LAST ATMOS_RENDERER_BEAMS
 
 #define ATMOS_SCENE_PATH_MAX 1024
 
@@ -121,6 +123,52 @@ typedef struct atmos_scene_harris {
     int impostor_max_res;     /* an impostor's texels per side at most; 512 */
 } atmos_scene_harris;
 
+/* Settings of the beam renderer ("beams" in the file); the table is
+ * atmos_renderer_settings(ATMOS_RENDERER_BEAMS) (docs/beams.md). */
+typedef struct atmos_scene_beams {
+    double plane_spacing_m;   /* distance between the main sampling planes along the view; 0 = 1/40 of the lights'
+                                 depth range in view */
+    double epsilon;           /* sub-planes: each may add at most this share of the pixel's unshadowed airlight
+                                 (Dobashi's threshold); 0.01 */
+    int max_subplanes;        /* sub-planes between two main planes at most; 64 */
+    int shadow_size;          /* shadow map texels per side (per cube face for point lights); 512 */
+} atmos_scene_beams;
+
+/* Lights besides the sun ("lights" in the file; the beam renderer's). */
+#define ATMOS_SCENE_MAX_LIGHTS 32
+typedef enum { ATMOS_LIGHT_POINT = 0, ATMOS_LIGHT_SPOT = 1 } atmos_light_type;
+typedef struct atmos_scene_light {
+    atmos_light_type type;
+    double position_m[3];
+    double direction[3];      /* spot: the axis (normalised by the parser); point: unused */
+    double cone_deg;          /* spot: full intensity within this angle of the axis, [0, 89] */
+    double edge_deg;          /* spot: falling smoothly to zero over this much more, [0, 90]; cone + edge <= 90 */
+    double intensity_w_sr;    /* radiant intensity on the axis, W sr^-1, (0, 1e9] */
+    double colour_temperature_k; /* > 0: the spectrum of a black body at this temperature, [1000, 40000];
+                                    0: colour */
+    double colour[3];         /* rgb weights in [0, 1e3] (rgb wavelengths only), with no temperature; 1, 1, 1 */
+    double range_m;           /* the light's reach: the beam renderer samples the air within it; (0, 1e6]; 100 */
+} atmos_scene_light;
+
+/* A uniform participating medium ("fog" in the file): Dobashi's constant density, as
+ * coefficients per metre, the same at every wavelength, with a Henyey-Greenstein phase function. */
+typedef struct atmos_scene_fog {
+    int enabled;
+    double extinction_per_m;  /* (0, 10] */
+    double scattering_per_m;  /* [0, extinction] */
+    double g;                 /* Henyey-Greenstein asymmetry, (-1, 1); 0 */
+} atmos_scene_fog;
+
+/* Opaque Lambertian objects ("objects" in the file). */
+#define ATMOS_SCENE_MAX_OBJECTS 16
+typedef struct atmos_scene_object {
+    char mesh[ATMOS_SCENE_PATH_MAX]; /* "builtin:NAME" or an OBJ file (relative paths: against the scene's folder) */
+    double position_m[3];
+    double scale[3];          /* per axis, nonzero, |s| <= 1e6; 1, 1, 1 */
+    double rotation_deg[3];   /* about x, then y, then z; 0 */
+    double albedo[3];         /* Lambertian reflectance per rgb channel (one value for spectral), [0, 1]; 0.5 */
+} atmos_scene_object;
+
 /* A sequence of images with the sun moving ("animation" in the file): frame i of N
  * (0-based) takes the sun at fraction i / (N - 1) of the way from the scene's sun to the
  * end given here (atmos_scene_animation_frame). With a sun given by time, the time is
@@ -177,6 +225,12 @@ typedef struct atmos_scene {
     int camera_given;                     /* the scene file has a "camera" (a volume scene without
                                              one is framed by atmos_scene_frame_volume) */
     atmos_scene_earth earth;              /* the spherical atmosphere's maps and clouds */
+    atmos_scene_beams beams;
+    int light_count;
+    atmos_scene_light lights[ATMOS_SCENE_MAX_LIGHTS];
+    atmos_scene_fog fog;
+    int object_count;
+    atmos_scene_object objects[ATMOS_SCENE_MAX_OBJECTS];
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
@@ -326,7 +380,7 @@ ATMOS_API const atmos_setting *atmos_renderer_settings(atmos_renderer_kind rende
  * is not checked: atmos_scene_validate does that). */
 ATMOS_API double atmos_scene_setting_get(const atmos_scene *scene, const atmos_setting *setting);
 ATMOS_API void atmos_scene_setting_set(atmos_scene *scene, const atmos_setting *setting, double value);
-/* "sky", "slice", "path", "nishita", "harris"; NULL for an unknown kind. */
+/* "sky", "slice", "path", "nishita", "harris", "beams"; NULL for an unknown kind. */
 ATMOS_API const char *atmos_renderer_name(atmos_renderer_kind renderer);
 
 #ifdef __cplusplus

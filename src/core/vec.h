@@ -5,6 +5,11 @@
 
 #include <math.h>
 
+/* The larger and the smaller of two numbers that are not NaN (a compare and a select, where
+ * fmax and fmin may be library calls for their NaN rules). */
+static inline double atmos__maxd(double a, double b) { return a > b ? a : b; }
+static inline double atmos__mind(double a, double b) { return a < b ? a : b; }
+
 /* x limited to [lo, hi]. */
 static inline double atmos__clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 

@@ -86,6 +86,7 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
     else if (p->renderer == ATMOS_RENDERER_PATH) st = atmos__path_plan_create(p, &p->path);
     else if (p->renderer == ATMOS_RENDERER_NISHITA) st = atmos__nishita_plan_create(p, &p->nishita);
     else if (p->renderer == ATMOS_RENDERER_HARRIS) st = atmos__harris_plan_create(p, &p->harris);
+    else if (p->renderer == ATMOS_RENDERER_BEAMS) st = atmos__beams_plan_create(p, &p->beams);
     if (st != ATMOS_OK) goto fail;
     *out = p;
     return ATMOS_OK;
@@ -101,6 +102,7 @@ void atmos_plan_destroy(atmos_plan *p)
     atmos__path_plan_destroy(p->path);
     atmos__nishita_plan_destroy(p->nishita);
     atmos__harris_plan_destroy(p->harris);
+    atmos__beams_plan_destroy(p->beams);
     atmos__sky_keep_destroy(p->sky_keep);
     atmos_volume_optics_free(&p->own_optics);
     atmos_volume_destroy(p->own_volume);
@@ -274,8 +276,10 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
                                         "slice (Riley et al. 2004, half-angle slicing)",
                                         "path (spectral Monte Carlo volumetric path tracing)",
                                         "nishita (Nishita et al. 1996, orders 1-3 and sky light by a light field)",
-                                        "harris (Harris 2002, particle clouds: multiple forward scattering, splats)"};
-    char buf[256];
+                                        "harris (Harris 2002, particle clouds: multiple forward scattering, splats)",
+                                        "beams (Dobashi et al. 2002, light beams: sampling planes, pre-integrated table, "
+                                        "sub-planes, shadow maps)"};
+    char buf[384];
     double el = 0, az = 0;
     atmos_direction_to_angles(v->sun, &el, &az);
     atmos_image_set_meta(out, "atmos:version", atmos_version());
@@ -311,6 +315,9 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
     } else if (p->renderer == ATMOS_RENDERER_HARRIS) {
         atmos__harris_describe(p, buf, sizeof buf);
         atmos_image_set_meta(out, "atmos:harris", buf);
+    } else if (p->renderer == ATMOS_RENDERER_BEAMS) {
+        atmos__beams_describe(p, buf, sizeof buf);
+        atmos_image_set_meta(out, "atmos:beams", buf);
     }
 }
 
@@ -345,6 +352,8 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
         st = atmos__nishita_render(p, &v, &r, out);
     } else if (p->renderer == ATMOS_RENDERER_HARRIS) {
         st = atmos__harris_render(p, &v, &r, out);
+    } else if (p->renderer == ATMOS_RENDERER_BEAMS) {
+        st = atmos__beams_render(p, &v, &r, out);
     } else {
         st = atmos__path_render(p, &v, &r, out, &stats->path);
     }

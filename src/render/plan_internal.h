@@ -11,6 +11,7 @@ typedef struct atmos__slice_plan atmos__slice_plan;
 typedef struct atmos__path_plan atmos__path_plan;
 typedef struct atmos__nishita_plan atmos__nishita_plan;
 typedef struct atmos__harris_plan atmos__harris_plan;
+typedef struct atmos__beams_plan atmos__beams_plan;
 
 struct atmos_plan {
     atmos_context *ctx;
@@ -37,6 +38,7 @@ struct atmos_plan {
     atmos__path_plan *path;
     atmos__nishita_plan *nishita;
     atmos__harris_plan *harris;
+    atmos__beams_plan *beams;
 };
 
 /* The slice renderer's part (slice_plan.c): the render grid, the optics tables, the buffers
@@ -78,5 +80,13 @@ void atmos__harris_plan_destroy(atmos__harris_plan *h);
 /* The sky, then the particles splatted over it, over the pixels of r. */
 atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);
 void atmos__harris_describe(const atmos_plan *p, char *buf, size_t cap);
+
+/* The beam renderer (beams_plan.c, beams_render.c; Dobashi et al. 2002 §4): the scene's
+ * objects, lights with their shadow maps, the fog's scattering table. */
+atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out);
+void atmos__beams_plan_destroy(atmos__beams_plan *b);
+/* The sky, then the objects and the light the fog scatters, over the pixels of r. */
+atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);
+void atmos__beams_describe(const atmos_plan *p, char *buf, size_t cap);
 
 #endif

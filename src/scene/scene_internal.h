@@ -89,6 +89,13 @@ double atmos__scene_norm3(const double v[3]);
 /* Sine of the angle between a and b (0 when parallel); -1 if either is zero. */
 double atmos__scene_sin_angle(const double a[3], const double b[3]);
 
+/* scene_lights.c: a light's and an object's defaults (a point light of 100 W/sr, white, reaching
+ * 100 m; the spot's axis straight down, cone 30 and edge 5 degrees; an object at the origin,
+ * unscaled, albedo 0.5), and the checks of the lights, the fog and the objects. */
+void atmos__scene_light_defaults(atmos_scene_light *l);
+void atmos__scene_object_defaults(atmos_scene_object *o);
+atmos_status atmos__scene_validate_lights(atmos_context *ctx, const char *source, const atmos_scene *scene);
+
 /* scene_earth.c: the Earth's map and cloud files of a scene loaded from `path`, made
  * relative to its folder (the first dir bytes of path; 0: the current folder) and checked
  * to be readable. */

@@ -1045,6 +1045,120 @@ static atmos_status parse_settings(const jp *p, const cJSON *j, const char *path
 /* "animation": {"frames": N, "time_end": T} or {"frames": N, "elevation_end_deg": E,
  * "azimuth_end_deg": A}; whether the end matches the sun is checked once the whole file
  * is read (the sun may come later). */
+/* ------------------------------------------------------------------ lights, fog, objects */
+
+static atmos_status parse_light(const jp *p, const cJSON *j, const char *path, atmos_scene_light *L)
+{
+    static const char *const keys[] = {"type", "position_m", "direction", "cone_deg", "edge_deg", "intensity_w_sr",
+                                       "colour_temperature_k", "colour", "range_m"};
+    static const char *const types[] = {"point", "spot"};
+    const atmos__range *const any[3] = {NULL, NULL, NULL};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, type;
+    TRY(iter_begin(p, j, path, keys, 9, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) {
+            const double n = atmos__scene_norm3(L->direction); /* zero: refused by the validator */
+            if (n > 0 && isfinite(n))
+                for (int a = 0; a < 3; a++) L->direction[a] /= n;
+            return ATMOS_OK;
+        }
+        switch (k) {
+        case 0: TRY(get_enum(p, v, ip, types, 2, &type)); L->type = (atmos_light_type)type; break;
+        case 1: TRY(get_vec3(p, v, ip, any, L->position_m)); break;
+        case 2: TRY(get_vec3(p, v, ip, any, L->direction)); break;
+        case 3: TRY(get_number(p, v, ip, NULL, NULL, &L->cone_deg)); break;
+        case 4: TRY(get_number(p, v, ip, NULL, NULL, &L->edge_deg)); break;
+        case 5: TRY(get_number(p, v, ip, NULL, NULL, &L->intensity_w_sr)); break;
+        case 6: TRY(get_number(p, v, ip, NULL, NULL, &L->colour_temperature_k)); break;
+        case 7: TRY(get_vec3(p, v, ip, any, L->colour)); break;
+        case 8: TRY(get_number(p, v, ip, NULL, NULL, &L->range_m)); break;
+        }
+    }
+}
+
+/* An array of at most max objects, each read by one of the two parsers into slot i. */
+static atmos_status parse_array(const jp *p, const cJSON *j, const char *path, int max, int *count,
+                                atmos_status (*item)(const jp *, const cJSON *, const char *, atmos_scene *, int),
+                                atmos_scene *s)
+{
+    if (!cJSON_IsArray(j)) return type_error(p, path, "an array of objects", j);
+    int n = 0;
+    for (const cJSON *e = j->child; e; e = e->next, n++) {
+        char ip[PATH_CAP];
+        snprintf(ip, sizeof ip, "%s/%d", path, n);
+        if (n >= max)
+            return atmos__scene_fail(p->ctx, ATMOS_E_LIMIT, p->source, ip, "at most %d are allowed", max);
+        TRY(item(p, e, ip, s, n));
+    }
+    *count = n;
+    return ATMOS_OK;
+}
+
+static atmos_status light_item(const jp *p, const cJSON *j, const char *path, atmos_scene *s, int i)
+{
+    atmos__scene_light_defaults(&s->lights[i]);
+    return parse_light(p, j, path, &s->lights[i]);
+}
+
+static atmos_status object_item(const jp *p, const cJSON *j, const char *path, atmos_scene *s, int i)
+{
+    static const char *const keys[] = {"mesh", "position_m", "scale", "rotation_deg", "albedo"};
+    const atmos__range *const any[3] = {NULL, NULL, NULL};
+    atmos_scene_object *o = &s->objects[i];
+    atmos__scene_object_defaults(o);
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 5, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        double x;
+        switch (k) {
+        case 0: TRY(get_text(p, v, ip, o->mesh, sizeof o->mesh)); break;
+        case 1: TRY(get_vec3(p, v, ip, any, o->position_m)); break;
+        case 2: /* one number: the same on every axis */
+        case 4:
+            if (cJSON_IsNumber(v)) {
+                TRY(get_number(p, v, ip, NULL, NULL, &x));
+                double *d = k == 2 ? o->scale : o->albedo;
+                d[0] = d[1] = d[2] = x;
+            } else TRY(get_vec3(p, v, ip, any, k == 2 ? o->scale : o->albedo));
+            break;
+        case 3: TRY(get_vec3(p, v, ip, any, o->rotation_deg)); break;
+        }
+    }
+    if (!o->mesh[0]) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"mesh\"");
+    return ATMOS_OK;
+}
+
+static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
+{
+    static const char *const keys[] = {"extinction_per_m", "scattering_per_m", "g"};
+    obj_iter it;
+    char ip[PATH_CAP];
+    const cJSON *v;
+    int k, scattering = 0;
+    atmos_scene_fog *f = &s->fog;
+    TRY(iter_begin(p, j, path, keys, 3, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        double *d = k == 0 ? &f->extinction_per_m : k == 1 ? &f->scattering_per_m : &f->g;
+        TRY(get_number(p, v, ip, NULL, NULL, d));
+        scattering |= k == 1;
+    }
+    if (!(it.seen & 1u)) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"extinction_per_m\"");
+    if (!scattering) f->scattering_per_m = f->extinction_per_m; /* no absorption unless given */
+    f->enabled = 1;
+    return ATMOS_OK;
+}
+
 static atmos_status parse_animation(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
     static const char *const keys[] = {"frames", "time_end", "elevation_end_deg", "azimuth_end_deg"};
@@ -1088,11 +1202,12 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
 {
     static const char *const keys[] = {"name", "image", "camera", "sun", "atmosphere", "wavelengths",
                                        "output", "renderer", "particles", "background", "volume", "slice",
-                                       "path", "animation", "nishita", "harris"};
-    static const char *const renderers[] = {"sky", "slice", "path", "nishita", "harris"};
+                                       "path", "animation", "nishita", "harris", "beams", "lights", "fog",
+                                       "objects"};
+    static const char *const renderers[] = {"sky", "slice", "path", "nishita", "harris", "beams"};
     enum {
         K_NAME, K_IMAGE, K_CAMERA, K_SUN, K_ATMOSPHERE, K_WAVELENGTHS, K_OUTPUT, K_RENDERER, K_PARTICLES,
-        K_BACKGROUND, K_VOLUME, K_SLICE, K_PATH, K_ANIMATION, K_NISHITA, K_HARRIS
+        K_BACKGROUND, K_VOLUME, K_SLICE, K_PATH, K_ANIMATION, K_NISHITA, K_HARRIS, K_BEAMS, K_LIGHTS, K_FOG, K_OBJECTS
     };
     jp p = {ctx, source};
     obj_iter it;
@@ -1101,7 +1216,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
     const char *name = NULL;
     int k, renderer;
     if (!cJSON_IsObject(root)) return type_error(&p, "/", "an object", root);
-    TRY(iter_begin(&p, root, "", keys, 16, &it));
+    TRY(iter_begin(&p, root, "", keys, 20, &it));
     for (;;) {
         TRY(iter_next(&p, &it, &k, &v, ip));
         if (k < 0) {
@@ -1129,7 +1244,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_WAVELENGTHS: TRY(parse_wavelengths(&p, v, ip, s)); break;
         case K_OUTPUT: TRY(parse_output(&p, v, ip, s)); break;
         case K_RENDERER:
-            TRY(get_enum(&p, v, ip, renderers, 5, &renderer));
+            TRY(get_enum(&p, v, ip, renderers, 6, &renderer));
             s->renderer = (atmos_renderer_kind)renderer;
             break;
         case K_PARTICLES: TRY(parse_particles(&p, v, ip, s)); break;
@@ -1140,6 +1255,10 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
         case K_ANIMATION: TRY(parse_animation(&p, v, ip, s)); break;
         case K_NISHITA: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_NISHITA, s)); break;
         case K_HARRIS: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_HARRIS, s)); break;
+        case K_BEAMS: TRY(parse_settings(&p, v, ip, ATMOS_RENDERER_BEAMS, s)); break;
+        case K_LIGHTS: TRY(parse_array(&p, v, ip, ATMOS_SCENE_MAX_LIGHTS, &s->light_count, light_item, s)); break;
+        case K_FOG: TRY(parse_fog(&p, v, ip, s)); break;
+        case K_OBJECTS: TRY(parse_array(&p, v, ip, ATMOS_SCENE_MAX_OBJECTS, &s->object_count, object_item, s)); break;
         }
     }
 }

@@ -12,6 +12,7 @@
 #define PATH(field) offsetof(atmos_scene, path.field)
 #define NISHITA(field) offsetof(atmos_scene, nishita.field)
 #define HARRIS(field) offsetof(atmos_scene, harris.field)
+#define BEAMS(field) offsetof(atmos_scene, beams.field)
 
 static const char *const update_names[] = {"eq25", "eq24", NULL};
 
@@ -100,6 +101,19 @@ static const atmos_setting harris_settings[] = {
      "an impostor's texels per side at most", HARRIS(impostor_max_res)},
 };
 
+static const atmos_setting beams_settings[] = {
+    {"plane_spacing_m", "plane-spacing", ATMOS_SETTING_REAL, "m", 0, 1e5, 0, 0, 0, NULL, 0,
+     "distance between the main sampling planes along the view; 0 = 1/40 of the depth the lights reach in view",
+     BEAMS(plane_spacing_m)},
+    {"epsilon", "beams-epsilon", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 0.01, NULL, 0,
+     "sub-planes: each may add at most this share of the pixel's unshadowed airlight (Dobashi et al. 2002 §4.2.2)",
+     BEAMS(epsilon)},
+    {"max_subplanes", "max-subplanes", ATMOS_SETTING_INT, "", 1, 4096, 0, 0, 64, NULL, 0,
+     "sub-planes between two main planes at most (1: none, the main planes alone)", BEAMS(max_subplanes)},
+    {"shadow_size", "shadow-size", ATMOS_SETTING_INT, "texels", 16, 8192, 0, 0, 512, NULL, 0,
+     "shadow map texels per side (per cube face for a point light)", BEAMS(shadow_size)},
+};
+
 const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)
 {
     int n = 0;
@@ -108,13 +122,14 @@ const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *
     if (renderer == ATMOS_RENDERER_PATH) t = path_settings, n = (int)(sizeof path_settings / sizeof *t);
     if (renderer == ATMOS_RENDERER_NISHITA) t = nishita_settings, n = (int)(sizeof nishita_settings / sizeof *t);
     if (renderer == ATMOS_RENDERER_HARRIS) t = harris_settings, n = (int)(sizeof harris_settings / sizeof *t);
+    if (renderer == ATMOS_RENDERER_BEAMS) t = beams_settings, n = (int)(sizeof beams_settings / sizeof *t);
     if (count) *count = n;
     return t;
 }
 
 const char *atmos_renderer_name(atmos_renderer_kind renderer)
 {
-    static const char *const names[] = {"sky", "slice", "path", "nishita", "harris"};
+    static const char *const names[] = {"sky", "slice", "path", "nishita", "harris", "beams"};
     return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_LAST ? names[renderer] : NULL;
 }
 

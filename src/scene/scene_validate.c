@@ -343,7 +343,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/density_unit",
                                  "must be auto, per_m3, g_m3 or fraction, got %d", (int)s->volume.density_unit);
     if (s->renderer < ATMOS_RENDERER_SKY || s->renderer > ATMOS_RENDERER_LAST)
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice, path, nishita or harris, got %d",
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer", "must be sky, slice, path, nishita, harris or beams, got %d",
                                  (int)s->renderer);
     const atmos_scene_sun *sun = &s->sun;
     if (sun->irradiance_count != 0 && sun->irradiance_count != 1 && sun->irradiance_count != 3)
@@ -364,6 +364,9 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/renderer",
                                  "\"%s\" renders a volume: the scene needs \"volume\" (a file or a generator)",
                                  atmos_renderer_name(s->renderer));
+    if (s->renderer == ATMOS_RENDERER_BEAMS && s->volume.source[0])
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume",
+                                 "the beams renderer draws no volume (lights, fog and objects only)");
     if (!volume_renderer && s->volume.source[0])
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume",
                                  "the sky renderer draws no volume (use \"renderer\": \"slice\" or \"path\")");
@@ -390,6 +393,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     };
     for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++)
         if ((st = atmos__scene_check_range(ctx, source, checks[i].path, checks[i].v, checks[i].r, NULL))) return st;
+    if ((st = atmos__scene_validate_lights(ctx, source, s))) return st;
     return atmos__settings_check(ctx, source, s);
 }
 

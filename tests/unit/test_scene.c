@@ -235,7 +235,7 @@ typedef struct bad_case {
 
 static const bad_case bad_cases[] = {
     /* structure and types */
-    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path, animation, nishita, harris)", NULL},
+    {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path, animation, nishita, harris, beams, lights, fog, objects)", NULL},
     {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
     {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
     {"{\"a/b~c\": 1}", ATMOS_E_INVALID_ARG, "/a~1b~0c: unknown key", NULL},
@@ -254,7 +254,30 @@ static const bad_case bad_cases[] = {
     {"{\"output\": {\"exr_pixel\": \"double\"}}", ATMOS_E_INVALID_ARG, "/output/exr_pixel: must be one of float, half", NULL},
     {"{\"output\": {\"exposure\": \"bright\"}}", ATMOS_E_INVALID_ARG, "/output/exposure: must be \"auto\" or a number", NULL},
     {"{\"output\": {\"exposure\": true}}", ATMOS_E_INVALID_ARG, "/output/exposure: expected \"auto\" or a number (EV100), got a boolean", NULL},
-    {"{\"renderer\": \"raytrace\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, slice, path, nishita, harris, got \"raytrace\"", NULL},
+    {"{\"renderer\": \"raytrace\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, slice, path, nishita, harris, beams, got \"raytrace\"", NULL},
+    /* lights, fog, objects: absurd values */
+    {"{\"lights\": [{\"type\": \"torch\"}]}", ATMOS_E_INVALID_ARG, "/lights/0/type: must be one of point, spot", NULL},
+    {"{\"lights\": [{}, {\"intensity_w_sr\": -5}]}", ATMOS_E_INVALID_ARG, "/lights/1/intensity_w_sr: must be in (0, 1000000000]", NULL},
+    {"{\"lights\": [{\"type\": \"spot\", \"cone_deg\": 120}]}", ATMOS_E_INVALID_ARG, "/lights/0/cone_deg: must be in [0, 89]", NULL},
+    {"{\"lights\": [{\"type\": \"spot\", \"cone_deg\": 80, \"edge_deg\": 20}]}", ATMOS_E_INVALID_ARG, "/lights/0/edge_deg: cone_deg + edge_deg must be at most 90", NULL},
+    {"{\"lights\": [{\"type\": \"spot\", \"direction\": [0, 0, 0]}]}", ATMOS_E_INVALID_ARG, "/lights/0/direction: must be a nonzero finite vector", NULL},
+    {"{\"lights\": [{\"colour_temperature_k\": 100}]}", ATMOS_E_INVALID_ARG, "/lights/0/colour_temperature_k: must be in [1000, 40000] (0: colour)", NULL},
+    {"{\"lights\": [{\"position_m\": [0, 1e300, 0]}]}", ATMOS_E_INVALID_ARG, "/lights/0/position_m/1: must be in", NULL},
+    {"{\"lights\": [{\"range_m\": 0}]}", ATMOS_E_INVALID_ARG, "/lights/0/range_m: must be in (0, 1000000]", NULL},
+    {"{\"wavelengths\": {\"mode\": \"spectral\"}, \"lights\": [{\"colour\": [1, 0.5, 0.2]}]}", ATMOS_E_INVALID_ARG, "/lights/0/colour: rgb colours need rgb wavelengths", NULL},
+    {"{\"lights\": {\"type\": \"spot\"}}", ATMOS_E_INVALID_ARG, "/lights: expected an array of objects, got an object", NULL},
+    {"{\"lights\": [{\"cone\": 5}]}", ATMOS_E_INVALID_ARG, "/lights/0/cone: unknown key", NULL},
+    {"{\"fog\": {\"extinction_per_m\": 0}}", ATMOS_E_INVALID_ARG, "/fog/extinction_per_m: must be in (0, 10]", NULL},
+    {"{\"fog\": {\"extinction_per_m\": 0.1, \"scattering_per_m\": 0.2}}", ATMOS_E_INVALID_ARG, "/fog/scattering_per_m: must be in [0, 0.1] (at most the extinction)", NULL},
+    {"{\"fog\": {\"extinction_per_m\": 0.1, \"g\": 1}}", ATMOS_E_INVALID_ARG, "/fog/g: must be in (-1, 1)", NULL},
+    {"{\"fog\": {\"g\": 0.5}}", ATMOS_E_INVALID_ARG, "/fog: needs \"extinction_per_m\"", NULL},
+    {"{\"objects\": [{\"position_m\": [0, 0, 0]}]}", ATMOS_E_INVALID_ARG, "/objects/0: needs \"mesh\"", NULL},
+    {"{\"objects\": [{\"mesh\": \"builtin:teapot\"}]}", ATMOS_E_INVALID_ARG, "/objects/0: mesh \"builtin:teapot\" is no built-in", NULL},
+    {"{\"objects\": [{\"mesh\": \"builtin:box\", \"scale\": [1, 0, 1]}]}", ATMOS_E_INVALID_ARG, "/objects/0/scale/1: must not be zero", NULL},
+    {"{\"objects\": [{\"mesh\": \"builtin:box\", \"albedo\": 1.5}]}", ATMOS_E_INVALID_ARG, "/objects/0/albedo/0: must be in [0, 1]", NULL},
+    {"{\"renderer\": \"beams\"}", ATMOS_E_INVALID_ARG, "/lights: the beams renderer draws the light of \"lights\": the scene has none", NULL},
+    {"{\"renderer\": \"beams\", \"lights\": [{}], \"camera\": {\"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/type: the beams renderer supports pinhole cameras only", NULL},
+    {"{\"renderer\": \"beams\", \"lights\": [{}], \"beams\": {\"epsilon\": 0}}", ATMOS_E_INVALID_ARG, "/beams/epsilon: must be in (0, 1]", NULL},
     /* renderers, background, volume */
     {"{\"renderer\": \"slice\"}", ATMOS_E_INVALID_ARG, "/renderer: \"slice\" renders a volume: the scene needs \"volume\"", NULL},
     {"{\"renderer\": \"sky\", \"volume\": {\"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume: the sky renderer draws no volume", NULL},
@@ -373,6 +396,43 @@ static const bad_case bad_cases[] = {
     {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": -91}}", ATMOS_E_INVALID_ARG, "/animation/elevation_end_deg: must be in [-90, 90]", NULL},
     {"{\"image\": {\"width\": 10}} \x01", ATMOS_E_FORMAT, "control character", NULL},
 };
+
+/* Lights, fog and objects read back value by value, with the defaults of what is absent. */
+static void test_lights(void)
+{
+    const char *json = "{\"renderer\": \"beams\", \"beams\": {\"epsilon\": 0.02, \"shadow_size\": 256},"
+                       " \"lights\": [{\"type\": \"spot\", \"position_m\": [1, 20, 3], \"direction\": [0, -2, 0],"
+                       " \"cone_deg\": 15, \"edge_deg\": 3, \"intensity_w_sr\": 5000, \"colour_temperature_k\": 3200,"
+                       " \"range_m\": 40}, {\"colour\": [1, 0.5, 0.25]}],"
+                       " \"fog\": {\"extinction_per_m\": 0.05, \"g\": 0.3},"
+                       " \"objects\": [{\"mesh\": \"builtin:sphere\", \"position_m\": [0, 5, 0], \"scale\": 2,"
+                       " \"albedo\": [0.8, 0.7, 0.6], \"rotation_deg\": [0, 45, 0]}]}";
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    CHECK(s.light_count == 0 && s.object_count == 0 && !s.fog.enabled && s.beams.epsilon == 0.01 &&
+          s.beams.max_subplanes == 64 && s.beams.shadow_size == 512 && s.beams.plane_spacing_m == 0);
+    CHECK_OK(parse(json, &s));
+    CHECK(s.renderer == ATMOS_RENDERER_BEAMS && s.beams.epsilon == 0.02 && s.beams.shadow_size == 256);
+    CHECK(s.light_count == 2 && s.object_count == 1);
+    const atmos_scene_light *a = &s.lights[0], *b = &s.lights[1];
+    CHECK(a->type == ATMOS_LIGHT_SPOT && a->position_m[1] == 20 && a->direction[1] == -1 && a->cone_deg == 15 &&
+          a->edge_deg == 3 && a->intensity_w_sr == 5000 && a->colour_temperature_k == 3200 && a->range_m == 40);
+    CHECK(b->type == ATMOS_LIGHT_POINT && b->intensity_w_sr == 100 && b->range_m == 100 && b->colour[1] == 0.5 &&
+          b->colour_temperature_k == 0);
+    CHECK(s.fog.enabled && s.fog.extinction_per_m == 0.05 && s.fog.scattering_per_m == 0.05 && s.fog.g == 0.3);
+    const atmos_scene_object *o = &s.objects[0];
+    CHECK(!strcmp(o->mesh, "builtin:sphere") && o->position_m[1] == 5 && o->scale[0] == 2 && o->scale[2] == 2 &&
+          o->albedo[2] == 0.6 && o->rotation_deg[1] == 45);
+    CHECK_OK(atmos_scene_validate(ctx, &s, "scene"));
+    s.lights[1].intensity_w_sr = 1e12; /* set in code: the validator's message is the parser's */
+    CHECK(atmos_scene_validate(ctx, &s, "scene") == ATMOS_E_INVALID_ARG &&
+          contains(atmos_context_error(ctx), "scene: /lights/1/intensity_w_sr: must be in (0, 1000000000]"));
+    /* more lights than the bound */
+    char big[4096] = "{\"lights\": [";
+    for (int i = 0; i <= ATMOS_SCENE_MAX_LIGHTS; i++) strcat(big, i ? ", {}" : "{}");
+    strcat(big, "]}");
+    CHECK(parse(big, &s) == ATMOS_E_LIMIT && contains(atmos_context_error(ctx), "/lights/32: at most 32 are allowed"));
+}
 
 static void test_bad_scenes(void)
 {
@@ -674,6 +734,7 @@ int main(void)
     test_full_scene();
     test_absent_keys();
     test_bad_scenes();
+    test_lights();
     test_limits();
     test_validate();
     test_load();

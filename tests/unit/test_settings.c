@@ -97,7 +97,7 @@ int main(void)
     atmos_context *ctx = NULL;
     CHECK_OK(atmos_context_create(NULL, &ctx));
     int total = 0;
-    for (int r = ATMOS_RENDERER_SKY; r <= ATMOS_RENDERER_PATH; r++) {
+    for (int r = ATMOS_RENDERER_SKY; r <= ATMOS_RENDERER_BEAMS; r = r == ATMOS_RENDERER_PATH ? ATMOS_RENDERER_BEAMS : r + 1) {
         int n = -1;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
         CHECK(r == ATMOS_RENDERER_SKY ? (!t && n == 0) : (t && n > 0));

@@ -150,7 +150,7 @@ static int parse_vec3(const char *opt, const char *arg, double v[3], int *given)
 static int parse_named(int c, const char *arg, render_opts *o)
 {
     static const char *const cams[] = {"pinhole", "fisheye", "equirect"}, *const tones[] = {"filmic", "reinhard", "clamp"},
-                             *const renderers[] = {"sky", "slice", "path", "nishita", "harris"}, *const airs[] = {"riley", "homogeneous"};
+                             *const renderers[] = {"sky", "slice", "path", "nishita", "harris", "beams"}, *const airs[] = {"riley", "homogeneous"};
     switch (c) {
     case 'o': o->png = arg; return 1;
     case O_EXR: o->exr = arg; return 1;
@@ -168,7 +168,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_RGB: o->rgb = 1; return 1;
     case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
-    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 5, &o->renderer);
+    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 6, &o->renderer);
     case O_ATMOSPHERE: return parse_choice("--atmosphere", arg, airs, 2, &o->air);
     case O_EXPOSURE:
         if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
@@ -601,12 +601,14 @@ void render_opts_help(void)
            "                                ranks, a single image's bands of rows are split between them;\n"
            "                                rank 0 writes every output, the same bytes as one process\n"
            "                                (docs/cluster.md; not with --variance or --order)\n"
-           "      --renderer sky|slice|path|nishita|harris   the atmosphere alone (default), Riley et\n"
+           "      --renderer sky|slice|path|nishita|harris|beams   the atmosphere alone (default), Riley et\n"
            "                                al.'s half-angle slicing over a volume (default when a volume is\n"
            "                                given), spectral Monte Carlo path tracing (the reference,\n"
            "                                docs/path.md), Nishita et al. 1996's ray marching with orders 2-3\n"
            "                                and sky light from a light field (docs/lightfield.md), or\n"
-           "                                Harris's particle clouds (the volume as particles, docs/particles.md)\n"
+           "                                Harris's particle clouds (the volume as particles, docs/particles.md),\n"
+           "                                or Dobashi et al. 2002's light beams of the scene's \"lights\" in its\n"
+           "                                \"fog\" with the shadows of its \"objects\" (docs/beams.md)\n"
            "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
            "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
@@ -640,6 +642,7 @@ void render_opts_help(void)
     help_settings(ATMOS_RENDERER_PATH, "Path tracer");
     help_settings(ATMOS_RENDERER_NISHITA, "Nishita renderer (Nishita et al. 1996: orders 2-3 and sky light by a light field)");
     help_settings(ATMOS_RENDERER_HARRIS, "Harris's particle renderer");
+    help_settings(ATMOS_RENDERER_BEAMS, "Beam renderer (Dobashi et al. 2002 §4: sampling planes, sub-planes, shadow maps)");
     printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
            "                                more than one frame numbers the outputs: -o out/sky.png writes\n"

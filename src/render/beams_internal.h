@@ -1,0 +1,121 @@
+/* Dobashi, Yamamoto and Nishita 2002 §4's light beams ("renderer": "beams", docs/beams.md):
+ * point lights and spotlights in a uniform fog, the shadows of meshes in the air by shadow
+ * maps, sampling planes facing the view with a pre-integrated scattering table and
+ * sub-planes. The plan's part (beams_plan.c), the table (beams_table.c), the shadow maps
+ * (beams_shadow.c) and the frame (beams_render.c). Not part of the API. */
+#ifndef ATMOS_RENDER_BEAMS_INTERNAL_H
+#define ATMOS_RENDER_BEAMS_INTERNAL_H
+
+#include "render/plan_internal.h"
+
+/* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
+ * substitution of Sun et al. 2005). For a ray passing at distance v from the light, with u
+ * the signed distance along the ray from Q (the ray's point nearest the light) and
+ * theta = atan(u / v), the light scattered toward the eye between u_a and u_b per unit
+ * intensity is
+ *     exp(-sigma_t t_Q) / v * (W(theta_b, x) - W(theta_a, x)),  x = sigma_t v,
+ *     W(theta, x) = sigma_s * int_{-pi/2}^{theta} p(-sin th) exp(-x tan(pi/4 + th/2)) dth,
+ * t_Q the distance from the eye to Q and p the phase function: two look-ups for any
+ * interval, whatever its length (Dobashi's q(u, v) is a difference of W at a fixed
+ * interval). Tabulated over nt values of s = u / (|u| + v) in [-1, 1] (theta
+ * without an arctangent per look-up: tan theta = s / (1 - |s|)) and nx values of
+ * x = x_max w^2, w in [0, 1] (finer near the light); linear in s, cubic in w. */
+/* The fog's reach from a light, in optical depths: beyond, exp(-50) of the light is left. */
+#define ATMOS__BEAMS_MAX_OPTICAL_RANGE 50.0
+
+typedef struct atmos__beams_table {
+    int nt, nx;
+    double x_max;
+    double *w;               /* nx rows of nt values */
+} atmos__beams_table;
+
+atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, double g, double x_max,
+                                      atmos__beams_table *out);
+void atmos__beams_table_free(atmos__beams_table *t);
+
+/* The four rows and their weights for one x (a ray and a light): W at any theta is then
+ * atmos__beams_table_at. */
+typedef struct atmos__beams_column {
+    const double *row[4];
+    double wt[4];
+} atmos__beams_column;
+void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__beams_column *c);
+double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s);
+/* The table's coordinate of the point u along a ray passing at v from the light. */
+static inline double atmos__beams_table_s(double u, double v) { return u / ((u < 0 ? -u : u) + v); }
+
+/* A depth map seen from a light through one frustum: the distance along fwd of the nearest
+ * surface through each of n x n texels spanning [-tan_half, tan_half]^2 of the image plane. */
+typedef struct atmos__beams_face {
+    double right[3], up[3], fwd[3];
+    double tan_half;
+    int n;
+    float *depth;
+    /* per tile of TILE x TILE texels, the least and the greatest depth of the tile and the
+     * texels around it (what a filtered look-up in it may read): nearer than the least is
+     * lit, farther than the greatest is in shadow, without reading the map; then the same
+     * over 2x2, 4x4, ... tiles up to the whole map (level k at offset level_at[k], level_n[k]
+     * cells a side) */
+    int tiles, levels;
+    int level_n[24];
+    size_t level_at[24];
+    float *tile_min, *tile_max;
+} atmos__beams_face;
+
+typedef struct atmos__beams_light {
+    atmos_light_type type;
+    double pos[3], axis[3];
+    double cos_inner, cos_outer; /* spot: full within cos_inner, zero beyond cos_outer */
+    double range;
+    double I[ATMOS_MAX_WAVELENGTHS]; /* spectral intensity on the axis, W sr^-1 nm^-1 */
+    double I_max;                /* the largest of I */
+    int nfaces;                  /* 0: no shadow casters; 1: a spot's frustum; 6: a cube map */
+    atmos__beams_face face[6];
+} atmos__beams_light;
+
+/* The light's shadow maps of the meshes, size texels a side (beams_shadow.c). */
+atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l, atmos_mesh *const *mesh, int nmesh,
+                                       int size);
+void atmos__beams_shadow_free(atmos__beams_light *l);
+/* H: the share of the light reaching p past the meshes, in [0, 1] (2x2 filtered). */
+double atmos__beams_visibility(const atmos__beams_light *l, const double p[3]);
+/* The spot's smooth falloff at p (1 for a point light): a smoothstep in the cosine of the
+ * angle from the axis between cos_outer and cos_inner. */
+double atmos__beams_falloff(const atmos__beams_light *l, const double p[3]);
+
+/* One ray's view of one light, for the sub-planes: the point o + t d relative to the light,
+ * its depth along the spot's axis and its coordinates in each shadow face, all linear in t
+ * (set once per ray; a sample then costs a few multiply-adds and at most one square root). */
+typedef struct atmos__beams_ray {
+    const atmos__beams_light *l;
+    double ww0, wd;          /* |w(0)|^2 and w(0).d: |w(t)|^2 = ww0 + 2 t wd + t^2 */
+    double w0[3], d[3];      /* w(t) = w0 + t d */
+    double a0, a1;           /* the depth along the axis: a0 + t a1 */
+    double f0[6][3], f1[6][3]; /* per face: (right, up, fwd) coordinates a0 + t a1 */
+} atmos__beams_ray;
+void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r);
+/* The spot's falloff times the visibility H at o + t d (as the two functions above). */
+double atmos__beams_ray_light(const atmos__beams_ray *r, double t);
+/* What is the same all along [ta, tb] of the ray: 1 if H is (*h: 0 or 1; the segment nearer
+ * or farther than every depth of the shadow map's tiles it crosses), and then *full = 1 if the
+ * falloff is 1 too (the segment inside the spot's inner cone); 0 when H may vary. */
+int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full);
+/* The spot's falloff alone at o + t d (1 for a point light). */
+double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t);
+
+struct atmos__beams_plan {
+    int nmesh;
+    atmos_mesh **mesh;
+    double (*albedo)[ATMOS_MAX_WAVELENGTHS]; /* per mesh */
+    int nlights;
+    atmos__beams_light *lights;
+    double sigma_t, sigma_s;                 /* 0 without fog */
+    atmos__beams_table table;
+    /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
+    int centre_planes, centre_subplanes;
+};
+
+/* The light sources' spectra (beams_plan.c): the intensity at wavelength nm of a light. */
+double atmos__beams_spectrum(const atmos_scene_light *l, const atmos_wavelengths *wl, int k);
+
+#endif

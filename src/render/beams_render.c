@@ -1,0 +1,259 @@
+/* The beam renderer's frame (Dobashi, Yamamoto and Nishita 2002 §4): per pixel, the sky
+ * behind (dimmed by the fog), or the nearest object's Lambertian surface lit by every light
+ * it sees (Dobashi's I_b, attenuated by the fog on both legs), plus per light the light the
+ * fog scatters toward the eye (Eq. 2):
+ *   - the ray is cut by sampling planes perpendicular to the view direction, spaced evenly
+ *     in depth across the sphere the light reaches (the same planes for every pixel);
+ *   - between two planes the scattering of an unshadowed light of unit intensity is two
+ *     look-ups of the pre-integrated table (f_l, Eq. 8-9; beams_table.c);
+ *   - the visibility H and the spot's falloff (f_h, Eq. 10) are averaged over sub-planes
+ *     between the planes, m_k of them where f_l could add more than epsilon of the pixel's
+ *     unshadowed airlight (Dobashi §4.2.2's criterion, per pixel: m_k = ceil(f_l,k /
+ *     (epsilon sum_k f_l,k)) up to max_subplanes), at the midpoints of m_k equal parts;
+ *   - the interval adds I f_h f_l (Eq. 6); an interval along which H cannot change (clear of
+ *     every depth the shadow map's tiles there hold, or beyond them all) samples the falloff
+ *     alone, or nothing when it is in shadow or inside the inner cone: the value its samples
+ *     would all have.
+ * Rows go to the threads; each pixel depends on nothing but its own ray, so the image does
+ * not depend on the thread count. */
+#include "render/beams_internal.h"
+#include "core/vec.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Intervals per light along one ray at most: planes closer than 2 range / this are spread. */
+#define MAX_INTERVALS 4096
+
+typedef struct job {
+    const atmos__beams_plan *b;
+    const atmos_camera *cam;
+    const double *eye;
+    double fwd[3];
+    int nw, cx, cy;
+    double *z_lo, *dz, *reach; /* per light: the first plane's depth, the spacing, the sampled radius */
+    double epsilon;
+    int max_sub;
+    int centre_planes, centre_subplanes;
+} job;
+
+static int first_hit(const atmos__beams_plan *b, const double o[3], const double d[3], double tmin, double tmax,
+                     atmos_mesh_hit *hit, int *which)
+{
+    int any = 0;
+    for (int m = 0; m < b->nmesh; m++) {
+        atmos_mesh_hit h = {0, 0, {0, 0, 0}};
+        if (atmos_mesh_intersect(b->mesh[m], o, d, tmin, tmax, hit ? &h : NULL)) {
+            if (!hit) return 1;
+            *hit = h, *which = m, tmax = h.t, any = 1;
+        }
+    }
+    return any;
+}
+
+/* The object's surface at the eye's ray's hit, lit by the lights, dimmed on the way to the eye. */
+static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double *L)
+{
+    const atmos__beams_plan *b = J->b;
+    double P[3], sum[ATMOS_MAX_WAVELENGTHS] = {0};
+    for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
+    const double off = 1e-4 * (1 + h->t);
+    for (int i = 0; i < b->nlights; i++) {
+        const atmos__beams_light *l = &b->lights[i];
+        double w[3] = {l->pos[0] - P[0], l->pos[1] - P[1], l->pos[2] - P[2]};
+        const double r = sqrt(atmos__dot3(w, w));
+        if (r <= 0) continue;
+        for (int a = 0; a < 3; a++) w[a] /= r;
+        const double c = atmos__dot3(h->normal, w), fall = atmos__beams_falloff(l, P);
+        if (c <= 0 || fall <= 0) continue;
+        const double o[3] = {P[0] + off * h->normal[0], P[1] + off * h->normal[1], P[2] + off * h->normal[2]};
+        if (first_hit(b, o, w, 0, r - off, NULL, NULL)) continue;
+        const double e = fall * c / (r * r) * exp(-b->sigma_t * r);
+        for (int k = 0; k < J->nw; k++) sum[k] += l->I[k] * e;
+    }
+    const double t = exp(-b->sigma_t * h->t);
+    for (int k = 0; k < J->nw; k++) L[k] = b->albedo[m][k] / ATMOS_PI * sum[k] * t;
+}
+
+/* Narrows [*t0, *t1] of the ray d to the part inside a spot's outer cone (Dobashi's bounding
+ * pyramid, exactly): the roots of ((P - L).a)^2 = cos^2 |P - L|^2 cut the span into at most
+ * three pieces; the hull of those whose middle is lit. 0 if none is. */
+static int clip_cone(const atmos__beams_light *l, const double e[3], const double d[3], double *t0, double *t1)
+{
+    if (l->type != ATMOS_LIGHT_SPOT) return 1;
+    const double w[3] = {e[0] - l->pos[0], e[1] - l->pos[1], e[2] - l->pos[2]}, c2 = l->cos_outer * l->cos_outer;
+    const double wa = atmos__dot3(w, l->axis), da = atmos__dot3(d, l->axis);
+    const double A = da * da - c2, B = 2 * (wa * da - c2 * atmos__dot3(w, d)), C = wa * wa - c2 * atmos__dot3(w, w);
+    double cut[4] = {*t0, *t0, *t1, *t1};
+    const double disc = B * B - 4 * A * C;
+    if (disc > 0 && A != 0) {
+        const double q = -0.5 * (B + copysign(sqrt(disc), B)), r1 = q / A, r2 = C / q;
+        cut[1] = atmos__clampd(fmin(r1, r2), *t0, *t1), cut[2] = atmos__clampd(fmax(r1, r2), *t0, *t1);
+    }
+    double lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+        if (!(cut[k + 1] > cut[k])) continue;
+        const double tm = 0.5 * (cut[k] + cut[k + 1]);
+        const double P[3] = {e[0] + tm * d[0], e[1] + tm * d[1], e[2] + tm * d[2]};
+        if (atmos__beams_falloff(l, P) > 0) lo = fmin(lo, cut[k]), hi = fmax(hi, cut[k + 1]);
+    }
+    if (!(lo < hi)) return 0;
+    *t0 = lo, *t1 = hi;
+    return 1;
+}
+
+/* Light i scattered toward the eye along [0, T) of the ray d, added to L. f holds room for
+ * MAX_INTERVALS + 1 values. */
+static void airlight(job *J, int i, const double d[3], double T, double *f, double *L, int centre)
+{
+    const atmos__beams_plan *b = J->b;
+    const atmos__beams_light *l = &b->lights[i];
+    const double R = J->reach[i], sig = b->sigma_t;
+    const double Lp[3] = {l->pos[0] - J->eye[0], l->pos[1] - J->eye[1], l->pos[2] - J->eye[2]};
+    const double tQ = atmos__dot3(Lp, d);
+    const double q[3] = {Lp[0] - tQ * d[0], Lp[1] - tQ * d[1], Lp[2] - tQ * d[2]};
+    const double v = atmos__maxd(sqrt(atmos__dot3(q, q)), 1e-6 * R);
+    if (v >= R) return;
+    const double hh = sqrt(R * R - v * v);
+    double t0 = atmos__maxd(0, tQ - hh), t1 = atmos__mind(T, tQ + hh);
+    if (!(t0 < t1) || !clip_cone(l, J->eye, d, &t0, &t1)) return;
+    atmos__beams_column col;
+    atmos__beams_table_column(&b->table, sig * v, &col);
+    const double scale = exp(-sig * tQ) / v, cosf = atmos__dot3(d, J->fwd), dz = J->dz[i], zl = J->z_lo[i];
+    /* the intervals between the planes crossing [t0, t1], and their f_l */
+    double a = t0, Wa = atmos__beams_table_at(&b->table, &col, atmos__beams_table_s(t0 - tQ, v)), S = 0;
+    long j = (long)floor((t0 * cosf - zl) / dz) + 1;
+    int n = 0;
+    while (a < t1) {
+        double e = n == MAX_INTERVALS - 1 ? t1 : atmos__mind(t1, (zl + j * dz) / cosf);
+        if (e <= a) e = atmos__mind(t1, a + 1e-9 * (1 + a)); /* a plane at a itself */
+        const double We = atmos__beams_table_at(&b->table, &col, atmos__beams_table_s(e - tQ, v));
+        f[2 * n] = a, f[2 * n + 1] = atmos__maxd(0, We - Wa) * scale;
+        S += f[2 * n + 1];
+        a = e, Wa = We, j++, n++;
+    }
+    f[2 * n] = t1;
+    if (centre) J->centre_planes += n;
+    if (!(S > 0)) return;
+    if (!l->nfaces && l->type == ATMOS_LIGHT_POINT) { /* H = 1 and no falloff: the sum is exact */
+        for (int k = 0; k < J->nw; k++) L[k] += l->I[k] * S;
+        return;
+    }
+    atmos__beams_ray ray;
+    atmos__beams_ray_init(l, J->eye, d, &ray);
+    double sum = 0;
+    for (int k = 0; k < n; k++) {
+        const double fl = f[2 * k + 1];
+        if (fl <= 0) continue;
+        const double need = ceil(fl / (J->epsilon * S));
+        const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
+        double h = 0, same = 0;
+        int full = 0;
+        const int uniform = m > 1 && atmos__beams_ray_uniform(&ray, ta, f[2 * k + 2], &same, &full);
+        if (uniform && (full || same == 0)) { /* what every sample would say */
+            sum += same * fl;
+            continue;
+        }
+        if (uniform) /* lit all along: the falloff alone varies */
+            for (int s = 0; s < m; s++) h += atmos__beams_ray_falloff(&ray, ta + (s + 0.5) * step);
+        else
+            for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + 0.5) * step);
+        sum += h / m * fl;
+        if (centre) J->centre_subplanes += m;
+    }
+    for (int k = 0; k < J->nw; k++) L[k] += l->I[k] * sum;
+}
+
+static void pixel(job *J, int x, int y, float *px, double *f)
+{
+    const atmos__beams_plan *b = J->b;
+    double d[3], L[ATMOS_MAX_WAVELENGTHS];
+    atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
+    atmos_mesh_hit h = {0, 0, {0, 0, 0}};
+    int m = -1;
+    const int hit = first_hit(b, J->eye, d, 0, INFINITY, &h, &m);
+    const double T = hit ? h.t : INFINITY;
+    if (hit) shade_surface(J, d, &h, m, L);
+    else
+        for (int k = 0; k < J->nw; k++) L[k] = b->sigma_t > 0 ? 0 : px[k]; /* the sky, behind endless fog */
+    if (b->sigma_t > 0)
+        for (int i = 0; i < b->nlights; i++) airlight(J, i, d, T, f, L, x == J->cx && y == J->cy);
+    for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
+}
+
+/* Each light's planes: evenly spaced in depth along the view across the sphere it reaches. */
+static atmos_status planes(atmos_plan *p, job *J)
+{
+    const atmos__beams_plan *b = J->b;
+    J->z_lo = malloc(sizeof(double) * 3 * (size_t)(b->nlights ? b->nlights : 1));
+    if (!J->z_lo) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
+    J->dz = J->z_lo + b->nlights, J->reach = J->dz + b->nlights;
+    for (int i = 0; i < b->nlights; i++) {
+        const atmos__beams_light *l = &b->lights[i];
+        const double R = b->sigma_t > 0 ? fmin(l->range, ATMOS__BEAMS_MAX_OPTICAL_RANGE / b->sigma_t) : l->range;
+        const double Lp[3] = {l->pos[0] - J->eye[0], l->pos[1] - J->eye[1], l->pos[2] - J->eye[2]};
+        const double given = p->scene.beams.plane_spacing_m;
+        J->reach[i] = R;
+        J->z_lo[i] = atmos__dot3(Lp, J->fwd) - R;
+        J->dz[i] = fmax(given > 0 ? given : 2 * R / 40, 2 * R / (MAX_INTERVALS - 8));
+    }
+    return ATMOS_OK;
+}
+
+atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
+{
+    atmos__beams_plan *b = p->beams;
+    atmos_status st = atmos__sky_render(p->ctx, p->atm, v, r, out, p->sky_keep);
+    if (st != ATMOS_OK) return st;
+    job J;
+    memset(&J, 0, sizeof J);
+    J.b = b, J.cam = &v->cam, J.eye = v->cam.position, J.nw = p->wl.count;
+    memcpy(J.fwd, v->cam.forward, sizeof J.fwd);
+    J.cx = v->cam.width / 2, J.cy = v->cam.height / 2;
+    J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
+    if ((st = planes(p, &J)) != ATMOS_OK) return st;
+    const int W = out->width, C = out->channels, rows = r->y1 - r->y0;
+    int failed = 0, cancelled = 0, done = 0;
+#pragma omp parallel num_threads(atmos__threads(p->ctx))
+    {
+        double *f = malloc(sizeof(double) * (2 * MAX_INTERVALS + 2));
+        if (!f) {
+#pragma omp atomic write
+            failed = 1;
+        }
+        /* rows handed out dynamically; a pixel depends on its own ray alone, so the image is
+         * the same for any thread count */
+#pragma omp for schedule(dynamic, 1)
+        for (int y = r->y0; y < r->y1; y++) {
+            int stop;
+#pragma omp atomic read
+            stop = cancelled;
+            if (stop || !f) continue;
+            for (int x = r->x0; x < r->x1; x++) pixel(&J, x, y, out->pixels + ((size_t)y * W + x) * C, f);
+            int d;
+#pragma omp atomic capture
+            d = ++done;
+#ifdef _OPENMP
+            if (omp_get_thread_num() == 0)
+#endif
+            {
+                if (atmos__progress(p->ctx, "render beams", (double)d / rows)) {
+#pragma omp atomic write
+                    cancelled = 1;
+                }
+            }
+        }
+        free(f);
+    }
+    free(J.z_lo);
+    b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
+    if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
+    if (cancelled) return atmos__error(p->ctx, ATMOS_E_CANCELLED, "render beams: cancelled");
+    atmos__progress(p->ctx, "render beams", 1.0);
+    return ATMOS_OK;
+}

@@ -1,0 +1,427 @@
+/* The beam renderer (Dobashi et al. 2002 §4) against closed forms:
+ *   - the airlight of an isotropic point light in a homogeneous medium without shadows, the
+ *     single-scattering integral in Sun, Ramamoorthi, Narasimhan and Nayar 2005 (Eq. 7-8):
+ *       L = sigma_s I exp(-sigma d cos g) / (2 pi d sin g) [F(A1, xi_b) - F(A1, g / 2)],
+ *       A1 = sigma d sin g, F(a, xi) = int_0^xi exp(-a tan z) dz,
+ *     d the light's distance from the eye, g the angle between the ray and the light,
+ *     xi_b = pi/4 + atan((t_end - d cos g) / (d sin g)) / 2; F by Simpson's rule here;
+ *   - a shadow: a ray passing below a sphere lit from above loses exactly the light of the
+ *     segment inside the sphere's shadow cone (its ends solved from the cone's quadric);
+ *   - the same image with one thread and with two, byte for byte;
+ *   - the units of a light's spectrum (its intensity is the integral over 380-780 nm).
+ */
+#include "atmos/atmos.h"
+#include "render/beams_internal.h"
+#include "test.h"
+
+static atmos_context *ctx;
+
+/* F(a, xi) by composite Simpson's rule (n even intervals). */
+static double sun_F(double a, double xi)
+{
+    const int n = 20000;
+    const double h = xi / n;
+    double s = 0;
+    for (int i = 0; i <= n; i++) {
+        const double z = i * h, tz = tan(z);
+        const double f = z >= 0.5 * ATMOS_PI - 1e-12 ? 0 : exp(-a * tz);
+        s += f * (i == 0 || i == n ? 1 : i % 2 ? 4 : 2);
+    }
+    return s * h / 3;
+}
+
+/* Sun et al. 2005's airlight along [ta, tb] of the ray o + t dir (unit) from a light of
+ * intensity I at lp, per unit of I. */
+static double airlight(const double o[3], const double dir[3], const double lp[3], double sig_t, double sig_s,
+                       double ta, double tb)
+{
+    const double Lp[3] = {lp[0] - o[0], lp[1] - o[1], lp[2] - o[2]};
+    const double tq = Lp[0] * dir[0] + Lp[1] * dir[1] + Lp[2] * dir[2];
+    const double dd = sqrt(Lp[0] * Lp[0] + Lp[1] * Lp[1] + Lp[2] * Lp[2]);
+    const double v = sqrt(fmax(0, dd * dd - tq * tq));
+    const double xa = 0.25 * ATMOS_PI + 0.5 * atan((ta - tq) / v);
+    const double xb = isinf(tb) ? 0.5 * ATMOS_PI : 0.25 * ATMOS_PI + 0.5 * atan((tb - tq) / v);
+    return sig_s * exp(-sig_t * tq) / (2 * ATMOS_PI * v) * (sun_F(sig_t * v, xb) - sun_F(sig_t * v, xa));
+}
+
+static void base_scene(atmos_scene *s, int w, int h)
+{
+    atmos_scene_defaults(s);
+    s->renderer = ATMOS_RENDERER_BEAMS;
+    s->width = w, s->height = h;
+    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+    s->atmosphere.background_radiance = 0;
+    s->fog.enabled = 1;
+    s->fog.extinction_per_m = 0.05, s->fog.scattering_per_m = 0.04, s->fog.g = 0;
+    s->light_count = 1;
+    atmos_scene_light *l = &s->lights[0];
+    memset(l, 0, sizeof *l);
+    l->type = ATMOS_LIGHT_POINT;
+    l->intensity_w_sr = 400, l->colour[0] = l->colour[1] = l->colour[2] = 1; /* 1 W sr^-1 nm^-1 */
+    l->range_m = 2000;
+    l->direction[1] = -1;
+}
+
+static atmos_image *render(atmos_context *c, const atmos_scene *s)
+{
+    atmos_image *img = NULL;
+    const atmos_status st = atmos_render_scene(c, s, NULL, &img, NULL);
+    CHECK_MSG(st == ATMOS_OK, "render: %s", atmos_context_error(c));
+    return img;
+}
+
+static void test_airlight(void)
+{
+    atmos_scene s;
+    base_scene(&s, 40, 30);
+    const double eye[3] = {0, 2, 0}, lp[3] = {3, 4, -20};
+    memcpy(s.camera.position, eye, sizeof eye);
+    s.camera.look_at[0] = 1, s.camera.look_at[1] = 2.5, s.camera.look_at[2] = -10;
+    s.camera.fov_deg = 50;
+    memcpy(s.lights[0].position_m, lp, sizeof lp);
+    atmos_image *img = render(ctx, &s);
+    if (!img) return;
+    atmos_camera cam;
+    CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
+    double worst = 0, lo = INFINITY, hi = 0;
+    for (int y = 0; y < s.height; y++)
+        for (int x = 0; x < s.width; x++) {
+            double d[3];
+            atmos_camera_ray(&cam, x + 0.5, y + 0.5, d);
+            const double want = airlight(eye, d, lp, 0.05, 0.04, 0, INFINITY); /* x 1 W sr^-1 nm^-1 */
+            for (int k = 0; k < 3; k++) {
+                const double got = img->pixels[((size_t)y * s.width + x) * img->channels + k];
+                worst = fmax(worst, fabs(got / want - 1));
+            }
+            lo = fmin(lo, want), hi = fmax(hi, want);
+        }
+    printf("airlight: %dx%d pixels from %.4g to %.4g W m^-2 sr^-1 nm^-1, worst relative error %.2e\n", s.width,
+           s.height, lo, hi, worst);
+    CHECK_MSG(worst <= 1e-4, "the airlight is off Sun et al.'s closed form by %.3g", worst);
+    atmos_image_destroy(img);
+}
+
+/* The ends of the part of the ray o + t d (t > 0) inside the shadow cone of a sphere (centre
+ * c, radius r) lit from lp, beyond the sphere: |(P - lp) x a| <= sin(al) |P - lp|, a toward c. */
+static int shadow_span(const double o[3], const double d[3], const double lp[3], const double c[3], double r,
+                       double *ta, double *tb)
+{
+    double a[3], w[3];
+    const double dc = sqrt((c[0] - lp[0]) * (c[0] - lp[0]) + (c[1] - lp[1]) * (c[1] - lp[1]) + (c[2] - lp[2]) * (c[2] - lp[2]));
+    for (int k = 0; k < 3; k++) a[k] = (c[k] - lp[k]) / dc, w[k] = o[k] - lp[k];
+    const double cos2 = 1 - (r / dc) * (r / dc);
+    /* ((w + t d).a)^2 - cos2 |w + t d|^2 = 0 */
+    const double wa = w[0] * a[0] + w[1] * a[1] + w[2] * a[2], da = d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
+    const double ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2], wd = w[0] * d[0] + w[1] * d[1] + w[2] * d[2];
+    const double A = da * da - cos2, B = 2 * (wa * da - cos2 * wd), C = wa * wa - cos2 * ww;
+    const double disc = B * B - 4 * A * C;
+    if (disc <= 0) return 0;
+    double t1 = (-B - sqrt(disc)) / (2 * A), t2 = (-B + sqrt(disc)) / (2 * A);
+    if (t1 > t2) {
+        const double t = t1;
+        t1 = t2, t2 = t;
+    }
+    *ta = t1, *tb = t2;
+    return t2 > 0;
+}
+
+/* The light reaching the ray o + t d over [t0, t1] past the mesh itself (not the sphere it
+ * approximates): the lit and shadowed spans found by casting rays toward the light (2000
+ * steps, each change of visibility refined by bisection to 1e-12 m), the lit spans
+ * integrated by Sun et al.'s closed form. */
+static int lit(const atmos_mesh *m, const double o[3], const double d[3], const double lp[3], double t)
+{
+    const double p[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+    double w[3] = {lp[0] - p[0], lp[1] - p[1], lp[2] - p[2]};
+    const double r = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    for (int k = 0; k < 3; k++) w[k] /= r;
+    return !atmos_mesh_intersect(m, p, w, 0, r, NULL);
+}
+
+static double airlight_past_mesh(const atmos_mesh *m, const double o[3], const double d[3], const double lp[3], double t0,
+                                 double t1)
+{
+    const int n = 2000;
+    double sum = 0, a = t0;
+    int state = lit(m, o, d, lp, t0);
+    for (int i = 1; i <= n; i++) {
+        double b = t0 + (t1 - t0) * i / n;
+        const int sb = lit(m, o, d, lp, b);
+        if (sb != state || i == n) {
+            double lo = t0 + (t1 - t0) * (i - 1) / n, hi = b;
+            while (sb != state && hi - lo > 1e-12)
+                if (lit(m, o, d, lp, 0.5 * (lo + hi)) == state) lo = 0.5 * (lo + hi);
+                else hi = 0.5 * (lo + hi);
+            const double e = sb != state ? 0.5 * (lo + hi) : t1;
+            if (state) sum += airlight(o, d, lp, 0.05, 0.04, a, e);
+            a = e, state = sb;
+        }
+    }
+    return sum;
+}
+
+static void test_shadow(void)
+{
+    atmos_scene s;
+    base_scene(&s, 41, 3);
+    const double eye[3] = {-15, 2, 0.4}, lp[3] = {0, 10, 0}, c[3] = {0, 5, 0};
+    memcpy(s.camera.position, eye, sizeof eye);
+    s.camera.look_at[0] = 0, s.camera.look_at[1] = 2, s.camera.look_at[2] = 0.4;
+    s.camera.fov_deg = 1.4; /* about 19 degrees across */
+    memcpy(s.lights[0].position_m, lp, sizeof lp);
+    s.lights[0].range_m = 40;
+    s.object_count = 1;
+    atmos_scene_object *o = &s.objects[0];
+    memset(o, 0, sizeof *o);
+    snprintf(o->mesh, sizeof o->mesh, "builtin:sphere");
+    memcpy(o->position_m, c, sizeof c);
+    o->scale[0] = o->scale[1] = o->scale[2] = 1;
+    s.beams.shadow_size = 1024, s.beams.epsilon = 1e-3, s.beams.max_subplanes = 512, s.beams.plane_spacing_m = 0.25;
+    atmos_image *img = render(ctx, &s);
+    if (!img) return;
+    atmos_camera cam;
+    CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
+    double worst = 0, worst_part = 0, worst_mesh = 0, max_part = 0;
+    int shadowed = 0;
+    atmos_mesh *mesh = NULL;
+    atmos_mesh_transform tr;
+    atmos_mesh_transform_identity(&tr);
+    memcpy(tr.position_m, c, sizeof c);
+    CHECK_OK(atmos_mesh_load(ctx, "builtin:sphere", 0, &mesh));
+    if (mesh) CHECK_OK(atmos_mesh_apply_transform(ctx, mesh, &tr));
+    const double R = 40; /* the light's range: the renderer samples the air within it */
+    for (int x = 0; x < s.width; x++) {
+        double d[3], ta, tb;
+        atmos_camera_ray(&cam, x + 0.5, 1.5, d);
+        const double Lp[3] = {lp[0] - eye[0], lp[1] - eye[1], lp[2] - eye[2]};
+        const double tq = Lp[0] * d[0] + Lp[1] * d[1] + Lp[2] * d[2];
+        const double v2 = Lp[0] * Lp[0] + Lp[1] * Lp[1] + Lp[2] * Lp[2] - tq * tq, hh = sqrt(R * R - v2);
+        const double t0 = fmax(0, tq - hh), t1 = tq + hh;
+        double want = airlight(eye, d, lp, 0.05, 0.04, t0, t1), part = 0;
+        if (shadow_span(eye, d, lp, c, 1.0, &ta, &tb)) {
+            part = airlight(eye, d, lp, 0.05, 0.04, fmax(ta, t0), fmin(tb, t1));
+            want -= part;
+            shadowed++;
+        }
+        const double got = img->pixels[((size_t)1 * s.width + x) * img->channels + 1];
+        const double exact = mesh ? airlight_past_mesh(mesh, eye, d, lp, t0, t1) : want;
+        worst = fmax(worst, fabs(got / want - 1));
+        worst_mesh = fmax(worst_mesh, fabs(got / exact - 1));
+        max_part = fmax(max_part, part);
+        if (part > 0) worst_part = fmax(worst_part, fabs(got - want));
+        if (getenv("BEAMS_VERBOSE"))
+            printf("x %d part %.4g want %.6g mesh %.6g got %.6g rel %.2e %.2e\n", x, part, want, exact, got, got / want - 1,
+                   got / exact - 1);
+    }
+    worst_part /= max_part;
+    printf("shadow: %d of %d rays through the sphere's shadow; worst relative error against the mesh's own shadow "
+           "%.2e; against the sphere's %.2e of the pixel, %.2e of the most light a ray loses\n",
+           shadowed, s.width, worst_mesh, worst, worst_part);
+    CHECK(shadowed > s.width / 3);
+    /* against the mesh's own shadow, what is left is the shadow map's and the sub-planes'
+     * sampling and Eq. 6's product: within 1e-3 (epsilon) where the ray crosses the shadow,
+     * 3.5e-3 where it grazes the shadow cone (a 1024 map per cube face, 2 mrad texels; 2048
+     * gives 5.7e-4); the sphere's shadow differs besides by the tessellation (the polyhedron
+     * is inside the unit sphere by up to 2.4e-3, more at grazing rays) */
+    CHECK_MSG(worst_mesh <= 5e-3, "pixels are off the mesh's shadow by %.3g", worst_mesh);
+    CHECK_MSG(worst_part <= 0.03, "the shadowed light is off the sphere's by %.3g of the most a ray loses", worst_part);
+    atmos_mesh_destroy(mesh);
+    atmos_image_destroy(img);
+}
+
+/* A spotlight over a sphere and a floor, rendered with 1 and with 2 threads. */
+static void test_threads(void)
+{
+    atmos_scene s;
+    base_scene(&s, 48, 36);
+    s.camera.position[0] = 0, s.camera.position[1] = 6, s.camera.position[2] = 25;
+    s.camera.look_at[1] = 5;
+    s.lights[0].type = ATMOS_LIGHT_SPOT;
+    s.lights[0].position_m[1] = 20;
+    s.lights[0].cone_deg = 15, s.lights[0].edge_deg = 5;
+    s.lights[0].range_m = 40;
+    s.object_count = 2;
+    for (int i = 0; i < 2; i++) {
+        memset(&s.objects[i], 0, sizeof s.objects[i]);
+        s.objects[i].scale[0] = s.objects[i].scale[1] = s.objects[i].scale[2] = i ? 30 : 2;
+        s.objects[i].albedo[0] = s.objects[i].albedo[1] = s.objects[i].albedo[2] = 0.6;
+    }
+    snprintf(s.objects[0].mesh, sizeof s.objects[0].mesh, "builtin:sphere");
+    s.objects[0].position_m[1] = 5;
+    snprintf(s.objects[1].mesh, sizeof s.objects[1].mesh, "builtin:plane");
+    s.beams.shadow_size = 256;
+    atmos_image *img[2] = {NULL, NULL};
+    for (int t = 0; t < 2; t++) {
+        atmos_context_desc d;
+        memset(&d, 0, sizeof d);
+        d.threads = t + 1;
+        atmos_context *c = NULL;
+        CHECK_OK(atmos_context_create(&d, &c));
+        img[t] = render(c, &s);
+        atmos_context_destroy(c);
+    }
+    if (img[0] && img[1]) {
+        const size_t n = (size_t)s.width * s.height * img[0]->channels;
+        CHECK_MSG(!memcmp(img[0]->pixels, img[1]->pixels, n * sizeof(float)), "1 and 2 threads differ");
+        /* and the picture has what Fig. 4 has: a lit floor, a shadow below the sphere, a beam */
+        const float *p = img[0]->pixels;
+        double sum = 0;
+        for (size_t i = 0; i < n; i++) sum += p[i];
+        CHECK(sum > 0);
+    }
+    atmos_image_destroy(img[0]);
+    atmos_image_destroy(img[1]);
+}
+
+/* The Fig. 4 scene file, smaller: the picture has what the figure has. And objects from OBJ
+ * files named relative to the scene's folder: a good one renders, a broken one is an error
+ * naming the file. */
+static void test_scene_files(void)
+{
+    const char *src = getenv("ATMOS_SOURCE_DIR");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/dobashi_fig04_spotlight.json", src && *src ? src : ".");
+    atmos_scene s;
+    CHECK_OK(atmos_scene_load(ctx, path, &s));
+    s.width = 60, s.height = 90;
+    atmos_image *img = render(ctx, &s);
+    if (img) {
+        atmos_camera cam;
+        CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
+        /* the pixels looking at the sphere's lit top, through its shadow below, at the lit floor */
+        const double top[3] = {0, 9.4, 0}, under[3] = {0, 4, 0}, floor_lit[3] = {5.5, 0, 0}, floor_dark[3] = {0, 0, 0};
+        const double *pts[4] = {top, under, floor_lit, floor_dark};
+        double val[4];
+        for (int i = 0; i < 4; i++) {
+            double d[3], best = -1;
+            int bx = 0, by = 0;
+            for (int y = 0; y < s.height; y++)
+                for (int x = 0; x < s.width; x++) { /* the pixel whose ray passes nearest the point */
+                    atmos_camera_ray(&cam, x + 0.5, y + 0.5, d);
+                    double w[3], t = 0;
+                    for (int k = 0; k < 3; k++) w[k] = pts[i][k] - s.camera.position[k], t += w[k] * d[k];
+                    double e = 0;
+                    for (int k = 0; k < 3; k++) e += (w[k] - t * d[k]) * (w[k] - t * d[k]);
+                    if (best < 0 || e < best) best = e, bx = x, by = y;
+                }
+            val[i] = img->pixels[((size_t)by * s.width + bx) * img->channels + 1];
+        }
+        printf("fig04: sphere top %.4g, the air below it %.4g, lit floor %.4g, its shadow %.4g\n", val[0], val[1], val[2],
+               val[3]);
+        CHECK(val[0] > 2 * val[1] && val[2] > 3 * val[3] && val[1] > 0);
+        atmos_image_destroy(img);
+    }
+    char obj[1024], scene[1024];
+    test_tmp_path(obj, sizeof obj, "tri.obj");
+    FILE *f = fopen(obj, "wb");
+    if (f) fputs("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 3 2\n", f), fclose(f);
+    const char *text = "{\"renderer\": \"beams\", \"image\": {\"width\": 16, \"height\": 12}, \"background\": \"black\","
+                       " \"camera\": {\"position_m\": [0, 3, 6], \"look_at_m\": [0, 0, 0]},"
+                       " \"fog\": {\"extinction_per_m\": 0.1}, \"lights\": [{\"position_m\": [0, 4, 0]}],"
+                       " \"objects\": [{\"mesh\": \"%s\", \"scale\": 2}]}";
+    for (int broken = 0; broken < 2; broken++) {
+        test_tmp_path(scene, sizeof scene, broken ? "broken_scene.json" : "obj_scene.json");
+        f = fopen(scene, "wb");
+        if (f) fprintf(f, text, broken ? "nothing_here.obj" : "tri.obj"), fclose(f);
+        CHECK_OK(atmos_scene_load(ctx, scene, &s));
+        atmos_image *im = NULL;
+        const atmos_status st = atmos_render_scene(ctx, &s, NULL, &im, NULL);
+        if (broken)
+            CHECK_MSG(st == ATMOS_E_IO && strstr(atmos_context_error(ctx), "nothing_here.obj"), "broken OBJ: %s",
+                      atmos_context_error(ctx));
+        else
+            CHECK_MSG(st == ATMOS_OK && im && im->pixels[((size_t)6 * 16 + 8) * im->channels + 1] > 0, "OBJ scene: %s",
+                      atmos_context_error(ctx));
+        atmos_image_destroy(im);
+    }
+}
+
+/* Valid scenes at the ends of the ranges render, with finite pixels (the plan refuses a NaN or
+ * an infinity), and nothing negative. */
+static void test_extremes(void)
+{
+    for (int c = 0; c < 8; c++) {
+        atmos_scene s;
+        base_scene(&s, 16, 12);
+        s.camera.position[0] = 0, s.camera.position[1] = 2, s.camera.position[2] = 10;
+        s.camera.look_at[1] = 2;
+        atmos_scene_light *l = &s.lights[0];
+        l->position_m[1] = 4;
+        s.object_count = 1;
+        atmos_scene_object *o = &s.objects[0];
+        memset(o, 0, sizeof *o);
+        snprintf(o->mesh, sizeof o->mesh, "builtin:sphere");
+        o->position_m[1] = 2, o->scale[0] = o->scale[1] = o->scale[2] = 1, o->albedo[0] = o->albedo[1] = o->albedo[2] = 1;
+        switch (c) {
+        case 0: l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 0, l->edge_deg = 0; break; /* a beam of no width */
+        case 1: l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 89, l->edge_deg = 1; break; /* a half space: cube map */
+        case 2: memcpy(l->position_m, s.camera.position, sizeof l->position_m); break; /* at the eye */
+        case 3: l->position_m[1] = 2; break;                                           /* inside the sphere */
+        case 4: s.fog.extinction_per_m = s.fog.scattering_per_m = 10, l->range_m = 1e6; break;
+        case 5: s.fog.extinction_per_m = s.fog.scattering_per_m = 1e-9, l->range_m = 1e6; break;
+        case 6: s.fog.g = 0.999, l->intensity_w_sr = 1e9; break;
+        case 7: s.fog.enabled = 0; break; /* no fog: the lit sphere alone */
+        }
+        atmos_image *img = NULL;
+        const atmos_status st = atmos_render_scene(ctx, &s, NULL, &img, NULL);
+        CHECK_MSG(st == ATMOS_OK, "extreme case %d: %s", c, atmos_context_error(ctx));
+        int negative = 0;
+        for (size_t i = 0; img && i < (size_t)s.width * s.height * img->channels; i++) negative += img->pixels[i] < 0;
+        CHECK_MSG(negative == 0, "extreme case %d: %d negative values", c, negative);
+        atmos_image_destroy(img);
+    }
+}
+
+/* A progress callback that asks to stop once the beams are being drawn. */
+static int stop_beams(void *user, const char *stage, double fraction)
+{
+    (void)fraction;
+    if (strcmp(stage, "render beams")) return 0;
+    ++*(int *)user;
+    return 1;
+}
+
+static void test_cancel(void)
+{
+    atmos_scene s;
+    base_scene(&s, 32, 24);
+    s.lights[0].position_m[2] = -20;
+    atmos_context_desc d;
+    memset(&d, 0, sizeof d);
+    int calls = 0;
+    d.progress = stop_beams, d.progress_user = &calls;
+    d.threads = 1; /* progress comes from the calling thread: with one, from the first row on */
+    atmos_context *c = NULL;
+    CHECK_OK(atmos_context_create(&d, &c));
+    atmos_image *img = NULL;
+    const atmos_status st = atmos_render_scene(c, &s, NULL, &img, NULL);
+    CHECK_MSG(st == ATMOS_E_CANCELLED && calls >= 1 && !img, "%s, %d calls: %s", atmos_status_string(st), calls, atmos_context_error(c));
+    atmos_image_destroy(img);
+    atmos_context_destroy(c);
+}
+
+static void test_spectrum(void)
+{
+    atmos_scene_light l;
+    memset(&l, 0, sizeof l);
+    l.intensity_w_sr = 250, l.colour_temperature_k = 3200;
+    atmos_wavelengths wl;
+    CHECK_OK(atmos_wavelengths_spectral(40, &wl));
+    double sum = 0;
+    for (int k = 0; k < wl.count; k++) sum += atmos__beams_spectrum(&l, &wl, k) * wl.width_nm[k];
+    CHECK_REL(sum, 250, 2e-3);
+}
+
+int main(void)
+{
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    test_spectrum();
+    test_airlight();
+    test_shadow();
+    test_threads();
+    test_scene_files();
+    test_cancel();
+    test_extremes();
+    atmos_context_destroy(ctx);
+    return test_summary("test_beams");
+}

@@ -1,0 +1,90 @@
+/* atmos bench beams: the beam renderer's frame rate (Dobashi et al. 2002 §4, docs/beams.md)
+ * on the Fig. 4 scene (a sphere under a spotlight, 300x450) and on variants of it: without
+ * sub-planes (at the scene's plane spacing, 0.3 m and 0.1 m), with a coarser epsilon, with two
+ * and four lights (the spot copied around the first), and at twice the size. Each case makes one plan (objects, shadow maps, the scattering table) and renders
+ * frames with the camera moving round the sphere (a degree a frame): what interactive use
+ * pays per frame. */
+#include "bench_beams.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct beams_case {
+    const char *name;
+    int lights, scale, subplanes;
+    double spacing_m, epsilon; /* 0: the scene's */
+} beams_case;
+
+static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_case *c, int frames, int threads)
+{
+    atmos_scene s = *base;
+    s.width *= c->scale, s.height *= c->scale;
+    if (!c->subplanes) s.beams.max_subplanes = 1;
+    if (c->spacing_m > 0) s.beams.plane_spacing_m = c->spacing_m;
+    if (c->epsilon > 0) s.beams.epsilon = c->epsilon;
+    for (int i = 1; i < c->lights && i < ATMOS_SCENE_MAX_LIGHTS; i++) { /* copies of the first, round it */
+        s.lights[i] = s.lights[0];
+        s.lights[i].position_m[0] += 6 * cos(2 * 3.14159265358979 * i / c->lights);
+        s.lights[i].position_m[2] += 6 * sin(2 * 3.14159265358979 * i / c->lights);
+    }
+    if (c->lights > s.light_count) s.light_count = c->lights;
+    atmos_plan *plan = NULL;
+    atmos_frame f;
+    atmos_image *img = NULL;
+    double t0 = cli_now_s();
+    atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
+    const double plan_s = cli_now_s() - t0;
+    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &s, &f);
+    if (st == ATMOS_OK) st = atmos_plan_image_create(plan, &f, &img);
+    double total = 0, best = 1e30, cpu = 0;
+    for (int i = 0; st == ATMOS_OK && i < frames; i++) {
+        atmos_frame_orbit(&f, plan, 1.0);
+        t0 = cli_now_s();
+        const clock_t c0 = clock();
+        st = atmos_plan_render(plan, &f, NULL, img, NULL);
+        const double t = cli_now_s() - t0;
+        cpu += (double)(clock() - c0) / CLOCKS_PER_SEC;
+        total += t, best = t < best ? t : best;
+    }
+    int rc = CLI_EXIT_OK;
+    if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
+    else
+        printf("bench=beams scene=%s size=%dx%d lights=%d subplanes=%s plane_spacing_m=%g epsilon=%g threads=%d frames=%d "
+               "plan_seconds=%.3f frame_ms=%.1f best_ms=%.1f cpu_ms=%.1f fps=%.1f\n",
+               c->name, s.width, s.height, s.light_count, c->subplanes ? "on" : "off", s.beams.plane_spacing_m,
+               s.beams.epsilon, threads, frames, plan_s, 1e3 * total / frames, 1e3 * best, 1e3 * cpu / frames,
+               frames / total);
+    fflush(stdout);
+    atmos_image_destroy(img);
+    atmos_plan_destroy(plan);
+    return rc;
+}
+
+int bench_beams(const char *file, int frames, int threads)
+{
+    const char *path = file ? file : "scenes/dobashi_fig04_spotlight.json";
+    atmos_context *ctx = cli_context(threads, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_scene s;
+    atmos_status st = atmos_scene_load(ctx, path, &s);
+    if (st == ATMOS_OK && s.renderer != ATMOS_RENDERER_BEAMS)
+        st = ATMOS_E_INVALID_ARG, fprintf(stderr, "atmos bench: %s: not a beams scene\n", path);
+    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error("bench", ctx, st);
+    static const beams_case cases[] = {
+        {"dobashi_fig04", 1, 1, 1, 0, 0},
+        {"dobashi_fig04_no_subplanes", 1, 1, 0, 0, 0},
+        {"dobashi_fig04_no_subplanes_0.3m", 1, 1, 0, 0.3, 0},
+        {"dobashi_fig04_no_subplanes_0.1m", 1, 1, 0, 0.1, 0},
+        {"dobashi_fig04_epsilon_0.03", 1, 1, 1, 0, 0.03},
+        {"dobashi_fig04_2_lights", 2, 1, 1, 0, 0},
+        {"dobashi_fig04_4_lights", 4, 1, 1, 0, 0},
+        {"dobashi_fig04_double_size", 1, 2, 1, 0, 0},
+    };
+    const int used = atmos_context_threads(ctx);
+    for (size_t i = 0; rc == CLI_EXIT_OK && i < sizeof cases / sizeof *cases; i++)
+        rc = run_case(ctx, &s, &cases[i], frames, used);
+    atmos_context_destroy(ctx);
+    return rc;
+}
