@@ -7,6 +7,8 @@
 #ifndef ATMOS_MESH_H
 #define ATMOS_MESH_H
 
+#include "atmos/base.h"
+
 #include <stdint.h>
 
 #ifdef __cplusplus

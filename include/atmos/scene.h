@@ -331,6 +331,17 @@ ATMOS_API void atmos_scene_volume_offset(const atmos_scene *scene, const atmos_v
 ATMOS_API void atmos_scene_frame_volume(atmos_scene *scene, const atmos_volume *volume, const double offset_m[3],
                                         double view_elevation_deg);
 
+/* The rule `atmos render` follows for a scene that names a volume file (not a generator)
+ * and gives no camera, with a pinhole camera and a renderer other than the sky: the volume
+ * is loaded into *out and placed (scene->volume.position_m made explicit, placed = 1), and
+ * the camera frames it (atmos_scene_frame_volume) from view_elevation_deg, NAN for the
+ * default: from 30 degrees above for a model domain (NetCDF), level for a cloud; the scene
+ * then counts as having a camera. Render with the volume (atmos_render_scene,
+ * atmos_plan_create) to draw it where it was framed. *out is NULL (and the scene unchanged)
+ * when there is nothing to frame; the caller destroys it. */
+ATMOS_API atmos_status atmos_scene_frame_volume_file(atmos_context *ctx, atmos_scene *scene, double view_elevation_deg,
+                                                     atmos_volume **out);
+
 /* Frame index (0-based, < the frame count) of the scene's animation: *out is the scene
  * with the sun moved as atmos_scene_animation describes and no animation left in it.
  * A scene without an animation has one frame, itself. ATMOS_E_INVALID_ARG for an index

@@ -19,6 +19,7 @@ CDEF = r"""
 typedef enum { ATMOS_OK = 0, ATMOS_E_INVALID_ARG, ATMOS_E_NOMEM, ATMOS_E_IO, ATMOS_E_FORMAT,
                ATMOS_E_UNSUPPORTED, ATMOS_E_LIMIT, ATMOS_E_CANCELLED } atmos_status;
 typedef struct atmos_context atmos_context;
+typedef struct atmos_volume atmos_volume;
 typedef struct atmos_context_desc { int threads; const char *cache_dir; ...; } atmos_context_desc;
 const char *atmos_version(void);
 const char *atmos_status_string(atmos_status status);
@@ -56,11 +57,12 @@ atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t
                                     const char *const *overrides, int count, atmos_scene *out);
 atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const char *const *overrides, int count,
                                    atmos_scene *out);
+atmos_status atmos_scene_frame_volume_file(atmos_context *ctx, atmos_scene *scene, double view_elevation_deg,
+                                           atmos_volume **out);
 atmos_status atmos_scene_wavelengths(atmos_context *ctx, const atmos_scene *scene, atmos_wavelengths *out);
 atmos_status atmos_scene_sun_direction(atmos_context *ctx, const atmos_scene *scene, double dir[3],
                                        double *elevation_deg, double *azimuth_deg);
 
-typedef struct atmos_volume atmos_volume;
 typedef struct atmos_volume_desc { int dims[3]; double voxel_size_m; double origin_m[3]; ...; } atmos_volume_desc;
 atmos_status atmos_volume_create(atmos_context *ctx, const atmos_volume_desc *desc, atmos_volume **out);
 void atmos_volume_destroy(atmos_volume *vol);

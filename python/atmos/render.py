@@ -32,15 +32,24 @@ def render(scene: Scene | None = None, volume=None, **kw) -> Image:
             return plan.render()
     ctx = context()
     s = scene._struct()
+    framed = _frame(ctx, s)
     spec = ffi.new("atmos_image **")
     info = ffi.new("atmos_render_info *")
-    check(lib.atmos_render_scene(ctx, s, ffi.NULL, spec, info), ctx)
+    check(lib.atmos_render_scene(ctx, s, framed if framed is not None else ffi.NULL, spec, info), ctx)
     spec_img = ffi.gc(spec[0], lib.atmos_image_destroy)
     wl = ffi.new("atmos_wavelengths *")
     check(lib.atmos_scene_wavelengths(ctx, s, wl), ctx)
     rgb = _to_srgb(ctx, spec_img, wl)
     ffi.release(spec_img)
     return Image(rgb, _info(info))
+
+
+def _frame(ctx, s):
+    """A scene naming a volume file and no camera is framed as `atmos render` frames it
+    (atmos_scene_frame_volume_file): the loaded volume, or None when there was nothing to frame."""
+    vol = ffi.new("atmos_volume **")
+    check(lib.atmos_scene_frame_volume_file(ctx, s, float("nan"), vol), ctx)
+    return ffi.gc(vol[0], lib.atmos_volume_destroy) if vol[0] != ffi.NULL else None
 
 
 def _scene_for_volume(scene: Scene) -> Scene:
@@ -74,9 +83,10 @@ class Plan:
             desc = ffi.new("atmos_plan_desc *")
             desc.offset_given = 1  # the volume stays where its origin puts it
         self._scene = scene._struct()
-        self._volume = volume  # borrowed by the plan: kept alive with it
+        vptr = volume._ptr if volume is not None else _frame(ctx, self._scene)
+        self._volume = vptr  # borrowed by the plan: kept alive with it
         p = ffi.new("atmos_plan **")
-        check(lib.atmos_plan_create(ctx, self._scene, volume._ptr if volume is not None else ffi.NULL, desc, p), ctx)
+        check(lib.atmos_plan_create(ctx, self._scene, vptr if vptr is not None else ffi.NULL, desc, p), ctx)
         self._ptr = ffi.gc(p[0], lib.atmos_plan_destroy)
         self._frame = ffi.new("atmos_frame *")
         check(lib.atmos_frame_from_scene(ctx, self._scene, self._frame), ctx)

@@ -225,3 +225,21 @@ def test_cli_exr_layers_and_metadata(tmp_path):
     bad = subprocess.run([CLI, "render", scene, "--width", "8", "--height", "6", "--exr", str(exr), "--exr-layers", "nope"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "nope" in bad.stderr
+
+
+def test_volume_file_without_camera_is_framed_as_the_cli_frames_it(tmp_path):
+    vol = tmp_path / "cu.json"
+    subprocess.run([CLI, "volume", "generate", "cumulus", "-o", str(vol), "--voxel-size", "60"], check=True,
+                   capture_output=True)
+    scene_path = tmp_path / "s.json"
+    scene_path.write_text('{"image": {"width": 48, "height": 32}, "volume": {"file": "cu.json"}}')
+    pfm = tmp_path / "cli.pfm"
+    subprocess.run([CLI, "render", str(scene_path), "-q", "--pfm", str(pfm), "-o", str(tmp_path / "c.png")], check=True,
+                   capture_output=True)
+    scene = atmos.Scene.load(scene_path)
+    a = np.asarray(atmos.render(scene))
+    cli = read_pfm(pfm)
+    assert np.array_equal(a[..., :3], cli)
+    assert a[16, 24, 3] > 0.5  # the cloud is in the middle of the frame
+    with atmos.Plan(scene) as plan:
+        assert np.array_equal(np.asarray(plan.render())[..., :3], cli)

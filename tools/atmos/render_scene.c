@@ -38,29 +38,18 @@ static int looks_like_volume(const char *path)
     return n >= 8 && !memcmp(b, "\x89HDF\r\n\x1a\n", 8);
 }
 
-/* A volume file with no camera given: loaded and placed here, the camera framing it. */
+/* A volume file with no camera given: framed as atmos_scene_frame_volume_file frames it, and said. */
 static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
 {
-    double off[3], lo[3], hi[3];
-    atmos_status st = atmos_scene_load_volume(ctx, scene, volume, off);
-    if (st != ATMOS_OK) return st;
+    atmos_status st = atmos_scene_frame_volume_file(ctx, scene, o->view_el, volume);
+    if (st != ATMOS_OK || !*volume || o->quiet) return st;
+    double lo[3], hi[3];
     atmos_volume_bounds(*volume, lo, hi);
-    /* The placement made explicit, so that the plan puts the volume where it was framed. */
-    scene->volume.placed = 1;
-    scene->volume.position_m[0] = off[0] + 0.5 * (lo[0] + hi[0]);
-    scene->volume.position_m[1] = off[1] + lo[1];
-    scene->volume.position_m[2] = off[2] + 0.5 * (lo[2] + hi[2]);
-    /* A model domain is wide and flat: seen from above; a cloud from its own height. */
-    const int model = !strcmp(atmos_volume_source_format(*volume), "netcdf");
-    const double el = !isnan(o->view_el) ? o->view_el : model ? -30.0 : 0.0;
-    atmos_scene_frame_volume(scene, *volume, off, el);
-    if (!o->quiet) {
-        const double *p = scene->camera.position, *l = scene->camera.look_at;
-        fprintf(stderr,
-                "atmos render: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
-                "looking at (%.0f, %.0f, %.0f) m\n",
-                hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
-    }
+    const double *p = scene->camera.position, *l = scene->camera.look_at;
+    fprintf(stderr,
+            "atmos render: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
+            "looking at (%.0f, %.0f, %.0f) m\n",
+            hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
     return ATMOS_OK;
 }
 
@@ -93,11 +82,8 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
         return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
     }
-    const int file = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) != 0;
-    if (file && scene->renderer != ATMOS_RENDERER_SKY && !scene->camera_given && !render_opts_camera_given(o) &&
-        scene->camera.type == ATMOS_CAMERA_PINHOLE) {
-        if ((st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK) return cli_runtime_error("render", ctx, st);
-    }
+    if (!render_opts_camera_given(o) && (st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK)
+        return cli_runtime_error("render", ctx, st);
     return CLI_EXIT_OK;
 }
 
