@@ -83,9 +83,12 @@ const char *const *atmos__pcloud_generator_names(void);
 /* Makes a preset's particles (one "cloud" field of droplets; world positions as a generated
  * volume's: about x = z = 0, the bases at 1.5 km times scale); same seed, same particles. scale multiplies the extent (0:
  * 1). *voxel_m: the grid spacing for atmos__pcloud_to_volume (half the finest particle spacing,
- * at most 640 voxels across: a field's grid blurs its smallest clouds). */
+ * at most 640 voxels across: a field's grid blurs its smallest clouds). spacing_m > 0: the
+ * particles' lattice edge in every cloud (0: the preset's, 1/24 of the cumulus's width, 1/16 of
+ * each of the field's clouds'; a given spacing leaves a field's clouds in other places than the
+ * preset's, the same for every spacing). */
 atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint64_t seed, double scale,
-                                    atmos__pcloud *out, double *voxel_m);
+                                    double spacing_m, atmos__pcloud *out, double *voxel_m);
 
 /* ---- pcluster.c: the clouds of a particle set (what Harris's impostors are made of) */
 typedef struct atmos__pclusters {

@@ -273,8 +273,8 @@ static void generated(void)
 {
     atmos__pcloud a, b;
     double va, vb;
-    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, &a, &va));
-    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, &b, &vb));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, 0.0, &a, &va));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, 0.0, &b, &vb));
     CHECK(a.n == b.n && a.n > 50000 && va == vb);
     CHECK(a.n == b.n && !memcmp(a.x, b.x, sizeof(float) * (size_t)a.n) && !memcmp(a.n0, b.n0, sizeof(float) * (size_t)a.n));
     atmos__pclusters cl;
@@ -288,7 +288,7 @@ static void generated(void)
     gd.seed = 2;
     atmos_volume *v = NULL;
     CHECK_OK(atmos_scene_generate_volume(NULL, "harris_cumulus", &gd, &v));
-    CHECK_OK(atmos__pcloud_generate(NULL, "harris_cumulus", 2, 1.0, &b, &vb));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_cumulus", 2, 1.0, 0.0, &b, &vb));
     double mass = 0, want = 0, lo[3], hi[3];
     for (int p = 0; p < b.n; p++) want += b.n0[p] * 0.9707091134651118 * 15.749609945722419 * pow(b.s[p], 3);
     atmos_volume_bounds(v, lo, hi);
@@ -300,6 +300,17 @@ static void generated(void)
             }
     printf("harris_cumulus: %d particles, grid mass %.5g of %.5g\n", b.n, mass, want);
     CHECK_REL(mass, want, 0.02);
+    /* a given spacing (the scene's "harris": {"spacing_m"}) samples the same cloud finer: about
+     * 8 times the particles at half the preset's spacing (1100 m / 24), the same droplets */
+    atmos__pcloud fine;
+    double vf, fine_mass = 0;
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_cumulus", 2, 1.0, 0.5 * 1100.0 / 24.0, &fine, &vf));
+    for (int p = 0; p < fine.n; p++) fine_mass += fine.n0[p] * 0.9707091134651118 * 15.749609945722419 * pow(fine.s[p], 3);
+    printf("harris_cumulus at half the spacing: %d particles (%.2f times), mass %.5g of %.5g\n", fine.n,
+           (double)fine.n / b.n, fine_mass, want);
+    CHECK(fine.n > 7 * b.n && fine.n < 9 * b.n);
+    CHECK_REL(fine_mass, want, 0.03);
+    atmos__pcloud_free(&fine);
     int known = 0;
     for (const char *const *n = atmos_scene_generator_names(); *n; n++) known += !strcmp(*n, "harris_field") + !strcmp(*n, "cumulus");
     CHECK(known == 2);
