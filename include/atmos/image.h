@@ -69,6 +69,13 @@ ATMOS_API double atmos_tonemap_scale(const atmos_image *img, const atmos_tonemap
  * it. Rows are processed on atmos_context_threads(ctx) threads. */
 ATMOS_API atmos_status atmos_tonemap(atmos_context *ctx, const atmos_image *linear,
                                      const atmos_tonemap_desc *desc, atmos_image **out);
+/* atmos_tonemap into an existing image out of the input's size and channels (no metadata
+ * copied): a viewer's frame without allocating one. The curve and the exposure are applied in
+ * single precision, the sRGB transfer function from a table: within 4e-6 of the curve and the
+ * transfer function in double precision (a quarter of a 16-bit PNG's level; atmos_tonemap is
+ * the same). */
+ATMOS_API atmos_status atmos_tonemap_into(atmos_context *ctx, const atmos_image *linear,
+                                          const atmos_tonemap_desc *desc, atmos_image *out);
 
 /* The sRGB transfer function (IEC 61966-2-1) and its inverse. NaN gives 0. */
 ATMOS_API double atmos_srgb_encode(double linear);
