@@ -211,6 +211,9 @@ ATMOS_API atmos_status atmos_image_compare_binned_matched(atmos_context *ctx, co
  * channels), scaled so that Y is luminance in cd m^-2. Metadata is copied. */
 ATMOS_API atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral,
                                            const atmos_wavelengths *wl, atmos_image **out);
+/* The same into an existing 4-channel image of the input's size (no metadata copied). */
+ATMOS_API atmos_status atmos_image_to_srgb_into(atmos_context *ctx, const atmos_image *spectral,
+                                                const atmos_wavelengths *wl, atmos_image *rgb);
 
 #ifdef __cplusplus
 }

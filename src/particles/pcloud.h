@@ -181,11 +181,13 @@ int atmos__pimpostor_serves(const atmos__pimpostor *im, const double c[3], doubl
 atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
                                    const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
                                    const double c[3], double r, const double e[3], int res);
-/* Draws im over img seen by cam within rect: each pixel's ray meets the impostor's plane
- * (through c, facing im's view), the texture is read there (bilinear), and the pixel becomes
- * pixel (1 - coverage) + colour. */
-void atmos__pimpostor_draw(atmos_context *ctx, const atmos__pimpostor *im, const double c[3], double r,
-                           const atmos_camera *cam, const int rect[4], atmos_image *img);
+/* Draws the impostors ims[0..n) in that order (far to near; cloud q's centre c[q], radius r[q])
+ * over img seen by cam within rect: each pixel's ray meets an impostor's plane (through its
+ * cloud's centre, facing its view), the texture is read there (bilinear), and the pixel
+ * becomes pixel (1 - coverage) + colour. One pass over the rows on the threads for up to 64
+ * impostors. */
+void atmos__pimpostor_draw(atmos_context *ctx, int n, const atmos__pimpostor *const *ims, const double *const *c,
+                           const double *r, const atmos_camera *cam, const int rect[4], atmos_image *img);
 void atmos__pimpostor_free(atmos__pimpostor *im);
 /* Harris §3.1, the head in the clouds: the particles idx[0..nidx) splatted into an image of
  * 1/factor of cam's pixels per axis (the same view), then laid over img within rect, read

@@ -235,9 +235,11 @@ static void impostors(void)
     const double f = 160 / (2 * tan(10 * 3.141592653589793 / 180));
     atmos__pimpostor im;
     memset(&im, 0, sizeof im);
+    const atmos__pimpostor *one = &im;
+    const double *cc = cl.centre[0];
     const int res = atmos__pimpostor_res(cl.radius[0], 6000, f, 512);
     CHECK_OK(atmos__pimpostor_make(NULL, &im, &pc, &o, &L, idx, nidx, cl.centre[0], cl.radius[0], eye, res));
-    atmos__pimpostor_draw(NULL, &im, cl.centre[0], cl.radius[0], &cam, rect, imp);
+    atmos__pimpostor_draw(NULL, 1, &one, &cc, cl.radius, &cam, rect, imp);
     const double e0 = rel_rms(imp, direct);
     /* the eye 0.5 degree round the cloud: the stale impostor against the direct splats */
     double eye2[3];
@@ -248,7 +250,7 @@ static void impostors(void)
     CHECK_OK(atmos_camera_init(NULL, &cd, 160, 160, &cam));
     memset(direct->pixels, 0, sizeof(float) * 160 * 160 * 2), memset(imp->pixels, 0, sizeof(float) * 160 * 160 * 2);
     CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L, idx, nidx, &cam, rect, direct, NULL));
-    atmos__pimpostor_draw(NULL, &im, cl.centre[0], cl.radius[0], &cam, rect, imp);
+    atmos__pimpostor_draw(NULL, 1, &one, &cc, cl.radius, &cam, rect, imp);
     const double e05 = rel_rms(imp, direct);
     printf("impostor: %d texels, rel rms against the splats %.4f where made, %.4f 0.5 degree round\n", res, e0, e05);
     CHECK(e0 < 0.03);
