@@ -82,7 +82,8 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
  * u: b^2 = (a0 + a1 u + a2 u^2) / (e0 + e1 u + e2 u^2), the coefficients once per row (double:
  * a0 is |rel|^2 |d|^2, b^2 a small difference). The row's column depths go through a
  * branch-free loop first (vectorised), then the pixels inside the cut are composited. */
-static void draw(const sp *q, int nw, const atmos_camera *cam, int tx, int ty, atmos_image *img)
+__attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, int nw, const atmos_camera *cam, int tx,
+                                                                    int ty, atmos_image *img)
 {
     const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
     const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
@@ -94,8 +95,8 @@ static void draw(const sp *q, int nw, const atmos_camera *cam, int tx, int ty, a
     cross(rel, R, Q);
     const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, u0 = (2.0 * x0 + 1.0 - W) / H * t;
     const int C = img->channels, n = x1 - x0;
+    double b2[TILE];
     float g[TILE];
-    int in[TILE];
     for (int y = y0; y < y1; y++) {
         const double v = (H - 2.0 * (y + 0.5)) / H * t;
         double D[3], P[3];
@@ -103,13 +104,13 @@ static void draw(const sp *q, int nw, const atmos_camera *cam, int tx, int ty, a
         cross(rel, D, P);
         const double a0 = dot(P, P), a1 = 2.0 * dot(P, Q), e0 = dot(D, D), e1 = 2.0 * dot(D, R);
         for (int j = 0; j < n; j++) {
-            const double u = u0 + j * du, b2 = (a0 + u * (a1 + u * a2)) / (e0 + u * (e1 + u * e2));
-            in[j] = b2 <= rc2;
-            g[j] = atmos__pcloud_column((float)(b2 * k2));
+            const double u = u0 + j * du;
+            b2[j] = (a0 + u * (a1 + u * a2)) / (e0 + u * (e1 + u * e2));
         }
+        for (int j = 0; j < n; j++) g[j] = atmos__pcloud_column((float)(b2[j] * k2));
         float *row = img->pixels + ((size_t)y * cam->width + x0) * C;
         for (int j = 0; j < n; j++) {
-            if (!in[j]) continue;
+            if (b2[j] > rc2) continue;
             float *px = row + (size_t)j * C, tm = 0;
             for (int k = 0; k < nw; k++) {
                 const float T = atmos__expf_fast(-q->tc[k] * g[j]);
