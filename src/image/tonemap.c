@@ -102,23 +102,36 @@ static inline __attribute__((always_inline)) float curve_of(atmos_tone_curve cur
     return y < 1.0f ? y : 1.0f;
 }
 
-/* Pixels [0, n) of src (C = 3 or 4 channels) to display values in dst: scale, the curve per
- * channel (it desaturates very bright colours towards white, as film does the sun's disk),
- * the sRGB transfer function; alpha clamped to [0, 1]. Inlined per curve: no branch on the
- * curve in the loop. */
-static inline __attribute__((always_inline)) void map_pixels(atmos_tone_curve curve, const float *src, float *dst,
-                                                             size_t n, int C, float scale, const float *enc)
+/* Values [0, n) of src to display values in dst: scale, the curve (per channel: it desaturates
+ * very bright colours towards white, as film does the sun's disk), the sRGB transfer function.
+ * Inlined per curve: no branch on the curve in the loop (alpha is mapped too and set right
+ * afterwards). GCC 12 does not vectorise it: the table read is a gather it will not if-convert
+ * without -ffast-math. */
+static inline __attribute__((always_inline)) void map_values(atmos_tone_curve curve, const float *src, float *dst,
+                                                             size_t n, float scale, const float *enc)
 {
-    for (size_t p = 0; p < n; p++, src += C, dst += C) {
-        for (int c = 0; c < 3; c++) {
-            const float x = src[c] > 0 ? src[c] * scale : 0.0f; /* NaN and negatives: 0 */
-            const float v = curve_of(curve, x) * SRGB_LUT;
-            const int i = (int)v;
-            const float e = enc[i] + (v - (float)i) * (enc[i + 1] - enc[i]);
-            dst[c] = e < 1.0f ? e : 1.0f;
-        }
-        if (C == 4) dst[3] = src[3] > 0 ? (src[3] < 1 ? src[3] : 1.0f) : 0.0f;
+    for (size_t j = 0; j < n; j++) {
+        float x = src[j] * scale;
+        x = x > 0 ? x : 0.0f; /* NaN and negatives: 0 */
+        const float v = curve_of(curve, x) * SRGB_LUT;
+        const int i = (int)v;
+        const float e = enc[i] + (v - (float)i) * (enc[i + 1] - enc[i]);
+        dst[j] = e < 1.0f ? e : 1.0f;
     }
+}
+
+/* One row of `width` pixels of C channels; alpha clamped to [0, 1]. */
+static void map_row(atmos_tone_curve curve, const float *src, float *dst, size_t width, int C, float scale,
+                    const float *enc)
+{
+    if (curve == ATMOS_TONE_REINHARD) map_values(ATMOS_TONE_REINHARD, src, dst, width * C, scale, enc);
+    else if (curve == ATMOS_TONE_CLAMP) map_values(ATMOS_TONE_CLAMP, src, dst, width * C, scale, enc);
+    else map_values(ATMOS_TONE_FILMIC, src, dst, width * C, scale, enc);
+    if (C == 4)
+        for (size_t p = 0; p < width; p++) {
+            const float a = src[4 * p + 3];
+            dst[4 * p + 3] = a > 0 ? (a < 1 ? a : 1.0f) : 0.0f;
+        }
 }
 
 atmos_status atmos_tonemap_into(atmos_context *ctx, const atmos_image *linear, const atmos_tonemap_desc *desc,
@@ -142,11 +155,7 @@ atmos_status atmos_tonemap_into(atmos_context *ctx, const atmos_image *linear, c
     /* Each row is independent: static schedule, no shared state. */
 #pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
     for (long y = 0; y < rows; y++) {
-        const float *src = linear->pixels + (size_t)y * width * C;
-        float *dst = out->pixels + (size_t)y * width * C;
-        if (curve == ATMOS_TONE_REINHARD) map_pixels(ATMOS_TONE_REINHARD, src, dst, width, C, scale, enc);
-        else if (curve == ATMOS_TONE_CLAMP) map_pixels(ATMOS_TONE_CLAMP, src, dst, width, C, scale, enc);
-        else map_pixels(ATMOS_TONE_FILMIC, src, dst, width, C, scale, enc);
+        map_row(curve, linear->pixels + (size_t)y * width * C, out->pixels + (size_t)y * width * C, width, C, scale, enc);
     }
     return ATMOS_OK;
 }
