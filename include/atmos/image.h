@@ -72,6 +72,13 @@ ATMOS_API double atmos_tonemap_scale(const atmos_image *img, const atmos_tonemap
  * it. Rows are processed on atmos_context_threads(ctx) threads. */
 ATMOS_API atmos_status atmos_tonemap(atmos_context *ctx, const atmos_image *linear,
                                      const atmos_tonemap_desc *desc, atmos_image **out);
+/* atmos_tonemap into an existing image out of the input's size and channels (no metadata
+ * copied): a viewer's frame without allocating one. The curve and the exposure are applied in
+ * single precision, the sRGB transfer function from a table: within 4e-6 of the curve and the
+ * transfer function in double precision (a quarter of a 16-bit PNG's level; atmos_tonemap is
+ * the same). */
+ATMOS_API atmos_status atmos_tonemap_into(atmos_context *ctx, const atmos_image *linear,
+                                          const atmos_tonemap_desc *desc, atmos_image *out);
 
 /* The sRGB transfer function (IEC 61966-2-1) and its inverse. NaN gives 0. */
 ATMOS_API double atmos_srgb_encode(double linear);
@@ -207,6 +214,9 @@ ATMOS_API atmos_status atmos_image_compare_binned_matched(atmos_context *ctx, co
  * channels), scaled so that Y is luminance in cd m^-2. Metadata is copied. */
 ATMOS_API atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral,
                                            const atmos_wavelengths *wl, atmos_image **out);
+/* The same into an existing 4-channel image of the input's size (no metadata copied). */
+ATMOS_API atmos_status atmos_image_to_srgb_into(atmos_context *ctx, const atmos_image *spectral,
+                                                const atmos_wavelengths *wl, atmos_image *rgb);
 
 #ifdef __cplusplus
 }

@@ -83,9 +83,12 @@ const char *const *atmos__pcloud_generator_names(void);
 /* Makes a preset's particles (one "cloud" field of droplets; world positions as a generated
  * volume's: about x = z = 0, the bases at 1.5 km times scale); same seed, same particles. scale multiplies the extent (0:
  * 1). *voxel_m: the grid spacing for atmos__pcloud_to_volume (half the finest particle spacing,
- * at most 640 voxels across: a field's grid blurs its smallest clouds). */
+ * at most 640 voxels across: a field's grid blurs its smallest clouds). spacing_m > 0: the
+ * particles' lattice edge in every cloud (0: the preset's, 1/24 of the cumulus's width, 1/16 of
+ * each of the field's clouds'; a given spacing leaves a field's clouds in other places than the
+ * preset's, the same for every spacing). */
 atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint64_t seed, double scale,
-                                    atmos__pcloud *out, double *voxel_m);
+                                    double spacing_m, atmos__pcloud *out, double *voxel_m);
 
 /* ---- pcluster.c: the clouds of a particle set (what Harris's impostors are made of) */
 typedef struct atmos__pclusters {
@@ -178,11 +181,13 @@ int atmos__pimpostor_serves(const atmos__pimpostor *im, const double c[3], doubl
 atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
                                    const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
                                    const double c[3], double r, const double e[3], int res);
-/* Draws im over img seen by cam within rect: each pixel's ray meets the impostor's plane
- * (through c, facing im's view), the texture is read there (bilinear), and the pixel becomes
- * pixel (1 - coverage) + colour. */
-void atmos__pimpostor_draw(atmos_context *ctx, const atmos__pimpostor *im, const double c[3], double r,
-                           const atmos_camera *cam, const int rect[4], atmos_image *img);
+/* Draws the impostors ims[0..n) in that order (far to near; cloud q's centre c[q], radius r[q])
+ * over img seen by cam within rect: each pixel's ray meets an impostor's plane (through its
+ * cloud's centre, facing its view), the texture is read there (bilinear), and the pixel
+ * becomes pixel (1 - coverage) + colour. One pass over the rows on the threads for up to 64
+ * impostors. */
+void atmos__pimpostor_draw(atmos_context *ctx, int n, const atmos__pimpostor *const *ims, const double *const *c,
+                           const double *r, const atmos_camera *cam, const int rect[4], atmos_image *img);
 void atmos__pimpostor_free(atmos__pimpostor *im);
 /* Harris §3.1, the head in the clouds: the particles idx[0..nidx) splatted into an image of
  * 1/factor of cam's pixels per axis (the same view), then laid over img within rect, read

@@ -74,7 +74,7 @@ static atmos_status fill(atmos__pcloud *pc, uint64_t *rng, const ellipsoid *e, i
 /* Cumuli over a half x half square about the origin, widths 300..1200 m (small ones more
  * often), thrown as darts kept 0.6 of their summed widths apart. */
 static atmos_status field(atmos__pcloud *pc, uint64_t *rng, double scale, int count, double half, double per_width,
-                          double *h_out)
+                          double spacing, double *h_out)
 {
     double cx[256], cz[256], cw[256];
     int n = 0;
@@ -90,16 +90,19 @@ static atmos_status field(atmos__pcloud *pc, uint64_t *rng, double scale, int co
         cx[n] = x, cz[n] = z, cw[n] = w, n++;
         ellipsoid e[32];
         const int ne = cumulus_shape(rng, x, z, base * scale, w, e);
-        const double h = w / per_width; /* lattice cells across the cloud's width */
+        /* lattice cells across the cloud's width, or the given spacing; a given spacing fills
+         * from a stream of its own, so that the clouds' places and shapes do not depend on it */
+        const double h = spacing > 0 ? spacing : w / per_width;
         *h_out = fmin(*h_out, h);
-        atmos_status st = fill(pc, rng, e, ne, base * scale, h);
+        uint64_t own = *rng ^ 0xA5A5A5A5DEADBEEFull;
+        atmos_status st = fill(pc, spacing > 0 ? &own : rng, e, ne, base * scale, h);
         if (st != ATMOS_OK) return st;
     }
     return ATMOS_OK;
 }
 
 atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint64_t seed, double scale,
-                                    atmos__pcloud *out, double *voxel_m)
+                                    double spacing_m, atmos__pcloud *out, double *voxel_m)
 {
     memset(out, 0, sizeof *out);
     out->nfields = 1;
@@ -109,8 +112,8 @@ atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint
     uint64_t rng = seed * 0x9E3779B97F4A7C15ull + 0x1234567ull;
     double h = 0;
     atmos_status st;
-    if (!strcmp(preset, "harris_cumulus")) st = field(out, &rng, scale, 1, 0, 24, &h);
-    else if (!strcmp(preset, "harris_field")) st = field(out, &rng, scale, 120, 15000 * scale, 16, &h);
+    if (!strcmp(preset, "harris_cumulus")) st = field(out, &rng, scale, 1, 0, 24, spacing_m, &h);
+    else if (!strcmp(preset, "harris_field")) st = field(out, &rng, scale, 120, 15000 * scale, 16, spacing_m, &h);
     else return atmos__error(ctx, ATMOS_E_INVALID_ARG, "particles: no preset \"%s\" (known: harris_cumulus, harris_field)", preset);
     if (st != ATMOS_OK) {
         atmos__pcloud_free(out);

@@ -109,17 +109,30 @@ static void draw_row(const atmos__pimpostor *im, const double c[3], const double
     }
 }
 
-void atmos__pimpostor_draw(atmos_context *ctx, const atmos__pimpostor *im, const double c[3], double r,
-                           const atmos_camera *cam, const int rect[4], atmos_image *img)
+void atmos__pimpostor_draw(atmos_context *ctx, int n, const atmos__pimpostor *const *ims, const double *const *c,
+                           const double *r, const atmos_camera *cam, const int rect[4], atmos_image *img)
 {
-    double nrm[3], l = 0, Z;
-    int bb[4];
-    /* (the caller splats clouds near or behind the eye) */
-    if (!atmos__pcloud_screen_box(cam, c, r, rect, bb, &Z)) return;
-    for (int i = 0; i < 3; i++) nrm[i] = im->view[i] - c[i], l += nrm[i] * nrm[i];
-    for (int i = 0; i < 3; i++) nrm[i] /= sqrt(l);
+    /* in chunks of 64 impostors (far to near, so the order holds), each chunk one pass over its
+     * rows on the threads: a row draws every impostor it meets in order, so a pixel sees the
+     * same order whatever thread draws it */
+    enum { CHUNK = 64 };
+    for (int q0 = 0; q0 < n; q0 += CHUNK) {
+        int bb[CHUNK][4], use[CHUNK], m = 0, y0 = rect[3], y1 = rect[1];
+        double nrm[CHUNK][3];
+        for (int q = q0; q < n && q < q0 + CHUNK; q++) {
+            double l = 0, Z;
+            /* (the caller splats clouds near or behind the eye) */
+            if (!atmos__pcloud_screen_box(cam, c[q], r[q], rect, bb[m], &Z)) continue;
+            for (int i = 0; i < 3; i++) nrm[m][i] = ims[q]->view[i] - c[q][i], l += nrm[m][i] * nrm[m][i];
+            for (int i = 0; i < 3; i++) nrm[m][i] /= sqrt(l);
+            y0 = bb[m][2] < y0 ? bb[m][2] : y0, y1 = bb[m][3] > y1 ? bb[m][3] : y1;
+            use[m++] = q;
+        }
 #pragma omp parallel for schedule(dynamic, 8) num_threads(atmos__threads(ctx))
-    for (int y = bb[2]; y < bb[3]; y++) draw_row(im, c, nrm, cam, y, bb[0], bb[1], img);
+        for (int y = y0; y < y1; y++)
+            for (int j = 0; j < m; j++)
+                if (y >= bb[j][2] && y < bb[j][3]) draw_row(ims[use[j]], c[use[j]], nrm[j], cam, y, bb[j][0], bb[j][1], img);
+    }
 }
 
 atmos_status atmos__pimpostor_screen(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,

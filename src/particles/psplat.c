@@ -39,6 +39,13 @@ int atmos__pcloud_screen_box(const atmos_camera *cam, const double c[3], double 
     return bb[0] < bb[1] && bb[2] < bb[3];
 }
 
+static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void cross(const double a[3], const double b[3], double out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 /* The splat of particle p as seen by cam; 0 when it is not drawn. */
 static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const atmos__plights *L, const atmos_camera *cam,
                    const int rect[4], sp *out)
@@ -69,30 +76,44 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
     return 1;
 }
 
-/* Composites splat q over the pixels of its box inside tile (tx, ty). */
-static void draw(const sp *q, int nw, const atmos_camera *cam, int tx, int ty, atmos_image *img)
+/* Composites splat q over the pixels of its box inside tile (tx, ty). Pixel (x, y)'s ray is
+ * d = F + u R + v U (u, v: the pixel's place on the image plane at unit distance); its squared
+ * distance from the centre is b^2 = |rel x d|^2 / |d|^2, and along a row both are quadratics in
+ * u: b^2 = (a0 + a1 u + a2 u^2) / (e0 + e1 u + e2 u^2), the coefficients once per row (double:
+ * a0 is |rel|^2 |d|^2, b^2 a small difference). The row's column depths go through a
+ * branch-free loop first (vectorised), then the pixels inside the cut are composited. */
+__attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, int nw, const atmos_camera *cam, int tx,
+                                                                    int ty, atmos_image *img)
 {
     const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
     const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
     const double W = cam->width, H = cam->height, t = cam->tan_half_fov, k2 = 1.0 / (q->s * q->s);
     const double rc2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT * q->s * q->s;
-    double rel[3];
+    const double *F = cam->forward, *R = cam->right, *U = cam->up;
+    double rel[3], Q[3];
     for (int i = 0; i < 3; i++) rel[i] = q->c[i] - cam->position[i];
-    const double rr = rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2];
-    const int C = img->channels;
+    cross(rel, R, Q);
+    const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, u0 = (2.0 * x0 + 1.0 - W) / H * t;
+    const int C = img->channels, n = x1 - x0;
+    double b2[TILE];
+    float g[TILE];
     for (int y = y0; y < y1; y++) {
         const double v = (H - 2.0 * (y + 0.5)) / H * t;
-        for (int x = x0; x < x1; x++) {
-            const double u = (2.0 * (x + 0.5) - W) / H * t;
-            double d[3], dd = 0, rd = 0;
-            for (int i = 0; i < 3; i++) d[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i], dd += d[i] * d[i];
-            for (int i = 0; i < 3; i++) rd += rel[i] * d[i];
-            const double b2 = rr - rd * rd / dd;
-            if (b2 > rc2) continue;
-            const float g = atmos__pcloud_column((float)(b2 * k2));
-            float *px = img->pixels + ((size_t)y * cam->width + x) * C, tm = 0;
+        double D[3], P[3];
+        for (int i = 0; i < 3; i++) D[i] = F[i] + v * U[i];
+        cross(rel, D, P);
+        const double a0 = dot(P, P), a1 = 2.0 * dot(P, Q), e0 = dot(D, D), e1 = 2.0 * dot(D, R);
+        for (int j = 0; j < n; j++) {
+            const double u = u0 + j * du;
+            b2[j] = (a0 + u * (a1 + u * a2)) / (e0 + u * (e1 + u * e2));
+        }
+        for (int j = 0; j < n; j++) g[j] = atmos__pcloud_column((float)(b2[j] * k2));
+        float *row = img->pixels + ((size_t)y * cam->width + x0) * C;
+        for (int j = 0; j < n; j++) {
+            if (b2[j] > rc2) continue;
+            float *px = row + (size_t)j * C, tm = 0;
             for (int k = 0; k < nw; k++) {
-                const float T = atmos__expf_fast(-q->tc[k] * g);
+                const float T = atmos__expf_fast(-q->tc[k] * g[j]);
                 px[k] = px[k] * T + q->col[k] * (1.0f - T);
                 tm += T;
             }

@@ -96,7 +96,15 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
                               (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
     const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
-    for (int q = 0; q < n; q++) air(p, h, v, ap, c->idx + c->start[list[q]], c->start[list[q] + 1] - c->start[list[q]]);
+    /* the air to all their particles in one pass on the threads */
+    int total = 0;
+    for (int q = 0; q < n; q++) total += c->start[list[q] + 1] - c->start[list[q]];
+    int *all = malloc(sizeof(int) * (size_t)(total ? total : 1));
+    if (!all) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    for (int q = 0, m = 0; q < n; q++)
+        for (int i = c->start[list[q]]; i < c->start[list[q] + 1]; i++) all[m++] = c->idx[i];
+    air(p, h, v, ap, all, total);
+    free(all);
     atmos_status st = ATMOS_OK;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
     for (int q = 0; q < n; q++) {
@@ -115,7 +123,7 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
     return st;
 }
 
-/* Cloud k drawn over the frame as mode() says (its impostor made already). */
+/* Cloud k splatted particle by particle (how 1) or as a screen-sized impostor (how 2). */
 static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
                          int k, int how, const int rect[4], atmos_image *out)
 {
@@ -135,8 +143,23 @@ static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos
         h->direct++, h->updates++;
         return atmos__pimpostor_screen(p->ctx, &h->pc, &h->o, &L, idx, n, &v->cam, 4, rect, out);
     }
-    atmos__pimpostor_draw(p->ctx, &h->imp[k], c->centre[k], c->radius[k], &v->cam, rect, out);
     return ATMOS_OK;
+}
+
+/* The clouds ord[q0..) drawn from their impostors (how 3, 4; those out of view skipped) up to
+ * the next one drawn otherwise, in one pass; the index after them. */
+static int draw_impostors(const atmos_plan *p, const atmos__harris_plan *h, const atmos__view *v, const atmos__keyed *ord,
+                          const int *how, int q0, int nc, const int rect[4], atmos_image *out, const atmos__pimpostor **ims,
+                          const double **cs, double *rs)
+{
+    int q = q0, n = 0;
+    for (; q < nc && (how[ord[q].index] >= 3 || !how[ord[q].index]); q++) {
+        const int k = ord[q].index;
+        if (!how[k]) continue;
+        ims[n] = &h->imp[k], cs[n] = h->clouds.centre[k], rs[n++] = h->clouds.radius[k];
+    }
+    atmos__pimpostor_draw(p->ctx, n, ims, cs, rs, &v->cam, rect, out);
+    return q;
 }
 
 atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
@@ -163,13 +186,20 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     h->drawn = h->updates = h->direct = 0;
     const size_t cap = nc > 0 ? (size_t)nc : 1;
     int *how = malloc(sizeof(int) * 2 * cap), *stale = how ? how + cap : NULL, nstale = 0;
-    if (!how) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
-    for (int k = 0; k < nc && how; k++)
+    const atmos__pimpostor **ims = malloc(sizeof *ims * cap);
+    const double **cs = malloc(sizeof *cs * cap);
+    double *rs = malloc(sizeof *rs * cap);
+    if (!how || !ims || !cs || !rs) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
+    for (int k = 0; k < nc && st == ATMOS_OK; k++)
         if ((how[k] = mode(p, h, v, k)) == 4) stale[nstale++] = k;
     if (st == ATMOS_OK) st = remake(p, h, v, ap, stale, nstale);
-    for (int q = 0; q < nc && st == ATMOS_OK; q++)
-        if (how[ord[q].index]) st = draw(p, h, v, ap, ord[q].index, how[ord[q].index], rect, out);
-    free(how);
+    for (int q = 0; q < nc && st == ATMOS_OK;) {
+        const int k = ord[q].index;
+        if (how[k] >= 3) q = draw_impostors(p, h, v, ord, how, q, nc, rect, out, ims, cs, rs);
+        else if (how[k]) st = draw(p, h, v, ap, k, how[k], rect, out), q++;
+        else q++;
+    }
+    free(how), free(ims), free(cs), free(rs);
     free(ord);
     p->stats.impostor_updates = h->updates;
     return st;

@@ -90,7 +90,8 @@ static atmos_status particles(atmos_plan *p, atmos__harris_plan *h)
     for (const char *const *g = atmos__pcloud_generator_names(); *g; g++)
         if (!strncmp(sv->source, "generate:", 9) && !strcmp(sv->source + 9, *g)) {
             double voxel;
-            atmos_status st = atmos__pcloud_generate(p->ctx, *g, sv->seed, sv->scale > 0 ? sv->scale : 1.0, &h->pc, &voxel);
+            atmos_status st = atmos__pcloud_generate(p->ctx, *g, sv->seed, sv->scale > 0 ? sv->scale : 1.0,
+                                                       p->scene.harris.spacing_m, &h->pc, &voxel);
             if (st != ATMOS_OK) return st;
             /* the grid the plan placed starts at the particles' box (atmos__pcloud_to_volume) */
             double lo[3], hi[3];

@@ -80,7 +80,8 @@ static const atmos_setting nishita_settings[] = {
 
 static const atmos_setting harris_settings[] = {
     {"spacing_m", "spacing", ATMOS_SETTING_REAL, "m", 0, 1e5, 0, 0, 0, NULL, 0,
-     "one particle per cell of this edge; 0 = the volume's voxel, coarser until at most max_particles",
+     "one particle per cell of this edge; 0 = the volume's voxel, coarser until at most max_particles (the "
+     "harris_ generators: their own lattice)",
      HARRIS(spacing_m)},
     {"max_particles", "max-particles", ATMOS_SETTING_INT, "", 1, 20000000, 0, 0, 50000, NULL, 0,
      "the most particles made from the volume (with spacing 0)", HARRIS(max_particles)},

@@ -24,7 +24,7 @@ atmos_status atmos_scene_generate_volume(atmos_context *ctx, const char *preset,
         if (preset && !strcmp(*v, preset)) {
             atmos__pcloud pc;
             double voxel;
-            atmos_status st = atmos__pcloud_generate(ctx, preset, desc ? desc->seed : 1, desc ? desc->scale : 1, &pc, &voxel);
+            atmos_status st = atmos__pcloud_generate(ctx, preset, desc ? desc->seed : 1, desc ? desc->scale : 1, 0.0, &pc, &voxel);
             if (st == ATMOS_OK)
                 st = atmos__pcloud_to_volume(ctx, &pc, desc && desc->voxel_size_m > 0 ? desc->voxel_size_m : voxel, out);
             atmos__pcloud_free(&pc);

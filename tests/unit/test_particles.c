@@ -235,9 +235,11 @@ static void impostors(void)
     const double f = 160 / (2 * tan(10 * 3.141592653589793 / 180));
     atmos__pimpostor im;
     memset(&im, 0, sizeof im);
+    const atmos__pimpostor *one = &im;
+    const double *cc = cl.centre[0];
     const int res = atmos__pimpostor_res(cl.radius[0], 6000, f, 512);
     CHECK_OK(atmos__pimpostor_make(NULL, &im, &pc, &o, &L, idx, nidx, cl.centre[0], cl.radius[0], eye, res));
-    atmos__pimpostor_draw(NULL, &im, cl.centre[0], cl.radius[0], &cam, rect, imp);
+    atmos__pimpostor_draw(NULL, 1, &one, &cc, cl.radius, &cam, rect, imp);
     const double e0 = rel_rms(imp, direct);
     /* the eye 0.5 degree round the cloud: the stale impostor against the direct splats */
     double eye2[3];
@@ -248,7 +250,7 @@ static void impostors(void)
     CHECK_OK(atmos_camera_init(NULL, &cd, 160, 160, &cam));
     memset(direct->pixels, 0, sizeof(float) * 160 * 160 * 2), memset(imp->pixels, 0, sizeof(float) * 160 * 160 * 2);
     CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L, idx, nidx, &cam, rect, direct, NULL));
-    atmos__pimpostor_draw(NULL, &im, cl.centre[0], cl.radius[0], &cam, rect, imp);
+    atmos__pimpostor_draw(NULL, 1, &one, &cc, cl.radius, &cam, rect, imp);
     const double e05 = rel_rms(imp, direct);
     printf("impostor: %d texels, rel rms against the splats %.4f where made, %.4f 0.5 degree round\n", res, e0, e05);
     CHECK(e0 < 0.03);
@@ -273,8 +275,8 @@ static void generated(void)
 {
     atmos__pcloud a, b;
     double va, vb;
-    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, &a, &va));
-    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, &b, &vb));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, 0.0, &a, &va));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_field", 7, 1.0, 0.0, &b, &vb));
     CHECK(a.n == b.n && a.n > 50000 && va == vb);
     CHECK(a.n == b.n && !memcmp(a.x, b.x, sizeof(float) * (size_t)a.n) && !memcmp(a.n0, b.n0, sizeof(float) * (size_t)a.n));
     atmos__pclusters cl;
@@ -288,7 +290,7 @@ static void generated(void)
     gd.seed = 2;
     atmos_volume *v = NULL;
     CHECK_OK(atmos_scene_generate_volume(NULL, "harris_cumulus", &gd, &v));
-    CHECK_OK(atmos__pcloud_generate(NULL, "harris_cumulus", 2, 1.0, &b, &vb));
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_cumulus", 2, 1.0, 0.0, &b, &vb));
     double mass = 0, want = 0, lo[3], hi[3];
     for (int p = 0; p < b.n; p++) want += b.n0[p] * 0.9707091134651118 * 15.749609945722419 * pow(b.s[p], 3);
     atmos_volume_bounds(v, lo, hi);
@@ -300,6 +302,17 @@ static void generated(void)
             }
     printf("harris_cumulus: %d particles, grid mass %.5g of %.5g\n", b.n, mass, want);
     CHECK_REL(mass, want, 0.02);
+    /* a given spacing (the scene's "harris": {"spacing_m"}) samples the same cloud finer: about
+     * 8 times the particles at half the preset's spacing (1100 m / 24), the same droplets */
+    atmos__pcloud fine;
+    double vf, fine_mass = 0;
+    CHECK_OK(atmos__pcloud_generate(NULL, "harris_cumulus", 2, 1.0, 0.5 * 1100.0 / 24.0, &fine, &vf));
+    for (int p = 0; p < fine.n; p++) fine_mass += fine.n0[p] * 0.9707091134651118 * 15.749609945722419 * pow(fine.s[p], 3);
+    printf("harris_cumulus at half the spacing: %d particles (%.2f times), mass %.5g of %.5g\n", fine.n,
+           (double)fine.n / b.n, fine_mass, want);
+    CHECK(fine.n > 7 * b.n && fine.n < 9 * b.n);
+    CHECK_REL(fine_mass, want, 0.03);
+    atmos__pcloud_free(&fine);
     int known = 0;
     for (const char *const *n = atmos_scene_generator_names(); *n; n++) known += !strcmp(*n, "harris_field") + !strcmp(*n, "cumulus");
     CHECK(known == 2);

@@ -66,9 +66,15 @@ static double exposure_scale(const atmos_image *lin, const atmos_tonemap_desc *t
  * (a third of the way in log a frame) unless `snap`. */
 static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int snap, double *ev_used)
 {
-    atmos_image_destroy(L->lin), L->lin = NULL;
-    atmos_image_destroy(L->disp), L->disp = NULL;
-    atmos_status st = atmos_image_to_srgb(L->ctx, L->img, atmos_plan_wavelengths(p), &L->lin);
+    /* the frame's images are kept from one frame to the next while its size stays (made anew,
+     * they carry the render's metadata: a save makes them anew) */
+    const int keep = L->lin && L->disp && L->lin->width == L->img->width && L->lin->height == L->img->height;
+    if (!keep) {
+        atmos_image_destroy(L->lin), L->lin = NULL;
+        atmos_image_destroy(L->disp), L->disp = NULL;
+    }
+    atmos_status st = keep ? atmos_image_to_srgb_into(L->ctx, L->img, atmos_plan_wavelengths(p), L->lin)
+                           : atmos_image_to_srgb(L->ctx, L->img, atmos_plan_wavelengths(p), &L->lin);
     if (st != ATMOS_OK) return st;
     atmos_tonemap_desc td;
     memset(&td, 0, sizeof td);
@@ -84,7 +90,7 @@ static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int sna
         td.exposure_ev = -log2(1.2 * exp(L->log_scale));
     }
     *ev_used = td.exposure_ev;
-    return atmos_tonemap(L->ctx, L->lin, &td, &L->disp);
+    return keep ? atmos_tonemap_into(L->ctx, L->lin, &td, L->disp) : atmos_tonemap(L->ctx, L->lin, &td, &L->disp);
 }
 
 /* Renders the state's frame; preview: the reduced quality of a moving view. */
@@ -116,6 +122,7 @@ static int save(loop *L, const view_opts *o, view_state *s, const char *text)
     atmos_plan *p;
     const int keep_spp = L->spp;
     L->spp = 1 << 30; /* the scene's full budget */
+    atmos_image_destroy(L->lin), L->lin = NULL; /* made anew: with the render's metadata */
     double ev;
     atmos_status st = render(L, s, 0, &p);
     if (st == ATMOS_OK) st = display(L, p, s, 0, &ev);

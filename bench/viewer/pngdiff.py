@@ -1,0 +1,54 @@
+#!/usr/bin/env python3
+"""The 8-bit display values of two recorded flights (atmos view --record DIR), frame by frame:
+the frames whose pixels are identical, the largest difference in levels of 255 and the share
+of values that differ. Metadata (the PNGs' text chunks) is ignored.
+
+    bench/viewer/pngdiff.py DIR_A DIR_B
+"""
+import glob, os, struct, sys, zlib
+
+
+def pixels(path):
+    data = open(path, "rb").read()
+    i, idat = 8, b""
+    while i < len(data):
+        n, = struct.unpack(">I", data[i:i + 4])
+        kind = data[i + 4:i + 8]
+        if kind == b"IHDR":
+            w, h, depth, ctype = struct.unpack(">IIBB", data[i + 8:i + 18])
+        elif kind == b"IDAT":
+            idat += data[i + 8:i + 8 + n]
+        i += 12 + n
+    bpp = {2: 3, 6: 4}[ctype] * depth // 8
+    raw, stride = zlib.decompress(idat), w * bpp
+    out, prev, o = bytearray(), bytearray(stride), 0
+    for _ in range(h):
+        f, line = raw[o], bytearray(raw[o + 1:o + 1 + stride])
+        o += 1 + stride
+        for x in range(stride):
+            a = line[x - bpp] if x >= bpp else 0
+            b = prev[x]
+            c = prev[x - bpp] if x >= bpp else 0
+            if f == 1: line[x] = (line[x] + a) & 255
+            elif f == 2: line[x] = (line[x] + b) & 255
+            elif f == 3: line[x] = (line[x] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        out += line
+        prev = line
+    return out
+
+
+same = worst = differ = total = 0
+files = sorted(glob.glob(os.path.join(sys.argv[1], "frame_*.png")))
+for fa in files:
+    a, b = pixels(fa), pixels(os.path.join(sys.argv[2], os.path.basename(fa)))
+    d = [abs(x - y) for x, y in zip(a, b)]
+    same += max(d) == 0
+    worst = max(worst, max(d))
+    differ += sum(1 for v in d if v)
+    total += len(d)
+print("frames=%d identical=%d largest_difference=%d differing_values=%.2g" % (len(files), same, worst,
+                                                                               differ / max(1, total)))

@@ -1,0 +1,72 @@
+#!/bin/sh
+# The viewer's frame rates (docs/viewer.md, issue 16's benchmark goals): recorded flights played
+# headless, one line per case with the median frame and the slowest 1 % as frames a second.
+#
+#   bench/viewer/run.sh [--atmos BIN] [--cases "field million inside slice"] [--frames N] [--out DIR]
+#
+# The cases (1280x720 unless said):
+#   field    scenes/harris_cloud_field.json (120 clouds, 99 101 particles) along
+#            scenes/flights/harris_cloud_field.json, 480 frames; goal 60 fps
+#   million  the same field with particles 19.7 m apart (--spacing 19.7: 1 209 835 particles),
+#            240 frames; goal 20 fps
+#   inside   scenes/harris_fly_through.json's cumulus, the eye inside it all along
+#            (bench/viewer/inside_cumulus.json), 240 frames; goal 30 fps
+#   slice    scenes/fig14_interactive_storm.json at 512x512, the sun moving every frame
+#            (bench/viewer/storm_sun.json), 120 frames; goal 10 fps
+# ms is frames.csv's: a frame's wall time with the conversion to display values, without
+# writing its PNG. The first frame (the light passes, a plan's first use) is reported on its
+# own (first_ms) and left out of the percentiles. fps_1pct_low: 1000 / the mean of the slowest
+# 1 % of the other frames (at least one). cpu_s: the run's CPU time (user + system, with making
+# the plan), steadier than wall times on a shared machine. load: the 1-minute load average
+# before the case.
+set -eu
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+ATMOS=$root/build/atmos
+CASES="field million inside slice"
+FRAMES=
+OUT=${TMPDIR:-/tmp}/atmos-viewer-bench
+while [ $# -gt 0 ]; do
+    case "$1" in
+    --atmos) ATMOS=$2; shift 2 ;;
+    --cases) CASES=$2; shift 2 ;;
+    --frames) FRAMES=$2; shift 2 ;;
+    --out) OUT=$2; shift 2 ;;
+    *) echo "run.sh: unknown option $1" >&2; exit 2 ;;
+    esac
+done
+mkdir -p "$OUT"
+
+run_case() { # name scene flight frames size [extra options]
+    name=$1 scene=$2 flight=$3 n=${FRAMES:-$4} size=$5
+    shift 5
+    load=$(cut -d' ' -f1 /proc/loadavg)
+    rm -rf "$OUT/$name"
+    (cd "$root" && /usr/bin/time -f "%U %S" -o "$OUT/$name.cpu" "$ATMOS" view "$scene" --script "$flight" \
+        --frames "$n" --headless --size "$size" --record "$OUT/$name" -q "$@")
+    python3 - "$OUT/$name/frames.csv" "$name" "$size" "$load" "$OUT/$name.cpu" <<'PY'
+import csv, sys
+cpu = sum(float(x) for x in open(sys.argv[5]).read().split()[-2:])
+rows = list(csv.DictReader(open(sys.argv[1])))
+ms = [float(r["ms"]) for r in rows]
+rest = sorted(ms[1:]) or ms
+med = rest[len(rest) // 2] if len(rest) % 2 else 0.5 * (rest[len(rest) // 2 - 1] + rest[len(rest) // 2])
+k = max(1, len(rest) // 100)
+low = sum(rest[-k:]) / k
+upd = sum(float(r["impostor_updates"]) for r in rows[1:]) / max(1, len(rows) - 1)
+print("case=%s frames=%d size=%s ms_median=%.1f fps_median=%.1f fps_1pct_low=%.1f first_ms=%.0f "
+      "impostor_updates=%.1f cpu_s=%.1f load=%s" % (sys.argv[2], len(rows), sys.argv[3], med, 1000 / med, 1000 / low,
+                                                   ms[0], upd, cpu, sys.argv[4]))
+PY
+}
+
+for c in $CASES; do
+    case "$c" in
+    field) run_case field scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 480 1280x720 ;;
+    million) run_case million scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 240 1280x720 \
+        --spacing 19.7 ;;
+    inside) run_case inside scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 240 1280x720 ;;
+    slice) run_case slice scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 120 512x512 ;;
+    *) echo "run.sh: unknown case $c" >&2; exit 2 ;;
+    esac
+done
