@@ -35,6 +35,17 @@ while d:
     if d[4:8] in (b"IHDR", b"IDAT"): sys.stdout.buffer.write(d[:12 + n])
     d = d[12 + n:]' "$1"
 }
+# png_text FILE KEY: the value of a tEXt chunk.
+png_text() {
+    python3 -c 'import struct, sys
+d = open(sys.argv[1], "rb").read()[8:]
+while d:
+    n = struct.unpack(">I", d[:4])[0]
+    if d[4:8] == b"tEXt":
+        k, v = d[8:8 + n].split(b"\0", 1)
+        if k.decode() == sys.argv[2]: print(v.decode())
+    d = d[12 + n:]' "$1" "$2"
+}
 same_png() {
     png_data "$1" >"$1.data" && png_data "$2" >"$2.data" && same "$1.data" "$2.data" "$3"
 }
@@ -69,6 +80,11 @@ if mpi 2 "$T/a2" "$scene" $anim -o "$T/a2/f.png" --pfm "$T/a2/f.pfm"; then
         same_png "$T/a1/f_000$i.png" "$T/a2/f_000$i.png" "animation frame $i, 2 ranks: the single process's PNG pixels"
     done
     grep -q "rendered by rank 1" "$T/a2.log" && ok "rank 1 rendered frames" || bad "no frame reported from rank 1"
+    # Each frame carries its own renderer's metadata (its sun), wherever it was rendered.
+    for i in 2 3 4; do
+        e1=$(png_text "$T/a1/f_000$i.png" atmos:sun_elevation_deg) e2=$(png_text "$T/a2/f_000$i.png" atmos:sun_elevation_deg)
+        [ -n "$e1" ] && [ "$e1" = "$e2" ] && ok "frame $i's sun in its metadata ($e2)" || bad "frame $i's sun: '$e2', expected '$e1'"
+    done
 else bad "mpirun -np 2 animation"; sed 's/^/  /' "$T/a2.log" >&2; fi
 
 # An output that cannot be written (its folder is a file): a clear error, no hang, nothing left.

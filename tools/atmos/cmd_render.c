@@ -283,7 +283,7 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const at
         total += info.seconds;
         if (!o->quiet) {
             if (prog->shown) fputc('\n', stderr), prog->shown = 0;
-            report_frame(plan, &fs, &fo->ff, source, &info, frame, nframes, owner > 0 ? owner : (d->size > 1 ? -1 : 0));
+            report_frame(plan, &fs, &fo->ff, source, &info, frame, nframes, owner >= 0 ? owner : (d->size > 1 ? -1 : 0));
         }
     }
     cli_outputs_discard(&fo->set);

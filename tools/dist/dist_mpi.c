@@ -5,6 +5,7 @@
 #include "cli.h"
 
 #include <mpi.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -108,6 +109,12 @@ atmos_status cli_dist_render(const cli_dist *d, atmos_plan *plan, const atmos_fr
         free(buf);
         return ok ? ATMOS_OK : ATMOS_E_NOMEM;
     }
+    char ranks[32];
+    snprintf(ranks, sizeof ranks, "%d", d->size);
+    atmos_image_set_meta(img, "atmos:ranks", ranks);
+    /* Statistics of the samples are per rank: rank 0's alone would mislead. */
+    if (atmos_image_get_meta(img, "atmos:path_mean_rel_error"))
+        atmos_image_set_meta(img, "atmos:path_mean_rel_error", "not combined over the ranks");
     atmos_status worst = ATMOS_OK;
     for (int r = 1; r < d->size; r++) {
         int ok = 0;
@@ -123,23 +130,58 @@ atmos_status cli_dist_render(const cli_dist *d, atmos_plan *plan, const atmos_fr
     return worst;
 }
 
+/* The image's metadata as "key\0value\0..." (a new buffer, *n bytes; NULL when out of memory). */
+static char *pack_meta(const atmos_image *img, int *n)
+{
+    size_t len = 0;
+    for (int i = 0; i < img->meta_count; i++) len += strlen(img->meta[i].key) + strlen(img->meta[i].value) + 2;
+    char *buf = malloc(len + 1), *q = buf;
+    if (!buf || len > (size_t)1 << 30) return free(buf), *n = 0, NULL;
+    for (int i = 0; i < img->meta_count; i++) {
+        const size_t k = strlen(img->meta[i].key) + 1, v = strlen(img->meta[i].value) + 1;
+        memcpy(q, img->meta[i].key, k), q += k;
+        memcpy(q, img->meta[i].value, v), q += v;
+    }
+    *n = (int)len;
+    return buf;
+}
+
 atmos_status cli_dist_send(const cli_dist *d, const atmos_image *img, atmos_status st, const atmos_render_info *info)
 {
-    double head[4] = {(double)st, info ? info->seconds : 0, info ? info->sun_elevation_deg : 0,
-                      info ? info->sun_azimuth_deg : 0};
-    MPI_Send(head, 4, MPI_DOUBLE, 0, TAG_HEAD, MPI_COMM_WORLD);
-    if (st == ATMOS_OK) send_floats(img->pixels, (size_t)img->width * img->height * img->channels, 0);
+    int nmeta = 0;
+    char *meta = st == ATMOS_OK ? pack_meta(img, &nmeta) : NULL;
+    if (st == ATMOS_OK && !meta) st = ATMOS_E_NOMEM;
+    double head[5] = {(double)st, info ? info->seconds : 0, info ? info->sun_elevation_deg : 0,
+                      info ? info->sun_azimuth_deg : 0, (double)nmeta};
+    MPI_Send(head, 5, MPI_DOUBLE, 0, TAG_HEAD, MPI_COMM_WORLD);
+    if (st == ATMOS_OK) {
+        MPI_Send(meta, nmeta, MPI_CHAR, 0, TAG_HEAD, MPI_COMM_WORLD);
+        send_floats(img->pixels, (size_t)img->width * img->height * img->channels, 0);
+    }
+    free(meta);
     (void)d;
     return st;
 }
 
+/* The frame's image with its renderer's metadata (the sun of that frame, its statistics). */
 atmos_status cli_dist_recv(const cli_dist *d, int from, atmos_image *img, atmos_render_info *info)
 {
-    double head[4];
-    MPI_Recv(head, 4, MPI_DOUBLE, from, TAG_HEAD, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    const atmos_status st = (atmos_status)head[0];
+    double head[5];
+    MPI_Recv(head, 5, MPI_DOUBLE, from, TAG_HEAD, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    atmos_status st = (atmos_status)head[0];
     info->seconds = head[1], info->sun_elevation_deg = head[2], info->sun_azimuth_deg = head[3];
-    if (st == ATMOS_OK) recv_floats(img->pixels, (size_t)img->width * img->height * img->channels, from);
+    if (st != ATMOS_OK) return st;
+    const int nmeta = (int)head[4];
+    char *meta = malloc((size_t)nmeta + 1);
+    if (!meta) return ATMOS_E_NOMEM; /* the sender blocks: the caller ends the job */
+    MPI_Recv(meta, nmeta, MPI_CHAR, from, TAG_HEAD, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    for (int q = 0; q < nmeta;) {
+        const char *k = meta + q, *v = k + strlen(k) + 1;
+        atmos_image_set_meta(img, k, v);
+        q = (int)(v + strlen(v) + 1 - meta);
+    }
+    free(meta);
+    recv_floats(img->pixels, (size_t)img->width * img->height * img->channels, from);
     (void)d;
     return st;
 }
