@@ -18,7 +18,7 @@ install(FILES ${CMAKE_BINARY_DIR}/atmos-config.cmake ${CMAKE_BINARY_DIR}/atmos-c
         DESTINATION ${ATMOS_CMAKE_DIR})
 
 # pkg-config: what a static link needs beyond libatmos.a, by the build's options.
-set(ATMOS_PC_REQUIRES_PRIVATE "libpng libcjson libjpeg OpenEXR")
+set(ATMOS_PC_REQUIRES_PRIVATE "libpng libcjson libjpeg OpenEXR tinyobjloader")
 set(ATMOS_PC_LIBS_PRIVATE "-fopenmp -lm")
 if(ATMOS_HAVE_NETCDF)
   string(APPEND ATMOS_PC_REQUIRES_PRIVATE " netcdf")
@@ -42,5 +42,5 @@ add_custom_command(OUTPUT ${CMAKE_BINARY_DIR}/man/atmos.1
                    COMMENT "Man pages from 'atmos --help'")
 add_custom_target(atmos_man ALL DEPENDS ${CMAKE_BINARY_DIR}/man/atmos.1)
 install(DIRECTORY ${CMAKE_BINARY_DIR}/man/ DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 FILES_MATCHING PATTERN "*.1")
-install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs)
 install(FILES README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})

@@ -47,11 +47,15 @@ class Image:
         return np.asarray(self)
 
     def write_exr(self, path: str) -> None:
-        """Writes the image as OpenEXR (linear, atomically)."""
+        """Writes the image as OpenEXR (linear, atomically); the name must end in .exr."""
+        if not str(path).lower().endswith(".exr"):
+            raise ValueError(f"atmos.Image.write_exr: {path}: an OpenEXR file's name ends in .exr")
         check(lib.atmos_write_exr(context(), self._live(), str(path).encode(), ffi.NULL))
 
     def write_pfm(self, path: str) -> None:
-        """Writes the first three channels as a portable float map (atomically)."""
+        """Writes the first three channels as a portable float map (atomically); the name must end in .pfm."""
+        if not str(path).lower().endswith(".pfm"):
+            raise ValueError(f"atmos.Image.write_pfm: {path}: a portable float map's name ends in .pfm")
         check(lib.atmos_write_pfm(context(), self._live(), str(path).encode()))
 
     def close(self) -> None:

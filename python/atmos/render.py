@@ -10,9 +10,9 @@ def _to_srgb(ctx, spectral, wl):
     return out[0]
 
 
-def _info(info):
+def _info(info, wl):
     return {"seconds": info.seconds, "sun_elevation_deg": info.sun_elevation_deg,
-            "sun_azimuth_deg": info.sun_azimuth_deg}
+            "sun_azimuth_deg": info.sun_azimuth_deg, "wavelengths_nm": [wl.nm[k] for k in range(wl.count)]}
 
 
 def render(scene: Scene | None = None, volume=None, **kw) -> Image:
@@ -22,7 +22,7 @@ def render(scene: Scene | None = None, volume=None, **kw) -> Image:
     (``Scene.with_``). ``volume``: an ``atmos.Volume`` drawn instead of the scene's own, where
     its origin puts it (see ``Plan``); name a renderer for it here (``renderer="path"``), as a
     scene without a volume of its own cannot name a volume renderer. The GIL is released while the library renders."""
-    scene = scene or Scene.default()
+    scene = _as_scene(scene)
     if volume is not None:
         scene = _scene_for_volume(scene)
     if kw:
@@ -41,7 +41,15 @@ def render(scene: Scene | None = None, volume=None, **kw) -> Image:
     check(lib.atmos_scene_wavelengths(ctx, s, wl), ctx)
     rgb = _to_srgb(ctx, spec_img, wl)
     ffi.release(spec_img)
-    return Image(rgb, _info(info))
+    return Image(rgb, _info(info, wl))
+
+
+def _as_scene(scene) -> Scene:
+    if scene is None:
+        return Scene.default()
+    if not isinstance(scene, Scene):
+        raise TypeError(f"atmos: expected an atmos.Scene (atmos.Scene.load(path) for a file), got {type(scene).__name__}")
+    return scene
 
 
 def _frame(ctx, s):
@@ -76,6 +84,7 @@ class Plan:
     """
 
     def __init__(self, scene: Scene, volume=None):
+        scene = _as_scene(scene)
         ctx = context()
         desc = ffi.NULL
         if volume is not None:
@@ -116,9 +125,10 @@ class Plan:
         spec = ffi.gc(img[0], lib.atmos_image_destroy)
         info = ffi.new("atmos_render_info *")
         check(lib.atmos_plan_render(self._ptr, f, ffi.NULL, spec, info), ctx)
-        rgb = _to_srgb(ctx, spec, lib.atmos_plan_wavelengths(self._ptr))
+        wl = lib.atmos_plan_wavelengths(self._ptr)
+        rgb = _to_srgb(ctx, spec, wl)
         ffi.release(spec)
-        return Image(rgb, _info(info))
+        return Image(rgb, _info(info, wl))
 
     def close(self) -> None:
         """Frees the plan now."""

@@ -17,9 +17,20 @@ _SHORT = {
 }
 
 
+def _plain(value):
+    """NumPy scalars and arrays as the Python numbers and lists JSON knows."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"atmos: a scene value must be JSON-like, got {type(value).__name__}")
+
+
+def _dumps(value) -> str:
+    return json.dumps(value, default=_plain)
+
+
 def _override(key: str, value) -> str:
     path = _SHORT.get(key, key.replace("__", "."))
-    return f"{path}={json.dumps(value)}"
+    return f"{path}={_dumps(value)}"
 
 
 class Scene:
@@ -52,7 +63,9 @@ class Scene:
     @classmethod
     def from_dict(cls, d: dict, source: str = "dict") -> "Scene":
         """A scene from a dict with the scene file's keys."""
-        return cls(json.dumps(d), source=source)
+        if not isinstance(d, dict):
+            raise TypeError(f"atmos.Scene.from_dict: expected a dict, got {type(d).__name__}")
+        return cls(_dumps(d), source=source)
 
     @classmethod
     def from_json(cls, text: str, source: str = "json") -> "Scene":
@@ -78,6 +91,14 @@ class Scene:
             st = lib.atmos_scene_parse_with(ctx, raw, len(raw), self._source.encode(), arr, len(keep), out)
         check(st, ctx)
         return out
+
+    @property
+    def wavelengths_nm(self):
+        """The scene's wavelengths in nm: what the K of render images and sky_radiance are."""
+        ctx = context()
+        wl = ffi.new("atmos_wavelengths *")
+        check(lib.atmos_scene_wavelengths(ctx, self._struct(), wl), ctx)
+        return [wl.nm[k] for k in range(wl.count)]
 
     @property
     def size(self):

@@ -20,6 +20,8 @@ def sky_radiance(scene: Scene, dirs, position_m=None) -> np.ndarray:
     d = np.ascontiguousarray(dirs, dtype=np.float64)
     if d.shape[-1] != 3:
         raise ValueError(f"atmos.sky_radiance: directions must have shape (..., 3), got {d.shape}")
+    if not np.all(np.isfinite(d)):
+        raise ValueError("atmos.sky_radiance: a direction is not finite (NaN or infinity)")
     norm = np.linalg.norm(d, axis=-1, keepdims=True)
     if not np.all(norm > 0):
         raise ValueError("atmos.sky_radiance: a direction has zero length")

@@ -78,7 +78,7 @@ class Volume:
     def to_array(self, field: str | int = 0) -> np.ndarray:
         """A field's densities at the voxel centres as a new (nz, ny, nx) float32 array."""
         names = list(self.fields)
-        i = names.index(field) if isinstance(field, str) else int(field)
+        i = names.index(field) if isinstance(field, str) and field in names else (-1 if isinstance(field, str) else int(field))
         if not 0 <= i < len(names):
             raise KeyError(f"atmos.Volume: no field {field!r}; fields: {names}")
         out = np.empty(self.shape, dtype=np.float32)

@@ -77,6 +77,15 @@ for f in os.listdir(d):
     assert b[:8] == b"\x89PNG\r\n\x1a\n" and b[-12:-4] == b"\x00\x00\x00\x00IEND", f
 PY
 
+# A later frame's output that cannot be written (a folder by its name) fails before any frame
+# is rendered: nothing written.
+mkdir -p "$T/late/f_0003.png"
+"$A" render --width 16 --height 8 --frames 4 --sun-elevation 5 --sun-elevation-end 20 -q -o "$T/late/f.png" \
+    2>"$T/late.err"
+st=$?
+if [ $st -eq 1 ] && grep -q "frame 3" "$T/late.err" && [ ! -e "$T/late/f_0001.png" ]; then ok; else
+    bad "a later frame's bad output: exit $st, $(cat "$T/late.err")"; fi
+
 rm -rf "$T"
 echo "render_frames: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -28,7 +28,7 @@ libdir=$(dirname "$(find "$P" -name libatmos.so -print | head -n 1)")
 [ -n "$libdir" ] && [ -d "$libdir" ] || { bad "no libatmos.so installed"; exit 1; }
 for f in "$P/include/atmos/atmos.h" "$libdir/libatmos.a" "$libdir/pkgconfig/atmos.pc" \
          "$libdir/cmake/atmos/atmos-config.cmake" "$libdir/cmake/atmos/atmos-config-version.cmake" \
-         "$P/bin/atmos" "$P/share/man/man1/atmos.1" "$P/share/doc/atmos/README.md"; do
+         "$P/bin/atmos" "$P/share/man/man1/atmos.1" "$P/share/doc/atmos/README.md" "$P/share/doc/atmos/docs/install.md"; do
     [ -s "$f" ] && ok "installed ${f#"$P"/}" || bad "missing ${f#"$P"/}"
 done
 soname=$(objdump -p "$libdir/libatmos.so" 2>/dev/null | awk '$1 == "SONAME" {print $2}')
@@ -75,6 +75,19 @@ objdump -p "$T/pc/sky_static" 2>/dev/null | grep -q "NEEDED.*libatmos" && bad "t
 check "examples/ configured with find_package(atmos)" cmake -S "$src/examples" -B "$T/cm" -DCMAKE_PREFIX_PATH="$P" \
     -DCMAKE_C_COMPILER="$CC" -DCMAKE_BUILD_TYPE=Release
 check "examples/ built with atmos::atmos and atmos::atmos_static" cmake --build "$T/cm"
+
+# A C++-only project (no C enabled) finds the package and links the library.
+mkdir -p "$T/cxxproj"
+cp "$T/cxx.cpp" "$T/cxxproj/main.cpp"
+cat >"$T/cxxproj/CMakeLists.txt" <<'CM'
+cmake_minimum_required(VERSION 3.16)
+project(cxxonly CXX)
+find_package(atmos 0.1 REQUIRED)
+add_executable(cxxonly main.cpp)
+target_link_libraries(cxxonly PRIVATE atmos::atmos)
+CM
+check "a C++-only CMake project finds atmos" cmake -S "$T/cxxproj" -B "$T/cxxb" -DCMAKE_PREFIX_PATH="$P" -DCMAKE_CXX_COMPILER="$CXX"
+check "the C++-only project builds" cmake --build "$T/cxxb"
 
 # Run them (small sizes).
 cd "$T" || exit 1

@@ -243,3 +243,20 @@ def test_volume_file_without_camera_is_framed_as_the_cli_frames_it(tmp_path):
     assert a[16, 24, 3] > 0.5  # the cloud is in the middle of the frame
     with atmos.Plan(scene) as plan:
         assert np.array_equal(np.asarray(plan.render())[..., :3], cli)
+
+
+def test_numpy_values_and_wrong_types():
+    s = atmos.Scene.default().with_(width=np.int64(20), height=np.int32(10), sun_elevation_deg=np.float32(12),
+                                    camera__position_m=np.array([0.0, 900.0, 0.0]))
+    assert s.size == (20, 10)
+    assert atmos.Scene.from_dict({"image": {"width": np.int64(8), "height": 6}}).size == (8, 6)
+    assert s.wavelengths_nm == [680.0, 550.0, 440.0]
+    assert atmos.render(s).meta["wavelengths_nm"] == s.wavelengths_nm
+    with pytest.raises(TypeError):
+        atmos.render("scene.json")
+    with pytest.raises(KeyError):
+        atmos.Volume.from_array(np.ones((2, 2, 2)), 1.0).to_array("nope")
+    with pytest.raises(ValueError, match="not finite"):
+        atmos.sky_radiance(s, np.array([[np.nan, 1.0, 0.0]]))
+    with pytest.raises(ValueError, match=".exr"):
+        atmos.render(s).write_exr("x.png")

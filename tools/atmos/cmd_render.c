@@ -1,6 +1,7 @@
 /* atmos render: a scene file (or the built-in default) to PNG / EXR / PFM. The options
  * (render_opts.c) become a scene; the scene becomes one plan; every frame of its animation
  * is rendered from that plan (atmos_plan_render, the same call atmos_render_scene makes). */
+#define _POSIX_C_SOURCE 200809L /* access */
 #include "outputs.h"
 #include "render_opts.h"
 #include "dist.h"
@@ -11,6 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 /* The options that name files, in the order of frame_files' names. */
 static const char *const out_option[6] = {"-o", "--exr", "--pfm", "--variance", "--order", "--tau"};
@@ -57,6 +60,32 @@ static int name_frame_files(const render_opts *o, const char *png, int frame, in
         *dst[i] = ff->buf[i];
     }
     return 1;
+}
+
+/* Every frame's outputs after the first can be written where they are named: not an
+ * existing folder, in a folder that exists and takes files or can be made (frame 1's are
+ * staged before any work; an animation must not fail at frame 200 for a name). Returns
+ * CLI_EXIT_OK or CLI_EXIT_RUNTIME (message printed). */
+static int check_frame_names(const render_opts *o, const char *png, int nframes)
+{
+    frame_files ff;
+    for (int frame = 2; frame <= nframes; frame++) {
+        if (!name_frame_files(o, png, frame, nframes, &ff)) return CLI_EXIT_RUNTIME;
+        const char *names[5] = {ff.out, ff.exr, ff.pfm, ff.var, ff.ord};
+        for (int i = 0; i < 5; i++) {
+            struct stat st;
+            if (!names[i]) continue;
+            if (stat(names[i], &st) == 0 && S_ISDIR(st.st_mode)) {
+                fprintf(stderr, "atmos render: %s: frame %d's output is a folder\n", names[i], frame);
+                return CLI_EXIT_RUNTIME;
+            }
+            if (stat(names[i], &st) == 0 && access(names[i], W_OK) != 0) {
+                fprintf(stderr, "atmos render: %s: frame %d's output cannot be written\n", names[i], frame);
+                return CLI_EXIT_RUNTIME;
+            }
+        }
+    }
+    return CLI_EXIT_OK;
 }
 
 /* The outputs of frame `frame` named (ff), checked and staged (set): w gets the staging
@@ -337,6 +366,7 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     if (d->rank == 0) {
         rc = check_outputs(o, scene, png);
         if (rc == CLI_EXIT_OK) rc = stage_frame(o, png, 1, nframes, &fo.ff, &fo.set, &fo.w);
+        if (rc == CLI_EXIT_OK && nframes > 1) rc = check_frame_names(o, png, nframes);
     }
     if ((rc = cli_dist_max(d, rc)) != CLI_EXIT_OK) return cli_outputs_discard(&fo.set), rc;
     atmos_plan *plan = NULL;

@@ -259,6 +259,8 @@ static int check_options(const render_opts *o)
         return cli_usage_error(C, "--variance, --order and the order and variance layers are not written with --mpi "
                                   "(each rank holds its own samples)");
     if (o->exr_layers && !o->exr) return cli_usage_error(C, "--exr-layers: they go in the --exr file; give one");
+    if (o->mpi && o->scene_path && !strcmp(o->scene_path, "-"))
+        return cli_usage_error(C, "--mpi: the scene must be a file (standard input reaches rank 0 only)");
     if (o->time_end && (!isnan(o->sun_el_end) || !isnan(o->sun_az_end)))
         return cli_usage_error(C, "--time-end (a sun given by time) and --sun-elevation-end/--sun-azimuth-end "
                                   "(a sun given by angles) exclude each other");
@@ -500,6 +502,10 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
     if (o->volume_pos_given) s->volume.placed = 1, memcpy(s->volume.position_m, o->volume_pos, sizeof o->volume_pos);
     if (o->density_scale > 0) s->volume.density_scale = o->density_scale;
     if (o->tau && !s->volume.source[0]) return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
+    if ((o->exr_layers & (RENDER_LAYER_TAU | RENDER_LAYER_TRANSMITTANCE)) && !s->volume.source[0])
+        return cli_usage_error(C, "--exr-layers tau, transmittance: they need a volume (--volume or a scene with one)");
+    if ((o->exr_layers & (RENDER_LAYER_ORDER | RENDER_LAYER_VARIANCE)) && s->renderer != ATMOS_RENDERER_PATH)
+        return cli_usage_error(C, "--exr-layers order, variance: they are the path tracer's (--renderer path)");
     if (!o->scene_path && (r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_NISHITA || r == ATMOS_RENDERER_HARRIS) &&
         !s->volume.source[0])
         return cli_usage_error(C, "--renderer %s needs --volume FILE or --volume generate:PRESET", atmos_renderer_name(r));
