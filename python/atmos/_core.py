@@ -58,3 +58,23 @@ def check(status: int, ctx=None) -> None:
 def version() -> str:
     """The library's version, "MAJOR.MINOR.PATCH"."""
     return ffi.string(lib.atmos_version()).decode()
+
+
+class Owned:
+    """An object holding one library object in ``_ptr`` (a cffi pointer with its destructor):
+    ``close()`` frees it at once, ``with`` closes it at the block's end, and collection
+    frees it otherwise."""
+
+    _ptr = None
+
+    def close(self) -> None:
+        """Frees the library object now."""
+        if self._ptr is not None:
+            ffi.release(self._ptr)
+            self._ptr = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -1,10 +1,10 @@
 """Images: an atmos image seen by NumPy without a copy."""
 import numpy as np
 
-from atmos._core import check, context, ffi, lib
+from atmos._core import Owned, check, context, ffi, lib
 
 
-class Image:
+class Image(Owned):
     """An image the library made: ``height x width`` pixels of ``channels`` float32 values,
     row-major, top row first. ``numpy.asarray(image)`` is a ``(height, width, channels)``
     float32 view of the library's own buffer (no copy; the array keeps the image alive).
@@ -12,7 +12,8 @@ class Image:
     Rendered images hold linear sRGB (Rec. 709 primaries, D65; Y in cd/m^2) and coverage alpha:
     channels 0-2 are what ``atmos render --pfm`` writes. ``meta`` holds the image's metadata
     (scene, renderer, sun, camera: the library's atmos:* keys, and the render's time) as a
-    dict of strings; ``channels`` names the channels. ``close()`` (or ``with``) frees it at once."""
+    dict of strings; ``channels`` names the channels. ``close()`` (or ``with``) frees it at once;
+    arrays made from it must not be used afterwards."""
 
     def __init__(self, ptr, meta=None, channels=None):
         self._ptr = ffi.gc(ptr, lib.atmos_image_destroy)
@@ -57,18 +58,6 @@ class Image:
         if not str(path).lower().endswith(".pfm"):
             raise ValueError(f"atmos.Image.write_pfm: {path}: a portable float map's name ends in .pfm")
         check(lib.atmos_write_pfm(context(), self._live(), str(path).encode()))
-
-    def close(self) -> None:
-        """Frees the pixels now. Arrays made from the image must not be used afterwards."""
-        if self._ptr is not None:
-            ffi.release(self._ptr)
-            self._ptr = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
     def __repr__(self):
         if self._ptr is None:

@@ -1,5 +1,5 @@
 """Rendering: one call for one image, a plan for many frames of one scene."""
-from atmos._core import check, context, ffi, lib
+from atmos._core import Owned, check, context, ffi, lib
 from atmos.image import Image
 from atmos.scene import Scene
 
@@ -69,7 +69,7 @@ def _scene_for_volume(scene: Scene) -> Scene:
     return scene.with_(volume__generate="cumulus")
 
 
-class Plan:
+class Plan(Owned):
     """A plan: the scene's atmosphere, volume, optics and renderer state made once; each
     ``render(camera=..., sun=...)`` does only the work its changes need (a moved sun does not
     resample the volume; the path tracer adds samples while nothing moves). ``volume``: an
@@ -129,18 +129,6 @@ class Plan:
         rgb = _to_srgb(ctx, spec, wl)
         ffi.release(spec)
         return Image(rgb, _info(info, wl))
-
-    def close(self) -> None:
-        """Frees the plan now."""
-        if self._ptr is not None:
-            ffi.release(self._ptr)
-            self._ptr = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
     def __repr__(self):
         return "<atmos.Plan closed>" if self._ptr is None else f"<atmos.Plan {self._frame.width}x{self._frame.height}>"

@@ -20,6 +20,11 @@ void atmos__log(const atmos_context *ctx, atmos_log_level level, const char *fmt
 void atmos__context_redirect_log(atmos_context *ctx, atmos_log_fn fn, void *user);
 /* Reports progress; returns nonzero if the caller asked to cancel. */
 int atmos__progress(const atmos_context *ctx, const char *stage, double fraction);
+/* Inside a parallel loop over n items: one more item done (*done, shared); the calling
+ * thread reports the fraction and sets *cancelled (shared) when asked to stop
+ * (progress_step.c). atmos__cancelled reads that flag. */
+void atmos__progress_step(const atmos_context *ctx, const char *stage, int *done, int n, int *cancelled);
+int atmos__cancelled(const int *cancelled);
 /* Thread count to use for ctx (>= 1): the context's setting, all cores when ctx is NULL. */
 int atmos__threads(const atmos_context *ctx);
 /* A large buffer that is read at random (render grids, light buffers, per-pixel planes):

@@ -19,9 +19,6 @@
 #include "render/beams_internal.h"
 #include "core/vec.h"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -230,23 +227,9 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
          * the same for any thread count */
 #pragma omp for schedule(dynamic, 1)
         for (int y = r->y0; y < r->y1; y++) {
-            int stop;
-#pragma omp atomic read
-            stop = cancelled;
-            if (stop || !f) continue;
+            if (atmos__cancelled(&cancelled) || !f) continue;
             for (int x = r->x0; x < r->x1; x++) pixel(&J, x, y, out->pixels + ((size_t)y * W + x) * C, f);
-            int d;
-#pragma omp atomic capture
-            d = ++done;
-#ifdef _OPENMP
-            if (omp_get_thread_num() == 0)
-#endif
-            {
-                if (atmos__progress(p->ctx, "render beams", (double)d / rows)) {
-#pragma omp atomic write
-                    cancelled = 1;
-                }
-            }
+            atmos__progress_step(p->ctx, "render beams", &done, rows, &cancelled);
         }
         free(f);
     }

@@ -9,9 +9,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 /* Van der Corput radical inverse in base 2: the second coordinate of the
  * Hammersley set used for deterministic, thread-independent pixel samples. */
@@ -265,24 +262,10 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
          * only on its own position, so the image is identical for any thread count. */
 #pragma omp for schedule(dynamic, 1)
         for (int b = 0; b < nbands; b++) {
-            int stop;
-#pragma omp atomic read
-            stop = cancelled;
-            if (stop || !mem) continue;
+            if (atmos__cancelled(&cancelled) || !mem) continue;
             for (int y = r->y0 + b * band; y < r->y1 && y < r->y0 + (b + 1) * band; y++)
                 shade_row(&job, batch, col_sc, y, r->x0, count, &rb, out->pixels + (size_t)y * W * C, C);
-            int d;
-#pragma omp atomic capture
-            d = ++done;
-#ifdef _OPENMP
-            if (omp_get_thread_num() == 0)
-#endif
-            {
-                if (atmos__progress(ctx, "render sky", (double)d / nbands)) {
-#pragma omp atomic write
-                    cancelled = 1;
-                }
-            }
+            atmos__progress_step(ctx, "render sky", &done, nbands, &cancelled);
         }
         free(mem);
     }
