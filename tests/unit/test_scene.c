@@ -233,8 +233,8 @@ typedef struct bad_case {
     const char *expect1, *expect2; /* substrings of the message (NULL: none) */
 } bad_case;
 
-static const bad_case bad_cases[] = {
-    /* structure and types */
+/* Bad scenes: structure and types. */
+static const bad_case bad_structure[] = {
     {"{\"bogus\": 1}", ATMOS_E_INVALID_ARG, "scene.json: /bogus: unknown key (allowed: name, image, camera, sun, atmosphere, wavelengths, output, renderer, particles, background, volume, slice, path, animation, nishita, harris, beams, lights, fog, objects)", NULL},
     {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
     {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
@@ -255,7 +255,10 @@ static const bad_case bad_cases[] = {
     {"{\"output\": {\"exposure\": \"bright\"}}", ATMOS_E_INVALID_ARG, "/output/exposure: must be \"auto\" or a number", NULL},
     {"{\"output\": {\"exposure\": true}}", ATMOS_E_INVALID_ARG, "/output/exposure: expected \"auto\" or a number (EV100), got a boolean", NULL},
     {"{\"renderer\": \"raytrace\"}", ATMOS_E_INVALID_ARG, "/renderer: must be one of sky, slice, path, nishita, harris, beams, got \"raytrace\"", NULL},
-    /* lights, fog, objects: absurd values */
+};
+
+/* Bad scenes: lights, fog, objects: absurd values. */
+static const bad_case bad_lights[] = {
     {"{\"lights\": [{\"type\": \"torch\"}]}", ATMOS_E_INVALID_ARG, "/lights/0/type: must be one of point, spot", NULL},
     {"{\"lights\": [{}, {\"intensity_w_sr\": -5}]}", ATMOS_E_INVALID_ARG, "/lights/1/intensity_w_sr: must be in (0, 1000000000]", NULL},
     {"{\"lights\": [{\"type\": \"spot\", \"cone_deg\": 120}]}", ATMOS_E_INVALID_ARG, "/lights/0/cone_deg: must be in [0, 89]", NULL},
@@ -278,7 +281,10 @@ static const bad_case bad_cases[] = {
     {"{\"renderer\": \"beams\"}", ATMOS_E_INVALID_ARG, "/lights: the beams renderer draws the light of \"lights\": the scene has none", NULL},
     {"{\"renderer\": \"beams\", \"lights\": [{}], \"camera\": {\"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/type: the beams renderer supports pinhole cameras only", NULL},
     {"{\"renderer\": \"beams\", \"lights\": [{}], \"beams\": {\"epsilon\": 0}}", ATMOS_E_INVALID_ARG, "/beams/epsilon: must be in (0, 1]", NULL},
-    /* renderers, background, volume */
+};
+
+/* Bad scenes: renderers, background, volume. */
+static const bad_case bad_renderers[] = {
     {"{\"renderer\": \"slice\"}", ATMOS_E_INVALID_ARG, "/renderer: \"slice\" renders a volume: the scene needs \"volume\"", NULL},
     {"{\"renderer\": \"sky\", \"volume\": {\"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume: the sky renderer draws no volume", NULL},
     {"{\"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/type: the slice renderer supports pinhole cameras only", NULL},
@@ -315,7 +321,10 @@ static const bad_case bad_cases[] = {
     {"{\"sun\": {\"irradiance\": -2}}", ATMOS_E_INVALID_ARG, "/sun/irradiance: must be in [0, 1000000], got -2", NULL},
     {"{\"sun\": {\"irradiance\": [1, 2, 3]}, \"wavelengths\": {\"mode\": \"spectral\"}}", ATMOS_E_INVALID_ARG, "/sun/irradiance: three values are the rgb channels", NULL},
     {"{\"image\": {\"width\": 10, \"width\": 20}}", ATMOS_E_INVALID_ARG, "/image/width: duplicate key", NULL},
-    /* ranges, at each side of each boundary that matters */
+};
+
+/* Bad scenes: ranges, at each side of each boundary that matters. */
+static const bad_case bad_ranges[] = {
     {"{\"image\": {\"width\": 0}}", ATMOS_E_INVALID_ARG, "/image/width: must be in [1, 16384], got 0", NULL},
     {"{\"image\": {\"height\": 16385}}", ATMOS_E_INVALID_ARG, "/image/height: must be in [1, 16384], got 16385", NULL},
     {"{\"image\": {\"width\": 1e10}}", ATMOS_E_INVALID_ARG, "/image/width: must be in [1, 16384]", NULL},
@@ -361,12 +370,18 @@ static const bad_case bad_cases[] = {
     {"{\"output\": {\"png_bits\": 12}}", ATMOS_E_INVALID_ARG, "/output/png_bits: must be 8 or 16, got 12", NULL},
     {"{\"output\": {\"png_bits\": 1e300}}", ATMOS_E_INVALID_ARG, "/output/png_bits", NULL},
     {"{\"name\": \"nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn\"}", ATMOS_E_INVALID_ARG, "/name: must be at most 127 bytes, got 128", NULL},
-    /* numbers that are not finite doubles */
+};
+
+/* Bad scenes: numbers that are not finite doubles. */
+static const bad_case bad_numbers[] = {
     {"{\"camera\": {\"fov_deg\": 1e999}}", ATMOS_E_INVALID_ARG, "/camera/fov_deg: must be a finite number", NULL},
     {"{\"image\": {\"width\": -1e999}}", ATMOS_E_INVALID_ARG, "/image/width: must be a finite number", NULL},
     {"{\"camera\": {\"position_m\": [0, 1e400, 0]}}", ATMOS_E_INVALID_ARG, "/camera/position_m/1: must be a finite number", NULL},
     {"{\"camera\": {\"fov_deg\": NaN}}", ATMOS_E_FORMAT, "scene.json:1:", "malformed JSON"},
-    /* malformed text */
+};
+
+/* Bad scenes: malformed text. */
+static const bad_case bad_text[] = {
     {"", ATMOS_E_FORMAT, "scene.json: empty input", NULL},
     {" \n\t ", ATMOS_E_FORMAT, "empty input", NULL},
     {"{\"image\": {\"width\": 10,}}", ATMOS_E_FORMAT, "scene.json:1:", "malformed JSON"},
@@ -381,7 +396,10 @@ static const bad_case bad_cases[] = {
     {"{\"name\": \"nul \\u0000 escape\"}", ATMOS_E_FORMAT, "\\u0000 is not allowed", NULL},
     {"{\"_deep\": [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]}", ATMOS_E_LIMIT, "scene.json:1:", "nesting deeper than 64 levels"},
     {"\"just a string\"", ATMOS_E_INVALID_ARG, "/: expected an object, got a string", NULL},
-    /* animation */
+};
+
+/* Bad scenes: animation. */
+static const bad_case bad_animation[] = {
     {"{\"animation\": {\"time_end\": \"2026-06-21T12:00:00Z\"}}", ATMOS_E_INVALID_ARG, "/animation: missing key \"frames\"", NULL},
     {"{\"animation\": {\"frames\": 0, \"elevation_end_deg\": 3}}", ATMOS_E_INVALID_ARG, "/animation/frames: must be in [1, 100000], got 0", NULL},
     {"{\"animation\": {\"frames\": 4, \"fps\": 24}}", ATMOS_E_INVALID_ARG, "/animation/fps: unknown key", "time_end"},
@@ -395,6 +413,21 @@ static const bad_case bad_cases[] = {
     {"{\"animation\": {\"frames\": 4, \"azimuth_end_deg\": 360}}", ATMOS_E_INVALID_ARG, "/animation/azimuth_end_deg: must be in [0, 360)", NULL},
     {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": -91}}", ATMOS_E_INVALID_ARG, "/animation/elevation_end_deg: must be in [-90, 90]", NULL},
     {"{\"image\": {\"width\": 10}} \x01", ATMOS_E_FORMAT, "control character", NULL},
+};
+
+/* The groups of bad scenes, each checked case by case. */
+static const struct {
+    const char *name;
+    const bad_case *cases;
+    int n;
+} bad_groups[] = {
+    {"structure and types", bad_structure, (int)(sizeof bad_structure / sizeof bad_structure[0])},
+    {"lights, fog, objects: absurd values", bad_lights, (int)(sizeof bad_lights / sizeof bad_lights[0])},
+    {"renderers, background, volume", bad_renderers, (int)(sizeof bad_renderers / sizeof bad_renderers[0])},
+    {"ranges, at each side of each boundary that matters", bad_ranges, (int)(sizeof bad_ranges / sizeof bad_ranges[0])},
+    {"numbers that are not finite doubles", bad_numbers, (int)(sizeof bad_numbers / sizeof bad_numbers[0])},
+    {"malformed text", bad_text, (int)(sizeof bad_text / sizeof bad_text[0])},
+    {"animation", bad_animation, (int)(sizeof bad_animation / sizeof bad_animation[0])},
 };
 
 /* Lights, fog and objects read back value by value, with the defaults of what is absent. */
@@ -434,25 +467,32 @@ static void test_lights(void)
     CHECK(parse(big, &s) == ATMOS_E_LIMIT && contains(atmos_context_error(ctx), "/lights/32: at most 32 are allowed"));
 }
 
-static void test_bad_scenes(void)
+/* Every case of one group is refused with its status and message, the output untouched. */
+static int check_bad_group(const char *group, const bad_case *cases, int n)
 {
-    int n = (int)(sizeof bad_cases / sizeof bad_cases[0]);
     for (int i = 0; i < n; i++) {
-        const bad_case *c = &bad_cases[i];
+        const bad_case *c = &cases[i];
         atmos_scene s, before;
         memset(&s, 0x5A, sizeof s);
         before = s;
         atmos_context_clear_error(ctx);
         atmos_status st = parse(c->json, &s);
         const char *msg = atmos_context_error(ctx);
-        CHECK_MSG(st == c->status, "case %d (%s): status %s, expected %s; message: %s", i, c->json,
+        CHECK_MSG(st == c->status, "%s case %d (%s): status %s, expected %s; message: %s", group, i, c->json,
                   atmos_status_string(st), atmos_status_string(c->status), msg);
         CHECK_MSG(contains(msg, c->expect1) && contains(msg, c->expect2),
-                  "case %d (%s): message \"%s\" lacks \"%s\" / \"%s\"", i, c->json, msg, c->expect1,
+                  "%s case %d (%s): message \"%s\" lacks \"%s\" / \"%s\"", group, i, c->json, msg, c->expect1,
                   c->expect2 ? c->expect2 : "");
-        CHECK_MSG(strncmp(msg, "scene.json", 10) == 0, "case %d: message \"%s\" does not start with the source", i, msg);
-        CHECK_MSG(memcmp(&s, &before, sizeof s) == 0, "case %d: output modified on failure", i);
+        CHECK_MSG(strncmp(msg, "scene.json", 10) == 0, "%s case %d: message \"%s\" does not start with the source", group, i, msg);
+        CHECK_MSG(memcmp(&s, &before, sizeof s) == 0, "%s case %d: output modified on failure", group, i);
     }
+    return n;
+}
+
+static void test_bad_scenes(void)
+{
+    int n = 0;
+    for (size_t g = 0; g < sizeof bad_groups / sizeof bad_groups[0]; g++) n += check_bad_group(bad_groups[g].name, bad_groups[g].cases, bad_groups[g].n);
     printf("%d bad scenes checked\n", n);
 
     /* The brief's examples, word for word. */

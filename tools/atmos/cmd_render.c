@@ -74,13 +74,10 @@ static int check_frame_names(const render_opts *o, const char *png, int nframes)
         const char *names[5] = {ff.out, ff.exr, ff.pfm, ff.var, ff.ord};
         for (int i = 0; i < 5; i++) {
             struct stat st;
-            if (!names[i]) continue;
-            if (stat(names[i], &st) == 0 && S_ISDIR(st.st_mode)) {
-                fprintf(stderr, "atmos render: %s: frame %d's output is a folder\n", names[i], frame);
-                return CLI_EXIT_RUNTIME;
-            }
-            if (stat(names[i], &st) == 0 && access(names[i], W_OK) != 0) {
-                fprintf(stderr, "atmos render: %s: frame %d's output cannot be written\n", names[i], frame);
+            if (!names[i] || stat(names[i], &st) != 0) continue; /* new files: their folder is frame 1's */
+            const char *why = S_ISDIR(st.st_mode) ? "is a folder" : access(names[i], W_OK) ? "cannot be written" : NULL;
+            if (why) {
+                fprintf(stderr, "atmos render: %s: frame %d's output %s\n", names[i], frame, why);
                 return CLI_EXIT_RUNTIME;
             }
         }
