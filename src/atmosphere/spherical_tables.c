@@ -193,15 +193,19 @@ atmos_status atmos__sph_build(atmos_context *ctx, const atmos__planet *pl, atmos
     const double g0[3] = {0, 0, 0};
     double albedo[ATMOS_MAX_WAVELENGTHS];
     for (int k = 0; k < m->n; k++) albedo[k] = atmos__planet_ground_albedo(pl, g0, k);
+    const double steps = 3.0 + ATMOS__SPH_J_ITER;
+    atmos__progress(ctx, "sky tables", 0.0);
     build_tau(pl, m);
     build_psi(pl, m, albedo);
     build_esky(pl, m);
+    atmos__progress(ctx, "sky tables", 3.0 / steps);
     /* the higher orders with their angular dependence: fixed-point iterations from Psi_ms,
      * the sky's irradiance of the ground renewed after each (spherical_ms.c) */
     for (int it = 0; it < ATMOS__SPH_J_ITER; it++) {
         const atmos_status st = atmos__sph_build_j(pl, m, albedo);
         if (st != ATMOS_OK) return atmos__error(ctx, st, "atmosphere: out of memory");
         build_esky(pl, m);
+        atmos__progress(ctx, "sky tables", (4.0 + it) / steps);
     }
     m->build_seconds = atmos__now() - t0;
     return ATMOS_OK;

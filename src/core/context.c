@@ -112,6 +112,13 @@ void atmos__context_redirect_log(atmos_context *ctx, atmos_log_fn fn, void *user
     ctx->desc.log_user = user;
 }
 
+void atmos__context_redirect_progress(atmos_context *ctx, atmos_progress_fn fn, void *user)
+{
+    if (!ctx) return;
+    ctx->desc.progress = fn;
+    ctx->desc.progress_user = user;
+}
+
 int atmos__threads(const atmos_context *ctx)
 {
     if (ctx && ctx->desc.threads > 0) return ctx->desc.threads;

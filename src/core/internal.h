@@ -18,6 +18,8 @@ void atmos__log(const atmos_context *ctx, atmos_log_level level, const char *fmt
 /* Sends ctx's log messages to fn instead of the user's callback (a reader's child process
  * forwards them to its parent, volume/reader_fence.c); the level filter stays. */
 void atmos__context_redirect_log(atmos_context *ctx, atmos_log_fn fn, void *user);
+/* Sends ctx's progress reports to fn instead (the volume readers' child process). */
+void atmos__context_redirect_progress(atmos_context *ctx, atmos_progress_fn fn, void *user);
 /* Reports progress; returns nonzero if the caller asked to cancel. */
 int atmos__progress(const atmos_context *ctx, const char *stage, double fraction);
 /* Inside a parallel loop over n items: one more item done (*done, shared); the calling

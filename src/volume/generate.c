@@ -73,8 +73,10 @@ atmos_status atmos_volume_generate(atmos_context *ctx, const char *preset, const
     job.max_memory = desc->max_memory ? desc->max_memory : ATMOS_VOLUME_DEFAULT_MAX_MEMORY;
     job.threads = atmos__threads(ctx);
     job.rng.s = desc->seed ^ 0xA7305C10D5ull;
+    atmos__progress(ctx, "volume generate", 0.0);
     atmos_status st = atmos__gen_preset(&job, which);
     if (st == ATMOS_OK) st = to_volume(&job, out);
+    if (st == ATMOS_OK) atmos__progress(ctx, "volume generate", 1.0);
     for (int g = 0; g < GEN_MAX_GRIDS; g++) free(job.grid[g].v);
     atmos__gen_balls_free(&job.balls);
     return st;

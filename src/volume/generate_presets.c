@@ -77,7 +77,7 @@ static void cloud_density(gen_job *job, gen_grid *g, double base, double height,
 static atmos_status refine(gen_job *job, gen_grid *g, double r0, int levels, int floor_j, int fringe)
 {
     gen_refine p = {.levels = levels, .r0 = r0, .ratio = 0.5, .coverage = 1.5, .iso = ISO,
-                    .floor_j = floor_j, .max_balls = 20000, .fringe = fringe};
+                    .floor_j = floor_j, .max_balls = 20000, .fringe = fringe, .ctx = job->ctx};
     return atmos__gen_refine(g, &job->balls, &p, &job->rng, job->threads) ? ATMOS_OK : nomem(job);
 }
 

@@ -85,6 +85,7 @@ typedef struct {
     int floor_j;
     int max_balls;      /* per level */
     int fringe;         /* shrink radii away from the centre (one cloud) */
+    const atmos_context *ctx; /* progress "volume generate" from 0.1 to 0.9 over the levels */
 } gen_refine;
 int atmos__gen_refine(gen_grid *g, gen_balls *bl, const gen_refine *p, gen_rng *rng, int threads);
 

@@ -148,6 +148,7 @@ int atmos__gen_refine(gen_grid *g, gen_balls *bl, const gen_refine *p, gen_rng *
         free(cdf);
         free(mesh.t);
         atmos__gen_accumulate(g, bl, first, threads);
+        atmos__progress(p->ctx, "volume generate", 0.1 + 0.8 * (level + 1.0) / p->levels);
     }
     return 1;
 }

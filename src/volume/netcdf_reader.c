@@ -914,16 +914,22 @@ static atmos_status load(loader *L)
         (st = check_density_vars(L)) || (st = read_extents(L)) || (st = choose_region(L)) ||
         (st = allocate_slabs(L)) || (st = read_columns(L)))
         return st;
-    for (int si = 0; si < L->nsel; si++)
+    const double steps = 2.0 * L->nsel + 2;
+    atmos__progress(L->s.ctx, "volume load", 1 / steps);
+    for (int si = 0; si < L->nsel; si++) {
         if ((st = number_density(L, si))) return st;
+        atmos__progress(L->s.ctx, "volume load", (2.0 + si) / steps);
+    }
     if ((st = output_grid(L)) || (st = resample_buffers(L))) return st;
     if (L->desc->subgrid_detail > 0)
         atmos__log(L->s.ctx, ATMOS_LOG_WARN,
                    "%s: sub-grid detail added (amplitude %g): an artistic texture below the model's %.0f m grid, "
                    "not model data",
                    L->s.path, L->desc->subgrid_detail, fmin(L->dx, L->dy));
-    for (int si = 0; si < L->nsel; si++)
+    for (int si = 0; si < L->nsel; si++) {
         if ((st = resample_field(L, si))) return st;
+        atmos__progress(L->s.ctx, "volume load", (2.0 + L->nsel + si) / steps);
+    }
     return atmos_volume_finalize(L->s.ctx, L->vol);
 }
 

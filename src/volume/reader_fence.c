@@ -2,6 +2,7 @@
  *
  * Pipe records (native byte order: parent and child are the same program):
  *   'L' int32 level, uint32 n, n bytes     a log message of the child
+ *   'P' int32 fraction x 1e6, uint32 n, n bytes   a progress report of the child (its stage)
  *   'E' int32 status, uint32 n, n bytes    the load failed with this error
  *   'V' atmos_volume_desc, int32 nfields   the volume, followed by nfields x
  *   'F' name[64], particle[64], uint64 file_active, uint32 bricks, bricks x (uint64 position, 512 floats)
@@ -76,6 +77,14 @@ static void forward_log(void *user, atmos_log_level level, const char *msg)
     if (level != ATMOS_LOG_ERROR) send_text(*(const int *)user, 'L', (int32_t)level, msg);
 }
 
+/* The child's progress goes to the parent, which reports it as the first 90 % of the load. */
+static int forward_progress(void *user, const char *stage, double fraction)
+{
+    double f = fraction < 0 ? 0 : fraction > 1 ? 1 : fraction;
+    send_text(*(const int *)user, 'P', (int32_t)(f * 1e6), stage ? stage : "volume load");
+    return 0;
+}
+
 static int send_volume(int fd, const atmos_volume *v)
 {
     const char type_v = 'V', type_f = 'F', type_d = 'D';
@@ -128,6 +137,7 @@ static void child_main(int fd, atmos_context *ctx, const char *path, const atmos
     static int out_fd;
     out_fd = fd;
     atmos__context_redirect_log(ctx, forward_log, &out_fd);
+    atmos__context_redirect_progress(ctx, forward_progress, &out_fd);
     child_limits(l);
     atmos_volume *vol = NULL;
     atmos_status st = load(ctx, path, desc, &vol);
@@ -270,7 +280,7 @@ static atmos_status receive(atmos_context *ctx, in_pipe *p, atmos_volume **out, 
     for (;;) {
         char type;
         if (read_all(p, &type, 1)) return ATMOS_E_IO;
-        if (type == 'L' || type == 'E') {
+        if (type == 'L' || type == 'E' || type == 'P') {
             int32_t code;
             uint32_t n;
             if (read_all(p, &code, 4) || read_all(p, &n, 4) || n > (1u << 20)) return ATMOS_E_IO;
@@ -279,6 +289,7 @@ static atmos_status receive(atmos_context *ctx, in_pipe *p, atmos_volume **out, 
             int bad = read_all(p, msg, n);
             msg[bad ? 0 : n] = '\0';
             if (!bad && type == 'L') atmos__log(ctx, (atmos_log_level)code, "%s", msg);
+            if (!bad && type == 'P') atmos__progress(ctx, msg, 0.9e-6 * code);
             if (!bad && type == 'E') {
                 *reported = 1;
                 atmos__error(ctx, (atmos_status)code, "%s", msg);
@@ -297,6 +308,7 @@ static atmos_status receive(atmos_context *ctx, in_pipe *p, atmos_volume **out, 
         for (int f = 0; f < nf && st == ATMOS_OK; f++) st = receive_field(ctx, p, *out);
         if (st == ATMOS_OK && (read_all(p, &type, 1) || type != 'D')) st = ATMOS_E_IO;
         if (st == ATMOS_OK) st = atmos_volume_finalize(ctx, *out);
+        if (st == ATMOS_OK) atmos__progress(ctx, "volume load", 1.0);
         if (st != ATMOS_E_IO) *reported = st != ATMOS_OK;
         return st;
     }

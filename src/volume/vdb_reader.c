@@ -274,7 +274,10 @@ static atmos_status load(vdb_load *L)
     atmos_status st = select_grids(L->ctx, L->path, L->f, L->desc->grids, L->sel, &L->nsel);
     for (int s = 0; s < L->nsel && st == ATMOS_OK; s++) st = measure_grid(L, s);
     if (st == ATMOS_OK) st = create_volume(L);
-    for (int s = 0; s < L->nsel && st == ATMOS_OK; s++) st = write_grid(L, s);
+    for (int s = 0; s < L->nsel && st == ATMOS_OK; s++) {
+        st = write_grid(L, s);
+        atmos__progress(L->ctx, "volume load", 0.5 * (s + 1.0) / L->nsel);
+    }
     return st == ATMOS_OK ? atmos_volume_finalize(L->ctx, L->vol) : st;
 }
 

@@ -17,8 +17,8 @@ bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
 render_s() { sed -n 's/^atmos render: .*, \([0-9.]*\) s rendering$/\1/p' "$1" | head -n 1; }
 
 # A budget inside a pass: 6 s on passes that would take minutes; stderr is a file, so
-# progress comes as log lines (one every 5 s).
-"$A" render --renderer path --volume generate:cumulus --density-scale 1e6 --width 64 --height 48 --spp 100000 \
+# progress comes as log lines (ATMOS_PROGRESS_INTERVAL asks for one every 2 s).
+ATMOS_PROGRESS_INTERVAL=2 "$A" render --renderer path --volume generate:cumulus --density-scale 1e6 --width 64 --height 48 --spp 100000 \
     --time-budget 6 --threads 2 --pfm "$T/b.pfm" 2> "$T/b.log" && ok || bad "render with --time-budget 6"
 s=$(render_s "$T/b.log")
 python3 -c "import sys; sys.exit(0 if 0 < float('$s') < 7.5 else 1)" 2>/dev/null && ok \

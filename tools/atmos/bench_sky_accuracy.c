@@ -194,7 +194,8 @@ static atmos_status measure_first(acc_run *r, const acc_opts *o, const atmos_atm
                                   atmos_atmosphere *const *models)
 {
     const int total = r->nalt * r->nsun * ACC_MAX_VIEWS, n = r->wl.count;
-    int failed = 0;
+    int failed = 0, done = 0, views = 0;
+    for (int a = 0; a < r->nalt; a++) views += r->nsun * r->nview[a];
 #pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(o))
     for (int t = 0; t < total; t++) {
         int a, s;
@@ -215,6 +216,8 @@ static atmos_status measure_first(acc_run *r, const acc_opts *o, const atmos_atm
             }
             atmos_atmosphere_radiance(models[m], p, d, sun, r->mod[m] + i, NULL);
         }
+#pragma omp critical(acc_progress)
+        cli_progress_bar(cli_shared_progress(), "sky accuracy: first batch", (double)++done / views);
     }
     return failed ? ATMOS_E_INVALID_ARG : ATMOS_OK;
 }
@@ -233,7 +236,6 @@ static atmos_status measure_refine(acc_run *r, const acc_opts *o, const atmos_at
             ymax[a][s] = acc_block_max(r, a, s, -1);
             views += r->nview[a];
         }
-    const double t0 = cli_now_s();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(o))
     for (int t = 0; t < total; t++) {
         int a, s;
@@ -245,12 +247,8 @@ static atmos_status measure_refine(acc_run *r, const acc_opts *o, const atmos_at
 #pragma omp atomic write
             failed = 1;
         }
-        int now;
-#pragma omp atomic capture
-        now = ++done;
-        if (!o->quick && now * 10 / views != (now - 1) * 10 / views)
-            fprintf(stderr, "atmos bench sky-accuracy: %d of %d views refined, %.0f s\n", now, views,
-                    cli_now_s() - t0);
+#pragma omp critical(acc_progress)
+        cli_progress_bar(cli_shared_progress(), "sky accuracy: refining", (double)++done / views);
     }
     return failed ? ATMOS_E_INVALID_ARG : ATMOS_OK;
 }

@@ -149,6 +149,7 @@ int bench_sky_models(int threads, int repeat, double budget_s, const char *model
     if (threads > 0) cd.threads = threads;
     cd.cache_dir = dir;
     cd.log_level = ATMOS_LOG_ERROR;
+    cli_desc_progress(&cd);
     atmos_context *ctx = NULL;
     if (atmos_context_create(&cd, &ctx) != ATMOS_OK) return CLI_EXIT_RUNTIME;
     atmos_status st = ATMOS_OK;

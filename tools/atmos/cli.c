@@ -69,7 +69,23 @@ static void log_stderr(void *user, atmos_log_level level, const char *msg)
     fprintf(stderr, "atmos: %s: %s\n", level == ATMOS_LOG_WARN ? "warning" : "info", buf);
 }
 
-atmos_context *cli_context(int threads, int quiet) { return cli_context_with_progress(threads, quiet, NULL, NULL); }
+static cli_progress shared_progress; /* shown on a terminal whatever the log level */
+
+cli_progress *cli_shared_progress(void) { return &shared_progress; }
+
+void cli_desc_progress(atmos_context_desc *d)
+{
+    cli_progress_init(&shared_progress, 0);
+    d->progress = cli_progress_bar;
+    d->progress_user = &shared_progress;
+}
+
+atmos_context *cli_context(int threads, int quiet)
+{
+    atmos_context_desc d;
+    cli_desc_progress(&d);
+    return cli_context_with_progress(threads, quiet, d.progress, d.progress_user);
+}
 
 atmos_context *cli_context_with_progress(int threads, int quiet, atmos_progress_fn fn, void *user)
 {
@@ -130,16 +146,34 @@ double cli_now_s(void)
 
 void cli_progress_init(cli_progress *p, int quiet)
 {
+    memset(p, 0, sizeof *p);
     p->enabled = !quiet && isatty(2);
-    p->log = !quiet && !p->enabled;
-    p->start = cli_now_s();
-    p->shown = 0;
-    p->last_draw = 0.0;
-    p->last_log = 0.0;
     const char *iv = getenv("ATMOS_PROGRESS_INTERVAL");
     char *end = NULL;
     p->interval = iv && *iv ? strtod(iv, &end) : 5.0;
     if (!(p->interval >= 0) || (end && *end)) p->interval = 5.0;
+    p->log = !quiet && !p->enabled && iv && *iv;
+    const char *dl = getenv("ATMOS_PROGRESS_DELAY");
+    end = NULL;
+    p->delay = dl && *dl ? strtod(dl, &end) : 1.0;
+    if (!(p->delay >= 0) || (end && *end)) p->delay = 1.0;
+    p->start = cli_now_s();
+}
+
+/* A new stage (another name, or the fraction starting again) restarts the clock; a bar
+ * left unfinished on the terminal ends its line first. */
+static void progress_stage(cli_progress *p, const char *stage, double f)
+{
+    if (!strncmp(p->stage, stage, sizeof p->stage - 1) && f >= p->last_fraction) {
+        p->last_fraction = f;
+        return;
+    }
+    if (p->shown && p->enabled) fputc('\n', stderr);
+    snprintf(p->stage, sizeof p->stage, "%s", stage);
+    p->start = cli_now_s();
+    p->shown = 0;
+    p->last_draw = p->last_log = 0.0;
+    p->last_fraction = f;
 }
 
 /* Off a terminal: a line every interval seconds, the first after one interval. */
@@ -155,11 +189,13 @@ static void progress_log(cli_progress *p, const char *stage, double f)
 int cli_progress_bar(void *user, const char *stage, double f)
 {
     cli_progress *p = user;
+    if (!p->enabled && !p->log) return 0;
+    if (!stage) stage = "working";
+    progress_stage(p, stage, f);
     if (p->log) progress_log(p, stage, f);
     if (!p->enabled) return 0;
     double t = cli_now_s() - p->start;
-    if (t < 1.0 && f < 1.0) return 0;
-    if (t < 1.0 && !p->shown) return 0;
+    if (t < p->delay && !p->shown) return 0;
     if (f < 1.0 && t - p->last_draw < 0.1) return 0; /* redraw at most ten times a second */
     p->last_draw = t;
     int width = 30, fill = (int)(f * width + 0.5);
@@ -168,9 +204,13 @@ int cli_progress_bar(void *user, const char *stage, double f)
     bar[width] = '\0';
     double eta = f > 0 ? t * (1.0 - f) / f : 0;
     fprintf(stderr, "\r%s [%s] %3.0f%%  %.1fs elapsed, ETA %.1fs ", stage, bar, 100.0 * f, t, eta);
-    if (f >= 1.0) fputc('\n', stderr);
-    fflush(stderr);
     p->shown = 1;
+    if (f >= 1.0) {
+        fputc('\n', stderr);
+        p->stage[0] = '\0'; /* the line is ended: the next report starts a new bar */
+        p->shown = 0;
+    }
+    fflush(stderr);
     return 0;
 }
 

@@ -19,25 +19,34 @@ int cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format
 int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st);
 /* A context for a subcommand: logs warnings and errors to stderr, threads as given (0 = all). */
 atmos_context *cli_context(int threads, int quiet);
-/* The same with a progress callback. */
+/* Commands' contexts draw the library's progress (a process-wide cli_progress: a bar on a
+ * terminal whatever quiet says of the log); cli_context_with_progress names its own. */
 atmos_context *cli_context_with_progress(int threads, int quiet, atmos_progress_fn fn, void *user);
-/* A progress bar with ETA on stderr for work that takes over ~1 s, redrawn at most
- * ten times a second, when stderr is a terminal and not quiet. When stderr is not a
- * terminal (a log, a batch job) and not quiet: a line "atmos: STAGE: N %, T s elapsed"
- * every few seconds (ATMOS_PROGRESS_INTERVAL seconds, default 5) once the work has taken
- * that long. Pass cli_progress_bar with a cli_progress as the context's progress callback;
- * if p.shown after the work, the bar has already ended its line. */
+/* A progress bar with ETA on stderr for work that takes over a second (ATMOS_PROGRESS_DELAY), redrawn at most
+ * ten times a second, when stderr is a terminal and not quiet; each stage (a new name, or
+ * a fraction that starts again) has its own bar and ETA. When stderr is not a terminal (a
+ * log, a batch job) the bar is not drawn: nothing is written unless ATMOS_PROGRESS_INTERVAL
+ * is set, and then a line "atmos: STAGE: N %, T s elapsed" every that many seconds once the
+ * stage has taken that long. Pass cli_progress_bar with a cli_progress as the context's
+ * progress callback; p.shown: a bar is on the terminal and its line is not ended. */
 typedef struct {
     int enabled;
     double start;
     int shown;
     double last_draw;
-    int log;                /* not a terminal: log lines instead of the bar */
+    int log;                /* not a terminal and ATMOS_PROGRESS_INTERVAL set: log lines */
     double interval;        /* seconds between log lines */
     double last_log;
+    char stage[48];         /* the stage being shown */
+    double last_fraction;
+    double delay;           /* seconds before a bar appears (ATMOS_PROGRESS_DELAY, default 1) */
 } cli_progress;
 void cli_progress_init(cli_progress *p, int quiet);
 int cli_progress_bar(void *user, const char *stage, double fraction);
+/* The commands' shared progress bar as d's progress callback (contexts made by hand). */
+void cli_desc_progress(atmos_context_desc *d);
+/* That bar, for a command's own stages (one thread at a time). */
+cli_progress *cli_shared_progress(void);
 /* atmos sky --table NAME [-o FILE] (sky_tables.c): "list" prints the model's tables. */
 int cli_sky_table(const char *C, atmos_context *ctx, const atmos_atmosphere *atm, const char *name, const char *out);
 /* Monotonic clock, seconds. */

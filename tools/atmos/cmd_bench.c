@@ -212,6 +212,7 @@ static int bench_optics(int threads, int fast, const char *presets)
     if (threads > 0) d.threads = threads;
     d.cache_dir = dir;
     d.log_level = ATMOS_LOG_ERROR;
+    cli_desc_progress(&d);
     atmos_context *ctx = NULL;
     if (atmos_context_create(&d, &ctx) != ATMOS_OK) return CLI_EXIT_RUNTIME;
     char list[256];

@@ -170,6 +170,24 @@ static int make_parents(const char *path, char *bad, size_t cap)
     }
 }
 
+int cli_output_folder(const char *cmd, const char *option, const char *path)
+{
+    char bad[CLI_OUTPUT_PATH_MAX];
+    const int e = make_parents(path, bad, sizeof bad);
+    if (e) {
+        fprintf(stderr, "atmos %s: %s %s: cannot create the folder %s: %s\n", cmd, option, path, bad, strerror(e));
+        return 1;
+    }
+    const char *slash = strrchr(path, '/');
+    char dir[CLI_OUTPUT_PATH_MAX];
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path + (slash == path)) : 1, slash ? path : ".");
+    if (access(dir, W_OK) != 0) {
+        fprintf(stderr, "atmos %s: %s %s: cannot write in %s: %s\n", cmd, option, path, dir, strerror(errno));
+        return 1;
+    }
+    return 0;
+}
+
 int cli_outputs_prepare(const char *cmd, cli_outputs *set)
 {
     for (int i = 0; i < set->n; i++) {

@@ -46,6 +46,9 @@ int cli_outputs_check(const char *cmd, const cli_outputs *set, const char *const
  * and creates the staging files. Returns 0 or 1 (CLI_EXIT_RUNTIME) with a message on
  * stderr; on failure no staging file is left. */
 int cli_outputs_prepare(const char *cmd, cli_outputs *set);
+/* Before work whose output the library writes itself (a raw volume and its sidecar): the
+ * folder of path made (mkdir -p) and writable. 0, or 1 with the reason printed. */
+int cli_output_folder(const char *cmd, const char *option, const char *path);
 /* Renames every staging file onto its final name. Returns 0 or 1 (message printed). */
 int cli_outputs_commit(const char *cmd, cli_outputs *set);
 /* Removes the staging files (and the writers' temporaries next to them). */
