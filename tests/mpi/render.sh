@@ -96,6 +96,34 @@ else bad "unwritable output: exit $st"; sed 's/^/  /' "$T/bad.log" >&2; fi
 left=$(find "$T" -name '*.tmp*' | head -n 1)
 [ -z "$left" ] && ok "no staging file left behind" || bad "left behind: $left"
 
+# A rank that dies mid-animation (rank 1 killed): the job ends with an error, without a hang,
+# and leaves no staging file.
+mkdir -p "$T/die"
+(mpi 2 "$T/die" "$scene" --renderer path --spp 256 --width 64 --height 36 --frames 8 -o "$T/die/f.png"
+ echo $? >"$T/die.rc") &
+victim=""
+i=0
+while [ -z "$victim" ] && [ $i -lt 300 ]; do
+    for p in $(pgrep -f "$T/die/f.png" 2>/dev/null); do
+        tr '\0' '\n' <"/proc/$p/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1" && victim=$p
+    done
+    i=$((i + 1))
+    sleep 0.1
+done
+if [ -n "$victim" ]; then
+    sleep 2
+    kill -9 "$victim"
+    wait
+    st=$(cat "$T/die.rc")
+    if [ "$st" -ne 0 ] && [ "$st" -ne 124 ]; then ok "a killed rank ends the job (exit $st)"
+    else bad "a killed rank: exit $st"; sed 's/^/  /' "$T/die.log" >&2; fi
+    left=$(find "$T/die" -name '*.tmp*' | head -n 1)
+    [ -z "$left" ] && ok "no staging file left by the killed job" || bad "left behind by the killed job: $left"
+else
+    wait
+    bad "rank 1 of the job to kill was not found"
+fi
+
 # --mpi outside mpirun: one rank, a plain render.
 "$cli" render "$scene" --width 80 --height 45 --threads 1 -q --mpi --pfm "$T/single.pfm" -o "$T/single.png" \
     && same "$T/one.pfm" "$T/single.pfm" "--mpi without mpirun: the plain render" || bad "--mpi without mpirun"

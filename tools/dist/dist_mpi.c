@@ -26,9 +26,42 @@ int cli_dist_start(int want, cli_dist *d)
     return CLI_EXIT_OK;
 }
 
+/* Frames a rank has sent to rank 0 without waiting for it (cli_dist_send): a copy of each
+ * frame's header, metadata and pixels in flight, at most PENDING_MAX at a time, so the rank
+ * renders its next frame while rank 0 is still busy with earlier ones. */
+#define PENDING_MAX 3
+typedef struct {
+    MPI_Request req[3];
+    double head[5];
+    char *meta;
+    float *px;
+} pending_frame;
+static pending_frame pending[PENDING_MAX];
+static int npending;
+
+static void pending_free(pending_frame *p)
+{
+    free(p->meta);
+    free(p->px);
+    memset(p, 0, sizeof *p);
+}
+
+/* Waits for the oldest frames until at most keep are in flight (keep 0: all). */
+static void pending_wait(int keep)
+{
+    while (npending > keep) {
+        MPI_Waitall(3, pending[0].req, MPI_STATUSES_IGNORE);
+        pending_free(&pending[0]);
+        memmove(pending, pending + 1, (size_t)(npending - 1) * sizeof pending[0]);
+        memset(&pending[--npending], 0, sizeof pending[0]);
+    }
+}
+
 void cli_dist_stop(const cli_dist *d)
 {
-    if (d->active) MPI_Finalize();
+    if (!d->active) return;
+    pending_wait(0);
+    MPI_Finalize();
 }
 
 void cli_dist_abort(const cli_dist *d, int rc)
@@ -148,18 +181,34 @@ static char *pack_meta(const atmos_image *img, int *n)
 
 atmos_status cli_dist_send(const cli_dist *d, const atmos_image *img, atmos_status st, const atmos_render_info *info)
 {
-    int nmeta = 0;
-    char *meta = st == ATMOS_OK ? pack_meta(img, &nmeta) : NULL;
-    if (st == ATMOS_OK && !meta) st = ATMOS_E_NOMEM;
-    double head[5] = {(double)st, info ? info->seconds : 0, info ? info->sun_elevation_deg : 0,
-                      info ? info->sun_azimuth_deg : 0, (double)nmeta};
-    MPI_Send(head, 5, MPI_DOUBLE, 0, TAG_HEAD, MPI_COMM_WORLD);
-    if (st == ATMOS_OK) {
-        MPI_Send(meta, nmeta, MPI_CHAR, 0, TAG_HEAD, MPI_COMM_WORLD);
-        send_floats(img->pixels, (size_t)img->width * img->height * img->channels, 0);
-    }
-    free(meta);
     (void)d;
+    pending_wait(PENDING_MAX - 1);
+    pending_frame *p = &pending[npending];
+    const size_t n = (size_t)img->width * img->height * img->channels;
+    int nmeta = 0;
+    if (st == ATMOS_OK) {
+        p->meta = pack_meta(img, &nmeta);
+        p->px = n <= CHUNK ? malloc(n * sizeof(float) + 1) : NULL;
+        if (!p->meta || (n <= CHUNK && !p->px)) st = ATMOS_E_NOMEM;
+        else if (p->px) memcpy(p->px, img->pixels, n * sizeof(float));
+    }
+    const double head[5] = {(double)st, info ? info->seconds : 0, info ? info->sun_elevation_deg : 0,
+                            info ? info->sun_azimuth_deg : 0, (double)nmeta};
+    memcpy(p->head, head, sizeof head);
+    for (int i = 0; i < 3; i++) p->req[i] = MPI_REQUEST_NULL;
+    MPI_Isend(p->head, 5, MPI_DOUBLE, 0, TAG_HEAD, MPI_COMM_WORLD, &p->req[0]);
+    if (st == ATMOS_OK) {
+        /* Messages between two ranks with one tag arrive in the order sent, so rank 0's
+         * receives match these frames one after another. */
+        MPI_Isend(p->meta, nmeta, MPI_CHAR, 0, TAG_HEAD, MPI_COMM_WORLD, &p->req[1]);
+        if (p->px) MPI_Isend(p->px, (int)n, MPI_FLOAT, 0, TAG_DATA, MPI_COMM_WORLD, &p->req[2]);
+    }
+    npending++;
+    if (st == ATMOS_OK && !p->px) { /* a frame of over 2^28 floats: sent from the image, in pieces */
+        pending_wait(0);
+        send_floats(img->pixels, n, 0);
+    }
+    if (st != ATMOS_OK) pending_wait(0);
     return st;
 }
 
