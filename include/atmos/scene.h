@@ -268,6 +268,11 @@ ATMOS_API atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *js
                                               const char *const *overrides, int count, atmos_scene *out);
 ATMOS_API atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const char *const *overrides,
                                              int count, atmos_scene *out);
+/* atmos_scene_load_with on a scene file's text already read (json, length bytes): its
+ * relative paths (volume, Earth maps, meshes) are taken from path's folder; path "-" names
+ * standard input (messages say so; relative paths from the current folder). */
+ATMOS_API atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t length, const char *path,
+                                              const char *const *overrides, int count, atmos_scene *out);
 
 /* Checks a scene built or modified in code (CLI overrides) with the same rules
  * and messages as the parser, using source as the message prefix. */

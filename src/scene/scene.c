@@ -310,8 +310,18 @@ atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const c
     }
     if (!in) fclose(f);
     if (!buf) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", path);
-    if (st == ATMOS_OK) st = atmos_scene_parse_with(ctx, buf, len, path, overrides, count, out);
+    if (st == ATMOS_OK) st = atmos_scene_parse_file(ctx, buf, len, in ? "-" : path, overrides, count, out);
     free(buf);
+    return st;
+}
+
+atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t length, const char *path,
+                                    const char *const *overrides, int count, atmos_scene *out)
+{
+    if (!json || !path || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_scene_parse_file: an argument is NULL");
+    const int in = !strcmp(path, "-");
+    if (in) path = "standard input";
+    atmos_status st = atmos_scene_parse_with(ctx, json, length, path, overrides, count, out);
     /* A relative volume file is relative to the scene file's folder, so scenes can
      * be rendered from anywhere. */
     atmos_scene_volume *v = &out->volume;

@@ -225,6 +225,11 @@ def test_cli_exr_layers_and_metadata(tmp_path):
     bad = subprocess.run([CLI, "render", scene, "--width", "8", "--height", "6", "--exr", str(exr), "--exr-layers", "nope"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "nope" in bad.stderr
+    # a scene on standard input is read once: rendered, and carried in the metadata
+    text = '{"image": {"width": 12, "height": 8}, "sun": {"elevation_deg": 20}}'
+    subprocess.run([CLI, "render", "-", "-q", "--exr", str(exr)], input=text, text=True, check=True)
+    img = atmos.read_exr(exr)
+    assert img.meta["atmos:scene_json"] == text and np.asarray(img).shape == (8, 12, 4)
 
 
 def test_volume_file_without_camera_is_framed_as_the_cli_frames_it(tmp_path):

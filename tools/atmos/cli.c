@@ -111,10 +111,8 @@ void cli_print_json_array(const double *v, int n)
     putchar(']');
 }
 
-char *cli_read_text(const char *path, size_t max)
+char *cli_read_stream(FILE *f, size_t max)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
     char *buf = NULL;
     size_t n = 0, cap = 0;
     int bad = 0;
@@ -131,9 +129,17 @@ char *cli_read_text(const char *path, size_t max)
         if (r < 4096) break;
     }
     bad = bad || ferror(f) || !buf || memchr(buf, 0, n);
-    fclose(f);
     if (bad) return free(buf), NULL;
     buf[n] = '\0';
+    return buf;
+}
+
+char *cli_read_text(const char *path, size_t max)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    char *buf = cli_read_stream(f, max);
+    fclose(f);
     return buf;
 }
 

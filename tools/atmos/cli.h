@@ -5,6 +5,8 @@
 
 #include "atmos/atmos.h"
 
+#include <stdio.h>
+
 /* Exit statuses of every subcommand. */
 enum { CLI_EXIT_OK = 0, CLI_EXIT_RUNTIME = 1, CLI_EXIT_USAGE = 2 };
 
@@ -54,6 +56,8 @@ double cli_now_s(void);
 /* The whole of a text file as a new string; NULL when it cannot be read, is longer than max
  * bytes or holds a NUL byte. */
 char *cli_read_text(const char *path, size_t max);
+/* The same from an open stream (standard input), read to its end. */
+char *cli_read_stream(FILE *f, size_t max);
 #define CLI_TEXT_MAX ((size_t)16 << 20)
 /* Option with a value, as "--name VALUE" or "--name=VALUE": returns 1 if argv[*i] is
  * that option (advancing *i past a separate value) with *value set (NULL when the value

@@ -65,8 +65,18 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
                     o->scene_path, o->scene_path);
             return CLI_EXIT_USAGE;
         }
-        if ((st = atmos_scene_load_with(ctx, o->scene_path, o->defines, o->ndefines, scene)) != ATMOS_OK)
-            return cli_runtime_error("render", ctx, st);
+        if (!strcmp(o->scene_path, "-")) {
+            if (!o->scene_text) {
+                fprintf(stderr, "atmos render: standard input: cannot read the scene (larger than 16 MiB, the limit "
+                                "for scene files, a NUL byte or a read error)\n");
+                return CLI_EXIT_RUNTIME;
+            }
+            st = atmos_scene_parse_file(ctx, o->scene_text, strlen(o->scene_text), "-", o->defines, o->ndefines,
+                                        scene);
+        } else {
+            st = atmos_scene_load_with(ctx, o->scene_path, o->defines, o->ndefines, scene);
+        }
+        if (st != ATMOS_OK) return cli_runtime_error("render", ctx, st);
     } else if (o->ndefines) {
         /* the built-in default scene is the parse of an empty one */
         if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", o->defines, o->ndefines, scene)) != ATMOS_OK) {
@@ -100,5 +110,8 @@ const char *render_scene_output_name(const render_opts *o, const atmos_scene *sc
 
 char *render_scene_text(const char *path)
 {
-    return path && strcmp(path, "-") ? cli_read_text(path, (size_t)1 << 20) : NULL;
+    if (!path) return NULL;
+    /* standard input is read here, once: the scene is parsed from this text and the
+     * outputs carry it */
+    return strcmp(path, "-") ? cli_read_text(path, (size_t)1 << 20) : cli_read_stream(stdin, (size_t)16 << 20);
 }
