@@ -3,7 +3,10 @@
 #include "light/lamp.h"
 #include "core/vec.h"
 
+#include "atmos/image.h"
+
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Planck's law up to constants: the spectral radiance of a black body at T (K), nm. */
@@ -54,8 +57,69 @@ double atmos__lamp_falloff(const atmos__lamp *l, const double p[3])
 double atmos__lamp_toward(const atmos__lamp *l, const double p[3], int m, const int *k, double *out)
 {
     const double f = atmos__lamp_falloff(l, p);
-    for (int i = 0; i < m; i++) out[i] = f * l->I[k[i]];
+    double tint[3] = {1, 1, 1};
+    if (l->tex && f > 0) atmos__lamp_tint(l, p, tint);
+    for (int i = 0; i < m; i++) out[i] = f * l->I[k[i]] * tint[k[i] < 3 ? k[i] : 2];
     return f;
+}
+
+static double srgb_linear(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
+
+atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene_light *s, atmos__lamp *l)
+{
+    if (!s->image[0]) return ATMOS_OK;
+    atmos_image *img = NULL;
+    atmos_status st = atmos_read_png(ctx, s->image, &img);
+    if (st != ATMOS_OK) return st; /* the reader's message names the file */
+    const size_t n = (size_t)img->width * img->height;
+    l->tex = malloc(sizeof(float) * 3 * n);
+    if (!l->tex) {
+        atmos_image_destroy(img);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for a light's image", s->image);
+    }
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            const int ch = img->channels < 3 ? 0 : c;
+            l->tex[3 * i + c] = (float)srgb_linear(img->pixels[i * img->channels + ch]);
+        }
+    l->tw = img->width, l->th = img->height;
+    atmos_image_destroy(img);
+    /* the image's frame: its up toward +y's side of the axis, or north for a vertical axis */
+    const double ref[3] = {0, fabs(l->axis[1]) < 0.9 ? 1 : 0, fabs(l->axis[1]) < 0.9 ? 0 : -1};
+    atmos__cross3(l->axis, ref, l->right);
+    atmos__normalize3(l->right);
+    atmos__cross3(l->right, l->axis, l->up);
+    l->tan_max = tan(acos(atmos__clampd(l->cos_outer, -1, 1)));
+    return ATMOS_OK;
+}
+
+void atmos__lamp_free(atmos__lamp *l)
+{
+    free(l->tex);
+    l->tex = NULL;
+}
+
+void atmos__lamp_tint(const atmos__lamp *l, const double p[3], double rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 1;
+    if (!l->tex) return;
+    const double w[3] = {p[0] - l->pos[0], p[1] - l->pos[1], p[2] - l->pos[2]};
+    const double z = atmos__dot3(w, l->axis);
+    rgb[0] = rgb[1] = rgb[2] = 0;
+    if (!(z > 0)) return;
+    const double x = atmos__dot3(w, l->right) / (z * l->tan_max), y = atmos__dot3(w, l->up) / (z * l->tan_max);
+    const double fx = 0.5 * (x + 1) * l->tw - 0.5, fy = 0.5 * (1 - y) * l->th - 0.5;
+    if (!(fx > -1 && fx < l->tw && fy > -1 && fy < l->th)) return;
+    const int x0 = (int)floor(fx), y0 = (int)floor(fy);
+    const double ax = fx - x0, ay = fy - y0;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            const int xi = x0 + i < 0 ? 0 : x0 + i >= l->tw ? l->tw - 1 : x0 + i;
+            const int yj = y0 + j < 0 ? 0 : y0 + j >= l->th ? l->th - 1 : y0 + j;
+            const double wt = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
+            const float *t = l->tex + 3 * ((size_t)yj * l->tw + xi);
+            for (int c = 0; c < 3; c++) rgb[c] += wt * t[c];
+        }
 }
 
 int atmos__lamp_clip(const atmos__lamp *l, const double e[3], const double d[3], double *t0, double *t1)

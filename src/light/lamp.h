@@ -15,6 +15,12 @@ typedef struct atmos__lamp {
     double range;
     double I[ATMOS_MAX_WAVELENGTHS]; /* spectral intensity on the axis, W sr^-1 nm^-1 */
     double I_max;                /* the largest of I */
+    /* a spot's projected image (stained glass; NULL: none): tw x th linear rgb texels, row 0
+     * at the top, spanning [-tan_max, tan_max]^2 of the plane at unit distance along the axis
+     * (right, up: the image's axes there) */
+    float *tex;
+    int tw, th;
+    double tan_max, right[3], up[3];
 } atmos__lamp;
 
 /* The intensity at wavelength k of a scene light (W sr^-1 nm^-1): intensity_w_sr is the
@@ -36,11 +42,20 @@ static inline double atmos__lamp_falloff_cos(const atmos__lamp *l, double c)
     return s * s * (3 - 2 * s);
 }
 
+/* The light's image (scene light s's "image", a PNG of sRGB values, linearised) read into l
+ * (made by atmos__lamp_make); a missing or malformed file is an error naming it. */
+atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene_light *s, atmos__lamp *l);
+void atmos__lamp_free(atmos__lamp *l);
+
+/* The image's tint toward point p (rgb, bilinear; 0 outside the image; 1, 1, 1 without an
+ * image). */
+void atmos__lamp_tint(const atmos__lamp *l, const double p[3], double rgb[3]);
+
 /* The falloff toward point p (1 at the light itself). */
 double atmos__lamp_falloff(const atmos__lamp *l, const double p[3]);
 
 /* The light's spectral intensity toward p for the wavelengths k[0..m-1] (I[k] times the
- * falloff) into out; returns the falloff (0: p is dark). */
+ * falloff, times the image's tint) into out; returns the falloff (0: p is dark). */
 double atmos__lamp_toward(const atmos__lamp *l, const double p[3], int m, const int *k, double *out);
 
 /* Narrows [*t0, *t1] of the ray e + t d to the part inside a spot's outer cone (Dobashi's

@@ -9,17 +9,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void make_light(const atmos_scene_light *s, const atmos_wavelengths *wl, atmos__beams_light *l)
+static atmos_status make_light(atmos_context *ctx, const atmos_scene_light *s, const atmos_wavelengths *wl,
+                               atmos__beams_light *l)
 {
     memset(l, 0, sizeof *l);
     atmos__lamp_make(s, wl, &l->L);
+    return atmos__lamp_load_image(ctx, s, &l->L);
 }
 
 void atmos__beams_plan_destroy(atmos__beams_plan *b)
 {
     if (!b) return;
     atmos__objects_free(&b->obj);
-    for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]);
+    for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]), atmos__lamp_free(&b->lights[i].L);
     free(b->lights);
     atmos__beams_table_free(&b->table);
     free(b);
@@ -35,10 +37,10 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
         st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     double range = 0;
     for (int i = 0; st == ATMOS_OK && i < s->light_count; i++) {
-        make_light(&s->lights[i], &p->wl, &b->lights[i]);
+        st = make_light(p->ctx, &s->lights[i], &p->wl, &b->lights[i]);
         b->nlights = i + 1;
         range = fmax(range, b->lights[i].L.range);
-        st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->obj.mesh, b->obj.n, s->beams.shadow_size);
+        if (st == ATMOS_OK) st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->obj.mesh, b->obj.n, s->beams.shadow_size);
     }
     if (st == ATMOS_OK && s->fog.enabled) { /* x = sigma_t v reaches sigma_t times the largest reach */
         b->sigma_t = s->fog.extinction_per_m, b->sigma_s = s->fog.scattering_per_m;

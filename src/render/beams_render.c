@@ -56,10 +56,39 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
         const double o[3] = {P[0] + off * h->normal[0], P[1] + off * h->normal[1], P[2] + off * h->normal[2]};
         if (atmos__objects_hit(&b->obj, o, w, 0, r - off, NULL, NULL)) continue;
         const double e = fall * c / (r * r) * exp(-b->sigma_t * r);
-        for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e;
+        double tint[3];
+        atmos__lamp_tint(&l->L, P, tint);
+        for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
     const double t = exp(-b->sigma_t * h->t);
     for (int k = 0; k < J->nw; k++) L[k] = b->obj.albedo[m][k] / ATMOS_PI * sum[k] * t;
+}
+
+/* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
+ * image's tint at every sample (so no interval is taken as uniform: its colour varies). */
+static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *ray, const double d[3], const double *f,
+                   int n, double S, double *L, int centre)
+{
+    double sum[3] = {0, 0, 0};
+    for (int k = 0; k < n; k++) {
+        const double fl = f[2 * k + 1];
+        if (fl <= 0) continue;
+        const double need = ceil(fl / (J->epsilon * S));
+        const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
+        double h[3] = {0, 0, 0};
+        for (int s = 0; s < m; s++) {
+            const double t = ta + (s + 0.5) * step, v = atmos__beams_ray_light(ray, t);
+            if (!(v > 0)) continue;
+            const double P[3] = {J->eye[0] + t * d[0], J->eye[1] + t * d[1], J->eye[2] + t * d[2]};
+            double tint[3];
+            atmos__lamp_tint(&l->L, P, tint);
+            for (int c = 0; c < 3; c++) h[c] += v * tint[c];
+        }
+        for (int c = 0; c < 3; c++) sum[c] += h[c] / m * fl;
+        if (centre) J->centre_subplanes += m;
+    }
+    for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum[k < 3 ? k : 2];
 }
 
 /* Light i scattered toward the eye along [0, T) of the ray d, added to L. f holds room for
@@ -101,6 +130,10 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     }
     atmos__beams_ray ray;
     atmos__beams_ray_init(l, J->eye, d, &ray);
+    if (l->L.tex) {
+        tinted(J, l, &ray, d, f, n, S, L, centre);
+        return;
+    }
     double sum = 0;
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];

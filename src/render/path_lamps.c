@@ -34,7 +34,10 @@ atmos_status atmos__path_lamps_build(atmos_context *ctx, const atmos_scene *s, c
     L->lamp = calloc((size_t)(s->light_count ? s->light_count : 1), sizeof *L->lamp);
     if (!L->lamp) return atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the lights");
     L->nlamps = s->light_count;
-    for (int i = 0; i < s->light_count; i++) atmos__lamp_make(&s->lights[i], wl, &L->lamp[i]);
+    for (int i = 0; i < s->light_count; i++) {
+        atmos__lamp_make(&s->lights[i], wl, &L->lamp[i]);
+        if ((st = atmos__lamp_load_image(ctx, &s->lights[i], &L->lamp[i])) != ATMOS_OK) return st;
+    }
     if (s->fog.enabled) {
         L->sigma_s = s->fog.scattering_per_m;
         L->sigma_a = s->fog.extinction_per_m - s->fog.scattering_per_m;
@@ -47,6 +50,7 @@ void atmos__path_lamps_free(path_lamps *L)
 {
     if (!L) return;
     atmos__objects_free(&L->obj);
+    for (int i = 0; L->lamp && i < L->nlamps; i++) atmos__lamp_free(&L->lamp[i]);
     free(L->lamp);
     memset(L, 0, sizeof *L);
 }

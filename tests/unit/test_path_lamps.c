@@ -261,6 +261,57 @@ static void test_refused(void)
     atmos_plan_destroy(plan);
 }
 
+/* A spot's image (stained glass): a red window tints the light red in both renderers, through
+ * the air and on the floor; a missing or corrupt file is an error naming it. */
+static void test_image(void)
+{
+    char png[1024], bad[1024];
+    test_tmp_path(png, sizeof png, "red_window.png");
+    test_tmp_path(bad, sizeof bad, "corrupt_window.png");
+    atmos_image *w = NULL;
+    CHECK_OK(atmos_image_create(ctx, 4, 4, 3, &w));
+    if (!w) return;
+    for (int i = 0; i < 16; i++) w->pixels[3 * i] = 1;
+    CHECK_OK(atmos_write_png(ctx, w, png, 8));
+    atmos_image_destroy(w);
+    FILE *f = fopen(bad, "wb");
+    if (f) fputs("\x89PNG\r\n\x1a\nnot a png at all", f), fclose(f);
+    for (int r = 0; r < 2; r++) {
+        atmos_scene s;
+        path_scene(&s, 12, 10, 16, 1);
+        s.renderer = r ? ATMOS_RENDERER_BEAMS : ATMOS_RENDERER_PATH;
+        s.fog.enabled = 1, s.fog.extinction_per_m = 0.05, s.fog.scattering_per_m = 0.04;
+        atmos_scene_light *l = &s.lights[0];
+        l->type = ATMOS_LIGHT_SPOT, l->position_m[1] = 6, l->cone_deg = 20, l->edge_deg = 2, l->range_m = 50;
+        snprintf(l->image, sizeof l->image, "%s", png);
+        s.camera.position[0] = 0, s.camera.position[1] = 3, s.camera.position[2] = 12;
+        s.camera.look_at[0] = 0, s.camera.look_at[1] = 2, s.camera.look_at[2] = 0;
+        s.object_count = 1;
+        atmos_scene_object *o = &s.objects[0];
+        memset(o, 0, sizeof *o);
+        snprintf(o->mesh, sizeof o->mesh, "builtin:plane");
+        o->scale[0] = o->scale[1] = o->scale[2] = 20;
+        o->albedo[0] = o->albedo[1] = o->albedo[2] = 0.5;
+        atmos_image *img = render(&s, NULL);
+        if (img) {
+            double sum[3] = {0, 0, 0};
+            for (int i = 0; i < s.width * s.height; i++)
+                for (int c = 0; c < 3; c++) sum[c] += img->pixels[(size_t)i * img->channels + c];
+            printf("%s, a red window: r %.4g, g %.4g, b %.4g\n", r ? "beams" : "path", sum[0], sum[1], sum[2]);
+            CHECK(sum[0] > 0 && sum[1] == 0 && sum[2] == 0);
+            atmos_image_destroy(img);
+        }
+        for (int k = 0; k < 2; k++) {
+            snprintf(l->image, sizeof l->image, "%s", k ? bad : "no_such_window.png");
+            atmos_plan *plan = NULL;
+            const atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
+            CHECK_MSG(st != ATMOS_OK && strstr(atmos_context_error(ctx), k ? "corrupt_window.png" : "no_such_window.png"),
+                      "%s", atmos_context_error(ctx));
+            atmos_plan_destroy(plan);
+        }
+    }
+}
+
 int main(void)
 {
     CHECK_OK(atmos_context_create(NULL, &ctx));
@@ -268,6 +319,7 @@ int main(void)
     test_plane();
     test_fig04();
     test_refused();
+    test_image();
     atmos_context_destroy(ctx);
     return test_summary("test_path_lamps");
 }
