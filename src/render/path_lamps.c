@@ -3,22 +3,25 @@
  *
  * A camera path walks through the fog (homogeneous: sigma_s, sigma_a, a Henyey-Greenstein
  * phase function, filling all space) and between the objects (opaque, Lambertian, two-sided,
- * through the meshes' bounding volume hierarchies):
- *   - the distance to the next scattering is drawn from sigma_s exp(-sigma_s t); the
- *     absorption is carried in the weights, exp(-sigma_a t), so a pure absorber needs no
- *     random number and a scattering event keeps the weight (sigma_s / sigma_s);
- *   - at a scattering event inside the fog, or at an object's surface met first, next-event
- *     estimation toward every light: its intensity toward the point (light/lamp.h: the spot's
- *     falloff, the spectrum), 1 / r^2, the fog's transmittance exp(-sigma_t r), the objects'
- *     visibility (a shadow ray), times the phase function (fog) or albedo cos / pi (surface).
+ * through the meshes' bounding volume hierarchies). Per segment, from the path's point to the
+ * first object ahead (or to infinity):
+ *   - the lights' single scattering in the fog along it: per light one point by equi-angular
+ *     sampling on the part inside a spot's cone (fog_lights), then next-event estimation there;
+ *   - the object at its end: next-event estimation of every light, weighted by the fog's
+ *     transmittance exp(-sigma_t T);
+ *   - next-event estimation (nee) is the light's intensity toward the point (light/lamp.h: the
+ *     spot's falloff, the spectrum, the projected image), 1 / r^2, exp(-sigma_t r), a shadow
+ *     ray through the meshes, times the phase function (fog) or albedo cos / pi (surface).
  *     The lights are points (delta lights): next-event estimation is the only way to see them;
- *   - then, unless the path has had path.max_depth events (1: single scattering, what the
- *     beam renderer computes), Russian roulette and a new direction: drawn from the phase
- *     function in the fog, cosine-distributed about the normal at a surface (weight times
- *     the albedo);
+ *   - then, unless the path has path.max_depth vertices (1: single scattering, what the beam
+ *     renderer computes), the continuation: the distance to the next scattering drawn from
+ *     sigma_s exp(-sigma_s t) with the absorption exp(-sigma_a t) carried in the weights (a
+ *     pure absorber needs no random number), a new direction from the phase function in the
+ *     fog or cosine-distributed about the normal at the object (weight times the albedo),
+ *     Russian roulette;
  *   - a path that leaves (no fog, no object ahead) sees the vacuum's uniform background.
  * The sun, the atmosphere's air and a cloud volume are not part of such a scene here
- * (path_plan.c refuses them). */
+ * (path_plan.c refuses the air and the volume). */
 #include "core/vec.h"
 #include "render/path_trace.h"
 
