@@ -148,6 +148,9 @@ typedef struct atmos_scene_light {
                                     0: colour */
     double colour[3];         /* rgb weights in [0, 1e3] (rgb wavelengths only), with no temperature; 1, 1, 1 */
     double range_m;           /* the light's reach: the beam renderer samples the air within it; (0, 1e6]; 100 */
+    char image[ATMOS_SCENE_PATH_MAX]; /* spot, rgb wavelengths: a PNG projected through the cone (stained glass):
+                                         the light toward a direction is tinted by the image's texel there
+                                         (docs/scene-format.md); relative paths against the scene's folder; "" none */
 } atmos_scene_light;
 
 /* A uniform participating medium ("fog" in the file): Dobashi's constant density, as

@@ -6,6 +6,8 @@
 #ifndef ATMOS_RENDER_BEAMS_INTERNAL_H
 #define ATMOS_RENDER_BEAMS_INTERNAL_H
 
+#include "light/lamp.h"
+#include "render/objects.h"
 #include "render/plan_internal.h"
 
 /* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
@@ -63,12 +65,7 @@ typedef struct atmos__beams_face {
 } atmos__beams_face;
 
 typedef struct atmos__beams_light {
-    atmos_light_type type;
-    double pos[3], axis[3];
-    double cos_inner, cos_outer; /* spot: full within cos_inner, zero beyond cos_outer */
-    double range;
-    double I[ATMOS_MAX_WAVELENGTHS]; /* spectral intensity on the axis, W sr^-1 nm^-1 */
-    double I_max;                /* the largest of I */
+    atmos__lamp L;               /* the light itself (light/lamp.h) */
     int nfaces;                  /* 0: no shadow casters; 1: a spot's frustum; 6: a cube map */
     atmos__beams_face face[6];
 } atmos__beams_light;
@@ -79,9 +76,6 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
 void atmos__beams_shadow_free(atmos__beams_light *l);
 /* H: the share of the light reaching p past the meshes, in [0, 1] (2x2 filtered). */
 double atmos__beams_visibility(const atmos__beams_light *l, const double p[3]);
-/* The spot's smooth falloff at p (1 for a point light): a smoothstep in the cosine of the
- * angle from the axis between cos_outer and cos_inner. */
-double atmos__beams_falloff(const atmos__beams_light *l, const double p[3]);
 
 /* One ray's view of one light, for the sub-planes: the point o + t d relative to the light,
  * its depth along the spot's axis and its coordinates in each shadow face, all linear in t
@@ -104,9 +98,7 @@ int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, do
 double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t);
 
 struct atmos__beams_plan {
-    int nmesh;
-    atmos_mesh **mesh;
-    double (*albedo)[ATMOS_MAX_WAVELENGTHS]; /* per mesh */
+    atmos__objects obj;                      /* the meshes and their albedos */
     int nlights;
     atmos__beams_light *lights;
     double sigma_t, sigma_s;                 /* 0 without fog */
@@ -114,8 +106,5 @@ struct atmos__beams_plan {
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
     int centre_planes, centre_subplanes;
 };
-
-/* The light sources' spectra (beams_plan.c): the intensity at wavelength nm of a light. */
-double atmos__beams_spectrum(const atmos_scene_light *l, const atmos_wavelengths *wl, int k);
 
 #endif

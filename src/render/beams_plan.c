@@ -9,75 +9,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Planck's law up to constants: the spectral radiance of a black body at T (K), nm. */
-static double planck(double nm, double T)
-{
-    const double c2 = 1.438776877e7; /* h c / k, nm K */
-    const double l = nm * 1e-3;      /* micrometres, to keep the numbers moderate */
-    return 1.0 / (l * l * l * l * l * expm1(c2 / (nm * T)));
-}
-
-/* A light's intensity_w_sr is its radiant intensity over 380-780 nm: the spectrum is the
- * black body's normalised over that band, or for an rgb colour a flat 1/400 nm^-1 per
- * channel times the channel's weight (atmos_scene_light). */
-double atmos__beams_spectrum(const atmos_scene_light *l, const atmos_wavelengths *wl, int k)
-{
-    if (l->colour_temperature_k > 0) {
-        double band = 0;
-        for (int i = 0; i < 400; i++) band += planck(380.5 + i, l->colour_temperature_k);
-        return l->intensity_w_sr * planck(wl->nm[k], l->colour_temperature_k) / band;
-    }
-    const double c = wl->mode == ATMOS_WAVELENGTHS_RGB ? l->colour[k < 3 ? k : 2] : l->colour[0];
-    return l->intensity_w_sr * c / 400.0;
-}
-
-static void make_light(const atmos_scene_light *s, const atmos_wavelengths *wl, atmos__beams_light *l)
+static atmos_status make_light(atmos_context *ctx, const atmos_scene_light *s, const atmos_wavelengths *wl,
+                               atmos__beams_light *l)
 {
     memset(l, 0, sizeof *l);
-    l->type = s->type;
-    memcpy(l->pos, s->position_m, sizeof l->pos);
-    memcpy(l->axis, s->direction, sizeof l->axis);
-    atmos__normalize3(l->axis);
-    l->cos_inner = cos(s->cone_deg * ATMOS_DEG2RAD);
-    l->cos_outer = cos((s->cone_deg + s->edge_deg) * ATMOS_DEG2RAD);
-    if (l->cos_inner <= l->cos_outer) l->cos_outer = l->cos_inner - 1e-9; /* a hard edge */
-    l->range = s->range_m;
-    for (int k = 0; k < wl->count; k++) {
-        l->I[k] = atmos__beams_spectrum(s, wl, k);
-        l->I_max = fmax(l->I_max, l->I[k]);
-    }
-}
-
-static atmos_status load_objects(atmos_plan *p, atmos__beams_plan *b)
-{
-    const atmos_scene *s = &p->scene;
-    b->mesh = calloc((size_t)(s->object_count ? s->object_count : 1), sizeof *b->mesh);
-    b->albedo = calloc((size_t)(s->object_count ? s->object_count : 1), sizeof *b->albedo);
-    if (!b->mesh || !b->albedo) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
-    for (int i = 0; i < s->object_count; i++) {
-        const atmos_scene_object *o = &s->objects[i];
-        atmos_status st = atmos_mesh_load(p->ctx, o->mesh, 0, &b->mesh[i]);
-        if (st != ATMOS_OK) return st;
-        b->nmesh = i + 1;
-        atmos_mesh_transform t;
-        memcpy(t.position_m, o->position_m, sizeof t.position_m);
-        memcpy(t.scale, o->scale, sizeof t.scale);
-        memcpy(t.rotation_deg, o->rotation_deg, sizeof t.rotation_deg);
-        if ((st = atmos_mesh_apply_transform(p->ctx, b->mesh[i], &t)) != ATMOS_OK) return st;
-        for (int k = 0; k < p->wl.count; k++)
-            b->albedo[i][k] = p->wl.mode == ATMOS_WAVELENGTHS_RGB ? o->albedo[k < 3 ? k : 2]
-                                                                : (o->albedo[0] + o->albedo[1] + o->albedo[2]) / 3;
-    }
-    return ATMOS_OK;
+    atmos__lamp_make(s, wl, &l->L);
+    return atmos__lamp_load_image(ctx, s, &l->L);
 }
 
 void atmos__beams_plan_destroy(atmos__beams_plan *b)
 {
     if (!b) return;
-    for (int i = 0; i < b->nmesh; i++) atmos_mesh_destroy(b->mesh[i]);
-    for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]);
-    free(b->mesh);
-    free(b->albedo);
+    atmos__objects_free(&b->obj);
+    for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]), atmos__lamp_free(&b->lights[i].L);
     free(b->lights);
     atmos__beams_table_free(&b->table);
     free(b);
@@ -88,15 +32,15 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
     const atmos_scene *s = &p->scene;
     atmos__beams_plan *b = calloc(1, sizeof *b);
     if (!b) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
-    atmos_status st = load_objects(p, b);
+    atmos_status st = atmos__objects_load(p->ctx, s, &p->wl, &b->obj);
     if (st == ATMOS_OK && !(b->lights = calloc((size_t)s->light_count, sizeof *b->lights)))
         st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     double range = 0;
     for (int i = 0; st == ATMOS_OK && i < s->light_count; i++) {
-        make_light(&s->lights[i], &p->wl, &b->lights[i]);
+        st = make_light(p->ctx, &s->lights[i], &p->wl, &b->lights[i]);
         b->nlights = i + 1;
-        range = fmax(range, b->lights[i].range);
-        st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->mesh, b->nmesh, s->beams.shadow_size);
+        range = fmax(range, b->lights[i].L.range);
+        if (st == ATMOS_OK) st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->obj.mesh, b->obj.n, s->beams.shadow_size);
     }
     if (st == ATMOS_OK && s->fog.enabled) { /* x = sigma_t v reaches sigma_t times the largest reach */
         b->sigma_t = s->fog.extinction_per_m, b->sigma_s = s->fog.scattering_per_m;
@@ -117,6 +61,6 @@ void atmos__beams_describe(const atmos_plan *p, char *buf, size_t cap)
     const atmos_scene_beams *s = &p->scene.beams;
     snprintf(buf, cap, "%d lights, %d objects, fog %g/m; plane spacing %g m (0: auto), epsilon %g, at most %d sub-planes, "
              "shadow maps %d; centre ray: %d main planes, %d sub-planes",
-             b->nlights, b->nmesh, b->sigma_t, s->plane_spacing_m, s->epsilon, s->max_subplanes, s->shadow_size,
+             b->nlights, b->obj.n, b->sigma_t, s->plane_spacing_m, s->epsilon, s->max_subplanes, s->shadow_size,
              b->centre_planes, b->centre_subplanes);
 }

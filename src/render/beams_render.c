@@ -38,20 +38,6 @@ typedef struct job {
     int centre_planes, centre_subplanes;
 } job;
 
-static int first_hit(const atmos__beams_plan *b, const double o[3], const double d[3], double tmin, double tmax,
-                     atmos_mesh_hit *hit, int *which)
-{
-    int any = 0;
-    for (int m = 0; m < b->nmesh; m++) {
-        atmos_mesh_hit h = {0, 0, {0, 0, 0}};
-        if (atmos_mesh_intersect(b->mesh[m], o, d, tmin, tmax, hit ? &h : NULL)) {
-            if (!hit) return 1;
-            *hit = h, *which = m, tmax = h.t, any = 1;
-        }
-    }
-    return any;
-}
-
 /* The object's surface at the eye's ray's hit, lit by the lights, dimmed on the way to the eye. */
 static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double *L)
 {
@@ -61,46 +47,48 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
     const double off = 1e-4 * (1 + h->t);
     for (int i = 0; i < b->nlights; i++) {
         const atmos__beams_light *l = &b->lights[i];
-        double w[3] = {l->pos[0] - P[0], l->pos[1] - P[1], l->pos[2] - P[2]};
+        double w[3] = {l->L.pos[0] - P[0], l->L.pos[1] - P[1], l->L.pos[2] - P[2]};
         const double r = sqrt(atmos__dot3(w, w));
         if (r <= 0) continue;
         for (int a = 0; a < 3; a++) w[a] /= r;
-        const double c = atmos__dot3(h->normal, w), fall = atmos__beams_falloff(l, P);
+        const double c = atmos__dot3(h->normal, w), fall = atmos__lamp_falloff(&l->L, P);
         if (c <= 0 || fall <= 0) continue;
         const double o[3] = {P[0] + off * h->normal[0], P[1] + off * h->normal[1], P[2] + off * h->normal[2]};
-        if (first_hit(b, o, w, 0, r - off, NULL, NULL)) continue;
+        if (atmos__objects_hit(&b->obj, o, w, 0, r - off, NULL, NULL)) continue;
         const double e = fall * c / (r * r) * exp(-b->sigma_t * r);
-        for (int k = 0; k < J->nw; k++) sum[k] += l->I[k] * e;
+        double tint[3];
+        atmos__lamp_tint(&l->L, P, tint);
+        for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
     const double t = exp(-b->sigma_t * h->t);
-    for (int k = 0; k < J->nw; k++) L[k] = b->albedo[m][k] / ATMOS_PI * sum[k] * t;
+    for (int k = 0; k < J->nw; k++) L[k] = b->obj.albedo[m][k] / ATMOS_PI * sum[k] * t;
 }
 
-/* Narrows [*t0, *t1] of the ray d to the part inside a spot's outer cone (Dobashi's bounding
- * pyramid, exactly): the roots of ((P - L).a)^2 = cos^2 |P - L|^2 cut the span into at most
- * three pieces; the hull of those whose middle is lit. 0 if none is. */
-static int clip_cone(const atmos__beams_light *l, const double e[3], const double d[3], double *t0, double *t1)
+/* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
+ * image's tint at every sample (so no interval is taken as uniform: its colour varies). */
+static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *ray, const double d[3], const double *f,
+                   int n, double S, double *L, int centre)
 {
-    if (l->type != ATMOS_LIGHT_SPOT) return 1;
-    const double w[3] = {e[0] - l->pos[0], e[1] - l->pos[1], e[2] - l->pos[2]}, c2 = l->cos_outer * l->cos_outer;
-    const double wa = atmos__dot3(w, l->axis), da = atmos__dot3(d, l->axis);
-    const double A = da * da - c2, B = 2 * (wa * da - c2 * atmos__dot3(w, d)), C = wa * wa - c2 * atmos__dot3(w, w);
-    double cut[4] = {*t0, *t0, *t1, *t1};
-    const double disc = B * B - 4 * A * C;
-    if (disc > 0 && A != 0) {
-        const double q = -0.5 * (B + copysign(sqrt(disc), B)), r1 = q / A, r2 = C / q;
-        cut[1] = atmos__clampd(fmin(r1, r2), *t0, *t1), cut[2] = atmos__clampd(fmax(r1, r2), *t0, *t1);
+    double sum[3] = {0, 0, 0};
+    for (int k = 0; k < n; k++) {
+        const double fl = f[2 * k + 1];
+        if (fl <= 0) continue;
+        const double need = ceil(fl / (J->epsilon * S));
+        const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
+        double h[3] = {0, 0, 0};
+        for (int s = 0; s < m; s++) {
+            const double t = ta + (s + 0.5) * step, v = atmos__beams_ray_light(ray, t);
+            if (!(v > 0)) continue;
+            const double P[3] = {J->eye[0] + t * d[0], J->eye[1] + t * d[1], J->eye[2] + t * d[2]};
+            double tint[3];
+            atmos__lamp_tint(&l->L, P, tint);
+            for (int c = 0; c < 3; c++) h[c] += v * tint[c];
+        }
+        for (int c = 0; c < 3; c++) sum[c] += h[c] / m * fl;
+        if (centre) J->centre_subplanes += m;
     }
-    double lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k < 3; k++) {
-        if (!(cut[k + 1] > cut[k])) continue;
-        const double tm = 0.5 * (cut[k] + cut[k + 1]);
-        const double P[3] = {e[0] + tm * d[0], e[1] + tm * d[1], e[2] + tm * d[2]};
-        if (atmos__beams_falloff(l, P) > 0) lo = fmin(lo, cut[k]), hi = fmax(hi, cut[k + 1]);
-    }
-    if (!(lo < hi)) return 0;
-    *t0 = lo, *t1 = hi;
-    return 1;
+    for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum[k < 3 ? k : 2];
 }
 
 /* Light i scattered toward the eye along [0, T) of the ray d, added to L. f holds room for
@@ -110,14 +98,14 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     const atmos__beams_plan *b = J->b;
     const atmos__beams_light *l = &b->lights[i];
     const double R = J->reach[i], sig = b->sigma_t;
-    const double Lp[3] = {l->pos[0] - J->eye[0], l->pos[1] - J->eye[1], l->pos[2] - J->eye[2]};
+    const double Lp[3] = {l->L.pos[0] - J->eye[0], l->L.pos[1] - J->eye[1], l->L.pos[2] - J->eye[2]};
     const double tQ = atmos__dot3(Lp, d);
     const double q[3] = {Lp[0] - tQ * d[0], Lp[1] - tQ * d[1], Lp[2] - tQ * d[2]};
     const double v = atmos__maxd(sqrt(atmos__dot3(q, q)), 1e-6 * R);
     if (v >= R) return;
     const double hh = sqrt(R * R - v * v);
     double t0 = atmos__maxd(0, tQ - hh), t1 = atmos__mind(T, tQ + hh);
-    if (!(t0 < t1) || !clip_cone(l, J->eye, d, &t0, &t1)) return;
+    if (!(t0 < t1) || !atmos__lamp_clip(&l->L, J->eye, d, &t0, &t1)) return;
     atmos__beams_column col;
     atmos__beams_table_column(&b->table, sig * v, &col);
     const double scale = exp(-sig * tQ) / v, cosf = atmos__dot3(d, J->fwd), dz = J->dz[i], zl = J->z_lo[i];
@@ -136,12 +124,16 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     f[2 * n] = t1;
     if (centre) J->centre_planes += n;
     if (!(S > 0)) return;
-    if (!l->nfaces && l->type == ATMOS_LIGHT_POINT) { /* H = 1 and no falloff: the sum is exact */
-        for (int k = 0; k < J->nw; k++) L[k] += l->I[k] * S;
+    if (!l->nfaces && l->L.type == ATMOS_LIGHT_POINT) { /* H = 1 and no falloff: the sum is exact */
+        for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * S;
         return;
     }
     atmos__beams_ray ray;
     atmos__beams_ray_init(l, J->eye, d, &ray);
+    if (l->L.tex) {
+        tinted(J, l, &ray, d, f, n, S, L, centre);
+        return;
+    }
     double sum = 0;
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
@@ -163,7 +155,7 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
         sum += h / m * fl;
         if (centre) J->centre_subplanes += m;
     }
-    for (int k = 0; k < J->nw; k++) L[k] += l->I[k] * sum;
+    for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum;
 }
 
 static void pixel(job *J, int x, int y, float *px, double *f)
@@ -173,7 +165,7 @@ static void pixel(job *J, int x, int y, float *px, double *f)
     atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
     atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
-    const int hit = first_hit(b, J->eye, d, 0, INFINITY, &h, &m);
+    const int hit = atmos__objects_hit(&b->obj, J->eye, d, 0, INFINITY, &h, &m);
     const double T = hit ? h.t : INFINITY;
     if (hit) shade_surface(J, d, &h, m, L);
     else
@@ -192,8 +184,8 @@ static atmos_status planes(atmos_plan *p, job *J)
     J->dz = J->z_lo + b->nlights, J->reach = J->dz + b->nlights;
     for (int i = 0; i < b->nlights; i++) {
         const atmos__beams_light *l = &b->lights[i];
-        const double R = b->sigma_t > 0 ? fmin(l->range, ATMOS__BEAMS_MAX_OPTICAL_RANGE / b->sigma_t) : l->range;
-        const double Lp[3] = {l->pos[0] - J->eye[0], l->pos[1] - J->eye[1], l->pos[2] - J->eye[2]};
+        const double R = b->sigma_t > 0 ? fmin(l->L.range, ATMOS__BEAMS_MAX_OPTICAL_RANGE / b->sigma_t) : l->L.range;
+        const double Lp[3] = {l->L.pos[0] - J->eye[0], l->L.pos[1] - J->eye[1], l->L.pos[2] - J->eye[2]};
         const double given = p->scene.beams.plane_spacing_m;
         J->reach[i] = R;
         J->z_lo[i] = atmos__dot3(Lp, J->fwd) - R;

@@ -152,11 +152,11 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
 {
     l->nfaces = 0;
     if (nmesh == 0) return ATMOS_OK;
-    const int spot = l->type == ATMOS_LIGHT_SPOT && l->cos_outer >= cos(SPOT_FRUSTUM_MAX_DEG * ATMOS_DEG2RAD);
+    const int spot = l->L.type == ATMOS_LIGHT_SPOT && l->L.cos_outer >= cos(SPOT_FRUSTUM_MAX_DEG * ATMOS_DEG2RAD);
     const int nf = spot ? 1 : 6;
     for (int f = 0; f < nf; f++) {
         atmos__beams_face *F = &l->face[f];
-        if (spot) set_face(F, l->axis, fmax(1e-3, tan(acos(l->cos_outer)) * 1.02));
+        if (spot) set_face(F, l->L.axis, fmax(1e-3, tan(acos(l->L.cos_outer)) * 1.02));
         else {
             double d[3] = {0, 0, 0};
             d[f / 2] = f % 2 ? -1 : 1;
@@ -175,7 +175,7 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     }
     l->nfaces = nf;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
-    for (int f = 0; f < nf; f++) raster_face(&l->face[f], l->pos, mesh, nmesh);
+    for (int f = 0; f < nf; f++) raster_face(&l->face[f], l->L.pos, mesh, nmesh);
     return ATMOS_OK;
 }
 
@@ -210,7 +210,7 @@ static int cube_face(const double w[3])
 double atmos__beams_visibility(const atmos__beams_light *l, const double p[3])
 {
     if (!l->nfaces) return 1;
-    const double d[3] = {p[0] - l->pos[0], p[1] - l->pos[1], p[2] - l->pos[2]};
+    const double d[3] = {p[0] - l->L.pos[0], p[1] - l->L.pos[1], p[2] - l->L.pos[2]};
     const atmos__beams_face *F = &l->face[l->nfaces == 6 ? cube_face(d) : 0];
     return lookup(F, atmos__dot3(d, F->right), atmos__dot3(d, F->up), atmos__dot3(d, F->fwd));
 }
@@ -218,9 +218,9 @@ double atmos__beams_visibility(const atmos__beams_light *l, const double p[3])
 void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r)
 {
     r->l = l;
-    for (int a = 0; a < 3; a++) r->w0[a] = o[a] - l->pos[a], r->d[a] = d[a];
+    for (int a = 0; a < 3; a++) r->w0[a] = o[a] - l->L.pos[a], r->d[a] = d[a];
     r->ww0 = atmos__dot3(r->w0, r->w0), r->wd = atmos__dot3(r->w0, d);
-    r->a0 = atmos__dot3(r->w0, l->axis), r->a1 = atmos__dot3(d, l->axis);
+    r->a0 = atmos__dot3(r->w0, l->L.axis), r->a1 = atmos__dot3(d, l->L.axis);
     for (int f = 0; f < l->nfaces; f++) {
         const atmos__beams_face *F = &l->face[f];
         r->f0[f][0] = atmos__dot3(r->w0, F->right), r->f1[f][0] = atmos__dot3(d, F->right);
@@ -244,13 +244,13 @@ static int project(const atmos__beams_ray *r, int f, double t, double *fx, doubl
 static int inside_inner(const atmos__beams_ray *r, double t)
 {
     const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
-    return z > 0 && z * z >= r->l->cos_inner * r->l->cos_inner * w2;
+    return z > 0 && z * z >= r->l->L.cos_inner * r->l->L.cos_inner * w2;
 }
 
 int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full)
 {
     const atmos__beams_light *l = r->l;
-    *full = l->type != ATMOS_LIGHT_SPOT || (inside_inner(r, ta) && inside_inner(r, tb)); /* the cone is convex */
+    *full = l->L.type != ATMOS_LIGHT_SPOT || (inside_inner(r, ta) && inside_inner(r, tb)); /* the cone is convex */
     *h = 1;
     if (!l->nfaces) return 1;
     int f = 0;
@@ -282,11 +282,11 @@ int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, do
 double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
-    if (l->type != ATMOS_LIGHT_SPOT) return 1;
+    if (l->L.type != ATMOS_LIGHT_SPOT) return 1;
     const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
-    if (z <= 0 || z * z <= l->cos_outer * l->cos_outer * w2) return 0;
-    if (z * z >= l->cos_inner * l->cos_inner * w2) return 1;
-    const double s = (z / sqrt(w2) - l->cos_outer) / (l->cos_inner - l->cos_outer);
+    if (z <= 0 || z * z <= l->L.cos_outer * l->L.cos_outer * w2) return 0;
+    if (z * z >= l->L.cos_inner * l->L.cos_inner * w2) return 1;
+    const double s = (z / sqrt(w2) - l->L.cos_outer) / (l->L.cos_inner - l->L.cos_outer);
     return s * s * (3 - 2 * s);
 }
 
@@ -302,17 +302,4 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
     }
     return fall * lookup(&l->face[f], r->f0[f][0] + t * r->f1[f][0], r->f0[f][1] + t * r->f1[f][1],
                          r->f0[f][2] + t * r->f1[f][2]);
-}
-
-double atmos__beams_falloff(const atmos__beams_light *l, const double p[3])
-{
-    if (l->type != ATMOS_LIGHT_SPOT) return 1;
-    const double d[3] = {p[0] - l->pos[0], p[1] - l->pos[1], p[2] - l->pos[2]};
-    const double r = sqrt(atmos__dot3(d, d));
-    if (r == 0) return 1;
-    const double c = atmos__dot3(d, l->axis) / r;
-    if (c >= l->cos_inner) return 1;
-    if (c <= l->cos_outer) return 0;
-    const double s = (c - l->cos_outer) / (l->cos_inner - l->cos_outer);
-    return s * s * (3 - 2 * s);
 }

@@ -26,6 +26,8 @@
  *       scattered (after a volume event the sun is counted by the two weighted estimates at
  *       the event, after a ground bounce by next-event estimation alone).
  *
+ * In a scene of point lights, spotlights, fog and objects the path is path_lamps.c's.
+ *
  * Without a volume, over a planet (the DOBASHI and SPHERICAL kinds), a path is instead the
  * atmosphere's own Monte Carlo reference (trace_reference): the reference sky.
  *
@@ -46,7 +48,7 @@
 #include <string.h>
 
 /* Russian roulette on the largest weight; returns 0 to stop. */
-static int roulette(double *w, int m, atmos__stream *r)
+int atmos__path_roulette(double *w, int m, atmos__stream *r)
 {
     double q = 0;
     for (int i = 0; i < m; i++)
@@ -164,7 +166,7 @@ static int volume_event(const path_run *R, path_state *s, double t, const float 
         atmos__path_aureole(R, &ea);
     }
     s->depth++;
-    if (!roulette(s->w, m, R->r)) return 0;
+    if (!atmos__path_roulette(s->w, m, R->r)) return 0;
     return new_direction(R, s, &ev, E, lit, pa_on, q_rr);
 }
 
@@ -228,17 +230,9 @@ static int ground(const path_run *R, path_state *s, double K)
         return 0;
     }
     for (int i = 0; i < m; i++) s->w[i] *= J->albedo;
-    if (!roulette(s->w, m, R->r)) return 0;
-    /* cosine-distributed about n, in a frame that is the world's axes for n = +y */
-    double t[3], b[3];
-    const double z[3] = {0, 0, 1};
-    atmos__cross3(n, z, t);
-    if (atmos__dot3(t, t) < 1e-12) t[0] = 1, t[1] = t[2] = 0;
-    atmos__normalize3(t);
-    atmos__cross3(t, n, b);
-    const double u1 = atmos__stream_u(R->r), phi = 2.0 * ATMOS_PI * atmos__stream_u(R->r), st = sqrt(u1);
-    const double x = st * cos(phi), y = sqrt(fmax(0.0, 1.0 - u1)), zz = st * sin(phi);
-    for (int a = 0; a < 3; a++) s->d[a] = x * t[a] + y * n[a] + zz * b[a];
+    if (!atmos__path_roulette(s->w, m, R->r)) return 0;
+    const double u1 = atmos__stream_u(R->r);
+    atmos__path_cosine(n, u1, atmos__stream_u(R->r), s->d);
     s->primary = 0;
     s->esc_wt = 1.0;
     s->hprev = 1;
@@ -279,6 +273,7 @@ static void trace_reference(const path_run *R, const double o[3], const double d
 int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d0[3], atmos__stream *r,
                       double *L, double *Lo, path_counts *cnt)
 {
+    if (J->lamps) return atmos__path_trace_lamps(J, b, o, d0, r, L, Lo, cnt);
     const path_run R = {J, b, r, cnt, L, Lo};
     path_state s = {.primary = 1, .hero = -1, .esc_wt = 1.0, .hprev = 1};
     memcpy(s.p, o, sizeof s.p);

@@ -29,6 +29,8 @@ struct atmos__path_plan {
     path_medium med;
     path_phase ph;
     int has_medium;                /* a volume with something in it */
+    path_lamps lamps;              /* the scene's lights, fog and objects (path_lamps.c) */
+    int lamps_on;
     int aureole;                   /* the aureole estimate is used */
     double trunc_lo, trunc_hi;     /* the fraction of the scattering the truncation removed */
     double prepare_s;
@@ -51,6 +53,7 @@ void atmos__path_plan_destroy(atmos__path_plan *pp)
     if (!pp) return;
     atmos__path_medium_free(&pp->med);
     atmos__path_phase_free(&pp->ph);
+    atmos__path_lamps_free(&pp->lamps);
     free(pp->acc);
     free(pp->count);
     free(pp);
@@ -105,6 +108,24 @@ atmos_status atmos__path_plan_create(atmos_plan *p, atmos__path_plan **out)
     atmos__path_plan *pp = calloc(1, sizeof *pp);
     if (!pp) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render path: out of memory");
     pp->NA = 2 * p->wl.count + 5;
+    const atmos_scene *s = &p->scene;
+    if (s->light_count > 0 || s->fog.enabled || s->object_count > 0) {
+        atmos_status st = ATMOS_OK;
+        if (p->volume)
+            st = atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
+                              "render path: a scene with lights, fog or objects cannot have a volume yet (docs/path.md)");
+        else if (atmos_atmosphere_get_kind(p->atm) != ATMOS_ATMOSPHERE_VACUUM)
+            st = atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
+                              "render path: a scene with lights, fog or objects needs \"background\": \"black\" or "
+                              "a uniform one (the sky's air is not traced with them yet; docs/path.md)");
+        else
+            st = atmos__path_lamps_build(p->ctx, s, &p->wl, &pp->lamps);
+        if (st != ATMOS_OK) {
+            atmos__path_plan_destroy(pp);
+            return st;
+        }
+        pp->lamps_on = 1;
+    }
     if (p->volume && atmos_volume_field_count(p->volume) > 0) {
         atmos_status st = build_medium(p, pp);
         if (st != ATMOS_OK) {
@@ -165,6 +186,7 @@ static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, 
     J->reference = !pp->has_medium && (kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL);
     sky_light(p, pp, v->sun);
     if (pp->env_on) J->env = &pp->env;
+    if (pp->lamps_on) J->lamps = &pp->lamps, J->reference = 0;
 }
 
 /* The clock of a render's passes: the time budget, checked before every sample, and the

@@ -25,6 +25,21 @@ void atmos__path_around(const double n[3], double mu, double phi, double out[3])
     for (int a = 0; a < 3; a++) out[a] *= l;
 }
 
+/* A direction cosine-distributed about unit n (u1, u2 uniform in [0, 1)), in a frame that is
+ * the world's axes for n = +y. */
+void atmos__path_cosine(const double n[3], double u1, double u2, double out[3])
+{
+    double t[3], b[3];
+    const double z[3] = {0, 0, 1};
+    atmos__cross3(n, z, t);
+    if (atmos__dot3(t, t) < 1e-12) t[0] = 1, t[1] = t[2] = 0;
+    atmos__normalize3(t);
+    atmos__cross3(t, n, b);
+    const double phi = 2.0 * ATMOS_PI * u2, st = sqrt(u1);
+    const double x = st * cos(phi), y = sqrt(fmax(0.0, 1.0 - u1)), zz = st * sin(phi);
+    for (int a = 0; a < 3; a++) out[a] = x * t[a] + y * n[a] + zz * b[a];
+}
+
 /* Phase function of the mixture of fields at a scattering event for every carried
  * wavelength: pk[i] = sum_f ssf[f][i] p_f,k(mu) / ss[i], 0 where nothing scatters. */
 void atmos__path_phase_mix(const path_phase *P, const path_bundle *b, int nf, const path_scatter *e, double mu,

@@ -6,6 +6,7 @@
 #define ATMOS_RENDER_PATH_TRACE_H
 
 #include "render/path_internal.h"
+#include "render/path_lamps.h"
 
 typedef struct {
     const path_medium *med; /* NULL: no volume */
@@ -25,6 +26,7 @@ typedef struct {
     int depth_default;      /* max_depth is the default: a path stopped by it counts as cut */
     double deadline;        /* atmos__now() past which a path is abandoned (the time budget); INFINITY: none */
     int reference;          /* no volume, a planet's air: every path is the atmosphere's Monte Carlo reference */
+    const path_lamps *lamps; /* the scene's lights, fog and objects: every path is traced by path_lamps.c */
     uint64_t seed;
 } path_job;
 
@@ -94,6 +96,11 @@ double atmos__path_strategies(int m, const double *S, const int *g, const double
 double atmos__path_aureole_pdf(const path_job *J, const path_bundle *b, const path_scatter *e, const double a[3]);
 /* A direction at cos(theta) = mu, azimuth phi, around unit axis n. */
 void atmos__path_around(const double n[3], double mu, double phi, double out[3]);
+/* A direction cosine-distributed about unit n (u1, u2 uniform in [0, 1)). */
+void atmos__path_cosine(const double n[3], double u1, double u2, double out[3]);
+/* Russian roulette on the largest of the m weights w (divided by the survival probability
+ * when it is below 1); 0 to stop. */
+int atmos__path_roulette(double *w, int m, atmos__stream *r);
 
 /* ---- the light (path_light.c) */
 
@@ -139,5 +146,8 @@ int atmos__path_forced_single(const path_run *R, const double p[3], const double
 #define PATH_ABANDONED (-1)
 int atmos__path_trace(const path_job *J, const path_bundle *b, const double o[3], const double d[3], atmos__stream *r,
                        double *L, double *Lo, path_counts *cnt);
+/* A camera path in a scene of lights, fog and objects (path_lamps.c), as atmos__path_trace. */
+int atmos__path_trace_lamps(const path_job *J, const path_bundle *b, const double o[3], const double d[3],
+                            atmos__stream *r, double *L, double *Lo, path_counts *cnt);
 
 #endif

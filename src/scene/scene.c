@@ -335,6 +335,17 @@ atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t
         memcpy(v->source, path, dir);
     }
     if (st == ATMOS_OK) st = atmos__scene_earth_paths(ctx, path, slash ? (size_t)(slash - path) + 1 : 0, &out->earth);
+    /* the lights' images likewise */
+    for (int i = 0; st == ATMOS_OK && slash && i < out->light_count; i++) {
+        char *m = out->lights[i].image;
+        const size_t dir = (size_t)(slash - path) + 1, n = strlen(m);
+        if (!m[0] || m[0] == '/') continue;
+        if (dir + n >= sizeof out->lights[i].image)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /lights/%d/image: the path is too long once joined to the "
+                                "scene's folder", path, i);
+        memmove(m + dir, m, n + 1);
+        memcpy(m, path, dir);
+    }
     /* the objects' OBJ files likewise */
     for (int i = 0; st == ATMOS_OK && slash && i < out->object_count; i++) {
         char *m = out->objects[i].mesh;

@@ -1050,14 +1050,14 @@ static atmos_status parse_settings(const jp *p, const cJSON *j, const char *path
 static atmos_status parse_light(const jp *p, const cJSON *j, const char *path, atmos_scene_light *L)
 {
     static const char *const keys[] = {"type", "position_m", "direction", "cone_deg", "edge_deg", "intensity_w_sr",
-                                       "colour_temperature_k", "colour", "range_m"};
+                                       "colour_temperature_k", "colour", "range_m", "image"};
     static const char *const types[] = {"point", "spot"};
     const atmos__range *const any[3] = {NULL, NULL, NULL};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
     int k, type;
-    TRY(iter_begin(p, j, path, keys, 9, &it));
+    TRY(iter_begin(p, j, path, keys, 10, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) {
@@ -1076,6 +1076,7 @@ static atmos_status parse_light(const jp *p, const cJSON *j, const char *path, a
         case 6: TRY(get_number(p, v, ip, NULL, NULL, &L->colour_temperature_k)); break;
         case 7: TRY(get_vec3(p, v, ip, any, L->colour)); break;
         case 8: TRY(get_number(p, v, ip, NULL, NULL, &L->range_m)); break;
+        case 9: TRY(get_text(p, v, ip, L->image, sizeof L->image)); break;
         }
     }
 }

@@ -70,6 +70,17 @@ static atmos_status check_light(atmos_context *ctx, const char *source, const at
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path,
                                  "rgb colours need rgb wavelengths; in spectral mode give colour_temperature_k");
     }
+    if (l->image[0]) {
+        char path[96];
+        snprintf(path, sizeof path, "%s/image", at);
+        if (!memchr(l->image, '\0', sizeof l->image))
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path, "the path is not terminated");
+        if (l->type != ATMOS_LIGHT_SPOT)
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path,
+                                     "an image is projected through a spot's cone: give \"type\": \"spot\"");
+        if (s->wavelengths != ATMOS_WAVELENGTHS_RGB)
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path, "an image on a light needs rgb wavelengths");
+    }
     if (l->type != ATMOS_LIGHT_SPOT) return ATMOS_OK;
     if ((st = check1(ctx, source, at, "cone_deg", l->cone_deg, &r_cone, NULL))) return st;
     if ((st = check1(ctx, source, at, "edge_deg", l->edge_deg, &r_edge, NULL))) return st;

@@ -408,7 +408,7 @@ static void test_spectrum(void)
     atmos_wavelengths wl;
     CHECK_OK(atmos_wavelengths_spectral(40, &wl));
     double sum = 0;
-    for (int k = 0; k < wl.count; k++) sum += atmos__beams_spectrum(&l, &wl, k) * wl.width_nm[k];
+    for (int k = 0; k < wl.count; k++) sum += atmos__lamp_spectrum(&l, &wl, k) * wl.width_nm[k];
     CHECK_REL(sum, 250, 2e-3);
 }
 

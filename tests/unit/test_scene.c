@@ -270,6 +270,8 @@ static const bad_case bad_lights[] = {
     {"{\"wavelengths\": {\"mode\": \"spectral\"}, \"lights\": [{\"colour\": [1, 0.5, 0.2]}]}", ATMOS_E_INVALID_ARG, "/lights/0/colour: rgb colours need rgb wavelengths", NULL},
     {"{\"lights\": {\"type\": \"spot\"}}", ATMOS_E_INVALID_ARG, "/lights: expected an array of objects, got an object", NULL},
     {"{\"lights\": [{\"cone\": 5}]}", ATMOS_E_INVALID_ARG, "/lights/0/cone: unknown key", NULL},
+    {"{\"lights\": [{\"image\": \"w.png\"}]}", ATMOS_E_INVALID_ARG, "/lights/0/image: an image is projected through a spot's cone", NULL},
+    {"{\"wavelengths\": {\"mode\": \"spectral\"}, \"lights\": [{\"type\": \"spot\", \"colour_temperature_k\": 3000, \"image\": \"w.png\"}]}", ATMOS_E_INVALID_ARG, "/lights/0/image: an image on a light needs rgb wavelengths", NULL},
     {"{\"fog\": {\"extinction_per_m\": 0}}", ATMOS_E_INVALID_ARG, "/fog/extinction_per_m: must be in (0, 10]", NULL},
     {"{\"fog\": {\"extinction_per_m\": 0.1, \"scattering_per_m\": 0.2}}", ATMOS_E_INVALID_ARG, "/fog/scattering_per_m: must be in [0, 0.1] (at most the extinction)", NULL},
     {"{\"fog\": {\"extinction_per_m\": 0.1, \"g\": 1}}", ATMOS_E_INVALID_ARG, "/fog/g: must be in (-1, 1)", NULL},

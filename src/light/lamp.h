@@ -1,0 +1,67 @@
+/* The scene's point lights and spotlights as every renderer sees them (docs/beams.md,
+ * docs/path.md): position, axis, the spot's cone with its smooth falloff, the spectral
+ * intensity on the axis (a black body's or an rgb colour's). One evaluation for the beam
+ * renderer and the path tracer, so that both see the same light. Not part of the API. */
+#ifndef ATMOS_LIGHT_LAMP_H
+#define ATMOS_LIGHT_LAMP_H
+
+#include "core/internal.h"
+#include "atmos/scene.h"
+
+typedef struct atmos__lamp {
+    atmos_light_type type;
+    double pos[3], axis[3];
+    double cos_inner, cos_outer; /* spot: full within cos_inner, zero beyond cos_outer */
+    double range;
+    double I[ATMOS_MAX_WAVELENGTHS]; /* spectral intensity on the axis, W sr^-1 nm^-1 */
+    double I_max;                /* the largest of I */
+    /* a spot's projected image (stained glass; NULL: none): tw x th linear rgb texels, row 0
+     * at the top, spanning [-tan_max, tan_max]^2 of the plane at unit distance along the axis
+     * (right, up: the image's axes there) */
+    float *tex;
+    int tw, th;
+    double tan_max, right[3], up[3];
+} atmos__lamp;
+
+/* The intensity at wavelength k of a scene light (W sr^-1 nm^-1): intensity_w_sr is the
+ * radiant intensity over 380-780 nm, the spectrum a black body's normalised over that band,
+ * or for an rgb colour a flat 1/400 nm^-1 per channel times the channel's weight. */
+double atmos__lamp_spectrum(const atmos_scene_light *l, const atmos_wavelengths *wl, int k);
+
+/* The lamp of a scene light for the wavelength set. */
+void atmos__lamp_make(const atmos_scene_light *s, const atmos_wavelengths *wl, atmos__lamp *l);
+
+/* The spot's smooth falloff for a point whose offset from the light has cosine c with the
+ * axis: 1 within cos_inner, 0 beyond cos_outer, a smoothstep in c between (1 for a point
+ * light). */
+static inline double atmos__lamp_falloff_cos(const atmos__lamp *l, double c)
+{
+    if (l->type != ATMOS_LIGHT_SPOT || c >= l->cos_inner) return 1;
+    if (c <= l->cos_outer) return 0;
+    const double s = (c - l->cos_outer) / (l->cos_inner - l->cos_outer);
+    return s * s * (3 - 2 * s);
+}
+
+/* The light's image (scene light s's "image", a PNG of sRGB values, linearised) read into l
+ * (made by atmos__lamp_make); a missing or malformed file is an error naming it. */
+atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene_light *s, atmos__lamp *l);
+void atmos__lamp_free(atmos__lamp *l);
+
+/* The image's tint toward point p (rgb, bilinear; 0 outside the image; 1, 1, 1 without an
+ * image). */
+void atmos__lamp_tint(const atmos__lamp *l, const double p[3], double rgb[3]);
+
+/* The falloff toward point p (1 at the light itself). */
+double atmos__lamp_falloff(const atmos__lamp *l, const double p[3]);
+
+/* The light's spectral intensity toward p for the wavelengths k[0..m-1] (I[k] times the
+ * falloff, times the image's tint) into out; returns the falloff (0: p is dark). */
+double atmos__lamp_toward(const atmos__lamp *l, const double p[3], int m, const int *k, double *out);
+
+/* Narrows [*t0, *t1] of the ray e + t d to the part inside a spot's outer cone (Dobashi's
+ * bounding pyramid, exactly): the roots of ((P - L).a)^2 = cos^2 |P - L|^2 cut the span
+ * into at most three pieces; the hull of those whose middle is lit. 0 if none is; a point
+ * light keeps the span. */
+int atmos__lamp_clip(const atmos__lamp *l, const double e[3], const double d[3], double *t0, double *t1);
+
+#endif

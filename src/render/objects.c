@@ -1,0 +1,53 @@
+/* The scene's objects for the renderers (objects.h). */
+#include "render/objects.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const atmos_wavelengths *wl,
+                                 atmos__objects *ob)
+{
+    memset(ob, 0, sizeof *ob);
+    const size_t n = (size_t)(s->object_count ? s->object_count : 1);
+    ob->mesh = calloc(n, sizeof *ob->mesh);
+    ob->albedo = calloc(n, sizeof *ob->albedo);
+    if (!ob->mesh || !ob->albedo) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for the objects");
+    for (int i = 0; i < s->object_count; i++) {
+        const atmos_scene_object *o = &s->objects[i];
+        atmos_status st = atmos_mesh_load(ctx, o->mesh, 0, &ob->mesh[i]);
+        if (st != ATMOS_OK) return st;
+        ob->n = i + 1;
+        atmos_mesh_transform t;
+        memcpy(t.position_m, o->position_m, sizeof t.position_m);
+        memcpy(t.scale, o->scale, sizeof t.scale);
+        memcpy(t.rotation_deg, o->rotation_deg, sizeof t.rotation_deg);
+        if ((st = atmos_mesh_apply_transform(ctx, ob->mesh[i], &t)) != ATMOS_OK) return st;
+        for (int k = 0; k < wl->count; k++)
+            ob->albedo[i][k] = wl->mode == ATMOS_WAVELENGTHS_RGB ? o->albedo[k < 3 ? k : 2]
+                                                               : (o->albedo[0] + o->albedo[1] + o->albedo[2]) / 3;
+    }
+    return ATMOS_OK;
+}
+
+void atmos__objects_free(atmos__objects *ob)
+{
+    if (!ob) return;
+    for (int i = 0; i < ob->n; i++) atmos_mesh_destroy(ob->mesh[i]);
+    free(ob->mesh);
+    free(ob->albedo);
+    memset(ob, 0, sizeof *ob);
+}
+
+int atmos__objects_hit(const atmos__objects *ob, const double o[3], const double d[3], double tmin, double tmax,
+                       atmos_mesh_hit *hit, int *which)
+{
+    int any = 0;
+    for (int m = 0; m < ob->n; m++) {
+        atmos_mesh_hit h = {0, 0, {0, 0, 0}};
+        if (atmos_mesh_intersect(ob->mesh[m], o, d, tmin, tmax, hit ? &h : NULL)) {
+            if (!hit) return 1;
+            *hit = h, *which = m, tmax = h.t, any = 1;
+        }
+    }
+    return any;
+}

@@ -1,0 +1,197 @@
+/* The path tracer in a scene of point lights, spotlights, fog and objects (docs/path.md,
+ * "Lights, fog and objects"): the ground truth of the beam renderer (docs/beams.md).
+ *
+ * A camera path walks through the fog (homogeneous: sigma_s, sigma_a, a Henyey-Greenstein
+ * phase function, filling all space) and between the objects (opaque, Lambertian, two-sided,
+ * through the meshes' bounding volume hierarchies). Per segment, from the path's point to the
+ * first object ahead (or to infinity):
+ *   - the lights' single scattering in the fog along it: per light one point by equi-angular
+ *     sampling on the part inside a spot's cone (fog_lights), then next-event estimation there;
+ *   - the object at its end: next-event estimation of every light, weighted by the fog's
+ *     transmittance exp(-sigma_t T);
+ *   - next-event estimation (nee) is the light's intensity toward the point (light/lamp.h: the
+ *     spot's falloff, the spectrum, the projected image), 1 / r^2, exp(-sigma_t r), a shadow
+ *     ray through the meshes, times the phase function (fog) or albedo cos / pi (surface).
+ *     The lights are points (delta lights): next-event estimation is the only way to see them;
+ *   - then, unless the path has path.max_depth vertices (1: single scattering, what the beam
+ *     renderer computes), the continuation: the distance to the next scattering drawn from
+ *     sigma_s exp(-sigma_s t) with the absorption exp(-sigma_a t) carried in the weights (a
+ *     pure absorber needs no random number), a new direction from the phase function in the
+ *     fog or cosine-distributed about the normal at the object (weight times the albedo),
+ *     Russian roulette;
+ *   - a path that leaves (no fog, no object ahead) sees the vacuum's uniform background.
+ * The sun, the atmosphere's air and a cloud volume are not part of such a scene here
+ * (path_plan.c refuses the air and the volume). */
+#include "core/vec.h"
+#include "render/path_trace.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+atmos_status atmos__path_lamps_build(atmos_context *ctx, const atmos_scene *s, const atmos_wavelengths *wl,
+                                     path_lamps *L)
+{
+    memset(L, 0, sizeof *L);
+    atmos_status st = atmos__objects_load(ctx, s, wl, &L->obj);
+    if (st != ATMOS_OK) return st;
+    L->lamp = calloc((size_t)(s->light_count ? s->light_count : 1), sizeof *L->lamp);
+    if (!L->lamp) return atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the lights");
+    L->nlamps = s->light_count;
+    for (int i = 0; i < s->light_count; i++) {
+        atmos__lamp_make(&s->lights[i], wl, &L->lamp[i]);
+        if ((st = atmos__lamp_load_image(ctx, &s->lights[i], &L->lamp[i])) != ATMOS_OK) return st;
+    }
+    if (s->fog.enabled) {
+        L->sigma_s = s->fog.scattering_per_m;
+        L->sigma_a = s->fog.extinction_per_m - s->fog.scattering_per_m;
+        L->g = s->fog.g;
+    }
+    return ATMOS_OK;
+}
+
+void atmos__path_lamps_free(path_lamps *L)
+{
+    if (!L) return;
+    atmos__objects_free(&L->obj);
+    for (int i = 0; L->lamp && i < L->nlamps; i++) atmos__lamp_free(&L->lamp[i]);
+    free(L->lamp);
+    memset(L, 0, sizeof *L);
+}
+
+/* Henyey-Greenstein at cos theta mu (per steradian), and cos theta drawn from it. */
+static double hg(double g, double mu)
+{
+    const double d = 1 + g * g - 2 * g * mu;
+    return (1 - g * g) / (4 * ATMOS_PI * d * sqrt(d));
+}
+
+static double hg_sample(double g, double u)
+{
+    if (fabs(g) < 1e-4) return 1 - 2 * u;
+    const double s = (1 - g * g) / (1 - g + 2 * g * u);
+    return atmos__clampd((1 + g * g - s * s) / (2 * g), -1, 1);
+}
+
+/* Next-event estimation toward every light from p, reached along d with weights w: in the
+ * fog (n NULL) times the phase function, at a surface (normal n facing the path, albedo
+ * alb per carried wavelength, shadow rays leaving from p lifted by off along n) times
+ * alb cos / pi. Every light, or only light `only` (>= 0). */
+static void nee(const path_run *R, const double p[3], const double d[3], const double *n, const double *alb, double off,
+                const double *w, int order, int only)
+{
+    const path_lamps *P = R->J->lamps;
+    const int m = R->b->m;
+    const double st = P->sigma_s + P->sigma_a;
+    double o[3];
+    for (int a = 0; a < 3; a++) o[a] = p[a] + (n ? off * n[a] : 0);
+    for (int j = only < 0 ? 0 : only; j < (only < 0 ? P->nlamps : only + 1); j++) {
+        const atmos__lamp *l = &P->lamp[j];
+        double u[3] = {l->pos[0] - p[0], l->pos[1] - p[1], l->pos[2] - p[2]};
+        const double r2 = atmos__dot3(u, u), r = sqrt(r2);
+        if (!(r > 0)) continue;
+        for (int a = 0; a < 3; a++) u[a] /= r;
+        double I[PATH_B];
+        if (!(atmos__lamp_toward(l, p, m, R->b->k, I) > 0)) continue;
+        const double c = n ? atmos__dot3(n, u) / ATMOS_PI : hg(P->g, atmos__dot3(d, u));
+        if (!(c > 0)) continue;
+        R->cnt->shadow++;
+        if (atmos__objects_hit(&P->obj, o, u, 0, r - off, NULL, NULL)) continue;
+        const double f = c * exp(-st * r) / r2;
+        for (int i = 0; i < m; i++) atmos__path_add(R, i, w[i] * (alb ? alb[i] : 1) * f * I[i], order);
+    }
+}
+
+/* The fog's single scattering of every light along p + t d, t in [0, T) (T: the object
+ * ahead, or INFINITY), added times w: per light one point drawn by equi-angular sampling
+ * (Kulla and Fajardo 2012: density D / ((theta_b - theta_a) (D^2 + (t - t_Q)^2)), D the light's
+ * distance from the ray, t_Q its foot), on the part of the ray inside a spot's cone, the
+ * transmittance exp(-sigma_t t) to it, then the light at the point as nee() sees it. */
+static void fog_lights(const path_run *R, const double p[3], const double d[3], double T, const double *w, int order)
+{
+    const path_lamps *P = R->J->lamps;
+    const int m = R->b->m;
+    const double st = P->sigma_s + P->sigma_a;
+    for (int j = 0; j < P->nlamps; j++) {
+        const atmos__lamp *l = &P->lamp[j];
+        const double c[3] = {l->pos[0] - p[0], l->pos[1] - p[1], l->pos[2] - p[2]};
+        const double tq = atmos__dot3(c, d);
+        const double q[3] = {c[0] - tq * d[0], c[1] - tq * d[1], c[2] - tq * d[2]};
+        const double D = fmax(sqrt(atmos__dot3(q, q)), 1e-9 * (1 + fabs(tq)));
+        /* beyond optical depth 60 from the ray's start nothing is left (exp(-60) = 9e-27) */
+        double a = 0, b = fmin(T, fmax(tq, 0) + D + 60 / st);
+        if (!atmos__lamp_clip(l, p, d, &a, &b)) continue;
+        const double ta = atan((a - tq) / D), tb = atan((b - tq) / D);
+        if (!(tb > ta)) continue;
+        const double t = tq + D * tan(ta + atmos__stream_u(R->r) * (tb - ta));
+        if (!(t >= a && t <= b)) continue;
+        const double pdf = D / ((tb - ta) * (D * D + (t - tq) * (t - tq)));
+        const double x[3] = {p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]};
+        double wt[PATH_B];
+        const double f = P->sigma_s * exp(-st * t) / pdf;
+        for (int i = 0; i < m; i++) wt[i] = w[i] * f;
+        nee(R, x, d, NULL, NULL, 0, wt, order, j);
+    }
+}
+
+int atmos__path_trace_lamps(const path_job *J, const path_bundle *b, const double o[3], const double d0[3],
+                            atmos__stream *r, double *L, double *Lo, path_counts *cnt)
+{
+    const path_run R = {J, b, r, cnt, L, Lo};
+    const path_lamps *P = J->lamps;
+    const int m = b->m;
+    const double st = P->sigma_s + P->sigma_a;
+    double w[PATH_B], p[3], d[3];
+    memcpy(p, o, sizeof p);
+    memcpy(d, d0, sizeof d);
+    for (int i = 0; i < m; i++) w[i] = 1, L[i] = 0, Lo[i] = 0;
+    int depth = 0;
+    for (int guard = 0; guard < 1 << 24; guard++) {
+        if ((guard & 15) == 15 && J->deadline < INFINITY && atmos__now() >= J->deadline) return PATH_ABANDONED;
+        atmos_mesh_hit h = {0, 0, {0, 0, 0}};
+        int which = 0;
+        const int hit = atmos__objects_hit(&P->obj, p, d, 0, INFINITY, &h, &which);
+        const double T = hit ? h.t : INFINITY, off = 1e-4 * (1 + fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + (hit ? T : 0));
+        double alb[PATH_B], ps[3] = {0, 0, 0};
+        if (hit)
+            for (int i = 0; i < m; i++) alb[i] = P->obj.albedo[which][b->k[i]];
+        for (int a = 0; a < 3 && hit; a++) ps[a] = p[a] + T * d[a];
+        /* the lights' direct share of this segment's next event: the fog's single scattering
+         * along it and the object's surface at its end, both exactly weighted by the fog's
+         * transmittance (the free flight below only continues the path) */
+        const int goes_on = !J->max_depth || depth + 1 < J->max_depth;
+        if (P->sigma_s > 0) fog_lights(&R, p, d, T, w, depth + 1);
+        if (hit) {
+            double wt[PATH_B];
+            for (int i = 0; i < m; i++) wt[i] = w[i] * exp(-st * T);
+            nee(&R, ps, d, h.normal, alb, off, wt, depth + 1, -1);
+        } else if (st == 0 && J->bg != 0) {
+            for (int i = 0; i < m; i++) atmos__path_add(&R, i, w[i] * J->bg, depth);
+        }
+        if (!goes_on) {
+            if (J->depth_default && (hit || P->sigma_s > 0)) cnt->cut++;
+            return depth > 0 || hit || P->sigma_s > 0;
+        }
+        /* the continuation: the next scattering in the fog or the object's surface */
+        const double t = P->sigma_s > 0 ? -log(1 - atmos__stream_u(r)) / P->sigma_s : INFINITY;
+        if (isinf(t) && !hit) return depth > 0;
+        const double s = fmin(t, T), ab = exp(-P->sigma_a * s);
+        for (int i = 0; i < m; i++) w[i] *= ab;
+        cnt->events++;
+        depth++;
+        if (t < T) {
+            for (int a = 0; a < 3; a++) p[a] += t * d[a];
+            if (!atmos__path_roulette(w, m, r)) return 1;
+            const double mu = hg_sample(P->g, atmos__stream_u(r));
+            double nd[3];
+            atmos__path_around(d, mu, 2 * ATMOS_PI * atmos__stream_u(r), nd);
+            memcpy(d, nd, sizeof d);
+        } else {
+            for (int i = 0; i < m; i++) w[i] *= alb[i];
+            if (!atmos__path_roulette(w, m, r)) return 1;
+            const double u1 = atmos__stream_u(r);
+            atmos__path_cosine(h.normal, u1, atmos__stream_u(r), d);
+            for (int a = 0; a < 3; a++) p[a] = ps[a] + off * h.normal[a];
+        }
+    }
+    return 1;
+}
