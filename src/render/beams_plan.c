@@ -50,25 +50,7 @@ static void make_light(const atmos_scene_light *s, const atmos_wavelengths *wl, 
 
 static atmos_status load_objects(atmos_plan *p, atmos__beams_plan *b)
 {
-    const atmos_scene *s = &p->scene;
-    b->mesh = calloc((size_t)(s->object_count ? s->object_count : 1), sizeof *b->mesh);
-    b->albedo = calloc((size_t)(s->object_count ? s->object_count : 1), sizeof *b->albedo);
-    if (!b->mesh || !b->albedo) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
-    for (int i = 0; i < s->object_count; i++) {
-        const atmos_scene_object *o = &s->objects[i];
-        atmos_status st = atmos_mesh_load(p->ctx, o->mesh, 0, &b->mesh[i]);
-        if (st != ATMOS_OK) return st;
-        b->nmesh = i + 1;
-        atmos_mesh_transform t;
-        memcpy(t.position_m, o->position_m, sizeof t.position_m);
-        memcpy(t.scale, o->scale, sizeof t.scale);
-        memcpy(t.rotation_deg, o->rotation_deg, sizeof t.rotation_deg);
-        if ((st = atmos_mesh_apply_transform(p->ctx, b->mesh[i], &t)) != ATMOS_OK) return st;
-        for (int k = 0; k < p->wl.count; k++)
-            b->albedo[i][k] = p->wl.mode == ATMOS_WAVELENGTHS_RGB ? o->albedo[k < 3 ? k : 2]
-                                                                : (o->albedo[0] + o->albedo[1] + o->albedo[2]) / 3;
-    }
-    return ATMOS_OK;
+    return atmos__scene_objects_load(p, &b->mesh, &b->albedo, &b->nmesh);
 }
 
 void atmos__beams_plan_destroy(atmos__beams_plan *b)

@@ -46,23 +46,38 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
      * passes), the pairs on the threads; the result does not depend on the count */
     atmos_status st = ATMOS_OK;
     const atmos__pclusters *cl = &h->clouds;
-    const int pairs = h->nlights * cl->n;
+    const int pairs = h->nlights * cl->n, nv = h->obj ? h->obj->nv : 0, nw = h->o.nw;
+    /* the objects' vertices read every pass as particles would: the light each pair leaves them */
+    float *probe = nv ? malloc(sizeof(float) * (size_t)(pairs ? pairs : 1) * nv * nw) : NULL;
+    if (nv && !probe) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the objects' light");
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
     for (int q = 0; q < pairs; q++) {
         const int j = q / cl->n, k = q % cl->n;
+        const atmos__pprobes pr = {nv, h->obj ? h->obj->xyz : NULL, probe + (size_t)q * nv * nw};
         /* the sky's light is soft: its buffers have texels three times as wide */
-        const atmos_status sj = atmos__pcloud_shade(p->ctx, &h->pc, cl->idx + cl->start[k], cl->start[k + 1] - cl->start[k],
-                                                    &h->o, h->dir[j], p->scene.harris.light_size, j ? 3.0 : 1.0,
-                                                    h->light[j], h->order[j]);
+        const atmos_status sj = atmos__pcloud_shade_probes(p->ctx, &h->pc, cl->idx + cl->start[k],
+                                                           cl->start[k + 1] - cl->start[k], &h->o, h->dir[j],
+                                                           p->scene.harris.light_size, j ? 3.0 : 1.0, h->light[j],
+                                                           h->order[j], nv ? &pr : NULL);
         if (sj != ATMOS_OK) {
 #pragma omp critical
             st = sj;
         }
     }
+    /* a vertex gets what every cloud leaves of each light (in the clouds' order: the same sum
+     * whatever the threads) */
+    for (int j = 0; j < h->nlights && nv && st == ATMOS_OK; j++)
+        for (size_t i = 0; i < (size_t)nv * nw; i++) {
+            float t = 1.0f;
+            for (int k = 0; k < cl->n; k++) t *= probe[((size_t)j * cl->n + k) * nv * nw + i];
+            h->obj->light[j][i] = t;
+        }
+    free(probe);
     if (st != ATMOS_OK) return st;
     memcpy(h->sun, sun, sizeof h->sun);
     h->have_sun = 1;
     for (int k = 0; k < h->clouds.n; k++) h->imp[k].valid = 0; /* lit anew */
+    for (int k = 0; h->split && k < 2 * h->clouds.n; k++) h->split[k].valid = 0;
     return ATMOS_OK;
 }
 
@@ -105,6 +120,21 @@ static atmos_status particles(atmos_plan *p, atmos__harris_plan *h)
     return atmos__pcloud_from_volume(p->ctx, p->volume, p->offset, hs->spacing_m, hs->max_particles, &h->pc);
 }
 
+/* The scene's objects and what splitting the clouds' impostors about them needs (Harris §3.2). */
+static atmos_status objects(atmos_plan *p, atmos__harris_plan *h)
+{
+    atmos_status st = atmos__harris_objects_create(p, &h->obj);
+    if (st != ATMOS_OK) return st;
+    const size_t nc = h->clouds.n ? (size_t)h->clouds.n : 1;
+    h->split = calloc(2 * nc, sizeof *h->split);
+    h->part = malloc(sizeof(int) * (size_t)(h->pc.n ? h->pc.n : 1));
+    h->nfar = calloc(nc, sizeof *h->nfar);
+    h->key = calloc(nc, sizeof *h->key);
+    if (!h->split || !h->part || !h->nfar || !h->key)
+        return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the split impostors");
+    return ATMOS_OK;
+}
+
 atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
 {
     *out = NULL;
@@ -125,6 +155,7 @@ atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
         h->order[j] = malloc(sizeof(float) * (size_t)(h->pc.n ? h->pc.n : 1));
         if (!h->light[j] || !h->order[j]) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     }
+    if (st == ATMOS_OK && p->scene.object_count > 0) st = objects(p, h);
     if (st != ATMOS_OK) {
         atmos__harris_plan_destroy(h);
         return st;
@@ -139,6 +170,9 @@ void atmos__harris_plan_destroy(atmos__harris_plan *h)
     if (!h) return;
     for (int k = 0; h->imp && k < h->clouds.n; k++) atmos__pimpostor_free(&h->imp[k]);
     free(h->imp);
+    for (int k = 0; h->split && k < 2 * h->clouds.n; k++) atmos__pimpostor_free(&h->split[k]);
+    free(h->split), free(h->part), free(h->nfar), free(h->key);
+    atmos__harris_objects_destroy(h->obj);
     atmos__pclusters_free(&h->clouds);
     atmos__pcloud_free(&h->pc);
     for (int j = 0; j < ATMOS__HARRIS_MAX_LIGHTS; j++) free(h->light[j]), free(h->order[j]);
@@ -152,4 +186,8 @@ void atmos__harris_describe(const atmos_plan *p, char *buf, size_t cap)
     const atmos__harris_plan *h = p->harris;
     snprintf(buf, cap, "%d particles in %d clouds (%d splatted, %d clouds direct), %d sky lights, light passes %.3f s, "
              "%d impostor updates", h->pc.n, h->clouds.n, h->drawn, h->direct, h->nlights - 1, h->shade_s, h->updates);
+    if (h->obj) {
+        const size_t l = strlen(buf);
+        snprintf(buf + l, cap - l, ", %d objects, %d clouds split at %.0f m", h->obj->n, h->splits, h->split_m);
+    }
 }

@@ -41,6 +41,12 @@ struct atmos_plan {
     atmos__beams_plan *beams;
 };
 
+/* The scene's objects (scene_objects.c): *n meshes loaded and placed, their albedo per
+ * wavelength (rgb: the channel's; spectral: the mean). On failure *n holds the meshes made
+ * (the caller frees them and both arrays). */
+atmos_status atmos__scene_objects_load(atmos_plan *p, atmos_mesh ***mesh, double (**albedo)[ATMOS_MAX_WAVELENGTHS],
+                                       int *n);
+
 /* The slice renderer's part (slice_plan.c): the render grid, the optics tables, the buffers
  * kept between frames, the per-sun light cache. */
 atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out);
