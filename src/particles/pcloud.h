@@ -177,7 +177,7 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
  * colour, coverage) by a camera at `view` fitted to the cloud's sphere. */
 typedef struct atmos__pimpostor {
     int valid, res;
-    uint64_t key;         /* the caller's mark of which particles it holds (a split's near set) */
+    double split;         /* the caller's: where a split cloud was cut for it (m from the cloud's centre) */
     double view[3];
     atmos_camera cam;
     atmos_image *img;

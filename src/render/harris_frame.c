@@ -88,13 +88,15 @@ static int mode(const atmos_plan *p, const atmos__harris_plan *h, const atmos__v
 }
 
 /* Whether a split cloud k's part impostor (pass 0 far, 1 near) still serves: as a whole one
- * does, and made of the same particles. */
+ * does, and cut where the cloud is cut now (within half its narrowest particle's width). */
 static int part_mode(const atmos_plan *p, const atmos__harris_plan *h, const atmos__view *v, int k, int pass)
 {
     const atmos_scene_harris *hs = &p->scene.harris;
     const atmos__pimpostor *im = &h->split[2 * k + pass];
     const double f = v->cam.height / (2.0 * v->cam.tan_half_fov), tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
-    return im->key == h->key[k] && atmos__pimpostor_serves(im, h->clouds.centre[k], h->clouds.radius[k], v->cam.position,
+    /* the split may move by half the cloud's narrowest particle width (Harris's layers hold the
+     * particles "approximately" behind and in front of the object) */
+    return fabs(im->split - h->offset[k]) <= 0.5 * h->smin[k] && atmos__pimpostor_serves(im, h->clouds.centre[k], h->clouds.radius[k], v->cam.position,
                                                            tol, f, hs->impostor_max_res) ? 3 : 4;
 }
 
@@ -133,7 +135,7 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
         for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
         const int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
         const atmos_status sk = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, &L, idx, m, c->centre[k], c->radius[k], e, res);
-        im->key = part ? h->key[k] : 0;
+        im->split = part ? h->offset[k] : 0;
         if (sk != ATMOS_OK) {
 #pragma omp critical
             st = sk;

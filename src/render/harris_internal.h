@@ -45,7 +45,8 @@ struct atmos__harris_plan {
     atmos__pimpostor *split;             /* [2 clouds.n] with objects: each cloud's far and near impostors */
     int *part;                           /* [pc.n] this frame's split clouds' particles, far ones first */
     int *nfar;                           /* [clouds.n] how many of those are far */
-    uint64_t *key;                       /* [clouds.n] the near set's mark */
+    double *offset;                      /* [clouds.n] the split distance less the cloud centre's, this frame */
+    double *smin;                        /* [clouds.n] each cloud's narrowest particle width */
     int splits;                          /* clouds split this frame */
     double split_m;                      /* this frame's split distance (INFINITY: none) */
     int nlights;                         /* the sun, then the sky lights */
@@ -64,7 +65,7 @@ enum { ATMOS__HARRIS_NEAR = 0, ATMOS__HARRIS_FAR = 1, ATMOS__HARRIS_SPLIT = 2 };
 /* The split of view v (the objects' layer made): h->split_m the distance from the eye to the
  * objects' centre (INFINITY: no objects in view), side[k] each cloud's (how[k]: 0 for a cloud out
  * of view): NEAR drawn whole after the objects, FAR whole before them, SPLIT its far particles
- * before and its near ones after (h->part, h->nfar, h->key). */
+ * before and its near ones after (h->part, h->nfar, h->offset). */
 void atmos__harris_split(atmos__harris_plan *h, const atmos__view *v, const int rect[4], const int *how, int *side);
 /* What cloud k (drawn by how, on side) shows in pass 0 (before the objects) or 1 (after): its
  * impostor *im (whole or the part's) and its particles idx[0..n) of the part; returns how, or 0

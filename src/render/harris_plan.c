@@ -129,9 +129,14 @@ static atmos_status objects(atmos_plan *p, atmos__harris_plan *h)
     h->split = calloc(2 * nc, sizeof *h->split);
     h->part = malloc(sizeof(int) * (size_t)(h->pc.n ? h->pc.n : 1));
     h->nfar = calloc(nc, sizeof *h->nfar);
-    h->key = calloc(nc, sizeof *h->key);
-    if (!h->split || !h->part || !h->nfar || !h->key)
+    h->offset = calloc(nc, sizeof *h->offset);
+    h->smin = malloc(sizeof *h->smin * nc);
+    if (!h->split || !h->part || !h->nfar || !h->offset || !h->smin)
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the split impostors");
+    for (int k = 0; k < h->clouds.n; k++) {
+        h->smin[k] = INFINITY;
+        for (int q = h->clouds.start[k]; q < h->clouds.start[k + 1]; q++) h->smin[k] = fmin(h->smin[k], h->pc.s[h->clouds.idx[q]]);
+    }
     return ATMOS_OK;
 }
 
@@ -171,7 +176,7 @@ void atmos__harris_plan_destroy(atmos__harris_plan *h)
     for (int k = 0; h->imp && k < h->clouds.n; k++) atmos__pimpostor_free(&h->imp[k]);
     free(h->imp);
     for (int k = 0; h->split && k < 2 * h->clouds.n; k++) atmos__pimpostor_free(&h->split[k]);
-    free(h->split), free(h->part), free(h->nfar), free(h->key);
+    free(h->split), free(h->part), free(h->nfar), free(h->offset), free(h->smin);
     atmos__harris_objects_destroy(h->obj);
     atmos__pclusters_free(&h->clouds);
     atmos__pcloud_free(&h->pc);

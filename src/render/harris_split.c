@@ -15,16 +15,6 @@ static double dist(const double a[3], const double b[3])
     return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-/* A mark of a set of particle indices (a sum of their hashes, splitmix64's finaliser): the near
- * set an impostor was made of, to know when the split has moved a particle across. */
-static uint64_t mark(uint64_t i)
-{
-    i += 0x9e3779b97f4a7c15ull;
-    i = (i ^ (i >> 30)) * 0xbf58476d1ce4e5b9ull;
-    i = (i ^ (i >> 27)) * 0x94d049bb133111ebull;
-    return i ^ (i >> 31);
-}
-
 /* Cloud k's particles into h->part: the far ones first (ascending), then the near ones; 1 when
  * both sides have some. */
 static int partition(atmos__harris_plan *h, const double eye[3], int k)
@@ -32,7 +22,6 @@ static int partition(atmos__harris_plan *h, const double eye[3], int k)
     const atmos__pclusters *c = &h->clouds;
     const int s = c->start[k], n = c->start[k + 1] - s;
     int nf = 0, nn = 0;
-    uint64_t key = 0;
     for (int q = 0; q < n; q++) {
         const int i = c->idx[s + q];
         const double pc[3] = {h->pc.x[i], h->pc.y[i], h->pc.z[i]};
@@ -41,9 +30,9 @@ static int partition(atmos__harris_plan *h, const double eye[3], int k)
     for (int q = 0; q < n; q++) {
         const int i = c->idx[s + q];
         const double pc[3] = {h->pc.x[i], h->pc.y[i], h->pc.z[i]};
-        if (!(dist(pc, eye) > h->split_m)) h->part[s + nf + nn++] = i, key += mark((uint64_t)i);
+        if (!(dist(pc, eye) > h->split_m)) h->part[s + nf + nn++] = i;
     }
-    h->nfar[k] = nf, h->key[k] = key ^ mark((uint64_t)nn << 32);
+    h->nfar[k] = nf;
     return nf > 0 && nn > 0;
 }
 
@@ -59,6 +48,7 @@ void atmos__harris_split(atmos__harris_plan *h, const atmos__view *v, const int 
     for (int k = 0; k < c->n; k++) {
         if (!how[k]) continue;
         const double d = dist(c->centre[k], eye);
+        h->offset[k] = h->split_m - d;
         side[k] = d > h->split_m ? ATMOS__HARRIS_FAR : ATMOS__HARRIS_NEAR;
         if (fabs(d - h->split_m) >= c->radius[k]) continue; /* wholly on one side */
         int bb[4];

@@ -119,7 +119,8 @@ int main(void)
         if (sqrt(pow(h->pc.x[i] - eye[0], 2) + pow(h->pc.y[i] - eye[1], 2) + pow(h->pc.z[i] - eye[2], 2)) <= split)
             near[nn++] = i;
     }
-    printf("%d particles, cloud radius %.0f m, %d in front of the split at %.1f m\n", h->pc.n, h->clouds.radius[0], nn, split);
+    printf("%d particles, cloud centre (%.0f, %.0f, %.0f) m, radius %.0f m, %d in front of the split at %.1f m\n", h->pc.n, c[0],
+           c[1], c[2], h->clouds.radius[0], nn, split);
     CHECK(nn > 100 && nn < h->pc.n - 100);
     /* the near particles alone and all of them, splatted over black with the plan's light */
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
@@ -184,6 +185,18 @@ int main(void)
            pi->harris->splits, pi->harris->updates, e);
     CHECK(pi->harris->splits == 1 && pi->harris->updates == 2);
     CHECK(e < 0.01);
+    /* the eye 4 m aside (0.1 degree round the cloud): the split impostors serve on */
+    const double eye2[3] = {eye[0] + 4, eye[1], eye[2]};
+    atmos_image *I2 = render(c2, pi, c, eye2);
+    const int reused = pi->harris->updates == 0 && pi->harris->splits == 1;
+    atmos_plan *pd = plan(c2, c, ac, eye2, 0.8, 0);
+    atmos_image *D2 = render(c2, pd, c, eye2);
+    const double e2 = rel_rms(I2, D2);
+    printf("4 m aside: %d impostor updates, rel rms against the particles %.2e\n", pi->harris->updates, e2);
+    CHECK(reused);
+    CHECK(e2 < 0.01);
+    atmos_image_destroy(I2), atmos_image_destroy(D2);
+    atmos_plan_destroy(pd);
     /* the same bytes on one thread */
     atmos_plan *pa1 = plan(c1, c, ac, eye, 0.8, 0), *pi1 = plan(c1, c, ac, eye, 0.8, 1);
     atmos_image *A1 = render(c1, pa1, c, eye), *I1 = render(c1, pi1, c, eye);
