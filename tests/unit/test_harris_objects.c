@@ -1,4 +1,6 @@
-/* Objects inside Harris's particle clouds (Harris 2002 §3.2, impostor splitting): an opaque
+/* Objects inside Harris's particle clouds (Harris 2002 §3.2, impostor splitting): the light
+ * passes' probes (an object's vertices) read the light buffer as particles do, and below a cloud
+ * the transmittance of its column; an opaque
  * aircraft in a cumulus is veiled by exactly the particles in front of it (the transmittance of
  * their columns along each pixel's ray, summed here from the particles themselves), the particles
  * behind it are hidden, the split impostors give the particles' own image within the impostors'
@@ -84,8 +86,46 @@ static double column(const atmos__pcloud *pc, int p, const double eye[3], const 
     return u >= 9 ? 0 : exp(-0.5 * u) * erf(sqrt(0.5 * (9 - u))) * pc->n0[p] * pc->s[p] * 2.5066282746310002;
 }
 
+/* The light passes' probes: a probe at a particle's centre reads what the particle reads, one
+ * beside the cloud or sunward of it the whole light, one in its shadow less; the particles' own
+ * light is the same bytes with and without probes. */
+static void probes(void)
+{
+    atmos__pcloud pc;
+    memset(&pc, 0, sizeof pc);
+    pc.nfields = 1;
+    for (int i = 0; i < 300; i++)
+        CHECK_OK(atmos__pcloud_add(&pc, 200 * sin(i * 1.7), 2000 + 200 * cos(i * 0.9), 200 * sin(i * 0.37 + 1),
+                                   40 + 10 * (i % 3), 4e8, 0));
+    atmos__poptics o;
+    memset(&o, 0, sizeof o);
+    o.nw = 1, o.sigma_ext[0][0] = 2e-12, o.albedo[0][0] = 0.9;
+    const double sun[3] = {0, 1, 0};
+    float *l0 = malloc(sizeof(float) * 300), *l1 = malloc(sizeof(float) * 300), *o0 = malloc(sizeof(float) * 300),
+          *o1 = malloc(sizeof(float) * 300), plight[5];
+    const float xyz[15] = {pc.x[7], pc.y[7], pc.z[7], pc.x[123], pc.y[123], pc.z[123], 2000, 2000, 0, 0, 2600, 0, 0, 1500, 0};
+    const atmos__pprobes pr = {5, xyz, plight};
+    CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun, 0, 1.0, l0, o0));
+    CHECK_OK(atmos__pcloud_shade_probes(NULL, &pc, NULL, 0, &o, sun, 0, 1.0, l1, o1, &pr));
+    printf("probes: at particles %.4f (%.4f), %.4f (%.4f); beside %.3f, above %.3f, below %.4f\n", plight[0], l0[7],
+           plight[1], l0[123], plight[2], plight[3], plight[4]);
+    CHECK(!memcmp(l0, l1, sizeof(float) * 300) && !memcmp(o0, o1, sizeof(float) * 300));
+    CHECK(plight[0] == l0[7] && plight[1] == l0[123]);
+    CHECK(plight[2] == 1.0f && plight[3] == 1.0f);
+    /* below the cloud (no forward scattering without tables): exp(-tau) of the whole column */
+    double tau = 0;
+    const double below[3] = {0, 1500, 0}, up[3] = {0, 1, 0};
+    for (int i = 0; i < pc.n; i++) tau += column(&pc, i, below, up) * o.sigma_ext[0][0];
+    printf("probe below the cloud %.4f, exp(-tau) of the particles' column %.4f\n", plight[4], exp(-tau));
+    CHECK(exp(-tau) < 0.5);
+    CHECK_REL(plight[4], exp(-tau), 0.02);
+    free(l0), free(l1), free(o0), free(o1);
+    atmos__pcloud_free(&pc);
+}
+
 int main(void)
 {
+    probes();
     atmos_context *c2 = context(2), *c1 = context(1);
     /* the cloud's centre, from a plan without the aircraft */
     double c[3], eye[3];
