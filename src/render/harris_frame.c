@@ -96,8 +96,9 @@ static int part_mode(const atmos_plan *p, const atmos__harris_plan *h, const atm
     const double f = v->cam.height / (2.0 * v->cam.tan_half_fov), tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
     /* the split may move by half the cloud's narrowest particle width (Harris's layers hold the
      * particles "approximately" behind and in front of the object) */
-    return fabs(im->split - h->offset[k]) <= 0.5 * h->smin[k] && atmos__pimpostor_serves(im, h->clouds.centre[k], h->clouds.radius[k], v->cam.position,
-                                                           tol, f, hs->impostor_max_res) ? 3 : 4;
+    const int cut = fabs(im->split - h->offset[k]) <= 0.5 * h->smin[k];
+    return cut && atmos__pimpostor_serves(im, h->clouds.centre[k], h->clouds.radius[k], v->cam.position, tol, f,
+                                          hs->impostor_max_res) ? 3 : 4;
 }
 
 /* Makes the impostors list[0..n) again (each k 3 + part: part 0 cloud k's whole impostor, 1 its
