@@ -19,9 +19,10 @@ typedef struct atmos__harris_objects {
     int *first;                          /* [n + 1]: mesh m's vertices are first[m] .. */
     float *light[ATMOS__HARRIS_MAX_LIGHTS]; /* [nv nw]: the share of light j the clouds leave at each vertex */
     double centre[3], radius;            /* the sphere about all of them: the split is at its centre */
-    /* the last frame's layer: per pixel the distance to the surface (INFINITY: none) and its
-     * radiance seen through the air, over box [x0, x1) x [y0, y1) */
-    float *depth, *col;
+    /* the last frame's layer over box [x0, x1) x [y0, y1): per pixel the nearest distance to a
+     * surface (INFINITY: none), the share of the pixel covered (2 x 2 rays) and the radiance
+     * seen through the air, premultiplied by the coverage */
+    float *depth, *cover, *col;
     size_t cap;
     int box[4];
 } atmos__harris_objects;
@@ -32,7 +33,7 @@ void atmos__harris_objects_destroy(atmos__harris_objects *ob);
  * the light passes done (h->light's probes in ob->light). */
 atmos_status atmos__harris_objects_frame(const atmos_plan *p, const atmos__harris_plan *h, atmos__harris_objects *ob,
                                          const atmos__view *v, const atmos__aerial *ap, const int rect[4]);
-/* Lays the layer over img: the surface where a pixel's ray meets it (opaque). */
+/* Lays the layer over img: pixel (1 - coverage) + colour (the surfaces are opaque). */
 void atmos__harris_objects_over(atmos_context *ctx, const atmos__harris_objects *ob, int nw, const atmos_camera *cam,
                                 atmos_image *img);
 

@@ -88,14 +88,45 @@ static void shade(const atmos__harris_plan *h, const atmos__harris_objects *ob, 
     for (int k = 0; k < nw; k++) L[k] *= ob->albedo[m][k] / ATMOS_PI;
 }
 
-/* Pixel (x, y)'s ray of cam (unit). */
-static void pixel_ray(const atmos_camera *cam, int x, int y, double d[3])
+/* The ray of cam through image point (x, y) (pixel units; a pixel's centre at + 0.5), unit. */
+static void pixel_ray(const atmos_camera *cam, double x, double y, double d[3])
 {
     const double W = cam->width, H = cam->height, t = cam->tan_half_fov;
-    const double u = (2.0 * (x + 0.5) - W) / H * t, v = (H - 2.0 * (y + 0.5)) / H * t;
+    const double u = (2.0 * x - W) / H * t, v = (H - 2.0 * y) / H * t;
     double l = 0;
     for (int i = 0; i < 3; i++) d[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i], l += d[i] * d[i];
     for (int i = 0; i < 3; i++) d[i] /= sqrt(l);
+}
+
+/* Pixel (x, y) of the layer: 2 x 2 rays (stratified), the nearest surface of each; the
+ * coverage is the share of them that meet one, the colour their mean (premultiplied), the depth
+ * the nearest. */
+static void subpixels(const atmos_plan *p, const atmos__harris_plan *h, atmos__harris_objects *ob, const atmos__view *v,
+                      const atmos__aerial *ap, int x, int y)
+{
+    const atmos_camera *cam = &v->cam;
+    const int nw = h->o.nw;
+    const size_t at = (size_t)y * cam->width + x;
+    double sum[ATMOS_MAX_WAVELENGTHS] = {0}, nearest = INFINITY;
+    int hits = 0;
+    for (int s = 0; s < 4; s++) {
+        double d[3], best = INFINITY, L[ATMOS_MAX_WAVELENGTHS], La[ATMOS_MAX_WAVELENGTHS], Ta[ATMOS_MAX_WAVELENGTHS];
+        pixel_ray(cam, x + 0.25 + 0.5 * (s & 1), y + 0.25 + 0.5 * (s >> 1), d);
+        atmos_mesh_hit hit, first;
+        int mb = -1;
+        for (int m = 0; m < ob->n; m++)
+            if (atmos_mesh_intersect(ob->mesh[m], cam->position, d, 0.0, best, &hit)) best = hit.t, first = hit, mb = m;
+        if (mb < 0) continue;
+        hits++, nearest = fmin(nearest, best);
+        shade(h, ob, mb, &first, cam->position, d, L);
+        if (!ap || !atmos__aerial_eval(ap, d, best, La, Ta)) {
+            atmos_atmosphere_inscatter(p->atm, cam->position, d, best, v->sun, La);
+            atmos_atmosphere_transmittance(p->atm, cam->position, d, best, Ta);
+        }
+        for (int k = 0; k < nw; k++) sum[k] += La[k] + Ta[k] * L[k];
+    }
+    ob->depth[at] = (float)nearest, ob->cover[at] = 0.25f * hits;
+    for (int k = 0; k < nw; k++) ob->col[at * nw + k] = (float)(0.25 * sum[k]);
 }
 
 atmos_status atmos__harris_objects_frame(const atmos_plan *p, const atmos__harris_plan *h, atmos__harris_objects *ob,
@@ -106,7 +137,8 @@ atmos_status atmos__harris_objects_frame(const atmos_plan *p, const atmos__harri
     const size_t npx = (size_t)cam->width * cam->height;
     if (npx > ob->cap) {
         free(ob->depth), free(ob->col);
-        ob->depth = malloc(sizeof(float) * npx), ob->col = malloc(sizeof(float) * npx * nw);
+        ob->depth = malloc(sizeof(float) * npx * 2), ob->col = malloc(sizeof(float) * npx * nw);
+        ob->cover = ob->depth ? ob->depth + npx : NULL;
         ob->cap = ob->depth && ob->col ? npx : 0;
         if (!ob->cap) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the objects' layer");
     }
@@ -124,23 +156,8 @@ atmos_status atmos__harris_objects_frame(const atmos_plan *p, const atmos__harri
     memcpy(ob->box, bb, sizeof ob->box);
 #pragma omp parallel for schedule(dynamic, 4) num_threads(atmos__threads(p->ctx))
     for (int y = bb[2]; y < bb[3]; y++)
-        for (int x = bb[0]; x < bb[1]; x++) {
-            const size_t at = (size_t)y * cam->width + x;
-            double d[3], best = INFINITY, L[ATMOS_MAX_WAVELENGTHS], La[ATMOS_MAX_WAVELENGTHS], Ta[ATMOS_MAX_WAVELENGTHS];
-            pixel_ray(cam, x, y, d);
-            atmos_mesh_hit hit, first;
-            int mb = -1;
-            for (int m = 0; m < ob->n; m++)
-                if (atmos_mesh_intersect(ob->mesh[m], cam->position, d, 0.0, best, &hit)) best = hit.t, first = hit, mb = m;
-            ob->depth[at] = (float)best;
-            if (mb < 0) continue;
-            shade(h, ob, mb, &first, cam->position, d, L);
-            if (!ap || !atmos__aerial_eval(ap, d, best, La, Ta)) {
-                atmos_atmosphere_inscatter(p->atm, cam->position, d, best, v->sun, La);
-                atmos_atmosphere_transmittance(p->atm, cam->position, d, best, Ta);
-            }
-            for (int k = 0; k < nw; k++) ob->col[at * nw + k] = (float)(La[k] + Ta[k] * L[k]);
-        }
+        for (int x = bb[0]; x < bb[1]; x++)
+            subpixels(p, h, ob, v, ap, x, y);
     return ATMOS_OK;
 }
 
@@ -152,9 +169,10 @@ void atmos__harris_objects_over(atmos_context *ctx, const atmos__harris_objects 
     for (int y = ob->box[2]; y < ob->box[3]; y++)
         for (int x = ob->box[0]; x < ob->box[1]; x++) {
             const size_t at = (size_t)y * cam->width + x;
-            if (!(ob->depth[at] < INFINITY)) continue;
+            if (!(ob->cover[at] > 0)) continue;
             float *px = img->pixels + at * C;
-            for (int k = 0; k < nw; k++) px[k] = ob->col[at * nw + k];
-            px[nw] = 1.0f;
+            const float keep = 1.0f - ob->cover[at];
+            for (int k = 0; k < nw; k++) px[k] = px[k] * keep + ob->col[at * nw + k];
+            px[nw] = 1.0f - (1.0f - px[nw]) * keep;
         }
 }
