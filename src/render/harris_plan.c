@@ -22,6 +22,32 @@ static void sky_dirs(int n, const double sun[3], double (*d)[3])
     for (int i = 1; i < n; i++) atmos_direction_from_angles(30.0, fmod(az + 360.0 * (i - 0.5) / (n - 1), 360.0), d[i]);
 }
 
+/* The light passes of the pairs q0 .. q1 (pair q: light q / clouds, cloud q % clouds), each light
+ * and each cloud on its own (clouds do not shade one another, as in Harris's passes), on the
+ * threads (the result does not depend on the count); the objects' vertices' light into
+ * probe[(q - q0) nv nw ..]. */
+static atmos_status light_pairs(atmos_plan *p, atmos__harris_plan *h, int q0, int q1, float *probe)
+{
+    atmos_status st = ATMOS_OK;
+    const atmos__pclusters *cl = &h->clouds;
+    const int nv = h->obj ? h->obj->nv : 0, nw = h->o.nw;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
+    for (int q = q0; q < q1; q++) {
+        const int j = q / cl->n, k = q % cl->n;
+        const atmos__pprobes pr = {nv, h->obj ? h->obj->xyz : NULL, probe + (size_t)(q - q0) * nv * nw};
+        /* the sky's light is soft: its buffers have texels three times as wide */
+        const atmos_status sj = atmos__pcloud_shade_probes(p->ctx, &h->pc, cl->idx + cl->start[k],
+                                                           cl->start[k + 1] - cl->start[k], &h->o, h->dir[j],
+                                                           p->scene.harris.light_size, j ? 3.0 : 1.0, h->light[j],
+                                                           h->order[j], nv ? &pr : NULL);
+        if (sj != ATMOS_OK) {
+#pragma omp critical
+            st = sj;
+        }
+    }
+    return st;
+}
+
 atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const double sun[3])
 {
     double lo[3], hi[3], c[3];
@@ -42,36 +68,25 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
         }
         for (int k = 0; k < h->o.nw; k++) h->e[j][k] *= 2.0 * ATMOS_PI / sky; /* radiance x its share of the sky */
     }
-    /* each light and each cloud on its own (clouds do not shade one another, as in Harris's
-     * passes), the pairs on the threads; the result does not depend on the count */
-    atmos_status st = ATMOS_OK;
+    /* the objects' vertices read every pass as particles would: the light each pair leaves them,
+     * the pairs in batches that keep that within 64 MB */
     const atmos__pclusters *cl = &h->clouds;
     const int pairs = h->nlights * cl->n, nv = h->obj ? h->obj->nv : 0, nw = h->o.nw;
-    /* the objects' vertices read every pass as particles would: the light each pair leaves them */
-    float *probe = nv ? malloc(sizeof(float) * (size_t)(pairs ? pairs : 1) * nv * nw) : NULL;
+    const size_t per = (size_t)nv * nw, fit = per ? ((size_t)64 << 20) / (sizeof(float) * per) : (size_t)pairs;
+    const int batch = pairs < 1 ? 1 : (fit < 1 ? 1 : (fit < (size_t)pairs ? (int)fit : pairs));
+    float *probe = nv ? malloc(sizeof(float) * (size_t)batch * per) : NULL;
     if (nv && !probe) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the objects' light");
-#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
-    for (int q = 0; q < pairs; q++) {
-        const int j = q / cl->n, k = q % cl->n;
-        const atmos__pprobes pr = {nv, h->obj ? h->obj->xyz : NULL, probe + (size_t)q * nv * nw};
-        /* the sky's light is soft: its buffers have texels three times as wide */
-        const atmos_status sj = atmos__pcloud_shade_probes(p->ctx, &h->pc, cl->idx + cl->start[k],
-                                                           cl->start[k + 1] - cl->start[k], &h->o, h->dir[j],
-                                                           p->scene.harris.light_size, j ? 3.0 : 1.0, h->light[j],
-                                                           h->order[j], nv ? &pr : NULL);
-        if (sj != ATMOS_OK) {
-#pragma omp critical
-            st = sj;
-        }
+    for (int j = 0; j < h->nlights && nv; j++)
+        for (size_t i = 0; i < per; i++) h->obj->light[j][i] = 1.0f;
+    atmos_status st = ATMOS_OK;
+    for (int q0 = 0; q0 < pairs && st == ATMOS_OK; q0 += batch) {
+        const int q1 = q0 + batch < pairs ? q0 + batch : pairs;
+        st = light_pairs(p, h, q0, q1, probe);
+        /* a vertex gets what every cloud leaves of each light (in the clouds' order: the same
+         * product whatever the threads) */
+        for (int q = q0; q < q1 && nv && st == ATMOS_OK; q++)
+            for (size_t i = 0; i < per; i++) h->obj->light[q / cl->n][i] *= probe[(size_t)(q - q0) * per + i];
     }
-    /* a vertex gets what every cloud leaves of each light (in the clouds' order: the same sum
-     * whatever the threads) */
-    for (int j = 0; j < h->nlights && nv && st == ATMOS_OK; j++)
-        for (size_t i = 0; i < (size_t)nv * nw; i++) {
-            float t = 1.0f;
-            for (int k = 0; k < cl->n; k++) t *= probe[((size_t)j * cl->n + k) * nv * nw + i];
-            h->obj->light[j][i] = t;
-        }
     free(probe);
     if (st != ATMOS_OK) return st;
     memcpy(h->sun, sun, sizeof h->sun);
