@@ -13,6 +13,9 @@
 #            (bench/viewer/inside_cumulus.json), 240 frames; goal 30 fps
 #   slice    scenes/fig14_interactive_storm.json at 512x512, the sun moving every frame
 #            (bench/viewer/storm_sun.json), 120 frames; goal 10 fps
+#   aircraft scenes/harris_aircraft.json (an aircraft inside a cumulus: impostor splitting)
+#            along scenes/flights/harris_aircraft.json, 120 frames
+#   aircraft_none  the same cumulus and flight without the aircraft (what splitting costs)
 # ms is frames.csv's: a frame's wall time with the conversion to display values, without
 # writing its PNG. The first frame (the light passes, a plan's first use) is reported on its
 # own (first_ms) and left out of the percentiles. fps_1pct_low: 1000 / the mean of the slowest
@@ -23,7 +26,7 @@ set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 ATMOS=$root/build/atmos
-CASES="field million inside slice"
+CASES="field million inside slice aircraft aircraft_none"
 FRAMES=
 OUT=${TMPDIR:-/tmp}/atmos-viewer-bench
 while [ $# -gt 0 ]; do
@@ -67,6 +70,11 @@ for c in $CASES; do
         --spacing 19.7 ;;
     inside) run_case inside scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 240 1280x720 ;;
     slice) run_case slice scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 120 512x512 ;;
+    aircraft) run_case aircraft scenes/harris_aircraft.json scenes/flights/harris_aircraft.json 120 1280x720 ;;
+    aircraft_none)
+        python3 -c 'import json, sys; s = json.load(open(sys.argv[1])); del s["objects"]; json.dump(s, open(sys.argv[2], "w"))' \
+            "$root/scenes/harris_aircraft.json" "$OUT/harris_no_aircraft.json"
+        run_case aircraft_none "$OUT/harris_no_aircraft.json" scenes/flights/harris_aircraft.json 120 1280x720 ;;
     *) echo "run.sh: unknown case $c" >&2; exit 2 ;;
     esac
 done

@@ -129,6 +129,20 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
                                  const atmos__poptics *o, const double sun[3], int res, double texel_scale, float *light,
                                  float *order);
 
+/* Points (not particles) that read a light pass as particles do, and splat nothing: the
+ * vertices of an object inside a cloud (Harris §3.2), lit by the light buffer. light[i * nw + k]
+ * receives the share of the light arriving at point i (1 where the buffer does not reach). */
+typedef struct atmos__pprobes {
+    int n;
+    const float *xyz;     /* [3 n], world metres */
+    float *light;         /* [n nw] */
+} atmos__pprobes;
+/* atmos__pcloud_shade with probes pr (NULL: none; the particles' light is the same with and
+ * without them). */
+atmos_status atmos__pcloud_shade_probes(atmos_context *ctx, const atmos__pcloud *pc, const int *idx, int nidx,
+                                        const atmos__poptics *o, const double sun[3], int res, double texel_scale,
+                                        float *light, float *order, const atmos__pprobes *pr);
+
 /* ---- psplat.c: the eye pass (§2.2.2, Eq. 9) */
 /* The pixels of rect [x0, y0, x1, y1) that the sphere (c, r) may cover seen by the pinhole cam:
  * bb[4] = [x0, x1) x [y0, y1); *Z its centre's depth along the view. 0 when the sphere holds the
@@ -163,6 +177,7 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
  * colour, coverage) by a camera at `view` fitted to the cloud's sphere. */
 typedef struct atmos__pimpostor {
     int valid, res;
+    double split;         /* the caller's: where a split cloud was cut for it (m from the cloud's centre) */
     double view[3];
     atmos_camera cam;
     atmos_image *img;

@@ -83,20 +83,35 @@ static void splat(const atmos__pcloud *pc, int p, const lframe *f, float tc, flo
     }
 }
 
+/* The light at probe i (ord's index -1 - i) for wavelength k: the buffer's share where the
+ * probe falls on it, 1 beside it (no particle of the cloud in the way). */
+static void probe_read(const atmos__pprobes *pr, int i, const lframe *f, const float *trans, int k, int nw)
+{
+    const float *w = pr->xyz + 3 * (size_t)i;
+    const double x = (dot(f->e1, w[0], w[1], w[2]) - f->u0) / f->texel, y = (dot(f->e2, w[0], w[1], w[2]) - f->v0) / f->texel;
+    const int in = x >= 0 && y >= 0 && x <= f->res && y <= f->res;
+    pr->light[(size_t)i * nw + k] = in ? (float)read_at(trans, f->res, x, y) : 1.0f;
+}
+
 /* The light pass of wavelength k. The particles go in groups of depths within half the
  * first one's width; a group splats the front halves of its blobs (optical depth tc / 2),
  * reads the light at its particles' centres, then splats the back halves: particles side by
- * side shade each other's centres as the halves of a slab do. */
+ * side shade each other's centres as the halves of a slab do. Probes (negative indices in ord)
+ * read the buffer with their group's centres and splat nothing. */
 static void pass(const atmos__pcloud *pc, int n, const atmos__poptics *o, const lframe *f, const atmos__keyed *ord, int k,
-                 float *trans, float *taus, float *light, float *ns)
+                 const atmos__pprobes *pr, float *trans, float *taus, float *light, float *ns)
 {
     const int res = f->res, nw = o->nw;
     for (size_t t = 0; t < (size_t)res * res; t++) trans[t] = 1.0f, taus[t] = 0.0f;
     for (int q0 = 0, q1; q0 < n; q0 = q1) {
-        const double dmax = ord[q0].key + 0.5 * pc->s[ord[q0].index];
+        const double dmax = ord[q0].key + (ord[q0].index >= 0 ? 0.5 * pc->s[ord[q0].index] : 0.0);
         for (q1 = q0 + 1; q1 < n && ord[q1].key < dmax; q1++) {}
         for (int phase = 0; phase < 3; phase++)
             for (int q = q0; q < q1; q++) {
+                if (ord[q].index < 0) {
+                    if (phase == 1) probe_read(pr, -1 - ord[q].index, f, trans, k, nw);
+                    continue;
+                }
                 const int p = ord[q].index, fi = pc->field[p];
                 const double x = (dot(f->e1, pc->x[p], pc->y[p], pc->z[p]) - f->u0) / f->texel;
                 const double y = (dot(f->e2, pc->x[p], pc->y[p], pc->z[p]) - f->v0) / f->texel;
@@ -118,11 +133,21 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
                                  const atmos__poptics *o, const double sun[3], int res, double texel_scale, float *light,
                                  float *order)
 {
-    const int n = idx ? nidx : pc->n;
-    if (n == 0) return ATMOS_OK;
+    return atmos__pcloud_shade_probes(ctx, pc, idx, nidx, o, sun, res, texel_scale, light, order, NULL);
+}
+
+atmos_status atmos__pcloud_shade_probes(atmos_context *ctx, const atmos__pcloud *pc, const int *idx, int nidx,
+                                        const atmos__poptics *o, const double sun[3], int res, double texel_scale,
+                                        float *light, float *order, const atmos__pprobes *pr)
+{
+    const int n = idx ? nidx : pc->n, np = pr ? pr->n : 0;
+    if (n == 0) {
+        for (size_t i = 0; i < (size_t)np * o->nw; i++) pr->light[i] = 1.0f;
+        return ATMOS_OK;
+    }
     lframe f;
     make_frame(pc, idx, n, sun, res, texel_scale > 0 ? texel_scale : 1.0, &f);
-    atmos__keyed *ord = malloc(sizeof *ord * (size_t)n);
+    atmos__keyed *ord = malloc(sizeof *ord * (size_t)(n + np));
     float *ns = malloc(sizeof(float) * (size_t)pc->n * o->nw);
     if (!ord || !ns) {
         free(ord), free(ns);
@@ -132,7 +157,11 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
         const int p = idx ? idx[q] : q;
         ord[q].key = -dot(sun, pc->x[p], pc->y[p], pc->z[p]), ord[q].index = p;
     }
-    atmos__keyed_sort(ord, (size_t)n, 0);
+    for (int i = 0; i < np; i++) {
+        const float *w = pr->xyz + 3 * (size_t)i;
+        ord[n + i].key = -dot(sun, w[0], w[1], w[2]), ord[n + i].index = -1 - i;
+    }
+    atmos__keyed_sort(ord, (size_t)(n + np), 0);
     int nomem = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
     for (int k = 0; k < o->nw; k++) {
@@ -142,7 +171,7 @@ atmos_status atmos__pcloud_shade(atmos_context *ctx, const atmos__pcloud *pc, co
             nomem = 1;
             continue;
         }
-        pass(pc, n, o, &f, ord, k, buf, buf + (size_t)f.res * f.res, light, ns);
+        pass(pc, n + np, o, &f, ord, k, pr, buf, buf + (size_t)f.res * f.res, light, ns);
         free(buf);
     }
     for (int q = 0; q < n && order; q++) {

@@ -87,8 +87,23 @@ static int mode(const atmos_plan *p, const atmos__harris_plan *h, const atmos__v
     return atmos__pimpostor_serves(&h->imp[k], c->centre[k], c->radius[k], e, tol, f, hs->impostor_max_res) ? 3 : 4;
 }
 
-/* Makes the impostors of the clouds list[0..n) again, the clouds on the threads (each one's
- * splats on one: the result does not depend on the thread count). */
+/* Whether a split cloud k's part impostor (pass 0 far, 1 near) still serves: as a whole one
+ * does, and cut where the cloud is cut now (within half its narrowest particle's width). */
+static int part_mode(const atmos_plan *p, const atmos__harris_plan *h, const atmos__view *v, int k, int pass)
+{
+    const atmos_scene_harris *hs = &p->scene.harris;
+    const atmos__pimpostor *im = &h->split[2 * k + pass];
+    const double f = v->cam.height / (2.0 * v->cam.tan_half_fov), tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
+    /* the split may move by half the cloud's narrowest particle width (Harris's layers hold the
+     * particles "approximately" behind and in front of the object) */
+    const int cut = fabs(im->split - h->offset[k]) <= 0.5 * h->smin[k];
+    return cut && atmos__pimpostor_serves(im, h->clouds.centre[k], h->clouds.radius[k], v->cam.position, tol, f,
+                                          hs->impostor_max_res) ? 3 : 4;
+}
+
+/* Makes the impostors list[0..n) again (each k 3 + part: part 0 cloud k's whole impostor, 1 its
+ * far one, 2 its near one), the impostors on the threads (each one's splats on one: the result
+ * does not depend on the thread count). */
 static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
                            const int *list, int n)
 {
@@ -96,24 +111,32 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
                               (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
     const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
-    /* the air to all their particles in one pass on the threads */
+    /* the air to all their clouds' particles in one pass on the threads (a cloud's parts follow
+     * each other in list) */
     int total = 0;
-    for (int q = 0; q < n; q++) total += c->start[list[q] + 1] - c->start[list[q]];
+    for (int q = 0; q < n; q++)
+        if (!q || list[q] / 3 != list[q - 1] / 3) total += c->start[list[q] / 3 + 1] - c->start[list[q] / 3];
     int *all = malloc(sizeof(int) * (size_t)(total ? total : 1));
     if (!all) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     for (int q = 0, m = 0; q < n; q++)
-        for (int i = c->start[list[q]]; i < c->start[list[q] + 1]; i++) all[m++] = c->idx[i];
+        if (!q || list[q] / 3 != list[q - 1] / 3)
+            for (int i = c->start[list[q] / 3]; i < c->start[list[q] / 3 + 1]; i++) all[m++] = c->idx[i];
     air(p, h, v, ap, all, total);
     free(all);
     atmos_status st = ATMOS_OK;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
     for (int q = 0; q < n; q++) {
-        const int k = list[q], *idx = c->idx + c->start[k], m = c->start[k + 1] - c->start[k];
+        const int k = list[q] / 3, part = list[q] % 3;
+        const atmos__pimpostor *cim;
+        const int *idx;
+        int m;
+        atmos__harris_piece(h, k, part ? part - 1 : 1, 3, part ? ATMOS__HARRIS_SPLIT : ATMOS__HARRIS_NEAR, &cim, &idx, &m);
+        atmos__pimpostor *im = part ? &h->split[2 * k + part - 1] : &h->imp[k];
         double d2 = 0;
         for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
         const int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
-        const atmos_status sk = atmos__pimpostor_make(p->ctx, &h->imp[k], &h->pc, &h->o, &L, idx, m, c->centre[k],
-                                                      c->radius[k], e, res);
+        const atmos_status sk = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, &L, idx, m, c->centre[k], c->radius[k], e, res);
+        im->split = part ? h->offset[k] : 0;
         if (sk != ATMOS_OK) {
 #pragma omp critical
             st = sk;
@@ -123,12 +146,10 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
     return st;
 }
 
-/* Cloud k splatted particle by particle (how 1) or as a screen-sized impostor (how 2). */
+/* Particles idx[0..n) splatted one by one (how 1) or as a screen-sized impostor (how 2). */
 static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
-                         int k, int how, const int rect[4], atmos_image *out)
+                         const int *idx, int n, int how, const int rect[4], atmos_image *out)
 {
-    const atmos__pclusters *c = &h->clouds;
-    const int *idx = c->idx + c->start[k], n = c->start[k + 1] - c->start[k];
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
                               (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
     if (how == 1) {
@@ -146,20 +167,62 @@ static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos
     return ATMOS_OK;
 }
 
-/* The clouds ord[q0..) drawn from their impostors (how 3, 4; those out of view skipped) up to
- * the next one drawn otherwise, in one pass; the index after them. */
-static int draw_impostors(const atmos_plan *p, const atmos__harris_plan *h, const atmos__view *v, const atmos__keyed *ord,
-                          const int *how, int q0, int nc, const int rect[4], atmos_image *out, const atmos__pimpostor **ims,
-                          const double **cs, double *rs)
+/* How each cloud is drawn this frame (mode; a split cloud's parts in hp[2 k + pass]) and what
+ * shows in one pass (0 before the objects, 1 after). */
+typedef struct frame_plan {
+    const int *how, *side, *hp;
+} frame_plan;
+
+static int piece(const atmos__harris_plan *h, const frame_plan *fp, int k, int pass, const atmos__pimpostor **im,
+                 const int **idx, int *n)
 {
-    int q = q0, n = 0;
-    for (; q < nc && (how[ord[q].index] >= 3 || !how[ord[q].index]); q++) {
-        const int k = ord[q].index;
-        if (!how[k]) continue;
-        ims[n] = &h->imp[k], cs[n] = h->clouds.centre[k], rs[n++] = h->clouds.radius[k];
+    const int how = fp->side[k] == ATMOS__HARRIS_SPLIT && fp->how[k] >= 3 ? fp->hp[2 * k + pass] : fp->how[k];
+    return atmos__harris_piece(h, k, pass, how, fp->side[k], im, idx, n);
+}
+
+/* One pass over the clouds far to near: runs of impostors (those out of view or showing nothing
+ * skipped) in one pass each, the others splatted. */
+static atmos_status draw_pass(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
+                              const atmos__keyed *ord, const frame_plan *fp, int pass, const int rect[4], atmos_image *out,
+                              const atmos__pimpostor **ims, const double **cs, double *rs)
+{
+    const int nc = h->clouds.n;
+    atmos_status st = ATMOS_OK;
+    for (int q = 0; q < nc && st == ATMOS_OK;) {
+        const atmos__pimpostor *im;
+        const int *idx;
+        int n, m = 0, hw = piece(h, fp, ord[q].index, pass, &im, &idx, &n);
+        if (hw && hw < 3) {
+            st = draw(p, h, v, ap, idx, n, hw, rect, out), q++;
+            continue;
+        }
+        for (; q < nc && (!(hw = piece(h, fp, ord[q].index, pass, &im, &idx, &n)) || hw >= 3); q++) {
+            if (!hw) continue;
+            const int k = ord[q].index;
+            ims[m] = im, cs[m] = h->clouds.centre[k], rs[m++] = h->clouds.radius[k];
+        }
+        atmos__pimpostor_draw(p->ctx, m, ims, cs, rs, &v->cam, rect, out);
     }
-    atmos__pimpostor_draw(p->ctx, n, ims, cs, rs, &v->cam, rect, out);
-    return q;
+    return st;
+}
+
+/* The modes of the clouds (how), the split (side, hp) and the impostors to make again (stale). */
+static int modes(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const int rect[4], int *how,
+                 int *side, int *hp, int *stale)
+{
+    const int nc = h->clouds.n;
+    int nstale = 0;
+    for (int k = 0; k < nc; k++) how[k] = mode(p, h, v, k);
+    atmos__harris_split(h, v, rect, how, side);
+    for (int k = 0; k < nc; k++) {
+        if (side[k] != ATMOS__HARRIS_SPLIT || how[k] < 3) {
+            if (how[k] == 4) stale[nstale++] = 3 * k;
+            continue;
+        }
+        for (int pass = 0; pass < 2; pass++)
+            if ((hp[2 * k + pass] = part_mode(p, h, v, k, pass)) == 4) stale[nstale++] = 3 * k + 1 + pass;
+    }
+    return nstale;
 }
 
 atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
@@ -174,6 +237,7 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     }
     const int rect[4] = {r->x0, r->y0, r->x1, r->y1};
     const atmos__aerial *ap = frame_aerial(p, h, v);
+    if (h->obj && (st = atmos__harris_objects_frame(p, h, h->obj, v, ap, rect)) != ATMOS_OK) return st;
     const int nc = h->clouds.n;
     atmos__keyed *ord = malloc(sizeof *ord * (size_t)(nc ? nc : 1));
     if (!ord) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
@@ -185,20 +249,18 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     atmos__keyed_sort(ord, (size_t)nc, 1);
     h->drawn = h->updates = h->direct = 0;
     const size_t cap = nc > 0 ? (size_t)nc : 1;
-    int *how = malloc(sizeof(int) * 2 * cap), *stale = how ? how + cap : NULL, nstale = 0;
+    int *how = malloc(sizeof(int) * 7 * cap), *side = how ? how + cap : NULL, *hp = how ? how + 2 * cap : NULL;
+    int *stale = how ? how + 4 * cap : NULL;
     const atmos__pimpostor **ims = malloc(sizeof *ims * cap);
     const double **cs = malloc(sizeof *cs * cap);
     double *rs = malloc(sizeof *rs * cap);
     if (!how || !ims || !cs || !rs) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
-    for (int k = 0; k < nc && st == ATMOS_OK; k++)
-        if ((how[k] = mode(p, h, v, k)) == 4) stale[nstale++] = k;
-    if (st == ATMOS_OK) st = remake(p, h, v, ap, stale, nstale);
-    for (int q = 0; q < nc && st == ATMOS_OK;) {
-        const int k = ord[q].index;
-        if (how[k] >= 3) q = draw_impostors(p, h, v, ord, how, q, nc, rect, out, ims, cs, rs);
-        else if (how[k]) st = draw(p, h, v, ap, k, how[k], rect, out), q++;
-        else q++;
-    }
+    const frame_plan fp = {how, side, hp};
+    if (st == ATMOS_OK) st = remake(p, h, v, ap, stale, modes(p, h, v, rect, how, side, hp, stale));
+    /* far to near: the far layer, the objects, the near layer (without objects: the near alone) */
+    if (st == ATMOS_OK && h->split_m < INFINITY) st = draw_pass(p, h, v, ap, ord, &fp, 0, rect, out, ims, cs, rs);
+    if (st == ATMOS_OK && h->split_m < INFINITY) atmos__harris_objects_over(p->ctx, h->obj, h->o.nw, &v->cam, out);
+    if (st == ATMOS_OK) st = draw_pass(p, h, v, ap, ord, &fp, 1, rect, out, ims, cs, rs);
     free(how), free(ims), free(cs), free(rs);
     free(ord);
     p->stats.impostor_updates = h->updates;

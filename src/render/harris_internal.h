@@ -9,11 +9,47 @@
 
 #define ATMOS__HARRIS_MAX_LIGHTS 17
 
+/* The scene's objects in Harris's renderer (harris_objects.c). */
+typedef struct atmos__harris_objects {
+    int n;                               /* meshes */
+    atmos_mesh **mesh;
+    double (*albedo)[ATMOS_MAX_WAVELENGTHS];
+    int nv;                              /* vertices of all meshes: the light passes' probes */
+    float *xyz;                          /* [3 nv] */
+    int *first;                          /* [n + 1]: mesh m's vertices are first[m] .. */
+    float *light[ATMOS__HARRIS_MAX_LIGHTS]; /* [nv nw]: the share of light j the clouds leave at each vertex */
+    double centre[3], radius;            /* the sphere about all of them: the split is at its centre */
+    /* the last frame's layer over box [x0, x1) x [y0, y1): per pixel the nearest distance to a
+     * surface (INFINITY: none), the share of the pixel covered (2 x 2 rays) and the radiance
+     * seen through the air, premultiplied by the coverage */
+    float *depth, *cover, *col;
+    size_t cap;
+    int box[4];
+} atmos__harris_objects;
+
+atmos_status atmos__harris_objects_create(atmos_plan *p, atmos__harris_objects **out);
+void atmos__harris_objects_destroy(atmos__harris_objects *ob);
+/* The objects' layer of view v within rect (ap: the frame's aerial-perspective volume or NULL),
+ * the light passes done (h->light's probes in ob->light). */
+atmos_status atmos__harris_objects_frame(const atmos_plan *p, const atmos__harris_plan *h, atmos__harris_objects *ob,
+                                         const atmos__view *v, const atmos__aerial *ap, const int rect[4]);
+/* Lays the layer over img: pixel (1 - coverage) + colour (the surfaces are opaque). */
+void atmos__harris_objects_over(atmos_context *ctx, const atmos__harris_objects *ob, int nw, const atmos_camera *cam,
+                                atmos_image *img);
+
 struct atmos__harris_plan {
     atmos__pcloud pc;
     atmos__poptics o;
     atmos__pclusters clouds;             /* the particles' clouds (the impostors') */
     atmos__pimpostor *imp;               /* [clouds.n] */
+    atmos__harris_objects *obj;          /* NULL: the scene has no objects */
+    atmos__pimpostor *split;             /* [2 clouds.n] with objects: each cloud's far and near impostors */
+    int *part;                           /* [pc.n] this frame's split clouds' particles, far ones first */
+    int *nfar;                           /* [clouds.n] how many of those are far */
+    double *offset;                      /* [clouds.n] the split distance less the cloud centre's, this frame */
+    double *smin;                        /* [clouds.n] each cloud's narrowest particle width */
+    int splits;                          /* clouds split this frame */
+    double split_m;                      /* this frame's split distance (INFINITY: none) */
     int nlights;                         /* the sun, then the sky lights */
     double dir[ATMOS__HARRIS_MAX_LIGHTS][3];           /* toward each light */
     double e[ATMOS__HARRIS_MAX_LIGHTS][ATMOS_MAX_WAVELENGTHS]; /* its irradiance outside the cloud */
@@ -24,6 +60,19 @@ struct atmos__harris_plan {
     int have_sun, drawn, updates, direct;
     double shade_s;
 };
+
+/* Impostor splitting (harris_split.c): where each cloud goes this frame. */
+enum { ATMOS__HARRIS_NEAR = 0, ATMOS__HARRIS_FAR = 1, ATMOS__HARRIS_SPLIT = 2 };
+/* The split of view v (the objects' layer made): h->split_m the distance from the eye to the
+ * objects' centre (INFINITY: no objects in view), side[k] each cloud's (how[k]: 0 for a cloud out
+ * of view): NEAR drawn whole after the objects, FAR whole before them, SPLIT its far particles
+ * before and its near ones after (h->part, h->nfar, h->offset). */
+void atmos__harris_split(atmos__harris_plan *h, const atmos__view *v, const int rect[4], const int *how, int *side);
+/* What cloud k (drawn by how, on side) shows in pass 0 (before the objects) or 1 (after): its
+ * impostor *im (whole or the part's) and its particles idx[0..n) of the part; returns how, or 0
+ * when it shows nothing in that pass. */
+int atmos__harris_piece(const atmos__harris_plan *h, int k, int pass, int how, int side, const atmos__pimpostor **im,
+                        const int **idx, int *n);
 
 /* The light passes of the sun sun and the sky lights (harris_plan.c); the impostors become
  * stale. */

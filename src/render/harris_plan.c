@@ -22,6 +22,32 @@ static void sky_dirs(int n, const double sun[3], double (*d)[3])
     for (int i = 1; i < n; i++) atmos_direction_from_angles(30.0, fmod(az + 360.0 * (i - 0.5) / (n - 1), 360.0), d[i]);
 }
 
+/* The light passes of the pairs q0 .. q1 (pair q: light q / clouds, cloud q % clouds), each light
+ * and each cloud on its own (clouds do not shade one another, as in Harris's passes), on the
+ * threads (the result does not depend on the count); the objects' vertices' light into
+ * probe[(q - q0) nv nw ..]. */
+static atmos_status light_pairs(atmos_plan *p, atmos__harris_plan *h, int q0, int q1, float *probe)
+{
+    atmos_status st = ATMOS_OK;
+    const atmos__pclusters *cl = &h->clouds;
+    const int nv = h->obj ? h->obj->nv : 0, nw = h->o.nw;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
+    for (int q = q0; q < q1; q++) {
+        const int j = q / cl->n, k = q % cl->n;
+        const atmos__pprobes pr = {nv, h->obj ? h->obj->xyz : NULL, probe + (size_t)(q - q0) * nv * nw};
+        /* the sky's light is soft: its buffers have texels three times as wide */
+        const atmos_status sj = atmos__pcloud_shade_probes(p->ctx, &h->pc, cl->idx + cl->start[k],
+                                                           cl->start[k + 1] - cl->start[k], &h->o, h->dir[j],
+                                                           p->scene.harris.light_size, j ? 3.0 : 1.0, h->light[j],
+                                                           h->order[j], nv ? &pr : NULL);
+        if (sj != ATMOS_OK) {
+#pragma omp critical
+            st = sj;
+        }
+    }
+    return st;
+}
+
 atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const double sun[3])
 {
     double lo[3], hi[3], c[3];
@@ -42,27 +68,31 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
         }
         for (int k = 0; k < h->o.nw; k++) h->e[j][k] *= 2.0 * ATMOS_PI / sky; /* radiance x its share of the sky */
     }
-    /* each light and each cloud on its own (clouds do not shade one another, as in Harris's
-     * passes), the pairs on the threads; the result does not depend on the count */
-    atmos_status st = ATMOS_OK;
+    /* the objects' vertices read every pass as particles would: the light each pair leaves them,
+     * the pairs in batches that keep that within 64 MB */
     const atmos__pclusters *cl = &h->clouds;
-    const int pairs = h->nlights * cl->n;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
-    for (int q = 0; q < pairs; q++) {
-        const int j = q / cl->n, k = q % cl->n;
-        /* the sky's light is soft: its buffers have texels three times as wide */
-        const atmos_status sj = atmos__pcloud_shade(p->ctx, &h->pc, cl->idx + cl->start[k], cl->start[k + 1] - cl->start[k],
-                                                    &h->o, h->dir[j], p->scene.harris.light_size, j ? 3.0 : 1.0,
-                                                    h->light[j], h->order[j]);
-        if (sj != ATMOS_OK) {
-#pragma omp critical
-            st = sj;
-        }
+    const int pairs = h->nlights * cl->n, nv = h->obj ? h->obj->nv : 0, nw = h->o.nw;
+    const size_t per = (size_t)nv * nw, fit = per ? ((size_t)64 << 20) / (sizeof(float) * per) : (size_t)pairs;
+    const int batch = pairs < 1 ? 1 : (fit < 1 ? 1 : (fit < (size_t)pairs ? (int)fit : pairs));
+    float *probe = nv ? malloc(sizeof(float) * (size_t)batch * per) : NULL;
+    if (nv && !probe) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the objects' light");
+    for (int j = 0; j < h->nlights && nv; j++)
+        for (size_t i = 0; i < per; i++) h->obj->light[j][i] = 1.0f;
+    atmos_status st = ATMOS_OK;
+    for (int q0 = 0; q0 < pairs && st == ATMOS_OK; q0 += batch) {
+        const int q1 = q0 + batch < pairs ? q0 + batch : pairs;
+        st = light_pairs(p, h, q0, q1, probe);
+        /* a vertex gets what every cloud leaves of each light (in the clouds' order: the same
+         * product whatever the threads) */
+        for (int q = q0; q < q1 && nv && st == ATMOS_OK; q++)
+            for (size_t i = 0; i < per; i++) h->obj->light[q / cl->n][i] *= probe[(size_t)(q - q0) * per + i];
     }
+    free(probe);
     if (st != ATMOS_OK) return st;
     memcpy(h->sun, sun, sizeof h->sun);
     h->have_sun = 1;
     for (int k = 0; k < h->clouds.n; k++) h->imp[k].valid = 0; /* lit anew */
+    for (int k = 0; h->split && k < 2 * h->clouds.n; k++) h->split[k].valid = 0;
     return ATMOS_OK;
 }
 
@@ -105,6 +135,26 @@ static atmos_status particles(atmos_plan *p, atmos__harris_plan *h)
     return atmos__pcloud_from_volume(p->ctx, p->volume, p->offset, hs->spacing_m, hs->max_particles, &h->pc);
 }
 
+/* The scene's objects and what splitting the clouds' impostors about them needs (Harris §3.2). */
+static atmos_status objects(atmos_plan *p, atmos__harris_plan *h)
+{
+    atmos_status st = atmos__harris_objects_create(p, &h->obj);
+    if (st != ATMOS_OK) return st;
+    const size_t nc = h->clouds.n ? (size_t)h->clouds.n : 1;
+    h->split = calloc(2 * nc, sizeof *h->split);
+    h->part = malloc(sizeof(int) * (size_t)(h->pc.n ? h->pc.n : 1));
+    h->nfar = calloc(nc, sizeof *h->nfar);
+    h->offset = calloc(nc, sizeof *h->offset);
+    h->smin = malloc(sizeof *h->smin * nc);
+    if (!h->split || !h->part || !h->nfar || !h->offset || !h->smin)
+        return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the split impostors");
+    for (int k = 0; k < h->clouds.n; k++) {
+        h->smin[k] = INFINITY;
+        for (int q = h->clouds.start[k]; q < h->clouds.start[k + 1]; q++) h->smin[k] = fmin(h->smin[k], h->pc.s[h->clouds.idx[q]]);
+    }
+    return ATMOS_OK;
+}
+
 atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
 {
     *out = NULL;
@@ -125,6 +175,7 @@ atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
         h->order[j] = malloc(sizeof(float) * (size_t)(h->pc.n ? h->pc.n : 1));
         if (!h->light[j] || !h->order[j]) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     }
+    if (st == ATMOS_OK && p->scene.object_count > 0) st = objects(p, h);
     if (st != ATMOS_OK) {
         atmos__harris_plan_destroy(h);
         return st;
@@ -139,6 +190,9 @@ void atmos__harris_plan_destroy(atmos__harris_plan *h)
     if (!h) return;
     for (int k = 0; h->imp && k < h->clouds.n; k++) atmos__pimpostor_free(&h->imp[k]);
     free(h->imp);
+    for (int k = 0; h->split && k < 2 * h->clouds.n; k++) atmos__pimpostor_free(&h->split[k]);
+    free(h->split), free(h->part), free(h->nfar), free(h->offset), free(h->smin);
+    atmos__harris_objects_destroy(h->obj);
     atmos__pclusters_free(&h->clouds);
     atmos__pcloud_free(&h->pc);
     for (int j = 0; j < ATMOS__HARRIS_MAX_LIGHTS; j++) free(h->light[j]), free(h->order[j]);
@@ -152,4 +206,8 @@ void atmos__harris_describe(const atmos_plan *p, char *buf, size_t cap)
     const atmos__harris_plan *h = p->harris;
     snprintf(buf, cap, "%d particles in %d clouds (%d splatted, %d clouds direct), %d sky lights, light passes %.3f s, "
              "%d impostor updates", h->pc.n, h->clouds.n, h->drawn, h->direct, h->nlights - 1, h->shade_s, h->updates);
+    if (h->obj) {
+        const size_t l = strlen(buf);
+        snprintf(buf + l, cap - l, ", %d objects, %d clouds split at %.0f m", h->obj->n, h->splits, h->split_m);
+    }
 }
