@@ -48,6 +48,15 @@ static void make_light(const atmos_scene_light *s, const atmos_wavelengths *wl, 
     }
 }
 
+static atmos_status load_terrain(atmos_context *ctx, const atmos_scene_object *o, atmos_mesh **out)
+{
+    atmos_terrain_desc d;
+    memset(&d, 0, sizeof d);
+    d.source = o->terrain, d.size_m = o->size_m, d.height_m = o->height_m, d.height_scale = o->height_scale;
+    d.stride = o->stride, d.samples = o->samples, d.max_triangles = o->max_triangles, d.seed = o->seed;
+    return atmos_mesh_terrain(ctx, &d, out);
+}
+
 static atmos_status load_objects(atmos_plan *p, atmos__beams_plan *b)
 {
     const atmos_scene *s = &p->scene;
@@ -56,7 +65,7 @@ static atmos_status load_objects(atmos_plan *p, atmos__beams_plan *b)
     if (!b->mesh || !b->albedo) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     for (int i = 0; i < s->object_count; i++) {
         const atmos_scene_object *o = &s->objects[i];
-        atmos_status st = atmos_mesh_load(p->ctx, o->mesh, 0, &b->mesh[i]);
+        atmos_status st = o->terrain[0] ? load_terrain(p->ctx, o, &b->mesh[i]) : atmos_mesh_load(p->ctx, o->mesh, 0, &b->mesh[i]);
         if (st != ATMOS_OK) return st;
         b->nmesh = i + 1;
         atmos_mesh_transform t;

@@ -1104,9 +1104,26 @@ static atmos_status light_item(const jp *p, const cJSON *j, const char *path, at
     return parse_light(p, j, path, &s->lights[i]);
 }
 
+/* An object's terrain keys (keys 5-12 of object_item's). */
+static atmos_status object_terrain_key(const jp *p, const cJSON *v, const char *ip, int k, atmos_scene_object *o)
+{
+    static const atmos__range r_count = {0, 1e9, 0, 0};
+    switch (k) {
+    case 5: return get_text(p, v, ip, o->terrain, sizeof o->terrain);
+    case 6: return get_number(p, v, ip, NULL, NULL, &o->size_m);
+    case 7: return get_number(p, v, ip, NULL, NULL, &o->height_m);
+    case 8: return get_number(p, v, ip, NULL, NULL, &o->height_scale);
+    case 9: return get_int(p, v, ip, &r_count, &o->stride);
+    case 10: return get_int(p, v, ip, &r_count, &o->samples);
+    case 11: return get_int(p, v, ip, &r_count, &o->max_triangles);
+    default: return get_u64(p, v, ip, &r_seed, &o->seed);
+    }
+}
+
 static atmos_status object_item(const jp *p, const cJSON *j, const char *path, atmos_scene *s, int i)
 {
-    static const char *const keys[] = {"mesh", "position_m", "scale", "rotation_deg", "albedo"};
+    static const char *const keys[] = {"mesh",   "position_m", "scale",   "rotation_deg", "albedo",        "terrain", "size_m",
+                                       "height_m", "height_scale", "stride", "samples", "max_triangles", "seed"};
     const atmos__range *const any[3] = {NULL, NULL, NULL};
     atmos_scene_object *o = &s->objects[i];
     atmos__scene_object_defaults(o);
@@ -1114,7 +1131,7 @@ static atmos_status object_item(const jp *p, const cJSON *j, const char *path, a
     char ip[PATH_CAP];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 5, &it));
+    TRY(iter_begin(p, j, path, keys, 13, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -1131,9 +1148,11 @@ static atmos_status object_item(const jp *p, const cJSON *j, const char *path, a
             } else TRY(get_vec3(p, v, ip, any, k == 2 ? o->scale : o->albedo));
             break;
         case 3: TRY(get_vec3(p, v, ip, any, o->rotation_deg)); break;
+        default: TRY(object_terrain_key(p, v, ip, k, o));
         }
     }
-    if (!o->mesh[0]) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"mesh\"");
+    if (!o->mesh[0] && !o->terrain[0])
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"mesh\" or \"terrain\"");
     return ATMOS_OK;
 }
 

@@ -23,6 +23,7 @@ void atmos__scene_object_defaults(atmos_scene_object *o)
     memset(o, 0, sizeof *o);
     o->scale[0] = o->scale[1] = o->scale[2] = 1;
     o->albedo[0] = o->albedo[1] = o->albedo[2] = 0.5;
+    o->size_m = 1000;
 }
 
 /* Each of the three components of v at prefix/key/i within r. */
@@ -89,6 +90,28 @@ static atmos_status check_light(atmos_context *ctx, const char *source, const at
     return ATMOS_OK;
 }
 
+/* A terrain's values (atmos_terrain_desc's ranges); the file itself is read by the plan. */
+static atmos_status check_terrain(atmos_context *ctx, const char *source, const char *at, const atmos_scene_object *o)
+{
+    static const atmos__range r_size = {0, 1e7, 1, 0}, r_height = {0, 1e5, 0, 0}, r_hscale = {-1e5, 1e5, 0, 0},
+                              r_samples = {2, 4097, 0, 0}, r_stride = {0, 1e6, 0, 0},
+                              r_tris = {0, ATMOS_MESH_MAX_TRIANGLES, 0, 0};
+    atmos_status st;
+    if ((st = check1(ctx, source, at, "size_m", o->size_m, &r_size, NULL))) return st;
+    if ((st = check1(ctx, source, at, "height_m", o->height_m, &r_height, " (0: height_scale)"))) return st;
+    if ((st = check1(ctx, source, at, "height_scale", o->height_scale, &r_hscale, NULL))) return st;
+    if (o->samples && (st = check1(ctx, source, at, "samples", o->samples, &r_samples, " (or 0: 257)"))) return st;
+    if ((st = check1(ctx, source, at, "stride", o->stride, &r_stride, " (0: automatic)"))) return st;
+    if ((st = check1(ctx, source, at, "max_triangles", o->max_triangles, &r_tris, " (0: 1000000)"))) return st;
+    if (strncmp(o->terrain, "generate:", 9)) return ATMOS_OK;
+    if (strcmp(o->terrain + 9, "ridges"))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at,
+                                 "terrain \"%.64s\" is no generator (known: generate:ridges)", o->terrain);
+    if (!(o->height_m > 0))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at, "a generated terrain needs height_m > 0");
+    return ATMOS_OK;
+}
+
 static atmos_status check_object(atmos_context *ctx, const char *source, const atmos_scene *s, int i)
 {
     static const atmos__range r_scale = {-1e6, 1e6, 0, 0}, r_rot = {-3600, 3600, 0, 0}, r_albedo = {0, 1, 0, 0};
@@ -96,8 +119,12 @@ static atmos_status check_object(atmos_context *ctx, const char *source, const a
     char at[48];
     snprintf(at, sizeof at, "/objects/%d", i);
     atmos_status st;
-    if (!memchr(o->mesh, '\0', sizeof o->mesh) || !o->mesh[0])
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at, "needs \"mesh\" (builtin:NAME or an OBJ file)");
+    if (!memchr(o->mesh, '\0', sizeof o->mesh) || !memchr(o->terrain, '\0', sizeof o->terrain) ||
+        !o->mesh[0] == !o->terrain[0])
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at,
+                                 "needs either \"mesh\" (builtin:NAME or an OBJ file) or \"terrain\" (a height map file or "
+                                 "generate:ridges), not both");
+    if (o->terrain[0] && (st = check_terrain(ctx, source, at, o))) return st;
     if (!strncmp(o->mesh, "builtin:", 8)) {
         int known = 0;
         for (const char *const *n = atmos_mesh_builtin_names(); *n; n++) known |= !strcmp(o->mesh + 8, *n);
