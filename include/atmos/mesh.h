@@ -62,8 +62,9 @@ ATMOS_API atmos_status atmos_mesh_load(atmos_context *ctx, const char *source, i
  * columns run along +x, its rows along +z, heights along +y; it is centred on the origin in x
  * and z, size_m wide along x (square cells: the depth along z follows the raster's shape).
  * source: a raster file read through GDAL (16-bit PNG, GeoTIFF, anything GDAL reads; band 1;
- * no-data pixels take the lowest valid height) or "generate:ridges" (a ridged fractal made
- * here, deterministic by seed, samples x samples points). Heights: with height_m > 0 the
+ * no-data pixels take the lowest valid height) or a generated map, deterministic by seed,
+ * samples x samples points: "generate:ridges" (a ridged fractal) or "generate:city" (blocks
+ * of buildings of random heights between streets, 12 samples a block). Heights: with height_m > 0 the
  * lowest value becomes 0 and the highest height_m; otherwise value * height_scale (0: 1, the
  * raster holds metres). Every stride-th row and column is kept (stride 0: the least stride
  * that keeps 2 (nx - 1)(nz - 1) within max_triangles, 0: 1 000 000). Missing, unreadable and

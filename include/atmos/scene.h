@@ -132,6 +132,8 @@ typedef struct atmos_scene_beams {
                                  (Dobashi's threshold); 0.01 */
     int max_subplanes;        /* sub-planes between two main planes at most; 64 */
     int shadow_size;          /* shadow map texels per side (per cube face for point lights); 512 */
+    int sun;                  /* 1: the scene's sun lights the fog and the objects too (a directional light with a
+                                 shadow map, docs/beams.md); 0 */
 } atmos_scene_beams;
 
 /* Lights besides the sun ("lights" in the file; the beam renderer's). */
@@ -157,6 +159,9 @@ typedef struct atmos_scene_fog {
     double extinction_per_m;  /* (0, 10] */
     double scattering_per_m;  /* [0, extinction] */
     double g;                 /* Henyey-Greenstein asymmetry, (-1, 1); 0 */
+    double height_m;          /* > 0: the coefficients fall off as exp(-(y - base_m) / height_m) (the beam renderer's
+                                 sun only); 0: uniform */
+    double base_m;            /* the height where the coefficients are as given; 0 */
 } atmos_scene_fog;
 
 /* Opaque Lambertian objects ("objects" in the file). */

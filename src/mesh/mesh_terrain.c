@@ -60,6 +60,30 @@ static atmos_status generate_ridges(atmos_context *ctx, int n, uint64_t seed, at
     return ATMOS_OK;
 }
 
+/* A block city: n x n samples in blocks of CITY_BLOCK samples, each block's inner part a
+ * building of a random height in [0.15, 1] (a few in five tall), a street of CITY_STREET
+ * samples at height 0 round it; walls lean over one sample. */
+#define CITY_BLOCK 12
+#define CITY_STREET 3
+static atmos_status generate_city(atmos_context *ctx, int n, uint64_t seed, atmos__heights *out)
+{
+    out->nx = out->nz = n;
+    if (!(out->h = malloc(sizeof(double) * (size_t)n * n))) return atmos__error(ctx, ATMOS_E_NOMEM, "terrain: out of memory");
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            const int bi = i / CITY_BLOCK, bj = j / CITY_BLOCK, li = i % CITY_BLOCK, lj = j % CITY_BLOCK;
+            const int lot = (li >= CITY_STREET) + (li >= CITY_BLOCK / 2 + 1); /* two lots a block each way */
+            const int lotj = (lj >= CITY_STREET) + (lj >= CITY_BLOCK / 2 + 1);
+            double h = 0;
+            if (li >= CITY_STREET && lj >= CITY_STREET && i < n - 1 && j < n - 1) {
+                const double r = lattice(seed, 99, 4L * bi + lot, 4L * bj + lotj);
+                h = r < 0.8 ? 0.15 + 0.35 * r / 0.8 : 0.5 + 2.5 * (r - 0.8);
+            }
+            out->h[(size_t)j * n + i] = h;
+        }
+    return ATMOS_OK;
+}
+
 /* The grid as triangles facing +y: cell (i, j) is (a, c, b) and (b, c, d). */
 static atmos_status grid_mesh(atmos_context *ctx, const atmos__heights *g, double cell, atmos_mesh **out)
 {
@@ -117,15 +141,17 @@ atmos_status atmos_mesh_terrain(atmos_context *ctx, const atmos_terrain_desc *d,
     atmos__heights g = {0, 0, NULL};
     atmos_status st;
     if (!strncmp(d->source, "generate:", 9)) {
-        if (strcmp(d->source + 9, "ridges"))
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "terrain %s: unknown generator (known: generate:ridges)", d->source);
+        const int city = !strcmp(d->source + 9, "city");
+        if (!city && strcmp(d->source + 9, "ridges"))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "terrain %s: unknown generator (known: generate:ridges, "
+                                "generate:city)", d->source);
         if (!(d->height_m > 0))
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "terrain %s: a generated terrain needs height_m > 0", d->source);
         const int n = d->samples ? d->samples : DEFAULT_SAMPLES;
         if (2L * (n - 1) * (n - 1) > max_t)
             return atmos__error(ctx, ATMOS_E_LIMIT, "terrain %s: %d x %d samples make %ld triangles, more than %ld",
                                 d->source, n, n, 2L * (n - 1) * (n - 1), max_t);
-        st = generate_ridges(ctx, n, d->seed, &g);
+        st = city ? generate_city(ctx, n, d->seed, &g) : generate_ridges(ctx, n, d->seed, &g);
     } else
         st = atmos__terrain_read(ctx, d->source, d->stride, max_t, &g);
     if (st == ATMOS_OK) st = scale_heights(ctx, d, &g);

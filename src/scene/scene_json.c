@@ -1158,17 +1158,18 @@ static atmos_status object_item(const jp *p, const cJSON *j, const char *path, a
 
 static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"extinction_per_m", "scattering_per_m", "g"};
+    static const char *const keys[] = {"extinction_per_m", "scattering_per_m", "g", "height_m", "base_m"};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
     int k, scattering = 0;
     atmos_scene_fog *f = &s->fog;
-    TRY(iter_begin(p, j, path, keys, 3, &it));
+    TRY(iter_begin(p, j, path, keys, 5, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
-        double *d = k == 0 ? &f->extinction_per_m : k == 1 ? &f->scattering_per_m : &f->g;
+        double *const fields[5] = {&f->extinction_per_m, &f->scattering_per_m, &f->g, &f->height_m, &f->base_m};
+        double *d = fields[k];
         TRY(get_number(p, v, ip, NULL, NULL, d));
         scattering |= k == 1;
     }

@@ -104,9 +104,9 @@ static atmos_status check_terrain(atmos_context *ctx, const char *source, const 
     if ((st = check1(ctx, source, at, "stride", o->stride, &r_stride, " (0: automatic)"))) return st;
     if ((st = check1(ctx, source, at, "max_triangles", o->max_triangles, &r_tris, " (0: 1000000)"))) return st;
     if (strncmp(o->terrain, "generate:", 9)) return ATMOS_OK;
-    if (strcmp(o->terrain + 9, "ridges"))
+    if (strcmp(o->terrain + 9, "ridges") && strcmp(o->terrain + 9, "city"))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at,
-                                 "terrain \"%.64s\" is no generator (known: generate:ridges)", o->terrain);
+                                 "terrain \"%.64s\" is no generator (known: generate:ridges, generate:city)", o->terrain);
     if (!(o->height_m > 0))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at, "a generated terrain needs height_m > 0");
     return ATMOS_OK;
@@ -147,7 +147,7 @@ static atmos_status check_object(atmos_context *ctx, const char *source, const a
 
 atmos_status atmos__scene_validate_lights(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
-    static const atmos__range r_ext = {0, 10, 1, 0}, r_g = {-1, 1, 1, 1};
+    static const atmos__range r_ext = {0, 10, 1, 0}, r_g = {-1, 1, 1, 1}, r_fog_h = {0, 1e5, 0, 0};
     atmos_status st;
     if (s->light_count < 0 || s->light_count > ATMOS_SCENE_MAX_LIGHTS)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/lights", "at most %d lights, got %d",
@@ -167,11 +167,19 @@ atmos_status atmos__scene_validate_lights(atmos_context *ctx, const char *source
                                            " (at most the extinction)")))
             return st;
         if ((st = atmos__scene_check_range(ctx, source, "/fog/g", s->fog.g, &r_g, NULL))) return st;
+        if ((st = atmos__scene_check_range(ctx, source, "/fog/height_m", s->fog.height_m, &r_fog_h, " (0: uniform)")) ||
+            (st = atmos__scene_check_range(ctx, source, "/fog/base_m", s->fog.base_m, &atmos__r_pos, NULL)))
+            return st;
+        if (s->fog.height_m > 0 && s->light_count > 0)
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/fog/height_m",
+                                     "a height-dependent fog is lit by the sun alone: point and spot lights need a "
+                                     "uniform fog (height_m 0)");
     }
     if (s->renderer != ATMOS_RENDERER_BEAMS) return ATMOS_OK;
-    if (s->light_count < 1)
+    if (s->light_count < 1 && !s->beams.sun)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/lights",
-                                 "the beams renderer draws the light of \"lights\": the scene has none");
+                                 "the beams renderer draws the light of \"lights\" (and of the sun with beams/sun): the "
+                                 "scene has neither");
     if (s->camera.type != ATMOS_CAMERA_PINHOLE)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/type",
                                  "the beams renderer supports pinhole cameras only (its sampling planes face the view)");

@@ -284,7 +284,9 @@ static const bad_case bad_lights[] = {
     {"{\"objects\": [{\"terrain\": \"dem.tif\", \"size_m\": 0}]}", ATMOS_E_INVALID_ARG, "/objects/0/size_m: must be in (0, 10000000]", NULL},
     {"{\"objects\": [{\"terrain\": \"dem.tif\", \"samples\": 1}]}", ATMOS_E_INVALID_ARG, "/objects/0/samples: must be in [2, 4097]", NULL},
     {"{\"objects\": [{\"terrain\": \"dem.tif\", \"max_triangles\": 9000000}]}", ATMOS_E_INVALID_ARG, "/objects/0/max_triangles: must be in [0, 4000000]", NULL},
-    {"{\"renderer\": \"beams\"}", ATMOS_E_INVALID_ARG, "/lights: the beams renderer draws the light of \"lights\": the scene has none", NULL},
+    {"{\"renderer\": \"beams\"}", ATMOS_E_INVALID_ARG, "/lights: the beams renderer draws the light of \"lights\" (and of the sun with beams/sun): the scene has neither", NULL},
+    {"{\"lights\": [{}], \"fog\": {\"extinction_per_m\": 0.01, \"height_m\": 100}}", ATMOS_E_INVALID_ARG, "/fog/height_m: a height-dependent fog is lit by the sun alone", NULL},
+    {"{\"fog\": {\"extinction_per_m\": 0.01, \"height_m\": -1}}", ATMOS_E_INVALID_ARG, "/fog/height_m: must be in [0, 100000]", NULL},
     {"{\"renderer\": \"beams\", \"lights\": [{}], \"camera\": {\"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/type: the beams renderer supports pinhole cameras only", NULL},
     {"{\"renderer\": \"beams\", \"lights\": [{}], \"beams\": {\"epsilon\": 0}}", ATMOS_E_INVALID_ARG, "/beams/epsilon: must be in (0, 1]", NULL},
 };

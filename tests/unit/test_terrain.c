@@ -67,6 +67,22 @@ static void test_generated(void)
               h.normal[1] > 0);
     }
     atmos_mesh_destroy(a), atmos_mesh_destroy(b), atmos_mesh_destroy(c);
+    /* the city: streets at 0 (the first 3 samples of every 12), buildings within [0.15, 1] of height_m */
+    d.source = "generate:city", d.samples = 49, d.seed = 3;
+    CHECK_OK(atmos_mesh_terrain(ctx, &d, &a));
+    if (a) {
+        int street_ok = 1, building_ok = 1;
+        for (int j = 0; j < 49; j++)
+            for (int i = 0; i < 49; i++) {
+                const double y = vy(a, 49, i, j);
+                if (i % 12 < 3 || j % 12 < 3) street_ok &= y == 0;
+                else if (i < 48 && j < 48) building_ok &= y >= 0.15 * 250 - 1e-3 && y <= 250 + 1e-3;
+            }
+        CHECK(street_ok && building_ok);
+        atmos_mesh_destroy(a);
+        a = NULL;
+    }
+    d.source = "generate:ridges", d.samples = 65;
     d.source = "generate:dunes";
     CHECK(atmos_mesh_terrain(ctx, &d, &a) == ATMOS_E_INVALID_ARG && !a);
     d.source = "generate:ridges", d.samples = 4097;
