@@ -5,7 +5,10 @@
  *   - uniform and height-dependent (exponential) fog without shadows: the closed form between
  *     the ends, to 1e-6;
  *   - a wall floating in uniform fog casting a shadow across the rays: the renderer's steps
- *     (epsilon 1e-3) with the shadow map against the quadrature with exact shadow rays. */
+ *     (epsilon 1e-3) with the shadow map against the quadrature with exact shadow rays;
+ *   - the Fig. 10(a) scene small: the same image with one thread and with two, byte for byte;
+ *     finite, non-negative pixels; the sunlit sky above the ridge brighter than the shadowed
+ *     ground below it. */
 #include "atmos/atmos.h"
 #include "render/beams_sun.h"
 #include "test.h"
@@ -115,11 +118,60 @@ static void test_shadow(void)
     atmos_mesh_destroy(wall);
 }
 
+/* The scene file at w x h rendered with the given threads. */
+static atmos_image *render_file(const char *path, int w, int h, int threads)
+{
+    atmos_context_desc d;
+    memset(&d, 0, sizeof d);
+    d.threads = threads;
+    atmos_context *c = NULL;
+    atmos_image *img = NULL;
+    atmos_scene s;
+    CHECK_OK(atmos_context_create(&d, &c));
+    if (!c) return NULL;
+    if (atmos_scene_load(c, path, &s) == ATMOS_OK) {
+        s.width = w, s.height = h;
+        const atmos_status st = atmos_render_scene(c, &s, NULL, &img, NULL);
+        CHECK_MSG(st == ATMOS_OK, "%s: %s", path, atmos_context_error(c));
+    } else
+        CHECK_MSG(0, "%s: %s", path, atmos_context_error(c));
+    atmos_context_destroy(c);
+    return img;
+}
+
+static void test_scene(void)
+{
+    const char *src = getenv("ATMOS_SOURCE_DIR");
+    if (!src) {
+        printf("ATMOS_SOURCE_DIR not set: the scene test skipped\n");
+        return;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/dobashi_fig10a_mountain_shafts.json", src);
+    atmos_image *a = render_file(path, 48, 32, 1), *b = render_file(path, 48, 32, 2);
+    if (a && b) {
+        const size_t n = (size_t)a->width * a->height * a->channels;
+        CHECK(!memcmp(a->pixels, b->pixels, n * sizeof(float)));
+        int ok = 1;
+        for (size_t i = 0; i < n; i++) ok &= isfinite(a->pixels[i]) && a->pixels[i] >= 0;
+        CHECK(ok);
+        double top = 0, bottom = 0;
+        for (int x = 0; x < a->width; x++)
+            for (int k = 0; k + 1 < a->channels; k++) { /* the last channel is alpha */
+                top += a->pixels[((size_t)2 * a->width + x) * a->channels + k];
+                bottom += a->pixels[((size_t)(a->height - 3) * a->width + x) * a->channels + k];
+            }
+        CHECK_MSG(top > 10 * bottom, "sky %g, ground %g", top, bottom);
+    }
+    atmos_image_destroy(a), atmos_image_destroy(b);
+}
+
 int main(void)
 {
     CHECK_OK(atmos_context_create(NULL, &ctx));
     test_no_shadow();
     test_shadow();
+    test_scene();
     atmos_context_destroy(ctx);
     return test_summary("test_beams_sun");
 }
