@@ -115,13 +115,12 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
     return ATMOS_OK;
 }
 
-double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3])
+/* H at texel coordinates (fx, fy) and depth z (the bias taken off): the four nearest
+ * comparisons, blended; 1 beside the map. */
+static double lookup(const atmos__beams_sun *s, double fx, double fy, double z)
 {
-    if (!s->n) return 1;
     const int n = s->n;
-    const double fx = (atmos__dot3(p, s->right) - s->u0) / s->texel - 0.5, fy = (atmos__dot3(p, s->up) - s->v0) / s->texel - 0.5;
     if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* beside every object */
-    const double z = atmos__dot3(p, s->fwd) - s->bias;
     const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1;
     const double ax = fx - x0, ay = fy - y0;
     const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
@@ -129,6 +128,13 @@ double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3])
     const float *ra = s->depth + (size_t)ya * n, *rb = s->depth + (size_t)yb * n;
     const double top = (1 - ax) * (z < ra[xa]) + ax * (z < ra[xb]), bottom = (1 - ax) * (z < rb[xa]) + ax * (z < rb[xb]);
     return (1 - ay) * top + ay * bottom;
+}
+
+double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3])
+{
+    if (!s->n) return 1;
+    return lookup(s, (atmos__dot3(p, s->right) - s->u0) / s->texel - 0.5, (atmos__dot3(p, s->up) - s->v0) / s->texel - 0.5,
+                  atmos__dot3(p, s->fwd) - s->bias);
 }
 
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
@@ -141,10 +147,14 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
     int n = (int)ceil(1 / fmax(epsilon, 1e-9));
     n = n < 1 ? 1 : n > max_steps ? max_steps : n;
     double sum = 0;
-    for (int i = 0; i < n; i++) { /* step i: exp(-tau) from 1 - i whole / n to 1 - (i + 1) whole / n */
+    if (!s->n) sum = n;
+    /* the map's coordinates along the ray, linear in t: x0 + t x1 */
+    const double x0 = (atmos__dot3(o, s->right) - s->u0) / s->texel - 0.5, x1 = atmos__dot3(d, s->right) / s->texel;
+    const double y0 = (atmos__dot3(o, s->up) - s->v0) / s->texel - 0.5, y1 = atmos__dot3(d, s->up) / s->texel;
+    const double z0 = atmos__dot3(o, s->fwd) - s->bias, z1 = atmos__dot3(d, s->fwd);
+    for (int i = 0; s->n && i < n; i++) { /* step i: exp(-tau) from 1 - i whole / n to 1 - (i + 1) whole / n */
         const double tm = fmin(T, line_t(A, k, -log1p(-(i + 0.5) * whole / n)));
-        const double p[3] = {o[0] + tm * d[0], o[1] + tm * d[1], o[2] + tm * d[2]};
-        sum += atmos__beams_sun_visibility(s, p);
+        sum += tm < INFINITY ? lookup(s, x0 + tm * x1, y0 + tm * y1, z0 + tm * z1) : 1;
     }
     return f->albedo * atmos__beams_hg(f->g, atmos__dot3(s->dir, d)) * whole * sum / n;
 }

@@ -25,12 +25,12 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     if (!c->subplanes) s.beams.max_subplanes = 1;
     if (c->spacing_m > 0) s.beams.plane_spacing_m = c->spacing_m;
     if (c->epsilon > 0) s.beams.epsilon = c->epsilon;
-    for (int i = 1; i < c->lights && i < ATMOS_SCENE_MAX_LIGHTS; i++) { /* copies of the first, round it */
+    for (int i = 1; base->light_count > 0 && i < c->lights && i < ATMOS_SCENE_MAX_LIGHTS; i++) { /* copies of the first */
         s.lights[i] = s.lights[0];
         s.lights[i].position_m[0] += 6 * cos(2 * 3.14159265358979 * i / c->lights);
         s.lights[i].position_m[2] += 6 * sin(2 * 3.14159265358979 * i / c->lights);
     }
-    if (c->lights > s.light_count) s.light_count = c->lights;
+    if (base->light_count > 0 && c->lights > s.light_count) s.light_count = c->lights; /* a sun-only scene: as it is */
     atmos_plan *plan = NULL;
     atmos_frame f;
     atmos_image *img = NULL;
