@@ -58,6 +58,33 @@ ATMOS_API const char *const *atmos_mesh_builtin_names(void);
  * finished (its hierarchy built). */
 ATMOS_API atmos_status atmos_mesh_load(atmos_context *ctx, const char *source, int max_triangles, atmos_mesh **out);
 
+/* Terrain: a height map turned into a grid of triangles (docs/beams.md#terrain). The grid's
+ * columns run along +x, its rows along +z, heights along +y; it is centred on the origin in x
+ * and z, size_m wide along x (square cells: the depth along z follows the raster's shape).
+ * source: a raster file read through GDAL (16-bit PNG, GeoTIFF, anything GDAL reads; band 1;
+ * no-data pixels take the lowest valid height) or a generated map, deterministic by seed,
+ * samples x samples points: "generate:ridges" (a ridged fractal) or "generate:city" (blocks
+ * of buildings of random heights between streets, 12 samples a block). Heights: with height_m > 0 the
+ * lowest value becomes 0 and the highest height_m; otherwise value * height_scale (0: 1, the
+ * raster holds metres). Every stride-th row and column is kept (stride 0: the least stride
+ * that keeps 2 (nx - 1)(nz - 1) within max_triangles, 0: 1 000 000). Missing, unreadable and
+ * non-raster files, rasters under 2 x 2 or over ATMOS_TERRAIN_MAX_SIDE a side, non-finite
+ * values, a flat normalised map and an unknown generator are errors naming the source; a
+ * build without GDAL answers ATMOS_E_UNSUPPORTED for files (the generator still works). */
+#define ATMOS_TERRAIN_MAX_SIDE 65536
+typedef struct atmos_terrain_desc {
+    const char *source;
+    double size_m;       /* (0, 1e7] */
+    double height_m;     /* > 0: normalised to [0, height_m] */
+    double height_scale; /* with height_m 0: metres per raster unit (0: 1) */
+    int stride;          /* 0: automatic */
+    int max_triangles;   /* 0: 1 000 000; at most ATMOS_MESH_MAX_TRIANGLES */
+    int samples;         /* generate: points a side, [2, 4097]; 0: 257 */
+    uint64_t seed;       /* generate */
+} atmos_terrain_desc;
+
+ATMOS_API atmos_status atmos_mesh_terrain(atmos_context *ctx, const atmos_terrain_desc *desc, atmos_mesh **out);
+
 /* Applies t to the positions and normals and rebuilds the hierarchy. A scale of zero on any
  * axis, or a non-finite value, is ATMOS_E_INVALID_ARG. */
 ATMOS_API atmos_status atmos_mesh_apply_transform(atmos_context *ctx, atmos_mesh *mesh, const atmos_mesh_transform *t);

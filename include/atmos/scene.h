@@ -132,6 +132,8 @@ typedef struct atmos_scene_beams {
                                  (Dobashi's threshold); 0.01 */
     int max_subplanes;        /* sub-planes between two main planes at most; 64 */
     int shadow_size;          /* shadow map texels per side (per cube face for point lights); 512 */
+    int sun;                  /* 1: the scene's sun lights the fog and the objects too (a directional light with a
+                                 shadow map, docs/beams.md); 0 */
 } atmos_scene_beams;
 
 /* Lights besides the sun ("lights" in the file; the beam renderer's). */
@@ -160,12 +162,23 @@ typedef struct atmos_scene_fog {
     double extinction_per_m;  /* (0, 10] */
     double scattering_per_m;  /* [0, extinction] */
     double g;                 /* Henyey-Greenstein asymmetry, (-1, 1); 0 */
+    double height_m;          /* > 0: the coefficients fall off as exp(-(y - base_m) / height_m) (the beam renderer's
+                                 sun only); 0: uniform */
+    double base_m;            /* the height where the coefficients are as given; 0 */
 } atmos_scene_fog;
 
 /* Opaque Lambertian objects ("objects" in the file). */
 #define ATMOS_SCENE_MAX_OBJECTS 16
 typedef struct atmos_scene_object {
-    char mesh[ATMOS_SCENE_PATH_MAX]; /* "builtin:NAME" or an OBJ file (relative paths: against the scene's folder) */
+    char mesh[ATMOS_SCENE_PATH_MAX]; /* "builtin:NAME" or an OBJ file (relative paths: against the scene's folder);
+                                        empty for a terrain */
+    char terrain[ATMOS_SCENE_PATH_MAX]; /* a height map (raster file, relative paths as mesh) or
+                                           "generate:ridges" (atmos_terrain_desc); empty for a mesh */
+    double size_m;            /* terrain: width along x, (0, 1e7]; 1000 */
+    double height_m;          /* terrain: > 0 normalises the heights to [0, height_m]; 0 */
+    double height_scale;      /* terrain: with height_m 0, metres per raster unit; 0 = 1 */
+    int stride, samples, max_triangles; /* terrain: atmos_terrain_desc's; 0 */
+    uint64_t seed;            /* terrain: the generator's; 0 */
     double position_m[3];
     double scale[3];          /* per axis, nonzero, |s| <= 1e6; 1, 1, 1 */
     double rotation_deg[3];   /* about x, then y, then z; 0 */

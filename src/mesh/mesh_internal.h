@@ -15,4 +15,19 @@ atmos_status atmos__mesh_builtin(atmos_context *ctx, const char *name, atmos_mes
 atmos_status atmos__mesh_bvh_build(atmos_context *ctx, atmos_mesh *mesh);
 void atmos__mesh_bvh_destroy(atmos__mesh_bvh *bvh);
 
+/* A height map's kept samples (mesh_terrain.c, mesh_gdal.c): nx x nz values, row by row. */
+typedef struct atmos__heights {
+    int nx, nz;
+    double *h;
+} atmos__heights;
+
+/* The least stride that keeps 2 (nx - 1)(nz - 1) triangles of a w x h grid within max. */
+int atmos__terrain_stride(long w, long h, long max_triangles);
+
+/* Band 1 of a raster file through GDAL, every stride-th row and column (stride 0: the
+ * automatic one), no-data pixels set to the lowest valid value (mesh_gdal.c).
+ * ATMOS_E_UNSUPPORTED without GDAL. */
+atmos_status atmos__terrain_read(atmos_context *ctx, const char *path, int stride, long max_triangles,
+                                 atmos__heights *out);
+
 #endif

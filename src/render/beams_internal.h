@@ -8,6 +8,7 @@
 
 #include "light/lamp.h"
 #include "render/objects.h"
+#include "render/beams_sun.h"
 #include "render/plan_internal.h"
 
 /* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
@@ -103,8 +104,16 @@ struct atmos__beams_plan {
     atmos__beams_light *lights;
     double sigma_t, sigma_s;                 /* 0 without fog */
     atmos__beams_table table;
+    atmos__beams_fog fog;                    /* the fog along rays (beams_sun.h) */
+    int sun_on;                              /* the sun lights the scene (beams/sun) */
+    atmos__beams_sun sun;                    /* its map, built for the last frame's sun (sun.dir) */
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
     int centre_planes, centre_subplanes;
 };
+
+/* The sun for a frame (beams_plan.c): its light at the eye, its shadow map (made again when
+ * the sun has moved). */
+atmos_status atmos__beams_sun_frame(atmos_plan *p, const atmos__view *v);
+
 
 #endif

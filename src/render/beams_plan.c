@@ -23,6 +23,7 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b)
     atmos__objects_free(&b->obj);
     for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]), atmos__lamp_free(&b->lights[i].L);
     free(b->lights);
+    atmos__beams_sun_free(&b->sun);
     atmos__beams_table_free(&b->table);
     free(b);
 }
@@ -42,17 +43,32 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
         range = fmax(range, b->lights[i].L.range);
         if (st == ATMOS_OK) st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->obj.mesh, b->obj.n, s->beams.shadow_size);
     }
-    if (st == ATMOS_OK && s->fog.enabled) { /* x = sigma_t v reaches sigma_t times the largest reach */
+    if (st == ATMOS_OK && s->fog.enabled && s->light_count > 0) { /* x = sigma_t v reaches sigma_t times the largest reach */
         b->sigma_t = s->fog.extinction_per_m, b->sigma_s = s->fog.scattering_per_m;
         st = atmos__beams_table_build(p->ctx, b->sigma_t, b->sigma_s, s->fog.g,
                                       fmin(b->sigma_t * range, ATMOS__BEAMS_MAX_OPTICAL_RANGE), &b->table);
     }
+    if (s->fog.enabled) {
+        const atmos__beams_fog f = {s->fog.extinction_per_m, s->fog.scattering_per_m / s->fog.extinction_per_m, s->fog.g,
+                                    s->fog.base_m, s->fog.height_m};
+        b->fog = f;
+    }
+    b->sun_on = s->beams.sun;
     if (st != ATMOS_OK) {
         atmos__beams_plan_destroy(b);
         return st;
     }
     *out = b;
     return ATMOS_OK;
+}
+
+atmos_status atmos__beams_sun_frame(atmos_plan *p, const atmos__view *v)
+{
+    atmos__beams_plan *b = p->beams;
+    atmos__beams_sun *sun = &b->sun;
+    atmos_atmosphere_sunlight(p->atm, v->cam.position, v->sun, sun->E); /* the sun's colour where the eye is */
+    if (sun->depth && !memcmp(sun->dir, v->sun, sizeof sun->dir)) return ATMOS_OK;
+    return atmos__beams_sun_build(p->ctx, sun, v->sun, b->obj.mesh, b->obj.n, p->scene.beams.shadow_size);
 }
 
 void atmos__beams_describe(const atmos_plan *p, char *buf, size_t cap)

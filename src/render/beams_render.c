@@ -39,7 +39,7 @@ typedef struct job {
 } job;
 
 /* The object's surface at the eye's ray's hit, lit by the lights, dimmed on the way to the eye. */
-static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double *L)
+static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
     double P[3], sum[ATMOS_MAX_WAVELENGTHS] = {0};
@@ -60,8 +60,7 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
         atmos__lamp_tint(&l->L, P, tint);
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
-    const double t = exp(-b->sigma_t * h->t);
-    for (int k = 0; k < J->nw; k++) L[k] = b->obj.albedo[m][k] / ATMOS_PI * sum[k] * t;
+    for (int k = 0; k < J->nw; k++) L[k] = b->obj.albedo[m][k] / ATMOS_PI * sum[k] * fog_t;
 }
 
 /* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
@@ -158,6 +157,25 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum;
 }
 
+/* The sun's share (beams_sun.h): the surface hit (if any) lit where a ray toward the sun is
+ * free, dimmed by fog_t; the fog's scattering of sunlight along [0, T). */
+static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double T, double fog_t, double *L)
+{
+    const atmos__beams_plan *b = J->b;
+    const atmos__beams_sun *s = &b->sun;
+    if (h) {
+        const double c = atmos__dot3(h->normal, s->dir), off = 1e-4 * (1 + h->t);
+        const double o[3] = {J->eye[0] + h->t * d[0] + off * h->normal[0], J->eye[1] + h->t * d[1] + off * h->normal[1],
+                             J->eye[2] + h->t * d[2] + off * h->normal[2]};
+        if (c > 0 && !atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
+            for (int k = 0; k < J->nw; k++) L[k] += b->obj.albedo[m][k] / ATMOS_PI * s->E[k] * c * fog_t;
+    }
+    if (b->fog.sigma0 > 0) {
+        const double a = atmos__beams_sun_airlight(s, &b->fog, J->eye, d, T, J->epsilon, MAX_INTERVALS);
+        for (int k = 0; k < J->nw; k++) L[k] += s->E[k] * a;
+    }
+}
+
 static void pixel(job *J, int x, int y, float *px, double *f)
 {
     const atmos__beams_plan *b = J->b;
@@ -167,11 +185,13 @@ static void pixel(job *J, int x, int y, float *px, double *f)
     int m = -1;
     const int hit = atmos__objects_hit(&b->obj, J->eye, d, 0, INFINITY, &h, &m);
     const double T = hit ? h.t : INFINITY;
-    if (hit) shade_surface(J, d, &h, m, L);
+    const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, T)); /* 0 to the sky behind endless fog */
+    if (hit) shade_surface(J, d, &h, m, fog_t, L);
     else
-        for (int k = 0; k < J->nw; k++) L[k] = b->sigma_t > 0 ? 0 : px[k]; /* the sky, behind endless fog */
+        for (int k = 0; k < J->nw; k++) L[k] = px[k] * fog_t;
     if (b->sigma_t > 0)
         for (int i = 0; i < b->nlights; i++) airlight(J, i, d, T, f, L, x == J->cx && y == J->cy);
+    if (b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
     for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
 }
 
@@ -206,6 +226,10 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.cx = v->cam.width / 2, J.cy = v->cam.height / 2;
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
+    if (b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) {
+        free(J.z_lo);
+        return st;
+    }
     const int W = out->width, C = out->channels, rows = r->y1 - r->y0;
     int failed = 0, cancelled = 0, done = 0;
 #pragma omp parallel num_threads(atmos__threads(p->ctx))

@@ -4,6 +4,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A terrain object's mesh from its height map (a file through GDAL, or generated). */
+static atmos_status load_terrain(atmos_context *ctx, const atmos_scene_object *o, atmos_mesh **out)
+{
+    atmos_terrain_desc d;
+    memset(&d, 0, sizeof d);
+    d.source = o->terrain, d.size_m = o->size_m, d.height_m = o->height_m, d.height_scale = o->height_scale;
+    d.stride = o->stride, d.samples = o->samples, d.max_triangles = o->max_triangles, d.seed = o->seed;
+    return atmos_mesh_terrain(ctx, &d, out);
+}
+
 atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const atmos_wavelengths *wl,
                                  atmos__objects *ob)
 {
@@ -14,7 +24,7 @@ atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const
     if (!ob->mesh || !ob->albedo) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for the objects");
     for (int i = 0; i < s->object_count; i++) {
         const atmos_scene_object *o = &s->objects[i];
-        atmos_status st = atmos_mesh_load(ctx, o->mesh, 0, &ob->mesh[i]);
+        atmos_status st = o->terrain[0] ? load_terrain(ctx, o, &ob->mesh[i]) : atmos_mesh_load(ctx, o->mesh, 0, &ob->mesh[i]);
         if (st != ATMOS_OK) return st;
         ob->n = i + 1;
         atmos_mesh_transform t;

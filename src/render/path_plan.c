@@ -118,6 +118,10 @@ atmos_status atmos__path_plan_create(atmos_plan *p, atmos__path_plan **out)
             st = atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
                               "render path: a scene with lights, fog or objects needs \"background\": \"black\" or "
                               "a uniform one (the sky's air is not traced with them yet; docs/path.md)");
+        else if (s->fog.enabled && s->fog.height_m > 0)
+            st = atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
+                              "render path: /fog/height_m: a fog thinning with height is not traced yet (a uniform fog "
+                              "is; docs/path.md)");
         else
             st = atmos__path_lamps_build(p->ctx, s, &p->wl, &pp->lamps);
         if (st != ATMOS_OK) {

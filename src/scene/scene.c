@@ -347,13 +347,13 @@ atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t
         memcpy(m, path, dir);
     }
     /* the objects' OBJ files likewise */
-    for (int i = 0; st == ATMOS_OK && slash && i < out->object_count; i++) {
-        char *m = out->objects[i].mesh;
+    for (int i = 0; st == ATMOS_OK && slash && i < 2 * out->object_count; i++) {
+        char *m = i % 2 ? out->objects[i / 2].terrain : out->objects[i / 2].mesh; /* both ATMOS_SCENE_PATH_MAX */
         const size_t dir = (size_t)(slash - path) + 1, n = strlen(m);
-        if (m[0] == '/' || !strncmp(m, "builtin:", 8)) continue;
-        if (dir + n >= sizeof out->objects[i].mesh)
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /objects/%d/mesh: the path is too long once joined to the "
-                                "scene's folder", path, i);
+        if (!m[0] || m[0] == '/' || !strncmp(m, "builtin:", 8) || !strncmp(m, "generate:", 9)) continue;
+        if (dir + n >= ATMOS_SCENE_PATH_MAX)
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /objects/%d/%s: the path is too long once joined to the "
+                                "scene's folder", path, i / 2, i % 2 ? "terrain" : "mesh");
         memmove(m + dir, m, n + 1);
         memcpy(m, path, dir);
     }

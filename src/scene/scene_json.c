@@ -1105,9 +1105,26 @@ static atmos_status light_item(const jp *p, const cJSON *j, const char *path, at
     return parse_light(p, j, path, &s->lights[i]);
 }
 
+/* An object's terrain keys (keys 5-12 of object_item's). */
+static atmos_status object_terrain_key(const jp *p, const cJSON *v, const char *ip, int k, atmos_scene_object *o)
+{
+    static const atmos__range r_count = {0, 1e9, 0, 0};
+    switch (k) {
+    case 5: return get_text(p, v, ip, o->terrain, sizeof o->terrain);
+    case 6: return get_number(p, v, ip, NULL, NULL, &o->size_m);
+    case 7: return get_number(p, v, ip, NULL, NULL, &o->height_m);
+    case 8: return get_number(p, v, ip, NULL, NULL, &o->height_scale);
+    case 9: return get_int(p, v, ip, &r_count, &o->stride);
+    case 10: return get_int(p, v, ip, &r_count, &o->samples);
+    case 11: return get_int(p, v, ip, &r_count, &o->max_triangles);
+    default: return get_u64(p, v, ip, &r_seed, &o->seed);
+    }
+}
+
 static atmos_status object_item(const jp *p, const cJSON *j, const char *path, atmos_scene *s, int i)
 {
-    static const char *const keys[] = {"mesh", "position_m", "scale", "rotation_deg", "albedo"};
+    static const char *const keys[] = {"mesh",   "position_m", "scale",   "rotation_deg", "albedo",        "terrain", "size_m",
+                                       "height_m", "height_scale", "stride", "samples", "max_triangles", "seed"};
     const atmos__range *const any[3] = {NULL, NULL, NULL};
     atmos_scene_object *o = &s->objects[i];
     atmos__scene_object_defaults(o);
@@ -1115,7 +1132,7 @@ static atmos_status object_item(const jp *p, const cJSON *j, const char *path, a
     char ip[PATH_CAP];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 5, &it));
+    TRY(iter_begin(p, j, path, keys, 13, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -1132,25 +1149,28 @@ static atmos_status object_item(const jp *p, const cJSON *j, const char *path, a
             } else TRY(get_vec3(p, v, ip, any, k == 2 ? o->scale : o->albedo));
             break;
         case 3: TRY(get_vec3(p, v, ip, any, o->rotation_deg)); break;
+        default: TRY(object_terrain_key(p, v, ip, k, o));
         }
     }
-    if (!o->mesh[0]) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"mesh\"");
+    if (!o->mesh[0] && !o->terrain[0])
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"mesh\" or \"terrain\"");
     return ATMOS_OK;
 }
 
 static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"extinction_per_m", "scattering_per_m", "g"};
+    static const char *const keys[] = {"extinction_per_m", "scattering_per_m", "g", "height_m", "base_m"};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
     int k, scattering = 0;
     atmos_scene_fog *f = &s->fog;
-    TRY(iter_begin(p, j, path, keys, 3, &it));
+    TRY(iter_begin(p, j, path, keys, 5, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
-        double *d = k == 0 ? &f->extinction_per_m : k == 1 ? &f->scattering_per_m : &f->g;
+        double *const fields[5] = {&f->extinction_per_m, &f->scattering_per_m, &f->g, &f->height_m, &f->base_m};
+        double *d = fields[k];
         TRY(get_number(p, v, ip, NULL, NULL, d));
         scattering |= k == 1;
     }

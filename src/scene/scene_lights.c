@@ -23,6 +23,7 @@ void atmos__scene_object_defaults(atmos_scene_object *o)
     memset(o, 0, sizeof *o);
     o->scale[0] = o->scale[1] = o->scale[2] = 1;
     o->albedo[0] = o->albedo[1] = o->albedo[2] = 0.5;
+    o->size_m = 1000;
 }
 
 /* Each of the three components of v at prefix/key/i within r. */
@@ -100,6 +101,28 @@ static atmos_status check_light(atmos_context *ctx, const char *source, const at
     return ATMOS_OK;
 }
 
+/* A terrain's values (atmos_terrain_desc's ranges); the file itself is read by the plan. */
+static atmos_status check_terrain(atmos_context *ctx, const char *source, const char *at, const atmos_scene_object *o)
+{
+    static const atmos__range r_size = {0, 1e7, 1, 0}, r_height = {0, 1e5, 0, 0}, r_hscale = {-1e5, 1e5, 0, 0},
+                              r_samples = {2, 4097, 0, 0}, r_stride = {0, 1e6, 0, 0},
+                              r_tris = {0, ATMOS_MESH_MAX_TRIANGLES, 0, 0};
+    atmos_status st;
+    if ((st = check1(ctx, source, at, "size_m", o->size_m, &r_size, NULL))) return st;
+    if ((st = check1(ctx, source, at, "height_m", o->height_m, &r_height, " (0: height_scale)"))) return st;
+    if ((st = check1(ctx, source, at, "height_scale", o->height_scale, &r_hscale, NULL))) return st;
+    if (o->samples && (st = check1(ctx, source, at, "samples", o->samples, &r_samples, " (or 0: 257)"))) return st;
+    if ((st = check1(ctx, source, at, "stride", o->stride, &r_stride, " (0: automatic)"))) return st;
+    if ((st = check1(ctx, source, at, "max_triangles", o->max_triangles, &r_tris, " (0: 1000000)"))) return st;
+    if (strncmp(o->terrain, "generate:", 9)) return ATMOS_OK;
+    if (strcmp(o->terrain + 9, "ridges") && strcmp(o->terrain + 9, "city"))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at,
+                                 "terrain \"%.64s\" is no generator (known: generate:ridges, generate:city)", o->terrain);
+    if (!(o->height_m > 0))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at, "a generated terrain needs height_m > 0");
+    return ATMOS_OK;
+}
+
 static atmos_status check_object(atmos_context *ctx, const char *source, const atmos_scene *s, int i)
 {
     static const atmos__range r_scale = {-1e6, 1e6, 0, 0}, r_rot = {-3600, 3600, 0, 0}, r_albedo = {0, 1, 0, 0};
@@ -107,8 +130,12 @@ static atmos_status check_object(atmos_context *ctx, const char *source, const a
     char at[48];
     snprintf(at, sizeof at, "/objects/%d", i);
     atmos_status st;
-    if (!memchr(o->mesh, '\0', sizeof o->mesh) || !o->mesh[0])
-        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at, "needs \"mesh\" (builtin:NAME or an OBJ file)");
+    if (!memchr(o->mesh, '\0', sizeof o->mesh) || !memchr(o->terrain, '\0', sizeof o->terrain) ||
+        !o->mesh[0] == !o->terrain[0])
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, at,
+                                 "needs either \"mesh\" (builtin:NAME or an OBJ file) or \"terrain\" (a height map file or "
+                                 "generate:ridges), not both");
+    if (o->terrain[0] && (st = check_terrain(ctx, source, at, o))) return st;
     if (!strncmp(o->mesh, "builtin:", 8)) {
         int known = 0;
         for (const char *const *n = atmos_mesh_builtin_names(); *n; n++) known |= !strcmp(o->mesh + 8, *n);
@@ -131,7 +158,7 @@ static atmos_status check_object(atmos_context *ctx, const char *source, const a
 
 atmos_status atmos__scene_validate_lights(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
-    static const atmos__range r_ext = {0, 10, 1, 0}, r_g = {-1, 1, 1, 1};
+    static const atmos__range r_ext = {0, 10, 1, 0}, r_g = {-1, 1, 1, 1}, r_fog_h = {0, 1e5, 0, 0};
     atmos_status st;
     if (s->light_count < 0 || s->light_count > ATMOS_SCENE_MAX_LIGHTS)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/lights", "at most %d lights, got %d",
@@ -151,11 +178,19 @@ atmos_status atmos__scene_validate_lights(atmos_context *ctx, const char *source
                                            " (at most the extinction)")))
             return st;
         if ((st = atmos__scene_check_range(ctx, source, "/fog/g", s->fog.g, &r_g, NULL))) return st;
+        if ((st = atmos__scene_check_range(ctx, source, "/fog/height_m", s->fog.height_m, &r_fog_h, " (0: uniform)")) ||
+            (st = atmos__scene_check_range(ctx, source, "/fog/base_m", s->fog.base_m, &atmos__r_pos, NULL)))
+            return st;
+        if (s->fog.height_m > 0 && s->light_count > 0)
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/fog/height_m",
+                                     "a height-dependent fog is lit by the sun alone: point and spot lights need a "
+                                     "uniform fog (height_m 0)");
     }
     if (s->renderer != ATMOS_RENDERER_BEAMS) return ATMOS_OK;
-    if (s->light_count < 1)
+    if (s->light_count < 1 && !s->beams.sun)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/lights",
-                                 "the beams renderer draws the light of \"lights\": the scene has none");
+                                 "the beams renderer draws the light of \"lights\" (and of the sun with beams/sun): the "
+                                 "scene has neither");
     if (s->camera.type != ATMOS_CAMERA_PINHOLE)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/camera/type",
                                  "the beams renderer supports pinhole cameras only (its sampling planes face the view)");

@@ -1,7 +1,8 @@
 /* atmos bench beams: the beam renderer's frame rate (Dobashi et al. 2002 §4, docs/beams.md)
  * on the Fig. 4 scene (a sphere under a spotlight, 300x450) and on variants of it: without
  * sub-planes (at the scene's plane spacing, 0.3 m and 0.1 m), with a coarser epsilon, with two
- * and four lights (the spot copied around the first), and at twice the size. Each case makes one plan (objects, shadow maps, the scattering table) and renders
+ * and four lights (the spot copied around the first), and at twice the size; then the studio
+ * of Fig. 9(a), the searchlights and the mountains of Fig. 10(a) at Table 1's 720x480. Each case makes one plan (objects, shadow maps, the scattering table) and renders
  * frames with the camera moving round the sphere (a degree a frame): what interactive use
  * pays per frame. */
 #include "bench_beams.h"
@@ -24,12 +25,12 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     if (!c->subplanes) s.beams.max_subplanes = 1;
     if (c->spacing_m > 0) s.beams.plane_spacing_m = c->spacing_m;
     if (c->epsilon > 0) s.beams.epsilon = c->epsilon;
-    for (int i = 1; i < c->lights && i < ATMOS_SCENE_MAX_LIGHTS; i++) { /* copies of the first, round it */
+    for (int i = 1; base->light_count > 0 && i < c->lights && i < ATMOS_SCENE_MAX_LIGHTS; i++) { /* copies of the first */
         s.lights[i] = s.lights[0];
         s.lights[i].position_m[0] += 6 * cos(2 * 3.14159265358979 * i / c->lights);
         s.lights[i].position_m[2] += 6 * sin(2 * 3.14159265358979 * i / c->lights);
     }
-    if (c->lights > s.light_count) s.light_count = c->lights;
+    if (base->light_count > 0 && c->lights > s.light_count) s.light_count = c->lights; /* a sun-only scene: as it is */
     atmos_plan *plan = NULL;
     atmos_frame f;
     atmos_image *img = NULL;
@@ -85,6 +86,15 @@ int bench_beams(const char *file, int frames, int threads)
     const int used = atmos_context_threads(ctx);
     for (size_t i = 0; rc == CLI_EXIT_OK && i < sizeof cases / sizeof *cases; i++)
         rc = run_case(ctx, &s, &cases[i], frames, used);
+    /* without a file: the other scenes as they are (Table 1's size, 720x480) */
+    static const char *const table1[][2] = {{"dobashi_fig09a_studio", "scenes/dobashi_fig09a_studio.json"},
+                                            {"searchlights_fog", "scenes/searchlights_fog.json"},
+                                            {"dobashi_fig10a_mountain_shafts", "scenes/dobashi_fig10a_mountain_shafts.json"}};
+    for (size_t i = 0; !file && rc == CLI_EXIT_OK && i < sizeof table1 / sizeof *table1; i++) {
+        const beams_case c = {table1[i][0], 0, 1, 1, 0, 0};
+        if ((st = atmos_scene_load(ctx, table1[i][1], &s)) != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
+        else rc = run_case(ctx, &s, &c, frames, used);
+    }
     atmos_context_destroy(ctx);
     return rc;
 }

@@ -1,0 +1,50 @@
+/* The sun as a light of the beam renderer (docs/beams.md#the-sun): a directional light with
+ * an orthographic shadow map over the scene's objects (terrain), the sunlight of the
+ * atmosphere at the eye, and the fog's optical depth along a ray (uniform, or falling off
+ * exponentially with height). For a directional light the scattering angle is the same all
+ * along a ray, and with the sunlight not dimmed by the fog on its way in, the single
+ * scattering between t_a and t_b is a closed form for any fog profile:
+ *     int sigma_s(t) p E exp(-tau(t)) dt = omega p E [exp(-tau(t_a)) - exp(-tau(t_b))],
+ * omega = sigma_s / sigma_t; the ray is cut into steps of equal share of that integral (each at
+ * most epsilon of the whole, Dobashi's criterion) and the visibility H sampled once a step.
+ * Not part of the API. */
+#ifndef ATMOS_RENDER_BEAMS_SUN_H
+#define ATMOS_RENDER_BEAMS_SUN_H
+
+#include "core/internal.h"
+
+/* The fog along rays: sigma_t(y) = sigma0 exp(-(y - base) / H) (H = 0: uniform sigma0). */
+typedef struct atmos__beams_fog {
+    double sigma0, albedo, g;
+    double base_m, height_m;
+} atmos__beams_fog;
+
+/* The optical depth from the eye o to o + t d (t may be INFINITY). */
+double atmos__beams_fog_tau(const atmos__beams_fog *f, const double o[3], const double d[3], double t);
+
+typedef struct atmos__beams_sun {
+    double dir[3];                      /* toward the sun, unit */
+    double E[ATMOS_MAX_WAVELENGTHS];    /* the sunlight (W m^-2 nm^-1) */
+    /* the shadow map: depth along fwd = -dir over n x n texels of size texel from (u0, v0) in
+     * (right, up); empty (n = 0) without objects */
+    double right[3], up[3], fwd[3];
+    double u0, v0, texel, bias;
+    int n;
+    float *depth;
+} atmos__beams_sun;
+
+/* The map of the meshes seen from the sun dir (unit); size texels a side. */
+atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, const double dir[3], atmos_mesh *const *mesh,
+                                    int nmesh, int size);
+void atmos__beams_sun_free(atmos__beams_sun *s);
+/* H at p: the share of sunlight reaching p past the meshes, in [0, 1] (2x2 filtered). */
+double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3]);
+/* The sunlight the fog scatters toward o along [0, T) of the ray d (unit), per unit of E:
+ * steps of at most epsilon of the unshadowed whole (at most max_steps), each weighted by H
+ * at its middle (in optical depth). */
+double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
+                                 const double d[3], double T, double epsilon, int max_steps);
+/* The Henyey-Greenstein phase function at cos theta. */
+double atmos__beams_hg(double g, double cos_theta);
+
+#endif

@@ -1,0 +1,177 @@
+/* The sun of the beam renderer (render/beams_sun.h) against an independent numeric
+ * quadrature of the single-scattering integral
+ *     L = int_0^T sigma_s(t) p(theta) H(t) exp(-tau(t)) dt   (per unit of sunlight),
+ * tau by its own cumulative quadrature, H by casting a ray toward the sun through the mesh:
+ *   - uniform and height-dependent (exponential) fog without shadows: the closed form between
+ *     the ends, to 1e-6;
+ *   - a wall floating in uniform fog casting a shadow across the rays: the renderer's steps
+ *     (epsilon 1e-3) with the shadow map against the quadrature with exact shadow rays;
+ *   - the Fig. 10(a) scene small: the same image with one thread and with two, byte for byte;
+ *     finite, non-negative pixels; the sunlit sky above the ridge brighter than the shadowed
+ *     ground below it. */
+#include "atmos/atmos.h"
+#include "render/beams_sun.h"
+#include "test.h"
+
+static atmos_context *ctx;
+
+/* sigma_t at the point p of the fog */
+static double sigma_at(const atmos__beams_fog *f, const double p[3])
+{
+    return f->height_m > 0 ? f->sigma0 * exp(-(p[1] - f->base_m) / f->height_m) : f->sigma0;
+}
+
+/* The integral by the midpoint rule over n steps up to T (finite), H from shadow rays
+ * through mesh (NULL: none). */
+static double quadrature(const atmos__beams_fog *f, const double sun[3], const atmos_mesh *mesh, const double o[3],
+                         const double d[3], double T, int n)
+{
+    const double h = T / n;
+    double tau = 0, sum = 0;
+    for (int i = 0; i < n; i++) {
+        const double t = (i + 0.5) * h, p[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+        const double s = sigma_at(f, p);
+        const double tau_mid = tau + 0.5 * s * h; /* the optical depth to the step's middle */
+        const int lit = !mesh || !atmos_mesh_intersect(mesh, p, sun, 0, 1e9, NULL);
+        sum += f->albedo * s * exp(-tau_mid) * lit * h;
+        tau += s * h;
+    }
+    return sum * atmos__beams_hg(f->g, sun[0] * d[0] + sun[1] * d[1] + sun[2] * d[2]);
+}
+
+static void unit(double v[3])
+{
+    const double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int a = 0; a < 3; a++) v[a] /= l;
+}
+
+static void test_no_shadow(void)
+{
+    atmos__beams_sun s;
+    memset(&s, 0, sizeof s);
+    double sun[3] = {0.3, 0.5, -0.8};
+    unit(sun);
+    CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, NULL, 0, 64));
+    const atmos__beams_fog uniform = {2e-3, 0.9, 0.6, 0, 0}, layer = {5e-3, 0.8, 0.3, 100, 250};
+    const atmos__beams_fog *fogs[2] = {&uniform, &layer};
+    const double o[3] = {0, 20, 0};
+    double worst = 0;
+    for (int fi = 0; fi < 2; fi++)
+        for (int r = 0; r < 6; r++) {
+            double d[3] = {cos(r), 0.4 * sin(1.7 * r) - 0.1, sin(r)};
+            unit(d);
+            const double T = 300 + 400 * r;
+            const double got = atmos__beams_sun_airlight(&s, fogs[fi], o, d, T, 0.01, 1000);
+            const double want = quadrature(fogs[fi], sun, NULL, o, d, T, 200000);
+            worst = fmax(worst, fabs(got - want) / want);
+            /* the optical depth too */
+            double tau = 0;
+            for (int i = 0; i < 20000; i++) {
+                const double t = (i + 0.5) * T / 20000, p[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+                tau += sigma_at(fogs[fi], p) * T / 20000;
+            }
+            CHECK_REL(atmos__beams_fog_tau(fogs[fi], o, d, T), tau, 1e-6);
+        }
+    printf("sun airlight without shadows against the quadrature: worst relative error %.2e\n", worst);
+    CHECK(worst < 1e-6);
+    /* an upward ray through the exponential layer: a finite optical depth to infinity */
+    const double up[3] = {0, 1, 0};
+    CHECK_REL(atmos__beams_fog_tau(&layer, o, up, INFINITY), 5e-3 * 250 * exp(-(20 - 100) / 250.0), 1e-12);
+    CHECK(atmos__beams_fog_tau(&uniform, o, up, INFINITY) == INFINITY);
+    atmos__beams_sun_free(&s);
+}
+
+static void test_shadow(void)
+{
+    atmos_mesh *wall = NULL;
+    CHECK_OK(atmos_mesh_load(ctx, "builtin:box", 0, &wall));
+    if (!wall) return;
+    atmos_mesh_transform t;
+    atmos_mesh_transform_identity(&t);
+    t.position_m[1] = 40, t.position_m[2] = -60, t.scale[0] = 40, t.scale[1] = 15, t.scale[2] = 15;
+    CHECK_OK(atmos_mesh_apply_transform(ctx, wall, &t));
+    double sun[3] = {0.2, 0.5, 0.6};
+    unit(sun);
+    atmos__beams_sun s;
+    memset(&s, 0, sizeof s);
+    CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, &wall, 1, 2048));
+    const atmos__beams_fog fog = {4e-3, 1, 0.2, 0, 0};
+    const double o[3] = {0, 5, 0};
+    double worst = 0, lost = 0;
+    int shadowed = 0;
+    for (int r = 0; r < 21; r++) { /* rays fanning across the wall's shadow below it */
+        double d[3] = {-0.6 + 0.06 * r, 0.02, -1};
+        unit(d);
+        const double T = 400;
+        const double got = atmos__beams_sun_airlight(&s, &fog, o, d, T, 1e-3, 100000);
+        const double want = quadrature(&fog, sun, wall, o, d, T, 100000);
+        const double full = quadrature(&fog, sun, NULL, o, d, T, 100000);
+        shadowed += want < 0.99 * full;
+        worst = fmax(worst, fabs(got - want) / full);
+        lost = fmax(lost, (full - want) / full);
+    }
+    printf("sun airlight with a wall's shadow: %d of 21 rays shadowed (up to %.1f %% of their light), worst error %.2e "
+           "of the unshadowed light\n", shadowed, 100 * lost, worst);
+    CHECK(shadowed >= 8 && lost > 0.1);
+    CHECK(worst < 3e-3);
+    atmos__beams_sun_free(&s);
+    atmos_mesh_destroy(wall);
+}
+
+/* The scene file at w x h rendered with the given threads. */
+static atmos_image *render_file(const char *path, int w, int h, int threads)
+{
+    atmos_context_desc d;
+    memset(&d, 0, sizeof d);
+    d.threads = threads;
+    atmos_context *c = NULL;
+    atmos_image *img = NULL;
+    atmos_scene s;
+    CHECK_OK(atmos_context_create(&d, &c));
+    if (!c) return NULL;
+    if (atmos_scene_load(c, path, &s) == ATMOS_OK) {
+        s.width = w, s.height = h;
+        const atmos_status st = atmos_render_scene(c, &s, NULL, &img, NULL);
+        CHECK_MSG(st == ATMOS_OK, "%s: %s", path, atmos_context_error(c));
+    } else
+        CHECK_MSG(0, "%s: %s", path, atmos_context_error(c));
+    atmos_context_destroy(c);
+    return img;
+}
+
+static void test_scene(void)
+{
+    const char *src = getenv("ATMOS_SOURCE_DIR");
+    if (!src) {
+        printf("ATMOS_SOURCE_DIR not set: the scene test skipped\n");
+        return;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/scenes/dobashi_fig10a_mountain_shafts.json", src);
+    atmos_image *a = render_file(path, 48, 32, 1), *b = render_file(path, 48, 32, 2);
+    if (a && b) {
+        const size_t n = (size_t)a->width * a->height * a->channels;
+        CHECK(!memcmp(a->pixels, b->pixels, n * sizeof(float)));
+        int ok = 1;
+        for (size_t i = 0; i < n; i++) ok &= isfinite(a->pixels[i]) && a->pixels[i] >= 0;
+        CHECK(ok);
+        double top = 0, bottom = 0;
+        for (int x = 0; x < a->width; x++)
+            for (int k = 0; k + 1 < a->channels; k++) { /* the last channel is alpha */
+                top += a->pixels[((size_t)2 * a->width + x) * a->channels + k];
+                bottom += a->pixels[((size_t)(a->height - 3) * a->width + x) * a->channels + k];
+            }
+        CHECK_MSG(top > 10 * bottom, "sky %g, ground %g", top, bottom);
+    }
+    atmos_image_destroy(a), atmos_image_destroy(b);
+}
+
+int main(void)
+{
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    test_no_shadow();
+    test_shadow();
+    test_scene();
+    atmos_context_destroy(ctx);
+    return test_summary("test_beams_sun");
+}
