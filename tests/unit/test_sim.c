@@ -44,6 +44,7 @@ static void test_adjust(void)
                         if (bad++ < 3) printf("  adjust: T %g p %g rh %g qc %g -> qv %g qs %g qc %g\n", t, p, rh, qc0, qv, qs, qc);
                     }
                 }
+    printf("  adjust: %d states\n", cases);
     CHECK_MSG(bad == 0, "%d of %d adjusted states saturated wrongly", bad, cases);
 }
 
