@@ -7,25 +7,54 @@
 
 #include <math.h>
 
-/* Trilinear sample of a field of nz_f levels at (x, y, z) in its own index space. */
-static inline float sample(const atmos_sim *s, const float *f, int nz_f, double x, double y, double z)
+/* The eight corners and weights of a trilinear sample at (x, y, z) in the index space of a
+ * field of nz_f levels: set up once, evaluated for any field on that grid. */
+typedef struct {
+    size_t c[4];      /* offsets of the corners (i0, j, k) of rows j0/j1 at levels k0/k1 */
+    int i0, i1;
+    float ax, ay, az;
+} tri;
+
+static inline int wrap(int i, int n)
+{
+    if ((unsigned)i >= (unsigned)n) {
+        i %= n;
+        if (i < 0) i += n;
+    }
+    return i;
+}
+
+static inline void tri_setup(const atmos_sim *s, int nz_f, double x, double y, double z, tri *t)
 {
     const int nx = s->nx, ny = s->ny;
     if (z < 0) z = 0;
     if (z > nz_f - 1) z = nz_f - 1;
     const double fx0 = floor(x), fy0 = floor(y), fz0 = floor(z);
-    const float ax = (float)(x - fx0), ay = (float)(y - fy0), az = (float)(z - fz0);
-    int i0 = (int)fx0 % nx, j0 = (int)fy0 % ny, k0 = (int)fz0;
-    if (i0 < 0) i0 += nx;
-    if (j0 < 0) j0 += ny;
-    const int i1 = i0 + 1 == nx ? 0 : i0 + 1, j1 = j0 + 1 == ny ? 0 : j0 + 1, k1 = k0 + 1 < nz_f ? k0 + 1 : k0;
-    const size_t l0 = (size_t)k0 * nx * ny, l1 = (size_t)k1 * nx * ny, r0 = (size_t)j0 * nx, r1 = (size_t)j1 * nx;
-    const float c00 = f[l0 + r0 + i0] + ax * (f[l0 + r0 + i1] - f[l0 + r0 + i0]);
-    const float c01 = f[l0 + r1 + i0] + ax * (f[l0 + r1 + i1] - f[l0 + r1 + i0]);
-    const float c10 = f[l1 + r0 + i0] + ax * (f[l1 + r0 + i1] - f[l1 + r0 + i0]);
-    const float c11 = f[l1 + r1 + i0] + ax * (f[l1 + r1 + i1] - f[l1 + r1 + i0]);
-    const float c0 = c00 + ay * (c01 - c00), c1 = c10 + ay * (c11 - c10);
-    return c0 + az * (c1 - c0);
+    t->ax = (float)(x - fx0), t->ay = (float)(y - fy0), t->az = (float)(z - fz0);
+    const int i0 = wrap((int)fx0, nx), j0 = wrap((int)fy0, ny), k0 = (int)fz0;
+    const int j1 = j0 + 1 == ny ? 0 : j0 + 1, k1 = k0 + 1 < nz_f ? k0 + 1 : k0;
+    t->i0 = i0, t->i1 = i0 + 1 == nx ? 0 : i0 + 1;
+    const size_t l0 = (size_t)k0 * nx * ny, l1 = (size_t)k1 * nx * ny;
+    t->c[0] = l0 + (size_t)j0 * nx, t->c[1] = l0 + (size_t)j1 * nx;
+    t->c[2] = l1 + (size_t)j0 * nx, t->c[3] = l1 + (size_t)j1 * nx;
+}
+
+static inline float tri_eval(const float *f, const tri *t)
+{
+    const int i0 = t->i0, i1 = t->i1;
+    const float c00 = f[t->c[0] + i0] + t->ax * (f[t->c[0] + i1] - f[t->c[0] + i0]);
+    const float c01 = f[t->c[1] + i0] + t->ax * (f[t->c[1] + i1] - f[t->c[1] + i0]);
+    const float c10 = f[t->c[2] + i0] + t->ax * (f[t->c[2] + i1] - f[t->c[2] + i0]);
+    const float c11 = f[t->c[3] + i0] + t->ax * (f[t->c[3] + i1] - f[t->c[3] + i0]);
+    const float c0 = c00 + t->ay * (c01 - c00), c1 = c10 + t->ay * (c11 - c10);
+    return c0 + t->az * (c1 - c0);
+}
+
+static inline float sample(const atmos_sim *s, const float *f, int nz_f, double x, double y, double z)
+{
+    tri t;
+    tri_setup(s, nz_f, x, y, z, &t);
+    return tri_eval(f, &t);
 }
 
 /* The velocity (cells per second times dx) at a point given in cell-centre index space. */
@@ -52,8 +81,9 @@ static void advect_scalars(atmos_sim *s, double dt)
                 const double wc = 0.5 * (s->w[n] + s->w[n + (size_t)nx * ny]);
                 double v[3];
                 velocity(s, i - 0.5 * c * uc, j - 0.5 * c * vc, k - 0.5 * c * wc, v);
-                const double x = i - c * v[0], y = j - c * v[1], z = k - c * v[2];
-                for (int f = 0; f < 4; f++) dst[f][n] = sample(s, src[f], s->nz, x, y, z);
+                tri t;
+                tri_setup(s, s->nz, i - c * v[0], j - c * v[1], k - c * v[2], &t);
+                for (int f = 0; f < 4; f++) dst[f][n] = tri_eval(src[f], &t);
             }
     float *t;
     t = s->th, s->th = s->s[0], s->s[0] = t;
@@ -62,32 +92,41 @@ static void advect_scalars(atmos_sim *s, double dt)
     t = s->qr, s->qr = s->s[3], s->s[3] = t;
 }
 
-/* The new velocity into s[4..6] from the old one (each face traced from itself: in a field's
- * own index space the departure point is its index minus dt v / dx). */
+/* The new velocity into s[4..6] from the old one (each face traced from itself with its own
+ * component and the other two averaged from the four nearest faces; in a field's own index
+ * space the departure point is its index minus dt v / dx). */
 static void advect_velocity(atmos_sim *s, double dt)
 {
     const int nx = s->nx, ny = s->ny, nz = s->nz;
+    const size_t lev = (size_t)nx * ny;
     const double c = dt / s->dx;
+    const float *u = s->u, *v = s->v, *w = s->w;
     float *nu = s->s[4], *nv = s->s[5], *nw = s->s[6];
 #pragma omp parallel for schedule(static) num_threads(s->threads)
     for (int k = 0; k <= nz; k++)
-        for (int j = 0; j < ny; j++)
+        for (int j = 0; j < ny; j++) {
+            const size_t r = (size_t)k * lev + (size_t)j * nx;
+            const size_t rm = (size_t)k * lev + (size_t)(j ? j - 1 : ny - 1) * nx;
+            const size_t rp = (size_t)k * lev + (size_t)(j + 1 == ny ? 0 : j + 1) * nx;
             for (int i = 0; i < nx; i++) {
-                const size_t n = sim_idx(s, i, j, k);
-                double v[3];
+                const int im = i ? i - 1 : nx - 1, ip = i + 1 == nx ? 0 : i + 1;
                 if (k < nz) { /* u on the face x = i - 1/2, v on y = j - 1/2 */
-                    velocity(s, i - 0.5, j, k, v);
-                    nu[n] = sample(s, s->u, nz, i - c * s->u[n], j - c * v[1], k - c * v[2]);
-                    velocity(s, i, j - 0.5, k, v);
-                    nv[n] = sample(s, s->v, nz, i - c * v[0], j - c * s->v[n], k - c * v[2]);
+                    const double vu = 0.25 * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
+                    const double wu = 0.25 * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
+                    nu[r + i] = sample(s, u, nz, i - c * u[r + i], j - c * vu, k - c * wu);
+                    const double uv = 0.25 * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
+                    const double wv = 0.25 * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
+                    nv[r + i] = sample(s, v, nz, i - c * uv, j - c * v[r + i], k - c * wv);
                 }
                 if (k == 0 || k == nz) {
-                    nw[n] = 0;
+                    nw[r + i] = 0;
                 } else { /* w on the face z = k - 1/2 */
-                    velocity(s, i, j, k - 0.5, v);
-                    nw[n] = sample(s, s->w, nz + 1, i - c * v[0], j - c * v[1], k - c * s->w[n]);
+                    const double uw = 0.25 * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
+                    const double vw = 0.25 * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);
+                    nw[r + i] = sample(s, w, nz + 1, i - c * uw, j - c * vw, k - c * w[r + i]);
                 }
             }
+        }
 }
 
 /* Sum of q_v + q_c + q_r (and of q_v alone), level by level in order: the same for any

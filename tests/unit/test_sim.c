@@ -261,8 +261,42 @@ static void test_volume(void)
     atmos_context_destroy(c);
 }
 
+/* A scene names a simulation: its settings parsed, bad ones refused with the key's path. */
+static void test_scene(void)
+{
+    atmos_context *c = make_ctx(1);
+    atmos_scene sc;
+    const char *good = "{\"volume\": {\"simulate\": {\"preset\": \"stratocumulus\", \"minutes\": 2, \"grid\": 16, "
+                       "\"seed\": 5}, \"position_m\": [0, 0, -3000]}}";
+    CHECK_OK(atmos_scene_parse(c, good, strlen(good), "test", &sc));
+    CHECK(!strcmp(sc.volume.source, "simulate:stratocumulus") && sc.volume.sim_minutes == 2 && sc.volume.sim_grid == 16 &&
+          sc.volume.seed == 5);
+    atmos_volume *v = NULL;
+    double off[3];
+    CHECK_OK(atmos_scene_load_volume(c, &sc, &v, off));
+    CHECK(v && atmos_volume_field_count(v) == 2);
+    atmos_volume_destroy(v);
+    const char *bad[] = {
+        "{\"volume\": {\"simulate\": {\"preset\": \"cirrus\"}}}",
+        "{\"volume\": {\"simulate\": {\"minutes\": 3}}}",
+        "{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\", \"grid\": 8}}}",
+        "{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\", \"minutes\": 0}}}",
+        "{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\", \"wind\": 3}}}",
+        "{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\"}, \"generate\": \"storm\"}}",
+        "{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\"}, \"seed\": 3}}",
+        "{\"volume\": {\"simulate\": \"cumulonimbus\"}}",
+    };
+    for (int i = 0; i < (int)(sizeof bad / sizeof bad[0]); i++) {
+        const atmos_status st = atmos_scene_parse(c, bad[i], strlen(bad[i]), "test", &sc);
+        CHECK_MSG(st == ATMOS_E_INVALID_ARG, "accepted: %s", bad[i]);
+        if (i == 0) CHECK(strstr(atmos_context_error(c), "towering_cumulus") != NULL);
+    }
+    atmos_context_destroy(c);
+}
+
 int main(void)
 {
+    test_scene();
     test_adjust();
     test_bad();
     test_volume();
