@@ -18,6 +18,7 @@ static double time_step(const atmos_sim *s)
 #pragma omp parallel for schedule(static) reduction(max : m) num_threads(s->threads)
         for (size_t n = 0; n < len_a; n++) m = fmaxf(m, fabsf(p[n]));
     }
+    if (m != m || m > 1e30f) return 0.0; /* NaN or overflow: unstable */
     const double dt = m > 0 ? 1.5 * s->dx / m : s->dt_max;
     return fmin(dt, s->dt_max);
 }
@@ -51,10 +52,11 @@ atmos_status atmos_sim_run(atmos_context *ctx, atmos_sim *s, double seconds)
     if (atmos__progress(ctx, "simulate", 0.0)) return atmos__error(ctx, ATMOS_E_CANCELLED, "simulate: cancelled");
     while (s->t < end - 1e-9) {
         double dt = time_step(s);
+        /* winds over 300 m/s (or NaN) mean the model has blown up: stop rather than crawl */
+        if (!(dt >= 1.5 * s->dx / 300.0) || !isfinite(s->th[0]))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: the model became unstable at t = %g s", s->t);
         if (s->t + dt > end) dt = end - s->t;
         advance(s, dt);
-        if (!isfinite(s->th[0]))
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: the model became unstable at t = %g s", s->t);
         if (atmos__progress(ctx, "simulate", seconds > 0 ? 1.0 - (end - s->t) / seconds : 1.0))
             return atmos__error(ctx, ATMOS_E_CANCELLED, "simulate: cancelled at t = %g s", s->t);
     }
