@@ -24,14 +24,22 @@ static inline int wrap(int i, int n)
     return i;
 }
 
+/* floor() without the library call (the baseline x86-64 target has no rounding instruction);
+ * positions stay far inside int's range. */
+static inline int ifloor(double x)
+{
+    const int i = (int)x;
+    return i - (x < i);
+}
+
 static inline void tri_setup(const atmos_sim *s, int nz_f, double x, double y, double z, tri *t)
 {
     const int nx = s->nx, ny = s->ny;
     if (z < 0) z = 0;
     if (z > nz_f - 1) z = nz_f - 1;
-    const double fx0 = floor(x), fy0 = floor(y), fz0 = floor(z);
+    const int fx0 = ifloor(x), fy0 = ifloor(y), fz0 = ifloor(z);
     t->ax = (float)(x - fx0), t->ay = (float)(y - fy0), t->az = (float)(z - fz0);
-    const int i0 = wrap((int)fx0, nx), j0 = wrap((int)fy0, ny), k0 = (int)fz0;
+    const int i0 = wrap(fx0, nx), j0 = wrap(fy0, ny), k0 = fz0;
     const int j1 = j0 + 1 == ny ? 0 : j0 + 1, k1 = k0 + 1 < nz_f ? k0 + 1 : k0;
     t->i0 = i0, t->i1 = i0 + 1 == nx ? 0 : i0 + 1;
     const size_t l0 = (size_t)k0 * nx * ny, l1 = (size_t)k1 * nx * ny;
@@ -57,32 +65,33 @@ static inline float sample(const atmos_sim *s, const float *f, int nz_f, double 
     return tri_eval(f, &t);
 }
 
-/* The velocity (cells per second times dx) at a point given in cell-centre index space. */
-static inline void velocity(const atmos_sim *s, double x, double y, double z, double v[3])
-{
-    v[0] = sample(s, s->u, s->nz, x + 0.5, y, z);
-    v[1] = sample(s, s->v, s->nz, x, y + 0.5, z);
-    v[2] = sample(s, s->w, s->nz + 1, x, y, z + 0.5);
-}
-
 static void advect_scalars(atmos_sim *s, double dt)
 {
     const int nx = s->nx, ny = s->ny;
+    const size_t lev = (size_t)nx * ny;
     const double c = dt / s->dx;
     const float *src[4] = {s->th, s->qv, s->qc, s->qr};
     float *dst[4] = {s->s[0], s->s[1], s->s[2], s->s[3]};
+    float *uc = s->s[8], *vc = s->s[9], *wc = s->s[10];
+    /* the velocity at the cell centres: the trace's first stage and its midpoint samples */
 #pragma omp parallel for schedule(static) num_threads(s->threads)
     for (int k = 0; k < s->nz; k++)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx; i++) {
                 const size_t n = sim_idx(s, i, j, k);
-                const double uc = 0.5 * (s->u[n] + s->u[sim_idx(s, i + 1 == nx ? 0 : i + 1, j, k)]);
-                const double vc = 0.5 * (s->v[n] + s->v[sim_idx(s, i, j + 1 == ny ? 0 : j + 1, k)]);
-                const double wc = 0.5 * (s->w[n] + s->w[n + (size_t)nx * ny]);
-                double v[3];
-                velocity(s, i - 0.5 * c * uc, j - 0.5 * c * vc, k - 0.5 * c * wc, v);
+                uc[n] = 0.5f * (s->u[n] + s->u[sim_idx(s, i + 1 == nx ? 0 : i + 1, j, k)]);
+                vc[n] = 0.5f * (s->v[n] + s->v[sim_idx(s, i, j + 1 == ny ? 0 : j + 1, k)]);
+                wc[n] = 0.5f * (s->w[n] + s->w[n + lev]);
+            }
+#pragma omp parallel for schedule(static) num_threads(s->threads)
+    for (int k = 0; k < s->nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                const size_t n = sim_idx(s, i, j, k);
                 tri t;
-                tri_setup(s, s->nz, i - c * v[0], j - c * v[1], k - c * v[2], &t);
+                tri_setup(s, s->nz, i - 0.5 * c * uc[n], j - 0.5 * c * vc[n], k - 0.5 * c * wc[n], &t);
+                const double vx = tri_eval(uc, &t), vy = tri_eval(vc, &t), vz = tri_eval(wc, &t);
+                tri_setup(s, s->nz, i - c * vx, j - c * vy, k - c * vz, &t);
                 for (int f = 0; f < 4; f++) dst[f][n] = tri_eval(src[f], &t);
             }
     float *t;

@@ -54,7 +54,7 @@ struct atmos_sim {
     double dx, dt_max;
     size_t n, nw;                 /* cells; w faces (nx ny (nz + 1)) */
     float *u, *v, *w, *th, *qv, *qc, *qr;
-    float *s[8];                  /* scratch arrays of nw floats */
+    float *s[11];                 /* scratch arrays of nw floats */
     /* base state at the cell-centre levels z_k = (k + 0.5) dx */
     double *th0, *qv0, *pi0, *p0, *rho0, *ue;
     double rho_ref;               /* Boussinesq reference density (the budget's) */
