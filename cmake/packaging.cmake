@@ -18,7 +18,7 @@ install(FILES ${CMAKE_BINARY_DIR}/atmos-config.cmake ${CMAKE_BINARY_DIR}/atmos-c
         DESTINATION ${ATMOS_CMAKE_DIR})
 
 # pkg-config: what a static link needs beyond libatmos.a, by the build's options.
-set(ATMOS_PC_REQUIRES_PRIVATE "libpng libcjson libjpeg OpenEXR tinyobjloader")
+set(ATMOS_PC_REQUIRES_PRIVATE "libpng libcjson libjpeg OpenEXR tinyobjloader fftw3f")
 set(ATMOS_PC_LIBS_PRIVATE "-fopenmp -lm")
 if(ATMOS_HAVE_NETCDF)
   string(APPEND ATMOS_PC_REQUIRES_PRIVATE " netcdf")

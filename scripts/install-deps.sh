@@ -3,12 +3,12 @@
 # arguments, those packages instead (scripts/install-bench-deps.sh).
 # Safe to run repeatedly: it does nothing when everything is present.
 set -eu
-# Images: libpng, libjpeg (maps of the Earth), OpenEXR. Meshes: tinyobjloader (OBJ files), GDAL (terrain height maps). Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
+# FFTW 3 for the cloud simulation's pressure solver. Images: libpng, libjpeg (maps of the Earth), OpenEXR. Meshes: tinyobjloader (OBJ files), GDAL (terrain height maps). Volume readers: NetCDF (WRF/CM1), NanoVDB (PNanoVDB.h), OpenVDB (+ the Boost headers
 # its headers include, which Debian does not pull in); gnuplot for 'atmos phase --plot'; SDL2, SDL2_ttf
 # and the DejaVu fonts for 'atmos view', Xvfb (and xauth for xvfb-run) for its tests.
 # help2man writes the man pages from the CLI's help text; the Python package needs cffi, NumPy and
 # Python's headers, its tests pytest and pip; atmos render --mpi Open MPI.
-PKGS="build-essential cmake pkg-config libpng-dev libjpeg-dev libopenexr-dev libcjson-dev libtinyobjloader-dev libgdal-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3 libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth help2man python3-dev python3-cffi python3-numpy python3-pytest python3-pip libopenmpi-dev openmpi-bin"
+PKGS="build-essential cmake pkg-config libfftw3-dev libpng-dev libjpeg-dev libopenexr-dev libcjson-dev libtinyobjloader-dev libgdal-dev libnetcdf-dev libnanovdb-dev libopenvdb-dev libboost-dev gnuplot-nox python3 libsdl2-dev libsdl2-ttf-dev fonts-dejavu-core xvfb xauth help2man python3-dev python3-cffi python3-numpy python3-pytest python3-pip libopenmpi-dev openmpi-bin"
 [ $# -gt 0 ] && PKGS="$*"
 missing=""
 for p in $PKGS; do

@@ -30,5 +30,6 @@
 #include "atmos/path.h"
 #include "atmos/plan.h"
 #include "atmos/mesh.h"
+#include "atmos/sim.h"
 
 #endif

@@ -54,7 +54,8 @@ typedef enum {
 typedef struct atmos_scene_volume {
     char source[ATMOS_SCENE_PATH_MAX]; /* a file (.vdb .nvdb .nc .json; relative paths are resolved
                                           against the scene file's folder by atmos_scene_load) or
-                                          "generate:PRESET" */
+                                          "generate:PRESET" or "simulate:PRESET" (the cloud
+                                          simulation, atmos/sim.h) */
     char grids[256];          /* VDB grid / NetCDF variable names, comma-separated ("" = reader default) */
     char particle[64];        /* particle type of a single-grid file: a preset or a "particles"
                                  entry ("" = "cloud") */
@@ -69,6 +70,8 @@ typedef struct atmos_scene_volume {
     double subgrid_detail;    /* NetCDF: artists' sub-grid detail amplitude, 0 = off (atmos_volume_load_desc) */
     int placed;               /* 1: position_m given; 0: atmos_scene_volume_offset's default */
     double position_m[3];     /* world position of the centre of the bottom face of the volume's box */
+    double sim_minutes;       /* "simulate": simulated minutes (0 = the preset's default) */
+    int sim_grid;             /* "simulate": horizontal cells (0 = 64); the seed is `seed` */
 } atmos_scene_volume;
 
 /* Settings of the slice renderer ("slice" in the file). Their ranges, defaults and meaning

@@ -326,7 +326,8 @@ atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t
      * be rendered from anywhere. */
     atmos_scene_volume *v = &out->volume;
     const char *slash = in ? NULL : strrchr(path, '/'); /* from standard input: the current folder */
-    if (st == ATMOS_OK && v->source[0] && v->source[0] != '/' && strncmp(v->source, "generate:", 9) && slash) {
+    if (st == ATMOS_OK && v->source[0] && v->source[0] != '/' && strncmp(v->source, "generate:", 9) &&
+        strncmp(v->source, "simulate:", 9) && slash) {
         size_t dir = (size_t)(slash - path) + 1, n = strlen(v->source);
         if (dir + n >= sizeof v->source)
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /volume/file: the path is too long once joined to the scene's folder",

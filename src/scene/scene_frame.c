@@ -10,7 +10,8 @@ atmos_status atmos_scene_frame_volume_file(atmos_context *ctx, atmos_scene *scen
                                            atmos_volume **out)
 {
     *out = NULL;
-    const int file = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) != 0;
+    const int file = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) != 0 &&
+                     strncmp(scene->volume.source, "simulate:", 9) != 0;
     if (!file || scene->renderer == ATMOS_RENDERER_SKY || scene->camera_given || scene->camera.type != ATMOS_CAMERA_PINHOLE)
         return ATMOS_OK;
     double off[3], lo[3], hi[3];

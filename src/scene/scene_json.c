@@ -906,12 +906,47 @@ static atmos_status parse_background(const jp *p, const cJSON *j, const char *pa
     return ATMOS_OK;
 }
 
+/* "simulate": {"preset": NAME, "minutes": M, "grid": N, "seed": S} (atmos/sim.h). */
+static atmos_status parse_simulate(const jp *p, const cJSON *j, const char *path, atmos_scene_volume *vol)
+{
+    static const char *const keys[] = {"preset", "minutes", "grid", "seed"};
+    static const atmos__range r_min = {0, ATMOS_SIM_MAX_MINUTES, 1, 0}, r_grid = {ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID, 0, 0};
+    obj_iter it;
+    char ip[PATH_CAP], buf[64];
+    const cJSON *v;
+    int k;
+    TRY(iter_begin(p, j, path, keys, 4, &it));
+    for (;;) {
+        TRY(iter_next(p, &it, &k, &v, ip));
+        if (k < 0) break;
+        switch (k) {
+        case 0: {
+            TRY(get_text(p, v, ip, buf, sizeof buf));
+            if (!atmos_sim_preset_minutes(buf)) {
+                char list[256] = "";
+                for (const char *const *n = atmos_sim_preset_names(); *n; n++)
+                    snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", *n, n[1] ? ", " : "");
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip, "unknown preset (known: %s)", list);
+            }
+            snprintf(vol->source, sizeof vol->source, "simulate:%s", buf);
+            break;
+        }
+        case 1: TRY(get_number(p, v, ip, &r_min, NULL, &vol->sim_minutes)); break;
+        case 2: TRY(get_int(p, v, ip, &r_grid, &vol->sim_grid)); break;
+        case 3: TRY(get_u64(p, v, ip, &r_seed, &vol->seed)); break;
+        }
+    }
+    if (!(it.seen & 1u)) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "missing key \"preset\"");
+    return ATMOS_OK;
+}
+
 static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"file",  "generate", "grids", "particle",   "density_scale", "time_index",
-                                       "voxel_size_m", "seed", "scale", "position_m", "density_unit", "subgrid_detail"};
+    static const char *const keys[] = {"file",         "generate", "grids", "particle",   "density_scale",
+                                       "time_index",   "voxel_size_m", "seed",  "scale",  "position_m",
+                                       "density_unit", "subgrid_detail", "simulate"};
     static const char *const units[] = {"auto", "per_m3", "g_m3", "fraction"};
-    enum { K_FILE, K_GEN, K_GRIDS, K_PARTICLE, K_DSCALE, K_TIME, K_VOXEL, K_SEED, K_SCALE, K_POS, K_UNIT, K_DETAIL };
+    enum { K_FILE, K_GEN, K_GRIDS, K_PARTICLE, K_DSCALE, K_TIME, K_VOXEL, K_SEED, K_SCALE, K_POS, K_UNIT, K_DETAIL, K_SIM };
     static const atmos__range r_detail = {0, 1, 0, 0};
     const atmos__range *pos_r[3] = {&atmos__r_pos, &atmos__r_pos, &atmos__r_pos};
     atmos_scene_volume vol = s->volume;
@@ -919,7 +954,7 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
     char ip[PATH_CAP], buf[64];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 12, &it));
+    TRY(iter_begin(p, j, path, keys, 13, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -930,6 +965,7 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
             vol.density_unit = (atmos_density_unit)u;
             break;
         }
+        case K_SIM: TRY(parse_simulate(p, v, ip, &vol)); break;
         case K_FILE:
         case K_GEN:
             if (it.seen & (k == K_FILE ? 1u << K_GEN : 1u << K_FILE))
@@ -991,8 +1027,24 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
             break;
         }
     }
-    if (!(it.seen & (1u << K_FILE | 1u << K_GEN)))
-        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"file\" or \"generate\"");
+    const unsigned sources = it.seen & (1u << K_FILE | 1u << K_GEN | 1u << K_SIM);
+    if (!sources)
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "needs \"file\", \"generate\" or \"simulate\"");
+    if (sources & (sources - 1))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "\"file\", \"generate\" and \"simulate\" exclude each other");
+    if (it.seen & (1u << K_SIM)) {
+        static const int sim_bad[] = {K_GRIDS, K_TIME, K_UNIT, K_DETAIL, K_SEED, K_VOXEL, K_SCALE, K_PARTICLE};
+        for (int i = 0; i < 8; i++)
+            if (it.seen & (1u << sim_bad[i]))
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                         "\"%s\" does not apply to a simulated volume (its settings go inside "
+                                         "\"simulate\": preset, minutes, grid, seed)",
+                                         keys[sim_bad[i]]);
+        s->volume = vol;
+        return ATMOS_OK;
+    }
     /* The keys one kind of volume would ignore are refused with it. */
     static const int file_only[] = {K_GRIDS, K_TIME, K_UNIT, K_DETAIL}, gen_only[] = {K_SEED};
     const int is_file = (it.seen & (1u << K_FILE)) != 0;

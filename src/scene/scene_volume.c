@@ -49,6 +49,14 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         gd.voxel_size_m = sv->voxel_size_m;
         gd.scale = sv->scale > 0 ? sv->scale : 1.0;
         st = atmos_scene_generate_volume(ctx, sv->source + 9, &gd, &vol);
+    } else if (!strncmp(sv->source, "simulate:", 9)) {
+        atmos_sim_desc sd;
+        memset(&sd, 0, sizeof sd);
+        sd.preset = sv->source + 9;
+        sd.minutes = sv->sim_minutes;
+        sd.grid = sv->sim_grid;
+        sd.seed = sv->seed;
+        st = atmos_simulate(ctx, &sd, &vol);
     } else {
         atmos_volume_load_desc ld;
         memset(&ld, 0, sizeof ld);

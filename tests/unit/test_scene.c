@@ -303,7 +303,7 @@ static const bad_case bad_renderers[] = {
     {"{\"volume\": {\"file\": \"a.vdb\", \"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume/generate: \"file\" and \"generate\" exclude each other", NULL},
     {"{\"volume\": {\"file\": \"\"}}", ATMOS_E_INVALID_ARG, "/volume/file: must not be empty", NULL},
     {"{\"volume\": {\"file\": \"generate:storm\"}}", ATMOS_E_INVALID_ARG, "/volume/file: use \"generate\": \"storm\"", NULL},
-    {"{\"volume\": {\"density_scale\": 2}}", ATMOS_E_INVALID_ARG, "/volume: needs \"file\" or \"generate\"", NULL},
+    {"{\"volume\": {\"density_scale\": 2}}", ATMOS_E_INVALID_ARG, "/volume: needs \"file\", \"generate\" or \"simulate\"", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"density_scale\": 0}}", ATMOS_E_INVALID_ARG, "/volume/density_scale: must be in (0, 1e+30], got 0", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"grids\": \"cloud\"}}", ATMOS_E_INVALID_ARG, "/volume/grids: expected an array of grid names, got a string", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"grids\": []}}", ATMOS_E_INVALID_ARG, "/volume/grids: must not be empty", NULL},

@@ -77,6 +77,7 @@ int cli_cmd_phase(int argc, char **argv);
 int cli_cmd_cache(int argc, char **argv);
 int cli_cmd_mie(int argc, char **argv);
 int cli_cmd_volume(int argc, char **argv);
+int cli_cmd_simulate(int argc, char **argv);
 int cli_cmd_compare(int argc, char **argv);
 int cli_cmd_view(int argc, char **argv); /* tools/view/ */
 

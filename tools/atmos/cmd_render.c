@@ -338,7 +338,10 @@ static int check_outputs(const render_opts *o, const atmos_scene *scene, const c
             return cli_usage_error("render", "%s %s: expected a %s file name", out_option[i], names[i], ext[want[i]]);
         cli_outputs_add(&set, out_option[i], names[i]);
     }
-    const char *vol = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) ? scene->volume.source : NULL;
+    const char *vol = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) &&
+                              strncmp(scene->volume.source, "simulate:", 9)
+                          ? scene->volume.source
+                          : NULL;
     const char *inputs[2] = {o->scene_path, vol};
     return cli_outputs_check("render", &set, inputs, 2);
 }

@@ -422,7 +422,7 @@ static int apply_volume_file(const render_opts *o, atmos_scene *s)
     if (!s->volume.source[0])
         return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit, --voxel-size and --volume-scale "
                                   "need a volume (--volume or a scene with one)");
-    if (given && !strncmp(s->volume.source, "generate:", 9))
+    if (given && (!strncmp(s->volume.source, "generate:", 9) || !strncmp(s->volume.source, "simulate:", 9)))
         return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit and --subgrid-detail apply to a "
                                   "volume file, not to a generated volume");
     if (o->grids) snprintf(s->volume.grids, sizeof s->volume.grids, "%s", o->grids);

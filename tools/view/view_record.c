@@ -115,10 +115,19 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
     cJSON_DeleteItemFromObjectCaseSensitive(root, "animation");
     if (sc->volume.source[0]) {
         cJSON *vol = object(root, "volume");
-        const int gen = !strncmp(sc->volume.source, "generate:", 9);
-        static const char *const src_keys[] = {"file", "generate"};
-        clear(vol, src_keys, 2);
-        set(vol, gen ? "generate" : "file", cJSON_CreateString(gen ? sc->volume.source + 9 : sc->volume.source));
+        const int gen = !strncmp(sc->volume.source, "generate:", 9), sim = !strncmp(sc->volume.source, "simulate:", 9);
+        static const char *const src_keys[] = {"file", "generate", "simulate"};
+        clear(vol, src_keys, 3);
+        if (sim) { /* the scene's own simulation settings, as parsed */
+            cJSON *o = cJSON_CreateObject();
+            cJSON_AddStringToObject(o, "preset", sc->volume.source + 9);
+            if (sc->volume.sim_minutes > 0) cJSON_AddNumberToObject(o, "minutes", sc->volume.sim_minutes);
+            if (sc->volume.sim_grid > 0) cJSON_AddNumberToObject(o, "grid", sc->volume.sim_grid);
+            cJSON_AddNumberToObject(o, "seed", (double)sc->volume.seed);
+            set(vol, "simulate", o);
+        } else {
+            set(vol, gen ? "generate" : "file", cJSON_CreateString(gen ? sc->volume.source + 9 : sc->volume.source));
+        }
     }
     char *text = cJSON_Print(root);
     cJSON_Delete(root);

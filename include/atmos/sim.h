@@ -1,0 +1,78 @@
+/* A cloud-physics simulation as a volume source (docs/clouds.md): a 3-D Boussinesq fluid on
+ * a staggered (MAC) grid with potential temperature, water vapour, cloud water and rain,
+ * semi-Lagrangian advection, vorticity confinement, buoyancy from temperature and water
+ * loading, an exact FFT pressure projection (periodic sides, rigid ground and lid), Kessler
+ * warm rain and saturation adjustment with latent heat. Its state is handed to the renderers
+ * as an atmos volume ("cloud" and "rain" number densities through the particle types' mean
+ * masses, like the WRF reader).
+ *
+ * Deterministic: the same preset, grid and seed give the same bytes for any thread count.
+ */
+#ifndef ATMOS_SIM_H
+#define ATMOS_SIM_H
+
+#include "atmos/base.h"
+#include "atmos/volume.h"
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ATMOS_SIM_MIN_GRID 16
+#define ATMOS_SIM_MAX_GRID 512
+#define ATMOS_SIM_MAX_MINUTES 600.0
+
+/* What to simulate; zero means default where stated. */
+typedef struct atmos_sim_desc {
+    const char *preset;  /* "cumulus_field", "towering_cumulus", "cumulonimbus", "stratocumulus" */
+    double minutes;      /* simulated time for atmos_simulate; 0 = the preset's default */
+    int grid;            /* cells along each horizontal side, in [ATMOS_SIM_MIN_GRID,
+                            ATMOS_SIM_MAX_GRID]; 0 = 64. The domain's size is the preset's: a finer
+                            grid has smaller (cubic) cells */
+    uint64_t seed;       /* the random perturbations (bubble places, surface-flux noise) */
+} atmos_sim_desc;
+
+typedef struct atmos_sim atmos_sim;
+
+/* The presets, NULL-terminated. */
+ATMOS_API const char *const *atmos_sim_preset_names(void);
+/* A preset's default simulated time, minutes (0 for an unknown name). */
+ATMOS_API double atmos_sim_preset_minutes(const char *preset);
+
+/* Builds the initial state (the preset's sounding and triggers). Unknown presets and
+ * out-of-range values: ATMOS_E_INVALID_ARG naming the known presets / the range. */
+ATMOS_API atmos_status atmos_sim_create(atmos_context *ctx, const atmos_sim_desc *desc, atmos_sim **out);
+ATMOS_API void atmos_sim_destroy(atmos_sim *sim);
+/* Advances by one time step (chosen from the flow's speed, at most the preset's maximum). */
+ATMOS_API atmos_status atmos_sim_step(atmos_context *ctx, atmos_sim *sim);
+/* Advances by `seconds`, reporting progress (stage "simulate") through ctx; the progress
+ * callback may cancel (ATMOS_E_CANCELLED). */
+ATMOS_API atmos_status atmos_sim_run(atmos_context *ctx, atmos_sim *sim, double seconds);
+
+typedef struct atmos_sim_stats {
+    int dims[3];            /* cells along x, y (horizontal) and z (up) */
+    double cell_m;          /* cell edge, metres */
+    double time_s;          /* simulated time */
+    long steps;
+    double water;           /* vapour + cloud + rain in the domain, kg per m^2 of ground (Boussinesq
+                               reference density) */
+    double rain_out;        /* rain that fell through the ground, kg m^-2 */
+    double surface_in;      /* water the surface moisture flux added, kg m^-2 */
+    double max_w;           /* largest updraught, m/s */
+    double max_qc, max_qr;  /* largest cloud and rain mixing ratios, kg/kg */
+    double cloud_base_m, cloud_top_m; /* lowest and highest cell centre with q_c > 1e-5 (-1: no cloud) */
+} atmos_sim_stats;
+ATMOS_API void atmos_sim_get_stats(const atmos_sim *sim, atmos_sim_stats *out);
+
+/* The state as a volume: fields "cloud" and "rain" (number densities, m^-3: q rho / m, m from
+ * atmos_particle_mean_mass), voxels the model's cells, y up with the ground at y = 0 and the
+ * domain centred on x = z = 0. */
+ATMOS_API atmos_status atmos_sim_to_volume(atmos_context *ctx, const atmos_sim *sim, atmos_volume **out);
+/* create + run(desc->minutes, or the preset's default) + to_volume. */
+ATMOS_API atmos_status atmos_simulate(atmos_context *ctx, const atmos_sim_desc *desc, atmos_volume **out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

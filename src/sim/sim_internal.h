@@ -1,0 +1,106 @@
+/* The cloud simulation's state and its steps (docs/clouds.md). Fields live on a staggered
+ * (MAC) grid of nx * ny * nz cubic cells of edge dx, z up, x and y periodic: scalars at cell
+ * centres, u and v on the x and y faces (u[i] between cells i-1 and i), w on the nz + 1
+ * horizontal faces (w = 0 at the ground and the lid). Index (k ny + j) nx + i. */
+#ifndef ATMOS_SIM_INTERNAL_H
+#define ATMOS_SIM_INTERNAL_H
+
+#include "atmos/sim.h"
+#include "core/internal.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Physical constants (SI). */
+#define SIM_G 9.81
+#define SIM_CP 1004.0
+#define SIM_RD 287.0
+#define SIM_LV 2.5e6
+#define SIM_P00 1e5
+#define SIM_EPS 0.622
+
+/* The environment and the triggers of a run (a preset is one of these). */
+typedef enum { SIM_SOUNDING_LAYERED = 0, SIM_SOUNDING_WK82 = 1 } sim_sounding_kind;
+typedef struct sim_env {
+    sim_sounding_kind kind;
+    double domain_m, height_m;    /* horizontal side and depth of the domain */
+    double minutes;               /* default simulated time */
+    double dt_max;                /* longest step, s */
+    /* layered sounding: theta_s up to zi (mixed layer), a jump dtheta_inv over inv_depth, then
+     * gamma_ft (K/m) up to z_tp, gamma_strat above; vapour qv_bl in the mixed layer, above
+     * qv_ft exp(-(z - zi - inv_depth) / hq) */
+    double theta_s, zi, dtheta_inv, inv_depth, gamma_ft, z_tp, gamma_strat;
+    double qv_bl, qv_ft, hq;
+    /* Weisman & Klemp (1982): theta = theta_s + (theta_tr - theta_s) (z / z_tp)^1.25 below z_tp,
+     * RH = 1 - 0.75 (z / z_tp)^1.25, vapour at most qv_bl */
+    double theta_tr, t_tr;
+    /* wind: u = u_s tanh(z / z_shear) - u_move, v = 0 */
+    double u_s, z_shear, u_move;
+    /* warm bubbles: count, horizontal and vertical radii, centre height, theta excess (K),
+     * vapour excess (kg/kg); placed at random (seeded) when count > 1, else at the centre */
+    int bubbles;
+    double bubble_rh, bubble_rv, bubble_z, bubble_dth, bubble_dqv;
+    /* surface fluxes: kinematic heat (K m/s) and moisture (kg/kg m/s), each cell's times
+     * 1 + flux_noise (2 r - 1), r uniform (seeded, new every step) */
+    double shf, lhf, flux_noise;
+    double noise_th;              /* initial theta noise amplitude below zi, at least 1 km (K) */
+    double top_cooling;           /* cloud-top radiative cooling, W m^-2 (0 = none) */
+    double confinement;           /* vorticity confinement epsilon (Fedkiw et al. 2001) */
+    int micro;                    /* 0: dry (no phase changes) */
+} sim_env;
+
+struct atmos_sim {
+    int nx, ny, nz, threads;
+    double dx, dt_max;
+    size_t n, nw;                 /* cells; w faces (nx ny (nz + 1)) */
+    float *u, *v, *w, *th, *qv, *qc, *qr;
+    float *s[11];                 /* scratch arrays of nw floats */
+    /* base state at the cell-centre levels z_k = (k + 0.5) dx */
+    double *th0, *qv0, *pi0, *p0, *rho0, *ue;
+    double rho_ref;               /* Boussinesq reference density (the budget's) */
+    sim_env env;
+    uint64_t seed;
+    double t;
+    long steps;
+    double rain_out, surface_in;  /* in (kg/kg) x cells */
+    void *fft_fwd, *fft_inv;      /* fftwf plans of one level */
+    void *spec;                   /* complex spectrum, nz ny (nx / 2 + 1) */
+};
+
+static inline size_t sim_idx(const atmos_sim *s, int i, int j, int k)
+{
+    return ((size_t)k * s->ny + j) * s->nx + i;
+}
+
+/* Presets (sim_presets.c). NULL if unknown. */
+const sim_env *atmos__sim_preset(const char *name);
+
+/* Builds a simulation of an environment on nx * ny * nz cells of dx metres (sim_create.c). */
+atmos_status atmos__sim_create_env(atmos_context *ctx, const sim_env *env, int nx, int ny, int nz, double dx,
+                                   uint64_t seed, atmos_sim **out);
+
+/* Thermodynamics (sim_thermo.c). Saturation vapour pressure over water (Bolton 1980, Eq. 10), Pa;
+ * saturation mixing ratio; dew point (its inverse), K. */
+double atmos__sim_esat(double t_k);
+double atmos__sim_qsat(double t_k, double p_pa);
+double atmos__sim_dewpoint(double qv, double p_pa);
+/* Saturation adjustment of one cell at pressure p and Exner function pi: condenses vapour
+ * above saturation or evaporates cloud water into unsaturated air, with the latent heat,
+ * so that afterwards q_c = 0 and q_v <= q_s, or q_c > 0 and q_v = q_s (Newton iteration). */
+void atmos__sim_adjust(double *th, double *qv, double *qc, double p_pa, double pi);
+/* Fills the base state (th0, qv0, pi0, p0, rho0, ue) from sim->env. */
+void atmos__sim_sounding(atmos_sim *sim);
+
+/* The step's parts. */
+void atmos__sim_advect(atmos_sim *sim, double dt);        /* sim_advect.c */
+void atmos__sim_forces(atmos_sim *sim, double dt);        /* sim_forces.c: buoyancy, sponge, fluxes */
+void atmos__sim_confine(atmos_sim *sim, double dt);       /* sim_confine.c: vorticity confinement */
+void atmos__sim_project(atmos_sim *sim);                  /* sim_pressure.c */
+atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *sim);
+void atmos__sim_fft_free(atmos_sim *sim);
+void atmos__sim_micro(atmos_sim *sim, double dt);         /* sim_micro.c: Kessler + adjustment */
+void atmos__sim_fall(atmos_sim *sim, double dt);          /* sim_micro.c: rain sedimentation */
+/* Largest |divergence| x dx (m/s) over the cells, to check the projection. */
+double atmos__sim_max_divergence(const atmos_sim *sim);
+
+#endif

@@ -1,0 +1,86 @@
+/* Kessler warm rain in the form of Klemp & Wilhelmson (1978, J. Atmos. Sci. 35, 1070,
+ * Eq. 2.13-2.15), cell by cell:
+ *   autoconversion  A = k1 (q_c - a)+,  k1 = 1e-3 s^-1, a = 1e-3 kg/kg (Kessler 1969)
+ *   accretion       C = 2.2 q_c q_r^0.875 s^-1
+ *   rain evaporation E = (1 - q_v/q_s) C' (rho q_r)^0.525 / (rho (5.4e5 + 2.55e6 / (p q_s)))
+ *                   with C' = 1.6 + 124.9 (rho q_r)^0.2046, rho in g cm^-3, p in mb
+ *   fall speed      V = 36.34 (rho q_r)^0.1346 (rho / rho_ground)^-1/2 m/s, rho in g cm^-3
+ * then the saturation adjustment with latent heat (atmos__sim_adjust). Every transfer moves
+ * water between q_v, q_c and q_r, so their sum changes only through the rain that falls out
+ * (counted in rain_out). */
+#include "sim/sim_internal.h"
+
+#include <math.h>
+
+void atmos__sim_micro(atmos_sim *s, double dt)
+{
+    if (!s->env.micro) return;
+    const size_t lev = (size_t)s->nx * s->ny;
+#pragma omp parallel for schedule(static) num_threads(s->threads)
+    for (int k = 0; k < s->nz; k++) {
+        const double p = s->p0[k], pi = s->pi0[k], rho = 1e-3 * s->rho0[k];
+        for (size_t n = k * lev; n < (k + 1) * lev; n++) {
+            double th = s->th[n], qv = s->qv[n], qc = s->qc[n], qr = s->qr[n];
+            if (qc <= 0 && qr <= 0 && qv < 0.9 * atmos__sim_qsat(th * pi, p)) continue; /* clear, dry air */
+            if (qc < 0) qc = 0;
+            if (qr < 0) qr = 0;
+            /* rain from cloud water */
+            const double rate = 1e-3 * fmax(qc - 1e-3, 0.0) + 2.2 * qc * pow(qr, 0.875);
+            const double dr = fmin(qc, rate * dt);
+            qc -= dr, qr += dr;
+            /* rain evaporating into unsaturated air */
+            const double qs = atmos__sim_qsat(th * pi, p);
+            if (qr > 0 && qv < qs) {
+                const double rq = rho * qr;
+                const double e = (1.6 + 124.9 * pow(rq, 0.2046)) * pow(rq, 0.525) /
+                                 (2.55e8 / (p * qs) + 5.4e5) * (qs - qv) / (rho * qs);
+                const double de = fmin(fmin(e * dt, qr), qs - qv);
+                qr -= de, qv += de;
+                th -= SIM_LV / SIM_CP * de / pi;
+            }
+            atmos__sim_adjust(&th, &qv, &qc, p, pi);
+            s->th[n] = (float)th, s->qv[n] = (float)qv, s->qc[n] = (float)qc, s->qr[n] = (float)qr;
+        }
+    }
+}
+
+/* Rain falls with V by first-order upwind fluxes, sub-stepped so that V dt_sub < dx; what
+ * leaves the lowest cell is rain on the ground. One column at a time (any thread: the same
+ * arithmetic); the ground's sum is added in column order. */
+void atmos__sim_fall(atmos_sim *s, double dt)
+{
+    if (!s->env.micro) return;
+    const int nx = s->nx, ny = s->ny, nz = s->nz;
+    const size_t lev = (size_t)nx * ny;
+    float *out = s->s[7]; /* per column: rain out of the ground this step */
+#pragma omp parallel for schedule(static) num_threads(s->threads)
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) {
+            const size_t c = (size_t)j * nx + i;
+            double vmax = 0, fell = 0;
+            double vel[2 * ATMOS_SIM_MAX_GRID];
+            for (int k = 0; k < nz; k++) {
+                const double q = s->qr[c + k * lev];
+                vel[k] = q > 1e-9 ? 36.34 * pow(1e-3 * s->rho0[k] * q, 0.1346) * sqrt(s->rho0[0] / s->rho0[k]) : 0.0;
+                vmax = fmax(vmax, vel[k]);
+            }
+            if (vmax > 0) {
+                const int sub = (int)ceil(vmax * dt / (0.9 * s->dx));
+                const double h = dt / sub / s->dx;
+                for (int m = 0; m < sub; m++) {
+                    double from_above = 0; /* flux into cell k from k + 1, in q units */
+                    for (int k = nz - 1; k >= 0; k--) {
+                        float *q = &s->qr[c + k * lev];
+                        const double leave = fmin((double)*q, h * vel[k] * *q);
+                        *q = (float)(*q - leave + from_above);
+                        from_above = leave;
+                    }
+                    fell += from_above;
+                }
+            }
+            out[c] = (float)fell;
+        }
+    double sum = 0;
+    for (size_t c = 0; c < lev; c++) sum += out[c];
+    s->rain_out += sum;
+}

@@ -1,0 +1,97 @@
+/* One time step of the cloud simulation, a run of many with progress, and its statistics. */
+#include "sim/sim_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The step: the largest that keeps the fastest wind within 1.5 cells (the semi-Lagrangian
+ * trace stays accurate), at most the preset's dt_max. The maximum is exact whatever the
+ * order, so it does not depend on the threads. */
+static double time_step(const atmos_sim *s)
+{
+    float m = 0;
+    const float *f[3] = {s->u, s->v, s->w};
+    const size_t len[3] = {s->n, s->n, s->nw};
+    for (int a = 0; a < 3; a++) {
+        const float *p = f[a];
+        const size_t len_a = len[a];
+#pragma omp parallel for schedule(static) reduction(max : m) num_threads(s->threads)
+        for (size_t n = 0; n < len_a; n++) m = fmaxf(m, fabsf(p[n]));
+    }
+    if (m != m || m > 1e30f) return 0.0; /* NaN or overflow: unstable */
+    const double dt = m > 0 ? 1.5 * s->dx / m : s->dt_max;
+    return fmin(dt, s->dt_max);
+}
+
+static void advance(atmos_sim *s, double dt)
+{
+    atmos__sim_advect(s, dt);
+    atmos__sim_micro(s, dt);
+    atmos__sim_fall(s, dt);
+    atmos__sim_forces(s, dt);
+    atmos__sim_confine(s, dt);
+    atmos__sim_project(s);
+    s->t += dt;
+    s->steps++;
+}
+
+atmos_status atmos_sim_step(atmos_context *ctx, atmos_sim *s)
+{
+    if (!s) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: no simulation");
+    advance(s, time_step(s));
+    return ATMOS_OK;
+}
+
+atmos_status atmos_sim_run(atmos_context *ctx, atmos_sim *s, double seconds)
+{
+    if (!s) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: no simulation");
+    if (!(seconds >= 0 && seconds <= ATMOS_SIM_MAX_MINUTES * 60))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: %g s is out of range [0, %g]", seconds,
+                            ATMOS_SIM_MAX_MINUTES * 60);
+    const double end = s->t + seconds;
+    if (atmos__progress(ctx, "simulate", 0.0)) return atmos__error(ctx, ATMOS_E_CANCELLED, "simulate: cancelled");
+    while (s->t < end - 1e-9) {
+        double dt = time_step(s);
+        /* winds over 300 m/s (or NaN) mean the model has blown up: stop rather than crawl */
+        if (!(dt >= 1.5 * s->dx / 300.0) || !isfinite(s->th[0]))
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: the model became unstable at t = %g s", s->t);
+        if (s->t + dt > end) dt = end - s->t;
+        advance(s, dt);
+        if (atmos__progress(ctx, "simulate", seconds > 0 ? 1.0 - (end - s->t) / seconds : 1.0))
+            return atmos__error(ctx, ATMOS_E_CANCELLED, "simulate: cancelled at t = %g s", s->t);
+    }
+    return ATMOS_OK;
+}
+
+void atmos_sim_get_stats(const atmos_sim *s, atmos_sim_stats *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof *o);
+    if (!s) return;
+    o->dims[0] = s->nx, o->dims[1] = s->ny, o->dims[2] = s->nz;
+    o->cell_m = s->dx;
+    o->time_s = s->t;
+    o->steps = s->steps;
+    o->cloud_base_m = o->cloud_top_m = -1;
+    const size_t lev = (size_t)s->nx * s->ny;
+    double water = 0;
+    for (int k = 0; k < s->nz; k++) { /* level by level, in order: the same sum for any thread count */
+        double wl = 0;
+        for (size_t n = k * lev; n < (k + 1) * lev; n++) {
+            wl += (double)s->qv[n] + s->qc[n] + s->qr[n];
+            o->max_qc = fmax(o->max_qc, s->qc[n]);
+            o->max_qr = fmax(o->max_qr, s->qr[n]);
+            o->max_w = fmax(o->max_w, s->w[n]);
+            if (s->qc[n] > 1e-5) {
+                if (o->cloud_base_m < 0) o->cloud_base_m = (k + 0.5) * s->dx;
+                o->cloud_top_m = (k + 0.5) * s->dx;
+            }
+        }
+        water += wl;
+    }
+    /* (kg/kg) x cells -> kg per m^2 of ground */
+    const double per = s->rho_ref * s->dx / (double)lev;
+    o->water = water * per;
+    o->rain_out = s->rain_out * per;
+    o->surface_in = s->surface_in * per;
+}

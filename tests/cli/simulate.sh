@@ -1,0 +1,61 @@
+#!/bin/sh
+# `atmos simulate` end to end: usage errors exit 2 with a message and write nothing; a small
+# run writes the sidecar and one raw file per field (cloud, rain) whose sizes match the grid,
+# with cloud in it; the same seed gives the same bytes with 1 and 2 threads.
+# Run by ctest with ATMOS_CLI = path of the atmos binary.
+set -u
+
+cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
+fail=0
+dir=${ATMOS_TEST_TMP:-/tmp}/cli_simulate.$$
+mkdir -p "$dir"
+trap 'rm -rf "$dir"' EXIT
+
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+
+usage() { # expect exit 2, a message naming $1, no output file
+    want=$1; shift
+    "$cli" simulate "$@" >"$dir/out" 2>"$dir/err"
+    rc=$?
+    if [ $rc -eq 2 ] && grep -q -- "$want" "$dir/err" && [ ! -e "$dir/x.json" ]; then ok "simulate $*: $want"
+    else bad "simulate $*: exit $rc, stderr: $(cat "$dir/err")"; fi
+}
+usage "unknown preset 'cirrus'" cirrus -o "$dir/x.json"
+usage "which preset" -o "$dir/x.json"
+usage "missing -o" cumulus_field
+usage "--grid" cumulus_field --grid 8 -o "$dir/x.json"
+usage "--minutes" cumulus_field --minutes 0 -o "$dir/x.json"
+usage "--minutes" cumulus_field --minutes abc -o "$dir/x.json"
+usage "--seed" cumulus_field --seed -1 -o "$dir/x.json"
+usage "unknown or incomplete option" cumulus_field --bogus -o "$dir/x.json"
+"$cli" simulate --help | grep -q "towering_cumulus" && ok "--help lists the presets" || bad "--help"
+
+# stratocumulus starts with its deck: a 16-cell grid, half a minute
+for t in 1 2; do
+    if "$cli" simulate stratocumulus --grid 16 --minutes 0.5 --threads $t --quiet -o "$dir/s$t.json" 2>"$dir/err"; then
+        ok "run with $t threads"
+    else bad "run with $t threads: $(cat "$dir/err")"; fi
+done
+python3 - "$dir" <<'PY' && ok "sidecar, raw sizes, cloud present" || bad "output files"
+import json, os, struct, sys
+d = sys.argv[1]
+j = json.load(open(os.path.join(d, "s1.json")))
+text = json.dumps(j)
+assert "cloud" in text and "rain" in text, text
+dims = j["dims"]
+n = dims[0] * dims[1] * dims[2]
+raws = sorted(f for f in os.listdir(d) if f.startswith("s1") and f.endswith(".raw"))
+assert len(raws) == 2, raws
+for r in raws:
+    assert os.path.getsize(os.path.join(d, r)) == 4 * n, (r, os.path.getsize(os.path.join(d, r)), n)
+cloud = [f for f in raws if "cloud" in f][0]
+v = struct.unpack("<%df" % n, open(os.path.join(d, cloud), "rb").read())
+assert max(v) > 1e6, max(v)
+PY
+for f in "$dir"/s1*.raw; do
+    g="$dir/s2${f#"$dir"/s1}"
+    cmp -s "$f" "$g" || bad "1 and 2 threads differ: $(basename "$f")"
+done
+[ $fail -eq 0 ] && ok "1 and 2 threads give the same raw files"
+exit $fail

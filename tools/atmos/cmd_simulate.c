@@ -1,0 +1,141 @@
+/* atmos simulate: runs the cloud simulation and writes its volume as raw float32 files
+ * plus a JSON sidecar (like 'atmos volume generate'). No physics here. */
+#include "cli.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *C = "simulate";
+
+static void help(void)
+{
+    printf("Usage: atmos simulate PRESET -o NAME.json [--minutes M] [--grid N] [--seed S] [--threads T] [--quiet]\n\n"
+           "Runs the cloud-physics simulation (docs/clouds.md): a 3-D Boussinesq fluid with potential\n"
+           "temperature, water vapour, cloud water and rain, Kessler warm rain and saturation adjustment,\n"
+           "periodic sides. Writes the state at time M as a volume of \"cloud\" and \"rain\" number\n"
+           "densities (m^-3; mixing ratio x air density / the particle type's mean mass), raw float32\n"
+           "files next to the JSON sidecar, y up, the ground at y = 0.\n\n"
+           "Presets: ");
+    for (const char *const *n = atmos_sim_preset_names(); *n; n++)
+        printf("%s (%g min)%s", *n, atmos_sim_preset_minutes(*n), n[1] ? ", " : "\n");
+    printf("  --minutes M  simulated time (default: the preset's, above), 0 < M <= %g\n"
+           "  --grid N     cells along each horizontal side, %d..%d (default 64); the domain's size is the\n"
+           "               preset's, so a larger N gives smaller cells\n"
+           "  --seed S     the random perturbations (default 1); the same seed gives the same bytes\n"
+           "  --threads T  worker threads (default: all cores); the result does not depend on T\n"
+           "  --quiet      no progress bar\n"
+           "  --bench K    instead of writing a volume: K time steps, then the mean time of one step and the\n"
+           "               state (simulated time, largest updraught, cloud base and top); with --minutes, runs\n"
+           "               that long first and reports the time taken (bench/sim/run.sh)\n\n"
+           "Exit status: 0 success, 1 runtime error, 2 usage error.\n",
+           ATMOS_SIM_MAX_MINUTES, ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID);
+}
+
+static void print_state(const atmos_sim *s)
+{
+    atmos_sim_stats st;
+    atmos_sim_get_stats(s, &st);
+    printf("  state: %d x %d x %d cells of %g m, t = %.0f s after %ld steps, max w %.1f m/s, max q_c %.2g, max q_r %.2g, "
+           "cloud base %.0f m, top %.0f m, rain on the ground %.3f kg/m^2\n",
+           st.dims[0], st.dims[1], st.dims[2], st.cell_m, st.time_s, st.steps, st.max_w, st.max_qc, st.max_qr,
+           st.cloud_base_m, st.cloud_top_m, st.rain_out);
+}
+
+/* --bench: the run to --minutes (timed), then K steps (timed each). */
+static int run_bench(const atmos_sim_desc *d, int threads, int steps)
+{
+    atmos_context *ctx = cli_context(threads, 1);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_sim *s = NULL;
+    double t0 = cli_now_s();
+    atmos_status st = atmos_sim_create(ctx, d, &s);
+    if (st == ATMOS_OK) {
+        printf("atmos simulate --bench: %s, grid %d, %d threads; create %.3f s\n", d->preset, d->grid ? d->grid : 64,
+               atmos_context_threads(ctx), cli_now_s() - t0);
+        if (d->minutes > 0) {
+            t0 = cli_now_s();
+            st = atmos_sim_run(ctx, s, d->minutes * 60.0);
+            printf("  %g simulated minutes in %.2f s\n", d->minutes, cli_now_s() - t0);
+            print_state(s);
+        }
+    }
+    if (st == ATMOS_OK) {
+        t0 = cli_now_s();
+        for (int k = 0; k < steps && st == ATMOS_OK; k++) st = atmos_sim_step(ctx, s);
+        printf("  %d steps: %.1f ms per step\n", steps, 1e3 * (cli_now_s() - t0) / steps);
+        print_state(s);
+    }
+    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    atmos_sim_destroy(s);
+    atmos_context_destroy(ctx);
+    return rc;
+}
+
+int cli_cmd_simulate(int argc, char **argv)
+{
+    atmos_sim_desc d;
+    memset(&d, 0, sizeof d);
+    d.seed = 1;
+    const char *out = NULL;
+    int threads = 0, quiet = 0, bench = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            quiet = 1;
+        } else if (!strcmp(a, "-o") && i + 1 < argc) {
+            out = argv[++i];
+            if (!*out) return cli_usage_error(C, "-o: expected a file name");
+        } else if (!strcmp(a, "--minutes") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--minutes", argv[++i], &d.minutes)) return CLI_EXIT_USAGE;
+            if (!(d.minutes > 0 && d.minutes <= ATMOS_SIM_MAX_MINUTES))
+                return cli_usage_error(C, "--minutes: expected 0 < M <= %g, got %s", ATMOS_SIM_MAX_MINUTES, argv[i]);
+        } else if (!strcmp(a, "--grid") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--grid", argv[++i], ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID, &d.grid))
+                return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--seed") && i + 1 < argc) {
+            char *end = NULL;
+            const char *t = argv[++i];
+            unsigned long long s = strtoull(t, &end, 10);
+            if (!*t || *end || t[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", t);
+            d.seed = s;
+        } else if (!strcmp(a, "--bench") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--bench", argv[++i], 1, 1000000, &bench)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--threads") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
+        } else if (a[0] == '-') {
+            return cli_usage_error(C, "unknown or incomplete option '%s'", a);
+        } else if (!d.preset) {
+            d.preset = a;
+        } else {
+            return cli_usage_error(C, "unexpected argument '%s'", a);
+        }
+    }
+    if (!d.preset) return cli_usage_error(C, "which preset?");
+    if (!atmos_sim_preset_minutes(d.preset)) {
+        char list[256] = "";
+        for (const char *const *n = atmos_sim_preset_names(); *n; n++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", *n, n[1] ? ", " : "");
+        return cli_usage_error(C, "unknown preset '%s' (known: %s)", d.preset, list);
+    }
+    if (bench) return run_bench(&d, threads, bench);
+    if (!out) return cli_usage_error(C, "missing -o NAME.json");
+    cli_progress prog;
+    cli_progress_init(&prog, quiet);
+    atmos_context *ctx = cli_context_with_progress(threads, quiet, cli_progress_bar, &prog);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    atmos_volume *v = NULL;
+    const double t0 = cli_now_s();
+    atmos_status st = atmos_simulate(ctx, &d, &v);
+    if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
+    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    if (rc == CLI_EXIT_OK && !quiet)
+        fprintf(stderr, "atmos simulate: %s, %g min on a %d grid in %.1f s: wrote %s\n", d.preset,
+                d.minutes > 0 ? d.minutes : atmos_sim_preset_minutes(d.preset), d.grid ? d.grid : 64, cli_now_s() - t0, out);
+    atmos_volume_destroy(v);
+    atmos_context_destroy(ctx);
+    return rc;
+}
