@@ -12,6 +12,13 @@
 #include <cpl_error.h>
 #include <gdal.h>
 
+int atmos__terrain_stride(long w, long h, long max_triangles)
+{
+    int s = 1;
+    while (2L * ((w - 1) / s) * ((h - 1) / s) > max_triangles) s++;
+    return s;
+}
+
 /* GDAL's last message, or a default. */
 static const char *gdal_message(const char *fallback)
 {

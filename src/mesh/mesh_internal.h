@@ -22,7 +22,7 @@ typedef struct atmos__heights {
 } atmos__heights;
 
 /* The least stride that keeps 2 (nx - 1)(nz - 1) triangles of a w x h grid within max. */
-int atmos__terrain_stride(long w, long h, long max_triangles);
+int atmos__terrain_stride(long w, long h, long max_triangles); /* mesh_gdal.c */
 
 /* Band 1 of a raster file through GDAL, every stride-th row and column (stride 0: the
  * automatic one), no-data pixels set to the lowest valid value (mesh_gdal.c).

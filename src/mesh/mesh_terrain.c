@@ -10,13 +10,6 @@
 #define DEFAULT_SAMPLES 257
 #define RIDGE_OCTAVES 7
 
-int atmos__terrain_stride(long w, long h, long max_triangles)
-{
-    int s = 1;
-    while (2L * ((w - 1) / s) * ((h - 1) / s) > max_triangles) s++;
-    return s;
-}
-
 /* A number in [0, 1) for a lattice point of one octave (splitmix64's finaliser). */
 static double lattice(uint64_t seed, int octave, long ix, long iz)
 {

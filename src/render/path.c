@@ -47,19 +47,6 @@
 
 #include <string.h>
 
-/* Russian roulette on the largest weight; returns 0 to stop. */
-int atmos__path_roulette(double *w, int m, atmos__stream *r)
-{
-    double q = 0;
-    for (int i = 0; i < m; i++)
-        if (w[i] > q) q = w[i];
-    if (!(q > 0)) return 0;
-    if (q >= 1) return 1;
-    if (atmos__stream_u(r) >= q) return 0;
-    for (int i = 0; i < m; i++) w[i] /= q;
-    return 1;
-}
-
 /* Where a camera path is and what it carries. */
 typedef struct {
     double w[PATH_B], p[3], d[3];

@@ -14,6 +14,19 @@ static inline void onb(const double n[3], double t[3], double b[3])
     b[0] = c, b[1] = s + n[1] * n[1] * a, b[2] = -n[1];
 }
 
+/* Russian roulette on the largest weight; returns 0 to stop. */
+int atmos__path_roulette(double *w, int m, atmos__stream *r)
+{
+    double q = 0;
+    for (int i = 0; i < m; i++)
+        if (w[i] > q) q = w[i];
+    if (!(q > 0)) return 0;
+    if (q >= 1) return 1;
+    if (atmos__stream_u(r) >= q) return 0;
+    for (int i = 0; i < m; i++) w[i] /= q;
+    return 1;
+}
+
 /* Direction at cos(theta) = mu, azimuth phi around unit axis n. */
 void atmos__path_around(const double n[3], double mu, double phi, double out[3])
 {
