@@ -13,7 +13,7 @@
 #include <string.h>
 
 /* Bumped whenever the tables' content or layout changes. */
-#define SPH_TABLE_VERSION 4
+#define SPH_TABLE_VERSION 5
 
 static void sph_destroy(void *model)
 {
