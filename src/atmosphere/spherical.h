@@ -24,7 +24,7 @@
  * build it from Psi_ms. */
 #define ATMOS__SPH_J_R 16
 #define ATMOS__SPH_J_MUS 32
-#define ATMOS__SPH_J_G 20
+#define ATMOS__SPH_J_G 24
 #define ATMOS__SPH_J_P 10
 #define ATMOS__SPH_J_ITER 2
 /* gamma's mapping gamma = pi (a x + b x^2 + c x^3): its slope a / pi at the sun (GA) and at

@@ -24,10 +24,12 @@
  *          horizon of every point of the air); below, the lowest column times
  *          e^(-60 (-0.3 - mu_s)), a steep fade standing for the night's darkening;
  *   gamma  the angle between the view and the sun, gamma = pi (a x + b x^2 + c x^3) with
- *          the slope a = 0.3 at both ends (nodes 2.8 degrees apart at the sun and at the
- *          anti-sun, 12.8 between: with a low sun the anti-sun is at the horizon, where the
- *          gathered light jumps from the sky's to the ground's; the quadratic mapping's 16
- *          degrees there left the anti-solar horizon 3 % too dark);
+ *          the slope a = 0.3 at both ends (24 nodes 2.3 degrees apart at the sun and at the
+ *          anti-sun, 10.6 between: with a low sun the anti-sun is at the horizon, where the
+ *          gathered light jumps from the sky's to the ground's; 20 nodes in the quadratic
+ *          mapping pi (a x + (1 - a) x^2), 16 degrees apart there, left the anti-solar horizon
+ *          3 % too dark; 20 in the cubic one, 12.8 degrees apart between, made J's kinks
+ *          between the aerial-perspective volume's node rays too large in twilight);
  *   psi    the azimuth of the view about the sun's direction, 0 on the zenith's side,
  *          x = (1 - cos psi) / 2 (the light is symmetric about the sun's vertical plane).
  * The gather integrates over the same sun-centred frame: gamma' = pi (a s + (1 - a) s^2), by
