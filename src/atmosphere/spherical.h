@@ -24,11 +24,14 @@
  * build it from Psi_ms. */
 #define ATMOS__SPH_J_R 16
 #define ATMOS__SPH_J_MUS 32
-#define ATMOS__SPH_J_G 20
+#define ATMOS__SPH_J_G 24
 #define ATMOS__SPH_J_P 10
 #define ATMOS__SPH_J_ITER 2
-/* gamma's linear share in its mapping gamma = pi (a x + (1 - a) x^2) */
+/* gamma's mapping gamma = pi (a x + b x^2 + c x^3): the slope of gamma / pi is GA at the sun
+ * (a = GA) and GE at the anti-sun, b and c from gamma(1) = pi; the gather's own nodes
+ * (spherical_ms.c) map s as gamma = pi (a s + (1 - a) s^2) */
 #define ATMOS__SPH_J_GA 0.3
+#define ATMOS__SPH_J_GE 0.3
 /* The table holds log(j + ATMOS__SPH_J_FLOOR) and is interpolated in it: in twilight j falls by ~3.6
  * times per degree of the sun's depression (the sky's irradiance of the ground between
  * 5.2 and 6.4 degrees below), which linear interpolation over a node spacing of a degree

@@ -37,6 +37,13 @@
 #define KEEP_HS 10000.0 /* the altitude's quantum: HS DH near the ground (m) */
 #define KEEP_DH 1e-4
 #define KEEP_DMU 1e-5 /* the sun's zenith cosine's quantum */
+/* The look-up's helpers are inlined into each clone of eval_table (a helper left out of line
+ * would be compiled for the baseline only). */
+#if defined(__GNUC__)
+#define SV_INLINE static inline __attribute__((always_inline))
+#else
+#define SV_INLINE static inline
+#endif
 
 typedef struct sv_state {
     int march, n;
@@ -182,7 +189,7 @@ void atmos__sph_batch_release(atmos__atm_batch *b)
 }
 
 /* atan(y / x) for 0 <= y <= x by Abramowitz & Stegun 4.4.49 (|error| <= 2e-8). */
-static inline float atan_unit(float z)
+SV_INLINE float atan_unit(float z)
 {
     const float z2 = z * z;
     float p = 0.0028662257f;
@@ -197,7 +204,7 @@ static inline float atan_unit(float z)
 }
 
 /* The azimuth in [0, pi] of (x, y) with y >= 0. */
-static inline float azimuth(float x, float y)
+SV_INLINE float azimuth(float x, float y)
 {
     const float ax = fabsf(x);
     const int swap = y > ax;
@@ -225,7 +232,7 @@ static void eval_march(const atmos__atm_batch *b, int count, const float *dx, co
  * table's of every ray (vectorises), the look-ups of the table's logarithms, their
  * exponentials (vectorises), the phase functions applied. */
 #define BLK 16
-static void eval_block(const sv_state *s, const float *ra, const float *rb, int i0, int m, int count,
+SV_INLINE void eval_block(const sv_state *s, const float *ra, const float *rb, int i0, int m, int count,
                        const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
     const int n = s->n, S = 3 * n;
@@ -272,6 +279,18 @@ static void eval_block(const sv_state *s, const float *ra, const float *rb, int 
     }
 }
 
+/* The table's rays, block by block; built for AVX2 as well as the baseline (the loader picks
+ * the best at run time; without FMA both give the same bits). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+static void eval_table(const sv_state *s, const float *ra, const float *rb, int count, const float *dx,
+                       const float *dy, const float *dz, const float *weight, float *out)
+{
+    for (int i0 = 0; i0 < count; i0 += BLK)
+        eval_block(s, ra, rb, i0, count - i0 < BLK ? count - i0 : BLK, count, dx, dy, dz, weight, out);
+}
+
 void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch)
 {
@@ -288,6 +307,5 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
     /* the air's depolarized Rayleigh phase function (planet.h): kr (ra + rb nu^2) */
     float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS];
     for (int k = 0; k < s->n; k++) atmos__planet_rayleigh_ab(b->atm->planet, k, &ra[k], &rb[k]);
-    for (int i0 = 0; i0 < count; i0 += BLK)
-        eval_block(s, ra, rb, i0, count - i0 < BLK ? count - i0 : BLK, count, dx, dy, dz, weight, out);
+    eval_table(s, ra, rb, count, dx, dy, dz, weight, out);
 }

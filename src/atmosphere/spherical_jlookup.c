@@ -17,11 +17,20 @@
 #define JFLOOR ATMOS__SPH_J_FLOOR
 
 /* ------------------------------------------------------------------ mappings */
-double atmos__sph_j_x_to_gamma(double x) { return ATMOS_PI * (GA * x + (1.0 - GA) * x * x); }
+#define GE ATMOS__SPH_J_GE
+#define GC (GE + GA - 2.0)      /* the cubic's coefficients: gamma(1) = pi, */
+#define GB (1.0 - GA - GC)     /* slopes GA and GE at the ends */
+double atmos__sph_j_x_to_gamma(double x) { return ATMOS_PI * x * (GA + x * (GB + x * GC)); }
+/* The inverse by Newton's method from x = gamma / pi (the slope stays >= min(GA, GE)). */
 static double gamma_to_x(double g)
 {
     const double u = atmos__clampd(g / ATMOS_PI, 0.0, 1.0);
-    return (-GA + sqrt(GA * GA + 4.0 * (1.0 - GA) * u)) / (2.0 * (1.0 - GA));
+    double x = u;
+    for (int it = 0; it < 6; it++) {
+        const double f = x * (GA + x * (GB + x * GC)) - u, df = GA + x * (2.0 * GB + 3.0 * x * GC);
+        x = atmos__clampd(x - f / df, 0.0, 1.0);
+    }
+    return x;
 }
 static double mus_x(double mus)
 {

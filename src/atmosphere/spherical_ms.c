@@ -23,14 +23,21 @@
  *          horizon: twilight), down to mu_s = -0.3 (17.5 degrees down: the sun is below the
  *          horizon of every point of the air); below, the lowest column times
  *          e^(-60 (-0.3 - mu_s)), a steep fade standing for the night's darkening;
- *   gamma  the angle between the view and the sun, gamma = pi (a x + (1 - a) x^2),
- *          a = 0.3 (nodes 2.8 degrees apart at the sun, 16 at the anti-sun);
+ *   gamma  the angle between the view and the sun, gamma = pi (a x + b x^2 + c x^3) with
+ *          the slope a = 0.3 at both ends (24 nodes 2.3 degrees apart at the sun and at the
+ *          anti-sun, 10.6 between: with a low sun the anti-sun is at the horizon, where the
+ *          gathered light jumps from the sky's to the ground's; 20 nodes in the quadratic
+ *          mapping pi (a x + (1 - a) x^2), 16 degrees apart there, left the anti-solar horizon
+ *          3 % too dark; 20 in the cubic one, 12.8 degrees apart between, made J's kinks
+ *          between the aerial-perspective volume's node rays too large in twilight);
  *   psi    the azimuth of the view about the sun's direction, 0 on the zenith's side,
  *          x = (1 - cos psi) / 2 (the light is symmetric about the sun's vertical plane).
- * The gather integrates over the same sun-centred frame: gamma' mapped like gamma from s, by
+ * The gather integrates over the same sun-centred frame: gamma' = pi (a s + (1 - a) s^2), by
  * three 8-point Gauss-Legendre panels in s (the aureole of the incoming single scattering is
  * resolved, and a view's phase lobe far from the sun still meets nodes 9 degrees apart), psi'
- * by 16 midpoints over [0, pi], folded (the light is symmetric in psi'). The phase weights of each view node,
+ * by 16 midpoints over [0, pi], folded (the light is symmetric in psi'); a node whose cell
+ * straddles the horizon takes the light beyond it at that part's centre, weighted by its
+ * share of the cell (horizon_cell). The phase weights of each view node,
  * normalised so that a uniform field gathers exactly (energy), depend only on the two
  * grids and are computed once per build. The table holds the logarithm, interpolated
  * quadrilinearly (ATMOS__SPH_J_FLOOR; the look-up and the mappings are in
@@ -68,7 +75,7 @@ static void sun_dir(double ss, double ms, double g, double psi, double d[3])
 /* The gather's nodes (gamma', psi', solid angle) and the normalised phase weights
  * w[k][type][v][q] of view node v and incoming node q (psi' folded with -psi'). */
 typedef struct j_quad {
-    double g[QN], p[QN], dw[QN];
+    double g[QN], p[QN], dw[QN], gh[QN]; /* gh: half the node's cell in gamma' */
     float *w; /* [n][2][JV][QN] */
 } j_quad;
 
@@ -81,11 +88,11 @@ static void quad_nodes(j_quad *qd)
                                  0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
     for (int a = 0; a < QG; a++) { /* QG / 8 panels of 8 points in s over [0, 1] */
         const double s = (0.5 * (1 + gx[a % 8]) + a / 8) / (QG / 8), ws = 0.5 * gw[a % 8] / (QG / 8);
-        const double g = atmos__sph_j_x_to_gamma(s), dg = ATMOS_PI * (GA + 2.0 * (1.0 - GA) * s) * ws;
+        const double g = ATMOS_PI * (GA * s + (1.0 - GA) * s * s), dg = ATMOS_PI * (GA + 2.0 * (1.0 - GA) * s) * ws;
         for (int b = 0; b < QP; b++) {
             const int q = a * QP + b;
             qd->g[q] = g, qd->p[q] = (b + 0.5) * ATMOS_PI / QP;
-            qd->dw[q] = sin(g) * dg * ATMOS_PI / QP;
+            qd->dw[q] = sin(g) * dg * ATMOS_PI / QP, qd->gh[q] = 0.5 * dg;
         }
     }
 }
@@ -142,6 +149,50 @@ static void incoming(const atmos__planet *pl, const atmos__sph_model *m, double 
                s.ms[k] + s.t[k] * G[k];
 }
 
+/* The node q's cell split at the horizon mu_h: the share f of the cell on the other side of
+ * the horizon from its centre (mu, linear over the cell, on a 8 x 8 grid) and the centre of
+ * that part (g, p); 0 when the cell lies on one side. */
+#define HS 8
+static double cell_split(const j_quad *qd, int q, double ss, double ms, double muh, double *g, double *p,
+                         int *below)
+{
+    const double g0 = qd->g[q], p0 = qd->p[q], gh = qd->gh[q], ph = 0.5 * ATMOS_PI / QP;
+    const double cg = cos(g0), sg = sin(g0), cp = cos(p0), sp = sin(p0);
+    const double mu = cg * ms + sg * cp * ss;
+    const double dmg = -sg * ms + cg * cp * ss, dmp = -sg * sp * ss;
+    if (fabs(mu - muh) >= fabs(dmg) * gh + fabs(dmp) * ph) return 0.0;
+    *below = mu < muh;
+    int cnt = 0;
+    double sgs = 0.0, sps = 0.0;
+    for (int i = 0; i < HS; i++)
+        for (int j = 0; j < HS; j++) {
+            const double a = gh * ((2.0 * i + 1.0) / HS - 1.0), b = ph * ((2.0 * j + 1.0) / HS - 1.0);
+            if ((mu + dmg * a + dmp * b < muh) != *below) cnt++, sgs += a, sps += b;
+        }
+    if (!cnt) return 0.0;
+    *g = g0 + sgs / cnt, *p = p0 + sps / cnt;
+    return (double)cnt / (HS * HS);
+}
+
+/* The incoming light of node q over its cell (L: [n][QN]): where the cell straddles the
+ * horizon, the light from beyond it (the sky's or the ground's) at its part's centre,
+ * weighted by that part's share. The light jumps there, and a view near the horizon
+ * gathers it through the aerosols' narrow forward lobe from few nodes. */
+static void horizon_cell(const atmos__planet *pl, const atmos__sph_model *m, const j_quad *qd, int q, double r,
+                         const double sun[3], const double *albedo, float *L)
+{
+    const int n = m->n;
+    const double rr = m->R / r, muh = -sqrt(fmax(0.0, 1.0 - rr * rr));
+    double g, p, d[3], l[ATMOS_MAX_WAVELENGTHS];
+    int below;
+    const double f = cell_split(qd, q, sun[0], sun[1], muh, &g, &p, &below);
+    if (f <= 0.0) return;
+    sun_dir(sun[0], sun[1], g, p, d);
+    if ((d[1] < muh) == below) return; /* the linear mu's part is not beyond the horizon */
+    incoming(pl, m, r, d, sun, albedo, l);
+    for (int k = 0; k < n; k++) L[(size_t)k * QN + q] = (float)((1.0 - f) * L[(size_t)k * QN + q] + f * l[k]);
+}
+
 static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_quad *qd, int ir, int is,
                   const double *albedo, float *out)
 {
@@ -158,6 +209,7 @@ static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_qu
         incoming(pl, m, r, d, sun, albedo, l);
         for (int k = 0; k < n; k++) L[(size_t)k * QN + q] = (float)l[k];
     }
+    for (int q = 0; q < QN; q++) horizon_cell(pl, m, qd, q, r, sun, albedo, L);
     for (int v = 0; v < JV; v++)
         for (int k = 0; k < n; k++) {
             const float *wr = qd->w + (((size_t)k * 2 + 0) * JV + v) * QN, *wm = wr + (size_t)JV * QN;

@@ -17,7 +17,9 @@ static double lum(const double *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.07
 
 /* The sky of a sun 2 degrees high from the ground, against the reference: 13 and 45 degrees
  * of azimuth from the sun near the horizon (the aerosols' forward lobe of the second order)
- * and the anti-solar side. Tolerance 3 % plus 3 standard errors of the reference. */
+ * and the anti-solar side. Tolerance 3 % plus 3 standard errors of the reference; the
+ * anti-solar horizon (el 5, az 180) within 2 % plus 2 (J's quadratic gamma mapping, 16
+ * degrees between its nodes at the anti-sun, left it 3.6 % too dark with 0.74 % of noise). */
 static void low_sun(atmos_atmosphere *a)
 {
     static const double view[4][2] = {{15, 0}, {5, 45}, {5, 180}, {30, 180}};
@@ -39,6 +41,7 @@ static void low_sun(atmos_atmosphere *a)
         printf("sun 2, view el %g az %g: J %+.2f %%, Psi %+.2f %% (tolerance %.2f %%)\n", view[v][0], view[v][1],
                100 * e, 100 * eo, 100 * tol);
         CHECK(fabs(e) < tol);
+        if (view[v][0] == 5 && view[v][1] == 180) CHECK(fabs(e) < 0.02 + 2.0 * sY / Y);
         old_misses += fabs(eo) > tol;
     }
     CHECK(old_misses >= 2); /* the test tells the two apart */
