@@ -5,6 +5,7 @@
  * with perspective-correct depth at texel centres; a look-up filters the four nearest
  * comparisons bilinearly, so that shadow edges move smoothly between texels. */
 #include "render/beams_internal.h"
+#include "render/beams_raster.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -44,23 +45,7 @@ static void draw(atmos__beams_face *F, const double v[3][3])
         sx[k] = (0.5 + 0.5 * v[k][0] * iz[k] / F->tan_half) * n;
         sy[k] = (0.5 + 0.5 * v[k][1] * iz[k] / F->tan_half) * n;
     }
-    const double area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
-    if (area == 0 || !isfinite(area)) return;
-    const int x0 = (int)fmax(0, floor(fmin(sx[0], fmin(sx[1], sx[2])))), x1 = (int)fmin(n - 1, ceil(fmax(sx[0], fmax(sx[1], sx[2]))));
-    const int y0 = (int)fmax(0, floor(fmin(sy[0], fmin(sy[1], sy[2])))), y1 = (int)fmin(n - 1, ceil(fmax(sy[0], fmax(sy[1], sy[2]))));
-    for (int y = y0; y <= y1; y++)
-        for (int x = x0; x <= x1; x++) {
-            const double px = x + 0.5, py = y + 0.5;
-            double b[3];
-            for (int k = 0; k < 3; k++) {
-                const int i = (k + 1) % 3, j = (k + 2) % 3;
-                b[k] = ((sx[j] - sx[i]) * (py - sy[i]) - (sy[j] - sy[i]) * (px - sx[i])) / area;
-            }
-            if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
-            const float z = (float)(1.0 / (b[0] * iz[0] + b[1] * iz[1] + b[2] * iz[2]));
-            float *d = F->depth + (size_t)y * n + x;
-            if (z < *d) *d = z;
-        }
+    atmos__beams_raster(F->depth, n, sx, sy, iz, 1);
 }
 
 /* Clips the triangle (face frame) at z = near (Sutherland-Hodgman) and draws what is left. */

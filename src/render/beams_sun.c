@@ -1,6 +1,7 @@
 /* The sun of the beam renderer (beams_sun.h): the fog's optical depth along a ray, the sun's
  * orthographic shadow map of the meshes, and the sunlight the fog scatters along a ray. */
 #include "render/beams_sun.h"
+#include "render/beams_raster.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -52,26 +53,8 @@ void atmos__beams_sun_free(atmos__beams_sun *s)
 /* One triangle (u, v in texels, depth) into the map: depth is linear in an orthographic view. */
 static void draw(atmos__beams_sun *s, const double v[3][3])
 {
-    const int n = s->n;
-    const double area = (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]);
-    if (area == 0 || !isfinite(area)) return;
-    const int x0 = (int)fmax(0, floor(fmin(v[0][0], fmin(v[1][0], v[2][0])))),
-              x1 = (int)fmin(n - 1, ceil(fmax(v[0][0], fmax(v[1][0], v[2][0]))));
-    const int y0 = (int)fmax(0, floor(fmin(v[0][1], fmin(v[1][1], v[2][1])))),
-              y1 = (int)fmin(n - 1, ceil(fmax(v[0][1], fmax(v[1][1], v[2][1]))));
-    for (int y = y0; y <= y1; y++)
-        for (int x = x0; x <= x1; x++) {
-            const double px = x + 0.5, py = y + 0.5;
-            double b[3];
-            for (int k = 0; k < 3; k++) {
-                const int i = (k + 1) % 3, j = (k + 2) % 3;
-                b[k] = ((v[j][0] - v[i][0]) * (py - v[i][1]) - (v[j][1] - v[i][1]) * (px - v[i][0])) / area;
-            }
-            if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
-            const float z = (float)(b[0] * v[0][2] + b[1] * v[1][2] + b[2] * v[2][2]);
-            float *d = s->depth + (size_t)y * n + x;
-            if (z < *d) *d = z;
-        }
+    const double x[3] = {v[0][0], v[1][0], v[2][0]}, y[3] = {v[0][1], v[1][1], v[2][1]}, z[3] = {v[0][2], v[1][2], v[2][2]};
+    atmos__beams_raster(s->depth, s->n, x, y, z, 0);
 }
 
 atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, const double dir[3], atmos_mesh *const *mesh,

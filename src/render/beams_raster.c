@@ -1,0 +1,28 @@
+/* The depth maps' triangle rasteriser (beams_raster.h): barycentric coverage of texel
+ * centres over the triangle's bounding box. */
+#include "render/beams_raster.h"
+
+#include <math.h>
+#include <stddef.h>
+
+void atmos__beams_raster(float *depth, int n, const double x[3], const double y[3], const double z[3], int perspective)
+{
+    const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    if (area == 0 || !isfinite(area)) return;
+    const int x0 = (int)fmax(0, floor(fmin(x[0], fmin(x[1], x[2])))), x1 = (int)fmin(n - 1, ceil(fmax(x[0], fmax(x[1], x[2]))));
+    const int y0 = (int)fmax(0, floor(fmin(y[0], fmin(y[1], y[2])))), y1 = (int)fmin(n - 1, ceil(fmax(y[0], fmax(y[1], y[2]))));
+    for (int py = y0; py <= y1; py++)
+        for (int px = x0; px <= x1; px++) {
+            const double cx = px + 0.5, cy = py + 0.5;
+            double b[3];
+            for (int k = 0; k < 3; k++) {
+                const int i = (k + 1) % 3, j = (k + 2) % 3;
+                b[k] = ((x[j] - x[i]) * (cy - y[i]) - (y[j] - y[i]) * (cx - x[i])) / area;
+            }
+            if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
+            const double w = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];
+            const float d = (float)(perspective ? 1.0 / w : w);
+            float *t = depth + (size_t)py * n + px;
+            if (d < *t) *t = d;
+        }
+}

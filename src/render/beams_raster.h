@@ -1,0 +1,12 @@
+/* The beam renderer's triangle rasteriser for its depth maps (the spotlights' cube faces,
+ * beams_shadow.c, and the sun's orthographic map, beams_sun.c). Not part of the API. */
+#ifndef ATMOS_RENDER_BEAMS_RASTER_H
+#define ATMOS_RENDER_BEAMS_RASTER_H
+
+/* One triangle into an n x n depth map, keeping the least depth per texel whose centre it
+ * covers: its vertices at texel coordinates (x[k], y[k]) with z[k] their depth (perspective 0:
+ * the depth is affine across the map, an orthographic view) or its reciprocal (perspective 1:
+ * 1/depth is affine, a pinhole view). */
+void atmos__beams_raster(float *depth, int n, const double x[3], const double y[3], const double z[3], int perspective);
+
+#endif
