@@ -169,23 +169,10 @@ static void test_cauchy(void)
     CHECK_REL(atmos__crystal_projected_area(&c, face), 2.0 * R * L, 1e-12);
 }
 
-int main(void)
+/* ice columns at three wavelengths: halos, chromatic order, normalisation */
+static double test_ice_columns(atmos_context *ctx2, atmos_particle_desc *ice_out, int n, const double *th,
+                               double *P)
 {
-    test_fresnel();
-    test_energy_per_ray();
-    test_cauchy();
-
-    const double *th;
-    int n = atmos_phase_grid(&th);
-    double *P = malloc(sizeof(double) * (size_t)n), *Q = malloc(sizeof(double) * (size_t)n);
-    atmos_context *ctx1 = NULL, *ctx2 = NULL;
-    atmos_context_desc cd = {0};
-    cd.threads = 1;
-    CHECK_OK(atmos_context_create(&cd, &ctx1));
-    cd.threads = 2;
-    CHECK_OK(atmos_context_create(&cd, &ctx2));
-
-    /* ---- ice columns at three wavelengths: halos, chromatic order, normalisation */
     atmos_particle_desc ice = {0};
     ice.kind = ATMOS_PARTICLE_ICE;
     ice.habit = ATMOS_CRYSTAL_COLUMN;
@@ -240,116 +227,148 @@ int main(void)
     CHECK(edge22[2] < edge22[1] && edge22[1] < edge22[0]);
     CHECK(peak22[2] < peak22[0]);
     CHECK(edge46[2] < edge46[0]);
+    *ice_out = ice;
+    return contrast_ice;
+}
 
-    /* ---- size from sigma_ext_m2 (Riley Table 2's ice), and plates */
-    {
-        atmos_particle_desc p = ice;
+/* size from sigma_ext_m2 (Riley Table 2's ice), and plates */
+static void test_plates(atmos_context *ctx2, const atmos_particle_desc *ice, int n, const double *th, double *P)
+{
+    atmos_particle_desc p = *ice;
+    atmos__phase_result r;
+    atmos__crystal_stats st;
+    p.size.r_m = 0.0;
+    p.sigma_ext_m2 = 1.82e-6;
+    p.habit = ATMOS_CRYSTAL_PLATE;
+    p.rays = 20000;
+    CHECK_OK(atmos__crystal_phase_ex(ctx2, &p, 550.0, n, th, P, &r, NULL, NULL, &st));
+    CHECK_REL(r.sigma_ext_m2, 1.82e-6, 1e-12);
+    CHECK_REL(st.length_m, 0.2 * 2.0 * st.radius_m, 1e-12);
+    double S = 3.0 * sqrt(3.0) * st.radius_m * st.radius_m + 6.0 * st.radius_m * st.length_m;
+    CHECK_REL(S / 2.0, 1.82e-6, 1e-12);
+    CHECK(all_finite(n, P));
+    CHECK_NEAR(atmos__sphere_integral(n, th, P), 1.0, 1e-4);
+    CHECK_MSG(r.g > 0.7 && r.g < 0.9, "plate g %g", r.g);
+    /* No size at all: 100 µm. */
+    p.sigma_ext_m2 = 0.0;
+    CHECK_OK(atmos__crystal_phase_ex(ctx2, &p, 550.0, n, th, P, &r, NULL, NULL, &st));
+    CHECK(st.radius_m == 100e-6);
+}
+
+/* snow: distorted crystals, no sharp halo, smooth */
+static void test_snow(atmos_context *ctx2, const atmos_particle_desc *ice, double contrast_ice, int n,
+                      const double *th, double *P)
+{
+    atmos_particle_desc snow = *ice;
+    snow.kind = ATMOS_PARTICLE_SNOW;
+    snow.habit = ATMOS_CRYSTAL_PLATE;
+    atmos__phase_result r;
+    atmos__crystal_stats st;
+    CHECK_OK(atmos__crystal_phase_ex(ctx2, &snow, 680.0, n, th, P, &r, NULL, NULL, &st));
+    CHECK(all_finite(n, P));
+    CHECK_NEAR(atmos__sphere_integral(n, th, P), 1.0, 1e-4);
+    CHECK(st.tilt_rad == 0.3);
+    CHECK_NEAR(st.reflected + st.transmitted + st.absorbed + st.lost, 1.0, 1e-9);
+    double contrast = at(n, th, P, 22.0) / at(n, th, P, 18.0);
+    printf("22°/18° contrast: ice %.2f, snow %.2f; snow g %.4f\n", contrast_ice, contrast, r.g);
+    CHECK_MSG(contrast < 1.3 && contrast < 0.2 * contrast_ice, "snow contrast %g (ice %g)", contrast, contrast_ice);
+    double c46 = at(n, th, P, 46.5) / at(n, th, P, 42.0);
+    CHECK_MSG(c46 < 1.1, "snow 46°/42° contrast %g", c46);
+    /* Smooth where the halos would be: relative second differences at 1° spacing
+     * from 10° to 60° (ice has ~20 at its halo edges; fast-mode noise is ~0.1). */
+    double worst = 0.0;
+    for (double t = 10.0; t <= 60.0; t += 1.0) {
+        double a = at(n, th, P, t - 1.0), b = at(n, th, P, t), c = at(n, th, P, t + 1.0);
+        worst = fmax(worst, fabs(a - 2.0 * b + c) / b);
+    }
+    CHECK_MSG(worst < 0.35, "snow roughness %g", worst);
+    CHECK_MSG(r.g > 0.6 && r.g < 0.9, "snow g %g", r.g);
+}
+
+/* determinism: 1 and 2 threads give the same bits */
+static void test_determinism(atmos_context *ctx1, atmos_context *ctx2, const atmos_particle_desc *ice, int n,
+                             const double *th, double *P, double *Q)
+{
+    atmos_particle_desc p = *ice;
+    p.rays = 12800;
+    atmos__phase_result r1, r2;
+    CHECK_OK(atmos__crystal_phase(ctx1, &p, 500.0, n, th, P, &r1, NULL, NULL));
+    CHECK_OK(atmos__crystal_phase(ctx2, &p, 500.0, n, th, Q, &r2, NULL, NULL));
+    CHECK(memcmp(P, Q, sizeof(double) * (size_t)n) == 0);
+    CHECK(r1.g == r2.g && r1.albedo == r2.albedo && r1.sigma_ext_m2 == r2.sigma_ext_m2);
+    p.kind = ATMOS_PARTICLE_SNOW;
+    CHECK_OK(atmos__crystal_phase(ctx1, &p, 500.0, n, th, P, &r1, NULL, NULL));
+    CHECK_OK(atmos__crystal_phase(ctx2, &p, 500.0, n, th, Q, &r2, NULL, NULL));
+    CHECK(memcmp(P, Q, sizeof(double) * (size_t)n) == 0);
+}
+
+/* cancellation and bad input */
+static void test_bad_input(atmos_context *ctx2, const atmos_particle_desc *ice, int n, const double *th, double *P)
+{
+    atmos_particle_desc p = *ice;
+    p.rays = 6400;
+    int calls = 0;
+    CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, cancel_progress, &calls) == ATMOS_E_CANCELLED);
+    CHECK(calls >= 1);
+    p.kind = ATMOS_PARTICLE_WATER;
+    CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
+    p.kind = ATMOS_PARTICLE_ICE;
+    p.aspect_ratio = -1.0;
+    CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
+    CHECK(strstr(atmos_context_error(ctx2), "aspect_ratio") != NULL);
+    p.aspect_ratio = NAN;
+    CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
+    p.aspect_ratio = 0.0;
+    p.rays = 1L << 40;
+    CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_LIMIT);
+    p.rays = 6400;
+    CHECK(atmos__crystal_phase(ctx2, &p, NAN, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
+    p.size.r_m = -1.0;
+    CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
+    p.size.r_m = 100e-6;
+    p.distortion = 5.0;
+    p.kind = ATMOS_PARTICLE_SNOW;
+    CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
+    /* Extremes stay finite: a needle and a thin plate, tiny and huge crystals. */
+    p.distortion = 0.0;
+    const double aspects[4] = {100.0, 0.01, 2.0, 0.2};
+    const double radii[4] = {1e-6, 1e-6, 0.1, 5e-3};
+    for (int i = 0; i < 4; i++) {
+        p.aspect_ratio = aspects[i];
+        p.size.r_m = radii[i];
+        p.kind = i % 2 ? ATMOS_PARTICLE_ICE : ATMOS_PARTICLE_SNOW;
         atmos__phase_result r;
-        atmos__crystal_stats st;
-        p.size.r_m = 0.0;
-        p.sigma_ext_m2 = 1.82e-6;
-        p.habit = ATMOS_CRYSTAL_PLATE;
-        p.rays = 20000;
-        CHECK_OK(atmos__crystal_phase_ex(ctx2, &p, 550.0, n, th, P, &r, NULL, NULL, &st));
-        CHECK_REL(r.sigma_ext_m2, 1.82e-6, 1e-12);
-        CHECK_REL(st.length_m, 0.2 * 2.0 * st.radius_m, 1e-12);
-        double S = 3.0 * sqrt(3.0) * st.radius_m * st.radius_m + 6.0 * st.radius_m * st.length_m;
-        CHECK_REL(S / 2.0, 1.82e-6, 1e-12);
-        CHECK(all_finite(n, P));
-        CHECK_NEAR(atmos__sphere_integral(n, th, P), 1.0, 1e-4);
-        CHECK_MSG(r.g > 0.7 && r.g < 0.9, "plate g %g", r.g);
-        /* No size at all: 100 µm. */
-        p.sigma_ext_m2 = 0.0;
-        CHECK_OK(atmos__crystal_phase_ex(ctx2, &p, 550.0, n, th, P, &r, NULL, NULL, &st));
-        CHECK(st.radius_m == 100e-6);
-    }
-
-    /* ---- snow: distorted crystals, no sharp halo, smooth */
-    {
-        atmos_particle_desc snow = ice;
-        snow.kind = ATMOS_PARTICLE_SNOW;
-        snow.habit = ATMOS_CRYSTAL_PLATE;
-        atmos__phase_result r;
-        atmos__crystal_stats st;
-        CHECK_OK(atmos__crystal_phase_ex(ctx2, &snow, 680.0, n, th, P, &r, NULL, NULL, &st));
-        CHECK(all_finite(n, P));
-        CHECK_NEAR(atmos__sphere_integral(n, th, P), 1.0, 1e-4);
-        CHECK(st.tilt_rad == 0.3);
-        CHECK_NEAR(st.reflected + st.transmitted + st.absorbed + st.lost, 1.0, 1e-9);
-        double contrast = at(n, th, P, 22.0) / at(n, th, P, 18.0);
-        printf("22°/18° contrast: ice %.2f, snow %.2f; snow g %.4f\n", contrast_ice, contrast, r.g);
-        CHECK_MSG(contrast < 1.3 && contrast < 0.2 * contrast_ice, "snow contrast %g (ice %g)", contrast, contrast_ice);
-        double c46 = at(n, th, P, 46.5) / at(n, th, P, 42.0);
-        CHECK_MSG(c46 < 1.1, "snow 46°/42° contrast %g", c46);
-        /* Smooth where the halos would be: relative second differences at 1° spacing
-         * from 10° to 60° (ice has ~20 at its halo edges; fast-mode noise is ~0.1). */
-        double worst = 0.0;
-        for (double t = 10.0; t <= 60.0; t += 1.0) {
-            double a = at(n, th, P, t - 1.0), b = at(n, th, P, t), c = at(n, th, P, t + 1.0);
-            worst = fmax(worst, fabs(a - 2.0 * b + c) / b);
-        }
-        CHECK_MSG(worst < 0.35, "snow roughness %g", worst);
-        CHECK_MSG(r.g > 0.6 && r.g < 0.9, "snow g %g", r.g);
-    }
-
-    /* ---- determinism: 1 and 2 threads give the same bits */
-    {
-        atmos_particle_desc p = ice;
-        p.rays = 12800;
-        atmos__phase_result r1, r2;
-        CHECK_OK(atmos__crystal_phase(ctx1, &p, 500.0, n, th, P, &r1, NULL, NULL));
-        CHECK_OK(atmos__crystal_phase(ctx2, &p, 500.0, n, th, Q, &r2, NULL, NULL));
-        CHECK(memcmp(P, Q, sizeof(double) * (size_t)n) == 0);
-        CHECK(r1.g == r2.g && r1.albedo == r2.albedo && r1.sigma_ext_m2 == r2.sigma_ext_m2);
-        p.kind = ATMOS_PARTICLE_SNOW;
-        CHECK_OK(atmos__crystal_phase(ctx1, &p, 500.0, n, th, P, &r1, NULL, NULL));
-        CHECK_OK(atmos__crystal_phase(ctx2, &p, 500.0, n, th, Q, &r2, NULL, NULL));
-        CHECK(memcmp(P, Q, sizeof(double) * (size_t)n) == 0);
-    }
-
-    /* ---- cancellation and bad input */
-    {
-        atmos_particle_desc p = ice;
-        p.rays = 6400;
-        int calls = 0;
-        CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, cancel_progress, &calls) == ATMOS_E_CANCELLED);
-        CHECK(calls >= 1);
-        p.kind = ATMOS_PARTICLE_WATER;
-        CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
-        p.kind = ATMOS_PARTICLE_ICE;
-        p.aspect_ratio = -1.0;
-        CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
-        CHECK(strstr(atmos_context_error(ctx2), "aspect_ratio") != NULL);
-        p.aspect_ratio = NAN;
-        CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
-        p.aspect_ratio = 0.0;
-        p.rays = 1L << 40;
-        CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_LIMIT);
-        p.rays = 6400;
-        CHECK(atmos__crystal_phase(ctx2, &p, NAN, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
-        p.size.r_m = -1.0;
-        CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
-        p.size.r_m = 100e-6;
-        p.distortion = 5.0;
-        p.kind = ATMOS_PARTICLE_SNOW;
-        CHECK(atmos__crystal_phase(ctx2, &p, 550.0, n, th, P, NULL, NULL, NULL) == ATMOS_E_INVALID_ARG);
-        /* Extremes stay finite: a needle and a thin plate, tiny and huge crystals. */
-        p.distortion = 0.0;
-        const double aspects[4] = {100.0, 0.01, 2.0, 0.2};
-        const double radii[4] = {1e-6, 1e-6, 0.1, 5e-3};
-        for (int i = 0; i < 4; i++) {
-            p.aspect_ratio = aspects[i];
-            p.size.r_m = radii[i];
-            p.kind = i % 2 ? ATMOS_PARTICLE_ICE : ATMOS_PARTICLE_SNOW;
-            atmos__phase_result r;
-            atmos_status s = atmos__crystal_phase(ctx2, &p, 400.0, n, th, P, &r, NULL, NULL);
-            CHECK_MSG(s == ATMOS_OK || s == ATMOS_E_INVALID_ARG, "extreme %d: %s", i, atmos_status_string(s));
-            if (s == ATMOS_OK) {
-                CHECK(all_finite(n, P));
-                CHECK(isfinite(r.g) && isfinite(r.albedo) && isfinite(r.sigma_ext_m2));
-            }
+        atmos_status s = atmos__crystal_phase(ctx2, &p, 400.0, n, th, P, &r, NULL, NULL);
+        CHECK_MSG(s == ATMOS_OK || s == ATMOS_E_INVALID_ARG, "extreme %d: %s", i, atmos_status_string(s));
+        if (s == ATMOS_OK) {
+            CHECK(all_finite(n, P));
+            CHECK(isfinite(r.g) && isfinite(r.albedo) && isfinite(r.sigma_ext_m2));
         }
     }
+}
+
+int main(void)
+{
+    test_fresnel();
+    test_energy_per_ray();
+    test_cauchy();
+
+    const double *th;
+    int n = atmos_phase_grid(&th);
+    double *P = malloc(sizeof(double) * (size_t)n), *Q = malloc(sizeof(double) * (size_t)n);
+    atmos_context *ctx1 = NULL, *ctx2 = NULL;
+    atmos_context_desc cd = {0};
+    cd.threads = 1;
+    CHECK_OK(atmos_context_create(&cd, &ctx1));
+    cd.threads = 2;
+    CHECK_OK(atmos_context_create(&cd, &ctx2));
+
+    atmos_particle_desc ice;
+    double contrast_ice = test_ice_columns(ctx2, &ice, n, th, P);
+    test_plates(ctx2, &ice, n, th, P);
+    test_snow(ctx2, &ice, contrast_ice, n, th, P);
+    test_determinism(ctx1, ctx2, &ice, n, th, P, Q);
+    test_bad_input(ctx2, &ice, n, th, P);
 
     atmos_context_destroy(ctx1);
     atmos_context_destroy(ctx2);
