@@ -1,7 +1,8 @@
 #!/bin/sh
 # Sub-planes against none (docs/beams.md, "Planes and sub-planes"): Dobashi et al. 2002's Fig. 4
 # scene rendered by the beam renderer with its settings, with a coarser and a finer epsilon,
-# and without sub-planes at plane spacings of 1.2, 0.3 and 0.1 m, each against a reference of
+# without sub-planes at plane spacings of 1.2, 0.3 and 0.1 m, and with interleaved sampling
+# instead of sub-planes (2x2, 3x3), each against a reference of
 # the same renderer converged far beyond them (epsilon 5e-4, up to 2048 sub-planes, planes
 # 0.3 m apart, 2048-texel shadow map); per case the mean and the worst relative difference
 # over the pixels above 1e-3 of the brightest. `atmos bench beams` times the same cases.
@@ -45,4 +46,7 @@ epsilon_0.003 -D beams.epsilon=0.003 -D beams.max_subplanes=256
 no_subplanes_1.2m -D beams.max_subplanes=1
 no_subplanes_0.3m -D beams.max_subplanes=1 -D beams.plane_spacing_m=0.3
 no_subplanes_0.1m -D beams.max_subplanes=1 -D beams.plane_spacing_m=0.1
+interleaved_2 -D beams.max_subplanes=1 -D beams.interleave=2
+interleaved_3 -D beams.max_subplanes=1 -D beams.interleave=3
+interleaved_3_0.3m -D beams.max_subplanes=1 -D beams.interleave=3 -D beams.plane_spacing_m=0.3
 CASES

@@ -137,6 +137,9 @@ typedef struct atmos_scene_beams {
     int shadow_size;          /* shadow map texels per side (per cube face for point lights); 512 */
     int sun;                  /* 1: the scene's sun lights the fog and the objects too (a directional light with a
                                  shadow map, docs/beams.md); 0 */
+    int interleave;           /* Keller and Heidrich 2001's interleaved sampling: each pixel of an N x N block samples
+                                 between the planes at its own offset, and the airlight is averaged over N x N pixels
+                                 of similar depth; 1 = off (the default) */
 } atmos_scene_beams;
 
 /* Lights besides the sun ("lights" in the file; the beam renderer's). */

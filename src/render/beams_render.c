@@ -14,9 +14,12 @@
  *     every depth the shadow map's tiles there hold, or beyond them all) samples the falloff
  *     alone, or nothing when it is in shadow or inside the inner cone: the value its samples
  *     would all have.
+ * With interleaved sampling (beams/interleave N > 1, beams_interleave.h) the samples between
+ * the planes sit at a pixel's own offset, and the airlight is filtered over N x N pixels.
  * Rows go to the threads; each pixel depends on nothing but its own ray, so the image does
  * not depend on the thread count. */
 #include "render/beams_internal.h"
+#include "render/beams_interleave.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -66,7 +69,7 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
 /* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
  * image's tint at every sample (so no interval is taken as uniform: its colour varies). */
 static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *ray, const double d[3], const double *f,
-                   int n, double S, double *L, int centre)
+                   int n, double S, double *L, int centre, double o)
 {
     double sum[3] = {0, 0, 0};
     for (int k = 0; k < n; k++) {
@@ -77,7 +80,7 @@ static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
         double h[3] = {0, 0, 0};
         for (int s = 0; s < m; s++) {
-            const double t = ta + (s + 0.5) * step, v = atmos__beams_ray_light(ray, t);
+            const double t = ta + (s + o) * step, v = atmos__beams_ray_light(ray, t);
             if (!(v > 0)) continue;
             const double P[3] = {J->eye[0] + t * d[0], J->eye[1] + t * d[1], J->eye[2] + t * d[2]};
             double tint[3];
@@ -90,9 +93,10 @@ static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum[k < 3 ? k : 2];
 }
 
-/* Light i scattered toward the eye along [0, T) of the ray d, added to L. f holds room for
+/* Light i scattered toward the eye along [0, T) of the ray d, added to L; the samples between
+ * two planes at offset o (0.5: the midpoints) of their parts. f holds room for
  * MAX_INTERVALS + 1 values. */
-static void airlight(job *J, int i, const double d[3], double T, double *f, double *L, int centre)
+static void airlight(job *J, int i, const double d[3], double T, double *f, double *L, int centre, double o)
 {
     const atmos__beams_plan *b = J->b;
     const atmos__beams_light *l = &b->lights[i];
@@ -130,7 +134,7 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     atmos__beams_ray ray;
     atmos__beams_ray_init(l, J->eye, d, &ray);
     if (l->L.tex) {
-        tinted(J, l, &ray, d, f, n, S, L, centre);
+        tinted(J, l, &ray, d, f, n, S, L, centre, o);
         return;
     }
     double sum = 0;
@@ -148,9 +152,9 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
             continue;
         }
         if (uniform) /* lit all along: the falloff alone varies */
-            for (int s = 0; s < m; s++) h += atmos__beams_ray_falloff(&ray, ta + (s + 0.5) * step);
+            for (int s = 0; s < m; s++) h += atmos__beams_ray_falloff(&ray, ta + (s + o) * step);
         else
-            for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + 0.5) * step);
+            for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + o) * step);
         sum += h / m * fl;
         if (centre) J->centre_subplanes += m;
     }
@@ -176,23 +180,40 @@ static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, i
     }
 }
 
-static void pixel(job *J, int x, int y, float *px, double *f)
+/* Pixel (x, y): the surface or the sky behind, the lights' airlight and the sun's, into px.
+ * With interleaved sampling (il) the lights' airlight goes to il instead, with what the pixel
+ * sees; px NULL: a pixel outside the frame's rectangle that the filter reads, its airlight
+ * alone. */
+static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *il)
 {
     const atmos__beams_plan *b = J->b;
-    double d[3], L[ATMOS_MAX_WAVELENGTHS];
+    double d[3], L[ATMOS_MAX_WAVELENGTHS], A[ATMOS_MAX_WAVELENGTHS];
     atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
     atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
     const int hit = atmos__objects_hit(&b->obj, J->eye, d, 0, INFINITY, &h, &m);
     const double T = hit ? h.t : INFINITY;
-    const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, T)); /* 0 to the sky behind endless fog */
-    if (hit) shade_surface(J, d, &h, m, fog_t, L);
-    else
-        for (int k = 0; k < J->nw; k++) L[k] = px[k] * fog_t;
+    if (px) {
+        const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, T)); /* 0 to the sky behind endless fog */
+        if (hit) shade_surface(J, d, &h, m, fog_t, L);
+        else
+            for (int k = 0; k < J->nw; k++) L[k] = px[k] * fog_t;
+        if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
+        if (!il) {
+            if (b->sigma_t > 0)
+                for (int i = 0; i < b->nlights; i++) airlight(J, i, d, T, f, L, x == J->cx && y == J->cy, 0.5);
+            if (b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
+        }
+        for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
+    }
+    if (!il) return;
+    const long q = atmos__beams_il_index(il, x, y);
+    const double o = atmos__beams_il_offset(il->n, x, y);
+    for (int k = 0; k < J->nw; k++) A[k] = 0;
     if (b->sigma_t > 0)
-        for (int i = 0; i < b->nlights; i++) airlight(J, i, d, T, f, L, x == J->cx && y == J->cy);
-    if (b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
-    for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
+        for (int i = 0; i < b->nlights; i++) airlight(J, i, d, T, f, A, px && x == J->cx && y == J->cy, o);
+    for (int k = 0; k < J->nw; k++) il->air[(size_t)q * J->nw + k] = (float)A[k];
+    il->depth[q] = (float)T, il->object[q] = hit ? m : -1;
 }
 
 /* Each light's planes: evenly spaced in depth along the view across the sphere it reaches. */
@@ -214,6 +235,44 @@ static atmos_status planes(atmos_plan *p, job *J)
     return ATMOS_OK;
 }
 
+/* The pixels of rows [y0, y1) over columns [x0, x1), each row to one thread (dynamically: a
+ * pixel depends on its own ray alone, so the image is the same for any thread count); with
+ * il, the pixels outside r get their airlight alone. Returns 1 when out of memory. */
+static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *e, atmos_image *out, atmos__beams_il *il,
+                int *cancelled)
+{
+    const int W = out->width, C = out->channels, n = e->y1 - e->y0;
+    int failed = 0, done = 0;
+#pragma omp parallel num_threads(atmos__threads(p->ctx))
+    {
+        double *f = malloc(sizeof(double) * (2 * MAX_INTERVALS + 2));
+        if (!f) {
+#pragma omp atomic write
+            failed = 1;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (int y = e->y0; y < e->y1; y++) {
+            if (atmos__cancelled(cancelled) || !f) continue;
+            for (int x = e->x0; x < e->x1; x++) {
+                const int inside = x >= r->x0 && x < r->x1 && y >= r->y0 && y < r->y1;
+                pixel(J, x, y, inside ? out->pixels + ((size_t)y * W + x) * C : NULL, f, il);
+            }
+            atmos__progress_step(p->ctx, "render beams", &done, n, cancelled);
+        }
+        free(f);
+    }
+    return failed;
+}
+
+/* Interleaved sampling's second pass: each pixel of r gets its filtered airlight. */
+static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const atmos__beams_il *il)
+{
+    const int W = out->width, C = out->channels;
+#pragma omp parallel for schedule(static) num_threads(atmos__threads(p->ctx))
+    for (int y = r->y0; y < r->y1; y++)
+        for (int x = r->x0; x < r->x1; x++) atmos__beams_il_add(il, x, y, out->pixels + ((size_t)y * W + x) * C);
+}
+
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
 {
     atmos__beams_plan *b = p->beams;
@@ -230,25 +289,15 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         free(J.z_lo);
         return st;
     }
-    const int W = out->width, C = out->channels, rows = r->y1 - r->y0;
-    int failed = 0, cancelled = 0, done = 0;
-#pragma omp parallel num_threads(atmos__threads(p->ctx))
-    {
-        double *f = malloc(sizeof(double) * (2 * MAX_INTERVALS + 2));
-        if (!f) {
-#pragma omp atomic write
-            failed = 1;
-        }
-        /* rows handed out dynamically; a pixel depends on its own ray alone, so the image is
-         * the same for any thread count */
-#pragma omp for schedule(dynamic, 1)
-        for (int y = r->y0; y < r->y1; y++) {
-            if (atmos__cancelled(&cancelled) || !f) continue;
-            for (int x = r->x0; x < r->x1; x++) pixel(&J, x, y, out->pixels + ((size_t)y * W + x) * C, f);
-            atmos__progress_step(p->ctx, "render beams", &done, rows, &cancelled);
-        }
-        free(f);
+    atmos__beams_il il = {0}, *ilp = NULL;
+    int failed = 0, cancelled = 0;
+    if (p->scene.beams.interleave > 1) {
+        ilp = &il;
+        failed = atmos__beams_il_init(&il, p->scene.beams.interleave, J.nw, r, out->width, out->height);
     }
+    if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
+    if (ilp && !failed && !cancelled) filter(p, r, out, &il);
+    atmos__beams_il_free(&il);
     free(J.z_lo);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");

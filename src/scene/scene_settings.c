@@ -115,6 +115,10 @@ static const atmos_setting beams_settings[] = {
      "shadow map texels per side (per cube face for a point light)", BEAMS(shadow_size)},
     {"sun", "beams-sun", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 0,
      "the scene's sun lights the fog and the objects too: a directional light with a shadow map", BEAMS(sun)},
+    {"interleave", "interleave", ATMOS_SETTING_INT, "pixels", 1, 8, 0, 0, 1, NULL, 0,
+     "interleaved sampling (Keller and Heidrich 2001): the pixels of each N x N block sample between the planes at N^2 "
+     "different offsets, their airlight averaged over N x N pixels of similar depth (1: off)",
+     BEAMS(interleave)},
 };
 
 const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)

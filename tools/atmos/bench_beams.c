@@ -1,6 +1,7 @@
 /* atmos bench beams: the beam renderer's frame rate (Dobashi et al. 2002 §4, docs/beams.md)
  * on the Fig. 4 scene (a sphere under a spotlight, 300x450) and on variants of it: without
- * sub-planes (at the scene's plane spacing, 0.3 m and 0.1 m), with a coarser epsilon, with two
+ * sub-planes (at the scene's plane spacing, 0.3 m and 0.1 m), with a coarser epsilon, with
+ * interleaved sampling instead of sub-planes (Keller and Heidrich 2001: 2x2 and 3x3), with two
  * and four lights (the spot copied around the first), and at twice the size; then the studio
  * of Fig. 9(a), the searchlights and the mountains of Fig. 10(a) at Table 1's 720x480. Each case makes one plan (objects, shadow maps, the scattering table) and renders
  * frames with the camera moving round the sphere (a degree a frame): what interactive use
@@ -16,6 +17,7 @@ typedef struct beams_case {
     const char *name;
     int lights, scale, subplanes;
     double spacing_m, epsilon; /* 0: the scene's */
+    int interleave;            /* 0: the scene's */
 } beams_case;
 
 static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_case *c, int frames, int threads)
@@ -25,6 +27,7 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     if (!c->subplanes) s.beams.max_subplanes = 1;
     if (c->spacing_m > 0) s.beams.plane_spacing_m = c->spacing_m;
     if (c->epsilon > 0) s.beams.epsilon = c->epsilon;
+    if (c->interleave > 0) s.beams.interleave = c->interleave;
     for (int i = 1; base->light_count > 0 && i < c->lights && i < ATMOS_SCENE_MAX_LIGHTS; i++) { /* copies of the first */
         s.lights[i] = s.lights[0];
         s.lights[i].position_m[0] += 6 * cos(2 * 3.14159265358979 * i / c->lights);
@@ -52,10 +55,10 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     int rc = CLI_EXIT_OK;
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
     else
-        printf("bench=beams scene=%s size=%dx%d lights=%d subplanes=%s plane_spacing_m=%g epsilon=%g threads=%d frames=%d "
+        printf("bench=beams scene=%s size=%dx%d lights=%d subplanes=%s plane_spacing_m=%g epsilon=%g interleave=%d threads=%d frames=%d "
                "plan_seconds=%.3f frame_ms=%.1f best_ms=%.1f cpu_ms=%.1f fps=%.1f\n",
                c->name, s.width, s.height, s.light_count, c->subplanes ? "on" : "off", s.beams.plane_spacing_m,
-               s.beams.epsilon, threads, frames, plan_s, 1e3 * total / frames, 1e3 * best, 1e3 * cpu / frames,
+               s.beams.epsilon, s.beams.interleave, threads, frames, plan_s, 1e3 * total / frames, 1e3 * best, 1e3 * cpu / frames,
                frames / total);
     fflush(stdout);
     atmos_image_destroy(img);
@@ -74,14 +77,17 @@ int bench_beams(const char *file, int frames, int threads)
         st = ATMOS_E_INVALID_ARG, fprintf(stderr, "atmos bench: %s: not a beams scene\n", path);
     int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error("bench", ctx, st);
     static const beams_case cases[] = {
-        {"dobashi_fig04", 1, 1, 1, 0, 0},
-        {"dobashi_fig04_no_subplanes", 1, 1, 0, 0, 0},
-        {"dobashi_fig04_no_subplanes_0.3m", 1, 1, 0, 0.3, 0},
-        {"dobashi_fig04_no_subplanes_0.1m", 1, 1, 0, 0.1, 0},
-        {"dobashi_fig04_epsilon_0.03", 1, 1, 1, 0, 0.03},
-        {"dobashi_fig04_2_lights", 2, 1, 1, 0, 0},
-        {"dobashi_fig04_4_lights", 4, 1, 1, 0, 0},
-        {"dobashi_fig04_double_size", 1, 2, 1, 0, 0},
+        {"dobashi_fig04", 1, 1, 1, 0, 0, 0},
+        {"dobashi_fig04_no_subplanes", 1, 1, 0, 0, 0, 0},
+        {"dobashi_fig04_no_subplanes_0.3m", 1, 1, 0, 0.3, 0, 0},
+        {"dobashi_fig04_no_subplanes_0.1m", 1, 1, 0, 0.1, 0, 0},
+        {"dobashi_fig04_epsilon_0.03", 1, 1, 1, 0, 0.03, 0},
+        {"dobashi_fig04_interleaved_2", 1, 1, 0, 0, 0, 2},
+        {"dobashi_fig04_interleaved_3", 1, 1, 0, 0, 0, 3},
+        {"dobashi_fig04_interleaved_3_0.3m", 1, 1, 0, 0.3, 0, 3},
+        {"dobashi_fig04_2_lights", 2, 1, 1, 0, 0, 0},
+        {"dobashi_fig04_4_lights", 4, 1, 1, 0, 0, 0},
+        {"dobashi_fig04_double_size", 1, 2, 1, 0, 0, 0},
     };
     const int used = atmos_context_threads(ctx);
     for (size_t i = 0; rc == CLI_EXIT_OK && i < sizeof cases / sizeof *cases; i++)
@@ -91,7 +97,7 @@ int bench_beams(const char *file, int frames, int threads)
                                             {"searchlights_fog", "scenes/searchlights_fog.json"},
                                             {"dobashi_fig10a_mountain_shafts", "scenes/dobashi_fig10a_mountain_shafts.json"}};
     for (size_t i = 0; !file && rc == CLI_EXIT_OK && i < sizeof table1 / sizeof *table1; i++) {
-        const beams_case c = {table1[i][0], 0, 1, 1, 0, 0};
+        const beams_case c = {table1[i][0], 0, 1, 1, 0, 0, 0};
         if ((st = atmos_scene_load(ctx, table1[i][1], &s)) != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
         else rc = run_case(ctx, &s, &c, frames, used);
     }
