@@ -57,7 +57,10 @@ if renderer == "slice":
 m = re.match(r"Riley et al\. 2004, (Figs?\. [0-9]+(?:(?:, | and |-)[0-9]+)*)", s.get("_comment", ""))
 fig = m.group(1) if m else "-"
 f = vol.get("file") if vol else None
-f = os.path.join(os.path.dirname(path), f) if f and not os.path.isabs(f) else f
+if f and f.startswith("data:"):  # the data folder (docs/scene-format.md)
+    f = os.path.join(os.environ.get("ATMOS_DATA") or os.path.join(os.path.dirname(os.path.abspath(path)), "..", "..", "shared", "data"), f[5:])
+elif f and not f.startswith(("generate:", "simulate:")) and not os.path.isabs(f):
+    f = os.path.join(os.path.dirname(path), f)
 print("%d\t%d\t%s\t%s\t%s" % (w, h, renderer, fig, f or "-"))
 PY
 ) || { echo "| $name | (unreadable scene) | | | | |"; status=1; continue; }

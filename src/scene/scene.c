@@ -322,41 +322,22 @@ atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t
     const int in = !strcmp(path, "-");
     if (in) path = "standard input";
     atmos_status st = atmos_scene_parse_with(ctx, json, length, path, overrides, count, out);
-    /* A relative volume file is relative to the scene file's folder, so scenes can
-     * be rendered from anywhere. */
-    atmos_scene_volume *v = &out->volume;
+    /* Relative files are relative to the scene file's folder, so scenes can be rendered from
+     * anywhere; "data:" files are in the data folder (scene_paths.c). */
     const char *slash = in ? NULL : strrchr(path, '/'); /* from standard input: the current folder */
-    if (st == ATMOS_OK && v->source[0] && v->source[0] != '/' && strncmp(v->source, "generate:", 9) &&
-        strncmp(v->source, "simulate:", 9) && slash) {
-        size_t dir = (size_t)(slash - path) + 1, n = strlen(v->source);
-        if (dir + n >= sizeof v->source)
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /volume/file: the path is too long once joined to the scene's folder",
-                                path);
-        memmove(v->source + dir, v->source, n + 1);
-        memcpy(v->source, path, dir);
+    const size_t dir = slash ? (size_t)(slash - path) + 1 : 0;
+    char key[64];
+    if (st == ATMOS_OK)
+        st = atmos__scene_join_path(ctx, path, dir, out->volume.source, sizeof out->volume.source, "volume/file");
+    if (st == ATMOS_OK) st = atmos__scene_earth_paths(ctx, path, dir, &out->earth);
+    for (int i = 0; st == ATMOS_OK && i < out->light_count; i++) {
+        snprintf(key, sizeof key, "lights/%d/image", i);
+        st = atmos__scene_join_path(ctx, path, dir, out->lights[i].image, ATMOS_SCENE_PATH_MAX, key);
     }
-    if (st == ATMOS_OK) st = atmos__scene_earth_paths(ctx, path, slash ? (size_t)(slash - path) + 1 : 0, &out->earth);
-    /* the lights' images likewise */
-    for (int i = 0; st == ATMOS_OK && slash && i < out->light_count; i++) {
-        char *m = out->lights[i].image;
-        const size_t dir = (size_t)(slash - path) + 1, n = strlen(m);
-        if (!m[0] || m[0] == '/') continue;
-        if (dir + n >= sizeof out->lights[i].image)
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /lights/%d/image: the path is too long once joined to the "
-                                "scene's folder", path, i);
-        memmove(m + dir, m, n + 1);
-        memcpy(m, path, dir);
-    }
-    /* the objects' OBJ files likewise */
-    for (int i = 0; st == ATMOS_OK && slash && i < 2 * out->object_count; i++) {
+    for (int i = 0; st == ATMOS_OK && i < 2 * out->object_count; i++) {
         char *m = i % 2 ? out->objects[i / 2].terrain : out->objects[i / 2].mesh; /* both ATMOS_SCENE_PATH_MAX */
-        const size_t dir = (size_t)(slash - path) + 1, n = strlen(m);
-        if (!m[0] || m[0] == '/' || !strncmp(m, "builtin:", 8) || !strncmp(m, "generate:", 9)) continue;
-        if (dir + n >= ATMOS_SCENE_PATH_MAX)
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: /objects/%d/%s: the path is too long once joined to the "
-                                "scene's folder", path, i / 2, i % 2 ? "terrain" : "mesh");
-        memmove(m + dir, m, n + 1);
-        memcpy(m, path, dir);
+        snprintf(key, sizeof key, "objects/%d/%s", i / 2, i % 2 ? "terrain" : "mesh");
+        st = atmos__scene_join_path(ctx, path, dir, m, ATMOS_SCENE_PATH_MAX, key);
     }
     return st;
 }

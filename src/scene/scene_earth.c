@@ -13,15 +13,10 @@ static atmos_status fix_path(atmos_context *ctx, const char *scene, size_t dir, 
                              const char *key)
 {
     if (!p[0]) return ATMOS_OK;
-    if (p[0] != '/' && dir > 0) {
-        const size_t n = strlen(p);
-        if (dir + n >= cap)
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG,
-                                "%s: /atmosphere/%s: the path is too long once joined to the scene's folder", scene,
-                                key);
-        memmove(p + dir, p, n + 1);
-        memcpy(p, scene, dir);
-    }
+    char field[64];
+    snprintf(field, sizeof field, "atmosphere/%s", key);
+    atmos_status st = atmos__scene_join_path(ctx, scene, dir, p, cap, field);
+    if (st != ATMOS_OK) return st;
     if (access(p, R_OK) != 0)
         return atmos__error(ctx, ATMOS_E_IO, "%s: /atmosphere/%s: cannot read %s: %s", scene, key, p, strerror(errno));
     return ATMOS_OK;

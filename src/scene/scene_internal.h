@@ -101,4 +101,13 @@ atmos_status atmos__scene_validate_lights(atmos_context *ctx, const char *source
  * to be readable. */
 atmos_status atmos__scene_earth_paths(atmos_context *ctx, const char *path, size_t dir, atmos_scene_earth *e);
 
+/* scene_paths.c: the path p (cap bytes) of a scene loaded from `scene` made usable from
+ * anywhere: relative to the scene's folder (its first dir bytes; 0: standard input, the
+ * current folder), "data:REST" in the data folder (atmos__scene_data_dir(), which must hold
+ * it); absolute paths and generated sources unchanged. key names the field in messages. */
+atmos_status atmos__scene_join_path(atmos_context *ctx, const char *scene, size_t dir, char *p, size_t cap,
+                                    const char *key);
+/* $ATMOS_DATA, else the folder the build was configured with (ATMOS_DATA_DIR). */
+const char *atmos__scene_data_dir(void);
+
 #endif

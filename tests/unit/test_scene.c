@@ -7,6 +7,7 @@
 #include "test.h"
 
 #include <dirent.h>
+#include <stdlib.h>
 
 static atmos_context *ctx;
 
@@ -777,6 +778,34 @@ static void test_crashers(void)
     printf("%d crasher files refused\n", n);
 }
 
+/* Files named "data:..." are read from $ATMOS_DATA; relative files from the scene's folder. */
+static void test_data_paths(void)
+{
+    char dir[512], file[600], expect[700];
+    test_tmp_path(dir, sizeof dir, "");
+    snprintf(file, sizeof file, "%s/test_scene_data.vdb", dir);
+    FILE *f = fopen(file, "wb");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("not read", f);
+    fclose(f);
+    setenv("ATMOS_DATA", dir, 1);
+    const char *text = "{\"volume\": {\"file\": \"data:test_scene_data.vdb\"}}";
+    atmos_scene s;
+    CHECK_OK(atmos_scene_parse_file(ctx, text, strlen(text), "some/folder/scene.json", NULL, 0, &s));
+    CHECK_MSG(!strcmp(s.volume.source, file), "data: path %s, expected %s", s.volume.source, file);
+    const char *rel = "{\"volume\": {\"file\": \"clouds/c.vdb\"}}";
+    CHECK_OK(atmos_scene_parse_file(ctx, rel, strlen(rel), "some/folder/scene.json", NULL, 0, &s));
+    CHECK(!strcmp(s.volume.source, "some/folder/clouds/c.vdb"));
+    const char *missing = "{\"atmosphere\": {\"ground_map\": \"data:nothing/here.jpg\"}}";
+    CHECK(atmos_scene_parse_file(ctx, missing, strlen(missing), "scene.json", NULL, 0, &s) == ATMOS_E_IO);
+    snprintf(expect, sizeof expect, "%s/nothing/here.jpg", dir);
+    CHECK(contains(atmos_context_error(ctx), "/atmosphere/ground_map") && contains(atmos_context_error(ctx), expect) &&
+          contains(atmos_context_error(ctx), "ATMOS_DATA"));
+    unsetenv("ATMOS_DATA");
+    remove(file);
+}
+
 int main(void)
 {
     CHECK_OK(atmos_context_create(NULL, &ctx));
@@ -788,6 +817,7 @@ int main(void)
     test_limits();
     test_validate();
     test_load();
+    test_data_paths();
     test_sun_direction();
     test_animation();
     test_crashers();
