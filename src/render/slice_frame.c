@@ -100,18 +100,25 @@ static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, cons
  * diagonal bands. The planes are therefore spaced so that the box's thinnest extent
  * measured along h, min_a E_a / |h_a|, holds SLICE_AUTO_ACROSS of them, with at least
  * SLICE_AUTO_MIN slices (compact volumes keep that count) and at most SLICE_AUTO_MAX
- * (*needed then tells how many the rule asked for). */
+ * (*needed then tells how many the rule asked for). And a ray must not step over a render
+ * voxel: the planes' spacing along the eye's and the light's rays, ds / (h . l) (h lies
+ * halfway between the two, so one figure serves both), stays within half a render voxel
+ * (SLICE_AUTO_PER_VOXEL samples a voxel). Without that a wide domain seen at a slant (a WRF
+ * run: 300 km across, a cloud layer a few 1.2 km render voxels thick) took 256 planes 1.5 km
+ * apart and drew the layer in stripes; at one sample a voxel faint stripes stayed. */
 #define SLICE_AUTO_MIN 256
 #define SLICE_AUTO_MAX 2048
 #define SLICE_AUTO_ACROSS 64.0
-static int auto_slices(const sgrid *g, const double h[3], double extent, int *needed)
+#define SLICE_AUTO_PER_VOXEL 2.0
+static int auto_slices(const sgrid *g, const double h[3], double hl, double extent, int *needed)
 {
     double k = 0; /* max_a |h_a| / E_a: the inverse of the thinnest extent along h */
     for (int a = 0; a < 3; a++) {
         const double E = g->box_hi[a] - g->box_lo[a];
         if (E > 0) k = fmax(k, fabs(h[a]) / E);
     }
-    const double want = ceil(SLICE_AUTO_ACROSS * extent * k);
+    const double across = SLICE_AUTO_ACROSS * extent * k, voxel = 1.0 / g->sc;
+    const double want = ceil(fmax(across, SLICE_AUTO_PER_VOXEL * extent / (voxel * hl)));
     *needed = want > 1e9 ? 1000000000 : (int)want;
     if (*needed <= SLICE_AUTO_MIN) return SLICE_AUTO_MIN;
     return *needed < SLICE_AUTO_MAX ? *needed : SLICE_AUTO_MAX;
@@ -159,7 +166,7 @@ static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob
             j->W = we, j->H = he;
         }
     }
-    j->nslices = v->slices > 0 ? v->slices : auto_slices(g, j->h, smax - smin, needed);
+    j->nslices = v->slices > 0 ? v->slices : auto_slices(g, j->h, j->hl, smax - smin, needed);
     j->s0 = smin;
     j->ds = (smax - smin) / j->nslices;
     j->he = atmos__dot3(j->h, j->eye);
