@@ -15,7 +15,7 @@ void atmos__sim_confine(atmos_sim *s, double dt)
     const int nx = s->nx, ny = s->ny, nz = s->nz;
     const size_t lev = (size_t)nx * ny;
     float *uc = s->s[0], *vc = s->s[1], *wc = s->s[2], *ox = s->s[3], *oy = s->s[4], *oz = s->s[5], *om = s->s[6];
-#pragma omp parallel for schedule(static) num_threads(s->threads)
+    SIM_FOR
     for (int k = 0; k < nz; k++)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx; i++) {
@@ -24,8 +24,9 @@ void atmos__sim_confine(atmos_sim *s, double dt)
                 vc[n] = 0.5f * (s->v[n] + s->v[sim_idx(s, i, (j + 1) % ny, k)]);
                 wc[n] = 0.5f * (s->w[n] + s->w[n + lev]);
             }
+    atmos__sim_sync(s);
     const float inv2 = (float)(0.5 / s->dx);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
+    SIM_FOR
     for (int k = 0; k < nz; k++)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx; i++) {
@@ -39,9 +40,10 @@ void atmos__sim_confine(atmos_sim *s, double dt)
                 oz[n] = (vc[xp] - vc[xm]) * inv2 - (uc[yp] - uc[ym]) * inv2;
                 om[n] = sqrtf(ox[n] * ox[n] + oy[n] * oy[n] + oz[n] * oz[n]);
             }
+    atmos__sim_sync(s);
     /* the force at the centres into uc, vc, wc */
     const float a = (float)(eps * s->dx);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
+    SIM_FOR
     for (int k = 0; k < nz; k++)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx; i++) {
@@ -57,8 +59,9 @@ void atmos__sim_confine(atmos_sim *s, double dt)
                 vc[n] = am * (gz * ox[n] - gx * oz[n]);
                 wc[n] = am * (gx * oy[n] - gy * ox[n]);
             }
+    atmos__sim_sync(s);
     const float h = (float)(0.5 * dt);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
+    SIM_FOR
     for (int k = 0; k < nz; k++)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx; i++) {
@@ -67,4 +70,5 @@ void atmos__sim_confine(atmos_sim *s, double dt)
                 s->v[n] += h * (vc[n] + vc[sim_idx(s, i, (j + ny - 1) % ny, k)]);
                 if (k > 0) s->w[n] += h * (wc[n] + wc[n - lev]);
             }
+    atmos__sim_sync(s);
 }
