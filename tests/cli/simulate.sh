@@ -16,7 +16,7 @@ bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
 
 usage() { # expect exit 2, a message naming $1, no output file
     want=$1; shift
-    "$cli" simulate "$@" >"$dir/out" 2>"$dir/err"
+    timeout 30 "$cli" simulate "$@" >"$dir/out" 2>"$dir/err" # a usage error comes at once
     rc=$?
     if [ $rc -eq 2 ] && grep -q -- "$want" "$dir/err" && [ ! -e "$dir/x.json" ]; then ok "simulate $*: $want"
     else bad "simulate $*: exit $rc, stderr: $(cat "$dir/err")"; fi
@@ -30,6 +30,26 @@ usage "--minutes" cumulus_field --minutes abc -o "$dir/x.json"
 usage "--seed" cumulus_field --seed -1 -o "$dir/x.json"
 usage "unknown or incomplete option" cumulus_field --bogus -o "$dir/x.json"
 "$cli" simulate --help | grep -q "towering_cumulus" && ok "--help lists the presets" || bad "--help"
+# an output it cannot write is refused before any work: a 512-cell grid for 600 minutes would
+# take hours, so a quick exit shows nothing was computed
+for ext in vdb nvdb png raw; do
+    usage "writes only a raw volume" stratocumulus --grid 512 --minutes 600 --quiet -o "$dir/x.$ext"
+    [ -e "$dir/x.$ext" ] && bad "-o x.$ext: a file was written"
+done
+"$cli" simulate --help > "$dir/help"
+missing=""
+for p in cumulus_field towering_cumulus cumulonimbus stratocumulus; do
+    grep -q "$p.*first cloud after" "$dir/help" || missing="$missing $p"
+done
+[ -z "$missing" ] && ok "--help gives each preset's first-cloud time" || bad "--help: no first-cloud time for$missing"
+
+# a run too short for any cloud: the files are written, with a warning on stderr that the volume
+# is empty and what to do about it; a run with cloud gives no such warning
+if "$cli" simulate towering_cumulus --grid 16 --minutes 0.5 --quiet -o "$dir/e.json" 2>"$dir/err"; then
+    if grep -q "empty" "$dir/err" && grep -q -- "--minutes" "$dir/err" && [ -e "$dir/e.json" ]; then
+        ok "an empty volume is reported"
+    else bad "no warning for an empty volume: $(cat "$dir/err")"; fi
+else bad "short run failed: $(cat "$dir/err")"; fi
 
 # stratocumulus starts with its deck: a 16-cell grid, half a minute
 for t in 1 2; do
@@ -53,6 +73,7 @@ cloud = [f for f in raws if "cloud" in f][0]
 v = struct.unpack("<%df" % n, open(os.path.join(d, cloud), "rb").read())
 assert max(v) > 1e6, max(v)
 PY
+grep -q "empty" "$dir/err" && bad "stratocumulus (a deck from the start) reported empty: $(cat "$dir/err")"
 for f in "$dir"/s1*.raw; do
     g="$dir/s2${f#"$dir"/s1}"
     cmp -s "$f" "$g" || bad "1 and 2 threads differ: $(basename "$f")"
