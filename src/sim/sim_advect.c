@@ -6,6 +6,7 @@
 #include "sim/sim_internal.h"
 
 #include <math.h>
+#include <string.h>
 
 /* The eight corners and weights of a trilinear sample at (x, y, z) in the index space of a
  * field of nz_f levels: set up once, evaluated for any field on that grid. */
@@ -58,6 +59,29 @@ static inline float tri_eval(const float *f, const tri *t)
     return c0 + t->az * (c1 - c0);
 }
 
+/* Four fields packed per cell (AoS, 16 bytes a cell) sampled at once: the same arithmetic as
+ * tri_eval on each lane, one 4-wide load per corner. */
+typedef float v4f __attribute__((vector_size(16)));
+
+static inline v4f ld4(const float *p)
+{
+    v4f v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+static inline v4f tri_eval4(const float *f4, const tri *t)
+{
+    const size_t i0 = 4 * (size_t)t->i0, i1 = 4 * (size_t)t->i1;
+    v4f c[4];
+    for (int r = 0; r < 4; r++) {
+        const v4f a = ld4(f4 + 4 * t->c[r] + i0), b = ld4(f4 + 4 * t->c[r] + i1);
+        c[r] = a + t->ax * (b - a);
+    }
+    const v4f c0 = c[0] + t->ay * (c[1] - c[0]), c1 = c[2] + t->ay * (c[3] - c[2]);
+    return c0 + t->az * (c1 - c0);
+}
+
 static inline float sample(const atmos_sim *s, const float *f, int nz_f, double x, double y, double z)
 {
     tri t;
@@ -65,19 +89,23 @@ static inline float sample(const atmos_sim *s, const float *f, int nz_f, double 
     return tri_eval(f, &t);
 }
 
-/* The velocity at the cell centres of level k into s[8..10] (the scalars' trace samples it),
- * and the level's water before the advection: q_v into part[k], q_c + q_r into part[nz + 1 + k]. */
+/* Level k packed for the scalars' trace (s->pack): the velocity at the cell centres (u, v, w, 0)
+ * and the scalars (theta, q_v, q_c, q_r), 4 floats a cell each; and the level's water before
+ * the advection: q_v into part[k], q_c + q_r into part[nz + 1 + k]. */
 static void centres(atmos_sim *s, int k)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
-    float *uc = s->s[8], *vc = s->s[9], *wc = s->s[10];
+    float *vel4 = s->pack, *sc4 = s->pack + 4 * s->n;
     for (int j = 0; j < ny; j++)
         for (int i = 0; i < nx; i++) {
             const size_t n = sim_idx(s, i, j, k);
-            uc[n] = 0.5f * (s->u[n] + s->u[sim_idx(s, i + 1 == nx ? 0 : i + 1, j, k)]);
-            vc[n] = 0.5f * (s->v[n] + s->v[sim_idx(s, i, j + 1 == ny ? 0 : j + 1, k)]);
-            wc[n] = 0.5f * (s->w[n] + s->w[n + lev]);
+            float *p = vel4 + 4 * n, *q = sc4 + 4 * n;
+            p[0] = 0.5f * (s->u[n] + s->u[sim_idx(s, i + 1 == nx ? 0 : i + 1, j, k)]);
+            p[1] = 0.5f * (s->v[n] + s->v[sim_idx(s, i, j + 1 == ny ? 0 : j + 1, k)]);
+            p[2] = 0.5f * (s->w[n] + s->w[n + lev]);
+            p[3] = 0;
+            q[0] = s->th[n], q[1] = s->qv[n], q[2] = s->qc[n], q[3] = s->qr[n];
         }
     double vl = 0, tl = 0;
     for (size_t n = k * lev; n < (k + 1) * lev; n++) {
@@ -94,17 +122,18 @@ static void scalars(atmos_sim *s, int k, double c)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
-    const float *src[4] = {s->th, s->qv, s->qc, s->qr};
     float *dst[4] = {s->s[0], s->s[1], s->s[2], s->s[3]};
-    const float *uc = s->s[8], *vc = s->s[9], *wc = s->s[10];
+    const float *vel4 = s->pack, *sc4 = s->pack + 4 * s->n;
     for (int j = 0; j < ny; j++)
         for (int i = 0; i < nx; i++) {
             const size_t n = sim_idx(s, i, j, k);
+            const float *p = vel4 + 4 * n;
             tri t;
-            tri_setup(s, s->nz, i - 0.5 * c * uc[n], j - 0.5 * c * vc[n], k - 0.5 * c * wc[n], &t);
-            const double vx = tri_eval(uc, &t), vy = tri_eval(vc, &t), vz = tri_eval(wc, &t);
-            tri_setup(s, s->nz, i - c * vx, j - c * vy, k - c * vz, &t);
-            for (int f = 0; f < 4; f++) dst[f][n] = tri_eval(src[f], &t);
+            tri_setup(s, s->nz, i - 0.5 * c * p[0], j - 0.5 * c * p[1], k - 0.5 * c * p[2], &t);
+            const v4f vm = tri_eval4(vel4, &t);
+            tri_setup(s, s->nz, i - c * (double)vm[0], j - c * (double)vm[1], k - c * (double)vm[2], &t);
+            const v4f q = tri_eval4(sc4, &t);
+            dst[0][n] = q[0], dst[1][n] = q[1], dst[2][n] = q[2], dst[3][n] = q[3];
         }
     double vl = 0, tl = 0;
     for (size_t n = k * lev; n < (k + 1) * lev; n++) {

@@ -55,7 +55,8 @@ struct atmos_sim {
     double dx, dt_max;
     size_t n, nw;                 /* cells; w faces (nx ny (nz + 1)) */
     float *u, *v, *w, *th, *qv, *qc, *qr;
-    float *s[11];                 /* scratch arrays of nw floats */
+    float *s[8];                  /* scratch arrays of nw floats */
+    float *pack;                  /* 8 n floats: the advection's packed fields (sim_advect.c) */
     double *part;                 /* per-level or per-row partial sums, 4 (max(nz, ny) + 1) doubles:
                                    * each filled by one thread, added in index order afterwards */
     /* base state at the cell-centre levels z_k = (k + 0.5) dx */
