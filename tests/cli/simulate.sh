@@ -1,7 +1,8 @@
 #!/bin/sh
 # `atmos simulate` end to end: usage errors exit 2 with a message and write nothing; a small
 # run writes the sidecar and one raw file per field (cloud, rain) whose sizes match the grid,
-# with cloud in it; the same seed gives the same bytes with 1 and 2 threads.
+# with cloud in it; the same seed gives the same bytes with 1, 2 and 3 threads; -o names only
+# a .json sidecar; a run too short for cloud warns; atmos bench simulate prints its line.
 # Run by ctest with ATMOS_CLI = path of the atmos binary.
 set -u
 
@@ -52,7 +53,7 @@ if "$cli" simulate towering_cumulus --grid 16 --minutes 0.5 --quiet -o "$dir/e.j
 else bad "short run failed: $(cat "$dir/err")"; fi
 
 # stratocumulus starts with its deck: a 16-cell grid, half a minute
-for t in 1 2; do
+for t in 1 2 3; do
     if "$cli" simulate stratocumulus --grid 16 --minutes 0.5 --threads $t --quiet -o "$dir/s$t.json" 2>"$dir/err"; then
         ok "run with $t threads"
     else bad "run with $t threads: $(cat "$dir/err")"; fi
@@ -75,8 +76,16 @@ assert max(v) > 1e6, max(v)
 PY
 grep -q "empty" "$dir/err" && bad "stratocumulus (a deck from the start) reported empty: $(cat "$dir/err")"
 for f in "$dir"/s1*.raw; do
-    g="$dir/s2${f#"$dir"/s1}"
-    cmp -s "$f" "$g" || bad "1 and 2 threads differ: $(basename "$f")"
+    for t in 2 3; do
+        g="$dir/s$t${f#"$dir"/s1}"
+        cmp -s "$f" "$g" || bad "1 and $t threads differ: $(basename "$f")"
+    done
 done
-[ $fail -eq 0 ] && ok "1 and 2 threads give the same raw files"
+[ $fail -eq 0 ] && ok "1, 2 and 3 threads give the same raw files"
+
+# atmos bench simulate: one machine-readable line with the figures
+if "$cli" bench simulate --size 16 --repeat 2 --threads 2 >"$dir/bench" 2>"$dir/err" &&
+    grep -Eq '^bench=simulate preset=towering_cumulus grid=16 cells=16x16x16 threads=2 steps=2 ms_per_step=[0-9.]+ best_ms=[0-9.]+ cpu_ms_per_step=[0-9.]+ load=' "$dir/bench"; then
+    ok "bench simulate"
+else bad "bench simulate: $(cat "$dir/bench" "$dir/err")"; fi
 exit $fail
