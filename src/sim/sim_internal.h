@@ -113,6 +113,7 @@ void atmos__sim_sounding(atmos_sim *sim);
 /* The step's parts. */
 /* sim_advect.c; returns the water fixer's factor for the vapour (applied by atmos__sim_micro) */
 double atmos__sim_advect(atmos_sim *sim, double dt);
+void atmos__sim_advected_velocity(atmos_sim *sim);
 /* sim_forces.c: surface fluxes, cloud-top cooling, buoyancy and the sponge of row j (y = j);
  * returns the water the surface added to the row */
 double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);

@@ -52,6 +52,8 @@ void atmos__sim_sync(atmos_sim *s)
 static void phases(atmos_sim *s, double dt)
 {
     const float fix = (float)atmos__sim_advect(s, dt);
+#pragma omp master
+    atmos__sim_advected_velocity(s); /* the microphysics does not touch u, v, w; it ends at a barrier */
     atmos__sim_micro(s, dt, fix);
     const int ny = s->ny;
     double *rain = s->part, *surf = s->part + ny + 1;
