@@ -8,6 +8,8 @@ set -eu
 ATMOS=${1:-build/atmos}
 T=${2:-2}
 echo "load: $(uptime)"
+"$ATMOS" bench simulate --threads "$T" # 64^3 and 128^3: wall, best and CPU ms a step, the load
+echo "load: $(uptime)"
 "$ATMOS" simulate towering_cumulus --grid 128 --bench 5 --threads "$T"
 echo "load: $(uptime)"
 "$ATMOS" simulate cumulonimbus --grid 64 --minutes 25 --bench 1 --threads "$T"

@@ -40,6 +40,11 @@ ATMOS_API const char *const *atmos_sim_preset_names(void);
 /* A preset's default simulated time, minutes (0 for an unknown name). */
 ATMOS_API double atmos_sim_preset_minutes(const char *preset);
 
+/* Roughly when a preset's first cloud (q_c > 1e-5 kg/kg) forms, simulated minutes, as measured at
+ * the default grid with seed 1 (docs/clouds.md); a shorter run gives an empty volume. 0 for a
+ * preset that starts cloudy and for an unknown name. */
+ATMOS_API double atmos_sim_preset_first_cloud_minutes(const char *preset);
+
 /* Builds the initial state (the preset's sounding and triggers). Unknown presets and
  * out-of-range values: ATMOS_E_INVALID_ARG naming the known presets / the range. */
 ATMOS_API atmos_status atmos_sim_create(atmos_context *ctx, const atmos_sim_desc *desc, atmos_sim **out);

@@ -8,63 +8,121 @@
 
 #include <math.h>
 
+/* The rows of a cell's neighbours: j - 1 and j + 1 wrapped, level k - 1 and k + 1 clamped (as
+ * offsets from the cell's own row), and i - 1 / i + 1 wrapped. */
+typedef struct {
+    size_t r, ym, yp;
+    ptrdiff_t zm, zp;
+} rows;
+
+static rows rows_of(const atmos_sim *s, int j, int k)
+{
+    const int ny = s->ny, nz = s->nz;
+    const ptrdiff_t lev = (ptrdiff_t)s->nx * ny;
+    rows o;
+    o.r = sim_idx(s, 0, j, k);
+    o.ym = sim_idx(s, 0, j ? j - 1 : ny - 1, k);
+    o.yp = sim_idx(s, 0, j + 1 == ny ? 0 : j + 1, k);
+    o.zm = k > 0 ? -lev : 0;
+    o.zp = k + 1 < nz ? lev : 0;
+    return o;
+}
+
+/* The velocity at the cell centres of level k. */
+static void centres(atmos_sim *s, int k, float *uc, float *vc, float *wc)
+{
+    const int nx = s->nx;
+    const size_t lev = (size_t)nx * s->ny;
+    for (int j = 0; j < s->ny; j++) {
+        const rows o = rows_of(s, j, k);
+        for (int i = 0; i < nx; i++) {
+            const size_t n = o.r + i;
+            uc[n] = 0.5f * (s->u[n] + s->u[o.r + (i + 1 == nx ? 0 : i + 1)]);
+            vc[n] = 0.5f * (s->v[n] + s->v[o.yp + i]);
+            wc[n] = 0.5f * (s->w[n] + s->w[n + lev]);
+        }
+    }
+}
+
+/* The vorticity omega and its length at the centres of level k (central differences, one-sided
+ * at the ground and the lid). */
+static void vorticity(atmos_sim *s, int k, float *const f[7])
+{
+    const float *uc = f[0], *vc = f[1], *wc = f[2];
+    float *ox = f[3], *oy = f[4], *oz = f[5], *om = f[6];
+    const int nx = s->nx, nz = s->nz;
+    const float inv2 = (float)(0.5 / s->dx), zf = (k > 0 && k + 1 < nz) ? inv2 : 2 * inv2;
+    for (int j = 0; j < s->ny; j++) {
+        const rows o = rows_of(s, j, k);
+        for (int i = 0; i < nx; i++) {
+            const size_t n = o.r + i;
+            const size_t xp = o.r + (i + 1 == nx ? 0 : i + 1), xm = o.r + (i ? i - 1 : nx - 1);
+            const size_t yp = o.yp + i, ym = o.ym + i, zp = n + o.zp, zm = n + o.zm;
+            ox[n] = (wc[yp] - wc[ym]) * inv2 - (vc[zp] - vc[zm]) * zf;
+            oy[n] = (uc[zp] - uc[zm]) * zf - (wc[xp] - wc[xm]) * inv2;
+            oz[n] = (vc[xp] - vc[xm]) * inv2 - (uc[yp] - uc[ym]) * inv2;
+            om[n] = sqrtf(ox[n] * ox[n] + oy[n] * oy[n] + oz[n] * oz[n]);
+        }
+    }
+}
+
+/* The force eps dx |omega| (N x omega) at the centres of level k into f[0..2]. */
+static void force(atmos_sim *s, int k, float a, float *const f[7])
+{
+    float *fx = f[0], *fy = f[1], *fz = f[2];
+    const float *ox = f[3], *oy = f[4], *oz = f[5], *om = f[6];
+    const int nx = s->nx;
+    for (int j = 0; j < s->ny; j++) {
+        const rows o = rows_of(s, j, k);
+        for (int i = 0; i < nx; i++) {
+            const size_t n = o.r + i;
+            float gx = om[o.r + (i + 1 == nx ? 0 : i + 1)] - om[o.r + (i ? i - 1 : nx - 1)];
+            float gy = om[o.yp + i] - om[o.ym + i];
+            float gz = om[n + o.zp] - om[n + o.zm];
+            const float gl = sqrtf(gx * gx + gy * gy + gz * gz) + 1e-20f;
+            gx /= gl, gy /= gl, gz /= gl;
+            const float am = a * om[n];
+            fx[n] = am * (gy * oz[n] - gz * oy[n]);
+            fy[n] = am * (gz * ox[n] - gx * oz[n]);
+            fz[n] = am * (gx * oy[n] - gy * ox[n]);
+        }
+    }
+}
+
+/* The centred force averaged onto the faces of level k, times dt. */
+static void apply(atmos_sim *s, int k, float dt, float *const f[7])
+{
+    const float *fx = f[0], *fy = f[1], *fz = f[2];
+    const int nx = s->nx;
+    const size_t lev = (size_t)nx * s->ny;
+    const float h = 0.5f * dt;
+    for (int j = 0; j < s->ny; j++) {
+        const rows o = rows_of(s, j, k);
+        for (int i = 0; i < nx; i++) {
+            const size_t n = o.r + i;
+            s->u[n] += h * (fx[n] + fx[o.r + (i ? i - 1 : nx - 1)]);
+            s->v[n] += h * (fy[n] + fy[o.ym + i]);
+            if (k > 0) s->w[n] += h * (fz[n] + fz[n - lev]);
+        }
+    }
+}
+
 void atmos__sim_confine(atmos_sim *s, double dt)
 {
     const double eps = s->env.confinement;
     if (!(eps > 0)) return;
-    const int nx = s->nx, ny = s->ny, nz = s->nz;
-    const size_t lev = (size_t)nx * ny;
-    float *uc = s->s[0], *vc = s->s[1], *wc = s->s[2], *ox = s->s[3], *oy = s->s[4], *oz = s->s[5], *om = s->s[6];
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                const size_t n = sim_idx(s, i, j, k);
-                uc[n] = 0.5f * (s->u[n] + s->u[sim_idx(s, (i + 1) % nx, j, k)]);
-                vc[n] = 0.5f * (s->v[n] + s->v[sim_idx(s, i, (j + 1) % ny, k)]);
-                wc[n] = 0.5f * (s->w[n] + s->w[n + lev]);
-            }
-    const float inv2 = (float)(0.5 / s->dx);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                const size_t n = sim_idx(s, i, j, k);
-                const size_t xp = sim_idx(s, (i + 1) % nx, j, k), xm = sim_idx(s, (i + nx - 1) % nx, j, k);
-                const size_t yp = sim_idx(s, i, (j + 1) % ny, k), ym = sim_idx(s, i, (j + ny - 1) % ny, k);
-                const size_t zp = k + 1 < nz ? n + lev : n, zm = k > 0 ? n - lev : n;
-                const float zf = (k > 0 && k + 1 < nz) ? inv2 : 2 * inv2;
-                ox[n] = (wc[yp] - wc[ym]) * inv2 - (vc[zp] - vc[zm]) * zf;
-                oy[n] = (uc[zp] - uc[zm]) * zf - (wc[xp] - wc[xm]) * inv2;
-                oz[n] = (vc[xp] - vc[xm]) * inv2 - (uc[yp] - uc[ym]) * inv2;
-                om[n] = sqrtf(ox[n] * ox[n] + oy[n] * oy[n] + oz[n] * oz[n]);
-            }
-    /* the force at the centres into uc, vc, wc */
-    const float a = (float)(eps * s->dx);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                const size_t n = sim_idx(s, i, j, k);
-                const size_t zp = k + 1 < nz ? n + lev : n, zm = k > 0 ? n - lev : n;
-                float gx = om[sim_idx(s, (i + 1) % nx, j, k)] - om[sim_idx(s, (i + nx - 1) % nx, j, k)];
-                float gy = om[sim_idx(s, i, (j + 1) % ny, k)] - om[sim_idx(s, i, (j + ny - 1) % ny, k)];
-                float gz = om[zp] - om[zm];
-                const float gl = sqrtf(gx * gx + gy * gy + gz * gz) + 1e-20f;
-                gx /= gl, gy /= gl, gz /= gl;
-                const float am = a * om[n];
-                uc[n] = am * (gy * oz[n] - gz * oy[n]);
-                vc[n] = am * (gz * ox[n] - gx * oz[n]);
-                wc[n] = am * (gx * oy[n] - gy * ox[n]);
-            }
-    const float h = (float)(0.5 * dt);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                const size_t n = sim_idx(s, i, j, k);
-                s->u[n] += h * (uc[n] + uc[sim_idx(s, (i + nx - 1) % nx, j, k)]);
-                s->v[n] += h * (vc[n] + vc[sim_idx(s, i, (j + ny - 1) % ny, k)]);
-                if (k > 0) s->w[n] += h * (wc[n] + wc[n - lev]);
-            }
+    const int nz = s->nz;
+    float *const f[7] = {s->s[0], s->s[1], s->s[2], s->s[3], s->s[4], s->s[5], s->s[6]};
+    SIM_FOR
+    for (int k = 0; k < nz; k++) centres(s, k, f[0], f[1], f[2]);
+    atmos__sim_sync(s);
+    SIM_FOR
+    for (int k = 0; k < nz; k++) vorticity(s, k, f);
+    atmos__sim_sync(s);
+    SIM_FOR
+    for (int k = 0; k < nz; k++) force(s, k, (float)(eps * s->dx), f);
+    atmos__sim_sync(s);
+    SIM_FOR
+    for (int k = 0; k < nz; k++) apply(s, k, (float)dt, f);
+    atmos__sim_sync(s);
 }

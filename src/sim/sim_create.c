@@ -85,9 +85,11 @@ atmos_status atmos__sim_create_env(atmos_context *ctx, const sim_env *env, int n
     int ok = 1;
     float **f[] = {&s->u, &s->v, &s->w, &s->th, &s->qv, &s->qc, &s->qr};
     for (int a = 0; a < 7; a++) ok &= (*f[a] = calloc(s->nw, sizeof(float))) != NULL;
-    for (int a = 0; a < 11; a++) ok &= (s->s[a] = calloc(s->nw, sizeof(float))) != NULL;
+    for (int a = 0; a < 8; a++) ok &= (s->s[a] = calloc(s->nw, sizeof(float))) != NULL;
+    ok &= (s->pack = malloc(8 * s->n * sizeof(float))) != NULL;
     double **b[] = {&s->th0, &s->qv0, &s->pi0, &s->p0, &s->rho0, &s->ue};
     for (int a = 0; a < 6; a++) ok &= (*b[a] = calloc((size_t)nz, sizeof(double))) != NULL;
+    ok &= (s->part = calloc(4 * ((size_t)(nz > ny ? nz : ny) + 1), sizeof(double))) != NULL;
     if (!ok) {
         atmos_sim_destroy(s);
         return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: out of memory for %d x %d x %d cells", nx, ny, nz);
@@ -97,8 +99,10 @@ atmos_status atmos__sim_create_env(atmos_context *ctx, const sim_env *env, int n
         atmos_sim_destroy(s);
         return st;
     }
+    atmos__sim_sync_init(s);
     atmos__sim_sounding(s);
     init_fields(s);
+#pragma omp parallel num_threads(s->threads)
     atmos__sim_project(s);
     *out = s;
     return ATMOS_OK;
@@ -131,10 +135,13 @@ void atmos_sim_destroy(atmos_sim *s)
 {
     if (!s) return;
     atmos__sim_fft_free(s);
+    atmos__sim_sync_free(s);
     float *f[] = {s->u, s->v, s->w, s->th, s->qv, s->qc, s->qr};
     for (int a = 0; a < 7; a++) free(f[a]);
-    for (int a = 0; a < 11; a++) free(s->s[a]);
+    for (int a = 0; a < 8; a++) free(s->s[a]);
+    free(s->pack);
     double *b[] = {s->th0, s->qv0, s->pi0, s->p0, s->rho0, s->ue};
     for (int a = 0; a < 6; a++) free(b[a]);
+    free(s->part);
     free(s);
 }

@@ -25,6 +25,7 @@ typedef struct sim_env {
     sim_sounding_kind kind;
     double domain_m, height_m;    /* horizontal side and depth of the domain */
     double minutes;               /* default simulated time */
+    double first_cloud;           /* minutes to the first cloud (q_c > 1e-5) at grid 64, seed 1, measured */
     double dt_max;                /* longest step, s */
     /* layered sounding: theta_s up to zi (mixed layer), a jump dtheta_inv over inv_depth, then
      * gamma_ft (K/m) up to z_tp, gamma_strat above; vapour qv_bl in the mixed layer, above
@@ -54,7 +55,10 @@ struct atmos_sim {
     double dx, dt_max;
     size_t n, nw;                 /* cells; w faces (nx ny (nz + 1)) */
     float *u, *v, *w, *th, *qv, *qc, *qr;
-    float *s[11];                 /* scratch arrays of nw floats */
+    float *s[8];                  /* scratch arrays of nw floats */
+    float *pack;                  /* 8 n floats: the advection's packed fields (sim_advect.c) */
+    double *part;                 /* per-level or per-row partial sums, 4 (max(nz, ny) + 1) doubles:
+                                   * each filled by one thread, added in index order afterwards */
     /* base state at the cell-centre levels z_k = (k + 0.5) dx */
     double *th0, *qv0, *pi0, *p0, *rho0, *ue;
     double rho_ref;               /* Boussinesq reference density (the budget's) */
@@ -63,9 +67,24 @@ struct atmos_sim {
     double t;
     long steps;
     double rain_out, surface_in;  /* in (kg/kg) x cells */
+    float vmax;                   /* largest |u|, |v|, |w| after the last projection */
+    void *bar;                    /* a pthread barrier of `threads` threads (NULL: one thread) */
     void *fft_fwd, *fft_inv;      /* fftwf plans of one level */
     void *spec;                   /* complex spectrum, nz ny (nx / 2 + 1) */
 };
+
+/* Threads. A step is one OpenMP parallel region (sim_step.c); its phases hand out whole
+ * levels or rows (SIM_FOR: dynamic, so a thread that the machine's other work keeps off its
+ * core holds the others up by one level at most) and end at atmos__sim_sync, a barrier whose
+ * waiting threads sleep instead of spinning (OpenMP's own barriers spin, which on a busy
+ * machine takes the core from the thread being waited for). A cell's arithmetic is the same
+ * whichever thread does it and sums are made per level or row and added in order, so the
+ * results do not depend on the thread count. Called outside a parallel region, the phases
+ * run on the calling thread. */
+#define SIM_FOR _Pragma("omp for schedule(dynamic, 1) nowait")
+void atmos__sim_sync(atmos_sim *s); /* sim_step.c */
+void atmos__sim_sync_init(atmos_sim *s);
+void atmos__sim_sync_free(atmos_sim *s);
 
 static inline size_t sim_idx(const atmos_sim *s, int i, int j, int k)
 {
@@ -92,14 +111,20 @@ void atmos__sim_adjust(double *th, double *qv, double *qc, double p_pa, double p
 void atmos__sim_sounding(atmos_sim *sim);
 
 /* The step's parts. */
-void atmos__sim_advect(atmos_sim *sim, double dt);        /* sim_advect.c */
-void atmos__sim_forces(atmos_sim *sim, double dt);        /* sim_forces.c: buoyancy, sponge, fluxes */
+/* sim_advect.c; returns the water fixer's factor for the vapour (applied by atmos__sim_micro) */
+double atmos__sim_advect(atmos_sim *sim, double dt);
+void atmos__sim_advected_velocity(atmos_sim *sim);
+/* sim_forces.c: surface fluxes, cloud-top cooling, buoyancy and the sponge of row j (y = j);
+ * returns the water the surface added to the row */
+double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);
 void atmos__sim_confine(atmos_sim *sim, double dt);       /* sim_confine.c: vorticity confinement */
 void atmos__sim_project(atmos_sim *sim);                  /* sim_pressure.c */
 atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *sim);
 void atmos__sim_fft_free(atmos_sim *sim);
-void atmos__sim_micro(atmos_sim *sim, double dt);         /* sim_micro.c: Kessler + adjustment */
-void atmos__sim_fall(atmos_sim *sim, double dt);          /* sim_micro.c: rain sedimentation */
+/* sim_micro.c: the vapour times fix, Kessler + adjustment; rain sedimentation in the columns of
+ * row j, returning the rain that left through the ground */
+void atmos__sim_micro(atmos_sim *sim, double dt, float fix);
+double atmos__sim_fall_row(atmos_sim *sim, double dt, int j);
 /* Largest |divergence| x dx (m/s) over the cells, to check the projection. */
 double atmos__sim_max_divergence(const atmos_sim *sim);
 

@@ -12,14 +12,18 @@
 
 #include <math.h>
 
-void atmos__sim_micro(atmos_sim *s, double dt)
+/* Each cell's vapour times the advection's fixer factor (always), then Kessler and the
+ * adjustment (with phase changes). */
+void atmos__sim_micro(atmos_sim *s, double dt, float fix)
 {
-    if (!s->env.micro) return;
     const size_t lev = (size_t)s->nx * s->ny;
-#pragma omp parallel for schedule(static) num_threads(s->threads)
+    const int micro = s->env.micro;
+    SIM_FOR
     for (int k = 0; k < s->nz; k++) {
         const double p = s->p0[k], pi = s->pi0[k], rho = 1e-3 * s->rho0[k];
         for (size_t n = k * lev; n < (k + 1) * lev; n++) {
+            s->qv[n] *= fix;
+            if (!micro) continue;
             double th = s->th[n], qv = s->qv[n], qc = s->qc[n], qr = s->qr[n];
             if (qc <= 0 && qr <= 0 && qv < 0.9 * atmos__sim_qsat(th * pi, p)) continue; /* clear, dry air */
             if (qc < 0) qc = 0;
@@ -42,45 +46,42 @@ void atmos__sim_micro(atmos_sim *s, double dt)
             s->th[n] = (float)th, s->qv[n] = (float)qv, s->qc[n] = (float)qc, s->qr[n] = (float)qr;
         }
     }
+    atmos__sim_sync(s);
 }
 
 /* Rain falls with V by first-order upwind fluxes, sub-stepped so that V dt_sub < dx; what
- * leaves the lowest cell is rain on the ground. One column at a time (any thread: the same
- * arithmetic); the ground's sum is added in column order. */
-void atmos__sim_fall(atmos_sim *s, double dt)
+ * leaves the lowest cell is rain on the ground. The columns of row j, one at a time; returns
+ * the row's rain out, added column by column. */
+double atmos__sim_fall_row(atmos_sim *s, double dt, int j)
 {
-    if (!s->env.micro) return;
-    const int nx = s->nx, ny = s->ny, nz = s->nz;
-    const size_t lev = (size_t)nx * ny;
-    float *out = s->s[7]; /* per column: rain out of the ground this step */
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int j = 0; j < ny; j++)
-        for (int i = 0; i < nx; i++) {
-            const size_t c = (size_t)j * nx + i;
-            double vmax = 0, fell = 0;
-            double vel[2 * ATMOS_SIM_MAX_GRID];
-            for (int k = 0; k < nz; k++) {
-                const double q = s->qr[c + k * lev];
-                vel[k] = q > 1e-9 ? 36.34 * pow(1e-3 * s->rho0[k] * q, 0.1346) * sqrt(s->rho0[0] / s->rho0[k]) : 0.0;
-                vmax = fmax(vmax, vel[k]);
-            }
-            if (vmax > 0) {
-                const int sub = (int)ceil(vmax * dt / (0.9 * s->dx));
-                const double h = dt / sub / s->dx;
-                for (int m = 0; m < sub; m++) {
-                    double from_above = 0; /* flux into cell k from k + 1, in q units */
-                    for (int k = nz - 1; k >= 0; k--) {
-                        float *q = &s->qr[c + k * lev];
-                        const double leave = fmin((double)*q, h * vel[k] * *q);
-                        *q = (float)(*q - leave + from_above);
-                        from_above = leave;
-                    }
-                    fell += from_above;
-                }
-            }
-            out[c] = (float)fell;
+    if (!s->env.micro) return 0.0;
+    const int nx = s->nx, nz = s->nz;
+    const size_t lev = (size_t)nx * s->ny;
+    double row = 0;
+    for (int i = 0; i < nx; i++) {
+        const size_t c = (size_t)j * nx + i;
+        double vmax = 0, fell = 0;
+        double vel[2 * ATMOS_SIM_MAX_GRID];
+        for (int k = 0; k < nz; k++) {
+            const double q = s->qr[c + k * lev];
+            vel[k] = q > 1e-9 ? 36.34 * pow(1e-3 * s->rho0[k] * q, 0.1346) * sqrt(s->rho0[0] / s->rho0[k]) : 0.0;
+            vmax = fmax(vmax, vel[k]);
         }
-    double sum = 0;
-    for (size_t c = 0; c < lev; c++) sum += out[c];
-    s->rain_out += sum;
+        if (vmax > 0) {
+            const int sub = (int)ceil(vmax * dt / (0.9 * s->dx));
+            const double h = dt / sub / s->dx;
+            for (int m = 0; m < sub; m++) {
+                double from_above = 0; /* flux into cell k from k + 1, in q units */
+                for (int k = nz - 1; k >= 0; k--) {
+                    float *q = &s->qr[c + k * lev];
+                    const double leave = fmin((double)*q, h * vel[k] * *q);
+                    *q = (float)(*q - leave + from_above);
+                    from_above = leave;
+                }
+                fell += from_above;
+            }
+        }
+        row += (float)fell;
+    }
+    return row;
 }

@@ -14,7 +14,7 @@ static const preset presets[] = {
      * inversion and a trade-wind inversion at 2 km; surface heating and moistening plus
      * a dozen small seeded warm, moist bubbles; light wind. */
     {"cumulus_field",
-     {.kind = SIM_SOUNDING_LAYERED, .domain_m = 6400, .height_m = 3200, .minutes = 20, .dt_max = 6,
+     {.kind = SIM_SOUNDING_LAYERED, .domain_m = 6400, .height_m = 3200, .minutes = 20, .first_cloud = 7, .dt_max = 6,
       .theta_s = 298, .zi = 700, .dtheta_inv = 0.5, .inv_depth = 100, .gamma_ft = 3.5e-3, .z_tp = 2000,
       .gamma_strat = 15e-3, .qv_bl = 13.5e-3, .qv_ft = 11e-3, .hq = 1500, .u_s = 3, .z_shear = 1000,
       .u_move = 0, .bubbles = 12, .bubble_rh = 350, .bubble_rv = 250, .bubble_z = 300, .bubble_dth = 0.8,
@@ -23,7 +23,7 @@ static const preset presets[] = {
     /* A towering cumulus: the Weisman-Klemp sounding with less vapour and no tropopause
      * in reach, one warm bubble, weak shear. */
     {"towering_cumulus",
-     {.kind = SIM_SOUNDING_WK82, .domain_m = 8000, .height_m = 8000, .minutes = 20, .dt_max = 8,
+     {.kind = SIM_SOUNDING_WK82, .domain_m = 8000, .height_m = 8000, .minutes = 20, .first_cloud = 3, .dt_max = 8,
       .theta_s = 300, .theta_tr = 343, .t_tr = 213, .z_tp = 12000, .qv_bl = 13e-3, .u_s = 5, .z_shear = 3000,
       .u_move = 2.5, .bubbles = 1, .bubble_rh = 1500, .bubble_rv = 800, .bubble_z = 800, .bubble_dth = 2.0,
       .bubble_dqv = 1e-3, .shf = 0, .lhf = 0, .flux_noise = 0, .noise_th = 0.2, .confinement = 0.2, .micro = 1}},
@@ -31,7 +31,7 @@ static const preset presets[] = {
      * tropopause at 12 km, 213 K) and wind (U_s tanh(z / 3 km), U_s = 15 m/s), their warm bubble
      * (2 K; 10 km x 1.4 km radii, here 5 km across the smaller domain). */
     {"cumulonimbus",
-     {.kind = SIM_SOUNDING_WK82, .domain_m = 25600, .height_m = 16000, .minutes = 45, .dt_max = 10,
+     {.kind = SIM_SOUNDING_WK82, .domain_m = 25600, .height_m = 16000, .minutes = 45, .first_cloud = 4, .dt_max = 10,
       .theta_s = 300, .theta_tr = 343, .t_tr = 213, .z_tp = 12000, .qv_bl = 14e-3, .u_s = 15, .z_shear = 3000,
       .u_move = 8, .bubbles = 1, .bubble_rh = 5000, .bubble_rv = 1400, .bubble_z = 1400, .bubble_dth = 2.0,
       .bubble_dqv = 0, .shf = 0, .lhf = 0, .flux_noise = 0, .noise_th = 0.2, .confinement = 0.2, .micro = 1}},
@@ -65,4 +65,10 @@ double atmos_sim_preset_minutes(const char *name)
 {
     const sim_env *e = atmos__sim_preset(name);
     return e ? e->minutes : 0.0;
+}
+
+double atmos_sim_preset_first_cloud_minutes(const char *name)
+{
+    const sim_env *e = atmos__sim_preset(name);
+    return e ? e->first_cloud : 0.0;
 }

@@ -40,23 +40,23 @@ void atmos__sim_fft_free(atmos_sim *s)
     s->fft_fwd = s->fft_inv = s->spec = NULL;
 }
 
-/* dx times the divergence of every cell into d. */
-static void divergence(const atmos_sim *s, float *d)
+/* dx times the divergence of the cells of level k into d. */
+static void divergence(const atmos_sim *s, int k, float *d)
 {
     const int nx = s->nx, ny = s->ny;
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int k = 0; k < s->nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                const size_t n = sim_idx(s, i, j, k);
-                const size_t ip = sim_idx(s, (i + 1) % nx, j, k), jp = sim_idx(s, i, (j + 1) % ny, k);
-                d[n] = (s->u[ip] - s->u[n]) + (s->v[jp] - s->v[n]) + (s->w[n + (size_t)nx * ny] - s->w[n]);
-            }
+    const size_t lev = (size_t)nx * ny;
+    for (int j = 0; j < ny; j++) {
+        const size_t r = sim_idx(s, 0, j, k), rp = sim_idx(s, 0, j + 1 == ny ? 0 : j + 1, k);
+        for (int i = 0; i < nx; i++) {
+            const size_t n = r + i, ip = r + (i + 1 == nx ? 0 : i + 1);
+            d[n] = (s->u[ip] - s->u[n]) + (s->v[rp + i] - s->v[n]) + (s->w[n + lev] - s->w[n]);
+        }
+    }
 }
 
 double atmos__sim_max_divergence(const atmos_sim *s)
 {
-    divergence(s, s->s[7]);
+    for (int k = 0; k < s->nz; k++) divergence(s, k, s->s[7]);
     double m = 0;
     for (size_t n = 0; n < s->n; n++) m = fmax(m, fabs(s->s[7][n]));
     return m;
@@ -96,17 +96,40 @@ static void column(fftwf_complex *r, size_t stride, int nz, double lam, double n
     for (int k = 0; k < nz; k++) r[(size_t)k * stride] = (float)(dre[k] * norm) + I * (float)(dim[k] * norm);
 }
 
+/* u -= grad phi on the faces of level k (w stays 0 at the ground and the lid); returns the
+ * level's largest |u|, |v|, |w| afterwards (the next step's time step). */
+static float gradient(atmos_sim *s, int k, const float *d)
+{
+    const int nx = s->nx, ny = s->ny;
+    const size_t lev = (size_t)nx * ny;
+    float m = 0;
+    for (int j = 0; j < ny; j++) {
+        const size_t r = sim_idx(s, 0, j, k), rm = sim_idx(s, 0, j ? j - 1 : ny - 1, k);
+        for (int i = 0; i < nx; i++) {
+            const size_t n = r + i;
+            s->u[n] -= d[n] - d[r + (i ? i - 1 : nx - 1)];
+            s->v[n] -= d[n] - d[rm + i];
+            if (k > 0) s->w[n] -= d[n] - d[n - lev];
+            m = fmaxf(m, fmaxf(fabsf(s->u[n]), fmaxf(fabsf(s->v[n]), fabsf(s->w[n]))));
+        }
+    }
+    return m;
+}
+
 void atmos__sim_project(atmos_sim *s)
 {
     const int nx = s->nx, ny = s->ny, nz = s->nz, nh = nx / 2 + 1;
     const size_t lev = (size_t)nx * ny, clev = (size_t)nh * ny;
     float *d = s->s[7];
     fftwf_complex *c = s->spec;
-    divergence(s, d);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int k = 0; k < nz; k++) fftwf_execute_dft_r2c(s->fft_fwd, d + k * lev, c + k * clev);
+    SIM_FOR
+    for (int k = 0; k < nz; k++) {
+        divergence(s, k, d);
+        fftwf_execute_dft_r2c(s->fft_fwd, d + k * lev, c + k * clev);
+    }
+    atmos__sim_sync(s);
     const double norm = 1.0 / ((double)nx * ny);
-#pragma omp parallel for schedule(static) num_threads(s->threads)
+    SIM_FOR
     for (int b = 0; b < ny; b++) {
         double tmp[3 * 2 * ATMOS_SIM_MAX_GRID]; /* nz <= 2 ATMOS_SIM_MAX_GRID */
         for (int a = 0; a < nh; a++) {
@@ -114,16 +137,18 @@ void atmos__sim_project(atmos_sim *s)
             column(c + (size_t)b * nh + a, clev, nz, lam, norm, tmp);
         }
     }
-#pragma omp parallel for schedule(static) num_threads(s->threads)
+    atmos__sim_sync(s);
+    SIM_FOR
     for (int k = 0; k < nz; k++) fftwf_execute_dft_c2r(s->fft_inv, c + k * clev, d + k * lev);
-    /* u -= grad phi on every interior face (w stays 0 at the ground and the lid) */
-#pragma omp parallel for schedule(static) num_threads(s->threads)
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                const size_t n = sim_idx(s, i, j, k);
-                s->u[n] -= d[n] - d[sim_idx(s, (i + nx - 1) % nx, j, k)];
-                s->v[n] -= d[n] - d[sim_idx(s, i, (j + ny - 1) % ny, k)];
-                if (k > 0) s->w[n] -= d[n] - d[n - lev];
-            }
+    atmos__sim_sync(s);
+    double *lm = s->part;
+    SIM_FOR
+    for (int k = 0; k < nz; k++) lm[k] = gradient(s, k, d);
+    atmos__sim_sync(s);
+#pragma omp master
+    {
+        float m = 0; /* the lid's w is 0 */
+        for (int k = 0; k < nz; k++) m = fmaxf(m, (float)lm[k]);
+        s->vmax = m; /* read after the parallel region */
+    }
 }

@@ -1,36 +1,78 @@
 /* One time step of the cloud simulation, a run of many with progress, and its statistics. */
+#define _POSIX_C_SOURCE 200809L /* pthread barriers */
 #include "sim/sim_internal.h"
 
 #include <math.h>
+#include <omp.h>
+#include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The step: the largest that keeps the fastest wind within 1.5 cells (the semi-Lagrangian
- * trace stays accurate), at most the preset's dt_max. The maximum is exact whatever the
- * order, so it does not depend on the threads. */
+ * trace stays accurate), at most the preset's dt_max. The fastest wind is the last
+ * projection's (exact whatever the order, so it does not depend on the threads). */
 static double time_step(const atmos_sim *s)
 {
-    float m = 0;
-    const float *f[3] = {s->u, s->v, s->w};
-    const size_t len[3] = {s->n, s->n, s->nw};
-    for (int a = 0; a < 3; a++) {
-        const float *p = f[a];
-        const size_t len_a = len[a];
-#pragma omp parallel for schedule(static) reduction(max : m) num_threads(s->threads)
-        for (size_t n = 0; n < len_a; n++) m = fmaxf(m, fabsf(p[n]));
-    }
+    const float m = s->vmax;
     if (m != m || m > 1e30f) return 0.0; /* NaN or overflow: unstable */
     const double dt = m > 0 ? 1.5 * s->dx / m : s->dt_max;
     return fmin(dt, s->dt_max);
 }
 
-static void advance(atmos_sim *s, double dt)
+void atmos__sim_sync_init(atmos_sim *s)
 {
-    atmos__sim_advect(s, dt);
-    atmos__sim_micro(s, dt);
-    atmos__sim_fall(s, dt);
-    atmos__sim_forces(s, dt);
+    s->bar = NULL;
+    if (s->threads < 2) return;
+    pthread_barrier_t *b = malloc(sizeof *b);
+    if (b && pthread_barrier_init(b, NULL, (unsigned)s->threads) == 0) s->bar = b;
+    else free(b); /* OpenMP's barriers then */
+}
+
+void atmos__sim_sync_free(atmos_sim *s)
+{
+    if (!s->bar) return;
+    pthread_barrier_destroy(s->bar);
+    free(s->bar);
+    s->bar = NULL;
+}
+
+void atmos__sim_sync(atmos_sim *s)
+{
+    const int team = omp_get_num_threads();
+    if (team == 1) return;
+    if (s->bar && team == s->threads) {
+        pthread_barrier_wait(s->bar);
+    } else { /* a smaller team than asked for (nested or limited): OpenMP's own barrier */
+#pragma omp barrier
+    }
+}
+
+/* The step's phases in one parallel region; the column-local ones (rain fall, surface fluxes,
+ * cooling, buoyancy, sponge) share one pass over the rows. */
+static void phases(atmos_sim *s, double dt)
+{
+    const float fix = (float)atmos__sim_advect(s, dt);
+#pragma omp master
+    atmos__sim_advected_velocity(s); /* the microphysics does not touch u, v, w; it ends at a barrier */
+    atmos__sim_micro(s, dt, fix);
+    const int ny = s->ny;
+    double *rain = s->part, *surf = s->part + ny + 1;
+    SIM_FOR
+    for (int j = 0; j < ny; j++) {
+        rain[j] = atmos__sim_fall_row(s, dt, j);
+        surf[j] = atmos__sim_forces_row(s, dt, j);
+    }
+    atmos__sim_sync(s);
+#pragma omp master
+    for (int j = 0; j < ny; j++) s->rain_out += rain[j], s->surface_in += surf[j];
     atmos__sim_confine(s, dt);
     atmos__sim_project(s);
+}
+
+static void advance(atmos_sim *s, double dt)
+{
+#pragma omp parallel num_threads(s->threads)
+    phases(s, dt);
     s->t += dt;
     s->steps++;
 }

@@ -61,7 +61,16 @@ atmos_status atmos_simulate(atmos_context *ctx, const atmos_sim_desc *desc, atmo
     if (st != ATMOS_OK) return st;
     const double minutes = desc->minutes > 0 ? desc->minutes : atmos_sim_preset_minutes(desc->preset);
     st = atmos_sim_run(ctx, s, minutes * 60.0);
-    if (st == ATMOS_OK) st = atmos_sim_to_volume(ctx, s, out);
+    if (st == ATMOS_OK) {
+        atmos_sim_stats ss;
+        atmos_sim_get_stats(s, &ss);
+        if (ss.max_qc < 1e-5 && ss.max_qr < 1e-5) /* nothing a renderer would see */
+            atmos__log(ctx, ATMOS_LOG_WARN,
+                       "simulate: %s after %g minutes has no cloud or rain yet: the volume is empty (the first cloud "
+                       "forms after about %g minutes at grid 64)",
+                       desc->preset, minutes, atmos_sim_preset_first_cloud_minutes(desc->preset));
+        st = atmos_sim_to_volume(ctx, s, out);
+    }
     atmos_sim_destroy(s);
     return st;
 }

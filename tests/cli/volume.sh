@@ -33,6 +33,12 @@ cmp -s "$T/rs.cloud.raw" "$T/rs2.cloud.raw" || fail "not deterministic"
 # errors: usage 2, runtime 1
 set +e
 "$A" volume generate nosuch -o "$T/x.json"; [ $? -eq 2 ] || fail "unknown preset exit"
+for ext in vdb nvdb png; do # only a raw volume with its JSON sidecar is written
+    rm -f "$T/x.$ext"
+    "$A" volume generate cumulus -o "$T/x.$ext" 2> "$T/err.txt"; [ $? -eq 2 ] || fail "-o x.$ext exit"
+    grep -q "writes only a raw volume" "$T/err.txt" || fail "-o x.$ext message: $(cat "$T/err.txt")"
+    [ -e "$T/x.$ext" ] && fail "-o x.$ext: a file was written"
+done
 "$A" volume slice "$T/rs.json" --axis w -o "$T/s.png"; [ $? -eq 2 ] || fail "bad axis exit"
 "$A" volume info; [ $? -eq 2 ] || fail "missing file exit"
 "$A" volume info "$T/does_not_exist.json"; [ $? -eq 1 ] || fail "missing file exit"

@@ -3,7 +3,8 @@
  * ground and the surface flux counted); cloud base at the lifting condensation level of
  * Espy's rule (Lawrence 2005); a dry spherical thermal accelerates at 2B/3 (Jeevanjee &
  * Lecoanet 2018); the projection leaves no divergence; results are the same bytes for 1 and
- * 2 threads and for a seed; bad presets and arguments are errors. Small grids, seconds. */
+ * 2 threads and for a seed; bad presets and arguments are errors; an empty result warns.
+ * Small grids, seconds. */
 #include "atmos/atmos.h"
 #include "sim/sim_internal.h"
 #include "test.h"
@@ -294,9 +295,39 @@ static void test_scene(void)
     atmos_context_destroy(c);
 }
 
+static void keep_warning(void *user, atmos_log_level level, const char *msg)
+{
+    if (level == ATMOS_LOG_WARN) snprintf(user, 256, "%s", msg);
+}
+
+/* A run too short for any cloud (a scene's "simulate" source too) warns that the volume is
+ * empty; one with cloud does not. */
+static void test_empty_warning(void)
+{
+    for (int cloudy = 0; cloudy < 2; cloudy++) {
+        char warned[256] = "";
+        atmos_context_desc cd;
+        atmos_context_defaults(&cd);
+        cd.threads = 1;
+        cd.log = keep_warning;
+        cd.log_user = warned;
+        cd.log_level = ATMOS_LOG_WARN;
+        atmos_context *c = NULL;
+        CHECK_OK(atmos_context_create(&cd, &c));
+        atmos_sim_desc d = {cloudy ? "stratocumulus" : "towering_cumulus", 0.5, 16, 1};
+        atmos_volume *v = NULL;
+        CHECK_OK(atmos_simulate(c, &d, &v));
+        if (cloudy) CHECK_MSG(!warned[0], "stratocumulus warned: %s", warned);
+        else CHECK_MSG(strstr(warned, "empty") && strstr(warned, "minutes"), "no empty-volume warning: '%s'", warned);
+        atmos_volume_destroy(v);
+        atmos_context_destroy(c);
+    }
+}
+
 int main(void)
 {
     test_scene();
+    test_empty_warning();
     test_adjust();
     test_bad();
     test_volume();

@@ -5,6 +5,7 @@
 #include "bench_render.h"
 #include "bench_beams.h"
 #include "bench_sky.h"
+#include "bench_sim.h"
 
 #include <math.h>
 
@@ -26,7 +27,8 @@ static void help(void)
            "                         [--repeat R] [--threads T] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
            "                        [--no-forced] [--no-sky-nee] [--no-aureole] [--json]\n"
-           "       atmos bench beams [--file SCENE] [--repeat R] [--threads T]\n\n"
+           "       atmos bench beams [--file SCENE] [--repeat R] [--threads T]\n"
+           "       atmos bench simulate [--size N] [--repeat R] [--threads T]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
            "          prints per case the best wall time and megapixels per second:\n"
@@ -116,7 +118,13 @@ static void help(void)
            "            bench=beams scene=dobashi_fig04 size=300x450 lights=1 subplanes=on plane_spacing_m=1.2\n"
            "            epsilon=0.01 threads=2 frames=20 plan_seconds=0.05 frame_ms=40.1 best_ms=38.0 cpu_ms=75.2 fps=24.9\n"
            "          (frame_ms: mean wall time a frame; cpu_ms: the process's CPU time a frame, steadier on\n"
-           "          a loaded machine; OMP_WAIT_POLICY=passive leaves out idle threads' spinning).\n");
+           "          a loaded machine; OMP_WAIT_POLICY=passive leaves out idle threads' spinning).\n"
+           "  simulate the cloud simulation (docs/clouds.md): the towering_cumulus preset on an N grid (default\n"
+           "          64, then 128: 64x64x64 and 128x128x128 cells), one warm-up step from the initial state\n"
+           "          and then R steps (default 5); mean and best wall time a step, the process's CPU time\n"
+           "          a step and the 1-minute load average:\n"
+           "            bench=simulate preset=towering_cumulus grid=128 cells=128x128x128 threads=2 steps=5\n"
+           "              ms_per_step=180.2 best_ms=170.1 cpu_ms_per_step=350.3 load=1.02\n");
 }
 
 static int bench_sky(int size, int repeat, int threads, const char *models, double budget)
@@ -565,7 +573,8 @@ int cli_cmd_bench(int argc, char **argv)
             return cli_usage_error(C, "unexpected argument '%s'", argv[i]);
         }
     }
-    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, sky-accuracy, optics, volume, slice, path, beams)");
+    if (!what) return cli_usage_error(C, "which benchmark? (available: sky, sky-accuracy, optics, volume, slice, path, beams, simulate)");
+    if (!strcmp(what, "simulate")) return bench_simulate(size, repeat, threads);
     if (!strcmp(what, "beams")) return bench_beams(file, 4 * (repeat_set ? repeat : 5), threads);
     pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale, pflags.json = json;
     if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
@@ -576,5 +585,5 @@ int cli_cmd_bench(int argc, char **argv)
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads, models, budget);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);
-    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, sky-accuracy, optics, volume, slice, path, beams)", what);
+    return cli_usage_error(C, "unknown benchmark '%s' (available: sky, sky-accuracy, optics, volume, slice, path, beams, simulate)", what);
 }

@@ -1,6 +1,7 @@
 /* atmos simulate: runs the cloud simulation and writes its volume as raw float32 files
  * plus a JSON sidecar (like 'atmos volume generate'). No physics here. */
 #include "cli.h"
+#include "outputs.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,11 +16,18 @@ static void help(void)
            "temperature, water vapour, cloud water and rain, Kessler warm rain and saturation adjustment,\n"
            "periodic sides. Writes the state at time M as a volume of \"cloud\" and \"rain\" number\n"
            "densities (m^-3; mixing ratio x air density / the particle type's mean mass), raw float32\n"
-           "files next to the JSON sidecar, y up, the ground at y = 0.\n\n"
-           "Presets: ");
-    for (const char *const *n = atmos_sim_preset_names(); *n; n++)
-        printf("%s (%g min)%s", *n, atmos_sim_preset_minutes(*n), n[1] ? ", " : "\n");
-    printf("  --minutes M  simulated time (default: the preset's, above), 0 < M <= %g\n"
+           "files next to the JSON sidecar (-o must name a .json file; nothing else is written), y up, the\n"
+           "ground at y = 0. A volume with no cloud and no rain is written with a warning.\n\n"
+           "Presets (default simulated time; a shorter run may end before any cloud has formed, and the\n"
+           "volume is then empty: at least the first-cloud time, better twice it; coarser grids take\n"
+           "longer, e.g. cumulus_field ~12 min at --grid 32):\n");
+    for (const char *const *n = atmos_sim_preset_names(); *n; n++) {
+        const double first = atmos_sim_preset_first_cloud_minutes(*n);
+        printf("  %-17s %g min; ", *n, atmos_sim_preset_minutes(*n));
+        if (first > 0) printf("first cloud after ~%g min at the default grid\n", first);
+        else printf("first cloud after 0 min: the deck is there from the start\n");
+    }
+    printf("\n  --minutes M  simulated time (default: the preset's, above), 0 < M <= %g\n"
            "  --grid N     cells along each horizontal side, %d..%d (default 64); the domain's size is the\n"
            "               preset's, so a larger N gives smaller cells\n"
            "  --seed S     the random perturbations (default 1); the same seed gives the same bytes\n"
@@ -67,6 +75,47 @@ static int run_bench(const atmos_sim_desc *d, int threads, int steps)
         print_state(s);
     }
     int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    atmos_sim_destroy(s);
+    atmos_context_destroy(ctx);
+    return rc;
+}
+
+/* Says on stderr when the state has no cloud and no rain a renderer would see (every mixing
+ * ratio under 1e-5 kg/kg, the stats' cloud threshold): the run was too short. */
+static void warn_if_empty(const atmos_sim *s, const atmos_sim_desc *d, double minutes)
+{
+    atmos_sim_stats st;
+    atmos_sim_get_stats(s, &st);
+    if (st.max_qc >= 1e-5 || st.max_qr >= 1e-5) return;
+    const double first = atmos_sim_preset_first_cloud_minutes(d->preset);
+    fprintf(stderr,
+            "atmos simulate: warning: the volume is empty: no cloud or rain after %g simulated minutes (largest cloud "
+            "water %.2g g/kg); %s's first cloud forms after about %g minutes at the default grid: try --minutes %g or "
+            "more\n",
+            minutes, 1e3 * st.max_qc, d->preset, first, first > 0 ? 2 * first : 1);
+}
+
+/* The run and the volume written as NAME.json + raw files. */
+static int run_write(const atmos_sim_desc *d, int threads, int quiet, const char *out)
+{
+    cli_progress prog;
+    cli_progress_init(&prog, quiet);
+    atmos_context *ctx = cli_context_with_progress(threads, quiet, cli_progress_bar, &prog);
+    if (!ctx) return CLI_EXIT_RUNTIME;
+    const double minutes = d->minutes > 0 ? d->minutes : atmos_sim_preset_minutes(d->preset);
+    atmos_sim *s = NULL;
+    atmos_volume *v = NULL;
+    const double t0 = cli_now_s();
+    atmos_status st = atmos_sim_create(ctx, d, &s);
+    if (st == ATMOS_OK) st = atmos_sim_run(ctx, s, minutes * 60.0);
+    if (st == ATMOS_OK) st = atmos_sim_to_volume(ctx, s, &v);
+    if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
+    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    if (rc == CLI_EXIT_OK) warn_if_empty(s, d, minutes);
+    if (rc == CLI_EXIT_OK && !quiet)
+        fprintf(stderr, "atmos simulate: %s, %g min on a %d grid in %.1f s: wrote %s\n", d->preset, minutes,
+                d->grid ? d->grid : 64, cli_now_s() - t0, out);
+    atmos_volume_destroy(v);
     atmos_sim_destroy(s);
     atmos_context_destroy(ctx);
     return rc;
@@ -123,19 +172,7 @@ int cli_cmd_simulate(int argc, char **argv)
     }
     if (bench) return run_bench(&d, threads, bench);
     if (!out) return cli_usage_error(C, "missing -o NAME.json");
-    cli_progress prog;
-    cli_progress_init(&prog, quiet);
-    atmos_context *ctx = cli_context_with_progress(threads, quiet, cli_progress_bar, &prog);
-    if (!ctx) return CLI_EXIT_RUNTIME;
-    atmos_volume *v = NULL;
-    const double t0 = cli_now_s();
-    atmos_status st = atmos_simulate(ctx, &d, &v);
-    if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
-    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
-    if (rc == CLI_EXIT_OK && !quiet)
-        fprintf(stderr, "atmos simulate: %s, %g min on a %d grid in %.1f s: wrote %s\n", d.preset,
-                d.minutes > 0 ? d.minutes : atmos_sim_preset_minutes(d.preset), d.grid ? d.grid : 64, cli_now_s() - t0, out);
-    atmos_volume_destroy(v);
-    atmos_context_destroy(ctx);
-    return rc;
+    if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
+    if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
+    return run_write(&d, threads, quiet, out);
 }

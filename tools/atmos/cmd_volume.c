@@ -248,6 +248,7 @@ static int cmd_generate(int argc, char **argv)
     int known = 0;
     for (const char *const *n = atmos_scene_generator_names(); *n; n++) known |= !strcmp(*n, preset);
     if (!known) return cli_usage_error(C, "generate: unknown preset '%s'", preset);
+    if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
@@ -388,6 +389,7 @@ static int cmd_clouds(int argc, char **argv)
     if (!scene_path) return cli_usage_error(C, "clouds: which scene?");
     if (!out) return cli_usage_error(C, "clouds: missing -o NAME.json");
     if (!(half > 0 && voxel > 0)) return cli_usage_error(C, "clouds: --half-width and --voxel-size must be > 0");
+    if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;

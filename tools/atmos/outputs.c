@@ -21,6 +21,21 @@ cli_file_kind cli_file_kind_of(const char *path)
     return CLI_FILE_OTHER;
 }
 
+int cli_volume_output(const char *cmd, const char *option, const char *path)
+{
+    const char *base = strrchr(path, '/'), *dot = strrchr(path, '.');
+    base = base ? base + 1 : path;
+    const int ext = dot && dot > base;
+    if (ext && !strcasecmp(dot, ".json")) return 0;
+    char why[96] = "the name needs the .json extension";
+    if (ext) snprintf(why, sizeof why, "'%.40s' is not a format it can write", dot);
+    fprintf(stderr,
+            "atmos %s: %s %s: %s writes only a raw volume, NAME.json (the sidecar) with a NAME.FIELD.raw per field; "
+            "%s\nTry 'atmos %s --help'.\n",
+            cmd, option, path, cmd, why, cmd);
+    return 1;
+}
+
 /* ------------------------------------------------ temporaries removed on signals ---- */
 
 /* Every staging file and the writer's temporary next to it (STAGE.tmpPID, as the
