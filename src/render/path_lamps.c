@@ -21,7 +21,8 @@
  *     Russian roulette;
  *   - a path that leaves (no fog, no object ahead) sees the vacuum's uniform background.
  * The sun, the atmosphere's air and a cloud volume are not part of such a scene here
- * (path_plan.c refuses the air and the volume). */
+ * (path_plan.c refuses the air, the volume, a fog thinning with height and the beam
+ * renderer's sun, all in one error). */
 #include "core/vec.h"
 #include "render/path_trace.h"
 

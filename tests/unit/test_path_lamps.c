@@ -248,16 +248,30 @@ static void test_fig04(void)
     atmos_image_destroy(pt), atmos_image_destroy(var), atmos_image_destroy(bm), atmos_image_destroy(all);
 }
 
-/* A scene the path tracer cannot yet trace with lights is refused with a message. */
+/* A scene the path tracer cannot yet trace with lights is refused with one message naming
+ * every reason at once (not one per try), and the beam renderer's sun is never dropped
+ * silently: a scene lit by it alone would come out black. */
 static void test_refused(void)
 {
     atmos_scene s;
     path_scene(&s, 8, 6, 1, 1);
     s.atmosphere.kind = ATMOS_ATMOSPHERE_RILEY;
+    s.light_count = 0; /* the sun alone lights a fog thinning with height */
+    s.fog.enabled = 1, s.fog.extinction_per_m = 0.05, s.fog.scattering_per_m = 0.04, s.fog.height_m = 100;
+    s.beams.sun = 1;
     atmos_plan *plan = NULL;
-    const atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
-    CHECK_MSG(st == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), "background"), "%s",
-              atmos_context_error(ctx));
+    atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
+    const char *e = atmos_context_error(ctx);
+    CHECK_MSG(st == ATMOS_E_INVALID_ARG && strstr(e, "background") && strstr(e, "/fog/height_m") && strstr(e, "/beams/sun"),
+              "all three reasons in one error: %s", e);
+    printf("refused: %s\n", e);
+    atmos_plan_destroy(plan), plan = NULL;
+    path_scene(&s, 8, 6, 1, 1); /* the sun alone is what the path tracer would leave out */
+    s.beams.sun = 1;
+    st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
+    CHECK_MSG(st == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), "/beams/sun") &&
+                  !strstr(atmos_context_error(ctx), "background"),
+              "beams/sun dropped: %s", atmos_context_error(ctx));
     atmos_plan_destroy(plan);
 }
 
