@@ -315,12 +315,17 @@ static void test_image(void)
             CHECK(sum[0] > 0 && sum[1] == 0 && sum[2] == 0);
             atmos_image_destroy(img);
         }
+        /* the window on the second light: the error names its key and the file (a relative
+         * one as relative to the current folder, where it was looked for) */
+        s.light_count = 2, s.lights[1] = s.lights[0], s.lights[0].image[0] = 0;
         for (int k = 0; k < 2; k++) {
-            snprintf(l->image, sizeof l->image, "%s", k ? bad : "no_such_window.png");
+            snprintf(s.lights[1].image, sizeof s.lights[1].image, "%s", k ? bad : "no_such_window.png");
             atmos_plan *plan = NULL;
             const atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
-            CHECK_MSG(st != ATMOS_OK && strstr(atmos_context_error(ctx), k ? "corrupt_window.png" : "no_such_window.png"),
-                      "%s", atmos_context_error(ctx));
+            const char *e = atmos_context_error(ctx);
+            CHECK_MSG(st != ATMOS_OK && strstr(e, "/lights/1/image") && strstr(e, k ? bad : "no_such_window.png") &&
+                          (k || strstr(e, "current folder")),
+                      "%s", e);
             atmos_plan_destroy(plan);
         }
     }
