@@ -111,4 +111,24 @@ while IFS='|' read -r opt define r same; do
     if cmp -s "$T/opt$i.pfm" "$T/def$i.pfm"; then ok "$opt = -D $define"; else bad "$opt renders differently from -D $define"; fi
     if [ -z "$same" ] && cmp -s "$T/opt$i.pfm" "$T/default_$r.pfm"; then bad "$opt changes nothing in the image"; fi
 done <"$T/table"
+
+# --exposure auto on a scene with a manual EV: the -D form's exposure, not that EV taken as
+# a compensation of +9 stops (which turned Fig. 4's beam white).
+png_scale() { # the exposure scale a PNG's metadata records
+    python3 -c '
+import struct, sys
+d = open(sys.argv[1], "rb").read()
+i = 8
+while i < len(d):
+    n, = struct.unpack(">I", d[i:i + 4])
+    if d[i + 4:i + 8] == b"tEXt" and d[i + 8:i + 8 + n].startswith(b"atmos:exposure_scale\0"):
+        print(d[i + 8:i + 8 + n].split(b"\0")[1].decode())
+    i += 12 + n' "$1"
+}
+# shellcheck disable=SC2046
+"$A" render $(base beams) --exposure auto -q -o "$T/auto_opt.png" || bad "render --exposure auto"
+# shellcheck disable=SC2046
+"$A" render $(base beams) -D output.exposure=auto -q -o "$T/auto_def.png" || bad "render -D output.exposure=auto"
+a=$(png_scale "$T/auto_opt.png") b=$(png_scale "$T/auto_def.png")
+if [ -n "$a" ] && [ "$a" = "$b" ]; then ok "--exposure auto = -D output.exposure=auto (scale $a)"; else bad "--exposure auto scale $a, -D form $b"; fi
 exit $fail

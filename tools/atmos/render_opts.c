@@ -455,7 +455,8 @@ static int apply_view(const render_opts *o, atmos_scene *s)
     apply_camera(o, &s->camera);
     if (o->spectral) s->wavelengths = ATMOS_WAVELENGTHS_SPECTRAL, s->spectral_samples = o->spectral;
     if (o->rgb) s->wavelengths = ATMOS_WAVELENGTHS_RGB;
-    if (o->exposure_auto) s->tonemap.manual_exposure = 0;
+    if (o->exposure_auto && s->tonemap.manual_exposure) /* the scene's EV is no compensation */
+        s->tonemap.manual_exposure = 0, s->tonemap.exposure_ev = 0;
     if (!isnan(o->ev)) s->tonemap.manual_exposure = 1, s->tonemap.exposure_ev = o->ev;
     if (!isnan(o->ev_comp)) {
         if (s->tonemap.manual_exposure) return cli_usage_error("render", "--exposure-comp applies to automatic exposure only");
