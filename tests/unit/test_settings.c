@@ -93,6 +93,19 @@ static void check_help(void)
                       "render --help lacks %s or its doc", opt);
         }
     }
+    /* the --volume paragraph names every generator and simulation preset the library takes */
+    const char *vol = text ? strstr(text, "--volume SOURCE") : NULL, *end = vol ? strstr(vol, "--volume-position") : NULL;
+    CHECK_MSG(vol && end, "render --help has no --volume SOURCE paragraph");
+    for (int k = 0; vol && end && k < 2; k++)
+        for (const char *const *nm = k ? atmos_sim_preset_names() : atmos_scene_generator_names(); *nm; nm++) {
+            int found = 0;
+            for (const char *at = vol; !found && (at = strstr(at, *nm)) && at < end; at += strlen(*nm)) {
+                const char before = at[-1], after = at[strlen(*nm)];
+                found = (before == ' ' || before == ':') && (after == ',' || after == ')' || after == ';' || after == '\n');
+            }
+            CHECK_MSG(found, "render --help's --volume paragraph lacks %s %s", k ? "simulate:" : "generate:", *nm);
+        }
+    CHECK_MSG(vol && end && memmem(vol, (size_t)(end - vol), "simulate:PRESET", 15), "--volume: simulate:PRESET not named");
     free(text);
 }
 
