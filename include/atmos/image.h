@@ -58,10 +58,13 @@ typedef struct atmos_tonemap_desc {
  * values are linear sRGB scaled so that Y is luminance in cd m^-2 (what the
  * renderers produce):
  *   manual:    1 / (1.2 * 2^EV)  (saturation-based EV100: 1.2*2^EV cd/m^2 maps to 1)
- *   automatic: 0.18 / Lavg * 2^EV, Lavg = exp(mean(log(1e-4 + Y))) over the image's
- *              pixels with alpha > 0 (all pixels if there is no alpha channel);
- *              NaN and negative values count as 0, pixels with infinite Y are
- *              skipped; with no pixel left the scale is 2^EV.
+ *   automatic: min(0.18 / Lavg, 4 / Y99) * 2^EV over the image's pixels with
+ *              alpha > 0 (all pixels if there is no alpha channel): Y99 the 99th
+ *              percentile of their Y (within 1.1 %; the cap leaves out a Y99 of 0),
+ *              Lavg = exp(mean(log(1e-4 + Y))) over those of them with Y >= 1e-3 Y99
+ *              (a black background does not set the key; the brightest 1 %, a lamp,
+ *              may burn out); NaN and negative values count as 0, pixels with
+ *              infinite Y are skipped; with no pixel left the scale is 2^EV.
  * img must have 3 or 4 channels (otherwise the automatic scale is 2^EV). */
 ATMOS_API double atmos_tonemap_scale(const atmos_image *img, const atmos_tonemap_desc *desc);
 

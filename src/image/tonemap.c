@@ -36,6 +36,50 @@ double atmos_srgb_decode(double encoded)
     return pow((encoded + 0.055) / 1.055, 2.4);
 }
 
+/* A pixel's luminance, or -1 for a pixel that does not count (alpha 0, infinite Y). */
+static double pixel_luminance(const atmos_image *img, size_t i)
+{
+    const float *p = img->pixels + i * (size_t)img->channels;
+    if (img->channels == 4 && !(p[3] > 0)) return -1;
+    const double y = luminance(sanitize(p[0]), sanitize(p[1]), sanitize(p[2]));
+    return isfinite(y) ? y : -1; /* an Inf pixel would drive the average to Inf */
+}
+
+/* The HIGH_PERCENTILE-th percentile of the counted pixels' luminance, from a histogram of
+ * HIST_PER_STOP bins a stop over [2^HIST_LO, 2^(HIST_LO + HIST_STOPS)) cd/m^2 (the bin's
+ * middle: within 1.1 % of the exact value); 0 when that many pixels are black. */
+#define HIGH_PERCENTILE 99.0
+#define HIST_PER_STOP 32
+#define HIST_LO (-40)
+#define HIST_STOPS 80
+static double high_luminance(const atmos_image *img, size_t n)
+{
+    enum { BINS = HIST_STOPS * HIST_PER_STOP };
+    size_t hist[BINS] = {0}, black = 0, count = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double y = pixel_luminance(img, i);
+        if (y < 0) continue;
+        count++;
+        const double b = (log2(y) - HIST_LO) * HIST_PER_STOP; /* -inf for y = 0 */
+        if (!(b >= 0)) black++;
+        else hist[b < BINS - 1 ? (int)b : BINS - 1]++;
+    }
+    const double need = ceil(HIGH_PERCENTILE / 100 * (double)count);
+    size_t seen = black;
+    if ((double)seen >= need) return 0;
+    for (int b = 0; b < BINS; b++)
+        if ((double)(seen += hist[b]) >= need) return exp2(HIST_LO + (b + 0.5) / HIST_PER_STOP);
+    return 0;
+}
+
+/* Automatic exposure (docs/scene-format.md, "exposure"): Reinhard et al.'s key, the log
+ * average mapped to middle grey, taken over the pixels within LIT_RANGE of the image's
+ * highlights (the 99th percentile) only, so that a black background does not vote; and at
+ * most HIGH_X / that percentile, so that a small bright part (a beam over a dim glow) stays
+ * just below white (4: 0.99 of it in sRGB through the filmic curve) while the brightest 1 %
+ * (a lamp, the sun's disc) may burn out. */
+#define LIT_RANGE 1e-3
+#define HIGH_X 4.0
 double atmos_tonemap_scale(const atmos_image *img, const atmos_tonemap_desc *desc)
 {
     atmos_tonemap_desc d;
@@ -45,24 +89,23 @@ double atmos_tonemap_scale(const atmos_image *img, const atmos_tonemap_desc *des
     if (d.manual_exposure) return 1.0 / (1.2 * pow(2.0, ev));
     if (!img || !img->pixels || (img->channels != 3 && img->channels != 4)) return pow(2.0, ev);
 
-    /* Serial sum in a fixed order so that the scale (and so the image) is the same
+    /* Serial sums in a fixed order so that the scale (and so the image) is the same
      * bit for bit whatever the thread count. */
-    const int nc = img->channels;
     const size_t n = (size_t)img->width * (size_t)img->height;
+    const double high = high_luminance(img, n), lit = LIT_RANGE * high;
     double sum = 0.0;
     size_t count = 0;
     for (size_t i = 0; i < n; i++) {
-        const float *p = img->pixels + i * (size_t)nc;
-        if (nc == 4 && !(p[3] > 0)) continue;
-        double y = luminance(sanitize(p[0]), sanitize(p[1]), sanitize(p[2]));
-        if (!isfinite(y)) continue; /* an Inf pixel would drive the average to Inf */
+        const double y = pixel_luminance(img, i);
+        if (y < 0 || y < lit) continue;
         sum += log(LOG_AVG_EPSILON + y);
         count++;
     }
     /* Nothing visible: any scale gives the same (empty) picture. */
     if (count == 0) return pow(2.0, ev);
-    double lavg = exp(sum / (double)count);
-    return KEY_VALUE / lavg * pow(2.0, ev);
+    double scale = KEY_VALUE / exp(sum / (double)count);
+    if (high > 0) scale = fmin(scale, HIGH_X / high);
+    return scale * pow(2.0, ev);
 }
 
 /* The sRGB transfer function tabulated over [0, 1] (a curve's output) in floats, read linearly:

@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 
 /* Planck's law up to constants: the spectral radiance of a black body at T (K), nm. */
@@ -65,17 +66,24 @@ double atmos__lamp_toward(const atmos__lamp *l, const double p[3], int m, const 
 
 static double srgb_linear(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
 
-atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene_light *s, atmos__lamp *l)
+atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene_light *s, int index, atmos__lamp *l)
 {
     if (!s->image[0]) return ATMOS_OK;
     atmos_image *img = NULL;
     atmos_status st = atmos_read_png(ctx, s->image, &img);
-    if (st != ATMOS_OK) return st; /* the reader's message names the file */
+    if (st != ATMOS_OK) {
+        /* the reader's message names the file; the scene's key goes in front, and a relative
+         * path (a scene from standard input or from code) says where it was looked for */
+        char why[1024];
+        snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
+        return atmos__error(ctx, st, "/lights/%d/image: %s%s", index, why,
+                            s->image[0] == '/' ? "" : " (a relative path: from the current folder)");
+    }
     const size_t n = (size_t)img->width * img->height;
     l->tex = malloc(sizeof(float) * 3 * n);
     if (!l->tex) {
         atmos_image_destroy(img);
-        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for a light's image", s->image);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "/lights/%d/image: %s: out of memory for a light's image", index, s->image);
     }
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {

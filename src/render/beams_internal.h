@@ -71,9 +71,18 @@ typedef struct atmos__beams_light {
     atmos__beams_face face[6];
 } atmos__beams_light;
 
-/* The light's shadow maps of the meshes, size texels a side (beams_shadow.c). */
+/* The plan's progress over every light's shadow maps (stage "beams shadow maps"): faces done
+ * of the total, and the caller's wish to stop (atmos__progress_step). */
+typedef struct atmos__beams_progress {
+    int done, total, cancelled;
+} atmos__beams_progress;
+
+/* How many depth maps the light gets: 0 without meshes, 1 for a spot's frustum, 6 for a cube. */
+int atmos__beams_shadow_faces(const atmos__lamp *L, int nmesh);
+/* The light's shadow maps of the meshes, size texels a side (beams_shadow.c), each face done
+ * counted in *pr; ATMOS_E_CANCELLED when the progress callback asked to stop. */
 atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l, atmos_mesh *const *mesh, int nmesh,
-                                       int size);
+                                       int size, atmos__beams_progress *pr);
 void atmos__beams_shadow_free(atmos__beams_light *l);
 /* H: the share of the light reaching p past the meshes, in [0, 1] (2x2 filtered). */
 double atmos__beams_visibility(const atmos__beams_light *l, const double p[3]);

@@ -9,12 +9,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-static atmos_status make_light(atmos_context *ctx, const atmos_scene_light *s, const atmos_wavelengths *wl,
+static atmos_status make_light(atmos_context *ctx, const atmos_scene_light *s, int index, const atmos_wavelengths *wl,
                                atmos__beams_light *l)
 {
     memset(l, 0, sizeof *l);
     atmos__lamp_make(s, wl, &l->L);
-    return atmos__lamp_load_image(ctx, s, &l->L);
+    return atmos__lamp_load_image(ctx, s, index, &l->L);
 }
 
 void atmos__beams_plan_destroy(atmos__beams_plan *b)
@@ -28,6 +28,19 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b)
     free(b);
 }
 
+/* Every light's shadow maps, with progress from 0 to 1 (a city's take seconds). */
+static atmos_status shadow_maps(atmos_plan *p, atmos__beams_plan *b, atmos__beams_progress *pr)
+{
+    const char *stage = "beams shadow maps";
+    if (atmos__progress(p->ctx, stage, 0.0)) return atmos__error(p->ctx, ATMOS_E_CANCELLED, "render beams: cancelled");
+    for (int i = 0; i < b->nlights; i++) {
+        atmos_status st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->obj.mesh, b->obj.n, p->scene.beams.shadow_size, pr);
+        if (st != ATMOS_OK) return st;
+    }
+    if (atmos__progress(p->ctx, stage, 1.0)) return atmos__error(p->ctx, ATMOS_E_CANCELLED, "render beams: cancelled");
+    return ATMOS_OK;
+}
+
 atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
 {
     const atmos_scene *s = &p->scene;
@@ -37,12 +50,14 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
     if (st == ATMOS_OK && !(b->lights = calloc((size_t)s->light_count, sizeof *b->lights)))
         st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     double range = 0;
+    atmos__beams_progress pr = {0, 0, 0};
     for (int i = 0; st == ATMOS_OK && i < s->light_count; i++) {
-        st = make_light(p->ctx, &s->lights[i], &p->wl, &b->lights[i]);
+        st = make_light(p->ctx, &s->lights[i], i, &p->wl, &b->lights[i]);
         b->nlights = i + 1;
         range = fmax(range, b->lights[i].L.range);
-        if (st == ATMOS_OK) st = atmos__beams_shadow_build(p->ctx, &b->lights[i], b->obj.mesh, b->obj.n, s->beams.shadow_size);
+        pr.total += atmos__beams_shadow_faces(&b->lights[i].L, b->obj.n);
     }
+    if (st == ATMOS_OK && pr.total > 0) st = shadow_maps(p, b, &pr);
     if (st == ATMOS_OK && s->fog.enabled && s->light_count > 0) { /* x = sigma_t v reaches sigma_t times the largest reach */
         b->sigma_t = s->fog.extinction_per_m, b->sigma_s = s->fog.scattering_per_m;
         st = atmos__beams_table_build(p->ctx, b->sigma_t, b->sigma_s, s->fog.g,

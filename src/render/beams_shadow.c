@@ -132,13 +132,18 @@ static void raster_face(atmos__beams_face *F, const double pos[3], atmos_mesh *c
     tile_bounds(F);
 }
 
+int atmos__beams_shadow_faces(const atmos__lamp *L, int nmesh)
+{
+    if (nmesh == 0) return 0;
+    return L->type == ATMOS_LIGHT_SPOT && L->cos_outer >= cos(SPOT_FRUSTUM_MAX_DEG * ATMOS_DEG2RAD) ? 1 : 6;
+}
+
 atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l, atmos_mesh *const *mesh, int nmesh,
-                                       int size)
+                                       int size, atmos__beams_progress *pr)
 {
     l->nfaces = 0;
-    if (nmesh == 0) return ATMOS_OK;
-    const int spot = l->L.type == ATMOS_LIGHT_SPOT && l->L.cos_outer >= cos(SPOT_FRUSTUM_MAX_DEG * ATMOS_DEG2RAD);
-    const int nf = spot ? 1 : 6;
+    const int nf = atmos__beams_shadow_faces(&l->L, nmesh), spot = nf == 1;
+    if (nf == 0) return ATMOS_OK;
     for (int f = 0; f < nf; f++) {
         atmos__beams_face *F = &l->face[f];
         if (spot) set_face(F, l->L.axis, fmax(1e-3, tan(acos(l->L.cos_outer)) * 1.02));
@@ -160,7 +165,12 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     }
     l->nfaces = nf;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
-    for (int f = 0; f < nf; f++) raster_face(&l->face[f], l->L.pos, mesh, nmesh);
+    for (int f = 0; f < nf; f++) {
+        if (atmos__cancelled(&pr->cancelled)) continue;
+        raster_face(&l->face[f], l->L.pos, mesh, nmesh);
+        atmos__progress_step(ctx, "beams shadow maps", &pr->done, pr->total, &pr->cancelled);
+    }
+    if (atmos__cancelled(&pr->cancelled)) return atmos__error(ctx, ATMOS_E_CANCELLED, "render beams: cancelled");
     return ATMOS_OK;
 }
 

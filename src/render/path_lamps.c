@@ -21,7 +21,8 @@
  *     Russian roulette;
  *   - a path that leaves (no fog, no object ahead) sees the vacuum's uniform background.
  * The sun, the atmosphere's air and a cloud volume are not part of such a scene here
- * (path_plan.c refuses the air and the volume). */
+ * (path_plan.c refuses the air, the volume, a fog thinning with height and the beam
+ * renderer's sun, all in one error). */
 #include "core/vec.h"
 #include "render/path_trace.h"
 
@@ -39,7 +40,7 @@ atmos_status atmos__path_lamps_build(atmos_context *ctx, const atmos_scene *s, c
     L->nlamps = s->light_count;
     for (int i = 0; i < s->light_count; i++) {
         atmos__lamp_make(&s->lights[i], wl, &L->lamp[i]);
-        if ((st = atmos__lamp_load_image(ctx, &s->lights[i], &L->lamp[i])) != ATMOS_OK) return st;
+        if ((st = atmos__lamp_load_image(ctx, &s->lights[i], i, &L->lamp[i])) != ATMOS_OK) return st;
     }
     if (s->fog.enabled) {
         L->sigma_s = s->fog.scattering_per_m;

@@ -102,6 +102,31 @@ static atmos_status build_medium(atmos_plan *p, atmos__path_plan *pp)
     return ATMOS_OK;
 }
 
+/* A scene with lights, fog or objects: what the path tracer does not trace with them yet,
+ * every reason in one error (a user fixing one at a time would otherwise meet the next only
+ * on the next try). The beam renderer's sun is among them: leaving it out would render its
+ * light as black without a word. */
+static atmos_status lamps_supported(const atmos_plan *p)
+{
+    const atmos_scene *s = &p->scene;
+    const char *why[4];
+    int n = 0;
+    if (p->volume) why[n++] = "a cloud volume (remove it)";
+    if (atmos_atmosphere_get_kind(p->atm) != ATMOS_ATMOSPHERE_VACUUM)
+        why[n++] = "the sky's air (/background: set \"black\" or a uniform one)";
+    if (s->fog.enabled && s->fog.height_m > 0)
+        why[n++] = "a fog thinning with height (/fog/height_m: 0 makes it uniform, which is traced)";
+    if (s->beams.sun) why[n++] = "the sun as a light (/beams/sun: set it false, or render with the beam renderer)";
+    if (!n) return ATMOS_OK;
+    char list[768] = "";
+    for (int i = 0; i < n; i++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s (%d) %s", i ? ";" : "", i + 1, why[i]);
+    return atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
+                        "render path: lights, fog and objects are not traced yet together with what this scene has "
+                        "(docs/path.md):%s",
+                        list);
+}
+
 atmos_status atmos__path_plan_create(atmos_plan *p, atmos__path_plan **out)
 {
     const double t0 = atmos__now();
@@ -110,20 +135,8 @@ atmos_status atmos__path_plan_create(atmos_plan *p, atmos__path_plan **out)
     pp->NA = 2 * p->wl.count + 5;
     const atmos_scene *s = &p->scene;
     if (s->light_count > 0 || s->fog.enabled || s->object_count > 0) {
-        atmos_status st = ATMOS_OK;
-        if (p->volume)
-            st = atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
-                              "render path: a scene with lights, fog or objects cannot have a volume yet (docs/path.md)");
-        else if (atmos_atmosphere_get_kind(p->atm) != ATMOS_ATMOSPHERE_VACUUM)
-            st = atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
-                              "render path: a scene with lights, fog or objects needs \"background\": \"black\" or "
-                              "a uniform one (the sky's air is not traced with them yet; docs/path.md)");
-        else if (s->fog.enabled && s->fog.height_m > 0)
-            st = atmos__error(p->ctx, ATMOS_E_INVALID_ARG,
-                              "render path: /fog/height_m: a fog thinning with height is not traced yet (a uniform fog "
-                              "is; docs/path.md)");
-        else
-            st = atmos__path_lamps_build(p->ctx, s, &p->wl, &pp->lamps);
+        atmos_status st = lamps_supported(p);
+        if (st == ATMOS_OK) st = atmos__path_lamps_build(p->ctx, s, &p->wl, &pp->lamps);
         if (st != ATMOS_OK) {
             atmos__path_plan_destroy(pp);
             return st;

@@ -113,7 +113,7 @@ static const atmos_setting beams_settings[] = {
      "sub-planes between two main planes at most (1: none, the main planes alone)", BEAMS(max_subplanes)},
     {"shadow_size", "shadow-size", ATMOS_SETTING_INT, "texels", 16, 8192, 0, 0, 512, NULL, 0,
      "shadow map texels per side (per cube face for a point light)", BEAMS(shadow_size)},
-    {"sun", "beams-sun", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 0,
+    {"sun", "beams-sun", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
      "the scene's sun lights the fog and the objects too: a directional light with a shadow map", BEAMS(sun)},
     {"interleave", "interleave", ATMOS_SETTING_INT, "pixels", 1, 8, 0, 0, 1, NULL, 0,
      "interleaved sampling (Keller and Heidrich 2001): the pixels of each N x N block sample between the planes at N^2 "

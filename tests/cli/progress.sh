@@ -44,6 +44,10 @@ check "volume load" bench_volume "$A" bench volume --file "$T/cu.json" --repeat 
 ATMOS_PROGRESS_INTERVAL=0 "$A" volume generate cumulus --voxel-size 40 -o "$T/cu2.json" 2> "$T/log.err" \
     || bad "generate with a progress log"
 grep -q "^atmos: volume generate: [0-9]* %, [0-9.]* s elapsed$" "$T/log.err" && ok || bad "no log line: $(cat "$T/log.err")"
+# The beam renderer's plan reports its shadow maps (a city's took seconds without a word).
+ATMOS_PROGRESS_INTERVAL=0 "$A" render "${ATMOS_SOURCE_DIR:?}/scenes/dobashi_fig04_spotlight.json" --width 12 --height 18 \
+    -o "$T/beams.png" 2> "$T/beams.err" || bad "beams render with a progress log"
+grep -q "^atmos: beams shadow maps: 100 %, [0-9.]* s elapsed$" "$T/beams.err" && ok || bad "no shadow map log: $(cat "$T/beams.err")"
 
 # Outputs whose folder does not exist yet: made before the work, or refused before it.
 "$A" volume generate cumulus --voxel-size 40 -o "$T/new/dir/cu.json" 2> "$T/mk.err" && [ -f "$T/new/dir/cu.json" ] && ok \

@@ -409,6 +409,59 @@ static void test_cancel(void)
     atmos_context_destroy(c);
 }
 
+/* The plan's shadow maps report progress ("beams shadow maps", rising to 1 before the frame's
+ * "render beams") and can be cancelled there: a large scene spends seconds in them. */
+typedef struct {
+    int calls, rendering_after, stop;
+    double last;
+} plan_progress;
+
+static int watch_maps(void *user, const char *stage, double fraction)
+{
+    plan_progress *w = user;
+    if (!strcmp(stage, "render beams")) w->rendering_after += w->calls > 0;
+    if (strcmp(stage, "beams shadow maps")) return 0;
+    CHECK_MSG(fraction >= w->last && fraction <= 1, "shadow map progress %g after %g", fraction, w->last);
+    w->last = fraction, w->calls++;
+    return w->stop;
+}
+
+static void test_plan_progress(void)
+{
+    atmos_scene s;
+    base_scene(&s, 16, 12);
+    s.camera.position[0] = 0, s.camera.position[1] = 6, s.camera.position[2] = 25;
+    s.light_count = 2; /* a point light (six cube faces) and a narrow spot (one map) */
+    s.lights[1] = s.lights[0];
+    s.lights[1].type = ATMOS_LIGHT_SPOT, s.lights[1].position_m[1] = 20, s.lights[1].cone_deg = 5;
+    s.lights[0].position_m[0] = 8, s.lights[0].position_m[1] = 4;
+    s.object_count = 1;
+    memset(&s.objects[0], 0, sizeof s.objects[0]);
+    snprintf(s.objects[0].mesh, sizeof s.objects[0].mesh, "builtin:sphere");
+    s.objects[0].scale[0] = s.objects[0].scale[1] = s.objects[0].scale[2] = 2;
+    s.objects[0].albedo[0] = s.objects[0].albedo[1] = s.objects[0].albedo[2] = 0.6;
+    s.beams.shadow_size = 64;
+    for (int stop = 0; stop < 2; stop++) {
+        plan_progress w = {0, 0, stop, 0};
+        atmos_context_desc d;
+        memset(&d, 0, sizeof d);
+        d.progress = watch_maps, d.progress_user = &w;
+        atmos_context *c = NULL;
+        CHECK_OK(atmos_context_create(&d, &c));
+        atmos_image *img = NULL;
+        const atmos_status st = atmos_render_scene(c, &s, NULL, &img, NULL);
+        if (!stop)
+            CHECK_MSG(st == ATMOS_OK && w.calls >= 2 && w.last == 1 && w.rendering_after > 0,
+                      "%s: %d shadow map reports, the last %g, %d render reports after", atmos_context_error(c), w.calls,
+                      w.last, w.rendering_after);
+        else
+            CHECK_MSG(st == ATMOS_E_CANCELLED && !img && w.rendering_after == 0, "cancelled in the shadow maps: %s (%s)",
+                      atmos_status_string(st), atmos_context_error(c));
+        atmos_image_destroy(img);
+        atmos_context_destroy(c);
+    }
+}
+
 static void test_spectrum(void)
 {
     atmos_scene_light l;
@@ -496,6 +549,7 @@ int main(void)
     test_interleave();
     test_scene_files();
     test_cancel();
+    test_plan_progress();
     test_extremes();
     atmos_context_destroy(ctx);
     return test_summary("test_beams");

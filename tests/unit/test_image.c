@@ -678,6 +678,49 @@ static void test_exposure(void)
     atmos_image_destroy(img);
 }
 
+/* A grey image of n pixels: counts[k] pixels of luminance levels[k], in that order. */
+static atmos_image *levels_image(int n, const int *counts, const double *levels, int nlevels)
+{
+    atmos_image *img = make_image(n, 1, 3);
+    int at = 0;
+    for (int k = 0; k < nlevels; k++)
+        for (int i = 0; i < counts[k]; i++, at++)
+            for (int c = 0; c < 3; c++) img->pixels[3 * at + c] = (float)levels[k];
+    return img;
+}
+
+/* Automatic exposure of a dark scene with a small bright beam and lamp (the beam renderer's
+ * scenes): the black pixels do not vote for the key (a log average of mostly 1e-4 sent the
+ * scale to thousands and the beam to white), and the 99th percentile, the beam, stays below
+ * white (it is scaled to at most 4: 0.99 of white through the filmic curve) while the lamp's
+ * 0.5 % may burn. */
+static void test_exposure_dark_scene(void)
+{
+    atmos_tonemap_desc a = {0, 0.0, ATMOS_TONE_FILMIC};
+    /* 1000 pixels: 960 black, 35 beam at 10 cd/m^2, 5 lamp at 1e5 */
+    const int c1[3] = {960, 35, 5};
+    const double l1[3] = {0, 10, 1e5};
+    atmos_image *img = levels_image(1000, c1, l1, 3);
+    const double lavg = exp((35 * log(1e-4 + 10) + 5 * log(1e-4 + 1e5)) / 40); /* over the lit pixels */
+    double s = atmos_tonemap_scale(img, &a);
+    CHECK_MSG(fabs(s / (0.18 / lavg) - 1) < 1e-6, "dark scene: scale %g, expected 0.18 / %g", s, lavg);
+    atmos_image *out = NULL;
+    CHECK_OK(atmos_tonemap(NULL, img, &a, &out));
+    if (out) CHECK_MSG(out->pixels[3 * 970] > 0.05 && out->pixels[3 * 970] < 0.9, "the beam displays as %g", out->pixels[3 * 970]);
+    atmos_image_destroy(out);
+    atmos_image_destroy(img);
+    /* a dim glow everywhere (1e-3), a beam on 9.5 % (0.2), lamps on 0.5 % (20): the glow's key
+     * would scale the beam to 16 (white); the cap scales the 99th percentile to 4 */
+    const int c2[3] = {900, 95, 5};
+    const double l2[3] = {1e-3, 0.2, 20};
+    img = levels_image(1000, c2, l2, 3);
+    s = atmos_tonemap_scale(img, &a);
+    CHECK_MSG(fabs(s * 0.2 / 4 - 1) < 0.02, "glow and beam: the beam scaled to %g, expected 4", s * 0.2);
+    a.exposure_ev = 1;
+    CHECK_REL(atmos_tonemap_scale(img, &a), 2 * s, 1e-12);
+    atmos_image_destroy(img);
+}
+
 static float tm_one(atmos_tone_curve curve, float v)
 {
     atmos_image *img = make_image(1, 1, 3), *out = NULL;
@@ -955,6 +998,7 @@ int main(void)
     test_kill_during_write();
     test_srgb();
     test_exposure();
+    test_exposure_dark_scene();
     test_tonemap();
     test_tonemap_precision();
     return test_summary("test_image");

@@ -248,16 +248,30 @@ static void test_fig04(void)
     atmos_image_destroy(pt), atmos_image_destroy(var), atmos_image_destroy(bm), atmos_image_destroy(all);
 }
 
-/* A scene the path tracer cannot yet trace with lights is refused with a message. */
+/* A scene the path tracer cannot yet trace with lights is refused with one message naming
+ * every reason at once (not one per try), and the beam renderer's sun is never dropped
+ * silently: a scene lit by it alone would come out black. */
 static void test_refused(void)
 {
     atmos_scene s;
     path_scene(&s, 8, 6, 1, 1);
     s.atmosphere.kind = ATMOS_ATMOSPHERE_RILEY;
+    s.light_count = 0; /* the sun alone lights a fog thinning with height */
+    s.fog.enabled = 1, s.fog.extinction_per_m = 0.05, s.fog.scattering_per_m = 0.04, s.fog.height_m = 100;
+    s.beams.sun = 1;
     atmos_plan *plan = NULL;
-    const atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
-    CHECK_MSG(st == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), "background"), "%s",
-              atmos_context_error(ctx));
+    atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
+    const char *e = atmos_context_error(ctx);
+    CHECK_MSG(st == ATMOS_E_INVALID_ARG && strstr(e, "background") && strstr(e, "/fog/height_m") && strstr(e, "/beams/sun"),
+              "all three reasons in one error: %s", e);
+    printf("refused: %s\n", e);
+    atmos_plan_destroy(plan), plan = NULL;
+    path_scene(&s, 8, 6, 1, 1); /* the sun alone is what the path tracer would leave out */
+    s.beams.sun = 1;
+    st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
+    CHECK_MSG(st == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), "/beams/sun") &&
+                  !strstr(atmos_context_error(ctx), "background"),
+              "beams/sun dropped: %s", atmos_context_error(ctx));
     atmos_plan_destroy(plan);
 }
 
@@ -301,12 +315,17 @@ static void test_image(void)
             CHECK(sum[0] > 0 && sum[1] == 0 && sum[2] == 0);
             atmos_image_destroy(img);
         }
+        /* the window on the second light: the error names its key and the file (a relative
+         * one as relative to the current folder, where it was looked for) */
+        s.light_count = 2, s.lights[1] = s.lights[0], s.lights[0].image[0] = 0;
         for (int k = 0; k < 2; k++) {
-            snprintf(l->image, sizeof l->image, "%s", k ? bad : "no_such_window.png");
+            snprintf(s.lights[1].image, sizeof s.lights[1].image, "%s", k ? bad : "no_such_window.png");
             atmos_plan *plan = NULL;
             const atmos_status st = atmos_plan_create(ctx, &s, NULL, NULL, &plan);
-            CHECK_MSG(st != ATMOS_OK && strstr(atmos_context_error(ctx), k ? "corrupt_window.png" : "no_such_window.png"),
-                      "%s", atmos_context_error(ctx));
+            const char *e = atmos_context_error(ctx);
+            CHECK_MSG(st != ATMOS_OK && strstr(e, "/lights/1/image") && strstr(e, k ? bad : "no_such_window.png") &&
+                          (k || strstr(e, "current folder")),
+                      "%s", e);
             atmos_plan_destroy(plan);
         }
     }

@@ -31,6 +31,10 @@ static void check_row(atmos_context *ctx, atmos_renderer_kind r, const atmos_set
     CHECK_MSG(atmos_scene_setting_get(&d, st) == st->def, "%s: the scene's default %g is not the row's %g", path,
               atmos_scene_setting_get(&d, st), st->def);
     if (st->type == ATMOS_SETTING_BOOL) {
+        /* a flag turns its setting on, a --no- flag off (--beams-sun once turned the sun off) */
+        if (st->flag)
+            CHECK_MSG(st->flag_sets == (strncmp(st->flag, "no-", 3) != 0), "--%s sets %s to %d", st->flag, path,
+                      st->flag_sets);
         CHECK_OK(parse_one(ctx, r, st->key, st->def ? "false" : "true", &s));
         CHECK(atmos_scene_setting_get(&s, st) == !st->def);
         CHECK(parse_one(ctx, r, st->key, "1", &s) == ATMOS_E_INVALID_ARG);
@@ -79,7 +83,7 @@ static void check_help(void)
     CHECK(system(cmd) == 0);
     size_t n = 0;
     char *text = (char *)test_slurp(out, &n);
-    for (int r = ATMOS_RENDERER_SLICE; text && r <= ATMOS_RENDERER_PATH; r++) {
+    for (int r = ATMOS_RENDERER_SLICE; text && r <= ATMOS_RENDERER_LAST; r++) {
         int count;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &count);
         for (int i = 0; i < count; i++) {
@@ -89,6 +93,19 @@ static void check_help(void)
                       "render --help lacks %s or its doc", opt);
         }
     }
+    /* the --volume paragraph names every generator and simulation preset the library takes */
+    const char *vol = text ? strstr(text, "--volume SOURCE") : NULL, *end = vol ? strstr(vol, "--volume-position") : NULL;
+    CHECK_MSG(vol && end, "render --help has no --volume SOURCE paragraph");
+    for (int k = 0; vol && end && k < 2; k++)
+        for (const char *const *nm = k ? atmos_sim_preset_names() : atmos_scene_generator_names(); *nm; nm++) {
+            int found = 0;
+            for (const char *at = vol; !found && (at = strstr(at, *nm)) && at < end; at += strlen(*nm)) {
+                const char before = at[-1], after = at[strlen(*nm)];
+                found = (before == ' ' || before == ':') && (after == ',' || after == ')' || after == ';' || after == '\n');
+            }
+            CHECK_MSG(found, "render --help's --volume paragraph lacks %s %s", k ? "simulate:" : "generate:", *nm);
+        }
+    CHECK_MSG(vol && end && memmem(vol, (size_t)(end - vol), "simulate:PRESET", 15), "--volume: simulate:PRESET not named");
     free(text);
 }
 
@@ -97,7 +114,7 @@ int main(void)
     atmos_context *ctx = NULL;
     CHECK_OK(atmos_context_create(NULL, &ctx));
     int total = 0;
-    for (int r = ATMOS_RENDERER_SKY; r <= ATMOS_RENDERER_BEAMS; r = r == ATMOS_RENDERER_PATH ? ATMOS_RENDERER_BEAMS : r + 1) {
+    for (int r = ATMOS_RENDERER_SKY; r <= ATMOS_RENDERER_LAST; r++) {
         int n = -1;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &n);
         CHECK(r == ATMOS_RENDERER_SKY ? (!t && n == 0) : (t && n > 0));

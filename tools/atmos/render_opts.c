@@ -455,7 +455,8 @@ static int apply_view(const render_opts *o, atmos_scene *s)
     apply_camera(o, &s->camera);
     if (o->spectral) s->wavelengths = ATMOS_WAVELENGTHS_SPECTRAL, s->spectral_samples = o->spectral;
     if (o->rgb) s->wavelengths = ATMOS_WAVELENGTHS_RGB;
-    if (o->exposure_auto) s->tonemap.manual_exposure = 0;
+    if (o->exposure_auto && s->tonemap.manual_exposure) /* the scene's EV is no compensation */
+        s->tonemap.manual_exposure = 0, s->tonemap.exposure_ev = 0;
     if (!isnan(o->ev)) s->tonemap.manual_exposure = 1, s->tonemap.exposure_ev = o->ev;
     if (!isnan(o->ev_comp)) {
         if (s->tonemap.manual_exposure) return cli_usage_error("render", "--exposure-comp applies to automatic exposure only");
@@ -508,7 +509,8 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
         return cli_usage_error(C, "--exr-layers order, variance: they are the path tracer's (--renderer path)");
     if (!o->scene_path && (r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_NISHITA || r == ATMOS_RENDERER_HARRIS) &&
         !s->volume.source[0])
-        return cli_usage_error(C, "--renderer %s needs --volume FILE or --volume generate:PRESET", atmos_renderer_name(r));
+        return cli_usage_error(C, "--renderer %s needs --volume SOURCE (a file, generate:NAME or simulate:PRESET)",
+                                atmos_renderer_name(r));
     return CLI_EXIT_OK;
 }
 
@@ -548,13 +550,40 @@ static void help_settings(atmos_renderer_kind r, const char *title)
     printf("\n");
 }
 
+/* Words into --help's right column, wrapped at 100 characters: "a, b, c" then tail. */
+static void help_list(int *col, const char *const *names, const char *tail)
+{
+    for (const char *const *n = names; *n; n++) {
+        const int w = (int)strlen(*n) + (n[1] ? 2 : (int)strlen(tail));
+        if (*col + 1 + w > 100) printf("\n%31s", ""), *col = 31;
+        *col += printf(" %s%s", *n, n[1] ? "," : tail);
+    }
+}
+
+/* The --volume paragraph: the generators and the simulation's presets from the library's own
+ * lists, so that --help names every source a scene's "volume" takes. */
+static void help_volume(void)
+{
+    printf("      --volume SOURCE           a cloud volume: a file (.vdb OpenVDB, .nvdb NanoVDB, .nc WRF or CM1\n"
+           "                                NetCDF, .json raw float32 + sidecar; docs/volumes.md),\n"
+           "                                generate:NAME, a generated one (docs/volumes.md, harris_*: Harris's\n"
+           "                                particle clouds, docs/particles.md):");
+    int col = 100;
+    help_list(&col, atmos_scene_generator_names(), ";");
+    printf("\n                                or simulate:PRESET, grown by the cloud simulation (docs/clouds.md):");
+    col = 100;
+    help_list(&col, atmos_sim_preset_names(), "\n");
+}
+
 void render_opts_help(void)
 {
     printf("Usage: atmos render [SCENE.json|-] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
            "Renders a scene file ('-': read from standard input), or the built-in default scene when none\n"
            "is given. With no output option, writes NAME.png in the current directory (NAME = the scene\n"
            "file's name without its extension; the scene's \"name\" for the default scene or standard input).\n"
-           "A volume file is rendered with --volume FILE (not as the scene).\n\n"
+           "A volume file is rendered with --volume FILE (not as the scene). The files a scene names\n"
+           "(its volume, the lights' images, the objects' meshes and terrains) are relative to the scene\n"
+           "file's folder; those of a scene from standard input are relative to the current folder.\n\n"
            "Outputs (the format is the extension's; folders are created; every output is checked\n"
            "before rendering and all are written or none: two options naming the same file, or\n"
            "an output that is an input, are refused):\n"
@@ -615,8 +644,9 @@ void render_opts_help(void)
            "                                Harris's particle clouds (the volume as particles, docs/particles.md),\n"
            "                                or Dobashi et al. 2002's light beams of the scene's \"lights\" in its\n"
            "                                \"fog\" with the shadows of its \"objects\" (docs/beams.md)\n"
-           "      --volume FILE|generate:PRESET   cloud volume (.vdb .nvdb .nc .json) or a generated one\n"
-           "                                (cumulus, cumulonimbus, cumulus_field, cirrus, rain_shaft, storm)\n"
+           );
+    help_volume();
+    printf(
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
            "                                (default: 3 widths, at least 4 km, in front of the camera; a\n"
            "                                VDB/NanoVDB file's base at 1500 m, a cloud's)\n"

@@ -1,0 +1,36 @@
+#!/bin/sh
+# Relative paths of a scene read from standard input (`atmos render -`) are relative to the
+# current folder (a scene file's are relative to its folder): a spot's window image found
+# there renders; one that is not there is an error naming the scene key and the file, and
+# saying where it was looked for; `atmos render --help` says so.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
+T=${ATMOS_TEST_TMP:-/tmp}/render_stdin_paths.$$
+rm -rf "$T"
+mkdir -p "$T/here" "$T/elsewhere" || exit 1
+trap 'rm -rf "$T"' EXIT
+export XDG_CACHE_HOME="$T/cache"
+fail=0
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+
+cp "$S/scenes/dobashi_fig09b_window.png" "$T/here/win.png" || exit 1
+sed 's/"image": "[^"]*"/"image": "win.png"/' "$S/scenes/dobashi_fig09b_stained_glass.json" >"$T/scene.json"
+grep -q '"image": "win.png"' "$T/scene.json" || bad "the scene's image key not found"
+
+(cd "$T/here" && "$A" render - --width 24 --height 16 -q -o "$T/ok.png" <"$T/scene.json" 2>"$T/ok.err") &&
+    [ -s "$T/ok.png" ] && ok "a window image relative to the current folder" || bad "render from here: $(cat "$T/ok.err")"
+
+(cd "$T/elsewhere" && "$A" render - --width 24 --height 16 -q -o "$T/no.png" <"$T/scene.json" 2>"$T/no.err")
+rc=$?
+if [ $rc -eq 1 ] && grep -q "/lights/0/image: win.png: .*current folder" "$T/no.err" && [ ! -e "$T/no.png" ]; then
+    ok "a missing window image names /lights/0/image and the file"
+else
+    bad "missing image (exit $rc): $(cat "$T/no.err")"
+fi
+
+"$A" render --help >"$T/help.txt"
+grep -q "standard input.*current folder\|current folder.*standard input" "$T/help.txt" &&
+    ok "render --help says where a scene from standard input finds its files" || bad "render --help does not say it"
+exit $fail
