@@ -47,9 +47,9 @@ static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos
     atmos_volume_bounds(*volume, lo, hi);
     const double *p = scene->camera.position, *l = scene->camera.look_at;
     fprintf(stderr,
-            "atmos render: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
+            "atmos %s: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
             "looking at (%.0f, %.0f, %.0f) m\n",
-            hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
+            o->cmd, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
     return ATMOS_OK;
 }
 
@@ -60,15 +60,15 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     if (o->scene_path) {
         if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
             fprintf(stderr,
-                    "atmos render: %s is a volume file, not a scene: render it with\n"
-                    "  atmos render --volume %s\n",
-                    o->scene_path, o->scene_path);
+                    "atmos %s: %s is a volume file, not a scene: open it with\n"
+                    "  atmos %s --volume %s\n",
+                    o->cmd, o->scene_path, o->cmd, o->scene_path);
             return CLI_EXIT_USAGE;
         }
         if (!strcmp(o->scene_path, "-")) {
             if (!o->scene_text) {
-                fprintf(stderr, "atmos render: standard input: cannot read the scene (larger than 16 MiB, the limit "
-                                "for scene files, a NUL byte or a read error)\n");
+                fprintf(stderr, "atmos %s: standard input: cannot read the scene (larger than 16 MiB, the limit "
+                                "for scene files, a NUL byte or a read error)\n", o->cmd);
                 return CLI_EXIT_RUNTIME;
             }
             st = atmos_scene_parse_file(ctx, o->scene_text, strlen(o->scene_text), "-", o->defines, o->ndefines,
@@ -76,11 +76,11 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         } else {
             st = atmos_scene_load_with(ctx, o->scene_path, o->defines, o->ndefines, scene);
         }
-        if (st != ATMOS_OK) return cli_runtime_error("render", ctx, st);
+        if (st != ATMOS_OK) return cli_runtime_error(o->cmd, ctx, st);
     } else if (o->ndefines) {
         /* the built-in default scene is the parse of an empty one */
         if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", o->defines, o->ndefines, scene)) != ATMOS_OK) {
-            fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+            fprintf(stderr, "atmos %s: %s\n", o->cmd, atmos_context_error(ctx));
             return CLI_EXIT_USAGE;
         }
     } else {
@@ -89,11 +89,11 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     int rc = render_opts_apply(ctx, o, scene);
     if (rc != CLI_EXIT_OK) return rc;
     if ((st = atmos_scene_validate(ctx, scene, o->scene_path ? o->scene_path : "options")) != ATMOS_OK) {
-        fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+        fprintf(stderr, "atmos %s: %s\n", o->cmd, atmos_context_error(ctx));
         return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
     }
     if (!render_opts_camera_given(o) && (st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK)
-        return cli_runtime_error("render", ctx, st);
+        return cli_runtime_error(o->cmd, ctx, st);
     return CLI_EXIT_OK;
 }
 
