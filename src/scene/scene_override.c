@@ -71,6 +71,19 @@ static cJSON *child(cJSON *node, const char *tok)
     return i < 0 ? NULL : cJSON_GetArrayItem(node, i);
 }
 
+/* The volume's source is one of "file", "generate" and "simulate": one set by an override
+ * replaces the others the file had (as --volume replaces the scene's volume). */
+static void drop_other_sources(cJSON *root, const cJSON *node, const char *tok)
+{
+    static const char *const sources[] = {"file", "generate", "simulate"};
+    cJSON *vol = cJSON_GetObjectItemCaseSensitive(root, "volume");
+    if (!vol || node != vol) return;
+    int is_source = 0;
+    for (int i = 0; i < 3; i++) is_source |= !strcmp(tok, sources[i]);
+    for (int i = 0; is_source && i < 3; i++)
+        if (strcmp(tok, sources[i])) cJSON_DeleteItemFromObjectCaseSensitive(vol, sources[i]);
+}
+
 static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *root, const char *ov)
 {
     const char *eq = strchr(ov, '=');
@@ -93,7 +106,7 @@ static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *roo
     while ((r = next_token(&p, pointer, tok)) > 0) {
         if (!cJSON_IsObject(node) && !cJSON_IsArray(node)) break;
         if (!*p) {
-            if (put(node, tok, value)) return ATMOS_OK;
+            if (put(node, tok, value)) return drop_other_sources(root, node, tok), ATMOS_OK;
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%s': cannot set '%s' there", source, path, tok);
         }
         node = child(node, tok);

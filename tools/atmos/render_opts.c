@@ -642,7 +642,9 @@ void render_opts_help(void)
            "                                amplitude A in (0, 1] (not model data; default off)\n"
            "  -D, --define PATH=VALUE      sets a scene key before the scene is read, as if in the file:\n"
            "                                PATH dotted (camera.fov_deg) or a JSON pointer (/camera/fov_deg),\n"
-           "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable\n"
+           "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable;\n"
+           "                                with --volume, -D volume.KEY applies to that volume; a -D setting\n"
+           "                                volume.file, .generate or .simulate replaces the scene's source\n"
            "      --atmosphere riley|homogeneous   the air: Riley et al.'s exponential atmosphere (default)\n"
            "                                or a uniform layer from the ground to --thickness (docs/models.md)\n"
            "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");

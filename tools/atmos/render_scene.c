@@ -1,6 +1,7 @@
 /* atmos render's scene: the scene file (or the default), the options applied, validated,
  * and a volume file without a camera framed: the volume loaded here, placed, and the
  * camera pointed at it (atmos_scene_frame_volume). */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "render_scene.h"
 
 #include <math.h>
@@ -53,10 +54,47 @@ static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos
     return ATMOS_OK;
 }
 
+/* -D volume.KEY=VALUE with --volume SOURCE: the scene's "volume" is read from the JSON tree
+ * before --volume applies, so without a source there it would be refused ("needs file,
+ * generate or simulate") and a source of another kind would make the key wrong. The source
+ * goes first as a -D of its own (a file as an absolute path: the scene file's folder does not
+ * apply to a command-line path), the user's -D after it. defs: room for ndefines + 1; buf:
+ * the source's define. Returns the count. */
+static int volume_defines(const render_opts *o, const char **defs, char *buf, size_t cap)
+{
+    int touches = 0;
+    for (int i = 0; i < o->ndefines; i++)
+        touches |= !strncmp(o->defines[i], "volume.", 7) || !strncmp(o->defines[i], "/volume/", 8);
+    int n = 0;
+    if (o->volume && touches) {
+        if (!strncmp(o->volume, "generate:", 9)) {
+            snprintf(buf, cap, "volume.generate=\"%s\"", o->volume + 9);
+        } else if (!strncmp(o->volume, "simulate:", 9)) {
+            snprintf(buf, cap, "volume.simulate={\"preset\": \"%s\"}", o->volume + 9);
+        } else {
+            char *abs = realpath(o->volume, NULL);
+            const char *p = abs ? abs : o->volume;
+            size_t k = (size_t)snprintf(buf, cap, "volume.file=\"");
+            for (; *p && k + 3 < cap; p++) {
+                if (*p == '"' || *p == '\\') buf[k++] = '\\';
+                buf[k++] = *p;
+            }
+            snprintf(buf + k, cap - k, "\"");
+            free(abs);
+        }
+        defs[n++] = buf;
+    }
+    for (int i = 0; i < o->ndefines; i++) defs[n++] = o->defines[i];
+    return n;
+}
+
 int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
 {
     atmos_status st;
     *volume = NULL;
+    const char *defs[RENDER_OPTS_MAX_DEFINES + 1];
+    char source_def[ATMOS_SCENE_PATH_MAX + 64];
+    const int ndefs = volume_defines(o, defs, source_def, sizeof source_def);
     if (o->scene_path) {
         if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
             fprintf(stderr,
@@ -71,15 +109,15 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
                                 "for scene files, a NUL byte or a read error)\n", o->cmd);
                 return CLI_EXIT_RUNTIME;
             }
-            st = atmos_scene_parse_file(ctx, o->scene_text, strlen(o->scene_text), "-", o->defines, o->ndefines,
+            st = atmos_scene_parse_file(ctx, o->scene_text, strlen(o->scene_text), "-", defs, ndefs,
                                         scene);
         } else {
-            st = atmos_scene_load_with(ctx, o->scene_path, o->defines, o->ndefines, scene);
+            st = atmos_scene_load_with(ctx, o->scene_path, defs, ndefs, scene);
         }
         if (st != ATMOS_OK) return cli_runtime_error(o->cmd, ctx, st);
-    } else if (o->ndefines) {
+    } else if (ndefs) {
         /* the built-in default scene is the parse of an empty one */
-        if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", o->defines, o->ndefines, scene)) != ATMOS_OK) {
+        if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", defs, ndefs, scene)) != ATMOS_OK) {
             fprintf(stderr, "atmos %s: %s\n", o->cmd, atmos_context_error(ctx));
             return CLI_EXIT_USAGE;
         }
