@@ -76,6 +76,7 @@ static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int sna
     }
     atmos_status st = keep ? atmos_image_to_srgb_into(L->ctx, L->img, atmos_plan_wavelengths(p), L->lin)
                            : atmos_image_to_srgb(L->ctx, L->img, atmos_plan_wavelengths(p), &L->lin);
+    if (st == ATMOS_OK) st = atmos_image_gamut_map(L->ctx, L->lin, NULL); /* as atmos render writes it */
     if (st != ATMOS_OK) return st;
     atmos_tonemap_desc td;
     memset(&td, 0, sizeof td);
