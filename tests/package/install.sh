@@ -118,7 +118,7 @@ check "pkg-config slice_volume runs" "$T/pc/slice_volume" --size 32 20 -o "$T/sl
 # checkout stays clean; --target: the system's site-packages are left alone).
 py=${ATMOS_PYTHON:-python3}
 if "$py" -c "import setuptools, cffi, numpy, pip" 2>/dev/null; then
-    cp -r "$src/python" "$T/pysrc" && rm -f "$T"/pysrc/atmos/_native*.so
+    cp -r "$src/python" "$T/pysrc" && rm -f "$T"/pysrc/atmos/_native*.so "$T"/pysrc/atmos/_build_info.py
     check "pip install ./python against the installed atmos" "$py" -m pip install --no-build-isolation --no-index \
         --no-deps --target "$T/site" "$T/pysrc"
     check "the pip-installed package imports and renders" env PYTHONPATH="$T/site" LD_LIBRARY_PATH= "$py" -c \
