@@ -48,4 +48,11 @@ cmp -s "$T/opt.pfm" "$T/def.pfm" && ok "-D volume.density_unit = --density-unit 
 "$A" render $common -D "$P" -D volume.density_scale=1e-3 --pfm "$T/ds.pfm" >/dev/null 2>"$T/err"
 st=$?
 [ $st -eq 0 ] && ok "-D volume.density_scale with --volume (exit 0)" || { bad "-D volume.density_scale with --volume: exit $st"; cat "$T/err" >&2; }
+# a scene with a generated volume (and its seed): --volume FILE replaces it, -D volume.KEY
+# applies to the file, and the generator's seed goes with the generator
+printf '{"volume": {"generate": "cumulus", "seed": 3}}' >"$T/gen.json"
+# shellcheck disable=SC2086
+"$A" render "$T/gen.json" $common -D "$P" -D volume.density_unit=per_m3 --pfm "$T/gen.pfm" >/dev/null 2>"$T/err"
+st=$?
+[ $st -eq 0 ] && ok "scene with a generated volume, --volume FILE -D volume.density_unit (exit 0)" || { bad "generated scene + --volume FILE + -D volume.density_unit: exit $st"; cat "$T/err" >&2; }
 exit $fail
