@@ -31,6 +31,15 @@ if(NOT ATMOS_HAVE_PYTHON)
   return()
 endif()
 message(STATUS "atmos: Python bindings: yes (${ATMOS_PYTHON_EXE}, ${_suffix})")
+message(STATUS "atmos: the Python package is built for ${ATMOS_PYTHON_EXE}: run it with that interpreter "
+               "(PYTHONPATH=python ${ATMOS_PYTHON_EXE} ...); -DATMOS_PYTHON=PATH picks another")
+if(ATMOS_PATH_PYTHON AND NOT ATMOS_PATH_PYTHON STREQUAL ATMOS_PYTHON_EXE)
+  message(STATUS "atmos: note: the python3 first on PATH is ${ATMOS_PATH_PYTHON}, not ${ATMOS_PYTHON_EXE}")
+endif()
+# The interpreter the build is for, named by the package's ImportError in another one.
+file(WRITE ${CMAKE_SOURCE_DIR}/python/atmos/_build_info.py
+     "# Written by cmake/python.cmake: the interpreter the native module was built for.\n"
+     "PYTHON = \"${ATMOS_PYTHON_EXE}\"\n")
 
 set(_gen ${CMAKE_BINARY_DIR}/python/_native.c)
 file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/python)

@@ -10,8 +10,9 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 help2man --no-info --no-discard-stderr --version-string="atmos $version" \
     -n "physically based rendering of atmospheric phenomena" -o "$tmp/atmos.1" "$atmos"
-# The commands: the indented lines of the "Commands:" block, "  NAME   description".
-"$atmos" --help | awk '/^Commands:/ {c = 1; next} c && /^  [a-z]+  / {print} c && /^$/ {exit}' > "$tmp/commands"
+# The commands: the indented lines of the "Commands:" block up to its blank line,
+# "  NAME  description" (any run of spaces between the two).
+"$atmos" --help | awk '/^Commands:/ {c = 1; next} c && /^$/ {exit} c && /^  [a-z]+ +[^ ]/ {print}' > "$tmp/commands"
 [ -s "$tmp/commands" ] || { echo "atmos: no commands found in 'atmos --help'" >&2; exit 1; }
 while read -r name desc; do
     help2man --no-info --no-discard-stderr --version-string="atmos-$name $version" \

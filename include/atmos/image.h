@@ -220,6 +220,14 @@ ATMOS_API atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image
 /* The same into an existing 4-channel image of the input's size (no metadata copied). */
 ATMOS_API atmos_status atmos_image_to_srgb_into(atmos_context *ctx, const atmos_image *spectral,
                                                 const atmos_wavelengths *wl, atmos_image *rgb);
+/* Linear sRGB (3 or 4 channels) brought inside the sRGB gamut: a pixel with a negative
+ * component (a spectrum more saturated than the primaries, atmos_image_to_srgb being exact and
+ * linear) is moved toward the grey of its luminance, c' = Y + t (c - Y) with the t that makes
+ * its smallest component 0, so Y (Rec. 709) and the hue are kept and the saturation reduced;
+ * a pixel whose Y is <= 0 becomes black. Other pixels and alpha are untouched. *mapped (may be
+ * NULL): the pixels moved. atmos render and atmos view apply it to what they write
+ * (docs/colour.md). */
+ATMOS_API atmos_status atmos_image_gamut_map(atmos_context *ctx, atmos_image *rgb, long long *mapped);
 
 #ifdef __cplusplus
 }

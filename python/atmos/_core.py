@@ -1,14 +1,47 @@
 """The native module, atmos's errors as exceptions, and one context per thread."""
 import threading
 
+
+
+def _import_error(missing, cause):
+    """The ImportError of an interpreter that cannot load the package: which interpreter
+    the build was for (CMake's choice, python/atmos/_build_info.py), which this is, and
+    what it lacks."""
+    import sys
+    try:
+        from atmos._build_info import PYTHON as built
+    except ImportError:
+        built = None
+    this = f"{sys.executable} (Python {sys.version.split()[0]})"
+    where = (f"built for {built} (cmake/python.cmake chose it; CMake prints it when configuring)"
+             if built else "built by pip for the interpreter that ran it")
+    if missing:
+        what = f"this interpreter, {this}, lacks {' and '.join(missing)}"
+    else:
+        what = (f"the native module cannot be loaded by {this} (not built: run `make build` in the "
+                f"checkout, or `pip install ./python` against an installed atmos; or built for "
+                f"another Python version) ({cause})")
+    fix = (f"run it with {built}, or configure with -DATMOS_PYTHON={sys.executable} once this "
+           f"interpreter has cffi and NumPy" if built else "install cffi and NumPy and reinstall")
+    return ImportError(f"atmos: {what}; the package was {where}: {fix}")
+
+
+def _missing():
+    missing = []
+    for module, package in (("numpy", "numpy"), ("_cffi_backend", "cffi")):
+        try:
+            __import__(module)
+        except ImportError:
+            missing.append(package)
+    return missing
+
+
 try:
     from atmos._native import ffi, lib
 except ImportError as e:  # pragma: no cover - the message is the point
-    raise ImportError(
-        "atmos: the native module is not built. Run `make build` (or `make test`) in the "
-        "checkout, which puts it in python/atmos/, or `pip install ./python` against an "
-        f"installed atmos ({e})"
-    ) from e
+    raise _import_error(_missing(), e) from e
+if _missing():  # pragma: no cover - NumPy is imported by the modules after this one
+    raise _import_error(_missing(), None)
 
 STATUS_NAMES = {
     lib.ATMOS_E_INVALID_ARG: "invalid argument",

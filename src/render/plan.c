@@ -2,6 +2,7 @@
  * volume placed, its optics, each renderer's tables and buffers); a frame becomes a view and
  * is rendered from the plan, redoing only what changed since the last frame. */
 #include "render/plan_internal.h"
+#include "scene/scene_internal.h"
 #include "volume/volume_grid.h"
 
 #include <math.h>
@@ -54,6 +55,7 @@ static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const
     if (p->optics->count != atmos_volume_field_count(p->volume))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: optics for %d fields, the volume has %d", p->optics->count,
                             atmos_volume_field_count(p->volume));
+    atmos__scene_volume_warnings(ctx, &p->scene, p->volume, p->optics);
     return ATMOS_OK;
 }
 

@@ -31,16 +31,29 @@ atmos_status atmos__scene_earth_paths(atmos_context *ctx, const char *path, size
     return st;
 }
 
-/* A JPEG (FF D8) or a PNG by the file's first bytes. */
-static atmos_status read_map(atmos_context *ctx, const char *path, int reduce, atmos_image **out)
+/* A JPEG (FF D8 FF) or a PNG (its 8-byte signature) by the file's first bytes; key: the
+ * scene key that names it, in every message. */
+static atmos_status read_map(atmos_context *ctx, const char *key, const char *path, int reduce, atmos_image **out)
 {
-    unsigned char m[2] = {0, 0};
+    unsigned char m[8] = {0};
     FILE *f = fopen(path, "rb");
-    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
-    const size_t n = fread(m, 1, 2, f);
+    if (!f) return atmos__error(ctx, ATMOS_E_IO, "/atmosphere/%s: %s: cannot open: %s", key, path, strerror(errno));
+    const size_t n = fread(m, 1, sizeof m, f);
     fclose(f);
-    if (n == 2 && m[0] == 0xFF && m[1] == 0xD8) return atmos_read_jpeg_scaled(ctx, path, reduce ? reduce : 1, out);
-    return atmos_read_png(ctx, path, out);
+    const int jpeg = n >= 3 && m[0] == 0xFF && m[1] == 0xD8 && m[2] == 0xFF;
+    const int png = n == 8 && !memcmp(m, "\x89PNG\r\n\x1a\n", 8);
+    if (!jpeg && !png)
+        return atmos__error(ctx, ATMOS_E_FORMAT,
+                            "/atmosphere/%s: %s is not an image atmos reads: the Earth's maps are PNG or JPEG files "
+                            "(known by their first bytes)",
+                            key, path);
+    atmos_status st = jpeg ? atmos_read_jpeg_scaled(ctx, path, reduce ? reduce : 1, out) : atmos_read_png(ctx, path, out);
+    if (st != ATMOS_OK) { /* the reader's message, with the key in front */
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", atmos_context_error(ctx));
+        return atmos__error(ctx, st, "/atmosphere/%s: %s", key, msg);
+    }
+    return ATMOS_OK;
 }
 
 /* An ESRI world file (six numbers: x size of a pixel, two rotations, y size, and the
@@ -76,9 +89,9 @@ atmos_status atmos_scene_atmosphere_create(atmos_context *ctx, const atmos_scene
     atmos_atmosphere_desc d = scene->atmosphere;
     atmos_image *ground = NULL, *night = NULL, *clouds = NULL;
     atmos_status st = ATMOS_OK;
-    if (spherical && e->ground_map[0]) st = read_map(ctx, e->ground_map, e->map_reduce, &ground);
-    if (!st && spherical && e->night_lights[0]) st = read_map(ctx, e->night_lights, e->map_reduce, &night);
-    if (!st && spherical && e->cloud_image[0]) st = read_map(ctx, e->cloud_image, 1, &clouds);
+    if (spherical && e->ground_map[0]) st = read_map(ctx, "ground_map", e->ground_map, e->map_reduce, &ground);
+    if (!st && spherical && e->night_lights[0]) st = read_map(ctx, "night_lights", e->night_lights, e->map_reduce, &night);
+    if (!st && spherical && e->cloud_image[0]) st = read_map(ctx, "clouds/image", e->cloud_image, 1, &clouds);
     if (!st && clouds && e->cloud_world_file[0])
         st = world_file(ctx, e->cloud_world_file, clouds->width, clouds->height, &d.clouds);
     if (!st) {

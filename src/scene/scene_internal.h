@@ -22,6 +22,15 @@
 #define ATMOS__SCENE_MAX_POS 1e8
 #define ATMOS__SCENE_MAX_LOOK 1e9
 
+/* A volume whose peak extinction times its box's diagonal (a bound on the optical depth of
+ * any ray across it) is below this is reported as nearly invisible. */
+#define ATMOS__SCENE_THIN_TAU 0.01
+/* The warnings about a scene's volume once its optics are known (a plan's): a VDB file read
+ * as a 0..1 fraction and scaled by >= 1e3 (values meant as particles per m^3), and a volume
+ * too thin to see (ATMOS__SCENE_THIN_TAU), naming the density unit and scale options. */
+void atmos__scene_volume_warnings(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
+                                  const atmos_volume_optics *optics);
+
 /* A closed, open or half-open interval. */
 typedef struct atmos__range {
     double lo, hi;

@@ -1235,7 +1235,9 @@ static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atm
 static atmos_status parse_animation(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
     static const char *const keys[] = {"frames", "time_end", "elevation_end_deg", "azimuth_end_deg"};
-    static const atmos__range r_frames = {1, ATMOS_SCENE_MAX_FRAMES, 0, 0};
+    /* 0 and 1: a single image (0 = no animation, include/atmos/scene.h), so -D animation.frames=0
+     * turns a scene's animation off */
+    static const atmos__range r_frames = {0, ATMOS_SCENE_MAX_FRAMES, 0, 0};
     atmos_scene_animation a;
     memset(&a, 0, sizeof a);
     obj_iter it;

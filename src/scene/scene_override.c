@@ -71,6 +71,32 @@ static cJSON *child(cJSON *node, const char *tok)
     return i < 0 ? NULL : cJSON_GetArrayItem(node, i);
 }
 
+/* The volume's source is one of "file", "generate" and "simulate": one set by an override
+ * replaces the others the file had (as --volume replaces the scene's volume), with the keys
+ * only the old kind takes (scene_json.c refuses them with the new one); overrides after it
+ * may set them again. */
+static void drop_other_sources(cJSON *root, const cJSON *node, const char *tok)
+{
+    static const char *const sources[] = {"file", "generate", "simulate"};
+    static const char *const file_only[] = {"grids", "time_index", "density_unit", "subgrid_detail", NULL},
+                             *const gen_only[] = {"seed", NULL},
+                             *const sim_bad[] = {"grids", "time_index", "density_unit", "subgrid_detail", "seed",
+                                                 "voxel_size_m", "scale", "particle", NULL};
+    cJSON *vol = cJSON_GetObjectItemCaseSensitive(root, "volume");
+    int kind = -1;
+    for (int i = 0; i < 3; i++)
+        if (!strcmp(tok, sources[i])) kind = i;
+    if (!vol || node != vol || kind < 0) return;
+    int had = -1;
+    for (int i = 0; i < 3; i++)
+        if (i != kind && cJSON_GetObjectItemCaseSensitive(vol, sources[i])) had = i;
+    if (had < 0) return;
+    for (int i = 0; i < 3; i++)
+        if (i != kind) cJSON_DeleteItemFromObjectCaseSensitive(vol, sources[i]);
+    const char *const *drop = kind == 0 ? gen_only : kind == 1 ? file_only : sim_bad;
+    for (int i = 0; drop[i]; i++) cJSON_DeleteItemFromObjectCaseSensitive(vol, drop[i]);
+}
+
 static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *root, const char *ov)
 {
     const char *eq = strchr(ov, '=');
@@ -93,7 +119,7 @@ static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *roo
     while ((r = next_token(&p, pointer, tok)) > 0) {
         if (!cJSON_IsObject(node) && !cJSON_IsArray(node)) break;
         if (!*p) {
-            if (put(node, tok, value)) return ATMOS_OK;
+            if (put(node, tok, value)) return drop_other_sources(root, node, tok), ATMOS_OK;
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%s': cannot set '%s' there", source, path, tok);
         }
         node = child(node, tok);

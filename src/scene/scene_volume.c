@@ -1,7 +1,7 @@
 /* The volume a scene names ("volume" in a scene file): loading or generating it and
  * placing it in the world. */
-#include "core/internal.h"
 #include "particles/pcloud.h"
+#include "scene/scene_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -70,15 +70,6 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         st = atmos_volume_load(ctx, sv->source, &ld, &vol);
     }
     if (st != ATMOS_OK) return st;
-    /* A scene written when VDB values were read as particles per m^3 scaled them by ~1e8;
-     * read as a 0..1 fraction (1 = 1e8 m^-3) they would be that much denser again. */
-    const char *fmt = atmos_volume_source_format(vol);
-    if (sv->density_unit == ATMOS_DENSITY_AUTO && sv->density_scale >= 1e3 &&
-        (!strcmp(fmt, "openvdb") || !strcmp(fmt, "nanovdb")))
-        atmos__log(ctx, ATMOS_LOG_WARN,
-                   "%s: read as a 0..1 density (1 = %g m^-3) and then scaled by %g: for values in particles per m^3 "
-                   "give \"density_unit\": \"per_m3\" (--density-unit per_m3)",
-                   sv->source, ATMOS_DENSITY_FRACTION_PER_M3, sv->density_scale);
     atmos_scene_volume_offset(scene, vol, offset_m);
     *out = vol;
     return ATMOS_OK;
@@ -154,4 +145,56 @@ void atmos_scene_frame_volume(atmos_scene *scene, const atmos_volume *volume, co
     if (c->position[1] < 2.0) c->position[1] = 2.0; /* above the ground, still looking at the centre */
     memcpy(c->look_at, ctr, sizeof ctr);
     c->up[0] = 0, c->up[1] = 1, c->up[2] = 0;
+}
+
+/* The largest extinction (m^-1) any voxel can have: every field's densest voxel times its
+ * largest cross-section over the wavelengths, summed, times the scene's density scale. */
+static double peak_extinction(const atmos_scene *scene, const atmos_volume *vol, const atmos_volume_optics *optics)
+{
+    const double scale = scene->volume.density_scale > 0 ? scene->volume.density_scale : 1.0;
+    double peak = 0;
+    for (int f = 0; f < optics->count && f < atmos_volume_field_count(vol); f++) {
+        atmos_volume_field_stats fs;
+        if (!optics->phase[f] || atmos_volume_field_stats_get(NULL, vol, f, &fs) != ATMOS_OK) continue;
+        double sigma = 0;
+        for (int k = 0; k < atmos_phase_table_wavelength_count(optics->phase[f]); k++) {
+            double e = 0, sca = 0;
+            atmos_phase_table_cross_sections(optics->phase[f], k, &e, &sca);
+            if (e > sigma) sigma = e;
+        }
+        peak += fs.max * sigma;
+    }
+    return scale * peak;
+}
+
+void atmos__scene_volume_warnings(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
+                                  const atmos_volume_optics *optics)
+{
+    const atmos_scene_volume *sv = &scene->volume;
+    const char *name = sv->source[0] ? sv->source : "the volume";
+    /* A scene written when VDB values were read as particles per m^3 scaled them by ~1e8;
+     * read as a 0..1 fraction (1 = 1e8 m^-3) they would be that much denser again. */
+    const char *fmt = atmos_volume_source_format(vol);
+    if (sv->density_unit == ATMOS_DENSITY_AUTO && sv->density_scale >= 1e3 &&
+        (!strcmp(fmt, "openvdb") || !strcmp(fmt, "nanovdb")))
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "%s: read as a 0..1 density (1 = %g m^-3) and then scaled by %g: for values in particles per m^3 "
+                   "give \"density_unit\": \"per_m3\" (--density-unit per_m3)",
+                   name, ATMOS_DENSITY_FRACTION_PER_M3, sv->density_scale);
+    /* Too thin to see: no ray across the box can have an optical depth above the peak
+     * extinction times the box's diagonal. Under 0.01 the volume dims and lights less than
+     * 1 % of what crosses it, and the image is the sky alone. */
+    if (!optics) return;
+    double lo[3], hi[3];
+    atmos_volume_bounds(vol, lo, hi);
+    const double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    const double peak = peak_extinction(scene, vol, optics), tau = peak * diag;
+    if (diag > 0 && tau < ATMOS__SCENE_THIN_TAU)
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "%s: nearly invisible: its peak extinction is %.3g m^-1, so no ray across its %.0f m box has an "
+                   "optical depth above %.3g (the image will be the sky alone); if the file's values are not what "
+                   "the density unit says, give --density-unit (\"density_unit\": per_m3, g_m3 or fraction), or "
+                   "raise --density-scale (\"density_scale\", now %g)",
+                   name, peak, diag, tau, sv->density_scale > 0 ? sv->density_scale : 1.0);
 }

@@ -82,6 +82,11 @@ static atmos_status load_format(atmos_context *ctx, const char *path, vol_format
         if (st == ATMOS_OK) atmos__volume_set_source_format(*out, format_names[fmt]);
         return st;
     }
+    if (d.time_index != 0)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "%s: a time index (%d) applies to a NetCDF model's time steps only (a VDB or raw volume "
+                            "holds one time): leave it out",
+                            path, d.time_index);
     if (d.subgrid_detail != 0)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
                             "%s: sub-grid detail applies to a NetCDF model's fields only (a VDB or raw volume has "

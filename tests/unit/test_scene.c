@@ -412,7 +412,7 @@ static const bad_case bad_text[] = {
 /* Bad scenes: animation. */
 static const bad_case bad_animation[] = {
     {"{\"animation\": {\"time_end\": \"2026-06-21T12:00:00Z\"}}", ATMOS_E_INVALID_ARG, "/animation: missing key \"frames\"", NULL},
-    {"{\"animation\": {\"frames\": 0, \"elevation_end_deg\": 3}}", ATMOS_E_INVALID_ARG, "/animation/frames: must be in [1, 100000], got 0", NULL},
+    {"{\"animation\": {\"frames\": -1, \"elevation_end_deg\": 3}}", ATMOS_E_INVALID_ARG, "/animation/frames: must be in [0, 100000], got -1", NULL},
     {"{\"animation\": {\"frames\": 4, \"fps\": 24}}", ATMOS_E_INVALID_ARG, "/animation/fps: unknown key", "time_end"},
     {"{\"animation\": {\"frames\": 4}}", ATMOS_E_INVALID_ARG, "/animation: 4 frames need an end", NULL},
     {"{\"animation\": {\"frames\": 4, \"time_end\": \"2026-06-21T12:00:00Z\"}}", ATMOS_E_INVALID_ARG,

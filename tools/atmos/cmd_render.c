@@ -198,7 +198,17 @@ static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, co
 {
     atmos_image *lin = NULL, *disp = NULL;
     atmos_status st = atmos_image_to_srgb(ctx, spec, atmos_plan_wavelengths(plan), &lin);
-    if (st != ATMOS_OK) return st;
+    long long mapped = 0;
+    if (st == ATMOS_OK) st = atmos_image_gamut_map(ctx, lin, &mapped); /* no negative component written */
+    if (st != ATMOS_OK) {
+        atmos_image_destroy(lin);
+        return st;
+    }
+    if (mapped > 0) {
+        char buf[128];
+        snprintf(buf, sizeof buf, "%lld pixels outside sRGB desaturated at constant luminance", mapped);
+        atmos_image_set_meta(lin, "atmos:gamut_mapped", buf);
+    }
     atmos_image_set_meta(lin, "atmos:source", source);
     if (o->command) atmos_image_set_meta(lin, "atmos:command", o->command);
     if (o->scene_text) atmos_image_set_meta(lin, "atmos:scene_json", o->scene_text);

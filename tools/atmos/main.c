@@ -25,13 +25,18 @@ static const command commands[] = {
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 
+/* The help's list of commands: each name padded to the longest, then two spaces, the layout
+ * help2man and scripts/make-man.sh read as "item, description". */
 static void usage(FILE *f)
 {
+    int width = 0;
+    for (int i = 0; i < NCOMMANDS; i++)
+        if ((int)strlen(commands[i].name) > width) width = (int)strlen(commands[i].name);
     fprintf(f,
             "Usage: atmos COMMAND [OPTIONS]\n"
             "Physically based rendering of atmospheric phenomena.\n\n"
             "Commands:\n");
-    for (int i = 0; i < NCOMMANDS; i++) fprintf(f, "  %-8s %s\n", commands[i].name, commands[i].summary);
+    for (int i = 0; i < NCOMMANDS; i++) fprintf(f, "  %-*s  %s\n", width, commands[i].name, commands[i].summary);
     fprintf(f,
             "\n  atmos COMMAND --help   help for one command\n"
             "  atmos --version        print the version\n\n"

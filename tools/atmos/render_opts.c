@@ -82,7 +82,7 @@ static int build_options(struct option *opts, int cap)
 }
 
 /* A setting's value from the command line, checked against its row's range. */
-static int parse_setting(const atmos_setting *s, const char *text, double *out)
+static int parse_setting(const char *C, const atmos_setting *s, const char *text, double *out)
 {
     char opt[64];
     snprintf(opt, sizeof opt, "--%s", s->flag);
@@ -94,17 +94,17 @@ static int parse_setting(const atmos_setting *s, const char *text, double *out)
         char *end = NULL;
         unsigned long long v = strtoull(text, &end, 10);
         if (!*text || *end || text[0] == '-' || (double)v > s->max) {
-            cli_usage_error("render", "%s: expected an integer in [0, %.0f], got '%s'", opt, s->max, text);
+            cli_usage_error(C, "%s: expected an integer in [0, %.0f], got '%s'", opt, s->max, text);
             return 0;
         }
         *out = (double)v;
         return 1;
     }
     double v;
-    if (!cli_parse_double("render", opt, text, &v)) return 0;
+    if (!cli_parse_double(C, opt, text, &v)) return 0;
     const int low = s->min_open ? v <= s->min : v < s->min, high = s->max_open ? v >= s->max : v > s->max;
     if (low || high || (s->type == ATMOS_SETTING_INT && v != floor(v))) {
-        cli_usage_error("render", "%s: expected %s in %c%g, %g%c%s%s, got '%s'", opt,
+        cli_usage_error(C, "%s: expected %s in %c%g, %g%c%s%s, got '%s'", opt,
                         s->type == ATMOS_SETTING_INT ? "an integer" : "a value", s->min_open ? '(' : '[', s->min, s->max,
                         s->max_open ? ')' : ']', s->unit[0] ? " " : "", s->unit, text);
         return 0;
@@ -113,13 +113,13 @@ static int parse_setting(const atmos_setting *s, const char *text, double *out)
     return 1;
 }
 
-static int parse_choice(const char *opt, const char *text, const char *const *names, int n, int *out)
+static int parse_choice(const char *C, const char *opt, const char *text, const char *const *names, int n, int *out)
 {
     for (int i = 0; i < n; i++)
         if (!strcmp(text, names[i])) return *out = i, 1;
     char list[128] = "";
     for (int i = 0; i < n; i++) snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", names[i]);
-    cli_usage_error("render", "%s: expected %s, got '%s'", opt, list, text);
+    cli_usage_error(C, "%s: expected %s, got '%s'", opt, list, text);
     return 0;
 }
 
@@ -134,12 +134,12 @@ static void opts_init(render_opts *o)
 }
 
 /* X,Y,Z in metres. */
-static int parse_vec3(const char *opt, const char *arg, double v[3], int *given)
+static int parse_vec3(const char *C, const char *opt, const char *arg, double v[3], int *given)
 {
     char tail;
     if (sscanf(arg, "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !isfinite(v[0]) || !isfinite(v[1]) ||
         !isfinite(v[2])) {
-        cli_usage_error("render", "%s: expected X,Y,Z in metres, got '%s'", opt, arg);
+        cli_usage_error(C, "%s: expected X,Y,Z in metres, got '%s'", opt, arg);
         return 0;
     }
     return *given = 1, 1;
@@ -151,6 +151,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
 {
     static const char *const cams[] = {"pinhole", "fisheye", "equirect"}, *const tones[] = {"filmic", "reinhard", "clamp"},
                              *const renderers[] = {"sky", "slice", "path", "nishita", "harris", "beams"}, *const airs[] = {"riley", "homogeneous"};
+    const char *C = o->cmd;
     switch (c) {
     case 'o': o->png = arg; return 1;
     case O_EXR: o->exr = arg; return 1;
@@ -166,21 +167,21 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_MPI: o->mpi = 1; return 1;
     case O_LAYERS: return render_layers_parse(arg, &o->exr_layers);
     case O_RGB: o->rgb = 1; return 1;
-    case O_CAM: return parse_choice("--camera", arg, cams, 3, &o->cam_type);
-    case O_TONE: return parse_choice("--tone", arg, tones, 3, &o->tone);
-    case O_RENDERER: return parse_choice("--renderer", arg, renderers, 6, &o->renderer);
-    case O_ATMOSPHERE: return parse_choice("--atmosphere", arg, airs, 2, &o->air);
+    case O_CAM: return parse_choice(o->cmd, "--camera", arg, cams, 3, &o->cam_type);
+    case O_TONE: return parse_choice(o->cmd, "--tone", arg, tones, 3, &o->tone);
+    case O_RENDERER: return parse_choice(o->cmd, "--renderer", arg, renderers, 6, &o->renderer);
+    case O_ATMOSPHERE: return parse_choice(o->cmd, "--atmosphere", arg, airs, 2, &o->air);
     case O_EXPOSURE:
         if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
-        return cli_parse_double("render", "--exposure", arg, &o->ev);
-    case O_VPOS: return parse_vec3("--volume-position", arg, o->volume_pos, &o->volume_pos_given);
-    case O_POSITION: return parse_vec3("--position", arg, o->position, &o->position_given);
-    case O_LOOKAT: return parse_vec3("--look-at", arg, o->look_at, &o->look_at_given);
+        return cli_parse_double(C, "--exposure", arg, &o->ev);
+    case O_VPOS: return parse_vec3(o->cmd, "--volume-position", arg, o->volume_pos, &o->volume_pos_given);
+    case O_POSITION: return parse_vec3(o->cmd, "--position", arg, o->position, &o->position_given);
+    case O_LOOKAT: return parse_vec3(o->cmd, "--look-at", arg, o->look_at, &o->look_at_given);
     case O_GRIDS: o->grids = arg; return 1;
     case O_PARTICLE: o->particle = arg; return 1;
     case O_DUNIT: {
         static const char *const units[] = {"auto", "per_m3", "g_m3", "fraction"};
-        return parse_choice("--density-unit", arg, units, 4, &o->density_unit);
+        return parse_choice(o->cmd, "--density-unit", arg, units, 4, &o->density_unit);
     }
     default: return -1;
     }
@@ -189,7 +190,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
 /* The numeric options. Returns 1, 0 (usage error printed) or -1 (not one of these). */
 static int parse_number(int c, const char *arg, render_opts *o)
 {
-    const char *C = "render";
+    const char *C = o->cmd;
     switch (c) {
     case O_PNGBITS:
         if (!cli_parse_int(C, "--png-bits", arg, 8, 16, &o->png_bits)) return 0;
@@ -247,7 +248,7 @@ static int parse_number(int c, const char *arg, render_opts *o)
 /* Rules between options that hold whatever the scene says. */
 static int check_options(const render_opts *o)
 {
-    const char *C = "render";
+    const char *C = o->cmd;
     if (o->spectral && o->rgb) return cli_usage_error(C, "--spectral and --rgb exclude each other");
     const int use_time = o->time || !isnan(o->lat) || !isnan(o->lon);
     if (use_time && (!o->time || isnan(o->lat) || isnan(o->lon)))
@@ -311,14 +312,17 @@ int render_opts_parse(int argc, char **argv, render_opts *o)
     struct option opts[NFIXED + 2 * RENDER_OPTS_MAX_SETTINGS + 1];
     build_options(opts, (int)(sizeof opts / sizeof opts[0]));
     opts_init(o);
+    /* the command whose options these are, for the messages: atmos view passes its own */
+    o->cmd = argc > 0 && argv[0] && !strcmp(argv[0], "view") ? "view" : "render";
+    const char *C = o->cmd;
     optind = 1;
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, "o:qhD:", opts, NULL)) != -1) {
         if (c == 'h') return render_opts_help(), -1;
         if (c == 'D') {
-            if (o->ndefines >= RENDER_OPTS_MAX_DEFINES) return cli_usage_error("render", "too many -D options");
-            if (!strchr(optarg, '=')) return cli_usage_error("render", "-D: expected KEY=VALUE, got '%s'", optarg);
+            if (o->ndefines >= RENDER_OPTS_MAX_DEFINES) return cli_usage_error(C, "too many -D options");
+            if (!strchr(optarg, '=')) return cli_usage_error(C, "-D: expected KEY=VALUE, got '%s'", optarg);
             o->defines[o->ndefines++] = optarg;
             continue;
         }
@@ -329,19 +333,19 @@ int render_opts_parse(int argc, char **argv, render_opts *o)
         if (c >= O_SETTING) {
             atmos_renderer_kind r = ATMOS_RENDERER_SLICE;
             const atmos_setting *s = table_row(c - O_SETTING, &r);
-            if (o->nset >= RENDER_OPTS_MAX_SETTINGS) return cli_usage_error("render", "too many options");
+            if (o->nset >= RENDER_OPTS_MAX_SETTINGS) return cli_usage_error(C, "too many options");
             render_setting *rs = &o->set[o->nset];
-            if (!parse_setting(s, optarg, &rs->value)) return CLI_EXIT_USAGE;
+            if (!parse_setting(o->cmd, s, optarg, &rs->value)) return CLI_EXIT_USAGE;
             rs->renderer = r, rs->setting = s, o->nset++;
             continue;
         }
         int done = parse_named(c, optarg, o);
         if (done < 0) done = parse_number(c, optarg, o);
         if (done == 0) return CLI_EXIT_USAGE;
-        if (done < 0) return cli_usage_error("render", "unknown or incomplete option '%s'", argv[optind - 1]);
+        if (done < 0) return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
     }
     if (optind < argc) o->scene_path = argv[optind++];
-    if (optind < argc) return cli_usage_error("render", "unexpected argument '%s' (one scene file at most)", argv[optind]);
+    if (optind < argc) return cli_usage_error(C, "unexpected argument '%s' (one scene file at most)", argv[optind]);
     o->command = command_line(argc, argv);
     return check_options(o);
 }
@@ -349,6 +353,7 @@ int render_opts_parse(int argc, char **argv, render_opts *o)
 /* The sun and the animation's end. */
 static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
 {
+    const char *C = o->cmd;
     if (!isnan(o->sun_el) || !isnan(o->sun_az)) {
         if (s->sun.from_time) {
             /* Overriding one angle of a sun placed by time keeps the other one it had. */
@@ -362,7 +367,7 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
     }
     if (o->time) {
         if (atmos_parse_utc_time(ctx, o->time, &s->sun.time) != ATMOS_OK)
-            return cli_usage_error("render", "--time: %s", atmos_context_error(ctx));
+            return cli_usage_error(C, "--time: %s", atmos_context_error(ctx));
         s->sun.from_time = 1;
         s->sun.latitude_deg = o->lat, s->sun.longitude_deg = o->lon;
         s->animation.elevation_end_set = s->animation.azimuth_end_set = 0;
@@ -370,13 +375,13 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
     if (o->frames) s->animation.frames = o->frames;
     if (o->time_end) {
         if (atmos_parse_utc_time(ctx, o->time_end, &s->animation.time_end) != ATMOS_OK)
-            return cli_usage_error("render", "--time-end: %s", atmos_context_error(ctx));
+            return cli_usage_error(C, "--time-end: %s", atmos_context_error(ctx));
         s->animation.time_end_set = 1;
     }
     if (!isnan(o->sun_el_end)) s->animation.elevation_end_deg = o->sun_el_end, s->animation.elevation_end_set = 1;
     if (!isnan(o->sun_az_end)) s->animation.azimuth_end_deg = o->sun_az_end, s->animation.azimuth_end_set = 1;
     if ((o->time_end || !isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->animation.frames < 2)
-        return cli_usage_error("render", "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N (N >= 2) "
+        return cli_usage_error(C, "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N (N >= 2) "
                                          "or a scene with an \"animation\"");
     return CLI_EXIT_OK;
 }
@@ -416,7 +421,7 @@ int render_opts_camera_given(const render_opts *o)
 /* The volume file's options: refused with a generated volume, which has none of them. */
 static int apply_volume_file(const render_opts *o, atmos_scene *s)
 {
-    const char *C = "render";
+    const char *C = o->cmd;
     const int given = o->grids || o->particle || o->time_index >= 0 || o->density_unit >= 0 || o->subgrid_detail > 0;
     if (!given && !(o->voxel_size > 0) && !(o->volume_scale > 0)) return CLI_EXIT_OK;
     if (!s->volume.source[0])
@@ -438,6 +443,7 @@ static int apply_volume_file(const render_opts *o, atmos_scene *s)
 /* The image, camera, wavelengths and exposure. */
 static int apply_view(const render_opts *o, atmos_scene *s)
 {
+    const char *C = o->cmd;
     if (o->width) s->width = o->width;
     if (o->height) s->height = o->height;
     if (o->png_bits) s->png_bits = o->png_bits;
@@ -459,7 +465,7 @@ static int apply_view(const render_opts *o, atmos_scene *s)
         s->tonemap.manual_exposure = 0, s->tonemap.exposure_ev = 0;
     if (!isnan(o->ev)) s->tonemap.manual_exposure = 1, s->tonemap.exposure_ev = o->ev;
     if (!isnan(o->ev_comp)) {
-        if (s->tonemap.manual_exposure) return cli_usage_error("render", "--exposure-comp applies to automatic exposure only");
+        if (s->tonemap.manual_exposure) return cli_usage_error(C, "--exposure-comp applies to automatic exposure only");
         s->tonemap.exposure_ev = o->ev_comp;
     }
     if (o->tone >= 0) s->tonemap.curve = (atmos_tone_curve)o->tone;
@@ -473,7 +479,7 @@ static int apply_view(const render_opts *o, atmos_scene *s)
 /* The renderer, the volume and the renderers' settings. */
 static int apply_renderer(const render_opts *o, atmos_scene *s)
 {
-    const char *C = "render";
+    const char *C = o->cmd;
     if (o->volume) {
         snprintf(s->volume.source, sizeof s->volume.source, "%s", o->volume);
         if (s->renderer == ATMOS_RENDERER_SKY) s->renderer = ATMOS_RENDERER_SLICE;
@@ -666,7 +672,9 @@ void render_opts_help(void)
            "                                amplitude A in (0, 1] (not model data; default off)\n"
            "  -D, --define PATH=VALUE      sets a scene key before the scene is read, as if in the file:\n"
            "                                PATH dotted (camera.fov_deg) or a JSON pointer (/camera/fov_deg),\n"
-           "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable\n"
+           "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable;\n"
+           "                                with --volume, -D volume.KEY applies to that volume; a -D setting\n"
+           "                                volume.file, .generate or .simulate replaces the scene's source\n"
            "      --atmosphere riley|homogeneous   the air: Riley et al.'s exponential atmosphere (default)\n"
            "                                or a uniform layer from the ground to --thickness (docs/models.md)\n"
            "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");

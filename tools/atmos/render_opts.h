@@ -17,6 +17,7 @@ typedef struct {
 } render_setting;
 
 typedef struct {
+    const char *cmd;        /* "render" or "view": the command the messages name */
     const char *scene_path;
     /* outputs */
     const char *png, *exr, *pfm, *variance, *order, *tau;

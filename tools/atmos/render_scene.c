@@ -1,6 +1,7 @@
 /* atmos render's scene: the scene file (or the default), the options applied, validated,
  * and a volume file without a camera framed: the volume loaded here, placed, and the
  * camera pointed at it (atmos_scene_frame_volume). */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "render_scene.h"
 
 #include <math.h>
@@ -47,40 +48,77 @@ static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos
     atmos_volume_bounds(*volume, lo, hi);
     const double *p = scene->camera.position, *l = scene->camera.look_at;
     fprintf(stderr,
-            "atmos render: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
+            "atmos %s: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
             "looking at (%.0f, %.0f, %.0f) m\n",
-            hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
+            o->cmd, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
     return ATMOS_OK;
+}
+
+/* -D volume.KEY=VALUE with --volume SOURCE: the scene's "volume" is read from the JSON tree
+ * before --volume applies, so without a source there it would be refused ("needs file,
+ * generate or simulate") and a source of another kind would make the key wrong. The source
+ * goes first as a -D of its own (a file as an absolute path: the scene file's folder does not
+ * apply to a command-line path), the user's -D after it. defs: room for ndefines + 1; buf:
+ * the source's define. Returns the count. */
+static int volume_defines(const render_opts *o, const char **defs, char *buf, size_t cap)
+{
+    int touches = 0;
+    for (int i = 0; i < o->ndefines; i++)
+        touches |= !strncmp(o->defines[i], "volume.", 7) || !strncmp(o->defines[i], "/volume/", 8);
+    int n = 0;
+    if (o->volume && touches) {
+        if (!strncmp(o->volume, "generate:", 9)) {
+            snprintf(buf, cap, "volume.generate=\"%s\"", o->volume + 9);
+        } else if (!strncmp(o->volume, "simulate:", 9)) {
+            snprintf(buf, cap, "volume.simulate={\"preset\": \"%s\"}", o->volume + 9);
+        } else {
+            char *abs = realpath(o->volume, NULL);
+            const char *p = abs ? abs : o->volume;
+            size_t k = (size_t)snprintf(buf, cap, "volume.file=\"");
+            for (; *p && k + 3 < cap; p++) {
+                if (*p == '"' || *p == '\\') buf[k++] = '\\';
+                buf[k++] = *p;
+            }
+            snprintf(buf + k, cap - k, "\"");
+            free(abs);
+        }
+        defs[n++] = buf;
+    }
+    for (int i = 0; i < o->ndefines; i++) defs[n++] = o->defines[i];
+    return n;
 }
 
 int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
 {
     atmos_status st;
     *volume = NULL;
+    const char *defs[RENDER_OPTS_MAX_DEFINES + 1];
+    char source_def[ATMOS_SCENE_PATH_MAX + 64];
+    const int ndefs = volume_defines(o, defs, source_def, sizeof source_def);
     if (o->scene_path) {
         if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
             fprintf(stderr,
-                    "atmos render: %s is a volume file, not a scene: render it with\n"
-                    "  atmos render --volume %s\n",
-                    o->scene_path, o->scene_path);
+                    "atmos %s: %s is a volume file, not a scene: open it with\n"
+                    "  atmos %s --volume %s\n",
+                    o->cmd, o->scene_path, o->cmd, o->scene_path);
             return CLI_EXIT_USAGE;
         }
         if (!strcmp(o->scene_path, "-")) {
             if (!o->scene_text) {
-                fprintf(stderr, "atmos render: standard input: cannot read the scene (larger than 16 MiB, the limit "
-                                "for scene files, a NUL byte or a read error)\n");
+                fprintf(stderr, "atmos %s: standard input: cannot read the scene (larger than 16 MiB, the limit "
+                                "for scene files, a NUL byte or a read error)\n", o->cmd);
                 return CLI_EXIT_RUNTIME;
             }
-            st = atmos_scene_parse_file(ctx, o->scene_text, strlen(o->scene_text), "-", o->defines, o->ndefines,
+            st = atmos_scene_parse_file(ctx, o->scene_text, strlen(o->scene_text), "-", defs, ndefs,
                                         scene);
         } else {
-            st = atmos_scene_load_with(ctx, o->scene_path, o->defines, o->ndefines, scene);
+            st = atmos_scene_load_with(ctx, o->scene_path, defs, ndefs, scene);
         }
-        if (st != ATMOS_OK) return cli_runtime_error("render", ctx, st);
-    } else if (o->ndefines) {
+        if (st != ATMOS_OK) return cli_runtime_error(o->cmd, ctx, st);
+    } else if (ndefs) {
         /* the built-in default scene is the parse of an empty one */
-        if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", o->defines, o->ndefines, scene)) != ATMOS_OK) {
-            fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+        if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", defs, ndefs, scene)) != ATMOS_OK) {
+            fprintf(stderr, "atmos %s: %s\n", o->cmd, atmos_context_error(ctx));
             return CLI_EXIT_USAGE;
         }
     } else {
@@ -89,11 +127,11 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     int rc = render_opts_apply(ctx, o, scene);
     if (rc != CLI_EXIT_OK) return rc;
     if ((st = atmos_scene_validate(ctx, scene, o->scene_path ? o->scene_path : "options")) != ATMOS_OK) {
-        fprintf(stderr, "atmos render: %s\n", atmos_context_error(ctx));
+        fprintf(stderr, "atmos %s: %s\n", o->cmd, atmos_context_error(ctx));
         return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
     }
     if (!render_opts_camera_given(o) && (st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK)
-        return cli_runtime_error("render", ctx, st);
+        return cli_runtime_error(o->cmd, ctx, st);
     return CLI_EXIT_OK;
 }
 

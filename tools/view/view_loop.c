@@ -1,5 +1,6 @@
 /* The viewer's loop (view.h, view_cmd.c): the plans, one frame after another, the display,
  * the overlay, the recording and the saved views. */
+#include "outputs.h"
 #include "view.h"
 
 #include <SDL2/SDL_keycode.h>
@@ -75,6 +76,7 @@ static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int sna
     }
     atmos_status st = keep ? atmos_image_to_srgb_into(L->ctx, L->img, atmos_plan_wavelengths(p), L->lin)
                            : atmos_image_to_srgb(L->ctx, L->img, atmos_plan_wavelengths(p), &L->lin);
+    if (st == ATMOS_OK) st = atmos_image_gamut_map(L->ctx, L->lin, NULL); /* as atmos render writes it */
     if (st != ATMOS_OK) return st;
     atmos_tonemap_desc td;
     memset(&td, 0, sizeof td);
@@ -132,6 +134,8 @@ static int save(loop *L, const view_opts *o, view_state *s, const char *text)
     saved.manual_exposure = 1, saved.ev = ev;
     char base[4096];
     snprintf(base, sizeof base, "%s_%03d", o->save_base ? o->save_base : "view", ++L->saves);
+    /* its folder made as atmos render makes its outputs' */
+    if (cli_output_folder("view", "--save-base", base) != 0) return CLI_EXIT_RUNTIME;
     return view_save(L->ctx, base, text, L->sc, &saved, L->lin, L->disp);
 }
 
@@ -212,7 +216,10 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         if (win && view_window_present(win, L.disp, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
         last_ms = 1000.0 * (cli_now_s() - t0);
         if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates, &s);
-        if (rc == CLI_EXIT_OK && s.save) rc = save(&L, o, &s, text), s.save = 0;
+        /* a save that fails is said (save prints why) and the session goes on */
+        if (rc == CLI_EXIT_OK && s.save && save(&L, o, &s, text) != CLI_EXIT_OK)
+            fprintf(stderr, "atmos view: the frame was not saved; the session goes on\n");
+        s.save = 0;
     }
     if (view_record_close(&rec) != CLI_EXIT_OK && rc == CLI_EXIT_OK) rc = CLI_EXIT_RUNTIME;
     view_window_close(win);

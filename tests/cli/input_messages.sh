@@ -1,0 +1,58 @@
+#!/bin/sh
+# Inputs a new user gets wrong, and the messages that tell them what to do:
+#  - a file that is not an image given as an Earth map: the message names the scene key, the
+#    path and the formats read (PNG, JPEG), not the image library's "Read Error";
+#  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
+#    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3).
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/input_messages.$$
+rm -rf "$T"
+mkdir -p "$T" || exit 1
+trap 'rm -rf "$T"' EXIT
+export XDG_CACHE_HOME="$T/cache"
+fail=0
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
+
+# --- a text file as the ground map
+echo "not an image" >"$T/notes.txt"
+"$A" render -D atmosphere.model=spherical -D "atmosphere.ground_map=$T/notes.txt" --width 8 --height 8 \
+    -o "$T/g.png" >/dev/null 2>"$T/err"
+st=$?
+[ $st -ne 0 ] && ok "a text ground map is refused (exit $st)" || bad "a text ground map was accepted"
+has "text ground map" "/atmosphere/ground_map"
+has "text ground map" "notes.txt"
+has "text ground map" "PNG or JPEG"
+grep -q "Read Error" "$T/err" && bad "the message is libpng's 'Read Error'" || ok "no bare 'Read Error'"
+# a truncated PNG still names the key
+printf '\211PNG\r\n\032\n' >"$T/cut.png"
+"$A" render -D atmosphere.model=spherical -D "atmosphere.night_lights=$T/cut.png" --width 8 --height 8 \
+    -o "$T/g.png" >/dev/null 2>"$T/err"
+[ $? -ne 0 ] && ok "a truncated PNG map is refused" || bad "a truncated PNG map was accepted"
+has "truncated PNG map" "/atmosphere/night_lights"
+
+# --- -D volume.* with --volume FILE
+"$A" volume generate cumulus -o "$T/v.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"
+P='particles.cloud={"kind":"analytic","lobes":[{"type":"hg","g":0.8}],"sigma_ext_m2":6e-10}'
+common="--volume $T/v.json --width 16 --height 9 --renderer path --spp 2"
+# shellcheck disable=SC2086
+"$A" render $common -D "$P" --density-unit per_m3 --pfm "$T/opt.pfm" >/dev/null 2>"$T/err" || { bad "--density-unit per_m3"; cat "$T/err" >&2; }
+# shellcheck disable=SC2086
+"$A" render $common -D "$P" -D volume.density_unit=per_m3 --pfm "$T/def.pfm" >/dev/null 2>"$T/err"
+st=$?
+[ $st -eq 0 ] && ok "-D volume.density_unit=per_m3 with --volume (exit 0)" || { bad "-D volume.density_unit with --volume: exit $st"; cat "$T/err" >&2; }
+cmp -s "$T/opt.pfm" "$T/def.pfm" && ok "-D volume.density_unit = --density-unit (same pixels)" || bad "-D volume.density_unit and --density-unit differ"
+# shellcheck disable=SC2086
+"$A" render $common -D "$P" -D volume.density_scale=1e-3 --pfm "$T/ds.pfm" >/dev/null 2>"$T/err"
+st=$?
+[ $st -eq 0 ] && ok "-D volume.density_scale with --volume (exit 0)" || { bad "-D volume.density_scale with --volume: exit $st"; cat "$T/err" >&2; }
+# a scene with a generated volume (and its seed): --volume FILE replaces it, -D volume.KEY
+# applies to the file, and the generator's seed goes with the generator
+printf '{"volume": {"generate": "cumulus", "seed": 3}}' >"$T/gen.json"
+# shellcheck disable=SC2086
+"$A" render "$T/gen.json" $common -D "$P" -D volume.density_unit=per_m3 --pfm "$T/gen.pfm" >/dev/null 2>"$T/err"
+st=$?
+[ $st -eq 0 ] && ok "scene with a generated volume, --volume FILE -D volume.density_unit (exit 0)" || { bad "generated scene + --volume FILE + -D volume.density_unit: exit $st"; cat "$T/err" >&2; }
+exit $fail
