@@ -82,6 +82,7 @@ cat >"$T/table" <<'EOF'
 --max-subplanes 1|beams.max_subplanes=1|beams|
 --shadow-size 16|beams.shadow_size=16|beams|
 --beams-sun|beams.sun=true|beams|
+--interleave 2|beams.interleave=2|beams|
 EOF
 
 # Every renderer option of --help is in the table.
