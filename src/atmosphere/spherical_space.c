@@ -236,7 +236,7 @@ static void ground(const atmos__sph_space *s, const atmos_atmosphere *a, const d
 /* Rays i0 .. i0 + m - 1 (m <= BLK): the look-ups of the rays that meet the air and their
  * ground, the exponentials in one loop (which vectorises), then the phase functions. */
 #define BLK 16
-static void eval_block(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int i0, int m,
+static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int i0, int m,
                        int count, const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
     const int n = s->n, S = NC * n;
@@ -273,5 +273,5 @@ void atmos__sph_space_eval(const atmos__sph_space *s, const atmos_atmosphere *a,
                            const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
     for (int i0 = 0; i0 < count; i0 += BLK)
-        eval_block(s, a, sun, i0, count - i0 < BLK ? count - i0 : BLK, count, dx, dy, dz, weight, out);
+        space_block(s, a, sun, i0, count - i0 < BLK ? count - i0 : BLK, count, dx, dy, dz, weight, out);
 }

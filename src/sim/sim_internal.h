@@ -82,7 +82,7 @@ struct atmos_sim {
  * results do not depend on the thread count. Called outside a parallel region, the phases
  * run on the calling thread. */
 #define SIM_FOR _Pragma("omp for schedule(dynamic, 1) nowait")
-void atmos__sim_sync(atmos_sim *s); /* sim_step.c */
+void atmos__sim_sync(atmos_sim *s); /* sim_sync.c */
 void atmos__sim_sync_init(atmos_sim *s);
 void atmos__sim_sync_free(atmos_sim *s);
 

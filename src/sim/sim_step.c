@@ -1,10 +1,8 @@
 /* One time step of the cloud simulation, a run of many with progress, and its statistics. */
-#define _POSIX_C_SOURCE 200809L /* pthread barriers */
 #include "sim/sim_internal.h"
 
 #include <math.h>
 #include <omp.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,34 +15,6 @@ static double time_step(const atmos_sim *s)
     if (m != m || m > 1e30f) return 0.0; /* NaN or overflow: unstable */
     const double dt = m > 0 ? 1.5 * s->dx / m : s->dt_max;
     return fmin(dt, s->dt_max);
-}
-
-void atmos__sim_sync_init(atmos_sim *s)
-{
-    s->bar = NULL;
-    if (s->threads < 2) return;
-    pthread_barrier_t *b = malloc(sizeof *b);
-    if (b && pthread_barrier_init(b, NULL, (unsigned)s->threads) == 0) s->bar = b;
-    else free(b); /* OpenMP's barriers then */
-}
-
-void atmos__sim_sync_free(atmos_sim *s)
-{
-    if (!s->bar) return;
-    pthread_barrier_destroy(s->bar);
-    free(s->bar);
-    s->bar = NULL;
-}
-
-void atmos__sim_sync(atmos_sim *s)
-{
-    const int team = omp_get_num_threads();
-    if (team == 1) return;
-    if (s->bar && team == s->threads) {
-        pthread_barrier_wait(s->bar);
-    } else { /* a smaller team than asked for (nested or limited): OpenMP's own barrier */
-#pragma omp barrier
-    }
 }
 
 /* The step's phases in one parallel region; the column-local ones (rain fall, surface fluxes,
