@@ -30,9 +30,11 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define DIFF_OMEGA 1.8    /* over-relaxation */
 #define DIFF_REFRESH 4    /* sweeps between refreshes of the flux-limited D */
+#define DIFF_LEVELS 4     /* most coarse grids of a cold start's cascade */
 
 
 /* The six neighbours of a cell: offsets, -1: a vacuum face, -2: none (a periodic axis of one
@@ -181,20 +183,74 @@ static int solve_one(const atmos__lmedium *m, const atmos__lsource *q, float *ph
     return s;
 }
 
+/* A level of the cascade: a coarse medium, its source and its solution. */
+typedef struct {
+    atmos__lmedium m;
+    float *Q, *Q1, *phi;
+} dlevel;
+
+static void levels_free(dlevel *lv, int nl)
+{
+    for (int l = 0; l < nl; l++) free(lv[l].Q), free(lv[l].Q1), free(lv[l].phi), atmos__lmedium_free(&lv[l].m);
+}
+
+/* Up to `want` coarse levels below m (lv[0] the finest of them), their phi zero; returns how
+ * many (-1: out of memory). */
+static int levels_make(const atmos__lmedium *m, const atmos__lsource *q, int want, dlevel *lv)
+{
+    int nl = 0;
+    const atmos__lmedium *fm = m;
+    atmos__lsource fq = *q;
+    while (nl < want && nl < DIFF_LEVELS && atmos__lmedium_can_coarsen(fm)) {
+        dlevel *l = &lv[nl];
+        memset(l, 0, sizeof *l);
+        if (!atmos__lmedium_coarsen(fm, &fq, &l->m, &l->Q, &l->Q1) ||
+            !(l->phi = calloc(atmos__lmedium_cells(&l->m) * (size_t)m->n, sizeof(float)))) {
+            levels_free(lv, nl + 1);
+            return -1;
+        }
+        nl++;
+        fm = &l->m, fq.Q = l->Q, fq.Q1 = l->Q1;
+    }
+    return nl;
+}
+
+/* Wavelength w's cascade: the coarsest level from zero, each finer one from the prolonged
+ * solution of the one below, phi (the fine grid) from lv[0]'s; -1: out of memory. */
+static int cascade_one(const atmos__lmedium *m, float *phi, const dlevel *lv, int nl, int w, int maxs, double tol,
+                       int limiter)
+{
+    for (int l = nl - 1; l >= 0; l--) {
+        const atmos__lsource cq = {lv[l].Q, lv[l].Q1};
+        if (solve_one(&lv[l].m, &cq, lv[l].phi, w, maxs, tol, limiter) < 0) return -1;
+        if (l > 0) atmos__lfield_prolong(&lv[l].m, lv[l].phi, &lv[l - 1].m, lv[l - 1].phi, w);
+        else atmos__lfield_prolong(&lv[0].m, lv[0].phi, m, phi, w);
+    }
+    return 0;
+}
+
 int atmos__lfield_diffuse(const atmos__lmedium *m, const atmos__lsource *q, float *phi, const atmos__ldiffusion_opts *o,
                           int threads)
 {
     const int n = m->n, maxs = o && o->max_sweeps > 0 ? o->max_sweeps : 2000, limiter = o ? o->limiter : 0;
     const double tol = o && o->tol > 0 ? o->tol : 1e-4;
     int most = 0, fail = 0;
+    dlevel lv[DIFF_LEVELS];
+    const int nl = o && o->cascade > 0 ? levels_make(m, q, o->cascade, lv) : 0;
+    if (nl < 0) return -1;
     /* the wavelengths in parallel, each solved by one thread: no barrier per sweep (which
      * costs a time slice whenever the machine is busy), the same result for any thread count */
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(max : most) reduction(| : fail)
     for (int w = 0; w < n; w++) {
+        if (nl > 0 && cascade_one(m, phi, lv, nl, w, maxs, tol, limiter) < 0) {
+            fail = 1;
+            continue;
+        }
         const int s = solve_one(m, q, phi, w, maxs, tol, limiter);
         if (s < 0) fail = 1;
         most = s > most ? s : most;
     }
+    levels_free(lv, nl);
     return fail ? -1 : most;
 }
 

@@ -78,7 +78,7 @@ static atmos_status bench_plan(atmos_context *ctx, atmos_volume *v, const atmos_
 }
 
 static void print_slice(const char *name, int size, int threads, const double fps[3], const atmos_plan_stats *s,
-                        double prepare_s, int diffuse, int json)
+                        const atmos_slice_timing *first, double prepare_s, int diffuse, int json)
 {
     const atmos_slice_timing *t = &s->slice;
     const long long samples = t->eye_samples + t->light_samples;
@@ -88,15 +88,15 @@ static void print_slice(const char *name, int size, int threads, const double fp
                              "\"ms_per_frame\":%.2f,\"ns_per_sample\":%.2f,\"setup_ms\":%.2f,\"light_ms\":%.2f,"
                              "\"eye_ms\":%.2f,\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"eye_samples\":%lld,"
                              "\"light_samples\":%lld,\"grid\":[%d,%d,%d],\"diffuse\":%d,\"field_ms\":%.2f,"
-                             "\"field_sweeps\":%d}\n"
+                             "\"field_sweeps\":%d,\"field_cold_ms\":%.2f,\"field_cold_sweeps\":%d}\n"
                            : "bench=slice case=%s size=%d threads=%d eye=%dx%d fps_camera_moving=%.3f fps_sun_moving=%.3f "
                              "fps_static=%.3f ms_per_frame=%.2f ns_per_sample=%.2f setup_ms=%.2f light_ms=%.2f eye_ms=%.2f "
                              "sky_ms=%.2f prepare_ms=%.2f eye_samples=%lld light_samples=%lld grid=%dx%dx%d diffuse=%d "
-                             "field_ms=%.2f field_sweeps=%d\n";
+                             "field_ms=%.2f field_sweeps=%d field_cold_ms=%.2f field_cold_sweeps=%d\n";
     printf(fmt, name, size, threads, t->eye_dims[0], t->eye_dims[1], fps[MOVE_CAMERA], fps[MOVE_SUN], fps[MOVE_NOTHING],
            1e3 / fps[MOVE_SUN], ns, 1e3 * t->setup, 1e3 * t->light, 1e3 * t->eye, 1e3 * t->sky, 1e3 * prepare_s,
            t->eye_samples, t->light_samples, t->grid_dims[0], t->grid_dims[1], t->grid_dims[2], diffuse, 1e3 * t->field,
-           t->field_sweeps);
+           t->field_sweeps, 1e3 * first->field, first->field_sweeps);
     fflush(stdout);
 }
 
@@ -117,12 +117,17 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
     if (eye_scale > 0) start.eye_scale = eye_scale;
     if (st == ATMOS_OK) st = atmos_plan_image_create(plan, &start, &img);
+    /* the plan's first frame: the field's cold build (no warm start) */
+    atmos_plan_stats first;
+    memset(&first, 0, sizeof first);
+    if (st == ATMOS_OK) st = atmos_plan_render(plan, &start, NULL, img, NULL);
+    if (st == ATMOS_OK) atmos_plan_get_stats(plan, &first);
     for (int m = 0; m < 3 && st == ATMOS_OK; m++) st = run_mode(plan, &start, m, frames, img, &sec[m], &stats[m]);
     atmos_image_destroy(img);
     atmos_plan_destroy(plan);
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
-    print_slice(name, size, atmos_context_threads(ctx), fps, &stats[MOVE_SUN], prepare, diffuse, json);
+    print_slice(name, size, atmos_context_threads(ctx), fps, &stats[MOVE_SUN], &first.slice, prepare, diffuse, json);
     return CLI_EXIT_OK;
 }
 
