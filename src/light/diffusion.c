@@ -90,9 +90,12 @@ static double cell_D(const atmos__lmedium *m, const float *phi, const long long 
 }
 
 /* The lagged coefficients of wavelength w: D per cell and, with a first moment of the
- * source, the flux it drives, P = 3 D Q1 ([cell * 3 + axis]). */
+ * source, the flux it drives, P = 3 D Q1 ([cell * 3 + axis]). damp: D becomes the mean of
+ * the old and the new value (the same fixed point): refreshed outright, the limiter's D and
+ * phi could chase each other without end (the generated storm's field after a sun move ran
+ * into the 2000-sweep cap twice in nine moves). */
 static void refresh_D(const atmos__lmedium *m, const atmos__lsource *q, const float *phi, int w, int limiter, float *D,
-                      float *P)
+                      float *P, int damp)
 {
     const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
     for (int k = 0; k < cz; k++)
@@ -101,7 +104,7 @@ static void refresh_D(const atmos__lmedium *m, const atmos__lsource *q, const fl
                 long long nb[6];
                 neighbours(m, i, j, k, nb);
                 const size_t cell = ((size_t)k * cy + j) * cx + i;
-                const double d = cell_D(m, phi, nb, cell, w, limiter);
+                const double d0 = cell_D(m, phi, nb, cell, w, limiter), d = damp ? 0.5 * (d0 + D[cell]) : d0;
                 D[cell] = (float)d;
                 if (P)
                     for (int a = 0; a < 3; a++) P[cell * 3 + a] = (float)(3.0 * d * q->Q1[(cell * n + w) * 3 + a]);
@@ -168,7 +171,7 @@ static int solve_one(const atmos__lmedium *m, const atmos__lsource *q, float *ph
     }
     int s = 0;
     for (; s < maxs; s++) {
-        if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, q, phi, w, limiter, D, P);
+        if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, q, phi, w, limiter, D, P, s > 0);
         double top0, top1;
         double ch = half_sweep(m, q->Q, phi, D, P, w, 0, &top0);
         const double ch1 = half_sweep(m, q->Q, phi, D, P, w, 1, &top1);
