@@ -77,6 +77,8 @@ static void help(void)
            "          --diffuse adds the diffuse light field (\"diffuse\"); field_ms: its build (source and\n"
            "          diffusion solve, warm-started) after the sun's last move, field_sweeps its sweeps;\n"
            "          field_cold_ms, field_cold_sweeps: the plan's first frame's (no warm start).\n"
+           "          cpu_ms_camera_moving, cpu_ms_sun_moving: the process's CPU time per frame (with\n"
+           "          OMP_WAIT_POLICY=passive the work done; steadier than fps on a shared machine).\n"
            "          --json prints one JSON object per case.\n"
            "          --aerial: instead, the cost of the atmosphere around a sliced volume: FILE (default\n"
            "          the generated storm) under each model of --models (default riley,spherical), 8 R\n"
