@@ -30,9 +30,11 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define DIFF_OMEGA 1.8    /* over-relaxation */
 #define DIFF_REFRESH 4    /* sweeps between refreshes of the flux-limited D */
+#define DIFF_LEVELS 4     /* most coarse grids of a cold start's cascade */
 
 
 /* The six neighbours of a cell: offsets, -1: a vacuum face, -2: none (a periodic axis of one
@@ -88,9 +90,12 @@ static double cell_D(const atmos__lmedium *m, const float *phi, const long long 
 }
 
 /* The lagged coefficients of wavelength w: D per cell and, with a first moment of the
- * source, the flux it drives, P = 3 D Q1 ([cell * 3 + axis]). */
+ * source, the flux it drives, P = 3 D Q1 ([cell * 3 + axis]). damp: D becomes the mean of
+ * the old and the new value (the same fixed point): refreshed outright, the limiter's D and
+ * phi could chase each other without end (the generated storm's field after a sun move ran
+ * into the 2000-sweep cap twice in nine moves). */
 static void refresh_D(const atmos__lmedium *m, const atmos__lsource *q, const float *phi, int w, int limiter, float *D,
-                      float *P)
+                      float *P, int damp)
 {
     const int n = m->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
     for (int k = 0; k < cz; k++)
@@ -99,7 +104,7 @@ static void refresh_D(const atmos__lmedium *m, const atmos__lsource *q, const fl
                 long long nb[6];
                 neighbours(m, i, j, k, nb);
                 const size_t cell = ((size_t)k * cy + j) * cx + i;
-                const double d = cell_D(m, phi, nb, cell, w, limiter);
+                const double d0 = cell_D(m, phi, nb, cell, w, limiter), d = damp ? 0.5 * (d0 + D[cell]) : d0;
                 D[cell] = (float)d;
                 if (P)
                     for (int a = 0; a < 3; a++) P[cell * 3 + a] = (float)(3.0 * d * q->Q1[(cell * n + w) * 3 + a]);
@@ -166,7 +171,7 @@ static int solve_one(const atmos__lmedium *m, const atmos__lsource *q, float *ph
     }
     int s = 0;
     for (; s < maxs; s++) {
-        if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, q, phi, w, limiter, D, P);
+        if (s == 0 || (limiter && s % DIFF_REFRESH == 0)) refresh_D(m, q, phi, w, limiter, D, P, s > 0);
         double top0, top1;
         double ch = half_sweep(m, q->Q, phi, D, P, w, 0, &top0);
         const double ch1 = half_sweep(m, q->Q, phi, D, P, w, 1, &top1);
@@ -181,20 +186,74 @@ static int solve_one(const atmos__lmedium *m, const atmos__lsource *q, float *ph
     return s;
 }
 
+/* A level of the cascade: a coarse medium, its source and its solution. */
+typedef struct {
+    atmos__lmedium m;
+    float *Q, *Q1, *phi;
+} dlevel;
+
+static void levels_free(dlevel *lv, int nl)
+{
+    for (int l = 0; l < nl; l++) free(lv[l].Q), free(lv[l].Q1), free(lv[l].phi), atmos__lmedium_free(&lv[l].m);
+}
+
+/* Up to `want` coarse levels below m (lv[0] the finest of them), their phi zero; returns how
+ * many (-1: out of memory). */
+static int levels_make(const atmos__lmedium *m, const atmos__lsource *q, int want, dlevel *lv)
+{
+    int nl = 0;
+    const atmos__lmedium *fm = m;
+    atmos__lsource fq = *q;
+    while (nl < want && nl < DIFF_LEVELS && atmos__lmedium_can_coarsen(fm)) {
+        dlevel *l = &lv[nl];
+        memset(l, 0, sizeof *l);
+        if (!atmos__lmedium_coarsen(fm, &fq, &l->m, &l->Q, &l->Q1) ||
+            !(l->phi = calloc(atmos__lmedium_cells(&l->m) * (size_t)m->n, sizeof(float)))) {
+            levels_free(lv, nl + 1);
+            return -1;
+        }
+        nl++;
+        fm = &l->m, fq.Q = l->Q, fq.Q1 = l->Q1;
+    }
+    return nl;
+}
+
+/* Wavelength w's cascade: the coarsest level from zero, each finer one from the prolonged
+ * solution of the one below, phi (the fine grid) from lv[0]'s; -1: out of memory. */
+static int cascade_one(const atmos__lmedium *m, float *phi, const dlevel *lv, int nl, int w, int maxs, double tol,
+                       int limiter)
+{
+    for (int l = nl - 1; l >= 0; l--) {
+        const atmos__lsource cq = {lv[l].Q, lv[l].Q1};
+        if (solve_one(&lv[l].m, &cq, lv[l].phi, w, maxs, tol, limiter) < 0) return -1;
+        if (l > 0) atmos__lfield_prolong(&lv[l].m, lv[l].phi, &lv[l - 1].m, lv[l - 1].phi, w);
+        else atmos__lfield_prolong(&lv[0].m, lv[0].phi, m, phi, w);
+    }
+    return 0;
+}
+
 int atmos__lfield_diffuse(const atmos__lmedium *m, const atmos__lsource *q, float *phi, const atmos__ldiffusion_opts *o,
                           int threads)
 {
     const int n = m->n, maxs = o && o->max_sweeps > 0 ? o->max_sweeps : 2000, limiter = o ? o->limiter : 0;
     const double tol = o && o->tol > 0 ? o->tol : 1e-4;
     int most = 0, fail = 0;
+    dlevel lv[DIFF_LEVELS];
+    const int nl = o && o->cascade > 0 ? levels_make(m, q, o->cascade, lv) : 0;
+    if (nl < 0) return -1;
     /* the wavelengths in parallel, each solved by one thread: no barrier per sweep (which
      * costs a time slice whenever the machine is busy), the same result for any thread count */
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(max : most) reduction(| : fail)
     for (int w = 0; w < n; w++) {
+        if (nl > 0 && cascade_one(m, phi, lv, nl, w, maxs, tol, limiter) < 0) {
+            fail = 1;
+            continue;
+        }
         const int s = solve_one(m, q, phi, w, maxs, tol, limiter);
         if (s < 0) fail = 1;
         most = s > most ? s : most;
     }
+    levels_free(lv, nl);
     return fail ? -1 : most;
 }
 

@@ -139,6 +139,10 @@ typedef struct {
     int max_sweeps; /* 0: 2000 */
     double tol;     /* largest change of a sweep over the largest fluence; 0: 1e-4 */
     int limiter;    /* 1: flux-limited diffusion coefficient (Levermore-Pomraning sum limiter) */
+    int cascade;    /* a cold start: up to this many coarser grids (cells of 2, 4 ... cells), each
+                       solved from the next coarser one's solution, the coarsest from zero, then
+                       the fine grid from the finest coarse one's (phi's content ignored); 0: none,
+                       phi is the start (a warm start) */
 } atmos__ldiffusion_opts;
 
 /* Solves -div(D grad phi) + sig_a phi = Q - div(3 D Q1) on the medium's grid (diffusion.c), D =
@@ -147,6 +151,16 @@ typedef struct {
  * faces; phi holds the warm start on entry. Returns the sweeps used. */
 int atmos__lfield_diffuse(const atmos__lmedium *m, const atmos__lsource *q, float *phi, const atmos__ldiffusion_opts *o,
                           int threads);
+
+/* The cascade's coarse grids (diffusion_coarse.c). 1: m has a coarser grid (every axis of 4
+ * cells or more, or a periodic axis of one). Coarsen: cm, its source *cq, *cq1 (NULL when q->Q1
+ * is; the caller frees them) on cells twice as large, the means of the fine cells' (an odd
+ * count padded with vacuum); 0 if out of memory. Prolong: wavelength w of phi on m from the
+ * coarse solution cphi on cm (trilinear between the coarse cells' centres). */
+int atmos__lmedium_can_coarsen(const atmos__lmedium *m);
+int atmos__lmedium_coarsen(const atmos__lmedium *m, const atmos__lsource *q, atmos__lmedium *cm, float **cq,
+                           float **cq1);
+void atmos__lfield_prolong(const atmos__lmedium *cm, const float *cphi, const atmos__lmedium *m, float *phi, int w);
 
 /* The net power leaving through each of the six faces (-x, +x, -y, +y, -z, +z), (outgoing
  * minus the incoming jin), summed over the face's cells, of wavelength w: out[6], W nm^-1. */

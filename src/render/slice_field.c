@@ -91,12 +91,31 @@ atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *s
         for (int w = 0; w < sp->n; w++) sp->fg[f][w] = (float)atmos_phase_table_g(o->phase[f], w);
     const size_t cells = (size_t)cx * cy * cz;
     sp->fdens = malloc(sizeof(float) * cells * (size_t)sp->nf);
-    if (!sp->fdens || !atmos__lmedium_alloc(&sp->fmed, cx, cy, cz, sp->n, s / (double)g->sc) ||
+    sp->fvq = sp->n == 3 ? 4 : sp->n;
+    sp->fview = calloc(cells * (size_t)sp->nf * sp->fvq, sizeof(float));
+    if (!sp->fdens || !sp->fview || !atmos__lmedium_alloc(&sp->fmed, cx, cy, cz, sp->n, s / (double)g->sc) ||
         !(sp->fmed.jin = calloc((size_t)6 * sp->n, sizeof(float))) ||
         !atmos__lfield_alloc(&sp->field, ATMOS__LFIELD_DIFFUSION, cx, cy, cz, sp->n, s))
         return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
     field_medium(sp, s);
     return ATMOS_OK;
+}
+
+void atmos__slice_field_view(atmos__slice_plan *sp, const double eye[3], int threads)
+{
+    atmos__lfield *fl = &sp->field;
+    atmos__lfield_toward(fl, eye, threads);
+    const int n = sp->n, nf = sp->nf, q = sp->fvq;
+    const long long cells = (long long)atmos__lmedium_cells(&sp->fmed);
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long cell = 0; cell < cells; cell++) {
+        const float *la = fl->LA + (size_t)cell * 2 * n;
+        for (int f = 0; f < nf; f++) {
+            float *o = sp->fview + ((size_t)cell * nf + f) * q;
+            for (int c = 0; c < q; c++)
+                o[c] = c < n ? sp->tab.sca[f][c] * (la[c] + sp->fg[f][c] * la[n + c]) : 0.0f;
+        }
+    }
 }
 
 /* The sky's and the ground's light coming in through each face of the field's box: the
@@ -157,6 +176,7 @@ atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp
     const double t1 = atmos__now();
     atmos__ldiffusion_opts o = {0};
     o.limiter = 1; /* measured better than without (docs/lightfield.md) */
+    o.cascade = fl->valid ? 0 : 2; /* a cold start from coarser grids' solutions; else the last sun's field */
     fl->sweeps = atmos__lfield_diffuse(&sp->fmed, &src, fl->phi, &o, threads);
     if (fl->sweeps < 0) {
         free(Q);

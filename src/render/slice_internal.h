@@ -39,6 +39,9 @@ typedef struct {
     const stables *t;
     const atmos__lfield *field;  /* the diffuse light field, or NULL */
     const float (*fg)[ATMOS_MAX_WAVELENGTHS]; /* the fields' asymmetry g per wavelength */
+    const float *fview;          /* the field toward the frame's eye as the fast eye pass reads it:
+                                    [(cell * nf + f) * fvq + c] (atmos__slice_field_view) */
+    int fvq;                     /* floats per cell and field: 4 for RGB (the fourth 0), else n */
     /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
      * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
      * coordinate (texel units, centres at integers) F0 + k dF. */
@@ -110,6 +113,8 @@ struct atmos__slice_plan {
     float *fdens;
     float fg[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     atmos__lfield field;
+    float *fview; /* per frame: see sjob.fview */
+    int fvq;
 };
 
 /* The diffuse light field: its medium built from the render grid and the optics (once per
@@ -118,6 +123,12 @@ struct atmos__slice_plan {
 atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *sp, const atmos_volume_optics *o);
 atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
                                        const double sun_w[3], int *built);
+
+/* The field turned toward the eye at render-voxel coordinate eye: the field's L and A
+ * (atmos__lfield_toward, the reference passes' view) and, per cell and field f, what a unit
+ * density of f scatters toward the eye, sca_f (L + g_f A) per wavelength (sp->fview, the fast
+ * eye pass's: one trilinear read of 4 floats per field and sample for RGB). */
+void atmos__slice_field_view(atmos__slice_plan *sp, const double eye[3], int threads);
 
 /* The diffuse field at render-voxel point (u, v, w), toward the frame's eye: per wavelength
  * its mean radiance L[c] and A[c] = 3/(4 pi) J . d, d the unit direction to the eye (from the

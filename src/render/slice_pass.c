@@ -319,39 +319,78 @@ SLICE_INLINE void eye_optics(const sjob *j, const echunk *e, int c, float *restr
     }
 }
 
-/* The diffuse light field at the samples of slice k, read at the points eye_samples
- * computed: L and A ([q * n + c], atmos__slice_field_at). */
-SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict Lf, float *restrict Af)
+/* The diffuse field's cells at the samples of slice k: per sample the offset of the lower
+ * corner cell in the per-frame view (j->fview) and the trilinear weights, as
+ * atmos__lfield_sample finds them (the cells' centres at render voxel (i + 1/2) s - 1/2,
+ * clamped to the outer ones). One vector loop over the chunk. */
+typedef struct {
+    int32_t cell[CH];
+    float w[8][CH];
+    int32_t st[3]; /* the view's strides to the next cell along each axis (0: an axis of one cell) */
+} fchunk;
+
+SLICE_INLINE void field_axis(float x, int c, int32_t *i, float *t)
 {
-    const float kf = (float)k;
-    const int n = j->n;
+    const float lim = (float)(c - 1);
+    x = x < 0.0f ? 0.0f : (x > lim ? lim : x);
+    int a = (int)x;
+    a = a > c - 2 ? c - 2 : a;
+    a = a < 0 ? 0 : a;
+    *i = a, *t = c > 1 ? x - (float)a : 0.0f;
+}
+
+SLICE_INLINE void eye_field_cells(const sjob *j, int k, size_t p0, const echunk *e, fchunk *fc)
+{
+    const atmos__lfield *f = j->field;
+    const int cx = f->c[0], cy = f->c[1], cz = f->c[2];
+    const int32_t m = j->nf * j->fvq;
+    const float kf = (float)k, off = 0.5f * (float)(f->s - 1), is = 1.0f / (float)f->s;
+    fc->st[0] = cx > 1 ? m : 0, fc->st[1] = cy > 1 ? cx * m : 0, fc->st[2] = cz > 1 ? cx * cy * m : 0;
     for (int q = 0; q < e->mv; q++) {
         const size_t p = p0 + (size_t)lane(e, q);
         const float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
                     w = j->pU0[2][p] + kf * j->pdU[2][p];
-        atmos__slice_field_at(j->field, u, v, w, Lf + (size_t)q * n, Af + (size_t)q * n);
+        int32_t i, jj, kk;
+        float a, b, c;
+        field_axis((u - off) * is, cx, &i, &a);
+        field_axis((v - off) * is, cy, &jj, &b);
+        field_axis((w - off) * is, cz, &kk, &c);
+        fc->cell[q] = ((kk * cy + jj) * cx + i) * m;
+        fc->w[0][q] = (1 - a) * (1 - b) * (1 - c), fc->w[1][q] = a * (1 - b) * (1 - c);
+        fc->w[2][q] = (1 - a) * b * (1 - c), fc->w[3][q] = a * b * (1 - c);
+        fc->w[4][q] = (1 - a) * (1 - b) * c, fc->w[5][q] = a * (1 - b) * c;
+        fc->w[6][q] = (1 - a) * b * c, fc->w[7][q] = a * b * c;
     }
 }
 
-/* Wavelength c of the diffuse field scattered toward the eye: ds[q] = sum over the fields of
- * beta_sca (L + g A), not below 0 (NULL without a field). */
-SLICE_INLINE float *eye_field_src(const sjob *j, const echunk *e, int c, const float *Lf, const float *Af,
-                                  float *restrict ds)
+/* The diffuse field scattered toward the eye at the chunk's samples, wavelength c in
+ * ds[c * CH + q]: sum over the live fields of density times the view's sca (L + g A)
+ * (trilinear), not below 0. */
+SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict ds)
 {
-    if (!j->field) return NULL;
-    const int n = j->n;
-    for (int q = 0; q < e->mv; q++) ds[q] = 0.0f;
-    for (int f = 0; f < j->nf; f++) {
+    fchunk fc;
+    eye_field_cells(j, k, p0, e, &fc);
+    const int n = j->n, nf = j->nf, fq = j->fvq;
+    const int32_t sx = fc.st[0], sy = fc.st[1], sz = fc.st[2];
+    const int32_t o8[8] = {0, sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz};
+    for (int c = 0; c < n; c++)
+        for (int q = 0; q < e->mv; q++) ds[c * CH + q] = 0.0f;
+    for (int f = 0; f < nf; f++) {
         if (!e->live[f]) continue;
-        const float sa = j->t->sca[f][c], g = j->fg[f][c];
         const float *restrict d = e->dens + f * CH;
-        for (int q = 0; q < e->mv; q++) {
-            const float bs = (d[q] > 0.0f ? d[q] : 0.0f) * sa;
-            ds[q] += bs > 0.0f ? bs * (Lf[(size_t)q * n + c] + g * Af[(size_t)q * n + c]) : 0.0f;
+        for (int c = 0; c < n; c++) {
+            const float *restrict V = j->fview + f * fq + c;
+            float *restrict o = ds + c * CH;
+            for (int q = 0; q < e->mv; q++) {
+                const float *p = V + fc.cell[q];
+                float v = 0.0f;
+                for (int x = 0; x < 8; x++) v += fc.w[x][q] * p[o8[x]];
+                o[q] += (d[q] > 0.0f ? d[q] : 0.0f) * v;
+            }
         }
     }
-    for (int q = 0; q < e->mv; q++) ds[q] = ds[q] > 0.0f ? ds[q] : 0.0f;
-    return ds;
+    for (int c = 0; c < n; c++)
+        for (int q = 0; q < e->mv; q++) ds[c * CH + q] = ds[c * CH + q] > 0.0f ? ds[c * CH + q] : 0.0f;
 }
 
 /* Eq. 26 for wavelength c: the slab's transmittance and in-scattered light, composited
@@ -360,16 +399,21 @@ SLICE_INLINE float *eye_field_src(const sjob *j, const echunk *e, int c, const f
 SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
                              const float *restrict bext, const float *restrict src, const float *restrict ds)
 {
-    float Tq[CH], Cq[CH];
+    float Tq[CH], Cq[CH], Sq[CH];
+    /* the in-scattering; the field's added by a loop of its own: a test of ds inside the loop
+     * became a masked load from the null pointer, whose every lane masked off still cost a
+     * microcode assist per vector (a quarter of the eye pass without the field) */
+    for (int q = 0; q < e->mv; q++) Sq[q] = Ic[q] * src[q];
+    if (ds)
+        for (int q = 0; q < e->mv; q++) Sq[q] += ds[q];
     for (int q = 0; q < e->mv; q++) {
         const float be = bext[q], tau = be * e->del[q];
         const float T = atmos__expf_poly(-tau);
         /* beta_sca Delta of Eq. 26, integrated over the slab with its own attenuation:
          * (1 - T)/beta_ext (-> Delta when thin). */
         const float len = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
-        const float contrib = (ds ? Ic[q] * src[q] + ds[q] : Ic[q] * src[q]) * len;
         Tq[q] = be > 0.0f ? T : 1.0f;
-        Cq[q] = be > 0.0f ? contrib : 0.0f;
+        Cq[q] = be > 0.0f ? Sq[q] * len : 0.0f;
     }
     float *restrict Lb = j->L_eye + c * j->pst + p0, *restrict Tb = j->T_eye + c * j->pst + p0;
     const int m = e->m;
@@ -463,15 +507,45 @@ SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float (*restric
     }
 }
 
+/* eye_field for RGB: a cell's view of a field is one 16-byte vector (fvq 4), so a sample's
+ * three wavelengths are 8 vector loads per live field. */
+SLICE_INLINE void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e, float (*restrict ds3)[CH])
+{
+    fchunk fc;
+    eye_field_cells(j, k, p0, e, &fc);
+    const int nf = j->nf;
+    const int32_t sx = fc.st[0], sy = fc.st[1], sz = fc.st[2];
+    const int32_t o8[8] = {0, sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz};
+    const __m128 zero = _mm_setzero_ps();
+    for (int q0 = 0; q0 < e->mv; q0 += 4) {
+        __m128 r[4];
+        for (int i = 0; i < 4; i++) {
+            const int q = q0 + i;
+            __m128 acc = zero;
+            for (int f = 0; f < nf; f++) {
+                if (!e->live[f]) continue;
+                const float *p = j->fview + fc.cell[q] + f * 4;
+                __m128 v = _mm_mul_ps(_mm_set1_ps(fc.w[0][q]), _mm_loadu_ps(p));
+                for (int x = 1; x < 8; x++) v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(fc.w[x][q]), _mm_loadu_ps(p + o8[x])));
+                const float d = e->dens[f * CH + q];
+                acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(d > 0.0f ? d : 0.0f), v));
+            }
+            r[i] = _mm_max_ps(acc, zero);
+        }
+        _MM_TRANSPOSE4_PS(r[0], r[1], r[2], r[3]);
+        for (int c = 0; c < 3; c++) _mm_storeu_ps(ds3[c] + q0, r[c]);
+    }
+}
+
 /* The light, the optics and the blend of an RGB chunk. */
 SLICE_INLINE void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib)
 {
-    float I3[4][CH], be3[3][CH], src3[3][CH], Lf[3 * CH], Af[3 * CH], ds[CH];
+    float I3[4][CH], be3[3][CH], src3[3][CH], ds3[4][CH];
     eye_rgb_light(j, e, Ib, I3);
     eye_orders(j, p0, e);
     eye_rgb_optics(j, e, be3, src3);
-    if (j->field) eye_field(j, k, p0, e, Lf, Af);
-    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], eye_field_src(j, e, c, Lf, Af, ds));
+    if (j->field) eye_rgb_field(j, k, p0, e, ds3);
+    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], j->field ? ds3[c] : NULL);
 }
 #else
 #define SLICE_RGB 0
@@ -483,8 +557,8 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
     const int n = j->n;
     const int32_t ns = n + 1, LN = j->L * ns; /* texels interleave I per wavelength and n */
     echunk e;
-    float Ic[CH], bext[CH], src[CH], ds[CH];
-    float Lf[CH * ATMOS_MAX_WAVELENGTHS], Af[CH * ATMOS_MAX_WAVELENGTHS]; /* the diffuse field at the samples */
+    float Ic[CH], bext[CH], src[CH];
+    float ds[CH * ATMOS_MAX_WAVELENGTHS]; /* the diffuse field's in-scattering at the samples */
     long long count = 0;
     for (int xs = x0; xs <= x1; xs += CH) {
         const int cnt = x1 - xs + 1 < CH ? x1 - xs + 1 : CH;
@@ -500,11 +574,11 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
 #endif
         eye_bilinear(&e, nb, ns, LN, e.nsc);
         eye_orders(j, p0, &e);
-        if (j->field) eye_field(j, k, p0, &e, Lf, Af);
+        if (j->field) eye_field(j, k, p0, &e, ds);
         for (int c = 0; c < n; c++) {
             eye_bilinear(&e, Ib + c, ns, LN, Ic);
             eye_optics(j, &e, c, bext, src);
-            eye_blend(j, p0, &e, c, Ic, bext, src, eye_field_src(j, &e, c, Lf, Af, ds));
+            eye_blend(j, p0, &e, c, Ic, bext, src, j->field ? ds + c * CH : NULL);
         }
     }
     return count;

@@ -18,7 +18,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     free(sp->pixblock), free(sp->spans), free(sp->lk), free(sp->ring), free(sp->I), free(sp->nsc);
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
     atmos__aerial_free(&sp->aerial);
-    atmos__lmedium_free(&sp->fmed), atmos__lfield_free(&sp->field), free(sp->fdens);
+    atmos__lmedium_free(&sp->fmed), atmos__lfield_free(&sp->field), free(sp->fdens), free(sp->fview);
     free(sp);
 }
 
@@ -122,7 +122,8 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
             j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->fg;
             double eu[3]; /* the eye in render-voxel coordinates */
             for (int a = 0; a < 3; a++) eu[a] = j.eye[a] * sp->g.sc + sp->g.off[a];
-            atmos__lfield_toward(&sp->field, eu, atmos__threads(ctx));
+            atmos__slice_field_view(sp, eu, atmos__threads(ctx));
+            j.fview = sp->fview, j.fvq = sp->fvq;
             if (built) tm->field = sp->field.build_s, tm->field_sweeps = sp->field.sweeps;
         }
         tm->setup = atmos__now() - t_setup;
