@@ -2,16 +2,7 @@
 # "animation": {"frames": 0} is a single image (include/atmos/scene.h, docs/scene-format.md):
 # accepted in a scene file and by -D, which so turns a scene's animation off; the output is
 # the one file named, without a frame number.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/animation_off.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 
 cat >"$T/anim.json" <<'JSON'
 {"image": {"width": 12, "height": 8}, "sun": {"elevation_deg": 10, "azimuth_deg": 250},

@@ -4,16 +4,7 @@
 # its disc fills the frame, gave blue components of -1.3e7 (a red beyond the sRGB gamut);
 # its PFM and EXR (the same pixels) must be >= 0 everywhere, and the PFM is gamut-mapped,
 # not clipped to nothing: the disc is not black.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/gamut.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 
 "$A" render --spectral 16 --sun-elevation 2 --sun-azimuth 250 --view-elevation 2 --view-azimuth 250 --fov 2 \
     --width 16 --height 16 --pfm "$T/s.pfm" --exr "$T/s.exr" -o "$T/s.png" >/dev/null 2>"$T/err" ||

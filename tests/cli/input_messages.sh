@@ -4,16 +4,7 @@
 #    path and the formats read (PNG, JPEG), not the image library's "Read Error";
 #  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
 #    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3).
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/input_messages.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
 
 # --- a text file as the ground map

@@ -3,17 +3,9 @@
 # current folder (a scene file's are relative to its folder): a spot's window image found
 # there renders; one that is not there is an error naming the scene key and the file, and
 # saying where it was looked for; `atmos render --help` says so.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
+. "$(dirname "$0")/common.inc"
 S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
-T=${ATMOS_TEST_TMP:-/tmp}/render_stdin_paths.$$
-rm -rf "$T"
 mkdir -p "$T/here" "$T/elsewhere" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
 
 cp "$S/scenes/dobashi_fig09b_window.png" "$T/here/win.png" || exit 1
 sed 's/"image": "[^"]*"/"image": "win.png"/' "$S/scenes/dobashi_fig09b_stained_glass.json" >"$T/scene.json"

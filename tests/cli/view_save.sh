@@ -4,16 +4,7 @@
 # cannot be written prints why and the session goes on (every frame still rendered, exit
 # 0); the scene options' errors are the viewer's ("atmos view: ...", "Try 'atmos view
 # --help'"), never atmos render's.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/view_save.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 
 # the scene options' errors, headless: the viewer's name, not atmos render's
 msg() { # NAME WANT_STATUS TEXT ARGS...

@@ -5,16 +5,7 @@
 #    ray's optical depth across it, under 0.01) renders with a warning that names the peak
 #    extinction and optical depth and the density unit / scale options; a visible one
 #    gets no such warning.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/volume_noops.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
 
 "$A" volume generate cumulus -o "$T/v.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"
