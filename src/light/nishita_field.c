@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define DEFAULT_PATHS3 256
+#define DEFAULT_PATHS3 1024
 
 typedef struct {
     const atmos__lmedium *m;

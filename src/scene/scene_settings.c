@@ -68,7 +68,7 @@ static const atmos_setting nishita_settings[] = {
      NISHITA(orders)},
     {"ratio", "nishita-ratio", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 0.95, NULL, 0,
      "the share r of the sample space's contribution the reference patterns keep", NISHITA(ratio)},
-    {"paths", "nishita-paths", ATMOS_SETTING_INT, "", 1, 100000, 0, 0, 256, NULL, 0,
+    {"paths", "nishita-paths", ATMOS_SETTING_INT, "", 1, 100000, 0, 0, 1024, NULL, 0,
      "order-3 paths computed per cell (n1, chosen at random among the pattern's)", NISHITA(paths)},
     {"cells", "nishita-cells", ATMOS_SETTING_INT, "", 4, 96, 0, 0, 32, NULL, 0,
      "the light field's grid: at most this many cells per axis", NISHITA(cells)},
