@@ -242,7 +242,7 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source, fs->width, fs->height,
             info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
     if (ranks > 0) fprintf(stderr, "  rendered by rank %d\n", ranks);
-    if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
+    if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of at most %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
     for (int i = 0; i < 6; i++)
         if (files[i]) fprintf(stderr, "  wrote %s\n", files[i]);

@@ -99,9 +99,10 @@ static void recv_floats(float *p, size_t n, int from)
 static size_t copy_bands(atmos_image *img, float *buf, int r, int size, int to_img)
 {
     const size_t row = (size_t)img->width * img->channels;
+    const int h = cli_dist_band_rows(img->height, size);
     size_t q = 0;
-    for (int y0 = r * CLI_DIST_BAND_ROWS; y0 < img->height; y0 += size * CLI_DIST_BAND_ROWS) {
-        const int y1 = y0 + CLI_DIST_BAND_ROWS < img->height ? y0 + CLI_DIST_BAND_ROWS : img->height;
+    for (int y0 = r * h; y0 < img->height; y0 += size * h) {
+        const int y1 = y0 + h < img->height ? y0 + h : img->height;
         float *px = img->pixels + (size_t)y0 * row;
         const size_t n = (size_t)(y1 - y0) * row;
         if (buf) memcpy(to_img ? px : buf + q, to_img ? buf + q : px, n * sizeof(float));
@@ -116,8 +117,9 @@ static atmos_status render_bands(const cli_dist *d, atmos_plan *plan, const atmo
 {
     atmos_status st = ATMOS_OK;
     double seconds = 0;
-    for (int y0 = d->rank * CLI_DIST_BAND_ROWS; y0 < img->height && st == ATMOS_OK; y0 += d->size * CLI_DIST_BAND_ROWS) {
-        atmos_region rg = {0, y0, img->width, y0 + CLI_DIST_BAND_ROWS < img->height ? y0 + CLI_DIST_BAND_ROWS : img->height};
+    const int h = cli_dist_band_rows(img->height, d->size);
+    for (int y0 = d->rank * h; y0 < img->height && st == ATMOS_OK; y0 += d->size * h) {
+        atmos_region rg = {0, y0, img->width, y0 + h < img->height ? y0 + h : img->height};
         st = atmos_plan_render(plan, f, &rg, img, info);
         seconds += info->seconds;
     }
