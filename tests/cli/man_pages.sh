@@ -4,16 +4,9 @@
 # from the command table in the source (tools/atmos/main.c), not from `atmos --help`, so a
 # help layout the script misreads cannot hide a missing page.
 # Run by ctest with ATMOS_CLI = the atmos binary, ATMOS_SOURCE_DIR and ATMOS_TEST_TMP.
-set -u
-cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
+. "$(dirname "$0")/common.inc"
+cli=$A
 src=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR must name the source tree}
-T=${ATMOS_TEST_TMP:-/tmp}/man_pages.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
 
 if ! command -v help2man >/dev/null 2>&1; then
     bad "help2man is missing (scripts/install-deps.sh installs it)"

@@ -5,15 +5,8 @@
 # ImportError says which interpreter the build was for and what is missing, not only
 # "No module named 'numpy'". An interpreter without its site-packages (python -S) stands in
 # for one without NumPy.
-set -u
+. "$(dirname "$0")/common.inc"
 src=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
-T=${ATMOS_TEST_TMP:-/tmp}/python_interpreter.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
 
 py=/usr/bin/python3
 [ -x "$py" ] || py=$(command -v python3)

@@ -6,17 +6,8 @@
 # made from), and a flag in --help that this list lacks is a failure, so a new option cannot
 # go untested. Options that change a tiny image must also differ from the default render, so
 # an option that does nothing is caught even when its -D form does nothing either.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
+. "$(dirname "$0")/common.inc"
 S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
-T=${ATMOS_TEST_TMP:-/tmp}/render_option_forms.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
 
 # A 12^3 ball of dense air (raw float32 + sidecar: optical depth about 1 across) for the
 # volume renderers; air, not cloud droplets, whose phase tables would take seconds to make.
