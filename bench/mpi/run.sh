@@ -5,6 +5,7 @@
 #   case=... ranks=R threads=T wall_s=... speedup=... (against 1 x 1) load=...
 # and the sizes a scaling model needs (setup, per-frame / per-band render time, bytes sent).
 #   sh bench/mpi/run.sh [ATMOS_BINARY] [REPEATS]
+# Environment: CASES (default "anim image"), ATMOS_BENCH_IMAGE_W / _H (the still, 640x360).
 set -eu
 atmos=${1:-build/atmos}
 reps=${2:-1}
@@ -14,7 +15,7 @@ trap 'rm -rf "$T"' EXIT
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 OMP_WAIT_POLICY=passive
 export XDG_CACHE_HOME=$T/cache
 anim="-D renderer=path -D path.spp=16 --width 160 --height 90 --frames 16 --sun-elevation 2 --sun-elevation-end 30"
-image="-D renderer=path -D path.spp=64 --width 320 --height 180"
+image="-D renderer=path -D path.spp=64 --width ${ATMOS_BENCH_IMAGE_W:-640} --height ${ATMOS_BENCH_IMAGE_H:-360}"
 # warm the optics cache so every run measures rendering
 "$atmos" render "$scene" --width 32 --height 18 -q -o "$T/warm.png"
 now() { date +%s.%N; }
@@ -38,7 +39,7 @@ run() { # run CASE RANKS THREADS ARGS...
     done
     echo "$best"
 }
-for c in anim image; do
+for c in ${CASES:-anim image}; do
     # shellcheck disable=SC2086
     eval "args=\$$c"
     # shellcheck disable=SC2086
