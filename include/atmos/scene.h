@@ -162,12 +162,16 @@ typedef struct atmos_scene_light {
 } atmos_scene_light;
 
 /* A uniform participating medium ("fog" in the file): Dobashi's constant density, as
- * coefficients per metre, the same at every wavelength, with a Henyey-Greenstein phase function. */
+ * coefficients per metre, the same at every wavelength, with a Henyey-Greenstein phase function;
+ * or a fog of a particle type (Mie droplets: its phase function and albedo from the type's
+ * table, the renderers' coefficients the means over the wavelengths; docs/scene-format.md). */
 typedef struct atmos_scene_fog {
     int enabled;
-    double extinction_per_m;  /* (0, 10] */
-    double scattering_per_m;  /* [0, extinction] */
-    double g;                 /* Henyey-Greenstein asymmetry, (-1, 1); 0 */
+    double extinction_per_m;  /* (0, 10]; with particle: the extinction at 550 nm */
+    double scattering_per_m;  /* [0, extinction]; with particle: unused (the type's albedo) */
+    double g;                 /* Henyey-Greenstein asymmetry, (-1, 1); 0; with particle: unused */
+    char particle[32];        /* a particle type (a preset or the scene's "particles"), or "" */
+    double visibility_m;      /* > 0: given as visibility (extinction_per_m = 3.912 / visibility at 550 nm) */
     double height_m;          /* > 0: the coefficients fall off as exp(-(y - base_m) / height_m) (the beam renderer's
                                  sun only); 0: uniform */
     double base_m;            /* the height where the coefficients are as given; 0 */

@@ -32,8 +32,8 @@ typedef struct atmos__beams_table {
     double *w;               /* nx rows of nt values */
 } atmos__beams_table;
 
-atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, double g, double x_max,
-                                      atmos__beams_table *out);
+atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, const atmos__fog_optics *phase,
+                                      double x_max, atmos__beams_table *out);
 void atmos__beams_table_free(atmos__beams_table *t);
 
 /* The four rows and their weights for one x (a ray and a light): W at any theta is then
@@ -114,6 +114,7 @@ struct atmos__beams_plan {
     double sigma_t, sigma_s;                 /* 0 without fog */
     atmos__beams_table table;
     atmos__beams_fog fog;                    /* the fog along rays (beams_sun.h) */
+    atmos__fog_optics optics;                /* the fog's coefficients and phase function */
     int sun_on;                              /* the sun lights the scene (beams/sun) */
     atmos__beams_sun sun;                    /* its map, built for the last frame's sun (sun.dir) */
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */

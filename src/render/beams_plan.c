@@ -25,6 +25,7 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b)
     free(b->lights);
     atmos__beams_sun_free(&b->sun);
     atmos__beams_table_free(&b->table);
+    atmos__fog_optics_free(&b->optics);
     free(b);
 }
 
@@ -58,14 +59,15 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
         pr.total += atmos__beams_shadow_faces(&b->lights[i].L, b->obj.n);
     }
     if (st == ATMOS_OK && pr.total > 0) st = shadow_maps(p, b, &pr);
+    if (st == ATMOS_OK) st = atmos__fog_optics_build(p->ctx, s, &p->wl, &b->optics);
+    const atmos__fog_optics *o = &b->optics;
     if (st == ATMOS_OK && s->fog.enabled && s->light_count > 0) { /* x = sigma_t v reaches sigma_t times the largest reach */
-        b->sigma_t = s->fog.extinction_per_m, b->sigma_s = s->fog.scattering_per_m;
-        st = atmos__beams_table_build(p->ctx, b->sigma_t, b->sigma_s, s->fog.g,
+        b->sigma_t = o->sigma_t, b->sigma_s = o->sigma_s;
+        st = atmos__beams_table_build(p->ctx, b->sigma_t, b->sigma_s, o,
                                       fmin(b->sigma_t * range, ATMOS__BEAMS_MAX_OPTICAL_RANGE), &b->table);
     }
-    if (s->fog.enabled) {
-        const atmos__beams_fog f = {s->fog.extinction_per_m, s->fog.scattering_per_m / s->fog.extinction_per_m, s->fog.g,
-                                    s->fog.base_m, s->fog.height_m};
+    if (st == ATMOS_OK && s->fog.enabled) {
+        const atmos__beams_fog f = {o->sigma_t, o->sigma_s / o->sigma_t, o->g, s->fog.base_m, s->fog.height_m, o};
         b->fog = f;
     }
     b->sun_on = s->beams.sun;

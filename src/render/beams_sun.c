@@ -139,5 +139,6 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
         const double tm = fmin(T, line_t(A, k, -log1p(-(i + 0.5) * whole / n)));
         sum += tm < INFINITY ? lookup(s, x0 + tm * x1, y0 + tm * y1, z0 + tm * z1) : 1;
     }
-    return f->albedo * atmos__beams_hg(f->g, atmos__dot3(s->dir, d)) * whole * sum / n;
+    const double c = atmos__dot3(s->dir, d);
+    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos__beams_hg(f->g, c)) * whole * sum / n;
 }

@@ -12,11 +12,13 @@
 #define ATMOS_RENDER_BEAMS_SUN_H
 
 #include "core/internal.h"
+#include "scene/scene_fog.h"
 
 /* The fog along rays: sigma_t(y) = sigma0 exp(-(y - base) / H) (H = 0: uniform sigma0). */
 typedef struct atmos__beams_fog {
     double sigma0, albedo, g;
     double base_m, height_m;
+    const atmos__fog_optics *phase; /* the phase function; NULL: Henyey-Greenstein with g */
 } atmos__beams_fog;
 
 /* The optical depth from the eye o to o + t d (t may be INFINITY). */

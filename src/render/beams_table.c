@@ -21,17 +21,11 @@ void atmos__beams_table_free(atmos__beams_table *t)
     memset(t, 0, sizeof *t);
 }
 
-static double hg(double g, double mu)
-{
-    const double d = 1 + g * g - 2 * g * mu;
-    return (1 - g * g) / (4 * ATMOS_PI * d * sqrt(d));
-}
-
 /* The angle of the table's coordinate s = u / (|u| + v): tan(theta) = u / v = s / (1 - |s|). */
 static double theta_of(double s) { return atan2(s, 1 - fabs(s)); }
 
-atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, double g, double x_max,
-                                      atmos__beams_table *t)
+atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, const atmos__fog_optics *phase,
+                                      double x_max, atmos__beams_table *t)
 {
     memset(t, 0, sizeof *t);
     const int nt = TABLE_S, nx = TABLE_X, ns = 2 * nt - 1; /* the cells' ends and their angular midpoints */
@@ -46,7 +40,7 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
         const double a = theta_of(-1 + 2.0 * (i / 2) / (nt - 1)), b = theta_of(-1 + 2.0 * ((i + 1) / 2) / (nt - 1));
         const double th = 0.5 * (a + b); /* a node, or the middle of a cell in angle */
         if (i % 2 == 0) h[i / 2] = i + 2 < ns ? theta_of(-1 + 2.0 * (i / 2 + 1) / (nt - 1)) - a : 0;
-        ph[i] = sigma_s * hg(g, -sin(th));
+        ph[i] = sigma_s * atmos__fog_phase(phase, -sin(th));
         tn[i] = i == ns - 1 ? INFINITY : tan(0.25 * ATMOS_PI + 0.5 * th); /* (1 + sin th) / cos th */
     }
 #pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))

@@ -42,11 +42,8 @@ atmos_status atmos__path_lamps_build(atmos_context *ctx, const atmos_scene *s, c
         atmos__lamp_make(&s->lights[i], wl, &L->lamp[i]);
         if ((st = atmos__lamp_load_image(ctx, &s->lights[i], i, &L->lamp[i])) != ATMOS_OK) return st;
     }
-    if (s->fog.enabled) {
-        L->sigma_s = s->fog.scattering_per_m;
-        L->sigma_a = s->fog.extinction_per_m - s->fog.scattering_per_m;
-        L->g = s->fog.g;
-    }
+    if ((st = atmos__fog_optics_build(ctx, s, wl, &L->fog)) != ATMOS_OK) return st;
+    L->sigma_s = L->fog.sigma_s, L->sigma_a = L->fog.sigma_t - L->fog.sigma_s;
     return ATMOS_OK;
 }
 
@@ -54,23 +51,10 @@ void atmos__path_lamps_free(path_lamps *L)
 {
     if (!L) return;
     atmos__objects_free(&L->obj);
+    atmos__fog_optics_free(&L->fog);
     for (int i = 0; L->lamp && i < L->nlamps; i++) atmos__lamp_free(&L->lamp[i]);
     free(L->lamp);
     memset(L, 0, sizeof *L);
-}
-
-/* Henyey-Greenstein at cos theta mu (per steradian), and cos theta drawn from it. */
-static double hg(double g, double mu)
-{
-    const double d = 1 + g * g - 2 * g * mu;
-    return (1 - g * g) / (4 * ATMOS_PI * d * sqrt(d));
-}
-
-static double hg_sample(double g, double u)
-{
-    if (fabs(g) < 1e-4) return 1 - 2 * u;
-    const double s = (1 - g * g) / (1 - g + 2 * g * u);
-    return atmos__clampd((1 + g * g - s * s) / (2 * g), -1, 1);
 }
 
 /* Next-event estimation toward every light from p, reached along d with weights w: in the
@@ -93,7 +77,7 @@ static void nee(const path_run *R, const double p[3], const double d[3], const d
         for (int a = 0; a < 3; a++) u[a] /= r;
         double I[PATH_B];
         if (!(atmos__lamp_toward(l, p, m, R->b->k, I) > 0)) continue;
-        const double c = n ? atmos__dot3(n, u) / ATMOS_PI : hg(P->g, atmos__dot3(d, u));
+        const double c = n ? atmos__dot3(n, u) / ATMOS_PI : atmos__fog_phase(&P->fog, atmos__dot3(d, u));
         if (!(c > 0)) continue;
         R->cnt->shadow++;
         if (atmos__objects_hit(&P->obj, o, u, 0, r - off, NULL, NULL)) continue;
@@ -182,7 +166,7 @@ int atmos__path_trace_lamps(const path_job *J, const path_bundle *b, const doubl
         if (t < T) {
             for (int a = 0; a < 3; a++) p[a] += t * d[a];
             if (!atmos__path_roulette(w, m, r)) return 1;
-            const double mu = hg_sample(P->g, atmos__stream_u(r));
+            const double mu = atmos__fog_phase_sample(&P->fog, atmos__stream_u(r));
             double nd[3];
             atmos__path_around(d, mu, 2 * ATMOS_PI * atmos__stream_u(r), nd);
             memcpy(d, nd, sizeof d);

@@ -5,12 +5,14 @@
 
 #include "light/lamp.h"
 #include "render/objects.h"
+#include "scene/scene_fog.h"
 
 typedef struct path_lamps {
     int nlamps;
     atmos__lamp *lamp;
     atmos__objects obj;
-    double sigma_s, sigma_a, g; /* the fog's (0, 0 without one) */
+    double sigma_s, sigma_a;    /* the fog's (0, 0 without one) */
+    atmos__fog_optics fog;      /* its phase function (and coefficients) */
 } path_lamps;
 
 /* The scene's lights, objects and fog for the wavelength set. */

@@ -5,6 +5,7 @@
  * reader meets. Keys starting with "_" are annotations and are skipped.
  */
 #include "scene/scene_internal.h"
+#include "scene/scene_fog.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -1209,25 +1210,46 @@ static atmos_status object_item(const jp *p, const cJSON *j, const char *path, a
     return ATMOS_OK;
 }
 
+/* "fog": coefficients (extinction_per_m or visibility_m; scattering_per_m, g), or a particle
+ * type with its extinction at 550 nm (extinction_per_m or visibility_m) and nothing else of its
+ * optics; height_m, base_m with either. */
 static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"extinction_per_m", "scattering_per_m", "g", "height_m", "base_m"};
+    static const char *const keys[] = {"extinction_per_m", "scattering_per_m", "g", "height_m", "base_m",
+                                       "visibility_m", "particle"};
+    static const atmos__range r_vis = {ATMOS__KOSCHMIEDER / 10, 1e7, 0, 0};
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
-    int k, scattering = 0;
+    int k;
     atmos_scene_fog *f = &s->fog;
-    TRY(iter_begin(p, j, path, keys, 5, &it));
+    TRY(iter_begin(p, j, path, keys, 7, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
-        double *const fields[5] = {&f->extinction_per_m, &f->scattering_per_m, &f->g, &f->height_m, &f->base_m};
-        double *d = fields[k];
-        TRY(get_number(p, v, ip, NULL, NULL, d));
-        scattering |= k == 1;
+        if (k == 6) {
+            const char *name = NULL;
+            TRY(get_string(p, v, ip, &name));
+            if (!name[0] || strlen(name) >= sizeof f->particle)
+                return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
+                                         "must name a particle type (1-31 characters)");
+            strcpy(f->particle, name);
+            continue;
+        }
+        double *const fields[6] = {&f->extinction_per_m, &f->scattering_per_m, &f->g, &f->height_m, &f->base_m,
+                                   &f->visibility_m};
+        TRY(get_number(p, v, ip, k == 5 ? &r_vis : NULL, k == 5 ? " (metres)" : NULL, fields[k]));
     }
-    if (!(it.seen & 1u)) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "needs \"extinction_per_m\"");
-    if (!scattering) f->scattering_per_m = f->extinction_per_m; /* no absorption unless given */
+    const unsigned ext = 1u, sca = 2u, g = 4u, vis = 32u, part = 64u;
+    if (!!(it.seen & ext) == !!(it.seen & vis))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "needs one of \"extinction_per_m\" and \"visibility_m\"");
+    if ((it.seen & part) && (it.seen & (sca | g)))
+        return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
+                                 "a fog of a particle type takes its albedo and phase function from the type: "
+                                 "\"scattering_per_m\" and \"g\" go with a fog without \"particle\"");
+    if (it.seen & vis) f->extinction_per_m = ATMOS__KOSCHMIEDER / f->visibility_m;
+    if (!(it.seen & sca)) f->scattering_per_m = f->extinction_per_m; /* no absorption unless given */
     f->enabled = 1;
     return ATMOS_OK;
 }

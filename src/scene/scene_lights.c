@@ -178,6 +178,11 @@ atmos_status atmos__scene_validate_lights(atmos_context *ctx, const char *source
                                            " (at most the extinction)")))
             return st;
         if ((st = atmos__scene_check_range(ctx, source, "/fog/g", s->fog.g, &r_g, NULL))) return st;
+        atmos_particle_desc pd;
+        if (s->fog.particle[0] && atmos_scene_particle(NULL, s, s->fog.particle, &pd) != ATMOS_OK)
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/fog/particle",
+                                     "'%s' is neither in the scene's \"particles\" nor a preset (atmos phase lists them)",
+                                     s->fog.particle);
         if ((st = atmos__scene_check_range(ctx, source, "/fog/height_m", s->fog.height_m, &r_fog_h, " (0: uniform)")) ||
             (st = atmos__scene_check_range(ctx, source, "/fog/base_m", s->fog.base_m, &atmos__r_pos, NULL)))
             return st;

@@ -52,7 +52,7 @@ static void test_no_shadow(void)
     double sun[3] = {0.3, 0.5, -0.8};
     unit(sun);
     CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, NULL, 0, 64));
-    const atmos__beams_fog uniform = {2e-3, 0.9, 0.6, 0, 0}, layer = {5e-3, 0.8, 0.3, 100, 250};
+    const atmos__beams_fog uniform = {2e-3, 0.9, 0.6, 0, 0, NULL}, layer = {5e-3, 0.8, 0.3, 100, 250, NULL};
     const atmos__beams_fog *fogs[2] = {&uniform, &layer};
     const double o[3] = {0, 20, 0};
     double worst = 0;
@@ -95,7 +95,7 @@ static void test_shadow(void)
     atmos__beams_sun s;
     memset(&s, 0, sizeof s);
     CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, &wall, 1, 2048));
-    const atmos__beams_fog fog = {4e-3, 1, 0.2, 0, 0};
+    const atmos__beams_fog fog = {4e-3, 1, 0.2, 0, 0, NULL};
     const double o[3] = {0, 5, 0};
     double worst = 0, lost = 0;
     int shadowed = 0;

@@ -276,7 +276,12 @@ static const bad_case bad_lights[] = {
     {"{\"fog\": {\"extinction_per_m\": 0}}", ATMOS_E_INVALID_ARG, "/fog/extinction_per_m: must be in (0, 10]", NULL},
     {"{\"fog\": {\"extinction_per_m\": 0.1, \"scattering_per_m\": 0.2}}", ATMOS_E_INVALID_ARG, "/fog/scattering_per_m: must be in [0, 0.1] (at most the extinction)", NULL},
     {"{\"fog\": {\"extinction_per_m\": 0.1, \"g\": 1}}", ATMOS_E_INVALID_ARG, "/fog/g: must be in (-1, 1)", NULL},
-    {"{\"fog\": {\"g\": 0.5}}", ATMOS_E_INVALID_ARG, "/fog: needs \"extinction_per_m\"", NULL},
+    {"{\"fog\": {\"g\": 0.5}}", ATMOS_E_INVALID_ARG, "/fog: needs one of \"extinction_per_m\" and \"visibility_m\"", NULL},
+    {"{\"fog\": {\"extinction_per_m\": 0.1, \"visibility_m\": 100}}", ATMOS_E_INVALID_ARG, "/fog: needs one of \"extinction_per_m\" and \"visibility_m\"", NULL},
+    {"{\"fog\": {\"visibility_m\": 0.1}}", ATMOS_E_INVALID_ARG, "/fog/visibility_m: must be in [0.3912, 10000000] (metres)", NULL},
+    {"{\"fog\": {\"visibility_m\": 100, \"particle\": \"cloud\", \"g\": 0.5}}", ATMOS_E_INVALID_ARG, "/fog: a fog of a particle type takes its albedo and phase function from the type", NULL},
+    {"{\"fog\": {\"visibility_m\": 100, \"particle\": \"smog\"}}", ATMOS_E_INVALID_ARG, "/fog/particle: 'smog' is neither in the scene's \"particles\" nor a preset", NULL},
+    {"{\"fog\": {\"visibility_m\": 100, \"particle\": \"\"}}", ATMOS_E_INVALID_ARG, "/fog/particle: must name a particle type", NULL},
     {"{\"objects\": [{\"position_m\": [0, 0, 0]}]}", ATMOS_E_INVALID_ARG, "/objects/0: needs \"mesh\" or \"terrain\"", NULL},
     {"{\"objects\": [{\"mesh\": \"builtin:teapot\"}]}", ATMOS_E_INVALID_ARG, "/objects/0: mesh \"builtin:teapot\" is no built-in", NULL},
     {"{\"objects\": [{\"mesh\": \"builtin:box\", \"scale\": [1, 0, 1]}]}", ATMOS_E_INVALID_ARG, "/objects/0/scale/1: must not be zero", NULL},
@@ -464,6 +469,13 @@ static void test_lights(void)
     CHECK(b->type == ATMOS_LIGHT_POINT && b->intensity_w_sr == 100 && b->range_m == 100 && b->colour[1] == 0.5 &&
           b->colour_temperature_k == 0);
     CHECK(s.fog.enabled && s.fog.extinction_per_m == 0.05 && s.fog.scattering_per_m == 0.05 && s.fog.g == 0.3);
+    /* visibility (Koschmieder: 3.912 / V at 550 nm) and a fog of a particle type */
+    atmos_scene v;
+    atmos_scene_defaults(&v);
+    CHECK_OK(parse("{\"fog\": {\"visibility_m\": 391.2, \"particle\": \"cloud\"}}", &v));
+    CHECK(v.fog.enabled && fabs(v.fog.extinction_per_m - 0.01) < 1e-12 && !strcmp(v.fog.particle, "cloud") &&
+          v.fog.visibility_m == 391.2);
+    CHECK_OK(atmos_scene_validate(ctx, &v, "scene"));
     const atmos_scene_object *o = &s.objects[0];
     CHECK(!strcmp(o->mesh, "builtin:sphere") && o->position_m[1] == 5 && o->scale[0] == 2 && o->scale[2] == 2 &&
           o->albedo[2] == 0.6 && o->rotation_deg[1] == 45);
