@@ -106,6 +106,9 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t);
 int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full);
 /* The spot's falloff alone at o + t d (1 for a point light). */
 double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t);
+/* The sum of the falloff at the m points t = ta + (s + o) step, s = 0 .. m - 1 (one tight loop:
+ * the same values as m calls of atmos__beams_ray_falloff, added in order). */
+double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m);
 
 struct atmos__beams_plan {
     atmos__objects obj;                      /* the meshes and their albedos */

@@ -152,7 +152,7 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
             continue;
         }
         if (uniform) /* lit all along: the falloff alone varies */
-            for (int s = 0; s < m; s++) h += atmos__beams_ray_falloff(&ray, ta + (s + o) * step);
+            h = atmos__beams_ray_falloff_sum(&ray, ta, step, o, m);
         else
             for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + o) * step);
         sum += h / m * fl;

@@ -285,6 +285,29 @@ double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
     return s * s * (3 - 2 * s);
 }
 
+double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m)
+{
+    const atmos__beams_light *l = r->l;
+    if (l->L.type != ATMOS_LIGHT_SPOT) return m;
+    /* branch-free, so that the loop vectorises: the cosine off the axis clamped into the edge
+     * (below the outer cone 0, inside the inner 1: the smoothstep's own values there) */
+    const double co = l->L.cos_outer, inv = 1 / (l->L.cos_inner - l->L.cos_outer);
+    double sum = 0, f[64];
+    for (int s0 = 0; s0 < m; s0 += 64) {
+        const int n = m - s0 < 64 ? m - s0 : 64;
+        for (int s = 0; s < n; s++) { /* vectorised: no reduction here */
+            const double t = ta + (s0 + s + o) * step;
+            const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
+            double q = (z / sqrt(w2 > 1e-300 ? w2 : 1e-300) - co) * inv;
+            q = q < 0 ? 0 : q;
+            q = q > 1 ? 1 : q;
+            f[s] = q * q * (3 - 2 * q);
+        }
+        for (int s = 0; s < n; s++) sum += f[s]; /* in order */
+    }
+    return sum;
+}
+
 double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
