@@ -2,7 +2,9 @@
 # Relative paths of a scene read from standard input (`atmos render -`) are relative to the
 # current folder (a scene file's are relative to its folder): a spot's window image found
 # there renders; one that is not there is an error naming the scene key and the file, and
-# saying where it was looked for; `atmos render --help` says so.
+# saying where it was looked for; `atmos render --help` says so. A file given with -D
+# (-D lights.0.image=win.png) is relative to the current folder too, whatever the scene
+# file's folder.
 . "$(dirname "$0")/common.inc"
 S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
 mkdir -p "$T/here" "$T/elsewhere" || exit 1
@@ -21,6 +23,17 @@ if [ $rc -eq 1 ] && grep -q "/lights/0/image: win.png: .*current folder" "$T/no.
 else
     bad "missing image (exit $rc): $(cat "$T/no.err")"
 fi
+
+# -D KEY=FILE names FILE from the current folder, not from the scene file's folder
+cp "$T/scene.json" "$T/elsewhere/scene.json" || exit 1
+(cd "$T/here" && "$A" render "$T/elsewhere/scene.json" -D lights.0.image=win.png --width 24 --height 16 -q \
+    -o "$T/d.png" 2>"$T/d.err") && [ -s "$T/d.png" ] && ok "-D lights.0.image=FILE from the current folder" ||
+    bad "-D image from here: $(cat "$T/d.err")"
+(cd "$T/elsewhere" && "$A" render "$T/elsewhere/scene.json" -D 'lights.0.image="win.png"' --width 24 --height 16 \
+    -q -o "$T/d2.png" 2>"$T/d2.err")
+rc=$?
+if [ $rc -ne 0 ] && grep -q "$T/elsewhere/win.png" "$T/d2.err"; then ok "a -D file missing from the current folder is named with it"
+else bad "-D missing image (exit $rc): $(cat "$T/d2.err")"; fi
 
 "$A" render --help >"$T/help.txt"
 grep -q "standard input.*current folder\|current folder.*standard input" "$T/help.txt" &&

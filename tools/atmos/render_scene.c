@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static int ends_with(const char *s, const char *ext)
 {
@@ -54,13 +55,56 @@ static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos
     return ATMOS_OK;
 }
 
+/* Writes "KEY=\"VALUE\"" into buf with VALUE's quotes and backslashes escaped for JSON. */
+static void quoted_define(char *buf, size_t cap, const char *key, size_t klen, const char *value)
+{
+    size_t k = (size_t)snprintf(buf, cap, "%.*s=\"", (int)klen, key);
+    for (const char *p = value; *p && k + 3 < cap; p++) {
+        if (*p == '"' || *p == '\\') buf[k++] = '\\';
+        buf[k++] = *p;
+    }
+    snprintf(buf + k, cap - k, "\"");
+}
+
+/* A -D that sets a file (volume.file, a light's image, an object's mesh or terrain, the Earth's
+ * maps) to a relative path names it from the current folder, as a path typed on the command
+ * line does everywhere, not from the scene file's folder: the path is made absolute here
+ * (realpath when it exists). Others, "data:", "builtin:", "generate:" and "simulate:" values
+ * are kept. Returns def itself or buf. */
+static const char *cwd_define(const char *def, char *buf, size_t cap)
+{
+    static const char *const keys[] = {"file", "image", "mesh", "terrain", "ground_map", "night_lights", "world_file"};
+    const char *eq = strchr(def, '=');
+    if (!eq) return def;
+    const char *last = eq;
+    while (last > def && last[-1] != '.' && last[-1] != '/') last--;
+    int path_key = 0;
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
+        path_key |= (size_t)(eq - last) == strlen(keys[i]) && !strncmp(last, keys[i], strlen(keys[i]));
+    char value[ATMOS_SCENE_PATH_MAX];
+    const char *v = eq + 1;
+    size_t n = strlen(v);
+    if (n >= 2 && v[0] == '"' && v[n - 1] == '"' && !memchr(v + 1, '\\', n - 2)) v++, n -= 2;
+    if (!path_key || n == 0 || n >= sizeof value || v[0] == '/' || v[0] == '"' || strchr(v, ':')) return def;
+    memcpy(value, v, n);
+    value[n] = 0;
+    char *abs = realpath(value, NULL), cwd[ATMOS_SCENE_PATH_MAX], joined[2 * ATMOS_SCENE_PATH_MAX];
+    if (!abs && getcwd(cwd, sizeof cwd)) snprintf(joined, sizeof joined, "%s/%s", cwd, value);
+    else snprintf(joined, sizeof joined, "%s", abs ? abs : value);
+    free(abs);
+    quoted_define(buf, cap, def, (size_t)(eq - def), joined);
+    return buf;
+}
+
 /* -D volume.KEY=VALUE with --volume SOURCE: the scene's "volume" is read from the JSON tree
  * before --volume applies, so without a source there it would be refused ("needs file,
  * generate or simulate") and a source of another kind would make the key wrong. The source
  * goes first as a -D of its own (a file as an absolute path: the scene file's folder does not
- * apply to a command-line path), the user's -D after it. defs: room for ndefines + 1; buf:
- * the source's define. Returns the count. */
-static int volume_defines(const render_opts *o, const char **defs, char *buf, size_t cap)
+ * apply to a command-line path), the user's -D after it (a relative file made absolute,
+ * cwd_define, into paths[i]). defs: room for ndefines + 1; buf: the source's define. Returns
+ * the count. */
+static int volume_defines(const render_opts *o, const char **defs, char *buf, size_t cap,
+                          char (*paths)[ATMOS_SCENE_PATH_MAX * 2 + 64])
 {
     int touches = 0;
     for (int i = 0; i < o->ndefines; i++)
@@ -73,18 +117,12 @@ static int volume_defines(const render_opts *o, const char **defs, char *buf, si
             snprintf(buf, cap, "volume.simulate={\"preset\": \"%s\"}", o->volume + 9);
         } else {
             char *abs = realpath(o->volume, NULL);
-            const char *p = abs ? abs : o->volume;
-            size_t k = (size_t)snprintf(buf, cap, "volume.file=\"");
-            for (; *p && k + 3 < cap; p++) {
-                if (*p == '"' || *p == '\\') buf[k++] = '\\';
-                buf[k++] = *p;
-            }
-            snprintf(buf + k, cap - k, "\"");
+            quoted_define(buf, cap, "volume.file", 11, abs ? abs : o->volume);
             free(abs);
         }
         defs[n++] = buf;
     }
-    for (int i = 0; i < o->ndefines; i++) defs[n++] = o->defines[i];
+    for (int i = 0; i < o->ndefines; i++) defs[n++] = cwd_define(o->defines[i], paths[i], sizeof paths[i]);
     return n;
 }
 
@@ -94,7 +132,8 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     *volume = NULL;
     const char *defs[RENDER_OPTS_MAX_DEFINES + 1];
     char source_def[ATMOS_SCENE_PATH_MAX + 64];
-    const int ndefs = volume_defines(o, defs, source_def, sizeof source_def);
+    static char paths[RENDER_OPTS_MAX_DEFINES][ATMOS_SCENE_PATH_MAX * 2 + 64]; /* one command's defines */
+    const int ndefs = volume_defines(o, defs, source_def, sizeof source_def, paths);
     if (o->scene_path) {
         if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
             fprintf(stderr,
