@@ -120,12 +120,26 @@ double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3])
                   atmos__dot3(p, s->fwd) - s->bias);
 }
 
+double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], const double p[3])
+{
+    if (!(f->height_m > 0)) return 0; /* a uniform fog has no top: lit as it is */
+    if (!(sun[1] > 0)) return INFINITY;
+    return f->sigma0 * exp(-(p[1] - f->base_m) / f->height_m) * f->height_m / sun[1];
+}
+
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
                                  const double d[3], double T, double epsilon, int max_steps)
 {
     double A, k;
     fog_line(f, o, d, &A, &k);
-    const double whole = -expm1(-line_tau(A, k, T)); /* 1 - exp(-tau(T)) */
+    /* the sunlight at t is dimmed by C exp(-k t), C its optical depth in at the eye: with the
+     * eye's optical depth tau as the variable (d tau = sigma dt, exp(-k t) = 1 - k tau / A) the
+     * integrand is exp(-C) exp(-gamma tau), gamma = 1 - d_y / sun_y (1 in uniform fog) */
+    const double C = atmos__beams_sun_fog_in(f, s->dir, o);
+    if (!(C < 700)) return 0;
+    const double gamma = f->height_m > 0 ? 1 - d[1] / s->dir[1] : 1, tauT = line_tau(A, k, T);
+    const int flat = !(fabs(gamma * tauT) > 1e-9);
+    const double whole = flat ? tauT : -expm1(-gamma * tauT) / gamma; /* int_0^tau(T) exp(-gamma tau) */
     if (!(whole > 0)) return 0;
     int n = (int)ceil(1 / fmax(epsilon, 1e-9));
     n = n < 1 ? 1 : n > max_steps ? max_steps : n;
@@ -135,10 +149,11 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
     const double x0 = (atmos__dot3(o, s->right) - s->u0) / s->texel - 0.5, x1 = atmos__dot3(d, s->right) / s->texel;
     const double y0 = (atmos__dot3(o, s->up) - s->v0) / s->texel - 0.5, y1 = atmos__dot3(d, s->up) / s->texel;
     const double z0 = atmos__dot3(o, s->fwd) - s->bias, z1 = atmos__dot3(d, s->fwd);
-    for (int i = 0; s->n && i < n; i++) { /* step i: exp(-tau) from 1 - i whole / n to 1 - (i + 1) whole / n */
-        const double tm = fmin(T, line_t(A, k, -log1p(-(i + 0.5) * whole / n)));
+    for (int i = 0; s->n && i < n; i++) { /* step i: from i whole / n to (i + 1) whole / n of the integral */
+        const double q = (i + 0.5) * whole / n, tau = flat ? q : -log1p(-gamma * q) / gamma;
+        const double tm = fmin(T, line_t(A, k, tau));
         sum += tm < INFINITY ? lookup(s, x0 + tm * x1, y0 + tm * y1, z0 + tm * z1) : 1;
     }
     const double c = atmos__dot3(s->dir, d);
-    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos__beams_hg(f->g, c)) * whole * sum / n;
+    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos__beams_hg(f->g, c)) * exp(-C) * whole * sum / n;
 }

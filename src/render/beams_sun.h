@@ -2,12 +2,14 @@
  * an orthographic shadow map over the scene's objects (terrain), the sunlight of the
  * atmosphere at the eye, and the fog's optical depth along a ray (uniform, or falling off
  * exponentially with height). For a directional light the scattering angle is the same all
- * along a ray, and with the sunlight not dimmed by the fog on its way in, the single
- * scattering between t_a and t_b is a closed form for any fog profile:
- *     int sigma_s(t) p E exp(-tau(t)) dt = omega p E [exp(-tau(t_a)) - exp(-tau(t_b))],
- * omega = sigma_s / sigma_t; the ray is cut into steps of equal share of that integral (each at
- * most epsilon of the whole, Dobashi's criterion) and the visibility H sampled once a step.
- * Not part of the API. */
+ * along a ray. A height-dependent fog dims the sunlight on its way in by its layer above the
+ * point, C(t) = sigma(t) H / sun_y (a uniform fog has no top and is lit undimmed: C = 0); with
+ * the eye's optical depth tau as the variable, C(t) = C(0) (1 - gamma' tau) and the single
+ * scattering is a closed form:
+ *     int sigma_s p E exp(-tau - C) dt = omega p E exp(-C(0)) int exp(-gamma tau) d tau,
+ * gamma = 1 - d_y / sun_y, omega = sigma_s / sigma_t; the ray is cut into steps of equal share
+ * of that integral (each at most epsilon of the whole, Dobashi's criterion) and the visibility
+ * H sampled once a step. Not part of the API. */
 #ifndef ATMOS_RENDER_BEAMS_SUN_H
 #define ATMOS_RENDER_BEAMS_SUN_H
 
@@ -46,6 +48,10 @@ double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3])
  * at its middle (in optical depth). */
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
                                  const double d[3], double T, double epsilon, int max_steps);
+/* The fog's optical depth between p and the sun (unit sun, toward it): a height-dependent
+ * fog's layer above p, sigma(p) H / sun_y (INFINITY with the sun below the horizon); 0 in a
+ * uniform fog (it has no top, and is lit undimmed). */
+double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], const double p[3]);
 /* The Henyey-Greenstein phase function at cos theta. */
 double atmos__beams_hg(double g, double cos_theta);
 
