@@ -107,12 +107,15 @@ static atmos_status cumulus_field(gen_job *job)
     double lo[3] = {-half, base - 40 * s, -half}, hi[3] = {half, base + 1500 * s, half};
     atmos_status st = atmos__gen_grid_init(job, lo, hi);
     if (st != ATMOS_OK) return st;
-    /* Dart throwing: up to 16 fair-weather cumuli, diameters 300..1300 m (small ones
-     * more frequent), kept apart by 0.6 x the sum of their diameters. */
-    double cx[16], cz[16], cw[16];
+    /* Dart throwing: up to NF fair-weather cumuli, diameters from a power law n(w) ~ w^-1.7
+     * (the cloud size density of shallow cumulus, Neggers et al. 2003) over 250..1600 m, kept
+     * apart by 0.6 x the sum of their diameters. */
+    enum { NF = 64 };
+    double cx[NF], cz[NF], cw[NF];
     int n = 0;
-    for (int attempt = 0; attempt < 400 && n < 16; attempt++) {
-        double w = (300 + 1000 * pow(gen_u01(&job->rng), 2)) * s;
+    const double b = 1.7, w0 = pow(250, 1 - b), w1 = pow(1600, 1 - b);
+    for (int attempt = 0; attempt < 3000 && n < NF; attempt++) {
+        double w = pow(w0 + gen_u01(&job->rng) * (w1 - w0), 1 / (1 - b)) * s;
         double lim = half - 0.7 * w - 300 * s;
         double x = gen_range(&job->rng, -lim, lim), z = gen_range(&job->rng, -lim, lim);
         int ok = 1;
