@@ -29,7 +29,8 @@ typedef struct atmos_cloud_columns {
     float *top_m;  /* the same counted from above */
 } atmos_cloud_columns;
 
-/* Allocates the three arrays (tau 0, bases and tops NAN). */
+/* Allocates the three arrays (tau 0, bases and tops NAN); 1..65536 pixels a side, at most 2^30
+ * in all. */
 ATMOS_API atmos_status atmos_cloud_columns_create(atmos_context *ctx, int nx, int ny, double dx_m,
                                                   atmos_cloud_columns *out);
 ATMOS_API void atmos_cloud_columns_free(atmos_cloud_columns *c);

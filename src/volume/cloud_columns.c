@@ -11,9 +11,10 @@ atmos_status atmos_cloud_columns_create(atmos_context *ctx, int nx, int ny, doub
 {
     if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud columns: no output");
     memset(out, 0, sizeof *out);
-    if (nx < 1 || ny < 1 || nx > 65536 || ny > 65536 || !(dx_m > 0 && isfinite(dx_m)))
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud columns: %d x %d pixels of %g m (expected 1..65536 pixels of > 0 m)",
-                            nx, ny, dx_m);
+    if (nx < 1 || ny < 1 || nx > 65536 || ny > 65536 || (long long)nx * ny > (1LL << 30) || !(dx_m > 0 && isfinite(dx_m)))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "cloud columns: %d x %d pixels of %g m (expected 1..65536 a side, at most 2^30 in all, of > 0 m)", nx,
+                            ny, dx_m);
     size_t n = (size_t)nx * ny;
     out->tau = calloc(n, sizeof *out->tau);
     out->base_m = malloc(n * sizeof *out->base_m);

@@ -148,7 +148,8 @@ atmos_status atmos_cloud_stats_measure(atmos_context *ctx, const atmos_cloud_col
 {
     if (!out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud stats: no output");
     memset(out, 0, sizeof *out);
-    if (!cols || !cols->tau || !cols->base_m || !cols->top_m || cols->nx < 1 || cols->ny < 1 || !(cols->dx_m > 0))
+    if (!cols || !cols->tau || !cols->base_m || !cols->top_m || cols->nx < 1 || cols->ny < 1 ||
+        (long long)cols->nx * cols->ny > (1LL << 30) || !(cols->dx_m > 0))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud stats: no columns");
     atmos_cloud_stats_desc d = desc ? *desc : (atmos_cloud_stats_desc){0};
     if (d.tau_threshold == 0) d.tau_threshold = 1;

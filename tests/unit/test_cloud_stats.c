@@ -238,6 +238,7 @@ static void test_bad_input(void)
     atmos_cloud_columns c;
     CHECK(atmos_cloud_columns_create(ctx, 0, 10, 1, &c) == ATMOS_E_INVALID_ARG);
     CHECK(atmos_cloud_columns_create(ctx, 10, 10, NAN, &c) == ATMOS_E_INVALID_ARG);
+    CHECK(atmos_cloud_columns_create(ctx, 65536, 65536, 1, &c) == ATMOS_E_INVALID_ARG);
     CHECK_OK(atmos_cloud_columns_create(ctx, 10, 10, 1, &c));
     atmos_cloud_stats s;
     atmos_cloud_stats_desc d = {.tau_threshold = -1};

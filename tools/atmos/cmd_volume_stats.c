@@ -127,7 +127,7 @@ static atmos_status load_source(atmos_context *ctx, const opts *o, const char *s
 static int cross_sections(atmos_context *ctx, const opts *o, const atmos_volume *v, const char *src, double *sigma)
 {
     int used = 0;
-    for (int f = 0; f < atmos_volume_field_count(v) && f < 16; f++) {
+    for (int f = 0; f < atmos_volume_field_count(v) && f < ATMOS_VOLUME_MAX_FIELDS; f++) {
         sigma[f] = 0;
         if (o->field && strcmp(o->field, atmos_volume_field_name(v, f))) continue;
         atmos_particle_desc p;
@@ -197,7 +197,7 @@ static int measure(atmos_context *ctx, const opts *o, const char *src, uint64_t 
     atmos_volume *v = NULL;
     atmos_status st = load_source(ctx, o, src, seed, &v);
     if (st != ATMOS_OK) return cli_runtime_error(C, ctx, st);
-    double sigma[16];
+    double sigma[ATMOS_VOLUME_MAX_FIELDS];
     if (cross_sections(ctx, o, v, src, sigma)) {
         atmos_volume_destroy(v);
         return CLI_EXIT_RUNTIME;
