@@ -31,5 +31,6 @@
 #include "atmos/plan.h"
 #include "atmos/mesh.h"
 #include "atmos/sim.h"
+#include "atmos/cloudstats.h"
 
 #endif

@@ -107,21 +107,33 @@ static atmos_status cumulus_field(gen_job *job)
     double lo[3] = {-half, base - 40 * s, -half}, hi[3] = {half, base + 1500 * s, half};
     atmos_status st = atmos__gen_grid_init(job, lo, hi);
     if (st != ATMOS_OK) return st;
-    /* Dart throwing: up to 16 fair-weather cumuli, diameters 300..1300 m (small ones
-     * more frequent), kept apart by 0.6 x the sum of their diameters. */
-    double cx[16], cz[16], cw[16];
+    /* NF fair-weather cumuli, diameters drawn from a power law n(w) ~ w^-1.7 (the cloud size
+     * density of shallow cumulus, Neggers et al. 2003) over 250..1600 m, then placed largest
+     * first by dart throwing, kept apart by 0.6 x the sum of their diameters (a cloud that finds
+     * no place in 200 throws is left out: drawing a new size instead would favour small ones). */
+    enum { NF = 64 };
+    double cx[NF], cz[NF], cw[NF], wd[NF];
+    const double b = 1.7, w0 = pow(250, 1 - b), w1 = pow(1600, 1 - b);
+    for (int m = 0; m < NF; m++) wd[m] = pow(w0 + gen_u01(&job->rng) * (w1 - w0), 1 / (1 - b)) * s;
+    for (int m = 1; m < NF; m++) /* largest first (insertion sort) */
+        for (int q = m; q > 0 && wd[q] > wd[q - 1]; q--) {
+            double t = wd[q];
+            wd[q] = wd[q - 1], wd[q - 1] = t;
+        }
     int n = 0;
-    for (int attempt = 0; attempt < 400 && n < 16; attempt++) {
-        double w = (300 + 1000 * pow(gen_u01(&job->rng), 2)) * s;
-        double lim = half - 0.7 * w - 300 * s;
-        double x = gen_range(&job->rng, -lim, lim), z = gen_range(&job->rng, -lim, lim);
-        int ok = 1;
-        for (int m = 0; m < n && ok; m++)
-            if (hypot(x - cx[m], z - cz[m]) < 0.6 * (w + cw[m])) ok = 0;
-        if (!ok) continue;
-        cx[n] = x, cz[n] = z, cw[n] = w;
-        if (!cumulus_balls(job, &job->balls, x, z, base, w)) return nomem(job);
-        n++;
+    for (int m = 0; m < NF; m++) {
+        double w = wd[m], lim = half - 0.7 * w - 300 * s;
+        for (int attempt = 0; attempt < 200; attempt++) {
+            double x = gen_range(&job->rng, -lim, lim), z = gen_range(&job->rng, -lim, lim);
+            int ok = 1;
+            for (int q = 0; q < n && ok; q++)
+                if (hypot(x - cx[q], z - cz[q]) < 0.6 * (w + cw[q])) ok = 0;
+            if (!ok) continue;
+            cx[n] = x, cz[n] = z, cw[n] = w;
+            if (!cumulus_balls(job, &job->balls, x, z, base, w)) return nomem(job);
+            n++;
+            break;
+        }
     }
     atmos__gen_accumulate(&job->grid[0], &job->balls, 0, job->threads);
     int fj = atmos__gen_floor_j(job, base);

@@ -77,6 +77,11 @@ int cli_cmd_phase(int argc, char **argv);
 int cli_cmd_cache(int argc, char **argv);
 int cli_cmd_mie(int argc, char **argv);
 int cli_cmd_volume(int argc, char **argv);
+/* atmos volume's help, and its stats subcommand (cmd_volume_stats.c) with its parts of the help */
+void cli_volume_help(void);
+int cli_cmd_volume_stats(int argc, char **argv);
+void cli_volume_stats_usage(void);
+void cli_volume_stats_help(void);
 int cli_cmd_simulate(int argc, char **argv);
 int cli_cmd_compare(int argc, char **argv);
 int cli_cmd_view(int argc, char **argv); /* tools/view/ */

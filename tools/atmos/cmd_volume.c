@@ -11,12 +11,14 @@
 
 static const char *C = "volume";
 
-static void help(void)
+void cli_volume_help(void)
 {
     printf("Usage: atmos volume info FILE [--json] [reading options]\n"
            "       atmos volume generate PRESET -o NAME.json [--seed N] [--voxel-size M] [--scale S] [--threads T]\n"
            "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png [reading options]\n"
-           "       atmos volume clouds SCENE.json -o NAME.json [--centre X,Z] [--half-width M] [--voxel-size M]\n\n"
+           "       atmos volume clouds SCENE.json -o NAME.json [--centre X,Z] [--half-width M] [--voxel-size M]\n");
+    cli_volume_stats_usage();
+    printf("\n"
            "  info      fields, dimensions, world-space bounds (metres, after the grid transform), value\n"
            "            ranges (number densities, m^-3), active voxels and memory of a volume file\n"
            "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
@@ -36,7 +38,9 @@ static void help(void)
            "            a raw + JSON volume of \"cloud\" particles with the same optical depths, in the\n"
            "            world frame (x east, y up, z south at the scene's latitude/longitude): a box\n"
            "            2 M wide around (X, Z) (default 0,0; half width 20000 m) from the layer's base to\n"
-           "            its top, voxels of --voxel-size metres (default 500).\n\n"
+           "            its top, voxels of --voxel-size metres (default 500).\n");
+    cli_volume_stats_help();
+    printf("\n"
            "Reading options (info, slice):\n"
            "  --grids LIST      VDB/NanoVDB grids or NetCDF variables to read (comma-separated)\n"
            "  --as NAME         field name for a single-grid file (default cloud)\n"
@@ -120,7 +124,7 @@ static int cmd_info(int argc, char **argv)
     memset(&ld, 0, sizeof ld);
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            help();
+            cli_volume_help();
             return CLI_EXIT_OK;
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
@@ -216,7 +220,7 @@ static int cmd_generate(int argc, char **argv)
     int threads = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            help();
+            cli_volume_help();
             return CLI_EXIT_OK;
         } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
             out = argv[++i];
@@ -270,7 +274,7 @@ static int cmd_slice(int argc, char **argv)
     memset(&ld, 0, sizeof ld);
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            help();
+            cli_volume_help();
             return CLI_EXIT_OK;
         } else if ((lo = load_option(argc, argv, &i, &ld)) != 0) {
             if (lo < 0) return CLI_EXIT_USAGE;
@@ -360,7 +364,7 @@ static int cmd_clouds(int argc, char **argv)
     double centre[2] = {0, 0}, half = 20000, voxel = 500;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            help();
+            cli_volume_help();
             return CLI_EXIT_OK;
         } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
             out = argv[++i];
@@ -407,15 +411,16 @@ static int cmd_clouds(int argc, char **argv)
 
 int cli_cmd_volume(int argc, char **argv)
 {
-    if (argc < 2) return cli_usage_error(C, "expected a subcommand: info, generate, slice or clouds");
+    if (argc < 2) return cli_usage_error(C, "expected a subcommand: info, generate, slice, clouds or stats");
     const char *sub = argv[1];
     if (!strcmp(sub, "--help") || !strcmp(sub, "-h")) {
-        help();
+        cli_volume_help();
         return CLI_EXIT_OK;
     }
     if (!strcmp(sub, "info")) return cmd_info(argc - 1, argv + 1);
     if (!strcmp(sub, "generate")) return cmd_generate(argc - 1, argv + 1);
     if (!strcmp(sub, "slice")) return cmd_slice(argc - 1, argv + 1);
     if (!strcmp(sub, "clouds")) return cmd_clouds(argc - 1, argv + 1);
-    return cli_usage_error(C, "unknown subcommand '%s' (info, generate, slice, clouds)", sub);
+    if (!strcmp(sub, "stats")) return cli_cmd_volume_stats(argc - 1, argv + 1);
+    return cli_usage_error(C, "unknown subcommand '%s' (info, generate, slice, clouds, stats)", sub);
 }

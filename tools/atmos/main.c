@@ -18,7 +18,7 @@ static const command commands[] = {
     {"phase", cli_cmd_phase, "particle phase functions: list presets, print or plot a table"},
     {"cache", cli_cmd_cache, "the table cache: 'atmos cache path', 'atmos cache clear'"},
     {"mie", cli_cmd_mie, "Mie efficiencies and amplitudes of one sphere"},
-    {"volume", cli_cmd_volume, "inspect, generate and slice cloud volumes"},
+    {"volume", cli_cmd_volume, "inspect, generate, slice and measure cloud volumes"},
     {"simulate", cli_cmd_simulate, "grow clouds in a cloud-physics simulation, written as a volume"},
     {"compare", cli_cmd_compare, "error statistics of an HDR image against a reference"},
     {"view", cli_cmd_view, "the interactive viewer: fly around a scene, move the sun (SDL2 window)"},

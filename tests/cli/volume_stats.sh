@@ -1,0 +1,65 @@
+#!/bin/sh
+# atmos volume stats: the shape statistics of a raw volume with three known discs of cloud
+# (count, fraction, areas in the per-cloud CSV), --kv keys, the mask PNG, a generated preset
+# measured from its file and from generate: alike, and usage and runtime errors.
+. "$(dirname "$0")/common.inc"
+
+# 64 x 6 x 64 voxels of 100 m: discs of radius 5, 8 and 12 voxels, cloud in layers 1..3
+python3 - "$T" <<'PY' || bad "writing the test volume"
+import json, struct, sys
+t = sys.argv[1]
+nx, ny, nz = 64, 6, 64
+discs = [(12.3, 14.2, 5), (40.1, 15.6, 8), (30.4, 44.8, 12)]
+v = [0.0] * (nx * ny * nz)
+cols = 0
+for k in range(nz):
+    for i in range(nx):
+        if any((i - x) ** 2 + (k - z) ** 2 <= r * r for x, z, r in discs):
+            cols += 1
+            for j in (1, 2, 3):
+                v[(k * ny + j) * nx + i] = 1e8
+open(t + "/d.cloud.raw", "wb").write(struct.pack("<%df" % len(v), *v))
+json.dump({"dims": [nx, ny, nz], "voxel_size_m": 100, "origin_m": [0, 0, 0],
+           "fields": [{"name": "cloud", "particle": "cloud", "file": "d.cloud.raw"}]}, open(t + "/d.json", "w"))
+open(t + "/cols", "w").write(str(cols))
+PY
+"$A" volume stats "$T/d.json" --kv --csv "$T/d.csv" --mask-png "$T/d.png" >"$T/kv" 2>"$T/err" || bad "stats of the disc volume: $(cat "$T/err")"
+kv() { sed -n "s/^$1=//p" "$T/kv"; }
+[ "$(kv clouds)" = 3 ] && ok "three clouds" || bad "clouds=$(kv clouds), expected 3"
+[ "$(kv edge_clouds)" = 0 ] && [ "$(kv connectivity)" = 4 ] && [ "$(kv threshold_tau)" = 1 ] && ok "defaults reported" ||
+    bad "edge clouds, connectivity or threshold wrong"
+python3 - "$T" <<'PY' && ok "fraction, areas and D of the discs" || bad "fraction, areas or D of the discs"
+import csv, math, sys
+t = sys.argv[1]
+kv = dict(l.strip().split("=", 1) for l in open(t + "/kv"))
+cols = int(open(t + "/cols").read())
+assert abs(float(kv["cloud_fraction"]) - cols / 4096) < 1e-6, kv["cloud_fraction"]
+rows = list(csv.DictReader(open(t + "/d.csv")))
+assert len(rows) == 3
+areas = sorted(float(r["area_m2"]) for r in rows)
+for a, r in zip(areas, (5, 8, 12)):
+    h = math.sqrt(0.5)
+    assert math.pi * (r - h) ** 2 * 1e4 <= a <= math.pi * (r + h) ** 2 * 1e4, (a, r)
+assert abs(float(kv["D"]) - 1) < 0.1, kv["D"]
+for r in rows:
+    assert abs(float(r["base_m"]) - (100 + 100 * 0.1 / 6.28)) < 0.5 and float(r["base_sd_m"]) < 1e-3, r
+PY
+head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "the mask is not a PNG"
+"$A" volume stats "$T/d.json" | grep -q "perimeter-area dimension D" && ok "readable summary" || bad "summary"
+
+# a generated preset: from its file and from generate: alike
+"$A" volume generate cumulus_field -o "$T/g.json" >/dev/null 2>&1 || bad "generate"
+"$A" volume stats "$T/g.json" --kv >"$T/g1" 2>&1 && "$A" volume stats generate:cumulus_field --kv >"$T/g2" 2>&1 &&
+    cmp -s "$T/g1" "$T/g2" && ok "a file and generate: give the same statistics" || bad "file and generate: differ"
+
+# errors
+"$A" volume stats >/dev/null 2>&1; [ $? -eq 2 ] && ok "no source: usage error" || bad "no source"
+"$A" volume stats "$T/d.json" --threshold -1 >/dev/null 2>&1; [ $? -eq 2 ] && ok "negative threshold" || bad "negative threshold"
+"$A" volume stats "$T/d.json" --connectivity 6 >/dev/null 2>&1; [ $? -eq 2 ] && ok "connectivity 6" || bad "connectivity 6"
+"$A" volume stats "$T/d.json" --size-range 5,2 >/dev/null 2>&1; [ $? -eq 2 ] && ok "bad size range" || bad "bad size range"
+"$A" volume stats "$T/none.json" >/dev/null 2>&1; [ $? -eq 1 ] && ok "missing file: runtime error" || bad "missing file"
+"$A" volume stats generate:nope >/dev/null 2>"$T/e"; [ $? -eq 1 ] && grep -q cumulus "$T/e" && ok "unknown preset named with the known ones" ||
+    bad "unknown preset: $(cat "$T/e")"
+"$A" volume stats "$T/d.json" --field rain >/dev/null 2>"$T/e"; [ $? -eq 1 ] && grep -q "no field" "$T/e" && ok "--field rain: no such field" ||
+    bad "--field rain"
+exit $fail
