@@ -272,7 +272,7 @@ int atmos__aerial_single_profile(const atmos__aerial *ap, const double d[3], dou
     const float *base = ap->tab + (size_t)iv * row + (size_t)iu * node;
     const float *cn[4] = {base, base + node, base + row, base + row + node};
     const double w[4] = {(1 - wu) * (1 - wv), wu * (1 - wv), (1 - wu) * wv, wu * wv};
-    double ph[ATMOS_MAX_WAVELENGTHS][2];
+    float ph[ATMOS_MAX_WAVELENGTHS][2];
     if (ap->split) {
         const double nu = atmos__dot3(d, g->sun);
         double fp = sqrt(fmax(0.0, 0.5 * (1.0 - nu))) * (AP_NPH - 1);
@@ -281,8 +281,8 @@ int atmos__aerial_single_profile(const atmos__aerial *ap, const double d[3], dou
         fp -= ip;
         for (int k = 0; k < n; k++) {
             const float *mp = ap->mie + k * AP_NPH + ip;
-            ph[k][0] = atmos__planet_rayleigh_phase(ap->atm->planet, k, nu);
-            ph[k][1] = mp[0] + fp * (mp[1] - mp[0]);
+            ph[k][0] = (float)atmos__planet_rayleigh_phase(ap->atm->planet, k, nu);
+            ph[k][1] = (float)(mp[0] + fp * (mp[1] - mp[0]));
         }
     }
     const int ja = slice_index(g, t0), jl = slice_index(g, t1), jb = jl < nd - 1 && slice_t(g, jl) < t1 ? jl + 1 : jl;
@@ -295,10 +295,12 @@ int atmos__aerial_single_profile(const atmos__aerial *ap, const double d[3], dou
         /* the four node rays' sums, all wavelengths and terms at once (contiguous: vectorised) */
         for (int i = 0; i < 4 * n; i++)
             acc[i] = wf[0] * cn[0][o + i] + wf[1] * cn[1][o + i] + wf[2] * cn[2][o + i] + wf[3] * cn[3][o + i];
-        for (int k = 0; k < n; k++) {
-            const double L = ap->split ? ph[k][0] * acc[4 * k] + ph[k][1] * acc[4 * k + 1] : acc[4 * k + 2];
-            S[(size_t)(j - ja) * n + k] = (float)(L > 0 ? L : 0.0);
-        }
+        float *Sj = S + (size_t)(j - ja) * n;
+        if (ap->split)
+            for (int k = 0; k < n; k++) Sj[k] = ph[k][0] * acc[4 * k] + ph[k][1] * acc[4 * k + 1];
+        else
+            for (int k = 0; k < n; k++) Sj[k] = acc[4 * k + 2];
+        for (int k = 0; k < n; k++) Sj[k] = Sj[k] > 0.0f ? Sj[k] : 0.0f;
     }
     return jb - ja + 1;
 }
