@@ -105,6 +105,7 @@ typedef struct {
     int N, D;
     double lt[3], e1[3], e2[3];
     double u0, v0, du, dv, w0, dw;
+    double lo[3], hi[3];     /* map coordinates (padded texel, node) where T < 1 can be read */
     float *T;
     double build_s;          /* the last build's time */
 } sshadow;

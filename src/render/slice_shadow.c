@@ -88,7 +88,8 @@ static int shadow_build(atmos__slice_plan *sp, int threads)
     }
     const int m = (int)ceil(sh->dw * g->sc / 0.5);
     const double h = sh->dw / (m < 1 ? 1 : m);
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+    int amin = N, amax = -1, bmin = N, bmax = -1, kmin = D;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) reduction(min : amin, bmin, kmin) reduction(max : amax, bmax)
     for (int b = 0; b < N; b++)
         for (int a = 0; a < N; a++) {
             const double u = sh->u0 + (a + 0.5) * sh->du, v = sh->v0 + (b + 0.5) * sh->dv;
@@ -108,8 +109,16 @@ static int shadow_build(atmos__slice_plan *sp, int threads)
                         acc += grey_extinction(g, sig, p) * h;
                     }
                 col[k] = (float)exp(-acc);
+                if (col[k] < 1.0f && k < kmin) kmin = k;
             }
+            if (col[D - 1] < 1.0f)
+                amin = a < amin ? a : amin, amax = a > amax ? a : amax, bmin = b < bmin ? b : bmin, bmax = b > bmax ? b : bmax;
         }
+    /* where a ray can meet the shadow: within one texel of the texels that cast one (their
+     * taps reach one padded index either side), from the node before the first that does */
+    sh->lo[0] = amin, sh->hi[0] = amax + 2.0, sh->lo[1] = bmin, sh->hi[1] = bmax + 2.0;
+    sh->lo[2] = kmin - 1.0;
+    if (amax < 0) sh->lo[0] = sh->lo[1] = 1, sh->hi[0] = sh->hi[1] = 0; /* no shadow at all */
     return 1;
 }
 
@@ -172,13 +181,15 @@ static int clip_axis(double x0, double dx, double lo, double hi, double *ta, dou
     return *ta < *tb;
 }
 
-/* The part [ta, tb] of [0, tlim] where the ray's points may be in the volume's shadow: within
- * the map across the light (its ring of zeros included) and not upstream of the box. */
+/* The part [ta, tb] of [0, tlim] where the ray's points may be in the volume's shadow: across
+ * the light within reach of the texels that cast one, along it not upstream of the first depth
+ * where one begins. */
 static int shadow_span(const sshadow *sh, const mray *m, double tlim, double *ta, double *tb)
 {
     *ta = 0, *tb = tlim;
-    return clip_axis(m->q0[0], m->qd[0], 0.0, sh->N + 1.0, ta, tb) &&
-           clip_axis(m->q0[1], m->qd[1], 0.0, sh->N + 1.0, ta, tb) && clip_axis(m->q0[2], m->qd[2], 0.0, INFINITY, ta, tb);
+    return clip_axis(m->q0[0], m->qd[0], sh->lo[0], sh->hi[0], ta, tb) &&
+           clip_axis(m->q0[1], m->qd[1], sh->lo[1], sh->hi[1], ta, tb) &&
+           clip_axis(m->q0[2], m->qd[2], sh->lo[2], INFINITY, ta, tb);
 }
 
 /* What the shadow takes from the air along one ray's span [ta, tb]: in front of the halfway
@@ -199,23 +210,25 @@ static void span_shadow(const sshadow *sh, const mray *m, double ta, double tb, 
     const float b0 = (float)(m->q0[1] + (ta + xi * h) * m->qd[1]), bd = (float)(h * m->qd[1]);
     const float j0 = (float)(m->q0[2] + (ta + xi * h) * m->qd[2]), jd = (float)(h * m->qd[2]);
     shadow_samples(sh->T, sh->N + 2, sh->D, a0, ad, b0, bd, j0, jd, ns, q);
-    for (int c = 0; c < n; c++) Df[c] = Db[c] = 0.0;
-    double Sp[ATMOS_MAX_WAVELENGTHS];
+    /* the in-scatter at the steps' ends, linear between the profile's distances */
+    float Sb[(SHADOW_STEPS_MAX + 1) * ATMOS_MAX_WAVELENGTHS];
     int k = 0;
     for (int i = 0; i <= ns; i++) {
         const double t = ta + i * h;
         while (k < nd - 2 && tt[k + 1] < t) k++;
         double w = tt[k + 1] > tt[k] ? (t - tt[k]) / (tt[k + 1] - tt[k]) : 0.0;
-        w = w < 0 ? 0 : (w > 1 ? 1 : w);
-        for (int c = 0; c < n; c++) {
-            const double s = S[(size_t)k * n + c] + w * (S[(size_t)(k + 1) * n + c] - S[(size_t)k * n + c]);
-            if (i > 0 && q[i - 1] > 0.0f) {
-                const double dS = (s - Sp[c]) * q[i - 1];
-                if (ta + (i - 1 + xi) * h < th) Df[c] += dS;
-                else Db[c] += dS;
-            }
-            Sp[c] = s;
-        }
+        const float wf = (float)(w < 0 ? 0 : (w > 1 ? 1 : w));
+        const float *s0 = S + (size_t)k * n, *s1 = s0 + n;
+        for (int c = 0; c < n; c++) Sb[i * n + c] = s0[c] + wf * (s1[c] - s0[c]);
+    }
+    /* steps whose shadow sample lies before the halfway plane are in front of the volume */
+    const double f = (th - ta) / h - xi;
+    const int nf = !(f > 0) ? 0 : (f >= ns ? ns : (int)ceil(f));
+    for (int c = 0; c < n; c++) {
+        float a = 0.0f, b = 0.0f;
+        for (int i = 0; i < nf; i++) a += (Sb[(i + 1) * n + c] - Sb[i * n + c]) * q[i];
+        for (int i = nf; i < ns; i++) b += (Sb[(i + 1) * n + c] - Sb[i * n + c]) * q[i];
+        Df[c] = a, Db[c] = b;
     }
 }
 
