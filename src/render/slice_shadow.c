@@ -187,6 +187,7 @@ static int clip_axis(double x0, double dx, double lo, double hi, double *ta, dou
 static int shadow_span(const sshadow *sh, const mray *m, double tlim, double *ta, double *tb)
 {
     *ta = 0, *tb = tlim;
+    if (!(sh->hi[0] >= sh->lo[0])) return 0; /* no texel casts a shadow */
     return clip_axis(m->q0[0], m->qd[0], sh->lo[0], sh->hi[0], ta, tb) &&
            clip_axis(m->q0[1], m->qd[1], sh->lo[1], sh->hi[1], ta, tb) &&
            clip_axis(m->q0[2], m->qd[2], sh->lo[2], INFINITY, ta, tb);
