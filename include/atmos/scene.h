@@ -87,6 +87,8 @@ typedef struct atmos_scene_slice {
     double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1]; 1 */
     int max_order;            /* Ams orders tabulated; 64 */
     int diffuse;              /* 1: add the diffuse light field (the light Eq. 24/25 drop, by diffusion) */
+    int air_shadows;          /* 1 (default): the volume shadows the air's single scattering
+                                 (light shafts, crepuscular rays); 0: the air is lit unshadowed */
 } atmos_scene_slice;
 
 /* Settings of the path tracer ("path" in the file); the table is

@@ -41,6 +41,9 @@ typedef struct atmos_slice_timing {
     double field;            /* the diffuse light field ("diffuse"), when the sun moved: its source
                                 and its diffusion solve; part of setup */
     int field_sweeps;        /* that solve's sweeps (0: kept from the last frame) */
+    double air_shadow;       /* the volume's shadow on the air ("air_shadows"): its shadow map when
+                                the sun moved, its per-frame table and the per-pixel march; part of
+                                sky */
 } atmos_slice_timing;
 
 /* What atmos_render_slice needs beyond the scene; zero means default for every field. The

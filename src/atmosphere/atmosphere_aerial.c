@@ -243,3 +243,64 @@ int atmos__aerial_eval(const atmos__aerial *ap, const double d[3], double t, dou
     }
     return 1;
 }
+
+/* The slice at or before distance t (0 before the first), as atmos__aerial_eval finds it. */
+static int slice_index(const atmos__aerial_grid *g, double t)
+{
+    const double f = fmin(1.0, fmax(0.0, (t - g->tmin) / (g->tmax - g->tmin)));
+    int j = (int)((g->nd - 1) * (g->crowd_far ? 1.0 - sqrt(fmax(0.0, 1.0 - f)) : sqrt(f)));
+    j = j > g->nd - 1 ? g->nd - 1 : (j < 0 ? 0 : j);
+    while (j > 0 && slice_t(g, j) > t) j--; /* rounding */
+    while (j < g->nd - 1 && slice_t(g, j + 1) <= t) j++;
+    return j;
+}
+
+int atmos__aerial_single_profile(const atmos__aerial *ap, const double d[3], double t0, double t1, double *t,
+                                 float *S)
+{
+    const atmos__aerial_grid *g = &ap->g;
+    const double c = atmos__dot3(d, g->fwd);
+    if (!ap->tab || !(c > 0)) return 0;
+    const double u = atmos__dot3(d, g->right) / c, v = atmos__dot3(d, g->up) / c;
+    int iu, iv;
+    double wu, wv;
+    if (!locate((u - g->u0) / (g->u1 - g->u0) * (g->nu - 1), g->nu, &iu, &wu) ||
+        !locate((v - g->v0) / (g->v1 - g->v0) * (g->nv - 1), g->nv, &iv, &wv))
+        return 0;
+    const int n = ap->n, nd = g->nd;
+    const size_t node = (size_t)nd * n * 4, row = node * g->nu;
+    const float *base = ap->tab + (size_t)iv * row + (size_t)iu * node;
+    const float *cn[4] = {base, base + node, base + row, base + row + node};
+    const double w[4] = {(1 - wu) * (1 - wv), wu * (1 - wv), (1 - wu) * wv, wu * wv};
+    float ph[ATMOS_MAX_WAVELENGTHS][2];
+    if (ap->split) {
+        const double nu = atmos__dot3(d, g->sun);
+        double fp = sqrt(fmax(0.0, 0.5 * (1.0 - nu))) * (AP_NPH - 1);
+        int ip = (int)fp;
+        ip = ip > AP_NPH - 2 ? AP_NPH - 2 : ip;
+        fp -= ip;
+        for (int k = 0; k < n; k++) {
+            const float *mp = ap->mie + k * AP_NPH + ip;
+            ph[k][0] = (float)atmos__planet_rayleigh_phase(ap->atm->planet, k, nu);
+            ph[k][1] = (float)(mp[0] + fp * (mp[1] - mp[0]));
+        }
+    }
+    const int ja = slice_index(g, t0), jl = slice_index(g, t1), jb = jl < nd - 1 && slice_t(g, jl) < t1 ? jl + 1 : jl;
+    if (jb <= ja) return 0;
+    const float wf[4] = {(float)w[0], (float)w[1], (float)w[2], (float)w[3]};
+    float acc[ATMOS_MAX_WAVELENGTHS * 4];
+    for (int j = ja; j <= jb; j++) {
+        t[j - ja] = slice_t(g, j);
+        const size_t o = (size_t)j * n * 4;
+        /* the four node rays' sums, all wavelengths and terms at once (contiguous: vectorised) */
+        for (int i = 0; i < 4 * n; i++)
+            acc[i] = wf[0] * cn[0][o + i] + wf[1] * cn[1][o + i] + wf[2] * cn[2][o + i] + wf[3] * cn[3][o + i];
+        float *Sj = S + (size_t)(j - ja) * n;
+        if (ap->split)
+            for (int k = 0; k < n; k++) Sj[k] = ph[k][0] * acc[4 * k] + ph[k][1] * acc[4 * k + 1];
+        else
+            for (int k = 0; k < n; k++) Sj[k] = acc[4 * k + 2];
+        for (int k = 0; k < n; k++) Sj[k] = Sj[k] > 0.0f ? Sj[k] : 0.0f;
+    }
+    return jb - ja + 1;
+}

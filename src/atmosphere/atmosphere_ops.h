@@ -132,6 +132,16 @@ int atmos__aerial_build(atmos__aerial *ap, const atmos_atmosphere *a, const atmo
  * 0 (outputs untouched) when (d, t) lies outside the grid: ask the atmosphere then. */
 int atmos__aerial_eval(const atmos__aerial *ap, const double d[3], double t, double *inscatter,
                        double *transmittance);
+/* The single-scattered in-scatter from the eye to the slice distances along unit direction d
+ * (bilinear between the node rays around d) that cover [t0, t1]: the distances in t[0..m-1]
+ * (t[0] <= t0 unless t0 lies before the first slice, t[m-1] >= t1 unless t1 lies past the
+ * last) and S[j * n + k] (the planet kinds' Rayleigh and aerosol terms with their phase
+ * functions at d's angle, without the higher orders; another kind's whole in-scatter, which
+ * is single scattering). Returns m >= 2, or 0 when d lies outside the grid or the range is
+ * empty (t and S untouched). For the renderers' shadows on the air: the difference between
+ * two distances is what the air between them scatters toward the eye. */
+int atmos__aerial_single_profile(const atmos__aerial *ap, const double d[3], double t0, double t1, double *t,
+                                 float *S);
 void atmos__aerial_free(atmos__aerial *ap);
 
 #endif

@@ -15,7 +15,7 @@
  * back) and receives front + T_front * L_vol + T_vol * (B - front). */
 static void composite_pixel(const atmos_atmosphere *atm, const atmos__aerial *ap, const atmos_camera *cam,
                             const double dw[3], double th, const double sun_w[3], int n, const float *Lv,
-                            const float *Tv, float *px)
+                            const float *Tv, const float *Df, float *px)
 {
     if (!(th > 0)) th = 0;
     double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
@@ -25,6 +25,8 @@ static void composite_pixel(const atmos_atmosphere *atm, const atmos__aerial *ap
         atmos_atmosphere_inscatter(atm, cam->position, dw, th, sun_w, front);
         atmos_atmosphere_transmittance(atm, cam->position, dw, th, Tf);
     }
+    if (Df) /* the volume's shadow on that air (slice_shadow.c; px has lost it already) */
+        for (int c = 0; c < n; c++) front[c] = front[c] > Df[c] ? front[c] - Df[c] : 0.0;
     for (int c = 0; c < n; c++) {
         double B = px[c], L = Lv[c], T = Tv[c];
         double r = front[c] + Tf[c] * L + T * (B - front[c]);
@@ -138,7 +140,8 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     double th = j->pinv[p] != 0.0f ? (hc - j->he) * j->pinv[p] : 0.0;
                     float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
                     for (int c = 0; c < j->n; c++) Lv[c] = j->L_eye[c * j->pst + p], Tv[c] = j->T_eye[c * j->pst + p];
-                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + p * C);
+                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, j->air_front ? j->air_front + p * j->n : NULL,
+                                    img->pixels + p * C);
                 }
         } else {
             /* Eye buffer smaller than the image: L_vol and T_vol bilinear between the
@@ -186,7 +189,9 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     atmos__vol_dir_to_frame(xf, dw, d);
                     const double hd = atmos__dot3(j->h, d);
                     double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j->he) / hd : 0.0;
-                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, img->pixels + ((size_t)y * W + x) * C);
+                    const size_t q = (size_t)y * W + x;
+                    composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, j->air_front ? j->air_front + q * j->n : NULL,
+                                    img->pixels + q * C);
                 }
             }
         }

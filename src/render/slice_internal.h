@@ -69,6 +69,10 @@ typedef struct {
     /* Their union over the slices, per image row and per light row: the only pixels
      * and texels the render reads or writes (the rest keep the sky / are never read). */
     sspan *erow, *lrow;
+    /* The volume's shadow on the air in front of the halfway plane, per image pixel
+     * ([pixel * n + c], image width; slice_shadow.c), taken from the air in front in the
+     * composite; NULL: none (the option off, or no air). */
+    const float *air_front;
 } sjob;
 
 /* The light frame of one sun direction (everything of the light buffer that does not depend
@@ -85,6 +89,26 @@ typedef struct {
     unsigned char *hit;
     float *sl;
 } slight;
+
+/* The volume's shadow for the air (slice_shadow.c), kept until the sun moves: a deep
+ * optical-depth map over a plane across the sun's light (the light frame's axes lt, e1, e2 in
+ * the grid frame): per texel (a, b) of N x N over the box's projection (centre at
+ * u0 + (a + 0.5) du, v0 + (b + 0.5) dv) and per depth node j at w = w0 + j dw along lt (D nodes
+ * over the box's extent along the light), the volume's transmittance toward the sun from that
+ * depth, exp(-tau) with tau the optical depth (each field's cross-section averaged over the
+ * wavelengths) from the sun's side of the box. Stored with one texel of ones around
+ * ((N + 2)^2 texels of D floats), so a bilinear tap outside the map reads 1; past the last
+ * node a texel keeps its total (the shadow below and behind the box). */
+typedef struct {
+    int valid;
+    double sun[3];
+    int N, D;
+    double lt[3], e1[3], e2[3];
+    double u0, v0, du, dv, w0, dw;
+    double lo[3], hi[3];     /* map coordinates (padded texel, node) where T < 1 can be read */
+    float *T;
+    double build_s;          /* the last build's time */
+} sshadow;
 
 struct atmos__slice_plan {
     sgrid g;                 /* g.v NULL: an empty volume, the sky alone */
@@ -115,7 +139,25 @@ struct atmos__slice_plan {
     atmos__lfield field;
     float *fview; /* per frame: see sjob.fview */
     int fvq;
+    /* The volume's shadow on the air ("air_shadows"; slice_shadow.c): the map, kept per sun
+     * direction, the per-frame aerial-perspective table over the shadowed pixels (storage kept)
+     * and the per-pixel front part (sjob.air_front; grown to the largest image). */
+    int air_shadows;
+    sshadow shadow;
+    atmos__aerial shadow_ap;
+    float *air_front;
+    size_t air_cap;
 };
+
+/* The volume's shadow on the air's single scattering over the region r of img (which holds
+ * the sky image): the map built when the sun moved, then per pixel the light the shadow takes
+ * from the air, subtracted from the image, the part in front of the volume's halfway plane
+ * kept in sp->air_front and set as j->air_front for the composite. Does nothing (j->air_front
+ * NULL) for a vacuum or a sun that lights no air. *secs receives its time. */
+atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
+                                     const atmos__view *v, const atmos__rect *r, sjob *j, atmos_image *img,
+                                     double *secs);
+void atmos__slice_shadow_free(atmos__slice_plan *sp);
 
 /* The diffuse light field: its medium built from the render grid and the optics (once per
  * plan), and the field brought up to date for the sun direction sun_w (a solve when the sun

@@ -6,27 +6,6 @@
 
 #include <math.h>
 
-/* Trilinear densities of all fields at render-voxel coordinate (u, v, w). Returns 0
- * if the point is outside the grid or in an empty occupancy block (dens untouched). */
-static inline int sgrid_sample_u(const sgrid *g, float u, float v, float w, float *dens)
-{
-    if (!(u >= 0.0f && v >= 0.0f && w >= 0.0f)) return 0;
-    int i = (int)u, j = (int)v, k = (int)w;
-    if (i > g->c[0] - 2 || j > g->c[1] - 2 || k > g->c[2] - 2) return 0;
-    if (!g->occ[((size_t)(k / SLICE_OCC_B) * g->ob[1] + j / SLICE_OCC_B) * g->ob[0] + i / SLICE_OCC_B]) return 0;
-    float fu = u - i, fv = v - j, fw = w - k;
-    const int nf = g->nf;
-    const size_t sx = (size_t)nf, sy = (size_t)g->c[0] * nf, sz = (size_t)g->c[0] * g->c[1] * nf;
-    const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
-    float w000 = (1 - fu) * (1 - fv) * (1 - fw), w100 = fu * (1 - fv) * (1 - fw), w010 = (1 - fu) * fv * (1 - fw),
-          w110 = fu * fv * (1 - fw), w001 = (1 - fu) * (1 - fv) * fw, w101 = fu * (1 - fv) * fw,
-          w011 = (1 - fu) * fv * fw, w111 = fu * fv * fw;
-    for (int f = 0; f < nf; f++)
-        dens[f] = w000 * p[f] + w100 * p[sx + f] + w010 * p[sy + f] + w110 * p[sx + sy + f] + w001 * p[sz + f] +
-                  w101 * p[sx + sz + f] + w011 * p[sy + sz + f] + w111 * p[sx + sy + sz + f];
-    return 1;
-}
-
 /* Light buffer lookup at light-buffer coordinate (fu, fv): bilinear I per wavelength and n. */
 static inline void light_lookup(const sjob *j, const float *Ib, const float *nb, float fu, float fv, float *I, float *n)
 {

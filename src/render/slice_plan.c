@@ -19,6 +19,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
     atmos__aerial_free(&sp->aerial);
     atmos__lmedium_free(&sp->fmed), atmos__lfield_free(&sp->field), free(sp->fdens), free(sp->fview);
+    atmos__slice_shadow_free(sp);
     free(sp);
 }
 
@@ -63,6 +64,7 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     sp->xi = (float)ss->xi;
     sp->diffuse = ss->diffuse && !ss->low_albedo;
     sp->reference = p->reference;
+    sp->air_shadows = ss->air_shadows;
     atmos__vol_xform_init(p->volume, p->offset, &sp->x);
     atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, ss->grid_max_dim, &sp->g);
     if (st == ATMOS_OK && sp->g.v) st = atmos__stables_build(ctx, p->optics, sp->n, ss->max_order, &sp->tab);
@@ -130,12 +132,16 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         tm->prepare = sp->prepare_s;
         tm->eye_dims[0] = j.W, tm->eye_dims[1] = j.H;
         if ((st = atmos__slice_passes(ctx, sp, &j, tm)) != ATMOS_OK) return st;
+        /* the volume's shadow on the air, taken from the sky image (and, in front of the
+         * volume, from the air the composite puts there) */
+        if (sp->air_shadows && (st = atmos__slice_air_shadow(ctx, sp, p->atm, v, r, &j, out, &tm->air_shadow)) != ATMOS_OK)
+            return st;
         const double t_c0 = atmos__now();
         /* the reference passes ask the atmosphere per pixel: the check of the aerial volume */
         atmos__slice_composite(&j, p->atm, &v->cam, v->sun, &sp->x, r, sp->reference ? NULL : &sp->aerial, out,
                                atmos__threads(ctx));
         tm->aerial = atmos__now() - t_c0;
-        tm->sky += tm->aerial;
+        tm->sky += tm->aerial + tm->air_shadow;
         tm->sunlight = sp->sunlight_s;
     }
     tm->total = atmos__now() - t_start;

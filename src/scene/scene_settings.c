@@ -40,6 +40,10 @@ static const atmos_setting slice_settings[] = {
      "add the diffuse light of all orders that Eq. 24/25 drop: a diffusion solve on a coarse grid, "
      "once per sun direction (docs/lightfield.md)",
      SLICE(diffuse)},
+    {"air_shadows", "no-air-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "the volume's shadow on the air's single scattering (light shafts, crepuscular rays); "
+     "off: the air is lit as if the volume were not there",
+     SLICE(air_shadows)},
 };
 
 static const atmos_setting path_settings[] = {

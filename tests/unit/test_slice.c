@@ -231,6 +231,7 @@ static void compare_with_marcher(atmos_context *ctx, float peak, int low_albedo,
     ss.optics = &op.o;
     ss.xi = -1; /* no back-scatter term: pure single scattering in the thin limit */
     ss.low_albedo = low_albedo;
+    s.slice.air_shadows = 0; /* the marcher leaves the air unshadowed (test_slice_shafts checks the shadow) */
     atmos_image *img = render(ctx, &s, v, &ss);
     atmos_image *sky = NULL, *ref = NULL;
     CHECK_OK(atmos_render_sky(ctx, &s, &sky, NULL));

@@ -22,7 +22,8 @@ static void help(void)
            "       atmos bench sky-accuracy [--quick] [--paths N] ... (atmos bench sky-accuracy --help)\n"
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
-           "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--diffuse] [--json]\n"
+           "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S] [--diffuse]\n"
+           "                         [--no-air-shadows] [--json]\n"
            "       atmos bench slice --aerial [--file FILE] [--models LIST] [--density-scale S] [--size N]\n"
            "                         [--repeat R] [--threads T] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
@@ -79,6 +80,8 @@ static void help(void)
            "          --diffuse adds the diffuse light field (\"diffuse\"); field_ms: its build (source and\n"
            "          diffusion solve, warm-started) after the sun's last move, field_sweeps its sweeps;\n"
            "          field_cold_ms, field_cold_sweeps: the plan's first frame's (no warm start).\n"
+           "          --no-air-shadows leaves out the volume's shadow on the air (\"air_shadows\", on by\n"
+           "          default); air_shadow_ms: its share of the last sun-moving frame (part of sky_ms).\n"
            "          cpu_ms_camera_moving, cpu_ms_sun_moving: the process's CPU time per frame (with\n"
            "          OMP_WAIT_POLICY=passive the work done; steadier than fps on a shared machine).\n"
            "          --json prints one JSON object per case.\n"
@@ -474,7 +477,8 @@ static int bench_aerial(const char *file, int size, int frames, int threads, con
 }
 
 /* The slice renderer's cases: the generated storm and, with FILE, that volume. */
-static int bench_slice(const char *file, int size, int frames, int threads, double eye_scale, int diffuse, int json)
+static int bench_slice(const char *file, int size, int frames, int threads, double eye_scale, int diffuse,
+                       int air_shadows, int json)
 {
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
@@ -483,14 +487,15 @@ static int bench_slice(const char *file, int size, int frames, int threads, doub
     atmos_volume *v = NULL;
     atmos_status st = atmos_volume_generate(ctx, "storm", &g, &v);
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-    else rc = bench_slice_case(ctx, "generated_storm", v, size, frames, eye_scale, diffuse, json);
+    else rc = bench_slice_case(ctx, "generated_storm", v, size, frames, eye_scale, diffuse, air_shadows, json);
     atmos_volume_destroy(v);
     v = NULL;
     if (rc == CLI_EXIT_OK && file) {
         st = atmos_volume_load(ctx, file, &bench_load, &v);
         const char *base = strrchr(file, '/');
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, frames, eye_scale, diffuse, json);
+        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, frames, eye_scale, diffuse, air_shadows,
+                                   json);
         atmos_volume_destroy(v);
     }
     atmos_context_destroy(ctx);
@@ -518,7 +523,7 @@ int cli_cmd_bench(int argc, char **argv)
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16, aerial = 0;
     double dscale = 0, eye_scale = 0, budget = 2;
-    int diffuse = 0;
+    int diffuse = 0, air_shadows = 1;
     const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL;
     if (argc > 1 && !strcmp(argv[1], "sky-accuracy")) return bench_sky_accuracy_main(argc - 1, argv + 1);
     bench_path_opts pflags;
@@ -552,6 +557,8 @@ int cli_cmd_bench(int argc, char **argv)
             aerial = 1;
         } else if (!strcmp(argv[i], "--diffuse")) {
             diffuse = 1;
+        } else if (!strcmp(argv[i], "--no-air-shadows")) {
+            air_shadows = 0;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "--fast")) {
@@ -583,8 +590,9 @@ int cli_cmd_bench(int argc, char **argv)
     if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
     if (!strcmp(what, "slice") && aerial)
         return bench_aerial(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, models, dscale, json);
-    if (!strcmp(what, "slice")) return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, diffuse,
-                                              json);
+    if (!strcmp(what, "slice"))
+        return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, diffuse, air_shadows,
+                           json);
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads, models, budget);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);
