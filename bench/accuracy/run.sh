@@ -31,7 +31,7 @@ csv="$OUT/results.csv"
 echo "case,sun,variant,seconds,rel_rmse,bias_rel,tau_bins,order_bins" > "$csv"
 
 # Seconds from atmos render's own timing line ("..., 1.234 s").
-secs() { sed -n 's/.*, \([0-9.]*\) s$/\1/p' "$1" | tail -1; }
+secs() { if [ -f "$1" ]; then sed -n 's/.*, \([0-9.]*\) s$/\1/p' "$1" | tail -1; fi; }
 
 for c in $CASES; do
     scene="$here/$c.json"
