@@ -3,7 +3,8 @@
  * back-scattered part, taken as the source of a diffuse field of all orders and solved by
  * diffusion on a grid coarser than the render grid (src/light/). The medium on that grid is
  * built once per plan; the field once per sun direction, warm-started from the last one.
- * The eye passes add its radiance with an isotropic phase function (slice_pass.c). */
+ * The eye passes add what it scatters toward the eye, sca (L + g A) per field (slice_pass.c),
+ * A from the view's flux (field_keep_view). */
 #include "atmosphere/atmosphere_ops.h"
 #include "render/slice_internal.h"
 
