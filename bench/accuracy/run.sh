@@ -11,7 +11,8 @@
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
 # CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
 # VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer, "harris",
-# "harris_sun": Harris's, not in the default list), THREADS.
+# "harris_sun": Harris's, not in the default list), THREADS, REUSE (1: keep the reference images
+# already in OUT_DIR, e.g. to compare a new build's variants against the same references).
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -30,7 +31,7 @@ csv="$OUT/results.csv"
 echo "case,sun,variant,seconds,rel_rmse,bias_rel,tau_bins,order_bins" > "$csv"
 
 # Seconds from atmos render's own timing line ("..., 1.234 s").
-secs() { sed -n 's/.*, \([0-9.]*\) s$/\1/p' "$1" | tail -1; }
+secs() { if [ -f "$1" ]; then sed -n 's/.*, \([0-9.]*\) s$/\1/p' "$1" | tail -1; fi; }
 
 for c in $CASES; do
     scene="$here/$c.json"
@@ -39,9 +40,13 @@ for c in $CASES; do
         if [ "$sun" = behind ]; then az=180; else az=0; fi
         base="$OUT/${c}_$sun"
         echo "== $c, sun $sun" >&2
-        "$A" render "$scene" $TH --sun-azimuth $az --renderer path --spp "$SPP" --truncate "$TRUNCATE" --pfm "$base.path.pfm" \
-            --variance "$base.path.var.exr" --order "$base.order.pfm" --tau "$base.tau.pfm" -o "$base.path.png" \
-            2> "$base.path.log"
+        if [ "${REUSE:-0}" = 1 ] && [ -s "$base.path.pfm" ] && [ -s "$base.tau.pfm" ] && [ -s "$base.order.pfm" ]; then
+            echo "   (reusing $base.path.pfm)" >&2
+        else
+            "$A" render "$scene" $TH --sun-azimuth $az --renderer path --spp "$SPP" --truncate "$TRUNCATE" --pfm "$base.path.pfm" \
+                --variance "$base.path.var.exr" --order "$base.order.pfm" --tau "$base.tau.pfm" -o "$base.path.png" \
+                2> "$base.path.log"
+        fi
         echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[],[]" >> "$csv"
         for v in $VARIANTS; do
             case $v in
