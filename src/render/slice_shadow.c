@@ -244,14 +244,41 @@ typedef struct {
     const sjob *j;
 } sframe;
 
-/* Pixel (x, y)'s ray: its world and grid-frame directions, its map ray and its span. */
-static int pixel_span(const sframe *f, int x, int y, double dw[3], double d[3], mray *m, double *ta, double *tb)
+/* Pixel (x, y)'s ray: its world and grid-frame directions, its map ray, its span and the
+ * distance to the ground (*tg, INFINITY: none). */
+static int pixel_span(const sframe *f, int x, int y, double dw[3], double d[3], mray *m, double *ta, double *tb,
+                      double *tg)
 {
     atmos_camera_ray(f->cam, x + 0.5, y + 0.5, dw);
     atmos__vol_dir_to_frame(f->xf, dw, d);
     map_ray(f->sh, f->j->eye, d, m);
-    const double tg = atmos_atmosphere_ground_distance(f->atm, f->cam->position, dw);
-    return shadow_span(f->sh, m, fmin(tg, f->tfar), ta, tb);
+    *tg = atmos_atmosphere_ground_distance(f->atm, f->cam->position, dw);
+    return shadow_span(f->sh, m, fmin(*tg, f->tfar), ta, tb);
+}
+
+/* The ground's direct sunlight that the volume's shadow takes from a ray (world direction dw)
+ * meeting the flat ground at tg: albedo / pi E sun_y T_eye (1 - T_vol), as the sky image lit
+ * it (atmos_atmosphere_radiance's flat ground). The planet kinds' ground (curved, with maps)
+ * is left lit. */
+static void ground_shadow(const sframe *f, const mray *m, const double dw[3], double tg, const double sun[3], int n,
+                          double *G)
+{
+    for (int c = 0; c < n; c++) G[c] = 0.0;
+    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(f->atm);
+    const double albedo = atmos_atmosphere_ground_albedo(f->atm);
+    if ((kind != ATMOS_ATMOSPHERE_RILEY && kind != ATMOS_ATMOSPHERE_HOMOGENEOUS) || !(tg < f->tfar) || !(sun[1] > 0) ||
+        !(albedo > 0))
+        return;
+    const sshadow *sh = f->sh;
+    float q = 0.0f;
+    shadow_samples(sh->T, sh->N + 2, sh->D, (float)(m->q0[0] + tg * m->qd[0]), 0.0f, (float)(m->q0[1] + tg * m->qd[1]),
+                   0.0f, (float)(m->q0[2] + tg * m->qd[2]), 0.0f, 1, &q);
+    if (!(q > 0.0f)) return;
+    const double *e = f->cam->position, g[3] = {e[0] + tg * dw[0], 0.0, e[2] + tg * dw[2]};
+    double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    atmos_atmosphere_sunlight(f->atm, g, sun, E);
+    atmos_atmosphere_transmittance(f->atm, e, dw, tg, T);
+    for (int c = 0; c < n; c++) G[c] = q * albedo / ATMOS_PI * sun[1] * E[c] * T[c];
 }
 
 static double shadow_range(const sgrid *g, const atmos__vol_xform *xf, const atmos_camera *cam, const double sun[3])
@@ -282,9 +309,9 @@ static const atmos__aerial *shadow_table(atmos__slice_plan *sp, const sframe *f,
 #pragma omp parallel for schedule(static) num_threads(threads) reduction(min : u0, v0) reduction(max : u1, v1, tmax)
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
-            double dw[3], d[3], ta, tb;
+            double dw[3], d[3], ta, tb, tg;
             mray m;
-            if (!pixel_span(f, x, y, dw, d, &m, &ta, &tb)) continue;
+            if (!pixel_span(f, x, y, dw, d, &m, &ta, &tb, &tg)) continue;
             const double z = atmos__dot3(dw, cam->forward), u = atmos__dot3(dw, cam->right) / z,
                          v = atmos__dot3(dw, cam->up) / z;
             u0 = fmin(u0, u), u1 = fmax(u1, u), v0 = fmin(v0, v), v1 = fmax(v1, v), tmax = fmax(tmax, tb);
@@ -349,10 +376,13 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
             const size_t p = (size_t)y * W + x;
             float *fr = sp->air_front + p * n;
             for (int c = 0; c < n; c++) fr[c] = 0.0f;
-            double dw[3], d[3], ta, tb, tt[ATMOS__AERIAL_MAX_SLICES];
+            double dw[3], d[3], ta, tb, tg, tt[ATMOS__AERIAL_MAX_SLICES], G[ATMOS_MAX_WAVELENGTHS];
             float S[ATMOS__AERIAL_MAX_SLICES * ATMOS_MAX_WAVELENGTHS];
             mray m;
-            if (!pixel_span(&f, x, y, dw, d, &m, &ta, &tb)) continue;
+            if (!pixel_span(&f, x, y, dw, d, &m, &ta, &tb, &tg)) continue;
+            float *px = img->pixels + p * C;
+            ground_shadow(&f, &m, dw, tg, v->sun, n, G);
+            for (int c = 0; c < n; c++) px[c] = (float)fmax(px[c] - G[c], 0.0);
             const int nd = atmos__aerial_single_profile(ap, dw, ta, tb, tt, S);
             if (nd < 2) continue;
             const double hd = atmos__dot3(j->h, d);
@@ -360,7 +390,6 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
             const double xi = atmos__u01(atmos__mix64(((uint64_t)(uint32_t)y << 32) | (uint32_t)x));
             double Df[ATMOS_MAX_WAVELENGTHS], Db[ATMOS_MAX_WAVELENGTHS];
             span_shadow(sh, &m, ta, tb, th, xi, nd, tt, S, n, Df, Db);
-            float *px = img->pixels + p * C;
             for (int c = 0; c < n; c++) {
                 const double s = px[c] - (Df[c] + Db[c]);
                 px[c] = (float)(s > 0 ? s : 0.0);

@@ -10,7 +10,8 @@
  * looks past the volume (its ray never enters the box), so before the shadow existed it was
  * the sky image exactly, the same as with the slab removed. A pixel looking the other way
  * (away from the shadow) must be unchanged bit for bit, the option off must give the
- * unshadowed sky, and 1 and 2 threads the same bytes. Riley's air and a homogeneous layer. */
+ * unshadowed sky, and 1 and 2 threads the same bytes. Riley's air and a homogeneous layer.
+ * And the ground in the slab's shadow loses the sunlight the slab takes (check_ground). */
 #include "atmos/atmos.h"
 #include "test.h"
 #include "test_optics.h"
@@ -166,10 +167,55 @@ static void check_kind(int kind, const char *name)
     atmos_context_destroy(ctx);
 }
 
+/* The ground in the slab's shadow: a ray 45 degrees down from (0, RAY_Y, 0) toward -z meets
+ * the ground at z = -RAY_Y, under the slab. The sunlight the slab takes from the ground there
+ * is albedo / pi E(ground) T(eye -> ground) (1 - e^-tau) (the sun at the zenith); the air's
+ * share is the same with and without the ground's albedo, so the difference between what the
+ * shadow takes at albedo 0.3 and at albedo 0 is the ground's alone. */
+static void check_ground(int kind, const char *name)
+{
+    atmos_context *ctx = make_ctx(2);
+    test_optics op;
+    test_hg_optics(ctx, "hg", 0.0, 1e-6, 1, &op);
+    atmos_volume *none = slab(ctx, 0), *v = slab(ctx, 50);
+    double took[2][3];
+    atmos_scene s;
+    for (int a = 0; a < 2; a++) {
+        scene_for(&s, kind, 0);
+        s.camera.look_at[1] = 0, s.camera.look_at[2] = -RAY_Y;
+        s.atmosphere.ground_albedo = a ? 0.3 : 0.0;
+        atmos_image *open = render(ctx, &s, none, &op), *img = render(ctx, &s, v, &op);
+        const int C = open->channels, mid = (2 * 5 + 2) * C;
+        for (int c = 0; c < 3; c++) took[a][c] = open->pixels[mid + c] - img->pixels[mid + c];
+        atmos_image_destroy(open), atmos_image_destroy(img);
+    }
+    atmos_wavelengths wl;
+    CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(ctx, &s.atmosphere, &wl, &sky));
+    const double eye[3] = {0, RAY_Y, 0}, g[3] = {0, 0, -RAY_Y}, up[3] = {0, 1, 0};
+    const double dir[3] = {0, -sqrt(0.5), -sqrt(0.5)};
+    double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    atmos_atmosphere_sunlight(sky, g, up, E);
+    atmos_atmosphere_transmittance(sky, eye, dir, RAY_Y * sqrt(2.0), T);
+    for (int c = 0; c < 3; c++) {
+        const double want = 0.3 / 3.14159265358979323846 * E[c] * T[c] * (1 - exp(-50.0)), got = took[1][c] - took[0][c];
+        printf("%s, the ground in the shadow, channel %d: the shadow takes %.6g from it, closed form %.6g (%+.2f %%)\n",
+               name, c, got, want, 100 * (got / want - 1));
+        CHECK_MSG(fabs(got - want) < 0.01 * want, "%s ground channel %d: %.6g vs %.6g", name, c, got, want);
+    }
+    atmos_atmosphere_destroy(sky);
+    atmos_volume_destroy(none), atmos_volume_destroy(v);
+    test_optics_free(&op);
+    atmos_context_destroy(ctx);
+}
+
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "cache");
     check_kind(ATMOS_ATMOSPHERE_RILEY, "Riley");
     check_kind(ATMOS_ATMOSPHERE_HOMOGENEOUS, "homogeneous layer");
+    check_ground(ATMOS_ATMOSPHERE_RILEY, "Riley");
+    check_ground(ATMOS_ATMOSPHERE_HOMOGENEOUS, "homogeneous layer");
     return test_summary("test_slice_shafts");
 }
