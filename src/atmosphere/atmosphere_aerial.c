@@ -79,6 +79,17 @@ void atmos__aerial_nodes(const atmos_atmosphere *a, atmos__aerial_grid *g)
     }
 }
 
+/* The aerosols' phase table's node below cos(theta) nu (over x = sin(theta / 2)) and the
+ * weight *fp of the next one. */
+static int phase_node(double nu, double *fp)
+{
+    double f = sqrt(fmax(0.0, 0.5 * (1.0 - nu))) * (AP_NPH - 1);
+    int ip = (int)f;
+    ip = ip > AP_NPH - 2 ? AP_NPH - 2 : ip;
+    *fp = f - ip;
+    return ip;
+}
+
 static double slice_t(const atmos__aerial_grid *g, int j)
 {
     const double x = (double)j / (g->nd - 1), f = g->crowd_far ? 1.0 - (1.0 - x) * (1.0 - x) : x * x;
@@ -225,10 +236,8 @@ int atmos__aerial_eval(const atmos__aerial *ap, const double d[3], double t, dou
         w[q] = wd * (1 - wt), w[q + 4] = wd * wt;
     }
     const double nu = atmos__dot3(d, g->sun);
-    double fp = sqrt(fmax(0.0, 0.5 * (1.0 - nu))) * (AP_NPH - 1);
-    int ip = (int)fp;
-    ip = ip > AP_NPH - 2 ? AP_NPH - 2 : ip;
-    fp -= ip;
+    double fp;
+    const int ip = phase_node(nu, &fp);
     for (int k = 0; k < n; k++) {
         double s[4] = {0, 0, 0, 0};
         for (int q = 0; q < 8; q++)
@@ -275,10 +284,8 @@ int atmos__aerial_single_profile(const atmos__aerial *ap, const double d[3], dou
     float ph[ATMOS_MAX_WAVELENGTHS][2];
     if (ap->split) {
         const double nu = atmos__dot3(d, g->sun);
-        double fp = sqrt(fmax(0.0, 0.5 * (1.0 - nu))) * (AP_NPH - 1);
-        int ip = (int)fp;
-        ip = ip > AP_NPH - 2 ? AP_NPH - 2 : ip;
-        fp -= ip;
+        double fp;
+        const int ip = phase_node(nu, &fp);
         for (int k = 0; k < n; k++) {
             const float *mp = ap->mie + k * AP_NPH + ip;
             ph[k][0] = (float)atmos__planet_rayleigh_phase(ap->atm->planet, k, nu);

@@ -10,40 +10,14 @@
  * 0.49. Small sizes (a 32^3 blob, 32 x 32 pixels) keep it fast. */
 #include "atmos/atmos.h"
 #include "test.h"
+#include "test_blob.h"
 #include "test_optics.h"
 
-#define N 32
-#define VOX 20.0
 #define W 32
 #define SKY 0.2 /* the sky's radiance, W m^-2 sr^-1 nm^-1 */
 
 static char cache_dir[1024];
 
-/* A Gaussian blob of peak density peak (m^-3), 640 m across, 1000 m north of the camera. */
-static atmos_volume *blob(atmos_context *ctx, float peak)
-{
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = vd.dims[1] = vd.dims[2] = N;
-    vd.voxel_size_m = VOX;
-    vd.origin_m[0] = -N * VOX / 2, vd.origin_m[1] = 1500 - N * VOX / 2, vd.origin_m[2] = -1000 - N * VOX / 2;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "cloud", &f));
-    static float buf[N * N * N];
-    for (int k = 0; k < N; k++)
-        for (int j = 0; j < N; j++)
-            for (int i = 0; i < N; i++) {
-                const double x = (i + 0.5 - N / 2.0) / (N / 2.0), y = (j + 0.5 - N / 2.0) / (N / 2.0),
-                             z = (k + 0.5 - N / 2.0) / (N / 2.0), r2 = x * x + y * y + z * z;
-                buf[(k * N + j) * N + i] = r2 < 0.8 ? (float)(peak * exp(-4 * r2) * (0.8 - r2) / 0.8) : 0.0f;
-            }
-    int off[3] = {0, 0, 0}, size[3] = {N, N, N};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
-    CHECK_OK(atmos_volume_finalize(ctx, v));
-    return v;
-}
 
 static void scene_for(atmos_scene *s)
 {
@@ -104,7 +78,7 @@ int main(void)
     test_optics op;
     test_hg_optics(ctx, "hg085", 0.85, 0.9, 1, &op);
     /* peak 1.5e7 m^-3: optical depth ~2.7 through the centre, ~0.5 near the rim */
-    atmos_volume *v = blob(ctx, 1.5e7f);
+    atmos_volume *v = test_blob(ctx, 1.5e7f);
     atmos_scene s;
     scene_for(&s);
     s.samples_per_pixel = 1;
