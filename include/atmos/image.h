@@ -229,6 +229,17 @@ ATMOS_API atmos_status atmos_image_to_srgb_into(atmos_context *ctx, const atmos_
  * (docs/colour.md). */
 ATMOS_API atmos_status atmos_image_gamut_map(atmos_context *ctx, atmos_image *rgb, long long *mapped);
 
+/* The three steps a frame takes to the screen in one pass, a row at a time: spectral radiance
+ * (wl's channels + alpha or not) -> linear sRGB (atmos_image_to_srgb_into) -> gamut map
+ * (atmos_image_gamut_map) -> tone map with desc's manual exposure (atmos_tonemap_into; an
+ * automatic one is refused: atmos_tonemap_scale of the linear image gives the manual scale)
+ * into disp (4 channels of display values; NULL: not kept) and/or rgba8 (width x height x 4
+ * bytes rounded as atmos_write_png rounds, alpha 255; NULL: not made). The same values as the
+ * three calls, bit for bit, for any thread count. */
+ATMOS_API atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spectral,
+                                                const atmos_wavelengths *wl, const atmos_tonemap_desc *desc,
+                                                atmos_image *disp, unsigned char *rgba8);
+
 #ifdef __cplusplus
 }
 #endif
