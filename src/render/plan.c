@@ -192,6 +192,9 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
     v->spp = f->spp ? f->spp : p->scene.path.spp;
     v->slices = f->slices ? f->slices : p->scene.slice.slices;
     v->eye_scale = f->eye_scale != 0 ? f->eye_scale : p->scene.slice.eye_scale;
+    v->sky_step = f->sky_step > 1 ? f->sky_step : 1;
+    if (f->sky_step < 0 || f->sky_step > 16)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: sky_step must be in [0, 16], got %d", f->sky_step);
     if (v->samples_per_pixel < 1 || v->samples_per_pixel > 256)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: samples_per_pixel must be in [1, 256], got %d",
                             v->samples_per_pixel);
@@ -224,7 +227,8 @@ static atmos_status resolve_rect(atmos_context *ctx, const atmos_region *region,
 static int same_view(const atmos__view *a, const atmos__view *b)
 {
     return !memcmp(&a->cam, &b->cam, sizeof a->cam) && !memcmp(a->sun, b->sun, sizeof a->sun) &&
-           a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale;
+           a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale &&
+           a->sky_step == b->sky_step;
 }
 
 static int rect_inside(const atmos__rect *a, const atmos__rect *b)
