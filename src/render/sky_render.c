@@ -254,10 +254,11 @@ static void pinhole_cols(const atmos_camera *cam, int y, const int *xs, int m, f
     }
 }
 
-/* Radiance of pixels xs[0..m) of row y into val[i * n + k] (the sun's disk added); ground[i]
- * (may be NULL): whether the pixel's ray meets the ground. */
+/* Radiance of pixels xs[0..m) of row y into val[i * n + k] (the sun's disk added); flags[i]
+ * (may be NULL): 1 when the pixel's ray meets the ground, + 2 when it is within the angle whose
+ * cosine is cos_near of the sun. */
 static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, int y, const int *xs, int m, row_buffers *rb,
-                      float *val, unsigned char *ground)
+                      float *val, unsigned char *flags, double cos_near)
 {
     const int n = job->n;
     pinhole_cols(job->cam, y, xs, m, rb->dx, rb->dy, rb->dz, rb->w);
@@ -266,9 +267,10 @@ static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, int y, 
     const float sx = (float)job->sun[0], sy = (float)job->sun[1], sz = (float)job->sun[2], cs = (float)job->cos_disk_search;
     for (int i = 0; i < m; i++) {
         for (int k = 0; k < n; k++) val[(size_t)i * n + k] = rb->acc[(size_t)k * m + i];
-        if (ground) {
+        if (flags) {
             const double d[3] = {rb->dx[i], rb->dy[i], rb->dz[i]};
-            ground[i] = atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY;
+            flags[i] = (unsigned char)((atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY) +
+                                       2 * (job->sun_visible && d[0] * job->sun[0] + d[1] * job->sun[1] + d[2] * job->sun[2] >= cos_near));
         }
         if (!job->sun_visible || rb->dx[i] * sx + rb->dy[i] * sy + rb->dz[i] * sz < cs) continue;
         const double cov = sun_coverage(job, xs[i], y);
@@ -279,7 +281,7 @@ static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, int y, 
 typedef struct coarse {
     int step, nx, ny, *cx, *cy;  /* the grid's columns and rows (pixel indices) */
     float *val;                  /* [ny nx n] */
-    unsigned char *ground, *fine; /* [ny nx]: the node's ray meets the ground; cell (j, i) evaluated pixel by pixel */
+    unsigned char *flags, *fine; /* [ny nx]: the node's eval_cols flags; cell (j, i) evaluated pixel by pixel */
 } coarse;
 
 /* Whether the sky bends too much about node (j, i) for a bilinear read: its second differences
@@ -299,20 +301,14 @@ static int bends(const coarse *g, int n, int j, int i)
 
 /* Whether cell (j, i) must be evaluated pixel by pixel: the horizon crosses it, the sky bends
  * at its corners, the sun is near, or it is the last row or column's narrower cell. */
-static int cell_fine(const sky_job *job, const coarse *g, int j, int i, double cos_near)
+static int cell_fine(const sky_job *job, const coarse *g, int j, int i)
 {
     const int c[4] = {j * g->nx + i, j * g->nx + i + 1, (j + 1) * g->nx + i, (j + 1) * g->nx + i + 1};
     if (g->cx[i + 1] - g->cx[i] != g->step || g->cy[j + 1] - g->cy[j] != g->step) return 1;
-    for (int q = 1; q < 4; q++)
-        if (g->ground[c[q]] != g->ground[c[0]]) return 1;
+    for (int q = 0; q < 4; q++)
+        if (g->flags[c[q]] != (g->flags[c[0]] & 1)) return 1; /* the horizon between them, or the sun near */
     for (int q = 0; q < 4; q++)
         if (bends(g, job->n, c[q] / g->nx, c[q] % g->nx)) return 1;
-    if (!job->sun_visible) return 0;
-    for (int q = 0; q < 4; q++) {
-        double d[3];
-        atmos_camera_ray(job->cam, g->cx[c[q] % g->nx] + 0.5, g->cy[c[q] / g->nx] + 0.5, d);
-        if (d[0] * job->sun[0] + d[1] * job->sun[1] + d[2] * job->sun[2] >= cos_near) return 1;
-    }
     return 0;
 }
 
@@ -323,21 +319,28 @@ static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const 
     const int n = job->n, j = (y - r->y0) / g->step < g->ny - 1 ? (y - r->y0) / g->step : g->ny - 2;
     const float fy = (float)(y - g->cy[j]) / (float)(g->cy[j + 1] - g->cy[j]);
     int m = 0;
-    for (int x = r->x0; x < r->x1; x++) {
-        const int i = (x - r->x0) / g->step < g->nx - 1 ? (x - r->x0) / g->step : g->nx - 2;
-        float *px = dst + (size_t)x * C;
-        px[n] = 1.0f;
+    for (int i = 0; i < g->nx - 1; i++) {
+        const int xa = g->cx[i], xb = i == g->nx - 2 ? g->cx[i + 1] + 1 : g->cx[i + 1];
         if (g->fine[j * g->nx + i]) {
-            xs[m++] = x;
+            for (int x = xa; x < xb; x++) xs[m++] = x, dst[(size_t)x * C + n] = 1.0f;
             continue;
         }
-        const float fx = (float)(x - g->cx[i]) / (float)(g->cx[i + 1] - g->cx[i]);
-        const float *a = g->val + ((size_t)j * g->nx + i) * n, *b = a + (size_t)g->nx * n;
-        for (int k = 0; k < n; k++)
-            px[k] = (1 - fy) * ((1 - fx) * a[k] + fx * a[n + k]) + fy * ((1 - fx) * b[k] + fx * b[n + k]);
+        const float *a = g->val + ((size_t)j * g->nx + i) * n, *b = a + (size_t)g->nx * n, inv = 1.0f / (float)(g->cx[i + 1] - xa);
+        float r0[ATMOS_MAX_WAVELENGTHS], dif[ATMOS_MAX_WAVELENGTHS], l0[ATMOS_MAX_WAVELENGTHS];
+        for (int k = 0; k < n; k++) {
+            l0[k] = (1 - fy) * a[k] + fy * b[k];
+            r0[k] = (1 - fy) * a[n + k] + fy * b[n + k];
+            dif[k] = r0[k] - l0[k]; /* the cell's left and right edges at row y */
+        }
+        for (int x = xa; x < xb; x++) {
+            const float fx = (float)(x - xa) * inv;
+            float *px = dst + (size_t)x * C;
+            for (int k = 0; k < n; k++) px[k] = l0[k] + fx * dif[k];
+            px[n] = 1.0f;
+        }
     }
     if (!m) return;
-    eval_cols(job, batch, y, xs, m, rb, val, NULL);
+    eval_cols(job, batch, y, xs, m, rb, val, NULL, 1.0);
     for (int q = 0; q < m; q++)
         for (int k = 0; k < n; k++) dst[(size_t)xs[q] * C + k] = val[(size_t)q * n + k];
 }
@@ -351,12 +354,12 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
     if (count < 2 || rows < 2) return 1;
     coarse g = {F, (count - 2 + F) / F + 1, (rows - 2 + F) / F + 1, NULL, NULL, NULL, NULL, NULL};
     g.cx = malloc(sizeof(int) * (size_t)(g.nx + g.ny)), g.cy = g.cx ? g.cx + g.nx : NULL;
-    g.val = malloc(sizeof(float) * (size_t)g.nx * g.ny * n), g.ground = malloc(2 * (size_t)g.nx * g.ny);
-    if (!g.cx || !g.val || !g.ground) {
-        free(g.cx), free(g.val), free(g.ground);
+    g.val = malloc(sizeof(float) * (size_t)g.nx * g.ny * n), g.flags = malloc(2 * (size_t)g.nx * g.ny);
+    if (!g.cx || !g.val || !g.flags) {
+        free(g.cx), free(g.val), free(g.flags);
         return *nomem = 1, 0;
     }
-    g.fine = g.ground + (size_t)g.nx * g.ny;
+    g.fine = g.flags + (size_t)g.nx * g.ny;
     for (int i = 0; i < g.nx; i++) g.cx[i] = r->x0 + i * F < r->x1 - 1 ? r->x0 + i * F : r->x1 - 1;
     for (int j = 0; j < g.ny; j++) g.cy[j] = r->y0 + j * F < r->y1 - 1 ? r->y0 + j * F : r->y1 - 1;
     const double cos_near = cos(job->sun_radius + (2.5 + 1.5 * F) * pixel_footprint(&v->cam));
@@ -377,17 +380,18 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
         float *val = mem ? rb.scratch + per * ATMOS__ATM_BATCH_SCRATCH : NULL;
 #pragma omp for schedule(dynamic, 4)
         for (int j = 0; j < g.ny; j++)
-            if (mem && xs) eval_cols(job, batch, g.cy[j], g.cx, g.nx, &rb, g.val + (size_t)j * g.nx * n, g.ground + (size_t)j * g.nx);
+            if (mem && xs) eval_cols(job, batch, g.cy[j], g.cx, g.nx, &rb, g.val + (size_t)j * g.nx * n, g.flags + (size_t)j * g.nx,
+                          cos_near);
 #pragma omp for schedule(static)
         for (int j = 0; j < g.ny - 1; j++)
-            for (int i = 0; i < g.nx - 1; i++) g.fine[j * g.nx + i] = (unsigned char)cell_fine(job, &g, j, i, cos_near);
+            for (int i = 0; i < g.nx - 1; i++) g.fine[j * g.nx + i] = (unsigned char)cell_fine(job, &g, j, i);
 #pragma omp for schedule(dynamic, 1)
         for (int b = 0; b < nbands; b++)
             for (int y = r->y0 + b * band; mem && xs && y < r->y1 && y < r->y0 + (b + 1) * band; y++)
                 coarse_row(job, batch, &g, r, y, &rb, xs, val, out->pixels + (size_t)y * v->cam.width * C, C);
         free(mem), free(xs);
     }
-    free(g.cx), free(g.val), free(g.ground);
+    free(g.cx), free(g.val), free(g.flags);
     return 0;
 }
 
