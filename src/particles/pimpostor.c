@@ -68,6 +68,15 @@ static void over(const float *tex, int w, int h, int C, double tx, double ty, fl
     const int i0 = (int)tx, j0 = (int)ty;
     const double ax = tx - i0, ay = ty - j0;
     const float *t00 = tex + ((size_t)j0 * w + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)w * C, *t11 = t10 + C;
+    if (C == 4) { /* three wavelengths and coverage: in single precision, the four as one vector */
+        const float bx = (float)ax, by = (float)ay;
+        float q[4];
+        for (int k = 0; k < 4; k++) q[k] = (1 - by) * ((1 - bx) * t00[k] + bx * t01[k]) + by * ((1 - bx) * t10[k] + bx * t11[k]);
+        const float keep4 = 1.0f - q[3];
+        for (int k = 0; k < 3; k++) px[k] = px[k] * keep4 + q[k];
+        px[3] = 1.0f - (1.0f - px[3]) * keep4;
+        return;
+    }
     float v[ATMOS_MAX_WAVELENGTHS + 1] = {0};
     for (int k = 0; k < C; k++)
         v[k] = (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
