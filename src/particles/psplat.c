@@ -96,7 +96,7 @@ __attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, 
     const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, u0 = (2.0 * x0 + 1.0 - W) / H * t;
     const int C = img->channels, n = x1 - x0;
     double b2[TILE];
-    float g[TILE], T[ATMOS_MAX_WAVELENGTHS][TILE];
+    float g[TILE];
     for (int y = y0; y < y1; y++) {
         const double v = (H - 2.0 * (y + 0.5)) / H * t;
         double D[3], P[3];
@@ -108,17 +108,14 @@ __attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, 
             b2[j] = (a0 + u * (a1 + u * a2)) / (e0 + u * (e1 + u * e2));
         }
         for (int j = 0; j < n; j++) g[j] = atmos__pcloud_column((float)(b2[j] * k2));
-        /* the transmittances of the whole run, a wavelength at a time (vectorised; those
-         * outside the cut are not used) */
-        for (int k = 0; k < nw; k++)
-            for (int j = 0; j < n; j++) T[k][j] = atmos__expf_fast(-q->tc[k] * g[j]);
         float *row = img->pixels + ((size_t)y * cam->width + x0) * C;
         for (int j = 0; j < n; j++) {
             if (b2[j] > rc2) continue;
             float *px = row + (size_t)j * C, tm = 0;
             for (int k = 0; k < nw; k++) {
-                px[k] = px[k] * T[k][j] + q->col[k] * (1.0f - T[k][j]);
-                tm += T[k][j];
+                const float T = atmos__expf_fast(-q->tc[k] * g[j]);
+                px[k] = px[k] * T + q->col[k] * (1.0f - T);
+                tm += T;
             }
             px[nw] = 1.0f - (1.0f - px[nw]) * tm / nw;
         }
