@@ -127,6 +127,10 @@ ATMOS_API atmos_status atmos_read_exr_named(atmos_context *ctx, const char *path
  * level. Metadata as tEXt chunks (iTXt for non-ASCII values; keys 1..79 bytes). */
 ATMOS_API atmos_status atmos_write_png(atmos_context *ctx, const atmos_image *display, const char *path,
                                        int bits);
+/* The same with zlib's compression level 0..9 (-1: libpng's default, what atmos_write_png
+ * uses): the same pixels, 1 much faster and a larger file (the viewer's recorded frames). */
+ATMOS_API atmos_status atmos_write_png_level(atmos_context *ctx, const atmos_image *display, const char *path,
+                                             int bits, int level);
 /* Reads a PNG (any bit depth and colour type) into a float image in [0,1] with 1
  * (grey), 3 (RGB) or 4 (RGBA; also for grey+alpha and palettes with transparency)
  * channels; text chunks go into img->meta. Malformed files: ATMOS_E_FORMAT. */
