@@ -127,6 +127,10 @@ ATMOS_API atmos_status atmos_read_exr_named(atmos_context *ctx, const char *path
  * level. Metadata as tEXt chunks (iTXt for non-ASCII values; keys 1..79 bytes). */
 ATMOS_API atmos_status atmos_write_png(atmos_context *ctx, const atmos_image *display, const char *path,
                                        int bits);
+/* The same with zlib's compression level 0..9 (-1: libpng's default, what atmos_write_png
+ * uses): the same pixels, 1 much faster and a larger file (the viewer's recorded frames). */
+ATMOS_API atmos_status atmos_write_png_level(atmos_context *ctx, const atmos_image *display, const char *path,
+                                             int bits, int level);
 /* Reads a PNG (any bit depth and colour type) into a float image in [0,1] with 1
  * (grey), 3 (RGB) or 4 (RGBA; also for grey+alpha and palettes with transparency)
  * channels; text chunks go into img->meta. Malformed files: ATMOS_E_FORMAT. */
@@ -228,6 +232,17 @@ ATMOS_API atmos_status atmos_image_to_srgb_into(atmos_context *ctx, const atmos_
  * NULL): the pixels moved. atmos render and atmos view apply it to what they write
  * (docs/colour.md). */
 ATMOS_API atmos_status atmos_image_gamut_map(atmos_context *ctx, atmos_image *rgb, long long *mapped);
+
+/* The three steps a frame takes to the screen in one pass, a row at a time: spectral radiance
+ * (wl's channels + alpha or not) -> linear sRGB (atmos_image_to_srgb_into) -> gamut map
+ * (atmos_image_gamut_map) -> tone map with desc's manual exposure (atmos_tonemap_into; an
+ * automatic one is refused: atmos_tonemap_scale of the linear image gives the manual scale)
+ * into disp (4 channels of display values; NULL: not kept) and/or rgba8 (width x height x 4
+ * bytes rounded as atmos_write_png rounds, alpha 255; NULL: not made). The same values as the
+ * three calls, bit for bit, for any thread count. */
+ATMOS_API atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spectral,
+                                                const atmos_wavelengths *wl, const atmos_tonemap_desc *desc,
+                                                atmos_image *disp, unsigned char *rgba8);
 
 #ifdef __cplusplus
 }

@@ -66,6 +66,9 @@ typedef struct atmos_frame {
     int spp;                    /* path tracer: samples per pixel to reach (progressive), 1..ATMOS_PATH_MAX_SPP */
     int slices;                 /* slice renderer: sampling planes, 0 = the scene's */
     double eye_scale;           /* slice renderer: eye buffer scale in (0, 1], 0 = the scene's */
+    int sky_step;               /* the sky behind the volume evaluated every sky_step pixels, 1..16, and read
+                                   bilinearly where it is smooth (pinhole cameras, one sample a pixel;
+                                   docs/viewer.md): the viewer's frames; 0 or 1 = every pixel */
     atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
 } atmos_frame;
 

@@ -2,14 +2,14 @@
  * the sRGB primaries, such as the sun's disc near the horizon) brought inside it by
  * desaturation at constant luminance (docs/colour.md). */
 #include "core/internal.h"
+#include "image/display_internal.h"
 
 #include <math.h>
 
 /* Rec. 709 / sRGB luminance row (IEC 61966-2-1): Y of linear R, G, B. */
 static const double LUM[3] = {0.2126729, 0.7151522, 0.0721750};
 
-/* One pixel: 1 when it was moved. */
-static int map_pixel(float *p)
+int atmos__gamut_pixel(float *p)
 {
     const double r = p[0], g = p[1], b = p[2];
     const double lo = fmin(r, fmin(g, b));
@@ -41,7 +41,7 @@ atmos_status atmos_image_gamut_map(atmos_context *ctx, atmos_image *rgb, long lo
     const int C = rgb->channels;
     long long n = 0;
 #pragma omp parallel for schedule(static) reduction(+ : n) num_threads(atmos__threads(ctx))
-    for (long long i = 0; i < npx; i++) n += map_pixel(rgb->pixels + i * C);
+    for (long long i = 0; i < npx; i++) n += atmos__gamut_pixel(rgb->pixels + i * C);
     if (mapped) *mapped = n;
     return ATMOS_OK;
 }

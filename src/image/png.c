@@ -55,7 +55,7 @@ static unsigned quantize(float v, unsigned maxv)
 typedef struct {
     const char *path; /* final name, for messages */
     const atmos_image *img;
-    int bits;
+    int bits, level;  /* level: zlib's 0..9, -1 libpng's default */
 } png_write_job;
 
 static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *user)
@@ -91,6 +91,7 @@ static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *us
     }
 
     png_init_io(png, f);
+    if (job->level >= 0) png_set_compression_level(png, job->level);
     int color = nc == 1 ? PNG_COLOR_TYPE_GRAY : nc == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA;
     png_set_IHDR(png, info, (png_uint_32)img->width, (png_uint_32)img->height, job->bits, color, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -139,6 +140,15 @@ static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *us
 
 atmos_status atmos_write_png(atmos_context *ctx, const atmos_image *display, const char *path, int bits)
 {
+    return atmos_write_png_level(ctx, display, path, bits, -1);
+}
+
+atmos_status atmos_write_png_level(atmos_context *ctx, const atmos_image *display, const char *path, int bits,
+                                   int level)
+{
+    if (level < -1 || level > 9)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: PNG compression level must be -1 or 0..9, got %d",
+                            path ? path : "PNG", level);
     if (!display || !display->pixels || !path)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_write_png: missing image or path");
     if (bits != 8 && bits != 16)
@@ -155,7 +165,7 @@ atmos_status atmos_write_png(atmos_context *ctx, const atmos_image *display, con
                                 "%s: metadata key '%s': PNG text keys need 1 to 79 bytes and no leading or trailing space",
                                 path, k);
     }
-    png_write_job job = {path, display, bits};
+    png_write_job job = {path, display, bits, level};
     return atmos__write_atomic(ctx, path, png_write_file, &job);
 }
 

@@ -1,6 +1,7 @@
 /* Exposure, tone curves and the sRGB transfer function: linear HDR radiance to
  * display-referred values in [0, 1] for PNG output. */
 #include "core/internal.h"
+#include "image/display_internal.h"
 
 #include <math.h>
 #include <stdatomic.h>
@@ -148,22 +149,35 @@ static inline __attribute__((always_inline)) float curve_of(atmos_tone_curve cur
 /* Values [0, n) of src to display values in dst: scale, the curve (per channel: it desaturates
  * very bright colours towards white, as film does the sun's disk), the sRGB transfer function.
  * Inlined per curve: no branch on the curve in the loop (alpha is mapped too and set right
- * afterwards). GCC 12 does not vectorise it: the table read is a gather it will not if-convert
- * without -ffast-math. */
-static inline __attribute__((always_inline)) void map_values(atmos_tone_curve curve, const float *src, float *dst,
-                                                             size_t n, float scale, const float *enc)
+ * afterwards). In chunks of two loops, the curve's and the table's: GCC 12 vectorises each (the
+ * table read a gather, given restrict) but not the two as one loop. */
+static inline __attribute__((always_inline)) void map_values(atmos_tone_curve curve, const float *restrict src,
+                                                             float *restrict dst, size_t n, float scale,
+                                                             const float *restrict enc)
 {
-    for (size_t j = 0; j < n; j++) {
-        float x = src[j] * scale;
-        x = x > 0 ? x : 0.0f; /* NaN and negatives: 0 */
-        const float v = curve_of(curve, x) * SRGB_LUT;
-        const int i = (int)v;
-        const float e = enc[i] + (v - (float)i) * (enc[i + 1] - enc[i]);
-        dst[j] = e < 1.0f ? e : 1.0f;
+    enum { CHUNK = 256 };
+    float vb[CHUNK];
+    for (size_t j0 = 0; j0 < n; j0 += CHUNK) {
+        const size_t m = n - j0 < CHUNK ? n - j0 : CHUNK;
+        for (size_t j = 0; j < m; j++) {
+            float x = src[j0 + j] * scale;
+            x = x > 0 ? x : 0.0f; /* NaN and negatives: 0 */
+            vb[j] = curve_of(curve, x) * SRGB_LUT;
+        }
+        for (size_t j = 0; j < m; j++) {
+            const float v = vb[j];
+            const int i = (int)v;
+            const float e = enc[i] + (v - (float)i) * (enc[i + 1] - enc[i]);
+            dst[j0 + j] = e < 1.0f ? e : 1.0f;
+        }
     }
 }
 
-/* One row of `width` pixels of C channels; alpha clamped to [0, 1]. */
+/* One row of `width` pixels of C channels; alpha clamped to [0, 1]. The AVX2 clone maps eight
+ * values at a time with a gather from the table (no FMA: the same bits as the baseline). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 static void map_row(atmos_tone_curve curve, const float *src, float *dst, size_t width, int C, float scale,
                     const float *enc)
 {
@@ -175,6 +189,11 @@ static void map_row(atmos_tone_curve curve, const float *src, float *dst, size_t
             const float a = src[4 * p + 3];
             dst[4 * p + 3] = a > 0 ? (a < 1 ? a : 1.0f) : 0.0f;
         }
+}
+
+void atmos__tonemap_row(atmos_tone_curve curve, const float *src, float *dst, size_t width, int C, float scale)
+{
+    map_row(curve, src, dst, width, C, scale, srgb_table());
 }
 
 atmos_status atmos_tonemap_into(atmos_context *ctx, const atmos_image *linear, const atmos_tonemap_desc *desc,

@@ -58,29 +58,25 @@ atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, con
     return ATMOS_OK;
 }
 
-/* The impostor's texel coordinates of the world point w (0 when behind its camera). */
-static int to_texel(const atmos__pimpostor *im, const double w[3], double *tx, double *ty)
-{
-    const atmos_camera *k = &im->cam;
-    double X = 0, Y = 0, Z = 0;
-    for (int i = 0; i < 3; i++) {
-        const double rel = w[i] - k->position[i];
-        X += rel * k->right[i], Y += rel * k->up[i], Z += rel * k->forward[i];
-    }
-    if (!(Z > 0)) return 0;
-    const double f = k->height / (2.0 * k->tan_half_fov);
-    *tx = 0.5 * k->width + f * X / Z - 0.5, *ty = 0.5 * k->height - f * Y / Z - 0.5;
-    return 1;
-}
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* Lays texel coordinates (tx, ty) of the w x h texture tex (C channels: colour, coverage),
  * read bilinearly, over pixel px: px (1 - coverage) + colour. */
 static void over(const float *tex, int w, int h, int C, double tx, double ty, float *px)
 {
-    tx = fmin(fmax(tx, 0.0), w - 1.001), ty = fmin(fmax(ty, 0.0), h - 1.001);
+    tx = tx > 0.0 ? (tx < w - 1.001 ? tx : w - 1.001) : 0.0, ty = ty > 0.0 ? (ty < h - 1.001 ? ty : h - 1.001) : 0.0;
     const int i0 = (int)tx, j0 = (int)ty;
     const double ax = tx - i0, ay = ty - j0;
     const float *t00 = tex + ((size_t)j0 * w + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)w * C, *t11 = t10 + C;
+    if (C == 4) { /* three wavelengths and coverage: in single precision, the four as one vector */
+        const float bx = (float)ax, by = (float)ay;
+        float q[4];
+        for (int k = 0; k < 4; k++) q[k] = (1 - by) * ((1 - bx) * t00[k] + bx * t01[k]) + by * ((1 - bx) * t10[k] + bx * t11[k]);
+        const float keep4 = 1.0f - q[3];
+        for (int k = 0; k < 3; k++) px[k] = px[k] * keep4 + q[k];
+        px[3] = 1.0f - (1.0f - px[3]) * keep4;
+        return;
+    }
     float v[ATMOS_MAX_WAVELENGTHS + 1] = {0};
     for (int k = 0; k < C; k++)
         v[k] = (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
@@ -89,22 +85,34 @@ static void over(const float *tex, int w, int h, int C, double tx, double ty, fl
     px[C - 1] = 1.0f - (1.0f - px[C - 1]) * keep;
 }
 
-/* Pixel row y of the frame: the impostor over [x0, x1). */
+/* Pixel row y of the frame: the impostor over [x0, x1). The pixel's ray F + v U + u R meets
+ * the impostor's plane (through c, normal nrm) at s = ce / (d . nrm) along it, and that point
+ * seen from the impostor's camera is a quotient of functions linear in u: their coefficients
+ * once per row. */
 static void draw_row(const atmos__pimpostor *im, const double c[3], const double nrm[3], const atmos_camera *cam, int y,
                      int x0, int x1, atmos_image *img)
 {
     const int C = img->channels, R = im->res;
+    const atmos_camera *k = &im->cam;
     const double W = cam->width, H = cam->height, t = cam->tan_half_fov, v = (H - 2.0 * (y + 0.5)) / H * t;
-    double ce = 0, dn;
-    for (int i = 0; i < 3; i++) ce += (c[i] - cam->position[i]) * nrm[i];
+    const double fk = k->height / (2.0 * k->tan_half_fov);
+    double B[3], P[3], cr[3];
+    for (int i = 0; i < 3; i++)
+        B[i] = cam->forward[i] + v * cam->up[i], P[i] = cam->position[i] - k->position[i], cr[i] = c[i] - cam->position[i];
+    const double ce = dot3(cr, nrm), bn = dot3(B, nrm), rn = dot3(cam->right, nrm);
+    const double px = dot3(P, k->right), py = dot3(P, k->up), pz = dot3(P, k->forward);
+    const double bx = dot3(B, k->right), by = dot3(B, k->up), bz = dot3(B, k->forward);
+    const double rx = dot3(cam->right, k->right), ry = dot3(cam->right, k->up), rz = dot3(cam->right, k->forward);
     for (int x = x0; x < x1; x++) {
-        const double u = (2.0 * (x + 0.5) - W) / H * t;
-        double d[3], w[3], tx, ty;
-        dn = 0;
-        for (int i = 0; i < 3; i++) d[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i], dn += d[i] * nrm[i];
-        if (!(fabs(dn) > 1e-12) || ce / dn <= 0) continue;
-        for (int i = 0; i < 3; i++) w[i] = cam->position[i] + ce / dn * d[i];
-        if (!to_texel(im, w, &tx, &ty) || tx < -0.5 || ty < -0.5 || tx > R - 0.5 || ty > R - 0.5) continue;
+        const double u = (2.0 * (x + 0.5) - W) / H * t, dn = bn + u * rn;
+        if (!(fabs(dn) > 1e-12)) continue;
+        const double s = ce / dn;
+        if (s <= 0) continue;
+        const double Z = pz + s * (bz + u * rz);
+        if (!(Z > 0)) continue;
+        const double q = fk / Z, tx = 0.5 * R + q * (px + s * (bx + u * rx)) - 0.5,
+                     ty = 0.5 * R - q * (py + s * (by + u * ry)) - 0.5;
+        if (tx < -0.5 || ty < -0.5 || tx > R - 0.5 || ty > R - 0.5) continue;
         over(im->img->pixels, R, R, C, tx, ty, img->pixels + ((size_t)y * cam->width + x) * C);
     }
 }

@@ -230,6 +230,171 @@ static float *column_table(const sky_job *job)
     return col_sc;
 }
 
+/* ---- the sky every `step` pixels (atmos__view.sky_step; pinhole cameras, one sample a pixel):
+ * the sky is smooth, so it is evaluated on a grid of pixel centres every step pixels and read
+ * bilinearly between them, except in the cells of the grid where that could err by more than
+ * COARSE_TOL of the value in a wavelength (bends), where the horizon crosses (the corners' rays
+ * do not all meet the ground or all miss it) and near the sun (its disk): those are evaluated
+ * pixel by pixel. */
+#define COARSE_TOL 1e-3f
+
+/* The rays of pixel centres xs[0..m) of row y, as pinhole_rays makes them. */
+static void pinhole_cols(const atmos_camera *cam, int y, const int *xs, int m, float *dx, float *dy, float *dz, float *w)
+{
+    const double t = cam->tan_half_fov, H = cam->height, W = cam->width;
+    const double v = (H - 2.0 * (y + 0.5)) / H * t;
+    const double bx = cam->forward[0] + v * cam->up[0], by = cam->forward[1] + v * cam->up[1],
+                 bz = cam->forward[2] + v * cam->up[2];
+    for (int i = 0; i < m; i++) {
+        const double u = (2.0 * (xs[i] + 0.5) - W) / H * t;
+        const double ox = bx + u * cam->right[0], oy = by + u * cam->right[1], oz = bz + u * cam->right[2];
+        const double inv = 1.0 / sqrt(ox * ox + oy * oy + oz * oz);
+        dx[i] = (float)(ox * inv), dy[i] = (float)(oy * inv), dz[i] = (float)(oz * inv);
+        w[i] = 1.0f;
+    }
+}
+
+/* Radiance of pixels xs[0..m) of row y into val[i * n + k] (the sun's disk added); flags[i]
+ * (may be NULL): 1 when the pixel's ray meets the ground, + 2 when it is within the angle whose
+ * cosine is cos_near of the sun. */
+static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, int y, const int *xs, int m, row_buffers *rb,
+                      float *val, unsigned char *flags, double cos_near)
+{
+    const int n = job->n;
+    pinhole_cols(job->cam, y, xs, m, rb->dx, rb->dy, rb->dz, rb->w);
+    memset(rb->acc, 0, sizeof(float) * (size_t)m * n);
+    atmos__atm_batch_eval(batch, m, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
+    const float sx = (float)job->sun[0], sy = (float)job->sun[1], sz = (float)job->sun[2], cs = (float)job->cos_disk_search;
+    for (int i = 0; i < m; i++) {
+        for (int k = 0; k < n; k++) val[(size_t)i * n + k] = rb->acc[(size_t)k * m + i];
+        if (flags) {
+            const double d[3] = {rb->dx[i], rb->dy[i], rb->dz[i]};
+            flags[i] = (unsigned char)((atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY) +
+                                       2 * (job->sun_visible && d[0] * job->sun[0] + d[1] * job->sun[1] + d[2] * job->sun[2] >= cos_near));
+        }
+        if (!job->sun_visible || rb->dx[i] * sx + rb->dy[i] * sy + rb->dz[i] * sz < cs) continue;
+        const double cov = sun_coverage(job, xs[i], y);
+        for (int k = 0; k < n; k++) val[(size_t)i * n + k] += (float)(cov * job->sun_radiance[k]);
+    }
+}
+
+typedef struct coarse {
+    int step, nx, ny, *cx, *cy;  /* the grid's columns and rows (pixel indices) */
+    float *val;                  /* [ny nx n] */
+    unsigned char *flags, *fine; /* [ny nx]: the node's eval_cols flags; cell (j, i) evaluated pixel by pixel */
+} coarse;
+
+/* Whether the sky bends too much about node (j, i) for a bilinear read: its second differences
+ * along the grid's rows and columns (where it has neighbours), over 8 times the tolerance of its
+ * value (bilinear reading errs by at most an eighth of the second difference over a cell). */
+static int bends(const coarse *g, int n, int j, int i)
+{
+    const float *c = g->val + ((size_t)j * g->nx + i) * n;
+    const size_t dx = (size_t)n, dy = (size_t)g->nx * n;
+    for (int k = 0; k < n; k++) {
+        const float lim = 8.0f * COARSE_TOL * fabsf(c[k]);
+        if (i > 0 && i < g->nx - 1 && !(fabsf(c[k - dx] - 2.0f * c[k] + c[k + dx]) <= lim)) return 1;
+        if (j > 0 && j < g->ny - 1 && !(fabsf(c[k - dy] - 2.0f * c[k] + c[k + dy]) <= lim)) return 1;
+    }
+    return 0;
+}
+
+/* Whether cell (j, i) must be evaluated pixel by pixel: the horizon crosses it, the sky bends
+ * at its corners, the sun is near, or it is the last row or column's narrower cell. */
+static int cell_fine(const sky_job *job, const coarse *g, int j, int i)
+{
+    const int c[4] = {j * g->nx + i, j * g->nx + i + 1, (j + 1) * g->nx + i, (j + 1) * g->nx + i + 1};
+    if (g->cx[i + 1] - g->cx[i] != g->step || g->cy[j + 1] - g->cy[j] != g->step) return 1;
+    for (int q = 0; q < 4; q++)
+        if (g->flags[c[q]] != (g->flags[c[0]] & 1)) return 1; /* the horizon between them, or the sun near */
+    for (int q = 0; q < 4; q++)
+        if (bends(g, job->n, c[q] / g->nx, c[q] % g->nx)) return 1;
+    return 0;
+}
+
+/* Row y from the grid: cells read bilinearly, fine cells' pixels evaluated. */
+static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const coarse *g, const atmos__rect *r, int y,
+                       row_buffers *rb, int *xs, float *val, float *dst, int C)
+{
+    const int n = job->n, j = (y - r->y0) / g->step < g->ny - 1 ? (y - r->y0) / g->step : g->ny - 2;
+    const float fy = (float)(y - g->cy[j]) / (float)(g->cy[j + 1] - g->cy[j]);
+    int m = 0;
+    for (int i = 0; i < g->nx - 1; i++) {
+        const int xa = g->cx[i], xb = i == g->nx - 2 ? g->cx[i + 1] + 1 : g->cx[i + 1];
+        if (g->fine[j * g->nx + i]) {
+            for (int x = xa; x < xb; x++) xs[m++] = x, dst[(size_t)x * C + n] = 1.0f;
+            continue;
+        }
+        const float *a = g->val + ((size_t)j * g->nx + i) * n, *b = a + (size_t)g->nx * n, inv = 1.0f / (float)(g->cx[i + 1] - xa);
+        float r0[ATMOS_MAX_WAVELENGTHS], dif[ATMOS_MAX_WAVELENGTHS], l0[ATMOS_MAX_WAVELENGTHS];
+        for (int k = 0; k < n; k++) {
+            l0[k] = (1 - fy) * a[k] + fy * b[k];
+            r0[k] = (1 - fy) * a[n + k] + fy * b[n + k];
+            dif[k] = r0[k] - l0[k]; /* the cell's left and right edges at row y */
+        }
+        for (int x = xa; x < xb; x++) {
+            const float fx = (float)(x - xa) * inv;
+            float *px = dst + (size_t)x * C;
+            for (int k = 0; k < n; k++) px[k] = l0[k] + fx * dif[k];
+            px[n] = 1.0f;
+        }
+    }
+    if (!m) return;
+    eval_cols(job, batch, y, xs, m, rb, val, NULL, 1.0);
+    for (int q = 0; q < m; q++)
+        for (int k = 0; k < n; k++) dst[(size_t)xs[q] * C + k] = val[(size_t)q * n + k];
+}
+
+/* The sky of rect r every v->sky_step pixels (coarse_row); 1 when it cannot (too small a rect:
+ * the caller renders every pixel). */
+static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__atm_batch *batch, const atmos__view *v,
+                         const atmos__rect *r, atmos_image *out, int *nomem)
+{
+    const int F = v->sky_step, n = job->n, count = r->x1 - r->x0, rows = r->y1 - r->y0, C = out->channels;
+    if (count < 2 || rows < 2) return 1;
+    coarse g = {F, (count - 2 + F) / F + 1, (rows - 2 + F) / F + 1, NULL, NULL, NULL, NULL, NULL};
+    g.cx = malloc(sizeof(int) * (size_t)(g.nx + g.ny)), g.cy = g.cx ? g.cx + g.nx : NULL;
+    g.val = malloc(sizeof(float) * (size_t)g.nx * g.ny * n), g.flags = malloc(2 * (size_t)g.nx * g.ny);
+    if (!g.cx || !g.val || !g.flags) {
+        free(g.cx), free(g.val), free(g.flags);
+        return *nomem = 1, 0;
+    }
+    g.fine = g.flags + (size_t)g.nx * g.ny;
+    for (int i = 0; i < g.nx; i++) g.cx[i] = r->x0 + i * F < r->x1 - 1 ? r->x0 + i * F : r->x1 - 1;
+    for (int j = 0; j < g.ny; j++) g.cy[j] = r->y0 + j * F < r->y1 - 1 ? r->y0 + j * F : r->y1 - 1;
+    const double cos_near = cos(job->sun_radius + (2.5 + 1.5 * F) * pixel_footprint(&v->cam));
+    const int band = 8, nbands = (rows + band - 1) / band;
+#pragma omp parallel num_threads(atmos__threads(ctx))
+    {
+        row_buffers rb = {0};
+        const size_t per = (size_t)count;
+        float *mem = malloc(sizeof(float) * per * (4 + 2 * (size_t)n + ATMOS__ATM_BATCH_SCRATCH));
+        int *xs = malloc(sizeof(int) * per);
+        if (mem && xs) {
+            rb.dx = mem, rb.dy = mem + per, rb.dz = mem + 2 * per, rb.w = mem + 3 * per, rb.acc = mem + 4 * per;
+            rb.scratch = rb.acc + per * n;
+        } else {
+#pragma omp atomic write
+            *nomem = 1;
+        }
+        float *val = mem ? rb.scratch + per * ATMOS__ATM_BATCH_SCRATCH : NULL;
+#pragma omp for schedule(dynamic, 4)
+        for (int j = 0; j < g.ny; j++)
+            if (mem && xs) eval_cols(job, batch, g.cy[j], g.cx, g.nx, &rb, g.val + (size_t)j * g.nx * n, g.flags + (size_t)j * g.nx,
+                          cos_near);
+#pragma omp for schedule(static)
+        for (int j = 0; j < g.ny - 1; j++)
+            for (int i = 0; i < g.nx - 1; i++) g.fine[j * g.nx + i] = (unsigned char)cell_fine(job, &g, j, i);
+#pragma omp for schedule(dynamic, 1)
+        for (int b = 0; b < nbands; b++)
+            for (int y = r->y0 + b * band; mem && xs && y < r->y1 && y < r->y0 + (b + 1) * band; y++)
+                coarse_row(job, batch, &g, r, y, &rb, xs, val, out->pixels + (size_t)y * v->cam.width * C, C);
+        free(mem), free(xs);
+    }
+    free(g.cx), free(g.val), free(g.flags);
+    return 0;
+}
+
 struct atmos__sky_keep {
     atmos__atm_batch batch; /* zeroed until the first frame */
 };
@@ -256,6 +421,13 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
     if (keep) atmos__atm_batch_update(bp, atm, v->cam.position, job.sun);
     else atmos__atm_batch_init(bp, atm, v->cam.position, job.sun);
     const atmos__atm_batch *batch = bp;
+    if (v->sky_step > 1 && v->cam.type == ATMOS_CAMERA_PINHOLE && job.spp == 1 &&
+        !render_coarse(ctx, &job, batch, v, r, out, &nomem)) {
+        if (!keep) atmos__atm_batch_release(&own);
+        if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for the sky's grid");
+        atmos__progress(ctx, "render sky", 1.0);
+        return ATMOS_OK;
+    }
     float *col_sc = column_table(&job);
 #pragma omp parallel num_threads(atmos__threads(ctx))
     {

@@ -132,9 +132,10 @@ typedef struct view_window view_window;
 /* Opens a window of w x h; NULL with a message when no display can be opened. */
 view_window *view_window_open(int w, int h, const char *title);
 void view_window_close(view_window *win);
-/* Shows a display-sRGB image (3 or 4 channels, [0, 1]) scaled to the window, with the
- * overlay's lines on top (NULL: none). Returns 0 or -1. */
-int view_window_present(view_window *win, const atmos_image *disp, const char *const *lines, int nlines);
+/* Shows a w x h frame of 8-bit display-sRGB RGBA (atmos_image_display_into's bytes) scaled to
+ * the window, with the overlay's lines on top (NULL: none). Returns 0 or -1. */
+int view_window_present(view_window *win, const unsigned char *rgba, int w, int h, const char *const *lines,
+                        int nlines);
 /* Polls the window's events into the state (held keys act over dt). */
 void view_window_events(view_window *win, view_state *s, double dt);
 /* Pushes a key press and release of the SDL key code sym into the window's queue (the tests'

@@ -16,6 +16,8 @@ typedef struct loop {
     atmos_plan *plan[ATMOS_RENDERER_LAST + 1]; /* per renderer kind, made when first used */
     int spectral;                /* the wavelengths the plans were made for */
     atmos_image *img, *lin, *disp;
+    unsigned char *rgba;         /* the window's frame */
+    size_t rgba_cap;
     double log_scale;            /* the exposure's smoothed log scale (automatic exposure) */
     int have_scale, spp, saves;
     int impostor_updates;        /* the last frame's */
@@ -44,59 +46,93 @@ static atmos_status get_plan(loop *L, const view_state *s, atmos_plan **out)
     return ATMOS_OK;
 }
 
-/* The automatic exposure's scale (atmos_tonemap_scale) of every 4th pixel of every 4th row:
- * the log average of a frame changes little, and the serial sum over every pixel of a
- * 1280 x 720 frame took a tenth of its time. */
-static double exposure_scale(const atmos_image *lin, const atmos_tonemap_desc *td)
+/* The automatic exposure's scale (atmos_tonemap_scale) of the frame's linear sRGB, from every
+ * 4th pixel of every 4th row of a large frame, converted as the display converts them (to
+ * linear sRGB, gamut mapped): the log average of a frame changes little, and the serial sum over
+ * every pixel of a 1280 x 720 frame took a tenth of its time. */
+static double exposure_scale(atmos_context *ctx, const atmos_image *img, const atmos_wavelengths *wl,
+                             const atmos_tonemap_desc *td)
 {
-    const int step = lin->width * lin->height > 65536 ? 4 : 1, w = (lin->width + step - 1) / step,
-              h = (lin->height + step - 1) / step, C = lin->channels;
-    atmos_image *sub = NULL;
-    if (step == 1 || atmos_image_create(NULL, w, h, C, &sub) != ATMOS_OK) return atmos_tonemap_scale(lin, td);
+    const int step = img->width * img->height > 65536 ? 4 : 1, w = (img->width + step - 1) / step,
+              h = (img->height + step - 1) / step, C = img->channels;
+    atmos_image *sub = NULL, *lin = NULL;
+    double scale = 1.0;
+    if (atmos_image_create(NULL, w, h, C, &sub) != ATMOS_OK) return scale;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++)
-            memcpy(sub->pixels + ((size_t)y * w + x) * C, lin->pixels + ((size_t)y * step * lin->width + x * step) * C,
+            memcpy(sub->pixels + ((size_t)y * w + x) * C, img->pixels + ((size_t)y * step * img->width + x * step) * C,
                    sizeof(float) * C);
-    const double scale = atmos_tonemap_scale(sub, td);
-    atmos_image_destroy(sub);
+    if (atmos_image_to_srgb(ctx, sub, wl, &lin) == ATMOS_OK && atmos_image_gamut_map(ctx, lin, NULL) == ATMOS_OK)
+        scale = atmos_tonemap_scale(lin, td);
+    atmos_image_destroy(sub), atmos_image_destroy(lin);
     return scale;
 }
 
-/* The display image of L->img: linear sRGB, then the tone map with the exposure held as a
- * manual EV (so that a saved scene reproduces it): automatic exposure adapts smoothly
- * (a third of the way in log a frame) unless `snap`. */
-static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int snap, double *ev_used)
+/* The tone map of L->img: the scene's curve, the exposure held as a manual EV (so that a saved
+ * scene reproduces it); automatic exposure adapts smoothly (a third of the way in log a frame)
+ * unless `snap`. */
+static atmos_tonemap_desc frame_tonemap(loop *L, const atmos_plan *p, const view_state *s, int snap)
 {
-    /* the frame's images are kept from one frame to the next while its size stays (made anew,
-     * they carry the render's metadata: a save makes them anew) */
-    const int keep = L->lin && L->disp && L->lin->width == L->img->width && L->lin->height == L->img->height;
-    if (!keep) {
-        atmos_image_destroy(L->lin), L->lin = NULL;
-        atmos_image_destroy(L->disp), L->disp = NULL;
-    }
-    atmos_status st = keep ? atmos_image_to_srgb_into(L->ctx, L->img, atmos_plan_wavelengths(p), L->lin)
-                           : atmos_image_to_srgb(L->ctx, L->img, atmos_plan_wavelengths(p), &L->lin);
-    if (st == ATMOS_OK) st = atmos_image_gamut_map(L->ctx, L->lin, NULL); /* as atmos render writes it */
-    if (st != ATMOS_OK) return st;
     atmos_tonemap_desc td;
     memset(&td, 0, sizeof td);
     td.curve = L->sc->tonemap.curve;
     td.manual_exposure = s->manual_exposure;
     td.exposure_ev = s->ev;
     if (!s->manual_exposure) {
-        const double ls = log(fmax(exposure_scale(L->lin, &td), 1e-30));
+        const double ls = log(fmax(exposure_scale(L->ctx, L->img, atmos_plan_wavelengths(p), &td), 1e-30));
         L->log_scale = (!L->have_scale || snap) ? ls : L->log_scale + (ls - L->log_scale) / 3.0;
         L->have_scale = 1;
         /* manual: scale = 1 / (1.2 2^EV) */
         td.manual_exposure = 1;
         td.exposure_ev = -log2(1.2 * exp(L->log_scale));
     }
-    *ev_used = td.exposure_ev;
-    return keep ? atmos_tonemap_into(L->ctx, L->lin, &td, L->disp) : atmos_tonemap(L->ctx, L->lin, &td, &L->disp);
+    return td;
 }
 
-/* Renders the state's frame; preview: the reduced quality of a moving view. */
-static atmos_status render(loop *L, view_state *s, int preview, atmos_plan **pp)
+/* A save's images of L->img (L->lin linear sRGB with the render's metadata, L->disp the display
+ * values), made anew by the library's steps one after the other. */
+static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int snap, double *ev_used)
+{
+    atmos_image_destroy(L->lin), L->lin = NULL;
+    atmos_image_destroy(L->disp), L->disp = NULL;
+    const atmos_tonemap_desc td = frame_tonemap(L, p, s, snap);
+    *ev_used = td.exposure_ev;
+    atmos_status st = atmos_image_to_srgb(L->ctx, L->img, atmos_plan_wavelengths(p), &L->lin);
+    if (st == ATMOS_OK) st = atmos_image_gamut_map(L->ctx, L->lin, NULL); /* as atmos render writes it */
+    if (st == ATMOS_OK) st = atmos_tonemap(L->ctx, L->lin, &td, &L->disp);
+    return st;
+}
+
+/* A frame's display values in one pass (atmos_image_display_into: the same values as display's
+ * steps): L->disp when recording or without a window, L->rgba for the window. */
+static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, int snap, int floats, int bytes)
+{
+    const int W = L->img->width, H = L->img->height;
+    atmos_status st = ATMOS_OK;
+    if (floats && (!L->disp || L->disp->width != W || L->disp->height != H)) {
+        atmos_image_destroy(L->disp), L->disp = NULL;
+        st = atmos_image_create(L->ctx, W, H, 4, &L->disp);
+    }
+    if (bytes && st == ATMOS_OK && (size_t)W * H * 4 > L->rgba_cap) {
+        free(L->rgba), L->rgba_cap = 0;
+        if (!(L->rgba = malloc((size_t)W * H * 4))) return ATMOS_E_NOMEM;
+        L->rgba_cap = (size_t)W * H * 4;
+    }
+    if (st != ATMOS_OK) return st;
+    const atmos_tonemap_desc td = frame_tonemap(L, p, s, snap);
+    st = atmos_image_display_into(L->ctx, L->img, atmos_plan_wavelengths(p), &td, floats ? L->disp : NULL,
+                                  bytes ? L->rgba : NULL);
+    return st;
+}
+
+/* The viewer's frames evaluate the sky behind the volume every VIEW_SKY_STEP pixels and read it
+ * between them where it is smooth (atmos_frame.sky_step: within 0.1 % of every pixel's); a
+ * save, every pixel, as atmos render does. */
+#define VIEW_SKY_STEP 4
+
+/* Renders the state's frame; preview: the reduced quality of a moving view; saving: the scene's
+ * full quality. */
+static atmos_status render(loop *L, view_state *s, int preview, int saving, atmos_plan **pp)
 {
     atmos_plan *p;
     atmos_status st = get_plan(L, s, &p);
@@ -104,6 +140,7 @@ static atmos_status render(loop *L, view_state *s, int preview, atmos_plan **pp)
     atmos_frame f;
     if ((st = atmos_frame_from_scene(L->ctx, L->sc, &f)) != ATMOS_OK) return st;
     view_state_frame(s, &f);
+    if (!saving) f.sky_step = VIEW_SKY_STEP;
     if (s->renderer == ATMOS_RENDERER_SLICE && preview) f.eye_scale = 0.5 * (f.eye_scale > 0 ? f.eye_scale : 1.0);
     if (s->renderer == ATMOS_RENDERER_PATH) {
         const int full = L->sc->path.spp > 0 ? L->sc->path.spp : 64;
@@ -124,9 +161,8 @@ static int save(loop *L, const view_opts *o, view_state *s, const char *text)
     atmos_plan *p;
     const int keep_spp = L->spp;
     L->spp = 1 << 30; /* the scene's full budget */
-    atmos_image_destroy(L->lin), L->lin = NULL; /* made anew: with the render's metadata */
     double ev;
-    atmos_status st = render(L, s, 0, &p);
+    atmos_status st = render(L, s, 0, 1, &p);
     if (st == ATMOS_OK) st = display(L, p, s, 0, &ev);
     L->spp = keep_spp;
     if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
@@ -203,9 +239,8 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         const int moving = (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && i > 0 && !scripted;
         s.changes = 0;
         atmos_plan *p = NULL;
-        double ev;
-        atmos_status st = render(&L, &s, moving, &p);
-        if (st == ATMOS_OK) st = display(&L, p, &s, i == 0 || scripted, &ev);
+        atmos_status st = render(&L, &s, moving, 0, &p);
+        if (st == ATMOS_OK) st = display_frame(&L, p, &s, i == 0 || scripted, o->record || !win, win != NULL);
         if (st != ATMOS_OK) {
             rc = cli_runtime_error("view", ctx, st);
             break;
@@ -213,7 +248,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         char lines[4][160];
         const char *lp[4] = {lines[0], lines[1], lines[2], lines[3]};
         overlay(&s, last_ms, lines);
-        if (win && view_window_present(win, L.disp, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
+        if (win && view_window_present(win, L.rgba, L.img->width, L.img->height, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
         last_ms = 1000.0 * (cli_now_s() - t0);
         if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates, &s);
         /* a save that fails is said (save prints why) and the session goes on */
@@ -227,5 +262,6 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
     drop_plans(&L);
     atmos_image_destroy(L.lin);
     atmos_image_destroy(L.disp);
+    free(L.rgba);
     return rc;
 }

@@ -16,7 +16,6 @@ struct view_window {
     SDL_Renderer *ren;
     SDL_Texture *tex;
     int tw, th;
-    unsigned char *rgba;
     TTF_Font *font;
     int held[VA_COUNT];
     int dragging;
@@ -53,30 +52,20 @@ void view_window_close(view_window *v)
     if (v->tex) SDL_DestroyTexture(v->tex);
     if (v->ren) SDL_DestroyRenderer(v->ren);
     if (v->win) SDL_DestroyWindow(v->win);
-    free(v->rgba);
     free(v);
     SDL_Quit();
 }
 
 /* The frame into the streaming texture (8-bit, as the display shows it). */
-static int upload(view_window *v, const atmos_image *d)
+static int upload(view_window *v, const unsigned char *rgba, int w, int h)
 {
-    if (!v->tex || v->tw != d->width || v->th != d->height) {
+    if (!v->tex || v->tw != w || v->th != h) {
         if (v->tex) SDL_DestroyTexture(v->tex);
-        free(v->rgba);
-        v->tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ABGR8888, SDL_TEXTUREACCESS_STREAMING, d->width, d->height);
-        v->rgba = malloc((size_t)4 * d->width * d->height);
-        if (!v->tex || !v->rgba) return -1;
-        v->tw = d->width, v->th = d->height;
+        v->tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ABGR8888, SDL_TEXTUREACCESS_STREAMING, w, h);
+        if (!v->tex) return -1;
+        v->tw = w, v->th = h;
     }
-    const int C = d->channels;
-    for (size_t i = 0; i < (size_t)d->width * d->height; i++)
-        for (int c = 0; c < 4; c++) {
-            float x = c < 3 ? d->pixels[i * C + (C >= 3 ? c : 0)] : 1.0f;
-            x = x < 0 ? 0 : (x > 1 ? 1 : x);
-            v->rgba[i * 4 + c] = (unsigned char)(x * 255.0f + 0.5f);
-        }
-    return SDL_UpdateTexture(v->tex, NULL, v->rgba, 4 * d->width);
+    return SDL_UpdateTexture(v->tex, NULL, rgba, 4 * w);
 }
 
 static void draw_lines(view_window *v, const char *const *lines, int n)
@@ -109,9 +98,9 @@ static void draw_lines(view_window *v, const char *const *lines, int n)
     }
 }
 
-int view_window_present(view_window *v, const atmos_image *disp, const char *const *lines, int nlines)
+int view_window_present(view_window *v, const unsigned char *rgba, int w, int h, const char *const *lines, int nlines)
 {
-    if (upload(v, disp) != 0) return -1;
+    if (upload(v, rgba, w, h) != 0) return -1;
     SDL_RenderClear(v->ren);
     SDL_RenderCopy(v->ren, v->tex, NULL, NULL);
     if (lines && nlines > 0) draw_lines(v, lines, nlines);
