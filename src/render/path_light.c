@@ -155,9 +155,16 @@ void atmos__path_air_scatter(const path_run *R, const double p[3], const double 
         if (rest > 0) atmos__path_add(R, i, w[i] * wt * rest, order);
     }
     double ta, ratio[PATH_B];
-    if (!span || !atmos__atm_scatter_point(J->atm, p0, d, s1 - s0, m, b->k, w, R->r, &ta, ratio)) return;
-    atmos__path_air_transmit(R, p, d, s0, ratio); /* the point's ratio counts the air from p0 on */
-    ta += s0;
+    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(J->atm);
+    const int planet = kind == ATMOS_ATMOSPHERE_SPHERICAL || kind == ATMOS_ATMOSPHERE_DOBASHI;
+    if (!span) return;
+    if (planet) { /* no sampler of the planet's air: a point drawn evenly on the span */
+        ta = s0 + atmos__stream_u(R->r) * (s1 - s0);
+    } else {
+        if (!atmos__atm_scatter_point(J->atm, p0, d, s1 - s0, m, b->k, w, R->r, &ta, ratio)) return;
+        atmos__path_air_transmit(R, p, d, s0, ratio); /* the point's ratio counts the air from p0 on */
+        ta += s0;
+    }
     const double pa[3] = {p[0] + ta * d[0], p[1] + ta * d[1], p[2] + ta * d[2]};
     double T[PATH_B], Tv[PATH_B], E[PATH_B];
     atmos__path_shadow(R, pa, J->sun, T);
@@ -167,6 +174,14 @@ void atmos__path_air_scatter(const path_run *R, const double p[3], const double 
     if (view) {
         atmos__path_transmittance(J->med, view->q, view->qd, view->t0, view->t0 + ta, b, R->r, Tv);
         for (int i = 0; i < m; i++) T[i] *= Tv[i];
+    }
+    if (planet) {
+        /* the planet's in-scatter of the span (its aerosols' phase function and every order
+         * in it) times the shadow at the point: a ratio estimate, which the span's evenly drawn
+         * point keeps unbiased where the shadow does not vary along it */
+        for (int i = 0; i < m; i++)
+            if (w[i] != 0 && T[i] > 0) atmos__path_add(R, i, w[i] * wt * fs[i] * T[i], order);
+        return;
     }
     atmos__path_sunlight(R, pa, E);
     const double P = atmos_atmosphere_phase(J->atm, pa, atmos__dot3(d, J->sun));

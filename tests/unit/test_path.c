@@ -841,7 +841,9 @@ static void test_air_in_box(atmos_context *ctx)
         for (int c = 0; c < 3; c++) {
             double a = img->pixels[p * 4 + c], b = sky->pixels[p * 4 + c], se = sqrt(var->pixels[p * 4 + c]);
             if (fabs(a - b) / b > worst) worst = fabs(a - b) / b;
-            if (fabs(a - b) > 4 * se + 2e-3 * b) bad++;
+            /* the spherical sky image reads its sky-view table, within ~1 % of the in-scatter
+             * the path tracer's air marches */
+            if (fabs(a - b) > 4 * se + (air_kind == ATMOS_ATMOSPHERE_SPHERICAL ? 0.02 : 2e-3) * b) bad++;
         }
     printf("air in a transparent volume's box: largest difference from the sky %.2g (relative)\n", worst);
     CHECK_MSG(bad == 0, "%d pixel channels differ from the sky", bad);
@@ -1007,6 +1009,10 @@ int main(void)
         test_air_shadow(ctx);
         test_air_inside(ctx);
     }
+    /* over a planet: the air in the volume's shadow span was dropped (a sky 2-3 times too dark) */
+    air_kind = ATMOS_ATMOSPHERE_SPHERICAL;
+    printf("-- air: the spherical model\n");
+    test_air_in_box(ctx);
     air_kind = ATMOS_ATMOSPHERE_RILEY;
     test_estimators_agree(ctx);
     test_absorber(ctx);
