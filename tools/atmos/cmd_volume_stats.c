@@ -236,8 +236,11 @@ int cli_cmd_volume_stats(int argc, char **argv)
     memset(&o, 0, sizeof o);
     o.periodic = -1, o.seed = 1, o.seeds = 1;
     for (int i = 1; i < argc; i++)
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            cli_volume_help();
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) { /* its own part of atmos volume --help */
+            printf("Usage:\n");
+            cli_volume_stats_usage();
+            printf("\n");
+            cli_volume_stats_help();
             return CLI_EXIT_OK;
         }
     int rc = parse(argc, argv, &o);
