@@ -81,7 +81,7 @@ PY
             break
         fi
         t1=$(now)
-        secs=$(sed -n 's/^atmos render: .*, \([0-9.]*\) s$/\1/p' "$log" | tail -n 1)
+        secs=$(sed -n 's/^atmos render: .*, \([0-9.]*\) s rendering$/\1/p' "$log" | tail -n 1)
         wall=$(python3 -c "print('%.1f' % ($t1 - $t0))")
         if [ -z "$best" ] || python3 -c "import sys; sys.exit(0 if float('${secs:-1e9}') < float('$best') else 1)"; then
             best=${secs:-?}; bestwall=$wall
