@@ -69,6 +69,8 @@ typedef struct atmos_frame {
     int sky_step;               /* the sky behind the volume evaluated every sky_step pixels, 1..16, and read
                                    bilinearly where it is smooth (pinhole cameras, one sample a pixel;
                                    docs/viewer.md): the viewer's frames; 0 or 1 = every pixel */
+    int no_air_shadows;         /* slice renderer: 1 leaves out the volume's shadow on the air and the ground
+                                   (the scene's "air_shadows") for this frame: the viewer's moving preview; 0 */
     atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
 } atmos_frame;
 

@@ -193,6 +193,7 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
     v->slices = f->slices ? f->slices : p->scene.slice.slices;
     v->eye_scale = f->eye_scale != 0 ? f->eye_scale : p->scene.slice.eye_scale;
     v->sky_step = f->sky_step > 1 ? f->sky_step : 1;
+    v->no_air_shadows = f->no_air_shadows != 0;
     if (f->sky_step < 0 || f->sky_step > 16)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: sky_step must be in [0, 16], got %d", f->sky_step);
     if (v->samples_per_pixel < 1 || v->samples_per_pixel > 256)
@@ -228,7 +229,7 @@ static int same_view(const atmos__view *a, const atmos__view *b)
 {
     return !memcmp(&a->cam, &b->cam, sizeof a->cam) && !memcmp(a->sun, b->sun, sizeof a->sun) &&
            a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale &&
-           a->sky_step == b->sky_step;
+           a->sky_step == b->sky_step && a->no_air_shadows == b->no_air_shadows;
 }
 
 static int rect_inside(const atmos__rect *a, const atmos__rect *b)

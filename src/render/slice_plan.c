@@ -134,7 +134,8 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         if ((st = atmos__slice_passes(ctx, sp, &j, tm)) != ATMOS_OK) return st;
         /* the volume's shadow on the air, taken from the sky image (and, in front of the
          * volume, from the air the composite puts there) */
-        if (sp->air_shadows && (st = atmos__slice_air_shadow(ctx, sp, p->atm, v, r, &j, out, &tm->air_shadow)) != ATMOS_OK)
+        if (sp->air_shadows && !v->no_air_shadows &&
+            (st = atmos__slice_air_shadow(ctx, sp, p->atm, v, r, &j, out, &tm->air_shadow)) != ATMOS_OK)
             return st;
         const double t_c0 = atmos__now();
         /* the reference passes ask the atmosphere per pixel: the check of the aerial volume */

@@ -14,6 +14,7 @@ typedef struct atmos__view {
     int slices;                /* slice renderer: sampling planes */
     double eye_scale;          /* slice renderer: eye buffer scale, (0, 1] */
     int sky_step;              /* the sky background every sky_step pixels (1: every pixel) */
+    int no_air_shadows;        /* slice renderer: the volume's shadow on the air left out this frame */
 } atmos__view;
 
 /* A region clipped to the image: [x0, x1) x [y0, y1), never empty unless the image is. */

@@ -94,6 +94,58 @@ static atmos_image *render(atmos_context *ctx, const atmos_scene *s, const atmos
     return img;
 }
 
+/* One frame of a fresh plan of s with its "air_shadows" set to air (5 x 5 pixels). */
+static atmos_image *plan_frame(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,
+                               const atmos_plan_desc *pd, int air)
+{
+    atmos_scene sc = *s;
+    sc.renderer = ATMOS_RENDERER_SLICE;
+    sc.slice.air_shadows = air;
+    atmos_plan *plan = NULL;
+    atmos_frame f;
+    atmos_image *img = NULL;
+    if (atmos_plan_create(ctx, &sc, v, pd, &plan) == ATMOS_OK && atmos_frame_from_scene(ctx, &sc, &f) == ATMOS_OK &&
+        atmos_plan_image_create(plan, &f, &img) == ATMOS_OK && atmos_plan_render(plan, &f, NULL, img, NULL) != ATMOS_OK)
+        atmos_image_destroy(img), img = NULL;
+    atmos_plan_destroy(plan);
+    return img;
+}
+
+/* Two frames of one plan: without the shadows (atmos_frame.no_air_shadows) the bytes of a plan
+ * with "air_shadows" false, then with them those of a fresh plan with it true, and the two
+ * different (the shadow takes something). */
+static int frames_without_then_with(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,
+                                    const test_optics *op)
+{
+    atmos_plan_desc pd;
+    memset(&pd, 0, sizeof pd);
+    pd.optics = &op->o;
+    atmos_image *off = plan_frame(ctx, s, v, &pd, 0), *on = plan_frame(ctx, s, v, &pd, 1), *a = NULL, *b = NULL;
+    atmos_scene sc = *s;
+    sc.renderer = ATMOS_RENDERER_SLICE;
+    s = &sc;
+    atmos_plan *plan = NULL;
+    atmos_frame f;
+    int ok = off && on && atmos_plan_create(ctx, s, v, &pd, &plan) == ATMOS_OK &&
+             atmos_frame_from_scene(ctx, s, &f) == ATMOS_OK && atmos_plan_image_create(plan, &f, &a) == ATMOS_OK &&
+             atmos_plan_image_create(plan, &f, &b) == ATMOS_OK;
+    f.no_air_shadows = 1;
+    ok = ok && atmos_plan_render(plan, &f, NULL, a, NULL) == ATMOS_OK;
+    f.no_air_shadows = 0;
+    ok = ok && atmos_plan_render(plan, &f, NULL, b, NULL) == ATMOS_OK;
+    const size_t bytes = ok ? sizeof(float) * 25 * (size_t)a->channels : 0;
+    const int same = ok && !memcmp(a->pixels, off->pixels, bytes) && !memcmp(b->pixels, on->pixels, bytes) &&
+                     memcmp(a->pixels, b->pixels, bytes) != 0;
+    if (!same && ok)
+        printf("plan frames: A=off %d, B=on %d, A!=B %d; centre green A %g B %g off %g on %g\n",
+               !memcmp(a->pixels, off->pixels, bytes), !memcmp(b->pixels, on->pixels, bytes),
+               memcmp(a->pixels, b->pixels, bytes) != 0, a->pixels[12 * a->channels + 1], b->pixels[12 * a->channels + 1],
+               off->pixels[12 * a->channels + 1], on->pixels[12 * a->channels + 1]);
+    atmos_image_destroy(a), atmos_image_destroy(b), atmos_image_destroy(off), atmos_image_destroy(on);
+    atmos_plan_destroy(plan);
+    return same;
+}
+
 /* The closed form of what the shadow takes from the centre pixel, per channel. */
 static void closed_form(atmos_context *ctx, const atmos_scene *s, double tau, double *D)
 {
@@ -145,6 +197,8 @@ static void check_kind(int kind, const char *name)
             atmos_image *off = render(ctx, &so, v, &op);
             CHECK(memcmp(off->pixels, open->pixels, sizeof(float) * 25 * C) == 0);
             atmos_image_destroy(off);
+            /* a frame that leaves them out (the viewer's moving preview), then one with them */
+            CHECK(frames_without_then_with(ctx, &s, v, &op));
             /* one thread: the same bytes */
             atmos_context *c1 = make_ctx(1);
             atmos_image *one = render(c1, &s, v, &op);
