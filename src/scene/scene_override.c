@@ -97,6 +97,17 @@ static void drop_other_sources(cJSON *root, const cJSON *node, const char *tok)
     for (int i = 0; drop[i]; i++) cJSON_DeleteItemFromObjectCaseSensitive(vol, drop[i]);
 }
 
+/* The fog's density is one of "extinction_per_m" and "visibility_m": one set by an override
+ * replaces the other the file had (-D fog.visibility_m=500 on a scene that gives the
+ * extinction). */
+static void drop_other_density(cJSON *root, const cJSON *node, const char *tok)
+{
+    cJSON *fog = cJSON_GetObjectItemCaseSensitive(root, "fog");
+    if (!fog || node != fog) return;
+    if (!strcmp(tok, "visibility_m")) cJSON_DeleteItemFromObjectCaseSensitive(fog, "extinction_per_m");
+    else if (!strcmp(tok, "extinction_per_m")) cJSON_DeleteItemFromObjectCaseSensitive(fog, "visibility_m");
+}
+
 static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *root, const char *ov)
 {
     const char *eq = strchr(ov, '=');
@@ -119,8 +130,12 @@ static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *roo
     while ((r = next_token(&p, pointer, tok)) > 0) {
         if (!cJSON_IsObject(node) && !cJSON_IsArray(node)) break;
         if (!*p) {
-            if (put(node, tok, value)) return drop_other_sources(root, node, tok), ATMOS_OK;
-            return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%s': cannot set '%s' there", source, path, tok);
+            if (!put(node, tok, value))
+                return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%s': cannot set '%s' there", source, path,
+                                    tok);
+            drop_other_sources(root, node, tok);
+            drop_other_density(root, node, tok);
+            return ATMOS_OK;
         }
         node = child(node, tok);
         if (!node) break;

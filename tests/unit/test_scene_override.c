@@ -42,6 +42,12 @@ int main(void)
     /* no overrides: the plain parse */
     CHECK_OK(parse("{\"name\": \"x\"}", NULL, 0, &s));
     CHECK(!strcmp(s.name, "x") && !s.camera_given);
+    /* the fog's density is an extinction or a visibility: an override of one replaces the other */
+    const char *f[] = {"fog.visibility_m=391.2"}, *g[] = {"fog.extinction_per_m=0.02"};
+    CHECK_OK(parse("{\"fog\": {\"extinction_per_m\": 0.05}}", f, 1, &s));
+    CHECK(fabs(s.fog.extinction_per_m - 0.01) < 1e-12 && s.fog.visibility_m == 391.2);
+    CHECK_OK(parse("{\"fog\": {\"visibility_m\": 100}}", g, 1, &s));
+    CHECK(s.fog.extinction_per_m == 0.02 && s.fog.visibility_m == 0);
     atmos_context_destroy(ctx);
     return test_summary("test_scene_override");
 }
