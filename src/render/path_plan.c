@@ -487,7 +487,9 @@ static void report(atmos_context *ctx, const atmos_path_stats *st)
         atmos__log(ctx, ATMOS_LOG_WARN,
                    "render path: %lld of %lld paths (%.3g %%) reached the default limit of %d scattering events and "
                    "were stopped, their further light lost (an optically very thick volume: a conservative slab of "
-                   "optical depth 1000 loses about 4 %% of the light this way); path.max_depth sets the limit",
+                   "optical depth 1000 loses about 4 %% of the light this way; or a fog that fills all space and "
+                   "absorbs little, where paths wander without end: path.max_depth 1 gives its single scattering, "
+                   "what the beam renderer draws); path.max_depth sets the limit",
                    st->cut_paths, st->paths, 100.0 * (double)st->cut_paths / (double)(st->paths ? st->paths : 1),
                    PATH_DEFAULT_DEPTH);
     if (st->walks_ended > 0)

@@ -1243,7 +1243,9 @@ static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atm
     const unsigned ext = 1u, sca = 2u, g = 4u, vis = 32u, part = 64u;
     if (!!(it.seen & ext) == !!(it.seen & vis))
         return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
-                                 "needs one of \"extinction_per_m\" and \"visibility_m\"");
+                                 (it.seen & ext) ? "give only one of \"extinction_per_m\" and \"visibility_m\" (the same "
+                                                   "density two ways)"
+                                                 : "needs one of \"extinction_per_m\" and \"visibility_m\"");
     if ((it.seen & part) && (it.seen & (sca | g)))
         return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
                                  "a fog of a particle type takes its albedo and phase function from the type: "

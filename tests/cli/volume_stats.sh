@@ -52,6 +52,11 @@ head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "
 "$A" volume stats "$T/g.json" --kv >"$T/g1" 2>&1 && "$A" volume stats generate:cumulus_field --kv >"$T/g2" 2>&1 &&
     cmp -s "$T/g1" "$T/g2" && ok "a file and generate: give the same statistics" || bad "file and generate: differ"
 
+# outputs into folders not made yet: made, as atmos render makes them
+"$A" volume stats "$T/d.json" --mask-png "$T/new/sub/m.png" --csv "$T/new/c.csv" >/dev/null 2>"$T/e" &&
+    [ -s "$T/new/sub/m.png" ] && [ -s "$T/new/c.csv" ] && ok "--mask-png and --csv into new folders" ||
+    bad "outputs into new folders: $(cat "$T/e")"
+
 # errors
 "$A" volume stats >/dev/null 2>&1; [ $? -eq 2 ] && ok "no source: usage error" || bad "no source"
 "$A" volume stats "$T/d.json" --threshold -1 >/dev/null 2>&1; [ $? -eq 2 ] && ok "negative threshold" || bad "negative threshold"

@@ -277,7 +277,7 @@ static const bad_case bad_lights[] = {
     {"{\"fog\": {\"extinction_per_m\": 0.1, \"scattering_per_m\": 0.2}}", ATMOS_E_INVALID_ARG, "/fog/scattering_per_m: must be in [0, 0.1] (at most the extinction)", NULL},
     {"{\"fog\": {\"extinction_per_m\": 0.1, \"g\": 1}}", ATMOS_E_INVALID_ARG, "/fog/g: must be in (-1, 1)", NULL},
     {"{\"fog\": {\"g\": 0.5}}", ATMOS_E_INVALID_ARG, "/fog: needs one of \"extinction_per_m\" and \"visibility_m\"", NULL},
-    {"{\"fog\": {\"extinction_per_m\": 0.1, \"visibility_m\": 100}}", ATMOS_E_INVALID_ARG, "/fog: needs one of \"extinction_per_m\" and \"visibility_m\"", NULL},
+    {"{\"fog\": {\"extinction_per_m\": 0.1, \"visibility_m\": 100}}", ATMOS_E_INVALID_ARG, "/fog: give only one of \"extinction_per_m\" and \"visibility_m\"", NULL},
     {"{\"fog\": {\"visibility_m\": 0.1}}", ATMOS_E_INVALID_ARG, "/fog/visibility_m: must be in [0.3912, 10000000] (metres)", NULL},
     {"{\"fog\": {\"visibility_m\": 100, \"particle\": \"cloud\", \"g\": 0.5}}", ATMOS_E_INVALID_ARG, "/fog: a fog of a particle type takes its albedo and phase function from the type", NULL},
     {"{\"fog\": {\"visibility_m\": 100, \"particle\": \"smog\"}}", ATMOS_E_INVALID_ARG, "/fog/particle: 'smog' is neither in the scene's \"particles\" nor a preset", NULL},

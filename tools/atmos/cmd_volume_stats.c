@@ -1,6 +1,7 @@
 /* atmos volume stats: the shape statistics of cloud fields seen from above
  * (include/atmos/cloudstats.h, docs/clouds.md "Shape statistics"). No physics here. */
 #include "cli.h"
+#include "outputs.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -245,6 +246,9 @@ int cli_cmd_volume_stats(int argc, char **argv)
         }
     int rc = parse(argc, argv, &o);
     if (rc != CLI_EXIT_OK) return rc;
+    /* the outputs' folders made as atmos render makes them */
+    if ((o.csv && cli_output_folder("volume", "--csv", o.csv)) || (o.png && cli_output_folder("volume", "--mask-png", o.png)))
+        return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(o.threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
     FILE *csv = NULL;
