@@ -8,12 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-double atmos__beams_hg(double g, double c)
-{
-    const double q = 1 + g * g - 2 * g * c;
-    return (1 - g * g) / (4 * ATMOS_PI * q * sqrt(q));
-}
-
 /* Along o + t d the fog is A exp(-k t): A at the eye, k = d_y / H (0 for uniform fog). */
 static void fog_line(const atmos__beams_fog *f, const double o[3], const double d[3], double *A, double *k)
 {
@@ -155,5 +149,5 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
         sum += tm < INFINITY ? lookup(s, x0 + tm * x1, y0 + tm * y1, z0 + tm * z1) : 1;
     }
     const double c = atmos__dot3(s->dir, d);
-    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos__beams_hg(f->g, c)) * exp(-C) * whole * sum / n;
+    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C) * whole * sum / n;
 }

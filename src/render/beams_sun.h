@@ -52,7 +52,5 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
  * fog's layer above p, sigma(p) H / sun_y (INFINITY with the sun below the horizon); 0 in a
  * uniform fog (it has no top, and is lit undimmed). */
 double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], const double p[3]);
-/* The Henyey-Greenstein phase function at cos theta. */
-double atmos__beams_hg(double g, double cos_theta);
 
 #endif

@@ -242,6 +242,7 @@ typedef struct {
     const sshadow *sh;
     double hc, tfar;
     const sjob *j;
+    double ground_albedo; /* the flat ground's (Riley's, the homogeneous air's); 0: its shadow not drawn */
 } sframe;
 
 /* Pixel (x, y)'s ray: its world and grid-frame directions, its map ray, its span and the
@@ -264,11 +265,8 @@ static void ground_shadow(const sframe *f, const mray *m, const double dw[3], do
                           double *G)
 {
     for (int c = 0; c < n; c++) G[c] = 0.0;
-    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(f->atm);
-    const double albedo = atmos_atmosphere_ground_albedo(f->atm);
-    if ((kind != ATMOS_ATMOSPHERE_RILEY && kind != ATMOS_ATMOSPHERE_HOMOGENEOUS) || !(tg < f->tfar) || !(sun[1] > 0) ||
-        !(albedo > 0))
-        return;
+    const double albedo = f->ground_albedo;
+    if (!(albedo > 0) || !(tg < f->tfar) || !(sun[1] > 0)) return;
     const sshadow *sh = f->sh;
     float q = 0.0f;
     shadow_samples(sh->T, sh->N + 2, sh->D, (float)(m->q0[0] + tg * m->qd[0]), 0.0f, (float)(m->q0[1] + tg * m->qd[1]),
@@ -357,7 +355,10 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
         sh->valid = 1;
         sh->build_s = atmos__now() - tb0;
     }
-    sframe f = {atm, &v->cam, &sp->x, sh, atmos__dot3(j->h, cen), shadow_range(g, &sp->x, &v->cam, v->sun), j};
+    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(atm);
+    const int flat = kind == ATMOS_ATMOSPHERE_RILEY || kind == ATMOS_ATMOSPHERE_HOMOGENEOUS;
+    sframe f = {atm, &v->cam, &sp->x, sh, atmos__dot3(j->h, cen), shadow_range(g, &sp->x, &v->cam, v->sun), j,
+                flat ? atmos_atmosphere_ground_albedo(atm) : 0.0};
     const atmos__aerial *ap = shadow_table(sp, &f, v->sun, threads);
     if (!ap) {
         *secs = atmos__now() - t0;

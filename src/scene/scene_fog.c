@@ -7,12 +7,6 @@
 #include <math.h>
 #include <string.h>
 
-static double hg(double g, double mu)
-{
-    const double d = 1 + g * g - 2 * g * mu;
-    return (1 - g * g) / (4 * ATMOS_PI * d * sqrt(d));
-}
-
 static double hg_sample(double g, double u)
 {
     if (fabs(g) < 1e-4) return 1 - 2 * u;
@@ -92,7 +86,7 @@ atmos_status atmos__fog_optics_build(atmos_context *ctx, const atmos_scene *s, c
 
 double atmos__fog_phase(const atmos__fog_optics *f, double mu)
 {
-    if (!f->table) return hg(f->g, mu);
+    if (!f->table) return atmos_phase_hg(mu, f->g);
     double p = 0;
     for (int k = 0; k < f->nwl; k++) p += atmos_phase_table_eval(f->table, k, mu);
     return p / f->nwl;

@@ -39,7 +39,7 @@ static double quadrature(const atmos__beams_fog *f, const double sun[3], const a
         sum += f->albedo * s * exp(-tau_mid - in) * lit * h;
         tau += s * h;
     }
-    return sum * atmos__beams_hg(f->g, sun[0] * d[0] + sun[1] * d[1] + sun[2] * d[2]);
+    return sum * atmos_phase_hg(sun[0] * d[0] + sun[1] * d[1] + sun[2] * d[2], f->g);
 }
 
 static void unit(double v[3])
