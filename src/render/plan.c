@@ -60,6 +60,29 @@ static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const
     return ATMOS_OK;
 }
 
+/* The fog, the lights and the objects are drawn by the beam renderer and the path tracer only:
+ * a scene that gives them to another renderer is told so rather than silently drawn without. */
+static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
+{
+    if (s->renderer == ATMOS_RENDERER_BEAMS || s->renderer == ATMOS_RENDERER_PATH) return;
+    const char *part[3] = {s->fog.enabled ? "fog" : NULL, s->light_count > 0 ? "lights" : NULL,
+                           s->object_count > 0 ? "objects" : NULL};
+    const char *in_list[3];
+    int n = 0;
+    for (int i = 0; i < 3; i++)
+        if (part[i]) in_list[n++] = part[i];
+    char list[64] = "";
+    for (int i = 0; i < n; i++) {
+        if (i) strcat(list, i == n - 1 ? " and " : ", ");
+        strcat(list, in_list[i]);
+    }
+    if (list[0])
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "the %s renderer does not draw the scene's %s (the beam renderer and the path tracer do: "
+                   "\"renderer\": \"beams\" or \"path\")",
+                   atmos_renderer_name(s->renderer), list);
+}
+
 atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
                                const atmos_plan_desc *desc, atmos_plan **out)
 {
@@ -70,6 +93,7 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
     if (desc) d = *desc;
     atmos_status st = check_scene(ctx, scene, volume, &d);
     if (st != ATMOS_OK) return st;
+    warn_unused_parts(ctx, scene);
     atmos_plan *p = calloc(1, sizeof *p);
     if (!p) return atmos__error(ctx, ATMOS_E_NOMEM, "plan: out of memory");
     p->ctx = ctx;

@@ -3,8 +3,12 @@
 #  - a file that is not an image given as an Earth map: the message names the scene key, the
 #    path and the formats read (PNG, JPEG), not the image library's "Read Error";
 #  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
-#    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3).
+#    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3);
+#  - --volume with a -D naming another volume source: refused, both named, nothing written;
+#  - fog or lights given to the slice renderer: a warning that it does not draw them;
+#  - a beam scene without a sun: the status line names its lights, not an unused sun.
 . "$(dirname "$0")/common.inc"
+S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
 
 # --- a text file as the ground map
@@ -46,4 +50,25 @@ printf '{"volume": {"generate": "cumulus", "seed": 3}}' >"$T/gen.json"
 "$A" render "$T/gen.json" $common -D "$P" -D volume.density_unit=per_m3 --pfm "$T/gen.pfm" >/dev/null 2>"$T/err"
 st=$?
 [ $st -eq 0 ] && ok "scene with a generated volume, --volume FILE -D volume.density_unit (exit 0)" || { bad "generated scene + --volume FILE + -D volume.density_unit: exit $st"; cat "$T/err" >&2; }
+
+# --- --volume with a -D that names another source: refused, both named
+"$A" render --volume "$T/v.json" -D volume.generate=cirrus --width 8 --height 8 -o "$T/two.png" >/dev/null 2>"$T/err"
+st=$?
+[ $st -ne 0 ] && ok "--volume FILE with -D volume.generate is refused (exit $st)" || bad "--volume FILE with -D volume.generate was accepted"
+has "two volume sources" "volume.generate=cirrus"
+has "two volume sources" "give one of them"
+[ ! -e "$T/two.png" ] && ok "no image written for two sources" || bad "an image was written for two sources"
+
+# --- the fog and lights given to the slice renderer: drawn without them, and told so
+"$A" render --volume "$T/v.json" -D 'fog={"visibility_m":500}' --width 8 --height 8 -o "$T/fog.png" >/dev/null 2>"$T/err" ||
+    { bad "slice render with a fog"; cat "$T/err" >&2; }
+has "fog on the slice renderer" "slice renderer does not draw the scene's fog"
+"$A" render --volume "$T/v.json" --width 8 --height 8 -o "$T/nofog.png" >/dev/null 2>"$T/err"
+grep -q "does not draw" "$T/err" && bad "a warning without fog or lights" || ok "no warning without fog or lights"
+
+# --- a beam scene without a sun says what lights it, not where the unused sun stands
+"$A" render "$S/scenes/searchlights_fog.json" --width 24 --height 16 -o "$T/sl.png" >/dev/null 2>"$T/err" ||
+    { bad "searchlights render"; cat "$T/err" >&2; }
+has "searchlights status" "lit by its 7 lights and no sun"
+grep -q "sun at" "$T/err" && bad "the searchlights' status names a sun" || ok "the searchlights' status names no sun"
 exit $fail

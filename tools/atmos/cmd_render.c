@@ -239,8 +239,15 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
 {
     if (nframes > 1) fprintf(stderr, "atmos render: frame %d/%d: ", frame, nframes);
     else fprintf(stderr, "atmos render: ");
-    fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source, fs->width, fs->height,
-            info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
+    const atmos_renderer_kind rk = atmos_plan_renderer(plan);
+    const int lamps_only = (rk == ATMOS_RENDERER_BEAMS && !fs->beams.sun) ||
+                           (rk == ATMOS_RENDERER_PATH && (fs->light_count > 0 || fs->fog.enabled || fs->object_count > 0));
+    if (lamps_only) /* the sun lights neither (docs/beams.md, docs/path.md) */
+        fprintf(stderr, "%s, %dx%d, lit by its %d light%s and no sun, %.3f s rendering\n", source,
+                fs->width, fs->height, fs->light_count, fs->light_count == 1 ? "" : "s", info->seconds);
+    else
+        fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source,
+                fs->width, fs->height, info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
     if (ranks > 0) fprintf(stderr, "  rendered by rank %d\n", ranks);
     if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of at most %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
@@ -252,9 +259,9 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
         const atmos_path_stats *q = &ps.path;
         if (q->volume_pixels > 0)
             fprintf(stderr,
-                    "  path: %d spp, %lld scattering events; relative standard error over the volume's %lld pixels: "
+                    "  path: %d spp, %lld scattering events; relative standard error over the %s's %lld pixels: "
                     "mean %.2f %%, median %.2f %%, 90th percentile %.2f %% (over all pixels: mean %.2f %%)\n",
-                    q->spp, q->events, q->volume_pixels, 100.0 * q->volume_rel_error_mean,
+                    q->spp, q->events, atmos_plan_volume(plan, NULL) ? "volume" : "medium", q->volume_pixels, 100.0 * q->volume_rel_error_mean,
                     100.0 * q->volume_rel_error_median, 100.0 * q->volume_rel_error_p90, 100.0 * q->mean_rel_error);
         else
             fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", q->spp,

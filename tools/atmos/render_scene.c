@@ -126,6 +126,19 @@ static int volume_defines(const render_opts *o, const char **defs, char *buf, si
     return n;
 }
 
+/* --volume SOURCE names the volume; a -D that names one too (volume.file, .generate, .simulate
+ * or the whole "volume") would be overridden by one of them without a word: refused. Returns
+ * the offending define or NULL. */
+static const char *second_volume_source(const render_opts *o)
+{
+    static const char *keys[] = {"volume=", "volume.file=", "volume.generate=", "volume.simulate=",
+                                 "/volume=", "/volume/file=", "/volume/generate=", "/volume/simulate="};
+    for (int i = 0; o->volume && i < o->ndefines; i++)
+        for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+            if (!strncmp(o->defines[i], keys[k], strlen(keys[k]))) return o->defines[i];
+    return NULL;
+}
+
 int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
 {
     atmos_status st;
@@ -133,6 +146,12 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     const char *defs[RENDER_OPTS_MAX_DEFINES + 1];
     char source_def[ATMOS_SCENE_PATH_MAX + 64];
     static char paths[RENDER_OPTS_MAX_DEFINES][ATMOS_SCENE_PATH_MAX * 2 + 64]; /* one command's defines */
+    const char *twice = second_volume_source(o);
+    if (twice) {
+        fprintf(stderr, "atmos %s: --volume %s and -D %s both name the volume: give one of them\n", o->cmd, o->volume,
+                twice);
+        return CLI_EXIT_USAGE;
+    }
     const int ndefs = volume_defines(o, defs, source_def, sizeof source_def, paths);
     if (o->scene_path) {
         if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
