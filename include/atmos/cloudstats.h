@@ -79,7 +79,8 @@ typedef struct atmos_cloud_fit {
                                          [size_min_m, size_max_m] (a truncated power law) */
     double size_slope_hist, size_slope_hist_se; /* b by least squares on the log-binned
                                          histogram (bins a factor sqrt 2 wide) */
-    double size_min_m, size_max_m;
+    double size_min_m, size_max_m;    /* the range used; NaN when none was given and no cloud
+                                         was fitted (nothing to fit: every slope is NaN) */
     int size_n;                       /* clouds inside the size range */
     double flatness_median, flatness_mean; /* base sd / depth over the fitted clouds: median,
                                          and the mean weighted by area */

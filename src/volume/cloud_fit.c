@@ -133,9 +133,11 @@ void atmos_cloud_stats_fit(const atmos_cloud *clouds, int n, long cloudy_pixels,
     o->fit_area_max_m2 = o->fitted ? amax : NAN;
     o->size_min_m = desc && desc->size_min_m > 0 ? desc->size_min_m : (o->fitted ? dmin : sqrt(4 * min_px / ATMOS_PI) * dx_m);
     o->size_max_m = desc && desc->size_max_m > 0 ? desc->size_max_m : dmax;
+    const int range_given = desc && desc->size_min_m > 0 && desc->size_max_m > 0;
+    if (!range_given && !(o->fitted > 0 && o->size_max_m > o->size_min_m)) o->size_min_m = o->size_max_m = NAN; /* no range */
     double *ln_u = malloc((size_t)(n ? n : 1) * sizeof *ln_u), *dd = malloc((size_t)(n ? n : 1) * sizeof *dd);
     int m = 0;
-    for (int i = 0; i < n && ln_u && dd; i++) {
+    for (int i = 0; i < n && ln_u && dd && o->size_max_m > o->size_min_m; i++) {
         const atmos_cloud *c = &clouds[i];
         if (c->edge || c->diameter_m < o->size_min_m * (1 - 1e-12) || c->diameter_m > o->size_max_m * (1 + 1e-12)) continue;
         dd[m] = c->diameter_m;

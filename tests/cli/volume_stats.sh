@@ -67,4 +67,20 @@ head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "
     bad "unknown preset: $(cat "$T/e")"
 "$A" volume stats "$T/d.json" --field rain >/dev/null 2>"$T/e"; [ $? -eq 1 ] && grep -q "no field" "$T/e" && ok "--field rain: no such field" ||
     bad "--field rain"
+
+# no cloud above the threshold: said, not NaN and an inverted size range
+"$A" volume stats "$T/d.json" --threshold 1e9 >"$T/o" 2>&1 && grep -q "nothing to fit" "$T/o" && ! grep -q nan "$T/o" &&
+    ok "no clouds: nothing to fit, no NaN" || bad "no clouds: $(cat "$T/o")"
+"$A" volume stats "$T/d.json" --threshold 1e9 --kv >"$T/o" 2>&1 && grep -q "^size_min_m=nan" "$T/o" && grep -q "^size_clouds=0" "$T/o" &&
+    ok "no clouds: --kv size range nan" || bad "no clouds --kv: $(grep size_m "$T/o")"
+# reading options reach the file: --scale 0.5 halves every optical depth (the discs have tau between 10 and 20:
+# clouds at --threshold 10 read as they are, none read at half)
+"$A" volume stats "$T/d.json" --threshold 10 --kv >"$T/o" 2>&1 && [ "$(sed -n 's/^clouds=//p' "$T/o")" = 3 ] &&
+    "$A" volume stats "$T/d.json" --threshold 10 --scale 0.5 --kv >"$T/o" 2>&1 && [ "$(sed -n 's/^clouds=//p' "$T/o")" = 0 ] &&
+    ok "--scale reads the file scaled" || bad "--scale: $(cat "$T/o")"
+# options that would do nothing, and a source twice: usage errors naming them
+"$A" volume stats "$T/d.json" "$T/d.json" >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q "given twice" "$T/e" && ok "a source twice" || bad "a source twice"
+"$A" volume stats "$T/d.json" --minutes 3 >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q -- "--minutes" "$T/e" && ok "--minutes on a file" || bad "--minutes on a file"
+"$A" volume stats "$T/d.json" --seeds 3 >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q -- "--seeds" "$T/e" && ok "--seeds on a file" || bad "--seeds on a file"
+"$A" volume stats generate:cumulus --time 2 >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q "reading options" "$T/e" && ok "--time on a generator" || bad "--time on a generator"
 exit $fail

@@ -248,6 +248,7 @@ static void test_bad_input(void)
     CHECK(atmos_cloud_stats_measure(ctx, NULL, NULL, &s) == ATMOS_E_INVALID_ARG);
     CHECK_OK(atmos_cloud_stats_measure(ctx, &c, NULL, &s)); /* clear sky: no clouds, fits NAN */
     CHECK(s.nclouds == 0 && s.fit.cloud_fraction == 0 && isnan(s.fit.d) && isnan(s.fit.size_slope));
+    CHECK(s.fit.size_n == 0 && isnan(s.fit.size_min_m) && isnan(s.fit.size_max_m)); /* no range, not an inverted one */
     atmos_cloud_stats_free(&s);
     atmos_cloud_columns_free(&c);
     atmos_volume_desc vd = {.dims = {8, 8, 8}, .voxel_size_m = 10, .rotation = {0, 0, 1, 0, 1, 0, -1, 0, 0}};

@@ -41,7 +41,7 @@ void cli_volume_help(void)
            "            its top, voxels of --voxel-size metres (default 500).\n");
     cli_volume_stats_help();
     printf("\n"
-           "Reading options (info, slice):\n"
+           "Reading options (info, slice, stats):\n"
            "  --grids LIST      VDB/NanoVDB grids or NetCDF variables to read (comma-separated)\n"
            "  --as NAME         field name for a single-grid file (default cloud)\n"
            "  --scale S         multiplies the file's values (after the density unit's conversion)\n"
@@ -63,9 +63,9 @@ static int load(const char *path, atmos_context *ctx, const atmos_volume_load_de
     return st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
 }
 
-/* Options of how a file is read, shared by info and slice. Returns 1 if argv[*i] was
+/* Options of how a file is read, shared by info, slice and stats. Returns 1 if argv[*i] was
  * one (consuming its value), 0 if not, -1 after a usage error was printed. */
-static int load_option(int argc, char **argv, int *i, atmos_volume_load_desc *d)
+int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc *d)
 {
     const char *a = argv[*i];
     if (*i + 1 >= argc) return 0;
@@ -128,7 +128,7 @@ static int cmd_info(int argc, char **argv)
             return CLI_EXIT_OK;
         } else if (!strcmp(argv[i], "--json")) {
             json = 1;
-        } else if ((r = load_option(argc, argv, &i, &ld)) != 0) {
+        } else if ((r = cli_volume_load_option(argc, argv, &i, &ld)) != 0) {
             if (r < 0) return CLI_EXIT_USAGE;
         } else if (argv[i][0] == '-') {
             return cli_usage_error(C, "info: unknown or incomplete option '%s'", argv[i]);
@@ -276,7 +276,7 @@ static int cmd_slice(int argc, char **argv)
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             cli_volume_help();
             return CLI_EXIT_OK;
-        } else if ((lo = load_option(argc, argv, &i, &ld)) != 0) {
+        } else if ((lo = cli_volume_load_option(argc, argv, &i, &ld)) != 0) {
             if (lo < 0) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
             out = argv[++i];

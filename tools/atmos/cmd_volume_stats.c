@@ -17,15 +17,17 @@ typedef struct {
     const char *field, *csv, *png;
     double base_tau, minutes;
     uint64_t seed;
-    int seeds, grid, threads;
+    int seeds, grid, threads, seed_given, read_given;
     atmos_cloud_stats_desc sd;
+    atmos_volume_load_desc ld; /* how files are read (atmos volume's reading options) */
 } opts;
 
 void cli_volume_stats_usage(void)
 {
     printf("       atmos volume stats SOURCE... [--threshold T] [--connectivity 4|8] [--periodic|--no-periodic]\n"
            "                 [--min-pixels N] [--size-range DMIN,DMAX] [--field NAME] [--base-tau T]\n"
-           "                 [--seed S] [--seeds N] [--minutes M] [--grid N] [--kv] [--csv FILE] [--mask-png FILE]\n");
+           "                 [--seed S] [--seeds N] [--minutes M] [--grid N] [--kv] [--csv FILE] [--mask-png FILE]\n"
+           "                 [reading options]\n");
 }
 
 void cli_volume_stats_help(void)
@@ -48,14 +50,45 @@ void cli_volume_stats_help(void)
            "            depth from below reaches --base-tau, default 0.1) over its columns divided by its\n"
            "            depth (median and area-weighted mean). --kv prints key=value lines instead of the\n"
            "            summary; --csv writes one line per cloud; --mask-png the first source's mask (white\n"
-           "            clouds, grey edge clouds, dark grey thinner cloud, black clear; rows along z).\n");
+           "            clouds, grey edge clouds, dark grey thinner cloud, black clear; rows along z).\n"
+           "            Files are read with the reading options below; each source is measured once.\n");
+}
+
+/* Options that would do nothing for the sources given, and a source given twice (it would be
+ * pooled twice), are usage errors rather than silently ignored. */
+static int check_sources(const opts *o)
+{
+    int files = 0, gens = 0, sims = 0;
+    for (int s = 0; s < o->nsources; s++) {
+        const char *a = o->sources[s];
+        if (!strncmp(a, "simulate:", 9)) sims++;
+        else if (!strncmp(a, "generate:", 9)) gens++;
+        else files++;
+        for (int t = 0; t < s; t++)
+            if (!strcmp(a, o->sources[t]))
+                return cli_usage_error(C, "stats: '%s' is given twice: each source is measured once (--seeds N measures "
+                                          "N seeds of a generated or simulated one)", a);
+    }
+    if (o->read_given && !files)
+        return cli_usage_error(C, "stats: the reading options (--grids, --time, --density-unit, ...) apply to volume "
+                                  "files, and no source is a file");
+    if ((o->minutes > 0 || o->grid > 0) && !sims)
+        return cli_usage_error(C, "stats: --minutes and --grid apply to simulate:PRESET sources, and none is given");
+    if ((o->seed_given || o->seeds > 1) && !gens && !sims)
+        return cli_usage_error(C, "stats: --seed and --seeds apply to generate: and simulate: sources, and none is given");
+    return CLI_EXIT_OK;
 }
 
 static int parse(int argc, char **argv, opts *o)
 {
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int ok = 1;
+        int ok = 1, r = cli_volume_load_option(argc, argv, &i, &o->ld);
+        if (r < 0) return CLI_EXIT_USAGE;
+        if (r > 0) {
+            o->read_given = 1;
+            continue;
+        }
         if (!strcmp(a, "--kv")) o->kv = 1;
         else if (!strcmp(a, "--periodic")) o->periodic = 1;
         else if (!strcmp(a, "--no-periodic")) o->periodic = 0;
@@ -95,7 +128,7 @@ static int parse(int argc, char **argv, opts *o)
                 char *end = NULL;
                 unsigned long long s = strtoull(v, &end, 10);
                 if (!*v || *end || v[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", v);
-                o->seed = s;
+                o->seed = s, o->seed_given = 1;
             } else if (!strcmp(a, "--seeds")) ok = cli_parse_int(C, a, v, 1, 1000, &o->seeds);
             else if (!strcmp(a, "--minutes")) {
                 ok = cli_parse_double(C, a, v, &o->minutes);
@@ -108,7 +141,7 @@ static int parse(int argc, char **argv, opts *o)
         if (!ok) return CLI_EXIT_USAGE;
     }
     if (!o->nsources) return cli_usage_error(C, "stats: which volume? (a file, generate:PRESET or simulate:PRESET)");
-    return CLI_EXIT_OK;
+    return check_sources(o);
 }
 
 static atmos_status load_source(atmos_context *ctx, const opts *o, const char *src, uint64_t seed, atmos_volume **v)
@@ -121,7 +154,7 @@ static atmos_status load_source(atmos_context *ctx, const opts *o, const char *s
         atmos_sim_desc s = {.preset = src + 9, .minutes = o->minutes, .grid = o->grid, .seed = seed};
         return atmos_simulate(ctx, &s, v);
     }
-    return atmos_volume_load(ctx, src, NULL, v);
+    return atmos_volume_load(ctx, src, &o->ld, v);
 }
 
 /* The fields' extinction cross-sections (0 for fields left out by --field). */
@@ -182,6 +215,12 @@ static void print_fit(const opts *o, const atmos_cloud_fit *f, int sources, doub
     printf("%d source(s), pixels of %g m, cloudy where tau >= %g, %d-connected clouds\n", sources, dx, tau0,
            o->sd.connectivity ? o->sd.connectivity : 4);
     printf("  clouds %d (%d touching the edge, left out), cloud fraction %.3f\n", f->clouds, f->edge_clouds, f->cloud_fraction);
+    if (!f->fitted) {
+        printf("  no cloud of at least %g pixels away from the edge: nothing to fit (a lower --threshold, --min-pixels or "
+               "--periodic may find some)\n",
+               o->sd.fit_min_pixels > 0 ? o->sd.fit_min_pixels : 10);
+        return;
+    }
     printf("  perimeter-area dimension D = %.3f +- %.3f (crack perimeter %.3f +- %.3f) over %d clouds of %.3g..%.3g km^2\n",
            f->d, f->d_se, f->d_crack, f->d_crack_se, f->fitted, f->fit_area_min_m2 * 1e-6, f->fit_area_max_m2 * 1e-6);
     printf("  size distribution n(d) ~ d^-b: b = %.2f +- %.2f (max. likelihood), %.2f +- %.2f (histogram) over %d clouds of "
