@@ -11,7 +11,8 @@ static const char *C = "simulate";
 
 static void help(void)
 {
-    printf("Usage: atmos simulate PRESET -o NAME.json [--minutes M] [--grid N] [--seed S] [--threads T] [--quiet]\n\n"
+    printf("Usage: atmos simulate PRESET -o NAME.json [--minutes M] [--grid N] [--seed S] [--threads T]\n"
+           "                      [--quiet]\n\n"
            "Runs the cloud-physics simulation (docs/clouds.md): a 3-D Boussinesq fluid with potential\n"
            "temperature, water vapour, cloud water and rain, Kessler warm rain and saturation adjustment,\n"
            "periodic sides. Writes the state at time M as a volume of \"cloud\" and \"rain\" number\n"

@@ -14,7 +14,8 @@ static const char *C = "volume";
 void cli_volume_help(void)
 {
     printf("Usage: atmos volume info FILE [--json] [reading options]\n"
-           "       atmos volume generate PRESET -o NAME.json [--seed N] [--voxel-size M] [--scale S] [--threads T]\n"
+           "       atmos volume generate PRESET -o NAME.json [--seed N] [--voxel-size M] [--scale S]\n"
+           "                 [--threads T]\n"
            "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png [reading options]\n"
            "       atmos volume clouds SCENE.json -o NAME.json [--centre X,Z] [--half-width M] [--voxel-size M]\n");
     cli_volume_stats_usage();
@@ -24,12 +25,16 @@ void cli_volume_help(void)
            "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
            "            {\"fields\": [{\"name\", \"particle\", \"active_voxels\", \"nonzero_voxels\", \"min\", \"max\",\n"
            "             \"bounds_m\"}], \"dims\", \"voxel_size_m\", \"origin_m\", \"grid_bounds_m\", \"memory_bytes\"}.\n"
-           "            active_voxels\n"
-           "            is the file's own count where it has one (OpenVDB, NanoVDB: active tiles count as\n"
-           "            the voxels they cover, active zeros included), else the voxels > 0.\n"
+           "            active_voxels is the file's own count where it has one (OpenVDB, NanoVDB: active\n"
+           "            tiles count as the voxels they cover, active zeros included), else the voxels > 0.\n"
            "  generate  builds a preset cloud volume and writes it as raw float32 files plus a JSON\n"
            "            sidecar. Presets: ");
-    for (const char *const *n = atmos_scene_generator_names(); *n; n++) printf("%s%s", *n, n[1] ? ", " : "\n");
+    int col = 30; /* "            sidecar. Presets: " */
+    for (const char *const *n = atmos_scene_generator_names(); *n; n++) {
+        if (col + (int)strlen(*n) + 2 > 100) printf("\n            "), col = 12;
+        col += printf("%s%s", *n, n[1] ? "," : "\n");
+        if (n[1] && col + (int)strlen(n[1]) + 3 <= 100) col += printf(" ");
+    }
     printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
            "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"

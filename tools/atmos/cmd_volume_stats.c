@@ -26,8 +26,8 @@ void cli_volume_stats_usage(void)
 {
     printf("       atmos volume stats SOURCE... [--threshold T] [--connectivity 4|8] [--periodic|--no-periodic]\n"
            "                 [--min-pixels N] [--size-range DMIN,DMAX] [--field NAME] [--base-tau T]\n"
-           "                 [--seed S] [--seeds N] [--minutes M] [--grid N] [--kv] [--csv FILE] [--mask-png FILE]\n"
-           "                 [reading options]\n");
+           "                 [--seed S] [--seeds N] [--minutes M] [--grid N] [--kv] [--csv FILE]\n"
+           "                 [--mask-png FILE] [reading options]\n");
 }
 
 void cli_volume_stats_help(void)

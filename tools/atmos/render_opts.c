@@ -536,12 +536,36 @@ static const char *num(char *buf, size_t cap, double v)
     return buf;
 }
 
-/* One --help line per settings row: flag, argument, doc, range and default. */
+#define NBSP '\x1f' /* a space --help's wrapping does not break at */
+
+/* An option and its text in --help's two columns, the text wrapped at 100 characters on
+ * word boundaries (a word longer than the column runs on). */
+static void help_wrapped(const char *opt, const char *text)
+{
+    enum { LEFT = 30, WIDTH = 100 };
+    int col = printf("      %-24s", opt);
+    const char *w = text;
+    while (*w) {
+        size_t n = strcspn(w, " ");
+        if (col > LEFT && col + 1 + (int)n > WIDTH) printf("\n%*s", LEFT, ""), col = LEFT;
+        col += printf(" ");
+        for (size_t k = 0; k < n; k++) putchar(w[k] == NBSP ? ' ' : w[k]); /* a range stays on one line */
+        col += (int)n;
+        w += n;
+        while (*w == ' ') w++;
+    }
+    printf("\n");
+}
+
+/* One --help line per settings row: flag, argument, doc, range and default; a flag that
+ * turns a setting off says so. */
 static void help_settings(atmos_renderer_kind r, const char *title)
 {
     int n;
     const atmos_setting *t = atmos_renderer_settings(r, &n);
-    printf("%s (the scene's \"%s\" section; docs/scene-format.md):\n", title, atmos_renderer_name(r));
+    const int len = (int)strlen(title) + (int)strlen(atmos_renderer_name(r)) + 45;
+    printf("%s%s(the scene's \"%s\" section; docs/scene-format.md):\n", title, len > 100 ? "\n  " : " ",
+           atmos_renderer_name(r));
     for (int i = 0; i < n; i++) {
         const atmos_setting *s = &t[i];
         if (!s->flag) continue;
@@ -551,7 +575,13 @@ static void help_settings(atmos_renderer_kind r, const char *title)
             snprintf(range, sizeof range, " [%s%s, %s%s%s%s], default %s", s->min_open ? "> " : "", num(a, sizeof a, s->min),
                      num(b, sizeof b, s->max), s->max_open ? ")" : "", s->unit[0] ? " " : "", s->unit,
                      num(c, sizeof c, s->def));
-        printf("      %-24s %s%s\n", opt, s->doc, range);
+        for (char *q = range + 1; *q; q++) /* " [min, max unit], default d": the bracket unbroken */
+            if (*q == ' ' && q[-1] != ']' && q[-1] != ',') *q = NBSP;
+            else if (*q == ' ' && q[-1] == ',' && strchr(q, ']')) *q = NBSP;
+        char text[1024];
+        snprintf(text, sizeof text, "%s%s%s", strncmp(s->flag, "no-", 3) ? "" : "turns off (on by default): ", s->doc,
+                 range);
+        help_wrapped(opt, text);
     }
     printf("\n");
 }
@@ -648,9 +678,10 @@ void render_opts_help(void)
            "                                given), spectral Monte Carlo path tracing (the reference,\n"
            "                                docs/path.md), Nishita et al. 1996's ray marching with orders 2-3\n"
            "                                and sky light from a light field (docs/lightfield.md), or\n"
-           "                                Harris's particle clouds (the volume as particles, docs/particles.md),\n"
-           "                                or Dobashi et al. 2002's light beams of the scene's \"lights\" in its\n"
-           "                                \"fog\" with the shadows of its \"objects\" (docs/beams.md)\n"
+           "                                Harris's particle clouds (the volume as particles,\n"
+           "                                docs/particles.md), or Dobashi et al. 2002's light beams of the\n"
+           "                                scene's \"lights\" in its \"fog\" with the shadows of its \"objects\"\n"
+           "                                (docs/beams.md)\n"
            );
     help_volume();
     printf(
@@ -681,8 +712,8 @@ void render_opts_help(void)
            "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");
     printf("One rule for every renderer: an option of another renderer than the one rendering is refused\n"
            "(exit 2, naming the renderer it goes with); --spp is the one option all renderers share. A scene\n"
-           "file may keep a \"slice\", a \"path\" and a \"harris\" section (for --renderer to switch between them); only the\n"
-           "rendering renderer's is used.\n\n");
+           "file may keep a section for each renderer (\"slice\", \"path\", \"nishita\", \"harris\", \"beams\":\n"
+           "--renderer switches between them); only the rendering renderer's is used.\n\n");
     help_settings(ATMOS_RENDERER_SLICE, "Slice renderer");
     help_settings(ATMOS_RENDERER_PATH, "Path tracer");
     help_settings(ATMOS_RENDERER_NISHITA, "Nishita renderer (Nishita et al. 1996: orders 2-3 and sky light by a light field)");
@@ -707,5 +738,6 @@ void render_opts_help(void)
            "  atmos render --volume wdas_cloud_sixteenth.vdb --renderer path --spp 64\n"
            "  atmos render --volume wrfout_d01.nc --time-index 6 --grids QCLOUD,QICE --view-elevation -45\n"
            "  atmos render scenes/fig06_halo_cirrus.json -D camera.fov_deg=30 -D renderer=path\n"
-           "  atmos render scenes/fig01_cirrus_sunrise.json --frames 8 --time-end 2026-06-21T12:30:00Z -o out/cirrus.png\n");
+           "  atmos render scenes/fig01_cirrus_sunrise.json --frames 8 --time-end 2026-06-21T12:30:00Z \\\n"
+           "      -o out/cirrus.png\n");
 }

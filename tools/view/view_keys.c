@@ -72,7 +72,12 @@ void view_keys_help(FILE *f)
     fprintf(f, "Mouse: drag with any button to look around (orbiting: to move about the volume);\n"
                "  the wheel zooms.\n"
                "Script names of the keys (\"press\" in a flight file):");
-    for (int i = 1; i < VA_COUNT; i++) fprintf(f, "%s%s", i == 1 ? " " : ", ", names[i]);
+    int col = 100; /* the names from the next line on, wrapped at 100 characters */
+    for (int i = 1; i < VA_COUNT; i++) {
+        if (col + (int)strlen(names[i]) + 3 > 100) fprintf(f, "%s\n ", i == 1 ? "" : ","), col = 1;
+        else if (i > 1) fprintf(f, ","), col++;
+        col += fprintf(f, " %s", names[i]);
+    }
     fprintf(f, "\n");
 }
 
