@@ -50,13 +50,13 @@ for c in $CASES; do
         echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[],[]" >> "$csv"
         for v in $VARIANTS; do
             case $v in
-            eq25) opts="" ;;
-            eq25_xi0) opts="--xi 0" ;;
-            eq25_xi4) opts="--xi 0.0318" ;;
-            eq24) opts="--eq24" ;;
+            eq25) opts="--no-diffuse" ;;
+            eq25_xi0) opts="--no-diffuse --xi 0" ;;
+            eq25_xi4) opts="--no-diffuse --xi 0.0318" ;;
+            eq24) opts="--no-diffuse --eq24" ;;
             low_albedo) opts="--low-albedo" ;;
-            diffuse) opts="--diffuse" ;;
-            diffuse_xi0) opts="--diffuse --xi 0" ;;
+            diffuse) opts="" ;;
+            diffuse_xi0) opts="--xi 0" ;;
             nishita) opts="--renderer nishita" ;;
             harris) opts="--renderer harris" ;;
             harris_sun) opts="--renderer harris --sky-lights 0" ;;

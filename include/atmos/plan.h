@@ -71,6 +71,10 @@ typedef struct atmos_frame {
                                    docs/viewer.md): the viewer's frames; 0 or 1 = every pixel */
     int no_air_shadows;         /* slice renderer: 1 leaves out the volume's shadow on the air and the ground
                                    (the scene's "air_shadows") for this frame: the viewer's moving preview; 0 */
+    int warm_field;             /* slice renderer: 1 starts the diffuse field after a sun move from the last
+                                   sun's (2-3 times faster, but the image then depends on the frames before it
+                                   to the solver's tolerance: the viewer); 0 builds it afresh, so that a frame
+                                   is the same however it was reached (renders, animations, MPI ranks) */
     atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
 } atmos_frame;
 

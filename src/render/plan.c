@@ -218,6 +218,7 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
     v->eye_scale = f->eye_scale != 0 ? f->eye_scale : p->scene.slice.eye_scale;
     v->sky_step = f->sky_step > 1 ? f->sky_step : 1;
     v->no_air_shadows = f->no_air_shadows != 0;
+    v->warm_field = f->warm_field != 0;
     if (f->sky_step < 0 || f->sky_step > 16)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: sky_step must be in [0, 16], got %d", f->sky_step);
     if (v->samples_per_pixel < 1 || v->samples_per_pixel > 256)

@@ -183,7 +183,7 @@ static void field_sky(atmos__slice_plan *sp, const atmos_atmosphere *atm, const 
 }
 
 atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
-                                       const double sun_w[3], int *built)
+                                       const double sun_w[3], int warm, int *built)
 {
     atmos__lfield *fl = &sp->field;
     *built = 0;
@@ -207,7 +207,7 @@ atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp
     const double t1 = atmos__now();
     atmos__ldiffusion_opts o = {0};
     o.limiter = 1; /* measured better than without (docs/lightfield.md) */
-    o.cascade = fl->valid ? 0 : 2; /* a cold start from coarser grids' solutions; else the last sun's field */
+    o.cascade = fl->valid && warm ? 0 : 2; /* a cold start from coarser grids' solutions; else the last sun's field */
     fl->sweeps = atmos__lfield_diffuse(&sp->fmed, &src, fl->phi, &o, threads);
     if (fl->sweeps < 0) {
         free(Q);

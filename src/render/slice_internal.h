@@ -161,10 +161,11 @@ void atmos__slice_shadow_free(atmos__slice_plan *sp);
 
 /* The diffuse light field: its medium built from the render grid and the optics (once per
  * plan), and the field brought up to date for the sun direction sun_w (a solve when the sun
- * moved, warm-started from the last one; *built: 1 if it solved, 0 if it kept the field). */
+ * moved: warm-started from the last one when warm, else from the coarse grids' cascade as
+ * the first; *built: 1 if it solved, 0 if it kept the field). */
 atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *sp, const atmos_volume_optics *o);
 atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
-                                       const double sun_w[3], int *built);
+                                       const double sun_w[3], int warm, int *built);
 
 /* The field turned toward the eye at render-voxel coordinate eye: the field's L and A
  * (atmos__lfield_toward, the reference passes' view) and, per cell and field f, what a unit

@@ -119,7 +119,7 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         if ((st = atmos__slice_frame_setup(ctx, sp, p->atm, v, r, &j)) != ATMOS_OK) return st;
         if (sp->diffuse) {
             int built;
-            if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun, &built)) != ATMOS_OK) return st;
+            if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun, v->warm_field, &built)) != ATMOS_OK) return st;
             j.field = &sp->field;
             j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->fg;
             double eu[3]; /* the eye in render-voxel coordinates */

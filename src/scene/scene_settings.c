@@ -36,9 +36,10 @@ static const atmos_setting slice_settings[] = {
      SLICE(eye_scale)},
     {"max_order", "max-order", ATMOS_SETTING_INT, "", 1, 1000, 0, 0, 64, NULL, 0,
      "orders of Ams tabulated (higher scattering orders use the last)", SLICE(max_order)},
-    {"diffuse", "diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
-     "add the diffuse light of all orders that Eq. 24/25 drop: a diffusion solve on a coarse grid, "
-     "once per sun direction (docs/lightfield.md)",
+    {"diffuse", "no-diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "the diffuse light of all orders that Eq. 24/25 drop, from a diffusion solve on a coarse grid once "
+     "per sun direction (docs/lightfield.md); off: Riley's Eq. 24/25 alone, which lose most of the light "
+     "of dense clouds",
      SLICE(diffuse)},
     {"air_shadows", "no-air-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
      "the volume's shadow on the air's single scattering (light shafts, crepuscular rays); "

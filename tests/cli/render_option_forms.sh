@@ -46,7 +46,7 @@ cat >"$T/table" <<'EOF'
 --grid-max-dim 8|slice.grid_max_dim=8|slice|
 --eye-scale 0.5|slice.eye_scale=0.5|slice|
 --max-order 1|slice.max_order=1|slice|same
---diffuse|slice.diffuse=true|slice|
+--no-diffuse|slice.diffuse=false|slice|
 --no-air-shadows|slice.air_shadows=false|slice|
 --spp 3|path.spp=3|path|
 --time-budget 1000|path.time_budget_s=1000|path|same

@@ -23,7 +23,7 @@ static void help(void)
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S]\n"
-           "                         [--diffuse] [--no-air-shadows] [--json]\n"
+           "                         [--no-diffuse] [--no-air-shadows] [--json]\n"
            "       atmos bench slice --aerial [--file FILE] [--models LIST] [--density-scale S] [--size N]\n"
            "                         [--repeat R] [--threads T] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
@@ -77,8 +77,9 @@ static void help(void)
            "          (sun moving), ns per sample and the breakdown of a frame (setup, light, eye, sky);\n"
            "          prepare_ms: making the plan (render grid, tables; the optics included).\n"
            "          --eye-scale S renders the eye passes on an S-times smaller buffer per axis.\n"
-           "          --diffuse adds the diffuse light field (\"diffuse\"); field_ms: its build (source and\n"
-           "          diffusion solve, warm-started) after the sun's last move, field_sweeps its sweeps;\n"
+           "          --no-diffuse leaves out the diffuse light field (\"diffuse\", on by default); field_ms:\n"
+           "          its build (source and diffusion solve, warm-started) after the sun's last move,\n"
+           "          field_sweeps its sweeps;\n"
            "          field_cold_ms, field_cold_sweeps: the plan's first frame's (no warm start).\n"
            "          --no-air-shadows leaves out the volume's shadow on the air (\"air_shadows\", on by\n"
            "          default); air_shadow_ms: its share of the last sun-moving frame (part of sky_ms).\n"
@@ -524,7 +525,7 @@ int cli_cmd_bench(int argc, char **argv)
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16, aerial = 0;
     double dscale = 0, eye_scale = 0, budget = 2;
-    int diffuse = 0, air_shadows = 1;
+    int diffuse = 1, air_shadows = 1;
     const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL;
     if (argc > 1 && !strcmp(argv[1], "sky-accuracy")) return bench_sky_accuracy_main(argc - 1, argv + 1);
     bench_path_opts pflags;
@@ -556,8 +557,8 @@ int cli_cmd_bench(int argc, char **argv)
             json = 1;
         } else if (!strcmp(argv[i], "--aerial")) {
             aerial = 1;
-        } else if (!strcmp(argv[i], "--diffuse")) {
-            diffuse = 1;
+        } else if (!strcmp(argv[i], "--diffuse") || !strcmp(argv[i], "--no-diffuse")) {
+            diffuse = argv[i][2] == 'd';
         } else if (!strcmp(argv[i], "--no-air-shadows")) {
             air_shadows = 0;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {

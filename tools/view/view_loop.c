@@ -141,6 +141,7 @@ static atmos_status render(loop *L, view_state *s, int preview, int saving, atmo
     if ((st = atmos_frame_from_scene(L->ctx, L->sc, &f)) != ATMOS_OK) return st;
     view_state_frame(s, &f);
     if (!saving) f.sky_step = VIEW_SKY_STEP;
+    f.warm_field = !saving; /* a saved frame is the offline render's: its field built afresh */
     if (s->renderer == ATMOS_RENDERER_SLICE && preview) {
         f.eye_scale = 0.5 * (f.eye_scale > 0 ? f.eye_scale : 1.0);
         f.no_air_shadows = 1; /* the shadows on the air and ground come back when the view is still */
