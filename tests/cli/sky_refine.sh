@@ -5,6 +5,7 @@
 #    (--max-paths = --paths), each view's reference is the previous run's to the digit;
 #  - with a threshold, exactly the views of FILE above it get more walks (a smaller standard
 #    error), every other view keeps FILE's reference, walks and error;
+#  - with --refine-sigmas K, also the views within K standard errors of the threshold;
 #  - the report lists the picked views; the same figures with 1 and 2 threads;
 #  - a FILE that does not fit the run (another grid, another wavelength set, no rows, not a
 #    CSV, missing) is refused with a clear message, before any walk.
@@ -34,6 +35,8 @@ acc --threads 2 --refine "$T/a/results.csv" --refine-above "$X" --target-se 0.00
     --out "$T/b" >"$T/b.txt" 2>"$T/b.err" || { bad "--refine-above $X failed"; cat "$T/b.err" >&2; }
 acc --threads 1 --refine "$T/a/results.csv" --refine-above "$X" --target-se 0.002 --max-paths 1024 \
     --out "$T/b1" >/dev/null 2>&1 || bad "--refine with 1 thread failed"
+acc --threads 2 --refine "$T/a/results.csv" --refine-above "$X" --refine-sigmas 1 --target-se 0.002 --max-paths 256 \
+    --out "$T/c" >/dev/null 2>&1 || bad "--refine-sigmas 1 failed"
 grep -q "Views measured again" "$T/b.txt" && ok "the report lists the views measured again" ||
     bad "no list of the views measured again"
 
@@ -72,6 +75,18 @@ text = open(T + "/b.txt").read()
 listed = text[text.find("Views measured again"):].splitlines() if "Views measured again" in text else []
 n = sum(1 for line in listed if line.startswith("| ") and not line.startswith("| altitude"))
 check(n == len(picked), "the list has one row per picked view (%d, %d picked)" % (n, len(picked)))
+# --refine-sigmas K: also the views whose error could pass X within K standard errors (relative
+# to the errors' denominator, max(Y, 1e-3 x the block's largest Y))
+c = rows("c")
+bmax = {}
+for k in a:
+    bmax[k[:2]] = max(bmax.get(k[:2], 0.0), float(a[k]["ref_Y"]))
+def could(k):
+    den = max(float(a[k]["ref_Y"]), 1e-3 * bmax[k[:2]])
+    return abs(float(a[k]["rel_err_Y"])) + (float(a[k]["ref_Y_se"]) / den if den > 0 else 0) > X
+wide = [k for k in a if could(k)]
+check(len(wide) > len(picked) and all((c[k]["paths"] != "128") == (k in wide) for k in a),
+      "--refine-sigmas 1: %d views measured again, the %d within a standard error of the threshold too" % (len(wide), len(wide) - len(picked)))
 sys.exit(failed)
 EOF
 
@@ -94,4 +109,7 @@ refused "a missing file" 1 --quick --refine "$T/none.csv"
 "$cli" bench sky-accuracy --quick --refine "$T/a/results.csv" --refine-above -1 >/dev/null 2>"$T/neg.err"
 [ $? -eq 2 ] && grep -q -- "--refine-above" "$T/neg.err" && ok "--refine-above -1 is a usage error" ||
     bad "--refine-above -1 should exit 2"
+"$cli" bench sky-accuracy --quick --refine "$T/a/results.csv" --refine-sigmas -1 >/dev/null 2>"$T/negs.err"
+[ $? -eq 2 ] && grep -q -- "--refine-sigmas" "$T/negs.err" && ok "--refine-sigmas -1 is a usage error" ||
+    bad "--refine-sigmas -1 should exit 2"
 exit $fail

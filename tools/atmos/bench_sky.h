@@ -40,6 +40,7 @@ typedef struct {
     double alt_m[8], sun_deg[8];
     const char *refine;      /* a previous run's results.csv: its references, its worst views again */
     double refine_above;     /* ... those whose |relative error of Y| exceeds this */
+    double refine_sigmas;    /* ... or could, within this many of the reference's standard errors */
 } acc_opts;
 
 /* Everything a run measured, for the report. */
@@ -55,7 +56,7 @@ typedef struct {
     /* --refine (per view, NULL otherwise): measured again; the previous run's reference Y,
      * its standard error and walks */
     unsigned char *pick;
-    double *prev_y, *prev_se_y;
+    double *prev_y, *prev_se_y, *prev_err; /* prev_err: the largest |error of Y| of the run's models */
     long *prev_paths;
     acc_stats stats[ACC_MODELS][8][8];
     double seconds;

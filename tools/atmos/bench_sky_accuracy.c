@@ -24,7 +24,8 @@ static void help(void)
     printf("Usage: atmos bench sky-accuracy [--quick] [--paths N] [--target-se X] [--max-paths N]\n"
            "                                [--models riley,dobashi,spherical] [--spectral N] [--seed S]\n"
            "                                [--threads T] [--out DIR] [--map-range X] [--floor X]\n"
-           "                                [--altitudes LIST] [--suns LIST] [--refine FILE [--refine-above X]]\n\n"
+           "                                [--altitudes LIST] [--suns LIST]\n"
+           "                                [--refine FILE [--refine-above X] [--refine-sigmas K]]\n\n"
            "Compares each model's view radiance (atmos_atmosphere_radiance, the sun's disk hidden) with\n"
            "the reference (atmos_atmosphere_reference_radiance: Monte Carlo walks, all orders) on a fixed\n"
            "grid: observers at 0, 10, 100, 1000 and 36 000 km above the ground, suns at 90, 45, 10, 2,\n"
@@ -52,7 +53,9 @@ static void help(void)
            "                   --quick, --altitudes, --suns, --spectral, --seed and --paths) and measure again,\n"
            "                   from their first batch with their own seeds, the views whose |relative error of\n"
            "                   Y| in FILE (for a model of --models) exceeds --refine-above X (default 0.03),\n"
-           "                   with --target-se and --max-paths; the report lists them before and after\n");
+           "                   with --target-se and --max-paths; the report lists them before and after\n"
+           "  --refine-sigmas K  ... also the views whose error could exceed X within K of FILE's standard\n"
+           "                   errors (|error| + K s.e. > X; default 0)\n");
 }
 
 /* ------------------------------------------------------------------ the grid */
@@ -385,6 +388,9 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
         } else if (!strcmp(a, "--refine-above")) {
             if (!cli_parse_double(C, a, val, &o->refine_above) || !(o->refine_above >= 0))
                 return cli_usage_error(C, "--refine-above: expected a relative error >= 0");
+        } else if (!strcmp(a, "--refine-sigmas")) {
+            if (!cli_parse_double(C, a, val, &o->refine_sigmas) || !(o->refine_sigmas >= 0 && o->refine_sigmas <= 100))
+                return cli_usage_error(C, "--refine-sigmas: expected a number of standard errors in [0, 100]");
         } else if (!strcmp(a, "--out")) {
             o->out = val;
         } else if (!strcmp(a, "--map-range")) {
@@ -437,7 +443,7 @@ static atmos_status acc_alloc(acc_run *r)
 static void acc_free(acc_run *r)
 {
     free(r->ref), free(r->se), free(r->paths_used);
-    free(r->pick), free(r->prev_y), free(r->prev_se_y), free(r->prev_paths);
+    free(r->pick), free(r->prev_y), free(r->prev_se_y), free(r->prev_paths), free(r->prev_err);
     for (int m = 0; m < ACC_MODELS; m++) free(r->mod[m]);
 }
 

@@ -79,8 +79,8 @@ static int header_cols(const acc_run *r, const acc_opts *o, char **head, int nh,
     return 0;
 }
 
-/* One row: its view's reference, standard errors and walks; picks the view when the row's
- * model is one of the run's and its error of Y exceeds the threshold. */
+/* One row: its view's reference, standard errors and walks, and its error of Y when the
+ * row's model is one of the run's. */
 static int load_row(acc_run *r, const acc_opts *o, char **f, const int *col, const int *ref, const int *se,
                     unsigned char *have, int line)
 {
@@ -109,7 +109,7 @@ static int load_row(acc_run *r, const acc_opts *o, char **f, const int *col, con
     r->prev_y[j] = acc_luminance(&r->wl, r->ref + i);
     r->prev_se_y[j] = sqrt(vy);
     have[j] = 1;
-    if (model_used(o, f[col[COL_MODEL]]) && fabs(x[COL_ERR]) > o->refine_above) r->pick[j] = 1;
+    if (model_used(o, f[col[COL_MODEL]])) r->prev_err[j] = fmax(r->prev_err[j], fabs(x[COL_ERR]));
     return 0;
 }
 
@@ -133,6 +133,23 @@ static int load_rows(acc_run *r, const acc_opts *o, char *text, unsigned char *h
     return rc;
 }
 
+/* The views to measure again: |error of Y| + sigmas x the reference's relative standard
+ * error of Y (over the errors' denominator, max(Y, floor x the block's largest Y)) above
+ * the threshold. */
+static void pick_views(acc_run *r, const acc_opts *o)
+{
+    for (int a = 0; a < r->nalt; a++)
+        for (int s = 0; s < r->nsun; s++) {
+            const double ymax = acc_block_max(r, a, s, -1);
+            for (int v = 0; v < r->nview[a]; v++) {
+                const size_t j = acc_index(r, a, s, v) / (size_t)r->wl.count;
+                const double den = fmax(r->prev_y[j], o->floor * ymax);
+                const double rse = den > 0 ? r->prev_se_y[j] / den : 0.0;
+                r->pick[j] = r->prev_err[j] + o->refine_sigmas * rse > o->refine_above;
+            }
+        }
+}
+
 int acc_refine_load(acc_run *r, const acc_opts *o)
 {
     const size_t nv = (size_t)r->nalt * (size_t)r->nsun * ACC_MAX_VIEWS;
@@ -142,11 +159,12 @@ int acc_refine_load(acc_run *r, const acc_opts *o)
     r->prev_y = calloc(nv, sizeof(double));
     r->prev_se_y = calloc(nv, sizeof(double));
     r->prev_paths = calloc(nv, sizeof(long));
+    r->prev_err = calloc(nv, sizeof(double));
     int rc = 0;
     if (!text) {
         fprintf(stderr, "atmos bench: --refine: cannot read %s\n", o->refine);
         rc = CLI_EXIT_RUNTIME;
-    } else if (!have || !r->pick || !r->prev_y || !r->prev_se_y || !r->prev_paths) {
+    } else if (!have || !r->pick || !r->prev_y || !r->prev_se_y || !r->prev_paths || !r->prev_err) {
         rc = CLI_EXIT_RUNTIME;
     } else {
         rc = load_rows(r, o, text, have);
@@ -160,6 +178,7 @@ int acc_refine_load(acc_run *r, const acc_opts *o)
                                          "this run's grid",
                                          o->refine, r->alt_m[a], r->sun_deg[s], r->view[a][v].zenith_deg,
                                          r->view[a][v].dazimuth_deg);
+    if (!rc) pick_views(r, o);
     free(text);
     free(have);
     return rc;
@@ -176,10 +195,10 @@ static double err_against(const acc_run *r, const acc_opts *o, int m, int a, int
 void acc_refine_table(FILE *f, const acc_run *r, const acc_opts *o)
 {
     if (!r->pick) return;
-    fprintf(f, "\nViews measured again (--refine %s: |error of Y| > %g), each model's error of Y against the "
-               "previous reference and the new one, with their relative standard errors:\n\n"
+    fprintf(f, "\nViews measured again (--refine %s: |error of Y| + %g standard errors > %g), each model's error "
+               "of Y against the previous reference and the new one, with their relative standard errors:\n\n"
                "| altitude | sun | class | zenith | azimuth | walks before | walks now |",
-            o->refine, o->refine_above);
+            o->refine, o->refine_sigmas, o->refine_above);
     for (int m = 0; m < ACC_MODELS; m++)
         if (o->use[m]) fprintf(f, " %s before | %s now |", acc_model_names[m], acc_model_names[m]);
     fprintf(f, " s.e. before | s.e. now |\n|---|---|---|---|---|---|---|");
