@@ -112,4 +112,7 @@ refused "a missing file" 1 --quick --refine "$T/none.csv"
 "$cli" bench sky-accuracy --quick --refine "$T/a/results.csv" --refine-sigmas -1 >/dev/null 2>"$T/negs.err"
 [ $? -eq 2 ] && grep -q -- "--refine-sigmas" "$T/negs.err" && ok "--refine-sigmas -1 is a usage error" ||
     bad "--refine-sigmas -1 should exit 2"
+"$cli" bench sky-accuracy --quick --refine-above 0.02 >/dev/null 2>"$T/alone.err"
+[ $? -eq 2 ] && grep -q -- "--refine FILE" "$T/alone.err" && ok "--refine-above without --refine is a usage error" ||
+    bad "--refine-above without --refine should exit 2"
 exit $fail

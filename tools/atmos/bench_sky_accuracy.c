@@ -347,6 +347,7 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
     const char *C = "bench sky-accuracy";
     int spectral = 0;
     double seed = 1, paths = 4096, max_paths = 0;
+    int refine_knob = 0; /* --refine-above or --refine-sigmas given */
     *o = (acc_opts){.use = {1, 1, 1}, .map_range = 0.1, .floor = 1e-3, .refine_above = 0.03};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -386,9 +387,11 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
         } else if (!strcmp(a, "--refine")) {
             o->refine = val;
         } else if (!strcmp(a, "--refine-above")) {
+            refine_knob = 1;
             if (!cli_parse_double(C, a, val, &o->refine_above) || !(o->refine_above >= 0))
                 return cli_usage_error(C, "--refine-above: expected a relative error >= 0");
         } else if (!strcmp(a, "--refine-sigmas")) {
+            refine_knob = 1;
             if (!cli_parse_double(C, a, val, &o->refine_sigmas) || !(o->refine_sigmas >= 0 && o->refine_sigmas <= 100))
                 return cli_usage_error(C, "--refine-sigmas: expected a number of standard errors in [0, 100]");
         } else if (!strcmp(a, "--out")) {
@@ -404,6 +407,8 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
         }
         i++;
     }
+    if (refine_knob && !o->refine)
+        return cli_usage_error(C, "--refine-above and --refine-sigmas choose the views of --refine FILE: give it");
     o->spectral = spectral;
     o->seed = (unsigned long long)seed;
     o->paths = (long)paths;
