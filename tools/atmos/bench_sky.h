@@ -38,6 +38,9 @@ typedef struct {
     double floor;            /* relative errors are divided by max(ref, floor * block max) */
     int nalt, nsun;          /* > 0: these observer altitudes (m) and sun elevations (deg) */
     double alt_m[8], sun_deg[8];
+    const char *refine;      /* a previous run's results.csv: its references, its worst views again */
+    double refine_above;     /* ... those whose |relative error of Y| exceeds this */
+    double refine_sigmas;    /* ... or could, within this many of the reference's standard errors */
 } acc_opts;
 
 /* Everything a run measured, for the report. */
@@ -50,6 +53,11 @@ typedef struct {
     /* per (altitude, sun, view): reference, its standard error, each model (NAN: n/a) */
     double *ref, *se, *mod[ACC_MODELS];
     long *paths_used;
+    /* --refine (per view, NULL otherwise): measured again; the previous run's reference Y,
+     * its standard error and walks */
+    unsigned char *pick;
+    double *prev_y, *prev_se_y, *prev_err; /* prev_err: the largest |error of Y| of the run's models */
+    long *prev_paths;
     acc_stats stats[ACC_MODELS][8][8];
     double seconds;
 } acc_run;
@@ -63,6 +71,13 @@ double acc_rel_errors(const acc_run *r, const acc_opts *o, int m, int a, int s, 
 double acc_luminance(const atmos_wavelengths *wl, const double *L);
 /* The largest reference value of block (a, s) at wavelength k (k = -1: of Y). */
 double acc_block_max(const acc_run *r, int a, int s, int k);
+
+/* --refine FILE (bench_sky_refine.c): loads every view's reference from FILE (written by a run
+ * with the same grid and wavelengths) and picks the views to measure again; prints a usage
+ * error and returns CLI_EXIT_USAGE (or CLI_EXIT_RUNTIME) when FILE does not fit the run. */
+int acc_refine_load(acc_run *r, const acc_opts *o);
+/* The picked views before and after, as a Markdown table (nothing without --refine). */
+void acc_refine_table(FILE *f, const acc_run *r, const acc_opts *o);
 
 /* The report: Markdown tables on stdout (and table.md), results.csv, summary.csv and the
  * error maps (error_map_MODEL.png) in o->out. */

@@ -24,7 +24,8 @@ static void help(void)
     printf("Usage: atmos bench sky-accuracy [--quick] [--paths N] [--target-se X] [--max-paths N]\n"
            "                                [--models riley,dobashi,spherical] [--spectral N] [--seed S]\n"
            "                                [--threads T] [--out DIR] [--map-range X] [--floor X]\n"
-           "                                [--altitudes LIST] [--suns LIST]\n\n"
+           "                                [--altitudes LIST] [--suns LIST]\n"
+           "                                [--refine FILE [--refine-above X] [--refine-sigmas K]]\n\n"
            "Compares each model's view radiance (atmos_atmosphere_radiance, the sun's disk hidden) with\n"
            "the reference (atmos_atmosphere_reference_radiance: Monte Carlo walks, all orders) on a fixed\n"
            "grid: observers at 0, 10, 100, 1000 and 36 000 km above the ground, suns at 90, 45, 10, 2,\n"
@@ -47,7 +48,14 @@ static void help(void)
            "                   DIR/error_map_MODEL.png (signed error of Y per view, docs/sky-accuracy.md)\n"
            "  --map-range X    the maps' colours saturate at +-X (default 0.1 = 10 %%)\n"
            "  --floor X        relative errors are |model - ref| / max(ref, X * the block's largest ref)\n"
-           "                   (default 1e-3), so that views far darker than the rest do not dominate\n");
+           "                   (default 1e-3), so that views far darker than the rest do not dominate\n"
+           "  --refine FILE    take every view's reference from FILE (the results.csv of a run with the same\n"
+           "                   --quick, --altitudes, --suns, --spectral, --seed and --paths) and measure again,\n"
+           "                   from their first batch with their own seeds, the views whose |relative error of\n"
+           "                   Y| in FILE (for a model of --models) exceeds --refine-above X (default 0.03),\n"
+           "                   with --target-se and --max-paths; the report lists them before and after\n"
+           "  --refine-sigmas K  ... also the views whose error could exceed X within K of FILE's standard\n"
+           "                   errors (|error| + K s.e. > X; default 0)\n");
 }
 
 /* ------------------------------------------------------------------ the grid */
@@ -202,8 +210,13 @@ static atmos_status measure_first(acc_run *r, const acc_opts *o, const atmos_atm
         double p[3], sun[3], d[3];
         size_t i;
         if (!grid_point(r, t, &a, &s, p, sun, d, &i)) continue;
-        if (reference_more(ref, o, &r->wl, p, d, sun, view_seed(o, t), 0, 1, r->ref + i, r->se + i,
-                           r->paths_used + i / (size_t)n) != ATMOS_OK) {
+        const size_t j = i / (size_t)n;
+        if (r->pick && r->pick[j]) { /* --refine: from the first batch again */
+            memset(r->ref + i, 0, sizeof(double) * (size_t)n), memset(r->se + i, 0, sizeof(double) * (size_t)n);
+            r->paths_used[j] = 0;
+        }
+        if ((!r->pick || r->pick[j]) && reference_more(ref, o, &r->wl, p, d, sun, view_seed(o, t), 0, 1, r->ref + i,
+                                                       r->se + i, r->paths_used + j) != ATMOS_OK) {
 #pragma omp atomic write
             failed = 1;
             continue;
@@ -234,14 +247,14 @@ static atmos_status measure_refine(acc_run *r, const acc_opts *o, const atmos_at
     for (int a = 0; a < r->nalt; a++)
         for (int s = 0; s < r->nsun; s++) {
             ymax[a][s] = acc_block_max(r, a, s, -1);
-            views += r->nview[a];
+            for (int v = 0; v < r->nview[a]; v++) views += !r->pick || r->pick[acc_index(r, a, s, v) / (size_t)n];
         }
 #pragma omp parallel for schedule(dynamic, 1) num_threads(omp_threads(o))
     for (int t = 0; t < total; t++) {
         int a, s;
         double p[3], sun[3], d[3];
         size_t i;
-        if (!grid_point(r, t, &a, &s, p, sun, d, &i)) continue;
+        if (!grid_point(r, t, &a, &s, p, sun, d, &i) || (r->pick && !r->pick[i / (size_t)n])) continue;
         if (reference_more(ref, o, &r->wl, p, d, sun, view_seed(o, t), o->floor * ymax[a][s], 0, r->ref + i,
                            r->se + i, r->paths_used + i / (size_t)n) != ATMOS_OK) {
 #pragma omp atomic write
@@ -334,7 +347,8 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
     const char *C = "bench sky-accuracy";
     int spectral = 0;
     double seed = 1, paths = 4096, max_paths = 0;
-    *o = (acc_opts){.use = {1, 1, 1}, .map_range = 0.1, .floor = 1e-3};
+    int refine_knob = 0; /* --refine-above or --refine-sigmas given */
+    *o = (acc_opts){.use = {1, 1, 1}, .map_range = 0.1, .floor = 1e-3, .refine_above = 0.03};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -370,6 +384,16 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
                 return cli_usage_error(C, "--seed: expected an integer >= 0");
         } else if (!strcmp(a, "--threads")) {
             if (!cli_parse_int(C, a, val, 1, 1024, &o->threads)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--refine")) {
+            o->refine = val;
+        } else if (!strcmp(a, "--refine-above")) {
+            refine_knob = 1;
+            if (!cli_parse_double(C, a, val, &o->refine_above) || !(o->refine_above >= 0))
+                return cli_usage_error(C, "--refine-above: expected a relative error >= 0");
+        } else if (!strcmp(a, "--refine-sigmas")) {
+            refine_knob = 1;
+            if (!cli_parse_double(C, a, val, &o->refine_sigmas) || !(o->refine_sigmas >= 0 && o->refine_sigmas <= 100))
+                return cli_usage_error(C, "--refine-sigmas: expected a number of standard errors in [0, 100]");
         } else if (!strcmp(a, "--out")) {
             o->out = val;
         } else if (!strcmp(a, "--map-range")) {
@@ -383,6 +407,8 @@ static int parse_opts(int argc, char **argv, acc_opts *o)
         }
         i++;
     }
+    if (refine_knob && !o->refine)
+        return cli_usage_error(C, "--refine-above and --refine-sigmas choose the views of --refine FILE: give it");
     o->spectral = spectral;
     o->seed = (unsigned long long)seed;
     o->paths = (long)paths;
@@ -422,6 +448,7 @@ static atmos_status acc_alloc(acc_run *r)
 static void acc_free(acc_run *r)
 {
     free(r->ref), free(r->se), free(r->paths_used);
+    free(r->pick), free(r->prev_y), free(r->prev_se_y), free(r->prev_paths), free(r->prev_err);
     for (int m = 0; m < ACC_MODELS; m++) free(r->mod[m]);
 }
 
@@ -437,12 +464,14 @@ int bench_sky_accuracy_main(int argc, char **argv)
     atmos_status st = r ? ATMOS_OK : ATMOS_E_NOMEM;
     if (st == ATMOS_OK && o.spectral) st = atmos_wavelengths_spectral(o.spectral, &r->wl);
     else if (st == ATMOS_OK) atmos_wavelengths_rgb(&r->wl);
-    if (st == ATMOS_OK) st = acc_create(ctx, &o, &r->wl, &ref, models);
-    if (st == ATMOS_OK) {
-        const atmos_atmosphere_desc *d = atmos_atmosphere_get_desc(ref);
-        acc_grid(r, &o, d->planet_radius_m, d->top_m);
+    if (st == ATMOS_OK) { /* the grid, and a --refine file read, before the atmospheres' tables */
+        atmos_atmosphere_desc d;
+        atmos_atmosphere_defaults(&d);
+        acc_grid(r, &o, d.planet_radius_m, d.top_m);
         st = acc_alloc(r);
     }
+    if (st == ATMOS_OK && o.refine && (rc = acc_refine_load(r, &o)) != 0) st = ATMOS_E_INVALID_ARG;
+    if (st == ATMOS_OK) st = acc_create(ctx, &o, &r->wl, &ref, models);
     const double t0 = cli_now_s();
     if (st == ATMOS_OK) st = measure_first(r, &o, ref, models);
     if (st == ATMOS_OK) st = measure_refine(r, &o, ref);
@@ -453,7 +482,7 @@ int bench_sky_accuracy_main(int argc, char **argv)
                 for (int s = 0; s < r->nsun; s++)
                     if (o.use[m]) acc_block_stats(r, &o, m, a, s, &r->stats[m][a][s]);
         rc = acc_report(ctx, r, &o);
-    } else {
+    } else if (!rc) {
         rc = cli_runtime_error("bench", ctx, st);
     }
     atmos_atmosphere_destroy(ref);

@@ -97,6 +97,7 @@ static void write_tables(FILE *f, const acc_run *r, const acc_opts *o)
         fprintf(f, "\n%s: relative error of the spectral radiance, per wavelength\n\n", acc_model_names[m]);
         table_model(f, r, m);
     }
+    acc_refine_table(f, r, o);
 }
 
 static void csv_results(FILE *f, const acc_run *r, const acc_opts *o)
