@@ -71,6 +71,7 @@ struct atmos_sim {
     void *bar;                    /* a pthread barrier of `threads` threads (NULL: one thread) */
     void *fft_fwd, *fft_inv;      /* fftwf plans of one level */
     void *spec;                   /* complex spectrum, nz ny (nx / 2 + 1) */
+    double *colbuf;               /* the projection's column solves: SIM_COLUMN_SCRATCH(nz) a thread */
 };
 
 /* Threads. A step is one OpenMP parallel region (sim_step.c); its phases hand out whole
@@ -126,6 +127,8 @@ void atmos__sim_sample4_row(const atmos_sim *sim, const float *f4, int nz_f, con
 double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);
 void atmos__sim_confine(atmos_sim *sim, double dt);       /* sim_confine.c: vorticity confinement */
 void atmos__sim_project(atmos_sim *sim);                  /* sim_pressure.c */
+#define SIM_CW 8 /* columns of modes solved side by side (sim_pressure.c) */
+#define SIM_COLUMN_SCRATCH(nz) (4 * (size_t)SIM_CW * (size_t)(nz))
 atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *sim);
 void atmos__sim_fft_free(atmos_sim *sim);
 /* sim_micro.c: the vapour times fix, Kessler + adjustment; rain sedimentation in the columns of
