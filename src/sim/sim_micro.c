@@ -12,6 +12,23 @@
 
 #include <math.h>
 
+/* A vapour below which every cell of level k is clear, dry air (q_v < 0.9 q_s(T)): 0.9 q_s at
+ * the level's coldest theta, less 1e-6 of it (q_s rises with T, and its rounding is far below
+ * that margin, so a cell below the bound passes the exact test too: the bound only saves the
+ * exponential); 0 if a theta is NaN. */
+static double dry_below(const atmos_sim *s, int k, double p, double pi)
+{
+    const size_t lev = (size_t)s->nx * s->ny;
+    const float *th = s->th + k * lev;
+    float m = th[0];
+    int nan = 0;
+    for (size_t n = 0; n < lev; n++) {
+        m = th[n] < m ? th[n] : m;
+        nan |= th[n] != th[n];
+    }
+    return nan ? 0.0 : 0.9 * atmos__sim_qsat(m * pi, p) * (1.0 - 1e-6);
+}
+
 /* Each cell's vapour times the advection's fixer factor (always), then Kessler and the
  * adjustment (with phase changes). */
 void atmos__sim_micro(atmos_sim *s, double dt, float fix)
@@ -21,11 +38,12 @@ void atmos__sim_micro(atmos_sim *s, double dt, float fix)
     SIM_FOR
     for (int k = 0; k < s->nz; k++) {
         const double p = s->p0[k], pi = s->pi0[k], rho = 1e-3 * s->rho0[k];
+        const double dry = micro ? dry_below(s, k, p, pi) : 0;
         for (size_t n = k * lev; n < (k + 1) * lev; n++) {
             s->qv[n] *= fix;
             if (!micro) continue;
             double th = s->th[n], qv = s->qv[n], qc = s->qc[n], qr = s->qr[n];
-            if (qc <= 0 && qr <= 0 && qv < 0.9 * atmos__sim_qsat(th * pi, p)) continue; /* clear, dry air */
+            if (qc <= 0 && qr <= 0 && (qv < dry || qv < 0.9 * atmos__sim_qsat(th * pi, p))) continue; /* clear, dry air */
             if (qc < 0) qc = 0;
             if (qr < 0) qr = 0;
             /* rain from cloud water */
