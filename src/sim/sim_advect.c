@@ -7,24 +7,39 @@
 
 #include <math.h>
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define ADV_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define ADV_CLONES
+#endif
+/* Inlined into each clone (a helper left out of line would be built for the baseline only). The
+ * loops over a row run i = 1 .. nx - 2 with i - 1 and i + 1 as they are (so that the compiler
+ * vectorises them) and the row's ends wrapped apart. */
+#define ADV_INLINE static inline __attribute__((always_inline))
+
 /* Level k packed for the scalars' trace (s->pack): the velocity at the cell centres (u, v, w, 0)
  * and the scalars (theta, q_v, q_c, q_r), 4 floats a cell each; and the level's water before
  * the advection: q_v into part[k], q_c + q_r into part[nz + 1 + k]. */
-static void centres(atmos_sim *s, int k)
+ADV_INLINE void pack_cell(const atmos_sim *s, size_t n, size_t xp, size_t yp, size_t lev, float *restrict p,
+                          float *restrict q)
+{
+    p[0] = 0.5f * (s->u[n] + s->u[xp]);
+    p[1] = 0.5f * (s->v[n] + s->v[yp]);
+    p[2] = 0.5f * (s->w[n] + s->w[n + lev]);
+    p[3] = 0;
+    q[0] = s->th[n], q[1] = s->qv[n], q[2] = s->qc[n], q[3] = s->qr[n];
+}
+
+ADV_CLONES static void centres(atmos_sim *s, int k)
 {
     const int nx = s->nx, ny = s->ny;
-    const size_t lev = (size_t)nx * ny;
+    const size_t lev = (size_t)nx * ny, e = (size_t)nx - 1;
     float *vel4 = s->pack, *sc4 = s->pack + 4 * s->n;
-    for (int j = 0; j < ny; j++)
-        for (int i = 0; i < nx; i++) {
-            const size_t n = sim_idx(s, i, j, k);
-            float *p = vel4 + 4 * n, *q = sc4 + 4 * n;
-            p[0] = 0.5f * (s->u[n] + s->u[sim_idx(s, i + 1 == nx ? 0 : i + 1, j, k)]);
-            p[1] = 0.5f * (s->v[n] + s->v[sim_idx(s, i, j + 1 == ny ? 0 : j + 1, k)]);
-            p[2] = 0.5f * (s->w[n] + s->w[n + lev]);
-            p[3] = 0;
-            q[0] = s->th[n], q[1] = s->qv[n], q[2] = s->qc[n], q[3] = s->qr[n];
-        }
+    for (int j = 0; j < ny; j++) {
+        const size_t r = sim_idx(s, 0, j, k), rp = sim_idx(s, 0, j + 1 == ny ? 0 : j + 1, k);
+        for (size_t i = 0; i < e; i++) pack_cell(s, r + i, r + i + 1, rp + i, lev, vel4 + 4 * (r + i), sc4 + 4 * (r + i));
+        pack_cell(s, r + e, r, rp + e, lev, vel4 + 4 * (r + e), sc4 + 4 * (r + e));
+    }
     double vl = 0, tl = 0;
     for (size_t n = k * lev; n < (k + 1) * lev; n++) {
         vl += s->qv[n];
@@ -36,7 +51,7 @@ static void centres(atmos_sim *s, int k)
 /* Level k of the scalars into s[0..3], each cell's departure point traced once (midpoint rule
  * on the cell-centred velocity) for all four; the level's new water into part[2 (nz + 1) + k]
  * (vapour) and part[3 (nz + 1) + k] (the rest). */
-static void scalars(atmos_sim *s, int k, double c)
+ADV_CLONES static void scalars(atmos_sim *s, int k, double c)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
@@ -65,12 +80,38 @@ static void scalars(atmos_sim *s, int k, double c)
     s->part[2 * (s->nz + 1) + k] = vl, s->part[3 * (s->nz + 1) + k] = tl;
 }
 
+/* The departure points of the faces of a row: u's, v's and w's (the velocity's components
+ * other than the face's own averaged from its four nearest faces). */
+ADV_INLINE void pos_u(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
+                      size_t lev, int i, int im, int j, int k, double c, double *x, double *y, double *z)
+{
+    const double vu = 0.25 * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
+    const double wu = 0.25 * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
+    x[i] = i - c * u[r + i], y[i] = j - c * vu, z[i] = k - c * wu;
+}
+
+ADV_INLINE void pos_v(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rm,
+                      size_t lev, int i, int ip, int j, int k, double c, double *x, double *y, double *z)
+{
+    const double uv = 0.25 * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
+    const double wv = 0.25 * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
+    x[i] = i - c * uv, y[i] = j - c * v[r + i], z[i] = k - c * wv;
+}
+
+ADV_INLINE void pos_w(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
+                      size_t lev, int i, int ip, int j, int k, double c, double *x, double *y, double *z)
+{
+    const double uw = 0.25 * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
+    const double vw = 0.25 * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);
+    x[i] = i - c * uw, y[i] = j - c * vw, z[i] = k - c * w[r + i];
+}
+
 /* Level k of the new velocity into s[4..6] from the old one (each face traced from itself with
  * its own component and the other two averaged from the four nearest faces; in a field's own
  * index space the departure point is its index minus dt v / dx); k = nz is the lid's w. */
-static void velocity(atmos_sim *s, int k, double c)
+ADV_CLONES static void velocity(atmos_sim *s, int k, double c)
 {
-    const int nx = s->nx, ny = s->ny, nz = s->nz;
+    const int nx = s->nx, ny = s->ny, nz = s->nz, e = nx - 1;
     const size_t lev = (size_t)nx * ny;
     const float *u = s->u, *v = s->v, *w = s->w;
     float *nu = s->s[4], *nv = s->s[5], *nw = s->s[6];
@@ -79,32 +120,20 @@ static void velocity(atmos_sim *s, int k, double c)
         const size_t r = (size_t)k * lev + (size_t)j * nx;
         const size_t rm = (size_t)k * lev + (size_t)(j ? j - 1 : ny - 1) * nx;
         const size_t rp = (size_t)k * lev + (size_t)(j + 1 == ny ? 0 : j + 1) * nx;
-        if (k < nz) {
-            for (int i = 0; i < nx; i++) { /* u on the face x = i - 1/2 */
-                const int im = i ? i - 1 : nx - 1;
-                const double vu = 0.25 * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
-                const double wu = 0.25 * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
-                x[i] = i - c * u[r + i], y[i] = j - c * vu, z[i] = k - c * wu;
-            }
+        if (k < nz) { /* u on the face x = i - 1/2, v on y = j - 1/2 */
+            pos_u(u, v, w, r, rp, lev, 0, e, j, k, c, x, y, z);
+            for (int i = 1; i < nx; i++) pos_u(u, v, w, r, rp, lev, i, i - 1, j, k, c, x, y, z);
             atmos__sim_sample_row(s, u, nz, x, y, z, nu + r, nx);
-            for (int i = 0; i < nx; i++) { /* v on y = j - 1/2 */
-                const int ip = i + 1 == nx ? 0 : i + 1;
-                const double uv = 0.25 * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
-                const double wv = 0.25 * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
-                x[i] = i - c * uv, y[i] = j - c * v[r + i], z[i] = k - c * wv;
-            }
+            for (int i = 0; i < e; i++) pos_v(u, v, w, r, rm, lev, i, i + 1, j, k, c, x, y, z);
+            pos_v(u, v, w, r, rm, lev, e, 0, j, k, c, x, y, z);
             atmos__sim_sample_row(s, v, nz, x, y, z, nv + r, nx);
         }
         if (k == 0 || k == nz) {
             for (int i = 0; i < nx; i++) nw[r + i] = 0;
             continue;
         }
-        for (int i = 0; i < nx; i++) { /* w on the face z = k - 1/2 */
-            const int ip = i + 1 == nx ? 0 : i + 1;
-            const double uw = 0.25 * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
-            const double vw = 0.25 * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);
-            x[i] = i - c * uw, y[i] = j - c * vw, z[i] = k - c * w[r + i];
-        }
+        for (int i = 0; i < e; i++) pos_w(u, v, w, r, rp, lev, i, i + 1, j, k, c, x, y, z); /* w on z = k - 1/2 */
+        pos_w(u, v, w, r, rp, lev, e, 0, j, k, c, x, y, z);
         atmos__sim_sample_row(s, w, nz + 1, x, y, z, nw + r, nx);
     }
 }
