@@ -122,6 +122,11 @@ void atmos__sim_sample_row(const atmos_sim *sim, const float *f, int nz_f, const
                            const double *z, float *out, int n);
 void atmos__sim_sample4_row(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
                             const double *z, float *out4, int n);
+/* The same by the scalar code only (what the vectorised path must match bit for bit; tests) */
+void atmos__sim_sample_row_scalar(const atmos_sim *sim, const float *f, int nz_f, const double *x, const double *y,
+                                  const double *z, float *out, int n);
+void atmos__sim_sample4_row_scalar(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
+                                   const double *z, float *out4, int n);
 /* sim_forces.c: surface fluxes, cloud-top cooling, buoyancy and the sponge of row j (y = j);
  * returns the water the surface added to the row */
 double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);

@@ -267,3 +267,15 @@ void atmos__sim_sample4_row(const atmos_sim *s, const float *f4, int nz_f, const
 #endif
     sample4_scalar(s, f4, nz_f, x, y, z, out4, 0, n);
 }
+
+void atmos__sim_sample_row_scalar(const atmos_sim *s, const float *f, int nz_f, const double *x, const double *y,
+                                  const double *z, float *out, int n)
+{
+    sample_scalar(s, f, nz_f, x, y, z, out, 0, n);
+}
+
+void atmos__sim_sample4_row_scalar(const atmos_sim *s, const float *f4, int nz_f, const double *x, const double *y,
+                                   const double *z, float *out4, int n)
+{
+    sample4_scalar(s, f4, nz_f, x, y, z, out4, 0, n);
+}
