@@ -227,9 +227,17 @@ AVX2 static void sample4_avx2(const atmos_sim *s, const float *f4, int nz_f, con
         for (int p = 0; p < 4; p += 2) {
             const __m256 ax = spread_pair(a.ax, p), ay = spread_pair(a.ay, p), az = spread_pair(a.az, p);
             __m256 c[4];
+            const int whole = i1[p] && i1[p + 1]; /* no wrap: the corners i0, i0 + 1 side by side */
             for (int q = 0; q < 4; q++) {
-                const __m256 lo = load_pair(f4, r[q][p] + i0[p], r[q][p + 1] + i0[p + 1]);
-                const __m256 hi = load_pair(f4, r[q][p] + i1[p], r[q][p + 1] + i1[p + 1]);
+                __m256 lo, hi;
+                if (whole) {
+                    const __m256 dp = _mm256_loadu_ps(f4 + 4 * (size_t)(r[q][p] + i0[p]));
+                    const __m256 dq = _mm256_loadu_ps(f4 + 4 * (size_t)(r[q][p + 1] + i0[p + 1]));
+                    lo = _mm256_permute2f128_ps(dp, dq, 0x20), hi = _mm256_permute2f128_ps(dp, dq, 0x31);
+                } else {
+                    lo = load_pair(f4, r[q][p] + i0[p], r[q][p + 1] + i0[p + 1]);
+                    hi = load_pair(f4, r[q][p] + i1[p], r[q][p + 1] + i1[p + 1]);
+                }
                 c[q] = lerp8(lo, hi, ax);
             }
             _mm256_storeu_ps(out4 + 4 * (size_t)(m + p), lerp8(lerp8(c[0], c[1], ay), lerp8(c[2], c[3], ay), az));
