@@ -6,107 +6,40 @@
 #include "sim/sim_internal.h"
 
 #include <math.h>
-#include <string.h>
 
-/* The eight corners and weights of a trilinear sample at (x, y, z) in the index space of a
- * field of nz_f levels: set up once, evaluated for any field on that grid. */
-typedef struct {
-    size_t c[4];      /* offsets of the corners (i0, j, k) of rows j0/j1 at levels k0/k1 */
-    int i0, i1;
-    float ax, ay, az;
-} tri;
-
-static inline int wrap(int i, int n)
-{
-    if ((unsigned)i >= (unsigned)n) {
-        i %= n;
-        if (i < 0) i += n;
-    }
-    return i;
-}
-
-/* floor() without the library call (the baseline x86-64 target has no rounding instruction);
- * positions stay far inside int's range. */
-static inline int ifloor(double x)
-{
-    const int i = (int)x;
-    return i - (x < i);
-}
-
-static inline void tri_setup(const atmos_sim *s, int nz_f, double x, double y, double z, tri *t)
-{
-    const int nx = s->nx, ny = s->ny;
-    if (z < 0) z = 0;
-    if (z > nz_f - 1) z = nz_f - 1;
-    const int fx0 = ifloor(x), fy0 = ifloor(y), fz0 = ifloor(z);
-    t->ax = (float)(x - fx0), t->ay = (float)(y - fy0), t->az = (float)(z - fz0);
-    const int i0 = wrap(fx0, nx), j0 = wrap(fy0, ny), k0 = fz0;
-    const int j1 = j0 + 1 == ny ? 0 : j0 + 1, k1 = k0 + 1 < nz_f ? k0 + 1 : k0;
-    t->i0 = i0, t->i1 = i0 + 1 == nx ? 0 : i0 + 1;
-    const size_t l0 = (size_t)k0 * nx * ny, l1 = (size_t)k1 * nx * ny;
-    t->c[0] = l0 + (size_t)j0 * nx, t->c[1] = l0 + (size_t)j1 * nx;
-    t->c[2] = l1 + (size_t)j0 * nx, t->c[3] = l1 + (size_t)j1 * nx;
-}
-
-static inline float tri_eval(const float *f, const tri *t)
-{
-    const int i0 = t->i0, i1 = t->i1;
-    const float c00 = f[t->c[0] + i0] + t->ax * (f[t->c[0] + i1] - f[t->c[0] + i0]);
-    const float c01 = f[t->c[1] + i0] + t->ax * (f[t->c[1] + i1] - f[t->c[1] + i0]);
-    const float c10 = f[t->c[2] + i0] + t->ax * (f[t->c[2] + i1] - f[t->c[2] + i0]);
-    const float c11 = f[t->c[3] + i0] + t->ax * (f[t->c[3] + i1] - f[t->c[3] + i0]);
-    const float c0 = c00 + t->ay * (c01 - c00), c1 = c10 + t->ay * (c11 - c10);
-    return c0 + t->az * (c1 - c0);
-}
-
-/* Four fields packed per cell (AoS, 16 bytes a cell) sampled at once: the same arithmetic as
- * tri_eval on each lane, one 4-wide load per corner. */
-typedef float v4f __attribute__((vector_size(16)));
-
-static inline v4f ld4(const float *p)
-{
-    v4f v;
-    memcpy(&v, p, sizeof v);
-    return v;
-}
-
-static inline v4f tri_eval4(const float *f4, const tri *t)
-{
-    const size_t i0 = 4 * (size_t)t->i0, i1 = 4 * (size_t)t->i1;
-    v4f c[4];
-    for (int r = 0; r < 4; r++) {
-        const v4f a = ld4(f4 + 4 * t->c[r] + i0), b = ld4(f4 + 4 * t->c[r] + i1);
-        c[r] = a + t->ax * (b - a);
-    }
-    const v4f c0 = c[0] + t->ay * (c[1] - c[0]), c1 = c[2] + t->ay * (c[3] - c[2]);
-    return c0 + t->az * (c1 - c0);
-}
-
-static inline float sample(const atmos_sim *s, const float *f, int nz_f, double x, double y, double z)
-{
-    tri t;
-    tri_setup(s, nz_f, x, y, z, &t);
-    return tri_eval(f, &t);
-}
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define ADV_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define ADV_CLONES
+#endif
+/* Inlined into each clone (a helper left out of line would be built for the baseline only). The
+ * loops over a row run i = 1 .. nx - 2 with i - 1 and i + 1 as they are (so that the compiler
+ * vectorises them) and the row's ends wrapped apart. */
+#define ADV_INLINE static inline __attribute__((always_inline))
 
 /* Level k packed for the scalars' trace (s->pack): the velocity at the cell centres (u, v, w, 0)
  * and the scalars (theta, q_v, q_c, q_r), 4 floats a cell each; and the level's water before
  * the advection: q_v into part[k], q_c + q_r into part[nz + 1 + k]. */
-static void centres(atmos_sim *s, int k)
+ADV_INLINE void pack_cell(const atmos_sim *s, size_t n, size_t xp, size_t yp, size_t lev, float *restrict p,
+                          float *restrict q)
+{
+    p[0] = 0.5f * (s->u[n] + s->u[xp]);
+    p[1] = 0.5f * (s->v[n] + s->v[yp]);
+    p[2] = 0.5f * (s->w[n] + s->w[n + lev]);
+    p[3] = 0;
+    q[0] = s->th[n], q[1] = s->qv[n], q[2] = s->qc[n], q[3] = s->qr[n];
+}
+
+ADV_CLONES static void centres(atmos_sim *s, int k)
 {
     const int nx = s->nx, ny = s->ny;
-    const size_t lev = (size_t)nx * ny;
+    const size_t lev = (size_t)nx * ny, e = (size_t)nx - 1;
     float *vel4 = s->pack, *sc4 = s->pack + 4 * s->n;
-    for (int j = 0; j < ny; j++)
-        for (int i = 0; i < nx; i++) {
-            const size_t n = sim_idx(s, i, j, k);
-            float *p = vel4 + 4 * n, *q = sc4 + 4 * n;
-            p[0] = 0.5f * (s->u[n] + s->u[sim_idx(s, i + 1 == nx ? 0 : i + 1, j, k)]);
-            p[1] = 0.5f * (s->v[n] + s->v[sim_idx(s, i, j + 1 == ny ? 0 : j + 1, k)]);
-            p[2] = 0.5f * (s->w[n] + s->w[n + lev]);
-            p[3] = 0;
-            q[0] = s->th[n], q[1] = s->qv[n], q[2] = s->qc[n], q[3] = s->qr[n];
-        }
+    for (int j = 0; j < ny; j++) {
+        const size_t r = sim_idx(s, 0, j, k), rp = sim_idx(s, 0, j + 1 == ny ? 0 : j + 1, k);
+        for (size_t i = 0; i < e; i++) pack_cell(s, r + i, r + i + 1, rp + i, lev, vel4 + 4 * (r + i), sc4 + 4 * (r + i));
+        pack_cell(s, r + e, r, rp + e, lev, vel4 + 4 * (r + e), sc4 + 4 * (r + e));
+    }
     double vl = 0, tl = 0;
     for (size_t n = k * lev; n < (k + 1) * lev; n++) {
         vl += s->qv[n];
@@ -118,23 +51,27 @@ static void centres(atmos_sim *s, int k)
 /* Level k of the scalars into s[0..3], each cell's departure point traced once (midpoint rule
  * on the cell-centred velocity) for all four; the level's new water into part[2 (nz + 1) + k]
  * (vapour) and part[3 (nz + 1) + k] (the rest). */
-static void scalars(atmos_sim *s, int k, double c)
+ADV_CLONES static void scalars(atmos_sim *s, int k, double c)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
     float *dst[4] = {s->th, s->qv, s->qc, s->qr}; /* in place: the sources are the packed copies */
     const float *vel4 = s->pack, *sc4 = s->pack + 4 * s->n;
-    for (int j = 0; j < ny; j++)
-        for (int i = 0; i < nx; i++) {
-            const size_t n = sim_idx(s, i, j, k);
-            const float *p = vel4 + 4 * n;
-            tri t;
-            tri_setup(s, s->nz, i - 0.5 * c * p[0], j - 0.5 * c * p[1], k - 0.5 * c * p[2], &t);
-            const v4f vm = tri_eval4(vel4, &t);
-            tri_setup(s, s->nz, i - c * (double)vm[0], j - c * (double)vm[1], k - c * (double)vm[2], &t);
-            const v4f q = tri_eval4(sc4, &t);
-            dst[0][n] = q[0], dst[1][n] = q[1], dst[2][n] = q[2], dst[3][n] = q[3];
+    double x[ATMOS_SIM_MAX_GRID], y[ATMOS_SIM_MAX_GRID], z[ATMOS_SIM_MAX_GRID];
+    float q[4 * ATMOS_SIM_MAX_GRID];
+    for (int j = 0; j < ny; j++) {
+        const size_t r = sim_idx(s, 0, j, k);
+        for (int i = 0; i < nx; i++) { /* half a step back with the velocity here */
+            const float *p = vel4 + 4 * (r + i);
+            x[i] = i - 0.5 * c * p[0], y[i] = j - 0.5 * c * p[1], z[i] = k - 0.5 * c * p[2];
         }
+        atmos__sim_sample4_row(s, vel4, s->nz, x, y, z, q, nx);
+        for (int i = 0; i < nx; i++) /* a whole step back with the velocity there */
+            x[i] = i - c * (double)q[4 * i], y[i] = j - c * (double)q[4 * i + 1], z[i] = k - c * (double)q[4 * i + 2];
+        atmos__sim_sample4_row(s, sc4, s->nz, x, y, z, q, nx);
+        for (int i = 0; i < nx; i++)
+            for (int f = 0; f < 4; f++) dst[f][r + i] = q[4 * i + f];
+    }
     double vl = 0, tl = 0;
     for (size_t n = k * lev; n < (k + 1) * lev; n++) {
         vl += dst[1][n];
@@ -143,37 +80,61 @@ static void scalars(atmos_sim *s, int k, double c)
     s->part[2 * (s->nz + 1) + k] = vl, s->part[3 * (s->nz + 1) + k] = tl;
 }
 
+/* The departure points of the faces of a row: u's, v's and w's (the velocity's components
+ * other than the face's own averaged from its four nearest faces). */
+ADV_INLINE void pos_u(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
+                      size_t lev, int i, int im, int j, int k, double c, double *x, double *y, double *z)
+{
+    const double vu = 0.25 * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
+    const double wu = 0.25 * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
+    x[i] = i - c * u[r + i], y[i] = j - c * vu, z[i] = k - c * wu;
+}
+
+ADV_INLINE void pos_v(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rm,
+                      size_t lev, int i, int ip, int j, int k, double c, double *x, double *y, double *z)
+{
+    const double uv = 0.25 * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
+    const double wv = 0.25 * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
+    x[i] = i - c * uv, y[i] = j - c * v[r + i], z[i] = k - c * wv;
+}
+
+ADV_INLINE void pos_w(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
+                      size_t lev, int i, int ip, int j, int k, double c, double *x, double *y, double *z)
+{
+    const double uw = 0.25 * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
+    const double vw = 0.25 * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);
+    x[i] = i - c * uw, y[i] = j - c * vw, z[i] = k - c * w[r + i];
+}
+
 /* Level k of the new velocity into s[4..6] from the old one (each face traced from itself with
  * its own component and the other two averaged from the four nearest faces; in a field's own
  * index space the departure point is its index minus dt v / dx); k = nz is the lid's w. */
-static void velocity(atmos_sim *s, int k, double c)
+ADV_CLONES static void velocity(atmos_sim *s, int k, double c)
 {
-    const int nx = s->nx, ny = s->ny, nz = s->nz;
+    const int nx = s->nx, ny = s->ny, nz = s->nz, e = nx - 1;
     const size_t lev = (size_t)nx * ny;
     const float *u = s->u, *v = s->v, *w = s->w;
     float *nu = s->s[4], *nv = s->s[5], *nw = s->s[6];
+    double x[ATMOS_SIM_MAX_GRID], y[ATMOS_SIM_MAX_GRID], z[ATMOS_SIM_MAX_GRID];
     for (int j = 0; j < ny; j++) {
         const size_t r = (size_t)k * lev + (size_t)j * nx;
         const size_t rm = (size_t)k * lev + (size_t)(j ? j - 1 : ny - 1) * nx;
         const size_t rp = (size_t)k * lev + (size_t)(j + 1 == ny ? 0 : j + 1) * nx;
-        for (int i = 0; i < nx; i++) {
-            const int im = i ? i - 1 : nx - 1, ip = i + 1 == nx ? 0 : i + 1;
-            if (k < nz) { /* u on the face x = i - 1/2, v on y = j - 1/2 */
-                const double vu = 0.25 * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
-                const double wu = 0.25 * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
-                nu[r + i] = sample(s, u, nz, i - c * u[r + i], j - c * vu, k - c * wu);
-                const double uv = 0.25 * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
-                const double wv = 0.25 * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
-                nv[r + i] = sample(s, v, nz, i - c * uv, j - c * v[r + i], k - c * wv);
-            }
-            if (k == 0 || k == nz) {
-                nw[r + i] = 0;
-            } else { /* w on the face z = k - 1/2 */
-                const double uw = 0.25 * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
-                const double vw = 0.25 * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);
-                nw[r + i] = sample(s, w, nz + 1, i - c * uw, j - c * vw, k - c * w[r + i]);
-            }
+        if (k < nz) { /* u on the face x = i - 1/2, v on y = j - 1/2 */
+            pos_u(u, v, w, r, rp, lev, 0, e, j, k, c, x, y, z);
+            for (int i = 1; i < nx; i++) pos_u(u, v, w, r, rp, lev, i, i - 1, j, k, c, x, y, z);
+            atmos__sim_sample_row(s, u, nz, x, y, z, nu + r, nx);
+            for (int i = 0; i < e; i++) pos_v(u, v, w, r, rm, lev, i, i + 1, j, k, c, x, y, z);
+            pos_v(u, v, w, r, rm, lev, e, 0, j, k, c, x, y, z);
+            atmos__sim_sample_row(s, v, nz, x, y, z, nv + r, nx);
         }
+        if (k == 0 || k == nz) {
+            for (int i = 0; i < nx; i++) nw[r + i] = 0;
+            continue;
+        }
+        for (int i = 0; i < e; i++) pos_w(u, v, w, r, rp, lev, i, i + 1, j, k, c, x, y, z); /* w on z = k - 1/2 */
+        pos_w(u, v, w, r, rp, lev, e, 0, j, k, c, x, y, z);
+        atmos__sim_sample_row(s, w, nz + 1, x, y, z, nw + r, nx);
     }
 }
 

@@ -8,8 +8,17 @@
 
 #include <math.h>
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define CONF_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CONF_CLONES
+#endif
+/* Inlined into each clone (a helper left out of line would be built for the baseline only). */
+#define CONF_INLINE static inline __attribute__((always_inline))
+
 /* The rows of a cell's neighbours: j - 1 and j + 1 wrapped, level k - 1 and k + 1 clamped (as
- * offsets from the cell's own row), and i - 1 / i + 1 wrapped. */
+ * offsets from the cell's own row). The loops over a row run i = 1 .. nx - 2 with i - 1 and
+ * i + 1 as they are (so that the compiler vectorises them) and the two ends wrapped. */
 typedef struct {
     size_t r, ym, yp;
     ptrdiff_t zm, zp;
@@ -29,82 +38,101 @@ static rows rows_of(const atmos_sim *s, int j, int k)
 }
 
 /* The velocity at the cell centres of level k. */
-static void centres(atmos_sim *s, int k, float *uc, float *vc, float *wc)
+CONF_CLONES static void centres(atmos_sim *s, int k, float *restrict uc, float *restrict vc, float *restrict wc)
 {
     const int nx = s->nx;
     const size_t lev = (size_t)nx * s->ny;
+    const float *restrict u = s->u, *restrict v = s->v, *restrict w = s->w;
     for (int j = 0; j < s->ny; j++) {
         const rows o = rows_of(s, j, k);
         for (int i = 0; i < nx; i++) {
             const size_t n = o.r + i;
-            uc[n] = 0.5f * (s->u[n] + s->u[o.r + (i + 1 == nx ? 0 : i + 1)]);
-            vc[n] = 0.5f * (s->v[n] + s->v[o.yp + i]);
-            wc[n] = 0.5f * (s->w[n] + s->w[n + lev]);
+            vc[n] = 0.5f * (v[n] + v[o.yp + i]);
+            wc[n] = 0.5f * (w[n] + w[n + lev]);
         }
+        for (int i = 0; i + 1 < nx; i++) uc[o.r + i] = 0.5f * (u[o.r + i] + u[o.r + i + 1]);
+        uc[o.r + nx - 1] = 0.5f * (u[o.r + nx - 1] + u[o.r]);
     }
 }
 
-/* The vorticity omega and its length at the centres of level k (central differences, one-sided
- * at the ground and the lid). */
-static void vorticity(atmos_sim *s, int k, float *const f[7])
+/* The vorticity omega and its length at cell n of a row (neighbours along x at xm and xp). */
+CONF_INLINE void vort_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float inv2, float zf,
+                           const float *restrict uc, const float *restrict vc, const float *restrict wc,
+                           float *restrict ox, float *restrict oy, float *restrict oz, float *restrict om)
 {
-    const float *uc = f[0], *vc = f[1], *wc = f[2];
-    float *ox = f[3], *oy = f[4], *oz = f[5], *om = f[6];
+    const size_t yp = o->yp + i, ym = o->ym + i, zp = n + o->zp, zm = n + o->zm;
+    const float x = (wc[yp] - wc[ym]) * inv2 - (vc[zp] - vc[zm]) * zf;
+    const float y = (uc[zp] - uc[zm]) * zf - (wc[xp] - wc[xm]) * inv2;
+    const float z = (vc[xp] - vc[xm]) * inv2 - (uc[yp] - uc[ym]) * inv2;
+    ox[n] = x, oy[n] = y, oz[n] = z;
+    om[n] = sqrtf(x * x + y * y + z * z);
+}
+
+/* The vorticity at the centres of level k (central differences, one-sided at the ground and
+ * the lid). */
+CONF_CLONES static void vorticity(atmos_sim *s, int k, float *const f[7])
+{
+    const float *restrict uc = f[0], *restrict vc = f[1], *restrict wc = f[2];
+    float *restrict ox = f[3], *restrict oy = f[4], *restrict oz = f[5], *restrict om = f[6];
     const int nx = s->nx, nz = s->nz;
     const float inv2 = (float)(0.5 / s->dx), zf = (k > 0 && k + 1 < nz) ? inv2 : 2 * inv2;
     for (int j = 0; j < s->ny; j++) {
         const rows o = rows_of(s, j, k);
-        for (int i = 0; i < nx; i++) {
-            const size_t n = o.r + i;
-            const size_t xp = o.r + (i + 1 == nx ? 0 : i + 1), xm = o.r + (i ? i - 1 : nx - 1);
-            const size_t yp = o.yp + i, ym = o.ym + i, zp = n + o.zp, zm = n + o.zm;
-            ox[n] = (wc[yp] - wc[ym]) * inv2 - (vc[zp] - vc[zm]) * zf;
-            oy[n] = (uc[zp] - uc[zm]) * zf - (wc[xp] - wc[xm]) * inv2;
-            oz[n] = (vc[xp] - vc[xm]) * inv2 - (uc[yp] - uc[ym]) * inv2;
-            om[n] = sqrtf(ox[n] * ox[n] + oy[n] * oy[n] + oz[n] * oz[n]);
-        }
+        const size_t r = o.r, e = (size_t)nx - 1;
+        vort_cell(&o, r, 0, r + e, r + 1, inv2, zf, uc, vc, wc, ox, oy, oz, om);
+        for (size_t i = 1; i < e; i++) vort_cell(&o, r + i, i, r + i - 1, r + i + 1, inv2, zf, uc, vc, wc, ox, oy, oz, om);
+        vort_cell(&o, r + e, e, r + e - 1, r, inv2, zf, uc, vc, wc, ox, oy, oz, om);
     }
 }
 
-/* The force eps dx |omega| (N x omega) at the centres of level k into f[0..2]. */
-static void force(atmos_sim *s, int k, float a, float *const f[7])
+/* The force eps dx |omega| (N x omega) at cell n of a row into fx, fy, fz. */
+CONF_INLINE void force_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float a, float *const f[7])
 {
-    float *fx = f[0], *fy = f[1], *fz = f[2];
-    const float *ox = f[3], *oy = f[4], *oz = f[5], *om = f[6];
+    const float *restrict ox = f[3], *restrict oy = f[4], *restrict oz = f[5], *restrict om = f[6];
+    float gx = om[xp] - om[xm];
+    float gy = om[o->yp + i] - om[o->ym + i];
+    float gz = om[n + o->zp] - om[n + o->zm];
+    const float gl = sqrtf(gx * gx + gy * gy + gz * gz) + 1e-20f;
+    gx /= gl, gy /= gl, gz /= gl;
+    const float am = a * om[n];
+    f[0][n] = am * (gy * oz[n] - gz * oy[n]);
+    f[1][n] = am * (gz * ox[n] - gx * oz[n]);
+    f[2][n] = am * (gx * oy[n] - gy * ox[n]);
+}
+
+/* The force at the centres of level k, then (the level's forces known) its x and y components
+ * averaged onto the u and v faces of the level, times dt (the w faces need the level below:
+ * apply_w, after a barrier). */
+CONF_CLONES static void force(atmos_sim *s, int k, float a, float dt, float *const f[7])
+{
     const int nx = s->nx;
+    const size_t e = (size_t)nx - 1;
     for (int j = 0; j < s->ny; j++) {
         const rows o = rows_of(s, j, k);
-        for (int i = 0; i < nx; i++) {
-            const size_t n = o.r + i;
-            float gx = om[o.r + (i + 1 == nx ? 0 : i + 1)] - om[o.r + (i ? i - 1 : nx - 1)];
-            float gy = om[o.yp + i] - om[o.ym + i];
-            float gz = om[n + o.zp] - om[n + o.zm];
-            const float gl = sqrtf(gx * gx + gy * gy + gz * gz) + 1e-20f;
-            gx /= gl, gy /= gl, gz /= gl;
-            const float am = a * om[n];
-            fx[n] = am * (gy * oz[n] - gz * oy[n]);
-            fy[n] = am * (gz * ox[n] - gx * oz[n]);
-            fz[n] = am * (gx * oy[n] - gy * ox[n]);
-        }
+        const size_t r = o.r;
+        force_cell(&o, r, 0, r + e, r + 1, a, f);
+        for (size_t i = 1; i < e; i++) force_cell(&o, r + i, i, r + i - 1, r + i + 1, a, f);
+        force_cell(&o, r + e, e, r + e - 1, r, a, f);
     }
-}
-
-/* The centred force averaged onto the faces of level k, times dt. */
-static void apply(atmos_sim *s, int k, float dt, float *const f[7])
-{
-    const float *fx = f[0], *fy = f[1], *fz = f[2];
-    const int nx = s->nx;
-    const size_t lev = (size_t)nx * s->ny;
+    const float *restrict fx = f[0], *restrict fy = f[1];
+    float *restrict u = s->u, *restrict v = s->v;
     const float h = 0.5f * dt;
     for (int j = 0; j < s->ny; j++) {
         const rows o = rows_of(s, j, k);
-        for (int i = 0; i < nx; i++) {
-            const size_t n = o.r + i;
-            s->u[n] += h * (fx[n] + fx[o.r + (i ? i - 1 : nx - 1)]);
-            s->v[n] += h * (fy[n] + fy[o.ym + i]);
-            if (k > 0) s->w[n] += h * (fz[n] + fz[n - lev]);
-        }
+        const size_t r = o.r;
+        u[r] += h * (fx[r] + fx[r + e]);
+        for (size_t i = 1; i < (size_t)nx; i++) u[r + i] += h * (fx[r + i] + fx[r + i - 1]);
+        for (size_t i = 0; i < (size_t)nx; i++) v[r + i] += h * (fy[r + i] + fy[o.ym + i]);
     }
+}
+
+/* The force's z component averaged onto the w faces of level k > 0, times dt. */
+CONF_CLONES static void apply_w(atmos_sim *s, int k, float dt, const float *restrict fz)
+{
+    const size_t lev = (size_t)s->nx * s->ny;
+    float *restrict w = s->w;
+    const float h = 0.5f * dt;
+    for (size_t n = k * lev; n < (k + 1) * lev; n++) w[n] += h * (fz[n] + fz[n - lev]);
 }
 
 void atmos__sim_confine(atmos_sim *s, double dt)
@@ -120,9 +148,9 @@ void atmos__sim_confine(atmos_sim *s, double dt)
     for (int k = 0; k < nz; k++) vorticity(s, k, f);
     atmos__sim_sync(s);
     SIM_FOR
-    for (int k = 0; k < nz; k++) force(s, k, (float)(eps * s->dx), f);
+    for (int k = 0; k < nz; k++) force(s, k, (float)(eps * s->dx), (float)dt, f);
     atmos__sim_sync(s);
     SIM_FOR
-    for (int k = 0; k < nz; k++) apply(s, k, (float)dt, f);
+    for (int k = 1; k < nz; k++) apply_w(s, k, (float)dt, f[2]);
     atmos__sim_sync(s);
 }

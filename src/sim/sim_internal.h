@@ -71,6 +71,7 @@ struct atmos_sim {
     void *bar;                    /* a pthread barrier of `threads` threads (NULL: one thread) */
     void *fft_fwd, *fft_inv;      /* fftwf plans of one level */
     void *spec;                   /* complex spectrum, nz ny (nx / 2 + 1) */
+    double *colbuf;               /* the projection's column solves: SIM_COLUMN_SCRATCH(nz) a thread */
 };
 
 /* Threads. A step is one OpenMP parallel region (sim_step.c); its phases hand out whole
@@ -114,11 +115,25 @@ void atmos__sim_sounding(atmos_sim *sim);
 /* sim_advect.c; returns the water fixer's factor for the vapour (applied by atmos__sim_micro) */
 double atmos__sim_advect(atmos_sim *sim, double dt);
 void atmos__sim_advected_velocity(atmos_sim *sim);
+/* sim_trace.c: trilinear samples of a field of nz_f levels (x, y wrapped, z clamped) at n points
+ * of its index space, into out[m]; of four fields packed per cell (f4[4 cell + field]) into
+ * out4[4 m + field] */
+void atmos__sim_sample_row(const atmos_sim *sim, const float *f, int nz_f, const double *x, const double *y,
+                           const double *z, float *out, int n);
+void atmos__sim_sample4_row(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
+                            const double *z, float *out4, int n);
+/* The same by the scalar code only (what the vectorised path must match bit for bit; tests) */
+void atmos__sim_sample_row_scalar(const atmos_sim *sim, const float *f, int nz_f, const double *x, const double *y,
+                                  const double *z, float *out, int n);
+void atmos__sim_sample4_row_scalar(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
+                                   const double *z, float *out4, int n);
 /* sim_forces.c: surface fluxes, cloud-top cooling, buoyancy and the sponge of row j (y = j);
  * returns the water the surface added to the row */
 double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);
 void atmos__sim_confine(atmos_sim *sim, double dt);       /* sim_confine.c: vorticity confinement */
 void atmos__sim_project(atmos_sim *sim);                  /* sim_pressure.c */
+#define SIM_CW 8 /* columns of modes solved side by side (sim_pressure.c) */
+#define SIM_COLUMN_SCRATCH(nz) (4 * (size_t)SIM_CW * (size_t)(nz))
 atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *sim);
 void atmos__sim_fft_free(atmos_sim *sim);
 /* sim_micro.c: the vapour times fix, Kessler + adjustment; rain sedimentation in the columns of

@@ -12,6 +12,28 @@
 
 #include <math.h>
 
+/* A vapour below which every cell of level k is clear, dry air (q_v < 0.9 q_s(T)): 0.9 q_s at
+ * the level's coldest theta, less 1e-6 of it (q_s rises with T, and its rounding is far below
+ * that margin, so a cell below the bound passes the exact test too: the bound only saves the
+ * exponential); 0 if a theta is NaN. */
+static double dry_below(const atmos_sim *s, int k, double p, double pi)
+{
+    const size_t lev = (size_t)s->nx * s->ny;
+    const float *th = s->th + k * lev;
+    float m = th[0];
+    int nan = 0;
+    for (size_t n = 0; n < lev; n++) {
+        m = th[n] < m ? th[n] : m;
+        nan |= th[n] != th[n];
+    }
+    return nan ? 0.0 : 0.9 * atmos__sim_qsat(m * pi, p) * (1.0 - 1e-6);
+}
+
+static inline int plus_zero(float f)
+{
+    return f == 0 && !signbit(f);
+}
+
 /* Each cell's vapour times the advection's fixer factor (always), then Kessler and the
  * adjustment (with phase changes). */
 void atmos__sim_micro(atmos_sim *s, double dt, float fix)
@@ -21,11 +43,19 @@ void atmos__sim_micro(atmos_sim *s, double dt, float fix)
     SIM_FOR
     for (int k = 0; k < s->nz; k++) {
         const double p = s->p0[k], pi = s->pi0[k], rho = 1e-3 * s->rho0[k];
+        const double dry = micro ? dry_below(s, k, p, pi) : 0;
         for (size_t n = k * lev; n < (k + 1) * lev; n++) {
             s->qv[n] *= fix;
             if (!micro) continue;
             double th = s->th[n], qv = s->qv[n], qc = s->qc[n], qr = s->qr[n];
-            if (qc <= 0 && qr <= 0 && qv < 0.9 * atmos__sim_qsat(th * pi, p)) continue; /* clear, dry air */
+            if (qc <= 0 && qr <= 0) {
+                if (qv < dry) continue; /* clear, dry air */
+                const double qs = atmos__sim_qsat(th * pi, p);
+                if (qv < 0.9 * qs) continue;
+                /* unsaturated and no condensate (both +0): every rate below is 0 and the adjustment
+                 * returns at once, the cell is left as it is */
+                if (qv <= qs && plus_zero(s->qc[n]) && plus_zero(s->qr[n])) continue;
+            }
             if (qc < 0) qc = 0;
             if (qr < 0) qr = 0;
             /* rain from cloud water */
@@ -49,6 +79,19 @@ void atmos__sim_micro(atmos_sim *s, double dt, float fix)
     atmos__sim_sync(s);
 }
 
+/* Whether a cell of row j holds rain that falls (q_r > 1e-9). */
+static int any_rain(const atmos_sim *s, int j)
+{
+    const size_t lev = (size_t)s->nx * s->ny;
+    for (int k = 0; k < s->nz; k++) {
+        const float *q = s->qr + k * lev + (size_t)j * s->nx;
+        int any = 0;
+        for (int i = 0; i < s->nx; i++) any |= q[i] > 1e-9;
+        if (any) return 1;
+    }
+    return 0;
+}
+
 /* Rain falls with V by first-order upwind fluxes, sub-stepped so that V dt_sub < dx; what
  * leaves the lowest cell is rain on the ground. The columns of row j, one at a time; returns
  * the row's rain out, added column by column. */
@@ -58,6 +101,7 @@ double atmos__sim_fall_row(atmos_sim *s, double dt, int j)
     const int nx = s->nx, nz = s->nz;
     const size_t lev = (size_t)nx * s->ny;
     double row = 0;
+    if (!any_rain(s, j)) return row; /* each column's rain_out would be 0 */
     for (int i = 0; i < nx; i++) {
         const size_t c = (size_t)j * nx + i;
         double vmax = 0, fell = 0;

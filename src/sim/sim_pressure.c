@@ -11,12 +11,21 @@
 #include <complex.h>
 #include <fftw3.h>
 #include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define PROJ_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define PROJ_CLONES
+#endif
 
 atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *s)
 {
     const int nh = s->nx / 2 + 1;
     s->spec = fftwf_malloc(sizeof(fftwf_complex) * (size_t)nh * s->ny * s->nz);
-    if (!s->spec) return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: out of memory for the pressure solver");
+    s->colbuf = malloc(sizeof(double) * SIM_COLUMN_SCRATCH(s->nz) * (size_t)(s->threads > 1 ? s->threads : 1));
+    if (!s->spec || !s->colbuf) return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: out of memory for the pressure solver");
     /* planned on scratch arrays (ESTIMATE leaves them alone); UNALIGNED so the plan runs on any level */
     fftwf_complex *c = s->spec;
     const unsigned flags = FFTW_ESTIMATE | FFTW_UNALIGNED;
@@ -37,20 +46,22 @@ void atmos__sim_fft_free(atmos_sim *s)
         if (s->fft_inv) fftwf_destroy_plan(s->fft_inv);
     }
     if (s->spec) fftwf_free(s->spec);
+    free(s->colbuf);
+    s->colbuf = NULL;
     s->fft_fwd = s->fft_inv = s->spec = NULL;
 }
 
-/* dx times the divergence of the cells of level k into d. */
-static void divergence(const atmos_sim *s, int k, float *d)
+/* dx times the divergence of the cells of level k into d (the row's last cell wraps). */
+PROJ_CLONES static void divergence(const atmos_sim *s, int k, float *restrict d)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
+    const float *restrict u = s->u, *restrict v = s->v, *restrict w = s->w;
     for (int j = 0; j < ny; j++) {
         const size_t r = sim_idx(s, 0, j, k), rp = sim_idx(s, 0, j + 1 == ny ? 0 : j + 1, k);
-        for (int i = 0; i < nx; i++) {
-            const size_t n = r + i, ip = r + (i + 1 == nx ? 0 : i + 1);
-            d[n] = (s->u[ip] - s->u[n]) + (s->v[rp + i] - s->v[n]) + (s->w[n + lev] - s->w[n]);
-        }
+        for (size_t n = r; n + 1 < r + nx; n++) d[n] = (u[n + 1] - u[n]) + (v[rp + n - r] - v[n]) + (w[n + lev] - w[n]);
+        const size_t n = r + nx - 1;
+        d[n] = (u[r] - u[n]) + (v[rp + nx - 1] - v[n]) + (w[n + lev] - w[n]);
     }
 }
 
@@ -64,54 +75,106 @@ double atmos__sim_max_divergence(const atmos_sim *s)
 
 /* Solves (phi[k+1] - 2 phi[k] + phi[k-1]) - lam phi[k] = r[k] along one column of modes
  * (stride between levels), zero gradient at both ends, in place, times `norm` (the inverse
- * transform's 1 / (nx ny)); tmp holds 3 nz doubles. */
-static void column(fftwf_complex *r, size_t stride, int nz, double lam, double norm, double *tmp)
+ * transform's 1 / (nx ny)): the mean mode (lam = 0), defined up to a constant, with phi[0] = 0
+ * and then row by row. */
+static void mean_column(fftwf_complex *r, size_t stride, int nz, double norm)
 {
-    double *cp = tmp, *dre = tmp + nz, *dim = tmp + 2 * nz;
-    for (int k = 0; k < nz; k++) {
-        dre[k] = crealf(r[(size_t)k * stride]);
-        dim[k] = cimagf(r[(size_t)k * stride]);
+    double pr = 0, pi = 0, qr = crealf(r[0]), qi = cimagf(r[0]);
+    r[0] = 0;
+    for (int k = 1; k < nz; k++) {
+        const double dr = crealf(r[(size_t)k * stride]), di = cimagf(r[(size_t)k * stride]);
+        r[(size_t)k * stride] = (float)(qr * norm) + I * (float)(qi * norm);
+        const double nr = dr + 2 * qr - pr, ni = di + 2 * qi - pi;
+        pr = qr, pi = qi, qr = nr, qi = ni;
     }
-    if (lam < 1e-9) { /* the mean mode, defined up to a constant: phi[0] = 0, then row by row */
-        double pr = 0, pi = 0, qr = dre[0], qi = dim[0];
-        r[0] = 0;
-        for (int k = 1; k < nz; k++) {
-            r[(size_t)k * stride] = (float)(qr * norm) + I * (float)(qi * norm);
-            const double nr = dre[k] + 2 * qr - pr, ni = dim[k] + 2 * qi - pi;
-            pr = qr, pi = qi, qr = nr, qi = ni;
+}
+
+/* The same (Thomas algorithm) for SIM_CW columns of modes side by side, r[0..SIM_CW) at each level,
+ * lam > 0 each; tmp holds 3 nz SIM_CW doubles. Every column's arithmetic is the one-column
+ * algorithm's, the columns are independent lanes (vectorised). */
+PROJ_CLONES static void columns(fftwf_complex *r, size_t stride, int nz, const double *lam, double norm, double *tmp)
+{
+    double(*cp)[SIM_CW] = (double(*)[SIM_CW])tmp, (*dre)[SIM_CW] = (double(*)[SIM_CW])(tmp + (size_t)nz * SIM_CW),
+        (*dim)[SIM_CW] = (double(*)[SIM_CW])(tmp + 2 * (size_t)nz * SIM_CW);
+    for (int k = 0; k < nz; k++) {
+        const float *q = (const float *)(r + (size_t)k * stride);
+        for (int l = 0; l < SIM_CW; l++) dre[k][l] = q[2 * l], dim[k][l] = q[2 * l + 1];
+    }
+    const double edge = -1.0, mid = -2.0;
+    for (int k = 0; k < nz; k++) {
+        const double d = k == 0 || k == nz - 1 ? edge : mid;
+        for (int l = 0; l < SIM_CW; l++) {
+            const double b = d - lam[l];
+            const double m = k ? b - cp[k - 1][l] : b;
+            cp[k][l] = 1.0 / m;
+            dre[k][l] = (dre[k][l] - (k ? dre[k - 1][l] : 0)) / m;
+            dim[k][l] = (dim[k][l] - (k ? dim[k - 1][l] : 0)) / m;
         }
-        return;
     }
+    for (int k = nz - 2; k >= 0; k--)
+        for (int l = 0; l < SIM_CW; l++) {
+            dre[k][l] -= cp[k][l] * dre[k + 1][l];
+            dim[k][l] -= cp[k][l] * dim[k + 1][l];
+        }
     for (int k = 0; k < nz; k++) {
-        const double b = (k == 0 || k == nz - 1 ? -1.0 : -2.0) - lam;
-        const double m = k ? b - cp[k - 1] : b;
-        cp[k] = 1.0 / m;
-        dre[k] = (dre[k] - (k ? dre[k - 1] : 0)) / m;
-        dim[k] = (dim[k] - (k ? dim[k - 1] : 0)) / m;
+        float *q = (float *)(r + (size_t)k * stride);
+        for (int l = 0; l < SIM_CW; l++) q[2 * l] = (float)(dre[k][l] * norm), q[2 * l + 1] = (float)(dim[k][l] * norm);
     }
-    for (int k = nz - 2; k >= 0; k--) {
-        dre[k] -= cp[k] * dre[k + 1];
-        dim[k] -= cp[k] * dim[k + 1];
+}
+
+/* The modes (a, b), a = 0 .. nh - 1, of row b of the spectrum, SIM_CW columns at a time; a group
+ * with the mean mode (0, 0), and the last group if short, go through a copy whose spare lanes
+ * repeat a mode of the group (solved and discarded). tmp holds SIM_COLUMN_SCRATCH(nz) doubles. */
+static void mode_row(fftwf_complex *c, size_t clev, int nx, int ny, int nz, int b, double norm, double *tmp)
+{
+    const int nh = nx / 2 + 1;
+    fftwf_complex *pad = (fftwf_complex *)(tmp + 3 * (size_t)nz * SIM_CW);
+    for (int a0 = 0; a0 < nh; a0 += SIM_CW) {
+        const int n = nh - a0 < SIM_CW ? nh - a0 : SIM_CW, mean = a0 == 0 && b == 0;
+        int src[SIM_CW];
+        double lam[SIM_CW];
+        for (int l = 0; l < SIM_CW; l++) {
+            src[l] = l >= n ? n - 1 : (mean && l == 0 ? 1 : l); /* nh >= 3: lane 1 exists */
+            const int a = a0 + src[l];
+            lam[l] = 4.0 - 2.0 * cos(2.0 * ATMOS_PI * a / nx) - 2.0 * cos(2.0 * ATMOS_PI * b / ny);
+        }
+        fftwf_complex *r = c + (size_t)b * nh + a0;
+        if (mean) mean_column(r, clev, nz, norm);
+        if (n == SIM_CW && !mean) {
+            columns(r, clev, nz, lam, norm, tmp);
+            continue;
+        }
+        for (int k = 0; k < nz; k++)
+            for (int l = 0; l < SIM_CW; l++) pad[(size_t)k * SIM_CW + l] = r[(size_t)k * clev + src[l]];
+        columns(pad, SIM_CW, nz, lam, norm, tmp);
+        for (int k = 0; k < nz; k++)
+            for (int l = mean; l < n; l++) r[(size_t)k * clev + l] = pad[(size_t)k * SIM_CW + l];
     }
-    for (int k = 0; k < nz; k++) r[(size_t)k * stride] = (float)(dre[k] * norm) + I * (float)(dim[k] * norm);
 }
 
 /* u -= grad phi on the faces of level k (w stays 0 at the ground and the lid); returns the
- * level's largest |u|, |v|, |w| afterwards (the next step's time step). */
-static float gradient(atmos_sim *s, int k, const float *d)
+ * level's largest |u|, |v|, |w| afterwards (the next step's time step; a NaN is passed over,
+ * as fmaxf would). */
+static inline float amax(float m, float a)
+{
+    a = fabsf(a);
+    return a > m ? a : m;
+}
+
+PROJ_CLONES static float gradient(atmos_sim *s, int k, const float *restrict d)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
+    float *restrict u = s->u, *restrict v = s->v, *restrict w = s->w;
     float m = 0;
     for (int j = 0; j < ny; j++) {
         const size_t r = sim_idx(s, 0, j, k), rm = sim_idx(s, 0, j ? j - 1 : ny - 1, k);
-        for (int i = 0; i < nx; i++) {
-            const size_t n = r + i;
-            s->u[n] -= d[n] - d[r + (i ? i - 1 : nx - 1)];
-            s->v[n] -= d[n] - d[rm + i];
-            if (k > 0) s->w[n] -= d[n] - d[n - lev];
-            m = fmaxf(m, fmaxf(fabsf(s->u[n]), fmaxf(fabsf(s->v[n]), fabsf(s->w[n]))));
-        }
+        u[r] -= d[r] - d[r + nx - 1];
+        for (size_t n = r + 1; n < r + nx; n++) u[n] -= d[n] - d[n - 1];
+        for (size_t i = 0; i < (size_t)nx; i++) v[r + i] -= d[r + i] - d[rm + i];
+        if (k > 0)
+            for (size_t n = r; n < r + nx; n++) w[n] -= d[n] - d[n - lev];
+        for (size_t n = r; n < r + nx; n++) m = amax(amax(amax(m, u[n]), v[n]), w[n]);
     }
     return m;
 }
@@ -131,11 +194,7 @@ void atmos__sim_project(atmos_sim *s)
     const double norm = 1.0 / ((double)nx * ny);
     SIM_FOR
     for (int b = 0; b < ny; b++) {
-        double tmp[3 * 2 * ATMOS_SIM_MAX_GRID]; /* nz <= 2 ATMOS_SIM_MAX_GRID */
-        for (int a = 0; a < nh; a++) {
-            const double lam = 4.0 - 2.0 * cos(2.0 * ATMOS_PI * a / nx) - 2.0 * cos(2.0 * ATMOS_PI * b / ny);
-            column(c + (size_t)b * nh + a, clev, nz, lam, norm, tmp);
-        }
+        mode_row(c, clev, nx, ny, nz, b, norm, s->colbuf + (size_t)omp_get_thread_num() * SIM_COLUMN_SCRATCH(nz));
     }
     atmos__sim_sync(s);
     SIM_FOR

@@ -1,0 +1,289 @@
+/* Trilinear samples at rows of departure points (the semi-Lagrangian advection's inner loop,
+ * sim_advect.c): one field, or four fields packed per cell. Positions are in the field's
+ * index space, x and y wrap, z clamps to [0, nz_f - 1]. On x86-64 CPUs with AVX2 the
+ * corners and weights of four or eight points are found at once and the corners fetched by
+ * gathers; every lane does the scalar code's operations in the same order and precision
+ * (double positions, float weights and interpolation, no fused multiply-adds), so both paths
+ * give the same bits. Points far outside the grid (more than one domain away) or NaN take the
+ * scalar path. */
+#include "sim/sim_internal.h"
+
+#include <string.h>
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define SIM_AVX2 1
+#include <immintrin.h>
+#define AVX2 __attribute__((target("avx2")))
+#define AVX2_INLINE static inline __attribute__((target("avx2"), always_inline))
+#endif
+
+/* The eight corners and weights of one sample (the scalar path). */
+typedef struct {
+    size_t c[4]; /* offsets of the corners (i0, j, k) of rows j0/j1 at levels k0/k1 */
+    int i0, i1;
+    float ax, ay, az;
+} tri;
+
+static inline int wrap(int i, int n)
+{
+    if ((unsigned)i >= (unsigned)n) {
+        i %= n;
+        if (i < 0) i += n;
+    }
+    return i;
+}
+
+/* floor() without the library call (the baseline x86-64 target has no rounding instruction);
+ * positions stay far inside int's range. */
+static inline int ifloor(double x)
+{
+    const int i = (int)x;
+    return i - (x < i);
+}
+
+static inline void tri_setup(const atmos_sim *s, int nz_f, double x, double y, double z, tri *t)
+{
+    const int nx = s->nx, ny = s->ny;
+    if (z < 0) z = 0;
+    if (z > nz_f - 1) z = nz_f - 1;
+    const int fx0 = ifloor(x), fy0 = ifloor(y), fz0 = ifloor(z);
+    t->ax = (float)(x - fx0), t->ay = (float)(y - fy0), t->az = (float)(z - fz0);
+    const int i0 = wrap(fx0, nx), j0 = wrap(fy0, ny), k0 = fz0;
+    const int j1 = j0 + 1 == ny ? 0 : j0 + 1, k1 = k0 + 1 < nz_f ? k0 + 1 : k0;
+    t->i0 = i0, t->i1 = i0 + 1 == nx ? 0 : i0 + 1;
+    const size_t l0 = (size_t)k0 * nx * ny, l1 = (size_t)k1 * nx * ny;
+    t->c[0] = l0 + (size_t)j0 * nx, t->c[1] = l0 + (size_t)j1 * nx;
+    t->c[2] = l1 + (size_t)j0 * nx, t->c[3] = l1 + (size_t)j1 * nx;
+}
+
+static inline float tri_eval(const float *f, const tri *t)
+{
+    const int i0 = t->i0, i1 = t->i1;
+    const float c00 = f[t->c[0] + i0] + t->ax * (f[t->c[0] + i1] - f[t->c[0] + i0]);
+    const float c01 = f[t->c[1] + i0] + t->ax * (f[t->c[1] + i1] - f[t->c[1] + i0]);
+    const float c10 = f[t->c[2] + i0] + t->ax * (f[t->c[2] + i1] - f[t->c[2] + i0]);
+    const float c11 = f[t->c[3] + i0] + t->ax * (f[t->c[3] + i1] - f[t->c[3] + i0]);
+    const float c0 = c00 + t->ay * (c01 - c00), c1 = c10 + t->ay * (c11 - c10);
+    return c0 + t->az * (c1 - c0);
+}
+
+/* Four fields packed per cell (16 bytes a cell): tri_eval's arithmetic on each of them. */
+typedef float v4f __attribute__((vector_size(16)));
+
+static inline v4f ld4(const float *p)
+{
+    v4f v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+static inline v4f tri_eval4(const float *f4, const tri *t)
+{
+    const size_t i0 = 4 * (size_t)t->i0, i1 = 4 * (size_t)t->i1;
+    v4f c[4];
+    for (int r = 0; r < 4; r++) {
+        const v4f a = ld4(f4 + 4 * t->c[r] + i0), b = ld4(f4 + 4 * t->c[r] + i1);
+        c[r] = a + t->ax * (b - a);
+    }
+    const v4f c0 = c[0] + t->ay * (c[1] - c[0]), c1 = c[2] + t->ay * (c[3] - c[2]);
+    return c0 + t->az * (c1 - c0);
+}
+
+static void sample_scalar(const atmos_sim *s, const float *f, int nz_f, const double *x, const double *y,
+                          const double *z, float *out, int a, int b)
+{
+    for (int m = a; m < b; m++) {
+        tri t;
+        tri_setup(s, nz_f, x[m], y[m], z[m], &t);
+        out[m] = tri_eval(f, &t);
+    }
+}
+
+static void sample4_scalar(const atmos_sim *s, const float *f4, int nz_f, const double *x, const double *y,
+                           const double *z, float *out4, int a, int b)
+{
+    for (int m = a; m < b; m++) {
+        tri t;
+        tri_setup(s, nz_f, x[m], y[m], z[m], &t);
+        const v4f q = tri_eval4(f4, &t);
+        memcpy(out4 + 4 * m, &q, sizeof q);
+    }
+}
+
+#ifdef SIM_AVX2
+/* Corners and weights of four points: i0, i1 (wrapped), the offsets of the four rows
+ * (j0/j1 at k0/k1), the weights. 0 if a point is outside [-n, 2n) along x or y, or NaN. */
+typedef struct {
+    __m128i i0, i1, r[4];
+    __m128 ax, ay, az;
+} lanes4;
+
+AVX2_INLINE __m128i wrap4(__m128i i, int n)
+{
+    const __m128i vn = _mm_set1_epi32(n);
+    const __m128i lo = _mm_cmpgt_epi32(_mm_setzero_si128(), i), hi = _mm_cmpgt_epi32(i, _mm_set1_epi32(n - 1));
+    return _mm_sub_epi32(_mm_add_epi32(i, _mm_and_si128(lo, vn)), _mm_and_si128(hi, vn));
+}
+
+AVX2_INLINE __m128i next4(__m128i i, int n) /* i + 1, n -> 0 */
+{
+    const __m128i p = _mm_add_epi32(i, _mm_set1_epi32(1));
+    return _mm_andnot_si128(_mm_cmpeq_epi32(p, _mm_set1_epi32(n)), p);
+}
+
+AVX2_INLINE int inside4(__m128i i, int lo, int hi) /* every lane in [lo, hi] */
+{
+    const __m128i bad = _mm_or_si128(_mm_cmpgt_epi32(_mm_set1_epi32(lo), i), _mm_cmpgt_epi32(i, _mm_set1_epi32(hi)));
+    return _mm_testz_si128(bad, bad);
+}
+
+AVX2_INLINE int setup4(const atmos_sim *s, int nz_f, const double *x, const double *y, const double *z, lanes4 *o)
+{
+    const int nx = s->nx, ny = s->ny;
+    const __m256d X = _mm256_loadu_pd(x), Y = _mm256_loadu_pd(y);
+    /* z < 0 -> 0, z > nz_f - 1 -> nz_f - 1, else z itself (a -0 or a NaN kept, as the scalar code) */
+    const __m256d Z = _mm256_min_pd(_mm256_set1_pd(nz_f - 1), _mm256_max_pd(_mm256_setzero_pd(), _mm256_loadu_pd(z)));
+    /* floor through int (the scalar ifloor: -0 gives +0); out of range and NaN give INT_MIN */
+    const __m128i ix = _mm256_cvttpd_epi32(_mm256_floor_pd(X)), iy = _mm256_cvttpd_epi32(_mm256_floor_pd(Y));
+    const __m128i iz = _mm256_cvttpd_epi32(_mm256_floor_pd(Z));
+    if (!inside4(ix, -nx, 2 * nx - 1) || !inside4(iy, -ny, 2 * ny - 1) || !inside4(iz, 0, nz_f - 1)) return 0;
+    o->ax = _mm256_cvtpd_ps(_mm256_sub_pd(X, _mm256_cvtepi32_pd(ix)));
+    o->ay = _mm256_cvtpd_ps(_mm256_sub_pd(Y, _mm256_cvtepi32_pd(iy)));
+    o->az = _mm256_cvtpd_ps(_mm256_sub_pd(Z, _mm256_cvtepi32_pd(iz)));
+    o->i0 = wrap4(ix, nx);
+    o->i1 = next4(o->i0, nx);
+    const __m128i j0 = wrap4(iy, ny), j1 = next4(j0, ny);
+    const __m128i k1 = _mm_min_epi32(_mm_add_epi32(iz, _mm_set1_epi32(1)), _mm_set1_epi32(nz_f - 1));
+    const __m128i vny = _mm_set1_epi32(ny), vnx = _mm_set1_epi32(nx);
+    const __m128i l0 = _mm_mullo_epi32(iz, vny), l1 = _mm_mullo_epi32(k1, vny);
+    o->r[0] = _mm_mullo_epi32(_mm_add_epi32(l0, j0), vnx);
+    o->r[1] = _mm_mullo_epi32(_mm_add_epi32(l0, j1), vnx);
+    o->r[2] = _mm_mullo_epi32(_mm_add_epi32(l1, j0), vnx);
+    o->r[3] = _mm_mullo_epi32(_mm_add_epi32(l1, j1), vnx);
+    return 1;
+}
+
+#define PAIR_I(a, b) _mm256_set_m128i((b), (a))
+#define PAIR_F(a, b) _mm256_set_m128((b), (a))
+
+AVX2_INLINE __m256 lerp8(__m256 a, __m256 b, __m256 t) /* a + t (b - a) */
+{
+    return _mm256_add_ps(a, _mm256_mul_ps(t, _mm256_sub_ps(b, a)));
+}
+
+/* Eight points of one field. */
+AVX2 static void sample_avx2(const atmos_sim *s, const float *f, int nz_f, const double *x, const double *y,
+                             const double *z, float *out, int n)
+{
+    int m = 0;
+    for (; m + 8 <= n; m += 8) {
+        lanes4 a, b;
+        if (!setup4(s, nz_f, x + m, y + m, z + m, &a) || !setup4(s, nz_f, x + m + 4, y + m + 4, z + m + 4, &b)) {
+            sample_scalar(s, f, nz_f, x, y, z, out, m, m + 8);
+            continue;
+        }
+        const __m256i i0 = PAIR_I(a.i0, b.i0), i1 = PAIR_I(a.i1, b.i1);
+        const __m256 ax = PAIR_F(a.ax, b.ax);
+        __m256 c[4];
+        for (int r = 0; r < 4; r++) {
+            const __m256i row = PAIR_I(a.r[r], b.r[r]);
+            const __m256 lo = _mm256_i32gather_ps(f, _mm256_add_epi32(row, i0), 4);
+            const __m256 hi = _mm256_i32gather_ps(f, _mm256_add_epi32(row, i1), 4);
+            c[r] = lerp8(lo, hi, ax);
+        }
+        const __m256 ay = PAIR_F(a.ay, b.ay), az = PAIR_F(a.az, b.az);
+        _mm256_storeu_ps(out + m, lerp8(lerp8(c[0], c[1], ay), lerp8(c[2], c[3], ay), az));
+    }
+    sample_scalar(s, f, nz_f, x, y, z, out, m, n);
+}
+
+/* Four points of four packed fields, two points a 256-bit register. */
+AVX2_INLINE __m256 load_pair(const float *f4, int p, int q)
+{
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f4 + 4 * (size_t)p)), _mm_loadu_ps(f4 + 4 * (size_t)q),
+                                1);
+}
+
+AVX2_INLINE __m256 spread_pair(__m128 w, int p) /* lanes p, p + 1 of w, each four times */
+{
+    const __m256i sel = _mm256_setr_epi32(p, p, p, p, p + 1, p + 1, p + 1, p + 1);
+    return _mm256_permutevar8x32_ps(_mm256_castps128_ps256(w), sel);
+}
+
+AVX2 static void sample4_avx2(const atmos_sim *s, const float *f4, int nz_f, const double *x, const double *y,
+                              const double *z, float *out4, int n)
+{
+    int m = 0;
+    for (; m + 4 <= n; m += 4) {
+        lanes4 a;
+        if (!setup4(s, nz_f, x + m, y + m, z + m, &a)) {
+            sample4_scalar(s, f4, nz_f, x, y, z, out4, m, m + 4);
+            continue;
+        }
+        int i0[4], i1[4], r[4][4];
+        _mm_storeu_si128((__m128i *)i0, a.i0);
+        _mm_storeu_si128((__m128i *)i1, a.i1);
+        for (int q = 0; q < 4; q++) _mm_storeu_si128((__m128i *)r[q], a.r[q]);
+        for (int p = 0; p < 4; p += 2) {
+            const __m256 ax = spread_pair(a.ax, p), ay = spread_pair(a.ay, p), az = spread_pair(a.az, p);
+            __m256 c[4];
+            const int whole = i1[p] && i1[p + 1]; /* no wrap: the corners i0, i0 + 1 side by side */
+            for (int q = 0; q < 4; q++) {
+                __m256 lo, hi;
+                if (whole) {
+                    const __m256 dp = _mm256_loadu_ps(f4 + 4 * (size_t)(r[q][p] + i0[p]));
+                    const __m256 dq = _mm256_loadu_ps(f4 + 4 * (size_t)(r[q][p + 1] + i0[p + 1]));
+                    lo = _mm256_permute2f128_ps(dp, dq, 0x20), hi = _mm256_permute2f128_ps(dp, dq, 0x31);
+                } else {
+                    lo = load_pair(f4, r[q][p] + i0[p], r[q][p + 1] + i0[p + 1]);
+                    hi = load_pair(f4, r[q][p] + i1[p], r[q][p + 1] + i1[p + 1]);
+                }
+                c[q] = lerp8(lo, hi, ax);
+            }
+            _mm256_storeu_ps(out4 + 4 * (size_t)(m + p), lerp8(lerp8(c[0], c[1], ay), lerp8(c[2], c[3], ay), az));
+        }
+    }
+    sample4_scalar(s, f4, nz_f, x, y, z, out4, m, n);
+}
+
+static int have_avx2(void)
+{
+    return __builtin_cpu_supports("avx2");
+}
+#endif
+
+void atmos__sim_sample_row(const atmos_sim *s, const float *f, int nz_f, const double *x, const double *y,
+                           const double *z, float *out, int n)
+{
+#ifdef SIM_AVX2
+    if (have_avx2()) {
+        sample_avx2(s, f, nz_f, x, y, z, out, n);
+        return;
+    }
+#endif
+    sample_scalar(s, f, nz_f, x, y, z, out, 0, n);
+}
+
+void atmos__sim_sample4_row(const atmos_sim *s, const float *f4, int nz_f, const double *x, const double *y,
+                            const double *z, float *out4, int n)
+{
+#ifdef SIM_AVX2
+    if (have_avx2()) {
+        sample4_avx2(s, f4, nz_f, x, y, z, out4, n);
+        return;
+    }
+#endif
+    sample4_scalar(s, f4, nz_f, x, y, z, out4, 0, n);
+}
+
+void atmos__sim_sample_row_scalar(const atmos_sim *s, const float *f, int nz_f, const double *x, const double *y,
+                                  const double *z, float *out, int n)
+{
+    sample_scalar(s, f, nz_f, x, y, z, out, 0, n);
+}
+
+void atmos__sim_sample4_row_scalar(const atmos_sim *s, const float *f4, int nz_f, const double *x, const double *y,
+                                   const double *z, float *out4, int n)
+{
+    sample4_scalar(s, f4, nz_f, x, y, z, out4, 0, n);
+}
