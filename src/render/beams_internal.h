@@ -102,6 +102,10 @@ double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t);
 /* The sum of the falloff at the m points t = ta + (s + o) step, s = 0 .. m - 1 (one tight loop:
  * the same values as m calls of atmos__beams_ray_falloff, added in order). */
 double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m);
+/* The sum of atmos__beams_ray_light at the points t = ta + (s + o) step, s = s0 .. s1 - 1: runs
+ * of them along which the shadow map's tiles prove H the same (atmos__beams_ray_uniform) cost
+ * the falloff alone or nothing; the others are halved, down to a few samples read one by one. */
+double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1);
 
 struct atmos__beams_plan {
     atmos__objects obj;                      /* the meshes and their albedos */

@@ -153,8 +153,8 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
         }
         if (uniform) /* lit all along: the falloff alone varies */
             h = atmos__beams_ray_falloff_sum(&ray, ta, step, o, m);
-        else
-            for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + o) * step);
+        else /* runs of the samples that the tiles prove alike, the rest one by one */
+            h = atmos__beams_ray_light_sum(&ray, ta, step, o, 0, m);
         sum += h / m * fl;
         if (centre) J->centre_subplanes += m;
     }

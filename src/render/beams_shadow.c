@@ -274,3 +274,20 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
     return fall * lookup(&l->face[f], r->f0[f][0] + t * r->f1[f][0], r->f0[f][1] + t * r->f1[f][1],
                          r->f0[f][2] + t * r->f1[f][2]);
 }
+
+double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
+{
+    if (s1 - s0 > 4) { /* what is the same along the run's samples, from the tiles */
+        double same;
+        int full;
+        if (atmos__beams_ray_uniform(r, ta + (s0 + o) * step, ta + (s1 - 1 + o) * step, &same, &full)) {
+            if (full || same == 0) return same * (s1 - s0);
+            return atmos__beams_ray_falloff_sum(r, ta, step, o + s0, s1 - s0);
+        }
+        const int mid = s0 + (s1 - s0) / 2;
+        return atmos__beams_ray_light_sum(r, ta, step, o, s0, mid) + atmos__beams_ray_light_sum(r, ta, step, o, mid, s1);
+    }
+    double h = 0;
+    for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
+    return h;
+}

@@ -7,6 +7,8 @@
  *     xi_b = pi/4 + atan((t_end - d cos g) / (d sin g)) / 2; F by Simpson's rule here;
  *   - a shadow: a ray passing below a sphere lit from above loses exactly the light of the
  *     segment inside the sphere's shadow cone (its ends solved from the cone's quadric);
+ *   - the sub-planes' samples summed through the shadow map's tiles (runs proven lit or dark
+ *     not read) against each sample read alone, for a point light's cube map and a spot;
  *   - the same image with one thread and with two, byte for byte;
  *   - the units of a light's spectrum (its intensity is the integral over 380-780 nm).
  */
@@ -539,12 +541,63 @@ static void test_interleave(void)
     atmos_image_destroy(inter);
 }
 
+/* atmos__beams_ray_light_sum against atmos__beams_ray_light at every sample, on rays across a
+ * sphere's shadow, for a point light (a cube map) and a spot (one face). */
+static void test_light_sum(void)
+{
+    atmos_mesh *mesh = NULL;
+    atmos_mesh_transform tr;
+    atmos_mesh_transform_identity(&tr);
+    tr.position_m[1] = 5;
+    CHECK_OK(atmos_mesh_load(ctx, "builtin:sphere", 0, &mesh));
+    if (!mesh) return;
+    CHECK_OK(atmos_mesh_apply_transform(ctx, mesh, &tr));
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_scene s;
+    base_scene(&s, 8, 8);
+    for (int kind = 0; kind < 2; kind++) {
+        atmos_scene_light sl = s.lights[0];
+        sl.position_m[1] = 10;
+        if (kind) sl.type = ATMOS_LIGHT_SPOT, sl.cone_deg = 30, sl.edge_deg = 5;
+        atmos__beams_light l;
+        memset(&l, 0, sizeof l);
+        atmos__lamp_make(&sl, &wl, &l.L);
+        atmos__beams_progress pr = {0, 6, 0};
+        CHECK_OK(atmos__beams_shadow_build(ctx, &l, &mesh, 1, 256, &pr));
+        double worst = 0, dark = 0;
+        for (int r = 0; r < 60; r++) {
+            const double o[3] = {-12, 0.5 + 0.1 * r, 0.3 - 0.01 * r};
+            double d[3] = {1, 0.02 * (r % 5) - 0.04, 0.05};
+            const double n = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int a = 0; a < 3; a++) d[a] /= n;
+            atmos__beams_ray ray;
+            atmos__beams_ray_init(&l, o, d, &ray);
+            const int m = 400;
+            const double step = 24.0 / m;
+            double want = 0, all = 0;
+            for (int k = 0; k < m; k++)
+                want += atmos__beams_ray_light(&ray, (k + 0.5) * step), all += atmos__beams_ray_falloff(&ray, (k + 0.5) * step);
+            const double got = atmos__beams_ray_light_sum(&ray, 0, step, 0.5, 0, m);
+            worst = fmax(worst, fabs(got - want) / fmax(all, 1));
+            dark += want < all - 1;
+        }
+        printf("sub-plane samples through the tiles (%s): worst difference %.2e of the unshadowed samples, "
+               "%g of 60 rays through the shadow\n", kind ? "spot" : "point light, cube map", worst, dark);
+        CHECK(dark >= 10);
+        CHECK(worst < 1e-12);
+        atmos__beams_shadow_free(&l);
+    }
+    atmos_mesh_destroy(mesh);
+}
+
 int main(void)
 {
     CHECK_OK(atmos_context_create(NULL, &ctx));
     test_spectrum();
     test_airlight();
     test_shadow();
+    test_light_sum();
     test_threads();
     test_interleave();
     test_scene_files();
