@@ -238,18 +238,46 @@ double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
     return s * s * (3 - 2 * s);
 }
 
-double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m)
+/* The samples t = ta + (s + o) step, s in [*ka, *kb), inside the spot's inner cone (falloff 1):
+ * the cone is convex, so they are one run, between the roots of (z(t))^2 = cos^2 |w(t)|^2 on
+ * the side where z > 0; a sample of margin each side, so that the roots' rounding cannot
+ * take in one outside (those are evaluated). An empty run when the roots are ill-conditioned. */
+static void inner_run(const atmos__beams_ray *r, double ta, double step, double o, int m, int *ka, int *kb)
+{
+    *ka = *kb = 0;
+    const double c2 = r->l->L.cos_inner * r->l->L.cos_inner;
+    const double A = r->a1 * r->a1 - c2, B = 2 * (r->a0 * r->a1 - c2 * r->wd), C = r->a0 * r->a0 - c2 * r->ww0;
+    const double disc = B * B - 4 * A * C;
+    if (!(fabs(A) > 1e-9) || !(disc > 0) || !(step > 0)) return;
+    const double q = -0.5 * (B + copysign(sqrt(disc), B)), r1 = fmin(q / A, C / q), r2 = fmax(q / A, C / q);
+    /* z > 0 on a half-line; within it, the double cone's one nappe */
+    const double tz = -r->a0 / r->a1;
+    double lo = -INFINITY, hi = INFINITY;
+    if (r->a1 > 0) lo = tz;
+    else if (r->a1 < 0) hi = tz;
+    else if (!(r->a0 > 0)) return;
+    if (A < 0) lo = fmax(lo, r1), hi = fmin(hi, r2); /* between the roots */
+    else if (r2 > lo && r2 < hi) lo = r2;           /* beyond the roots, on the half-line */
+    else if (r1 > lo && r1 < hi) hi = r1;
+    else return;
+    const double s0 = ceil((lo - ta) / step - o) + 1, s1 = floor((hi - ta) / step - o) - 1;
+    if (!(s0 <= s1)) return;
+    *ka = s0 < 0 ? 0 : s0 > m ? m : (int)s0;
+    *kb = s1 + 1 > m ? m : s1 + 1 < *ka ? *ka : (int)(s1 + 1);
+}
+
+/* The falloff summed over samples [s0, s1) (one tight loop the compiler vectorises). */
+static double falloff_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
-    if (l->L.type != ATMOS_LIGHT_SPOT) return m;
     /* branch-free, so that the loop vectorises: the cosine off the axis clamped into the edge
      * (below the outer cone 0, inside the inner 1: the smoothstep's own values there) */
     const double co = l->L.cos_outer, inv = 1 / (l->L.cos_inner - l->L.cos_outer);
     double sum = 0, f[64];
-    for (int s0 = 0; s0 < m; s0 += 64) {
-        const int n = m - s0 < 64 ? m - s0 : 64;
+    for (int b = s0; b < s1; b += 64) {
+        const int n = s1 - b < 64 ? s1 - b : 64;
         for (int s = 0; s < n; s++) { /* vectorised: no reduction here */
-            const double t = ta + (s0 + s + o) * step;
+            const double t = ta + (b + s + o) * step;
             const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
             double q = (z / sqrt(w2 > 1e-300 ? w2 : 1e-300) - co) * inv;
             q = q < 0 ? 0 : q;
@@ -259,6 +287,14 @@ double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double
         for (int s = 0; s < n; s++) sum += f[s]; /* in order */
     }
     return sum;
+}
+
+double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m)
+{
+    if (r->l->L.type != ATMOS_LIGHT_SPOT) return m;
+    int ka, kb;
+    inner_run(r, ta, step, o, m, &ka, &kb);
+    return falloff_run(r, ta, step, o, 0, ka) + (kb - ka) + falloff_run(r, ta, step, o, kb, m);
 }
 
 double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
@@ -277,7 +313,7 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
 
 double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
-    if (s1 - s0 > 4) { /* what is the same along the run's samples, from the tiles */
+    if (s1 - s0 > 8) { /* what is the same along the run's samples, from the tiles */
         double same;
         int full;
         if (atmos__beams_ray_uniform(r, ta + (s0 + o) * step, ta + (s1 - 1 + o) * step, &same, &full)) {
