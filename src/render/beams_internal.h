@@ -9,6 +9,7 @@
 #include "light/lamp.h"
 #include "render/objects.h"
 #include "render/beams_sun.h"
+#include "render/beams_tiles.h"
 #include "render/plan_internal.h"
 
 /* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
@@ -54,15 +55,7 @@ typedef struct atmos__beams_face {
     double tan_half;
     int n;
     float *depth;
-    /* per tile of TILE x TILE texels, the least and the greatest depth of the tile and the
-     * texels around it (what a filtered look-up in it may read): nearer than the least is
-     * lit, farther than the greatest is in shadow, without reading the map; then the same
-     * over 2x2, 4x4, ... tiles up to the whole map (level k at offset level_at[k], level_n[k]
-     * cells a side) */
-    int tiles, levels;
-    int level_n[24];
-    size_t level_at[24];
-    float *tile_min, *tile_max;
+    atmos__beams_tiles tiles;   /* its min/max pyramid (beams_tiles.h) */
 } atmos__beams_face;
 
 typedef struct atmos__beams_light {
@@ -109,6 +102,10 @@ double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t);
 /* The sum of the falloff at the m points t = ta + (s + o) step, s = 0 .. m - 1 (one tight loop:
  * the same values as m calls of atmos__beams_ray_falloff, added in order). */
 double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m);
+/* The sum of atmos__beams_ray_light at the points t = ta + (s + o) step, s = s0 .. s1 - 1: runs
+ * of them along which the shadow map's tiles prove H the same (atmos__beams_ray_uniform) cost
+ * the falloff alone or nothing; the others are halved, down to a few samples read one by one. */
+double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1);
 
 struct atmos__beams_plan {
     atmos__objects obj;                      /* the meshes and their albedos */

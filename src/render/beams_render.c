@@ -36,6 +36,7 @@ typedef struct job {
     double fwd[3];
     int nw, cx, cy;
     double *z_lo, *dz, *reach; /* per light: the first plane's depth, the spacing, the sampled radius */
+    int *span;                 /* per light and row: the columns [x0, x1) outside which its airlight is 0 */
     double epsilon;
     int max_sub;
     int centre_planes, centre_subplanes;
@@ -153,8 +154,8 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
         }
         if (uniform) /* lit all along: the falloff alone varies */
             h = atmos__beams_ray_falloff_sum(&ray, ta, step, o, m);
-        else
-            for (int s = 0; s < m; s++) h += atmos__beams_ray_light(&ray, ta + (s + o) * step);
+        else /* runs of the samples that the tiles prove alike, the rest one by one */
+            h = atmos__beams_ray_light_sum(&ray, ta, step, o, 0, m);
         sum += h / m * fl;
         if (centre) J->centre_subplanes += m;
     }
@@ -182,6 +183,12 @@ static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, i
     }
 }
 
+static int in_span(const job *J, int i, int x, int y)
+{
+    const int *r = J->span + 2 * ((size_t)i * J->cam->height + y);
+    return x >= r[0] && x < r[1];
+}
+
 /* Pixel (x, y): the surface or the sky behind, the lights' airlight and the sun's, into px.
  * With interleaved sampling (il) the lights' airlight goes to il instead, with what the pixel
  * sees; px NULL: a pixel outside the frame's rectangle that the filter reads, its airlight
@@ -203,7 +210,8 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
         if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         if (!il) {
             if (b->sigma_t > 0)
-                for (int i = 0; i < b->nlights; i++) airlight(J, i, d, T, f, L, x == J->cx && y == J->cy, 0.5);
+                for (int i = 0; i < b->nlights; i++)
+                    if (in_span(J, i, x, y)) airlight(J, i, d, T, f, L, x == J->cx && y == J->cy, 0.5);
             if (b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         }
         for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
@@ -213,17 +221,88 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     const double o = atmos__beams_il_offset(il->n, x, y);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
     if (b->sigma_t > 0)
-        for (int i = 0; i < b->nlights; i++) airlight(J, i, d, T, f, A, px && x == J->cx && y == J->cy, o);
+        for (int i = 0; i < b->nlights; i++)
+            if (in_span(J, i, x, y)) airlight(J, i, d, T, f, A, px && x == J->cx && y == J->cy, o);
     for (int k = 0; k < J->nw; k++) il->air[(size_t)q * J->nw + k] = (float)A[k];
     il->depth[q] = (float)T, il->object[q] = hit ? m : -1;
 }
 
-/* Each light's planes: evenly spaced in depth along the view across the sphere it reaches. */
+/* The least and greatest x of the convex hull of the n points q (x, y) over the band of
+ * heights [b0, b1]: over every segment between two points, the part within the band (the
+ * hull's edges are among them). lo > hi when the band misses the hull. */
+static void band_span(const double (*q)[2], int n, double b0, double b1, double *lo, double *hi)
+{
+    *lo = INFINITY, *hi = -INFINITY;
+    for (int i = 0; i < n; i++)
+        for (int j = i; j < n; j++) {
+            const double ya = q[i][1], yb = q[j][1], xa = q[i][0], xb = q[j][0];
+            const double y0 = fmax(b0, fmin(ya, yb)), y1 = fmin(b1, fmax(ya, yb));
+            if (y0 > y1) continue;
+            double x0 = xa, x1 = xb;
+            if (ya != yb) x0 = xa + (y0 - ya) / (yb - ya) * (xb - xa), x1 = xa + (y1 - ya) / (yb - ya) * (xb - xa);
+            *lo = fmin(*lo, fmin(x0, x1)), *hi = fmax(*hi, fmax(x0, x1));
+        }
+}
+
+/* The pixels whose rays may meet the part of light l that it lights within its reach R, as
+ * per row y the columns [span[2y], span[2y + 1]): a pinhole camera's image of a hull of that
+ * part (a spot's cone cut by the sphere lies within the pyramid of its apex and the octagon
+ * around the cone's circle at R along the axis; a point light's sphere within its cube), when
+ * every corner is in front of the camera (else, or for a wide spot or another camera, every
+ * pixel). Each row takes the hull over the band of its pixels' centres widened by a pixel,
+ * and a pixel of margin each side. */
+static void screen_spans(const job *J, const atmos__beams_light *l, double R, int *span)
+{
+    const atmos_camera *c = J->cam;
+    for (int y = 0; y < c->height; y++) span[2 * y] = 0, span[2 * y + 1] = c->width;
+    const int spot = l->L.type == ATMOS_LIGHT_SPOT;
+    if (c->type != ATMOS_CAMERA_PINHOLE || (spot && !(l->L.cos_outer > 0.2))) return;
+    double P[9][3], q[9][2], e1[3], e2[3];
+    int n = 0;
+    if (spot) {
+        const double *a = l->L.axis, ref[3] = {fabs(a[1]) < 0.9 ? 0 : 1, fabs(a[1]) < 0.9 ? 1 : 0, 0};
+        const double w = R * sqrt(1 - l->L.cos_outer * l->L.cos_outer) / l->L.cos_outer / cos(ATMOS_PI / 8);
+        atmos__cross3(a, ref, e1);
+        atmos__normalize3(e1);
+        atmos__cross3(a, e1, e2);
+        memcpy(P[n++], l->L.pos, sizeof P[0]);
+        for (int k = 0; k < 8; k++, n++) {
+            const double cs = cos(k * ATMOS_PI / 4), sn = sin(k * ATMOS_PI / 4);
+            for (int m = 0; m < 3; m++) P[n][m] = l->L.pos[m] + R * a[m] + w * (cs * e1[m] + sn * e2[m]);
+        }
+    } else
+        for (int k = 0; k < 8; k++, n++)
+            for (int m = 0; m < 3; m++) P[n][m] = l->L.pos[m] + (k >> m & 1 ? R : -R);
+    for (int k = 0; k < n; k++) {
+        const double v[3] = {P[k][0] - J->eye[0], P[k][1] - J->eye[1], P[k][2] - J->eye[2]};
+        const double z = atmos__dot3(v, c->forward);
+        if (!(z > 1e-9 * R)) return;
+        q[k][0] = 0.5 * (c->width + atmos__dot3(v, c->right) / z / c->tan_half_fov * c->height);
+        q[k][1] = 0.5 * c->height * (1 - atmos__dot3(v, c->up) / z / c->tan_half_fov);
+    }
+    for (int y = 0; y < c->height; y++) {
+        double lo, hi;
+        band_span((const double(*)[2])q, n, y - 0.5, y + 1.5, &lo, &hi);
+        if (!(lo <= hi)) {
+            span[2 * y] = span[2 * y + 1] = 0;
+            continue;
+        }
+        span[2 * y] = (int)atmos__clampd(floor(lo) - 1, 0, c->width);
+        span[2 * y + 1] = (int)atmos__clampd(ceil(hi) + 1, 0, c->width);
+    }
+}
+
+/* Each light's planes: evenly spaced in depth along the view across the sphere it reaches;
+ * the pixels it may light (screen_spans). */
 static atmos_status planes(atmos_plan *p, job *J)
 {
     const atmos__beams_plan *b = J->b;
     J->z_lo = malloc(sizeof(double) * 3 * (size_t)(b->nlights ? b->nlights : 1));
-    if (!J->z_lo) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
+    J->span = malloc(sizeof(int) * 2 * (size_t)J->cam->height * (size_t)(b->nlights ? b->nlights : 1));
+    if (!J->z_lo || !J->span) {
+        free(J->z_lo), free(J->span);
+        return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
+    }
     J->dz = J->z_lo + b->nlights, J->reach = J->dz + b->nlights;
     for (int i = 0; i < b->nlights; i++) {
         const atmos__beams_light *l = &b->lights[i];
@@ -233,6 +312,7 @@ static atmos_status planes(atmos_plan *p, job *J)
         J->reach[i] = R;
         J->z_lo[i] = atmos__dot3(Lp, J->fwd) - R;
         J->dz[i] = fmax(given > 0 ? given : 2 * R / 40, 2 * R / (MAX_INTERVALS - 8));
+        screen_spans(J, l, R, J->span + 2 * (size_t)i * J->cam->height);
     }
     return ATMOS_OK;
 }
@@ -288,7 +368,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
     if (b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) {
-        free(J.z_lo);
+        free(J.z_lo), free(J.span);
         return st;
     }
     atmos__beams_il il = {0}, *ilp = NULL;
@@ -300,7 +380,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
-    free(J.z_lo);
+    free(J.z_lo), free(J.span);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     if (cancelled) return atmos__error(p->ctx, ATMOS_E_CANCELLED, "render beams: cancelled");

@@ -13,14 +13,13 @@
 #include <string.h>
 
 #define NEAR_M 1e-3
-#define TILE 8
 #define SPOT_FRUSTUM_MAX_DEG 60.0
 
 void atmos__beams_shadow_free(atmos__beams_light *l)
 {
     for (int f = 0; f < l->nfaces; f++) {
-        free(l->face[f].depth), free(l->face[f].tile_min);
-        l->face[f].depth = l->face[f].tile_min = l->face[f].tile_max = NULL;
+        free(l->face[f].depth), atmos__beams_tiles_free(&l->face[f].tiles);
+        l->face[f].depth = NULL;
     }
     l->nfaces = 0;
 }
@@ -71,50 +70,6 @@ static void clip_draw(atmos__beams_face *F, const double in[3][3])
     }
 }
 
-/* The tiles' bounds (atmos__beams_face), each over its texels and a ring of one around, then
- * each coarser level's cells over their 2x2 children. */
-static void tile_bounds(atmos__beams_face *F)
-{
-    const int n = F->n, T = F->tiles;
-    for (int ty = 0; ty < T; ty++)
-        for (int tx = 0; tx < T; tx++) {
-            float lo = INFINITY, hi = 0;
-            for (int y = ty * TILE - 1; y <= (ty + 1) * TILE; y++)
-                for (int x = tx * TILE - 1; x <= (tx + 1) * TILE; x++) {
-                    const float z = F->depth[(size_t)(y < 0 ? 0 : y >= n ? n - 1 : y) * n + (x < 0 ? 0 : x >= n ? n - 1 : x)];
-                    lo = fminf(lo, z), hi = fmaxf(hi, z);
-                }
-            F->tile_min[ty * T + tx] = lo, F->tile_max[ty * T + tx] = hi;
-        }
-    for (int k = 1; k < F->levels; k++) {
-        const int m = F->level_n[k], c = F->level_n[k - 1];
-        const float *cmin = F->tile_min + F->level_at[k - 1], *cmax = F->tile_max + F->level_at[k - 1];
-        for (int j = 0; j < m; j++)
-            for (int i = 0; i < m; i++) {
-                float lo = INFINITY, hi = 0;
-                for (int y = 2 * j; y < 2 * j + 2 && y < c; y++)
-                    for (int x = 2 * i; x < 2 * i + 2 && x < c; x++)
-                        lo = fminf(lo, cmin[y * c + x]), hi = fmaxf(hi, cmax[y * c + x]);
-                F->tile_min[F->level_at[k] + (size_t)j * m + i] = lo, F->tile_max[F->level_at[k] + (size_t)j * m + i] = hi;
-            }
-    }
-}
-
-/* The levels' sizes and offsets; the cells of all levels. */
-static size_t plan_levels(atmos__beams_face *F)
-{
-    size_t at = 0;
-    int m = F->tiles, k = 0;
-    for (;;) {
-        F->level_n[k] = m, F->level_at[k] = at;
-        at += (size_t)m * m, k++;
-        if (m == 1) break;
-        m = (m + 1) / 2;
-    }
-    F->levels = k;
-    return at;
-}
-
 static void raster_face(atmos__beams_face *F, const double pos[3], atmos_mesh *const *mesh, int nmesh)
 {
     for (size_t i = 0; i < (size_t)F->n * F->n; i++) F->depth[i] = INFINITY;
@@ -129,7 +84,6 @@ static void raster_face(atmos__beams_face *F, const double pos[3], atmos_mesh *c
             if (v[0][2] < NEAR_M && v[1][2] < NEAR_M && v[2][2] < NEAR_M) continue;
             clip_draw(F, v);
         }
-    tile_bounds(F);
 }
 
 int atmos__beams_shadow_faces(const atmos__lamp *L, int nmesh)
@@ -152,23 +106,30 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
             d[f / 2] = f % 2 ? -1 : 1;
             set_face(F, d, 1.0);
         }
-        F->n = size, F->tiles = (size + TILE - 1) / TILE;
-        const size_t cells = plan_levels(F);
+        F->n = size;
         F->depth = malloc(sizeof(float) * (size_t)size * size);
-        F->tile_min = malloc(sizeof(float) * 2 * cells);
-        F->tile_max = F->tile_min ? F->tile_min + cells : NULL;
-        if (!F->depth || !F->tile_min) {
+        memset(&F->tiles, 0, sizeof F->tiles);
+        if (!F->depth) {
             l->nfaces = f + 1;
             atmos__beams_shadow_free(l);
             return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d shadow map", size, size);
         }
     }
     l->nfaces = nf;
+    int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
     for (int f = 0; f < nf; f++) {
         if (atmos__cancelled(&pr->cancelled)) continue;
         raster_face(&l->face[f], l->L.pos, mesh, nmesh);
+        if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n)) {
+#pragma omp atomic write
+            failed = 1;
+        }
         atmos__progress_step(ctx, "beams shadow maps", &pr->done, pr->total, &pr->cancelled);
+    }
+    if (failed) {
+        atmos__beams_shadow_free(l);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d shadow map's tiles", size, size);
     }
     if (atmos__cancelled(&pr->cancelled)) return atmos__error(ctx, ATMOS_E_CANCELLED, "render beams: cancelled");
     return ATMOS_OK;
@@ -183,9 +144,9 @@ static double lookup(const atmos__beams_face *F, double x, double y, double z)
     const double fx = 0.5 * n + x * k - 0.5, fy = 0.5 * n + y * k - 0.5;
     if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
     const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1; /* floor: fx, fy > -1 */
-    const int tile = (y0 < 0 ? 0 : y0 / TILE) * F->tiles + (x0 < 0 ? 0 : x0 / TILE);
-    if (z < F->tile_min[tile]) return 1;
-    if (z >= F->tile_max[tile]) return 0;
+    const int tile = atmos__beams_tiles_at(&F->tiles, x0, y0);
+    if (z < F->tiles.min[tile]) return 1;
+    if (z >= F->tiles.max[tile]) return 0;
     const double ax = fx - x0, ay = fy - y0;
     const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
     const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
@@ -259,16 +220,8 @@ int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, do
     const atmos__beams_face *F = &l->face[f];
     const int x0 = (int)(atmos__mind(xa, xb) + 1) - 1, x1 = (int)(atmos__maxd(xa, xb) + 1) - 1;
     const int y0 = (int)(atmos__mind(ya, yb) + 1) - 1, y1 = (int)(atmos__maxd(ya, yb) + 1) - 1;
-    const int tx0 = x0 < 0 ? 0 : x0 / TILE, tx1 = x1 < 0 ? 0 : x1 / TILE, ty0 = y0 < 0 ? 0 : y0 / TILE,
-              ty1 = y1 < 0 ? 0 : y1 / TILE;
-    int k = 0; /* the finest level where the tiles' box spans at most 2 x 2 cells */
-    while (k + 1 < F->levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
-    const float *cmin = F->tile_min + F->level_at[k], *cmax = F->tile_max + F->level_at[k];
-    const int m = F->level_n[k];
-    float lo = INFINITY, hi = 0;
-    for (int ty = ty0 >> k; ty <= ty1 >> k; ty++)
-        for (int tx = tx0 >> k; tx <= tx1 >> k; tx++)
-            lo = cmin[ty * m + tx] < lo ? cmin[ty * m + tx] : lo, hi = cmax[ty * m + tx] > hi ? cmax[ty * m + tx] : hi;
+    float lo, hi;
+    atmos__beams_tiles_range(&F->tiles, x0, x1, y0, y1, &lo, &hi);
     if (atmos__maxd(za, zb) < lo) return 1;
     if (atmos__mind(za, zb) >= hi) return *h = 0, 1;
     return 0;
@@ -285,18 +238,46 @@ double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
     return s * s * (3 - 2 * s);
 }
 
-double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m)
+/* The samples t = ta + (s + o) step, s in [*ka, *kb), inside the spot's inner cone (falloff 1):
+ * the cone is convex, so they are one run, between the roots of (z(t))^2 = cos^2 |w(t)|^2 on
+ * the side where z > 0; a sample of margin each side, so that the roots' rounding cannot
+ * take in one outside (those are evaluated). An empty run when the roots are ill-conditioned. */
+static void inner_run(const atmos__beams_ray *r, double ta, double step, double o, int m, int *ka, int *kb)
+{
+    *ka = *kb = 0;
+    const double c2 = r->l->L.cos_inner * r->l->L.cos_inner;
+    const double A = r->a1 * r->a1 - c2, B = 2 * (r->a0 * r->a1 - c2 * r->wd), C = r->a0 * r->a0 - c2 * r->ww0;
+    const double disc = B * B - 4 * A * C;
+    if (!(fabs(A) > 1e-9) || !(disc > 0) || !(step > 0)) return;
+    const double q = -0.5 * (B + copysign(sqrt(disc), B)), r1 = fmin(q / A, C / q), r2 = fmax(q / A, C / q);
+    /* z > 0 on a half-line; within it, the double cone's one nappe */
+    const double tz = -r->a0 / r->a1;
+    double lo = -INFINITY, hi = INFINITY;
+    if (r->a1 > 0) lo = tz;
+    else if (r->a1 < 0) hi = tz;
+    else if (!(r->a0 > 0)) return;
+    if (A < 0) lo = fmax(lo, r1), hi = fmin(hi, r2); /* between the roots */
+    else if (r2 > lo && r2 < hi) lo = r2;           /* beyond the roots, on the half-line */
+    else if (r1 > lo && r1 < hi) hi = r1;
+    else return;
+    const double s0 = ceil((lo - ta) / step - o) + 1, s1 = floor((hi - ta) / step - o) - 1;
+    if (!(s0 <= s1)) return;
+    *ka = s0 < 0 ? 0 : s0 > m ? m : (int)s0;
+    *kb = s1 + 1 > m ? m : s1 + 1 < *ka ? *ka : (int)(s1 + 1);
+}
+
+/* The falloff summed over samples [s0, s1) (one tight loop the compiler vectorises). */
+static double falloff_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
-    if (l->L.type != ATMOS_LIGHT_SPOT) return m;
     /* branch-free, so that the loop vectorises: the cosine off the axis clamped into the edge
      * (below the outer cone 0, inside the inner 1: the smoothstep's own values there) */
     const double co = l->L.cos_outer, inv = 1 / (l->L.cos_inner - l->L.cos_outer);
     double sum = 0, f[64];
-    for (int s0 = 0; s0 < m; s0 += 64) {
-        const int n = m - s0 < 64 ? m - s0 : 64;
+    for (int b = s0; b < s1; b += 64) {
+        const int n = s1 - b < 64 ? s1 - b : 64;
         for (int s = 0; s < n; s++) { /* vectorised: no reduction here */
-            const double t = ta + (s0 + s + o) * step;
+            const double t = ta + (b + s + o) * step;
             const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
             double q = (z / sqrt(w2 > 1e-300 ? w2 : 1e-300) - co) * inv;
             q = q < 0 ? 0 : q;
@@ -306,6 +287,14 @@ double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double
         for (int s = 0; s < n; s++) sum += f[s]; /* in order */
     }
     return sum;
+}
+
+double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double step, double o, int m)
+{
+    if (r->l->L.type != ATMOS_LIGHT_SPOT) return m;
+    int ka, kb;
+    inner_run(r, ta, step, o, m, &ka, &kb);
+    return falloff_run(r, ta, step, o, 0, ka) + (kb - ka) + falloff_run(r, ta, step, o, kb, m);
 }
 
 double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
@@ -320,4 +309,21 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
     }
     return fall * lookup(&l->face[f], r->f0[f][0] + t * r->f1[f][0], r->f0[f][1] + t * r->f1[f][1],
                          r->f0[f][2] + t * r->f1[f][2]);
+}
+
+double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
+{
+    if (s1 - s0 > 8) { /* what is the same along the run's samples, from the tiles */
+        double same;
+        int full;
+        if (atmos__beams_ray_uniform(r, ta + (s0 + o) * step, ta + (s1 - 1 + o) * step, &same, &full)) {
+            if (full || same == 0) return same * (s1 - s0);
+            return atmos__beams_ray_falloff_sum(r, ta, step, o + s0, s1 - s0);
+        }
+        const int mid = s0 + (s1 - s0) / 2;
+        return atmos__beams_ray_light_sum(r, ta, step, o, s0, mid) + atmos__beams_ray_light_sum(r, ta, step, o, mid, s1);
+    }
+    double h = 0;
+    for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
+    return h;
 }

@@ -41,6 +41,7 @@ double atmos__beams_fog_tau(const atmos__beams_fog *f, const double o[3], const 
 void atmos__beams_sun_free(atmos__beams_sun *s)
 {
     free(s->depth);
+    atmos__beams_tiles_free(&s->tiles);
     s->depth = NULL, s->n = 0;
 }
 
@@ -89,6 +90,10 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
             }
             draw(s, v);
         }
+    if (atmos__beams_tiles_build(&s->tiles, s->depth, size)) {
+        atmos__beams_sun_free(s);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d sun shadow map's tiles", size, size);
+    }
     return ATMOS_OK;
 }
 
@@ -121,33 +126,86 @@ double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], c
     return f->sigma0 * exp(-(p[1] - f->base_m) / f->height_m) * f->height_m / sun[1];
 }
 
+/* One ray's steps (atmos__beams_sun_airlight): sample i at t(i), the map's coordinates and
+ * depth linear in t (x0 + t x1, ...). */
+typedef struct sun_ray {
+    const atmos__beams_sun *s;
+    double A, k, gamma, whole, T;
+    int n, flat;
+    double x0, x1, y0, y1, z0, z1;
+} sun_ray;
+
+/* Where the integral reaches the share u of its whole (u in [0, n]: step i spans [i, i + 1],
+ * its sample at i + 0.5). */
+static double share_t(const sun_ray *r, double u)
+{
+    const double q = u * r->whole / r->n, tau = r->flat ? q : -log1p(-r->gamma * q) / r->gamma;
+    return fmin(r->T, line_t(r->A, r->k, tau));
+}
+
+static double sample(const sun_ray *r, double t)
+{
+    return t < INFINITY ? lookup(r->s, r->x0 + t * r->x1, r->y0 + t * r->y1, r->z0 + t * r->z1) : 1;
+}
+
+/* The texel (a look-up's floor) of coordinate f, clamped to [-1, n - 1]. */
+static int texel(double f, int n)
+{
+    return f < 0 ? -1 : f > n - 1 ? n - 1 : (int)f;
+}
+
+/* The sum of H over the samples of steps [i0, i1), ta and tb where the first begins and the
+ * last ends: the count, or 0, when the tiles the segment [ta, tb] crosses hold its depths all
+ * below (or all at or beyond) their bounds (a look-up beside the map says 1: only lit runs
+ * may leave it); else the two halves, down to runs of a few samples read one by one. */
+static double run(const sun_ray *r, int i0, int i1, double ta, double tb)
+{
+    const int n = r->s->n;
+    if (tb < INFINITY) {
+        const double xa = r->x0 + ta * r->x1, xb = r->x0 + tb * r->x1, ya = r->y0 + ta * r->y1, yb = r->y0 + tb * r->y1;
+        const double za = r->z0 + ta * r->z1, zb = r->z0 + tb * r->z1;
+        const int inside = xa > -1 && xa < n && xb > -1 && xb < n && ya > -1 && ya < n && yb > -1 && yb < n;
+        float lo, hi;
+        atmos__beams_tiles_range(&r->s->tiles, texel(fmin(xa, xb), n), texel(fmax(xa, xb), n), texel(fmin(ya, yb), n),
+                                 texel(fmax(ya, yb), n), &lo, &hi);
+        if (fmax(za, zb) < lo) return i1 - i0;
+        if (inside && fmin(za, zb) >= hi) return 0;
+    }
+    if (i1 - i0 <= 4) {
+        double sum = 0;
+        for (int i = i0; i < i1; i++) sum += sample(r, share_t(r, i + 0.5));
+        return sum;
+    }
+    const int mid = i0 + (i1 - i0) / 2;
+    const double tm = share_t(r, mid);
+    return run(r, i0, mid, ta, tm) + run(r, mid, i1, tm, tb);
+}
+
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
                                  const double d[3], double T, double epsilon, int max_steps)
 {
-    double A, k;
-    fog_line(f, o, d, &A, &k);
+    sun_ray r = {.s = s, .T = T};
+    fog_line(f, o, d, &r.A, &r.k);
     /* the sunlight at t is dimmed by C exp(-k t), C its optical depth in at the eye: with the
      * eye's optical depth tau as the variable (d tau = sigma dt, exp(-k t) = 1 - k tau / A) the
      * integrand is exp(-C) exp(-gamma tau), gamma = 1 - d_y / sun_y (1 in uniform fog) */
     const double C = atmos__beams_sun_fog_in(f, s->dir, o);
     if (!(C < 700)) return 0;
-    const double gamma = f->height_m > 0 ? 1 - d[1] / s->dir[1] : 1, tauT = line_tau(A, k, T);
-    const int flat = !(fabs(gamma * tauT) > 1e-9);
-    const double whole = flat ? tauT : -expm1(-gamma * tauT) / gamma; /* int_0^tau(T) exp(-gamma tau) */
-    if (!(whole > 0)) return 0;
+    r.gamma = f->height_m > 0 ? 1 - d[1] / s->dir[1] : 1;
+    const double tauT = line_tau(r.A, r.k, T);
+    r.flat = !(fabs(r.gamma * tauT) > 1e-9);
+    r.whole = r.flat ? tauT : -expm1(-r.gamma * tauT) / r.gamma; /* int_0^tau(T) exp(-gamma tau) */
+    if (!(r.whole > 0)) return 0;
     int n = (int)ceil(1 / fmax(epsilon, 1e-9));
-    n = n < 1 ? 1 : n > max_steps ? max_steps : n;
-    double sum = 0;
-    if (!s->n) sum = n;
-    /* the map's coordinates along the ray, linear in t: x0 + t x1 */
-    const double x0 = (atmos__dot3(o, s->right) - s->u0) / s->texel - 0.5, x1 = atmos__dot3(d, s->right) / s->texel;
-    const double y0 = (atmos__dot3(o, s->up) - s->v0) / s->texel - 0.5, y1 = atmos__dot3(d, s->up) / s->texel;
-    const double z0 = atmos__dot3(o, s->fwd) - s->bias, z1 = atmos__dot3(d, s->fwd);
-    for (int i = 0; s->n && i < n; i++) { /* step i: from i whole / n to (i + 1) whole / n of the integral */
-        const double q = (i + 0.5) * whole / n, tau = flat ? q : -log1p(-gamma * q) / gamma;
-        const double tm = fmin(T, line_t(A, k, tau));
-        sum += tm < INFINITY ? lookup(s, x0 + tm * x1, y0 + tm * y1, z0 + tm * z1) : 1;
+    r.n = n = n < 1 ? 1 : n > max_steps ? max_steps : n;
+    double sum = n;
+    if (s->n) {
+        /* the map's coordinates along the ray, linear in t */
+        r.x0 = (atmos__dot3(o, s->right) - s->u0) / s->texel - 0.5, r.x1 = atmos__dot3(d, s->right) / s->texel;
+        r.y0 = (atmos__dot3(o, s->up) - s->v0) / s->texel - 0.5, r.y1 = atmos__dot3(d, s->up) / s->texel;
+        r.z0 = atmos__dot3(o, s->fwd) - s->bias, r.z1 = atmos__dot3(d, s->fwd);
+        sum = run(&r, 0, n, 0, T);
     }
     const double c = atmos__dot3(s->dir, d);
-    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C) * whole * sum / n;
+    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C) * r.whole * sum / n;
 }

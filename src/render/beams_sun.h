@@ -15,6 +15,7 @@
 
 #include "core/internal.h"
 #include "scene/scene_fog.h"
+#include "render/beams_tiles.h"
 
 /* The fog along rays: sigma_t(y) = sigma0 exp(-(y - base) / H) (H = 0: uniform sigma0). */
 typedef struct atmos__beams_fog {
@@ -35,6 +36,7 @@ typedef struct atmos__beams_sun {
     double u0, v0, texel, bias;
     int n;
     float *depth;
+    atmos__beams_tiles tiles;           /* the map's min/max pyramid */
 } atmos__beams_sun;
 
 /* The map of the meshes seen from the sun dir (unit); size texels a side. */
@@ -45,7 +47,8 @@ void atmos__beams_sun_free(atmos__beams_sun *s);
 double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3]);
 /* The sunlight the fog scatters toward o along [0, T) of the ray d (unit), per unit of E:
  * steps of at most epsilon of the unshadowed whole (at most max_steps), each weighted by H
- * at its middle (in optical depth). */
+ * at its middle (in optical depth). Runs of steps whose samples the map's tiles prove all lit
+ * (or all in shadow) are counted without reading the map. */
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
                                  const double d[3], double T, double epsilon, int max_steps);
 /* The fog's optical depth between p and the sun (unit sun, toward it): a height-dependent

@@ -7,6 +7,11 @@
  *     xi_b = pi/4 + atan((t_end - d cos g) / (d sin g)) / 2; F by Simpson's rule here;
  *   - a shadow: a ray passing below a sphere lit from above loses exactly the light of the
  *     segment inside the sphere's shadow cone (its ends solved from the cone's quadric);
+ *   - the sub-planes' samples summed through the shadow map's tiles (runs proven lit or dark
+ *     not read) against each sample read alone, for a point light's cube map and a spot;
+ *   - the pixels a spot's beam is left out of (its cone's hull on the screen): every pixel
+ *     whose ray crosses the lit cone within the light's reach (found by marching the ray) is
+ *     lit, for spots seen from the side, end on and from behind;
  *   - the same image with one thread and with two, byte for byte;
  *   - the units of a light's spectrum (its intensity is the integral over 380-780 nm).
  */
@@ -539,12 +544,109 @@ static void test_interleave(void)
     atmos_image_destroy(inter);
 }
 
+/* atmos__beams_ray_light_sum against atmos__beams_ray_light at every sample, on rays across a
+ * sphere's shadow, for a point light (a cube map) and a spot (one face). */
+static void test_light_sum(void)
+{
+    atmos_mesh *mesh = NULL;
+    atmos_mesh_transform tr;
+    atmos_mesh_transform_identity(&tr);
+    tr.position_m[1] = 5;
+    CHECK_OK(atmos_mesh_load(ctx, "builtin:sphere", 0, &mesh));
+    if (!mesh) return;
+    CHECK_OK(atmos_mesh_apply_transform(ctx, mesh, &tr));
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_scene s;
+    base_scene(&s, 8, 8);
+    for (int kind = 0; kind < 2; kind++) {
+        atmos_scene_light sl = s.lights[0];
+        sl.position_m[1] = 10;
+        if (kind) sl.type = ATMOS_LIGHT_SPOT, sl.cone_deg = 30, sl.edge_deg = 5;
+        atmos__beams_light l;
+        memset(&l, 0, sizeof l);
+        atmos__lamp_make(&sl, &wl, &l.L);
+        atmos__beams_progress pr = {0, 6, 0};
+        CHECK_OK(atmos__beams_shadow_build(ctx, &l, &mesh, 1, 256, &pr));
+        double worst = 0, dark = 0;
+        for (int r = 0; r < 60; r++) {
+            const double o[3] = {-12, 0.5 + 0.1 * r, 0.3 - 0.01 * r};
+            double d[3] = {1, 0.02 * (r % 5) - 0.04, 0.05};
+            const double n = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int a = 0; a < 3; a++) d[a] /= n;
+            atmos__beams_ray ray;
+            atmos__beams_ray_init(&l, o, d, &ray);
+            const int m = 400;
+            const double step = 24.0 / m;
+            double want = 0, all = 0;
+            for (int k = 0; k < m; k++)
+                want += atmos__beams_ray_light(&ray, (k + 0.5) * step), all += atmos__beams_ray_falloff(&ray, (k + 0.5) * step);
+            const double got = atmos__beams_ray_light_sum(&ray, 0, step, 0.5, 0, m);
+            worst = fmax(worst, fabs(got - want) / fmax(all, 1));
+            dark += want < all - 1;
+        }
+        printf("sub-plane samples through the tiles (%s): worst difference %.2e of the unshadowed samples, "
+               "%g of 60 rays through the shadow\n", kind ? "spot" : "point light, cube map", worst, dark);
+        CHECK(dark >= 10);
+        CHECK(worst < 1e-12);
+        atmos__beams_shadow_free(&l);
+    }
+    atmos_mesh_destroy(mesh);
+}
+
+/* Spots seen from several places: every pixel whose ray meets the cone within its reach is lit. */
+static void test_screen_spans(void)
+{
+    const double eyes[4][3] = {{-30, 15, 5}, {0, 15, 25}, {4, 0.5, 2}, {2, 42, -3}}, look[3] = {0, 12, 0};
+    int missed = 0, crossing = 0;
+    for (int e = 0; e < 4; e++)
+        for (int kind = 0; kind < 2; kind++) {
+            atmos_scene s;
+            base_scene(&s, 64, 48);
+            s.fog.extinction_per_m = 0.01, s.fog.scattering_per_m = 0.01;
+            atmos_scene_light *l = &s.lights[0];
+            l->type = ATMOS_LIGHT_SPOT, l->cone_deg = kind ? 25 : 6, l->edge_deg = 2, l->range_m = 15;
+            l->position_m[0] = 0, l->position_m[1] = 20, l->position_m[2] = 0;
+            l->direction[0] = 0.3, l->direction[1] = -1, l->direction[2] = 0.2;
+            memcpy(s.camera.position, eyes[e], sizeof eyes[e]);
+            memcpy(s.camera.look_at, look, sizeof look);
+            s.camera.fov_deg = 50;
+            atmos_image *img = render(ctx, &s);
+            atmos_camera cam;
+            CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
+            if (!img) continue;
+            double ax[3] = {0.3, -1, 0.2};
+            const double n = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]), co = cos((l->cone_deg + l->edge_deg) * ATMOS_DEG2RAD);
+            for (int a = 0; a < 3; a++) ax[a] /= n;
+            for (int y = 0; y < s.height; y++)
+                for (int x = 0; x < s.width; x++) {
+                    double d[3];
+                    atmos_camera_ray(&cam, x + 0.5, y + 0.5, d);
+                    int inside = 0;
+                    for (int k = 0; k < 4000 && !inside; k++) { /* the ray to 60 m, every 1.5 cm */
+                        const double t = (k + 0.5) * 0.015;
+                        const double w[3] = {eyes[e][0] + t * d[0], eyes[e][1] + t * d[1] - 20, eyes[e][2] + t * d[2]};
+                        const double r = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+                        inside = r < 15 && w[0] * ax[0] + w[1] * ax[1] + w[2] * ax[2] > 1.0001 * co * r;
+                    }
+                    crossing += inside;
+                    missed += inside && !(img->pixels[((size_t)y * s.width + x) * img->channels] > 0);
+                }
+            atmos_image_destroy(img);
+        }
+    printf("spots' screen spans: %d pixels cross a lit cone, %d of them left dark\n", crossing, missed);
+    CHECK(crossing > 1000);
+    CHECK(missed == 0);
+}
+
 int main(void)
 {
     CHECK_OK(atmos_context_create(NULL, &ctx));
     test_spectrum();
     test_airlight();
     test_shadow();
+    test_light_sum();
+    test_screen_spans();
     test_threads();
     test_interleave();
     test_scene_files();

@@ -8,6 +8,9 @@
  *     a uniform fog is lit undimmed (it has no top);
  *   - a wall floating in uniform fog casting a shadow across the rays: the renderer's steps
  *     (epsilon 1e-3) with the shadow map against the quadrature with exact shadow rays;
+ *   - the steps' visibility read through the map's min/max tiles (runs proven lit or dark not
+ *     read) against every step's middle read one by one (atmos__beams_sun_visibility), on rays
+ *     crossing a wall's shadow, starting inside it, leaving the map and endless: to 1e-9;
  *   - the Fig. 10(a) scene small: the same image with one thread and with two, byte for byte;
  *     finite, non-negative pixels; the sunlit sky above the ridge brighter than the shadowed
  *     ground below it. */
@@ -125,6 +128,63 @@ static void test_shadow(void)
     atmos_mesh_destroy(wall);
 }
 
+/* The sun's airlight with H read at every step's middle: the steps of equal share of the
+ * closed-form integral in a uniform fog (tau = -ln(1 - q), t = tau / sigma), each read by
+ * atmos__beams_sun_visibility. */
+static double every_step(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3], const double d[3], double T,
+                         int n)
+{
+    const double whole = -expm1(-f->sigma0 * T);
+    double sum = 0;
+    for (int i = 0; i < n; i++) {
+        const double t = fmin(T, -log1p(-(i + 0.5) * whole / n) / f->sigma0);
+        const double p[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+        sum += atmos__beams_sun_visibility(s, p);
+    }
+    const double c = s->dir[0] * d[0] + s->dir[1] * d[1] + s->dir[2] * d[2];
+    return f->albedo * atmos_phase_hg(c, f->g) * whole * sum / n;
+}
+
+static void test_skipped_runs(void)
+{
+    atmos_mesh *wall = NULL;
+    CHECK_OK(atmos_mesh_load(ctx, "builtin:box", 0, &wall));
+    if (!wall) return;
+    atmos_mesh_transform t;
+    atmos_mesh_transform_identity(&t);
+    t.position_m[1] = 40, t.position_m[2] = -60, t.scale[0] = 40, t.scale[1] = 15, t.scale[2] = 15;
+    CHECK_OK(atmos_mesh_apply_transform(ctx, wall, &t));
+    double sun[3] = {0.2, 0.5, 0.6};
+    unit(sun);
+    atmos__beams_sun s;
+    memset(&s, 0, sizeof s);
+    CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, &wall, 1, 256));
+    const atmos__beams_fog fog = {4e-3, 1, 0.2, 0, 0, NULL};
+    /* below the wall looking across its shadow, inside the shadow looking along it (away from
+     * the sun), far off looking away from it */
+    const double eyes[3][3] = {{0, 5, 0}, {-15, 5, -104}, {-300, 60, 100}};
+    double worst = 0, dark = 0, lit = 0;
+    for (int e = 0; e < 3; e++)
+        for (int r = 0; r < 40; r++) {
+            double d[3] = {-0.8 + 0.04 * r, -0.3 + 0.02 * r, -1 + 0.05 * r};
+            if (e == 1) d[0] = -sun[0] + 0.01 * (r % 7 - 3), d[1] = -sun[1] + 0.01 * (r / 7 - 3), d[2] = -sun[2];
+            if (e == 2) d[0] = -1, d[1] = 0.5 - 0.02 * r, d[2] = 0.3;
+            unit(d);
+            const double T = r % 4 == 3 ? INFINITY : 50 + 40 * r;
+            const double got = atmos__beams_sun_airlight(&s, &fog, eyes[e], d, T, 2e-3, 100000);
+            const double want = every_step(&s, &fog, eyes[e], d, T, 500);
+            const double full = every_step(&(atmos__beams_sun){.n = 0}, &fog, eyes[e], d, T, 500);
+            worst = fmax(worst, fabs(got - want) / full);
+            dark += want < 0.5 * full, lit += want > (1 - 1e-12) * full;
+        }
+    printf("sun airlight through the map's tiles against every step read: worst difference %.2e of the unshadowed "
+           "light (%g of 120 rays half dark or more, %g wholly lit)\n", worst, dark, lit);
+    CHECK(dark >= 10 && lit >= 10);
+    CHECK(worst < 1e-9);
+    atmos__beams_sun_free(&s);
+    atmos_mesh_destroy(wall);
+}
+
 /* The scene file at w x h rendered with the given threads. */
 static atmos_image *render_file(const char *path, int w, int h, int threads)
 {
@@ -178,6 +238,7 @@ int main(void)
     CHECK_OK(atmos_context_create(NULL, &ctx));
     test_no_shadow();
     test_shadow();
+    test_skipped_runs();
     test_scene();
     atmos_context_destroy(ctx);
     return test_summary("test_beams_sun");

@@ -66,7 +66,7 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     return rc;
 }
 
-int bench_beams(const char *file, int frames, int threads)
+int bench_beams(const char *file, int frames, int threads, const char *only)
 {
     const char *path = file ? file : "scenes/dobashi_fig04_spotlight.json";
     atmos_context *ctx = cli_context(threads, 1);
@@ -90,17 +90,24 @@ int bench_beams(const char *file, int frames, int threads)
         {"dobashi_fig04_double_size", 1, 2, 1, 0, 0, 0},
     };
     const int used = atmos_context_threads(ctx);
+    int ran = 0;
     for (size_t i = 0; rc == CLI_EXIT_OK && i < sizeof cases / sizeof *cases; i++)
-        rc = run_case(ctx, &s, &cases[i], frames, used);
+        if (!only || !strcmp(only, cases[i].name)) rc = run_case(ctx, &s, &cases[i], frames, used), ran++;
     /* without a file: the other scenes as they are (Table 1's size, 720x480) */
     static const char *const table1[][2] = {{"dobashi_fig09a_studio", "scenes/dobashi_fig09a_studio.json"},
                                             {"searchlights_fog", "scenes/searchlights_fog.json"},
                                             {"dobashi_fig10a_mountain_shafts", "scenes/dobashi_fig10a_mountain_shafts.json"}};
     for (size_t i = 0; !file && rc == CLI_EXIT_OK && i < sizeof table1 / sizeof *table1; i++) {
         const beams_case c = {table1[i][0], 0, 1, 1, 0, 0, 0};
+        if (only && strcmp(only, c.name)) continue;
+        ran++;
         if ((st = atmos_scene_load(ctx, table1[i][1], &s)) != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
         else rc = run_case(ctx, &s, &c, frames, used);
     }
     atmos_context_destroy(ctx);
+    if (rc == CLI_EXIT_OK && only && !ran) {
+        fprintf(stderr, "atmos bench: no beams case is named '%s'%s\n", only, file ? " (with --file: the dobashi_fig04 cases)" : "");
+        return CLI_EXIT_USAGE;
+    }
     return rc;
 }

@@ -28,7 +28,7 @@ static void help(void)
            "                         [--repeat R] [--threads T] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
            "                        [--no-forced] [--no-sky-nee] [--no-aureole] [--json]\n"
-           "       atmos bench beams [--file SCENE] [--repeat R] [--threads T]\n"
+           "       atmos bench beams [--file SCENE] [--case NAME] [--repeat R] [--threads T]\n"
            "       atmos bench simulate [--size N] [--repeat R] [--threads T]\n\n"
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
@@ -127,6 +127,7 @@ static void help(void)
            "            cpu_ms=75.2 fps=24.9\n"
            "          (frame_ms: mean wall time a frame; cpu_ms: the process's CPU time a frame, steadier on\n"
            "          a loaded machine; OMP_WAIT_POLICY=passive leaves out idle threads' spinning).\n"
+           "          --case NAME runs only the case of that scene= name (e.g. dobashi_fig09a_studio).\n"
            "  simulate the cloud simulation (docs/clouds.md): the towering_cumulus preset on an N grid (default\n"
            "          64, then 128: 64x64x64 and 128x128x128 cells), one warm-up step from the initial state\n"
            "          and then R steps (default 5); mean and best wall time a step, the process's CPU time\n"
@@ -526,7 +527,7 @@ int cli_cmd_bench(int argc, char **argv)
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16, aerial = 0;
     double dscale = 0, eye_scale = 0, budget = 2;
     int diffuse = 1, air_shadows = 1;
-    const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL;
+    const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL, *beams_case = NULL;
     if (argc > 1 && !strcmp(argv[1], "sky-accuracy")) return bench_sky_accuracy_main(argc - 1, argv + 1);
     bench_path_opts pflags;
     memset(&pflags, 0, sizeof pflags);
@@ -575,6 +576,8 @@ int cli_cmd_bench(int argc, char **argv)
         } else if (!strcmp(argv[i], "--budget") && i + 1 < argc) {
             if (!cli_parse_double(C, "--budget", argv[++i], &budget) || !(budget > 0))
                 return cli_usage_error(C, "--budget: expected seconds > 0");
+        } else if (!strcmp(argv[i], "--case") && i + 1 < argc) {
+            beams_case = argv[++i];
         } else if (!strcmp(argv[i], "--file") && i + 1 < argc) {
             file = argv[++i];
         } else if (argv[i][0] == '-') {
@@ -587,7 +590,7 @@ int cli_cmd_bench(int argc, char **argv)
     }
     if (!what) return cli_usage_error(C, "which benchmark? (available: sky, sky-accuracy, optics, volume, slice, path, beams, simulate)");
     if (!strcmp(what, "simulate")) return bench_simulate(size, repeat, threads);
-    if (!strcmp(what, "beams")) return bench_beams(file, 4 * (repeat_set ? repeat : 5), threads);
+    if (!strcmp(what, "beams")) return bench_beams(file, 4 * (repeat_set ? repeat : 5), threads, beams_case);
     pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale, pflags.json = json;
     if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
     if (!strcmp(what, "slice") && aerial)

@@ -1,0 +1,90 @@
+/* The min/max pyramid of a depth map (beams_tiles.h). */
+#include "render/beams_tiles.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define TILE ATMOS__BEAMS_TILE
+
+void atmos__beams_tiles_free(atmos__beams_tiles *t)
+{
+    free(t->min);
+    t->min = t->max = NULL, t->tiles = t->levels = 0;
+}
+
+/* The levels' sizes and offsets; the cells of all levels. */
+static size_t plan_levels(atmos__beams_tiles *t)
+{
+    size_t at = 0;
+    int m = t->tiles, k = 0;
+    for (;;) {
+        t->level_n[k] = m, t->level_at[k] = at;
+        at += (size_t)m * m, k++;
+        if (m == 1) break;
+        m = (m + 1) / 2;
+    }
+    t->levels = k;
+    return at;
+}
+
+/* Level 0: each tile over its texels and a ring of one around. */
+static void finest(atmos__beams_tiles *t, const float *depth, int n)
+{
+    const int T = t->tiles;
+    for (int ty = 0; ty < T; ty++)
+        for (int tx = 0; tx < T; tx++) {
+            float lo = INFINITY, hi = -INFINITY;
+            for (int y = ty * TILE - 1; y <= (ty + 1) * TILE; y++) {
+                const float *row = depth + (size_t)(y < 0 ? 0 : y >= n ? n - 1 : y) * n;
+                for (int x = tx * TILE - 1; x <= (tx + 1) * TILE; x++) {
+                    const float z = row[x < 0 ? 0 : x >= n ? n - 1 : x];
+                    lo = z < lo ? z : lo, hi = z > hi ? z : hi;
+                }
+            }
+            t->min[ty * T + tx] = lo, t->max[ty * T + tx] = hi;
+        }
+}
+
+int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n)
+{
+    t->tiles = (n + TILE - 1) / TILE;
+    const size_t cells = plan_levels(t);
+    if (!(t->min = malloc(sizeof(float) * 2 * cells))) {
+        t->max = NULL, t->tiles = t->levels = 0;
+        return -1;
+    }
+    t->max = t->min + cells;
+    finest(t, depth, n);
+    for (int k = 1; k < t->levels; k++) {
+        const int m = t->level_n[k], c = t->level_n[k - 1];
+        const float *cmin = t->min + t->level_at[k - 1], *cmax = t->max + t->level_at[k - 1];
+        for (int j = 0; j < m; j++)
+            for (int i = 0; i < m; i++) {
+                float lo = INFINITY, hi = -INFINITY;
+                for (int y = 2 * j; y < 2 * j + 2 && y < c; y++)
+                    for (int x = 2 * i; x < 2 * i + 2 && x < c; x++) {
+                        const float a = cmin[y * c + x], b = cmax[y * c + x];
+                        lo = a < lo ? a : lo, hi = b > hi ? b : hi;
+                    }
+                t->min[t->level_at[k] + (size_t)j * m + i] = lo, t->max[t->level_at[k] + (size_t)j * m + i] = hi;
+            }
+    }
+    return 0;
+}
+
+void atmos__beams_tiles_range(const atmos__beams_tiles *t, int x0, int x1, int y0, int y1, float *lo, float *hi)
+{
+    const int tx0 = x0 < 0 ? 0 : x0 / TILE, tx1 = x1 < 0 ? 0 : x1 / TILE, ty0 = y0 < 0 ? 0 : y0 / TILE,
+              ty1 = y1 < 0 ? 0 : y1 / TILE;
+    int k = 0; /* the finest level where the tiles' box spans at most 2 x 2 cells */
+    while (k + 1 < t->levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
+    const float *cmin = t->min + t->level_at[k], *cmax = t->max + t->level_at[k];
+    const int m = t->level_n[k];
+    float a = INFINITY, b = -INFINITY;
+    for (int ty = ty0 >> k; ty <= ty1 >> k; ty++)
+        for (int tx = tx0 >> k; tx <= tx1 >> k; tx++) {
+            const float u = cmin[ty * m + tx], v = cmax[ty * m + tx];
+            a = u < a ? u : a, b = v > b ? v : b;
+        }
+    *lo = a, *hi = b;
+}

@@ -1,0 +1,27 @@
+#!/bin/sh
+# atmos bench beams --case NAME (docs/beams.md, "Speed"): only the named case runs (one line,
+# its scene= name), from a --file scene too; a name no case has is a usage error (exit 2)
+# naming it.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
+T=${ATMOS_TEST_TMP:-/tmp}/bench_beams_case.$$
+rm -rf "$T"
+mkdir -p "$T" || exit 1
+trap 'rm -rf "$T"' EXIT
+export XDG_CACHE_HOME="$T/cache"
+fail=0
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+
+"$A" bench beams --file "$S/scenes/dobashi_fig04_spotlight.json" --case dobashi_fig04_no_subplanes --repeat 1 \
+    --threads 1 >"$T/out.txt" 2>"$T/err.txt"
+st=$?
+[ $st -eq 0 ] && ok "bench beams --case exits 0" || { bad "bench beams --case: exit $st"; cat "$T/err.txt" >&2; }
+[ "$(grep -c '^bench=beams ' "$T/out.txt")" -eq 1 ] && grep -q ' scene=dobashi_fig04_no_subplanes .* fps=' "$T/out.txt" \
+    && ok "one line, the named case" || { bad "bench beams --case: not one line of that case"; cat "$T/out.txt" >&2; }
+"$A" bench beams --file "$S/scenes/dobashi_fig04_spotlight.json" --case no_such_case --repeat 1 >"$T/out2.txt" 2>"$T/err2.txt"
+st=$?
+[ $st -eq 2 ] && grep -q "no_such_case" "$T/err2.txt" && [ ! -s "$T/out2.txt" ] && ok "an unknown case is a usage error" \
+    || { bad "bench beams --case no_such_case: exit $st"; cat "$T/err2.txt" >&2; }
+exit $fail
