@@ -145,6 +145,7 @@ void atmos_scene_frame_volume(atmos_scene *scene, const atmos_volume *volume, co
     if (c->position[1] < 2.0) c->position[1] = 2.0; /* above the ground, still looking at the centre */
     memcpy(c->look_at, ctr, sizeof ctr);
     c->up[0] = 0, c->up[1] = 1, c->up[2] = 0;
+    if (fabs(f[1]) > 0.99999) memcpy(c->up, u, sizeof u); /* straight down or up: the heading's way is the top */
 }
 
 /* The largest extinction (m^-1) any voxel can have: every field's densest voxel times its

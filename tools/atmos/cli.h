@@ -19,7 +19,8 @@ int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, l
 int cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints "atmos CMD: <ctx error or status string>" to stderr; returns CLI_EXIT_RUNTIME. */
 int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st);
-/* A context for a subcommand: logs warnings and errors to stderr, threads as given (0 = all). */
+/* A context for a subcommand: logs warnings and errors to stderr (errors only when quiet: for
+ * commands whose own output replaces the warnings, not for a user's -q), threads as given (0 = all). */
 atmos_context *cli_context(int threads, int quiet);
 /* Commands' contexts draw the library's progress (a process-wide cli_progress: a bar on a
  * terminal whatever quiet says of the log); cli_context_with_progress names its own. */

@@ -55,6 +55,19 @@ static atmos_status read_hdr(atmos_context *ctx, const char *path, named_image *
     return st;
 }
 
+/* An 8-bit image given where an HDR one goes: "PNG" or "JPEG" by its first bytes, else NULL. */
+static const char *ldr_kind(const char *path)
+{
+    unsigned char b[4] = {0};
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    size_t n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    if (n == 4 && !memcmp(b, "\x89PNG", 4)) return "PNG";
+    if (n >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff) return "JPEG";
+    return NULL;
+}
+
 /* JSON has no NaN or infinity: such numbers are null. */
 static void json_number(double v)
 {
@@ -179,6 +192,13 @@ int cli_cmd_compare(int argc, char **argv)
         }
     }
     if (nf < 2) return cli_usage_error(C, "need IMAGE and REFERENCE");
+    const char *inputs3[3] = {files[0], files[1], by};
+    for (int k = 0; k < 3; k++) {
+        const char *kind = inputs3[k] ? ldr_kind(inputs3[k]) : NULL;
+        if (kind)
+            return cli_usage_error(C, "%s: a %s file is not an HDR input: compare reads OpenEXR (.exr) and portable "
+                                      "float maps (.pfm), e.g. atmos render's --exr or --pfm output", inputs3[k], kind);
+    }
     if (heat) { /* the heat map must not replace an image it compares */
         if (cli_file_kind_of(heat) != CLI_FILE_PNG) return cli_usage_error(C, "--heatmap %s: expected a .png file name", heat);
         cli_outputs out = {0};

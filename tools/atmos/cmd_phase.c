@@ -29,7 +29,7 @@ static void help(void)
            "  --no-cache                     neither read nor write the table cache (see 'atmos cache')\n"
            "  --fast                         preview quality (coarser size integration, fewer rays)\n"
            "  --threads N                    worker threads (default: all cores)\n"
-           "  -q, --quiet                    no progress bar or warnings\n"
+           "  -q, --quiet                    no progress bar or status lines (warnings are still printed)\n"
            "  -h, --help                     this help\n\n"
            "Without --csv or --plot, prints per wavelength the extinction cross-section, the albedo,\n"
            "the asymmetry g and P at 0 and 180 degrees.\n\n"
@@ -399,7 +399,7 @@ int cli_cmd_phase(int argc, char **argv)
 
     cli_progress prog;
     cli_progress_init(&prog, quiet);
-    atmos_context *ctx = cli_context_with_progress(threads, quiet, cli_progress_bar, &prog);
+    atmos_context *ctx = cli_context_with_progress(threads, 0, cli_progress_bar, &prog); /* -q keeps warnings */
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_particle_desc p;
     atmos_phase_table *t = NULL;

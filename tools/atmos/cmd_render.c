@@ -40,22 +40,22 @@ static void default_png_name(const char *scene_name, char *buf, size_t cap)
 }
 
 /* The output files of one frame: the options' names, numbered in an animation (the
- * optical depth image, made once, goes with the first frame). out: -o's file, of the
+ * optical depth image too: each frame's, from that frame's camera). out: -o's file, of the
  * format its extension names. */
 typedef struct {
     const char *out, *exr, *pfm, *var, *ord, *tau;
-    char buf[5][CLI_OUTPUT_PATH_MAX];
+    char buf[6][CLI_OUTPUT_PATH_MAX];
 } frame_files;
 
 static int name_frame_files(const render_opts *o, const char *png, int frame, int nframes, frame_files *ff)
 {
-    const char *base[6] = {png, o->exr, o->pfm, o->variance, o->order, frame == 1 ? o->tau : NULL};
+    const char *base[6] = {png, o->exr, o->pfm, o->variance, o->order, o->tau};
     const char **dst[6] = {&ff->out, &ff->exr, &ff->pfm, &ff->var, &ff->ord, &ff->tau};
     int digits = 4;
     for (int n = nframes; n >= 10000; n /= 10) digits++;
     for (int i = 0; i < 6; i++) {
         *dst[i] = base[i];
-        if (!base[i] || nframes < 2 || i == 5) continue;
+        if (!base[i] || nframes < 2) continue;
         if (!frame_name(base[i], frame, digits, ff->buf[i], sizeof ff->buf[i])) return 0;
         *dst[i] = ff->buf[i];
     }
@@ -71,8 +71,8 @@ static int check_frame_names(const render_opts *o, const char *png, int nframes)
     frame_files ff;
     for (int frame = 2; frame <= nframes; frame++) {
         if (!name_frame_files(o, png, frame, nframes, &ff)) return CLI_EXIT_RUNTIME;
-        const char *names[5] = {ff.out, ff.exr, ff.pfm, ff.var, ff.ord};
-        for (int i = 0; i < 5; i++) {
+        const char *names[6] = {ff.out, ff.exr, ff.pfm, ff.var, ff.ord, ff.tau};
+        for (int i = 0; i < 6; i++) {
             struct stat st;
             if (!names[i] || stat(names[i], &st) != 0) continue; /* new files: their folder is frame 1's */
             const char *why = S_ISDIR(st.st_mode) ? "is a folder" : access(names[i], W_OK) ? "cannot be written" : NULL;
@@ -257,7 +257,10 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
         const atmos_path_stats *q = &ps.path;
-        if (q->volume_pixels > 0)
+        if (q->spp < 2) /* one sample: no spread to estimate an error from */
+            fprintf(stderr, "  path: %d spp, %lld scattering events, relative standard error n/a (1 sample per pixel)\n",
+                    q->spp, q->events);
+        else if (q->volume_pixels > 0)
             fprintf(stderr,
                     "  path: %d spp, %lld scattering events; relative standard error over the %s's %lld pixels: "
                     "mean %.2f %%, median %.2f %%, 90th percentile %.2f %% (over all pixels: mean %.2f %%)\n",
@@ -317,6 +320,7 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const at
             continue;
         }
         if (st != ATMOS_OK) break;
+        if (fo->w.tau && (st = write_tau(ctx, &fs, plan, fo->w.tau)) != ATMOS_OK) break;
         st = write_outputs(ctx, plan, &fs, spec, &fo->w, out_kind, source, nframes > 1 ? label : NULL, &xl, o);
         if (st != ATMOS_OK) break;
         if (cli_outputs_commit("render", &fo->set) != 0) {
@@ -391,7 +395,6 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     atmos_status st = atmos_plan_create(ctx, scene, volume, NULL, &plan);
     if (d->size > 1 && (atmos_status)cli_dist_max(d, (int)st) != ATMOS_OK && st == ATMOS_OK) st = ATMOS_E_CANCELLED;
     const double t_plan = cli_now_s() - t0;
-    if (st == ATMOS_OK && d->rank == 0 && fo.w.tau) st = write_tau(ctx, scene, plan, fo.w.tau);
     if (st == ATMOS_OK) {
         st = render_frames(ctx, plan, scene, o, png, source, prog, &fo, &failed, d);
         *stuck = st != ATMOS_OK && d->rank == 0 && d->size > 1 && nframes > 1;
@@ -424,7 +427,9 @@ int cli_cmd_render(int argc, char **argv)
     if (d.rank != 0) o.quiet = 1; /* rank 0 reports; the others speak only of their failures */
     cli_progress prog;
     cli_progress_init(&prog, o.quiet);
-    atmos_context *ctx = cli_context_with_progress(o.threads, o.quiet, cli_progress_bar, &prog);
+    /* -q hides the progress and the status lines, not the warnings (README); the other ranks of
+     * an MPI job keep theirs to themselves (rank 0 gives them). */
+    atmos_context *ctx = cli_context_with_progress(o.threads, d.rank != 0, cli_progress_bar, &prog);
     const double t0 = cli_now_s();
     atmos_scene scene;
     atmos_volume *volume = NULL; /* loaded here when framed (render_scene.c), else by the plan */

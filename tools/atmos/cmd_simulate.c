@@ -101,7 +101,7 @@ static int run_write(const atmos_sim_desc *d, int threads, int quiet, const char
 {
     cli_progress prog;
     cli_progress_init(&prog, quiet);
-    atmos_context *ctx = cli_context_with_progress(threads, quiet, cli_progress_bar, &prog);
+    atmos_context *ctx = cli_context_with_progress(threads, 0, cli_progress_bar, &prog); /* --quiet keeps warnings */
     if (!ctx) return CLI_EXIT_RUNTIME;
     const double minutes = d->minutes > 0 ? d->minutes : atmos_sim_preset_minutes(d->preset);
     atmos_sim *s = NULL;

@@ -54,7 +54,8 @@ void cli_volume_help(void)
            "                    particle's mean mass), fraction (0..1, 1 = 1e8 m^-3) or auto (default:\n"
            "                    VDB fraction, raw per_m3; NetCDF: its mixing ratios, auto only)\n"
            "  --length-scale F  multiplies a VDB/raw file's lengths (0.01: a file in centimetres)\n"
-           "  --time N          NetCDF time step (default 0)\n"
+           "  --time-index N    NetCDF time step (default 0; as atmos render's --time-index;\n"
+           "                    --time N is the same)\n"
            "  --voxel-size M    NetCDF: resampling voxel edge in metres (default: the model's mean layer\n"
            "                    depth or DX if finer, at most 8.4 M voxels); VDB/raw: the voxel edge\n"
            "                    replacing the file's (its origin scaled with it)\n"
@@ -78,8 +79,8 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
         d->grids = argv[++*i];
     } else if (!strcmp(a, "--as")) {
         d->field = argv[++*i];
-    } else if (!strcmp(a, "--time")) {
-        if (!cli_parse_int(C, "--time", argv[++*i], 0, 1000000, &d->time_index)) return -1;
+    } else if (!strcmp(a, "--time") || !strcmp(a, "--time-index")) { /* --time-index: as atmos render's */
+        if (!cli_parse_int(C, a, argv[++*i], 0, 1000000, &d->time_index)) return -1;
     } else if (!strcmp(a, "--voxel-size")) {
         if (!cli_parse_double(C, "--voxel-size", argv[++*i], &d->voxel_size_m) || !(d->voxel_size_m > 0)) {
             cli_usage_error(C, "--voxel-size: expected metres > 0");

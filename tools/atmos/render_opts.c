@@ -233,8 +233,8 @@ static int parse_number(int c, const char *arg, render_opts *o)
             return cli_usage_error(C, "--fov: expected degrees in (0, 360]"), 0;
         return 1;
     case O_VIEW_EL:
-        if (!cli_parse_double(C, "--view-elevation", arg, &o->view_el) || !(fabs(o->view_el) < 90))
-            return cli_usage_error(C, "--view-elevation: expected degrees in (-90, 90)"), 0;
+        if (!cli_parse_double(C, "--view-elevation", arg, &o->view_el) || !(fabs(o->view_el) <= 90))
+            return cli_usage_error(C, "--view-elevation: expected degrees in [-90, 90]"), 0;
         return 1;
     case O_VIEW_AZ: return cli_parse_double(C, "--view-azimuth", arg, &o->view_az);
     case O_DSCALE:
@@ -409,6 +409,15 @@ static void apply_camera(const render_opts *o, atmos_camera_desc *c)
         double dir[3];
         atmos_direction_from_angles(el, az, dir);
         for (int a = 0; a < 3; a++) c->look_at[a] = c->position[a] + 1000.0 * dir[a];
+        /* Near the zenith or the nadir the up vector (0, 1, 0) is no longer one: the image's top
+         * is then the azimuth's horizontal direction (the nadir: the way the camera faced before
+         * tilting down; the zenith: behind it), as the view tends to it from lower elevations. */
+        const int def_up = c->up[0] == 0 && c->up[2] == 0;
+        if (fabs(el) > 89.9 && def_up) {
+            double h[3];
+            atmos_direction_from_angles(0, az, h);
+            for (int a = 0; a < 3; a++) c->up[a] = (el > 0 ? -1.0 : 1.0) * h[a];
+        }
     }
     if (!isnan(o->fov)) c->fov_deg = o->fov;
 }
@@ -507,7 +516,9 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
     }
     if (apply_volume_file(o, s) != CLI_EXIT_OK) return CLI_EXIT_USAGE;
     if (o->volume_pos_given) s->volume.placed = 1, memcpy(s->volume.position_m, o->volume_pos, sizeof o->volume_pos);
-    if (o->density_scale > 0) s->volume.density_scale = o->density_scale;
+    /* A factor on the scene's (or -D volume.density_scale's) value, as --help says. */
+    if (o->density_scale > 0)
+        s->volume.density_scale = (s->volume.density_scale > 0 ? s->volume.density_scale : 1.0) * o->density_scale;
     if (o->tau && !s->volume.source[0]) return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
     if ((o->exr_layers & (RENDER_LAYER_TAU | RENDER_LAYER_TRANSMITTANCE)) && !s->volume.source[0])
         return cli_usage_error(C, "--exr-layers tau, transmittance: they need a volume (--volume or a scene with one)");
@@ -652,7 +663,8 @@ void render_opts_help(void)
            "      --position X,Y,Z          camera position, metres (x east, y up, z south); keeps the view\n"
            "                                direction unless --look-at is given\n"
            "      --look-at X,Y,Z           the point the camera looks at, metres\n"
-           "      --view-elevation E        the view direction's elevation, degrees (negative: down)\n"
+           "      --view-elevation E        the view direction's elevation, degrees in [-90, 90] (negative:\n"
+           "                                down; at -90 the image's top faces the view azimuth)\n"
            "      --view-azimuth A          the view direction's azimuth, degrees clockwise from north\n"
            "      --fov DEG                 field of view: pinhole vertical, fisheye across the circle\n"
            "                                (a volume file with no camera given is framed: placed, and the\n"
@@ -688,7 +700,8 @@ void render_opts_help(void)
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
            "                                (default: 3 widths, at least 4 km, in front of the camera; a\n"
            "                                VDB/NanoVDB file's base at 1500 m, a cloud's)\n"
-           "      --density-scale S         multiplies the volume's densities\n"
+           "      --density-scale S         multiplies the volume's densities (a factor on the scene's\n"
+           "                                volume.density_scale; -D volume.density_scale=S sets it)\n"
            "      --density-unit U          what a volume file's values are: per_m3 (particles per m^3), g_m3\n"
            "                                (water content, by the particle's mean mass), fraction (0..1, 1 =\n"
            "                                1e8 m^-3, a cumulus), auto (default: VDB fraction, raw per_m3,\n"
@@ -721,15 +734,17 @@ void render_opts_help(void)
     help_settings(ATMOS_RENDERER_BEAMS, "Beam renderer (Dobashi et al. 2002 §4: sampling planes, sub-planes, shadow maps)");
     printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
-           "                                more than one frame numbers the outputs: -o out/sky.png writes\n"
-           "                                out/sky_0001.png ...; --frames 1: the first frame, as named\n"
+           "                                more than one frame numbers every output (--tau too): -o\n"
+           "                                out/sky.png writes out/sky_0001.png ...; --frames 1: the first\n"
+           "                                frame, as named\n"
            "                                (automatic exposure: the first frame's for all frames,\n"
            "                                see --exposure-per-frame)\n"
            "      --time-end T              the last frame's UTC time (a sun given by time); frames are\n"
            "                                spaced evenly in time from the scene's (or --time's) time\n"
            "      --sun-elevation-end E     the last frame's sun elevation (a sun given by angles)\n"
            "      --sun-azimuth-end A       the last frame's sun azimuth (the shorter way round)\n"
-           "  -q, --quiet                   no progress bar or messages\n"
+           "  -q, --quiet                   no progress bar or status lines (warnings and errors are\n"
+           "                                still printed)\n"
            "  -h, --help                    this help\n\n"
            "Examples:\n"
            "  atmos render -o sky.png --exr sky.exr\n"

@@ -4,6 +4,8 @@
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "render_scene.h"
 
+#include <cjson/cJSON.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -38,6 +40,61 @@ static int looks_like_volume(const char *path)
     if (n >= 7 && !memcmp(b, "NanoVDB", 7)) return 1;
     if (n >= 4 && !memcmp(b, "CDF", 3)) return 1;
     return n >= 8 && !memcmp(b, "\x89HDF\r\n\x1a\n", 8);
+}
+
+/* A raw volume's JSON sidecar (the volume file atmos reads): an object with "dims" and "fields". */
+static int is_raw_sidecar(const char *text)
+{
+    cJSON *j = text ? cJSON_Parse(text) : NULL;
+    const int yes = cJSON_IsObject(j) && cJSON_GetObjectItemCaseSensitive(j, "dims") &&
+                    cJSON_GetObjectItemCaseSensitive(j, "fields");
+    cJSON_Delete(j);
+    return yes;
+}
+
+/* The sidecar of raw file `raw` (atmos volume generate writes STEM.json and STEM.FIELD.raw):
+ * STEM.FIELD.json or STEM.json when it exists and is a sidecar. 1 if found (in buf). */
+static int raw_sidecar_of(const char *raw, char *buf, size_t cap)
+{
+    const char *slash = strrchr(raw, '/'), *name = slash ? slash + 1 : raw;
+    size_t stem = strlen(raw) - 4; /* without ".raw" */
+    for (int k = 0; k < 2; k++) {
+        int n = snprintf(buf, cap, "%.*s.json", (int)stem, raw);
+        if (n < 0 || (size_t)n >= cap) return 0;
+        char *text = cli_read_text(buf, (size_t)1 << 20);
+        const int yes = is_raw_sidecar(text);
+        free(text);
+        if (yes) return 1;
+        const char *dot = NULL; /* the stem's last '.', within the file name */
+        for (const char *c = name; c < raw + stem; c++)
+            if (*c == '.') dot = c;
+        if (!dot || dot == name) return 0;
+        stem = (size_t)(dot - raw);
+    }
+    return 0;
+}
+
+/* A volume file (or a raw volume's sidecar) given where a scene goes: refused with the command
+ * that opens it (a raw file through its sidecar). 1 if refused (message printed). */
+static int refuse_volume_file(const render_opts *o)
+{
+    const char *p = o->scene_path;
+    if (!strcmp(p, "-")) return 0;
+    const int sidecar = ends_with(p, ".json") && is_raw_sidecar(o->scene_text);
+    if (!sidecar && !looks_like_volume(p)) return 0;
+    char side[ATMOS_SCENE_PATH_MAX + 8];
+    const int raw = ends_with(p, ".raw");
+    if (raw && !raw_sidecar_of(p, side, sizeof side)) {
+        fprintf(stderr,
+                "atmos %s: %s is a raw volume file, not a scene: atmos reads it through its JSON sidecar\n"
+                "(a .json file with \"dims\" and \"fields\" naming it): atmos %s --volume SIDECAR.json\n",
+                o->cmd, p, o->cmd);
+        return 1;
+    }
+    fprintf(stderr, "atmos %s: %s is a volume file%s, not a scene: open it with\n  atmos %s --volume %s\n", o->cmd, p,
+            raw ? " (raw, read through its JSON sidecar)" : sidecar ? " (a raw volume's JSON sidecar)" : "", o->cmd,
+            raw ? side : p);
+    return 1;
 }
 
 /* A volume file with no camera given: framed as atmos_scene_frame_volume_file frames it, and said. */
@@ -154,13 +211,7 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     }
     const int ndefs = volume_defines(o, defs, source_def, sizeof source_def, paths);
     if (o->scene_path) {
-        if (strcmp(o->scene_path, "-") && looks_like_volume(o->scene_path)) {
-            fprintf(stderr,
-                    "atmos %s: %s is a volume file, not a scene: open it with\n"
-                    "  atmos %s --volume %s\n",
-                    o->cmd, o->scene_path, o->cmd, o->scene_path);
-            return CLI_EXIT_USAGE;
-        }
+        if (refuse_volume_file(o)) return CLI_EXIT_USAGE;
         if (!strcmp(o->scene_path, "-")) {
             if (!o->scene_text) {
                 fprintf(stderr, "atmos %s: standard input: cannot read the scene (larger than 16 MiB, the limit "

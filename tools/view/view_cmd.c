@@ -101,7 +101,7 @@ int cli_cmd_view(int argc, char **argv)
         render_opts_free(&ro);
         return cli_usage_error("view", "--press: unknown key in '%s' (atmos view --help lists the keys)", vo.press);
     }
-    atmos_context *ctx = cli_context(ro.threads, ro.quiet);
+    atmos_context *ctx = cli_context(ro.threads, 0); /* -q keeps warnings */
     atmos_scene sc;
     atmos_volume *vol = NULL;
     char *text = NULL;
