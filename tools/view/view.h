@@ -110,11 +110,13 @@ void view_script_step(const view_script *s, view_state *st, double t_prev, doubl
 /* ---- view_record.c */
 typedef struct view_recorder {
     const char *dir;        /* NULL: no recording */
-    FILE *csv;
+    FILE *csv;              /* made with the first frame: a start that fails leaves none */
     int frames;
 } view_recorder;
+/* Makes the folder DIR (if missing). */
 int view_record_open(view_recorder *r, const char *dir);
-/* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv. */
+/* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv (the
+ * file and its header made with the first frame). */
 int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms,
                       const char *renderer, int impostor_updates, const view_state *s);
 int view_record_close(view_recorder *r);
@@ -129,7 +131,9 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
 
 /* ---- view_window.c (SDL2) */
 typedef struct view_window view_window;
-/* Opens a window of w x h; NULL with a message when no display can be opened. */
+/* Opens a window of w x h; NULL with a message when no display can be opened, or when SDL2
+ * could only fall back on a video driver that shows nothing ("offscreen", "dummy") that
+ * SDL_VIDEODRIVER did not ask for. */
 view_window *view_window_open(int w, int h, const char *title);
 void view_window_close(view_window *win);
 /* Shows a w x h frame of 8-bit display-sRGB RGBA (atmos_image_display_into's bytes) scaled to

@@ -225,10 +225,11 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
     view_script script = {0};
     view_recorder rec = {0};
     view_window *win = NULL;
-    int rc = start(&L, o, &s, &script);
+    /* the window first: without a display the viewer stops at once, before any work */
+    int rc = CLI_EXIT_OK;
+    if (!o->headless && !(win = view_window_open(o->width, o->height, "atmos view"))) rc = CLI_EXIT_RUNTIME;
+    if (rc == CLI_EXIT_OK) rc = start(&L, o, &s, &script);
     if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record);
-    if (rc == CLI_EXIT_OK && !o->headless && !(win = view_window_open(o->width, o->height, "atmos view")))
-        rc = CLI_EXIT_RUNTIME;
     const int scripted = o->frames > 0 || o->script;
     double last_ms = 0.0;
     for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!o->frames || i < o->frames); i++) {

@@ -19,8 +19,15 @@ int view_record_open(view_recorder *r, const char *dir)
         fprintf(stderr, "atmos view: --record %s: %s\n", dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
+    return CLI_EXIT_OK;
+}
+
+/* frames.csv and its header, with the first frame (a session that never renders one leaves
+ * no header-only file behind). */
+static int open_csv(view_recorder *r)
+{
     char path[4096];
-    snprintf(path, sizeof path, "%s/frames.csv", dir);
+    snprintf(path, sizeof path, "%s/frames.csv", r->dir);
     if (!(r->csv = fopen(path, "w"))) {
         fprintf(stderr, "atmos view: --record: cannot write %s: %s\n", path, strerror(errno));
         return CLI_EXIT_RUNTIME;
@@ -33,6 +40,7 @@ int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *d
                       int impostor_updates, const view_state *s)
 {
     if (!r->dir) return CLI_EXIT_OK;
+    if (!r->csv && open_csv(r) != CLI_EXIT_OK) return CLI_EXIT_RUNTIME;
     char path[4096];
     snprintf(path, sizeof path, "%s/frame_%05d.png", r->dir, r->frames);
     /* zlib's fastest level: at the default, writing a 1280 x 720 frame took more CPU than
