@@ -104,11 +104,13 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
     set(img, "height", cJSON_CreateNumber(sc->height));
     cJSON *cam = object(root, "camera");
     static const char *const cam_keys[] = {"view", "position_m", "look_at_m", "up", "fov_deg", "type"};
+    static const char *const cam_types[] = {"pinhole", "fisheye", "equirect"};
     clear(cam, cam_keys, 6);
-    set(cam, "type", cJSON_CreateString("pinhole"));
+    set(cam, "type", cJSON_CreateString(cam_types[f.camera.type]));
     set(cam, "position_m", cJSON_CreateDoubleArray(f.camera.position, 3));
     set(cam, "look_at_m", cJSON_CreateDoubleArray(f.camera.look_at, 3));
-    set(cam, "fov_deg", cJSON_CreateNumber(f.camera.fov_deg));
+    set(cam, "up", cJSON_CreateDoubleArray(f.camera.up, 3));
+    if (f.camera.type != ATMOS_CAMERA_EQUIRECT) set(cam, "fov_deg", cJSON_CreateNumber(f.camera.fov_deg));
     cJSON *sun = object(root, "sun");
     static const char *const sun_keys[] = {"elevation_deg", "azimuth_deg", "time", "latitude_deg", "longitude_deg"};
     clear(sun, sun_keys, 5);
@@ -123,7 +125,9 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
     cJSON *wl = object(root, "wavelengths");
     set(wl, "mode", cJSON_CreateString(s->spectral ? "spectral" : "rgb"));
     cJSON_DeleteItemFromObjectCaseSensitive(root, "animation");
-    if (sc->volume.source[0]) {
+    if (s->renderer == ATMOS_RENDERER_SKY) {
+        cJSON_DeleteItemFromObjectCaseSensitive(root, "volume"); /* the sky renderer's frame is without it */
+    } else if (sc->volume.source[0]) {
         cJSON *vol = object(root, "volume");
         const int gen = !strncmp(sc->volume.source, "generate:", 9), sim = !strncmp(sc->volume.source, "simulate:", 9);
         static const char *const src_keys[] = {"file", "generate", "simulate"};
