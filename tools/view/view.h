@@ -29,8 +29,11 @@ typedef enum {
 typedef struct view_state {
     double pos[3];          /* the camera, m (world frame, y up) */
     double yaw_deg;         /* the view's azimuth, clockwise from north (-z) */
-    double pitch_deg;       /* the view's elevation, [-89, 89] */
-    double fov_deg;         /* vertical field of view, [5, 120] */
+    double pitch_deg;       /* the view's elevation, [-89, 89] (fisheye, equirect: [-90, 90]) */
+    double fov_deg;         /* the scene camera's field of view: pinhole [5, 120], fisheye [5, 360] */
+    atmos_camera_type camera; /* the scene's camera type, kept where the renderer draws it */
+    double pinhole_fov_deg; /* a fisheye's or equirect's stand-in pinhole (renderers that draw
+                               pinholes only), [5, 120] */
     double speed;           /* flight speed, m/s (scaled by the scene's size) */
     int orbit;              /* 1: moving turns the camera about target at its distance */
     double target[3];       /* the orbit's centre: the volume's centre, or the point looked at */
@@ -61,10 +64,22 @@ void view_state_apply(view_state *s, view_action a, double dt, int fast, int slo
 void view_state_look(view_state *s, double dx, double dy);
 /* Scroll: the field of view narrows (clicks > 0) or widens. */
 void view_state_zoom(view_state *s, double clicks);
-/* The frame of the state: camera, sun, exposure (f holds the rest: size, budgets). */
+/* The frame of the state: camera, sun, exposure (f holds the rest: size, budgets). The camera
+ * is the scene's type where the state's renderer draws it, else (view_state_camera) a pinhole
+ * looking the same way. */
 void view_state_frame(const view_state *s, atmos_frame *f);
-/* The view direction of the state (unit). */
+/* 1 when the renderer draws cameras of type t (the slice, Harris and beams renderers draw
+ * pinholes only; the sky, Nishita and path renderers every type). */
+int view_renderer_draws(atmos_renderer_kind r, atmos_camera_type t);
+/* The camera type the state's frame uses and its field of view (fov may be NULL). */
+atmos_camera_type view_state_camera(const view_state *s, double *fov_deg);
+/* The largest |pitch| of the state's camera: 89 for a pinhole scene, 90 for a fisheye's or an
+ * equirect's (looking straight up is their usual view). */
+double view_state_pitch_limit(const view_state *s);
+/* The view direction of the state (unit) and the image's up (unit, perpendicular to it: the
+ * world's up made perpendicular, or at pitch +-90 the heading's way down/up the image). */
 void view_state_forward(const view_state *s, double d[3]);
+void view_state_up(const view_state *s, double u[3]);
 /* The sun's direction from its angles or (sun_from_time) from the date, time and place. */
 void view_state_sun(view_state *s);
 
@@ -110,11 +125,13 @@ void view_script_step(const view_script *s, view_state *st, double t_prev, doubl
 /* ---- view_record.c */
 typedef struct view_recorder {
     const char *dir;        /* NULL: no recording */
-    FILE *csv;
+    FILE *csv;              /* made with the first frame: a start that fails leaves none */
     int frames;
 } view_recorder;
+/* Makes the folder DIR (if missing). */
 int view_record_open(view_recorder *r, const char *dir);
-/* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv. */
+/* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv (the
+ * file and its header made with the first frame). */
 int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms,
                       const char *renderer, int impostor_updates, const view_state *s);
 int view_record_close(view_recorder *r);
@@ -129,7 +146,9 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
 
 /* ---- view_window.c (SDL2) */
 typedef struct view_window view_window;
-/* Opens a window of w x h; NULL with a message when no display can be opened. */
+/* Opens a window of w x h; NULL with a message when no display can be opened, or when SDL2
+ * could only fall back on a video driver that shows nothing ("offscreen", "dummy") that
+ * SDL_VIDEODRIVER did not ask for. */
 view_window *view_window_open(int w, int h, const char *title);
 void view_window_close(view_window *win);
 /* Shows a w x h frame of 8-bit display-sRGB RGBA (atmos_image_display_into's bytes) scaled to

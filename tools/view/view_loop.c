@@ -21,6 +21,7 @@ typedef struct loop {
     double log_scale;            /* the exposure's smoothed log scale (automatic exposure) */
     int have_scale, spp, saves;
     int impostor_updates;        /* the last frame's */
+    int said_pinhole;            /* the stand-in pinhole for the scene's camera was announced */
 } loop;
 
 static void drop_plans(loop *L)
@@ -37,8 +38,15 @@ static atmos_status get_plan(loop *L, const view_state *s, atmos_plan **out)
         atmos_scene sc = *L->sc;
         sc.renderer = s->renderer;
         sc.wavelengths = s->spectral ? ATMOS_WAVELENGTHS_SPECTRAL : ATMOS_WAVELENGTHS_RGB;
+        if (!view_renderer_draws(sc.renderer, sc.camera.type)) { /* the stand-in pinhole of the frames */
+            atmos_frame f;
+            memset(&f, 0, sizeof f);
+            view_state_frame(s, &f);
+            sc.camera = f.camera;
+        }
+        if (sc.renderer == ATMOS_RENDERER_SKY) sc.volume.source[0] = 0; /* the sky alone, the volume left out */
         fprintf(stderr, "atmos view: preparing the %s renderer...\n", atmos_renderer_name(s->renderer));
-        atmos_status st = atmos_plan_create(L->ctx, &sc, L->vol, NULL, &L->plan[k]);
+        atmos_status st = atmos_plan_create(L->ctx, &sc, sc.renderer == ATMOS_RENDERER_SKY ? NULL : L->vol, NULL, &L->plan[k]);
         if (st != ATMOS_OK) return st;
         atmos_image_destroy(L->img), L->img = NULL;
     }
@@ -130,6 +138,23 @@ static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, i
  * save, every pixel, as atmos render does. */
 #define VIEW_SKY_STEP 4
 
+static const char *camera_name(atmos_camera_type t)
+{
+    return t == ATMOS_CAMERA_FISHEYE ? "fisheye" : t == ATMOS_CAMERA_EQUIRECT ? "equirect" : "pinhole";
+}
+
+/* Says once that a renderer shows the scene's camera as a pinhole (view_state_camera). */
+static void say_pinhole(loop *L, const view_state *s)
+{
+    double fov;
+    if (L->said_pinhole || view_state_camera(s, &fov) == s->camera) return;
+    fprintf(stderr,
+            "atmos view: the %s renderer draws pinhole cameras only: the scene's %s camera is shown as a "
+            "%.0f-degree pinhole looking the same way (the sky, nishita and path renderers show it as it is)\n",
+            atmos_renderer_name(s->renderer), camera_name(s->camera), fov);
+    L->said_pinhole = 1;
+}
+
 /* Renders the state's frame; preview: the reduced quality of a moving view; saving: the scene's
  * full quality. */
 static atmos_status render(loop *L, view_state *s, int preview, int saving, atmos_plan **pp)
@@ -140,6 +165,7 @@ static atmos_status render(loop *L, view_state *s, int preview, int saving, atmo
     atmos_frame f;
     if ((st = atmos_frame_from_scene(L->ctx, L->sc, &f)) != ATMOS_OK) return st;
     view_state_frame(s, &f);
+    say_pinhole(L, s);
     if (!saving) f.sky_step = VIEW_SKY_STEP;
     f.warm_field = !saving; /* a saved frame is the offline render's: its field built afresh */
     if (s->renderer == ATMOS_RENDERER_SLICE && preview) {
@@ -186,8 +212,15 @@ static void overlay(const view_state *s, double ms, char lines[4][160])
         snprintf(lines[1], 160, "sun %.1f / %.1f deg  %04d-%02d-%02d %02d:%02d UTC", s->sun_el, s->sun_az, s->time.year,
                  s->time.month, s->time.day, s->time.hour, s->time.minute);
     else snprintf(lines[1], 160, "sun elevation %.1f azimuth %.1f deg", s->sun_el, s->sun_az);
-    snprintf(lines[2], 160, "camera %.0f %.0f %.0f m  heading %.0f pitch %.0f  fov %.0f%s", s->pos[0], s->pos[1],
-             s->pos[2], s->yaw_deg, s->pitch_deg, s->fov_deg, s->orbit ? "  orbit" : "");
+    double fov;
+    const atmos_camera_type t = view_state_camera(s, &fov);
+    char cam[64] = ""; /* the scene's type, or the pinhole standing in for it; an equirect has no fov */
+    if (s->camera != ATMOS_CAMERA_PINHOLE)
+        snprintf(cam, sizeof cam, "  %s%s%s", camera_name(t), t != s->camera ? " for the " : "",
+                 t != s->camera ? camera_name(s->camera) : "");
+    if (t != ATMOS_CAMERA_EQUIRECT) snprintf(cam + strlen(cam), sizeof cam - strlen(cam), "  fov %.0f", fov);
+    snprintf(lines[2], 160, "camera %.0f %.0f %.0f m  heading %.0f pitch %.0f%s%s", s->pos[0], s->pos[1], s->pos[2],
+             s->yaw_deg, s->pitch_deg, cam, s->orbit ? "  orbit" : "");
     snprintf(lines[3], 160, "%s  EV %+.1f  H: hide  Esc: quit", s->spectral ? "spectral" : "rgb", s->ev);
 }
 
@@ -225,10 +258,11 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
     view_script script = {0};
     view_recorder rec = {0};
     view_window *win = NULL;
-    int rc = start(&L, o, &s, &script);
+    /* the window first: without a display the viewer stops at once, before any work */
+    int rc = CLI_EXIT_OK;
+    if (!o->headless && !(win = view_window_open(o->width, o->height, "atmos view"))) rc = CLI_EXIT_RUNTIME;
+    if (rc == CLI_EXIT_OK) rc = start(&L, o, &s, &script);
     if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record);
-    if (rc == CLI_EXIT_OK && !o->headless && !(win = view_window_open(o->width, o->height, "atmos view")))
-        rc = CLI_EXIT_RUNTIME;
     const int scripted = o->frames > 0 || o->script;
     double last_ms = 0.0;
     for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!o->frames || i < o->frames); i++) {

@@ -19,8 +19,15 @@ int view_record_open(view_recorder *r, const char *dir)
         fprintf(stderr, "atmos view: --record %s: %s\n", dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
+    return CLI_EXIT_OK;
+}
+
+/* frames.csv and its header, with the first frame (a session that never renders one leaves
+ * no header-only file behind). */
+static int open_csv(view_recorder *r)
+{
     char path[4096];
-    snprintf(path, sizeof path, "%s/frames.csv", dir);
+    snprintf(path, sizeof path, "%s/frames.csv", r->dir);
     if (!(r->csv = fopen(path, "w"))) {
         fprintf(stderr, "atmos view: --record: cannot write %s: %s\n", path, strerror(errno));
         return CLI_EXIT_RUNTIME;
@@ -33,6 +40,7 @@ int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *d
                       int impostor_updates, const view_state *s)
 {
     if (!r->dir) return CLI_EXIT_OK;
+    if (!r->csv && open_csv(r) != CLI_EXIT_OK) return CLI_EXIT_RUNTIME;
     char path[4096];
     snprintf(path, sizeof path, "%s/frame_%05d.png", r->dir, r->frames);
     /* zlib's fastest level: at the default, writing a 1280 x 720 frame took more CPU than
@@ -96,11 +104,13 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
     set(img, "height", cJSON_CreateNumber(sc->height));
     cJSON *cam = object(root, "camera");
     static const char *const cam_keys[] = {"view", "position_m", "look_at_m", "up", "fov_deg", "type"};
+    static const char *const cam_types[] = {"pinhole", "fisheye", "equirect"};
     clear(cam, cam_keys, 6);
-    set(cam, "type", cJSON_CreateString("pinhole"));
+    set(cam, "type", cJSON_CreateString(cam_types[f.camera.type]));
     set(cam, "position_m", cJSON_CreateDoubleArray(f.camera.position, 3));
     set(cam, "look_at_m", cJSON_CreateDoubleArray(f.camera.look_at, 3));
-    set(cam, "fov_deg", cJSON_CreateNumber(f.camera.fov_deg));
+    set(cam, "up", cJSON_CreateDoubleArray(f.camera.up, 3));
+    if (f.camera.type != ATMOS_CAMERA_EQUIRECT) set(cam, "fov_deg", cJSON_CreateNumber(f.camera.fov_deg));
     cJSON *sun = object(root, "sun");
     static const char *const sun_keys[] = {"elevation_deg", "azimuth_deg", "time", "latitude_deg", "longitude_deg"};
     clear(sun, sun_keys, 5);
@@ -115,7 +125,9 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
     cJSON *wl = object(root, "wavelengths");
     set(wl, "mode", cJSON_CreateString(s->spectral ? "spectral" : "rgb"));
     cJSON_DeleteItemFromObjectCaseSensitive(root, "animation");
-    if (sc->volume.source[0]) {
+    if (s->renderer == ATMOS_RENDERER_SKY) {
+        cJSON_DeleteItemFromObjectCaseSensitive(root, "volume"); /* the sky renderer's frame is without it */
+    } else if (sc->volume.source[0]) {
         cJSON *vol = object(root, "volume");
         const int gen = !strncmp(sc->volume.source, "generate:", 9), sim = !strncmp(sc->volume.source, "simulate:", 9);
         static const char *const src_keys[] = {"file", "generate", "simulate"};

@@ -93,9 +93,12 @@ static void place(view_state *st, const double pos[3], const double look_at[3])
 {
     double d[3];
     for (int i = 0; i < 3; i++) st->pos[i] = pos[i], d[i] = look_at[i] - pos[i];
-    atmos_direction_to_angles(d, &st->pitch_deg, &st->yaw_deg);
-    if (st->pitch_deg > 89) st->pitch_deg = 89;
-    if (st->pitch_deg < -89) st->pitch_deg = -89;
+    double yaw;
+    atmos_direction_to_angles(d, &st->pitch_deg, &yaw);
+    if (d[0] != 0 || d[2] != 0) st->yaw_deg = yaw; /* straight up or down: the heading kept */
+    const double limit = view_state_pitch_limit(st);
+    if (st->pitch_deg > limit) st->pitch_deg = limit;
+    if (st->pitch_deg < -limit) st->pitch_deg = -limit;
     st->changes |= VIEW_CHANGED_CAMERA;
 }
 

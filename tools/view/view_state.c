@@ -20,6 +20,35 @@ void view_state_forward(const view_state *s, double d[3])
     atmos_direction_from_angles(s->pitch_deg, s->yaw_deg, d);
 }
 
+void view_state_up(const view_state *s, double u[3])
+{
+    /* the forward direction turned 90 degrees up in its vertical plane: at pitch < 90 the
+     * world's up made perpendicular to the view (what atmos_camera_init does with (0, 1, 0)),
+     * at pitch 90 the heading's opposite, as when one tilts one's head back */
+    const double p = s->pitch_deg * DEG, y = s->yaw_deg * DEG;
+    u[0] = -sin(p) * sin(y), u[1] = cos(p), u[2] = sin(p) * cos(y);
+}
+
+int view_renderer_draws(atmos_renderer_kind r, atmos_camera_type t)
+{
+    /* the library's rules: src/render/plan.c (slice), src/particles/psplat.c (Harris's
+     * splats), src/scene/scene_lights.c (beams) */
+    return t == ATMOS_CAMERA_PINHOLE ||
+           !(r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_HARRIS || r == ATMOS_RENDERER_BEAMS);
+}
+
+atmos_camera_type view_state_camera(const view_state *s, double *fov_deg)
+{
+    const int kept = view_renderer_draws(s->renderer, s->camera);
+    if (fov_deg) *fov_deg = kept ? s->fov_deg : s->pinhole_fov_deg;
+    return kept ? s->camera : ATMOS_CAMERA_PINHOLE;
+}
+
+double view_state_pitch_limit(const view_state *s)
+{
+    return s->camera == ATMOS_CAMERA_PINHOLE ? 89.0 : 90.0;
+}
+
 void view_state_sun(view_state *s)
 {
     if (!s->sun_from_time) return;
@@ -30,15 +59,41 @@ void view_state_sun(view_state *s)
     }
 }
 
+/* The view's pitch and yaw of the scene's camera c, its defaults resolved (camera.h) by
+ * atmos_camera_init; looking straight up or down, the yaw is the one whose image up
+ * (view_state_up) is the camera's. An equirect's directions are those of a pinhole's. */
+static void orientation(const atmos_camera_desc *c, double *pitch, double *yaw)
+{
+    atmos_camera_desc d = *c;
+    if (d.type == ATMOS_CAMERA_EQUIRECT) d.type = ATMOS_CAMERA_PINHOLE, d.fov_deg = 60.0;
+    atmos_camera cam;
+    if (atmos_camera_init(NULL, &d, 16, 16, &cam) != ATMOS_OK) { /* the scene was validated: never */
+        *pitch = 0.0, *yaw = 0.0;
+        return;
+    }
+    atmos_direction_to_angles(cam.forward, pitch, yaw);
+    if (fabs(cam.forward[1]) > 0.99999) {
+        double el, up_az;
+        atmos_direction_to_angles(cam.up, &el, &up_az);
+        *pitch = cam.forward[1] > 0 ? 90.0 : -90.0;
+        *yaw = wrap360(up_az + (cam.forward[1] > 0 ? 180.0 : 0.0));
+    }
+}
+
 void view_state_init(view_state *s, const atmos_scene *sc, const atmos_frame *f, const double *target)
 {
     memset(s, 0, sizeof *s);
     memcpy(s->pos, f->camera.position, sizeof s->pos);
+    s->camera = f->camera.type;
+    orientation(&f->camera, &s->pitch_deg, &s->yaw_deg);
+    const double limit = view_state_pitch_limit(s);
+    s->pitch_deg = clampd(s->pitch_deg, -limit, limit);
+    /* the type's default for 0 (camera.h); an equirect's is unused */
+    s->fov_deg = f->camera.fov_deg > 0 && s->camera != ATMOS_CAMERA_EQUIRECT ? f->camera.fov_deg
+                 : s->camera == ATMOS_CAMERA_PINHOLE                          ? 60.0
+                                                                              : 180.0;
+    s->pinhole_fov_deg = fmin(s->fov_deg, 120.0);
     double d[3];
-    for (int i = 0; i < 3; i++) d[i] = f->camera.look_at[i] - f->camera.position[i];
-    atmos_direction_to_angles(d, &s->pitch_deg, &s->yaw_deg);
-    s->pitch_deg = clampd(s->pitch_deg, -89.0, 89.0);
-    s->fov_deg = f->camera.fov_deg > 0 ? f->camera.fov_deg : 60.0;
     if (target) memcpy(s->target, target, sizeof s->target);
     else memcpy(s->target, f->camera.look_at, sizeof s->target);
     for (int i = 0; i < 3; i++) d[i] = s->target[i] - s->pos[i];
@@ -88,7 +143,7 @@ static void fly(view_state *s, double fwd, double right, double up)
 static void turn(view_state *s, double dyaw, double dpitch)
 {
     s->yaw_deg = wrap360(s->yaw_deg + dyaw);
-    s->pitch_deg = clampd(s->pitch_deg + dpitch, -89.0, 89.0);
+    s->pitch_deg = clampd(s->pitch_deg + dpitch, -view_state_pitch_limit(s), view_state_pitch_limit(s));
     s->changes |= VIEW_CHANGED_CAMERA;
 }
 
@@ -162,7 +217,11 @@ void view_state_look(view_state *s, double dx, double dy)
 
 void view_state_zoom(view_state *s, double clicks)
 {
-    s->fov_deg = clampd(s->fov_deg * pow(0.9, clicks), 5.0, 120.0);
+    /* the field of view of the camera shown: the scene's, or its stand-in pinhole's */
+    const atmos_camera_type t = view_state_camera(s, NULL);
+    if (t == ATMOS_CAMERA_EQUIRECT) return; /* it shows every direction */
+    double *fov = t == s->camera ? &s->fov_deg : &s->pinhole_fov_deg;
+    *fov = clampd(*fov * pow(0.9, clicks), 5.0, t == ATMOS_CAMERA_FISHEYE ? 360.0 : 120.0);
     s->changes |= VIEW_CHANGED_CAMERA;
 }
 
@@ -170,12 +229,11 @@ void view_state_frame(const view_state *s, atmos_frame *f)
 {
     double d[3];
     view_state_forward(s, d);
-    f->camera.type = ATMOS_CAMERA_PINHOLE;
+    f->camera.type = view_state_camera(s, &f->camera.fov_deg);
     memcpy(f->camera.position, s->pos, sizeof s->pos);
     /* looked-at point 1 km ahead: the direction is what matters */
     for (int i = 0; i < 3; i++) f->camera.look_at[i] = s->pos[i] + 1000.0 * d[i];
-    f->camera.up[0] = 0, f->camera.up[1] = 1, f->camera.up[2] = 0;
-    f->camera.fov_deg = s->fov_deg;
+    view_state_up(s, f->camera.up);
     atmos_direction_from_angles(s->sun_el, s->sun_az, f->sun_dir);
     f->tonemap.manual_exposure = s->manual_exposure;
     f->tonemap.exposure_ev = s->ev;

@@ -21,19 +21,47 @@ struct view_window {
     int dragging;
 };
 
+#define NO_DISPLAY_HINT                                                                                       \
+    "record headless with --headless --frames N [--record DIR], or run it under a virtual display: xvfb-run -a " \
+    "atmos view ..."
+
+/* SDL2's video drivers that open no window anyone sees: without a display, SDL_Init falls back
+ * on "offscreen" (SDL 2.26) and succeeds. Kept when SDL_VIDEODRIVER asks for them. */
+static int shows_nothing(const char *driver)
+{
+    if (!driver || (strcmp(driver, "offscreen") && strcmp(driver, "dummy"))) return 0;
+    const char *asked = getenv("SDL_VIDEODRIVER");
+    return !(asked && strstr(asked, driver));
+}
+
 view_window *view_window_open(int w, int h, const char *title)
 {
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
-        fprintf(stderr, "atmos view: cannot open a window: %s (no display? run it under xvfb-run, or record "
-                        "headless with --frames N --record DIR --headless)\n", SDL_GetError());
+        fprintf(stderr, "atmos view: cannot open a window: %s (no display?): " NO_DISPLAY_HINT "\n", SDL_GetError());
+        return NULL;
+    }
+    const char *driver = SDL_GetCurrentVideoDriver();
+    if (shows_nothing(driver)) {
+        const char *x = getenv("DISPLAY"), *wl = getenv("WAYLAND_DISPLAY");
+        fprintf(stderr,
+                "atmos view: no display to open a window on (%s; SDL2 could only fall back on its \"%s\" video "
+                "driver, which shows nothing): " NO_DISPLAY_HINT "\n",
+                (x && *x) || (wl && *wl) ? "the display in DISPLAY / WAYLAND_DISPLAY could not be opened"
+                                         : "neither DISPLAY nor WAYLAND_DISPLAY is set",
+                driver);
+        SDL_Quit();
         return NULL;
     }
     view_window *v = calloc(1, sizeof *v);
-    if (!v) return NULL;
+    if (!v) {
+        SDL_Quit();
+        return NULL;
+    }
     v->win = SDL_CreateWindow(title, SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, w, h, SDL_WINDOW_RESIZABLE);
     if (v->win) v->ren = SDL_CreateRenderer(v->win, -1, 0);
     if (!v->win || !v->ren) {
-        fprintf(stderr, "atmos view: cannot open a window: %s\n", SDL_GetError());
+        fprintf(stderr, "atmos view: cannot open a window (video driver %s): %s: " NO_DISPLAY_HINT "\n",
+                driver ? driver : "none", SDL_GetError());
         view_window_close(v);
         return NULL;
     }
