@@ -2,17 +2,8 @@
 # atmos bench beams --case NAME (docs/beams.md, "Speed"): only the named case runs (one line,
 # its scene= name), from a --file scene too; a name no case has is a usage error (exit 2)
 # naming it.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
+. "$(dirname "$0")/common.inc"
 S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
-T=${ATMOS_TEST_TMP:-/tmp}/bench_beams_case.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
 
 "$A" bench beams --file "$S/scenes/dobashi_fig04_spotlight.json" --case dobashi_fig04_no_subplanes --repeat 1 \
     --threads 1 >"$T/out.txt" 2>"$T/err.txt"

@@ -9,17 +9,8 @@
 #  - the report lists the picked views; the same figures with 1 and 2 threads;
 #  - a FILE that does not fit the run (another grid, another wavelength set, no rows, not a
 #    CSV, missing) is refused with a clear message, before any walk.
-set -u
-
-cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
-T=${ATMOS_TEST_TMP:-/tmp}/sky_refine.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-fail=0
-
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
+cli=$A
 
 acc() { "$cli" bench sky-accuracy --quick --models spherical --paths 128 "$@"; }
 

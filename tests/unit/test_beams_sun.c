@@ -87,20 +87,30 @@ static void test_no_shadow(void)
     atmos__beams_sun_free(&s);
 }
 
-static void test_shadow(void)
+/* A wall 40 m wide hanging 40 m up, 60 m away, and the sun's shadow map of it (size texels a
+ * side) for a sun up to the right; NULL if the box could not be made. */
+static atmos_mesh *wall_and_sun(atmos__beams_sun *s, double sun[3], int size)
 {
     atmos_mesh *wall = NULL;
     CHECK_OK(atmos_mesh_load(ctx, "builtin:box", 0, &wall));
-    if (!wall) return;
+    if (!wall) return NULL;
     atmos_mesh_transform t;
     atmos_mesh_transform_identity(&t);
     t.position_m[1] = 40, t.position_m[2] = -60, t.scale[0] = 40, t.scale[1] = 15, t.scale[2] = 15;
     CHECK_OK(atmos_mesh_apply_transform(ctx, wall, &t));
-    double sun[3] = {0.2, 0.5, 0.6};
+    sun[0] = 0.2, sun[1] = 0.5, sun[2] = 0.6;
     unit(sun);
+    memset(s, 0, sizeof *s);
+    CHECK_OK(atmos__beams_sun_build(ctx, s, sun, &wall, 1, size));
+    return wall;
+}
+
+static void test_shadow(void)
+{
     atmos__beams_sun s;
-    memset(&s, 0, sizeof s);
-    CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, &wall, 1, 2048));
+    double sun[3];
+    atmos_mesh *wall = wall_and_sun(&s, sun, 2048);
+    if (!wall) return;
     /* a uniform fog, and a layer thinning upward (the sunlight dimmed on its way in) */
     const atmos__beams_fog fogs[2] = {{4e-3, 1, 0.2, 0, 0, NULL}, {4e-3, 1, 0.2, 60, 0, NULL}};
     const double o[3] = {0, 5, 0};
@@ -147,18 +157,10 @@ static double every_step(const atmos__beams_sun *s, const atmos__beams_fog *f, c
 
 static void test_skipped_runs(void)
 {
-    atmos_mesh *wall = NULL;
-    CHECK_OK(atmos_mesh_load(ctx, "builtin:box", 0, &wall));
-    if (!wall) return;
-    atmos_mesh_transform t;
-    atmos_mesh_transform_identity(&t);
-    t.position_m[1] = 40, t.position_m[2] = -60, t.scale[0] = 40, t.scale[1] = 15, t.scale[2] = 15;
-    CHECK_OK(atmos_mesh_apply_transform(ctx, wall, &t));
-    double sun[3] = {0.2, 0.5, 0.6};
-    unit(sun);
     atmos__beams_sun s;
-    memset(&s, 0, sizeof s);
-    CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, &wall, 1, 256));
+    double sun[3];
+    atmos_mesh *wall = wall_and_sun(&s, sun, 256);
+    if (!wall) return;
     const atmos__beams_fog fog = {4e-3, 1, 0.2, 0, 0, NULL};
     /* below the wall looking across its shadow, inside the shadow looking along it (away from
      * the sun), far off looking away from it */
