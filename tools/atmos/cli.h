@@ -83,7 +83,7 @@ void cli_volume_help(void);
 int cli_cmd_volume_stats(int argc, char **argv);
 void cli_volume_stats_usage(void);
 void cli_volume_stats_help(void);
-/* atmos volume's options of how a file is read (--grids, --time, ...; cmd_volume.c): 1 if
+/* atmos volume's options of how a file is read (--grids, --time, ...; volume_read_opts.c): 1 if
  * argv[*i] was one (its value consumed), 0 if not, -1 after a usage error was printed. */
 int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc *d);
 int cli_cmd_simulate(int argc, char **argv);
