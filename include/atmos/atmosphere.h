@@ -193,10 +193,13 @@ ATMOS_API double atmos_atmosphere_phase(const atmos_atmosphere *atm, const doubl
 /* The look-up tables of a spherical kind, to print or plot: names (NULL-terminated; an empty
  * list for kinds without tables) and one table as an image with one channel per wavelength
  * of the set, its metadata "atmos:table" (the name) and "atmos:axes" (what x and y are).
- * SPHERICAL: "transmittance", "multiple_scattering", "f_ms", "sky_irradiance"; DOBASHI:
- * "sun_attenuation", "plane_rayleigh", "plane_mie", "plane_attenuation" (docs/sky.md).
- * ATMOS_E_INVALID_ARG for an unknown name, listing the known ones. */
+ * SPHERICAL: "transmittance", "multiple_scattering", "f_ms", "sky_irradiance",
+ * "higher_orders_air", "higher_orders_aerosols"; DOBASHI: "sun_attenuation", "plane_rayleigh",
+ * "plane_mie", "plane_attenuation" (docs/sky.md). atmos_atmosphere_kind_table_names gives a
+ * kind's names without creating an atmosphere (an empty list for kinds without tables or an
+ * unknown kind). ATMOS_E_INVALID_ARG for an unknown name, listing the known ones. */
 ATMOS_API const char *const *atmos_atmosphere_table_names(const atmos_atmosphere *atm);
+ATMOS_API const char *const *atmos_atmosphere_kind_table_names(atmos_atmosphere_kind kind);
 ATMOS_API atmos_status atmos_atmosphere_table(atmos_context *ctx, const atmos_atmosphere *atm, const char *name,
                                               struct atmos_image **out);
 

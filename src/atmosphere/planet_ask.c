@@ -6,6 +6,15 @@
 
 #include <string.h>
 
+const char *const *atmos_atmosphere_kind_table_names(atmos_atmosphere_kind kind)
+{
+    static const char *const none[] = {NULL};
+    const atmos__planet_solver *s = kind == ATMOS_ATMOSPHERE_DOBASHI     ? &atmos__dobashi_solver
+                                    : kind == ATMOS_ATMOSPHERE_SPHERICAL ? &atmos__spherical_solver
+                                                                         : NULL;
+    return s && s->table_names ? s->table_names : none;
+}
+
 const char *const *atmos_atmosphere_table_names(const atmos_atmosphere *atm)
 {
     static const char *const none[] = {NULL};

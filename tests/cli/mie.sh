@@ -34,6 +34,19 @@ near(obj["qback"], 4 * (s1[2][0] ** 2 + s1[2][1] ** 2) / 100)
 near(obj["qext"], 4 * s1[0][0] / 100)
 ' "$tmp.out"; then ok "json, Wiscombe case 7"; else bad "json, Wiscombe case 7"; cat "$tmp.err" >&2; fi
 
+# a tiny sphere (the user report: g = -9.8e-4, Q_abs = -2.3e-41): the Rayleigh limit with its
+# first corrections (BH 5.1): Q_sca = 8/3 x^4 K^2, g = x^2 (m^2+3)(m^2+2) / (15 (2m^2+3)), no absorption
+if "$cli" mie --m 1.33,0 --x 1e-6 --json >"$tmp.out" 2>"$tmp.err" &&
+   python3 -c '
+import json, sys
+o = json.loads(open(sys.argv[1]).read())
+m2, x = 1.33 ** 2, 1e-6
+K = (m2 - 1) / (m2 + 2)
+assert abs(o["qsca"] / (8 / 3 * x ** 4 * K * K) - 1) < 1e-9, o["qsca"]
+assert abs(o["g"] / (x * x * (m2 + 3) * (m2 + 2) / (15 * (2 * m2 + 3))) - 1) < 1e-9, o["g"]
+assert o["qext"] == o["qsca"], (o["qext"], o["qsca"])
+' "$tmp.out" && "$cli" mie --m 1.33,0 --x 1e-6 | grep -q '^Q_abs  = 0$'; then ok "x = 1e-6: Rayleigh limit, g > 0, Q_abs = 0"; else bad "x = 1e-6"; cat "$tmp.out" "$tmp.err" >&2; fi
+
 # default angles: 0, 30, ..., 180 in the human-readable table
 if "$cli" mie --m 1.33,-1e-5 --x 100 >"$tmp.out" 2>"$tmp.err" && [ "$(grep -c '^ *[0-9.]* *[-0-9]' "$tmp.out")" -ge 7 ] &&
    grep -q 'Q_ext  = 2.1013' "$tmp.out"; then ok "text output"; else bad "text output"; cat "$tmp.out" >&2; fi

@@ -240,6 +240,19 @@ static void test_bad_input(void)
     atmos_context_destroy(ctx);
 }
 
+/* A kind's table names without making the atmosphere (atmos sky --table list uses them):
+ * empty for the kinds without tables and for an unknown kind. */
+static void test_kind_table_names(void)
+{
+    const atmos_atmosphere_kind none[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_VACUUM, ATMOS_ATMOSPHERE_HOMOGENEOUS,
+                                          (atmos_atmosphere_kind)99};
+    for (int i = 0; i < 4; i++) CHECK(atmos_atmosphere_kind_table_names(none[i])[0] == NULL);
+    const char *const *d = atmos_atmosphere_kind_table_names(ATMOS_ATMOSPHERE_DOBASHI);
+    const char *const *s = atmos_atmosphere_kind_table_names(ATMOS_ATMOSPHERE_SPHERICAL);
+    CHECK(d[0] && !strcmp(d[0], "sun_attenuation"));
+    CHECK(s[0] && !strcmp(s[0], "transmittance"));
+}
+
 int main(void)
 {
     const atmos_atmosphere_kind kinds[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS,
@@ -254,5 +267,6 @@ int main(void)
     }
     test_vacuum();
     test_bad_input();
+    test_kind_table_names();
     return test_summary("test_atmosphere");
 }

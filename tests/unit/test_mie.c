@@ -314,6 +314,51 @@ static void test_rayleigh(atmos_complex m)
     }
 }
 
+/* Tiny spheres, x = 1e-6 .. 1e-2, against the small-particle closed forms (BH §5.1,
+ * BH Eq. 5.8 for Q_sca; the x^5 terms of a_1 and the leading b_1, a_2 of the same
+ * section). With K = (m^2-1)/(m^2+2), L = (m^2-1)/(2m^2+3):
+ *   Q_sca = 8/3 x^4 |K|^2 (1 + 6/5 x^2 Re[(m^2-2)/(m^2+2)])   residual x^3 (absorbing), x^4
+ *   g     = x^2 Re[K conj(L/10 + (m^2-1)/30)] / |K|^2          residual x^2
+ *           (real m: g = x^2 (m^2+3)(m^2+2) / (15 (2m^2+3)) > 0)
+ *   Q_abs = 4 x Im K (Bohren-Huffman sign; -4 x Im K in MIEV0's)  residual x^2
+ *   Q_back = 4 x^4 |K|^2                                       residual 1.06 x^2
+ * The residual coefficients were checked against an 80-digit evaluation of the exact
+ * series (BH Eq. 4.53, 4.61, 4.62, 4.82 with mpmath, tests/data/README.md): below 0.07 x^3,
+ * 0.26 x^2, 0.9 x^2, 1.06 x^2 for the m used here. Below x ~ 1e-4 the closed forms are exact to
+ * double precision, so they pin down the series' rounding: a real m must not absorb
+ * (Q_abs exactly 0, not -2e-41) and g must not lose its sign (it was -9.8e-4 at 1e-6). */
+static void test_small_particles(void)
+{
+    const atmos_complex ms[] = {{1.33, 0.0}, {0.75, 0.0}, {2.0, 0.0}, {1.5, -0.1}, {1.5, -1.0}};
+    for (int i = 0; i < 5; i++)
+        for (double x = 1e-6; x < 0.011; x *= 10.0) {
+            double complex m = CMPLX(ms[i].re, ms[i].im), m2 = m * m;
+            double complex K = (m2 - 1.0) / (m2 + 2.0), L = (m2 - 1.0) / (2.0 * m2 + 3.0);
+            double k2 = creal(K * conj(K)), x2 = x * x;
+            double qsca = 8.0 / 3.0 * x2 * x2 * k2 * (1.0 + 1.2 * x2 * creal((m2 - 2.0) / (m2 + 2.0)));
+            double g = x2 * creal(K * conj(L / 10.0 + (m2 - 1.0) / 30.0)) / k2;
+            double qabs = -4.0 * x * cimag(K), qback = 4.0 * x2 * x2 * k2;
+            double mu[2] = {1.0, -1.0};
+            atmos_complex s1[2], s2[2];
+            atmos_mie_result r;
+            CHECK_OK(atmos_mie(NULL, ms[i], x, 2, mu, s1, s2, &r));
+            double tol_q = x2 * x + 1e-12, tol_g = 0.5 * x2 + 1e-11;
+            CHECK_MSG(fabs(r.qsca / qsca - 1.0) <= tol_q, "m=%g%+gi x=%g: Q_sca %.15g, closed form %.15g (rel %.3g)",
+                      ms[i].re, ms[i].im, x, r.qsca, qsca, r.qsca / qsca - 1.0);
+            CHECK_MSG(r.g > 0.0 && fabs(r.g / g - 1.0) <= tol_g, "m=%g%+gi x=%g: g %.15g, closed form %.15g (rel %.3g)",
+                      ms[i].re, ms[i].im, x, r.g, g, r.g / g - 1.0);
+            CHECK_MSG(fabs(r.qback / qback - 1.0) <= 1.2 * x2 + 1e-12, "m=%g%+gi x=%g: Q_back %.15g, closed form %.15g",
+                      ms[i].re, ms[i].im, x, r.qback, qback);
+            if (ms[i].im == 0.0)
+                CHECK_MSG(r.qext == r.qsca, "m=%g x=%g: Q_abs = %.3g for a real m", ms[i].re, x, r.qext - r.qsca);
+            else
+                CHECK_MSG(fabs((r.qext - r.qsca) / qabs - 1.0) <= 2.0 * x2 + 1e-12,
+                          "m=%g%+gi x=%g: Q_abs %.15g, closed form %.15g", ms[i].re, ms[i].im, x, r.qext - r.qsca, qabs);
+            /* the optical theorem holds for the amplitudes as well */
+            CHECK_REL(4.0 * s1[0].re / x2, r.qext, 1e-12);
+        }
+}
+
 /* Large spheres: Q_ext -> 2 (extinction paradox, BH §4.4.4); a 1 mm raindrop at 440 nm
  * and beyond, up to the API's limit x = 1e5; every output finite. */
 static void test_large(void)
@@ -395,6 +440,7 @@ int main(void)
     test_angular_integrals((atmos_complex){1.33, -1e-5}, 60.0);
     test_rayleigh((atmos_complex){1.33, 0.0});
     test_rayleigh((atmos_complex){1.5, -1.0});
+    test_small_particles();
     test_large();
     test_symmetry_folding();
     test_bad_input();

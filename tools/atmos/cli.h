@@ -50,7 +50,14 @@ int cli_progress_bar(void *user, const char *stage, double fraction);
 void cli_desc_progress(atmos_context_desc *d);
 /* That bar, for a command's own stages (one thread at a time). */
 cli_progress *cli_shared_progress(void);
-/* atmos sky --table NAME [-o FILE] (sky_tables.c): "list" prints the model's tables. */
+/* atmos sky's models (sky_tables.c): the kind of --model NAME (0 when unknown) and a kind's name. */
+int cli_sky_model(const char *name, atmos_atmosphere_kind *kind);
+const char *cli_sky_model_name(atmos_atmosphere_kind kind);
+/* atmos sky --table NAME [-o FILE] before any atmosphere is made: "list" prints the model's
+ * tables (or, for a model without any, every model's), a table another model keeps or an
+ * unknown one is a usage error. Returns -1 when NAME is to be written, else the exit code. */
+int cli_sky_table_check(const char *C, atmos_atmosphere_kind kind, const char *name, const char *out);
+/* Writes the table NAME of atm to out (.exr, .pfm or .png). */
 int cli_sky_table(const char *C, atmos_context *ctx, const atmos_atmosphere *atm, const char *name, const char *out);
 /* Monotonic clock, seconds. */
 double cli_now_s(void);

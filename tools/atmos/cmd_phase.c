@@ -22,7 +22,9 @@ static void help(void)
            "  --orders                       multiple-scattering phase functions Ams_n (Riley et al. 2004\n"
            "                                 Eq. 20) instead: --csv prints n,theta_deg,<nm>,... for every\n"
            "                                 order n >= 1 and angle; --plot draws several orders; the\n"
-           "                                 summary gives the highest order and forward fractions F_n\n"
+           "                                 summary gives the highest order N and the forward fractions\n"
+           "                                 F_n (Eq. 23, forward-scattered fraction) of orders 1..N if\n"
+           "                                 N <= 6, else of orders 1, 2, 5, 10, 26 below N and the last order N\n"
            "  --max-order N                  with --orders: stop at order N (default: until isotropic to 1e-6)\n"
            "  --scene FILE                   also look PRESET up among the user-defined particle types of a\n"
            "                                 scene file (its \"particles\" section, docs/scene-format.md)\n"
@@ -329,16 +331,39 @@ static void print_orders_csv(const atmos_phase_table *t, const atmos_msphase *m)
         }
 }
 
+/* The orders whose forward fraction the summary shows: all of 1..N for N <= 6, else 1, 2,
+ * 5, 10, 26 up to N and N itself (beyond N every order is isotropic, F = 0.5). */
+static int summary_orders(int N, int *ord)
+{
+    static const int fixed[] = {1, 2, 5, 10, 26};
+    int n = 0;
+    if (N <= 6) {
+        for (int i = 1; i <= N; i++) ord[n++] = i;
+        return n;
+    }
+    for (int i = 0; i < 5 && fixed[i] < N; i++) ord[n++] = fixed[i];
+    ord[n++] = N;
+    return n;
+}
+
 static void print_orders_summary(const char *preset, const atmos_phase_table *t, const atmos_msphase *m, double secs)
 {
-    int nw = atmos_msphase_wavelength_count(m);
-    printf("multiple-scattering phase functions '%s': orders 1..%d (isotropic beyond), %s in %.3f s\n", preset,
-           atmos_msphase_max_order(m), atmos_msphase_from_cache(m) ? "loaded from the cache" : "built", secs);
-    printf("%10s %10s %10s %10s %10s %10s %12s\n", "nm", "F_1", "F_2", "F_5", "F_10", "F_26", "legendre_l");
-    for (int k = 0; k < nw; k++)
-        printf("%10.10g %10.6f %10.6f %10.6f %10.6f %10.6f %12d\n", atmos_phase_table_wavelength_nm(t, k),
-               atmos_msphase_forward(m, k, 1), atmos_msphase_forward(m, k, 2), atmos_msphase_forward(m, k, 5),
-               atmos_msphase_forward(m, k, 10), atmos_msphase_forward(m, k, 26), atmos_msphase_legendre_count(m, k));
+    int nw = atmos_msphase_wavelength_count(m), N = atmos_msphase_max_order(m), ord[6];
+    int no = summary_orders(N, ord);
+    printf("multiple-scattering phase functions '%s': orders 1..%d (isotropic beyond), %s in %.3f s\n", preset, N,
+           atmos_msphase_from_cache(m) ? "loaded from the cache" : "built", secs);
+    printf("%10s", "nm");
+    for (int i = 0; i < no; i++) {
+        char h[16];
+        snprintf(h, sizeof h, "F_%d", ord[i]);
+        printf(" %10s", h);
+    }
+    printf(" %12s\n", "legendre_l");
+    for (int k = 0; k < nw; k++) {
+        printf("%10.10g", atmos_phase_table_wavelength_nm(t, k));
+        for (int i = 0; i < no; i++) printf(" %10.6f", atmos_msphase_forward(m, k, ord[i]));
+        printf(" %12d\n", atmos_msphase_legendre_count(m, k));
+    }
 }
 
 /* ------------------------------------------------------------------ the command */

@@ -10,7 +10,8 @@ static void help(void)
 {
     printf("Usage: atmos sky --sun-elevation E [--sun-azimuth A] --view-elevation e --view-azimuth a\n"
            "                 [--altitude h] [--distance K] [--spectral N] [--albedo R]\n"
-           "                 [--atmosphere riley|homogeneous] [--thickness M] [--json]\n\n"
+           "                 [--model riley|homogeneous|dobashi|spherical] [--thickness M] [--json]\n"
+           "       atmos sky --table NAME|list [--model NAME] [--spectral N] [--albedo R] [-o FILE]\n\n"
            "Prints, per wavelength, the single-scattered radiance arriving along one view\n"
            "(Riley et al. 2004 Eq. 15, corrected), the transmittance along it (Eq. 11) and the\n"
            "sun's attenuated radiance at the observer (Eq. 12 over the disk's solid angle).\n\n"
@@ -26,11 +27,16 @@ static void help(void)
            "                       layer from the ground to --thickness; docs/models.md), dobashi or\n"
            "                       spherical (the Earth's atmosphere over a spherical planet; docs/sky.md)\n"
            "  --atmosphere NAME    the same as --model\n"
-           "  --thickness M        the homogeneous layer's top, metres (default 8000)\n"
-           "  --table NAME -o FILE instead of a view: write the model's look-up table NAME (dobashi,\n"
-           "                       spherical) as FILE.exr (every wavelength), .pfm (the first three)\n"
-           "                       or .png (a plot, each channel scaled to its maximum); --table list\n"
-           "                       prints the names\n"
+           "  --thickness M        the homogeneous layer's top, metres (default 8000); goes with\n"
+           "                       --model homogeneous (a usage error with the other models)\n"
+           "  --table NAME -o FILE instead of a view: write the model's look-up table NAME as FILE.exr\n"
+           "                       (every wavelength), .pfm (the first three) or .png (a plot, each\n"
+           "                       channel scaled to its maximum). Only dobashi and spherical keep\n"
+           "                       tables: --model spherical --table list prints that model's names,\n"
+           "                       one a line; --table list with a model that keeps none (riley, the\n"
+           "                       default, or homogeneous) prints every model's. The view options\n"
+           "                       (--sun-*, --view-*, --altitude, --distance, --json) do not go with\n"
+           "                       --table, nor -o without it\n"
            "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
            "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n\n"
            "Units: radiance W m^-2 sr^-1 nm^-1. \"inscatter\" is the air's in-scattered radiance only;\n"
@@ -67,12 +73,14 @@ static atmos_atmosphere *make_sky(const char *C, atmos_atmosphere_kind kind, int
 }
 
 /* --table: the model's tables, no view. */
-static int sky_table(const char *C, atmos_atmosphere_kind kind, int spectral, const char *table, const char *out)
+static int sky_table(const char *C, atmos_atmosphere_kind kind, int spectral, double albedo, const char *table,
+                     const char *out)
 {
     atmos_context *ctx;
     atmos_wavelengths wl;
-    int rc;
-    atmos_atmosphere *atm = make_sky(C, kind, spectral, -1, 0, &ctx, &wl, &rc);
+    int rc = cli_sky_table_check(C, kind, table, out);
+    if (rc >= 0) return rc;
+    atmos_atmosphere *atm = make_sky(C, kind, spectral, albedo, 0, &ctx, &wl, &rc);
     if (!atm) return rc;
     rc = cli_sky_table(C, ctx, atm, table, out);
     atmos_atmosphere_destroy(atm);
@@ -80,76 +88,26 @@ static int sky_table(const char *C, atmos_atmosphere_kind kind, int spectral, co
     return rc;
 }
 
-int cli_cmd_sky(int argc, char **argv)
-{
-    static const struct option opts[] = {
-        {"sun-elevation", required_argument, 0, 'E'}, {"sun-azimuth", required_argument, 0, 'A'},
-        {"view-elevation", required_argument, 0, 'e'}, {"view-azimuth", required_argument, 0, 'a'},
-        {"altitude", required_argument, 0, 'h'},      {"distance", required_argument, 0, 'K'},
-        {"spectral", required_argument, 0, 'n'},      {"albedo", required_argument, 0, 'r'},
-        {"json", no_argument, 0, 'j'},                {"help", no_argument, 0, 'H'},
-        {"atmosphere", required_argument, 0, 'k'},    {"thickness", required_argument, 0, 't'},
-        {"model", required_argument, 0, 'k'},         {"table", required_argument, 0, 'L'},
-        {"output", required_argument, 0, 'o'},
-        {0, 0, 0, 0}};
-    double sun_el = NAN, sun_az = 180, view_el = NAN, view_az = NAN, alt = 0, dist = INFINITY, albedo = -1, top = 0;
-    atmos_atmosphere_kind kind = ATMOS_ATMOSPHERE_RILEY;
-    int spectral = 0, json = 0, c;
-    const char *C = "sky", *table = NULL, *out = NULL;
-    optind = 1;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:", opts, NULL)) != -1) {
-        switch (c) {
-        case 'E': if (!cli_parse_double(C, "--sun-elevation", optarg, &sun_el)) return CLI_EXIT_USAGE; break;
-        case 'A': if (!cli_parse_double(C, "--sun-azimuth", optarg, &sun_az)) return CLI_EXIT_USAGE; break;
-        case 'e': if (!cli_parse_double(C, "--view-elevation", optarg, &view_el)) return CLI_EXIT_USAGE; break;
-        case 'a': if (!cli_parse_double(C, "--view-azimuth", optarg, &view_az)) return CLI_EXIT_USAGE; break;
-        case 'h': if (!cli_parse_double(C, "--altitude", optarg, &alt)) return CLI_EXIT_USAGE; break;
-        case 'K': if (!cli_parse_double(C, "--distance", optarg, &dist)) return CLI_EXIT_USAGE; break;
-        case 'r': if (!cli_parse_double(C, "--albedo", optarg, &albedo)) return CLI_EXIT_USAGE; break;
-        case 'n': if (!cli_parse_int(C, "--spectral", optarg, 1, ATMOS_MAX_WAVELENGTHS, &spectral)) return CLI_EXIT_USAGE; break;
-        case 'j': json = 1; break;
-        case 'L': table = optarg; break;
-        case 'o': out = optarg; break;
-        case 'k':
-            if (!strcmp(optarg, "riley")) kind = ATMOS_ATMOSPHERE_RILEY;
-            else if (!strcmp(optarg, "homogeneous")) kind = ATMOS_ATMOSPHERE_HOMOGENEOUS;
-            else if (!strcmp(optarg, "dobashi")) kind = ATMOS_ATMOSPHERE_DOBASHI;
-            else if (!strcmp(optarg, "spherical")) kind = ATMOS_ATMOSPHERE_SPHERICAL;
-            else
-                return cli_usage_error(C, "--model: expected riley, homogeneous, dobashi or spherical, got '%s'",
-                                       optarg);
-            break;
-        case 't':
-            if (!cli_parse_double(C, "--thickness", optarg, &top) || !(top >= 1 && top <= 1e6))
-                return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]");
-            break;
-        case 'H': help(); return CLI_EXIT_OK;
-        default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
-        }
-    }
-    if (optind < argc) return cli_usage_error(C, "unexpected argument '%s'", argv[optind]);
-    if (table) return sky_table(C, kind, spectral, table, out);
-    if (isnan(sun_el)) return cli_usage_error(C, "--sun-elevation is required");
-    if (isnan(view_el)) return cli_usage_error(C, "--view-elevation is required");
-    if (isnan(view_az)) return cli_usage_error(C, "--view-azimuth is required");
-    if (sun_el < -90 || sun_el > 90) return cli_usage_error(C, "--sun-elevation: must be in [-90, 90], got %g", sun_el);
-    if (view_el < -90 || view_el > 90) return cli_usage_error(C, "--view-elevation: must be in [-90, 90], got %g", view_el);
-    if (alt < 0) return cli_usage_error(C, "--altitude: must be >= 0 metres, got %g", alt);
-    if (!(dist > 0)) return cli_usage_error(C, "--distance: must be > 0 metres, got %g", dist);
-    if (albedo != -1 && (albedo < 0 || albedo > 1)) return cli_usage_error(C, "--albedo: must be in [0, 1], got %g", albedo);
+typedef struct {
+    double sun_el, sun_az, view_el, view_az, alt, dist, albedo, top;
+    atmos_atmosphere_kind kind;
+    int spectral, json;
+} sky_opts;
 
+/* One view: in-scatter, transmittance, the sun and the ground along it, printed. */
+static int sky_view(const char *C, const sky_opts *o)
+{
     atmos_context *ctx;
     atmos_wavelengths wl;
     int rc;
-    atmos_atmosphere *sky = make_sky(C, kind, spectral, albedo, top, &ctx, &wl, &rc);
+    atmos_atmosphere *sky = make_sky(C, o->kind, o->spectral, o->albedo, o->top, &ctx, &wl, &rc);
     if (!sky) return rc;
-    double sun[3], dir[3], eye[3] = {0, alt, 0};
-    atmos_direction_from_angles(sun_el, sun_az, sun);
-    atmos_direction_from_angles(view_el, view_az, dir);
+    double sun[3], dir[3], eye[3] = {0, o->alt, 0};
+    atmos_direction_from_angles(o->sun_el, o->sun_az, sun);
+    atmos_direction_from_angles(o->view_el, o->view_az, dir);
     const double ground0[3] = {0, 0, 0};
     double K = atmos_atmosphere_ground_distance(sky, eye, dir);
-    if (dist < K) K = dist;
+    if (o->dist < K) K = o->dist;
     int n = wl.count, hits_ground = !isinf(K) && K == atmos_atmosphere_ground_distance(sky, eye, dir);
     double ins[ATMOS_MAX_WAVELENGTHS], tr[ATMOS_MAX_WAVELENGTHS], sunr[ATMOS_MAX_WAVELENGTHS],
         ground[ATMOS_MAX_WAVELENGTHS], lit[ATMOS_MAX_WAVELENGTHS];
@@ -157,7 +115,7 @@ int cli_cmd_sky(int argc, char **argv)
     atmos_atmosphere_transmittance(sky, eye, dir, K, tr);
     atmos_atmosphere_sun_radiance(sky, eye, sun, sunr);
     atmos_atmosphere_sunlight(sky, ground0, sun, lit);
-    if (kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL) {
+    if (o->kind == ATMOS_ATMOSPHERE_DOBASHI || o->kind == ATMOS_ATMOSPHERE_SPHERICAL) {
         /* a round ground: what the view ray sees there beyond the air's own light */
         double all[ATMOS_MAX_WAVELENGTHS];
         atmos_atmosphere_radiance(sky, eye, dir, sun, all, NULL);
@@ -166,7 +124,7 @@ int cli_cmd_sky(int argc, char **argv)
         const double albedo_pi = atmos_atmosphere_ground_albedo(sky) / 3.14159265358979323846;
         for (int i = 0; i < n; i++) ground[i] = hits_ground && sun[1] > 0 ? albedo_pi * sun[1] * lit[i] * tr[i] : 0.0;
     }
-    if (json) {
+    if (o->json) {
         printf("{\"wavelengths_nm\": ");
         cli_print_json_array(wl.nm, n);
         printf(", \"inscatter\": ");
@@ -191,4 +149,72 @@ int cli_cmd_sky(int argc, char **argv)
     atmos_atmosphere_destroy(sky);
     atmos_context_destroy(ctx);
     return CLI_EXIT_OK;
+}
+
+int cli_cmd_sky(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"sun-elevation", required_argument, 0, 'E'}, {"sun-azimuth", required_argument, 0, 'A'},
+        {"view-elevation", required_argument, 0, 'e'}, {"view-azimuth", required_argument, 0, 'a'},
+        {"altitude", required_argument, 0, 'h'},      {"distance", required_argument, 0, 'K'},
+        {"spectral", required_argument, 0, 'n'},      {"albedo", required_argument, 0, 'r'},
+        {"json", no_argument, 0, 'j'},                {"help", no_argument, 0, 'H'},
+        {"atmosphere", required_argument, 0, 'k'},    {"thickness", required_argument, 0, 't'},
+        {"model", required_argument, 0, 'k'},         {"table", required_argument, 0, 'L'},
+        {"output", required_argument, 0, 'o'},
+        {0, 0, 0, 0}};
+    sky_opts o = {NAN, 180, NAN, NAN, 0, INFINITY, -1, 0, ATMOS_ATMOSPHERE_RILEY, 0, 0};
+    int c, thickness = 0, li = -1;
+    const char *C = "sky", *table = NULL, *out = NULL, *view_opt = NULL;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "o:", opts, &li)) != -1) {
+        /* the first option of a view, to refuse it with --table */
+        if (!view_opt && c > 0 && strchr("EAeahKj", c) && li >= 0) view_opt = opts[li].name;
+        switch (c) {
+        case 'E': if (!cli_parse_double(C, "--sun-elevation", optarg, &o.sun_el)) return CLI_EXIT_USAGE; break;
+        case 'A': if (!cli_parse_double(C, "--sun-azimuth", optarg, &o.sun_az)) return CLI_EXIT_USAGE; break;
+        case 'e': if (!cli_parse_double(C, "--view-elevation", optarg, &o.view_el)) return CLI_EXIT_USAGE; break;
+        case 'a': if (!cli_parse_double(C, "--view-azimuth", optarg, &o.view_az)) return CLI_EXIT_USAGE; break;
+        case 'h': if (!cli_parse_double(C, "--altitude", optarg, &o.alt)) return CLI_EXIT_USAGE; break;
+        case 'K': if (!cli_parse_double(C, "--distance", optarg, &o.dist)) return CLI_EXIT_USAGE; break;
+        case 'r': if (!cli_parse_double(C, "--albedo", optarg, &o.albedo)) return CLI_EXIT_USAGE; break;
+        case 'n': if (!cli_parse_int(C, "--spectral", optarg, 1, ATMOS_MAX_WAVELENGTHS, &o.spectral)) return CLI_EXIT_USAGE; break;
+        case 'j': o.json = 1; break;
+        case 'L': table = optarg; break;
+        case 'o': out = optarg; break;
+        case 'k':
+            if (!cli_sky_model(optarg, &o.kind))
+                return cli_usage_error(C, "--model: expected riley, homogeneous, dobashi or spherical, got '%s'",
+                                       optarg);
+            break;
+        case 't':
+            if (!cli_parse_double(C, "--thickness", optarg, &o.top) || !(o.top >= 1 && o.top <= 1e6))
+                return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]");
+            thickness = 1;
+            break;
+        case 'H': help(); return CLI_EXIT_OK;
+        default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
+        }
+    }
+    if (optind < argc) return cli_usage_error(C, "unexpected argument '%s'", argv[optind]);
+    /* options that do not apply are refused, as `atmos render` refuses another renderer's */
+    if (thickness && o.kind != ATMOS_ATMOSPHERE_HOMOGENEOUS)
+        return cli_usage_error(C, "--thickness goes with --model homogeneous (the model here is %s)",
+                               cli_sky_model_name(o.kind));
+    if (out && !table) return cli_usage_error(C, "-o goes with --table (a view prints to standard output)");
+    if (table && view_opt)
+        return cli_usage_error(C, "--%s does not go with --table (the tables do not depend on the view)", view_opt);
+    if (o.albedo != -1 && (o.albedo < 0 || o.albedo > 1))
+        return cli_usage_error(C, "--albedo: must be in [0, 1], got %g", o.albedo);
+    if (table) return sky_table(C, o.kind, o.spectral, o.albedo, table, out);
+    if (isnan(o.sun_el)) return cli_usage_error(C, "--sun-elevation is required");
+    if (isnan(o.view_el)) return cli_usage_error(C, "--view-elevation is required");
+    if (isnan(o.view_az)) return cli_usage_error(C, "--view-azimuth is required");
+    if (o.sun_el < -90 || o.sun_el > 90) return cli_usage_error(C, "--sun-elevation: must be in [-90, 90], got %g", o.sun_el);
+    if (o.view_el < -90 || o.view_el > 90)
+        return cli_usage_error(C, "--view-elevation: must be in [-90, 90], got %g", o.view_el);
+    if (o.alt < 0) return cli_usage_error(C, "--altitude: must be >= 0 metres, got %g", o.alt);
+    if (!(o.dist > 0)) return cli_usage_error(C, "--distance: must be > 0 metres, got %g", o.dist);
+    return sky_view(C, &o);
 }
