@@ -2,18 +2,8 @@
 # `atmos phase PRESET --orders` summary: the forward-fraction columns F_n are orders that exist
 # (1..N for N <= 6, else 1, 2, 5, 10, 26 up to N and N itself), never orders beyond the last
 # (which printed the isotropic 0.5). Run by ctest with ATMOS_CLI = the atmos binary.
-set -u
-
-cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
-T=${ATMOS_TEST_TMP:-/tmp}/phase_orders.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-XDG_CACHE_HOME=$T/xdg
-export XDG_CACHE_HOME
-trap 'rm -rf "$T"' EXIT
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
+cli=$A
 
 # header: the line after the title; columns between "nm" and "legendre_l"
 cols() { sed -n 2p "$T/out" | sed 's/^ *nm *//; s/ *legendre_l *$//' | tr -s ' '; }

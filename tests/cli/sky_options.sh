@@ -9,17 +9,8 @@
 #  - --table list without --model (the default, riley, keeps none) names the models that keep
 #    tables and their tables; with --model spherical one name per line; a table of another
 #    model is refused naming the model that keeps it, before any table is built.
-set -u
-
-cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
-T=${ATMOS_TEST_TMP:-/tmp}/sky_options.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-fail=0
-
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
+cli=$A
 
 view="--sun-elevation 30 --view-elevation 10 --view-azimuth 90"
 
