@@ -191,7 +191,12 @@ void atmos__scene_volume_warnings(atmos_context *ctx, const atmos_scene *scene, 
     const double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                              (hi[2] - lo[2]) * (hi[2] - lo[2]));
     const double peak = peak_extinction(scene, vol, optics), tau = peak * diag;
-    if (diag > 0 && tau < ATMOS__SCENE_THIN_TAU)
+    if (diag > 0 && !(peak > 0))
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "%s: empty: every value is 0 (or the fields' particles do not scatter), so the image will be the "
+                   "sky alone; no density scale can change that (check the file's grids or fields: atmos volume info)",
+                   name);
+    else if (diag > 0 && tau < ATMOS__SCENE_THIN_TAU)
         atmos__log(ctx, ATMOS_LOG_WARN,
                    "%s: nearly invisible: its peak extinction is %.3g m^-1, so no ray across its %.0f m box has an "
                    "optical depth above %.3g (the image will be the sky alone); if the file's values are not what "

@@ -6,7 +6,8 @@
 #    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3);
 #  - --volume with a -D naming another volume source: refused, both named, nothing written;
 #  - fog or lights given to the slice renderer: a warning that it does not draw them;
-#  - a beam scene without a sun: the status line names its lights, not an unused sun.
+#  - a beam scene without a sun: the status line names its lights, not an unused sun;
+#  - an all-zero volume: said to be empty, not told to raise --density-scale.
 . "$(dirname "$0")/common.inc"
 S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
@@ -71,4 +72,17 @@ grep -q "does not draw" "$T/err" && bad "a warning without fog or lights" || ok 
     { bad "searchlights render"; cat "$T/err" >&2; }
 has "searchlights status" "lit by its 7 lights and no sun"
 grep -q "sun at" "$T/err" && bad "the searchlights' status names a sun" || ok "the searchlights' status names no sun"
+
+# --- an all-zero volume: said to be empty, not told to raise a density scale that cannot help
+python3 -c "
+import json, struct
+open('$T/z.cloud.raw', 'wb').write(struct.pack('<512f', *([0.0] * 512)))
+json.dump({'dims': [8, 8, 8], 'voxel_size_m': 100, 'origin_m': [0, 0, 0],
+           'fields': [{'name': 'cloud', 'particle': 'cloud', 'file': 'z.cloud.raw'}]}, open('$T/z.json', 'w'))
+" || bad "writing the empty volume"
+"$A" render --volume "$T/z.json" --width 8 --height 8 -o "$T/z.png" >/dev/null 2>"$T/err" ||
+    { bad "render of an empty volume"; cat "$T/err" >&2; }
+has "empty volume" "empty: every value is 0"
+grep -q "raise --density-scale" "$T/err" && bad "an empty volume is told to raise --density-scale" ||
+    ok "an empty volume is not told to raise --density-scale"
 exit $fail
