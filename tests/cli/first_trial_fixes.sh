@@ -122,4 +122,13 @@ has "raw without a sidecar" "sidecar"
 has "compare a PNG" "not an HDR input"
 has "compare a PNG" ".pfm"
 hasnt "compare a PNG" "not a readable OpenEXR"
+
+# --- 9. -o X.exr takes --exr-layers when there is no --exr; a PNG output alone still refuses them
+"$A" render --volume "$T/v.json" $small --exr-layers tau,transmittance -o "$T/l.exr" -q 2>"$T/err" ||
+    { bad "-o X.exr with --exr-layers"; cat "$T/err" >&2; }
+grep -aq "transmittance.Y" "$T/l.exr" 2>/dev/null && grep -aq "tau.Y" "$T/l.exr" && ok "-o X.exr holds the layers" ||
+    bad "-o X.exr without the layers"
+"$A" render --volume "$T/v.json" $small --exr-layers tau -o "$T/l.png" >/dev/null 2>"$T/err"
+[ $? -eq 2 ] && ok "--exr-layers with a PNG output alone: usage error" || bad "--exr-layers with a PNG output accepted"
+has "--exr-layers without an EXR" "-o FILE.exr"
 exit $fail

@@ -220,7 +220,8 @@ static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, co
     atmos_exr_desc ed = {fs->exr_half, NULL};
     if (w->exr) st = write_exr_layers(ctx, plan, fs, lin, w->exr, &ed, o->exr_layers);
     if (st == ATMOS_OK && w->pfm) st = atmos_write_pfm(ctx, lin, w->pfm);
-    if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_EXR) st = atmos_write_exr(ctx, lin, w->out, &ed);
+    if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_EXR) /* the layers go in --exr's file if there is one */
+        st = write_exr_layers(ctx, plan, fs, lin, w->out, &ed, w->exr ? 0 : o->exr_layers);
     if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_PFM) st = atmos_write_pfm(ctx, lin, w->out);
     if (st == ATMOS_OK && atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH) st = write_path_aux(ctx, plan, w, lin);
     if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_PNG) {

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 enum {
     O_EXR = 256, O_PFM, O_PNGBITS, O_EXRHALF, O_W, O_H, O_CAM, O_ALT, O_SEL, O_SAZ, O_TIME, O_LAT, O_LON, O_SPECTRAL,
@@ -259,7 +260,10 @@ static int check_options(const render_opts *o)
     if (o->mpi && (o->variance || o->order || (o->exr_layers & (RENDER_LAYER_ORDER | RENDER_LAYER_VARIANCE))))
         return cli_usage_error(C, "--variance, --order and the order and variance layers are not written with --mpi "
                                   "(each rank holds its own samples)");
-    if (o->exr_layers && !o->exr) return cli_usage_error(C, "--exr-layers: they go in the --exr file; give one");
+    const size_t olen = o->png ? strlen(o->png) : 0; /* -o X.exr takes the layers when there is no --exr */
+    const int out_exr = olen > 4 && !strcasecmp(o->png + olen - 4, ".exr");
+    if (o->exr_layers && !o->exr && !out_exr)
+        return cli_usage_error(C, "--exr-layers: they go in the EXR file (--exr FILE or -o FILE.exr); give one");
     if (o->mpi && o->scene_path && !strcmp(o->scene_path, "-"))
         return cli_usage_error(C, "--mpi: the scene must be a file (standard input reaches rank 0 only)");
     if (o->time_end && (!isnan(o->sun_el_end) || !isnan(o->sun_az_end)))
@@ -644,10 +648,11 @@ void render_opts_help(void)
            "      --exr-half          write EXR as 16-bit half floats (default: 32-bit float); values\n"
            "                          beyond the largest half (65504, e.g. the sun's disc) are clamped\n"
            "                          to 65504 with a warning\n"
-           "      --exr-layers LIST   more layers in the --exr file beside R,G,B,A (comma-separated):\n"
-           "                          tau (tau.Y, the volume's optical depth along the pixel's ray),\n"
-           "                          transmittance (transmittance.Y = exp(-tau)), and with the path\n"
-           "                          tracer order (order.Y) and variance (variance.<nm>nm, variance.Y)\n"
+           "      --exr-layers LIST   more layers in the EXR file (--exr, else -o X.exr) beside R,G,B,A,\n"
+           "                          comma-separated: tau (tau.Y, the volume's optical depth along the\n"
+           "                          pixel's ray), transmittance (transmittance.Y = exp(-tau)), and with\n"
+           "                          the path tracer order (order.Y) and variance (variance.<nm>nm,\n"
+           "                          variance.Y)\n"
            "      --tau FILE.pfm      also write the volume's optical depth along each pixel's ray\n"
            "                          (middle wavelength of the set; a key for atmos compare --by)\n"
            "      --variance FILE.exr path: per-pixel variance of the mean (channels var_<nm>nm per\n"
