@@ -72,7 +72,7 @@ static void check_row(atmos_context *ctx, atmos_renderer_kind r, const atmos_set
     }
 }
 
-/* atmos render's --help names every option of the tables. */
+/* atmos render's --help names every option of the tables, with its doc. */
 static void check_help(void)
 {
     const char *cli = getenv("ATMOS_CLI");
@@ -83,6 +83,15 @@ static void check_help(void)
     CHECK(system(cmd) == 0);
     size_t n = 0;
     char *text = (char *)test_slurp(out, &n);
+    /* --help wraps the docs at 100 columns: every run of spaces and line breaks read as one space */
+    size_t w = 0;
+    for (size_t i = 0; text && i < n; i++) {
+        const int sp = text[i] == ' ' || text[i] == '\n';
+        if (sp && w > 0 && text[w - 1] == ' ') continue;
+        text[w++] = sp ? ' ' : text[i];
+    }
+    n = w;
+    if (text) text[n] = 0;
     for (int r = ATMOS_RENDERER_SLICE; text && r <= ATMOS_RENDERER_LAST; r++) {
         int count;
         const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &count);
@@ -101,7 +110,7 @@ static void check_help(void)
             int found = 0;
             for (const char *at = vol; !found && (at = strstr(at, *nm)) && at < end; at += strlen(*nm)) {
                 const char before = at[-1], after = at[strlen(*nm)];
-                found = (before == ' ' || before == ':') && (after == ',' || after == ')' || after == ';' || after == '\n');
+                found = (before == ' ' || before == ':') && (after == ',' || after == ')' || after == ';' || after == ' ');
             }
             CHECK_MSG(found, "render --help's --volume paragraph lacks %s %s", k ? "simulate:" : "generate:", *nm);
         }
