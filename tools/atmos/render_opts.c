@@ -590,9 +590,11 @@ static void help_settings(atmos_renderer_kind r, const char *title)
             snprintf(range, sizeof range, " [%s%s, %s%s%s%s], default %s", s->min_open ? "> " : "", num(a, sizeof a, s->min),
                      num(b, sizeof b, s->max), s->max_open ? ")" : "", s->unit[0] ? " " : "", s->unit,
                      num(c, sizeof c, s->def));
-        for (char *q = range + 1; *q; q++) /* " [min, max unit], default d": the bracket unbroken */
-            if (*q == ' ' && q[-1] != ']' && q[-1] != ',') *q = NBSP;
-            else if (*q == ' ' && q[-1] == ',' && strchr(q, ']')) *q = NBSP;
+        int inside = 0; /* " [min, max unit], default d": the bracket and "default d" unbroken */
+        for (char *q = range + 1; *q; q++) {
+            inside = *q == '[' ? 1 : *q == ']' ? 0 : inside;
+            if (*q == ' ' && (inside || q[-1] == 't')) *q = NBSP;
+        }
         char text[1024];
         snprintf(text, sizeof text, "%s%s%s", strncmp(s->flag, "no-", 3) ? "" : "turns off (on by default): ", s->doc,
                  range);
