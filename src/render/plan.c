@@ -65,12 +65,11 @@ static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const
 static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
 {
     if (s->renderer == ATMOS_RENDERER_BEAMS || s->renderer == ATMOS_RENDERER_PATH) return;
-    const char *part[3] = {s->fog.enabled ? "fog" : NULL, s->light_count > 0 ? "lights" : NULL,
-                           s->object_count > 0 ? "objects" : NULL};
     const char *in_list[3];
     int n = 0;
-    for (int i = 0; i < 3; i++)
-        if (part[i]) in_list[n++] = part[i];
+    if (s->fog.enabled) in_list[n++] = "fog";
+    if (s->light_count > 0) in_list[n++] = "lights";
+    if (s->object_count > 0) in_list[n++] = "objects";
     char list[64] = "";
     for (int i = 0; i < n; i++) {
         if (i) strcat(list, i == n - 1 ? " and " : ", ");
