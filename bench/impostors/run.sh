@@ -4,7 +4,9 @@
 # 0.5 and 1 degree, and with every particle splatted every frame (the reference); per
 # tolerance the frames' mean absolute difference from the reference (8-bit display values, as
 # the viewer shows them, over all pixels and over the pixels the clouds change), the impostor
-# updates per frame and the frame times (median and the slowest 1 %).
+# updates per frame and the frame times (median and the slowest 1 %). Every out-of-date
+# impostor is made each frame (--impostor-budget 0), and then at 0.15 degree with the viewer's
+# budgets of 2 and 8 impostors a frame (rows "0.15/b2", "0.15/b8").
 #
 #   bench/impostors/run.sh [--atmos BIN] [--frames N] [--size WxH] [--out DIR]
 set -eu
@@ -29,7 +31,11 @@ mkdir -p "$OUT"
     --no-impostors -q
 for tol in 0.15 0.5 1; do
     "$ATMOS" view "$SCENE" --script "$FLIGHT" --frames "$FRAMES" --size "$SIZE" --headless --record "$OUT/t$tol" \
-        --impostor-tolerance "$tol" -q
+        --impostor-tolerance "$tol" --impostor-budget 0 -q
+done
+for b in 2 8; do
+    "$ATMOS" view "$SCENE" --script "$FLIGHT" --frames "$FRAMES" --size "$SIZE" --headless --record "$OUT/t0.15/b$b" \
+        --impostor-tolerance 0.15 --impostor-budget "$b" -q
 done
 python3 - "$OUT" "$FRAMES" <<'PY'
 import csv, os, struct, sys, zlib
@@ -62,7 +68,7 @@ rows, med, slow = times(os.path.join(out, "ref"))
 print("tolerance_deg,mean_abs_diff,max_frame_mean_abs_diff,updates_per_frame,median_ms,p99_ms")
 print("none (every particle),0,0,0,%.1f,%.1f" % (med, slow))
 step = max(1, frames // 24)
-for tol in ("0.15", "0.5", "1"):
+for tol in ("0.15", "0.5", "1", "0.15/b2", "0.15/b8"):
     d = os.path.join(out, "t" + tol)
     rows, med, slow = times(d)
     diffs = []

@@ -75,6 +75,10 @@ typedef struct atmos_frame {
                                    sun's (2-3 times faster, but the image then depends on the frames before it
                                    to the solver's tolerance: the viewer); 0 builds it afresh, so that a frame
                                    is the same however it was reached (renders, animations, MPI ranks) */
+    int impostor_budget;        /* Harris's renderer: at most this many impostors made again this frame, the
+                                   most out of date first, the others drawn as they are until a later frame
+                                   (the viewer's frames: the updates spread over frames); impostors never
+                                   made and a split cloud's parts always made; 0 = every stale one */
     atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
 } atmos_frame;
 
@@ -126,6 +130,8 @@ typedef struct atmos_plan_stats {
     atmos_slice_timing slice;   /* slice renderer */
     atmos_path_stats path;      /* path tracer */
     int impostor_updates;       /* Harris's renderer: impostors made again this frame */
+    int impostors_held;         /* Harris's renderer: out-of-date impostors the frame's budget left as they
+                                   were (the same frame rendered again makes them; not reused meanwhile) */
 } atmos_plan_stats;
 ATMOS_API void atmos_plan_get_stats(const atmos_plan *plan, atmos_plan_stats *out);
 

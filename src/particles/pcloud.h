@@ -191,6 +191,11 @@ int atmos__pimpostor_res(double r, double d, double f, int max_res);
  * translation error), and im's texels at least what the view needs (the resolution error). */
 int atmos__pimpostor_serves(const atmos__pimpostor *im, const double c[3], double r, const double e[3], double tol,
                             double f, int max_res);
+/* How far im is from serving the eye e (the larger of the angle round the centre over tol and
+ * the texels needed over im's): above 1 where atmos__pimpostor_serves says no, INFINITY for an
+ * impostor never made or the eye inside the sphere. Orders the impostors to make again. */
+double atmos__pimpostor_error(const atmos__pimpostor *im, const double c[3], double r, const double e[3], double tol,
+                              double f, int max_res);
 /* Makes im for the eye e: the particles idx[0..nidx) splatted by a camera at e looking at c
  * whose field just holds the sphere of radius r. */
 atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,

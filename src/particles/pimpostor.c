@@ -29,6 +29,19 @@ int atmos__pimpostor_serves(const atmos__pimpostor *im, const double c[3], doubl
     return atmos__pimpostor_res(r, sqrt(lb), f, max_res) <= im->res;
 }
 
+double atmos__pimpostor_error(const atmos__pimpostor *im, const double c[3], double r, const double e[3], double tol,
+                              double f, int max_res)
+{
+    if (!im->valid) return INFINITY;
+    double a[3], b[3], la = 0, lb = 0, ab = 0;
+    for (int i = 0; i < 3; i++) a[i] = im->view[i] - c[i], b[i] = e[i] - c[i];
+    for (int i = 0; i < 3; i++) la += a[i] * a[i], lb += b[i] * b[i], ab += a[i] * b[i];
+    if (lb <= r * r) return INFINITY;
+    const double ang = acos(fmax(-1.0, fmin(1.0, ab / sqrt(la * lb))));
+    const double texels = (double)atmos__pimpostor_res(r, sqrt(lb), f, max_res) / im->res;
+    return fmax(tol > 0 ? ang / tol : (ang > 0 ? INFINITY : 0.0), texels);
+}
+
 atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
                                    const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
                                    const double c[3], double r, const double e[3], int res)

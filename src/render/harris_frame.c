@@ -206,6 +206,36 @@ static atmos_status draw_pass(const atmos_plan *p, atmos__harris_plan *h, const 
     return st;
 }
 
+/* Holds the whole-cloud impostors to make again (stale[0..n), entries 3 k) to the frame's budget:
+ * those out of date by the most pixels (the error over the tolerance times the texels the view
+ * needs) are made, the others drawn as they are (how 3); impostors never made and split
+ * clouds' parts are always made. Returns the new count. */
+static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how,
+                          int *stale, int n, atmos__keyed *key)
+{
+    const atmos_scene_harris *hs = &p->scene.harris;
+    const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
+    const double tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
+    int m = 0, kept = 0;
+    for (int q = 0; q < n; q++) {
+        const int k = stale[q] / 3;
+        double d2 = 0;
+        for (int a = 0; a < 3; a++) d2 += (e[a] - h->clouds.centre[k][a]) * (e[a] - h->clouds.centre[k][a]);
+        const double err = stale[q] % 3 ? INFINITY
+                                         : atmos__pimpostor_error(&h->imp[k], h->clouds.centre[k], h->clouds.radius[k], e,
+                                                                  tol, f, hs->impostor_max_res);
+        if (isinf(err)) stale[kept++] = stale[q]; /* must be made */
+        else key[m].key = err * atmos__pimpostor_res(h->clouds.radius[k], sqrt(d2), f, hs->impostor_max_res),
+             key[m++].index = stale[q];
+    }
+    atmos__keyed_sort(key, (size_t)m, 1);
+    for (int q = 0; q < m; q++) {
+        if (kept < v->impostor_budget) stale[kept++] = key[q].index;
+        else how[key[q].index / 3] = 3, h->held++;
+    }
+    return kept;
+}
+
 /* The modes of the clouds (how), the split (side, hp) and the impostors to make again (stale). */
 static int modes(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const int rect[4], int *how,
                  int *side, int *hp, int *stale)
@@ -222,6 +252,11 @@ static int modes(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *
         for (int pass = 0; pass < 2; pass++)
             if ((hp[2 * k + pass] = part_mode(p, h, v, k, pass)) == 4) stale[nstale++] = 3 * k + 1 + pass;
     }
+    if (v->impostor_budget <= 0 || nstale <= v->impostor_budget) return nstale;
+    atmos__keyed *key = malloc(sizeof *key * (size_t)nstale);
+    if (!key) return nstale; /* no room to choose: every stale one made */
+    nstale = hold_to_budget(p, h, v, how, stale, nstale, key);
+    free(key);
     return nstale;
 }
 
@@ -247,7 +282,7 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
         ord[k].key = d2, ord[k].index = k;
     }
     atmos__keyed_sort(ord, (size_t)nc, 1);
-    h->drawn = h->updates = h->direct = 0;
+    h->drawn = h->updates = h->direct = h->held = 0;
     const size_t cap = nc > 0 ? (size_t)nc : 1;
     int *how = malloc(sizeof(int) * 7 * cap), *side = how ? how + cap : NULL, *hp = how ? how + 2 * cap : NULL;
     int *stale = how ? how + 4 * cap : NULL;
@@ -263,6 +298,6 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     if (st == ATMOS_OK) st = draw_pass(p, h, v, ap, ord, &fp, 1, rect, out, ims, cs, rs);
     free(how), free(ims), free(cs), free(rs);
     free(ord);
-    p->stats.impostor_updates = h->updates;
+    p->stats.impostor_updates = h->updates, p->stats.impostors_held = h->held;
     return st;
 }

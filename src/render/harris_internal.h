@@ -57,7 +57,7 @@ struct atmos__harris_plan {
     float *air_t, *air_l;                /* the air from the eye to each particle, this frame */
     atmos__aerial aerial;
     double sun[3];
-    int have_sun, drawn, updates, direct;
+    int have_sun, drawn, updates, direct, held;
     double shade_s;
 };
 

@@ -218,6 +218,10 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
     v->sky_step = f->sky_step > 1 ? f->sky_step : 1;
     v->no_air_shadows = f->no_air_shadows != 0;
     v->warm_field = f->warm_field != 0;
+    v->impostor_budget = f->impostor_budget;
+    if (f->impostor_budget < 0)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: impostor_budget must be >= 0 (0: no limit), got %d",
+                            f->impostor_budget);
     if (f->sky_step < 0 || f->sky_step > 16)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: sky_step must be in [0, 16], got %d", f->sky_step);
     if (v->samples_per_pixel < 1 || v->samples_per_pixel > 256)
@@ -400,7 +404,9 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
     } else {
         st = atmos__path_render(p, &v, &r, out, &stats->path);
     }
-    if (st == ATMOS_OK && !stats->reused) st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH);
+    /* a frame the impostor budget left unfinished is not kept: the same frame again finishes it */
+    if (st == ATMOS_OK && !stats->reused)
+        st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH && !stats->impostors_held);
     if (st != ATMOS_OK) {
         p->have_last = 0;
         return st;

@@ -261,6 +261,18 @@ static void impostors(void)
     const double near[3] = {c1[0], c1[1], c1[2] + 2 * cl.radius[0]}, inside[3] = {c1[0], c1[1], c1[2] + 10};
     CHECK(!atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], near, 0.1, f, 512)); /* too coarse */
     CHECK(!atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], inside, 3.0, f, 512));
+    /* how far out of date: the angle round the centre over the tolerance, the texels wanted over
+     * those made; never made or inside the sphere: infinite */
+    const double deg = 3.141592653589793 / 180;
+    CHECK(atmos__pimpostor_error(&im, cl.centre[0], cl.radius[0], eye, 0.15 * deg, f, 512) <= 1.0);
+    const double e2 = atmos__pimpostor_error(&im, cl.centre[0], cl.radius[0], eye2, 0.15 * deg, f, 512);
+    printf("impostor error 0.5 degree round, tolerance 0.15: %.4f (expect 3.333)\n", e2);
+    CHECK(fabs(e2 - 0.5 / 0.15) < 0.01);
+    CHECK(atmos__pimpostor_error(&im, cl.centre[0], cl.radius[0], near, 0.1, f, 512) > 1.0);
+    CHECK(isinf(atmos__pimpostor_error(&im, cl.centre[0], cl.radius[0], inside, 3.0, f, 512)));
+    atmos__pimpostor never;
+    memset(&never, 0, sizeof never);
+    CHECK(isinf(atmos__pimpostor_error(&never, cl.centre[0], cl.radius[0], eye, 0.15 * deg, f, 512)));
     atmos__pimpostor_free(&im);
     atmos_image_destroy(direct), atmos_image_destroy(imp);
     free(light), free(order);

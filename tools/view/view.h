@@ -164,6 +164,7 @@ void view_window_push_key(view_window *win, int sym);
 /* ---- view_cmd.c, view_loop.c */
 typedef struct view_opts {
     int width, height, frames, headless;
+    int impostor_budget; /* Harris's impostors made again a frame at most (0: all stale ones) */
     const char *script, *record, *save_base, *press;
     int passed;          /* arguments left for atmos render's parser */
     char **pass;

@@ -20,7 +20,7 @@ static void help(void)
 {
     printf("Usage: atmos view [SCENE.json] [--volume FILE|generate:PRESET] [--size WxH] [--script FLIGHT.json]\n"
            "                  [--frames N] [--record DIR] [--headless] [--press KEYS] [--save-base BASE]\n"
-           "                  [atmos render's scene options]\n\n"
+           "                  [--impostor-budget N] [atmos render's scene options]\n\n"
            "Opens a window on a scene (or the built-in default; a volume with --volume) and renders it\n"
            "with atmos's renderers on the CPU as you fly around it, move the sun or scrub the time of\n"
            "day. The renderers keep their plans: a frame recomputes only what changed. While the\n"
@@ -41,6 +41,10 @@ static void help(void)
            "                     through the window's event queue as a user's keys\n"
            "  --save-base BASE   where F12/P saves: BASE_NNN.exr, .png, .json (default view_NNN in the\n"
            "                     current folder); the .json renders the same frame with atmos render\n"
+           "  --impostor-budget N  Harris's renderer: make at most N out-of-date impostors a frame, the\n"
+           "                     most out of date first; the others are drawn as they are and caught up\n"
+           "                     over the next frames (default 2; 0: all of them every frame, as F12's\n"
+           "                     saves and atmos render do)\n"
            "  --help             this text\n"
            "Scene options are atmos render's (atmos render --help): --renderer, --volume, --sun-elevation,\n"
            "--time, --spp, -D KEY=VALUE, --threads, ...\n\n");
@@ -51,7 +55,7 @@ static void help(void)
 static int parse(int argc, char **argv, view_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->width = 960, o->height = 540;
+    o->width = 960, o->height = 540, o->impostor_budget = 2;
     o->pass = calloc((size_t)argc + 1, sizeof *o->pass);
     if (!o->pass) return CLI_EXIT_RUNTIME;
     o->pass[o->passed++] = argv[0];
@@ -65,6 +69,8 @@ static int parse(int argc, char **argv, view_opts *o)
                 return cli_usage_error("view", "--size: expected WxH in 1..8192, got '%s'", v ? v : "");
         } else if (cli_take_value(argc, argv, &i, "--frames", &v)) {
             if (!v || !cli_parse_int("view", "--frames", v, 1, 10000000, &o->frames)) return CLI_EXIT_USAGE;
+        } else if (cli_take_value(argc, argv, &i, "--impostor-budget", &v)) {
+            if (!v || !cli_parse_int("view", "--impostor-budget", v, 0, 1000000, &o->impostor_budget)) return CLI_EXIT_USAGE;
         } else if (cli_take_value(argc, argv, &i, "--script", &v)) {
             if (!(o->script = v)) return cli_usage_error("view", "--script needs a file");
         } else if (cli_take_value(argc, argv, &i, "--record", &v)) {
