@@ -210,6 +210,9 @@ typedef struct atmos_scene_animation {
     double elevation_end_deg;  /* the last frame's sun elevation, [-90, 90] */
     int azimuth_end_set;       /* 1: azimuth_end_deg given (a sun given by angles) */
     double azimuth_end_deg;    /* the last frame's sun azimuth, [0, 360) */
+    int minutes_end_set;       /* 1: minutes_end given (a simulated volume: a time-lapse) */
+    double minutes_end;        /* the last frame's simulated minutes; frame i's volume.sim_minutes goes
+                                  linearly from the volume's (its preset's default when 0) to this */
 } atmos_scene_animation;
 
 /* The Earth's maps and clouds of a spherical atmosphere ("atmosphere" keys "ground_map",

@@ -74,6 +74,11 @@ ATMOS_API void atmos_sim_get_stats(const atmos_sim *sim, atmos_sim_stats *out);
  * atmos_particle_mean_mass), voxels the model's cells, y up with the ground at y = 0 and the
  * domain centred on x = z = 0. */
 ATMOS_API atmos_status atmos_sim_to_volume(atmos_context *ctx, const atmos_sim *sim, atmos_volume **out);
+/* A time-lapse: the volume at `minutes` of simulated time, the same bytes as atmos_simulate
+ * with those minutes gives, from a simulation that goes on from where the last call left it:
+ * sim is advanced by whole steps up to that time (never past it) and the last, shortened step
+ * is taken on a copy. minutes must not be less than sim's time (ATMOS_E_INVALID_ARG). */
+ATMOS_API atmos_status atmos_sim_volume_at(atmos_context *ctx, atmos_sim *sim, double minutes, atmos_volume **out);
 /* create + run(desc->minutes, or the preset's default) + to_volume. */
 ATMOS_API atmos_status atmos_simulate(atmos_context *ctx, const atmos_sim_desc *desc, atmos_volume **out);
 

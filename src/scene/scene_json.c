@@ -1258,7 +1258,8 @@ static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atm
 
 static atmos_status parse_animation(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"frames", "time_end", "elevation_end_deg", "azimuth_end_deg"};
+    static const char *const keys[] = {"frames", "time_end", "elevation_end_deg", "azimuth_end_deg", "minutes_end"};
+    static const atmos__range r_minutes = {0, ATMOS_SIM_MAX_MINUTES, 1, 0};
     /* 0 and 1: a single image (0 = no animation, include/atmos/scene.h), so -D animation.frames=0
      * turns a scene's animation off */
     static const atmos__range r_frames = {0, ATMOS_SCENE_MAX_FRAMES, 0, 0};
@@ -1269,12 +1270,16 @@ static atmos_status parse_animation(const jp *p, const cJSON *j, const char *pat
     const cJSON *v;
     const char *text = NULL;
     int k;
-    TRY(iter_begin(p, j, path, keys, 4, &it));
+    TRY(iter_begin(p, j, path, keys, 5, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
         switch (k) {
         case 0: TRY(get_int(p, v, ip, &r_frames, &a.frames)); break;
+        case 4:
+            TRY(get_number(p, v, ip, &r_minutes, NULL, &a.minutes_end));
+            a.minutes_end_set = 1;
+            break;
         case 1:
             TRY(get_string(p, v, ip, &text));
             TRY(parse_time(p, text, ip, &a.time_end));

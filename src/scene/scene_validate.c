@@ -333,10 +333,16 @@ atmos_status atmos__scene_validate_animation(atmos_context *ctx, const char *sou
         (st = atmos__scene_check_range(ctx, source, "/animation/azimuth_end_deg", a->azimuth_end_deg,
                                        &atmos__r_azimuth, NULL)))
         return st;
-    if (a->frames > 1 && !a->time_end_set && !angle_end)
+    if (a->minutes_end_set && strncmp(scene->volume.source, "simulate:", 9) != 0)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/minutes_end",
+                                 "needs a simulated volume (\"volume\": {\"simulate\": {...}}): a time-lapse of its growth");
+    if (a->minutes_end_set && !(a->minutes_end > 0 && a->minutes_end <= ATMOS_SIM_MAX_MINUTES))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/minutes_end", "must be in (0, %g], got %g",
+                                 ATMOS_SIM_MAX_MINUTES, a->minutes_end);
+    if (a->frames > 1 && !a->time_end_set && !angle_end && !a->minutes_end_set)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation",
-                                 "%d frames need an end: time_end (a sun given by time) or elevation_end_deg/"
-                                 "azimuth_end_deg (a sun given by angles)", a->frames);
+                                 "%d frames need an end: time_end (a sun given by time), elevation_end_deg/"
+                                 "azimuth_end_deg (a sun given by angles) or minutes_end (a simulated volume)", a->frames);
     return ATMOS_OK;
 }
 

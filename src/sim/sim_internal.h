@@ -92,6 +92,11 @@ static inline size_t sim_idx(const atmos_sim *s, int i, int j, int k)
     return ((size_t)k * s->ny + j) * s->nx + i;
 }
 
+/* Runs to the time `end` (s), the last step shortened to end there, or with whole_steps only
+ * the steps that end at or before it (a time-lapse's run: sim_timelapse.c); progress as
+ * atmos_sim_run's (sim_step.c). */
+atmos_status atmos__sim_run_to(atmos_context *ctx, atmos_sim *s, double end, int whole_steps);
+
 /* Presets (sim_presets.c). NULL if unknown. */
 const sim_env *atmos__sim_preset(const char *name);
 

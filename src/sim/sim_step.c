@@ -54,25 +54,33 @@ atmos_status atmos_sim_step(atmos_context *ctx, atmos_sim *s)
     return ATMOS_OK;
 }
 
-atmos_status atmos_sim_run(atmos_context *ctx, atmos_sim *s, double seconds)
+atmos_status atmos__sim_run_to(atmos_context *ctx, atmos_sim *s, double end, int whole_steps)
 {
-    if (!s) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: no simulation");
-    if (!(seconds >= 0 && seconds <= ATMOS_SIM_MAX_MINUTES * 60))
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: %g s is out of range [0, %g]", seconds,
-                            ATMOS_SIM_MAX_MINUTES * 60);
-    const double end = s->t + seconds;
+    const double t0 = s->t, span = end - t0;
     if (atmos__progress(ctx, "simulate", 0.0)) return atmos__error(ctx, ATMOS_E_CANCELLED, "simulate: cancelled");
     while (s->t < end - 1e-9) {
         double dt = time_step(s);
         /* winds over 300 m/s (or NaN) mean the model has blown up: stop rather than crawl */
         if (!(dt >= 1.5 * s->dx / 300.0) || !isfinite(s->th[0]))
             return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: the model became unstable at t = %g s", s->t);
-        if (s->t + dt > end) dt = end - s->t;
+        if (s->t + dt > end) {
+            if (whole_steps) break;
+            dt = end - s->t;
+        }
         advance(s, dt);
-        if (atmos__progress(ctx, "simulate", seconds > 0 ? 1.0 - (end - s->t) / seconds : 1.0))
+        if (atmos__progress(ctx, "simulate", span > 0 ? (s->t - t0) / span : 1.0))
             return atmos__error(ctx, ATMOS_E_CANCELLED, "simulate: cancelled at t = %g s", s->t);
     }
     return ATMOS_OK;
+}
+
+atmos_status atmos_sim_run(atmos_context *ctx, atmos_sim *s, double seconds)
+{
+    if (!s) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: no simulation");
+    if (!(seconds >= 0 && seconds <= ATMOS_SIM_MAX_MINUTES * 60))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: %g s is out of range [0, %g]", seconds,
+                            ATMOS_SIM_MAX_MINUTES * 60);
+    return atmos__sim_run_to(ctx, s, s->t + seconds, 0);
 }
 
 void atmos_sim_get_stats(const atmos_sim *s, atmos_sim_stats *o)

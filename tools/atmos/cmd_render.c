@@ -7,6 +7,7 @@
 #include "dist.h"
 #include "render_layers.h"
 #include "render_scene.h"
+#include "render_timelapse.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -282,63 +283,106 @@ typedef struct {
     cli_outputs set;
 } frame_outputs;
 
-/* Every frame of the scene's animation from the one plan; frame 1's outputs are staged
- * already (fo), the others are staged here, and each frame's are renamed into place once
- * all of them are written. Returns a status; *failed_frame names the frame that failed. */
-static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan, const atmos_scene *scene, const render_opts *o,
-                                  const char *png, const char *source, cli_progress *prog, frame_outputs *fo,
-                                  int *failed_frame, const cli_dist *d)
+/* Frame fs's plan: the one plan (*own NULL), or for a time-lapse's frames after the first a
+ * plan of its own with the frame's volume (*own, *vol: the caller destroys them). */
+static atmos_status frame_plan(atmos_context *ctx, atmos_plan *plan, const atmos_scene *fs, int frame,
+                               render_timelapse *tl, atmos_plan **use, atmos_plan **own, atmos_volume **vol)
 {
-    const int nframes = scene->animation.frames > 1 ? scene->animation.frames : 1;
-    const cli_file_kind out_kind = png ? cli_file_kind_of(png) : CLI_FILE_OTHER;
-    exposure_lock xl = {nframes > 1 && !o->exposure_per_frame, 0, 0};
-    atmos_image *spec = NULL;
+    *use = plan, *own = NULL, *vol = NULL;
+    if (!tl || frame == 1) return ATMOS_OK;
+    atmos_status st = render_timelapse_volume(ctx, tl, fs, vol);
+    if (st == ATMOS_OK) st = atmos_plan_create(ctx, fs, *vol, NULL, own);
+    if (st == ATMOS_OK) *use = *own;
+    return st;
+}
+
+/* What every frame of one render shares. */
+typedef struct frames_run {
+    atmos_context *ctx;
+    const render_opts *o;
+    const char *png, *source;
+    cli_progress *prog;
+    frame_outputs *fo;
+    const cli_dist *d;
+    int nframes;
+    cli_file_kind out_kind;
+    exposure_lock xl;
+    atmos_image *spec;
+    double total;
+} frames_run;
+
+/* Frame `frame` (scene fs) rendered from plan by its owner (-1: all ranks) and written by rank
+ * 0; ready: the frame's plan's status (a failure is passed to rank 0 as the render's). */
+static atmos_status render_frame(frames_run *r, atmos_plan *plan, const atmos_scene *fs, int frame, int owner,
+                                 atmos_status ready)
+{
+    const cli_dist *d = r->d;
+    atmos_frame f;
+    atmos_render_info info;
+    memset(&info, 0, sizeof info);
+    char label[64];
+    snprintf(label, sizeof label, "%d/%d", frame, r->nframes);
+    atmos_status st = ready;
+    if (st == ATMOS_OK) st = atmos_frame_from_scene(r->ctx, fs, &f);
+    if (st == ATMOS_OK && !r->spec) st = atmos_plan_image_create(plan, &f, &r->spec);
+    if (st == ATMOS_OK || owner >= 0) {
+        if (st != ATMOS_OK) { /* the owner's failure goes to rank 0 as its render's */
+        } else if (owner < 0) st = cli_dist_render(d, plan, &f, r->spec, &info);
+        else if (owner == d->rank) st = atmos_plan_render(plan, &f, NULL, r->spec, &info);
+        else st = cli_dist_recv(d, owner, r->spec, &info);
+    }
+    if (d->rank != 0) return owner >= 0 ? cli_dist_send(d, r->spec, st, &info) : st;
+    if (st != ATMOS_OK) return st;
+    if (r->fo->w.tau && (st = write_tau(r->ctx, fs, plan, r->fo->w.tau)) != ATMOS_OK) return st;
+    st = write_outputs(r->ctx, plan, fs, r->spec, &r->fo->w, r->out_kind, r->source, r->nframes > 1 ? label : NULL, &r->xl, r->o);
+    if (st != ATMOS_OK) return st;
+    if (cli_outputs_commit("render", &r->fo->set) != 0) return ATMOS_E_IO;
+    r->total += info.seconds;
+    if (!r->o->quiet) {
+        if (r->prog->shown) fputc('\n', stderr), r->prog->shown = 0;
+        report_frame(plan, fs, &r->fo->ff, r->source, &info, frame, r->nframes, owner >= 0 ? owner : (d->size > 1 ? -1 : 0));
+    }
+    return ATMOS_OK;
+}
+
+/* Every frame of the scene's animation from the one plan (a time-lapse: a plan a frame, tl);
+ * frame 1's outputs are staged already (fo), the others are staged here, and each frame's are
+ * renamed into place once all of them are written. Returns a status; *failed_frame names the
+ * frame that failed. */
+static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const atmos_scene *scene, const render_opts *o,
+                                  const char *png, const char *source, cli_progress *prog, frame_outputs *fo,
+                                  int *failed_frame, const cli_dist *d, render_timelapse *tl)
+{
+    frames_run r = {ctx, o, png, source, prog, fo, d, scene->animation.frames > 1 ? scene->animation.frames : 1,
+                    png ? cli_file_kind_of(png) : CLI_FILE_OTHER, {0, 0, 0}, NULL, 0};
+    r.xl.lock = r.nframes > 1 && !o->exposure_per_frame;
     atmos_status st = ATMOS_OK;
-    double total = 0;
-    for (int frame = 1; frame <= nframes && st == ATMOS_OK; frame++) {
+    for (int frame = 1; frame <= r.nframes && st == ATMOS_OK; frame++) {
         *failed_frame = frame;
-        atmos_scene fs;
-        atmos_frame f;
-        atmos_render_info info;
-        char label[64];
-        snprintf(label, sizeof label, "%d/%d", frame, nframes);
         /* --mpi: an animation's frame is rendered by its owner and written by rank 0; a single
          * image is rendered by all ranks. */
-        const int owner = nframes > 1 ? cli_dist_frame_owner(d, frame) : -1;
+        const int owner = r.nframes > 1 ? cli_dist_frame_owner(d, frame) : -1;
         if (d->rank != 0 && owner >= 0 && owner != d->rank) continue;
-        if (frame > 1 && d->rank == 0 && stage_frame(o, png, frame, nframes, &fo->ff, &fo->set, &fo->w) != CLI_EXIT_OK) {
+        if (frame > 1 && d->rank == 0 && stage_frame(o, png, frame, r.nframes, &fo->ff, &fo->set, &fo->w) != CLI_EXIT_OK) {
             st = ATMOS_E_IO;
             break;
         }
+        atmos_scene fs;
         if ((st = atmos_scene_animation_frame(ctx, scene, frame - 1, &fs)) != ATMOS_OK) break;
-        if ((st = atmos_frame_from_scene(ctx, &fs, &f)) != ATMOS_OK) break;
-        if (!spec && (st = atmos_plan_image_create(plan, &f, &spec)) != ATMOS_OK) break;
-        if (owner < 0) st = cli_dist_render(d, plan, &f, spec, &info);
-        else if (owner == d->rank) st = atmos_plan_render(plan, &f, NULL, spec, &info);
-        else st = cli_dist_recv(d, owner, spec, &info);
-        if (d->rank != 0) {
-            if (owner >= 0) st = cli_dist_send(d, spec, st, &info);
-            continue;
-        }
-        if (st != ATMOS_OK) break;
-        if (fo->w.tau && (st = write_tau(ctx, &fs, plan, fo->w.tau)) != ATMOS_OK) break;
-        st = write_outputs(ctx, plan, &fs, spec, &fo->w, out_kind, source, nframes > 1 ? label : NULL, &xl, o);
-        if (st != ATMOS_OK) break;
-        if (cli_outputs_commit("render", &fo->set) != 0) {
-            st = ATMOS_E_IO;
-            break;
-        }
-        total += info.seconds;
-        if (!o->quiet) {
-            if (prog->shown) fputc('\n', stderr), prog->shown = 0;
-            report_frame(plan, &fs, &fo->ff, source, &info, frame, nframes, owner >= 0 ? owner : (d->size > 1 ? -1 : 0));
-        }
+        atmos_plan *plan = plan0, *own = NULL;
+        atmos_volume *vol = NULL;
+        const atmos_status ready = owner < 0 || owner == d->rank ? frame_plan(ctx, plan0, &fs, frame, tl, &plan, &own, &vol)
+                                                                  : ATMOS_OK;
+        st = render_frame(&r, plan ? plan : plan0, &fs, frame, owner, ready);
+        atmos_plan_destroy(own), atmos_volume_destroy(vol);
     }
     cli_outputs_discard(&fo->set);
-    atmos_image_destroy(spec);
-    if (st == ATMOS_OK && !o->quiet && nframes > 1)
-        fprintf(stderr, "atmos render: %d frames, %.3f s rendering (one plan: the volume and its optics made once)%s\n",
-                nframes, total, xl.locked ? "; exposure locked at frame 1's" : "");
+    atmos_image_destroy(r.spec);
+    if (st == ATMOS_OK && !o->quiet && r.nframes > 1)
+        fprintf(stderr, "atmos render: %d frames, %.3f s rendering (%s)%s\n", r.nframes, r.total,
+                tl ? "a time-lapse: the simulation carried from frame to frame, a plan a frame"
+                   : "one plan: the volume and its optics made once",
+                r.xl.locked ? "; exposure locked at frame 1's" : "");
     return st;
 }
 
@@ -393,11 +437,18 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     if ((rc = cli_dist_max(d, rc)) != CLI_EXIT_OK) return cli_outputs_discard(&fo.set), rc;
     atmos_plan *plan = NULL;
     int failed = 0;
-    atmos_status st = atmos_plan_create(ctx, scene, volume, NULL, &plan);
+    /* a time-lapse: the first frame's volume from the simulation the frames carry on */
+    render_timelapse tl = {0}, *tlp = render_timelapse_wanted(scene) ? &tl : NULL;
+    atmos_volume *first = NULL;
+    atmos_scene fs0;
+    atmos_status st = ATMOS_OK;
+    if (tlp && (st = atmos_scene_animation_frame(ctx, scene, 0, &fs0)) == ATMOS_OK)
+        st = render_timelapse_volume(ctx, tlp, &fs0, &first);
+    if (st == ATMOS_OK) st = atmos_plan_create(ctx, scene, first ? first : volume, NULL, &plan);
     if (d->size > 1 && (atmos_status)cli_dist_max(d, (int)st) != ATMOS_OK && st == ATMOS_OK) st = ATMOS_E_CANCELLED;
     const double t_plan = cli_now_s() - t0;
     if (st == ATMOS_OK) {
-        st = render_frames(ctx, plan, scene, o, png, source, prog, &fo, &failed, d);
+        st = render_frames(ctx, plan, scene, o, png, source, prog, &fo, &failed, d, tlp);
         *stuck = st != ATMOS_OK && d->rank == 0 && d->size > 1 && nframes > 1;
     }
     cli_outputs_discard(&fo.set);
@@ -414,6 +465,8 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     } else if (st == ATMOS_E_CANCELLED)
         rc = CLI_EXIT_RUNTIME; /* another rank failed and said why */
     atmos_plan_destroy(plan);
+    atmos_volume_destroy(first);
+    render_timelapse_free(&tl);
     return rc;
 }
 
