@@ -230,6 +230,15 @@ AVX2_INLINE __m256 spread_pair(__m128 w, int p) /* lanes p, p + 1 of w, each fou
     return _mm256_permutevar8x32_ps(_mm256_castps128_ps256(w), sel);
 }
 
+/* run8's test for four points. */
+AVX2_INLINE int run4(__m128i i0, __m128i row0, int nx)
+{
+    const __m128i d = _mm_sub_epi32(i0, _mm_setr_epi32(0, 1, 2, 3));
+    const __m128i same = _mm_and_si128(_mm_cmpeq_epi32(d, _mm_shuffle_epi32(d, 0)), _mm_cmpeq_epi32(row0, _mm_shuffle_epi32(row0, 0)));
+    const int first = _mm_cvtsi128_si32(i0);
+    return _mm_movemask_epi8(same) == 0xffff && first + 4 < nx ? first : -1;
+}
+
 AVX2 static void sample4_avx2(const atmos_sim *s, const float *f4, int nz_f, const double *x, const double *y,
                               const double *z, float *out4, int n)
 {
@@ -238,6 +247,19 @@ AVX2 static void sample4_avx2(const atmos_sim *s, const float *f4, int nz_f, con
         lanes4 a;
         if (!setup4(s, nz_f, x + m, y + m, z + m, &a)) {
             sample4_scalar(s, f4, nz_f, x, y, z, out4, m, m + 4);
+            continue;
+        }
+        const int first = run4(a.i0, a.r[0], s->nx);
+        if (first >= 0) { /* point p's corners at first + p and first + p + 1 of each row */
+            for (int p = 0; p < 4; p += 2) {
+                const __m256 ax = spread_pair(a.ax, p), ay = spread_pair(a.ay, p), az = spread_pair(a.az, p);
+                __m256 c[4];
+                for (int q = 0; q < 4; q++) {
+                    const float *row = f4 + 4 * ((size_t)_mm_cvtsi128_si32(a.r[q]) + first + p);
+                    c[q] = lerp8(_mm256_loadu_ps(row), _mm256_loadu_ps(row + 4), ax);
+                }
+                _mm256_storeu_ps(out4 + 4 * (size_t)(m + p), lerp8(lerp8(c[0], c[1], ay), lerp8(c[2], c[3], ay), az));
+            }
             continue;
         }
         int i0[4], i1[4], r[4][4];

@@ -60,10 +60,11 @@ static void test_rows(atmos_context *ctx)
     CHECK_OK(atmos__sim_create_env(ctx, atmos__sim_preset("towering_cumulus"), RX, NY, NZF - 1, 100.0, 1, &s));
     if (!s) return;
     const size_t cells = (size_t)RX * NY * NZF;
-    float *f = malloc(cells * sizeof *f);
+    float *f = malloc(cells * sizeof *f), *f4 = malloc(4 * cells * sizeof *f4);
     for (size_t n = 0; n < cells; n++) f[n] = (float)(u01() * 20.0 - 10.0);
+    for (size_t n = 0; n < 4 * cells; n++) f4[n] = (float)(u01() * 2.0 - 1.0);
     static double x[RN], y[RN], z[RN];
-    static float out[RN], ref_out[RN];
+    static float out[RN], ref_out[RN], out4[4 * RN], ref_out4[4 * RN];
     const double shift[4] = {0.3, -1.45, 0.6, 0.05};
     for (int r = 0; r < 4; r++)
         for (int i = 0; i < RX; i++) {
@@ -76,11 +77,19 @@ static void test_rows(atmos_context *ctx)
     z[3 * RX + 21] = 3.1;  /* one lane a level up */
     atmos__sim_sample_row(s, f, NZF, x, y, z, out, RN);
     atmos__sim_sample_row_scalar(s, f, NZF, x, y, z, ref_out, RN);
-    int bad = 0;
-    for (int m = 0; m < RN; m++) bad += fabs(out[m] - reference(f, RX, NY, 1, 0, x[m], y[m], z[m])) > 1e-4;
+    atmos__sim_sample4_row(s, f4, NZF, x, y, z, out4, RN);
+    atmos__sim_sample4_row_scalar(s, f4, NZF, x, y, z, ref_out4, RN);
+    int bad = 0, bad4 = 0;
+    for (int m = 0; m < RN; m++) {
+        bad += fabs(out[m] - reference(f, RX, NY, 1, 0, x[m], y[m], z[m])) > 1e-4;
+        for (int c = 0; c < 4; c++) bad4 += fabs(out4[4 * m + c] - reference(f4, RX, NY, 4, c, x[m], y[m], z[m])) > 1e-5;
+    }
     CHECK_MSG(bad == 0, "rows: %d samples off the reference", bad);
+    CHECK_MSG(bad4 == 0, "rows: %d packed samples off the reference", bad4);
     CHECK_MSG(!memcmp(out, ref_out, sizeof out), "rows: the vectorised samples differ from the scalar code's");
+    CHECK_MSG(!memcmp(out4, ref_out4, sizeof out4), "rows: the vectorised packed samples differ from the scalar code's");
     free(f);
+    free(f4);
     atmos_sim_destroy(s);
 }
 
