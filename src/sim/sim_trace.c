@@ -2,7 +2,8 @@
  * sim_advect.c): one field, or four fields packed per cell. Positions are in the field's
  * index space, x and y wrap, z clamps to [0, nz_f - 1]. On x86-64 CPUs with AVX2 the
  * corners and weights of four or eight points are found at once and the corners fetched by
- * gathers; every lane does the scalar code's operations in the same order and precision
+ * gathers, or, where the points' corners lie side by side in one grid row (most points of a
+ * row in a smooth wind), by plain loads of the row; every lane does the scalar code's operations in the same order and precision
  * (double positions, float weights and interpolation, no fused multiply-adds), so both paths
  * give the same bits. Points far outside the grid (more than one domain away) or NaN take the
  * scalar path. */
