@@ -55,4 +55,29 @@ if [ -s "$T/pin.pfm" ] && [ -s "$T/fish.pfm" ] && [ -s "$T/eq.pfm" ] && [ -s "$T
     within "$f" "$p" 0.02 && ok "fisheye's axis = pinhole's within 2 % ($f, $p)" || bad "fisheye's axis $f, pinhole's $p"
 fi
 
+# --- 2. options that shape the PNG only, with no PNG written
+"$A" render --width 8 --height 8 --tone reinhard --png-bits 16 --exr "$T/z.exr" -q 2>"$T/err" ||
+    { bad "render --exr with --tone"; cat "$T/err" >&2; }
+has "--tone, --png-bits, no PNG" "--tone, --png-bits"
+has "--tone, --png-bits, no PNG" "no PNG is written"
+"$A" render --width 8 --height 8 --tone reinhard --png-bits 16 -o "$T/z.png" --exr "$T/z2.exr" -q 2>"$T/err" ||
+    bad "render -o PNG with --tone"
+hasnt "-o PNG with --tone" "no PNG is written"
+"$A" render --width 8 --height 8 --exposure 12 --pfm "$T/z.pfm" -q 2>"$T/err" || bad "render --pfm --exposure"
+has "--exposure, no PNG" "--exposure"
+
+# --- 3. an output's format checked before the inputs are read: a missing volume is not
+# what is reported
+"$A" render --volume "$T/missing.vdb" -o "$T/x.jpg" 2>"$T/err"
+[ $? -eq 2 ] && ok "render -o x.jpg: a usage error" || bad "render -o x.jpg: not a usage error"
+has "render -o x.jpg" "x.jpg"
+hasnt "render -o x.jpg" "missing.vdb"
+"$A" volume slice "$T/missing.json" --axis z -o "$T/s.jpg" 2>"$T/err"
+[ $? -eq 2 ] && ok "volume slice -o s.jpg: a usage error" || bad "volume slice -o s.jpg: not a usage error"
+has "volume slice -o s.jpg" ".png"
+hasnt "volume slice -o s.jpg" "missing.json"
+"$A" volume stats "$T/missing.json" --mask-png "$T/m.jpg" 2>"$T/err"
+[ $? -eq 2 ] && ok "volume stats --mask-png m.jpg: a usage error" || bad "volume stats --mask-png m.jpg: not a usage error"
+hasnt "volume stats --mask-png m.jpg" "missing.json"
+
 exit $fail

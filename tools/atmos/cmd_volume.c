@@ -256,6 +256,7 @@ static int cmd_slice(int argc, char **argv)
     if (!file) return cli_usage_error(C, "slice: which file?");
     if (axis < 0) return cli_usage_error(C, "slice: missing --axis x|y|z");
     if (!out) return cli_usage_error(C, "slice: missing -o SLICE.png");
+    if (cli_png_output(C, "-o", out)) return CLI_EXIT_USAGE;
     atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;

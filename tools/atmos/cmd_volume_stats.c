@@ -285,6 +285,7 @@ int cli_cmd_volume_stats(int argc, char **argv)
         }
     int rc = parse(argc, argv, &o);
     if (rc != CLI_EXIT_OK) return rc;
+    if (o.png && cli_png_output("volume", "--mask-png", o.png)) return CLI_EXIT_USAGE;
     /* the outputs' folders made as atmos render makes them */
     if ((o.csv && cli_output_folder("volume", "--csv", o.csv)) || (o.png && cli_output_folder("volume", "--mask-png", o.png)))
         return CLI_EXIT_RUNTIME;
