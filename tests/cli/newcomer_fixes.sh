@@ -80,4 +80,23 @@ hasnt "volume slice -o s.jpg" "missing.json"
 [ $? -eq 2 ] && ok "volume stats --mask-png m.jpg: a usage error" || bad "volume stats --mask-png m.jpg: not a usage error"
 hasnt "volume stats --mask-png m.jpg" "missing.json"
 
+# --- 4. an empty slice: raw volumes of 8 x 4 x 8 voxels, all zero, and with one voxel set
+python3 - "$T" <<'EOF'
+import json, struct, sys
+t = sys.argv[1]
+for name, at in (("zero", None), ("corner", (0, 0, 0))):
+    v = [0.0] * (8 * 4 * 8)
+    if at:
+        v[at[0] + 8 * (at[1] + 4 * at[2])] = 1e8
+    open(f"{t}/{name}.raw", "wb").write(struct.pack("<%df" % len(v), *v))
+    json.dump({"file": f"{name}.raw", "dims": [8, 4, 8], "voxel_size_m": 100, "origin_m": [0, 0, 0]},
+              open(f"{t}/{name}.json", "w"))
+EOF
+"$A" volume slice "$T/zero.json" --axis z -o "$T/zs.png" 2>"$T/err" || bad "slice of an all-zero field"
+has "all-zero slice" "is empty"
+"$A" volume slice "$T/corner.json" --axis z --at 0.9 -o "$T/cs.png" 2>"$T/err" || bad "slice missing the density"
+has "slice missing the density" "holds none"
+"$A" volume slice "$T/corner.json" --axis z --at 0 -o "$T/c0.png" 2>"$T/err" || bad "slice through the density"
+hasnt "slice through the density" "warning"
+
 exit $fail

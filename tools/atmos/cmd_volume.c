@@ -220,6 +220,22 @@ static int cmd_generate(int argc, char **argv)
     return rc;
 }
 
+/* A slice with no density is written black, and said so: the whole field is empty (all zero),
+ * or only this plane is. */
+static void warn_empty_slice(atmos_context *ctx, const atmos_volume *v, int fi, int axis, double at)
+{
+    atmos_volume_field_stats s;
+    const char *name = atmos_volume_field_name(v, fi);
+    if (atmos_volume_field_stats_get(ctx, v, fi, &s) != ATMOS_OK || s.active_voxels == 0) {
+        fprintf(stderr, "atmos volume: warning: field '%s' is empty (every voxel zero): the slice is black\n", name);
+        return;
+    }
+    fprintf(stderr,
+            "atmos volume: warning: the slice at %g along %c holds none of field '%s' (its %llu voxels > 0 lie "
+            "elsewhere): the slice is black; another --at or --axis shows them\n",
+            at, 'x' + axis, name, (unsigned long long)s.active_voxels);
+}
+
 static int cmd_slice(int argc, char **argv)
 {
     const char *file = NULL, *out = NULL, *field = NULL;
@@ -302,6 +318,7 @@ static int cmd_slice(int argc, char **argv)
                 if (val > mx) mx = val;
             }
         for (size_t n = 0; n < (size_t)width * height; n++) img->pixels[n] = mx > 0 ? (float)(img->pixels[n] / mx) : 0;
+        if (!(mx > 0)) warn_empty_slice(ctx, v, fi, axis, at);
         char buf[64];
         snprintf(buf, sizeof buf, "%g", mx);
         atmos_image_set_meta(img, "atmos:slice_max_m-3", buf);
