@@ -99,4 +99,41 @@ has "slice missing the density" "holds none"
 "$A" volume slice "$T/corner.json" --axis z --at 0 -o "$T/c0.png" 2>"$T/err" || bad "slice through the density"
 hasnt "slice through the density" "warning"
 
+# --- 5. periodic sides kept through a file: a 16 x 4 x 16 cloud layer with one cloud across
+# the x edge (columns 0-1 and 14-15, rows 6-9)
+python3 - "$T" <<'EOF'
+import json, struct, sys
+t = sys.argv[1]
+v = [0.0] * (16 * 4 * 16)
+for k in range(6, 10):
+    for i in (0, 1, 14, 15):
+        for j in range(1, 3):
+            v[i + 16 * (j + 4 * k)] = 1e9
+open(f"{t}/edge.raw", "wb").write(struct.pack("<%df" % len(v), *v))
+for name, per in (("edge", False), ("edge_p", True)):
+    d = {"file": "edge.raw", "dims": [16, 4, 16], "voxel_size_m": 100, "origin_m": [0, 0, 0]}
+    if per:
+        d["periodic"] = True
+    json.dump(d, open(f"{t}/{name}.json", "w"))
+EOF
+stats() { "$A" volume stats "$@" --kv --min-pixels 1 2>"$T/err"; }
+stats "$T/edge_p.json" >"$T/sp" || { bad "stats of a periodic sidecar"; cat "$T/err" >&2; }
+stats "$T/edge.json" --periodic >"$T/sP" || bad "stats --periodic"
+stats "$T/edge.json" >"$T/sn" || bad "stats of a sidecar without periodic"
+cmp -s "$T/sp" "$T/sP" && ok "a sidecar's \"periodic\": true = --periodic" || bad "the sidecar's periodic was not read"
+cmp -s "$T/sp" "$T/sn" && bad "periodic and non-periodic stats agree (the test cannot tell)" || ok "non-periodic differs"
+stats "$T/edge_p.json" --no-periodic >"$T/spn" || bad "stats --no-periodic"
+cmp -s "$T/spn" "$T/sn" && ok "--no-periodic overrides the sidecar" || bad "--no-periodic did not override the sidecar"
+printf '{"file": "edge.raw", "dims": [16, 4, 16], "voxel_size_m": 100, "periodic": "yes"}' >"$T/bad.json"
+"$A" volume info "$T/bad.json" >/dev/null 2>"$T/err" && bad "\"periodic\": \"yes\" accepted" || has "periodic: yes" "periodic: expected true or false"
+if "$A" simulate stratocumulus --grid 16 --minutes 0.5 --quiet -o "$T/sim.json" 2>"$T/err"; then
+    grep -q '"periodic":[[:space:]]*true' "$T/sim.json" && ok "simulate -o writes \"periodic\": true" ||
+        { bad "no periodic in the simulation's sidecar:"; cat "$T/sim.json" >&2; }
+    "$A" volume info "$T/sim.json" >"$T/err" 2>&1 && has "volume info of a simulation" "periodic"
+else
+    bad "simulate"; cat "$T/err" >&2
+fi
+"$A" volume generate cumulus --voxel-size 200 -o "$T/gen.json" >/dev/null 2>&1 || bad "volume generate"
+grep -q periodic "$T/gen.json" && bad "a generated volume's sidecar says periodic" || ok "a generated volume is not periodic"
+
 exit $fail

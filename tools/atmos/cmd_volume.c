@@ -136,6 +136,7 @@ static int cmd_info(int argc, char **argv)
         cJSON_AddItemToArray(gb, vec3(hi));
         cJSON_AddItemToObject(root, "grid_bounds_m", gb);
         cJSON_AddNumberToObject(root, "memory_bytes", (double)atmos_volume_memory(v));
+        cJSON_AddBoolToObject(root, "periodic", d->periodic);
         char *text = cJSON_Print(root);
         if (text) printf("%s\n", text);
         free(text);
@@ -145,6 +146,7 @@ static int cmd_info(int argc, char **argv)
                d->dims[2], d->voxel_size_m, d->origin_m[0], d->origin_m[1], d->origin_m[2]);
         printf("  grid bounds (%g, %g, %g) .. (%g, %g, %g) m\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
         printf("  memory %.3f MB\n", atmos_volume_memory(v) / 1048576.0);
+        if (d->periodic) printf("  periodic: the grid wraps round along x and z (a simulation's sides)\n");
         for (int f = 0; f < atmos_volume_field_count(v); f++) {
             atmos_volume_field_stats s;
             atmos_volume_field_stats_get(ctx, v, f, &s);
