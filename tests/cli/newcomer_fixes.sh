@@ -136,4 +136,45 @@ fi
 "$A" volume generate cumulus --voxel-size 200 -o "$T/gen.json" >/dev/null 2>&1 || bad "volume generate"
 grep -q periodic "$T/gen.json" && bad "a generated volume's sidecar says periodic" || ok "a generated volume is not periodic"
 
+# --- 7. --lat/--lon over a round planet: a map white in the north and black in the south,
+# seen straight down from 2000 km over 30 N and over 30 S at the equinox's noon at 0 E (the
+# sun 60 degrees high at both): the ground turns under the camera, so the two differ by the
+# map's contrast; before, only the sun moved and the two saw the same ground
+python3 - "$T/map.png" <<'EOF'
+import struct, sys, zlib
+w, h = 16, 8
+rows = b"".join(b"\0" + bytes([255 if y < h // 2 else 0] * (3 * w)) for y in range(h))
+def chunk(t, d):
+    return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)) +
+       chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+open(sys.argv[1], "wb").write(png)
+EOF
+round="-D atmosphere.model=dobashi -D atmosphere.ground_map=$T/map.png --position 0,2000000,0 --view-elevation -90
+  --view-azimuth 0 --fov 10 --width 9 --height 9 --time 2026-03-20T12:07:00Z"
+# shellcheck disable=SC2086
+"$A" render $round --lat 30 --lon 0 --pfm "$T/n.pfm" 2>"$T/err" || { bad "round planet at 30 N"; cat "$T/err" >&2; }
+en=$(sed -n 's/.*sun at \([-0-9.]*\) deg elevation.*/\1/p' "$T/err")
+# shellcheck disable=SC2086
+"$A" render $round --lat -30 --lon 0 --pfm "$T/s.pfm" 2>"$T/err" || { bad "round planet at 30 S"; cat "$T/err" >&2; }
+es=$(sed -n 's/.*sun at \([-0-9.]*\) deg elevation.*/\1/p' "$T/err")
+if [ -s "$T/n.pfm" ] && [ -s "$T/s.pfm" ]; then
+    within "${en:-0}" 60 0.02 && within "${es:-0}" 60 0.02 && ok "the sun 60 deg high at 30 N and 30 S ($en, $es)" ||
+        bad "the sun at 30 N: '$en', at 30 S: '$es' (60 expected)"
+    n=$(pix "$T/n.pfm" 4 4) s=$(pix "$T/s.pfm" 4 4)
+    python3 -c "import sys; sys.exit(0 if $n > 4 * $s else 1)" && ok "--lat turns the map: white north $n, black south $s" ||
+        bad "--lat did not turn the map: 30 N $n, 30 S $s"
+fi
+# --time alone over a round planet: at the atmosphere's place (30 N, 0 E), as --lat 30 --lon 0
+# shellcheck disable=SC2086
+"$A" render $round -D atmosphere.latitude_deg=30 --pfm "$T/t.pfm" 2>"$T/err" || { bad "--time alone, round planet"; cat "$T/err" >&2; }
+[ -s "$T/t.pfm" ] && cmp -s "$T/t.pfm" "$T/n.pfm" && ok "--time alone = --time --lat 30 --lon 0 at the atmosphere's 30 N" ||
+    bad "--time alone over a round planet differs from --lat 30 --lon 0"
+# a flat sky still wants the place
+"$A" render --time 2026-03-20T12:00:00Z --width 8 --height 8 --pfm "$T/f.pfm" 2>"$T/err"
+[ $? -eq 2 ] && ok "--time alone over a flat sky: a usage error" || bad "--time alone over a flat sky accepted"
+has "--time alone, flat" "go together"
+"$A" render --help >"$T/err"
+has "render --help" "turn the Earth's map under the camera"
+
 exit $fail
