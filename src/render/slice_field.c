@@ -177,6 +177,7 @@ static int field_fade(atmos__slice_plan *sp)
         double x = t[i] > 0.0f ? log(t[i] / FADE_LO) / span : 0.0;
         x = x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
         t[i] = (float)(x * x * (3.0 - 2.0 * x));
+        sp->ffade_any |= t[i] > 0.0f;
     }
     return 1;
 }
@@ -262,6 +263,14 @@ atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp
     atmos__lfield *fl = &sp->field;
     *built = 0;
     if (fl->valid && memcmp(fl->sun, sun_w, sizeof fl->sun) == 0) return ATMOS_OK;
+    if (!sp->ffade_any) {
+        /* thin everywhere: the field is faded out in every cell and stays zero, no solve */
+        memcpy(fl->sun, sun_w, sizeof fl->sun);
+        fl->valid = 1, fl->sweeps = 0, fl->build_s = fl->source_s = fl->solve_s = 0;
+        *built = 1;
+        atmos__log(ctx, ATMOS_LOG_INFO, "render slice: diffuse field faded out everywhere (an optically thin medium), not solved");
+        return ATMOS_OK;
+    }
     const double t0 = atmos__now();
     const int threads = atmos__threads(ctx), n = sp->n;
     const sgrid *g = &sp->g;
