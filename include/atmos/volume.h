@@ -31,6 +31,11 @@ typedef struct atmos_volume_desc {
     double rotation[9];       /* row-major 3x3 rotation from grid axes to world axes;
                                  all zero = identity. world = origin + R (index * voxel_size) */
     uint64_t max_memory;      /* bytes the volume may use; 0 = ATMOS_VOLUME_DEFAULT_MAX_MEMORY */
+    int periodic;             /* nonzero: the grid wraps round along its x and z axes (the
+                                 periodic sides of a simulation, atmos_sim_to_volume); written
+                                 to and read from a raw volume's sidecar ("periodic": true).
+                                 The cloud statistics take it as their default; the renderers
+                                 do not repeat the grid. Default 0 */
 } atmos_volume_desc;
 
 typedef struct atmos_volume atmos_volume;

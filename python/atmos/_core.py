@@ -111,3 +111,47 @@ class Owned:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def number(where: str, value, integer: bool = False):
+    """value as a finite float (an int with integer=True) for the argument `where`: a
+    TypeError naming its type when it is not a number (bool included), a ValueError when it
+    is NaN or infinite (or not whole with integer=True)."""
+    import math
+    import numbers
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"atmos: {where}: expected a number, got {type(value).__name__} {value!r}")
+    f = float(value)
+    if not math.isfinite(f):
+        raise ValueError(f"atmos: {where}: {f} is not a finite number")
+    if integer:
+        if f != int(f):
+            raise ValueError(f"atmos: {where}: expected a whole number, got {value!r}")
+        return int(f)
+    return f
+
+
+def json_value(where: str, value):
+    """value as plain JSON data (NumPy scalars and arrays as numbers and lists), checked on
+    the way: NaN and infinities, which JSON cannot carry (the library would read them as words),
+    raise a ValueError naming where they are; values of other types a TypeError."""
+    import math
+    if hasattr(value, "tolist"):
+        value = value.tolist()
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise ValueError(f"atmos: {where}: {value} is not a finite number")
+        return value
+    if isinstance(value, (list, tuple)):
+        return [json_value(f"{where}[{i}]", v) for i, v in enumerate(value)]
+    if isinstance(value, dict):
+        out = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise TypeError(f"atmos: {where}: a key must be a string, got {type(k).__name__} {k!r}")
+            out[k] = json_value(f"{where}.{k}" if where else k, v)
+        return out
+    raise TypeError(f"atmos: {where}: expected a JSON value (number, string, bool, list or dict), "
+                    f"got {type(value).__name__}")

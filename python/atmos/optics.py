@@ -1,7 +1,7 @@
 """Optics as arrays: Lorenz-Mie scattering by one sphere, particle phase tables."""
 import numpy as np
 
-from atmos._core import check, context, ffi, lib
+from atmos._core import check, context, ffi, lib, number
 
 
 def refractive_index(material: str, nm: float) -> complex:
@@ -9,7 +9,7 @@ def refractive_index(material: str, nm: float) -> complex:
     f = {"water": lib.atmos_refractive_index_water, "ice": lib.atmos_refractive_index_ice}.get(material)
     if f is None:
         raise ValueError(f"atmos.refractive_index: material must be 'water' or 'ice', got {material!r}")
-    m = f(float(nm))
+    m = f(number("refractive_index: nm", nm))
     return complex(m.re, m.im)
 
 
@@ -24,7 +24,7 @@ def mie(m: complex, x: float, cos_theta=None) -> dict:
     s2 = ffi.new("atmos_complex[]", max(n, 1))
     res = ffi.new("atmos_mie_result *")
     ctx = context()
-    check(lib.atmos_mie(ctx, {"re": m.real, "im": m.imag}, float(x), n, ffi.from_buffer("double[]", mu) if n else ffi.NULL,
+    check(lib.atmos_mie(ctx, {"re": m.real, "im": m.imag}, number("mie: x", x), n, ffi.from_buffer("double[]", mu) if n else ffi.NULL,
                         s1, s2, res), ctx)
     out = {"qext": res.qext, "qsca": res.qsca, "qback": res.qback, "g": res.g, "terms": res.terms}
     if cos_theta is not None:

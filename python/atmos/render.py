@@ -1,5 +1,5 @@
 """Rendering: one call for one image, a plan for many frames of one scene."""
-from atmos._core import Owned, check, context, ffi, lib
+from atmos._core import Owned, check, context, ffi, lib, number
 from atmos.image import Image
 from atmos.scene import Scene
 
@@ -8,6 +8,13 @@ def _to_srgb(ctx, spectral, wl):
     out = ffi.new("atmos_image **")
     check(lib.atmos_image_to_srgb(ctx, spectral, wl, out), ctx)
     return out[0]
+
+
+def _vector(where: str, value, n: int, integer: bool = False) -> list:
+    """n numbers from a sequence, each checked as number() checks one."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != n:
+        raise TypeError(f"atmos: {where}: expected {n} numbers, got {type(value).__name__} {value!r}")
+    return [number(f"{where}[{i}]", v, integer) for i, v in enumerate(value)]
 
 
 def _info(info, wl):
@@ -107,18 +114,20 @@ class Plan(Owned):
         if self._ptr is None:
             raise ValueError("atmos.Plan: the plan was closed")
         f = self._frame
+        w = "Plan.render"
         if camera:
             for key, field in (("position_m", "position"), ("look_at_m", "look_at"), ("up", "up")):
                 if key in camera:
-                    setattr(f.camera, field, [float(v) for v in camera[key]])
+                    setattr(f.camera, field, _vector(f"{w}: camera {key}", camera[key], 3))
             if "fov_deg" in camera:
-                f.camera.fov_deg = float(camera["fov_deg"])
+                f.camera.fov_deg = number(f"{w}: camera fov_deg", camera["fov_deg"])
         if sun is not None:
-            lib.atmos_direction_from_angles(float(sun[0]), float(sun[1]), f.sun_dir)
+            el, az = _vector(f"{w}: sun (elevation_deg, azimuth_deg)", sun, 2)
+            lib.atmos_direction_from_angles(el, az, f.sun_dir)
         if size is not None:
-            f.width, f.height = int(size[0]), int(size[1])
+            f.width, f.height = _vector(f"{w}: size (width, height)", size, 2, integer=True)
         if spp is not None:
-            f.spp = int(spp)
+            f.spp = number(f"{w}: spp", spp, integer=True)
         ctx = context()
         img = ffi.new("atmos_image **")
         check(lib.atmos_plan_image_create(self._ptr, f, img), ctx)

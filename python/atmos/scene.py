@@ -2,7 +2,7 @@
 import json
 import os
 
-from atmos._core import check, context, ffi, lib
+from atmos._core import check, context, ffi, json_value, lib
 
 # Keyword arguments with a name of their own (as the CLI's options); any other keyword is a
 # path into the scene with "__" between keys: camera__fov_deg=35 is -D camera.fov_deg=35.
@@ -17,20 +17,15 @@ _SHORT = {
 }
 
 
-def _plain(value):
-    """NumPy scalars and arrays as the Python numbers and lists JSON knows."""
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    raise TypeError(f"atmos: a scene value must be JSON-like, got {type(value).__name__}")
-
-
-def _dumps(value) -> str:
-    return json.dumps(value, default=_plain)
+def _dumps(where: str, value) -> str:
+    """value as JSON text; NaN, infinities and other types refused naming where they are
+    (json.dumps would write NaN as a bare word, which the library reads as a string)."""
+    return json.dumps(json_value(where, value), allow_nan=False)
 
 
 def _override(key: str, value) -> str:
     path = _SHORT.get(key, key.replace("__", "."))
-    return f"{path}={_dumps(value)}"
+    return f"{path}={_dumps(path, value)}"
 
 
 class Scene:
@@ -65,7 +60,7 @@ class Scene:
         """A scene from a dict with the scene file's keys."""
         if not isinstance(d, dict):
             raise TypeError(f"atmos.Scene.from_dict: expected a dict, got {type(d).__name__}")
-        return cls(_dumps(d), source=source)
+        return cls(_dumps("", d), source=source)
 
     @classmethod
     def from_json(cls, text: str, source: str = "json") -> "Scene":

@@ -1,7 +1,7 @@
 """The sky as a function: radiance over arrays of view directions."""
 import numpy as np
 
-from atmos._core import check, context, ffi, lib
+from atmos._core import check, context, ffi, lib, number
 from atmos.scene import Scene
 
 
@@ -34,6 +34,6 @@ def sky_radiance(scene: Scene, dirs, position_m=None) -> np.ndarray:
     check(lib.atmos_scene_wavelengths(ctx, s, wl), ctx)
     out = np.empty((n, wl.count), dtype=np.float64)
     count = ffi.new("int *")
-    check(lib.atmos_py_sky_radiance(ctx, s, [float(v) for v in pos], ffi.from_buffer("double[]", d), n,
+    check(lib.atmos_py_sky_radiance(ctx, s, [number(f"sky_radiance: position_m[{i}]", v) for i, v in enumerate(pos)], ffi.from_buffer("double[]", d), n,
                                     ffi.from_buffer("double[]", out), count), ctx)
     return out.reshape(d.shape[:-1] + (wl.count,))

@@ -3,7 +3,7 @@ import os
 
 import numpy as np
 
-from atmos._core import check, context, ffi, lib
+from atmos._core import check, context, ffi, lib, number
 
 
 class Volume:
@@ -34,8 +34,8 @@ class Volume:
         ctx = context()
         desc = ffi.new("atmos_volume_desc *")
         desc.dims = [nx, ny, nz]
-        desc.voxel_size_m = float(voxel_size_m)
-        desc.origin_m = [float(v) for v in origin_m]
+        desc.voxel_size_m = number("Volume.from_array: voxel_size_m", voxel_size_m)
+        desc.origin_m = [number(f"Volume.from_array: origin_m[{i}]", v) for i, v in enumerate(origin_m)]
         p = ffi.new("atmos_volume **")
         check(lib.atmos_volume_create(ctx, desc, p), ctx)
         vol = cls(p[0])

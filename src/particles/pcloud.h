@@ -144,9 +144,11 @@ atmos_status atmos__pcloud_shade_probes(atmos_context *ctx, const atmos__pcloud 
                                         float *light, float *order, const atmos__pprobes *pr);
 
 /* ---- psplat.c: the eye pass (§2.2.2, Eq. 9) */
-/* The pixels of rect [x0, y0, x1, y1) that the sphere (c, r) may cover seen by the pinhole cam:
- * bb[4] = [x0, x1) x [y0, y1); *Z its centre's depth along the view. 0 when the sphere holds the
- * eye, lies behind it or misses rect. */
+/* ---- pscreen.c: where a sphere falls on the image */
+/* The pixels of rect [x0, y0, x1, y1) that the sphere (c, r) may cover seen by cam (pinhole,
+ * fisheye or equirect): bb[4] = [x0, x1) x [y0, y1); *Z its centre's depth along a pinhole's
+ * view, its distance from the eye for the others. 0 when the sphere holds the eye, lies behind
+ * a pinhole or out of a fisheye's field, or misses rect. */
 int atmos__pcloud_screen_box(const atmos_camera *cam, const double c[3], double r, const int rect[4], int bb[4],
                              double *Z);
 /* The lights of a frame: n lights toward dir[j] with irradiance e[j] outside the cloud, their
@@ -165,8 +167,8 @@ typedef struct atmos__plights {
  * exp(-tau(b)) of what is behind it, b the pixel ray's distance from its centre (Harris's
  * splat, exactly), theta_j the scattering angle from light j toward the eye; seen through the
  * air its colour is air_l + air_t colour (exact for an opaque particle; the air behind a
- * translucent one is in what it covers). Pinhole cameras; particles whose splat holds the
- * eye are left out. Threads over tiles of 32 x 32 pixels (the image does not depend on the
+ * translucent one is in what it covers). Every camera type (a wide one's pixel rays from
+ * atmos_camera_ray); particles whose splat holds the eye are left out. Threads over tiles of 32 x 32 pixels (the image does not depend on the
  * thread count). *drawn: the particles drawn (may be NULL). */
 atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
                                  const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,

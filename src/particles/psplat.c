@@ -19,26 +19,6 @@ typedef struct sp {
     float col[ATMOS_MAX_WAVELENGTHS], tc[ATMOS_MAX_WAVELENGTHS]; /* colour and central depth */
 } sp;
 
-int atmos__pcloud_screen_box(const atmos_camera *cam, const double c[3], double r, const int rect[4], int bb[4],
-                             double *Zout)
-{
-    double X = 0, Y = 0, Z = 0;
-    for (int i = 0; i < 3; i++) {
-        const double rel = c[i] - cam->position[i];
-        X += rel * cam->right[i], Y += rel * cam->up[i], Z += rel * cam->forward[i];
-    }
-    if (Z <= r) return 0; /* behind the eye, or the eye inside the sphere */
-    const double W = cam->width, H = cam->height, f = H / (2.0 * cam->tan_half_fov);
-    const double px = 0.5 * W + f * X / Z, py = 0.5 * H - f * Y / Z;
-    /* the sphere's outline on the image lies within r f / sqrt(Z^2 - r^2) of the centre's image,
-     * stretched toward the edges: bound it by the projection of its box */
-    const double rp = f * r / sqrt(Z * Z - r * r) * (1.0 + (fabs(X) + fabs(Y) + r) / Z);
-    bb[0] = (int)fmax(rect[0], floor(px - rp)), bb[1] = (int)fmin(rect[2], ceil(px + rp));
-    bb[2] = (int)fmax(rect[1], floor(py - rp)), bb[3] = (int)fmin(rect[3], ceil(py + rp));
-    *Zout = Z;
-    return bb[0] < bb[1] && bb[2] < bb[3];
-}
-
 static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 static void cross(const double a[3], const double b[3], double out[3])
@@ -46,7 +26,8 @@ static void cross(const double a[3], const double b[3], double out[3])
     out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* The splat of particle p as seen by cam; 0 when it is not drawn. */
+/* The splat of particle p as seen by cam; 0 when it is not drawn. Its depth z orders the
+ * splats far to near: along a pinhole's axis, from the eye for the wide cameras. */
 static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, const atmos__plights *L, const atmos_camera *cam,
                    const int rect[4], sp *out)
 {
@@ -122,13 +103,49 @@ __attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, 
     }
 }
 
+/* The rays of tile (tx, ty)'s pixels for a fisheye or equirectangular camera (atmos_camera_ray;
+ * a zero ray outside a fisheye's circle): wide cameras have no image plane to take b^2 from. */
+static void tile_rays(const atmos_camera *cam, int tx, int ty, double (*d)[3])
+{
+    for (int y = 0; y < TILE; y++)
+        for (int x = 0; x < TILE; x++) {
+            double *r = d[y * TILE + x];
+            if (tx + x >= cam->width || ty + y >= cam->height || !atmos_camera_ray(cam, tx + x + 0.5, ty + y + 0.5, r))
+                r[0] = r[1] = r[2] = 0.0;
+        }
+}
+
+/* draw() for a wide camera: pixel ray d (unit) passes the centre at b^2 = |rel|^2 - (rel.d)^2,
+ * in front of the eye when rel.d > 0 (a 360-degree fisheye sees behind it too). */
+static void draw_wide(const sp *q, int nw, const atmos_camera *cam, int tx, int ty, const double (*d)[3], atmos_image *img)
+{
+    const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
+    const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
+    const double k2 = 1.0 / (q->s * q->s), rc2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT * q->s * q->s;
+    double rel[3];
+    for (int i = 0; i < 3; i++) rel[i] = q->c[i] - cam->position[i];
+    const double rr = dot(rel, rel);
+    const int C = img->channels;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            const double t = dot(rel, d[(y - ty) * TILE + (x - tx)]), b2 = rr - t * t;
+            if (!(t > 0) || b2 > rc2) continue;
+            const float g = atmos__pcloud_column((float)(b2 * k2));
+            float *px = img->pixels + ((size_t)y * cam->width + x) * C, tm = 0;
+            for (int k = 0; k < nw; k++) {
+                const float T = atmos__expf_fast(-q->tc[k] * g);
+                px[k] = px[k] * T + q->col[k] * (1.0f - T);
+                tm += T;
+            }
+            px[nw] = 1.0f - (1.0f - px[nw]) * tm / nw;
+        }
+}
+
 atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
                                  const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
                                  const int rect[4], atmos_image *img, int *drawn)
 {
     if (drawn) *drawn = 0;
-    if (cam->type != ATMOS_CAMERA_PINHOLE)
-        return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "particles: the splat renderer draws pinhole cameras only");
     const int ntx = (rect[2] - rect[0] + TILE - 1) / TILE, nty = (rect[3] - rect[1] + TILE - 1) / TILE;
     sp *s = malloc(sizeof *s * (size_t)(pc->n ? pc->n : 1));
     atmos__keyed *ord = malloc(sizeof *ord * (size_t)(pc->n ? pc->n : 1));
@@ -157,10 +174,17 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
             for (int tx = (a->bb[0] - rect[0]) / TILE; tx <= (a->bb[1] - 1 - rect[0]) / TILE; tx++)
                 list[cnt[ty * ntx + tx] + fill[ty * ntx + tx]++] = ord[q].index;
     }
+    const int wide = cam->type != ATMOS_CAMERA_PINHOLE;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
-    for (int t = 0; t < ntx * nty; t++)
-        for (int q = cnt[t]; q < cnt[t + 1]; q++)
-            draw(&s[list[q]], o->nw, cam, rect[0] + (t % ntx) * TILE, rect[1] + (t / ntx) * TILE, img);
+    for (int t = 0; t < ntx * nty; t++) {
+        const int tx = rect[0] + (t % ntx) * TILE, ty = rect[1] + (t / ntx) * TILE;
+        double rays[TILE * TILE][3];
+        if (wide && cnt[t + 1] > cnt[t]) tile_rays(cam, tx, ty, rays);
+        for (int q = cnt[t]; q < cnt[t + 1]; q++) {
+            if (wide) draw_wide(&s[list[q]], o->nw, cam, tx, ty, (const double(*)[3])rays, img);
+            else draw(&s[list[q]], o->nw, cam, tx, ty, img);
+        }
+    }
     free(list), free(fill), free(s), free(ord), free(cnt);
     if (drawn) *drawn = n;
     return ATMOS_OK;

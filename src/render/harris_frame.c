@@ -58,9 +58,17 @@ static void air(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v
 }
 
 /* Whether the sphere (c, r) meets cam's view: inside all four side planes of the frustum
- * within r (and not wholly behind the eye). */
+ * within r (and not wholly behind the eye); for a wide camera, holding the eye or falling on
+ * the image. */
 static int visible(const atmos_camera *cam, const double c[3], double r)
 {
+    if (cam->type != ATMOS_CAMERA_PINHOLE) {
+        const int all[4] = {0, 0, cam->width, cam->height};
+        int bb[4];
+        double d2 = 0, Z;
+        for (int i = 0; i < 3; i++) d2 += (c[i] - cam->position[i]) * (c[i] - cam->position[i]);
+        return d2 <= r * r || atmos__pcloud_screen_box(cam, c, r, all, bb, &Z);
+    }
     double X = 0, Y = 0, Z = 0;
     for (int i = 0; i < 3; i++) {
         const double rel = c[i] - cam->position[i];

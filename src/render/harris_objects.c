@@ -91,14 +91,17 @@ static void shade(const atmos__harris_plan *h, const atmos__harris_objects *ob, 
     for (int k = 0; k < nw; k++) L[k] *= ob->albedo[m][k] / ATMOS_PI;
 }
 
-/* The ray of cam through image point (x, y) (pixel units; a pixel's centre at + 0.5), unit. */
-static void pixel_ray(const atmos_camera *cam, double x, double y, double d[3])
+/* The ray of cam through image point (x, y) (pixel units; a pixel's centre at + 0.5), unit;
+ * 0 where there is none (outside a fisheye's circle). */
+static int pixel_ray(const atmos_camera *cam, double x, double y, double d[3])
 {
+    if (cam->type != ATMOS_CAMERA_PINHOLE) return atmos_camera_ray(cam, x, y, d);
     const double W = cam->width, H = cam->height, t = cam->tan_half_fov;
     const double u = (2.0 * x - W) / H * t, v = (H - 2.0 * y) / H * t;
     double l = 0;
     for (int i = 0; i < 3; i++) d[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i], l += d[i] * d[i];
     for (int i = 0; i < 3; i++) d[i] /= sqrt(l);
+    return 1;
 }
 
 /* Pixel (x, y) of the layer: 2 x 2 rays (stratified), the nearest surface of each; the
@@ -114,7 +117,7 @@ static void subpixels(const atmos_plan *p, const atmos__harris_plan *h, atmos__h
     int hits = 0;
     for (int s = 0; s < 4; s++) {
         double d[3], best = INFINITY, L[ATMOS_MAX_WAVELENGTHS], La[ATMOS_MAX_WAVELENGTHS], Ta[ATMOS_MAX_WAVELENGTHS];
-        pixel_ray(cam, x + 0.25 + 0.5 * (s & 1), y + 0.25 + 0.5 * (s >> 1), d);
+        if (!pixel_ray(cam, x + 0.25 + 0.5 * (s & 1), y + 0.25 + 0.5 * (s >> 1), d)) continue;
         atmos_mesh_hit hit, first;
         int mb = -1;
         for (int m = 0; m < ob->n; m++)

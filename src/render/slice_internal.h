@@ -137,6 +137,8 @@ struct atmos__slice_plan {
     float *fdens;
     float fg[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     atmos__lfield field;
+    float *ffade; /* the field's weight per cell and wavelength, 0 where the medium is thin (slice_field.c) */
+    int ffade_any; /* 0: every weight is 0 (no solve) */
     float *fview; /* per frame: see sjob.fview */
     int fvq;
     /* The volume's shadow on the air ("air_shadows"; slice_shadow.c): the map, kept per sun

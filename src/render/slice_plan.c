@@ -19,6 +19,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
     atmos__aerial_free(&sp->aerial);
     atmos__lmedium_free(&sp->fmed), atmos__lfield_free(&sp->field), free(sp->fdens), free(sp->fview);
+    free(sp->ffade);
     atmos__slice_shadow_free(sp);
     free(sp);
 }

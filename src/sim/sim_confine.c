@@ -55,66 +55,94 @@ CONF_CLONES static void centres(atmos_sim *s, int k, float *restrict uc, float *
     }
 }
 
-/* The vorticity omega and its length at cell n of a row (neighbours along x at xm and xp). */
-CONF_INLINE void vort_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float inv2, float zf,
-                           const float *restrict uc, const float *restrict vc, const float *restrict wc,
-                           float *restrict ox, float *restrict oy, float *restrict oz, float *restrict om)
+/* The vorticity omega at cell n of a row (neighbours along x at xm and xp; zf the vertical
+ * difference's factor, one-sided at the ground and the lid). */
+typedef struct {
+    float x, y, z;
+} vec3f;
+
+CONF_INLINE vec3f vort_at(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float inv2, float zf,
+                          const float *restrict uc, const float *restrict vc, const float *restrict wc)
 {
     const size_t yp = o->yp + i, ym = o->ym + i, zp = n + o->zp, zm = n + o->zm;
-    const float x = (wc[yp] - wc[ym]) * inv2 - (vc[zp] - vc[zm]) * zf;
-    const float y = (uc[zp] - uc[zm]) * zf - (wc[xp] - wc[xm]) * inv2;
-    const float z = (vc[xp] - vc[xm]) * inv2 - (uc[yp] - uc[ym]) * inv2;
-    ox[n] = x, oy[n] = y, oz[n] = z;
-    om[n] = sqrtf(x * x + y * y + z * z);
+    vec3f w;
+    w.x = (wc[yp] - wc[ym]) * inv2 - (vc[zp] - vc[zm]) * zf;
+    w.y = (uc[zp] - uc[zm]) * zf - (wc[xp] - wc[xm]) * inv2;
+    w.z = (vc[xp] - vc[xm]) * inv2 - (uc[yp] - uc[ym]) * inv2;
+    return w;
 }
 
-/* The vorticity at the centres of level k (central differences, one-sided at the ground and
- * the lid). */
+CONF_INLINE float len(vec3f w)
+{
+    return sqrtf(w.x * w.x + w.y * w.y + w.z * w.z);
+}
+
+static float vert_factor(const atmos_sim *s, int k)
+{
+    const float inv2 = (float)(0.5 / s->dx);
+    return (k > 0 && k + 1 < s->nz) ? inv2 : 2 * inv2;
+}
+
+/* |omega| at the centres of level k into f[6] (omega itself is found again where the force
+ * needs it: three fields fewer written and read). */
 CONF_CLONES static void vorticity(atmos_sim *s, int k, float *const f[7])
 {
     const float *restrict uc = f[0], *restrict vc = f[1], *restrict wc = f[2];
-    float *restrict ox = f[3], *restrict oy = f[4], *restrict oz = f[5], *restrict om = f[6];
-    const int nx = s->nx, nz = s->nz;
-    const float inv2 = (float)(0.5 / s->dx), zf = (k > 0 && k + 1 < nz) ? inv2 : 2 * inv2;
+    float *restrict om = f[6];
+    const int nx = s->nx;
+    const float inv2 = (float)(0.5 / s->dx), zf = vert_factor(s, k);
     for (int j = 0; j < s->ny; j++) {
         const rows o = rows_of(s, j, k);
         const size_t r = o.r, e = (size_t)nx - 1;
-        vort_cell(&o, r, 0, r + e, r + 1, inv2, zf, uc, vc, wc, ox, oy, oz, om);
-        for (size_t i = 1; i < e; i++) vort_cell(&o, r + i, i, r + i - 1, r + i + 1, inv2, zf, uc, vc, wc, ox, oy, oz, om);
-        vort_cell(&o, r + e, e, r + e - 1, r, inv2, zf, uc, vc, wc, ox, oy, oz, om);
+        om[r] = len(vort_at(&o, r, 0, r + e, r + 1, inv2, zf, uc, vc, wc));
+        for (size_t i = 1; i < e; i++) om[r + i] = len(vort_at(&o, r + i, i, r + i - 1, r + i + 1, inv2, zf, uc, vc, wc));
+        om[r + e] = len(vort_at(&o, r + e, e, r + e - 1, r, inv2, zf, uc, vc, wc));
     }
 }
 
 /* The force eps dx |omega| (N x omega) at cell n of a row into fx, fy, fz. */
-CONF_INLINE void force_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float a, float *const f[7])
+#define FORCE_ARGS                                                                                                   \
+    const float *restrict uc, const float *restrict vc, const float *restrict wc, const float *restrict om,           \
+        float *restrict fx, float *restrict fy, float *restrict fz
+CONF_INLINE void force_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float a, float inv2, float zf,
+                            FORCE_ARGS)
 {
-    const float *restrict ox = f[3], *restrict oy = f[4], *restrict oz = f[5], *restrict om = f[6];
+    const vec3f w = vort_at(o, n, i, xm, xp, inv2, zf, uc, vc, wc);
     float gx = om[xp] - om[xm];
     float gy = om[o->yp + i] - om[o->ym + i];
     float gz = om[n + o->zp] - om[n + o->zm];
     const float gl = sqrtf(gx * gx + gy * gy + gz * gz) + 1e-20f;
     gx /= gl, gy /= gl, gz /= gl;
     const float am = a * om[n];
-    f[0][n] = am * (gy * oz[n] - gz * oy[n]);
-    f[1][n] = am * (gz * ox[n] - gx * oz[n]);
-    f[2][n] = am * (gx * oy[n] - gy * ox[n]);
+    fx[n] = am * (gy * w.z - gz * w.y);
+    fy[n] = am * (gz * w.x - gx * w.z);
+    fz[n] = am * (gx * w.y - gy * w.x);
 }
 
-/* The force at the centres of level k, then (the level's forces known) its x and y components
- * averaged onto the u and v faces of the level, times dt (the w faces need the level below:
- * apply_w, after a barrier). */
+/* A row's forces (its two ends wrapped apart, the rest vectorised: a function of its own, so
+ * that the compiler takes the fields' restrict at its word). */
+CONF_CLONES __attribute__((noinline)) static void force_row(const rows *o, size_t e, float a, float inv2, float zf, FORCE_ARGS)
+{
+    const size_t r = o->r;
+    force_cell(o, r, 0, r + e, r + 1, a, inv2, zf, uc, vc, wc, om, fx, fy, fz);
+    for (size_t i = 1; i < e; i++) force_cell(o, r + i, i, r + i - 1, r + i + 1, a, inv2, zf, uc, vc, wc, om, fx, fy, fz);
+    force_cell(o, r + e, e, r + e - 1, r, a, inv2, zf, uc, vc, wc, om, fx, fy, fz);
+}
+
+/* The force at the centres of level k (from the centred velocity f[0..2] and |omega| f[6],
+ * into f[3..5]), then (the level's forces known) its x and y components averaged onto the u
+ * and v faces of the level, times dt (the w faces need the level below: apply_w, after a
+ * barrier). */
 CONF_CLONES static void force(atmos_sim *s, int k, float a, float dt, float *const f[7])
 {
     const int nx = s->nx;
     const size_t e = (size_t)nx - 1;
+    const float inv2 = (float)(0.5 / s->dx), zf = vert_factor(s, k);
     for (int j = 0; j < s->ny; j++) {
         const rows o = rows_of(s, j, k);
-        const size_t r = o.r;
-        force_cell(&o, r, 0, r + e, r + 1, a, f);
-        for (size_t i = 1; i < e; i++) force_cell(&o, r + i, i, r + i - 1, r + i + 1, a, f);
-        force_cell(&o, r + e, e, r + e - 1, r, a, f);
+        force_row(&o, e, a, inv2, zf, f[0], f[1], f[2], f[6], f[3], f[4], f[5]);
     }
-    const float *restrict fx = f[0], *restrict fy = f[1];
+    const float *restrict fx = f[3], *restrict fy = f[4];
     float *restrict u = s->u, *restrict v = s->v;
     const float h = 0.5f * dt;
     for (int j = 0; j < s->ny; j++) {
@@ -151,6 +179,6 @@ void atmos__sim_confine(atmos_sim *s, double dt)
     for (int k = 0; k < nz; k++) force(s, k, (float)(eps * s->dx), (float)dt, f);
     atmos__sim_sync(s);
     SIM_FOR
-    for (int k = 1; k < nz; k++) apply_w(s, k, (float)dt, f[2]);
+    for (int k = 1; k < nz; k++) apply_w(s, k, (float)dt, f[5]);
     atmos__sim_sync(s);
 }

@@ -23,7 +23,8 @@
 atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *s)
 {
     const int nh = s->nx / 2 + 1;
-    s->spec = fftwf_malloc(sizeof(fftwf_complex) * (size_t)nh * s->ny * s->nz);
+    /* on 2 MB pages where the system gives them: the column solves stride through the levels */
+    s->spec = atmos__big_alloc(sizeof(fftwf_complex) * (size_t)nh * s->ny * s->nz);
     s->colbuf = malloc(sizeof(double) * SIM_COLUMN_SCRATCH(s->nz) * (size_t)(s->threads > 1 ? s->threads : 1));
     if (!s->spec || !s->colbuf) return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: out of memory for the pressure solver");
     /* planned on scratch arrays (ESTIMATE leaves them alone); UNALIGNED so the plan runs on any level */
@@ -45,7 +46,7 @@ void atmos__sim_fft_free(atmos_sim *s)
         if (s->fft_fwd) fftwf_destroy_plan(s->fft_fwd);
         if (s->fft_inv) fftwf_destroy_plan(s->fft_inv);
     }
-    if (s->spec) fftwf_free(s->spec);
+    free(s->spec);
     free(s->colbuf);
     s->colbuf = NULL;
     s->fft_fwd = s->fft_inv = s->spec = NULL;

@@ -2,7 +2,8 @@
  * sim_advect.c): one field, or four fields packed per cell. Positions are in the field's
  * index space, x and y wrap, z clamps to [0, nz_f - 1]. On x86-64 CPUs with AVX2 the
  * corners and weights of four or eight points are found at once and the corners fetched by
- * gathers; every lane does the scalar code's operations in the same order and precision
+ * gathers, or, where the points' corners lie side by side in one grid row (most points of a
+ * row in a smooth wind), by plain loads of the row; every lane does the scalar code's operations in the same order and precision
  * (double positions, float weights and interpolation, no fused multiply-adds), so both paths
  * give the same bits. Points far outside the grid (more than one domain away) or NaN take the
  * scalar path. */
@@ -171,6 +172,19 @@ AVX2_INLINE __m256 lerp8(__m256 a, __m256 b, __m256 t) /* a + t (b - a) */
     return _mm256_add_ps(a, _mm256_mul_ps(t, _mm256_sub_ps(b, a)));
 }
 
+/* Whether eight points' corners lie side by side: the same rows (j0 and k0, so row 0's offset,
+ * the same in every lane) and i0 = i0[0] + lane, none of the second corners wrapping (i0[0] + 8
+ * < nx). Then i0[0], else -1. Points along a row of the grid in a smooth wind are mostly so: the
+ * corners are then read by two unaligned loads a row instead of two gathers. */
+AVX2_INLINE int run8(__m256i i0, __m256i row0, int nx)
+{
+    const __m256i d = _mm256_sub_epi32(i0, _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    const __m256i same = _mm256_and_si256(_mm256_cmpeq_epi32(d, _mm256_broadcastd_epi32(_mm256_castsi256_si128(d))),
+                                          _mm256_cmpeq_epi32(row0, _mm256_broadcastd_epi32(_mm256_castsi256_si128(row0))));
+    const int first = _mm256_cvtsi256_si32(i0);
+    return _mm256_movemask_epi8(same) == -1 && first + 8 < nx ? first : -1;
+}
+
 /* Eight points of one field. */
 AVX2 static void sample_avx2(const atmos_sim *s, const float *f, int nz_f, const double *x, const double *y,
                              const double *z, float *out, int n)
@@ -184,11 +198,18 @@ AVX2 static void sample_avx2(const atmos_sim *s, const float *f, int nz_f, const
         }
         const __m256i i0 = PAIR_I(a.i0, b.i0), i1 = PAIR_I(a.i1, b.i1);
         const __m256 ax = PAIR_F(a.ax, b.ax);
+        const int first = run8(i0, PAIR_I(a.r[0], b.r[0]), s->nx);
         __m256 c[4];
         for (int r = 0; r < 4; r++) {
             const __m256i row = PAIR_I(a.r[r], b.r[r]);
-            const __m256 lo = _mm256_i32gather_ps(f, _mm256_add_epi32(row, i0), 4);
-            const __m256 hi = _mm256_i32gather_ps(f, _mm256_add_epi32(row, i1), 4);
+            __m256 lo, hi;
+            if (first >= 0) { /* the same corners as the gathers below, read in a row */
+                const float *p = f + (size_t)_mm_cvtsi128_si32(a.r[r]) + first;
+                lo = _mm256_loadu_ps(p), hi = _mm256_loadu_ps(p + 1);
+            } else {
+                lo = _mm256_i32gather_ps(f, _mm256_add_epi32(row, i0), 4);
+                hi = _mm256_i32gather_ps(f, _mm256_add_epi32(row, i1), 4);
+            }
             c[r] = lerp8(lo, hi, ax);
         }
         const __m256 ay = PAIR_F(a.ay, b.ay), az = PAIR_F(a.az, b.az);
@@ -210,6 +231,15 @@ AVX2_INLINE __m256 spread_pair(__m128 w, int p) /* lanes p, p + 1 of w, each fou
     return _mm256_permutevar8x32_ps(_mm256_castps128_ps256(w), sel);
 }
 
+/* run8's test for four points. */
+AVX2_INLINE int run4(__m128i i0, __m128i row0, int nx)
+{
+    const __m128i d = _mm_sub_epi32(i0, _mm_setr_epi32(0, 1, 2, 3));
+    const __m128i same = _mm_and_si128(_mm_cmpeq_epi32(d, _mm_shuffle_epi32(d, 0)), _mm_cmpeq_epi32(row0, _mm_shuffle_epi32(row0, 0)));
+    const int first = _mm_cvtsi128_si32(i0);
+    return _mm_movemask_epi8(same) == 0xffff && first + 4 < nx ? first : -1;
+}
+
 AVX2 static void sample4_avx2(const atmos_sim *s, const float *f4, int nz_f, const double *x, const double *y,
                               const double *z, float *out4, int n)
 {
@@ -218,6 +248,19 @@ AVX2 static void sample4_avx2(const atmos_sim *s, const float *f4, int nz_f, con
         lanes4 a;
         if (!setup4(s, nz_f, x + m, y + m, z + m, &a)) {
             sample4_scalar(s, f4, nz_f, x, y, z, out4, m, m + 4);
+            continue;
+        }
+        const int first = run4(a.i0, a.r[0], s->nx);
+        if (first >= 0) { /* point p's corners at first + p and first + p + 1 of each row */
+            for (int p = 0; p < 4; p += 2) {
+                const __m256 ax = spread_pair(a.ax, p), ay = spread_pair(a.ay, p), az = spread_pair(a.az, p);
+                __m256 c[4];
+                for (int q = 0; q < 4; q++) {
+                    const float *row = f4 + 4 * ((size_t)_mm_cvtsi128_si32(a.r[q]) + first + p);
+                    c[q] = lerp8(_mm256_loadu_ps(row), _mm256_loadu_ps(row + 4), ax);
+                }
+                _mm256_storeu_ps(out4 + 4 * (size_t)(m + p), lerp8(lerp8(c[0], c[1], ay), lerp8(c[2], c[3], ay), az));
+            }
             continue;
         }
         int i0[4], i1[4], r[4][4];

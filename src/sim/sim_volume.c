@@ -16,6 +16,7 @@ atmos_status atmos_sim_to_volume(atmos_context *ctx, const atmos_sim *s, atmos_v
     d.voxel_size_m = s->dx;
     d.origin_m[0] = -0.5 * s->nx * s->dx;
     d.origin_m[2] = -0.5 * s->ny * s->dx;
+    d.periodic = 1; /* the model's sides are periodic (sim_pressure.c) */
     atmos_volume *v = NULL;
     atmos_status st = atmos_volume_create(ctx, &d, &v);
     if (st != ATMOS_OK) return st;

@@ -5,6 +5,8 @@
  *   {"dims": ..., "voxel_size_m": ..., "origin_m": ..., "rotation": [9 numbers],
  *    "fields": [{"name": "cloud", "particle": "cloud", "file": "c.raw", "scale": 1}, ...]}
  *
+ * either with "periodic": true when the grid wraps round along x and z (a simulation's sides).
+ *
  * x varies fastest in the raw file; "file" is relative to the sidecar's directory.
  * Validation is strict: unknown or repeated keys, wrong types, dims whose byte
  * count differs from the raw file's size (checked before anything is allocated),
@@ -206,8 +208,8 @@ static atmos_status parse_sidecar(atmos_context *ctx, const char *path, const cJ
                                   raw_sidecar *sc)
 {
     static const char *const single_keys[] = {"file", "dims", "voxel_size_m", "origin_m", "rotation",
-                                              "field", "particle", "scale", NULL};
-    static const char *const multi_keys[] = {"dims", "voxel_size_m", "origin_m", "rotation", "fields", NULL};
+                                              "field", "particle", "scale", "periodic", NULL};
+    static const char *const multi_keys[] = {"dims", "voxel_size_m", "origin_m", "rotation", "fields", "periodic", NULL};
     if (!cJSON_IsObject(root)) return atmos__error(ctx, ATMOS_E_FORMAT, "%s: top level: expected a JSON object", path);
     const cJSON *fields = cJSON_GetObjectItemCaseSensitive(root, "fields");
     int single = fields == NULL;
@@ -219,6 +221,10 @@ static atmos_status parse_sidecar(atmos_context *ctx, const char *path, const cJ
         (st = get_vec(ctx, path, root, "origin_m", 3, sc->vd.origin_m)) ||
         (st = get_vec(ctx, path, root, "rotation", 9, sc->vd.rotation)))
         return st;
+    const cJSON *per = cJSON_GetObjectItemCaseSensitive(root, "periodic");
+    if (per && !cJSON_IsBool(per))
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: periodic: expected true or false", path);
+    sc->vd.periodic = cJSON_IsTrue(per);
     if (!(sc->vd.voxel_size_m > 0))
         return atmos__error(ctx, ATMOS_E_FORMAT, "%s: voxel_size_m: must be > 0", path);
     if (sc->vd.voxel_size_m < ATMOS_VOLUME_MIN_VOXEL_M || sc->vd.voxel_size_m > ATMOS_VOLUME_MAX_VOXEL_M)
@@ -463,6 +469,7 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     cJSON_AddRawToObject(root, "voxel_size_m", num);
     cJSON_AddItemToObject(root, "origin_m", exact_numbers(d->origin_m, 3));
     if (!is_identity(d->rotation)) cJSON_AddItemToObject(root, "rotation", exact_numbers(d->rotation, 9));
+    if (d->periodic) cJSON_AddTrueToObject(root, "periodic");
     cJSON_AddItemToObject(root, "fields", arr = cJSON_CreateArray());
     atmos_status st = ATMOS_OK;
     for (int f = 0; f < nf && st == ATMOS_OK; f++) {

@@ -18,6 +18,7 @@ static void mat_identity(double r[9])
 static atmos_status check_desc(atmos_context *ctx, const atmos_volume_desc *d, atmos_volume_desc *out)
 {
     *out = *d;
+    out->periodic = d->periodic != 0;
     static const char axis[3] = {'x', 'y', 'z'};
     for (int a = 0; a < 3; a++) {
         if (d->dims[a] < 1 || d->dims[a] > ATMOS_VOLUME_MAX_DIM)

@@ -265,3 +265,41 @@ def test_numpy_values_and_wrong_types():
         atmos.sky_radiance(s, np.array([[np.nan, 1.0, 0.0]]))
     with pytest.raises(ValueError, match=".exr"):
         atmos.render(s).write_exr("x.png")
+
+
+def test_non_finite_and_wrong_type_arguments_are_named():
+    # NaN and infinities are not finite numbers (JSON has none: json.dumps wrote them as bare
+    # words, which the library read as strings: "expected a number, got a string")
+    s = atmos.Scene.default()
+    with pytest.raises(ValueError, match=r"sun\.elevation_deg: nan is not a finite number"):
+        s.with_(sun_elevation_deg=float("nan"))
+    with pytest.raises(ValueError, match=r"camera\.fov_deg: inf is not a finite number"):
+        s.with_(camera__fov_deg=np.float64("inf"))
+    with pytest.raises(ValueError, match=r"camera\.position_m\[1\]: -inf is not a finite number"):
+        s.with_(camera__position_m=np.array([0.0, -np.inf, 0.0]))
+    with pytest.raises(ValueError, match=r"image\.width: nan is not a finite number"):
+        atmos.Scene.from_dict({"image": {"width": float("nan")}})
+    with pytest.raises(TypeError, match=r"camera\.fov_deg: expected a JSON value .*got object"):
+        s.with_(camera__fov_deg=object())
+    # a string where a number goes is still the library's "got a string", naming the key
+    with pytest.raises(atmos.AtmosError, match="fov_deg"):
+        s.with_(camera__fov_deg="wide")
+    # the plan's frame and the other numeric arguments: the type's name, or not finite
+    p = atmos.Plan(s.with_(width=8, height=6))
+    with pytest.raises(TypeError, match="camera fov_deg: expected a number, got str 'wide'"):
+        p.render(camera={"fov_deg": "wide"})
+    with pytest.raises(ValueError, match=r"sun \(elevation_deg, azimuth_deg\)\[0\]: inf is not a finite number"):
+        p.render(sun=(float("inf"), 10))
+    with pytest.raises(ValueError, match="spp: nan is not a finite number"):
+        p.render(spp=float("nan"))
+    with pytest.raises(TypeError, match="size .*expected 2 numbers"):
+        p.render(size=8)
+    with pytest.raises(TypeError, match="got bool"):
+        p.render(camera={"fov_deg": True})
+    with pytest.raises(TypeError, match="voxel_size_m: expected a number, got str"):
+        atmos.Volume.from_array(np.ones((2, 2, 2)), "1")
+    with pytest.raises(ValueError, match=r"origin_m\[2\]: nan is not a finite number"):
+        atmos.Volume.from_array(np.ones((2, 2, 2)), 1.0, origin_m=(0, 0, float("nan")))
+    with pytest.raises(ValueError, match="nm: nan is not a finite number"):
+        atmos.refractive_index("water", float("nan"))
+    assert p.render(camera={"fov_deg": np.float32(50)}, size=(np.int64(8), 6)).shape[:2] == (6, 8)

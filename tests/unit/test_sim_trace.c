@@ -29,13 +29,14 @@ static int wrap(long i, int n)
     return (int)(m < 0 ? m + n : m);
 }
 
-/* The reference: field g (stride `stride` floats a cell, component c) at (x, y, z). */
-static double reference(const float *g, int stride, int c, double x, double y, double z)
+/* The reference: field g of nx * ny * NZF cells (stride `stride` floats a cell, component c)
+ * at (x, y, z). */
+static double reference(const float *g, int nx, int ny, int stride, int c, double x, double y, double z)
 {
     z = fmin(fmax(z, 0.0), NZF - 1.0);
     const double fx = floor(x), fy = floor(y), fz = floor(z);
     const double ax = x - fx, ay = y - fy, az = z - fz;
-    const int i0 = wrap((long)fx, NX), i1 = wrap((long)fx + 1, NX), j0 = wrap((long)fy, NY), j1 = wrap((long)fy + 1, NY);
+    const int i0 = wrap((long)fx, nx), i1 = wrap((long)fx + 1, nx), j0 = wrap((long)fy, ny), j1 = wrap((long)fy + 1, ny);
     const int k0 = (int)fz, k1 = k0 + 1 < NZF ? k0 + 1 : k0;
     const int ii[2] = {i0, i1}, jj[2] = {j0, j1}, kk[2] = {k0, k1};
     const double wx[2] = {1 - ax, ax}, wy[2] = {1 - ay, ay}, wz[2] = {1 - az, az};
@@ -43,8 +44,53 @@ static double reference(const float *g, int stride, int c, double x, double y, d
     for (int a = 0; a < 2; a++)
         for (int b = 0; b < 2; b++)
             for (int d = 0; d < 2; d++)
-                v += wx[a] * wy[b] * wz[d] * g[stride * (((size_t)kk[d] * NY + jj[b]) * NX + ii[a]) + c];
+                v += wx[a] * wy[b] * wz[d] * g[stride * (((size_t)kk[d] * ny + jj[b]) * nx + ii[a]) + c];
     return v;
+}
+
+/* Rows of departure points as the advection makes them (point i of a row near i - shift, its
+ * y and z near the row's): a shift the same along the row, whose corners lie side by side
+ * (read in a row by the vectorised path), one that varies so that some points' corners do not,
+ * one lane in another grid row or level, and the row's end, where the second corner wraps.
+ * Against the reference and the scalar code, bit for bit. */
+enum { RX = 40, RN = 4 * RX };
+static void test_rows(atmos_context *ctx)
+{
+    atmos_sim *s = NULL;
+    CHECK_OK(atmos__sim_create_env(ctx, atmos__sim_preset("towering_cumulus"), RX, NY, NZF - 1, 100.0, 1, &s));
+    if (!s) return;
+    const size_t cells = (size_t)RX * NY * NZF;
+    float *f = malloc(cells * sizeof *f), *f4 = malloc(4 * cells * sizeof *f4);
+    for (size_t n = 0; n < cells; n++) f[n] = (float)(u01() * 20.0 - 10.0);
+    for (size_t n = 0; n < 4 * cells; n++) f4[n] = (float)(u01() * 2.0 - 1.0);
+    static double x[RN], y[RN], z[RN];
+    static float out[RN], ref_out[RN], out4[4 * RN], ref_out4[4 * RN];
+    const double shift[4] = {0.3, -1.45, 0.6, 0.05};
+    for (int r = 0; r < 4; r++)
+        for (int i = 0; i < RX; i++) {
+            const int m = r * RX + i;
+            const double wobble = r == 2 ? 0.5 * sin(0.7 * i) : 0.0; /* floors that change along the row */
+            x[m] = i - shift[r] + wobble;
+            y[m] = 3 + 0.4 * u01(), z[m] = 2 + 0.9 * u01();
+        }
+    y[3 * RX + 13] = 4.2;  /* one lane in the next grid row */
+    z[3 * RX + 21] = 3.1;  /* one lane a level up */
+    atmos__sim_sample_row(s, f, NZF, x, y, z, out, RN);
+    atmos__sim_sample_row_scalar(s, f, NZF, x, y, z, ref_out, RN);
+    atmos__sim_sample4_row(s, f4, NZF, x, y, z, out4, RN);
+    atmos__sim_sample4_row_scalar(s, f4, NZF, x, y, z, ref_out4, RN);
+    int bad = 0, bad4 = 0;
+    for (int m = 0; m < RN; m++) {
+        bad += fabs(out[m] - reference(f, RX, NY, 1, 0, x[m], y[m], z[m])) > 1e-4;
+        for (int c = 0; c < 4; c++) bad4 += fabs(out4[4 * m + c] - reference(f4, RX, NY, 4, c, x[m], y[m], z[m])) > 1e-5;
+    }
+    CHECK_MSG(bad == 0, "rows: %d samples off the reference", bad);
+    CHECK_MSG(bad4 == 0, "rows: %d packed samples off the reference", bad4);
+    CHECK_MSG(!memcmp(out, ref_out, sizeof out), "rows: the vectorised samples differ from the scalar code's");
+    CHECK_MSG(!memcmp(out4, ref_out4, sizeof out4), "rows: the vectorised packed samples differ from the scalar code's");
+    free(f);
+    free(f4);
+    atmos_sim_destroy(s);
 }
 
 int main(void)
@@ -84,11 +130,11 @@ int main(void)
     int bad = 0, bad4 = 0;
     double worst = 0;
     for (int m = 0; m < NP; m++) {
-        const double r = reference(f, 1, 0, x[m], y[m], z[m]);
+        const double r = reference(f, NX, NY, 1, 0, x[m], y[m], z[m]);
         worst = fmax(worst, fabs(out[m] - r));
         bad += fabs(out[m] - r) > 1e-5 * 10;
         for (int c = 0; c < 4; c++) {
-            const double r4 = reference(f4, 4, c, x[m], y[m], z[m]);
+            const double r4 = reference(f4, NX, NY, 4, c, x[m], y[m], z[m]);
             worst = fmax(worst, fabs(out4[4 * m + c] - r4) * 10);
             bad4 += fabs(out4[4 * m + c] - r4) > 1e-5;
         }
@@ -102,6 +148,7 @@ int main(void)
     free(f);
     free(f4);
     atmos_sim_destroy(s);
+    test_rows(ctx);
     atmos_context_destroy(ctx);
     return test_summary("test_sim_trace");
 }

@@ -386,14 +386,15 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
     return st;
 }
 
-/* Each output's extension names the format written, no two outputs are the same file and
- * none is an input (the scene file, the volume file). CLI_EXIT_OK or CLI_EXIT_USAGE. */
-static int check_outputs(const render_opts *o, const atmos_scene *scene, const char *png)
+/* Each output's extension names the format written: checked from the options alone, before
+ * the scene, its volume or anything else is read. The options that shape the PNG only
+ * (the tone curve, its bit depth, the exposure) are said to do nothing when no PNG is
+ * written. CLI_EXIT_OK or CLI_EXIT_USAGE. */
+static int check_output_names(const render_opts *o)
 {
-    const char *names[6] = {png, o->exr, o->pfm, o->variance, o->order, o->tau};
+    const char *names[6] = {o->png, o->exr, o->pfm, o->variance, o->order, o->tau};
     static const cli_file_kind want[6] = {CLI_FILE_OTHER, CLI_FILE_EXR, CLI_FILE_PFM, CLI_FILE_EXR, CLI_FILE_PFM, CLI_FILE_PFM};
     static const char *const ext[4] = {"", ".png", ".exr", ".pfm"};
-    cli_outputs set = {0};
     for (int i = 0; i < 6; i++) {
         if (!names[i]) continue;
         const cli_file_kind k = cli_file_kind_of(names[i]);
@@ -402,8 +403,29 @@ static int check_outputs(const render_opts *o, const atmos_scene *scene, const c
                                    names[i]);
         if (i > 0 && k != want[i])
             return cli_usage_error("render", "%s %s: expected a %s file name", out_option[i], names[i], ext[want[i]]);
-        cli_outputs_add(&set, out_option[i], names[i]);
     }
+    /* no -o, --exr nor --pfm: the default PNG is written */
+    const int png = o->png ? cli_file_kind_of(o->png) == CLI_FILE_PNG : !o->exr && !o->pfm;
+    const char *unused[5] = {o->tone >= 0 ? "--tone" : NULL, o->png_bits ? "--png-bits" : NULL,
+                             !isnan(o->ev) || o->exposure_auto ? "--exposure" : NULL,
+                             !isnan(o->ev_comp) ? "--exposure-comp" : NULL, o->exposure_per_frame ? "--exposure-per-frame" : NULL};
+    char list[96] = "";
+    for (int i = 0; i < 5 && !png; i++)
+        if (unused[i]) snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", unused[i]);
+    if (list[0])
+        fprintf(stderr, "atmos render: warning: %s: these shape the PNG only (-o FILE.png), and no PNG is written; the "
+                        "EXR and PFM outputs are linear, untouched by them\n", list);
+    return CLI_EXIT_OK;
+}
+
+/* No two outputs are the same file and none is an input (the scene file, the volume file).
+ * CLI_EXIT_OK or CLI_EXIT_USAGE. */
+static int check_outputs(const render_opts *o, const atmos_scene *scene, const char *png)
+{
+    const char *names[6] = {png, o->exr, o->pfm, o->variance, o->order, o->tau};
+    cli_outputs set = {0};
+    for (int i = 0; i < 6; i++)
+        if (names[i]) cli_outputs_add(&set, out_option[i], names[i]);
     const char *vol = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) &&
                               strncmp(scene->volume.source, "simulate:", 9)
                           ? scene->volume.source
@@ -476,6 +498,8 @@ int cli_cmd_render(int argc, char **argv)
     int rc = render_opts_parse(argc, argv, &o);
     if (rc != CLI_EXIT_OK) return render_opts_free(&o), rc < 0 ? CLI_EXIT_OK /* --help */ : rc;
     cli_dist d;
+    /* the outputs' names first: a wrong one is told before a volume is read */
+    if ((rc = check_output_names(&o)) != CLI_EXIT_OK) return render_opts_free(&o), rc;
     if ((rc = cli_dist_start(o.mpi, &d)) != CLI_EXIT_OK) return render_opts_free(&o), rc;
     o.scene_text = render_scene_text(o.scene_path);
     if (d.rank != 0) o.quiet = 1; /* rank 0 reports; the others speak only of their failures */

@@ -136,6 +136,7 @@ static int cmd_info(int argc, char **argv)
         cJSON_AddItemToArray(gb, vec3(hi));
         cJSON_AddItemToObject(root, "grid_bounds_m", gb);
         cJSON_AddNumberToObject(root, "memory_bytes", (double)atmos_volume_memory(v));
+        cJSON_AddBoolToObject(root, "periodic", d->periodic);
         char *text = cJSON_Print(root);
         if (text) printf("%s\n", text);
         free(text);
@@ -145,6 +146,7 @@ static int cmd_info(int argc, char **argv)
                d->dims[2], d->voxel_size_m, d->origin_m[0], d->origin_m[1], d->origin_m[2]);
         printf("  grid bounds (%g, %g, %g) .. (%g, %g, %g) m\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
         printf("  memory %.3f MB\n", atmos_volume_memory(v) / 1048576.0);
+        if (d->periodic) printf("  periodic: the grid wraps round along x and z (a simulation's sides)\n");
         for (int f = 0; f < atmos_volume_field_count(v); f++) {
             atmos_volume_field_stats s;
             atmos_volume_field_stats_get(ctx, v, f, &s);
@@ -220,6 +222,22 @@ static int cmd_generate(int argc, char **argv)
     return rc;
 }
 
+/* A slice with no density is written black, and said so: the whole field is empty (all zero),
+ * or only this plane is. */
+static void warn_empty_slice(atmos_context *ctx, const atmos_volume *v, int fi, int axis, double at)
+{
+    atmos_volume_field_stats s;
+    const char *name = atmos_volume_field_name(v, fi);
+    if (atmos_volume_field_stats_get(ctx, v, fi, &s) != ATMOS_OK || s.active_voxels == 0) {
+        fprintf(stderr, "atmos volume: warning: field '%s' is empty (every voxel zero): the slice is black\n", name);
+        return;
+    }
+    fprintf(stderr,
+            "atmos volume: warning: the slice at %g along %c holds none of field '%s' (its %llu voxels > 0 lie "
+            "elsewhere): the slice is black; another --at or --axis shows them\n",
+            at, 'x' + axis, name, (unsigned long long)s.active_voxels);
+}
+
 static int cmd_slice(int argc, char **argv)
 {
     const char *file = NULL, *out = NULL, *field = NULL;
@@ -256,6 +274,7 @@ static int cmd_slice(int argc, char **argv)
     if (!file) return cli_usage_error(C, "slice: which file?");
     if (axis < 0) return cli_usage_error(C, "slice: missing --axis x|y|z");
     if (!out) return cli_usage_error(C, "slice: missing -o SLICE.png");
+    if (cli_png_output(C, "-o", out)) return CLI_EXIT_USAGE;
     atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
@@ -301,6 +320,7 @@ static int cmd_slice(int argc, char **argv)
                 if (val > mx) mx = val;
             }
         for (size_t n = 0; n < (size_t)width * height; n++) img->pixels[n] = mx > 0 ? (float)(img->pixels[n] / mx) : 0;
+        if (!(mx > 0)) warn_empty_slice(ctx, v, fi, axis, at);
         char buf[64];
         snprintf(buf, sizeof buf, "%g", mx);
         atmos_image_set_meta(img, "atmos:slice_max_m-3", buf);

@@ -13,7 +13,7 @@ static const char *C = "volume";
 
 typedef struct {
     const char *sources[32];
-    int nsources, kv, periodic; /* periodic: -1 = by source (simulate: yes, others no) */
+    int nsources, kv, periodic; /* periodic: -1 = the volume's own (a simulation's, a sidecar's) */
     const char *field, *csv, *png;
     double base_tau, minutes;
     uint64_t seed;
@@ -39,8 +39,9 @@ void cli_volume_stats_help(void)
            "            with the particle presets' cross-sections; the grid's y axis is up) is at least T\n"
            "            (default 1). Clouds are 4-connected (default) or 8-connected; clouds touching the\n"
            "            grid's edge are counted in the cloud fraction and left out of the fits, except with\n"
-           "            --periodic (the default for simulate:, whose sides are periodic) where the grid wraps\n"
-           "            round. Reported: the cloud fraction; the perimeter-area dimension D (P ~ A^(D/2),\n"
+           "            --periodic (the default for simulate: and for a file whose sidecar says \"periodic\":\n"
+           "            true, as atmos simulate -o writes it) where the grid wraps round. Reported: the\n"
+           "            cloud fraction; the perimeter-area dimension D (P ~ A^(D/2),\n"
            "            least squares of log P on log A over clouds of at least N pixels, default 10) from the\n"
            "            marching-squares outline and from the pixel-edge (crack) perimeter, with standard\n"
            "            errors; the exponent b of the size distribution n(d) ~ d^-b of equivalent diameters\n"
@@ -244,10 +245,11 @@ static int measure(atmos_context *ctx, const opts *o, const char *src, uint64_t 
     }
     atmos_cloud_columns cols;
     st = atmos_cloud_columns_from_volume(ctx, v, sigma, o->base_tau > 0 ? o->base_tau : 0.1, &cols);
+    const int periodic = atmos_volume_get_desc(v)->periodic; /* a simulation's, or its sidecar's "periodic" */
     atmos_volume_destroy(v);
     if (st != ATMOS_OK) return cli_runtime_error(C, ctx, st);
     atmos_cloud_stats_desc d = o->sd;
-    d.periodic = o->periodic >= 0 ? o->periodic : !strncmp(src, "simulate:", 9);
+    d.periodic = o->periodic >= 0 ? o->periodic : periodic;
     atmos_cloud_stats s;
     st = atmos_cloud_stats_measure(ctx, &cols, &d, &s);
     if (st == ATMOS_OK && first && o->png) st = write_mask(ctx, &cols, &s, d.tau_threshold > 0 ? d.tau_threshold : 1, o->png);
@@ -285,6 +287,7 @@ int cli_cmd_volume_stats(int argc, char **argv)
         }
     int rc = parse(argc, argv, &o);
     if (rc != CLI_EXIT_OK) return rc;
+    if (o.png && cli_png_output("volume", "--mask-png", o.png)) return CLI_EXIT_USAGE;
     /* the outputs' folders made as atmos render makes them */
     if ((o.csv && cli_output_folder("volume", "--csv", o.csv)) || (o.png && cli_output_folder("volume", "--mask-png", o.png)))
         return CLI_EXIT_RUNTIME;

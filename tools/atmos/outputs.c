@@ -36,6 +36,14 @@ int cli_volume_output(const char *cmd, const char *option, const char *path)
     return 1;
 }
 
+int cli_png_output(const char *cmd, const char *option, const char *path)
+{
+    if (cli_file_kind_of(path) == CLI_FILE_PNG) return 0;
+    fprintf(stderr, "atmos %s: %s %s: writes a PNG image: the name needs the .png extension\nTry 'atmos %s --help'.\n",
+            cmd, option, path, cmd);
+    return 1;
+}
+
 /* ------------------------------------------------ temporaries removed on signals ---- */
 
 /* Every staging file and the writer's temporary next to it (STAGE.tmpPID, as the

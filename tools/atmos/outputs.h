@@ -22,6 +22,9 @@ cli_file_kind cli_file_kind_of(const char *path);
 /* 0 when path names a raw volume's JSON sidecar (NAME.json, any case); else prints which
  * extension cannot be written and returns 1 (a usage error, found before any work). */
 int cli_volume_output(const char *cmd, const char *option, const char *path);
+/* 0 when path names a PNG file (NAME.png, any case); else prints that the option writes a PNG
+ * and returns 1 (a usage error, found before any work). */
+int cli_png_output(const char *cmd, const char *option, const char *path);
 
 #define CLI_OUTPUTS_MAX 8
 #define CLI_OUTPUT_PATH_MAX 4096

@@ -252,8 +252,7 @@ static int check_options(const render_opts *o)
     const char *C = o->cmd;
     if (o->spectral && o->rgb) return cli_usage_error(C, "--spectral and --rgb exclude each other");
     const int use_time = o->time || !isnan(o->lat) || !isnan(o->lon);
-    if (use_time && (!o->time || isnan(o->lat) || isnan(o->lon)))
-        return cli_usage_error(C, "--time, --lat and --lon go together");
+    if (isnan(o->lat) != isnan(o->lon)) return cli_usage_error(C, "--lat and --lon go together");
     if (use_time && (!isnan(o->sun_el) || !isnan(o->sun_az)))
         return cli_usage_error(C, "--time/--lat/--lon and --sun-elevation/--sun-azimuth exclude each other");
     if (o->exposure_auto && !isnan(o->ev)) return cli_usage_error(C, "--exposure given twice");
@@ -369,13 +368,28 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
         if (!isnan(o->sun_az)) s->sun.azimuth_deg = o->sun_az;
         s->animation.time_end_set = 0; /* a sun switched to angles drops the end of the old form */
     }
+    /* Over a round planet the world frame is the ground's at the atmosphere's latitude_deg and
+     * longitude_deg (its maps are placed from there): --lat/--lon move that place (the Earth
+     * turns under the camera) and the sun's, so that a sun by time stands where the date and
+     * time put it over the map. --time alone keeps the place of a scene's sun by time, else
+     * takes the round planet's. Elsewhere --lat/--lon place the sun alone. */
+    const atmos_atmosphere_kind kind = s->atmosphere.kind;
+    const int round = kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL;
+    const int place = !isnan(o->lat), by_time = o->time || s->sun.from_time;
+    if ((o->time && !place && !s->sun.from_time && !round) || (place && !by_time && !round))
+        return cli_usage_error(C, "--time, --lat and --lon go together (--time alone keeps the place of a scene's sun "
+                                  "by time, or over a round planet, \"model\": \"dobashi\" or \"spherical\", "
+                                  "takes its latitude_deg/longitude_deg)");
     if (o->time) {
         if (atmos_parse_utc_time(ctx, o->time, &s->sun.time) != ATMOS_OK)
             return cli_usage_error(C, "--time: %s", atmos_context_error(ctx));
+        if (!place && !s->sun.from_time) /* a round planet's place */
+            s->sun.latitude_deg = s->atmosphere.latitude_deg, s->sun.longitude_deg = s->atmosphere.longitude_deg;
         s->sun.from_time = 1;
-        s->sun.latitude_deg = o->lat, s->sun.longitude_deg = o->lon;
         s->animation.elevation_end_set = s->animation.azimuth_end_set = 0;
     }
+    if (place && round) s->atmosphere.latitude_deg = o->lat, s->atmosphere.longitude_deg = o->lon;
+    if (place && s->sun.from_time) s->sun.latitude_deg = o->lat, s->sun.longitude_deg = o->lon;
     if (o->frames) s->animation.frames = o->frames;
     if (o->time_end) {
         if (atmos_parse_utc_time(ctx, o->time_end, &s->animation.time_end) != ATMOS_OK)
@@ -678,7 +692,11 @@ void render_opts_help(void)
            "                                camera pointed at it from where the whole box shows)\n"
            "      --sun-elevation E         sun elevation, degrees\n"
            "      --sun-azimuth A           sun azimuth, degrees clockwise from north\n"
-           "      --time T --lat L --lon L  sun from a UTC time (2026-06-21T12:00:00Z) and a place\n"
+           "      --time T --lat L --lon L  sun from a UTC time (2026-06-21T12:00:00Z) and a place; --time\n"
+           "                                alone keeps a scene's place. Over a round planet (\"dobashi\",\n"
+           "                                \"spherical\") the place is the atmosphere's origin's too: --lat\n"
+           "                                and --lon turn the Earth's map under the camera, and the sun\n"
+           "                                stands over the map where the date and time put it\n"
            "      --spectral N              N spectral samples in 380-780 nm (default: the paper's rgb)\n"
            "      --rgb                     the paper's three channels (680, 550, 440 nm)\n"
            "      --exposure EV|auto        manual exposure (EV100, daylight ~15) or automatic\n"

@@ -31,10 +31,9 @@ void view_state_up(const view_state *s, double u[3])
 
 int view_renderer_draws(atmos_renderer_kind r, atmos_camera_type t)
 {
-    /* the library's rules: src/render/plan.c (slice), src/particles/psplat.c (Harris's
-     * splats), src/scene/scene_lights.c (beams) */
-    return t == ATMOS_CAMERA_PINHOLE ||
-           !(r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_HARRIS || r == ATMOS_RENDERER_BEAMS);
+    /* the library's rules: src/render/plan.c (slice), src/scene/scene_lights.c (beams); Harris's
+     * splats take every camera (src/particles/psplat.c) */
+    return t == ATMOS_CAMERA_PINHOLE || !(r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_BEAMS);
 }
 
 atmos_camera_type view_state_camera(const view_state *s, double *fov_deg)
