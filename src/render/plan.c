@@ -82,6 +82,37 @@ static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
                    atmos_renderer_name(s->renderer), list);
 }
 
+/* The flat models (riley, homogeneous) read none of the round ones' air (aerosols, ozone, the
+ * planet): a scene that sets them is told, not silently given the flat sky. */
+static void warn_unused_air(atmos_context *ctx, const atmos_scene *s)
+{
+    const atmos_atmosphere_desc *a = &s->atmosphere;
+    if (a->kind != ATMOS_ATMOSPHERE_RILEY && a->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS) return;
+    atmos_atmosphere_desc d;
+    atmos_atmosphere_defaults(&d);
+    const char *names[9];
+    int n = 0;
+    if (a->aerosol != d.aerosol) names[n++] = "aerosol";
+    if (a->aerosol_scale_height_m != d.aerosol_scale_height_m) names[n++] = "aerosol_scale_height_m";
+    if (a->visibility_km != d.visibility_km) names[n++] = "visibility_km";
+    if (a->turbidity != d.turbidity) names[n++] = "turbidity";
+    if (a->no_ozone) names[n++] = "ozone";
+    if (a->ozone_du != d.ozone_du) names[n++] = "ozone_du";
+    if (a->rayleigh_scale_height_m != d.rayleigh_scale_height_m) names[n++] = "rayleigh_scale_height_m";
+    if (a->planet_radius_m != d.planet_radius_m) names[n++] = "planet_radius_m";
+    if (a->top_m != d.top_m) names[n++] = "top_m";
+    char list[200] = "";
+    for (int i = 0; i < n; i++) {
+        if (i) strcat(list, i == n - 1 ? " and " : ", ");
+        strcat(list, names[i]);
+    }
+    if (n)
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "the %s atmosphere model does not use %s (the round-planet models do: \"model\": \"spherical\" "
+                   "or \"dobashi\")",
+                   a->kind == ATMOS_ATMOSPHERE_RILEY ? "riley" : "homogeneous", list);
+}
+
 atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,
                                const atmos_plan_desc *desc, atmos_plan **out)
 {
@@ -93,6 +124,7 @@ atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, con
     atmos_status st = check_scene(ctx, scene, volume, &d);
     if (st != ATMOS_OK) return st;
     warn_unused_parts(ctx, scene);
+    warn_unused_air(ctx, scene);
     atmos_plan *p = calloc(1, sizeof *p);
     if (!p) return atmos__error(ctx, ATMOS_E_NOMEM, "plan: out of memory");
     p->ctx = ctx;

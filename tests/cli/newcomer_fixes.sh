@@ -177,4 +177,14 @@ has "--time alone, flat" "go together"
 "$A" render --help >"$T/err"
 has "render --help" "turn the Earth's map under the camera"
 
+# --- 8. the flat models do not use the round ones' air: said, not silently ignored
+"$A" render -D atmosphere.aerosol=desert -D atmosphere.visibility_km=1 -D atmosphere.ozone=false --width 8 --height 8 \
+    -o "$T/r.png" -q 2>"$T/err" || bad "riley with aerosol settings"
+has "riley ignores the round planet's air" "does not use aerosol, visibility_km and ozone"
+"$A" render -D atmosphere.model=spherical -D atmosphere.aerosol=desert --renderer sky --width 8 --height 8 \
+    -o "$T/s.png" -q 2>"$T/err" || bad "spherical with aerosol settings"
+hasnt "spherical uses its aerosol" "does not use"
+"$A" render --width 8 --height 8 -o "$T/d.png" -q 2>"$T/err" || bad "the default scene"
+hasnt "the default scene" "does not use"
+
 exit $fail
