@@ -23,7 +23,7 @@
  * sun cosines, angles from the sun, azimuths about it; the fixed-point iterations that
  * build it from Psi_ms. */
 #define ATMOS__SPH_J_R 16
-#define ATMOS__SPH_J_MUS 32
+#define ATMOS__SPH_J_MUS 40
 #define ATMOS__SPH_J_G 24
 #define ATMOS__SPH_J_P 10
 #define ATMOS__SPH_J_ITER 2

@@ -21,11 +21,11 @@
  *   rows   x_r = sqrt(h / top) (dense near the ground, where the aerosols are);
  *   mu_s   the sun's elevation e = (pi / 2) u |u|, the columns uniform in u from
  *          mu_s = -0.3 (17.5 degrees down: the sun is below the horizon of every point of
- *          the air) to the zenith: dense near the horizon (twilight; 0.1 to 1.9 degrees
- *          apart within 6 degrees of it, 3.5 at the lowest) and 8.2 at the zenith. (The columns
- *          were y|y| = mu_s, uniform in y: 25.5 degrees apart at the zenith, so with a high
- *          sun a view node near the horizon, fixed in angle from the sun, saw the sky in one
- *          column and the ground in the next: J 8-17 % off between them there,
+ *          the air) to the zenith, 40 of them: dense near the horizon (twilight; 0.1 to 1.6
+ *          degrees apart within 6 degrees of it, 2.8 at the lowest) and 6.5 at the zenith.
+ *          (The columns were 32, y|y| = mu_s uniform in y: 25.5 degrees apart at the zenith,
+ *          so with a high sun a view node near the horizon, fixed in angle from the sun, saw
+ *          the sky in one column and the ground in the next: J 8-17 % off between them there,
  *          tests/unit/test_sky_jsun.c.) Below the lowest column, that column times
  *          e^(-60 (-0.3 - mu_s)), a steep fade standing for the night's darkening;
  *   gamma  the angle between the view and the sun, gamma = pi (a x + b x^2 + c x^3) with
