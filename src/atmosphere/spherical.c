@@ -13,7 +13,7 @@
 #include <string.h>
 
 /* Bumped whenever the tables' content or layout changes. */
-#define SPH_TABLE_VERSION 5
+#define SPH_TABLE_VERSION 6
 
 static void sph_destroy(void *model)
 {
@@ -176,7 +176,7 @@ static atmos_status j_table(atmos_context *ctx, const atmos__sph_model *m, int p
         ctx, v, w, h, n, 1, (size_t)w, (size_t)w * h, 0, name,
         "x: gamma node * J_P + psi node (gamma, the angle from the sun, = pi (0.3 u + 2.1 u^2 - 1.4 u^3), u = node / "
         "(J_G - 1); psi, the azimuth about the sun, (1 - cos psi) / 2 = node / (J_P - 1)); y: altitude row * "
-        "J_MUS + sun column (rows sqrt(altitude / top); columns y|y|, y in [-sqrt 0.3, 1]); "
+        "J_MUS + sun column (rows sqrt(altitude / top); columns uniform in u, the sun's elevation (pi / 2) u |u|, from asin(-0.3) to the zenith); "
         "sr^-1 per unit irradiance and scattering coefficient",
         out);
     free(v);

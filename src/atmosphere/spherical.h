@@ -23,7 +23,7 @@
  * sun cosines, angles from the sun, azimuths about it; the fixed-point iterations that
  * build it from Psi_ms. */
 #define ATMOS__SPH_J_R 16
-#define ATMOS__SPH_J_MUS 32
+#define ATMOS__SPH_J_MUS 40
 #define ATMOS__SPH_J_G 24
 #define ATMOS__SPH_J_P 10
 #define ATMOS__SPH_J_ITER 2
@@ -113,6 +113,13 @@ void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, co
  * orders (Psi_ms, or jms of the iteration before) and sets use_j; albedo: the uniform
  * ground's. */
 atmos_status atmos__sph_build_j(const atmos__planet *pl, atmos__sph_model *m, const double *albedo);
+/* J_ms gathered directly at radius r with the sun at cosine mus (the build's gather over
+ * the field marched with the current tables, off the table's columns): out[(v * n + k) * 2
+ * + part] = log(j + ATMOS__SPH_J_FLOOR) at view node v = ig * J_P + ip (gamma of ig /
+ * (J_G - 1), psi's cosine 1 - 2 ip / (J_P - 1)), part 0 the air molecules, 1 the aerosols
+ * (a check of the table's interpolation between its sun columns). */
+atmos_status atmos__sph_j_direct(const atmos__planet *pl, const atmos__sph_model *m, double r, double mus,
+                                 const double *albedo, float *out);
 /* f_ms at (r, mu_s) of wavelength k (a diagnostic of the multiple-scattering table). */
 double atmos__sph_fms(const atmos__sph_model *m, double r, double mu_s, int k);
 /* The mappings' inverses the build needs (spherical_lookup.c): the (r, mu) of a depth-table

@@ -12,7 +12,8 @@
 #define JG ATMOS__SPH_J_G
 #define JP ATMOS__SPH_J_P
 #define GA ATMOS__SPH_J_GA
-#define XS 0.5477225575051661 /* sqrt(0.3): the columns' lowest sun, mu_s = -0.3 */
+#define MUS_LO (-0.3) /* the columns' lowest sun (17.5 degrees below the horizon) */
+#define XS 0.4404240774995806 /* sqrt(asin(0.3) / (pi / 2)): u of the lowest column */
 #define JFADE 60.0 /* J's decay per unit of mu_s below the lowest column (e^-6 at -0.4) */
 #define JFLOOR ATMOS__SPH_J_FLOOR
 
@@ -32,15 +33,17 @@ static double gamma_to_x(double g)
     }
     return x;
 }
+/* The sun columns: u = sign(e) sqrt(|e| / (pi / 2)) of the sun's elevation e, uniform in
+ * u from the lowest column to the zenith (spherical_ms.c). */
 static double mus_x(double mus)
 {
-    const double x = copysign(sqrt(fabs(atmos__clampd(mus, -1, 1))), mus);
-    return atmos__clampd((x + XS) / (1.0 + XS), 0.0, 1.0);
+    const double e = asin(atmos__clampd(mus, -1, 1)), u = copysign(sqrt(fabs(e) / (0.5 * ATMOS_PI)), e);
+    return atmos__clampd((u + XS) / (1.0 + XS), 0.0, 1.0);
 }
 double atmos__sph_j_x_mus(double x)
 {
-    const double y = -XS + (1.0 + XS) * x;
-    return y * fabs(y);
+    const double u = -XS + (1.0 + XS) * x;
+    return sin(0.5 * ATMOS_PI * u * fabs(u));
 }
 
 /* ------------------------------------------------------------------ look-up */
@@ -89,7 +92,7 @@ void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, co
     }
     /* below the lowest column a steep fade, not the column's light: the night side keeps
      * its darkness (the night lights stay the brightest thing there) */
-    const double fade = mus < -XS * XS ? exp(-JFADE * (-XS * XS - mus)) : 1.0;
+    const double fade = mus < MUS_LO ? exp(-JFADE * (MUS_LO - mus)) : 1.0;
     for (int i = 0; i < cnt; i++) jr[i] = (exp(acc[2 * i]) - JFLOOR) * fade, jm[i] = (exp(acc[2 * i + 1]) - JFLOOR) * fade;
 }
 

@@ -19,9 +19,14 @@
  *
  * Parametrization (sun-centred; J is smooth away from the sun and peaked toward it):
  *   rows   x_r = sqrt(h / top) (dense near the ground, where the aerosols are);
- *   mu_s   x = (y + sqrt(0.3)) / (1 + sqrt(0.3)), y = sign(mu_s) sqrt|mu_s| (dense near the
- *          horizon: twilight), down to mu_s = -0.3 (17.5 degrees down: the sun is below the
- *          horizon of every point of the air); below, the lowest column times
+ *   mu_s   the sun's elevation e = (pi / 2) u |u|, the columns uniform in u from
+ *          mu_s = -0.3 (17.5 degrees down: the sun is below the horizon of every point of
+ *          the air) to the zenith, 40 of them: dense near the horizon (twilight; 0.1 to 1.6
+ *          degrees apart within 6 degrees of it, 2.8 at the lowest) and 6.5 at the zenith.
+ *          (The columns were 32, y|y| = mu_s uniform in y: 25.5 degrees apart at the zenith,
+ *          so with a high sun a view node near the horizon, fixed in angle from the sun, saw
+ *          the sky in one column and the ground in the next: J 8-17 % off between them there,
+ *          tests/unit/test_sky_jsun.c.) Below the lowest column, that column times
  *          e^(-60 (-0.3 - mu_s)), a steep fade standing for the night's darkening;
  *   gamma  the angle between the view and the sun, gamma = pi (a x + b x^2 + c x^3) with
  *          the slope a = 0.3 at both ends (24 nodes 2.3 degrees apart at the sun and at the
@@ -44,6 +49,7 @@
  * spherical_jlookup.c). Threads over (r, mu_s) nodes: the result does not depend on their
  * number. */
 #include "atmosphere/spherical.h"
+#include "core/vec.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -193,12 +199,13 @@ static void horizon_cell(const atmos__planet *pl, const atmos__sph_model *m, con
     for (int k = 0; k < n; k++) L[(size_t)k * QN + q] = (float)((1.0 - f) * L[(size_t)k * QN + q] + f * l[k]);
 }
 
-static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_quad *qd, int ir, int is,
-                  const double *albedo, float *out)
+/* The gather at radius r with the sun at cosine ms: log(j + floor) of every view node, in
+ * the table's layout of one (r, mu_s) node ([JG][JP][n][2]). */
+static int j_gather(const atmos__planet *pl, const atmos__sph_model *m, const j_quad *qd, double r, double ms,
+                    const double *albedo, float *out)
 {
     const int n = m->n;
-    const double x = (double)ir / (JR - 1), r = m->R + (m->Rt - m->R) * x * x;
-    const double ms = atmos__sph_j_x_mus((double)is / (JS - 1)), ss = sqrt(fmax(0.0, 1.0 - ms * ms));
+    const double ss = sqrt(fmax(0.0, 1.0 - ms * ms));
     const double sun[3] = {ss, ms, 0};
     double l[ATMOS_MAX_WAVELENGTHS];
     float *L = malloc(sizeof(float) * QN * (size_t)n); /* [n][QN]: each wavelength's run contiguous */
@@ -224,19 +231,44 @@ static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_qu
     return 0;
 }
 
+static int j_node(const atmos__planet *pl, const atmos__sph_model *m, const j_quad *qd, int ir, int is,
+                  const double *albedo, float *out)
+{
+    const double x = (double)ir / (JR - 1), r = m->R + (m->Rt - m->R) * x * x;
+    return j_gather(pl, m, qd, r, atmos__sph_j_x_mus((double)is / (JS - 1)), albedo, out);
+}
+
+/* The quadrature's nodes and phase weights (qd->w allocated; NULL when out of memory). */
+static int j_quad_init(const atmos__planet *pl, j_quad *qd)
+{
+    quad_nodes(qd);
+    qd->w = malloc(sizeof(float) * (size_t)pl->n * 2 * JV * QN);
+    if (!qd->w) return 1;
+    quad_weights(pl, qd);
+    return 0;
+}
+
+atmos_status atmos__sph_j_direct(const atmos__planet *pl, const atmos__sph_model *m, double r, double mus,
+                                 const double *albedo, float *out)
+{
+    j_quad qd;
+    if (j_quad_init(pl, &qd)) return ATMOS_E_NOMEM;
+    const int fail = j_gather(pl, m, &qd, r, atmos__clampd(mus, -1.0, 1.0), albedo, out);
+    free(qd.w);
+    return fail ? ATMOS_E_NOMEM : ATMOS_OK;
+}
+
 atmos_status atmos__sph_build_j(const atmos__planet *pl, atmos__sph_model *m, const double *albedo)
 {
     const int n = m->n;
     const size_t per = (size_t)JV * 2 * n, total = (size_t)JR * JS * per;
     j_quad qd;
-    quad_nodes(&qd);
-    qd.w = malloc(sizeof(float) * (size_t)n * 2 * JV * QN);
+    if (j_quad_init(pl, &qd)) return ATMOS_E_NOMEM;
     float *next = malloc(sizeof(float) * total);
-    if (!qd.w || !next) {
-        free(qd.w), free(next);
+    if (!next) {
+        free(qd.w);
         return ATMOS_E_NOMEM;
     }
-    quad_weights(pl, &qd);
     int fail = 0;
 #pragma omp parallel for schedule(dynamic) reduction(| : fail)
     for (int e = 0; e < JR * JS; e++) fail |= j_node(pl, m, &qd, e / JS, e % JS, albedo, next + (size_t)e * per);

@@ -126,17 +126,17 @@ done
 "$cli" sky --model spherical --table list >"$T/tables.txt" 2>&1 && grep -qx transmittance "$T/tables.txt" &&
     grep -qx multiple_scattering "$T/tables.txt" && ok "sky --table list names the spherical tables" ||
     bad "sky --table list: $(cat "$T/tables.txt")"
-# the higher orders' 4-D scattering density as an image: 20 x 10 (gamma, psi) nodes across, 16 x 32
+# the higher orders' 4-D scattering density as an image: 24 x 10 (gamma, psi) nodes across, 16 x 40
 # (altitude, sun) nodes down, positive and finite (a PFM's header, then its floats)
 "$cli" sky --model spherical --table higher_orders_aerosols -o "$T/j.pfm" >/dev/null 2>&1 &&
-    [ "$(sed -n 2p "$T/j.pfm")" = "240 512" ] &&
+    [ "$(sed -n 2p "$T/j.pfm")" = "240 640" ] &&
     python3 -c "
 import struct, sys, math
 d = open(sys.argv[1], 'rb').read()
 head = d.split(b'\\n', 3)
-v = struct.unpack('<%df' % (240 * 512 * 3), head[3][:240 * 512 * 3 * 4])
+v = struct.unpack('<%df' % (240 * 640 * 3), head[3][:240 * 640 * 3 * 4])
 sys.exit(0 if all(math.isfinite(x) and x > 0 for x in v) and max(v) > 10 * min(v) else 1)
-" "$T/j.pfm" && ok "sky --table higher_orders_aerosols writes J_ms's 240 x 512 image, positive and finite" ||
+" "$T/j.pfm" && ok "sky --table higher_orders_aerosols writes J_ms's 240 x 640 image, positive and finite" ||
     bad "sky --table higher_orders_aerosols"
 "$cli" sky --model dobashi --table sun_attenuation -o "$T/gl.png" >/dev/null 2>&1 &&
     head -c 8 "$T/gl.png" | od -An -c | grep -q 'P   N   G' && ok "sky --table sun_attenuation -o x.png writes a PNG" ||
