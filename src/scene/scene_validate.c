@@ -284,8 +284,8 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
                                  "the slice renderer supports pinhole cameras only");
     if (!s->volume.placed && s->volume.source[0] && s->camera.type != ATMOS_CAMERA_PINHOLE)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/position_m",
-                                 "is needed with a %s camera (a volume is placed in front of pinhole cameras only)",
-                                 s->camera.type == ATMOS_CAMERA_FISHEYE ? "fisheye" : "equirect");
+                                 "is needed with %s camera (a volume is placed in front of pinhole cameras only)",
+                                 s->camera.type == ATMOS_CAMERA_FISHEYE ? "a fisheye" : "an equirect");
     const struct {
         const char *path;
         double v;

@@ -187,4 +187,12 @@ hasnt "spherical uses its aerosol" "does not use"
 "$A" render --width 8 --height 8 -o "$T/d.png" -q 2>"$T/err" || bad "the default scene"
 hasnt "the default scene" "does not use"
 
+# --- 9. a number that does not parse points to --help, as the other usage errors do
+for bad_opt in "--grid 15" "--minutes abc" "--threads 0"; do
+    # shellcheck disable=SC2086
+    "$A" simulate towering_cumulus $bad_opt -o "$T/x.json" 2>"$T/err"
+    [ $? -eq 2 ] && ok "simulate $bad_opt: a usage error" || bad "simulate $bad_opt: not a usage error"
+    has "simulate $bad_opt" "Try 'atmos simulate --help'."
+done
+
 exit $fail

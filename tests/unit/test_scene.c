@@ -304,7 +304,7 @@ static const bad_case bad_renderers[] = {
     {"{\"renderer\": \"slice\"}", ATMOS_E_INVALID_ARG, "/renderer: \"slice\" renders a volume: the scene needs \"volume\"", NULL},
     {"{\"renderer\": \"sky\", \"volume\": {\"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume: the sky renderer draws no volume", NULL},
     {"{\"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"fisheye\"}}", ATMOS_E_INVALID_ARG, "/camera/type: the slice renderer supports pinhole cameras only", NULL},
-    {"{\"renderer\": \"path\", \"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"equirect\"}}", ATMOS_E_INVALID_ARG, "/volume/position_m: is needed with a equirect camera", NULL},
+    {"{\"renderer\": \"path\", \"volume\": {\"generate\": \"storm\"}, \"camera\": {\"type\": \"equirect\"}}", ATMOS_E_INVALID_ARG, "/volume/position_m: is needed with an equirect camera", NULL},
     {"{\"volume\": {\"generate\": \"blob\"}}", ATMOS_E_INVALID_ARG, "/volume/generate: unknown generator (known: cumulus,", NULL},
     {"{\"volume\": {\"file\": \"a.vdb\", \"generate\": \"storm\"}}", ATMOS_E_INVALID_ARG, "/volume/generate: \"file\" and \"generate\" exclude each other", NULL},
     {"{\"volume\": {\"file\": \"\"}}", ATMOS_E_INVALID_ARG, "/volume/file: must not be empty", NULL},

@@ -18,7 +18,8 @@ int cli_parse_double(const char *cmd, const char *opt, const char *text, double 
     errno = 0;
     double v = text ? strtod(text, &end) : 0.0;
     if (!text || end == text || *end != '\0' || errno == ERANGE || !isfinite(v)) {
-        fprintf(stderr, "atmos %s: %s: expected a finite number, got '%s'\n", cmd, opt, text ? text : "");
+        fprintf(stderr, "atmos %s: %s: expected a finite number, got '%s'\nTry 'atmos %s --help'.\n", cmd, opt,
+                text ? text : "", cmd);
         return 0;
     }
     *out = v;
@@ -31,8 +32,8 @@ int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, l
     errno = 0;
     long v = text ? strtol(text, &end, 10) : 0;
     if (!text || end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
-        fprintf(stderr, "atmos %s: %s: expected an integer in [%ld, %ld], got '%s'\n", cmd, opt, lo, hi,
-                text ? text : "");
+        fprintf(stderr, "atmos %s: %s: expected an integer in [%ld, %ld], got '%s'\nTry 'atmos %s --help'.\n", cmd, opt,
+                lo, hi, text ? text : "", cmd);
         return 0;
     }
     *out = (int)v;

@@ -12,13 +12,14 @@ static const char *C = "simulate";
 static void help(void)
 {
     printf("Usage: atmos simulate PRESET -o NAME.json [--minutes M] [--grid N] [--seed S] [--threads T]\n"
-           "                      [--quiet]\n\n"
+           "                      [--quiet] [--bench K]\n\n"
            "Runs the cloud-physics simulation (docs/clouds.md): a 3-D Boussinesq fluid with potential\n"
            "temperature, water vapour, cloud water and rain, Kessler warm rain and saturation adjustment,\n"
            "periodic sides. Writes the state at time M as a volume of \"cloud\" and \"rain\" number\n"
            "densities (m^-3; mixing ratio x air density / the particle type's mean mass), raw float32\n"
-           "files next to the JSON sidecar (-o must name a .json file; nothing else is written), y up, the\n"
-           "ground at y = 0. A volume with no cloud and no rain is written with a warning.\n\n"
+           "files next to the JSON sidecar (-o must name a .json file, whose folder is made if missing;\n"
+           "nothing else is written), y up, the ground at y = 0. A volume with no cloud and no rain is\n"
+           "written with a warning.\n\n"
            "Presets (default simulated time; a shorter run may end before any cloud has formed, and the\n"
            "volume is then empty: at least the first-cloud time, better twice it; coarser grids take\n"
            "longer, e.g. cumulus_field ~12 min at --grid 32):\n");
