@@ -106,11 +106,17 @@ static void warn_unused_air(atmos_context *ctx, const atmos_scene *s)
         if (i) strcat(list, i == n - 1 ? " and " : ", ");
         strcat(list, names[i]);
     }
+    const char *kind = a->kind == ATMOS_ATMOSPHERE_RILEY ? "riley" : "homogeneous";
     if (n)
         atmos__log(ctx, ATMOS_LOG_WARN,
                    "the %s atmosphere model does not use %s (the round-planet models do: \"model\": \"spherical\" "
                    "or \"dobashi\")",
-                   a->kind == ATMOS_ATMOSPHERE_RILEY ? "riley" : "homogeneous", list);
+                   kind, list);
+    if (s->camera.position[1] > 100e3) /* above the Karman line: a user looking for the planet */
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "the %s atmosphere model is a flat earth: from %.0f km up it shows an endless plane; the "
+                   "round-planet models draw the Earth from space (\"model\": \"spherical\" or \"dobashi\")",
+                   kind, s->camera.position[1] / 1000.0);
 }
 
 atmos_status atmos_plan_create(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *volume,

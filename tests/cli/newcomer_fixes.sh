@@ -187,6 +187,12 @@ hasnt "spherical uses its aerosol" "does not use"
 "$A" render --width 8 --height 8 -o "$T/d.png" -q 2>"$T/err" || bad "the default scene"
 hasnt "the default scene" "does not use"
 
+# the flat sky from space says the planet is elsewhere
+"$A" render --altitude 400000 --view-elevation -30 --width 8 --height 8 -o "$T/f.png" -q 2>"$T/err" || bad "riley from 400 km"
+has "riley from 400 km" "flat earth"
+"$A" render --altitude 4000 --width 8 --height 8 -o "$T/f.png" -q 2>"$T/err" || bad "riley from 4 km"
+hasnt "riley from 4 km" "flat earth"
+
 # --- 9. a number that does not parse points to --help, as the other usage errors do
 for bad_opt in "--grid 15" "--minutes abc" "--threads 0"; do
     # shellcheck disable=SC2086
