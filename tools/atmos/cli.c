@@ -157,9 +157,11 @@ void cli_progress_init(cli_progress *p, int quiet)
     p->enabled = !quiet && isatty(2);
     const char *iv = getenv("ATMOS_PROGRESS_INTERVAL");
     char *end = NULL;
-    p->interval = iv && *iv ? strtod(iv, &end) : 5.0;
-    if (!(p->interval >= 0) || (end && *end)) p->interval = 5.0;
-    p->log = !quiet && !p->enabled && iv && *iv;
+    /* off a terminal (a batch job's log): a line a minute once a stage has run a minute, so a
+     * long first build of the tables is not silent; ATMOS_PROGRESS_INTERVAL=S sets the interval */
+    p->interval = iv && *iv ? strtod(iv, &end) : 60.0;
+    if (!(p->interval >= 0) || (end && *end)) p->interval = 60.0;
+    p->log = !quiet && !p->enabled;
     const char *dl = getenv("ATMOS_PROGRESS_DELAY");
     end = NULL;
     p->delay = dl && *dl ? strtod(dl, &end) : 1.0;
