@@ -4,6 +4,8 @@
 #ifndef ATMOS_TEST_H
 #define ATMOS_TEST_H
 
+#include "atmos/atmos.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,6 +57,20 @@ static inline int test_summary(const char *name)
 {
     printf("%s: %d passed, %d failed\n", name, test_passed_, test_failed_);
     return test_failed_ ? 1 : 0;
+}
+
+/* A context for a test: `threads` threads, no log, its tables cached in `cache_dir` (the test's
+ * scratch cache; NULL: the user's); exits on failure. */
+static inline atmos_context *test_context(int threads, const char *cache_dir)
+{
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    d.threads = threads;
+    d.cache_dir = cache_dir;
+    d.log = NULL;
+    atmos_context *ctx = NULL;
+    if (atmos_context_create(&d, &ctx) != ATMOS_OK) exit(1);
+    return ctx;
 }
 
 /* Scratch path for a test's output files: $ATMOS_TEST_TMP/name (or /tmp). */

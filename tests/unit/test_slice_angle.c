@@ -78,13 +78,7 @@ static double side_bias(atmos_context *ctx, const atmos_volume *v, const test_op
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "cache");
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = 2;
-    d.cache_dir = cache_dir;
-    d.log = NULL;
-    atmos_context *ctx = NULL;
-    if (atmos_context_create(&d, &ctx) != ATMOS_OK) return 1;
+    atmos_context *ctx = test_context(2, cache_dir);
     test_optics op;
     test_hg_optics(ctx, "hg085c", 0.85, 1.0, 1, &op);
     atmos_volume *v = test_blob(ctx, 1.2e8f); /* optical depth ~20 through the centre */

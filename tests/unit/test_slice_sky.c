@@ -68,13 +68,7 @@ static void cloud_error(const atmos_image *img, const atmos_image *ref, const at
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "cache");
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = 2;
-    d.cache_dir = cache_dir;
-    d.log = NULL;
-    atmos_context *ctx = NULL;
-    if (atmos_context_create(&d, &ctx) != ATMOS_OK) return 1;
+    atmos_context *ctx = test_context(2, cache_dir);
     test_optics op;
     test_hg_optics(ctx, "hg085", 0.85, 0.9, 1, &op);
     /* peak 1.5e7 m^-3: optical depth ~2.7 through the centre, ~0.5 near the rim */

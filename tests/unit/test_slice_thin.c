@@ -98,13 +98,7 @@ static double ratio(atmos_context *ctx, const test_optics *op, double tau, const
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "cache");
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = 2;
-    d.cache_dir = cache_dir;
-    d.log = NULL;
-    atmos_context *ctx = NULL;
-    if (atmos_context_create(&d, &ctx) != ATMOS_OK) return 1;
+    atmos_context *ctx = test_context(2, cache_dir);
     test_optics op;
     test_hg_optics(ctx, "hg085t", 0.85, 1.0, 1, &op);
     const double thin = ratio(ctx, &op, 0.25, "thin sheet"), dense = ratio(ctx, &op, 25.0, "dense sheet");
