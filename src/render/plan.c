@@ -62,6 +62,14 @@ static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const
 
 /* The fog, the lights and the objects are drawn by the beam renderer and the path tracer only:
  * a scene that gives them to another renderer is told so rather than silently drawn without. */
+/* names[0..n) as "a, b and c" into out (cap bytes). */
+static void join_names(const char *const *names, int n, char *out, size_t cap)
+{
+    out[0] = '\0';
+    for (int i = 0; i < n; i++)
+        snprintf(out + strlen(out), cap - strlen(out), "%s%s", i ? (i == n - 1 ? " and " : ", ") : "", names[i]);
+}
+
 static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
 {
     if (s->renderer == ATMOS_RENDERER_BEAMS || s->renderer == ATMOS_RENDERER_PATH) return;
@@ -70,11 +78,8 @@ static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
     if (s->fog.enabled) in_list[n++] = "fog";
     if (s->light_count > 0) in_list[n++] = "lights";
     if (s->object_count > 0) in_list[n++] = "objects";
-    char list[64] = "";
-    for (int i = 0; i < n; i++) {
-        if (i) strcat(list, i == n - 1 ? " and " : ", ");
-        strcat(list, in_list[i]);
-    }
+    char list[64];
+    join_names(in_list, n, list, sizeof list);
     if (list[0])
         atmos__log(ctx, ATMOS_LOG_WARN,
                    "the %s renderer does not draw the scene's %s (the beam renderer and the path tracer do: "
@@ -101,11 +106,8 @@ static void warn_unused_air(atmos_context *ctx, const atmos_scene *s)
     if (a->rayleigh_scale_height_m != d.rayleigh_scale_height_m) names[n++] = "rayleigh_scale_height_m";
     if (a->planet_radius_m != d.planet_radius_m) names[n++] = "planet_radius_m";
     if (a->top_m != d.top_m) names[n++] = "top_m";
-    char list[200] = "";
-    for (int i = 0; i < n; i++) {
-        if (i) strcat(list, i == n - 1 ? " and " : ", ");
-        strcat(list, names[i]);
-    }
+    char list[200];
+    join_names(names, n, list, sizeof list);
     const char *kind = a->kind == ATMOS_ATMOSPHERE_RILEY ? "riley" : "homogeneous";
     if (n)
         atmos__log(ctx, ATMOS_LOG_WARN,
