@@ -21,14 +21,7 @@ static int long_run;
 
 static atmos_context *make_ctx(int threads)
 {
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = threads;
-    d.cache_dir = cache_dir;
-    d.log = NULL;
-    atmos_context *ctx = NULL;
-    if (atmos_context_create(&d, &ctx) != ATMOS_OK) exit(1);
-    return ctx;
+    return test_context(threads, cache_dir);
 }
 
 /* ------------------------------------------------------------------ adding-doubling on its own */

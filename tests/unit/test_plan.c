@@ -29,14 +29,7 @@ static const char *scene_json =
 
 static atmos_context *make_ctx(int threads)
 {
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = threads;
-    d.cache_dir = cache_dir;
-    d.log = NULL;
-    atmos_context *ctx = NULL;
-    CHECK_OK(atmos_context_create(&d, &ctx));
-    return ctx;
+    return test_context(threads, cache_dir);
 }
 
 static void load_scene(atmos_context *ctx, atmos_renderer_kind r, atmos_scene *s)

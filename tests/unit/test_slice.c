@@ -15,14 +15,7 @@ static char cache_dir[1024];
 
 static atmos_context *make_ctx(int threads)
 {
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = threads;
-    d.cache_dir = cache_dir;
-    d.log = NULL;
-    atmos_context *ctx = NULL;
-    if (atmos_context_create(&d, &ctx) != ATMOS_OK) exit(1);
-    return ctx;
+    return test_context(threads, cache_dir);
 }
 
 /* A Gaussian blob of peak density peak (m^-3), zero at the edges, 640 m across,
