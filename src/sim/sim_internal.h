@@ -47,6 +47,7 @@ typedef struct sim_env {
     double noise_th;              /* initial theta noise amplitude below zi, at least 1 km (K) */
     double top_cooling;           /* cloud-top radiative cooling, W m^-2 (0 = none) */
     double confinement;           /* vorticity confinement epsilon (Fedkiw et al. 2001) */
+    double k_eddy;                /* sub-grid eddy diffusivity, m^2/s (0 = none; sim_diffuse.c) */
     int micro;                    /* 0: dry (no phase changes) */
 } sim_env;
 
@@ -135,6 +136,7 @@ void atmos__sim_sample4_row_scalar(const atmos_sim *sim, const float *f4, int nz
 /* sim_forces.c: surface fluxes, cloud-top cooling, buoyancy and the sponge of row j (y = j);
  * returns the water the surface added to the row */
 double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);
+void atmos__sim_diffuse(atmos_sim *sim, double dt);       /* sim_diffuse.c: sub-grid mixing */
 void atmos__sim_confine(atmos_sim *sim, double dt);       /* sim_confine.c: vorticity confinement */
 void atmos__sim_project(atmos_sim *sim);                  /* sim_pressure.c */
 #define SIM_CW 8 /* columns of modes solved side by side (sim_pressure.c) */

@@ -37,11 +37,14 @@ static const preset presets[] = {
       .bubble_dqv = 0, .shf = 0, .lhf = 0, .flux_noise = 0, .noise_th = 0.2, .confinement = 0.2, .micro = 1}},
     /* A stratocumulus deck after DYCOMS-II RF01 (Stevens et al. 2005): a well-mixed layer
      * (theta 289 K, 9 g/kg) to 840 m under an 8.5 K inversion with dry air above, cloud-top
-     * radiative cooling (60 W m^-2) stirring it. */
+     * radiative cooling (60 W m^-2) stirring it. No wind: the mixed layer's momentum is well
+     * mixed, so the domain moves with it (a tanh shear through the layer drew the deck out
+     * into streaks along the wind). Horizontal sub-grid mixing (k_eddy, sim_diffuse.c) keeps
+     * the cells several grid cells across (without it they were noise one cell wide). */
     {"stratocumulus",
      {.kind = SIM_SOUNDING_LAYERED, .domain_m = 6400, .height_m = 1600, .minutes = 20, .dt_max = 5,
       .theta_s = 289, .zi = 840, .dtheta_inv = 8.5, .inv_depth = 50, .gamma_ft = 3e-3, .z_tp = 5000,
-      .gamma_strat = 3e-3, .qv_bl = 9e-3, .qv_ft = 1.5e-3, .hq = 1e6, .u_s = 5, .z_shear = 1000, .u_move = 0,
+      .gamma_strat = 3e-3, .qv_bl = 9e-3, .qv_ft = 1.5e-3, .hq = 1e6, .u_s = 0, .z_shear = 1000, .u_move = 0, .k_eddy = 30,
       .bubbles = 0, .shf = 0.01, .lhf = 1e-5, .flux_noise = 0.5, .noise_th = 0.2, .top_cooling = 60,
       .confinement = 0.1, .micro = 1}},
 };

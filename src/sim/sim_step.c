@@ -35,6 +35,7 @@ static void phases(atmos_sim *s, double dt)
     atmos__sim_sync(s);
 #pragma omp master
     for (int j = 0; j < ny; j++) s->rain_out += rain[j], s->surface_in += surf[j];
+    atmos__sim_diffuse(s, dt);
     atmos__sim_confine(s, dt);
     atmos__sim_project(s);
 }
