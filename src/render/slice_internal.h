@@ -149,6 +149,8 @@ struct atmos__slice_plan {
     atmos__aerial shadow_ap;
     float *air_front;
     size_t air_cap;
+    double *air_lattice; /* the shadow evaluated at every other pixel (slice_shadow.c) */
+    size_t air_lattice_cap;
 };
 
 /* The volume's shadow on the air's single scattering over the region r of img (which holds

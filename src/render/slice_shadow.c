@@ -35,12 +35,14 @@
 #define SHADOW_PER_CELL 1.0 /* samples a map cell along a ray */
 #define SHADOW_STEPS_MAX 192
 #define SHADOW_RANGE_M 200e3  /* the farthest the shadow is followed along a ray */
+#define SHADOW_SMOOTH 0.01    /* interpolated where the lattice's values agree within this share of the pixel */
 
 void atmos__slice_shadow_free(atmos__slice_plan *sp)
 {
-    free(sp->shadow.T), free(sp->air_front);
+    free(sp->shadow.T), free(sp->air_front), free(sp->air_lattice);
     atmos__aerial_free(&sp->shadow_ap);
     sp->shadow.T = NULL, sp->air_front = NULL, sp->air_cap = 0, sp->shadow.valid = 0;
+    sp->air_lattice = NULL, sp->air_lattice_cap = 0;
 }
 
 /* The volume's grey extinction (m^-1: each field's cross-section averaged over the
@@ -328,6 +330,113 @@ static const atmos__aerial *shadow_table(atmos__slice_plan *sp, const sframe *f,
     return atmos__aerial_build(&sp->shadow_ap, f->atm, &g, threads) ? &sp->shadow_ap : NULL;
 }
 
+/* What the shadow takes from the air along pixel (x, y)'s ray, per wavelength: all of it into
+ * D, the part in front of the volume's halfway plane into Df. 0 (and zeros) when the ray has
+ * no shadowed span. */
+static int pixel_air(const sframe *f, const atmos__aerial *ap, const sjob *j, int n, int x, int y, double *D,
+                     double *Df)
+{
+    for (int c = 0; c < n; c++) D[c] = Df[c] = 0.0;
+    double dw[3], d[3], ta, tb, tg, tt[ATMOS__AERIAL_MAX_SLICES], Db[ATMOS_MAX_WAVELENGTHS];
+    float S[ATMOS__AERIAL_MAX_SLICES * ATMOS_MAX_WAVELENGTHS];
+    mray m;
+    if (!pixel_span(f, x, y, dw, d, &m, &ta, &tb, &tg)) return 0;
+    const int nd = atmos__aerial_single_profile(ap, dw, ta, tb, tt, S);
+    if (nd < 2) return 0;
+    const double hd = atmos__dot3(j->h, d);
+    const double th = fabs(hd) >= SLICE_HD_EPS ? (f->hc - j->he) / hd : 0.0;
+    const double xi = atmos__u01(atmos__mix64(((uint64_t)(uint32_t)y << 32) | (uint32_t)x));
+    span_shadow(f->sh, &m, ta, tb, th, xi, nd, tt, S, n, Df, Db);
+    for (int c = 0; c < n; c++) D[c] = Df[c] + Db[c];
+    return 1;
+}
+
+/* The shadow on the air evaluated exactly at the pixels of even x and y (a lattice covering
+ * the region: the values are the image's, whatever the region), in between interpolated
+ * where the lattice's neighbours all have a shadowed span and agree within SHADOW_SMOOTH of
+ * the pixel's value, else evaluated. The same values for any thread count or region. */
+typedef struct {
+    int a0, b0, na, nb, W, H;
+    size_t stride;  /* doubles a lattice point: its flag, D[n], Df[n] */
+    double *val;
+} slattice;
+
+static int lattice_make(atmos__slice_plan *sp, const atmos_camera *cam, const atmos__rect *r, int n, slattice *L)
+{
+    L->W = cam->width, L->H = cam->height;
+    L->a0 = r->x0 / 2, L->b0 = r->y0 / 2;
+    L->na = (r->x1 - 1) / 2 + 2 - L->a0, L->nb = (r->y1 - 1) / 2 + 2 - L->b0;
+    if (2 * (L->a0 + L->na - 1) > L->W - 1) L->na--; /* lattice points inside the image only */
+    if (2 * (L->b0 + L->nb - 1) > L->H - 1) L->nb--;
+    L->stride = 1 + 2 * (size_t)n;
+    const size_t need = (size_t)L->na * L->nb * L->stride;
+    if (need > sp->air_lattice_cap) {
+        double *b = realloc(sp->air_lattice, sizeof(double) * need);
+        if (!b) return 0;
+        sp->air_lattice = b, sp->air_lattice_cap = need;
+    }
+    L->val = sp->air_lattice;
+    return 1;
+}
+
+/* The lattice point (a, b) (image lattice coordinates), NULL outside the computed ones. */
+static const double *lattice_at(const slattice *L, int a, int b)
+{
+    if (a < L->a0 || b < L->b0 || a >= L->a0 + L->na || b >= L->b0 + L->nb) return NULL;
+    return L->val + ((size_t)(b - L->b0) * L->na + (a - L->a0)) * L->stride;
+}
+
+/* D and Df of pixel (x, y) from the lattice (1), or 0 when it must be evaluated. px: the
+ * pixel's value before the shadow is taken. */
+static int lattice_value(const slattice *L, int x, int y, int n, const float *px, double *D, double *Df)
+{
+    const int a = x / 2, b = y / 2, da = x & 1, db = y & 1;
+    const double *e[4];
+    int k = 0;
+    for (int q = 0; q <= db; q++)
+        for (int p = 0; p <= da; p++)
+            if (!(e[k++] = lattice_at(L, a + p, b + q)) || e[k - 1][0] == 0.0) return 0;
+    const double w = 1.0 / k;
+    for (int c = 0; c < n; c++) {
+        double lo = INFINITY, hi = -INFINITY, lf = INFINITY, hf = -INFINITY, s = 0, sf = 0;
+        for (int i = 0; i < k; i++) {
+            const double vd = e[i][1 + c], vf = e[i][1 + n + c];
+            lo = fmin(lo, vd), hi = fmax(hi, vd), lf = fmin(lf, vf), hf = fmax(hf, vf), s += vd, sf += vf;
+        }
+        const double tol = SHADOW_SMOOTH * px[c];
+        if (!(hi - lo <= tol && hf - lf <= tol)) return 0;
+        D[c] = w * s, Df[c] = w * sf;
+    }
+    return 1;
+}
+
+/* Pixel (x, y): the ground's lost sunlight and the air's, taken from the image; the front part
+ * into air_front. */
+static void air_pixel_apply(const sframe *f, const atmos__aerial *ap, const sjob *j, const slattice *L, atmos_image *img,
+                            float *air_front, int x, int y, int n, const double sun[3])
+{
+    const size_t p = (size_t)y * L->W + x;
+    float *fr = air_front + p * n, *px = img->pixels + p * img->channels;
+    for (int c = 0; c < n; c++) fr[c] = 0.0f;
+    double dw[3], d[3], ta, tb, tg, G[ATMOS_MAX_WAVELENGTHS], D[ATMOS_MAX_WAVELENGTHS], Df[ATMOS_MAX_WAVELENGTHS];
+    mray m;
+    if (!pixel_span(f, x, y, dw, d, &m, &ta, &tb, &tg)) return;
+    ground_shadow(f, &m, dw, tg, sun, n, G);
+    for (int c = 0; c < n; c++) px[c] = (float)fmax(px[c] - G[c], 0.0);
+    const double *e = !(x & 1) && !(y & 1) ? lattice_at(L, x / 2, y / 2) : NULL;
+    if (e) {
+        if (e[0] == 0.0) return;
+        for (int c = 0; c < n; c++) D[c] = e[1 + c], Df[c] = e[1 + n + c];
+    } else if (!lattice_value(L, x, y, n, px, D, Df) && !pixel_air(f, ap, j, n, x, y, D, Df)) {
+        return;
+    }
+    for (int c = 0; c < n; c++) {
+        const double s = px[c] - D[c];
+        px[c] = (float)(s > 0 ? s : 0.0);
+        fr[c] = (float)Df[c];
+    }
+}
+
 atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
                                      const atmos__view *v, const atmos__rect *r, sjob *j, atmos_image *img,
                                      double *secs)
@@ -370,33 +479,17 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
         if (!b) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the air's shadow");
         sp->air_front = b, sp->air_cap = need;
     }
-    const int W = v->cam.width, C = img->channels;
+    slattice L;
+    if (!lattice_make(sp, &v->cam, r, n, &L)) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the air's shadow");
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int b = 0; b < L.nb; b++)
+        for (int a = 0; a < L.na; a++) {
+            double *e = L.val + ((size_t)b * L.na + a) * L.stride;
+            e[0] = pixel_air(&f, ap, j, n, 2 * (L.a0 + a), 2 * (L.b0 + b), e + 1, e + 1 + n);
+        }
 #pragma omp parallel for schedule(dynamic, 2) num_threads(threads)
     for (int y = r->y0; y < r->y1; y++)
-        for (int x = r->x0; x < r->x1; x++) {
-            const size_t p = (size_t)y * W + x;
-            float *fr = sp->air_front + p * n;
-            for (int c = 0; c < n; c++) fr[c] = 0.0f;
-            double dw[3], d[3], ta, tb, tg, tt[ATMOS__AERIAL_MAX_SLICES], G[ATMOS_MAX_WAVELENGTHS];
-            float S[ATMOS__AERIAL_MAX_SLICES * ATMOS_MAX_WAVELENGTHS];
-            mray m;
-            if (!pixel_span(&f, x, y, dw, d, &m, &ta, &tb, &tg)) continue;
-            float *px = img->pixels + p * C;
-            ground_shadow(&f, &m, dw, tg, v->sun, n, G);
-            for (int c = 0; c < n; c++) px[c] = (float)fmax(px[c] - G[c], 0.0);
-            const int nd = atmos__aerial_single_profile(ap, dw, ta, tb, tt, S);
-            if (nd < 2) continue;
-            const double hd = atmos__dot3(j->h, d);
-            const double th = fabs(hd) >= SLICE_HD_EPS ? (f.hc - j->he) / hd : 0.0;
-            const double xi = atmos__u01(atmos__mix64(((uint64_t)(uint32_t)y << 32) | (uint32_t)x));
-            double Df[ATMOS_MAX_WAVELENGTHS], Db[ATMOS_MAX_WAVELENGTHS];
-            span_shadow(sh, &m, ta, tb, th, xi, nd, tt, S, n, Df, Db);
-            for (int c = 0; c < n; c++) {
-                const double s = px[c] - (Df[c] + Db[c]);
-                px[c] = (float)(s > 0 ? s : 0.0);
-                fr[c] = (float)Df[c];
-            }
-        }
+        for (int x = r->x0; x < r->x1; x++) air_pixel_apply(&f, ap, j, &L, img, sp->air_front, x, y, n, v->sun);
     j->air_front = sp->air_front;
     *secs = atmos__now() - t0;
     return ATMOS_OK;
