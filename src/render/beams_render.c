@@ -1,6 +1,7 @@
 /* The beam renderer's frame (Dobashi, Yamamoto and Nishita 2002 §4): per pixel, the sky
  * behind (dimmed by the fog), or the nearest object's Lambertian surface lit by every light
- * it sees (Dobashi's I_b, attenuated by the fog on both legs), plus per light the light the
+ * it sees (Dobashi's I_b, attenuated by the fog on both legs) and by the sky (beams_sky.h),
+ * plus per light the light the
  * fog scatters toward the eye (Eq. 2):
  *   - the ray is cut by sampling planes perpendicular to the view direction, spaced evenly
  *     in depth across the sphere the light reaches (the same planes for every pixel);
