@@ -9,8 +9,8 @@
  *     light-weighted mean order is near the one without the roulette (within 30 %: it has no
  *     variance to bound it by);
  *   - in an unbounded conservative fog the roulette ends the paths (none reaches the default
- *     depth limit), and without it the render warns as soon as a path does, before the count
- *     at the end.
+ *     depth limit), the image the same on one thread as on all, and without the roulette the
+ *     render warns as soon as a path does, before the count at the end.
  */
 #include "atmos/atmos.h"
 #include "test.h"
@@ -127,6 +127,18 @@ static void test_unbounded(void)
     fog_scene(&s, 4, 3, 16, 0, 1);
     told_early = told_end = 0;
     result r = render(&s);
+    /* the same bytes on one thread (the roulette draws from the path's own stream) */
+    atmos_context *all = ctx, *one = NULL;
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    d.threads = 1;
+    CHECK_OK(atmos_context_create(&d, &one));
+    ctx = one;
+    const result r1 = render(&s);
+    ctx = all;
+    atmos_context_destroy(one);
+    CHECK_MSG(r1.mean == r.mean && r1.order == r.order && r1.events_per_path == r.events_per_path,
+              "one thread: mean %.9g, order %.9g; all: %.9g, %.9g", r1.mean, r1.order, r.mean, r.order);
     printf("unbounded conservative fog, roulette on: %.1f events/path, %lld paths cut\n", r.events_per_path, r.cut);
     CHECK(r.cut == 0 && told_early == 0 && told_end == 0);
     fog_scene(&s, 2, 1, 1, 0, 0);
