@@ -102,6 +102,7 @@ typedef struct atmos_scene_path {
     int sky_nee;              /* next-event estimation toward the sky; 1 */
     int forced;               /* forced single scattering on camera rays; 1 */
     int aureole;              /* the aureole estimate in droplet clouds; 1 */
+    int roulette;             /* lights and fog: Russian roulette by the lights' nearness from order 4; 1 */
 } atmos_scene_path;
 
 /* Settings of the Nishita renderer ("nishita" in the file); the table is

@@ -1,6 +1,7 @@
 /* The beam renderer's frame (Dobashi, Yamamoto and Nishita 2002 §4): per pixel, the sky
  * behind (dimmed by the fog), or the nearest object's Lambertian surface lit by every light
- * it sees (Dobashi's I_b, attenuated by the fog on both legs), plus per light the light the
+ * it sees (Dobashi's I_b, attenuated by the fog on both legs) and by the sky (beams_sky.h),
+ * plus per light the light the
  * fog scatters toward the eye (Eq. 2):
  *   - the ray is cut by sampling planes perpendicular to the view direction, spaced evenly
  *     in depth across the sphere the light reaches (the same planes for every pixel);
@@ -20,6 +21,7 @@
  * not depend on the thread count. */
 #include "render/beams_internal.h"
 #include "render/beams_interleave.h"
+#include "render/beams_sky.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -40,9 +42,11 @@ typedef struct job {
     double epsilon;
     int max_sub;
     int centre_planes, centre_subplanes;
+    atmos__beams_sky sky; /* the sky's light on surfaces (none in a vacuum) */
 } job;
 
-/* The object's surface at the eye's ray's hit, lit by the lights, dimmed on the way to the eye. */
+/* The object's surface at the eye's ray's hit, lit by the lights and the sky, dimmed on the way
+ * to the eye. */
 static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
@@ -63,6 +67,11 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
         double tint[3];
         atmos__lamp_tint(&l->L, P, tint);
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
+    }
+    if (J->sky.nw) {
+        double E[ATMOS_MAX_WAVELENGTHS];
+        atmos__beams_sky_irradiance(&J->sky, h->normal, E);
+        for (int k = 0; k < J->nw; k++) sum[k] += E[k];
     }
     for (int k = 0; k < J->nw; k++) L[k] = b->obj.albedo[m][k] / ATMOS_PI * sum[k] * fog_t;
 }
@@ -367,7 +376,9 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.cx = v->cam.width / 2, J.cy = v->cam.height / 2;
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
-    if (b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) {
+    const double under[3] = {J.eye[0], 0, J.eye[2]}; /* the sky seen from the ground under the eye */
+    if ((b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) ||
+        (b->obj.n > 0 && (st = atmos__beams_sky_build(p->ctx, p->atm, under, v->sun, J.nw, &J.sky)) != ATMOS_OK)) {
         free(J.z_lo), free(J.span);
         return st;
     }
@@ -380,6 +391,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
+    atmos__beams_sky_free(&J.sky);
     free(J.z_lo), free(J.span);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");

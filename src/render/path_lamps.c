@@ -18,7 +18,8 @@
  *     sigma_s exp(-sigma_s t) with the absorption exp(-sigma_a t) carried in the weights (a
  *     pure absorber needs no random number), a new direction from the phase function in the
  *     fog or cosine-distributed about the normal at the object (weight times the albedo),
- *     Russian roulette;
+ *     Russian roulette (roulette(): on the weights, and from the 4th event on the lights'
+ *     nearness, so that paths in a fog that absorbs nothing end);
  *   - a path that leaves (no fog, no object ahead) sees the vacuum's uniform background.
  * The sun, the atmosphere's air and a cloud volume are not part of such a scene here
  * (path_plan.c refuses the air, the volume, a fog thinning with height and the beam
@@ -118,6 +119,51 @@ static void fog_lights(const path_run *R, const double p[3], const double d[3], 
     }
 }
 
+/* The lights' nearness at p: sum over the lights of their largest intensity / r^2 (the cone,
+ * the fog's extinction and the shadows left out: a smooth stand-in for the light a path
+ * from p can still gather, which is all the roulette below asks of it). */
+static double nearness(const path_lamps *P, const double p[3])
+{
+    double a = 0;
+    for (int j = 0; j < P->nlamps; j++) {
+        const atmos__lamp *l = &P->lamp[j];
+        const double u[3] = {l->pos[0] - p[0], l->pos[1] - p[1], l->pos[2] - p[2]};
+        a += l->I_max / fmax(atmos__dot3(u, u), 1e-12);
+    }
+    return a;
+}
+
+/* The event order from which roulette() also weighs the lights' nearness: orders 1-3, the
+ * bulk of the light in the scenes measured (docs/path.md), are never cut by it. */
+#define LAMPS_RR_ORDER 4
+
+/* Russian roulette at the path's depth-th event, at p (0: the path ends). Survival
+ * q = min(1, max_k w_k rho), the weights divided by q when it survives, with rho = 1 before
+ * LAMPS_RR_ORDER and min(1, A(p) / A_ref) from it on, A the lights' nearness and A_ref its
+ * value where the path reached LAMPS_RR_ORDER (*aref, 0 until then). In a fog that absorbs
+ * nothing the weights stay 1 and the weights alone would never end a path (it wanders to the
+ * depth limit); with rho, a path that has survived to p carries weights ~ A_ref / A(p), so
+ * its light there stays of the size of its light at A_ref's point, and a path leaving the
+ * lights ends. Unbiased for any q > 0 (A > 0 wherever a light has any intensity). */
+static int roulette(const path_run *R, const double p[3], int depth, double *aref, double *w)
+{
+    const path_lamps *P = R->J->lamps;
+    const int m = R->b->m;
+    if (!R->J->roulette || depth < LAMPS_RR_ORDER) return atmos__path_roulette(w, m, R->r);
+    const double a = nearness(P, p);
+    if (depth == LAMPS_RR_ORDER || !(*aref > 0)) *aref = a;
+    const double rho = *aref > 0 && a < *aref ? a / *aref : 1.0;
+    double q = 0;
+    for (int i = 0; i < m; i++)
+        if (w[i] > q) q = w[i];
+    q *= rho;
+    if (!(q > 0)) return 0;
+    if (q >= 1) return 1;
+    if (atmos__stream_u(R->r) >= q) return 0;
+    for (int i = 0; i < m; i++) w[i] /= q;
+    return 1;
+}
+
 int atmos__path_trace_lamps(const path_job *J, const path_bundle *b, const double o[3], const double d0[3],
                             atmos__stream *r, double *L, double *Lo, path_counts *cnt)
 {
@@ -130,6 +176,7 @@ int atmos__path_trace_lamps(const path_job *J, const path_bundle *b, const doubl
     memcpy(d, d0, sizeof d);
     for (int i = 0; i < m; i++) w[i] = 1, L[i] = 0, Lo[i] = 0;
     int depth = 0;
+    double aref = 0; /* the lights' nearness where roulette() began to weigh it */
     for (int guard = 0; guard < 1 << 24; guard++) {
         if ((guard & 15) == 15 && J->deadline < INFINITY && atmos__now() >= J->deadline) return PATH_ABANDONED;
         atmos_mesh_hit h = {0, 0, {0, 0, 0}};
@@ -165,14 +212,14 @@ int atmos__path_trace_lamps(const path_job *J, const path_bundle *b, const doubl
         depth++;
         if (t < T) {
             for (int a = 0; a < 3; a++) p[a] += t * d[a];
-            if (!atmos__path_roulette(w, m, r)) return 1;
+            if (!roulette(&R, p, depth, &aref, w)) return 1;
             const double mu = atmos__fog_phase_sample(&P->fog, atmos__stream_u(r));
             double nd[3];
             atmos__path_around(d, mu, 2 * ATMOS_PI * atmos__stream_u(r), nd);
             memcpy(d, nd, sizeof d);
         } else {
             for (int i = 0; i < m; i++) w[i] *= alb[i];
-            if (!atmos__path_roulette(w, m, r)) return 1;
+            if (!roulette(&R, ps, depth, &aref, w)) return 1;
             const double u1 = atmos__stream_u(r);
             atmos__path_cosine(h.normal, u1, atmos__stream_u(r), d);
             for (int a = 0; a < 3; a++) p[a] = ps[a] + off * h.normal[a];

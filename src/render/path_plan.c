@@ -203,7 +203,7 @@ static void make_job(atmos_plan *p, atmos__path_plan *pp, const atmos__view *v, 
     J->reference = !pp->has_medium && (kind == ATMOS_ATMOSPHERE_DOBASHI || kind == ATMOS_ATMOSPHERE_SPHERICAL);
     sky_light(p, pp, v->sun);
     if (pp->env_on) J->env = &pp->env;
-    if (pp->lamps_on) J->lamps = &pp->lamps, J->reference = 0;
+    if (pp->lamps_on) J->lamps = &pp->lamps, J->reference = 0, J->roulette = p->scene.path.roulette;
 }
 
 /* The clock of a render's passes: the time budget, checked before every sample, and the
@@ -215,7 +215,23 @@ typedef struct {
     long long total;   /* samples this call is to take */
     atomic_llong done; /* samples taken so far */
     atomic_int stop;   /* 1: the budget is spent, 2: cancelled */
+    atomic_int cut;    /* a path has reached the default depth limit */
+    int cut_told;      /* ... and the calling thread has warned of it */
 } path_clock;
+
+/* The first path stopped by the default depth limit is told at once (by the calling thread,
+ * at its next sample or pass), not only in the count at the render's end: such a render is
+ * usually one that stalls. */
+static void tell_cut(path_clock *c)
+{
+    if (c->cut_told || !atomic_load_explicit(&c->cut, memory_order_relaxed)) return;
+    c->cut_told = 1;
+    atmos__log(c->ctx, ATMOS_LOG_WARN,
+               "render path: a path reached the default limit of %d scattering events and was stopped (the render "
+               "goes on; their count comes at its end): paths this long make a render slow and lose light; "
+               "path.max_depth sets the limit",
+               PATH_DEFAULT_DEPTH);
+}
 
 /* Before a sample: 0 to take it, 1 to stop (budget spent or cancelled). */
 static int clock_tick(path_clock *c)
@@ -229,6 +245,7 @@ static int clock_tick(path_clock *c)
 #ifdef _OPENMP
     if (omp_get_thread_num() != 0) return 0;
 #endif
+    tell_cut(c);
     if (now < c->next_report) return 0;
     c->next_report = now + REPORT_S;
     double f = c->total > 0 ? (double)atomic_load_explicit(&c->done, memory_order_relaxed) / (double)c->total : 1.0;
@@ -268,7 +285,9 @@ static int sample_pixel(const path_job *J, int x, int y, size_t pix, int s0, int
         double jx = atmos__stream_u(&rng), jy = atmos__stream_u(&rng), dir[3];
         double L[PATH_B] = {0, 0, 0, 0}, Lo[PATH_B] = {0, 0, 0, 0}, Y = 0, Yo = 0;
         if (atmos_camera_ray(&J->cam, x + jx, y + jy, dir)) {
+            const long long cut0 = cnt->cut;
             const int met = atmos__path_trace(J, &b, J->cam.position, dir, &rng, L, Lo, cnt);
+            if (cnt->cut != cut0) atomic_store_explicit(&clk->cut, 1, memory_order_relaxed);
             if (met == PATH_ABANDONED) {
                 atomic_store(&clk->stop, 1);
                 break;
@@ -372,6 +391,7 @@ static atmos_status accumulate(atmos_plan *p, atmos__path_plan *pp, const path_j
     clk.next_report = clk.start + REPORT_S;
     atomic_init(&clk.done, 0);
     atomic_init(&clk.stop, 0);
+    atomic_init(&clk.cut, 0);
     long long empty = 0;
     int lowest = lowest_count(pp, r, target, &empty);
     for (int y = r->y0; y < r->y1; y++)
@@ -399,6 +419,7 @@ static atmos_status accumulate(atmos_plan *p, atmos__path_plan *pp, const path_j
         if (undo) save_rows(pp, r, &sv, 0);
         const double tp = atmos__now();
         pass(pp, &Jb, r, s1, threads, Ybar, &clk, st);
+        tell_cut(&clk);
         if (step < S && 16.0 * (atmos__now() - tp) < clk.budget) step = 2 * step < S ? 2 * step : S;
         const int stop = atomic_load(&clk.stop);
         if (stop == 2) {

@@ -27,6 +27,7 @@ typedef struct {
     double deadline;        /* atmos__now() past which a path is abandoned (the time budget); INFINITY: none */
     int reference;          /* no volume, a planet's air: every path is the atmosphere's Monte Carlo reference */
     const path_lamps *lamps; /* the scene's lights, fog and objects: every path is traced by path_lamps.c */
+    int roulette;           /* lamps: Russian roulette by the lights' nearness (path_lamps.c) */
     uint64_t seed;
 } path_job;
 

@@ -65,6 +65,10 @@ static const atmos_setting path_settings[] = {
      "forced single scattering on camera rays (off: same mean, more noise in thin media)", PATH(forced)},
     {"aureole", "no-aureole", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
      "the aureole estimate in droplet clouds (off: same mean, more fireflies)", PATH(aureole)},
+    {"roulette", "no-roulette", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
+     "with lights and fog, Russian roulette from the 4th event by the lights' nearness (off: same mean, "
+     "paths in a fog that absorbs nothing walk to the depth limit)",
+     PATH(roulette)},
 };
 
 static const atmos_setting nishita_settings[] = {

@@ -56,6 +56,7 @@ cat >"$T/table" <<'EOF'
 --no-sky-nee|path.sky_nee=false|path|
 --no-forced|path.forced=false|path|
 --no-aureole|path.aureole=false|path|same
+--no-roulette|path.roulette=false|path|same
 --nishita-orders 1|nishita.orders=1|nishita|
 --nishita-ratio 0.5|nishita.ratio=0.5|nishita|
 --nishita-paths 8|nishita.paths=8|nishita|same

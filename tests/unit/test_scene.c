@@ -326,7 +326,7 @@ static const bad_case bad_renderers[] = {
     {"{\"path\": {\"spp\": 0}}", ATMOS_E_INVALID_ARG, "/path/spp: must be in [1, 1000000], got 0", NULL},
     {"{\"path\": {\"time_budget_s\": -1}}", ATMOS_E_INVALID_ARG, "/path/time_budget_s: must be in [0, 10000000], got -1", NULL},
     {"{\"path\": {\"seed\": -3}}", ATMOS_E_INVALID_ARG, "/path/seed: must be in [0, ", NULL},
-    {"{\"path\": {\"bounces\": 3}}", ATMOS_E_INVALID_ARG, "/path/bounces: unknown key (allowed: spp, time_budget_s, seed, max_depth, truncate_deg, sky_nee, forced, aureole)", NULL},
+    {"{\"path\": {\"bounces\": 3}}", ATMOS_E_INVALID_ARG, "/path/bounces: unknown key (allowed: spp, time_budget_s, seed, max_depth, truncate_deg, sky_nee, forced, aureole, roulette)", NULL},
     {"{\"path\": {\"truncate_deg\": 21}}", ATMOS_E_INVALID_ARG, "/path/truncate_deg: must be in [0, 20], got 21", NULL},
     {"{\"background\": \"uniform\"}", ATMOS_E_INVALID_ARG, "/background: must be one of sky, black, got \"uniform\"", NULL},
     {"{\"background\": {\"type\": \"uniform\"}}", ATMOS_E_INVALID_ARG, "/background: missing key \"radiance\"", NULL},

@@ -1,0 +1,97 @@
+/* The sky's light on the beam renderer's surfaces (beams_sky.h). The irradiance of a surface
+ * of normal n from the sky is E(n) = int L(w) max(0, n . w) dw over the upper hemisphere, L the
+ * atmosphere's radiance without the sun's disk (the sun is the beam renderer's own light).
+ * Directions: BEAMS_SKY_MU rings of equal width in cos(zenith) by BEAMS_SKY_PHI azimuths,
+ * cells of equal solid angle 2 pi / (MU PHI), each at its centre. The sky is that of one point
+ * (the ground under the eye): what a surface sees below the horizon (the ground's light), the
+ * sky hidden by other objects, and the scene's fog between the sky and the surface are left
+ * out (docs/beams.md). */
+#include "render/beams_sky.h"
+#include "core/vec.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define BEAMS_SKY_MU 24
+#define BEAMS_SKY_PHI 48
+
+/* The radiance of the sky at p along d without the sun's disk (into L[nw]). */
+static void sky_radiance(const atmos_atmosphere *atm, const double p[3], const double d[3], const double sun[3],
+                         int nw, double *L)
+{
+    atmos_atmosphere_hit info;
+    atmos_atmosphere_radiance(atm, p, d, sun, L, &info);
+    if (info.in_sun_disk) {
+        double D[ATMOS_MAX_WAVELENGTHS];
+        atmos_atmosphere_sun_radiance(atm, p, sun, D);
+        for (int k = 0; k < nw; k++) L[k] = fmax(0.0, L[k] - D[k]);
+    }
+}
+
+/* The table's normal at node (iy, ia). */
+static void node_normal(int iy, int ia, double n[3])
+{
+    const double y = -1.0 + 2.0 * iy / (BEAMS_SKY_NY - 1), s = sqrt(fmax(0.0, 1.0 - y * y));
+    const double a = 2.0 * ATMOS_PI * ia / BEAMS_SKY_NA;
+    n[0] = s * cos(a), n[1] = y, n[2] = s * sin(a);
+}
+
+atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *atm, const double p[3],
+                                    const double sun_dir[3], int nw, atmos__beams_sky *s)
+{
+    memset(s, 0, sizeof *s);
+    if (atmos_atmosphere_get_kind(atm) == ATMOS_ATMOSPHERE_VACUUM) return ATMOS_OK;
+    const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI, nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
+    double *L = malloc(sizeof(double) * (size_t)nd * (nw + 3));
+    s->E = calloc((size_t)nn * nw, sizeof *s->E);
+    if (!L || !s->E) {
+        free(L), free(s->E), s->E = NULL;
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the sky's light");
+    }
+    const double dw = 2.0 * ATMOS_PI / nd;
+#pragma omp parallel for schedule(dynamic, 8) num_threads(atmos__threads(ctx))
+    for (int i = 0; i < nd; i++) {
+        const double mu = ((i / BEAMS_SKY_PHI) + 0.5) / BEAMS_SKY_MU, phi = 2.0 * ATMOS_PI * ((i % BEAMS_SKY_PHI) + 0.5) / BEAMS_SKY_PHI;
+        const double st = sqrt(fmax(0.0, 1.0 - mu * mu));
+        double *row = L + (size_t)i * (nw + 3);
+        row[0] = st * cos(phi), row[1] = mu, row[2] = st * sin(phi);
+        sky_radiance(atm, p, row, sun_dir, nw, row + 3);
+    }
+    for (int j = 0; j < nn; j++) {
+        double n[3], e[ATMOS_MAX_WAVELENGTHS] = {0};
+        node_normal(j / BEAMS_SKY_NA, j % BEAMS_SKY_NA, n);
+        for (int i = 0; i < nd; i++) {
+            const double *row = L + (size_t)i * (nw + 3), c = atmos__dot3(n, row);
+            if (c > 0)
+                for (int k = 0; k < nw; k++) e[k] += row[3 + k] * c * dw;
+        }
+        for (int k = 0; k < nw; k++) s->E[(size_t)j * nw + k] = (float)e[k];
+    }
+    free(L);
+    s->nw = nw;
+    return ATMOS_OK;
+}
+
+void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const double n[3], double *E)
+{
+    const int nw = s->nw;
+    if (!nw) return;
+    const double fy = (fmin(1.0, fmax(-1.0, n[1])) + 1.0) * 0.5 * (BEAMS_SKY_NY - 1);
+    double fa = atan2(n[2], n[0]) / (2.0 * ATMOS_PI) * BEAMS_SKY_NA;
+    if (fa < 0) fa += BEAMS_SKY_NA;
+    int iy = (int)fy, ia = (int)fa;
+    if (iy > BEAMS_SKY_NY - 2) iy = BEAMS_SKY_NY - 2;
+    if (ia > BEAMS_SKY_NA - 1) ia = BEAMS_SKY_NA - 1;
+    const double ty = fy - iy, ta = fa - ia;
+    const int ib = (ia + 1) % BEAMS_SKY_NA;
+    const float *e00 = s->E + ((size_t)iy * BEAMS_SKY_NA + ia) * nw, *e01 = s->E + ((size_t)iy * BEAMS_SKY_NA + ib) * nw;
+    const float *e10 = s->E + ((size_t)(iy + 1) * BEAMS_SKY_NA + ia) * nw;
+    const float *e11 = s->E + ((size_t)(iy + 1) * BEAMS_SKY_NA + ib) * nw;
+    for (int k = 0; k < nw; k++)
+        E[k] = (1 - ty) * ((1 - ta) * e00[k] + ta * e01[k]) + ty * ((1 - ta) * e10[k] + ta * e11[k]);
+}
+
+void atmos__beams_sky_free(atmos__beams_sky *s)
+{
+    if (s) free(s->E), memset(s, 0, sizeof *s);
+}
