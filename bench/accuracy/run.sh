@@ -11,7 +11,8 @@
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
 # CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
 # VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer, "harris",
-# "harris_sun": Harris's, not in the default list), THREADS, REUSE (1: keep the reference images
+# "harris_sun": Harris's, and the same with the diffuse light field, "nishita_diffuse",
+# "harris_diffuse", "harris_sun_diffuse": not in the default list), THREADS, REUSE (1: keep the reference images
 # already in OUT_DIR, e.g. to compare a new build's variants against the same references).
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
@@ -60,6 +61,9 @@ for c in $CASES; do
             nishita) opts="--renderer nishita" ;;
             harris) opts="--renderer harris" ;;
             harris_sun) opts="--renderer harris --sky-lights 0" ;;
+            nishita_diffuse) opts="--renderer nishita --nishita-diffuse" ;;
+            harris_diffuse) opts="--renderer harris --harris-diffuse" ;;
+            harris_sun_diffuse) opts="--renderer harris --sky-lights 0 --harris-diffuse" ;;
             esac
             "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
             "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \

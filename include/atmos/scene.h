@@ -114,6 +114,9 @@ typedef struct atmos_scene_nishita {
     int cells;                /* the light field's grid: at most this many cells per axis; 32 */
     int sky;                  /* the sky's and the ground's light through sky elements; 1 */
     int step_scale_pct;       /* eye-ray step, per cent of a render voxel; 50 */
+    int diffuse;              /* 1: the slice renderer's diffuse light field (all orders) and Riley's
+                                 scattered beam where the medium is thick, the orders 2-3 and the sky
+                                 elements where it is thin (docs/lightfield.md); 0 */
 } atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is
@@ -127,6 +130,8 @@ typedef struct atmos_scene_harris {
     int impostors;            /* 1: clouds drawn from dynamically generated impostors (Harris §3) */
     double impostor_tolerance_deg; /* the translation error that makes an impostor again; 0.15 */
     int impostor_max_res;     /* an impostor's texels per side at most; 512 */
+    int diffuse;              /* 1: each particle also scatters the slice renderer's diffuse light field
+                                 toward the eye (docs/particles.md); 0 */
 } atmos_scene_harris;
 
 /* Settings of the beam renderer ("beams" in the file); the table is

@@ -160,10 +160,12 @@ typedef struct atmos__plights {
     const double (*dir)[3];
     const double (*e)[ATMOS_MAX_WAVELENGTHS];
     const float *air_t, *air_l;
+    const float *diffuse; /* NULL, or [p * nw + k]: radiance particle p scatters toward the eye besides the
+                             lights' (the diffuse light field's), added to its colour before the air */
 } atmos__plights;
 /* Composites the particles idx[0..nidx) (idx NULL: all) over img (width x height, nw + 1
  * channels: radiance per wavelength, then coverage) back to front, within rect [x0, y0, x1,
- * y1): a particle adds a sum_j Ams_{n_j+1}(theta_j) E_j I_pj (1 - T) and leaves T =
+ * y1): a particle adds (a sum_j Ams_{n_j+1}(theta_j) E_j I_pj + diffuse_p) (1 - T) and leaves T =
  * exp(-tau(b)) of what is behind it, b the pixel ray's distance from its centre (Harris's
  * splat, exactly), theta_j the scattering angle from light j toward the eye; seen through the
  * air its colour is air_l + air_t colour (exact for an opaque particle; the air behind a

@@ -47,7 +47,7 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
             const double ph = o->ms[fi] ? atmos_msphase_eval(o->ms[fi], k, L->order[j][p] + 1.0, mu) : 1.0 / (4.0 * ATMOS_PI);
             sum += ph * L->e[j][k] * L->light[j][(size_t)p * o->nw + k];
         }
-        out->col[k] = (float)(o->albedo[fi][k] * sum);
+        out->col[k] = (float)(o->albedo[fi][k] * sum) + (L->diffuse ? L->diffuse[(size_t)p * o->nw + k] : 0.0f);
         if (L->air_t) { /* seen through the air: L_air + T_air colour (an opaque particle exactly) */
             const size_t at = (size_t)p * o->nw + k;
             out->col[k] = L->air_l[at] + L->air_t[at] * out->col[k];

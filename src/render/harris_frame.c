@@ -117,7 +117,8 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
 {
     const atmos__pclusters *c = &h->clouds;
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
-                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
+                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
+                              h->diffuse ? h->dview : NULL};
     const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
     /* the air to all their clouds' particles in one pass on the threads (a cloud's parts follow
      * each other in list) */
@@ -159,7 +160,8 @@ static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos
                          const int *idx, int n, int how, const int rect[4], atmos_image *out)
 {
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
-                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
+                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
+                              h->diffuse ? h->dview : NULL};
     if (how == 1) {
         air(p, h, v, ap, idx, n);
         int drawn = 0;
@@ -278,6 +280,7 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
         if ((st = atmos__harris_lights(p, h, v->sun)) != ATMOS_OK) return st;
         h->shade_s = atmos__now() - t0;
     }
+    atmos__harris_diffuse_view(p, h, v->cam.position);
     const int rect[4] = {r->x0, r->y0, r->x1, r->y1};
     const atmos__aerial *ap = frame_aerial(p, h, v);
     if (h->obj && (st = atmos__harris_objects_frame(p, h, h->obj, v, ap, rect)) != ATMOS_OK) return st;

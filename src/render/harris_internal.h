@@ -5,6 +5,7 @@
 
 #include "atmosphere/atmosphere_ops.h"
 #include "particles/pcloud.h"
+#include "render/dfield.h"
 #include "render/plan_internal.h"
 
 #define ATMOS__HARRIS_MAX_LIGHTS 17
@@ -59,6 +60,14 @@ struct atmos__harris_plan {
     double sun[3];
     int have_sun, drawn, updates, direct, held;
     double shade_s;
+    /* "diffuse" (harris_diffuse.c): the diffuse light field on the volume's grid, and per particle
+     * what it scatters toward this frame's eye ([p * nw + k]; the splats' atmos__plights.diffuse) */
+    int diffuse;
+    sgrid g;
+    stables tab;
+    atmos__vol_xform x;
+    atmos__dfield df;
+    float *dview;
 };
 
 /* Impostor splitting (harris_split.c): where each cloud goes this frame. */
@@ -77,5 +86,13 @@ int atmos__harris_piece(const atmos__harris_plan *h, int k, int pass, int how, i
 /* The light passes of the sun sun and the sky lights (harris_plan.c); the impostors become
  * stale. */
 atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const double sun[3]);
+
+/* The diffuse light field (harris_diffuse.c): its grid and medium once per plan (nothing
+ * unless the scene's "diffuse"), the field per sun direction, per frame its light at each
+ * particle toward the eye eye_w (h->dview). */
+atmos_status atmos__harris_diffuse_prepare(atmos_plan *p, atmos__harris_plan *h);
+void atmos__harris_diffuse_free(atmos__harris_plan *h);
+atmos_status atmos__harris_diffuse_sun(atmos_plan *p, atmos__harris_plan *h, const double sun[3]);
+void atmos__harris_diffuse_view(const atmos_plan *p, atmos__harris_plan *h, const double eye_w[3]);
 
 #endif

@@ -88,6 +88,7 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
             for (size_t i = 0; i < per; i++) h->obj->light[q / cl->n][i] *= probe[(size_t)(q - q0) * per + i];
     }
     free(probe);
+    if (st == ATMOS_OK) st = atmos__harris_diffuse_sun(p, h, sun);
     if (st != ATMOS_OK) return st;
     memcpy(h->sun, sun, sizeof h->sun);
     h->have_sun = 1;
@@ -176,6 +177,7 @@ atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
         if (!h->light[j] || !h->order[j]) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     }
     if (st == ATMOS_OK && p->scene.object_count > 0) st = objects(p, h);
+    if (st == ATMOS_OK) st = atmos__harris_diffuse_prepare(p, h);
     if (st != ATMOS_OK) {
         atmos__harris_plan_destroy(h);
         return st;
@@ -198,6 +200,7 @@ void atmos__harris_plan_destroy(atmos__harris_plan *h)
     for (int j = 0; j < ATMOS__HARRIS_MAX_LIGHTS; j++) free(h->light[j]), free(h->order[j]);
     free(h->air_t), free(h->air_l);
     atmos__aerial_free(&h->aerial);
+    atmos__harris_diffuse_free(h);
     free(h);
 }
 
@@ -205,7 +208,8 @@ void atmos__harris_describe(const atmos_plan *p, char *buf, size_t cap)
 {
     const atmos__harris_plan *h = p->harris;
     snprintf(buf, cap, "%d particles in %d clouds (%d splatted, %d clouds direct), %d sky lights, light passes %.3f s, "
-             "%d impostor updates", h->pc.n, h->clouds.n, h->drawn, h->direct, h->nlights - 1, h->shade_s, h->updates);
+             "%d impostor updates%s", h->pc.n, h->clouds.n, h->drawn, h->direct, h->nlights - 1, h->shade_s, h->updates,
+             h->diffuse ? ", diffuse field" : "");
     if (h->obj) {
         const size_t l = strlen(buf);
         snprintf(buf + l, cap - l, ", %d objects, %d clouds split at %.0f m", h->obj->n, h->splits, h->split_m);

@@ -7,12 +7,14 @@
  *                     sweep across the grid per sun direction), the light field per sun and
  *                     eye direction, its sky elements
  *   nishita_render.c  the eye rays and the composite over the sky
+ *   dfield.c          with "diffuse": the slice renderer's diffuse light field, shared
  *
  * Not part of the API. */
 #ifndef ATMOS_RENDER_NISHITA_INTERNAL_H
 #define ATMOS_RENDER_NISHITA_INTERNAL_H
 
 #include "light/nishita.h"
+#include "render/dfield.h"
 #include "render/plan_internal.h"
 #include "render/slice_grid.h"
 #include "volume/volume_access.h"
@@ -38,6 +40,12 @@ struct atmos__nishita_plan {
     int field_valid;
     atmos__nishita_stats stats;
     double col_s;            /* the last sweep's time */
+    /* "diffuse" (dfield.c, docs/lightfield.md): the slice renderer's diffuse field of all orders
+     * and Riley's scattered beam, weighted by the field's fade (1 where the medium is thick), the
+     * orders 2-3 and the sky elements by the rest */
+    int diffuse;
+    stables tab;             /* the field's tables: cross-sections, F_n, B_n, Ams_2 */
+    atmos__dfield df;
 };
 
 /* The forward-peak truncation of the orders 2-3 (nishita_light.c): trunc[] from the fields'

@@ -19,6 +19,8 @@ void atmos__nishita_plan_destroy(atmos__nishita_plan *s)
     free(s->col), free(s->fdens);
     atmos__lmedium_free(&s->med);
     atmos__lfield_free(&s->field);
+    atmos__dfield_free(&s->df);
+    atmos__stables_free(&s->tab);
     free(s);
 }
 
@@ -79,6 +81,12 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
             st = atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the light field");
         else
             cell_medium(np), atmos__nishita_truncate(np);
+    }
+    np->diffuse = p->scene.nishita.diffuse;
+    if (st == ATMOS_OK && np->g.v && np->diffuse) {
+        /* Ams_2 for the scattered beam (nishita_render.c); F_n and B_n for the field's source */
+        st = atmos__stables_build(ctx, p->optics, np->n, 2, &np->tab);
+        if (st == ATMOS_OK) st = atmos__dfield_prepare(ctx, &np->df, &np->g, &np->tab, &np->x, p->optics, "render nishita");
     }
     if (st != ATMOS_OK) {
         atmos__nishita_plan_destroy(np);

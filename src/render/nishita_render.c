@@ -22,7 +22,42 @@ typedef struct {
     double E[ATMOS_MAX_WAVELENGTHS]; /* the sunlight at the box's centre */
     double dt;                       /* step, m */
     int use_field;
+    int diffuse;                     /* the diffuse field and the scattered beam (dfield.h) */
 } rjob;
+
+/* Ams_2 of each field at scattering angle acos(mu) (the beam's scattered light, once scattered
+ * before, scattered toward the eye), per wavelength. */
+static void ams2_at(const stables *t, double mu, double out[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS])
+{
+    const double th = acos(mu > 1 ? 1 : (mu < -1 ? -1 : mu)) * ATMOS_RAD2DEG;
+    for (int f = 0; f < t->nf; f++) {
+        int a = 0;
+        float wt;
+        atmos__angle_locate(t->grid[f], t->ng[f], th, &a, &wt);
+        for (int w = 0; w < t->n; w++) {
+            const float *p0 = t->ams[f] + ((size_t)a * t->no + 1) * t->n + w, *p1 = p0 + (size_t)t->no * t->n;
+            out[f][w] = (1.0 - wt) * *p0 + wt * *p1;
+        }
+    }
+}
+
+/* What the diffuse field and the scattered beam add at render-voxel point u (per wavelength,
+ * W m^-3 sr^-1 nm^-1, into S) and the field's weight there (fade: 1 where the medium is thick). */
+static void diffuse_at(const atmos__nishita_plan *np, const float *u, const float *dens,
+                       double ams2[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS], double *S, float *fade)
+{
+    const atmos__dfield *df = &np->df;
+    const int n = np->n, nf = np->nf, q = df->vq;
+    float view[ATMOS_VOLUME_MAX_FIELDS * ATMOS_MAX_WAVELENGTHS], beam[ATMOS_MAX_WAVELENGTHS];
+    atmos__lfield_sample(&df->field, df->view, nf * q, u[0], u[1], u[2], view);
+    atmos__lfield_sample(&df->field, df->beam, n, u[0], u[1], u[2], beam);
+    atmos__lfield_sample(&df->field, df->fade, n, u[0], u[1], u[2], fade);
+    for (int w = 0; w < n; w++) {
+        double d = 0, b = 0;
+        for (int f = 0; f < nf; f++) d += dens[f] * view[f * q + w], b += dens[f] * np->tab.sca[f][w] * ams2[f][w];
+        S[w] = (d > 0 ? d : 0) + (beam[w] > 0 ? b * beam[w] : 0);
+    }
+}
 
 /* Trilinear value of m floats per voxel of a render-grid array at render-voxel coordinate
  * (u, v, w) (voxel centres at integers; clamped into the grid). */
@@ -63,6 +98,8 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
     const double mu = atmos__dot3(dw, J->sun_w); /* cos of the angle between the sunlight's and the ray's travel */
     for (int f = 0; f < nf; f++)
         for (int w = 0; w < n; w++) pf[f][w] = atmos_phase_table_eval(np->phase[f], w, mu);
+    double ams2[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    if (J->diffuse) ams2_at(&np->tab, mu, ams2);
     for (int w = 0; w < n; w++) L[w] = 0, T[w] = 1;
     const int steps = (int)ceil((t1 - t0) / J->dt);
     const double dt = (t1 - t0) / steps;
@@ -78,6 +115,13 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         if (!(any > 0)) continue;
         grid_at(g, np->col, nf, u[0], u[1], u[2], col);
         if (J->use_field) atmos__lfield_sample(&np->field, np->field.L, n, (float)u[0], (float)u[1], (float)u[2], Lf);
+        double Sd[ATMOS_MAX_WAVELENGTHS] = {0};
+        float fade[ATMOS_MAX_WAVELENGTHS];
+        for (int w = 0; w < n; w++) fade[w] = 0.0f;
+        if (J->diffuse) {
+            const float uf[3] = {(float)u[0], (float)u[1], (float)u[2]};
+            diffuse_at(np, uf, dens, ams2, Sd, fade);
+        }
         double Tmax = 0;
         for (int w = 0; w < n; w++) {
             double st = 0, ss = 0, s1 = 0, tau = 0;
@@ -86,8 +130,10 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
                 s1 += dens[f] * np->sca[f][w] * pf[f][w];
                 tau += col[f] * np->sig[f][w];
             }
-            /* the field's radiance is per unit truncated scattering, sig_s (1 - f) */
-            double S = s1 * J->E[w] * exp(-tau) + (J->use_field ? ss * (1 - np->trunc[w]) * (Lf[w] > 0 ? Lf[w] : 0) : 0);
+            /* the field's radiance is per unit truncated scattering, sig_s (1 - f); where the
+             * diffuse field is on (fade > 0) it takes the place of the orders 2-3 and the sky */
+            double S = s1 * J->E[w] * exp(-tau) + Sd[w] +
+                       (J->use_field ? (1.0 - fade[w]) * ss * (1 - np->trunc[w]) * (Lf[w] > 0 ? Lf[w] : 0) : 0);
             const double a = st > 0 ? -expm1(-st * dt) : 0;
             L[w] += st > 0 ? T[w] * S / st * a : 0;
             if (w == n / 2) wsum += T[w] * a, tsum += t * T[w] * a;
@@ -132,10 +178,17 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
     if (use_field && (st = atmos__nishita_field_update(p, v->sun, v->cam.position)) != ATMOS_OK) return st;
     rjob J;
     memset(&J, 0, sizeof J);
-    J.np = np, J.atm = p->atm, J.cam = &v->cam, J.use_field = use_field;
+    J.np = np, J.atm = p->atm, J.cam = &v->cam, J.use_field = use_field, J.diffuse = np->diffuse;
     memcpy(J.sun_w, v->sun, sizeof J.sun_w);
     for (int a = 0; a < 3; a++) rel[a] = v->cam.position[a] - np->x.org[a], cen[a] = 0.5 * (np->g.box_lo[a] + np->g.box_hi[a]);
     atmos__vol_dir_to_frame(&np->x, rel, J.eye_g);
+    if (np->diffuse) {
+        int built;
+        if ((st = atmos__dfield_update(p->ctx, &np->df, p->atm, v->sun, v->warm_field, 1, &built)) != ATMOS_OK) return st;
+        double eu[3]; /* the eye in render-voxel coordinates */
+        for (int a = 0; a < 3; a++) eu[a] = J.eye_g[a] * np->g.sc + np->g.off[a];
+        atmos__dfield_view(&np->df, eu, threads);
+    }
     atmos__vol_frame_to_point(&np->x, cen, cw);
     atmos_atmosphere_sunlight(p->atm, cw, v->sun, J.E);
     J.dt = p->scene.nishita.step_scale_pct / 100.0 / np->g.sc;
@@ -151,7 +204,7 @@ void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap)
     const atmos__nishita_plan *np = p->nishita;
     const atmos_scene_nishita *s = &p->scene.nishita;
     snprintf(buf, cap, "orders 1-%d, ratio %g, %d order-3 paths per cell, sky %s; field %dx%dx%d cells of %d voxels; "
-             "patterns: order 2 %d paths, order 3 %d of %lld",
+             "patterns: order 2 %d paths, order 3 %d of %lld%s",
              s->orders, s->ratio, s->paths, s->sky ? "on" : "off", np->med.c[0], np->med.c[1], np->med.c[2], np->s,
-             np->stats.n2, np->stats.n3, np->stats.n3_space);
+             np->stats.n2, np->stats.n3, np->stats.n3_space, np->diffuse ? "; diffuse field" : "");
 }

@@ -48,7 +48,9 @@ static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const
         p->optics = d->optics;
     } else {
         atmos_status st = atmos_volume_optics_build(ctx, &p->scene, p->volume, p->renderer == ATMOS_RENDERER_SLICE ||
-                                                                                 p->renderer == ATMOS_RENDERER_HARRIS,
+                                                                                 p->renderer == ATMOS_RENDERER_HARRIS ||
+                                                                                 (p->renderer == ATMOS_RENDERER_NISHITA &&
+                                                                                  p->scene.nishita.diffuse),
                                                     &p->own_optics);
         if (st != ATMOS_OK) return st;
         p->optics = &p->own_optics;

@@ -8,6 +8,7 @@
 #include "atmosphere/atmosphere_ops.h"
 #include "core/internal.h"
 #include "light/lfield.h"
+#include "render/dfield.h"
 #include "render/plan_internal.h"
 #include "render/slice_grid.h"
 #include "render/slice_tables.h"
@@ -40,7 +41,7 @@ typedef struct {
     const atmos__lfield *field;  /* the diffuse light field, or NULL */
     const float (*fg)[ATMOS_MAX_WAVELENGTHS]; /* the fields' asymmetry g per wavelength */
     const float *fview;          /* the field toward the frame's eye as the fast eye pass reads it:
-                                    [(cell * nf + f) * fvq + c] (atmos__slice_field_view) */
+                                    [(cell * nf + f) * fvq + c] (atmos__dfield_view) */
     int fvq;                     /* floats per cell and field: 4 for RGB (the fourth 0), else n */
     /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
      * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
@@ -130,17 +131,9 @@ struct atmos__slice_plan {
     float *ring, **I, **nsc; /* the light ring: batch + 1 slots */
     int batch;
     slight light;
-    /* The diffuse light field (slice_field.c; "diffuse"): the medium on its grid, each
-     * cell's mean density of each field ([cell * nf + f]), the fields' asymmetry g. */
+    /* The diffuse light field (dfield.c; "diffuse"). */
     int diffuse;
-    atmos__lmedium fmed;
-    float *fdens;
-    float fg[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
-    atmos__lfield field;
-    float *ffade; /* the field's weight per cell and wavelength, 0 where the medium is thin (slice_field.c) */
-    int ffade_any; /* 0: every weight is 0 (no solve) */
-    float *fview; /* per frame: see sjob.fview */
-    int fvq;
+    atmos__dfield df;
     /* The volume's shadow on the air ("air_shadows"; slice_shadow.c): the map, kept per sun
      * direction, the per-frame aerial-perspective table over the shadowed pixels (storage kept)
      * and the per-pixel front part (sjob.air_front; grown to the largest image). */
@@ -162,20 +155,6 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
                                      const atmos__view *v, const atmos__rect *r, sjob *j, atmos_image *img,
                                      double *secs);
 void atmos__slice_shadow_free(atmos__slice_plan *sp);
-
-/* The diffuse light field: its medium built from the render grid and the optics (once per
- * plan), and the field brought up to date for the sun direction sun_w (a solve when the sun
- * moved: warm-started from the last one when warm, else from the coarse grids' cascade as
- * the first; *built: 1 if it solved, 0 if it kept the field). */
-atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *sp, const atmos_volume_optics *o);
-atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
-                                       const double sun_w[3], int warm, int *built);
-
-/* The field turned toward the eye at render-voxel coordinate eye: the field's L and A
- * (atmos__lfield_toward, the reference passes' view) and, per cell and field f, what a unit
- * density of f scatters toward the eye, sca_f (L + g_f A) per wavelength (sp->fview, the fast
- * eye pass's: one trilinear read of 4 floats per field and sample for RGB). */
-void atmos__slice_field_view(atmos__slice_plan *sp, const double eye[3], int threads);
 
 /* The diffuse field at render-voxel point (u, v, w), toward the frame's eye: per wavelength
  * its mean radiance L[c] and A[c] = 3/(4 pi) J . d, d the unit direction to the eye (from the

@@ -18,8 +18,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     free(sp->pixblock), free(sp->spans), free(sp->lk), free(sp->ring), free(sp->I), free(sp->nsc);
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
     atmos__aerial_free(&sp->aerial);
-    atmos__lmedium_free(&sp->fmed), atmos__lfield_free(&sp->field), free(sp->fdens), free(sp->fview);
-    free(sp->ffade);
+    atmos__dfield_free(&sp->df);
     atmos__slice_shadow_free(sp);
     free(sp);
 }
@@ -71,7 +70,8 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     if (st == ATMOS_OK && sp->g.v) st = atmos__stables_build(ctx, p->optics, sp->n, ss->max_order, &sp->tab);
     if (st == ATMOS_OK && sp->g.v && !light_buffers(sp))
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the light buffer");
-    if (st == ATMOS_OK && sp->g.v && sp->diffuse) st = atmos__slice_field_prepare(ctx, sp, p->optics);
+    if (st == ATMOS_OK && sp->g.v && sp->diffuse)
+        st = atmos__dfield_prepare(ctx, &sp->df, &sp->g, &sp->tab, &sp->x, p->optics, "render slice");
     if (st != ATMOS_OK) {
         atmos__slice_plan_destroy(sp);
         return st;
@@ -120,14 +120,14 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         if ((st = atmos__slice_frame_setup(ctx, sp, p->atm, v, r, &j)) != ATMOS_OK) return st;
         if (sp->diffuse) {
             int built;
-            if ((st = atmos__slice_field_update(ctx, sp, p->atm, v->sun, v->warm_field, &built)) != ATMOS_OK) return st;
-            j.field = &sp->field;
-            j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->fg;
+            if ((st = atmos__dfield_update(ctx, &sp->df, p->atm, v->sun, v->warm_field, 0, &built)) != ATMOS_OK) return st;
+            j.field = &sp->df.field;
+            j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->df.fg;
             double eu[3]; /* the eye in render-voxel coordinates */
             for (int a = 0; a < 3; a++) eu[a] = j.eye[a] * sp->g.sc + sp->g.off[a];
-            atmos__slice_field_view(sp, eu, atmos__threads(ctx));
-            j.fview = sp->fview, j.fvq = sp->fvq;
-            if (built) tm->field = sp->field.build_s, tm->field_sweeps = sp->field.sweeps;
+            atmos__dfield_view(&sp->df, eu, atmos__threads(ctx));
+            j.fview = sp->df.view, j.fvq = sp->df.vq;
+            if (built) tm->field = sp->df.field.build_s, tm->field_sweeps = sp->df.field.sweeps;
         }
         tm->setup = atmos__now() - t_setup;
         tm->prepare = sp->prepare_s;

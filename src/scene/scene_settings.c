@@ -85,6 +85,11 @@ static const atmos_setting nishita_settings[] = {
      "the sky's and the ground's light through sky elements (off: the sunlight alone)", NISHITA(sky)},
     {"step_pct", "nishita-step", ATMOS_SETTING_INT, "%", 5, 400, 0, 0, 50, NULL, 0,
      "eye-ray step, per cent of a render voxel", NISHITA(step_scale_pct)},
+    {"diffuse", "nishita-diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "the slice renderer's diffuse light field of all orders and Riley's scattered forward beam where the "
+     "medium is thick, instead of the orders 2-3 and the sky elements there (docs/lightfield.md); off: "
+     "orders 1-3 only, which lose most of the light of dense clouds",
+     NISHITA(diffuse)},
 };
 
 static const atmos_setting harris_settings[] = {
@@ -109,6 +114,10 @@ static const atmos_setting harris_settings[] = {
      HARRIS(impostor_tolerance_deg)},
     {"impostor_max_res", "impostor-max-res", ATMOS_SETTING_INT, "texels", 16, 4096, 0, 0, 512, NULL, 0,
      "an impostor's texels per side at most", HARRIS(impostor_max_res)},
+    {"diffuse", "harris-diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "each particle also scatters the diffuse light field of all orders (the light the forward passes drop, "
+     "by the slice renderer's diffusion solve on the volume's grid) toward the eye (docs/particles.md)",
+     HARRIS(diffuse)},
 };
 
 static const atmos_setting beams_settings[] = {

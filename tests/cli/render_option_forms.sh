@@ -36,7 +36,7 @@ base() {
 
 # flag (with its argument) | the -D form | renderer | "same" if a tiny image may not show it
 # (a budget never reached, orders beyond what a thin ball scatters, order-3 paths with orders
-# 2, impostors smaller anyway)
+# 2, impostors smaller anyway, a diffuse field faded out in a thin ball)
 cat >"$T/table" <<'EOF'
 --slices 16|slice.slices=16|slice|
 --light-size 16|slice.light_size=16|slice|
@@ -63,6 +63,7 @@ cat >"$T/table" <<'EOF'
 --nishita-cells 5|nishita.cells=5|nishita|
 --no-nishita-sky|nishita.sky=false|nishita|
 --nishita-step 100|nishita.step_pct=100|nishita|
+--nishita-diffuse|nishita.diffuse=true|nishita|same
 --spacing 100|harris.spacing_m=100|harris|
 --max-particles 10|harris.max_particles=10|harris|
 --sky-lights 0|harris.sky_lights=0|harris|
@@ -70,6 +71,7 @@ cat >"$T/table" <<'EOF'
 --no-impostors|harris.impostors=false|harris|same
 --impostor-tolerance 5|harris.impostor_tolerance_deg=5|harris|same
 --impostor-max-res 16|harris.impostor_max_res=16|harris|same
+--harris-diffuse|harris.diffuse=true|harris|same
 --plane-spacing 0.5|beams.plane_spacing_m=0.5|beams|
 --beams-epsilon 0.1|beams.epsilon=0.1|beams|
 --max-subplanes 1|beams.max_subplanes=1|beams|

@@ -164,7 +164,8 @@ int main(void)
     CHECK(nn > 100 && nn < h->pc.n - 100);
     /* the near particles alone and all of them, splatted over black with the plan's light */
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
-                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l};
+                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
+                              NULL};
     atmos_image *nearimg = NULL, *allimg = NULL;
     CHECK_OK(atmos_image_create(c2, W, H, C, &nearimg));
     CHECK_OK(atmos_image_create(c2, W, H, C, &allimg));

@@ -16,7 +16,7 @@ typedef struct {
 
 enum {
     KEEP_ISO,   /* Riley's F_n, the dropped light an isotropic source */
-    KEEP_RILEY, /* Riley's F_n, the dropped light with its first moment (as slice_field.c) */
+    KEEP_RILEY, /* Riley's F_n, the dropped light with its first moment (as dfield.c) */
     KEEP_DE     /* delta-Eddington's split: f = g^2 kept, the rest of mean cosine g / (1 + g) */
 };
 

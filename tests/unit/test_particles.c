@@ -146,7 +146,7 @@ static void eye_pass(void)
     CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img));
     const int rect[4] = {0, 0, 65, 65};
     int drawn = 0;
-    const atmos__plights L1 = {1, lp, op, sun, sun_e, NULL, NULL};
+    const atmos__plights L1 = {1, lp, op, sun, sun_e, NULL, NULL, NULL};
     CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L1, NULL, 0, &cam, rect, img, &drawn));
     CHECK(drawn == 1);
     const double tau = 1e-12 * 1e9 * 20 * sqrt(2 * 3.141592653589793) * erf(3 / sqrt(2.0));
@@ -161,7 +161,7 @@ static void eye_pass(void)
     float *lt = malloc(sizeof(float) * (size_t)pc.n), *od = calloc((size_t)pc.n, sizeof(float));
     for (int i = 0; i < pc.n; i++) lt[i] = 0.5f + 0.001f * i;
     const float *ltp[1] = {lt}, *odp[1] = {od};
-    const atmos__plights L2 = {1, ltp, odp, sun, sun_e, NULL, NULL};
+    const atmos__plights L2 = {1, ltp, odp, sun, sun_e, NULL, NULL, NULL};
     atmos_image *img2 = NULL;
     CHECK_OK(atmos_image_create(NULL, 65, 65, 2, &img2));
 #ifdef _OPENMP
@@ -219,7 +219,7 @@ static void impostors(void)
     CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun[0], 0, 1.0, light, order));
     const float *lp[1] = {light}, *op[1] = {order};
     const double e1[1][ATMOS_MAX_WAVELENGTHS] = {{1.0}};
-    const atmos__plights L = {1, lp, op, sun, e1, NULL, NULL};
+    const atmos__plights L = {1, lp, op, sun, e1, NULL, NULL, NULL};
     atmos_camera_desc cd;
     const double eye[3] = {0, 1800, 0};
     atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, eye, &cd);

@@ -8,7 +8,7 @@
  * errors, (1 + bias behind) / (1 + bias in front), near 1 and each bias within a bound.
  * Measured (64 paths per pixel): with the solve's flux turned toward the eye (before) the
  * sunlit side +42.7 %, the shadowed side -2.3 %, ratio 1.46; with the view's flux
- * (slice_field.c, VIEW_SHARE 0.3) +23.6 % and +1.2 %, ratio 1.22 (share 0.5: +18 % / +8 %,
+ * (dfield.c, VIEW_SHARE 0.3) +23.6 % and +1.2 %, ratio 1.22 (share 0.5: +18 % / +8 %,
  * 1.09). Bounds: the ratio within 1 +- 0.3, the sunlit side's bias within +-30 %, the
  * shadowed side's within +-10 % (the path tracer's noise at 64 paths is about 1 % of the
  * mean over the cloud). Small sizes (a 32^3 blob of optical depth ~20 through its centre,

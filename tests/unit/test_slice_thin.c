@@ -6,7 +6,7 @@
  * (optical depth 0.25 across): the field must not add more than a few per cent to the
  * sheet's light. Dense (optical depth 25 across): the field must still add light (without it
  * the sheet is far too dark, docs/accuracy.md). Measured, the sum over the sheet's pixels
- * with the field over without: before the fade of the field in thin media (slice_field.c,
+ * with the field over without: before the fade of the field in thin media (dfield.c,
  * field_fade) thin 1.157, dense 4.548; with it thin 1.000, dense 4.548. Small sizes (a 48 x 6
  * x 48 grid, 32 x 32 pixels) keep it fast (2 s of CPU). */
 #include "atmos/atmos.h"

@@ -1,12 +1,12 @@
-/* The slice renderer's diffuse light field ("diffuse", docs/lightfield.md): the light that
+/* The diffuse light field over a render grid (dfield.h, docs/lightfield.md): the light that
  * Riley et al. 2004's forward model (Eq. 24/25) drops at each scattering, the side- and
  * back-scattered part, taken as the source of a diffuse field of all orders and solved by
  * diffusion on a grid coarser than the render grid (src/light/). The medium on that grid is
  * built once per plan; the field once per sun direction, warm-started from the last one.
- * The eye passes add what it scatters toward the eye, sca (L + g A) per field (slice_pass.c),
- * A from the view's flux (field_keep_view), faded out where the medium is thin (field_fade). */
-#include "atmosphere/atmosphere_ops.h"
-#include "render/slice_internal.h"
+ * The eye passes add what it scatters toward the eye, sca (L + g A) per field (slice_pass.c,
+ * nishita_render.c), A from the view's flux (field_keep_view), faded out where the medium is
+ * thin (field_fade). */
+#include "render/dfield.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -27,20 +27,20 @@
  * mu = mu0 + share (mu1 - mu0), held between B_n and 1. The diffusion solve takes share 0
  * (mu0: the slabs' fluxes against adding-doubling, docs/lightfield.md); the flux that turns
  * the field toward the eye takes VIEW_SHARE (below). */
-static float keep_share(const atmos__slice_plan *sp, size_t cell, int w, float n, float *mu, float share)
+static float keep_share(const atmos__dfield *df, size_t cell, int w, float n, float *mu, float share)
 {
-    const int nf = sp->nf;
-    const float *d = sp->fdens + cell * (size_t)nf;
+    const int nf = df->nf;
+    const float *d = df->dens + cell * (size_t)nf;
     float num = 0, den = 0, mnum = 0, mden = 0;
     for (int f = 0; f < nf; f++) {
-        const float bs = d[f] * sp->tab.sca[f][w];
+        const float bs = d[f] * df->tab->sca[f][w];
         if (!(bs > 0.0f)) continue;
         const size_t row = (size_t)w * (SLICE_F_ORDERS + 1);
-        const float F = order_lerp(sp->tab.F[f] + row, n, 0), drop = bs * (1.0f - F);
+        const float F = order_lerp(df->tab->F[f] + row, n, 0), drop = bs * (1.0f - F);
         num += bs * F;
         den += bs;
         if (!mu || !(drop > 0.0f)) continue;
-        const float g = sp->fg[f][w], lo = order_lerp(sp->tab.B[f] + row, n, 0);
+        const float g = df->fg[f][w], lo = order_lerp(df->tab->B[f] + row, n, 0);
         float m = (g - F) / (1.0f - F);
         if (share > 0.0f) {
             const float gn = g > 0.0f ? expf(n * logf(g)) : 0.0f; /* g^{n+1}: n is the order n + 1 */
@@ -76,11 +76,11 @@ static float field_keep_view(const void *user, size_t cell, int w, float n, floa
 
 /* The mean density of each field over the s^3 render voxels of every cell, and the cells'
  * extinction, scattering and asymmetry per wavelength. */
-static void field_medium(atmos__slice_plan *sp, int s)
+static void field_medium(atmos__dfield *df, int s)
 {
-    const sgrid *g = &sp->g;
-    atmos__lmedium *m = &sp->fmed;
-    const int nf = sp->nf, n = sp->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
+    const sgrid *g = df->g;
+    atmos__lmedium *m = &df->med;
+    const int nf = df->nf, n = df->n, cx = m->c[0], cy = m->c[1], cz = m->c[2];
     for (int K = 0; K < cz; K++)
         for (int J = 0; J < cy; J++)
             for (int I = 0; I < cx; I++) {
@@ -93,14 +93,14 @@ static void field_medium(atmos__slice_plan *sp, int s)
                             const float *p = g->v + (((size_t)k * g->c[1] + j) * g->c[0] + i) * nf;
                             for (int f = 0; f < nf; f++) sum[f] += p[f];
                         }
-                float *d = sp->fdens + cell * nf;
+                float *d = df->dens + cell * nf;
                 for (int f = 0; f < nf; f++) d[f] = cnt ? (float)(sum[f] / cnt) : 0.0f;
                 for (int w = 0; w < n; w++) {
                     double st = 0, ss = 0, sg = 0;
                     for (int f = 0; f < nf; f++) {
-                        st += d[f] * sp->tab.sig[f][w];
-                        ss += d[f] * sp->tab.sca[f][w];
-                        sg += d[f] * sp->tab.sca[f][w] * sp->fg[f][w];
+                        st += d[f] * df->tab->sig[f][w];
+                        ss += d[f] * df->tab->sca[f][w];
+                        sg += d[f] * df->tab->sca[f][w] * df->fg[f][w];
                     }
                     m->sig_t[cell * n + w] = (float)st;
                     m->sig_s[cell * n + w] = (float)ss;
@@ -109,7 +109,7 @@ static void field_medium(atmos__slice_plan *sp, int s)
             }
 }
 
-/* The field's weight per cell (sp->ffade), docs/lightfield.md "Thin media". The diffusion
+/* The field's weight per cell (df->fade), docs/lightfield.md "Thin media". The diffusion
  * solve stands for light that stays in the medium and diffuses; where the medium is optically
  * thin the light Eq. 25 drops mostly leaves it, and the field only added an excess (the bench's
  * thin cirrus +25 % with the field, -1 % without: its flux-limited diffusion spreads the dropped
@@ -145,12 +145,12 @@ static void fade_dilate(float *t, float *tmp, const atmos__lmedium *m, int a, in
     memcpy(t, tmp, sizeof(float) * cells * (size_t)n);
 }
 
-static int field_fade(atmos__slice_plan *sp)
+static int field_fade(atmos__dfield *df)
 {
-    const atmos__lmedium *m = &sp->fmed;
+    const atmos__lmedium *m = &df->med;
     const int n = m->n;
     const size_t cells = atmos__lmedium_cells(m), cnt = cells * (size_t)n;
-    float *t = sp->ffade, *line = malloc(sizeof(float) * cnt);
+    float *t = df->fade, *line = malloc(sizeof(float) * cnt);
     if (!line) return 0;
     for (size_t i = 0; i < cnt; i++) t[i] = INFINITY;
     for (int a = 0; a < 3; a++) {
@@ -177,49 +177,58 @@ static int field_fade(atmos__slice_plan *sp)
         double x = t[i] > 0.0f ? log(t[i] / FADE_LO) / span : 0.0;
         x = x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
         t[i] = (float)(x * x * (3.0 - 2.0 * x));
-        sp->ffade_any |= t[i] > 0.0f;
+        df->fade_any |= t[i] > 0.0f;
     }
     return 1;
 }
 
-atmos_status atmos__slice_field_prepare(atmos_context *ctx, atmos__slice_plan *sp, const atmos_volume_optics *o)
+void atmos__dfield_free(atmos__dfield *df)
 {
-    const sgrid *g = &sp->g;
+    atmos__lmedium_free(&df->med), atmos__lfield_free(&df->field);
+    free(df->dens), free(df->fade), free(df->beam), free(df->view);
+    memset(df, 0, sizeof *df);
+}
+
+atmos_status atmos__dfield_prepare(atmos_context *ctx, atmos__dfield *df, const sgrid *g, const stables *tab,
+                                   const atmos__vol_xform *x, const atmos_volume_optics *o, const char *who)
+{
+    df->g = g, df->tab = tab, df->x = x, df->who = who;
+    df->n = tab->n, df->nf = tab->nf;
     int big = g->c[0] > g->c[1] ? g->c[0] : g->c[1];
     big = big > g->c[2] ? big : g->c[2];
     /* cells of s render voxels: at least 2, at most FIELD_CELLS_MAX per axis */
     int s = (big + FIELD_CELLS_MAX - 1) / FIELD_CELLS_MAX;
     s = s < 2 ? 2 : s;
     const int cx = (g->c[0] + s - 1) / s, cy = (g->c[1] + s - 1) / s, cz = (g->c[2] + s - 1) / s;
-    for (int f = 0; f < sp->nf; f++)
-        for (int w = 0; w < sp->n; w++) sp->fg[f][w] = (float)atmos_phase_table_g(o->phase[f], w);
+    for (int f = 0; f < df->nf; f++)
+        for (int w = 0; w < df->n; w++) df->fg[f][w] = (float)atmos_phase_table_g(o->phase[f], w);
     const size_t cells = (size_t)cx * cy * cz;
-    sp->fdens = malloc(sizeof(float) * cells * (size_t)sp->nf);
-    sp->ffade = malloc(sizeof(float) * cells * (size_t)sp->n);
-    sp->fvq = sp->n == 3 ? 4 : sp->n;
-    sp->fview = calloc(cells * (size_t)sp->nf * sp->fvq, sizeof(float));
-    if (!sp->fdens || !sp->ffade || !sp->fview || !atmos__lmedium_alloc(&sp->fmed, cx, cy, cz, sp->n, s / (double)g->sc) ||
-        !(sp->fmed.jin = calloc((size_t)6 * sp->n, sizeof(float))) ||
-        !atmos__lfield_alloc(&sp->field, ATMOS__LFIELD_DIFFUSION, cx, cy, cz, sp->n, s))
-        return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
-    field_medium(sp, s);
-    if (!field_fade(sp)) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
+    df->dens = malloc(sizeof(float) * cells * (size_t)df->nf);
+    df->fade = malloc(sizeof(float) * cells * (size_t)df->n);
+    df->vq = df->n == 3 ? 4 : df->n;
+    df->view = calloc(cells * (size_t)df->nf * df->vq, sizeof(float));
+    if (!df->dens || !df->fade || !df->view || !atmos__lmedium_alloc(&df->med, cx, cy, cz, df->n, s / (double)g->sc) ||
+        !(df->med.jin = calloc((size_t)6 * df->n, sizeof(float))) ||
+        !atmos__lfield_alloc(&df->field, ATMOS__LFIELD_DIFFUSION, cx, cy, cz, df->n, s))
+        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for the diffuse light field", who);
+    field_medium(df, s);
+    if (!field_fade(df)) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for the diffuse light field", who);
     return ATMOS_OK;
 }
 
-void atmos__slice_field_view(atmos__slice_plan *sp, const double eye[3], int threads)
+void atmos__dfield_view(atmos__dfield *df, const double eye[3], int threads)
 {
-    atmos__lfield *fl = &sp->field;
+    atmos__lfield *fl = &df->field;
     atmos__lfield_toward(fl, eye, threads);
-    const int n = sp->n, nf = sp->nf, q = sp->fvq;
-    const long long cells = (long long)atmos__lmedium_cells(&sp->fmed);
+    const int n = df->n, nf = df->nf, q = df->vq;
+    const long long cells = (long long)atmos__lmedium_cells(&df->med);
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (long long cell = 0; cell < cells; cell++) {
         const float *la = fl->LA + (size_t)cell * 2 * n;
         for (int f = 0; f < nf; f++) {
-            float *o = sp->fview + ((size_t)cell * nf + f) * q;
+            float *o = df->view + ((size_t)cell * nf + f) * q;
             for (int c = 0; c < q; c++)
-                o[c] = c < n ? sp->tab.sca[f][c] * (la[c] + sp->fg[f][c] * la[n + c]) : 0.0f;
+                o[c] = c < n ? df->tab->sca[f][c] * (la[c] + df->fg[f][c] * la[n + c]) : 0.0f;
         }
     }
 }
@@ -231,10 +240,10 @@ void atmos__slice_field_view(atmos__slice_plan *sp, const double eye[3], int thr
  * the forward beam's), on SKY_NMU x SKY_NPHI cells of equal solid angle. */
 #define SKY_NMU 16
 #define SKY_NPHI 32
-static void field_sky(atmos__slice_plan *sp, const atmos_atmosphere *atm, const double cw[3], const double sun_w[3])
+static void field_sky(atmos__dfield *df, const atmos_atmosphere *atm, const double cw[3], const double sun_w[3])
 {
-    const int n = sp->n;
-    float *jin = sp->fmed.jin;
+    const int n = df->n;
+    float *jin = df->med.jin;
     for (int i = 0; i < 6 * n; i++) jin[i] = 0.0f;
     const double dom = 4.0 * 3.14159265358979323846 / (SKY_NMU * SKY_NPHI);
     double acc[6 * ATMOS_MAX_WAVELENGTHS] = {0};
@@ -243,13 +252,13 @@ static void field_sky(atmos__slice_plan *sp, const atmos_atmosphere *atm, const 
             const double mu = -1.0 + 2.0 * (a + 0.5) / SKY_NMU, sn = sqrt(1.0 - mu * mu),
                          ph = 2.0 * 3.14159265358979323846 * (b + 0.5) / SKY_NPHI;
             const double d[3] = {sn * cos(ph), mu, sn * sin(ph)};
-            double L[ATMOS_MAX_WAVELENGTHS], df[3];
+            double L[ATMOS_MAX_WAVELENGTHS], dg[3];
             atmos_atmosphere_hit info;
             atmos_atmosphere_radiance(atm, cw, d, sun_w, L, &info);
             if (info.in_sun_disk) continue;
-            atmos__vol_dir_to_frame(&sp->x, d, df);
+            atmos__vol_dir_to_frame(df->x, d, dg);
             for (int f = 0; f < 6; f++) {
-                const double c = (f & 1 ? 1.0 : -1.0) * df[f / 2];
+                const double c = (f & 1 ? 1.0 : -1.0) * dg[f / 2];
                 if (c > 0)
                     for (int w = 0; w < n; w++) acc[f * n + w] += L[w] * c * dom;
             }
@@ -257,63 +266,83 @@ static void field_sky(atmos__slice_plan *sp, const atmos_atmosphere *atm, const 
     for (int i = 0; i < 6 * n; i++) jin[i] = (float)acc[i];
 }
 
-atmos_status atmos__slice_field_update(atmos_context *ctx, atmos__slice_plan *sp, const atmos_atmosphere *atm,
-                                       const double sun_w[3], int warm, int *built)
+/* df->beam: Riley's beam Ib (its march with F, as the light buffer's) less the unscattered
+ * sunlight (the same march with F = 0), per cell; Q is scratch of the source's size. */
+static int field_beam(atmos__dfield *df, const double lt[3], const double *sl, const float *Ib, float *Q, int threads)
 {
-    atmos__lfield *fl = &sp->field;
+    const size_t cnt = atmos__lmedium_cells(&df->med) * (size_t)df->n;
+    if (!df->beam && !(df->beam = malloc(sizeof(float) * cnt))) return 0;
+    atmos__lfield_sun_source(&df->med, lt, sl, atmos__lkeep_none, NULL, Q, NULL, df->beam, threads);
+    for (size_t i = 0; i < cnt; i++) {
+        const float d = Ib[i] - df->beam[i];
+        df->beam[i] = d > 0.0f ? d * df->fade[i] : 0.0f;
+    }
+    return 1;
+}
+
+atmos_status atmos__dfield_update(atmos_context *ctx, atmos__dfield *df, const atmos_atmosphere *atm,
+                                  const double sun_w[3], int warm, int want_beam, int *built)
+{
+    atmos__lfield *fl = &df->field;
     *built = 0;
-    if (fl->valid && memcmp(fl->sun, sun_w, sizeof fl->sun) == 0) return ATMOS_OK;
-    if (!sp->ffade_any) {
+    if (fl->valid && memcmp(fl->sun, sun_w, sizeof fl->sun) == 0 && (!want_beam || df->beam)) return ATMOS_OK;
+    const int n = df->n;
+    const size_t cnt = atmos__lmedium_cells(&df->med) * (size_t)n;
+    if (!df->fade_any) {
         /* thin everywhere: the field is faded out in every cell and stays zero, no solve */
         memcpy(fl->sun, sun_w, sizeof fl->sun);
         fl->valid = 1, fl->sweeps = 0, fl->build_s = fl->source_s = fl->solve_s = 0;
+        if (want_beam && !df->beam && !(df->beam = calloc(cnt, sizeof(float))))
+            return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for the diffuse light field", df->who);
         *built = 1;
-        atmos__log(ctx, ATMOS_LOG_INFO, "render slice: diffuse field faded out everywhere (an optically thin medium), not solved");
+        atmos__log(ctx, ATMOS_LOG_INFO, "%s: diffuse field faded out everywhere (an optically thin medium), not solved",
+                   df->who);
         return ATMOS_OK;
     }
     const double t0 = atmos__now();
-    const int threads = atmos__threads(ctx), n = sp->n;
-    const sgrid *g = &sp->g;
-    const size_t cnt = atmos__lmedium_cells(&sp->fmed) * (size_t)n;
-    float *Q = malloc(sizeof(float) * cnt * 8), *Q1 = Q + cnt, *Qv = Q + 4 * cnt, *Q1v = Qv + cnt;
-    if (!Q) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffuse light field");
+    const int threads = atmos__threads(ctx);
+    const sgrid *g = df->g;
+    float *Q = malloc(sizeof(float) * cnt * 9), *Q1 = Q + cnt, *Qv = Q + 4 * cnt, *Q1v = Qv + cnt, *Ib = Q + 8 * cnt;
+    if (!Q) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for the diffuse light field", df->who);
     double sun_g[3], lt[3], sl[ATMOS_MAX_WAVELENGTHS], cen[3], cw[3];
-    atmos__vol_dir_to_frame(&sp->x, sun_w, sun_g);
+    atmos__vol_dir_to_frame(df->x, sun_w, sun_g);
     for (int a = 0; a < 3; a++) lt[a] = -sun_g[a], cen[a] = 0.5 * (g->box_lo[a] + g->box_hi[a]);
     /* the sunlight at the box's centre (the light buffer's per-texel entry points would
      * differ by the air's attenuation across the box) */
-    atmos__vol_frame_to_point(&sp->x, cen, cw);
+    atmos__vol_frame_to_point(df->x, cen, cw);
     atmos_atmosphere_sunlight(atm, cw, sun_w, sl);
-    atmos__lfield_sun_source(&sp->fmed, lt, sl, field_keep, sp, Q, Q1, NULL, threads);
+    atmos__lfield_sun_source(&df->med, lt, sl, field_keep, df, Q, Q1, Ib, threads);
     const atmos__lsource src = {Q, Q1};
-    field_sky(sp, atm, cw, sun_w);
+    field_sky(df, atm, cw, sun_w);
     const double t1 = atmos__now();
     atmos__ldiffusion_opts o = {0};
     o.limiter = 1; /* measured better than without (docs/lightfield.md) */
     o.cascade = fl->valid && warm ? 0 : 2; /* a cold start from coarser grids' solutions; else the last sun's field */
-    fl->sweeps = atmos__lfield_diffuse(&sp->fmed, &src, fl->phi, &o, threads);
+    fl->sweeps = atmos__lfield_diffuse(&df->med, &src, fl->phi, &o, threads);
     if (fl->sweeps < 0) {
         free(Q);
-        return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the diffusion solve");
+        return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for the diffusion solve", df->who);
     }
     const float inv4pi = (float)(1.0 / (4.0 * 3.14159265358979323846));
     /* the view's flux: the same Q, the source's moment toward mu1 (field_keep_view) */
-    atmos__lfield_sun_source(&sp->fmed, lt, sl, field_keep_view, sp, Qv, Q1v, NULL, threads);
+    atmos__lfield_sun_source(&df->med, lt, sl, field_keep_view, df, Qv, Q1v, NULL, threads);
     const atmos__lsource view = {Q, Q1v};
-    atmos__lfield_flux(&sp->fmed, &view, fl->phi, &o, fl->J, threads);
+    atmos__lfield_flux(&df->med, &view, fl->phi, &o, fl->J, threads);
     /* faded where the medium is thin (field_fade); phi, the warm start, is the solve's */
     for (size_t i = 0; i < cnt; i++) {
-        fl->L[i] = fl->phi[i] * inv4pi * sp->ffade[i];
-        for (int a = 0; a < 3; a++) fl->J[i * 3 + a] *= sp->ffade[i];
+        fl->L[i] = fl->phi[i] * inv4pi * df->fade[i];
+        for (int a = 0; a < 3; a++) fl->J[i * 3 + a] *= df->fade[i];
     }
+    const int beam_ok = !want_beam || field_beam(df, lt, sl, Ib, Qv, threads);
     free(Q);
+    if (!beam_ok) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for the diffuse light field", df->who);
     memcpy(fl->sun, sun_w, sizeof fl->sun);
     fl->valid = 1;
     *built = 1;
     fl->source_s = t1 - t0;
     fl->solve_s = atmos__now() - t1;
     fl->build_s = atmos__now() - t0;
-    atmos__log(ctx, ATMOS_LOG_INFO, "render slice: diffuse field %dx%dx%d cells of %d voxels, source %.3f s, %d sweeps %.3f s",
-               fl->c[0], fl->c[1], fl->c[2], fl->s, fl->source_s, fl->sweeps, fl->solve_s);
+    atmos__log(ctx, ATMOS_LOG_INFO, "%s: diffuse field %dx%dx%d cells of %d voxels, source %.3f s, %d sweeps %.3f s",
+               df->who, fl->c[0], fl->c[1], fl->c[2], fl->s, fl->source_s, fl->sweeps, fl->solve_s);
     return ATMOS_OK;
 }
