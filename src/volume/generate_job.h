@@ -30,5 +30,8 @@ int atmos__gen_floor_j(const gen_job *job, double y);
 /* Fills the job's grids (number densities, m^-3) for preset number `which`
  * (order of atmos_volume_generator_names()). */
 atmos_status atmos__gen_preset(gen_job *job, int which);
+/* The layer clouds, one file each (generate_cirrus.c, generate_stratocumulus.c). */
+atmos_status atmos__gen_cirrus(gen_job *job);
+atmos_status atmos__gen_stratocumulus(gen_job *job);
 
 #endif

@@ -15,8 +15,8 @@
  * Peak number densities, chosen so that the extinction with the optics presets'
  * cross-sections (cloud 6.28e-10, ice 1.82e-6, rain 6.28e-6 m^2; Riley Table 2) is
  * typical: cloud droplets 1e8 m^-3 (100 cm^-3; 63 km^-1), anvil ice 3e3 m^-3
- * (5.5 km^-1, a dense anvil), cirrus ice 500 m^-3 (0.9 km^-1), rain drops 2e3 m^-3
- * (moderate rain of ~1 mm drops; 13 km^-1).
+ * (5.5 km^-1, a dense anvil), rain drops 2e3 m^-3 (moderate rain of ~1 mm drops; 13 km^-1).
+ * The layer clouds (cirrus, stratocumulus) are in generate_cirrus.c and generate_stratocumulus.c.
  */
 #include "volume/generate_job.h"
 
@@ -25,7 +25,6 @@
 
 #define ETA_CLOUD 1e8
 #define ETA_ICE_ANVIL 3e3
-#define ETA_ICE_CIRRUS 500
 #define ETA_RAIN 2e3
 #define ISO 0.3f
 
@@ -256,47 +255,16 @@ static atmos_status cumulonimbus(gen_job *job, int with_rain)
     return ATMOS_OK;
 }
 
-/* Cirrus: a thin sheet of ice near 9 km whose height, thickness and coverage are
- * fractal value noise; coverage noise is stretched 5:1 along the wind (x) so the
- * sheet breaks into streaks. */
-static atmos_status cirrus(gen_job *job)
-{
-    const double s = job->scale, half = 10000 * s;
-    job->voxel = job->voxel_override ? job->voxel_override : 80 * s;
-    job->ngrids = 1;
-    job->field_name[0] = "ice";
-    double lo[3] = {-half, 8000, -half}, hi[3] = {half, 8000 + 2000 * s, half};
-    atmos_status st = atmos__gen_grid_init(job, lo, hi);
-    if (st != ATMOS_OK) return st;
-    uint64_t s1 = atmos__splitmix64(&job->rng.s), s2 = atmos__splitmix64(&job->rng.s), s3 = atmos__splitmix64(&job->rng.s), s4 = atmos__splitmix64(&job->rng.s);
-    gen_grid *g = &job->grid[0];
-#pragma omp parallel for schedule(static) num_threads(job->threads)
-    for (int k = 0; k < g->n[2]; k++)
-        for (int i = 0; i < g->n[0]; i++) {
-            double x = vox_x(job, i, 0), z = vox_x(job, k, 2);
-            double cover = smoothstep(0.45, 0.62, atmos__gen_fbm3(s3, x / (8000 * s), 0.5, z / (1600 * s), 5, 0.55));
-            if (cover <= 0) continue;
-            double hc = 8000 + 1000 * s + 700 * s * (atmos__gen_fbm3(s1, x / (6000 * s), 0.25, z / (6000 * s), 3, 0.5) - 0.5);
-            double th = 300 * s * (0.3 + 1.2 * atmos__gen_fbm3(s2, x / (3000 * s), 0.75, z / (3000 * s), 3, 0.5));
-            for (int j = 0; j < g->n[1]; j++) {
-                double y = vox_y(job, j), u = (y - hc) / th;
-                if (u * u >= 1) continue;
-                double fine = 0.6 + 0.4 * atmos__gen_fbm3(s4, x / (500 * s), y / (200 * s), z / (500 * s), 3, 0.5);
-                g->v[((size_t)k * g->n[1] + j) * g->n[0] + i] = (float)(ETA_ICE_CIRRUS * cover * (1 - u * u) * fine);
-            }
-        }
-    return ATMOS_OK;
-}
-
 atmos_status atmos__gen_preset(gen_job *job, int which)
 {
     switch (which) {
     case 0: return cumulus(job);
     case 1: return cumulonimbus(job, 0);
     case 2: return cumulus_field(job);
-    case 3: return cirrus(job);
+    case 3: return atmos__gen_cirrus(job);
     case 4: return rain_shaft_preset(job);
     case 5: return cumulonimbus(job, 1);
+    case 6: return atmos__gen_stratocumulus(job);
     default: return atmos__error(job->ctx, ATMOS_E_INVALID_ARG, "generate: no preset %d", which);
     }
 }

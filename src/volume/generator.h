@@ -94,4 +94,13 @@ int atmos__gen_refine(gen_grid *g, gen_balls *bl, const gen_refine *p, gen_rng *
 double atmos__gen_noise3(uint64_t seed, double x, double y, double z);
 double atmos__gen_fbm3(uint64_t seed, double x, double y, double z, int octaves, double gain);
 
+/* Cellular noise in the plane (noise_cells.c): one feature point per unit cell, jittered by
+ * `jitter` (0..1) of the cell; f1, f2 the distances to the nearest two, id a hash of the
+ * nearest one's cell (for per-cell random values). */
+typedef struct {
+    double f1, f2;
+    uint64_t id;
+} gen_cell;
+void atmos__gen_cells2(uint64_t seed, double x, double z, double jitter, gen_cell *out);
+
 #endif

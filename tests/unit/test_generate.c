@@ -249,7 +249,7 @@ static void test_presets_and_errors(atmos_context *ctx)
         }
         atmos_volume_destroy(v);
     }
-    CHECK(n == 6);
+    CHECK(n == 7);
     atmos_volume *v = NULL;
     atmos_volume_generate_desc g = {.seed = 1};
     CHECK(atmos_volume_generate(ctx, "nimbostratus", &g, &v) == ATMOS_E_INVALID_ARG && !v);
