@@ -160,8 +160,8 @@ typedef struct atmos_volume_generate_desc {
     uint64_t max_memory;      /* 0 = default */
 } atmos_volume_generate_desc;
 
-/* Presets: "cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm"
- * (docs/volumes.md). Unknown names list the known ones. */
+/* Presets: "cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm",
+ * "virga" (docs/volumes.md). Unknown names list the known ones. */
 ATMOS_API atmos_status atmos_volume_generate(atmos_context *ctx, const char *preset,
                                              const atmos_volume_generate_desc *desc, atmos_volume **out);
 ATMOS_API const char *const *atmos_volume_generator_names(void);

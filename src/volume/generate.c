@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const names[] = {"cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm", NULL};
+static const char *const names[] = {"cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm", "virga", NULL};
 
 const char *const *atmos_volume_generator_names(void) { return names; }
 

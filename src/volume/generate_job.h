@@ -30,5 +30,9 @@ int atmos__gen_floor_j(const gen_job *job, double y);
 /* Fills the job's grids (number densities, m^-3) for preset number `which`
  * (order of atmos_volume_generator_names()). */
 atmos_status atmos__gen_preset(gen_job *job, int which);
+/* The storm presets (generate_storm.c): cumulonimbus (with_rain 0) and storm (1);
+ * rain_shaft (virga 0) and virga (1). */
+atmos_status atmos__gen_cumulonimbus(gen_job *job, int with_rain);
+atmos_status atmos__gen_rain_shaft(gen_job *job, int virga);
 
 #endif
