@@ -223,7 +223,7 @@ atmos_status atmos__gen_rain_shaft(gen_job *job, int virga)
     job->ngrids = 2;
     job->field_name[0] = "cloud";
     job->field_name[1] = "rain";
-    double lo[3] = {-2100 * s, 0, -2100 * s}, hi[3] = {2100 * s, base + 2900 * s, 2100 * s};
+    double lo[3] = {-2100 * s, 0, -2100 * s}, hi[3] = {2100 * s, base + 3300 * s, 2100 * s};
     atmos_status st = atmos__gen_grid_init(job, lo, hi);
     if (st != ATMOS_OK) return st;
     tower_shape t = {.x = -300 * s, .z = 0, .base = base, .top = base + 2500 * s, .r_base = 1500 * s, .r_mid = 1250 * s,
