@@ -91,11 +91,11 @@ static atmos_status tower_field(gen_job *job, gen_grid *g, const tower_shape *t,
 }
 
 /* F -> number densities: liquid below the glaciation band [yg0, yg1], ice above it; the
- * liquid grows with height above the base (adiabatic water content). Rows below floor_j
- * are 0. ice may be NULL (no glaciation: yg0 above the grid). */
-static void tower_density(gen_job *job, gen_grid *cl, gen_grid *ice, double base, double yg0, double yg1, int floor_j)
+ * liquid grows with height above the base (adiabatic water content) to its peak hlw above
+ * it. Rows below floor_j are 0. ice may be NULL (no glaciation: yg0 above the grid). */
+static void tower_density(gen_job *job, gen_grid *cl, gen_grid *ice, double base, double hlw, double yg0, double yg1,
+                          int floor_j)
 {
-    const double hlw = 6000 * job->scale;
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < cl->n[2]; k++)
         for (int j = 0; j < cl->n[1]; j++) {
@@ -203,7 +203,7 @@ atmos_status atmos__gen_cumulonimbus(gen_job *job, int with_rain)
     int fj = atmos__gen_floor_j(job, base);
     if ((st = tower_field(job, &job->grid[0], &t, 3, fj)) != ATMOS_OK) return st;
     uint64_t seed_anvil = atmos__splitmix64(&job->rng.s), seed_rain = atmos__splitmix64(&job->rng.s);
-    tower_density(job, &job->grid[0], &job->grid[1], base, base + 6000 * s, base + 7500 * s, fj);
+    tower_density(job, &job->grid[0], &job->grid[1], base, 6000 * s, base + 6000 * s, base + 7500 * s, fj);
     /* Noise stretches the edge by up to 1/0.75, rarely beyond 1/0.8: the anvil ends inside the grid. */
     anvil(job, &job->grid[1], xo, y_top, 1.25 * t.r_top, 0.8 * (12900 * s - xo), 1.1 * t.r_top, 2400 * s, seed_anvil);
     if (with_rain) {
@@ -232,7 +232,7 @@ atmos_status atmos__gen_rain_shaft(gen_job *job, int virga)
     int fj = atmos__gen_floor_j(job, base);
     if ((st = tower_field(job, &job->grid[0], &t, 3, fj)) != ATMOS_OK) return st;
     uint64_t seed_rain = atmos__splitmix64(&job->rng.s);
-    tower_density(job, &job->grid[0], NULL, base, 1e30, 1e30, fj);
+    tower_density(job, &job->grid[0], NULL, base, 0.8 * (t.top - base), 1e30, 1e30, fj);
     rain_shape r = {.x0 = 0, .z0 = 0, .base = base, .radius = 900 * s, .slant = virga ? 0.12 : 0.15,
                     .y_end = virga ? 800 : 0, .eta = 2 * ETA_RAIN};
     rain(job, &job->grid[1], &r, seed_rain);
