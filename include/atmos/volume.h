@@ -161,7 +161,7 @@ typedef struct atmos_volume_generate_desc {
 } atmos_volume_generate_desc;
 
 /* Presets: "cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm",
- * "stratocumulus" (docs/volumes.md). Unknown names list the known ones. */
+ * "stratocumulus", "virga" (docs/volumes.md). Unknown names list the known ones. */
 ATMOS_API atmos_status atmos_volume_generate(atmos_context *ctx, const char *preset,
                                              const atmos_volume_generate_desc *desc, atmos_volume **out);
 ATMOS_API const char *const *atmos_volume_generator_names(void);

@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const names[] = {"cumulus", "cumulonimbus", "cumulus_field", "cirrus",
-                                    "rain_shaft", "storm", "stratocumulus", NULL};
+static const char *const names[] = {"cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft",
+                                    "storm", "stratocumulus", "virga", NULL};
 
 const char *const *atmos_volume_generator_names(void) { return names; }
 

@@ -33,5 +33,9 @@ atmos_status atmos__gen_preset(gen_job *job, int which);
 /* The layer clouds, one file each (generate_cirrus.c, generate_stratocumulus.c). */
 atmos_status atmos__gen_cirrus(gen_job *job);
 atmos_status atmos__gen_stratocumulus(gen_job *job);
+/* The storm presets (generate_storm.c): cumulonimbus (with_rain 0) and storm (1);
+ * rain_shaft (virga 0) and virga (1). */
+atmos_status atmos__gen_cumulonimbus(gen_job *job, int with_rain);
+atmos_status atmos__gen_rain_shaft(gen_job *job, int virga);
 
 #endif
