@@ -28,7 +28,6 @@
 
 static double clamp01(double x) { return x < 0 ? 0 : (x > 1 ? 1 : x); }
 static double vox_y(const gen_job *job, int j) { return job->origin[1] + (j + 0.5) * job->voxel; }
-static double vox_x(const gen_job *job, int i, int a) { return job->origin[a] + (i + 0.5) * job->voxel; }
 
 static atmos_status nomem(gen_job *job) { return atmos__error(job->ctx, ATMOS_E_NOMEM, "generate %s: out of memory", job->preset); }
 
@@ -130,11 +129,6 @@ static atmos_status cumulus_field(gen_job *job)
     int fj = atmos__gen_floor_j(job, base);
     if ((st = refine(job, &job->grid[0], 110 * s, 2, fj, 0)) != ATMOS_OK) return st;
     cloud_density(job, &job->grid[0], base, 900 * s, ETA_CLOUD, fj);
-    return ATMOS_OK;
-}
-
-            }
-        }
     return ATMOS_OK;
 }
 
