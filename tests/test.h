@@ -73,6 +73,43 @@ static inline atmos_context *test_context(int threads, const char *cache_dir)
     return ctx;
 }
 
+/* A generated preset volume (seed; voxel edge in metres, 0: the preset's own), checked. */
+static inline atmos_volume *test_generate(atmos_context *ctx, const char *preset, uint64_t seed, double voxel)
+{
+    atmos_volume_generate_desc g = {.seed = seed, .voxel_size_m = voxel};
+    atmos_volume *v = NULL;
+    atmos_status st = atmos_volume_generate(ctx, preset, &g, &v);
+    CHECK_MSG(st == ATMOS_OK, "%s: %s", preset, atmos_context_error(ctx));
+    return v;
+}
+
+/* The index of v's field called name, -1 if it has none. */
+static inline int test_field_index(const atmos_volume *v, const char *name)
+{
+    for (int f = 0; f < atmos_volume_field_count(v); f++)
+        if (!strcmp(atmos_volume_field_name(v, f), name)) return f;
+    return -1;
+}
+
+/* One frame of scene s (volume v, optics; the volume where its own coordinates put it, as
+ * atmos_render_path does) through a plan made for it, checked; NULL on failure. */
+static inline atmos_image *test_plan_frame(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,
+                                           const atmos_volume_optics *optics)
+{
+    atmos_plan_desc d;
+    memset(&d, 0, sizeof d);
+    d.optics = optics;
+    d.offset_given = 1;
+    atmos_plan *p = NULL;
+    atmos_frame f;
+    atmos_image *img = NULL;
+    CHECK_OK(atmos_plan_create(ctx, s, v, &d, &p));
+    if (p && atmos_frame_from_scene(ctx, s, &f) == ATMOS_OK && atmos_plan_image_create(p, &f, &img) == ATMOS_OK)
+        CHECK_MSG(atmos_plan_render(p, &f, NULL, img, NULL) == ATMOS_OK, "render: %s", atmos_context_error(ctx));
+    atmos_plan_destroy(p);
+    return img;
+}
+
 /* Scratch path for a test's output files: $ATMOS_TEST_TMP/name (or /tmp). */
 static inline void test_tmp_path(char *buf, size_t cap, const char *name)
 {

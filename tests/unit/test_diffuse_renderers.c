@@ -54,19 +54,7 @@ static atmos_image *render(atmos_context *ctx, const atmos_scene *sc, const atmo
     atmos_scene s = *sc;
     s.renderer = renderer;
     s.nishita.diffuse = s.harris.diffuse = diffuse;
-    atmos_plan_desc d;
-    memset(&d, 0, sizeof d);
-    d.optics = &op->o;
-    d.offset_given = 1; /* where the volume's own coordinates put it, as atmos_render_path does */
-    atmos_plan *p = NULL;
-    atmos_frame f;
-    atmos_image *img = NULL;
-    CHECK_OK(atmos_plan_create(ctx, &s, v, &d, &p));
-    CHECK_OK(atmos_frame_from_scene(ctx, &s, &f));
-    CHECK_OK(atmos_plan_image_create(p, &f, &img));
-    CHECK_MSG(atmos_plan_render(p, &f, NULL, img, NULL) == ATMOS_OK, "render: %s", atmos_context_error(ctx));
-    atmos_plan_destroy(p);
-    return img;
+    return test_plan_frame(ctx, &s, v, &op->o);
 }
 
 /* The green channel's sum over the pixels where ref (the path tracer) is above 1 % of its

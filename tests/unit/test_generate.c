@@ -5,32 +5,6 @@
 #include "test.h"
 #include "volume/volume_grid.h"
 
-static atmos_context *make_ctx(int threads)
-{
-    atmos_context_desc d;
-    memset(&d, 0, sizeof d);
-    d.threads = threads;
-    atmos_context *ctx = NULL;
-    atmos_context_create(&d, &ctx);
-    return ctx;
-}
-
-static atmos_volume *gen(atmos_context *ctx, const char *preset, uint64_t seed, double voxel)
-{
-    atmos_volume_generate_desc g = {.seed = seed, .voxel_size_m = voxel};
-    atmos_volume *v = NULL;
-    atmos_status st = atmos_volume_generate(ctx, preset, &g, &v);
-    CHECK_MSG(st == ATMOS_OK, "%s: %s", preset, atmos_context_error(ctx));
-    return v;
-}
-
-static int field_index(const atmos_volume *v, const char *name)
-{
-    for (int f = 0; f < atmos_volume_field_count(v); f++)
-        if (!strcmp(atmos_volume_field_name(v, f), name)) return f;
-    return -1;
-}
-
 /* Number of voxels that differ between two volumes of the same grid. */
 static long count_diff(const atmos_volume *a, const atmos_volume *b)
 {
@@ -47,12 +21,12 @@ static long count_diff(const atmos_volume *a, const atmos_volume *b)
 
 static void test_determinism(void)
 {
-    atmos_context *c1 = make_ctx(1), *c3 = make_ctx(3);
+    atmos_context *c1 = test_context(1, NULL), *c3 = test_context(3, NULL);
     static const char *presets[] = {"cumulus", "cirrus", "rain_shaft"};
     static const double voxels[] = {40, 250, 80};
     for (int p = 0; p < 3; p++) {
-        atmos_volume *a = gen(c1, presets[p], 7, voxels[p]), *b = gen(c3, presets[p], 7, voxels[p]);
-        atmos_volume *c = gen(c3, presets[p], 8, voxels[p]);
+        atmos_volume *a = test_generate(c1, presets[p], 7, voxels[p]), *b = test_generate(c3, presets[p], 7, voxels[p]);
+        atmos_volume *c = test_generate(c3, presets[p], 8, voxels[p]);
         if (a && b && c) {
             CHECK_MSG(count_diff(a, b) == 0, "%s: 1 vs 3 threads differ in %ld voxels", presets[p], count_diff(a, b));
             long d = count_diff(a, c);
@@ -81,7 +55,7 @@ static void layer_areas(const atmos_volume *v, int f, long *area)
 static void test_cumulus_shape(atmos_context *ctx)
 {
     for (uint64_t seed = 1; seed <= 3; seed++) {
-        atmos_volume *v = gen(ctx, "cumulus", seed, 20);
+        atmos_volume *v = test_generate(ctx, "cumulus", seed, 20);
         if (!v) continue;
         const int *n = v->desc.dims;
         long *area = calloc((size_t)n[1], sizeof *area);
@@ -171,9 +145,9 @@ static void test_rain(atmos_context *ctx)
     static const char *presets[] = {"rain_shaft", "storm"};
     static const double voxels[] = {60, 200};
     for (int p = 0; p < 2; p++) {
-        atmos_volume *v = gen(ctx, presets[p], 5, voxels[p]);
+        atmos_volume *v = test_generate(ctx, presets[p], 5, voxels[p]);
         if (!v) continue;
-        int fc = field_index(v, "cloud"), fr = field_index(v, "rain");
+        int fc = test_field_index(v, "cloud"), fr = test_field_index(v, "rain");
         CHECK(fc >= 0 && fr >= 0);
         atmos_volume_field_stats sc, sr;
         atmos_volume_field_stats_get(ctx, v, fc, &sc);
@@ -203,7 +177,7 @@ static void test_presets_and_errors(atmos_context *ctx)
     const char *const *names = atmos_volume_generator_names();
     int n = 0;
     for (; names[n]; n++) {
-        atmos_volume *v = gen(ctx, names[n], 1, 250);
+        atmos_volume *v = test_generate(ctx, names[n], 1, 250);
         if (!v) continue;
         for (int f = 0; f < atmos_volume_field_count(v); f++) {
             atmos_volume_field_stats s;
@@ -230,7 +204,7 @@ static void test_presets_and_errors(atmos_context *ctx)
 
 int main(void)
 {
-    atmos_context *ctx = make_ctx(0);
+    atmos_context *ctx = test_context(0, NULL);
     test_determinism();
     test_cumulus_shape(ctx);
     test_rain(ctx);

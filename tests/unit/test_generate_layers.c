@@ -15,25 +15,6 @@
 #define SIGMA_ICE 1.82e-6    /* m^2, the 'ice' preset (Riley Table 2) */
 #define SIGMA_CLOUD 6.28e-10 /* m^2, the 'cloud' preset */
 
-static atmos_context *make_ctx(int threads)
-{
-    atmos_context_desc d;
-    memset(&d, 0, sizeof d);
-    d.threads = threads;
-    atmos_context *ctx = NULL;
-    atmos_context_create(&d, &ctx);
-    return ctx;
-}
-
-static atmos_volume *gen(atmos_context *ctx, const char *preset, uint64_t seed, double voxel)
-{
-    atmos_volume_generate_desc g = {.seed = seed, .voxel_size_m = voxel};
-    atmos_volume *v = NULL;
-    atmos_status st = atmos_volume_generate(ctx, preset, &g, &v);
-    CHECK_MSG(st == ATMOS_OK, "%s: %s", preset, atmos_context_error(ctx));
-    return v;
-}
-
 static double at(const atmos_volume *v, int i, int j, int k) { return vol_voxel(v, &v->field[0], i, j, k); }
 
 /* Column optical depth tau[k * nx + i] of field 0. */
@@ -101,8 +82,8 @@ static long count_diff(const atmos_volume *a, const atmos_volume *b)
 
 static void test_determinism(const char *preset, double voxel)
 {
-    atmos_context *c1 = make_ctx(1), *c3 = make_ctx(3);
-    atmos_volume *a = gen(c1, preset, 5, voxel), *b = gen(c3, preset, 5, voxel), *c = gen(c1, preset, 6, voxel);
+    atmos_context *c1 = test_context(1, NULL), *c3 = test_context(3, NULL);
+    atmos_volume *a = test_generate(c1, preset, 5, voxel), *b = test_generate(c3, preset, 5, voxel), *c = test_generate(c1, preset, 6, voxel);
     if (a && b && c) {
         CHECK_MSG(count_diff(a, b) == 0, "%s: 1 vs 3 threads differ in %ld voxels", preset, count_diff(a, b));
         CHECK_MSG(count_diff(a, c) > 0, "%s: seeds 5 and 6 give the same volume", preset);
@@ -123,7 +104,7 @@ static int cmp_double(const void *a, const void *b)
 static void test_cirrus(atmos_context *ctx, uint64_t seed)
 {
     const double vox = 100;
-    atmos_volume *v = gen(ctx, "cirrus", seed, vox);
+    atmos_volume *v = test_generate(ctx, "cirrus", seed, vox);
     if (!v) return;
     CHECK(!strcmp(atmos_volume_field_name(v, 0), "ice"));
     const int *n = v->desc.dims;
@@ -194,7 +175,7 @@ static int count_cells(const double *tau, int nx, int nz, double thr, int min_pi
 static void test_stratocumulus(atmos_context *ctx, uint64_t seed)
 {
     const double vox = 50;
-    atmos_volume *v = gen(ctx, "stratocumulus", seed, vox);
+    atmos_volume *v = test_generate(ctx, "stratocumulus", seed, vox);
     if (!v) return;
     CHECK(!strcmp(atmos_volume_field_name(v, 0), "cloud"));
     const int *n = v->desc.dims;
@@ -252,7 +233,7 @@ static void test_stratocumulus(atmos_context *ctx, uint64_t seed)
 
 int main(void)
 {
-    atmos_context *ctx = make_ctx(0);
+    atmos_context *ctx = test_context(0, NULL);
     for (uint64_t seed = 1; seed <= 2; seed++) test_cirrus(ctx, seed);
     for (uint64_t seed = 1; seed <= 2; seed++) test_stratocumulus(ctx, seed);
     test_determinism("cirrus", 200);

@@ -7,32 +7,6 @@
 #include "test.h"
 #include "volume/volume_grid.h"
 
-static atmos_context *make_ctx(int threads)
-{
-    atmos_context_desc d;
-    memset(&d, 0, sizeof d);
-    d.threads = threads;
-    atmos_context *ctx = NULL;
-    atmos_context_create(&d, &ctx);
-    return ctx;
-}
-
-static atmos_volume *gen(atmos_context *ctx, const char *preset, uint64_t seed, double voxel)
-{
-    atmos_volume_generate_desc g = {.seed = seed, .voxel_size_m = voxel};
-    atmos_volume *v = NULL;
-    atmos_status st = atmos_volume_generate(ctx, preset, &g, &v);
-    CHECK_MSG(st == ATMOS_OK, "%s: %s", preset, atmos_context_error(ctx));
-    return v;
-}
-
-static int field_index(const atmos_volume *v, const char *name)
-{
-    for (int f = 0; f < atmos_volume_field_count(v); f++)
-        if (!strcmp(atmos_volume_field_name(v, f), name)) return f;
-    return -1;
-}
-
 static float at(const atmos_volume *v, int f, int i, int j, int k) { return vol_voxel(v, &v->field[f], i, j, k); }
 static double wx(const atmos_volume *v, int i, int a) { return v->desc.origin_m[a] + (i + 0.5) * v->desc.voxel_size_m; }
 
@@ -70,9 +44,9 @@ static double centroid_x(const atmos_volume *v, int f, int j0, int j1)
  * layer (±1), and the lowest cloudy layer is at least 5 km wide. */
 static void test_broad_flat_base(atmos_context *ctx)
 {
-    atmos_volume *v = gen(ctx, "cumulonimbus", 3, 160);
+    atmos_volume *v = test_generate(ctx, "cumulonimbus", 3, 160);
     if (!v) return;
-    const int *n = v->desc.dims, fc = field_index(v, "cloud");
+    const int *n = v->desc.dims, fc = test_field_index(v, "cloud");
     int jmin = n[1], jmax = -1, missing = 0, cols = 0;
     for (int k = 0; k < n[2]; k++)
         for (int i = 0; i < n[0]; i++) {
@@ -107,9 +81,9 @@ static void test_broad_flat_base(atmos_context *ctx)
  * above it. */
 static void test_anvil(atmos_context *ctx)
 {
-    atmos_volume *v = gen(ctx, "cumulonimbus", 3, 160);
+    atmos_volume *v = test_generate(ctx, "cumulonimbus", 3, 160);
     if (!v) return;
-    const int *n = v->desc.dims, fc = field_index(v, "cloud"), fi = field_index(v, "ice");
+    const int *n = v->desc.dims, fc = test_field_index(v, "cloud"), fi = test_field_index(v, "ice");
     const double vox = v->desc.voxel_size_m;
     atmos_volume_field_stats sc, si;
     atmos_volume_field_stats_get(ctx, v, fc, &sc);
@@ -175,9 +149,9 @@ static void test_anvil(atmos_context *ctx)
  * reaches the ground (rain) or stops ≥ 500 m above it, thinning downward (virga). */
 static void check_rain(atmos_context *ctx, const char *preset, double voxel, double max_step, int virga)
 {
-    atmos_volume *v = gen(ctx, preset, 5, voxel);
+    atmos_volume *v = test_generate(ctx, preset, 5, voxel);
     if (!v) return;
-    const int *n = v->desc.dims, fc = field_index(v, "cloud"), fr = field_index(v, "rain");
+    const int *n = v->desc.dims, fc = test_field_index(v, "cloud"), fr = test_field_index(v, "rain");
     atmos_volume_field_stats sc, sr;
     atmos_volume_field_stats_get(ctx, v, fc, &sc);
     atmos_volume_field_stats_get(ctx, v, fr, &sr);
@@ -220,12 +194,12 @@ static void check_rain(atmos_context *ctx, const char *preset, double voxel, dou
 
 static void test_determinism(void)
 {
-    atmos_context *c1 = make_ctx(1), *c3 = make_ctx(3);
+    atmos_context *c1 = test_context(1, NULL), *c3 = test_context(3, NULL);
     static const char *presets[] = {"storm", "virga"};
     static const double voxels[] = {200, 80};
     for (int p = 0; p < 2; p++) {
-        atmos_volume *a = gen(c1, presets[p], 7, voxels[p]), *b = gen(c3, presets[p], 7, voxels[p]);
-        atmos_volume *c = gen(c3, presets[p], 8, voxels[p]);
+        atmos_volume *a = test_generate(c1, presets[p], 7, voxels[p]), *b = test_generate(c3, presets[p], 7, voxels[p]);
+        atmos_volume *c = test_generate(c3, presets[p], 8, voxels[p]);
         if (a && b && c) {
             long same = 0, diff = 0;
             for (int f = 0; f < a->nfields; f++)
@@ -248,7 +222,7 @@ static void test_determinism(void)
 
 int main(void)
 {
-    atmos_context *ctx = make_ctx(0);
+    atmos_context *ctx = test_context(0, NULL);
     test_broad_flat_base(ctx);
     test_anvil(ctx);
     check_rain(ctx, "storm", 160, 0.35, 0);

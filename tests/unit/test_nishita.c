@@ -111,19 +111,7 @@ static atmos_image *nishita(atmos_context *ctx, const atmos_scene *sc, const atm
     s.renderer = ATMOS_RENDERER_NISHITA;
     s.nishita.orders = orders, s.nishita.sky = sky;
     s.nishita.ratio = ratio;
-    atmos_plan_desc d;
-    memset(&d, 0, sizeof d);
-    d.optics = &op->o;
-    d.offset_given = 1; /* where the volume's own coordinates put it, as atmos_render_path does */
-    atmos_plan *p = NULL;
-    atmos_frame f;
-    atmos_image *img = NULL;
-    CHECK_OK(atmos_plan_create(ctx, &s, v, &d, &p));
-    CHECK_OK(atmos_frame_from_scene(ctx, &s, &f));
-    CHECK_OK(atmos_plan_image_create(p, &f, &img));
-    CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
-    atmos_plan_destroy(p);
-    return img;
+    return test_plan_frame(ctx, &s, v, &op->o);
 }
 
 /* Mean over the mask's pixels of the mean of the colour channels of a - b (b may be NULL). */
