@@ -34,12 +34,6 @@ typedef struct {
     double x, z, r, depth, w;
 } cirrus_head;
 
-static double clamp01(double x) { return x < 0 ? 0 : (x > 1 ? 1 : x); }
-static double smoothstep(double a, double b, double x)
-{
-    double t = clamp01((x - a) / (b - a));
-    return t * t * (3 - 2 * t);
-}
 
 /* Ridged fractal noise in [0, 1]: 1 - |2n - 1| per octave, high on thin sheets. */
 static double ridged(uint64_t seed, double x, double y, double z, int octaves)
@@ -113,17 +107,17 @@ atmos_status atmos__gen_cirrus(gen_job *job)
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < g->n[2]; k++)
         for (int j = 0; j < g->n[1]; j++) {
-            double y = job->origin[1] + (j + 0.5) * job->voxel, d = ygen - y, dd = fmax(d, 0);
+            double y = gen_vox(job, j, 1), d = ygen - y, dd = fmax(d, 0);
             float *row = g->v + ((size_t)k * g->n[1] + j) * g->n[0];
             for (int i = 0; i < g->n[0]; i++) {
-                double x = job->origin[0] + (i + 0.5) * job->voxel, z = job->origin[2] + (k + 0.5) * job->voxel;
+                double x = gen_vox(job, i, 0), z = gen_vox(job, k, 2);
                 double x0 = x - dd * dd / (2 * L);
                 double ice = heads_at(heads, nh, x0, z, d, hh);
                 /* the fibratus sheet: 100..900 m below the generating level */
-                double sheet_v = smoothstep(-50 * s, 150 * s, d) * (1 - smoothstep(500 * s, 900 * s, d));
+                double sheet_v = gen_smoothstep(-50 * s, 150 * s, d) * (1 - gen_smoothstep(500 * s, 900 * s, d));
                 if (sheet_v > 0) {
                     double cov = atmos__gen_fbm3(s_cov, x0 / (9000 * s), 0.5, z / (1100 * s), 4, 0.5);
-                    ice = fmax(ice, 0.55 * smoothstep(0.5, 0.68, cov) * sheet_v *
+                    ice = fmax(ice, 0.55 * gen_smoothstep(0.5, 0.68, cov) * sheet_v *
                                         (0.6 + 0.4 * atmos__gen_noise3(s_sheet, x0 / (4000 * s), d / (300 * s), 0.3)));
                 }
                 if (ice <= 0) continue;

@@ -22,6 +22,20 @@ typedef struct {
     gen_balls balls;
 } gen_job;
 
+/* The generators' small shared pieces: x clamped to [0, 1]; the smooth step from a to b; the
+ * world coordinate along axis a of voxel centre i; the out-of-memory error. */
+static inline double gen_clamp01(double x) { return x < 0 ? 0 : (x > 1 ? 1 : x); }
+static inline double gen_smoothstep(double a, double b, double x)
+{
+    const double t = gen_clamp01((x - a) / (b - a));
+    return t * t * (3 - 2 * t);
+}
+static inline double gen_vox(const gen_job *job, int i, int a) { return job->origin[a] + (i + 0.5) * job->voxel; }
+static inline atmos_status gen_nomem(gen_job *job)
+{
+    return atmos__error(job->ctx, ATMOS_E_NOMEM, "generate %s: out of memory", job->preset);
+}
+
 /* Sets dims/origin from the world box [lo, hi] at job->voxel and allocates the
  * job->ngrids zeroed work grids after checking sizes and the memory limit. */
 atmos_status atmos__gen_grid_init(gen_job *job, const double lo[3], const double hi[3]);

@@ -26,10 +26,7 @@
 #define ETA_CLOUD 1e8
 #define ISO 0.3f
 
-static double clamp01(double x) { return x < 0 ? 0 : (x > 1 ? 1 : x); }
-static double vox_y(const gen_job *job, int j) { return job->origin[1] + (j + 0.5) * job->voxel; }
 
-static atmos_status nomem(gen_job *job) { return atmos__error(job->ctx, ATMOS_E_NOMEM, "generate %s: out of memory", job->preset); }
 
 /* The basic shape of one cumulus of diameter W on a base at height `base`: tiers
  * of balls, wide at the bottom and narrowing upward (a dome). Top of the
@@ -58,9 +55,9 @@ static void cloud_density(gen_job *job, gen_grid *g, double base, double height,
     for (int k = 0; k < g->n[2]; k++)
         for (int j = 0; j < g->n[1]; j++) {
             float *row = g->v + ((size_t)k * g->n[1] + j) * g->n[0];
-            double h = 0.35 + 0.65 * clamp01((vox_y(job, j) - base) / height);
+            double h = 0.35 + 0.65 * gen_clamp01((gen_vox(job, j, 1) - base) / height);
             for (int i = 0; i < g->n[0]; i++)
-                row[i] = j < floor_j ? 0.0f : (float)(eta * clamp01((row[i] - ISO) / 0.6) * h);
+                row[i] = j < floor_j ? 0.0f : (float)(eta * gen_clamp01((row[i] - ISO) / 0.6) * h);
         }
 }
 
@@ -68,7 +65,7 @@ static atmos_status refine(gen_job *job, gen_grid *g, double r0, int levels, int
 {
     gen_refine p = {.levels = levels, .r0 = r0, .ratio = 0.5, .coverage = 1.5, .iso = ISO,
                     .floor_j = floor_j, .max_balls = 20000, .fringe = fringe, .ctx = job->ctx};
-    return atmos__gen_refine(g, &job->balls, &p, &job->rng, job->threads) ? ATMOS_OK : nomem(job);
+    return atmos__gen_refine(g, &job->balls, &p, &job->rng, job->threads) ? ATMOS_OK : gen_nomem(job);
 }
 
 static atmos_status cumulus(gen_job *job)
@@ -80,7 +77,7 @@ static atmos_status cumulus(gen_job *job)
     double lo[3] = {-1000 * s, base - 20 * s, -1000 * s}, hi[3] = {1000 * s, base + 1550 * s, 1000 * s};
     atmos_status st = atmos__gen_grid_init(job, lo, hi);
     if (st != ATMOS_OK) return st;
-    if (!cumulus_balls(job, &job->balls, 0, 0, base, w)) return nomem(job);
+    if (!cumulus_balls(job, &job->balls, 0, 0, base, w)) return gen_nomem(job);
     atmos__gen_accumulate(&job->grid[0], &job->balls, 0, job->threads);
     int fj = atmos__gen_floor_j(job, base);
     if ((st = refine(job, &job->grid[0], 0.075 * w, 3, fj, 1)) != ATMOS_OK) return st;
@@ -120,7 +117,7 @@ static atmos_status cumulus_field(gen_job *job)
                 if (hypot(x - cx[q], z - cz[q]) < 0.6 * (w + cw[q])) ok = 0;
             if (!ok) continue;
             cx[n] = x, cz[n] = z, cw[n] = w;
-            if (!cumulus_balls(job, &job->balls, x, z, base, w)) return nomem(job);
+            if (!cumulus_balls(job, &job->balls, x, z, base, w)) return gen_nomem(job);
             n++;
             break;
         }

@@ -28,15 +28,6 @@
 #define ETA_ICE_ANVIL 2e3
 #define ETA_RAIN 5e2
 
-static double clamp01(double x) { return x < 0 ? 0 : (x > 1 ? 1 : x); }
-static double smoothstep(double a, double b, double x)
-{
-    double t = clamp01((x - a) / (b - a));
-    return t * t * (3 - 2 * t);
-}
-static double cy(const gen_job *job, int j) { return job->origin[1] + (j + 0.5) * job->voxel; }
-static double cx(const gen_job *job, int i, int a) { return job->origin[a] + (i + 0.5) * job->voxel; }
-static atmos_status nomem(gen_job *job) { return atmos__error(job->ctx, ATMOS_E_NOMEM, "generate %s: out of memory", job->preset); }
 
 /* A convective tower: the radius of its isosurface goes from r_base at the base through
  * r_mid half-way up to r_top at the top; the axis leans downwind by `lean` m per m. */
@@ -46,9 +37,9 @@ typedef struct {
 
 static double tower_radius(const tower_shape *t, double y)
 {
-    double u = clamp01((y - t->base) / (t->top - t->base));
-    return u < 0.5 ? t->r_base + (t->r_mid - t->r_base) * smoothstep(0, 0.5, u)
-                   : t->r_mid + (t->r_top - t->r_mid) * smoothstep(0.5, 1, u);
+    double u = gen_clamp01((y - t->base) / (t->top - t->base));
+    return u < 0.5 ? t->r_base + (t->r_mid - t->r_base) * gen_smoothstep(0, 0.5, u)
+                   : t->r_mid + (t->r_top - t->r_mid) * gen_smoothstep(0.5, 1, u);
 }
 
 static double tower_axis(const tower_shape *t, double y) { return t->x + t->lean * (y - t->base); }
@@ -87,7 +78,7 @@ static atmos_status tower_field(gen_job *job, gen_grid *g, const tower_shape *t,
     atmos__gen_accumulate(g, &job->balls, 0, job->threads);
     gen_refine p = {.levels = levels, .r0 = 0.4 * t->ball, .ratio = 0.5, .coverage = 1.5, .iso = ISO,
                     .floor_j = floor_j, .max_balls = 20000, .fringe = 0, .ctx = job->ctx};
-    return atmos__gen_refine(g, &job->balls, &p, &job->rng, job->threads) ? ATMOS_OK : nomem(job);
+    return atmos__gen_refine(g, &job->balls, &p, &job->rng, job->threads) ? ATMOS_OK : gen_nomem(job);
 }
 
 /* F -> number densities: liquid below the glaciation band [yg0, yg1], ice above it; the
@@ -99,11 +90,11 @@ static void tower_density(gen_job *job, gen_grid *cl, gen_grid *ice, double base
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < cl->n[2]; k++)
         for (int j = 0; j < cl->n[1]; j++) {
-            double y = cy(job, j), fi = ice ? smoothstep(yg0, yg1, y) : 0;
-            double h = 0.35 + 0.65 * clamp01((y - base) / hlw);
+            double y = gen_vox(job, j, 1), fi = ice ? gen_smoothstep(yg0, yg1, y) : 0;
+            double h = 0.35 + 0.65 * gen_clamp01((y - base) / hlw);
             size_t row = ((size_t)k * cl->n[1] + j) * cl->n[0];
             for (int i = 0; i < cl->n[0]; i++) {
-                double s = j < floor_j ? 0 : clamp01((cl->v[row + i] - ISO) / 0.6);
+                double s = j < floor_j ? 0 : gen_clamp01((cl->v[row + i] - ISO) / 0.6);
                 cl->v[row + i] = (float)(ETA_CLOUD * s * h * (1 - fi));
                 if (ice) ice->v[row + i] = (float)(ETA_ICE_TOWER * s * fi);
             }
@@ -123,20 +114,20 @@ static void anvil(gen_job *job, gen_grid *ice, double x0, double y_top, double l
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < ice->n[2]; k++)
         for (int i = 0; i < ice->n[0]; i++) {
-            double x = cx(job, i, 0), z = cx(job, k, 2), d = x - x0;
+            double x = gen_vox(job, i, 0), z = gen_vox(job, k, 2), d = x - x0;
             double fib = atmos__gen_fbm3(s_edge, x / (5000 * s), 0.3, z / (700 * s), 4, 0.55) - 0.5;
             double along = d < 0 ? -d / lu : d / ld, across = fabs(z) / (w0 + 0.2 * fmax(d, 0));
             double e = cbrt(across * across * across + along * along * along) * (1 + 0.5 * fib);
-            double edge = 1 - smoothstep(0.55, 1.0, e);
+            double edge = 1 - gen_smoothstep(0.55, 1.0, e);
             if (edge <= 0) continue;
             double dd = fmax(d, 0), fall = atmos__gen_fbm3(s_th, x / (3000 * s), 0.6, z / (3000 * s), 3, 0.5);
             double th = th0 * (0.3 + 0.7 * exp(-dd / (4000 * s))) * (0.6 + 0.8 * fall) * sqrt(edge);
             double thin = ETA_ICE_ANVIL * (0.3 + 0.7 * exp(-dd / (6000 * s))) * edge;
             for (int j = 0; j < ice->n[1]; j++) {
-                double y = cy(job, j), t = (y_top - y) / th;
+                double y = gen_vox(job, j, 1), t = (y_top - y) / th;
                 if (t <= -0.05 || t >= 1) continue;
-                double vert = smoothstep(-0.05, 0.12, t) * (1 - smoothstep(0.5, 1, t));
-                double fine = smoothstep(0.2, 0.8, atmos__gen_fbm3(s_fine, x / (3000 * s), y / (200 * s), z / (400 * s), 5, 0.55));
+                double vert = gen_smoothstep(-0.05, 0.12, t) * (1 - gen_smoothstep(0.5, 1, t));
+                double fine = gen_smoothstep(0.2, 0.8, atmos__gen_fbm3(s_fine, x / (3000 * s), y / (200 * s), z / (400 * s), 5, 0.55));
                 float v = (float)(thin * vert * (0.15 + 0.85 * fine));
                 float *p = ice->v + ((size_t)k * ice->n[1] + j) * ice->n[0] + i;
                 if (v > *p) *p = v;
@@ -159,18 +150,18 @@ static void rain(gen_job *job, gen_grid *g, const rain_shape *r, uint64_t seed)
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < g->n[2]; k++)
         for (int j = 0; j < g->n[1]; j++) {
-            double y = cy(job, j), fall = r->base - y;
+            double y = gen_vox(job, j, 1), fall = r->base - y;
             if (fall <= 0 || y <= r->y_end) continue;
-            double vert = smoothstep(0, ramp, fall);
-            vert *= r->y_end > 0 ? smoothstep(r->y_end, r->y_end + 0.8 * (r->base - r->y_end), y) : 0.7 + 0.3 * y / r->base;
+            double vert = gen_smoothstep(0, ramp, fall);
+            vert *= r->y_end > 0 ? gen_smoothstep(r->y_end, r->y_end + 0.8 * (r->base - r->y_end), y) : 0.7 + 0.3 * y / r->base;
             double ax = r->x0 + r->slant * fall;
             float *row = g->v + ((size_t)k * g->n[1] + j) * g->n[0];
             for (int i = 0; i < g->n[0]; i++) {
-                double x = cx(job, i, 0), z = cx(job, k, 2);
+                double x = gen_vox(job, i, 0), z = gen_vox(job, k, 2);
                 double q = hypot(x - ax, z - r->z0) / r->radius;
                 if (q > 1.6) continue;
                 double wob = atmos__gen_fbm3(s_edge, x / r->radius, y / (4 * r->radius), z / r->radius, 3, 0.5);
-                double radial = 1 - smoothstep(0.25, 1.0, q * (0.7 + 0.6 * wob));
+                double radial = 1 - gen_smoothstep(0.25, 1.0, q * (0.7 + 0.6 * wob));
                 if (radial <= 0) continue;
                 double streak = atmos__gen_fbm3(s_streak, x / (300 * s), y / (3000 * s), z / (300 * s), 3, 0.5);
                 row[i] = (float)(r->eta * radial * vert * (0.5 + 0.5 * streak));
@@ -192,13 +183,13 @@ atmos_status atmos__gen_cumulonimbus(gen_job *job, int with_rain)
     if (st != ATMOS_OK) return st;
     tower_shape t = {.x = 0, .z = 0, .base = base, .top = y_top - 200 * s, .r_base = 2900 * s, .r_mid = 2000 * s,
                      .r_top = 2600 * s, .ball = 1500 * s, .lean = 0.06};
-    if (!tower_balls(job, &job->balls, &t)) return nomem(job);
+    if (!tower_balls(job, &job->balls, &t)) return gen_nomem(job);
     /* The overshooting top: a dome over the updraft, ~1 km above the anvil after refinement. */
     double xo = tower_axis(&t, y_top);
     for (int n = 0; n < 3; n++) {
         double dx = gen_range(&job->rng, -500, 500) * s, dy = gen_range(&job->rng, -600, -400) * s;
         double z = gen_range(&job->rng, -500, 500) * s, r = 1300 * s * gen_range(&job->rng, 0.9, 1.1);
-        if (!atmos__gen_balls_add(&job->balls, xo + dx, y_top + dy, z, r, 1, 1)) return nomem(job);
+        if (!atmos__gen_balls_add(&job->balls, xo + dx, y_top + dy, z, r, 1, 1)) return gen_nomem(job);
     }
     int fj = atmos__gen_floor_j(job, base);
     if ((st = tower_field(job, &job->grid[0], &t, 3, fj)) != ATMOS_OK) return st;
@@ -228,7 +219,7 @@ atmos_status atmos__gen_rain_shaft(gen_job *job, int virga)
     if (st != ATMOS_OK) return st;
     tower_shape t = {.x = -300 * s, .z = 0, .base = base, .top = base + 2500 * s, .r_base = 1500 * s, .r_mid = 1250 * s,
                      .r_top = 800 * s, .ball = 700 * s, .lean = 0.05};
-    if (!tower_balls(job, &job->balls, &t)) return nomem(job);
+    if (!tower_balls(job, &job->balls, &t)) return gen_nomem(job);
     int fj = atmos__gen_floor_j(job, base);
     if ((st = tower_field(job, &job->grid[0], &t, 3, fj)) != ATMOS_OK) return st;
     uint64_t seed_rain = atmos__splitmix64(&job->rng.s);

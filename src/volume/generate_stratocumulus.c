@@ -9,7 +9,7 @@
  *  - Cells: cellular noise (noise_cells.c) on a 1.7 km lattice, jitter 0.9, its input moved by
  *    350 m of fractal noise so the borders wander. e = (F2 - F1) x 1.7 km is 0 on a border and
  *    grows inward.
- *  - Thickness: h = H c sqrt(1 - (1 - t)^2), t = smoothstep(g, g + 0.25, e / 1.7 km), a dome
+ *  - Thickness: h = H c sqrt(1 - (1 - t)^2), t = gen_smoothstep(g, g + 0.25, e / 1.7 km), a dome
  *    with steep rounded sides and a top flattened at the inversion (H = 450 m); c is 1 for
  *    most cells and 0.6-1 for a fifth of them (some cells lower); g (the gap's half width,
  *    0-0.12 of the lattice) from smooth noise, so the gaps are closed in places, open in
@@ -27,12 +27,6 @@
 
 #define ETA_SC 1e8
 
-static double clamp01(double x) { return x < 0 ? 0 : (x > 1 ? 1 : x); }
-static double smoothstep(double a, double b, double x)
-{
-    double t = clamp01((x - a) / (b - a));
-    return t * t * (3 - 2 * t);
-}
 
 /* The deck's thickness (m) over the point (x, z). */
 static double thickness(uint64_t s_cell, uint64_t s_warp, uint64_t s_gap, double x, double z, double sc, double H)
@@ -46,8 +40,8 @@ static double thickness(uint64_t s_cell, uint64_t s_warp, uint64_t s_gap, double
     atmos__gen_cells2(s_cell, wx / lambda, wz / lambda, 0.9, &c);
     gen_rng r = {c.id};
     double u = gen_u01(&r), lower = u < 0.2 ? 0.6 + 2 * u : 1;
-    double g = 0.12 * smoothstep(0.35, 0.65, atmos__gen_fbm3(s_gap, x / (5000 * sc), 0.5, z / (5000 * sc), 3, 0.5));
-    double t = smoothstep(g, g + 0.5, c.f2 - c.f1);
+    double g = 0.12 * gen_smoothstep(0.35, 0.65, atmos__gen_fbm3(s_gap, x / (5000 * sc), 0.5, z / (5000 * sc), 3, 0.5));
+    double t = gen_smoothstep(g, g + 0.5, c.f2 - c.f1);
     double bumps = 0.25 * H * (atmos__gen_fbm3(s_gap, x / (450 * sc), 2.5, z / (450 * sc), 4, 0.55) - 0.5);
     return fmin(H, H * lower * fmin(1, 1.25 * (1 - (1 - t) * (1 - t))) + bumps * t);
 }
@@ -67,16 +61,16 @@ atmos_status atmos__gen_stratocumulus(gen_job *job)
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < g->n[2]; k++)
         for (int i = 0; i < g->n[0]; i++) {
-            double x = job->origin[0] + (i + 0.5) * job->voxel, z = job->origin[2] + (k + 0.5) * job->voxel;
+            double x = gen_vox(job, i, 0), z = gen_vox(job, k, 2);
             double h = thickness(s_cell, s_warp, s_gap, x, z, s, H);
             for (int j = 0; j < g->n[1]; j++) {
-                double y = job->origin[1] + (j + 0.5) * job->voxel, a = y - base;
+                double y = gen_vox(job, j, 1), a = y - base;
                 if (a < 0 || a > h) continue;
                 /* the tops eroded by small turrets and dips (3-D noise, 180 m, up to 100 m deep) */
                 double er = 100 * s * atmos__gen_fbm3(s_tex ^ 0x5C, x / (180 * s), y / (120 * s), z / (180 * s), 3, 0.5);
                 if (a > h - er + 50 * s) continue;
                 double tex = 0.45 + 0.55 * atmos__gen_fbm3(s_tex, x / (350 * s), y / (200 * s), z / (350 * s), 4, 0.5);
-                double soft = smoothstep(0, 120 * s, h - er + 50 * s - a);
+                double soft = gen_smoothstep(0, 120 * s, h - er + 50 * s - a);
                 g->v[((size_t)k * g->n[1] + j) * g->n[0] + i] =
                     (float)(ETA_SC * (0.3 + 0.7 * a / H) * tex * (0.15 + 0.85 * soft));
             }
