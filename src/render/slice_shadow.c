@@ -330,17 +330,22 @@ static const atmos__aerial *shadow_table(atmos__slice_plan *sp, const sframe *f,
     return atmos__aerial_build(&sp->shadow_ap, f->atm, &g, threads) ? &sp->shadow_ap : NULL;
 }
 
-/* What the shadow takes from the air along pixel (x, y)'s ray, per wavelength: all of it into
- * D, the part in front of the volume's halfway plane into Df. 0 (and zeros) when the ray has
- * no shadowed span. */
-static int pixel_air(const sframe *f, const atmos__aerial *ap, const sjob *j, int n, int x, int y, double *D,
-                     double *Df)
+typedef struct { /* a pixel's ray (pixel_span) */
+    double dw[3], d[3], ta, tb, tg;
+    mray m;
+} sray;
+
+/* What the shadow takes from the air along pixel (x, y)'s ray R (its span found), per
+ * wavelength: all of it into D, the part in front of the volume's halfway plane into Df. 0
+ * (and zeros) when the air's profile along it is empty. */
+static int ray_air(const sframe *f, const atmos__aerial *ap, const sjob *j, int n, int x, int y, const sray *R,
+                   double *D, double *Df)
 {
     for (int c = 0; c < n; c++) D[c] = Df[c] = 0.0;
-    double dw[3], d[3], ta, tb, tg, tt[ATMOS__AERIAL_MAX_SLICES], Db[ATMOS_MAX_WAVELENGTHS];
+    double tt[ATMOS__AERIAL_MAX_SLICES], Db[ATMOS_MAX_WAVELENGTHS];
     float S[ATMOS__AERIAL_MAX_SLICES * ATMOS_MAX_WAVELENGTHS];
-    mray m;
-    if (!pixel_span(f, x, y, dw, d, &m, &ta, &tb, &tg)) return 0;
+    const double *dw = R->dw, *d = R->d, ta = R->ta, tb = R->tb;
+    const mray m = R->m;
     const int nd = atmos__aerial_single_profile(ap, dw, ta, tb, tt, S);
     if (nd < 2) return 0;
     const double hd = atmos__dot3(j->h, d);
@@ -349,6 +354,15 @@ static int pixel_air(const sframe *f, const atmos__aerial *ap, const sjob *j, in
     span_shadow(f->sh, &m, ta, tb, th, xi, nd, tt, S, n, Df, Db);
     for (int c = 0; c < n; c++) D[c] = Df[c] + Db[c];
     return 1;
+}
+
+/* The same for pixel (x, y), its span found first; 0 when it has none. */
+static int pixel_air(const sframe *f, const atmos__aerial *ap, const sjob *j, int n, int x, int y, double *D,
+                     double *Df)
+{
+    sray R;
+    for (int c = 0; c < n; c++) D[c] = Df[c] = 0.0;
+    return pixel_span(f, x, y, R.dw, R.d, &R.m, &R.ta, &R.tb, &R.tg) && ray_air(f, ap, j, n, x, y, &R, D, Df);
 }
 
 /* The shadow on the air evaluated exactly at the pixels of even x and y (a lattice covering
@@ -418,16 +432,16 @@ static void air_pixel_apply(const sframe *f, const atmos__aerial *ap, const sjob
     const size_t p = (size_t)y * L->W + x;
     float *fr = air_front + p * n, *px = img->pixels + p * img->channels;
     for (int c = 0; c < n; c++) fr[c] = 0.0f;
-    double dw[3], d[3], ta, tb, tg, G[ATMOS_MAX_WAVELENGTHS], D[ATMOS_MAX_WAVELENGTHS], Df[ATMOS_MAX_WAVELENGTHS];
-    mray m;
-    if (!pixel_span(f, x, y, dw, d, &m, &ta, &tb, &tg)) return;
-    ground_shadow(f, &m, dw, tg, sun, n, G);
+    double G[ATMOS_MAX_WAVELENGTHS], D[ATMOS_MAX_WAVELENGTHS], Df[ATMOS_MAX_WAVELENGTHS];
+    sray R;
+    if (!pixel_span(f, x, y, R.dw, R.d, &R.m, &R.ta, &R.tb, &R.tg)) return;
+    ground_shadow(f, &R.m, R.dw, R.tg, sun, n, G);
     for (int c = 0; c < n; c++) px[c] = (float)fmax(px[c] - G[c], 0.0);
     const double *e = !(x & 1) && !(y & 1) ? lattice_at(L, x / 2, y / 2) : NULL;
     if (e) {
         if (e[0] == 0.0) return;
         for (int c = 0; c < n; c++) D[c] = e[1 + c], Df[c] = e[1 + n + c];
-    } else if (!lattice_value(L, x, y, n, px, D, Df) && !pixel_air(f, ap, j, n, x, y, D, Df)) {
+    } else if (!lattice_value(L, x, y, n, px, D, Df) && !ray_air(f, ap, j, n, x, y, &R, D, Df)) {
         return;
     }
     for (int c = 0; c < n; c++) {
