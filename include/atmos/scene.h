@@ -72,6 +72,8 @@ typedef struct atmos_scene_volume {
     double position_m[3];     /* world position of the centre of the bottom face of the volume's box */
     double sim_minutes;       /* "simulate": simulated minutes (0 = the preset's default) */
     int sim_grid;             /* "simulate": horizontal cells (0 = 64); the seed is `seed` */
+    int sim_refine, sim_ice;  /* "simulate": "refine" (0 = 1), "ice" (atmos_sim_desc) */
+    double sim_detail;        /* "simulate": "detail" */
 } atmos_scene_volume;
 
 /* Settings of the slice renderer ("slice" in the file). Their ranges, defaults and meaning

@@ -22,6 +22,7 @@ extern "C" {
 #define ATMOS_SIM_MIN_GRID 16
 #define ATMOS_SIM_MAX_GRID 512
 #define ATMOS_SIM_MAX_MINUTES 600.0
+#define ATMOS_SIM_MAX_REFINE 4
 
 /* What to simulate; zero means default where stated. */
 typedef struct atmos_sim_desc {
@@ -31,6 +32,19 @@ typedef struct atmos_sim_desc {
                             ATMOS_SIM_MAX_GRID]; 0 = 64. The domain's size is the preset's: a finer
                             grid has smaller (cubic) cells */
     uint64_t seed;       /* the random perturbations (bubble places, surface-flux noise) */
+    /* How atmos_sim_to_volume writes the state (zeros: one voxel a cell, liquid only, no
+       texture: the model's fields as they are). */
+    int refine;          /* voxels per cell along each axis, 1..ATMOS_SIM_MAX_REFINE (0 = 1): the
+                            fields interpolated between cell centres in their logarithm, so that
+                            a cloud's edge lies where its smeared-out values cross, not on the
+                            faces of the cells */
+    double detail;       /* [0, 1], for artists: the fields sampled at places moved by a fractal
+                            noise of up to `detail` cells, whose features run from a cell down to
+                            a voxel: ragged edges the model does not hold (0 = off) */
+    int ice;             /* 1: condensate (cloud water) reported as "ice" in the fraction that the
+                            temperature gives (ECMWF IFS's mixed phase: all liquid at 0 C, all
+                            ice at -23 C, quadratic between), a diagnosis for the optics only:
+                            the model itself has no ice */
 } atmos_sim_desc;
 
 typedef struct atmos_sim atmos_sim;
@@ -70,9 +84,9 @@ typedef struct atmos_sim_stats {
 } atmos_sim_stats;
 ATMOS_API void atmos_sim_get_stats(const atmos_sim *sim, atmos_sim_stats *out);
 
-/* The state as a volume: fields "cloud" and "rain" (number densities, m^-3: q rho / m, m from
- * atmos_particle_mean_mass), voxels the model's cells, y up with the ground at y = 0 and the
- * domain centred on x = z = 0. */
+/* The state as a volume: fields "cloud" and "rain", and "ice" with desc->ice (number densities,
+ * m^-3: q rho / m, m from atmos_particle_mean_mass), voxels the model's cells (refined by
+ * desc->refine), y up with the ground at y = 0 and the domain centred on x = z = 0. */
 ATMOS_API atmos_status atmos_sim_to_volume(atmos_context *ctx, const atmos_sim *sim, atmos_volume **out);
 /* A time-lapse: the volume at `minutes` of simulated time, the same bytes as atmos_simulate
  * with those minutes gives, from a simulation that goes on from where the last call left it:

@@ -907,16 +907,18 @@ static atmos_status parse_background(const jp *p, const cJSON *j, const char *pa
     return ATMOS_OK;
 }
 
-/* "simulate": {"preset": NAME, "minutes": M, "grid": N, "seed": S} (atmos/sim.h). */
+/* "simulate": {"preset": NAME, "minutes": M, "grid": N, "seed": S, "refine": R, "detail": A,
+ * "ice": B} (atmos/sim.h). */
 static atmos_status parse_simulate(const jp *p, const cJSON *j, const char *path, atmos_scene_volume *vol)
 {
-    static const char *const keys[] = {"preset", "minutes", "grid", "seed"};
-    static const atmos__range r_min = {0, ATMOS_SIM_MAX_MINUTES, 1, 0}, r_grid = {ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID, 0, 0};
+    static const char *const keys[] = {"preset", "minutes", "grid", "seed", "refine", "detail", "ice"};
+    static const atmos__range r_min = {0, ATMOS_SIM_MAX_MINUTES, 1, 0}, r_grid = {ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID, 0, 0},
+                              r_refine = {1, ATMOS_SIM_MAX_REFINE, 0, 0};
     obj_iter it;
     char ip[PATH_CAP], buf[64];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 4, &it));
+    TRY(iter_begin(p, j, path, keys, 7, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -935,6 +937,9 @@ static atmos_status parse_simulate(const jp *p, const cJSON *j, const char *path
         case 1: TRY(get_number(p, v, ip, &r_min, NULL, &vol->sim_minutes)); break;
         case 2: TRY(get_int(p, v, ip, &r_grid, &vol->sim_grid)); break;
         case 3: TRY(get_u64(p, v, ip, &r_seed, &vol->seed)); break;
+        case 4: TRY(get_int(p, v, ip, &r_refine, &vol->sim_refine)); break;
+        case 5: TRY(get_number(p, v, ip, &r_unit, NULL, &vol->sim_detail)); break;
+        case 6: TRY(get_bool(p, v, ip, &vol->sim_ice)); break;
         }
     }
     if (!(it.seen & 1u)) return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path, "missing key \"preset\"");

@@ -55,6 +55,7 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         sd.preset = sv->source + 9;
         sd.minutes = sv->sim_minutes;
         sd.grid = sv->sim_grid;
+        sd.refine = sv->sim_refine, sd.detail = sv->sim_detail, sd.ice = sv->sim_ice;
         sd.seed = sv->seed;
         st = atmos_simulate(ctx, &sd, &vol);
     } else {

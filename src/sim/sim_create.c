@@ -134,10 +134,20 @@ atmos_status atmos_sim_create(atmos_context *ctx, const atmos_sim_desc *desc, at
     if (!(desc->minutes >= 0 && desc->minutes <= ATMOS_SIM_MAX_MINUTES))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: minutes %g is out of range [0, %g]", desc->minutes,
                             ATMOS_SIM_MAX_MINUTES);
+    if (desc->refine < 0 || desc->refine > ATMOS_SIM_MAX_REFINE || !(desc->detail >= 0 && desc->detail <= 1) ||
+        desc->ice < 0 || desc->ice > 1)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "simulate: refine %d (0..%d), detail %g ([0, 1]) or ice %d (0 or 1) is out of range",
+                            desc->refine, ATMOS_SIM_MAX_REFINE, desc->detail, desc->ice);
     const double dx = env->domain_m / g;
     int nz = (int)lround(env->height_m / dx);
     if (nz < 8) nz = 8;
-    return atmos__sim_create_env(ctx, env, g, g, nz, dx, desc->seed, out);
+    atmos_status st = atmos__sim_create_env(ctx, env, g, g, nz, dx, desc->seed, out);
+    if (st == ATMOS_OK) {
+        (*out)->out_refine = desc->refine > 0 ? desc->refine : 1;
+        (*out)->out_detail = desc->detail, (*out)->out_ice = desc->ice;
+    }
+    return st;
 }
 
 void atmos_sim_destroy(atmos_sim *s)

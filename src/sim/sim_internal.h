@@ -65,6 +65,8 @@ struct atmos_sim {
     double rho_ref;               /* Boussinesq reference density (the budget's) */
     sim_env env;
     uint64_t seed;
+    int out_refine, out_ice;      /* the volume's form (atmos_sim_desc; sim_volume.c) */
+    double out_detail;
     double t;
     long steps;
     double rain_out, surface_in;  /* in (kg/kg) x cells */
@@ -114,6 +116,8 @@ double atmos__sim_dewpoint(double qv, double p_pa);
  * above saturation or evaporates cloud water into unsaturated air, with the latent heat,
  * so that afterwards q_c = 0 and q_v <= q_s, or q_c > 0 and q_v = q_s (Newton iteration). */
 void atmos__sim_adjust(double *th, double *qv, double *qc, double p_pa, double pi);
+/* The fraction of condensate written as ice at temperature t, K (sim_volume.c). */
+double atmos__sim_ice_fraction(double t);
 /* Fills the base state (th0, qv0, pi0, p0, rho0, ue) from sim->env. */
 void atmos__sim_sounding(atmos_sim *sim);
 

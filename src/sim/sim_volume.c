@@ -1,49 +1,159 @@
-/* The simulation's state as an atmos volume: "cloud" and "rain" number densities
+/* The simulation's state as an atmos volume: "cloud", "rain" (and "ice") number densities
  * eta = q rho / m (rho the base-state air density of the level, m the particle type's mean
- * mass, atmos_particle_mean_mass: the WRF reader's conversion), y up. */
+ * mass, atmos_particle_mean_mass: the WRF reader's conversion), y up. Optionally refined (the
+ * mixing ratios interpolated in their logarithm), textured (sampled at places moved by a
+ * fractal noise) and with the condensate split into water and ice by temperature
+ * (atmos_sim_desc). */
 #include "sim/sim_internal.h"
+#include "volume/generator.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define SIM_Q_CUT 1e-7f    /* mixing ratios below this are written as 0 (kg/kg) */
+#define SIM_Q_FLOOR 1e-10f /* what an empty cell counts as in the logarithm's interpolation */
+#define SIM_MAX_VOXELS (64L << 20)
+
+/* The fraction of condensate that is ice at temperature t (K): 1 - alpha, alpha = ((t - t_ice) /
+ * (t_0 - t_ice))^2 the liquid fraction of ECMWF's IFS (IFS Documentation Cy47r1, Part IV:
+ * Physical processes, the mixed phase), t_0 = 273.16 K, t_ice = 250.16 K. */
+double atmos__sim_ice_fraction(double t)
+{
+    const double t0 = 273.16, ti = 250.16;
+    if (t >= t0) return 0;
+    if (t <= ti) return 1;
+    const double a = (t - ti) / (t0 - ti);
+    return 1 - a * a;
+}
+
+/* The written fields' mixing ratios per cell (kg/kg; cut below SIM_Q_CUT), nf of them:
+ * cloud water, rain and, with ice, cloud ice. */
+static void cell_fields(const atmos_sim *s, float *q[3], int nf)
+{
+    for (int k = 0; k < s->nz; k++)
+        for (int j = 0; j < s->ny; j++)
+            for (int i = 0; i < s->nx; i++) {
+                const size_t n = sim_idx(s, i, j, k);
+                const float c = s->qc[n] > SIM_Q_CUT ? s->qc[n] : 0.0f, r = s->qr[n] > SIM_Q_CUT ? s->qr[n] : 0.0f;
+                const float f = nf > 2 && c > 0 ? (float)atmos__sim_ice_fraction(s->th[n] * s->pi0[k]) : 0.0f;
+                q[0][n] = c - c * f, q[1][n] = r;
+                if (nf > 2) q[2][n] = c * f;
+            }
+}
+
+/* Trilinear interpolation of the logarithms lq at (x, y, z) in cell-index space (x, y wrapped,
+ * z clamped). */
+static float log_trilinear(const atmos_sim *s, const float *lq, double x, double y, double z)
+{
+    const double fx = floor(x), fy = floor(y);
+    double zc = z < 0 ? 0 : z > s->nz - 1 ? s->nz - 1 : z;
+    int k0 = (int)floor(zc);
+    if (k0 > s->nz - 2) k0 = s->nz - 2;
+    const double tx = x - fx, ty = y - fy, tz = zc - k0;
+    int i0 = (int)fx % s->nx, j0 = (int)fy % s->ny;
+    if (i0 < 0) i0 += s->nx;
+    if (j0 < 0) j0 += s->ny;
+    const int i1 = i0 + 1 == s->nx ? 0 : i0 + 1, j1 = j0 + 1 == s->ny ? 0 : j0 + 1;
+    double v = 0;
+    for (int c = 0; c < 8; c++) {
+        const int i = c & 1 ? i1 : i0, j = c & 2 ? j1 : j0, k = k0 + (c >> 2);
+        const double w = (c & 1 ? tx : 1 - tx) * (c & 2 ? ty : 1 - ty) * (c & 4 ? tz : 1 - tz);
+        v += w * lq[sim_idx(s, i, j, k)];
+    }
+    return (float)v;
+}
+
+/* One refined field: voxel (I, J, K) (x, up, y of the model) at the cell-index point
+ * ((I + 0.5) / r - 0.5, ...), moved by the detail noise, its mixing ratio exp of the
+ * interpolated logarithm, cut below SIM_Q_CUT, times rho0 / m (rho0 interpolated between levels). */
+static void refine_field(const atmos_sim *s, const float *lq, double mass, float *out, int threads)
+{
+    const int r = s->out_refine > 0 ? s->out_refine : 1, NX = r * s->nx, NZ = r * s->nz, NY = r * s->ny;
+    const double a = 2.0 * s->out_detail;
+    int octaves = 1;
+    while (octaves < 6 && (1 << (octaves - 1)) < r) octaves++;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int K = 0; K < NY; K++)
+        for (int J = 0; J < NZ; J++) {
+            float *row = out + ((size_t)K * NZ + J) * NX;
+            const double y = (K + 0.5) / r - 0.5, z = (J + 0.5) / r - 0.5;
+            const double zc = z < 0 ? 0 : z > s->nz - 1 ? s->nz - 1 : z;
+            const int k0 = (int)zc < s->nz - 1 ? (int)zc : s->nz - 2;
+            const double rho = s->rho0[k0] + (zc - k0) * (s->rho0[k0 + 1] - s->rho0[k0]);
+            for (int I = 0; I < NX; I++) {
+                double px = (I + 0.5) / r - 0.5, py = y, pz = z;
+                if (a > 0) { /* the warp: three noises, features from a cell down to a voxel */
+                    px += a * (atmos__gen_fbm3(0xA11CE, px, py, pz, octaves, 0.5) - 0.5);
+                    py += a * (atmos__gen_fbm3(0xB0B, px, py, pz, octaves, 0.5) - 0.5);
+                    pz += a * (atmos__gen_fbm3(0xCAFE, px, py, pz, octaves, 0.5) - 0.5);
+                }
+                const float q = expf(log_trilinear(s, lq, px, py, pz));
+                row[I] = q > SIM_Q_CUT ? (float)(q * rho / mass) : 0.0f;
+            }
+        }
+}
+
+/* A field's voxels into buf: the cells as they are (refine 1, no detail), else refined. */
+static void field_voxels(const atmos_sim *s, float *q, double mass, float *buf, int threads)
+{
+    if ((s->out_refine <= 1) && !(s->out_detail > 0)) {
+        for (int j = 0; j < s->ny; j++) /* volume voxel (i, k, j): x fastest, then up, then y */
+            for (int k = 0; k < s->nz; k++) {
+                const float c = (float)(s->rho0[k] / mass);
+                float *row = buf + ((size_t)j * s->nz + k) * s->nx;
+                const float *src = q + sim_idx(s, 0, j, k);
+                for (int i = 0; i < s->nx; i++) row[i] = src[i] > 0 ? src[i] * c : 0.0f;
+            }
+        return;
+    }
+    for (size_t n = 0; n < s->n; n++) q[n] = logf(q[n] > SIM_Q_FLOOR ? q[n] : SIM_Q_FLOOR);
+    refine_field(s, q, mass, buf, threads);
+}
+
+static atmos_status fill_fields(atmos_context *ctx, const atmos_sim *s, atmos_volume *v, const int dims[3])
+{
+    static const char *const names[3] = {"cloud", "rain", "ice"};
+    const int nf = s->out_ice ? 3 : 2;
+    const size_t nv = (size_t)dims[0] * dims[1] * dims[2];
+    float *q[3] = {NULL, NULL, NULL}, *buf = malloc(nv * sizeof *buf);
+    int ok = buf != NULL;
+    for (int f = 0; f < nf; f++) ok &= (q[f] = malloc(s->n * sizeof(float))) != NULL;
+    atmos_status st = ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_NOMEM, "simulate: out of memory for the volume");
+    if (ok) cell_fields(s, q, nf);
+    for (int f = 0; f < nf && st == ATMOS_OK; f++) {
+        int index = 0;
+        st = atmos_volume_add_field(ctx, v, names[f], names[f], &index);
+        if (st != ATMOS_OK) break;
+        field_voxels(s, q[f], atmos_particle_mean_mass(names[f]), buf, atmos__threads(ctx));
+        const int off[3] = {0, 0, 0};
+        st = atmos_volume_set_dense(ctx, v, index, off, dims, buf, 1.0f);
+    }
+    for (int f = 0; f < nf; f++) free(q[f]);
+    free(buf);
+    return st;
+}
 
 atmos_status atmos_sim_to_volume(atmos_context *ctx, const atmos_sim *s, atmos_volume **out)
 {
     if (!s || !out) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "simulate: missing argument");
     *out = NULL;
+    const int r = s->out_refine > 0 ? s->out_refine : 1;
+    const int dims[3] = {r * s->nx, r * s->nz, r * s->ny};
+    if ((long)dims[0] * dims[1] * dims[2] > SIM_MAX_VOXELS)
+        return atmos__error(ctx, ATMOS_E_LIMIT,
+                            "simulate: refine %d makes %d x %d x %d voxels, more than %ld M: a smaller refine or grid", r,
+                            dims[0], dims[1], dims[2], SIM_MAX_VOXELS >> 20);
     atmos_volume_desc d;
     memset(&d, 0, sizeof d);
-    d.dims[0] = s->nx, d.dims[1] = s->nz, d.dims[2] = s->ny;
-    d.voxel_size_m = s->dx;
+    d.dims[0] = dims[0], d.dims[1] = dims[1], d.dims[2] = dims[2];
+    d.voxel_size_m = s->dx / r;
     d.origin_m[0] = -0.5 * s->nx * s->dx;
     d.origin_m[2] = -0.5 * s->ny * s->dx;
     d.periodic = 1; /* the model's sides are periodic (sim_pressure.c) */
     atmos_volume *v = NULL;
     atmos_status st = atmos_volume_create(ctx, &d, &v);
-    if (st != ATMOS_OK) return st;
-    float *buf = malloc(s->n * sizeof *buf);
-    if (!buf) {
-        atmos_volume_destroy(v);
-        return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: out of memory");
-    }
-    const char *names[2] = {"cloud", "rain"};
-    const float *q[2] = {s->qc, s->qr};
-    for (int f = 0; f < 2 && st == ATMOS_OK; f++) {
-        int index = 0;
-        st = atmos_volume_add_field(ctx, v, names[f], names[f], &index);
-        if (st != ATMOS_OK) break;
-        const double m = atmos_particle_mean_mass(names[f]);
-        /* volume voxel (i, k, j): x fastest, then up, then y of the model */
-        for (int j = 0; j < s->ny; j++)
-            for (int k = 0; k < s->nz; k++) {
-                const float c = (float)(s->rho0[k] / m);
-                float *row = buf + ((size_t)j * s->nz + k) * s->nx;
-                const float *src = q[f] + sim_idx(s, 0, j, k);
-                for (int i = 0; i < s->nx; i++) row[i] = src[i] > 1e-7f ? src[i] * c : 0.0f;
-            }
-        const int off[3] = {0, 0, 0}, size[3] = {s->nx, s->nz, s->ny};
-        st = atmos_volume_set_dense(ctx, v, index, off, size, buf, 1.0f);
-    }
-    free(buf);
+    if (st == ATMOS_OK) st = fill_fields(ctx, s, v, dims);
     if (st == ATMOS_OK) st = atmos_volume_finalize(ctx, v);
     if (st != ATMOS_OK) {
         atmos_volume_destroy(v);

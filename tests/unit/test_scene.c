@@ -154,6 +154,11 @@ static void test_absent_keys(void)
     s.width = d.width;
     CHECK(memcmp(&s, &d, sizeof s) == 0);
 
+    /* The simulated volume's form (atmos_sim_desc's refine, detail, ice) */
+    CHECK_OK(parse("{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\", \"refine\": 3, \"detail\": 0.5, "
+                   "\"ice\": true}}}", &s));
+    CHECK(s.volume.sim_refine == 3 && s.volume.sim_detail == 0.5 && s.volume.sim_ice == 1);
+
     /* Moving only the position keeps the default view direction. */
     CHECK_OK(parse("{\"camera\": {\"position_m\": [5, 300, 7]}}", &s));
     double moved[3];
@@ -311,6 +316,9 @@ static const bad_case bad_renderers[] = {
     {"{\"volume\": {\"file\": \"generate:storm\"}}", ATMOS_E_INVALID_ARG, "/volume/file: use \"generate\": \"storm\"", NULL},
     {"{\"volume\": {\"density_scale\": 2}}", ATMOS_E_INVALID_ARG, "/volume: needs \"file\", \"generate\" or \"simulate\"", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"density_scale\": 0}}", ATMOS_E_INVALID_ARG, "/volume/density_scale: must be in (0, 1e+30], got 0", NULL},
+    {"{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\", \"refine\": 5}}}", ATMOS_E_INVALID_ARG, "/volume/simulate/refine: must be in [1, 4], got 5", NULL},
+    {"{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\", \"detail\": 2}}}", ATMOS_E_INVALID_ARG, "/volume/simulate/detail: must be in [0, 1], got 2", NULL},
+    {"{\"volume\": {\"simulate\": {\"preset\": \"cumulonimbus\", \"ice\": 1}}}", ATMOS_E_INVALID_ARG, "/volume/simulate/ice: expected true or false", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"grids\": \"cloud\"}}", ATMOS_E_INVALID_ARG, "/volume/grids: expected an array of grid names, got a string", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"grids\": []}}", ATMOS_E_INVALID_ARG, "/volume/grids: must not be empty", NULL},
     {"{\"volume\": {\"generate\": \"storm\", \"grids\": [\"a,b\"]}}", ATMOS_E_INVALID_ARG, "/volume/grids/0: a grid name has no ','", NULL},

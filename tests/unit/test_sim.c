@@ -174,7 +174,7 @@ static int same_state(const atmos_sim *a, const atmos_sim *b)
 static atmos_sim *run_preset(int threads, const char *preset, uint64_t seed, int steps)
 {
     atmos_context *c = make_ctx(threads);
-    atmos_sim_desc d = {preset, 0, 24, seed};
+    atmos_sim_desc d = {.preset = preset, .minutes = 0, .grid = 24, .seed = seed};
     atmos_sim *s = NULL;
     if (atmos_sim_create(c, &d, &s) == ATMOS_OK)
         for (int n = 0; n < steps; n++) atmos_sim_step(c, s);
@@ -205,7 +205,7 @@ static void test_bad(void)
 {
     atmos_context *c = make_ctx(1);
     atmos_sim *s = NULL;
-    atmos_sim_desc d = {"cumulonimbuss", 0, 32, 1};
+    atmos_sim_desc d = {.preset = "cumulonimbuss", .minutes = 0, .grid = 32, .seed = 1};
     CHECK(atmos_sim_create(c, &d, &s) == ATMOS_E_INVALID_ARG && !s);
     CHECK(strstr(atmos_context_error(c), "cumulus_field") != NULL);
     d.preset = NULL;
@@ -236,7 +236,7 @@ static void test_bad(void)
 static void test_volume(void)
 {
     atmos_context *c = make_ctx(1);
-    atmos_sim_desc d = {"stratocumulus", 0, 16, 1};
+    atmos_sim_desc d = {.preset = "stratocumulus", .minutes = 0, .grid = 16, .seed = 1};
     atmos_sim *s = NULL;
     CHECK_OK(atmos_sim_create(c, &d, &s));
     if (!s) return;
@@ -284,7 +284,7 @@ static int same_volume(const atmos_volume *a, const atmos_volume *b)
 static void test_timelapse(void)
 {
     atmos_context *c = make_ctx(2);
-    atmos_sim_desc d = {"towering_cumulus", 0, 16, 5};
+    atmos_sim_desc d = {.preset = "towering_cumulus", .minutes = 0, .grid = 16, .seed = 5};
     atmos_sim *s = NULL;
     CHECK_OK(atmos_sim_create(c, &d, &s));
     if (!s) return;
@@ -365,7 +365,7 @@ static void test_empty_warning(void)
         cd.log_level = ATMOS_LOG_WARN;
         atmos_context *c = NULL;
         CHECK_OK(atmos_context_create(&cd, &c));
-        atmos_sim_desc d = {cloudy ? "stratocumulus" : "towering_cumulus", 0.5, 16, 1};
+        atmos_sim_desc d = {.preset = cloudy ? "stratocumulus" : "towering_cumulus", .minutes = 0.5, .grid = 16, .seed = 1};
         atmos_volume *v = NULL;
         CHECK_OK(atmos_simulate(c, &d, &v));
         if (cloudy) CHECK_MSG(!warned[0], "stratocumulus warned: %s", warned);

@@ -18,7 +18,7 @@
 
 static atmos_sim *run(atmos_context *c, double minutes)
 {
-    atmos_sim_desc d = {"stratocumulus", 0, GRID, 1};
+    atmos_sim_desc d = {.preset = "stratocumulus", .minutes = 0, .grid = GRID, .seed = 1};
     atmos_sim *s = NULL;
     CHECK_OK(atmos_sim_create(c, &d, &s));
     if (s) CHECK_OK(atmos_sim_run(c, s, minutes * 60.0));
@@ -86,7 +86,7 @@ static void test_cells(void)
 static void test_budget_threads(void)
 {
     atmos_context *c1 = test_context(1, NULL), *c2 = test_context(2, NULL);
-    atmos_sim_desc d = {"stratocumulus", 0, 24, 1};
+    atmos_sim_desc d = {.preset = "stratocumulus", .minutes = 0, .grid = 24, .seed = 1};
     atmos_sim *a = NULL, *b = NULL;
     CHECK_OK(atmos_sim_create(c1, &d, &a));
     CHECK_OK(atmos_sim_create(c2, &d, &b));

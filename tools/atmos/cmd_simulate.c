@@ -12,7 +12,7 @@ static const char *C = "simulate";
 static void help(void)
 {
     printf("Usage: atmos simulate PRESET -o NAME.json [--minutes M] [--grid N] [--seed S] [--threads T]\n"
-           "                      [--quiet] [--bench K]\n\n"
+           "                      [--refine R] [--detail A] [--ice] [--quiet] [--bench K]\n\n"
            "Runs the cloud-physics simulation (docs/clouds.md): a 3-D Boussinesq fluid with potential\n"
            "temperature, water vapour, cloud water and rain, Kessler warm rain and saturation adjustment,\n"
            "periodic sides. Writes the state at time M as a volume of \"cloud\" and \"rain\" number\n"
@@ -33,13 +33,20 @@ static void help(void)
            "  --grid N     cells along each horizontal side, %d..%d (default 64); the domain's size is the\n"
            "               preset's, so a larger N gives smaller cells\n"
            "  --seed S     the random perturbations (default 1); the same seed gives the same bytes\n"
+           "  --refine R   voxels per model cell along each axis, 1..%d (default 1): the mixing ratios\n"
+           "               interpolated in their logarithm between cell centres, so that edges fall\n"
+           "               between the cells instead of on their faces\n"
+           "  --detail A   0..1 (default 0), for artists: the fields sampled at places moved by a fractal\n"
+           "               noise of up to A cells (ragged edges below the grid that the model does not hold)\n"
+           "  --ice        write cloud water colder than 0 C partly, below -23 C wholly, as \"ice\" (a\n"
+           "               diagnosis by temperature for the optics; the model itself has no ice)\n"
            "  --threads T  worker threads (default: all cores); the result does not depend on T\n"
            "  --quiet      no progress bar\n"
            "  --bench K    instead of writing a volume: K time steps, then the mean time of one step and the\n"
            "               state (simulated time, largest updraught, cloud base and top); with --minutes, runs\n"
            "               that long first and reports the time taken (bench/sim/run.sh)\n\n"
            "Exit status: 0 success, 1 runtime error, 2 usage error.\n",
-           ATMOS_SIM_MAX_MINUTES, ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID);
+           ATMOS_SIM_MAX_MINUTES, ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID, ATMOS_SIM_MAX_REFINE);
 }
 
 static void print_state(const atmos_sim *s)
@@ -153,6 +160,13 @@ int cli_cmd_simulate(int argc, char **argv)
             unsigned long long s = strtoull(t, &end, 10);
             if (!*t || *end || t[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", t);
             d.seed = s;
+        } else if (!strcmp(a, "--refine") && i + 1 < argc) {
+            if (!cli_parse_int(C, "--refine", argv[++i], 1, ATMOS_SIM_MAX_REFINE, &d.refine)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--detail") && i + 1 < argc) {
+            if (!cli_parse_double(C, "--detail", argv[++i], &d.detail)) return CLI_EXIT_USAGE;
+            if (!(d.detail >= 0 && d.detail <= 1)) return cli_usage_error(C, "--detail: expected 0 <= A <= 1, got %s", argv[i]);
+        } else if (!strcmp(a, "--ice")) {
+            d.ice = 1;
         } else if (!strcmp(a, "--bench") && i + 1 < argc) {
             if (!cli_parse_int(C, "--bench", argv[++i], 1, 1000000, &bench)) return CLI_EXIT_USAGE;
         } else if (!strcmp(a, "--threads") && i + 1 < argc) {

@@ -13,7 +13,7 @@ atmos_status render_timelapse_volume(atmos_context *ctx, render_timelapse *tl, c
 {
     const atmos_scene_volume *sv = &fs->volume;
     if (!tl->sim) {
-        const atmos_sim_desc d = {sv->source + 9, 0, sv->sim_grid, sv->seed};
+        const atmos_sim_desc d = {sv->source + 9, 0, sv->sim_grid, sv->seed, sv->sim_refine, sv->sim_detail, sv->sim_ice};
         atmos_status st = atmos_sim_create(ctx, &d, &tl->sim);
         if (st != ATMOS_OK) return st;
     }

@@ -138,6 +138,9 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
             if (sc->volume.sim_minutes > 0) cJSON_AddNumberToObject(o, "minutes", sc->volume.sim_minutes);
             if (sc->volume.sim_grid > 0) cJSON_AddNumberToObject(o, "grid", sc->volume.sim_grid);
             cJSON_AddNumberToObject(o, "seed", (double)sc->volume.seed);
+            if (sc->volume.sim_refine > 1) cJSON_AddNumberToObject(o, "refine", sc->volume.sim_refine);
+            if (sc->volume.sim_detail > 0) cJSON_AddNumberToObject(o, "detail", sc->volume.sim_detail);
+            if (sc->volume.sim_ice) cJSON_AddBoolToObject(o, "ice", 1);
             set(vol, "simulate", o);
         } else {
             set(vol, gen ? "generate" : "file", cJSON_CreateString(gen ? sc->volume.source + 9 : sc->volume.source));
