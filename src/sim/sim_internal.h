@@ -122,17 +122,17 @@ void atmos__sim_sounding(atmos_sim *sim);
 double atmos__sim_advect(atmos_sim *sim, double dt);
 void atmos__sim_advected_velocity(atmos_sim *sim);
 /* sim_trace.c: trilinear samples of a field of nz_f levels (x, y wrapped, z clamped) at n points
- * of its index space, into out[m]; of four fields packed per cell (f4[4 cell + field]) into
+ * of its index space (single precision), into out[m]; of four fields packed per cell (f4[4 cell + field]) into
  * out4[4 m + field] */
-void atmos__sim_sample_row(const atmos_sim *sim, const float *f, int nz_f, const double *x, const double *y,
-                           const double *z, float *out, int n);
-void atmos__sim_sample4_row(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
-                            const double *z, float *out4, int n);
+void atmos__sim_sample_row(const atmos_sim *sim, const float *f, int nz_f, const float *x, const float *y,
+                           const float *z, float *out, int n);
+void atmos__sim_sample4_row(const atmos_sim *sim, const float *f4, int nz_f, const float *x, const float *y,
+                            const float *z, float *out4, int n);
 /* The same by the scalar code only (what the vectorised path must match bit for bit; tests) */
-void atmos__sim_sample_row_scalar(const atmos_sim *sim, const float *f, int nz_f, const double *x, const double *y,
-                                  const double *z, float *out, int n);
-void atmos__sim_sample4_row_scalar(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
-                                   const double *z, float *out4, int n);
+void atmos__sim_sample_row_scalar(const atmos_sim *sim, const float *f, int nz_f, const float *x, const float *y,
+                                  const float *z, float *out, int n);
+void atmos__sim_sample4_row_scalar(const atmos_sim *sim, const float *f4, int nz_f, const float *x, const float *y,
+                                   const float *z, float *out4, int n);
 /* sim_forces.c: surface fluxes, cloud-top cooling, buoyancy and the sponge of row j (y = j);
  * returns the water the surface added to the row */
 double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);
