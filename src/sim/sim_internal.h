@@ -70,7 +70,8 @@ struct atmos_sim {
     double rain_out, surface_in;  /* in (kg/kg) x cells */
     float vmax;                   /* largest |u|, |v|, |w| after the last projection */
     void *bar;                    /* a pthread barrier of `threads` threads (NULL: one thread) */
-    void *fft_fwd, *fft_inv;      /* fftwf plans of one level */
+    void *fft_fwd, *fft_inv;      /* fftwf plans of one level, for levels aligned as the arrays are */
+    void *fft_fwd_u, *fft_inv_u;  /* the same for any level (FFTW_UNALIGNED) */
     void *spec;                   /* complex spectrum, nz ny (nx / 2 + 1) */
     double *colbuf;               /* the projection's column solves: SIM_COLUMN_SCRATCH(nz) a thread */
 };
@@ -97,6 +98,10 @@ static inline size_t sim_idx(const atmos_sim *s, int i, int j, int k)
  * the steps that end at or before it (a time-lapse's run: sim_timelapse.c); progress as
  * atmos_sim_run's (sim_step.c). */
 atmos_status atmos__sim_run_to(atmos_context *ctx, atmos_sim *s, double end, int whole_steps);
+
+/* The simulation's arrays (sim_create.c): 64-byte aligned, on 2 MB pages where large
+ * (atmos__big_alloc), so that a level's FFT plan does not depend on where malloc put it. */
+void *atmos__sim_alloc(size_t bytes);
 
 /* Presets (sim_presets.c). NULL if unknown. */
 const sim_env *atmos__sim_preset(const char *name);
