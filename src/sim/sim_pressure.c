@@ -203,8 +203,10 @@ void atmos__sim_project(atmos_sim *s)
     fftwf_complex *c = s->spec;
     SIM_FOR
     for (int k = 0; k < nz; k++) {
+        float *dk = d + k * lev;
+        fftwf_complex *ck = c + k * clev;
         divergence(s, k, d);
-        fftwf_execute_dft_r2c(aligned(d + k * lev, c + k * clev) ? s->fft_fwd : s->fft_fwd_u, d + k * lev, c + k * clev);
+        fftwf_execute_dft_r2c(aligned(dk, ck) ? s->fft_fwd : s->fft_fwd_u, dk, ck);
     }
     atmos__sim_sync(s);
     const double norm = 1.0 / ((double)nx * ny);
@@ -214,8 +216,11 @@ void atmos__sim_project(atmos_sim *s)
     }
     atmos__sim_sync(s);
     SIM_FOR
-    for (int k = 0; k < nz; k++)
-        fftwf_execute_dft_c2r(aligned(d + k * lev, c + k * clev) ? s->fft_inv : s->fft_inv_u, c + k * clev, d + k * lev);
+    for (int k = 0; k < nz; k++) {
+        float *dk = d + k * lev;
+        fftwf_complex *ck = c + k * clev;
+        fftwf_execute_dft_c2r(aligned(dk, ck) ? s->fft_inv : s->fft_inv_u, ck, dk);
+    }
     atmos__sim_sync(s);
     double *lm = s->part;
     SIM_FOR

@@ -129,7 +129,8 @@ typedef struct {
 AVX2_INLINE __m256i wrap8(__m256i i, int n)
 {
     const __m256i vn = _mm256_set1_epi32(n);
-    const __m256i lo = _mm256_cmpgt_epi32(_mm256_setzero_si256(), i), hi = _mm256_cmpgt_epi32(i, _mm256_set1_epi32(n - 1));
+    const __m256i lo = _mm256_cmpgt_epi32(_mm256_setzero_si256(), i);
+    const __m256i hi = _mm256_cmpgt_epi32(i, _mm256_set1_epi32(n - 1));
     return _mm256_sub_epi32(_mm256_add_epi32(i, _mm256_and_si256(lo, vn)), _mm256_and_si256(hi, vn));
 }
 
@@ -149,7 +150,8 @@ AVX2_INLINE int setup8(const atmos_sim *s, int nz_f, const float *x, const float
     const int nx = s->nx, ny = s->ny;
     const __m256 X = _mm256_loadu_ps(x), Y = _mm256_loadu_ps(y);
     /* z < 0 -> 0, z > nz_f - 1 -> nz_f - 1, else z itself (a -0 or a NaN kept, as the scalar code) */
-    const __m256 Z = _mm256_min_ps(_mm256_set1_ps((float)(nz_f - 1)), _mm256_max_ps(_mm256_setzero_ps(), _mm256_loadu_ps(z)));
+    const __m256 Z =
+        _mm256_min_ps(_mm256_set1_ps((float)(nz_f - 1)), _mm256_max_ps(_mm256_setzero_ps(), _mm256_loadu_ps(z)));
     /* floor through int (the scalar ifloor: -0 gives +0); out of range and NaN give INT_MIN */
     const __m256i ix = _mm256_cvttps_epi32(_mm256_floor_ps(X)), iy = _mm256_cvttps_epi32(_mm256_floor_ps(Y));
     const __m256i iz = _mm256_cvttps_epi32(_mm256_floor_ps(Z));
