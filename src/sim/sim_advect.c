@@ -51,23 +51,25 @@ ADV_CLONES static void centres(atmos_sim *s, int k)
 /* Level k of the scalars into s[0..3], each cell's departure point traced once (midpoint rule
  * on the cell-centred velocity) for all four; the level's new water into part[2 (nz + 1) + k]
  * (vapour) and part[3 (nz + 1) + k] (the rest). */
-ADV_CLONES static void scalars(atmos_sim *s, int k, double c)
+ADV_CLONES static void scalars(atmos_sim *s, int k, float c)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
     float *dst[4] = {s->th, s->qv, s->qc, s->qr}; /* in place: the sources are the packed copies */
     const float *vel4 = s->pack, *sc4 = s->pack + 4 * s->n;
-    double x[ATMOS_SIM_MAX_GRID], y[ATMOS_SIM_MAX_GRID], z[ATMOS_SIM_MAX_GRID];
+    float x[ATMOS_SIM_MAX_GRID], y[ATMOS_SIM_MAX_GRID], z[ATMOS_SIM_MAX_GRID];
     float q[4 * ATMOS_SIM_MAX_GRID];
+    const float h = 0.5f * c;
     for (int j = 0; j < ny; j++) {
         const size_t r = sim_idx(s, 0, j, k);
+        const float fj = (float)j, fk = (float)k;
         for (int i = 0; i < nx; i++) { /* half a step back with the velocity here */
             const float *p = vel4 + 4 * (r + i);
-            x[i] = i - 0.5 * c * p[0], y[i] = j - 0.5 * c * p[1], z[i] = k - 0.5 * c * p[2];
+            x[i] = (float)i - h * p[0], y[i] = fj - h * p[1], z[i] = fk - h * p[2];
         }
         atmos__sim_sample4_row(s, vel4, s->nz, x, y, z, q, nx);
         for (int i = 0; i < nx; i++) /* a whole step back with the velocity there */
-            x[i] = i - c * (double)q[4 * i], y[i] = j - c * (double)q[4 * i + 1], z[i] = k - c * (double)q[4 * i + 2];
+            x[i] = (float)i - c * q[4 * i], y[i] = fj - c * q[4 * i + 1], z[i] = fk - c * q[4 * i + 2];
         atmos__sim_sample4_row(s, sc4, s->nz, x, y, z, q, nx);
         for (int i = 0; i < nx; i++)
             for (int f = 0; f < 4; f++) dst[f][r + i] = q[4 * i + f];
@@ -83,57 +85,81 @@ ADV_CLONES static void scalars(atmos_sim *s, int k, double c)
 /* The departure points of the faces of a row: u's, v's and w's (the velocity's components
  * other than the face's own averaged from its four nearest faces). */
 ADV_INLINE void pos_u(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
-                      size_t lev, int i, int im, int j, int k, double c, double *x, double *y, double *z)
+                      size_t lev, int i, int im, float fj, float fk, float c, float *restrict x, float *restrict y,
+                      float *restrict z)
 {
-    const double vu = 0.25 * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
-    const double wu = 0.25 * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
-    x[i] = i - c * u[r + i], y[i] = j - c * vu, z[i] = k - c * wu;
+    const float vu = 0.25f * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
+    const float wu = 0.25f * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
+    x[i] = (float)i - c * u[r + i], y[i] = fj - c * vu, z[i] = fk - c * wu;
 }
 
 ADV_INLINE void pos_v(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rm,
-                      size_t lev, int i, int ip, int j, int k, double c, double *x, double *y, double *z)
+                      size_t lev, int i, int ip, float fj, float fk, float c, float *restrict x, float *restrict y,
+                      float *restrict z)
 {
-    const double uv = 0.25 * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
-    const double wv = 0.25 * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
-    x[i] = i - c * uv, y[i] = j - c * v[r + i], z[i] = k - c * wv;
+    const float uv = 0.25f * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
+    const float wv = 0.25f * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
+    x[i] = (float)i - c * uv, y[i] = fj - c * v[r + i], z[i] = fk - c * wv;
 }
 
 ADV_INLINE void pos_w(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
-                      size_t lev, int i, int ip, int j, int k, double c, double *x, double *y, double *z)
+                      size_t lev, int i, int ip, float fj, float fk, float c, float *restrict x, float *restrict y,
+                      float *restrict z)
 {
-    const double uw = 0.25 * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
-    const double vw = 0.25 * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);
-    x[i] = i - c * uw, y[i] = j - c * vw, z[i] = k - c * w[r + i];
+    const float uw = 0.25f * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
+    const float vw = 0.25f * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);
+    x[i] = (float)i - c * uw, y[i] = fj - c * vw, z[i] = fk - c * w[r + i];
+}
+
+/* The departure points of row r's faces of component f (0: u, 1: v, 2: w; rn the row j + 1's
+ * offset for u and w, j - 1's for v), each row's end wrapped apart. A function of its own whose
+ * restrict-qualified arrays let the compiler vectorise the loops (inlined, with x, y, z as
+ * floats like the fields, it needed too many run-time alias checks and stayed scalar). */
+ADV_CLONES __attribute__((noinline)) static void points(int f, const float *restrict u, const float *restrict v,
+                                                        const float *restrict w, size_t r, size_t rn, size_t lev,
+                                                        int nx, float fj, float fk, float c, float *restrict x,
+                                                        float *restrict y, float *restrict z)
+{
+    const int e = nx - 1;
+    if (f == 0) {
+        pos_u(u, v, w, r, rn, lev, 0, e, fj, fk, c, x, y, z);
+        for (int i = 1; i < nx; i++) pos_u(u, v, w, r, rn, lev, i, i - 1, fj, fk, c, x, y, z);
+    } else if (f == 1) {
+        for (int i = 0; i < e; i++) pos_v(u, v, w, r, rn, lev, i, i + 1, fj, fk, c, x, y, z);
+        pos_v(u, v, w, r, rn, lev, e, 0, fj, fk, c, x, y, z);
+    } else {
+        for (int i = 0; i < e; i++) pos_w(u, v, w, r, rn, lev, i, i + 1, fj, fk, c, x, y, z);
+        pos_w(u, v, w, r, rn, lev, e, 0, fj, fk, c, x, y, z);
+    }
 }
 
 /* Level k of the new velocity into s[4..6] from the old one (each face traced from itself with
  * its own component and the other two averaged from the four nearest faces; in a field's own
  * index space the departure point is its index minus dt v / dx); k = nz is the lid's w. */
-ADV_CLONES static void velocity(atmos_sim *s, int k, double c)
+static void velocity(atmos_sim *s, int k, float c)
 {
-    const int nx = s->nx, ny = s->ny, nz = s->nz, e = nx - 1;
+    const int nx = s->nx, ny = s->ny, nz = s->nz;
     const size_t lev = (size_t)nx * ny;
     const float *u = s->u, *v = s->v, *w = s->w;
     float *nu = s->s[4], *nv = s->s[5], *nw = s->s[6];
-    double x[ATMOS_SIM_MAX_GRID], y[ATMOS_SIM_MAX_GRID], z[ATMOS_SIM_MAX_GRID];
+    float x[ATMOS_SIM_MAX_GRID], y[ATMOS_SIM_MAX_GRID], z[ATMOS_SIM_MAX_GRID];
+    const float fk = (float)k;
     for (int j = 0; j < ny; j++) {
+        const float fj = (float)j;
         const size_t r = (size_t)k * lev + (size_t)j * nx;
         const size_t rm = (size_t)k * lev + (size_t)(j ? j - 1 : ny - 1) * nx;
         const size_t rp = (size_t)k * lev + (size_t)(j + 1 == ny ? 0 : j + 1) * nx;
         if (k < nz) { /* u on the face x = i - 1/2, v on y = j - 1/2 */
-            pos_u(u, v, w, r, rp, lev, 0, e, j, k, c, x, y, z);
-            for (int i = 1; i < nx; i++) pos_u(u, v, w, r, rp, lev, i, i - 1, j, k, c, x, y, z);
+            points(0, u, v, w, r, rp, lev, nx, fj, fk, c, x, y, z);
             atmos__sim_sample_row(s, u, nz, x, y, z, nu + r, nx);
-            for (int i = 0; i < e; i++) pos_v(u, v, w, r, rm, lev, i, i + 1, j, k, c, x, y, z);
-            pos_v(u, v, w, r, rm, lev, e, 0, j, k, c, x, y, z);
+            points(1, u, v, w, r, rm, lev, nx, fj, fk, c, x, y, z);
             atmos__sim_sample_row(s, v, nz, x, y, z, nv + r, nx);
         }
         if (k == 0 || k == nz) {
             for (int i = 0; i < nx; i++) nw[r + i] = 0;
             continue;
         }
-        for (int i = 0; i < e; i++) pos_w(u, v, w, r, rp, lev, i, i + 1, j, k, c, x, y, z); /* w on z = k - 1/2 */
-        pos_w(u, v, w, r, rp, lev, e, 0, j, k, c, x, y, z);
+        points(2, u, v, w, r, rp, lev, nx, fj, fk, c, x, y, z); /* w on z = k - 1/2 */
         atmos__sim_sample_row(s, w, nz + 1, x, y, z, nw + r, nx);
     }
 }
@@ -160,7 +186,7 @@ void atmos__sim_advected_velocity(atmos_sim *s)
 double atmos__sim_advect(atmos_sim *s, double dt)
 {
     const int nz = s->nz;
-    const double c = dt / s->dx;
+    const float c = (float)(dt / s->dx); /* the departure points in single precision (sim_trace.c) */
     SIM_FOR
     for (int k = 0; k < nz; k++) centres(s, k);
     atmos__sim_sync(s);

@@ -72,7 +72,8 @@ struct atmos_sim {
     double rain_out, surface_in;  /* in (kg/kg) x cells */
     float vmax;                   /* largest |u|, |v|, |w| after the last projection */
     void *bar;                    /* a pthread barrier of `threads` threads (NULL: one thread) */
-    void *fft_fwd, *fft_inv;      /* fftwf plans of one level */
+    void *fft_fwd, *fft_inv;      /* fftwf plans of one level, for levels aligned as the arrays are */
+    void *fft_fwd_u, *fft_inv_u;  /* the same for any level (FFTW_UNALIGNED) */
     void *spec;                   /* complex spectrum, nz ny (nx / 2 + 1) */
     double *colbuf;               /* the projection's column solves: SIM_COLUMN_SCRATCH(nz) a thread */
 };
@@ -100,6 +101,10 @@ static inline size_t sim_idx(const atmos_sim *s, int i, int j, int k)
  * atmos_sim_run's (sim_step.c). */
 atmos_status atmos__sim_run_to(atmos_context *ctx, atmos_sim *s, double end, int whole_steps);
 
+/* The simulation's arrays (sim_create.c): 64-byte aligned, on 2 MB pages where large
+ * (atmos__big_alloc), so that a level's FFT plan does not depend on where malloc put it. */
+void *atmos__sim_alloc(size_t bytes);
+
 /* Presets (sim_presets.c). NULL if unknown. */
 const sim_env *atmos__sim_preset(const char *name);
 
@@ -126,17 +131,17 @@ void atmos__sim_sounding(atmos_sim *sim);
 double atmos__sim_advect(atmos_sim *sim, double dt);
 void atmos__sim_advected_velocity(atmos_sim *sim);
 /* sim_trace.c: trilinear samples of a field of nz_f levels (x, y wrapped, z clamped) at n points
- * of its index space, into out[m]; of four fields packed per cell (f4[4 cell + field]) into
+ * of its index space (single precision), into out[m]; of four fields packed per cell (f4[4 cell + field]) into
  * out4[4 m + field] */
-void atmos__sim_sample_row(const atmos_sim *sim, const float *f, int nz_f, const double *x, const double *y,
-                           const double *z, float *out, int n);
-void atmos__sim_sample4_row(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
-                            const double *z, float *out4, int n);
+void atmos__sim_sample_row(const atmos_sim *sim, const float *f, int nz_f, const float *x, const float *y,
+                           const float *z, float *out, int n);
+void atmos__sim_sample4_row(const atmos_sim *sim, const float *f4, int nz_f, const float *x, const float *y,
+                            const float *z, float *out4, int n);
 /* The same by the scalar code only (what the vectorised path must match bit for bit; tests) */
-void atmos__sim_sample_row_scalar(const atmos_sim *sim, const float *f, int nz_f, const double *x, const double *y,
-                                  const double *z, float *out, int n);
-void atmos__sim_sample4_row_scalar(const atmos_sim *sim, const float *f4, int nz_f, const double *x, const double *y,
-                                   const double *z, float *out4, int n);
+void atmos__sim_sample_row_scalar(const atmos_sim *sim, const float *f, int nz_f, const float *x, const float *y,
+                                  const float *z, float *out, int n);
+void atmos__sim_sample4_row_scalar(const atmos_sim *sim, const float *f4, int nz_f, const float *x, const float *y,
+                                   const float *z, float *out4, int n);
 /* sim_forces.c: surface fluxes, cloud-top cooling, buoyancy and the sponge of row j (y = j);
  * returns the water the surface added to the row */
 double atmos__sim_forces_row(atmos_sim *sim, double dt, int j);

@@ -24,18 +24,23 @@ atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *s)
 {
     const int nh = s->nx / 2 + 1;
     /* on 2 MB pages where the system gives them: the column solves stride through the levels */
-    s->spec = atmos__big_alloc(sizeof(fftwf_complex) * (size_t)nh * s->ny * s->nz);
+    s->spec = atmos__sim_alloc(sizeof(fftwf_complex) * (size_t)nh * s->ny * s->nz);
     s->colbuf = malloc(sizeof(double) * SIM_COLUMN_SCRATCH(s->nz) * (size_t)(s->threads > 1 ? s->threads : 1));
     if (!s->spec || !s->colbuf) return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: out of memory for the pressure solver");
-    /* planned on scratch arrays (ESTIMATE leaves them alone); UNALIGNED so the plan runs on any level */
+    /* planned on scratch arrays (ESTIMATE leaves them alone, and chooses the same plan every
+     * time): one pair for the levels aligned as the (64-byte aligned) arrays' starts, whose
+     * SIMD codelets need that, and one pair (UNALIGNED) for any level */
     fftwf_complex *c = s->spec;
-    const unsigned flags = FFTW_ESTIMATE | FFTW_UNALIGNED;
+    const unsigned flags = FFTW_ESTIMATE;
 #pragma omp critical(atmos_fftw_planner)
     {
         s->fft_fwd = fftwf_plan_dft_r2c_2d(s->ny, s->nx, s->s[0], c, flags);
         s->fft_inv = fftwf_plan_dft_c2r_2d(s->ny, s->nx, c, s->s[0], flags);
+        s->fft_fwd_u = fftwf_plan_dft_r2c_2d(s->ny, s->nx, s->s[0], c, flags | FFTW_UNALIGNED);
+        s->fft_inv_u = fftwf_plan_dft_c2r_2d(s->ny, s->nx, c, s->s[0], flags | FFTW_UNALIGNED);
     }
-    if (!s->fft_fwd || !s->fft_inv) return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: FFTW could not plan");
+    if (!s->fft_fwd || !s->fft_inv || !s->fft_fwd_u || !s->fft_inv_u)
+        return atmos__error(ctx, ATMOS_E_NOMEM, "simulate: FFTW could not plan");
     return ATMOS_OK;
 }
 
@@ -45,11 +50,13 @@ void atmos__sim_fft_free(atmos_sim *s)
     {
         if (s->fft_fwd) fftwf_destroy_plan(s->fft_fwd);
         if (s->fft_inv) fftwf_destroy_plan(s->fft_inv);
+        if (s->fft_fwd_u) fftwf_destroy_plan(s->fft_fwd_u);
+        if (s->fft_inv_u) fftwf_destroy_plan(s->fft_inv_u);
     }
     free(s->spec);
     free(s->colbuf);
     s->colbuf = NULL;
-    s->fft_fwd = s->fft_inv = s->spec = NULL;
+    s->fft_fwd = s->fft_inv = s->fft_fwd_u = s->fft_inv_u = s->spec = NULL;
 }
 
 /* dx times the divergence of the cells of level k into d (the row's last cell wraps). */
@@ -180,6 +187,14 @@ PROJ_CLONES static float gradient(atmos_sim *s, int k, const float *restrict d)
     return m;
 }
 
+/* Whether a level's arrays are aligned as the plans' were (their starts, 64-byte aligned:
+ * atmos__sim_alloc), so that the aligned plans may run on it: a matter of the grid's size
+ * only, never of where the arrays are or of the thread that runs the level. */
+static int aligned(float *r, fftwf_complex *c)
+{
+    return fftwf_alignment_of(r) == 0 && fftwf_alignment_of((float *)c) == 0;
+}
+
 void atmos__sim_project(atmos_sim *s)
 {
     const int nx = s->nx, ny = s->ny, nz = s->nz, nh = nx / 2 + 1;
@@ -188,8 +203,10 @@ void atmos__sim_project(atmos_sim *s)
     fftwf_complex *c = s->spec;
     SIM_FOR
     for (int k = 0; k < nz; k++) {
+        float *dk = d + k * lev;
+        fftwf_complex *ck = c + k * clev;
         divergence(s, k, d);
-        fftwf_execute_dft_r2c(s->fft_fwd, d + k * lev, c + k * clev);
+        fftwf_execute_dft_r2c(aligned(dk, ck) ? s->fft_fwd : s->fft_fwd_u, dk, ck);
     }
     atmos__sim_sync(s);
     const double norm = 1.0 / ((double)nx * ny);
@@ -199,7 +216,11 @@ void atmos__sim_project(atmos_sim *s)
     }
     atmos__sim_sync(s);
     SIM_FOR
-    for (int k = 0; k < nz; k++) fftwf_execute_dft_c2r(s->fft_inv, c + k * clev, d + k * lev);
+    for (int k = 0; k < nz; k++) {
+        float *dk = d + k * lev;
+        fftwf_complex *ck = c + k * clev;
+        fftwf_execute_dft_c2r(aligned(dk, ck) ? s->fft_inv : s->fft_inv_u, ck, dk);
+    }
     atmos__sim_sync(s);
     double *lm = s->part;
     SIM_FOR

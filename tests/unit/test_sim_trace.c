@@ -63,18 +63,18 @@ static void test_rows(atmos_context *ctx)
     float *f = malloc(cells * sizeof *f), *f4 = malloc(4 * cells * sizeof *f4);
     for (size_t n = 0; n < cells; n++) f[n] = (float)(u01() * 20.0 - 10.0);
     for (size_t n = 0; n < 4 * cells; n++) f4[n] = (float)(u01() * 2.0 - 1.0);
-    static double x[RN], y[RN], z[RN];
+    static float x[RN], y[RN], z[RN];
     static float out[RN], ref_out[RN], out4[4 * RN], ref_out4[4 * RN];
     const double shift[4] = {0.3, -1.45, 0.6, 0.05};
     for (int r = 0; r < 4; r++)
         for (int i = 0; i < RX; i++) {
             const int m = r * RX + i;
             const double wobble = r == 2 ? 0.5 * sin(0.7 * i) : 0.0; /* floors that change along the row */
-            x[m] = i - shift[r] + wobble;
-            y[m] = 3 + 0.4 * u01(), z[m] = 2 + 0.9 * u01();
+            x[m] = (float)(i - shift[r] + wobble);
+            y[m] = (float)(3 + 0.4 * u01()), z[m] = (float)(2 + 0.9 * u01());
         }
-    y[3 * RX + 13] = 4.2;  /* one lane in the next grid row */
-    z[3 * RX + 21] = 3.1;  /* one lane a level up */
+    y[3 * RX + 13] = 4.2f; /* one lane in the next grid row */
+    z[3 * RX + 21] = 3.1f; /* one lane a level up */
     atmos__sim_sample_row(s, f, NZF, x, y, z, out, RN);
     atmos__sim_sample_row_scalar(s, f, NZF, x, y, z, ref_out, RN);
     atmos__sim_sample4_row(s, f4, NZF, x, y, z, out4, RN);
@@ -108,20 +108,20 @@ int main(void)
     float *f = malloc(cells * sizeof *f), *f4 = malloc(4 * cells * sizeof *f4);
     for (size_t n = 0; n < cells; n++) f[n] = (float)(u01() * 20.0 - 10.0);
     for (size_t n = 0; n < 4 * cells; n++) f4[n] = (float)(u01() * 2.0 - 1.0);
-    double x[NP], y[NP], z[NP];
+    float x[NP], y[NP], z[NP];
     for (int m = 0; m < NP; m++) {
-        x[m] = -NX + 3.0 * NX * u01();
-        y[m] = -NY + 3.0 * NY * u01();
-        z[m] = -1.5 + (NZF + 2.0) * u01();
+        x[m] = (float)(-NX + 3.0 * NX * u01());
+        y[m] = (float)(-NY + 3.0 * NY * u01());
+        z[m] = (float)(-1.5 + (NZF + 2.0) * u01());
     }
-    x[0] = NX - 0.25, y[0] = NY - 0.75, z[0] = 1.5;       /* both second corners wrap to 0 */
-    x[1] = -0.0, y[1] = -0.0, z[1] = -0.0;                 /* negative zeros */
-    x[2] = 2.5, y[2] = 3.25, z[2] = NZF - 1;               /* the top level */
-    x[3] = 4, y[3] = 5, z[3] = 2;                          /* a grid point */
-    x[4] = 3.5 * NX, y[4] = 1.5, z[4] = 1;                 /* beyond 2 NX: the scalar path */
-    x[5] = -NX - 0.5, y[5] = 1.5, z[5] = 1;                /* below -NX: the scalar path */
-    x[6] = 2.0 * NX - 0.01, y[6] = -NY + 0.01, z[6] = 40;  /* far side of the range, clamped z */
-    x[9] = 5.5, y[9] = 9.0 * NY, z[9] = 0.5;               /* y beyond: the scalar path */
+    x[0] = NX - 0.25f, y[0] = NY - 0.75f, z[0] = 1.5f;      /* both second corners wrap to 0 */
+    x[1] = -0.0f, y[1] = -0.0f, z[1] = -0.0f;               /* negative zeros */
+    x[2] = 2.5f, y[2] = 3.25f, z[2] = NZF - 1;              /* the top level */
+    x[3] = 4, y[3] = 5, z[3] = 2;                           /* a grid point */
+    x[4] = 3.5f * NX, y[4] = 1.5f, z[4] = 1;                /* beyond 2 NX: the scalar path */
+    x[5] = -NX - 0.5f, y[5] = 1.5f, z[5] = 1;               /* below -NX: the scalar path */
+    x[6] = 2.0f * NX - 0.01f, y[6] = -NY + 0.01f, z[6] = 40; /* far side of the range, clamped z */
+    x[9] = 5.5f, y[9] = 9.0f * NY, z[9] = 0.5f;             /* y beyond: the scalar path */
     float out[NP], ref_out[NP], out4[4 * NP], ref_out4[4 * NP];
     atmos__sim_sample_row(s, f, NZF, x, y, z, out, NP);
     atmos__sim_sample_row_scalar(s, f, NZF, x, y, z, ref_out, NP);
