@@ -25,29 +25,31 @@ typedef struct loop {
     int said_pinhole;            /* the stand-in pinhole for the scene's camera was announced */
 } loop;
 
-/* What a frame's camera and sun are made of: a frame whose pose equals the last one's is still. */
+/* What a frame's camera and sun are made of, as numbers: a frame whose pose equals the last
+ * one's is still. */
+#define VIEW_POSE_N 18
 typedef struct view_pose {
-    double v[12];
-    atmos_utc_time time;
+    double v[VIEW_POSE_N];
 } view_pose;
 
 static view_pose view_pose_of(const view_state *s)
 {
-    view_pose p;
-    memset(&p, 0, sizeof p);
-    const double v[12] = {s->pos[0], s->pos[1],  s->pos[2],           s->yaw_deg, s->pitch_deg, s->fov_deg,
-                          s->pinhole_fov_deg, s->sun_el, s->sun_az, s->sun_from_time, s->lat, s->lon};
-    memcpy(p.v, v, sizeof v);
-    if (s->sun_from_time) p.time = s->time;
+    const atmos_utc_time *t = &s->time;
+    const int timed = s->sun_from_time != 0;
+    const view_pose p = {{s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, s->fov_deg, s->pinhole_fov_deg,
+                          s->sun_el, s->sun_az, timed, s->lat, s->lon, timed ? t->year : 0, timed ? t->month : 0,
+                          timed ? t->day : 0, timed ? t->hour : 0, timed ? t->minute : 0, timed ? t->second : 0}};
     return p;
 }
 
 /* 1 when the state's camera or sun differs from the pose's (a scripted flight marks them changed
- * every frame, a key that cannot act further changes nothing). */
+ * every frame; a key that cannot act further changes nothing). */
 static int view_moved(const view_pose *last, const view_state *s)
 {
     const view_pose now = view_pose_of(s);
-    return memcmp(last, &now, sizeof now) != 0;
+    for (int i = 0; i < VIEW_POSE_N; i++)
+        if (now.v[i] != last->v[i]) return 1;
+    return 0;
 }
 
 static void drop_plans(loop *L)
