@@ -3,7 +3,8 @@
 # flight of N + 1 frames less those of 1 frame, over N, so that making the plan and the first
 # frame's light passes are left out; steadier than wall times on a shared machine.
 #
-#   bench/viewer/cpu.sh [--atmos BIN] [--cases "field inside slice"] [--frames N]
+#   bench/viewer/cpu.sh [--atmos BIN] [--cases "field inside slice slice_full"] [--frames N]
+# (slice: the preview frames of a moving sun, --preview; slice_full: full renders)
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -32,7 +33,8 @@ for c in $CASES; do
     field) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 ;;
     million) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 --spacing 19.7 ;;
     inside) set -- scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 1280x720 ;;
-    slice) set -- scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 512x512 ;;
+    slice) set -- scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 512x512 --preview ;;
+    slice_full) set -- scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 512x512 ;;
     *) echo "cpu.sh: unknown case $c" >&2; exit 2 ;;
     esac
     scene=$1 flight=$2 size=$3

@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
 """The 8-bit display values of two recorded flights (atmos view --record DIR), frame by frame:
-the frames whose pixels are identical, the largest difference in levels of 255 and the share
-of values that differ. Metadata (the PNGs' text chunks) is ignored.
+the frames whose pixels are identical, the largest difference in levels of 255, the share of
+values that differ, the mean difference (levels, over every colour value of every frame) and the
+largest frame's mean. Two PNG files instead of two folders compare those two images. Metadata
+(the PNGs' text chunks) and alpha are ignored.
 
     bench/viewer/pngdiff.py DIR_A DIR_B
+    bench/viewer/pngdiff.py A.png B.png
 """
 import glob, os, struct, sys, zlib
 
@@ -38,17 +41,28 @@ def pixels(path):
                 line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
         out += line
         prev = line
+    if bpp == 4 * depth // 8:  # RGBA: the colour values only
+        del out[3::4]
     return out
 
 
 same = worst = differ = total = 0
-files = sorted(glob.glob(os.path.join(sys.argv[1], "frame_*.png")))
-for fa in files:
-    a, b = pixels(fa), pixels(os.path.join(sys.argv[2], os.path.basename(fa)))
+sum_d = frame_mean = 0.0
+if os.path.isdir(sys.argv[1]):
+    pairs = [(fa, os.path.join(sys.argv[2], os.path.basename(fa)))
+             for fa in sorted(glob.glob(os.path.join(sys.argv[1], "frame_*.png")))]
+else:
+    pairs = [(sys.argv[1], sys.argv[2])]
+for fa, fb in pairs:
+    a, b = pixels(fa), pixels(fb)
+    if len(a) != len(b):
+        sys.exit("pngdiff: %s and %s differ in size" % (fa, fb))
     d = [abs(x - y) for x, y in zip(a, b)]
     same += max(d) == 0
     worst = max(worst, max(d))
     differ += sum(1 for v in d if v)
     total += len(d)
-print("frames=%d identical=%d largest_difference=%d differing_values=%.2g" % (len(files), same, worst,
-                                                                               differ / max(1, total)))
+    sum_d += sum(d)
+    frame_mean = max(frame_mean, sum(d) / len(d))
+print("frames=%d identical=%d largest_difference=%d differing_values=%.2g mean_difference=%.3f "
+      "largest_frame_mean=%.3f" % (len(pairs), same, worst, differ / max(1, total), sum_d / max(1, total), frame_mean))

@@ -2,7 +2,7 @@
 # The viewer's frame rates (docs/viewer.md, issue 16's benchmark goals): recorded flights played
 # headless, one line per case with the median frame and the slowest 1 % as frames a second.
 #
-#   bench/viewer/run.sh [--atmos BIN] [--cases "field million inside slice"] [--frames N] [--out DIR]
+#   bench/viewer/run.sh [--atmos BIN] [--cases "field million inside slice slice_full"] [--frames N] [--out DIR]
 #
 # The cases (1280x720 unless said):
 #   field    scenes/harris_cloud_field.json (120 clouds, 99 101 particles) along
@@ -12,7 +12,9 @@
 #   inside   scenes/harris_fly_through.json's cumulus, the eye inside it all along
 #            (bench/viewer/inside_cumulus.json), 240 frames; goal 30 fps
 #   slice    scenes/fig14_interactive_storm.json at 512x512, the sun moving every frame
-#            (bench/viewer/storm_sun.json), 120 frames; goal 10 fps
+#            (bench/viewer/storm_sun.json), 120 frames, rendered as an interactive session
+#            renders a moving sun (--preview: the slice renderer's preview); goal 10 fps
+#   slice_full  the same flight with every frame the full render (no --preview)
 #   aircraft scenes/harris_aircraft.json (an aircraft inside a cumulus: impostor splitting)
 #            along scenes/flights/harris_aircraft.json, 120 frames
 #   aircraft_none  the same cumulus and flight without the aircraft (what splitting costs)
@@ -26,7 +28,7 @@ set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 ATMOS=$root/build/atmos
-CASES="field million inside slice aircraft aircraft_none"
+CASES="field million inside slice slice_full aircraft aircraft_none"
 FRAMES=
 OUT=${TMPDIR:-/tmp}/atmos-viewer-bench
 while [ $# -gt 0 ]; do
@@ -69,7 +71,8 @@ for c in $CASES; do
     million) run_case million scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 240 1280x720 \
         --spacing 19.7 ;;
     inside) run_case inside scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 240 1280x720 ;;
-    slice) run_case slice scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 120 512x512 ;;
+    slice) run_case slice scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 120 512x512 --preview ;;
+    slice_full) run_case slice_full scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 120 512x512 ;;
     aircraft) run_case aircraft scenes/harris_aircraft.json scenes/flights/harris_aircraft.json 120 1280x720 ;;
     aircraft_none)
         python3 -c 'import json, sys; s = json.load(open(sys.argv[1])); del s["objects"]; json.dump(s, open(sys.argv[2], "w"))' \

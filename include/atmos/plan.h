@@ -66,6 +66,9 @@ typedef struct atmos_frame {
     int spp;                    /* path tracer: samples per pixel to reach (progressive), 1..ATMOS_PATH_MAX_SPP */
     int slices;                 /* slice renderer: sampling planes, 0 = the scene's */
     double eye_scale;           /* slice renderer: eye buffer scale in (0, 1], 0 = the scene's */
+    int light_size;             /* slice renderer: the light buffer's side in texels for this frame, at most
+                                   the scene's "light_size" (a larger one is the scene's), 0 = the scene's:
+                                   the viewer's preview while the sun moves */
     int sky_step;               /* the sky behind the volume evaluated every sky_step pixels, 1..16, and read
                                    bilinearly where it is smooth (pinhole cameras, one sample a pixel;
                                    docs/viewer.md): the viewer's frames; 0 or 1 = every pixel */
@@ -75,6 +78,11 @@ typedef struct atmos_frame {
                                    sun's (2-3 times faster, but the image then depends on the frames before it
                                    to the solver's tolerance: the viewer); 0 builds it afresh, so that a frame
                                    is the same however it was reached (renders, animations, MPI ranks) */
+    int hold_field;             /* slice renderer: 1 keeps the diffuse field of the last sun it was solved for
+                                   when the sun moved (no solve this frame; solved when the plan has none):
+                                   the viewer's preview while the sun moves. The next frame without it
+                                   solves the field for its sun (warm_field decides how), so that frame is
+                                   the one it would have been without the held frames before it; 0 */
     int impostor_budget;        /* Harris's renderer: at most this many impostors made again this frame, the
                                    most out of date first, the others drawn as they are until a later frame
                                    (the viewer's frames: the updates spread over frames); impostors never

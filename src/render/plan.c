@@ -257,9 +257,14 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
     v->spp = f->spp ? f->spp : p->scene.path.spp;
     v->slices = f->slices ? f->slices : p->scene.slice.slices;
     v->eye_scale = f->eye_scale != 0 ? f->eye_scale : p->scene.slice.eye_scale;
+    v->light_size = f->light_size;
+    if (f->light_size < 0 || f->light_size > 8192)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: light_size must be in [0, 8192] (0: the scene's), got %d",
+                            f->light_size);
     v->sky_step = f->sky_step > 1 ? f->sky_step : 1;
     v->no_air_shadows = f->no_air_shadows != 0;
     v->warm_field = f->warm_field != 0;
+    v->hold_field = f->hold_field != 0;
     v->impostor_budget = f->impostor_budget;
     if (f->impostor_budget < 0)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: impostor_budget must be >= 0 (0: no limit), got %d",
@@ -299,7 +304,9 @@ static int same_view(const atmos__view *a, const atmos__view *b)
 {
     return !memcmp(&a->cam, &b->cam, sizeof a->cam) && !memcmp(a->sun, b->sun, sizeof a->sun) &&
            a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale &&
-           a->sky_step == b->sky_step && a->no_air_shadows == b->no_air_shadows;
+           a->light_size == b->light_size &&
+           a->sky_step == b->sky_step && a->no_air_shadows == b->no_air_shadows &&
+           a->hold_field == b->hold_field;
 }
 
 static int rect_inside(const atmos__rect *a, const atmos__rect *b)

@@ -34,7 +34,7 @@ static void sunlight_at(const atmos_atmosphere *atm, const atmos__vol_xform *x, 
 /* The light frame of the sun direction sun_w (slight), kept until the sun moves: the buffer's
  * axes and extent across the light, and per texel where its ray crosses the box and the
  * sunlight entering there (Eq. 12, at the point where the ray enters the box). */
-static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, const double sun_w[3], int threads)
+static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, const double sun_w[3], int L, int threads)
 {
     slight *lf = &sp->light;
     const sgrid *g = &sp->g;
@@ -54,7 +54,8 @@ static void light_frame(atmos__slice_plan *sp, const atmos_atmosphere *atm, cons
         umin = fmin(umin, uv), umax = fmax(umax, uv);
         vmin = fmin(vmin, vv), vmax = fmax(vmax, vv);
     }
-    const int L = sp->L, n = sp->n;
+    const int n = sp->n;
+    lf->L = L;
     lf->u0 = umin, lf->v0 = vmin;
     lf->du = (umax - umin) / L, lf->dv = (vmax - vmin) / L;
     if (!(lf->du > 0)) lf->du = 1;
@@ -156,7 +157,7 @@ static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob
     j->n = sp->n, j->nf = sp->nf;
     /* The eye buffer: the image, or eye_scale of it per axis (eye pixel x covers image
      * pixels x sx .. (x + 1) sx; its ray goes through the centre of that area). */
-    j->W = cam->width, j->H = cam->height, j->L = sp->L;
+    j->W = cam->width, j->H = cam->height, j->L = lf->L;
     j->sx = j->sy = 1.0;
     if (v->eye_scale < 1.0) {
         int we = (int)lround(v->eye_scale * cam->width), he = (int)lround(v->eye_scale * cam->height);
@@ -349,7 +350,10 @@ atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp,
     const int threads = atmos__threads(ctx);
     memset(j, 0, sizeof *j);
     sp->sunlight_s = 0;
-    if (!sp->light.valid || memcmp(sp->light.sun, v->sun, sizeof v->sun) != 0) light_frame(sp, atm, v->sun, threads);
+    /* a frame's smaller light buffer (the viewer's preview) fits in the plan's */
+    const int L = v->light_size > 0 && v->light_size < sp->L ? v->light_size : sp->L;
+    if (!sp->light.valid || sp->light.L != L || memcmp(sp->light.sun, v->sun, sizeof v->sun) != 0)
+        light_frame(sp, atm, v->sun, L, threads);
     int needed = 0;
     job_geometry(sp, v, j, &needed);
     if (needed > j->nslices)

@@ -84,6 +84,7 @@ typedef struct {
 typedef struct {
     int valid;
     double sun[3];
+    int L;                       /* the buffer's side: the plan's, or a frame's smaller one */
     double lt[3], e1[3], e2[3];
     double u0, v0, du, dv;
     double *ta, *tb;

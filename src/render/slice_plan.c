@@ -119,8 +119,12 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
         const double t_setup = atmos__now();
         if ((st = atmos__slice_frame_setup(ctx, sp, p->atm, v, r, &j)) != ATMOS_OK) return st;
         if (sp->diffuse) {
-            int built;
-            if ((st = atmos__dfield_update(ctx, &sp->df, p->atm, v->sun, v->warm_field, 0, &built)) != ATMOS_OK) return st;
+            int built = 0;
+            /* held (the viewer's preview while the sun moves): the last solved sun's field, not
+             * solved again; the next frame without hold_field solves it for its sun */
+            if ((!v->hold_field || !sp->df.field.valid) &&
+                (st = atmos__dfield_update(ctx, &sp->df, p->atm, v->sun, v->warm_field, 0, &built)) != ATMOS_OK)
+                return st;
             j.field = &sp->df.field;
             j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->df.fg;
             double eu[3]; /* the eye in render-voxel coordinates */

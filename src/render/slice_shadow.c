@@ -72,7 +72,7 @@ static int shadow_build(atmos__slice_plan *sp, int threads)
     sh->N = N, sh->D = D;
     memcpy(sh->lt, lf->lt, sizeof sh->lt), memcpy(sh->e1, lf->e1, sizeof sh->e1), memcpy(sh->e2, lf->e2, sizeof sh->e2);
     sh->u0 = lf->u0, sh->v0 = lf->v0;
-    sh->du = lf->du * sp->L / N, sh->dv = lf->dv * sp->L / N;
+    sh->du = lf->du * lf->L / N, sh->dv = lf->dv * lf->L / N;
     double wmin = INFINITY, wmax = -INFINITY;
     for (int c = 0; c < 8; c++) {
         const double p[3] = {c & 1 ? g->box_hi[0] : g->box_lo[0], c & 2 ? g->box_hi[1] : g->box_lo[1],

@@ -131,9 +131,9 @@ typedef struct view_recorder {
 /* Makes the folder DIR (if missing). */
 int view_record_open(view_recorder *r, const char *dir);
 /* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv (the
- * file and its header made with the first frame). */
+ * file and its header made with the first frame; preview: 1 for a moving view's preview). */
 int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms,
-                      const char *renderer, int impostor_updates, const view_state *s);
+                      const char *renderer, int impostor_updates, int preview, const view_state *s);
 int view_record_close(view_recorder *r);
 /* Saves the current view: BASE.exr (linear sRGB), BASE.png (what is shown), BASE.json (the
  * scene that renders the same image with `atmos render BASE.json`). scene_json: the text of
@@ -165,6 +165,8 @@ void view_window_push_key(view_window *win, int sym);
 typedef struct view_opts {
     int width, height, frames, headless;
     int impostor_budget; /* Harris's impostors made again a frame at most (0: all stale ones) */
+    int preview;         /* --preview: scripted frames previewed while the camera or the sun moves
+                            and refined when still, as an interactive session's are */
     const char *script, *record, *save_base, *press;
     int passed;          /* arguments left for atmos render's parser */
     char **pass;

@@ -20,13 +20,16 @@ static void help(void)
 {
     printf("Usage: atmos view [SCENE.json] [--volume FILE|generate:PRESET] [--size WxH] [--script FLIGHT.json]\n"
            "                  [--frames N] [--record DIR] [--headless] [--press KEYS] [--save-base BASE]\n"
-           "                  [--impostor-budget N] [atmos render's scene options]\n\n"
+           "                  [--impostor-budget N] [--preview] [atmos render's scene options]\n\n"
            "Opens a window on a scene (or the built-in default; a volume with --volume) and renders it\n"
            "with atmos's renderers on the CPU as you fly around it, move the sun or scrub the time of\n"
            "day. The renderers keep their plans: a frame recomputes only what changed. While the\n"
-           "camera or the sun moves the slice renderer draws at half resolution and the path tracer\n"
-           "one sample per pixel; when still, the full quality, and the path tracer keeps adding\n"
-           "samples up to the scene's budget (\"path\": {\"spp\": N}).\n\n"
+           "camera or the sun moves the slice renderer draws a preview (half resolution, 48 slices,\n"
+           "half the light buffer's side, no shadows on the air, the diffuse field of the sun before\n"
+           "the move) and the path tracer one sample per pixel; the first still frame is the full\n"
+           "render (the slice renderer's the same as atmos render's), and the path tracer keeps\n"
+           "adding samples up to the scene's budget (\"path\": {\"spp\": N}). Scripted frames\n"
+           "(--script, --frames) are full renders unless --preview.\n\n"
            "Options:\n"
            "  --size WxH         the rendered frame's size (default 960x540; the window scales it)\n"
            "  --script FILE      play a flight: {\"fps\": 24, \"keys\": [{\"t\": 0, \"position_m\": [x, y, z],\n"
@@ -45,6 +48,8 @@ static void help(void)
            "                     most out of date first; the others are drawn as they are and caught up\n"
            "                     over the next frames (default 2; 0: all of them every frame, as F12's\n"
            "                     saves and atmos render do)\n"
+           "  --preview          scripted frames too: previews while the camera or the sun moves, the\n"
+           "                     full render when still (as an interactive session)\n"
            "  --help             this text\n"
            "Scene options are atmos render's (atmos render --help): --renderer, --volume, --sun-elevation,\n"
            "--time, --spp, -D KEY=VALUE, --threads, ...\n\n");
@@ -63,6 +68,7 @@ static int parse(int argc, char **argv, view_opts *o)
         const char *v = NULL;
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return help(), -1;
         if (!strcmp(argv[i], "--headless")) o->headless = 1;
+        else if (!strcmp(argv[i], "--preview")) o->preview = 1;
         else if (cli_take_value(argc, argv, &i, "--size", &v)) {
             if (!v || sscanf(v, "%dx%d", &o->width, &o->height) != 2 || o->width < 1 || o->height < 1 ||
                 o->width > 8192 || o->height > 8192)

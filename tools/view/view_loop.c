@@ -25,6 +25,33 @@ typedef struct loop {
     int said_pinhole;            /* the stand-in pinhole for the scene's camera was announced */
 } loop;
 
+/* What a frame's camera and sun are made of, as numbers: a frame whose pose equals the last
+ * one's is still. */
+#define VIEW_POSE_N 18
+typedef struct view_pose {
+    double v[VIEW_POSE_N];
+} view_pose;
+
+static view_pose view_pose_of(const view_state *s)
+{
+    const atmos_utc_time *t = &s->time;
+    const int timed = s->sun_from_time != 0;
+    const view_pose p = {{s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, s->fov_deg, s->pinhole_fov_deg,
+                          s->sun_el, s->sun_az, timed, s->lat, s->lon, timed ? t->year : 0, timed ? t->month : 0,
+                          timed ? t->day : 0, timed ? t->hour : 0, timed ? t->minute : 0, timed ? t->second : 0}};
+    return p;
+}
+
+/* 1 when the state's camera or sun differs from the pose's (a scripted flight marks them changed
+ * every frame; a key that cannot act further changes nothing). */
+static int view_moved(const view_pose *last, const view_state *s)
+{
+    const view_pose now = view_pose_of(s);
+    for (int i = 0; i < VIEW_POSE_N; i++)
+        if (now.v[i] != last->v[i]) return 1;
+    return 0;
+}
+
 static void drop_plans(loop *L)
 {
     for (int k = 0; k <= ATMOS_RENDERER_LAST; k++) atmos_plan_destroy(L->plan[k]), L->plan[k] = NULL;
@@ -156,10 +183,34 @@ static void say_pinhole(loop *L, const view_state *s)
     L->said_pinhole = 1;
 }
 
-/* Renders the state's frame; preview: the reduced quality of a moving view; saving: the scene's
- * full quality. */
-static atmos_status render(loop *L, view_state *s, int preview, int saving, atmos_plan **pp)
+/* The slice renderer's preview while the camera or the sun moves: this many slices at most
+ * (the scene's own count when smaller), the eye buffer at half the scene's scale per axis and
+ * the light buffer at half the scene's side. */
+#define VIEW_PREVIEW_SLICES 48
+
+/* A frame's quality: the preview of a moving view; the full render of a still view in a session
+ * that previews (the slice renderer's equal to atmos render's: the sky at every pixel, the
+ * diffuse field solved afresh); a scripted frame without --preview (the scene's quality, the
+ * sky every VIEW_SKY_STEP pixels, the field warm-started); a save. */
+typedef enum { VIEW_PREVIEW, VIEW_STILL, VIEW_SCRIPTED, VIEW_SAVE } view_quality;
+
+/* The slice renderer's frame settings for a quality (f: the scene's frame). */
+static void slice_quality(atmos_frame *f, const atmos_scene *sc, view_quality q)
 {
+    if (q == VIEW_STILL) f->sky_step = 1, f->warm_field = 0;
+    if (q != VIEW_PREVIEW) return;
+    f->eye_scale = 0.5 * (f->eye_scale > 0 ? f->eye_scale : 1.0);
+    f->light_size = sc->slice.light_size / 2 > 16 ? sc->slice.light_size / 2 : sc->slice.light_size;
+    f->no_air_shadows = 1; /* the shadows on the air and ground come back when the view is still */
+    f->hold_field = 1;     /* the diffuse field of the sun before the move, solved when still */
+    const int scene_slices = f->slices > 0 ? f->slices : sc->slice.slices;
+    f->slices = scene_slices > 0 && scene_slices < VIEW_PREVIEW_SLICES ? scene_slices : VIEW_PREVIEW_SLICES;
+}
+
+/* Renders the state's frame at a quality. */
+static atmos_status render(loop *L, view_state *s, view_quality q, atmos_plan **pp)
+{
+    const int preview = q == VIEW_PREVIEW, saving = q == VIEW_SAVE;
     atmos_plan *p;
     atmos_status st = get_plan(L, s, &p);
     if (st != ATMOS_OK) return st;
@@ -169,10 +220,7 @@ static atmos_status render(loop *L, view_state *s, int preview, int saving, atmo
     say_pinhole(L, s);
     if (!saving) f.sky_step = VIEW_SKY_STEP, f.impostor_budget = L->impostor_budget;
     f.warm_field = !saving; /* a saved frame is the offline render's: its field built afresh */
-    if (s->renderer == ATMOS_RENDERER_SLICE && preview) {
-        f.eye_scale = 0.5 * (f.eye_scale > 0 ? f.eye_scale : 1.0);
-        f.no_air_shadows = 1; /* the shadows on the air and ground come back when the view is still */
-    }
+    if (s->renderer == ATMOS_RENDERER_SLICE) slice_quality(&f, L->sc, q);
     if (s->renderer == ATMOS_RENDERER_PATH) {
         const int full = L->sc->path.spp > 0 ? L->sc->path.spp : 64;
         L->spp = preview ? 1 : (L->spp < full ? L->spp + 1 : full);
@@ -193,7 +241,7 @@ static int save(loop *L, const view_opts *o, view_state *s, const char *text)
     const int keep_spp = L->spp;
     L->spp = 1 << 30; /* the scene's full budget */
     double ev;
-    atmos_status st = render(L, s, 0, 1, &p);
+    atmos_status st = render(L, s, VIEW_SAVE, &p);
     if (st == ATMOS_OK) st = display(L, p, s, 0, &ev);
     L->spp = keep_spp;
     if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
@@ -267,6 +315,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
     if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record);
     const int scripted = o->frames > 0 || o->script;
     double last_ms = 0.0;
+    view_pose pose = view_pose_of(&s);
     for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!o->frames || i < o->frames); i++) {
         const double t0 = cli_now_s();
         if (scripted) view_script_step(&script, &s, (i - 1) / script.fps, i / (script.fps > 0 ? script.fps : 24), i, o->frames);
@@ -276,10 +325,12 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
             for (int k = 0; k < n; k++) view_window_push_key(win, codes[k]);
         }
         if (win) view_window_events(win, &s, last_ms > 0 ? last_ms / 1000.0 : 1.0 / 30.0);
-        const int moving = (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && i > 0 && !scripted;
+        const int moving = i > 0 && (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && view_moved(&pose, &s);
         s.changes = 0;
+        pose = view_pose_of(&s);
         atmos_plan *p = NULL;
-        atmos_status st = render(&L, &s, moving, 0, &p);
+        const view_quality q = scripted && !o->preview ? VIEW_SCRIPTED : moving ? VIEW_PREVIEW : VIEW_STILL;
+        atmos_status st = render(&L, &s, q, &p);
         if (st == ATMOS_OK) st = display_frame(&L, p, &s, i == 0 || scripted, o->record || !win, win != NULL);
         if (st != ATMOS_OK) {
             rc = cli_runtime_error("view", ctx, st);
@@ -290,7 +341,8 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         overlay(&s, last_ms, lines);
         if (win && view_window_present(win, L.rgba, L.img->width, L.img->height, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
         last_ms = 1000.0 * (cli_now_s() - t0);
-        if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates, &s);
+        if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates,
+                                                      q == VIEW_PREVIEW, &s);
         /* a save that fails is said (save prints why) and the session goes on */
         if (rc == CLI_EXIT_OK && s.save && save(&L, o, &s, text) != CLI_EXIT_OK)
             fprintf(stderr, "atmos view: the frame was not saved; the session goes on\n");
