@@ -1,5 +1,6 @@
 /* The beam renderer's frame (Dobashi, Yamamoto and Nishita 2002 §4): per pixel, the sky
- * behind (dimmed by the fog), or the nearest object's Lambertian surface lit by every light
+ * behind (dimmed by the fog), or the nearest object's Lambertian surface (the triangle the
+ * meshes rasterised from the camera put there, beams_primary.h) lit by every light
  * it sees (Dobashi's I_b, attenuated by the fog on both legs) and by the sky (beams_sky.h),
  * plus per light the light the
  * fog scatters toward the eye (Eq. 2):
@@ -21,6 +22,7 @@
  * not depend on the thread count. */
 #include "render/beams_internal.h"
 #include "render/beams_interleave.h"
+#include "render/beams_primary.h"
 #include "render/beams_sky.h"
 #include "core/vec.h"
 
@@ -43,6 +45,7 @@ typedef struct job {
     int max_sub;
     int centre_planes, centre_subplanes;
     atmos__beams_sky sky; /* the sky's light on surfaces (none in a vacuum) */
+    const atmos__beams_primary *prim; /* what each pixel sees, rasterised (NULL: no objects) */
 } job;
 
 /* The object's surface at the eye's ray's hit, lit by the lights and the sky, dimmed on the way
@@ -209,7 +212,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
     atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
-    const int hit = atmos__objects_hit(&b->obj, J->eye, d, 0, INFINITY, &h, &m);
+    const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
     const double T = hit ? h.t : INFINITY;
     if (px) {
         const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, T)); /* 0 to the sky behind endless fog */
@@ -383,12 +386,21 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         return st;
     }
     atmos__beams_il il = {0}, *ilp = NULL;
+    atmos__beams_primary prim = {{0, 0, 0, 0}, NULL, NULL, 0};
     int failed = 0, cancelled = 0;
     if (p->scene.beams.interleave > 1) {
         ilp = &il;
         failed = atmos__beams_il_init(&il, p->scene.beams.interleave, J.nw, r, out->width, out->height);
     }
+    if (!failed && b->obj.n > 0) {
+        if ((st = atmos__beams_primary_build(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &prim)) != ATMOS_OK) {
+            atmos__beams_il_free(&il), atmos__beams_sky_free(&J.sky), free(J.z_lo), free(J.span);
+            return st;
+        }
+        J.prim = &prim;
+    }
     if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
+    atmos__beams_primary_free(&prim);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
     atmos__beams_sky_free(&J.sky);
