@@ -156,7 +156,7 @@ static void draw(band *B, const stri *s, const atmos__rect *r)
             for (int px = s->px0; px <= s->px1; px++) rival(B, (size_t)(py - B->y0) * W + (px - r->x0), z);
         return;
     }
-    const double sg = area > 0 ? 1 : -1, inv = 1.0 / fabs(area);
+    const double sg = area > 0 ? 1 : -1, inv = 1.0 / fabs(area), ilen[3] = {1 / len[0], 1 / len[1], 1 / len[2]};
     for (int py = ya; py <= yb; py++) {
         const double cy = py + 0.5;
         int pa, pb;
@@ -167,7 +167,8 @@ static void draw(band *B, const stri *s, const atmos__rect *r)
             for (int k = 0; k < 3; k++) {
                 const int i = (k + 1) % 3, j = (k + 2) % 3;
                 e[k] = sg * ((x[j] - x[i]) * (cy - y[i]) - (y[j] - y[i]) * (cx - x[i]));
-                dmin = fmin(dmin, e[k] / len[k]);
+                const double dk = e[k] * ilen[k];
+                dmin = dk < dmin ? dk : dmin;
             }
             if (dmin < -EDGE_PX) continue;
             const double z = 1.0 / ((e[0] * s->iz[0] + e[1] * s->iz[1] + e[2] * s->iz[2]) * inv);
