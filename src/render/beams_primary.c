@@ -148,7 +148,10 @@ static void draw(band *B, const stri *s, const atmos__rect *r)
     const double *x = s->x, *y = s->y;
     const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
     double len[3];
-    for (int k = 0; k < 3; k++) len[k] = hypot(x[(k + 2) % 3] - x[(k + 1) % 3], y[(k + 2) % 3] - y[(k + 1) % 3]);
+    for (int k = 0; k < 3; k++) {
+        const double ex = x[(k + 2) % 3] - x[(k + 1) % 3], ey = y[(k + 2) % 3] - y[(k + 1) % 3];
+        len[k] = sqrt(ex * ex + ey * ey);
+    }
     if (!(fabs(area) > 1e-9 * (len[0] + len[1] + len[2])) || !(len[0] > 0 && len[1] > 0 && len[2] > 0)) {
         /* edge-on: a rival over its box, as near as its nearest vertex */
         const double z = 1.0 / fmax(s->iz[0], fmax(s->iz[1], s->iz[2]));

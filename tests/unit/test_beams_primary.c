@@ -105,6 +105,11 @@ static void test_studio(void)
     CHECK(Q.traced == 48 * 48);
     atmos__beams_primary_free(&Q);
     atmos__beams_primary_free(&P);
+    /* the single-triangle test refuses a triangle out of range */
+    const double o[3] = {0, 5, 0}, down[3] = {0, -1, 0};
+    CHECK(!atmos_mesh_intersect_triangle(m[0], -1, o, down, 0, INFINITY, NULL));
+    CHECK(!atmos_mesh_intersect_triangle(m[0], m[0]->triangle_count, o, down, 0, INFINITY, NULL));
+    CHECK(!atmos_mesh_intersect_triangle(NULL, 0, o, down, 0, INFINITY, NULL));
     for (int i = 0; i < 5; i++) atmos_mesh_destroy(m[i]);
 }
 
