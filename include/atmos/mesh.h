@@ -105,6 +105,12 @@ typedef struct atmos_mesh_hit {
 ATMOS_API int atmos_mesh_intersect(const atmos_mesh *mesh, const double o[3], const double d[3], double tmin,
                                    double tmax, atmos_mesh_hit *hit);
 
+/* The same test against the one triangle tri of the mesh (0 <= tri < triangle_count): 1 and *hit
+ * if the ray meets it with t in (tmin, tmax), with the t and normal atmos_mesh_intersect gives
+ * when that triangle is the first hit. */
+ATMOS_API int atmos_mesh_intersect_triangle(const atmos_mesh *mesh, int tri, const double o[3], const double d[3],
+                                            double tmin, double tmax, atmos_mesh_hit *hit);
+
 #ifdef __cplusplus
 }
 #endif

@@ -208,3 +208,16 @@ int atmos_mesh_intersect(const atmos_mesh *m, const double o[3], const double d[
     }
     return 1;
 }
+
+int atmos_mesh_intersect_triangle(const atmos_mesh *m, int tri, const double o[3], const double d[3], double tmin,
+                                  double tmax, atmos_mesh_hit *hit)
+{
+    double t, u, v;
+    if (!m || tri < 0 || tri >= m->triangle_count || !hit_triangle(m, tri, o, d, &t, &u, &v) || !(t > tmin && t < tmax))
+        return 0;
+    if (hit) {
+        hit->t = t, hit->triangle = tri;
+        hit_normal(m, tri, u, v, d, hit->normal);
+    }
+    return 1;
+}

@@ -1,5 +1,6 @@
 /* The beam renderer's frame (Dobashi, Yamamoto and Nishita 2002 §4): per pixel, the sky
- * behind (dimmed by the fog), or the nearest object's Lambertian surface lit by every light
+ * behind (dimmed by the fog), or the nearest object's Lambertian surface (the triangle the
+ * meshes rasterised from the camera put there, beams_primary.h) lit by every light
  * it sees (Dobashi's I_b, attenuated by the fog on both legs) and by the sky (beams_sky.h),
  * plus per light the light the
  * fog scatters toward the eye (Eq. 2):
@@ -9,8 +10,9 @@
  *     look-ups of the pre-integrated table (f_l, Eq. 8-9; beams_table.c);
  *   - the visibility H and the spot's falloff (f_h, Eq. 10) are averaged over sub-planes
  *     between the planes, m_k of them where f_l could add more than epsilon of the pixel's
- *     unshadowed airlight (Dobashi §4.2.2's criterion, per pixel: m_k = ceil(f_l,k /
- *     (epsilon sum_k f_l,k)) up to max_subplanes), at the midpoints of m_k equal parts;
+ *     unshadowed airlight (Dobashi §4.2.2's criterion, per pixel over all its lights: m_k =
+ *     ceil(I_i f_l,k / (epsilon sum_j I_j sum_k f_l,k)) up to max_subplanes, I the lights' mean
+ *     intensities), at the midpoints of m_k equal parts;
  *   - the interval adds I f_h f_l (Eq. 6); an interval along which H cannot change (clear of
  *     every depth the shadow map's tiles there hold, or beyond them all) samples the falloff
  *     alone, or nothing when it is in shadow or inside the inner cone: the value its samples
@@ -21,6 +23,7 @@
  * not depend on the thread count. */
 #include "render/beams_internal.h"
 #include "render/beams_interleave.h"
+#include "render/beams_primary.h"
 #include "render/beams_sky.h"
 #include "core/vec.h"
 
@@ -38,11 +41,13 @@ typedef struct job {
     double fwd[3];
     int nw, cx, cy;
     double *z_lo, *dz, *reach; /* per light: the first plane's depth, the spacing, the sampled radius */
+    double *weight;            /* per light: its mean intensity over the wavelengths */
     int *span;                 /* per light and row: the columns [x0, x1) outside which its airlight is 0 */
     double epsilon;
     int max_sub;
     int centre_planes, centre_subplanes;
     atmos__beams_sky sky; /* the sky's light on surfaces (none in a vacuum) */
+    const atmos__beams_primary *prim; /* what each pixel sees, rasterised (NULL: no objects) */
 } job;
 
 /* The object's surface at the eye's ray's hit, lit by the lights and the sky, dimmed on the way
@@ -79,13 +84,13 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
 /* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
  * image's tint at every sample (so no interval is taken as uniform: its colour varies). */
 static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *ray, const double d[3], const double *f,
-                   int n, double S, double *L, int centre, double o)
+                   int n, double unit, double *L, int centre, double o)
 {
     double sum[3] = {0, 0, 0};
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
         if (fl <= 0) continue;
-        const double need = ceil(fl / (J->epsilon * S));
+        const double need = ceil(fl / unit);
         const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
         double h[3] = {0, 0, 0};
@@ -103,10 +108,11 @@ static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum[k < 3 ? k : 2];
 }
 
-/* Light i scattered toward the eye along [0, T) of the ray d, added to L; the samples between
- * two planes at offset o (0.5: the midpoints) of their parts. f holds room for
- * MAX_INTERVALS + 1 values. */
-static void airlight(job *J, int i, const double d[3], double T, double *f, double *L, int centre, double o)
+/* Light i's intervals along [0, T) of the ray d between the planes crossing it: f[2k] where
+ * interval k starts, f[2k + 1] its f_l (an unshadowed light of unit intensity), f[2n] where the
+ * last ends (f holds room for 2 MAX_INTERVALS + 1 values). Returns n (0: none), *sum the sum of
+ * the f_l. */
+static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre)
 {
     const atmos__beams_plan *b = J->b;
     const atmos__beams_light *l = &b->lights[i];
@@ -115,10 +121,11 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     const double tQ = atmos__dot3(Lp, d);
     const double q[3] = {Lp[0] - tQ * d[0], Lp[1] - tQ * d[1], Lp[2] - tQ * d[2]};
     const double v = atmos__maxd(sqrt(atmos__dot3(q, q)), 1e-6 * R);
-    if (v >= R) return;
+    *sum = 0;
+    if (v >= R) return 0;
     const double hh = sqrt(R * R - v * v);
     double t0 = atmos__maxd(0, tQ - hh), t1 = atmos__mind(T, tQ + hh);
-    if (!(t0 < t1) || !atmos__lamp_clip(&l->L, J->eye, d, &t0, &t1)) return;
+    if (!(t0 < t1) || !atmos__lamp_clip(&l->L, J->eye, d, &t0, &t1)) return 0;
     atmos__beams_column col;
     atmos__beams_table_column(&b->table, sig * v, &col);
     const double scale = exp(-sig * tQ) / v, cosf = atmos__dot3(d, J->fwd), dz = J->dz[i], zl = J->z_lo[i];
@@ -136,7 +143,18 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     }
     f[2 * n] = t1;
     if (centre) J->centre_planes += n;
-    if (!(S > 0)) return;
+    *sum = S;
+    return S > 0 ? n : 0;
+}
+
+/* Light i scattered toward the eye over its n intervals f (their f_l summing to S), added to
+ * L: an interval whose f_l exceeds unit (epsilon of the pixel's airlight, in this light's
+ * units) gets ceil(f_l / unit) sub-planes; the samples at offset o (0.5: the midpoints) of
+ * their parts. */
+static void airlight(job *J, int i, const double d[3], const double *f, int n, double S, double unit, double *L,
+                     int centre, double o)
+{
+    const atmos__beams_light *l = &J->b->lights[i];
     if (!l->nfaces && l->L.type == ATMOS_LIGHT_POINT) { /* H = 1 and no falloff: the sum is exact */
         for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * S;
         return;
@@ -144,14 +162,14 @@ static void airlight(job *J, int i, const double d[3], double T, double *f, doub
     atmos__beams_ray ray;
     atmos__beams_ray_init(l, J->eye, d, &ray);
     if (l->L.tex) {
-        tinted(J, l, &ray, d, f, n, S, L, centre, o);
+        tinted(J, l, &ray, d, f, n, unit, L, centre, o);
         return;
     }
     double sum = 0;
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
         if (fl <= 0) continue;
-        const double need = ceil(fl / (J->epsilon * S));
+        const double need = ceil(fl / unit);
         const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
         double h = 0, same = 0;
@@ -198,6 +216,31 @@ static int in_span(const job *J, int i, int x, int y)
     return x >= r[0] && x < r[1];
 }
 
+/* The doubles of a thread's buffer for lights(): each light's intervals, then their sums and counts. */
+#define LIGHT_STRIDE (2 * MAX_INTERVALS + 2)
+static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights : 1) * (LIGHT_STRIDE + 2); }
+
+/* Every light's airlight along [0, T) of the ray d through pixel (x, y) (the lights whose span
+ * holds it), added to L, with Dobashi's criterion over all the lights of the pixel (§4.2.2): an
+ * interval gets a sub-plane for every epsilon of the pixel's unshadowed airlight from all its
+ * lights (each light's f_l sum weighted by its mean intensity) that it could add, so a light
+ * whose airlight is a small share of the pixel's gets few; with one light, epsilon of its own. */
+static void lights(job *J, int x, int y, const double d[3], double T, double *f, double *L, int centre, double o)
+{
+    const int nl = J->b->nlights;
+    double *S = f + (size_t)nl * LIGHT_STRIDE, *cnt = S + nl, tot = 0;
+    int lit = 0;
+    for (int i = 0; i < nl; i++) {
+        cnt[i] = in_span(J, i, x, y) ? intervals(J, i, d, T, f + (size_t)i * LIGHT_STRIDE, &S[i], centre) : 0;
+        if (cnt[i] > 0) tot += J->weight[i] * S[i], lit++;
+    }
+    for (int i = 0; i < nl; i++)
+        if (cnt[i] > 0) {
+            const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
+            airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o);
+        }
+}
+
 /* Pixel (x, y): the surface or the sky behind, the lights' airlight and the sun's, into px.
  * With interleaved sampling (il) the lights' airlight goes to il instead, with what the pixel
  * sees; px NULL: a pixel outside the frame's rectangle that the filter reads, its airlight
@@ -209,7 +252,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
     atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
-    const int hit = atmos__objects_hit(&b->obj, J->eye, d, 0, INFINITY, &h, &m);
+    const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
     const double T = hit ? h.t : INFINITY;
     if (px) {
         const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, T)); /* 0 to the sky behind endless fog */
@@ -218,9 +261,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
             for (int k = 0; k < J->nw; k++) L[k] = px[k] * fog_t;
         if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         if (!il) {
-            if (b->sigma_t > 0)
-                for (int i = 0; i < b->nlights; i++)
-                    if (in_span(J, i, x, y)) airlight(J, i, d, T, f, L, x == J->cx && y == J->cy, 0.5);
+            if (b->sigma_t > 0) lights(J, x, y, d, T, f, L, x == J->cx && y == J->cy, 0.5);
             if (b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         }
         for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
@@ -229,9 +270,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     const long q = atmos__beams_il_index(il, x, y);
     const double o = atmos__beams_il_offset(il->n, x, y);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
-    if (b->sigma_t > 0)
-        for (int i = 0; i < b->nlights; i++)
-            if (in_span(J, i, x, y)) airlight(J, i, d, T, f, A, px && x == J->cx && y == J->cy, o);
+    if (b->sigma_t > 0) lights(J, x, y, d, T, f, A, px && x == J->cx && y == J->cy, o);
     for (int k = 0; k < J->nw; k++) il->air[(size_t)q * J->nw + k] = (float)A[k];
     il->depth[q] = (float)T, il->object[q] = hit ? m : -1;
 }
@@ -306,19 +345,20 @@ static void screen_spans(const job *J, const atmos__beams_light *l, double R, in
 static atmos_status planes(atmos_plan *p, job *J)
 {
     const atmos__beams_plan *b = J->b;
-    J->z_lo = malloc(sizeof(double) * 3 * (size_t)(b->nlights ? b->nlights : 1));
+    J->z_lo = malloc(sizeof(double) * 4 * (size_t)(b->nlights ? b->nlights : 1));
     J->span = malloc(sizeof(int) * 2 * (size_t)J->cam->height * (size_t)(b->nlights ? b->nlights : 1));
     if (!J->z_lo || !J->span) {
         free(J->z_lo), free(J->span);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     }
-    J->dz = J->z_lo + b->nlights, J->reach = J->dz + b->nlights;
+    J->dz = J->z_lo + b->nlights, J->reach = J->dz + b->nlights, J->weight = J->reach + b->nlights;
     for (int i = 0; i < b->nlights; i++) {
         const atmos__beams_light *l = &b->lights[i];
         const double R = b->sigma_t > 0 ? fmin(l->L.range, ATMOS__BEAMS_MAX_OPTICAL_RANGE / b->sigma_t) : l->L.range;
         const double Lp[3] = {l->L.pos[0] - J->eye[0], l->L.pos[1] - J->eye[1], l->L.pos[2] - J->eye[2]};
         const double given = p->scene.beams.plane_spacing_m;
-        J->reach[i] = R;
+        J->reach[i] = R, J->weight[i] = 0;
+        for (int k = 0; k < J->nw; k++) J->weight[i] += l->L.I[k] / J->nw;
         J->z_lo[i] = atmos__dot3(Lp, J->fwd) - R;
         J->dz[i] = fmax(given > 0 ? given : 2 * R / 40, 2 * R / (MAX_INTERVALS - 8));
         screen_spans(J, l, R, J->span + 2 * (size_t)i * J->cam->height);
@@ -336,7 +376,7 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
     int failed = 0, done = 0;
 #pragma omp parallel num_threads(atmos__threads(p->ctx))
     {
-        double *f = malloc(sizeof(double) * (2 * MAX_INTERVALS + 2));
+        double *f = malloc(sizeof(double) * buffer_size(J->b->nlights));
         if (!f) {
 #pragma omp atomic write
             failed = 1;
@@ -383,12 +423,21 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         return st;
     }
     atmos__beams_il il = {0}, *ilp = NULL;
+    atmos__beams_primary prim = {{0, 0, 0, 0}, NULL, NULL, 0};
     int failed = 0, cancelled = 0;
     if (p->scene.beams.interleave > 1) {
         ilp = &il;
         failed = atmos__beams_il_init(&il, p->scene.beams.interleave, J.nw, r, out->width, out->height);
     }
+    if (!failed && b->obj.n > 0) {
+        if ((st = atmos__beams_primary_build(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &prim)) != ATMOS_OK) {
+            atmos__beams_il_free(&il), atmos__beams_sky_free(&J.sky), free(J.z_lo), free(J.span);
+            return st;
+        }
+        J.prim = &prim;
+    }
     if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
+    atmos__beams_primary_free(&prim);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
     atmos__beams_sky_free(&J.sky);
