@@ -17,6 +17,7 @@ typedef struct atmos__view {
     int no_air_shadows;        /* slice renderer: the volume's shadow on the air left out this frame */
     int warm_field;            /* slice renderer: the diffuse field warm-started from the last sun's */
     int impostor_budget;       /* Harris's renderer: impostors made again this frame at most (0: all stale) */
+    double screen_layer_px;    /* Harris's renderer: the screen-sized impostor's coarser layers (0: none) */
 } atmos__view;
 
 /* A region clipped to the image: [x0, x1) x [y0, y1), never empty unless the image is. */

@@ -165,6 +165,7 @@ void view_window_push_key(view_window *win, int sym);
 typedef struct view_opts {
     int width, height, frames, headless;
     int impostor_budget; /* Harris's impostors made again a frame at most (0: all stale ones) */
+    double screen_layer_px; /* Harris's cloud holding the eye: atmos_frame.screen_layer_px (0: off) */
     const char *script, *record, *save_base, *press;
     int passed;          /* arguments left for atmos render's parser */
     char **pass;
