@@ -47,7 +47,7 @@ static void help(void)
            "                     saves and atmos render do)\n"
            "  --screen-layer-px PX  Harris's renderer, the eye inside a cloud: its near particles, whose\n"
            "                     splats are large, drawn in coarser layers where each is still PX pixels\n"
-           "                     in radius (default 8; 0: all at the 1/4 resolution F12 and atmos render\n"
+           "                     in radius (default 4; 0: all at the 1/4 resolution F12 and atmos render\n"
            "                     draw them at)\n"
            "  --help             this text\n"
            "Scene options are atmos render's (atmos render --help): --renderer, --volume, --sun-elevation,\n"
@@ -59,7 +59,7 @@ static void help(void)
 static int parse(int argc, char **argv, view_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->width = 960, o->height = 540, o->impostor_budget = 2, o->screen_layer_px = 8;
+    o->width = 960, o->height = 540, o->impostor_budget = 2, o->screen_layer_px = 4;
     o->pass = calloc((size_t)argc + 1, sizeof *o->pass);
     if (!o->pass) return CLI_EXIT_RUNTIME;
     o->pass[o->passed++] = argv[0];
