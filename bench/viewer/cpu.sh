@@ -3,7 +3,7 @@
 # flight of N + 1 frames less those of 1 frame, over N, so that making the plan and the first
 # frame's light passes are left out; steadier than wall times on a shared machine.
 #
-#   bench/viewer/cpu.sh [--atmos BIN] [--cases "field inside slice slice_full"] [--frames N]
+#   bench/viewer/cpu.sh [--atmos BIN] [--cases "field inside slice slice_full"] [--frames N] [--opts "VIEW OPTIONS"]
 # (slice: the preview frames of a moving sun, --preview; slice_full: full renders)
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -11,10 +11,12 @@ root=$(cd "$here/../.." && pwd)
 ATMOS=$root/build/atmos
 CASES="field inside slice"
 N=48
+OPTS=
 while [ $# -gt 0 ]; do
     case "$1" in
     --atmos) ATMOS=$2; shift 2 ;;
     --cases) CASES=$2; shift 2 ;;
+    --opts) OPTS=$2; shift 2 ;;
     --frames) N=$2; shift 2 ;;
     *) echo "cpu.sh: unknown option $1" >&2; exit 2 ;;
     esac
@@ -25,7 +27,7 @@ cpu() { # scene flight size frames [extra options]
     scene=$1 flight=$2 size=$3 n=$4
     shift 4
     (cd "$root" && /usr/bin/time -f "%U %S" -o "$tmp" "$ATMOS" view "$scene" --script "$flight" --frames "$n" \
-        --headless --size "$size" -q "$@" >/dev/null 2>&1)
+        --headless --size "$size" -q $OPTS "$@" >/dev/null 2>&1)
     awk '{print $1 + $2}' "$tmp"
 }
 for c in $CASES; do

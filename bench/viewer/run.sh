@@ -3,6 +3,7 @@
 # headless, one line per case with the median frame and the slowest 1 % as frames a second.
 #
 #   bench/viewer/run.sh [--atmos BIN] [--cases "field million inside slice slice_full"] [--frames N] [--out DIR]
+#                       [--opts "VIEW OPTIONS"]  (atmos view options for every case, e.g. "--screen-layer-px 0")
 #
 # The cases (1280x720 unless said):
 #   field    scenes/harris_cloud_field.json (120 clouds, 99 101 particles) along
@@ -30,11 +31,13 @@ root=$(cd "$here/../.." && pwd)
 ATMOS=$root/build/atmos
 CASES="field million inside slice slice_full aircraft aircraft_none"
 FRAMES=
+OPTS=
 OUT=${TMPDIR:-/tmp}/atmos-viewer-bench
 while [ $# -gt 0 ]; do
     case "$1" in
     --atmos) ATMOS=$2; shift 2 ;;
     --cases) CASES=$2; shift 2 ;;
+    --opts) OPTS=$2; shift 2 ;;
     --frames) FRAMES=$2; shift 2 ;;
     --out) OUT=$2; shift 2 ;;
     *) echo "run.sh: unknown option $1" >&2; exit 2 ;;
@@ -48,7 +51,7 @@ run_case() { # name scene flight frames size [extra options]
     load=$(cut -d' ' -f1 /proc/loadavg)
     rm -rf "$OUT/$name"
     (cd "$root" && /usr/bin/time -f "%U %S" -o "$OUT/$name.cpu" "$ATMOS" view "$scene" --script "$flight" \
-        --frames "$n" --headless --size "$size" --record "$OUT/$name" -q "$@")
+        --frames "$n" --headless --size "$size" --record "$OUT/$name" -q $OPTS "$@")
     python3 - "$OUT/$name/frames.csv" "$name" "$size" "$load" "$OUT/$name.cpu" <<'PY'
 import csv, sys
 cpu = sum(float(x) for x in open(sys.argv[5]).read().split()[-2:])

@@ -87,6 +87,12 @@ typedef struct atmos_frame {
                                    most out of date first, the others drawn as they are until a later frame
                                    (the viewer's frames: the updates spread over frames); impostors never
                                    made and a split cloud's parts always made; 0 = every stale one */
+    double screen_layer_px;     /* Harris's renderer, a cloud holding the eye (drawn as a screen-sized impostor
+                                   at 1/4 of the frame's resolution): > 0 splats its nearer particles into up
+                                   to three coarser depth layers (1/8, 1/16, 1/32), a particle at the
+                                   coarsest whose splat is still this many of its pixels in radius, laid over
+                                   the 1/4 one bilinearly (the viewer's frames; docs/viewer.md); 0 = every
+                                   particle at 1/4, as atmos render draws; else in [1, 1000] */
     atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
 } atmos_frame;
 

@@ -44,6 +44,31 @@ static inline double atmos__pcloud_peak(double mean, double h, double s)
     return mean * h * h * h / (0.9707091134651118 * 15.749609945722419 * s * s * s);
 }
 
+/* Lays texel coordinates (tx, ty) of the w x h texture tex (C channels: colour, coverage),
+ * read bilinearly, over pixel px: px (1 - coverage) + colour. */
+static inline void atmos__pcloud_over(const float *tex, int w, int h, int C, double tx, double ty, float *px)
+{
+    tx = tx > 0.0 ? (tx < w - 1.001 ? tx : w - 1.001) : 0.0, ty = ty > 0.0 ? (ty < h - 1.001 ? ty : h - 1.001) : 0.0;
+    const int i0 = (int)tx, j0 = (int)ty;
+    const double ax = tx - i0, ay = ty - j0;
+    const float *t00 = tex + ((size_t)j0 * w + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)w * C, *t11 = t10 + C;
+    if (C == 4) { /* three wavelengths and coverage: in single precision, the four as one vector */
+        const float bx = (float)ax, by = (float)ay;
+        float q[4];
+        for (int k = 0; k < 4; k++) q[k] = (1 - by) * ((1 - bx) * t00[k] + bx * t01[k]) + by * ((1 - bx) * t10[k] + bx * t11[k]);
+        const float keep4 = 1.0f - q[3];
+        for (int k = 0; k < 3; k++) px[k] = px[k] * keep4 + q[k];
+        px[3] = 1.0f - (1.0f - px[3]) * keep4;
+        return;
+    }
+    float v[ATMOS_MAX_WAVELENGTHS + 1] = {0};
+    for (int k = 0; k < C; k++)
+        v[k] = (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
+    const float keep = 1.0f - v[C - 1];
+    for (int k = 0; k < C - 1; k++) px[k] = px[k] * keep + v[k];
+    px[C - 1] = 1.0f - (1.0f - px[C - 1]) * keep;
+}
+
 typedef struct atmos__pcloud {
     int n, cap;
     float *x, *y, *z;     /* centres, m (world) */
@@ -213,11 +238,16 @@ atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, con
 void atmos__pimpostor_draw(atmos_context *ctx, int n, const atmos__pimpostor *const *ims, const double *const *c,
                            const double *r, const atmos_camera *cam, const int rect[4], atmos_image *img);
 void atmos__pimpostor_free(atmos__pimpostor *im);
-/* Harris §3.1, the head in the clouds: the particles idx[0..nidx) splatted into an image of
- * 1/factor of cam's pixels per axis (the same view), then laid over img within rect, read
- * bilinearly: pixel (1 - coverage) + colour. */
+
+/* ---- pinside.c: Harris §3.1, the head in the clouds */
+/* The particles idx[0..nidx) splatted into an image of 1/factor of cam's pixels (a pinhole) per
+ * axis (the same view), then laid over img within rect, read bilinearly: pixel (1 - coverage) +
+ * colour. layer_px > 0: the particles nearer than where a splat of the narrowest one spans
+ * layer_px pixels of an image 2, 4 or 8 times coarser still are splatted into that image (depth
+ * bands, so each layer lies wholly in front of the ones behind it), laid over the 1/factor one
+ * bilinearly, nearest last. 0: every particle at 1/factor. */
 atmos_status atmos__pimpostor_screen(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
                                      const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
-                                     int factor, const int rect[4], atmos_image *img);
+                                     int factor, double layer_px, const int rect[4], atmos_image *img);
 
 #endif

@@ -73,31 +73,6 @@ atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, con
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* Lays texel coordinates (tx, ty) of the w x h texture tex (C channels: colour, coverage),
- * read bilinearly, over pixel px: px (1 - coverage) + colour. */
-static void over(const float *tex, int w, int h, int C, double tx, double ty, float *px)
-{
-    tx = tx > 0.0 ? (tx < w - 1.001 ? tx : w - 1.001) : 0.0, ty = ty > 0.0 ? (ty < h - 1.001 ? ty : h - 1.001) : 0.0;
-    const int i0 = (int)tx, j0 = (int)ty;
-    const double ax = tx - i0, ay = ty - j0;
-    const float *t00 = tex + ((size_t)j0 * w + i0) * C, *t01 = t00 + C, *t10 = t00 + (size_t)w * C, *t11 = t10 + C;
-    if (C == 4) { /* three wavelengths and coverage: in single precision, the four as one vector */
-        const float bx = (float)ax, by = (float)ay;
-        float q[4];
-        for (int k = 0; k < 4; k++) q[k] = (1 - by) * ((1 - bx) * t00[k] + bx * t01[k]) + by * ((1 - bx) * t10[k] + bx * t11[k]);
-        const float keep4 = 1.0f - q[3];
-        for (int k = 0; k < 3; k++) px[k] = px[k] * keep4 + q[k];
-        px[3] = 1.0f - (1.0f - px[3]) * keep4;
-        return;
-    }
-    float v[ATMOS_MAX_WAVELENGTHS + 1] = {0};
-    for (int k = 0; k < C; k++)
-        v[k] = (float)((1 - ay) * ((1 - ax) * t00[k] + ax * t01[k]) + ay * ((1 - ax) * t10[k] + ax * t11[k]));
-    const float keep = 1.0f - v[C - 1];
-    for (int k = 0; k < C - 1; k++) px[k] = px[k] * keep + v[k];
-    px[C - 1] = 1.0f - (1.0f - px[C - 1]) * keep;
-}
-
 /* Pixel row y of the frame: the impostor over [x0, x1). The pixel's ray F + v U + u R meets
  * the impostor's plane (through c, normal nrm) at s = ce / (d . nrm) along it, and that point
  * seen from the impostor's camera is a quotient of functions linear in u: their coefficients
@@ -126,7 +101,7 @@ static void draw_row(const atmos__pimpostor *im, const double c[3], const double
         const double q = fk / Z, tx = 0.5 * R + q * (px + s * (bx + u * rx)) - 0.5,
                      ty = 0.5 * R - q * (py + s * (by + u * ry)) - 0.5;
         if (tx < -0.5 || ty < -0.5 || tx > R - 0.5 || ty > R - 0.5) continue;
-        over(im->img->pixels, R, R, C, tx, ty, img->pixels + ((size_t)y * cam->width + x) * C);
+        atmos__pcloud_over(im->img->pixels, R, R, C, tx, ty, img->pixels + ((size_t)y * cam->width + x) * C);
     }
 }
 
@@ -154,32 +129,6 @@ void atmos__pimpostor_draw(atmos_context *ctx, int n, const atmos__pimpostor *co
             for (int j = 0; j < m; j++)
                 if (y >= bb[j][2] && y < bb[j][3]) draw_row(ims[use[j]], c[use[j]], nrm[j], cam, y, bb[j][0], bb[j][1], img);
     }
-}
-
-atmos_status atmos__pimpostor_screen(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
-                                     const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
-                                     int factor, const int rect[4], atmos_image *img)
-{
-    const int w = (cam->width + factor - 1) / factor, h = (cam->height + factor - 1) / factor, C = img->channels;
-    atmos_camera small = *cam;
-    small.width = w, small.height = h;
-    /* the same field of view over the rounded-up size: the small image covers the frame */
-    small.tan_half_fov = cam->tan_half_fov * (double)h * factor / cam->height;
-    atmos_image *lo = NULL;
-    atmos_status st = atmos_image_create(ctx, w, h, C, &lo);
-    if (st != ATMOS_OK) return st;
-    memset(lo->pixels, 0, sizeof(float) * (size_t)w * h * C);
-    const int all[4] = {0, 0, w, h};
-    st = atmos__pcloud_splat(ctx, pc, o, L, idx, nidx, &small, all, lo, NULL);
-    if (st == ATMOS_OK) {
-#pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
-        for (int y = rect[1]; y < rect[3]; y++)
-            for (int x = rect[0]; x < rect[2]; x++)
-                over(lo->pixels, w, h, C, (x + 0.5) / factor - 0.5, (y + 0.5) / factor - 0.5,
-                     img->pixels + ((size_t)y * cam->width + x) * C);
-    }
-    atmos_image_destroy(lo);
-    return st;
 }
 
 void atmos__pimpostor_free(atmos__pimpostor *im)

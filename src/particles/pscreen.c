@@ -24,13 +24,14 @@ static int pinhole_box(const atmos_camera *cam, const double rel[3], double r, c
     double X = 0, Y = 0, Z = 0;
     for (int i = 0; i < 3; i++) X += rel[i] * cam->right[i], Y += rel[i] * cam->up[i], Z += rel[i] * cam->forward[i];
     if (Z <= r) return 0; /* behind the eye, or the eye inside the sphere */
-    const double W = cam->width, H = cam->height, f = H / (2.0 * cam->tan_half_fov);
-    const double px = 0.5 * W + f * X / Z, py = 0.5 * H - f * Y / Z;
-    /* the sphere's outline on the image lies within r f / sqrt(Z^2 - r^2) of the centre's image,
-     * stretched toward the edges: bound it by the projection of its box */
-    const double rp = f * r / sqrt(Z * Z - r * r) * (1.0 + (fabs(X) + fabs(Y) + r) / Z);
-    bb[0] = (int)fmax(rect[0], floor(px - rp)), bb[1] = (int)fmin(rect[2], ceil(px + rp));
-    bb[2] = (int)fmax(rect[1], floor(py - rp)), bb[3] = (int)fmin(rect[3], ceil(py + rp));
+    const double W = cam->width, H = cam->height, f = H / (2.0 * cam->tan_half_fov), den = Z * Z - r * r;
+    /* the sphere's outline exactly: the planes x = u z through the eye that touch it, |X - u Z| =
+     * r sqrt(1 + u^2), have u = (X Z -+ r sqrt(X^2 + Z^2 - r^2)) / (Z^2 - r^2); the same for y.
+     * A pixel more on each side for the rounding of the splat's own test. */
+    const double sx = r * sqrt(X * X + den), sy = r * sqrt(Y * Y + den);
+    const double u0 = (X * Z - sx) / den, u1 = (X * Z + sx) / den, v0 = (Y * Z - sy) / den, v1 = (Y * Z + sy) / den;
+    bb[0] = (int)fmax(rect[0], floor(0.5 * W + f * u0) - 1.0), bb[1] = (int)fmin(rect[2], ceil(0.5 * W + f * u1) + 1.0);
+    bb[2] = (int)fmax(rect[1], floor(0.5 * H - f * v1) - 1.0), bb[3] = (int)fmin(rect[3], ceil(0.5 * H - f * v0) + 1.0);
     *Zout = Z;
     return bb[0] < bb[1] && bb[2] < bb[3];
 }

@@ -172,7 +172,7 @@ static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos
     if (how == 2) { /* the head in the cloud (§3.1): a screen-sized impostor at 1/4 resolution */
         air(p, h, v, ap, idx, n);
         h->direct++, h->updates++;
-        return atmos__pimpostor_screen(p->ctx, &h->pc, &h->o, &L, idx, n, &v->cam, 4, rect, out);
+        return atmos__pimpostor_screen(p->ctx, &h->pc, &h->o, &L, idx, n, &v->cam, 4, v->screen_layer_px, rect, out);
     }
     return ATMOS_OK;
 }

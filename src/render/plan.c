@@ -266,6 +266,10 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
     v->warm_field = f->warm_field != 0;
     v->hold_field = f->hold_field != 0;
     v->impostor_budget = f->impostor_budget;
+    v->screen_layer_px = f->screen_layer_px;
+    if (!(f->screen_layer_px == 0 || (f->screen_layer_px >= 1 && f->screen_layer_px <= 1000)))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: screen_layer_px must be 0 (off) or in [1, 1000], got %g",
+                            f->screen_layer_px);
     if (f->impostor_budget < 0)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: impostor_budget must be >= 0 (0: no limit), got %d",
                             f->impostor_budget);
@@ -306,7 +310,7 @@ static int same_view(const atmos__view *a, const atmos__view *b)
            a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale &&
            a->light_size == b->light_size &&
            a->sky_step == b->sky_step && a->no_air_shadows == b->no_air_shadows &&
-           a->hold_field == b->hold_field;
+           a->hold_field == b->hold_field && a->screen_layer_px == b->screen_layer_px;
 }
 
 static int rect_inside(const atmos__rect *a, const atmos__rect *b)

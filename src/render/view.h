@@ -19,6 +19,7 @@ typedef struct atmos__view {
     int warm_field;            /* slice renderer: the diffuse field warm-started from the last sun's */
     int hold_field;            /* slice renderer: the last solved sun's diffuse field kept, not solved */
     int impostor_budget;       /* Harris's renderer: impostors made again this frame at most (0: all stale) */
+    double screen_layer_px;    /* Harris's renderer: the screen-sized impostor's coarser layers (0: none) */
 } atmos__view;
 
 /* A region clipped to the image: [x0, x1) x [y0, y1), never empty unless the image is. */

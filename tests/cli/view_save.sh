@@ -24,6 +24,7 @@ msg "bad --renderer's help hint" 2 "Try 'atmos view --help'" --renderer nope
 msg "bad -D" 2 "atmos view: -D: /camera/fov_deg" -D camera.fov_deg=500
 msg "volume file options on a generated volume" 2 "atmos view: --grids" --volume generate:cumulus --grids a
 msg "a missing scene file" 1 "atmos view: " "$T/no_such_scene.json"
+msg "bad --screen-layer-px" 2 "atmos view: --screen-layer-px: expected 0 (off)" --screen-layer-px 0.5
 
 if ! command -v xvfb-run >/dev/null 2>&1; then
     bad "xvfb-run is missing (scripts/install-deps.sh installs xvfb and xauth)"

@@ -167,6 +167,7 @@ typedef struct view_opts {
     int impostor_budget; /* Harris's impostors made again a frame at most (0: all stale ones) */
     int preview;         /* --preview: scripted frames previewed while the camera or the sun moves
                             and refined when still, as an interactive session's are */
+    double screen_layer_px; /* Harris's cloud holding the eye: atmos_frame.screen_layer_px (0: off) */
     const char *script, *record, *save_base, *press;
     int passed;          /* arguments left for atmos render's parser */
     char **pass;

@@ -20,7 +20,7 @@ static void help(void)
 {
     printf("Usage: atmos view [SCENE.json] [--volume FILE|generate:PRESET] [--size WxH] [--script FLIGHT.json]\n"
            "                  [--frames N] [--record DIR] [--headless] [--press KEYS] [--save-base BASE]\n"
-           "                  [--impostor-budget N] [--preview] [atmos render's scene options]\n\n"
+           "                  [--impostor-budget N] [--screen-layer-px PX] [--preview] [atmos render's scene options]\n\n"
            "Opens a window on a scene (or the built-in default; a volume with --volume) and renders it\n"
            "with atmos's renderers on the CPU as you fly around it, move the sun or scrub the time of\n"
            "day. The renderers keep their plans: a frame recomputes only what changed. While the\n"
@@ -50,6 +50,10 @@ static void help(void)
            "                     saves and atmos render do)\n"
            "  --preview          scripted frames too: previews while the camera or the sun moves, the\n"
            "                     full render when still (as an interactive session)\n"
+           "  --screen-layer-px PX  Harris's renderer, the eye inside a cloud: its near particles, whose\n"
+           "                     splats are large, drawn in coarser layers where each is still PX pixels\n"
+           "                     in radius (default 4; 0: all at the 1/4 resolution F12 and atmos render\n"
+           "                     draw them at)\n"
            "  --help             this text\n"
            "Scene options are atmos render's (atmos render --help): --renderer, --volume, --sun-elevation,\n"
            "--time, --spp, -D KEY=VALUE, --threads, ...\n\n");
@@ -60,7 +64,7 @@ static void help(void)
 static int parse(int argc, char **argv, view_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->width = 960, o->height = 540, o->impostor_budget = 2;
+    o->width = 960, o->height = 540, o->impostor_budget = 2, o->screen_layer_px = 4;
     o->pass = calloc((size_t)argc + 1, sizeof *o->pass);
     if (!o->pass) return CLI_EXIT_RUNTIME;
     o->pass[o->passed++] = argv[0];
@@ -77,6 +81,12 @@ static int parse(int argc, char **argv, view_opts *o)
             if (!v || !cli_parse_int("view", "--frames", v, 1, 10000000, &o->frames)) return CLI_EXIT_USAGE;
         } else if (cli_take_value(argc, argv, &i, "--impostor-budget", &v)) {
             if (!v || !cli_parse_int("view", "--impostor-budget", v, 0, 1000000, &o->impostor_budget)) return CLI_EXIT_USAGE;
+        } else if (cli_take_value(argc, argv, &i, "--screen-layer-px", &v)) {
+            char *end = NULL;
+            o->screen_layer_px = v ? strtod(v, &end) : -1;
+            if (!v || end == v || *end || !(o->screen_layer_px == 0 || (o->screen_layer_px >= 1 && o->screen_layer_px <= 1000)))
+                return cli_usage_error("view", "--screen-layer-px: expected 0 (off) or a number of pixels in [1, 1000], got '%s'",
+                                       v ? v : "");
         } else if (cli_take_value(argc, argv, &i, "--script", &v)) {
             if (!(o->script = v)) return cli_usage_error("view", "--script needs a file");
         } else if (cli_take_value(argc, argv, &i, "--record", &v)) {

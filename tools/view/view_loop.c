@@ -22,6 +22,7 @@ typedef struct loop {
     int have_scale, spp, saves;
     int impostor_updates;        /* the last frame's */
     int impostor_budget;         /* view_opts's */
+    double screen_layer_px;      /* view_opts's */
     int said_pinhole;            /* the stand-in pinhole for the scene's camera was announced */
 } loop;
 
@@ -218,7 +219,8 @@ static atmos_status render(loop *L, view_state *s, view_quality q, atmos_plan **
     if ((st = atmos_frame_from_scene(L->ctx, L->sc, &f)) != ATMOS_OK) return st;
     view_state_frame(s, &f);
     say_pinhole(L, s);
-    if (!saving) f.sky_step = VIEW_SKY_STEP, f.impostor_budget = L->impostor_budget;
+    if (!saving) /* a cloud holding the eye: its near particles in coarser layers (docs/viewer.md) */
+        f.sky_step = VIEW_SKY_STEP, f.impostor_budget = L->impostor_budget, f.screen_layer_px = L->screen_layer_px;
     f.warm_field = !saving; /* a saved frame is the offline render's: its field built afresh */
     if (s->renderer == ATMOS_RENDERER_SLICE) slice_quality(&f, L->sc, q);
     if (s->renderer == ATMOS_RENDERER_PATH) {
@@ -303,7 +305,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
     loop L;
     memset(&L, 0, sizeof L);
     L.ctx = ctx, L.sc = sc, L.vol = vol, L.spectral = sc->wavelengths == ATMOS_WAVELENGTHS_SPECTRAL;
-    L.impostor_budget = o->impostor_budget;
+    L.impostor_budget = o->impostor_budget, L.screen_layer_px = o->screen_layer_px;
     view_state s;
     view_script script = {0};
     view_recorder rec = {0};
