@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 void atmos__beams_raster(float *depth, int n, const double x[3], const double y[3], const double z[3], int perspective)
 {
@@ -30,4 +31,20 @@ void atmos__beams_raster(float *depth, int n, const double x[3], const double y[
             float *t = depth + (size_t)py * n + px;
             if (d < *t) *t = d;
         }
+}
+
+int atmos__beams_clip_near(const double in[3][3], double near, double poly[4][3])
+{
+    int m = 0;
+    for (int k = 0; k < 3; k++) {
+        const double *a = in[k], *b = in[(k + 1) % 3];
+        const int ia = a[2] >= near, ib = b[2] >= near;
+        if (ia) memcpy(poly[m++], a, sizeof poly[0]);
+        if (ia != ib) {
+            const double s = (near - a[2]) / (b[2] - a[2]);
+            for (int c = 0; c < 3; c++) poly[m][c] = a[c] + s * (b[c] - a[c]);
+            poly[m++][2] = near;
+        }
+    }
+    return m;
 }

@@ -9,4 +9,8 @@
  * 1/depth is affine, a pinhole view). */
 void atmos__beams_raster(float *depth, int n, const double x[3], const double y[3], const double z[3], int perspective);
 
+/* Clips a triangle (a view's frame, z forward) at z = near (Sutherland-Hodgman) into poly;
+ * returns its vertex count, 0 or 3..4 (a fan from poly[0]). */
+int atmos__beams_clip_near(const double in[3][3], double near, double poly[4][3]);
+
 #endif

@@ -51,17 +51,7 @@ static void draw(atmos__beams_face *F, const double v[3][3])
 static void clip_draw(atmos__beams_face *F, const double in[3][3])
 {
     double poly[4][3];
-    int m = 0;
-    for (int k = 0; k < 3; k++) {
-        const double *a = in[k], *b = in[(k + 1) % 3];
-        const int ia = a[2] >= NEAR_M, ib = b[2] >= NEAR_M;
-        if (ia) memcpy(poly[m++], a, sizeof poly[0]);
-        if (ia != ib) {
-            const double s = (NEAR_M - a[2]) / (b[2] - a[2]);
-            for (int c = 0; c < 3; c++) poly[m][c] = a[c] + s * (b[c] - a[c]);
-            poly[m++][2] = NEAR_M;
-        }
-    }
+    const int m = atmos__beams_clip_near(in, NEAR_M, poly);
     for (int k = 1; k + 1 < m; k++) {
         const double tri[3][3] = {{poly[0][0], poly[0][1], poly[0][2]},
                                   {poly[k][0], poly[k][1], poly[k][2]},

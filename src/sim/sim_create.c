@@ -67,12 +67,6 @@ static void init_fields(atmos_sim *s)
         }
 }
 
-void *atmos__sim_alloc(size_t bytes)
-{
-    if (bytes >= ((size_t)1 << 20)) return atmos__big_alloc(bytes); /* 2 MB aligned */
-    return aligned_alloc(64, (bytes + 63) / 64 * 64 + (bytes ? 0 : 64));
-}
-
 /* A zeroed array of the grid's size: on 2 MB pages where the system gives them
  * (atmos__big_alloc), as the passes read levels and columns far apart (fewer TLB misses). */
 static float *grid_array(size_t floats)

@@ -101,7 +101,7 @@ static inline size_t sim_idx(const atmos_sim *s, int i, int j, int k)
  * atmos_sim_run's (sim_step.c). */
 atmos_status atmos__sim_run_to(atmos_context *ctx, atmos_sim *s, double end, int whole_steps);
 
-/* The simulation's arrays (sim_create.c): 64-byte aligned, on 2 MB pages where large
+/* The simulation's arrays (sim_alloc.c): 64-byte aligned, on 2 MB pages where large
  * (atmos__big_alloc), so that a level's FFT plan does not depend on where malloc put it. */
 void *atmos__sim_alloc(size_t bytes);
 
