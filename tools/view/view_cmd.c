@@ -20,7 +20,8 @@ static void help(void)
 {
     printf("Usage: atmos view [SCENE.json] [--volume FILE|generate:PRESET] [--size WxH] [--script FLIGHT.json]\n"
            "                  [--frames N] [--record DIR] [--headless] [--press KEYS] [--save-base BASE]\n"
-           "                  [--impostor-budget N] [--screen-layer-px PX] [--preview] [atmos render's scene options]\n\n"
+           "                  [--impostor-budget N] [--screen-layer-px PX] [--preview]\n"
+           "                  [atmos render's scene options]\n\n"
            "Opens a window on a scene (or the built-in default; a volume with --volume) and renders it\n"
            "with atmos's renderers on the CPU as you fly around it, move the sun or scrub the time of\n"
            "day. The renderers keep their plans: a frame recomputes only what changed. While the\n"
