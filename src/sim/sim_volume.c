@@ -44,7 +44,7 @@ static void cell_fields(const atmos_sim *s, float *q[3], int nf)
 
 /* Trilinear interpolation of a per-cell array at (x, y, z) in cell-index space (x, y wrapped,
  * z clamped). */
-static float cell_trilinear(const atmos_sim *s, const float *lq, double x, double y, double z)
+static float cell_trilinear(const atmos_sim *s, const float *a, double x, double y, double z)
 {
     const double fx = floor(x), fy = floor(y);
     double zc = z < 0 ? 0 : z > s->nz - 1 ? s->nz - 1 : z;
@@ -59,7 +59,7 @@ static float cell_trilinear(const atmos_sim *s, const float *lq, double x, doubl
     for (int c = 0; c < 8; c++) {
         const int i = c & 1 ? i1 : i0, j = c & 2 ? j1 : j0, k = k0 + (c >> 2);
         const double w = (c & 1 ? tx : 1 - tx) * (c & 2 ? ty : 1 - ty) * (c & 4 ? tz : 1 - tz);
-        v += w * lq[sim_idx(s, i, j, k)];
+        v += w * a[sim_idx(s, i, j, k)];
     }
     return (float)v;
 }
