@@ -12,11 +12,16 @@ double atmos__sim_esat(double t_k)
     return 611.2 * exp(17.67 * tc / (tc + 243.5));
 }
 
+/* The mixing ratio at vapour pressure e. */
+static double mixing_ratio(double e, double p_pa)
+{
+    if (e > 0.5 * p_pa) e = 0.5 * p_pa; /* never at atmospheric temperatures; keeps q finite */
+    return SIM_EPS * e / (p_pa - e);
+}
+
 double atmos__sim_qsat(double t_k, double p_pa)
 {
-    double es = atmos__sim_esat(t_k);
-    if (es > 0.5 * p_pa) es = 0.5 * p_pa; /* never at atmospheric temperatures; keeps q finite */
-    return SIM_EPS * es / (p_pa - es);
+    return mixing_ratio(atmos__sim_esat(t_k), p_pa);
 }
 
 double atmos__sim_dewpoint(double qv, double p_pa)
@@ -44,12 +49,6 @@ double atmos__sim_ice_fraction(double t)
     if (t <= ti) return 1;
     const double a = (t - ti) / (t0 - ti);
     return 1 - a * a;
-}
-
-static double mixing_ratio(double e, double p_pa)
-{
-    if (e > 0.5 * p_pa) e = 0.5 * p_pa;
-    return SIM_EPS * e / (p_pa - e);
 }
 
 /* The saturation mixing ratio of the condensate at t: over water at 0 C and above, blended
