@@ -1,8 +1,9 @@
-/* A cloud-physics simulation as a volume source (docs/clouds.md): a 3-D Boussinesq fluid on
- * a staggered (MAC) grid with potential temperature, water vapour, cloud water and rain,
- * semi-Lagrangian advection, vorticity confinement, buoyancy from temperature and water
- * loading, an exact FFT pressure projection (periodic sides, rigid ground and lid), Kessler
- * warm rain and saturation adjustment with latent heat. Its state is handed to the renderers
+/* A cloud-physics simulation as a volume source (docs/clouds.md): a 3-D anelastic fluid on
+ * a staggered (MAC) grid with potential temperature, water vapour, cloud (water or ice by
+ * temperature) and rain (or snow), semi-Lagrangian advection, vorticity confinement, buoyancy
+ * from temperature and water loading, an exact FFT pressure projection (periodic sides, rigid
+ * ground and lid), Kessler rain with Lin et al.'s ice and snow, and saturation adjustment over
+ * water and ice with latent heat. Its state is handed to the renderers
  * as an atmos volume ("cloud" and "rain" number densities through the particle types' mean
  * masses, like the WRF reader).
  *
@@ -43,8 +44,8 @@ typedef struct atmos_sim_desc {
                             a voxel: ragged edges the model does not hold (0 = off) */
     int ice;             /* 1: condensate (cloud water) reported as "ice" in the fraction that the
                             temperature gives (ECMWF IFS's mixed phase: all liquid at 0 C, all
-                            ice at -23 C, quadratic between), a diagnosis for the optics only:
-                            the model itself has no ice */
+                            ice at -23 C, quadratic between): the fraction the model's
+                            saturation and latent heat use too, written as a field of its own */
 } atmos_sim_desc;
 
 typedef struct atmos_sim atmos_sim;
@@ -74,8 +75,8 @@ typedef struct atmos_sim_stats {
     double cell_m;          /* cell edge, metres */
     double time_s;          /* simulated time */
     long steps;
-    double water;           /* vapour + cloud + rain in the domain, kg per m^2 of ground (Boussinesq
-                               reference density) */
+    double water;           /* vapour + cloud + rain in the domain, kg per m^2 of ground (each
+                               level's base-state density) */
     double rain_out;        /* rain that fell through the ground, kg m^-2 */
     double surface_in;      /* water the surface moisture flux added, kg m^-2 */
     double max_w;           /* largest updraught, m/s */

@@ -200,10 +200,11 @@ double atmos__sim_advect(atmos_sim *s, double dt)
     double w0 = 0, w1 = 0, v1 = 0;
     const double *p = s->part;
     const size_t m = (size_t)nz + 1;
-    for (int k = 0; k < nz; k++) {
-        w0 += p[m + k] + p[k];
-        w1 += p[3 * m + k] + p[2 * m + k];
-        v1 += p[2 * m + k];
+    for (int k = 0; k < nz; k++) { /* water's mass: each level's by its density (anelastic) */
+        const double r = s->rho_c[k];
+        w0 += r * (p[m + k] + p[k]);
+        w1 += r * (p[3 * m + k] + p[2 * m + k]);
+        v1 += r * p[2 * m + k];
     }
     return v1 > 0 ? (double)(float)(1.0 + (w0 - w1) / v1) : 1.0;
 }

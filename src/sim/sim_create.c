@@ -98,6 +98,8 @@ atmos_status atmos__sim_create_env(atmos_context *ctx, const sim_env *env, int n
     ok &= (s->pack = atmos__big_alloc(8 * s->n * sizeof(float))) != NULL; /* written before it is read */
     double **b[] = {&s->th0, &s->qv0, &s->pi0, &s->p0, &s->rho0, &s->ue};
     for (int a = 0; a < 6; a++) ok &= (*b[a] = calloc((size_t)nz, sizeof(double))) != NULL;
+    ok &= (s->rho_c = calloc((size_t)nz, sizeof(double))) != NULL;
+    ok &= (s->rho_f = calloc((size_t)nz + 1, sizeof(double))) != NULL;
     ok &= (s->part = calloc(4 * ((size_t)(nz > ny ? nz : ny) + 1), sizeof(double))) != NULL;
     if (!ok) {
         atmos_sim_destroy(s);
@@ -162,5 +164,7 @@ void atmos_sim_destroy(atmos_sim *s)
     double *b[] = {s->th0, s->qv0, s->pi0, s->p0, s->rho0, s->ue};
     for (int a = 0; a < 6; a++) free(b[a]);
     free(s->part);
+    free(s->rho_c);
+    free(s->rho_f);
     free(s);
 }

@@ -1,6 +1,7 @@
 /* Forces and sources of one step: buoyancy from the potential temperature and vapour
- * excesses and the water loading, B = g (theta'/theta0 + 0.61 q_v' - q_c - q_r) (Boussinesq;
- * e.g. Klemp & Wilhelmson 1978, Eq. 2.1), averaged onto the w faces; a Rayleigh sponge under
+ * excesses and the water loading, B = g (theta'/theta0 + 0.61 q_v' - q_c - q_r) (the
+ * Boussinesq form, kept in the anelastic model; e.g. Klemp & Wilhelmson 1978, Eq. 2.1),
+ * averaged onto the w faces; a Rayleigh sponge under
  * the lid; the surface heat and moisture fluxes with seeded noise; cloud-top radiative cooling. */
 #include "sim/sim_internal.h"
 #include "core/rng.h"

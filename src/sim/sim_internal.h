@@ -16,6 +16,7 @@
 #define SIM_CP 1004.0
 #define SIM_RD 287.0
 #define SIM_LV 2.5e6
+#define SIM_LF 3.34e5 /* latent heat of fusion */
 #define SIM_P00 1e5
 #define SIM_EPS 0.622
 
@@ -62,7 +63,9 @@ struct atmos_sim {
                                    * each filled by one thread, added in index order afterwards */
     /* base state at the cell-centre levels z_k = (k + 0.5) dx */
     double *th0, *qv0, *pi0, *p0, *rho0, *ue;
-    double rho_ref;               /* Boussinesq reference density (the budget's) */
+    double rho_ref;               /* the ground's density (the budget's reference) */
+    double *rho_c, *rho_f;        /* rho0 / rho_ref at the centres (nz) and on the w faces (nz + 1;
+                                   * 0 at the ground and the lid): the anelastic projection's */
     sim_env env;
     uint64_t seed;
     int out_refine, out_ice;      /* the volume's form (atmos_sim_desc; sim_volume.c) */
@@ -117,12 +120,19 @@ atmos_status atmos__sim_create_env(atmos_context *ctx, const sim_env *env, int n
 double atmos__sim_esat(double t_k);
 double atmos__sim_qsat(double t_k, double p_pa);
 double atmos__sim_dewpoint(double qv, double p_pa);
-/* Saturation adjustment of one cell at pressure p and Exner function pi: condenses vapour
- * above saturation or evaporates cloud water into unsaturated air, with the latent heat,
- * so that afterwards q_c = 0 and q_v <= q_s, or q_c > 0 and q_v = q_s (Newton iteration). */
-void atmos__sim_adjust(double *th, double *qv, double *qc, double p_pa, double pi);
-/* The fraction of condensate written as ice at temperature t, K (sim_volume.c). */
+/* Saturation over ice (Alduchov & Eskridge 1996), Pa; the fraction of the condensate that is
+ * ice at temperature t, K (the IFS's mixed phase: all water at 0 C, all ice at -23 C); the
+ * condensate's saturation mixing ratio (over water and ice by that fraction) and its latent
+ * heat, L_v + L_f times the fraction. */
+double atmos__sim_esat_ice(double t_k);
 double atmos__sim_ice_fraction(double t);
+double atmos__sim_qsat_cond(double t_k, double p_pa);
+double atmos__sim_latent(double t_k);
+/* Saturation adjustment of one cell at pressure p and Exner function pi: condenses vapour
+ * above the condensate's saturation or evaporates cloud into subsaturated air, with the
+ * latent heat of the cell's starting temperature, so that afterwards q_c = 0 and
+ * q_v <= q_s,cond, or q_c > 0 and q_v = q_s,cond (Newton iteration). */
+void atmos__sim_adjust(double *th, double *qv, double *qc, double p_pa, double pi);
 /* Fills the base state (th0, qv0, pi0, p0, rho0, ue) from sim->env. */
 void atmos__sim_sounding(atmos_sim *sim);
 

@@ -5,9 +5,13 @@
  *   rain evaporation E = (1 - q_v/q_s) C' (rho q_r)^0.525 / (rho (5.4e5 + 2.55e6 / (p q_s)))
  *                   with C' = 1.6 + 124.9 (rho q_r)^0.2046, rho in g cm^-3, p in mb
  *   fall speed      V = 36.34 (rho q_r)^0.1346 (rho / rho_ground)^-1/2 m/s, rho in g cm^-3
- * then the saturation adjustment with latent heat (atmos__sim_adjust). Every transfer moves
- * water between q_v, q_c and q_r, so their sum changes only through the rain that falls out
- * (counted in rain_out). */
+ * with ice below 0 C (docs/clouds.md, *The anvil*): the cloud's and the precipitation's ice
+ * fraction that of the IFS's mixed phase (atmos__sim_ice_fraction), the ice's autoconversion
+ * slower and its precipitation (snow) falling slower, after Lin, Farley & Orville (1983,
+ * J. Clim. Appl. Meteor. 22, 1065, Eq. 21 and the snow's fall speed), the cloud's ice falling
+ * slowly (Heymsfield & Donner 1990); then the saturation adjustment over water and ice with
+ * latent heat (atmos__sim_adjust). Every transfer moves water between q_v, q_c and q_r, so
+ * their sum changes only through what falls out (counted in rain_out). */
 #include "sim/sim_internal.h"
 
 #include <math.h>
@@ -26,7 +30,7 @@ static double dry_below(const atmos_sim *s, int k, double p, double pi)
         m = th[n] < m ? th[n] : m;
         nan |= th[n] != th[n];
     }
-    return nan ? 0.0 : 0.9 * atmos__sim_qsat(m * pi, p) * (1.0 - 1e-6);
+    return nan ? 0.0 : 0.9 * atmos__sim_qsat_cond(m * pi, p) * (1.0 - 1e-6);
 }
 
 static inline int plus_zero(float f)
@@ -59,7 +63,7 @@ static void cell(atmos_sim *s, size_t n, double dt, double p, double pi, double 
     double th = s->th[n], qv = s->qv[n], qc = s->qc[n], qr = s->qr[n];
     if (qc <= 0 && qr <= 0) {
         if (qv < dry) return; /* clear, dry air */
-        const double qs = atmos__sim_qsat(th * pi, p);
+        const double qs = atmos__sim_qsat_cond(th * pi, p);
         if (qv < 0.9 * qs) return;
         /* unsaturated and no condensate (both +0): every rate below is 0 and the adjustment
          * returns at once, the cell is left as it is */
@@ -67,8 +71,11 @@ static void cell(atmos_sim *s, size_t n, double dt, double p, double pi, double 
     }
     if (qc < 0) qc = 0;
     if (qr < 0) qr = 0;
-    /* rain from cloud water */
-    const double rate = 1e-3 * fmax(qc - 1e-3, 0.0) + 2.2 * qc * pow(qr, 0.875);
+    /* rain (or snow) from cloud water (ice): the autoconversion's rate for the ice part of
+     * Lin et al. (1983), 1e-3 exp(0.025 (T - T_0)) s^-1 */
+    const double fi = atmos__sim_ice_fraction(th * pi);
+    const double k_auto = 1e-3 * (fi > 0 ? 1 - fi + fi * exp(0.025 * (th * pi - 273.16)) : 1.0);
+    const double rate = k_auto * fmax(qc - 1e-3, 0.0) + 2.2 * qc * pow(qr, 0.875);
     const double dr = fmin(qc, rate * dt);
     qc -= dr, qr += dr;
     /* rain evaporating into unsaturated air */
@@ -106,12 +113,12 @@ void atmos__sim_micro(atmos_sim *s, double dt, float fix)
     atmos__sim_sync(s);
 }
 
-/* Whether a cell of row j holds rain that falls (q_r > 1e-9). */
-static int any_rain(const atmos_sim *s, int j)
+/* Whether a cell of row j holds more than 1e-9 of q. */
+static int any_in_row(const atmos_sim *s, const float *qf, int j)
 {
     const size_t lev = (size_t)s->nx * s->ny;
     for (int k = 0; k < s->nz; k++) {
-        const float *q = s->qr + k * lev + (size_t)j * s->nx;
+        const float *q = qf + k * lev + (size_t)j * s->nx;
         int any = 0;
         for (int i = 0; i < s->nx; i++) any |= q[i] > 1e-9;
         if (any) return 1;
@@ -119,38 +126,68 @@ static int any_rain(const atmos_sim *s, int j)
     return 0;
 }
 
-/* Rain falls with V by first-order upwind fluxes, sub-stepped so that V dt_sub < dx; what
- * leaves the lowest cell is rain on the ground. The columns of row j, one at a time; returns
- * the row's rain out, added column by column. */
+/* The fall speed (m/s) of precipitation of rho q kg m^-3 at density ratio rho_ground / rho, a
+ * fraction fi of it snow: Kessler's rain (header) and Lin et al. (1983)'s snow, mass-weighted
+ * over their exponential size distribution (V = 11.72 D^0.41 m/s, D in m; n_0 = 3e6 m^-4,
+ * density 100 kg m^-3): 11.72 Gamma(4.41) / 6 (pi 100 n_0)^-0.1025 (rho q)^0.1025 =
+ * 2.416 (rho q)^0.1025, about a quarter of the rain's. */
+static double fall_speed(double rq, double ratio, double fi)
+{
+    const double rain = 36.34 * pow(1e-3 * rq, 0.1346);
+    const double snow = fi > 0 ? 2.416 * pow(rq, 0.1025) : 0.0;
+    return ((1 - fi) * rain + fi * snow) * sqrt(ratio);
+}
+
+/* q of column c falls with vel[k] (m/s) by first-order upwind fluxes, sub-stepped so that
+ * V dt_sub < dx; returns what left the lowest cell (q times rho0 / rho_ref). */
+static double fall_column(const atmos_sim *s, float *qf, size_t c, const double *vel, double vmax, double dt)
+{
+    const size_t lev = (size_t)s->nx * s->ny;
+    double fell = 0;
+    if (!(vmax > 0)) return fell;
+    const int sub = (int)ceil(vmax * dt / (0.9 * s->dx));
+    const double h = dt / sub / s->dx;
+    for (int m = 0; m < sub; m++) {
+        double from_above = 0; /* flux into cell k from k + 1: q times rho0 / rho_ref */
+        for (int k = s->nz - 1; k >= 0; k--) {
+            float *q = &qf[c + k * lev];
+            const double leave = fmin((double)*q, h * vel[k] * *q);
+            *q = (float)(*q - leave + from_above / s->rho_c[k]);
+            from_above = leave * s->rho_c[k]; /* the mass that falls (rho_c[0] = 1) */
+        }
+        fell += from_above;
+    }
+    return fell;
+}
+
+/* Rain (and snow) falls at fall_speed, and the cloud's ice at Heymsfield & Donner's (1990,
+ * J. Atmos. Sci. 47, 1865) V = 3.29 (rho q_i)^0.16 m/s (rho q_i in kg m^-3; 0.75 m/s at
+ * 1e-4), times the cell's ice fraction. What leaves the lowest cell is precipitation on the
+ * ground. The columns of row j, one at a time; returns the row's water out, added column by
+ * column. */
 double atmos__sim_fall_row(atmos_sim *s, double dt, int j)
 {
     if (!s->env.micro) return 0.0;
     const int nx = s->nx, nz = s->nz;
     const size_t lev = (size_t)nx * s->ny;
     double row = 0;
-    if (!any_rain(s, j)) return row; /* each column's rain_out would be 0 */
+    const int rain = any_in_row(s, s->qr, j), ice = any_in_row(s, s->qc, j);
+    if (!rain && !ice) return row; /* each column's water out would be 0 */
     for (int i = 0; i < nx; i++) {
         const size_t c = (size_t)j * nx + i;
-        double vmax = 0, fell = 0;
-        double vel[2 * ATMOS_SIM_MAX_GRID];
-        for (int k = 0; k < nz; k++) {
-            const double q = s->qr[c + k * lev];
-            vel[k] = q > 1e-9 ? 36.34 * pow(1e-3 * s->rho0[k] * q, 0.1346) * sqrt(s->rho0[0] / s->rho0[k]) : 0.0;
-            vmax = fmax(vmax, vel[k]);
-        }
-        if (vmax > 0) {
-            const int sub = (int)ceil(vmax * dt / (0.9 * s->dx));
-            const double h = dt / sub / s->dx;
-            for (int m = 0; m < sub; m++) {
-                double from_above = 0; /* flux into cell k from k + 1, in q units */
-                for (int k = nz - 1; k >= 0; k--) {
-                    float *q = &s->qr[c + k * lev];
-                    const double leave = fmin((double)*q, h * vel[k] * *q);
-                    *q = (float)(*q - leave + from_above);
-                    from_above = leave;
-                }
-                fell += from_above;
+        double fell = 0, vel[2 * ATMOS_SIM_MAX_GRID];
+        for (int pass = 0; pass < 2; pass++) {
+            if (!(pass ? ice : rain)) continue;
+            float *qf = pass ? s->qc : s->qr;
+            double vmax = 0;
+            for (int k = 0; k < nz; k++) {
+                const double q = qf[c + k * lev], fi = atmos__sim_ice_fraction(s->th[c + k * lev] * s->pi0[k]);
+                vel[k] = q <= 1e-9 ? 0.0
+                         : pass    ? fi * 3.29 * pow(s->rho0[k] * q, 0.16)
+                                   : fall_speed(s->rho0[k] * q, s->rho0[0] / s->rho0[k], fi);
+                vmax = fmax(vmax, vel[k]);
             }
+            fell += fall_column(s, qf, c, vel, vmax, dt);
         }
         row += (float)fell;
     }

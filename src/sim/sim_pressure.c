@@ -1,9 +1,12 @@
-/* The pressure projection: makes the staggered velocity divergence-free exactly (to
- * rounding) for periodic sides and a rigid ground and lid. The discrete Poisson equation
- * L phi = dx div u (L the 7-point Laplacian without 1/dx^2) is diagonal in the horizontal
- * Fourier modes (eigenvalue -lambda = -(4 - 2 cos(2 pi a / nx) - 2 cos(2 pi b / ny))), leaving one
- * tridiagonal system per mode along z with phi's zero-gradient rows at the ground and the lid;
- * then u -= phi[i] - phi[i-1] on every face. The 2-D transforms are FFTW's (one plan of one
+/* The pressure projection: makes the staggered velocity satisfy the anelastic continuity
+ * equation div(rho0 u) = 0 exactly (to rounding; Ogura & Phillips 1962, J. Atmos. Sci. 19,
+ * 173) for periodic sides and a rigid ground and lid, rho0(z) the base state's density (its
+ * ratio to the ground's: a at the cell centres, b on the w faces, sim_sounding). The discrete
+ * equation div(rho0 grad phi) = dx div(rho0 u) (without 1/dx^2) is diagonal in the horizontal
+ * Fourier modes (eigenvalue -lambda a_k, lambda = 4 - 2 cos(2 pi a / nx) - 2 cos(2 pi b / ny)),
+ * leaving one tridiagonal system per mode along z, b_(k+1) (phi_(k+1) - phi_k) -
+ * b_k (phi_k - phi_(k-1)) - lambda a_k phi_k = r_k, with b = 0 at the ground and the lid
+ * (zero gradient); then u -= phi[i] - phi[i-1] on every face. The 2-D transforms are FFTW's (one plan of one
  * level, run for every level in parallel: each level's arithmetic is the same whichever thread
  * runs it, so the result does not depend on the thread count). */
 #include "sim/sim_internal.h"
@@ -59,17 +62,20 @@ void atmos__sim_fft_free(atmos_sim *s)
     s->fft_fwd = s->fft_inv = s->fft_fwd_u = s->fft_inv_u = s->spec = NULL;
 }
 
-/* dx times the divergence of the cells of level k into d (the row's last cell wraps). */
+/* dx times the divergence of rho0 u (relative to the ground's density) of the cells of level k
+ * into d (the row's last cell wraps). */
 PROJ_CLONES static void divergence(const atmos_sim *s, int k, float *restrict d)
 {
     const int nx = s->nx, ny = s->ny;
     const size_t lev = (size_t)nx * ny;
     const float *restrict u = s->u, *restrict v = s->v, *restrict w = s->w;
+    const float a = (float)s->rho_c[k], b0 = (float)s->rho_f[k], b1 = (float)s->rho_f[k + 1];
     for (int j = 0; j < ny; j++) {
         const size_t r = sim_idx(s, 0, j, k), rp = sim_idx(s, 0, j + 1 == ny ? 0 : j + 1, k);
-        for (size_t n = r; n + 1 < r + nx; n++) d[n] = (u[n + 1] - u[n]) + (v[rp + n - r] - v[n]) + (w[n + lev] - w[n]);
+        for (size_t n = r; n + 1 < r + nx; n++)
+            d[n] = a * ((u[n + 1] - u[n]) + (v[rp + n - r] - v[n])) + (b1 * w[n + lev] - b0 * w[n]);
         const size_t n = r + nx - 1;
-        d[n] = (u[r] - u[n]) + (v[rp + nx - 1] - v[n]) + (w[n + lev] - w[n]);
+        d[n] = a * ((u[r] - u[n]) + (v[rp + nx - 1] - v[n])) + (b1 * w[n + lev] - b0 * w[n]);
     }
 }
 
@@ -81,26 +87,28 @@ double atmos__sim_max_divergence(const atmos_sim *s)
     return m;
 }
 
-/* Solves (phi[k+1] - 2 phi[k] + phi[k-1]) - lam phi[k] = r[k] along one column of modes
- * (stride between levels), zero gradient at both ends, in place, times `norm` (the inverse
+/* Solves b[k+1] (phi[k+1] - phi[k]) - b[k] (phi[k] - phi[k-1]) = r[k] along one column of
+ * modes (stride between levels), b[0] = b[nz] = 0, in place, times `norm` (the inverse
  * transform's 1 / (nx ny)): the mean mode (lam = 0), defined up to a constant, with phi[0] = 0
- * and then row by row. */
-static void mean_column(fftwf_complex *r, size_t stride, int nz, double norm)
+ * and then row by row through the fluxes F[k+1] = b[k+1] (phi[k+1] - phi[k]) = F[k] + r[k]. */
+static void mean_column(fftwf_complex *r, size_t stride, int nz, const double *b, double norm)
 {
-    double pr = 0, pi = 0, qr = crealf(r[0]), qi = cimagf(r[0]);
-    r[0] = 0;
-    for (int k = 1; k < nz; k++) {
+    double pr = 0, pi = 0, fr = 0, fi = 0;
+    for (int k = 0; k < nz; k++) {
         const double dr = crealf(r[(size_t)k * stride]), di = cimagf(r[(size_t)k * stride]);
-        r[(size_t)k * stride] = (float)(qr * norm) + I * (float)(qi * norm);
-        const double nr = dr + 2 * qr - pr, ni = di + 2 * qi - pi;
-        pr = qr, pi = qi, qr = nr, qi = ni;
+        r[(size_t)k * stride] = (float)(pr * norm) + I * (float)(pi * norm);
+        if (k + 1 == nz) break;
+        fr += dr, fi += di;
+        pr += fr / b[k + 1], pi += fi / b[k + 1];
     }
 }
 
-/* The same (Thomas algorithm) for SIM_CW columns of modes side by side, r[0..SIM_CW) at each level,
- * lam > 0 each; tmp holds 3 nz SIM_CW doubles. Every column's arithmetic is the one-column
- * algorithm's, the columns are independent lanes (vectorised). */
-PROJ_CLONES static void columns(fftwf_complex *r, size_t stride, int nz, const double *lam, double norm, double *tmp)
+/* The system with lam (Thomas algorithm) for SIM_CW columns of modes side by side,
+ * r[0..SIM_CW) at each level, lam > 0 each, a and b the densities (the file's header); tmp
+ * holds 3 nz SIM_CW doubles. Every column's arithmetic is the one-column algorithm's, the
+ * columns are independent lanes (vectorised). */
+PROJ_CLONES static void columns(fftwf_complex *r, size_t stride, int nz, const double *lam, const double *a,
+                                const double *b, double norm, double *tmp)
 {
     double(*cp)[SIM_CW] = (double(*)[SIM_CW])tmp, (*dre)[SIM_CW] = (double(*)[SIM_CW])(tmp + (size_t)nz * SIM_CW),
         (*dim)[SIM_CW] = (double(*)[SIM_CW])(tmp + 2 * (size_t)nz * SIM_CW);
@@ -108,15 +116,14 @@ PROJ_CLONES static void columns(fftwf_complex *r, size_t stride, int nz, const d
         const float *q = (const float *)(r + (size_t)k * stride);
         for (int l = 0; l < SIM_CW; l++) dre[k][l] = q[2 * l], dim[k][l] = q[2 * l + 1];
     }
-    const double edge = -1.0, mid = -2.0;
     for (int k = 0; k < nz; k++) {
-        const double d = k == 0 || k == nz - 1 ? edge : mid;
+        const double lo = b[k], up = b[k + 1], d = -(lo + up);
         for (int l = 0; l < SIM_CW; l++) {
-            const double b = d - lam[l];
-            const double m = k ? b - cp[k - 1][l] : b;
-            cp[k][l] = 1.0 / m;
-            dre[k][l] = (dre[k][l] - (k ? dre[k - 1][l] : 0)) / m;
-            dim[k][l] = (dim[k][l] - (k ? dim[k - 1][l] : 0)) / m;
+            const double diag = d - lam[l] * a[k];
+            const double m = k ? diag - lo * cp[k - 1][l] : diag;
+            cp[k][l] = up / m;
+            dre[k][l] = (dre[k][l] - (k ? lo * dre[k - 1][l] : 0)) / m;
+            dim[k][l] = (dim[k][l] - (k ? lo * dim[k - 1][l] : 0)) / m;
         }
     }
     for (int k = nz - 2; k >= 0; k--)
@@ -133,8 +140,9 @@ PROJ_CLONES static void columns(fftwf_complex *r, size_t stride, int nz, const d
 /* The modes (a, b), a = 0 .. nh - 1, of row b of the spectrum, SIM_CW columns at a time; a group
  * with the mean mode (0, 0), and the last group if short, go through a copy whose spare lanes
  * repeat a mode of the group (solved and discarded). tmp holds SIM_COLUMN_SCRATCH(nz) doubles. */
-static void mode_row(fftwf_complex *c, size_t clev, int nx, int ny, int nz, int b, double norm, double *tmp)
+static void mode_row(const atmos_sim *s, fftwf_complex *c, size_t clev, int b, double norm, double *tmp)
 {
+    const int nx = s->nx, ny = s->ny, nz = s->nz;
     const int nh = nx / 2 + 1;
     fftwf_complex *pad = (fftwf_complex *)(tmp + 3 * (size_t)nz * SIM_CW);
     for (int a0 = 0; a0 < nh; a0 += SIM_CW) {
@@ -147,14 +155,14 @@ static void mode_row(fftwf_complex *c, size_t clev, int nx, int ny, int nz, int 
             lam[l] = 4.0 - 2.0 * cos(2.0 * ATMOS_PI * a / nx) - 2.0 * cos(2.0 * ATMOS_PI * b / ny);
         }
         fftwf_complex *r = c + (size_t)b * nh + a0;
-        if (mean) mean_column(r, clev, nz, norm);
+        if (mean) mean_column(r, clev, nz, s->rho_f, norm);
         if (n == SIM_CW && !mean) {
-            columns(r, clev, nz, lam, norm, tmp);
+            columns(r, clev, nz, lam, s->rho_c, s->rho_f, norm, tmp);
             continue;
         }
         for (int k = 0; k < nz; k++)
             for (int l = 0; l < SIM_CW; l++) pad[(size_t)k * SIM_CW + l] = r[(size_t)k * clev + src[l]];
-        columns(pad, SIM_CW, nz, lam, norm, tmp);
+        columns(pad, SIM_CW, nz, lam, s->rho_c, s->rho_f, norm, tmp);
         for (int k = 0; k < nz; k++)
             for (int l = mean; l < n; l++) r[(size_t)k * clev + l] = pad[(size_t)k * SIM_CW + l];
     }
@@ -212,7 +220,7 @@ void atmos__sim_project(atmos_sim *s)
     const double norm = 1.0 / ((double)nx * ny);
     SIM_FOR
     for (int b = 0; b < ny; b++) {
-        mode_row(c, clev, nx, ny, nz, b, norm, s->colbuf + (size_t)omp_get_thread_num() * SIM_COLUMN_SCRATCH(nz));
+        mode_row(s, c, clev, b, norm, s->colbuf + (size_t)omp_get_thread_num() * SIM_COLUMN_SCRATCH(nz));
     }
     atmos__sim_sync(s);
     SIM_FOR

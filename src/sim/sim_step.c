@@ -108,9 +108,9 @@ void atmos_sim_get_stats(const atmos_sim *s, atmos_sim_stats *o)
                 o->cloud_top_m = (k + 0.5) * s->dx;
             }
         }
-        water += wl;
+        water += wl * s->rho_c[k];
     }
-    /* (kg/kg) x cells -> kg per m^2 of ground */
+    /* (kg/kg) x cells (of the ground's density) -> kg per m^2 of ground */
     const double per = s->rho_ref * s->dx / (double)lev;
     o->water = water * per;
     o->rain_out = s->rain_out * per;

@@ -12,11 +12,16 @@ double atmos__sim_esat(double t_k)
     return 611.2 * exp(17.67 * tc / (tc + 243.5));
 }
 
+/* The mixing ratio at vapour pressure e. */
+static double mixing_ratio(double e, double p_pa)
+{
+    if (e > 0.5 * p_pa) e = 0.5 * p_pa; /* never at atmospheric temperatures; keeps q finite */
+    return SIM_EPS * e / (p_pa - e);
+}
+
 double atmos__sim_qsat(double t_k, double p_pa)
 {
-    double es = atmos__sim_esat(t_k);
-    if (es > 0.5 * p_pa) es = 0.5 * p_pa; /* never at atmospheric temperatures; keeps q finite */
-    return SIM_EPS * es / (p_pa - es);
+    return mixing_ratio(atmos__sim_esat(t_k), p_pa);
 }
 
 double atmos__sim_dewpoint(double qv, double p_pa)
@@ -26,16 +31,67 @@ double atmos__sim_dewpoint(double qv, double p_pa)
     return 273.15 + 243.5 * l / (17.67 - l);
 }
 
+/* Alduchov & Eskridge (1996), J. Appl. Meteor. 35, 601 (AERKi): saturation vapour pressure
+ * over ice, e_i = 6.1121 exp(22.587 T / (T + 273.86)) hPa, T in degrees Celsius. */
+double atmos__sim_esat_ice(double t_k)
+{
+    const double tc = t_k - 273.15;
+    return 611.21 * exp(22.587 * tc / (tc + 273.86));
+}
+
+/* The fraction of condensate that is ice at temperature t (K): 1 - alpha, alpha = ((t - t_ice) /
+ * (t_0 - t_ice))^2 the liquid fraction of ECMWF's IFS (IFS Documentation Cy47r1, Part IV:
+ * Physical processes, the mixed phase), t_0 = 273.16 K, t_ice = 250.16 K. */
+double atmos__sim_ice_fraction(double t)
+{
+    const double t0 = 273.16, ti = 250.16;
+    if (t >= t0) return 0;
+    if (t <= ti) return 1;
+    const double a = (t - ti) / (t0 - ti);
+    return 1 - a * a;
+}
+
+/* The saturation mixing ratio of the condensate at t: over water at 0 C and above, blended
+ * by the ice fraction f towards that over ice below, (1 - f) q_sw + f q_si (the mixed phase's
+ * saturation, as in the IFS); its derivative in t into *dq (analytic: Newton's step). */
+static double qsat_cond_d(double t_k, double p_pa, double *dq)
+{
+    const double tc = t_k - 273.15, qw = atmos__sim_qsat(t_k, p_pa);
+    const double dw = qw * 17.67 * 243.5 / ((tc + 243.5) * (tc + 243.5)) * (1.0 + qw / SIM_EPS);
+    const double f = atmos__sim_ice_fraction(t_k);
+    if (f <= 0) {
+        *dq = dw;
+        return qw;
+    }
+    const double qi = mixing_ratio(atmos__sim_esat_ice(t_k), p_pa);
+    const double di = qi * 22.587 * 273.86 / ((tc + 273.86) * (tc + 273.86)) * (1.0 + qi / SIM_EPS);
+    const double ti = 250.16, t0 = 273.16;
+    const double df = t_k > ti ? -2.0 * (t_k - ti) / ((t0 - ti) * (t0 - ti)) : 0.0;
+    *dq = (1 - f) * dw + f * di + df * (qi - qw);
+    return (1 - f) * qw + f * qi;
+}
+
+double atmos__sim_qsat_cond(double t_k, double p_pa)
+{
+    double d;
+    return qsat_cond_d(t_k, p_pa, &d);
+}
+
+double atmos__sim_latent(double t_k)
+{
+    return SIM_LV + SIM_LF * atmos__sim_ice_fraction(t_k);
+}
+
 void atmos__sim_adjust(double *th, double *qv, double *qc, double p_pa, double pi)
 {
     double t = *th * pi, v = *qv, c = *qc;
-    const double lcp = SIM_LV / SIM_CP;
-    if (v <= atmos__sim_qsat(t, p_pa) && c <= 0) return;
+    if (v <= atmos__sim_qsat_cond(t, p_pa) && c <= 0) return;
+    const double lcp = atmos__sim_latent(t) / SIM_CP;
     /* Newton on f(d) = v - d - q_s(T + L d / c_p): d condensed (negative: evaporated). */
     double d = 0;
-    for (int it = 0; it < 6; it++) {
-        const double tt = t + lcp * d, qs = atmos__sim_qsat(tt, p_pa), tc = tt - 273.15;
-        const double dqs = qs * 17.67 * 243.5 / ((tc + 243.5) * (tc + 243.5)) * (1.0 + qs / SIM_EPS);
+    for (int it = 0; it < 8; it++) {
+        double dqs;
+        const double qs = qsat_cond_d(t + lcp * d, p_pa, &dqs);
         const double step = (v - d - qs) / (1.0 + lcp * dqs);
         d += step;
         if (fabs(step) < 1e-12) break;
@@ -108,4 +164,7 @@ void atmos__sim_sounding(atmos_sim *sim)
         sim->ue[k] = e->u_s * (e->z_shear > 0 ? tanh(zc / e->z_shear) : 1.0) - e->u_move;
     }
     sim->rho_ref = sim->rho0[0];
+    for (int k = 0; k < sim->nz; k++) sim->rho_c[k] = sim->rho0[k] / sim->rho_ref;
+    for (int k = 1; k < sim->nz; k++) sim->rho_f[k] = 0.5 * (sim->rho_c[k - 1] + sim->rho_c[k]);
+    sim->rho_f[0] = sim->rho_f[sim->nz] = 0; /* w = 0 there: no flux */
 }

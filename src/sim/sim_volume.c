@@ -15,18 +15,6 @@
 #define SIM_Q_FLOOR 1e-10f /* what an empty cell counts as in the logarithm's interpolation */
 #define SIM_MAX_VOXELS (64L << 20)
 
-/* The fraction of condensate that is ice at temperature t (K): 1 - alpha, alpha = ((t - t_ice) /
- * (t_0 - t_ice))^2 the liquid fraction of ECMWF's IFS (IFS Documentation Cy47r1, Part IV:
- * Physical processes, the mixed phase), t_0 = 273.16 K, t_ice = 250.16 K. */
-double atmos__sim_ice_fraction(double t)
-{
-    const double t0 = 273.16, ti = 250.16;
-    if (t >= t0) return 0;
-    if (t <= ti) return 1;
-    const double a = (t - ti) / (t0 - ti);
-    return 1 - a * a;
-}
-
 /* The written fields' mixing ratios per cell (kg/kg; cut below SIM_Q_CUT), nf of them:
  * cloud water, rain and, with ice, cloud ice. */
 static void cell_fields(const atmos_sim *s, float *q[3], int nf)
