@@ -2,6 +2,7 @@
  * orthographic shadow map of the meshes, and the sunlight the fog scatters along a ray. */
 #include "render/beams_sun.h"
 #include "render/beams_raster.h"
+#include "core/fastmath.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -28,7 +29,7 @@ static double line_t(double A, double k, double tau)
     if (!(A > 0)) return INFINITY;
     if (fabs(k) * tau < 1e-9 * A) return tau / A;
     const double x = k * tau / A;
-    return x >= 1 ? INFINITY : -log1p(-x) / k;
+    return x >= 1 ? INFINITY : -atmos__log1p_fast(-x) / k;
 }
 
 double atmos__beams_fog_tau(const atmos__beams_fog *f, const double o[3], const double d[3], double t)
@@ -139,8 +140,9 @@ typedef struct sun_ray {
  * its sample at i + 0.5). */
 static double share_t(const sun_ray *r, double u)
 {
-    const double q = u * r->whole / r->n, tau = r->flat ? q : -log1p(-r->gamma * q) / r->gamma;
-    return fmin(r->T, line_t(r->A, r->k, tau));
+    const double q = u * r->whole / r->n, tau = r->flat ? q : -atmos__log1p_fast(-r->gamma * q) / r->gamma;
+    const double t = line_t(r->A, r->k, tau);
+    return t < r->T ? t : r->T; /* fmin, inlined (no NaN here) */
 }
 
 static double sample(const sun_ray *r, double t)
@@ -166,10 +168,12 @@ static double run(const sun_ray *r, int i0, int i1, double ta, double tb)
         const double za = r->z0 + ta * r->z1, zb = r->z0 + tb * r->z1;
         const int inside = xa > -1 && xa < n && xb > -1 && xb < n && ya > -1 && ya < n && yb > -1 && yb < n;
         float lo, hi;
-        atmos__beams_tiles_range(&r->s->tiles, texel(fmin(xa, xb), n), texel(fmax(xa, xb), n), texel(fmin(ya, yb), n),
-                                 texel(fmax(ya, yb), n), &lo, &hi);
-        if (fmax(za, zb) < lo) return i1 - i0;
-        if (inside && fmin(za, zb) >= hi) return 0;
+        /* the ends ordered by comparisons: fmin and fmax are calls of the library here */
+        const int xs = xa < xb, ys = ya < yb, zs = za < zb;
+        atmos__beams_tiles_range(&r->s->tiles, texel(xs ? xa : xb, n), texel(xs ? xb : xa, n), texel(ys ? ya : yb, n),
+                                 texel(ys ? yb : ya, n), &lo, &hi);
+        if ((zs ? zb : za) < lo) return i1 - i0;
+        if (inside && (zs ? za : zb) >= hi) return 0;
     }
     if (i1 - i0 <= 4) {
         double sum = 0;
