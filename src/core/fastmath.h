@@ -40,12 +40,12 @@ static inline float atmos__expf_poly(float x)
 /* exp(x) with the polynomial above, 0 below -87 (relative error < 2e-7 over [-87, 88]). */
 static inline float atmos__expf_fast(float x) { return x < -87.0f ? 0.0f : atmos__expf_poly(x); }
 
-/* ln(1 + x) for x > -1 by one call of log, which the C library evaluates in a fraction of
- * log1p's time: with u = 1 + x rounded, ln(1 + x) = x ln(u) / (u - 1) (Goldberg 1991, "What
- * every computer scientist should know about floating-point arithmetic", Theorem 4: a
- * relative error of at most 5 ulps when log is correctly rounded; u - 1 is exact, and
- * ln(u) / (u - 1) varies slowly enough that the rounding of u cancels). x itself where
- * u = 1. */
+/* ln(1 + x) for x > -1 by one call of log, which takes fewer instructions than the C
+ * library's log1p: with u = 1 + x rounded, ln(1 + x) = x ln(u) / (u - 1), x itself where
+ * u = 1 (Goldberg 1991, "What every computer scientist should know about floating-point
+ * arithmetic", Theorem 4: a relative error of at most 5 epsilon for 0 <= x < 3/4 with log
+ * within half an ulp; u - 1 is exact and ln(u) / (u - 1) varies slowly, so the rounding of
+ * u cancels). test_beams_sun measures it against log1p over (-1, 10]: 3.7e-16 at worst. */
 static inline double atmos__log1p_fast(double x)
 {
     const double u = 1 + x;

@@ -23,15 +23,6 @@ static double line_tau(double A, double k, double t)
     return fabs(k * t) < 1e-9 ? A * t : A * -expm1(-k * t) / k;
 }
 
-/* The t where the optical depth reaches tau (INFINITY if it never does). */
-static double line_t(double A, double k, double tau)
-{
-    if (!(A > 0)) return INFINITY;
-    if (fabs(k) * tau < 1e-9 * A) return tau / A;
-    const double x = k * tau / A;
-    return x >= 1 ? INFINITY : -atmos__log1p_fast(-x) / k;
-}
-
 double atmos__beams_fog_tau(const atmos__beams_fog *f, const double o[3], const double d[3], double t)
 {
     double A, k;
@@ -132,16 +123,25 @@ double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], c
 typedef struct sun_ray {
     const atmos__beams_sun *s;
     double A, k, gamma, whole, T;
+    double step, inv_gamma, k_over_A, inv_A, inv_k; /* whole / n and the reciprocals share_t uses */
     int n, flat;
     double x0, x1, y0, y1, z0, z1;
 } sun_ray;
 
 /* Where the integral reaches the share u of its whole (u in [0, n]: step i spans [i, i + 1],
- * its sample at i + 0.5). */
+ * its sample at i + 0.5): the eye's optical depth tau there, then the t where the fog's
+ * A exp(-k t) integrates to tau (INFINITY if it never does). Divisions by per-ray constants
+ * are products with their reciprocals. */
 static double share_t(const sun_ray *r, double u)
 {
-    const double q = u * r->whole / r->n, tau = r->flat ? q : -atmos__log1p_fast(-r->gamma * q) / r->gamma;
-    const double t = line_t(r->A, r->k, tau);
+    const double q = u * r->step, tau = r->flat ? q : -atmos__log1p_fast(-r->gamma * q) * r->inv_gamma;
+    double t;
+    if (!(r->A > 0)) t = INFINITY;
+    else if (fabs(r->k) * tau < 1e-9 * r->A) t = tau * r->inv_A;
+    else {
+        const double x = tau * r->k_over_A;
+        t = x >= 1 ? INFINITY : -atmos__log1p_fast(-x) * r->inv_k;
+    }
     return t < r->T ? t : r->T; /* fmin, inlined (no NaN here) */
 }
 
@@ -202,6 +202,8 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
     if (!(r.whole > 0)) return 0;
     int n = (int)ceil(1 / fmax(epsilon, 1e-9));
     r.n = n = n < 1 ? 1 : n > max_steps ? max_steps : n;
+    r.step = r.whole / n, r.inv_gamma = r.flat ? 0 : 1 / r.gamma, r.inv_k = r.k != 0 ? 1 / r.k : 0;
+    r.inv_A = r.A > 0 ? 1 / r.A : 0, r.k_over_A = r.k * r.inv_A;
     double sum = n;
     if (s->n) {
         /* the map's coordinates along the ray, linear in t */
