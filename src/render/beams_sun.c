@@ -2,6 +2,7 @@
  * orthographic shadow map of the meshes, and the sunlight the fog scatters along a ray. */
 #include "render/beams_sun.h"
 #include "render/beams_raster.h"
+#include "core/fastmath.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -20,15 +21,6 @@ static double line_tau(double A, double k, double t)
 {
     if (t == INFINITY) return k > 0 ? A / k : A > 0 ? INFINITY : 0;
     return fabs(k * t) < 1e-9 ? A * t : A * -expm1(-k * t) / k;
-}
-
-/* The t where the optical depth reaches tau (INFINITY if it never does). */
-static double line_t(double A, double k, double tau)
-{
-    if (!(A > 0)) return INFINITY;
-    if (fabs(k) * tau < 1e-9 * A) return tau / A;
-    const double x = k * tau / A;
-    return x >= 1 ? INFINITY : -log1p(-x) / k;
 }
 
 double atmos__beams_fog_tau(const atmos__beams_fog *f, const double o[3], const double d[3], double t)
@@ -131,16 +123,26 @@ double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], c
 typedef struct sun_ray {
     const atmos__beams_sun *s;
     double A, k, gamma, whole, T;
+    double step, inv_gamma, k_over_A, inv_A, inv_k; /* whole / n and the reciprocals share_t uses */
     int n, flat;
     double x0, x1, y0, y1, z0, z1;
 } sun_ray;
 
 /* Where the integral reaches the share u of its whole (u in [0, n]: step i spans [i, i + 1],
- * its sample at i + 0.5). */
+ * its sample at i + 0.5): the eye's optical depth tau there, then the t where the fog's
+ * A exp(-k t) integrates to tau (INFINITY if it never does). Divisions by per-ray constants
+ * are products with their reciprocals. */
 static double share_t(const sun_ray *r, double u)
 {
-    const double q = u * r->whole / r->n, tau = r->flat ? q : -log1p(-r->gamma * q) / r->gamma;
-    return fmin(r->T, line_t(r->A, r->k, tau));
+    const double q = u * r->step, tau = r->flat ? q : -atmos__log1p_fast(-r->gamma * q) * r->inv_gamma;
+    double t;
+    if (!(r->A > 0)) t = INFINITY;
+    else if (fabs(r->k) * tau < 1e-9 * r->A) t = tau * r->inv_A;
+    else {
+        const double x = tau * r->k_over_A;
+        t = x >= 1 ? INFINITY : -atmos__log1p_fast(-x) * r->inv_k;
+    }
+    return t < r->T ? t : r->T; /* fmin, inlined (no NaN here) */
 }
 
 static double sample(const sun_ray *r, double t)
@@ -166,10 +168,12 @@ static double run(const sun_ray *r, int i0, int i1, double ta, double tb)
         const double za = r->z0 + ta * r->z1, zb = r->z0 + tb * r->z1;
         const int inside = xa > -1 && xa < n && xb > -1 && xb < n && ya > -1 && ya < n && yb > -1 && yb < n;
         float lo, hi;
-        atmos__beams_tiles_range(&r->s->tiles, texel(fmin(xa, xb), n), texel(fmax(xa, xb), n), texel(fmin(ya, yb), n),
-                                 texel(fmax(ya, yb), n), &lo, &hi);
-        if (fmax(za, zb) < lo) return i1 - i0;
-        if (inside && fmin(za, zb) >= hi) return 0;
+        /* the ends ordered by comparisons: fmin and fmax are calls of the library here */
+        const int xs = xa < xb, ys = ya < yb, zs = za < zb;
+        atmos__beams_tiles_range(&r->s->tiles, texel(xs ? xa : xb, n), texel(xs ? xb : xa, n), texel(ys ? ya : yb, n),
+                                 texel(ys ? yb : ya, n), &lo, &hi);
+        if ((zs ? zb : za) < lo) return i1 - i0;
+        if (inside && (zs ? za : zb) >= hi) return 0;
     }
     if (i1 - i0 <= 4) {
         double sum = 0;
@@ -198,6 +202,8 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
     if (!(r.whole > 0)) return 0;
     int n = (int)ceil(1 / fmax(epsilon, 1e-9));
     r.n = n = n < 1 ? 1 : n > max_steps ? max_steps : n;
+    r.step = r.whole / n, r.inv_gamma = r.flat ? 0 : 1 / r.gamma, r.inv_k = r.k != 0 ? 1 / r.k : 0;
+    r.inv_A = r.A > 0 ? 1 / r.A : 0, r.k_over_A = r.k * r.inv_A;
     double sum = n;
     if (s->n) {
         /* the map's coordinates along the ray, linear in t */

@@ -11,11 +11,15 @@
  *   - the steps' visibility read through the map's min/max tiles (runs proven lit or dark not
  *     read) against every step's middle read one by one (atmos__beams_sun_visibility), on rays
  *     crossing a wall's shadow, starting inside it, leaving the map and endless: to 1e-9;
+ *   - the steps' placement's ln(1 + x) (atmos__log1p_fast, core/fastmath.h) against the
+ *     library's log1p over x in (-1, 10], tiny arguments of both signs included: within
+ *     1e-15 of it, relative;
  *   - the Fig. 10(a) scene small: the same image with one thread and with two, byte for byte;
  *     finite, non-negative pixels; the sunlit sky above the ridge brighter than the shadowed
  *     ground below it. */
 #include "atmos/atmos.h"
 #include "render/beams_sun.h"
+#include "core/fastmath.h"
 #include "test.h"
 
 static atmos_context *ctx;
@@ -208,6 +212,24 @@ static atmos_image *render_file(const char *path, int w, int h, int threads)
     return img;
 }
 
+/* atmos__log1p_fast against log1p: x from -1 + 2^-40 to 10 on a grid, and +-10^-k (k 1..300)
+ * times a spread of mantissas, where 1 + x loses the most of x. */
+static void test_log1p(void)
+{
+    double worst = 0, at = 0;
+    for (int i = 1; i < 400000; i++) {
+        const double x[2] = {-1 + 0x1p-40 + 11.0 * i / 400000, (i % 2 ? 1 : -1) * (1 + (i % 997) / 997.0) * pow(10, -1 - i % 300)};
+        for (int j = 0; j < 2; j++) {
+            const double exact = log1p(x[j]);
+            if (exact == 0) continue;
+            const double e = fabs(atmos__log1p_fast(x[j]) - exact) / fabs(exact);
+            if (e > worst) worst = e, at = x[j];
+        }
+    }
+    printf("log1p_fast: worst relative error %.3g at x = %.17g\n", worst, at);
+    CHECK_MSG(worst <= 1e-15, "worst %g at %.17g", worst, at);
+}
+
 static void test_scene(void)
 {
     const char *src = getenv("ATMOS_SOURCE_DIR");
@@ -241,6 +263,7 @@ int main(void)
     test_no_shadow();
     test_shadow();
     test_skipped_runs();
+    test_log1p();
     test_scene();
     atmos_context_destroy(ctx);
     return test_summary("test_beams_sun");
