@@ -120,11 +120,22 @@ static void node_dir(const atmos__sph_space *s, int row, int col, double d[3])
 /* Steps of the march per piece of the slices between cloud spheres and below them. */
 #define STEPS_CLOUDS 3
 
+/* A node's stop: the logarithms of the sums times the sun's irradiance. */
+static void put_stop(const atmos_atmosphere *a, int n, const atmos__sph_sums *u, float *t)
+{
+    for (int k = 0; k < n; k++) {
+        t[NC * k] = (float)log(fmax(u->sr[k] * a->sun_e[k], TINY));
+        t[NC * k + 1] = (float)log(fmax(u->sm[k] * a->sun_e[k], TINY));
+        t[NC * k + 2] = (float)log(fmax(u->ms[k] * a->sun_e[k], TINY));
+        t[NC * k + 3] = (float)log(fmax(u->t[k], TINY));
+    }
+}
+
 /* The march's sums from t0 to each stop of a ray of the disk through the cloud spheres (the
- * entries of spheres m - 1 .. 0, then the ground at K), chained slice by slice: over
- * [t0, b] = over [t0, a] + T(t0, a) x over [a, b]. */
+ * entries of spheres m - 1 .. 0, then the ground at K) into the node's stops t, chained
+ * slice by slice: over [t0, b] = over [t0, a] + T(t0, a) x over [a, b]. */
 static void march_stops(const atmos_atmosphere *a, const atmos__sph_space *s, const double d[3], double t0,
-                        double K, const double sun[3], atmos__sph_sums *st)
+                        double K, const double sun[3], float *t)
 {
     const atmos__planet *pl = a->planet;
     const atmos__clouds *cl = pl->clouds;
@@ -145,11 +156,12 @@ static void march_stops(const atmos_atmosphere *a, const atmos__sph_space *s, co
                 acc.ms[k] += acc.t[k] * seg.ms[k], acc.t[k] *= seg.t[k];
             }
         }
-        st[j] = acc;
+        put_stop(a, n, &acc, t + (size_t)j * NC * n);
         ta = tb;
     }
 }
 
+/* A node: the whole ray in every stop, or with cloud spheres on the disk's rows each stop. */
 static void fill_node(const atmos_atmosphere *a, atmos__sph_space *s, const double eye[3], const double sun[3],
                       int row, int col)
 {
@@ -158,24 +170,19 @@ static void fill_node(const atmos_atmosphere *a, atmos__sph_space *s, const doub
     double d[3], t0, t1;
     node_dir(s, row, col, d);
     const double K = atmos__planet_ground_distance(pl, eye, d);
-    atmos__sph_sums sm[ATMOS__CLOUDS_MAX + 1];
-    if (!atmos__planet_clip(pl, eye, d, K, &t0, &t1)) {
-        memset(&sm[0], 0, sizeof sm[0]);
-        for (int k = 0; k < n; k++) sm[0].t[k] = 1.0;
-    } else if (ns > 1 && row < NG && K < INFINITY)
-        march_stops(a, s, d, t0, K, sun, sm);
-    else atmos__sph_march(pl, a->model, s->q, d, t0, t1, sun, ATMOS__SPH_STEPS_SPACE, 1, n, NULL, &sm[0]);
-    const int whole = ns > 1 && row < NG && K < INFINITY;
-    for (int j = 0; j < ns; j++) {
-        const atmos__sph_sums *u = whole ? &sm[j] : &sm[0];
-        float *t = s->tab + (((size_t)row * NA + col) * ns + j) * NC * n;
-        for (int k = 0; k < n; k++) {
-            t[NC * k] = (float)log(fmax(u->sr[k] * a->sun_e[k], TINY));
-            t[NC * k + 1] = (float)log(fmax(u->sm[k] * a->sun_e[k], TINY));
-            t[NC * k + 2] = (float)log(fmax(u->ms[k] * a->sun_e[k], TINY));
-            t[NC * k + 3] = (float)log(fmax(u->t[k], TINY));
-        }
+    float *t = s->tab + ((size_t)row * NA + col) * ns * NC * n;
+    const int inside = atmos__planet_clip(pl, eye, d, K, &t0, &t1);
+    if (inside && ns > 1 && row < NG && K < INFINITY) {
+        march_stops(a, s, d, t0, K, sun, t);
+        return;
     }
+    atmos__sph_sums sm;
+    if (inside) atmos__sph_march(pl, a->model, s->q, d, t0, t1, sun, ATMOS__SPH_STEPS_SPACE, 1, n, NULL, &sm);
+    else {
+        memset(&sm, 0, sizeof sm);
+        for (int k = 0; k < n; k++) sm.t[k] = 1.0;
+    }
+    for (int j = 0; j < ns; j++) put_stop(a, n, &sm, t + (size_t)j * NC * n);
 }
 
 atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3])
