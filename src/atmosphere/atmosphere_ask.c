@@ -258,8 +258,9 @@ void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx
         return;
     }
     default:
-        /* clouds: ray by ray through the cloud spheres (planet_clouds_render.c) */
-        if (b->atm->solver && b->atm->solver->batch_eval && !b->atm->planet->clouds)
+        /* clouds: ray by ray through the cloud spheres (planet_clouds_render.c) unless the
+         * solver's batch answers them */
+        if (b->atm->solver && b->atm->solver->batch_eval && (!b->atm->planet->clouds || b->atm->solver->batch_clouds))
             b->atm->solver->batch_eval(b, count, dx, dy, dz, weight, out, scratch);
         else batch_generic(b, count, dx, dy, dz, weight, out);
     }

@@ -45,4 +45,13 @@ double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[
 void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3], const double d[3],
                                    const double sun[3], double *out, atmos_atmosphere_hit *info);
 
+/* The same ray from an eye above the cloud layer that meets the ground, the air's part given:
+ * Lc[j n + k], Tc[j n + k] the air's in-scatter (phase functions applied) and transmittance
+ * from p to stop j, the crossing of sphere m - 1 - j for j < m, the ground for j = m (a
+ * per-eye table's, spherical_space.c). The clouds' light and the ground's are composited
+ * as atmos__planet_radiance_clouds does. Returns 0 (out untouched) when the ray does not
+ * cross each sphere once, top to bottom, before the ground. */
+int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
+                                 const double *Lc, const double *Tc, double *out);
+
 #endif

@@ -62,8 +62,12 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
 {
     const atmos__planet *pl = a->planet;
     const atmos__clouds *cl = pl->clouds;
-    const double tau = atmos__clouds_crossing_tau(pl, i, x, d);
-    if (tau <= 0) return 1.0;
+    /* the column at x once, for the view's crossing and the sun's */
+    double lat, lon;
+    atmos__planet_latlon(pl, x, &lat, &lon);
+    const double col = atmos__clouds_column_tau(cl, lat, lon) / cl->m;
+    if (col <= 0) return 1.0;
+    const double tau = col / fmax(fabs(atmos__planet_mu(pl, x, d)), cl->mu_min[i]);
     const double t = exp(-tau);
     const int n = a->wl.count;
     double E[ATMOS_MAX_WAVELENGTHS];
@@ -75,7 +79,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     double J = G * hg(cl->g, atmos__dot3(d, sun));
     const double mus = atmos__planet_mu(pl, x, sun);
     if (!cl->single && mus > 0) {
-        const double own = atmos__clouds_crossing_tau(pl, i, x, sun); /* the whole shell along the sun */
+        const double own = col / fmax(mus, cl->mu_min[i]); /* the whole shell along the sun */
         J += mus * (1.0 - G * exp(-0.5 * own)) / ATMOS_PI;
     }
     for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];
@@ -141,6 +145,34 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
         info->hits_ground = K < INFINITY;
         info->in_sun_disk = 0;
     }
+}
+
+int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
+                                 const double *Lc, const double *Tc, double *out)
+{
+    const atmos__planet *pl = a->planet;
+    const int n = a->wl.count, m = pl->clouds->m;
+    const double K = atmos__planet_ground_distance(pl, p, d);
+    crossing c[MAX_CROSSINGS];
+    if (!(K < INFINITY) || find_crossings(pl, p, d, K, c) != m) return 0;
+    for (int j = 0; j < m; j++)
+        if (c[j].sphere != m - 1 - j) return 0;
+    double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
+    for (int k = 0; k < n; k++) out[k] = 0.0;
+    for (int j = 0; j <= m; j++) {
+        /* the air between stop j - 1 and stop j as the eye sees it, through the clouds */
+        for (int k = 0; k < n; k++)
+            out[k] += clouds * fmax(Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0), 0.0);
+        for (int k = 0; k < n; k++) w[k] = clouds * Tc[(size_t)j * n + k];
+        if (j == m) {
+            ground_light(a, p, d, K, sun, w, out);
+            break;
+        }
+        const double x[3] = {p[0] + c[j].t * d[0], p[1] + c[j].t * d[1], p[2] + c[j].t * d[2]};
+        clouds *= crossing_light(a, x, d, sun, c[j].sphere, w, out);
+        if (clouds < OPAQUE) break;
+    }
+    return 1;
 }
 
 void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const double sun[3], int w, int h,

@@ -32,6 +32,8 @@ typedef struct atmos__planet_solver {
     void (*batch_eval)(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                        const float *weight, float *out, float *scratch);
     void (*batch_release)(atmos__atm_batch *b);
+    /* nonzero: batch_eval answers rays through cloud spheres too (else they go one by one) */
+    int batch_clouds;
     /* whether b's per-eye tables answer for a new eye and sun as they are (turned toward
      * them); NULL: never */
     int (*batch_keep)(atmos__atm_batch *b, const double eye[3], const double sun[3]);

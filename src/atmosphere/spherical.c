@@ -223,5 +223,6 @@ const atmos__planet_solver atmos__spherical_solver = {
     .batch_eval = atmos__sph_batch_eval,
     .batch_release = atmos__sph_batch_release,
     .batch_keep = atmos__sph_batch_keep,
+    .batch_clouds = 1,
     .aerial = atmos__sph_aerial,
 };

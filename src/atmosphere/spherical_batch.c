@@ -22,6 +22,7 @@
  * The horizon's row follows the true altitude. */
 #include "atmosphere/spherical.h"
 
+#include "atmosphere/planet_clouds.h"
 #include "core/fastmath.h"
 #include "core/vec.h"
 
@@ -156,11 +157,11 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
     s->n = a->wl.count;
     s->march = atmos__planet_altitude(pl, b->eye) >= pl->r_top - pl->r_ground;
     b->state = s;
-    if (pl->clouds) return; /* rays through cloud spheres are answered one by one (atmosphere_ask.c) */
-    if (s->march) {
+    if (s->march) { /* the eye above the air, with or without cloud spheres */
         s->space = atmos__sph_space_create(a, b->eye, b->sun);
         return;
     }
+    if (pl->clouds) return; /* rays through cloud spheres from inside the air: one by one */
     double eye[3], sun[3];
     s->keyed = sv_key(pl, b->eye, b->sun, s->key, eye, sun);
     if (!s->keyed) memcpy(eye, b->eye, sizeof eye), memcpy(sun, b->sun, sizeof sun);
@@ -224,6 +225,20 @@ static void eval_march(const atmos__atm_batch *b, int count, const float *dx, co
         const double l = sqrt(atmos__dot3(d, d));
         for (int c = 0; c < 3; c++) d[c] /= l;
         atmos__sph_radiance(b->atm, b->eye, d, b->sun, ATMOS__SPH_STEPS, L, NULL);
+        for (int k = 0; k < n; k++) out[(size_t)k * count + i] += weight[i] * (float)L[k];
+    }
+}
+
+static void eval_clouds(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                        const float *weight, float *out)
+{
+    const int n = b->atm->wl.count;
+    for (int i = 0; i < count; i++) {
+        if (weight[i] == 0.0f) continue;
+        double d[3] = {dx[i], dy[i], dz[i]}, L[ATMOS_MAX_WAVELENGTHS];
+        const double l = sqrt(atmos__dot3(d, d));
+        for (int c = 0; c < 3; c++) d[c] /= l;
+        atmos__planet_radiance_clouds(b->atm, b->eye, d, b->sun, L, NULL);
         for (int k = 0; k < n; k++) out[(size_t)k * count + i] += weight[i] * (float)L[k];
     }
 }
@@ -298,6 +313,10 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
     const sv_state *s = b->state;
     if (s && s->space) {
         atmos__sph_space_eval(s->space, b->atm, b->sun, count, dx, dy, dz, weight, out);
+        return;
+    }
+    if (b->atm->planet->clouds) { /* without the table: ray by ray through the cloud spheres */
+        eval_clouds(b, count, dx, dy, dz, weight, out);
         return;
     }
     if (!s || s->march) {

@@ -25,6 +25,7 @@
  * miss the air cost a dot product. */
 #include "atmosphere/spherical.h"
 
+#include "atmosphere/planet_clouds.h"
 #include "core/fastmath.h"
 #include "core/vec.h"
 
@@ -41,12 +42,16 @@
 #define NCS 2048 /* the ground's irradiance over the sun's cosine there, in [-1, 1] */
 
 struct atmos__sph_space {
-    int n;
+    int n, ns;                   /* wavelengths; stops per node (1, or m + 1 with m cloud spheres) */
+    double eye[3];               /* world frame */
+    double rc2;                  /* the top cloud sphere's radius squared (0: no clouds) */
     double q[3], qq, r;          /* the eye from the planet's centre, |q|^2, |q| */
     double up[3], e1[3], e2[3];  /* up = q / r, e1 toward the sun's side, e2 = up x e1 */
     double R, Rt;
-    float *tab;                  /* [NG + NL][NA][n][NC]: rows 0..NG-1 the disk (row 0 at its
-                                    edge), NG..NG+NL-1 the limb (row NG at its bottom) */
+    float *tab;                  /* [NG + NL][NA][ns][n][NC]: rows 0..NG-1 the disk (row 0 at its
+                                    edge), NG..NG+NL-1 the limb (row NG at its bottom); stop
+                                    ns - 1 the whole ray, stops j < ns - 1 of the disk's rows
+                                    from the eye to the crossing of cloud sphere m - 1 - j */
     double phit[NG + NL];        /* per row: the azimuth where the sun sets at the row's
                                     reference point (its columns crowd there) */
     float *mie;                  /* [n][NPH] */
@@ -112,28 +117,72 @@ static void node_dir(const atmos__sph_space *s, int row, int col, double d[3])
     for (int i = 0; i < 3; i++) d[i] = -ct * s->up[i] + st * (c * s->e1[i] + sn * s->e2[i]);
 }
 
+/* Steps of the march per piece of the slices between cloud spheres and below them. */
+#define STEPS_CLOUDS 3
+
+/* A node's stop: the logarithms of the sums times the sun's irradiance. */
+static void put_stop(const atmos_atmosphere *a, int n, const atmos__sph_sums *u, float *t)
+{
+    for (int k = 0; k < n; k++) {
+        t[NC * k] = (float)log(fmax(u->sr[k] * a->sun_e[k], TINY));
+        t[NC * k + 1] = (float)log(fmax(u->sm[k] * a->sun_e[k], TINY));
+        t[NC * k + 2] = (float)log(fmax(u->ms[k] * a->sun_e[k], TINY));
+        t[NC * k + 3] = (float)log(fmax(u->t[k], TINY));
+    }
+}
+
+/* The march's sums from t0 to each stop of a ray of the disk through the cloud spheres (the
+ * entries of spheres m - 1 .. 0, then the ground at K) into the node's stops t, chained
+ * slice by slice: over [t0, b] = over [t0, a] + T(t0, a) x over [a, b]. */
+static void march_stops(const atmos_atmosphere *a, const atmos__sph_space *s, const double d[3], double t0,
+                        double K, const double sun[3], float *t)
+{
+    const atmos__planet *pl = a->planet;
+    const atmos__clouds *cl = pl->clouds;
+    const int n = s->n, m = cl->m;
+    const double b = atmos__dot3(s->q, d);
+    double ta = t0;
+    atmos__sph_sums acc, seg;
+    memset(&acc, 0, sizeof acc);
+    for (int k = 0; k < n; k++) acc.t[k] = 1.0;
+    for (int j = 0; j <= m; j++) {
+        const double rr = j < m ? cl->r[m - 1 - j] : s->R;
+        const double tb = j < m ? fmax(-b - sqrt(fmax(0.0, b * b - (s->qq - rr * rr))), ta) : K;
+        if (tb > ta) {
+            atmos__sph_march(pl, a->model, s->q, d, ta, tb, sun, j ? STEPS_CLOUDS : ATMOS__SPH_STEPS_SPACE, 1, n,
+                             NULL, &seg);
+            for (int k = 0; k < n; k++) {
+                acc.sr[k] += acc.t[k] * seg.sr[k], acc.sm[k] += acc.t[k] * seg.sm[k];
+                acc.ms[k] += acc.t[k] * seg.ms[k], acc.t[k] *= seg.t[k];
+            }
+        }
+        put_stop(a, n, &acc, t + (size_t)j * NC * n);
+        ta = tb;
+    }
+}
+
+/* A node: the whole ray in every stop, or with cloud spheres on the disk's rows each stop. */
 static void fill_node(const atmos_atmosphere *a, atmos__sph_space *s, const double eye[3], const double sun[3],
                       int row, int col)
 {
     const atmos__planet *pl = a->planet;
-    const int n = s->n;
+    const int n = s->n, ns = s->ns;
     double d[3], t0, t1;
     node_dir(s, row, col, d);
     const double K = atmos__planet_ground_distance(pl, eye, d);
+    float *t = s->tab + ((size_t)row * NA + col) * ns * NC * n;
+    const int inside = atmos__planet_clip(pl, eye, d, K, &t0, &t1);
+    if (inside && ns > 1 && row < NG && K < INFINITY) {
+        march_stops(a, s, d, t0, K, sun, t);
+        return;
+    }
     atmos__sph_sums sm;
-    if (atmos__planet_clip(pl, eye, d, K, &t0, &t1))
-        atmos__sph_march(pl, a->model, s->q, d, t0, t1, sun, ATMOS__SPH_STEPS_SPACE, 1, n, NULL, &sm);
+    if (inside) atmos__sph_march(pl, a->model, s->q, d, t0, t1, sun, ATMOS__SPH_STEPS_SPACE, 1, n, NULL, &sm);
     else {
         memset(&sm, 0, sizeof sm);
         for (int k = 0; k < n; k++) sm.t[k] = 1.0;
     }
-    float *t = s->tab + ((size_t)row * NA + col) * NC * n;
-    for (int k = 0; k < n; k++) {
-        t[NC * k] = (float)log(fmax(sm.sr[k] * a->sun_e[k], TINY));
-        t[NC * k + 1] = (float)log(fmax(sm.sm[k] * a->sun_e[k], TINY));
-        t[NC * k + 2] = (float)log(fmax(sm.ms[k] * a->sun_e[k], TINY));
-        t[NC * k + 3] = (float)log(fmax(sm.t[k], TINY));
-    }
+    for (int j = 0; j < ns; j++) put_stop(a, n, &sm, t + (size_t)j * NC * n);
 }
 
 atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3])
@@ -142,17 +191,28 @@ atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const doubl
     atmos__sph_space *s = calloc(1, sizeof *s);
     if (!s) return NULL;
     s->n = a->wl.count;
+    s->ns = 1;
+    if (pl->clouds) {
+        const int m = pl->clouds->m;
+        if ((m + 1) * s->n > ATMOS_MAX_WAVELENGTHS) { /* the look-up's buffers; rays one by one */
+            free(s);
+            return NULL;
+        }
+        s->ns = m + 1, s->rc2 = pl->clouds->r[m - 1] * pl->clouds->r[m - 1];
+    }
+    memcpy(s->eye, eye, sizeof s->eye);
     s->q[0] = eye[0], s->q[1] = eye[1] + pl->r_ground, s->q[2] = eye[2];
     s->qq = atmos__dot3(s->q, s->q), s->r = sqrt(s->qq);
     s->R = pl->r_ground, s->Rt = pl->r_top;
     const double mu_s = atmos__planet_sun_frame(s->q, sun, s->up, s->e1, s->e2);
     for (int row = 0; row < NG + NL; row++) s->phit[row] = row_phit(s, row, mu_s);
-    s->tab = malloc(sizeof(float) * ((size_t)(NG + NL) * NA * NC * s->n + (size_t)s->n * (NPH + NCS)));
+    const size_t nodes = (size_t)(NG + NL) * NA * NC * s->ns * s->n;
+    s->tab = malloc(sizeof(float) * (nodes + (size_t)s->n * (NPH + NCS)));
     if (!s->tab) {
         free(s);
         return NULL;
     }
-    s->mie = s->tab + (size_t)(NG + NL) * NA * NC * s->n;
+    s->mie = s->tab + nodes;
     s->gi = s->mie + (size_t)s->n * NPH;
     for (int j = 0; j < NCS; j++) { /* (cos T_sun + E_sky) E / pi, as atmos__sph_ground */
         const double cs = -1.0 + 2.0 * j / (NCS - 1);
@@ -191,7 +251,7 @@ static double row_coord(const atmos__sph_space *s, double p2, int *disk)
  * squared): the table's logarithms interpolated into l[NC n]; returns 1 on the disk. */
 static int ray_logs(const atmos__sph_space *s, const double d[3], double p2, float *l)
 {
-    const int S = NC * s->n;
+    const int S = NC * s->ns * s->n;
     int disk;
     const double fy = row_coord(s, p2, &disk);
     const double phi = atan2(fabs(atmos__dot3(d, s->e2)), atmos__dot3(d, s->e1));
@@ -233,13 +293,43 @@ static void ground(const atmos__sph_space *s, const atmos_atmosphere *a, const d
     }
 }
 
+/* One ray through the cloud spheres answered alone (planet_clouds_render.c). */
+static void cloud_ray(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], const double d[3],
+                      float wt, int count, int i, float *out)
+{
+    double L[ATMOS_MAX_WAVELENGTHS];
+    atmos__planet_radiance_clouds(a, s->eye, d, sun, L, NULL);
+    for (int k = 0; k < s->n; k++) out[(size_t)k * count + i] += wt * (float)L[k];
+}
+
+/* A ray of the disk through the cloud spheres: the air's light and transmittance to each
+ * stop from its exponentiated look-up v, composited with the clouds' light. */
+static void cloud_disk(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], const double d[3],
+                       const float *v, const float *pr, const float *pm, float wt, int count, int i, float *out)
+{
+    const int n = s->n;
+    double Lc[ATMOS_MAX_WAVELENGTHS], Tc[ATMOS_MAX_WAVELENGTHS], L[ATMOS_MAX_WAVELENGTHS];
+    for (int j = 0; j < s->ns; j++)
+        for (int k = 0; k < n; k++) {
+            const float *u = v + ((size_t)j * n + k) * NC;
+            Lc[j * n + k] = pr[k] * u[0] + pm[k] * u[1] + u[2], Tc[j * n + k] = u[3];
+        }
+    if (!atmos__clouds_radiance_stops(a, s->eye, d, sun, Lc, Tc, L)) {
+        cloud_ray(s, a, sun, d, wt, count, i, out);
+        return;
+    }
+    for (int k = 0; k < n; k++) out[(size_t)k * count + i] += wt * (float)L[k];
+}
+
 /* Rays i0 .. i0 + m - 1 (m <= BLK): the look-ups of the rays that meet the air and their
- * ground, the exponentials in one loop (which vectorises), then the phase functions. */
+ * ground, the exponentials in one loop (which vectorises), then the phase functions. With
+ * cloud spheres the disk's rays composite the clouds on the table's stops (cloud_disk) and
+ * the limb's rays through the cloud layer are answered alone. */
 #define BLK 16
 static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int i0, int m,
                        int count, const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
-    const int n = s->n, S = NC * n;
+    const int n = s->n, S = NC * s->ns * n, last = NC * (s->ns - 1) * n, clouds = s->ns > 1;
     const float kr = 3.0f / (16.0f * 3.14159265359f);
     float lv[BLK * NC * ATMOS_MAX_WAVELENGTHS], G[BLK * ATMOS_MAX_WAVELENGTHS], nu2[BLK], ap[BLK];
     int ip[BLK], idx[BLK], disk[BLK], h = 0;
@@ -250,9 +340,13 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
         for (int c = 0; c < 3; c++) d[c] /= l;
         const double b = atmos__dot3(s->q, d), p2 = s->qq - b * b;
         if (b >= 0 || p2 >= s->Rt * s->Rt) continue; /* misses the air */
+        if (clouds && p2 >= s->R * s->R && p2 < s->rc2) {
+            cloud_ray(s, a, sun, d, weight[i], count, i, out);
+            continue;
+        }
         idx[h] = i;
         disk[h] = ray_logs(s, d, p2, lv + h * S);
-        if (disk[h]) ground(s, a, sun, d, b, G + h * n);
+        if (disk[h] && !clouds) ground(s, a, sun, d, b, G + h * n);
         const float nu = (float)atmos__dot3(d, sun);
         const float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
         ip[h] = (int)fp < NPH - 2 ? (int)fp : NPH - 2;
@@ -260,13 +354,26 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
         h++;
     }
     for (int j = 0; j < h * S; j++) lv[j] = atmos__expf_fast(lv[j]);
-    for (int r = 0; r < h; r++)
+    for (int r = 0; r < h; r++) {
+        float pr[ATMOS_MAX_WAVELENGTHS], pm[ATMOS_MAX_WAVELENGTHS];
         for (int k = 0; k < n; k++) {
-            const float *mp = s->mie + k * NPH + ip[r], *v = lv + r * S + NC * k;
-            const float pm = mp[0] + ap[r] * (mp[1] - mp[0]);
-            const float L = kr * (s->ra[k] + s->rb[k] * nu2[r]) * v[0] + pm * v[1] + v[2] + (disk[r] ? v[3] * G[r * n + k] : 0.0f);
-            out[(size_t)k * count + idx[r]] += weight[idx[r]] * L;
+            const float *mp = s->mie + k * NPH + ip[r];
+            pm[k] = mp[0] + ap[r] * (mp[1] - mp[0]), pr[k] = kr * (s->ra[k] + s->rb[k] * nu2[r]);
         }
+        const int i = idx[r];
+        if (clouds && disk[r]) {
+            double d[3] = {dx[i], dy[i], dz[i]};
+            const double l = sqrt(atmos__dot3(d, d));
+            for (int c = 0; c < 3; c++) d[c] /= l;
+            cloud_disk(s, a, sun, d, lv + r * S, pr, pm, weight[i], count, i, out);
+            continue;
+        }
+        for (int k = 0; k < n; k++) {
+            const float *v = lv + r * S + last + NC * k;
+            const float L = pr[k] * v[0] + pm[k] * v[1] + v[2] + (disk[r] ? v[3] * G[r * n + k] : 0.0f);
+            out[(size_t)k * count + i] += weight[i] * L;
+        }
+    }
 }
 
 void atmos__sph_space_eval(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int count,

@@ -95,7 +95,11 @@ atmos_status atmos_scene_atmosphere_create(atmos_context *ctx, const atmos_scene
     if (!st && clouds && e->cloud_world_file[0])
         st = world_file(ctx, e->cloud_world_file, clouds->width, clouds->height, &d.clouds);
     if (!st) {
-        d.ground_map = ground, d.night_map = night, d.clouds.image = clouds;
+        /* the files named in the scene, else the images the scene's desc holds (a scene built
+         * in code) */
+        if (ground) d.ground_map = ground;
+        if (night) d.night_map = night;
+        if (clouds) d.clouds.image = clouds;
         st = atmos_atmosphere_create(ctx, &d, wl, out);
     }
     atmos_image_destroy(ground);

@@ -1,6 +1,7 @@
 /* atmos bench sky, the atmosphere models (bench_sky.h): per model the time to build the
  * atmosphere (its tables) cold and again with its cache, and the sky renderer's cost
- * through the plan API at 720x480 from the ground and from 36 000 km. */
+ * through the plan API at 720x480 from the ground and from 36 000 km, there also with cloud
+ * spheres (the spherical kinds). */
 #define _POSIX_C_SOURCE 200809L /* getpid */
 #include "bench_sky.h"
 #include "atmos/cache.h"
@@ -43,13 +44,34 @@ static atmos_status bench_precompute(atmos_context *ctx, atmos_atmosphere_kind k
     return ATMOS_OK;
 }
 
+/* A synthetic global cloud image (bench only; the satellite images live in the data folder):
+ * brightness in 10 x 5 degree blocks from 0 to 0.9 plus a smooth wave, clear, thin and thick
+ * clouds side by side; NULL when out of memory. */
+static atmos_image *bench_cloud_image(atmos_context *ctx)
+{
+    atmos_image *img = NULL;
+    const int w = 720, h = 360;
+    if (atmos_image_create(ctx, w, h, 1, &img) != ATMOS_OK) return NULL;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const double lon = -180.0 + (x + 0.5) / 2.0, lat = 90.0 - (y + 0.5) / 2.0;
+            const int i = (int)floor(lon / 10.0) + 7 * (int)floor(lat / 5.0);
+            const double blocks = 0.1 * (double)(((i % 10) + 10) % 10);
+            const double wave = 0.5 + 0.5 * sin(lon * 3.14159265358979 / 45.0) * cos(lat * 3.14159265358979 / 30.0);
+            img->pixels[(size_t)y * w + x] = (float)(0.5 * blocks + 0.4 * wave);
+        }
+    return img;
+}
+
 /* The two views: from 2 m above the ground toward the horizon (90 degrees vertical field,
  * the sun 30 degrees high in view), and from 36 000 km straight down at the whole planet
  * (20 degrees vertical field: the disk, the limb and space; the sun 30 degrees high over
  * the origin, so the terminator crosses the disk). */
-static void view_scene(atmos_scene *sc, atmos_atmosphere_kind kind, int space, int w, int h)
+static void view_scene(atmos_scene *sc, atmos_atmosphere_kind kind, int space, int w, int h,
+                       const atmos_image *clouds)
 {
     atmos_scene_defaults(sc);
+    sc->atmosphere.clouds.image = clouds; /* five spheres between 2 and 8 km by default */
     sc->width = w, sc->height = h;
     sc->wavelengths = ATMOS_WAVELENGTHS_RGB;
     sc->atmosphere.kind = kind;
@@ -105,15 +127,15 @@ static atmos_status time_frames(atmos_context *ctx, const atmos_scene *sc, int f
  * two sizes predict for the next one (fixed + per pixel) fits budget_s for `repeat` frames;
  * the last size is measured with `repeat` frames when they fit (slow models: smaller). */
 static atmos_status bench_view(atmos_context *ctx, const char *name, atmos_atmosphere_kind kind, int space,
-                               int climb, int repeat, double budget_s)
+                               int climb, const atmos_image *clouds, int repeat, double budget_s)
 {
     static const int divs[] = {60, 16, 8, 4, 2, 1};
     atmos_scene sc;
     double t_prev, t, cpu;
-    view_scene(&sc, kind, space, 1, 1);
+    view_scene(&sc, kind, space, 1, 1, clouds);
     atmos_status st = time_frames(ctx, &sc, 2, climb, &t_prev, &cpu);
     double px_prev = 1, px = (double)(FULL_W / divs[0]) * (FULL_H / divs[0]);
-    view_scene(&sc, kind, space, FULL_W / divs[0], FULL_H / divs[0]);
+    view_scene(&sc, kind, space, FULL_W / divs[0], FULL_H / divs[0], clouds);
     if (st == ATMOS_OK) st = time_frames(ctx, &sc, 2, climb, &t, &cpu);
     int i = 0;
     while (st == ATMOS_OK && i < 5) {
@@ -121,7 +143,7 @@ static atmos_status bench_view(atmos_context *ctx, const char *name, atmos_atmos
         const double px_next = (double)(FULL_W / divs[i + 1]) * (FULL_H / divs[i + 1]);
         if ((fixed + per_px * px_next) * (repeat > 2 ? repeat : 2) > budget_s) break;
         i++;
-        view_scene(&sc, kind, space, FULL_W / divs[i], FULL_H / divs[i]);
+        view_scene(&sc, kind, space, FULL_W / divs[i], FULL_H / divs[i], clouds);
         t_prev = t, px_prev = px, px = px_next;
         st = time_frames(ctx, &sc, 2, climb, &t, &cpu);
     }
@@ -131,7 +153,7 @@ static atmos_status bench_view(atmos_context *ctx, const char *name, atmos_atmos
     const int threads = atmos_context_threads(ctx);
     printf("bench=sky case=%s model=%s wavelengths=rgb size=%dx%d threads=%d seconds=%.5f ns_per_pixel=%.1f "
            "cpu_ns_per_pixel=%.1f",
-           space ? "space" : (climb ? "ground_climb" : "ground"), name, sc.width, sc.height, threads, t, t * threads * 1e9 / px, cpu * 1e9 / px);
+           space ? (clouds ? "space_clouds" : "space") : (climb ? "ground_climb" : "ground"), name, sc.width, sc.height, threads, t, t * threads * 1e9 / px, cpu * 1e9 / px);
     if (space) printf(" fps=%.3g", 1.0 / (t * scale));
     if (divs[i] > 1) printf(" extrapolated=1");
     printf("\n");
@@ -153,6 +175,7 @@ int bench_sky_models(int threads, int repeat, double budget_s, const char *model
     atmos_context *ctx = NULL;
     if (atmos_context_create(&cd, &ctx) != ATMOS_OK) return CLI_EXIT_RUNTIME;
     atmos_status st = ATMOS_OK;
+    atmos_image *clouds = bench_cloud_image(ctx);
     for (size_t m = 0; m < sizeof kinds / sizeof kinds[0] && st == ATMOS_OK; m++) {
         if (models && !cli_list_has(models, kinds[m].name)) continue;
         double cold = 0, cached = 0;
@@ -162,9 +185,14 @@ int bench_sky_models(int threads, int repeat, double budget_s, const char *model
                "cached_seconds=%.4f\n",
                kinds[m].name, atmos_context_threads(ctx), cold, cached);
         fflush(stdout);
-        for (int v = 0; v < 3 && st == ATMOS_OK; v++) /* ground, ground climbing, space */
-            st = bench_view(ctx, kinds[m].name, kinds[m].kind, v == 2, v == 1, repeat, budget_s);
+        /* ground, ground climbing, space, space with cloud spheres (the spherical kinds) */
+        for (int v = 0; v < 4 && st == ATMOS_OK; v++) {
+            if (v == 3 && (kinds[m].kind == ATMOS_ATMOSPHERE_RILEY || !clouds)) continue;
+            st = bench_view(ctx, kinds[m].name, kinds[m].kind, v >= 2, v == 1, v == 3 ? clouds : NULL, repeat,
+                            budget_s);
+        }
     }
+    atmos_image_destroy(clouds);
     int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error("bench", ctx, st);
     atmos_cache_clear(ctx, NULL);
     rmdir(dir);

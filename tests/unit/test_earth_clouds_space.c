@@ -1,0 +1,101 @@
+/* The Earth with cloud spheres seen from above the air (docs/sky.md, "Cloud spheres"): the
+ * sky renderer's batch, which takes the air between the eye, the spheres and the ground from
+ * the per-eye table's stops (spherical_space.c), against the one-ray answer that integrates
+ * the air of every piece between crossings afresh (atmos__planet_radiance_clouds), on a small
+ * image of the disk, the limb and space from 12 000 km: the luminance's RMS and worst
+ * relative error over the rays that meet the air. */
+#include "atmos/atmos.h"
+#include "atmosphere/atmosphere_internal.h"
+#include "atmosphere/atmosphere_ops.h"
+#include "atmosphere/planet_clouds.h"
+#include "test.h"
+
+#define PI 3.14159265358979323846
+#define W 96
+#define H 64
+
+/* Clouds in 20 x 10 degree blocks of brightness 0 .. 0.9 (optical depths 0 to ~60) and a
+ * smooth band: thin, thick and no cloud side by side. */
+static float cloud_brightness(double lon, double lat)
+{
+    const int i = (int)floor(lon / 20.0) + 7 * (int)floor(lat / 10.0);
+    const double blocks = 0.1 * (double)(((i % 10) + 10) % 10);
+    return (float)(0.5 * blocks + 0.4 * (0.5 + 0.5 * sin(lon * PI / 45.0) * cos(lat * PI / 30.0)));
+}
+
+static atmos_image *cloud_image(void)
+{
+    atmos_image *img = NULL;
+    const int w = 360, h = 180;
+    if (atmos_image_create(NULL, w, h, 1, &img) != ATMOS_OK) exit(2);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            img->pixels[(size_t)y * w + x] = cloud_brightness(-180.0 + x + 0.5, 90.0 - y - 0.5);
+    return img;
+}
+
+static double lum(const double *L) { return 0.2126 * L[0] + 0.7152 * L[1] + 0.0722 * L[2]; }
+
+/* One view: the eye 12 000 km up, looking down with a 46 degree field (the disk, the limb
+ * and space), the sun sun_elev_deg high over the point under the eye. */
+static void check_view(const atmos_atmosphere *a, double sun_elev_deg, double rms_max, double worst_max)
+{
+    const double eye[3] = {0, 12000e3, 0};
+    const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
+    const double sun[3] = {cos(se) * sin(az), sin(se), -cos(se) * cos(az)};
+    atmos__atm_batch b;
+    atmos__atm_batch_init(&b, a, eye, sun);
+    static float dx[W], dy[W], dz[W], wt[W], out[3 * W];
+    double s2 = 0, worst = 0, ref_max = 0;
+    int cnt = 0;
+    static double ref[H][W][3], got[H][W][3];
+    const double f = tan(23.0 * PI / 180) / (H / 2.0);
+    for (int y = 0; y < H; y++) {
+        for (int x = 0; x < W; x++) {
+            double d[3] = {(x + 0.5 - W / 2.0) * f, -1.0, (y + 0.5 - H / 2.0) * f};
+            const double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int c = 0; c < 3; c++) d[c] /= l;
+            dx[x] = (float)d[0], dy[x] = (float)d[1], dz[x] = (float)d[2], wt[x] = 1.0f;
+            atmos__planet_radiance_clouds(a, eye, d, sun, ref[y][x], NULL);
+        }
+        for (int i = 0; i < 3 * W; i++) out[i] = 0.0f;
+        atmos__atm_batch_eval(&b, W, dx, dy, dz, wt, out, NULL);
+        for (int x = 0; x < W; x++) {
+            for (int k = 0; k < 3; k++) got[y][x][k] = out[k * W + x];
+            ref_max = fmax(ref_max, lum(ref[y][x]));
+        }
+    }
+    atmos__atm_batch_release(&b);
+    /* relative to the pixel, floored at 1 % of the brightest (the night side's black) */
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const double r = lum(ref[y][x]), e = fabs(lum(got[y][x]) - r) / fmax(r, 0.01 * ref_max);
+            if (r <= 0 && lum(got[y][x]) <= 0) continue;
+            s2 += e * e, cnt++, worst = fmax(worst, e);
+        }
+    const double rms = sqrt(s2 / cnt);
+    printf("sun %g deg: %d rays, luminance error RMS %.4f, worst %.4f\n", sun_elev_deg, cnt, rms, worst);
+    CHECK(cnt > W * H / 3);
+    CHECK(rms <= rms_max);
+    CHECK(worst <= worst_max);
+}
+
+int main(void)
+{
+    atmos_image *clouds = cloud_image();
+    atmos_atmosphere_desc d;
+    atmos_atmosphere_defaults(&d);
+    d.kind = ATMOS_ATMOSPHERE_SPHERICAL;
+    d.latitude_deg = 35, d.longitude_deg = 138;
+    d.clouds.image = clouds;
+    d.clouds.spheres = 5;
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_atmosphere *a = NULL;
+    CHECK_OK(atmos_atmosphere_create(NULL, &d, &wl, &a));
+    check_view(a, 45, 0.005, 0.08);
+    check_view(a, 5, 0.005, 0.08); /* the terminator on the disk */
+    atmos_atmosphere_destroy(a);
+    atmos_image_destroy(clouds);
+    return test_summary("test_earth_clouds_space");
+}
