@@ -25,6 +25,12 @@
 # 1 % of the other frames (at least one). cpu_s: the run's CPU time (user + system, with making
 # the plan), steadier than wall times on a shared machine. load: the 1-minute load average
 # before the case.
+#
+# Last figures: on the idle machine before the round that left the plan's copy of moving frames
+# out (docs/viewer.md, "Where the field's frame goes"): field 36.9 fps median, 1 % low 12.6, first
+# frame 1.4 s; million 10.4 fps, 1 % low 5.7, first 9.9 s; inside 50 fps. After it, only on the
+# loaded machine (load 6.5-8.5, OMP_WAIT_POLICY=passive, --frames 120 / 36): field 13.7 / 23.4
+# fps median (before 12.8 / 11.8 in the same minutes), million 2.9 / 4.7 (before 2.7 / 1.8).
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)

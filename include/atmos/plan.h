@@ -93,6 +93,10 @@ typedef struct atmos_frame {
                                    coarsest whose splat is still this many of its pixels in radius, laid over
                                    the 1/4 one bilinearly (the viewer's frames; docs/viewer.md); 0 = every
                                    particle at 1/4, as atmos render draws; else in [1, 1000] */
+    int no_keep;                /* 1: the plan does not keep this frame's pixels for the next call (which copies
+                                   them when nothing changed): a frame of a view that moves every frame (the
+                                   viewer's scripted flights and previews; docs/viewer.md) saves the copy; the
+                                   next frame of the same view is then rendered, and kept; 0 keeps it */
     atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
 } atmos_frame;
 

@@ -147,12 +147,13 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
 {
     if (drawn) *drawn = 0;
     const int ntx = (rect[2] - rect[0] + TILE - 1) / TILE, nty = (rect[3] - rect[1] + TILE - 1) / TILE;
-    sp *s = malloc(sizeof *s * (size_t)(pc->n ? pc->n : 1));
-    atmos__keyed *ord = malloc(sizeof *ord * (size_t)(pc->n ? pc->n : 1));
+    /* room for the particles asked for (a cloud's impostor: its own, not the whole field's) */
+    const int count = idx ? nidx : pc->n;
+    sp *s = malloc(sizeof *s * (size_t)(count > 0 ? count : 1));
+    atmos__keyed *ord = malloc(sizeof *ord * (size_t)(count > 0 ? count : 1));
     int *cnt = calloc((size_t)ntx * nty + 1, sizeof(int));
     int n = 0;
     if (!s || !ord || !cnt) goto nomem;
-    const int count = idx ? nidx : pc->n;
     for (int q = 0; q < count; q++)
         if (prepare(pc, idx ? idx[q] : q, o, L, cam, rect, &s[n])) ord[n].key = s[n].z, ord[n].index = n, n++;
     atmos__keyed_sort(ord, (size_t)n, 1);

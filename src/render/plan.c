@@ -6,6 +6,7 @@
 #include "volume/volume_grid.h"
 
 #include <limits.h>
+#include <stdint.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -326,18 +327,28 @@ static void copy_rect(float *dst, const float *src, int W, int C, const atmos__r
                sizeof(float) * (size_t)(r->x1 - r->x0) * C);
 }
 
+/* 1 for a NaN or an infinity: all exponent bits set (integer operations, so that the loop over
+ * a row vectorises: isfinite's did not). */
+static inline unsigned not_finite(float x)
+{
+    uint32_t u;
+    memcpy(&u, &x, sizeof u);
+    return (u & 0x7f800000u) == 0x7f800000u;
+}
+
 /* No valid scene may give a NaN or an infinity (DESIGN §5): a renderer that does has a
  * bug, and an image holding one is refused here, whatever the renderer, rather than
- * written with exit status 0. With keep (a sky, slice, Nishita, Harris or beams frame), the
- * rendered pixels are kept for the next call in the same pass: rows on the threads (one pass
- * over a 1280 x 720 frame instead of two serial ones; the count and the first bad pixel do not
- * depend on the thread count). */
+ * written with exit status 0. With keep (a sky, slice, Nishita, Harris or beams frame, not
+ * atmos_frame.no_keep), the rendered pixels are kept for the next call in the same pass: rows on
+ * the threads (one pass over a 1280 x 720 frame instead of two serial ones; the count and the
+ * first bad pixel do not depend on the thread count). The view is remembered either way (what
+ * the next frame changed). */
 static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const atmos__rect *r, const atmos_image *out,
                                    int keep)
 {
     const int W = out->width, C = out->channels;
     const size_t need = (size_t)out->width * out->height * out->channels, n = (size_t)(r->x1 - r->x0) * C;
-    p->have_last = 0;
+    p->have_last = p->have_pixels = 0;
     if (keep && need > p->last_cap) {
         float *b = realloc(p->last_pixels, sizeof(float) * need);
         if (b) p->last_pixels = b, p->last_cap = need;
@@ -348,8 +359,9 @@ static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const at
 #pragma omp parallel for schedule(static) reduction(+ : bad) reduction(min : first) num_threads(atmos__threads(p->ctx))
     for (int y = r->y0; y < r->y1; y++) {
         const float *row = out->pixels + ((size_t)y * W + r->x0) * C;
-        size_t b = 0;
-        for (size_t i = 0; i < n; i++) b += !isfinite(row[i]);
+        unsigned b = 0;
+#pragma omp simd reduction(+ : b)
+        for (size_t i = 0; i < n; i++) b += not_finite(row[i]);
         if (b) {
             for (size_t i = 0; i < n; i++)
                 if (!isfinite(row[i])) {
@@ -366,7 +378,8 @@ static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const at
                             "renderer bug for this scene; the image is not written, please report the scene",
                             bad, (size_t)(r->y1 - r->y0) * n, r->x0 + (first % ((long long)W * C)) / C,
                             first / ((long long)W * C));
-    if (keep) p->last_view = *v, p->last_rect = *r, p->have_last = 1;
+    p->last_view = *v, p->have_last = 1;
+    if (keep) p->last_rect = *r, p->have_pixels = 1;
     return ATMOS_OK;
 }
 
@@ -440,7 +453,7 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
     memset(stats, 0, sizeof *stats);
     stats->camera_changed = !p->have_last || memcmp(&v.cam, &p->last_view.cam, sizeof v.cam) != 0;
     stats->sun_changed = !p->have_last || memcmp(v.sun, p->last_view.sun, sizeof v.sun) != 0;
-    if (p->renderer != ATMOS_RENDERER_PATH && p->have_last && same_view(&v, &p->last_view) && rect_inside(&r, &p->last_rect)) {
+    if (p->renderer != ATMOS_RENDERER_PATH && p->have_pixels && same_view(&v, &p->last_view) && rect_inside(&r, &p->last_rect)) {
         copy_rect(out->pixels, p->last_pixels, out->width, out->channels, &r);
         stats->reused = 1;
         stats->slice = prev.slice;
@@ -459,9 +472,9 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
     }
     /* a frame the impostor budget left unfinished is not kept: the same frame again finishes it */
     if (st == ATMOS_OK && !stats->reused)
-        st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH && !stats->impostors_held);
+        st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH && !stats->impostors_held && !f->no_keep);
     if (st != ATMOS_OK) {
-        p->have_last = 0;
+        p->have_last = p->have_pixels = 0;
         return st;
     }
     if (p->renderer == ATMOS_RENDERER_PATH) p->last_view = v, p->have_last = 1;

@@ -27,7 +27,8 @@ struct atmos_plan {
     int reference;
     /* The last frame rendered and its pixels (sky and slice renderers: returned again when
      * nothing changed). */
-    int have_last;
+    int have_last;                       /* last_view is the last frame rendered */
+    int have_pixels;                     /* and last_pixels its pixels over last_rect */
     atmos__view last_view;
     atmos__rect last_rect;
     float *last_pixels;

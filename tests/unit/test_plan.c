@@ -100,6 +100,47 @@ static void test_sequence(atmos_context *ctx, atmos_renderer_kind r, const atmos
     atmos_plan_destroy(p);
 }
 
+/* A frame with no_keep is not kept: the same frame next is rendered again (not copied), equal
+ * to a fresh plan's, and kept; the one after it is copied. A frame that moved after a no_keep
+ * one is rendered as always. */
+static void test_no_keep(atmos_context *ctx, atmos_renderer_kind r, const atmos_volume *v)
+{
+    atmos_scene s;
+    load_scene(ctx, r, &s);
+    atmos_plan *p = NULL;
+    CHECK_OK(atmos_plan_create(ctx, &s, v, NULL, &p));
+    if (!p) exit(1);
+    atmos_frame f, g;
+    CHECK_OK(atmos_frame_from_scene(ctx, &s, &f));
+    CHECK(f.no_keep == 0);
+    g = f;
+    atmos_frame_orbit(&g, p, 25);
+    g.no_keep = 1;
+    atmos_image *img = NULL;
+    CHECK_OK(atmos_plan_image_create(p, &f, &img));
+    atmos_plan_stats st;
+    CHECK_OK(atmos_plan_render(p, &g, NULL, img, NULL)); /* moved, not kept */
+    g.no_keep = 0;
+    CHECK_OK(atmos_plan_render(p, &g, NULL, img, NULL)); /* the same view: rendered again */
+    atmos_plan_get_stats(p, &st);
+    CHECK_MSG(!st.reused && !st.camera_changed && !st.sun_changed, "renderer %d: a no_keep frame was kept (reused %d)",
+              (int)r, st.reused);
+    atmos_image *ref = fresh(ctx, &s, v, &g);
+    CHECK_MSG(same(img, ref), "renderer %d: the frame after a no_keep one differs from a fresh plan's", (int)r);
+    CHECK_OK(atmos_plan_render(p, &g, NULL, img, NULL)); /* now kept: copied */
+    atmos_plan_get_stats(p, &st);
+    CHECK_MSG(st.reused && same(img, ref), "renderer %d: the frame after the re-rendered one was not reused", (int)r);
+    f.no_keep = 1;
+    CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL)); /* moved back: rendered */
+    atmos_plan_get_stats(p, &st);
+    atmos_image_destroy(ref);
+    ref = fresh(ctx, &s, v, &f);
+    CHECK(!st.reused && st.camera_changed && same(img, ref));
+    atmos_image_destroy(ref);
+    atmos_image_destroy(img);
+    atmos_plan_destroy(p);
+}
+
 /* A region of a frame: its pixels are the whole frame's, the others are left as they were. */
 static void test_region(atmos_context *ctx, atmos_renderer_kind r, const atmos_volume *v, double eye_scale)
 {
@@ -281,6 +322,9 @@ int main(void)
         test_region(ctx, (atmos_renderer_kind)r, v, 1.0);
         test_cli_equals_library(ctx, (atmos_renderer_kind)r);
     }
+    test_no_keep(ctx, ATMOS_RENDERER_SKY, v);
+    test_no_keep(ctx, ATMOS_RENDERER_SLICE, v);
+    test_no_keep(ctx, ATMOS_RENDERER_HARRIS, v);
     test_region(ctx, ATMOS_RENDERER_SLICE, v, 0.6);
     test_progressive(ctx, v);
     test_orbit(ctx, v);

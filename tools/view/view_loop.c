@@ -222,6 +222,9 @@ static atmos_status render(loop *L, view_state *s, view_quality q, atmos_plan **
     if (!saving) /* a cloud holding the eye: its near particles in coarser layers (docs/viewer.md) */
         f.sky_step = VIEW_SKY_STEP, f.impostor_budget = L->impostor_budget, f.screen_layer_px = L->screen_layer_px;
     f.warm_field = !saving; /* a saved frame is the offline render's: its field built afresh */
+    /* a moving view's frame is not kept by the plan for an unchanged next one (the copy of a
+     * 1280 x 720 frame saved; a still view's frame is kept) */
+    f.no_keep = q == VIEW_PREVIEW || q == VIEW_SCRIPTED;
     if (s->renderer == ATMOS_RENDERER_SLICE) slice_quality(&f, L->sc, q);
     if (s->renderer == ATMOS_RENDERER_PATH) {
         const int full = L->sc->path.spp > 0 ? L->sc->path.spp : 64;
