@@ -215,8 +215,10 @@ SV_INLINE float azimuth(float x, float y)
     return x < 0 ? 3.14159265359f - a : a;
 }
 
-static void eval_march(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
-                       const float *weight, float *out)
+/* Ray by ray, each ray's radiance by the march of the production model's solver, or through
+ * the cloud spheres when clouds is set. */
+static void eval_rays(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
+                      const float *weight, float *out, int clouds)
 {
     const int n = b->atm->wl.count;
     for (int i = 0; i < count; i++) {
@@ -224,21 +226,10 @@ static void eval_march(const atmos__atm_batch *b, int count, const float *dx, co
         double d[3] = {dx[i], dy[i], dz[i]}, L[ATMOS_MAX_WAVELENGTHS];
         const double l = sqrt(atmos__dot3(d, d));
         for (int c = 0; c < 3; c++) d[c] /= l;
-        atmos__sph_radiance(b->atm, b->eye, d, b->sun, ATMOS__SPH_STEPS, L, NULL);
-        for (int k = 0; k < n; k++) out[(size_t)k * count + i] += weight[i] * (float)L[k];
-    }
-}
-
-static void eval_clouds(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
-                        const float *weight, float *out)
-{
-    const int n = b->atm->wl.count;
-    for (int i = 0; i < count; i++) {
-        if (weight[i] == 0.0f) continue;
-        double d[3] = {dx[i], dy[i], dz[i]}, L[ATMOS_MAX_WAVELENGTHS];
-        const double l = sqrt(atmos__dot3(d, d));
-        for (int c = 0; c < 3; c++) d[c] /= l;
-        atmos__planet_radiance_clouds(b->atm, b->eye, d, b->sun, L, NULL);
+        if (clouds)
+            atmos__planet_radiance_clouds(b->atm, b->eye, d, b->sun, L, NULL);
+        else
+            atmos__sph_radiance(b->atm, b->eye, d, b->sun, ATMOS__SPH_STEPS, L, NULL);
         for (int k = 0; k < n; k++) out[(size_t)k * count + i] += weight[i] * (float)L[k];
     }
 }
@@ -316,11 +307,11 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
         return;
     }
     if (b->atm->planet->clouds) { /* without the table: ray by ray through the cloud spheres */
-        eval_clouds(b, count, dx, dy, dz, weight, out);
+        eval_rays(b, count, dx, dy, dz, weight, out, 1);
         return;
     }
     if (!s || s->march) {
-        eval_march(b, count, dx, dy, dz, weight, out);
+        eval_rays(b, count, dx, dy, dz, weight, out, 0);
         return;
     }
     /* the air's depolarized Rayleigh phase function (planet.h): kr (ra + rb nu^2) */

@@ -8,6 +8,7 @@
 #include "atmos/atmos.h"
 #include "sim/sim_internal.h"
 #include "test.h"
+#include "test_sim_state.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -172,14 +173,6 @@ static void test_thermal(void)
     atmos_context_destroy(c);
 }
 
-static int same_state(const atmos_sim *a, const atmos_sim *b)
-{
-    const float *fa[] = {a->u, a->v, a->w, a->th, a->qv, a->qc, a->qr}, *fb[] = {b->u, b->v, b->w, b->th, b->qv, b->qc, b->qr};
-    for (int f = 0; f < 7; f++)
-        if (memcmp(fa[f], fb[f], (f == 2 ? a->nw : a->n) * sizeof(float))) return 0;
-    return a->rain_out == b->rain_out && a->surface_in == b->surface_in && a->t == b->t;
-}
-
 static atmos_sim *run_preset(int threads, const char *preset, uint64_t seed, int steps)
 {
     atmos_context *c = make_ctx(threads);
@@ -201,8 +194,8 @@ static void test_threads(void)
         atmos_sim_get_stats(a, &st);
         printf("  threads: towering_cumulus 24^2 x %d, %ld steps to %.0f s, max w %.2f m/s, max q_c %.2g\n", st.dims[2],
                st.steps, st.time_s, st.max_w, st.max_qc);
-        CHECK_MSG(same_state(a, b), "1 and 2 threads differ");
-        CHECK_MSG(!same_state(a, d), "seeds 3 and 4 give the same state");
+        CHECK_MSG(test_sim_same_state(a, b), "1 and 2 threads differ");
+        CHECK_MSG(!test_sim_same_state(a, d), "seeds 3 and 4 give the same state");
         CHECK(st.max_qc > 0); /* clouds formed */
     }
     atmos_sim_destroy(a);

@@ -7,6 +7,7 @@
 #include "atmos/atmos.h"
 #include "sim/sim_internal.h"
 #include "test.h"
+#include "test_sim_state.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -103,11 +104,7 @@ static void test_threads(void)
         atmos_sim_get_stats(a, &st);
         printf("  threads: grid 32, 22 min, top %.0f m, max w %.1f m/s\n", st.cloud_top_m, st.max_w);
         CHECK_MSG(st.cloud_top_m > 0.75 * a->env.z_tp, "no deep cloud to compare (top %.0f m)", st.cloud_top_m);
-        int same = 1;
-        const float *fa[7] = {a->u, a->v, a->w, a->th, a->qv, a->qc, a->qr};
-        const float *fb[7] = {b->u, b->v, b->w, b->th, b->qv, b->qc, b->qr};
-        for (int f = 0; f < 7; f++) same &= !memcmp(fa[f], fb[f], sizeof(float) * (f == 2 ? a->nw : a->n));
-        CHECK_MSG(same, "1 and 2 threads differ");
+        CHECK_MSG(test_sim_same_state(a, b), "1 and 2 threads differ");
     }
     atmos_sim_destroy(a);
     atmos_sim_destroy(b);
