@@ -76,14 +76,19 @@ int main(void)
     CHECK_OK(atmos_context_create(&d, &one));
     d.threads = 3;
     CHECK_OK(atmos_context_create(&d, &three));
-    atmos_wavelengths rgb, spec;
+    atmos_wavelengths rgb, spec, three_bands;
     atmos_wavelengths_rgb(&rgb);
     CHECK_OK(atmos_wavelengths_spectral(8, &spec));
+    /* three bands with alpha, as the viewer's RGB frames (their vectorised path), but with a full
+     * matrix to sRGB (RGB's is the identity): the sums' order shows in the bits */
+    CHECK_OK(atmos_wavelengths_spectral(3, &three_bands));
     check(one, &rgb, 97, 31, ATMOS_TONE_FILMIC, 9.0);
     check(three, &rgb, 97, 31, ATMOS_TONE_FILMIC, 9.0);
     check(three, &rgb, 64, 17, ATMOS_TONE_REINHARD, 4.0);
     check(three, &spec, 53, 29, ATMOS_TONE_CLAMP, -3.0);
     check(one, &spec, 53, 29, ATMOS_TONE_FILMIC, 12.0);
+    check(one, &three_bands, 97, 31, ATMOS_TONE_FILMIC, 9.0);
+    check(three, &three_bands, 61, 23, ATMOS_TONE_CLAMP, 2.0);
     /* refused: an automatic exposure, no output, a wrong size */
     atmos_image *img = NULL, *small = NULL;
     CHECK_OK(atmos_image_create(NULL, 8, 8, 4, &img));
