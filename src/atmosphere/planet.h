@@ -137,6 +137,9 @@ double atmos__planet_ground_lights(const atmos__planet *pl, const double g[3], c
 /* Latitude and longitude (degrees; longitude in [-180, 180]) of the direction of x from the
  * planet's centre. */
 void atmos__planet_latlon(const atmos__planet *pl, const double x[3], double *lat_deg, double *lon_deg);
+/* The same for texture look-ups (the cloud image), without the library's asin and atan2:
+ * within 1.2e-6 degrees of atmos__planet_latlon (test_earth's test_latlon_fast). */
+void atmos__planet_latlon_fast(const atmos__planet *pl, const double x[3], double *lat_deg, double *lon_deg);
 /* Builds the geographic frame and the maps of d (planet_surface.c) and the cloud spheres
  * (planet_clouds.c) into pl; the release functions free them (NULL-safe). */
 atmos_status atmos__planet_surface_create(atmos_context *ctx, atmos__planet *pl, const atmos_atmosphere_desc *d,

@@ -161,7 +161,7 @@ double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x
 {
     const atmos__clouds *cl = pl->clouds;
     double lat, lon;
-    atmos__planet_latlon(pl, x, &lat, &lon);
+    atmos__planet_latlon_fast(pl, x, &lat, &lon);
     const double tau = atmos__clouds_column_tau(cl, lat, lon);
     if (tau <= 0) return 0.0;
     const double mu = fabs(atmos__planet_mu(pl, x, d));

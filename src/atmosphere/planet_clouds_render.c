@@ -64,7 +64,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     const atmos__clouds *cl = pl->clouds;
     /* the column at x once, for the view's crossing and the sun's */
     double lat, lon;
-    atmos__planet_latlon(pl, x, &lat, &lon);
+    atmos__planet_latlon_fast(pl, x, &lat, &lon);
     const double col = atmos__clouds_column_tau(cl, lat, lon) / cl->m;
     if (col <= 0) return 1.0;
     const double tau = col / fmax(fabs(atmos__planet_mu(pl, x, d)), cl->mu_min[i]);

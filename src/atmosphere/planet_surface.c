@@ -11,6 +11,7 @@
 #include "atmosphere/planet.h"
 
 #include "atmos/image.h"
+#include "core/fastmath.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -106,6 +107,15 @@ void atmos__planet_latlon(const atmos__planet *pl, const double x[3], double *la
     const double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
     *lat_deg = r > 0 ? asin(fmax(-1.0, fmin(1.0, q[2] / r))) * ATMOS_RAD2DEG : 0.0;
     *lon_deg = atan2(q[1], q[0]) * ATMOS_RAD2DEG;
+}
+
+void atmos__planet_latlon_fast(const atmos__planet *pl, const double x[3], double *lat_deg, double *lon_deg)
+{
+    const double v[3] = {x[0], x[1] + pl->r_ground, -x[2]};
+    double q[3];
+    for (int i = 0; i < 3; i++) q[i] = v[0] * pl->geo_east[i] + v[1] * pl->geo_up[i] + v[2] * pl->geo_north[i];
+    *lat_deg = atmos__atan2_fast(q[2], sqrt(q[0] * q[0] + q[1] * q[1])) * ATMOS_RAD2DEG;
+    *lon_deg = atmos__atan2_fast(q[1], q[0]) * ATMOS_RAD2DEG;
 }
 
 /* The linear value of wavelength k of map m at (lat, lon), bilinear between pixel centres

@@ -1,5 +1,5 @@
 /* Branch-free float exponential for the renderers' vectorised loops; ln(1 + x) without
- * the library's log1p. */
+ * the library's log1p; atan2 without the library's. */
 #ifndef ATMOS_FASTMATH_H
 #define ATMOS_FASTMATH_H
 
@@ -50,6 +50,33 @@ static inline double atmos__log1p_fast(double x)
 {
     const double u = 1 + x;
     return u == 1 ? x : log(u) * (x / (u - 1));
+}
+
+/* atan(z) for 0 <= z <= 1 by Abramowitz & Stegun 4.4.49 (|error| <= 2e-8 rad). */
+static inline double atmos__atan_unit(double z)
+{
+    const double z2 = z * z;
+    double p = 0.0028662257;
+    p = p * z2 - 0.0161657367;
+    p = p * z2 + 0.0429096138;
+    p = p * z2 - 0.0752896400;
+    p = p * z2 + 0.1065626393;
+    p = p * z2 - 0.1420889944;
+    p = p * z2 + 0.1999355085;
+    p = p * z2 - 0.3333314528;
+    return z * (1.0 + p * z2);
+}
+
+/* atan2(y, x) in (-pi, pi] from atmos__atan_unit of the smaller over the larger of |y|
+ * and |x| (the same 2e-8 rad); 0 at the origin. */
+static inline double atmos__atan2_fast(double y, double x)
+{
+    const double ax = fabs(x), ay = fabs(y), hi = fmax(ax, ay);
+    if (!(hi > 0)) return 0.0;
+    double a = atmos__atan_unit(fmin(ax, ay) / hi);
+    a = ay > ax ? 1.57079632679489662 - a : a;
+    a = x < 0 ? 3.14159265358979324 - a : a;
+    return y < 0 ? -a : a;
 }
 
 #endif

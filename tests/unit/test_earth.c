@@ -307,6 +307,38 @@ static void test_regional_edges(void)
     atmos_image_destroy(img);
 }
 
+/* The texture look-ups' latitude and longitude (atmos__planet_latlon_fast) against the exact
+ * ones: the arctangent of Abramowitz & Stegun 4.4.49 is within 2e-8 rad (1.15e-6 degrees) of
+ * atan over [0, 1], so both angles stay within 1.2e-6 degrees of atmos__planet_latlon's
+ * (longitudes compared across the date line), at any radius and origin, the poles included. */
+static void test_latlon_fast(void)
+{
+    const double origins[3][2] = {{30, 100}, {-89.9, -179.9}, {0, 180}};
+    double worst = 0.0;
+    unsigned s = 12345u;
+    for (int o = 0; o < 3; o++) {
+        atmos_atmosphere *a = make(origins[o][0], origins[o][1], NULL, NULL, NULL, 0);
+        const atmos__planet *pl = a->planet;
+        for (int i = 0; i < 20000; i++) {
+            double x[3];
+            for (int c = 0; c < 3; c++) {
+                s = s * 1664525u + 1013904223u;
+                x[c] = ((double)s / 4294967296.0 - 0.5) * 2.0e7;
+            }
+            if (i < 4) x[0] = 0, x[2] = 0, x[1] = i < 2 ? 7e6 : -7e6 - 2 * pl->r_ground; /* above the poles */
+            double lat, lon, flat, flon;
+            atmos__planet_latlon(pl, x, &lat, &lon);
+            atmos__planet_latlon_fast(pl, x, &flat, &flon);
+            double dl = fabs(flon - lon);
+            dl = fmin(dl, 360.0 - dl);
+            if (fabs(lat) > 90.0 - 1e-6) dl = 0; /* the pole's longitude is any */
+            worst = fmax(worst, fmax(fabs(flat - lat), dl));
+        }
+        atmos_atmosphere_destroy(a);
+    }
+    CHECK(worst <= 1.2e-6);
+}
+
 int main(void)
 {
     test_regional_edges();
@@ -315,5 +347,6 @@ int main(void)
     test_night_lights();
     test_brightness_mapping();
     test_cloud_attenuation();
+    test_latlon_fast();
     return test_summary("test_earth");
 }
