@@ -189,28 +189,13 @@ void atmos__sph_batch_release(atmos__atm_batch *b)
     b->state = NULL;
 }
 
-/* atan(y / x) for 0 <= y <= x by Abramowitz & Stegun 4.4.49 (|error| <= 2e-8). */
-SV_INLINE float atan_unit(float z)
-{
-    const float z2 = z * z;
-    float p = 0.0028662257f;
-    p = p * z2 - 0.0161657367f;
-    p = p * z2 + 0.0429096138f;
-    p = p * z2 - 0.0752896400f;
-    p = p * z2 + 0.1065626393f;
-    p = p * z2 - 0.1420889944f;
-    p = p * z2 + 0.1999355085f;
-    p = p * z2 - 0.3333314528f;
-    return z * (1.0f + p * z2);
-}
-
 /* The azimuth in [0, pi] of (x, y) with y >= 0. */
 SV_INLINE float azimuth(float x, float y)
 {
     const float ax = fabsf(x);
     const int swap = y > ax;
     const float num = swap ? ax : y, den = swap ? y : ax;
-    float a = den > 0 ? atan_unit(num / den) : 0.0f;
+    float a = den > 0 ? atmos__atan_unitf(num / den) : 0.0f;
     a = swap ? 1.57079632679f - a : a;
     return x < 0 ? 3.14159265359f - a : a;
 }

@@ -52,19 +52,21 @@ static inline double atmos__log1p_fast(double x)
     return u == 1 ? x : log(u) * (x / (u - 1));
 }
 
-/* atan(z) for 0 <= z <= 1 by Abramowitz & Stegun 4.4.49 (|error| <= 2e-8 rad). */
+/* atan(z) for 0 <= z <= 1 by Abramowitz & Stegun 4.4.49 (|error| <= 2e-8 rad), the polynomial
+ * in z^2 = Z evaluated in type T; double and float versions. */
+#define ATMOS__ATAN_POLY(T, Z)                                                                          \
+    (((((((((T)0.0028662257 * (Z) - (T)0.0161657367) * (Z) + (T)0.0429096138) * (Z) - (T)0.0752896400) * \
+             (Z) + (T)0.1065626393) * (Z) - (T)0.1420889944) * (Z) + (T)0.1999355085) * (Z) -                \
+      (T)0.3333314528))
 static inline double atmos__atan_unit(double z)
 {
     const double z2 = z * z;
-    double p = 0.0028662257;
-    p = p * z2 - 0.0161657367;
-    p = p * z2 + 0.0429096138;
-    p = p * z2 - 0.0752896400;
-    p = p * z2 + 0.1065626393;
-    p = p * z2 - 0.1420889944;
-    p = p * z2 + 0.1999355085;
-    p = p * z2 - 0.3333314528;
-    return z * (1.0 + p * z2);
+    return z * (1.0 + ATMOS__ATAN_POLY(double, z2) * z2);
+}
+static inline float atmos__atan_unitf(float z)
+{
+    const float z2 = z * z;
+    return z * (1.0f + ATMOS__ATAN_POLY(float, z2) * z2);
 }
 
 /* atan2(y, x) in (-pi, pi] from atmos__atan_unit of the smaller over the larger of |y|
