@@ -157,6 +157,11 @@ double atmos__clouds_column_tau(const atmos__clouds *cl, double lat, double lon)
     return R / (k * (1.0 - R));
 }
 
+double atmos__clouds_shell_tau(const atmos__clouds *cl, int i, double tau, double mu)
+{
+    return tau / cl->m / fmax(fabs(mu), cl->mu_min[i]);
+}
+
 double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x[3], const double d[3])
 {
     const atmos__clouds *cl = pl->clouds;
@@ -164,8 +169,7 @@ double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x
     atmos__planet_latlon_fast(pl, x, &lat, &lon);
     const double tau = atmos__clouds_column_tau(cl, lat, lon);
     if (tau <= 0) return 0.0;
-    const double mu = fabs(atmos__planet_mu(pl, x, d));
-    return tau / cl->m / fmax(mu, cl->mu_min[i]);
+    return atmos__clouds_shell_tau(cl, i, tau, atmos__planet_mu(pl, x, d));
 }
 
 double atmos__clouds_sun_attenuation(const atmos__planet *pl, const double x[3], const double sun[3], int below)

@@ -24,6 +24,9 @@ typedef struct atmos__clouds {
 double atmos__clouds_tau_from_brightness(double b, double threshold, double max_tau);
 /* Column optical depth at (lat, lon), bilinear; 0 outside the image. */
 double atmos__clouds_column_tau(const atmos__clouds *cl, double lat, double lon);
+/* Optical depth of shell i crossed at cosine mu to the vertical where the column's is tau:
+ * tau / m / max(|mu|, the shell's grazing limit). */
+double atmos__clouds_shell_tau(const atmos__clouds *cl, int i, double tau, double mu);
 /* Optical depth of shell i crossed at x (on sphere i) in direction d. */
 double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x[3], const double d[3]);
 /* G: the transmittance of the cloud spheres above sphere `below` (-1: all of them, for the

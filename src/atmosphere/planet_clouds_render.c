@@ -65,9 +65,9 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     /* the column at x once, for the view's crossing and the sun's */
     double lat, lon;
     atmos__planet_latlon_fast(pl, x, &lat, &lon);
-    const double col = atmos__clouds_column_tau(cl, lat, lon) / cl->m;
+    const double col = atmos__clouds_column_tau(cl, lat, lon);
     if (col <= 0) return 1.0;
-    const double tau = col / fmax(fabs(atmos__planet_mu(pl, x, d)), cl->mu_min[i]);
+    const double tau = atmos__clouds_shell_tau(cl, i, col, atmos__planet_mu(pl, x, d));
     const double t = exp(-tau);
     const int n = a->wl.count;
     double E[ATMOS_MAX_WAVELENGTHS];
@@ -79,7 +79,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     double J = G * hg(cl->g, atmos__dot3(d, sun));
     const double mus = atmos__planet_mu(pl, x, sun);
     if (!cl->single && mus > 0) {
-        const double own = col / fmax(mus, cl->mu_min[i]); /* the whole shell along the sun */
+        const double own = atmos__clouds_shell_tau(cl, i, col, mus); /* the whole shell along the sun */
         J += mus * (1.0 - G * exp(-0.5 * own)) / ATMOS_PI;
     }
     for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];

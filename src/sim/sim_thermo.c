@@ -41,14 +41,23 @@ double atmos__sim_esat_ice(double t_k)
 
 /* The fraction of condensate that is ice at temperature t (K): 1 - alpha, alpha = ((t - t_ice) /
  * (t_0 - t_ice))^2 the liquid fraction of ECMWF's IFS (IFS Documentation Cy47r1, Part IV:
- * Physical processes, the mixed phase), t_0 = 273.16 K, t_ice = 250.16 K. */
-double atmos__sim_ice_fraction(double t)
+ * Physical processes, the mixed phase), t_0 = 273.16 K, t_ice = 250.16 K; its derivative in t
+ * into *df. */
+static double ice_fraction_d(double t, double *df)
 {
     const double t0 = 273.16, ti = 250.16;
+    *df = 0;
     if (t >= t0) return 0;
     if (t <= ti) return 1;
     const double a = (t - ti) / (t0 - ti);
+    *df = -2.0 * a / (t0 - ti);
     return 1 - a * a;
+}
+
+double atmos__sim_ice_fraction(double t)
+{
+    double df;
+    return ice_fraction_d(t, &df);
 }
 
 /* The saturation mixing ratio of the condensate at t: over water at 0 C and above, blended
@@ -58,15 +67,14 @@ static double qsat_cond_d(double t_k, double p_pa, double *dq)
 {
     const double tc = t_k - 273.15, qw = atmos__sim_qsat(t_k, p_pa);
     const double dw = qw * 17.67 * 243.5 / ((tc + 243.5) * (tc + 243.5)) * (1.0 + qw / SIM_EPS);
-    const double f = atmos__sim_ice_fraction(t_k);
+    double df;
+    const double f = ice_fraction_d(t_k, &df);
     if (f <= 0) {
         *dq = dw;
         return qw;
     }
     const double qi = mixing_ratio(atmos__sim_esat_ice(t_k), p_pa);
     const double di = qi * 22.587 * 273.86 / ((tc + 273.86) * (tc + 273.86)) * (1.0 + qi / SIM_EPS);
-    const double ti = 250.16, t0 = 273.16;
-    const double df = t_k > ti ? -2.0 * (t_k - ti) / ((t0 - ti) * (t0 - ti)) : 0.0;
     *dq = (1 - f) * dw + f * di + df * (qi - qw);
     return (1 - f) * qw + f * qi;
 }
