@@ -8,6 +8,7 @@
 
 #include "light/lamp.h"
 #include "render/objects.h"
+#include "render/beams_sky.h"
 #include "render/beams_sun.h"
 #include "render/beams_tiles.h"
 #include "render/plan_internal.h"
@@ -117,6 +118,7 @@ struct atmos__beams_plan {
     atmos__fog_optics optics;                /* the fog's coefficients and phase function */
     int sun_on;                              /* the sun lights the scene (beams/sun) */
     atmos__beams_sun sun;                    /* its map, built for the last frame's sun (sun.dir) */
+    atmos__beams_sky sky;                    /* the sky's light on the objects, kept between frames */
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
     int centre_planes, centre_subplanes;
 };

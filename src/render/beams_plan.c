@@ -24,6 +24,7 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b)
     for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]), atmos__lamp_free(&b->lights[i].L);
     free(b->lights);
     atmos__beams_sun_free(&b->sun);
+    atmos__beams_sky_free(&b->sky);
     atmos__beams_table_free(&b->table);
     atmos__fog_optics_free(&b->optics);
     free(b);

@@ -46,7 +46,7 @@ typedef struct job {
     double epsilon;
     int max_sub;
     int centre_planes, centre_subplanes;
-    atmos__beams_sky sky; /* the sky's light on surfaces (none in a vacuum) */
+    const atmos__beams_sky *sky; /* the sky's light on surfaces (none in a vacuum or without objects) */
     const atmos__beams_primary *prim; /* what each pixel sees, rasterised (NULL: no objects) */
 } job;
 
@@ -73,9 +73,9 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
         atmos__lamp_tint(&l->L, P, tint);
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
-    if (J->sky.nw) {
+    if (J->sky && J->sky->nw) {
         double E[ATMOS_MAX_WAVELENGTHS];
-        atmos__beams_sky_irradiance(&J->sky, h->normal, E);
+        atmos__beams_sky_irradiance(J->sky, h->normal, E);
         for (int k = 0; k < J->nw; k++) sum[k] += E[k];
     }
     for (int k = 0; k < J->nw; k++) L[k] = b->obj.albedo[m][k] / ATMOS_PI * sum[k] * fog_t;
@@ -416,9 +416,9 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.cx = v->cam.width / 2, J.cy = v->cam.height / 2;
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
-    const double under[3] = {J.eye[0], 0, J.eye[2]}; /* the sky seen from the ground under the eye */
+    /* the sky seen from the ground under the eye, kept while that stays within its quantum */
     if ((b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) ||
-        (b->obj.n > 0 && (st = atmos__beams_sky_build(p->ctx, p->atm, under, v->sun, J.nw, &J.sky)) != ATMOS_OK)) {
+        (b->obj.n > 0 && (st = atmos__beams_sky_keep(p->ctx, p->atm, J.eye, v->sun, J.nw, &b->sky)) != ATMOS_OK)) {
         free(J.z_lo), free(J.span);
         return st;
     }
@@ -431,16 +431,16 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     }
     if (!failed && b->obj.n > 0) {
         if ((st = atmos__beams_primary_build(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &prim)) != ATMOS_OK) {
-            atmos__beams_il_free(&il), atmos__beams_sky_free(&J.sky), free(J.z_lo), free(J.span);
+            atmos__beams_il_free(&il), free(J.z_lo), free(J.span);
             return st;
         }
         J.prim = &prim;
+        J.sky = &b->sky;
     }
     if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
     atmos__beams_primary_free(&prim);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
-    atmos__beams_sky_free(&J.sky);
     free(J.z_lo), free(J.span);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");

@@ -95,3 +95,19 @@ void atmos__beams_sky_free(atmos__beams_sky *s)
 {
     if (s) free(s->E), memset(s, 0, sizeof *s);
 }
+
+atmos_status atmos__beams_sky_keep(atmos_context *ctx, const atmos_atmosphere *atm, const double eye[3],
+                                   const double sun_dir[3], int nw, atmos__beams_sky *s)
+{
+    const long key[2] = {lround(eye[0] / BEAMS_SKY_KEEP_M), lround(eye[2] / BEAMS_SKY_KEEP_M)};
+    if (s->built && s->atm == atm && s->nw == nw && s->key[0] == key[0] && s->key[1] == key[1] &&
+        !memcmp(s->sun, sun_dir, sizeof s->sun))
+        return ATMOS_OK;
+    const double under[3] = {key[0] * BEAMS_SKY_KEEP_M, 0, key[1] * BEAMS_SKY_KEEP_M};
+    atmos__beams_sky_free(s);
+    const atmos_status st = atmos__beams_sky_build(ctx, atm, under, sun_dir, nw, s);
+    if (st != ATMOS_OK) return st;
+    s->atm = atm, s->key[0] = key[0], s->key[1] = key[1], s->built = 1;
+    memcpy(s->sun, sun_dir, sizeof s->sun);
+    return ATMOS_OK;
+}

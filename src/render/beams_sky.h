@@ -1,6 +1,7 @@
 /* The sky's light on the beam renderer's surfaces (docs/beams.md#the-skys-light): the
  * irradiance a Lambertian surface receives from the sky model's upper hemisphere, tabulated
- * once per frame over the surface's normal. Not part of the API. */
+ * over the surface's normal, kept between frames while the ground under the eye stays within
+ * the same quantum. Not part of the API. */
 #ifndef ATMOS_RENDER_BEAMS_SKY_H
 #define ATMOS_RENDER_BEAMS_SKY_H
 
@@ -11,9 +12,19 @@
 #define BEAMS_SKY_NY 17
 #define BEAMS_SKY_NA 32
 
+/* The ground point under the eye is quantised to this many metres in x and z for the table
+ * kept between frames (atmos__beams_sky_keep). */
+#define BEAMS_SKY_KEEP_M 100.0
+
 typedef struct atmos__beams_sky {
     int nw;   /* wavelengths; 0: no sky (a vacuum) */
     float *E; /* [(iy * BEAMS_SKY_NA + ia) * nw + k]: W m^-2 nm^-1 */
+    /* what a kept table was built for (atmos__beams_sky_keep): the atmosphere, the quantised
+     * ground point (x, z in units of BEAMS_SKY_KEEP_M), the sun; built: 0 before the first */
+    const atmos_atmosphere *atm;
+    long key[2];
+    double sun[3];
+    int built;
 } atmos__beams_sky;
 
 /* The table for the sun at sun_dir, the sky as seen from p (the ground under the eye): the
@@ -21,6 +32,12 @@ typedef struct atmos__beams_sky {
  * upper hemisphere on a grid of directions of equal solid angle, times max(0, n . w). */
 atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *atm, const double p[3],
                                     const double sun_dir[3], int nw, atmos__beams_sky *s);
+/* The table of the frame whose eye is at eye, kept in s between frames: the ground under the
+ * eye quantised to BEAMS_SKY_KEEP_M metres in x and z (the point (kx Q, 0, kz Q)), so the
+ * table is made again only when that point, the sun, the atmosphere or nw change, and a
+ * frame's table is the same whatever frames came before it. s starts zeroed. */
+atmos_status atmos__beams_sky_keep(atmos_context *ctx, const atmos_atmosphere *atm, const double eye[3],
+                                   const double sun_dir[3], int nw, atmos__beams_sky *s);
 /* The sky's irradiance on a surface of unit normal n (bilinear in the table) into E[nw]. */
 void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const double n[3], double *E);
 void atmos__beams_sky_free(atmos__beams_sky *s);

@@ -1,0 +1,90 @@
+/* The beam renderer's sky irradiance table kept between frames (src/render/beams_sky.c,
+ * docs/beams.md "The sky's light"): atmos__beams_sky_keep builds the table for the ground under
+ * the eye quantised to BEAMS_SKY_KEEP_M metres and keeps it while that point and the sun stay.
+ *   - an eye moved within its quantum keeps the very table (not made again: a value written
+ *     into it stays), and it equals, value
+ *     for value, a fresh atmos__beams_sky_build at the quantised point;
+ *   - an eye moved into another quantum, or another sun, gets a new table equal to a fresh one;
+ *   - the quantisation's cost: the table at the quantised point against the table at the true
+ *     point half a quantum away in x and z (the spherical model, the sun 8 and 30 degrees up),
+ *     within a relative 10^-3 at every node with light above 10^-3 of the brightest. */
+#include "atmos/atmos.h"
+#include "render/beams_sky.h"
+#include "test.h"
+
+static atmos_context *ctx;
+
+static int nodes(const atmos__beams_sky *s) { return BEAMS_SKY_NY * BEAMS_SKY_NA * s->nw; }
+
+/* The worst relative difference of a against b over b's values above 1e-3 of its largest;
+ * -1 when the sizes differ. */
+static double worst(const atmos__beams_sky *a, const atmos__beams_sky *b)
+{
+    if (a->nw != b->nw || !a->E || !b->E) return -1;
+    double top = 0, w = 0;
+    for (int i = 0; i < nodes(b); i++) top = fmax(top, b->E[i]);
+    for (int i = 0; i < nodes(b); i++)
+        if (b->E[i] > 1e-3 * top) w = fmax(w, fabs(a->E[i] - b->E[i]) / b->E[i]);
+    return w;
+}
+
+static int same(const atmos__beams_sky *a, const atmos__beams_sky *b)
+{
+    if (a->nw != b->nw || !a->E || !b->E) return 0;
+    return !memcmp(a->E, b->E, sizeof(float) * (size_t)nodes(a));
+}
+
+int main(void)
+{
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    atmos_atmosphere_desc desc;
+    atmos_atmosphere_defaults(&desc);
+    desc.kind = ATMOS_ATMOSPHERE_SPHERICAL, desc.ground_albedo = 0.15;
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_atmosphere *atm = NULL;
+    CHECK_OK(atmos_atmosphere_create(ctx, &desc, &wl, &atm));
+    const int nw = wl.count;
+    const double Q = BEAMS_SKY_KEEP_M;
+    for (int e = 0; e < 2; e++) {
+        double sun[3];
+        atmos_direction_from_angles(e ? 30 : 8, 266, sun);
+        atmos__beams_sky keep = {0}, fresh = {0}, exact = {0};
+        const double eye1[3] = {0.3 * Q, 200, -0.2 * Q}, eye2[3] = {0.1 * Q, 250, 0.4 * Q}, q0[3] = {0, 0, 0};
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye1, sun, nw, &keep));
+        const float mark = keep.E[0];
+        keep.E[0] = -1; /* a table made again would not keep this */
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye2, sun, nw, &keep));
+        CHECK_MSG(keep.E[0] == -1, "an eye moved within its quantum: the table was made again");
+        keep.E[0] = mark;
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, q0, sun, nw, &fresh));
+        CHECK_MSG(same(&keep, &fresh), "the kept table differs from a fresh one at the quantised point");
+        atmos__beams_sky_free(&fresh);
+        /* another quantum */
+        const double eye3[3] = {3.6 * Q, 200, -1.7 * Q}, q3[3] = {4 * Q, 0, -2 * Q};
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye3, sun, nw, &keep));
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun, nw, &fresh));
+        CHECK_MSG(same(&keep, &fresh), "after the eye left its quantum: not the fresh table of the new one");
+        atmos__beams_sky_free(&fresh);
+        /* the quantisation's cost: half a quantum in x and z away */
+        const double eye4[3] = {4.5 * Q - 1e-6, 10, -2.5 * Q + 1e-6}, p4[3] = {eye4[0], 0, eye4[2]};
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun, nw, &keep));
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, p4, sun, nw, &exact));
+        const double w = worst(&keep, &exact);
+        printf("sun %g deg up: the table half a quantum (%g m in x and z) from the true point: worst relative "
+               "difference %.3g\n", e ? 30.0 : 8.0, 0.5 * Q, w);
+        CHECK_MSG(w >= 0 && w < 1e-3, "quantisation error %.3g", w);
+        atmos__beams_sky_free(&exact);
+        /* another sun */
+        double sun2[3];
+        atmos_direction_from_angles(e ? 31 : 9, 266, sun2);
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun2, nw, &keep));
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun2, nw, &fresh));
+        CHECK_MSG(same(&keep, &fresh), "after the sun moved: not the fresh table");
+        atmos__beams_sky_free(&fresh);
+        atmos__beams_sky_free(&keep);
+    }
+    atmos_atmosphere_destroy(atm);
+    atmos_context_destroy(ctx);
+    return test_summary("test_beams_sky_keep");
+}
