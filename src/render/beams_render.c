@@ -190,7 +190,7 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
 }
 
 /* The sun's share (beams_sun.h): the surface hit (if any) lit where a ray toward the sun is
- * free, dimmed by a height-dependent fog above it on the way in and by fog_t on the way out;
+ * free (not cast where the sun's map proves the point in shadow, atmos__beams_sun_dark), dimmed by a height-dependent fog above it on the way in and by fog_t on the way out;
  * the fog's scattering of sunlight along [0, T). */
 static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double T, double fog_t, double *L)
 {
@@ -201,7 +201,7 @@ static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, i
         const double o[3] = {J->eye[0] + h->t * d[0] + off * h->normal[0], J->eye[1] + h->t * d[1] + off * h->normal[1],
                              J->eye[2] + h->t * d[2] + off * h->normal[2]};
         const double in = c > 0 ? exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)) : 0; /* dimmed on its way in */
-        if (c > 0 && in > 0 && !atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
+        if (c > 0 && in > 0 && !atmos__beams_sun_dark(s, o) && !atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
             for (int k = 0; k < J->nw; k++) L[k] += b->obj.albedo[m][k] / ATMOS_PI * s->E[k] * c * in * fog_t;
     }
     if (b->fog.sigma0 > 0) {

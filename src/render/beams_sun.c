@@ -111,6 +111,15 @@ double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3])
                   atmos__dot3(p, s->fwd) - s->bias);
 }
 
+int atmos__beams_sun_dark(const atmos__beams_sun *s, const double p[3])
+{
+    if (!s->n) return 0;
+    const double fx = (atmos__dot3(p, s->right) - s->u0) / s->texel - 0.5, fy = (atmos__dot3(p, s->up) - s->v0) / s->texel - 0.5;
+    if (!(fx >= 0 && fx < s->n - 1 && fy >= 0 && fy < s->n - 1)) return 0; /* beside the map: it cannot tell */
+    const int tile = atmos__beams_tiles_at(&s->tiles, (int)fx, (int)fy); /* its ring holds the texels round p */
+    return s->tiles.max[tile] < atmos__dot3(p, s->fwd) - 2 * s->texel;
+}
+
 double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], const double p[3])
 {
     if (!(f->height_m > 0)) return 0; /* a uniform fog has no top: lit as it is */

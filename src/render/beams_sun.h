@@ -45,6 +45,11 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
 void atmos__beams_sun_free(atmos__beams_sun *s);
 /* H at p: the share of sunlight reaching p past the meshes, in [0, 1] (2x2 filtered). */
 double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3]);
+/* 1 when p is surely in the meshes' shadow by the map: the depths over p's finest tile (8 x 8
+ * texels and the ring a filtered look-up reads) all nearer the sun than p by more than two
+ * texels; 0 when the map cannot tell (then a ray decides). Approximate only where an opening
+ * narrower than a texel lets the sun through. */
+int atmos__beams_sun_dark(const atmos__beams_sun *s, const double p[3]);
 /* The sunlight the fog scatters toward o along [0, T) of the ray d (unit), per unit of E:
  * steps of at most epsilon of the unshadowed whole (at most max_steps), each weighted by H
  * at its middle (in optical depth). Runs of steps whose samples the map's tiles prove all lit
