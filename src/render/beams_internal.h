@@ -107,6 +107,11 @@ double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double
  * of them along which the shadow map's tiles prove H the same (atmos__beams_ray_uniform) cost
  * the falloff alone or nothing; the others are halved, down to a few samples read one by one. */
 double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1);
+/* The same sum when the tiles have just failed to settle a span holding [s0, s1): a run of
+ * more than 8 is halved at once, without testing it again (a test of a part that the span's
+ * test would have passed passes too, the pyramid's ranges being nested, so for a point light
+ * the sum is the same to the bit; for a spot the falloff's runs may be added in another order). */
+double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1);
 
 struct atmos__beams_plan {
     atmos__objects obj;                      /* the meshes and their albedos */

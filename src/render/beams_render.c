@@ -33,6 +33,10 @@
 
 /* Intervals per light along one ray at most: planes closer than 2 range / this are spread. */
 #define MAX_INTERVALS 4096
+/* A point light's interval of at most this many sub-planes reads them without the tiles' test. */
+#ifndef POINT_READ_MAX
+#define POINT_READ_MAX 3
+#endif
 
 typedef struct job {
     const atmos__beams_plan *b;
@@ -165,6 +169,7 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         tinted(J, l, &ray, d, f, n, unit, L, centre, o);
         return;
     }
+    const int spot = l->L.type == ATMOS_LIGHT_SPOT;
     double sum = 0;
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
@@ -174,14 +179,19 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
         double h = 0, same = 0;
         int full = 0;
-        const int uniform = m > 1 && atmos__beams_ray_uniform(&ray, ta, f[2 * k + 2], &same, &full);
+        /* a point light's few samples are read rather than tested: the tiles' test costs more, and
+         * the samples give what it would (each exactly 0 or 1 where it would settle the span) */
+        const int tested = m > 1 && (spot || m > POINT_READ_MAX);
+        const int uniform = tested && atmos__beams_ray_uniform(&ray, ta, f[2 * k + 2], &same, &full);
         if (uniform && (full || same == 0)) { /* what every sample would say */
             sum += same * fl;
             continue;
         }
         if (uniform) /* lit all along: the falloff alone varies */
             h = atmos__beams_ray_falloff_sum(&ray, ta, step, o, m);
-        else /* runs of the samples that the tiles prove alike, the rest one by one */
+        else if (tested) /* runs of the samples that the tiles prove alike, the rest one by one */
+            h = atmos__beams_ray_light_sum_split(&ray, ta, step, o, 0, m);
+        else
             h = atmos__beams_ray_light_sum(&ray, ta, step, o, 0, m);
         sum += h / m * fl;
         if (centre) J->centre_subplanes += m;

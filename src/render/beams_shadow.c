@@ -317,3 +317,10 @@ double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double s
     for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
     return h;
 }
+
+double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
+{
+    if (s1 - s0 <= 8) return atmos__beams_ray_light_sum(r, ta, step, o, s0, s1);
+    const int mid = s0 + (s1 - s0) / 2;
+    return atmos__beams_ray_light_sum(r, ta, step, o, s0, mid) + atmos__beams_ray_light_sum(r, ta, step, o, mid, s1);
+}

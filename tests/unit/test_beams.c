@@ -545,7 +545,9 @@ static void test_interleave(void)
 }
 
 /* atmos__beams_ray_light_sum against atmos__beams_ray_light at every sample, on rays across a
- * sphere's shadow, for a point light (a cube map) and a spot (one face). */
+ * sphere's shadow, for a point light (a cube map) and a spot (one face); and
+ * atmos__beams_ray_light_sum_split (halved without its own test) on parts of the rays, the same
+ * as the tested sum to the bit for the point light. */
 static void test_light_sum(void)
 {
     atmos_mesh *mesh = NULL;
@@ -569,6 +571,7 @@ static void test_light_sum(void)
         atmos__beams_progress pr = {0, 6, 0};
         CHECK_OK(atmos__beams_shadow_build(ctx, &l, &mesh, 1, 256, &pr));
         double worst = 0, dark = 0;
+        int split_differs = 0;
         for (int r = 0; r < 60; r++) {
             const double o[3] = {-12, 0.5 + 0.1 * r, 0.3 - 0.01 * r};
             double d[3] = {1, 0.02 * (r % 5) - 0.04, 0.05};
@@ -583,12 +586,21 @@ static void test_light_sum(void)
                 want += atmos__beams_ray_light(&ray, (k + 0.5) * step), all += atmos__beams_ray_falloff(&ray, (k + 0.5) * step);
             const double got = atmos__beams_ray_light_sum(&ray, 0, step, 0.5, 0, m);
             worst = fmax(worst, fabs(got - want) / fmax(all, 1));
+            for (int c = 0; c < 4; c++) { /* halved at once, as after a failed test of the whole span */
+                const int s0 = c * 37, s1 = m - c * 91;
+                double part = 0;
+                for (int k = s0; k < s1; k++) part += atmos__beams_ray_light(&ray, (k + 0.5) * step);
+                const double split = atmos__beams_ray_light_sum_split(&ray, 0, step, 0.5, s0, s1);
+                worst = fmax(worst, fabs(split - part) / fmax(all, 1));
+                if (!kind) split_differs += split != atmos__beams_ray_light_sum(&ray, 0, step, 0.5, s0, s1);
+            }
             dark += want < all - 1;
         }
         printf("sub-plane samples through the tiles (%s): worst difference %.2e of the unshadowed samples, "
                "%g of 60 rays through the shadow\n", kind ? "spot" : "point light, cube map", worst, dark);
         CHECK(dark >= 10);
         CHECK(worst < 1e-12);
+        CHECK_MSG(split_differs == 0, "the point light's sums halved at once differ from the tested ones %d times", split_differs);
         atmos__beams_shadow_free(&l);
     }
     atmos_mesh_destroy(mesh);
