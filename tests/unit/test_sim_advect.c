@@ -7,23 +7,13 @@
 #include "atmos/atmos.h"
 #include "sim/sim_internal.h"
 #include "test.h"
+#include "test_sim_state.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #define N 32
-
-static atmos_context *make_ctx(int threads)
-{
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = threads;
-    d.log = NULL;
-    atmos_context *c = NULL;
-    atmos_context_create(&d, &c);
-    return c;
-}
 
 /* A dry, uniform (neutral, 300 K) state with the wind (u, v) and a Gaussian excess of 1 K of
  * sigma 1.5 cells at the domain's centre. */
@@ -61,7 +51,7 @@ static void carry(atmos_sim *s, double dt, int steps)
 
 static void once_round(double u, double v, double keep)
 {
-    atmos_context *c = make_ctx(1);
+    atmos_context *c = test_sim_ctx(1);
     atmos_sim *s = blob(c, u, v);
     if (!s) return;
     /* 5 s steps of 0.36 cells along x: 88 of them carry the blob 32 cells, once round */
@@ -88,7 +78,7 @@ static void once_round(double u, double v, double keep)
 
 static void test_threads(void)
 {
-    atmos_context *c1 = make_ctx(1), *c2 = make_ctx(2);
+    atmos_context *c1 = test_sim_ctx(1), *c2 = test_sim_ctx(2);
     atmos_sim *a = blob(c1, 7.3, 3.1), *b = blob(c2, 7.3, 3.1);
     if (a && b) {
         carry(a, 5.0, 20);
