@@ -1,11 +1,13 @@
 /* Semi-Lagrangian advection (Stam 1999; Staniforth & Cote 1991): every value is what arrives
  * from its departure point, sampled trilinearly (monotone: no new extrema). Scalars share one
- * departure point per cell found with a midpoint (second-order) trace; each velocity component
- * is traced from its own face with the velocity there. Positions are in cell units; x and y
+ * departure point per cell found with a midpoint (second-order) trace and are then corrected
+ * by MacCormack's step (sim_maccormack.c); each velocity component is traced from its own face
+ * with the velocity there. Positions are in cell units; x and y
  * wrap, z clamps to the grid. */
 #include "sim/sim_internal.h"
 
 #include <math.h>
+#include <string.h>
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 #define ADV_CLONES __attribute__((target_clones("avx2", "default")))
@@ -48,15 +50,14 @@ ADV_CLONES static void centres(atmos_sim *s, int k)
     s->part[k] = vl, s->part[s->nz + 1 + k] = tl;
 }
 
-/* Level k of the scalars into s[0..3], each cell's departure point traced once (midpoint rule
- * on the cell-centred velocity) for all four; the level's new water into part[2 (nz + 1) + k]
- * (vapour) and part[3 (nz + 1) + k] (the rest). */
+/* Level k of the scalars' semi-Lagrangian step, packed into pack[8 n ..], each cell's departure
+ * point traced once (midpoint rule on the cell-centred velocity) for all four and kept in
+ * s[0..2] for MacCormack's correction (sim_maccormack.c), which writes the fields. */
 ADV_CLONES static void scalars(atmos_sim *s, int k, float c)
 {
     const int nx = s->nx, ny = s->ny;
-    const size_t lev = (size_t)nx * ny;
-    float *dst[4] = {s->th, s->qv, s->qc, s->qr}; /* in place: the sources are the packed copies */
     const float *vel4 = s->pack, *sc4 = s->pack + 4 * s->n;
+    float *hat4 = s->pack + 8 * s->n;
     float x[ATMOS_SIM_MAX_GRID], y[ATMOS_SIM_MAX_GRID], z[ATMOS_SIM_MAX_GRID];
     float q[4 * ATMOS_SIM_MAX_GRID];
     const float h = 0.5f * c;
@@ -70,16 +71,11 @@ ADV_CLONES static void scalars(atmos_sim *s, int k, float c)
         atmos__sim_sample4_row(s, vel4, s->nz, x, y, z, q, nx);
         for (int i = 0; i < nx; i++) /* a whole step back with the velocity there */
             x[i] = (float)i - c * q[4 * i], y[i] = fj - c * q[4 * i + 1], z[i] = fk - c * q[4 * i + 2];
-        atmos__sim_sample4_row(s, sc4, s->nz, x, y, z, q, nx);
-        for (int i = 0; i < nx; i++)
-            for (int f = 0; f < 4; f++) dst[f][r + i] = q[4 * i + f];
+        atmos__sim_sample4_row(s, sc4, s->nz, x, y, z, hat4 + 4 * r, nx);
+        memcpy(s->s[0] + r, x, nx * sizeof *x); /* the departure points, for the correction */
+        memcpy(s->s[1] + r, y, nx * sizeof *y);
+        memcpy(s->s[2] + r, z, nx * sizeof *z);
     }
-    double vl = 0, tl = 0;
-    for (size_t n = k * lev; n < (k + 1) * lev; n++) {
-        vl += dst[1][n];
-        tl += (double)dst[2][n] + dst[3][n];
-    }
-    s->part[2 * (s->nz + 1) + k] = vl, s->part[3 * (s->nz + 1) + k] = tl;
 }
 
 /* The departure points of the faces of a row: u's, v's and w's (the velocity's components
@@ -196,6 +192,7 @@ double atmos__sim_advect(atmos_sim *s, double dt)
         if (k < nz) scalars(s, k, c);
     }
     atmos__sim_sync(s);
+    atmos__sim_maccormack(s);
     /* the sums level by level, in order (as one serial pass would add them); every thread */
     double w0 = 0, w1 = 0, v1 = 0;
     const double *p = s->part;

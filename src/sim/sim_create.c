@@ -95,7 +95,7 @@ atmos_status atmos__sim_create_env(atmos_context *ctx, const sim_env *env, int n
     float **f[] = {&s->u, &s->v, &s->w, &s->th, &s->qv, &s->qc, &s->qr};
     for (int a = 0; a < 7; a++) ok &= (*f[a] = grid_array(s->nw)) != NULL;
     for (int a = 0; a < 8; a++) ok &= (s->s[a] = grid_array(s->nw)) != NULL;
-    ok &= (s->pack = atmos__big_alloc(8 * s->n * sizeof(float))) != NULL; /* written before it is read */
+    ok &= (s->pack = atmos__big_alloc(12 * s->n * sizeof(float))) != NULL; /* written before it is read */
     double **b[] = {&s->th0, &s->qv0, &s->pi0, &s->p0, &s->rho0, &s->ue};
     for (int a = 0; a < 6; a++) ok &= (*b[a] = calloc((size_t)nz, sizeof(double))) != NULL;
     ok &= (s->rho_c = calloc((size_t)nz, sizeof(double))) != NULL;

@@ -58,7 +58,7 @@ struct atmos_sim {
     size_t n, nw;                 /* cells; w faces (nx ny (nz + 1)) */
     float *u, *v, *w, *th, *qv, *qc, *qr;
     float *s[8];                  /* scratch arrays of nw floats */
-    float *pack;                  /* 8 n floats: the advection's packed fields (sim_advect.c) */
+    float *pack;                  /* 12 n floats: the advection's packed fields (sim_advect.c) */
     double *part;                 /* per-level or per-row partial sums, 4 (max(nz, ny) + 1) doubles:
                                    * each filled by one thread, added in index order afterwards */
     /* base state at the cell-centre levels z_k = (k + 0.5) dx */
@@ -97,6 +97,23 @@ void atmos__sim_sync_free(atmos_sim *s);
 static inline size_t sim_idx(const atmos_sim *s, int i, int j, int k)
 {
     return ((size_t)k * s->ny + j) * s->nx + i;
+}
+
+/* i wrapped into [0, n) (the periodic sides); floor() without the library call (the baseline
+ * x86-64 target has no rounding instruction), for positions far inside int's range. */
+static inline int sim_wrap(int i, int n)
+{
+    if ((unsigned)i >= (unsigned)n) {
+        i %= n;
+        if (i < 0) i += n;
+    }
+    return i;
+}
+
+static inline int sim_ifloor(float x)
+{
+    const int i = (int)x;
+    return i - (x < i);
 }
 
 /* Runs to the time `end` (s), the last step shortened to end there, or with whole_steps only
@@ -140,6 +157,11 @@ void atmos__sim_sounding(atmos_sim *sim);
 /* sim_advect.c; returns the water fixer's factor for the vapour (applied by atmos__sim_micro) */
 double atmos__sim_advect(atmos_sim *sim, double dt);
 void atmos__sim_advected_velocity(atmos_sim *sim);
+/* sim_maccormack.c: the scalars' correction after the semi-Lagrangian step, which left its
+ * result packed in pack[8 n ..], the old values in pack[4 n ..] and the departure points in
+ * s[0..2] (cell units); the corrected fields into th, q_v, q_c, q_r, the level's water after it
+ * into part[2 (nz + 1) + k] and part[3 (nz + 1) + k]. Ends at a barrier. */
+void atmos__sim_maccormack(atmos_sim *sim);
 /* sim_trace.c: trilinear samples of a field of nz_f levels (x, y wrapped, z clamped) at n points
  * of its index space (single precision), into out[m]; of four fields packed per cell (f4[4 cell + field]) into
  * out4[4 m + field] */

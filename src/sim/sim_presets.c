@@ -14,7 +14,7 @@ static const preset presets[] = {
      * inversion and a trade-wind inversion at 2 km; surface heating and moistening plus
      * a dozen small seeded warm, moist bubbles; light wind. */
     {"cumulus_field",
-     {.kind = SIM_SOUNDING_LAYERED, .domain_m = 6400, .height_m = 3200, .minutes = 20, .first_cloud = 6, .dt_max = 6,
+     {.kind = SIM_SOUNDING_LAYERED, .domain_m = 6400, .height_m = 3200, .minutes = 20, .first_cloud = 4, .dt_max = 6,
       .theta_s = 298, .zi = 700, .dtheta_inv = 0.5, .inv_depth = 100, .gamma_ft = 3.5e-3, .z_tp = 2000,
       .gamma_strat = 15e-3, .qv_bl = 13.5e-3, .qv_ft = 11e-3, .hq = 1500, .u_s = 3, .z_shear = 1000,
       .u_move = 0, .bubbles = 12, .bubble_rh = 350, .bubble_rv = 250, .bubble_z = 300, .bubble_dth = 0.8,

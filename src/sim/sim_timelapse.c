@@ -17,7 +17,7 @@ static atmos_status copy_of(atmos_context *ctx, const atmos_sim *s, atmos_sim **
     float *const to[] = {c->u, c->v, c->w, c->th, c->qv, c->qc, c->qr};
     for (int a = 0; a < 7; a++) memcpy(to[a], from[a], s->nw * sizeof(float));
     for (int a = 0; a < 8; a++) memcpy(c->s[a], s->s[a], s->nw * sizeof(float));
-    memcpy(c->pack, s->pack, 8 * s->n * sizeof(float));
+    memcpy(c->pack, s->pack, 12 * s->n * sizeof(float));
     c->t = s->t, c->steps = s->steps, c->rain_out = s->rain_out, c->surface_in = s->surface_in, c->vmax = s->vmax;
     c->out_refine = s->out_refine, c->out_detail = s->out_detail, c->out_ice = s->out_ice;
     return ATMOS_OK;

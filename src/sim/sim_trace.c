@@ -27,31 +27,14 @@ typedef struct {
     float ax, ay, az;
 } tri;
 
-static inline int wrap(int i, int n)
-{
-    if ((unsigned)i >= (unsigned)n) {
-        i %= n;
-        if (i < 0) i += n;
-    }
-    return i;
-}
-
-/* floor() without the library call (the baseline x86-64 target has no rounding instruction);
- * positions stay far inside int's range. */
-static inline int ifloor(float x)
-{
-    const int i = (int)x;
-    return i - (x < i);
-}
-
 static inline void tri_setup(const atmos_sim *s, int nz_f, float x, float y, float z, tri *t)
 {
     const int nx = s->nx, ny = s->ny;
     if (z < 0) z = 0;
     if (z > nz_f - 1) z = (float)(nz_f - 1);
-    const int fx0 = ifloor(x), fy0 = ifloor(y), fz0 = ifloor(z);
+    const int fx0 = sim_ifloor(x), fy0 = sim_ifloor(y), fz0 = sim_ifloor(z);
     t->ax = x - (float)fx0, t->ay = y - (float)fy0, t->az = z - (float)fz0;
-    const int i0 = wrap(fx0, nx), j0 = wrap(fy0, ny), k0 = fz0;
+    const int i0 = sim_wrap(fx0, nx), j0 = sim_wrap(fy0, ny), k0 = fz0;
     const int j1 = j0 + 1 == ny ? 0 : j0 + 1, k1 = k0 + 1 < nz_f ? k0 + 1 : k0;
     t->i0 = i0, t->i1 = i0 + 1 == nx ? 0 : i0 + 1;
     const size_t l0 = (size_t)k0 * nx * ny, l1 = (size_t)k1 * nx * ny;
@@ -152,7 +135,7 @@ AVX2_INLINE int setup8(const atmos_sim *s, int nz_f, const float *x, const float
     /* z < 0 -> 0, z > nz_f - 1 -> nz_f - 1, else z itself (a -0 or a NaN kept, as the scalar code) */
     const __m256 Z =
         _mm256_min_ps(_mm256_set1_ps((float)(nz_f - 1)), _mm256_max_ps(_mm256_setzero_ps(), _mm256_loadu_ps(z)));
-    /* floor through int (the scalar ifloor: -0 gives +0); out of range and NaN give INT_MIN */
+    /* floor through int (the scalar sim_ifloor: -0 gives +0); out of range and NaN give INT_MIN */
     const __m256i ix = _mm256_cvttps_epi32(_mm256_floor_ps(X)), iy = _mm256_cvttps_epi32(_mm256_floor_ps(Y));
     const __m256i iz = _mm256_cvttps_epi32(_mm256_floor_ps(Z));
     const __m256i bad = _mm256_or_si256(_mm256_or_si256(outside8(ix, -nx, 2 * nx - 1), outside8(iy, -ny, 2 * ny - 1)),

@@ -15,17 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static atmos_context *make_ctx(int threads)
-{
-    atmos_context_desc d;
-    atmos_context_defaults(&d);
-    d.threads = threads;
-    d.log = NULL;
-    atmos_context *c = NULL;
-    atmos_context_create(&d, &c);
-    return c;
-}
-
 /* After the adjustment: q_c = 0 and q_v <= q_s, or q_c > 0 and q_v = q_s (the condensate's
  * saturation: over ice below -23 C, mixed between); water and the moist static energy
  * c_p T + L q_v (at fixed pressure; L that of the starting temperature) unchanged. */
@@ -63,7 +52,7 @@ static void test_adjust(void)
  * on the ground - water from the surface, to 1 %. */
 static void test_budget(void)
 {
-    atmos_context *c = make_ctx(1);
+    atmos_context *c = test_sim_ctx(1);
     sim_env e = *atmos__sim_preset("towering_cumulus");
     e.bubble_dth = 3.0, e.bubble_dqv = 3e-3, e.lhf = 5e-5, e.shf = 0.05, e.flux_noise = 0.5;
     atmos_sim *s = NULL;
@@ -96,7 +85,7 @@ static void test_budget(void)
  * 225, Eq. 24), of the bubble's air at the ground, within one cell. */
 static void test_lcl(void)
 {
-    atmos_context *c = make_ctx(1);
+    atmos_context *c = test_sim_ctx(1);
     sim_env e;
     memset(&e, 0, sizeof e);
     e.kind = SIM_SOUNDING_LAYERED, e.dt_max = 5, e.micro = 1;
@@ -136,7 +125,7 @@ static void test_lcl(void)
  * found in their DNS over a rise of about one thermal length), to 10 %. */
 static void test_thermal(void)
 {
-    atmos_context *c = make_ctx(1);
+    atmos_context *c = test_sim_ctx(1);
     sim_env e;
     memset(&e, 0, sizeof e);
     e.kind = SIM_SOUNDING_LAYERED, e.dt_max = 4, e.micro = 0;
@@ -175,7 +164,7 @@ static void test_thermal(void)
 
 static atmos_sim *run_preset(int threads, const char *preset, uint64_t seed, int steps)
 {
-    atmos_context *c = make_ctx(threads);
+    atmos_context *c = test_sim_ctx(threads);
     atmos_sim_desc d = {.preset = preset, .minutes = 0, .grid = 24, .seed = seed};
     atmos_sim *s = NULL;
     if (atmos_sim_create(c, &d, &s) == ATMOS_OK)
@@ -205,7 +194,7 @@ static void test_threads(void)
 
 static void test_bad(void)
 {
-    atmos_context *c = make_ctx(1);
+    atmos_context *c = test_sim_ctx(1);
     atmos_sim *s = NULL;
     atmos_sim_desc d = {.preset = "cumulonimbuss", .minutes = 0, .grid = 32, .seed = 1};
     CHECK(atmos_sim_create(c, &d, &s) == ATMOS_E_INVALID_ARG && !s);
@@ -237,7 +226,7 @@ static void test_bad(void)
 /* The volume: cloud and rain number densities q rho / m, y up. */
 static void test_volume(void)
 {
-    atmos_context *c = make_ctx(1);
+    atmos_context *c = test_sim_ctx(1);
     atmos_sim_desc d = {.preset = "stratocumulus", .minutes = 0, .grid = 16, .seed = 1};
     atmos_sim *s = NULL;
     CHECK_OK(atmos_sim_create(c, &d, &s));
@@ -285,7 +274,7 @@ static int same_volume(const atmos_volume *a, const atmos_volume *b)
  * time, whatever was asked before; going back is refused. */
 static void test_timelapse(void)
 {
-    atmos_context *c = make_ctx(2);
+    atmos_context *c = test_sim_ctx(2);
     atmos_sim_desc d = {.preset = "towering_cumulus", .minutes = 0, .grid = 16, .seed = 5};
     atmos_sim *s = NULL;
     CHECK_OK(atmos_sim_create(c, &d, &s));
@@ -318,7 +307,7 @@ static void test_timelapse(void)
 /* A scene names a simulation: its settings parsed, bad ones refused with the key's path. */
 static void test_scene(void)
 {
-    atmos_context *c = make_ctx(1);
+    atmos_context *c = test_sim_ctx(1);
     atmos_scene sc;
     const char *good = "{\"volume\": {\"simulate\": {\"preset\": \"stratocumulus\", \"minutes\": 2, \"grid\": 16, "
                        "\"seed\": 5}, \"position_m\": [0, 0, -3000]}}";

@@ -1,11 +1,22 @@
 /* Whether two simulations hold the same state, byte for byte: the thread-count checks of the
- * simulation's tests. */
+ * simulation's tests; and their context of a given thread count, without a log. */
 #ifndef ATMOS_TEST_SIM_STATE_H
 #define ATMOS_TEST_SIM_STATE_H
 
 #include "sim/sim_internal.h"
 
 #include <string.h>
+
+static inline atmos_context *test_sim_ctx(int threads)
+{
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    d.threads = threads;
+    d.log = NULL;
+    atmos_context *c = NULL;
+    atmos_context_create(&d, &c);
+    return c;
+}
 
 static inline int test_sim_same_state(const atmos_sim *a, const atmos_sim *b)
 {
