@@ -2,12 +2,14 @@
 # The viewer's frame rates (docs/viewer.md, issue 16's benchmark goals): recorded flights played
 # headless, one line per case with the median frame and the slowest 1 % as frames a second.
 #
-#   bench/viewer/run.sh [--atmos BIN] [--cases "field million inside slice slice_full"] [--frames N] [--out DIR]
+#   bench/viewer/run.sh [--atmos BIN] [--cases "field field200k million inside slice slice_full"] [--frames N] [--out DIR]
 #                       [--opts "VIEW OPTIONS"]  (atmos view options for every case, e.g. "--screen-layer-px 0")
 #
 # The cases (1280x720 unless said):
 #   field    scenes/harris_cloud_field.json (120 clouds, 99 101 particles) along
 #            scenes/flights/harris_cloud_field.json, 480 frames; goal 60 fps
+#   field200k  the same field with particles 35.5 m apart (--spacing 35.5: 207 030 particles),
+#            480 frames: issue 16's ">= 100 clouds / >= 200 000 particles"; goal 60 fps
 #   million  the same field with particles 19.7 m apart (--spacing 19.7: 1 209 835 particles),
 #            240 frames; goal 20 fps
 #   inside   scenes/harris_fly_through.json's cumulus, the eye inside it all along
@@ -35,7 +37,7 @@ set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 ATMOS=$root/build/atmos
-CASES="field million inside slice slice_full aircraft aircraft_none"
+CASES="field field200k million inside slice slice_full aircraft aircraft_none"
 FRAMES=
 OPTS=
 OUT=${TMPDIR:-/tmp}/atmos-viewer-bench
@@ -77,6 +79,8 @@ PY
 for c in $CASES; do
     case "$c" in
     field) run_case field scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 480 1280x720 ;;
+    field200k) run_case field200k scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 480 1280x720 \
+        --spacing 35.5 ;;
     million) run_case million scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 240 1280x720 \
         --spacing 19.7 ;;
     inside) run_case inside scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 240 1280x720 ;;
