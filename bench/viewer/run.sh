@@ -33,6 +33,11 @@
 # frame 1.4 s; million 10.4 fps, 1 % low 5.7, first 9.9 s; inside 50 fps. After it, only on the
 # loaded machine (load 6.5-8.5, OMP_WAIT_POLICY=passive, --frames 120 / 36): field 13.7 / 23.4
 # fps median (before 12.8 / 11.8 in the same minutes), million 2.9 / 4.7 (before 2.7 / 1.8).
+# The round that put a light pass's wavelengths through one sweep and the splats' rows in vector
+# loops (docs/viewer.md), in turns at load 6.5-11, --frames 120 / 120 / 36 / 60, before -> after:
+# field200k 4.1 -> 8.0 fps median in the quieter round (1 % low 2.3 -> 3.2; run's CPU 24.2 ->
+# 19.8 s, first frame 7.9 -> 3.8 s), field 5.1 -> 7.1 (CPU 18.5 -> 16.3 s), million 1.6 -> 2.2
+# (CPU 34.3 -> 24.7 s), inside the same (CPU 8.9 / 8.9 s). Not measured idle.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
