@@ -3,7 +3,7 @@
 # flight of N + 1 frames less those of 1 frame, over N, so that making the plan and the first
 # frame's light passes are left out; steadier than wall times on a shared machine.
 #
-#   bench/viewer/cpu.sh [--atmos BIN] [--cases "field inside slice slice_full"] [--frames N] [--opts "VIEW OPTIONS"]
+#   bench/viewer/cpu.sh [--atmos BIN] [--cases "field field200k million inside slice slice_full"] [--frames N] [--opts "VIEW OPTIONS"]
 # (slice: the preview frames of a moving sun, --preview; slice_full: full renders)
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -33,6 +33,7 @@ cpu() { # scene flight size frames [extra options]
 for c in $CASES; do
     case "$c" in
     field) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 ;;
+    field200k) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 --spacing 35.5 ;;
     million) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 --spacing 19.7 ;;
     inside) set -- scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 1280x720 ;;
     slice) set -- scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 512x512 --preview ;;

@@ -2,12 +2,14 @@
 # The viewer's frame rates (docs/viewer.md, issue 16's benchmark goals): recorded flights played
 # headless, one line per case with the median frame and the slowest 1 % as frames a second.
 #
-#   bench/viewer/run.sh [--atmos BIN] [--cases "field million inside slice slice_full"] [--frames N] [--out DIR]
+#   bench/viewer/run.sh [--atmos BIN] [--cases "field field200k million inside slice slice_full"] [--frames N] [--out DIR]
 #                       [--opts "VIEW OPTIONS"]  (atmos view options for every case, e.g. "--screen-layer-px 0")
 #
 # The cases (1280x720 unless said):
 #   field    scenes/harris_cloud_field.json (120 clouds, 99 101 particles) along
 #            scenes/flights/harris_cloud_field.json, 480 frames; goal 60 fps
+#   field200k  the same field with particles 35.5 m apart (--spacing 35.5: 207 030 particles),
+#            480 frames: issue 16's ">= 100 clouds / >= 200 000 particles"; goal 60 fps
 #   million  the same field with particles 19.7 m apart (--spacing 19.7: 1 209 835 particles),
 #            240 frames; goal 20 fps
 #   inside   scenes/harris_fly_through.json's cumulus, the eye inside it all along
@@ -31,11 +33,16 @@
 # frame 1.4 s; million 10.4 fps, 1 % low 5.7, first 9.9 s; inside 50 fps. After it, only on the
 # loaded machine (load 6.5-8.5, OMP_WAIT_POLICY=passive, --frames 120 / 36): field 13.7 / 23.4
 # fps median (before 12.8 / 11.8 in the same minutes), million 2.9 / 4.7 (before 2.7 / 1.8).
+# The round that put a light pass's wavelengths through one sweep and the splats' rows in vector
+# loops (docs/viewer.md), in turns at load 6.5-11, --frames 120 / 120 / 36 / 60, before -> after:
+# field200k 4.1 -> 8.0 fps median in the quieter round (1 % low 2.3 -> 3.2; run's CPU 24.2 ->
+# 19.8 s, first frame 7.9 -> 3.8 s), field 5.1 -> 7.1 (CPU 18.5 -> 16.3 s), million 1.6 -> 2.2
+# (CPU 34.3 -> 24.7 s), inside the same (CPU 8.9 / 8.9 s). Not measured idle.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 ATMOS=$root/build/atmos
-CASES="field million inside slice slice_full aircraft aircraft_none"
+CASES="field field200k million inside slice slice_full aircraft aircraft_none"
 FRAMES=
 OPTS=
 OUT=${TMPDIR:-/tmp}/atmos-viewer-bench
@@ -77,6 +84,8 @@ PY
 for c in $CASES; do
     case "$c" in
     field) run_case field scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 480 1280x720 ;;
+    field200k) run_case field200k scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 480 1280x720 \
+        --spacing 35.5 ;;
     million) run_case million scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 240 1280x720 \
         --spacing 19.7 ;;
     inside) run_case inside scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 240 1280x720 ;;

@@ -145,8 +145,10 @@ typedef struct atmos__poptics {
  * I_k = g_{k-1} + T_{k-1} I_{k-1} on a light buffer seen from the sun, the particles
  * splatted nearest-first, with Riley's forward share: a particle of optical depth tau along
  * a texel leaves T + (1 - T) a F_{n+1} of the light, T = exp(-tau) (Eq. 25 for a thin slab),
- * F_{n+1} the forward fraction at the particle's scattering count. One thread per
- * wavelength (the result does not depend on the thread count). Only the particles idx[0..nidx)
+ * F_{n+1} the forward fraction at the particle's scattering count. The wavelengths go in
+ * groups of up to 4 through one pass, which computes a texel's column once for the group (each
+ * wavelength's light the same as in a pass of its own), one thread per group (the result does
+ * not depend on the thread count). Only the particles idx[0..nidx)
  * (idx NULL: all) are lit and shade each other: a cloud at a time, each with a buffer fitted
  * to it. res: the buffer's texels per
  * side (0: texels of texel_scale x 0.7 of the smallest particle's width, at most 1024). */

@@ -59,26 +59,44 @@ static double read_at(const float *b, int res, double x, double y)
     return (1 - ay) * ((1 - ax) * r0[0] + ax * r0[1]) + ay * ((1 - ax) * r1[0] + ax * r1[1]);
 }
 
-/* The splat of particle p into the light buffer at texel coordinates (x, y): row by row
- * over the texels within the cut (a loop the compiler vectorises). */
-static void splat(const atmos__pcloud *pc, int p, const lframe *f, float tc, float aF, float a, float x, float y,
-                  float *trans, float *taus)
+/* The wavelengths a light pass carries at once (their buffers side by side): the particle's
+ * column over a texel, the same at every wavelength, is computed once for all of them. */
+#define GROUP 4
+#define CHUNK 64
+
+/* The splat of particle p into the light buffers of the group's G wavelengths (plane g of
+ * trans and taus: res x res texels each) at texel coordinates (x, y): row by row over the
+ * texels within the cut, the column of a run of texels first, then each wavelength's
+ * transmittance and scattering depth over the run (loops the compiler vectorises). */
+static void splat(const atmos__pcloud *pc, int p, const lframe *f, int G, const float *tc, const float *aF,
+                  const float *a, float x, float y, float *trans, float *taus)
 {
     const int res = f->res;
+    const size_t plane = (size_t)res * res;
     const float s = pc->s[p], k2 = (float)(f->texel * f->texel) / (s * s), rt = (float)(ATMOS__PCLOUD_CUT * s / f->texel);
     const int j0 = (int)fmaxf(0.0f, floorf(y - rt)), j1 = (int)fminf(res - 1.0f, ceilf(y + rt));
+    float col[CHUNK];
     for (int j = j0; j <= j1; j++) {
         const float dy = (float)j + 0.5f - y, rem = rt * rt - dy * dy;
         if (rem < 0) continue;
         const float w = sqrtf(rem);
         const int i0 = (int)fmaxf(0.0f, ceilf(x - 0.5f - w)), i1 = (int)fminf(res - 1.0f, floorf(x - 0.5f + w));
-        float *tr = trans + (size_t)j * res, *ts = taus + (size_t)j * res;
-        for (int i = i0; i <= i1; i++) {
-            const float dx = (float)i + 0.5f - x;
-            const float tau = tc * atmos__pcloud_column((dx * dx + dy * dy) * k2);
-            const float T = atmos__expf_poly(-tau); /* tau <= a particle's column: far above -87 */
-            tr[i] *= T + (1.0f - T) * aF;
-            ts[i] += a * tau;
+        for (int c0 = i0; c0 <= i1; c0 += CHUNK) {
+            const int m = i1 - c0 + 1 < CHUNK ? i1 - c0 + 1 : CHUNK;
+            for (int i = 0; i < m; i++) {
+                const float dx = (float)(c0 + i) + 0.5f - x;
+                col[i] = atmos__pcloud_column((dx * dx + dy * dy) * k2);
+            }
+            for (int g = 0; g < G; g++) {
+                float *tr = trans + g * plane + (size_t)j * res + c0, *ts = taus + g * plane + (size_t)j * res + c0;
+                const float tg = tc[g], ag = aF[g], sg = a[g];
+                for (int i = 0; i < m; i++) {
+                    const float tau = tg * col[i];
+                    const float T = atmos__expf_poly(-tau); /* tau <= a particle's column: far above -87 */
+                    tr[i] *= T + (1.0f - T) * ag;
+                    ts[i] += sg * tau;
+                }
+            }
         }
     }
 }
@@ -93,38 +111,49 @@ static void probe_read(const atmos__pprobes *pr, int i, const lframe *f, const f
     pr->light[(size_t)i * nw + k] = in ? (float)read_at(trans, f->res, x, y) : 1.0f;
 }
 
-/* The light pass of wavelength k. The particles go in groups of depths within half the
- * first one's width; a group splats the front halves of its blobs (optical depth tc / 2),
- * reads the light at its particles' centres, then splats the back halves: particles side by
- * side shade each other's centres as the halves of a slab do. Probes (negative indices in ord)
- * read the buffer with their group's centres and splat nothing. */
-static void pass(const atmos__pcloud *pc, int n, const atmos__poptics *o, const lframe *f, const atmos__keyed *ord, int k,
-                 const atmos__pprobes *pr, float *trans, float *taus, float *light, float *ns)
+/* The light pass of wavelengths k0 .. k0 + G - 1 (G <= GROUP; their buffers plane by plane in
+ * trans and taus). The particles go in groups of depths within half the first one's width; a
+ * group splats the front halves of its blobs (optical depth tc / 2), reads the light at its
+ * particles' centres, then splats the back halves: particles side by side shade each other's
+ * centres as the halves of a slab do. Probes (negative indices in ord) read the buffer with
+ * their group's centres and splat nothing. Each wavelength's buffers see the same arithmetic
+ * as in a pass of its own. */
+static void pass(const atmos__pcloud *pc, int n, const atmos__poptics *o, const lframe *f, const atmos__keyed *ord, int k0,
+                 int G, const atmos__pprobes *pr, float *trans, float *taus, float *light, float *ns)
 {
     const int res = f->res, nw = o->nw;
-    for (size_t t = 0; t < (size_t)res * res; t++) trans[t] = 1.0f, taus[t] = 0.0f;
+    const size_t plane = (size_t)res * res;
+    for (size_t t = 0; t < G * plane; t++) trans[t] = 1.0f, taus[t] = 0.0f;
     for (int q0 = 0, q1; q0 < n; q0 = q1) {
         const double dmax = ord[q0].key + (ord[q0].index >= 0 ? 0.5 * pc->s[ord[q0].index] : 0.0);
         for (q1 = q0 + 1; q1 < n && ord[q1].key < dmax; q1++) {}
         for (int phase = 0; phase < 3; phase++)
             for (int q = q0; q < q1; q++) {
                 if (ord[q].index < 0) {
-                    if (phase == 1) probe_read(pr, -1 - ord[q].index, f, trans, k, nw);
+                    for (int g = 0; g < G && phase == 1; g++)
+                        probe_read(pr, -1 - ord[q].index, f, trans + g * plane, k0 + g, nw);
                     continue;
                 }
                 const int p = ord[q].index, fi = pc->field[p];
                 const double x = (dot(f->e1, pc->x[p], pc->y[p], pc->z[p]) - f->u0) / f->texel;
                 const double y = (dot(f->e2, pc->x[p], pc->y[p], pc->z[p]) - f->v0) / f->texel;
-                const double a = o->albedo[fi][k], tc = o->sigma_ext[fi][k] * pc->n0[p] * pc->s[p] * SQRT_2PI;
-                const size_t at = (size_t)p * nw + k;
                 if (phase == 1) {
-                    light[at] = (float)read_at(trans, res, x, y);
-                    ns[at] = (float)read_at(taus, res, x, y);
+                    for (int g = 0; g < G; g++) {
+                        const size_t at = (size_t)p * nw + k0 + g;
+                        light[at] = (float)read_at(trans + g * plane, res, x, y);
+                        ns[at] = (float)read_at(taus + g * plane, res, x, y);
+                    }
                     continue;
                 }
-                const double sc = phase ? ns[at] : read_at(taus, res, x, y);
-                const double F = o->ms[fi] ? atmos_msphase_forward(o->ms[fi], k, sc + 1.0) : 0.0;
-                splat(pc, p, f, (float)(0.5 * tc), (float)(a * F), (float)a, (float)x, (float)y, trans, taus);
+                float tc[GROUP], aF[GROUP], a[GROUP];
+                for (int g = 0; g < G; g++) {
+                    const int k = k0 + g;
+                    const double sc = phase ? ns[(size_t)p * nw + k] : read_at(taus + g * plane, res, x, y);
+                    const double F = o->ms[fi] ? atmos_msphase_forward(o->ms[fi], k, sc + 1.0) : 0.0;
+                    const double ak = o->albedo[fi][k], tk = o->sigma_ext[fi][k] * pc->n0[p] * pc->s[p] * SQRT_2PI;
+                    tc[g] = (float)(0.5 * tk), aF[g] = (float)(ak * F), a[g] = (float)ak;
+                }
+                splat(pc, p, f, G, tc, aF, a, (float)x, (float)y, trans, taus);
             }
     }
 }
@@ -163,15 +192,18 @@ atmos_status atmos__pcloud_shade_probes(atmos_context *ctx, const atmos__pcloud 
     }
     atmos__keyed_sort(ord, (size_t)(n + np), 0);
     int nomem = 0;
+    const int groups = (o->nw + GROUP - 1) / GROUP;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
-    for (int k = 0; k < o->nw; k++) {
-        float *buf = malloc(sizeof(float) * 2 * (size_t)f.res * f.res);
+    for (int gi = 0; gi < groups; gi++) {
+        const int k0 = gi * GROUP, G = o->nw - k0 < GROUP ? o->nw - k0 : GROUP;
+        const size_t plane = (size_t)f.res * f.res;
+        float *buf = malloc(sizeof(float) * 2 * (size_t)G * plane);
         if (!buf) {
 #pragma omp atomic write
             nomem = 1;
             continue;
         }
-        pass(pc, n + np, o, &f, ord, k, pr, buf, buf + (size_t)f.res * f.res, light, ns);
+        pass(pc, n + np, o, &f, ord, k0, G, pr, buf, buf + G * plane, light, ns);
         free(buf);
     }
     for (int q = 0; q < n && order; q++) {

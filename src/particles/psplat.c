@@ -16,7 +16,8 @@
 typedef struct sp {
     double c[3], s, z;       /* centre, width, depth along the camera's axis */
     int bb[4];               /* pixel box [x0, x1) x [y0, y1) */
-    float col[ATMOS_MAX_WAVELENGTHS], tc[ATMOS_MAX_WAVELENGTHS]; /* colour and central depth */
+    float *col, *tc;         /* colour and central depth per wavelength (nw each, in the splats'
+                                shared pool: the records stay small, a tile's list in cache) */
 } sp;
 
 static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -69,34 +70,54 @@ __attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, 
     const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
     const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
     const double W = cam->width, H = cam->height, t = cam->tan_half_fov, k2 = 1.0 / (q->s * q->s);
+    const float *tc = q->tc, *col = q->col;
     const double rc2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT * q->s * q->s;
     const double *F = cam->forward, *R = cam->right, *U = cam->up;
     double rel[3], Q[3];
     for (int i = 0; i < 3; i++) rel[i] = q->c[i] - cam->position[i];
     cross(rel, R, Q);
     const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, u0 = (2.0 * x0 + 1.0 - W) / H * t;
-    const int C = img->channels, n = x1 - x0;
+    /* the row's loops run over whole vectors of 8 (nn: n rounded up, at most TILE; the values
+     * past n are not used): no scalar remainder loops */
+    const int C = img->channels, n = x1 - x0, nn = (n + 7) & ~7;
     double b2[TILE];
-    float g[TILE];
+    float g[TILE], T[ATMOS_MAX_WAVELENGTHS][TILE];
     for (int y = y0; y < y1; y++) {
         const double v = (H - 2.0 * (y + 0.5)) / H * t;
         double D[3], P[3];
         for (int i = 0; i < 3; i++) D[i] = F[i] + v * U[i];
         cross(rel, D, P);
         const double a0 = dot(P, P), a1 = 2.0 * dot(P, Q), e0 = dot(D, D), e1 = 2.0 * dot(D, R);
-        for (int j = 0; j < n; j++) {
+        for (int j = 0; j < nn; j++) {
             const double u = u0 + j * du;
             b2[j] = (a0 + u * (a1 + u * a2)) / (e0 + u * (e1 + u * e2));
         }
-        for (int j = 0; j < n; j++) g[j] = atmos__pcloud_column((float)(b2[j] * k2));
+        for (int j = 0; j < nn; j++) g[j] = atmos__pcloud_column((float)(b2[j] * k2));
+        /* the transmittances wavelength by wavelength over the row (vectorised), then the
+         * pixels within the cut composited with them */
+        for (int k = 0; k < nw; k++)
+            for (int j = 0; j < nn; j++) T[k][j] = atmos__expf_fast(-tc[k] * g[j]);
         float *row = img->pixels + ((size_t)y * cam->width + x0) * C;
+        if (nw == 3 && C == 4) {
+            /* three wavelengths and coverage: every value v of the row becomes v t + c (1 - t),
+             * t = 1 (the pixel left as it is, exactly) beyond the cut, the coverage's t the
+             * mean transmittance and c = 1 (1 - (1 - v) t); one loop over the row's values */
+            float TT[4 * TILE];
+            const float c4[4] = {col[0], col[1], col[2], 1.0f};
+            for (int j = 0; j < n; j++) {
+                const int in = b2[j] <= rc2;
+                const float t0 = in ? T[0][j] : 1.0f, t1 = in ? T[1][j] : 1.0f, t2 = in ? T[2][j] : 1.0f;
+                TT[4 * j] = t0, TT[4 * j + 1] = t1, TT[4 * j + 2] = t2, TT[4 * j + 3] = in ? (t0 + t1 + t2) / 3.0f : 1.0f;
+            }
+            for (int i = 0; i < 4 * n; i++) row[i] = row[i] * TT[i] + c4[i & 3] * (1.0f - TT[i]);
+            continue;
+        }
         for (int j = 0; j < n; j++) {
             if (b2[j] > rc2) continue;
             float *px = row + (size_t)j * C, tm = 0;
             for (int k = 0; k < nw; k++) {
-                const float T = atmos__expf_fast(-q->tc[k] * g[j]);
-                px[k] = px[k] * T + q->col[k] * (1.0f - T);
-                tm += T;
+                px[k] = px[k] * T[k][j] + col[k] * (1.0f - T[k][j]);
+                tm += T[k][j];
             }
             px[nw] = 1.0f - (1.0f - px[nw]) * tm / nw;
         }
@@ -150,12 +171,15 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
     /* room for the particles asked for (a cloud's impostor: its own, not the whole field's) */
     const int count = idx ? nidx : pc->n;
     sp *s = malloc(sizeof *s * (size_t)(count > 0 ? count : 1));
+    float *pool = malloc(sizeof(float) * 2 * (size_t)o->nw * (size_t)(count > 0 ? count : 1));
     atmos__keyed *ord = malloc(sizeof *ord * (size_t)(count > 0 ? count : 1));
     int *cnt = calloc((size_t)ntx * nty + 1, sizeof(int));
     int n = 0;
-    if (!s || !ord || !cnt) goto nomem;
-    for (int q = 0; q < count; q++)
+    if (!s || !ord || !cnt || !pool) goto nomem;
+    for (int q = 0; q < count; q++) {
+        s[n].col = pool + 2 * (size_t)o->nw * n, s[n].tc = s[n].col + o->nw;
         if (prepare(pc, idx ? idx[q] : q, o, L, cam, rect, &s[n])) ord[n].key = s[n].z, ord[n].index = n, n++;
+    }
     atmos__keyed_sort(ord, (size_t)n, 1);
     /* tile lists: counts, offsets, then the splats in far-to-near order */
     for (int q = 0; q < n; q++) {
@@ -186,10 +210,10 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
             else draw(&s[list[q]], o->nw, cam, tx, ty, img);
         }
     }
-    free(list), free(fill), free(s), free(ord), free(cnt);
+    free(list), free(fill), free(s), free(ord), free(cnt), free(pool);
     if (drawn) *drawn = n;
     return ATMOS_OK;
 nomem:
-    free(s), free(ord), free(cnt);
+    free(s), free(ord), free(cnt), free(pool);
     return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the splats");
 }

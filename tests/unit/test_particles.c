@@ -120,6 +120,47 @@ static void light_pass(void)
     atmos_volume_destroy(v);
 }
 
+/* The light pass of six wavelengths at once (in groups that share each texel's column) against
+ * six passes of one wavelength each with the same optics: the same light at every particle
+ * (within 1e-6) and the same scattering count (the mean of the six). */
+static void light_groups(void)
+{
+    atmos_volume_generate_desc gd;
+    memset(&gd, 0, sizeof gd);
+    gd.seed = 5, gd.voxel_size_m = 100;
+    atmos_volume *v = NULL;
+    CHECK_OK(atmos_volume_generate(NULL, "cumulus", &gd, &v));
+    const double off[3] = {0, 0, 0};
+    atmos__pcloud pc;
+    CHECK_OK(atmos__pcloud_from_volume(NULL, v, off, 100.0, 0, &pc));
+    enum { NW = 6 };
+    atmos__poptics o, o1;
+    memset(&o, 0, sizeof o);
+    o.nw = NW;
+    for (int k = 0; k < NW; k++) o.sigma_ext[0][k] = (1.0 + 0.3 * k) * 1e-11, o.albedo[0][k] = 0.99 - 0.05 * k;
+    double sun[3];
+    atmos_direction_from_angles(35, 120, sun);
+    const size_t n = (size_t)pc.n;
+    float *light = malloc(sizeof(float) * n * NW), *order = malloc(sizeof(float) * n);
+    float *l1 = malloc(sizeof(float) * n), *o1s = malloc(sizeof(float) * n), *mean = calloc(n, sizeof(float));
+    CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun, 0, 1.0, light, order));
+    double worst = 0, worst_n = 0;
+    for (int k = 0; k < NW; k++) {
+        memset(&o1, 0, sizeof o1);
+        o1.nw = 1, o1.sigma_ext[0][0] = o.sigma_ext[0][k], o1.albedo[0][0] = o.albedo[0][k];
+        CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o1, sun, 0, 1.0, l1, o1s));
+        for (size_t p = 0; p < n; p++) worst = fmax(worst, fabs(light[p * NW + k] - l1[p])), mean[p] += o1s[p] / NW;
+    }
+    for (size_t p = 0; p < n; p++) worst_n = fmax(worst_n, fabs(order[p] - mean[p]) / (mean[p] + 1.0));
+    printf("light pass, %d wavelengths at once against one at a time: %d particles, light differs by %.3g, "
+           "scattering count by %.3g\n", NW, pc.n, worst, worst_n);
+    CHECK(worst <= 1e-6);
+    CHECK(worst_n <= 1e-5);
+    free(light), free(order), free(l1), free(o1s), free(mean);
+    atmos__pcloud_free(&pc);
+    atmos_volume_destroy(v);
+}
+
 /* One thin particle seen face on, isotropic scattering, against the single-scattering
  * integral a/(4 pi) E (1 - exp(-tau)) on the ray through its centre; and the same bytes
  * on 1 and 2 threads for a cloud of them. */
@@ -338,6 +379,7 @@ int main(void)
     generated();
     impostors();
     light_pass();
+    light_groups();
     eye_pass();
     return test_summary("test_particles");
 }
