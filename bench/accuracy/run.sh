@@ -12,7 +12,8 @@
 # CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
 # VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer, "harris",
 # "harris_sun": Harris's, and the same with the diffuse light field, "nishita_diffuse",
-# "harris_diffuse", "harris_sun_diffuse": not in the default list), THREADS, REUSE (1: keep the reference images
+# "harris_diffuse", "harris_sun_diffuse"; "diffuse_aa": the default with four eye rays per pixel,
+# antialiased: not in the default list), THREADS, REUSE (1: keep the reference images
 # already in OUT_DIR, e.g. to compare a new build's variants against the same references).
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
@@ -58,6 +59,7 @@ for c in $CASES; do
             low_albedo) opts="--low-albedo" ;;
             diffuse) opts="" ;;
             diffuse_xi0) opts="--xi 0" ;;
+            diffuse_aa) opts="--eye-scale 2" ;;
             nishita) opts="--renderer nishita" ;;
             harris) opts="--renderer harris" ;;
             harris_sun) opts="--renderer harris --sky-lights 0" ;;

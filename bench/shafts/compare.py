@@ -68,4 +68,5 @@ def main():
               " all air: %+.2f %%, %.2f %%" % (name, b1, a1, b2, a2))
 
 
-main()
+if __name__ == "__main__":
+    main()

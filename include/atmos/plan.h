@@ -65,7 +65,7 @@ typedef struct atmos_frame {
     int samples_per_pixel;      /* sky and slice renderers: stratified samples of the sky, 1..256 */
     int spp;                    /* path tracer: samples per pixel to reach (progressive), 1..ATMOS_PATH_MAX_SPP */
     int slices;                 /* slice renderer: sampling planes, 0 = the scene's */
-    double eye_scale;           /* slice renderer: eye buffer scale in (0, 1], 0 = the scene's */
+    double eye_scale;           /* slice renderer: eye buffer scale in (0, 1] or 2, 0 = the scene's */
     int light_size;             /* slice renderer: the light buffer's side in texels for this frame, at most
                                    the scene's "light_size" (a larger one is the scene's), 0 = the scene's:
                                    the viewer's preview while the sun moves */

@@ -86,7 +86,7 @@ typedef struct atmos_scene_slice {
     int eq24;                 /* "update": 0 = "eq25" (default), 1 = "eq24" */
     int low_albedo;           /* 0 */
     int grid_max_dim;         /* 256 */
-    double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1]; 1 */
+    double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1] or 2; 1 */
     int max_order;            /* Ams orders tabulated; 64 */
     int diffuse;              /* 1: add the diffuse light field (the light Eq. 24/25 drop, by diffusion) */
     int air_shadows;          /* 1 (default): the volume shadows the air's single scattering

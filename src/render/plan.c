@@ -284,8 +284,8 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
     if (v->slices < 0 || v->slices > 8192)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: slices must be in [0, 8192] (0: chosen from the volume), got %d",
                             v->slices);
-    if (!(v->eye_scale > 0 && v->eye_scale <= 1))
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: eye_scale must be in (0, 1], got %g", v->eye_scale);
+    if (!(v->eye_scale > 0 && (v->eye_scale <= 1 || v->eye_scale == 2)))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: eye_scale must be in (0, 1] or 2, got %g", v->eye_scale);
     if (p->renderer == ATMOS_RENDERER_SLICE && v->cam.type != ATMOS_CAMERA_PINHOLE)
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "render slice: only pinhole cameras are supported");
     return ATMOS_OK;

@@ -144,7 +144,8 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                                     img->pixels + p * C);
                 }
         } else {
-            /* Eye buffer smaller than the image: L_vol and T_vol bilinear between the
+            /* Eye buffer smaller than the image (or twice its size: the taps then fall
+             * midway, the 2 x 2 box): L_vol and T_vol bilinear between the
              * four eye pixels around the image pixel's centre (both are premultiplied by
              * the volume's coverage, so this blurs the silhouette by one eye pixel but
              * does not tint it). Eye pixels outside their row's union of spans were

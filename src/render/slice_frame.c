@@ -156,10 +156,12 @@ static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob
     }
     j->n = sp->n, j->nf = sp->nf;
     /* The eye buffer: the image, or eye_scale of it per axis (eye pixel x covers image
-     * pixels x sx .. (x + 1) sx; its ray goes through the centre of that area). */
+     * pixels x sx .. (x + 1) sx; its ray goes through the centre of that area). At 2 the
+     * composite's bilinear taps at an image pixel's centre fall midway between its four
+     * eye pixels: their mean, the pixel's 2 x 2 box filter. */
     j->W = cam->width, j->H = cam->height, j->L = lf->L;
     j->sx = j->sy = 1.0;
-    if (v->eye_scale < 1.0) {
+    if (v->eye_scale != 1.0) {
         int we = (int)lround(v->eye_scale * cam->width), he = (int)lround(v->eye_scale * cam->height);
         we = we < 1 ? 1 : we, he = he < 1 ? 1 : he;
         if (we != j->W || he != j->H) {

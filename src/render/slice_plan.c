@@ -85,7 +85,7 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
 static void eye_size(const atmos__view *v, int *w, int *h)
 {
     *w = v->cam.width, *h = v->cam.height;
-    if (v->eye_scale < 1.0) {
+    if (v->eye_scale != 1.0) {
         int we = (int)lround(v->eye_scale * v->cam.width), he = (int)lround(v->eye_scale * v->cam.height);
         *w = we < 1 ? 1 : we, *h = he < 1 ? 1 : he;
     }

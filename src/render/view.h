@@ -12,7 +12,7 @@ typedef struct atmos__view {
     int samples_per_pixel;     /* stratified samples of the sky, 1..256 */
     int spp;                   /* path tracer: samples per pixel to reach */
     int slices;                /* slice renderer: sampling planes */
-    double eye_scale;          /* slice renderer: eye buffer scale, (0, 1] */
+    double eye_scale;          /* slice renderer: eye buffer scale, (0, 1] or 2 */
     int light_size;            /* slice renderer: light buffer side, 0 = the scene's (at most the scene's) */
     int sky_step;              /* the sky background every sky_step pixels (1: every pixel) */
     int no_air_shadows;        /* slice renderer: the volume's shadow on the air left out this frame */

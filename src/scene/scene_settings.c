@@ -31,8 +31,9 @@ static const atmos_setting slice_settings[] = {
      SLICE(low_albedo)},
     {"grid_max_dim", "grid-max-dim", ATMOS_SETTING_INT, "voxels", 8, 2048, 0, 0, 256, NULL, 0,
      "the volume is box-filtered onto a grid of at most this many voxels per axis", SLICE(grid_max_dim)},
-    {"eye_scale", "eye-scale", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 1, NULL, 0,
-     "eye buffer resolution relative to the image, per axis (0.5: a quarter of the rays, upsampled)",
+    {"eye_scale", "eye-scale", ATMOS_SETTING_REAL, "", 0, 2, 1, 0, 1, NULL, 0,
+     "eye buffer resolution relative to the image, per axis, in (0, 1] or 2 (0.5: a quarter of the "
+     "rays, upsampled; 2: four rays per pixel, averaged: antialiased)",
      SLICE(eye_scale)},
     {"max_order", "max-order", ATMOS_SETTING_INT, "", 1, 1000, 0, 0, 64, NULL, 0,
      "orders of Ams tabulated (higher scattering orders use the last)", SLICE(max_order)},

@@ -238,6 +238,12 @@ atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const
                                                                                             t[i].min_open, t[i].max_open};
             atmos_status st = atmos__scene_check_range(ctx, source, path, v, &range, NULL);
             if (st != ATMOS_OK) return st;
+            /* the slice renderer's eye_scale: (0, 1], or 2 (four rays per pixel, averaged) */
+            if (r == ATMOS_RENDERER_SLICE && !strcmp(t[i].key, "eye_scale") && v > 1 && v != 2) {
+                char got[40];
+                atmos__scene_fmt_num(got, sizeof got, v);
+                return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path, "must be in (0, 1] or 2, got %s", got);
+            }
         }
     }
     return ATMOS_OK;

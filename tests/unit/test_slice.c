@@ -558,6 +558,67 @@ static void test_eye_scale(void)
     atmos_context_destroy(c2);
 }
 
+/* eye_scale 2: two rays per pixel along each axis, averaged, as the path tracer spreads its
+ * samples over the pixel's area. The image must be the 2 x 2 box average of the render at
+ * twice the size (what the accuracy bench measured: docs/accuracy.md, "What the per-pixel
+ * error is made of"), within what the sky's and the air's change across a pixel allows, and
+ * nearer it than the one-ray image is. A dense blob of 48 x 48 pixels with the sun to the side,
+ * seen from below. */
+static void test_eye_scale_box(void)
+{
+    optics op;
+    atmos_context *c2 = make_ctx(2);
+    make_optics(c2, &op);
+    atmos_volume *v = blob(c2, 3e7f);
+    atmos_scene s;
+    scene_for(&s, 20, 100);
+    s.camera.position[1] = 900; /* looking up at it: no horizon in the image, whose step across a
+                                   pixel the composite (one sky value per pixel) does not filter */
+    const int W = 48, H = 48;
+    sopts ss = {0};
+    ss.optics = &op.o;
+    ss.slices = 96;
+    s.width = 2 * W, s.height = 2 * H;
+    atmos_image *big = render(c2, &s, v, &ss), *sky = NULL, *sky2 = NULL;
+    CHECK_OK(atmos_render_sky(c2, &s, &sky2, NULL));
+    s.width = W, s.height = H;
+    CHECK_OK(atmos_render_sky(c2, &s, &sky, NULL));
+    atmos_image *one = render(c2, &s, v, &ss);
+    ss.eye_scale = 2.0;
+    atmos_image *two = render(c2, &s, v, &ss);
+    if (!big || !one || !two || !sky || !sky2) {
+        CHECK(0);
+    } else {
+        double d2 = 0, d1 = 0, m2 = 0, vmax = 0, eff = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                for (int c = 0; c < 3; c++) {
+                    double box = 0;
+                    for (int q = 0; q < 4; q++) {
+                        const size_t b = ((size_t)(2 * y + (q >> 1)) * 2 * W + 2 * x + (q & 1)) * 4 + c;
+                        box += 0.25 * ((double)big->pixels[b] - sky2->pixels[b]);
+                    }
+                    /* the volume's effects (image - sky): the sky's own curvature across a pixel cancels */
+                    const size_t p = ((size_t)y * W + x) * 4 + c;
+                    const double e2 = (double)two->pixels[p] - sky->pixels[p], e1 = (double)one->pixels[p] - sky->pixels[p];
+                    d2 += fabs(e2 - box), d1 += fabs(e1 - box);
+                    m2 = fmax(m2, fabs(e2 - box)), vmax = fmax(vmax, fabs(box)), eff += fabs(box);
+                }
+        printf("slice eye_scale 2 vs the 2x2 box of the double-size image: mean |difference| %.3f%% of the mean "
+               "effect (1 ray per pixel: %.3f%%), max %.3f%% of the largest effect\n",
+               100 * d2 / eff, 100 * d1 / eff, 100 * m2 / vmax);
+        CHECK(all_finite(two));
+        CHECK_MSG(d2 <= 0.002 * eff, "eye_scale 2: mean difference %g of the effect", d2 / eff);
+        CHECK_MSG(m2 <= 0.01 * vmax, "eye_scale 2: max difference %g of the largest effect", m2 / vmax);
+        CHECK_MSG(d2 <= 0.25 * d1, "eye_scale 2 is no nearer the box (%g) than one ray per pixel (%g)", d2, d1);
+    }
+    atmos_image_destroy(big), atmos_image_destroy(one), atmos_image_destroy(two), atmos_image_destroy(sky);
+    atmos_image_destroy(sky2);
+    atmos_volume_destroy(v);
+    free_optics(&op);
+    atmos_context_destroy(c2);
+}
+
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "cache");
@@ -568,5 +629,6 @@ int main(void)
     test_empty_and_errors();
     test_fast_vs_reference();
     test_eye_scale();
+    test_eye_scale_box();
     return test_summary("test_slice");
 }

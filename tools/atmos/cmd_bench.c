@@ -77,7 +77,8 @@ static void help(void)
            "          composite included): fps_camera_moving, fps_sun_moving, fps_static; ms_per_frame\n"
            "          (sun moving), ns per sample and the breakdown of a frame (setup, light, eye, sky);\n"
            "          prepare_ms: making the plan (render grid, tables; the optics included).\n"
-           "          --eye-scale S renders the eye passes on an S-times smaller buffer per axis.\n"
+           "          --eye-scale S renders the eye passes on a buffer S times the image per axis, S in\n"
+           "          (0, 1] or 2 (2: four rays per pixel, averaged).\n"
            "          --no-diffuse leaves out the diffuse light field (\"diffuse\", on by default); field_ms:\n"
            "          its build (source and diffusion solve, warm-started) after the sun's last move,\n"
            "          field_sweeps its sweeps;\n"
@@ -547,8 +548,8 @@ int cli_cmd_bench(int argc, char **argv)
             if (!cli_parse_double(C, "--density-scale", argv[++i], &dscale) || !(dscale > 0))
                 return cli_usage_error(C, "--density-scale: expected a factor > 0");
         } else if (!strcmp(argv[i], "--eye-scale") && i + 1 < argc) {
-            if (!cli_parse_double(C, "--eye-scale", argv[++i], &eye_scale) || !(eye_scale > 0 && eye_scale <= 1))
-                return cli_usage_error(C, "--eye-scale: expected a value in (0, 1]");
+            if (!cli_parse_double(C, "--eye-scale", argv[++i], &eye_scale) || !(eye_scale > 0 && (eye_scale <= 1 || eye_scale == 2)))
+                return cli_usage_error(C, "--eye-scale: expected a value in (0, 1] or 2");
         } else if (!strcmp(argv[i], "--no-forced")) {
             pflags.no_forced = 1;
         } else if (!strcmp(argv[i], "--no-sky-nee")) {
