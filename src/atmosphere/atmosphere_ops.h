@@ -66,7 +66,9 @@ void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const
 void atmos__atm_batch_release(atmos__atm_batch *b);
 /* b (zeroed, or initialised before) made to answer for atmosphere a, eye and sun: its per-eye
  * tables kept when they answer for them as they are (returns 1), else built again (0). The
- * rays' values are those of atmos__atm_batch_init's either way. */
+ * rays' values are those of atmos__atm_batch_init's either way, but for cloud spheres seen
+ * from above the air: from the second frame with the same sun on, their attenuation comes
+ * from textures (planet_clouds.h), within the textures' error of the first frame's. */
 int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3]);
 void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);

@@ -38,6 +38,22 @@ double atmos__clouds_sun_attenuation(const atmos__planet *pl, const double x[3],
 void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const double sun[3], int w, int h,
                                        float *out);
 
+/* The attenuation textures of one sun direction (planet_clouds_sun.c): G of every sphere
+ * below the top one and of the ground tabulated over a latitude/longitude grid at a quarter
+ * of the cloud image's pitch, filled tile by tile as look-ups need them (any thread; the
+ * values do not depend on which). NULL without clouds or memory. */
+typedef struct atmos__clouds_sun atmos__clouds_sun;
+atmos__clouds_sun *atmos__clouds_sun_create(const atmos__planet *pl, const double sun[3]);
+void atmos__clouds_sun_destroy(atmos__clouds_sun *s);
+/* Nonzero when s was made for exactly this sun. */
+int atmos__clouds_sun_same(const atmos__clouds_sun *s, const double sun[3]);
+/* G at x (on sphere `below`, or the ground for -1) of latitude and longitude lat, lon
+ * (degrees, atmos__planet_latlon_fast's), interpolated bilinearly; outside the grid's box
+ * atmos__clouds_sun_attenuation itself. */
+double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon);
+/* The world-frame point at radius r from the planet's centre over lat, lon (degrees). */
+void atmos__clouds_geo_point(const atmos__planet *pl, double r, double lat_deg, double lon_deg, double x[3]);
+
 /* The clouds' transmittance along p + t d, t in [0, dist] (the sun's disk behind them). */
 double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[3], const double d[3], double dist);
 
@@ -52,9 +68,10 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
  * Lc[j n + k], Tc[j n + k] the air's in-scatter (phase functions applied) and transmittance
  * from p to stop j, the crossing of sphere m - 1 - j for j < m, the ground for j = m (a
  * per-eye table's, spherical_space.c). The clouds' light and the ground's are composited
- * as atmos__planet_radiance_clouds does. Returns 0 (out untouched) when the ray does not
+ * as atmos__planet_radiance_clouds does, with G from sun's textures (NULL: evaluated at each
+ * crossing). Returns 0 (out untouched) when the ray does not
  * cross each sphere once, top to bottom, before the ground. */
 int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
-                                 const double *Lc, const double *Tc, double *out);
+                                 const double *Lc, const double *Tc, atmos__clouds_sun *gs, double *out);
 
 #endif

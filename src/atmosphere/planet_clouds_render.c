@@ -56,9 +56,9 @@ static double hg(double g, double cos_theta)
 }
 
 /* Adds the crossing's light (times the transmittance w in front of it) to out; returns
- * the crossing's transmittance. */
+ * the crossing's transmittance. G from gs's textures, or evaluated here when gs is NULL. */
 static double crossing_light(const atmos_atmosphere *a, const double x[3], const double d[3], const double sun[3],
-                             int i, const double *w, double *out)
+                             int i, const double *w, atmos__clouds_sun *gs, double *out)
 {
     const atmos__planet *pl = a->planet;
     const atmos__clouds *cl = pl->clouds;
@@ -75,7 +75,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     int lit = 0;
     for (int k = 0; k < n; k++) lit |= E[k] > 0;
     if (!lit) return t;
-    const double G = atmos__clouds_sun_attenuation(pl, x, sun, i);
+    const double G = gs ? atmos__clouds_sun_lookup(gs, x, i, lat, lon) : atmos__clouds_sun_attenuation(pl, x, sun, i);
     double J = G * hg(cl->g, atmos__dot3(d, sun));
     const double mus = atmos__planet_mu(pl, x, sun);
     if (!cl->single && mus > 0) {
@@ -89,7 +89,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
 /* The ground at distance K: lit by the sunlight through the air and the clouds, and its
  * lights; times w. */
 static void ground_light(const atmos_atmosphere *a, const double p[3], const double d[3], double K,
-                         const double sun[3], const double *w, double *out)
+                         const double sun[3], const double *w, atmos__clouds_sun *gs, double *out)
 {
     const atmos__planet *pl = a->planet;
     const int n = a->wl.count;
@@ -100,7 +100,11 @@ static void ground_light(const atmos_atmosphere *a, const double p[3], const dou
     double G = 0.0;
     if (cs > 0) {
         a->solver->sunlight(a, g, sun, n, NULL, E);
-        G = atmos__clouds_sun_attenuation(pl, g, sun, -1);
+        if (gs) {
+            double lat, lon;
+            atmos__planet_latlon_fast(pl, g, &lat, &lon);
+            G = atmos__clouds_sun_lookup(gs, g, -1, lat, lon);
+        } else G = atmos__clouds_sun_attenuation(pl, g, sun, -1);
     }
     for (int k = 0; k < n; k++) {
         const double lit = cs > 0 ? atmos__planet_ground_albedo(pl, g, k) / ATMOS_PI * cs * E[k] * G : 0.0;
@@ -130,11 +134,11 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
             for (int k = 0; k < n; k++) w[k] *= T[k];
         }
         if (j == nc) {
-            if (K < INFINITY) ground_light(a, p, d, K, sun, w, out);
+            if (K < INFINITY) ground_light(a, p, d, K, sun, w, NULL, out);
             break;
         }
         for (int i = 0; i < 3; i++) x[i] = p[i] + t_end * d[i];
-        const double tc = crossing_light(a, x, d, sun, c[j].sphere, w, out);
+        const double tc = crossing_light(a, x, d, sun, c[j].sphere, w, NULL, out);
         clouds *= tc;
         for (int k = 0; k < n; k++) w[k] *= tc;
         opaque = clouds < OPAQUE;
@@ -148,7 +152,7 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
 }
 
 int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
-                                 const double *Lc, const double *Tc, double *out)
+                                 const double *Lc, const double *Tc, atmos__clouds_sun *gs, double *out)
 {
     const atmos__planet *pl = a->planet;
     const int n = a->wl.count, m = pl->clouds->m;
@@ -165,11 +169,11 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
             out[k] += clouds * fmax(Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0), 0.0);
         for (int k = 0; k < n; k++) w[k] = clouds * Tc[(size_t)j * n + k];
         if (j == m) {
-            ground_light(a, p, d, K, sun, w, out);
+            ground_light(a, p, d, K, sun, w, gs, out);
             break;
         }
         const double x[3] = {p[0] + c[j].t * d[0], p[1] + c[j].t * d[1], p[2] + c[j].t * d[2]};
-        clouds *= crossing_light(a, x, d, sun, c[j].sphere, w, out);
+        clouds *= crossing_light(a, x, d, sun, c[j].sphere, w, gs, out);
         if (clouds < OPAQUE) break;
     }
     return 1;
@@ -178,19 +182,13 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
 void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const double sun[3], int w, int h,
                                        float *out)
 {
-    const double r = pl->clouds->r[i];
-    for (int y = 0; y < h; y++) {
-        const double lat = (90.0 - (y + 0.5) * 180.0 / h) * ATMOS_DEG2RAD;
+    for (int y = 0; y < h; y++)
         for (int xx = 0; xx < w; xx++) {
-            const double lon = (-180.0 + (xx + 0.5) * 360.0 / w) * ATMOS_DEG2RAD;
-            /* the Earth-centred direction, then the world's axes (east, up, -north) */
-            const double q[3] = {cos(lat) * cos(lon), cos(lat) * sin(lon), sin(lat)};
-            const double e = atmos__dot3(q, pl->geo_east), u = atmos__dot3(q, pl->geo_up),
-                         no = atmos__dot3(q, pl->geo_north);
-            const double x[3] = {r * e, r * u - pl->r_ground, -r * no};
+            double x[3];
+            const double lat = 90.0 - (y + 0.5) * 180.0 / h, lon = -180.0 + (xx + 0.5) * 360.0 / w;
+            atmos__clouds_geo_point(pl, pl->clouds->r[i], lat, lon, x);
             out[(size_t)y * (size_t)w + (size_t)xx] = (float)atmos__clouds_sun_attenuation(pl, x, sun, i);
         }
-    }
 }
 
 double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[3], const double d[3], double dist)

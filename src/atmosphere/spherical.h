@@ -166,12 +166,23 @@ void atmos__sph_batch_eval(const atmos__atm_batch *b, int count, const float *dx
                            const float *weight, float *out, float *scratch);
 void atmos__sph_batch_release(atmos__atm_batch *b);
 /* Whether b's table answers for a new eye and sun (the same quanta; spherical_batch.c), and
- * if so turns it to them. */
+ * if so turns it to them; an eye above the air with cloud spheres and the sun of the frame
+ * before: the sun's attenuation textures made or kept, the per-eye table kept or built
+ * again (returns 1; the clouds' G then from the textures, within their error of the first
+ * frame's). */
 int atmos__sph_batch_keep(atmos__atm_batch *b, const double eye[3], const double sun[3]);
 /* An eye above the top of the air (spherical_space.c): its table (NULL when out of memory),
- * the radiance of many view rays added to out as batch_eval does, and the release. */
+ * the radiance of many view rays added to out as batch_eval does, and the release. gs: the
+ * cloud spheres' attenuation textures for this sun (planet_clouds.h; not owned), or NULL. */
 typedef struct atmos__sph_space atmos__sph_space;
-atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3]);
+struct atmos__clouds_sun;
+atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3],
+                                          struct atmos__clouds_sun *gs);
+/* Whether s's table answers for a new eye and sun (built for the same quantised distance
+ * from the centre and sun's cosine), and if so turns it to them, with the clouds' textures
+ * gs (NULL: none). */
+int atmos__sph_space_keep(atmos__sph_space *s, const atmos__planet *pl, const double eye[3], const double sun[3],
+                          struct atmos__clouds_sun *gs);
 void atmos__sph_space_eval(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int count,
                            const float *dx, const float *dy, const float *dz, const float *weight, float *out);
 void atmos__sph_space_destroy(atmos__sph_space *s);

@@ -51,6 +51,9 @@ typedef struct sv_state {
     int keyed;    /* built for the quantised altitude and sun (key) */
     long key[2];
     atmos__sph_space *space; /* the eye above the air; NULL (march per ray) if out of memory */
+    atmos__clouds_sun *gs;   /* with cloud spheres from above the air: their attenuation
+                                textures for the sun, made on the second frame with the same
+                                sun and kept while it stays (NULL: G at each crossing) */
     double up[3], e1[3], e2[3];
     float fup[3], fe1[3], fe2[3], fsun[3];
     float muh;
@@ -142,6 +145,21 @@ int atmos__sph_batch_keep(atmos__atm_batch *b, const double eye[3], const double
     sv_state *s = b->state;
     long key[2];
     double eq[3], sq[3];
+    if (s && s->space) { /* above the air */
+        const atmos__planet *pl = b->atm->planet;
+        /* with cloud spheres, the second frame in a row with the same sun (the eye moved)
+         * makes their attenuation textures, the later ones keep them; a single frame, drawn
+         * in one call or in parts, does without */
+        const int same = sun[0] == b->sun[0] && sun[1] == b->sun[1] && sun[2] == b->sun[2];
+        const int moved = eye[0] != b->eye[0] || eye[1] != b->eye[1] || eye[2] != b->eye[2];
+        if (pl->clouds && !same) return 0;
+        if (pl->clouds && moved && !s->gs) s->gs = atmos__clouds_sun_create(pl, sun);
+        if (atmos__sph_space_keep(s->space, pl, eye, sun, s->gs)) return 1;
+        if (!pl->clouds || atmos__planet_altitude(pl, eye) < pl->r_top - pl->r_ground) return 0;
+        atmos__sph_space_destroy(s->space); /* the eye's table again, the sun's textures kept */
+        s->space = atmos__sph_space_create(b->atm, eye, sun, s->gs);
+        return 1;
+    }
     if (!s || !s->tab || !s->keyed || !sv_key(b->atm->planet, eye, sun, key, eq, sq)) return 0;
     if (key[0] != s->key[0] || key[1] != s->key[1]) return 0;
     frame(s, b->atm->planet, eye, sun);
@@ -158,7 +176,7 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
     s->march = atmos__planet_altitude(pl, b->eye) >= pl->r_top - pl->r_ground;
     b->state = s;
     if (s->march) { /* the eye above the air, with or without cloud spheres */
-        s->space = atmos__sph_space_create(a, b->eye, b->sun);
+        s->space = atmos__sph_space_create(a, b->eye, b->sun, NULL);
         return;
     }
     if (pl->clouds) return; /* rays through cloud spheres from inside the air: one by one */
@@ -184,6 +202,7 @@ void atmos__sph_batch_release(atmos__atm_batch *b)
     if (s) {
         free(s->tab);
         atmos__sph_space_destroy(s->space);
+        atmos__clouds_sun_destroy(s->gs);
     }
     free(s);
     b->state = NULL;

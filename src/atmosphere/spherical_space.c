@@ -43,6 +43,9 @@
 
 struct atmos__sph_space {
     int n, ns;                   /* wavelengths; stops per node (1, or m + 1 with m cloud spheres) */
+    int keyed;                   /* the table is the key's (else the eye's own) */
+    long key[2];                 /* the eye's distance from the centre and the sun's cosine there,
+                                    quantised (KEEP_DR, KEEP_DMU) */
     double eye[3];               /* world frame */
     double rc2;                  /* the top cloud sphere's radius squared (0: no clouds) */
     double q[3], qq, r;          /* the eye from the planet's centre, |q|^2, |q| */
@@ -58,6 +61,8 @@ struct atmos__sph_space {
     float *gi;                   /* [n][NCS]: the ground's irradiance by the sun and the sky
                                     over pi, times the sun's, as atmos__sph_ground has it */
     float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS]; /* Rayleigh: kr (ra + rb nu^2) */
+    atmos__clouds_sun *gs;       /* the cloud spheres' attenuation textures for the sun (not
+                                    owned; NULL: G at each crossing) */
 };
 
 #define AD 0.3 /* the disk's rows: the linear share of their mapping (above) */
@@ -115,6 +120,34 @@ static void node_dir(const atmos__sph_space *s, int row, int col, double d[3])
     const double st = row_p(s, row) / s->r, ct = sqrt(fmax(0.0, 1.0 - st * st));
     const double phi = col_phi(s->phit[row], (double)col / (NA - 1)), c = cos(phi), sn = sin(phi);
     for (int i = 0; i < 3; i++) d[i] = -ct * s->up[i] + st * (c * s->e1[i] + sn * s->e2[i]);
+}
+
+/* The look-ups' frame for an eye and a sun: the eye, q, |q|, the axes; returns the sun's
+ * cosine to the eye's vertical. */
+static double space_frame(atmos__sph_space *s, const atmos__planet *pl, const double eye[3], const double sun[3])
+{
+    memcpy(s->eye, eye, sizeof s->eye);
+    s->q[0] = eye[0], s->q[1] = eye[1] + pl->r_ground, s->q[2] = eye[2];
+    s->qq = atmos__dot3(s->q, s->q), s->r = sqrt(s->qq);
+    return atmos__planet_sun_frame(s->q, sun, s->up, s->e1, s->e2);
+}
+
+/* The key of the frame's distance r and the sun's cosine mu (quanta KEEP_DR of log r and
+ * KEEP_DMU of mu), and an eye eq and a sun sq with the quantised values in a fixed frame
+ * (the eye over the origin): the table depends on nothing else (the air is the same all
+ * round the planet's centre; the ground's maps and the clouds are looked up per ray). 0 when
+ * the eye or the quantised eye is not above the air. */
+#define KEEP_DR 1e-6
+#define KEEP_DMU 1e-5
+static int key_eye(const atmos__sph_space *s, const atmos__planet *pl, double mu, long key[2], double eq[3],
+                   double sq[3])
+{
+    key[0] = lround(log(s->r) / KEEP_DR), key[1] = lround(fmax(-1.0, fmin(1.0, mu)) / KEEP_DMU);
+    const double rq = exp((double)key[0] * KEEP_DR), mq = fmax(-1.0, fmin(1.0, (double)key[1] * KEEP_DMU));
+    if (!(rq > pl->r_top * (1.0 + 1e-9)) || !(s->r > pl->r_top)) return 0;
+    eq[0] = 0.0, eq[1] = rq - pl->r_ground, eq[2] = 0.0;
+    sq[0] = sqrt(fmax(0.0, 1.0 - mq * mq)), sq[1] = mq, sq[2] = 0.0;
+    return 1;
 }
 
 /* Steps of the march per piece of the slices between cloud spheres and below them. */
@@ -185,11 +218,13 @@ static void fill_node(const atmos_atmosphere *a, atmos__sph_space *s, const doub
     for (int j = 0; j < ns; j++) put_stop(a, n, &sm, t + (size_t)j * NC * n);
 }
 
-atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3])
+atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3],
+                                          atmos__clouds_sun *gs)
 {
     const atmos__planet *pl = a->planet;
     atmos__sph_space *s = calloc(1, sizeof *s);
     if (!s) return NULL;
+    s->gs = gs;
     s->n = a->wl.count;
     s->ns = 1;
     if (pl->clouds) {
@@ -200,11 +235,13 @@ atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const doubl
         }
         s->ns = m + 1, s->rc2 = pl->clouds->r[m - 1] * pl->clouds->r[m - 1];
     }
-    memcpy(s->eye, eye, sizeof s->eye);
-    s->q[0] = eye[0], s->q[1] = eye[1] + pl->r_ground, s->q[2] = eye[2];
-    s->qq = atmos__dot3(s->q, s->q), s->r = sqrt(s->qq);
     s->R = pl->r_ground, s->Rt = pl->r_top;
-    const double mu_s = atmos__planet_sun_frame(s->q, sun, s->up, s->e1, s->e2);
+    /* the table for the quantised distance and sun (key), in a frame of its own: its values
+     * are the same whenever the key is */
+    double eq[3], sq[3];
+    const int keyed = key_eye(s, pl, space_frame(s, pl, eye, sun), s->key, eq, sq);
+    if (!keyed) memcpy(eq, eye, sizeof eq), memcpy(sq, sun, sizeof sq);
+    const double mu_s = space_frame(s, pl, eq, sq);
     for (int row = 0; row < NG + NL; row++) s->phit[row] = row_phit(s, row, mu_s);
     const size_t nodes = (size_t)(NG + NL) * NA * NC * s->ns * s->n;
     s->tab = malloc(sizeof(float) * (nodes + (size_t)s->n * (NPH + NCS)));
@@ -223,8 +260,24 @@ atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const doubl
     for (int k = 0; k < s->n; k++) atmos__planet_rayleigh_ab(pl, k, &s->ra[k], &s->rb[k]);
     atmos__planet_mie_phase_table(pl, s->n, NPH, s->mie);
 #pragma omp parallel for schedule(dynamic)
-    for (int e = 0; e < (NG + NL) * NA; e++) fill_node(a, s, eye, sun, e / NA, e % NA);
+    for (int e = 0; e < (NG + NL) * NA; e++) fill_node(a, s, eq, sq, e / NA, e % NA);
+    s->keyed = keyed;
+    space_frame(s, pl, eye, sun); /* the look-ups in the eye's own frame */
     return s;
+}
+
+int atmos__sph_space_keep(atmos__sph_space *s, const atmos__planet *pl, const double eye[3], const double sun[3],
+                          struct atmos__clouds_sun *gs)
+{
+    atmos__sph_space t = *s;
+    long key[2];
+    double eq[3], sq[3];
+    if (!s->keyed || !key_eye(&t, pl, space_frame(&t, pl, eye, sun), key, eq, sq) || key[0] != s->key[0] ||
+        key[1] != s->key[1])
+        return 0;
+    space_frame(s, pl, eye, sun);
+    s->gs = gs;
+    return 1;
 }
 
 void atmos__sph_space_destroy(atmos__sph_space *s)
@@ -314,7 +367,7 @@ static void cloud_disk(const atmos__sph_space *s, const atmos_atmosphere *a, con
             const float *u = v + ((size_t)j * n + k) * NC;
             Lc[j * n + k] = pr[k] * u[0] + pm[k] * u[1] + u[2], Tc[j * n + k] = u[3];
         }
-    if (!atmos__clouds_radiance_stops(a, s->eye, d, sun, Lc, Tc, L)) {
+    if (!atmos__clouds_radiance_stops(a, s->eye, d, sun, Lc, Tc, s->gs, L)) {
         cloud_ray(s, a, sun, d, wt, count, i, out);
         return;
     }

@@ -43,8 +43,12 @@ static void check_view(const atmos_atmosphere *a, double sun_elev_deg, double rm
     const double eye[3] = {0, 12000e3, 0};
     const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
     const double sun[3] = {cos(se) * sin(az), sin(se), -cos(se) * cos(az)};
+    /* the batch of the frame before (the eye 1 m west), moved to this eye with the same sun:
+     * the per-eye table built again, the sun's attenuation textures kept */
+    const double before[3] = {eye[0] - 1.0, eye[1], eye[2]};
     atmos__atm_batch b;
-    atmos__atm_batch_init(&b, a, eye, sun);
+    atmos__atm_batch_init(&b, a, before, sun);
+    CHECK(atmos__atm_batch_update(&b, a, eye, sun) == 1);
     static float dx[W], dy[W], dz[W], wt[W], out[3 * W];
     double s2 = 0, worst = 0, ref_max = 0;
     int cnt = 0;
@@ -80,6 +84,43 @@ static void check_view(const atmos_atmosphere *a, double sun_elev_deg, double rm
     CHECK(worst <= worst_max);
 }
 
+/* The attenuation textures (planet_clouds_sun.c) against G evaluated at the point itself,
+ * at random points of each sphere below the top one and of the ground on the sunlit side:
+ * the mean and the worst absolute difference (G is in [0, 1]). */
+static void check_textures(const atmos_atmosphere *a, double sun_elev_deg, double mean_max, double worst_max)
+{
+    const atmos__planet *pl = a->planet;
+    const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
+    const double sun[3] = {cos(se) * sin(az), sin(se), -cos(se) * cos(az)};
+    atmos__clouds_sun *gs = atmos__clouds_sun_create(pl, sun);
+    CHECK(gs != NULL);
+    if (!gs) return;
+    const int m = pl->clouds->m;
+    double sum = 0, worst = 0;
+    int cnt = 0;
+    unsigned state = 12345;
+    for (int below = -1; below < m; below++)
+        for (int k = 0; k < 4000; k++) {
+            state = state * 1664525u + 1013904223u;
+            const double lat = asin(2.0 * (state >> 8) / 16777216.0 - 1.0) * 180 / PI;
+            state = state * 1664525u + 1013904223u;
+            const double lon = -180.0 + 360.0 * (state >> 8) / 16777216.0;
+            double x[3], la, lo;
+            atmos__clouds_geo_point(pl, below >= 0 ? pl->clouds->r[below] : pl->r_ground, lat, lon, x);
+            if (atmos__planet_mu(pl, x, sun) <= 0.02) continue; /* the night side: G is not asked */
+            atmos__planet_latlon_fast(pl, x, &la, &lo);
+            const double e = fabs(atmos__clouds_sun_lookup(gs, x, below, la, lo) -
+                                  atmos__clouds_sun_attenuation(pl, x, sun, below));
+            sum += e, worst = fmax(worst, e), cnt++;
+        }
+    printf("sun %g deg: attenuation textures at %d points, mean error %.5f, worst %.4f\n", sun_elev_deg, cnt,
+           sum / cnt, worst);
+    CHECK(cnt > 4000);
+    CHECK(sum / cnt <= mean_max);
+    CHECK(worst <= worst_max);
+    atmos__clouds_sun_destroy(gs);
+}
+
 int main(void)
 {
     atmos_image *clouds = cloud_image();
@@ -93,6 +134,8 @@ int main(void)
     atmos_wavelengths_rgb(&wl);
     atmos_atmosphere *a = NULL;
     CHECK_OK(atmos_atmosphere_create(NULL, &d, &wl, &a));
+    check_textures(a, 45, 0.002, 0.6);
+    check_textures(a, 5, 0.002, 0.6);
     check_view(a, 45, 0.005, 0.08);
     check_view(a, 5, 0.005, 0.08); /* the terminator on the disk */
     atmos_atmosphere_destroy(a);
