@@ -13,16 +13,18 @@ static void help(void)
 {
     printf("Usage: atmos simulate PRESET -o NAME.json [--minutes M] [--grid N] [--seed S] [--threads T]\n"
            "                      [--refine R] [--detail A] [--ice] [--quiet] [--bench K]\n\n"
-           "Runs the cloud-physics simulation (docs/clouds.md): a 3-D Boussinesq fluid with potential\n"
-           "temperature, water vapour, cloud water and rain, Kessler warm rain and saturation adjustment,\n"
-           "periodic sides. Writes the state at time M as a volume of \"cloud\" and \"rain\" number\n"
-           "densities (m^-3; mixing ratio x air density / the particle type's mean mass), raw float32\n"
-           "files next to the JSON sidecar (-o must name a .json file, whose folder is made if missing;\n"
-           "nothing else is written), y up, the ground at y = 0. A volume with no cloud and no rain is\n"
-           "written with a warning.\n\n"
+           "Runs the cloud-physics simulation (docs/clouds.md): a 3-D anelastic fluid with potential\n"
+           "temperature, water vapour, condensate and precipitation; Kessler warm rain and a simple ice\n"
+           "phase (the condensate partly ice below 0 C, wholly below -23 C: saturation over ice, its latent\n"
+           "heat, snow and falling cloud ice), saturation adjustment, periodic sides. Writes the state at\n"
+           "time M as a volume of \"cloud\" and \"rain\" (rain and snow) number densities (m^-3; mixing\n"
+           "ratio x air density / the particle type's mean mass; \"ice\" too with --ice), raw float32 files\n"
+           "next to the JSON sidecar (-o must name a .json file, whose folder is made if missing; nothing\n"
+           "else is written), y up, the ground at y = 0. A volume with no cloud and no rain is written\n"
+           "with a warning.\n\n"
            "Presets (default simulated time; a shorter run may end before any cloud has formed, and the\n"
            "volume is then empty: at least the first-cloud time, better twice it; coarser grids take\n"
-           "longer, e.g. cumulus_field ~12 min at --grid 32):\n");
+           "longer, e.g. cumulus_field ~10 min at --grid 32):\n");
     for (const char *const *n = atmos_sim_preset_names(); *n; n++) {
         const double first = atmos_sim_preset_first_cloud_minutes(*n);
         printf("  %-17s %g min; ", *n, atmos_sim_preset_minutes(*n));
@@ -38,8 +40,9 @@ static void help(void)
            "               between the cells instead of on their faces\n"
            "  --detail A   0..1 (default 0), for artists: the fields sampled at places moved by a fractal\n"
            "               noise of up to A cells (ragged edges below the grid that the model does not hold)\n"
-           "  --ice        write cloud water colder than 0 C partly, below -23 C wholly, as \"ice\" (a\n"
-           "               diagnosis by temperature for the optics; the model itself has no ice)\n"
+           "  --ice        write cloud water colder than 0 C partly, below -23 C wholly, as \"ice\" (the\n"
+           "               fraction by temperature the model's own saturation, latent heat and snow use;\n"
+           "               without --ice the whole condensate is written as \"cloud\")\n"
            "  --threads T  worker threads (default: all cores); the result does not depend on T\n"
            "  --quiet      no progress bar\n"
            "  --bench K    instead of writing a volume: K time steps, then the mean time of one step and the\n"
