@@ -47,6 +47,9 @@ for c in $cmds; do
     # a terminal of 100 columns shows every line unbroken (bench's sample output lines too)
     long=$(awk 'length > 100' "$T/out" | head -3)
     [ -z "$long" ] && ok "$c --help fits in 100 columns" || bad "$c --help has lines over 100 columns: $long"
+    # -h is --help for every command
+    run "$c -h" 0 "$c" -h
+    if grep -q "Usage" "$T/out"; then ok "$c -h prints Usage"; else bad "$c -h prints no Usage"; fi
 done
 for c in "bench sky-accuracy" "volume stats"; do
     run "$c --help" 0 $c --help
