@@ -37,7 +37,7 @@ static void help(void)
            "  --seed S     the random perturbations (default 1); the same seed gives the same bytes\n"
            "  --refine R   voxels per model cell along each axis, 1..%d (default 1): the mixing ratios\n"
            "               interpolated in their logarithm between cell centres, so that edges fall\n"
-           "               between the cells instead of on their faces\n"
+           "               between the cells instead of on their faces; at most 64 M voxels in all\n"
            "  --detail A   0..1 (default 0), for artists: the fields sampled at places moved by a fractal\n"
            "               noise of up to A cells (ragged edges below the grid that the model does not hold)\n"
            "  --ice        write cloud water colder than 0 C partly, below -23 C wholly, as \"ice\" (the\n"
