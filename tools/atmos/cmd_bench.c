@@ -137,9 +137,9 @@ static void help(void)
            "          a loaded machine; OMP_WAIT_POLICY=passive leaves out idle threads' spinning).\n"
            "          --case NAME runs only the case of that scene= name (e.g. dobashi_fig09a_studio).\n"
            "  simulate the cloud simulation (docs/clouds.md): the towering_cumulus preset on an N grid (default\n"
-           "          64, then 128: 64x64x64 and 128x128x128 cells), one warm-up step from the initial state\n"
-           "          and then R steps (default 5); mean and best wall time a step, the process's CPU time\n"
-           "          a step and the 1-minute load average:\n"
+           "          64, then 128: 64x64x64 and 128x128x128 cells; --size N: N alone, 16..512), one warm-up\n"
+           "          step from the initial state and then R steps (default 5); mean and best wall time a\n"
+           "          step, the process's CPU time a step and the 1-minute load average:\n"
            "            bench=simulate preset=towering_cumulus grid=128 cells=128x128x128 threads=2 steps=5\n"
            "              ms_per_step=180.2 best_ms=170.1 cpu_ms_per_step=350.3 load=1.02\n");
 }
@@ -597,6 +597,9 @@ int cli_cmd_bench(int argc, char **argv)
         }
     }
     if (!what) return cli_usage_error(C, "which benchmark? (available: sky, sky-accuracy, optics, volume, slice, path, beams, simulate)");
+    if (!strcmp(what, "simulate") && size && (size < ATMOS_SIM_MIN_GRID || size > ATMOS_SIM_MAX_GRID))
+        return cli_usage_error(C, "--size: the simulation's grid is in [%d, %d], got %d", ATMOS_SIM_MIN_GRID,
+                               ATMOS_SIM_MAX_GRID, size);
     if (!strcmp(what, "simulate")) return bench_simulate(size, repeat, threads);
     if (!strcmp(what, "beams")) return bench_beams(file, 4 * (repeat_set ? repeat : 5), threads, beams_case);
     pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale, pflags.json = json;
