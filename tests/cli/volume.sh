@@ -32,7 +32,8 @@ head -c 8 "$T/slice.png" | od -An -c | grep -q "P   N   G" || fail "slice is not
 cmp -s "$T/rs.cloud.raw" "$T/rs2.cloud.raw" || fail "not deterministic"
 # errors: usage 2, runtime 1
 set +e
-"$A" volume generate nosuch -o "$T/x.json"; [ $? -eq 2 ] || fail "unknown preset exit"
+"$A" volume generate nosuch -o "$T/x.json" 2> "$T/err.txt"; [ $? -eq 2 ] || fail "unknown preset exit"
+grep -q "harris_field" "$T/err.txt" || fail "unknown preset: the known ones (Harris's too) not named: $(cat "$T/err.txt")"
 for ext in vdb nvdb png; do # only a raw volume with its JSON sidecar is written
     rm -f "$T/x.$ext"
     "$A" volume generate cumulus -o "$T/x.$ext" 2> "$T/err.txt"; [ $? -eq 2 ] || fail "-o x.$ext exit"
