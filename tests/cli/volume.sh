@@ -27,6 +27,8 @@ PY
 "$A" volume info "$T/rs.json" | grep -q "field cloud" || fail "info text"
 "$A" volume slice "$T/rs.json" --axis z --field rain -o "$T/slice.png" || fail "slice"
 head -c 8 "$T/slice.png" | od -An -c | grep -q "P   N   G" || fail "slice is not a PNG"
+# into a folder that does not exist: the folder is made, as render's outputs'
+"$A" volume slice "$T/rs.json" --axis z -o "$T/new/sub/slice.png" && [ -s "$T/new/sub/slice.png" ] || fail "slice into a new folder"
 # same seed, same bytes
 "$A" volume generate rain_shaft -o "$T/rs2.json" --seed 3 --voxel-size 100
 cmp -s "$T/rs.cloud.raw" "$T/rs2.cloud.raw" || fail "not deterministic"

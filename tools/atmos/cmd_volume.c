@@ -38,7 +38,8 @@ void cli_volume_help(void)
     printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
            "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
-           "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image.\n"
+           "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image (a\n"
+           "            missing folder is made).\n"
            "  clouds    the cloud layer of SCENE's spherical atmosphere (\"clouds\" from a satellite image) as\n"
            "            a raw + JSON volume of \"cloud\" particles with the same optical depths, in the\n"
            "            world frame (x east, y up, z south at the scene's latitude/longitude): a box\n"
@@ -280,6 +281,7 @@ static int cmd_slice(int argc, char **argv)
     if (axis < 0) return cli_usage_error(C, "slice: missing --axis x|y|z");
     if (!out) return cli_usage_error(C, "slice: missing -o SLICE.png");
     if (cli_png_output(C, "-o", out)) return CLI_EXIT_USAGE;
+    if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
