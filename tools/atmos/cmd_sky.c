@@ -1,5 +1,6 @@
 /* atmos sky: the atmosphere (Riley et al. 2004 §4.1 by default) along one view. */
 #include "cli.h"
+#include "outputs.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -33,12 +34,12 @@ static void help(void)
            "                       --model homogeneous (a usage error with the other models)\n"
            "  --table NAME -o FILE instead of a view: write the model's look-up table NAME as FILE.exr\n"
            "                       (every wavelength), .pfm (the first three) or .png (a plot, each\n"
-           "                       channel scaled to its maximum). Only dobashi and spherical keep\n"
-           "                       tables: --model spherical --table list prints that model's names,\n"
-           "                       one a line; --table list with a model that keeps none (riley, the\n"
-           "                       default, or homogeneous) prints every model's. The view options\n"
-           "                       (--sun-*, --view-*, --altitude, --distance, --json) do not go with\n"
-           "                       --table, nor -o without it\n"
+           "                       channel scaled to its maximum; a missing folder is made). Only\n"
+           "                       dobashi and spherical keep tables: --model spherical --table list\n"
+           "                       prints that model's names, one a line; --table list with a model\n"
+           "                       that keeps none (riley, the default, or homogeneous) prints every\n"
+           "                       model's. The view options (--sun-*, --view-*, --altitude,\n"
+           "                       --distance, --json) do not go with --table, nor -o without it\n"
            "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
            "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n"
            "  -h, --help           this help\n\n"
@@ -83,6 +84,7 @@ static int sky_table(const char *C, atmos_atmosphere_kind kind, int spectral, do
     atmos_wavelengths wl;
     int rc = cli_sky_table_check(C, kind, table, out);
     if (rc >= 0) return rc;
+    if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_atmosphere *atm = make_sky(C, kind, spectral, albedo, 0, &ctx, &wl, &rc);
     if (!atm) return rc;
     rc = cli_sky_table(C, ctx, atm, table, out);
