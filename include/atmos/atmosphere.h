@@ -154,8 +154,9 @@ ATMOS_API void atmos_atmosphere_transmittance(const atmos_atmosphere *atm, const
  * earth. */
 ATMOS_API void atmos_atmosphere_sunlight(const atmos_atmosphere *atm, const double p[3], const double sun_dir[3],
                                          double *out);
-/* Single-scattered radiance of the air arriving at p from the segment p -> p + distance*dir
- * (distance may be INFINITY). */
+/* Radiance the air scatters toward p from the segment p -> p + distance*dir (distance may be
+ * INFINITY): single scattering for riley, homogeneous and dobashi (plus its ambient term when
+ * set), every order for spherical (docs/sky.md). */
 ATMOS_API void atmos_atmosphere_inscatter(const atmos_atmosphere *atm, const double p[3], const double dir[3],
                                           double distance, const double sun_dir[3], double *out);
 

@@ -61,7 +61,8 @@ ATMOS_API double atmos_sim_preset_minutes(const char *preset);
 ATMOS_API double atmos_sim_preset_first_cloud_minutes(const char *preset);
 
 /* Builds the initial state (the preset's sounding and triggers). Unknown presets and
- * out-of-range values: ATMOS_E_INVALID_ARG naming the known presets / the range. */
+ * out-of-range values: ATMOS_E_INVALID_ARG naming the known presets / the range; a refine
+ * whose volume would exceed 64 M voxels (refine^3 x the cells): ATMOS_E_LIMIT, before any run. */
 ATMOS_API atmos_status atmos_sim_create(atmos_context *ctx, const atmos_sim_desc *desc, atmos_sim **out);
 ATMOS_API void atmos_sim_destroy(atmos_sim *sim);
 /* Advances by one time step (chosen from the flow's speed, at most the preset's maximum). */

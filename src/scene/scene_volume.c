@@ -4,6 +4,7 @@
 #include "scene/scene_internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 const char *const *atmos_scene_generator_names(void)
@@ -30,6 +31,15 @@ atmos_status atmos_scene_generate_volume(atmos_context *ctx, const char *preset,
             atmos__pcloud_free(&pc);
             return st;
         }
+    int known = 0;
+    for (const char *const *v = atmos_scene_generator_names(); *v; v++) known |= preset && !strcmp(*v, preset);
+    if (!known) { /* the volume generators' own message would leave out the particle clouds' */
+        char list[512] = "";
+        for (const char *const *v = atmos_scene_generator_names(); *v; v++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", *v, v[1] ? ", " : "");
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate: unknown preset '%s' (known: %s)",
+                            preset ? preset : "(null)", list);
+    }
     return atmos_volume_generate(ctx, preset, desc, out);
 }
 

@@ -144,6 +144,11 @@ atmos_status atmos_sim_create(atmos_context *ctx, const atmos_sim_desc *desc, at
     const double dx = env->domain_m / g;
     int nz = (int)lround(env->height_m / dx);
     if (nz < 8) nz = 8;
+    const long r = desc->refine > 0 ? desc->refine : 1;
+    if (r * r * r * g * g * nz > SIM_MAX_VOXELS) /* found now rather than after the run */
+        return atmos__error(ctx, ATMOS_E_LIMIT,
+                            "simulate: refine %ld makes %ld x %ld x %ld voxels, more than %ld M: a smaller refine or grid",
+                            r, r * g, r * nz, r * g, SIM_MAX_VOXELS >> 20);
     atmos_status st = atmos__sim_create_env(ctx, env, g, g, nz, dx, desc->seed, out);
     if (st == ATMOS_OK) {
         (*out)->out_refine = desc->refine > 0 ? desc->refine : 1;

@@ -17,6 +17,7 @@
 #define SIM_RD 287.0
 #define SIM_LV 2.5e6
 #define SIM_LF 3.34e5 /* latent heat of fusion */
+#define SIM_MAX_VOXELS (64L << 20) /* the most voxels a state is written as (sim_volume.c) */
 #define SIM_P00 1e5
 #define SIM_EPS 0.622
 

@@ -13,7 +13,6 @@
 
 #define SIM_Q_CUT 1e-7f    /* mixing ratios below this are written as 0 (kg/kg) */
 #define SIM_Q_FLOOR 1e-10f /* what an empty cell counts as in the logarithm's interpolation */
-#define SIM_MAX_VOXELS (64L << 20)
 
 /* The written fields' mixing ratios per cell (kg/kg; cut below SIM_Q_CUT), nf of them:
  * cloud water, rain and, with ice, cloud ice. */

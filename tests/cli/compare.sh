@@ -16,6 +16,9 @@ echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rms
 out=$("$A" compare "$T/b.pfm" "$T/a.pfm" --json --heatmap "$T/h.png") || bad "compare different"
 echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] > 0 and d["rel_rmse"] > 0 and len(d["bias"]) == 3, d' && ok || bad "different images: $out"
 python3 -c 'import sys; assert open(sys.argv[1],"rb").read(8) == b"\x89PNG\r\n\x1a\n"' "$T/h.png" && ok || bad "heat map is not a PNG"
+# a heat map into a folder that does not exist: the folder is made, as render's outputs'
+"$A" compare "$T/b.pfm" "$T/a.pfm" --heatmap "$T/new/sub/h.png" >/dev/null 2>"$T/err" && [ -s "$T/new/sub/h.png" ] && ok ||
+    bad "--heatmap into a new folder: $(cat "$T/err")"
 "$A" render -q --width 8 --height 8 --pfm "$T/small.pfm" || bad "render small"
 "$A" compare "$T/small.pfm" "$T/a.pfm" 2>/dev/null; [ $? -eq 1 ] && ok || bad "size mismatch should exit 1"
 "$A" compare "$T/a.pfm" 2>/dev/null; [ $? -eq 2 ] && ok || bad "one file should exit 2"

@@ -88,4 +88,9 @@ if "$cli" bench simulate --size 16 --repeat 2 --threads 2 >"$dir/bench" 2>"$dir/
     grep -Eq '^bench=simulate preset=towering_cumulus grid=16 cells=16x16x16 threads=2 steps=2 ms_per_step=[0-9.]+ best_ms=[0-9.]+ cpu_ms_per_step=[0-9.]+ load=' "$dir/bench"; then
     ok "bench simulate"
 else bad "bench simulate: $(cat "$dir/bench" "$dir/err")"; fi
+# a grid the simulation does not take is a usage error (exit 2) naming its range
+"$cli" bench simulate --size 1000 >"$dir/bench" 2>"$dir/err"
+st=$?
+[ $st -eq 2 ] && grep -q "16, 512" "$dir/err" && ok "bench simulate --size 1000: usage error" ||
+    bad "bench simulate --size 1000: exit $st, $(cat "$dir/err")"
 exit $fail

@@ -73,6 +73,10 @@ plane_attenuation" ]; then ok "--model dobashi --table list: one name per line";
 grep -q 'homogeneous.*no tables' "$T/list" "$T/err" && grep -q 'spherical' "$T/list" "$T/err" &&
     ok "--model homogeneous --table list says it keeps none" || bad "homogeneous list: $(cat "$T/list" "$T/err")"
 
+# -o into a folder that does not exist: the folder is made, as render's outputs'
+"$cli" sky --model dobashi --table sun_attenuation -o "$T/new/sub/t.pfm" >"$T/out" 2>"$T/err" && [ -s "$T/new/sub/t.pfm" ] &&
+    ok "--table -o into a new folder" || bad "--table -o into a new folder: $(cat "$T/err")"
+
 # the help says what --table list does
 "$cli" sky --help >"$T/help" 2>&1
 grep -q 'table list' "$T/help" && grep -q 'goes with' "$T/help" && ok "help" || bad "help: $(cat "$T/help")"

@@ -27,12 +27,15 @@ PY
 "$A" volume info "$T/rs.json" | grep -q "field cloud" || fail "info text"
 "$A" volume slice "$T/rs.json" --axis z --field rain -o "$T/slice.png" || fail "slice"
 head -c 8 "$T/slice.png" | od -An -c | grep -q "P   N   G" || fail "slice is not a PNG"
+# into a folder that does not exist: the folder is made, as render's outputs'
+"$A" volume slice "$T/rs.json" --axis z -o "$T/new/sub/slice.png" && [ -s "$T/new/sub/slice.png" ] || fail "slice into a new folder"
 # same seed, same bytes
 "$A" volume generate rain_shaft -o "$T/rs2.json" --seed 3 --voxel-size 100
 cmp -s "$T/rs.cloud.raw" "$T/rs2.cloud.raw" || fail "not deterministic"
 # errors: usage 2, runtime 1
 set +e
-"$A" volume generate nosuch -o "$T/x.json"; [ $? -eq 2 ] || fail "unknown preset exit"
+"$A" volume generate nosuch -o "$T/x.json" 2> "$T/err.txt"; [ $? -eq 2 ] || fail "unknown preset exit"
+grep -q "harris_field" "$T/err.txt" || fail "unknown preset: the known ones (Harris's too) not named: $(cat "$T/err.txt")"
 for ext in vdb nvdb png; do # only a raw volume with its JSON sidecar is written
     rm -f "$T/x.$ext"
     "$A" volume generate cumulus -o "$T/x.$ext" 2> "$T/err.txt"; [ $? -eq 2 ] || fail "-o x.$ext exit"

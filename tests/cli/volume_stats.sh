@@ -63,7 +63,7 @@ head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "
 "$A" volume stats "$T/d.json" --connectivity 6 >/dev/null 2>&1; [ $? -eq 2 ] && ok "connectivity 6" || bad "connectivity 6"
 "$A" volume stats "$T/d.json" --size-range 5,2 >/dev/null 2>&1; [ $? -eq 2 ] && ok "bad size range" || bad "bad size range"
 "$A" volume stats "$T/none.json" >/dev/null 2>&1; [ $? -eq 1 ] && ok "missing file: runtime error" || bad "missing file"
-"$A" volume stats generate:nope >/dev/null 2>"$T/e"; [ $? -eq 1 ] && grep -q cumulus "$T/e" && ok "unknown preset named with the known ones" ||
+"$A" volume stats generate:nope >/dev/null 2>"$T/e"; [ $? -eq 1 ] && grep -q cumulus "$T/e" && grep -q harris_field "$T/e" && ok "unknown preset named with the known ones" ||
     bad "unknown preset: $(cat "$T/e")"
 "$A" volume stats "$T/d.json" --field rain >/dev/null 2>"$T/e"; [ $? -eq 1 ] && grep -q "no field" "$T/e" && ok "--field rain: no such field" ||
     bad "--field rain"

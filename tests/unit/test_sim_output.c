@@ -223,6 +223,14 @@ int main(void)
         CHECK(atmos_sim_create(c, &d, &bad) == ATMOS_E_INVALID_ARG && !bad);
         d.refine = 2, d.detail = 1.5;
         CHECK(atmos_sim_create(c, &d, &bad) == ATMOS_E_INVALID_ARG && !bad);
+        /* a refined volume too large to write is refused before the run, not after it:
+         * the cumulonimbus at grid 128 has 128 x 128 x 80 cells, x 4^3 = 84 M voxels > 64 M */
+        atmos_sim_desc big = {.preset = "cumulonimbus", .grid = 128, .seed = 1, .refine = 4};
+        CHECK(atmos_sim_create(c, &big, &bad) == ATMOS_E_LIMIT && !bad);
+        atmos_sim_destroy(bad), bad = NULL;
+        big.refine = 3; /* 35 M voxels: allowed */
+        CHECK(atmos_sim_create(c, &big, &bad) == ATMOS_OK && bad);
+        atmos_sim_destroy(bad);
     }
     atmos_sim_destroy(s);
     atmos_context_destroy(c);

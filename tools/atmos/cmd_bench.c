@@ -33,12 +33,14 @@ static void help(void)
            "  sky     renders an NxN sky (default 1024) with each camera (pinhole, fisheye,\n"
            "          equirect) and wavelength set (rgb, spectral 16), R times (default 5), and\n"
            "          prints per case the best wall time and megapixels per second:\n"
-           "            bench=sky camera=pinhole wavelengths=rgb size=1024x1024 threads=2 seconds=0.0401 mpix_per_s=26.1\n"
+           "            bench=sky camera=pinhole wavelengths=rgb size=1024x1024 threads=2 seconds=0.0401\n"
+           "              mpix_per_s=26.1\n"
            "          The time covers rendering the spectral image and converting it to linear sRGB.\n"
            "          Then per atmosphere model (--models, default riley,dobashi,spherical): the time to\n"
            "          create it at rgb (its tables) in an empty private cache and again (best of 2; the\n"
            "          same when the model keeps no cache):\n"
-           "            bench=sky case=precompute model=spherical wavelengths=rgb threads=2 precompute_seconds=0.41 cached_seconds=0.01\n"
+           "            bench=sky case=precompute model=spherical wavelengths=rgb threads=2\n"
+           "              precompute_seconds=0.41 cached_seconds=0.01\n"
            "          and the sky renderer's cost per frame of one plan (the camera moving 1 m east a\n"
            "          frame, the sun fixed; best of R) at 720x480, from 2 m above the ground toward the\n"
            "          horizon (90 degree field; case=ground_climb: the camera rising 2 m a frame, so the\n"
@@ -49,7 +51,8 @@ static void help(void)
            "          cpu_ns_per_pixel = the process's CPU time / pixels (best frame; on a loaded\n"
            "          machine the steadier of the two; OMP_WAIT_POLICY=passive leaves out the time\n"
            "          idle threads spend spinning):\n"
-           "            bench=sky case=space model=spherical wavelengths=rgb size=720x480 threads=2 seconds=0.0123 ns_per_pixel=71.2 cpu_ns_per_pixel=68.0 fps=81.3\n"
+           "            bench=sky case=space model=spherical wavelengths=rgb size=720x480 threads=2\n"
+           "              seconds=0.0123 ns_per_pixel=71.2 cpu_ns_per_pixel=68.0 fps=81.3\n"
            "          The image grows from 1x1 and 12x8 through 45x30 ... 720x480 while the time the last\n"
            "          two sizes predict (a fixed part per frame plus a part per pixel) fits --budget S\n"
            "          seconds per case (default 2); a model too slow for 720x480 is reported at the last\n"
@@ -60,15 +63,18 @@ static void help(void)
            "          then, per preset (default rain, cloud, ice, snow; --presets to choose) and wavelength\n"
            "          set (rgb, spectral:16), the phase table's cold build (no cache) and its load from the\n"
            "          cache, using a private temporary cache directory (your cache is not touched):\n"
-           "            bench=optics case=table preset=rain wavelengths=rgb cold_seconds=1.23 cached_seconds=0.0004\n"
+           "            bench=optics case=table preset=rain wavelengths=rgb cold_seconds=1.23\n"
+           "              cached_seconds=0.0004\n"
            "          and of the multiple-scattering phase functions built from each table:\n"
-           "            bench=optics case=msphase preset=rain wavelengths=rgb orders=121 cold_seconds=... cached_seconds=...\n"
+           "            bench=optics case=msphase preset=rain wavelengths=rgb orders=121 cold_seconds=...\n"
+           "              cached_seconds=...\n"
            "          --fast builds preview-quality tables (atmos phase --fast).\n"
-           "  volume  [--file FILE] loads FILE (if given; best of R loads) and generates the 'cumulus'\n"
-           "          preset, then measures on one thread: trilinear samples per second at random points\n"
-           "          and along coherent scanlines inside the active bounds, and optical-depth rays per\n"
-           "          second (exact DDA with empty-space skipping) between random points on those bounds:\n"
-           "            bench=volume case=cumulus load_s=1.2 active_voxels=605554 memory_bytes=3774592 ...\n"
+           "  volume  [--file FILE] loads FILE (if given; best of R loads, at most 3) and generates the\n"
+           "          'cumulus' preset, then measures on one thread: trilinear samples per second at random\n"
+           "          points and along coherent scanlines inside the active bounds, and optical-depth rays\n"
+           "          per second (exact DDA with empty-space skipping) between random points on those\n"
+           "          bounds; case= the file's name or generated_cumulus (load_s: its generation):\n"
+           "            bench=volume case=generated_cumulus load_s=1.2 active_voxels=605554 ...\n"
            "  slice   the half-angle slicing renderer (Riley et al. 2004 Fig. 14: NxN, default 512, 256\n"
            "          slices) on the generated storm and, with --file, on that volume (the Disney cloud),\n"
            "          from one plan as an interactive session renders: 8 R frames (default R 3) with the\n"
@@ -93,7 +99,8 @@ static void help(void)
            "          frames with the camera orbiting and 8 R with the sun turning; per frame on average\n"
            "          the frame, the sky image, the air in front of the volume (aerial perspective, its\n"
            "          table included) and the sunlight entering the light buffer, and their shares:\n"
-           "            bench=slice case=aerial volume=wdas_cloud_sixteenth.vdb model=spherical motion=camera ...\n"
+           "            bench=slice case=aerial volume=wdas_cloud_sixteenth.vdb model=spherical motion=camera\n"
+           "              size=512 threads=2 frames=24\n"
            "              ms_per_frame=98.1 sky_ms=9.5 aerial_ms=2.1 sunlight_ms=0.00 aerial_share=0.021\n"
            "              atmosphere_share=0.118 frame_rms_rel=1.2e-04 frame_max_rel=2.1e-03\n"
            "          aerial_share = (aerial + sunlight) / frame; atmosphere_share adds the sky image;\n"
@@ -131,9 +138,9 @@ static void help(void)
            "          a loaded machine; OMP_WAIT_POLICY=passive leaves out idle threads' spinning).\n"
            "          --case NAME runs only the case of that scene= name (e.g. dobashi_fig09a_studio).\n"
            "  simulate the cloud simulation (docs/clouds.md): the towering_cumulus preset on an N grid (default\n"
-           "          64, then 128: 64x64x64 and 128x128x128 cells), one warm-up step from the initial state\n"
-           "          and then R steps (default 5); mean and best wall time a step, the process's CPU time\n"
-           "          a step and the 1-minute load average:\n"
+           "          64, then 128: 64x64x64 and 128x128x128 cells; --size N: N alone, 16..512), one warm-up\n"
+           "          step from the initial state and then R steps (default 5); mean and best wall time a\n"
+           "          step, the process's CPU time a step and the 1-minute load average:\n"
            "            bench=simulate preset=towering_cumulus grid=128 cells=128x128x128 threads=2 steps=5\n"
            "              ms_per_step=180.2 best_ms=170.1 cpu_ms_per_step=350.3 load=1.02\n");
 }
@@ -591,6 +598,9 @@ int cli_cmd_bench(int argc, char **argv)
         }
     }
     if (!what) return cli_usage_error(C, "which benchmark? (available: sky, sky-accuracy, optics, volume, slice, path, beams, simulate)");
+    if (!strcmp(what, "simulate") && size && (size < ATMOS_SIM_MIN_GRID || size > ATMOS_SIM_MAX_GRID))
+        return cli_usage_error(C, "--size: the simulation's grid is in [%d, %d], got %d", ATMOS_SIM_MIN_GRID,
+                               ATMOS_SIM_MAX_GRID, size);
     if (!strcmp(what, "simulate")) return bench_simulate(size, repeat, threads);
     if (!strcmp(what, "beams")) return bench_beams(file, 4 * (repeat_set ? repeat : 5), threads, beams_case);
     pflags.size = size ? size : 256, pflags.spp = spp, pflags.density_scale = dscale, pflags.json = json;

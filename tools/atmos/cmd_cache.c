@@ -8,11 +8,12 @@
 static void help(void)
 {
     printf("Usage: atmos cache path | clear\n\n"
-           "Precomputed tables (phase tables, ...) are cached on disk so that they are built once.\n"
+           "Precomputed tables (particle phase tables, multiple-scattering phase functions, the\n"
+           "spherical sky's tables, aerosol optics) are cached on disk so that they are built once.\n"
            "  path    print the cache directory: $XDG_CACHE_HOME/atmos, else ~/.cache/atmos\n"
            "  clear   remove every atmos cache entry (*.atmoscache) from it; other files are left alone\n\n"
            "A stale or corrupt entry is detected on load, reported, removed and rebuilt, so clearing is\n"
-           "only needed to reclaim space. Commands that build tables accept --no-cache.\n");
+           "only needed to reclaim space; 'atmos phase --no-cache' builds a table without the cache.\n");
 }
 
 int cli_cmd_cache(int argc, char **argv)

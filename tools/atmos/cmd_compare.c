@@ -19,8 +19,8 @@ static void help(void)
            "  rel_rmse  rmse divided by the reference's mean absolute value\n"
            "  bias      mean of IMAGE - REFERENCE\n"
            "and the worst 16x16 region. --heatmap writes a PNG (a .png name that is none of the\n"
-           "images read) of the per-pixel relative difference (black, red, yellow, white = the\n"
-           "largest). --json prints\n"
+           "images read; a missing folder is made) of the per-pixel relative difference (black, red,\n"
+           "yellow, white = the largest). --json prints\n"
            "  {\"rmse\": ..., \"rel_rmse\": ..., \"bias\": [...], \"rmse_per_channel\": [...],\n"
            "   \"rel_rmse_per_channel\": [...], \"channels\": [names], \"worst_region\": [x, y, w, h],\n"
            "   \"worst_rmse\": ..., \"nonfinite\": N, \"nonfinite_image\": N1, \"nonfinite_reference\": N2}\n"
@@ -205,6 +205,7 @@ int cli_cmd_compare(int argc, char **argv)
         cli_outputs_add(&out, "--heatmap", heat);
         const char *inputs[3] = {files[0], files[1], by};
         if (cli_outputs_check(C, &out, inputs, 3) != CLI_EXIT_OK) return CLI_EXIT_USAGE;
+        if (cli_output_folder(C, "--heatmap", heat)) return CLI_EXIT_RUNTIME;
     }
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;

@@ -1,6 +1,7 @@
 /* atmos phase: list the particle presets; print, summarise or plot a preset's phase table. */
 #define _POSIX_C_SOURCE 200809L /* mkstemp, popen, fdopen, access */
 #include "cli.h"
+#include "outputs.h"
 
 #include <errno.h>
 #include <math.h>
@@ -18,7 +19,8 @@ static void help(void)
            "  --csv                          print the table: header theta_deg,<nm>,<nm>,... then one row\n"
            "                                 per tabulated angle, P in 1/sr (integral over the sphere = 1)\n"
            "  --plot OUT.png                 plot log P against the scattering angle, one curve per\n"
-           "                                 wavelength (needs gnuplot: Debian package gnuplot-nox)\n"
+           "                                 wavelength, as a PNG (a .png name; a missing folder is made;\n"
+           "                                 needs gnuplot: Debian package gnuplot-nox)\n"
            "  --orders                       multiple-scattering phase functions Ams_n (Riley et al. 2004\n"
            "                                 Eq. 20) instead: --csv prints n,theta_deg,<nm>,... for every\n"
            "                                 order n >= 1 and angle; --plot draws several orders; the\n"
@@ -421,6 +423,10 @@ int cli_cmd_phase(int argc, char **argv)
         return cli_usage_error(C, "unknown preset '%s' (known presets: %s; user-defined types need --scene)", preset, list);
     }
     if (plot && !*plot) return cli_usage_error(C, "--plot: empty file name");
+    /* the rules between the options and the output's name, before any work */
+    if (max_order && !orders) return cli_usage_error(C, "--max-order goes with --orders");
+    if (plot && cli_png_output(C, "--plot", plot)) return CLI_EXIT_USAGE;
+    if (plot && cli_output_folder(C, "--plot", plot)) return CLI_EXIT_RUNTIME;
 
     cli_progress prog;
     cli_progress_init(&prog, quiet);
@@ -446,11 +452,6 @@ int cli_cmd_phase(int argc, char **argv)
         int rc = cli_runtime_error(C, ctx, st);
         atmos_context_destroy(ctx);
         return rc;
-    }
-    if (max_order && !orders) {
-        atmos_phase_table_destroy(t);
-        atmos_context_destroy(ctx);
-        return cli_usage_error(C, "--max-order goes with --orders");
     }
     int rc = CLI_EXIT_OK;
     char title[160];

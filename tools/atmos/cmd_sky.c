@@ -1,5 +1,6 @@
 /* atmos sky: the atmosphere (Riley et al. 2004 §4.1 by default) along one view. */
 #include "cli.h"
+#include "outputs.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -12,9 +13,11 @@ static void help(void)
            "                 [--altitude h] [--distance K] [--spectral N] [--albedo R]\n"
            "                 [--model riley|homogeneous|dobashi|spherical] [--thickness M] [--json]\n"
            "       atmos sky --table NAME|list [--model NAME] [--spectral N] [--albedo R] [-o FILE]\n\n"
-           "Prints, per wavelength, the single-scattered radiance arriving along one view\n"
-           "(Riley et al. 2004 Eq. 15, corrected), the transmittance along it (Eq. 11) and the\n"
-           "sun's attenuated radiance at the observer (Eq. 12 over the disk's solid angle).\n\n"
+           "Prints, per wavelength, the radiance the air scatters toward the observer along one view,\n"
+           "the transmittance along it and the sun's attenuated radiance at the observer (over the\n"
+           "disk's solid angle). riley: single scattering in closed form (Riley et al. 2004 Eq. 15,\n"
+           "corrected; Eq. 11, 12); homogeneous: closed forms too; dobashi: single scattering by\n"
+           "Dobashi et al. 2002's tables; spherical: every order of scattering (docs/sky.md).\n\n"
            "  --sun-elevation E    sun elevation, degrees above the horizon [-90, 90]\n"
            "  --sun-azimuth A      sun azimuth, degrees clockwise from north (default 180)\n"
            "  --view-elevation e   view elevation, degrees [-90, 90]\n"
@@ -31,14 +34,15 @@ static void help(void)
            "                       --model homogeneous (a usage error with the other models)\n"
            "  --table NAME -o FILE instead of a view: write the model's look-up table NAME as FILE.exr\n"
            "                       (every wavelength), .pfm (the first three) or .png (a plot, each\n"
-           "                       channel scaled to its maximum). Only dobashi and spherical keep\n"
-           "                       tables: --model spherical --table list prints that model's names,\n"
-           "                       one a line; --table list with a model that keeps none (riley, the\n"
-           "                       default, or homogeneous) prints every model's. The view options\n"
-           "                       (--sun-*, --view-*, --altitude, --distance, --json) do not go with\n"
-           "                       --table, nor -o without it\n"
+           "                       channel scaled to its maximum; a missing folder is made). Only\n"
+           "                       dobashi and spherical keep tables: --model spherical --table list\n"
+           "                       prints that model's names, one a line; --table list with a model\n"
+           "                       that keeps none (riley, the default, or homogeneous) prints every\n"
+           "                       model's. The view options (--sun-*, --view-*, --altitude,\n"
+           "                       --distance, --json) do not go with --table, nor -o without it\n"
            "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
-           "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n\n"
+           "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n"
+           "  -h, --help           this help\n\n"
            "Units: radiance W m^-2 sr^-1 nm^-1. \"inscatter\" is the air's in-scattered radiance only;\n"
            "\"ground\" is the lit ground's radiance after the air (0 unless the view ends on the\n"
            "ground); \"sun\" is the radiance of the sun's 0.5 degree disk seen from the observer.\n"
@@ -80,6 +84,7 @@ static int sky_table(const char *C, atmos_atmosphere_kind kind, int spectral, do
     atmos_wavelengths wl;
     int rc = cli_sky_table_check(C, kind, table, out);
     if (rc >= 0) return rc;
+    if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_atmosphere *atm = make_sky(C, kind, spectral, albedo, 0, &ctx, &wl, &rc);
     if (!atm) return rc;
     rc = cli_sky_table(C, ctx, atm, table, out);
@@ -156,7 +161,7 @@ int cli_cmd_sky(int argc, char **argv)
     static const struct option opts[] = {
         {"sun-elevation", required_argument, 0, 'E'}, {"sun-azimuth", required_argument, 0, 'A'},
         {"view-elevation", required_argument, 0, 'e'}, {"view-azimuth", required_argument, 0, 'a'},
-        {"altitude", required_argument, 0, 'h'},      {"distance", required_argument, 0, 'K'},
+        {"altitude", required_argument, 0, 'z'},      {"distance", required_argument, 0, 'K'},
         {"spectral", required_argument, 0, 'n'},      {"albedo", required_argument, 0, 'r'},
         {"json", no_argument, 0, 'j'},                {"help", no_argument, 0, 'H'},
         {"atmosphere", required_argument, 0, 'k'},    {"thickness", required_argument, 0, 't'},
@@ -168,15 +173,15 @@ int cli_cmd_sky(int argc, char **argv)
     const char *C = "sky", *table = NULL, *out = NULL, *view_opt = NULL;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "o:", opts, &li)) != -1) {
+    while ((c = getopt_long(argc, argv, "o:h", opts, &li)) != -1) {
         /* the first option of a view, to refuse it with --table */
-        if (!view_opt && c > 0 && strchr("EAeahKj", c) && li >= 0) view_opt = opts[li].name;
+        if (!view_opt && c > 0 && strchr("EAeazKj", c) && li >= 0) view_opt = opts[li].name;
         switch (c) {
         case 'E': if (!cli_parse_double(C, "--sun-elevation", optarg, &o.sun_el)) return CLI_EXIT_USAGE; break;
         case 'A': if (!cli_parse_double(C, "--sun-azimuth", optarg, &o.sun_az)) return CLI_EXIT_USAGE; break;
         case 'e': if (!cli_parse_double(C, "--view-elevation", optarg, &o.view_el)) return CLI_EXIT_USAGE; break;
         case 'a': if (!cli_parse_double(C, "--view-azimuth", optarg, &o.view_az)) return CLI_EXIT_USAGE; break;
-        case 'h': if (!cli_parse_double(C, "--altitude", optarg, &o.alt)) return CLI_EXIT_USAGE; break;
+        case 'z': if (!cli_parse_double(C, "--altitude", optarg, &o.alt)) return CLI_EXIT_USAGE; break;
         case 'K': if (!cli_parse_double(C, "--distance", optarg, &o.dist)) return CLI_EXIT_USAGE; break;
         case 'r': if (!cli_parse_double(C, "--albedo", optarg, &o.albedo)) return CLI_EXIT_USAGE; break;
         case 'n': if (!cli_parse_int(C, "--spectral", optarg, 1, ATMOS_MAX_WAVELENGTHS, &o.spectral)) return CLI_EXIT_USAGE; break;
@@ -193,6 +198,7 @@ int cli_cmd_sky(int argc, char **argv)
                 return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]");
             thickness = 1;
             break;
+        case 'h':
         case 'H': help(); return CLI_EXIT_OK;
         default: return cli_usage_error(C, "unknown or incomplete option '%s'", argv[optind - 1]);
         }

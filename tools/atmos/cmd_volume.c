@@ -24,7 +24,8 @@ void cli_volume_help(void)
            "            ranges (number densities, m^-3), active voxels and memory of a volume file\n"
            "            (.json raw sidecar, .vdb, .nvdb, .nc). --json prints\n"
            "            {\"fields\": [{\"name\", \"particle\", \"active_voxels\", \"nonzero_voxels\", \"min\", \"max\",\n"
-           "             \"bounds_m\"}], \"dims\", \"voxel_size_m\", \"origin_m\", \"grid_bounds_m\", \"memory_bytes\"}.\n"
+           "             \"bounds_m\"}], \"dims\", \"voxel_size_m\", \"origin_m\", \"grid_bounds_m\", \"memory_bytes\",\n"
+           "             \"periodic\"}.\n"
            "            active_voxels is the file's own count where it has one (OpenVDB, NanoVDB: active\n"
            "            tiles count as the voxels they cover, active zeros included), else the voxels > 0.\n"
            "  generate  builds a preset cloud volume and writes it as raw float32 files plus a JSON\n"
@@ -38,7 +39,8 @@ void cli_volume_help(void)
     printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
            "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
-           "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image.\n"
+           "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image (a\n"
+           "            missing folder is made).\n"
            "  clouds    the cloud layer of SCENE's spherical atmosphere (\"clouds\" from a satellite image) as\n"
            "            a raw + JSON volume of \"cloud\" particles with the same optical depths, in the\n"
            "            world frame (x east, y up, z south at the scene's latitude/longitude): a box\n"
@@ -208,7 +210,12 @@ static int cmd_generate(int argc, char **argv)
     if (!out) return cli_usage_error(C, "generate: missing -o NAME.json");
     int known = 0;
     for (const char *const *n = atmos_scene_generator_names(); *n; n++) known |= !strcmp(*n, preset);
-    if (!known) return cli_usage_error(C, "generate: unknown preset '%s'", preset);
+    if (!known) {
+        char list[512] = "";
+        for (const char *const *n = atmos_scene_generator_names(); *n; n++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", *n, n[1] ? ", " : "");
+        return cli_usage_error(C, "generate: unknown preset '%s' (known: %s)", preset, list);
+    }
     if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(threads, 1);
@@ -275,6 +282,7 @@ static int cmd_slice(int argc, char **argv)
     if (axis < 0) return cli_usage_error(C, "slice: missing --axis x|y|z");
     if (!out) return cli_usage_error(C, "slice: missing -o SLICE.png");
     if (cli_png_output(C, "-o", out)) return CLI_EXIT_USAGE;
+    if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;

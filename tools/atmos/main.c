@@ -12,7 +12,7 @@ typedef struct {
 
 static const command commands[] = {
     {"render", cli_cmd_render, "render a scene (or the built-in default) to PNG/EXR/PFM"},
-    {"sky", cli_cmd_sky, "query the analytic sky model along one view direction"},
+    {"sky", cli_cmd_sky, "query a sky model along one view direction, or write its tables"},
     {"sun", cli_cmd_sun, "solar elevation and azimuth for a UTC time and place"},
     {"bench", cli_cmd_bench, "benchmarks (e.g. 'atmos bench sky')"},
     {"phase", cli_cmd_phase, "particle phase functions: list presets, print or plot a table"},

@@ -757,7 +757,9 @@ void render_opts_help(void)
     help_settings(ATMOS_RENDERER_NISHITA, "Nishita renderer (Nishita et al. 1996: orders 2-3 and sky light by a light field)");
     help_settings(ATMOS_RENDERER_HARRIS, "Harris's particle renderer");
     help_settings(ATMOS_RENDERER_BEAMS, "Beam renderer (Dobashi et al. 2002 §4: sampling planes, sub-planes, shadow maps)");
-    printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once):\n"
+    printf("Animation (the sun moves; the volume, its optics and the renderer's plan are made once; a\n"
+           "simulated volume with \"animation\": {\"minutes_end\": M} grows instead, a volume and a plan a\n"
+           "frame from one simulation carried through the frames, docs/clouds.md):\n"
            "      --frames N                render N frames (default: the scene's \"animation\", else 1);\n"
            "                                more than one frame numbers every output (--tau too): -o\n"
            "                                out/sky.png writes out/sky_0001.png ...; --frames 1: the first\n"
