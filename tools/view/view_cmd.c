@@ -39,7 +39,7 @@ static void help(void)
            "  --frames N         play N frames (of the script, or an orbit about the volume) and exit\n"
            "  --record DIR       write every frame as DIR/frame_NNNNN.png and DIR/frames.csv (frame, ms =\n"
            "                     the frame's wall time including presentation, renderer, impostor_updates,\n"
-           "                     camera, sun)\n"
+           "                     camera, sun, preview, impostors_coarse)\n"
            "  --headless         no window (with --frames: render and record only)\n"
            "  --press KEYS       press these keys (names as below, comma-separated) at the first frame,\n"
            "                     through the window's event queue as a user's keys\n"
