@@ -86,7 +86,9 @@ typedef struct atmos_frame {
     int impostor_budget;        /* Harris's renderer: at most this many impostors made again this frame, the
                                    most out of date first, the others drawn as they are until a later frame
                                    (the viewer's frames: the updates spread over frames); impostors never
-                                   made and a split cloud's parts always made; 0 = every stale one */
+                                   made come first, those beyond the budget made at a quarter of their
+                                   resolution (cheap stand-ins, refined by later frames); a split cloud's
+                                   parts always made; 0 = every stale one */
     double screen_layer_px;     /* Harris's renderer, a cloud holding the eye (drawn as a screen-sized impostor
                                    at 1/4 of the frame's resolution): > 0 splats its nearer particles into up
                                    to three coarser depth layers (1/8, 1/16, 1/32), a particle at the
@@ -150,6 +152,9 @@ typedef struct atmos_plan_stats {
     int impostor_updates;       /* Harris's renderer: impostors made again this frame */
     int impostors_held;         /* Harris's renderer: out-of-date impostors the frame's budget left as they
                                    were (the same frame rendered again makes them; not reused meanwhile) */
+    int impostors_coarse;       /* Harris's renderer: impostors never made before that the frame's budget made
+                                   at a quarter of their resolution (made in full by a later frame; not
+                                   counted in impostor_updates) */
 } atmos_plan_stats;
 ATMOS_API void atmos_plan_get_stats(const atmos_plan *plan, atmos_plan_stats *out);
 

@@ -109,12 +109,14 @@ static int part_mode(const atmos_plan *p, const atmos__harris_plan *h, const atm
                                           hs->impostor_max_res) ? 3 : 4;
 }
 
-/* Makes the impostors list[0..n) again (each k 3 + part: part 0 cloud k's whole impostor, 1 its
- * far one, 2 its near one), the impostors on the threads (each one's splats on one: the result
+/* Makes the impostors list[0..n + nc) again (each k 3 + part: part 0 cloud k's whole impostor, 1
+ * its far one, 2 its near one; the last nc whole ones at a quarter of the resolution the view
+ * needs, rounded up to 8 texels), the impostors on the threads (each one's splats on one: the result
  * does not depend on the thread count). */
 static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
-                           const int *list, int n)
+                           const int *list, int nfull, int nc)
 {
+    const int n = nfull + nc;
     const atmos__pclusters *c = &h->clouds;
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
                               (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
@@ -143,7 +145,8 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
         atmos__pimpostor *im = part ? &h->split[2 * k + part - 1] : &h->imp[k];
         double d2 = 0;
         for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
-        const int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
+        int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
+        if (q >= nfull) res = 8 * ((res / 4 + 7) / 8);
         const atmos_status sk = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, &L, idx, m, c->centre[k], c->radius[k], e, res);
         im->split = part ? h->offset[k] : 0;
         if (sk != ATMOS_OK) {
@@ -151,7 +154,7 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
             st = sk;
         }
     }
-    h->updates += n;
+    h->updates += nfull, h->coarse += nc;
     return st;
 }
 
@@ -216,42 +219,59 @@ static atmos_status draw_pass(const atmos_plan *p, atmos__harris_plan *h, const 
     return st;
 }
 
-/* Holds the whole-cloud impostors to make again (stale[0..n), entries 3 k) to the frame's budget:
- * those out of date by the most pixels (the error over the tolerance times the texels the view
- * needs) are made, the others drawn as they are (how 3); impostors never made and split
- * clouds' parts are always made. Returns the new count. */
-static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how,
-                          int *stale, int n, atmos__keyed *key)
+/* The texels a side of cloud k's impostor needs from eye e (f: the focal length in pixels). */
+static int needed_res(const atmos_plan *p, const atmos__harris_plan *h, int k, const double e[3], double f)
+{
+    double d2 = 0;
+    for (int a = 0; a < 3; a++) d2 += (e[a] - h->clouds.centre[k][a]) * (e[a] - h->clouds.centre[k][a]);
+    return atmos__pimpostor_res(h->clouds.radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
+}
+
+/* Holds the impostors to make (stale[0..n), entries 3 k + part) to the frame's budget B: split
+ * clouds' parts are always made; then the whole-cloud impostors never made, the largest on the
+ * screen first; then those out of date by the most pixels (the error over the tolerance times
+ * the texels the view needs); B in all are made. The out-of-date ones left are drawn as they
+ * are (how 3), the never-made ones left are made at a quarter of their resolution (a coarse
+ * stand-in, out of date by its texels, so a later frame makes it in full). Reorders stale: the
+ * full makes first; returns their count, the coarse ones after them (*ncoarse). */
+static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how, int *stale,
+                          int n, atmos__keyed *key, int *ncoarse)
 {
     const atmos_scene_harris *hs = &p->scene.harris;
     const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
     const double tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
-    int m = 0, kept = 0;
+    int m = 0, kept = 0, nfirst = 0;
+    atmos__keyed *first = key + n; /* key has room for 2 n */
     for (int q = 0; q < n; q++) {
-        const int k = stale[q] / 3;
-        double d2 = 0;
-        for (int a = 0; a < 3; a++) d2 += (e[a] - h->clouds.centre[k][a]) * (e[a] - h->clouds.centre[k][a]);
+        const int k = stale[q] / 3, res = needed_res(p, h, k, e, f);
         const double err = stale[q] % 3 ? INFINITY
                                          : atmos__pimpostor_error(&h->imp[k], h->clouds.centre[k], h->clouds.radius[k], e,
                                                                   tol, f, hs->impostor_max_res);
-        if (isinf(err)) stale[kept++] = stale[q]; /* must be made */
-        else key[m].key = err * atmos__pimpostor_res(h->clouds.radius[k], sqrt(d2), f, hs->impostor_max_res),
-             key[m++].index = stale[q];
+        if (!(stale[q] % 3) && !h->imp[k].valid) first[nfirst].key = res, first[nfirst++].index = stale[q];
+        else if (isinf(err)) stale[kept++] = stale[q]; /* must be made */
+        else key[m].key = err * res, key[m++].index = stale[q];
     }
+    atmos__keyed_sort(first, (size_t)nfirst, 1);
     atmos__keyed_sort(key, (size_t)m, 1);
+    int taken = 0; /* never-made ones made in full: the first of first[] */
+    for (; taken < nfirst && kept < v->impostor_budget; taken++) stale[kept++] = first[taken].index;
     for (int q = 0; q < m; q++) {
         if (kept < v->impostor_budget) stale[kept++] = key[q].index;
         else how[key[q].index / 3] = 3, h->held++;
     }
+    for (int q = taken; q < nfirst; q++) stale[kept + q - taken] = first[q].index; /* the coarse ones */
+    *ncoarse = nfirst - taken;
     return kept;
 }
 
-/* The modes of the clouds (how), the split (side, hp) and the impostors to make again (stale). */
+/* The modes of the clouds (how), the split (side, hp) and the impostors to make (stale: the
+ * full makes, returned, then *ncoarse coarse ones). */
 static int modes(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const int rect[4], int *how,
-                 int *side, int *hp, int *stale)
+                 int *side, int *hp, int *stale, int *ncoarse)
 {
     const int nc = h->clouds.n;
     int nstale = 0;
+    *ncoarse = 0;
     for (int k = 0; k < nc; k++) how[k] = mode(p, h, v, k);
     atmos__harris_split(h, v, rect, how, side);
     for (int k = 0; k < nc; k++) {
@@ -263,9 +283,9 @@ static int modes(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *
             if ((hp[2 * k + pass] = part_mode(p, h, v, k, pass)) == 4) stale[nstale++] = 3 * k + 1 + pass;
     }
     if (v->impostor_budget <= 0 || nstale <= v->impostor_budget) return nstale;
-    atmos__keyed *key = malloc(sizeof *key * (size_t)nstale);
+    atmos__keyed *key = malloc(sizeof *key * 2 * (size_t)nstale);
     if (!key) return nstale; /* no room to choose: every stale one made */
-    nstale = hold_to_budget(p, h, v, how, stale, nstale, key);
+    nstale = hold_to_budget(p, h, v, how, stale, nstale, key, ncoarse);
     free(key);
     return nstale;
 }
@@ -293,7 +313,7 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
         ord[k].key = d2, ord[k].index = k;
     }
     atmos__keyed_sort(ord, (size_t)nc, 1);
-    h->drawn = h->updates = h->direct = h->held = 0;
+    h->drawn = h->updates = h->direct = h->held = h->coarse = 0;
     const size_t cap = nc > 0 ? (size_t)nc : 1;
     int *how = malloc(sizeof(int) * 7 * cap), *side = how ? how + cap : NULL, *hp = how ? how + 2 * cap : NULL;
     int *stale = how ? how + 4 * cap : NULL;
@@ -302,7 +322,11 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     double *rs = malloc(sizeof *rs * cap);
     if (!how || !ims || !cs || !rs) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     const frame_plan fp = {how, side, hp};
-    if (st == ATMOS_OK) st = remake(p, h, v, ap, stale, modes(p, h, v, rect, how, side, hp, stale));
+    if (st == ATMOS_OK) {
+        int ncoarse = 0;
+        const int nfull = modes(p, h, v, rect, how, side, hp, stale, &ncoarse);
+        st = remake(p, h, v, ap, stale, nfull, ncoarse);
+    }
     /* far to near: the far layer, the objects, the near layer (without objects: the near alone) */
     if (st == ATMOS_OK && h->split_m < INFINITY) st = draw_pass(p, h, v, ap, ord, &fp, 0, rect, out, ims, cs, rs);
     if (st == ATMOS_OK && h->split_m < INFINITY) atmos__harris_objects_over(p->ctx, h->obj, h->o.nw, &v->cam, out);
@@ -310,5 +334,6 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     free(how), free(ims), free(cs), free(rs);
     free(ord);
     p->stats.impostor_updates = h->updates, p->stats.impostors_held = h->held;
+    p->stats.impostors_coarse = h->coarse;
     return st;
 }

@@ -58,7 +58,7 @@ struct atmos__harris_plan {
     float *air_t, *air_l;                /* the air from the eye to each particle, this frame */
     atmos__aerial aerial;
     double sun[3];
-    int have_sun, drawn, updates, direct, held;
+    int have_sun, drawn, updates, direct, held, coarse;
     double shade_s;
     /* "diffuse" (harris_diffuse.c): the diffuse light field on the volume's grid, and per particle
      * what it scatters toward this frame's eye ([p * nw + k]; the splats' atmos__plights.diffuse) */

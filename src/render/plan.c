@@ -472,7 +472,7 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
     }
     /* a frame the impostor budget left unfinished is not kept: the same frame again finishes it */
     if (st == ATMOS_OK && !stats->reused)
-        st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH && !stats->impostors_held && !f->no_keep);
+        st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH && !stats->impostors_held && !stats->impostors_coarse && !f->no_keep);
     if (st != ATMOS_OK) {
         p->have_last = p->have_pixels = 0;
         return st;

@@ -35,7 +35,7 @@ fly() { # DIR THREADS
 fly rec 2
 st=$?
 [ $st -eq 0 ] && ok "9 frames with --preview, exit 0" || { bad "--preview: exit $st"; cat rec.txt >&2; exit 1; }
-p=$(tail -n +2 rec/frames.csv | awk -F, '{printf "%s", $NF}')
+p=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "preview") c = i; next } { printf "%s", $c }' rec/frames.csv)
 [ "$p" = "011110000" ] && ok "frames 1-4 (the sun moving) are previews, the others full ($p)" ||
     bad "the preview column: '$p', want 011110000"
 

@@ -133,7 +133,8 @@ int view_record_open(view_recorder *r, const char *dir);
 /* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv (the
  * file and its header made with the first frame; preview: 1 for a moving view's preview). */
 int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms,
-                      const char *renderer, int impostor_updates, int preview, const view_state *s);
+                      const char *renderer, int impostor_updates, int impostors_coarse, int preview,
+                      const view_state *s);
 int view_record_close(view_recorder *r);
 /* Saves the current view: BASE.exr (linear sRGB), BASE.png (what is shown), BASE.json (the
  * scene that renders the same image with `atmos render BASE.json`). scene_json: the text of

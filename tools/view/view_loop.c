@@ -21,6 +21,7 @@ typedef struct loop {
     double log_scale;            /* the exposure's smoothed log scale (automatic exposure) */
     int have_scale, spp, saves;
     int impostor_updates;        /* the last frame's */
+    int impostors_coarse;        /* the last frame's (never made: made at 1/4 resolution) */
     int impostor_budget;         /* view_opts's */
     double screen_layer_px;      /* view_opts's */
     int said_pinhole;            /* the stand-in pinhole for the scene's camera was announced */
@@ -236,7 +237,7 @@ static atmos_status render(loop *L, view_state *s, view_quality q, atmos_plan **
     st = atmos_plan_render(p, &f, NULL, L->img, NULL);
     atmos_plan_stats ps;
     atmos_plan_get_stats(p, &ps);
-    L->impostor_updates = ps.impostor_updates;
+    L->impostor_updates = ps.impostor_updates, L->impostors_coarse = ps.impostors_coarse;
     return st;
 }
 
@@ -347,7 +348,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         if (win && view_window_present(win, L.rgba, L.img->width, L.img->height, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
         last_ms = 1000.0 * (cli_now_s() - t0);
         if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates,
-                                                      q == VIEW_PREVIEW, &s);
+                                                      L.impostors_coarse, q == VIEW_PREVIEW, &s);
         /* a save that fails is said (save prints why) and the session goes on */
         if (rc == CLI_EXIT_OK && s.save && save(&L, o, &s, text) != CLI_EXIT_OK)
             fprintf(stderr, "atmos view: the frame was not saved; the session goes on\n");

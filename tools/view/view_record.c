@@ -32,12 +32,13 @@ static int open_csv(view_recorder *r)
         fprintf(stderr, "atmos view: --record: cannot write %s: %s\n", path, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    fprintf(r->csv, "frame,ms,renderer,impostor_updates,x_m,y_m,z_m,yaw_deg,pitch_deg,sun_elevation_deg,sun_azimuth_deg,preview\n");
+    fprintf(r->csv, "frame,ms,renderer,impostor_updates,x_m,y_m,z_m,yaw_deg,pitch_deg,sun_elevation_deg,sun_azimuth_deg,preview,"
+                     "impostors_coarse\n");
     return CLI_EXIT_OK;
 }
 
 int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms, const char *renderer,
-                      int impostor_updates, int preview, const view_state *s)
+                      int impostor_updates, int impostors_coarse, int preview, const view_state *s)
 {
     if (!r->dir) return CLI_EXIT_OK;
     if (!r->csv && open_csv(r) != CLI_EXIT_OK) return CLI_EXIT_RUNTIME;
@@ -47,8 +48,8 @@ int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *d
      * rendering it */
     atmos_status st = atmos_write_png_level(ctx, disp, path, 8, 1);
     if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
-    fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.4f,%.4f,%d\n", r->frames, ms, renderer, impostor_updates,
-            s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, s->sun_el, s->sun_az, preview);
+    fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.4f,%.4f,%d,%d\n", r->frames, ms, renderer, impostor_updates,
+            s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, s->sun_el, s->sun_az, preview, impostors_coarse);
     r->frames++;
     return CLI_EXIT_OK;
 }
