@@ -10,6 +10,7 @@
  * threads. Points outside the box get atmos__clouds_sun_attenuation itself. */
 #include "atmosphere/planet_clouds.h"
 
+#include <sched.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -145,8 +146,9 @@ static void need(atmos__clouds_sun *s, int layer, int x, int y)
         atomic_store_explicit(st, 2, memory_order_release);
         return;
     }
-    while (atomic_load_explicit(st, memory_order_acquire) != 2) {
-    }
+    /* another thread fills it: give up the core meanwhile (on a busy machine the filler may be
+     * waiting for one) */
+    while (atomic_load_explicit(st, memory_order_acquire) != 2) sched_yield();
 }
 
 double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon)
