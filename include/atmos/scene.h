@@ -350,6 +350,9 @@ ATMOS_API void atmos_volume_optics_free(atmos_volume_optics *o);
  * a particle cloud's is its particles summed on a grid (so every renderer draws the same cloud;
  * Harris's renderer takes the particles themselves). */
 ATMOS_API const char *const *atmos_scene_generator_names(void);
+/* Whether name is one of them (0 for NULL); the names, ", "-separated, into list[0..n) when
+ * list is not NULL (for a message). */
+ATMOS_API int atmos_scene_generator_known(const char *name, char *list, size_t n);
 ATMOS_API atmos_status atmos_scene_generate_volume(atmos_context *ctx, const char *preset,
                                                    const atmos_volume_generate_desc *desc, atmos_volume **out);
 /* Loads or generates the volume a scene names (scene->volume: file, grids, particle, time

@@ -984,15 +984,8 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
                                              "use \"generate\": \"%.40s\" for a generated volume", vol.source + 9);
             } else {
                 TRY(get_text(p, v, ip, buf, sizeof buf));
-                int known = 0;
-                const char *const *names = atmos_scene_generator_names();
-                char list[256] = "";
-                for (int i = 0; names && names[i]; i++) {
-                    known |= !strcmp(names[i], buf);
-                    strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-                    strncat(list, names[i], sizeof list - strlen(list) - 1);
-                }
-                if (!known)
+                char list[512];
+                if (!atmos_scene_generator_known(buf, list, sizeof list))
                     return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, ip,
                                              "unknown generator (known: %s)", list);
                 snprintf(vol.source, sizeof vol.source, "generate:%s", buf);

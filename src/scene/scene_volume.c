@@ -18,6 +18,17 @@ const char *const *atmos_scene_generator_names(void)
     return all;
 }
 
+int atmos_scene_generator_known(const char *name, char *list, size_t n)
+{
+    int known = 0;
+    if (list && n) list[0] = 0;
+    for (const char *const *v = atmos_scene_generator_names(); *v; v++) {
+        known |= name && !strcmp(*v, name);
+        if (list && n) snprintf(list + strlen(list), n - strlen(list), "%s%s", *v, v[1] ? ", " : "");
+    }
+    return known;
+}
+
 atmos_status atmos_scene_generate_volume(atmos_context *ctx, const char *preset, const atmos_volume_generate_desc *desc,
                                          atmos_volume **out)
 {
@@ -31,15 +42,11 @@ atmos_status atmos_scene_generate_volume(atmos_context *ctx, const char *preset,
             atmos__pcloud_free(&pc);
             return st;
         }
-    int known = 0;
-    for (const char *const *v = atmos_scene_generator_names(); *v; v++) known |= preset && !strcmp(*v, preset);
-    if (!known) { /* the volume generators' own message would leave out the particle clouds' */
-        char list[512] = "";
-        for (const char *const *v = atmos_scene_generator_names(); *v; v++)
-            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", *v, v[1] ? ", " : "");
+    char list[512];
+    /* the volume generators' own message would leave out the particle clouds' */
+    if (!atmos_scene_generator_known(preset, list, sizeof list))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate: unknown preset '%s' (known: %s)",
                             preset ? preset : "(null)", list);
-    }
     return atmos_volume_generate(ctx, preset, desc, out);
 }
 

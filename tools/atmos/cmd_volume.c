@@ -208,14 +208,9 @@ static int cmd_generate(int argc, char **argv)
     }
     if (!preset) return cli_usage_error(C, "generate: which preset?");
     if (!out) return cli_usage_error(C, "generate: missing -o NAME.json");
-    int known = 0;
-    for (const char *const *n = atmos_scene_generator_names(); *n; n++) known |= !strcmp(*n, preset);
-    if (!known) {
-        char list[512] = "";
-        for (const char *const *n = atmos_scene_generator_names(); *n; n++)
-            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", *n, n[1] ? ", " : "");
+    char list[512];
+    if (!atmos_scene_generator_known(preset, list, sizeof list))
         return cli_usage_error(C, "generate: unknown preset '%s' (known: %s)", preset, list);
-    }
     if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(threads, 1);
