@@ -34,38 +34,36 @@ TAU_EDGES = [0.01, 0.3, 1, 3, 10, 30, 1e30]
 SIGMAS = [1, 2, 4]
 
 
+def blur_pass(src, w, h, k, r, along_x):
+    """One 1-D pass of the kernel k (radius r) over rows (along_x) or columns of src."""
+    chans = len(src[0])
+    out = [[0.0] * chans for _ in range(w * h)]
+    for y in range(h):
+        for x in range(w):
+            acc = out[y * w + x]
+            for i, kv in enumerate(k):
+                xx, yy = (x + i - r, y) if along_x else (x, y + i - r)
+                if 0 <= xx < w and 0 <= yy < h:
+                    s = src[yy * w + xx]
+                    for c in range(chans):
+                        acc[c] += kv * s[c]
+    return out
+
+
 def blur(img, w, h, n, mask, sigma):
     """Gaussian blur of an n-channel image, normalised over the mask's pixels (outside: 0)."""
     r = int(math.ceil(3 * sigma))
     k = [math.exp(-0.5 * (i / sigma) ** 2) for i in range(-r, r + 1)]
-    chans = n + 1  # the channels and the mask's weight
     src = []
-    for p in range(w * h):
+    for p in range(w * h):  # the channels and the mask's weight
         m = 1.0 if mask[p] else 0.0
         src.append([img[p * n + c] * m for c in range(n)] + [m])
-    tmp = [[0.0] * chans for _ in range(w * h)]
-    for y in range(h):
-        for x in range(w):
-            acc = tmp[y * w + x]
-            for i, kv in enumerate(k):
-                xx = x + i - r
-                if 0 <= xx < w:
-                    s = src[y * w + xx]
-                    for c in range(chans):
-                        acc[c] += kv * s[c]
+    acc = blur_pass(blur_pass(src, w, h, k, r, True), w, h, k, r, False)
     out = [0.0] * (w * h * n)
-    for y in range(h):
-        for x in range(w):
-            acc = [0.0] * chans
-            for i, kv in enumerate(k):
-                yy = y + i - r
-                if 0 <= yy < h:
-                    s = tmp[yy * w + x]
-                    for c in range(chans):
-                        acc[c] += kv * s[c]
-            if acc[n] > 0:
-                for c in range(n):
-                    out[(y * w + x) * n + c] = acc[c] / acc[n]
+    for p, a in enumerate(acc):
+        if a[n] > 0:
+            for c in range(n):
+                out[p * n + c] = a[c] / a[n]
     return out
 
 
