@@ -8,6 +8,7 @@
 #define ATMOS_FUZZ_VOLUME_FILE_H
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #include "atmos/atmos.h"
+#include "fuzz_tmpdir.h"
 #include "volume/volume_internal.h"
 
 #include <math.h>
@@ -30,10 +31,8 @@ static void fuzz_fail(const char *what, const char *msg)
 
 static void fuzz_setup(const char *file_name)
 {
-    const char *t = getenv("TMPDIR");
-    char dir[256];
-    snprintf(dir, sizeof dir, "%s/atmos-fuzz-XXXXXX", t && *t ? t : "/tmp");
-    if (!mkdtemp(dir)) fuzz_fail("cannot create a temporary directory", dir);
+    const char *dir = fuzz_tmpdir();
+    if (!dir) fuzz_fail("cannot create a temporary directory", fuzz_tmpdir_path);
     snprintf(fuzz_path, sizeof fuzz_path, "%s/%s", dir, file_name);
 }
 

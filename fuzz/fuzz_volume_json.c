@@ -11,6 +11,7 @@
  */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp */
 #include "atmos/atmos.h"
+#include "fuzz_tmpdir.h"
 #include "volume/volume_internal.h"
 
 #include <math.h>
@@ -21,7 +22,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static char dir[256];
+static const char *dir;
 
 static void fail(const char *what, const char *msg)
 {
@@ -31,9 +32,8 @@ static void fail(const char *what, const char *msg)
 
 static void setup(void)
 {
-    const char *t = getenv("TMPDIR");
-    snprintf(dir, sizeof dir, "%s/atmos-fuzz-XXXXXX", t && *t ? t : "/tmp");
-    if (!mkdtemp(dir)) fail("cannot create a temporary directory", dir);
+    dir = fuzz_tmpdir();
+    if (!dir) fail("cannot create a temporary directory", fuzz_tmpdir_path);
     char p[320];
     snprintf(p, sizeof p, "%s/x.raw", dir);
     FILE *f = fopen(p, "wb");
@@ -47,7 +47,7 @@ static void setup(void)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (!dir[0]) setup();
+    if (!dir) setup();
     char path[320];
     snprintf(path, sizeof path, "%s/fuzz.json", dir);
     FILE *f = fopen(path, "wb");
