@@ -201,4 +201,21 @@ for bad_opt in "--grid 15" "--minutes abc" "--threads 0"; do
     has "simulate $bad_opt" "Try 'atmos simulate --help'."
 done
 
+# --- 10. --atmosphere names every model a scene's "atmosphere": {"model"} may: each renders,
+# the spherical ones a different sky from the flat one, and from orbit without the flat-earth note
+for m in riley homogeneous dobashi spherical; do
+    "$A" render --atmosphere "$m" --width 8 --height 6 --pfm "$T/air_$m.pfm" -q 2>"$T/err" \
+        && ok "render --atmosphere $m" || { bad "render --atmosphere $m:"; sed 's/^/  /' "$T/err" >&2; }
+done
+for m in dobashi spherical; do
+    cmp -s "$T/air_riley.pfm" "$T/air_$m.pfm" && bad "--atmosphere $m: the same sky as riley" \
+        || ok "--atmosphere $m: its own sky"
+done
+"$A" render --atmosphere spherical --altitude 400000 --view-elevation -30 --width 8 --height 8 -o "$T/f.png" -q \
+    2>"$T/err" || bad "spherical from 400 km"
+hasnt "spherical from 400 km" "flat earth"
+"$A" render --atmosphere fog --width 8 --height 6 -o "$T/f.png" -q 2>"$T/err"
+[ $? -eq 2 ] && ok "--atmosphere fog: a usage error" || bad "--atmosphere fog: not a usage error"
+has "--atmosphere fog" "dobashi"
+
 exit $fail

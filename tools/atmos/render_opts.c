@@ -151,7 +151,7 @@ static int parse_vec3(const char *C, const char *opt, const char *arg, double v[
 static int parse_named(int c, const char *arg, render_opts *o)
 {
     static const char *const cams[] = {"pinhole", "fisheye", "equirect"}, *const tones[] = {"filmic", "reinhard", "clamp"},
-                             *const renderers[] = {"sky", "slice", "path", "nishita", "harris", "beams"}, *const airs[] = {"riley", "homogeneous"};
+                             *const renderers[] = {"sky", "slice", "path", "nishita", "harris", "beams"}, *const airs[] = {"riley", "homogeneous", "dobashi", "spherical"};
     const char *C = o->cmd;
     switch (c) {
     case 'o': o->png = arg; return 1;
@@ -171,7 +171,7 @@ static int parse_named(int c, const char *arg, render_opts *o)
     case O_CAM: return parse_choice(o->cmd, "--camera", arg, cams, 3, &o->cam_type);
     case O_TONE: return parse_choice(o->cmd, "--tone", arg, tones, 3, &o->tone);
     case O_RENDERER: return parse_choice(o->cmd, "--renderer", arg, renderers, 6, &o->renderer);
-    case O_ATMOSPHERE: return parse_choice(o->cmd, "--atmosphere", arg, airs, 2, &o->air);
+    case O_ATMOSPHERE: return parse_choice(o->cmd, "--atmosphere", arg, airs, 4, &o->air);
     case O_EXPOSURE:
         if (!strcmp(arg, "auto")) return o->exposure_auto = 1, 1;
         return cli_parse_double(C, "--exposure", arg, &o->ev);
@@ -497,8 +497,9 @@ static int apply_view(const render_opts *o, atmos_scene *s)
     }
     if (o->tone >= 0) s->tonemap.curve = (atmos_tone_curve)o->tone;
     /* the kind of air (a vacuum background stays a vacuum) */
-    if (o->air >= 0 && s->atmosphere.kind != ATMOS_ATMOSPHERE_VACUUM)
-        s->atmosphere.kind = o->air ? ATMOS_ATMOSPHERE_HOMOGENEOUS : ATMOS_ATMOSPHERE_RILEY;
+    static const atmos_atmosphere_kind kinds[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS,
+                                                  ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL};
+    if (o->air >= 0 && s->atmosphere.kind != ATMOS_ATMOSPHERE_VACUUM) s->atmosphere.kind = kinds[o->air];
     if (o->thickness > 0) s->atmosphere.thickness_m = o->thickness;
     return CLI_EXIT_OK;
 }
@@ -745,8 +746,10 @@ void render_opts_help(void)
            "                                VALUE JSON (35, [0, 900, 0]) or a bare word (a string); repeatable;\n"
            "                                with --volume, -D volume.KEY applies to that volume; a -D setting\n"
            "                                volume.file, .generate or .simulate replaces the scene's source\n"
-           "      --atmosphere riley|homogeneous   the air: Riley et al.'s exponential atmosphere (default)\n"
-           "                                or a uniform layer from the ground to --thickness (docs/models.md)\n"
+           "      --atmosphere MODEL        the air, in place of the scene's: riley (Riley et al.'s\n"
+           "                                exponential atmosphere over a flat earth), homogeneous (a uniform\n"
+           "                                layer up to --thickness; docs/models.md), dobashi or spherical (a\n"
+           "                                spherical earth with aerosols and ozone; docs/sky.md)\n"
            "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");
     printf("One rule for every renderer: an option of another renderer than the one rendering is refused\n"
            "(exit 2, naming the renderer it goes with); --spp is the one option all renderers share. A scene\n"
