@@ -51,5 +51,9 @@ atmos_status atmos__gen_stratocumulus(gen_job *job);
  * rain_shaft (virga 0) and virga (1). */
 atmos_status atmos__gen_cumulonimbus(gen_job *job, int with_rain);
 atmos_status atmos__gen_rain_shaft(gen_job *job, int virga);
+/* Per column (x fastest) the height above which the cumulus field's cloud is cut: the clouds'
+ * fractal footprints (generate_footprint.c); NULL when out of memory. */
+float *atmos__gen_fractal_tops(gen_job *job, int n, const double *cx, const double *cz, const double *cw,
+                               double base, double depth);
 
 #endif

@@ -21,17 +21,22 @@
 #include "volume/generate_job.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define ETA_CLOUD 1e8
 #define ISO 0.3f
+/* The field's domes are this much wider (and as much flatter) than their footprints
+ * (generate_footprint.c), so that the rough outline cut from a dome rarely meets its rim. */
+#define WIDE 1.4
 
 
 
 /* The basic shape of one cumulus of diameter W on a base at height `base`: tiers
  * of balls, wide at the bottom and narrowing upward (a dome). Top of the
- * isosurface at about base + 0.75 W before refinement. */
-static int cumulus_balls(gen_job *job, gen_balls *bl, double cx, double cz, double base, double w)
+ * isosurface at about base + 0.75 W / squash before refinement (squash > 1: the balls
+ * oblate and the tiers closer, a dome squash times wider than it is tall). */
+static int cumulus_balls(gen_job *job, gen_balls *bl, double cx, double cz, double base, double w, double squash)
 {
     static const struct {
         int n;
@@ -41,23 +46,29 @@ static int cumulus_balls(gen_job *job, gen_balls *bl, double cx, double cz, doub
     for (int t = 0; t < 4; t++)
         for (int n = 0; n < tiers[t].n; n++) {
             double ang = gen_range(&job->rng, 0, 2 * ATMOS_PI), rad = sqrt(gen_u01(&job->rng)) * d * tiers[t].disc;
-            double y = base + (tiers[t].yoff + gen_range(&job->rng, -0.05, 0.05)) * r0;
+            double y = base + (tiers[t].yoff + gen_range(&job->rng, -0.05, 0.05)) * r0 / squash;
             double r = tiers[t].rfac * r0 * gen_range(&job->rng, 0.85, 1.15);
-            if (!atmos__gen_balls_add(bl, cx + rad * cos(ang), y, cz + rad * sin(ang), r, 1, 1)) return 0;
+            if (!atmos__gen_balls_add(bl, cx + rad * cos(ang), y, cz + rad * sin(ang), r, 1, squash)) return 0;
         }
     return 1;
 }
 
-/* F -> eta in place (see the top comment); rows below floor_j become 0. */
-static void cloud_density(gen_job *job, gen_grid *g, double base, double height, double eta, int floor_j)
+/* F -> eta in place (see the top comment); rows below floor_j become 0, and with `top` (one
+ * height per column, x fastest) the voxels above the column's top fade out over one voxel. */
+static void cloud_density(gen_job *job, gen_grid *g, double base, double height, double eta, int floor_j,
+                          const float *top)
 {
 #pragma omp parallel for schedule(static) num_threads(job->threads)
     for (int k = 0; k < g->n[2]; k++)
         for (int j = 0; j < g->n[1]; j++) {
             float *row = g->v + ((size_t)k * g->n[1] + j) * g->n[0];
             double h = 0.35 + 0.65 * gen_clamp01((gen_vox(job, j, 1) - base) / height);
-            for (int i = 0; i < g->n[0]; i++)
-                row[i] = j < floor_j ? 0.0f : (float)(eta * gen_clamp01((row[i] - ISO) / 0.6) * h);
+            const float *tc = top ? top + (size_t)k * g->n[0] : NULL;
+            const double y = gen_vox(job, j, 1);
+            for (int i = 0; i < g->n[0]; i++) {
+                double cut = tc ? gen_clamp01((tc[i] - y) / g->voxel + 0.5) : 1;
+                row[i] = j < floor_j ? 0.0f : (float)(eta * gen_clamp01((row[i] - ISO) / 0.6) * h * cut);
+            }
         }
 }
 
@@ -77,11 +88,11 @@ static atmos_status cumulus(gen_job *job)
     double lo[3] = {-1000 * s, base - 20 * s, -1000 * s}, hi[3] = {1000 * s, base + 1550 * s, 1000 * s};
     atmos_status st = atmos__gen_grid_init(job, lo, hi);
     if (st != ATMOS_OK) return st;
-    if (!cumulus_balls(job, &job->balls, 0, 0, base, w)) return gen_nomem(job);
+    if (!cumulus_balls(job, &job->balls, 0, 0, base, w, 1)) return gen_nomem(job);
     atmos__gen_accumulate(&job->grid[0], &job->balls, 0, job->threads);
     int fj = atmos__gen_floor_j(job, base);
     if ((st = refine(job, &job->grid[0], 0.075 * w, 3, fj, 1)) != ATMOS_OK) return st;
-    cloud_density(job, &job->grid[0], base, 0.8 * w, ETA_CLOUD, fj);
+    cloud_density(job, &job->grid[0], base, 0.8 * w, ETA_CLOUD, fj, NULL);
     return ATMOS_OK;
 }
 
@@ -97,7 +108,9 @@ static atmos_status cumulus_field(gen_job *job)
     /* NF fair-weather cumuli, diameters drawn from a power law n(w) ~ w^-1.7 (the cloud size
      * density of shallow cumulus, Neggers et al. 2003) over 250..1600 m, then placed largest
      * first by dart throwing, kept apart by 0.6 x the sum of their diameters (a cloud that finds
-     * no place in 200 throws is left out: drawing a new size instead would favour small ones). */
+     * no place in 200 throws is left out: drawing a new size instead would favour small ones).
+     * Each is a dome of metaballs WIDE times its width, cut down to a fractal footprint of its
+     * width (generate_footprint.c). */
     enum { NF = 64 };
     double cx[NF], cz[NF], cw[NF], wd[NF];
     const double b = 1.7, w0 = pow(250, 1 - b), w1 = pow(1600, 1 - b);
@@ -117,7 +130,7 @@ static atmos_status cumulus_field(gen_job *job)
                 if (hypot(x - cx[q], z - cz[q]) < 0.6 * (w + cw[q])) ok = 0;
             if (!ok) continue;
             cx[n] = x, cz[n] = z, cw[n] = w;
-            if (!cumulus_balls(job, &job->balls, x, z, base, w)) return gen_nomem(job);
+            if (!cumulus_balls(job, &job->balls, x, z, base, WIDE * w, WIDE)) return gen_nomem(job);
             n++;
             break;
         }
@@ -125,7 +138,10 @@ static atmos_status cumulus_field(gen_job *job)
     atmos__gen_accumulate(&job->grid[0], &job->balls, 0, job->threads);
     int fj = atmos__gen_floor_j(job, base);
     if ((st = refine(job, &job->grid[0], 110 * s, 2, fj, 0)) != ATMOS_OK) return st;
-    cloud_density(job, &job->grid[0], base, 900 * s, ETA_CLOUD, fj);
+    float *top = atmos__gen_fractal_tops(job, n, cx, cz, cw, base, 0.8);
+    if (!top) return gen_nomem(job);
+    cloud_density(job, &job->grid[0], base, 900 * s, ETA_CLOUD, fj, top);
+    free(top);
     return ATMOS_OK;
 }
 

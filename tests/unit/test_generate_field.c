@@ -1,0 +1,99 @@
+/* The generated cumulus field seen from above against observed cumulus fields
+ * (docs/clouds.md "Against observations"): outlines of perimeter-area dimension near Lovejoy's
+ * (1982, Science 216, 185) 1.35 (a bound of 1.2, which the smooth metaball outlines, 1.06, did
+ * not reach), a fair-weather cloud fraction, bases at one level; and the same voxels for any
+ * thread count. Three seeds at the default 40 m voxels: a few seconds. */
+#include "atmos/atmos.h"
+#include "atmos/cloudstats.h"
+#include "test.h"
+#include "volume/volume_grid.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { SEEDS = 3 };
+
+/* Extinction cross-section of the cloud droplets (r = 10 um, Q_ext = 2: 2 pi r^2). */
+static const double SIGMA_CLOUD = 2 * 3.14159265358979 * 1e-5 * 1e-5;
+
+static void test_outlines(atmos_context *ctx)
+{
+    atmos_cloud *all = NULL;
+    int nall = 0;
+    long cloudy = 0, pixels = 0;
+    double dx = 0, bsum = 0, bsum2 = 0;
+    int nb = 0;
+    for (uint64_t seed = 1; seed <= SEEDS; seed++) {
+        atmos_volume *v = test_generate(ctx, "cumulus_field", seed, 0);
+        if (!v) return;
+        atmos_cloud_columns cols;
+        CHECK_OK(atmos_cloud_columns_from_volume(ctx, v, &SIGMA_CLOUD, 0.1, &cols));
+        atmos_volume_destroy(v);
+        atmos_cloud_stats s;
+        CHECK_OK(atmos_cloud_stats_measure(ctx, &cols, NULL, &s));
+        atmos_cloud *p = realloc(all, (size_t)(nall + s.nclouds) * sizeof *all);
+        CHECK(p != NULL);
+        if (!p) return;
+        all = p;
+        memcpy(all + nall, s.clouds, (size_t)s.nclouds * sizeof *all);
+        nall += s.nclouds;
+        cloudy += s.cloudy_pixels, pixels += s.pixels, dx = cols.dx_m;
+        for (int c = 0; c < s.nclouds; c++)
+            if (s.clouds[c].pixels >= 10 && !isnan(s.clouds[c].base_mean_m)) {
+                bsum += s.clouds[c].base_mean_m, bsum2 += s.clouds[c].base_mean_m * s.clouds[c].base_mean_m;
+                nb++;
+            }
+        atmos_cloud_stats_free(&s);
+        atmos_cloud_columns_free(&cols);
+    }
+    atmos_cloud_fit f;
+    atmos_cloud_stats_fit(all, nall, cloudy, pixels, dx, NULL, &f);
+    free(all);
+    printf("  D %.3f +- %.3f over %d clouds, fraction %.3f, b %.2f +- %.2f, flatness %.3f\n", f.d, f.d_se, f.fitted,
+           f.cloud_fraction, f.size_slope, f.size_slope_se, f.flatness_median);
+    CHECK_MSG(f.fitted >= 100, "%d clouds fitted", f.fitted);
+    CHECK_MSG(f.d >= 1.2 && f.d <= 1.5, "perimeter-area dimension %.3f +- %.3f (observed about 1.35)", f.d, f.d_se);
+    CHECK_MSG(f.cloud_fraction >= 0.05 && f.cloud_fraction <= 0.3, "cloud fraction %.3f", f.cloud_fraction);
+    /* one condensation level: the clouds' mean bases within a voxel of each other */
+    const double bm = bsum / nb, bsd = sqrt(fmax(0, bsum2 / nb - bm * bm));
+    printf("  mean bases %.1f m, sd %.1f m over %d clouds\n", bm, bsd, nb);
+    CHECK_MSG(nb > 0 && bsd < dx, "the clouds' mean bases spread by %.1f m (voxel %.0f m)", bsd, dx);
+}
+
+/* Voxels that differ between two volumes of the same grid (-1: not the same grid). */
+static long count_diff(const atmos_volume *a, const atmos_volume *b)
+{
+    const int *n = a->desc.dims;
+    if (memcmp(n, b->desc.dims, sizeof a->desc.dims) || a->nfields != b->nfields) return -1;
+    long d = 0;
+    for (int k = 0; k < n[2]; k++)
+        for (int j = 0; j < n[1]; j++)
+            for (int i = 0; i < n[0]; i++) d += vol_voxel(a, &a->field[0], i, j, k) != vol_voxel(b, &b->field[0], i, j, k);
+    return d;
+}
+
+static void test_threads(void)
+{
+    atmos_context *c1 = test_context(1, NULL), *c3 = test_context(3, NULL);
+    atmos_volume *a = test_generate(c1, "cumulus_field", 5, 80), *b = test_generate(c3, "cumulus_field", 5, 80);
+    atmos_volume *c = test_generate(c3, "cumulus_field", 6, 80);
+    if (a && b && c) {
+        CHECK_MSG(count_diff(a, b) == 0, "1 vs 3 threads differ in %ld voxels", count_diff(a, b));
+        CHECK_MSG(count_diff(a, c) > 0, "seeds 5 and 6 give the same field");
+    }
+    atmos_volume_destroy(a);
+    atmos_volume_destroy(b);
+    atmos_volume_destroy(c);
+    atmos_context_destroy(c1);
+    atmos_context_destroy(c3);
+}
+
+int main(void)
+{
+    atmos_context *ctx = test_context(0, NULL);
+    test_outlines(ctx);
+    test_threads();
+    atmos_context_destroy(ctx);
+    return test_summary("test_generate_field");
+}
