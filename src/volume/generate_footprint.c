@@ -17,8 +17,11 @@
  * The column's cloud is cut above  base + clamp(phi / 0.1, 0, 1) max(HMIN, depth w clamp(phi_s /
  * RAMP, 0, 1)):  outside the outline nothing; inside it at least a thin layer HMIN deep on the
  * flat base, rising towards the core as phi_s, the same sum over its first LOW octaves only (the
- * cloud-sized undulations), grows. The metaball dome is kept where it is lower than the cut: the
- * rough outline is a skirt of thin cloud round a cauliflower core, not a cookie-cutter wall. */
+ * cloud-sized undulations), grows; where phi_s reaches RAMP (and phi EDGE) there is no cut at
+ * all. The metaball dome is kept where it is lower than the cut: the rough outline is a skirt of
+ * thin cloud round a cauliflower core, not a cookie-cutter wall. (With RAMP 1.5 the cut ran
+ * through most cores and gave them flat tops, mesas seen from the side; at 0.25 the core keeps
+ * its rounded dome and D is the same.) */
 #include "volume/generate_job.h"
 
 #include <math.h>
@@ -27,12 +30,13 @@
 #define HURST 0.15
 #define SIGMA 16.0
 #define T 0.2
-#define RAMP 1.5
+#define RAMP 0.25
 #define EDGE 0.1
 #define LOW 2
 #define HMIN 120.0
 
-/* The cut height (m) of the column at (x, z) owned by the cloud at (cx, cz) of width w. */
+/* The cut height (m) of the column at (x, z) owned by the cloud at (cx, cz) of width w; infinite
+ * in the core (no cut). */
 static double column_top(const gen_job *job, uint64_t seed, double x, double z, double cx, double cz, double w,
                          double e, double base, double depth)
 {
@@ -45,6 +49,7 @@ static double column_top(const gen_job *job, uint64_t seed, double x, double z, 
     const double share = (1 - pow(gain, low)) / (1 - pow(gain, oct));
     const double phi = e + SIGMA * (atmos__gen_fbm3(seed, u, 0.5, v, oct, gain) - 0.5) - T;
     const double phi_s = e + SIGMA * share * (atmos__gen_fbm3(seed, u, 0.5, v, low, gain) - 0.5) - T;
+    if (phi_s >= RAMP && phi >= EDGE) return HUGE_VAL; /* the core: the dome uncut */
     return base + gen_clamp01(phi / EDGE) * fmax(HMIN * job->scale, depth * w * gen_clamp01(phi_s / RAMP));
 }
 

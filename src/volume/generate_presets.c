@@ -29,6 +29,8 @@
 /* The field's domes are this much wider (and as much flatter) than their footprints
  * (generate_footprint.c), so that the rough outline cut from a dome rarely meets its rim. */
 #define WIDE 1.4
+/* The share of a cut column's depth over which its top fades out. */
+#define FADE 0.4
 
 
 
@@ -66,7 +68,11 @@ static void cloud_density(gen_job *job, gen_grid *g, double base, double height,
             const float *tc = top ? top + (size_t)k * g->n[0] : NULL;
             const double y = gen_vox(job, j, 1);
             for (int i = 0; i < g->n[0]; i++) {
-                double cut = tc ? gen_clamp01((tc[i] - y) / g->voxel + 0.5) : 1;
+                double cut = 1;
+                if (tc && isfinite(tc[i])) { /* a soft top, fading over FADE of its depth (a voxel at least) */
+                    double f = gen_clamp01((tc[i] - y) / fmax(g->voxel, FADE * (tc[i] - base)) + 0.5);
+                    cut = f * f * (3 - 2 * f);
+                }
                 row[i] = j < floor_j ? 0.0f : (float)(eta * gen_clamp01((row[i] - ISO) / 0.6) * h * cut);
             }
         }
