@@ -510,6 +510,8 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
 {
     const int W = r->x1 - r->x0, H = r->y1 - r->y0, nw = J->nw;
     const size_t n = (size_t)W * H;
+    *evaluated = 0;
+    if (W <= 0 || H <= 0) return 0;
     screen_buf q = {malloc(sizeof(int) * (size_t)((W - 1) / k + 2)), malloc(sizeof(int) * (size_t)((H - 1) / k + 2)),
                     malloc(sizeof(int) * n), malloc(sizeof(double) * n), NULL, malloc(sizeof(float) * n * nw)};
     int failed = !q.X || !q.Y || !q.obj || !q.T || !q.base, done = 0;
