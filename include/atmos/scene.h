@@ -150,6 +150,8 @@ typedef struct atmos_scene_beams {
     int interleave;           /* Keller and Heidrich 2001's interleaved sampling: each pixel of an N x N block samples
                                  between the planes at its own offset, and the airlight is averaged over N x N pixels
                                  of similar depth; 1 = off (the default) */
+    int screen_step;          /* the airlight evaluated every screen_step pixels and interpolated where the lattice's
+                                 cells agree, evaluated per pixel elsewhere (docs/beams.md); 1 = every pixel */
 } atmos_scene_beams;
 
 /* Lights besides the sun ("lights" in the file; the beam renderer's). */

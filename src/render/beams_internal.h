@@ -126,6 +126,9 @@ struct atmos__beams_plan {
     atmos__beams_sky sky;                    /* the sky's light on the objects, kept between frames */
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
     int centre_planes, centre_subplanes;
+    /* the last frame's pixels, and how many of them had their airlight evaluated (the others
+     * interpolated: beams/screen_step, beams_screen.h; evaluations counted again where two bands meet) */
+    long air_pixels, air_evaluated;
 };
 
 /* The sun for a frame (beams_plan.c): its light at the eye, its shadow map (made again when

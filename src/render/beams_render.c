@@ -19,11 +19,15 @@
  *     would all have.
  * With interleaved sampling (beams/interleave N > 1, beams_interleave.h) the samples between
  * the planes sit at a pixel's own offset, and the airlight is filtered over N x N pixels.
- * Rows go to the threads; each pixel depends on nothing but its own ray, so the image does
- * not depend on the thread count. */
+ * With beams/screen_step k > 1 (beams_screen.h) the airlight (the lights' and the sun's) is
+ * evaluated on a lattice of every k-th pixel and interpolated across the cells where that is
+ * safe, the surfaces still per pixel.
+ * Rows go to the threads; each pixel depends on nothing but its own ray (or its band of the
+ * lattice), so the image does not depend on the thread count. */
 #include "render/beams_internal.h"
 #include "render/beams_interleave.h"
 #include "render/beams_primary.h"
+#include "render/beams_screen.h"
 #include "render/beams_sky.h"
 #include "core/vec.h"
 
@@ -50,6 +54,7 @@ typedef struct job {
     double epsilon;
     int max_sub;
     int centre_planes, centre_subplanes;
+    int centre_now;            /* subsampling: the air_pixel() being evaluated is the centre's */
     const atmos__beams_sky *sky; /* the sky's light on surfaces (none in a vacuum or without objects) */
     const atmos__beams_primary *prim; /* what each pixel sees, rasterised (NULL: no objects) */
 } job;
@@ -199,25 +204,35 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum;
 }
 
-/* The sun's share (beams_sun.h): the surface hit (if any) lit where a ray toward the sun is
- * free (not cast where the sun's map proves the point in shadow, atmos__beams_sun_dark), dimmed by a height-dependent fog above it on the way in and by fog_t on the way out;
- * the fog's scattering of sunlight along [0, T). */
-static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double T, double fog_t, double *L)
+/* The sun's light on the surface hit (beams_sun.h): where a ray toward the sun is free (not
+ * cast where the sun's map proves the point in shadow, atmos__beams_sun_dark), dimmed by a
+ * height-dependent fog above it on the way in and by fog_t on the way out. */
+static void sun_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
     const atmos__beams_sun *s = &b->sun;
-    if (h) {
-        const double c = atmos__dot3(h->normal, s->dir), off = 1e-4 * (1 + h->t);
-        const double o[3] = {J->eye[0] + h->t * d[0] + off * h->normal[0], J->eye[1] + h->t * d[1] + off * h->normal[1],
-                             J->eye[2] + h->t * d[2] + off * h->normal[2]};
-        const double in = c > 0 ? exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)) : 0; /* dimmed on its way in */
-        if (c > 0 && in > 0 && !atmos__beams_sun_dark(s, o) && !atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
-            for (int k = 0; k < J->nw; k++) L[k] += b->obj.albedo[m][k] / ATMOS_PI * s->E[k] * c * in * fog_t;
-    }
-    if (b->fog.sigma0 > 0) {
-        const double a = atmos__beams_sun_airlight(s, &b->fog, J->eye, d, T, J->epsilon, MAX_INTERVALS);
-        for (int k = 0; k < J->nw; k++) L[k] += s->E[k] * a;
-    }
+    const double c = atmos__dot3(h->normal, s->dir), off = 1e-4 * (1 + h->t);
+    const double o[3] = {J->eye[0] + h->t * d[0] + off * h->normal[0], J->eye[1] + h->t * d[1] + off * h->normal[1],
+                         J->eye[2] + h->t * d[2] + off * h->normal[2]};
+    const double in = c > 0 ? exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)) : 0; /* dimmed on its way in */
+    if (c > 0 && in > 0 && !atmos__beams_sun_dark(s, o) && !atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
+        for (int k = 0; k < J->nw; k++) L[k] += b->obj.albedo[m][k] / ATMOS_PI * s->E[k] * c * in * fog_t;
+}
+
+/* The fog's scattering of sunlight along [0, T) of the ray d. */
+static void sun_air(const job *J, const double d[3], double T, double *L)
+{
+    const atmos__beams_plan *b = J->b;
+    if (!(b->fog.sigma0 > 0)) return;
+    const double a = atmos__beams_sun_airlight(&b->sun, &b->fog, J->eye, d, T, J->epsilon, MAX_INTERVALS);
+    for (int k = 0; k < J->nw; k++) L[k] += b->sun.E[k] * a;
+}
+
+/* The sun's share: on the surface hit (if any), and in the fog along [0, T). */
+static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double T, double fog_t, double *L)
+{
+    if (h) sun_surface(J, d, h, m, fog_t, L);
+    sun_air(J, d, T, L);
 }
 
 static int in_span(const job *J, int i, int x, int y)
@@ -405,6 +420,151 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
     return failed;
 }
 
+/* Subsampling's tolerances (docs/beams.md, *Subsampling the airlight*): the corners of a cell
+ * may differ by SPREAD of their pixels' light, its centre from the interpolation by CURVE, its
+ * depths by the ratio 1 + DEPTH. */
+#ifndef SCREEN_SPREAD
+#define SCREEN_SPREAD 0.1
+#endif
+#ifndef SCREEN_CURVE
+#define SCREEN_CURVE 0.01
+#endif
+#ifndef SCREEN_DEPTH
+#define SCREEN_DEPTH 0.5
+#endif
+
+/* Subsampling's first pass: pixel (x, y) without its airlight into B (bg: the sky behind it),
+ * what it sees into *T and *obj. */
+static void surface_pixel(job *J, int x, int y, const float *bg, float *B, double *T, int *obj)
+{
+    const atmos__beams_plan *b = J->b;
+    double d[3], L[ATMOS_MAX_WAVELENGTHS];
+    atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
+    atmos_mesh_hit h = {0, 0, {0, 0, 0}};
+    int m = -1;
+    const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
+    *T = hit ? h.t : INFINITY, *obj = hit ? m : -1;
+    const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, *T));
+    if (hit) shade_surface(J, d, &h, m, fog_t, L);
+    else
+        for (int k = 0; k < J->nw; k++) L[k] = bg[k] * fog_t;
+    if (hit && b->sun_on) sun_surface(J, d, &h, m, fog_t, L);
+    for (int k = 0; k < J->nw; k++) B[k] = (float)L[k];
+}
+
+/* The airlight of pixel (x, y) (atmos__beams_air_fn): the lights' and the sun's. */
+static void air_pixel(void *user, double *f, int x, int y, double T, double *A)
+{
+    job *J = user;
+    double d[3];
+    atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
+    for (int k = 0; k < J->nw; k++) A[k] = 0;
+    if (J->b->sigma_t > 0) lights(J, x, y, d, T, f, A, J->centre_now, 0.5);
+    if (J->b->sun_on) sun_air(J, d, T, A);
+}
+
+/* The buffers of a subsampled frame over r (each NULL until made). */
+typedef struct screen_buf {
+    int *X, *Y, *obj;
+    double *T, *node;
+    float *base;
+} screen_buf;
+
+static void screen_buf_free(screen_buf *q)
+{
+    free(q->X), free(q->Y), free(q->obj), free(q->T), free(q->node), free(q->base);
+}
+
+/* Band j of a subsampled frame (atmos__beams_screen_band) from the lattice's nodes, added to the
+ * pixels' light (its last row only in the last band: the next band's first). Returns the pixels
+ * evaluated. */
+static long screen_band(const atmos__beams_screen *s, const screen_buf *q, int nx, int ny, int j, double *f,
+                        double *band, unsigned char *state, atmos_image *out)
+{
+    const atmos__rect *r = &s->r;
+    const int W = r->x1 - r->x0, nw = s->nw, y0 = q->Y[j], y1 = ny > 1 ? q->Y[j + 1] : y0;
+    memset(state, 0, (size_t)W * (size_t)(y1 - y0 + 1));
+    for (int e = 0; e < (ny > 1 ? 2 : 1); e++)
+        for (int i = 0; i < nx; i++) {
+            const size_t at = (size_t)(e ? y1 - y0 : 0) * W + (size_t)(q->X[i] - r->x0);
+            memcpy(band + at * nw, q->node + ((size_t)(j + e) * nx + i) * nw, sizeof(double) * nw);
+            state[at] = 2;
+        }
+    const long ev = atmos__beams_screen_band(s, f, q->X, nx, y0, y1, band, state);
+    const int last = j + 2 >= ny ? y1 : y1 - 1;
+    for (int y = y0; y <= last; y++)
+        for (int x = r->x0; x < r->x1; x++) {
+            const size_t a = (size_t)(y - y0) * W + (size_t)(x - r->x0), p = (size_t)(y - r->y0) * W + (size_t)(x - r->x0);
+            float *px = out->pixels + ((size_t)y * out->width + x) * out->channels;
+            for (int k = 0; k < nw; k++) px[k] = (float)((double)q->base[p * nw + k] + band[a * nw + k]);
+        }
+    return ev;
+}
+
+/* The frame over r with the airlight subsampled every k pixels (beams_screen.h): the pixels'
+ * surfaces, the lattice's nodes, then its bands, each pass's rows to the threads (each value
+ * depends on its own pixel or band alone: the image is the same for any thread count). Returns
+ * 1 when out of memory; *evaluated: the pixels whose airlight was evaluated. */
+static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *out, int k, int *cancelled,
+                      long *evaluated)
+{
+    const int W = r->x1 - r->x0, H = r->y1 - r->y0, nw = J->nw;
+    const size_t n = (size_t)W * H;
+    *evaluated = 0;
+    if (W <= 0 || H <= 0) return 0;
+    screen_buf q = {malloc(sizeof(int) * (size_t)((W - 1) / k + 2)), malloc(sizeof(int) * (size_t)((H - 1) / k + 2)),
+                    malloc(sizeof(int) * n), malloc(sizeof(double) * n), NULL, malloc(sizeof(float) * n * nw)};
+    int failed = !q.X || !q.Y || !q.obj || !q.T || !q.base, done = 0;
+    const int nx = failed ? 0 : atmos__beams_screen_nodes(r->x0, r->x1, k, q.X);
+    const int ny = failed ? 0 : atmos__beams_screen_nodes(r->y0, r->y1, k, q.Y), nb = ny > 1 ? ny - 1 : 1;
+    if (!failed) failed = !(q.node = malloc(sizeof(double) * (size_t)nx * ny * nw));
+    if (failed) {
+        screen_buf_free(&q);
+        return 1;
+    }
+    const atmos__beams_screen s = {*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base, air_pixel, J};
+    long ev = 0;
+#pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev)
+    {
+        double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), *band = malloc(sizeof(double) * W * (k + 1) * nw);
+        unsigned char *state = malloc((size_t)W * (k + 1));
+        const int ok = f && band && state;
+        if (!ok) {
+#pragma omp atomic write
+            failed = 1;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (int y = r->y0; y < r->y1; y++)
+            for (int x = r->x0; x < r->x1 && ok && !atmos__cancelled(cancelled); x++) {
+                const size_t i = (size_t)(y - r->y0) * W + (size_t)(x - r->x0);
+                surface_pixel(J, x, y, out->pixels + ((size_t)y * out->width + x) * out->channels, q.base + i * nw,
+                              &q.T[i], &q.obj[i]);
+            }
+#pragma omp for schedule(dynamic, 1)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx && ok && !atmos__cancelled(cancelled); i++, ev++)
+                air_pixel(J, f, q.X[i], q.Y[j], q.T[(size_t)(q.Y[j] - r->y0) * W + (size_t)(q.X[i] - r->x0)],
+                          q.node + ((size_t)j * nx + i) * nw);
+#pragma omp for schedule(dynamic, 1)
+        for (int j = 0; j < nb; j++) {
+            if (!ok || atmos__cancelled(cancelled)) continue;
+            ev += screen_band(&s, &q, nx, ny, j, f, band, state, out);
+            atmos__progress_step(p->ctx, "render beams", &done, nb, cancelled);
+        }
+        free(f), free(band), free(state);
+    }
+    if (!failed && J->cx >= r->x0 && J->cx < r->x1 && J->cy >= r->y0 && J->cy < r->y1) { /* the centre ray's counts */
+        double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), A[ATMOS_MAX_WAVELENGTHS];
+        J->centre_now = 1;
+        if (f) air_pixel(J, f, J->cx, J->cy, q.T[(size_t)(J->cy - r->y0) * W + (size_t)(J->cx - r->x0)], A);
+        J->centre_now = 0;
+        free(f);
+    }
+    screen_buf_free(&q);
+    *evaluated = ev;
+    return failed;
+}
+
 /* Interleaved sampling's second pass: each pixel of r gets its filtered airlight. */
 static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const atmos__beams_il *il)
 {
@@ -447,12 +607,16 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         J.prim = &prim;
         J.sky = &b->sky;
     }
-    if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
+    const int step = p->scene.beams.screen_step;
+    long evaluated = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
+    if (!failed && step > 1 && !ilp) failed = subsampled(p, &J, r, out, step, &cancelled, &evaluated);
+    else if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
     atmos__beams_primary_free(&prim);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
     free(J.z_lo), free(J.span);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
+    b->air_evaluated = evaluated, b->air_pixels = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     if (cancelled) return atmos__error(p->ctx, ATMOS_E_CANCELLED, "render beams: cancelled");
     atmos__progress(p->ctx, "render beams", 1.0);

@@ -138,6 +138,10 @@ static const atmos_setting beams_settings[] = {
      "interleaved sampling (Keller and Heidrich 2001): the pixels of each N x N block sample between the planes at N^2 "
      "different offsets, their airlight averaged over N x N pixels of similar depth (1: off)",
      BEAMS(interleave)},
+    {"screen_step", "screen-step", ATMOS_SETTING_INT, "pixels", 1, 16, 0, 0, 4, NULL, 0,
+     "the airlight evaluated every N pixels and interpolated across the cells whose corners agree, per pixel "
+     "elsewhere (1: every pixel; with interleave 1)",
+     BEAMS(screen_step)},
 };
 
 const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)

@@ -78,6 +78,7 @@ cat >"$T/table" <<'EOF'
 --shadow-size 16|beams.shadow_size=16|beams|
 --beams-sun|beams.sun=true|beams|
 --interleave 2|beams.interleave=2|beams|
+--screen-step 1|beams.screen_step=1|beams|
 EOF
 
 # Every renderer option of --help is in the table.

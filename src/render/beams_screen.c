@@ -1,0 +1,120 @@
+/* Screen-space adaptive subsampling of the airlight (beams_screen.h). */
+#include "render/beams_screen.h"
+
+#include <math.h>
+
+/* One band being filled: the screen, the thread's scratch, the band's pixels and their state. */
+typedef struct band {
+    const atmos__beams_screen *s;
+    double *scratch;
+    int y0, w;       /* the band's first row, its width (the screen's) */
+    double *out;
+    unsigned char *state;
+    long evaluated;
+} band;
+
+static size_t at(const band *b, int x, int y) { return (size_t)(y - b->y0) * b->w + (size_t)(x - b->s->r.x0); }
+static size_t pix(const atmos__beams_screen *s, int x, int y)
+{
+    return (size_t)(y - s->r.y0) * (size_t)(s->r.x1 - s->r.x0) + (size_t)(x - s->r.x0);
+}
+
+int atmos__beams_screen_nodes(int a, int b, int k, int *X)
+{
+    int n = 0;
+    for (int x = a; x < b; x += k) X[n++] = x;
+    if (n && X[n - 1] != b - 1) X[n++] = b - 1;
+    return n;
+}
+
+/* Pixel (x, y) evaluated exactly, unless it was. */
+static void eval(band *b, int x, int y)
+{
+    const size_t i = at(b, x, y);
+    if (b->state[i] == 2) return;
+    const atmos__beams_screen *s = b->s;
+    s->air(s->user, b->scratch, x, y, s->T[pix(s, x, y)], b->out + i * s->nw);
+    b->state[i] = 2, b->evaluated++;
+}
+
+/* Whether every pixel of [x0, x1] x [y0, y1] sees the same object at depths within the ratio
+ * 1 + s->depth of each other (or all the sky); dim[k]: the least light without the airlight of
+ * its pixels, per wavelength. */
+static int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1, double *dim)
+{
+    const int m = s->object[pix(s, x0, y0)], nw = s->nw;
+    double lo = INFINITY, hi = 0;
+    for (int k = 0; k < nw; k++) dim[k] = INFINITY;
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            const size_t i = pix(s, x, y);
+            if (s->object[i] != m) return 0;
+            lo = fmin(lo, s->T[i]), hi = fmax(hi, s->T[i]);
+            for (int k = 0; k < nw; k++) dim[k] = fmin(dim[k], s->base[i * nw + k]);
+        }
+    return isinf(lo) || hi <= lo * (1 + s->depth);
+}
+
+/* The bilinear weights of (x, y) in the cell [x0, x1] x [y0, y1]. */
+static void weights(int x0, int y0, int x1, int y1, int x, int y, double w[4])
+{
+    const double u = x1 > x0 ? (double)(x - x0) / (x1 - x0) : 0, v = y1 > y0 ? (double)(y - y0) / (y1 - y0) : 0;
+    w[0] = (1 - u) * (1 - v), w[1] = u * (1 - v), w[2] = (1 - u) * v, w[3] = u * v;
+}
+
+/* Whether the cell's corners c agree (beams_screen.h), its centre (xm, ym) too when cm is given. */
+static int agree(const band *b, const double *c[4], int x0, int y0, int x1, int y1, const double *cm, int xm, int ym)
+{
+    const atmos__beams_screen *s = b->s;
+    double dim[ATMOS__BEAMS_SCREEN_MAX_NW], w[4];
+    if (!same_surface(s, x0, y0, x1, y1, dim)) return 0;
+    weights(x0, y0, x1, y1, xm, ym, w);
+    for (int k = 0; k < s->nw; k++) {
+        const double lo = fmin(fmin(c[0][k], c[1][k]), fmin(c[2][k], c[3][k]));
+        const double hi = fmax(fmax(c[0][k], c[1][k]), fmax(c[2][k], c[3][k]));
+        const double scale = lo + dim[k]; /* the least light a pixel of the cell may have */
+        if (!(hi - lo <= s->spread * scale)) return 0;
+        const double mid = w[0] * c[0][k] + w[1] * c[1][k] + w[2] * c[2][k] + w[3] * c[3][k];
+        if (cm && !(fabs(cm[k] - mid) <= s->curve * scale)) return 0;
+    }
+    return 1;
+}
+
+/* The cell [x0, x1] x [y0, y1], its corners evaluated: interpolated, or cut into four. */
+static void cell(band *b, int x0, int y0, int x1, int y1)
+{
+    const atmos__beams_screen *s = b->s;
+    const int nw = s->nw, xm = (x0 + x1) / 2, ym = (y0 + y1) / 2, big = x1 - x0 > 2 || y1 - y0 > 2;
+    if (x1 - x0 <= 1 && y1 - y0 <= 1) return; /* every pixel a corner */
+    const double *c[4] = {b->out + at(b, x0, y0) * nw, b->out + at(b, x1, y0) * nw, b->out + at(b, x0, y1) * nw,
+                          b->out + at(b, x1, y1) * nw};
+    if (big) eval(b, xm, ym);
+    if (agree(b, c, x0, y0, x1, y1, big ? b->out + at(b, xm, ym) * nw : NULL, xm, ym)) {
+        for (int y = y0; y <= y1; y++)
+            for (int x = x0; x <= x1; x++) {
+                const size_t i = at(b, x, y);
+                if (b->state[i]) continue;
+                double w[4];
+                weights(x0, y0, x1, y1, x, y, w);
+                for (int k = 0; k < nw; k++)
+                    b->out[i * nw + k] = w[0] * c[0][k] + w[1] * c[1][k] + w[2] * c[2][k] + w[3] * c[3][k];
+                b->state[i] = 1;
+            }
+        return;
+    }
+    const int px[3] = {x0, xm, x1}, py[3] = {y0, ym, y1};
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++) eval(b, px[i], py[j]);
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++)
+            if (px[i + 1] > px[i] || py[j + 1] > py[j]) cell(b, px[i], py[j], px[i + 1], py[j + 1]);
+}
+
+long atmos__beams_screen_band(const atmos__beams_screen *s, double *scratch, const int *X, int nx, int y0, int y1,
+                              double *out, unsigned char *state)
+{
+    band b = {s, scratch, y0, s->r.x1 - s->r.x0, out, state, 0};
+    for (int i = 0; i + 1 < nx; i++) cell(&b, X[i], y0, X[i + 1], y1);
+    if (nx == 1 && y1 > y0) cell(&b, X[0], y0, X[0], y1); /* a single column */
+    return b.evaluated;
+}

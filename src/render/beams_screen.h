@@ -1,0 +1,47 @@
+/* Screen-space adaptive subsampling of the beam renderer's airlight (docs/beams.md,
+ * *Subsampling the airlight*): the light the fog scatters toward the eye is evaluated on a
+ * lattice of every k-th pixel, and each cell of the lattice is filled by bilinear
+ * interpolation when its corners agree (the same object seen at similar depths by every pixel
+ * of the cell, the corners' airlight within a share of the pixels' light of each other, and,
+ * for a cell wider than 2, its centre evaluated and close to the interpolation); otherwise it
+ * is cut into four and each part tried again, down to single pixels evaluated exactly. The
+ * surfaces' direct light stays per pixel (the caller's). Not part of the API. */
+#ifndef ATMOS_RENDER_BEAMS_SCREEN_H
+#define ATMOS_RENDER_BEAMS_SCREEN_H
+
+#include "render/view.h"
+#include "atmos/spectrum.h"
+
+/* The most values a pixel. */
+#define ATMOS__BEAMS_SCREEN_MAX_NW ATMOS_MAX_WAVELENGTHS
+
+/* The airlight of pixel (x, y), whose ray ends at depth T (INFINITY: none), into A[0 .. nw);
+ * scratch is the calling thread's own buffer. */
+typedef void (*atmos__beams_air_fn)(void *user, double *scratch, int x, int y, double T, double *A);
+
+typedef struct atmos__beams_screen {
+    atmos__rect r;            /* the pixels */
+    int k, nw;                /* the lattice's step (a power of two), the values a pixel */
+    double spread;            /* the corners' airlight may differ by this share of their light */
+    double curve;             /* a cell's centre may differ from the interpolation by this share */
+    double depth;             /* the depths of a cell may differ by this ratio less 1 */
+    const double *T;          /* per pixel of r, row by row: the distance to the surface seen */
+    const int *object;        /* per pixel of r: the object seen, -1 for none */
+    const float *base;        /* per pixel of r: its light without the airlight, nw values */
+    atmos__beams_air_fn air;
+    void *user;
+} atmos__beams_screen;
+
+/* The lattice's coordinates over [a, b): a, a + k, a + 2k, ... and b - 1, into X (room for
+ * (b - a - 1) / k + 2); returns their count. */
+int atmos__beams_screen_nodes(int a, int b, int k, int *X);
+
+/* The airlight of a band of the image: the pixels [r.x0, r.x1) x [y0, y1] (y1 included) into
+ * out (nw values a pixel, row by row over the band), of which the lattice's nodes on rows y0
+ * and y1 (columns X[0 .. nx)) are given (state 2 there, 0 elsewhere); each cell between them
+ * filled from left to right, state 1 where interpolated, 2 where evaluated. Returns the
+ * pixels evaluated. */
+long atmos__beams_screen_band(const atmos__beams_screen *s, double *scratch, const int *X, int nx, int y0, int y1,
+                              double *out, unsigned char *state);
+
+#endif
