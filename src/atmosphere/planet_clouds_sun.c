@@ -19,7 +19,7 @@
 #define MAX_W 2048    /* texels around the globe at most (0.18 degree) */
 #define MARGIN 3.0    /* degrees around a regional image */
 #define FINER 4       /* texels per image pixel along each axis */
-#define SPREAD 0.02f  /* a look-up whose four texels differ by more evaluates G itself */
+#define SPREAD 0.05f  /* a look-up whose four texels differ by more steps G down itself */
 
 struct atmos__clouds_sun {
     const atmos__planet *pl;
@@ -102,7 +102,8 @@ static double step_down(atmos__clouds_sun *s, const double p[3], int above)
     atmos__planet_latlon_fast(pl, q, &la, &lo);
     const double col = atmos__clouds_column_tau(cl, la, lo);
     const double G = atmos__clouds_sun_lookup(s, q, above, la, lo);
-    return col > 0 ? G * exp(-atmos__clouds_shell_tau(cl, above, col, atmos__planet_mu(pl, q, s->sun))) : G;
+    return col > 0 ? G * atmos__expf_fast((float)-atmos__clouds_shell_tau(cl, above, col, atmos__planet_mu(pl, q, s->sun)))
+                   : G;
 }
 
 /* G at the texel centres of a tile, sphere by sphere downward as Dobashi et al. build their

@@ -134,8 +134,8 @@ int main(void)
     atmos_wavelengths_rgb(&wl);
     atmos_atmosphere *a = NULL;
     CHECK_OK(atmos_atmosphere_create(NULL, &d, &wl, &a));
-    check_textures(a, 45, 0.002, 0.03);
-    check_textures(a, 5, 0.002, 0.03);
+    check_textures(a, 45, 0.002, 0.06);
+    check_textures(a, 5, 0.002, 0.06);
     check_view(a, 45, 0.003, 0.08);
     check_view(a, 5, 0.003, 0.08); /* the terminator on the disk */
     atmos_atmosphere_destroy(a);
