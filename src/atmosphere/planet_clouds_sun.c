@@ -178,7 +178,12 @@ double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int bel
         x0 = (int)u, x1 = x0 + 1 < s->w ? x0 + 1 : x0, u -= x0;
     }
     const double av = v - y0;
-    need(s, layer, x0, y0), need(s, layer, x1, y0), need(s, layer, x0, y1), need(s, layer, x1, y1);
+    /* the tiles of the four texels: mostly one */
+    const int sx = x0 / TILE != x1 / TILE, sy = y0 / TILE != y1 / TILE;
+    need(s, layer, x0, y0);
+    if (sx) need(s, layer, x1, y0);
+    if (sy) need(s, layer, x0, y1);
+    if (sx && sy) need(s, layer, x1, y1);
     const float *g = s->g + (size_t)layer * s->w * s->h;
     const size_t W = (size_t)s->w;
     const float g00 = g[y0 * W + x0], g01 = g[y0 * W + x1], g10 = g[y1 * W + x0], g11 = g[y1 * W + x1];
