@@ -75,8 +75,9 @@ void atmos__clouds_sun_destroy(atmos__clouds_sun *s);
 /* Nonzero when s was made for exactly this sun. */
 int atmos__clouds_sun_same(const atmos__clouds_sun *s, const double sun[3]);
 /* G at x (on sphere `below`, or the ground for -1) of latitude and longitude lat, lon
- * (degrees, atmos__planet_latlon_fast's), interpolated bilinearly; outside the grid's box
- * atmos__clouds_sun_attenuation itself. */
+ * (degrees, atmos__planet_latlon_fast's), interpolated bilinearly; where the four texels
+ * differ by more than 0.05 (a sharp edge between them) one step down from the sphere above
+ * at x itself; outside the grid's box atmos__clouds_sun_attenuation itself. */
 double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon);
 /* The world-frame point at radius r from the planet's centre over lat, lon (degrees). */
 void atmos__clouds_geo_point(const atmos__planet *pl, double r, double lat_deg, double lon_deg, double x[3]);

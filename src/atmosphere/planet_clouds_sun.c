@@ -7,7 +7,10 @@
  * texels are filled tile by tile when a look-up first needs them (the sunlit part of what
  * the eye sees), by whichever thread gets there first while the others wait for it: a
  * texel's value does not depend on who fills it, so the image does not depend on the
- * threads. Points outside the box get atmos__clouds_sun_attenuation itself. */
+ * threads. A look-up whose four texels differ by more than SPREAD takes one step down from
+ * the sphere above at the point itself instead of interpolating across the sharp edge that
+ * runs between them (step_down). Points outside the box get atmos__clouds_sun_attenuation
+ * itself. */
 #include "atmosphere/planet_clouds.h"
 
 #include <sched.h>
