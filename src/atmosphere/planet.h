@@ -8,6 +8,7 @@
 #ifndef ATMOS_PLANET_H
 #define ATMOS_PLANET_H
 
+#include "core/fastmath.h"
 #include "core/internal.h"
 #include "core/rng.h"
 
@@ -139,7 +140,15 @@ double atmos__planet_ground_lights(const atmos__planet *pl, const double g[3], c
 void atmos__planet_latlon(const atmos__planet *pl, const double x[3], double *lat_deg, double *lon_deg);
 /* The same for texture look-ups (the cloud image), without the library's asin and atan2:
  * within 1.2e-6 degrees of atmos__planet_latlon (test_earth's test_latlon_fast). */
-void atmos__planet_latlon_fast(const atmos__planet *pl, const double x[3], double *lat_deg, double *lon_deg);
+static inline void atmos__planet_latlon_fast(const atmos__planet *pl, const double x[3], double *lat_deg,
+                                             double *lon_deg)
+{
+    const double v[3] = {x[0], x[1] + pl->r_ground, -x[2]};
+    double q[3];
+    for (int i = 0; i < 3; i++) q[i] = v[0] * pl->geo_east[i] + v[1] * pl->geo_up[i] + v[2] * pl->geo_north[i];
+    *lat_deg = atmos__atan2_fast(q[2], sqrt(q[0] * q[0] + q[1] * q[1])) * ATMOS_RAD2DEG;
+    *lon_deg = atmos__atan2_fast(q[1], q[0]) * ATMOS_RAD2DEG;
+}
 /* Builds the geographic frame and the maps of d (planet_surface.c) and the cloud spheres
  * (planet_clouds.c) into pl; the release functions free them (NULL-safe). */
 atmos_status atmos__planet_surface_create(atmos_context *ctx, atmos__planet *pl, const atmos_atmosphere_desc *d,

@@ -133,33 +133,19 @@ static double edge_fade(const atmos__clouds *cl, double u, double v)
     return x * x * (3.0 - 2.0 * x);
 }
 
-double atmos__clouds_column_tau(const atmos__clouds *cl, double lat, double lon)
+double atmos__clouds_column_tau_edge(const atmos__clouds *cl, double lat, double lon)
 {
-    if (cl->global) lon = lon - 360.0 * floor((lon - cl->lon_w) / 360.0);
-    else if (lon < cl->lon_w) lon += 360.0;
+    if (lon < cl->lon_w) lon += 360.0;
     if (lat < cl->lat_s || lat > cl->lat_n || lon < cl->lon_w || lon > cl->lon_e) return 0.0;
-    double u = (lon - cl->lon_w) / (cl->lon_e - cl->lon_w) * cl->w - 0.5;
-    double v = (cl->lat_n - lat) / (cl->lat_n - cl->lat_s) * cl->h - 0.5;
-    const double fade = cl->global ? 1.0 : edge_fade(cl, u, v);
-    u = fmin(fmax(u, 0.0), cl->w - 1.0), v = fmin(fmax(v, 0.0), cl->h - 1.0);
-    const int x0 = (int)u, y0 = (int)v;
-    const int x1 = x0 + 1 < cl->w ? x0 + 1 : x0, y1 = y0 + 1 < cl->h ? y0 + 1 : y0;
-    const double au = u - x0, av = v - y0;
-    const float *t = cl->tau;
-    const size_t W = (size_t)cl->w;
-    const double tau = (1 - av) * ((1 - au) * t[y0 * W + x0] + au * t[y0 * W + x1]) +
-                       av * ((1 - au) * t[y1 * W + x0] + au * t[y1 * W + x1]);
+    const double u = (lon - cl->lon_w) / (cl->lon_e - cl->lon_w) * cl->w - 0.5;
+    const double v = (cl->lat_n - lat) / (cl->lat_n - cl->lat_s) * cl->h - 0.5;
+    const double fade = edge_fade(cl, u, v), tau = atmos__clouds_bilinear(cl, u, v);
     if (fade >= 1.0) return tau;
     /* faded in reflectance, R = k tau / (1 + k tau) as atmos__clouds_tau_from_brightness
      * inverts it, so that a thick cloud thins out over the margin instead of staying opaque
      * to its last pixel */
     const double k = 0.5 * (1.0 - CLOUD_G_INVERSION), R = fade * k * tau / (1.0 + k * tau);
     return R / (k * (1.0 - R));
-}
-
-double atmos__clouds_shell_tau(const atmos__clouds *cl, int i, double tau, double mu)
-{
-    return tau / cl->m / fmax(fabs(mu), cl->mu_min[i]);
 }
 
 double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x[3], const double d[3])

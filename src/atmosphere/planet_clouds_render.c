@@ -16,6 +16,7 @@
  * sunlight is multiplied by G of all spheres. */
 #include "atmosphere/planet_clouds.h"
 
+#include "core/fastmath.h"
 #include "core/vec.h"
 
 #define MAX_CROSSINGS (2 * ATMOS__CLOUDS_MAX)
@@ -55,10 +56,30 @@ static double hg(double g, double cos_theta)
     return (1.0 - g * g) / (4.0 * ATMOS_PI * q * sqrt(q));
 }
 
+/* The sunlight E at x of radius index j (sphere j, or the ground for j = m) whose sun's cosine
+ * is mus: from the table e when given (linear in mus), else the solver's. */
+static void sunlight_at(const atmos_atmosphere *a, const atmos__sunlight_table *e, int j, const double x[3],
+                        const double sun[3], double mus, double *E)
+{
+    const int n = a->wl.count;
+    if (!e) {
+        a->solver->sunlight(a, x, sun, n, NULL, E);
+        return;
+    }
+    const double u = (fmin(fmax(mus, -1.0), 1.0) + 1.0) * 0.5 * (e->ne - 1);
+    int i = (int)u;
+    i = i > e->ne - 2 ? e->ne - 2 : i;
+    const float f = (float)(u - i);
+    const float *v = e->e + (size_t)j * n * e->ne + i;
+    for (int k = 0; k < n; k++, v += e->ne) E[k] = v[0] + f * (v[1] - v[0]);
+}
+
 /* Adds the crossing's light (times the transmittance w in front of it) to out; returns
- * the crossing's transmittance. G from gs's textures, or evaluated here when gs is NULL. */
+ * the crossing's transmittance. G from gs's textures, or evaluated here when gs is NULL;
+ * ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
 static double crossing_light(const atmos_atmosphere *a, const double x[3], const double d[3], const double sun[3],
-                             int i, const double *w, atmos__clouds_sun *gs, double *out)
+                             int i, double ph, const double *w, atmos__clouds_sun *gs,
+                             const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
     const atmos__clouds *cl = pl->clouds;
@@ -67,20 +88,22 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     atmos__planet_latlon_fast(pl, x, &lat, &lon);
     const double col = atmos__clouds_column_tau(cl, lat, lon);
     if (col <= 0) return 1.0;
-    const double tau = atmos__clouds_shell_tau(cl, i, col, atmos__planet_mu(pl, x, d));
-    const double t = exp(-tau);
+    /* x is on sphere i: its vertical is (x + centre) / r_i */
+    const double inv_r = 1.0 / cl->r[i], xc[3] = {x[0], x[1] + pl->r_ground, x[2]};
+    const double tau = atmos__clouds_shell_tau(cl, i, col, atmos__dot3(xc, d) * inv_r);
+    const double t = atmos__expf_fast((float)-tau); /* within 2e-7 of exp */
     const int n = a->wl.count;
+    const double mus = atmos__dot3(xc, sun) * inv_r;
     double E[ATMOS_MAX_WAVELENGTHS];
-    a->solver->sunlight(a, x, sun, n, NULL, E);
+    sunlight_at(a, e, i, x, sun, mus, E);
     int lit = 0;
     for (int k = 0; k < n; k++) lit |= E[k] > 0;
     if (!lit) return t;
     const double G = gs ? atmos__clouds_sun_lookup(gs, x, i, lat, lon) : atmos__clouds_sun_attenuation(pl, x, sun, i);
-    double J = G * hg(cl->g, atmos__dot3(d, sun));
-    const double mus = atmos__planet_mu(pl, x, sun);
+    double J = G * ph;
     if (!cl->single && mus > 0) {
         const double own = atmos__clouds_shell_tau(cl, i, col, mus); /* the whole shell along the sun */
-        J += mus * (1.0 - G * exp(-0.5 * own)) / ATMOS_PI;
+        J += mus * (1.0 - G * atmos__expf_fast((float)(-0.5 * own))) / ATMOS_PI;
     }
     for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];
     return t;
@@ -89,7 +112,8 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
 /* The ground at distance K: lit by the sunlight through the air and the clouds, and its
  * lights; times w. */
 static void ground_light(const atmos_atmosphere *a, const double p[3], const double d[3], double K,
-                         const double sun[3], const double *w, atmos__clouds_sun *gs, double *out)
+                         const double sun[3], const double *w, atmos__clouds_sun *gs,
+                         const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
     const int n = a->wl.count;
@@ -99,7 +123,7 @@ static void ground_light(const atmos_atmosphere *a, const double p[3], const dou
     double E[ATMOS_MAX_WAVELENGTHS];
     double G = 0.0;
     if (cs > 0) {
-        a->solver->sunlight(a, g, sun, n, NULL, E);
+        sunlight_at(a, e, pl->clouds->m, g, sun, cs, E);
         if (gs) {
             double lat, lon;
             atmos__planet_latlon_fast(pl, g, &lat, &lon);
@@ -123,6 +147,7 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
     double w[ATMOS_MAX_WAVELENGTHS], S[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
     for (int k = 0; k < n; k++) out[k] = 0.0, w[k] = 1.0;
     double x[3] = {p[0], p[1], p[2]}, t_prev = 0.0, clouds = 1.0;
+    const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
     int opaque = 0;
     for (int j = 0; j <= nc && !opaque; j++) {
         const double t_end = j < nc ? c[j].t : K, seg = t_end - t_prev;
@@ -134,11 +159,11 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
             for (int k = 0; k < n; k++) w[k] *= T[k];
         }
         if (j == nc) {
-            if (K < INFINITY) ground_light(a, p, d, K, sun, w, NULL, out);
+            if (K < INFINITY) ground_light(a, p, d, K, sun, w, NULL, NULL, out);
             break;
         }
         for (int i = 0; i < 3; i++) x[i] = p[i] + t_end * d[i];
-        const double tc = crossing_light(a, x, d, sun, c[j].sphere, w, NULL, out);
+        const double tc = crossing_light(a, x, d, sun, c[j].sphere, ph, w, NULL, NULL, out);
         clouds *= tc;
         for (int k = 0; k < n; k++) w[k] *= tc;
         opaque = clouds < OPAQUE;
@@ -152,7 +177,8 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
 }
 
 int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
-                                 const double *Lc, const double *Tc, atmos__clouds_sun *gs, double *out)
+                                 const double *Lc, const double *Tc, atmos__clouds_sun *gs,
+                                 const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
     const int n = a->wl.count, m = pl->clouds->m;
@@ -162,6 +188,7 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
     for (int j = 0; j < m; j++)
         if (c[j].sphere != m - 1 - j) return 0;
     double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
+    const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
     for (int k = 0; k < n; k++) out[k] = 0.0;
     for (int j = 0; j <= m; j++) {
         /* the air between stop j - 1 and stop j as the eye sees it, through the clouds */
@@ -169,14 +196,30 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
             out[k] += clouds * fmax(Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0), 0.0);
         for (int k = 0; k < n; k++) w[k] = clouds * Tc[(size_t)j * n + k];
         if (j == m) {
-            ground_light(a, p, d, K, sun, w, gs, out);
+            ground_light(a, p, d, K, sun, w, gs, e, out);
             break;
         }
         const double x[3] = {p[0] + c[j].t * d[0], p[1] + c[j].t * d[1], p[2] + c[j].t * d[2]};
-        clouds *= crossing_light(a, x, d, sun, c[j].sphere, w, gs, out);
+        clouds *= crossing_light(a, x, d, sun, c[j].sphere, ph, w, gs, e, out);
         if (clouds < OPAQUE) break;
     }
     return 1;
+}
+
+void atmos__clouds_sunlight_fill(const atmos_atmosphere *a, int ne, float *out)
+{
+    const atmos__planet *pl = a->planet;
+    const atmos__clouds *cl = pl->clouds;
+    const int n = a->wl.count;
+    for (int j = 0; j <= cl->m; j++) {
+        const double x[3] = {0.0, (j < cl->m ? cl->r[j] : pl->r_ground) - pl->r_ground, 0.0};
+        for (int i = 0; i < ne; i++) {
+            const double mu = -1.0 + 2.0 * i / (ne - 1), sun[3] = {sqrt(fmax(0.0, 1.0 - mu * mu)), mu, 0.0};
+            double E[ATMOS_MAX_WAVELENGTHS];
+            a->solver->sunlight(a, x, sun, n, NULL, E);
+            for (int k = 0; k < n; k++) out[((size_t)j * n + k) * ne + i] = (float)E[k];
+        }
+    }
 }
 
 void atmos__clouds_attenuation_texture(const atmos__planet *pl, int i, const double sun[3], int w, int h,

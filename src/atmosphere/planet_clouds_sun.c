@@ -7,7 +7,10 @@
  * texels are filled tile by tile when a look-up first needs them (the sunlit part of what
  * the eye sees), by whichever thread gets there first while the others wait for it: a
  * texel's value does not depend on who fills it, so the image does not depend on the
- * threads. Points outside the box get atmos__clouds_sun_attenuation itself. */
+ * threads. A look-up whose four texels differ by more than SPREAD takes one step down from
+ * the sphere above at the point itself instead of interpolating across the sharp edge that
+ * runs between them (step_down). Points outside the box get atmos__clouds_sun_attenuation
+ * itself. */
 #include "atmosphere/planet_clouds.h"
 
 #include <sched.h>
@@ -19,6 +22,7 @@
 #define MAX_W 2048    /* texels around the globe at most (0.18 degree) */
 #define MARGIN 3.0    /* degrees around a regional image */
 #define FINER 4       /* texels per image pixel along each axis */
+#define SPREAD 0.05f  /* a look-up whose four texels differ by more steps G down itself */
 
 struct atmos__clouds_sun {
     const atmos__planet *pl;
@@ -87,6 +91,24 @@ void atmos__clouds_geo_point(const atmos__planet *pl, double r, double lat_deg, 
     x[0] = r * e, x[1] = r * u - pl->r_ground, x[2] = -r * no;
 }
 
+/* G at p (on the sphere below sphere `above`, or the ground) from the sphere above: G there
+ * at the point y where p's ray to the sun crosses it (looked up) times that crossing's
+ * transmittance. */
+static double step_down(atmos__clouds_sun *s, const double p[3], int above)
+{
+    const atmos__planet *pl = s->pl;
+    const atmos__clouds *cl = pl->clouds;
+    const double t = atmos__planet_sphere_hit(pl, p, s->sun, cl->r[above]);
+    if (!(t < INFINITY)) return 1.0;
+    const double q[3] = {p[0] + t * s->sun[0], p[1] + t * s->sun[1], p[2] + t * s->sun[2]};
+    double la, lo;
+    atmos__planet_latlon_fast(pl, q, &la, &lo);
+    const double col = atmos__clouds_column_tau(cl, la, lo);
+    const double G = atmos__clouds_sun_lookup(s, q, above, la, lo);
+    return col > 0 ? G * atmos__expf_fast((float)-atmos__clouds_shell_tau(cl, above, col, atmos__planet_mu(pl, q, s->sun)))
+                   : G;
+}
+
 /* G at the texel centres of a tile, sphere by sphere downward as Dobashi et al. build their
  * textures: the sunlight at a point of sphere i (or the ground) is what reaches the point y
  * where its ray to the sun crosses sphere i + 1 (sphere 0) times that crossing's
@@ -119,17 +141,7 @@ static void fill_tile(atmos__clouds_sun *s, int layer, int tx, int ty)
              * world's axes (east, up, -north), atmos__clouds_geo_point's */
             const double p[3] = {r * (cl_ * ce[k] + sl_ * se), r * (cl_ * cu[k] + sl_ * su) - pl->r_ground,
                                  -r * (cl_ * cn[k] + sl_ * sn)};
-            double G = 1.0;
-            const double t = atmos__planet_sphere_hit(pl, p, s->sun, cl->r[above]);
-            if (t < INFINITY) {
-                const double q[3] = {p[0] + t * s->sun[0], p[1] + t * s->sun[1], p[2] + t * s->sun[2]};
-                double la, lo;
-                atmos__planet_latlon_fast(pl, q, &la, &lo);
-                const double col = atmos__clouds_column_tau(cl, la, lo);
-                G = atmos__clouds_sun_lookup(s, q, above, la, lo);
-                if (col > 0) G *= exp(-atmos__clouds_shell_tau(cl, above, col, atmos__planet_mu(pl, q, s->sun)));
-            }
-            g[(size_t)y * s->w + x] = (float)G;
+            g[(size_t)y * s->w + x] = (float)step_down(s, p, above);
         }
     }
 }
@@ -169,9 +181,16 @@ double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int bel
         x0 = (int)u, x1 = x0 + 1 < s->w ? x0 + 1 : x0, u -= x0;
     }
     const double av = v - y0;
-    need(s, layer, x0, y0), need(s, layer, x1, y0), need(s, layer, x0, y1), need(s, layer, x1, y1);
+    /* the tiles of the four texels: mostly one */
+    const int sx = x0 / TILE != x1 / TILE, sy = y0 / TILE != y1 / TILE;
+    need(s, layer, x0, y0);
+    if (sx) need(s, layer, x1, y0);
+    if (sy) need(s, layer, x0, y1);
+    if (sx && sy) need(s, layer, x1, y1);
     const float *g = s->g + (size_t)layer * s->w * s->h;
     const size_t W = (size_t)s->w;
-    return (1 - av) * ((1 - u) * g[y0 * W + x0] + u * g[y0 * W + x1]) +
-           av * ((1 - u) * g[y1 * W + x0] + u * g[y1 * W + x1]);
+    const float g00 = g[y0 * W + x0], g01 = g[y0 * W + x1], g10 = g[y1 * W + x0], g11 = g[y1 * W + x1];
+    const float lo = fminf(fminf(g00, g01), fminf(g10, g11)), hi = fmaxf(fmaxf(g00, g01), fmaxf(g10, g11));
+    if (hi - lo > SPREAD) return step_down(s, x, below + 1);
+    return (1 - av) * ((1 - u) * g00 + u * g01) + av * ((1 - u) * g10 + u * g11);
 }

@@ -109,15 +109,6 @@ void atmos__planet_latlon(const atmos__planet *pl, const double x[3], double *la
     *lon_deg = atan2(q[1], q[0]) * ATMOS_RAD2DEG;
 }
 
-void atmos__planet_latlon_fast(const atmos__planet *pl, const double x[3], double *lat_deg, double *lon_deg)
-{
-    const double v[3] = {x[0], x[1] + pl->r_ground, -x[2]};
-    double q[3];
-    for (int i = 0; i < 3; i++) q[i] = v[0] * pl->geo_east[i] + v[1] * pl->geo_up[i] + v[2] * pl->geo_north[i];
-    *lat_deg = atmos__atan2_fast(q[2], sqrt(q[0] * q[0] + q[1] * q[1])) * ATMOS_RAD2DEG;
-    *lon_deg = atmos__atan2_fast(q[1], q[0]) * ATMOS_RAD2DEG;
-}
-
 /* The linear value of wavelength k of map m at (lat, lon), bilinear between pixel centres
  * (wrapping in longitude). */
 static double map_lookup(const struct atmos__surface *s, const atmos__map *m, double lat, double lon, int k)

@@ -63,6 +63,8 @@ struct atmos__sph_space {
     float ra[ATMOS_MAX_WAVELENGTHS], rb[ATMOS_MAX_WAVELENGTHS]; /* Rayleigh: kr (ra + rb nu^2) */
     atmos__clouds_sun *gs;       /* the cloud spheres' attenuation textures for the sun (not
                                     owned; NULL: G at each crossing) */
+    float *ec;                   /* [m + 1][n][NCS]: the sunlight at each cloud sphere's radius
+                                    and the ground's over the sun's cosine (clouds only) */
 };
 
 #define AD 0.3 /* the disk's rows: the linear share of their mapping (above) */
@@ -244,13 +246,16 @@ atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const doubl
     const double mu_s = space_frame(s, pl, eq, sq);
     for (int row = 0; row < NG + NL; row++) s->phit[row] = row_phit(s, row, mu_s);
     const size_t nodes = (size_t)(NG + NL) * NA * NC * s->ns * s->n;
-    s->tab = malloc(sizeof(float) * (nodes + (size_t)s->n * (NPH + NCS)));
+    const size_t nec = s->ns > 1 ? (size_t)s->ns * s->n * NCS : 0;
+    s->tab = malloc(sizeof(float) * (nodes + (size_t)s->n * (NPH + NCS) + nec));
     if (!s->tab) {
         free(s);
         return NULL;
     }
     s->mie = s->tab + nodes;
     s->gi = s->mie + (size_t)s->n * NPH;
+    s->ec = nec ? s->gi + (size_t)s->n * NCS : NULL;
+    if (s->ec) atmos__clouds_sunlight_fill(a, NCS, s->ec);
     for (int j = 0; j < NCS; j++) { /* (cos T_sun + E_sky) E / pi, as atmos__sph_ground */
         const double cs = -1.0 + 2.0 * j / (NCS - 1);
         double e[ATMOS_MAX_WAVELENGTHS];
@@ -367,7 +372,8 @@ static void cloud_disk(const atmos__sph_space *s, const atmos_atmosphere *a, con
             const float *u = v + ((size_t)j * n + k) * NC;
             Lc[j * n + k] = pr[k] * u[0] + pm[k] * u[1] + u[2], Tc[j * n + k] = u[3];
         }
-    if (!atmos__clouds_radiance_stops(a, s->eye, d, sun, Lc, Tc, s->gs, L)) {
+    const atmos__sunlight_table e = {s->ec, NCS};
+    if (!atmos__clouds_radiance_stops(a, s->eye, d, sun, Lc, Tc, s->gs, &e, L)) {
         cloud_ray(s, a, sun, d, wt, count, i, out);
         return;
     }

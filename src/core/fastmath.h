@@ -73,9 +73,10 @@ static inline float atmos__atan_unitf(float z)
  * and |x| (the same 2e-8 rad); 0 at the origin. */
 static inline double atmos__atan2_fast(double y, double x)
 {
-    const double ax = fabs(x), ay = fabs(y), hi = fmax(ax, ay);
+    /* selects rather than fmax / fmin, which are library calls without -ffinite-math-only */
+    const double ax = fabs(x), ay = fabs(y), hi = ay > ax ? ay : ax, lo = ay > ax ? ax : ay;
     if (!(hi > 0)) return 0.0;
-    double a = atmos__atan_unit(fmin(ax, ay) / hi);
+    double a = atmos__atan_unit(lo / hi);
     a = ay > ax ? 1.57079632679489662 - a : a;
     a = x < 0 ? 3.14159265358979324 - a : a;
     return y < 0 ? -a : a;

@@ -134,10 +134,10 @@ int main(void)
     atmos_wavelengths_rgb(&wl);
     atmos_atmosphere *a = NULL;
     CHECK_OK(atmos_atmosphere_create(NULL, &d, &wl, &a));
-    check_textures(a, 45, 0.002, 0.6);
-    check_textures(a, 5, 0.002, 0.6);
-    check_view(a, 45, 0.005, 0.08);
-    check_view(a, 5, 0.005, 0.08); /* the terminator on the disk */
+    check_textures(a, 45, 0.002, 0.06);
+    check_textures(a, 5, 0.002, 0.06);
+    check_view(a, 45, 0.003, 0.08);
+    check_view(a, 5, 0.003, 0.08); /* the terminator on the disk */
     atmos_atmosphere_destroy(a);
     atmos_image_destroy(clouds);
     return test_summary("test_earth_clouds_space");
