@@ -45,6 +45,9 @@
 # (CPU 34.3 -> 24.7 s), inside the same (CPU 8.9 / 8.9 s). Not measured idle.
 # The impostors never made held to the budget (coarse stand-ins), in turns at load 2.7-3.9:
 # field_snap's 1 % low 27.2 / 23.1 -> 33.7 / 26.7 fps; field and field200k unchanged (docs/viewer.md).
+# Impostors no finer than their particles (docs/viewer.md), in turns at load 6.6-10.2,
+# OMP_WAIT_POLICY=passive, --frames 120: field200k 7.4 / 12.4 -> 11.3 / 14.7 fps median, run's CPU
+# 13.0 / 13.3 -> 12.0 / 12.0 s; field 14.8 / 13.9 -> 18.1 / 23.1 fps; field_snap the same CPU.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
