@@ -45,6 +45,10 @@
 # (CPU 34.3 -> 24.7 s), inside the same (CPU 8.9 / 8.9 s). Not measured idle.
 # The impostors never made held to the budget (coarse stand-ins), in turns at load 2.7-3.9:
 # field_snap's 1 % low 27.2 / 23.1 -> 33.7 / 26.7 fps; field and field200k unchanged (docs/viewer.md).
+# Impostors no finer than their particles (docs/viewer.md), in turns at load 2.9-3.6,
+# OMP_WAIT_POLICY=passive, --frames 120: field200k 15.5 / 15.3 -> 19.7 / 18.6 fps median (1 % low
+# 7.8 / 8.0 -> 10.0 / 10.3, run's CPU 13.7 / 13.5 -> 12.1 / 12.1 s); field 26.0 / 26.3 -> 31.2 /
+# 28.9 fps (1 % low 17.6 / 15.4 -> 22.4 / 21.7); field_snap the same CPU.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)

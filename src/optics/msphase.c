@@ -713,6 +713,25 @@ double atmos_msphase_eval(const atmos_msphase *m, int k, double n, double cos_th
     return w > 0 ? a * (1 - w) + eval_order(m, k, n0 + 1, i, f) * w : a;
 }
 
+void atmos__msphase_eval_all(const atmos_msphase *m, int nw, double n, double cos_theta, double *out)
+{
+    if (!(n >= 1)) n = 1;
+    if (cos_theta > 1) cos_theta = 1;
+    if (cos_theta < -1) cos_theta = -1;
+    double f = 0;
+    const int i = m ? atmos__angle_lerp(m->ag, acos(cos_theta) * ATMOS_RAD2DEG, &f) : 0;
+    const int high = !m || n >= m->max_order + 1, n0 = high ? 0 : (int)floor(n);
+    const double w = n - n0;
+    for (int k = 0; k < nw; k++) {
+        if (!wl_ok(m, k)) out[k] = 0.0;
+        else if (high) out[k] = 1.0 / (4.0 * ATMOS_PI);
+        else {
+            const double a = eval_order(m, k, n0, i, f);
+            out[k] = w > 0 ? a * (1 - w) + eval_order(m, k, n0 + 1, i, f) * w : a;
+        }
+    }
+}
+
 double atmos_msphase_forward(const atmos_msphase *m, int k, double n)
 {
     if (!wl_ok(m, k)) return 0.0;

@@ -35,6 +35,9 @@ atmos_status atmos__crystal_phase(atmos_context *ctx, const atmos_particle_desc 
  * trapezoid rule in theta with the sin(theta) weight: 2 pi int f sin(theta) dtheta. */
 double atmos__sphere_integral(int n, const double *theta_deg, const double *f);
 
+/* atmos_msphase_eval(m, k, n, cos_theta) for k = 0..nw-1 into out[k], the angle looked up once:
+ * the same numbers, bit for bit (a light pass's or a splat's wavelengths at one angle). */
+void atmos__msphase_eval_all(const atmos_msphase *m, int nw, double n, double cos_theta, double *out);
 /* Ams_n from phase functions tabulated on the grid of atmos_phase_grid() (n and theta_deg
  * as it returns them; another grid is ATMOS_E_INVALID_ARG), one array per wavelength: the
  * core of atmos_msphase_build, also used by tests with analytic phase functions. */

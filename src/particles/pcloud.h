@@ -212,11 +212,20 @@ typedef struct atmos__pimpostor {
     double view[3];
     atmos_camera cam;
     atmos_image *img;
+    int has_box, box[4]; /* atmos__pimpostor_make's: the texels holding anything, [x0, x1) x [y0, y1) */
 } atmos__pimpostor;
 /* The texels a cloud of radius r needs seen from distance d by a frame of focal length f
  * pixels: its projected diameter 2 r f / d (Schaufler's resolution, Harris Eq. 11), rounded
  * up to a multiple of 8, in [8, max_res]. */
 int atmos__pimpostor_res(double r, double d, double f, int max_res);
+/* The texels a particle's width s (its Gaussian's standard deviation) spans at least in an
+ * impostor limited by atmos__pimpostor_max_res: the splats are smooth over that scale, so the
+ * impostor's bilinear reading between texels holds them (test_particles' impostor_texels). */
+#define ATMOS__PIMPOSTOR_TEXELS_PER_WIDTH 2.0
+/* The most texels an impostor of a cloud of radius r whose narrowest particle has width smin
+ * needs whatever the view: the fewest, a multiple of 8, across which smin spans
+ * ATMOS__PIMPOSTOR_TEXELS_PER_WIDTH texels; in [8, max_res] (max_res when smin is not > 0). */
+int atmos__pimpostor_max_res(double r, double smin, int max_res);
 /* Whether im still serves the eye e for the cloud (centre c, radius r): the eye outside the
  * sphere, the angle at the centre between im's view and e within tol radians (Harris's
  * translation error), and im's texels at least what the view needs (the resolution error). */

@@ -16,6 +16,13 @@ int atmos__pimpostor_res(double r, double d, double f, int max_res)
     return res < max_res ? res : max_res;
 }
 
+int atmos__pimpostor_max_res(double r, double smin, int max_res)
+{
+    if (!(smin > 0)) return max_res;
+    const double res = 8.0 * ceil(2.0 * r * ATMOS__PIMPOSTOR_TEXELS_PER_WIDTH / smin / 8.0);
+    return res < 8.0 ? 8 : (res < max_res ? (int)res : max_res);
+}
+
 int atmos__pimpostor_serves(const atmos__pimpostor *im, const double c[3], double r, const double e[3], double tol,
                             double f, int max_res)
 {
@@ -40,6 +47,24 @@ double atmos__pimpostor_error(const atmos__pimpostor *im, const double c[3], dou
     const double ang = acos(fmax(-1.0, fmin(1.0, ab / sqrt(la * lb))));
     const double texels = (double)atmos__pimpostor_res(r, sqrt(lb), f, max_res) / im->res;
     return fmax(tol > 0 ? ang / tol : (ang > 0 ? INFINITY : 0.0), texels);
+}
+
+/* im->box: the texels of im's image with any value other than 0 (empty: x0 = x1 = 0). */
+static void texel_box(atmos__pimpostor *im)
+{
+    const int R = im->res, C = im->img->channels;
+    int x0 = R, x1 = 0, y0 = R, y1 = 0;
+    for (int y = 0; y < R; y++) {
+        const float *row = im->img->pixels + (size_t)y * R * C;
+        int a = 0, b = R * C;
+        while (a < b && row[a] == 0.0f) a++;
+        if (a == b) continue;
+        while (row[b - 1] == 0.0f) b--;
+        x0 = a / C < x0 ? a / C : x0, x1 = (b - 1) / C + 1 > x1 ? (b - 1) / C + 1 : x1;
+        y0 = y < y0 ? y : y0, y1 = y + 1;
+    }
+    im->has_box = 1;
+    im->box[0] = x0 < x1 ? x0 : 0, im->box[1] = x0 < x1 ? x1 : 0, im->box[2] = y0, im->box[3] = y1;
 }
 
 atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
@@ -68,6 +93,7 @@ atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, con
     if ((st = atmos__pcloud_splat(ctx, pc, o, L, idx, nidx, &im->cam, rect, im->img, NULL)) != ATMOS_OK) return st;
     memcpy(im->view, e, sizeof im->view);
     im->res = res, im->valid = 1;
+    texel_box(im);
     return ATMOS_OK;
 }
 
@@ -105,6 +131,45 @@ static void draw_row(const atmos__pimpostor *im, const double c[3], const double
     }
 }
 
+/* Shrinks bb (cam's pixels) to those whose rays read a texel of im's box: the box widened by
+ * two texels (a bilinear read takes the texels on both sides, and one clamped at the texture's
+ * edge the one before the last) is a quad on the impostor's plane
+ * (through c, normal nrm), and its corners' pixels bound it. Returns 0 when im holds nothing;
+ * bb is kept as it was when a corner is not in front of the eye. */
+static int shrink_to_texels(const atmos__pimpostor *im, const double c[3], const double nrm[3], const atmos_camera *cam,
+                            int bb[4])
+{
+    if (!im->has_box) return 1;
+    if (im->box[0] >= im->box[1]) return 0;
+    const atmos_camera *k = &im->cam;
+    const double R = im->res, fk = k->height / (2.0 * k->tan_half_fov), W = cam->width, H = cam->height;
+    const double t = cam->tan_half_fov;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, ck[3];
+    for (int i = 0; i < 3; i++) ck[i] = c[i] - k->position[i];
+    for (int corner = 0; corner < 4; corner++) {
+        const double tx = corner & 1 ? im->box[1] + 1 : im->box[0] - 2, ty = corner & 2 ? im->box[3] + 1 : im->box[2] - 2;
+        const double a = (tx + 0.5 - 0.5 * R) / fk, b = (0.5 * R - 0.5 - ty) / fk;
+        double dir[3], rel[3];
+        for (int i = 0; i < 3; i++) dir[i] = k->forward[i] + a * k->right[i] + b * k->up[i];
+        const double dn = dot3(dir, nrm);
+        if (!(fabs(dn) > 1e-12)) return 1;
+        const double s = dot3(ck, nrm) / dn;
+        for (int i = 0; i < 3; i++) rel[i] = k->position[i] + s * dir[i] - cam->position[i];
+        const double Z = dot3(rel, cam->forward);
+        if (!(Z > 1e-9 * sqrt(dot3(rel, rel)))) return 1;
+        const double x = 0.5 * (dot3(rel, cam->right) / Z * H / t + W) - 0.5;
+        const double y = 0.5 * (H - dot3(rel, cam->up) / Z * H / t) - 0.5;
+        lo[0] = fmin(lo[0], x), hi[0] = fmax(hi[0], x), lo[1] = fmin(lo[1], y), hi[1] = fmax(hi[1], y);
+    }
+    /* a pixel's whole index range round the corners' bounds, and one more on each side */
+    for (int a = 0; a < 2; a++) {
+        const double l = floor(lo[a]) - 1, h = ceil(hi[a]) + 2;
+        if (l > bb[2 * a]) bb[2 * a] = l < bb[2 * a + 1] ? (int)l : bb[2 * a + 1];
+        if (h < bb[2 * a + 1]) bb[2 * a + 1] = h > bb[2 * a] ? (int)h : bb[2 * a];
+    }
+    return bb[0] < bb[1] && bb[2] < bb[3];
+}
+
 void atmos__pimpostor_draw(atmos_context *ctx, int n, const atmos__pimpostor *const *ims, const double *const *c,
                            const double *r, const atmos_camera *cam, const int rect[4], atmos_image *img)
 {
@@ -121,6 +186,7 @@ void atmos__pimpostor_draw(atmos_context *ctx, int n, const atmos__pimpostor *co
             if (!atmos__pcloud_screen_box(cam, c[q], r[q], rect, bb[m], &Z)) continue;
             for (int i = 0; i < 3; i++) nrm[m][i] = ims[q]->view[i] - c[q][i], l += nrm[m][i] * nrm[m][i];
             for (int i = 0; i < 3; i++) nrm[m][i] /= sqrt(l);
+            if (!shrink_to_texels(ims[q], c[q], nrm[m], cam, bb[m])) continue;
             y0 = bb[m][2] < y0 ? bb[m][2] : y0, y1 = bb[m][3] > y1 ? bb[m][3] : y1;
             use[m++] = q;
         }

@@ -5,6 +5,7 @@
 #include "particles/pcloud.h"
 #include "core/fastmath.h"
 #include "core/internal.h"
+#include "optics/optics_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -40,14 +41,19 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
     out->s = s, out->z = Z;
     const double d = sqrt(rel[0] * rel[0] + rel[1] * rel[1] + rel[2] * rel[2]);
     const int fi = pc->field[p];
+    /* each light's phase functions at its scattering angle, every wavelength at once (one
+     * angle lookup), summed over the lights in order per wavelength */
+    double sums[ATMOS_MAX_WAVELENGTHS] = {0}, ph[ATMOS_MAX_WAVELENGTHS];
+    for (int j = 0; j < L->n; j++) {
+        /* scattering angle: the light travels along -dir, the eye is at -rel from the centre */
+        const double mu = (L->dir[j][0] * rel[0] + L->dir[j][1] * rel[1] + L->dir[j][2] * rel[2]) / d;
+        if (o->ms[fi]) atmos__msphase_eval_all(o->ms[fi], o->nw, L->order[j][p] + 1.0, mu, ph);
+        else
+            for (int k = 0; k < o->nw; k++) ph[k] = 1.0 / (4.0 * ATMOS_PI);
+        for (int k = 0; k < o->nw; k++) sums[k] += ph[k] * L->e[j][k] * L->light[j][(size_t)p * o->nw + k];
+    }
     for (int k = 0; k < o->nw; k++) {
-        double sum = 0;
-        for (int j = 0; j < L->n; j++) {
-            /* scattering angle: the light travels along -dir, the eye is at -rel from the centre */
-            const double mu = (L->dir[j][0] * rel[0] + L->dir[j][1] * rel[1] + L->dir[j][2] * rel[2]) / d;
-            const double ph = o->ms[fi] ? atmos_msphase_eval(o->ms[fi], k, L->order[j][p] + 1.0, mu) : 1.0 / (4.0 * ATMOS_PI);
-            sum += ph * L->e[j][k] * L->light[j][(size_t)p * o->nw + k];
-        }
+        const double sum = sums[k];
         out->col[k] = (float)(o->albedo[fi][k] * sum) + (L->diffuse ? L->diffuse[(size_t)p * o->nw + k] : 0.0f);
         if (L->air_t) { /* seen through the air: L_air + T_air colour (an opaque particle exactly) */
             const size_t at = (size_t)p * o->nw + k;

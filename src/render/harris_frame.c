@@ -78,6 +78,13 @@ static int visible(const atmos_camera *cam, const double c[3], double r)
     return Z > -r && fabs(X) - Z * tw <= r * sqrt(1 + tw * tw) && fabs(Y) - Z * th <= r * sqrt(1 + th * th);
 }
 
+/* The most texels cloud k's impostor needs: the scene's limit, or fewer where its narrowest
+ * particle spans ATMOS__PIMPOSTOR_TEXELS_PER_WIDTH texels with fewer. */
+static int max_res(const atmos_plan *p, const atmos__harris_plan *h, int k)
+{
+    return atmos__pimpostor_max_res(h->clouds.radius[k], h->smin[k], p->scene.harris.impostor_max_res);
+}
+
 /* How cloud k is drawn this frame: 0 not at all (out of view), 1 its particles, 2 a screen-sized
  * impostor (the eye inside it), 3 its impostor as it is, 4 its impostor made again. */
 static int mode(const atmos_plan *p, const atmos__harris_plan *h, const atmos__view *v, int k)
@@ -92,7 +99,7 @@ static int mode(const atmos_plan *p, const atmos__harris_plan *h, const atmos__v
     const double margin = 1.05 * c->radius[k]; /* an impostor's plane needs the eye well outside */
     if (d2 <= margin * margin) return 2;
     const double tol = hs->impostor_tolerance_deg * ATMOS_PI / 180.0;
-    return atmos__pimpostor_serves(&h->imp[k], c->centre[k], c->radius[k], e, tol, f, hs->impostor_max_res) ? 3 : 4;
+    return atmos__pimpostor_serves(&h->imp[k], c->centre[k], c->radius[k], e, tol, f, max_res(p, h, k)) ? 3 : 4;
 }
 
 /* Whether a split cloud k's part impostor (pass 0 far, 1 near) still serves: as a whole one
@@ -106,7 +113,7 @@ static int part_mode(const atmos_plan *p, const atmos__harris_plan *h, const atm
      * particles "approximately" behind and in front of the object) */
     const int cut = fabs(im->split - h->offset[k]) <= 0.5 * h->smin[k];
     return cut && atmos__pimpostor_serves(im, h->clouds.centre[k], h->clouds.radius[k], v->cam.position, tol, f,
-                                          hs->impostor_max_res) ? 3 : 4;
+                                          max_res(p, h, k)) ? 3 : 4;
 }
 
 /* Makes the impostors list[0..n + nc) again (each k 3 + part: part 0 cloud k's whole impostor, 1
@@ -145,7 +152,7 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
         atmos__pimpostor *im = part ? &h->split[2 * k + part - 1] : &h->imp[k];
         double d2 = 0;
         for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
-        int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
+        int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, max_res(p, h, k));
         if (q >= nfull) res = 8 * ((res / 4 + 7) / 8);
         const atmos_status sk = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, &L, idx, m, c->centre[k], c->radius[k], e, res);
         im->split = part ? h->offset[k] : 0;
@@ -224,7 +231,7 @@ static int needed_res(const atmos_plan *p, const atmos__harris_plan *h, int k, c
 {
     double d2 = 0;
     for (int a = 0; a < 3; a++) d2 += (e[a] - h->clouds.centre[k][a]) * (e[a] - h->clouds.centre[k][a]);
-    return atmos__pimpostor_res(h->clouds.radius[k], sqrt(d2), f, p->scene.harris.impostor_max_res);
+    return atmos__pimpostor_res(h->clouds.radius[k], sqrt(d2), f, max_res(p, h, k));
 }
 
 /* Holds the impostors to make (stale[0..n), entries 3 k + part) to the frame's budget B: split
@@ -246,7 +253,7 @@ static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmo
         const int k = stale[q] / 3, res = needed_res(p, h, k, e, f);
         const double err = stale[q] % 3 ? INFINITY
                                          : atmos__pimpostor_error(&h->imp[k], h->clouds.centre[k], h->clouds.radius[k], e,
-                                                                  tol, f, hs->impostor_max_res);
+                                                                  tol, f, max_res(p, h, k));
         if (!(stale[q] % 3) && !h->imp[k].valid) first[nfirst].key = res, first[nfirst++].index = stale[q];
         else if (isinf(err)) stale[kept++] = stale[q]; /* must be made */
         else key[m].key = err * res, key[m++].index = stale[q];

@@ -48,7 +48,7 @@ struct atmos__harris_plan {
     int *part;                           /* [pc.n] this frame's split clouds' particles, far ones first */
     int *nfar;                           /* [clouds.n] how many of those are far */
     double *offset;                      /* [clouds.n] the split distance less the cloud centre's, this frame */
-    double *smin;                        /* [clouds.n] each cloud's narrowest particle width */
+    double *smin;                        /* [clouds.n] each cloud's narrowest particle width (impostor texels, split) */
     int splits;                          /* clouds split this frame */
     double split_m;                      /* this frame's split distance (INFINITY: none) */
     int nlights;                         /* the sun, then the sky lights */

@@ -146,9 +146,16 @@ static atmos_status objects(atmos_plan *p, atmos__harris_plan *h)
     h->part = malloc(sizeof(int) * (size_t)(h->pc.n ? h->pc.n : 1));
     h->nfar = calloc(nc, sizeof *h->nfar);
     h->offset = calloc(nc, sizeof *h->offset);
-    h->smin = malloc(sizeof *h->smin * nc);
-    if (!h->split || !h->part || !h->nfar || !h->offset || !h->smin)
+    if (!h->split || !h->part || !h->nfar || !h->offset)
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the split impostors");
+    return ATMOS_OK;
+}
+
+/* Each cloud's narrowest particle width (what its impostor's texels and its split need). */
+static atmos_status narrowest(atmos_plan *p, atmos__harris_plan *h)
+{
+    h->smin = malloc(sizeof *h->smin * (size_t)(h->clouds.n ? h->clouds.n : 1));
+    if (!h->smin) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     for (int k = 0; k < h->clouds.n; k++) {
         h->smin[k] = INFINITY;
         for (int q = h->clouds.start[k]; q < h->clouds.start[k + 1]; q++) h->smin[k] = fmin(h->smin[k], h->pc.s[h->clouds.idx[q]]);
@@ -176,6 +183,7 @@ atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
         h->order[j] = malloc(sizeof(float) * (size_t)(h->pc.n ? h->pc.n : 1));
         if (!h->light[j] || !h->order[j]) st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory");
     }
+    if (st == ATMOS_OK) st = narrowest(p, h);
     if (st == ATMOS_OK && p->scene.object_count > 0) st = objects(p, h);
     if (st == ATMOS_OK) st = atmos__harris_diffuse_prepare(p, h);
     if (st != ATMOS_OK) {

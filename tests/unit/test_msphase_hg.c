@@ -238,6 +238,44 @@ static void check_eval(void)
     atmos_msphase_destroy(m);
 }
 
+/* Every wavelength's Ams at once (atmos__msphase_eval_all, one angle lookup for all) gives
+ * atmos_msphase_eval's numbers bit for bit, wavelength by wavelength; a wavelength beyond the
+ * object's gives 0, as atmos_msphase_eval does. */
+static void check_eval_all(void)
+{
+    const double *theta;
+    const int n = atmos_phase_grid(&theta);
+    double *P = malloc(sizeof(double) * 3 * (size_t)n);
+    if (!P) return;
+    const double g[3] = {0.7, 0.5, 0.85};
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < n; i++) P[k * n + i] = hg(cos(theta[i] * PI / 180), g[k]);
+    const double *Ps[3] = {P, P + n, P + 2 * n};
+    atmos_msphase *m = NULL;
+    atmos_msphase_desc d = {0};
+    d.max_order = 6;
+    CHECK_OK(atmos__msphase_build_arrays(NULL, 3, n, theta, Ps, &d, &m));
+    free(P);
+    if (!m) return;
+    const double orders[] = {1, 2.5, 6, 6.75, 9, 0.2, NAN};
+    const double ends[] = {1, -1, 1.5, -3, NAN};
+    long bad = 0, count = 0;
+    for (int q = 0; q < 20000 + 5; q++) {
+        const double mu = q < 20000 ? cos(PI * uniform()) : ends[q - 20000];
+        for (int o = 0; o < 7; o++) {
+            double all[4];
+            atmos__msphase_eval_all(m, 4, orders[o], mu, all);
+            for (int k = 0; k < 4; k++) {
+                const double one = atmos_msphase_eval(m, k, orders[o], mu);
+                bad += memcmp(&one, &all[k], sizeof one) != 0;
+                count++;
+            }
+        }
+    }
+    CHECK_MSG(bad == 0, "atmos__msphase_eval_all: %ld of %ld values differ from atmos_msphase_eval", bad, count);
+    atmos_msphase_destroy(m);
+}
+
 /* The accessors on a NULL object: 0 or NULL, no crash (issue: they dereferenced it). */
 static void check_null(void)
 {
@@ -311,6 +349,7 @@ int main(void)
 {
     check_null();
     check_eval();
+    check_eval_all();
     check_mix_failure();
     check_mixture();
     check_hg(0.0);

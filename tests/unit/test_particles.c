@@ -237,6 +237,88 @@ static double rel_rms(const atmos_image *a, const atmos_image *b)
     return sqrt(d2 / r2);
 }
 
+/* An impostor's box of texels holding anything (atmos__pimpostor_make's) is tight, and drawing
+ * only over the pixels that read it leaves every pixel's colour as drawing over the cloud's
+ * whole sphere does (the same impostor without its box), bit for bit, the coverage within a
+ * rounding (1 - (1 - a) for a); drawn over a frame that is not empty. */
+static void texel_box_check(atmos__pimpostor *im, const double *c, const double *r, const atmos_camera *cam)
+{
+    const int R = im->res, C = im->img->channels, *b = im->box;
+    int outside = 0, edge[4] = {0, 0, 0, 0};
+    for (int y = 0; y < R; y++)
+        for (int x = 0; x < R; x++)
+            for (int k = 0; k < C; k++) {
+                const float v = im->img->pixels[((size_t)y * R + x) * C + k];
+                if (x < b[0] || x >= b[1] || y < b[2] || y >= b[3]) outside += v != 0.0f;
+                else edge[0] |= x == b[0] && v != 0, edge[1] |= x == b[1] - 1 && v != 0, edge[2] |= y == b[2] && v != 0,
+                    edge[3] |= y == b[3] - 1 && v != 0;
+            }
+    printf("impostor texel box [%d, %d) x [%d, %d) of %d\n", b[0], b[1], b[2], b[3], R);
+    CHECK(im->has_box && outside == 0 && edge[0] && edge[1] && edge[2] && edge[3]);
+    CHECK(b[1] - b[0] < R || b[3] - b[2] < R); /* the test means something: the box is smaller */
+    const int W = cam->width, H = cam->height;
+    atmos_image *boxed = NULL, *drawn = NULL;
+    CHECK_OK(atmos_image_create(NULL, W, H, C, &boxed));
+    CHECK_OK(atmos_image_create(NULL, W, H, C, &drawn));
+    for (size_t i = 0; i < (size_t)W * H * C; i++) boxed->pixels[i] = drawn->pixels[i] = 0.1f + 0.3f * (float)(i % 7) / 7;
+    atmos__pimpostor whole = *im;
+    whole.has_box = 0;
+    const atmos__pimpostor *one = im, *sphere = &whole;
+    atmos__pimpostor_draw(NULL, 1, &one, &c, r, cam, (const int[4]){0, 0, W, H}, boxed);
+    atmos__pimpostor_draw(NULL, 1, &sphere, &c, r, cam, (const int[4]){0, 0, W, H}, drawn);
+    int colour = 0, cover = 0;
+    for (size_t i = 0; i < (size_t)W * H * C; i++) {
+        if ((int)(i % C) < C - 1) colour += memcmp(&boxed->pixels[i], &drawn->pixels[i], sizeof(float)) != 0;
+        else cover += fabsf(boxed->pixels[i] - drawn->pixels[i]) > 1e-7f;
+    }
+    CHECK_MSG(colour == 0 && cover == 0, "texel box: %d colour values, %d coverages differ", colour, cover);
+    atmos_image_destroy(boxed), atmos_image_destroy(drawn);
+}
+
+/* texel_box_check at the texture's edge: only the column before the last holds anything, which
+ * a bilinear read clamped at the edge still takes (a thousandth of it) for rays beyond the last
+ * column; seen magnified (a narrow camera at the impostor's eye looking at that edge), drawing
+ * over the box's pixels gives the colours of drawing over the sphere's, bit for bit. */
+static void texel_box_edge(atmos__pimpostor *im, const double *c, const double *r)
+{
+    const int R = im->res, C = im->img->channels;
+    float *keep = malloc(sizeof(float) * (size_t)R * R * C);
+    memcpy(keep, im->img->pixels, sizeof(float) * (size_t)R * R * C);
+    memset(im->img->pixels, 0, sizeof(float) * (size_t)R * R * C);
+    for (int y = 0; y < R; y++)
+        for (int k = 0; k < C; k++) im->img->pixels[((size_t)y * R + R - 2) * C + k] = k < C - 1 ? 0.2f : 0.5f;
+    const int box[4] = {im->box[0], im->box[1], im->box[2], im->box[3]};
+    im->box[0] = R - 2, im->box[1] = R - 1, im->box[2] = 0, im->box[3] = R;
+    atmos_camera_desc cd;
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, im->view, &cd);
+    for (int i = 0; i < 3; i++) cd.look_at[i] = c[i] + 0.97 * r[0] * im->cam.right[i];
+    cd.fov_deg = 1;
+    atmos_camera cam;
+    CHECK_OK(atmos_camera_init(NULL, &cd, 160, 160, &cam));
+    atmos_image *boxed = NULL, *drawn = NULL;
+    CHECK_OK(atmos_image_create(NULL, 160, 160, C, &boxed));
+    CHECK_OK(atmos_image_create(NULL, 160, 160, C, &drawn));
+    for (size_t i = 0; i < (size_t)160 * 160 * C; i++) boxed->pixels[i] = drawn->pixels[i] = 0.3f;
+    atmos__pimpostor whole = *im;
+    whole.has_box = 0;
+    const atmos__pimpostor *one = im, *sphere = &whole;
+    atmos__pimpostor_draw(NULL, 1, &one, &c, r, &cam, (const int[4]){0, 0, 160, 160}, boxed);
+    atmos__pimpostor_draw(NULL, 1, &sphere, &c, r, &cam, (const int[4]){0, 0, 160, 160}, drawn);
+    int colour = 0, touched = 0;
+    for (size_t i = 0; i < (size_t)160 * 160 * C; i++)
+        if ((int)(i % C) < C - 1) {
+            colour += memcmp(&boxed->pixels[i], &drawn->pixels[i], sizeof(float)) != 0;
+            touched += drawn->pixels[i] != 0.3f;
+        }
+    printf("texel box at the edge: %d colour values drawn, %d differ\n", touched, colour);
+    CHECK(touched > 0);
+    CHECK_MSG(colour == 0, "texel box at the edge: %d colour values differ", colour);
+    memcpy(im->img->pixels, keep, sizeof(float) * (size_t)R * R * C);
+    memcpy(im->box, box, sizeof box);
+    free(keep);
+    atmos_image_destroy(boxed), atmos_image_destroy(drawn);
+}
+
 /* Clouds found as connected particles; an impostor drawn from where it was made matches the
  * particles splatted directly (within its resampling), drifts as the eye moves round the
  * cloud, and stops serving beyond the tolerance angle, inside the cloud or when too coarse. */
@@ -294,6 +376,8 @@ static void impostors(void)
     atmos__pimpostor_draw(NULL, 1, &one, &cc, cl.radius, &cam, rect, imp);
     const double e05 = rel_rms(imp, direct);
     printf("impostor: %d texels, rel rms against the splats %.4f where made, %.4f 0.5 degree round\n", res, e0, e05);
+    texel_box_check(&im, cl.centre[0], cl.radius, &cam);
+    texel_box_edge(&im, cl.centre[0], cl.radius);
     CHECK(e0 < 0.03);
     CHECK(e05 > e0);
     CHECK(atmos__pimpostor_serves(&im, cl.centre[0], cl.radius[0], eye, 0.15 * 3.141592653589793 / 180, f, 512));
@@ -316,6 +400,74 @@ static void impostors(void)
     CHECK(isinf(atmos__pimpostor_error(&never, cl.centre[0], cl.radius[0], eye, 0.15 * deg, f, 512)));
     atmos__pimpostor_free(&im);
     atmos_image_destroy(direct), atmos_image_destroy(imp);
+    free(light), free(order);
+    atmos__pclusters_free(&cl);
+    atmos__pcloud_free(&pc);
+}
+
+/* An impostor's texels limited by its narrowest particle (atmos__pimpostor_max_res): the
+ * fewest texels, in multiples of 8, in which that particle's width spans
+ * ATMOS__PIMPOSTOR_TEXELS_PER_WIDTH texels. Seen so near that the view wants four times as
+ * many, the impostor at the limit matches the particles splatted directly at the screen's
+ * pixels (the independent reference) about as well as the one with every texel wanted. */
+static void impostor_texels(void)
+{
+    atmos__pcloud pc;
+    memset(&pc, 0, sizeof pc);
+    pc.nfields = 1;
+    const double c1[3] = {0, 2000, -6000};
+    blob(&pc, c1, 200, 300);
+    atmos__pclusters cl;
+    CHECK_OK(atmos__pcloud_cluster(NULL, &pc, 0, &cl));
+    double smin = INFINITY;
+    for (int i = 0; i < pc.n; i++) smin = fmin(smin, pc.s[i]);
+    const double r = cl.radius[0], K = ATMOS__PIMPOSTOR_TEXELS_PER_WIDTH;
+    const int cap = atmos__pimpostor_max_res(r, smin, 512);
+    printf("impostor texels: radius %.0f m, narrowest particle %.0f m: at most %d\n", r, smin, cap);
+    CHECK(cap % 8 == 0 && smin * cap / (2 * r) >= K && smin * (cap - 8) / (2 * r) < K);
+    CHECK(atmos__pimpostor_max_res(r, smin, 16) == 16);       /* never above the scene's limit */
+    CHECK(atmos__pimpostor_max_res(r, 0.0, 512) == 512);      /* no width: the scene's limit */
+    CHECK(atmos__pimpostor_max_res(1.0, 1000.0, 512) == 8);   /* at least 8 */
+    atmos__poptics o;
+    memset(&o, 0, sizeof o);
+    o.nw = 1, o.sigma_ext[0][0] = 1e-11, o.albedo[0][0] = 0.9;
+    float *light = malloc(sizeof(float) * (size_t)pc.n), *order = malloc(sizeof(float) * (size_t)pc.n);
+    double sun[1][3];
+    atmos_direction_from_angles(40, 100, sun[0]);
+    CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun[0], 0, 1.0, light, order));
+    const float *lp[1] = {light}, *op[1] = {order};
+    const double e1[1][ATMOS_MAX_WAVELENGTHS] = {{1.0}};
+    const atmos__plights L = {1, lp, op, sun, e1, NULL, NULL, NULL};
+    /* the eye so near that the cloud wants 4 cap texels across on a 320-pixel frame */
+    enum { S = 320 };
+    const double fov = 60, f = S / (2 * tan(0.5 * fov * 3.141592653589793 / 180)), d = 2 * r * f / (4 * cap);
+    const double eye[3] = {c1[0], c1[1] - 0.3 * d, c1[2] + d * sqrt(1 - 0.09)};
+    atmos_camera_desc cd;
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, eye, &cd);
+    memcpy(cd.look_at, c1, sizeof cd.look_at);
+    cd.fov_deg = fov;
+    atmos_camera cam;
+    CHECK_OK(atmos_camera_init(NULL, &cd, S, S, &cam));
+    CHECK(atmos__pimpostor_res(r, d, f, 512) >= 4 * cap);
+    atmos_image *direct = NULL, *img[2] = {NULL, NULL};
+    CHECK_OK(atmos_image_create(NULL, S, S, 2, &direct));
+    const int rect[4] = {0, 0, S, S}, *idx = cl.idx, nidx = cl.start[1];
+    CHECK_OK(atmos__pcloud_splat(NULL, &pc, &o, &L, idx, nidx, &cam, rect, direct, NULL));
+    double e[2];
+    for (int i = 0; i < 2; i++) {
+        atmos__pimpostor im;
+        memset(&im, 0, sizeof im);
+        const atmos__pimpostor *one = &im;
+        const double *cc = cl.centre[0];
+        CHECK_OK(atmos_image_create(NULL, S, S, 2, &img[i]));
+        CHECK_OK(atmos__pimpostor_make(NULL, &im, &pc, &o, &L, idx, nidx, cl.centre[0], r, eye, i ? 4 * cap : cap));
+        atmos__pimpostor_draw(NULL, 1, &one, &cc, cl.radius, &cam, rect, img[i]);
+        e[i] = rel_rms(img[i], direct);
+        atmos__pimpostor_free(&im);
+    }
+    printf("impostor texels: rel rms against the splats %.4f at %d texels, %.4f at %d\n", e[0], cap, e[1], 4 * cap);
+    CHECK(e[0] < 0.03 && e[0] < e[1] + 0.01);
+    atmos_image_destroy(direct), atmos_image_destroy(img[0]), atmos_image_destroy(img[1]);
     free(light), free(order);
     atmos__pclusters_free(&cl);
     atmos__pcloud_free(&pc);
@@ -378,6 +530,7 @@ int main(void)
     convert();
     generated();
     impostors();
+    impostor_texels();
     light_pass();
     light_groups();
     eye_pass();
