@@ -60,7 +60,8 @@ typedef struct job {
 } job;
 
 /* The object's surface at the eye's ray's hit, lit by the lights and the sky, dimmed on the way
- * to the eye. */
+ * to the eye. Each light's shadow there from its shadow map where the map settles it
+ * (atmos__beams_surface_visible), else (or with beams/exact_shadows) by an exact ray. */
 static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
