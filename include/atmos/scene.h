@@ -152,6 +152,8 @@ typedef struct atmos_scene_beams {
                                  of similar depth; 1 = off (the default) */
     int screen_step;          /* the airlight evaluated every screen_step pixels and interpolated where the lattice's
                                  cells agree, evaluated per pixel elsewhere (docs/beams.md); 1 = every pixel */
+    int exact_shadows;        /* 1: the surfaces' shadows of the lights by an exact ray per pixel and light; 0 (the
+                                 default): from the lights' shadow maps where they settle it, rays elsewhere */
 } atmos_scene_beams;
 
 /* Lights besides the sun ("lights" in the file; the beam renderer's). */

@@ -80,6 +80,12 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
 void atmos__beams_shadow_free(atmos__beams_light *l);
 /* H: the share of the light reaching p past the meshes, in [0, 1] (2x2 filtered). */
 double atmos__beams_visibility(const atmos__beams_light *l, const double p[3]);
+/* Whether the light's shadow map settles the surface point p (cos_n: the cosine between its
+ * normal and the direction toward the light): 1 lit, 0 in shadow, -1 when it cannot tell (an
+ * exact shadow ray is needed). The 3 x 3 texels round p's are compared with p's depth less a
+ * bias that grows with the texels' size and the slope of the surface seen from the light: lit
+ * when none of them holds a nearer surface, dark when all do (docs/beams.md *Surfaces' shadows*). */
+int atmos__beams_surface_visible(const atmos__beams_light *l, const double p[3], double cos_n);
 
 /* One ray's view of one light, for the sub-planes: the point o + t d relative to the light,
  * its depth along the spot's axis and its coordinates in each shadow face, all linear in t
@@ -122,6 +128,7 @@ struct atmos__beams_plan {
     atmos__beams_fog fog;                    /* the fog along rays (beams_sun.h) */
     atmos__fog_optics optics;                /* the fog's coefficients and phase function */
     int sun_on;                              /* the sun lights the scene (beams/sun) */
+    int exact_shadows;                       /* surfaces' shadows of the lights by exact rays alone */
     atmos__beams_sun sun;                    /* its map, built for the last frame's sun (sun.dir) */
     atmos__beams_sky sky;                    /* the sky's light on the objects, kept between frames */
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */

@@ -72,6 +72,7 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
         b->fog = f;
     }
     b->sun_on = s->beams.sun;
+    b->exact_shadows = s->beams.exact_shadows;
     if (st != ATMOS_OK) {
         atmos__beams_plan_destroy(b);
         return st;

@@ -60,7 +60,8 @@ typedef struct job {
 } job;
 
 /* The object's surface at the eye's ray's hit, lit by the lights and the sky, dimmed on the way
- * to the eye. */
+ * to the eye. Each light's shadow there from its shadow map where the map settles it
+ * (atmos__beams_surface_visible), else (or with beams/exact_shadows) by an exact ray. */
 static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
@@ -76,7 +77,8 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
         const double c = atmos__dot3(h->normal, w), fall = atmos__lamp_falloff(&l->L, P);
         if (c <= 0 || fall <= 0) continue;
         const double o[3] = {P[0] + off * h->normal[0], P[1] + off * h->normal[1], P[2] + off * h->normal[2]};
-        if (atmos__objects_hit(&b->obj, o, w, 0, r - off, NULL, NULL)) continue;
+        const int lit = b->exact_shadows ? -1 : atmos__beams_surface_visible(l, P, c); /* the map, or an exact ray */
+        if (lit == 0 || (lit < 0 && atmos__objects_hit(&b->obj, o, w, 0, r - off, NULL, NULL))) continue;
         const double e = fall * c / (r * r) * exp(-b->sigma_t * r);
         double tint[3];
         atmos__lamp_tint(&l->L, P, tint);

@@ -324,3 +324,34 @@ double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, do
     const int mid = s0 + (s1 - s0) / 2;
     return atmos__beams_ray_light_sum(r, ta, step, o, s0, mid) + atmos__beams_ray_light_sum(r, ta, step, o, mid, s1);
 }
+
+/* The texels' size relative to the depth and the slope: a plane through p with normal cosine
+ * cos_n toward the light is seen, through a direction d texels (of angular size a) off p's, at
+ * a depth differing from p's by about d a z / (cos_n r) (r the distance, z the depth): the 3 x 3
+ * texels lie within 1.5 sqrt 2 texels, taken twice over, plus the floats' rounding. Beyond a
+ * bias of a fifth of the depth (a surface seen edge-on) the map cannot tell. */
+#define SURFACE_BIAS_TEXELS 4.3
+#define SURFACE_BIAS_MAX 0.2
+
+int atmos__beams_surface_visible(const atmos__beams_light *l, const double p[3], double cos_n)
+{
+    if (!l->nfaces) return 1;
+    const double d[3] = {p[0] - l->L.pos[0], p[1] - l->L.pos[1], p[2] - l->L.pos[2]};
+    const atmos__beams_face *F = &l->face[l->nfaces == 6 ? cube_face(d) : 0];
+    const double z = atmos__dot3(d, F->fwd), r = sqrt(atmos__dot3(d, d));
+    if (!(z > NEAR_M) || !(cos_n > 0)) return -1;
+    const int n = F->n;
+    const double k = 0.5 * n / (z * F->tan_half);
+    const double fx = 0.5 * n + atmos__dot3(d, F->right) * k - 0.5, fy = 0.5 * n + atmos__dot3(d, F->up) * k - 0.5;
+    if (!(fx >= 1 && fx < n - 2 && fy >= 1 && fy < n - 2)) return -1; /* its ring beside the map */
+    const int cx = (int)(fx + 0.5), cy = (int)(fy + 0.5);
+    const double rel = SURFACE_BIAS_TEXELS * (2 * F->tan_half / n) * z / (cos_n * r) + 1e-5;
+    if (rel > SURFACE_BIAS_MAX) return -1;
+    const double zb = z * (1 - rel);
+    int nearer = 0;
+    for (int y = cy - 1; y <= cy + 1; y++) {
+        const float *row = F->depth + (size_t)y * n;
+        for (int x = cx - 1; x <= cx + 1; x++) nearer += row[x] < zb;
+    }
+    return nearer == 0 ? 1 : nearer == 9 ? 0 : -1;
+}

@@ -142,6 +142,10 @@ static const atmos_setting beams_settings[] = {
      "the airlight evaluated every N pixels and interpolated across the cells whose corners agree, per pixel "
      "elsewhere (1: every pixel; with interleave 1)",
      BEAMS(screen_step)},
+    {"exact_shadows", "exact-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "the surfaces' shadows of the lights by an exact ray per pixel and light (off: from the shadow maps where "
+     "they settle it)",
+     BEAMS(exact_shadows)},
 };
 
 const atmos_setting *atmos_renderer_settings(atmos_renderer_kind renderer, int *count)

@@ -79,6 +79,7 @@ cat >"$T/table" <<'EOF'
 --beams-sun|beams.sun=true|beams|
 --interleave 2|beams.interleave=2|beams|
 --screen-step 1|beams.screen_step=1|beams|
+--exact-shadows|beams.exact_shadows=true|beams|same
 EOF
 
 # Every renderer option of --help is in the table.
