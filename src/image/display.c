@@ -6,7 +6,12 @@
 #include "core/internal.h"
 #include "image/display_internal.h"
 
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
+#if defined(__SSE__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+#include <xmmintrin.h>
+#endif
 
 /* One row: spectral pixels src (C channels, n radiance + alpha or not) to linear sRGB + alpha
  * in lin (4 channels), as atmos_image_to_srgb_into does, then gamut mapped. */
@@ -25,6 +30,20 @@ static void linear_row(const float *src, int width, int C, int n, int has_alpha,
         o[3] = has_alpha ? s[n] : 1.0f;
         if (r < 0 || g < 0 || b < 0) atmos__gamut_pixel(o);
     }
+}
+
+/* Row src of width 4-channel pixels to dst, past the cache where the target has streaming
+ * stores (the frame's display values are not read again while it is made: a plain store would
+ * first read each line of dst from memory). */
+static void stream_row(const float *src, float *dst, int width)
+{
+#if defined(__SSE__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+    if (((uintptr_t)dst & 15) == 0) {
+        for (int x = 0; x < width; x++) _mm_stream_ps(dst + 4 * x, _mm_loadu_ps(src + 4 * x));
+        return;
+    }
+#endif
+    memcpy(dst, src, sizeof(float) * 4 * (size_t)width);
 }
 
 /* Display values [0, 1] to 8-bit RGBA as atmos_write_png rounds them, alpha 255. */
@@ -70,11 +89,15 @@ atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spe
 #pragma omp for schedule(static)
         for (int y = 0; y < spectral->height; y++) {
             if (!buf) continue;
-            float *out = disp ? disp->pixels + (size_t)y * W * 4 : buf + (size_t)4 * W;
+            float *out = buf + (size_t)4 * W;
             linear_row(spectral->pixels + (size_t)y * W * C, W, C, n, has_alpha, (const float(*)[3])w, buf);
             atmos__tonemap_row(curve, buf, out, (size_t)W, 4, scale);
+            if (disp) stream_row(out, disp->pixels + (size_t)y * W * 4, W);
             if (rgba8) bytes_row(out, W, rgba8 + (size_t)y * W * 4);
         }
+#if defined(__SSE__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+        _mm_sfence(); /* the streamed rows visible before the barrier closing the region */
+#endif
         free(buf);
     }
     return nomem ? atmos__error(ctx, ATMOS_E_NOMEM, "display: out of memory") : ATMOS_OK;

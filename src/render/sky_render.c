@@ -282,6 +282,7 @@ typedef struct coarse {
     int step, nx, ny, *cx, *cy;  /* the grid's columns and rows (pixel indices) */
     float *val;                  /* [ny nx n] */
     unsigned char *flags, *fine; /* [ny nx]: the node's eval_cols flags; cell (j, i) evaluated pixel by pixel */
+    unsigned char *bent;         /* [ny nx]: the node's bends, found once for the four cells about it */
 } coarse;
 
 /* Whether the sky bends too much about node (j, i) for a bilinear read: its second differences
@@ -301,15 +302,13 @@ static int bends(const coarse *g, int n, int j, int i)
 
 /* Whether cell (j, i) must be evaluated pixel by pixel: the horizon crosses it, the sky bends
  * at its corners, the sun is near, or it is the last row or column's narrower cell. */
-static int cell_fine(const sky_job *job, const coarse *g, int j, int i)
+static int cell_fine(const coarse *g, int j, int i)
 {
     const int c[4] = {j * g->nx + i, j * g->nx + i + 1, (j + 1) * g->nx + i, (j + 1) * g->nx + i + 1};
     if (g->cx[i + 1] - g->cx[i] != g->step || g->cy[j + 1] - g->cy[j] != g->step) return 1;
     for (int q = 0; q < 4; q++)
         if (g->flags[c[q]] != (g->flags[c[0]] & 1)) return 1; /* the horizon between them, or the sun near */
-    for (int q = 0; q < 4; q++)
-        if (bends(g, job->n, c[q] / g->nx, c[q] % g->nx)) return 1;
-    return 0;
+    return g->bent[c[0]] | g->bent[c[1]] | g->bent[c[2]] | g->bent[c[3]];
 }
 
 /* Row y from the grid: cells read bilinearly, fine cells' pixels evaluated. */
@@ -363,14 +362,14 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
 {
     const int F = v->sky_step, n = job->n, count = r->x1 - r->x0, rows = r->y1 - r->y0, C = out->channels;
     if (count < 2 || rows < 2) return 1;
-    coarse g = {F, (count - 2 + F) / F + 1, (rows - 2 + F) / F + 1, NULL, NULL, NULL, NULL, NULL};
+    coarse g = {F, (count - 2 + F) / F + 1, (rows - 2 + F) / F + 1, NULL, NULL, NULL, NULL, NULL, NULL};
     g.cx = malloc(sizeof(int) * (size_t)(g.nx + g.ny)), g.cy = g.cx ? g.cx + g.nx : NULL;
-    g.val = malloc(sizeof(float) * (size_t)g.nx * g.ny * n), g.flags = malloc(2 * (size_t)g.nx * g.ny);
+    g.val = malloc(sizeof(float) * (size_t)g.nx * g.ny * n), g.flags = malloc(3 * (size_t)g.nx * g.ny);
     if (!g.cx || !g.val || !g.flags) {
         free(g.cx), free(g.val), free(g.flags);
         return *nomem = 1, 0;
     }
-    g.fine = g.flags + (size_t)g.nx * g.ny;
+    g.fine = g.flags + (size_t)g.nx * g.ny, g.bent = g.fine + (size_t)g.nx * g.ny;
     for (int i = 0; i < g.nx; i++) g.cx[i] = r->x0 + i * F < r->x1 - 1 ? r->x0 + i * F : r->x1 - 1;
     for (int j = 0; j < g.ny; j++) g.cy[j] = r->y0 + j * F < r->y1 - 1 ? r->y0 + j * F : r->y1 - 1;
     const double cos_near = cos(job->sun_radius + (2.5 + 1.5 * F) * pixel_footprint(&v->cam));
@@ -394,8 +393,11 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
             if (mem && xs) eval_cols(job, batch, g.cy[j], g.cx, g.nx, &rb, g.val + (size_t)j * g.nx * n, g.flags + (size_t)j * g.nx,
                           cos_near);
 #pragma omp for schedule(static)
+        for (int j = 0; j < g.ny; j++)
+            for (int i = 0; i < g.nx; i++) g.bent[j * g.nx + i] = (unsigned char)bends(&g, n, j, i);
+#pragma omp for schedule(static)
         for (int j = 0; j < g.ny - 1; j++)
-            for (int i = 0; i < g.nx - 1; i++) g.fine[j * g.nx + i] = (unsigned char)cell_fine(job, &g, j, i);
+            for (int i = 0; i < g.nx - 1; i++) g.fine[j * g.nx + i] = (unsigned char)cell_fine(&g, j, i);
 #pragma omp for schedule(dynamic, 1)
         for (int b = 0; b < nbands; b++)
             for (int y = r->y0 + b * band; mem && xs && y < r->y1 && y < r->y0 + (b + 1) * band; y++)
