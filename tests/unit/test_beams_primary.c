@@ -10,18 +10,15 @@
 #include "atmos/atmos.h"
 #include "render/beams_primary.h"
 #include "test.h"
+#include "test_mesh.h"
 
 static atmos_context *ctx;
 
 static atmos_mesh *placed(const char *source, double x, double y, double z, double sx, double sy, double sz, double ry)
 {
     atmos_mesh *m = NULL;
-    atmos_mesh_transform t;
-    atmos_mesh_transform_identity(&t);
-    t.position_m[0] = x, t.position_m[1] = y, t.position_m[2] = z;
-    t.scale[0] = sx, t.scale[1] = sy, t.scale[2] = sz, t.rotation_deg[1] = ry;
-    if (atmos_mesh_load(ctx, source, 0, &m) != ATMOS_OK || atmos_mesh_apply_transform(ctx, m, &t) != ATMOS_OK) exit(1);
-    return m;
+    if (atmos_mesh_load(ctx, source, 0, &m) != ATMOS_OK) exit(1);
+    return test_mesh_place(ctx, m, x, y, z, sx, sy, sz, ry);
 }
 
 static atmos_camera camera(atmos_camera_type type, const double eye[3], const double at[3], double fov, int w, int h)

@@ -10,16 +10,13 @@
 #include "atmos/atmos.h"
 #include "render/beams_sun.h"
 #include "test.h"
+#include "test_mesh.h"
 
 static atmos_context *ctx;
 
 static atmos_mesh *placed(atmos_mesh *m, double x, double y, double z, double sx, double sy, double sz)
 {
-    atmos_mesh_transform t;
-    atmos_mesh_transform_identity(&t);
-    t.position_m[0] = x, t.position_m[1] = y, t.position_m[2] = z, t.scale[0] = sx, t.scale[1] = sy, t.scale[2] = sz;
-    CHECK_OK(atmos_mesh_apply_transform(ctx, m, &t));
-    return m;
+    return test_mesh_place(ctx, m, x, y, z, sx, sy, sz, 0);
 }
 
 static int blocked(atmos_mesh *const *mesh, int n, const double o[3], const double d[3])

@@ -319,6 +319,28 @@ static void texel_box_edge(atmos__pimpostor *im, const double *c, const double *
     atmos_image_destroy(boxed), atmos_image_destroy(drawn);
 }
 
+/* The impostor tests' light: one sun (40 degrees up, azimuth 100) on pc's particles, grey
+ * droplets of albedo 0.9, its light pass made; L points into the struct (sunlit_free after). */
+typedef struct sunlit {
+    atmos__poptics o;
+    float *light, *order;
+    const float *lp[1], *op[1];
+    double sun[1][3], e1[1][ATMOS_MAX_WAVELENGTHS];
+    atmos__plights L;
+} sunlit;
+
+static void sunlit_make(sunlit *s, const atmos__pcloud *pc)
+{
+    memset(s, 0, sizeof *s);
+    s->o.nw = 1, s->o.sigma_ext[0][0] = 1e-11, s->o.albedo[0][0] = 0.9;
+    s->light = malloc(sizeof(float) * (size_t)pc->n), s->order = malloc(sizeof(float) * (size_t)pc->n);
+    atmos_direction_from_angles(40, 100, s->sun[0]);
+    CHECK_OK(atmos__pcloud_shade(NULL, pc, NULL, 0, &s->o, s->sun[0], 0, 1.0, s->light, s->order));
+    s->lp[0] = s->light, s->op[0] = s->order, s->e1[0][0] = 1.0;
+    const atmos__plights L = {1, s->lp, s->op, s->sun, s->e1, NULL, NULL, NULL};
+    s->L = L;
+}
+
 /* Clouds found as connected particles; an impostor drawn from where it was made matches the
  * particles splatted directly (within its resampling), drifts as the eye moves round the
  * cloud, and stops serving beyond the tolerance angle, inside the cloud or when too coarse. */
@@ -333,16 +355,10 @@ static void impostors(void)
     CHECK_OK(atmos__pcloud_cluster(NULL, &pc, 0, &cl));
     CHECK(cl.n == 2);
     CHECK(cl.n == 2 && cl.start[1] == 200 && cl.idx[0] == 0 && cl.idx[200] == 200);
-    atmos__poptics o;
-    memset(&o, 0, sizeof o);
-    o.nw = 1, o.sigma_ext[0][0] = 1e-11, o.albedo[0][0] = 0.9;
-    float *light = malloc(sizeof(float) * (size_t)pc.n), *order = malloc(sizeof(float) * (size_t)pc.n);
-    double sun[1][3];
-    atmos_direction_from_angles(40, 100, sun[0]);
-    CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun[0], 0, 1.0, light, order));
-    const float *lp[1] = {light}, *op[1] = {order};
-    const double e1[1][ATMOS_MAX_WAVELENGTHS] = {{1.0}};
-    const atmos__plights L = {1, lp, op, sun, e1, NULL, NULL, NULL};
+    sunlit sl;
+    sunlit_make(&sl, &pc);
+    const atmos__poptics o = sl.o;
+    const atmos__plights L = sl.L;
     atmos_camera_desc cd;
     const double eye[3] = {0, 1800, 0};
     atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, eye, &cd);
@@ -400,7 +416,7 @@ static void impostors(void)
     CHECK(isinf(atmos__pimpostor_error(&never, cl.centre[0], cl.radius[0], eye, 0.15 * deg, f, 512)));
     atmos__pimpostor_free(&im);
     atmos_image_destroy(direct), atmos_image_destroy(imp);
-    free(light), free(order);
+    free(sl.light), free(sl.order);
     atmos__pclusters_free(&cl);
     atmos__pcloud_free(&pc);
 }
@@ -428,16 +444,10 @@ static void impostor_texels(void)
     CHECK(atmos__pimpostor_max_res(r, smin, 16) == 16);       /* never above the scene's limit */
     CHECK(atmos__pimpostor_max_res(r, 0.0, 512) == 512);      /* no width: the scene's limit */
     CHECK(atmos__pimpostor_max_res(1.0, 1000.0, 512) == 8);   /* at least 8 */
-    atmos__poptics o;
-    memset(&o, 0, sizeof o);
-    o.nw = 1, o.sigma_ext[0][0] = 1e-11, o.albedo[0][0] = 0.9;
-    float *light = malloc(sizeof(float) * (size_t)pc.n), *order = malloc(sizeof(float) * (size_t)pc.n);
-    double sun[1][3];
-    atmos_direction_from_angles(40, 100, sun[0]);
-    CHECK_OK(atmos__pcloud_shade(NULL, &pc, NULL, 0, &o, sun[0], 0, 1.0, light, order));
-    const float *lp[1] = {light}, *op[1] = {order};
-    const double e1[1][ATMOS_MAX_WAVELENGTHS] = {{1.0}};
-    const atmos__plights L = {1, lp, op, sun, e1, NULL, NULL, NULL};
+    sunlit sl;
+    sunlit_make(&sl, &pc);
+    const atmos__poptics o = sl.o;
+    const atmos__plights L = sl.L;
     /* the eye so near that the cloud wants 4 cap texels across on a 320-pixel frame */
     enum { S = 320 };
     const double fov = 60, f = S / (2 * tan(0.5 * fov * 3.141592653589793 / 180)), d = 2 * r * f / (4 * cap);
@@ -468,7 +478,7 @@ static void impostor_texels(void)
     printf("impostor texels: rel rms against the splats %.4f at %d texels, %.4f at %d\n", e[0], cap, e[1], 4 * cap);
     CHECK(e[0] < 0.03 && e[0] < e[1] + 0.01);
     atmos_image_destroy(direct), atmos_image_destroy(img[0]), atmos_image_destroy(img[1]);
-    free(light), free(order);
+    free(sl.light), free(sl.order);
     atmos__pclusters_free(&cl);
     atmos__pcloud_free(&pc);
 }
