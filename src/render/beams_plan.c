@@ -95,7 +95,10 @@ void atmos__beams_describe(const atmos_plan *p, char *buf, size_t cap)
     const atmos__beams_plan *b = p->beams;
     const atmos_scene_beams *s = &p->scene.beams;
     snprintf(buf, cap, "%d lights, %d objects, fog %g/m; plane spacing %g m (0: auto), epsilon %g, at most %d sub-planes, "
-             "shadow maps %d, screen step %d; centre ray: %d main planes, %d sub-planes; airlight evaluated at %ld of %ld pixels",
+             "shadow maps %d, screen step %d%s, %s shadows on surfaces; centre ray: %d main planes, %d sub-planes; "
+             "airlight evaluated at %ld of %ld pixels",
              b->nlights, b->obj.n, b->sigma_t, s->plane_spacing_m, s->epsilon, s->max_subplanes, s->shadow_size,
-             s->screen_step, b->centre_planes, b->centre_subplanes, b->air_evaluated, b->air_pixels);
+             s->interleave > 1 ? 1 : s->screen_step, s->interleave > 1 && s->screen_step > 1 ? " (interleaved: not subsampled)" : "",
+             s->exact_shadows ? "exact" : "map-decided", b->centre_planes, b->centre_subplanes, b->air_evaluated,
+             b->air_pixels);
 }

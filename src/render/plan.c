@@ -385,7 +385,7 @@ static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const at
 
 static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, atmos_image *out)
 {
-    static const char *const names[] = {"sky (analytic single scattering of the atmosphere)",
+    static const char *const names[] = {"sky (the atmosphere model alone: atmos:atmosphere)",
                                         "slice (Riley et al. 2004, half-angle slicing)",
                                         "path (spectral Monte Carlo volumetric path tracing)",
                                         "nishita (Nishita et al. 1996, orders 1-3 and sky light by a light field)",
@@ -398,6 +398,9 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
     atmos_image_set_meta(out, "atmos:version", atmos_version());
     atmos_image_set_meta(out, "atmos:scene", p->scene.name);
     atmos_image_set_meta(out, "atmos:renderer", names[p->renderer]);
+    static const char *const airs[] = {"riley", "vacuum", "homogeneous", "dobashi", "spherical"};
+    const unsigned kind = (unsigned)p->scene.atmosphere.kind;
+    atmos_image_set_meta(out, "atmos:atmosphere", kind < 5u ? airs[kind] : "?");
     snprintf(buf, sizeof buf, "%.6f", el);
     atmos_image_set_meta(out, "atmos:sun_elevation_deg", buf);
     snprintf(buf, sizeof buf, "%.6f", az);

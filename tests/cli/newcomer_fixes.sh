@@ -217,5 +217,11 @@ hasnt "spherical from 400 km" "flat earth"
 "$A" render --atmosphere fog --width 8 --height 6 -o "$T/f.png" -q 2>"$T/err"
 [ $? -eq 2 ] && ok "--atmosphere fog: a usage error" || bad "--atmosphere fog: not a usage error"
 has "--atmosphere fog" "dobashi"
+# --thickness goes with the homogeneous layer; with another model it would do nothing
+"$A" render --atmosphere spherical --thickness 200 --width 8 --height 6 -o "$T/f.png" -q 2>"$T/err"
+[ $? -eq 2 ] && ok "--thickness with spherical: a usage error" || bad "--thickness with spherical: not a usage error"
+has "--thickness with spherical" "homogeneous"
+"$A" render --atmosphere homogeneous --thickness 200 --width 8 --height 6 -o "$T/f.png" -q 2>"$T/err" \
+    && ok "--thickness with homogeneous" || bad "--thickness with homogeneous: $(cat "$T/err")"
 
 exit $fail

@@ -78,7 +78,8 @@ echo "$out" | grep -q '"nonfinite": 0[,}]' && ok || bad "--exr-half wrote non-fi
 exr_header "$T/v.exr" > "$T/vh" || bad "variance EXR unreadable"
 grep -q "^channels chlist var_440.0nm,var_550.0nm,var_680.0nm,var_Y$" "$T/vh" && ok || bad "variance channels: $(grep chlist "$T/vh")"
 for key in "atmos:scene string" "atmos:renderer string path" "atmos:sun_elevation_deg double 22.0" \
-    "atmos:sun_azimuth_deg double 235.0" "atmos:threads int" "atmos:version string" "atmos:wavelengths_nm string 680.0 550.0 440.0"; do
+    "atmos:sun_azimuth_deg double 235.0" "atmos:threads int" "atmos:version string" "atmos:wavelengths_nm string 680.0 550.0 440.0" \
+    "atmos:atmosphere string"; do
     grep -q "^$key" "$T/vh" && ok || bad "variance EXR lacks '$key'"
 done
 for f in o.exr f.exr h.exr p.exr v.exr; do

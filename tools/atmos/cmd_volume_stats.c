@@ -223,8 +223,10 @@ static void print_fit(const opts *o, const atmos_cloud_fit *f, int sources, doub
                o->sd.fit_min_pixels > 0 ? o->sd.fit_min_pixels : 10);
         return;
     }
-    printf("  perimeter-area dimension D = %.3f +- %.3f (crack perimeter %.3f +- %.3f) over %d clouds of %.3g..%.3g km^2\n",
-           f->d, f->d_se, f->d_crack, f->d_crack_se, f->fitted, f->fit_area_min_m2 * 1e-6, f->fit_area_max_m2 * 1e-6);
+    printf("  perimeter-area dimension D = %.3f +- %.3f (crack perimeter %.3f +- %.3f) over %d clouds of %.3g..%.3g km^2 "
+           "(the %d of at least %g pixels away from the edge)\n",
+           f->d, f->d_se, f->d_crack, f->d_crack_se, f->fitted, f->fit_area_min_m2 * 1e-6, f->fit_area_max_m2 * 1e-6,
+           f->fitted, o->sd.fit_min_pixels > 0 ? o->sd.fit_min_pixels : 10);
     printf("  size distribution n(d) ~ d^-b: b = %.2f +- %.2f (max. likelihood), %.2f +- %.2f (histogram) over %d clouds of "
            "%.0f..%.0f m\n",
            f->size_slope, f->size_slope_se, f->size_slope_hist, f->size_slope_hist_se, f->size_n, f->size_min_m, f->size_max_m);

@@ -500,6 +500,9 @@ static int apply_view(const render_opts *o, atmos_scene *s)
     static const atmos_atmosphere_kind kinds[] = {ATMOS_ATMOSPHERE_RILEY, ATMOS_ATMOSPHERE_HOMOGENEOUS,
                                                   ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL};
     if (o->air >= 0 && s->atmosphere.kind != ATMOS_ATMOSPHERE_VACUUM) s->atmosphere.kind = kinds[o->air];
+    if (o->thickness > 0 && s->atmosphere.kind != ATMOS_ATMOSPHERE_HOMOGENEOUS)
+        return cli_usage_error(C, "--thickness goes with the homogeneous atmosphere (the model here is %s)",
+                               cli_sky_model_name(s->atmosphere.kind));
     if (o->thickness > 0) s->atmosphere.thickness_m = o->thickness;
     return CLI_EXIT_OK;
 }
@@ -749,8 +752,10 @@ void render_opts_help(void)
            "      --atmosphere MODEL        the air, in place of the scene's: riley (Riley et al.'s\n"
            "                                exponential atmosphere over a flat earth), homogeneous (a uniform\n"
            "                                layer up to --thickness; docs/models.md), dobashi or spherical (a\n"
-           "                                spherical earth with aerosols and ozone; docs/sky.md)\n"
-           "      --thickness M             the homogeneous layer's top, metres (default 8000)\n\n");
+           "                                spherical earth with aerosols and ozone; docs/sky.md); a scene in\n"
+           "                                a vacuum (\"background\") keeps its vacuum\n"
+           "      --thickness M             the homogeneous layer's top, metres (default 8000); goes with\n"
+           "                                the homogeneous atmosphere (with another, a usage error)\n\n");
     printf("One rule for every renderer: an option of another renderer than the one rendering is refused\n"
            "(exit 2, naming the renderer it goes with); --spp is the one option all renderers share. A scene\n"
            "file may keep a section for each renderer (\"slice\", \"path\", \"nishita\", \"harris\", \"beams\":\n"
