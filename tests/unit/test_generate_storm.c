@@ -2,7 +2,8 @@
  * flat base, an anvil that is a thin flat sheet at the tropopause spreading downwind,
  * optically thinner than the tower, with an overshooting top; rain that starts at the cloud
  * base, has no walls and drifts downwind; virga that is gone before the ground. Coarse
- * voxels keep it fast; the thresholds are physical claims, not snapshots. */
+ * voxels keep it fast; the thresholds are physical claims, not snapshots. Also: these and the
+ * cumulus field the same voxels for any thread count, another for another seed. */
 #include "atmos/atmos.h"
 #include "test.h"
 #include "volume/volume_grid.h"
@@ -195,9 +196,9 @@ static void check_rain(atmos_context *ctx, const char *preset, double voxel, dou
 static void test_determinism(void)
 {
     atmos_context *c1 = test_context(1, NULL), *c3 = test_context(3, NULL);
-    static const char *presets[] = {"storm", "virga"};
-    static const double voxels[] = {200, 80};
-    for (int p = 0; p < 2; p++) {
+    static const char *presets[] = {"storm", "virga", "cumulus_field"};
+    static const double voxels[] = {200, 80, 80};
+    for (int p = 0; p < 3; p++) {
         atmos_volume *a = test_generate(c1, presets[p], 7, voxels[p]), *b = test_generate(c3, presets[p], 7, voxels[p]);
         atmos_volume *c = test_generate(c3, presets[p], 8, voxels[p]);
         if (a && b && c) {
