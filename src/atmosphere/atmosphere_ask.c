@@ -148,6 +148,27 @@ static void planet_radiance(const atmos_atmosphere *atm, const double p[3], cons
     if (info) *info = h;
 }
 
+void atmos__atm_ground_sunlit(const atmos_atmosphere *atm, const double p[3], const double dir[3], double K,
+                              const double sun_dir[3], double *out)
+{
+    const int n = atm->wl.count;
+    for (int i = 0; i < n; i++) out[i] = 0.0;
+    if (!(K < INFINITY)) return;
+    if (atm->solver) {
+        atmos__planet_ground_sunlit(atm, p, dir, K, sun_dir, 0, out);
+        return;
+    }
+    /* the flat ground (y = 0), Lambertian, lit by the attenuated sun, seen through the air
+     * between it and the eye */
+    const double ly = sun_dir[1], albedo = atmos_atmosphere_ground_albedo(atm);
+    if (!(ly > 0 && albedo > 0)) return;
+    const double g[3] = {p[0] + K * dir[0], 0.0, p[2] + K * dir[2]};
+    double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    atmos_atmosphere_sunlight(atm, g, sun_dir, E);
+    atmos_atmosphere_transmittance(atm, p, dir, K, T);
+    for (int i = 0; i < n; i++) out[i] = albedo / ATMOS_PI * ly * E[i] * T[i];
+}
+
 /* What a view ray sees; the sun's disk only with disk. */
 static void radiance(const atmos_atmosphere *atm, const double p[3], const double dir[3], const double sun_dir[3],
                      int disk, double *out, atmos_atmosphere_hit *info)
@@ -163,15 +184,8 @@ static void radiance(const atmos_atmosphere *atm, const double p[3], const doubl
     double tmp[ATMOS_MAX_WAVELENGTHS], sun[ATMOS_MAX_WAVELENGTHS];
     int in_disk = 0;
     if (ground) {
-        /* Lambertian ground lit by the attenuated sun, seen through the air between it and
-         * the eye. */
-        const double ly = sun_dir[1], albedo = atmos_atmosphere_ground_albedo(atm);
-        if (ly > 0 && albedo > 0) {
-            const double g[3] = {p[0] + K * dir[0], 0.0, p[2] + K * dir[2]};
-            atmos_atmosphere_sunlight(atm, g, sun_dir, sun);
-            atmos_atmosphere_transmittance(atm, p, dir, K, tmp);
-            for (int i = 0; i < n; i++) out[i] += albedo / ATMOS_PI * ly * sun[i] * tmp[i];
-        }
+        atmos__atm_ground_sunlit(atm, p, dir, K, sun_dir, tmp);
+        for (int i = 0; i < n; i++) out[i] += tmp[i];
     } else if (atm->desc.kind == ATMOS_ATMOSPHERE_VACUUM) {
         for (int i = 0; i < n; i++) out[i] += atm->desc.background_radiance;
     } else if (disk && !atm->desc.hide_sun_disk) {

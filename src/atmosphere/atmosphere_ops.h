@@ -34,6 +34,13 @@ int atmos__atm_scatter_point(const atmos_atmosphere *a, const double p[3], const
  * ground's outward normal there. */
 void atmos__atm_ground_hit(const atmos_atmosphere *a, double p[3], double n[3]);
 
+/* The ground at distance K along dir from p (K infinite: none) lit by the attenuated sun,
+ * seen through the air between: the part of atmos_atmosphere_radiance's ground that a shadow
+ * between the ground and the sun takes (albedo / pi cos E T, without the sky's light or a
+ * planet's night lights and cloud spheres). */
+void atmos__atm_ground_sunlit(const atmos_atmosphere *atm, const double p[3], const double dir[3], double K,
+                              const double sun_dir[3], double *out);
+
 /* The extraterrestrial solar irradiance per wavelength of the set (W m^-2 nm^-1) and the
  * cosine of the sun's angular radius. */
 const double *atmos__atm_sun_irradiance(const atmos_atmosphere *a);

@@ -61,6 +61,23 @@ atmos_status atmos__planet_table_image(atmos_context *ctx, const float *src, int
     return st;
 }
 
+void atmos__planet_ground_sunlit(const atmos_atmosphere *a, const double p[3], const double d[3], double K,
+                                 const double sun[3], int lights, double *out)
+{
+    const atmos__planet *pl = a->planet;
+    const int n = a->wl.count;
+    double g[3] = {p[0] + K * d[0], p[1] + K * d[1], p[2] + K * d[2]}, nrm[3];
+    atmos__planet_ground_point(pl, g, nrm);
+    const double cs = fmax(atmos__dot3(nrm, sun), 0.0);
+    double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    a->solver->transmittance(a, p, d, K, n, NULL, T);
+    if (cs > 0) a->solver->sunlight(a, g, sun, n, NULL, E);
+    for (int i = 0; i < n; i++) {
+        const double lit = cs > 0 ? atmos__planet_ground_albedo(pl, g, i) / ATMOS_PI * cs * E[i] : 0.0;
+        out[i] = (lit + (lights ? atmos__planet_ground_lights(pl, g, sun, i) : 0.0)) * T[i];
+    }
+}
+
 void atmos__planet_radiance_generic(const atmos_atmosphere *a, const double p[3], const double d[3],
                                     const double sun[3], double *out, atmos_atmosphere_hit *info)
 {
@@ -71,16 +88,9 @@ void atmos__planet_radiance_generic(const atmos_atmosphere *a, const double p[3]
     if (!a->solver->inscatter(a, p, d, K, sun, n, NULL, out))
         for (int i = 0; i < n; i++) out[i] = 0.0;
     if (ground) {
-        double g[3] = {p[0] + K * d[0], p[1] + K * d[1], p[2] + K * d[2]}, nrm[3];
-        atmos__planet_ground_point(pl, g, nrm);
-        const double cs = fmax(atmos__dot3(nrm, sun), 0.0);
-        double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
-        a->solver->transmittance(a, p, d, K, n, NULL, T);
-        if (cs > 0) a->solver->sunlight(a, g, sun, n, NULL, E);
-        for (int i = 0; i < n; i++) {
-            const double lit = cs > 0 ? atmos__planet_ground_albedo(pl, g, i) / ATMOS_PI * cs * E[i] : 0.0;
-            out[i] += (lit + atmos__planet_ground_lights(pl, g, sun, i)) * T[i];
-        }
+        double G[ATMOS_MAX_WAVELENGTHS];
+        atmos__planet_ground_sunlit(a, p, d, K, sun, 1, G);
+        for (int i = 0; i < n; i++) out[i] += G[i];
     }
     if (info) {
         info->distance_m = K;

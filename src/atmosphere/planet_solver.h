@@ -75,5 +75,9 @@ int atmos__numeric_inscatter(const atmos_atmosphere *a, const double p[3], const
  * the ground or space, plus the ground lit by the attenuated sun), without the disk. */
 void atmos__planet_radiance_generic(const atmos_atmosphere *a, const double p[3], const double d[3],
                                     const double sun[3], double *out, atmos_atmosphere_hit *info);
+/* The ground at distance K along d from p, lit by the attenuated sun (and, with lights, the
+ * night side's lights), seen through the air between: albedo / pi cos E T per wavelength. */
+void atmos__planet_ground_sunlit(const atmos_atmosphere *a, const double p[3], const double d[3], double K,
+                                 const double sun[3], int lights, double *out);
 
 #endif

@@ -244,7 +244,7 @@ typedef struct {
     const sshadow *sh;
     double hc, tfar;
     const sjob *j;
-    double ground_albedo; /* the flat ground's (Riley's, the homogeneous air's); 0: its shadow not drawn */
+    int ground; /* the atmosphere has a ground that the sun lights (not a vacuum) */
 } sframe;
 
 /* Pixel (x, y)'s ray: its world and grid-frame directions, its map ray, its span and the
@@ -260,25 +260,21 @@ static int pixel_span(const sframe *f, int x, int y, double dw[3], double d[3], 
 }
 
 /* The ground's direct sunlight that the volume's shadow takes from a ray (world direction dw)
- * meeting the flat ground at tg: albedo / pi E sun_y T_eye (1 - T_vol), as the sky image lit
- * it (atmos_atmosphere_radiance's flat ground). The planet kinds' ground (curved, with maps)
- * is left lit. */
+ * meeting the ground at tg: (1 - T_vol) times the sunlit ground the sky image holds there
+ * (albedo / pi cos E T_eye, atmos__atm_ground_sunlit: the flat ground or a planet's, with
+ * its maps). */
 static void ground_shadow(const sframe *f, const mray *m, const double dw[3], double tg, const double sun[3], int n,
                           double *G)
 {
     for (int c = 0; c < n; c++) G[c] = 0.0;
-    const double albedo = f->ground_albedo;
-    if (!(albedo > 0) || !(tg < f->tfar) || !(sun[1] > 0)) return;
+    if (!f->ground || !(tg < f->tfar)) return;
     const sshadow *sh = f->sh;
     float q = 0.0f;
     shadow_samples(sh->T, sh->N + 2, sh->D, (float)(m->q0[0] + tg * m->qd[0]), 0.0f, (float)(m->q0[1] + tg * m->qd[1]),
                    0.0f, (float)(m->q0[2] + tg * m->qd[2]), 0.0f, 1, &q);
     if (!(q > 0.0f)) return;
-    const double *e = f->cam->position, g[3] = {e[0] + tg * dw[0], 0.0, e[2] + tg * dw[2]};
-    double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
-    atmos_atmosphere_sunlight(f->atm, g, sun, E);
-    atmos_atmosphere_transmittance(f->atm, e, dw, tg, T);
-    for (int c = 0; c < n; c++) G[c] = q * albedo / ATMOS_PI * sun[1] * E[c] * T[c];
+    atmos__atm_ground_sunlit(f->atm, f->cam->position, dw, tg, sun, G);
+    for (int c = 0; c < n; c++) G[c] *= q;
 }
 
 static double shadow_range(const sgrid *g, const atmos__vol_xform *xf, const atmos_camera *cam, const double sun[3])
@@ -478,10 +474,8 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
         sh->valid = 1;
         sh->build_s = atmos__now() - tb0;
     }
-    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(atm);
-    const int flat = kind == ATMOS_ATMOSPHERE_RILEY || kind == ATMOS_ATMOSPHERE_HOMOGENEOUS;
     sframe f = {atm, &v->cam, &sp->x, sh, atmos__dot3(j->h, cen), shadow_range(g, &sp->x, &v->cam, v->sun), j,
-                flat ? atmos_atmosphere_ground_albedo(atm) : 0.0};
+                atmos_atmosphere_get_kind(atm) != ATMOS_ATMOSPHERE_VACUUM};
     const atmos__aerial *ap = shadow_table(sp, &f, v->sun, threads);
     if (!ap) {
         *secs = atmos__now() - t0;

@@ -11,7 +11,8 @@
  * the sky image exactly, the same as with the slab removed. A pixel looking the other way
  * (away from the shadow) must be unchanged bit for bit, the option off must give the
  * unshadowed sky, and 1 and 2 threads the same bytes. Riley's air and a homogeneous layer.
- * And the ground in the slab's shadow loses the sunlight the slab takes (check_ground). */
+ * And the ground in the slab's shadow loses the sunlight the slab takes (check_ground), the
+ * flat ground's and a planet's. */
 #include "atmos/atmos.h"
 #include "test.h"
 #include "test_optics.h"
@@ -264,5 +265,7 @@ int main(void)
     check_kind(ATMOS_ATMOSPHERE_HOMOGENEOUS, "homogeneous layer");
     check_ground(ATMOS_ATMOSPHERE_RILEY, "Riley");
     check_ground(ATMOS_ATMOSPHERE_HOMOGENEOUS, "homogeneous layer");
+    check_ground(ATMOS_ATMOSPHERE_SPHERICAL, "spherical");
+    check_ground(ATMOS_ATMOSPHERE_DOBASHI, "Dobashi");
     return test_summary("test_slice_shafts");
 }
