@@ -148,25 +148,31 @@ static void planet_radiance(const atmos_atmosphere *atm, const double p[3], cons
     if (info) *info = h;
 }
 
+/* The flat ground (y = 0) at distance K along dir from p, Lambertian, lit by the attenuated
+ * sun and, with sky, by the sky above it (flat_skylight.c), seen through the air between. */
+static void flat_ground(const atmos_atmosphere *atm, const double p[3], const double dir[3], double K,
+                        const double sun_dir[3], int sky, double *out)
+{
+    const int n = atm->wl.count;
+    const double ly = sun_dir[1], albedo = atmos_atmosphere_ground_albedo(atm);
+    for (int i = 0; i < n; i++) out[i] = 0.0;
+    if (!(ly > 0 && albedo > 0)) return;
+    const double g[3] = {p[0] + K * dir[0], 0.0, p[2] + K * dir[2]};
+    double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS], S[ATMOS_MAX_WAVELENGTHS];
+    atmos_atmosphere_sunlight(atm, g, sun_dir, E);
+    atmos_atmosphere_transmittance(atm, p, dir, K, T);
+    atmos__flat_skylight(atm, sky ? ly : 0.0, S);
+    for (int i = 0; i < n; i++) out[i] = albedo / ATMOS_PI * (ly * E[i] + S[i]) * T[i];
+}
+
 void atmos__atm_ground_sunlit(const atmos_atmosphere *atm, const double p[3], const double dir[3], double K,
                               const double sun_dir[3], double *out)
 {
     const int n = atm->wl.count;
     for (int i = 0; i < n; i++) out[i] = 0.0;
     if (!(K < INFINITY)) return;
-    if (atm->solver) {
-        atmos__planet_ground_sunlit(atm, p, dir, K, sun_dir, 0, out);
-        return;
-    }
-    /* the flat ground (y = 0), Lambertian, lit by the attenuated sun, seen through the air
-     * between it and the eye */
-    const double ly = sun_dir[1], albedo = atmos_atmosphere_ground_albedo(atm);
-    if (!(ly > 0 && albedo > 0)) return;
-    const double g[3] = {p[0] + K * dir[0], 0.0, p[2] + K * dir[2]};
-    double E[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
-    atmos_atmosphere_sunlight(atm, g, sun_dir, E);
-    atmos_atmosphere_transmittance(atm, p, dir, K, T);
-    for (int i = 0; i < n; i++) out[i] = albedo / ATMOS_PI * ly * E[i] * T[i];
+    if (atm->solver) atmos__planet_ground_sunlit(atm, p, dir, K, sun_dir, 0, out);
+    else flat_ground(atm, p, dir, K, sun_dir, 0, out);
 }
 
 /* What a view ray sees; the sun's disk only with disk. */
@@ -184,7 +190,7 @@ static void radiance(const atmos_atmosphere *atm, const double p[3], const doubl
     double tmp[ATMOS_MAX_WAVELENGTHS], sun[ATMOS_MAX_WAVELENGTHS];
     int in_disk = 0;
     if (ground) {
-        atmos__atm_ground_sunlit(atm, p, dir, K, sun_dir, tmp);
+        flat_ground(atm, p, dir, K, sun_dir, 1, tmp);
         for (int i = 0; i < n; i++) out[i] += tmp[i];
     } else if (atm->desc.kind == ATMOS_ATMOSPHERE_VACUUM) {
         for (int i = 0; i < n; i++) out[i] += atm->desc.background_radiance;

@@ -177,6 +177,10 @@ atmos_status atmos_atmosphere_create(atmos_context *ctx, const atmos_atmosphere_
         atmos_atmosphere_destroy(a);
         return st;
     }
+    if (!atmos__flat_skylight_build(a)) {
+        atmos_atmosphere_destroy(a);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "atmosphere: out of memory");
+    }
     *out = a;
     return ATMOS_OK;
 }
@@ -188,6 +192,7 @@ void atmos_atmosphere_destroy(atmos_atmosphere *atm)
     atmos__planet_surface_release(atm->planet);
     atmos__planet_clouds_release(atm->planet);
     free(atm->planet);
+    free(atm->sky_ground);
     free(atm);
 }
 atmos_atmosphere_kind atmos_atmosphere_get_kind(const atmos_atmosphere *atm) { return atm->desc.kind; }

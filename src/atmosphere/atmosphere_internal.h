@@ -21,7 +21,16 @@ struct atmos_atmosphere {
     struct atmos__planet *planet;
     const struct atmos__planet_solver *solver;
     void *model;
+    /* RILEY, HOMOGENEOUS with a ground albedo: the sky's irradiance on the ground at
+     * ATMOS__SKYLIGHT_NODES sun heights l_y = j / (nodes - 1), per wavelength (flat_skylight.c) */
+    double *sky_ground;
 };
+
+#define ATMOS__SKYLIGHT_NODES 33
+/* flat_skylight.c: builds a->sky_ground (0: out of memory); the irradiance for the sun at
+ * height l_y (0 when there is no table or the sun is down). */
+int atmos__flat_skylight_build(atmos_atmosphere *a);
+void atmos__flat_skylight(const atmos_atmosphere *a, double ly, double *out);
 
 /* Wavelength i of a subset: k[i], or i itself when k is NULL (the whole set). */
 #define ATMOS__WL(k, i) ((k) ? (k)[i] : (i))

@@ -17,8 +17,9 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, dou
     for (int k = 0; k < 3; k++) b->sun[k] = (float)sun[k];
     b->sun_up = sun[1] > 0;
     b->high = sky->gamma * eye_y > ATMOS__RILEY_HIGH_EYE;
-    double ey = exp(-sky->gamma * eye_y), ground[ATMOS_MAX_WAVELENGTHS];
+    double ey = exp(-sky->gamma * eye_y), ground[ATMOS_MAX_WAVELENGTHS], skyl[ATMOS_MAX_WAVELENGTHS];
     atmos__riley_sunlight(sky, 0.0, sun, b->n, NULL, ground);
+    atmos__flat_skylight(sky, sun[1], skyl);
     for (int i = 0; i < b->n; i++) {
         double be = sky->beta_sl[i] * ey;
         b->beta_eye[i] = (float)be;
@@ -26,7 +27,7 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, dou
         b->ts0[i] = (float)fmin(ts0, 1e30);
         b->e_ts0[i] = (float)exp(-ts0);
         b->sun_e[i] = (float)sky->sun_e[i];
-        b->ground[i] = (float)(sky->desc.ground_albedo / ATMOS_PI * fmax(sun[1], 0.0) * ground[i]);
+        b->ground[i] = (float)(sky->desc.ground_albedo / ATMOS_PI * (fmax(sun[1], 0.0) * ground[i] + skyl[i]));
     }
 }
 

@@ -18,7 +18,7 @@ typedef struct atmos__sky_batch {
     float ts0[ATMOS_MAX_WAVELENGTHS];         /* sun's optical depth at the eye */
     float e_ts0[ATMOS_MAX_WAVELENGTHS];       /* exp(-ts0) */
     float sun_e[ATMOS_MAX_WAVELENGTHS];       /* extraterrestrial irradiance */
-    float ground[ATMOS_MAX_WAVELENGTHS];      /* albedo/pi * l_y * sunlight at y = 0 */
+    float ground[ATMOS_MAX_WAVELENGTHS];      /* albedo/pi * (l_y * sunlight + sky light) at y = 0 */
 } atmos__sky_batch;
 
 void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, double eye_y, const double sun[3]);

@@ -190,7 +190,8 @@ static void test_vacuum(void)
     atmos_atmosphere_destroy(a);
 }
 
-/* What a view ray sees is the in-scatter, plus the lit ground or the disk. */
+/* What a view ray sees is the in-scatter, plus the ground lit by the sun and the sky, or the
+ * disk. */
 static void test_radiance_parts(atmos_atmosphere_kind kind)
 {
     atmos_wavelengths wl;
@@ -207,7 +208,24 @@ static void test_radiance_parts(atmos_atmosphere_kind kind)
     const double g[3] = {p[0] + hit.distance_m * down[0], 0, p[2] + hit.distance_m * down[2]};
     atmos_atmosphere_sunlight(a, g, sun, E);
     atmos_atmosphere_transmittance(a, p, down, hit.distance_m, T);
-    for (int k = 0; k < 3; k++) CHECK_REL(L[k], I[k] + 0.25 / PI * sun[1] * E[k] * T[k], 1e-12);
+    /* the ground lit by the sun and by the sky: the sky's irradiance summed here finely over
+     * the whole upper hemisphere from the kind's own in-scatter */
+    double Es[3] = {0, 0, 0};
+    const double o[3] = {0, 0, 0};
+    for (int i = 0; i < 64; i++)
+        for (int j = 0; j < 128; j++) {
+            const double mu = (i + 0.5) / 64, s = sqrt(1 - mu * mu), phi = (j + 0.5) * 2 * PI / 128;
+            const double d[3] = {s * cos(phi), mu, s * sin(phi)};
+            double Ls[3];
+            atmos_atmosphere_inscatter(a, o, d, INFINITY, sun, Ls);
+            for (int k = 0; k < 3; k++) Es[k] += mu * Ls[k] * (1.0 / 64) * (2 * PI / 128);
+        }
+    for (int k = 0; k < 3; k++) {
+        const double want = I[k] + 0.25 / PI * (sun[1] * E[k] + Es[k]) * T[k];
+        printf("kind %d channel %d: ground %.6g, sun and sky %.6g (%+.4f %%), sky's share %.3f\n", (int)kind, k, L[k],
+               want, 100 * (L[k] / want - 1), Es[k] / (sun[1] * E[k] + Es[k]));
+        CHECK_REL(L[k], want, 2e-3);
+    }
     atmos_atmosphere_radiance(a, p, sun, sun, L, &hit);
     atmos_atmosphere_inscatter(a, p, sun, INFINITY, sun, I);
     atmos_atmosphere_sun_radiance(a, p, sun, S);
