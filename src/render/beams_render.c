@@ -65,7 +65,8 @@ typedef struct job {
 static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
-    double P[3], sum[ATMOS_MAX_WAVELENGTHS] = {0};
+    double P[3], sum[ATMOS_MAX_WAVELENGTHS];
+    for (int k = 0; k < J->nw; k++) sum[k] = 0; /* the wavelengths in use only: not 1 kB a pixel */
     for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
     const double off = 1e-4 * (1 + h->t);
     for (int i = 0; i < b->nlights; i++) {
