@@ -4,6 +4,7 @@
  * lopsided), at most LEAF triangles a leaf. Traversal keeps a stack and visits the nearer
  * child first; triangles are tested by the Moller-Trumbore algorithm (1997) in double. */
 #include "mesh/mesh_internal.h"
+#include "mesh/mesh_walk.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -220,4 +221,35 @@ int atmos_mesh_intersect_triangle(const atmos_mesh *m, int tri, const double o[3
         hit_normal(m, tri, u, v, d, hit->normal);
     }
     return 1;
+}
+
+static double centre_distance2(const node *n, const double eye[3])
+{
+    double s = 0;
+    for (int k = 0; k < 3; k++) {
+        const double c = 0.5 * ((double)n->lo[k] + n->hi[k]) - eye[k];
+        s += c * c;
+    }
+    return s;
+}
+
+void atmos__mesh_walk(const atmos_mesh *m, const double eye[3], atmos__mesh_enter_fn enter, atmos__mesh_leaf_fn leaf,
+                      void *user)
+{
+    if (!m || !m->bvh) return;
+    const atmos__mesh_bvh *b = m->bvh;
+    int stack[MAX_DEPTH + 2], sp = 0;
+    stack[sp++] = 0;
+    while (sp) {
+        const node *n = &b->nodes[stack[--sp]];
+        if (!enter(user, n->lo, n->hi)) continue;
+        if (n->count) {
+            leaf(user, b->order + n->first, n->count);
+            continue;
+        }
+        const int a = n->first, c = n->first + 1;
+        const int near = centre_distance2(&b->nodes[a], eye) <= centre_distance2(&b->nodes[c], eye) ? a : c;
+        stack[sp++] = near == a ? c : a;
+        stack[sp++] = near;
+    }
 }

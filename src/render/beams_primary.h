@@ -26,9 +26,8 @@ typedef struct atmos__beams_primary {
     long traced;    /* pixels marked TRACE */
 } atmos__beams_primary;
 
-/* The buffer over the pixels r of cam's image (a pinhole camera; other cameras, and meshes of
- * more triangles than 0.6 a pixel of the image, which cost more to draw than to trace: every pixel
- * TRACE). Bands of rows go to the threads; the buffer does not depend on their number. */
+/* The buffer over the pixels r of cam's image (a pinhole camera; other cameras: every pixel
+ * TRACE). Tiles of the image go to the threads; the buffer does not depend on their number. */
 atmos_status atmos__beams_primary_build(atmos_context *ctx, const atmos__objects *ob, const atmos_camera *cam,
                                         const atmos__rect *r, atmos__beams_primary *P);
 void atmos__beams_primary_free(atmos__beams_primary *P);

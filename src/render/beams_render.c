@@ -65,7 +65,8 @@ typedef struct job {
 static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
-    double P[3], sum[ATMOS_MAX_WAVELENGTHS] = {0};
+    double P[3], sum[ATMOS_MAX_WAVELENGTHS];
+    for (int k = 0; k < J->nw; k++) sum[k] = 0; /* the wavelengths in use only: not 1 kB a pixel */
     for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
     const double off = 1e-4 * (1 + h->t);
     for (int i = 0; i < b->nlights; i++) {
@@ -74,12 +75,18 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
         const double r = sqrt(atmos__dot3(w, w));
         if (r <= 0) continue;
         for (int a = 0; a < 3; a++) w[a] /= r;
-        const double c = atmos__dot3(h->normal, w), fall = atmos__lamp_falloff(&l->L, P);
-        if (c <= 0 || fall <= 0) continue;
+        const double c = atmos__dot3(h->normal, w);
+        if (c <= 0) continue; /* facing away: no falloff, map or tint to look up */
+        const double fall = atmos__lamp_falloff(&l->L, P);
+        if (fall <= 0) continue;
         const double o[3] = {P[0] + off * h->normal[0], P[1] + off * h->normal[1], P[2] + off * h->normal[2]};
         const int lit = b->exact_shadows ? -1 : atmos__beams_surface_visible(l, P, c); /* the map, or an exact ray */
         if (lit == 0 || (lit < 0 && atmos__objects_hit(&b->obj, o, w, 0, r - off, NULL, NULL))) continue;
         const double e = fall * c / (r * r) * exp(-b->sigma_t * r);
+        if (!l->L.tex) {
+            for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e;
+            continue;
+        }
         double tint[3];
         atmos__lamp_tint(&l->L, P, tint);
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
