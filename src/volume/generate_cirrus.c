@@ -13,7 +13,10 @@
  *  - Heads: tufts on a jittered lattice (2.5 km, 60 % of the sites), each an ellipse
  *    200-450 m across and 2x longer along the wind, 250 m deep, over a streak that spreads
  *    (1 + 0.6 d / D) and thins to nothing at the depth D (600-1500 m) where the crystals
- *    have sublimated.
+ *    have sublimated. Each head and its streak is cut to a fractal outline
+ *    (atmos__gen_fractal_phi, the cumulus field's) fixed on the ground, so that seen from above
+ *    the swept streak's outline is rough at every scale: perimeter-area dimension 1.33, Kuo et
+ *    al. 1988 measured 1.3-1.4 on cirrus (smooth ellipses: 1.05).
  *  - Fibratus: a sheet of streaks between the heads whose coverage is fractal noise stretched
  *    8:1 along the wind.
  *  - Fibres: everything is multiplied by ridged fractal noise sampled at scales 2.5 km along
@@ -32,7 +35,15 @@
 
 typedef struct {
     double x, z, r, depth, w;
+    uint64_t seed; /* its fractal outline's */
 } cirrus_head;
+
+/* A head's dome is this much wider than its fractal outline (atmos__gen_fractal_phi), so that
+ * the rough outline cut from it rarely meets the dome's smooth rim. */
+#define WIDE 1.5
+/* Their outlines' roughness, of the cumulus field's (atmos__gen_fractal_phi): D 1.33 for 0.6
+ * (Kuo et al. 1988: 1.3-1.4; 1.0 gave 1.38, 0.5 1.28; docs/clouds.md "Against observations") */
+#define ROUGH 0.6
 
 
 /* Ridged fractal noise in [0, 1]: 1 - |2n - 1| per octave, high on thin sheets. */
@@ -63,7 +74,7 @@ static int place_heads(gen_job *job, double half, double sp, cirrus_head **out)
             double z = -half + (b + gen_range(&job->rng, 0.1, 0.9)) * sp;
             double r = gen_range(&job->rng, 200, 450) * s, depth = gen_range(&job->rng, 600, 1500) * s;
             double w = gen_range(&job->rng, 0.6, 1.0);
-            if (gen_u01(&job->rng) < 0.6) h[n++] = (cirrus_head){x, z, r, depth, w};
+            if (gen_u01(&job->rng) < 0.6) h[n++] = (cirrus_head){x, z, r, depth, w, 0};
         }
     *out = h;
     return n;
@@ -71,17 +82,24 @@ static int place_heads(gen_job *job, double half, double sp, cirrus_head **out)
 
 /* The heads' and streaks' ice (0..1) at the sheared-frame point (x0, z), depth d below the
  * generating level. */
-static double heads_at(const cirrus_head *h, int nh, double x0, double z, double d, double hh)
+static double heads_at(const cirrus_head *h, int nh, double x0, double shift, double z, double d, double hh,
+                       double voxel)
 {
     double best = 0;
     for (int q = 0; q < nh; q++) {
         if (d > h[q].depth || d < -0.5 * hh) continue;
         double spread = 1 + 0.6 * fmax(d, 0) / h[q].depth, rz = h[q].r * spread, rx = 2 * rz;
         double ex = (x0 - h[q].x) / rx, ez = (z - h[q].z) / rz, e2 = ex * ex + ez * ez;
-        if (e2 >= 1) continue;
+        if (e2 >= WIDE * WIDE) continue;
         double vert = d < hh ? 1 : 0.8 * (1 - (d - hh) / (h[q].depth - hh)) / spread;
         double top = d < 0 ? 1 - d / (-0.5 * hh) : 1; /* the head's rounded top */
-        double v = h[q].w * (1 - e2) * (1 - e2) * vert * top;
+        double dome = 1 - e2 / (WIDE * WIDE), v = h[q].w * dome * dome * vert * top;
+        if (v <= best) continue;
+        /* the outline: noise fixed on the ground (x = x0 + shift), in units of the head's
+         * width each way, so that seen from above the streak's outline is one level set */
+        double phi = atmos__gen_fractal_phi(h[q].seed, (x0 + shift - h[q].x) / (4 * h[q].r), (z - h[q].z) / (2 * h[q].r),
+                                            1 - e2, atmos__gen_fractal_octaves(2 * h[q].r, voxel), ROUGH);
+        v *= gen_clamp01(phi / 0.1);
         if (v > best) best = v;
     }
     return best;
@@ -102,6 +120,12 @@ atmos_status atmos__gen_cirrus(gen_job *job)
     /* heads over a margin upwind: their streaks drift downwind into the box */
     int nh = place_heads(job, half + 3000 * s, 2500 * s, &heads);
     if (nh < 0) return atmos__error(job->ctx, ATMOS_E_NOMEM, "generate %s: out of memory", job->preset);
+    /* drawn after the heads, which stay where they were before the outlines were fractal */
+    const uint64_t s_outline = atmos__splitmix64(&job->rng.s);
+    for (int q = 0; q < nh; q++) {
+        uint64_t t = s_outline + (uint64_t)q;
+        heads[q].seed = atmos__splitmix64(&t);
+    }
     const double ygen = 8000 + 1650 * s, hh = 250 * s, L = 180 * s;
     gen_grid *g = &job->grid[0];
 #pragma omp parallel for schedule(static) num_threads(job->threads)
@@ -112,7 +136,7 @@ atmos_status atmos__gen_cirrus(gen_job *job)
             for (int i = 0; i < g->n[0]; i++) {
                 double x = gen_vox(job, i, 0), z = gen_vox(job, k, 2);
                 double x0 = x - dd * dd / (2 * L);
-                double ice = heads_at(heads, nh, x0, z, d, hh);
+                double ice = heads_at(heads, nh, x0, x - x0, z, d, hh, job->voxel);
                 /* the fibratus sheet: 100..900 m below the generating level */
                 double sheet_v = gen_smoothstep(-50 * s, 150 * s, d) * (1 - gen_smoothstep(500 * s, 900 * s, d));
                 if (sheet_v > 0) {

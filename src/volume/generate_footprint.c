@@ -1,4 +1,5 @@
-/* Fractal footprints for the generated cumulus field (docs/clouds.md "Against observations").
+/* Fractal footprints for the generated cumulus field (docs/clouds.md "Against observations");
+ * the outline (atmos__gen_fractal_phi) also cuts the cirrus's generating heads (generate_cirrus.c).
  *
  * Each cloud m (centre cx, cz, footprint diameter w) owns the columns where its smooth envelope
  * e = 1 - rho^2, rho = distance / (w / 2), is the largest of all clouds'. In those columns
@@ -35,19 +36,29 @@
 #define LOW 2
 #define HMIN 120.0
 
+int atmos__gen_fractal_octaves(double width, double finest)
+{
+    const int oct = (int)ceil(log2(width / (0.5 * finest)));
+    return oct < 1 ? 1 : oct;
+}
+
+double atmos__gen_fractal_phi(uint64_t seed, double u, double v, double e, int octaves, double rough)
+{
+    return e + rough * SIGMA * (atmos__gen_fbm3(seed, u, 0.5, v, octaves, pow(2, -HURST)) - 0.5) - T;
+}
+
 /* The cut height (m) of the column at (x, z) owned by the cloud at (cx, cz) of width w; infinite
  * in the core (no cut). */
 static double column_top(const gen_job *job, uint64_t seed, double x, double z, double cx, double cz, double w,
                          double e, double base, double depth)
 {
     const double gain = pow(2, -HURST), u = (x - cx) / w, v = (z - cz) / w;
-    int oct = (int)ceil(log2(w / (0.5 * job->voxel)));
-    if (oct < 1) oct = 1;
+    const int oct = atmos__gen_fractal_octaves(w, job->voxel);
     const int low = oct < LOW ? oct : LOW;
     /* atmos__gen_fbm3 divides the sum by its amplitudes' total: the low octaves' sum on the
      * full sum's scale is the low octaves' mean times their share of the total. */
     const double share = (1 - pow(gain, low)) / (1 - pow(gain, oct));
-    const double phi = e + SIGMA * (atmos__gen_fbm3(seed, u, 0.5, v, oct, gain) - 0.5) - T;
+    const double phi = atmos__gen_fractal_phi(seed, u, v, e, oct, 1.0);
     const double phi_s = e + SIGMA * share * (atmos__gen_fbm3(seed, u, 0.5, v, low, gain) - 0.5) - T;
     if (phi_s >= RAMP && phi >= EDGE) return HUGE_VAL; /* the core: the dome uncut */
     return base + gen_clamp01(phi / EDGE) * fmax(HMIN * job->scale, depth * w * gen_clamp01(phi_s / RAMP));

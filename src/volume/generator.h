@@ -94,6 +94,15 @@ int atmos__gen_refine(gen_grid *g, gen_balls *bl, const gen_refine *p, gen_rng *
 double atmos__gen_noise3(uint64_t seed, double x, double y, double z);
 double atmos__gen_fbm3(uint64_t seed, double x, double y, double z, int octaves, double gain);
 
+/* A fractal outline (generate_footprint.c): phi = e + rough SIGMA (N - 1/2) - T at (u, v), the
+ * point in units of the cloud's width, e its smooth envelope there (1 at the centre, 0 at the
+ * nominal rim), N fractional Brownian noise of Hurst exponent 0.15 over `octaves` octaves from
+ * one width down (atmos__gen_fractal_octaves: to half of `finest`). The cloud is where phi >= 0;
+ * with rough = 1 the cumulus field's outlines have a perimeter-area dimension of 1.34, near the
+ * observed 1.35 (docs/clouds.md); less roughness leaves more of the smooth envelope. */
+double atmos__gen_fractal_phi(uint64_t seed, double u, double v, double e, int octaves, double rough);
+int atmos__gen_fractal_octaves(double width, double finest);
+
 /* Cellular noise in the plane (noise_cells.c): one feature point per unit cell, jittered by
  * `jitter` (0..1) of the cell; f1, f2 the distances to the nearest two, id a hash of the
  * nearest one's cell (for per-cell random values). */
