@@ -22,14 +22,17 @@ static void sky_irradiance(const atmos_atmosphere *a, double ly, double *E)
     const int n = a->wl.count;
     for (int k = 0; k < n; k++) E[k] = 0.0;
     if (!(ly > 0)) return;
-    const double sun[3] = {sqrt(fmax(1.0 - ly * ly, 0.0)), ly, 0.0}, p[3] = {0, 0, 0};
+    const double sun[3] = {sqrt(fmax(1.0 - ly * ly, 0.0)), ly, 0.0};
     const double w = 2.0 * (1.0 / MU_STEPS) * (ATMOS_PI / PHI_STEPS);
     double L[ATMOS_MAX_WAVELENGTHS];
     for (int i = 0; i < MU_STEPS; i++) {
         const double mu = (i + 0.5) / MU_STEPS, s = sqrt(1.0 - mu * mu);
         for (int j = 0; j < PHI_STEPS; j++) {
             const double phi = (j + 0.5) * ATMOS_PI / PHI_STEPS, d[3] = {s * cos(phi), mu, s * sin(phi)};
-            atmos_atmosphere_inscatter(a, p, d, INFINITY, sun, L);
+            const int lit = a->desc.kind == ATMOS_ATMOSPHERE_RILEY
+                                ? atmos__riley_inscatter(a, 0.0, d, INFINITY, sun, n, NULL, L)
+                                : atmos__homog_inscatter(a, 0.0, d, INFINITY, sun, n, NULL, L);
+            if (!lit) continue;
             for (int k = 0; k < n; k++) E[k] += w * mu * L[k];
         }
     }
