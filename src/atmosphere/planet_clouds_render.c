@@ -66,7 +66,8 @@ static void sunlight_at(const atmos_atmosphere *a, const atmos__sunlight_table *
         a->solver->sunlight(a, x, sun, n, NULL, E);
         return;
     }
-    const double u = (fmin(fmax(mus, -1.0), 1.0) + 1.0) * 0.5 * (e->ne - 1);
+    const double mc = mus > -1.0 ? (mus < 1.0 ? mus : 1.0) : -1.0; /* selects, not library calls */
+    const double u = (mc + 1.0) * 0.5 * (e->ne - 1);
     int i = (int)u;
     i = i > e->ne - 2 ? e->ne - 2 : i;
     const float f = (float)(u - i);
@@ -89,7 +90,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     const double col = atmos__clouds_column_tau(cl, lat, lon);
     if (col <= 0) return 1.0;
     /* x is on sphere i: its vertical is (x + centre) / r_i */
-    const double inv_r = 1.0 / cl->r[i], xc[3] = {x[0], x[1] + pl->r_ground, x[2]};
+    const double inv_r = cl->inv_r[i], xc[3] = {x[0], x[1] + pl->r_ground, x[2]};
     const double tau = atmos__clouds_shell_tau(cl, i, col, atmos__dot3(xc, d) * inv_r);
     const double t = atmos__expf_fast((float)-tau); /* within 2e-7 of exp */
     const int n = a->wl.count;
@@ -119,7 +120,7 @@ static void ground_light(const atmos_atmosphere *a, const double p[3], const dou
     const int n = a->wl.count;
     double g[3] = {p[0] + K * d[0], p[1] + K * d[1], p[2] + K * d[2]}, nrm[3];
     atmos__planet_ground_point(pl, g, nrm);
-    const double cs = fmax(atmos__dot3(nrm, sun), 0.0);
+    const double cn = atmos__dot3(nrm, sun), cs = cn > 0.0 ? cn : 0.0;
     double E[ATMOS_MAX_WAVELENGTHS];
     double G = 0.0;
     if (cs > 0) {
@@ -192,8 +193,10 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
     for (int k = 0; k < n; k++) out[k] = 0.0;
     for (int j = 0; j <= m; j++) {
         /* the air between stop j - 1 and stop j as the eye sees it, through the clouds */
-        for (int k = 0; k < n; k++)
-            out[k] += clouds * fmax(Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0), 0.0);
+        for (int k = 0; k < n; k++) { /* a select, not the library's fmax */
+            const double dl = Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0);
+            out[k] += clouds * (dl > 0.0 ? dl : 0.0);
+        }
         for (int k = 0; k < n; k++) w[k] = clouds * Tc[(size_t)j * n + k];
         if (j == m) {
             ground_light(a, p, d, K, sun, w, gs, e, out);
