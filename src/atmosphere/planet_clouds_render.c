@@ -76,18 +76,15 @@ static void sunlight_at(const atmos_atmosphere *a, const atmos__sunlight_table *
 }
 
 /* Adds the crossing's light (times the transmittance w in front of it) to out; returns
- * the crossing's transmittance. G from gs's textures, or evaluated here when gs is NULL;
- * ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
-static double crossing_light(const atmos_atmosphere *a, const double x[3], const double d[3], const double sun[3],
-                             int i, double ph, const double *w, atmos__clouds_sun *gs,
-                             const atmos__sunlight_table *e, double *out)
+ * the crossing's transmittance. x at latitude and longitude lat, lon (atmos__planet_latlon_fast's)
+ * where the column's optical depth is col. G from gs's textures, or evaluated here when gs is
+ * NULL; ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
+static double crossing_light(const atmos_atmosphere *a, const double x[3], double lat, double lon, double col,
+                             const double d[3], const double sun[3], int i, double ph, const double *w,
+                             atmos__clouds_sun *gs, const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
     const atmos__clouds *cl = pl->clouds;
-    /* the column at x once, for the view's crossing and the sun's */
-    double lat, lon;
-    atmos__planet_latlon_fast(pl, x, &lat, &lon);
-    const double col = atmos__clouds_column_tau(cl, lat, lon);
     if (col <= 0) return 1.0;
     /* x is on sphere i: its vertical is (x + centre) / r_i */
     const double inv_r = cl->inv_r[i], xc[3] = {x[0], x[1] + pl->r_ground, x[2]};
@@ -164,7 +161,10 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
             break;
         }
         for (int i = 0; i < 3; i++) x[i] = p[i] + t_end * d[i];
-        const double tc = crossing_light(a, x, d, sun, c[j].sphere, ph, w, NULL, NULL, out);
+        double lat, lon;
+        atmos__planet_latlon_fast(pl, x, &lat, &lon);
+        const double col = atmos__clouds_column_tau(pl->clouds, lat, lon);
+        const double tc = crossing_light(a, x, lat, lon, col, d, sun, c[j].sphere, ph, w, NULL, NULL, out);
         clouds *= tc;
         for (int k = 0; k < n; k++) w[k] *= tc;
         opaque = clouds < OPAQUE;
@@ -188,6 +188,14 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
     if (!(K < INFINITY) || find_crossings(pl, p, d, K, c) != m) return 0;
     for (int j = 0; j < m; j++)
         if (c[j].sphere != m - 1 - j) return 0;
+    /* the crossings' points, coordinates and columns first: independent of each other, so
+     * their divisions and memory reads overlap instead of waiting on the compositing */
+    double x[MAX_CROSSINGS][3], lat[MAX_CROSSINGS], lon[MAX_CROSSINGS], col[MAX_CROSSINGS];
+    for (int j = 0; j < m; j++) {
+        for (int i = 0; i < 3; i++) x[j][i] = p[i] + c[j].t * d[i];
+        atmos__planet_latlon_fast(pl, x[j], &lat[j], &lon[j]);
+        col[j] = atmos__clouds_column_tau(pl->clouds, lat[j], lon[j]);
+    }
     double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
     const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
     for (int k = 0; k < n; k++) out[k] = 0.0;
@@ -202,8 +210,7 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
             ground_light(a, p, d, K, sun, w, gs, e, out);
             break;
         }
-        const double x[3] = {p[0] + c[j].t * d[0], p[1] + c[j].t * d[1], p[2] + c[j].t * d[2]};
-        clouds *= crossing_light(a, x, d, sun, c[j].sphere, ph, w, gs, e, out);
+        clouds *= crossing_light(a, x[j], lat[j], lon[j], col[j], d, sun, c[j].sphere, ph, w, gs, e, out);
         if (clouds < OPAQUE) break;
     }
     return 1;
