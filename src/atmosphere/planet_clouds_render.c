@@ -50,6 +50,28 @@ static int find_crossings(const atmos__planet *pl, const double p[3], const doub
     return n;
 }
 
+/* From an eye above the top sphere, a ray that meets the ground at K enters every sphere,
+ * the top one first, and leaves none before K: the entries as find_crossings computes them,
+ * without its sorting. 0 (c undefined) when they are not m in (0, K), nearest first. */
+static int entries(const atmos__planet *pl, const double p[3], const double d[3], double K, crossing *c)
+{
+    const atmos__clouds *cl = pl->clouds;
+    const double o[3] = {p[0], p[1] + pl->r_ground, p[2]};
+    const double b = atmos__dot3(o, d), oo = atmos__dot3(o, o);
+    const int m = cl->m;
+    if (!(oo > cl->r[m - 1] * cl->r[m - 1])) return 0;
+    double t_prev = 0.0;
+    for (int j = 0; j < m; j++) {
+        const int i = m - 1 - j;
+        const double disc = b * b - (oo - cl->r[i] * cl->r[i]);
+        if (disc <= 0) return 0;
+        const double t = -b - sqrt(disc);
+        if (!(t > t_prev && t < K)) return 0;
+        c[j].t = t_prev = t, c[j].sphere = i;
+    }
+    return 1;
+}
+
 static double hg(double g, double cos_theta)
 {
     const double q = 1.0 + g * g - 2.0 * g * cos_theta;
@@ -185,9 +207,7 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
     const int n = a->wl.count, m = pl->clouds->m;
     const double K = atmos__planet_ground_distance(pl, p, d);
     crossing c[MAX_CROSSINGS];
-    if (!(K < INFINITY) || find_crossings(pl, p, d, K, c) != m) return 0;
-    for (int j = 0; j < m; j++)
-        if (c[j].sphere != m - 1 - j) return 0;
+    if (!(K < INFINITY) || !entries(pl, p, d, K, c)) return 0;
     /* the crossings' points, coordinates and columns first: independent of each other, so
      * their divisions and memory reads overlap instead of waiting on the compositing */
     double x[MAX_CROSSINGS][3], lat[MAX_CROSSINGS], lon[MAX_CROSSINGS], col[MAX_CROSSINGS];
