@@ -211,11 +211,11 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
     /* the crossings' points, coordinates and columns first: independent of each other, so
      * their divisions and memory reads overlap instead of waiting on the compositing */
     double x[MAX_CROSSINGS][3], lat[MAX_CROSSINGS], lon[MAX_CROSSINGS], col[MAX_CROSSINGS];
-    for (int j = 0; j < m; j++) {
+    for (int j = 0; j < m; j++) { /* arithmetic only: the compiler may do the crossings side by side */
         for (int i = 0; i < 3; i++) x[j][i] = p[i] + c[j].t * d[i];
         atmos__planet_latlon_fast(pl, x[j], &lat[j], &lon[j]);
-        col[j] = atmos__clouds_column_tau(pl->clouds, lat[j], lon[j]);
     }
+    for (int j = 0; j < m; j++) col[j] = atmos__clouds_column_tau(pl->clouds, lat[j], lon[j]);
     double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
     const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
     for (int k = 0; k < n; k++) out[k] = 0.0;

@@ -81,8 +81,8 @@ static inline double atmos__atan2_fast(double y, double x)
 {
     /* selects rather than fmax / fmin, which are library calls without -ffinite-math-only */
     const double ax = fabs(x), ay = fabs(y), hi = ay > ax ? ay : ax, lo = ay > ax ? ax : ay;
-    if (!(hi > 0)) return 0.0;
-    double a = atmos__atan_unit(lo / hi);
+    /* 0 at the origin; a select, not a branch, so that loops of it can be vectorised */
+    double a = atmos__atan_unit(hi > 0 ? lo / hi : 0.0);
     a = ay > ax ? 1.57079632679489662 - a : a;
     a = x < 0 ? 3.14159265358979324 - a : a;
     return y < 0 ? -a : a;
