@@ -123,7 +123,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], doubl
     double J = G * ph;
     if (!cl->single && mus > 0) {
         const double own = atmos__clouds_shell_tau(cl, i, col, mus); /* the whole shell along the sun */
-        J += mus * (1.0 - G * atmos__expf_fast((float)(-0.5 * own))) / ATMOS_PI;
+        J += mus * (1.0 - G * atmos__expf_fast((float)(-0.5 * own))) * (1.0 / ATMOS_PI);
     }
     for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];
     return t;

@@ -113,7 +113,7 @@ static double phi_col(double t, double phi)
     const double len = left ? t : ATMOS_PI - t;
     if (!(len > 1e-12)) return xt;
     const double y = fabs(phi - t) / len;
-    const double s = (-A + sqrt(A * A + 4.0 * (1.0 - A) * y)) / (2.0 * (1.0 - A));
+    const double s = (-A + sqrt(A * A + 4.0 * (1.0 - A) * y)) * (0.5 / (1.0 - A));
     return left ? xt * (1.0 - s) : xt + (1.0 - xt) * s;
 }
 
@@ -298,8 +298,8 @@ static double row_coord(const atmos__sph_space *s, double p2, int *disk)
     const double R2 = s->R * s->R;
     *disk = p2 < R2;
     if (*disk) {
-        const double y = atmos__atan2_fast(sqrt(R2 - p2), sqrt(p2)) / (0.5 * ATMOS_PI);
-        return (-AD + sqrt(AD * AD + 4.0 * (1.0 - AD) * y)) / (2.0 * (1.0 - AD)) * (NG - 1);
+        const double y = atmos__atan2_fast(sqrt(R2 - p2), sqrt(p2)) * (2.0 / ATMOS_PI);
+        return (-AD + sqrt(AD * AD + 4.0 * (1.0 - AD) * y)) * (0.5 / (1.0 - AD)) * (NG - 1);
     }
     const double h = sqrt(p2) - s->R;
     return sqrt(fmin(1.0, h / (s->Rt - s->R))) * (NL - 1);
