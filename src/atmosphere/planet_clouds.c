@@ -92,12 +92,15 @@ atmos_status atmos__planet_clouds_create(atmos_context *ctx, atmos__planet *pl, 
     cl->lon_w = c.lon_west_deg, cl->lon_e = c.lon_east_deg, cl->lat_s = c.lat_south_deg, cl->lat_n = c.lat_north_deg;
     cl->global = cl->lon_e - cl->lon_w >= 360.0 - 1e-9;
     cl->m = c.spheres;
+    cl->inv_m = 1.0 / c.spheres;
+    cl->u_per_deg = cl->w / (cl->lon_e - cl->lon_w), cl->v_per_deg = cl->h / (cl->lat_n - cl->lat_s);
     cl->base = c.base_m, cl->top = c.top_m;
     cl->dh = (c.top_m - c.base_m) / c.spheres;
     cl->sigma_per_tau = 1.0 / (c.top_m - c.base_m);
     for (int i = 0; i < cl->m; i++) {
         cl->r[i] = pl->r_ground + c.base_m + (i + 0.5) * cl->dh;
         cl->mu_min[i] = sqrt(cl->dh / (2.0 * cl->r[i]));
+        cl->inv_r[i] = 1.0 / cl->r[i];
     }
     cl->g = c.g;
     cl->single = c.single_scattering;
@@ -137,8 +140,7 @@ double atmos__clouds_column_tau_edge(const atmos__clouds *cl, double lat, double
 {
     if (lon < cl->lon_w) lon += 360.0;
     if (lat < cl->lat_s || lat > cl->lat_n || lon < cl->lon_w || lon > cl->lon_e) return 0.0;
-    const double u = (lon - cl->lon_w) / (cl->lon_e - cl->lon_w) * cl->w - 0.5;
-    const double v = (cl->lat_n - lat) / (cl->lat_n - cl->lat_s) * cl->h - 0.5;
+    const double u = (lon - cl->lon_w) * cl->u_per_deg - 0.5, v = (cl->lat_n - lat) * cl->v_per_deg - 0.5;
     const double fade = edge_fade(cl, u, v), tau = atmos__clouds_bilinear(cl, u, v);
     if (fade >= 1.0) return tau;
     /* faded in reflectance, R = k tau / (1 + k tau) as atmos__clouds_tau_from_brightness

@@ -12,9 +12,12 @@ typedef struct atmos__clouds {
     double base, top, dh;        /* the layer's heights and one shell's thickness, m */
     double r[ATMOS__CLOUDS_MAX]; /* radii of the spheres, lowest first */
     double mu_min[ATMOS__CLOUDS_MAX];
+    double inv_r[ATMOS__CLOUDS_MAX]; /* 1 / r */
+    double inv_m;                /* 1 / m */
     double sigma_per_tau;        /* the layer's extinction per unit column optical depth, m^-1 */
     int w, h, global;            /* the optical depth image and whether it spans 360 degrees */
     double lon_w, lon_e, lat_s, lat_n;
+    double u_per_deg, v_per_deg; /* the image's pixels a degree of longitude and of latitude */
     float *tau;                  /* column optical depth per pixel, row 0 north */
     double g;                    /* Henyey-Greenstein asymmetry of single scattering */
     int single;                  /* nonzero: no diffuse source */
@@ -26,8 +29,8 @@ double atmos__clouds_tau_from_brightness(double b, double threshold, double max_
  * at integers; clamped to the image). */
 static inline double atmos__clouds_bilinear(const atmos__clouds *cl, double u, double v)
 {
-    u = u < 0.0 ? 0.0 : (u > cl->w - 1.0 ? cl->w - 1.0 : u);
-    v = v < 0.0 ? 0.0 : (v > cl->h - 1.0 ? cl->h - 1.0 : v);
+    u = u > 0.0 ? u : 0.0, u = u < cl->w - 1.0 ? u : cl->w - 1.0; /* selects, not library calls */
+    v = v > 0.0 ? v : 0.0, v = v < cl->h - 1.0 ? v : cl->h - 1.0;
     const int x0 = (int)u, y0 = (int)v;
     const int x1 = x0 + 1 < cl->w ? x0 + 1 : x0, y1 = y0 + 1 < cl->h ? y0 + 1 : y0;
     const double au = u - x0, av = v - y0;
@@ -43,16 +46,17 @@ static inline double atmos__clouds_column_tau(const atmos__clouds *cl, double la
 {
     if (!cl->global) return atmos__clouds_column_tau_edge(cl, lat, lon);
     if (lat < cl->lat_s || lat > cl->lat_n) return 0.0;
-    lon = lon - 360.0 * floor((lon - cl->lon_w) / 360.0);
-    return atmos__clouds_bilinear(cl, (lon - cl->lon_w) / (cl->lon_e - cl->lon_w) * cl->w - 0.5,
-                                  (cl->lat_n - lat) / (cl->lat_n - cl->lat_s) * cl->h - 0.5);
+    /* lon in [-180, 180] and the image's west edge in [-360, 360]: one turn at most */
+    lon = lon < cl->lon_w ? lon + 360.0 : lon;
+    lon = lon >= cl->lon_w + 360.0 ? lon - 360.0 : lon;
+    return atmos__clouds_bilinear(cl, (lon - cl->lon_w) * cl->u_per_deg - 0.5, (cl->lat_n - lat) * cl->v_per_deg - 0.5);
 }
 /* Optical depth of shell i crossed at cosine mu to the vertical where the column's is tau:
  * tau / m / max(|mu|, the shell's grazing limit). */
 static inline double atmos__clouds_shell_tau(const atmos__clouds *cl, int i, double tau, double mu)
 {
     const double a = fabs(mu);
-    return tau / cl->m / (a > cl->mu_min[i] ? a : cl->mu_min[i]);
+    return tau * cl->inv_m / (a > cl->mu_min[i] ? a : cl->mu_min[i]);
 }
 /* Optical depth of shell i crossed at x (on sphere i) in direction d. */
 double atmos__clouds_crossing_tau(const atmos__planet *pl, int i, const double x[3], const double d[3]);

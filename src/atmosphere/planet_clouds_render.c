@@ -50,6 +50,28 @@ static int find_crossings(const atmos__planet *pl, const double p[3], const doub
     return n;
 }
 
+/* From an eye above the top sphere, a ray that meets the ground at K enters every sphere,
+ * the top one first, and leaves none before K: the entries as find_crossings computes them,
+ * without its sorting. 0 (c undefined) when they are not m in (0, K), nearest first. */
+static int entries(const atmos__planet *pl, const double p[3], const double d[3], double K, crossing *c)
+{
+    const atmos__clouds *cl = pl->clouds;
+    const double o[3] = {p[0], p[1] + pl->r_ground, p[2]};
+    const double b = atmos__dot3(o, d), oo = atmos__dot3(o, o);
+    const int m = cl->m;
+    if (!(oo > cl->r[m - 1] * cl->r[m - 1])) return 0;
+    double t_prev = 0.0;
+    for (int j = 0; j < m; j++) {
+        const int i = m - 1 - j;
+        const double disc = b * b - (oo - cl->r[i] * cl->r[i]);
+        if (disc <= 0) return 0;
+        const double t = -b - sqrt(disc);
+        if (!(t > t_prev && t < K)) return 0;
+        c[j].t = t_prev = t, c[j].sphere = i;
+    }
+    return 1;
+}
+
 static double hg(double g, double cos_theta)
 {
     const double q = 1.0 + g * g - 2.0 * g * cos_theta;
@@ -66,7 +88,8 @@ static void sunlight_at(const atmos_atmosphere *a, const atmos__sunlight_table *
         a->solver->sunlight(a, x, sun, n, NULL, E);
         return;
     }
-    const double u = (fmin(fmax(mus, -1.0), 1.0) + 1.0) * 0.5 * (e->ne - 1);
+    const double mc = mus > -1.0 ? (mus < 1.0 ? mus : 1.0) : -1.0; /* selects, not library calls */
+    const double u = (mc + 1.0) * 0.5 * (e->ne - 1);
     int i = (int)u;
     i = i > e->ne - 2 ? e->ne - 2 : i;
     const float f = (float)(u - i);
@@ -75,21 +98,18 @@ static void sunlight_at(const atmos_atmosphere *a, const atmos__sunlight_table *
 }
 
 /* Adds the crossing's light (times the transmittance w in front of it) to out; returns
- * the crossing's transmittance. G from gs's textures, or evaluated here when gs is NULL;
- * ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
-static double crossing_light(const atmos_atmosphere *a, const double x[3], const double d[3], const double sun[3],
-                             int i, double ph, const double *w, atmos__clouds_sun *gs,
-                             const atmos__sunlight_table *e, double *out)
+ * the crossing's transmittance. x at latitude and longitude lat, lon (atmos__planet_latlon_fast's)
+ * where the column's optical depth is col. G from gs's textures, or evaluated here when gs is
+ * NULL; ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
+static double crossing_light(const atmos_atmosphere *a, const double x[3], double lat, double lon, double col,
+                             const double d[3], const double sun[3], int i, double ph, const double *w,
+                             atmos__clouds_sun *gs, const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
     const atmos__clouds *cl = pl->clouds;
-    /* the column at x once, for the view's crossing and the sun's */
-    double lat, lon;
-    atmos__planet_latlon_fast(pl, x, &lat, &lon);
-    const double col = atmos__clouds_column_tau(cl, lat, lon);
     if (col <= 0) return 1.0;
     /* x is on sphere i: its vertical is (x + centre) / r_i */
-    const double inv_r = 1.0 / cl->r[i], xc[3] = {x[0], x[1] + pl->r_ground, x[2]};
+    const double inv_r = cl->inv_r[i], xc[3] = {x[0], x[1] + pl->r_ground, x[2]};
     const double tau = atmos__clouds_shell_tau(cl, i, col, atmos__dot3(xc, d) * inv_r);
     const double t = atmos__expf_fast((float)-tau); /* within 2e-7 of exp */
     const int n = a->wl.count;
@@ -103,7 +123,7 @@ static double crossing_light(const atmos_atmosphere *a, const double x[3], const
     double J = G * ph;
     if (!cl->single && mus > 0) {
         const double own = atmos__clouds_shell_tau(cl, i, col, mus); /* the whole shell along the sun */
-        J += mus * (1.0 - G * atmos__expf_fast((float)(-0.5 * own))) / ATMOS_PI;
+        J += mus * (1.0 - G * atmos__expf_fast((float)(-0.5 * own))) * (1.0 / ATMOS_PI);
     }
     for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];
     return t;
@@ -119,7 +139,7 @@ static void ground_light(const atmos_atmosphere *a, const double p[3], const dou
     const int n = a->wl.count;
     double g[3] = {p[0] + K * d[0], p[1] + K * d[1], p[2] + K * d[2]}, nrm[3];
     atmos__planet_ground_point(pl, g, nrm);
-    const double cs = fmax(atmos__dot3(nrm, sun), 0.0);
+    const double cn = atmos__dot3(nrm, sun), cs = cn > 0.0 ? cn : 0.0;
     double E[ATMOS_MAX_WAVELENGTHS];
     double G = 0.0;
     if (cs > 0) {
@@ -163,7 +183,10 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
             break;
         }
         for (int i = 0; i < 3; i++) x[i] = p[i] + t_end * d[i];
-        const double tc = crossing_light(a, x, d, sun, c[j].sphere, ph, w, NULL, NULL, out);
+        double lat, lon;
+        atmos__planet_latlon_fast(pl, x, &lat, &lon);
+        const double col = atmos__clouds_column_tau(pl->clouds, lat, lon);
+        const double tc = crossing_light(a, x, lat, lon, col, d, sun, c[j].sphere, ph, w, NULL, NULL, out);
         clouds *= tc;
         for (int k = 0; k < n; k++) w[k] *= tc;
         opaque = clouds < OPAQUE;
@@ -184,23 +207,30 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
     const int n = a->wl.count, m = pl->clouds->m;
     const double K = atmos__planet_ground_distance(pl, p, d);
     crossing c[MAX_CROSSINGS];
-    if (!(K < INFINITY) || find_crossings(pl, p, d, K, c) != m) return 0;
-    for (int j = 0; j < m; j++)
-        if (c[j].sphere != m - 1 - j) return 0;
+    if (!(K < INFINITY) || !entries(pl, p, d, K, c)) return 0;
+    /* the crossings' points, coordinates and columns first: independent of each other, so
+     * their divisions and memory reads overlap instead of waiting on the compositing */
+    double x[MAX_CROSSINGS][3], lat[MAX_CROSSINGS], lon[MAX_CROSSINGS], col[MAX_CROSSINGS];
+    for (int j = 0; j < m; j++) { /* arithmetic only: the compiler may do the crossings side by side */
+        for (int i = 0; i < 3; i++) x[j][i] = p[i] + c[j].t * d[i];
+        atmos__planet_latlon_fast(pl, x[j], &lat[j], &lon[j]);
+    }
+    for (int j = 0; j < m; j++) col[j] = atmos__clouds_column_tau(pl->clouds, lat[j], lon[j]);
     double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
     const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
     for (int k = 0; k < n; k++) out[k] = 0.0;
     for (int j = 0; j <= m; j++) {
         /* the air between stop j - 1 and stop j as the eye sees it, through the clouds */
-        for (int k = 0; k < n; k++)
-            out[k] += clouds * fmax(Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0), 0.0);
+        for (int k = 0; k < n; k++) { /* a select, not the library's fmax */
+            const double dl = Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0);
+            out[k] += clouds * (dl > 0.0 ? dl : 0.0);
+        }
         for (int k = 0; k < n; k++) w[k] = clouds * Tc[(size_t)j * n + k];
         if (j == m) {
             ground_light(a, p, d, K, sun, w, gs, e, out);
             break;
         }
-        const double x[3] = {p[0] + c[j].t * d[0], p[1] + c[j].t * d[1], p[2] + c[j].t * d[2]};
-        clouds *= crossing_light(a, x, d, sun, c[j].sphere, ph, w, gs, e, out);
+        clouds *= crossing_light(a, x[j], lat[j], lon[j], col[j], d, sun, c[j].sphere, ph, w, gs, e, out);
         if (clouds < OPAQUE) break;
     }
     return 1;

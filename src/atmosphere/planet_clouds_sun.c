@@ -29,7 +29,7 @@ struct atmos__clouds_sun {
     double sun[3];
     int layers;                    /* m: spheres 0 .. m - 2, then the ground */
     int w, h, tw, th, wrap;        /* texels, tiles; wrap: the grid spans 360 degrees */
-    double lat_n, lon_w, dlat, dlon;
+    double lat_n, lon_w, dlat, dlon, inv_dlat, inv_dlon;
     float *g;                      /* [layers][h][w] */
     atomic_int *state;             /* [layers][th][tw]: 0 empty, 1 being filled, 2 ready */
 };
@@ -57,6 +57,7 @@ atmos__clouds_sun *atmos__clouds_sun_create(const atmos__planet *pl, const doubl
     s->w = s->w < 2 ? 2 : s->w, s->h = s->h < 2 ? 2 : s->h;
     s->lat_n = lat_n, s->lon_w = lon_w;
     s->dlat = (lat_n - lat_s) / s->h, s->dlon = (lon_e - lon_w) / s->w;
+    s->inv_dlat = s->h / (lat_n - lat_s), s->inv_dlon = s->w / (lon_e - lon_w);
     s->tw = (s->w + TILE - 1) / TILE, s->th = (s->h + TILE - 1) / TILE;
     const size_t tiles = (size_t)s->layers * s->tw * s->th;
     s->g = malloc(sizeof(float) * (size_t)s->layers * s->w * s->h);
@@ -167,17 +168,20 @@ double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int bel
 {
     const int layer = below >= 0 ? below : s->layers - 1;
     if (below >= s->layers - 1) return 1.0; /* the top sphere: nothing above it */
-    if (lon < s->lon_w) lon += 360.0;
-    double u = (lon - s->lon_w) / s->dlon - 0.5, v = (s->lat_n - lat) / s->dlat - 0.5;
+    lon = lon < s->lon_w ? lon + 360.0 : lon;
+    double u = (lon - s->lon_w) * s->inv_dlon - 0.5, v = (s->lat_n - lat) * s->inv_dlat - 0.5;
     if (!s->wrap && (u < -0.5 || u > s->w - 0.5)) return atmos__clouds_sun_attenuation(s->pl, x, s->sun, below);
-    if (v < -0.5 || v > s->h - 0.5) return atmos__clouds_sun_attenuation(s->pl, x, s->sun, below);
-    v = fmin(fmax(v, 0.0), s->h - 1.0);
+    if (!(v >= -0.5 && v <= s->h - 0.5)) return atmos__clouds_sun_attenuation(s->pl, x, s->sun, below);
+    /* selects rather than fmin / fmax and floor, which are library calls here */
+    v = v > 0.0 ? v : 0.0, v = v < s->h - 1.0 ? v : s->h - 1.0;
     int y0 = (int)v, y1 = y0 + 1 < s->h ? y0 + 1 : y0, x0, x1;
-    if (s->wrap) {
-        const double f = floor(u);
-        x0 = ((int)f % s->w + s->w) % s->w, x1 = (x0 + 1) % s->w, u -= f;
+    if (s->wrap) { /* u in [-0.5, w - 0.5] (lon within one turn east of lon_w) */
+        const int f = (int)(u + 1.0) - 1; /* floor(u) for u >= -1 */
+        u -= f;
+        x0 = f < 0 ? f + s->w : (f >= s->w ? f - s->w : f);
+        x1 = x0 + 1 < s->w ? x0 + 1 : 0;
     } else {
-        u = fmin(fmax(u, 0.0), s->w - 1.0);
+        u = u > 0.0 ? u : 0.0, u = u < s->w - 1.0 ? u : s->w - 1.0;
         x0 = (int)u, x1 = x0 + 1 < s->w ? x0 + 1 : x0, u -= x0;
     }
     const double av = v - y0;
@@ -190,7 +194,8 @@ double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int bel
     const float *g = s->g + (size_t)layer * s->w * s->h;
     const size_t W = (size_t)s->w;
     const float g00 = g[y0 * W + x0], g01 = g[y0 * W + x1], g10 = g[y1 * W + x0], g11 = g[y1 * W + x1];
-    const float lo = fminf(fminf(g00, g01), fminf(g10, g11)), hi = fmaxf(fmaxf(g00, g01), fmaxf(g10, g11));
+    const float l0 = g00 < g01 ? g00 : g01, l1 = g10 < g11 ? g10 : g11, lo = l0 < l1 ? l0 : l1;
+    const float h0 = g00 > g01 ? g00 : g01, h1 = g10 > g11 ? g10 : g11, hi = h0 > h1 ? h0 : h1;
     if (hi - lo > SPREAD) return step_down(s, x, below + 1);
     return (1 - av) * ((1 - u) * g00 + u * g01) + av * ((1 - u) * g10 + u * g11);
 }

@@ -60,8 +60,14 @@ static inline double atmos__log1p_fast(double x)
       (T)0.3333314528))
 static inline double atmos__atan_unit(double z)
 {
-    const double z2 = z * z;
-    return z * (1.0 + ATMOS__ATAN_POLY(double, z2) * z2);
+    /* the same polynomial by Estrin's scheme: four independent pairs, then two levels, so
+     * its latency is about half of Horner's eight dependent steps (the texture look-ups of
+     * the clouds wait on it) */
+    const double Z = z * z, Z2 = Z * Z, Z4 = Z2 * Z2;
+    const double p01 = -0.3333314528 + 0.1999355085 * Z, p23 = -0.1420889944 + 0.1065626393 * Z;
+    const double p45 = -0.0752896400 + 0.0429096138 * Z, p67 = -0.0161657367 + 0.0028662257 * Z;
+    const double q = (p01 + p23 * Z2) + Z4 * (p45 + p67 * Z2);
+    return z * (1.0 + q * Z);
 }
 static inline float atmos__atan_unitf(float z)
 {
@@ -75,8 +81,8 @@ static inline double atmos__atan2_fast(double y, double x)
 {
     /* selects rather than fmax / fmin, which are library calls without -ffinite-math-only */
     const double ax = fabs(x), ay = fabs(y), hi = ay > ax ? ay : ax, lo = ay > ax ? ax : ay;
-    if (!(hi > 0)) return 0.0;
-    double a = atmos__atan_unit(lo / hi);
+    /* 0 at the origin; a select, not a branch, so that loops of it can be vectorised */
+    double a = atmos__atan_unit(hi > 0 ? lo / hi : 0.0);
     a = ay > ax ? 1.57079632679489662 - a : a;
     a = x < 0 ? 3.14159265358979324 - a : a;
     return y < 0 ? -a : a;
