@@ -22,7 +22,7 @@ for k in W S A D E Q Left Right Up Down I K J L '\[' '\]' Z X = - O R V H F12 P 
 done
 ok "help lists the keys"
 
-# headless, scripted (an orbit: the default scene pans in place)
+# headless, scripted (an orbit: the default scene's camera about the point it looks at)
 "$A" view --headless --frames 3 --size 64x36 --record "$T/rec" >"$T/out.txt" 2>&1 || { bad "headless run"; cat "$T/out.txt" >&2; }
 python3 - "$T/rec" <<'PY' && ok "headless record: 3 frames, csv columns" || bad "headless record"
 import csv, os, sys
@@ -61,8 +61,13 @@ assert len(r) == 3, r
 f = lambda i, k: float(r[i][k])
 assert abs(f(1, "sun_elevation_deg") - f(0, "sun_elevation_deg") - 20.0 / 30) < 1e-3, r   # I: 20 deg/s, a tap
 assert f(2, "sun_elevation_deg") == f(1, "sun_elevation_deg")
-d = math.dist([f(1, "x_m"), f(1, "y_m"), f(1, "z_m")], [f(0, "x_m"), f(0, "y_m"), f(0, "z_m")])
-assert abs(d - 100.0 / 30) < 1e-2, d    # W: the default scene's 100 m/s (a tenth of 1 km), a tap
+# W: the default scene's 100 m/s (a tenth of 1 km), a tap, towards the point the default camera
+# looks at (1 km ahead of it), about which --frames orbits at a constant distance
+y, p = math.radians(f(0, "yaw_deg")), math.radians(f(0, "pitch_deg"))
+ahead = [math.cos(p) * math.sin(y), math.sin(p), -math.cos(p) * math.cos(y)]
+c = [f(0, k) + 1000.0 * ahead[i] for i, k in enumerate(["x_m", "y_m", "z_m"])]
+d = [math.dist([f(i, "x_m"), f(i, "y_m"), f(i, "z_m")], c) for i in range(3)]
+assert abs(d[0] - 1000.0) < 1e-2 and abs(d[0] - d[1] - 100.0 / 30) < 1e-2 and abs(d[2] - d[1]) < 1e-2, d
 PY
 if [ -f "$T/shot_001.json" ] && [ -f "$T/shot_001.exr" ] && [ -f "$T/shot_001.png" ]; then
     ok "F12 saved EXR, PNG and JSON"

@@ -60,6 +60,10 @@ void view_state_init(view_state *s, const atmos_scene *sc, const atmos_frame *f,
 /* One action over dt seconds (held actions) or once (pressed ones); fast / slow: the
  * speed modifiers (x10, x0.1). */
 void view_state_apply(view_state *s, view_action a, double dt, int fast, int slow);
+/* A tap of a key: a held action for VIEW_TAP_S seconds, a pressed one once (what a key pressed
+ * and released at once does in the window; headless --press acts so on the state). */
+#define VIEW_TAP_S (1.0 / 30.0)
+void view_state_tap(view_state *s, view_action a);
 /* Mouse motion of (dx, dy) pixels: turns the view (or, orbiting, moves about the target). */
 void view_state_look(view_state *s, double dx, double dy);
 /* Scroll: the field of view narrows (clicks > 0) or widens. */
@@ -169,12 +173,15 @@ typedef struct view_opts {
     int preview;         /* --preview: scripted frames previewed while the camera or the sun moves
                             and refined when still, as an interactive session's are */
     double screen_layer_px; /* Harris's cloud holding the eye: atmos_frame.screen_layer_px (0: off) */
-    const char *script, *record, *save_base, *press;
+    const char *script, *record, *save_base;
+    const char *press;   /* --press: keys pressed at the second frame (window: through its event
+                            queue; headless: view_state_tap) */
     int passed;          /* arguments left for atmos render's parser */
     char **pass;
 } view_opts;
-/* The SDL key codes of comma-separated key names (as --help prints them, any case) into
- * codes; returns the count, or -1 for an unknown name or more than cap (view_keys.c). */
+/* The SDL key codes of comma-separated key names or script names (as --help prints them, any
+ * case; a script name gives its action's first key) into codes; returns the count, or -1 for
+ * an unknown name or more than cap (view_keys.c). */
 int view_key_codes(const char *list, int *codes, int cap);
 /* Opens the window (unless headless) and runs frames until quit or o->frames; text: the
  * scene file's JSON ("{}" for none). Returns an exit status. */

@@ -37,13 +37,15 @@ static void help(void)
            "  --script FILE      play a flight: {\"fps\": 24, \"keys\": [{\"t\": 0, \"position_m\": [x, y, z],\n"
            "                     \"look_at_m\": [x, y, z], \"sun\": {\"elevation_deg\": e, \"azimuth_deg\": a},\n"
            "                     \"press\": \"NAME\"}, ...]} (camera and sun interpolated; \"press\" acts at t)\n"
-           "  --frames N         play N frames (of the script, or an orbit about the volume) and exit\n"
+           "  --frames N         play N frames and exit: of the script, or else a full turn of the camera\n"
+           "                     about the volume's centre (no volume: the point the camera looks at)\n"
            "  --record DIR       write every frame as DIR/frame_NNNNN.png and DIR/frames.csv (frame, ms =\n"
            "                     the frame's wall time including presentation, renderer, impostor_updates,\n"
            "                     camera, sun, preview, impostors_coarse)\n"
            "  --headless         no window (with --frames: render and record only)\n"
-           "  --press KEYS       press these keys (names as below, comma-separated) at the first frame,\n"
-           "                     through the window's event queue as a user's keys\n"
+           "  --press KEYS       press these keys (key or script names as below, comma-separated) at the\n"
+           "                     second frame (so --frames 2 at least): through the window's event queue\n"
+           "                     as a user's keys; --headless, each acts on the view as a tap (1/30 s)\n"
            "  --save-base BASE   where F12/P saves: BASE_NNN.exr, .png, .json (default view_NNN in the\n"
            "                     current folder); the .json renders the same frame with atmos render\n"
            "  --impostor-budget N  Harris's renderer: make at most N impostors a frame in full, those\n"
@@ -103,6 +105,8 @@ static int parse(int argc, char **argv, view_opts *o)
         }
     }
     if (o->headless && !o->frames) return cli_usage_error("view", "--headless needs --frames N");
+    if (o->press && o->frames == 1)
+        return cli_usage_error("view", "--press acts at the second frame: it needs --frames 2 or more");
     return CLI_EXIT_OK;
 }
 

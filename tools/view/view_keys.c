@@ -89,6 +89,13 @@ int view_key_codes(const char *list, int *codes, int cap)
         const size_t len = e ? (size_t)(e - p) : strlen(p);
         const view_key *k = keys;
         while (k->sym && !(strlen(k->key) == len && !strncasecmp(k->key, p, len))) k++;
+        if (!k->sym) { /* a script name: its action's first key */
+            char name[32] = "";
+            if (len < sizeof name) memcpy(name, p, len), name[len] = 0;
+            const view_action a = view_action_named(name);
+            k = keys;
+            while (k->sym && (a == VA_NONE || k->action != a)) k++;
+        }
         if (!k->sym || n >= cap) return -1;
         codes[n++] = k->sym;
         p += len + (e != NULL);

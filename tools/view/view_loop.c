@@ -253,11 +253,20 @@ static int save(loop *L, const view_opts *o, view_state *s, const char *text)
     if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
     view_state saved = *s;
     saved.manual_exposure = 1, saved.ev = ev;
+    atmos_scene sc = *L->sc; /* the volume where the plan put it (a default placement follows the
+                                camera, which has moved since) */
+    double off[3], lo[3], hi[3];
+    const atmos_volume *v = atmos_plan_volume(p, off);
+    if (v) {
+        atmos_volume_bounds(v, lo, hi);
+        sc.volume.placed = 1;
+        for (int i = 0; i < 3; i++) sc.volume.position_m[i] = off[i] + (i == 1 ? lo[i] : 0.5 * (lo[i] + hi[i]));
+    }
     char base[4096];
     snprintf(base, sizeof base, "%s_%03d", o->save_base ? o->save_base : "view", ++L->saves);
     /* its folder made as atmos render makes its outputs' */
     if (cli_output_folder("view", "--save-base", base) != 0) return CLI_EXIT_RUNTIME;
-    return view_save(L->ctx, base, text, L->sc, &saved, L->lin, L->disp);
+    return view_save(L->ctx, base, text, &sc, &saved, L->lin, L->disp);
 }
 
 static void overlay(const view_state *s, double ms, char lines[4][160])
@@ -304,6 +313,18 @@ static int start(loop *L, const view_opts *o, view_state *s, view_script *script
     return CLI_EXIT_OK;
 }
 
+/* --press's keys: through the window's event queue, as a user's; headless, tapped on the state
+ * (view_state_tap: what the window does with a key pressed and released at once). */
+static void press(view_window *win, view_state *s, const char *keys)
+{
+    int codes[16];
+    const int n = view_key_codes(keys, codes, 16);
+    for (int k = 0; k < n; k++) {
+        if (win) view_window_push_key(win, codes[k]);
+        else view_state_tap(s, view_key_action(codes[k]));
+    }
+}
+
 int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atmos_volume *vol, const char *text)
 {
     loop L;
@@ -321,15 +342,12 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
     if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record);
     const int scripted = o->frames > 0 || o->script;
     double last_ms = 0.0;
+    int pressed = 0;
     view_pose pose = view_pose_of(&s);
     for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!o->frames || i < o->frames); i++) {
         const double t0 = cli_now_s();
         if (scripted) view_script_step(&script, &s, (i - 1) / script.fps, i / (script.fps > 0 ? script.fps : 24), i, o->frames);
-        if (win && i == 1 && o->press) {
-            int codes[16];
-            const int n = view_key_codes(o->press, codes, 16);
-            for (int k = 0; k < n; k++) view_window_push_key(win, codes[k]);
-        }
+        if (i == 1 && o->press) press(win, &s, o->press), pressed = 1;
         if (win) view_window_events(win, &s, last_ms > 0 ? last_ms / 1000.0 : 1.0 / 30.0);
         const int moving = i > 0 && (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && view_moved(&pose, &s);
         s.changes = 0;
@@ -354,6 +372,8 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
             fprintf(stderr, "atmos view: the frame was not saved; the session goes on\n");
         s.save = 0;
     }
+    if (o->press && !pressed && rc == CLI_EXIT_OK) /* the session ended before its second frame */
+        fprintf(stderr, "atmos view: --press %s: not pressed: the session ended before its second frame\n", o->press);
     if (view_record_close(&rec) != CLI_EXIT_OK && rc == CLI_EXIT_OK) rc = CLI_EXIT_RUNTIME;
     view_window_close(win);
     view_script_free(&script);

@@ -1,7 +1,9 @@
 /* Recording a flight and saving a view (view.h). A saved view is the frame's linear EXR,
  * the PNG as shown, and a scene file that renders the same image offline: the scene file
  * the viewer opened, edited with cJSON to hold the viewer's camera, sun, size, renderer and
- * exposure (and the volume's resolved path), so every other setting stays as written. */
+ * exposure (and the volume's absolute path and its placement), so every other setting stays
+ * as written. */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "view.h"
 
 #include <cjson/cJSON.h>
@@ -143,9 +145,14 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
             if (sc->volume.sim_detail > 0) cJSON_AddNumberToObject(o, "detail", sc->volume.sim_detail);
             if (sc->volume.sim_ice) cJSON_AddBoolToObject(o, "ice", 1);
             set(vol, "simulate", o);
-        } else {
-            set(vol, gen ? "generate" : "file", cJSON_CreateString(gen ? sc->volume.source + 9 : sc->volume.source));
+        } else if (gen) {
+            set(vol, "generate", cJSON_CreateString(sc->volume.source + 9));
+        } else { /* absolute: the saved scene's own folder is not the one the path was relative to */
+            char *abs = realpath(sc->volume.source, NULL);
+            set(vol, "file", cJSON_CreateString(abs ? abs : sc->volume.source));
+            free(abs);
         }
+        if (sc->volume.placed) set(vol, "position_m", cJSON_CreateDoubleArray(sc->volume.position_m, 3));
     }
     char *text = cJSON_Print(root);
     cJSON_Delete(root);

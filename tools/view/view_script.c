@@ -1,5 +1,5 @@
 /* Flights (view.h): keyframes of the camera and the sun read from a JSON file with cJSON,
- * played on the viewer's clock; without a script, an orbit about the target. */
+ * played on the viewer's clock; without a script, an orbit about the target (view_state's). */
 #include "view.h"
 
 #include <cjson/cJSON.h>
@@ -102,13 +102,13 @@ static void place(view_state *st, const double pos[3], const double look_at[3])
     st->changes |= VIEW_CHANGED_CAMERA;
 }
 
-/* A frame's step of a full turn: about the volume, or (no volume) the camera panning in
- * place. */
+/* A frame's step of a full turn about the target, looking at it: the volume's centre, or (no
+ * volume) the point the scene's camera looks at, whose frame 0 is then the scene's own (a
+ * volume's is aimed at its centre). */
 static void orbit(view_state *st, int frame, int frames)
 {
     const double step = 360.0 / (frames > 0 ? frames : 1) * (frame > 0);
-    if (!st->has_volume) {
-        st->yaw_deg = fmod(st->yaw_deg + step, 360.0);
+    if (!st->has_volume && frame == 0) {
         st->changes |= VIEW_CHANGED_CAMERA;
         return;
     }

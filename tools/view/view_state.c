@@ -96,6 +96,12 @@ void view_state_init(view_state *s, const atmos_scene *sc, const atmos_frame *f,
     if (target) memcpy(s->target, target, sizeof s->target);
     else memcpy(s->target, f->camera.look_at, sizeof s->target);
     for (int i = 0; i < 3; i++) d[i] = s->target[i] - s->pos[i];
+    const double *la = f->camera.look_at;
+    if (!target && (!(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0) || (la[0] == 0 && la[1] == 0 && la[2] == 0))) {
+        /* the default look-at (zero, camera.h): 1 km ahead */
+        view_state_forward(s, d);
+        for (int i = 0; i < 3; i++) d[i] *= 1000.0, s->target[i] = s->pos[i] + d[i];
+    }
     /* a tenth of the distance to what is looked at per second, at least 5 m/s */
     s->speed = fmax(5.0, 0.1 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
     atmos_direction_to_angles(f->sun_dir, &s->sun_el, &s->sun_az);
@@ -109,6 +115,11 @@ void view_state_init(view_state *s, const atmos_scene *sc, const atmos_frame *f,
     s->spectral = sc->wavelengths == ATMOS_WAVELENGTHS_SPECTRAL;
     s->overlay = 1;
     s->changes = VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN;
+}
+
+void view_state_tap(view_state *s, view_action a)
+{
+    view_state_apply(s, a, view_action_held(a) ? VIEW_TAP_S : 0.0, 0, 0);
 }
 
 /* Moves the camera along its own axes (or, orbiting, about the target). */

@@ -136,9 +136,8 @@ int view_window_present(view_window *v, const unsigned char *rgba, int w, int h,
     return 0;
 }
 
-/* A held action's press acts at once by a thirtieth of a second's worth (a tap), then for
- * every frame's time while held. */
-#define TAP_S (1.0 / 30.0)
+/* A held action's press acts at once by a tap's worth (VIEW_TAP_S), then for every frame's
+ * time while held. */
 
 static void key_event(view_window *v, view_state *s, const SDL_KeyboardEvent *k)
 {
@@ -148,7 +147,7 @@ static void key_event(view_window *v, view_state *s, const SDL_KeyboardEvent *k)
     if (view_action_held(a)) {
         if (k->type == SDL_KEYDOWN && !k->repeat) {
             v->held[a] = 1 + fast + 2 * slow;
-            view_state_apply(s, a, TAP_S, fast, slow);
+            view_state_apply(s, a, VIEW_TAP_S, fast, slow);
         } else if (k->type == SDL_KEYUP) {
             v->held[a] = 0;
         }

@@ -1,0 +1,62 @@
+#!/bin/sh
+# atmos view --press (docs/viewer.md): the keys act at the second frame, in a window (through
+# its event queue) and headless (on the state) alike; script names are accepted as key names;
+# a press that cannot act is refused or said, never dropped. And --frames N without a volume
+# orbits the camera about the point it looks at (it used to pan in place, away from it).
+. "$(dirname "$0")/common.inc"
+cd "$T" || exit 1
+
+# headless: I raises the sun by a tap's worth (20 degrees a second for 1/30 s) at frame 1
+for k in I sun_up; do
+    "$A" view --headless --frames 3 --size 16x9 --press "$k" --record "r_$k" >"$T/o_$k.txt" 2>&1
+    st=$?
+    python3 - "r_$k/frames.csv" <<'PY' && ok "--headless --press $k: exit $st, the sun 20/30 degrees higher at frame 1" || { bad "--headless --press $k (exit $st)"; cat "$T/o_$k.txt" >&2; }
+import csv, sys
+r = list(csv.DictReader(open(sys.argv[1])))
+e = [float(x["sun_elevation_deg"]) for x in r]
+assert len(e) == 3 and abs(e[1] - e[0] - 20.0 / 30) < 1e-3 and e[2] == e[1], e
+PY
+done
+
+# headless F12: saved at frame 1
+"$A" view --headless --frames 2 --size 16x9 --press F12 --save-base hs/v >"$T/o_s.txt" 2>&1
+st=$?
+[ $st -eq 0 ] && [ -s hs/v_001.json ] && [ -s hs/v_001.exr ] && [ ! -e hs/v_002.json ] &&
+    ok "--headless --press F12: one save" || { bad "--headless --press F12 (exit $st)"; cat "$T/o_s.txt" >&2; }
+
+# a session too short for the second frame: refused before any work, with a usage error
+"$A" view --headless --frames 1 --size 16x9 --press F12 --save-base one/v >/dev/null 2>"$T/e1.txt"
+st=$?
+[ $st -eq 2 ] && grep -q "atmos view: --press" "$T/e1.txt" && [ ! -e one ] &&
+    ok "--frames 1 --press: exit 2, said" || { bad "--frames 1 --press: exit $st"; cat "$T/e1.txt" >&2; }
+
+# an unknown name: exit 2
+"$A" view --headless --frames 2 --size 16x9 --press nope >/dev/null 2>"$T/e2.txt"
+st=$?
+[ $st -eq 2 ] && grep -q "unknown key" "$T/e2.txt" && ok "--press nope: exit 2" || bad "--press nope: exit $st"
+
+# --frames without a volume: an orbit about the camera's look-at point (the spotlight scene's
+# [0, 9, 0]): every frame at the same distance from it, looking at it
+cat >orbit.json <<'JSON'
+{"camera": {"type": "pinhole", "position_m": [0, 7, 32], "look_at_m": [0, 9, 0], "fov_deg": 55}}
+JSON
+"$A" view orbit.json --headless --frames 5 --size 16x9 --record orb >"$T/o_o.txt" 2>&1
+st=$?
+python3 - orb/frames.csv <<'PY' && ok "--frames 5 without a volume orbits the look-at point (exit $st)" || { bad "--frames without a volume (exit $st)"; cat "$T/o_o.txt" >&2; }
+import csv, math, sys
+r = list(csv.DictReader(open(sys.argv[1])))
+assert len(r) == 5, r
+c = [0.0, 9.0, 0.0]
+d0 = math.dist([0, 7, 32], c)
+yaws = set()
+for x in r:
+    p = [float(x["x_m"]), float(x["y_m"]), float(x["z_m"])]
+    assert abs(math.dist(p, c) - d0) < 0.01 * d0, (p, d0)
+    yaw, pitch = math.radians(float(x["yaw_deg"])), math.radians(float(x["pitch_deg"]))
+    f = [math.cos(pitch) * math.sin(yaw), math.sin(pitch), -math.cos(pitch) * math.cos(yaw)]
+    t = [p[i] + math.dist(p, c) * f[i] for i in range(3)]   # where the view points at that distance
+    assert math.dist(t, c) < 0.01 * d0, (x, t)
+    yaws.add(round(float(x["yaw_deg"])))
+assert len(yaws) == 5, yaws   # it does go round
+PY
+exit $fail
