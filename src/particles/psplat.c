@@ -66,14 +66,15 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
     return 1;
 }
 
-/* The columns [*ja, *jb) of a row (n pixels from u0, du apart) that may lie within the cut:
+/* The columns [*ja, *jb) of a row (n pixels from u0, 1 / idu apart) that may lie within the cut:
  * b^2 <= rc2 is g(u) = (a2 - rc2 e2) u^2 + (a1 - rc2 e1) u + a0 - rc2 e0 <= 0 (the denominator
  * |d|^2 > 0), between g's roots, widened by SPAN_SLACK pixels on each side for the roots'
  * rounding (far below a pixel in double precision; the pixels' own test decides); none when
  * g has no root by far more than its terms' rounding; the whole row when g is not a parabola
  * open upwards (the eye within the cut's reach). */
-static void row_span(double a0, double a1, double a2, double e0, double e1, double e2, double rc2, double u0, double du,
-                     int n, int *ja, int *jb)
+static inline __attribute__((always_inline)) void row_span(double a0, double a1, double a2, double e0, double e1,
+                                                           double e2, double rc2, double u0, double idu, int n, int *ja,
+                                                           int *jb)
 {
     const double A = a2 - rc2 * e2, B = a1 - rc2 * e1, C = a0 - rc2 * e0, disc = B * B - 4.0 * A * C;
     *ja = 0, *jb = n;
@@ -82,8 +83,8 @@ static void row_span(double a0, double a1, double a2, double e0, double e1, doub
         *jb = 0;
         return;
     }
-    const double sq = sqrt(disc > 0 ? disc : 0.0), lo = (-B - sq) / (2.0 * A), hi = (-B + sq) / (2.0 * A);
-    const double jl = ceil(fmax((lo - u0) / du - SPAN_SLACK, -1.0)), jh = floor(fmin((hi - u0) / du + SPAN_SLACK, n)) + 1;
+    const double sq = sqrt(disc > 0 ? disc : 0.0), h = 0.5 / A, lo = (-B - sq) * h, hi = (-B + sq) * h;
+    const double jl = ceil(fmax((lo - u0) * idu - SPAN_SLACK, -1.0)), jh = floor(fmin((hi - u0) * idu + SPAN_SLACK, n)) + 1;
     *ja = jl > 0 ? (int)jl : 0, *jb = jh < n ? (int)jh : n;
     if (*jb < *ja) *jb = *ja;
 }
@@ -171,7 +172,7 @@ __attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, 
         cross(rel, D, P);
         const double a0 = dot(P, P), a1 = 2.0 * dot(P, Q), e0 = dot(D, D), e1 = 2.0 * dot(D, R);
         int ja, jb;
-        row_span(a0, a1, a2, e0, e1, e2, rc2, u0, du, x1 - x0, &ja, &jb);
+        row_span(a0, a1, a2, e0, e1, e2, rc2, u0, 1.0 / du, x1 - x0, &ja, &jb);
         if (ja >= jb) continue;
         if (L.n + (jb - ja) > LANES) flush(&L, q, nw, x0, rc2, k2, cam->width, img);
         /* whole vectors of 4 (the lanes past the span are the next row's or unused) */
