@@ -116,18 +116,16 @@ static inline __attribute__((always_inline)) void flush(lanes *L, const sp *q, i
         const double *b2 = L->b2 + o;
         float *row = img->pixels + ((size_t)L->y[r] * width + x0 + L->ja[r]) * C;
         if (nw == 3 && C == 4) {
-            /* three wavelengths and coverage: every value v of the span becomes v t + c (1 - t),
-             * t = 1 (the pixel left as it is, exactly) beyond the cut, the coverage's t the
-             * mean transmittance and c = 1 (1 - (1 - v) t); one loop over the span's values */
-            float TT[4 * TILE];
-            const float c4[4] = {col[0], col[1], col[2], 1.0f};
+            /* three wavelengths and coverage: every value v of a pixel within the cut becomes
+             * v t + c (1 - t), the coverage's t the mean transmittance and c = 1 */
+            const float *T0 = L->T[0] + o, *T1 = L->T[1] + o, *T2 = L->T[2] + o;
             for (int j = 0; j < n; j++) {
-                const int in = b2[j] <= rc2;
-                const float t0 = in ? L->T[0][o + j] : 1.0f, t1 = in ? L->T[1][o + j] : 1.0f,
-                            t2 = in ? L->T[2][o + j] : 1.0f;
-                TT[4 * j] = t0, TT[4 * j + 1] = t1, TT[4 * j + 2] = t2, TT[4 * j + 3] = in ? (t0 + t1 + t2) / 3.0f : 1.0f;
+                if (b2[j] > rc2) continue;
+                float *px = row + 4 * j;
+                const float t0 = T0[j], t1 = T1[j], t2 = T2[j], tm = (t0 + t1 + t2) / 3.0f;
+                px[0] = px[0] * t0 + col[0] * (1.0f - t0), px[1] = px[1] * t1 + col[1] * (1.0f - t1);
+                px[2] = px[2] * t2 + col[2] * (1.0f - t2), px[3] = px[3] * tm + 1.0f * (1.0f - tm);
             }
-            for (int i = 0; i < 4 * n; i++) row[i] = row[i] * TT[i] + c4[i & 3] * (1.0f - TT[i]);
             continue;
         }
         for (int j = 0; j < n; j++) {
