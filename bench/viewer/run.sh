@@ -49,6 +49,8 @@
 # OMP_WAIT_POLICY=passive, --frames 120: field200k 15.5 / 15.3 -> 19.7 / 18.6 fps median (1 % low
 # 7.8 / 8.0 -> 10.0 / 10.3, run's CPU 13.7 / 13.5 -> 12.1 / 12.1 s); field 26.0 / 26.3 -> 31.2 /
 # 28.9 fps (1 % low 17.6 / 15.4 -> 22.4 / 21.7); field_snap the same CPU.
+# A splat's rows only within its cut (docs/viewer.md), the same images: one thread's CPU a
+# field200k frame 38 / 39 -> 30 / 31 ms (bench/viewer/cpu.sh, load 5); wall times at load 4-8 scatter.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)

@@ -12,6 +12,8 @@
 #include <string.h>
 
 #define TILE 32
+#define SPAN_SLACK 0.05 /* pixels */
+#define LANES 64        /* a batch of row spans (draw) */
 #define SQRT_2PI 2.5066282746310002
 
 typedef struct sp {
@@ -64,70 +66,123 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
     return 1;
 }
 
-/* Composites splat q over the pixels of its box inside tile (tx, ty). Pixel (x, y)'s ray is
- * d = F + u R + v U (u, v: the pixel's place on the image plane at unit distance); its squared
- * distance from the centre is b^2 = |rel x d|^2 / |d|^2, and along a row both are quadratics in
- * u: b^2 = (a0 + a1 u + a2 u^2) / (e0 + e1 u + e2 u^2), the coefficients once per row (double:
- * a0 is |rel|^2 |d|^2, b^2 a small difference). The row's column depths go through a
- * branch-free loop first (vectorised), then the pixels inside the cut are composited. */
-__attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, int nw, const atmos_camera *cam, int tx,
-                                                                    int ty, atmos_image *img)
+/* The columns [*ja, *jb) of a row (n pixels from u0, 1 / idu apart) that may lie within the cut:
+ * b^2 <= rc2 is g(u) = (a2 - rc2 e2) u^2 + (a1 - rc2 e1) u + a0 - rc2 e0 <= 0 (the denominator
+ * |d|^2 > 0), between g's roots, widened by SPAN_SLACK pixels on each side for the roots'
+ * rounding (far below a pixel in double precision; the pixels' own test decides); none when
+ * g has no root by far more than its terms' rounding; the whole row when g is not a parabola
+ * open upwards (the eye within the cut's reach). */
+static inline __attribute__((always_inline)) void row_span(double a0, double a1, double a2, double e0, double e1,
+                                                           double e2, double rc2, double u0, double idu, int n, int *ja,
+                                                           int *jb)
 {
-    const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
-    const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
-    const double W = cam->width, H = cam->height, t = cam->tan_half_fov, k2 = 1.0 / (q->s * q->s);
+    const double A = a2 - rc2 * e2, B = a1 - rc2 * e1, C = a0 - rc2 * e0, disc = B * B - 4.0 * A * C;
+    *ja = 0, *jb = n;
+    if (!(A > 0) || !isfinite(disc)) return;
+    if (disc < -1e-12 * (B * B + fabs(4.0 * A * C))) {
+        *jb = 0;
+        return;
+    }
+    const double sq = sqrt(disc > 0 ? disc : 0.0), h = 0.5 / A, lo = (-B - sq) * h, hi = (-B + sq) * h;
+    const double jl = ceil(fmax((lo - u0) * idu - SPAN_SLACK, -1.0)), jh = floor(fmin((hi - u0) * idu + SPAN_SLACK, n)) + 1;
+    *ja = jl > 0 ? (int)jl : 0, *jb = jh < n ? (int)jh : n;
+    if (*jb < *ja) *jb = *ja;
+}
+
+/* A batch of a splat's row spans laid end to end (lanes), so that the columns and the
+ * transmittances run over whole vectors of 8 for several short rows at once; lane off[r] + i
+ * is pixel (ja[r] + i, y[r]) of the rows' box. */
+typedef struct lanes {
+    int n, rows;                                   /* lanes and rows held */
+    int y[TILE], ja[TILE], len[TILE], off[TILE];   /* a piece has at most TILE rows */
+    double b2[LANES + 8];                          /* squared distance from the centre */
+    float g[LANES + 8], T[ATMOS_MAX_WAVELENGTHS][LANES + 8];
+} lanes;
+
+/* The batch's columns and transmittances (vector loops over its lanes rounded up to 8; the
+ * lanes past n hold the centre), then each row's pixels within the cut composited; empties
+ * the batch. */
+static inline __attribute__((always_inline)) void flush(lanes *L, const sp *q, int nw, int x0, double rc2, double k2,
+                                                        int width, atmos_image *img)
+{
+    const int nn = (L->n + 7) & ~7, C = img->channels;
     const float *tc = q->tc, *col = q->col;
-    const double rc2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT * q->s * q->s;
-    const double *F = cam->forward, *R = cam->right, *U = cam->up;
-    double rel[3], Q[3];
-    for (int i = 0; i < 3; i++) rel[i] = q->c[i] - cam->position[i];
-    cross(rel, R, Q);
-    const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, u0 = (2.0 * x0 + 1.0 - W) / H * t;
-    /* the row's loops run over whole vectors of 8 (nn: n rounded up, at most TILE; the values
-     * past n are not used): no scalar remainder loops */
-    const int C = img->channels, n = x1 - x0, nn = (n + 7) & ~7;
-    double b2[TILE];
-    float g[TILE], T[ATMOS_MAX_WAVELENGTHS][TILE];
-    for (int y = y0; y < y1; y++) {
-        const double v = (H - 2.0 * (y + 0.5)) / H * t;
-        double D[3], P[3];
-        for (int i = 0; i < 3; i++) D[i] = F[i] + v * U[i];
-        cross(rel, D, P);
-        const double a0 = dot(P, P), a1 = 2.0 * dot(P, Q), e0 = dot(D, D), e1 = 2.0 * dot(D, R);
-        for (int j = 0; j < nn; j++) {
-            const double u = u0 + j * du;
-            b2[j] = (a0 + u * (a1 + u * a2)) / (e0 + u * (e1 + u * e2));
-        }
-        for (int j = 0; j < nn; j++) g[j] = atmos__pcloud_column((float)(b2[j] * k2));
-        /* the transmittances wavelength by wavelength over the row (vectorised), then the
-         * pixels within the cut composited with them */
-        for (int k = 0; k < nw; k++)
-            for (int j = 0; j < nn; j++) T[k][j] = atmos__expf_fast(-tc[k] * g[j]);
-        float *row = img->pixels + ((size_t)y * cam->width + x0) * C;
+    for (int i = L->n; i < nn; i++) L->b2[i] = 0.0;
+    for (int i = 0; i < nn; i++) L->g[i] = atmos__pcloud_column((float)(L->b2[i] * k2));
+    for (int k = 0; k < nw; k++)
+        for (int i = 0; i < nn; i++) L->T[k][i] = atmos__expf_fast(-tc[k] * L->g[i]);
+    for (int r = 0; r < L->rows; r++) {
+        const int n = L->len[r], o = L->off[r];
+        const double *b2 = L->b2 + o;
+        float *row = img->pixels + ((size_t)L->y[r] * width + x0 + L->ja[r]) * C;
         if (nw == 3 && C == 4) {
-            /* three wavelengths and coverage: every value v of the row becomes v t + c (1 - t),
-             * t = 1 (the pixel left as it is, exactly) beyond the cut, the coverage's t the
-             * mean transmittance and c = 1 (1 - (1 - v) t); one loop over the row's values */
-            float TT[4 * TILE];
-            const float c4[4] = {col[0], col[1], col[2], 1.0f};
+            /* three wavelengths and coverage: every value v of a pixel within the cut becomes
+             * v t + c (1 - t), the coverage's t the mean transmittance and c = 1 */
+            const float *T0 = L->T[0] + o, *T1 = L->T[1] + o, *T2 = L->T[2] + o;
             for (int j = 0; j < n; j++) {
-                const int in = b2[j] <= rc2;
-                const float t0 = in ? T[0][j] : 1.0f, t1 = in ? T[1][j] : 1.0f, t2 = in ? T[2][j] : 1.0f;
-                TT[4 * j] = t0, TT[4 * j + 1] = t1, TT[4 * j + 2] = t2, TT[4 * j + 3] = in ? (t0 + t1 + t2) / 3.0f : 1.0f;
+                if (b2[j] > rc2) continue;
+                float *px = row + 4 * j;
+                const float t0 = T0[j], t1 = T1[j], t2 = T2[j], tm = (t0 + t1 + t2) / 3.0f;
+                px[0] = px[0] * t0 + col[0] * (1.0f - t0), px[1] = px[1] * t1 + col[1] * (1.0f - t1);
+                px[2] = px[2] * t2 + col[2] * (1.0f - t2), px[3] = px[3] * tm + 1.0f * (1.0f - tm);
             }
-            for (int i = 0; i < 4 * n; i++) row[i] = row[i] * TT[i] + c4[i & 3] * (1.0f - TT[i]);
             continue;
         }
         for (int j = 0; j < n; j++) {
             if (b2[j] > rc2) continue;
             float *px = row + (size_t)j * C, tm = 0;
             for (int k = 0; k < nw; k++) {
-                px[k] = px[k] * T[k][j] + col[k] * (1.0f - T[k][j]);
-                tm += T[k][j];
+                px[k] = px[k] * L->T[k][o + j] + col[k] * (1.0f - L->T[k][o + j]);
+                tm += L->T[k][o + j];
             }
             px[nw] = 1.0f - (1.0f - px[nw]) * tm / nw;
         }
     }
+    L->n = L->rows = 0;
+}
+
+/* Composites splat q over the pixels of its box inside tile (tx, ty). Pixel (x, y)'s ray is
+ * d = F + u R + v U (u, v: the pixel's place on the image plane at unit distance); its squared
+ * distance from the centre is b^2 = |rel x d|^2 / |d|^2, and along a row both are quadratics in
+ * u: b^2 = (a0 + a1 u + a2 u^2) / (e0 + e1 u + e2 u^2), the coefficients once per row (double:
+ * a0 is |rel|^2 |d|^2, b^2 a small difference). Only the row's columns that may lie within the
+ * cut are visited (row_span: a small splat's box is mostly outside its cut), their b^2 laid in
+ * a batch of lanes (flush) with the next rows'. A pixel beyond the cut is left as it is, so
+ * the spans change no value. */
+__attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, int nw, const atmos_camera *cam, int tx,
+                                                                    int ty, atmos_image *img)
+{
+    const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;
+    const int y0 = q->bb[2] > ty ? q->bb[2] : ty, y1 = q->bb[3] < ty + TILE ? q->bb[3] : ty + TILE;
+    const double W = cam->width, H = cam->height, t = cam->tan_half_fov, k2 = 1.0 / (q->s * q->s);
+    const double rc2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT * q->s * q->s;
+    const double *F = cam->forward, *R = cam->right, *U = cam->up;
+    double rel[3], Q[3];
+    for (int i = 0; i < 3; i++) rel[i] = q->c[i] - cam->position[i];
+    cross(rel, R, Q);
+    const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, u0 = (2.0 * x0 + 1.0 - W) / H * t;
+    lanes L;
+    L.n = L.rows = 0;
+    for (int y = y0; y < y1; y++) {
+        const double v = (H - 2.0 * (y + 0.5)) / H * t;
+        double D[3], P[3];
+        for (int i = 0; i < 3; i++) D[i] = F[i] + v * U[i];
+        cross(rel, D, P);
+        const double a0 = dot(P, P), a1 = 2.0 * dot(P, Q), e0 = dot(D, D), e1 = 2.0 * dot(D, R);
+        int ja, jb;
+        row_span(a0, a1, a2, e0, e1, e2, rc2, u0, 1.0 / du, x1 - x0, &ja, &jb);
+        if (ja >= jb) continue;
+        if (L.n + (jb - ja) > LANES) flush(&L, q, nw, x0, rc2, k2, cam->width, img);
+        /* whole vectors of 4 (the lanes past the span are the next row's or unused) */
+        double *b2 = L.b2 + L.n;
+        const int n4 = (jb - ja + 3) & ~3;
+        for (int i = 0; i < n4; i++) {
+            const double u = u0 + (ja + i) * du;
+            b2[i] = (a0 + u * (a1 + u * a2)) / (e0 + u * (e1 + u * e2));
+        }
+        L.y[L.rows] = y, L.ja[L.rows] = ja, L.len[L.rows] = jb - ja, L.off[L.rows++] = L.n, L.n += jb - ja;
+    }
+    if (L.rows) flush(&L, q, nw, x0, rc2, k2, cam->width, img);
 }
 
 /* The rays of tile (tx, ty)'s pixels for a fisheye or equirectangular camera (atmos_camera_ray;
