@@ -77,6 +77,52 @@ same_as_render "clear_noon_fisheye.json" 48x48 corners "$S/clear_noon_fisheye.js
 same_as_render "sunrise_equirect.json" 64x32 "" "$S/sunrise_equirect.json"
 same_as_render "--camera fisheye" 48x48 corners --camera fisheye
 
+# A volume's frame 0 is framed as atmos render frames it (the scene's camera, not one aimed at
+# the volume's centre), for a generated volume given on the command line and for a scene's
+# (Harris's field, its camera pitched 4 degrees up); the sun's columns of frames.csv give the
+# sun that lights them
+same_as_render "--volume generate:cumulus" 64x36 "" --volume generate:cumulus
+python3 - rec/frames.csv <<'PY' && ok "frames.csv: the sun of a sunlit volume" || bad "frames.csv: the sunlit volume's sun"
+import csv, sys
+r = list(csv.DictReader(open(sys.argv[1])))
+assert abs(float(r[0]["sun_elevation_deg"]) - 22) < 1e-3 and abs(float(r[0]["sun_azimuth_deg"]) - 235) < 1e-3, r
+PY
+# its --frames orbit: the scene's camera turned about the vertical through the cloud's centre,
+# 90 degrees a frame, its pitch and height kept, its distance from that vertical too
+rm -rf orb
+"$A" view --volume generate:cumulus --headless --frames 4 --size 16x9 --record orb >orb.txt 2>&1 ||
+    { bad "--volume generate:cumulus --frames 4"; cat orb.txt >&2; }
+python3 - orb/frames.csv <<'PY' && ok "--frames 4 with a volume: the scene's camera turned about it, pitch kept" ||
+import csv, math, sys
+r = list(csv.DictReader(open(sys.argv[1])))
+assert len(r) == 4, r
+g = lambda x, k: float(x[k])
+assert abs(g(r[0], "pitch_deg") - 1) < 1e-3, r[0]   # atmos render's camera: 1 degree up
+for a, b in zip(r, r[1:]):
+    assert abs((g(b, "yaw_deg") - g(a, "yaw_deg")) % 360 - 90) < 1e-3, (a, b)
+    assert g(b, "pitch_deg") == g(a, "pitch_deg") and g(b, "y_m") == g(a, "y_m"), (a, b)
+# the centre on the vertical where the lines of sight of frames 0 and 2 (opposite) meet
+p = [(g(x, "x_m"), g(x, "z_m")) for x in r]
+c = ((p[0][0] + p[2][0]) / 2, (p[0][1] + p[2][1]) / 2)
+d = [math.dist(q, c) for q in p]
+assert max(d) - min(d) < 1e-3 * max(d) and max(d) > 100, d
+PY
+    bad "--frames 4 with a volume: not a turn of the scene's camera about the volume"
+same_as_render "harris_cloud_field.json" 64x36 "" "$S/harris_cloud_field.json"
+python3 - rec/frames.csv <<'PY' && ok "harris_cloud_field.json: frame 0 pitched 4 degrees up" || bad "harris_cloud_field.json: frame 0's pitch"
+import csv, sys
+r = list(csv.DictReader(open(sys.argv[1])))
+assert abs(float(r[0]["pitch_deg"]) - 4) < 0.01, r
+PY
+# a beam scene lit by its lamps only (atmos render: "lit by its 1 light and no sun"): no sun
+# in frames.csv either (docs/viewer.md: the sun's columns are empty)
+same_as_render "dobashi_fig04_spotlight.json" 64x36 "" "$S/dobashi_fig04_spotlight.json"
+python3 - rec/frames.csv <<'PY' && ok "frames.csv: no sun for a scene lit by its lamps only" || bad "frames.csv: a sun for a scene without one"
+import csv, sys
+r = list(csv.DictReader(open(sys.argv[1])))
+assert r[0]["sun_elevation_deg"] == "" and r[0]["sun_azimuth_deg"] == "", r
+PY
+
 # A fisheye with a volume: path, sky, then the slice renderer, which draws pinholes only
 # (the renderer key pressed by a flight at frames 1 and 2; F12 at frame 3). The droplets' phase
 # function is a Henyey-Greenstein lobe: no Mie tables to make in the test's fresh cache.

@@ -51,6 +51,12 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
     return CLI_EXIT_USAGE;
 }
 
+int cli_lit_without_sun(const atmos_scene *s, atmos_renderer_kind r)
+{
+    return (r == ATMOS_RENDERER_BEAMS && !s->beams.sun) ||
+           (r == ATMOS_RENDERER_PATH && (s->light_count > 0 || s->fog.enabled || s->object_count > 0));
+}
+
 int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st)
 {
     const char *msg = ctx ? atmos_context_error(ctx) : "";

@@ -19,6 +19,9 @@ int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, l
 int cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints "atmos CMD: <ctx error or status string>" to stderr; returns CLI_EXIT_RUNTIME. */
 int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st);
+/* 1 when renderer r lights scene s by its lamps only, without the sun: the beam renderer without
+ * beams.sun, the path tracer of a scene with lights, fog or objects (docs/beams.md, docs/path.md). */
+int cli_lit_without_sun(const atmos_scene *s, atmos_renderer_kind r);
 /* A context for a subcommand: logs warnings and errors to stderr (errors only when quiet: for
  * commands whose own output replaces the warnings, not for a user's -q), threads as given (0 = all). */
 atmos_context *cli_context(int threads, int quiet);

@@ -242,8 +242,7 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     if (nframes > 1) fprintf(stderr, "atmos render: frame %d/%d: ", frame, nframes);
     else fprintf(stderr, "atmos render: ");
     const atmos_renderer_kind rk = atmos_plan_renderer(plan);
-    const int lamps_only = (rk == ATMOS_RENDERER_BEAMS && !fs->beams.sun) ||
-                           (rk == ATMOS_RENDERER_PATH && (fs->light_count > 0 || fs->fog.enabled || fs->object_count > 0));
+    const int lamps_only = cli_lit_without_sun(fs, rk);
     if (lamps_only) /* the sun lights neither (docs/beams.md, docs/path.md) */
         fprintf(stderr, "%s, %dx%d, lit by its %d light%s and no sun, %.3f s rendering\n", source,
                 fs->width, fs->height, fs->light_count, fs->light_count == 1 ? "" : "s", info->seconds);

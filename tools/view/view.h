@@ -135,10 +135,11 @@ typedef struct view_recorder {
 /* Makes the folder DIR (if missing). */
 int view_record_open(view_recorder *r, const char *dir);
 /* Writes frame i: DIR/frame_NNNNN.png (disp: display sRGB) and its row of frames.csv (the
- * file and its header made with the first frame; preview: 1 for a moving view's preview). */
+ * file and its header made with the first frame; preview: 1 for a moving view's preview;
+ * sunless: 1 when the renderer lights the scene by its lamps only, the sun's columns empty). */
 int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms,
                       const char *renderer, int impostor_updates, int impostors_coarse, int preview,
-                      const view_state *s);
+                      int sunless, const view_state *s);
 int view_record_close(view_recorder *r);
 /* Saves the current view: BASE.exr (linear sRGB), BASE.png (what is shown), BASE.json (the
  * scene that renders the same image with `atmos render BASE.json`). scene_json: the text of

@@ -366,7 +366,8 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         if (win && view_window_present(win, L.rgba, L.img->width, L.img->height, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
         last_ms = 1000.0 * (cli_now_s() - t0);
         if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates,
-                                                      L.impostors_coarse, q == VIEW_PREVIEW, &s);
+                                                      L.impostors_coarse, q == VIEW_PREVIEW,
+                                                      cli_lit_without_sun(sc, s.renderer), &s);
         /* a save that fails is said (save prints why) and the session goes on */
         if (rc == CLI_EXIT_OK && s.save && save(&L, o, &s, text) != CLI_EXIT_OK)
             fprintf(stderr, "atmos view: the frame was not saved; the session goes on\n");

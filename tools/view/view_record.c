@@ -40,7 +40,7 @@ static int open_csv(view_recorder *r)
 }
 
 int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *disp, double ms, const char *renderer,
-                      int impostor_updates, int impostors_coarse, int preview, const view_state *s)
+                      int impostor_updates, int impostors_coarse, int preview, int sunless, const view_state *s)
 {
     if (!r->dir) return CLI_EXIT_OK;
     if (!r->csv && open_csv(r) != CLI_EXIT_OK) return CLI_EXIT_RUNTIME;
@@ -50,8 +50,11 @@ int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *d
      * rendering it */
     atmos_status st = atmos_write_png_level(ctx, disp, path, 8, 1);
     if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
-    fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.4f,%.4f,%d,%d\n", r->frames, ms, renderer, impostor_updates,
-            s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, s->sun_el, s->sun_az, preview, impostors_coarse);
+    char sun[64] = ""; /* empty without a sun (lit by lamps only) */
+    if (!sunless) snprintf(sun, sizeof sun, "%.4f,%.4f", s->sun_el, s->sun_az);
+    else snprintf(sun, sizeof sun, ",");
+    fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%s,%d,%d\n", r->frames, ms, renderer, impostor_updates,
+            s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, sun, preview, impostors_coarse);
     r->frames++;
     return CLI_EXIT_OK;
 }

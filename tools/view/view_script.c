@@ -102,25 +102,23 @@ static void place(view_state *st, const double pos[3], const double look_at[3])
     st->changes |= VIEW_CHANGED_CAMERA;
 }
 
-/* A frame's step of a full turn about the target, looking at it: the volume's centre, or (no
- * volume) the point the scene's camera looks at, whose frame 0 is then the scene's own (a
- * volume's is aimed at its centre). */
+/* A frame's step of a full turn of the scene's camera about the vertical through the target
+ * (the volume's centre, or without a volume the point the scene's camera looks at): its
+ * position and heading turn together, its pitch is kept, so frame 0 is the scene's own view
+ * (atmos render's) and each frame sees the target as the first one did. */
 static void orbit(view_state *st, int frame, int frames)
 {
-    const double step = 360.0 / (frames > 0 ? frames : 1) * (frame > 0);
-    if (!st->has_volume && frame == 0) {
-        st->changes |= VIEW_CHANGED_CAMERA;
-        return;
+    st->changes |= VIEW_CHANGED_CAMERA;
+    if (frame == 0) return;
+    const double step = 360.0 / (frames > 0 ? frames : 1);
+    double d[3] = {st->pos[0] - st->target[0], 0.0, st->pos[2] - st->target[2]}, el, az;
+    const double r = sqrt(d[0] * d[0] + d[2] * d[2]);
+    if (r > 0) {
+        atmos_direction_to_angles(d, &el, &az);
+        atmos_direction_from_angles(0.0, fmod(az + step, 360.0), d);
+        st->pos[0] = st->target[0] + r * d[0], st->pos[2] = st->target[2] + r * d[2];
     }
-    double d[3], el, az;
-    for (int i = 0; i < 3; i++) d[i] = st->pos[i] - st->target[i];
-    const double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    atmos_direction_to_angles(d, &el, &az);
-    az = fmod(az + step, 360.0);
-    atmos_direction_from_angles(el, az, d);
-    double pos[3];
-    for (int i = 0; i < 3; i++) pos[i] = st->target[i] + r * d[i];
-    place(st, pos, st->target);
+    st->yaw_deg = fmod(st->yaw_deg + step, 360.0);
 }
 
 void view_script_step(const view_script *s, view_state *st, double t_prev, double t, int frame, int frames)
