@@ -97,36 +97,26 @@ static void sunlight_at(const atmos_atmosphere *a, const atmos__sunlight_table *
     for (int k = 0; k < n; k++, v += e->ne) E[k] = v[0] + f * (v[1] - v[0]);
 }
 
-/* Adds the crossing's light (times the transmittance w in front of it) to out; returns
- * the crossing's transmittance. x at latitude and longitude lat, lon (atmos__planet_latlon_fast's)
- * where the column's optical depth is col. G from gs's textures, or evaluated here when gs is
- * NULL; ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
-static double crossing_light(const atmos_atmosphere *a, const double x[3], double lat, double lon, double col,
-                             const double d[3], const double sun[3], int i, double ph, const double *w,
-                             atmos__clouds_sun *gs, const atmos__sunlight_table *e, double *out)
+/* Adds the light of a crossing of sphere i at x (latitude and longitude lat, lon) to out
+ * (times the transmittance w in front of it): t the crossing's transmittance, mus the sun's
+ * cosine to the vertical there, eo = exp(-own / 2) with own the whole shell's optical depth
+ * along the sun (used when mus > 0). G from gs's textures, or evaluated here when gs is NULL;
+ * ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
+static void crossing_shade(const atmos_atmosphere *a, const double x[3], const double sun[3], double lat, double lon,
+                           int i, double t, double mus, double eo, double ph, const double *w, atmos__clouds_sun *gs,
+                           const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
-    const atmos__clouds *cl = pl->clouds;
-    if (col <= 0) return 1.0;
-    /* x is on sphere i: its vertical is (x + centre) / r_i */
-    const double inv_r = cl->inv_r[i], xc[3] = {x[0], x[1] + pl->r_ground, x[2]};
-    const double tau = atmos__clouds_shell_tau(cl, i, col, atmos__dot3(xc, d) * inv_r);
-    const double t = atmos__expf_fast((float)-tau); /* within 2e-7 of exp */
     const int n = a->wl.count;
-    const double mus = atmos__dot3(xc, sun) * inv_r;
     double E[ATMOS_MAX_WAVELENGTHS];
     sunlight_at(a, e, i, x, sun, mus, E);
     int lit = 0;
     for (int k = 0; k < n; k++) lit |= E[k] > 0;
-    if (!lit) return t;
+    if (!lit) return;
     const double G = gs ? atmos__clouds_sun_lookup(gs, x, i, lat, lon) : atmos__clouds_sun_attenuation(pl, x, sun, i);
     double J = G * ph;
-    if (!cl->single && mus > 0) {
-        const double own = atmos__clouds_shell_tau(cl, i, col, mus); /* the whole shell along the sun */
-        J += mus * (1.0 - G * atmos__expf_fast((float)(-0.5 * own))) * (1.0 / ATMOS_PI);
-    }
+    if (!pl->clouds->single && mus > 0) J += mus * (1.0 - G * eo) * (1.0 / ATMOS_PI);
     for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];
-    return t;
 }
 
 /* The ground at distance K: lit by the sunlight through the air and the clouds, and its
@@ -186,7 +176,16 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
         double lat, lon;
         atmos__planet_latlon_fast(pl, x, &lat, &lon);
         const double col = atmos__clouds_column_tau(pl->clouds, lat, lon);
-        const double tc = crossing_light(a, x, lat, lon, col, d, sun, c[j].sphere, ph, w, NULL, NULL, out);
+        double tc = 1.0;
+        if (col > 0) {
+            const atmos__clouds *cl = pl->clouds;
+            const int i = c[j].sphere;
+            const double xc[3] = {x[0], x[1] + pl->r_ground, x[2]}; /* x is on sphere i */
+            const double mus = atmos__dot3(xc, sun) * cl->inv_r[i];
+            tc = atmos__expf_fast((float)-atmos__clouds_shell_tau(cl, i, col, atmos__dot3(xc, d) * cl->inv_r[i]));
+            const double eo = atmos__expf_fast((float)(-0.5 * atmos__clouds_shell_tau(cl, i, col, mus)));
+            crossing_shade(a, x, sun, lat, lon, i, tc, mus, eo, ph, w, NULL, NULL, out);
+        }
         clouds *= tc;
         for (int k = 0; k < n; k++) w[k] *= tc;
         opaque = clouds < OPAQUE;
@@ -197,6 +196,33 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
         info->hits_ground = K < INFINITY;
         info->in_sun_disk = 0;
     }
+}
+
+/* The exponentials of the crossings' fields, side by side (built for AVX2 as well as the
+ * baseline; without FMA both give the same bits). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+static void exp_fields(float *v, int count)
+{
+    for (int j = 0; j < count; j++) v[j] = atmos__expf_fast(v[j]);
+}
+
+/* The fields of the m crossings c at x whose columns' optical depths are col, as arrays:
+ * the sun's cosine to the vertical mus[j], the crossing's transmittance ex[j] = exp(-tau)
+ * and ex[m + j] = exp(-own / 2), own the whole shell's optical depth along the sun. */
+static void crossing_fields(const atmos__planet *pl, const double d[3], const double sun[3], int m,
+                            const crossing *c, const double x[][3], const double *col, double *mus, float *ex)
+{
+    const atmos__clouds *cl = pl->clouds;
+    for (int j = 0; j < m; j++) { /* x[j] is on sphere c[j].sphere: its vertical is (x + centre) / r */
+        const int i = c[j].sphere;
+        const double xc[3] = {x[j][0], x[j][1] + pl->r_ground, x[j][2]};
+        mus[j] = atmos__dot3(xc, sun) * cl->inv_r[i];
+        ex[j] = (float)-atmos__clouds_shell_tau(cl, i, col[j], atmos__dot3(xc, d) * cl->inv_r[i]);
+        ex[m + j] = (float)(-0.5 * atmos__clouds_shell_tau(cl, i, col[j], mus[j]));
+    }
+    exp_fields(ex, 2 * m);
 }
 
 int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
@@ -216,6 +242,9 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
         atmos__planet_latlon_fast(pl, x[j], &lat[j], &lon[j]);
     }
     for (int j = 0; j < m; j++) col[j] = atmos__clouds_column_tau(pl->clouds, lat[j], lon[j]);
+    double mus[MAX_CROSSINGS];
+    float ex[2 * MAX_CROSSINGS];
+    crossing_fields(pl, d, sun, m, c, x, col, mus, ex);
     double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
     const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
     for (int k = 0; k < n; k++) out[k] = 0.0;
@@ -230,7 +259,10 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
             ground_light(a, p, d, K, sun, w, gs, e, out);
             break;
         }
-        clouds *= crossing_light(a, x[j], lat[j], lon[j], col[j], d, sun, c[j].sphere, ph, w, gs, e, out);
+        if (col[j] <= 0) continue;
+        const double t = ex[j];
+        crossing_shade(a, x[j], sun, lat[j], lon[j], c[j].sphere, t, mus[j], ex[m + j], ph, w, gs, e, out);
+        clouds *= t;
         if (clouds < OPAQUE) break;
     }
     return 1;
