@@ -198,16 +198,6 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
     }
 }
 
-/* The exponentials of the crossings' fields, side by side (built for AVX2 as well as the
- * baseline; without FMA both give the same bits). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-static void exp_fields(float *v, int count)
-{
-    for (int j = 0; j < count; j++) v[j] = atmos__expf_fast(v[j]);
-}
-
 /* The fields of the m crossings c at x whose columns' optical depths are col, as arrays:
  * the sun's cosine to the vertical mus[j], the crossing's transmittance ex[j] = exp(-tau)
  * and ex[m + j] = exp(-own / 2), own the whole shell's optical depth along the sun. */
@@ -222,7 +212,7 @@ static void crossing_fields(const atmos__planet *pl, const double d[3], const do
         ex[j] = (float)-atmos__clouds_shell_tau(cl, i, col[j], atmos__dot3(xc, d) * cl->inv_r[i]);
         ex[m + j] = (float)(-0.5 * atmos__clouds_shell_tau(cl, i, col[j], mus[j]));
     }
-    exp_fields(ex, 2 * m);
+    atmos__expf_fast_array(ex, 2 * m);
 }
 
 int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],

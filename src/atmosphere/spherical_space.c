@@ -380,16 +380,6 @@ static void cloud_disk(const atmos__sph_space *s, const atmos_atmosphere *a, con
     for (int k = 0; k < n; k++) out[(size_t)k * count + i] += wt * (float)L[k];
 }
 
-/* The exponentials of a block's interpolated logarithms; built for AVX2 as well as the
- * baseline (eight at a time instead of four; without FMA both give the same bits). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-static void exp_logs(float *v, int count)
-{
-    for (int j = 0; j < count; j++) v[j] = atmos__expf_fast(v[j]);
-}
-
 /* Rays i0 .. i0 + m - 1 (m <= BLK): the look-ups of the rays that meet the air and their
  * ground, the exponentials in one loop (which vectorises), then the phase functions. With
  * cloud spheres the disk's rays composite the clouds on the table's stops (cloud_disk) and
@@ -422,7 +412,7 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
         ap[h] = fp - ip[h], nu2[h] = nu * nu;
         h++;
     }
-    exp_logs(lv, h * S);
+    atmos__expf_fast_array(lv, h * S);
     for (int r = 0; r < h; r++) {
         float pr[ATMOS_MAX_WAVELENGTHS], pm[ATMOS_MAX_WAVELENGTHS];
         for (int k = 0; k < n; k++) {

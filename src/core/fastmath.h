@@ -39,6 +39,8 @@ static inline float atmos__expf_poly(float x)
 
 /* exp(x) with the polynomial above, 0 below -87 (relative error < 2e-7 over [-87, 88]). */
 static inline float atmos__expf_fast(float x) { return x < -87.0f ? 0.0f : atmos__expf_poly(x); }
+/* v[j] = atmos__expf_fast(v[j]) for j < count, vectorised (fastmath_array.c). */
+void atmos__expf_fast_array(float *v, int count);
 
 /* ln(1 + x) for x > -1 by one call of log, which takes fewer instructions than the C
  * library's log1p: with u = 1 + x rounded, ln(1 + x) = x ln(u) / (u - 1), x itself where

@@ -84,7 +84,9 @@ static inline __attribute__((always_inline)) void row_span(double a0, double a1,
         return;
     }
     const double sq = sqrt(disc > 0 ? disc : 0.0), h = 0.5 / A, lo = (-B - sq) * h, hi = (-B + sq) * h;
-    const double jl = ceil(fmax((lo - u0) * idu - SPAN_SLACK, -1.0)), jh = floor(fmin((hi - u0) * idu + SPAN_SLACK, n)) + 1;
+    /* both clamped to [-1, n] before the conversion (a root far off the row would overflow int) */
+    const double jl = ceil(fmin(fmax((lo - u0) * idu - SPAN_SLACK, -1.0), n));
+    const double jh = floor(fmin(fmax((hi - u0) * idu + SPAN_SLACK, -1.0), n)) + 1;
     *ja = jl > 0 ? (int)jl : 0, *jb = jh < n ? (int)jh : n;
     if (*jb < *ja) *jb = *ja;
 }
