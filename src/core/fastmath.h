@@ -56,18 +56,26 @@ static inline double atmos__log1p_fast(double x)
 
 /* atan(z) for 0 <= z <= 1 by Abramowitz & Stegun 4.4.49 (|error| <= 2e-8 rad), the polynomial
  * in z^2 = Z evaluated in type T; double and float versions. */
-#define ATMOS__ATAN_POLY(T, Z)                                                                          \
-    (((((((((T)0.0028662257 * (Z) - (T)0.0161657367) * (Z) + (T)0.0429096138) * (Z) - (T)0.0752896400) * \
-             (Z) + (T)0.1065626393) * (Z) - (T)0.1420889944) * (Z) + (T)0.1999355085) * (Z) -                \
-      (T)0.3333314528))
+#define ATMOS__ATAN_C1 -0.3333314528
+#define ATMOS__ATAN_C2 0.1999355085
+#define ATMOS__ATAN_C3 -0.1420889944
+#define ATMOS__ATAN_C4 0.1065626393
+#define ATMOS__ATAN_C5 -0.0752896400
+#define ATMOS__ATAN_C6 0.0429096138
+#define ATMOS__ATAN_C7 -0.0161657367
+#define ATMOS__ATAN_C8 0.0028662257
+#define ATMOS__ATAN_POLY(T, Z)                                                                           \
+    ((((((((T)ATMOS__ATAN_C8 * (Z) + (T)ATMOS__ATAN_C7) * (Z) + (T)ATMOS__ATAN_C6) * (Z) +              \
+          (T)ATMOS__ATAN_C5) * (Z) + (T)ATMOS__ATAN_C4) * (Z) + (T)ATMOS__ATAN_C3) * (Z) +               \
+       (T)ATMOS__ATAN_C2) * (Z) + (T)ATMOS__ATAN_C1)
 static inline double atmos__atan_unit(double z)
 {
     /* the same polynomial by Estrin's scheme: four independent pairs, then two levels, so
      * its latency is about half of Horner's eight dependent steps (the texture look-ups of
      * the clouds wait on it) */
     const double Z = z * z, Z2 = Z * Z, Z4 = Z2 * Z2;
-    const double p01 = -0.3333314528 + 0.1999355085 * Z, p23 = -0.1420889944 + 0.1065626393 * Z;
-    const double p45 = -0.0752896400 + 0.0429096138 * Z, p67 = -0.0161657367 + 0.0028662257 * Z;
+    const double p01 = ATMOS__ATAN_C1 + ATMOS__ATAN_C2 * Z, p23 = ATMOS__ATAN_C3 + ATMOS__ATAN_C4 * Z;
+    const double p45 = ATMOS__ATAN_C5 + ATMOS__ATAN_C6 * Z, p67 = ATMOS__ATAN_C7 + ATMOS__ATAN_C8 * Z;
     const double q = (p01 + p23 * Z2) + Z4 * (p45 + p67 * Z2);
     return z * (1.0 + q * Z);
 }
