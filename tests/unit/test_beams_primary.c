@@ -111,13 +111,20 @@ static void test_studio(void)
     for (int i = 0; i < 5; i++) atmos_mesh_destroy(m[i]);
 }
 
-static void test_ridges(void)
+/* A generated terrain mesh (NULL on failure, which is checked). */
+static atmos_mesh *terrain(const char *source, double size_m, double height_m, int samples, uint64_t seed)
 {
     atmos_terrain_desc t;
     memset(&t, 0, sizeof t);
-    t.source = "generate:ridges", t.size_m = 8000, t.height_m = 1500, t.samples = 65, t.seed = 7;
+    t.source = source, t.size_m = size_m, t.height_m = height_m, t.samples = samples, t.seed = seed;
     atmos_mesh *m = NULL;
     CHECK_OK(atmos_mesh_terrain(ctx, &t, &m));
+    return m;
+}
+
+static void test_ridges(void)
+{
+    atmos_mesh *m = terrain("generate:ridges", 8000, 1500, 65, 7);
     if (!m) return;
     double alb[1][ATMOS_MAX_WAVELENGTHS] = {{0}};
     const atmos__objects ob = {1, &m, alb};
@@ -146,11 +153,7 @@ static void test_ridges(void)
  * hidden or smaller than a pixel), 1.3 triangles a pixel: drawn, the same hits as traced. */
 static void test_city(void)
 {
-    atmos_terrain_desc t;
-    memset(&t, 0, sizeof t);
-    t.source = "generate:city", t.size_m = 2000, t.height_m = 150, t.samples = 97, t.seed = 5;
-    atmos_mesh *m = NULL;
-    CHECK_OK(atmos_mesh_terrain(ctx, &t, &m));
+    atmos_mesh *m = terrain("generate:city", 2000, 150, 97, 5);
     if (!m) return;
     double alb[1][ATMOS_MAX_WAVELENGTHS] = {{0}};
     const atmos__objects ob = {1, &m, alb};
