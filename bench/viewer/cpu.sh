@@ -33,8 +33,8 @@ cpu() { # scene flight size frames [extra options]
 for c in $CASES; do
     case "$c" in
     field) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 ;;
-    field200k) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 --spacing 35.5 ;;
-    million) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 --spacing 19.7 ;;
+    field200k) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 --spacing 32.6 ;;
+    million) set -- scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 1280x720 --spacing 18.1 ;;
     inside) set -- scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 1280x720 ;;
     slice) set -- scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 512x512 --preview ;;
     slice_full) set -- scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 512x512 ;;

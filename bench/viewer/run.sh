@@ -6,16 +6,19 @@
 #                       [--opts "VIEW OPTIONS"]  (atmos view options for every case, e.g. "--screen-layer-px 0")
 #
 # The cases (1280x720 unless said):
-#   field    scenes/harris_cloud_field.json (120 clouds, 99 101 particles) along
+#   field    scenes/harris_cloud_field.json (120 clouds, 100 911 particles; 99 101 before the
+#            fractal outlines) along
 #            scenes/flights/harris_cloud_field.json, 480 frames; goal 60 fps
-#   field200k  the same field with particles 35.5 m apart (--spacing 35.5: 207 030 particles),
+#   field200k  the same field with particles 32.6 m apart (--spacing 32.6: 207 584 particles;
+#            before the fractal outlines --spacing 35.5 gave 207 030),
 #            480 frames: issue 16's ">= 100 clouds / >= 200 000 particles"; goal 60 fps
 #   field_turn  the same field, the eye at its centre turning round once in 10 s
 #            (bench/viewer/field_turn.json), 240 frames: clouds never seen come into view
 #            every frame (the impostors made for the first time)
 #   field_snap  the same eye turning 90 degrees in 0.25 s three times, 2 s apart
 #            (bench/viewer/field_snap.json), 192 frames: many clouds first seen at once
-#   million  the same field with particles 19.7 m apart (--spacing 19.7: 1 209 835 particles),
+#   million  the same field with particles 18.1 m apart (--spacing 18.1: 1 198 644 particles;
+#            before the fractal outlines --spacing 19.7 gave 1 209 835),
 #            240 frames; goal 20 fps
 #   inside   scenes/harris_fly_through.json's cumulus, the eye inside it all along
 #            (bench/viewer/inside_cumulus.json), 240 frames; goal 30 fps
@@ -98,11 +101,11 @@ for c in $CASES; do
     case "$c" in
     field) run_case field scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 480 1280x720 ;;
     field200k) run_case field200k scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 480 1280x720 \
-        --spacing 35.5 ;;
+        --spacing 32.6 ;;
     field_turn) run_case field_turn scenes/harris_cloud_field.json bench/viewer/field_turn.json 240 1280x720 ;;
     field_snap) run_case field_snap scenes/harris_cloud_field.json bench/viewer/field_snap.json 192 1280x720 ;;
     million) run_case million scenes/harris_cloud_field.json scenes/flights/harris_cloud_field.json 240 1280x720 \
-        --spacing 19.7 ;;
+        --spacing 18.1 ;;
     inside) run_case inside scenes/harris_fly_through.json bench/viewer/inside_cumulus.json 240 1280x720 ;;
     slice) run_case slice scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 120 512x512 --preview ;;
     slice_full) run_case slice_full scenes/fig14_interactive_storm.json bench/viewer/storm_sun.json 120 512x512 ;;

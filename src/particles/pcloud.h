@@ -109,11 +109,29 @@ const char *const *atmos__pcloud_generator_names(void);
  * volume's: about x = z = 0, the bases at 1.5 km times scale); same seed, same particles. scale multiplies the extent (0:
  * 1). *voxel_m: the grid spacing for atmos__pcloud_to_volume (half the finest particle spacing,
  * at most 640 voxels across: a field's grid blurs its smallest clouds). spacing_m > 0: the
- * particles' lattice edge in every cloud (0: the preset's, 1/24 of the cumulus's width, 1/16 of
- * each of the field's clouds'; a given spacing leaves a field's clouds in other places than the
- * preset's, the same for every spacing). */
+ * particles' lattice edge in every cloud (0: the preset's, 1/24 of the cumulus's width, 42 m in
+ * every cloud of the field, each cut to a fractal outline (pfootprint.c); a given spacing leaves
+ * a field's clouds in other places than the preset's, the same for every spacing). */
 atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint64_t seed, double scale,
                                     double spacing_m, atmos__pcloud *out, double *voxel_m);
+
+/* ---- pfootprint.c: the fractal outline a field's particle cloud is cut to */
+typedef struct atmos__pfootprint_desc {
+    uint64_t seed;         /* the outline's noise */
+    double cx, cz, w;      /* the cloud's centre and width (the noise's unit) */
+    double a, b;           /* the outline's smooth ellipse: semi-axes along x and z */
+    double reach_a, reach_b; /* no column outside this ellipse is kept */
+    double core;           /* the columns where the smooth ellipse's 1 - (x/a)^2 - (z/b)^2 >= core: never cut */
+    double x0, z0, h;      /* column (i, k) at (x0 + i h, z0 + k h) */
+    int nx, nz;
+} atmos__pfootprint_desc;
+typedef struct atmos__pfootprint {
+    int nx, nz;
+    float *phi; /* [k nx + i]: the outline's function (>= 0 inside), -1 where cut or not joined to the core */
+} atmos__pfootprint;
+/* The columns' outline function; ATMOS_E_NOMEM (nothing held) if out of memory. */
+atmos_status atmos__pfootprint_make(const atmos__pfootprint_desc *d, atmos__pfootprint *out);
+void atmos__pfootprint_free(atmos__pfootprint *f);
 
 /* ---- pcluster.c: the clouds of a particle set (what Harris's impostors are made of) */
 typedef struct atmos__pclusters {
