@@ -39,7 +39,6 @@ atmos_status atmos__pfootprint_make(const atmos__pfootprint_desc *d, atmos__pfoo
             in[q] = (core || phi >= 0) && bu * bu + bv * bv < 1; /* inside the outline and its reach */
             if (in[q] && x * x + z * z < best) best = x * x + z * z, start = (int)q;
         }
-    for (size_t q = 0; q < n; q++) out->phi[q] = -1.0f * !in[q] + out->phi[q] * in[q];
     /* the flood: in[] 2 for the columns reached from the start */
     int top = 0;
     if (start >= 0) stack[top++] = start, in[start] = 2;
