@@ -1,7 +1,8 @@
 #!/bin/sh
 # The viewer's CPU time a frame (docs/viewer.md): the CPU seconds (user + system) of a headless
 # flight of N + 1 frames less those of 1 frame, over N, so that making the plan and the first
-# frame's light passes are left out; steadier than wall times on a shared machine.
+# frame's light passes are left out; steadier than wall times on a shared machine. The frames
+# are not recorded, so their display values are the window's 8-bit ones.
 #
 #   bench/viewer/cpu.sh [--atmos BIN] [--cases "field field200k million inside slice slice_full"] [--frames N] [--opts "VIEW OPTIONS"]
 # (slice: the preview frames of a moving sun, --preview; slice_full: full renders)

@@ -9,8 +9,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#if defined(__SSE__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
-#include <xmmintrin.h>
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+#include <emmintrin.h>
 #endif
 
 /* One row: spectral pixels src (C channels, n radiance + alpha or not) to linear sRGB + alpha
@@ -32,12 +32,32 @@ static void linear_row(const float *src, int width, int C, int n, int has_alpha,
     }
 }
 
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+/* linear_row for three radiances and alpha (the viewer's RGB frames) a pixel to a vector: the
+ * matrix's three columns times the radiances broadcast, added in linear_row's order from 0 (the
+ * same bits: 0 + w s as the first term turns a -0 into +0 there too), alpha in the last lane. */
+static void linear_row3a(const float *src, int width, const float (*w)[3], float *lin)
+{
+    const __m128 zero = _mm_setzero_ps(), w0 = _mm_setr_ps(w[0][0], w[0][1], w[0][2], 0),
+                 w1 = _mm_setr_ps(w[1][0], w[1][1], w[1][2], 0), w2 = _mm_setr_ps(w[2][0], w[2][1], w[2][2], 0),
+                 last = _mm_castsi128_ps(_mm_setr_epi32(0, 0, 0, -1));
+    for (int x = 0; x < width; x++) {
+        const __m128 s = _mm_loadu_ps(src + 4 * x);
+        __m128 a = _mm_add_ps(zero, _mm_mul_ps(w0, _mm_shuffle_ps(s, s, 0x00)));
+        a = _mm_add_ps(a, _mm_mul_ps(w1, _mm_shuffle_ps(s, s, 0x55)));
+        a = _mm_add_ps(a, _mm_mul_ps(w2, _mm_shuffle_ps(s, s, 0xaa)));
+        _mm_storeu_ps(lin + 4 * x, _mm_or_ps(_mm_and_ps(last, s), _mm_andnot_ps(last, a)));
+        if (_mm_movemask_ps(_mm_cmplt_ps(a, zero)) & 7) atmos__gamut_pixel(lin + 4 * x);
+    }
+}
+#endif
+
 /* Row src of width 4-channel pixels to dst, past the cache where the target has streaming
  * stores (the frame's display values are not read again while it is made: a plain store would
  * first read each line of dst from memory). */
 static void stream_row(const float *src, float *dst, int width)
 {
-#if defined(__SSE__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
     if (((uintptr_t)dst & 15) == 0) {
         for (int x = 0; x < width; x++) _mm_stream_ps(dst + 4 * x, _mm_loadu_ps(src + 4 * x));
         return;
@@ -46,10 +66,27 @@ static void stream_row(const float *src, float *dst, int width)
     memcpy(dst, src, sizeof(float) * 4 * (size_t)width);
 }
 
-/* Display values [0, 1] to 8-bit RGBA as atmos_write_png rounds them, alpha 255. */
+/* Display values [0, 1] to 8-bit RGBA as atmos_write_png rounds them, alpha 255. With SSE2
+ * four values a vector: max(v, 0) is 0 for NaN as well (maxps gives its second operand then),
+ * min(., 1), then v 255 + 1/2 truncated, the same expression as the scalar one. */
 static void bytes_row(const float *d, int width, unsigned char *out)
 {
-    for (int x = 0; x < width; x++) {
+    int x0 = 0;
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), k = _mm_set1_ps(255.0f), half = _mm_set1_ps(0.5f);
+    const __m128i opaque = _mm_setr_epi32(0, 0, 0, 255);
+    const __m128i keep = _mm_setr_epi32(-1, -1, -1, 0);
+    for (; x0 + 4 <= width; x0 += 4) {
+        __m128i q[4];
+        for (int p = 0; p < 4; p++) {
+            const __m128 v = _mm_min_ps(_mm_max_ps(_mm_loadu_ps(d + 4 * (x0 + p)), zero), one);
+            q[p] = _mm_or_si128(_mm_and_si128(_mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(v, k), half)), keep), opaque);
+        }
+        const __m128i w = _mm_packus_epi16(_mm_packs_epi32(q[0], q[1]), _mm_packs_epi32(q[2], q[3]));
+        _mm_storeu_si128((__m128i *)(out + 4 * x0), w);
+    }
+#endif
+    for (int x = x0; x < width; x++) {
         for (int c = 0; c < 3; c++) {
             const float v = d[4 * x + c];
             out[4 * x + c] = !(v > 0) ? 0 : v >= 1 ? 255 : (unsigned char)(v * 255.0f + 0.5f);
@@ -90,12 +127,17 @@ atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spe
         for (int y = 0; y < spectral->height; y++) {
             if (!buf) continue;
             float *out = buf + (size_t)4 * W;
-            linear_row(spectral->pixels + (size_t)y * W * C, W, C, n, has_alpha, (const float(*)[3])w, buf);
+            const float *row = spectral->pixels + (size_t)y * W * C;
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+            if (n == 3 && has_alpha) linear_row3a(row, W, (const float(*)[3])w, buf);
+            else
+#endif
+                linear_row(row, W, C, n, has_alpha, (const float(*)[3])w, buf);
             atmos__tonemap_row(curve, buf, out, (size_t)W, 4, scale);
             if (disp) stream_row(out, disp->pixels + (size_t)y * W * 4, W);
             if (rgba8) bytes_row(out, W, rgba8 + (size_t)y * W * 4);
         }
-#if defined(__SSE__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
         _mm_sfence(); /* the streamed rows visible before the barrier closing the region */
 #endif
         free(buf);

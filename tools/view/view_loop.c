@@ -142,7 +142,8 @@ static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int sna
 }
 
 /* A frame's display values in one pass (atmos_image_display_into: the same values as display's
- * steps): L->disp when recording or without a window, L->rgba for the window. */
+ * steps): L->disp when recording, L->rgba for the window, and for a headless run that records
+ * nothing (the window's work, not float values nothing reads). */
 static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, int snap, int floats, int bytes)
 {
     const int W = L->img->width, H = L->img->height;
@@ -355,7 +356,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         atmos_plan *p = NULL;
         const view_quality q = scripted && !o->preview ? VIEW_SCRIPTED : moving ? VIEW_PREVIEW : VIEW_STILL;
         atmos_status st = render(&L, &s, q, &p);
-        if (st == ATMOS_OK) st = display_frame(&L, p, &s, i == 0 || scripted, o->record || !win, win != NULL);
+        if (st == ATMOS_OK) st = display_frame(&L, p, &s, i == 0 || scripted, o->record != NULL, win != NULL || !o->record);
         if (st != ATMOS_OK) {
             rc = cli_runtime_error("view", ctx, st);
             break;
