@@ -95,6 +95,16 @@ double atmos__clouds_view_transmittance(const atmos__planet *pl, const double p[
  * lies behind it; the ground is shadowed by G of all spheres. Without the sun's disk. */
 void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3], const double d[3],
                                    const double sun[3], double *out, atmos_atmosphere_hit *info);
+/* The same with the air of each segment from air->segment (x + t d, t in [0, len]; between:
+ * the segment runs from one crossing to the next): its light S (as the solver's in-scatter)
+ * and transmittance T, per wavelength. */
+typedef struct atmos__clouds_air {
+    void (*segment)(const void *ctx, const double x[3], const double d[3], double len, int between, double *S,
+                    double *T);
+    const void *ctx;
+} atmos__clouds_air;
+void atmos__planet_radiance_clouds_air(const atmos_atmosphere *a, const double p[3], const double d[3],
+                                       const double sun[3], const atmos__clouds_air *air, double *out);
 
 /* The sunlight through the air at the radius of each cloud sphere and of the ground over the
  * sun's cosine there: e[(j n + k) ne + i] for sphere j (j = m: the ground), wavelength k and

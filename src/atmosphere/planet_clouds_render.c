@@ -146,15 +146,38 @@ static void ground_light(const atmos_atmosphere *a, const double p[3], const dou
     }
 }
 
-void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3], const double d[3],
-                                   const double sun[3], double *out, atmos_atmosphere_hit *info)
+/* The air of the segment x + t d, t in [0, seg], seen through w: its light added to out, w
+ * times its transmittance (when anything lies behind it: last, the segment into space, has
+ * nothing); from air when given, else the solver's. */
+static void air_segment(const atmos_atmosphere *a, const atmos__clouds_air *air, const double x[3], const double d[3],
+                        double seg, int between, int last, const double sun[3], double *w, double *out)
+{
+    const int n = a->wl.count;
+    double S[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    if (air) {
+        air->segment(air->ctx, x, d, seg, between, S, T);
+        for (int k = 0; k < n; k++) out[k] += w[k] * S[k];
+        if (!last)
+            for (int k = 0; k < n; k++) w[k] *= T[k];
+        return;
+    }
+    if (a->solver->inscatter(a, x, d, seg, sun, n, NULL, S))
+        for (int k = 0; k < n; k++) out[k] += w[k] * S[k];
+    if (!last) {
+        a->solver->transmittance(a, x, d, seg, n, NULL, T);
+        for (int k = 0; k < n; k++) w[k] *= T[k];
+    }
+}
+
+static void radiance_clouds(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
+                            const atmos__clouds_air *air, double *out, atmos_atmosphere_hit *info)
 {
     const atmos__planet *pl = a->planet;
     const int n = a->wl.count;
     const double K = atmos__planet_ground_distance(pl, p, d);
     crossing c[MAX_CROSSINGS];
     const int nc = find_crossings(pl, p, d, K, c);
-    double w[ATMOS_MAX_WAVELENGTHS], S[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
+    double w[ATMOS_MAX_WAVELENGTHS];
     for (int k = 0; k < n; k++) out[k] = 0.0, w[k] = 1.0;
     double x[3] = {p[0], p[1], p[2]}, t_prev = 0.0, clouds = 1.0;
     const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
@@ -162,12 +185,7 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
     for (int j = 0; j <= nc && !opaque; j++) {
         const double t_end = j < nc ? c[j].t : K, seg = t_end - t_prev;
         /* the air of the segment, seen through everything in front of it */
-        if (seg > 0 && a->solver->inscatter(a, x, d, seg, sun, n, NULL, S))
-            for (int k = 0; k < n; k++) out[k] += w[k] * S[k];
-        if (seg > 0 && (j < nc || K < INFINITY)) {
-            a->solver->transmittance(a, x, d, seg, n, NULL, T);
-            for (int k = 0; k < n; k++) w[k] *= T[k];
-        }
+        if (seg > 0) air_segment(a, air, x, d, seg, j > 0 && j < nc, !(j < nc || K < INFINITY), sun, w, out);
         if (j == nc) {
             if (K < INFINITY) ground_light(a, p, d, K, sun, w, NULL, NULL, out);
             break;
@@ -196,6 +214,18 @@ void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3],
         info->hits_ground = K < INFINITY;
         info->in_sun_disk = 0;
     }
+}
+
+void atmos__planet_radiance_clouds(const atmos_atmosphere *a, const double p[3], const double d[3],
+                                   const double sun[3], double *out, atmos_atmosphere_hit *info)
+{
+    radiance_clouds(a, p, d, sun, NULL, out, info);
+}
+
+void atmos__planet_radiance_clouds_air(const atmos_atmosphere *a, const double p[3], const double d[3],
+                                       const double sun[3], const atmos__clouds_air *air, double *out)
+{
+    radiance_clouds(a, p, d, sun, air, out, NULL);
 }
 
 /* The fields of the m crossings c at x whose columns' optical depths are col, as arrays:

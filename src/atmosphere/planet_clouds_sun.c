@@ -30,7 +30,9 @@ struct atmos__clouds_sun {
     int layers;                    /* m: spheres 0 .. m - 2, then the ground */
     int w, h, tw, th, wrap;        /* texels, tiles; wrap: the grid spans 360 degrees */
     double lat_n, lon_w, dlat, dlon, inv_dlat, inv_dlon;
-    float *g;                      /* [layers][h][w] */
+    float *g;                      /* [h][w][layers]: a texel's layers side by side, so that the
+                                      look-ups of a ray's crossings (nearly one point seen from
+                                      above) and of the step down share cache lines */
     atomic_int *state;             /* [layers][th][tw]: 0 empty, 1 being filled, 2 ready */
 };
 
@@ -121,7 +123,8 @@ static void fill_tile(atmos__clouds_sun *s, int layer, int tx, int ty)
     const atmos__clouds *cl = pl->clouds;
     const int below = layer < s->layers - 1 ? layer : -1, above = below + 1;
     const double r = below >= 0 ? cl->r[below] : pl->r_ground;
-    float *g = s->g + (size_t)layer * s->w * s->h;
+    const size_t L = (size_t)s->layers;
+    float *g = s->g + layer;
     const int x0 = tx * TILE, x1 = x0 + TILE < s->w ? x0 + TILE : s->w;
     /* per column, cos lat times (cos lon, sin lon, 0) on the axes east, up, north; the
      * axes' third components take sin lat */
@@ -142,7 +145,7 @@ static void fill_tile(atmos__clouds_sun *s, int layer, int tx, int ty)
              * world's axes (east, up, -north), atmos__clouds_geo_point's */
             const double p[3] = {r * (cl_ * ce[k] + sl_ * se), r * (cl_ * cu[k] + sl_ * su) - pl->r_ground,
                                  -r * (cl_ * cn[k] + sl_ * sn)};
-            g[(size_t)y * s->w + x] = (float)step_down(s, p, above);
+            g[((size_t)y * s->w + x) * L] = (float)step_down(s, p, above);
         }
     }
 }
@@ -191,9 +194,10 @@ double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int bel
     if (sx) need(s, layer, x1, y0);
     if (sy) need(s, layer, x0, y1);
     if (sx && sy) need(s, layer, x1, y1);
-    const float *g = s->g + (size_t)layer * s->w * s->h;
-    const size_t W = (size_t)s->w;
-    const float g00 = g[y0 * W + x0], g01 = g[y0 * W + x1], g10 = g[y1 * W + x0], g11 = g[y1 * W + x1];
+    const float *g = s->g + layer;
+    const size_t W = (size_t)s->w, L = (size_t)s->layers;
+    const float g00 = g[(y0 * W + x0) * L], g01 = g[(y0 * W + x1) * L], g10 = g[(y1 * W + x0) * L],
+                g11 = g[(y1 * W + x1) * L];
     const float l0 = g00 < g01 ? g00 : g01, l1 = g10 < g11 ? g10 : g11, lo = l0 < l1 ? l0 : l1;
     const float h0 = g00 > g01 ? g00 : g01, h1 = g10 > g11 ? g10 : g11, hi = h0 > h1 ? h0 : h1;
     if (hi - lo > SPREAD) return step_down(s, x, below + 1);

@@ -154,6 +154,8 @@ static int key_eye(const atmos__sph_space *s, const atmos__planet *pl, double mu
 
 /* Steps of the march per piece of the slices between cloud spheres and below them. */
 #define STEPS_CLOUDS 3
+/* the same for a limb's ray between its crossings (longer: the ray runs along the layer) */
+#define STEPS_LIMB 8
 
 /* A node's stop: the logarithms of the sums times the sun's irradiance. */
 static void put_stop(const atmos_atmosphere *a, int n, const atmos__sph_sums *u, float *t)
@@ -305,28 +307,40 @@ static double row_coord(const atmos__sph_space *s, double p2, int *disk)
     return sqrt(fmin(1.0, h / (s->Rt - s->R))) * (NL - 1);
 }
 
-/* One ray's look-up (d a unit vector toward the air, b = q . d, p2 its impact parameter
- * squared): the table's logarithms interpolated into l[NC n]; returns 1 on the disk. */
-static int ray_logs(const atmos__sph_space *s, const double d[3], double p2, float *l)
+/* A ray's place in the table: its rows (row, row + 1; ay between them), its columns in each
+ * (ix0, ix1; ax0, ax1), whether it meets the ground (disk). */
+typedef struct {
+    int row, ix0, ix1, disk;
+    float ay, ax0, ax1;
+} node_at;
+
+/* The node coordinates of one ray (d a unit vector toward the air, p2 its impact parameter
+ * squared). */
+static void ray_node(const atmos__sph_space *s, const double d[3], double p2, node_at *c)
 {
-    const int S = NC * s->ns * s->n;
-    int disk;
-    const double fy = row_coord(s, p2, &disk);
+    const double fy = row_coord(s, p2, &c->disk);
     const double phi = atmos__atan2_fast(fabs(atmos__dot3(d, s->e2)), atmos__dot3(d, s->e1));
-    const int lim = (disk ? NG : NL) - 2;
+    const int lim = (c->disk ? NG : NL) - 2;
     int iy = (int)fy;
     iy = iy > lim ? lim : iy;
-    const int row = iy + (disk ? 0 : NG);
+    const int row = iy + (c->disk ? 0 : NG);
     const double fx0 = phi_col(s->phit[row], phi) * (NA - 1), fx1 = phi_col(s->phit[row + 1], phi) * (NA - 1);
     int ix0 = (int)fx0, ix1 = (int)fx1;
     ix0 = ix0 > NA - 2 ? NA - 2 : ix0;
     ix1 = ix1 > NA - 2 ? NA - 2 : ix1;
-    const float ay = (float)(fy - iy), ax0 = (float)(fx0 - ix0), ax1 = (float)(fx1 - ix1);
-    const float *t00 = s->tab + ((size_t)row * NA + ix0) * S, *t01 = t00 + S;
-    const float *t10 = s->tab + ((size_t)(row + 1) * NA + ix1) * S, *t11 = t10 + S;
+    c->row = row, c->ix0 = ix0, c->ix1 = ix1;
+    c->ay = (float)(fy - iy), c->ax0 = (float)(fx0 - ix0), c->ax1 = (float)(fx1 - ix1);
+}
+
+/* The table's logarithms at a ray's place interpolated into l[NC ns n]. */
+static void node_logs(const atmos__sph_space *s, const node_at *c, float *l)
+{
+    const int S = NC * s->ns * s->n;
+    const float ay = c->ay, ax0 = c->ax0, ax1 = c->ax1;
+    const float *t00 = s->tab + ((size_t)c->row * NA + c->ix0) * S, *t01 = t00 + S;
+    const float *t10 = s->tab + ((size_t)(c->row + 1) * NA + c->ix1) * S, *t11 = t10 + S;
     const float w00 = (1 - ay) * (1 - ax0), w01 = (1 - ay) * ax0, w10 = ay * (1 - ax1), w11 = ay * ax1;
     for (int j = 0; j < S; j++) l[j] = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
-    return disk;
 }
 
 /* The light of the ground where the ray d (b = q . d) meets it: its albedo and night lights
@@ -360,6 +374,49 @@ static void cloud_ray(const atmos__sph_space *s, const atmos_atmosphere *a, cons
     for (int k = 0; k < s->n; k++) out[(size_t)k * count + i] += wt * (float)L[k];
 }
 
+/* The air of a segment of a limb's ray through the cloud spheres (atmos__clouds_air): one
+ * march for its light and transmittance together, as the table's nodes take them, with the
+ * ray's own phase functions (pr, pm) and the steps of the table's slices (between crossings)
+ * or of its nodes (the segments into and out of the layer). */
+typedef struct {
+    const atmos_atmosphere *a;
+    const double *sun;
+    double pr[ATMOS_MAX_WAVELENGTHS], pm[ATMOS_MAX_WAVELENGTHS];
+} limb_air;
+
+static void limb_segment(const void *ctx, const double x[3], const double d[3], double len, int between, double *S,
+                         double *T)
+{
+    const limb_air *l = ctx;
+    const atmos__planet *pl = l->a->planet;
+    const int n = l->a->wl.count;
+    double t0, t1;
+    if (!atmos__planet_clip(pl, x, d, len, &t0, &t1)) {
+        for (int k = 0; k < n; k++) S[k] = 0.0, T[k] = 1.0;
+        return;
+    }
+    const double q[3] = {x[0], x[1] + pl->r_ground, x[2]};
+    atmos__sph_sums u;
+    atmos__sph_march(pl, l->a->model, q, d, t0, t1, l->sun, between ? STEPS_LIMB : ATMOS__SPH_STEPS_SPACE, 1, n,
+                     NULL, &u);
+    for (int k = 0; k < n; k++) S[k] = (l->pr[k] * u.sr[k] + l->pm[k] * u.sm[k] + u.ms[k]) * l->a->sun_e[k], T[k] = u.t[k];
+}
+
+/* A ray of the limb through the cloud spheres: the one-ray path's crossings with the air's
+ * segments marched as above. */
+static void cloud_limb(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], const double d[3],
+                       float wt, int count, int i, float *out)
+{
+    limb_air l = {a, sun, {0}, {0}};
+    const double nu = atmos__dot3(d, sun);
+    for (int k = 0; k < s->n; k++)
+        l.pr[k] = atmos__planet_rayleigh_phase(a->planet, k, nu), l.pm[k] = atmos__planet_mie_phase(a->planet, k, nu);
+    const atmos__clouds_air air = {limb_segment, &l};
+    double L[ATMOS_MAX_WAVELENGTHS];
+    atmos__planet_radiance_clouds_air(a, s->eye, d, sun, &air, L);
+    for (int k = 0; k < s->n; k++) out[(size_t)k * count + i] += wt * (float)L[k];
+}
+
 /* A ray of the disk through the cloud spheres: the air's light and transmittance to each
  * stop from its exponentiated look-up v, composited with the clouds' light. */
 static void cloud_disk(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], const double d[3],
@@ -380,10 +437,12 @@ static void cloud_disk(const atmos__sph_space *s, const atmos_atmosphere *a, con
     for (int k = 0; k < n; k++) out[(size_t)k * count + i] += wt * (float)L[k];
 }
 
-/* Rays i0 .. i0 + m - 1 (m <= BLK): the look-ups of the rays that meet the air and their
- * ground, the exponentials in one loop (which vectorises), then the phase functions. With
- * cloud spheres the disk's rays composite the clouds on the table's stops (cloud_disk) and
- * the limb's rays through the cloud layer are answered alone. */
+/* Rays i0 .. i0 + m - 1 (m <= BLK): which of them meet the air, then their places in the
+ * table (a loop of its own, so that the rays' chains of divisions and square roots overlap),
+ * the look-ups and their ground, the exponentials in one loop (which vectorises), then the
+ * phase functions. With cloud spheres the disk's rays composite the clouds on the table's
+ * stops (cloud_disk) and the limb's rays through the cloud layer are answered alone, their
+ * air marched piece by piece (cloud_limb). */
 #define BLK 16
 static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, const double sun[3], int i0, int m,
                        int count, const float *dx, const float *dy, const float *dz, const float *weight, float *out)
@@ -391,7 +450,9 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
     const int n = s->n, S = NC * s->ns * n, last = NC * (s->ns - 1) * n, clouds = s->ns > 1;
     const float kr = 3.0f / (16.0f * 3.14159265359f);
     float lv[BLK * NC * ATMOS_MAX_WAVELENGTHS], G[BLK * ATMOS_MAX_WAVELENGTHS], nu2[BLK], ap[BLK];
-    int ip[BLK], idx[BLK], disk[BLK], h = 0;
+    double dd[BLK][3], bb[BLK], pp[BLK];
+    node_at nd[BLK];
+    int ip[BLK], idx[BLK], h = 0;
     for (int i = i0; i < i0 + m; i++) {
         if (weight[i] == 0.0f) continue;
         double d[3] = {dx[i], dy[i], dz[i]};
@@ -400,17 +461,23 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
         const double b = atmos__dot3(s->q, d), p2 = s->qq - b * b;
         if (b >= 0 || p2 >= s->Rt * s->Rt) continue; /* misses the air */
         if (clouds && p2 >= s->R * s->R && p2 < s->rc2) {
-            cloud_ray(s, a, sun, d, weight[i], count, i, out);
+            cloud_limb(s, a, sun, d, weight[i], count, i, out);
             continue;
         }
-        idx[h] = i;
-        disk[h] = ray_logs(s, d, p2, lv + h * S);
-        if (disk[h] && !clouds) ground(s, a, sun, d, b, G + h * n);
-        const float nu = (float)atmos__dot3(d, sun);
-        const float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
-        ip[h] = (int)fp < NPH - 2 ? (int)fp : NPH - 2;
-        ap[h] = fp - ip[h], nu2[h] = nu * nu;
+        idx[h] = i, bb[h] = b, pp[h] = p2;
+        memcpy(dd[h], d, sizeof d);
         h++;
+    }
+    for (int r = 0; r < h; r++) {
+        ray_node(s, dd[r], pp[r], &nd[r]);
+        const float nu = (float)atmos__dot3(dd[r], sun);
+        const float fp = sqrtf(fmaxf(0.0f, 0.5f * (1.0f - nu))) * (NPH - 1);
+        ip[r] = (int)fp < NPH - 2 ? (int)fp : NPH - 2;
+        ap[r] = fp - ip[r], nu2[r] = nu * nu;
+    }
+    for (int r = 0; r < h; r++) {
+        node_logs(s, &nd[r], lv + r * S);
+        if (nd[r].disk && !clouds) ground(s, a, sun, dd[r], bb[r], G + r * n);
     }
     atmos__expf_fast_array(lv, h * S);
     for (int r = 0; r < h; r++) {
@@ -420,16 +487,13 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
             pm[k] = mp[0] + ap[r] * (mp[1] - mp[0]), pr[k] = kr * (s->ra[k] + s->rb[k] * nu2[r]);
         }
         const int i = idx[r];
-        if (clouds && disk[r]) {
-            double d[3] = {dx[i], dy[i], dz[i]};
-            const double l = sqrt(atmos__dot3(d, d));
-            for (int c = 0; c < 3; c++) d[c] /= l;
-            cloud_disk(s, a, sun, d, lv + r * S, pr, pm, weight[i], count, i, out);
+        if (clouds && nd[r].disk) {
+            cloud_disk(s, a, sun, dd[r], lv + r * S, pr, pm, weight[i], count, i, out);
             continue;
         }
         for (int k = 0; k < n; k++) {
             const float *v = lv + r * S + last + NC * k;
-            const float L = pr[k] * v[0] + pm[k] * v[1] + v[2] + (disk[r] ? v[3] * G[r * n + k] : 0.0f);
+            const float L = pr[k] * v[0] + pm[k] * v[1] + v[2] + (nd[r].disk ? v[3] * G[r * n + k] : 0.0f);
             out[(size_t)k * count + i] += weight[i] * L;
         }
     }

@@ -84,6 +84,48 @@ static void check_view(const atmos_atmosphere *a, double sun_elev_deg, double rm
     CHECK(worst <= worst_max);
 }
 
+/* The limb's rays through the cloud layer (impact parameters between the ground's radius and
+ * the top sphere's, which the table's stops do not cover): the batch marches the air of their
+ * segments itself, against the one-ray path, the RMS and worst relative error of the
+ * luminance (floored at 1 % of the brightest). */
+static void check_limb(const atmos_atmosphere *a, double sun_elev_deg, double rms_max, double worst_max)
+{
+    enum { NP = 8, NA = 64, N = NP * NA };
+    const double eye[3] = {0, 12000e3, 0}, R = a->planet->r_ground;
+    const double rc = a->planet->clouds->r[a->planet->clouds->m - 1], r = R + eye[1];
+    const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
+    const double sun[3] = {cos(se) * sin(az), sin(se), -cos(se) * cos(az)};
+    const double before[3] = {eye[0] - 1.0, eye[1], eye[2]};
+    atmos__atm_batch b;
+    atmos__atm_batch_init(&b, a, before, sun);
+    CHECK(atmos__atm_batch_update(&b, a, eye, sun) == 1);
+    static float dx[N], dy[N], dz[N], wt[N], out[3 * N];
+    static double ref[N][3];
+    double ref_max = 0;
+    for (int i = 0; i < N; i++) { /* impact parameter p, azimuth phi about the nadir */
+        const double p = R + (rc - R) * ((i / NA) + 0.5) / NP, phi = 2 * PI * ((i % NA) + 0.5) / NA;
+        const double st = p / r, ct = sqrt(1 - st * st);
+        const double d[3] = {st * cos(phi), -ct, st * sin(phi)};
+        dx[i] = (float)d[0], dy[i] = (float)d[1], dz[i] = (float)d[2], wt[i] = 1.0f;
+        atmos__planet_radiance_clouds(a, eye, d, sun, ref[i], NULL);
+        ref_max = fmax(ref_max, lum(ref[i]));
+    }
+    for (int i = 0; i < 3 * N; i++) out[i] = 0.0f;
+    atmos__atm_batch_eval(&b, N, dx, dy, dz, wt, out, NULL);
+    atmos__atm_batch_release(&b);
+    double s2 = 0, worst = 0;
+    for (int i = 0; i < N; i++) {
+        const double got[3] = {out[i], out[N + i], out[2 * N + i]}, r0 = lum(ref[i]);
+        const double e = fabs(lum(got) - r0) / fmax(r0, 0.01 * ref_max);
+        s2 += e * e, worst = fmax(worst, e);
+    }
+    printf("sun %g deg: %d limb rays through the cloud layer, luminance error RMS %.5f, worst %.5f\n", sun_elev_deg,
+           N, sqrt(s2 / N), worst);
+    CHECK(ref_max > 0);
+    CHECK(sqrt(s2 / N) <= rms_max);
+    CHECK(worst <= worst_max);
+}
+
 /* The attenuation textures (planet_clouds_sun.c) against G evaluated at the point itself,
  * at random points of each sphere below the top one and of the ground on the sunlit side:
  * the mean and the worst absolute difference (G is in [0, 1]). */
@@ -206,6 +248,8 @@ int main(void)
     check_textures(a, 5, 0.002, 0.06);
     check_view(a, 45, 0.003, 0.08);
     check_view(a, 5, 0.003, 0.08); /* the terminator on the disk */
+    check_limb(a, 45, 0.004, 0.015);
+    check_limb(a, 5, 0.004, 0.015); /* the terminator at the limb */
     check_stops_taken(a);
     check_regional_wrap(clouds);
     atmos_atmosphere_destroy(a);
