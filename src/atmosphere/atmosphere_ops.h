@@ -20,6 +20,16 @@ void atmos__atm_sunlight_sub(const atmos_atmosphere *a, const double p[3], const
 int atmos__atm_inscatter_sub(const atmos_atmosphere *a, const double p[3], const double d[3], double dist,
                              const double sun[3], int m, const int *k, double *out);
 
+/* The air's single scattering of sunlight toward p over [s0, s1] of the segment p + t d
+ * (s1 finite), by the midpoint rule over n equal cells: out[c * m + i] (wavelength k[i] of
+ * the subset) = the scattering coefficient times the phase function at theta (cos theta =
+ * d . sun; a planet's Rayleigh and aerosol parts each with its own, per wavelength) times
+ * the sunlight (atmos__atm_sunlight_sub) at cell c's centre, times the air's transmittance
+ * from p to the centre, times the cell's length. Over a planet the transmittance is the
+ * model's to s0 and from there the planet's extinction at the cells' centres (atmosphere_single.c). */
+void atmos__atm_single_cells_sub(const atmos_atmosphere *a, const double p[3], const double d[3], double s0,
+                                 double s1, int n, const double sun[3], int m, const int *k, double *out);
+
 /* A point of the segment p + t d, t in [0, dist], drawn with density proportional to the
  * air's scattering times its transmittance from p at one wavelength h of the subset (the one
  * with w[i] != 0 that scatters least, so that the others' ratios stay bounded), for

@@ -126,12 +126,22 @@ static int sun_shadow_span(const path_medium *M, const double p[3], const double
  *    (of the carried wavelength that scatters least, so that the others' ratios stay
  *    bounded) times T_sun there.
  *  - Inside the box the whole segment is estimated so, times T_view too.
+ *  - Over a planet (the spherical kinds) the model's in-scatter holds every order of
+ *    scattering, of which the volume shadows only the sun's single scattering: the higher
+ *    orders come from the whole sky, which the volume mostly does not hide. The shadowed
+ *    part's single scattering is computed by quadrature (atmos__path_air_single), the rest
+ *    of the model's in-scatter (every other order, and the single scattering elsewhere) is
+ *    added as it is, and the point is drawn from the quadrature's cells. Inside the box
+ *    that rest is seen through the volume too: it rides on the point, spread along the
+ *    segment as the single scattering is (the sunlight changes little across a box).
  * Every sample is >= 0. (The first version added the analytic value of the whole segment and
  * subtracted f (1 - T_view T_sun) / pdf at one point drawn over all of it: unbiased too, but
  * where nearly everything is shadowed, as inside a cloud, a sample was the analytic value
  * minus its one-point estimate, negative about half the time: pixels with little other
  * light came out negative at low sample counts, and a ray to space beside a cloud
- * subtracted the whole sky's in-scatter at a point in the cloud's shadow.) */
+ * subtracted the whole sky's in-scatter at a point in the cloud's shadow. Over a planet the
+ * span's whole in-scatter was shadowed until the single scattering was told apart: shadows
+ * in the air too dark and too blue, docs/gallery.md, "A cumulus field from above".) */
 void atmos__path_air_scatter(const path_run *R, const double p[3], const double d[3], double K, const double *w,
                              double wt, int order, const air_view *view)
 {
@@ -142,24 +152,34 @@ void atmos__path_air_scatter(const path_run *R, const double p[3], const double 
     double f[PATH_B], fs[PATH_B], s0 = 0, s1 = K;
     if (!atmos__atm_inscatter_sub(J->atm, p, d, K, J->sun, m, b->k, f)) return;
     const int span = J->med && (view || sun_shadow_span(J->med, p, d, J->sun, K, &s0, &s1));
+    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(J->atm);
+    const int planet = kind == ATMOS_ATMOSPHERE_SPHERICAL || kind == ATMOS_ATMOSPHERE_DOBASHI;
     const double p0[3] = {p[0] + s0 * d[0], p[1] + s0 * d[1], p[2] + s0 * d[2]};
+    air_single S;
     for (int i = 0; i < m; i++) fs[i] = 0;
-    if (view) memcpy(fs, f, sizeof fs); /* the span is the whole segment */
-    else if (span) { /* the analytic in-scatter of the span, seen through the air from p */
+    if (span && planet) { /* what the volume can take: the span's single scattering */
+        atmos__path_air_single(R, p, d, s0, s1, &S);
+        memcpy(fs, S.sum, sizeof fs);
+    } else if (view) {
+        memcpy(fs, f, sizeof fs); /* the span is the whole segment */
+    } else if (span) { /* the analytic in-scatter of the span, seen through the air from p */
         atmos__atm_inscatter_sub(J->atm, p0, d, s1 - s0, J->sun, m, b->k, fs);
         atmos__path_air_transmit(R, p, d, s0, fs);
     }
+    /* inside the box over a planet the higher orders are not shadowed but still seen through
+     * the volume: carried with the single scattering's point, as hi[i] times its share */
+    double hi[PATH_B];
     for (int i = 0; i < m; i++) {
+        hi[i] = 0;
         if (w[i] == 0) continue;
         const double rest = f[i] - fs[i];
-        if (rest > 0) atmos__path_add(R, i, w[i] * wt * rest, order);
+        if (view && planet && fs[i] > 0) hi[i] = rest > 0 ? rest / fs[i] : 0.0;
+        else if (rest > 0) atmos__path_add(R, i, w[i] * wt * rest, order);
     }
-    double ta, ratio[PATH_B];
-    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(J->atm);
-    const int planet = kind == ATMOS_ATMOSPHERE_SPHERICAL || kind == ATMOS_ATMOSPHERE_DOBASHI;
     if (!span) return;
-    if (planet) { /* no sampler of the planet's air: a point drawn evenly on the span */
-        ta = s0 + atmos__stream_u(R->r) * (s1 - s0);
+    double ta, ratio[PATH_B];
+    if (planet) { /* ratio: the single scattering's integrand over the density, sunlight included */
+        if (!atmos__path_air_single_point(R, &S, w, &ta, ratio)) return;
     } else {
         if (!atmos__atm_scatter_point(J->atm, p0, d, s1 - s0, m, b->k, w, R->r, &ta, ratio)) return;
         atmos__path_air_transmit(R, p, d, s0, ratio); /* the point's ratio counts the air from p0 on */
@@ -169,24 +189,22 @@ void atmos__path_air_scatter(const path_run *R, const double p[3], const double 
     double T[PATH_B], Tv[PATH_B], E[PATH_B];
     atmos__path_shadow(R, pa, J->sun, T);
     int lit = 0;
-    for (int i = 0; i < m; i++) lit |= w[i] != 0 && T[i] > 0;
+    for (int i = 0; i < m; i++) {
+        T[i] += hi[i];
+        lit |= w[i] != 0 && T[i] > 0;
+    }
     if (!lit) return;
     if (view) {
         atmos__path_transmittance(J->med, view->q, view->qd, view->t0, view->t0 + ta, b, R->r, Tv);
         for (int i = 0; i < m; i++) T[i] *= Tv[i];
     }
-    if (planet) {
-        /* the planet's in-scatter of the span (its aerosols' phase function and every order
-         * in it) times the shadow at the point: a ratio estimate, which the span's evenly drawn
-         * point keeps unbiased where the shadow does not vary along it */
-        for (int i = 0; i < m; i++)
-            if (w[i] != 0 && T[i] > 0) atmos__path_add(R, i, w[i] * wt * fs[i] * T[i], order);
-        return;
+    if (!planet) {
+        atmos__path_sunlight(R, pa, E);
+        const double P = atmos_atmosphere_phase(J->atm, pa, atmos__dot3(d, J->sun));
+        for (int i = 0; i < m; i++) ratio[i] *= P * E[i];
     }
-    atmos__path_sunlight(R, pa, E);
-    const double P = atmos_atmosphere_phase(J->atm, pa, atmos__dot3(d, J->sun));
     for (int i = 0; i < m; i++)
-        if (w[i] != 0 && T[i] > 0) atmos__path_add(R, i, w[i] * wt * P * E[i] * ratio[i] * T[i], order);
+        if (w[i] != 0 && T[i] > 0) atmos__path_add(R, i, w[i] * wt * ratio[i] * T[i], order);
 }
 
 /* Next-event estimation at a scattering point p of the volume reached along d with weights

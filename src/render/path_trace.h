@@ -128,6 +128,24 @@ typedef struct {
  * (path_light.c explains the shadowed part). */
 void atmos__path_air_scatter(const path_run *R, const double p[3], const double d[3], double K, const double *w,
                              double wt, int order, const air_view *view);
+/* The air's single scattering over [s0, s1] of the segment p + t d seen from p, by the
+ * midpoint rule over AIR_SINGLE_N equal cells (path_air_single.c): per cell c and carried
+ * wavelength i, g[c][i] = the single scattering's integrand (atmos__atm_single_source_sub)
+ * at the cell's centre times the air's transmittance from p to it times the cell's length;
+ * sum[i] = the sum over the cells. */
+#define AIR_SINGLE_N 8
+typedef struct {
+    double g[AIR_SINGLE_N][PATH_B], sum[PATH_B];
+    double s0, dt;
+} air_single;
+void atmos__path_air_single(const path_run *R, const double p[3], const double d[3], double s0, double s1,
+                            air_single *S);
+/* A point *t of S's range: a cell drawn with probability proportional to the mean of
+ * g[c][i] / sum[i] over the wavelengths with w[i] != 0, then uniformly in it; ratio[i] =
+ * g[c][i] / that probability, so that sum over the cells of g[c][i] times the cell's mean
+ * of a shadow is the expectation of ratio[i] times the shadow at *t. Returns 0 (no point)
+ * when nothing scatters there. */
+int atmos__path_air_single_point(const path_run *R, const air_single *S, const double *w, double *t, double *ratio);
 /* Next-event estimation of the sun (E: its light at the event, NULL when it does not light
  * it; hs: the path's share against the aureole estimate) and of the sky at an event. */
 void atmos__path_nee(const path_run *R, const path_event *ev, const double *E, double hs);

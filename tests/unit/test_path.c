@@ -11,6 +11,9 @@
  * wavelengths) agrees with rgb mode, no NaN/Inf, an empty scene is the sky.
  * ATMOS_PATH_LONG=1 runs the slab comparison with 16x the samples (docs/path.md). */
 #include "atmos/atmos.h"
+#include "atmosphere/atmosphere_internal.h"
+#include "atmosphere/atmosphere_ops.h"
+#include "atmosphere/planet.h"
 #include "test.h"
 #include "path_ad.h"
 
@@ -858,6 +861,15 @@ static void test_air_in_box(atmos_context *ctx)
     atmos_phase_table_destroy(op.t);
 }
 
+/* test_air_shadow's slab: 2 km x 100 m x 10 km (x from -1 to 1 km, y from 1500 to 1600 m, z
+ * from -10.5 to -0.5 km), optical depth tau across its 100 m. */
+static atmos_volume *shadow_slab(atmos_context *ctx, double tau)
+{
+    static float buf[20 * 100];
+    for (int i = 0; i < 20 * 100; i++) buf[i] = (float)(tau / (1e-9 * 100));
+    return dense_volume(ctx, 20, 1, 100, 100, -1000, 1500, -10500, buf);
+}
+
 /* An opaque absorbing slab 500 m above a horizontal ray, the sun at the zenith: the air
  * under it, from 500 m to 10.5 km along the ray, is in its shadow. Single scattering of
  * the sun in the air seen along an endless horizontal ray at altitude y is
@@ -866,9 +878,7 @@ static void test_air_shadow(atmos_context *ctx)
 {
     optics op;
     make_optics(ctx, 0, 0.0, 1e-12, &op);
-    static float buf[20 * 100];
-    for (int i = 0; i < 20 * 100; i++) buf[i] = (float)(50.0 / (1e-9 * 100)); /* tau 50 across */
-    atmos_volume *v = dense_volume(ctx, 20, 1, 100, 100, -1000, 1500, -10500, buf);
+    atmos_volume *v = shadow_slab(ctx, 50.0); /* tau 50 across */
     atmos_scene s;
     const double y0 = 1000, pos[3] = {0, y0, 0}, look[3] = {0, y0, -1};
     sky_scene(&s, 4, 4, 90, 0, pos, look, 0.01);
@@ -898,6 +908,76 @@ static void test_air_shadow(atmos_context *ctx)
     atmos_image_destroy(img);
     atmos_image_destroy(var);
     atmos_volume_destroy(v);
+    atmos_phase_table_destroy(op.t);
+}
+
+/* Over a planet the model's in-scatter holds every order of scattering, but the slab's
+ * shadow takes only the sun's single scattering from the air under it: the higher orders
+ * come from the whole sky, which the slab hardly hides. test_air_shadow's slab and ray in
+ * the spherical model: the radiance the slab takes (the ray beside a transparent slab less
+ * the ray under the opaque one) against the single scattering of the shadowed part
+ * [500 m, 10.5 km] by the planet's brute-force quadrature (atmos__planet_single_scatter:
+ * 512 midpoints, transmittances from the planet's own optical depths, not the model's
+ * tables). Until the single scattering was told apart, the loss was the part's whole
+ * in-scatter (printed: its ratio to the single scattering, above 1.1 in every channel). */
+static void test_air_shadow_planet(atmos_context *ctx)
+{
+    optics op;
+    make_optics(ctx, 0, 0.0, 1e-12, &op);
+    atmos_scene s;
+    const double y0 = 1000, pos[3] = {0, y0, 0}, look[3] = {0, y0, -1}, dir[3] = {0, 0, -1}, up[3] = {0, 1, 0};
+    sky_scene(&s, 4, 4, 90, 0, pos, look, 0.01);
+    s.atmosphere.ground_albedo = 0;
+    double m[2][3] = {{0}}, vv[2][3] = {{0}};
+    for (int shadowed = 0; shadowed < 2; shadowed++) {
+        atmos_volume *v = shadow_slab(ctx, shadowed ? 50.0 : 1e-6);
+        atmos_image *var = NULL, *img = render(ctx, &s, v, &op, 64, 0, &var);
+        for (int c = 0; c < 3; c++)
+            for (int p = 0; p < 16; p++) {
+                m[shadowed][c] += img->pixels[p * 4 + c] / 16;
+                vv[shadowed][c] += var->pixels[p * 4 + c] / (16.0 * 16.0);
+            }
+        atmos_image_destroy(img);
+        atmos_image_destroy(var);
+        atmos_volume_destroy(v);
+    }
+    atmos_wavelengths wl;
+    CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
+    atmos_atmosphere *sky = NULL;
+    CHECK_OK(atmos_atmosphere_create(ctx, &s.atmosphere, &wl, &sky));
+    double a[3], b[3], fa[3], fb[3];
+    atmos__planet_single_scatter(sky->planet, pos, dir, 500, up, 3, NULL, a);
+    atmos__planet_single_scatter(sky->planet, pos, dir, 10500, up, 3, NULL, b);
+    atmos_atmosphere_inscatter(sky, pos, dir, 500, up, fa);
+    atmos_atmosphere_inscatter(sky, pos, dir, 10500, up, fb);
+    for (int c = 0; c < 3; c++) {
+        const double E0 = atmos__atm_sun_irradiance(sky)[c], ref = E0 * (b[c] - a[c]);
+        const double loss = m[0][c] - m[1][c], se = sqrt(vv[0][c] + vv[1][c]);
+        printf("air shadow over a planet, channel %d: loss %.6g +- %.2g, single scattering %.6g (%+.2f %%), "
+               "whole in-scatter of the part / single %.3f\n",
+               c, loss, se, ref, 100 * (loss / ref - 1), (fb[c] - fa[c]) / ref);
+        CHECK(fabs(loss - ref) < 4 * se + 0.02 * ref);
+        CHECK((fb[c] - fa[c]) / ref > 1.1); /* the test has teeth: the higher orders are there */
+    }
+    /* the higher orders are not shadowed, but the volume still hides them: a ray from 1 km in
+     * front of the opaque slab into it, along its 10 km, sees the air's whole in-scatter of
+     * that 1 km (not shadowed: nothing lies above it) and nothing of the air in the slab */
+    const double pos2[3] = {0, 1550, 500};
+    sky_scene(&s, 4, 4, 90, 0, pos2, (const double[3]){0, 1550, -1}, 0.01);
+    s.atmosphere.ground_albedo = 0;
+    atmos_volume *v = shadow_slab(ctx, 50.0);
+    atmos_image *var = NULL, *img = render(ctx, &s, v, &op, 16, 0, &var);
+    atmos_atmosphere_inscatter(sky, pos2, dir, 1000, up, fa);
+    for (int c = 0; c < 3; c++) {
+        double mm = 0, v2 = 0;
+        for (int p = 0; p < 16; p++) mm += img->pixels[p * 4 + c] / 16, v2 += var->pixels[p * 4 + c] / (16.0 * 16.0);
+        printf("  into the slab, channel %d: %.6g +- %.2g, the air in front %.6g\n", c, mm, sqrt(v2), fa[c]);
+        CHECK(fabs(mm - fa[c]) < 4 * sqrt(v2) + 0.01 * fa[c]);
+    }
+    atmos_image_destroy(img);
+    atmos_image_destroy(var);
+    atmos_volume_destroy(v);
+    atmos_atmosphere_destroy(sky);
     atmos_phase_table_destroy(op.t);
 }
 
@@ -1017,6 +1097,7 @@ int main(void)
     air_kind = ATMOS_ATMOSPHERE_SPHERICAL;
     printf("-- air: the spherical model\n");
     test_air_in_box(ctx);
+    test_air_shadow_planet(ctx);
     air_kind = ATMOS_ATMOSPHERE_RILEY;
     test_estimators_agree(ctx);
     test_absorber(ctx);
