@@ -621,7 +621,9 @@ static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const 
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
 {
     atmos__beams_plan *b = p->beams;
-    atmos_status st = atmos__sky_render(p->ctx, p->atm, v, r, out, p->sky_keep);
+    atmos__view sv = *v; /* the sky behind on the airlight's lattice too (the sky renderer's grid: sky_render.c) */
+    if (p->scene.beams.interleave <= 1 && p->scene.beams.screen_step > sv.sky_step) sv.sky_step = p->scene.beams.screen_step;
+    atmos_status st = atmos__sky_render(p->ctx, p->atm, &sv, r, out, p->sky_keep);
     if (st != ATMOS_OK) return st;
     job J;
     memset(&J, 0, sizeof J);

@@ -703,6 +703,39 @@ static void test_surface_spans(void)
     CHECK(wrong == 0);
 }
 
+/* The sky behind, no fog or lights: with the airlight subsampled (screen_step 4) the sky too is
+ * read from the sky renderer's grid of every 4th pixel, within 0.3 % of its every pixel's value
+ * (the grid's tolerance: test_sky_step) and not the same image; screen_step 1: every pixel. */
+static void test_sky_on_lattice(void)
+{
+    atmos_scene s;
+    base_scene(&s, 256, 160);
+    s.fog.enabled = 0; /* the point light lights nothing: no fog, no objects */
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_RILEY;
+    s.sun.from_time = 0, s.sun.elevation_deg = 8, s.sun.azimuth_deg = 150; /* low, in view */
+    s.camera.position[0] = 0, s.camera.position[1] = 1200, s.camera.position[2] = 0;
+    s.camera.look_at[0] = 495, s.camera.look_at[1] = 1270, s.camera.look_at[2] = 857;
+    s.camera.fov_deg = 60;
+    atmos_image *exact = render(ctx, &s);
+    s.beams.screen_step = 4;
+    atmos_image *grid = render(ctx, &s);
+    if (exact && grid) {
+        const size_t n = (size_t)s.width * s.height * exact->channels;
+        double worst = 0;
+        long differ = 0;
+        for (size_t i = 0; i < n; i++) {
+            const double a = exact->pixels[i], b = grid->pixels[i];
+            worst = fmax(worst, fabs(b - a) / fmax(a, 1e-30));
+            differ += a != b;
+        }
+        printf("the sky behind on the lattice: %ld of %zu samples differ, worst relative difference %.2e\n", differ, n,
+               worst);
+        CHECK(differ > 0);
+        CHECK(worst < 3e-3);
+    }
+    atmos_image_destroy(exact), atmos_image_destroy(grid);
+}
+
 /* One frame of s by a plan (on context c); *evaluated, *pixels: the renderer's count of the
  * pixels whose airlight it evaluated rather than interpolated, of all. */
 static atmos_image *render_counted(atmos_context *c, const atmos_scene *s, long *evaluated, long *pixels)
@@ -808,6 +841,7 @@ int main(void)
     test_light_sum();
     test_screen_spans();
     test_surface_spans();
+    test_sky_on_lattice();
     test_threads();
     test_interleave();
     test_screen_step();
