@@ -21,7 +21,7 @@
  * the planes sit at a pixel's own offset, and the airlight is filtered over N x N pixels.
  * With beams/screen_step k > 1 (beams_screen.h) the airlight (the lights' and the sun's) is
  * evaluated on a lattice of every k-th pixel and interpolated across the cells where that is
- * safe, the surfaces still per pixel.
+ * safe, the surfaces still per pixel, the sky behind from the sky renderer's grid of every k-th pixel.
  * Rows go to the threads; each pixel depends on nothing but its own ray (or its band of the
  * lattice), so the image does not depend on the thread count. */
 #include "render/beams_internal.h"
