@@ -151,7 +151,8 @@ typedef struct atmos_scene_beams {
                                  between the planes at its own offset, and the airlight is averaged over N x N pixels
                                  of similar depth; 1 = off (the default) */
     int screen_step;          /* the airlight evaluated every screen_step pixels and interpolated where the lattice's
-                                 cells agree, evaluated per pixel elsewhere (docs/beams.md); 1 = every pixel */
+                                 cells agree, evaluated per pixel elsewhere, and the sky behind read from the sky
+                                 renderer's grid of every screen_step pixels (docs/beams.md); 1 = every pixel */
     int exact_shadows;        /* 1: the surfaces' shadows of the lights by an exact ray per pixel and light; 0 (the
                                  default): from the lights' shadow maps where they settle it, rays elsewhere */
 } atmos_scene_beams;

@@ -1,4 +1,5 @@
 /* Cameras: pinhole, equidistant fisheye, equirectangular. */
+#include "core/camera.h"
 #include "core/internal.h"
 #include "core/vec.h"
 
@@ -126,6 +127,23 @@ atmos_status atmos_camera_init(atmos_context *ctx, const atmos_camera_desc *desc
     return ATMOS_OK;
 }
 
+double atmos__camera_pinhole_u(const atmos_camera *cam, double x)
+{
+    return (2.0 * x - cam->width) / cam->height * cam->tan_half_fov;
+}
+
+double atmos__camera_pinhole_v(const atmos_camera *cam, double y)
+{
+    const double H = cam->height;
+    return (H - 2.0 * y) / H * cam->tan_half_fov;
+}
+
+void atmos__camera_pinhole_dir(const atmos_camera *cam, double u, double v, double dir[3])
+{
+    for (int i = 0; i < 3; i++) dir[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i];
+    norm3(dir);
+}
+
 int atmos_camera_ray(const atmos_camera *cam, double x, double y, double dir[3])
 {
     const double W = cam->width, H = cam->height;
@@ -137,10 +155,7 @@ int atmos_camera_ray(const atmos_camera *cam, double x, double y, double dir[3])
     }
     double u, v; /* image-plane coordinates: right, up */
     if (cam->type == ATMOS_CAMERA_PINHOLE) {
-        u = (2.0 * x - W) / H * cam->tan_half_fov;
-        v = (H - 2.0 * y) / H * cam->tan_half_fov;
-        for (int i = 0; i < 3; i++) dir[i] = cam->forward[i] + u * cam->right[i] + v * cam->up[i];
-        norm3(dir);
+        atmos__camera_pinhole_dir(cam, atmos__camera_pinhole_u(cam, x), atmos__camera_pinhole_v(cam, y), dir);
         return 1;
     }
     /* Equidistant fisheye: angle from the axis proportional to the distance from

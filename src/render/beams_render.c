@@ -21,7 +21,7 @@
  * the planes sit at a pixel's own offset, and the airlight is filtered over N x N pixels.
  * With beams/screen_step k > 1 (beams_screen.h) the airlight (the lights' and the sun's) is
  * evaluated on a lattice of every k-th pixel and interpolated across the cells where that is
- * safe, the surfaces still per pixel.
+ * safe, the surfaces still per pixel, the sky behind from the sky renderer's grid of every k-th pixel.
  * Rows go to the threads; each pixel depends on nothing but its own ray (or its band of the
  * lattice), so the image does not depend on the thread count. */
 #include "render/beams_internal.h"
@@ -29,6 +29,7 @@
 #include "render/beams_primary.h"
 #include "render/beams_screen.h"
 #include "render/beams_sky.h"
+#include "core/camera.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -37,6 +38,11 @@
 
 /* Intervals per light along one ray at most: planes closer than 2 range / this are spread. */
 #define MAX_INTERVALS 4096
+/* A surface point within this share of a light's sampled radius squared, seen from a pixel
+ * outside the light's span, is outside its cone (the span's margins cover the radius itself). */
+#ifndef SPAN_SAFE
+#define SPAN_SAFE 0.98
+#endif
 /* A point light's interval of at most this many sub-planes reads them without the tiles' test. */
 #ifndef POINT_READ_MAX
 #define POINT_READ_MAX 3
@@ -57,12 +63,45 @@ typedef struct job {
     int centre_now;            /* subsampling: the air_pixel() being evaluated is the centre's */
     const atmos__beams_sky *sky; /* the sky's light on surfaces (none in a vacuum or without objects) */
     const atmos__beams_primary *prim; /* what each pixel sees, rasterised (NULL: no objects) */
+    double *ru, *rv;           /* a pinhole camera's image-plane coordinates per column and row (else NULL) */
 } job;
 
-/* The object's surface at the eye's ray's hit, lit by the lights and the sky, dimmed on the way
- * to the eye. Each light's shadow there from its shadow map where the map settles it
- * (atmos__beams_surface_visible), else (or with beams/exact_shadows) by an exact ray. */
-static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
+/* The eye's ray through pixel (x, y)'s centre: atmos_camera_ray's, from the coordinates kept
+ * per column and row (the same bits, without its two divisions) for a pinhole camera. */
+static void eye_ray(const job *J, int x, int y, double d[3])
+{
+    if (J->ru) atmos__camera_pinhole_dir(J->cam, J->ru[x], J->rv[y], d);
+    else atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
+}
+
+/* The coordinates per column and row of a pinhole camera (J->ru, J->rv; one block). Returns 1
+ * when out of memory. */
+static int eye_coordinates(job *J)
+{
+    const atmos_camera *c = J->cam;
+    J->ru = J->rv = NULL;
+    if (c->type != ATMOS_CAMERA_PINHOLE) return 0;
+    if (!(J->ru = malloc(sizeof(double) * ((size_t)c->width + c->height)))) return 1;
+    J->rv = J->ru + c->width;
+    for (int x = 0; x < c->width; x++) J->ru[x] = atmos__camera_pinhole_u(c, x + 0.5);
+    for (int y = 0; y < c->height; y++) J->rv[y] = atmos__camera_pinhole_v(c, y + 0.5);
+    return 0;
+}
+
+static int in_span(const job *J, int i, int x, int y)
+{
+    const int *r = J->span + 2 * ((size_t)i * J->cam->height + y);
+    return x >= r[0] && x < r[1];
+}
+
+/* The object's surface at the eye's ray's hit through pixel (x, y), lit by the lights and the
+ * sky, dimmed on the way to the eye. Each light's shadow there from its shadow map where the map
+ * settles it (atmos__beams_surface_visible), else (or with beams/exact_shadows) by an exact ray. A
+ * pixel outside a light's span (screen_spans) sees no point that the light reaches within the
+ * sampled radius: a surface point nearer the light than that is outside its cone (falloff 0),
+ * so the light is skipped there before its distance's root and the falloff are evaluated. */
+static void shade_surface(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int m, double fog_t,
+                          double *L)
 {
     const atmos__beams_plan *b = J->b;
     double P[3], sum[ATMOS_MAX_WAVELENGTHS];
@@ -72,7 +111,9 @@ static void shade_surface(const job *J, const double d[3], const atmos_mesh_hit 
     for (int i = 0; i < b->nlights; i++) {
         const atmos__beams_light *l = &b->lights[i];
         double w[3] = {l->L.pos[0] - P[0], l->L.pos[1] - P[1], l->L.pos[2] - P[2]};
-        const double r = sqrt(atmos__dot3(w, w));
+        const double r2 = atmos__dot3(w, w);
+        if (r2 < SPAN_SAFE * J->reach[i] * J->reach[i] && !in_span(J, i, x, y)) continue;
+        const double r = sqrt(r2);
         if (r <= 0) continue;
         for (int a = 0; a < 3; a++) w[a] /= r;
         const double c = atmos__dot3(h->normal, w);
@@ -244,12 +285,6 @@ static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, i
     sun_air(J, d, T, L);
 }
 
-static int in_span(const job *J, int i, int x, int y)
-{
-    const int *r = J->span + 2 * ((size_t)i * J->cam->height + y);
-    return x >= r[0] && x < r[1];
-}
-
 /* The doubles of a thread's buffer for lights(): each light's intervals, then their sums and counts. */
 #define LIGHT_STRIDE (2 * MAX_INTERVALS + 2)
 static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights : 1) * (LIGHT_STRIDE + 2); }
@@ -283,14 +318,14 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
 {
     const atmos__beams_plan *b = J->b;
     double d[3], L[ATMOS_MAX_WAVELENGTHS], A[ATMOS_MAX_WAVELENGTHS];
-    atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
+    eye_ray(J, x, y, d);
     atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
     const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
     const double T = hit ? h.t : INFINITY;
     if (px) {
         const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, T)); /* 0 to the sky behind endless fog */
-        if (hit) shade_surface(J, d, &h, m, fog_t, L);
+        if (hit) shade_surface(J, x, y, d, &h, m, fog_t, L);
         else
             for (int k = 0; k < J->nw; k++) L[k] = px[k] * fog_t;
         if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
@@ -448,13 +483,13 @@ static void surface_pixel(job *J, int x, int y, const float *bg, float *B, doubl
 {
     const atmos__beams_plan *b = J->b;
     double d[3], L[ATMOS_MAX_WAVELENGTHS];
-    atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
+    eye_ray(J, x, y, d);
     atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
     const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
     *T = hit ? h.t : INFINITY, *obj = hit ? m : -1;
     const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, *T));
-    if (hit) shade_surface(J, d, &h, m, fog_t, L);
+    if (hit) shade_surface(J, x, y, d, &h, m, fog_t, L);
     else
         for (int k = 0; k < J->nw; k++) L[k] = bg[k] * fog_t;
     if (hit && b->sun_on) sun_surface(J, d, &h, m, fog_t, L);
@@ -466,7 +501,7 @@ static void air_pixel(void *user, double *f, int x, int y, double T, double *A)
 {
     job *J = user;
     double d[3];
-    atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d);
+    eye_ray(J, x, y, d);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
     if (J->b->sigma_t > 0) lights(J, x, y, d, T, f, A, J->centre_now, 0.5);
     if (J->b->sun_on) sun_air(J, d, T, A);
@@ -586,7 +621,9 @@ static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const 
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
 {
     atmos__beams_plan *b = p->beams;
-    atmos_status st = atmos__sky_render(p->ctx, p->atm, v, r, out, p->sky_keep);
+    atmos__view sv = *v; /* the sky behind on the airlight's lattice too (the sky renderer's grid: sky_render.c) */
+    if (p->scene.beams.interleave <= 1 && p->scene.beams.screen_step > sv.sky_step) sv.sky_step = p->scene.beams.screen_step;
+    atmos_status st = atmos__sky_render(p->ctx, p->atm, &sv, r, out, p->sky_keep);
     if (st != ATMOS_OK) return st;
     job J;
     memset(&J, 0, sizeof J);
@@ -595,10 +632,14 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.cx = v->cam.width / 2, J.cy = v->cam.height / 2;
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
+    if (eye_coordinates(&J)) {
+        free(J.z_lo), free(J.span);
+        return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
+    }
     /* the sky seen from the ground under the eye, kept while that stays within its quantum */
     if ((b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) ||
         (b->obj.n > 0 && (st = atmos__beams_sky_keep(p->ctx, p->atm, J.eye, v->sun, J.nw, &b->sky)) != ATMOS_OK)) {
-        free(J.z_lo), free(J.span);
+        free(J.z_lo), free(J.span), free(J.ru);
         return st;
     }
     atmos__beams_il il = {0}, *ilp = NULL;
@@ -610,7 +651,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     }
     if (!failed && b->obj.n > 0) {
         if ((st = atmos__beams_primary_build(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &prim)) != ATMOS_OK) {
-            atmos__beams_il_free(&il), free(J.z_lo), free(J.span);
+            atmos__beams_il_free(&il), free(J.z_lo), free(J.span), free(J.ru);
             return st;
         }
         J.prim = &prim;
@@ -623,7 +664,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     atmos__beams_primary_free(&prim);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
-    free(J.z_lo), free(J.span);
+    free(J.z_lo), free(J.span), free(J.ru);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     b->air_evaluated = evaluated, b->air_pixels = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");

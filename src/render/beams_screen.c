@@ -1,5 +1,6 @@
 /* Screen-space adaptive subsampling of the airlight (beams_screen.h). */
 #include "render/beams_screen.h"
+#include "core/vec.h"
 
 #include <math.h>
 
@@ -49,8 +50,8 @@ static int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, in
         for (int x = x0; x <= x1; x++) {
             const size_t i = pix(s, x, y);
             if (s->object[i] != m) return 0;
-            lo = fmin(lo, s->T[i]), hi = fmax(hi, s->T[i]);
-            for (int k = 0; k < nw; k++) dim[k] = fmin(dim[k], s->base[i * nw + k]);
+            lo = atmos__mind(s->T[i], lo), hi = atmos__maxd(s->T[i], hi); /* fmin, fmax: no NaN here */
+            for (int k = 0; k < nw; k++) dim[k] = atmos__mind(s->base[i * nw + k], dim[k]);
         }
     return isinf(lo) || hi <= lo * (1 + s->depth);
 }
@@ -70,8 +71,8 @@ static int agree(const band *b, const double *c[4], int x0, int y0, int x1, int 
     if (!same_surface(s, x0, y0, x1, y1, dim)) return 0;
     weights(x0, y0, x1, y1, xm, ym, w);
     for (int k = 0; k < s->nw; k++) {
-        const double lo = fmin(fmin(c[0][k], c[1][k]), fmin(c[2][k], c[3][k]));
-        const double hi = fmax(fmax(c[0][k], c[1][k]), fmax(c[2][k], c[3][k]));
+        const double lo = atmos__mind(atmos__mind(c[0][k], c[1][k]), atmos__mind(c[2][k], c[3][k]));
+        const double hi = atmos__maxd(atmos__maxd(c[0][k], c[1][k]), atmos__maxd(c[2][k], c[3][k]));
         const double scale = lo + dim[k]; /* the least light a pixel of the cell may have */
         if (!(hi - lo <= s->spread * scale)) return 0;
         const double mid = w[0] * c[0][k] + w[1] * c[1][k] + w[2] * c[2][k] + w[3] * c[3][k];

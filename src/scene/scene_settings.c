@@ -140,7 +140,7 @@ static const atmos_setting beams_settings[] = {
      BEAMS(interleave)},
     {"screen_step", "screen-step", ATMOS_SETTING_INT, "pixels", 1, 16, 0, 0, 4, NULL, 0,
      "the airlight evaluated every N pixels and interpolated across the cells whose corners agree, per pixel "
-     "elsewhere (1: every pixel; with interleave 1)",
+     "elsewhere, the sky behind on the sky's grid of every N pixels (1: every pixel; with interleave 1)",
      BEAMS(screen_step)},
     {"exact_shadows", "exact-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
      "the surfaces' shadows of the lights by an exact ray per pixel and light (off: from the shadow maps where "

@@ -652,6 +652,90 @@ static void test_screen_spans(void)
     CHECK(missed == 0);
 }
 
+/* A floor under a spot, seen from several places, no light scattered by the air: every pixel whose
+ * floor point lies inside the spot's outer cone is lit, every other is dark — the surfaces' light
+ * skipped outside the light's screen span must be zero there, also where the floor lies beyond the
+ * light's reach (the spans cover the cone within the reach only; a surface is lit at any distance). */
+static void test_surface_spans(void)
+{
+    const double eyes[3][3] = {{-30, 15, 5}, {0, 25, 28}, {6, 3, -9}}, ranges[2] = {12, 40};
+    int lit = 0, dark = 0, wrong = 0;
+    for (int e = 0; e < 3; e++)
+        for (int k = 0; k < 2; k++) {
+            atmos_scene s;
+            base_scene(&s, 64, 48);
+            s.fog.extinction_per_m = 0.001, s.fog.scattering_per_m = 0;
+            atmos_scene_light *l = &s.lights[0];
+            l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 20, l->edge_deg = 5, l->range_m = ranges[k];
+            l->position_m[0] = 0, l->position_m[1] = 20, l->position_m[2] = 0;
+            l->direction[0] = 0.3, l->direction[1] = -1, l->direction[2] = 0.2;
+            s.object_count = 1;
+            memset(&s.objects[0], 0, sizeof s.objects[0]);
+            s.objects[0].scale[0] = s.objects[0].scale[1] = s.objects[0].scale[2] = 30;
+            s.objects[0].albedo[0] = s.objects[0].albedo[1] = s.objects[0].albedo[2] = 0.6;
+            snprintf(s.objects[0].mesh, sizeof s.objects[0].mesh, "builtin:plane");
+            memcpy(s.camera.position, eyes[e], sizeof eyes[e]);
+            s.camera.look_at[0] = 3, s.camera.look_at[1] = 0, s.camera.look_at[2] = 2;
+            s.camera.fov_deg = 70;
+            atmos_image *img = render(ctx, &s);
+            atmos_camera cam;
+            CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
+            if (!img) continue;
+            double ax[3] = {0.3, -1, 0.2};
+            const double n = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]), co = cos(25 * ATMOS_DEG2RAD);
+            for (int a = 0; a < 3; a++) ax[a] /= n;
+            for (int y = 0; y < s.height; y++)
+                for (int x = 0; x < s.width; x++) {
+                    double d[3];
+                    atmos_camera_ray(&cam, x + 0.5, y + 0.5, d);
+                    if (!(d[1] < 0)) continue;
+                    const double t = -eyes[e][1] / d[1], w[3] = {eyes[e][0] + t * d[0], -20, eyes[e][2] + t * d[2]};
+                    if (fabs(w[0]) > 10 || fabs(w[2]) > 10) continue; /* well inside the floor */
+                    const double c = (w[0] * ax[0] + w[1] * ax[1] + w[2] * ax[2]) / sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+                    const float v = img->pixels[((size_t)y * s.width + x) * img->channels];
+                    if (c > co + 1e-3) lit++, wrong += !(v > 0);
+                    else if (c < co - 1e-3) dark++, wrong += v != 0;
+                }
+            atmos_image_destroy(img);
+        }
+    printf("surfaces under a spot: %d floor pixels inside its cone, %d outside, %d wrong\n", lit, dark, wrong);
+    CHECK(lit > 1000 && dark > 1000);
+    CHECK(wrong == 0);
+}
+
+/* The sky behind, no fog or lights: with the airlight subsampled (screen_step 4) the sky too is
+ * read from the sky renderer's grid of every 4th pixel, within 0.3 % of its every pixel's value
+ * (the grid's tolerance: test_sky_step) and not the same image; screen_step 1: every pixel. */
+static void test_sky_on_lattice(void)
+{
+    atmos_scene s;
+    base_scene(&s, 256, 160);
+    s.fog.enabled = 0; /* the point light lights nothing: no fog, no objects */
+    s.atmosphere.kind = ATMOS_ATMOSPHERE_RILEY;
+    s.sun.from_time = 0, s.sun.elevation_deg = 8, s.sun.azimuth_deg = 150; /* low, in view */
+    s.camera.position[0] = 0, s.camera.position[1] = 1200, s.camera.position[2] = 0;
+    s.camera.look_at[0] = 495, s.camera.look_at[1] = 1270, s.camera.look_at[2] = 857;
+    s.camera.fov_deg = 60;
+    atmos_image *exact = render(ctx, &s);
+    s.beams.screen_step = 4;
+    atmos_image *grid = render(ctx, &s);
+    if (exact && grid) {
+        const size_t n = (size_t)s.width * s.height * exact->channels;
+        double worst = 0;
+        long differ = 0;
+        for (size_t i = 0; i < n; i++) {
+            const double a = exact->pixels[i], b = grid->pixels[i];
+            worst = fmax(worst, fabs(b - a) / fmax(a, 1e-30));
+            differ += a != b;
+        }
+        printf("the sky behind on the lattice: %ld of %zu samples differ, worst relative difference %.2e\n", differ, n,
+               worst);
+        CHECK(differ > 0);
+        CHECK(worst < 3e-3);
+    }
+    atmos_image_destroy(exact), atmos_image_destroy(grid);
+}
+
 /* One frame of s by a plan (on context c); *evaluated, *pixels: the renderer's count of the
  * pixels whose airlight it evaluated rather than interpolated, of all. */
 static atmos_image *render_counted(atmos_context *c, const atmos_scene *s, long *evaluated, long *pixels)
@@ -756,6 +840,8 @@ int main(void)
     test_shadow();
     test_light_sum();
     test_screen_spans();
+    test_surface_spans();
+    test_sky_on_lattice();
     test_threads();
     test_interleave();
     test_screen_step();
