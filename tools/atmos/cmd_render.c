@@ -335,7 +335,7 @@ static atmos_status render_frame(frames_run *r, atmos_plan *plan, const atmos_sc
     if (r->fo->w.tau && (st = write_tau(r->ctx, fs, plan, r->fo->w.tau)) != ATMOS_OK) return st;
     st = write_outputs(r->ctx, plan, fs, r->spec, &r->fo->w, r->out_kind, r->source, r->nframes > 1 ? label : NULL, &r->xl, r->o);
     if (st != ATMOS_OK) return st;
-    if (cli_outputs_commit("render", &r->fo->set) != 0) return ATMOS_E_IO;
+    if (cli_outputs_hold("render", &r->fo->set) != 0) return ATMOS_E_IO; /* renamed when all frames are */
     r->total += info.seconds;
     if (!r->o->quiet) {
         if (r->prog->shown) fputc('\n', stderr), r->prog->shown = 0;
@@ -345,8 +345,8 @@ static atmos_status render_frame(frames_run *r, atmos_plan *plan, const atmos_sc
 }
 
 /* Every frame of the scene's animation from the one plan (a time-lapse: a plan a frame, tl);
- * frame 1's outputs are staged already (fo), the others are staged here, and each frame's are
- * renamed into place once all of them are written. Returns a status; *failed_frame names the
+ * frame 1's outputs are staged already (fo), the others are staged here, and all frames' are
+ * renamed into place once every frame is written (a failure removes them all). Returns a status; *failed_frame names the
  * frame that failed. */
 static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const atmos_scene *scene, const render_opts *o,
                                   const char *png, const char *source, cli_progress *prog, frame_outputs *fo,
@@ -356,6 +356,8 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
                     png ? cli_file_kind_of(png) : CLI_FILE_OTHER, {0, 0, 0}, NULL, 0};
     r.xl.lock = r.nframes > 1 && !o->exposure_per_frame;
     atmos_status st = ATMOS_OK;
+    if (d->rank == 0 && cli_outputs_hold_reserve(r.nframes * 6) != 0)
+        return fprintf(stderr, "atmos render: out of memory for the frames' names\n"), ATMOS_E_IO;
     for (int frame = 1; frame <= r.nframes && st == ATMOS_OK; frame++) {
         *failed_frame = frame;
         /* --mpi: an animation's frame is rendered by its owner and written by rank 0; a single
@@ -376,6 +378,9 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
         atmos_plan_destroy(own), atmos_volume_destroy(vol);
     }
     cli_outputs_discard(&fo->set);
+    /* every frame's files renamed into place together, or none when a frame failed */
+    if (d->rank == 0 && st == ATMOS_OK && cli_outputs_held_commit("render") != 0) st = ATMOS_E_IO;
+    if (st != ATMOS_OK) cli_outputs_held_discard();
     atmos_image_destroy(r.spec);
     if (st == ATMOS_OK && !o->quiet && r.nframes > 1)
         fprintf(stderr, "atmos render: %d frames, %.3f s rendering (%s)%s\n", r.nframes, r.total,
