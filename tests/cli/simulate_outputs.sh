@@ -1,0 +1,28 @@
+#!/bin/sh
+# atmos simulate checks every file it will write (the .json sidecar and each NAME.FIELD.raw)
+# before the run, and writes all or none: a folder in the way of one field's file fails at
+# once (no simulation run, no other field's file left); NAME.JSON names its raw files as
+# NAME.json does.
+. "$(dirname "$0")/common.inc"
+mkdir -p "$T/o/x.rain.raw"
+"$A" simulate cumulus_field -o "$T/o/x.json" --grid 16 --minutes 3 -q 2>"$T/err"
+rc=$?
+[ $rc -eq 1 ] && grep -q "x.rain.raw" "$T/err" && grep -q "folder" "$T/err" && ok "a folder in the way of x.rain.raw refused" ||
+    { bad "x.rain.raw a folder: exit $rc"; cat "$T/err" >&2; }
+[ "$(ls "$T/o")" = "x.rain.raw" ] && ok "nothing else written" || bad "left: $(ls "$T/o" | tr '\n' ' ')"
+# --ice: the ice field's file is checked too
+mkdir -p "$T/o/i.ice.raw"
+"$A" simulate cumulus_field -o "$T/o/i.json" --grid 16 --minutes 3 --ice -q 2>"$T/err"
+rc=$?
+[ $rc -eq 1 ] && grep -q "i.ice.raw" "$T/err" && [ ! -e "$T/o/i.cloud.raw" ] && [ ! -e "$T/o/i.json" ] &&
+    ok "--ice: a folder in the way of i.ice.raw refused, nothing written" || { bad "--ice: exit $rc"; cat "$T/err" >&2; }
+# the sidecar itself a folder: refused before the run (no progress, no state)
+mkdir -p "$T/o/y.json"
+"$A" simulate cumulus_field -o "$T/o/y.json" --grid 16 --minutes 3 2>"$T/err"
+rc=$?
+[ $rc -eq 1 ] && grep -q "y.json" "$T/err" && ! grep -q "wrote\|%" "$T/err" && [ ! -e "$T/o/y.cloud.raw" ] &&
+    ok "-o a folder refused before the run" || { bad "-o a folder: exit $rc"; cat "$T/err" >&2; }
+# NAME.JSON: raw files NAME.FIELD.raw, as for NAME.json
+"$A" simulate stratocumulus --grid 16 --minutes 0.5 -o "$T/s.JSON" -q 2>"$T/err" || { bad "s.JSON"; cat "$T/err" >&2; }
+[ -s "$T/s.cloud.raw" ] && [ ! -e "$T/s.JSON.cloud.raw" ] && ok "s.JSON writes s.cloud.raw" || bad "s.JSON's raw names: $(ls "$T")"
+exit $fail
