@@ -67,6 +67,17 @@ $EXR "$T/xyz.exr" 2 2 X:float:1 Y:float:2 Z:float:3 || bad "write xyz.exr"
 "$A" compare "$T/xyz.exr" "$T/ref.pfm" >/dev/null 2>"$T/err"; rc=$?
 [ $rc -eq 1 ] && grep -q "do not pair by name" "$T/err" && ok || bad "X,Y,Z against R,G,B: exit $rc, $(cat "$T/err")"
 
+# An all-zero reference has no relative figure: null in JSON, never a number (-1), as the
+# text's inf; every value parses as JSON. --edges without --by is warned of.
+pfm "$T/zero.pfm" '\n' 0 0 0 0 0 0 0 0 0 0 0 0
+pfm "$T/one.pfm" '\n' 1 1 1 1 1 1 1 1 1 1 1 1
+out=$("$A" compare "$T/one.pfm" "$T/zero.pfm" --json) || bad "compare against zeros"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rel_rmse"] is None and d["rmse"] == 1 and d["rel_rmse_per_channel"] == [None]*3, d' \
+    && ok || bad "an all-zero reference: rel_rmse not null: $out"
+"$A" compare "$T/one.pfm" "$T/zero.pfm" | grep -q "all .* inf" && ok || bad "the text's rel_rmse for an all-zero reference"
+"$A" compare "$T/one.pfm" "$T/zero.pfm" --edges 1,2 >/dev/null 2>"$T/err"; rc=$?
+[ $rc -eq 0 ] && grep -q "edges.*without --by" "$T/err" && ok || bad "--edges without --by: exit $rc, $(cat "$T/err")"
+
 rm -rf "$T"
 echo "compare: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
