@@ -25,4 +25,10 @@ rc=$?
 # NAME.JSON: raw files NAME.FIELD.raw, as for NAME.json
 "$A" simulate stratocumulus --grid 16 --minutes 0.5 -o "$T/s.JSON" -q 2>"$T/err" || { bad "s.JSON"; cat "$T/err" >&2; }
 [ -s "$T/s.cloud.raw" ] && [ ! -e "$T/s.JSON.cloud.raw" ] && ok "s.JSON writes s.cloud.raw" || bad "s.JSON's raw names: $(ls "$T")"
+# a grid past the 64 M voxels: refused at once, the command named once, the limit in --help
+"$A" simulate cumulonimbus --grid 512 -o "$T/cb.json" -q 2>"$T/err"
+rc=$?
+[ $rc -eq 1 ] && grep -q "64 M" "$T/err" && ! grep -q "simulate: simulate:" "$T/err" && [ ! -e "$T/cb.json" ] &&
+    ok "--grid 512 for cumulonimbus refused, the prefix once" || { bad "--grid 512: exit $rc"; cat "$T/err" >&2; }
+"$A" simulate --help | grep -A2 -- "--grid N" | grep -q "64 M" && ok "--help states --grid's limit" || bad "--grid's limit not in --help"
 exit $fail
