@@ -30,5 +30,10 @@ rc=$?
 rc=$?
 [ $rc -eq 1 ] && grep -q "64 M" "$T/err" && ! grep -q "simulate: simulate:" "$T/err" && [ ! -e "$T/cb.json" ] &&
     ok "--grid 512 for cumulonimbus refused, the prefix once" || { bad "--grid 512: exit $rc"; cat "$T/err" >&2; }
-"$A" simulate --help | grep -A2 -- "--grid N" | grep -q "64 M" && ok "--help states --grid's limit" || bad "--grid's limit not in --help"
+"$A" simulate --help | grep -A6 -- "--grid N" | grep -q "64 M" && ok "--help states --grid's limit" || bad "--grid's limit not in --help"
+# stratocumulus at --grid 16: 8 levels of 400 m (the floor of 8 levels), and --help says so
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["dims"] == [16, 8, 16] and abs(d["voxel_size_m"] - 400) < 1e-9, d' \
+    "$T/s.JSON" && ok "stratocumulus at grid 16: 16 x 8 x 16 cells of 400 m" || bad "stratocumulus at grid 16: $(cat "$T/s.JSON")"
+"$A" simulate --help | grep -A4 -- "--grid N" | grep -q "at least 8 levels" && ok "--help states the 8 levels" ||
+    bad "--help silent on the 8 levels"
 exit $fail

@@ -34,7 +34,9 @@ static void help(void)
     }
     printf("\n  --minutes M  simulated time (default: the preset's, above), 0 < M <= %g\n"
            "  --grid N     cells along each horizontal side, %d..%d (default 64); the domain's size is the\n"
-           "               preset's, so a larger N gives smaller cells; the volume holds at most 64 M\n"
+           "               preset's, so a larger N gives smaller cells, but at least 8 levels: a coarse\n"
+           "               grid makes a shallow domain taller (stratocumulus below N = 32: 3.2 km at 16\n"
+           "               instead of 1.6 km); the volume holds at most 64 M\n"
            "               voxels (N x levels x N x R^3), refused at once past that: at --refine 1\n"
            "               towering_cumulus to about N = 400, cumulonimbus to about 470\n"
            "  --seed S     the random perturbations (default 1); the same seed gives the same bytes\n"
