@@ -249,6 +249,9 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     else
         fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source,
                 fs->width, fs->height, info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
+    if (nframes > 1 && !strncmp(fs->volume.source, "simulate:", 9)) /* a time-lapse's frame: its time */
+        fprintf(stderr, "  the simulated cloud at %g minutes\n",
+                fs->volume.sim_minutes > 0 ? fs->volume.sim_minutes : atmos_sim_preset_minutes(fs->volume.source + 9));
     if (ranks > 0) fprintf(stderr, "  rendered by rank %d\n", ranks);
     if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of at most %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
@@ -258,18 +261,24 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
         const atmos_path_stats *q = &ps.path;
+        /* --max-depth 1: the single scattering is estimated along each ray (next-event
+         * estimation) and no path goes on, so no real event may be sampled at all */
+        char ev[96];
+        if (q->events == 0 && fs->path.max_depth == 1)
+            snprintf(ev, sizeof ev, "single scattering (max depth 1: estimated along each ray, no path goes on)");
+        else
+            snprintf(ev, sizeof ev, "%lld scattering events", q->events);
         if (q->spp < 2) /* one sample: no spread to estimate an error from */
-            fprintf(stderr, "  path: %d spp, %lld scattering events, relative standard error n/a (1 sample per pixel)\n",
-                    q->spp, q->events);
+            fprintf(stderr, "  path: %d spp, %s, relative standard error n/a (1 sample per pixel)\n", q->spp, ev);
         else if (q->volume_pixels > 0)
             fprintf(stderr,
-                    "  path: %d spp, %lld scattering events; relative standard error over the %s's %lld pixels: "
+                    "  path: %d spp, %s; relative standard error over the %s's %lld pixels: "
                     "mean %.2f %%, median %.2f %%, 90th percentile %.2f %% (over all pixels: mean %.2f %%)\n",
-                    q->spp, q->events, atmos_plan_volume(plan, NULL) ? "volume" : "medium", q->volume_pixels, 100.0 * q->volume_rel_error_mean,
+                    q->spp, ev, atmos_plan_volume(plan, NULL) ? "volume" : "medium", q->volume_pixels, 100.0 * q->volume_rel_error_mean,
                     100.0 * q->volume_rel_error_median, 100.0 * q->volume_rel_error_p90, 100.0 * q->mean_rel_error);
         else
-            fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", q->spp,
-                    q->events, 100.0 * q->mean_rel_error);
+            fprintf(stderr, "  path: %d spp, %s, mean relative standard error %.2f %%\n", q->spp, ev,
+                    100.0 * q->mean_rel_error);
         if (ps.path.truncate_deg > 0)
             fprintf(stderr, "  path: forward peak truncated at %g deg: %.3f-%.3f of the scattering counted as unscattered\n",
                     ps.path.truncate_deg, ps.path.truncated_min, ps.path.truncated_max);
