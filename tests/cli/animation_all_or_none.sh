@@ -46,4 +46,7 @@ rc=$?
     ok "a backwards time-lapse refused by /animation/minutes_end before rendering" ||
     { bad "backwards time-lapse: exit $rc"; cat "$T/err4" >&2; }
 ls "$T" | grep -q back && bad "a backwards time-lapse wrote files" || ok "nothing written for it"
+# --frames 1 with an end for the sun: the first frame, as named (--help)
+"$A" render --frames 1 --sun-elevation 12 --sun-elevation-end -1 --width 32 --height 18 -o "$T/one.png" -q 2>"$T/err5" &&
+    [ -s "$T/one.png" ] && ok "--frames 1 renders the first frame as named" || { bad "--frames 1"; cat "$T/err5" >&2; }
 exit $fail

@@ -41,5 +41,10 @@ check "vertex 0" err6 "line 4" "vertex 0"
 mkdir dir.obj
 "$A" render s.json -D objects.0.mesh=dir.obj -o x.png -q 2>err7
 check "a folder" err7 "/objects/0/mesh" "folder"
+# a terrain whose max_triangles leaves no cell: said of max_triangles, not of a stride never set
+"$A" render --width 33 --height 33 -o h.png -q 2>/dev/null || bad "a height map"
+"$A" render s.json -D objects.1.terrain=h.png -D objects.1.max_triangles=1 -o x.png -q 2>err9
+check "max_triangles 1" err9 "/objects/1/terrain" "max_triangles 1"
+grep -q "stride" err9 && bad "max_triangles 1 spoken of as a stride: $(cat err9)"
 "$A" render s.json -o x.png -q 2>err8 && ok "the good mesh renders" || bad "the good mesh: $(cat err8)"
 exit $fail

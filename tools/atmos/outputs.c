@@ -85,9 +85,11 @@ static void register_stage(int i, const char *stage)
         static const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE};
         for (size_t k = 0; k < sizeof sigs / sizeof sigs[0]; k++) {
             struct sigaction old;
-            /* a signal ignored by the caller stays ignored (nohup; a write past a file size
-             * limit then fails as a write, and the outputs are discarded as on any failure) */
-            if (sigaction(sigs[k], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+            /* besides SIGINT and SIGTERM (caught always: a shell's background job ignores
+             * SIGINT, yet kill -INT from its script means stop), a signal ignored by the
+             * caller stays ignored (nohup; a write past a file size limit then fails as a
+             * write, and the outputs are discarded as on any failure) */
+            if (k >= 2 && sigaction(sigs[k], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
             sigaction(sigs[k], &sa, NULL);
         }
         installed = 1;

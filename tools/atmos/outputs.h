@@ -9,7 +9,8 @@
  * failure removes them (cli_outputs_discard) so that no output is replaced; an animation
  * holds each frame's staging files until all its frames are written (cli_outputs_hold).
  * SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ and SIGPIPE remove the staging files, the held
- * ones and the writers' temporaries before the process ends by the signal. */
+ * ones and the writers' temporaries before the process ends by the signal (the last four
+ * stay ignored when the caller ignores them). */
 #ifndef ATMOS_CLI_OUTPUTS_H
 #define ATMOS_CLI_OUTPUTS_H
 

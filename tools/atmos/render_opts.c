@@ -398,8 +398,8 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
     }
     if (!isnan(o->sun_el_end)) s->animation.elevation_end_deg = o->sun_el_end, s->animation.elevation_end_set = 1;
     if (!isnan(o->sun_az_end)) s->animation.azimuth_end_deg = o->sun_az_end, s->animation.azimuth_end_set = 1;
-    if ((o->time_end || !isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->animation.frames < 2)
-        return cli_usage_error(C, "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N (N >= 2) "
+    if ((o->time_end || !isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->animation.frames < 1)
+        return cli_usage_error(C, "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N "
                                          "or a scene with an \"animation\"");
     return CLI_EXIT_OK;
 }
