@@ -470,6 +470,13 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         if (rc == CLI_EXIT_OK && nframes > 1) rc = check_frame_names(o, png, nframes);
     }
     if ((rc = cli_dist_max(d, rc)) != CLI_EXIT_OK) return cli_outputs_discard(&fo.set), rc;
+    /* a moving sun that lights nothing: the lamps alone light the objects and the fog, and the
+     * background is a vacuum (no sky to move across) */
+    if (d->rank == 0 && nframes > 1 && !render_timelapse_wanted(scene) && cli_lit_without_sun(scene, scene->renderer) &&
+        scene->atmosphere.kind == ATMOS_ATMOSPHERE_VACUUM)
+        fprintf(stderr, "atmos render: warning: the animation moves the sun, but the sun lights nothing here (lamps "
+                        "only%s, a vacuum behind): every frame is the same image\n",
+                scene->renderer == ATMOS_RENDERER_BEAMS ? ": no \"beams\": {\"sun\"}" : "");
     atmos_plan *plan = NULL;
     int failed = 0;
     /* a time-lapse: the first frame's volume from the simulation the frames carry on */
