@@ -161,8 +161,8 @@ ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmo
  * (in total and per image) and skipped, and statistics with no finite sample are NaN.
  * A caller that uses the result as a test must treat nonfinite > 0 as a failure.
  * heatmap (optional): a display-encoded RGB image of the per-pixel relative
- * difference, black -> red -> yellow -> white at heat_scale (the 99th percentile of the
- * pixels' differences, the largest when that is 0; the pixels above it are white). */
+ * difference, black -> red -> yellow -> white at heat_scale (the largest difference, at
+ * most 10 times the 99th percentile of the pixels'; the few above it are white too). */
 #define ATMOS_IMAGE_DIFF_MAX_CHANNELS 16
 /* Which channels to compare: pair c is channel image[c] of the image against channel
  * reference[c] of the reference. */
@@ -187,7 +187,7 @@ typedef struct atmos_image_diff {
     int worst_x, worst_y, worst_w, worst_h; /* pixels */
     double worst_rmse;
     size_t nonfinite;                       /* compared samples skipped: either value NaN or infinite */
-    double heat_scale;                      /* relative difference shown as white (99th percentile) */
+    double heat_scale;                      /* relative difference shown as white */
     size_t nonfinite_image, nonfinite_reference; /* of those, the non-finite values in each image */
 } atmos_image_diff;
 ATMOS_API atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *image, const atmos_image *reference,

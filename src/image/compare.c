@@ -162,11 +162,12 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
         h->pixels[p * 3] = (float)d;
         if (d > scale) scale = d;
     }
-    /* white at the 99th percentile of the pixels' differences, not at the largest: one
-     * pixel far off (a lamp, the sun's disc) would leave the rest black; the pixels above it
-     * saturate. The largest when the percentile is 0 (a few pixels differ at all). */
+    /* white at the largest difference, but at most 10 times the 99th percentile of the
+     * pixels' differences: one pixel far off (a lamp, the sun's disc) would leave the rest
+     * black; the few above the scale saturate. The largest when the percentile is 0 (a few
+     * pixels differ at all). */
     const double p99 = heat_percentile(h, npx, 0.99);
-    if (p99 > 0) scale = p99;
+    if (p99 > 0 && scale > 10 * p99) scale = 10 * p99;
     out->heat_scale = scale;
     for (size_t p = 0; p < npx; p++) {
         double t = scale > 0 ? h->pixels[p * 3] / scale : 0;
