@@ -161,7 +161,8 @@ ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmo
  * (in total and per image) and skipped, and statistics with no finite sample are NaN.
  * A caller that uses the result as a test must treat nonfinite > 0 as a failure.
  * heatmap (optional): a display-encoded RGB image of the per-pixel relative
- * difference, black -> red -> yellow -> white at heat_scale. */
+ * difference, black -> red -> yellow -> white at heat_scale (the largest difference, at
+ * most 10 times the 99th percentile of the pixels'; the few above it are white too). */
 #define ATMOS_IMAGE_DIFF_MAX_CHANNELS 16
 /* Which channels to compare: pair c is channel image[c] of the image against channel
  * reference[c] of the reference. */

@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define COMPARE_TILE 16
@@ -45,6 +46,25 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
     atmos_status st = positional_match(ctx, a, ref, &m);
     if (st != ATMOS_OK) return st;
     return atmos_image_compare_matched(ctx, a, ref, &m, out, heatmap);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The q-quantile of the heat map's values (every third float of h, npx pixels); 0 when
+ * there is no memory to sort them (the caller keeps the largest). */
+static double heat_percentile(const atmos_image *h, size_t npx, double q)
+{
+    double *v = malloc(sizeof(double) * (npx ? npx : 1));
+    if (!v) return 0;
+    for (size_t p = 0; p < npx; p++) v[p] = h->pixels[p * 3];
+    qsort(v, npx, sizeof(double), cmp_double);
+    const double r = npx ? v[(size_t)floor(q * (double)(npx - 1))] : 0;
+    free(v);
+    return r;
 }
 
 atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
@@ -142,6 +162,12 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
         h->pixels[p * 3] = (float)d;
         if (d > scale) scale = d;
     }
+    /* white at the largest difference, but at most 10 times the 99th percentile of the
+     * pixels' differences: one pixel far off (a lamp, the sun's disc) would leave the rest
+     * black; the few above the scale saturate. The largest when the percentile is 0 (a few
+     * pixels differ at all). */
+    const double p99 = heat_percentile(h, npx, 0.99);
+    if (p99 > 0 && scale > 10 * p99) scale = 10 * p99;
     out->heat_scale = scale;
     for (size_t p = 0; p < npx; p++) {
         double t = scale > 0 ? h->pixels[p * 3] / scale : 0;

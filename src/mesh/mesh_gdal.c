@@ -81,9 +81,14 @@ atmos_status atmos__terrain_read(atmos_context *ctx, const char *path, int strid
         st = atmos__error(ctx, ATMOS_E_LIMIT, "terrain %s: %d x %d pixels: a height map needs 2 to %d a side", path, w,
                           h, ATMOS_TERRAIN_MAX_SIDE);
     if (st == ATMOS_OK) {
-        if (stride <= 0) stride = atmos__terrain_stride(w, h, max_triangles);
+        const int chosen = stride <= 0; /* the stride from max_triangles, not the scene's */
+        if (chosen) stride = atmos__terrain_stride(w, h, max_triangles);
         out->nx = (w - 1) / stride + 1, out->nz = (h - 1) / stride + 1;
-        if (out->nx < 2 || out->nz < 2)
+        if ((out->nx < 2 || out->nz < 2) && chosen)
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                              "terrain %s: max_triangles %ld is too few for a height map of %d x %d: at least 2 (one "
+                              "cell of two triangles)", path, max_triangles, w, h);
+        else if (out->nx < 2 || out->nz < 2)
             st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "terrain %s: a stride of %d leaves fewer than 2 x 2 samples of %d x %d",
                               path, stride, w, h);
         else if (2L * (out->nx - 1) * (out->nz - 1) > max_triangles)

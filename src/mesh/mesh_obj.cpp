@@ -5,6 +5,9 @@
 
 #include <tiny_obj_loader.h>
 
+#include <sys/stat.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,18 +24,65 @@ void say(char *msg, size_t cap, const char *text)
     if (cap) std::snprintf(msg, cap, "%s", text);
 }
 
-// The pass before the reader: the triangles the faces will give (every "f" line of n
-// vertices gives n - 2; stops counting past stop_after), and the first vertex line whose
-// coordinates are not finite numbers (the reader would take "nan" or "inf" as they are or
-// as zero). -1 if the file cannot be opened.
-long scan(const char *path, long stop_after, long *bad_line)
+// One face vertex as written ("7", "-2", "7/1/3", "7//3"): its vertex index in *out.
+// 0 when the text before the first '/' is not an integer.
+int face_index(const std::string &tok, long *out)
 {
+    const std::string head = tok.substr(0, tok.find('/'));
+    const char *p = head.c_str();
+    char *end = nullptr;
+    errno = 0;
+    const long v = std::strtol(p, &end, 10);
+    if (end == p || *end || errno) return 0;
+    *out = v;
+    return 1;
+}
+
+// A face line's vertices checked as written: integers, not 0, a negative one within the
+// vertices before the line (OBJ counts it back from there), a positive one noted in
+// *max_pos (checked against the file's count at the end). Empty, or what is wrong.
+std::string check_face(const std::string &rest, long line_no, long vertices, long *max_pos, long *max_line)
+{
+    std::istringstream in(rest);
+    std::string tok;
+    char buf[256];
+    while (in >> tok) {
+        long v = 0;
+        if (!face_index(tok, &v)) {
+            std::snprintf(buf, sizeof buf, "line %ld: a face's vertex '%.40s' is not a number (a vertex index, "
+                          "counted from 1)", line_no, tok.c_str());
+            return buf;
+        }
+        if (v == 0) {
+            std::snprintf(buf, sizeof buf, "line %ld: a face refers to vertex 0 (indices count from 1)", line_no);
+            return buf;
+        }
+        if (v < 0 && -v > vertices) {
+            std::snprintf(buf, sizeof buf, "line %ld: a face refers to vertex %ld, %ld back, with %ld vertices before "
+                          "the line", line_no, v, -v, vertices);
+            return buf;
+        }
+        if (v > *max_pos) *max_pos = v, *max_line = line_no;
+    }
+    return std::string();
+}
+
+// The pass before the reader: the triangles the faces will give (every "f" line of n
+// vertices gives n - 2; stops counting past stop_after), and the first line that is wrong:
+// a vertex whose coordinates are not finite numbers (the reader would take "nan" or "inf"
+// as they are or as zero) or a face vertex that is not a vertex of the file (the reader's
+// own message for those names neither the index nor the line). -1 if the file cannot be
+// opened (why says why).
+long scan(const char *path, long stop_after, std::string *why)
+{
+    struct stat sb;
+    if (stat(path, &sb) != 0) return *why = std::strerror(errno), -1;
+    if (S_ISDIR(sb.st_mode)) return *why = "it is a folder, not a file", -1;
     std::ifstream f(path, std::ios::binary);
-    if (!f) return -1;
-    long tris = 0, line_no = 0;
-    *bad_line = 0;
+    if (!f) return *why = std::strerror(errno ? errno : EIO), -1;
+    long tris = 0, line_no = 0, vertices = 0, max_pos = 0, max_line = 0;
     std::string line;
-    while (std::getline(f, line) && tris <= stop_after) {
+    while (std::getline(f, line) && tris <= stop_after && why->empty()) {
         line_no++;
         if (line.size() < 2 || (line[1] != ' ' && line[1] != '\t')) continue;
         if (line[0] == 'f') {
@@ -41,18 +91,28 @@ long scan(const char *path, long stop_after, long *bad_line)
             long n = 0;
             while (in >> tok) n++;
             if (n > 2) tris += n - 2;
-        } else if (line[0] == 'v' && !*bad_line) {
+            *why = check_face(line.substr(2), line_no, vertices, &max_pos, &max_line);
+        } else if (line[0] == 'v') {
+            vertices++;
             const char *p = line.c_str() + 2;
             for (int k = 0; k < 3; k++) {
                 char *end = nullptr;
                 const double x = std::strtod(p, &end);
                 if (end == p || !std::isfinite(x)) {
-                    *bad_line = line_no;
+                    char buf[96];
+                    std::snprintf(buf, sizeof buf, "line %ld: a vertex needs three finite numbers", line_no);
+                    *why = buf;
                     break;
                 }
                 p = end;
             }
         }
+    }
+    if (why->empty() && max_pos > vertices && tris <= stop_after) {
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "line %ld: a face refers to vertex %ld, the file has %ld", max_line, max_pos,
+                      vertices);
+        *why = buf;
     }
     return tris;
 }
@@ -60,17 +120,17 @@ long scan(const char *path, long stop_after, long *bad_line)
 int read_obj(const char *path, long max_triangles, float **positions, long *nv, uint32_t **indices, long *nt,
              char *msg, size_t cap)
 {
-    long bad_line = 0;
-    const long counted = scan(path, max_triangles, &bad_line);
-    if (counted < 0) return say(msg, cap, "cannot open the file"), ATMOS__OBJ_E_IO;
+    std::string why;
+    const long counted = scan(path, max_triangles, &why);
+    if (counted < 0) {
+        if (cap) std::snprintf(msg, cap, "cannot open: %s", why.c_str());
+        return ATMOS__OBJ_E_IO;
+    }
     if (counted > max_triangles) {
         if (cap) std::snprintf(msg, cap, "more than %ld triangles (the bound)", max_triangles);
         return ATMOS__OBJ_E_LIMIT;
     }
-    if (bad_line) {
-        if (cap) std::snprintf(msg, cap, "line %ld: a vertex needs three finite numbers", bad_line);
-        return ATMOS__OBJ_E_FORMAT;
-    }
+    if (!why.empty()) return say(msg, cap, why.c_str()), ATMOS__OBJ_E_FORMAT;
     tinyobj::ObjReaderConfig config;
     config.triangulate = false; // fanned here, so that the count matches the one above
     config.vertex_color = false;

@@ -1,6 +1,7 @@
 /* The scene's objects for the renderers (objects.h). */
 #include "render/objects.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,6 +15,19 @@ static atmos_status load_terrain(atmos_context *ctx, const atmos_scene_object *o
     return atmos_mesh_terrain(ctx, &d, out);
 }
 
+/* A failed mesh or terrain's message with the scene's key in front, and for a relative
+ * path (a scene from standard input or from code) where it was looked for, as a light's
+ * image says (lamp.c). */
+static atmos_status name_key(atmos_context *ctx, atmos_status st, const atmos_scene_object *o, int i)
+{
+    const char *path = o->terrain[0] ? o->terrain : o->mesh;
+    const int file = path[0] != '/' && strncmp(path, "builtin:", 8) && strncmp(path, "generate:", 9);
+    char why[1024];
+    snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
+    return atmos__error(ctx, st, "/objects/%d/%s: %s%s", i, o->terrain[0] ? "terrain" : "mesh", why,
+                        file && st == ATMOS_E_IO ? " (a relative path: from the current folder)" : "");
+}
+
 atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const atmos_wavelengths *wl,
                                  atmos__objects *ob)
 {
@@ -25,7 +39,7 @@ atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const
     for (int i = 0; i < s->object_count; i++) {
         const atmos_scene_object *o = &s->objects[i];
         atmos_status st = o->terrain[0] ? load_terrain(ctx, o, &ob->mesh[i]) : atmos_mesh_load(ctx, o->mesh, 0, &ob->mesh[i]);
-        if (st != ATMOS_OK) return st;
+        if (st != ATMOS_OK) return name_key(ctx, st, o, i);
         ob->n = i + 1;
         atmos_mesh_transform t;
         memcpy(t.position_m, o->position_m, sizeof t.position_m);

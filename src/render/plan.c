@@ -469,7 +469,7 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
     } else if (p->renderer == ATMOS_RENDERER_HARRIS) {
         st = atmos__harris_render(p, &v, &r, out);
     } else if (p->renderer == ATMOS_RENDERER_BEAMS) {
-        st = atmos__beams_render(p, &v, &r, out);
+        st = atmos__beams_render_spp(p, &v, &r, out);
     } else {
         st = atmos__path_render(p, &v, &r, out, &stats->path);
     }

@@ -89,5 +89,9 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b);
 /* The sky, then the objects and the light the fog scatters, over the pixels of r. */
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);
 void atmos__beams_describe(const atmos_plan *p, char *buf, size_t cap);
+/* atmos__beams_render with the frame's samples per pixel N as n x n rays a pixel, n =
+ * round(sqrt(N)) (beams_antialias.c); N = 1 (the default): one ray through each centre. */
+atmos_status atmos__beams_render_spp(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);
+int atmos__beams_rays_per_side(int samples_per_pixel);
 
 #endif

@@ -345,6 +345,16 @@ atmos_status atmos__scene_validate_animation(atmos_context *ctx, const char *sou
     if (a->minutes_end_set && !(a->minutes_end > 0 && a->minutes_end <= ATMOS_SIM_MAX_MINUTES))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/minutes_end", "must be in (0, %g], got %g",
                                  ATMOS_SIM_MAX_MINUTES, a->minutes_end);
+    if (a->minutes_end_set && a->frames > 1) {
+        /* the first frame's minutes, as atmos_scene_animation_frame takes them */
+        const double m0 = scene->volume.sim_minutes > 0 ? scene->volume.sim_minutes
+                                                        : atmos_sim_preset_minutes(scene->volume.source + 9);
+        if (!(a->minutes_end > m0))
+            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/minutes_end",
+                                     "must exceed the first frame's %g minutes (/volume/simulate/minutes): a "
+                                     "time-lapse runs forward, got %g",
+                                     m0, a->minutes_end);
+    }
     if (a->frames > 1 && !a->time_end_set && !angle_end && !a->minutes_end_set)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation",
                                  "%d frames need an end: time_end (a sun given by time), elevation_end_deg/"

@@ -24,6 +24,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #define SIDECAR_MAX_BYTES (1 << 20)
@@ -448,6 +449,25 @@ static atmos_status write_text_fn(atmos_context *ctx, const char *tmp, void *use
     return ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_IO, "%s: write failed: %s", tmp, strerror(errno));
 }
 
+/* Field f's raw file: rel, its name next to the sidecar (<stem>.<field>.raw), and full, its
+ * path. 0 when a name does not fit. */
+static int raw_name(const atmos_volume *vol, int f, const char *json_path, const char *base, size_t stem_len,
+                    char rel[PATH_CAP], char full[PATH_CAP])
+{
+    int n = snprintf(rel, PATH_CAP, "%.*s.%s.raw", (int)stem_len, base, atmos_volume_field_name(vol, f));
+    int m = snprintf(full, PATH_CAP, "%.*s%s", (int)(base - json_path), json_path, rel);
+    return n >= 0 && m >= 0 && n < PATH_CAP && m < PATH_CAP;
+}
+
+/* Removes the raw files of fields 0..n-1 (a write that failed leaves none). */
+static void remove_raws(const atmos_volume *vol, int n, const char *json_path, const char *base, size_t stem_len)
+{
+    for (int f = 0; f < n; f++) {
+        char rel[PATH_CAP], full[PATH_CAP];
+        if (raw_name(vol, f, json_path, base, stem_len, rel, full)) remove(full);
+    }
+}
+
 atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol, const char *json_path)
 {
     if (!vol || !json_path || !*json_path)
@@ -458,7 +478,7 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     const char *base = strrchr(json_path, '/');
     base = base ? base + 1 : json_path;
     size_t stem_len = strlen(base);
-    if (stem_len > 5 && !strcmp(base + stem_len - 5, ".json")) stem_len -= 5;
+    if (stem_len > 5 && !strcasecmp(base + stem_len - 5, ".json")) stem_len -= 5; /* any case, as the CLI's */
     cJSON *root = cJSON_CreateObject(), *arr;
     if (!root) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", json_path);
     const atmos_volume_desc *d = atmos_volume_get_desc(vol);
@@ -472,16 +492,16 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     if (d->periodic) cJSON_AddTrueToObject(root, "periodic");
     cJSON_AddItemToObject(root, "fields", arr = cJSON_CreateArray());
     atmos_status st = ATMOS_OK;
+    int written = 0; /* the raw files written so far */
     for (int f = 0; f < nf && st == ATMOS_OK; f++) {
         char rel[PATH_CAP], full[PATH_CAP];
-        int n = snprintf(rel, sizeof rel, "%.*s.%s.raw", (int)stem_len, base, atmos_volume_field_name(vol, f));
-        int m = snprintf(full, sizeof full, "%.*s%s", (int)(base - json_path), json_path, rel);
-        if (n < 0 || m < 0 || (size_t)n >= sizeof rel || (size_t)m >= sizeof full) {
+        if (!raw_name(vol, f, json_path, base, stem_len, rel, full)) {
             st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: path too long", json_path);
             break;
         }
         raw_write_job job = {vol, f, NULL};
         st = atmos__write_atomic(ctx, full, write_field_fn, &job);
+        written += st == ATMOS_OK;
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", atmos_volume_field_name(vol, f));
         cJSON_AddStringToObject(o, "particle", atmos_volume_field_particle(vol, f));
@@ -491,8 +511,8 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     }
     char *text = st == ATMOS_OK ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);
-    if (st != ATMOS_OK) return st;
-    if (!text) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", json_path);
+    if (st == ATMOS_OK && !text) st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", json_path);
+    if (st != ATMOS_OK) return remove_raws(vol, written, json_path, base, stem_len), st;
     size_t len = strlen(text);
     char *t2 = realloc(text, len + 2);
     if (t2) {
@@ -503,14 +523,7 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     raw_write_job job = {vol, 0, text};
     st = atmos__write_atomic(ctx, json_path, write_text_fn, &job);
     free(text);
-    if (st != ATMOS_OK) {
-        /* All or nothing: without its sidecar the raw files are orphans. */
-        for (int f = 0; f < nf; f++) {
-            char rel[PATH_CAP], full[PATH_CAP];
-            int n = snprintf(rel, sizeof rel, "%.*s.%s.raw", (int)stem_len, base, atmos_volume_field_name(vol, f));
-            int m = snprintf(full, sizeof full, "%.*s%s", (int)(base - json_path), json_path, rel);
-            if (n > 0 && m > 0 && (size_t)n < sizeof rel && (size_t)m < sizeof full) remove(full);
-        }
-    }
+    /* All or nothing: without its sidecar the raw files are orphans. */
+    if (st != ATMOS_OK) remove_raws(vol, nf, json_path, base, stem_len);
     return st;
 }

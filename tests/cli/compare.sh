@@ -67,6 +67,26 @@ $EXR "$T/xyz.exr" 2 2 X:float:1 Y:float:2 Z:float:3 || bad "write xyz.exr"
 "$A" compare "$T/xyz.exr" "$T/ref.pfm" >/dev/null 2>"$T/err"; rc=$?
 [ $rc -eq 1 ] && grep -q "do not pair by name" "$T/err" && ok || bad "X,Y,Z against R,G,B: exit $rc, $(cat "$T/err")"
 
+# An all-zero reference has no relative figure: null in JSON, never a number (-1), as the
+# text's inf; every value parses as JSON. --edges without --by is warned of.
+pfm "$T/zero.pfm" '\n' 0 0 0 0 0 0 0 0 0 0 0 0
+pfm "$T/one.pfm" '\n' 1 1 1 1 1 1 1 1 1 1 1 1
+out=$("$A" compare "$T/one.pfm" "$T/zero.pfm" --json) || bad "compare against zeros"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rel_rmse"] is None and d["rmse"] == 1 and d["rel_rmse_per_channel"] == [None]*3, d' \
+    && ok || bad "an all-zero reference: rel_rmse not null: $out"
+"$A" compare "$T/one.pfm" "$T/zero.pfm" | grep -q "all .* inf" && ok || bad "the text's rel_rmse for an all-zero reference"
+"$A" compare "$T/one.pfm" "$T/zero.pfm" --edges 1,2 >/dev/null 2>"$T/err"; rc=$?
+[ $rc -eq 0 ] && grep -q "edges.*without --by" "$T/err" && ok || bad "--edges without --by: exit $rc, $(cat "$T/err")"
+
+# The heat map's white is at most 10 times the 99th percentile of the pixels' differences:
+# one far-off pixel among 100 off by 10 % does not set it (it saturates at 1), so the rest
+# are not black.
+python3 -c 'import struct,sys
+for name, v in ((sys.argv[1], [1.0] * 300), (sys.argv[2], [1.1] * 297 + [1000.0] * 3)):
+    open(name, "wb").write(b"PF\n10 10\n-1.0\n" + struct.pack("<300f", *v))' "$T/h_ref.pfm" "$T/h_img.pfm"
+out=$("$A" compare "$T/h_img.pfm" "$T/h_ref.pfm" --heatmap "$T/hh.png") || bad "compare with one far-off pixel"
+echo "$out" | grep -q "white = 1 relative" && ok || bad "the heat map's white with one far-off pixel: $out"
+
 rm -rf "$T"
 echo "compare: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

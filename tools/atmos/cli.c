@@ -62,7 +62,10 @@ int cli_runtime_error(const char *cmd, atmos_context *ctx, atmos_status st)
     const char *msg = ctx ? atmos_context_error(ctx) : "";
     char buf[2048];
     cli_outputs_final_names(msg && *msg ? msg : atmos_status_string(st), buf, sizeof buf);
-    fprintf(stderr, "atmos %s: %s\n", cmd, buf);
+    /* the library's messages may start with the command's own name ("simulate: ..."): once */
+    const size_t n = strlen(cmd);
+    const char *text = !strncmp(buf, cmd, n) && buf[n] == ':' && buf[n + 1] == ' ' ? buf + n + 2 : buf;
+    fprintf(stderr, "atmos %s: %s\n", cmd, text);
     return CLI_EXIT_RUNTIME;
 }
 

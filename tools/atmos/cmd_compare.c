@@ -20,17 +20,20 @@ static void help(void)
            "  bias      mean of IMAGE - REFERENCE\n"
            "and the worst 16x16 region. --heatmap writes a PNG (a .png name that is none of the\n"
            "images read; a missing folder is made) of the per-pixel relative difference (black, red,\n"
-           "yellow, white = the largest). --json prints\n"
+           "yellow, white = the largest, at most 10 x the 99th percentile of the pixels' differences:\n"
+           "one far-off pixel such as a lamp saturates instead of leaving the rest black). --json prints\n"
            "  {\"rmse\": ..., \"rel_rmse\": ..., \"bias\": [...], \"rmse_per_channel\": [...],\n"
            "   \"rel_rmse_per_channel\": [...], \"channels\": [names], \"worst_region\": [x, y, w, h],\n"
            "   \"worst_rmse\": ..., \"nonfinite\": N, \"nonfinite_image\": N1, \"nonfinite_reference\": N2}\n"
-           "(numbers without a finite value are null). NaN or infinite samples in either image\n"
+           "(numbers without a finite value are null: the relative ones of an all-zero reference,\n"
+           "printed inf or nan as text). NaN or infinite samples in either image\n"
            "fail the comparison: the statistics over the finite ones are printed, then an error\n"
            "with the counts, and the exit status is 1.\n\n"
            "--by KEY splits the statistics by a per-pixel key image of the same size (channel 0),\n"
            "such as the optical depth written by `atmos render --tau`: pixels with the key in\n"
            "[E_i, E_i+1) form bin i (default edges 0.01,0.1,0.5,1,2,4,8,16,32,64,1e30). Per bin it\n"
-           "prints the pixel count, rel_rmse and rel_bias (over the reference's mean in the bin);\n"
+           "prints the pixel count, rel_rmse and rel_bias (over the reference's mean in the bin;\n"
+           "--edges without --by is warned of and does nothing);\n"
            "--json adds \"bins\": [{\"lo\", \"hi\", \"pixels\", \"rel_rmse\", \"rel_bias\"}, ...].\n");
 }
 
@@ -102,7 +105,9 @@ static void print_json(const atmos_image_diff *d, const char *const *names, cons
 {
     printf("{\"rmse\": ");
     json_number(d->rmse_all);
-    printf(", \"rel_rmse\": %.9g, \"bias\": ", isfinite(d->rel_rmse_all) ? d->rel_rmse_all : -1.0);
+    printf(", \"rel_rmse\": ");
+    json_number(d->rel_rmse_all); /* an all-zero reference: no relative figure (the text's inf or nan) */
+    printf(", \"bias\": ");
     json_numbers(d->bias, d->channels);
     printf(", \"rmse_per_channel\": ");
     json_numbers(d->rmse, d->channels);
@@ -123,8 +128,11 @@ static void print_json(const atmos_image_diff *d, const char *const *names, cons
             /* Empty bins say null. */
             printf("%s{\"lo\": %.9g, \"hi\": %.9g, \"pixels\": %zu, ", i ? ", " : "", bins->edges[i], bins->edges[i + 1],
                    bins->count[i]);
-            if (isfinite(bins->rel_rmse[i])) printf("\"rel_rmse\": %.9g, \"rel_bias\": %.9g}", bins->rel_rmse[i], bins->rel_bias[i]);
-            else printf("\"rel_rmse\": null, \"rel_bias\": null}");
+            printf("\"rel_rmse\": ");
+            json_number(bins->rel_rmse[i]);
+            printf(", \"rel_bias\": ");
+            json_number(bins->rel_bias[i]);
+            printf("}");
         }
         printf("]");
     }
@@ -154,7 +162,7 @@ static void print_text(const char *const *files, const atmos_image *a, const atm
 int cli_cmd_compare(int argc, char **argv)
 {
     const char *C = "compare", *files[2] = {NULL, NULL}, *heat = NULL, *by = NULL;
-    int json = 0, nf = 0, n_edges = 11;
+    int json = 0, nf = 0, n_edges = 11, edges_given = 0;
     double edges[ATMOS_IMAGE_BINS_MAX + 1] = {0.01, 0.1, 0.5, 1, 2, 4, 8, 16, 32, 64, 1e30};
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
@@ -171,7 +179,7 @@ int cli_cmd_compare(int argc, char **argv)
             by = v;
         } else if (cli_take_value(argc, argv, &i, "--edges", &v)) {
             if (!v) return cli_usage_error(C, "--edges: missing list");
-            n_edges = 0;
+            n_edges = 0, edges_given = 1;
             const char *q = v;
             while (*q && n_edges <= ATMOS_IMAGE_BINS_MAX) {
                 char *end = NULL;
@@ -192,6 +200,7 @@ int cli_cmd_compare(int argc, char **argv)
         }
     }
     if (nf < 2) return cli_usage_error(C, "need IMAGE and REFERENCE");
+    if (edges_given && !by) fprintf(stderr, "atmos %s: warning: --edges does nothing without --by KEY (the bins' edges)\n", C);
     const char *inputs3[3] = {files[0], files[1], by};
     for (int k = 0; k < 3; k++) {
         const char *kind = inputs3[k] ? ldr_kind(inputs3[k]) : NULL;

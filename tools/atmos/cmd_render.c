@@ -249,6 +249,9 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     else
         fprintf(stderr, "%s, %dx%d, sun at %.2f deg elevation / %.2f deg azimuth, %.3f s rendering\n", source,
                 fs->width, fs->height, info->sun_elevation_deg, info->sun_azimuth_deg, info->seconds);
+    if (nframes > 1 && !strncmp(fs->volume.source, "simulate:", 9)) /* a time-lapse's frame: its time */
+        fprintf(stderr, "  the simulated cloud at %g minutes\n",
+                fs->volume.sim_minutes > 0 ? fs->volume.sim_minutes : atmos_sim_preset_minutes(fs->volume.source + 9));
     if (ranks > 0) fprintf(stderr, "  rendered by rank %d\n", ranks);
     if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of at most %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
@@ -258,18 +261,24 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
         const atmos_path_stats *q = &ps.path;
+        /* --max-depth 1: the single scattering is estimated along each ray (next-event
+         * estimation) and no path goes on, so no real event may be sampled at all */
+        char ev[96];
+        if (q->events == 0 && fs->path.max_depth == 1)
+            snprintf(ev, sizeof ev, "single scattering (max depth 1: estimated along each ray, no path goes on)");
+        else
+            snprintf(ev, sizeof ev, "%lld scattering events", q->events);
         if (q->spp < 2) /* one sample: no spread to estimate an error from */
-            fprintf(stderr, "  path: %d spp, %lld scattering events, relative standard error n/a (1 sample per pixel)\n",
-                    q->spp, q->events);
+            fprintf(stderr, "  path: %d spp, %s, relative standard error n/a (1 sample per pixel)\n", q->spp, ev);
         else if (q->volume_pixels > 0)
             fprintf(stderr,
-                    "  path: %d spp, %lld scattering events; relative standard error over the %s's %lld pixels: "
+                    "  path: %d spp, %s; relative standard error over the %s's %lld pixels: "
                     "mean %.2f %%, median %.2f %%, 90th percentile %.2f %% (over all pixels: mean %.2f %%)\n",
-                    q->spp, q->events, atmos_plan_volume(plan, NULL) ? "volume" : "medium", q->volume_pixels, 100.0 * q->volume_rel_error_mean,
+                    q->spp, ev, atmos_plan_volume(plan, NULL) ? "volume" : "medium", q->volume_pixels, 100.0 * q->volume_rel_error_mean,
                     100.0 * q->volume_rel_error_median, 100.0 * q->volume_rel_error_p90, 100.0 * q->mean_rel_error);
         else
-            fprintf(stderr, "  path: %d spp, %lld scattering events, mean relative standard error %.2f %%\n", q->spp,
-                    q->events, 100.0 * q->mean_rel_error);
+            fprintf(stderr, "  path: %d spp, %s, mean relative standard error %.2f %%\n", q->spp, ev,
+                    100.0 * q->mean_rel_error);
         if (ps.path.truncate_deg > 0)
             fprintf(stderr, "  path: forward peak truncated at %g deg: %.3f-%.3f of the scattering counted as unscattered\n",
                     ps.path.truncate_deg, ps.path.truncated_min, ps.path.truncated_max);
@@ -335,7 +344,7 @@ static atmos_status render_frame(frames_run *r, atmos_plan *plan, const atmos_sc
     if (r->fo->w.tau && (st = write_tau(r->ctx, fs, plan, r->fo->w.tau)) != ATMOS_OK) return st;
     st = write_outputs(r->ctx, plan, fs, r->spec, &r->fo->w, r->out_kind, r->source, r->nframes > 1 ? label : NULL, &r->xl, r->o);
     if (st != ATMOS_OK) return st;
-    if (cli_outputs_commit("render", &r->fo->set) != 0) return ATMOS_E_IO;
+    if (cli_outputs_hold("render", &r->fo->set) != 0) return ATMOS_E_IO; /* renamed when all frames are */
     r->total += info.seconds;
     if (!r->o->quiet) {
         if (r->prog->shown) fputc('\n', stderr), r->prog->shown = 0;
@@ -345,8 +354,8 @@ static atmos_status render_frame(frames_run *r, atmos_plan *plan, const atmos_sc
 }
 
 /* Every frame of the scene's animation from the one plan (a time-lapse: a plan a frame, tl);
- * frame 1's outputs are staged already (fo), the others are staged here, and each frame's are
- * renamed into place once all of them are written. Returns a status; *failed_frame names the
+ * frame 1's outputs are staged already (fo), the others are staged here, and all frames' are
+ * renamed into place once every frame is written (a failure removes them all). Returns a status; *failed_frame names the
  * frame that failed. */
 static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const atmos_scene *scene, const render_opts *o,
                                   const char *png, const char *source, cli_progress *prog, frame_outputs *fo,
@@ -356,6 +365,8 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
                     png ? cli_file_kind_of(png) : CLI_FILE_OTHER, {0, 0, 0}, NULL, 0};
     r.xl.lock = r.nframes > 1 && !o->exposure_per_frame;
     atmos_status st = ATMOS_OK;
+    if (d->rank == 0 && cli_outputs_hold_reserve(r.nframes * 6) != 0)
+        return fprintf(stderr, "atmos render: out of memory for the frames' names\n"), ATMOS_E_IO;
     for (int frame = 1; frame <= r.nframes && st == ATMOS_OK; frame++) {
         *failed_frame = frame;
         /* --mpi: an animation's frame is rendered by its owner and written by rank 0; a single
@@ -376,6 +387,9 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
         atmos_plan_destroy(own), atmos_volume_destroy(vol);
     }
     cli_outputs_discard(&fo->set);
+    /* every frame's files renamed into place together, or none when a frame failed */
+    if (d->rank == 0 && st == ATMOS_OK && cli_outputs_held_commit("render") != 0) st = ATMOS_E_IO;
+    if (st != ATMOS_OK) cli_outputs_held_discard();
     atmos_image_destroy(r.spec);
     if (st == ATMOS_OK && !o->quiet && r.nframes > 1)
         fprintf(stderr, "atmos render: %d frames, %.3f s rendering (%s)%s\n", r.nframes, r.total,
@@ -456,6 +470,13 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         if (rc == CLI_EXIT_OK && nframes > 1) rc = check_frame_names(o, png, nframes);
     }
     if ((rc = cli_dist_max(d, rc)) != CLI_EXIT_OK) return cli_outputs_discard(&fo.set), rc;
+    /* a moving sun that lights nothing: the lamps alone light the objects and the fog, and the
+     * background is a vacuum (no sky to move across) */
+    if (d->rank == 0 && nframes > 1 && !render_timelapse_wanted(scene) && cli_lit_without_sun(scene, scene->renderer) &&
+        scene->atmosphere.kind == ATMOS_ATMOSPHERE_VACUUM)
+        fprintf(stderr, "atmos render: warning: the animation moves the sun, but the sun lights nothing here (lamps "
+                        "only%s, a vacuum behind): every frame is the same image\n",
+                scene->renderer == ATMOS_RENDERER_BEAMS ? ": no \"beams\": {\"sun\"}" : "");
     atmos_plan *plan = NULL;
     int failed = 0;
     /* a time-lapse: the first frame's volume from the simulation the frames carry on */

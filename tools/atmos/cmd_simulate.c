@@ -20,8 +20,9 @@ static void help(void)
            "time M as a volume of \"cloud\" and \"rain\" (rain and snow) number densities (m^-3; mixing\n"
            "ratio x air density / the particle type's mean mass; \"ice\" too with --ice), raw float32 files\n"
            "next to the JSON sidecar (-o must name a .json file, whose folder is made if missing; nothing\n"
-           "else is written), y up, the ground at y = 0. A volume with no cloud and no rain is written\n"
-           "with a warning.\n\n"
+           "else is written), y up, the ground at y = 0. Every file is checked before the run (an existing\n"
+           "folder in the way or a place that cannot be written fails at once), and all are written or\n"
+           "none. A volume with no cloud and no rain is written with a warning.\n\n"
            "Presets (default simulated time; a shorter run may end before any cloud has formed, and the\n"
            "volume is then empty: at least the first-cloud time, better twice it; coarser grids take\n"
            "longer, e.g. cumulus_field ~7 min at --grid 32):\n");
@@ -33,7 +34,11 @@ static void help(void)
     }
     printf("\n  --minutes M  simulated time (default: the preset's, above), 0 < M <= %g\n"
            "  --grid N     cells along each horizontal side, %d..%d (default 64); the domain's size is the\n"
-           "               preset's, so a larger N gives smaller cells\n"
+           "               preset's, so a larger N gives smaller cells, but at least 8 levels: a coarse\n"
+           "               grid makes a shallow domain taller (stratocumulus below N = 32: 3.2 km at 16\n"
+           "               instead of 1.6 km); the volume holds at most 64 M\n"
+           "               voxels (N x levels x N x R^3), refused at once past that: at --refine 1\n"
+           "               towering_cumulus to about N = 400, cumulonimbus to about 470\n"
            "  --seed S     the random perturbations (default 1); the same seed gives the same bytes\n"
            "  --refine R   voxels per model cell along each axis, 1..%d (default 1): the mixing ratios\n"
            "               interpolated in their logarithm between cell centres, so that edges fall\n"
@@ -107,6 +112,28 @@ static void warn_if_empty(const atmos_sim *s, const atmos_sim_desc *d, double mi
             minutes, 1e3 * st.max_qc, d->preset, first, first > 0 ? 2 * first : 1);
 }
 
+/* Every file the run will write (the sidecar out = NAME.json and NAME.FIELD.raw for each of
+ * the simulation's fields: cloud, rain and with --ice ice, as atmos_volume_write_raw names
+ * them), checked before the run: the folders made, no existing folder or link in the way,
+ * each file creatable (a staging file made and removed). CLI_EXIT_OK or the exit status. */
+static int check_outputs(const char *out, int ice)
+{
+    static const char *const fields[3] = {"cloud", "rain", "ice"};
+    char raw[3][CLI_OUTPUT_PATH_MAX];
+    cli_outputs set = {0};
+    const int stem = (int)strlen(out) - 5; /* without .json (cli_volume_output) */
+    cli_outputs_add(&set, "-o", out);
+    for (int f = 0; f < 2 + (ice != 0); f++) {
+        const int n = snprintf(raw[f], sizeof raw[f], "%.*s.%s.raw", stem, out, fields[f]);
+        if (n < 0 || n >= (int)sizeof raw[f]) return cli_usage_error(C, "-o %s: the path is too long", out);
+        cli_outputs_add(&set, "-o", raw[f]);
+    }
+    int rc = cli_outputs_check(C, &set, NULL, 0);
+    if (rc == CLI_EXIT_OK) rc = cli_outputs_prepare(C, &set);
+    cli_outputs_discard(&set);
+    return rc;
+}
+
 /* The run and the volume written as NAME.json + raw files. */
 static int run_write(const atmos_sim_desc *d, int threads, int quiet, const char *out)
 {
@@ -139,7 +166,7 @@ int cli_cmd_simulate(int argc, char **argv)
     memset(&d, 0, sizeof d);
     d.seed = 1;
     const char *out = NULL;
-    int threads = 0, quiet = 0, bench = 0;
+    int threads = 0, quiet = 0, bench = 0, rc;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -192,6 +219,6 @@ int cli_cmd_simulate(int argc, char **argv)
     if (bench) return run_bench(&d, threads, bench);
     if (!out) return cli_usage_error(C, "missing -o NAME.json");
     if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
-    if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
+    if ((rc = check_outputs(out, d.ice)) != CLI_EXIT_OK) return rc;
     return run_write(&d, threads, quiet, out);
 }

@@ -53,10 +53,21 @@ int cli_png_output(const char *cmd, const char *option, const char *path)
 static char slot_name[SLOTS][CLI_OUTPUT_PATH_MAX + 64];
 static volatile sig_atomic_t slot_used[SLOTS];
 
+/* The staging files of an animation's finished frames, held until every frame is written
+ * (cli_outputs_hold): an entry is filled before held_n counts it. */
+typedef struct {
+    char *stage, *path;
+    const char *option;
+} held_file;
+static held_file *held;
+static volatile sig_atomic_t held_n;
+static int held_cap;
+
 static void on_signal(int sig)
 {
     for (int i = 0; i < SLOTS; i++)
         if (slot_used[i]) unlink(slot_name[i]);
+    for (int i = 0; i < held_n; i++) unlink(held[i].stage);
     signal(sig, SIG_DFL);
     raise(sig);
 }
@@ -69,8 +80,18 @@ static void register_stage(int i, const char *stage)
         memset(&sa, 0, sizeof sa);
         sa.sa_handler = on_signal;
         sigemptyset(&sa.sa_mask);
-        sigaction(SIGINT, &sa, NULL);
-        sigaction(SIGTERM, &sa, NULL);
+        /* the signals that end a process by default and can be caught: a terminal hung up, a
+         * file size limit reached (the writers' files are removed with the others) */
+        static const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE};
+        for (size_t k = 0; k < sizeof sigs / sizeof sigs[0]; k++) {
+            struct sigaction old;
+            /* besides SIGINT and SIGTERM (caught always: a shell's background job ignores
+             * SIGINT, yet kill -INT from its script means stop), a signal ignored by the
+             * caller stays ignored (nohup; a write past a file size limit then fails as a
+             * write, and the outputs are discarded as on any failure) */
+            if (k >= 2 && sigaction(sigs[k], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+            sigaction(sigs[k], &sa, NULL);
+        }
         installed = 1;
     }
     slot_used[2 * i] = slot_used[2 * i + 1] = 0;
@@ -243,7 +264,9 @@ int cli_outputs_prepare(const char *cmd, cli_outputs *set)
     return 0;
 }
 
-int cli_outputs_commit(const char *cmd, cli_outputs *set)
+/* 0 when every staging file of set is written (not empty); else 1, the message printed and
+ * the staging files removed. */
+static int all_written(const char *cmd, cli_outputs *set)
 {
     for (int i = 0; i < set->n; i++) {
         struct stat sb;
@@ -253,6 +276,65 @@ int cli_outputs_commit(const char *cmd, cli_outputs *set)
             return 1;
         }
     }
+    return 0;
+}
+
+int cli_outputs_hold_reserve(int n)
+{
+    cli_outputs_held_discard();
+    held = n > 0 ? calloc((size_t)n, sizeof *held) : NULL;
+    held_cap = held ? n : 0;
+    return n > 0 && !held;
+}
+
+int cli_outputs_hold(const char *cmd, cli_outputs *set)
+{
+    if (all_written(cmd, set)) return 1;
+    for (int i = 0; i < set->n; i++) {
+        cli_output *o = &set->f[i];
+        held_file h = {strdup(o->stage), strdup(o->path), o->option};
+        if (held_n >= held_cap || !h.stage || !h.path) {
+            fprintf(stderr, "atmos %s: %s %s: out of memory to hold the frame's files\n", cmd, o->option, o->path);
+            free(h.stage), free(h.path);
+            cli_outputs_discard(set);
+            return 1;
+        }
+        held[held_n] = h;
+        held_n++; /* counted once its names are in place (the signal handler reads them) */
+        unregister_stage(i);
+        o->stage[0] = '\0';
+    }
+    return 0;
+}
+
+int cli_outputs_held_commit(const char *cmd)
+{
+    for (int i = 0; i < held_n; i++)
+        if (rename(held[i].stage, held[i].path) != 0) {
+            fprintf(stderr, "atmos %s: %s: cannot rename %s into place: %s\n", cmd, held[i].path, held[i].stage,
+                    strerror(errno));
+            cli_outputs_held_discard();
+            return 1;
+        }
+    const int n = held_n;
+    held_n = 0;
+    for (int i = 0; i < n; i++) free(held[i].stage), free(held[i].path);
+    free(held), held = NULL, held_cap = 0;
+    return 0;
+}
+
+void cli_outputs_held_discard(void)
+{
+    const int n = held_n;
+    for (int i = 0; i < n; i++) unlink(held[i].stage); /* those renamed already are gone */
+    held_n = 0;
+    for (int i = 0; i < n; i++) free(held[i].stage), free(held[i].path);
+    free(held), held = NULL, held_cap = 0;
+}
+
+int cli_outputs_commit(const char *cmd, cli_outputs *set)
+{
+    if (all_written(cmd, set)) return 1;
     for (int i = 0; i < set->n; i++) {
         cli_output *o = &set->f[i];
         if (rename(o->stage, o->path) != 0) {

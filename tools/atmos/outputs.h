@@ -6,9 +6,11 @@
  * made next to each output (cli_outputs_prepare): a folder or file that cannot be
  * written fails the command before anything is rendered. The writers write the staging
  * files; cli_outputs_commit renames them all onto the final names at the end, and any
- * failure removes them (cli_outputs_discard) so that no output is replaced. SIGINT and
- * SIGTERM remove the staging files and the writers' temporaries before the process
- * ends by the signal. */
+ * failure removes them (cli_outputs_discard) so that no output is replaced; an animation
+ * holds each frame's staging files until all its frames are written (cli_outputs_hold).
+ * SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ and SIGPIPE remove the staging files, the held
+ * ones and the writers' temporaries before the process ends by the signal (the last four
+ * stay ignored when the caller ignores them). */
 #ifndef ATMOS_CLI_OUTPUTS_H
 #define ATMOS_CLI_OUTPUTS_H
 
@@ -58,6 +60,16 @@ int cli_outputs_prepare(const char *cmd, cli_outputs *set);
 int cli_output_folder(const char *cmd, const char *option, const char *path);
 /* Renames every staging file onto its final name. Returns 0 or 1 (message printed). */
 int cli_outputs_commit(const char *cmd, cli_outputs *set);
+/* An animation's frames, all or none: room for n held files (0 or 1: out of memory). */
+int cli_outputs_hold_reserve(int n);
+/* Instead of cli_outputs_commit: the staging files of set, all written, are held (kept
+ * under their staging names, removed on signals) until cli_outputs_held_commit renames
+ * every held file onto its final name; set is emptied of them. Returns 0 or 1 (message
+ * printed, set's staging files removed). */
+int cli_outputs_hold(const char *cmd, cli_outputs *set);
+int cli_outputs_held_commit(const char *cmd);
+/* Removes the held files (after a failure). */
+void cli_outputs_held_discard(void);
 /* Removes the staging files (and the writers' temporaries next to them). */
 void cli_outputs_discard(cli_outputs *set);
 /* A message with the staging suffix (".tmpPID") taken out of the names it holds, so

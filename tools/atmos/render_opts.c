@@ -398,8 +398,8 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
     }
     if (!isnan(o->sun_el_end)) s->animation.elevation_end_deg = o->sun_el_end, s->animation.elevation_end_set = 1;
     if (!isnan(o->sun_az_end)) s->animation.azimuth_end_deg = o->sun_az_end, s->animation.azimuth_end_set = 1;
-    if ((o->time_end || !isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->animation.frames < 2)
-        return cli_usage_error(C, "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N (N >= 2) "
+    if ((o->time_end || !isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->animation.frames < 1)
+        return cli_usage_error(C, "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N "
                                          "or a scene with an \"animation\"");
     return CLI_EXIT_OK;
 }
@@ -682,7 +682,8 @@ void render_opts_help(void)
            "Overrides of the scene's settings:\n"
            "      --width W --height H      image size in pixels\n"
            "      --spp N                   sky and slice renderers: stratified samples of the sky per pixel\n"
-           "                                (1..256); path tracer: its samples per pixel (below)\n"
+           "                                (1..256); path tracer: its samples per pixel (below); beams:\n"
+           "                                n x n rays a pixel, n = round(sqrt(N)) (antialiasing; 1 default)\n"
            "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
            "      --altitude M              camera altitude above sea level, metres\n"
            "      --position X,Y,Z          camera position, metres (x east, y up, z south); keeps the view\n"

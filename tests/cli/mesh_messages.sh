@@ -1,0 +1,50 @@
+#!/bin/sh
+# A mesh or terrain file that cannot be read is named by its scene key with the system's
+# reason and, for a relative path, where it was looked for (as a light's image is); an OBJ
+# file's wrong face says what is wrong, as written, and on which line; a folder is a folder.
+. "$(dirname "$0")/common.inc"
+cd "$T" || exit 1
+mesh_scene() { # mesh_scene MESH TERRAIN
+    cat <<JSON
+{"image": {"width": 16, "height": 12}, "wavelengths": {"mode": "rgb"}, "background": "black", "renderer": "beams",
+ "camera": {"type": "pinhole", "position_m": [0, 8, 40], "look_at_m": [0, 5, 0], "fov_deg": 50},
+ "fog": {"extinction_per_m": 0.03, "scattering_per_m": 0.027, "g": 0.2},
+ "lights": [{"type": "point", "position_m": [0, 20, 0], "intensity_w_sr": 3000}],
+ "objects": [{"mesh": "$1", "position_m": [0, 8, 0]}, {"terrain": "$2", "size_m": 60, "height_m": 3}]}
+JSON
+}
+# check NAME FILE-OR-STDIN PATTERN...: the render fails and its message holds every pattern
+check() {
+    name=$1 err=$2
+    shift 2
+    for p in "$@"; do grep -q -- "$p" "$err" || { bad "$name: no '$p' in: $(cat "$err")"; return; }; done
+    ok "$name"
+}
+mesh_scene nobox.obj generate:ridges | "$A" render - -o x.png -q 2>err1
+check "a missing mesh from standard input" err1 "/objects/0/mesh" "nobox.obj" "No such file" "relative path"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >ok.obj
+mesh_scene ok.obj nohills.png | "$A" render - -o x.png -q 2>err2
+check "a missing terrain" err2 "/objects/1/terrain" "nohills.png" "No such file" "relative path"
+mesh_scene ok.obj generate:ridges >s.json
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 abc\n' >junk.obj
+"$A" render s.json -D objects.0.mesh=junk.obj -o x.png -q 2>err3
+check "a face vertex that is not a number" err3 "/objects/0/mesh" "line 4" "'abc'" "not a number"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -5\n' >neg.obj
+"$A" render s.json -D objects.0.mesh=neg.obj -o x.png -q 2>err4
+check "a negative index out of range, as written" err4 "line 4" "vertex -5" "3 vertices"
+printf 'v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\nf 1 2 9\n' >big.obj
+"$A" render s.json -D objects.0.mesh=big.obj -o x.png -q 2>err5
+check "a positive index past the file's vertices" err5 "line 5" "vertex 9" "has 3"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n' >zero.obj
+"$A" render s.json -D objects.0.mesh=zero.obj -o x.png -q 2>err6
+check "vertex 0" err6 "line 4" "vertex 0"
+mkdir dir.obj
+"$A" render s.json -D objects.0.mesh=dir.obj -o x.png -q 2>err7
+check "a folder" err7 "/objects/0/mesh" "folder"
+# a terrain whose max_triangles leaves no cell: said of max_triangles, not of a stride never set
+"$A" render --width 33 --height 33 -o h.png -q 2>/dev/null || bad "a height map"
+"$A" render s.json -D objects.1.terrain=h.png -D objects.1.max_triangles=1 -o x.png -q 2>err9
+check "max_triangles 1" err9 "/objects/1/terrain" "max_triangles 1"
+grep -q "stride" err9 && bad "max_triangles 1 spoken of as a stride: $(cat err9)"
+"$A" render s.json -o x.png -q 2>err8 && ok "the good mesh renders" || bad "the good mesh: $(cat err8)"
+exit $fail
