@@ -79,9 +79,12 @@ static double hg(double g, double cos_theta)
 }
 
 /* The sunlight E at x of radius index j (sphere j, or the ground for j = m) whose sun's cosine
- * is mus: from the table e when given (linear in mus), else the solver's. */
-static void sunlight_at(const atmos_atmosphere *a, const atmos__sunlight_table *e, int j, const double x[3],
-                        const double sun[3], double mus, double *E)
+ * is mus: from the table e when given (linear in mus), else the solver's. Inline in its
+ * callers (the compiler left it a call: a few per cent of the frame). */
+static inline __attribute__((always_inline)) void sunlight_at(const atmos_atmosphere *a,
+                                                              const atmos__sunlight_table *e, int j,
+                                                              const double x[3], const double sun[3],
+                                                              double mus, double *E)
 {
     const int n = a->wl.count;
     if (!e) {

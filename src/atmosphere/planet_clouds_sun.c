@@ -108,8 +108,9 @@ static double step_down(atmos__clouds_sun *s, const double p[3], int above)
     atmos__planet_latlon_fast(pl, q, &la, &lo);
     const double col = atmos__clouds_column_tau(cl, la, lo);
     const double G = atmos__clouds_sun_lookup(s, q, above, la, lo);
-    return col > 0 ? G * atmos__expf_fast((float)-atmos__clouds_shell_tau(cl, above, col, atmos__planet_mu(pl, q, s->sun)))
-                   : G;
+    /* q is on sphere `above`: its vertical is (q + centre) / r, without a square root */
+    const double mu = (q[0] * s->sun[0] + (q[1] + pl->r_ground) * s->sun[1] + q[2] * s->sun[2]) * cl->inv_r[above];
+    return col > 0 ? G * atmos__expf_fast((float)-atmos__clouds_shell_tau(cl, above, col, mu)) : G;
 }
 
 /* G at the texel centres of a tile, sphere by sphere downward as Dobashi et al. build their
