@@ -13,5 +13,9 @@ double atmos__camera_pinhole_u(const atmos_camera *cam, double x);
 double atmos__camera_pinhole_v(const atmos_camera *cam, double y);
 /* The unit direction through the image-plane point (u, v). */
 void atmos__camera_pinhole_dir(const atmos_camera *cam, double u, double v, double dir[3]);
+/* The unit directions through (u[i], v) for i < n, in three arrays (x, y, z): the same bits as
+ * atmos__camera_pinhole_dir's, a row at a time (the roots and divisions vectorised). */
+void atmos__camera_pinhole_dirs(const atmos_camera *cam, const double *u, int n, double v, double *dx, double *dy,
+                                double *dz);
 
 #endif

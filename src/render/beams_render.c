@@ -64,6 +64,8 @@ typedef struct job {
     const atmos__beams_sky *sky; /* the sky's light on surfaces (none in a vacuum or without objects) */
     const atmos__beams_primary *prim; /* what each pixel sees, rasterised (NULL: no objects) */
     double *ru, *rv;           /* a pinhole camera's image-plane coordinates per column and row (else NULL) */
+    const double *dir;         /* subsampling, a pinhole camera: the eye's rays over dir_r (x, y, z; else NULL) */
+    atmos__rect dir_r;
 } job;
 
 /* The eye's ray through pixel (x, y)'s centre: atmos_camera_ray's, from the coordinates kept
@@ -477,13 +479,26 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
 #define SCREEN_DEPTH 0.5
 #endif
 
+/* The eye's ray through pixel (x, y) in a subsampled frame: kept from the first pass (J->dir) when
+ * there is one, the same bits as eye_ray's. */
+static void kept_ray(const job *J, int x, int y, double d[3])
+{
+    if (!J->dir) {
+        eye_ray(J, x, y, d);
+        return;
+    }
+    const size_t W = (size_t)(J->dir_r.x1 - J->dir_r.x0), n = W * (size_t)(J->dir_r.y1 - J->dir_r.y0);
+    const size_t i = (size_t)(y - J->dir_r.y0) * W + (size_t)(x - J->dir_r.x0);
+    d[0] = J->dir[i], d[1] = J->dir[n + i], d[2] = J->dir[2 * n + i];
+}
+
 /* Subsampling's first pass: pixel (x, y) without its airlight into B (bg: the sky behind it),
  * what it sees into *T and *obj. */
 static void surface_pixel(job *J, int x, int y, const float *bg, float *B, double *T, int *obj)
 {
     const atmos__beams_plan *b = J->b;
     double d[3], L[ATMOS_MAX_WAVELENGTHS];
-    eye_ray(J, x, y, d);
+    kept_ray(J, x, y, d);
     atmos_mesh_hit h = {0, 0, {0, 0, 0}};
     int m = -1;
     const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
@@ -501,7 +516,7 @@ static void air_pixel(void *user, double *f, int x, int y, double T, double *A)
 {
     job *J = user;
     double d[3];
-    eye_ray(J, x, y, d);
+    kept_ray(J, x, y, d);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
     if (J->b->sigma_t > 0) lights(J, x, y, d, T, f, A, J->centre_now, 0.5);
     if (J->b->sun_on) sun_air(J, d, T, A);
@@ -512,11 +527,12 @@ typedef struct screen_buf {
     int *X, *Y, *obj;
     double *T, *node;
     float *base;
+    double *dir; /* the eye's rays (a pinhole camera; else NULL) */
 } screen_buf;
 
 static void screen_buf_free(screen_buf *q)
 {
-    free(q->X), free(q->Y), free(q->obj), free(q->T), free(q->node), free(q->base);
+    free(q->X), free(q->Y), free(q->obj), free(q->T), free(q->node), free(q->base), free(q->dir);
 }
 
 /* Band j of a subsampled frame (atmos__beams_screen_band) from the lattice's nodes, added to the
@@ -557,7 +573,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     *evaluated = 0;
     if (W <= 0 || H <= 0) return 0;
     screen_buf q = {malloc(sizeof(int) * (size_t)((W - 1) / k + 2)), malloc(sizeof(int) * (size_t)((H - 1) / k + 2)),
-                    malloc(sizeof(int) * n), malloc(sizeof(double) * n), NULL, malloc(sizeof(float) * n * nw)};
+                    malloc(sizeof(int) * n), malloc(sizeof(double) * n), NULL, malloc(sizeof(float) * n * nw), NULL};
     int failed = !q.X || !q.Y || !q.obj || !q.T || !q.base, done = 0;
     const int nx = failed ? 0 : atmos__beams_screen_nodes(r->x0, r->x1, k, q.X);
     const int ny = failed ? 0 : atmos__beams_screen_nodes(r->y0, r->y1, k, q.Y), nb = ny > 1 ? ny - 1 : 1;
@@ -566,6 +582,8 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
         screen_buf_free(&q);
         return 1;
     }
+    q.dir = J->ru ? malloc(sizeof(double) * 3 * n) : NULL; /* none: each pass makes its rays */
+    J->dir = q.dir, J->dir_r = *r;
     const atmos__beams_screen s = {*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base, air_pixel, J};
     long ev = 0;
 #pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev)
@@ -578,12 +596,15 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
             failed = 1;
         }
 #pragma omp for schedule(dynamic, 1)
-        for (int y = r->y0; y < r->y1; y++)
+        for (int y = r->y0; y < r->y1; y++) {
+            double *row = q.dir ? q.dir + (size_t)(y - r->y0) * W : NULL;
+            if (row && ok) atmos__camera_pinhole_dirs(J->cam, J->ru + r->x0, W, J->rv[y], row, row + n, row + 2 * n);
             for (int x = r->x0; x < r->x1 && ok && !atmos__cancelled(cancelled); x++) {
                 const size_t i = (size_t)(y - r->y0) * W + (size_t)(x - r->x0);
                 surface_pixel(J, x, y, out->pixels + ((size_t)y * out->width + x) * out->channels, q.base + i * nw,
                               &q.T[i], &q.obj[i]);
             }
+        }
 #pragma omp for schedule(dynamic, 1)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx && ok && !atmos__cancelled(cancelled); i++, ev++)
@@ -604,6 +625,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
         J->centre_now = 0;
         free(f);
     }
+    J->dir = NULL;
     screen_buf_free(&q);
     *evaluated = ev;
     return failed;

@@ -8,6 +8,7 @@
  *  - equirectangular: azimuth linear in x (north at the centre), elevation linear in y.
  * Frame: x east, y up, z south; azimuth clockwise from north (docs/models.md). */
 #include "atmos/atmos.h"
+#include "core/camera.h"
 #include "test.h"
 
 #include <math.h>
@@ -321,12 +322,41 @@ static void test_invalid(atmos_context *ctx)
     CHECK_OK(atmos_camera_init(ctx, &base, 64, 64, &cam));
 }
 
+/* A pinhole camera's rays a row at a time (atmos__camera_pinhole_dirs, the beams' subsampled
+ * frames) are atmos_camera_ray's to the bit, over an odd width (the vector loop's tail) and an
+ * oblique view. */
+static void test_pinhole_rows(atmos_context *ctx)
+{
+    atmos_camera_desc d;
+    memset(&d, 0, sizeof d);
+    d.type = ATMOS_CAMERA_PINHOLE;
+    const double pos[3] = {3, 7, 1.5}, look[3] = {-2, 5, -9};
+    memcpy(d.position, pos, sizeof pos), memcpy(d.look_at, look, sizeof look);
+    d.fov_deg = 57;
+    enum { W = 37, H = 23 };
+    atmos_camera cam = make(ctx, &d, W, H);
+    double u[W], dx[W], dy[W], dz[W];
+    for (int x = 0; x < W; x++) u[x] = atmos__camera_pinhole_u(&cam, x + 0.5);
+    int differ = 0;
+    for (int y = 0; y < H; y++) {
+        atmos__camera_pinhole_dirs(&cam, u, W, atmos__camera_pinhole_v(&cam, y + 0.5), dx, dy, dz);
+        for (int x = 0; x < W; x++) {
+            double r[3];
+            atmos_camera_ray(&cam, x + 0.5, y + 0.5, r);
+            const double got[3] = {dx[x], dy[x], dz[x]};
+            differ += memcmp(got, r, sizeof r) != 0;
+        }
+    }
+    CHECK_MSG(differ == 0, "pinhole rows: %d of %d rays differ from atmos_camera_ray", differ, W * H);
+}
+
 int main(void)
 {
     atmos_context *ctx = NULL;
     CHECK_OK(atmos_context_create(NULL, &ctx));
     test_angles();
     test_pinhole(ctx);
+    test_pinhole_rows(ctx);
     test_fisheye(ctx);
     test_equirect(ctx);
     test_invalid(ctx);
