@@ -72,6 +72,12 @@ typedef struct atmos_frame {
     int sky_step;               /* the sky behind the volume evaluated every sky_step pixels, 1..16, and read
                                    bilinearly where it is smooth (pinhole cameras, one sample a pixel;
                                    docs/viewer.md): the viewer's frames; 0 or 1 = every pixel */
+    int sky_table;              /* 1: the sky behind the volume read bilinearly from a table over view directions
+                                   (azimuth from the sun x elevation, crowded at the horizon; Hillaire 2020 §5.3)
+                                   made for the eye's height and the sun, kept while they stay: at sky_step's
+                                   grid nodes and the pixels it evaluates (within about one level of 255 of
+                                   every pixel's; flat kinds, pinhole cameras, one sample a pixel; the viewer's
+                                   frames: docs/viewer.md); 0 = the atmosphere evaluated */
     int no_air_shadows;         /* slice renderer: 1 leaves out the volume's shadow on the air and the ground
                                    (the scene's "air_shadows") for this frame: the viewer's moving preview; 0 */
     int warm_field;             /* slice renderer: 1 starts the diffuse field after a sun move from the last

@@ -263,6 +263,7 @@ static atmos_status resolve_view(atmos_plan *p, const atmos_frame *f, atmos__vie
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "frame: light_size must be in [0, 8192] (0: the scene's), got %d",
                             f->light_size);
     v->sky_step = f->sky_step > 1 ? f->sky_step : 1;
+    v->sky_table = f->sky_table != 0;
     v->no_air_shadows = f->no_air_shadows != 0;
     v->warm_field = f->warm_field != 0;
     v->hold_field = f->hold_field != 0;
@@ -310,7 +311,7 @@ static int same_view(const atmos__view *a, const atmos__view *b)
     return !memcmp(&a->cam, &b->cam, sizeof a->cam) && !memcmp(a->sun, b->sun, sizeof a->sun) &&
            a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale &&
            a->light_size == b->light_size &&
-           a->sky_step == b->sky_step && a->no_air_shadows == b->no_air_shadows &&
+           a->sky_step == b->sky_step && a->sky_table == b->sky_table && a->no_air_shadows == b->no_air_shadows &&
            a->hold_field == b->hold_field && a->screen_layer_px == b->screen_layer_px;
 }
 

@@ -4,6 +4,7 @@
  * depends only on its own rays (a fixed Hammersley set of sample positions, no random
  * numbers), so the image is the same for any thread count and any region. */
 #include "atmosphere/atmosphere_ops.h"
+#include "render/sky_view.h"
 #include "render/view.h"
 
 #include <math.h>
@@ -154,6 +155,8 @@ static void sample_offset(int s, int spp, double *sx, double *sy)
 
 typedef struct {
     float *dx, *dy, *dz, *w, *acc, *scratch, *hits;
+    float *tu, *tcoord, *tval; /* the sky-view table's reads: u, coordinates, values (n + 1 a pixel) */
+    int *tnear, *txs;          /* the pixels near the sun among them, and their columns */
 } row_buffers;
 
 /* Pixels x0 .. x0 + count - 1 of row y into dst (the row's first pixel). */
@@ -254,24 +257,53 @@ static void pinhole_cols(const atmos_camera *cam, int y, const int *xs, int m, f
     }
 }
 
-/* Radiance of pixels xs[0..m) of row y into val[i * n + k] (the sun's disk added); flags[i]
- * (may be NULL): 1 when the pixel's ray meets the ground, + 2 when it is within the angle whose
- * cosine is cos_near of the sun. */
-static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, int y, const int *xs, int m, row_buffers *rb,
-                      float *val, unsigned char *flags, double cos_near)
+static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t, int y, const int *xs,
+                      int m, row_buffers *rb, float *val, unsigned char *flags, double cos_near);
+
+/* Radiance of pixels xs[0..m) of row y read from the sky-view table t into val[i * n + k]; the
+ * pixels near the sun (its disk) evaluated by the batch, their disk added. */
+static void table_cols(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t, int y, const int *xs,
+                       int m, row_buffers *rb, float *val)
+{
+    const atmos_camera *cam = job->cam;
+    const int n = job->n;
+    const double tn = cam->tan_half_fov, H = cam->height, W = cam->width, v = (H - 2.0 * (y + 0.5)) / H * tn;
+    const double base[3] = {cam->forward[0] + v * cam->up[0], cam->forward[1] + v * cam->up[1],
+                            cam->forward[2] + v * cam->up[2]};
+    for (int i = 0; i < m; i++) rb->tu[i] = (float)((2.0 * (xs[i] + 0.5) - W) / H * tn);
+    const int q = atmos__sky_view_row(t, base, cam->right, rb->tu, m, job->cos_disk_search, rb->tval, n + 1, rb->tcoord,
+                                      rb->tnear);
+    for (int i = 0; i < m; i++)
+        for (int k = 0; k < n; k++) val[(size_t)i * n + k] = rb->tval[(size_t)i * (n + 1) + k];
+    if (!q) return;
+    for (int j = 0; j < q; j++) rb->txs[j] = xs[rb->tnear[j]];
+    eval_cols(job, batch, NULL, y, rb->txs, q, rb, rb->tval, NULL, 1.0);
+    for (int j = 0; j < q; j++)
+        for (int k = 0; k < n; k++) val[(size_t)rb->tnear[j] * n + k] = rb->tval[(size_t)j * n + k];
+}
+
+/* Radiance of pixels xs[0..m) of row y into val[i * n + k] (the sun's disk added), from the
+ * sky-view table t when not NULL, else evaluated; flags[i] (may be NULL): 1 when the pixel's ray
+ * meets the ground, + 2 when it is within the angle whose cosine is cos_near of the sun. */
+static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t, int y, const int *xs,
+                      int m, row_buffers *rb, float *val, unsigned char *flags, double cos_near)
 {
     const int n = job->n;
     pinhole_cols(job->cam, y, xs, m, rb->dx, rb->dy, rb->dz, rb->w);
+    for (int i = 0; flags && i < m; i++) {
+        const double d[3] = {rb->dx[i], rb->dy[i], rb->dz[i]};
+        flags[i] = (unsigned char)((atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY) +
+                                   2 * (job->sun_visible && d[0] * job->sun[0] + d[1] * job->sun[1] + d[2] * job->sun[2] >= cos_near));
+    }
+    if (t) {
+        table_cols(job, batch, t, y, xs, m, rb, val);
+        return;
+    }
     memset(rb->acc, 0, sizeof(float) * (size_t)m * n);
     atmos__atm_batch_eval(batch, m, rb->dx, rb->dy, rb->dz, rb->w, rb->acc, rb->scratch);
     const float sx = (float)job->sun[0], sy = (float)job->sun[1], sz = (float)job->sun[2], cs = (float)job->cos_disk_search;
     for (int i = 0; i < m; i++) {
         for (int k = 0; k < n; k++) val[(size_t)i * n + k] = rb->acc[(size_t)k * m + i];
-        if (flags) {
-            const double d[3] = {rb->dx[i], rb->dy[i], rb->dz[i]};
-            flags[i] = (unsigned char)((atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY) +
-                                       2 * (job->sun_visible && d[0] * job->sun[0] + d[1] * job->sun[1] + d[2] * job->sun[2] >= cos_near));
-        }
         if (!job->sun_visible || rb->dx[i] * sx + rb->dy[i] * sy + rb->dz[i] * sz < cs) continue;
         const double cov = sun_coverage(job, xs[i], y);
         for (int k = 0; k < n; k++) val[(size_t)i * n + k] += (float)(cov * job->sun_radiance[k]);
@@ -312,8 +344,8 @@ static int cell_fine(const coarse *g, int j, int i)
 }
 
 /* Row y from the grid: cells read bilinearly, fine cells' pixels evaluated. */
-static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const coarse *g, const atmos__rect *r, int y,
-                       row_buffers *rb, int *xs, float *val, float *dst, int C)
+static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t, const coarse *g,
+                       const atmos__rect *r, int y, row_buffers *rb, int *xs, float *val, float *dst, int C)
 {
     const int n = job->n, j = (y - r->y0) / g->step < g->ny - 1 ? (y - r->y0) / g->step : g->ny - 2;
     const float fy = (float)(y - g->cy[j]) / (float)(g->cy[j + 1] - g->cy[j]);
@@ -350,17 +382,17 @@ static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const 
         }
     }
     if (!m) return;
-    eval_cols(job, batch, y, xs, m, rb, val, NULL, 1.0);
+    eval_cols(job, batch, t, y, xs, m, rb, val, NULL, 1.0);
     for (int q = 0; q < m; q++)
         for (int k = 0; k < n; k++) dst[(size_t)xs[q] * C + k] = val[(size_t)q * n + k];
 }
 
-/* The sky of rect r every v->sky_step pixels (coarse_row); 1 when it cannot (too small a rect:
- * the caller renders every pixel). */
-static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__atm_batch *batch, const atmos__view *v,
-                         const atmos__rect *r, atmos_image *out, int *nomem)
+/* The sky of rect r every v->sky_step pixels (coarse_row), the values from the sky-view table t
+ * when not NULL; 1 when it cannot (too small a rect: the caller renders every pixel). */
+static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t,
+                         const atmos__view *v, const atmos__rect *r, atmos_image *out, int *nomem)
 {
-    const int F = v->sky_step, n = job->n, count = r->x1 - r->x0, rows = r->y1 - r->y0, C = out->channels;
+    const int F = v->sky_step > 1 ? v->sky_step : 1, n = job->n, count = r->x1 - r->x0, rows = r->y1 - r->y0, C = out->channels;
     if (count < 2 || rows < 2) return 1;
     coarse g = {F, (count - 2 + F) / F + 1, (rows - 2 + F) / F + 1, NULL, NULL, NULL, NULL, NULL, NULL};
     g.cx = malloc(sizeof(int) * (size_t)(g.nx + g.ny)), g.cy = g.cx ? g.cx + g.nx : NULL;
@@ -379,10 +411,12 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
         row_buffers rb = {0};
         const size_t per = (size_t)count;
         float *mem = malloc(sizeof(float) * per * (4 + 2 * (size_t)n + ATMOS__ATM_BATCH_SCRATCH));
-        int *xs = malloc(sizeof(int) * per);
-        if (mem && xs) {
+        int *xs = malloc(sizeof(int) * per * 3);
+        float *tmem = malloc(sizeof(float) * per * (5 + (size_t)n));
+        if (mem && xs && tmem) {
             rb.dx = mem, rb.dy = mem + per, rb.dz = mem + 2 * per, rb.w = mem + 3 * per, rb.acc = mem + 4 * per;
             rb.scratch = rb.acc + per * n;
+            rb.tu = tmem, rb.tcoord = tmem + per, rb.tval = tmem + 4 * per, rb.tnear = xs + per, rb.txs = xs + 2 * per;
         } else {
 #pragma omp atomic write
             *nomem = 1;
@@ -390,7 +424,7 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
         float *val = mem ? rb.scratch + per * ATMOS__ATM_BATCH_SCRATCH : NULL;
 #pragma omp for schedule(dynamic, 4)
         for (int j = 0; j < g.ny; j++)
-            if (mem && xs) eval_cols(job, batch, g.cy[j], g.cx, g.nx, &rb, g.val + (size_t)j * g.nx * n, g.flags + (size_t)j * g.nx,
+            if (mem && xs && tmem) eval_cols(job, batch, t, g.cy[j], g.cx, g.nx, &rb, g.val + (size_t)j * g.nx * n, g.flags + (size_t)j * g.nx,
                           cos_near);
 #pragma omp for schedule(static)
         for (int j = 0; j < g.ny; j++)
@@ -400,9 +434,9 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
             for (int i = 0; i < g.nx - 1; i++) g.fine[j * g.nx + i] = (unsigned char)cell_fine(&g, j, i);
 #pragma omp for schedule(dynamic, 1)
         for (int b = 0; b < nbands; b++)
-            for (int y = r->y0 + b * band; mem && xs && y < r->y1 && y < r->y0 + (b + 1) * band; y++)
-                coarse_row(job, batch, &g, r, y, &rb, xs, val, out->pixels + (size_t)y * v->cam.width * C, C);
-        free(mem), free(xs);
+            for (int y = r->y0 + b * band; mem && xs && tmem && y < r->y1 && y < r->y0 + (b + 1) * band; y++)
+                coarse_row(job, batch, t, &g, r, y, &rb, xs, val, out->pixels + (size_t)y * v->cam.width * C, C);
+        free(mem), free(xs), free(tmem);
     }
     free(g.cx), free(g.val), free(g.flags);
     return 0;
@@ -410,13 +444,14 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
 
 struct atmos__sky_keep {
     atmos__atm_batch batch; /* zeroed until the first frame */
+    atmos__sky_view table;  /* zeroed until a frame asks for it */
 };
 
 atmos__sky_keep *atmos__sky_keep_create(void) { return calloc(1, sizeof(atmos__sky_keep)); }
 
 void atmos__sky_keep_destroy(atmos__sky_keep *k)
 {
-    if (k) atmos__atm_batch_release(&k->batch);
+    if (k) atmos__atm_batch_release(&k->batch), atmos__sky_view_free(&k->table);
     free(k);
 }
 
@@ -434,8 +469,15 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
     if (keep) atmos__atm_batch_update(bp, atm, v->cam.position, job.sun);
     else atmos__atm_batch_init(bp, atm, v->cam.position, job.sun);
     const atmos__atm_batch *batch = bp;
-    if (v->sky_step > 1 && v->cam.type == ATMOS_CAMERA_PINHOLE && job.spp == 1 &&
-        !render_coarse(ctx, &job, batch, v, r, out, &nomem)) {
+    const atmos__sky_view *table = NULL;
+    if (v->sky_table && keep && v->cam.type == ATMOS_CAMERA_PINHOLE && job.spp == 1 &&
+        atmos__sky_view_wanted(atm, v->cam.position)) {
+        if (!atmos__sky_view_update(&keep->table, atm, batch, atmos__threads(ctx)))
+            return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for the sky-view table");
+        table = &keep->table;
+    }
+    if ((v->sky_step > 1 || table) && v->cam.type == ATMOS_CAMERA_PINHOLE && job.spp == 1 &&
+        !render_coarse(ctx, &job, batch, table, v, r, out, &nomem)) {
         if (!keep) atmos__atm_batch_release(&own);
         if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for the sky's grid");
         atmos__progress(ctx, "render sky", 1.0);

@@ -15,6 +15,7 @@ typedef struct atmos__view {
     double eye_scale;          /* slice renderer: eye buffer scale, (0, 1] or 2 */
     int light_size;            /* slice renderer: light buffer side, 0 = the scene's (at most the scene's) */
     int sky_step;              /* the sky background every sky_step pixels (1: every pixel) */
+    int sky_table;             /* the sky background from a table over view directions (sky_view.h) */
     int no_air_shadows;        /* slice renderer: the volume's shadow on the air left out this frame */
     int warm_field;            /* slice renderer: the diffuse field warm-started from the last sun's */
     int hold_field;            /* slice renderer: the last solved sun's diffuse field kept, not solved */

@@ -164,9 +164,10 @@ static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, i
     return st;
 }
 
-/* The viewer's frames evaluate the sky behind the volume every VIEW_SKY_STEP pixels and read it
- * between them where it is smooth (atmos_frame.sky_step: within 0.1 % of every pixel's); a
- * save, every pixel, as atmos render does. */
+/* The viewer's frames take the sky behind the volume every VIEW_SKY_STEP pixels and read it
+ * between them where it is smooth (atmos_frame.sky_step: within 0.1 % of every pixel's), its
+ * values from the sky-view table (atmos_frame.sky_table: within about one level of 255); a save
+ * and a preview session's still frame, every pixel evaluated, as atmos render does. */
 #define VIEW_SKY_STEP 4
 
 static const char *camera_name(atmos_camera_type t)
@@ -200,7 +201,7 @@ typedef enum { VIEW_PREVIEW, VIEW_STILL, VIEW_SCRIPTED, VIEW_SAVE } view_quality
 /* The slice renderer's frame settings for a quality (f: the scene's frame). */
 static void slice_quality(atmos_frame *f, const atmos_scene *sc, view_quality q)
 {
-    if (q == VIEW_STILL) f->sky_step = 1, f->warm_field = 0;
+    if (q == VIEW_STILL) f->sky_step = 1, f->sky_table = 0, f->warm_field = 0;
     if (q != VIEW_PREVIEW) return;
     f->eye_scale = 0.5 * (f->eye_scale > 0 ? f->eye_scale : 1.0);
     f->light_size = sc->slice.light_size / 2 > 16 ? sc->slice.light_size / 2 : sc->slice.light_size;
@@ -222,7 +223,7 @@ static atmos_status render(loop *L, view_state *s, view_quality q, atmos_plan **
     view_state_frame(s, &f);
     say_pinhole(L, s);
     if (!saving) /* a cloud holding the eye: its near particles in coarser layers (docs/viewer.md) */
-        f.sky_step = VIEW_SKY_STEP, f.impostor_budget = L->impostor_budget, f.screen_layer_px = L->screen_layer_px;
+        f.sky_step = VIEW_SKY_STEP, f.sky_table = 1, f.impostor_budget = L->impostor_budget, f.screen_layer_px = L->screen_layer_px;
     f.warm_field = !saving; /* a saved frame is the offline render's: its field built afresh */
     /* a moving view's frame is not kept by the plan for an unchanged next one (the copy of a
      * 1280 x 720 frame saved; a still view's frame is kept) */
