@@ -29,6 +29,9 @@ int atmos__atm_inscatter_sub(const atmos_atmosphere *a, const double p[3], const
  * model's to s0 and from there the planet's extinction at the cells' centres (atmosphere_single.c). */
 void atmos__atm_single_cells_sub(const atmos_atmosphere *a, const double p[3], const double d[3], double s0,
                                  double s1, int n, const double sun[3], int m, const int *k, double *out);
+/* [*s0, *s1] along p + t d narrowed to the air (a planet's: below its top, above its ground;
+ * the flat kinds' is left as it is); 0 when no air is left in it. */
+int atmos__atm_air_span(const atmos_atmosphere *a, const double p[3], const double d[3], double *s0, double *s1);
 
 /* A point of the segment p + t d, t in [0, dist], drawn with density proportional to the
  * air's scattering times its transmittance from p at one wavelength h of the subset (the one

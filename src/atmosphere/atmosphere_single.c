@@ -44,3 +44,12 @@ void atmos__atm_single_cells_sub(const atmos_atmosphere *a, const double p[3], c
         }
     }
 }
+
+int atmos__atm_air_span(const atmos_atmosphere *a, const double p[3], const double d[3], double *s0, double *s1)
+{
+    double t0, t1;
+    if (!a->planet) return *s1 > *s0;
+    if (!atmos__planet_clip(a->planet, p, d, *s1, &t0, &t1)) return 0;
+    *s0 = fmax(*s0, t0), *s1 = fmin(*s1, t1);
+    return *s1 > *s0;
+}

@@ -137,6 +137,9 @@ static atmos_status field(atmos__pcloud *pc, uint64_t *rng, double scale, int co
     return ATMOS_OK;
 }
 
+/* The finest spacing the generators take (m, times the scale): 1.2 million particles are 18 m apart. */
+#define PGEN_SPACING_MIN_M 1.0
+
 atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint64_t seed, double scale,
                                     double spacing_m, atmos__pcloud *out, double *voxel_m)
 {
@@ -145,6 +148,9 @@ atmos_status atmos__pcloud_generate(atmos_context *ctx, const char *preset, uint
     snprintf(out->field_name[0], sizeof out->field_name[0], "cloud");
     snprintf(out->particle[0], sizeof out->particle[0], "cloud");
     if (!(scale > 0)) scale = 1.0;
+    if (spacing_m != 0 && !(spacing_m >= PGEN_SPACING_MIN_M * scale)) /* the columns' int indices, the memory */
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "particles: spacing %g m under the generators' least, %g m (0: "
+                            "their own lattice)", spacing_m, PGEN_SPACING_MIN_M * scale);
     uint64_t rng = seed * 0x9E3779B97F4A7C15ull + 0x1234567ull;
     double h = 0;
     atmos_status st;

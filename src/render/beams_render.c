@@ -605,9 +605,12 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
                               &q.T[i], &q.obj[i]);
             }
         }
+        int any_failed; /* after the rows' barrier: a thread's failure leaves its rows' rays unset */
+#pragma omp atomic read
+        any_failed = failed;
 #pragma omp for schedule(dynamic, 1)
         for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx && ok && !atmos__cancelled(cancelled); i++, ev++)
+            for (int i = 0; i < nx && ok && !any_failed && !atmos__cancelled(cancelled); i++, ev++)
                 air_pixel(J, f, q.X[i], q.Y[j], q.T[(size_t)(q.Y[j] - r->y0) * W + (size_t)(q.X[i] - r->x0)],
                           q.node + ((size_t)j * nx + i) * nw);
 #pragma omp for schedule(dynamic, 1)

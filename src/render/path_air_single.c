@@ -8,13 +8,20 @@
 
 #include <math.h>
 
-/* Where an endless span is cut (m): past the top of any planet's air seen from inside it. */
+/* Where an endless span is cut (m) if the air left it endless (a planet's is clipped to its top). */
 #define AIR_SINGLE_FAR 1.0e6
 
 void atmos__path_air_single(const path_run *R, const double p[3], const double d[3], double s0, double s1,
                             air_single *S)
 {
     const int m = R->b->m;
+    if (!atmos__atm_air_span(R->J->atm, p, d, &s0, &s1)) { /* no air in the span: nothing to shadow */
+        S->s0 = s0, S->dt = 0;
+        for (int i = 0; i < m; i++) S->sum[i] = 0;
+        for (int c = 0; c < AIR_SINGLE_N; c++)
+            for (int i = 0; i < m; i++) S->g[c][i] = 0;
+        return;
+    }
     if (!isfinite(s1)) s1 = s0 + AIR_SINGLE_FAR; /* a ray along the shadow's axis, away from the sun */
     S->s0 = s0, S->dt = (s1 - s0) / AIR_SINGLE_N;
     double g[AIR_SINGLE_N * PATH_B]; /* cell c, wavelength i at c * m + i */

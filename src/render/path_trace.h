@@ -130,7 +130,7 @@ void atmos__path_air_scatter(const path_run *R, const double p[3], const double 
                              double wt, int order, const air_view *view);
 /* The air's single scattering over [s0, s1] of the segment p + t d seen from p, by the
  * midpoint rule over AIR_SINGLE_N equal cells (path_air_single.c): per cell c and carried
- * wavelength i, g[c][i] = the single scattering's integrand (atmos__atm_single_source_sub)
+ * wavelength i, g[c][i] = the single scattering's integrand (atmos__atm_single_cells_sub)
  * at the cell's centre times the air's transmittance from p to it times the cell's length;
  * sum[i] = the sum over the cells. */
 #define AIR_SINGLE_N 8

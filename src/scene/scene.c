@@ -409,10 +409,15 @@ atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *
         }
     }
     if (n > 1 && a->minutes_end_set) {
-        const double m0 = s.volume.sim_minutes > 0 ? s.volume.sim_minutes : atmos_sim_preset_minutes(s.volume.source + 9);
+        const double m0 = atmos__scene_first_sim_minutes(&s);
         s.volume.sim_minutes = index == n - 1 ? a->minutes_end : m0 + (double)index / (n - 1) * (a->minutes_end - m0);
     }
     memset(&s.animation, 0, sizeof s.animation);
     *out = s;
     return ATMOS_OK;
+}
+
+double atmos__scene_first_sim_minutes(const atmos_scene *scene)
+{
+    return scene->volume.sim_minutes > 0 ? scene->volume.sim_minutes : atmos_sim_preset_minutes(scene->volume.source + 9);
 }

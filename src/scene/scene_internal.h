@@ -45,6 +45,9 @@ extern const atmos__range atmos__r_dim, atmos__r_spp, atmos__r_altitude, atmos__
     atmos__r_ozone, atmos__r_dobashi_ambient;
 
 /* Reports "SOURCE: PATH: <fmt>" through ctx and returns status. */
+/* A simulated volume's minutes at the animation's first frame: the scene's, or its preset's
+ * (source "simulate:PRESET"). */
+double atmos__scene_first_sim_minutes(const atmos_scene *scene);
 atmos_status atmos__scene_fail(atmos_context *ctx, atmos_status status, const char *source,
                                const char *path, const char *fmt, ...) ATMOS_PRINTF(5, 6);
 

@@ -347,8 +347,7 @@ atmos_status atmos__scene_validate_animation(atmos_context *ctx, const char *sou
                                  ATMOS_SIM_MAX_MINUTES, a->minutes_end);
     if (a->minutes_end_set && a->frames > 1) {
         /* the first frame's minutes, as atmos_scene_animation_frame takes them */
-        const double m0 = scene->volume.sim_minutes > 0 ? scene->volume.sim_minutes
-                                                        : atmos_sim_preset_minutes(scene->volume.source + 9);
+        const double m0 = atmos__scene_first_sim_minutes(scene);
         if (!(a->minutes_end > m0))
             return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/minutes_end",
                                      "must exceed the first frame's %g minutes (/volume/simulate/minutes): a "

@@ -460,12 +460,26 @@ static int raw_name(const atmos_volume *vol, int f, const char *json_path, const
 }
 
 /* Removes the raw files of fields 0..n-1 (a write that failed leaves none). */
-static void remove_raws(const atmos_volume *vol, int n, const char *json_path, const char *base, size_t stem_len)
+/* The name a file is written under until the whole set is (full + ".staged"); 0 when too long. */
+static int staged_name(const char *full, char out[PATH_CAP])
 {
+    const int n = snprintf(out, PATH_CAP, "%s.staged", full);
+    return n >= 0 && n < PATH_CAP;
+}
+
+/* The raw files 0..n-1 of the set: their staged copies removed, or (put != 0) renamed into
+ * place; 0 when a rename failed. */
+static int finish_raws(const atmos_volume *vol, int n, const char *json_path, const char *base, size_t stem_len, int put)
+{
+    int ok = 1;
     for (int f = 0; f < n; f++) {
-        char rel[PATH_CAP], full[PATH_CAP];
-        if (raw_name(vol, f, json_path, base, stem_len, rel, full)) remove(full);
+        char rel[PATH_CAP], full[PATH_CAP], staged[PATH_CAP];
+        if (!raw_name(vol, f, json_path, base, stem_len, rel, full) || !staged_name(full, staged)) continue;
+        if (!put) remove(staged);
+        else if (ok && rename(staged, full) != 0) ok = 0;
+        else if (!ok) remove(staged);
     }
+    return ok;
 }
 
 atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol, const char *json_path)
@@ -499,8 +513,13 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
             st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: path too long", json_path);
             break;
         }
+        char staged[PATH_CAP];
+        if (!staged_name(full, staged)) {
+            st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: path too long", json_path);
+            break;
+        }
         raw_write_job job = {vol, f, NULL};
-        st = atmos__write_atomic(ctx, full, write_field_fn, &job);
+        st = atmos__write_atomic(ctx, staged, write_field_fn, &job);
         written += st == ATMOS_OK;
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", atmos_volume_field_name(vol, f));
@@ -512,7 +531,7 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     char *text = st == ATMOS_OK ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);
     if (st == ATMOS_OK && !text) st = atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", json_path);
-    if (st != ATMOS_OK) return remove_raws(vol, written, json_path, base, stem_len), st;
+    if (st != ATMOS_OK) return finish_raws(vol, written, json_path, base, stem_len, 0), st;
     size_t len = strlen(text);
     char *t2 = realloc(text, len + 2);
     if (t2) {
@@ -521,9 +540,16 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
         text[len + 1] = '\0';
     }
     raw_write_job job = {vol, 0, text};
-    st = atmos__write_atomic(ctx, json_path, write_text_fn, &job);
+    char staged[PATH_CAP];
+    st = staged_name(json_path, staged) ? atmos__write_atomic(ctx, staged, write_text_fn, &job)
+                                        : atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: path too long", json_path);
     free(text);
-    /* All or nothing: without its sidecar the raw files are orphans. */
-    if (st != ATMOS_OK) remove_raws(vol, nf, json_path, base, stem_len);
-    return st;
+    /* All or nothing: every file is staged before any is put in place, so a failure leaves an
+     * earlier set of these names whole (only a rename failing part way could mix them). */
+    if (st != ATMOS_OK) return finish_raws(vol, nf, json_path, base, stem_len, 0), st;
+    if (!finish_raws(vol, nf, json_path, base, stem_len, 1) || rename(staged, json_path) != 0) {
+        remove(staged);
+        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot put the volume's files in place: %s", json_path, strerror(errno));
+    }
+    return ATMOS_OK;
 }

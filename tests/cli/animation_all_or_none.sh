@@ -13,11 +13,12 @@ cp "$T/a_0001.png" "$T/old1.png" && cp "$T/a_0002.png" "$T/old2.png" || bad "no 
 wait_for() {
     i=0
     while ! grep -q "$2" "$1" 2>/dev/null && [ $i -lt 1200 ]; do sleep 0.05; i=$((i + 1)); done
+    grep -q "$2" "$1" 2>/dev/null
 }
 "$A" render --frames 2 --sun-elevation 40 --sun-elevation-end 10 --width 64 --height 36 --renderer path \
     --spp 4096 --threads 1 -o "$T/a.png" 2>"$T/err2" &
 pid=$!
-wait_for "$T/err2" "wrote .*a_0001.png"
+wait_for "$T/err2" "made .*a_0001.png" || bad "frame 1 was never reported: nothing interrupted"
 kill -INT $pid
 wait $pid
 rc=$?
@@ -32,6 +33,7 @@ for sig in HUP XFSZ; do
     pid=$!
     i=0
     while ! ls "$T" | grep -q 'h.pfm.tmp' && [ $i -lt 1200 ]; do sleep 0.05; i=$((i + 1)); done
+    ls "$T" | grep -q 'h.pfm.tmp' || bad "SIG$sig: the render never staged its files: nothing interrupted"
     sleep 0.3
     kill -$sig $pid
     wait $pid

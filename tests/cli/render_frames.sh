@@ -60,15 +60,20 @@ cmp -s "$T/b/ov_0002.pfm" "$T/b/one.pfm" && ok || bad "--time-end 14:00: last fr
 [ $? -eq 2 ] && ok || bad "an impossible --time-end should exit 2"
 [ -z "$(ls "$T" | grep '^x')" ] && ok || bad "a failed run wrote $(ls "$T" | grep '^x')"
 
-# 4. Interrupted: SIGINT during a long animation leaves whole frames and no temporaries.
-"$A" render -q --width 320 --height 180 --spp 4 --frames 400 --sun-elevation-end 80 -o "$T/c/f.png" &
+# 4. Interrupted: SIGINT during a long animation, once frame 2 is made, leaves no frame (an
+# animation's files go in place together when every frame is made) and no temporaries.
+"$A" render --width 320 --height 180 --spp 4 --frames 400 --sun-elevation-end 80 -o "$T/c/f.png" 2>"$T/c.err" &
 pid=$!
 n=0
-while [ ! -e "$T/c/f_0002.png" ] && [ $n -lt 600 ] && kill -0 $pid 2>/dev/null; do sleep 0.05; n=$((n + 1)); done
+while ! grep -q "made .*f_0002.png" "$T/c.err" && [ $n -lt 600 ] && kill -0 $pid 2>/dev/null; do
+    sleep 0.05; n=$((n + 1))
+done
+grep -q "made .*f_0002.png" "$T/c.err" && ok || bad "frame 2 was never reported made: nothing interrupted"
 kill -INT $pid 2>/dev/null
 wait $pid; rc=$?
 [ $rc -ne 0 ] && ok || bad "an interrupted run should fail (rc $rc)"
 [ -z "$(ls "$T/c" | grep tmp)" ] && ok || bad "temporaries left: $(ls "$T/c" | grep tmp)"
+[ -z "$(ls "$T/c" | grep '^f_')" ] && ok || bad "frames put in place by an interrupted run: $(ls "$T/c" | head -3)"
 python3 - "$T/c" <<'PY' && ok || bad "a frame file is not a whole PNG"
 import os, sys
 d = sys.argv[1]

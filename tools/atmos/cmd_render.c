@@ -255,8 +255,8 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     if (ranks > 0) fprintf(stderr, "  rendered by rank %d\n", ranks);
     if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of at most %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
-    for (int i = 0; i < 6; i++)
-        if (files[i]) fprintf(stderr, "  wrote %s\n", files[i]);
+    for (int i = 0; i < 6; i++) /* an animation's files go in place when every frame is made */
+        if (files[i]) fprintf(stderr, nframes > 1 ? "  made %s (in place with the last frame)\n" : "  wrote %s\n", files[i]);
     if (atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH && ranks == 0) {
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
@@ -392,7 +392,7 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
     if (st != ATMOS_OK) cli_outputs_held_discard();
     atmos_image_destroy(r.spec);
     if (st == ATMOS_OK && !o->quiet && r.nframes > 1)
-        fprintf(stderr, "atmos render: %d frames, %.3f s rendering (%s)%s\n", r.nframes, r.total,
+        fprintf(stderr, "atmos render: %d frames written, %.3f s rendering (%s)%s\n", r.nframes, r.total,
                 tl ? "a time-lapse: the simulation carried from frame to frame, a plan a frame"
                    : "one plan: the volume and its optics made once",
                 r.xl.locked ? "; exposure locked at frame 1's" : "");

@@ -4,6 +4,7 @@
 
 #include <errno.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,6 +64,10 @@ static held_file *held;
 static volatile sig_atomic_t held_n;
 static int held_cap;
 
+/* The signals that end a process by default and can be caught: a terminal hung up, a file
+ * size limit reached (the writers' files are removed with the others). */
+static const int ENDING[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE};
+
 static void on_signal(int sig)
 {
     for (int i = 0; i < SLOTS; i++)
@@ -80,17 +85,14 @@ static void register_stage(int i, const char *stage)
         memset(&sa, 0, sizeof sa);
         sa.sa_handler = on_signal;
         sigemptyset(&sa.sa_mask);
-        /* the signals that end a process by default and can be caught: a terminal hung up, a
-         * file size limit reached (the writers' files are removed with the others) */
-        static const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE};
-        for (size_t k = 0; k < sizeof sigs / sizeof sigs[0]; k++) {
+        for (size_t k = 0; k < sizeof ENDING / sizeof ENDING[0]; k++) {
             struct sigaction old;
             /* besides SIGINT and SIGTERM (caught always: a shell's background job ignores
              * SIGINT, yet kill -INT from its script means stop), a signal ignored by the
              * caller stays ignored (nohup; a write past a file size limit then fails as a
              * write, and the outputs are discarded as on any failure) */
-            if (k >= 2 && sigaction(sigs[k], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
-            sigaction(sigs[k], &sa, NULL);
+            if (k >= 2 && sigaction(ENDING[k], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+            sigaction(ENDING[k], &sa, NULL);
         }
         installed = 1;
     }
@@ -300,6 +302,7 @@ int cli_outputs_hold(const char *cmd, cli_outputs *set)
             return 1;
         }
         held[held_n] = h;
+        atomic_signal_fence(memory_order_seq_cst); /* the names stored before the count */
         held_n++; /* counted once its names are in place (the signal handler reads them) */
         unregister_stage(i);
         o->stage[0] = '\0';
@@ -307,17 +310,27 @@ int cli_outputs_hold(const char *cmd, cli_outputs *set)
     return 0;
 }
 
+/* The held files renamed into place with the ending signals blocked, so that a signal cannot
+ * remove the frames not yet renamed once the first is (it is taken after the loop, when every
+ * frame is in place). A rename that fails part way leaves the frames before it new: said. */
 int cli_outputs_held_commit(const char *cmd)
 {
+    sigset_t block, old;
+    sigemptyset(&block);
+    for (size_t k = 0; k < sizeof ENDING / sizeof ENDING[0]; k++) sigaddset(&block, ENDING[k]);
+    sigprocmask(SIG_BLOCK, &block, &old);
     for (int i = 0; i < held_n; i++)
         if (rename(held[i].stage, held[i].path) != 0) {
-            fprintf(stderr, "atmos %s: %s: cannot rename %s into place: %s\n", cmd, held[i].path, held[i].stage,
-                    strerror(errno));
+            fprintf(stderr, "atmos %s: %s: cannot rename %s into place: %s (%d of %d files renamed before it)\n",
+                    cmd, held[i].path, held[i].stage, strerror(errno), i, held_n);
             cli_outputs_held_discard();
+            sigprocmask(SIG_SETMASK, &old, NULL);
             return 1;
         }
     const int n = held_n;
     held_n = 0;
+    atomic_signal_fence(memory_order_seq_cst);
+    sigprocmask(SIG_SETMASK, &old, NULL);
     for (int i = 0; i < n; i++) free(held[i].stage), free(held[i].path);
     free(held), held = NULL, held_cap = 0;
     return 0;
@@ -328,6 +341,7 @@ void cli_outputs_held_discard(void)
     const int n = held_n;
     for (int i = 0; i < n; i++) unlink(held[i].stage); /* those renamed already are gone */
     held_n = 0;
+    atomic_signal_fence(memory_order_seq_cst); /* the handler reads none of them once freed */
     for (int i = 0; i < n; i++) free(held[i].stage), free(held[i].path);
     free(held), held = NULL, held_cap = 0;
 }
