@@ -1,5 +1,5 @@
 /* Cameras: pinhole, equidistant fisheye, equirectangular. */
-#include "core/camera.h"
+#include "core/pinhole.h"
 #include "core/internal.h"
 #include "core/vec.h"
 

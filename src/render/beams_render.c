@@ -29,7 +29,7 @@
 #include "render/beams_primary.h"
 #include "render/beams_screen.h"
 #include "render/beams_sky.h"
-#include "core/camera.h"
+#include "core/pinhole.h"
 #include "core/vec.h"
 
 #include <math.h>

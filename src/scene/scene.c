@@ -416,8 +416,3 @@ atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *
     *out = s;
     return ATMOS_OK;
 }
-
-double atmos__scene_first_sim_minutes(const atmos_scene *scene)
-{
-    return scene->volume.sim_minutes > 0 ? scene->volume.sim_minutes : atmos_sim_preset_minutes(scene->volume.source + 9);
-}

@@ -384,3 +384,8 @@ atmos_status atmos_scene_validate(atmos_context *ctx, const atmos_scene *scene, 
     if ((st = atmos__scene_validate_animation(ctx, source, scene))) return st;
     return atmos__scene_validate_output(ctx, source, scene);
 }
+
+double atmos__scene_first_sim_minutes(const atmos_scene *scene)
+{
+    return scene->volume.sim_minutes > 0 ? scene->volume.sim_minutes : atmos_sim_preset_minutes(scene->volume.source + 9);
+}

@@ -8,7 +8,7 @@
  *  - equirectangular: azimuth linear in x (north at the centre), elevation linear in y.
  * Frame: x east, y up, z south; azimuth clockwise from north (docs/models.md). */
 #include "atmos/atmos.h"
-#include "core/camera.h"
+#include "core/pinhole.h"
 #include "test.h"
 
 #include <math.h>

@@ -2,8 +2,8 @@
  * column and row (a division each), then the direction from them. atmos_camera_ray is the two
  * together; a renderer that keeps the coordinates per column and per row gets its rays, the
  * same bits, without the divisions. */
-#ifndef ATMOS_CORE_CAMERA_H
-#define ATMOS_CORE_CAMERA_H
+#ifndef ATMOS_CORE_PINHOLE_H
+#define ATMOS_CORE_PINHOLE_H
 
 #include "atmos/camera.h"
 
