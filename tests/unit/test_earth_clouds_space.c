@@ -36,19 +36,27 @@ static atmos_image *cloud_image(void)
 
 static double lum(const double *L) { return 0.2126 * L[0] + 0.7152 * L[1] + 0.0722 * L[2]; }
 
+/* The sun sun_elev_deg high (azimuth 240 degrees) and the batch of the frame before (the eye
+ * 1 m west), moved to eye with the same sun: the per-eye table built again, the sun's
+ * attenuation textures kept. */
+static void batch_at_eye(const atmos_atmosphere *a, const double eye[3], double sun_elev_deg, double sun[3],
+                         atmos__atm_batch *b)
+{
+    const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
+    sun[0] = cos(se) * sin(az), sun[1] = sin(se), sun[2] = -cos(se) * cos(az);
+    const double before[3] = {eye[0] - 1.0, eye[1], eye[2]};
+    atmos__atm_batch_init(b, a, before, sun);
+    CHECK(atmos__atm_batch_update(b, a, eye, sun) == 1);
+}
+
 /* One view: the eye 12 000 km up, looking down with a 46 degree field (the disk, the limb
  * and space), the sun sun_elev_deg high over the point under the eye. */
 static void check_view(const atmos_atmosphere *a, double sun_elev_deg, double rms_max, double worst_max)
 {
     const double eye[3] = {0, 12000e3, 0};
-    const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
-    const double sun[3] = {cos(se) * sin(az), sin(se), -cos(se) * cos(az)};
-    /* the batch of the frame before (the eye 1 m west), moved to this eye with the same sun:
-     * the per-eye table built again, the sun's attenuation textures kept */
-    const double before[3] = {eye[0] - 1.0, eye[1], eye[2]};
+    double sun[3];
     atmos__atm_batch b;
-    atmos__atm_batch_init(&b, a, before, sun);
-    CHECK(atmos__atm_batch_update(&b, a, eye, sun) == 1);
+    batch_at_eye(a, eye, sun_elev_deg, sun, &b);
     static float dx[W], dy[W], dz[W], wt[W], out[3 * W];
     double s2 = 0, worst = 0, ref_max = 0;
     int cnt = 0;
@@ -93,12 +101,9 @@ static void check_limb(const atmos_atmosphere *a, double sun_elev_deg, double rm
     enum { NP = 8, NA = 64, N = NP * NA };
     const double eye[3] = {0, 12000e3, 0}, R = a->planet->r_ground;
     const double rc = a->planet->clouds->r[a->planet->clouds->m - 1], r = R + eye[1];
-    const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
-    const double sun[3] = {cos(se) * sin(az), sin(se), -cos(se) * cos(az)};
-    const double before[3] = {eye[0] - 1.0, eye[1], eye[2]};
+    double sun[3];
     atmos__atm_batch b;
-    atmos__atm_batch_init(&b, a, before, sun);
-    CHECK(atmos__atm_batch_update(&b, a, eye, sun) == 1);
+    batch_at_eye(a, eye, sun_elev_deg, sun, &b);
     static float dx[N], dy[N], dz[N], wt[N], out[3 * N];
     static double ref[N][3];
     double ref_max = 0;
