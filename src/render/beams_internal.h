@@ -8,6 +8,7 @@
 
 #include "light/lamp.h"
 #include "render/objects.h"
+#include "render/beams_kept.h"
 #include "render/beams_sky.h"
 #include "render/beams_sun.h"
 #include "render/beams_tiles.h"
@@ -119,6 +120,17 @@ double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double s
  * the sum is the same to the bit; for a spot the falloff's runs may be added in another order). */
 double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1);
 
+/* The plan's kept buffers (struct atmos__beams_plan's kept). */
+enum {
+    ATMOS__BEAMS_KEPT_PRIMARY, /* two: the mesh and the triangle arrays */
+    ATMOS__BEAMS_KEPT_OBJECT = ATMOS__BEAMS_KEPT_PRIMARY + 2,
+    ATMOS__BEAMS_KEPT_DEPTH,
+    ATMOS__BEAMS_KEPT_BASE,
+    ATMOS__BEAMS_KEPT_NODE,
+    ATMOS__BEAMS_KEPT_DIR,
+    ATMOS__BEAMS_KEPT_COUNT
+};
+
 struct atmos__beams_plan {
     atmos__objects obj;                      /* the meshes and their albedos */
     int nlights;
@@ -136,6 +148,9 @@ struct atmos__beams_plan {
     /* the last frame's pixels, and how many of them had their airlight evaluated (the others
      * interpolated: beams/screen_step, beams_screen.h; evaluations counted again where two bands meet) */
     long air_pixels, air_evaluated;
+    /* a frame's per-pixel buffers, kept for the next frame (beams_kept.h): the primary
+     * visibility's two, then the subsampled frame's (beams_render.c) */
+    atmos__beams_kept kept[ATMOS__BEAMS_KEPT_COUNT];
 };
 
 /* The sun for a frame (beams_plan.c): its light at the eye, its shadow map (made again when

@@ -27,6 +27,7 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b)
     atmos__beams_sky_free(&b->sky);
     atmos__beams_table_free(&b->table);
     atmos__fog_optics_free(&b->optics);
+    for (int k = 0; k < ATMOS__BEAMS_KEPT_COUNT; k++) atmos__beams_kept_free(&b->kept[k]);
     free(b);
 }
 

@@ -255,11 +255,19 @@ static int draw_tiles(atmos_context *ctx, const atmos__objects *ob, const atmos_
 atmos_status atmos__beams_primary_build(atmos_context *ctx, const atmos__objects *ob, const atmos_camera *cam,
                                         const atmos__rect *r, atmos__beams_primary *P)
 {
+    return atmos__beams_primary_build_kept(ctx, ob, cam, r, NULL, P);
+}
+
+atmos_status atmos__beams_primary_build_kept(atmos_context *ctx, const atmos__objects *ob, const atmos_camera *cam,
+                                             const atmos__rect *r, atmos__beams_kept keep[2], atmos__beams_primary *P)
+{
     const int W = r->x1 - r->x0, H = r->y1 - r->y0;
-    const size_t n = (size_t)(W > 0 ? W : 0) * (size_t)(H > 0 ? H : 0);
+    const size_t n = (size_t)(W > 0 ? W : 0) * (size_t)(H > 0 ? H : 0), bytes = sizeof(int) * (n ? n : 1);
     memset(P, 0, sizeof *P);
     P->r = *r;
-    P->mesh = malloc(sizeof(int) * (n ? n : 1)), P->tri = malloc(sizeof(int) * (n ? n : 1));
+    P->owned = !keep;
+    P->mesh = keep ? atmos__beams_kept_get(&keep[0], bytes) : malloc(bytes);
+    P->tri = keep ? atmos__beams_kept_get(&keep[1], bytes) : malloc(bytes);
     if (!P->mesh || !P->tri) {
         atmos__beams_primary_free(P);
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the primary visibility");
@@ -279,7 +287,7 @@ atmos_status atmos__beams_primary_build(atmos_context *ctx, const atmos__objects
 
 void atmos__beams_primary_free(atmos__beams_primary *P)
 {
-    free(P->mesh), free(P->tri);
+    if (P->owned) free(P->mesh), free(P->tri);
     P->mesh = P->tri = NULL;
 }
 

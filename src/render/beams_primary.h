@@ -12,6 +12,7 @@
 
 #include "render/objects.h"
 #include "render/view.h"
+#include "render/beams_kept.h"
 #include "atmos/camera.h"
 
 /* A pixel's entry: the mesh and triangle nearest along its centre's ray, NONE when it sees no
@@ -24,12 +25,17 @@ typedef struct atmos__beams_primary {
     int *mesh;      /* per pixel of r, row by row: the mesh, or NONE / TRACE */
     int *tri;       /* the triangle of that mesh */
     long traced;    /* pixels marked TRACE */
+    int owned;      /* mesh and tri are the buffer's own (else kept buffers') */
 } atmos__beams_primary;
 
 /* The buffer over the pixels r of cam's image (a pinhole camera; other cameras: every pixel
  * TRACE). Tiles of the image go to the threads; the buffer does not depend on their number. */
 atmos_status atmos__beams_primary_build(atmos_context *ctx, const atmos__objects *ob, const atmos_camera *cam,
                                         const atmos__rect *r, atmos__beams_primary *P);
+/* The same in keep[0] and keep[1] (the mesh and triangle arrays, kept by the caller; freed by
+ * atmos__beams_kept_free, not by atmos__beams_primary_free). */
+atmos_status atmos__beams_primary_build_kept(atmos_context *ctx, const atmos__objects *ob, const atmos_camera *cam,
+                                             const atmos__rect *r, atmos__beams_kept keep[2], atmos__beams_primary *P);
 void atmos__beams_primary_free(atmos__beams_primary *P);
 
 /* As atmos__objects_hit(ob, eye, d, 0, INFINITY, hit, which) for the ray d through the centre of

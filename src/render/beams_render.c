@@ -530,9 +530,9 @@ typedef struct screen_buf {
     double *dir; /* the eye's rays (a pinhole camera; else NULL) */
 } screen_buf;
 
-static void screen_buf_free(screen_buf *q)
+static void screen_buf_free(screen_buf *q) /* the others are the plan's, kept for the next frame */
 {
-    free(q->X), free(q->Y), free(q->obj), free(q->T), free(q->node), free(q->base), free(q->dir);
+    free(q->X), free(q->Y);
 }
 
 /* Band j of a subsampled frame (atmos__beams_screen_band) from the lattice's nodes, added to the
@@ -572,17 +572,22 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     const size_t n = (size_t)W * H;
     *evaluated = 0;
     if (W <= 0 || H <= 0) return 0;
+    atmos__beams_kept *kept = p->beams->kept; /* the plan's, for the next frame too */
     screen_buf q = {malloc(sizeof(int) * (size_t)((W - 1) / k + 2)), malloc(sizeof(int) * (size_t)((H - 1) / k + 2)),
-                    malloc(sizeof(int) * n), malloc(sizeof(double) * n), NULL, malloc(sizeof(float) * n * nw), NULL};
+                    atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_OBJECT], sizeof(int) * n),
+                    atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_DEPTH], sizeof(double) * n), NULL,
+                    atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_BASE], sizeof(float) * n * nw), NULL};
     int failed = !q.X || !q.Y || !q.obj || !q.T || !q.base, done = 0;
     const int nx = failed ? 0 : atmos__beams_screen_nodes(r->x0, r->x1, k, q.X);
     const int ny = failed ? 0 : atmos__beams_screen_nodes(r->y0, r->y1, k, q.Y), nb = ny > 1 ? ny - 1 : 1;
-    if (!failed) failed = !(q.node = malloc(sizeof(double) * (size_t)nx * ny * nw));
+    if (!failed)
+        failed = !(q.node = atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_NODE], sizeof(double) * (size_t)nx * ny * nw));
     if (failed) {
         screen_buf_free(&q);
         return 1;
     }
-    q.dir = J->ru ? malloc(sizeof(double) * 3 * n) : NULL; /* none: each pass makes its rays */
+    /* none: each pass makes its rays */
+    q.dir = J->ru ? atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_DIR], sizeof(double) * 3 * n) : NULL;
     J->dir = q.dir, J->dir_r = *r;
     const atmos__beams_screen s = {*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base, air_pixel, J};
     long ev = 0;
@@ -668,14 +673,15 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         return st;
     }
     atmos__beams_il il = {0}, *ilp = NULL;
-    atmos__beams_primary prim = {{0, 0, 0, 0}, NULL, NULL, 0};
+    atmos__beams_primary prim = {{0, 0, 0, 0}, NULL, NULL, 0, 0};
     int failed = 0, cancelled = 0;
     if (p->scene.beams.interleave > 1) {
         ilp = &il;
         failed = atmos__beams_il_init(&il, p->scene.beams.interleave, J.nw, r, out->width, out->height);
     }
     if (!failed && b->obj.n > 0) {
-        if ((st = atmos__beams_primary_build(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &prim)) != ATMOS_OK) {
+        if ((st = atmos__beams_primary_build_kept(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &b->kept[ATMOS__BEAMS_KEPT_PRIMARY],
+                                                  &prim)) != ATMOS_OK) {
             atmos__beams_il_free(&il), free(J.z_lo), free(J.span), free(J.ru);
             return st;
         }

@@ -753,6 +753,58 @@ static atmos_image *render_counted(atmos_context *c, const atmos_scene *s, long 
     return img;
 }
 
+/* A plan keeps its frame's per-pixel buffers for the next frame (beams_kept.h): frames whose
+ * camera moves, a region smaller than the frame, then the whole frame again, each the same to
+ * the byte as a fresh plan's; and a kept buffer grows when asked for more, stays when asked for
+ * less. */
+static atmos_image *plan_frame(atmos_plan *plan, const atmos_frame *f, const atmos_region *r)
+{
+    atmos_image *img = NULL;
+    CHECK_OK(atmos_plan_image_create(plan, f, &img));
+    if (img) {
+        memset(img->pixels, 0, sizeof(float) * (size_t)img->width * img->height * img->channels);
+        CHECK_OK(atmos_plan_render(plan, f, r, img, NULL));
+    }
+    return img;
+}
+
+static void test_kept_frames(void)
+{
+    atmos__beams_kept k = {NULL, 0};
+    void *a = atmos__beams_kept_get(&k, 100), *b = atmos__beams_kept_get(&k, 60);
+    CHECK(a && a == b && k.size == 100);
+    CHECK(atmos__beams_kept_get(&k, 1000) && k.size == 1000);
+    atmos__beams_kept_free(&k);
+    CHECK(!k.p && k.size == 0);
+
+    atmos_scene s;
+    spot_scene(&s, 96, 72);
+    s.beams.screen_step = 4;
+    atmos_frame f[2];
+    CHECK_OK(atmos_frame_from_scene(ctx, &s, &f[0]));
+    f[1] = f[0];
+    f[1].camera.position[0] += 3, f[1].camera.position[1] -= 1;
+    const atmos_region part = {10, 20, 60, 49};
+    /* f[0]'s part (the buffers made small), f[0] (made larger), f[1], f[0] again (kept) */
+    const atmos_region *order[4] = {&part, NULL, NULL, NULL};
+    const int which[4] = {0, 0, 1, 0};
+    atmos_plan *kept = NULL;
+    CHECK_OK(atmos_plan_create(ctx, &s, NULL, NULL, &kept));
+    if (!kept) return;
+    for (int i = 0; i < 4; i++) {
+        const atmos_frame *fr = &f[which[i]];
+        atmos_plan *fresh = NULL;
+        CHECK_OK(atmos_plan_create(ctx, &s, NULL, NULL, &fresh));
+        atmos_image *want = fresh ? plan_frame(fresh, fr, order[i]) : NULL, *got = plan_frame(kept, fr, order[i]);
+        const size_t bytes = got ? sizeof(float) * (size_t)got->width * got->height * got->channels : 0;
+        CHECK_MSG(want && got && !memcmp(want->pixels, got->pixels, bytes), "frame %d of a plan differs from a fresh plan's",
+                  i);
+        atmos_image_destroy(want), atmos_image_destroy(got);
+        atmos_plan_destroy(fresh);
+    }
+    atmos_plan_destroy(kept);
+}
+
 /* The airlight subsampled on a lattice of every 4th pixel (beams/screen_step 4): a point
  * light's smooth glow is interpolated over most pixels (the renderer's count of those it
  * evaluated at most half), within 1 % of Sun et al.'s closed form at the pixels between the
@@ -845,6 +897,7 @@ int main(void)
     test_threads();
     test_interleave();
     test_screen_step();
+    test_kept_frames();
     test_scene_files();
     test_cancel();
     test_plan_progress();
