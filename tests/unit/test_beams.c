@@ -785,7 +785,8 @@ static void test_kept_frames(void)
     f[1] = f[0];
     f[1].camera.position[0] += 3, f[1].camera.position[1] -= 1;
     const atmos_region part = {10, 20, 60, 49};
-    /* f[0]'s part (the buffers made small), f[0] (made larger), f[1], f[0] again (kept) */
+    /* f[0]'s part (the buffers made small), f[0] (made larger), f[1], f[0] again (kept); not a
+     * part right after its whole frame: the plan copies that frame's pixels (stats.reused) */
     const atmos_region *order[4] = {&part, NULL, NULL, NULL};
     const int which[4] = {0, 0, 1, 0};
     atmos_plan *kept = NULL;
