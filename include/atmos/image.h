@@ -244,6 +244,13 @@ ATMOS_API atmos_status atmos_image_gamut_map(atmos_context *ctx, atmos_image *rg
 ATMOS_API atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spectral,
                                                 const atmos_wavelengths *wl, const atmos_tonemap_desc *desc,
                                                 atmos_image *disp, unsigned char *rgba8);
+/* atmos_image_display_into that refuses (ATMOS_E_UNSUPPORTED) a frame holding a NaN or an
+ * infinity in any channel, found from the same reads of the frame (the viewer's frames rendered
+ * with atmos_frame.no_check: one pass over the frame instead of two). The display values are
+ * made either way; the message names the count and the first such pixel. */
+ATMOS_API atmos_status atmos_image_display_checked(atmos_context *ctx, const atmos_image *spectral,
+                                                   const atmos_wavelengths *wl, const atmos_tonemap_desc *desc,
+                                                   atmos_image *disp, unsigned char *rgba8);
 
 #ifdef __cplusplus
 }

@@ -6,6 +6,7 @@
 #include "core/internal.h"
 #include "image/display_internal.h"
 
+#include <limits.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,13 +14,24 @@
 #include <emmintrin.h>
 #endif
 
-/* One row: spectral pixels src (C channels, n radiance + alpha or not) to linear sRGB + alpha
- * in lin (4 channels), as atmos_image_to_srgb_into does, then gamut mapped. */
-static void linear_row(const float *src, int width, int C, int n, int has_alpha, const float (*w)[3], float *lin)
+/* 1 for a NaN or an infinity: all exponent bits set. */
+static inline unsigned not_finite(float x)
 {
+    uint32_t u;
+    memcpy(&u, &x, sizeof u);
+    return (u & 0x7f800000u) == 0x7f800000u;
+}
+
+/* One row: spectral pixels src (C channels, n radiance + alpha or not) to linear sRGB + alpha
+ * in lin (4 channels), as atmos_image_to_srgb_into does, then gamut mapped. Returns the count of
+ * the row's values (every channel) that are NaN or infinite. */
+static unsigned linear_row(const float *src, int width, int C, int n, int has_alpha, const float (*w)[3], float *lin)
+{
+    unsigned bad = 0;
     for (int x = 0; x < width; x++) {
         const float *s = src + (size_t)x * C;
         float r = 0, g = 0, b = 0;
+        for (int i = 0; i < C; i++) bad += not_finite(s[i]);
         for (int i = 0; i < n; i++) {
             r += w[i][0] * s[i];
             g += w[i][1] * s[i];
@@ -30,25 +42,34 @@ static void linear_row(const float *src, int width, int C, int n, int has_alpha,
         o[3] = has_alpha ? s[n] : 1.0f;
         if (r < 0 || g < 0 || b < 0) atmos__gamut_pixel(o);
     }
+    return bad;
 }
 
 #if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
 /* linear_row for three radiances and alpha (the viewer's RGB frames) a pixel to a vector: the
  * matrix's three columns times the radiances broadcast, added in linear_row's order from 0 (the
- * same bits: 0 + w s as the first term turns a -0 into +0 there too), alpha in the last lane. */
-static void linear_row3a(const float *src, int width, const float (*w)[3], float *lin)
+ * same bits: 0 + w s as the first term turns a -0 into +0 there too), alpha in the last lane.
+ * Returns the count of the row's values that are NaN or infinite (exponent bits all set), counted
+ * from the same loads. */
+static unsigned linear_row3a(const float *src, int width, const float (*w)[3], float *lin)
 {
     const __m128 zero = _mm_setzero_ps(), w0 = _mm_setr_ps(w[0][0], w[0][1], w[0][2], 0),
                  w1 = _mm_setr_ps(w[1][0], w[1][1], w[1][2], 0), w2 = _mm_setr_ps(w[2][0], w[2][1], w[2][2], 0),
                  last = _mm_castsi128_ps(_mm_setr_epi32(0, 0, 0, -1));
+    const __m128i expo = _mm_set1_epi32(0x7f800000);
+    __m128i bad = _mm_setzero_si128(); /* minus the count, a lane a channel */
     for (int x = 0; x < width; x++) {
         const __m128 s = _mm_loadu_ps(src + 4 * x);
+        bad = _mm_add_epi32(bad, _mm_cmpeq_epi32(_mm_and_si128(_mm_castps_si128(s), expo), expo));
         __m128 a = _mm_add_ps(zero, _mm_mul_ps(w0, _mm_shuffle_ps(s, s, 0x00)));
         a = _mm_add_ps(a, _mm_mul_ps(w1, _mm_shuffle_ps(s, s, 0x55)));
         a = _mm_add_ps(a, _mm_mul_ps(w2, _mm_shuffle_ps(s, s, 0xaa)));
         _mm_storeu_ps(lin + 4 * x, _mm_or_ps(_mm_and_ps(last, s), _mm_andnot_ps(last, a)));
         if (_mm_movemask_ps(_mm_cmplt_ps(a, zero)) & 7) atmos__gamut_pixel(lin + 4 * x);
     }
+    uint32_t lane[4];
+    _mm_storeu_si128((__m128i *)lane, bad);
+    return 0u - (lane[0] + lane[1] + lane[2] + lane[3]);
 }
 #endif
 
@@ -95,8 +116,11 @@ static void bytes_row(const float *d, int width, unsigned char *out)
     }
 }
 
-atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spectral, const atmos_wavelengths *wl,
-                                      const atmos_tonemap_desc *desc, atmos_image *disp, unsigned char *rgba8)
+/* atmos_image_display_into, and with check atmos_image_display_checked: the count of the frame's
+ * NaN and infinite values from the rows' own loads, and the first of them (y W C + i, the least
+ * over the rows: the same for any thread count). */
+static atmos_status display_pass(atmos_context *ctx, const atmos_image *spectral, const atmos_wavelengths *wl,
+                                 const atmos_tonemap_desc *desc, atmos_image *disp, unsigned char *rgba8, int check)
 {
     if (!spectral || !spectral->pixels || !wl || !desc || (!disp && !rgba8))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "display: missing argument");
@@ -116,7 +140,9 @@ atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spe
     const float scale = (float)atmos_tonemap_scale(NULL, desc);
     const int has_alpha = C == n + 1;
     int nomem = 0;
-#pragma omp parallel num_threads(atmos__threads(ctx))
+    size_t bad = 0;
+    long long first = LLONG_MAX;
+#pragma omp parallel num_threads(atmos__threads(ctx)) reduction(+ : bad) reduction(min : first)
     {
         float *buf = malloc(sizeof(float) * 8 * (size_t)W);
         if (!buf) {
@@ -128,11 +154,21 @@ atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spe
             if (!buf) continue;
             float *out = buf + (size_t)4 * W;
             const float *row = spectral->pixels + (size_t)y * W * C;
+            unsigned b;
 #if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
-            if (n == 3 && has_alpha) linear_row3a(row, W, (const float(*)[3])w, buf);
+            if (n == 3 && has_alpha) b = linear_row3a(row, W, (const float(*)[3])w, buf);
             else
 #endif
-                linear_row(row, W, C, n, has_alpha, (const float(*)[3])w, buf);
+                b = linear_row(row, W, C, n, has_alpha, (const float(*)[3])w, buf);
+            if (b && check) {
+                bad += b;
+                for (size_t i = 0; i < (size_t)W * C; i++)
+                    if (not_finite(row[i])) {
+                        const long long at = (long long)y * W * C + (long long)i;
+                        first = first < at ? first : at;
+                        break;
+                    }
+            }
             atmos__tonemap_row(curve, buf, out, (size_t)W, 4, scale);
             if (disp) stream_row(out, disp->pixels + (size_t)y * W * 4, W);
             if (rgba8) bytes_row(out, W, rgba8 + (size_t)y * W * 4);
@@ -142,5 +178,23 @@ atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spe
 #endif
         free(buf);
     }
-    return nomem ? atmos__error(ctx, ATMOS_E_NOMEM, "display: out of memory") : ATMOS_OK;
+    if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "display: out of memory");
+    if (bad)
+        return atmos__error(ctx, ATMOS_E_UNSUPPORTED,
+                            "display: %zu of %zu pixel values are NaN or infinite (the first at pixel %lld, %lld): a "
+                            "renderer bug for this scene; the frame is not shown, please report the scene",
+                            bad, (size_t)W * spectral->height * C, (first % ((long long)W * C)) / C, first / ((long long)W * C));
+    return ATMOS_OK;
+}
+
+atmos_status atmos_image_display_into(atmos_context *ctx, const atmos_image *spectral, const atmos_wavelengths *wl,
+                                      const atmos_tonemap_desc *desc, atmos_image *disp, unsigned char *rgba8)
+{
+    return display_pass(ctx, spectral, wl, desc, disp, rgba8, 0);
+}
+
+atmos_status atmos_image_display_checked(atmos_context *ctx, const atmos_image *spectral, const atmos_wavelengths *wl,
+                                         const atmos_tonemap_desc *desc, atmos_image *disp, unsigned char *rgba8)
+{
+    return display_pass(ctx, spectral, wl, desc, disp, rgba8, 1);
 }

@@ -342,14 +342,19 @@ static inline unsigned not_finite(float x)
  * written with exit status 0. With keep (a sky, slice, Nishita, Harris or beams frame, not
  * atmos_frame.no_keep), the rendered pixels are kept for the next call in the same pass: rows on
  * the threads (one pass over a 1280 x 720 frame instead of two serial ones; the count and the
- * first bad pixel do not depend on the thread count). The view is remembered either way (what
+ * first bad pixel do not depend on the thread count). A frame not kept with no_check is not read
+ * here: the caller checks it (atmos_frame.no_check). The view is remembered either way (what
  * the next frame changed). */
 static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const atmos__rect *r, const atmos_image *out,
-                                   int keep)
+                                   int keep, int no_check)
 {
     const int W = out->width, C = out->channels;
     const size_t need = (size_t)out->width * out->height * out->channels, n = (size_t)(r->x1 - r->x0) * C;
     p->have_last = p->have_pixels = 0;
+    if (!keep && no_check) { /* the caller checks the frame in its display pass */
+        p->last_view = *v, p->have_last = 1;
+        return ATMOS_OK;
+    }
     if (keep && need > p->last_cap) {
         float *b = realloc(p->last_pixels, sizeof(float) * need);
         if (b) p->last_pixels = b, p->last_cap = need;
@@ -476,7 +481,8 @@ atmos_status atmos_plan_render(atmos_plan *p, const atmos_frame *f, const atmos_
     }
     /* a frame the impostor budget left unfinished is not kept: the same frame again finishes it */
     if (st == ATMOS_OK && !stats->reused)
-        st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH && !stats->impostors_held && !stats->impostors_coarse && !f->no_keep);
+        st = check_and_keep(p, &v, &r, out, p->renderer != ATMOS_RENDERER_PATH && !stats->impostors_held && !stats->impostors_coarse && !f->no_keep,
+                            f->no_check);
     if (st != ATMOS_OK) {
         p->have_last = p->have_pixels = 0;
         return st;

@@ -33,6 +33,8 @@ typedef struct {
     double sun_radiance[ATMOS_MAX_WAVELENGTHS];
     int sun_visible;        /* disk drawn and sun above the horizon */
     double cos_disk_search; /* cos(sun radius + 1.5 pixel footprints) */
+    int ground_below;       /* 1: a ray meets the ground exactly when it points down (a flat kind's plane
+                               y = 0 seen from above it: atmos_atmosphere_ground_distance's answer) */
 } sky_job;
 
 /* An upper bound on the angle one pixel spans, radians. */
@@ -203,6 +205,8 @@ static void job_init(sky_job *job, const atmos_atmosphere *atm, const atmos__vie
     job->sun_radius = 0.5 * atmos_atmosphere_get_desc(atm)->sun_diameter_deg * ATMOS_DEG2RAD;
     atmos_atmosphere_sun_radiance(atm, v->cam.position, job->sun, job->sun_radiance);
     job->sun_visible = atmos_atmosphere_sun_disk_visible(atm, job->sun);
+    const atmos_atmosphere_kind kind = atmos_atmosphere_get_kind(atm);
+    job->ground_below = (kind == ATMOS_ATMOSPHERE_RILEY || kind == ATMOS_ATMOSPHERE_HOMOGENEOUS) && v->cam.position[1] > 0;
     /* Disk radius plus 2.5 pixel footprints: a sample ray is within one footprint
      * of the pixel centre, the pixel's far corner within another. */
     double foot = pixel_footprint(&v->cam);
@@ -290,6 +294,14 @@ static void eval_cols(const sky_job *job, const atmos__atm_batch *batch, const a
 {
     const int n = job->n;
     pinhole_cols(job->cam, y, xs, m, rb->dx, rb->dy, rb->dz, rb->w);
+    if (flags && job->ground_below) { /* the horizon test by the ray's sign, in a vector loop */
+        const double s0 = job->sun[0], s1 = job->sun[1], s2 = job->sun[2];
+        const int sun = job->sun_visible;
+        for (int i = 0; i < m; i++)
+            flags[i] = (unsigned char)((rb->dy[i] < 0.0f) +
+                                       2 * (sun && rb->dx[i] * s0 + rb->dy[i] * s1 + rb->dz[i] * s2 >= cos_near));
+        flags = NULL;
+    }
     for (int i = 0; flags && i < m; i++) {
         const double d[3] = {rb->dx[i], rb->dy[i], rb->dz[i]};
         flags[i] = (unsigned char)((atmos_atmosphere_ground_distance(job->atm, job->cam->position, d) < INFINITY) +

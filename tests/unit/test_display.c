@@ -3,7 +3,8 @@
  * atmos_image_gamut_map, atmos_tonemap_into): the same display values to the bit, for RGB and
  * spectral images with out-of-gamut colours, negatives, NaN, infinities and the sun's
  * radiance, on one thread and on three; its 8-bit RGBA equal to what atmos_write_png writes of
- * those values (read back with atmos_read_png). */
+ * those values (read back with atmos_read_png); atmos_image_display_checked refusing a frame with
+ * a NaN or an infinity, naming the first. */
 #include "test.h"
 
 #include "atmos/atmos.h"
@@ -76,6 +77,40 @@ static void check(atmos_context *ctx, const atmos_wavelengths *wl, int W, int H,
     atmos_image_destroy(disp);
 }
 
+/* atmos_image_display_checked: a finite frame's values and bytes as atmos_image_display_into's;
+ * a frame with a NaN in alpha and an infinity in a radiance refused, the count and the first
+ * pixel named (the least of the rows', on any thread count), where atmos_image_display_into takes
+ * it. */
+static void check_refusal(atmos_context *ctx, const atmos_wavelengths *wl, int W, int H)
+{
+    const int C = wl->count + 1;
+    atmos_image *img = NULL, *a = NULL, *b = NULL;
+    CHECK_OK(atmos_image_create(NULL, W, H, C, &img));
+    CHECK_OK(atmos_image_create(NULL, W, H, 4, &a));
+    CHECK_OK(atmos_image_create(NULL, W, H, 4, &b));
+    unsigned char *ba = malloc((size_t)W * H * 4), *bb = malloc((size_t)W * H * 4);
+    if (!img || !a || !b || !ba || !bb) return;
+    for (size_t i = 0; i < (size_t)W * H * C; i++) img->pixels[i] = (i % C == (size_t)C - 1) ? 1.0f : 0.01f * (float)(i % 97);
+    atmos_tonemap_desc td = {1, 3.0, ATMOS_TONE_FILMIC};
+    CHECK_OK(atmos_image_display_into(ctx, img, wl, &td, a, ba));
+    CHECK_OK(atmos_image_display_checked(ctx, img, wl, &td, b, bb));
+    CHECK(memcmp(a->pixels, b->pixels, sizeof(float) * (size_t)W * H * 4) == 0);
+    CHECK(memcmp(ba, bb, (size_t)W * H * 4) == 0);
+    /* alpha NaN at (W - 2, H - 1), a radiance infinite at (W - 3, H / 2), the first */
+    img->pixels[((size_t)(H - 1) * W + W - 2) * C + C - 1] = NAN;
+    img->pixels[((size_t)(H / 2) * W + W - 3) * C + 1] = -INFINITY;
+    CHECK_OK(atmos_image_display_into(ctx, img, wl, &td, a, ba));
+    CHECK(atmos_image_display_checked(ctx, img, wl, &td, b, bb) == ATMOS_E_UNSUPPORTED);
+    char want[160];
+    snprintf(want, sizeof want, "2 of %d pixel values are NaN or infinite (the first at pixel %d, %d)", W * H * C, W - 3,
+             H / 2);
+    const char *msg = atmos_context_error(ctx);
+    CHECK_MSG(msg && strstr(msg, want), "the refusal says \"%s\", not \"%s\"", msg ? msg : "", want);
+    atmos_context_clear_error(ctx);
+    free(ba), free(bb);
+    atmos_image_destroy(img), atmos_image_destroy(a), atmos_image_destroy(b);
+}
+
 int main(void)
 {
     atmos_context *one = NULL, *three = NULL;
@@ -98,6 +133,9 @@ int main(void)
     check(one, &spec, 53, 29, ATMOS_TONE_FILMIC, 12.0);
     check(one, &three_bands, 97, 31, ATMOS_TONE_FILMIC, 9.0);
     check(three, &three_bands, 61, 23, ATMOS_TONE_CLAMP, 2.0);
+    check_refusal(one, &rgb, 37, 9);
+    check_refusal(three, &rgb, 37, 9);
+    check_refusal(three, &spec, 21, 7);
     /* refused: an automatic exposure, no output, a wrong size */
     atmos_image *img = NULL, *small = NULL;
     CHECK_OK(atmos_image_create(NULL, 8, 8, 4, &img));

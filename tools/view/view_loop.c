@@ -141,9 +141,10 @@ static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int sna
     return st;
 }
 
-/* A frame's display values in one pass (atmos_image_display_into: the same values as display's
- * steps): L->disp when recording, L->rgba for the window, and for a headless run that records
- * nothing (the window's work, not float values nothing reads). */
+/* A frame's display values in one pass (atmos_image_display_checked: the same values as display's
+ * steps, a NaN or an infinity in the frame refused in the same pass, the plan not checking it:
+ * atmos_frame.no_check): L->disp when recording, L->rgba for the window, and for a headless run
+ * that records nothing (the window's work, not float values nothing reads). */
 static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, int snap, int floats, int bytes)
 {
     const int W = L->img->width, H = L->img->height;
@@ -159,8 +160,8 @@ static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, i
     }
     if (st != ATMOS_OK) return st;
     const atmos_tonemap_desc td = frame_tonemap(L, p, s, snap);
-    st = atmos_image_display_into(L->ctx, L->img, atmos_plan_wavelengths(p), &td, floats ? L->disp : NULL,
-                                  bytes ? L->rgba : NULL);
+    st = atmos_image_display_checked(L->ctx, L->img, atmos_plan_wavelengths(p), &td, floats ? L->disp : NULL,
+                                     bytes ? L->rgba : NULL);
     return st;
 }
 
@@ -228,6 +229,7 @@ static atmos_status render(loop *L, view_state *s, view_quality q, atmos_plan **
     /* a moving view's frame is not kept by the plan for an unchanged next one (the copy of a
      * 1280 x 720 frame saved; a still view's frame is kept) */
     f.no_keep = q == VIEW_PREVIEW || q == VIEW_SCRIPTED;
+    f.no_check = !saving; /* display_frame's pass checks the frame; a save's, by the plan */
     if (s->renderer == ATMOS_RENDERER_SLICE) slice_quality(&f, L->sc, q);
     if (s->renderer == ATMOS_RENDERER_PATH) {
         const int full = L->sc->path.spp > 0 ? L->sc->path.spp : 64;
