@@ -119,6 +119,12 @@ typedef struct atmos_scene_nishita {
     int diffuse;              /* 1: the slice renderer's diffuse light field (all orders) and Riley's
                                  scattered beam where the medium is thick, the orders 2-3 and the sky
                                  elements where it is thin (docs/lightfield.md); 0 */
+    int mc_kphotons;          /* > 0: a diagnostic, the orders >= 2 from a Monte Carlo field of this many
+                                 thousand photons per wavelength toward the eye's central direction, the
+                                 medium cut at 3 degrees (docs/lightfield.md, "A Monte Carlo field"); 0 */
+    int mc_cell;              /* that field's cell edge, render voxels; 4 */
+    int mc_lmax;              /* -1: the field toward the view's centre alone; 0-3: its spherical harmonics of
+                                 degree <= this, turned toward the eye per cell; -1 */
 } atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is

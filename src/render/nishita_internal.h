@@ -19,6 +19,8 @@
 #include "render/slice_grid.h"
 #include "volume/volume_access.h"
 
+typedef struct atmos__nishita_mc atmos__nishita_mc;
+
 struct atmos__nishita_plan {
     int nf, n;
     sgrid g;                 /* the volume box-filtered onto the render grid (slice_grid.c) */
@@ -46,7 +48,23 @@ struct atmos__nishita_plan {
     int diffuse;
     stables tab;             /* the field's tables: cross-sections, F_n, B_n, Ams_2 */
     atmos__dfield df;
+    /* "mc_kphotons" (nishita_mc.c): the Monte Carlo field of the orders >= 2 toward the eye, the
+     * first order and the eye rays in the medium truncated as its photons see it (sig', sca') */
+    atmos__nishita_mc *mc;
+    float mc_sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    float mc_sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    double mc_s;             /* the last field's time */
 };
+
+/* The Monte Carlo field (nishita_mc.c): made once per plan (the path tracer's medium and phase
+ * tables, cut at 3 degrees), filled per sun (and, toward one direction, per out_w: the light's
+ * direction toward the eye), turned toward the eye at eye_w per frame (E: the sunlight per
+ * wavelength), read by the eye rays. */
+atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np);
+void atmos__nishita_mc_free(atmos__nishita_mc *mc);
+atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], const double out_w[3],
+                                      const double eye_w[3], const double *E, int threads);
+const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np);
 
 /* The forward-peak truncation of the orders 2-3 (nishita_light.c): trunc[] from the fields'
  * mean phase function, the field's medium scaled (sig_s (1 - f), sig_t - f sig_s). */

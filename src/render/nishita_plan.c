@@ -21,6 +21,7 @@ void atmos__nishita_plan_destroy(atmos__nishita_plan *s)
     atmos__lfield_free(&s->field);
     atmos__dfield_free(&s->df);
     atmos__stables_free(&s->tab);
+    atmos__nishita_mc_free(s->mc);
     free(s);
 }
 
@@ -88,6 +89,7 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
         st = atmos__stables_build(ctx, p->optics, np->n, 2, &np->tab);
         if (st == ATMOS_OK) st = atmos__dfield_prepare(ctx, &np->df, &np->g, &np->tab, &np->x, p->optics, "render nishita");
     }
+    if (st == ATMOS_OK && np->g.v && p->scene.nishita.mc_kphotons > 0) st = atmos__nishita_mc_create(p, np);
     if (st != ATMOS_OK) {
         atmos__nishita_plan_destroy(np);
         return st;

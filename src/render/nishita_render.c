@@ -23,6 +23,9 @@ typedef struct {
     double dt;                       /* step, m */
     int use_field;
     int diffuse;                     /* the diffuse field and the scattered beam (dfield.h) */
+    const atmos__lfield *mc;         /* the Monte Carlo field (nishita_mc.c), NULL: none */
+    float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* extinction of the first order and the eye
+                                                                  rays (truncated with mc) */
 } rjob;
 
 /* Ams_2 of each field at scattering angle acos(mu) (the beam's scattered light, once scattered
@@ -115,6 +118,8 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         if (!(any > 0)) continue;
         grid_at(g, np->col, nf, u[0], u[1], u[2], col);
         if (J->use_field) atmos__lfield_sample(&np->field, np->field.L, n, (float)u[0], (float)u[1], (float)u[2], Lf);
+        float Lmc[ATMOS_MAX_WAVELENGTHS];
+        if (J->mc) atmos__lfield_sample(J->mc, J->mc->L, n, (float)u[0], (float)u[1], (float)u[2], Lmc);
         double Sd[ATMOS_MAX_WAVELENGTHS] = {0};
         float fade[ATMOS_MAX_WAVELENGTHS];
         for (int w = 0; w < n; w++) fade[w] = 0.0f;
@@ -126,9 +131,10 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         for (int w = 0; w < n; w++) {
             double st = 0, ss = 0, s1 = 0, tau = 0;
             for (int f = 0; f < nf; f++) {
-                st += dens[f] * np->sig[f][w], ss += dens[f] * np->sca[f][w];
+                st += dens[f] * J->sig[f][w], ss += dens[f] * np->sca[f][w];
                 s1 += dens[f] * np->sca[f][w] * pf[f][w];
-                tau += col[f] * np->sig[f][w];
+                tau += col[f] * J->sig[f][w];
+                if (J->mc) Sd[w] += dens[f] * np->mc_sca[f][w] * (Lmc[w] > 0 ? Lmc[w] : 0);
             }
             /* the field's radiance is per unit truncated scattering, sig_s (1 - f); where the
              * diffuse field is on (fade > 0) it takes the place of the orders 2-3 and the sky */
@@ -192,6 +198,15 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
     atmos__vol_frame_to_point(&np->x, cen, cw);
     atmos_atmosphere_sunlight(p->atm, cw, v->sun, J.E);
     J.dt = p->scene.nishita.step_scale_pct / 100.0 / np->g.sc;
+    memcpy(J.sig, np->mc ? np->mc_sig : np->sig, sizeof J.sig);
+    if (np->mc) {
+        double dc[3], ot[3];
+        if (!atmos_camera_ray(&v->cam, 0.5 * out->width, 0.5 * out->height, dc))
+            return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render nishita: no central view direction");
+        for (int a = 0; a < 3; a++) ot[a] = -dc[a];
+        if ((st = atmos__nishita_mc_update(p, v->sun, ot, v->cam.position, J.E, threads)) != ATMOS_OK) return st;
+        J.mc = atmos__nishita_mc_field(np);
+    }
     const int W = out->width, C = out->channels;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int y = r->y0; y < r->y1; y++)
@@ -207,4 +222,10 @@ void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap)
              "patterns: order 2 %d paths, order 3 %d of %lld%s",
              s->orders, s->ratio, s->paths, s->sky ? "on" : "off", np->med.c[0], np->med.c[1], np->med.c[2], np->s,
              np->stats.n2, np->stats.n3, np->stats.n3_space, np->diffuse ? "; diffuse field" : "");
+    if (np->mc) {
+        const atmos__lfield *F = atmos__nishita_mc_field(np);
+        const size_t l = strlen(buf);
+        snprintf(buf + l, cap - l, "; Monte Carlo field of %d thousand photons, %dx%dx%d cells of %d voxels, %.3f s",
+                 s->mc_kphotons, F->c[0], F->c[1], F->c[2], F->s, np->mc_s);
+    }
 }

@@ -1,0 +1,50 @@
+#!/bin/sh
+# The floor of a per-cell light field (docs/lightfield.md, "A Monte Carlo field"): in a vacuum
+# (no sky, no ground: the field's photons come from the sun alone), the path tracer's reference
+# (seeds 1 and 2, the second for its noise), the slice renderer with its diffuse (P1) field, and
+# the Nishita renderer's exact first order plus the Monte Carlo field of the orders >= 2, each
+# split by bench/accuracy/breakdown.py against the reference.
+#
+#   bench/accuracy/mcfield.sh OUT_DIR
+#
+# Environment: ATMOS (default build/atmos), SPP (the references', default 256), CASES (default
+# "disney cumulus"), KPHOTONS (thousands of photons per wavelength, default 2000), CELL (the
+# field's cell edge in render voxels, default 4), LMAX (-1: toward the view's centre; 0-3:
+# spherical harmonics), TAG (the variant's file name, default mcCELL_LMAX), THREADS, REUSE (1:
+# keep the references already in OUT_DIR). Writes OUT_DIR/CASE_SUN.TAG.bd.txt.
+set -eu
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+A=${ATMOS:-$root/build/atmos}
+OUT=${1:?usage: mcfield.sh OUT_DIR}
+SPP=${SPP:-256}
+CASES=${CASES:-"disney cumulus"}
+K=${KPHOTONS:-2000}
+CELL=${CELL:-4}
+LMAX=${LMAX:--1}
+TAG=${TAG:-mc${CELL}_$LMAX}
+TH=${THREADS:+--threads $THREADS}
+mkdir -p "$OUT"
+for c in $CASES; do
+    scene="$here/$c.json"
+    for sun in behind front; do
+        if [ "$sun" = behind ]; then az=180; else az=0; fi
+        b="$OUT/${c}_$sun"
+        V="$A render $scene $TH --sun-azimuth $az -D background=black"
+        for seed in 1 2; do
+            s=$([ $seed = 1 ] && echo "" || echo 2)
+            if [ "${REUSE:-0}" != 1 ] || [ ! -s "$b.vpath$s.pfm" ]; then
+                $V --renderer path --spp "$SPP" --truncate 3 --seed $seed --pfm "$b.vpath$s.pfm" --tau "$b.tau.pfm" \
+                    -o "$b.vpath$s.png" 2> "$b.vpath$s.log"
+            fi
+        done
+        if [ ! -s "$b.p1.pfm" ]; then
+            $V --pfm "$b.p1.pfm" -o "$b.p1.png" 2> "$b.p1.log"
+            python3 "$here/breakdown.py" "$b.p1.pfm" "$b.vpath.pfm" "$b.tau.pfm" "$b.vpath2.pfm" > "$b.p1.bd.txt"
+        fi
+        $V --renderer nishita --nishita-orders 1 --no-nishita-sky --nishita-mc "$K" --nishita-mc-cell "$CELL" \
+            --nishita-mc-lmax "$LMAX" --pfm "$b.$TAG.pfm" -o "$b.$TAG.png" 2> "$b.$TAG.log"
+        python3 "$here/breakdown.py" "$b.$TAG.pfm" "$b.vpath.pfm" "$b.tau.pfm" "$b.vpath2.pfm" > "$b.$TAG.bd.txt"
+        echo "== $c, sun $sun, $TAG: $(head -2 "$b.$TAG.bd.txt" | tr '\n' ' ')" >&2
+    done
+done

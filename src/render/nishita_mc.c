@@ -1,0 +1,383 @@
+/* The Nishita renderer's Monte Carlo field of the orders >= 2 (a bench option, "nishita":
+ * {"mc_kphotons": K}; docs/lightfield.md, "A Monte Carlo field"): photons from the sun traced
+ * through the path tracer's medium with its forward peak cut at 3 degrees (path_medium.c,
+ * path_phase.c: the free flights, the phase sampling and the mixture's phase function are the
+ * path tracer's own), and at every collision after the first the collision estimate of what
+ * scatters toward the eye, sigma_s' p(d_in . omega) L, summed per cell of s render voxels with
+ * the trilinear read's weights and divided by the cells' sigma_s' weighted alike: the radiance
+ * of orders >= 2 per unit (truncated) scattering coefficient. Either toward one direction,
+ * omega = -(the camera's central view direction) ("mc_lmax" -1: the "perfect-angle" field that
+ * the P1 field approximates), or as real spherical harmonics of degree <= lmax of the emission
+ * (p_l Y_lm(d_in) per collision, the addition theorem), turned toward the eye per cell and frame.
+ * The sums are fixed point, one random stream per photon: the same field for a seed whatever
+ * the threads. The eye pass adds sigma_s' times its trilinear value to the first order, both in
+ * the truncated medium (nishita_render.c). */
+#include "core/vec.h"
+#include "render/nishita_internal.h"
+#include "render/path_trace.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#define MC_TRUNC_DEG 3.0 /* as the bench's references (--truncate 3) and the orders 2-3 */
+#define MC_MAX_DEPTH 100000
+#define MC_SS_FLOOR 1e-3
+#define MC_FIX 16777216.0 /* 2^24: the sums are integers of this many units per 1 (exact, in any order) */
+#define MC_KMAX 16        /* coefficients per cell and wavelength at most: degree 3 */
+
+struct atmos__nishita_mc {
+    path_medium med;
+    path_phase ph;
+    int lmax, K;         /* -1: the phase toward one direction (K = 1); else degree lmax, K = (lmax + 1)^2 */
+    double pl[PATH_F][ATMOS_MAX_WAVELENGTHS][4]; /* Legendre moments 2 pi int p P_l dmu of the cut phase */
+    float *coef;         /* [(cell * n + w) * K + k]: the emission of orders >= 2 per unit sigma_s' */
+    atmos__lfield field; /* L: its radiance toward the eye (cells of s render voxels) */
+    double sun[3], out[3], eye[3];
+    int valid, view_valid;
+};
+
+void atmos__nishita_mc_free(atmos__nishita_mc *mc)
+{
+    if (!mc) return;
+    atmos__path_medium_free(&mc->med);
+    atmos__path_phase_free(&mc->ph);
+    atmos__lfield_free(&mc->field);
+    free(mc->coef);
+    free(mc);
+}
+
+/* Real spherical harmonics (orthonormal over the sphere) of degree <= lmax at unit d. */
+static void sh_eval(int lmax, const double d[3], double *Y)
+{
+    const double x = d[0], y = d[1], z = d[2];
+    Y[0] = 0.28209479177387814;
+    if (lmax < 1) return;
+    Y[1] = 0.4886025119029199 * y, Y[2] = 0.4886025119029199 * z, Y[3] = 0.4886025119029199 * x;
+    if (lmax < 2) return;
+    Y[4] = 1.0925484305920792 * x * y, Y[5] = 1.0925484305920792 * y * z;
+    Y[6] = 0.31539156525252005 * (3 * z * z - 1), Y[7] = 1.0925484305920792 * x * z;
+    Y[8] = 0.5462742152960396 * (x * x - y * y);
+    if (lmax < 3) return;
+    Y[9] = 0.5900435899266435 * y * (3 * x * x - y * y), Y[10] = 2.890611442640554 * x * y * z;
+    Y[11] = 0.4570457994644658 * y * (5 * z * z - 1), Y[12] = 0.3731763325901154 * z * (5 * z * z - 3);
+    Y[13] = 0.4570457994644658 * x * (5 * z * z - 1), Y[14] = 1.445305721320277 * z * (x * x - y * y);
+    Y[15] = 0.5900435899266435 * x * (x * x - 3 * y * y);
+}
+
+/* The Legendre moments p_l = 2 pi int p(mu) P_l(mu) dmu, l <= 3, of every field's cut phase
+ * function (the path tracer's tables, p_0 = 1 up to their rounding). */
+static void legendre_moments(atmos__nishita_mc *mc, int nf, int n)
+{
+    enum { STEPS = 36000 };
+    for (int f = 0; f < nf; f++)
+        for (int k = 0; k < n; k++) {
+            double acc[4] = {0};
+            for (int i = 0; i < STEPS; i++) {
+                const double th = (i + 0.5) * ATMOS_PI / STEPS, mu = cos(th);
+                path_angle a;
+                atmos__path_angle(&mc->ph, mu, &a);
+                const double p = atmos__path_phase_eval(&mc->ph, f, k, &a) * 2 * ATMOS_PI * sin(th) * ATMOS_PI / STEPS;
+                const double P[4] = {1, mu, 0.5 * (3 * mu * mu - 1), 0.5 * (5 * mu * mu * mu - 3 * mu)};
+                for (int l = 0; l < 4; l++) acc[l] += p * P[l];
+            }
+            for (int l = 0; l < 4; l++) mc->pl[f][k][l] = acc[l];
+        }
+}
+
+atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
+{
+    atmos_context *ctx = p->ctx;
+    atmos__nishita_mc *mc = calloc(1, sizeof *mc);
+    if (!mc) return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory");
+    np->mc = mc;
+    const int n = np->n;
+    atmos_status st = atmos__path_phase_build(ctx, p->optics, n, MC_TRUNC_DEG, &mc->ph);
+    if (st == ATMOS_OK)
+        st = atmos__path_medium_build(ctx, p->volume, p->scene.volume.density_scale, p->offset, p->optics, n, &mc->med);
+    if (st != ATMOS_OK) return st;
+    atmos__path_medium_truncate(&mc->med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])mc->ph.trunc);
+    for (int f = 0; f < np->nf; f++)
+        for (int w = 0; w < n; w++) np->mc_sig[f][w] = mc->med.sig[f][w], np->mc_sca[f][w] = mc->med.sca[f][w];
+    mc->lmax = p->scene.nishita.mc_lmax;
+    mc->K = mc->lmax < 0 ? 1 : (mc->lmax + 1) * (mc->lmax + 1);
+    legendre_moments(mc, np->nf, n);
+    const int s = p->scene.nishita.mc_cell;
+    const sgrid *g = &np->g;
+    if (!atmos__lfield_alloc(&mc->field, ATMOS__LFIELD_NONE, (g->c[0] + s - 1) / s, (g->c[1] + s - 1) / s,
+                             (g->c[2] + s - 1) / s, n, s) ||
+        !(mc->coef = calloc((size_t)mc->field.c[0] * mc->field.c[1] * mc->field.c[2] * n * mc->K, sizeof(float))))
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the Monte Carlo field");
+    return ATMOS_OK;
+}
+
+const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np) { return &np->mc->field; }
+
+/* The occupied box's faces lit by the sunlight travelling along lt (grid frame): each face's
+ * area across the beam (area3, m^2) and their sum. */
+static double box_area(const path_medium *m, const double lt[3], double *area3)
+{
+    double A = 0;
+    for (int a = 0; a < 3; a++) {
+        const int b = (a + 1) % 3, c = (a + 2) % 3;
+        area3[a] = fabs(lt[a]) * (m->box_hi[b] - m->box_lo[b]) * (m->box_hi[c] - m->box_lo[c]) * m->vs * m->vs;
+        A += area3[a];
+    }
+    return A;
+}
+
+/* The photon's start: a point of those faces drawn in proportion to their area across the beam
+ * (index space q). */
+static void start_point(const path_medium *m, const double lt[3], const double *area3, double A, atmos__stream *r,
+                        double q[3])
+{
+    double u = atmos__stream_u(r) * A;
+    int a = 0;
+    while (a < 2 && u >= area3[a]) u -= area3[a], a++;
+    for (int b = 0; b < 3; b++) q[b] = m->box_lo[b] + atmos__stream_u(r) * (m->box_hi[b] - m->box_lo[b]);
+    q[a] = lt[a] > 0 ? m->box_lo[a] : m->box_hi[a];
+}
+
+typedef struct {
+    const atmos__nishita_plan *np;
+    const atmos__nishita_mc *mc;
+    path_job J;
+    double lt[3], out[3]; /* world: the sunlight's travel, the direction toward the eye (lmax -1) */
+    double area3[3], A;
+} mc_job;
+
+/* Adds v[0..K) times the trilinear read's weights at render-voxel point u (atmos__lfield_sample's)
+ * to the 8 cells' acc[((cell * n + w) * K + k]: reading the cells at x then returns the kernel
+ * estimate, sum_c W_c(x) (sum of v W_c) / (integral of sigma_s' W_c). Fixed point, atomic: the
+ * same integers whatever the threads' order. */
+static void splat(const atmos__lfield *F, const float u[3], const double *v, int K, int w, int64_t *acc)
+{
+    int i[3];
+    float f[3];
+    for (int a = 0; a < 3; a++) atmos__lfield_axis(u[a], F->s, F->c[a], &i[a], &f[a]);
+    for (int c = 0; c < 8; c++) {
+        double wt = 1;
+        size_t cell = 0;
+        for (int a = 2; a >= 0; a--) {
+            const int hi = (c >> a) & 1, ia = i[a] + hi < F->c[a] ? i[a] + hi : i[a];
+            wt *= hi ? f[a] : 1.0f - f[a];
+            cell = cell * F->c[a] + ia;
+        }
+        if (!(wt > 0)) continue;
+        const size_t o = (cell * F->n + w) * K;
+        for (int k = 0; k < K; k++) {
+            const int64_t x = (int64_t)llrint(wt * v[k] * MC_FIX);
+#pragma omp atomic
+            acc[o + k] += x;
+        }
+    }
+}
+
+/* What a collision of the photon travelling along d scatters: toward M->out (K = 1), or the
+ * spherical-harmonic coefficients of p(d . omega), p_l Y_lm(d) (the addition theorem). */
+static void emission(const mc_job *M, const path_scatter *e, int k, const double d[3], double *v)
+{
+    const atmos__nishita_mc *mc = M->mc;
+    const path_bundle b = {1, {k, 0, 0, 0}};
+    if (mc->lmax < 0) {
+        atmos__path_phase_mix(&mc->ph, &b, mc->med.nf, e, atmos__dot3(d, M->out), v);
+        return;
+    }
+    double pl[4] = {0}, Y[MC_KMAX];
+    for (int f = 0; f < mc->med.nf; f++)
+        for (int l = 0; l <= mc->lmax; l++) pl[l] += e->ssf[f][0] * mc->pl[f][k][l] / e->ss[0];
+    sh_eval(mc->lmax, d, Y);
+    for (int l = 0; l <= mc->lmax; l++)
+        for (int m = -l; m <= l; m++) v[l * l + l + m] = pl[l] * Y[l * l + l + m];
+}
+
+/* One photon of wavelength k: its collisions after the first add w times their emission. */
+static void photon(const mc_job *M, int k, atmos__stream *r, int64_t *acc)
+{
+    const atmos__nishita_mc *mc = M->mc;
+    const path_medium *m = &mc->med;
+    const sgrid *g = &M->np->g;
+    const path_bundle b = {1, {k, 0, 0, 0}};
+    double q[3], qd[3], d[3], ltg[3], w[PATH_B] = {1, 0, 0, 0};
+    atmos__vol_dir_to_frame(&m->x, M->lt, ltg);
+    start_point(m, ltg, M->area3, M->A, r, q);
+    memcpy(d, M->lt, sizeof d);
+    atmos__vol_dir_to_index(&m->x, d, qd);
+    long long tent = 0;
+    for (int order = 1; order <= MC_MAX_DEPTH; order++) {
+        double t0, t1, t;
+        float dens[PATH_F];
+        if (!atmos__path_clip(m, q, qd, INFINITY, &t0, &t1)) return;
+        if (atmos__path_free_flight(m, q, qd, t0, t1, &b, w, r, &t, dens, &tent) <= 0) return;
+        for (int a = 0; a < 3; a++) q[a] += t * qd[a];
+        path_scatter e;
+        int gi[PATH_B];
+        if (!atmos__path_scatter_at(&M->J, &b, dens, &e, gi)) return;
+        if (order >= 2) {
+            double v[MC_KMAX];
+            emission(M, &e, k, d, v);
+            for (int c = 0; c < mc->K; c++) v[c] *= w[0];
+            float u[3];
+            for (int a = 0; a < 3; a++) u[a] = (float)(q[a] * m->vs * g->sc + g->off[a]);
+            splat(&mc->field, u, v, mc->K, k, acc);
+        }
+        if (!atmos__path_roulette(w, 1, r)) return;
+        const int f = atmos__path_pick_field(&e, 0, m->nf, r);
+        const double mu = atmos__path_phase_sample(&mc->ph, f, k, atmos__stream_u(r));
+        double nd[3];
+        atmos__path_around(d, mu, 2.0 * ATMOS_PI * atmos__stream_u(r), nd);
+        memcpy(d, nd, sizeof d);
+        atmos__vol_dir_to_index(&m->x, d, qd);
+    }
+}
+
+/* Per cell and wavelength the integral of sigma_s' times the cell's trilinear weight (into ss,
+ * in units of sig_max times a render voxel's volume), by the midpoint rule on SUB^3 points per
+ * render voxel of the medium the photons see (the path tracer's: its density next to the
+ * volume's faces is not the render grid's). Fixed point, so the same whatever the threads. */
+static int cell_scattering(const atmos__nishita_plan *np, const atmos__nishita_mc *mc, double sig_max, double *ss,
+                           int threads)
+{
+    const sgrid *g = &np->g;
+    const atmos__lfield *F = &mc->field;
+    const path_medium *m = &mc->med;
+    const int nf = np->nf, n = np->n, sub = F->s >= 2 ? 2 : 4;
+    const size_t vals = (size_t)F->c[0] * F->c[1] * F->c[2] * n;
+    int64_t *acc = calloc(vals, sizeof(int64_t));
+    if (!acc) return 0;
+    const double unit = 1.0 / (sig_max * sub * sub * sub);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int k = 0; k < g->c[2]; k++)
+        for (int j = 0; j < g->c[1]; j++)
+            for (int i = 0; i < g->c[0]; i++)
+                for (int c = 0; c < sub * sub * sub; c++) {
+                    const float u[3] = {i + (c % sub + 0.5f) / sub - 0.5f, j + (c / sub % sub + 0.5f) / sub - 0.5f,
+                                        k + (c / (sub * sub) + 0.5f) / sub - 0.5f};
+                    double q[3];
+                    for (int a = 0; a < 3; a++) q[a] = (u[a] - g->off[a]) / g->sc * m->inv_vs;
+                    float dens[PATH_F];
+                    atmos__path_density(m, q[0], q[1], q[2], dens);
+                    for (int w = 0; w < n; w++) {
+                        double sum = 0;
+                        for (int f = 0; f < nf; f++) sum += (double)dens[f] * np->mc_sca[f][w];
+                        sum *= unit;
+                        if (sum > 0) splat(F, u, &sum, 1, w, acc);
+                    }
+                }
+    for (size_t c = 0; c < vals; c++) ss[c] = acc[c] / MC_FIX;
+    free(acc);
+    return 1;
+}
+
+/* The photons of one sun (and, for lmax -1, one direction toward the eye) into mc->coef. */
+static atmos_status trace(atmos_plan *p, const double sun_w[3], const double out_w[3], const double *E, int threads)
+{
+    atmos__nishita_plan *np = p->nishita;
+    atmos__nishita_mc *mc = np->mc;
+    const atmos__lfield *F = &mc->field;
+    const int n = np->n, K = mc->K;
+    const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2], vals = cells * n;
+    int64_t *acc = calloc(vals * K, sizeof(int64_t));
+    double *ss = calloc(vals, sizeof(double));
+    if (!acc || !ss) {
+        free(acc), free(ss);
+        return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the photons");
+    }
+    mc_job M;
+    memset(&M, 0, sizeof M);
+    M.np = np, M.mc = mc, M.J.med = &mc->med, M.J.ph = &mc->ph;
+    for (int a = 0; a < 3; a++) M.lt[a] = -sun_w[a], M.out[a] = out_w[a];
+    double ltg[3];
+    atmos__vol_dir_to_frame(&mc->med.x, M.lt, ltg);
+    M.A = mc->med.empty ? 0 : box_area(&mc->med, ltg, M.area3);
+    const long long N = (long long)p->scene.nishita.mc_kphotons * 1000;
+    const uint64_t seed = p->scene.path.seed;
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
+    for (long long i = 0; i < N * n; i++) {
+        atmos__stream r;
+        atmos__stream_seed(&r, seed, (uint64_t)(i / n), (uint64_t)(i % n) + 0x6d63u);
+        if (M.A > 0) photon(&M, (int)(i % n), &r, acc);
+    }
+    /* the kernel-weighted emission, acc E A / N, over the kernel-weighted sigma_s'; a cell whose
+     * kernel holds almost no scattering (the cloud's fringe) divided by at least MC_SS_FLOOR of
+     * the largest cell's: one collision there would otherwise make a radiance that the trilinear
+     * read carries into the dense neighbours */
+    const double h = 1.0 / np->g.sc;
+    double sig_max = 0;
+    for (size_t v = 0; v < (size_t)np->g.c[0] * np->g.c[1] * np->g.c[2]; v++)
+        for (int f = 0; f < np->nf; f++)
+            for (int w = 0; w < n; w++) sig_max = fmax(sig_max, 2.0 * np->g.v[v * np->nf + f] * np->mc_sca[f][w]);
+    if (!(sig_max > 0) || !cell_scattering(np, mc, sig_max, ss, threads)) {
+        free(acc), free(ss);
+        return sig_max > 0 ? atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the photons")
+                           : ATMOS_OK;
+    }
+    for (size_t c = 0; c < vals; c++) ss[c] *= sig_max * h * h * h;
+    double smax[ATMOS_MAX_WAVELENGTHS] = {0};
+    for (size_t c = 0; c < vals; c++)
+        if (ss[c] > smax[c % n]) smax[c % n] = ss[c];
+    for (size_t c = 0; c < vals; c++) {
+        const int w = (int)(c % n);
+        const double d = fmax(ss[c], MC_SS_FLOOR * smax[w]), sc = N > 0 && d > 0 ? E[w] * M.A / ((double)N * d) : 0;
+        for (int k = 0; k < K; k++) mc->coef[c * K + k] = (float)(acc[c * K + k] / MC_FIX * sc);
+    }
+    free(acc), free(ss);
+    return ATMOS_OK;
+}
+
+/* The field toward the eye at eye_w (world): per cell its coefficients at the direction from
+ * the cell's centre to the eye, not below 0. */
+static void view(atmos__nishita_plan *np, const double eye_w[3], int threads)
+{
+    atmos__nishita_mc *mc = np->mc;
+    atmos__lfield *F = &mc->field;
+    const sgrid *g = &np->g;
+    const int n = np->n, K = mc->K;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int k = 0; k < F->c[2]; k++)
+        for (int j = 0; j < F->c[1]; j++)
+            for (int i = 0; i < F->c[0]; i++) {
+                const size_t cell = ((size_t)k * F->c[1] + j) * F->c[0] + i;
+                double Y[MC_KMAX] = {1}, gc[3], pw[3], d[3];
+                const int ijk[3] = {i, j, k};
+                if (mc->lmax >= 0) {
+                    for (int a = 0; a < 3; a++) gc[a] = (ijk[a] * F->s + 0.5 * (F->s - 1) - g->off[a]) / g->sc;
+                    atmos__vol_frame_to_point(&np->x, gc, pw);
+                    for (int a = 0; a < 3; a++) d[a] = eye_w[a] - pw[a];
+                    atmos__normalize3(d);
+                    sh_eval(mc->lmax, d, Y);
+                }
+                for (int w = 0; w < n; w++) {
+                    const float *c = mc->coef + (cell * n + w) * K;
+                    double v = 0;
+                    for (int q = 0; q < K; q++) v += c[q] * Y[q];
+                    F->L[cell * n + w] = v > 0 ? (float)v : 0.0f;
+                }
+            }
+}
+
+atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], const double out_w[3],
+                                      const double eye_w[3], const double *E, int threads)
+{
+    atmos__nishita_plan *np = p->nishita;
+    atmos__nishita_mc *mc = np->mc;
+    const int same_out = mc->lmax >= 0 || !memcmp(mc->out, out_w, sizeof mc->out);
+    if (!mc->valid || memcmp(mc->sun, sun_w, sizeof mc->sun) || !same_out) {
+        const double t0 = atmos__now();
+        atmos_status st = trace(p, sun_w, out_w, E, threads < 1 ? 1 : threads);
+        if (st != ATMOS_OK) return st;
+        memcpy(mc->sun, sun_w, sizeof mc->sun), memcpy(mc->out, out_w, sizeof mc->out);
+        mc->valid = 1, mc->view_valid = 0;
+        np->mc_s = atmos__now() - t0;
+    }
+    if (!mc->view_valid || memcmp(mc->eye, eye_w, sizeof mc->eye)) {
+        view(np, eye_w, threads < 1 ? 1 : threads);
+        memcpy(mc->eye, eye_w, sizeof mc->eye);
+        mc->view_valid = 1;
+    }
+    return ATMOS_OK;
+}
