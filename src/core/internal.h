@@ -3,6 +3,7 @@
 #define ATMOS_INTERNAL_H
 
 #include "atmos/atmos.h"
+#include "core/clones.h"
 #include <stdarg.h>
 
 #if defined(__GNUC__)
