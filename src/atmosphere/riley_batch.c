@@ -32,9 +32,7 @@ void atmos__sky_batch_init(atmos__sky_batch *b, const atmos_atmosphere *sky, dou
 }
 
 /* Built for AVX2 as well as the baseline; the loader picks the best at run time. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+ATMOS_CLONES
 void atmos__sky_batch_eval(const atmos__sky_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch)
 {

@@ -291,9 +291,7 @@ SV_INLINE void eval_block(const sv_state *s, const float *ra, const float *rb, i
 
 /* The table's rays, block by block; built for AVX2 as well as the baseline (the loader picks
  * the best at run time; without FMA both give the same bits). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+ATMOS_CLONES
 static void eval_table(const sv_state *s, const float *ra, const float *rb, int count, const float *dx,
                        const float *dy, const float *dz, const float *weight, float *out)
 {

@@ -146,7 +146,7 @@ void atmos__camera_pinhole_dir(const atmos_camera *cam, double u, double v, doub
 
 /* As norm3 after the sum above, term by term in the same order (no contraction in ISO C: the
  * same bits); a zero length divides by 1, which leaves the zeros as norm3 does. */
-__attribute__((target_clones("avx2", "default"))) void atmos__camera_pinhole_dirs(const atmos_camera *cam,
+ATMOS_CLONES void atmos__camera_pinhole_dirs(const atmos_camera *cam,
                                                                                    const double *u, int n, double v,
                                                                                    double *dx, double *dy, double *dz)
 {

@@ -3,6 +3,7 @@
 #define ATMOS_INTERNAL_H
 
 #include "atmos/atmos.h"
+#include "core/clones.h"
 #include <stdarg.h>
 
 #if defined(__GNUC__)
@@ -36,6 +37,8 @@ int atmos__threads(const atmos_context *ctx);
 void *atmos__big_alloc(size_t bytes);
 /* Monotonic wall-clock time in seconds (for timings and time budgets only). */
 double atmos__now(void);
+/* The k-th smallest (0: the least) of n floats, none NaN (select.c); reorders v. k < n. */
+float atmos__select_float(float *v, size_t n, size_t k);
 /* Indices sorted by a key (keysort.c): ascending, or descending with desc; ties by ascending
  * index, a total order, so the result does not depend on the sort's algorithm. */
 typedef struct atmos__keyed {

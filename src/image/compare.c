@@ -48,21 +48,15 @@ atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *a, const
     return atmos_image_compare_matched(ctx, a, ref, &m, out, heatmap);
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* The q-quantile of the heat map's values (every third float of h, npx pixels); 0 when
- * there is no memory to sort them (the caller keeps the largest). */
+/* The q-quantile of the heat map's values (every third float of h, npx pixels), by selection
+ * (the same element a sort would put at floor(q (npx - 1))); 0 when there is no memory for
+ * the copy (the caller keeps the largest). */
 static double heat_percentile(const atmos_image *h, size_t npx, double q)
 {
-    double *v = malloc(sizeof(double) * (npx ? npx : 1));
+    float *v = malloc(sizeof(float) * (npx ? npx : 1));
     if (!v) return 0;
     for (size_t p = 0; p < npx; p++) v[p] = h->pixels[p * 3];
-    qsort(v, npx, sizeof(double), cmp_double);
-    const double r = npx ? v[(size_t)floor(q * (double)(npx - 1))] : 0;
+    const double r = npx ? atmos__select_float(v, npx, (size_t)floor(q * (double)(npx - 1))) : 0;
     free(v);
     return r;
 }

@@ -175,9 +175,7 @@ static inline __attribute__((always_inline)) void map_values(atmos_tone_curve cu
 
 /* One row of `width` pixels of C channels; alpha clamped to [0, 1]. The AVX2 clone maps eight
  * values at a time with a gather from the table (no FMA: the same bits as the baseline). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+ATMOS_CLONES
 static void map_row(atmos_tone_curve curve, const float *src, float *dst, size_t width, int C, float scale,
                     const float *enc)
 {

@@ -1,6 +1,9 @@
 // The Wavefront OBJ reader behind mesh_obj.h: tinyobjloader parses, this file counts the
 // triangles first (so an oversized file is refused before it is read into memory), then
-// copies vertices and triangle indices into malloc'd arrays and checks every index.
+// copies vertices and triangle indices into malloc'd arrays and checks every index. A comment
+// ('#' to the end of the line) may follow a line's content ("f 1 2 3 # tri"): the first pass
+// reads lines without their comments, and tinyobjloader, which takes a face's '#' for a vertex
+// index, is handed such a file's text without them.
 #include "mesh/mesh_obj.h"
 
 #include <tiny_obj_loader.h>
@@ -72,8 +75,8 @@ std::string check_face(const std::string &rest, long line_no, long vertices, lon
 // a vertex whose coordinates are not finite numbers (the reader would take "nan" or "inf"
 // as they are or as zero) or a face vertex that is not a vertex of the file (the reader's
 // own message for those names neither the index nor the line). -1 if the file cannot be
-// opened (why says why).
-long scan(const char *path, long stop_after, std::string *why)
+// opened (why says why). *trailing: whether a comment follows a line's content.
+long scan(const char *path, long stop_after, std::string *why, bool *trailing)
 {
     struct stat sb;
     if (stat(path, &sb) != 0) return *why = std::strerror(errno), -1;
@@ -84,6 +87,11 @@ long scan(const char *path, long stop_after, std::string *why)
     std::string line;
     while (std::getline(f, line) && tris <= stop_after && why->empty()) {
         line_no++;
+        const size_t hash = line.find('#');
+        if (hash != std::string::npos) {
+            *trailing = *trailing || line.find_first_not_of(" \t") < hash;
+            line.erase(hash);
+        }
         if (line.size() < 2 || (line[1] != ' ' && line[1] != '\t')) continue;
         if (line[0] == 'f') {
             std::istringstream in(line.substr(2));
@@ -117,11 +125,21 @@ long scan(const char *path, long stop_after, std::string *why)
     return tris;
 }
 
+// The file's text without its comments, line for line (false if it cannot be read again).
+bool uncommented(const char *path, std::string *text)
+{
+    std::ifstream f(path, std::ios::binary);
+    std::string line;
+    while (f && std::getline(f, line)) text->append(line, 0, line.find('#')).push_back('\n');
+    return f.eof();
+}
+
 int read_obj(const char *path, long max_triangles, float **positions, long *nv, uint32_t **indices, long *nt,
              char *msg, size_t cap)
 {
     std::string why;
-    const long counted = scan(path, max_triangles, &why);
+    bool trailing = false;
+    const long counted = scan(path, max_triangles, &why, &trailing);
     if (counted < 0) {
         if (cap) std::snprintf(msg, cap, "cannot open: %s", why.c_str());
         return ATMOS__OBJ_E_IO;
@@ -136,7 +154,15 @@ int read_obj(const char *path, long max_triangles, float **positions, long *nv, 
     config.vertex_color = false;
     config.mtl_search_path = "";
     tinyobj::ObjReader reader;
-    if (!reader.ParseFromFile(path, config)) {
+    // A file with a comment after a line's content is parsed from its text without comments
+    // (two copies of the text at the peak, this one and the reader's stream's; no material
+    // file read, only the geometry is used); any other from the file itself.
+    std::string text;
+    if (trailing && !uncommented(path, &text)) {
+        if (cap) std::snprintf(msg, cap, "cannot read: %s", std::strerror(errno ? errno : EIO));
+        return ATMOS__OBJ_E_IO;
+    }
+    if (!(trailing ? reader.ParseFromString(text, std::string(), config) : reader.ParseFromFile(path, config))) {
         std::string e = reader.Error();
         while (!e.empty() && (e.back() == '\n' || e.back() == '\r')) e.pop_back();
         if (cap) std::snprintf(msg, cap, "not a valid OBJ file: %s", e.empty() ? "the reader failed" : e.c_str());

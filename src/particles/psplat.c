@@ -151,7 +151,7 @@ static inline __attribute__((always_inline)) void flush(lanes *L, const sp *q, i
  * cut are visited (row_span: a small splat's box is mostly outside its cut), their b^2 laid in
  * a batch of lanes (flush) with the next rows'. A pixel beyond the cut is left as it is, so
  * the spans change no value. */
-__attribute__((target_clones("avx2", "default"))) static void draw(const sp *q, int nw, const atmos_camera *cam, int tx,
+ATMOS_CLONES static void draw(const sp *q, int nw, const atmos_camera *cam, int tx,
                                                                     int ty, atmos_image *img)
 {
     const int x0 = q->bb[0] > tx ? q->bb[0] : tx, x1 = q->bb[1] < tx + TILE ? q->bb[1] : tx + TILE;

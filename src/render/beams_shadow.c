@@ -13,11 +13,7 @@
 #include <string.h>
 
 #define NEAR_M 1e-3
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define BEAMS_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define BEAMS_CLONES
-#endif
+#define BEAMS_CLONES ATMOS_CLONES
 #define SPOT_FRUSTUM_MAX_DEG 60.0
 
 void atmos__beams_shadow_free(atmos__beams_light *l)

@@ -74,9 +74,7 @@ static double sun_coverage(const sky_job *job, int x, int y)
 
 /* A pinhole camera's rays of row y (row_rays), in double precision; built for AVX2 as well as
  * the baseline, where the square roots and divisions go four at a time (the same bits). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+ATMOS_CLONES
 static void pinhole_rays(const atmos_camera *cam, int y, int x0, int count, double sx, double sy, float *dx,
                          float *dy, float *dz, float *w)
 {

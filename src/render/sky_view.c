@@ -101,9 +101,7 @@ static inline float fast_atan2(float y, float x)
 
 /* The table coordinates of the row's pixels: coord[x] the column, coord[count + x] the row within
  * its half, coord[2 count + x] the half (0 the sky, 1 the ground; 2 near the sun). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+ATMOS_CLONES
 static void row_coords(const atmos__sky_view *t, const double base[3], const double right[3], const float *u_of,
                        int count, double cos_near, float *coord)
 {

@@ -15,11 +15,7 @@
 
 #define CH 64 /* samples per chunk: the SoA scratch stays in L1 */
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define SLICE_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define SLICE_CLONES
-#endif
+#define SLICE_CLONES ATMOS_CLONES
 /* The helpers below are inlined into each clone (a helper left out of line would be
  * compiled for the baseline only). */
 #if defined(__GNUC__)

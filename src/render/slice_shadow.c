@@ -124,11 +124,7 @@ static int shadow_build(atmos__slice_plan *sp, int threads)
     return 1;
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define SHADOW_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define SHADOW_CLONES
-#endif
+#define SHADOW_CLONES ATMOS_CLONES
 
 /* What the volume's shadow takes at ns points of a ray, 1 - T_vol, the points' map
  * coordinates (fa, fb: padded texel index, centres at integers; fj: depth node) linear in

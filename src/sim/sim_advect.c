@@ -9,11 +9,7 @@
 #include <math.h>
 #include <string.h>
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define ADV_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define ADV_CLONES
-#endif
+#define ADV_CLONES ATMOS_CLONES
 /* Inlined into each clone (a helper left out of line would be built for the baseline only). The
  * loops over a row run i = 1 .. nx - 2 with i - 1 and i + 1 as they are (so that the compiler
  * vectorises them) and the row's ends wrapped apart. */
@@ -111,7 +107,7 @@ ADV_INLINE void pos_w(const float *restrict u, const float *restrict v, const fl
  * offset for u and w, j - 1's for v), each row's end wrapped apart. A function of its own whose
  * restrict-qualified arrays let the compiler vectorise the loops (inlined, with x, y, z as
  * floats like the fields, it needed too many run-time alias checks and stayed scalar). */
-ADV_CLONES __attribute__((noinline)) static void points(int f, const float *restrict u, const float *restrict v,
+ATMOS_CLONES_NOINLINE static void points(int f, const float *restrict u, const float *restrict v,
                                                         const float *restrict w, size_t r, size_t rn, size_t lev,
                                                         int nx, float fj, float fk, float c, float *restrict x,
                                                         float *restrict y, float *restrict z)

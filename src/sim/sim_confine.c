@@ -8,11 +8,7 @@
 
 #include <math.h>
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define CONF_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define CONF_CLONES
-#endif
+#define CONF_CLONES ATMOS_CLONES
 /* Inlined into each clone (a helper left out of line would be built for the baseline only). */
 #define CONF_INLINE static inline __attribute__((always_inline))
 
@@ -121,7 +117,7 @@ CONF_INLINE void force_cell(const rows *o, size_t n, size_t i, size_t xm, size_t
 
 /* A row's forces (its two ends wrapped apart, the rest vectorised: a function of its own, so
  * that the compiler takes the fields' restrict at its word). */
-CONF_CLONES __attribute__((noinline)) static void force_row(const rows *o, size_t e, float a, float inv2, float zf, FORCE_ARGS)
+ATMOS_CLONES_NOINLINE static void force_row(const rows *o, size_t e, float a, float inv2, float zf, FORCE_ARGS)
 {
     const size_t r = o->r;
     force_cell(o, r, 0, r + e, r + 1, a, inv2, zf, uc, vc, wc, om, fx, fy, fz);

@@ -10,11 +10,7 @@
 
 #include <string.h>
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define MAC_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MAC_CLONES
-#endif
+#define MAC_CLONES ATMOS_CLONES
 
 typedef float v4f __attribute__((vector_size(16)));
 typedef int v4i __attribute__((vector_size(16)));

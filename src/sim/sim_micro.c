@@ -38,11 +38,7 @@ static inline int plus_zero(float f)
     return f == 0 && !signbit(f);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define MICRO_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MICRO_CLONES
-#endif
+#define MICRO_CLONES ATMOS_CLONES
 
 /* A row's vapour times the fixer factor, and which of its cells are not clear, dry air (the
  * cell loop's first test, for the whole row at once: vectorised). */

@@ -17,11 +17,7 @@
 #include <omp.h>
 #include <stdlib.h>
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define PROJ_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define PROJ_CLONES
-#endif
+#define PROJ_CLONES ATMOS_CLONES
 
 atmos_status atmos__sim_fft_init(atmos_context *ctx, atmos_sim *s)
 {

@@ -493,6 +493,11 @@ atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_volume *vol,
     base = base ? base + 1 : json_path;
     size_t stem_len = strlen(base);
     if (stem_len > 5 && !strcasecmp(base + stem_len - 5, ".json")) stem_len -= 5; /* any case, as the CLI's */
+    /* A write killed between staging and renaming (SIGKILL, a power cut) leaves staged files
+     * of these names: removed first, so that this one leaves none, failing or not. */
+    char stale[PATH_CAP];
+    finish_raws(vol, nf, json_path, base, stem_len, 0);
+    if (staged_name(json_path, stale)) remove(stale);
     cJSON *root = cJSON_CreateObject(), *arr;
     if (!root) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", json_path);
     const atmos_volume_desc *d = atmos_volume_get_desc(vol);

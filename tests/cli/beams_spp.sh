@@ -11,13 +11,11 @@ cmp -s "$T/one.pfm" "$T/spp1.pfm" && ok "--spp 1 is the default image" || bad "-
 "$A" render "$S" --width 30 --height 45 --spp 16 --pfm "$T/spp16.pfm" -q 2>"$T/err" || { bad "--spp 16"; cat "$T/err" >&2; }
 "$A" render "$S" --width 120 --height 180 --pfm "$T/big.pfm" -q 2>"$T/err" || bad "the 4x render"
 python3 - "$T/big.pfm" "$T/spp16.pfm" "$T/one.pfm" <<'PY' && ok "--spp 16 = the 4x render box-filtered 4 x 4" || bad "--spp 16 is not the 4 x 4 box filter"
-import struct, sys
-def pfm(p):
-    f = open(p, 'rb'); kind = f.readline().strip(); w, h = map(int, f.readline().split()); s = float(f.readline())
-    c = 3 if kind == b'PF' else 1
-    v = struct.unpack(('<' if s < 0 else '>') + '%df' % (w * h * c), f.read(4 * w * h * c))
-    return w, h, c, v
-W, H, C, big = pfm(sys.argv[1]); w, h, c, aa = pfm(sys.argv[2]); _, _, _, one = pfm(sys.argv[3])
+import sys, pfm
+def pfm4(p):
+    i = pfm.read(p)
+    return i.w, i.h, i.c, i.v
+W, H, C, big = pfm4(sys.argv[1]); w, h, c, aa = pfm4(sys.argv[2]); _, _, _, one = pfm4(sys.argv[3])
 assert (W, H) == (4 * w, 4 * h) and C == c
 worst, diff1 = 0.0, 0.0
 for y in range(h):

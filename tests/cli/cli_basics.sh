@@ -7,6 +7,7 @@
 # result (DESIGN.md §6: bit-identical output for any number of threads).
 # Run by ctest with ATMOS_CLI = the atmos binary and ATMOS_TEST_TMP = a scratch dir.
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 
 cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_basics.$$
@@ -116,17 +117,15 @@ check((w, h) == (64, 32), "PNG is 64x32 (got %dx%d)" % (w, h))
 check(depth in (8, 16) and colour in (2, 6), "PNG is 8/16-bit RGB(A) (depth %d, colour type %d)" % (depth, colour))
 exr = open(T + "/a.exr", "rb").read()
 check(exr[:4] == b"\x76\x2f\x31\x01", "EXR magic 76 2f 31 01")
-pfm = open(T + "/a.pfm", "rb").read()
-parts = pfm.split(b"\n", 3)
-check(parts[0] == b"PF", "PFM is 3-channel 'PF'")
-check(parts[1].split() == [b"64", b"32"], "PFM header says 64 32 (got %r)" % parts[1])
-scale = float(parts[2])
-check(scale < 0, "PFM scale negative (little-endian data), got %g" % scale)
-check(len(parts[3]) == 64 * 32 * 3 * 4, "PFM payload is 64*32*3 floats (%d bytes)" % len(parts[3]))
-import math
-vals = struct.unpack("<%df" % (64 * 32 * 3), parts[3])
-check(all(math.isfinite(v) and v >= 0 for v in vals), "PFM pixels finite and non-negative")
-check(max(vals) > 0, "PFM image is not black")
+import pfm
+img = pfm.read(T + "/a.pfm")
+check(img.kind == "PF", "PFM is 3-channel 'PF'")
+check((img.w, img.h) == (64, 32), "PFM header says 64 32 (got %d %d)" % (img.w, img.h))
+check(img.scale < 0, "PFM scale negative (little-endian data), got %g" % img.scale)
+check(len(img.payload) == 64 * 32 * 3 * 4, "PFM payload is 64*32*3 floats (%d bytes)" % len(img.payload))
+s = pfm.stats(img.v)
+check(s.nonfinite == 0 and s.min >= 0, "PFM pixels finite and non-negative")
+check(s.max > 0, "PFM image is not black")
 sys.exit(bad)
 EOF
 leftover=$(find "$T" -name '*.tmp*' -o -name '.*tmp*' | head -5)

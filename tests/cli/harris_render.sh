@@ -4,6 +4,7 @@
 # pixels and is brighter on its sunlit side than the air beside it, the "harris" section's
 # settings are read and checked, and the renderer refuses a scene without a volume.
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/harris_render.$$
 rm -rf "$T"
@@ -20,14 +21,12 @@ for n in 1 2; do
 done
 cmp -s "$T/h1.pfm" "$T/h2.pfm" && ok "same pixels on 1 and 2 threads" || bad "harris image depends on the thread count"
 python3 - "$T/h1.pfm" <<'PY' && ok "a cloud: finite, covers the middle, not black" || bad "harris image"
-import struct, sys
-d = open(sys.argv[1], "rb").read()
-parts = d.split(b"\n", 3)
-assert parts[0] == b"PF", parts[0]
-w, h = map(int, parts[1].split())
-px = struct.unpack("<%df" % (w * h * 3), parts[3][: w * h * 12])
-import math
-assert all(math.isfinite(v) and v >= 0 for v in px)
+import sys, pfm
+img = pfm.read(sys.argv[1])
+assert img.kind == "PF", img.kind
+w, h, px = img.w, img.h, img.v
+s = pfm.stats(px)
+assert s.nonfinite == 0 and s.min >= 0, s
 lum = [0.2126 * px[3 * i] + 0.7152 * px[3 * i + 1] + 0.0722 * px[3 * i + 2] for i in range(w * h)]
 mid = lum[(h // 2) * w + w // 2]
 assert mid > 0, mid

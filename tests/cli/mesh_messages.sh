@@ -1,7 +1,7 @@
 #!/bin/sh
 # A mesh or terrain file that cannot be read is named by its scene key with the system's
 # reason and, for a relative path, where it was looked for (as a light's image is); an OBJ
-# file's wrong face says what is wrong, as written, and on which line; a folder is a folder.
+# file's wrong face says what is wrong, as written, and on which line; a folder is a folder; a comment after a face is a comment.
 . "$(dirname "$0")/common.inc"
 cd "$T" || exit 1
 mesh_scene() { # mesh_scene MESH TERRAIN
@@ -47,4 +47,8 @@ check "a folder" err7 "/objects/0/mesh" "folder"
 check "max_triangles 1" err9 "/objects/1/terrain" "max_triangles 1"
 grep -q "stride" err9 && bad "max_triangles 1 spoken of as a stride: $(cat err9)"
 "$A" render s.json -o x.png -q 2>err8 && ok "the good mesh renders" || bad "the good mesh: $(cat err8)"
+# comments after a line's content are comments ('#' to the end of the line), not vertex indices
+printf '# a triangle\nv 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nf 1 2 3 # tri\nf 1 2 3#again\n' >comment.obj
+"$A" render s.json -D objects.0.mesh=comment.obj -o x.png -q 2>err10 && [ ! -s err10 ] &&
+    ok "an OBJ file with comments after faces and vertices" || bad "comments after a face: $(cat err10)"
 exit $fail

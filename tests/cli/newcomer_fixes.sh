@@ -7,16 +7,8 @@ hasnt() { grep -qF -- "$2" "$T/err" && { bad "$1: '$2' in:"; sed 's/^/  /' "$T/e
 # pix FILE.pfm X Y: the mean of the first three channels of pixel (X, Y) (Y from the top)
 pix() {
     python3 - "$@" <<'EOF'
-import struct, sys
-f = open(sys.argv[1], "rb")
-kind = f.readline().strip()
-w, h = map(int, f.readline().split())
-scale = float(f.readline())
-c = 3 if kind == b"PF" else 1
-data = f.read()
-x, y = int(sys.argv[2]), int(sys.argv[3])
-at = ((h - 1 - y) * w + x) * c * 4
-v = struct.unpack(("<" if scale < 0 else ">") + "f" * c, data[at:at + 4 * c])
+import sys, pfm
+v = pfm.pixel(pfm.read(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]))
 print(sum(v) / len(v))
 EOF
 }

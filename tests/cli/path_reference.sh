@@ -3,6 +3,7 @@
 # (docs/sky.md, "The reference"). The same bytes on 1 and 2 threads; finite, lit sky and ground;
 # all orders of scattering bring more light than the first alone (--max-depth 1).
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_path_reference.$$
 mkdir -p "$T"
@@ -22,16 +23,16 @@ JSON
 cmp -s "$T/a.pfm" "$T/b.pfm" && ok || bad "1 and 2 threads differ"
 "$A" render -q "$T/s.json" --threads 2 --max-depth 1 --pfm "$T/c.pfm" && ok || bad "render --max-depth 1"
 python3 - "$T/a.pfm" "$T/c.pfm" <<'PY' && ok || bad "image check"
-import math, struct, sys
-def pfm(p):
-    d = open(p, "rb").read()
-    parts = d.split(b"\n", 3)
-    w, h = map(int, parts[1].split())
-    return w, h, struct.unpack("<%df" % (w * h * 3), parts[3][: w * h * 12])
-w, h, a = pfm(sys.argv[1])
-_, _, c = pfm(sys.argv[2])
+import sys, pfm
+def rgb(p):
+    i = pfm.read(p)
+    assert i.c == 3, i.kind
+    return i.w, i.h, i.v
+w, h, a = rgb(sys.argv[1])
+_, _, c = rgb(sys.argv[2])
 assert (w, h) == (16, 8)
-assert all(math.isfinite(x) and x >= 0 for x in a + c), "bad pixel values"
+s = pfm.stats(a + c)
+assert s.nonfinite == 0 and s.min >= 0, "bad pixel values"
 # PFM rows run bottom to top: rows 0-3 look down (the ground), 4-7 up (the sky)
 ground = sum(a[: w * 4 * 3]); sky = sum(a[w * 4 * 3:])
 assert ground > 0 and sky > 0, (ground, sky)

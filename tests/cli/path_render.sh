@@ -3,6 +3,7 @@
 # bytes for 1 and 2 threads (also with --truncate and each --no-* switch), the --variance and --order outputs,
 # --time-budget, bad values.
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_path.$$
 mkdir -p "$T"
@@ -33,19 +34,16 @@ for sw in --no-sky-nee --no-forced --no-aureole; do
 done
 [ -s "$T/var.exr" ] && ok || bad "--variance file not written"
 python3 - "$T/b.pfm" "$T/order.pfm" <<'PY' && ok || bad "image / order check"
-import math, struct, sys
-def pfm(p):
-    d = open(p, "rb").read()
-    parts = d.split(b"\n", 3)
-    c = 3 if parts[0] == b"PF" else 1
-    w, h = map(int, parts[1].split())
-    return w, h, c, struct.unpack("<%df" % (w * h * c), parts[3][: w * h * c * 4])
-w, h, c, img = pfm(sys.argv[1])
+import sys, pfm
+def finite_nonneg(v):
+    s = pfm.stats(v)
+    return s.nonfinite == 0 and s.min >= 0
+i = pfm.read(sys.argv[1]); w, h, c, img = i.w, i.h, i.c, i.v
 assert (w, h, c) == (24, 16, 3), (w, h, c)
-assert all(math.isfinite(x) and x >= 0 for x in img), "bad pixel values"
-w, h, c, o = pfm(sys.argv[2])
+assert finite_nonneg(img), "bad pixel values"
+i = pfm.read(sys.argv[2]); w, h, c, o = i.w, i.h, i.c, i.v
 assert (w, h, c) == (24, 16, 1), (w, h, c)
-assert all(math.isfinite(x) and x >= 0 for x in o), "bad order values"
+assert finite_nonneg(o), "bad order values"
 # the sky pixels carry light that never met the volume (order 0); the cloud's carry more
 assert min(o) == 0 and max(o) >= 1, (min(o), max(o))
 PY

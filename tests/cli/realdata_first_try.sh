@@ -4,6 +4,7 @@
 # it; the WRF file's default render shows its clouds; options of another renderer are
 # refused; the render reports the plan's time, and progress goes to a log off a terminal.
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_realdata.$$
 mkdir -p "$T"
@@ -16,11 +17,8 @@ bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
 # The fraction of pixels whose optical depth exceeds a threshold, from a 1-channel PFM.
 coverage() {
     python3 - "$1" "$2" <<'PY'
-import struct, sys
-d = open(sys.argv[1], "rb").read()
-parts = d.split(b"\n", 3)
-w, h = map(int, parts[1].split())
-v = struct.unpack("<%df" % (w * h), parts[3][: w * h * 4])
+import sys, pfm
+v = pfm.read(sys.argv[1]).v
 print("%.4f" % (sum(1 for x in v if x > float(sys.argv[2])) / len(v)))
 PY
 }

@@ -4,6 +4,7 @@
 # --fov equals -D camera.fov_deg; -D reaches any key with the file's rules; '-' reads the
 # scene from standard input; the default output is named after the scene file.
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_camera.$$
 mkdir -p "$T"
@@ -17,21 +18,17 @@ S="-q --width 24 --height 16 --threads 1"
 "$A" render $S --position 0,1000,0 --look-at 0,1176.3269807,-1000 --pfm "$T/a.pfm" && ok || bad "--position --look-at"
 "$A" render $S --position 0,1000,0 --view-elevation 10 --view-azimuth 0 --pfm "$T/b.pfm" && ok || bad "--view-*"
 python3 - "$T/a.pfm" "$T/b.pfm" <<'PY' && ok || bad "--look-at and --view-elevation/--view-azimuth differ"
-import struct, sys
-def pfm(p):
-    d = open(p, "rb").read(); parts = d.split(b"\n", 3); w, h = map(int, parts[1].split())
-    return struct.unpack("<%df" % (w * h * 3), parts[3][: w * h * 12])
-a, b = pfm(sys.argv[1]), pfm(sys.argv[2])
+import sys, pfm
+a, b = pfm.read(sys.argv[1]).v, pfm.read(sys.argv[2]).v
 assert max(abs(x - y) / max(abs(x), 1e-30) for x, y in zip(a, b)) < 1e-3
 PY
 # looking up and looking down are different views: the zenith sky is bluer than the ground
 "$A" render $S --view-elevation 60 --pfm "$T/up.pfm" && "$A" render $S --view-elevation -60 --pfm "$T/down.pfm" \
     && ok || bad "--view-elevation +-60"
 python3 - "$T/up.pfm" "$T/down.pfm" <<'PY' && ok || bad "looking up is not bluer than looking down"
-import struct, sys
+import sys, pfm
 def ratio(p):
-    d = open(p, "rb").read(); parts = d.split(b"\n", 3); w, h = map(int, parts[1].split())
-    v = struct.unpack("<%df" % (w * h * 3), parts[3][: w * h * 12])
+    v = pfm.read(p).v
     return sum(v[2::3]) / sum(v[0::3])
 assert ratio(sys.argv[1]) > 1.2 * ratio(sys.argv[2]), (ratio(sys.argv[1]), ratio(sys.argv[2]))
 PY

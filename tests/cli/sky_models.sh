@@ -11,6 +11,7 @@
 #    (-100 %) with the sun 6 degrees below the horizon while the reference's twilight sky is
 #    lit, and the same figures with 1 and 2 threads.
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 
 cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
 T=${ATMOS_TEST_TMP:-/tmp}/sky_models.$$
@@ -131,11 +132,9 @@ done
 "$cli" sky --model spherical --table higher_orders_aerosols -o "$T/j.pfm" >/dev/null 2>&1 &&
     [ "$(sed -n 2p "$T/j.pfm")" = "240 640" ] &&
     python3 -c "
-import struct, sys, math
-d = open(sys.argv[1], 'rb').read()
-head = d.split(b'\\n', 3)
-v = struct.unpack('<%df' % (240 * 640 * 3), head[3][:240 * 640 * 3 * 4])
-sys.exit(0 if all(math.isfinite(x) and x > 0 for x in v) and max(v) > 10 * min(v) else 1)
+import sys, pfm
+i = pfm.read(sys.argv[1]); s = pfm.stats(i.v)
+sys.exit(0 if (i.w, i.h, i.c) == (240, 640, 3) and s.nonfinite == 0 and s.min > 0 and s.max > 10 * s.min else 1)
 " "$T/j.pfm" && ok "sky --table higher_orders_aerosols writes J_ms's 240 x 640 image, positive and finite" ||
     bad "sky --table higher_orders_aerosols"
 "$cli" sky --model dobashi --table sun_attenuation -o "$T/gl.png" >/dev/null 2>&1 &&

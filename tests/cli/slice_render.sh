@@ -2,6 +2,7 @@
 # atmos render --volume: the slicing renderer through the CLI. A generated cumulus placed in
 # front of the camera must change the image where it stands and leave the sky elsewhere.
 set -u
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_slice.$$
 mkdir -p "$T"
@@ -17,15 +18,13 @@ bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
     && ok || bad "slice render, 1 thread"
 cmp -s "$T/cloud.pfm" "$T/cloud1.pfm" && ok || bad "1 and 2 threads differ"
 python3 - "$T/sky.pfm" "$T/cloud.pfm" <<'PY' && ok || bad "cloud image check"
-import math, struct, sys
-def pfm(p):
-    d = open(p, "rb").read()
-    parts = d.split(b"\n", 3)
-    w, h = map(int, parts[1].split()); data = parts[3]
-    v = struct.unpack("<%df" % (w * h * 3), data[: w * h * 12])
-    return w, h, v
-w, h, a = pfm(sys.argv[1]); _, _, b = pfm(sys.argv[2])
-assert all(math.isfinite(x) for x in b), "non-finite values"
+import sys, pfm
+def rgb(p):
+    i = pfm.read(p)
+    assert i.c == 3, i.kind
+    return i.w, i.h, i.v
+w, h, a = rgb(sys.argv[1]); _, _, b = rgb(sys.argv[2])
+assert pfm.stats(b).nonfinite == 0, "non-finite values"
 px = lambda v, x, y: v[((h - 1 - y) * w + x) * 3:((h - 1 - y) * w + x) * 3 + 3]
 # the cloud stands near the image centre, just above the horizon; the corners are sky
 changed = sum(1 for x in range(24, 40) for y in range(8, 18) if abs(px(a, x, y)[1] - px(b, x, y)[1]) > 0.02 * px(a, x, y)[1])
@@ -38,17 +37,15 @@ PY
     --tau "$T/tau.pfm" --threads 2 && ok || bad "render --eq24 --tau"
 "$A" compare "$T/eq24.pfm" "$T/cloud.pfm" --by "$T/tau.pfm" --edges 0,0.001,1,1000 --json > "$T/bins.json" && ok || bad "compare --by"
 python3 - "$T/bins.json" "$T/tau.pfm" <<'PY' && ok || bad "tau image / bins check"
-import json, struct, sys
+import json, sys, pfm
 j = json.load(open(sys.argv[1]))
 b = j["bins"]
 assert [x["lo"] for x in b] == [0, 0.001, 1], b
 assert b[0]["pixels"] > 0 and b[0]["rel_rmse"] == 0, b[0]   # no volume on the ray: identical
 assert b[1]["pixels"] + b[2]["pixels"] > 10, b
-d = open(sys.argv[2], "rb").read()
-hdr = d.split(b"\n", 3)
-assert hdr[0] == b"Pf", hdr[0]                                  # one channel
-w, h = map(int, hdr[1].split())
-v = struct.unpack("<%df" % (w * h), hdr[3][: w * h * 4])
+i = pfm.read(sys.argv[2])
+assert i.kind == "Pf", i.kind                                   # one channel
+v = i.v
 assert min(v) == 0 and max(v) > 1, (min(v), max(v))
 PY
 "$A" compare "$T/eq24.pfm" "$T/cloud.pfm" --by "$T/tau.pfm" --edges 1,0 >/dev/null 2>&1; [ $? -eq 2 ] && ok || bad "descending --edges should exit 2"

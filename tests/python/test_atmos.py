@@ -4,6 +4,7 @@ Run by ctest (python.pytest) with PYTHONPATH=python, ATMOS_CLI = the atmos binar
 ATMOS_SOURCE_DIR = the checkout."""
 import os
 import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -13,17 +14,15 @@ import atmos
 
 CLI = os.environ.get("ATMOS_CLI", "atmos")
 SRC = os.environ.get("ATMOS_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "cli"))
+import pfm  # noqa: E402  (tests/cli/pfm.py, the PFM reader the CLI tests share)
 
 
 def read_pfm(path):
-    """A colour PFM read independently of the library: header "PF", size, scale (< 0: little
-    endian), rows bottom to top."""
-    with open(path, "rb") as f:
-        assert f.readline().strip() == b"PF"
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    return data.reshape(h, w, 3)[::-1]
+    """A colour PFM read independently of the library (tests/cli/pfm.py), rows top to bottom."""
+    img = pfm.read(path)
+    assert img.kind == "PF" and len(img.payload) == 12 * img.w * img.h
+    return np.array(img.v, dtype=np.float32).reshape(img.h, img.w, 3)[::-1]
 
 
 def test_version_is_the_cli_version():

@@ -3,6 +3,13 @@
 #include "test.h"
 
 #include <math.h>
+#include <stdlib.h>
+
+static int cmp_float(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
 
 int main(void)
 {
@@ -59,6 +66,35 @@ int main(void)
     CHECK(d.nonfinite == 48 && d.nonfinite_image == 48 && d.nonfinite_reference == 1);
     atmos_image_destroy(x);
     atmos_image_destroy(y);
+    /* the heat map's white: 10 times the 99th percentile of the pixels' differences when the
+     * largest is farther off (five outliers), the percentile found here by sorting */
+    {
+        enum { W = 300, H = 200, N = W * H };
+        atmos_image *r3 = NULL, *i3 = NULL, *h3 = NULL;
+        float *sorted = malloc(sizeof(float) * N);
+        CHECK_OK(atmos_image_create(NULL, W, H, 3, &r3));
+        CHECK_OK(atmos_image_create(NULL, W, H, 3, &i3));
+        if (r3 && i3 && sorted) {
+            for (int p = 0; p < N; p++)
+                for (int c = 0; c < 3; c++) {
+                    r3->pixels[p * 3 + c] = 1;
+                    i3->pixels[p * 3 + c] = 1 + (float)((p * 7919) % 1000) * 1e-5f + (p % 9973 == 5 ? 1000 : 0);
+                }
+            for (int p = 0; p < N; p++) {
+                const double dd = fabs((double)i3->pixels[p * 3] - 1.0);
+                sorted[p] = (float)((dd + dd + dd) / 3);
+            }
+            qsort(sorted, N, sizeof *sorted, cmp_float);
+            const double p99 = sorted[(size_t)floor(0.99 * (N - 1))];
+            CHECK_OK(atmos_image_compare(NULL, i3, r3, &d, &h3));
+            CHECK_MSG(d.heat_scale == 10 * p99, "heat scale %.9g, 10 x the sorted 99th percentile %.9g", d.heat_scale,
+                      10 * p99);
+        }
+        free(sorted);
+        atmos_image_destroy(h3);
+        atmos_image_destroy(i3);
+        atmos_image_destroy(r3);
+    }
     /* size mismatch is an error, not a crash */
     atmos_image *small = NULL;
     CHECK_OK(atmos_image_create(NULL, 4, 4, 4, &small));

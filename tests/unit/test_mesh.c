@@ -207,6 +207,24 @@ static void test_obj(void)
         CHECK(atmos_mesh_intersect(m, o, d, 0, 100, &h) && fabs(h.t - 5) < 1e-9 && h.normal[2] > 0.999);
         atmos_mesh_destroy(m);
     }
+    /* comments after a line's content (OBJ: '#' to the end of the line), the same triangles;
+     * a comment's own '#' after a face's vertices was read as a vertex index */
+    write_file(path, "v 0 0 0 # the origin\nv 2 0 0\nv 2 1 0\t#right\nv 0 1 0\nv 1 0.5 -3\n"
+                     "vn 0 0 1 # up\n"
+                     "f 1//1 2//1 3//1 4//1 # the quad\n"
+                     "f 1 3 5#tri\n"
+                     "# f 1 2 3 4 5\n");
+    m = NULL;
+    CHECK_OK(atmos_mesh_load(ctx, path, 0, &m));
+    if (m) {
+        CHECK(m->vertex_count == 5 && m->triangle_count == 3);
+        CHECK(m->lo[0] == 0 && m->lo[1] == 0 && m->lo[2] == -3 && m->hi[0] == 2 && m->hi[1] == 1 && m->hi[2] == 0);
+        atmos_mesh_destroy(m);
+    }
+    expect_fail("comment_bound.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 # 1 2 3\nf 1 2 3 # 4\n", 1,
+                ATMOS_E_LIMIT, "more than 1 triangles");
+    expect_fail("comment_after.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0 # third\nf 1 2 x # bad\n", 0, ATMOS_E_FORMAT,
+                "line 4: a face's vertex 'x'");
     expect_fail("missing.obj", NULL, 0, ATMOS_E_IO, "missing.obj");
     expect_fail("broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", 0, ATMOS_E_FORMAT, "broken.obj");
     expect_fail("garbage.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x y\n", 0, ATMOS_E_FORMAT, "garbage.obj");

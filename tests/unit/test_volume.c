@@ -8,6 +8,10 @@
 
 #include <dirent.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static uint64_t rng_state = 0x1234567ull;
 static double urand(void)
@@ -362,6 +366,37 @@ static void test_limits_and_errors(atmos_context *ctx)
     atmos_volume_destroy(NULL);
 }
 
+/* Staged files left by a write that was killed before renaming them (their names: the file's
+ * + ".staged"): a later write of the same set removes them first, so that even when it fails
+ * (here at the third field, whose staged name is a folder that cannot be replaced) none is
+ * left. */
+static void test_raw_stale_staged(atmos_context *ctx)
+{
+    const int dims[3] = {5, 4, 3};
+    double rot[9];
+    rot_axis_angle(0, 0, 1, 0, rot);
+    atmos_volume *v = random_volume(ctx, dims, rot, 0.4, 3);
+    if (!v) return;
+    char json[1024], staged_json[1100], raw0[1100], dir2[1100], inner[1200];
+    test_tmp_path(json, sizeof json, "stale.json");
+    const size_t stem = strlen(json) - 5;
+    snprintf(staged_json, sizeof staged_json, "%s.staged", json);
+    snprintf(raw0, sizeof raw0, "%.*s.%s.raw.staged", (int)stem, json, atmos_volume_field_name(v, 0));
+    snprintf(dir2, sizeof dir2, "%.*s.%s.raw.staged", (int)stem, json, atmos_volume_field_name(v, 2));
+    snprintf(inner, sizeof inner, "%s/x", dir2);
+    FILE *f;
+    if ((f = fopen(staged_json, "wb"))) fputs("{\"killed\": true}\n", f), fclose(f);
+    if ((f = fopen(raw0, "wb"))) fputs("partial", f), fclose(f);
+    mkdir(dir2, 0755);
+    if ((f = fopen(inner, "wb"))) fclose(f);
+    CHECK(atmos_volume_write_raw(ctx, v, json) != ATMOS_OK);
+    CHECK_MSG(access(staged_json, F_OK) != 0, "%s left behind", staged_json);
+    CHECK_MSG(access(raw0, F_OK) != 0, "%s left behind", raw0);
+    CHECK_MSG(access(json, F_OK) != 0, "%s written by a failed write", json);
+    remove(inner), rmdir(dir2);
+    atmos_volume_destroy(v);
+}
+
 static void test_raw_roundtrip(atmos_context *ctx)
 {
     const int dims[3] = {19, 7, 12};
@@ -541,6 +576,7 @@ int main(void)
     test_sparse_memory(ctx);
     test_limits_and_errors(ctx);
     test_raw_roundtrip(ctx);
+    test_raw_stale_staged(ctx);
     test_crashers(ctx);
     test_scene_volume(ctx);
     atmos_context_destroy(ctx);
