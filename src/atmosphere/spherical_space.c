@@ -17,7 +17,9 @@
  * Per node and wavelength the table keeps the logarithms of the air's light as the march
  * gives it (Rayleigh and Mie single scattering without their phase functions, the higher
  * orders) and of the view transmittance to the ground: interpolated as logarithms, the
- * exponential fall-offs (the limb's brightness with height, the twilight) stay smooth.
+ * exponential fall-offs (the limb's brightness with height, the twilight) stay smooth. With
+ * cloud spheres the disk's stops are also kept exponentiated, and interpolated as they are
+ * between nodes whose logarithms differ little (smooth_nodes).
  * Per pixel: the ray's node coordinates, the phase functions of its own scattering angle, and
  * on the disk the ground at the ray's own ground point (the maps' albedo and night lights,
  * the sun and the sky there: atmos__sph_ground) seen through the interpolated transmittance,
@@ -65,6 +67,9 @@ struct atmos__sph_space {
                                     owned; NULL: G at each crossing) */
     float *ec;                   /* [m + 1][n][NCS]: the sunlight at each cloud sphere's radius
                                     and the ground's over the sun's cosine (clouds only) */
+    float *lin;                  /* [NG][NA][ns][n][NC]: the disk's stops exponentiated (clouds
+                                    only; smooth_nodes) */
+    unsigned char *smooth;       /* [NG][NA]: 1 where lin may be interpolated (smooth_nodes) */
 };
 
 #define AD 0.3 /* the disk's rows: the linear share of their mapping (above) */
@@ -222,6 +227,36 @@ static void fill_node(const atmos_atmosphere *a, atmos__sph_space *s, const doub
     for (int j = 0; j < ns; j++) put_stop(a, n, &sm, t + (size_t)j * NC * n);
 }
 
+/* With cloud spheres, the disk's stops also exponentiated (lin), and a disk node marked smooth
+ * where none of its logarithms differs by more than DLOG from its neighbours' (the rows and
+ * columns either side): between smooth nodes the values themselves are interpolated, without
+ * an exponential per value and stop, and differ from the exponential of the interpolated
+ * logarithms by at most about DLOG^2 / 8 of the value. Elsewhere (across the terminator,
+ * where the air's light falls off by orders of magnitude over a cell, and at the dark side's
+ * floor) the logarithms are interpolated as on the limb. 0 when out of memory. */
+#define DLOG 0.5f
+static int smooth_nodes(atmos__sph_space *s)
+{
+    const size_t S = (size_t)NC * s->ns * s->n;
+    s->lin = malloc(sizeof(float) * NG * NA * S + NG * NA);
+    if (!s->lin) return 0;
+    s->smooth = (unsigned char *)(s->lin + NG * NA * S);
+    for (size_t j = 0; j < NG * NA * S; j++) s->lin[j] = atmos__expf_fast(s->tab[j]);
+    for (int row = 0; row < NG; row++)
+        for (int col = 0; col < NA; col++) {
+            const float *t = s->tab + ((size_t)row * NA + col) * S;
+            int ok = 1;
+            for (int r = row - 1; r <= row + 1 && ok; r++)
+                for (int c = col - 1; c <= col + 1 && ok; c++) {
+                    if (r < 0 || r >= NG || c < 0 || c >= NA) continue;
+                    const float *u = s->tab + ((size_t)r * NA + c) * S;
+                    for (size_t j = 0; j < S && ok; j++) ok = fabsf(u[j] - t[j]) <= DLOG;
+                }
+            s->smooth[row * NA + col] = (unsigned char)ok;
+        }
+    return 1;
+}
+
 atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const double eye[3], const double sun[3],
                                           atmos__clouds_sun *gs)
 {
@@ -268,6 +303,10 @@ atmos__sph_space *atmos__sph_space_create(const atmos_atmosphere *a, const doubl
     atmos__planet_mie_phase_table(pl, s->n, NPH, s->mie);
 #pragma omp parallel for schedule(dynamic)
     for (int e = 0; e < (NG + NL) * NA; e++) fill_node(a, s, eq, sq, e / NA, e % NA);
+    if (s->ns > 1 && !smooth_nodes(s)) {
+        atmos__sph_space_destroy(s);
+        return NULL;
+    }
     s->keyed = keyed;
     space_frame(s, pl, eye, sun); /* the look-ups in the eye's own frame */
     return s;
@@ -289,7 +328,7 @@ int atmos__sph_space_keep(atmos__sph_space *s, const atmos__planet *pl, const do
 
 void atmos__sph_space_destroy(atmos__sph_space *s)
 {
-    if (s) free(s->tab);
+    if (s) free(s->tab), free(s->lin);
     free(s);
 }
 
@@ -332,13 +371,14 @@ static void ray_node(const atmos__sph_space *s, const double d[3], double p2, no
     c->ay = (float)(fy - iy), c->ax0 = (float)(fx0 - ix0), c->ax1 = (float)(fx1 - ix1);
 }
 
-/* The table's logarithms at a ray's place interpolated into l[NC ns n]. */
-static void node_logs(const atmos__sph_space *s, const node_at *c, float *l)
+/* The table's values at a ray's place interpolated into l[NC ns n]: from tab (logarithms)
+ * or, on the disk, lin (the values). */
+static void node_logs(const atmos__sph_space *s, const float *tab, const node_at *c, float *l)
 {
     const int S = NC * s->ns * s->n;
     const float ay = c->ay, ax0 = c->ax0, ax1 = c->ax1;
-    const float *t00 = s->tab + ((size_t)c->row * NA + c->ix0) * S, *t01 = t00 + S;
-    const float *t10 = s->tab + ((size_t)(c->row + 1) * NA + c->ix1) * S, *t11 = t10 + S;
+    const float *t00 = tab + ((size_t)c->row * NA + c->ix0) * S, *t01 = t00 + S;
+    const float *t10 = tab + ((size_t)(c->row + 1) * NA + c->ix1) * S, *t11 = t10 + S;
     const float w00 = (1 - ay) * (1 - ax0), w01 = (1 - ay) * ax0, w10 = ay * (1 - ax1), w11 = ay * ax1;
     for (int j = 0; j < S; j++) l[j] = w00 * t00[j] + w01 * t01[j] + w10 * t10[j] + w11 * t11[j];
 }
@@ -452,7 +492,7 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
     float lv[BLK * NC * ATMOS_MAX_WAVELENGTHS], G[BLK * ATMOS_MAX_WAVELENGTHS], nu2[BLK], ap[BLK];
     double dd[BLK][3], bb[BLK], pp[BLK];
     node_at nd[BLK];
-    int ip[BLK], idx[BLK], h = 0;
+    int ip[BLK], idx[BLK], lin[BLK], h = 0;
     for (int i = i0; i < i0 + m; i++) {
         if (weight[i] == 0.0f) continue;
         double d[3] = {dx[i], dy[i], dz[i]};
@@ -476,10 +516,17 @@ static void space_block(const atmos__sph_space *s, const atmos_atmosphere *a, co
         ap[r] = fp - ip[r], nu2[r] = nu * nu;
     }
     for (int r = 0; r < h; r++) {
-        node_logs(s, &nd[r], lv + r * S);
-        if (nd[r].disk && !clouds) ground(s, a, sun, dd[r], bb[r], G + r * n);
+        const unsigned char *sm = s->smooth;
+        const node_at *c = &nd[r];
+        lin[r] = clouds && c->disk && sm[c->row * NA + c->ix0] && sm[c->row * NA + c->ix0 + 1] &&
+                 sm[(c->row + 1) * NA + c->ix1] && sm[(c->row + 1) * NA + c->ix1 + 1];
+        node_logs(s, lin[r] ? s->lin : s->tab, c, lv + r * S);
+        if (c->disk && !clouds) ground(s, a, sun, dd[r], bb[r], G + r * n);
     }
-    atmos__expf_fast_array(lv, h * S);
+    if (!clouds) atmos__expf_fast_array(lv, h * S); /* the logarithms' exponentials in one loop */
+    else
+        for (int r = 0; r < h; r++) /* those of the whole ray's stop alone where only it is read */
+            if (!lin[r]) atmos__expf_fast_array(lv + r * S + (nd[r].disk ? 0 : last), nd[r].disk ? S : NC * n);
     for (int r = 0; r < h; r++) {
         float pr[ATMOS_MAX_WAVELENGTHS], pm[ATMOS_MAX_WAVELENGTHS];
         for (int k = 0; k < n; k++) {

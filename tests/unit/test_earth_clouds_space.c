@@ -251,8 +251,10 @@ int main(void)
     CHECK_OK(atmos_atmosphere_create(NULL, &d, &wl, &a));
     check_textures(a, 45, 0.002, 0.06);
     check_textures(a, 5, 0.002, 0.06);
-    check_view(a, 45, 0.003, 0.08);
-    check_view(a, 5, 0.003, 0.08); /* the terminator on the disk */
+    /* (RMS 0.21 %, worst 2.7 % at 45 degrees, 0.19 % and 5.0 % at 5; the table's disk
+     * values interpolated as they are everywhere, not only between smooth nodes: 0.27 %) */
+    check_view(a, 45, 0.0024, 0.08);
+    check_view(a, 5, 0.0024, 0.08); /* the terminator on the disk */
     check_limb(a, 45, 0.004, 0.015);
     check_limb(a, 5, 0.004, 0.015); /* the terminator at the limb */
     check_stops_taken(a);
