@@ -153,7 +153,7 @@ ATMOS_API atmos_status atmos_atmosphere_check_ray(atmos_context *ctx, const atmo
                                                   const double dir[3], const double sun_dir[3]);
 
 /* Distance (m) from p along dir to the ground, or INFINITY if the ray never reaches it
- * (always INFINITY in a vacuum); NaN when p is not finite or dir not a finite unit vector. */
+ * (always INFINITY in a vacuum); NaN when p or dir is not finite. */
 ATMOS_API double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const double p[3],
                                                   const double dir[3]);
 /* Reflectance of the (Lambertian) ground; 0 where there is none. */

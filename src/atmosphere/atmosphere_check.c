@@ -33,6 +33,11 @@ const char *atmos__atm_ray_fault(const atmos_atmosphere *atm, const double p[3],
     return atmos__atm_unit_fault(dir) ? "direction is not a finite unit vector" : NULL;
 }
 
+const char *atmos__atm_finite_fault(const double p[3], const double dir[3])
+{
+    return finite3(p) && finite3(dir) ? NULL : "position or direction is not finite (NaN or infinity)";
+}
+
 const char *atmos__atm_light_fault(const double p[3], const double sun[3])
 {
     if (!finite3(p)) return "position is not finite (NaN or infinity)";

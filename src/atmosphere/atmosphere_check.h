@@ -15,6 +15,9 @@
 const char *atmos__atm_unit_fault(const double dir[3]);
 /* A view ray: p finite and not below the ground (beyond the tolerance), dir a unit vector. */
 const char *atmos__atm_ray_fault(const atmos_atmosphere *atm, const double p[3], const double dir[3]);
+/* p and dir finite (the ground's distance: the renderers also ask it along the zero
+ * direction of a fisheye's pixel outside its circle). */
+const char *atmos__atm_finite_fault(const double p[3], const double dir[3]);
 /* The sunlight at p: p finite (a point below the ground counts as on it), sun a unit vector. */
 const char *atmos__atm_light_fault(const double p[3], const double sun[3]);
 

@@ -81,7 +81,7 @@ static void test_kind(atmos_atmosphere_kind kind, const atmos_wavelengths *wl)
     CHECK(all_nan(E, n));
     atmos_atmosphere_sun_radiance(a, ground, nan3, E);
     CHECK(all_nan(E, n));
-    CHECK(isnan(atmos_atmosphere_ground_distance(a, ground, five)));
+    CHECK(isnan(atmos_atmosphere_ground_distance(a, ground, nan3)));
     CHECK(isnan(atmos_atmosphere_ground_distance(a, nan3, up)));
     /* good rays, a direction normalised in single precision, and an observer within the
      * tolerance below the ground still answer */
