@@ -36,6 +36,9 @@ endif()
 file(RELATIVE_PATH ATMOS_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
 configure_file(${CMAKE_SOURCE_DIR}/cmake/atmos.pc.in ${CMAKE_BINARY_DIR}/atmos.pc @ONLY)
 install(FILES ${CMAKE_BINARY_DIR}/atmos.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+# The build tree's (absolute paths, not installed): PKG_CONFIG_PATH=build finds it before
+# atmos.pc, whose paths are the installed prefix's.
+configure_file(${CMAKE_SOURCE_DIR}/cmake/atmos-uninstalled.pc.in ${CMAKE_BINARY_DIR}/atmos-uninstalled.pc @ONLY)
 
 # Man pages from the CLI's own help text (scripts/make-man.sh, with Debian's help2man).
 add_custom_command(OUTPUT ${CMAKE_BINARY_DIR}/man/atmos.1

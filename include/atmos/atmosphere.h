@@ -139,8 +139,21 @@ ATMOS_API atmos_atmosphere_kind atmos_atmosphere_get_kind(const atmos_atmosphere
 ATMOS_API const atmos_wavelengths *atmos_atmosphere_wavelengths(const atmos_atmosphere *atm);
 ATMOS_API const atmos_atmosphere_desc *atmos_atmosphere_get_desc(const atmos_atmosphere *atm);
 
+/* The questions below that take a point p and directions (dir, sun_dir) answer NaN (every
+ * wavelength of out; an atmos_atmosphere_hit's distance_m NaN, its flags 0) instead of
+ * reading out of their tables when
+ *  - p, dir or sun_dir is not finite, or dir or sun_dir is not a unit vector (|v| within
+ *    1e-6 of 1: normalise first);
+ *  - for a view ray (radiance, transmittance, inscatter) the observer p is more than 1 m below
+ *    the ground (y < 0 over a flat earth) or inside the planet of a spherical kind.
+ * They return void because the renderers call them in their inner loops with checked
+ * input; atmos_atmosphere_check_ray answers ATMOS_E_INVALID_ARG with the reason for the same
+ * rules (sun_dir may be NULL: not checked), for a caller whose input comes from outside. */
+ATMOS_API atmos_status atmos_atmosphere_check_ray(atmos_context *ctx, const atmos_atmosphere *atm, const double p[3],
+                                                  const double dir[3], const double sun_dir[3]);
+
 /* Distance (m) from p along dir to the ground, or INFINITY if the ray never reaches it
- * (always INFINITY in a vacuum). */
+ * (always INFINITY in a vacuum); NaN when p or dir is not finite. */
 ATMOS_API double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const double p[3],
                                                   const double dir[3]);
 /* Reflectance of the (Lambertian) ground; 0 where there is none. */
@@ -150,7 +163,7 @@ ATMOS_API double atmos_atmosphere_ground_albedo(const atmos_atmosphere *atm);
 ATMOS_API void atmos_atmosphere_transmittance(const atmos_atmosphere *atm, const double p[3], const double dir[3],
                                               double distance, double *out);
 /* Solar spectral irradiance on a surface facing the sun at p, attenuated by the air (a point
- * below the ground counts as on it); zero when the sun is on or below the horizon of a flat
+ * below the ground or inside the planet counts as on it); zero when the sun is on or below the horizon of a flat
  * earth. */
 ATMOS_API void atmos_atmosphere_sunlight(const atmos_atmosphere *atm, const double p[3], const double sun_dir[3],
                                          double *out);

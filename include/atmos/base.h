@@ -53,7 +53,10 @@ typedef void (*atmos_log_fn)(void *user, atmos_log_level level, const char *msg)
 
 /* Progress sink for long work. stage names the work ("render", "table ..."),
  * fraction is in [0, 1]. Called from the calling thread only. Return nonzero to
- * cancel: the running function then returns ATMOS_E_CANCELLED. */
+ * cancel: the running function then returns ATMOS_E_CANCELLED. Without one (NULL, the
+ * default) the library is silent while it works, table builds included: a first render
+ * that builds optics tables for many spectral samples (rain's at 16 samples: more than
+ * 10 minutes on two cores) logs nothing until it is done. Set one to show or cancel it. */
 typedef int (*atmos_progress_fn)(void *user, const char *stage, double fraction);
 
 /* Settings for a context; zero means default. */

@@ -87,7 +87,12 @@ ATMOS_API atmos_status atmos_tonemap_into(atmos_context *ctx, const atmos_image 
 ATMOS_API double atmos_srgb_encode(double linear);
 ATMOS_API double atmos_srgb_decode(double encoded);
 
-/* OpenEXR: single-part scanline file, ZIP compression. Channels named by
+/* The writers (atmos_write_exr, _png, _png_level, _pfm) write their own format whatever
+ * the path's extension: atmos_write_exr(ctx, img, "a.png", NULL) writes an EXR named a.png.
+ * Choosing the name is the caller's (the CLI refuses an output whose extension is another
+ * format's).
+ *
+ * OpenEXR: single-part scanline file, ZIP compression. Channels named by
  * channel_names when given (distinct, 1..255 bytes), else R,G,B[,A] for 3/4-channel
  * images and "C0".."Cn" otherwise. half: nonzero for 16-bit half floats, else 32-bit;
  * finite values beyond the largest half (+-65504) are written as +-65504, with a

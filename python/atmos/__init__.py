@@ -12,7 +12,7 @@ takes NumPy arrays in and gives them back; ``mie``, ``phase_table`` and ``sky_ra
 return arrays. Errors raise ``AtmosError`` with atmos's status code and message. Each thread
 has its own context, and the GIL is released while the library works. docs/python.md.
 """
-from atmos._core import AtmosError, version
+from atmos._core import AtmosError, AtmosTypeError, version
 from atmos.image import Image, read_exr
 from atmos.optics import mie, phase_table, refractive_index
 from atmos.render import Plan, render
@@ -21,5 +21,5 @@ from atmos.sky import directions, sky_radiance
 from atmos.volume import Volume
 
 __version__ = version()
-__all__ = ["AtmosError", "Image", "Plan", "Scene", "Volume", "directions", "mie", "phase_table",
+__all__ = ["AtmosError", "AtmosTypeError", "Image", "Plan", "Scene", "Volume", "directions", "mie", "phase_table",
            "read_exr", "refractive_index", "render", "sky_radiance", "version"]

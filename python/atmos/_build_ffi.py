@@ -150,10 +150,12 @@ static atmos_status atmos_py_sky_radiance(atmos_context *ctx, const atmos_scene 
     if (st == ATMOS_OK) st = atmos_scene_atmosphere_create(ctx, scene, &wl, &atm);
     if (st != ATMOS_OK) return st;
     *count = wl.count;
-    for (long i = 0; i < n; i++)
+    for (long i = 0; i < n && st == ATMOS_OK; i++) /* an observer under the ground, a bad direction */
+        st = atmos_atmosphere_check_ray(ctx, atm, position, dirs + 3 * i, sun);
+    for (long i = 0; i < n && st == ATMOS_OK; i++)
         atmos_atmosphere_radiance(atm, position, dirs + 3 * i, sun, out + (size_t)i * wl.count, NULL);
     atmos_atmosphere_destroy(atm);
-    return ATMOS_OK;
+    return st;
 }
 
 /* A field's densities at the voxel centres (world = origin + R (index + 1/2) voxel size), x fastest:

@@ -64,6 +64,11 @@ class AtmosError(RuntimeError):
         super().__init__(f"{message} ({STATUS_NAMES.get(self.status, 'error')}, status {self.status})")
 
 
+class AtmosTypeError(AtmosError, TypeError):
+    """An AtmosError for a scene value of the wrong type ("expected a number, got a string"):
+    also a TypeError, as the package's own checks of arguments raise."""
+
+
 _local = threading.local()
 
 
@@ -81,11 +86,17 @@ def context():
     return ctx
 
 
-def check(status: int, ctx=None) -> None:
-    """Raises AtmosError with the context's message unless status is ATMOS_OK."""
+def check(status: int, ctx=None, types: bool = False) -> None:
+    """Raises AtmosError with the context's message unless status is ATMOS_OK; with types, an
+    AtmosTypeError when the message is the scene reader's about a value's type ("/camera/fov_deg:
+    expected a number, got a string")."""
     if status != lib.ATMOS_OK:
+        import re
         ctx = ctx if ctx is not None else context()
-        raise AtmosError(status, ffi.string(lib.atmos_context_error(ctx)).decode(errors="replace"))
+        msg = ffi.string(lib.atmos_context_error(ctx)).decode(errors="replace")
+        if types and status == lib.ATMOS_E_INVALID_ARG and re.search(r": expected an? [^,]+, got an? [a-z ]+$", msg):
+            raise AtmosTypeError(status, msg)
+        raise AtmosError(status, msg)
 
 
 def version() -> str:

@@ -10,6 +10,10 @@ def _to_srgb(ctx, spectral, wl):
     return out[0]
 
 
+# What Plan.render's camera dict may hold.
+_CAMERA_KEYS = ("position_m", "look_at_m", "up", "fov_deg")
+
+
 def _vector(where: str, value, n: int, integer: bool = False) -> list:
     """n numbers from a sequence, each checked as number() checks one."""
     if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != n:
@@ -116,6 +120,10 @@ class Plan(Owned):
         f = self._frame
         w = "Plan.render"
         if camera:
+            unknown = sorted(str(k) for k in camera if k not in _CAMERA_KEYS)
+            if unknown:  # as a scene's unknown key is refused
+                raise ValueError(f"atmos: {w}: camera: unknown key {unknown[0]!r} "
+                                 f"(known: {', '.join(_CAMERA_KEYS)})")
             for key, field in (("position_m", "position"), ("look_at_m", "look_at"), ("up", "up")):
                 if key in camera:
                     setattr(f.camera, field, _vector(f"{w}: camera {key}", camera[key], 3))

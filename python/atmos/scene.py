@@ -84,7 +84,7 @@ class Scene:
         else:
             raw = self._text.encode()
             st = lib.atmos_scene_parse_with(ctx, raw, len(raw), self._source.encode(), arr, len(keep), out)
-        check(st, ctx)
+        check(st, ctx, types=True)
         return out
 
     @property

@@ -2,6 +2,7 @@
  * passed to its kind (riley.c, homogeneous.c; a vacuum answers here). Kinds are a closed,
  * tagged set: a switch is cheaper than a call through a pointer in the renderers' inner
  * loops and keeps every kind's answers side by side. */
+#include "atmosphere/atmosphere_check.h"
 #include "atmosphere/atmosphere_internal.h"
 #include "atmosphere/planet_clouds.h"
 #include "atmosphere/planet_solver.h"
@@ -67,27 +68,37 @@ int atmos__atm_scatter_point(const atmos_atmosphere *a, const double p[3], const
     }
 }
 
+/* out[0..count-1] = NaN: the answer to a question the public functions refuse
+ * (atmosphere_check.c). */
+static void refuse(const atmos_atmosphere *atm, double *out)
+{
+    for (int i = 0; i < atm->wl.count; i++) out[i] = NAN;
+}
+
 void atmos_atmosphere_transmittance(const atmos_atmosphere *atm, const double p[3], const double dir[3],
                                     double distance, double *out)
 {
-    atmos__atm_transmittance_sub(atm, p, dir, distance, atm->wl.count, NULL, out);
+    if (atmos__atm_ray_fault(atm, p, dir) || isnan(distance)) refuse(atm, out);
+    else atmos__atm_transmittance_sub(atm, p, dir, distance, atm->wl.count, NULL, out);
 }
 
 void atmos_atmosphere_sunlight(const atmos_atmosphere *atm, const double p[3], const double sun_dir[3], double *out)
 {
-    atmos__atm_sunlight_sub(atm, p, sun_dir, atm->wl.count, NULL, out);
+    if (atmos__atm_light_fault(p, sun_dir)) refuse(atm, out);
+    else atmos__atm_sunlight_sub(atm, p, sun_dir, atm->wl.count, NULL, out);
 }
 
 void atmos_atmosphere_inscatter(const atmos_atmosphere *atm, const double p[3], const double dir[3], double distance,
                                 const double sun_dir[3], double *out)
 {
-    atmos__atm_inscatter_sub(atm, p, dir, distance, sun_dir, atm->wl.count, NULL, out);
+    if (atmos__atm_ray_fault(atm, p, dir) || atmos__atm_unit_fault(sun_dir) || isnan(distance)) refuse(atm, out);
+    else atmos__atm_inscatter_sub(atm, p, dir, distance, sun_dir, atm->wl.count, NULL, out);
 }
 
 void atmos_atmosphere_sun_radiance(const atmos_atmosphere *atm, const double p[3], const double sun_dir[3],
                                    double *out)
 {
-    atmos_atmosphere_sunlight(atm, p, sun_dir, out);
+    atmos_atmosphere_sunlight(atm, p, sun_dir, out); /* NaN for what sunlight refuses */
     for (int i = 0; i < atm->wl.count; i++) out[i] /= atm->sun_solid_angle;
 }
 
@@ -212,6 +223,11 @@ static void radiance(const atmos_atmosphere *atm, const double p[3], const doubl
 void atmos_atmosphere_radiance(const atmos_atmosphere *atm, const double p[3], const double dir[3],
                                const double sun_dir[3], double *out, atmos_atmosphere_hit *info)
 {
+    if (atmos__atm_ray_fault(atm, p, dir) || atmos__atm_unit_fault(sun_dir)) {
+        refuse(atm, out);
+        if (info) info->distance_m = NAN, info->hits_ground = 0, info->in_sun_disk = 0;
+        return;
+    }
     radiance(atm, p, dir, sun_dir, 1, out, info);
 }
 

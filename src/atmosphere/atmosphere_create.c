@@ -1,6 +1,7 @@
 /* The atmosphere object (include/atmos/atmosphere.h): its settings, creation, and what every
  * kind shares (the wavelengths' coefficients, the sun, the flat ground). The questions are
  * asked in atmosphere_ask.c. */
+#include "atmosphere/atmosphere_check.h"
 #include "atmosphere/atmosphere_internal.h"
 #include "atmosphere/planet_solver.h"
 
@@ -215,6 +216,7 @@ double atmos_atmosphere_ground_albedo(const atmos_atmosphere *atm)
 /* The ground is the plane y = 0 of a flat earth; a point on or below it looking down is on it. */
 double atmos_atmosphere_ground_distance(const atmos_atmosphere *atm, const double p[3], const double dir[3])
 {
+    if (atmos__atm_finite_fault(p, dir)) return NAN; /* p and dir finite */
     if (atm->desc.kind == ATMOS_ATMOSPHERE_VACUUM) return INFINITY;
     if (atm->planet) return atmos__planet_ground_distance(atm->planet, p, dir);
     const double y = p[1];

@@ -82,6 +82,10 @@ atmos_status atmos__pcloud_from_volume(atmos_context *ctx, const atmos_volume *v
         snprintf(out->particle[fi], sizeof out->particle[fi], "%s", atmos_volume_field_particle(vol, fi));
     }
     int m = h > 0 ? (int)fmax(1.0, floor(h / f.vs + 0.5)) : 1;
+    if (h > 0 && fabs(m * f.vs - h) > 1e-6 * h) /* cells are whole voxels */
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "particles: a spacing of %g m %s the volume's voxel (%g m): the cells are %g m (%d voxel%s)",
+                   h, h < f.vs ? "is below" : "is not a multiple of", f.vs, m * f.vs, m, m > 1 ? "s" : "");
     while (!(h > 0)) { /* coarser cells until the particles fit */
         long total = 0;
         for (int fi = 0; fi < nf; fi++) total += sweep(vol, &f, fi, m, thr[fi], offset, NULL);

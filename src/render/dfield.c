@@ -8,6 +8,8 @@
  * thin (field_fade). */
 #include "render/dfield.h"
 
+#include "atmosphere/atmosphere_check.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -310,6 +312,7 @@ atmos_status atmos__dfield_update(atmos_context *ctx, atmos__dfield *df, const a
     /* the sunlight at the box's centre (the light buffer's per-texel entry points would
      * differ by the air's attenuation across the box) */
     atmos__vol_frame_to_point(df->x, cen, cw);
+    atmos__atm_onto_ground(atm, cw, cw); /* the sky seen from above the ground */
     atmos_atmosphere_sunlight(atm, cw, sun_w, sl);
     atmos__lfield_sun_source(&df->med, lt, sl, field_keep, df, Q, Q1, Ib, threads);
     const atmos__lsource src = {Q, Q1};

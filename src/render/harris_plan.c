@@ -5,6 +5,8 @@
  * upper hemisphere whose colour the atmosphere gives). */
 #include "render/harris_internal.h"
 
+#include "atmosphere/atmosphere_check.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,6 +55,7 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
     double lo[3], hi[3], c[3];
     atmos__pcloud_bounds(&h->pc, lo, hi);
     for (int a = 0; a < 3; a++) c[a] = 0.5 * (lo[a] + hi[a]);
+    atmos__atm_onto_ground(p->atm, c, c); /* the sky seen from above the ground */
     memcpy(h->dir[0], sun, sizeof h->dir[0]);
     atmos_atmosphere_sunlight(p->atm, c, sun, h->e[0]);
     const int sky = p->scene.harris.sky_lights;

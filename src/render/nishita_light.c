@@ -3,6 +3,7 @@
  * the sky and the lit ground as a view ray from the box's centre sees them, the sun's disk
  * left out, it is the sunlight's), the patterns' phase function, and the solve
  * (src/light/nishita_field.c). */
+#include "atmosphere/atmosphere_check.h"
 #include "atmosphere/atmosphere_ops.h"
 #include "core/vec.h"
 #include "render/nishita_internal.h"
@@ -226,6 +227,7 @@ atmos_status atmos__nishita_field_update(atmos_plan *p, const double sun_w[3], c
         !memcmp(np->field_ev, ev, sizeof np->field_ev))
         return ATMOS_OK;
     atmos__vol_frame_to_point(&np->x, cen, cw);
+    atmos__atm_onto_ground(p->atm, cw, cw); /* the sky seen from above the ground */
     double mix[ATMOS_VOLUME_MAX_FIELDS], sl[ATMOS_MAX_WAVELENGTHS];
     mean_mix(np, mix);
     atmos_atmosphere_sunlight(p->atm, cw, sun_w, sl);

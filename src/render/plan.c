@@ -90,14 +90,36 @@ static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
                    atmos_renderer_name(s->renderer), list);
 }
 
+/* A round model without aerosols ("aerosol": "none") reads none of the keys that set their
+ * amount or profile: a scene that sets them is told, as the flat models' are. */
+static void warn_no_aerosol(atmos_context *ctx, const atmos_atmosphere_desc *a, const atmos_atmosphere_desc *d)
+{
+    const char *names[3];
+    int n = 0;
+    if (a->visibility_km != d->visibility_km) names[n++] = "visibility_km";
+    if (a->turbidity != d->turbidity) names[n++] = "turbidity";
+    if (a->aerosol_scale_height_m != d->aerosol_scale_height_m) names[n++] = "aerosol_scale_height_m";
+    char list[100];
+    join_names(names, n, list, sizeof list);
+    if (n)
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "\"aerosol\": \"none\" leaves the air without aerosols: %s set%s nothing (they set the "
+                   "aerosols' amount and height)",
+                   list, n > 1 ? "" : "s");
+}
+
 /* The flat models (riley, homogeneous) read none of the round ones' air (aerosols, ozone, the
  * planet): a scene that sets them is told, not silently given the flat sky. */
 static void warn_unused_air(atmos_context *ctx, const atmos_scene *s)
 {
     const atmos_atmosphere_desc *a = &s->atmosphere;
-    if (a->kind != ATMOS_ATMOSPHERE_RILEY && a->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS) return;
     atmos_atmosphere_desc d;
     atmos_atmosphere_defaults(&d);
+    if (a->kind == ATMOS_ATMOSPHERE_SPHERICAL || a->kind == ATMOS_ATMOSPHERE_DOBASHI) {
+        if (a->aerosol == ATMOS_AEROSOL_NONE) warn_no_aerosol(ctx, a, &d);
+        return;
+    }
+    if (a->kind != ATMOS_ATMOSPHERE_RILEY && a->kind != ATMOS_ATMOSPHERE_HOMOGENEOUS) return;
     const char *names[9];
     int n = 0;
     if (a->aerosol != d.aerosol) names[n++] = "aerosol";

@@ -22,7 +22,7 @@ static void help(void)
            "  --sun-azimuth A      sun azimuth, degrees clockwise from north (default 180)\n"
            "  --view-elevation e   view elevation, degrees [-90, 90]\n"
            "  --view-azimuth a     view azimuth, degrees clockwise from north\n"
-           "  --altitude h         observer altitude, metres >= 0 (default 0)\n"
+           "  --altitude h         observer altitude, metres in [0, 1e8] (default 0)\n"
            "  --distance K         path length, metres > 0 (default: to the ground or to space)\n"
            "  --spectral N         N spectral samples in 380-780 nm (default: rgb = 680, 550, 440 nm)\n"
            "  --albedo R           ground albedo [0, 1] (default 0.1; used when the view hits the ground)\n"
@@ -220,7 +220,8 @@ int cli_cmd_sky(int argc, char **argv)
     if (o.sun_el < -90 || o.sun_el > 90) return cli_usage_error(C, "--sun-elevation: must be in [-90, 90], got %g", o.sun_el);
     if (o.view_el < -90 || o.view_el > 90)
         return cli_usage_error(C, "--view-elevation: must be in [-90, 90], got %g", o.view_el);
-    if (o.alt < 0) return cli_usage_error(C, "--altitude: must be >= 0 metres, got %g", o.alt);
+    if (!(o.alt >= 0 && o.alt <= 1e8)) /* a scene camera's y: atmos render refuses the same */
+        return cli_usage_error(C, "--altitude: must be in [0, 100000000] metres, got %g", o.alt);
     if (!(o.dist > 0)) return cli_usage_error(C, "--distance: must be > 0 metres, got %g", o.dist);
     return sky_view(C, &o);
 }
