@@ -12,7 +12,9 @@
  *     between the planes, m_k of them where f_l could add more than epsilon of the pixel's
  *     unshadowed airlight (Dobashi §4.2.2's criterion, per pixel over all its lights: m_k =
  *     ceil(I_i f_l,k / (epsilon sum_j I_j sum_k f_l,k)) up to max_subplanes, I the lights' mean
- *     intensities), at the midpoints of m_k equal parts;
+ *     intensities), at the midpoints of m_k equal parts; a point light's neighbouring
+ *     intervals each below a quarter of that share one sample while their sum stays below it
+ *     (merged());
  *   - the interval adds I f_h f_l (Eq. 6); an interval along which H cannot change (clear of
  *     every depth the shadow map's tiles there hold, or beyond them all) samples the falloff
  *     alone, or nothing when it is in shadow or inside the inner cone: the value its samples
@@ -46,6 +48,12 @@
 /* A point light's interval of at most this many sub-planes reads them without the tiles' test. */
 #ifndef POINT_READ_MAX
 #define POINT_READ_MAX 3
+#endif
+
+/* A point light's neighbouring intervals whose f_l sum to less than this share of a sub-plane's
+ * (epsilon of the pixel's airlight) share one sample (merged()). */
+#ifndef POINT_MERGE
+#define POINT_MERGE 0.25
 #endif
 
 typedef struct job {
@@ -208,6 +216,59 @@ static int intervals(job *J, int i, const double d[3], double T, double *f, doub
     return S > 0 ? n : 0;
 }
 
+/* Interval k of the intervals f (its f_l > 0) scattered toward the eye, added to *sum: ceil(f_l /
+ * unit) sub-planes, the samples at offset o of their parts. */
+static void interval(job *J, const atmos__beams_ray *ray, const double *f, int k, double unit, double *sum, int centre,
+                     double o)
+{
+    const double fl = f[2 * k + 1];
+    const double need = ceil(fl / unit);
+    const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+    const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
+    double h = 0, same = 0;
+    int full = 0;
+    /* a point light's few samples are read rather than tested: the tiles' test costs more, and
+     * the samples give what it would (each exactly 0 or 1 where it would settle the span) */
+    const int tested = m > 1 && (ray->l->L.type == ATMOS_LIGHT_SPOT || m > POINT_READ_MAX);
+    const int uniform = tested && atmos__beams_ray_uniform(ray, ta, f[2 * k + 2], &same, &full);
+    if (uniform && (full || same == 0)) { /* what every sample would say */
+        *sum += same * fl;
+        return;
+    }
+    if (uniform) /* lit all along: the falloff alone varies */
+        h = atmos__beams_ray_falloff_sum(ray, ta, step, o, m);
+    else if (tested) /* runs of the samples that the tiles prove alike, the rest one by one */
+        h = atmos__beams_ray_light_sum_split(ray, ta, step, o, 0, m);
+    else
+        h = atmos__beams_ray_light_sum(ray, ta, step, o, 0, m);
+    *sum += h / m * fl;
+    if (centre) J->centre_subplanes += m;
+}
+
+/* A point light's intervals from k on (the first's f_l below POINT_MERGE unit) while their f_l
+ * sum stays below POINT_MERGE unit, added to *sum as one sample: the visibility at the point
+ * where the sum reaches o of itself (interpolated within its interval) times the sum. A sample
+ * so carries at most POINT_MERGE epsilon of the pixel's airlight, where a sub-plane carries up to
+ * epsilon (docs/beams.md, *Eleventh round*). Returns the interval after the last taken. */
+static int merged(job *J, const atmos__beams_ray *ray, const double *f, int k, int n, double unit, double *sum,
+                  int centre, double o)
+{
+    double acc = 0;
+    int e = k;
+    while (e < n && acc + f[2 * e + 1] < POINT_MERGE * unit) acc += f[2 * e + 1], e++;
+    double c = o * acc, t = f[2 * e];
+    for (int q = k; q < e; q++) {
+        if (c <= f[2 * q + 1]) {
+            t = f[2 * q] + (f[2 * q + 1] > 0 ? c / f[2 * q + 1] : o) * (f[2 * q + 2] - f[2 * q]);
+            break;
+        }
+        c -= f[2 * q + 1];
+    }
+    *sum += atmos__beams_ray_light(ray, t) * acc;
+    if (centre) J->centre_subplanes++;
+    return e;
+}
+
 /* Light i scattered toward the eye over its n intervals f (their f_l summing to S), added to
  * L: an interval whose f_l exceeds unit (epsilon of the pixel's airlight, in this light's
  * units) gets ceil(f_l / unit) sub-planes; the samples at offset o (0.5: the midpoints) of
@@ -226,33 +287,14 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         tinted(J, l, &ray, d, f, n, unit, L, centre, o);
         return;
     }
-    const int spot = l->L.type == ATMOS_LIGHT_SPOT;
     double sum = 0;
-    for (int k = 0; k < n; k++) {
-        const double fl = f[2 * k + 1];
-        if (fl <= 0) continue;
-        const double need = ceil(fl / unit);
-        const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
-        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
-        double h = 0, same = 0;
-        int full = 0;
-        /* a point light's few samples are read rather than tested: the tiles' test costs more, and
-         * the samples give what it would (each exactly 0 or 1 where it would settle the span) */
-        const int tested = m > 1 && (spot || m > POINT_READ_MAX);
-        const int uniform = tested && atmos__beams_ray_uniform(&ray, ta, f[2 * k + 2], &same, &full);
-        if (uniform && (full || same == 0)) { /* what every sample would say */
-            sum += same * fl;
-            continue;
-        }
-        if (uniform) /* lit all along: the falloff alone varies */
-            h = atmos__beams_ray_falloff_sum(&ray, ta, step, o, m);
-        else if (tested) /* runs of the samples that the tiles prove alike, the rest one by one */
-            h = atmos__beams_ray_light_sum_split(&ray, ta, step, o, 0, m);
+    for (int k = 0; k < n;)
+        if (!(f[2 * k + 1] > 0))
+            k++;
+        else if (l->L.type == ATMOS_LIGHT_POINT && f[2 * k + 1] < POINT_MERGE * unit)
+            k = merged(J, &ray, f, k, n, unit, &sum, centre, o);
         else
-            h = atmos__beams_ray_light_sum(&ray, ta, step, o, 0, m);
-        sum += h / m * fl;
-        if (centre) J->centre_subplanes += m;
-    }
+            interval(J, &ray, f, k++, unit, &sum, centre, o);
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum;
 }
 
