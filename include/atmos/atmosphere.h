@@ -145,7 +145,8 @@ ATMOS_API const atmos_atmosphere_desc *atmos_atmosphere_get_desc(const atmos_atm
  *  - p, dir or sun_dir is not finite, or dir or sun_dir is not a unit vector (|v| within
  *    1e-6 of 1: normalise first);
  *  - for a view ray (radiance, transmittance, inscatter) the observer p is more than 1 m below
- *    the ground (y < 0 over a flat earth) or inside the planet of a spherical kind.
+ *    the ground (y < 0 over a flat earth) or inside the planet of a spherical kind;
+ *  - for transmittance and inscatter, the distance is NaN.
  * They return void because the renderers call them in their inner loops with checked
  * input; atmos_atmosphere_check_ray answers ATMOS_E_INVALID_ARG with the reason for the same
  * rules (sun_dir may be NULL: not checked), for a caller whose input comes from outside. */

@@ -105,11 +105,11 @@ typedef struct atmos_frame {
                                    them when nothing changed): a frame of a view that moves every frame (the
                                    viewer's scripted flights and previews; docs/viewer.md) saves the copy; the
                                    next frame of the same view is then rendered, and kept; 0 keeps it */
+    atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
     int no_check;               /* with no_keep: 1 leaves the check for NaN and infinities to the caller, who
                                    makes the frame's display values with atmos_image_display_checked (the
                                    viewer: one pass over the frame instead of two); 0: atmos_plan_render
                                    refuses such a frame itself (a kept frame is always checked there) */
-    atmos_tonemap_desc tonemap; /* the exposure: used where the image is displayed, not by the renderers */
 } atmos_frame;
 
 /* A rectangle of pixels [x0, x1) x [y0, y1). */

@@ -1,4 +1,5 @@
 """The native module, atmos's errors as exceptions, and one context per thread."""
+import re
 import threading
 
 
@@ -91,7 +92,6 @@ def check(status: int, ctx=None, types: bool = False) -> None:
     AtmosTypeError when the message is the scene reader's about a value's type ("/camera/fov_deg:
     expected a number, got a string")."""
     if status != lib.ATMOS_OK:
-        import re
         ctx = ctx if ctx is not None else context()
         msg = ffi.string(lib.atmos_context_error(ctx)).decode(errors="replace")
         if types and status == lib.ATMOS_E_INVALID_ARG and re.search(r": expected an? [^,]+, got an? [a-z ]+$", msg):

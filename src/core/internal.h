@@ -39,6 +39,8 @@ void *atmos__big_alloc(size_t bytes);
 double atmos__now(void);
 /* The k-th smallest (0: the least) of n floats, none NaN (select.c); reorders v. k < n. */
 float atmos__select_float(float *v, size_t n, size_t k);
+/* The same, the rest of the range sorted after depth partitions (the tests reach the sort). */
+float atmos__select_float_depth(float *v, size_t n, size_t k, int depth);
 /* Indices sorted by a key (keysort.c): ascending, or descending with desc; ties by ascending
  * index, a total order, so the result does not depend on the sort's algorithm. */
 typedef struct atmos__keyed {

@@ -20,9 +20,14 @@ static float median3(float a, float b, float c)
 
 float atmos__select_float(float *v, size_t n, size_t k)
 {
-    size_t lo = 0, hi = n; /* the k-th lies in [lo, hi) */
     int depth = 2;
     for (size_t m = n; m > 1; m >>= 1) depth += 2;
+    return atmos__select_float_depth(v, n, k, depth);
+}
+
+float atmos__select_float_depth(float *v, size_t n, size_t k, int depth)
+{
+    size_t lo = 0, hi = n; /* the k-th lies in [lo, hi) */
     while (hi - lo > 1) {
         if (depth-- == 0) {
             qsort(v + lo, hi - lo, sizeof *v, cmp_float);

@@ -3,6 +3,7 @@
  * cache (three passes over a 1280 x 720 frame took a quarter of the viewer's frame). The
  * per-pixel steps are those of atmos_image_to_srgb_into, atmos_image_gamut_map and
  * atmos_tonemap_into, in the same order: the same bits. */
+#include "core/finite.h"
 #include "core/internal.h"
 #include "image/display_internal.h"
 
@@ -14,14 +15,6 @@
 #include <emmintrin.h>
 #endif
 
-/* 1 for a NaN or an infinity: all exponent bits set. */
-static inline unsigned not_finite(float x)
-{
-    uint32_t u;
-    memcpy(&u, &x, sizeof u);
-    return (u & 0x7f800000u) == 0x7f800000u;
-}
-
 /* One row: spectral pixels src (C channels, n radiance + alpha or not) to linear sRGB + alpha
  * in lin (4 channels), as atmos_image_to_srgb_into does, then gamut mapped. Returns the count of
  * the row's values (every channel) that are NaN or infinite. */
@@ -31,7 +24,7 @@ static unsigned linear_row(const float *src, int width, int C, int n, int has_al
     for (int x = 0; x < width; x++) {
         const float *s = src + (size_t)x * C;
         float r = 0, g = 0, b = 0;
-        for (int i = 0; i < C; i++) bad += not_finite(s[i]);
+        for (int i = 0; i < C; i++) bad += atmos__not_finite(s[i]);
         for (int i = 0; i < n; i++) {
             r += w[i][0] * s[i];
             g += w[i][1] * s[i];
@@ -162,12 +155,8 @@ static atmos_status display_pass(atmos_context *ctx, const atmos_image *spectral
                 b = linear_row(row, W, C, n, has_alpha, (const float(*)[3])w, buf);
             if (b && check) {
                 bad += b;
-                for (size_t i = 0; i < (size_t)W * C; i++)
-                    if (not_finite(row[i])) {
-                        const long long at = (long long)y * W * C + (long long)i;
-                        first = first < at ? first : at;
-                        break;
-                    }
+                const long long at = (long long)y * W * C + (long long)atmos__first_not_finite(row, (size_t)W * C);
+                first = first < at ? first : at;
             }
             atmos__tonemap_row(curve, buf, out, (size_t)W, 4, scale);
             if (disp) stream_row(out, disp->pixels + (size_t)y * W * 4, W);

@@ -159,7 +159,7 @@ int read_obj(const char *path, long max_triangles, float **positions, long *nv, 
     // file read, only the geometry is used); any other from the file itself.
     std::string text;
     if (trailing && !uncommented(path, &text)) {
-        if (cap) std::snprintf(msg, cap, "cannot read: %s", std::strerror(errno ? errno : EIO));
+        if (cap) std::snprintf(msg, cap, "cannot read the file a second time (it changed or went away while read)");
         return ATMOS__OBJ_E_IO;
     }
     if (!(trailing ? reader.ParseFromString(text, std::string(), config) : reader.ParseFromFile(path, config))) {

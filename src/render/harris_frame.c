@@ -49,7 +49,9 @@ static void air(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v
         const double t = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         for (int a = 0; a < 3; a++) d[a] /= t > 0 ? t : 1.0;
         double L[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
-        if (!ap || !atmos__aerial_eval(ap, d, t, L, T)) {
+        if (!(t > 0)) /* a particle at the eye: no air between (a zero direction is refused) */
+            for (int k = 0; k < nw; k++) L[k] = 0, T[k] = 1;
+        else if (!ap || !atmos__aerial_eval(ap, d, t, L, T)) {
             atmos_atmosphere_inscatter(p->atm, v->cam.position, d, t, v->sun, L);
             atmos_atmosphere_transmittance(p->atm, v->cam.position, d, t, T);
         }

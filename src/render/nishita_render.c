@@ -180,15 +180,17 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
     atmos__vol_dir_to_frame(&np->x, v->sun, sun_g);
     atmos__nishita_columns(np, sun_g, threads);
     if (!np->col_valid) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the sunlight");
-    const int use_field = p->scene.nishita.orders > 1 || p->scene.nishita.sky;
+    /* the Monte Carlo field holds every order above the first of the sunlight: it replaces the orders
+     * 2-3, the sky elements and the diffuse field (counted twice otherwise) */
+    const int use_field = !np->mc && (p->scene.nishita.orders > 1 || p->scene.nishita.sky);
     if (use_field && (st = atmos__nishita_field_update(p, v->sun, v->cam.position)) != ATMOS_OK) return st;
     rjob J;
     memset(&J, 0, sizeof J);
-    J.np = np, J.atm = p->atm, J.cam = &v->cam, J.use_field = use_field, J.diffuse = np->diffuse;
+    J.np = np, J.atm = p->atm, J.cam = &v->cam, J.use_field = use_field, J.diffuse = np->diffuse && !np->mc;
     memcpy(J.sun_w, v->sun, sizeof J.sun_w);
     for (int a = 0; a < 3; a++) rel[a] = v->cam.position[a] - np->x.org[a], cen[a] = 0.5 * (np->g.box_lo[a] + np->g.box_hi[a]);
     atmos__vol_dir_to_frame(&np->x, rel, J.eye_g);
-    if (np->diffuse) {
+    if (J.diffuse) {
         int built;
         if ((st = atmos__dfield_update(p->ctx, &np->df, p->atm, v->sun, v->warm_field, 1, &built)) != ATMOS_OK) return st;
         double eu[3]; /* the eye in render-voxel coordinates */

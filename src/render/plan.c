@@ -1,6 +1,7 @@
 /* Plans and frames (include/atmos/plan.h): a scene becomes a plan once (the atmosphere, the
  * volume placed, its optics, each renderer's tables and buffers); a frame becomes a view and
  * is rendered from the plan, redoing only what changed since the last frame. */
+#include "core/finite.h"
 #include "render/plan_internal.h"
 #include "scene/scene_internal.h"
 #include "volume/volume_grid.h"
@@ -350,15 +351,6 @@ static void copy_rect(float *dst, const float *src, int W, int C, const atmos__r
                sizeof(float) * (size_t)(r->x1 - r->x0) * C);
 }
 
-/* 1 for a NaN or an infinity: all exponent bits set (integer operations, so that the loop over
- * a row vectorises: isfinite's did not). */
-static inline unsigned not_finite(float x)
-{
-    uint32_t u;
-    memcpy(&u, &x, sizeof u);
-    return (u & 0x7f800000u) == 0x7f800000u;
-}
-
 /* No valid scene may give a NaN or an infinity (DESIGN §5): a renderer that does has a
  * bug, and an image holding one is refused here, whatever the renderer, rather than
  * written with exit status 0. With keep (a sky, slice, Nishita, Harris or beams frame, not
@@ -389,13 +381,10 @@ static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const at
         const float *row = out->pixels + ((size_t)y * W + r->x0) * C;
         unsigned b = 0;
 #pragma omp simd reduction(+ : b)
-        for (size_t i = 0; i < n; i++) b += not_finite(row[i]);
+        for (size_t i = 0; i < n; i++) b += atmos__not_finite(row[i]);
         if (b) {
-            for (size_t i = 0; i < n; i++)
-                if (!isfinite(row[i])) {
-                    first = first < (long long)y * W * C + (long long)i ? first : (long long)y * W * C + (long long)i;
-                    break;
-                }
+            const long long at = (long long)y * W * C + (long long)atmos__first_not_finite(row, n);
+            first = first < at ? first : at;
             bad += b;
         }
         if (keep) memcpy(p->last_pixels + ((size_t)y * W + r->x0) * C, row, sizeof(float) * n);

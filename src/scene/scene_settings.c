@@ -91,9 +91,10 @@ static const atmos_setting nishita_settings[] = {
      "medium is thick, instead of the orders 2-3 and the sky elements there (docs/lightfield.md); off: "
      "orders 1-3 only, which lose most of the light of dense clouds",
      NISHITA(diffuse)},
-    {"mc_kphotons", "nishita-mc", ATMOS_SETTING_INT, "", 0, 1000000, 0, 0, 0, NULL, 0,
+    {"mc_kphotons", "nishita-mc", ATMOS_SETTING_INT, "", 0, 100000, 0, 0, 0, NULL, 0,
      "diagnostic: orders >= 2 from photons (thousands per wavelength) traced from the sun, the medium "
-     "cut at 3 deg, toward the view's centre (docs/lightfield.md); 0 = off",
+     "cut at 3 deg, toward the eye (see mc_lmax); in place of the orders 2-3, the sky elements and "
+     "the diffuse field, so the sky's light is left out (docs/lightfield.md); 0 = off",
      NISHITA(mc_kphotons)},
     {"mc_cell", "nishita-mc-cell", ATMOS_SETTING_INT, "voxels", 1, 16, 0, 0, 4, NULL, 0,
      "the Monte Carlo field's cell edge, render voxels", NISHITA(mc_cell)},

@@ -115,7 +115,10 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
         atmos_image *ex = test_plan_frame(ctx, &s, v, o);
         s.nishita.mc_kphotons = 0;
         atmos_image *one = test_plan_frame(ctx, &s, v, o);
-        if (!img || !ex || !one) return;
+        if (!img || !ex || !one) {
+            atmos_image_destroy(img), atmos_image_destroy(ex), atmos_image_destroy(one);
+            return;
+        }
         const double ref = ad_up(&r, mus[a]), m = image_mean(img), me = image_mean(ex), m1 = image_mean(one);
         printf("  slab tau %g, view mu %.2f: adding-doubling %.4f; first order %.4f (%+.1f %%), + field toward the "
                "view's centre %.4f (%+.1f %%), + field of degree 3 %.4f (%+.1f %%)\n",
@@ -128,9 +131,9 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
         CHECK(fabs(m1 / ref - 1) > 0.5);
         /* degree 3 (the spherical harmonics of each collision's phase function, HG 0.85: g^l does
          * not fall off by degree 3) is far off in the slab lit from the zenith: measured -18 % and
-         * +19 % (cells of 1 voxel; -35 and +20 % with cells of 2). Checked only for the sign of the error at each view, which is what it shows: too
-         * little of the light turned back toward the sun near it, too much at 53 degrees */
-        CHECK(a == 0 ? m / ref < 0.9 : m / ref > 1.05);
+         * +19 % (cells of 1 voxel; -35 and +20 % with cells of 2). Held within 30 % either way, so
+         * a better field passes and one that loses the light (the first order's -96 %) fails */
+        CHECK(fabs(m / ref - 1) < 0.3);
         atmos_image_destroy(img), atmos_image_destroy(ex), atmos_image_destroy(one);
     }
 }

@@ -42,13 +42,15 @@ int main(void)
             memcpy(sorted, v, n * sizeof *v);
             qsort(sorted, n, sizeof *sorted, cmp_float);
             const size_t ks[] = {0, n / 2, (size_t)(0.99 * (double)(n - 1)), n - 1};
-            for (int j = 0; j < 4; j++) {
+            for (int j = 0; j < 12; j++) { /* then after 0 and 1 partitions, the sort's fallback */
                 memcpy(w, v, n * sizeof *v);
-                const float got = atmos__select_float(w, n, ks[j]);
+                const float got = j < 4 ? atmos__select_float(w, n, ks[j % 4])
+                                        : atmos__select_float_depth(w, n, ks[j % 4], j < 8 ? 0 : 1);
                 runs++;
-                if (got != sorted[ks[j]]) {
+                if (got != sorted[ks[j % 4]]) {
                     bad++;
-                    fprintf(stderr, "kind %d n %zu k %zu: %g, sorted %g\n", kind, n, ks[j], got, sorted[ks[j]]);
+                    fprintf(stderr, "kind %d n %zu k %zu (%d): %g, sorted %g\n", kind, n, ks[j % 4], j / 4, got,
+                            sorted[ks[j % 4]]);
                 }
             }
             free(v), free(w), free(sorted);
