@@ -91,6 +91,26 @@ static inline int test_field_index(const atmos_volume *v, const char *name)
     return -1;
 }
 
+/* A finalized volume of one field (name, particle type) of dims voxels of size vs (m), its corner
+ * at origin (m), the density buf (x fastest, m^-3); NULL (and a failed check) on an error. */
+static inline atmos_volume *test_dense_volume(atmos_context *ctx, const int dims[3], double vs,
+                                              const double origin[3], const char *name, const char *type,
+                                              const float *buf)
+{
+    atmos_volume_desc vd;
+    memset(&vd, 0, sizeof vd);
+    for (int a = 0; a < 3; a++) vd.dims[a] = dims[a], vd.origin_m[a] = origin[a];
+    vd.voxel_size_m = vs;
+    atmos_volume *v = NULL;
+    int f = -1, off[3] = {0, 0, 0}, size[3] = {dims[0], dims[1], dims[2]};
+    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
+    if (!v) return NULL;
+    CHECK_OK(atmos_volume_add_field(ctx, v, name, type, &f));
+    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
+    CHECK_OK(atmos_volume_finalize(ctx, v));
+    return v;
+}
+
 /* One frame of scene s (volume v, optics; the volume where its own coordinates put it, as
  * atmos_render_path does) through a plan made for it, checked; NULL on failure. */
 static inline atmos_image *test_plan_frame(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,

@@ -17,16 +17,6 @@
 static atmos_volume *test_blob(atmos_context *ctx, float peak)
 {
     enum { N = TEST_BLOB_N };
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = vd.dims[1] = vd.dims[2] = N;
-    vd.voxel_size_m = TEST_BLOB_VOX;
-    vd.origin_m[0] = -N * TEST_BLOB_VOX / 2, vd.origin_m[1] = 1500 - N * TEST_BLOB_VOX / 2;
-    vd.origin_m[2] = -1000 - N * TEST_BLOB_VOX / 2;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "cloud", &f));
     static float buf[N * N * N];
     for (int k = 0; k < N; k++)
         for (int j = 0; j < N; j++)
@@ -35,10 +25,9 @@ static atmos_volume *test_blob(atmos_context *ctx, float peak)
                              z = (k + 0.5 - N / 2.0) / (N / 2.0), r2 = x * x + y * y + z * z;
                 buf[(k * N + j) * N + i] = r2 < 0.8 ? (float)(peak * exp(-4 * r2) * (0.8 - r2) / 0.8) : 0.0f;
             }
-    int off[3] = {0, 0, 0}, size[3] = {N, N, N};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
-    CHECK_OK(atmos_volume_finalize(ctx, v));
-    return v;
+    const int dims[3] = {N, N, N};
+    const double org[3] = {-N * TEST_BLOB_VOX / 2, 1500 - N * TEST_BLOB_VOX / 2, -1000 - N * TEST_BLOB_VOX / 2};
+    return test_dense_volume(ctx, dims, TEST_BLOB_VOX, org, "cloud", "cloud", buf);
 }
 
 #endif

@@ -59,18 +59,9 @@ static atmos_volume *ball(atmos_context *ctx, double tau)
                 const double q = (x * x + y * y + z * z) / (R * R);
                 buf[(k * N + j) * N + i] = q < 1 ? (float)(peak * (1 - q) * (1 - q)) : 0.0f;
             }
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = vd.dims[1] = vd.dims[2] = N;
-    vd.voxel_size_m = VS;
-    vd.origin_m[0] = -0.5 * N * VS, vd.origin_m[1] = 1000, vd.origin_m[2] = -0.5 * N * VS;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
-    int off[3] = {0, 0, 0}, size[3] = {N, N, N};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
-    CHECK_OK(atmos_volume_finalize(ctx, v));
+    const int dims[3] = {N, N, N};
+    const double org[3] = {-0.5 * N * VS, 1000, -0.5 * N * VS};
+    atmos_volume *v = test_dense_volume(ctx, dims, VS, org, "cloud", "hg", buf);
     free(buf);
     return v;
 }

@@ -43,18 +43,9 @@ static atmos_volume *slab(atmos_context *ctx)
     for (int k = 0; k < NX; k++)
         for (int j = (NY - NS) / 2; j < (NY + NS) / 2; j++)
             for (int i = 0; i < NX; i++) buf[((size_t)k * NY + j) * NX + i] = (float)(TAU / (SIGMA * VS * NS));
-    atmos_volume_desc vd;
-    memset(&vd, 0, sizeof vd);
-    vd.dims[0] = NX, vd.dims[1] = NY, vd.dims[2] = NX;
-    vd.voxel_size_m = VS;
-    vd.origin_m[0] = -0.5 * NX * VS, vd.origin_m[1] = 1000, vd.origin_m[2] = -0.5 * NX * VS;
-    atmos_volume *v = NULL;
-    CHECK_OK(atmos_volume_create(ctx, &vd, &v));
-    int f = -1;
-    CHECK_OK(atmos_volume_add_field(ctx, v, "cloud", "hg", &f));
-    int off[3] = {0, 0, 0}, size[3] = {NX, NY, NX};
-    CHECK_OK(atmos_volume_set_dense(ctx, v, f, off, size, buf, 1.0f));
-    CHECK_OK(atmos_volume_finalize(ctx, v));
+    const int dims[3] = {NX, NY, NX};
+    const double org[3] = {-0.5 * NX * VS, 1000, -0.5 * NX * VS};
+    atmos_volume *v = test_dense_volume(ctx, dims, VS, org, "cloud", "hg", buf);
     free(buf);
     return v;
 }
