@@ -7,17 +7,8 @@
 # result (DESIGN.md §6: bit-identical output for any number of threads).
 # Run by ctest with ATMOS_CLI = the atmos binary and ATMOS_TEST_TMP = a scratch dir.
 set -u
-PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
-
-cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
-T=${ATMOS_TEST_TMP:-/tmp}/cli_basics.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-fail=0
-
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
+cli=$A
 
 # run NAME WANT_STATUS ARGS... : runs atmos ARGS, stdout/stderr in $T/out, $T/err.
 run() {

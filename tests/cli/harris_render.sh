@@ -4,16 +4,7 @@
 # pixels and is brighter on its sunlit side than the air beside it, the "harris" section's
 # settings are read and checked, and the renderer refuses a scene without a volume.
 set -u
-PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/harris_render.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 
 for n in 1 2; do
     "$A" render --volume generate:cumulus --voxel-size 120 --renderer harris --width 96 --height 64 --fov 14 \

@@ -3,14 +3,7 @@
 # (docs/sky.md, "The reference"). The same bytes on 1 and 2 threads; finite, lit sky and ground;
 # all orders of scattering bring more light than the first alone (--max-depth 1).
 set -u
-PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/cli_path_reference.$$
-mkdir -p "$T"
-export XDG_CACHE_HOME="$T/cache"
-fail=0; pass=0
-ok() { pass=$((pass + 1)); }
-bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
+. "$(dirname "$0")/common.inc"
 cat > "$T/s.json" <<'JSON'
 {"name": "reference sky", "image": {"width": 16, "height": 8},
  "camera": {"type": "equirect", "position_m": [0, 100, 0]},
@@ -38,5 +31,5 @@ ground = sum(a[: w * 4 * 3]); sky = sum(a[w * 4 * 3:])
 assert ground > 0 and sky > 0, (ground, sky)
 assert sum(a) > 1.05 * sum(c), (sum(a), sum(c))
 PY
-echo "path_reference: $pass passed, $fail failed"
+echo "path_reference: $pass passed"
 [ "$fail" -eq 0 ]

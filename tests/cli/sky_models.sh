@@ -11,17 +11,8 @@
 #    (-100 %) with the sun 6 degrees below the horizon while the reference's twilight sky is
 #    lit, and the same figures with 1 and 2 threads.
 set -u
-PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
-
-cli=${ATMOS_CLI:?ATMOS_CLI must name the atmos binary}
-T=${ATMOS_TEST_TMP:-/tmp}/sky_models.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-fail=0
-
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
+cli=$A
 
 q() {
     name=$1

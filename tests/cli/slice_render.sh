@@ -2,14 +2,7 @@
 # atmos render --volume: the slicing renderer through the CLI. A generated cumulus placed in
 # front of the camera must change the image where it stands and leave the sky elsewhere.
 set -u
-PYTHONPATH=$(cd "$(dirname "$0")" && pwd)${PYTHONPATH:+:$PYTHONPATH}; export PYTHONPATH # pfm.py
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/cli_slice.$$
-mkdir -p "$T"
-export XDG_CACHE_HOME="$T/cache"
-fail=0; pass=0
-ok() { pass=$((pass + 1)); }
-bad() { echo "FAIL: $*" >&2; fail=$((fail + 1)); }
+. "$(dirname "$0")/common.inc"
 
 "$A" render -q --width 64 --height 36 --pfm "$T/sky.pfm" || bad "sky render"
 "$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --pfm "$T/cloud.pfm" --threads 2 \
@@ -60,5 +53,5 @@ PY
 "$A" render -q --volume generate:cumulus --eye-scale 1.5 -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--eye-scale 1.5 should exit 2"
 "$A" render -q --volume generate:nope -o "$T/x.png" 2>/dev/null; [ $? -eq 1 ] && ok || bad "unknown generator should exit 1"
 rm -rf "$T"
-echo "slice_render: $pass passed, $fail failed"
+echo "slice_render: $pass passed"
 [ "$fail" -eq 0 ]
