@@ -35,10 +35,10 @@
  * pi_n(-mu) = (-1)^(n+1) pi_n(mu), tau_n(-mu) = (-1)^n tau_n(mu): the terms are
  * accumulated into a part even in mu and a part odd in mu, and S(+-mu) = E +- O.
  */
+#include "core/cmplx.h"
 #include "core/internal.h"
 #include "optics/optics_internal.h"
 
-#include <complex.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -407,8 +407,8 @@ static void set_meta(const atmos_plan *p, const atmos__view *v, double seconds, 
                                         "path (spectral Monte Carlo volumetric path tracing)",
                                         "nishita (Nishita et al. 1996, orders 1-3 and sky light by a light field)",
                                         "harris (Harris 2002, particle clouds: multiple forward scattering, splats)",
-                                        "beams (Dobashi et al. 2002, light beams: sampling planes, pre-integrated table, "
-                                        "sub-planes, shadow maps)"};
+                                        ("beams (Dobashi et al. 2002, light beams: sampling planes, pre-integrated table, "
+                                         "sub-planes, shadow maps)")};
     char buf[384];
     double el = 0, az = 0;
     atmos_direction_to_angles(v->sun, &el, &az);

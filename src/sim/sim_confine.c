@@ -34,7 +34,7 @@ static rows rows_of(const atmos_sim *s, int j, int k)
 }
 
 /* The velocity at the cell centres of level k. */
-CONF_CLONES static void centres(atmos_sim *s, int k, float *restrict uc, float *restrict vc, float *restrict wc)
+CONF_CLONES static void velocity_centres(atmos_sim *s, int k, float *restrict uc, float *restrict vc, float *restrict wc)
 {
     const int nx = s->nx;
     const size_t lev = (size_t)nx * s->ny;
@@ -166,7 +166,7 @@ void atmos__sim_confine(atmos_sim *s, double dt)
     const int nz = s->nz;
     float *const f[7] = {s->s[0], s->s[1], s->s[2], s->s[3], s->s[4], s->s[5], s->s[6]};
     SIM_FOR
-    for (int k = 0; k < nz; k++) centres(s, k, f[0], f[1], f[2]);
+    for (int k = 0; k < nz; k++) velocity_centres(s, k, f[0], f[1], f[2]);
     atmos__sim_sync(s);
     SIM_FOR
     for (int k = 0; k < nz; k++) vorticity(s, k, f);

@@ -12,9 +12,8 @@
  * and are skipped.
  */
 #include "atmos/atmos.h"
+#include "core/cmplx.h"
 #include "test.h"
-
-#include <complex.h>
 
 #define MAXROWS 4096
 #define MAXANG 64

@@ -1,6 +1,7 @@
 /* The parser fence (src/volume/reader_fence.c): a load that crashes, runs away with memory
  * or fails in the child process becomes an error naming the file in the parent; a load that
  * succeeds comes back voxel for voxel, with the child's log messages. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, kill */
 #include "atmos/atmos.h"
 #include "test.h"
 #include "core/internal.h"
