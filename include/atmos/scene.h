@@ -232,6 +232,8 @@ typedef struct atmos_scene_animation {
     int minutes_end_set;       /* 1: minutes_end given (a simulated volume: a time-lapse) */
     double minutes_end;        /* the last frame's simulated minutes; frame i's volume.sim_minutes goes
                                   linearly from the volume's (its preset's default when 0) to this */
+    int exposure_per_frame;    /* 1: "exposure": "per_frame", an automatic exposure chosen for each
+                                  frame; 0: "locked" (default), the first frame's for all */
 } atmos_scene_animation;
 
 /* The Earth's maps and clouds of a spherical atmosphere ("atmosphere" keys "ground_map",

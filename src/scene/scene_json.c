@@ -604,7 +604,7 @@ static atmos_status parse_output(const jp *p, const cJSON *j, const char *path, 
     const cJSON *v;
     int k, e, manual = -1;
     double ev = 0.0, comp = 0.0;
-    TRY(iter_begin(p, j, path, keys, 5, &it));
+    TRY(iter_begin(p, j, path, keys, 6, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -1256,7 +1256,9 @@ static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atm
 
 static atmos_status parse_animation(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
-    static const char *const keys[] = {"frames", "time_end", "elevation_end_deg", "azimuth_end_deg", "minutes_end"};
+    static const char *const keys[] = {"frames",      "time_end", "elevation_end_deg", "azimuth_end_deg",
+                                       "minutes_end", "exposure"};
+    static const char *const exposures[] = {"locked", "per_frame"};
     static const atmos__range r_minutes = {0, ATMOS_SIM_MAX_MINUTES, 1, 0};
     /* 0 and 1: a single image (0 = no animation, include/atmos/scene.h), so -D animation.frames=0
      * turns a scene's animation off */
@@ -1268,12 +1270,13 @@ static atmos_status parse_animation(const jp *p, const cJSON *j, const char *pat
     const cJSON *v;
     const char *text = NULL;
     int k;
-    TRY(iter_begin(p, j, path, keys, 5, &it));
+    TRY(iter_begin(p, j, path, keys, 6, &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
         switch (k) {
         case 0: TRY(get_int(p, v, ip, &r_frames, &a.frames)); break;
+        case 5: TRY(get_enum(p, v, ip, exposures, 2, &a.exposure_per_frame)); break;
         case 4:
             TRY(get_number(p, v, ip, &r_minutes, NULL, &a.minutes_end));
             a.minutes_end_set = 1;

@@ -154,8 +154,10 @@ wait $pid; rc=$?
     && ok || bad "animation"
 "$A" render -q --width 48 --height 27 --frames 5 --sun-elevation 12 --sun-elevation-end -1 -o "$T/pf/s.png" \
     --exposure-per-frame && ok || bad "animation --exposure-per-frame"
+"$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/pk/s.png" -D animation.frames=5 \
+    -D animation.elevation_end_deg=-1 -D animation.exposure=per_frame && ok || bad "animation, the scene's exposure per_frame"
 "$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/one.png" && ok || bad "single render"
-python3 - "$T/an" "$T/pf" "$T/one.png" <<'PY' && ok || bad "exposure over the animation"
+python3 - "$T/an" "$T/pf" "$T/one.png" "$T/pk" <<'PY' && ok || bad "exposure over the animation"
 import os, struct, sys, zlib
 def mean(path):
     b = open(path, "rb").read()
@@ -192,6 +194,9 @@ assert all(b < a for a, b in zip(locked, locked[1:])), "not darker frame by fram
 assert locked[3] < 0.75 * locked[0], "frame 4 is nearly as bright as frame 1: re-exposed"
 assert mean(sys.argv[3]) == locked[0] == free[0], "the first frame is not exposed as a single render"
 assert free[3] > 1.5 * locked[3], "--exposure-per-frame does not re-expose"
+# The scene's key "animation": {"exposure": "per_frame"} is the option's scene form.
+keyed = [mean(os.path.join(sys.argv[4], "s_%04d.png" % k)) for k in range(1, 6)]
+assert keyed == free, "animation.exposure=per_frame differs from --exposure-per-frame: %s" % keyed
 PY
 
 rm -rf "$T"

@@ -436,6 +436,8 @@ static const bad_case bad_animation[] = {
     {"{\"sun\": {\"time\": \"2026-06-21T12:00:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105}, \"animation\": {\"frames\": 4, \"elevation_end_deg\": 3}}",
      ATMOS_E_INVALID_ARG, "/animation/elevation_end_deg: needs a sun given by angles", NULL},
     {"{\"animation\": {\"frames\": 4, \"azimuth_end_deg\": 360}}", ATMOS_E_INVALID_ARG, "/animation/azimuth_end_deg: must be in [0, 360)", NULL},
+    {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": 3, \"exposure\": \"auto\"}}", ATMOS_E_INVALID_ARG,
+     "/animation/exposure: must be one of locked, per_frame, got \"auto\"", NULL},
     {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": -91}}", ATMOS_E_INVALID_ARG, "/animation/elevation_end_deg: must be in [-90, 90]", NULL},
     {"{\"image\": {\"width\": 10}} \x01", ATMOS_E_FORMAT, "control character", NULL},
 };
@@ -713,6 +715,7 @@ static void test_animation(void)
     CHECK_OK(parse("{\"sun\": {\"time\": \"2026-06-30T23:00:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105},"
                    " \"animation\": {\"frames\": 5, \"time_end\": \"2026-07-01T01:00:00Z\"}}", &s));
     CHECK(s.animation.frames == 5 && s.animation.time_end_set && !s.animation.elevation_end_set);
+    CHECK(s.animation.exposure_per_frame == 0); /* "exposure": "locked" unless told */
     CHECK_OK(atmos_scene_animation_frame(ctx, &s, 0, &f));
     CHECK(f.sun.time.day == 30 && f.sun.time.hour == 23 && f.sun.time.minute == 0 && f.animation.frames == 0);
     CHECK_OK(atmos_scene_animation_frame(ctx, &s, 1, &f));
@@ -727,6 +730,12 @@ static void test_animation(void)
     CHECK_OK(atmos_scene_validate(ctx, &f, "frame"));
     CHECK(atmos_scene_animation_frame(ctx, &s, 5, &f) == ATMOS_E_INVALID_ARG);
     CHECK(atmos_scene_animation_frame(ctx, &s, -1, &f) == ATMOS_E_INVALID_ARG);
+    CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 5, \"azimuth_deg\": 90},"
+                   " \"animation\": {\"frames\": 2, \"elevation_end_deg\": 1, \"exposure\": \"per_frame\"}}", &s));
+    CHECK(s.animation.exposure_per_frame == 1);
+    CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 5, \"azimuth_deg\": 90},"
+                   " \"animation\": {\"frames\": 2, \"elevation_end_deg\": 1, \"exposure\": \"locked\"}}", &s));
+    CHECK(s.animation.exposure_per_frame == 0);
     /* Across a year end, backwards in time. */
     CHECK_OK(parse("{\"sun\": {\"time\": \"2027-01-01T00:30:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105},"
                    " \"animation\": {\"frames\": 2, \"time_end\": \"2026-12-31T23:30:00Z\"}}", &s));

@@ -363,7 +363,7 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
 {
     frames_run r = {ctx, o, png, source, prog, fo, d, scene->animation.frames > 1 ? scene->animation.frames : 1,
                     png ? cli_file_kind_of(png) : CLI_FILE_OTHER, {0, 0, 0}, NULL, 0};
-    r.xl.lock = r.nframes > 1 && !o->exposure_per_frame;
+    r.xl.lock = r.nframes > 1 && !o->exposure_per_frame && !scene->animation.exposure_per_frame;
     atmos_status st = ATMOS_OK;
     if (d->rank == 0 && cli_outputs_hold_reserve(r.nframes * 6) != 0)
         return fprintf(stderr, "atmos render: out of memory for the frames' names\n"), ATMOS_E_IO;
