@@ -83,6 +83,11 @@ int atmos__clouds_sun_same(const atmos__clouds_sun *s, const double sun[3]);
  * differ by more than 0.05 (a sharp edge between them) one step down from the sphere above
  * at x itself; outside the grid's box atmos__clouds_sun_attenuation itself. */
 double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon);
+/* The same for a point seen through clouds that pass `through` of its light (in (0, 1]): an
+ * error e of G reaches the eye as through e, so the look-up (and its steps down) interpolates
+ * over four texels that differ by up to 0.05 / through before it steps down. */
+double atmos__clouds_sun_lookup_through(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon,
+                                        double through);
 /* The world-frame point at radius r from the planet's centre over lat, lon (degrees). */
 void atmos__clouds_geo_point(const atmos__planet *pl, double r, double lat_deg, double lon_deg, double x[3]);
 

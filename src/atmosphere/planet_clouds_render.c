@@ -79,14 +79,13 @@ static double hg(double g, double cos_theta)
 }
 
 /* The sunlight E at x of radius index j (sphere j, or the ground for j = m) whose sun's cosine
- * is mus: from the table e when given (linear in mus), else the solver's. Inline in its
- * callers (the compiler left it a call: a few per cent of the frame). */
-static inline __attribute__((always_inline)) void sunlight_at(const atmos_atmosphere *a,
+ * is mus, n wavelengths: from the table e when given (linear in mus), else the solver's.
+ * Inline in its callers (the compiler left it a call: a few per cent of the frame). */
+static inline __attribute__((always_inline)) void sunlight_at(const atmos_atmosphere *a, int n,
                                                               const atmos__sunlight_table *e, int j,
                                                               const double x[3], const double sun[3],
                                                               double mus, double *E)
 {
-    const int n = a->wl.count;
     if (!e) {
         a->solver->sunlight(a, x, sun, n, NULL, E);
         return;
@@ -104,19 +103,21 @@ static inline __attribute__((always_inline)) void sunlight_at(const atmos_atmosp
  * (times the transmittance w in front of it): t the crossing's transmittance, mus the sun's
  * cosine to the vertical there, eo = exp(-own / 2) with own the whole shell's optical depth
  * along the sun (used when mus > 0). G from gs's textures, or evaluated here when gs is NULL;
- * ph the phase function of the ray's scattering angle, e the sunlight's table or NULL. */
-static void crossing_shade(const atmos_atmosphere *a, const double x[3], const double sun[3], double lat, double lon,
-                           int i, double t, double mus, double eo, double ph, const double *w, atmos__clouds_sun *gs,
-                           const atmos__sunlight_table *e, double *out)
+ * ph the phase function of the ray's scattering angle, e the sunlight's table or NULL; n the
+ * wavelengths (inline, so that a constant n unrolls its loops). */
+static inline __attribute__((always_inline)) void
+crossing_shade(const atmos_atmosphere *a, int n, const double x[3], const double sun[3], double lat, double lon, int i,
+               double t, double mus, double eo, double ph, const double *w, double through, atmos__clouds_sun *gs,
+               const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
-    const int n = a->wl.count;
     double E[ATMOS_MAX_WAVELENGTHS];
-    sunlight_at(a, e, i, x, sun, mus, E);
+    sunlight_at(a, n, e, i, x, sun, mus, E);
     int lit = 0;
     for (int k = 0; k < n; k++) lit |= E[k] > 0;
     if (!lit) return;
-    const double G = gs ? atmos__clouds_sun_lookup(gs, x, i, lat, lon) : atmos__clouds_sun_attenuation(pl, x, sun, i);
+    const double G = gs ? atmos__clouds_sun_lookup_through(gs, x, i, lat, lon, through)
+                       : atmos__clouds_sun_attenuation(pl, x, sun, i);
     double J = G * ph;
     if (!pl->clouds->single && mus > 0) J += mus * (1.0 - G * eo) * (1.0 / ATMOS_PI);
     for (int k = 0; k < n; k++) out[k] += w[k] * (1.0 - t) * J * E[k];
@@ -125,7 +126,7 @@ static void crossing_shade(const atmos_atmosphere *a, const double x[3], const d
 /* The ground at distance K: lit by the sunlight through the air and the clouds, and its
  * lights; times w. */
 static void ground_light(const atmos_atmosphere *a, const double p[3], const double d[3], double K,
-                         const double sun[3], const double *w, atmos__clouds_sun *gs,
+                         const double sun[3], const double *w, double through, atmos__clouds_sun *gs,
                          const atmos__sunlight_table *e, double *out)
 {
     const atmos__planet *pl = a->planet;
@@ -136,11 +137,11 @@ static void ground_light(const atmos_atmosphere *a, const double p[3], const dou
     double E[ATMOS_MAX_WAVELENGTHS];
     double G = 0.0;
     if (cs > 0) {
-        sunlight_at(a, e, pl->clouds->m, g, sun, cs, E);
+        sunlight_at(a, n, e, pl->clouds->m, g, sun, cs, E);
         if (gs) {
             double lat, lon;
             atmos__planet_latlon_fast(pl, g, &lat, &lon);
-            G = atmos__clouds_sun_lookup(gs, g, -1, lat, lon);
+            G = atmos__clouds_sun_lookup_through(gs, g, -1, lat, lon, through);
         } else G = atmos__clouds_sun_attenuation(pl, g, sun, -1);
     }
     for (int k = 0; k < n; k++) {
@@ -190,7 +191,7 @@ static void radiance_clouds(const atmos_atmosphere *a, const double p[3], const 
         /* the air of the segment, seen through everything in front of it */
         if (seg > 0) air_segment(a, air, x, d, seg, j > 0 && j < nc, !(j < nc || K < INFINITY), sun, w, out);
         if (j == nc) {
-            if (K < INFINITY) ground_light(a, p, d, K, sun, w, NULL, NULL, out);
+            if (K < INFINITY) ground_light(a, p, d, K, sun, w, 1.0, NULL, NULL, out);
             break;
         }
         for (int i = 0; i < 3; i++) x[i] = p[i] + t_end * d[i];
@@ -205,7 +206,7 @@ static void radiance_clouds(const atmos_atmosphere *a, const double p[3], const 
             const double mus = atmos__dot3(xc, sun) * cl->inv_r[i];
             tc = atmos__expf_fast((float)-atmos__clouds_shell_tau(cl, i, col, atmos__dot3(xc, d) * cl->inv_r[i]));
             const double eo = atmos__expf_fast((float)(-0.5 * atmos__clouds_shell_tau(cl, i, col, mus)));
-            crossing_shade(a, x, sun, lat, lon, i, tc, mus, eo, ph, w, NULL, NULL, out);
+            crossing_shade(a, n, x, sun, lat, lon, i, tc, mus, eo, ph, w, 1.0, NULL, NULL, out);
         }
         clouds *= tc;
         for (int k = 0; k < n; k++) w[k] *= tc;
@@ -248,6 +249,36 @@ static void crossing_fields(const atmos__planet *pl, const double d[3], const do
     atmos__expf_fast_array(ex, 2 * m);
 }
 
+/* The compositing of a ray's m crossings (their fields prepared by atmos__clouds_radiance_stops)
+ * on the air's stops Lc, Tc, front to back, and the ground behind them; n the wavelengths
+ * (inline: a constant n unrolls the loops over them). */
+static inline __attribute__((always_inline)) void
+composite(const atmos_atmosphere *a, int n, const double p[3], const double d[3], const double sun[3], double K,
+          const double *Lc, const double *Tc, atmos__clouds_sun *gs, const atmos__sunlight_table *e, int m,
+          const crossing *c, const double x[][3], const double *lat, const double *lon, const double *col,
+          const double *mus, const float *ex, double ph, double *out)
+{
+    double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
+    for (int k = 0; k < n; k++) out[k] = 0.0;
+    for (int j = 0; j <= m; j++) {
+        /* the air between stop j - 1 and stop j as the eye sees it, through the clouds */
+        for (int k = 0; k < n; k++) { /* a select, not the library's fmax */
+            const double dl = Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0);
+            out[k] += clouds * (dl > 0.0 ? dl : 0.0);
+        }
+        for (int k = 0; k < n; k++) w[k] = clouds * Tc[(size_t)j * n + k];
+        if (j == m) {
+            ground_light(a, p, d, K, sun, w, clouds, gs, e, out);
+            break;
+        }
+        if (col[j] <= 0) continue;
+        const double t = ex[j];
+        crossing_shade(a, n, x[j], sun, lat[j], lon[j], c[j].sphere, t, mus[j], ex[m + j], ph, w, clouds, gs, e, out);
+        clouds *= t;
+        if (clouds < OPAQUE) break;
+    }
+}
+
 int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], const double d[3], const double sun[3],
                                  const double *Lc, const double *Tc, atmos__clouds_sun *gs,
                                  const atmos__sunlight_table *e, double *out)
@@ -268,26 +299,11 @@ int atmos__clouds_radiance_stops(const atmos_atmosphere *a, const double p[3], c
     double mus[MAX_CROSSINGS];
     float ex[2 * MAX_CROSSINGS];
     crossing_fields(pl, d, sun, m, c, x, col, mus, ex);
-    double w[ATMOS_MAX_WAVELENGTHS], clouds = 1.0;
     const double ph = hg(pl->clouds->g, atmos__dot3(d, sun));
-    for (int k = 0; k < n; k++) out[k] = 0.0;
-    for (int j = 0; j <= m; j++) {
-        /* the air between stop j - 1 and stop j as the eye sees it, through the clouds */
-        for (int k = 0; k < n; k++) { /* a select, not the library's fmax */
-            const double dl = Lc[(size_t)j * n + k] - (j ? Lc[(size_t)(j - 1) * n + k] : 0.0);
-            out[k] += clouds * (dl > 0.0 ? dl : 0.0);
-        }
-        for (int k = 0; k < n; k++) w[k] = clouds * Tc[(size_t)j * n + k];
-        if (j == m) {
-            ground_light(a, p, d, K, sun, w, gs, e, out);
-            break;
-        }
-        if (col[j] <= 0) continue;
-        const double t = ex[j];
-        crossing_shade(a, x[j], sun, lat[j], lon[j], c[j].sphere, t, mus[j], ex[m + j], ph, w, gs, e, out);
-        clouds *= t;
-        if (clouds < OPAQUE) break;
-    }
+    if (n == 3) /* rgb: the compositing's loops over the wavelengths unrolled */
+        composite(a, 3, p, d, sun, K, Lc, Tc, gs, e, m, c, x, lat, lon, col, mus, ex, ph, out);
+    else
+        composite(a, n, p, d, sun, K, Lc, Tc, gs, e, m, c, x, lat, lon, col, mus, ex, ph, out);
     return 1;
 }
 

@@ -9,8 +9,9 @@
  * texel's value does not depend on who fills it, so the image does not depend on the
  * threads. A look-up whose four texels differ by more than SPREAD takes one step down from
  * the sphere above at the point itself instead of interpolating across the sharp edge that
- * runs between them (step_down). Points outside the box get atmos__clouds_sun_attenuation
- * itself. */
+ * runs between them (step_down); a point seen through clouds that pass c of its light allows
+ * SPREAD / c, and so do its steps down (atmos__clouds_sun_lookup_through). Points outside
+ * the box get atmos__clouds_sun_attenuation itself. */
 #include "atmosphere/planet_clouds.h"
 
 #include <sched.h>
@@ -95,9 +96,10 @@ void atmos__clouds_geo_point(const atmos__planet *pl, double r, double lat_deg, 
 }
 
 /* G at p (on the sphere below sphere `above`, or the ground) from the sphere above: G there
- * at the point y where p's ray to the sun crosses it (looked up) times that crossing's
- * transmittance. */
-static double step_down(atmos__clouds_sun *s, const double p[3], int above)
+ * at the point y where p's ray to the sun crosses it (looked up, interpolating over a spread
+ * of up to tol) times that crossing's transmittance. */
+static double lookup_tol(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon, float tol);
+static double step_down(atmos__clouds_sun *s, const double p[3], int above, float tol)
 {
     const atmos__planet *pl = s->pl;
     const atmos__clouds *cl = pl->clouds;
@@ -107,7 +109,7 @@ static double step_down(atmos__clouds_sun *s, const double p[3], int above)
     double la, lo;
     atmos__planet_latlon_fast(pl, q, &la, &lo);
     const double col = atmos__clouds_column_tau(cl, la, lo);
-    const double G = atmos__clouds_sun_lookup(s, q, above, la, lo);
+    const double G = lookup_tol(s, q, above, la, lo, tol);
     /* q is on sphere `above`: its vertical is (q + centre) / r, without a square root */
     const double mu = (q[0] * s->sun[0] + (q[1] + pl->r_ground) * s->sun[1] + q[2] * s->sun[2]) * cl->inv_r[above];
     return col > 0 ? G * atmos__expf_fast((float)-atmos__clouds_shell_tau(cl, above, col, mu)) : G;
@@ -146,7 +148,7 @@ static void fill_tile(atmos__clouds_sun *s, int layer, int tx, int ty)
              * world's axes (east, up, -north), atmos__clouds_geo_point's */
             const double p[3] = {r * (cl_ * ce[k] + sl_ * se), r * (cl_ * cu[k] + sl_ * su) - pl->r_ground,
                                  -r * (cl_ * cn[k] + sl_ * sn)};
-            g[((size_t)y * s->w + x) * L] = (float)step_down(s, p, above);
+            g[((size_t)y * s->w + x) * L] = (float)step_down(s, p, above, SPREAD);
         }
     }
 }
@@ -168,7 +170,7 @@ static void need(atmos__clouds_sun *s, int layer, int x, int y)
     while (atomic_load_explicit(st, memory_order_acquire) != 2) sched_yield();
 }
 
-double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon)
+static double lookup_tol(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon, float tol)
 {
     const int layer = below >= 0 ? below : s->layers - 1;
     if (below >= s->layers - 1) return 1.0; /* the top sphere: nothing above it */
@@ -201,6 +203,17 @@ double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int bel
                 g11 = g[(y1 * W + x1) * L];
     const float l0 = g00 < g01 ? g00 : g01, l1 = g10 < g11 ? g10 : g11, lo = l0 < l1 ? l0 : l1;
     const float h0 = g00 > g01 ? g00 : g01, h1 = g10 > g11 ? g10 : g11, hi = h0 > h1 ? h0 : h1;
-    if (hi - lo > SPREAD) return step_down(s, x, below + 1);
+    if (hi - lo > tol) return step_down(s, x, below + 1, tol);
     return (1 - av) * ((1 - u) * g00 + u * g01) + av * ((1 - u) * g10 + u * g11);
+}
+
+double atmos__clouds_sun_lookup(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon)
+{
+    return lookup_tol(s, x, below, lat, lon, SPREAD);
+}
+
+double atmos__clouds_sun_lookup_through(atmos__clouds_sun *s, const double x[3], int below, double lat, double lon,
+                                        double through)
+{
+    return lookup_tol(s, x, below, lat, lon, through > SPREAD ? (float)(SPREAD / through) : 1.0f);
 }
