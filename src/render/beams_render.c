@@ -31,10 +31,12 @@
 #include "render/beams_primary.h"
 #include "render/beams_screen.h"
 #include "render/beams_sky.h"
+#include "core/clones.h"
 #include "core/pinhole.h"
 #include "core/vec.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -74,6 +76,7 @@ typedef struct job {
     double *ru, *rv;           /* a pinhole camera's image-plane coordinates per column and row (else NULL) */
     const double *dir;         /* subsampling, a pinhole camera: the eye's rays over dir_r (x, y, z; else NULL) */
     atmos__rect dir_r;
+    double (*alb_pi)[ATMOS_MAX_WAVELENGTHS]; /* per object and wavelength: its albedo over pi */
 } job;
 
 /* The eye's ray through pixel (x, y)'s centre: atmos_camera_ray's, from the coordinates kept
@@ -104,21 +107,61 @@ static int in_span(const job *J, int i, int x, int y)
     return x >= r[0] && x < r[1];
 }
 
+/* Per pixel x of a row of n (its rays (dx, dy, dz)[x], the distances T[x] to the surfaces they
+ * hit), the lights that may reach the point seen, as bits (light i: bit i; at most 32 lights):
+ * all but the spots whose cone surely leaves it out, the cosine of its offset from the light
+ * with the axis below cos_outer by more than rounding can blur (atmos__lamp_falloff then
+ * returns 0), told without a root or a division. The point and its offset are shade_surface's
+ * (the same operations); one loop a light, vectorised across the row (an AVX2 clone). */
+_Static_assert(ATMOS_SCENE_MAX_LIGHTS <= 32, "row_cones: a light a bit of 32");
+ATMOS_CLONES static void row_cones(const job *J, const double *dx, const double *dy, const double *dz, const double *T,
+                                   int n, uint32_t *cones)
+{
+    const double e0 = J->eye[0], e1 = J->eye[1], e2 = J->eye[2];
+    for (int x = 0; x < n; x++) cones[x] = 0;
+    for (int i = 0; i < J->b->nlights; i++) {
+        const atmos__lamp *L = &J->b->lights[i].L;
+        const uint32_t bit = (uint32_t)1 << i;
+        if (L->type != ATMOS_LIGHT_SPOT || !(L->cos_outer > 0)) {
+            for (int x = 0; x < n; x++) cones[x] |= bit;
+            continue;
+        }
+        const double p0 = L->pos[0], p1 = L->pos[1], p2 = L->pos[2], a0 = L->axis[0], a1 = L->axis[1], a2 = L->axis[2];
+        const double c2 = L->cos_outer * L->cos_outer * (1 - 1e-9);
+        for (int x = 0; x < n; x++) {
+            const double t = T[x];
+            const double w0 = p0 - (e0 + t * dx[x]), w1 = p1 - (e1 + t * dy[x]), w2 = p2 - (e2 + t * dz[x]);
+            const double r2 = w0 * w0 + w1 * w1 + w2 * w2, s = -(w0 * a0 + w1 * a1 + w2 * a2);
+            cones[x] |= s <= 0 || s * s <= c2 * r2 ? 0 : bit;
+        }
+    }
+}
+
 /* The object's surface at the eye's ray's hit through pixel (x, y), lit by the lights and the
- * sky, dimmed on the way to the eye. Each light's shadow there from its shadow map where the map
- * settles it (atmos__beams_surface_visible), else (or with beams/exact_shadows) by an exact ray. A
- * pixel outside a light's span (screen_spans) sees no point that the light reaches within the
+ * sky, into L before the fog on the way to the eye (the caller's factor, the last of the
+ * product). Each light's shadow there from its shadow map where the map settles it
+ * (atmos__beams_surface_visible), else (or with beams/exact_shadows) by an exact ray. A pixel
+ * outside a light's span (screen_spans) sees no point that the light reaches within the
  * sampled radius: a surface point nearer the light than that is outside its cone (falloff 0),
- * so the light is skipped there before its distance's root and the falloff are evaluated. */
-static void shade_surface(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int m, double fog_t,
-                          double *L)
+ * so the light is skipped there before its distance's root and the falloff are evaluated; so
+ * is a light not in cones (row_cones: a spot whose cone surely leaves the point out). Returns
+ * 0 when no light and no sky reach the point (L all zeros: the fog need not be evaluated). */
+static int shade_surface(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int m, uint32_t cones,
+                         double *L)
 {
     const atmos__beams_plan *b = J->b;
+    const int sky = J->sky && J->sky->nw;
+    if (!cones && !sky) { /* no light can reach it: the sums' zeros, as the loops below would leave them */
+        for (int k = 0; k < J->nw; k++) L[k] = J->alb_pi[m][k] * 0.0;
+        return 0;
+    }
     double P[3], sum[ATMOS_MAX_WAVELENGTHS];
+    int any = 0;
     for (int k = 0; k < J->nw; k++) sum[k] = 0; /* the wavelengths in use only: not 1 kB a pixel */
     for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
     const double off = 1e-4 * (1 + h->t);
     for (int i = 0; i < b->nlights; i++) {
+        if (!(cones >> i & 1)) continue;
         const atmos__beams_light *l = &b->lights[i];
         double w[3] = {l->L.pos[0] - P[0], l->L.pos[1] - P[1], l->L.pos[2] - P[2]};
         const double r2 = atmos__dot3(w, w);
@@ -134,6 +177,7 @@ static void shade_surface(const job *J, int x, int y, const double d[3], const a
         const int lit = b->exact_shadows ? -1 : atmos__beams_surface_visible(l, P, c); /* the map, or an exact ray */
         if (lit == 0 || (lit < 0 && atmos__objects_hit(&b->obj, o, w, 0, r - off, NULL, NULL))) continue;
         const double e = fall * c / (r * r) * exp(-b->sigma_t * r);
+        any = 1;
         if (!l->L.tex) {
             for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e;
             continue;
@@ -142,12 +186,31 @@ static void shade_surface(const job *J, int x, int y, const double d[3], const a
         atmos__lamp_tint(&l->L, P, tint);
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
-    if (J->sky && J->sky->nw) {
+    if (sky) {
         double E[ATMOS_MAX_WAVELENGTHS];
         atmos__beams_sky_irradiance(J->sky, h->normal, E);
         for (int k = 0; k < J->nw; k++) sum[k] += E[k];
+        any = 1;
     }
-    for (int k = 0; k < J->nw; k++) L[k] = b->obj.albedo[m][k] / ATMOS_PI * sum[k] * fog_t;
+    for (int k = 0; k < J->nw; k++) L[k] = J->alb_pi[m][k] * sum[k];
+    return any;
+}
+
+/* The light of pixel (x, y) without the airlight, into L: the surface hit h (of object m) lit
+ * by the lights and the sky, or (h NULL) the sky behind bg, dimmed by the fog on the way to the
+ * eye. Returns the fog's transmittance to the hit, which is evaluated only where something is
+ * lit or when fog_needed (an unlit surface is 0 whatever it is: the same bits; then 1). */
+static double base_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int m, uint32_t cones,
+                         const float *bg, int fog_needed, double *L)
+{
+    if (h && !shade_surface(J, x, y, d, h, m, cones, L) && !fog_needed) return 1;
+    /* 0 to the sky behind endless fog */
+    const double fog_t = exp(-atmos__beams_fog_tau(&J->b->fog, J->eye, d, h ? h->t : INFINITY));
+    if (h)
+        for (int k = 0; k < J->nw; k++) L[k] *= fog_t;
+    else
+        for (int k = 0; k < J->nw; k++) L[k] = bg[k] * fog_t;
+    return fog_t;
 }
 
 /* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
@@ -310,7 +373,7 @@ static void sun_surface(const job *J, const double d[3], const atmos_mesh_hit *h
                          J->eye[2] + h->t * d[2] + off * h->normal[2]};
     const double in = c > 0 ? exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)) : 0; /* dimmed on its way in */
     if (c > 0 && in > 0 && !atmos__beams_sun_dark(s, o) && !atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
-        for (int k = 0; k < J->nw; k++) L[k] += b->obj.albedo[m][k] / ATMOS_PI * s->E[k] * c * in * fog_t;
+        for (int k = 0; k < J->nw; k++) L[k] += J->alb_pi[m][k] * s->E[k] * c * in * fog_t;
 }
 
 /* The fog's scattering of sunlight along [0, T) of the ray d. */
@@ -367,11 +430,10 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     int m = -1;
     const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
     const double T = hit ? h.t : INFINITY;
+    uint32_t cones = 0;
+    if (hit) row_cones(J, &d[0], &d[1], &d[2], &T, 1, &cones);
     if (px) {
-        const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, T)); /* 0 to the sky behind endless fog */
-        if (hit) shade_surface(J, x, y, d, &h, m, fog_t, L);
-        else
-            for (int k = 0; k < J->nw; k++) L[k] = px[k] * fog_t;
+        const double fog_t = base_light(J, x, y, d, hit ? &h : NULL, m, cones, px, b->sun_on, L);
         if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         if (!il) {
             if (b->sigma_t > 0) lights(J, x, y, d, T, f, L, x == J->cx && y == J->cy, 0.5);
@@ -453,17 +515,20 @@ static void screen_spans(const job *J, const atmos__beams_light *l, double R, in
     }
 }
 
-/* Each light's planes: evenly spaced in depth along the view across the sphere it reaches;
- * the pixels it may light (screen_spans). */
+/* Each object's albedo over pi (J->alb_pi); each light's planes: evenly spaced in depth along
+ * the view across the sphere it reaches; the pixels it may light (screen_spans). */
 static atmos_status planes(atmos_plan *p, job *J)
 {
     const atmos__beams_plan *b = J->b;
     J->z_lo = malloc(sizeof(double) * 4 * (size_t)(b->nlights ? b->nlights : 1));
     J->span = malloc(sizeof(int) * 2 * (size_t)J->cam->height * (size_t)(b->nlights ? b->nlights : 1));
-    if (!J->z_lo || !J->span) {
-        free(J->z_lo), free(J->span);
+    J->alb_pi = malloc(sizeof *J->alb_pi * (size_t)(b->obj.n > 0 ? b->obj.n : 1));
+    if (!J->z_lo || !J->span || !J->alb_pi) {
+        free(J->z_lo), free(J->span), free(J->alb_pi);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     }
+    for (int m = 0; m < b->obj.n; m++)
+        for (int k = 0; k < J->nw; k++) J->alb_pi[m][k] = b->obj.albedo[m][k] / ATMOS_PI;
     J->dz = J->z_lo + b->nlights, J->reach = J->dz + b->nlights, J->weight = J->reach + b->nlights;
     for (int i = 0; i < b->nlights; i++) {
         const atmos__beams_light *l = &b->lights[i];
@@ -523,7 +588,7 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
 
 /* The eye's ray through pixel (x, y) in a subsampled frame: kept from the first pass (J->dir) when
  * there is one, the same bits as eye_ray's. */
-static void kept_ray(const job *J, int x, int y, double d[3])
+static inline void kept_ray(const job *J, int x, int y, double d[3])
 {
     if (!J->dir) {
         eye_ray(J, x, y, d);
@@ -534,23 +599,50 @@ static void kept_ray(const job *J, int x, int y, double d[3])
     d[0] = J->dir[i], d[1] = J->dir[n + i], d[2] = J->dir[2 * n + i];
 }
 
-/* Subsampling's first pass: pixel (x, y) without its airlight into B (bg: the sky behind it),
- * what it sees into *T and *obj. */
-static void surface_pixel(job *J, int x, int y, const float *bg, float *B, double *T, int *obj)
+/* The buffers of a subsampled frame over r (each NULL until made). */
+typedef struct screen_buf {
+    int *X, *Y, *obj;
+    double *T, *node;
+    float *base;
+    double *dir; /* the eye's rays (a pinhole camera; else NULL) */
+} screen_buf;
+
+/* Subsampling's first pass, pixel (x, y) seeing h of object obj along the eye's ray d (-1: the
+ * sky behind, bg), lit by the lights in cones (row_cones): its light without the airlight into B. */
+static void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
+                          uint32_t cones, const float *bg, float *B)
 {
     const atmos__beams_plan *b = J->b;
-    double d[3], L[ATMOS_MAX_WAVELENGTHS];
-    kept_ray(J, x, y, d);
-    atmos_mesh_hit h = {0, 0, {0, 0, 0}};
-    int m = -1;
-    const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &b->obj, x, y, J->eye, d, &h, &m) : 0;
-    *T = hit ? h.t : INFINITY, *obj = hit ? m : -1;
-    const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, *T));
-    if (hit) shade_surface(J, x, y, d, &h, m, fog_t, L);
-    else
-        for (int k = 0; k < J->nw; k++) L[k] = bg[k] * fog_t;
-    if (hit && b->sun_on) sun_surface(J, d, &h, m, fog_t, L);
+    double L[ATMOS_MAX_WAVELENGTHS];
+    const int hit = obj >= 0;
+    const double fog_t = base_light(J, x, y, d, hit ? h : NULL, obj, cones, bg, hit && b->sun_on, L);
+    if (hit && b->sun_on) sun_surface(J, d, h, obj, fog_t, L);
     for (int k = 0; k < J->nw; k++) B[k] = (float)L[k];
+}
+
+/* Subsampling's first pass over row y (its rays made when kept): what each pixel sees (into T,
+ * obj and hits), the lights that may reach it (cones: a row at a time where the rays are kept),
+ * its light without the airlight (into base). */
+static void surface_row(const job *J, const atmos__rect *r, int y, const screen_buf *q, atmos_mesh_hit *hits,
+                        uint32_t *cones, atmos_image *out)
+{
+    const int W = r->x1 - r->x0;
+    const size_t n = (size_t)W * (size_t)(r->y1 - r->y0), row = (size_t)(y - r->y0) * W;
+    double *T = q->T + row, d[3];
+    int *obj = q->obj + row;
+    for (int x = r->x0, i = 0; x < r->x1; x++, i++) {
+        kept_ray(J, x, y, d);
+        int m = -1;
+        const int hit = J->prim ? atmos__beams_primary_hit(J->prim, &J->b->obj, x, y, J->eye, d, &hits[i], &m) : 0;
+        T[i] = hit ? hits[i].t : INFINITY, obj[i] = hit ? m : -1;
+        if (!q->dir) row_cones(J, &d[0], &d[1], &d[2], &T[i], 1, &cones[i]);
+    }
+    if (q->dir) row_cones(J, q->dir + row, q->dir + n + row, q->dir + 2 * n + row, T, W, cones);
+    for (int x = r->x0, i = 0; x < r->x1; x++, i++) {
+        kept_ray(J, x, y, d);
+        float *px = out->pixels + ((size_t)y * out->width + x) * out->channels;
+        surface_light(J, x, y, d, &hits[i], obj[i], cones[i], px, q->base + (row + i) * J->nw);
+    }
 }
 
 /* The airlight of pixel (x, y) (atmos__beams_air_fn): the lights' and the sun's. */
@@ -564,13 +656,6 @@ static void air_pixel(void *user, double *f, int x, int y, double T, double *A)
     if (J->b->sun_on) sun_air(J, d, T, A);
 }
 
-/* The buffers of a subsampled frame over r (each NULL until made). */
-typedef struct screen_buf {
-    int *X, *Y, *obj;
-    double *T, *node;
-    float *base;
-    double *dir; /* the eye's rays (a pinhole camera; else NULL) */
-} screen_buf;
 
 static void screen_buf_free(screen_buf *q) /* the others are the plan's, kept for the next frame */
 {
@@ -637,7 +722,9 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     {
         double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), *band = malloc(sizeof(double) * W * (k + 1) * nw);
         unsigned char *state = malloc((size_t)W * (k + 1));
-        const int ok = f && band && state;
+        atmos_mesh_hit *hits = malloc(sizeof *hits * (size_t)W);
+        uint32_t *cones = malloc(sizeof *cones * (size_t)W);
+        const int ok = f && band && state && hits && cones;
         if (!ok) {
 #pragma omp atomic write
             failed = 1;
@@ -646,11 +733,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
         for (int y = r->y0; y < r->y1; y++) {
             double *row = q.dir ? q.dir + (size_t)(y - r->y0) * W : NULL;
             if (row && ok) atmos__camera_pinhole_dirs(J->cam, J->ru + r->x0, W, J->rv[y], row, row + n, row + 2 * n);
-            for (int x = r->x0; x < r->x1 && ok && !atmos__cancelled(cancelled); x++) {
-                const size_t i = (size_t)(y - r->y0) * W + (size_t)(x - r->x0);
-                surface_pixel(J, x, y, out->pixels + ((size_t)y * out->width + x) * out->channels, q.base + i * nw,
-                              &q.T[i], &q.obj[i]);
-            }
+            if (ok && !atmos__cancelled(cancelled)) surface_row(J, r, y, &q, hits, cones, out);
         }
         int any_failed; /* after the rows' barrier: a thread's failure leaves its rows' rays unset */
 #pragma omp atomic read
@@ -666,7 +749,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
             ev += screen_band(&s, &q, nx, ny, j, f, band, state, out);
             atmos__progress_step(p->ctx, "render beams", &done, nb, cancelled);
         }
-        free(f), free(band), free(state);
+        free(f), free(band), free(state), free(hits), free(cones);
     }
     if (!failed && J->cx >= r->x0 && J->cx < r->x1 && J->cy >= r->y0 && J->cy < r->y1) { /* the centre ray's counts */
         double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), A[ATMOS_MAX_WAVELENGTHS];
@@ -705,13 +788,13 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
     if (eye_coordinates(&J)) {
-        free(J.z_lo), free(J.span);
+        free(J.z_lo), free(J.span), free(J.alb_pi);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     }
     /* the sky seen from the ground under the eye, kept while that stays within its quantum */
     if ((b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) ||
         (b->obj.n > 0 && (st = atmos__beams_sky_keep(p->ctx, p->atm, J.eye, v->sun, J.nw, &b->sky)) != ATMOS_OK)) {
-        free(J.z_lo), free(J.span), free(J.ru);
+        free(J.z_lo), free(J.span), free(J.alb_pi), free(J.ru);
         return st;
     }
     atmos__beams_il il = {0}, *ilp = NULL;
@@ -724,7 +807,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     if (!failed && b->obj.n > 0) {
         if ((st = atmos__beams_primary_build_kept(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &b->kept[ATMOS__BEAMS_KEPT_PRIMARY],
                                                   &prim)) != ATMOS_OK) {
-            atmos__beams_il_free(&il), free(J.z_lo), free(J.span), free(J.ru);
+            atmos__beams_il_free(&il), free(J.z_lo), free(J.span), free(J.alb_pi), free(J.ru);
             return st;
         }
         J.prim = &prim;
@@ -737,7 +820,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     atmos__beams_primary_free(&prim);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
-    free(J.z_lo), free(J.span), free(J.ru);
+    free(J.z_lo), free(J.span), free(J.alb_pi), free(J.ru);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     b->air_evaluated = evaluated, b->air_pixels = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");

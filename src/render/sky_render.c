@@ -465,6 +465,27 @@ void atmos__sky_keep_destroy(atmos__sky_keep *k)
     free(k);
 }
 
+/* A black vacuum seen through a pinhole, one sample a pixel: every ray's radiance is 0 (no air,
+ * no ground, no sun's disk) and its weight 1, so each pixel of r is what the rows would give it
+ * (0, alpha 1), written without evaluating the rays. Returns 0 for any other sky. */
+static int black_vacuum(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v, const sky_job *job,
+                        const atmos__rect *r, atmos_image *out)
+{
+    if (atmos_atmosphere_get_kind(atm) != ATMOS_ATMOSPHERE_VACUUM ||
+        atmos_atmosphere_get_desc(atm)->background_radiance != 0 || v->cam.type != ATMOS_CAMERA_PINHOLE ||
+        job->spp != 1 || job->sun_visible)
+        return 0;
+    const int W = v->cam.width, C = out->channels, n = job->n;
+#pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
+    for (int y = r->y0; y < r->y1; y++)
+        for (int x = r->x0; x < r->x1; x++) {
+            float *px = out->pixels + ((size_t)y * W + x) * C;
+            for (int k = 0; k < n; k++) px[k] = 0.0f;
+            px[n] = 1.0f;
+        }
+    return 1;
+}
+
 atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
                                const atmos__rect *r, atmos_image *out, atmos__sky_keep *keep)
 {
@@ -479,6 +500,11 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
     if (keep) atmos__atm_batch_update(bp, atm, v->cam.position, job.sun);
     else atmos__atm_batch_init(bp, atm, v->cam.position, job.sun);
     const atmos__atm_batch *batch = bp;
+    if (black_vacuum(ctx, atm, v, &job, r, out)) {
+        if (!keep) atmos__atm_batch_release(&own);
+        atmos__progress(ctx, "render sky", 1.0);
+        return ATMOS_OK;
+    }
     const atmos__sky_view *table = NULL;
     if (v->sky_table && keep && v->cam.type == ATMOS_CAMERA_PINHOLE && job.spp == 1 &&
         atmos__sky_view_wanted(atm, v->cam.position)) {

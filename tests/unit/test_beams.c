@@ -715,6 +715,73 @@ static void test_surface_spans(void)
     CHECK(wrong == 0);
 }
 
+/* A floor under a spot, no airlight (no scattering), every floor pixel against the closed form
+ * albedo / pi I f(c) cos / r^2 exp(-sigma r) exp(-sigma t) (f the smoothstep between the cone's
+ * cosines), with the airlight subsampled (the surfaces' lights a row at a time) and per pixel:
+ * the pixels at the cone's edge, where the falloff is barely above 0, lit as they should be
+ * (the renderer skips a light whose cone surely leaves a point out before its falloff); the
+ * black vacuum above the horizon 0 with alpha 1 (written without evaluating its rays). */
+static void test_surface_closed_form(void)
+{
+    const double eyes[2][3] = {{-30, 15, 5}, {6, 3, -9}}, lp[3] = {0, 20, 0}, sig = 0.001;
+    double worst = 0, ax[3] = {0.3, -1, 0.2};
+    int edge = 0, pixels = 0, sky = 0, sky_wrong = 0;
+    const double na = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+    const double ci = cos(20 * ATMOS_DEG2RAD), co = cos(25 * ATMOS_DEG2RAD);
+    for (int a = 0; a < 3; a++) ax[a] /= na;
+    for (int e = 0; e < 2; e++)
+        for (int step = 1; step <= 4; step += 3) {
+            atmos_scene s;
+            base_scene(&s, 160, 120);
+            s.beams.screen_step = step;
+            s.fog.extinction_per_m = sig, s.fog.scattering_per_m = 0;
+            atmos_scene_light *l = &s.lights[0];
+            l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 20, l->edge_deg = 5, l->range_m = 40;
+            memcpy(l->position_m, lp, sizeof lp);
+            l->direction[0] = 0.3, l->direction[1] = -1, l->direction[2] = 0.2;
+            s.object_count = 1;
+            memset(&s.objects[0], 0, sizeof s.objects[0]);
+            s.objects[0].scale[0] = s.objects[0].scale[1] = s.objects[0].scale[2] = 30;
+            s.objects[0].albedo[0] = s.objects[0].albedo[1] = s.objects[0].albedo[2] = 0.6;
+            snprintf(s.objects[0].mesh, sizeof s.objects[0].mesh, "builtin:plane");
+            memcpy(s.camera.position, eyes[e], sizeof eyes[e]);
+            s.camera.look_at[0] = 3, s.camera.look_at[1] = 0, s.camera.look_at[2] = 2;
+            s.camera.fov_deg = 70;
+            atmos_image *img = render(ctx, &s);
+            atmos_camera cam;
+            CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
+            if (!img) continue;
+            for (int y = 0; y < s.height; y++)
+                for (int x = 0; x < s.width; x++) {
+                    double d[3];
+                    atmos_camera_ray(&cam, x + 0.5, y + 0.5, d);
+                    const float *px = img->pixels + ((size_t)y * s.width + x) * img->channels;
+                    if (!(d[1] < 0)) { /* the black vacuum above: 0, alpha 1 */
+                        sky++, sky_wrong += px[0] != 0 || px[1] != 0 || px[2] != 0 || px[3] != 1;
+                        continue;
+                    }
+                    const double t = -eyes[e][1] / d[1];
+                    const double w[3] = {eyes[e][0] + t * d[0] - lp[0], -lp[1], eyes[e][2] + t * d[2] - lp[2]};
+                    if (fabs(w[0]) > 10 || fabs(w[2]) > 10) continue; /* well inside the floor */
+                    const double r = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+                    const double c = (w[0] * ax[0] + w[1] * ax[1] + w[2] * ax[2]) / r;
+                    const double q = c >= ci ? 1 : c <= co ? 0 : (c - co) / (ci - co), f = q * q * (3 - 2 * q);
+                    const double want = 0.6 / ATMOS_PI * f * (lp[1] / r) / (r * r) * exp(-sig * (r + t));
+                    const double got = px[0];
+                    const double err = fabs(got - want) / (want > 0 ? want : 1);
+                    pixels++, edge += f > 0 && f < 1e-3;
+                    worst = err > worst ? err : worst;
+                }
+            atmos_image_destroy(img);
+        }
+    printf("surfaces under a spot, closed form: %d floor pixels (%d at the cone's edge, falloff below 1e-3), "
+           "worst relative difference %.2g; %d sky pixels, %d not (0, 0, 0, alpha 1)\n",
+           pixels, edge, worst, sky, sky_wrong);
+    CHECK(edge > 20 && sky > 1000);
+    CHECK(sky_wrong == 0);
+    CHECK(worst < 1e-5);
+}
+
 /* The sky behind, no fog or lights: with the airlight subsampled (screen_step 4) the sky too is
  * read from the sky renderer's grid of every 4th pixel, within 0.3 % of its every pixel's value
  * (the grid's tolerance: test_sky_step) and not the same image; screen_step 1: every pixel. */
@@ -906,6 +973,7 @@ int main(void)
     test_light_sum();
     test_screen_spans();
     test_surface_spans();
+    test_surface_closed_form();
     test_sky_on_lattice();
     test_threads();
     test_interleave();
