@@ -125,6 +125,8 @@ typedef struct atmos_scene_nishita {
     int mc_cell;              /* that field's cell edge, render voxels; 4 */
     int mc_lmax;              /* -1: the field toward the view's centre alone; 0-3: its spherical harmonics of
                                  degree <= this, turned toward the eye per cell; -1 */
+    int mc_delta_m;           /* 1 (with mc_lmax >= 0): the photons traced in the delta-M scaled medium of
+                                 that degree (Wiscombe 1977), the field's part of the eye rays too; 0 */
 } atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is

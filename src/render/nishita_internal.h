@@ -49,9 +49,12 @@ struct atmos__nishita_plan {
     stables tab;             /* the field's tables: cross-sections, F_n, B_n, Ams_2 */
     atmos__dfield df;
     /* "mc_kphotons" (nishita_mc.c): the Monte Carlo field of the orders >= 2 toward the eye, the
-     * first order and the eye rays in the medium truncated as its photons see it (sig', sca') */
+     * first order and the eye rays in the medium truncated as its photons see it (sig'); the
+     * field's part of the eye rays attenuated by mc_sig_ms and weighted by mc_sca, the medium its
+     * photons see: sig' and sca' as well, or with "mc_delta_m" the delta-M scaled sig* and sca* */
     atmos__nishita_mc *mc;
     float mc_sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    float mc_sig_ms[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     float mc_sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     double mc_s;             /* the last field's time */
 };

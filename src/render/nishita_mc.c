@@ -8,7 +8,9 @@
  * of orders >= 2 per unit (truncated) scattering coefficient. Either toward one direction,
  * omega = -(the camera's central view direction) ("mc_lmax" -1: the "perfect-angle" field that
  * the P1 field approximates), or as real spherical harmonics of degree <= lmax of the emission
- * (p_l Y_lm(d_in) per collision, the addition theorem), turned toward the eye per cell and frame.
+ * (p_l Y_lm(d_in) per collision, the addition theorem), turned toward the eye per cell and frame;
+ * with "mc_delta_m" the photons traced in the delta-M scaled medium of that degree (delta_m()),
+ * the eye rays then taking the field and the first order in it (TMS).
  * The sums are fixed point, one random stream per photon: the same field for a seed whatever
  * the threads. The eye pass adds sigma_s' times its trilinear value to the first order, both in
  * the truncated medium (nishita_render.c). */
@@ -34,7 +36,11 @@ struct atmos__nishita_mc {
     path_medium med;
     path_phase ph;
     int lmax, K;         /* -1: the phase toward one direction (K = 1); else degree lmax, K = (lmax + 1)^2 */
-    double pl[PATH_F][ATMOS_MAX_WAVELENGTHS][4]; /* Legendre moments 2 pi int p P_l dmu of the cut phase */
+    /* Legendre moments 2 pi int p P_l dmu of the cut phase (l <= 4); with delta-M those of the
+     * scaled phase p*, (chi_l - f) / (1 - f) for l <= lmax */
+    double pl[PATH_F][ATMOS_MAX_WAVELENGTHS][5];
+    int delta_m;         /* the photons in the delta-M scaled medium, their phase HG of g* (hg) */
+    atmos_phase_mixture hg[PATH_F][ATMOS_MAX_WAVELENGTHS];
     float *coef;         /* [(cell * n + w) * K + k]: the emission of orders >= 2 per unit sigma_s' */
     atmos__lfield field; /* L: its radiance toward the eye (cells of s render voxels) */
     double sun[3], out[3], eye[3];
@@ -69,24 +75,49 @@ static void sh_eval(int lmax, const double d[3], double *Y)
     Y[15] = 0.5900435899266435 * x * (x * x - 3 * y * y);
 }
 
-/* The Legendre moments p_l = 2 pi int p(mu) P_l(mu) dmu, l <= 3, of every field's cut phase
+/* The Legendre moments p_l = 2 pi int p(mu) P_l(mu) dmu, l <= 4, of every field's cut phase
  * function (the path tracer's tables, p_0 = 1 up to their rounding). */
 static void legendre_moments(atmos__nishita_mc *mc, int nf, int n)
 {
     enum { STEPS = 36000 };
     for (int f = 0; f < nf; f++)
         for (int k = 0; k < n; k++) {
-            double acc[4] = {0};
+            double acc[5] = {0};
             for (int i = 0; i < STEPS; i++) {
                 const double th = (i + 0.5) * ATMOS_PI / STEPS, mu = cos(th);
                 path_angle a;
                 atmos__path_angle(&mc->ph, mu, &a);
                 const double p = atmos__path_phase_eval(&mc->ph, f, k, &a) * 2 * ATMOS_PI * sin(th) * ATMOS_PI / STEPS;
-                const double P[4] = {1, mu, 0.5 * (3 * mu * mu - 1), 0.5 * (5 * mu * mu * mu - 3 * mu)};
-                for (int l = 0; l < 4; l++) acc[l] += p * P[l];
+                double P[5] = {1, mu};
+                for (int l = 1; l < 4; l++) P[l + 1] = ((2 * l + 1) * mu * P[l] - l * P[l - 1]) / (l + 1);
+                for (int l = 0; l < 5; l++) acc[l] += p * P[l];
             }
-            for (int l = 0; l < 4; l++) mc->pl[f][k][l] = acc[l];
+            for (int l = 0; l < 5; l++) mc->pl[f][k][l] = acc[l];
         }
+}
+
+/* Delta-M (Wiscombe 1977) of degree L = lmax on top of the 3-degree cut: per field and
+ * wavelength f = chi_{L+1} (the cut phase's normalised moment) counts as not scattered,
+ * sigma_t* = sigma_t' - f sigma_s', sigma_s* = (1 - f) sigma_s' (so omega* = (1 - f) omega /
+ * (1 - f omega)); the scaled phase's moments chi*_l = (chi_l - f) / (1 - f), l <= L, replace
+ * the cut phase's in the projection, and the photons sample it as Henyey-Greenstein with g* =
+ * chi*_1 (its higher moments g*^l, not chi*_l). */
+static void delta_m(atmos__nishita_mc *mc, int nf, int n)
+{
+    float f[PATH_F][ATMOS_MAX_WAVELENGTHS];
+    const int L = mc->lmax;
+    for (int i = 0; i < nf; i++)
+        for (int k = 0; k < n; k++) {
+            double *pl = mc->pl[i][k];
+            const double p0 = pl[0], c = pl[L + 1] / p0, fk = c > 0 && c < 1 ? c : 0;
+            f[i][k] = (float)fk;
+            for (int l = 0; l <= L; l++) pl[l] = (pl[l] / p0 - fk) / (1 - fk);
+            atmos_phase_mixture *h = &mc->hg[i][k];
+            memset(h, 0, sizeof *h);
+            h->count = 1, h->kind[0] = ATMOS_PHASE_HG, h->weight[0] = 1;
+            h->g[0] = L >= 1 ? pl[1] : 0;
+        }
+    atmos__path_medium_truncate(&mc->med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])f);
 }
 
 atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
@@ -101,11 +132,15 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
         st = atmos__path_medium_build(ctx, p->volume, p->scene.volume.density_scale, p->offset, p->optics, n, &mc->med);
     if (st != ATMOS_OK) return st;
     atmos__path_medium_truncate(&mc->med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])mc->ph.trunc);
-    for (int f = 0; f < np->nf; f++)
-        for (int w = 0; w < n; w++) np->mc_sig[f][w] = mc->med.sig[f][w], np->mc_sca[f][w] = mc->med.sca[f][w];
     mc->lmax = p->scene.nishita.mc_lmax;
     mc->K = mc->lmax < 0 ? 1 : (mc->lmax + 1) * (mc->lmax + 1);
     legendre_moments(mc, np->nf, n);
+    for (int f = 0; f < np->nf; f++)
+        for (int w = 0; w < n; w++) np->mc_sig[f][w] = mc->med.sig[f][w];
+    mc->delta_m = p->scene.nishita.mc_delta_m && mc->lmax >= 0;
+    if (mc->delta_m) delta_m(mc, np->nf, n);
+    for (int f = 0; f < np->nf; f++)
+        for (int w = 0; w < n; w++) np->mc_sig_ms[f][w] = mc->med.sig[f][w], np->mc_sca[f][w] = mc->med.sca[f][w];
     const int s = p->scene.nishita.mc_cell;
     const sgrid *g = &np->g;
     if (!atmos__lfield_alloc(&mc->field, ATMOS__LFIELD_NONE, (g->c[0] + s - 1) / s, (g->c[1] + s - 1) / s,
@@ -227,7 +262,8 @@ static void photon(const mc_job *M, int k, atmos__stream *r, int64_t *acc)
         }
         if (!atmos__path_roulette(w, 1, r)) return;
         const int f = atmos__path_pick_field(&e, 0, m->nf, r);
-        const double mu = atmos__path_phase_sample(&mc->ph, f, k, atmos__stream_u(r));
+        const double mu = mc->delta_m ? atmos_phase_mixture_sample(&mc->hg[f][k], 0.5, atmos__stream_u(r))
+                                      : atmos__path_phase_sample(&mc->ph, f, k, atmos__stream_u(r));
         double nd[3];
         atmos__path_around(d, mu, 2.0 * ATMOS_PI * atmos__stream_u(r), nd);
         memcpy(d, nd, sizeof d);

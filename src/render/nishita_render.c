@@ -24,6 +24,8 @@ typedef struct {
     int use_field;
     int diffuse;                     /* the diffuse field and the scattered beam (dfield.h) */
     const atmos__lfield *mc;         /* the Monte Carlo field (nishita_mc.c), NULL: none */
+    int tms; /* delta-M (TMS, Nakajima & Tanaka 1988): the first order, its exact phase, in the scaled
+                medium too: sigma_s p E exp(-tau*_sun), attenuated toward the eye by sigma_t* */
     float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* extinction of the first order and the eye
                                                                   rays (truncated with mc) */
 } rjob;
@@ -103,7 +105,8 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         for (int w = 0; w < n; w++) pf[f][w] = atmos_phase_table_eval(np->phase[f], w, mu);
     double ams2[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     if (J->diffuse) ams2_at(&np->tab, mu, ams2);
-    for (int w = 0; w < n; w++) L[w] = 0, T[w] = 1;
+    double Tm[ATMOS_MAX_WAVELENGTHS]; /* the Monte Carlo field's transmittance (sig_ms) */
+    for (int w = 0; w < n; w++) L[w] = 0, T[w] = 1, Tm[w] = 1;
     const int steps = (int)ceil((t1 - t0) / J->dt);
     const double dt = (t1 - t0) / steps;
     double wsum = 0, tsum = 0;
@@ -129,22 +132,30 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         }
         double Tmax = 0;
         for (int w = 0; w < n; w++) {
-            double st = 0, ss = 0, s1 = 0, tau = 0;
+            double st = 0, ss = 0, s1 = 0, tau = 0, sm = 0, Sm = 0;
             for (int f = 0; f < nf; f++) {
                 st += dens[f] * J->sig[f][w], ss += dens[f] * np->sca[f][w];
                 s1 += dens[f] * np->sca[f][w] * pf[f][w];
-                tau += col[f] * J->sig[f][w];
-                if (J->mc) Sd[w] += dens[f] * np->mc_sca[f][w] * (Lmc[w] > 0 ? Lmc[w] : 0);
+                tau += col[f] * (J->tms ? np->mc_sig_ms[f][w] : J->sig[f][w]);
+                if (J->mc)
+                    sm += dens[f] * np->mc_sig_ms[f][w], Sm += dens[f] * np->mc_sca[f][w] * (Lmc[w] > 0 ? Lmc[w] : 0);
             }
             /* the field's radiance is per unit truncated scattering, sig_s (1 - f); where the
              * diffuse field is on (fade > 0) it takes the place of the orders 2-3 and the sky */
             double S = s1 * J->E[w] * exp(-tau) + Sd[w] +
                        (J->use_field ? (1.0 - fade[w]) * ss * (1 - np->trunc[w]) * (Lf[w] > 0 ? Lf[w] : 0) : 0);
+            if (J->tms) Sm += S, S = 0;
             const double a = st > 0 ? -expm1(-st * dt) : 0;
             L[w] += st > 0 ? T[w] * S / st * a : 0;
             if (w == n / 2) wsum += T[w] * a, tsum += t * T[w] * a;
             T[w] *= 1 - a;
             Tmax = T[w] > Tmax ? T[w] : Tmax;
+            if (J->mc) { /* the Monte Carlo field in the medium its photons saw (delta-M: sig*, its own Tm) */
+                const double am = sm > 0 ? -expm1(-sm * dt) : 0;
+                L[w] += sm > 0 ? Tm[w] * Sm / sm * am : 0;
+                Tm[w] *= 1 - am;
+                Tmax = Tm[w] > Tmax ? Tm[w] : Tmax;
+            }
         }
         if (Tmax < 1e-5) break;
     }
@@ -208,6 +219,7 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
         for (int a = 0; a < 3; a++) ot[a] = -dc[a];
         if ((st = atmos__nishita_mc_update(p, v->sun, ot, v->cam.position, J.E, threads)) != ATMOS_OK) return st;
         J.mc = atmos__nishita_mc_field(np);
+        J.tms = p->scene.nishita.mc_delta_m && p->scene.nishita.mc_lmax >= 0;
     }
     const int W = out->width, C = out->channels;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)

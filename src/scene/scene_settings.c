@@ -101,6 +101,10 @@ static const atmos_setting nishita_settings[] = {
     {"mc_lmax", "nishita-mc-lmax", ATMOS_SETTING_INT, "", -1, 3, 0, 0, -1, NULL, 0,
      "the Monte Carlo field's angles: -1 = toward the view's centre only; 0-3 = spherical harmonics "
      "of this degree", NISHITA(mc_lmax)},
+    {"mc_delta_m", "nishita-mc-delta-m", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "with mc_lmax >= 0: the photons and the field's part of the eye rays in the delta-M scaled medium "
+     "of that degree (its forward peak above the degree counted as not scattered)",
+     NISHITA(mc_delta_m)},
 };
 
 static const atmos_setting harris_settings[] = {
