@@ -1,0 +1,53 @@
+#!/bin/sh
+# What a second new user's trial (real data, long renders, --help) ran into:
+#  1. a truncated netCDF-4 (HDF5) file is named as truncated, with the size its superblock
+#     promises; an empty .nc file is named empty;
+#  2. render --time with a bare number (a time index) points to --time-index;
+#  3. an interrupted render says "interrupted" on a line of its own and removes the output
+#     folders it created and left empty; the exit status stays 130 (SIGINT) / 143 (SIGTERM);
+#  4. the default voxel chosen for a small classic WRF file draws no warning of its own;
+#  5. the auto-framed camera above the flat-earth model's range switches to the spherical one;
+#  6. table builds off a terminal log progress lines;
+#  7. volume takes render's option names (--particle, --volume-scale, --density-scale).
+. "$(dirname "$0")/common.inc"
+has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
+hasnt() { grep -qF -- "$2" "$T/err" && { bad "$1: '$2' in:"; sed 's/^/  /' "$T/err" >&2; } || ok "$1: no '$2'"; }
+DATA=${ATMOS_SHARED_DATA:-${ATMOS_SOURCE_DIR:-.}/../shared/data}/real
+
+# --- 1. truncated netCDF-4 and empty files. A hand-made HDF5 superblock (version 2, 8-byte
+# offsets and lengths) whose end-of-file address is 4096, in a file of 48 bytes: the format
+# (HDF5 file format specification, "Superblock", versions 2 and 3) says the file is 4096 bytes.
+python3 - "$T/cut.nc" <<'PY'
+import struct, sys
+sb = b"\x89HDF\r\n\x1a\n" + bytes([2, 8, 8, 0]) + struct.pack("<qqqq", 0, -1, 4096, 48) + b"\0" * 4
+open(sys.argv[1], "wb").write(sb)
+PY
+"$A" volume info "$T/cut.nc" 2>"$T/err"; rc=$?
+[ $rc -ne 0 ] && ok "truncated HDF5 refused" || bad "truncated HDF5 accepted"
+has "truncated HDF5" "$T/cut.nc: truncated"
+has "truncated HDF5" "4096"
+: >"$T/empty.nc"
+"$A" volume info "$T/empty.nc" 2>"$T/err"; [ $? -ne 0 ] && ok "empty file refused" || bad "empty file accepted"
+has "empty file" "$T/empty.nc: the file is empty"
+WRF=$DATA/salem_wrf_d01_allvars_cropped.nc
+if [ -f "$WRF" ]; then
+    for n in 2000 500000 985000; do
+        head -c $n "$WRF" >"$T/wrf_cut.nc"
+        "$A" volume info "$T/wrf_cut.nc" 2>"$T/err"
+        has "WRF file cut at $n bytes" "truncated"
+        hasnt "WRF file cut at $n bytes" "HDF error"
+    done
+    # a damaged file (not truncated): the HDF error says that the file is damaged
+    python3 - "$WRF" "$T/wrf_bad.nc" <<'PY'
+import sys
+b = bytearray(open(sys.argv[1], "rb").read())
+b[48:56] = b"\xff" * 8
+open(sys.argv[2], "wb").write(b)
+PY
+    "$A" volume info "$T/wrf_bad.nc" 2>"$T/err"
+    has "damaged WRF file" "damaged"
+else
+    echo "skip: no $WRF"
+fi
+
+exit $fail
