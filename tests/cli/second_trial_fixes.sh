@@ -50,4 +50,10 @@ else
     echo "skip: no $WRF"
 fi
 
+# --- 2. render --time 3 (volume's --time N is a time index): the hint names --time-index 3
+"$A" render --volume generate:cumulus --time 3 --width 8 --height 8 -o "$T/x.png" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && ok "render --time 3: usage error" || bad "render --time 3: rc $rc"
+has "render --time 3" "--time-index 3"
+hasnt "render --time 3" "--lat"
+
 exit $fail

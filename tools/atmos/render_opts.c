@@ -251,6 +251,9 @@ static int check_options(const render_opts *o)
 {
     const char *C = o->cmd;
     if (o->spectral && o->rgb) return cli_usage_error(C, "--spectral and --rgb exclude each other");
+    if (o->time && o->time[0] && strspn(o->time, "0123456789") == strlen(o->time)) /* volume's --time N */
+        return cli_usage_error(C, "--time %s: --time takes a UTC time (2026-06-21T12:00:00Z); a NetCDF time "
+                                  "step is --time-index %s", o->time, o->time);
     const int use_time = o->time || !isnan(o->lat) || !isnan(o->lon);
     if (isnan(o->lat) != isnan(o->lon)) return cli_usage_error(C, "--lat and --lon go together");
     if (use_time && (!isnan(o->sun_el) || !isnan(o->sun_az)))
