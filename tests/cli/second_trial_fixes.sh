@@ -56,4 +56,23 @@ fi
 has "render --time 3" "--time-index 3"
 hasnt "render --time 3" "--lat"
 
+# --- 3. an interrupted render: "interrupted" on a line of its own, the folders it made and left
+# empty removed (a folder that was there stays), the signal's exit status
+slow="--renderer path --spp 1000000 --width 32 --height 18"
+mkdir "$T/was"
+# shellcheck disable=SC2086
+timeout --preserve-status -s INT 3 "$A" render $slow -o "$T/was/new1/new2/a.png" 2>"$T/err"; rc=$?
+[ $rc -eq 130 ] && ok "SIGINT: exit status 130" || bad "SIGINT: exit status $rc"
+grep -qx "atmos render: interrupted" "$T/err" && ok "SIGINT: 'interrupted' line" || { bad "SIGINT: no line"; cat "$T/err" >&2; }
+[ -d "$T/was" ] && [ ! -e "$T/was/new1" ] && ok "SIGINT: the new empty folders removed, the old kept" \
+    || bad "SIGINT: folders: $(find "$T/was")"
+# an animation (frames of about 1-2 s): none of its frames is written, and the line says so
+# shellcheck disable=SC2086
+timeout --preserve-status -s TERM 4 "$A" render --frames 4 --sun-elevation 10 --sun-elevation-end 30 --renderer path \
+    --spp 3000 --width 32 --height 18 -q -o "$T/anim/a.png" 2>"$T/err"; rc=$?
+[ $rc -eq 143 ] && ok "SIGTERM: exit status 143" || bad "SIGTERM: exit status $rc"
+grep -qE "^atmos render: interrupted: no frame written \([0-9]+ finished frames? discarded" "$T/err" \
+    && ok "SIGTERM: the animation's line" || { bad "SIGTERM: no animation line"; cat "$T/err" >&2; }
+[ ! -e "$T/anim" ] && ok "SIGTERM: no folder left" || bad "SIGTERM: left $(find "$T/anim")"
+
 exit $fail

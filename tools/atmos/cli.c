@@ -186,7 +186,7 @@ static void progress_stage(cli_progress *p, const char *stage, double f)
         p->last_fraction = f;
         return;
     }
-    if (p->shown && p->enabled) fputc('\n', stderr);
+    if (p->shown && p->enabled) fputc('\n', stderr), cli_outputs_line_open(0);
     snprintf(p->stage, sizeof p->stage, "%s", stage);
     p->start = cli_now_s();
     p->shown = 0;
@@ -223,6 +223,7 @@ int cli_progress_bar(void *user, const char *stage, double f)
     double eta = f > 0 ? t * (1.0 - f) / f : 0;
     fprintf(stderr, "\r%s [%s] %3.0f%%  %.1fs elapsed, ETA %.1fs ", stage, bar, 100.0 * f, t, eta);
     p->shown = 1;
+    cli_outputs_line_open(f < 1.0);
     if (f >= 1.0) {
         fputc('\n', stderr);
         p->stage[0] = '\0'; /* the line is ended: the next report starts a new bar */
