@@ -728,14 +728,17 @@ static atmos_status number_density(loader *L, int si)
 
 /* The default voxel: the model's vertical resolution (its mean layer depth) unless the
  * horizontal spacing is finer, but no smaller than keeps the grid within DEFAULT_VOXELS
- * voxels (a coarse model over a wide domain: the vertical resolution then gives way). */
+ * voxels (a coarse model over a wide domain: the vertical resolution then gives way), and
+ * never so large that fewer than MIN_DEPTH_VOXELS span the model's depth (a model of a few
+ * levels: output_grid warns of a voxel that coarse). */
 #define DEFAULT_VOXELS 8388608.0
+#define MIN_DEPTH_VOXELS 8.0
 static double default_voxel(const loader *L, double depth)
 {
     const src *s = &L->s;
     double vs = fmin(fmin(L->dx, L->dy), depth / s->nz);
     const double budget = cbrt(s->nx * L->dx * s->ny * L->dy * depth / DEFAULT_VOXELS);
-    return fmax(vs, budget);
+    return fmin(fmax(vs, budget), depth / MIN_DEPTH_VOXELS);
 }
 
 /* The uniform output grid: from the lowest ground to the highest model top, voxels of
@@ -754,7 +757,7 @@ static atmos_status output_grid(loader *L)
     }
     const double dx = L->dx, dy = L->dy;
     double vs = L->desc->voxel_size_m > 0 ? L->desc->voxel_size_m : default_voxel(L, zhi - zlo);
-    if ((zhi - zlo) / vs < 8)
+    if ((zhi - zlo) / vs < MIN_DEPTH_VOXELS * (1 - 1e-9))
         atmos__log(s->ctx, ATMOS_LOG_WARN,
                    "%s: a voxel of %g m leaves only %.1f voxels over the model's %.0f m depth (thinnest mean layer "
                    "%.0f m); choose a smaller voxel size",

@@ -75,4 +75,40 @@ grep -qE "^atmos render: interrupted: no frame written \([0-9]+ finished frames?
     && ok "SIGTERM: the animation's line" || { bad "SIGTERM: no animation line"; cat "$T/err" >&2; }
 [ ! -e "$T/anim" ] && ok "SIGTERM: no folder left" || bad "SIGTERM: left $(find "$T/anim")"
 
+# --- 4. a small classic WRF file (CDF-1, 4 x 3 columns, 5 levels of 500 m): the default voxel
+# leaves at least 8 voxels over the model's 2500 m (no warning of its own making); a voxel the
+# user gives that is too coarse is still warned of
+python3 - "$T/wrf5.nc" <<'PY'
+import math, struct, sys
+i32 = lambda v: struct.pack(">i", v)
+def name(s):
+    b = s.encode()
+    return i32(len(b)) + b + b"\0" * (-len(b) % 4)
+NX, NY, NZ = 4, 3, 5
+zs = [500.0 * k for k in range(NZ + 1)]
+dims = [("Time", 0), ("west_east", NX), ("south_north", NY), ("bottom_top", NZ), ("bottom_top_stag", NZ + 1)]
+mass, stag = [0, 3, 2, 1], [0, 4, 2, 1]
+def f(fn, nz): return [fn(k) for k in range(nz) for j in range(NY) for i in range(NX)]
+zm = [(zs[k] + zs[k + 1]) / 2 for k in range(NZ)]
+vs = [("P", mass, f(lambda k: 0.0, NZ)), ("PB", mass, f(lambda k: 1e5 * math.exp(-zm[k] / 8000), NZ)),
+      ("T", mass, f(lambda k: 0.0, NZ)), ("QVAPOR", mass, f(lambda k: 0.005, NZ)),
+      ("QCLOUD", mass, f(lambda k: 1e-4 if k in (1, 2) else 0.0, NZ)),
+      ("PH", stag, f(lambda k: 0.0, NZ + 1)), ("PHB", stag, f(lambda k: 9.81 * zs[k], NZ + 1))]
+h = b"CDF\x01" + i32(1) + i32(0x0A) + i32(len(dims)) + b"".join(name(n) + i32(l) for n, l in dims)
+h += i32(0x0C) + i32(2) + b"".join(name(n) + i32(5) + i32(1) + struct.pack(">f", 1000.0) for n in ("DX", "DY"))
+def vh(begins):
+    return i32(0x0B) + i32(len(vs)) + b"".join(name(n) + i32(len(d)) + b"".join(i32(x) for x in d) + i32(0) + i32(0)
+                                             + i32(5) + i32(4 * len(v)) + i32(b) for (n, d, v), b in zip(vs, begins))
+off, begins = len(h + vh([0] * len(vs))), []
+for n, d, v in vs: begins.append(off); off += 4 * len(v)
+open(sys.argv[1], "wb").write(h + vh(begins) + b"".join(struct.pack(">%df" % len(v), *v) for n, d, v in vs))
+PY
+"$A" volume info "$T/wrf5.nc" >"$T/out" 2>"$T/err" && ok "small WRF file read" || { bad "small WRF file"; cat "$T/err" >&2; }
+hasnt "small WRF file, default voxel" "choose a smaller voxel"
+v=$(sed -n 's/.* voxels of \([0-9.]*\) m.*/\1/p' "$T/out" | head -1)
+python3 -c "import sys; sys.exit(0 if 0 < float('$v') <= 2500 / 8 else 1)" && ok "default voxel $v m <= 2500/8 m" \
+    || bad "default voxel '$v' m: fewer than 8 over 2500 m"
+"$A" volume info "$T/wrf5.nc" --voxel-size 500 >/dev/null 2>"$T/err"
+has "small WRF file, --voxel-size 500" "choose a smaller voxel"
+
 exit $fail
