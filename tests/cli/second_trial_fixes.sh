@@ -78,7 +78,8 @@ grep -qE "^atmos render: interrupted: no frame written \([0-9]+ finished frames?
 # --- 4. a small classic WRF file (CDF-1, 4 x 3 columns, 5 levels of 500 m): the default voxel
 # leaves at least 8 voxels over the model's 2500 m (no warning of its own making); a voxel the
 # user gives that is too coarse is still warned of
-python3 - "$T/wrf5.nc" <<'PY'
+wrf5() {
+    python3 - "$1" "$2" <<'PY'
 import math, struct, sys
 i32 = lambda v: struct.pack(">i", v)
 def name(s):
@@ -95,7 +96,7 @@ vs = [("P", mass, f(lambda k: 0.0, NZ)), ("PB", mass, f(lambda k: 1e5 * math.exp
       ("QCLOUD", mass, f(lambda k: 1e-4 if k in (1, 2) else 0.0, NZ)),
       ("PH", stag, f(lambda k: 0.0, NZ + 1)), ("PHB", stag, f(lambda k: 9.81 * zs[k], NZ + 1))]
 h = b"CDF\x01" + i32(1) + i32(0x0A) + i32(len(dims)) + b"".join(name(n) + i32(l) for n, l in dims)
-h += i32(0x0C) + i32(2) + b"".join(name(n) + i32(5) + i32(1) + struct.pack(">f", 1000.0) for n in ("DX", "DY"))
+h += i32(0x0C) + i32(2) + b"".join(name(n) + i32(5) + i32(1) + struct.pack(">f", float(sys.argv[2])) for n in ("DX", "DY"))
 def vh(begins):
     return i32(0x0B) + i32(len(vs)) + b"".join(name(n) + i32(len(d)) + b"".join(i32(x) for x in d) + i32(0) + i32(0)
                                              + i32(5) + i32(4 * len(v)) + i32(b) for (n, d, v), b in zip(vs, begins))
@@ -103,6 +104,8 @@ off, begins = len(h + vh([0] * len(vs))), []
 for n, d, v in vs: begins.append(off); off += 4 * len(v)
 open(sys.argv[1], "wb").write(h + vh(begins) + b"".join(struct.pack(">%df" % len(v), *v) for n, d, v in vs))
 PY
+}
+wrf5 "$T/wrf5.nc" 1000
 "$A" volume info "$T/wrf5.nc" >"$T/out" 2>"$T/err" && ok "small WRF file read" || { bad "small WRF file"; cat "$T/err" >&2; }
 hasnt "small WRF file, default voxel" "choose a smaller voxel"
 v=$(sed -n 's/.* voxels of \([0-9.]*\) m.*/\1/p' "$T/out" | head -1)
@@ -110,5 +113,19 @@ python3 -c "import sys; sys.exit(0 if 0 < float('$v') <= 2500 / 8 else 1)" && ok
     || bad "default voxel '$v' m: fewer than 8 over 2500 m"
 "$A" volume info "$T/wrf5.nc" --voxel-size 500 >/dev/null 2>"$T/err"
 has "small WRF file, --voxel-size 500" "choose a smaller voxel"
+
+# --- 5. no atmosphere and no camera given, a volume framed from above the flat-earth model's
+# range (a WRF domain of 400 x 300 km): the spherical model, said in a line, no warning of an
+# endless plane; --atmosphere riley keeps the flat model (and its warning)
+wrf5 "$T/wide.nc" 100000
+P='particles.cloud={"kind":"analytic","lobes":[{"type":"hg","g":0.8}],"sigma_ext_m2":6e-10}'
+"$A" render --volume "$T/wide.nc" -D "$P" --width 8 --height 8 --slices 8 -o "$T/wide.png" 2>"$T/err" \
+    && ok "wide WRF render" || { bad "wide WRF render"; cat "$T/err" >&2; }
+hasnt "wide WRF, no atmosphere given" "endless plane"
+has "wide WRF, no atmosphere given" "using the spherical atmosphere model"
+"$A" render --volume "$T/wide.nc" -D "$P" --atmosphere riley --width 8 --height 8 --slices 8 -o "$T/wide.png" \
+    2>"$T/err" && ok "wide WRF render, riley" || { bad "wide WRF render, riley"; cat "$T/err" >&2; }
+has "wide WRF, --atmosphere riley" "endless plane"
+hasnt "wide WRF, --atmosphere riley" "using the spherical"
 
 exit $fail
