@@ -128,4 +128,18 @@ has "wide WRF, no atmosphere given" "using the spherical atmosphere model"
 has "wide WRF, --atmosphere riley" "endless plane"
 hasnt "wide WRF, --atmosphere riley" "using the spherical"
 
+# --- 6. off a terminal, with no ATMOS_PROGRESS_INTERVAL, a long first render (the cloud's phase
+# tables built, the cache empty) logs a line every few seconds (5), whatever its stages last:
+# a run of over 12 s has at least two lines
+t0=$(date +%s)
+"$A" render --volume generate:cumulus --width 16 --height 9 --slices 16 -o "$T/cu.png" 2>"$T/err" \
+    || { bad "cumulus render"; cat "$T/err" >&2; }
+wall=$(( $(date +%s) - t0 ))
+lines=$(grep -c "^atmos: .*: [0-9]* %, [0-9.]* s elapsed$" "$T/err")
+if [ "$wall" -gt 12 ]; then
+    [ "$lines" -ge 2 ] && ok "progress log: $lines lines in $wall s" || { bad "progress log: $lines lines in $wall s"; cat "$T/err" >&2; }
+else
+    echo "skip: the render took $wall s (too short to need a progress line); $lines lines"
+fi
+
 exit $fail
