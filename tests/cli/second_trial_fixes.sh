@@ -8,7 +8,9 @@
 #  4. the default voxel chosen for a small classic WRF file draws no warning of its own;
 #  5. the auto-framed camera above the flat-earth model's range switches to the spherical one;
 #  6. table builds off a terminal log progress lines;
-#  7. volume takes render's option names (--particle, --volume-scale, --density-scale).
+#  7. volume takes render's option names (--particle, --volume-scale, --density-scale); the
+#     --help texts: one --eye-scale range, simulate's -q, the renderers' cameras, every
+#     command's exit statuses.
 . "$(dirname "$0")/common.inc"
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
 hasnt() { grep -qF -- "$2" "$T/err" && { bad "$1: '$2' in:"; sed 's/^/  /' "$T/err" >&2; } || ok "$1: no '$2'"; }
@@ -141,5 +143,27 @@ if [ "$wall" -gt 12 ]; then
 else
     echo "skip: the render took $wall s (too short to need a progress line); $lines lines"
 fi
+
+# --- 7. atmos volume takes render's names: the same numbers as its own
+"$A" volume generate cumulus --voxel-size 200 --scale 0.5 -o "$T/g1.json" >/dev/null 2>&1
+"$A" volume generate cumulus --voxel-size 200 --volume-scale 0.5 -o "$T/g2.json" >/dev/null 2>"$T/err" \
+    && ok "generate --volume-scale" || { bad "generate --volume-scale"; cat "$T/err" >&2; }
+"$A" volume info "$T/g1.json" --as rain --scale 3 --length-scale 2 >"$T/own" 2>&1
+"$A" volume info "$T/g2.json" --particle rain --density-scale 3 --volume-scale 2 >"$T/render" 2>"$T/err" \
+    && ok "info --particle --density-scale --volume-scale" || { bad "info with render's names"; cat "$T/err" >&2; }
+sed 's/g[12]\.json//' "$T/own" >"$T/own2"; sed 's/g[12]\.json//' "$T/render" >"$T/render2"
+[ -s "$T/own2" ] && cmp -s "$T/own2" "$T/render2" && ok "render's names read as volume's own" \
+    || { bad "render's names differ:"; diff "$T/own" "$T/render" >&2; }
+# the help texts
+"$A" render --help >"$T/err"
+hasnt "render --help" "[> 0, 2]"
+has "render --help, --camera" "slice and beams renderers take pinhole only"
+"$A" simulate --help >"$T/err"
+has "simulate --help" "-q, --quiet"
+for c in render sky sun mie phase volume simulate view compare cache bench; do
+    "$A" $c --help >"$T/err" 2>&1
+    has "$c --help" "Exit status: 0 success, 1 runtime error, 2 usage error."
+    awk 'length > 100 { exit 1 }' "$T/err" && ok "$c --help within 100 columns" || bad "$c --help: a line over 100 columns"
+done
 
 exit $fail

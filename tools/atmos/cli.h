@@ -7,7 +7,8 @@
 
 #include <stdio.h>
 
-/* Exit statuses of every subcommand. */
+/* Exit statuses of every subcommand; every --help ends with CLI_HELP_EXIT. */
+#define CLI_HELP_EXIT "\nExit status: 0 success, 1 runtime error, 2 usage error.\n"
 enum { CLI_EXIT_OK = 0, CLI_EXIT_RUNTIME = 1, CLI_EXIT_USAGE = 2 };
 
 /* Parses a finite number; on failure prints "atmos CMD: OPT: expected a number, got 'TEXT'"
