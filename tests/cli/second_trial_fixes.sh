@@ -10,7 +10,8 @@
 #  6. table builds off a terminal log progress lines;
 #  7. volume takes render's option names (--particle, --volume-scale, --density-scale); the
 #     --help texts: one --eye-scale range, simulate's -q, the renderers' cameras, every
-#     command's exit statuses.
+#     command's exit statuses;
+#  8. every `atmos render` command in README.md and docs/ uses only options render --help lists.
 . "$(dirname "$0")/common.inc"
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
 hasnt() { grep -qF -- "$2" "$T/err" && { bad "$1: '$2' in:"; sed 's/^/  /' "$T/err" >&2; } || ok "$1: no '$2'"; }
@@ -165,5 +166,32 @@ for c in render sky sun mie phase volume simulate view compare cache bench; do
     has "$c --help" "Exit status: 0 success, 1 runtime error, 2 usage error."
     awk 'length > 100 { exit 1 }' "$T/err" && ok "$c --help within 100 columns" || bad "$c --help: a line over 100 columns"
 done
+
+# --- 8. the docs' render commands (a command continued with a backslash included) take only
+# the options of atmos render --help
+"$A" render --help >"$T/help"
+python3 - "$T/help" "${ATMOS_SOURCE_DIR:?}" >"$T/err" <<'PY'
+import glob, re, sys
+opts = set(re.findall(r"(?<![\w-])--[a-z][a-z0-9-]*", open(sys.argv[1]).read()))
+root = sys.argv[2]
+for f in [root + "/README.md"] + sorted(glob.glob(root + "/docs/*.md")):
+    lines = open(f, encoding="utf-8").read().split("\n")
+    i = 0
+    while i < len(lines):
+        m = re.search(r"atmos render\b", lines[i])
+        j = i
+        if m:
+            cmd = lines[i][m.start():]
+            while cmd.rstrip().endswith("\\") and j + 1 < len(lines):
+                j += 1
+                cmd = cmd.rstrip()[:-1] + " " + lines[j]
+            cmd = re.split(r"`|\||;|#|&&", cmd)[0]  # the command alone, not what follows it
+            for o in re.findall(r"(?<![\w-])--[a-z][a-z0-9-]*", cmd):
+                if o not in opts:
+                    print("%s:%d: %s" % (f[len(root) + 1:], i + 1, o))
+        i = j + 1
+PY
+[ -s "$T/err" ] && { bad "docs' render commands with options render --help does not list:"; cat "$T/err" >&2; } \
+    || ok "the docs' render commands use render --help's options"
 
 exit $fail
