@@ -94,7 +94,6 @@ atmos_context *cli_context(int threads, int quiet)
 {
     atmos_context_desc d;
     cli_desc_progress(&d);
-    if (quiet) shared_progress.log = 0; /* the bar stays on a terminal; no log lines off one */
     return cli_context_with_progress(threads, quiet, d.progress, d.progress_user);
 }
 
