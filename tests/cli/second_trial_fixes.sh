@@ -69,6 +69,19 @@ timeout --preserve-status -s INT 3 "$A" render $slow -o "$T/was/new1/new2/a.png"
 grep -qx "atmos render: interrupted" "$T/err" && ok "SIGINT: 'interrupted' line" || { bad "SIGINT: no line"; cat "$T/err" >&2; }
 [ -d "$T/was" ] && [ ! -e "$T/was/new1" ] && ok "SIGINT: the new empty folders removed, the old kept" \
     || bad "SIGINT: folders: $(find "$T/was")"
+# on a terminal (script(1)) the progress bar's line is ended before the "interrupted" line
+if command -v script >/dev/null 2>&1; then
+    ATMOS_PROGRESS_DELAY=0 script -qec "timeout --preserve-status -s INT 3 '$A' render $slow -o '$T/tty/a.png'" \
+        /dev/null >"$T/tty.txt" 2>&1
+    python3 - "$T/tty.txt" <<'PY' && ok "on a terminal: the bar's line ended first" || bad "on a terminal: not on a line of its own"
+import sys
+d = open(sys.argv[1], "rb").read()
+i = d.find(b"atmos render: interrupted")
+sys.exit(0 if i > 0 and d[i - 1:i] == b"\n" and b"ETA" in d[:i] else 1)
+PY
+else
+    echo "skip: script(1) not installed"
+fi
 # an animation (frames of about 1-2 s): none of its frames is written, and the line says so
 # shellcheck disable=SC2086
 timeout --preserve-status -s TERM 4 "$A" render --frames 4 --sun-elevation 10 --sun-elevation-end 30 --renderer path \
