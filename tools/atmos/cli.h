@@ -34,8 +34,9 @@ atmos_context *cli_context_with_progress(int threads, int quiet, atmos_progress_
  * a fraction that starts again) has its own bar and ETA. When stderr is not a terminal (a
  * log, a batch job) the bar is not drawn: a line "atmos: STAGE: N %, T s elapsed" is written
  * every CLI_PROGRESS_LOG_INTERVAL seconds of the run (ATMOS_PROGRESS_INTERVAL=S: every S; 0:
- * every report), whichever stage runs then, T that stage's time. Pass cli_progress_bar with a cli_progress as the context's
- * progress callback; p.shown: a bar is on the terminal and its line is not ended. */
+ * every report), whichever stage runs then, T that stage's time. Pass cli_progress_bar with a
+ * cli_progress as the context's progress callback; p.shown: a bar is on the terminal and its
+ * line is not ended. */
 #define CLI_PROGRESS_LOG_INTERVAL 5.0
 typedef struct {
     int enabled;

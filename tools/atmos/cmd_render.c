@@ -256,7 +256,12 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of at most %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
     for (int i = 0; i < 6; i++) /* an animation's files go in place when every frame is made */
-        if (files[i]) fprintf(stderr, nframes > 1 ? "  made %s (moved into place with the other frames after the last one; none if interrupted)\n" : "  wrote %s\n", files[i]);
+        if (files[i])
+            fprintf(stderr,
+                    nframes > 1 ? "  made %s (moved into place with the other frames after the last one; none if "
+                                  "interrupted)\n"
+                                : "  wrote %s\n",
+                    files[i]);
     if (atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH && ranks == 0) {
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
