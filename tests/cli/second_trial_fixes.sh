@@ -64,14 +64,17 @@ hasnt "render --time 3" "--lat"
 slow="--renderer path --spp 1000000 --width 32 --height 18"
 mkdir "$T/was"
 # shellcheck disable=SC2086
-timeout --preserve-status -s INT 3 "$A" render $slow -o "$T/was/new1/new2/a.png" 2>"$T/err"; rc=$?
-[ $rc -eq 130 ] && ok "SIGINT: exit status 130" || bad "SIGINT: exit status $rc"
+timeout --preserve-status -s INT 8 "$A" render $slow -o "$T/was/new1/new2/a.png" 2>"$T/err"; rc=$?
+[ $rc -eq 130 ] && ok "SIGINT: exit status 130" || { bad "SIGINT: exit status $rc"; cat "$T/err" >&2; }
 grep -qx "atmos render: interrupted" "$T/err" && ok "SIGINT: 'interrupted' line" || { bad "SIGINT: no line"; cat "$T/err" >&2; }
+# (6.) off a terminal the 8 s render logged its progress (a line every 5 s; was every 60 s)
+grep -q "^atmos: render path: [0-9]* %, [0-9.]* s elapsed$" "$T/err" && ok "a progress line in 8 s off a terminal" \
+    || { bad "no progress line in 8 s off a terminal"; cat "$T/err" >&2; }
 [ -d "$T/was" ] && [ ! -e "$T/was/new1" ] && ok "SIGINT: the new empty folders removed, the old kept" \
     || bad "SIGINT: folders: $(find "$T/was")"
 # on a terminal (script(1)) the progress bar's line is ended before the "interrupted" line
 if command -v script >/dev/null 2>&1; then
-    ATMOS_PROGRESS_DELAY=0 script -qec "timeout --preserve-status -s INT 3 '$A' render $slow -o '$T/tty/a.png'" \
+    ATMOS_PROGRESS_DELAY=0 script -qec "timeout --preserve-status -s INT 6 '$A' render $slow -o '$T/tty/a.png'" \
         /dev/null >"$T/tty.txt" 2>&1
     python3 - "$T/tty.txt" <<'PY' && ok "on a terminal: the bar's line ended first" || bad "on a terminal: not on a line of its own"
 import sys
@@ -82,11 +85,11 @@ PY
 else
     echo "skip: script(1) not installed"
 fi
-# an animation (frames of about 1-2 s): none of its frames is written, and the line says so
-# shellcheck disable=SC2086
-timeout --preserve-status -s TERM 4 "$A" render --frames 4 --sun-elevation 10 --sun-elevation-end 30 --renderer path \
+# an animation (40 frames of about 1-2 s, far from done at 6 s): none of its frames is written,
+# and the line says so
+timeout --preserve-status -s TERM 6 "$A" render --frames 40 --sun-elevation 10 --sun-elevation-end 30 --renderer path \
     --spp 3000 --width 32 --height 18 -q -o "$T/anim/a.png" 2>"$T/err"; rc=$?
-[ $rc -eq 143 ] && ok "SIGTERM: exit status 143" || bad "SIGTERM: exit status $rc"
+[ $rc -eq 143 ] && ok "SIGTERM: exit status 143" || { bad "SIGTERM: exit status $rc"; cat "$T/err" >&2; }
 grep -qE "^atmos render: interrupted: no frame written \([0-9]+ finished frames? discarded" "$T/err" \
     && ok "SIGTERM: the animation's line" || { bad "SIGTERM: no animation line"; cat "$T/err" >&2; }
 [ ! -e "$T/anim" ] && ok "SIGTERM: no folder left" || bad "SIGTERM: left $(find "$T/anim")"
