@@ -17,6 +17,7 @@
  */
 #include "core/internal.h"
 #include "volume/generator.h"
+#include "volume/hdf5_superblock.h"
 #include "volume/netcdf_classic.h"
 #include "volume/reader_common.h"
 #include "volume/reader_fence.h"
@@ -249,6 +250,26 @@ static atmos_status classic_truncation(atmos_context *ctx, const char *path)
     return ATMOS_OK;
 }
 
+/* A netCDF-4 (HDF5) file shorter than the end its superblock records is truncated
+ * (hdf5_superblock.c): libhdf5 says only "HDF error" of it. An empty file is named so. */
+static atmos_status hdf5_truncation(atmos_context *ctx, const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return ATMOS_OK;
+    uint64_t need = 0, have = 0;
+    int rc = atmos__hdf5_data_end(f, &need, &have);
+    fclose(f);
+    if (have == 0) return atmos__error(ctx, ATMOS_E_FORMAT, "%s: the file is empty", path);
+    if (rc == 1)
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated inside the HDF5 superblock (%llu bytes)", path,
+                            (unsigned long long)have);
+    if (rc == 0 && have < need)
+        return atmos__error(ctx, ATMOS_E_FORMAT,
+                            "%s: truncated: the netCDF-4 (HDF5) file records %llu bytes, the file has %llu", path,
+                            (unsigned long long)need, (unsigned long long)have);
+    return ATMOS_OK;
+}
+
 static atmos_status check_classic_size(const src *s)
 {
     int fmt;
@@ -328,8 +349,8 @@ static atmos_status open_file(loader *L)
         FILE *f = fopen(L->s.path, "rb");
         if (!f) return atmos__error(L->s.ctx, ATMOS_E_IO, "%s: cannot open: %s", L->s.path, nc_strerror(rc));
         fclose(f);
-        return atmos__error(L->s.ctx, ATMOS_E_FORMAT, "%s: not a readable NetCDF file: %s", L->s.path,
-                            nc_strerror(rc));
+        return atmos__error(L->s.ctx, ATMOS_E_FORMAT, "%s: not a readable NetCDF file: %s%s", L->s.path,
+                            nc_strerror(rc), rc == NC_EHDFERR ? " (the file is damaged or truncated)" : "");
     }
     L->opened = 1;
     return ATMOS_OK;
@@ -707,14 +728,17 @@ static atmos_status number_density(loader *L, int si)
 
 /* The default voxel: the model's vertical resolution (its mean layer depth) unless the
  * horizontal spacing is finer, but no smaller than keeps the grid within DEFAULT_VOXELS
- * voxels (a coarse model over a wide domain: the vertical resolution then gives way). */
+ * voxels (a coarse model over a wide domain: the vertical resolution then gives way), and
+ * never so large that fewer than MIN_DEPTH_VOXELS span the model's depth (a model of a few
+ * levels: output_grid warns of a voxel that coarse). */
 #define DEFAULT_VOXELS 8388608.0
+#define MIN_DEPTH_VOXELS 8.0
 static double default_voxel(const loader *L, double depth)
 {
     const src *s = &L->s;
     double vs = fmin(fmin(L->dx, L->dy), depth / s->nz);
     const double budget = cbrt(s->nx * L->dx * s->ny * L->dy * depth / DEFAULT_VOXELS);
-    return fmax(vs, budget);
+    return fmin(fmax(vs, budget), depth / MIN_DEPTH_VOXELS);
 }
 
 /* The uniform output grid: from the lowest ground to the highest model top, voxels of
@@ -733,7 +757,7 @@ static atmos_status output_grid(loader *L)
     }
     const double dx = L->dx, dy = L->dy;
     double vs = L->desc->voxel_size_m > 0 ? L->desc->voxel_size_m : default_voxel(L, zhi - zlo);
-    if ((zhi - zlo) / vs < 8)
+    if ((zhi - zlo) / vs < MIN_DEPTH_VOXELS * (1 - 1e-9))
         atmos__log(s->ctx, ATMOS_LOG_WARN,
                    "%s: a voxel of %g m leaves only %.1f voxels over the model's %.0f m depth (thinnest mean layer "
                    "%.0f m); choose a smaller voxel size",
@@ -962,6 +986,7 @@ atmos_status atmos__volume_load_netcdf(atmos_context *ctx, const char *path, con
     /* atmos's own check of a classic file's size needs no library: done here, it spares a
      * truncated file the child process */
     atmos_status st = classic_truncation(ctx, path);
+    if (st == ATMOS_OK) st = hdf5_truncation(ctx, path);
     if (st != ATMOS_OK) return st;
     return atmos__reader_fenced(ctx, path, desc, "NetCDF/HDF5", load_direct, out);
 }

@@ -28,7 +28,8 @@ check() {
     rm -rf "$T/cache"
     XDG_CACHE_HOME="$T/cache" ATMOS_PROGRESS_DELAY=0 "$@" > "$T/$name.out" 2> "$T/$name.err" \
         || bad "$name off a terminal failed: $(tail -n 3 "$T/$name.err")"
-    if grep -q "ETA\|elapsed\|\[#" "$T/$name.err"; then bad "$name: progress off a terminal: $(head -c 300 "$T/$name.err")"; else ok; fi
+    # no bar off a terminal (log lines, "atmos: STAGE: N %, T s elapsed", every 5 s are fine)
+    if grep -q "ETA\|\[#" "$T/$name.err"; then bad "$name: a bar off a terminal: $(head -c 300 "$T/$name.err")"; else ok; fi
 }
 
 check "volume generate" generate "$A" volume generate cumulus --voxel-size 40 -o "$T/cu.json"

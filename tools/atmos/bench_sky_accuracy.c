@@ -56,6 +56,7 @@ static void help(void)
            "                   with --target-se and --max-paths; the report lists them before and after\n"
            "  --refine-sigmas K  ... also the views whose error could exceed X within K of FILE's standard\n"
            "                   errors (|error| + K s.e. > X; default 0)\n");
+    fputs(CLI_HELP_EXIT, stdout);
 }
 
 /* ------------------------------------------------------------------ the grid */

@@ -166,16 +166,17 @@ void cli_progress_init(cli_progress *p, int quiet)
     p->enabled = !quiet && isatty(2);
     const char *iv = getenv("ATMOS_PROGRESS_INTERVAL");
     char *end = NULL;
-    /* off a terminal (a batch job's log): a line a minute once a stage has run a minute, so a
-     * long first build of the tables is not silent; ATMOS_PROGRESS_INTERVAL=S sets the interval */
-    p->interval = iv && *iv ? strtod(iv, &end) : 60.0;
-    if (!(p->interval >= 0) || (end && *end)) p->interval = 60.0;
+    /* off a terminal (a batch job's log): a line every few seconds, whichever stage is running,
+     * so that a long first build of the tables (many stages of seconds each) is not silent;
+     * ATMOS_PROGRESS_INTERVAL=S sets the interval */
+    p->interval = iv && *iv ? strtod(iv, &end) : CLI_PROGRESS_LOG_INTERVAL;
+    if (!(p->interval >= 0) || (end && *end)) p->interval = CLI_PROGRESS_LOG_INTERVAL;
     p->log = !quiet && !p->enabled;
     const char *dl = getenv("ATMOS_PROGRESS_DELAY");
     end = NULL;
     p->delay = dl && *dl ? strtod(dl, &end) : 1.0;
     if (!(p->delay >= 0) || (end && *end)) p->delay = 1.0;
-    p->start = cli_now_s();
+    p->start = p->log_at = cli_now_s();
 }
 
 /* A new stage (another name, or the fraction starting again) restarts the clock; a bar
@@ -186,21 +187,22 @@ static void progress_stage(cli_progress *p, const char *stage, double f)
         p->last_fraction = f;
         return;
     }
-    if (p->shown && p->enabled) fputc('\n', stderr);
+    if (p->shown && p->enabled) fputc('\n', stderr), cli_outputs_line_open(0);
     snprintf(p->stage, sizeof p->stage, "%s", stage);
     p->start = cli_now_s();
     p->shown = 0;
-    p->last_draw = p->last_log = 0.0;
+    p->last_draw = 0.0;
     p->last_fraction = f;
 }
 
-/* Off a terminal: a line every interval seconds, the first after one interval. */
+/* Off a terminal: a line every interval seconds of the run, the first after one interval,
+ * whatever stage is running then (its own elapsed time). */
 static void progress_log(cli_progress *p, const char *stage, double f)
 {
-    double t = cli_now_s() - p->start;
-    if (t < p->interval || (p->last_log > 0 && t - p->last_log < p->interval)) return;
-    p->last_log = t > 0 ? t : 1e-9;
-    fprintf(stderr, "atmos: %s: %.0f %%, %.1f s elapsed\n", stage, 100.0 * f, t);
+    const double now = cli_now_s();
+    if (now - p->log_at < p->interval) return;
+    p->log_at = now;
+    fprintf(stderr, "atmos: %s: %.0f %%, %.1f s elapsed\n", stage, 100.0 * f, now - p->start);
     fflush(stderr);
 }
 
@@ -223,6 +225,7 @@ int cli_progress_bar(void *user, const char *stage, double f)
     double eta = f > 0 ? t * (1.0 - f) / f : 0;
     fprintf(stderr, "\r%s [%s] %3.0f%%  %.1fs elapsed, ETA %.1fs ", stage, bar, 100.0 * f, t, eta);
     p->shown = 1;
+    cli_outputs_line_open(f < 1.0);
     if (f >= 1.0) {
         fputc('\n', stderr);
         p->stage[0] = '\0'; /* the line is ended: the next report starts a new bar */

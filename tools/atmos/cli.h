@@ -7,7 +7,8 @@
 
 #include <stdio.h>
 
-/* Exit statuses of every subcommand. */
+/* Exit statuses of every subcommand; every --help ends with CLI_HELP_EXIT. */
+#define CLI_HELP_EXIT "\nExit status: 0 success, 1 runtime error, 2 usage error.\n"
 enum { CLI_EXIT_OK = 0, CLI_EXIT_RUNTIME = 1, CLI_EXIT_USAGE = 2 };
 
 /* Parses a finite number; on failure prints "atmos CMD: OPT: expected a number, got 'TEXT'"
@@ -31,18 +32,20 @@ atmos_context *cli_context_with_progress(int threads, int quiet, atmos_progress_
 /* A progress bar with ETA on stderr for work that takes over a second (ATMOS_PROGRESS_DELAY), redrawn at most
  * ten times a second, when stderr is a terminal and not quiet; each stage (a new name, or
  * a fraction that starts again) has its own bar and ETA. When stderr is not a terminal (a
- * log, a batch job) the bar is not drawn: nothing is written unless ATMOS_PROGRESS_INTERVAL
- * is set, and then a line "atmos: STAGE: N %, T s elapsed" every that many seconds once the
- * stage has taken that long. Pass cli_progress_bar with a cli_progress as the context's
- * progress callback; p.shown: a bar is on the terminal and its line is not ended. */
+ * log, a batch job) the bar is not drawn: a line "atmos: STAGE: N %, T s elapsed" is written
+ * every CLI_PROGRESS_LOG_INTERVAL seconds of the run (ATMOS_PROGRESS_INTERVAL=S: every S; 0:
+ * every report), whichever stage runs then, T that stage's time. Pass cli_progress_bar with a
+ * cli_progress as the context's progress callback; p.shown: a bar is on the terminal and its
+ * line is not ended. */
+#define CLI_PROGRESS_LOG_INTERVAL 5.0
 typedef struct {
     int enabled;
     double start;
     int shown;
     double last_draw;
-    int log;                /* not a terminal and ATMOS_PROGRESS_INTERVAL set: log lines */
+    int log;                /* not a terminal (and not quiet): log lines */
     double interval;        /* seconds between log lines */
-    double last_log;
+    double log_at;          /* when the last log line was written (or the start) */
     char stage[48];         /* the stage being shown */
     double last_fraction;
     double delay;           /* seconds before a bar appears (ATMOS_PROGRESS_DELAY, default 1) */

@@ -143,6 +143,7 @@ static void help(void)
            "          step, the process's CPU time a step and the 1-minute load average:\n"
            "            bench=simulate preset=towering_cumulus grid=128 cells=128x128x128 threads=2 steps=5\n"
            "              ms_per_step=180.2 best_ms=170.1 cpu_ms_per_step=350.3 load=1.02\n");
+    fputs(CLI_HELP_EXIT, stdout);
 }
 
 static int bench_sky(int size, int repeat, int threads, const char *models, double budget)

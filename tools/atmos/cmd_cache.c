@@ -14,6 +14,7 @@ static void help(void)
            "  clear   remove every atmos cache entry (*.atmoscache) from it; other files are left alone\n\n"
            "A stale or corrupt entry is detected on load, reported, removed and rebuilt, so clearing is\n"
            "only needed to reclaim space; 'atmos phase --no-cache' builds a table without the cache.\n");
+    fputs(CLI_HELP_EXIT, stdout);
 }
 
 int cli_cmd_cache(int argc, char **argv)

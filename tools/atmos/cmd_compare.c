@@ -35,6 +35,7 @@ static void help(void)
            "prints the pixel count, rel_rmse and rel_bias (over the reference's mean in the bin;\n"
            "--edges without --by is warned of and does nothing);\n"
            "--json adds \"bins\": [{\"lo\", \"hi\", \"pixels\", \"rel_rmse\", \"rel_bias\"}, ...].\n");
+    fputs(CLI_HELP_EXIT, stdout);
 }
 
 /* An image and its channel names (EXR: from the file; PFM: R,G,B or Y). */

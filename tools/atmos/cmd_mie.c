@@ -32,6 +32,7 @@ static void mie_usage(FILE *f)
           "S1, S2 follow MIEV0's convention (complex conjugates of Bohren & Huffman's);\n"
           "Q_ext = 4 Re S(0) / x^2, Q_back = 4 |S(180)|^2 / x^2.\n",
           f);
+    fputs(CLI_HELP_EXIT, f);
 }
 
 /* Splits "a,b,c" into doubles; returns the count, or -1 after printing a usage error. */

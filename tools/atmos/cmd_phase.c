@@ -34,13 +34,14 @@ static void help(void)
            "  --fast                         preview quality (coarser size integration, fewer rays)\n"
            "  --threads N                    worker threads (default: all cores)\n"
            "  -q, --quiet                    no progress bar or status lines (warnings are still printed)\n"
-           "  -h, --help                     this help\n\n"
+           "  -h, --help                     show this help\n\n"
            "Without --csv or --plot, prints per wavelength the extinction cross-section, the albedo,\n"
            "the asymmetry g and P at 0 and 180 degrees.\n\n"
            "Examples:\n"
            "  atmos phase rain --plot rain.png\n"
            "  atmos phase cloud --wavelengths spectral:16 --csv > cloud.csv\n"
            "  atmos phase rain --orders --csv > rain_ams.csv\n");
+    fputs(CLI_HELP_EXIT, stdout);
 }
 
 /* One line describing a preset, from its resolved description. */

@@ -256,7 +256,12 @@ static void report_frame(const atmos_plan *plan, const atmos_scene *fs, const fr
     if (ranks < 0) fprintf(stderr, "  rendered by all ranks in bands of at most %d rows; the times are rank 0's\n", CLI_DIST_BAND_ROWS);
     const char *files[6] = {ff->out, ff->exr, ff->pfm, ff->var, ff->ord, ff->tau};
     for (int i = 0; i < 6; i++) /* an animation's files go in place when every frame is made */
-        if (files[i]) fprintf(stderr, nframes > 1 ? "  made %s (in place with the last frame)\n" : "  wrote %s\n", files[i]);
+        if (files[i])
+            fprintf(stderr,
+                    nframes > 1 ? "  made %s (moved into place with the other frames after the last one; none if "
+                                  "interrupted)\n"
+                                : "  wrote %s\n",
+                    files[i]);
     if (atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH && ranks == 0) {
         atmos_plan_stats ps;
         atmos_plan_get_stats(plan, &ps);
@@ -347,7 +352,7 @@ static atmos_status render_frame(frames_run *r, atmos_plan *plan, const atmos_sc
     if (cli_outputs_hold("render", &r->fo->set) != 0) return ATMOS_E_IO; /* renamed when all frames are */
     r->total += info.seconds;
     if (!r->o->quiet) {
-        if (r->prog->shown) fputc('\n', stderr), r->prog->shown = 0;
+        if (r->prog->shown) fputc('\n', stderr), r->prog->shown = 0, cli_outputs_line_open(0);
         report_frame(plan, fs, &r->fo->ff, r->source, &info, frame, r->nframes, owner >= 0 ? owner : (d->size > 1 ? -1 : 0));
     }
     return ATMOS_OK;
@@ -365,7 +370,7 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
                     png ? cli_file_kind_of(png) : CLI_FILE_OTHER, {0, 0, 0}, NULL, 0};
     r.xl.lock = r.nframes > 1 && !o->exposure_per_frame && !scene->animation.exposure_per_frame;
     atmos_status st = ATMOS_OK;
-    if (d->rank == 0 && cli_outputs_hold_reserve(r.nframes * 6) != 0)
+    if (d->rank == 0 && cli_outputs_hold_reserve(r.nframes, 6) != 0)
         return fprintf(stderr, "atmos render: out of memory for the frames' names\n"), ATMOS_E_IO;
     for (int frame = 1; frame <= r.nframes && st == ATMOS_OK; frame++) {
         *failed_frame = frame;

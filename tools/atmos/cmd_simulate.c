@@ -49,7 +49,7 @@ static void help(void)
            "               fraction by temperature the model's own saturation, latent heat and snow use;\n"
            "               without --ice the whole condensate is written as \"cloud\")\n"
            "  --threads T  worker threads (default: all cores); the result does not depend on T\n"
-           "  --quiet      no progress bar\n"
+           "  -q, --quiet  no progress bar\n"
            "  --bench K    instead of writing a volume: K time steps, then the mean time of one step and the\n"
            "               state (simulated time, largest updraught, cloud base and top); with --minutes, runs\n"
            "               that long first and reports the time taken (bench/sim/run.sh)\n\n"

@@ -42,11 +42,12 @@ static void help(void)
            "                       --distance, --json) do not go with --table, nor -o without it\n"
            "  --json               one JSON object: {\"wavelengths_nm\", \"inscatter\", \"transmittance\",\n"
            "                       \"sun\", \"ground\", \"distance_m\", \"hits_ground\"}\n"
-           "  -h, --help           this help\n\n"
+           "  -h, --help           show this help\n\n"
            "Units: radiance W m^-2 sr^-1 nm^-1. \"inscatter\" is the air's in-scattered radiance only;\n"
            "\"ground\" is the lit ground's radiance after the air (0 unless the view ends on the\n"
            "ground); \"sun\" is the radiance of the sun's 0.5 degree disk seen from the observer.\n"
            "distance_m is null when the path reaches space.\n");
+    fputs(CLI_HELP_EXIT, stdout);
 }
 
 /* The context and the atmosphere of the options; on failure the exit code in *rc and

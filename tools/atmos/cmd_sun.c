@@ -25,6 +25,7 @@ static void sun_usage(FILE *f)
           "\n"
           "Azimuth is measured clockwise from north (east = 90).\n",
           f);
+    fputs(CLI_HELP_EXIT, f);
 }
 
 int cli_cmd_sun(int argc, char **argv)

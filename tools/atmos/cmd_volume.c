@@ -37,7 +37,8 @@ void cli_volume_help(void)
         if (n[1] && col + (int)strlen(n[1]) + 3 <= 100) col += printf(" ");
     }
     printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
-           "            voxel edge in metres; --scale multiplies its extent (default 1).\n"
+           "            voxel edge in metres; --scale (or atmos render's --volume-scale) multiplies its extent\n"
+           "            (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
            "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image (a\n"
            "            missing folder is made).\n"
@@ -59,9 +60,11 @@ void cli_volume_help(void)
            "  --time-index N    NetCDF time step (default 0; as atmos render's --time-index;\n"
            "                    --time N is the same)\n"
            "  --voxel-size M    NetCDF: resampling voxel edge in metres (default: the model's mean layer\n"
-           "                    depth or DX if finer, at most 8.4 M voxels); VDB/raw: the voxel edge\n"
-           "                    replacing the file's (its origin scaled with it)\n"
-           "  --max-memory MB   refuse volumes that would need more memory\n\n"
+           "                    depth or DX if finer, at most 8.4 M voxels, at least 8 over the depth);\n"
+           "                    VDB/raw: the voxel edge replacing the file's (its origin scaled with it)\n"
+           "  --max-memory MB   refuse volumes that would need more memory\n"
+           "atmos render's names of the same options are taken too: --particle NAME (--as), --density-scale S\n"
+           "(--scale) and --volume-scale F (--length-scale; generate: --scale, the extent).\n\n"
            "Exit status: 0 success, 1 runtime error, 2 usage error.\n");
 }
 
@@ -193,8 +196,9 @@ static int cmd_generate(int argc, char **argv)
         } else if (!strcmp(argv[i], "--voxel-size") && i + 1 < argc) {
             if (!cli_parse_double(C, "--voxel-size", argv[++i], &g.voxel_size_m)) return CLI_EXIT_USAGE;
             if (g.voxel_size_m <= 0) return cli_usage_error(C, "--voxel-size: must be > 0");
-        } else if (!strcmp(argv[i], "--scale") && i + 1 < argc) {
-            if (!cli_parse_double(C, "--scale", argv[++i], &g.scale)) return CLI_EXIT_USAGE;
+        } else if ((!strcmp(argv[i], "--scale") || !strcmp(argv[i], "--volume-scale")) && i + 1 < argc) {
+            if (!cli_parse_double(C, argv[i], argv[i + 1], &g.scale)) return CLI_EXIT_USAGE; /* render's name too */
+            i++;
             if (g.scale <= 0) return cli_usage_error(C, "--scale: must be > 0");
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;

@@ -68,11 +68,48 @@ static int held_cap;
  * size limit reached (the writers' files are removed with the others). */
 static const int ENDING[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE};
 
+/* The folders cli_outputs_prepare created (mkdir -p), outermost first: removed again, when
+ * empty, on a signal. A name is stored before made_n counts it. */
+#define MADE_MAX 16
+static char made_dir[MADE_MAX][CLI_OUTPUT_PATH_MAX];
+static volatile sig_atomic_t made_n;
+
+static volatile sig_atomic_t line_open;   /* a progress bar's line is not ended */
+static volatile sig_atomic_t frames_held; /* an animation's finished frames (held files) */
+static volatile sig_atomic_t animation;   /* cli_outputs_hold_reserve was called */
+static const char *signal_cmd = "";       /* the command, for the "interrupted" line */
+
+void cli_outputs_line_open(int open) { line_open = open; }
+
+static void put(const char *s) { (void)!write(2, s, strlen(s)); }
+
+/* "interrupted" on a line of its own (async-signal-safe: write, strlen, no stdio) */
+static void say_interrupted(void)
+{
+    if (line_open) put("\n");
+    put("atmos ");
+    put(signal_cmd);
+    put(": interrupted");
+    if (animation) {
+        char num[24], *q = num + sizeof num;
+        unsigned v = (unsigned)frames_held;
+        *--q = '\0';
+        do *--q = (char)('0' + v % 10); while ((v /= 10) && q > num);
+        put(": no frame written (");
+        put(q);
+        put(frames_held == 1 ? " finished frame discarded" : " finished frames discarded");
+        put(": an animation's frames are moved into place together, after the last one)");
+    }
+    put("\n");
+}
+
 static void on_signal(int sig)
 {
     for (int i = 0; i < SLOTS; i++)
         if (slot_used[i]) unlink(slot_name[i]);
     for (int i = 0; i < held_n; i++) unlink(held[i].stage);
+    for (int i = made_n - 1; i >= 0; i--) rmdir(made_dir[i]); /* fails when not empty: kept */
+    if (sig == SIGINT || sig == SIGTERM || sig == SIGHUP || sig == SIGQUIT) say_interrupted();
     signal(sig, SIG_DFL);
     raise(sig);
 }
@@ -203,9 +240,17 @@ static int make_parents(const char *path, char *bad, size_t cap)
         const char c = *p;
         *p = '\0';
         struct stat sb;
-        if (stat(dir, &sb) != 0 && mkdir(dir, 0777) != 0 && errno != EEXIST) {
-            snprintf(bad, cap, "%s", dir);
-            return errno;
+        if (stat(dir, &sb) != 0) {
+            if (mkdir(dir, 0777) == 0) {
+                if (made_n < MADE_MAX) {
+                    snprintf(made_dir[made_n], sizeof made_dir[0], "%s", dir);
+                    atomic_signal_fence(memory_order_seq_cst); /* the name stored before the count */
+                    made_n++;
+                }
+            } else if (errno != EEXIST) {
+                snprintf(bad, cap, "%s", dir);
+                return errno;
+            }
         }
         if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
             snprintf(bad, cap, "%s", dir);
@@ -236,6 +281,7 @@ int cli_output_folder(const char *cmd, const char *option, const char *path)
 
 int cli_outputs_prepare(const char *cmd, cli_outputs *set)
 {
+    signal_cmd = cmd;
     for (int i = 0; i < set->n; i++) {
         cli_output *o = &set->f[i];
         char bad[CLI_OUTPUT_PATH_MAX];
@@ -281,11 +327,14 @@ static int all_written(const char *cmd, cli_outputs *set)
     return 0;
 }
 
-int cli_outputs_hold_reserve(int n)
+int cli_outputs_hold_reserve(int frames, int per_frame)
 {
+    const int n = frames * per_frame;
     cli_outputs_held_discard();
     held = n > 0 ? calloc((size_t)n, sizeof *held) : NULL;
     held_cap = held ? n : 0;
+    frames_held = 0;
+    animation = frames > 1;
     return n > 0 && !held;
 }
 
@@ -307,6 +356,7 @@ int cli_outputs_hold(const char *cmd, cli_outputs *set)
         unregister_stage(i);
         o->stage[0] = '\0';
     }
+    frames_held++;
     return 0;
 }
 

@@ -10,7 +10,10 @@
  * holds each frame's staging files until all its frames are written (cli_outputs_hold).
  * SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ and SIGPIPE remove the staging files, the held
  * ones and the writers' temporaries before the process ends by the signal (the last four
- * stay ignored when the caller ignores them). */
+ * stay ignored when the caller ignores them), and the folders cli_outputs_prepare created
+ * when they are left empty; SIGINT, SIGTERM, SIGHUP and SIGQUIT print "atmos CMD:
+ * interrupted" on a line of its own (an animation's line adds how many finished frames are
+ * discarded). The exit status is the signal's (130 for SIGINT, 143 for SIGTERM). */
 #ifndef ATMOS_CLI_OUTPUTS_H
 #define ATMOS_CLI_OUTPUTS_H
 
@@ -60,8 +63,9 @@ int cli_outputs_prepare(const char *cmd, cli_outputs *set);
 int cli_output_folder(const char *cmd, const char *option, const char *path);
 /* Renames every staging file onto its final name. Returns 0 or 1 (message printed). */
 int cli_outputs_commit(const char *cmd, cli_outputs *set);
-/* An animation's frames, all or none: room for n held files (0 or 1: out of memory). */
-int cli_outputs_hold_reserve(int n);
+/* An animation's frames, all or none: room for frames * per_frame held files (0 or 1: out
+ * of memory); with frames > 1 a signal's "interrupted" line counts the finished frames. */
+int cli_outputs_hold_reserve(int frames, int per_frame);
 /* Instead of cli_outputs_commit: the staging files of set, all written, are held (kept
  * under their staging names, removed on signals) until cli_outputs_held_commit renames
  * every held file onto its final name; set is emptied of them. Returns 0 or 1 (message
@@ -72,6 +76,9 @@ int cli_outputs_held_commit(const char *cmd);
 void cli_outputs_held_discard(void);
 /* Removes the staging files (and the writers' temporaries next to them). */
 void cli_outputs_discard(cli_outputs *set);
+/* Whether a progress bar's line on the terminal is open (not ended): a signal's
+ * "interrupted" line starts on a new line then. */
+void cli_outputs_line_open(int open);
 /* A message with the staging suffix (".tmpPID") taken out of the names it holds, so
  * that the library's messages about a staging file name the output. */
 void cli_outputs_final_names(const char *msg, char *out, size_t cap);

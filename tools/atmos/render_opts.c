@@ -251,6 +251,9 @@ static int check_options(const render_opts *o)
 {
     const char *C = o->cmd;
     if (o->spectral && o->rgb) return cli_usage_error(C, "--spectral and --rgb exclude each other");
+    if (o->time && o->time[0] && strspn(o->time, "0123456789") == strlen(o->time)) /* volume's --time N */
+        return cli_usage_error(C, "--time %s: --time takes a UTC time (2026-06-21T12:00:00Z); a NetCDF time "
+                                  "step is --time-index %s", o->time, o->time);
     const int use_time = o->time || !isnan(o->lat) || !isnan(o->lon);
     if (isnan(o->lat) != isnan(o->lon)) return cli_usage_error(C, "--lat and --lon go together");
     if (use_time && (!isnan(o->sun_el) || !isnan(o->sun_az)))
@@ -604,7 +607,9 @@ static void help_settings(atmos_renderer_kind r, const char *title)
         if (!s->flag) continue;
         char opt[64], range[128] = "", a[32], b[32], c[32];
         snprintf(opt, sizeof opt, "--%s%s", s->flag, !takes_value(s) ? "" : s->type == ATMOS_SETTING_REAL ? " X" : " N");
-        if (takes_value(s))
+        if (takes_value(s) && strstr(s->doc, ", in (")) /* the doc states an irregular range itself */
+            snprintf(range, sizeof range, ", default %s", num(c, sizeof c, s->def));
+        else if (takes_value(s))
             snprintf(range, sizeof range, " [%s%s, %s%s%s%s], default %s", s->min_open ? "> " : "", num(a, sizeof a, s->min),
                      num(b, sizeof b, s->max), s->max_open ? ")" : "", s->unit[0] ? " " : "", s->unit,
                      num(c, sizeof c, s->def));
@@ -684,7 +689,8 @@ void render_opts_help(void)
            "      --spp N                   sky and slice renderers: stratified samples of the sky per pixel\n"
            "                                (1..256); path tracer: its samples per pixel (below); beams:\n"
            "                                n x n rays a pixel, n = round(sqrt(N)) (antialiasing; 1 default)\n"
-           "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map)\n"
+           "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map);\n"
+           "                                the slice and beams renderers take pinhole only, the others all\n"
            "      --altitude M              camera altitude above sea level, metres\n"
            "      --position X,Y,Z          camera position, metres (x east, y up, z south); keeps the view\n"
            "                                direction unless --look-at is given\n"
@@ -782,7 +788,7 @@ void render_opts_help(void)
            "      --sun-azimuth-end A       the last frame's sun azimuth (the shorter way round)\n"
            "  -q, --quiet                   no progress bar or status lines (warnings and errors are\n"
            "                                still printed)\n"
-           "  -h, --help                    this help\n\n"
+           "  -h, --help                    show this help\n\n"
            "Examples:\n"
            "  atmos render -o sky.png --exr sky.exr\n"
            "  atmos render scenes/sunset_fisheye.json --spectral 32 -o sunset.png\n"
@@ -792,4 +798,5 @@ void render_opts_help(void)
            "  atmos render scenes/fig06_halo_cirrus.json -D camera.fov_deg=30 -D renderer=path\n"
            "  atmos render scenes/fig01_cirrus_sunrise.json --frames 8 --time-end 2026-06-21T12:30:00Z \\\n"
            "      -o out/cirrus.png\n");
+    fputs(CLI_HELP_EXIT, stdout);
 }

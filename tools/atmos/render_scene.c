@@ -97,11 +97,40 @@ static int refuse_volume_file(const render_opts *o)
     return 1;
 }
 
+/* Whether the user chose the atmosphere: a scene file, --atmosphere or a -D atmosphere.*. */
+static int atmosphere_given(const render_opts *o)
+{
+    if (o->scene_path || o->air >= 0) return 1;
+    for (int i = 0; i < o->ndefines; i++)
+        if (!strncmp(o->defines[i], "atmosphere", 10)) return 1;
+    return 0;
+}
+
+/* The height above which the flat-earth models show an endless plane (the plan warns of it,
+ * src/render/plan.c): the Karman line. */
+#define FLAT_EARTH_TOP_M 100e3
+
+/* A camera framed above the flat-earth model's range with no atmosphere chosen: the round
+ * planet instead, which a user looking down on a domain from orbit expects (the flat
+ * model's plane would fill the sky to the horizon). */
+static void round_planet_from_orbit(const render_opts *o, atmos_scene *scene)
+{
+    if (atmosphere_given(o) || scene->atmosphere.kind != ATMOS_ATMOSPHERE_RILEY) return;
+    if (!(scene->camera.position[1] > FLAT_EARTH_TOP_M)) return;
+    scene->atmosphere.kind = ATMOS_ATMOSPHERE_SPHERICAL;
+    if (!o->quiet)
+        fprintf(stderr,
+                "atmos %s: the camera is %.0f km up, above the flat-earth riley model's range: using the spherical "
+                "atmosphere model (--atmosphere riley keeps the flat one)\n",
+                o->cmd, scene->camera.position[1] / 1000.0);
+}
+
 /* A volume file with no camera given: framed as atmos_scene_frame_volume_file frames it, and said. */
 static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
 {
     atmos_status st = atmos_scene_frame_volume_file(ctx, scene, o->view_el, volume);
-    if (st != ATMOS_OK || !*volume || o->quiet) return st;
+    if (st != ATMOS_OK || !*volume) return st;
+    if (o->quiet) return round_planet_from_orbit(o, scene), ATMOS_OK;
     double lo[3], hi[3];
     atmos_volume_bounds(*volume, lo, hi);
     const double *p = scene->camera.position, *l = scene->camera.look_at;
@@ -109,6 +138,7 @@ static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos
             "atmos %s: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
             "looking at (%.0f, %.0f, %.0f) m\n",
             o->cmd, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
+    round_planet_from_orbit(o, scene);
     return ATMOS_OK;
 }
 

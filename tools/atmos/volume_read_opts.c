@@ -15,7 +15,7 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
     if (*i + 1 >= argc) return 0;
     if (!strcmp(a, "--grids")) {
         d->grids = argv[++*i];
-    } else if (!strcmp(a, "--as")) {
+    } else if (!strcmp(a, "--as") || !strcmp(a, "--particle")) { /* --particle: atmos render's name */
         d->field = argv[++*i];
     } else if (!strcmp(a, "--time") || !strcmp(a, "--time-index")) { /* --time-index: as atmos render's */
         if (!cli_parse_int(C, a, argv[++*i], 0, 1000000, &d->time_index)) return -1;
@@ -24,9 +24,9 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
             cli_usage_error(C, "--voxel-size: expected metres > 0");
             return -1;
         }
-    } else if (!strcmp(a, "--scale")) {
-        if (!cli_parse_double(C, "--scale", argv[++*i], &d->density_scale) || !(d->density_scale > 0)) {
-            cli_usage_error(C, "--scale: expected a factor > 0");
+    } else if (!strcmp(a, "--scale") || !strcmp(a, "--density-scale")) { /* --density-scale: render's */
+        if (!cli_parse_double(C, a, argv[++*i], &d->density_scale) || !(d->density_scale > 0)) {
+            cli_usage_error(C, "%s: expected a factor > 0", a);
             return -1;
         }
     } else if (!strcmp(a, "--density-unit")) {
@@ -39,10 +39,9 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
             return -1;
         }
         d->density_unit = (atmos_density_unit)k;
-    } else if (!strcmp(a, "--length-scale")) {
-        if (!cli_parse_double(C, "--length-scale", argv[++*i], &d->length_scale) ||
-            !(d->length_scale > 0 && d->length_scale <= 1e6)) {
-            cli_usage_error(C, "--length-scale: expected a factor in (0, 1e6]");
+    } else if (!strcmp(a, "--length-scale") || !strcmp(a, "--volume-scale")) { /* --volume-scale: render's */
+        if (!cli_parse_double(C, a, argv[++*i], &d->length_scale) || !(d->length_scale > 0 && d->length_scale <= 1e6)) {
+            cli_usage_error(C, "%s: expected a factor in (0, 1e6]", a);
             return -1;
         }
     } else if (!strcmp(a, "--max-memory")) {

@@ -60,10 +60,11 @@ static void help(void)
            "                     splats are large, drawn in coarser layers where each is still PX pixels\n"
            "                     in radius (default 4; 0: all at the 1/4 resolution F12 and atmos render\n"
            "                     draw them at)\n"
-           "  --help             this text\n"
+           "  -h, --help         show this help\n"
            "Scene options are atmos render's (atmos render --help): --renderer, --volume, --sun-elevation,\n"
            "--time, --spp, -D KEY=VALUE, --threads, ...\n\n");
     view_keys_help(stdout);
+    fputs(CLI_HELP_EXIT, stdout);
 }
 
 /* Takes the viewer's own options out of argv; the rest goes to atmos render's parser. */
