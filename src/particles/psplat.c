@@ -237,12 +237,18 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
     float *pool = malloc(sizeof(float) * 2 * (size_t)o->nw * (size_t)(count > 0 ? count : 1));
     atmos__keyed *ord = malloc(sizeof *ord * (size_t)(count > 0 ? count : 1));
     int *cnt = calloc((size_t)ntx * nty + 1, sizeof(int));
+    unsigned char *kept = malloc((size_t)(count > 0 ? count : 1));
     int n = 0;
-    if (!s || !ord || !cnt || !pool) goto nomem;
+    if (!s || !ord || !cnt || !pool || !kept) goto nomem;
+    /* the splats on the threads (each particle's own record), then those drawn in order */
+#pragma omp parallel for schedule(dynamic, 256) num_threads(atmos__threads(ctx))
     for (int q = 0; q < count; q++) {
-        s[n].col = pool + 2 * (size_t)o->nw * n, s[n].tc = s[n].col + o->nw;
-        if (prepare(pc, idx ? idx[q] : q, o, L, cam, rect, &s[n])) ord[n].key = s[n].z, ord[n].index = n, n++;
+        s[q].col = pool + 2 * (size_t)o->nw * q, s[q].tc = s[q].col + o->nw;
+        kept[q] = (unsigned char)prepare(pc, idx ? idx[q] : q, o, L, cam, rect, &s[q]);
     }
+    for (int q = 0; q < count; q++)
+        if (kept[q]) ord[n].key = s[q].z, ord[n].index = q, n++;
+    free(kept), kept = NULL;
     atmos__keyed_sort(ord, (size_t)n, 1);
     /* tile lists: counts, offsets, then the splats in far-to-near order */
     for (int q = 0; q < n; q++) {
@@ -277,6 +283,6 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
     if (drawn) *drawn = n;
     return ATMOS_OK;
 nomem:
-    free(s), free(ord), free(cnt), free(pool);
+    free(s), free(ord), free(cnt), free(pool), free(kept);
     return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the splats");
 }

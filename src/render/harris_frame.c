@@ -118,10 +118,36 @@ static int part_mode(const atmos_plan *p, const atmos__harris_plan *h, const atm
                                           max_res(p, h, k)) ? 3 : 4;
 }
 
+/* Above this many impostors to make a thread, remake makes one on each thread. */
+#define REMAKE_ONE_A_THREAD 4
+
+/* Makes list[q]'s impostor (remake's entry q: full up to nfull, coarse after). */
+static atmos_status remake_one(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__plights *L,
+                               const int *list, int q, int nfull)
+{
+    const atmos__pclusters *c = &h->clouds;
+    const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
+    const int k = list[q] / 3, part = list[q] % 3;
+    const atmos__pimpostor *cim;
+    const int *idx;
+    int m;
+    atmos__harris_piece(h, k, part ? part - 1 : 1, 3, part ? ATMOS__HARRIS_SPLIT : ATMOS__HARRIS_NEAR, &cim, &idx, &m);
+    atmos__pimpostor *im = part ? &h->split[2 * k + part - 1] : &h->imp[k];
+    double d2 = 0;
+    for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
+    int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, max_res(p, h, k));
+    if (q >= nfull) res = 8 * ((res / 4 + 7) / 8);
+    const atmos_status st = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, L, idx, m, c->centre[k], c->radius[k], e, res);
+    im->split = part ? h->offset[k] : 0;
+    return st;
+}
+
 /* Makes the impostors list[0..n + nc) again (each k 3 + part: part 0 cloud k's whole impostor, 1
  * its far one, 2 its near one; the last nc whole ones at a quarter of the resolution the view
- * needs, rounded up to 8 texels), the impostors on the threads (each one's splats on one: the result
- * does not depend on the thread count). */
+ * needs, rounded up to 8 texels): many on the threads, each one's splats on one; a few (the
+ * frame's budget) one after the other, each one's particles and tiles on the threads, so that
+ * neither thread waits for the other's larger one (the result does not depend on the thread
+ * count). */
 static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
                            const int *list, int nfull, int nc)
 {
@@ -130,7 +156,6 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
                               (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
                               h->diffuse ? h->dview : NULL};
-    const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
     /* the air to all their clouds' particles in one pass on the threads (a cloud's parts follow
      * each other in list) */
     int total = 0;
@@ -144,25 +169,18 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
     air(p, h, v, ap, all, total);
     free(all);
     atmos_status st = ATMOS_OK;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(p->ctx))
-    for (int q = 0; q < n; q++) {
-        const int k = list[q] / 3, part = list[q] % 3;
-        const atmos__pimpostor *cim;
-        const int *idx;
-        int m;
-        atmos__harris_piece(h, k, part ? part - 1 : 1, 3, part ? ATMOS__HARRIS_SPLIT : ATMOS__HARRIS_NEAR, &cim, &idx, &m);
-        atmos__pimpostor *im = part ? &h->split[2 * k + part - 1] : &h->imp[k];
-        double d2 = 0;
-        for (int a = 0; a < 3; a++) d2 += (e[a] - c->centre[k][a]) * (e[a] - c->centre[k][a]);
-        int res = atmos__pimpostor_res(c->radius[k], sqrt(d2), f, max_res(p, h, k));
-        if (q >= nfull) res = 8 * ((res / 4 + 7) / 8);
-        const atmos_status sk = atmos__pimpostor_make(p->ctx, im, &h->pc, &h->o, &L, idx, m, c->centre[k], c->radius[k], e, res);
-        im->split = part ? h->offset[k] : 0;
-        if (sk != ATMOS_OK) {
+    const int threads = atmos__threads(p->ctx);
+    if (n > REMAKE_ONE_A_THREAD * threads) {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+        for (int q = 0; q < n; q++) {
+            const atmos_status sk = remake_one(p, h, v, &L, list, q, nfull);
+            if (sk != ATMOS_OK) {
 #pragma omp critical
-            st = sk;
+                st = sk;
+            }
         }
-    }
+    } else /* not inside a parallel region: each make's own loops take the threads */
+        for (int q = 0; q < n && st == ATMOS_OK; q++) st = remake_one(p, h, v, &L, list, q, nfull);
     h->updates += nfull, h->coarse += nc;
     return st;
 }

@@ -3,7 +3,8 @@
  * it leaves are made at a quarter of their resolution (the first frame, a view turned to clouds
  * not seen yet), the out-of-date ones are drawn as they were; the next frames make both in
  * full. Once caught up, the image is the same, byte for byte, as that of a plan that made them
- * all at once. */
+ * all at once (those one a thread, a frame's two one after the other, each on both threads),
+ * and as that of the same frames on one thread. */
 #include "atmos/atmos.h"
 #include "test.h"
 
@@ -100,6 +101,20 @@ int main(void)
     CHECK(sum == stale && frames == (stale + 1) / 2);
     CHECK(memcmp(a->pixels, b->pixels, sizeof(float) * (size_t)W * H * (size_t)a->channels) == 0);
     CHECK(render(all, 60, 0, a) == 0);
+    /* the same frames on one thread: the same bytes */
+    d.threads = 1;
+    atmos_context *ctx1 = NULL;
+    CHECK_OK(atmos_context_create(&d, &ctx1));
+    atmos_plan *one = plan(ctx1);
+    atmos_image *c = NULL;
+    CHECK_OK(atmos_plan_image_create(one, &f0, &c));
+    CHECK(render(one, 0, 2, c) == 2);
+    catch_up(one, 0, c, &frames);
+    catch_up(one, 60, c, &frames);
+    const int differ = memcmp(b->pixels, c->pixels, sizeof(float) * (size_t)W * H * (size_t)b->channels) != 0;
+    printf("one thread against two, budget 2, 60 m east: %s\n", differ ? "differ" : "the same bytes");
+    CHECK(!differ);
+    atmos_image_destroy(c), atmos_plan_destroy(one), atmos_context_destroy(ctx1);
     atmos_image_destroy(a), atmos_image_destroy(b);
     atmos_plan_destroy(all), atmos_plan_destroy(held);
     atmos_context_destroy(ctx);
