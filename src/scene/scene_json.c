@@ -174,6 +174,18 @@ typedef struct obj_iter {
     unsigned seen;
 } obj_iter;
 
+/* The number of names in a function's own keys[] array; a pointer does not compile (GCC, Clang). */
+#if defined(__GNUC__)
+#define KEY_COUNT(a)                                                                                             \
+    ((int)(sizeof(a) / sizeof *(a)) +                                                                             \
+     0 * (int)sizeof(struct {                                                                                     \
+         _Static_assert(!__builtin_types_compatible_p(__typeof__(a), __typeof__(&(a)[0])), "keys: an array");     \
+         int unused;                                                                                              \
+     }))
+#else
+#define KEY_COUNT(a) ((int)(sizeof(a) / sizeof *(a)))
+#endif
+
 static atmos_status iter_begin(const jp *p, const cJSON *obj, const char *path, const char *const *keys,
                                int nkeys, obj_iter *it)
 {
@@ -232,7 +244,7 @@ static atmos_status parse_image(const jp *p, const cJSON *j, const char *path, a
     char ip[PATH_CAP];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 3, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
@@ -249,7 +261,7 @@ static atmos_status parse_view(const jp *p, const cJSON *j, const char *path, do
     const cJSON *v;
     int k;
     double angle[2];
-    TRY(iter_begin(p, j, path, keys, 2, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -283,7 +295,7 @@ static atmos_status parse_camera(const jp *p, const cJSON *j, const char *path, 
     char ip[PATH_CAP], fov_path[PATH_CAP] = "", look_path[PATH_CAP] = "";
     const cJSON *v;
     int k, type;
-    TRY(iter_begin(p, j, path, keys, 6, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -418,7 +430,7 @@ static atmos_status parse_sun(const jp *p, const cJSON *j, const char *path, atm
     const cJSON *v;
     const char *text = NULL;
     int k;
-    TRY(iter_begin(p, j, path, keys, 7, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -577,7 +589,7 @@ static atmos_status parse_wavelengths(const jp *p, const cJSON *j, const char *p
     char ip[PATH_CAP];
     const cJSON *v;
     int k, mode;
-    TRY(iter_begin(p, j, path, keys, 2, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) return ATMOS_OK;
@@ -604,7 +616,7 @@ static atmos_status parse_output(const jp *p, const cJSON *j, const char *path, 
     const cJSON *v;
     int k, e, manual = -1;
     double ev = 0.0, comp = 0.0;
-    TRY(iter_begin(p, j, path, keys, 6, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -681,7 +693,7 @@ static atmos_status parse_size(const jp *p, const cJSON *j, const char *path, at
     char ip[PATH_CAP];
     const cJSON *v;
     int k, kind;
-    TRY(iter_begin(p, j, path, keys, 7, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -718,7 +730,7 @@ static atmos_status parse_lobes(const jp *p, const cJSON *j, const char *path, a
         const cJSON *v;
         int k, type = -1;
         m->weight[n] = 1.0;
-        TRY(iter_begin(p, e, ep, keys, 3, &it));
+        TRY(iter_begin(p, e, ep, keys, KEY_COUNT(keys), &it));
         for (;;) {
             TRY(iter_next(p, &it, &k, &v, ip));
             if (k < 0) break;
@@ -768,7 +780,7 @@ static atmos_status parse_particle(const jp *p, const cJSON *j, const char *path
     const cJSON *v;
     int k, e, have_kind = pre != NULL;
     double rays = 0;
-    TRY(iter_begin(p, j, path, keys, 10, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -882,7 +894,7 @@ static atmos_status parse_background(const jp *p, const cJSON *j, const char *pa
         char ip[PATH_CAP];
         const cJSON *v;
         int k;
-        TRY(iter_begin(p, j, path, keys, 2, &it));
+        TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
         for (;;) {
             TRY(iter_next(p, &it, &k, &v, ip));
             if (k < 0) break;
@@ -918,7 +930,7 @@ static atmos_status parse_simulate(const jp *p, const cJSON *j, const char *path
     char ip[PATH_CAP], buf[64];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 7, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -960,7 +972,7 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
     char ip[PATH_CAP], buf[64];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 13, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -1108,7 +1120,7 @@ static atmos_status parse_light(const jp *p, const cJSON *j, const char *path, a
     char ip[PATH_CAP];
     const cJSON *v;
     int k, type;
-    TRY(iter_begin(p, j, path, keys, 10, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) {
@@ -1183,7 +1195,7 @@ static atmos_status object_item(const jp *p, const cJSON *j, const char *path, a
     char ip[PATH_CAP];
     const cJSON *v;
     int k;
-    TRY(iter_begin(p, j, path, keys, 13, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -1221,7 +1233,7 @@ static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atm
     const cJSON *v;
     int k;
     atmos_scene_fog *f = &s->fog;
-    TRY(iter_begin(p, j, path, keys, 7, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -1270,7 +1282,7 @@ static atmos_status parse_animation(const jp *p, const cJSON *j, const char *pat
     const cJSON *v;
     const char *text = NULL;
     int k;
-    TRY(iter_begin(p, j, path, keys, 6, &it));
+    TRY(iter_begin(p, j, path, keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
         if (k < 0) break;
@@ -1321,7 +1333,7 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
     const char *name = NULL;
     int k, renderer;
     if (!cJSON_IsObject(root)) return type_error(&p, "/", "an object", root);
-    TRY(iter_begin(&p, root, "", keys, 20, &it));
+    TRY(iter_begin(&p, root, "", keys, KEY_COUNT(keys), &it));
     for (;;) {
         TRY(iter_next(&p, &it, &k, &v, ip));
         if (k < 0) {

@@ -245,6 +245,16 @@ static const bad_case bad_structure[] = {
     {"{\"sun\": {\"elevation_deg\": 5, \"Azimuth_deg\": 5}}", ATMOS_E_INVALID_ARG, "/sun/Azimuth_deg: unknown key", "azimuth_deg"},
     {"{\"camera\": {\"view\": {\"elevation_deg\": 5, \"azimuth_deg\": 5, \"roll\": 1}}}", ATMOS_E_INVALID_ARG, "/camera/view/roll: unknown key", NULL},
     {"{\"a/b~c\": 1}", ATMOS_E_INVALID_ARG, "/a~1b~0c: unknown key", NULL},
+    {"{\"output\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/output/zz: unknown key (allowed: ", "exr_pixel"}, /* every name listed, none past its array */
+    {"{\"animation\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/animation/zz: unknown key (allowed: ", "exposure"}, /* every name listed, none past its array */
+    {"{\"image\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/image/zz: unknown key (allowed: ", "height"}, /* every name listed, none past its array */
+    {"{\"wavelengths\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/wavelengths/zz: unknown key (allowed: ", "samples"}, /* every name listed, none past its array */
+    {"{\"slice\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/slice/zz: unknown key (allowed: ", "slices"}, /* every name listed, none past its array */
+    {"{\"nishita\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/nishita/zz: unknown key (allowed: ", "orders"}, /* every name listed, none past its array */
+    {"{\"harris\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/harris/zz: unknown key (allowed: ", "spacing_m"}, /* every name listed, none past its array */
+    {"{\"beams\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/beams/zz: unknown key (allowed: ", "epsilon"}, /* every name listed, none past its array */
+    {"{\"fog\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/fog/zz: unknown key (allowed: ", "extinction_per_m"}, /* every name listed, none past its array */
+    {"{\"atmosphere\": {\"zz\": 1}}", ATMOS_E_INVALID_ARG, "/atmosphere/zz: unknown key (allowed: ", "model"}, /* every name listed, none past its array */
     {"[1, 2]", ATMOS_E_INVALID_ARG, "scene.json: /: expected an object, got an array", NULL},
     {"{\"image\": 5}", ATMOS_E_INVALID_ARG, "/image: expected an object, got a number", NULL},
     {"{\"image\": {\"width\": 1.5}}", ATMOS_E_INVALID_ARG, "/image/width: expected an integer, got 1.5", NULL},
