@@ -9,7 +9,10 @@
  *     address, the free-space address and the end-of-file address, O bytes each;
  *   version 2 or 3: version, O (byte 9), size of lengths, flags; then the base address,
  *     the superblock extension address and the end-of-file address, O bytes each.
- * The end-of-file address is relative to the base address; all ones is "undefined".
+ * The end-of-file address is the file's size as the library that wrote it left it, user block
+ * included (libhdf5 compares it with the size on disk, not with the size past the base address);
+ * where a superblock was found elsewhere than its base address says, by that shift. All ones is
+ * "undefined".
  */
 #define _POSIX_C_SOURCE 200809L /* fseeko, ftello */
 #include "volume/hdf5_superblock.h"
@@ -66,6 +69,7 @@ int atmos__hdf5_data_end(FILE *f, uint64_t *end, uint64_t *size)
     uint64_t undefined = o == 8 ? UINT64_MAX : ((uint64_t)1 << (8 * o)) - 1;
     uint64_t base = le(sb + base_pos, (int)o), eof = le(sb + base_pos + 2 * o, (int)o);
     if (eof == undefined || base == undefined) return -1;
-    *end = base + eof < base ? UINT64_MAX : base + eof;
+    uint64_t shift = at > base ? at - base : 0;
+    *end = eof + shift < eof ? UINT64_MAX : eof + shift;
     return 0;
 }

@@ -256,7 +256,7 @@ static atmos_status hdf5_truncation(atmos_context *ctx, const char *path)
 {
     FILE *f = fopen(path, "rb");
     if (!f) return ATMOS_OK;
-    uint64_t need = 0, have = 0;
+    uint64_t need = 0, have = UINT64_MAX; /* stays so when the size cannot be had (a pipe) */
     int rc = atmos__hdf5_data_end(f, &need, &have);
     fclose(f);
     if (have == 0) return atmos__error(ctx, ATMOS_E_FORMAT, "%s: the file is empty", path);

@@ -65,7 +65,9 @@ int main(void)
     size_t n = v2(sb, 8, 0, 4096);
     CHECK(run(file_with(sb, n, 0, 100), &end, &size) == 0 && end == 4096 && size == 100);
     CHECK(run(file_with(sb, n, 0, 4096), &end, &size) == 0 && end == 4096 && size == 4096);
-    n = v2(sb, 4, 512, 1000); /* a user block: the end is relative to the base address */
+    n = v2(sb, 4, 512, 1000); /* a user block (base 512): the end counts the user block, as */
+    CHECK(run(file_with(sb, n, 512, 700), &end, &size) == 0 && end == 1000 && size == 700); /* libhdf5 */
+    n = v2(sb, 4, 0, 1000); /* found at 512 with base 0 (the file moved by 512): the end moves too */
     CHECK(run(file_with(sb, n, 512, 700), &end, &size) == 0 && end == 1512 && size == 700);
     n = v0(sb, 8, 3000);
     CHECK(run(file_with(sb, n, 0, 200), &end, &size) == 0 && end == 3000);
