@@ -77,7 +77,9 @@ static volatile sig_atomic_t made_n;
 static volatile sig_atomic_t line_open;   /* a progress bar's line is not ended */
 static volatile sig_atomic_t frames_held; /* an animation's finished frames (held files) */
 static volatile sig_atomic_t animation;   /* cli_outputs_hold_reserve was called */
-static const char *signal_cmd = "";       /* the command, for the "interrupted" line */
+static const char *signal_cmd = "render"; /* the command, for the "interrupted" line */
+static volatile sig_atomic_t committing;  /* held files being renamed: a signal waits for the end */
+static volatile sig_atomic_t deferred;    /* the signal that came meanwhile (any thread's) */
 
 void cli_outputs_line_open(int open) { line_open = open; }
 
@@ -105,6 +107,10 @@ static void say_interrupted(void)
 
 static void on_signal(int sig)
 {
+    if (committing) { /* a thread the commit's mask does not cover: all or none still holds */
+        deferred = sig;
+        return;
+    }
     for (int i = 0; i < SLOTS; i++)
         if (slot_used[i]) unlink(slot_name[i]);
     for (int i = 0; i < held_n; i++) unlink(held[i].stage);
@@ -363,24 +369,36 @@ int cli_outputs_hold(const char *cmd, cli_outputs *set)
 /* The held files renamed into place with the ending signals blocked, so that a signal cannot
  * remove the frames not yet renamed once the first is (it is taken after the loop, when every
  * frame is in place). A rename that fails part way leaves the frames before it new: said. */
+/* The end of a commit: signals act again, one that came during it (to another thread) now. */
+static void commit_end(const sigset_t *old)
+{
+    atomic_signal_fence(memory_order_seq_cst);
+    committing = 0;
+    atomic_signal_fence(memory_order_seq_cst);
+    sigprocmask(SIG_SETMASK, old, NULL);
+    if (deferred) raise(deferred);
+}
+
 int cli_outputs_held_commit(const char *cmd)
 {
     sigset_t block, old;
     sigemptyset(&block);
     for (size_t k = 0; k < sizeof ENDING / sizeof ENDING[0]; k++) sigaddset(&block, ENDING[k]);
-    sigprocmask(SIG_BLOCK, &block, &old);
+    sigprocmask(SIG_BLOCK, &block, &old); /* this thread; other threads' handlers defer */
+    committing = 1;
+    atomic_signal_fence(memory_order_seq_cst);
     for (int i = 0; i < held_n; i++)
         if (rename(held[i].stage, held[i].path) != 0) {
             fprintf(stderr, "atmos %s: %s: cannot rename %s into place: %s (%d of %d files renamed before it)\n",
                     cmd, held[i].path, held[i].stage, strerror(errno), i, held_n);
             cli_outputs_held_discard();
-            sigprocmask(SIG_SETMASK, &old, NULL);
+            commit_end(&old);
             return 1;
         }
     const int n = held_n;
     held_n = 0;
-    atomic_signal_fence(memory_order_seq_cst);
-    sigprocmask(SIG_SETMASK, &old, NULL);
+    animation = 0; /* the frames are in place: a signal now interrupts nothing of theirs */
+    commit_end(&old);
     for (int i = 0; i < n; i++) free(held[i].stage), free(held[i].path);
     free(held), held = NULL, held_cap = 0;
     return 0;
