@@ -68,6 +68,8 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc);
 atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], const double out_w[3],
                                       const double eye_w[3], const double *E, int threads);
 const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np);
+/* 1 when the Monte Carlo field is delta-M scaled (its photons saw sig*, not sig') */
+int atmos__nishita_mc_delta_m(const atmos__nishita_plan *np);
 
 /* The forward-peak truncation of the orders 2-3 (nishita_light.c): trunc[] from the fields'
  * mean phase function, the field's medium scaled (sig_s (1 - f), sig_t - f sig_s). */

@@ -152,6 +152,8 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
 
 const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np) { return &np->mc->field; }
 
+int atmos__nishita_mc_delta_m(const atmos__nishita_plan *np) { return np->mc->delta_m; }
+
 /* The occupied box's faces lit by the sunlight travelling along lt (grid frame): each face's
  * area across the beam (area3, m^2) and their sum. */
 static double box_area(const path_medium *m, const double lt[3], double *area3)

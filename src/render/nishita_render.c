@@ -145,12 +145,13 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
             double S = s1 * J->E[w] * exp(-tau) + Sd[w] +
                        (J->use_field ? (1.0 - fade[w]) * ss * (1 - np->trunc[w]) * (Lf[w] > 0 ? Lf[w] : 0) : 0);
             if (J->tms) Sm += S, S = 0;
+            else S += Sm; /* without delta-M the field's medium is the eye ray's: one transmittance */
             const double a = st > 0 ? -expm1(-st * dt) : 0;
             L[w] += st > 0 ? T[w] * S / st * a : 0;
             if (w == n / 2) wsum += T[w] * a, tsum += t * T[w] * a;
             T[w] *= 1 - a;
             Tmax = T[w] > Tmax ? T[w] : Tmax;
-            if (J->mc) { /* the Monte Carlo field in the medium its photons saw (delta-M: sig*, its own Tm) */
+            if (J->tms) { /* delta-M: the Monte Carlo field in the medium its photons saw, sig*, its own Tm */
                 const double am = sm > 0 ? -expm1(-sm * dt) : 0;
                 L[w] += sm > 0 ? Tm[w] * Sm / sm * am : 0;
                 Tm[w] *= 1 - am;
@@ -219,7 +220,7 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
         for (int a = 0; a < 3; a++) ot[a] = -dc[a];
         if ((st = atmos__nishita_mc_update(p, v->sun, ot, v->cam.position, J.E, threads)) != ATMOS_OK) return st;
         J.mc = atmos__nishita_mc_field(np);
-        J.tms = p->scene.nishita.mc_delta_m && p->scene.nishita.mc_lmax >= 0;
+        J.tms = atmos__nishita_mc_delta_m(np);
     }
     const int W = out->width, C = out->channels;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)

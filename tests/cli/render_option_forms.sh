@@ -135,4 +135,8 @@ while i < len(d):
 "$A" render $(base beams) -D output.exposure=auto -q -o "$T/auto_def.png" || bad "render -D output.exposure=auto"
 a=$(png_scale "$T/auto_opt.png") b=$(png_scale "$T/auto_def.png")
 if [ -n "$a" ] && [ "$a" = "$b" ]; then ok "--exposure auto = -D output.exposure=auto (scale $a)"; else bad "--exposure auto scale $a, -D form $b"; fi
+# an option that does nothing on its own says so
+# shellcheck disable=SC2046
+"$A" render $(base nishita) -q --nishita-mc-delta-m -o "$T/dm.png" 2>"$T/dm.err" || bad "render --nishita-mc-delta-m"
+grep -q "mc_delta_m does nothing" "$T/dm.err" && ok "--nishita-mc-delta-m without a field warns" || bad "no warning: $(cat "$T/dm.err")"
 exit $fail

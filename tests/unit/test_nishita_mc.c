@@ -133,10 +133,10 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
          * scattered, the rest's moments falling off by degree 3), its first order in the scaled
          * medium too (TMS): measured +1.4 % and +1.3 % with 300 thousand photons per wavelength
          * (+9.9 and +7.8 % with 100 thousand: the photons' noise), within the field toward the
-         * view's centre's error. Held within 10 %, a bound the unscaled degree 3 (above) fails at
-         * both angles, so the check can fail */
+         * view's centre's error. Held within 10 % (the unscaled degree 3, above, is outside it at
+         * both angles) and closer than the unscaled degree 3, so the check can fail */
         CHECK(fabs(md / ref - 1) < 0.1);
-        CHECK(fabs(m / ref - 1) > 0.1);
+        CHECK(fabs(md / ref - 1) < fabs(m / ref - 1));
         atmos_image_destroy(img), atmos_image_destroy(dm), atmos_image_destroy(ex), atmos_image_destroy(one);
     }
 }
