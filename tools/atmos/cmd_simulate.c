@@ -52,8 +52,7 @@ static void help(void)
            "  -q, --quiet  no progress bar\n"
            "  --bench K    instead of writing a volume: K time steps, then the mean time of one step and the\n"
            "               state (simulated time, largest updraught, cloud base and top); with --minutes, runs\n"
-           "               that long first and reports the time taken (bench/sim/run.sh)\n\n"
-           "Exit status: 0 success, 1 runtime error, 2 usage error.\n",
+           "               that long first and reports the time taken (bench/sim/run.sh)\n" CLI_HELP_EXIT,
            ATMOS_SIM_MAX_MINUTES, ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID, ATMOS_SIM_MAX_REFINE);
 }
 

@@ -64,8 +64,7 @@ void cli_volume_help(void)
            "                    VDB/raw: the voxel edge replacing the file's (its origin scaled with it)\n"
            "  --max-memory MB   refuse volumes that would need more memory\n"
            "atmos render's names of the same options are taken too: --particle NAME (--as), --density-scale S\n"
-           "(--scale) and --volume-scale F (--length-scale; generate: --scale, the extent).\n\n"
-           "Exit status: 0 success, 1 runtime error, 2 usage error.\n");
+           "(--scale) and --volume-scale F (--length-scale; generate: --scale, the extent).\n" CLI_HELP_EXIT);
 }
 
 static int load(const char *path, atmos_context *ctx, const atmos_volume_load_desc *d, atmos_volume **v)
@@ -199,7 +198,7 @@ static int cmd_generate(int argc, char **argv)
         } else if ((!strcmp(argv[i], "--scale") || !strcmp(argv[i], "--volume-scale")) && i + 1 < argc) {
             if (!cli_parse_double(C, argv[i], argv[i + 1], &g.scale)) return CLI_EXIT_USAGE; /* render's name too */
             i++;
-            if (g.scale <= 0) return cli_usage_error(C, "--scale: must be > 0");
+            if (g.scale <= 0) return cli_usage_error(C, "%s: must be > 0", argv[i - 1]);
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
         } else if (argv[i][0] == '-') {

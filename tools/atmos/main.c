@@ -39,8 +39,7 @@ static void usage(FILE *f)
     for (int i = 0; i < NCOMMANDS; i++) fprintf(f, "  %-*s  %s\n", width, commands[i].name, commands[i].summary);
     fprintf(f,
             "\n  atmos COMMAND --help   help for one command\n"
-            "  atmos --version        print the version\n\n"
-            "Exit status: 0 success, 1 runtime error, 2 usage error.\n");
+            "  atmos --version        print the version\n" CLI_HELP_EXIT);
 }
 
 int main(int argc, char **argv)
