@@ -773,6 +773,9 @@ static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const 
         for (int x = r->x0; x < r->x1; x++) atmos__beams_il_add(il, x, y, out->pixels + ((size_t)y * W + x) * C);
 }
 
+/* A frame's own buffers (a job is zeroed first: the ones not made yet are NULL). */
+static void job_free(job *J) { free(J->z_lo), free(J->span), free(J->alb_pi), free(J->ru); }
+
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
 {
     atmos__beams_plan *b = p->beams;
@@ -788,13 +791,13 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
     if (eye_coordinates(&J)) {
-        free(J.z_lo), free(J.span), free(J.alb_pi);
+        job_free(&J);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     }
     /* the sky seen from the ground under the eye, kept while that stays within its quantum */
     if ((b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) ||
         (b->obj.n > 0 && (st = atmos__beams_sky_keep(p->ctx, p->atm, J.eye, v->sun, J.nw, &b->sky)) != ATMOS_OK)) {
-        free(J.z_lo), free(J.span), free(J.alb_pi), free(J.ru);
+        job_free(&J);
         return st;
     }
     atmos__beams_il il = {0}, *ilp = NULL;
@@ -807,7 +810,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     if (!failed && b->obj.n > 0) {
         if ((st = atmos__beams_primary_build_kept(p->ctx, &b->obj, &v->cam, ilp ? &il.e : r, &b->kept[ATMOS__BEAMS_KEPT_PRIMARY],
                                                   &prim)) != ATMOS_OK) {
-            atmos__beams_il_free(&il), free(J.z_lo), free(J.span), free(J.alb_pi), free(J.ru);
+            atmos__beams_il_free(&il), job_free(&J);
             return st;
         }
         J.prim = &prim;
@@ -820,7 +823,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     atmos__beams_primary_free(&prim);
     if (ilp && !failed && !cancelled) filter(p, r, out, &il);
     atmos__beams_il_free(&il);
-    free(J.z_lo), free(J.span), free(J.alb_pi), free(J.ru);
+    job_free(&J);
     b->centre_planes = J.centre_planes, b->centre_subplanes = J.centre_subplanes;
     b->air_evaluated = evaluated, b->air_pixels = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
     if (failed) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
