@@ -664,6 +664,26 @@ static void test_screen_spans(void)
     CHECK(missed == 0);
 }
 
+/* A spot 20 m above a 60 m floor (albedo 0.6; cone 20 deg, edge 5 deg, pointing (0.3, -1, 0.2)),
+ * in a fog that absorbs sig per metre and scatters nothing, seen from eye toward (3, 0, 2). */
+static void spot_floor_scene(atmos_scene *s, int w, int h, const double eye[3], double range, double sig)
+{
+    base_scene(s, w, h);
+    s->fog.extinction_per_m = sig, s->fog.scattering_per_m = 0;
+    atmos_scene_light *l = &s->lights[0];
+    l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 20, l->edge_deg = 5, l->range_m = range;
+    l->position_m[0] = 0, l->position_m[1] = 20, l->position_m[2] = 0;
+    l->direction[0] = 0.3, l->direction[1] = -1, l->direction[2] = 0.2;
+    s->object_count = 1;
+    memset(&s->objects[0], 0, sizeof s->objects[0]);
+    s->objects[0].scale[0] = s->objects[0].scale[1] = s->objects[0].scale[2] = 30;
+    s->objects[0].albedo[0] = s->objects[0].albedo[1] = s->objects[0].albedo[2] = 0.6;
+    snprintf(s->objects[0].mesh, sizeof s->objects[0].mesh, "builtin:plane");
+    memcpy(s->camera.position, eye, 3 * sizeof *eye);
+    s->camera.look_at[0] = 3, s->camera.look_at[1] = 0, s->camera.look_at[2] = 2;
+    s->camera.fov_deg = 70;
+}
+
 /* A floor under a spot, seen from several places, no light scattered by the air: every pixel whose
  * floor point lies inside the spot's outer cone is lit, every other is dark — the surfaces' light
  * skipped outside the light's screen span must be zero there, also where the floor lies beyond the
@@ -675,20 +695,7 @@ static void test_surface_spans(void)
     for (int e = 0; e < 3; e++)
         for (int k = 0; k < 2; k++) {
             atmos_scene s;
-            base_scene(&s, 64, 48);
-            s.fog.extinction_per_m = 0.001, s.fog.scattering_per_m = 0;
-            atmos_scene_light *l = &s.lights[0];
-            l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 20, l->edge_deg = 5, l->range_m = ranges[k];
-            l->position_m[0] = 0, l->position_m[1] = 20, l->position_m[2] = 0;
-            l->direction[0] = 0.3, l->direction[1] = -1, l->direction[2] = 0.2;
-            s.object_count = 1;
-            memset(&s.objects[0], 0, sizeof s.objects[0]);
-            s.objects[0].scale[0] = s.objects[0].scale[1] = s.objects[0].scale[2] = 30;
-            s.objects[0].albedo[0] = s.objects[0].albedo[1] = s.objects[0].albedo[2] = 0.6;
-            snprintf(s.objects[0].mesh, sizeof s.objects[0].mesh, "builtin:plane");
-            memcpy(s.camera.position, eyes[e], sizeof eyes[e]);
-            s.camera.look_at[0] = 3, s.camera.look_at[1] = 0, s.camera.look_at[2] = 2;
-            s.camera.fov_deg = 70;
+            spot_floor_scene(&s, 64, 48, eyes[e], ranges[k], 0.001);
             atmos_image *img = render(ctx, &s);
             atmos_camera cam;
             CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
@@ -732,21 +739,8 @@ static void test_surface_closed_form(void)
     for (int e = 0; e < 2; e++)
         for (int step = 1; step <= 4; step += 3) {
             atmos_scene s;
-            base_scene(&s, 160, 120);
+            spot_floor_scene(&s, 160, 120, eyes[e], 40, sig);
             s.beams.screen_step = step;
-            s.fog.extinction_per_m = sig, s.fog.scattering_per_m = 0;
-            atmos_scene_light *l = &s.lights[0];
-            l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 20, l->edge_deg = 5, l->range_m = 40;
-            memcpy(l->position_m, lp, sizeof lp);
-            l->direction[0] = 0.3, l->direction[1] = -1, l->direction[2] = 0.2;
-            s.object_count = 1;
-            memset(&s.objects[0], 0, sizeof s.objects[0]);
-            s.objects[0].scale[0] = s.objects[0].scale[1] = s.objects[0].scale[2] = 30;
-            s.objects[0].albedo[0] = s.objects[0].albedo[1] = s.objects[0].albedo[2] = 0.6;
-            snprintf(s.objects[0].mesh, sizeof s.objects[0].mesh, "builtin:plane");
-            memcpy(s.camera.position, eyes[e], sizeof eyes[e]);
-            s.camera.look_at[0] = 3, s.camera.look_at[1] = 0, s.camera.look_at[2] = 2;
-            s.camera.fov_deg = 70;
             atmos_image *img = render(ctx, &s);
             atmos_camera cam;
             CHECK_OK(atmos_camera_init(ctx, &s.camera, s.width, s.height, &cam));
