@@ -651,7 +651,8 @@ static void help_volume(void)
     help_list(&col, atmos_sim_preset_names(), "\n");
 }
 
-void render_opts_help(void)
+/* The usage line, what the command does and the options up to --volume. */
+static void help_head(void)
 {
     printf("Usage: atmos render [SCENE.json|-] [-o OUT.png] [--exr OUT.exr] [--pfm OUT.pfm] [options]\n\n"
            "Renders a scene file ('-': read from standard input), or the built-in default scene when none\n"
@@ -732,6 +733,11 @@ void render_opts_help(void)
            "                                scene's \"lights\" in its \"fog\" with the shadows of its \"objects\"\n"
            "                                (docs/beams.md)\n"
            );
+}
+
+void render_opts_help(void)
+{
+    help_head();
     help_volume();
     printf(
            "      --volume-position X,Y,Z   where the centre of the volume box's bottom face goes, metres\n"
