@@ -210,4 +210,8 @@ PY
 [ -s "$T/err" ] && { bad "docs' render commands with options render --help does not list:"; cat "$T/err" >&2; } \
     || ok "the docs' render commands use render --help's options"
 
+# a value refused by the scene's check names the option that sets it, not only its JSON path
+"$A" render -q --volume generate:cumulus --eye-scale 1.5 -o "$T/es.png" 2>"$T/err"; st=$?
+[ $st -eq 2 ] && grep -q "/slice/eye_scale" "$T/err" && grep -q "the option --eye-scale sets it" "$T/err" \
+    && ok "a refused setting names its option" || { bad "refused setting (exit $st)"; cat "$T/err" >&2; }
 exit $fail

@@ -64,6 +64,24 @@ static const atmos_setting *table_row(int i, atmos_renderer_kind *r)
     return NULL;
 }
 
+/* atmos render's option for a renderer's setting /SECTION/KEY, as a validation message names it
+ * ("... /slice/eye_scale: ..."); NULL when the message names none or the setting has no option. */
+const char *render_opts_flag_in(const char *msg)
+{
+    const char *a = msg ? strchr(msg, '/') : NULL;
+    const char *b = a ? strchr(a + 1, '/') : NULL, *c = b ? strchr(b + 1, ':') : NULL;
+    if (!c) return NULL;
+    atmos_renderer_kind r;
+    const atmos_setting *t;
+    for (int i = 0; (t = table_row(i, &r)) != NULL; i++) {
+        const char *name = atmos_renderer_name(r);
+        if (t->flag && strlen(name) == (size_t)(b - a - 1) && !strncmp(name, a + 1, (size_t)(b - a - 1)) &&
+            strlen(t->key) == (size_t)(c - b - 1) && !strncmp(t->key, b + 1, (size_t)(c - b - 1)))
+            return t->flag;
+    }
+    return NULL;
+}
+
 static int takes_value(const atmos_setting *s)
 {
     return s->type != ATMOS_SETTING_BOOL && s->type != ATMOS_SETTING_CHOICE;

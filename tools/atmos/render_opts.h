@@ -57,6 +57,8 @@ void render_opts_help(void);
 /* Applies the options to a scene (loaded or the default); returns CLI_EXIT_OK or
  * CLI_EXIT_USAGE (message printed). ctx receives time-parsing errors. */
 int render_opts_apply(atmos_context *ctx, const render_opts *o, atmos_scene *scene);
+/* atmos render's option (without "--") for the renderer setting a validation message names, or NULL */
+const char *render_opts_flag_in(const char *msg);
 /* Nonzero when the options place the camera themselves (--position, --look-at, --altitude,
  * --camera): a volume file is then not framed by default. */
 int render_opts_camera_given(const render_opts *o);

@@ -266,7 +266,9 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     int rc = render_opts_apply(ctx, o, scene);
     if (rc != CLI_EXIT_OK) return rc;
     if ((st = atmos_scene_validate(ctx, scene, o->scene_path ? o->scene_path : "options")) != ATMOS_OK) {
+        const char *flag = render_opts_flag_in(atmos_context_error(ctx));
         fprintf(stderr, "atmos %s: %s\n", o->cmd, atmos_context_error(ctx));
+        if (flag) fprintf(stderr, "  (the option --%s sets it)\n", flag);
         return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
     }
     if (!render_opts_camera_given(o) && (st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK)
