@@ -214,4 +214,10 @@ PY
 "$A" render -q --volume generate:cumulus --eye-scale 1.5 -o "$T/es.png" 2>"$T/err"; st=$?
 [ $st -eq 2 ] && grep -q "/slice/eye_scale" "$T/err" && grep -q "the option --eye-scale sets it" "$T/err" \
     && ok "a refused setting names its option" || { bad "refused setting (exit $st)"; cat "$T/err" >&2; }
+# a render that fails after its outputs' folders were made (the plan: a mesh that is not there)
+# leaves none of the folders it made
+printf '{"renderer": "beams", "image": {"width": 16, "height": 8}, "lights": [{"type": "point", "position_m": [0, 5, 0]}], "objects": [{"mesh": "%s/none.obj"}]}' "$T" >"$T/nomesh.json"
+"$A" render -q "$T/nomesh.json" -o "$T/made/sub/x.png" 2>"$T/err"; st=$?
+[ $st -eq 1 ] && [ ! -e "$T/made" ] && ok "a failed render removes the folders it made" \
+    || { bad "failed render (exit $st) left $(ls -d "$T/made" 2>/dev/null)"; cat "$T/err" >&2; }
 exit $fail

@@ -105,6 +105,13 @@ static void say_interrupted(void)
     put("\n");
 }
 
+/* The folders this run made, removed where still empty (rmdir fails otherwise: kept); safe in
+ * a signal handler. */
+static void remove_made_dirs(void)
+{
+    for (int i = made_n - 1; i >= 0; i--) rmdir(made_dir[i]);
+}
+
 static void on_signal(int sig)
 {
     if (committing) { /* a thread the commit's mask does not cover: all or none still holds */
@@ -114,7 +121,7 @@ static void on_signal(int sig)
     for (int i = 0; i < SLOTS; i++)
         if (slot_used[i]) unlink(slot_name[i]);
     for (int i = 0; i < held_n; i++) unlink(held[i].stage);
-    for (int i = made_n - 1; i >= 0; i--) rmdir(made_dir[i]); /* fails when not empty: kept */
+    remove_made_dirs();
     if (sig == SIGINT || sig == SIGTERM || sig == SIGHUP || sig == SIGQUIT) say_interrupted();
     signal(sig, SIG_DFL);
     raise(sig);
@@ -412,6 +419,7 @@ void cli_outputs_held_discard(void)
     atomic_signal_fence(memory_order_seq_cst); /* the handler reads none of them once freed */
     for (int i = 0; i < n; i++) free(held[i].stage), free(held[i].path);
     free(held), held = NULL, held_cap = 0;
+    remove_made_dirs();
 }
 
 int cli_outputs_commit(const char *cmd, cli_outputs *set)
@@ -440,6 +448,7 @@ void cli_outputs_discard(cli_outputs *set)
         unregister_stage(i);
         o->stage[0] = '\0';
     }
+    remove_made_dirs();
 }
 
 void cli_outputs_final_names(const char *msg, char *out, size_t cap)
