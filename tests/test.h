@@ -91,6 +91,18 @@ static inline int test_field_index(const atmos_volume *v, const char *name)
     return -1;
 }
 
+/* The scenes the renderers' volume tests share: rgb, a vacuum (no air: the volume alone), the sun
+ * at sun_el, sun_az (degrees, not from a date) with a 0.05 degree disk. */
+static inline void test_vacuum_scene(atmos_scene *s, double sun_el, double sun_az)
+{
+    atmos_scene_defaults(s);
+    s->wavelengths = ATMOS_WAVELENGTHS_RGB;
+    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
+    s->atmosphere.sun_diameter_deg = 0.05;
+    s->sun.from_time = 0;
+    s->sun.elevation_deg = sun_el, s->sun.azimuth_deg = sun_az;
+}
+
 /* A finalized volume of one field (name, particle type) of dims voxels of size vs (m), its corner
  * at origin (m), the density buf (x fastest, m^-3); NULL (and a failed check) on an error. */
 static inline atmos_volume *test_dense_volume(atmos_context *ctx, const int dims[3], double vs,

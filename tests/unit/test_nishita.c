@@ -69,12 +69,7 @@ static atmos_volume *ball(atmos_context *ctx, double tau)
 /* A vacuum, the camera 3 km south of the ball looking at it, the sun at sun_el, sun_az. */
 static void scene(atmos_scene *s, double sun_el, double sun_az)
 {
-    atmos_scene_defaults(s);
-    s->wavelengths = ATMOS_WAVELENGTHS_RGB;
-    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
-    s->atmosphere.sun_diameter_deg = 0.05;
-    s->sun.from_time = 0;
-    s->sun.elevation_deg = sun_el, s->sun.azimuth_deg = sun_az;
+    test_vacuum_scene(s, sun_el, sun_az);
     s->width = s->height = 32;
     const double pos[3] = {0, 1500, 3000};
     atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s->camera);

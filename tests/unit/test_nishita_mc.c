@@ -54,12 +54,7 @@ static atmos_volume *slab(atmos_context *ctx)
  * looking down at it from zenith angle acos(mu), a narrow view of the slab's middle. */
 static void scene(atmos_scene *s, double mu, int lmax)
 {
-    atmos_scene_defaults(s);
-    s->wavelengths = ATMOS_WAVELENGTHS_RGB;
-    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
-    s->atmosphere.sun_diameter_deg = 0.05;
-    s->sun.from_time = 0;
-    s->sun.elevation_deg = 90, s->sun.azimuth_deg = 0;
+    test_vacuum_scene(s, 90, 0);
     s->sun.irradiance_count = 1, s->sun.irradiance[0] = 1.0;
     s->width = s->height = 12;
     const double top = 1000 + 0.5 * (NY + NS) * VS, D = 20000, st = sqrt(1 - mu * mu);

@@ -144,14 +144,9 @@ static atmos_volume *slab(atmos_context *ctx, int nxz, double tau)
 
 static void vacuum_scene(atmos_scene *s, int spectral, double sun_el, double sun_az)
 {
-    atmos_scene_defaults(s);
+    test_vacuum_scene(s, sun_el, sun_az);
     s->wavelengths = spectral ? ATMOS_WAVELENGTHS_SPECTRAL : ATMOS_WAVELENGTHS_RGB;
     s->spectral_samples = 16;
-    s->atmosphere.kind = ATMOS_ATMOSPHERE_VACUUM;
-    s->sun.from_time = 0;
-    s->sun.elevation_deg = sun_el;
-    s->sun.azimuth_deg = sun_az;
-    s->atmosphere.sun_diameter_deg = 0.05;
 }
 
 /* The kind of atmosphere the air tests run in: each runs in Riley's sky and in a homogeneous
