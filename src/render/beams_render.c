@@ -23,7 +23,8 @@
  * the planes sit at a pixel's own offset, and the airlight is filtered over N x N pixels.
  * With beams/screen_step k > 1 (beams_screen.h) the airlight (the lights' and the sun's) is
  * evaluated on a lattice of every k-th pixel and interpolated across the cells where that is
- * safe, the surfaces still per pixel, the sky behind from the sky renderer's grid of every k-th pixel.
+ * safe (a cell that a light's screen span crosses is always cut: the lit cones' hint), the surfaces
+ * still per pixel, the sky behind from the sky renderer's grid of every k-th pixel (at most 4).
  * Rows go to the threads; each pixel depends on nothing but its own ray (or its band of the
  * lattice), so the image does not depend on the thread count. */
 #include "render/beams_internal.h"
@@ -585,6 +586,15 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
 #ifndef SCREEN_DEPTH
 #define SCREEN_DEPTH 0.5
 #endif
+/* The sky behind is read from the sky renderer's grid of every screen_step pixels, at most
+ * this many (a grid of 8 misses more of the sky's bends than the lattice's tests let through). */
+#ifndef SKY_STEP_MAX
+#define SKY_STEP_MAX 4
+#endif
+/* 1: a cell that a light's span crosses is cut (the lit cones' hint, beams_screen.h). */
+#ifndef SCREEN_HINT
+#define SCREEN_HINT 1
+#endif
 
 /* The eye's ray through pixel (x, y) in a subsampled frame: kept from the first pass (J->dir) when
  * there is one, the same bits as eye_ray's. */
@@ -716,7 +726,9 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     /* none: each pass makes its rays */
     q.dir = J->ru ? atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_DIR], sizeof(double) * 3 * n) : NULL;
     J->dir = q.dir, J->dir_r = *r;
-    const atmos__beams_screen s = {*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base, air_pixel, J};
+    const atmos__beams_screen s = {*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base,
+                                   SCREEN_HINT ? J->span : NULL, SCREEN_HINT ? J->b->nlights : 0, J->cam->height,
+                                   air_pixel, J};
     long ev = 0;
 #pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev)
     {
@@ -780,7 +792,8 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
 {
     atmos__beams_plan *b = p->beams;
     atmos__view sv = *v; /* the sky behind on the airlight's lattice too (the sky renderer's grid: sky_render.c) */
-    if (p->scene.beams.interleave <= 1 && p->scene.beams.screen_step > sv.sky_step) sv.sky_step = p->scene.beams.screen_step;
+    const int sky_step = p->scene.beams.screen_step < SKY_STEP_MAX ? p->scene.beams.screen_step : SKY_STEP_MAX;
+    if (p->scene.beams.interleave <= 1 && sky_step > sv.sky_step) sv.sky_step = sky_step;
     atmos_status st = atmos__sky_render(p->ctx, p->atm, &sv, r, out, p->sky_keep);
     if (st != ATMOS_OK) return st;
     job J;

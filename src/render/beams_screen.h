@@ -4,8 +4,13 @@
  * interpolation when its corners agree (the same object seen at similar depths by every pixel
  * of the cell, the corners' airlight within a share of the pixels' light of each other, and,
  * for a cell wider than 2, its centre evaluated and close to the interpolation); otherwise it
- * is cut into four and each part tried again, down to single pixels evaluated exactly. The
- * surfaces' direct light stays per pixel (the caller's). Not part of the API. */
+ * is cut into four and each part tried again, down to single pixels evaluated exactly; a cell
+ * wider than 4 is tested on the nine corners of its quarters and, when they agree, filled
+ * quarter by quarter from them (its quarters' centres not evaluated). A cell that a light's
+ * span (the screen image of its lit cone) touches without holding its corners' rows a cell's
+ * width beyond it on either side is always cut: a beam narrower than the cell, between its
+ * corners, or an edge of a beam across it, is found without a node on it. The surfaces' direct
+ * light stays per pixel (the caller's). Not part of the API. */
 #ifndef ATMOS_RENDER_BEAMS_SCREEN_H
 #define ATMOS_RENDER_BEAMS_SCREEN_H
 
@@ -28,6 +33,11 @@ typedef struct atmos__beams_screen {
     const double *T;          /* per pixel of r, row by row: the distance to the surface seen */
     const int *object;        /* per pixel of r: the object seen, -1 for none */
     const float *base;        /* per pixel of r: its light without the airlight, nw values */
+    /* The lit cones' hint: per light i < nspan and image row y, the columns
+     * [span[2 (i span_h + y)], span[2 (i span_h + y) + 1]) outside which that light's airlight
+     * is 0 (the screen image of a hull of its lit part, convex per row); NULL: none. */
+    const int *span;
+    int nspan, span_h;
     atmos__beams_air_fn air;
     void *user;
 } atmos__beams_screen;

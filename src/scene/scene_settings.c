@@ -152,9 +152,9 @@ static const atmos_setting beams_settings[] = {
      "interleaved sampling (Keller and Heidrich 2001): the pixels of each N x N block sample between the planes at N^2 "
      "different offsets, their airlight averaged over N x N pixels of similar depth (1: off)",
      BEAMS(interleave)},
-    {"screen_step", "screen-step", ATMOS_SETTING_INT, "pixels", 1, 16, 0, 0, 4, NULL, 0,
+    {"screen_step", "screen-step", ATMOS_SETTING_INT, "pixels", 1, 16, 0, 0, 8, NULL, 0,
      "the airlight evaluated every N pixels and interpolated across the cells whose corners agree, per pixel "
-     "elsewhere, the sky behind on the sky's grid of every N pixels (1: every pixel; with interleave 1)",
+     "elsewhere, the sky behind on the sky's grid of every N pixels, at most 4 (1: every pixel; with interleave 1)",
      BEAMS(screen_step)},
     {"exact_shadows", "exact-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
      "the surfaces' shadows of the lights by an exact ray per pixel and light (off: from the shadow maps where "

@@ -960,6 +960,57 @@ static void test_screen_step(void)
     atmos_image_destroy(sub);
 }
 
+/* The lit cones' hint (beams_screen.h): a spot's beam about a pixel wide, upright on column 82 of
+ * 160 (between the nodes of a lattice of 8, 80 and 88, and the quarters' corners, 84), is caught
+ * by its span though no node lies on it: with screen_step 8, every pixel above 5 % of the
+ * brightest in the exact image (step 1) within 5 % of it, and 1 and 2 threads the same bytes. */
+static void test_thin_beam_hint(void)
+{
+    atmos_scene s;
+    base_scene(&s, 160, 120);
+    memset(s.camera.position, 0, sizeof s.camera.position), memset(s.camera.look_at, 0, sizeof s.camera.look_at);
+    s.camera.look_at[2] = -10, s.camera.fov_deg = 50;
+    atmos_scene_light *l = &s.lights[0];
+    l->type = ATMOS_LIGHT_SPOT, l->cone_deg = 0.5, l->edge_deg = 0.2, l->range_m = 60;
+    l->direction[1] = 1;
+    const double u = 82.5 - 80; /* the beam's column's centre, right of the image's centre */
+    l->position_m[0] = u / 60 * 30 * tan(25 * ATMOS_PI / 180), l->position_m[1] = -20, l->position_m[2] = -30;
+    long ev = 0, n = 1, ev1 = 0;
+    atmos_image *exact = render_counted(ctx, &s, &ev, &n);
+    s.beams.screen_step = 8;
+    atmos_image *sub = render_counted(ctx, &s, &ev, &n);
+    atmos_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.threads = 1;
+    atmos_context *c1 = NULL;
+    CHECK_OK(atmos_context_create(&cd, &c1));
+    atmos_image *one = c1 ? render_counted(c1, &s, &ev1, &n) : NULL;
+    if (exact && sub && one) {
+        const int W = s.width, C = exact->channels;
+        double top = 0, worst = 0;
+        long lit = 0, lo = W, hi = 0;
+        for (size_t i = 0; i < (size_t)W * s.height; i++) top = fmax(top, exact->pixels[i * C + 1]);
+        for (int y = 0; y < s.height; y++)
+            for (int x = 0; x < W; x++) {
+                const size_t i = ((size_t)y * W + x) * C;
+                if (!(exact->pixels[i + 1] > 0.05 * top)) continue;
+                lit++, lo = x < lo ? x : lo, hi = x > hi ? x : hi;
+                worst = fmax(worst, fabs(sub->pixels[i + 1] / exact->pixels[i + 1] - 1));
+            }
+        printf("screen step 8: a beam a pixel wide between the nodes, columns %ld-%ld, %ld pixels above 5 %% of the "
+               "brightest, worst relative difference %.2e; airlight evaluated at %ld of %ld pixels\n",
+               lo, hi, lit, worst, ev, n);
+        CHECK_MSG(lit > 100 && lo > 80 && hi < 84, "the beam is not where the test puts it (columns %ld-%ld)", lo, hi);
+        CHECK_MSG(worst <= 0.05, "the thin beam is lost between the nodes (%.3g off)", worst);
+        CHECK_MSG(ev1 == ev && !memcmp(one->pixels, sub->pixels, sizeof(float) * (size_t)W * s.height * C),
+                  "1 and 2 threads differ (screen step 8)");
+    }
+    atmos_image_destroy(one);
+    atmos_context_destroy(c1);
+    atmos_image_destroy(exact);
+    atmos_image_destroy(sub);
+}
+
 int main(void)
 {
     CHECK_OK(atmos_context_create(NULL, &ctx));
@@ -974,6 +1025,7 @@ int main(void)
     test_threads();
     test_interleave();
     test_screen_step();
+    test_thin_beam_hint();
     test_kept_frames();
     test_scene_files();
     test_cancel();
