@@ -37,10 +37,10 @@ assert abs((yaw[1] - yaw[0]) % 360 - 120) < 1e-6 and abs((yaw[2] - yaw[1]) % 360
 PY
 
 # bad input: usage errors with a message
-"$A" view --headless >/dev/null 2>"$T/e1.txt"; [ $? -eq 2 ] && grep -q "needs --frames" "$T/e1.txt" && ok "--headless alone refused" || bad "--headless alone"
+"$A" view --headless >/dev/null 2>"$T/e1.txt"; [ $? -eq 2 ] && grep -q "needs --frames N or --script" "$T/e1.txt" && ok "--headless alone refused" || bad "--headless alone"
 "$A" view --frames 2 --headless --press Nope >/dev/null 2>"$T/e2.txt"; [ $? -eq 2 ] && grep -q "unknown key" "$T/e2.txt" && ok "unknown key refused" || bad "unknown key"
 printf '{"keys": [{"t": 0, "position_m": [0, 1]}]}' >"$T/bad.json"
-"$A" view --frames 2 --headless --script "$T/bad.json" >/dev/null 2>"$T/e3.txt"; [ $? -eq 2 ] && grep -q "keys\[0\]" "$T/e3.txt" && ok "bad script refused" || bad "bad script"
+"$A" view --frames 2 --headless --script "$T/bad.json" >/dev/null 2>"$T/e3.txt"; [ $? -eq 2 ] && grep -q "/keys/0/position_m: expected an array of 3" "$T/e3.txt" && ok "bad script refused" || bad "bad script"
 
 if ! command -v xvfb-run >/dev/null 2>&1; then
     bad "xvfb-run is missing (scripts/install-deps.sh installs xvfb and xauth)"

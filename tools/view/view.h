@@ -103,6 +103,8 @@ int view_action_held(view_action a);
 void view_keys_help(FILE *f);
 /* An action by its name in a script ("forward", "sun_up", ...; VA_NONE if unknown). */
 view_action view_action_named(const char *name);
+/* The script name of an action ("none" for VA_NONE). */
+const char *view_action_name(view_action a);
 
 /* ---- view_script.c: a flight (keyframes of camera and sun), or an orbit */
 typedef struct view_key_frame {
@@ -118,9 +120,19 @@ typedef struct view_script {
     double fps;             /* frames per second of the flight's clock; 24 */
 } view_script;
 /* Reads a flight file: {"fps": 24, "keys": [{"t": 0, "position_m": [..], "look_at_m": [..],
- * "sun": {"elevation_deg": e, "azimuth_deg": a}, "press": "sun_up"}, ...]}. Returns 0 or an
- * exit status with a message. */
-int view_script_load(const char *path, view_script *out);
+ * "sun": {"elevation_deg": e, "azimuth_deg": a}, "press": "sun_up"}, ...]}, checked as strictly
+ * as a scene file (unknown and duplicate keys refused; the file read and its JSON checked by
+ * the scene reader, whose messages give the system's reason and a syntax error's line and
+ * column). A flight presses any key but the camera's (the key frames place the camera), and,
+ * when its key frames set the sun, the sun's and the time's. Returns 0 or an exit status with
+ * a message. */
+int view_script_load(atmos_context *ctx, const char *path, view_script *out);
+/* The frames a flight plays without --frames: frame i is at t = i / fps, so the last one is
+ * the first at or after its last key frame (t = T: T fps + 1 frames when T fps is whole). */
+int view_script_frames(const view_script *s);
+/* What a flight presses that the scene cannot act on (the time's keys without a date, time and
+ * place): 0 or a usage error with a message (path: the flight file). */
+int view_script_check(const view_script *s, const view_state *st, const char *path);
 void view_script_free(view_script *s);
 /* The state at time t of the script (camera and sun interpolated between keyframes; keys
  * pressed in (t_prev, t] applied); an empty script orbits the target once in `frames`. */
@@ -184,9 +196,11 @@ typedef struct view_opts {
  * case; a script name gives its action's first key) into codes; returns the count, or -1 for
  * an unknown name or more than cap (view_keys.c). */
 int view_key_codes(const char *list, int *codes, int cap);
-/* Opens the window (unless headless) and runs frames until quit or o->frames; text: the
- * scene file's JSON ("{}" for none). Returns an exit status. */
-int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atmos_volume *vol, const char *text);
+/* Opens the window (unless headless) and runs frames until quit or o->frames (with a flight and
+ * no --frames: view_script_frames); script: the flight (o->script's, read), NULL for none;
+ * text: the scene file's JSON ("{}" for none). Returns an exit status. */
+int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script, atmos_scene *sc,
+              const atmos_volume *vol, const char *text);
 
 
 #endif

@@ -36,14 +36,18 @@ static void help(void)
            "  --size WxH         the rendered frame's size (default 960x540; the window scales it)\n"
            "  --script FILE      play a flight: {\"fps\": 24, \"keys\": [{\"t\": 0, \"position_m\": [x, y, z],\n"
            "                     \"look_at_m\": [x, y, z], \"sun\": {\"elevation_deg\": e, \"azimuth_deg\": a},\n"
-           "                     \"press\": \"NAME\"}, ...]} (camera and sun interpolated; \"press\" acts at t)\n"
-           "  --frames N         play N frames and exit: of the script, or else a full turn of the scene's\n"
+           "                     \"press\": \"NAME\"}, ...]} (camera and sun interpolated; \"press\" acts at t\n"
+           "                     as its key's tap; unknown keys are errors, as in scene files). Frame i is\n"
+           "                     at t = i / fps; without --frames the flight stops at its last key frame\n"
+           "                     (T: T fps + 1 frames), a window closing then too\n"
+           "  --frames N         play N frames and exit: of the script (N = T fps + 1 ends at its last key\n"
+           "                     frame, t = T; later frames hold it), or else a full turn of the scene's\n"
            "                     camera about the vertical through the volume's centre (no volume: the\n"
            "                     point it looks at), its pitch kept: frame 0 is atmos render's view\n"
            "  --record DIR       write every frame as DIR/frame_NNNNN.png and DIR/frames.csv (frame, ms =\n"
            "                     the frame's wall time including presentation, renderer, impostor_updates,\n"
            "                     camera, sun (empty when lamps alone light it), preview, impostors_coarse)\n"
-           "  --headless         no window (with --frames: render and record only)\n"
+           "  --headless         no window (with --frames or --script: render and record only)\n"
            "  --press KEYS       press these keys (key or script names as below, comma-separated) at the\n"
            "                     second frame (so --frames 2 at least): through the window's event queue\n"
            "                     as a user's keys; --headless, each acts on the view as a tap (1/30 s)\n"
@@ -67,6 +71,17 @@ static void help(void)
     fputs(CLI_HELP_EXIT, stdout);
 }
 
+/* --size WxH: each number read as atmos render's --width and --height are (cli_parse_int). */
+static int size(const char *v, view_opts *o)
+{
+    const char *x = v ? strchr(v, 'x') : NULL;
+    if (!x) return cli_usage_error("view", "--size: expected WxH (960x540), got '%s'", v ? v : ""), 0;
+    char w[32];
+    snprintf(w, sizeof w, "%.*s", (int)(x - v < 31 ? x - v : 31), v);
+    return cli_parse_int("view", "--size's width", w, 1, 8192, &o->width) &&
+           cli_parse_int("view", "--size's height", x + 1, 1, 8192, &o->height);
+}
+
 /* Takes the viewer's own options out of argv; the rest goes to atmos render's parser. */
 static int parse(int argc, char **argv, view_opts *o)
 {
@@ -81,9 +96,7 @@ static int parse(int argc, char **argv, view_opts *o)
         if (!strcmp(argv[i], "--headless")) o->headless = 1;
         else if (!strcmp(argv[i], "--preview")) o->preview = 1;
         else if (cli_take_value(argc, argv, &i, "--size", &v)) {
-            if (!v || sscanf(v, "%dx%d", &o->width, &o->height) != 2 || o->width < 1 || o->height < 1 ||
-                o->width > 8192 || o->height > 8192)
-                return cli_usage_error("view", "--size: expected WxH in 1..8192, got '%s'", v ? v : "");
+            if (!size(v, o)) return CLI_EXIT_USAGE;
         } else if (cli_take_value(argc, argv, &i, "--frames", &v)) {
             if (!v || !cli_parse_int("view", "--frames", v, 1, 10000000, &o->frames)) return CLI_EXIT_USAGE;
         } else if (cli_take_value(argc, argv, &i, "--impostor-budget", &v)) {
@@ -106,7 +119,7 @@ static int parse(int argc, char **argv, view_opts *o)
             o->pass[o->passed++] = argv[i];
         }
     }
-    if (o->headless && !o->frames) return cli_usage_error("view", "--headless needs --frames N");
+    if (o->headless && !o->frames && !o->script) return cli_usage_error("view", "--headless needs --frames N or --script");
     if (o->press && o->frames == 1)
         return cli_usage_error("view", "--press acts at the second frame: it needs --frames 2 or more");
     return CLI_EXIT_OK;
@@ -136,13 +149,17 @@ int cli_cmd_view(int argc, char **argv)
     atmos_scene sc;
     atmos_volume *vol = NULL;
     char *text = NULL;
+    view_script script = {0};
     if (!ctx) rc = CLI_EXIT_RUNTIME;
+    /* the flight read first: its mistakes said before any work on the scene */
+    if (rc == CLI_EXIT_OK && vo.script) rc = view_script_load(ctx, vo.script, &script);
     if (rc == CLI_EXIT_OK) rc = render_scene_make(ctx, &ro, &sc, &vol);
     if (rc == CLI_EXIT_OK && ro.scene_path && strcmp(ro.scene_path, "-")) text = cli_read_text(ro.scene_path, CLI_TEXT_MAX);
     if (rc == CLI_EXIT_OK) {
         sc.width = vo.width, sc.height = vo.height;
-        rc = view_loop(ctx, &vo, &sc, vol, text ? text : "{}");
+        rc = view_loop(ctx, &vo, vo.script ? &script : NULL, &sc, vol, text ? text : "{}");
     }
+    view_script_free(&script);
     free(text);
     atmos_volume_destroy(vol);
     atmos_context_destroy(ctx);

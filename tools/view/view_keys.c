@@ -65,6 +65,8 @@ view_action view_action_named(const char *name)
     return VA_NONE;
 }
 
+const char *view_action_name(view_action a) { return a > VA_NONE && a < VA_COUNT ? names[a] : "none"; }
+
 void view_keys_help(FILE *f)
 {
     fprintf(f, "Keys (held keys act while held, a tap for 1/30 s; Shift: x10, Ctrl: x0.1):\n");
@@ -78,7 +80,9 @@ void view_keys_help(FILE *f)
         else if (i > 1) fprintf(f, ","), col++;
         col += fprintf(f, " %s", names[i]);
     }
-    fprintf(f, "\n");
+    fprintf(f, "\n  A flight presses all but the camera's (forward .. look_down, orbit: its key frames place the\n"
+               "  camera) and, when its key frames set \"sun\", the sun's and the time's; the time's need a\n"
+               "  scene whose sun follows a date, a time and a place.\n");
 }
 
 int view_key_codes(const char *list, int *codes, int cap)

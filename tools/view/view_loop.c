@@ -303,17 +303,18 @@ static int volume_centre(const atmos_plan *p, double c[3])
     return 1;
 }
 
-static int start(loop *L, const view_opts *o, view_state *s, view_script *script)
+static int start(loop *L, const view_opts *o, view_state *s, const view_script *script)
 {
     atmos_frame f;
     atmos_status st = atmos_frame_from_scene(L->ctx, L->sc, &f);
     view_state_init(s, L->sc, &f, NULL);
+    const int rc = view_script_check(script, s, o->script); /* before the plan's work */
+    if (rc != CLI_EXIT_OK) return rc;
     atmos_plan *p = NULL;
     if (st == ATMOS_OK) st = get_plan(L, s, &p);
     if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
     double c[3];
     if (volume_centre(p, c)) view_state_init(s, L->sc, &f, c);
-    if (o->script) return view_script_load(o->script, script);
     return CLI_EXIT_OK;
 }
 
@@ -329,28 +330,31 @@ static void press(view_window *win, view_state *s, const char *keys)
     }
 }
 
-int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atmos_volume *vol, const char *text)
+int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script, atmos_scene *sc,
+              const atmos_volume *vol, const char *text)
 {
     loop L;
     memset(&L, 0, sizeof L);
     L.ctx = ctx, L.sc = sc, L.vol = vol, L.spectral = sc->wavelengths == ATMOS_WAVELENGTHS_SPECTRAL;
     L.impostor_budget = o->impostor_budget, L.screen_layer_px = o->screen_layer_px;
     view_state s;
-    view_script script = {0};
     view_recorder rec = {0};
     view_window *win = NULL;
     /* the window first: without a display the viewer stops at once, before any work */
     int rc = CLI_EXIT_OK;
     if (!o->headless && !(win = view_window_open(o->width, o->height, "atmos view"))) rc = CLI_EXIT_RUNTIME;
-    if (rc == CLI_EXIT_OK) rc = start(&L, o, &s, &script);
+    if (rc == CLI_EXIT_OK) rc = start(&L, o, &s, script);
     if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record);
-    const int scripted = o->frames > 0 || o->script;
+    const int scripted = o->frames > 0 || script;
+    /* a flight without --frames: until its last key frame (a window closes then too) */
+    const int frames = o->frames > 0 ? o->frames : view_script_frames(script);
+    const double fps = script ? script->fps : 24;
     double last_ms = 0.0;
     int pressed = 0;
     view_pose pose = view_pose_of(&s);
-    for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!o->frames || i < o->frames); i++) {
+    for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!frames || i < frames); i++) {
         const double t0 = cli_now_s();
-        if (scripted) view_script_step(&script, &s, (i - 1) / script.fps, i / (script.fps > 0 ? script.fps : 24), i, o->frames);
+        if (scripted) view_script_step(script, &s, (i - 1) / fps, i / fps, i, frames);
         if (i == 1 && o->press) press(win, &s, o->press), pressed = 1;
         if (win) view_window_events(win, &s, last_ms > 0 ? last_ms / 1000.0 : 1.0 / 30.0);
         const int moving = i > 0 && (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && view_moved(&pose, &s);
@@ -381,7 +385,6 @@ int view_loop(atmos_context *ctx, const view_opts *o, atmos_scene *sc, const atm
         fprintf(stderr, "atmos view: --press %s: not pressed: the session ended before its second frame\n", o->press);
     if (view_record_close(&rec) != CLI_EXIT_OK && rc == CLI_EXIT_OK) rc = CLI_EXIT_RUNTIME;
     view_window_close(win);
-    view_script_free(&script);
     drop_plans(&L);
     atmos_image_destroy(L.lin);
     atmos_image_destroy(L.disp);

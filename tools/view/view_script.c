@@ -1,84 +1,191 @@
-/* Flights (view.h): keyframes of the camera and the sun read from a JSON file with cJSON,
- * played on the viewer's clock; without a script, an orbit about the target (view_state's). */
+/* Flights (view.h): keyframes of the camera and the sun read from a JSON file (read and its
+ * syntax checked by the scene reader, its keys here as strictly as a scene's), played on the
+ * viewer's clock; without a script, an orbit about the target (view_state's). */
 #include "view.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
-static int vec3(const cJSON *o, const char *name, double v[3])
+/* A flight file's mistakes are said as the scene reader says a scene's ("FILE: /keys/1/press:
+ * ..."): the JSON pointer of the value and what is wrong with it; exit status 2. */
+static int fail(const char *file, const char *ptr, const char *fmt, ...)
 {
-    const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, name);
-    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != 3) return 0;
-    for (int i = 0; i < 3; i++) {
-        const cJSON *x = cJSON_GetArrayItem(a, i);
-        if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) return 0;
-        v[i] = x->valuedouble;
-    }
-    return 1;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "atmos view: --script %s: %s: ", file, ptr);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n");
+    va_end(ap);
+    return CLI_EXIT_USAGE;
 }
 
-/* One keyframe; returns NULL or what is wrong with it. */
-static const char *key_frame(const cJSON *o, double t_prev, view_key_frame *k)
+/* An object's keys all among `allowed` (n of them), none twice; keys starting with "_" are
+ * notes, skipped (as in scene files). Returns 0 or an exit status with the message. */
+static int known_keys(const char *file, const cJSON *o, const char *ptr, const char *const *allowed, int n)
 {
+    if (!cJSON_IsObject(o)) return fail(file, ptr[0] ? ptr : "/", "expected an object");
+    unsigned seen = 0;
+    for (const cJSON *c = o->child; c; c = c->next) {
+        const char *key = c->string ? c->string : "";
+        if (key[0] == '_') continue;
+        int k = 0;
+        while (k < n && strcmp(key, allowed[k])) k++;
+        if (k < n && !(seen & (1u << k))) {
+            seen |= 1u << k;
+            continue;
+        }
+        char list[256] = "", child[128];
+        for (int i = 0; i < n; i++) snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", allowed[i]);
+        snprintf(child, sizeof child, "%s/%.48s", ptr, key);
+        return k < n ? fail(file, child, "duplicate key") : fail(file, child, "unknown key (allowed: %s)", list);
+    }
+    return CLI_EXIT_OK;
+}
+
+static int vec3(const char *file, const cJSON *o, const char *ptr, const char *name, double v[3])
+{
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, name);
+    if (!a) return fail(file, ptr, "\"%s\" is missing (an array of 3 numbers, metres)", name);
+    int ok = cJSON_IsArray(a) && cJSON_GetArraySize(a) == 3;
+    for (int i = 0; ok && i < 3; i++) {
+        const cJSON *x = cJSON_GetArrayItem(a, i);
+        ok = cJSON_IsNumber(x) && isfinite(x->valuedouble);
+        if (ok) v[i] = x->valuedouble;
+    }
+    char sub[96];
+    snprintf(sub, sizeof sub, "%s/%s", ptr, name);
+    return ok ? CLI_EXIT_OK : fail(file, sub, "expected an array of 3 finite numbers");
+}
+
+/* The actions a flight can press: not the camera's (the key frames place the camera every
+ * frame, so a move, a turn or the orbit's toggle would be undone at once), nor, when its key
+ * frames set the sun, the sun's and the time's (the sun follows the key frames). */
+static int flight_presses(view_action a, int sun_keyed)
+{
+    if ((a >= VA_FORWARD && a <= VA_LOOK_DOWN) || a == VA_ORBIT) return 0;
+    return !(sun_keyed && ((a >= VA_SUN_UP && a <= VA_SUN_RIGHT) || a == VA_TIME_BACK || a == VA_TIME_FORWARD));
+}
+
+static int press_name(const char *file, const cJSON *p, const char *ptr, int sun_keyed, view_action *out)
+{
+    *out = cJSON_IsString(p) ? view_action_named(p->valuestring) : VA_NONE;
+    if (*out != VA_NONE && flight_presses(*out, sun_keyed)) return CLI_EXIT_OK;
+    char list[512] = "";
+    for (int a = VA_NONE + 1; a < VA_COUNT; a++)
+        if (flight_presses((view_action)a, sun_keyed))
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", list[0] ? ", " : "", view_action_name((view_action)a));
+    if (!cJSON_IsString(p)) return fail(file, ptr, "expected a string, one of %s", list);
+    if (*out == VA_NONE) return fail(file, ptr, "must be one of %s, got \"%.48s\"", list, p->valuestring);
+    return fail(file, ptr, "\"%s\" cannot act in a flight: %s (it can press %s)", p->valuestring,
+                sun_keyed && *out != VA_ORBIT && !(*out >= VA_FORWARD && *out <= VA_LOOK_DOWN)
+                    ? "its key frames set the sun (\"sun\")"
+                    : "the key frames place the camera",
+                list);
+}
+
+/* Keyframe i (object o) after one at t_prev; sun_keyed: some key frame sets "sun". */
+static int key_frame(const char *file, const cJSON *o, int i, double t_prev, int sun_keyed, view_key_frame *k)
+{
+    static const char *const allowed[] = {"t", "position_m", "look_at_m", "sun", "press"};
+    static const char *const sun_keys[] = {"elevation_deg", "azimuth_deg"};
+    char ptr[64], sub[80];
+    snprintf(ptr, sizeof ptr, "/keys/%d", i);
+    int rc = known_keys(file, o, ptr, allowed, 5);
+    if (rc) return rc;
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "t");
-    if (!cJSON_IsNumber(t) || !(t->valuedouble >= t_prev)) return "\"t\" must be a number of seconds, not decreasing";
+    snprintf(sub, sizeof sub, "%s/t", ptr);
+    if (!cJSON_IsNumber(t) || !isfinite(t->valuedouble) || !(t->valuedouble >= t_prev))
+        return fail(file, t ? sub : ptr, "%s must be a number of seconds, not less than the key frame before's",
+                    t ? "it" : "\"t\" is missing:");
     k->t = t->valuedouble;
-    if (!vec3(o, "position_m", k->pos) || !vec3(o, "look_at_m", k->look_at))
-        return "\"position_m\" and \"look_at_m\" must be arrays of 3 numbers";
+    if ((rc = vec3(file, o, ptr, "position_m", k->pos)) || (rc = vec3(file, o, ptr, "look_at_m", k->look_at))) return rc;
     const cJSON *sun = cJSON_GetObjectItemCaseSensitive(o, "sun");
     if (sun) {
+        snprintf(sub, sizeof sub, "%s/sun", ptr);
+        if ((rc = known_keys(file, sun, sub, sun_keys, 2))) return rc;
         const cJSON *e = cJSON_GetObjectItemCaseSensitive(sun, "elevation_deg");
         const cJSON *a = cJSON_GetObjectItemCaseSensitive(sun, "azimuth_deg");
-        if (!cJSON_IsNumber(e) || !cJSON_IsNumber(a) || fabs(e->valuedouble) > 90)
-            return "\"sun\" needs \"elevation_deg\" in [-90, 90] and \"azimuth_deg\"";
+        if (!cJSON_IsNumber(e) || !cJSON_IsNumber(a) || !(fabs(e->valuedouble) <= 90) || !isfinite(a->valuedouble))
+            return fail(file, sub, "needs \"elevation_deg\" in [-90, 90] and \"azimuth_deg\", numbers");
         k->has_sun = 1, k->sun_el = e->valuedouble, k->sun_az = a->valuedouble;
     }
     const cJSON *p = cJSON_GetObjectItemCaseSensitive(o, "press");
-    if (p) {
-        if (!cJSON_IsString(p) || (k->press = view_action_named(p->valuestring)) == VA_NONE)
-            return "\"press\" must name a key's action (atmos view --help lists them)";
-    }
-    return NULL;
+    snprintf(sub, sizeof sub, "%s/press", ptr);
+    return p ? press_name(file, p, sub, sun_keyed, &k->press) : CLI_EXIT_OK;
 }
 
-int view_script_load(const char *path, view_script *out)
+/* The flight's JSON as the scene reader reads a scene file (atmos_scene_load: the same
+ * messages for a file that cannot be read, with the system's reason, and for malformed JSON,
+ * with its line and column); only those verdicts are kept, the text not being a scene. Returns
+ * the text (NULL with the message said, *rc its exit status). */
+static char *flight_text(atmos_context *ctx, const char *file, int *rc)
 {
+    atmos_scene *scratch = malloc(sizeof *scratch);
+    if (!scratch) return *rc = CLI_EXIT_RUNTIME, NULL;
+    const atmos_status st = atmos_scene_load(ctx, file, scratch);
+    free(scratch);
+    if (st == ATMOS_E_IO || st == ATMOS_E_FORMAT || st == ATMOS_E_LIMIT || st == ATMOS_E_NOMEM) {
+        fprintf(stderr, "atmos view: --script %s\n", atmos_context_error(ctx));
+        *rc = st == ATMOS_E_FORMAT ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME;
+        return NULL;
+    }
+    char *text = cli_read_text(file, CLI_TEXT_MAX);
+    if (!text) fprintf(stderr, "atmos view: --script %s: cannot read it\n", file), *rc = CLI_EXIT_RUNTIME;
+    return text;
+}
+
+int view_script_load(atmos_context *ctx, const char *path, view_script *out)
+{
+    static const char *const allowed[] = {"fps", "keys"};
     memset(out, 0, sizeof *out);
     out->fps = 24;
-    char *text = cli_read_text(path, CLI_TEXT_MAX);
-    if (!text) {
-        fprintf(stderr, "atmos view: --script %s: cannot read it\n", path);
-        return CLI_EXIT_RUNTIME;
-    }
+    int rc = CLI_EXIT_OK;
+    char *text = flight_text(ctx, path, &rc);
+    if (!text) return rc;
     cJSON *root = cJSON_Parse(text);
     free(text);
-    const cJSON *keys = root ? cJSON_GetObjectItemCaseSensitive(root, "keys") : NULL;
-    const char *err = !root ? "not valid JSON" : (!cJSON_IsArray(keys) || !cJSON_GetArraySize(keys)) ? "needs a non-empty \"keys\" array" : NULL;
-    const cJSON *fps = root ? cJSON_GetObjectItemCaseSensitive(root, "fps") : NULL;
-    if (!err && fps && (!cJSON_IsNumber(fps) || !(fps->valuedouble >= 1 && fps->valuedouble <= 1000)))
-        err = "\"fps\" must be in [1, 1000]";
-    if (!err) {
+    const cJSON *keys = cJSON_GetObjectItemCaseSensitive(root, "keys");
+    const cJSON *fps = cJSON_GetObjectItemCaseSensitive(root, "fps");
+    if (!root) rc = fail(path, "/", "not valid JSON");
+    else if ((rc = known_keys(path, root, "", allowed, 2)) != CLI_EXIT_OK) {
+    } else if (!cJSON_IsArray(keys) || !cJSON_GetArraySize(keys)) rc = fail(path, "/keys", "expected a non-empty array of key frames");
+    else if (fps && (!cJSON_IsNumber(fps) || !(fps->valuedouble >= 1 && fps->valuedouble <= 1000)))
+        rc = fail(path, "/fps", "must be a number in [1, 1000]");
+    else if (!(out->k = calloc((size_t)cJSON_GetArraySize(keys), sizeof *out->k))) rc = CLI_EXIT_RUNTIME;
+    if (rc == CLI_EXIT_OK) {
         if (fps) out->fps = fps->valuedouble;
         out->n = cJSON_GetArraySize(keys);
-        out->k = calloc((size_t)out->n, sizeof *out->k);
-        if (!out->k) err = "out of memory";
-        for (int i = 0; i < out->n && !err; i++) {
-            if ((err = key_frame(cJSON_GetArrayItem(keys, i), i ? out->k[i - 1].t : -INFINITY, &out->k[i]))) {
-                fprintf(stderr, "atmos view: --script %s: keys[%d]: %s\n", path, i, err);
-                cJSON_Delete(root);
-                view_script_free(out);
-                return CLI_EXIT_USAGE;
-            }
-        }
+        int sun_keyed = 0;
+        for (const cJSON *k = keys->child; k; k = k->next) sun_keyed |= cJSON_GetObjectItemCaseSensitive(k, "sun") != NULL;
+        for (int i = 0; i < out->n && rc == CLI_EXIT_OK; i++)
+            rc = key_frame(path, cJSON_GetArrayItem(keys, i), i, i ? out->k[i - 1].t : -INFINITY, sun_keyed, &out->k[i]);
     }
     cJSON_Delete(root);
-    if (err) {
-        fprintf(stderr, "atmos view: --script %s: %s\n", path, err);
-        view_script_free(out);
-        return CLI_EXIT_USAGE;
-    }
+    if (rc != CLI_EXIT_OK) view_script_free(out);
+    return rc;
+}
+
+int view_script_frames(const view_script *s)
+{
+    if (!s || s->n == 0) return 0;
+    /* frame i at t = i / fps: the first frame at or after the last key frame's time */
+    const double f = ceil(s->k[s->n - 1].t * s->fps - 1e-9);
+    return f < 10000000 ? (int)f + 1 : 10000000;
+}
+
+int view_script_check(const view_script *s, const view_state *st, const char *path)
+{
+    for (int i = 0; s && i < s->n; i++)
+        if (!st->sun_from_time && (s->k[i].press == VA_TIME_BACK || s->k[i].press == VA_TIME_FORWARD)) {
+            char ptr[64];
+            snprintf(ptr, sizeof ptr, "/keys/%d/press", i);
+            return fail(path, ptr, "\"%s\" needs a scene whose sun follows a date, a time and a place "
+                                   "(\"sun\": {\"time\": ...}, or --time with --lat and --lon)",
+                        view_action_name(s->k[i].press));
+        }
     return CLI_EXIT_OK;
 }
 
@@ -128,7 +235,7 @@ void view_script_step(const view_script *s, view_state *st, double t_prev, doubl
         return;
     }
     for (int i = 0; i < s->n; i++)
-        if (s->k[i].press != VA_NONE && s->k[i].t > t_prev && s->k[i].t <= t) view_state_apply(st, s->k[i].press, 0, 0, 0);
+        if (s->k[i].press != VA_NONE && s->k[i].t > t_prev && s->k[i].t <= t) view_state_tap(st, s->k[i].press);
     int i = 0;
     while (i + 1 < s->n && s->k[i + 1].t <= t) i++;
     const view_key_frame *a = &s->k[i], *b = &s->k[i + 1 < s->n ? i + 1 : i];
