@@ -142,6 +142,7 @@ struct atmos__beams_plan {
     int sun_on;                              /* the sun lights the scene (beams/sun) */
     int exact_shadows;                       /* surfaces' shadows of the lights by exact rays alone */
     atmos__beams_sun sun;                    /* its map, built for the last frame's sun (sun.dir) */
+    atmos__beams_epi epi;                    /* the map's epipolar lines from the last frame's eye */
     atmos__beams_sky sky;                    /* the sky's light on the objects, kept between frames */
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
     int centre_planes, centre_subplanes;

@@ -24,6 +24,7 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b)
     for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]), atmos__lamp_free(&b->lights[i].L);
     free(b->lights);
     atmos__beams_sun_free(&b->sun);
+    atmos__beams_epi_free(&b->epi);
     atmos__beams_sky_free(&b->sky);
     atmos__beams_table_free(&b->table);
     atmos__fog_optics_free(&b->optics);
@@ -83,13 +84,23 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
     return ATMOS_OK;
 }
 
+/* The most samples the epipolar lines may take (4 bytes each, and their trees 8 more): beyond,
+ * each ray walks the map's own tiles. */
+#define EPI_MAX_SAMPLES ((size_t)8 << 20)
+
 atmos_status atmos__beams_sun_frame(atmos_plan *p, const atmos__view *v)
 {
     atmos__beams_plan *b = p->beams;
     atmos__beams_sun *sun = &b->sun;
     atmos_atmosphere_sunlight(p->atm, v->cam.position, v->sun, sun->E); /* the sun's colour where the eye is */
-    if (sun->depth && !memcmp(sun->dir, v->sun, sizeof sun->dir)) return ATMOS_OK;
-    return atmos__beams_sun_build(p->ctx, sun, v->sun, b->obj.mesh, b->obj.n, p->scene.beams.shadow_size);
+    atmos_status st = ATMOS_OK;
+    if (!(sun->depth && !memcmp(sun->dir, v->sun, sizeof sun->dir)))
+        st = atmos__beams_sun_build(p->ctx, sun, v->sun, b->obj.mesh, b->obj.n, p->scene.beams.shadow_size);
+    /* the map along epipolar lines from the eye, for the fog's sunlight (none without fog) */
+    if (st == ATMOS_OK && b->fog.sigma0 > 0 &&
+        atmos__beams_epi_build(&b->epi, sun, v->cam.position, EPI_MAX_SAMPLES, atmos__threads(p->ctx)))
+        st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory for the sun's epipolar lines");
+    return st;
 }
 
 void atmos__beams_describe(const atmos_plan *p, char *buf, size_t cap)

@@ -382,7 +382,7 @@ static void sun_air(const job *J, const double d[3], double T, double *L)
 {
     const atmos__beams_plan *b = J->b;
     if (!(b->fog.sigma0 > 0)) return;
-    const double a = atmos__beams_sun_airlight(&b->sun, &b->fog, J->eye, d, T, J->epsilon, MAX_INTERVALS);
+    const double a = atmos__beams_sun_airlight_lines(&b->sun, &b->epi, &b->fog, J->eye, d, T, J->epsilon, MAX_INTERVALS);
     for (int k = 0; k < J->nw; k++) L[k] += b->sun.E[k] * a;
 }
 

@@ -65,6 +65,9 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
     s->n = size, s->texel = ext / (size - 2); /* a texel of margin on each side */
     s->u0 = lo[0] - s->texel, s->v0 = lo[1] - s->texel;
     s->bias = 0.5 * s->texel;
+    /* the objects lie within [1, 1 + (hi - lo) / texel] texels, [0.5, ...] in look-up coordinates */
+    s->box[0] = -1, s->box[1] = fmin(size, 2 + (hi[0] - lo[0]) / s->texel);
+    s->box[2] = -1, s->box[3] = fmin(size, 2 + (hi[1] - lo[1]) / s->texel);
     if (!(s->depth = malloc(sizeof(float) * (size_t)size * size))) {
         s->n = 0;
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d sun shadow map", size, size);
@@ -223,4 +226,47 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
     }
     const double c = atmos__dot3(s->dir, d);
     return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C) * r.whole * sum / n;
+}
+
+/* A ray's closed form over its lit stretches (atmos__beams_sun_airlight_lines): r texels
+ * along its line is t = r / p; W(t) = int_0^tau(t) exp(-gamma tau) d tau. */
+typedef struct lit_sum {
+    double A, k, gamma, inv_p, T, sum;
+    int flat;
+} lit_sum;
+
+static double lit_w(const lit_sum *l, double t)
+{
+    const double tau = line_tau(l->A, l->k, t < l->T ? t : l->T);
+    return l->flat ? tau : -expm1(-l->gamma * tau) / l->gamma;
+}
+
+static void lit_add(void *u, double ra, double rb)
+{
+    lit_sum *l = u;
+    l->sum += lit_w(l, rb * l->inv_p) - (ra > 0 ? lit_w(l, ra * l->inv_p) : 0);
+}
+
+double atmos__beams_sun_airlight_lines(const atmos__beams_sun *s, const atmos__beams_epi *e, const atmos__beams_fog *f,
+                                       const double o[3], const double d[3], double T, double epsilon, int max_steps)
+{
+    const double x1 = atmos__dot3(d, s->right) / s->texel, y1 = atmos__dot3(d, s->up) / s->texel, p = hypot(x1, y1);
+    const double ex = (atmos__dot3(o, s->right) - s->u0) / s->texel - 0.5, ey = (atmos__dot3(o, s->up) - s->v0) / s->texel - 0.5;
+    if (!s->n || !e || !e->lines || !(p > 1e-9) || ex != e->ex || ey != e->ey)
+        return atmos__beams_sun_airlight(s, f, o, d, T, epsilon, max_steps);
+    lit_sum l = {.T = T, .inv_p = 1 / p};
+    fog_line(f, o, d, &l.A, &l.k);
+    const double C = atmos__beams_sun_fog_in(f, s->dir, o);
+    if (!(C < 700)) return 0;
+    l.gamma = f->height_m > 0 ? 1 - d[1] / s->dir[1] : 1;
+    const double tauT = line_tau(l.A, l.k, T);
+    l.flat = !(fabs(l.gamma * tauT) > 1e-9);
+    /* the line nearest the ray's angle */
+    double a = atan2(y1, x1) / e->dth;
+    int j = (int)floor(a + 0.5);
+    j = j < 0 ? j + e->lines : j >= e->lines ? j - e->lines : j;
+    atmos__beams_epi_walk(e, j, atmos__dot3(o, s->fwd) - s->bias, atmos__dot3(d, s->fwd) / p, T * p, lit_add, &l);
+    const double sum = l.sum;
+    const double c = atmos__dot3(s->dir, d);
+    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C) * sum;
 }

@@ -16,6 +16,7 @@
 #include "core/internal.h"
 #include "scene/scene_fog.h"
 #include "render/beams_tiles.h"
+#include "render/beams_epipolar.h"
 
 /* The fog along rays: sigma_t(y) = sigma0 exp(-(y - base) / H) (H = 0: uniform sigma0). */
 typedef struct atmos__beams_fog {
@@ -34,6 +35,7 @@ typedef struct atmos__beams_sun {
      * (right, up); empty (n = 0) without objects */
     double right[3], up[3], fwd[3];
     double u0, v0, texel, bias;
+    double box[4];                      /* look-up coordinates x0, x1, y0, y1 round every object */
     int n;
     float *depth;
     atmos__beams_tiles tiles;           /* the map's min/max pyramid */
@@ -56,6 +58,12 @@ int atmos__beams_sun_dark(const atmos__beams_sun *s, const double p[3]);
  * (or all in shadow) are counted without reading the map. */
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
                                  const double d[3], double T, double epsilon, int max_steps);
+/* atmos__beams_sun_airlight from the map's epipolar lines e built for the eye o
+ * (beams_epipolar.h): the integral in closed form over the lit stretches of the line nearest
+ * the ray's projection (no steps: exact for the line's piecewise linear depths). Without lines
+ * (or lines built for another eye, or a ray along the sun), atmos__beams_sun_airlight. */
+double atmos__beams_sun_airlight_lines(const atmos__beams_sun *s, const atmos__beams_epi *e, const atmos__beams_fog *f,
+                                       const double o[3], const double d[3], double T, double epsilon, int max_steps);
 /* The fog's optical depth between p and the sun (unit sun, toward it): a height-dependent
  * fog's layer above p, sigma(p) H / sun_y (INFINITY with the sun below the horizon); 0 in a
  * uniform fog (it has no top, and is lit undimmed). */

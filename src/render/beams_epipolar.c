@@ -1,0 +1,234 @@
+/* The sun's map along epipolar lines (beams_epipolar.h): the lines' samples and 1-D min/max
+ * trees, built once a frame, and a ray's walk down one line's tree. */
+#include "render/beams_epipolar.h"
+#include "render/beams_sun.h"
+#include "core/internal.h"
+#include "core/vec.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_LEVELS 32
+#define LEAF 4 /* segments a cell of the trees' finest level covers */
+
+void atmos__beams_epi_free(atmos__beams_epi *e)
+{
+    free(e->at), free(e->m);
+    memset(e, 0, sizeof *e);
+}
+
+/* The depth of the map at look-up coordinates (fx, fy): the four nearest texels' depths blended
+ * when all four hold an object, else the nearest texel's; INFINITY beside the map. */
+static float depth_at(const atmos__beams_sun *s, double fx, double fy)
+{
+    const int n = s->n;
+    if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return INFINITY;
+    const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1;
+    const double ax = fx - x0, ay = fy - y0;
+    const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
+    const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
+    const float *ra = s->depth + (size_t)ya * n, *rb = s->depth + (size_t)yb * n;
+    const float d00 = ra[xa], d01 = ra[xb], d10 = rb[xa], d11 = rb[xb];
+    if (d00 < INFINITY && d01 < INFINITY && d10 < INFINITY && d11 < INFINITY)
+        return (float)((1 - ay) * ((1 - ax) * d00 + ax * d01) + ay * ((1 - ax) * d10 + ax * d11));
+    return ay < 0.5 ? (ax < 0.5 ? d00 : d01) : (ax < 0.5 ? d10 : d11);
+}
+
+/* The cells of a tree over nseg segments: level 0 holds ceil(nseg / LEAF) of them, each level
+ * above half as many, rounded up, down to one. */
+static size_t tree_cells(int nseg, int *levels)
+{
+    size_t total = 0;
+    int l = 0;
+    for (int c = (nseg + LEAF - 1) / LEAF; c > 0; c = c == 1 ? 0 : (c + 1) / 2) total += (size_t)c, l++;
+    if (levels) *levels = l;
+    return total;
+}
+
+/* Where the half-line from (ex, ey) at the angle of (c, sn) runs inside box: [*r0, *r1]
+ * (empty when *r1 <= *r0). */
+static void clip(const double box[4], double ex, double ey, double c, double sn, double *r0, double *r1)
+{
+    double a = 0, b = INFINITY;
+    const double o[2] = {ex, ey}, v[2] = {c, sn};
+    for (int k = 0; k < 2; k++) {
+        const double lo = box[2 * k], hi = box[2 * k + 1];
+        if (fabs(v[k]) < 1e-12) {
+            if (o[k] < lo || o[k] > hi) b = -1;
+            continue;
+        }
+        double t0 = (lo - o[k]) / v[k], t1 = (hi - o[k]) / v[k];
+        if (t0 > t1) {
+            const double x = t0;
+            t0 = t1, t1 = x;
+        }
+        a = fmax(a, t0), b = fmin(b, t1);
+    }
+    *r0 = a, *r1 = b;
+}
+
+/* Line j's samples and its tree. */
+static void fill(atmos__beams_epi *e, const atmos__beams_sun *s, int j)
+{
+    const double th = j * e->dth, c = cos(th), sn = sin(th);
+    const int cnt = e->cnt[j], k0 = e->k0[j];
+    float *m = e->m + e->at[j], *lh = e->lh + 2 * e->tat[j]; /* a cell's least depth, then its greatest */
+    for (int i = 0; i < cnt; i++) m[i] = depth_at(s, e->ex + (k0 + i) * c, e->ey + (k0 + i) * sn);
+    const int nseg = cnt - 1;
+    int c0 = (nseg + LEAF - 1) / LEAF;
+    for (int i = 0; i < c0; i++) {
+        float lo = m[LEAF * i], hi = lo;
+        for (int k = LEAF * i + 1; k <= LEAF * (i + 1) && k <= nseg; k++) lo = m[k] < lo ? m[k] : lo, hi = m[k] > hi ? m[k] : hi;
+        lh[2 * i] = lo, lh[2 * i + 1] = hi;
+    }
+    for (; c0 > 1; c0 = (c0 + 1) / 2) {
+        float *nlh = lh + 2 * c0;
+        for (int i = 0; 2 * i < c0; i++) {
+            const float *a = lh + 4 * i, *b = 2 * i + 1 < c0 ? a + 2 : a;
+            nlh[2 * i] = a[0] < b[0] ? a[0] : b[0], nlh[2 * i + 1] = a[1] < b[1] ? b[1] : a[1];
+        }
+        lh = nlh;
+    }
+}
+
+/* The block *p of at least want elements of size each (its capacity *cap): 0, or -1 out of memory. */
+static int reserve(void **p, size_t *cap, size_t want, size_t size)
+{
+    if (want <= *cap) return 0;
+    free(*p);
+    *cap = 0;
+    if (!(*p = malloc(size * want))) return -1;
+    *cap = want;
+    return 0;
+}
+
+int atmos__beams_epi_build(atmos__beams_epi *e, const atmos__beams_sun *s, const double eye[3], size_t max_samples,
+                           int threads)
+{
+    e->lines = 0;
+    if (!s->n) return 0;
+    e->ex = (atmos__dot3(eye, s->right) - s->u0) / s->texel - 0.5;
+    e->ey = (atmos__dot3(eye, s->up) - s->v0) / s->texel - 0.5;
+    double R = 1;
+    for (int k = 0; k < 4; k++) R = fmax(R, hypot(s->box[k & 1] - e->ex, s->box[2 + (k >> 1)] - e->ey));
+    const double lines = ceil(2 * ATMOS_PI * R);
+    if (lines > 1 << 20) return 0;
+    const int L = (int)lines < 8 ? 8 : (int)lines;
+    if (reserve((void **)&e->at, &e->cap_lines, (2 * sizeof(size_t) + 2 * sizeof(int)) * (size_t)L, 1)) {
+        atmos__beams_epi_free(e);
+        return -1;
+    }
+    e->tat = e->at + L, e->k0 = (int *)(e->tat + L), e->cnt = e->k0 + L;
+    e->dth = 2 * ATMOS_PI / L;
+    size_t samples = 0, cells = 0;
+    for (int j = 0; j < L; j++) {
+        double r0, r1;
+        clip(s->box, e->ex, e->ey, cos(j * e->dth), sin(j * e->dth), &r0, &r1);
+        e->k0[j] = r1 > r0 ? (int)floor(r0) : 0;
+        e->cnt[j] = r1 > r0 ? (int)ceil(r1) - e->k0[j] + 1 : 0;
+        e->at[j] = samples, e->tat[j] = cells;
+        samples += (size_t)e->cnt[j], cells += tree_cells(e->cnt[j] - 1, NULL);
+    }
+    if (samples > max_samples) return 0;
+    if (reserve((void **)&e->m, &e->cap_floats, samples + 2 * cells + 1, sizeof(float))) {
+        atmos__beams_epi_free(e);
+        return -1;
+    }
+    e->lh = e->m + samples;
+    e->lines = L;
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads > 0 ? threads : 1)
+    for (int j = 0; j < L; j++) fill(e, s, j);
+    return 0;
+}
+
+/* A walk down one line: the ray's range [r0, r1] and depth zc + r zs, the stretch being gathered. */
+typedef struct walk {
+    const float *m, *lh;
+    size_t off[MAX_LEVELS];
+    double k0, zc, zs, r0, r1, a, b;
+    int open;
+    void (*lit)(void *u, double ra, double rb);
+    void *u;
+} walk;
+
+static void add(walk *w, double ra, double rb)
+{
+    if (w->open && ra <= w->b) {
+        w->b = rb;
+        return;
+    }
+    if (w->open) w->lit(w->u, w->a, w->b);
+    w->a = ra, w->b = rb, w->open = 1;
+}
+
+/* [ra, rb] where the map's depth runs linearly from da to db (finite): lit up to or from where
+ * the ray's depth crosses it. */
+static void linear(walk *w, double ra, double rb, double da, double db)
+{
+    const double fa = da - (w->zc + ra * w->zs), fb = db - (w->zc + rb * w->zs);
+    if (fa > 0 && fb > 0) add(w, ra, rb);
+    else if (fa > 0) add(w, ra, ra + (rb - ra) * fa / (fa - fb));
+    else if (fb > 0) add(w, ra + (rb - ra) * fa / (fa - fb), rb);
+}
+
+/* Segment i (samples i and i + 1) over [ra, rb]: the depth linear between the samples; where a
+ * sample holds no object, each sample's depth over its nearer half. */
+static void leaf(walk *w, int i, double ra, double rb)
+{
+    const double mi = w->m[i], mj = w->m[i + 1], ri = w->k0 + i;
+    if (mi < INFINITY && mj < INFINITY) {
+        linear(w, ra, rb, mi + (ra - ri) * (mj - mi), mi + (rb - ri) * (mj - mi));
+        return;
+    }
+    const double half = ri + 0.5;
+    if (ra < half) {
+        const double b = fmin(rb, half);
+        if (mi < INFINITY) linear(w, ra, b, mi, mi);
+        else add(w, ra, b);
+    }
+    if (rb > half) {
+        const double a = fmax(ra, half);
+        if (mj < INFINITY) linear(w, a, rb, mj, mj);
+        else add(w, a, rb);
+    }
+}
+
+static void node(walk *w, int l, int q, int nseg)
+{
+    const int s0 = (q << l) * LEAF, s1 = ((q + 1) << l) * LEAF < nseg ? ((q + 1) << l) * LEAF : nseg;
+    const double a = w->k0 + s0, b = w->k0 + s1, ra = a > w->r0 ? a : w->r0, rb = b < w->r1 ? b : w->r1;
+    if (!(ra < rb)) return;
+    const double za = w->zc + ra * w->zs, zb = w->zc + rb * w->zs;
+    const double zlo = za < zb ? za : zb, zhi = za < zb ? zb : za;
+    const float lo = w->lh[2 * (w->off[l] + q)], hi = w->lh[2 * (w->off[l] + q) + 1];
+    if (zhi < lo) add(w, ra, rb);
+    else if (zlo >= hi) return;
+    else if (l == 0)
+        for (int i = s0; i < s1; i++) {
+            const double u = w->k0 + i, v = u + 1;
+            if (v > ra && u < rb) leaf(w, i, u > ra ? u : ra, v < rb ? v : rb);
+        }
+    else node(w, l - 1, 2 * q, nseg), node(w, l - 1, 2 * q + 1, nseg);
+}
+
+void atmos__beams_epi_walk(const atmos__beams_epi *e, int j, double zc, double zs, double rT,
+                           void (*lit)(void *u, double ra, double rb), void *u)
+{
+    if (!(rT > 0)) return;
+    const int nseg = e->cnt[j] - 1;
+    walk w = {.m = e->m + e->at[j], .lh = e->lh + 2 * e->tat[j], .k0 = e->k0[j], .zc = zc, .zs = zs,
+              .r0 = 0, .r1 = rT, .lit = lit, .u = u};
+    if (nseg <= 0) {
+        add(&w, 0, rT);
+    } else {
+        int levels;
+        tree_cells(nseg, &levels);
+        size_t off = 0;
+        for (int l = 0, c = (nseg + LEAF - 1) / LEAF; l < levels; l++, c = (c + 1) / 2) w.off[l] = off, off += (size_t)c;
+        if (w.k0 > 0) add(&w, 0, fmin(w.k0, rT));
+        node(&w, levels - 1, 0, nseg);
+        if (rT > w.k0 + nseg) add(&w, w.k0 + nseg, rT);
+    }
+    if (w.open) lit(u, w.a, w.b);
+}

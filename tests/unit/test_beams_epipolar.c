@@ -1,0 +1,156 @@
+/* The sun's map along epipolar lines (render/beams_epipolar.h) against the map itself and a
+ * brute-force march, on a fence of nine posts on a slab under a sun up to the right (its
+ * 256-texel map) and the lines from an eye in front of it:
+ *   - every fifth line's samples are the map's depth at their points (the four nearest texels'
+ *     depths blended where all four hold an object, else the nearest texel's; beside the map
+ *     INFINITY), to 1e-5 relative, and a quarter of them at least are not at the next line's;
+ *   - rays whose projections run exactly along those lines (three slopes in depth each): the
+ *     lit length the line's tree walk gives against a march along the ray itself in steps of
+ *     1/64 texel, each step lit where the ray is nearer the sun than the map's depth there:
+ *     within 0.05 texel plus 0.6 texel for each edge the march crosses (the line holds a
+ *     depth a texel, linear between: a shadow's edge may move by up to about half a texel
+ *     along it); walked along the next line, an eighth of the shadowed rays at least miss so;
+ *   - the fog's sunlight from the lines (atmos__beams_sun_airlight_lines) against the map's
+ *     own steps at epsilon 1e-4 (atmos__beams_sun_airlight) on rays across the fence's
+ *     shadows: within 2 % of the unshadowed whole a ray. */
+#include "atmos/atmos.h"
+#include "render/beams_sun.h"
+#include "render/beams_epipolar.h"
+#include "core/vec.h"
+#include "test.h"
+
+static atmos_context *ctx;
+
+/* The map's depth at look-up coordinates (fx, fy), by the rule above. */
+static double map_depth(const atmos__beams_sun *s, double fx, double fy)
+{
+    const int n = s->n;
+    if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return INFINITY;
+    const int x0 = (int)floor(fx), y0 = (int)floor(fy);
+    double d[2][2];
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++) {
+            const int x = x0 + b < 0 ? 0 : x0 + b > n - 1 ? n - 1 : x0 + b, y = y0 + a < 0 ? 0 : y0 + a > n - 1 ? n - 1 : y0 + a;
+            d[a][b] = s->depth[(size_t)y * n + x];
+        }
+    const double ax = fx - x0, ay = fy - y0;
+    if (isinf(d[0][0]) || isinf(d[0][1]) || isinf(d[1][0]) || isinf(d[1][1])) return d[ay >= 0.5][ax >= 0.5];
+    return (1 - ay) * ((1 - ax) * d[0][0] + ax * d[0][1]) + ay * ((1 - ax) * d[1][0] + ax * d[1][1]);
+}
+
+static void add_length(void *u, double ra, double rb) { *(double *)u += rb - ra; }
+
+/* Nine posts 1.5 m square and 30 m high, 6 m apart, 60 m away, on a slab 80 m by 40 (post[9]);
+ * the sun's map of them. */
+static int fence(atmos_mesh *post[10], atmos__beams_sun *s, const double sun[3])
+{
+    for (int i = 0; i < 10; i++) {
+        post[i] = NULL;
+        CHECK_OK(atmos_mesh_load(ctx, "builtin:box", 0, &post[i]));
+        if (!post[i]) return 0;
+        atmos_mesh_transform t;
+        atmos_mesh_transform_identity(&t);
+        t.position_m[0] = 6 * (i - 4), t.position_m[1] = 15, t.position_m[2] = -60;
+        t.scale[0] = 1.5, t.scale[1] = 30, t.scale[2] = 1.5;
+        if (i == 9) t.position_m[0] = 0, t.position_m[1] = -0.5, t.scale[0] = 80, t.scale[1] = 1, t.scale[2] = 40;
+        CHECK_OK(atmos_mesh_apply_transform(ctx, post[i], &t));
+    }
+    memset(s, 0, sizeof *s);
+    CHECK_OK(atmos__beams_sun_build(ctx, s, sun, post, 10, 256));
+    return s->n == 256;
+}
+
+static void test_lit_length(const atmos__beams_sun *s, const atmos__beams_epi *e, const double eye[3])
+{
+    int rays = 0, shadowed = 0, fails = 0, off_fails = 0, samples = 0, samples_off = 0, sampled = 0;
+    double worst = 0;
+    for (int j = 0; j < e->lines; j += 5) {
+        const double th = j * e->dth, th1 = (j + 1) * e->dth;
+        /* the line's samples are the map's depths at its points (and not at the next line's) */
+        for (int i = 0; i < e->cnt[j]; i++) {
+            const double r = e->k0[j] + i, m = e->m[e->at[j] + i];
+            const double want = map_depth(s, e->ex + r * cos(th), e->ey + r * sin(th));
+            const double next = map_depth(s, e->ex + r * cos(th1), e->ey + r * sin(th1));
+            sampled++;
+            samples += !(fabs(m - want) <= 1e-5 * fabs(want) || m == want);
+            samples_off += !(fabs(m - next) <= 1e-5 * fabs(next) || m == next);
+        }
+        for (int k = 0; k < 3; k++) {
+            const double zs = 0.3 * (k - 1); /* depth per texel along the line */
+            const double zc = atmos__dot3(eye, s->fwd) - s->bias, rT = e->k0[j] + e->cnt[j] + 5.0;
+            double walked = 0, off = 0, marched = 0;
+            atmos__beams_epi_walk(e, j, zc, zs, rT, add_length, &walked);
+            atmos__beams_epi_walk(e, (j + 1) % e->lines, zc, zs, rT, add_length, &off);
+            const double h = 1.0 / 64;
+            int edges = 0, was = 1;
+            for (double r = 0.5 * h; r < rT; r += h) {
+                const int lit = zc + r * zs < map_depth(s, e->ex + r * cos(th), e->ey + r * sin(th));
+                marched += h * lit, edges += lit != was, was = lit;
+            }
+            rays++;
+            if (marched < rT - 1) {
+                const double tol = 0.05 + 0.6 * edges;
+                shadowed++;
+                fails += fabs(walked - marched) > tol, off_fails += fabs(off - marched) > tol;
+                worst = fmax(worst, fabs(walked - marched) / tol);
+            }
+        }
+    }
+    printf("epipolar lines: %d lines; %d of %d samples not the map's depth at their point (%d not at the next "
+           "line's); %d rays, %d shadowed: %d with a lit length beyond 0.05 + 0.6 texel an edge of the march "
+           "(at most %.2f of it), %d along the next line\n",
+           e->lines, samples, sampled, samples_off, rays, shadowed, fails, worst, off_fails);
+    CHECK(samples == 0);
+    CHECK(samples_off > sampled / 4);
+    CHECK(shadowed > 40);
+    CHECK(fails == 0);
+    CHECK(off_fails >= shadowed / 8);
+}
+
+static void test_airlight(const atmos__beams_sun *s, const atmos__beams_epi *e, const double eye[3])
+{
+    const atmos__beams_fog fog = {.sigma0 = 0.002, .albedo = 0.9, .g = 0.5};
+    double worst = 0;
+    int shadowed = 0;
+    for (int r = 0; r < 41; r++)
+        for (int k = 0; k < 3; k++) {
+            double d[3] = {-0.6 + 0.03 * r, 0.1 + 0.15 * k, -1};
+            atmos__normalize3(d);
+            const double T = 200;
+            const double lines = atmos__beams_sun_airlight_lines(s, e, &fog, eye, d, T, 0.01, 256);
+            const double steps = atmos__beams_sun_airlight(s, &fog, eye, d, T, 1e-4, 10000);
+            atmos__beams_sun empty = *s;
+            empty.n = 0;
+            const double whole = atmos__beams_sun_airlight(&empty, &fog, eye, d, T, 1e-4, 10000);
+            shadowed += steps < 0.99 * whole;
+            worst = fmax(worst, fabs(lines - steps) / whole);
+        }
+    printf("epipolar lines: the fog's sunlight within %.3f %% of the unshadowed whole of the map's steps "
+           "(%d of 123 rays shadowed)\n", 100 * worst, shadowed);
+    CHECK(shadowed > 10);
+    CHECK(worst <= 0.02);
+}
+
+int main(void)
+{
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    atmos_mesh *post[10];
+    atmos__beams_sun s;
+    double sun[3] = {0.4, 0.5, 0.6};
+    atmos__normalize3(sun);
+    if (fence(post, &s, sun)) {
+        const double eye[3] = {3, 10, 0};
+        atmos__beams_epi e = {0};
+        CHECK(atmos__beams_epi_build(&e, &s, eye, (size_t)1 << 24, 2) == 0);
+        CHECK(e.lines > 0);
+        if (e.lines > 0) {
+            test_lit_length(&s, &e, eye);
+            test_airlight(&s, &e, eye);
+        }
+        atmos__beams_epi_free(&e);
+    }
+    atmos__beams_sun_free(&s);
+    for (int i = 0; i < 10; i++) atmos_mesh_destroy(post[i]);
+    atmos_context_destroy(ctx);
+    return test_summary("test_beams_epipolar");
+}
