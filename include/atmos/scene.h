@@ -127,6 +127,8 @@ typedef struct atmos_scene_nishita {
                                  degree <= this, turned toward the eye per cell; -1 */
     int mc_delta_m;           /* 1 (with mc_lmax >= 0): the photons traced in the delta-M scaled medium of
                                  that degree (Wiscombe 1977), the field's part of the eye rays too; 0 */
+    int do_field;             /* 1: that field of the orders >= 2 (degree mc_lmax, 3 if -1) solved by
+                                 discrete ordinates on its cells instead of photons (docs/lightfield.md); 0 */
 } atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is

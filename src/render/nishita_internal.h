@@ -8,6 +8,8 @@
  *                     eye direction, its sky elements
  *   nishita_render.c  the eye rays and the composite over the sky
  *   dfield.c          with "diffuse": the slice renderer's diffuse light field, shared
+ *   nishita_mc.c      with "mc_kphotons": the Monte Carlo field of the orders >= 2
+ *   nishita_do.c      with "do": the same field by discrete ordinates (light/lfield_do.c)
  *
  * Not part of the API. */
 #ifndef ATMOS_RENDER_NISHITA_INTERNAL_H
@@ -57,6 +59,10 @@ struct atmos__nishita_plan {
     float mc_sig_ms[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     float mc_sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     double mc_s;             /* the last field's time */
+    /* with "do" (nishita_do.c): the last solve's directions, GMRES iterations and sweeps (over the
+     * wavelengths), largest relative residual, CPU time */
+    int do_dirs, do_iters, do_sweeps;
+    double do_resid, do_cpu;
 };
 
 /* The Monte Carlo field (nishita_mc.c): made once per plan (the path tracer's medium and phase

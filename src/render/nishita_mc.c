@@ -13,8 +13,11 @@
  * the eye rays then taking the field and the first order in it (TMS).
  * The sums are fixed point, one random stream per photon: the same field for a seed whatever
  * the threads. The eye pass adds sigma_s' times its trilinear value to the first order, both in
- * the truncated medium (nishita_render.c). */
+ * the truncated medium (nishita_render.c). With "do" the same coefficients come from a
+ * discrete-ordinates solve instead of photons (solve(), nishita_do.c). */
 #include "core/vec.h"
+#include "light/lfield_do.h"
+#include "render/nishita_do.h"
 #include "render/nishita_internal.h"
 #include "render/path_trace.h"
 
@@ -55,24 +58,6 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc)
     atmos__lfield_free(&mc->field);
     free(mc->coef);
     free(mc);
-}
-
-/* Real spherical harmonics (orthonormal over the sphere) of degree <= lmax at unit d. */
-static void sh_eval(int lmax, const double d[3], double *Y)
-{
-    const double x = d[0], y = d[1], z = d[2];
-    Y[0] = 0.28209479177387814;
-    if (lmax < 1) return;
-    Y[1] = 0.4886025119029199 * y, Y[2] = 0.4886025119029199 * z, Y[3] = 0.4886025119029199 * x;
-    if (lmax < 2) return;
-    Y[4] = 1.0925484305920792 * x * y, Y[5] = 1.0925484305920792 * y * z;
-    Y[6] = 0.31539156525252005 * (3 * z * z - 1), Y[7] = 1.0925484305920792 * x * z;
-    Y[8] = 0.5462742152960396 * (x * x - y * y);
-    if (lmax < 3) return;
-    Y[9] = 0.5900435899266435 * y * (3 * x * x - y * y), Y[10] = 2.890611442640554 * x * y * z;
-    Y[11] = 0.4570457994644658 * y * (5 * z * z - 1), Y[12] = 0.3731763325901154 * z * (5 * z * z - 3);
-    Y[13] = 0.4570457994644658 * x * (5 * z * z - 1), Y[14] = 1.445305721320277 * z * (x * x - y * y);
-    Y[15] = 0.5900435899266435 * x * (x * x - 3 * y * y);
 }
 
 /* The Legendre moments p_l = 2 pi int p(mu) P_l(mu) dmu, l <= 4, of every field's cut phase
@@ -132,7 +117,7 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
         st = atmos__path_medium_build(ctx, p->volume, p->scene.volume.density_scale, p->offset, p->optics, n, &mc->med);
     if (st != ATMOS_OK) return st;
     atmos__path_medium_truncate(&mc->med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])mc->ph.trunc);
-    mc->lmax = p->scene.nishita.mc_lmax;
+    mc->lmax = p->scene.nishita.mc_lmax < 0 && p->scene.nishita.do_field ? 3 : p->scene.nishita.mc_lmax;
     mc->K = mc->lmax < 0 ? 1 : (mc->lmax + 1) * (mc->lmax + 1);
     legendre_moments(mc, np->nf, n);
     for (int f = 0; f < np->nf; f++)
@@ -227,7 +212,7 @@ static void emission(const mc_job *M, const path_scatter *e, int k, const double
     double pl[4] = {0}, Y[MC_KMAX];
     for (int f = 0; f < mc->med.nf; f++)
         for (int l = 0; l <= mc->lmax; l++) pl[l] += e->ssf[f][0] * mc->pl[f][k][l] / e->ss[0];
-    sh_eval(mc->lmax, d, Y);
+    atmos__sh_eval(mc->lmax, d, Y);
     for (int l = 0; l <= mc->lmax; l++)
         for (int m = -l; m <= l; m++) v[l * l + l + m] = pl[l] * Y[l * l + l + m];
 }
@@ -367,6 +352,37 @@ static atmos_status trace(atmos_plan *p, const double sun_w[3], const double out
     return ATMOS_OK;
 }
 
+/* The same coefficients by discrete ordinates (nishita_do.c): chi_l per wavelength, the cut or
+ * scaled phase's normalised moments mc->pl weighted by the fields' scattering in the grid. */
+static atmos_status solve(atmos_plan *p, const double sun_w[3], const double *E, int threads)
+{
+    atmos__nishita_plan *np = p->nishita;
+    atmos__nishita_mc *mc = np->mc;
+    const int n = np->n, nf = np->nf;
+    double chi[ATMOS_MAX_WAVELENGTHS][4] = {{0}}, dens[PATH_F] = {0};
+    for (size_t v = 0; v < (size_t)np->g.c[0] * np->g.c[1] * np->g.c[2]; v++)
+        for (int f = 0; f < nf; f++) dens[f] += np->g.v[v * nf + f];
+    for (int w = 0; w < n; w++) {
+        double S = 0;
+        for (int f = 0; f < nf; f++) {
+            const double sf = dens[f] * np->mc_sca[f][w], p0 = mc->delta_m ? 1 : mc->pl[f][w][0];
+            S += sf;
+            for (int l = 0; l <= mc->lmax; l++) chi[w][l] += sf * mc->pl[f][w][l] / p0;
+        }
+        for (int l = 0; l <= mc->lmax; l++) chi[w][l] = S > 0 ? chi[w][l] / S : l == 0;
+    }
+    if (mc->med.empty) {
+        memset(mc->coef, 0, sizeof(float) * (size_t)mc->field.c[0] * mc->field.c[1] * mc->field.c[2] * n * mc->K);
+        return ATMOS_OK;
+    }
+    atmos__nishita_do_info info;
+    const atmos_status st = atmos__nishita_do_fill(p, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E,
+                                                   threads, mc->coef, &info);
+    np->do_iters = info.iters, np->do_sweeps = info.sweeps, np->do_dirs = info.directions;
+    np->do_resid = info.resid, np->do_cpu = info.cpu_s;
+    return st;
+}
+
 /* The field toward the eye at eye_w (world): per cell its coefficients at the direction from
  * the cell's centre to the eye, not below 0. */
 static void view(atmos__nishita_plan *np, const double eye_w[3], int threads)
@@ -387,7 +403,7 @@ static void view(atmos__nishita_plan *np, const double eye_w[3], int threads)
                     atmos__vol_frame_to_point(&np->x, gc, pw);
                     for (int a = 0; a < 3; a++) d[a] = eye_w[a] - pw[a];
                     atmos__normalize3(d);
-                    sh_eval(mc->lmax, d, Y);
+                    atmos__sh_eval(mc->lmax, d, Y);
                 }
                 for (int w = 0; w < n; w++) {
                     const float *c = mc->coef + (cell * n + w) * K;
@@ -406,7 +422,8 @@ atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], cons
     const int same_out = mc->lmax >= 0 || !memcmp(mc->out, out_w, sizeof mc->out);
     if (!mc->valid || memcmp(mc->sun, sun_w, sizeof mc->sun) || !same_out) {
         const double t0 = atmos__now();
-        atmos_status st = trace(p, sun_w, out_w, E, threads < 1 ? 1 : threads);
+        atmos_status st = p->scene.nishita.do_field ? solve(p, sun_w, E, threads < 1 ? 1 : threads)
+                                                    : trace(p, sun_w, out_w, E, threads < 1 ? 1 : threads);
         if (st != ATMOS_OK) return st;
         memcpy(mc->sun, sun_w, sizeof mc->sun), memcpy(mc->out, out_w, sizeof mc->out);
         mc->valid = 1, mc->view_valid = 0;

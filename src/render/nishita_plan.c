@@ -89,8 +89,9 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
         st = atmos__stables_build(ctx, p->optics, np->n, 2, &np->tab);
         if (st == ATMOS_OK) st = atmos__dfield_prepare(ctx, &np->df, &np->g, &np->tab, &np->x, p->optics, "render nishita");
     }
-    if (st == ATMOS_OK && np->g.v && p->scene.nishita.mc_kphotons > 0) st = atmos__nishita_mc_create(p, np);
-    if (p->scene.nishita.mc_delta_m && (p->scene.nishita.mc_kphotons <= 0 || p->scene.nishita.mc_lmax < 0))
+    const atmos_scene_nishita *sn = &p->scene.nishita;
+    if (st == ATMOS_OK && np->g.v && (sn->mc_kphotons > 0 || sn->do_field)) st = atmos__nishita_mc_create(p, np);
+    if (sn->mc_delta_m && ((sn->mc_kphotons <= 0 && !sn->do_field) || (sn->mc_lmax < 0 && !sn->do_field)))
         atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_delta_m does nothing without a Monte Carlo field in spherical "
                                         "harmonics (mc_kphotons > 0 and mc_lmax >= 0)");
     if (st != ATMOS_OK) {

@@ -240,7 +240,14 @@ void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap)
     if (np->mc) {
         const atmos__lfield *F = atmos__nishita_mc_field(np);
         const size_t l = strlen(buf);
-        snprintf(buf + l, cap - l, "; Monte Carlo field of %d thousand photons, %dx%dx%d cells of %d voxels, %.3f s",
-                 s->mc_kphotons, F->c[0], F->c[1], F->c[2], F->s, np->mc_s);
+        if (s->do_field)
+            snprintf(buf + l, cap - l,
+                     "; discrete-ordinates field, %d directions, %d GMRES iterations, %d sweeps (residual %.1e), "
+                     "%dx%dx%d cells of %d voxels, %.3f s, %.3f s CPU",
+                     np->do_dirs, np->do_iters, np->do_sweeps, np->do_resid, F->c[0], F->c[1], F->c[2], F->s,
+                     np->mc_s, np->do_cpu);
+        else
+            snprintf(buf + l, cap - l, "; Monte Carlo field of %d thousand photons, %dx%dx%d cells of %d voxels, %.3f s",
+                     s->mc_kphotons, F->c[0], F->c[1], F->c[2], F->s, np->mc_s);
     }
 }

@@ -105,6 +105,10 @@ static const atmos_setting nishita_settings[] = {
      "with mc_lmax >= 0: the photons and the field's part of the eye rays in the delta-M scaled medium "
      "of that degree (its forward peak above the degree counted as not scattered)",
      NISHITA(mc_delta_m)},
+    {"do", "nishita-do", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "the field of the orders >= 2 in spherical harmonics (degree mc_lmax, 3 if -1) solved by discrete "
+     "ordinates on its cells, not by photons (docs/lightfield.md)",
+     NISHITA(do_field)},
 };
 
 static const atmos_setting harris_settings[] = {

@@ -1,0 +1,52 @@
+/* A discrete-ordinates solve of the diffuse light on a coarse grid of cubic cells (lfield_do.c,
+ * docs/lightfield.md "A discrete-ordinates field"): the radiance of the orders >= 1 that a given
+ * first-order emission starts, in a medium of per-cell extinction and scattering whose phase
+ * function is given by its normalised Legendre moments up to degree L <= 3; the answer is the
+ * radiance's real spherical harmonics of degree <= L per cell (the orthonormal ones of
+ * atmos__sh_eval). Upwind step sweeps (positive), the scattering source re-projected on degree
+ * <= L after every sweep, and restarted GMRES on the moments (the source iteration's fixed point).
+ * The same numbers whatever the threads. Not part of the API. */
+#ifndef ATMOS_LIGHT_LFIELD_DO_H
+#define ATMOS_LIGHT_LFIELD_DO_H
+
+#define ATMOS__DO_KMAX 16  /* coefficients per cell at most: degree 3 */
+#define ATMOS__DO_NMAX 512 /* directions at most */
+
+/* Real spherical harmonics (orthonormal over the sphere) of degree <= lmax (<= 3) at unit d. */
+void atmos__sh_eval(int lmax, const double d[3], double *Y);
+
+/* An angular quadrature: n directions (unit) and weights summing to 4 pi. */
+typedef struct {
+    int n;
+    double dir[ATMOS__DO_NMAX][3], w[ATMOS__DO_NMAX];
+} atmos__do_quad;
+
+/* The product set of nmu Gauss-Legendre cosines about the z axis and nphi equally spaced
+ * azimuths (half a step off the x axis): exact for the products of spherical harmonics of
+ * degree <= min(2 nmu - 1, nphi - 1) / 2 in each. Returns 0 when nmu * nphi > ATMOS__DO_NMAX. */
+int atmos__do_quadrature(int nmu, int nphi, atmos__do_quad *q);
+
+typedef struct {
+    int c[3];                   /* cells, the first axis fastest */
+    double h;                   /* cell edge, m */
+    int L;                      /* degree, 0-3 */
+    double chi[4];              /* the phase function's normalised Legendre moments, chi[0] = 1 */
+    const float *sig_t, *sig_s; /* per cell, 1/m */
+    const double *q1;           /* per cell and coefficient: the first-order emission's moments per m^3 */
+    const atmos__do_quad *quad; /* directions in the frame of the spherical harmonics */
+    double R[3][3];             /* a direction's components along the cells' axes: R d */
+    double tol;                 /* GMRES: relative residual */
+    int max_iter, restart, threads;
+} atmos__do_problem;
+
+typedef struct {
+    int iters, sweeps;    /* GMRES iterations; sweeps of all the directions */
+    double resid;         /* the last relative residual */
+    double leak, emitted; /* power leaving the grid, power of the first-order emission (per 1 of q1 units m^3) */
+} atmos__do_stats;
+
+/* The radiance moments phi[cell * K + k], K = (L + 1)^2, of the orders >= 1 (phi on entry: the
+ * start, 0 if nothing better). Returns 0 when out of memory. */
+int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st);
+
+#endif

@@ -1,0 +1,20 @@
+/* The Nishita renderer's discrete-ordinates field (nishita_do.c). Not part of the API. */
+#ifndef ATMOS_RENDER_NISHITA_DO_H
+#define ATMOS_RENDER_NISHITA_DO_H
+
+#include "render/nishita_internal.h"
+
+typedef struct {
+    int directions, iters, sweeps; /* GMRES iterations and sweeps, summed over the wavelengths */
+    double resid;                  /* the largest relative residual left */
+    double cpu_s;                  /* the process's CPU time during the solve */
+} atmos__nishita_do_info;
+
+/* The field's coefficients coef[(cell * n + w) * K + k], K = (L + 1)^2, for the sun sun_w
+ * (world; E the sunlight per wavelength) by discrete ordinates on F's cells, chi[w] the
+ * scattering's normalised Legendre moments; the sunlight's columns (np->col) made for this sun. */
+atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L, const double chi[][4],
+                                    const double sun_w[3], const double *E, int threads, float *coef,
+                                    atmos__nishita_do_info *info);
+
+#endif

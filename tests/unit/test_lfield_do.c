@@ -1,0 +1,113 @@
+/* The discrete-ordinates solve of the diffuse light (light/lfield_do.c, docs/lightfield.md "A
+ * discrete-ordinates field"): the quadrature integrates the products of the harmonics of degree
+ * <= 3 exactly; in a closed conservative cloud the power leaving the grid is the power the first
+ * order emitted (nothing is absorbed; one sweep alone, the first order's transport without the
+ * scattering, falls far short, so the check can fail); an absorbing cloud loses some; the same
+ * bytes with 1 and 2 threads. */
+#include "light/lfield_do.h"
+#include "test.h"
+
+#define NC 14
+#define LO 2
+#define HI 12 /* the cloud: cells LO..HI-1 on every axis */
+
+static void check_quadrature(int nmu, int nphi)
+{
+    atmos__do_quad q;
+    CHECK(atmos__do_quadrature(nmu, nphi, &q));
+    double sw = 0, worst = 0;
+    for (int n = 0; n < q.n; n++) sw += q.w[n];
+    for (int a = 0; a < 16; a++)
+        for (int b = 0; b < 16; b++) {
+            double s = 0, Y[16];
+            for (int n = 0; n < q.n; n++) {
+                atmos__sh_eval(3, q.dir[n], Y);
+                const double ya = Y[a], yb = Y[b];
+                s += q.w[n] * ya * yb;
+            }
+            worst = fmax(worst, fabs(s - (a == b)));
+        }
+    printf("  quadrature %d x %d: sum of weights - 4 pi %.1e, worst error of the harmonics' products %.1e\n", nmu,
+           nphi, sw - 4 * 3.14159265358979323846, worst);
+    CHECK(fabs(sw - 4 * 3.14159265358979323846) < 1e-12);
+    CHECK(worst < 1e-12);
+}
+
+typedef struct {
+    float st[NC * NC * NC], ss[NC * NC * NC];
+    double q1[NC * NC * NC * 16], phi[NC * NC * NC * 16];
+    atmos__do_quad q;
+    atmos__do_problem P;
+} cloud;
+
+/* A cube of side 10 cells (10 m each) of extinction 0.5 / m (50 optical depths across) and albedo
+ * omega in a grid with 2 empty cells around it, its top layer emitting the first order of a sun
+ * at the zenith (travelling down), HG g 0.5's moments. */
+static void make_cloud(cloud *C, double omega, int threads, int max_iter)
+{
+    memset(C, 0, sizeof *C);
+    atmos__do_quadrature(8, 16, &C->q);
+    atmos__do_problem *P = &C->P;
+    P->c[0] = P->c[1] = P->c[2] = NC, P->h = 10, P->L = 3;
+    P->chi[0] = 1, P->chi[1] = 0.5, P->chi[2] = 0.25, P->chi[3] = 0.125;
+    const double down[3] = {0, 0, -1};
+    double Y[16];
+    atmos__sh_eval(3, down, Y);
+    for (int k = 0; k < NC; k++)
+        for (int j = 0; j < NC; j++)
+            for (int i = 0; i < NC; i++) {
+                const size_t c = ((size_t)k * NC + j) * NC + i;
+                const int in = i >= LO && i < HI && j >= LO && j < HI && k >= LO && k < HI;
+                C->st[c] = in ? 0.5f : 0.0f, C->ss[c] = (float)(C->st[c] * omega);
+                for (int m = 0; m < 16 && in && k == HI - 1; m++) {
+                    const int l = m >= 9 ? 3 : m >= 4 ? 2 : m >= 1 ? 1 : 0;
+                    C->q1[c * 16 + m] = 0.3 * P->chi[l] * Y[m];
+                }
+            }
+    P->sig_t = C->st, P->sig_s = C->ss, P->q1 = C->q1, P->quad = &C->q;
+    P->R[0][0] = P->R[1][1] = P->R[2][2] = 1;
+    P->tol = 1e-6, P->max_iter = max_iter, P->restart = 30, P->threads = threads;
+}
+
+static void check_balance(cloud *C)
+{
+    atmos__do_stats S;
+    make_cloud(C, 1.0, 2, 0);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    const double one = S.leak / S.emitted;
+    make_cloud(C, 1.0, 2, 400);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    printf("  closed conservative cloud, 50 optical depths across: leaving / emitted %.6f after %d GMRES "
+           "iterations (%d sweeps, residual %.1e); without the scattering's solve (one sweep) %.3f\n",
+           S.leak / S.emitted, S.iters, S.sweeps, S.resid, one);
+    CHECK(S.emitted > 0);
+    CHECK(fabs(S.leak / S.emitted - 1) < 1e-3);
+    CHECK(one < 0.9);
+    make_cloud(C, 0.9, 2, 400);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    printf("  albedo 0.9: leaving / emitted %.4f after %d iterations\n", S.leak / S.emitted, S.iters);
+    CHECK(S.leak / S.emitted < 0.9 && S.leak > 0);
+}
+
+static void check_threads(cloud *C)
+{
+    static double phi1[NC * NC * NC * 16];
+    atmos__do_stats S;
+    make_cloud(C, 1.0, 1, 20);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    memcpy(phi1, C->phi, sizeof phi1);
+    make_cloud(C, 1.0, 2, 20);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    CHECK(!memcmp(phi1, C->phi, sizeof phi1));
+}
+
+int main(void)
+{
+    check_quadrature(8, 16);
+    check_quadrature(4, 8);
+    cloud *C = malloc(sizeof *C);
+    CHECK(C != NULL);
+    if (C) check_balance(C), check_threads(C);
+    free(C);
+    return test_summary("test_lfield_do");
+}
