@@ -127,6 +127,9 @@ typedef struct atmos_scene_nishita {
                                  degree <= this, turned toward the eye per cell; -1 */
     int mc_delta_m;           /* 1 (with mc_lmax >= 0): the photons traced in the delta-M scaled medium of
                                  that degree (Wiscombe 1977), the field's part of the eye rays too; 0 */
+    int mc_dm_clip;           /* 1 (with mc_delta_m): the photons sample the scaled phase exactly, the cut
+                                 phase with its peak clipped until delta-M's fraction is gone, instead of
+                                 Henyey-Greenstein of its g*; 0 */
 } atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is

@@ -105,6 +105,10 @@ static const atmos_setting nishita_settings[] = {
      "with mc_lmax >= 0: the photons and the field's part of the eye rays in the delta-M scaled medium "
      "of that degree (its forward peak above the degree counted as not scattered)",
      NISHITA(mc_delta_m)},
+    {"mc_dm_clip", "nishita-mc-dm-clip", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "with mc_delta_m: the photons sample the scaled phase exactly (the cut phase, its peak clipped until "
+     "delta-M's fraction is gone) instead of Henyey-Greenstein of its g*",
+     NISHITA(mc_dm_clip)},
 };
 
 static const atmos_setting harris_settings[] = {
