@@ -10,10 +10,11 @@
 # Environment: ATMOS (default build/atmos), SPP (the references', default 256), CASES (default
 # "disney cumulus"), KPHOTONS (thousands of photons per wavelength, default 2000), CELL (the
 # field's cell edge in render voxels, default 4), LMAX (-1: toward the view's centre; 0-3:
-# spherical harmonics), DELTA_M (1: with LMAX >= 0, the delta-M scaled field), TAG (the
-# variant's file name, default mcCELL_LMAX, dm appended with DELTA_M; doCELL_LMAX with DO), DO
-# (1: with LMAX >= 0, the field solved by discrete ordinates, --nishita-do, not by photons),
-# THREADS, REUSE (1: keep the references already in OUT_DIR). Writes OUT_DIR/CASE_SUN.TAG.bd.txt and the field's CPU
+# spherical harmonics), DELTA_M (1: with LMAX >= 0, the delta-M scaled field), DM_CLIP (1: with
+# DELTA_M, the photons sample the scaled phase exactly, --nishita-mc-dm-clip), DO (1: with LMAX >= 0,
+# the field solved by discrete ordinates, --nishita-do, not by photons), TAG (the variant's file name,
+# default mcCELL_LMAX, dm appended with DELTA_M, dmc with DM_CLIP; doCELL_LMAX with DO), THREADS,
+# REUSE (1: keep the references already in OUT_DIR). Writes OUT_DIR/CASE_SUN.TAG.bd.txt and the field's CPU
 # time (user+system, s) in OUT_DIR/CASE_SUN.TAG.cpu.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -27,7 +28,8 @@ CELL=${CELL:-4}
 LMAX=${LMAX:--1}
 DM=$([ "${DELTA_M:-0}" = 1 ] && echo "--nishita-mc-delta-m" || echo "")
 DO=$([ "${DO:-0}" = 1 ] && echo "--nishita-do" || echo "")
-TAG=${TAG:-$([ -n "$DO" ] && echo do || echo mc)${CELL}_$LMAX${DM:+dm}}
+DMC=$([ -n "$DM" ] && [ "${DM_CLIP:-0}" = 1 ] && echo "--nishita-mc-dm-clip" || echo "")
+TAG=${TAG:-$([ -n "$DO" ] && echo do || echo mc)${CELL}_$LMAX${DM:+dm}${DMC:+c}}
 TH=${THREADS:+--threads $THREADS}
 mkdir -p "$OUT"
 for c in $CASES; do
@@ -48,7 +50,7 @@ for c in $CASES; do
             python3 "$here/breakdown.py" "$b.p1.pfm" "$b.vpath.pfm" "$b.tau.pfm" "$b.vpath2.pfm" > "$b.p1.bd.txt"
         fi
         /usr/bin/time -f %U+%S -o "$b.$TAG.cpu" $V --renderer nishita --nishita-orders 1 --no-nishita-sky \
-            --nishita-mc "$K" --nishita-mc-cell "$CELL" --nishita-mc-lmax "$LMAX" $DM $DO --pfm "$b.$TAG.pfm" \
+            --nishita-mc "$K" --nishita-mc-cell "$CELL" --nishita-mc-lmax "$LMAX" $DM $DMC $DO --pfm "$b.$TAG.pfm" \
             -o "$b.$TAG.png" 2> "$b.$TAG.log"
         python3 "$here/breakdown.py" "$b.$TAG.pfm" "$b.vpath.pfm" "$b.tau.pfm" "$b.vpath2.pfm" > "$b.$TAG.bd.txt"
         echo "== $c, sun $sun, $TAG: $(head -2 "$b.$TAG.bd.txt" | tr '\n' ' ') cpu $(cat "$b.$TAG.cpu") s" >&2

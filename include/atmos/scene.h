@@ -129,6 +129,9 @@ typedef struct atmos_scene_nishita {
                                  that degree (Wiscombe 1977), the field's part of the eye rays too; 0 */
     int do_field;             /* 1: that field of the orders >= 2 (degree mc_lmax, 3 if -1) solved by
                                  discrete ordinates on its cells instead of photons (docs/lightfield.md); 0 */
+    int mc_dm_clip;           /* 1 (with mc_delta_m): the photons sample the scaled phase exactly, the cut
+                                 phase with its peak clipped until delta-M's fraction is gone, instead of
+                                 Henyey-Greenstein of its g*; 0 */
 } atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is

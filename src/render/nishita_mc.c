@@ -9,8 +9,9 @@
  * omega = -(the camera's central view direction) ("mc_lmax" -1: the "perfect-angle" field that
  * the P1 field approximates), or as real spherical harmonics of degree <= lmax of the emission
  * (p_l Y_lm(d_in) per collision, the addition theorem), turned toward the eye per cell and frame;
- * with "mc_delta_m" the photons traced in the delta-M scaled medium of that degree (delta_m()),
- * the eye rays then taking the field and the first order in it (TMS).
+ * with "mc_delta_m" the photons traced in the delta-M scaled medium of that degree (delta_m();
+ * with "mc_dm_clip" sampling its phase exactly, the cut phase's peak clipped further), the eye
+ * rays then taking the field and the first order in it (TMS).
  * The sums are fixed point, one random stream per photon: the same field for a seed whatever
  * the threads. The eye pass adds sigma_s' times its trilinear value to the first order, both in
  * the truncated medium (nishita_render.c). With "do" the same coefficients come from a
@@ -40,10 +41,12 @@ struct atmos__nishita_mc {
     path_phase ph;
     int lmax, K;         /* -1: the phase toward one direction (K = 1); else degree lmax, K = (lmax + 1)^2 */
     /* Legendre moments 2 pi int p P_l dmu of the cut phase (l <= 4); with delta-M those of the
-     * scaled phase p*, (chi_l - f) / (1 - f) for l <= lmax */
+     * scaled phase p* (ph_dm's table), l <= lmax, normalised */
     double pl[PATH_F][ATMOS_MAX_WAVELENGTHS][5];
     int delta_m;         /* the photons in the delta-M scaled medium, their phase HG of g* (hg) */
     atmos_phase_mixture hg[PATH_F][ATMOS_MAX_WAVELENGTHS];
+    int clip;            /* with delta_m: their phase the clipped scaled phase (ph_dm) instead */
+    path_phase ph_dm;
     float *coef;         /* [(cell * n + w) * K + k]: the emission of orders >= 2 per unit sigma_s' */
     atmos__lfield field; /* L: its radiance toward the eye (cells of s render voxels) */
     double sun[3], out[3], eye[3];
@@ -55,6 +58,7 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc)
     if (!mc) return;
     atmos__path_medium_free(&mc->med);
     atmos__path_phase_free(&mc->ph);
+    atmos__path_phase_free(&mc->ph_dm);
     atmos__lfield_free(&mc->field);
     free(mc->coef);
     free(mc);
@@ -64,32 +68,26 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc)
  * function (the path tracer's tables, p_0 = 1 up to their rounding). */
 static void legendre_moments(atmos__nishita_mc *mc, int nf, int n)
 {
-    enum { STEPS = 36000 };
     for (int f = 0; f < nf; f++)
-        for (int k = 0; k < n; k++) {
-            double acc[5] = {0};
-            for (int i = 0; i < STEPS; i++) {
-                const double th = (i + 0.5) * ATMOS_PI / STEPS, mu = cos(th);
-                path_angle a;
-                atmos__path_angle(&mc->ph, mu, &a);
-                const double p = atmos__path_phase_eval(&mc->ph, f, k, &a) * 2 * ATMOS_PI * sin(th) * ATMOS_PI / STEPS;
-                double P[5] = {1, mu};
-                for (int l = 1; l < 4; l++) P[l + 1] = ((2 * l + 1) * mu * P[l] - l * P[l - 1]) / (l + 1);
-                for (int l = 0; l < 5; l++) acc[l] += p * P[l];
-            }
-            for (int l = 0; l < 5; l++) mc->pl[f][k][l] = acc[l];
-        }
+        for (int k = 0; k < n; k++) atmos__path_phase_moments(&mc->ph, f, k, 4, mc->pl[f][k]);
 }
 
 /* Delta-M (Wiscombe 1977) of degree L = lmax on top of the 3-degree cut: per field and
  * wavelength f = chi_{L+1} (the cut phase's normalised moment) counts as not scattered,
  * sigma_t* = sigma_t' - f sigma_s', sigma_s* = (1 - f) sigma_s' (so omega* = (1 - f) omega /
- * (1 - f omega)); the scaled phase's moments chi*_l = (chi_l - f) / (1 - f), l <= L, replace
- * the cut phase's in the projection, and the photons sample it as Henyey-Greenstein with g* =
- * chi*_1 (its higher moments g*^l, not chi*_l). */
-static void delta_m(atmos__nishita_mc *mc, int nf, int n)
+ * (1 - f omega)). The scaled phase p*:
+ * - by default its moments chi*_l = (chi_l - f) / (1 - f), l <= L, replace the cut phase's in
+ *   the projection, and the photons sample it as Henyey-Greenstein with g* = chi*_1 (its higher
+ *   moments g*^l, not chi*_l);
+ * - with clip, the photons sample the cut phase with its peak clipped further until the fraction
+ *   f is gone (atmos__path_phase_clip: a truncation, Potter 1970, J. Atmos. Sci. 27, 617, at the
+ *   angle where the removed fraction is delta-M's f, 24 degrees for HG 0.85 and L 3), a positive
+ *   function, exactly. The projection keeps delta-M's chi*_l: the clipped table's own moments
+ *   exceed them by the removed peak's int (1 - P_l) / (1 - f) (+0.02, +0.05, +0.10 for HG 0.85),
+ *   and projecting with those was worse on the bench (docs/lightfield.md). */
+static atmos_status delta_m(atmos_context *ctx, atmos__nishita_mc *mc, int nf, int n)
 {
-    float f[PATH_F][ATMOS_MAX_WAVELENGTHS];
+    float f[PATH_F][ATMOS_MAX_WAVELENGTHS] = {{0}};
     const int L = mc->lmax;
     for (int i = 0; i < nf; i++)
         for (int k = 0; k < n; k++) {
@@ -102,7 +100,12 @@ static void delta_m(atmos__nishita_mc *mc, int nf, int n)
             h->count = 1, h->kind[0] = ATMOS_PHASE_HG, h->weight[0] = 1;
             h->g[0] = L >= 1 ? pl[1] : 0;
         }
+    if (mc->clip) {
+        atmos_status st = atmos__path_phase_clip(ctx, &mc->ph, (const float(*)[ATMOS_MAX_WAVELENGTHS])f, &mc->ph_dm);
+        if (st != ATMOS_OK) return st;
+    }
     atmos__path_medium_truncate(&mc->med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])f);
+    return ATMOS_OK;
 }
 
 atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
@@ -123,7 +126,8 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
     for (int f = 0; f < np->nf; f++)
         for (int w = 0; w < n; w++) np->mc_sig[f][w] = mc->med.sig[f][w];
     mc->delta_m = p->scene.nishita.mc_delta_m && mc->lmax >= 0;
-    if (mc->delta_m) delta_m(mc, np->nf, n);
+    mc->clip = mc->delta_m && p->scene.nishita.mc_dm_clip;
+    if (mc->delta_m && (st = delta_m(ctx, mc, np->nf, n)) != ATMOS_OK) return st;
     for (int f = 0; f < np->nf; f++)
         for (int w = 0; w < n; w++) np->mc_sig_ms[f][w] = mc->med.sig[f][w], np->mc_sca[f][w] = mc->med.sca[f][w];
     const int s = p->scene.nishita.mc_cell;
@@ -249,8 +253,9 @@ static void photon(const mc_job *M, int k, atmos__stream *r, int64_t *acc)
         }
         if (!atmos__path_roulette(w, 1, r)) return;
         const int f = atmos__path_pick_field(&e, 0, m->nf, r);
-        const double mu = mc->delta_m ? atmos_phase_mixture_sample(&mc->hg[f][k], 0.5, atmos__stream_u(r))
-                                      : atmos__path_phase_sample(&mc->ph, f, k, atmos__stream_u(r));
+        const double mu = mc->delta_m && !mc->clip
+                              ? atmos_phase_mixture_sample(&mc->hg[f][k], 0.5, atmos__stream_u(r))
+                              : atmos__path_phase_sample(mc->clip ? &mc->ph_dm : &mc->ph, f, k, atmos__stream_u(r));
         double nd[3];
         atmos__path_around(d, mu, 2.0 * ATMOS_PI * atmos__stream_u(r), nd);
         memcpy(d, nd, sizeof d);

@@ -130,3 +130,82 @@ double atmos__path_phase_sample(const path_phase *p, int f, int k, double u)
     const int i = atmos__angle_cdf_find(c, p->ng, &u);
     return atmos__angle_invert(p->grid, c, i, u, fv[i], fv[i + 1]);
 }
+
+/* The removed fraction of the density fv (a truncated table, fv[0] = 0) when P = fv / sin is
+ * clipped at level c in the forward hemisphere (into g if not NULL), by the trapezoids the
+ * tables are normalised with; T is fv's own trapezoid sum. */
+static double clip_removed(const atmos__angle_grid *g, const float *fv, double c, double T, double *out)
+{
+    double kept = 0, prev = 0;
+    for (int i = 0; i < g->n; i++) {
+        const double v = fv[i], lim = g->deg[i] < 90 ? c * g->sin[i] : INFINITY, x = v > lim ? lim : v;
+        if (out) out[i] = x;
+        if (i > 0) kept += 0.5 * (prev + x) * (g->rad[i] - g->rad[i - 1]);
+        prev = x;
+    }
+    return 1.0 - kept / T;
+}
+
+atmos_status atmos__path_phase_clip(atmos_context *ctx, const path_phase *src,
+                                    const float frac[PATH_F][ATMOS_MAX_WAVELENGTHS], path_phase *dst)
+{
+    memset(dst, 0, sizeof *dst);
+    dst->nf = src->nf, dst->nwl = src->nwl, dst->grid = src->grid, dst->ng = src->ng;
+    dst->ic = src->ic ? src->ic : 1, dst->cut_deg = src->cut_deg;
+    const atmos__angle_grid *g = src->grid;
+    const int ng = src->ng;
+    double *x = malloc(sizeof(double) * (size_t)ng);
+    for (int f = 0; f < src->nf; f++) {
+        dst->t[f] = src->t[f];
+        dst->fv[f] = malloc(sizeof(float) * (size_t)src->nwl * ng);
+        dst->cdf[f] = malloc(sizeof(double) * (size_t)src->nwl * ng);
+        if (!x || !dst->fv[f] || !dst->cdf[f]) {
+            free(x), atmos__path_phase_free(dst);
+            return atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the phase tables");
+        }
+        for (int k = 0; k < src->nwl; k++) {
+            const float *fv = src->fv[f] + (size_t)k * ng;
+            double T = 0, hi = 0, lo = 0;
+            for (int i = 1; i < ng; i++) {
+                T += 0.5 * ((double)fv[i - 1] + fv[i]) * (g->rad[i] - g->rad[i - 1]);
+                if (g->sin[i] > 0 && fv[i] / g->sin[i] > hi) hi = fv[i] / g->sin[i];
+            }
+            const double want = frac[f][k] > 0 && frac[f][k] < 1 ? frac[f][k] : 0;
+            for (int it = 0; it < 200 && want > 0 && hi > lo; it++) { /* removed(c) falls as c grows */
+                const double c = 0.5 * (lo + hi);
+                if (clip_removed(g, fv, c, T, NULL) > want) lo = c;
+                else hi = c;
+            }
+            const double r = T > 0 ? clip_removed(g, fv, want > 0 ? hi : INFINITY, T, x) : 0;
+            float *out = dst->fv[f] + (size_t)k * ng;
+            for (int i = 0; i < ng; i++) out[i] = (float)(T > 0 ? x[i] / (2 * ATMOS_PI * T * (1 - r)) : fv[i]);
+            dst->trunc[f][k] = (float)r;
+            truncated_cdf(g, out, dst->cdf[f] + (size_t)k * ng);
+        }
+    }
+    free(x);
+    return ATMOS_OK;
+}
+
+double atmos__path_phase_moments(const path_phase *p, int f, int k, int lmax, double *pl)
+{
+    enum { STEPS = 36000 };
+    double acc[ATMOS__PATH_PHASE_LMAX + 1] = {0};
+    if (lmax > ATMOS__PATH_PHASE_LMAX) lmax = ATMOS__PATH_PHASE_LMAX;
+    for (int i = 0; i < STEPS; i++) {
+        const double th = (i + 0.5) * ATMOS_PI / STEPS, mu = cos(th);
+        path_angle a;
+        atmos__path_angle(p, mu, &a);
+        const double w = atmos__path_phase_eval(p, f, k, &a) * 2 * ATMOS_PI * sin(th) * ATMOS_PI / STEPS;
+        double P0 = 1, P1 = mu;
+        acc[0] += w;
+        if (lmax >= 1) acc[1] += w * mu;
+        for (int l = 1; l < lmax; l++) {
+            const double P2 = ((2 * l + 1) * mu * P1 - l * P0) / (l + 1);
+            acc[l + 1] += w * P2;
+            P0 = P1, P1 = P2;
+        }
+    }
+    for (int l = 0; l <= lmax; l++) pl[l] = acc[l];
+    return acc[0];
+}

@@ -37,6 +37,20 @@ atmos_status atmos__path_phase_build(atmos_context *ctx, const atmos_volume_opti
 double atmos__path_phase_sample(const path_phase *p, int f, int k, double u);
 void atmos__path_phase_free(path_phase *p);
 
+/* The tables of src (truncated or not) with their forward peak clipped further, per field and
+ * wavelength at the level P_c that removes the fraction frac[f][k] of them: P*(theta) =
+ * min(P(theta), P_c) / (1 - frac) in the forward hemisphere, P / (1 - frac) elsewhere (the cut
+ * of atmos__path_phase_build at the angle theta_c where P falls to P_c, found by bisection on
+ * P_c rather than snapped to a grid angle), dst->trunc[][] the fractions removed, sampled by
+ * atmos__path_phase_sample from their own inverse CDF and evaluated by atmos__path_phase_eval. */
+atmos_status atmos__path_phase_clip(atmos_context *ctx, const path_phase *src,
+                                    const float frac[PATH_F][ATMOS_MAX_WAVELENGTHS], path_phase *dst);
+/* The Legendre moments pl[l] = 2 pi int p(mu) P_l(mu) dmu, l <= lmax (at most
+ * ATMOS__PATH_PHASE_LMAX), of the phase function atmos__path_phase_eval evaluates (midpoint
+ * rule on 36000 angles); returns pl[0] (1 up to the tables' rounding). */
+#define ATMOS__PATH_PHASE_LMAX 8
+double atmos__path_phase_moments(const path_phase *p, int f, int k, int lmax, double *pl);
+
 /* The interval of theta (from mu = cos theta) and the weights of f_i, f_{i+1} there: one
  * lookup serves every field and wavelength of a scattering event. */
 typedef atmos__angle_weights path_angle;

@@ -109,6 +109,10 @@ static const atmos_setting nishita_settings[] = {
      "the field of the orders >= 2 in spherical harmonics (degree mc_lmax, 3 if -1) solved by discrete "
      "ordinates on its cells, not by photons (docs/lightfield.md)",
      NISHITA(do_field)},
+    {"mc_dm_clip", "nishita-mc-dm-clip", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+     "with mc_delta_m: the photons sample the scaled phase exactly (the cut phase, its peak clipped until "
+     "delta-M's fraction is gone) instead of Henyey-Greenstein of its g*",
+     NISHITA(mc_dm_clip)},
 };
 
 static const atmos_setting harris_settings[] = {

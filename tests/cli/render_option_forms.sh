@@ -69,6 +69,7 @@ cat >"$T/table" <<'EOF'
 --nishita-mc-lmax 2|nishita.mc_lmax=2|nishita|same
 --nishita-mc-delta-m|nishita.mc_delta_m=true|nishita|same
 --nishita-do|nishita.do=true|nishita|
+--nishita-mc-dm-clip|nishita.mc_dm_clip=true|nishita|same
 --spacing 100|harris.spacing_m=100|harris|
 --max-particles 10|harris.max_particles=10|harris|
 --sky-lights 0|harris.sky_lights=0|harris|

@@ -2,11 +2,16 @@
  * docs/lightfield.md "A Monte Carlo field"): a wide uniform slab lit from the zenith, its
  * reflected radiance (the exact first order plus the field's spherical harmonics turned toward
  * the eye, unscaled and delta-M scaled) against the independent adding-doubling solver
- * (path_ad.h), and the same bytes with 1 and 2 threads (unscaled and delta-M); the same field of
- * degree 3, delta-M, solved by discrete ordinates (render/nishita_do.c) in slabs of optical depth
- * 1, 4 and 16, and its bytes with 1 and 2 threads. */
+ * (path_ad.h), and the same bytes with 1 and 2 threads (unscaled, delta-M, delta-M with the scaled
+ * phase sampled exactly, discrete ordinates); the delta-M scaled phase function the photons sample
+ * (atmos__path_phase_clip): normalised, its removed fraction delta-M's f, its sampled moments its
+ * tabulated ones; the same field of degree 3, delta-M, solved by discrete ordinates
+ * (render/nishita_do.c) in slabs of optical depth 1, 4 and 16. */
 #include "path_ad.h"
+#include "render/path_phase.h"
 #include "test.h"
+
+#include <stdint.h>
 
 #define NX 96
 #define NY 16 /* the slab's 12 voxels and 2 empty ones above and below */
@@ -103,20 +108,24 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
         atmos_image *img = test_plan_frame(ctx, &s, v, o);
         s.nishita.mc_delta_m = 1, s.nishita.mc_kphotons = 300;
         atmos_image *dm = test_plan_frame(ctx, &s, v, o);
+        s.nishita.mc_dm_clip = 1;
+        atmos_image *dc = test_plan_frame(ctx, &s, v, o);
         scene(&s, mus[a], -1);
         atmos_image *ex = test_plan_frame(ctx, &s, v, o);
         s.nishita.mc_kphotons = 0;
         atmos_image *one = test_plan_frame(ctx, &s, v, o);
-        if (!img || !dm || !ex || !one) {
-            atmos_image_destroy(img), atmos_image_destroy(dm), atmos_image_destroy(ex), atmos_image_destroy(one);
+        if (!img || !dm || !dc || !ex || !one) {
+            atmos_image_destroy(img), atmos_image_destroy(dm), atmos_image_destroy(dc), atmos_image_destroy(ex);
+            atmos_image_destroy(one);
             return;
         }
         const double ref = ad_up(&r, mus[a]), m = image_mean(img), md = image_mean(dm), me = image_mean(ex),
-                     m1 = image_mean(one);
+                     m1 = image_mean(one), mc = image_mean(dc);
         printf("  slab tau %g, view mu %.2f: adding-doubling %.4f; first order %.4f (%+.1f %%), + field toward the "
-               "view's centre %.4f (%+.1f %%), + field of degree 3 %.4f (%+.1f %%), delta-M %.4f (%+.1f %%)\n",
+               "view's centre %.4f (%+.1f %%), + field of degree 3 %.4f (%+.1f %%), delta-M %.4f (%+.1f %%), "
+               "clipped %.4f (%+.1f %%)\n",
                TAU, mus[a], ref, m1, 100 * (m1 / ref - 1), me, 100 * (me / ref - 1), m, 100 * (m / ref - 1), md,
-               100 * (md / ref - 1));
+               100 * (md / ref - 1), mc, 100 * (mc / ref - 1));
         /* the field toward the view's centre (the diagnostic's): measured -3.4 % and -12.4 % (100
          * thousand photons per wavelength, cells of 1 voxel; -1.4 and -7.8 % with 300 thousand,
          * -4.9 and -12.7 % with cells of 2: the photons' noise over the few cells the view sees,
@@ -136,7 +145,12 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
          * both angles) and closer than the unscaled degree 3, so the check can fail */
         CHECK(fabs(md / ref - 1) < 0.1);
         CHECK(fabs(md / ref - 1) < fabs(m / ref - 1));
-        atmos_image_destroy(img), atmos_image_destroy(dm), atmos_image_destroy(ex), atmos_image_destroy(one);
+        /* delta-M with the photons sampling the clipped scaled phase exactly (mc_dm_clip, the
+         * projection on delta-M's moments): measured -5.0 % and -5.2 % with 300 thousand photons
+         * (its table's own moments in the projection instead: -9.5 and -2.8 %); held as delta-M */
+        CHECK(fabs(mc / ref - 1) < 0.1);
+        CHECK(fabs(mc / ref - 1) < fabs(m / ref - 1));
+        atmos_image_destroy(dc), atmos_image_destroy(img), atmos_image_destroy(dm), atmos_image_destroy(ex), atmos_image_destroy(one);
     }
 }
 
@@ -178,8 +192,63 @@ static void check_do(atmos_context *ctx, const atmos_volume_optics *o)
     }
 }
 
+static uint64_t rng_state = 15;
+static double uniform(void)
+{
+    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+}
+
+/* The delta-M scaled phase of degree 3 (HG 0.85 cut at 3 degrees, its peak clipped further until
+ * f = chi_4 is gone, the photons' phase with mc_dm_clip): it integrates to 1, removes f, and the
+ * cosines drawn from it have the mean P_1, P_2, P_3 of its own table, which a Henyey-Greenstein
+ * lobe of the same g* (the sampler without mc_dm_clip: its moments g*^l) does not have. */
+static void check_scaled_phase(atmos_context *ctx, const atmos_volume_optics *o)
+{
+    enum { N = 2000000 };
+    path_phase ph, dm;
+    CHECK_OK(atmos__path_phase_build(ctx, o, 3, 3.0, &ph));
+    double chi[5], cs[4], hg[4] = {0}, smp[4] = {0};
+    const double p0 = atmos__path_phase_moments(&ph, 0, 0, 4, chi), f = chi[4] / p0;
+    float frac[PATH_F][ATMOS_MAX_WAVELENGTHS] = {{0}};
+    for (int k = 0; k < 3; k++) frac[0][k] = (float)f;
+    CHECK_OK(atmos__path_phase_clip(ctx, &ph, (const float(*)[ATMOS_MAX_WAVELENGTHS])frac, &dm));
+    const double q0 = atmos__path_phase_moments(&dm, 0, 0, 3, cs);
+    atmos_phase_mixture h;
+    memset(&h, 0, sizeof h);
+    h.count = 1, h.kind[0] = ATMOS_PHASE_HG, h.weight[0] = 1, h.g[0] = cs[1] / q0;
+    for (int i = 0; i < N; i++) {
+        const double mu[2] = {atmos__path_phase_sample(&dm, 0, 1, uniform()), atmos_phase_mixture_sample(&h, 0.5, uniform())};
+        for (int j = 0; j < 2; j++) {
+            const double P2 = 1.5 * mu[j] * mu[j] - 0.5, P3 = (5 * mu[j] * P2 - 2 * mu[j]) / 3;
+            double *acc = j ? hg : smp;
+            acc[1] += mu[j] / N, acc[2] += P2 / N, acc[3] += P3 / N;
+        }
+    }
+    double cut = 0; /* theta_c: the last angle where the clipped table is below the cut one */
+    for (int i = 1; i < ph.ng && ph.grid->deg[i] < 90; i++)
+        if (dm.fv[0][ph.ng + i] * (1 - dm.trunc[0][1]) < 0.9999 * ph.fv[0][ph.ng + i]) cut = ph.grid->deg[i];
+    printf("  scaled phase: clipped below %.2f deg,", cut);
+    printf(" f %.4f removed %.4f, integral %.5f; chi*_l table %.4f %.4f %.4f, sampled %.4f %.4f "
+           "%.4f, HG g* sampled %.4f %.4f %.4f; delta-M's (chi_l - f) / (1 - f) %.4f %.4f %.4f\n",
+           f, dm.trunc[0][1], q0, cs[1] / q0, cs[2] / q0, cs[3] / q0, smp[1], smp[2], smp[3], hg[1], hg[2], hg[3],
+           (chi[1] / p0 - f) / (1 - f), (chi[2] / p0 - f) / (1 - f), (chi[3] / p0 - f) / (1 - f));
+    CHECK(f > 0.4 && f < 0.6); /* g^4 = 0.52 for HG 0.85, a little less after the 3-degree cut */
+    CHECK(fabs(dm.trunc[0][1] - f) < 1e-4);
+    CHECK(fabs(q0 - 1) < 1e-3);
+    /* 2 million draws: the mean of P_l within 0.002 (about 4 standard deviations) */
+    for (int l = 1; l <= 3; l++) CHECK_MSG(fabs(smp[l] - cs[l] / q0) < 0.002, "l %d", l);
+    /* the HG lobe of the same g* matches P_1 but not P_2 (so the check above can fail) */
+    CHECK(fabs(hg[1] - cs[1] / q0) < 0.002);
+    CHECK(fabs(hg[2] - cs[2] / q0) > 0.01);
+    atmos__path_phase_free(&ph), atmos__path_phase_free(&dm);
+}
+
 /* The same image, byte for byte, with 1 and 2 threads (fixed-point sums, one stream per photon). */
-static void check_threads(const atmos_volume_optics *o, const atmos_volume *v, int delta_m, int do_field)
+static void check_threads(const atmos_volume_optics *o, const atmos_volume *v, int delta_m, int clip,
+                          int do_field)
 {
     atmos_image *img[2] = {NULL, NULL};
     for (int t = 0; t < 2; t++) {
@@ -190,7 +259,8 @@ static void check_threads(const atmos_volume_optics *o, const atmos_volume *v, i
         CHECK_OK(atmos_context_create(&d, &ctx));
         atmos_scene s;
         scene(&s, 0.6, 3);
-        s.nishita.mc_kphotons = 20, s.nishita.mc_delta_m = delta_m, s.nishita.do_field = do_field;
+        s.nishita.mc_kphotons = 20, s.nishita.mc_delta_m = delta_m, s.nishita.mc_dm_clip = clip;
+        s.nishita.do_field = do_field;
         if (do_field) s.nishita.mc_cell = 2;
         img[t] = test_plan_frame(ctx, &s, v, o);
         atmos_context_destroy(ctx);
@@ -213,11 +283,13 @@ int main(void)
     atmos_phase_table *t = NULL;
     atmos_volume_optics o;
     make_optics(ctx, &t, &o);
+    check_scaled_phase(ctx, &o);
     atmos_volume *v = slab(ctx);
     check_slab(ctx, &o, v);
-    check_threads(&o, v, 0, 0);
-    check_threads(&o, v, 1, 0);
-    check_threads(&o, v, 1, 1);
+    check_threads(&o, v, 0, 0, 0);
+    check_threads(&o, v, 1, 0, 0);
+    check_threads(&o, v, 1, 1, 0);
+    check_threads(&o, v, 1, 0, 1);
     check_do(ctx, &o);
     atmos_volume_destroy(v);
     atmos_phase_table_destroy(t);
