@@ -154,6 +154,9 @@ typedef struct atmos__poptics {
     double sigma_ext[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* m^2 */
     double albedo[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     const atmos_msphase *ms[ATMOS_VOLUME_MAX_FIELDS];    /* Ams_n and F_n of each type */
+    /* NULL, or ms[f]'s Ams_n on the scattering angle's cosine for the eye pass (pphase.h: no
+     * acos, within its error of ms[f]); the owner makes and frees them */
+    const struct atmos__pphase *ph[ATMOS_VOLUME_MAX_FIELDS];
 } atmos__poptics;
 
 /* The light reaching each particle from the sun (direction sun, toward it): light[p * nw + k]

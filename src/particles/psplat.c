@@ -3,6 +3,7 @@
  * tile composites its own list in that order, so a tile's pixels see every particle in the
  * same order whatever thread draws it. */
 #include "particles/pcloud.h"
+#include "particles/pphase.h"
 #include "core/fastmath.h"
 #include "core/internal.h"
 #include "optics/optics_internal.h"
@@ -49,7 +50,8 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
     for (int j = 0; j < L->n; j++) {
         /* scattering angle: the light travels along -dir, the eye is at -rel from the centre */
         const double mu = (L->dir[j][0] * rel[0] + L->dir[j][1] * rel[1] + L->dir[j][2] * rel[2]) / d;
-        if (o->ms[fi]) atmos__msphase_eval_all(o->ms[fi], o->nw, L->order[j][p] + 1.0, mu, ph);
+        if (o->ph[fi]) atmos__pphase_eval(o->ph[fi], L->order[j][p] + 1.0, mu, ph);
+        else if (o->ms[fi]) atmos__msphase_eval_all(o->ms[fi], o->nw, L->order[j][p] + 1.0, mu, ph);
         else
             for (int k = 0; k < o->nw; k++) ph[k] = 1.0 / (4.0 * ATMOS_PI);
         for (int k = 0; k < o->nw; k++) sums[k] += ph[k] * L->e[j][k] * L->light[j][(size_t)p * o->nw + k];

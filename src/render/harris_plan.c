@@ -4,6 +4,7 @@
  * lights clouds at sunset with several coloured lights, sky lights from directions over the
  * upper hemisphere whose colour the atmosphere gives). */
 #include "render/harris_internal.h"
+#include "particles/pphase.h"
 
 #include "atmosphere/atmosphere_check.h"
 
@@ -111,6 +112,9 @@ static atmos_status optics(atmos_plan *p, atmos__harris_plan *h)
         h->o.ms[f] = p->optics->ms[f];
         if (!h->o.ms[f])
             return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render harris: the optics need their Ams tables");
+        /* the eye pass's Ams_n on the cosine (docs/viewer.md: within its stated error) */
+        if (!(h->o.ph[f] = atmos__pphase_make(h->o.ms[f], h->o.nw)))
+            return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the phase tables");
     }
     return ATMOS_OK;
 }
@@ -208,6 +212,7 @@ void atmos__harris_plan_destroy(atmos__harris_plan *h)
     atmos__harris_objects_destroy(h->obj);
     atmos__pclusters_free(&h->clouds);
     atmos__pcloud_free(&h->pc);
+    for (int f = 0; f < ATMOS_VOLUME_MAX_FIELDS; f++) atmos__pphase_free(h->o.ph[f]);
     for (int j = 0; j < ATMOS__HARRIS_MAX_LIGHTS; j++) free(h->light[j]), free(h->order[j]);
     free(h->air_t), free(h->air_l);
     atmos__aerial_free(&h->aerial);
