@@ -189,6 +189,8 @@ atmos_status atmos__scene_blame_override(atmos_context *ctx, atmos_status st, co
         if (overrides[i] && override_sets(overrides[i], key)) {
             char rest[1024];
             snprintf(rest, sizeof rest, "%s", k);
+            if (!strcmp(source, "-D")) /* atmos render's name for a scene of overrides alone */
+                return atmos__error(ctx, st, "-D %.300s: %s", overrides[i], rest);
             return atmos__error(ctx, st, "-D %.300s (on %s): %s", overrides[i], source, rest);
         }
     return st;
