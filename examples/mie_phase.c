@@ -62,13 +62,24 @@ static atmos_status preset_table(atmos_context *ctx, const char *name, int fast)
     return ATMOS_OK;
 }
 
+/* A number in [lo, hi] from text ("abc", "10um" and "" are refused). */
+static int number_in(const char *text, double lo, double hi, double *v)
+{
+    char *end = NULL;
+    *v = strtod(text, &end);
+    return end != text && !*end && *v >= lo && *v <= hi;
+}
+
 int main(int argc, char **argv)
 {
     const char *preset = "cloud";
     double r_um = 10.0;
     int fast = 0;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--radius") && i + 1 < argc) r_um = atof(argv[++i]);
+        if (!strcmp(argv[i], "--radius") && i + 1 < argc) {
+            if (!number_in(argv[++i], 1e-3, 1e4, &r_um))
+                return fprintf(stderr, "mie_phase: --radius %s: expected a radius in micrometres, in [0.001, 10000]\n", argv[i]), 2;
+        }
         else if (!strcmp(argv[i], "--preset") && i + 1 < argc) preset = argv[++i];
         else if (!strcmp(argv[i], "--fast")) fast = 1;
         else return fprintf(stderr, "usage: mie_phase [--radius R_UM] [--preset NAME] [--fast]\n"), 2;

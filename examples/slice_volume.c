@@ -47,13 +47,24 @@ static atmos_status write_png(atmos_context *ctx, const atmos_scene *scene, cons
     return st;
 }
 
+/* A number in [lo, hi] from text ("abc", "30deg" and "" are refused). */
+static int number_in(const char *text, double lo, double hi, double *v)
+{
+    char *end = NULL;
+    *v = strtod(text, &end);
+    return end != text && !*end && *v >= lo && *v <= hi;
+}
+
 int main(int argc, char **argv)
 {
     const char *file = NULL, *out = "slice_volume.png";
     double sun = 30.0;
     int w = 0, h = 0;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--sun") && i + 1 < argc) sun = atof(argv[++i]);
+        if (!strcmp(argv[i], "--sun") && i + 1 < argc) {
+            if (!number_in(argv[++i], -90, 90, &sun))
+                return fprintf(stderr, "slice_volume: --sun %s: expected an elevation in degrees, in [-90, 90]\n", argv[i]), 2;
+        }
         else if (!strcmp(argv[i], "--size") && i + 2 < argc) w = atoi(argv[i + 1]), h = atoi(argv[i + 2]), i += 2;
         else if (!strcmp(argv[i], "-o") && i + 1 < argc) out = argv[++i];
         else if (argv[i][0] != '-') file = argv[i];

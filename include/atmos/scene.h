@@ -21,6 +21,9 @@ extern "C" {
 #define ATMOS_SCENE_MAX_DIM 16384
 #define ATMOS_SCENE_MAX_PARTICLES 8
 #define ATMOS_SCENE_MAX_FRAMES 100000
+/* An animation's automatic exposure is at most that of this EV100 by default: a camera's
+ * longest metered exposure, 30 s at f/2.8 and ISO 100 (log2(2.8^2 / 30) = -1.94). */
+#define ATMOS_SCENE_EXPOSURE_LIMIT_EV (-2.0)
 
 typedef struct atmos_scene_sun {
     int from_time;             /* 0: use elevation/azimuth; 1: compute from time/latitude/longitude */
@@ -240,7 +243,13 @@ typedef struct atmos_scene_animation {
     double minutes_end;        /* the last frame's simulated minutes; frame i's volume.sim_minutes goes
                                   linearly from the volume's (its preset's default when 0) to this */
     int exposure_per_frame;    /* 1: "exposure": "per_frame", an automatic exposure chosen for each
-                                  frame; 0: "locked" (default), the first frame's for all */
+                                  frame; 0: "locked" (default), the one of the frame with the
+                                  highest sun for all */
+    double exposure_limit_ev;  /* "exposure_limit_ev": an automatic exposure of the animation's
+                                  frames is at most that of this EV100 (a camera's limit, so
+                                  night stays dark), [-20, 40]; atmos_scene_defaults and a
+                                  scene file's "animation" without the key:
+                                  ATMOS_SCENE_EXPOSURE_LIMIT_EV */
 } atmos_scene_animation;
 
 /* The Earth's maps and clouds of a spherical atmosphere ("atmosphere" keys "ground_map",
@@ -290,6 +299,9 @@ typedef struct atmos_scene {
     atmos_scene_fog fog;
     int object_count;
     atmos_scene_object objects[ATMOS_SCENE_MAX_OBJECTS];
+    char file[ATMOS_SCENE_PATH_MAX];      /* the scene file atmos_scene_load read, whose folder its
+                                             relative paths were taken from (messages name it);
+                                             "" for a scene from text, standard input or code */
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */
@@ -321,8 +333,10 @@ ATMOS_API atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_
  * ("camera.fov_deg", "camera.position_m.1"), VALUE JSON text ("35", "[0, 900, 0]",
  * "\"path\"") or a bare word that is not JSON, taken as a string (renderer=path).
  * Objects on the path are made as needed; array items are replaced (or appended at the
- * array's size). Each value is then read with the rules and messages of the file's. The
- * load's path "-" reads standard input (relative volume paths: from the current folder). */
+ * array's size). Each value is then read with the rules and messages of the file's; a
+ * mistake at a key an override set is blamed on it ("-D camera.fovv_deg=30 (on SOURCE):
+ * /camera/fovv_deg: unknown key ..."). The load's path "-" reads standard input (relative
+ * volume paths: from the current folder). */
 ATMOS_API atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t length, const char *source,
                                               const char *const *overrides, int count, atmos_scene *out);
 ATMOS_API atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const char *const *overrides,

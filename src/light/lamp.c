@@ -1,6 +1,7 @@
 /* Point lights and spotlights (lamp.h): their spectra and their falloff, shared by the beam
  * renderer and the path tracer. */
 #include "light/lamp.h"
+#include "scene/scene_internal.h"
 #include "core/vec.h"
 
 #include "atmos/image.h"
@@ -66,18 +67,19 @@ double atmos__lamp_toward(const atmos__lamp *l, const double p[3], int m, const 
 
 static double srgb_linear(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
 
-atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene_light *s, int index, atmos__lamp *l)
+atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene, int index, atmos__lamp *l)
 {
+    const atmos_scene_light *s = &scene->lights[index];
     if (!s->image[0]) return ATMOS_OK;
     atmos_image *img = NULL;
     atmos_status st = atmos_read_png(ctx, s->image, &img);
     if (st != ATMOS_OK) {
-        /* the reader's message names the file; the scene's key goes in front, and a relative
-         * path (a scene from standard input or from code) says where it was looked for */
-        char why[1024];
+        /* the reader's message names the file; the scene file and its key go in front, and a
+         * relative path says where it was looked for */
+        char why[1024], sc[ATMOS_SCENE_PATH_MAX + 2], note[ATMOS_SCENE_PATH_MAX + 48];
         snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
-        return atmos__error(ctx, st, "/lights/%d/image: %s%s", index, why,
-                            s->image[0] == '/' ? "" : " (a relative path: from the current folder)");
+        atmos__scene_path_where(scene, s->image, sc, sizeof sc, note, sizeof note);
+        return atmos__error(ctx, st, "%s/lights/%d/image: %s%s", sc, index, why, note);
     }
     const size_t n = (size_t)img->width * img->height;
     l->tex = malloc(sizeof(float) * 3 * n);

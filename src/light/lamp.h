@@ -45,7 +45,7 @@ static inline double atmos__lamp_falloff_cos(const atmos__lamp *l, double c)
 /* The light's image (scene light s's "image", a PNG of sRGB values, linearised) read into l
  * (made by atmos__lamp_make); a missing or malformed file is an error naming its key
  * (/lights/INDEX/image) and the file. */
-atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene_light *s, int index, atmos__lamp *l);
+atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene, int index, atmos__lamp *l);
 void atmos__lamp_free(atmos__lamp *l);
 
 /* The image's tint toward point p (rgb, bilinear; 0 outside the image; 1, 1, 1 without an

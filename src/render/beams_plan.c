@@ -9,11 +9,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-static atmos_status make_light(atmos_context *ctx, const atmos_scene_light *s, int index, const atmos_wavelengths *wl,
+static atmos_status make_light(atmos_context *ctx, const atmos_scene *s, int index, const atmos_wavelengths *wl,
                                atmos__beams_light *l)
 {
     memset(l, 0, sizeof *l);
-    atmos__lamp_make(s, wl, &l->L);
+    atmos__lamp_make(&s->lights[index], wl, &l->L);
     return atmos__lamp_load_image(ctx, s, index, &l->L);
 }
 
@@ -57,7 +57,7 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
     double range = 0;
     atmos__beams_progress pr = {0, 0, 0};
     for (int i = 0; st == ATMOS_OK && i < s->light_count; i++) {
-        st = make_light(p->ctx, &s->lights[i], i, &p->wl, &b->lights[i]);
+        st = make_light(p->ctx, s, i, &p->wl, &b->lights[i]);
         b->nlights = i + 1;
         range = fmax(range, b->lights[i].L.range);
         pr.total += atmos__beams_shadow_faces(&b->lights[i].L, b->obj.n);

@@ -1,5 +1,6 @@
 /* The scene's objects for the renderers (objects.h). */
 #include "render/objects.h"
+#include "scene/scene_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,17 +16,17 @@ static atmos_status load_terrain(atmos_context *ctx, const atmos_scene_object *o
     return atmos_mesh_terrain(ctx, &d, out);
 }
 
-/* A failed mesh or terrain's message with the scene's key in front, and for a relative
- * path (a scene from standard input or from code) where it was looked for, as a light's
- * image says (lamp.c). */
-static atmos_status name_key(atmos_context *ctx, atmos_status st, const atmos_scene_object *o, int i)
+/* A failed mesh or terrain's message with the scene file and its key in front, and for a
+ * relative path where it was looked for, as a light's image says (lamp.c). */
+static atmos_status name_key(atmos_context *ctx, atmos_status st, const atmos_scene *s, int i)
 {
+    const atmos_scene_object *o = &s->objects[i];
     const char *path = o->terrain[0] ? o->terrain : o->mesh;
-    const int file = path[0] != '/' && strncmp(path, "builtin:", 8) && strncmp(path, "generate:", 9);
-    char why[1024];
+    char why[1024], scene[ATMOS_SCENE_PATH_MAX + 2], note[ATMOS_SCENE_PATH_MAX + 48];
     snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
-    return atmos__error(ctx, st, "/objects/%d/%s: %s%s", i, o->terrain[0] ? "terrain" : "mesh", why,
-                        file && st == ATMOS_E_IO ? " (a relative path: from the current folder)" : "");
+    atmos__scene_path_where(s, path, scene, sizeof scene, note, sizeof note);
+    return atmos__error(ctx, st, "%s/objects/%d/%s: %s%s", scene, i, o->terrain[0] ? "terrain" : "mesh", why,
+                        st == ATMOS_E_IO ? note : "");
 }
 
 atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const atmos_wavelengths *wl,
@@ -39,7 +40,7 @@ atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const
     for (int i = 0; i < s->object_count; i++) {
         const atmos_scene_object *o = &s->objects[i];
         atmos_status st = o->terrain[0] ? load_terrain(ctx, o, &ob->mesh[i]) : atmos_mesh_load(ctx, o->mesh, 0, &ob->mesh[i]);
-        if (st != ATMOS_OK) return name_key(ctx, st, o, i);
+        if (st != ATMOS_OK) return name_key(ctx, st, s, i);
         ob->n = i + 1;
         atmos_mesh_transform t;
         memcpy(t.position_m, o->position_m, sizeof t.position_m);

@@ -42,7 +42,7 @@ atmos_status atmos__path_lamps_build(atmos_context *ctx, const atmos_scene *s, c
     L->nlamps = s->light_count;
     for (int i = 0; i < s->light_count; i++) {
         atmos__lamp_make(&s->lights[i], wl, &L->lamp[i]);
-        if ((st = atmos__lamp_load_image(ctx, &s->lights[i], i, &L->lamp[i])) != ATMOS_OK) return st;
+        if ((st = atmos__lamp_load_image(ctx, s, i, &L->lamp[i])) != ATMOS_OK) return st;
     }
     if ((st = atmos__fog_optics_build(ctx, s, wl, &L->fog)) != ATMOS_OK) return st;
     L->sigma_s = L->fog.sigma_s, L->sigma_a = L->fog.sigma_t - L->fog.sigma_s;

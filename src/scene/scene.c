@@ -41,6 +41,7 @@ void atmos_scene_defaults(atmos_scene *s)
     atmos_atmosphere_defaults(&s->atmosphere);
     s->wavelengths = ATMOS_WAVELENGTHS_RGB;
     s->spectral_samples = ATMOS_SPECTRAL_DEFAULT;
+    s->animation.exposure_limit_ev = ATMOS_SCENE_EXPOSURE_LIMIT_EV;
     s->tonemap.manual_exposure = 0;
     s->tonemap.exposure_ev = 0.0;
     s->tonemap.curve = ATMOS_TONE_FILMIC;
@@ -243,7 +244,10 @@ atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t
         if (count > 0 && !cJSON_IsObject(root))
             st = atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: a scene must be a JSON object", source);
         else st = atmos__scene_apply_overrides(ctx, source, root, overrides, count);
-        if (st == ATMOS_OK) st = atmos__scene_from_json(ctx, source, root, &s);
+        if (st == ATMOS_OK) {
+            st = atmos__scene_from_json(ctx, source, root, &s);
+            if (st != ATMOS_OK && count > 0) st = atmos__scene_blame_override(ctx, st, source, overrides, count);
+        }
         if (st == ATMOS_OK) *out = s;
     }
     cJSON_Delete(root);
@@ -327,6 +331,7 @@ atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t
     const char *slash = in ? NULL : strrchr(path, '/'); /* from standard input: the current folder */
     const size_t dir = slash ? (size_t)(slash - path) + 1 : 0;
     char key[64];
+    if (st == ATMOS_OK && !in && strlen(path) < sizeof out->file) snprintf(out->file, sizeof out->file, "%s", path);
     if (st == ATMOS_OK)
         st = atmos__scene_join_path(ctx, path, dir, out->volume.source, sizeof out->volume.source, "volume/file");
     if (st == ATMOS_OK) st = atmos__scene_earth_paths(ctx, path, dir, &out->earth);
@@ -412,7 +417,8 @@ atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *
         const double m0 = atmos__scene_first_sim_minutes(&s);
         s.volume.sim_minutes = index == n - 1 ? a->minutes_end : m0 + (double)index / (n - 1) * (a->minutes_end - m0);
     }
-    memset(&s.animation, 0, sizeof s.animation);
+    memset(&s.animation, 0, sizeof s.animation); /* a frame is a single image, with the animation's limit */
+    s.animation.exposure_limit_ev = a->exposure_limit_ev;
     *out = s;
     return ATMOS_OK;
 }

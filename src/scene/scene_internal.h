@@ -86,6 +86,11 @@ atmos_status atmos__scene_from_json(atmos_context *ctx, const char *source, cons
 /* Sets each "PATH=VALUE" of overrides in root (scene_override.c; atmos_scene_parse_with). */
 atmos_status atmos__scene_apply_overrides(atmos_context *ctx, const char *source, struct cJSON *root,
                                           const char *const *overrides, int count);
+/* After a failed parse of a tree with overrides: when the message's key (SOURCE: /a/b: ...) is
+ * one an override set (or lies inside it), the message says so (-D PATH=VALUE on SOURCE),
+ * rather than blaming the file, which may not have the key at all. Returns st. */
+atmos_status atmos__scene_blame_override(atmos_context *ctx, atmos_status st, const char *source,
+                                         const char *const *overrides, int count);
 
 /* The view direction and up vector atmos_camera_init will use for cam, with
  * camera.h's zero-means-default rules for look_at and up applied. */
@@ -121,5 +126,11 @@ atmos_status atmos__scene_join_path(atmos_context *ctx, const char *scene, size_
                                     const char *key);
 /* $ATMOS_DATA, else the folder the build was configured with (ATMOS_DATA_DIR). */
 const char *atmos__scene_data_dir(void);
+/* Where a file the scene names (path, after atmos_scene_load joined it) was looked for, for a
+ * message: *scene_prefix "FILE: " for a scene from a file (else ""), *note " (a relative path:
+ * from the scene's folder DIR)" or " (a relative path: from the current folder)" ("" for an
+ * absolute path or a generated source). */
+void atmos__scene_path_where(const atmos_scene *s, const char *path, char *scene_prefix, size_t pcap, char *note,
+                             size_t ncap);
 
 #endif

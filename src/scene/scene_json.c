@@ -1057,9 +1057,11 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
         return ATMOS_OK;
     }
     /* The keys one kind of volume would ignore are refused with it. */
-    static const int file_only[] = {K_GRIDS, K_TIME, K_UNIT, K_DETAIL}, gen_only[] = {K_SEED};
+    /* A generator sets its fields' particle types itself (a storm's cloud, rain and ice), so
+     * "particle", which names a file's one field's, is refused with it rather than ignored. */
+    static const int file_only[] = {K_GRIDS, K_TIME, K_UNIT, K_DETAIL, K_PARTICLE}, gen_only[] = {K_SEED};
     const int is_file = (it.seen & (1u << K_FILE)) != 0;
-    const int *bad = is_file ? gen_only : file_only, nbad = is_file ? 1 : 4;
+    const int *bad = is_file ? gen_only : file_only, nbad = is_file ? 1 : 5;
     for (int i = 0; i < nbad; i++)
         if (it.seen & (1u << bad[i]))
             return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,
@@ -1269,14 +1271,16 @@ static atmos_status parse_fog(const jp *p, const cJSON *j, const char *path, atm
 static atmos_status parse_animation(const jp *p, const cJSON *j, const char *path, atmos_scene *s)
 {
     static const char *const keys[] = {"frames",      "time_end", "elevation_end_deg", "azimuth_end_deg",
-                                       "minutes_end", "exposure"};
+                                       "minutes_end", "exposure", "exposure_limit_ev"};
     static const char *const exposures[] = {"locked", "per_frame"};
+    static const atmos__range r_limit = {-20, 40, 0, 0}; /* as a manual exposure's */
     static const atmos__range r_minutes = {0, ATMOS_SIM_MAX_MINUTES, 1, 0};
     /* 0 and 1: a single image (0 = no animation, include/atmos/scene.h), so -D animation.frames=0
      * turns a scene's animation off */
     static const atmos__range r_frames = {0, ATMOS_SCENE_MAX_FRAMES, 0, 0};
     atmos_scene_animation a;
     memset(&a, 0, sizeof a);
+    a.exposure_limit_ev = ATMOS_SCENE_EXPOSURE_LIMIT_EV;
     obj_iter it;
     char ip[PATH_CAP];
     const cJSON *v;
@@ -1289,6 +1293,7 @@ static atmos_status parse_animation(const jp *p, const cJSON *j, const char *pat
         switch (k) {
         case 0: TRY(get_int(p, v, ip, &r_frames, &a.frames)); break;
         case 5: TRY(get_enum(p, v, ip, exposures, 2, &a.exposure_per_frame)); break;
+        case 6: TRY(get_number(p, v, ip, &r_limit, NULL, &a.exposure_limit_ev)); break;
         case 4:
             TRY(get_number(p, v, ip, &r_minutes, NULL, &a.minutes_end));
             a.minutes_end_set = 1;

@@ -4,6 +4,7 @@
 #include "scene/scene_internal.h"
 
 #include <cjson/cJSON.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -156,4 +157,41 @@ atmos_status atmos__scene_apply_overrides(atmos_context *ctx, const char *source
         if (st != ATMOS_OK) return st;
     }
     return ATMOS_OK;
+}
+
+/* Whether the override ov (PATH=VALUE, dotted or a JSON pointer) sets key (a JSON pointer,
+ * "/a/b/0") or an object or array that holds it. */
+static int override_sets(const char *ov, const char *key)
+{
+    const char *eq = strchr(ov, '=');
+    if (!eq || eq == ov) return 0;
+    char ptr[1024];
+    size_t n = 0;
+    const char *p = ov;
+    if (*p != '/') ptr[n++] = '/';
+    for (; p < eq && n + 1 < sizeof ptr; p++) ptr[n++] = *p == '.' && ov[0] != '/' ? '/' : *p;
+    ptr[n] = '\0';
+    return !strncmp(key, ptr, n) && (key[n] == '\0' || key[n] == '/');
+}
+
+atmos_status atmos__scene_blame_override(atmos_context *ctx, atmos_status st, const char *source,
+                                         const char *const *overrides, int count)
+{
+    const char *msg = atmos_context_error(ctx);
+    const size_t sl = strlen(source);
+    if (st != ATMOS_E_INVALID_ARG || !overrides || strncmp(msg, source, sl) || strncmp(msg + sl, ": /", 3)) return st;
+    char key[512];
+    const char *k = msg + sl + 2, *end = strstr(k, ": ");
+    if (!end || (size_t)(end - k) >= sizeof key) return st;
+    memcpy(key, k, (size_t)(end - k));
+    key[end - k] = '\0';
+    for (int i = count - 1; i >= 0; i--) /* the last override of a key is the one that holds */
+        if (overrides[i] && override_sets(overrides[i], key)) {
+            char rest[1024];
+            snprintf(rest, sizeof rest, "%s", k);
+            if (!strcmp(source, "-D")) /* atmos render's name for a scene of overrides alone */
+                return atmos__error(ctx, st, "-D %.300s: %s", overrides[i], rest);
+            return atmos__error(ctx, st, "-D %.300s (on %s): %s", overrides[i], source, rest);
+        }
+    return st;
 }

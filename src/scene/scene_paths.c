@@ -48,3 +48,16 @@ atmos_status atmos__scene_join_path(atmos_context *ctx, const char *scene, size_
     memcpy(p, joined, (size_t)n + 1);
     return ATMOS_OK;
 }
+
+void atmos__scene_path_where(const atmos_scene *s, const char *path, char *scene_prefix, size_t pcap, char *note,
+                             size_t ncap)
+{
+    const char *file = s && s->file[0] ? s->file : NULL;
+    snprintf(scene_prefix, pcap, "%s%s", file ? file : "", file ? ": " : "");
+    note[0] = '\0';
+    if (!path[0] || path[0] == '/' || generated(path)) return;
+    const char *slash = file ? strrchr(file, '/') : NULL;
+    if (slash) snprintf(note, ncap, " (a relative path: from the scene's folder %.*s)", (int)(slash - file + 1), file);
+    else if (file) snprintf(note, ncap, " (a relative path: from the scene's folder, the current folder)");
+    else snprintf(note, ncap, " (a relative path: from the current folder)");
+}

@@ -249,6 +249,26 @@ atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const
     return ATMOS_OK;
 }
 
+/* A volume's "particle": a file's (a generator sets its fields' own types), and a known
+ * type (the scene's "particles" or a preset), as the fog's. */
+static atmos_status validate_volume_particle(atmos_context *ctx, const char *source, const atmos_scene *s)
+{
+    const atmos_scene_volume *v = &s->volume;
+    if (!v->particle[0]) return ATMOS_OK;
+    if (!memchr(v->particle, '\0', sizeof v->particle))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/particle", "is not terminated");
+    if (!strncmp(v->source, "generate:", 9) || !strncmp(v->source, "simulate:", 9))
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/particle",
+                                 "applies to volume files, not to a %s volume (its fields have their own types)",
+                                 v->source[0] == 'g' ? "generated" : "simulated");
+    atmos_particle_desc pd;
+    if (atmos_scene_particle(NULL, s, v->particle, &pd) != ATMOS_OK)
+        return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/particle",
+                                 "'%s' is neither in the scene's \"particles\" nor a preset (atmos phase lists them)",
+                                 v->particle);
+    return ATMOS_OK;
+}
+
 atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
     static const atmos__range r_radiance = {0, 1e6, 0, 0}, r_dscale = {0, 1e30, 1, 0}, r_vscale = {0, 100, 1, 0},
@@ -308,6 +328,7 @@ atmos_status atmos__scene_validate_renderer(atmos_context *ctx, const char *sour
     };
     for (size_t i = 0; i < sizeof checks / sizeof checks[0]; i++)
         if ((st = atmos__scene_check_range(ctx, source, checks[i].path, checks[i].v, checks[i].r, NULL))) return st;
+    if ((st = validate_volume_particle(ctx, source, s))) return st;
     if ((st = atmos__scene_validate_lights(ctx, source, s))) return st;
     return atmos__settings_check(ctx, source, s);
 }

@@ -157,34 +157,10 @@ wait $pid; rc=$?
 "$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/pk/s.png" -D animation.frames=5 \
     -D animation.elevation_end_deg=-1 -D animation.exposure=per_frame && ok || bad "animation, the scene's exposure per_frame"
 "$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/one.png" && ok || bad "single render"
-python3 - "$T/an" "$T/pf" "$T/one.png" "$T/pk" <<'PY' && ok || bad "exposure over the animation"
-import os, struct, sys, zlib
-def mean(path):
-    b = open(path, "rb").read()
-    w, h, depth, ctype = struct.unpack(">IIBB", b[16:26])
-    assert depth == 8 and ctype in (2, 6)
-    i, data = 8, b""
-    while i < len(b):
-        n = struct.unpack(">I", b[i:i + 4])[0]
-        if b[i + 4:i + 8] == b"IDAT": data += b[i + 8:i + 8 + n]
-        i += 12 + n
-    raw, bpp = zlib.decompress(data), 3 if ctype == 2 else 4
-    stride, prev, tot, p = w * bpp, bytearray(w * bpp), 0, 0
-    for _ in range(h):
-        f, line = raw[p], bytearray(raw[p + 1:p + 1 + stride]); p += 1 + stride
-        for x in range(stride):
-            a = line[x - bpp] if x >= bpp else 0
-            c = prev[x - bpp] if x >= bpp else 0
-            up = prev[x]
-            if f == 1: line[x] = (line[x] + a) & 255
-            elif f == 2: line[x] = (line[x] + up) & 255
-            elif f == 3: line[x] = (line[x] + (a + up) // 2) & 255
-            elif f == 4:
-                pa, pb, pc = abs(up - c), abs(a - c), abs(a + up - 2 * c)
-                line[x] = (line[x] + (a if pa <= pb and pa <= pc else up if pb <= pc else c)) & 255
-        prev = line
-        tot += sum(line[x] for x in range(stride) if x % bpp < 3)
-    return tot / (w * h * 3)
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd) python3 - "$T/an" "$T/pf" "$T/one.png" "$T/pk" <<'PY' && ok ||
+    bad "exposure over the animation"
+import os, sys
+from png import mean  # tests/cli/png.py
 locked = [mean(os.path.join(sys.argv[1], "s_%04d.png" % k)) for k in range(1, 6)]
 free = [mean(os.path.join(sys.argv[2], "s_%04d.png" % k)) for k in range(1, 6)]
 print("locked", ["%.1f" % m for m in locked], "per frame", ["%.1f" % m for m in free])

@@ -449,6 +449,12 @@ static const bad_case bad_animation[] = {
     {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": 3, \"exposure\": \"auto\"}}", ATMOS_E_INVALID_ARG,
      "/animation/exposure: must be one of locked, per_frame, got \"auto\"", NULL},
     {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": -91}}", ATMOS_E_INVALID_ARG, "/animation/elevation_end_deg: must be in [-90, 90]", NULL},
+    {"{\"animation\": {\"frames\": 4, \"elevation_end_deg\": 3, \"exposure_limit_ev\": -21}}", ATMOS_E_INVALID_ARG,
+     "/animation/exposure_limit_ev: must be in [-20, 40]", NULL},
+    {"{\"volume\": {\"generate\": \"cumulus\", \"particle\": \"ice\"}}", ATMOS_E_INVALID_ARG,
+     "/volume: \"particle\" applies to volume files, not to a generated volume", NULL},
+    {"{\"volume\": {\"file\": \"c.vdb\", \"particle\": \"hail\"}}", ATMOS_E_INVALID_ARG,
+     "/volume/particle: 'hail' is neither", NULL},
     {"{\"image\": {\"width\": 10}} \x01", ATMOS_E_FORMAT, "control character", NULL},
 };
 
@@ -746,6 +752,13 @@ static void test_animation(void)
     CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 5, \"azimuth_deg\": 90},"
                    " \"animation\": {\"frames\": 2, \"elevation_end_deg\": 1, \"exposure\": \"locked\"}}", &s));
     CHECK(s.animation.exposure_per_frame == 0);
+    /* The animation's exposure limit: EV100 -2 unless told, kept by each frame. */
+    CHECK(s.animation.exposure_limit_ev == ATMOS_SCENE_EXPOSURE_LIMIT_EV && ATMOS_SCENE_EXPOSURE_LIMIT_EV == -2.0);
+    CHECK_OK(parse("{\"sun\": {\"elevation_deg\": 5, \"azimuth_deg\": 90},"
+                   " \"animation\": {\"frames\": 2, \"elevation_end_deg\": 1, \"exposure_limit_ev\": 3.5}}", &s));
+    CHECK(s.animation.exposure_limit_ev == 3.5);
+    CHECK_OK(atmos_scene_animation_frame(ctx, &s, 1, &f));
+    CHECK(f.animation.exposure_limit_ev == 3.5 && f.animation.frames == 0);
     /* Across a year end, backwards in time. */
     CHECK_OK(parse("{\"sun\": {\"time\": \"2027-01-01T00:30:00Z\", \"latitude_deg\": 40, \"longitude_deg\": -105},"
                    " \"animation\": {\"frames\": 2, \"time_end\": \"2026-12-31T23:30:00Z\"}}", &s));

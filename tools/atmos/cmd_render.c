@@ -5,6 +5,7 @@
 #include "outputs.h"
 #include "render_opts.h"
 #include "dist.h"
+#include "render_exposure.h"
 #include "render_layers.h"
 #include "render_scene.h"
 #include "render_timelapse.h"
@@ -153,31 +154,6 @@ static atmos_status write_path_aux(atmos_context *ctx, const atmos_plan *plan, c
     return st;
 }
 
-/* One exposure over an animation: the automatic exposure of the first frame, kept as the
- * manual exposure of the others (unless --exposure-per-frame). */
-typedef struct {
-    int lock, locked;
-    double ev;
-} exposure_lock;
-
-/* The tone-mapped image of a frame, with the exposure the animation keeps. */
-static atmos_status tone_map(atmos_context *ctx, atmos_image *lin, const atmos_scene *fs, exposure_lock *xl,
-                             atmos_image **disp)
-{
-    atmos_tonemap_desc td = fs->tonemap;
-    if (xl->locked && !td.manual_exposure) td.manual_exposure = 1, td.exposure_ev = xl->ev;
-    const double scale = atmos_tonemap_scale(lin, &td);
-    char buf[64];
-    snprintf(buf, sizeof buf, "%.6g", scale);
-    atmos_image_set_meta(lin, "atmos:exposure_scale", buf);
-    if (xl->lock && !xl->locked && !fs->tonemap.manual_exposure && scale > 0 && isfinite(scale)) {
-        xl->ev = log2(1.0 / (1.2 * scale)); /* the manual EV whose scale 1 / (1.2 * 2^EV) this is */
-        xl->locked = 1;
-    }
-    if (xl->locked && !fs->tonemap.manual_exposure) atmos_image_set_meta(lin, "atmos:exposure", "locked at frame 1");
-    return atmos_tonemap(ctx, lin, &td, disp);
-}
-
 /* The outputs of a rendered frame (w: the files to write): linear sRGB to EXR and PFM,
  * tone-mapped to PNG; -o's file in the format its extension names. */
 /* The --exr file: lin, with the --exr-layers appended when asked. */
@@ -226,7 +202,7 @@ static atmos_status write_outputs(atmos_context *ctx, const atmos_plan *plan, co
     if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_PFM) st = atmos_write_pfm(ctx, lin, w->out);
     if (st == ATMOS_OK && atmos_plan_renderer(plan) == ATMOS_RENDERER_PATH) st = write_path_aux(ctx, plan, w, lin);
     if (st == ATMOS_OK && w->out && out_kind == CLI_FILE_PNG) {
-        st = tone_map(ctx, lin, fs, xl, &disp);
+        st = render_exposure_tone_map(ctx, lin, fs, xl, &disp);
         if (st == ATMOS_OK) st = atmos_write_png(ctx, disp, w->out, fs->png_bits ? fs->png_bits : 8);
     }
     atmos_image_destroy(lin);
@@ -347,6 +323,7 @@ static atmos_status render_frame(frames_run *r, atmos_plan *plan, const atmos_sc
     if (d->rank != 0) return owner >= 0 ? cli_dist_send(d, r->spec, st, &info) : st;
     if (st != ATMOS_OK) return st;
     if (r->fo->w.tau && (st = write_tau(r->ctx, fs, plan, r->fo->w.tau)) != ATMOS_OK) return st;
+    r->xl.frame = frame;
     st = write_outputs(r->ctx, plan, fs, r->spec, &r->fo->w, r->out_kind, r->source, r->nframes > 1 ? label : NULL, &r->xl, r->o);
     if (st != ATMOS_OK) return st;
     if (cli_outputs_hold("render", &r->fo->set) != 0) return ATMOS_E_IO; /* renamed when all frames are */
@@ -367,9 +344,13 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
                                   int *failed_frame, const cli_dist *d, render_timelapse *tl)
 {
     frames_run r = {ctx, o, png, source, prog, fo, d, scene->animation.frames > 1 ? scene->animation.frames : 1,
-                    png ? cli_file_kind_of(png) : CLI_FILE_OTHER, {0, 0, 0}, NULL, 0};
-    r.xl.lock = r.nframes > 1 && !o->exposure_per_frame && !scene->animation.exposure_per_frame;
+                    png ? cli_file_kind_of(png) : CLI_FILE_OTHER, {0}, NULL, 0};
     atmos_status st = ATMOS_OK;
+    /* rank 0 tone-maps every frame: the exposure is its own */
+    if (d->rank == 0 && png && cli_file_kind_of(png) == CLI_FILE_PNG)
+        st = render_exposure_start(ctx, plan0, scene, r.nframes, o->exposure_per_frame || scene->animation.exposure_per_frame,
+                                   !tl && !cli_lit_without_sun(scene, scene->renderer), &r.xl);
+    if (st != ATMOS_OK) return st;
     if (d->rank == 0 && cli_outputs_hold_reserve(r.nframes, 6) != 0)
         return fprintf(stderr, "atmos render: out of memory for the frames' names\n"), ATMOS_E_IO;
     for (int frame = 1; frame <= r.nframes && st == ATMOS_OK; frame++) {
@@ -396,11 +377,13 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
     if (d->rank == 0 && st == ATMOS_OK && cli_outputs_held_commit("render") != 0) st = ATMOS_E_IO;
     if (st != ATMOS_OK) cli_outputs_held_discard();
     atmos_image_destroy(r.spec);
+    char lock[80] = "";
+    if (r.xl.locked) snprintf(lock, sizeof lock, "; exposure locked at frame %d's (the highest sun)", r.xl.key);
     if (st == ATMOS_OK && !o->quiet && r.nframes > 1)
         fprintf(stderr, "atmos render: %d frames written, %.3f s rendering (%s)%s\n", r.nframes, r.total,
                 tl ? "a time-lapse: the simulation carried from frame to frame, a plan a frame"
                    : "one plan: the volume and its optics made once",
-                r.xl.locked ? "; exposure locked at frame 1's" : "");
+                lock);
     return st;
 }
 

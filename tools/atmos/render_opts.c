@@ -374,6 +374,16 @@ int render_opts_parse(int argc, char **argv, render_opts *o)
     return check_options(o);
 }
 
+/* --time or --time-end (opt) into *t: a time the sun's position takes (years 1800-2200), or a
+ * usage error, whichever part of it is wrong. */
+static int parse_sun_time(atmos_context *ctx, const char *C, const char *opt, const char *text, atmos_utc_time *t)
+{
+    atmos_sun_position sp;
+    if (atmos_parse_utc_time(ctx, text, t) != ATMOS_OK || atmos_sun_position_compute(ctx, t, 0, 0, 0, &sp) != ATMOS_OK)
+        return cli_usage_error(C, "%s: %s", opt, atmos_context_error(ctx));
+    return CLI_EXIT_OK;
+}
+
 /* The sun and the animation's end. */
 static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
 {
@@ -402,8 +412,7 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
                                   "by time, or over a round planet, \"model\": \"dobashi\" or \"spherical\", "
                                   "takes its latitude_deg/longitude_deg)");
     if (o->time) {
-        if (atmos_parse_utc_time(ctx, o->time, &s->sun.time) != ATMOS_OK)
-            return cli_usage_error(C, "--time: %s", atmos_context_error(ctx));
+        if (parse_sun_time(ctx, C, "--time", o->time, &s->sun.time) != CLI_EXIT_OK) return CLI_EXIT_USAGE;
         if (!place && !s->sun.from_time) /* a round planet's place */
             s->sun.latitude_deg = s->atmosphere.latitude_deg, s->sun.longitude_deg = s->atmosphere.longitude_deg;
         s->sun.from_time = 1;
@@ -413,8 +422,8 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
     if (place && s->sun.from_time) s->sun.latitude_deg = o->lat, s->sun.longitude_deg = o->lon;
     if (o->frames) s->animation.frames = o->frames;
     if (o->time_end) {
-        if (atmos_parse_utc_time(ctx, o->time_end, &s->animation.time_end) != ATMOS_OK)
-            return cli_usage_error(C, "--time-end: %s", atmos_context_error(ctx));
+        if (parse_sun_time(ctx, C, "--time-end", o->time_end, &s->animation.time_end) != CLI_EXIT_OK)
+            return CLI_EXIT_USAGE;
         s->animation.time_end_set = 1;
     }
     if (!isnan(o->sun_el_end)) s->animation.elevation_end_deg = o->sun_el_end, s->animation.elevation_end_set = 1;
@@ -722,18 +731,22 @@ static void help_head(void)
            "                                camera pointed at it from where the whole box shows)\n"
            "      --sun-elevation E         sun elevation, degrees\n"
            "      --sun-azimuth A           sun azimuth, degrees clockwise from north\n"
-           "      --time T --lat L --lon L  sun from a UTC time (2026-06-21T12:00:00Z) and a place; --time\n"
-           "                                alone keeps a scene's place. Over a round planet (\"dobashi\",\n"
-           "                                \"spherical\") the place is the atmosphere's origin's too: --lat\n"
-           "                                and --lon turn the Earth's map under the camera, and the sun\n"
-           "                                stands over the map where the date and time put it\n"
+           "      --time T --lat L --lon L  sun from a time (2026-06-21T12:00:00Z, or an offset +HH:MM/-HH:MM;\n"
+           "                                years 1800-2200) and a place: L in degrees north and degrees\n"
+           "                                east (south and west negative); --time alone keeps a scene's\n"
+           "                                place. Over a round planet (\"dobashi\", \"spherical\") the\n"
+           "                                place is the atmosphere's origin's too: --lat and --lon\n"
+           "                                turn the Earth's map under the camera, and the sun stands\n"
+           "                                over the map where the date and time put it\n"
            "      --spectral N              N spectral samples in 380-780 nm (default: the paper's rgb)\n"
            "      --rgb                     the paper's three channels (680, 550, 440 nm)\n"
            "      --exposure EV|auto        manual exposure (EV100, daylight ~15) or automatic\n"
            "      --exposure-comp STOPS     compensation added to automatic exposure\n"
            "      --exposure-per-frame      animations: automatic exposure chosen for each frame; by\n"
-           "                                default the first frame's is kept for all (a locked exposure;\n"
-           "                                the scene's animation.exposure: locked | per_frame)\n"
+           "                                default the frame with the highest sun's is kept for all (a\n"
+           "                                locked exposure; the scene's animation.exposure: locked |\n"
+           "                                per_frame). Either way at most that of EV100 -2 (a camera's\n"
+           "                                30 s at f/2.8: night stays dark; animation.exposure_limit_ev)\n"
            "      --tone filmic|reinhard|clamp   tone curve for the PNG\n"
            "      --threads N               worker threads (default: all cores)\n"
            "      --mpi                     share the work between the ranks of an MPI job (mpirun -np N\n"
