@@ -7,6 +7,7 @@
 #include "atmos/atmos.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -52,6 +53,16 @@ static int test_passed_, test_failed_;
         else { test_failed_++; fprintf(stderr, "%s:%d: %s returned %s\n", __FILE__, __LINE__, #expr, \
                                        atmos_status_string(s_)); }                    \
     } while (0)
+
+/* A number in [0, 1) from a splitmix64 stream (Steele, Lea and Flood 2014): *state is the
+ * stream's position, advanced by one draw. */
+static inline double test_uniform_from(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+}
 
 static inline int test_summary(const char *name)
 {

@@ -197,19 +197,36 @@ static double run(const sun_ray *r, int i0, int i1, double ta, double tb)
     return run(r, i0, mid, ta, tm) + run(r, mid, i1, tm, tb);
 }
 
+/* The fog along a ray from o in direction d up to T: its line (A, k: fog_line), gamma and the
+ * eye's optical depth tauT at T, flat where gamma tauT is nil; returns C, the sunlight's optical
+ * depth in at the eye (700 or more: no light). The sunlight at t is dimmed by C exp(-k t): with
+ * the eye's optical depth tau as the variable (d tau = sigma dt, exp(-k t) = 1 - k tau / A) the
+ * integrand is exp(-C) exp(-gamma tau), gamma = 1 - d_y / sun_y (1 in uniform fog). */
+static double sun_fog_ray(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3], const double d[3],
+                          double T, double *A, double *k, double *gamma, double *tauT, int *flat)
+{
+    fog_line(f, o, d, A, k);
+    const double C = atmos__beams_sun_fog_in(f, s->dir, o);
+    *gamma = f->height_m > 0 ? 1 - d[1] / s->dir[1] : 1;
+    *tauT = line_tau(*A, *k, T);
+    *flat = !(fabs(*gamma * *tauT) > 1e-9);
+    return C;
+}
+
+/* The sunlight the fog scatters toward -d per unit of the ray's lit integral, exp(-C) dimmed. */
+static double sun_fog_light(const atmos__beams_sun *s, const atmos__beams_fog *f, const double d[3], double C)
+{
+    const double c = atmos__dot3(s->dir, d);
+    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C);
+}
+
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],
                                  const double d[3], double T, double epsilon, int max_steps)
 {
     sun_ray r = {.s = s, .T = T};
-    fog_line(f, o, d, &r.A, &r.k);
-    /* the sunlight at t is dimmed by C exp(-k t), C its optical depth in at the eye: with the
-     * eye's optical depth tau as the variable (d tau = sigma dt, exp(-k t) = 1 - k tau / A) the
-     * integrand is exp(-C) exp(-gamma tau), gamma = 1 - d_y / sun_y (1 in uniform fog) */
-    const double C = atmos__beams_sun_fog_in(f, s->dir, o);
+    double tauT;
+    const double C = sun_fog_ray(s, f, o, d, T, &r.A, &r.k, &r.gamma, &tauT, &r.flat);
     if (!(C < 700)) return 0;
-    r.gamma = f->height_m > 0 ? 1 - d[1] / s->dir[1] : 1;
-    const double tauT = line_tau(r.A, r.k, T);
-    r.flat = !(fabs(r.gamma * tauT) > 1e-9);
     r.whole = r.flat ? tauT : -expm1(-r.gamma * tauT) / r.gamma; /* int_0^tau(T) exp(-gamma tau) */
     if (!(r.whole > 0)) return 0;
     int n = (int)ceil(1 / fmax(epsilon, 1e-9));
@@ -224,8 +241,7 @@ double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_f
         r.z0 = atmos__dot3(o, s->fwd) - s->bias, r.z1 = atmos__dot3(d, s->fwd);
         sum = run(&r, 0, n, 0, T);
     }
-    const double c = atmos__dot3(s->dir, d);
-    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C) * r.whole * sum / n;
+    return sun_fog_light(s, f, d, C) * r.whole * sum / n;
 }
 
 /* A ray's closed form over its lit stretches (atmos__beams_sun_airlight_lines): r texels
@@ -255,18 +271,13 @@ double atmos__beams_sun_airlight_lines(const atmos__beams_sun *s, const atmos__b
     if (!s->n || !e || !e->lines || !(p > 1e-9) || ex != e->ex || ey != e->ey)
         return atmos__beams_sun_airlight(s, f, o, d, T, epsilon, max_steps);
     lit_sum l = {.T = T, .inv_p = 1 / p};
-    fog_line(f, o, d, &l.A, &l.k);
-    const double C = atmos__beams_sun_fog_in(f, s->dir, o);
+    double tauT;
+    const double C = sun_fog_ray(s, f, o, d, T, &l.A, &l.k, &l.gamma, &tauT, &l.flat);
     if (!(C < 700)) return 0;
-    l.gamma = f->height_m > 0 ? 1 - d[1] / s->dir[1] : 1;
-    const double tauT = line_tau(l.A, l.k, T);
-    l.flat = !(fabs(l.gamma * tauT) > 1e-9);
     /* the line nearest the ray's angle */
     double a = atan2(y1, x1) / e->dth;
     int j = (int)floor(a + 0.5);
     j = j < 0 ? j + e->lines : j >= e->lines ? j - e->lines : j;
     atmos__beams_epi_walk(e, j, atmos__dot3(o, s->fwd) - s->bias, atmos__dot3(d, s->fwd) / p, T * p, lit_add, &l);
-    const double sum = l.sum;
-    const double c = atmos__dot3(s->dir, d);
-    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C) * sum;
+    return sun_fog_light(s, f, d, C) * l.sum;
 }

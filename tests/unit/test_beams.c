@@ -828,6 +828,19 @@ static atmos_image *render_counted(atmos_context *c, const atmos_scene *s, long 
     return img;
 }
 
+/* render_counted on a context of one thread (the same bytes as two: the tests compare). */
+static atmos_image *render_counted_one_thread(const atmos_scene *s, long *evaluated, long *pixels)
+{
+    atmos_context_desc cd;
+    memset(&cd, 0, sizeof cd);
+    cd.threads = 1;
+    atmos_context *c1 = NULL;
+    CHECK_OK(atmos_context_create(&cd, &c1));
+    atmos_image *img = c1 ? render_counted(c1, s, evaluated, pixels) : NULL;
+    atmos_context_destroy(c1);
+    return img;
+}
+
 /* A plan keeps its frame's per-pixel buffers for the next frame (beams_kept.h): frames whose
  * camera moves, a region smaller than the frame, then the whole frame again, each the same to
  * the byte as a fresh plan's; and a kept buffer grows when asked for more, stays when asked for
@@ -921,13 +934,8 @@ static void test_screen_step(void)
     atmos_image *exact = render_counted(ctx, &s, &ev, &n);
     s.beams.screen_step = 4;
     atmos_image *sub = render_counted(ctx, &s, &ev, &n);
-    atmos_context_desc cd;
-    memset(&cd, 0, sizeof cd);
-    cd.threads = 1;
-    atmos_context *c1 = NULL;
-    CHECK_OK(atmos_context_create(&cd, &c1));
     long ev1 = 0;
-    atmos_image *one = c1 ? render_counted(c1, &s, &ev1, &n) : NULL;
+    atmos_image *one = render_counted_one_thread(&s, &ev1, &n);
     if (exact && sub && one) {
         const int W = s.width, C = exact->channels;
         double worst_edge = 0, sum = 0, top = 0;
@@ -955,7 +963,6 @@ static void test_screen_step(void)
                   "1 and 2 threads differ (screen step 4)");
     }
     atmos_image_destroy(one);
-    atmos_context_destroy(c1);
     atmos_image_destroy(exact);
     atmos_image_destroy(sub);
 }
@@ -979,12 +986,7 @@ static void test_thin_beam_hint(void)
     atmos_image *exact = render_counted(ctx, &s, &ev, &n);
     s.beams.screen_step = 8;
     atmos_image *sub = render_counted(ctx, &s, &ev, &n);
-    atmos_context_desc cd;
-    memset(&cd, 0, sizeof cd);
-    cd.threads = 1;
-    atmos_context *c1 = NULL;
-    CHECK_OK(atmos_context_create(&cd, &c1));
-    atmos_image *one = c1 ? render_counted(c1, &s, &ev1, &n) : NULL;
+    atmos_image *one = render_counted_one_thread(&s, &ev1, &n);
     if (exact && sub && one) {
         const int W = s.width, C = exact->channels;
         double top = 0, worst = 0;
@@ -1006,7 +1008,6 @@ static void test_thin_beam_hint(void)
                   "1 and 2 threads differ (screen step 8)");
     }
     atmos_image_destroy(one);
-    atmos_context_destroy(c1);
     atmos_image_destroy(exact);
     atmos_image_destroy(sub);
 }

@@ -149,10 +149,7 @@ static void check_mixture(void)
 static uint64_t rng_state = 99;
 static double uniform(void)
 {
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+    return test_uniform_from(&rng_state);
 }
 
 static atmos_msphase *hg_msphase(double g, int max_order)

@@ -14,11 +14,7 @@
 static uint64_t rng_state = 1234;
 static double uniform(void)
 {
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return (z >> 11) * (1.0 / 9007199254740992.0);
+    return test_uniform_from(&rng_state);
 }
 
 /* Worst and mean relative error of t against m over draws with theta in [lo, hi) degrees, at
