@@ -1,4 +1,4 @@
-# Installation (docs/install.md): the headers under include/atmos/, libatmos.so.0 and
+# Installation (docs/install.md): the headers under include/atmos/, libatmos.so.0.2 and
 # libatmos.a, the CLI, its man pages, the docs, a pkg-config file (atmos.pc) and a CMake
 # package (find_package(atmos) -> atmos::atmos, atmos::atmos_static).
 include(CMakePackageConfigHelpers)

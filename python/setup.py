@@ -8,7 +8,7 @@ from setuptools import setup
 
 setup(
     name="atmos",
-    version="0.1.0",
+    version="0.2.0",
     description="Physically based rendering of atmospheric phenomena (bindings to libatmos)",
     packages=["atmos"],
     python_requires=">=3.10",

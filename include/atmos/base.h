@@ -19,7 +19,7 @@ extern "C" {
 #endif
 
 #define ATMOS_VERSION_MAJOR 0
-#define ATMOS_VERSION_MINOR 1
+#define ATMOS_VERSION_MINOR 2
 #define ATMOS_VERSION_PATCH 0
 
 /* The library's version as "MAJOR.MINOR.PATCH". */

@@ -32,7 +32,7 @@ for f in "$P/include/atmos/atmos.h" "$libdir/libatmos.a" "$libdir/pkgconfig/atmo
     [ -s "$f" ] && ok "installed ${f#"$P"/}" || bad "missing ${f#"$P"/}"
 done
 soname=$(objdump -p "$libdir/libatmos.so" 2>/dev/null | awk '$1 == "SONAME" {print $2}')
-[ "$soname" = libatmos.so.0 ] && ok "SONAME libatmos.so.0" || bad "SONAME is '$soname', expected libatmos.so.0"
+[ "$soname" = libatmos.so.0.2 ] && ok "SONAME libatmos.so.0.2" || bad "SONAME is '$soname', expected libatmos.so.0.2"
 "$P/bin/atmos" --version >"$T/v" 2>&1 && grep -q "^atmos [0-9]" "$T/v" && ok "installed atmos --version" || bad "installed atmos --version"
 # The commands from the CLI's own table (tools/atmos/main.c), not from the --help text the
 # man pages are made from, so a help line the man-page script misreads shows as a missing page.
@@ -89,7 +89,7 @@ cp "$T/cxx.cpp" "$T/cxxproj/main.cpp"
 cat >"$T/cxxproj/CMakeLists.txt" <<'CM'
 cmake_minimum_required(VERSION 3.16)
 project(cxxonly CXX)
-find_package(atmos 0.1 REQUIRED)
+find_package(atmos 0.2 REQUIRED)
 add_executable(cxxonly main.cpp)
 target_link_libraries(cxxonly PRIVATE atmos::atmos)
 CM
