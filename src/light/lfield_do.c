@@ -209,8 +209,9 @@ static void axpy(double a, const double *x, double *y, size_t n, int threads)
     for (size_t i = 0; i < n; i++) y[i] += a * x[i];
 }
 
-/* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start. */
-static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp, atmos__do_stats *st)
+/* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
+ * its first residual b itself, no sweep). */
+static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp, atmos__do_stats *st, int zero_start)
 {
     const atmos__do_problem *P = W->P;
     const int m = P->restart;
@@ -222,9 +223,13 @@ static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp
     st->resid = 0;
     if (!(bn > 0)) return;
     while (st->iters < P->max_iter) {
-        apply(W, x, V, tmp);
-        st->sweeps++;
-        for (size_t i = 0; i < N; i++) V[i] = b[i] - V[i];
+        if (zero_start)
+            memcpy(V, b, sizeof(double) * N), zero_start = 0;
+        else {
+            apply(W, x, V, tmp);
+            st->sweeps++;
+            for (size_t i = 0; i < N; i++) V[i] = b[i] - V[i];
+        }
         const double beta = sqrt(dot(V, V, N, T));
         st->resid = beta / bn;
         if (st->resid <= P->tol) return;
@@ -299,7 +304,9 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         }
         sweep_all(&W, P->q1, b, NULL);
         st->sweeps++;
-        gmres(&W, b, phi, V, tmp, st);
+        int zero = 1;
+        for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
+        gmres(&W, b, phi, V, tmp, st, zero);
         scatter(&W, phi, tmp, 1);
         sweep_all(&W, tmp, phi, &st->leak);
         st->sweeps++;

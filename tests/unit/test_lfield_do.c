@@ -99,6 +99,10 @@ static void check_threads(cloud *C)
     make_cloud(C, 1.0, 2, 20);
     CHECK(atmos__do_solve(&C->P, C->phi, &S));
     CHECK(!memcmp(phi1, C->phi, sizeof phi1));
+    /* from phi = 0 (no restart within 20): the sweep of the first order, one per iteration, the last
+       one; the zero start's residual costs none */
+    printf("  from 0: %d iterations, %d sweeps\n", S.iters, S.sweeps);
+    CHECK(S.sweeps == S.iters + 2);
 }
 
 /* The moments of the cells more than one cell from the cloud are left 0 (no scattering and no
