@@ -71,7 +71,29 @@ typedef struct {
     double *acc[DO_GROUPS], *psi[DO_GROUPS];
     double leak[DO_GROUPS];
     unsigned char *live; /* per cell: it scatters or emits (else its source is 0) */
+    unsigned char *need; /* per cell: it or one of its 26 neighbours has a medium or a source (else
+                            its moments are left 0: no scattering reads them, nor a trilinear read
+                            of the field where there is a medium) */
 } do_work;
+
+/* W->need from W->live and the cells' extinction: the cells within one cell (26 neighbours) of a
+ * live cell or of one with sigma_t > 0. */
+static void mark_needed(do_work *W)
+{
+    const atmos__do_problem *P = W->P;
+    const int nx = P->c[0], ny = P->c[1], nz = P->c[2];
+    memset(W->need, 0, W->cells);
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                const size_t c = ((size_t)k * ny + j) * nx + i;
+                if (!W->live[c] && !(P->sig_t[c] != 0)) continue;
+                for (int z = k > 0 ? k - 1 : 0; z <= k + 1 && z < nz; z++)
+                    for (int y = j > 0 ? j - 1 : 0; y <= j + 1 && y < ny; y++)
+                        for (int x = i > 0 ? i - 1 : 0; x <= i + 1 && x < nx; x++)
+                            W->need[((size_t)z * ny + y) * nx + x] = 1;
+            }
+}
 
 /* One direction's sweep with the source moments Q (per cell, K each), its radiance into psi,
  * its moments added to acc (weight w), the power leaving through the grid's faces to *leak. */
@@ -102,7 +124,7 @@ static inline void sweep_k(const do_work *W, int n, const double *Q, double *psi
                              pz = kk ? psi[c - (ptrdiff_t)sz * (ptrdiff_t)sxy] : 0;
                 const double v = (s * h + ax * px + ay * py + az * pz) / (P->sig_t[c] * h + as);
                 psi[c] = v;
-                if (v != 0) {
+                if (v != 0 && W->need[c]) {
                     double *a = acc + c * K;
                     for (int m = 0; m < K; m++) a[m] += wY[m] * v;
                 }
@@ -187,8 +209,9 @@ static void axpy(double a, const double *x, double *y, size_t n, int threads)
     for (size_t i = 0; i < n; i++) y[i] += a * x[i];
 }
 
-/* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start. */
-static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp, atmos__do_stats *st)
+/* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
+ * its first residual b itself, no sweep). */
+static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp, atmos__do_stats *st, int zero_start)
 {
     const atmos__do_problem *P = W->P;
     const int m = P->restart;
@@ -200,9 +223,13 @@ static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp
     st->resid = 0;
     if (!(bn > 0)) return;
     while (st->iters < P->max_iter) {
-        apply(W, x, V, tmp);
-        st->sweeps++;
-        for (size_t i = 0; i < N; i++) V[i] = b[i] - V[i];
+        if (zero_start)
+            memcpy(V, b, sizeof(double) * N), zero_start = 0;
+        else {
+            apply(W, x, V, tmp);
+            st->sweeps++;
+            for (size_t i = 0; i < N; i++) V[i] = b[i] - V[i];
+        }
         const double beta = sqrt(dot(V, V, N, T));
         st->resid = beta / bn;
         if (st->resid <= P->tol) return;
@@ -258,8 +285,8 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     W.Y = malloc(sizeof *W.Y * nd), W.o = malloc(sizeof *W.o * nd);
     double *V = malloc(sizeof(double) * N * (m + 1)), *b = malloc(sizeof(double) * N),
            *tmp = malloc(sizeof(double) * N);
-    W.live = malloc(W.cells);
-    int ok = W.Y && W.o && V && b && tmp && W.live;
+    W.live = malloc(W.cells), W.need = malloc(W.cells);
+    int ok = W.Y && W.o && V && b && tmp && W.live && W.need;
     for (int g = 0; g < DO_GROUPS; g++) {
         W.acc[g] = malloc(sizeof(double) * N), W.psi[g] = malloc(sizeof(double) * W.cells);
         ok = ok && W.acc[g] && W.psi[g];
@@ -269,6 +296,7 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
             W.live[c] = P->sig_s[c] != 0;
             for (int k = 0; k < W.K; k++) W.live[c] |= P->q1[c * W.K + k] != 0;
         }
+        mark_needed(&W);
         for (int n = 0; n < nd; n++) {
             const double *d = P->quad->dir[n];
             atmos__sh_eval(P->L, d, W.Y[n]);
@@ -276,7 +304,9 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         }
         sweep_all(&W, P->q1, b, NULL);
         st->sweeps++;
-        gmres(&W, b, phi, V, tmp, st);
+        int zero = 1;
+        for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
+        gmres(&W, b, phi, V, tmp, st, zero);
         scatter(&W, phi, tmp, 1);
         sweep_all(&W, tmp, phi, &st->leak);
         st->sweeps++;
@@ -284,6 +314,6 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         st->emitted *= P->h * P->h * P->h;
     }
     for (int g = 0; g < DO_GROUPS; g++) free(W.acc[g]), free(W.psi[g]);
-    free(W.Y), free(W.o), free(V), free(b), free(tmp), free(W.live);
+    free(W.Y), free(W.o), free(V), free(b), free(tmp), free(W.live), free(W.need);
     return ok;
 }

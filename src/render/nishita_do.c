@@ -5,7 +5,8 @@
  * (sig' cut at 3 degrees, or delta-M scaled sig*), the first order's emission per cell from the
  * sunlight's columns per render voxel (nishita_plan.c's sweep, its voxel's mean transmittance
  * along the sun), the quadrature's directions about the world's axes (the harmonics' frame),
- * swept along the cells' axes; the moments times chi_l are the field's coefficients (the
+ * swept along the cells' axes, each wavelength after the first started from the last one's
+ * solution; the moments times chi_l are the field's coefficients (the
  * emission of orders >= 2 per unit sigma_s). */
 #include "core/vec.h"
 #include "light/lfield_do.h"
@@ -86,6 +87,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
     P.c[0] = F->c[0], P.c[1] = F->c[1], P.c[2] = F->c[2], P.h = F->s / (double)np->g.sc, P.L = L;
     P.sig_t = st, P.sig_s = st + cells, P.q1 = q1, P.quad = &quad;
     P.tol = DO_TOL, P.max_iter = DO_MAX_ITER, P.restart = DO_RESTART, P.threads = threads;
+    int w_last = -1; /* the wavelength whose solution phi holds */
     for (int w = 0; w < n && ok; w++) {
         cell_medium(np, F, w, ltg, st, st + cells, src, threads);
         /* a wavelength whose medium and phase are the last one's (a grey cloud): its field is the
@@ -104,7 +106,12 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
                 const int l = k >= 9 ? 3 : k >= 4 ? 2 : k >= 1 ? 1 : 0;
                 q1[c * K + k] = E[w] * src[c] * chi[w][l] * Ys[k];
             }
-        memset(phi, 0, sizeof(double) * cells * K);
+        /* the start: the last wavelength's solution times the ratio of the sunlight (the clouds are
+         * nearly grey), else 0 */
+        if (w_last >= 0 && E[w_last] > 0)
+            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] *= E[w] / E[w_last];
+        else
+            memset(phi, 0, sizeof(double) * cells * K);
         atmos__do_stats S;
         ok = atmos__do_solve(&P, phi, &S);
         for (size_t c = 0; c < cells && ok; c++)
@@ -112,6 +119,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
                 const int l = k >= 9 ? 3 : k >= 4 ? 2 : k >= 1 ? 1 : 0;
                 coef[(c * n + w) * K + k] = (float)(chi[w][l] * phi[c * K + k]);
             }
+        w_last = ok ? w : -1;
         info->iters += S.iters, info->sweeps += S.sweeps;
         info->resid = fmax(info->resid, S.resid);
     }

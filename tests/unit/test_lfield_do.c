@@ -99,6 +99,31 @@ static void check_threads(cloud *C)
     make_cloud(C, 1.0, 2, 20);
     CHECK(atmos__do_solve(&C->P, C->phi, &S));
     CHECK(!memcmp(phi1, C->phi, sizeof phi1));
+    /* from phi = 0 (no restart within 20): the sweep of the first order, one per iteration, the last
+       one; the zero start's residual costs none */
+    printf("  from 0: %d iterations, %d sweeps\n", S.iters, S.sweeps);
+    CHECK(S.sweeps == S.iters + 2);
+}
+
+/* The moments of the cells more than one cell from the cloud are left 0 (no scattering and no
+ * trilinear read of the field where there is a medium reads them), those next to it not; a start
+ * at the solution needs no GMRES iteration and gives the same leaving power. */
+static void check_needed_and_start(cloud *C)
+{
+    atmos__do_stats S, S2;
+    make_cloud(C, 1.0, 2, 400);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    const size_t corner = 0, next = ((size_t)(LO - 1) * NC + LO) * NC + LO; /* (0,0,0); (LO,LO,LO-1) */
+    double far = 0, near = 0;
+    for (int m = 0; m < 16; m++) far += fabs(C->phi[corner * 16 + m]), near += fabs(C->phi[next * 16 + m]);
+    printf("  moments 2 cells from the cloud %.1e, next to it %.3e\n", far, near);
+    CHECK(far == 0);
+    CHECK(near > 0);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S2));
+    printf("  started at the solution: %d GMRES iterations, leaving power %.6f of the first start's\n", S2.iters,
+           S2.leak / S.leak);
+    CHECK(S2.iters == 0);
+    CHECK(fabs(S2.leak / S.leak - 1) < 1e-5);
 }
 
 int main(void)
@@ -107,7 +132,7 @@ int main(void)
     check_quadrature(4, 8);
     cloud *C = malloc(sizeof *C);
     CHECK(C != NULL);
-    if (C) check_balance(C), check_threads(C);
+    if (C) check_balance(C), check_threads(C), check_needed_and_start(C);
     free(C);
     return test_summary("test_lfield_do");
 }
