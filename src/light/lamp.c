@@ -76,10 +76,9 @@ atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene
     if (st != ATMOS_OK) {
         /* the reader's message names the file; the scene file and its key go in front, and a
          * relative path says where it was looked for */
-        char why[1024], sc[ATMOS_SCENE_PATH_MAX + 2], note[ATMOS_SCENE_PATH_MAX + 48];
-        snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
-        atmos__scene_path_where(scene, s->image, sc, sizeof sc, note, sizeof note);
-        return atmos__error(ctx, st, "%s/lights/%d/image: %s%s", sc, index, why, note);
+        char key[48];
+        snprintf(key, sizeof key, "/lights/%d/image", index);
+        return atmos__scene_file_error(ctx, st, scene, s->image, key, 1);
     }
     const size_t n = (size_t)img->width * img->height;
     l->tex = malloc(sizeof(float) * 3 * n);

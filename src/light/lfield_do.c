@@ -174,7 +174,7 @@ static void scatter(const do_work *W, const double *x, double *Q, int add_q1)
     const int K = W->K;
     for (size_t c = 0; c < W->cells; c++)
         for (int k = 0; k < K; k++) {
-            const int l = k >= 9 ? 3 : k >= 4 ? 2 : k >= 1 ? 1 : 0;
+            const int l = atmos__sh_degree(k);
             Q[c * K + k] = P->sig_s[c] * P->chi[l] * x[c * K + k] + (add_q1 ? P->q1[c * K + k] : 0);
         }
 }

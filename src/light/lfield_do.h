@@ -12,6 +12,12 @@
 #define ATMOS__DO_KMAX 16  /* coefficients per cell at most: degree 3 */
 #define ATMOS__DO_NMAX 512 /* directions at most */
 
+/* The degree l of coefficient k of the real spherical harmonics (k = l^2 ... (l + 1)^2 - 1), k < 16. */
+static inline int atmos__sh_degree(int k)
+{
+    return k >= 9 ? 3 : k >= 4 ? 2 : k >= 1 ? 1 : 0;
+}
+
 /* Real spherical harmonics (orthonormal over the sphere) of degree <= lmax (<= 3) at unit d. */
 void atmos__sh_eval(int lmax, const double d[3], double *Y);
 

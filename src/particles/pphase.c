@@ -3,10 +3,17 @@
 
 #include <stdlib.h>
 
-atmos__pphase *atmos__pphase_make(const atmos_msphase *m, int nw)
+size_t atmos__pphase_bytes(const atmos_msphase *m, int nw)
+{
+    return m && nw > 0 ? sizeof(float) * (size_t)(atmos_msphase_max_order(m) + 1) * 2 * (ATMOS__PPHASE_NODES + 1) * nw
+                       : 0;
+}
+
+atmos__pphase *atmos__pphase_make(const atmos_msphase *m, int nw, size_t max_bytes)
 {
     enum { N = ATMOS__PPHASE_NODES, ROW = 2 * (N + 1) };
     if (!m || nw < 1 || nw > ATMOS_MAX_WAVELENGTHS) return NULL; /* k past m's wavelengths: 0, as eval_all */
+    if (atmos__pphase_bytes(m, nw) > max_bytes) return NULL;
     atmos__pphase *t = calloc(1, sizeof *t);
     if (!t) return NULL;
     t->nw = nw, t->orders = atmos_msphase_max_order(m) + 1;

@@ -19,8 +19,13 @@ typedef struct atmos__pphase {
     float *v;       /* [order - 1][half][node 0..NODES][k] */
 } atmos__pphase;
 
-/* The table of m for its first nw wavelengths; NULL when out of memory. */
-atmos__pphase *atmos__pphase_make(const atmos_msphase *m, int nw);
+#define ATMOS__PPHASE_MAX_BYTES ((size_t)64 << 20) /* a plan's cap per particle type (docs/viewer.md) */
+
+/* The bytes of m's table for nw wavelengths: orders x 2 (NODES + 1) x nw floats. */
+size_t atmos__pphase_bytes(const atmos_msphase *m, int nw);
+/* The table of m for its first nw wavelengths; NULL when it would take more than max_bytes
+ * or when out of memory (the caller then evaluates m exactly, as psplat.c does). */
+atmos__pphase *atmos__pphase_make(const atmos_msphase *m, int nw, size_t max_bytes);
 void atmos__pphase_free(const atmos__pphase *t);
 
 /* Ams_n(cos_theta) for every wavelength into out[0..nw), n >= 1 (below 1: 1), as

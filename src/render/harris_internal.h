@@ -95,4 +95,8 @@ void atmos__harris_diffuse_free(atmos__harris_plan *h);
 atmos_status atmos__harris_diffuse_sun(atmos_plan *p, atmos__harris_plan *h, const double sun[3]);
 void atmos__harris_diffuse_view(const atmos_plan *p, atmos__harris_plan *h, const double eye_w[3]);
 
+/* The bytes a particle type's phase table (particles/pphase.h) may take in a plan:
+ * ATMOS__PPHASE_MAX_BYTES; a test lowers it to see the exact look-up past the cap. */
+extern size_t atmos__harris_pphase_max_bytes;
+
 #endif

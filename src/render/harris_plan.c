@@ -101,6 +101,8 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
     return ATMOS_OK;
 }
 
+size_t atmos__harris_pphase_max_bytes = ATMOS__PPHASE_MAX_BYTES;
+
 static atmos_status optics(atmos_plan *p, atmos__harris_plan *h)
 {
     h->o.nw = p->wl.count;
@@ -112,9 +114,9 @@ static atmos_status optics(atmos_plan *p, atmos__harris_plan *h)
         h->o.ms[f] = p->optics->ms[f];
         if (!h->o.ms[f])
             return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render harris: the optics need their Ams tables");
-        /* the eye pass's Ams_n on the cosine (docs/viewer.md: within its stated error) */
-        if (!(h->o.ph[f] = atmos__pphase_make(h->o.ms[f], h->o.nw)))
-            return atmos__error(p->ctx, ATMOS_E_NOMEM, "render harris: out of memory for the phase tables");
+        /* the eye pass's Ams_n on the cosine (docs/viewer.md: within its stated error), under a
+         * size cap; NULL (too large, or no memory): the exact look-up */
+        h->o.ph[f] = atmos__pphase_make(h->o.ms[f], h->o.nw, atmos__harris_pphase_max_bytes);
     }
     return ATMOS_OK;
 }

@@ -103,7 +103,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
         for (int l = 0; l <= L; l++) P.chi[l] = chi[w][l];
         for (size_t c = 0; c < cells; c++)
             for (int k = 0; k < K; k++) {
-                const int l = k >= 9 ? 3 : k >= 4 ? 2 : k >= 1 ? 1 : 0;
+                const int l = atmos__sh_degree(k);
                 q1[c * K + k] = E[w] * src[c] * chi[w][l] * Ys[k];
             }
         /* the start: the last wavelength's solution times the ratio of the sunlight (the clouds are
@@ -116,7 +116,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
         ok = atmos__do_solve(&P, phi, &S);
         for (size_t c = 0; c < cells && ok; c++)
             for (int k = 0; k < K; k++) {
-                const int l = k >= 9 ? 3 : k >= 4 ? 2 : k >= 1 ? 1 : 0;
+                const int l = atmos__sh_degree(k);
                 coef[(c * n + w) * K + k] = (float)(chi[w][l] * phi[c * K + k]);
             }
         w_last = ok ? w : -1;

@@ -126,7 +126,7 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
     for (int f = 0; f < np->nf; f++)
         for (int w = 0; w < n; w++) np->mc_sig[f][w] = mc->med.sig[f][w];
     mc->delta_m = p->scene.nishita.mc_delta_m && mc->lmax >= 0;
-    mc->clip = mc->delta_m && p->scene.nishita.mc_dm_clip;
+    mc->clip = mc->delta_m && p->scene.nishita.mc_dm_clip && !p->scene.nishita.do_field; /* do traces no photons */
     if (mc->delta_m && (st = delta_m(ctx, mc, np->nf, n)) != ATMOS_OK) return st;
     for (int f = 0; f < np->nf; f++)
         for (int w = 0; w < n; w++) np->mc_sig_ms[f][w] = mc->med.sig[f][w], np->mc_sca[f][w] = mc->med.sca[f][w];

@@ -94,6 +94,12 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     if (sn->mc_delta_m && ((sn->mc_kphotons <= 0 && !sn->do_field) || (sn->mc_lmax < 0 && !sn->do_field)))
         atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_delta_m does nothing without a Monte Carlo field in spherical "
                                         "harmonics (mc_kphotons > 0 and mc_lmax >= 0)");
+    if (sn->mc_dm_clip && !sn->mc_delta_m)
+        atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_dm_clip does nothing without mc_delta_m (it clips the photons' "
+                                        "delta-M scaled phase)");
+    else if (sn->mc_dm_clip && sn->do_field)
+        atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_dm_clip does nothing with do (discrete ordinates trace no "
+                                        "photons)");
     if (st != ATMOS_OK) {
         atmos__nishita_plan_destroy(np);
         return st;

@@ -22,11 +22,9 @@ static atmos_status name_key(atmos_context *ctx, atmos_status st, const atmos_sc
 {
     const atmos_scene_object *o = &s->objects[i];
     const char *path = o->terrain[0] ? o->terrain : o->mesh;
-    char why[1024], scene[ATMOS_SCENE_PATH_MAX + 2], note[ATMOS_SCENE_PATH_MAX + 48];
-    snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
-    atmos__scene_path_where(s, path, scene, sizeof scene, note, sizeof note);
-    return atmos__error(ctx, st, "%s/objects/%d/%s: %s%s", scene, i, o->terrain[0] ? "terrain" : "mesh", why,
-                        st == ATMOS_E_IO ? note : "");
+    char key[48];
+    snprintf(key, sizeof key, "/objects/%d/%s", i, o->terrain[0] ? "terrain" : "mesh");
+    return atmos__scene_file_error(ctx, st, s, path, key, st == ATMOS_E_IO);
 }
 
 atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const atmos_wavelengths *wl,

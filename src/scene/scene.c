@@ -331,7 +331,11 @@ atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t
     const char *slash = in ? NULL : strrchr(path, '/'); /* from standard input: the current folder */
     const size_t dir = slash ? (size_t)(slash - path) + 1 : 0;
     char key[64];
-    if (st == ATMOS_OK && !in && strlen(path) < sizeof out->file) snprintf(out->file, sizeof out->file, "%s", path);
+    if (st == ATMOS_OK && !in) { /* for messages only: a path too long kept as "..." and its end */
+        const size_t len = strlen(path), cap = sizeof out->file;
+        if (len < cap) snprintf(out->file, cap, "%s", path);
+        else snprintf(out->file, cap, "...%s", path + len - (cap - 4));
+    }
     if (st == ATMOS_OK)
         st = atmos__scene_join_path(ctx, path, dir, out->volume.source, sizeof out->volume.source, "volume/file");
     if (st == ATMOS_OK) st = atmos__scene_earth_paths(ctx, path, dir, &out->earth);

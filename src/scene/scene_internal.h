@@ -126,11 +126,12 @@ atmos_status atmos__scene_join_path(atmos_context *ctx, const char *scene, size_
                                     const char *key);
 /* $ATMOS_DATA, else the folder the build was configured with (ATMOS_DATA_DIR). */
 const char *atmos__scene_data_dir(void);
-/* Where a file the scene names (path, after atmos_scene_load joined it) was looked for, for a
- * message: *scene_prefix "FILE: " for a scene from a file (else ""), *note " (a relative path:
- * from the scene's folder DIR)" or " (a relative path: from the current folder)" ("" for an
- * absolute path or a generated source). */
-void atmos__scene_path_where(const atmos_scene *s, const char *path, char *scene_prefix, size_t pcap, char *note,
-                             size_t ncap);
+/* A file the scene names (path, after atmos_scene_load joined it) could not be read: the
+ * reader's message (the context's error, status st) with "FILE: " (a scene from a file) and
+ * key (e.g. "/volume/file") in front and, when where is set and the path is relative, where
+ * it was looked for: " (resolved against the scene's folder DIR; the scene wrote REST)" or
+ * " (a relative path: from the current folder)". Returns st. */
+atmos_status atmos__scene_file_error(atmos_context *ctx, atmos_status st, const atmos_scene *s, const char *path,
+                                    const char *key, int where);
 
 #endif

@@ -49,15 +49,22 @@ atmos_status atmos__scene_join_path(atmos_context *ctx, const char *scene, size_
     return ATMOS_OK;
 }
 
-void atmos__scene_path_where(const atmos_scene *s, const char *path, char *scene_prefix, size_t pcap, char *note,
-                             size_t ncap)
+atmos_status atmos__scene_file_error(atmos_context *ctx, atmos_status st, const atmos_scene *s, const char *path,
+                                    const char *key, int where)
 {
+    char why[1024], note[2 * ATMOS_SCENE_PATH_MAX + 80];
+    snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
     const char *file = s && s->file[0] ? s->file : NULL;
-    snprintf(scene_prefix, pcap, "%s%s", file ? file : "", file ? ": " : "");
     note[0] = '\0';
-    if (!path[0] || path[0] == '/' || generated(path)) return;
-    const char *slash = file ? strrchr(file, '/') : NULL;
-    if (slash) snprintf(note, ncap, " (a relative path: from the scene's folder %.*s)", (int)(slash - file + 1), file);
-    else if (file) snprintf(note, ncap, " (a relative path: from the scene's folder, the current folder)");
-    else snprintf(note, ncap, " (a relative path: from the current folder)");
+    if (where && path[0] && path[0] != '/' && !generated(path)) {
+        const char *slash = file ? strrchr(file, '/') : NULL;
+        const size_t dir = slash ? (size_t)(slash - file) + 1 : 0;
+        if (slash && !strncmp(path, file, dir)) /* the joined path: the folder, then what the scene wrote */
+            snprintf(note, sizeof note, " (resolved against the scene's folder %.*s; the scene wrote %s)", (int)dir,
+                     file, path + dir);
+        else if (slash) snprintf(note, sizeof note, " (resolved against the scene's folder %.*s)", (int)dir, file);
+        else if (file) snprintf(note, sizeof note, " (a relative path: from the scene's folder, the current folder)");
+        else snprintf(note, sizeof note, " (a relative path: from the current folder)");
+    }
+    return atmos__error(ctx, st, "%s%s%s: %s%s", file ? file : "", file ? ": " : "", key, why, note);
 }

@@ -87,10 +87,7 @@ atmos_status atmos_scene_load_volume(atmos_context *ctx, const atmos_scene *scen
         ld.subgrid_detail = sv->subgrid_detail;
         st = atmos_volume_load(ctx, sv->source, &ld, &vol);
         if (st != ATMOS_OK) { /* the reader names the file: the scene file and its key go in front */
-            char why[1024], sc[ATMOS_SCENE_PATH_MAX + 2], note[ATMOS_SCENE_PATH_MAX + 48];
-            snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
-            atmos__scene_path_where(scene, sv->source, sc, sizeof sc, note, sizeof note);
-            return atmos__error(ctx, st, "%s/volume/file: %s%s", sc, why, st == ATMOS_E_IO ? note : "");
+            return atmos__scene_file_error(ctx, st, scene, sv->source, "/volume/file", st == ATMOS_E_IO);
         }
     }
     if (st != ATMOS_OK) return st;

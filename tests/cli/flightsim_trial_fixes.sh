@@ -68,14 +68,21 @@ t = sys.argv[1]
 assert png.mean(t + "/lm/d_0001.png") > 2 * png.mean(t + "/pf/d_0001.png") + 1
 PY
 
+# a locked exposure over frames whose sun keeps its height (it turns in azimuth alone): frame
+# 1's, not called the highest sun's
+printf '{"image": {"width": 16, "height": 9}, "sun": {"elevation_deg": 30, "azimuth_deg": 180},
+ "animation": {"frames": 2, "azimuth_end_deg": 200}}\n' >"$T/still.json"
+"$A" render "$T/still.json" -o "$T/still/s.png" 2>"$T/err" || bad "a still sun's animation"
+has "a still sun's locked exposure" "exposure locked at frame 1's"
+hasnt "a still sun's locked exposure" "the highest sun"
+
 # --- 4. A missing volume file, a missing mesh: the scene file, the key, the folder.
 mkdir -p "$T/sub"
 printf '{"image": {"width": 16, "height": 9}, "volume": {"file": "nope/cloud.vdb"}}\n' >"$T/sub/vol.json"
 (cd "$T" && "$A" render sub/vol.json -o x.png 2>"$T/err"); rc=$?
 [ $rc -ne 0 ] && ok "missing volume file refused" || bad "missing volume file: rc 0"
 has "missing volume file" "sub/vol.json: /volume/file"
-has "missing volume file" "/volume/file"
-has "missing volume file" "the scene's folder"
+has "missing volume file" "(resolved against the scene's folder sub/; the scene wrote nope/cloud.vdb)"
 hasnt "missing volume file" "from the current folder"
 printf '{"renderer": "beams", "image": {"width": 16, "height": 9}, "fog": {"visibility_m": 300},
  "lights": [{"type": "spot", "position_m": [0, 20, 0], "cone_deg": 14, "intensity_w_sr": 2000}],
@@ -83,7 +90,7 @@ printf '{"renderer": "beams", "image": {"width": 16, "height": 9}, "fog": {"visi
 (cd "$T" && "$A" render sub/mesh.json -o x.png 2>"$T/err"); rc=$?
 [ $rc -ne 0 ] && ok "missing mesh refused" || bad "missing mesh: rc 0"
 has "missing mesh" "/objects/0/mesh"
-has "missing mesh" "the scene's folder"
+has "missing mesh" "(resolved against the scene's folder sub/; the scene wrote meshes/plane.obj)"
 hasnt "missing mesh" "from the current folder"
 (cd "$T/sub" && "$A" render - -o "$T/x.png" <mesh.json 2>"$T/err"); rc=$?
 has "missing mesh, a scene from standard input" "from the current folder"

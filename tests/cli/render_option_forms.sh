@@ -141,4 +141,8 @@ if [ -n "$a" ] && [ "$a" = "$b" ]; then ok "--exposure auto = -D output.exposure
 # shellcheck disable=SC2046
 "$A" render $(base nishita) -q --nishita-mc-delta-m -o "$T/dm.png" 2>"$T/dm.err" || bad "render --nishita-mc-delta-m"
 grep -q "mc_delta_m does nothing" "$T/dm.err" && ok "--nishita-mc-delta-m without a field warns" || bad "no warning: $(cat "$T/dm.err")"
+# shellcheck disable=SC2046
+"$A" render $(base nishita) -q --nishita-mc-dm-clip -o "$T/clip.png" 2>"$T/clip.err" || bad "render --nishita-mc-dm-clip"
+grep -q "mc_dm_clip does nothing without mc_delta_m" "$T/clip.err" && ok "--nishita-mc-dm-clip without delta-M warns" ||
+    bad "no warning: $(cat "$T/clip.err")"
 exit $fail

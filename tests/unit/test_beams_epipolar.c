@@ -3,7 +3,8 @@
  * 256-texel map) and the lines from an eye in front of it:
  *   - every fifth line's samples are the map's depth at their points (the four nearest texels'
  *     depths blended where all four hold an object, else the nearest texel's; beside the map
- *     INFINITY), to 1e-5 relative, and a quarter of them at least are not at the next line's;
+ *     INFINITY; read here with tent weights over the texel lattice and the nearest texel by
+ *     rounding, not the code's index arithmetic), to 1e-5 relative, and a quarter of them at least are not at the next line's;
  *   - rays whose projections run exactly along those lines (three slopes in depth each): the
  *     lit length the line's tree walk gives against a march along the ray itself in steps of
  *     1/64 texel, each step lit where the ray is nearer the sun than the map's depth there:
@@ -26,16 +27,19 @@ static double map_depth(const atmos__beams_sun *s, double fx, double fy)
 {
     const int n = s->n;
     if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return INFINITY;
-    const int x0 = (int)floor(fx), y0 = (int)floor(fy);
-    double d[2][2];
-    for (int a = 0; a < 2; a++)
-        for (int b = 0; b < 2; b++) {
-            const int x = x0 + b < 0 ? 0 : x0 + b > n - 1 ? n - 1 : x0 + b, y = y0 + a < 0 ? 0 : y0 + a > n - 1 ? n - 1 : y0 + a;
-            d[a][b] = s->depth[(size_t)y * n + x];
-        }
-    const double ax = fx - x0, ay = fy - y0;
-    if (isinf(d[0][0]) || isinf(d[0][1]) || isinf(d[1][0]) || isinf(d[1][1])) return d[ay >= 0.5][ax >= 0.5];
-    return (1 - ay) * ((1 - ax) * d[0][0] + ax * d[0][1]) + ay * ((1 - ax) * d[1][0] + ax * d[1][1]);
+    /* the texels of the lattice points around (fx, fy), tent weights 1 - |distance| per axis,
+     * an index past the map's edge read at the edge */
+    double sum = 0, nearest = INFINITY;
+    int holes = 0;
+    for (int c = 0; c < 4; c++) {
+        const double x = floor(fx) + (c & 1), y = floor(fy) + (c >> 1);
+        const double w = (1 - fabs(fx - x)) * (1 - fabs(fy - y));
+        const double d = s->depth[(size_t)fmin(fmax(y, 0), n - 1) * n + (size_t)fmin(fmax(x, 0), n - 1)];
+        holes += isinf(d);
+        sum += isinf(d) ? 0 : w * d;
+        if (x == floor(fx + 0.5) && y == floor(fy + 0.5)) nearest = d; /* the nearest, ties upward */
+    }
+    return holes ? nearest : sum;
 }
 
 static void add_length(void *u, double ra, double rb) { *(double *)u += rb - ra; }

@@ -52,10 +52,15 @@ int main(void)
     CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, &pt));
     atmos_msphase *m = NULL;
     CHECK_OK(atmos_msphase_build(ctx, pt, NULL, &m));
-    atmos__pphase *t = m ? atmos__pphase_make(m, wl.count) : NULL;
+    const int top = m ? atmos_msphase_max_order(m) : 0;
+    /* the size cap: the table's floats, orders x both halves' nodes x wavelengths; one byte
+     * under it, no table */
+    const size_t bytes = sizeof(float) * (size_t)(top + 1) * 2 * (ATMOS__PPHASE_NODES + 1) * (size_t)wl.count;
+    CHECK(atmos__pphase_bytes(m, wl.count) == bytes);
+    CHECK(m && atmos__pphase_make(m, wl.count, bytes - 1) == NULL);
+    atmos__pphase *t = m ? atmos__pphase_make(m, wl.count, bytes) : NULL;
     CHECK(t != NULL);
     if (!t) return test_summary("test_pphase");
-    const int top = atmos_msphase_max_order(m);
     CHECK(t->orders == top + 1);
 
     /* the nodes of integer orders: the msphase's own values (in floats) */

@@ -698,6 +698,23 @@ static void test_load(void)
     CHECK(atmos_scene_load(ctx, path, &s) == ATMOS_E_IO); /* a directory */
     CHECK(contains(atmos_context_error(ctx), "Is a directory"));
     CHECK(atmos_scene_load(ctx, NULL, &s) == ATMOS_E_INVALID_ARG);
+
+    /* a path of ATMOS_SCENE_PATH_MAX bytes or more ("./" repeated): kept for messages as "..."
+     * and its end */
+    char dir[512], lng[1400];
+    test_tmp_path(dir, sizeof dir, "");
+    int o = snprintf(lng, sizeof lng, "%s/", dir);
+    while (o < ATMOS_SCENE_PATH_MAX + 40) o += snprintf(lng + o, sizeof lng - (size_t)o, "./");
+    snprintf(lng + o, sizeof lng - (size_t)o, "test_scene_long.json");
+    f = fopen(lng, "wb");
+    CHECK(f != NULL);
+    if (!f) return;
+    fputs("{}\n", f);
+    fclose(f);
+    CHECK_OK(atmos_scene_load(ctx, lng, &s));
+    CHECK(strlen(s.file) == ATMOS_SCENE_PATH_MAX - 1 && !strncmp(s.file, "...", 3));
+    CHECK(strlen(s.file) > 22 && !strcmp(s.file + strlen(s.file) - 22, "./test_scene_long.json"));
+    remove(lng);
 }
 
 static void test_sun_direction(void)

@@ -378,7 +378,8 @@ static atmos_status render_frames(atmos_context *ctx, atmos_plan *plan0, const a
     if (st != ATMOS_OK) cli_outputs_held_discard();
     atmos_image_destroy(r.spec);
     char lock[80] = "";
-    if (r.xl.locked) snprintf(lock, sizeof lock, "; exposure locked at frame %d's (the highest sun)", r.xl.key);
+    if (r.xl.locked)
+        snprintf(lock, sizeof lock, "; exposure locked at frame %d's%s", r.xl.key, r.xl.by_sun ? " (the highest sun)" : "");
     if (st == ATMOS_OK && !o->quiet && r.nframes > 1)
         fprintf(stderr, "atmos render: %d frames written, %.3f s rendering (%s)%s\n", r.nframes, r.total,
                 tl ? "a time-lapse: the simulation carried from frame to frame, a plan a frame"

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The manual EV100 whose scale (1 / (1.2 * 2^EV), atmos_tonemap_scale) is scale. */
@@ -23,30 +24,35 @@ static double auto_scale(const atmos_image *lin, const atmos_scene *fs, const ex
     return scale;
 }
 
-/* The frame (from 1) whose sun stands highest; the first of equals. */
-static int highest_sun(atmos_context *ctx, const atmos_scene *scene, int nframes)
+/* *key: the frame (from 1) whose sun stands highest; the first of equals; *moves: the sun's
+ * elevation is not the same in every frame. fs: room for a frame's scene. */
+static atmos_status highest_sun(atmos_context *ctx, const atmos_scene *scene, int nframes, atmos_scene *fs, int *key,
+                                int *moves)
 {
-    atmos_scene fs;
-    int key = 1;
-    double best = -INFINITY;
+    double best = -INFINITY, low = INFINITY;
+    *key = 1;
     for (int i = 0; i < nframes; i++) {
         double dir[3], el = 0, az = 0;
-        if (atmos_scene_animation_frame(ctx, scene, i, &fs) != ATMOS_OK ||
-            atmos_scene_sun_direction(ctx, &fs, dir, &el, &az) != ATMOS_OK)
-            return 1;
-        if (el > best) best = el, key = i + 1;
+        atmos_status st = atmos_scene_animation_frame(ctx, scene, i, fs);
+        if (st == ATMOS_OK) st = atmos_scene_sun_direction(ctx, fs, dir, &el, &az);
+        if (st != ATMOS_OK) return st;
+        if (el > best) best = el, *key = i + 1;
+        low = el < low ? el : low;
     }
-    return key;
+    *moves = best > low;
+    return ATMOS_OK;
 }
 
-/* The key frame's exposure from a render of it at a quarter of the width and height. */
-static atmos_status key_exposure(atmos_context *ctx, atmos_plan *plan, const atmos_scene *scene, exposure_lock *xl)
+/* The key frame's exposure from a render of it at a quarter of the width and height (fs:
+ * room for its scene); none to lock on (a black frame): the first frame's, as without a
+ * moving sun. */
+static atmos_status key_exposure(atmos_context *ctx, atmos_plan *plan, const atmos_scene *scene, exposure_lock *xl,
+                                 atmos_scene *fs)
 {
-    atmos_scene fs;
     atmos_frame f;
     atmos_image *spec = NULL, *lin = NULL;
-    atmos_status st = atmos_scene_animation_frame(ctx, scene, xl->key - 1, &fs);
-    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &fs, &f);
+    atmos_status st = atmos_scene_animation_frame(ctx, scene, xl->key - 1, fs);
+    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, fs, &f);
     if (st == ATMOS_OK) {
         f.width = f.width / 4 > 8 ? f.width / 4 : (f.width < 8 ? f.width : 8);
         f.height = f.height / 4 > 8 ? f.height / 4 : (f.height < 8 ? f.height : 8);
@@ -56,8 +62,9 @@ static atmos_status key_exposure(atmos_context *ctx, atmos_plan *plan, const atm
     if (st == ATMOS_OK) st = atmos_image_to_srgb(ctx, spec, atmos_plan_wavelengths(plan), &lin);
     if (st == ATMOS_OK) {
         int limited = 0;
-        const double scale = auto_scale(lin, &fs, xl, &limited);
+        const double scale = auto_scale(lin, fs, xl, &limited);
         if (scale > 0 && isfinite(scale)) xl->ev = ev_of_scale(scale), xl->locked = 1;
+        else xl->key = 1, xl->by_sun = 0; /* nothing to lock on: the first frame's, when it comes */
     }
     atmos_image_destroy(lin);
     atmos_image_destroy(spec);
@@ -73,8 +80,12 @@ atmos_status render_exposure_start(atmos_context *ctx, atmos_plan *plan, const a
     xl->limit = 1, xl->limit_ev = scene->animation.exposure_limit_ev;
     xl->lock = !per_frame;
     if (!xl->lock || !sun_moves) return ATMOS_OK;
-    xl->key = highest_sun(ctx, scene, nframes);
-    return xl->key > 1 ? key_exposure(ctx, plan, scene, xl) : ATMOS_OK;
+    atmos_scene *fs = malloc(sizeof *fs); /* large: not on the stack */
+    if (!fs) return fprintf(stderr, "atmos render: out of memory\n"), ATMOS_E_NOMEM;
+    atmos_status st = highest_sun(ctx, scene, nframes, fs, &xl->key, &xl->by_sun);
+    if (st == ATMOS_OK && xl->key > 1) st = key_exposure(ctx, plan, scene, xl, fs);
+    free(fs);
+    return st;
 }
 
 /* The share of pixels of a display image whose three channels are all at least 250/255. */
@@ -106,7 +117,7 @@ atmos_status render_exposure_tone_map(atmos_context *ctx, atmos_image *lin, cons
     if (xl->lock && !xl->locked && !fs->tonemap.manual_exposure && scale > 0 && isfinite(scale))
         xl->ev = ev_of_scale(scale), xl->locked = 1; /* the key frame is the first */
     if (xl->locked && !fs->tonemap.manual_exposure) {
-        snprintf(buf, sizeof buf, "locked at frame %d's (the highest sun)", xl->key);
+        snprintf(buf, sizeof buf, "locked at frame %d's%s", xl->key, xl->by_sun ? " (the highest sun)" : "");
         atmos_image_set_meta(lin, "atmos:exposure", buf);
     } else if (limited) {
         snprintf(buf, sizeof buf, "automatic, held at the limit EV %g", xl->limit_ev);

@@ -16,6 +16,7 @@
 typedef struct exposure_lock {
     int lock, locked; /* lock: one exposure for all frames; locked: it is chosen (ev) */
     int key;          /* the frame (from 1) whose exposure is locked */
+    int by_sun;       /* key is the frame of the highest sun (the sun moves), not the first */
     double ev;        /* the locked exposure as a manual EV100 */
     int limit;        /* an animation: automatic exposures stop at limit_ev */
     double limit_ev;

@@ -100,6 +100,7 @@ static int key_frame(const char *file, const cJSON *o, int i, double t_prev, int
     if (!cJSON_IsNumber(t) || !isfinite(t->valuedouble) || !(t->valuedouble >= t_prev))
         return fail(file, t ? sub : ptr, "%s must be a number of seconds, not less than the key frame before's",
                     t ? "it" : "\"t\" is missing:");
+    if (t->valuedouble < 0) return fail(file, sub, "must be >= 0, got %g", t->valuedouble);
     k->t = t->valuedouble;
     if ((rc = vec3(file, o, ptr, "position_m", k->pos)) || (rc = vec3(file, o, ptr, "look_at_m", k->look_at))) return rc;
     const cJSON *sun = cJSON_GetObjectItemCaseSensitive(o, "sun");
@@ -173,7 +174,7 @@ int view_script_frames(const view_script *s)
     if (!s || s->n == 0) return 0;
     /* frame i at t = i / fps: the first frame at or after the last key frame's time */
     const double f = ceil(s->k[s->n - 1].t * s->fps - 1e-9);
-    return f < 10000000 ? (int)f + 1 : 10000000;
+    return !(f > 0) ? 1 : f < 10000000 ? (int)f + 1 : 10000000;
 }
 
 int view_script_check(const view_script *s, const view_state *st, const char *path)
