@@ -36,6 +36,12 @@ yaw = [float(r["yaw_deg"]) for r in rows]
 assert abs((yaw[1] - yaw[0]) % 360 - 120) < 1e-6 and abs((yaw[2] - yaw[1]) % 360 - 120) < 1e-6, yaw
 PY
 
+# off a terminal the progress log speaks while a plan is made, not for each frame's renders (a log
+# line every interval: 0 logs every report)
+ATMOS_PROGRESS_INTERVAL=0 "$A" view --headless --frames 3 --size 32x18 >/dev/null 2>"$T/plog.txt"
+[ $? -eq 0 ] && ! grep -q "^atmos: render sky:" "$T/plog.txt" && ok "no progress log for the frames' renders" ||
+    { bad "frames' renders logged off a terminal"; cat "$T/plog.txt" >&2; }
+
 # bad input: usage errors with a message
 "$A" view --headless >/dev/null 2>"$T/e1.txt"; [ $? -eq 2 ] && grep -q "needs --frames N or --script" "$T/e1.txt" && ok "--headless alone refused" || bad "--headless alone"
 "$A" view --frames 2 --headless --press Nope >/dev/null 2>"$T/e2.txt"; [ $? -eq 2 ] && grep -q "unknown key" "$T/e2.txt" && ok "unknown key refused" || bad "unknown key"

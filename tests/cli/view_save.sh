@@ -21,7 +21,7 @@ msg() { # NAME WANT_STATUS TEXT ARGS...
 }
 msg "bad --renderer" 2 "atmos view: --renderer: expected" --renderer nope
 msg "bad --renderer's help hint" 2 "Try 'atmos view --help'" --renderer nope
-msg "bad -D" 2 "atmos view: -D: /camera/fov_deg" -D camera.fov_deg=500
+msg "bad -D" 2 "atmos view: -D camera.fov_deg=500: /camera/fov_deg" -D camera.fov_deg=500
 msg "volume file options on a generated volume" 2 "atmos view: --grids" --volume generate:cumulus --grids a
 msg "a missing scene file" 1 "atmos view: " "$T/no_such_scene.json"
 msg "bad --screen-layer-px" 2 "atmos view: --screen-layer-px: expected 0 (off)" --screen-layer-px 0.5

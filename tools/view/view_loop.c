@@ -25,6 +25,7 @@ typedef struct loop {
     int impostor_budget;         /* view_opts's */
     double screen_layer_px;      /* view_opts's */
     int said_pinhole;            /* the stand-in pinhole for the scene's camera was announced */
+    int progress_log;            /* off a terminal: the progress log, kept for the plans' making */
 } loop;
 
 /* What a frame's camera and sun are made of, as numbers: a frame whose pose equals the last
@@ -76,7 +77,9 @@ static atmos_status get_plan(loop *L, const view_state *s, atmos_plan **out)
         }
         if (sc.renderer == ATMOS_RENDERER_SKY) sc.volume.source[0] = 0; /* the sky alone, the volume left out */
         fprintf(stderr, "atmos view: preparing the %s renderer...\n", atmos_renderer_name(s->renderer));
+        cli_shared_progress()->log = L->progress_log; /* a plan's making may be long: logged */
         atmos_status st = atmos_plan_create(L->ctx, &sc, sc.renderer == ATMOS_RENDERER_SKY ? NULL : L->vol, NULL, &L->plan[k]);
+        cli_shared_progress()->log = 0; /* the frames' renders are not: a frame is short */
         if (st != ATMOS_OK) return st;
         atmos_image_destroy(L->img), L->img = NULL;
     }
@@ -337,6 +340,8 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     memset(&L, 0, sizeof L);
     L.ctx = ctx, L.sc = sc, L.vol = vol, L.spectral = sc->wavelengths == ATMOS_WAVELENGTHS_SPECTRAL;
     L.impostor_budget = o->impostor_budget, L.screen_layer_px = o->screen_layer_px;
+    L.progress_log = cli_shared_progress()->log;
+    cli_shared_progress()->log = 0;
     view_state s;
     view_recorder rec = {0};
     view_window *win = NULL;
@@ -389,5 +394,6 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     atmos_image_destroy(L.lin);
     atmos_image_destroy(L.disp);
     free(L.rgba);
+    cli_shared_progress()->log = L.progress_log;
     return rc;
 }
