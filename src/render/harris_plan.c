@@ -117,6 +117,11 @@ static atmos_status optics(atmos_plan *p, atmos__harris_plan *h)
         /* the eye pass's Ams_n on the cosine (docs/viewer.md: within its stated error), under a
          * size cap; NULL (too large, or no memory): the exact look-up */
         h->o.ph[f] = atmos__pphase_make(h->o.ms[f], h->o.nw, atmos__harris_pphase_max_bytes);
+        if (!h->o.ph[f])
+            atmos__log(p->ctx, ATMOS_LOG_WARN,
+                       "render harris: particle type %d's phase table (%zu MB; cap %zu MB) not made: "
+                       "the exact look-up, slower", f,
+                       atmos__pphase_bytes(h->o.ms[f], h->o.nw) >> 20, atmos__harris_pphase_max_bytes >> 20);
     }
     return ATMOS_OK;
 }

@@ -41,6 +41,10 @@ PY
 ATMOS_PROGRESS_INTERVAL=0 "$A" view --headless --frames 3 --size 32x18 >/dev/null 2>"$T/plog.txt"
 [ $? -eq 0 ] && ! grep -q "^atmos: render sky:" "$T/plog.txt" && ok "no progress log for the frames' renders" ||
     { bad "frames' renders logged off a terminal"; cat "$T/plog.txt" >&2; }
+ATMOS_PROGRESS_INTERVAL=0 "$A" view --headless --renderer harris --volume generate:cumulus --frames 2 --size 16x9 \
+    >/dev/null 2>"$T/plog2.txt"
+[ $? -eq 0 ] && grep -q "^atmos: phase cloud:" "$T/plog2.txt" && ok "the plan's making logged off a terminal" ||
+    { bad "no progress log for the plan's making"; cat "$T/plog2.txt" >&2; }
 
 # bad input: usage errors with a message
 "$A" view --headless >/dev/null 2>"$T/e1.txt"; [ $? -eq 2 ] && grep -q "needs --frames N or --script" "$T/e1.txt" && ok "--headless alone refused" || bad "--headless alone"
