@@ -48,9 +48,11 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                                 t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w];
                                 tau += np->col[v + f] * np->mc_sig_ms[f][w];
                             }
+                            at += t, as += sc;
+                            if (!(sc != 0)) continue; /* an empty voxel: no exponentials */
                             /* the voxel's mean of e^-tau along the sun about its centre, sinh(d/2)/(d/2) */
                             const double d = fmin(t * len, 2 * tau), m = d > 1e-6 ? sinh(0.5 * d) / (0.5 * d) : 1;
-                            at += t, as += sc, aq += sc * exp(-tau) * m;
+                            aq += sc * exp(-tau) * m;
                         }
                 st[c] = (float)(at * inv), ss[c] = (float)(as * inv), src[c] = aq * inv;
             }
