@@ -372,6 +372,54 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
     return 0;
 }
 
+struct atmos__do_ws {
+    void *mem;
+    size_t bytes;
+};
+
+atmos__do_ws *atmos__do_ws_create(void) { return calloc(1, sizeof(atmos__do_ws)); }
+
+void atmos__do_ws_free(atmos__do_ws *ws)
+{
+    if (ws) free(ws->mem), free(ws);
+}
+
+/* The next bytes of *at (rounded up to 64) when *at is not NULL; the running size into *total. */
+static void *carve(unsigned char **at, size_t bytes, size_t *total)
+{
+    bytes = (bytes + 63) & ~(size_t)63;
+    *total += bytes;
+    if (!*at) return NULL;
+    void *p = *at;
+    *at += bytes;
+    return p;
+}
+
+/* W's buffers and GMRES's (V, m + 1 vectors; b, tmp) from ws's memory, grown when too small (its
+ * pages then touched once for many solves). Returns 0 when out of memory. */
+static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp)
+{
+    const size_t N = W->cells * W->K;
+    for (int pass = 0; pass < 2; pass++) {
+        unsigned char *at = pass ? ws->mem : NULL;
+        size_t total = 0;
+        W->pack = carve(&at, sizeof *W->pack * ATMOS__DO_NMAX, &total);
+        *V = carve(&at, sizeof(double) * N * (m + 1), &total);
+        *b = carve(&at, sizeof(double) * N, &total), *tmp = carve(&at, sizeof(double) * N, &total);
+        W->live = carve(&at, W->cells, &total), W->need = carve(&at, W->cells, &total);
+        W->Q = carve(&at, sizeof(float) * N, &total), W->q1 = carve(&at, sizeof(float) * N, &total);
+        for (int g = 0; g < DO_GROUPS; g++)
+            W->acc[g] = carve(&at, sizeof(float) * N, &total),
+            W->psi[g] = carve(&at, sizeof(float) * W->cells * DO_PACK, &total);
+        if (!pass && ws->bytes < total) {
+            free(ws->mem);
+            ws->bytes = (ws->mem = malloc(total)) ? total : 0;
+            if (!ws->mem) return 0;
+        }
+    }
+    return 1;
+}
+
 int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st)
 {
     memset(st, 0, sizeof *st);
@@ -382,15 +430,9 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     const int m = P->restart < 1 ? 1 : P->restart > 64 ? 64 : P->restart;
     atmos__do_problem Pm = *P;
     Pm.restart = m, W.P = &Pm;
-    W.pack = malloc(sizeof *W.pack * ATMOS__DO_NMAX);
-    double *V = malloc(sizeof(double) * N * (m + 1)), *b = malloc(sizeof(double) * N),
-           *tmp = malloc(sizeof(double) * N);
-    W.live = malloc(W.cells), W.need = malloc(W.cells), W.Q = malloc(sizeof(float) * N), W.q1 = malloc(sizeof(float) * N);
-    int ok = W.pack && V && b && tmp && W.live && W.need && W.Q && W.q1;
-    for (int g = 0; g < DO_GROUPS; g++) {
-        W.acc[g] = malloc(sizeof(float) * N), W.psi[g] = malloc(sizeof(float) * W.cells * DO_PACK);
-        ok = ok && W.acc[g] && W.psi[g];
-    }
+    atmos__do_ws own = {NULL, 0}, *ws = P->ws ? P->ws : &own;
+    double *V = NULL, *b = NULL, *tmp = NULL;
+    const int ok = take_buffers(&W, m, ws, &V, &b, &tmp);
     if (ok) {
         for (size_t c = 0; c < W.cells; c++) {
             W.live[c] = P->sig_s[c] != 0;
@@ -415,7 +457,6 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         for (size_t c = 0; c < W.cells; c++) st->emitted += P->q1[c * W.K] * sqrt(4 * ATMOS_PI);
         st->emitted *= P->h * P->h * P->h;
     }
-    for (int g = 0; g < DO_GROUPS; g++) free(W.acc[g]), free(W.psi[g]);
-    free(W.pack), free(V), free(b), free(tmp), free(W.live), free(W.need), free(W.Q), free(W.q1);
+    free(own.mem);
     return ok;
 }

@@ -60,7 +60,7 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
 
 atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L, const double chi[][4],
                                     const double sun_w[3], const double *E, int threads, float *coef,
-                                    double *phi_all, int warm, atmos__nishita_do_info *info)
+                                    double *phi_all, int warm, atmos__do_ws *ws, atmos__nishita_do_info *info)
 {
     atmos__nishita_plan *np = p->nishita;
     const int n = np->n, K = (L + 1) * (L + 1);
@@ -87,7 +87,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
     int ok = st && src && q1;
     P.c[0] = F->c[0], P.c[1] = F->c[1], P.c[2] = F->c[2], P.h = F->s / (double)np->g.sc, P.L = L;
     P.sig_t = st, P.sig_s = st + cells, P.q1 = q1, P.quad = &quad;
-    P.tol = DO_TOL, P.max_iter = DO_MAX_ITER, P.restart = DO_RESTART, P.threads = threads;
+    P.tol = DO_TOL, P.max_iter = DO_MAX_ITER, P.restart = DO_RESTART, P.threads = threads, P.ws = ws;
     int w_last = -1; /* the wavelength whose solution phi holds */
     for (int w = 0; w < n && ok; w++) {
         double *phi = phi_all + (size_t)w * cells * K;
