@@ -8,6 +8,7 @@
  * directions are swept in a fixed number of groups, each summed into its own moments, the
  * groups added in order: the same numbers whatever the threads. */
 #include "light/lfield_do.h"
+#include "core/clones.h"
 #include "core/internal.h"
 
 #include <math.h>
@@ -15,6 +16,15 @@
 #include <string.h>
 
 #define DO_GROUPS 4
+#define DO_PACK 4 /* directions swept together: one vector of 4 floats */
+typedef float v4f __attribute__((vector_size(16)));
+
+static inline v4f load4(const float *p)
+{
+    v4f v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
 
 void atmos__sh_eval(int lmax, const double d[3], double *Y)
 {
@@ -62,13 +72,24 @@ int atmos__do_quadrature(int nmu, int nphi, atmos__do_quad *q)
     return 1;
 }
 
+/* A pack: up to DO_PACK directions of one octant (the same order of the cells in their sweeps),
+ * swept together: a cell's source moments are read and its moments written once for all of them
+ * (a sweep is bound by those reads and writes). Padded with weight 0 (a direction's copy). */
+typedef struct {
+    int s[3];                          /* the octant: the sweep's sign along each axis */
+    v4f Y[ATMOS__DO_KMAX];             /* the harmonics, per coefficient (the directions in a vector) */
+    float wY[DO_PACK][ATMOS__DO_KMAX]; /* times the weight, per direction and coefficient */
+    v4f a[3], as;                      /* |the components| along the axes; their sum */
+    double w[DO_PACK];                 /* the weight */
+} do_pack;
+
 typedef struct {
     const atmos__do_problem *P;
-    int K;
+    int K, npack;
     size_t cells;
-    double (*Y)[ATMOS__DO_KMAX]; /* per direction */
-    double (*o)[3];              /* per direction, along the cells' axes */
-    double *acc[DO_GROUPS], *psi[DO_GROUPS];
+    do_pack *pack;
+    float *acc[DO_GROUPS], *psi[DO_GROUPS]; /* in single precision; psi per cell, DO_PACK */
+    float *Q, *q1;                          /* the sweeps' source moments; q1 in single precision */
     double leak[DO_GROUPS];
     unsigned char *live; /* per cell: it scatters or emits (else its source is 0) */
     unsigned char *need; /* per cell: it or one of its 26 neighbours has a medium or a source (else
@@ -95,20 +116,55 @@ static void mark_needed(do_work *W)
             }
 }
 
-/* One direction's sweep with the source moments Q (per cell, K each), its radiance into psi,
- * its moments added to acc (weight w), the power leaving through the grid's faces to *leak. */
-static inline void sweep_k(const do_work *W, int n, const double *Q, double *psi, double *acc, double *leak,
-                           const int K)
+/* The packs: the directions by octant (in a fixed order), DO_PACK at a time. Returns their count;
+ * pack must hold ATMOS__DO_NMAX of them. */
+static int make_packs(const atmos__do_problem *P, do_pack *pack)
+{
+    const int nd = P->quad->n;
+    int np = 0;
+    for (int oct = 0; oct < 8; oct++) {
+        int d = DO_PACK;
+        for (int n = 0; n < nd; n++) {
+            const double *dw = P->quad->dir[n];
+            double o[3], Y[ATMOS__DO_KMAX] = {0};
+            int in = 1;
+            for (int a = 0; a < 3; a++) {
+                o[a] = P->R[a][0] * dw[0] + P->R[a][1] * dw[1] + P->R[a][2] * dw[2];
+                in = in && (o[a] >= 0) == !(oct >> a & 1);
+            }
+            if (!in) continue;
+            if (d == DO_PACK) {
+                do_pack *p = &pack[np++];
+                for (int a = 0; a < 3; a++) p->s[a] = oct >> a & 1 ? -1 : 1;
+                d = 0;
+            }
+            do_pack *p = &pack[np - 1];
+            atmos__sh_eval(P->L, dw, Y);
+            /* this direction in every slot left (the padding: weight 0) */
+            for (int e = d; e < DO_PACK; e++) {
+                const double w = e == d ? P->quad->w[n] : 0;
+                for (int m = 0; m < ATMOS__DO_KMAX; m++) p->Y[m][e] = (float)Y[m], p->wY[e][m] = (float)(w * Y[m]);
+                for (int a = 0; a < 3; a++) p->a[a][e] = (float)fabs(o[a]);
+                p->as[e] = p->a[0][e] + p->a[1][e] + p->a[2][e], p->w[e] = w;
+            }
+            d++;
+        }
+    }
+    return np;
+}
+
+/* One pack's sweep with the source moments Q (per cell, K each), its radiance into psi (per cell,
+ * DO_PACK), its moments added to acc, the power leaving through the grid's faces to *leak. In
+ * single precision but the leaving power (the directions of a pack in one vector). */
+static inline __attribute__((always_inline)) void sweep_k(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc,
+                           double *leak, const int K)
 {
     const atmos__do_problem *P = W->P;
-    const int nx = P->c[0], ny = P->c[1], nz = P->c[2];
-    const double *o = W->o[n], *Y = W->Y[n], w = P->quad->w[n], h = P->h;
-    double wY[ATMOS__DO_KMAX];
-    for (int m = 0; m < K; m++) wY[m] = w * Y[m];
-    const double ax = fabs(o[0]), ay = fabs(o[1]), az = fabs(o[2]), as = ax + ay + az;
-    const int sx = o[0] >= 0 ? 1 : -1, sy = o[1] >= 0 ? 1 : -1, sz = o[2] >= 0 ? 1 : -1;
+    const int nx = P->c[0], ny = P->c[1], nz = P->c[2], sx = pk->s[0], sy = pk->s[1], sz = pk->s[2];
+    const float h = (float)P->h;
+    const v4f zero = {0, 0, 0, 0};
     const size_t sxy = (size_t)nx * ny;
-    double out = 0;
+    double out[DO_PACK] = {0};
     for (int kk = 0; kk < nz; kk++) {
         const int k = sz > 0 ? kk : nz - 1 - kk;
         for (int jj = 0; jj < ny; jj++) {
@@ -116,74 +172,96 @@ static inline void sweep_k(const do_work *W, int n, const double *Q, double *psi
             for (int ii = 0; ii < nx; ii++) {
                 const int i = sx > 0 ? ii : nx - 1 - ii;
                 const size_t c = k * sxy + (size_t)j * nx + i;
-                const double *q = Q + c * K;
-                double s = 0;
-                if (W->live[c])
-                    for (int m = 0; m < K; m++) s += q[m] * Y[m];
-                const double px = ii ? psi[c - sx] : 0, py = jj ? psi[c - (ptrdiff_t)sy * nx] : 0,
-                             pz = kk ? psi[c - (ptrdiff_t)sz * (ptrdiff_t)sxy] : 0;
-                const double v = (s * h + ax * px + ay * py + az * pz) / (P->sig_t[c] * h + as);
-                psi[c] = v;
-                if (v != 0 && W->need[c]) {
-                    double *a = acc + c * K;
-                    for (int m = 0; m < K; m++) a[m] += wY[m] * v;
+                v4f src = {0, 0, 0, 0};
+                if (W->live[c]) {
+                    const float *q = Q + c * K;
+                    for (int m = 0; m < K; m++) src += q[m] * pk->Y[m];
                 }
-                out += v * ((ii == nx - 1) * ax + (jj == ny - 1) * ay + (kk == nz - 1) * az);
+                const v4f px = ii ? load4(psi + (c - sx) * DO_PACK) : zero,
+                          py = jj ? load4(psi + (c - (ptrdiff_t)sy * nx) * DO_PACK) : zero,
+                          pz = kk ? load4(psi + (c - (ptrdiff_t)sz * (ptrdiff_t)sxy) * DO_PACK) : zero;
+                const float th = P->sig_t[c] * h;
+                const v4f v = (src * h + pk->a[0] * px + pk->a[1] * py + pk->a[2] * pz) / (th + pk->as);
+                memcpy(psi + c * DO_PACK, &v, sizeof v);
+                if ((v[0] != 0 || v[1] != 0 || v[2] != 0 || v[3] != 0) && W->need[c]) {
+                    /* a vector over the coefficients */
+                    float *a = acc + c * K;
+                    int m = 0;
+                    for (; m + 4 <= K; m += 4) {
+                        v4f t = load4(&pk->wY[0][m]) * v[0];
+                        for (int d = 1; d < DO_PACK; d++) t += load4(&pk->wY[d][m]) * v[d];
+                        t = load4(a + m) + t;
+                        memcpy(a + m, &t, sizeof t);
+                    }
+                    for (; m < K; m++) {
+                        float t = pk->wY[0][m] * v[0];
+                        for (int d = 1; d < DO_PACK; d++) t += pk->wY[d][m] * v[d];
+                        a[m] += t;
+                    }
+                }
+                const int ex = ii == nx - 1, ey = jj == ny - 1, ez = kk == nz - 1;
+                if (ex | ey | ez)
+                    for (int d = 0; d < DO_PACK; d++)
+                        out[d] += (double)v[d] * (ex * pk->a[0][d] + ey * pk->a[1][d] + ez * pk->a[2][d]);
             }
         }
     }
-    *leak += w * out * h * h;
+    double l = 0;
+    for (int d = 0; d < DO_PACK; d++) l += pk->w[d] * out[d];
+    *leak += l * P->h * P->h;
 }
 
-/* The same with K a constant the compiler can unroll. */
-static void sweep_one(const do_work *W, int n, const double *Q, double *psi, double *acc, double *leak)
+/* The same with K a constant the compiler can unroll (and vectorise, for AVX2 too: the same
+ * operations in the same order, no contraction). */
+ATMOS_CLONES
+static void sweep_one(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc, double *leak)
 {
     switch (W->K) {
-    case 16: sweep_k(W, n, Q, psi, acc, leak, 16); break;
-    case 9: sweep_k(W, n, Q, psi, acc, leak, 9); break;
-    case 4: sweep_k(W, n, Q, psi, acc, leak, 4); break;
-    default: sweep_k(W, n, Q, psi, acc, leak, 1); break;
+    case 16: sweep_k(W, pk, Q, psi, acc, leak, 16); break;
+    case 9: sweep_k(W, pk, Q, psi, acc, leak, 9); break;
+    case 4: sweep_k(W, pk, Q, psi, acc, leak, 4); break;
+    default: sweep_k(W, pk, Q, psi, acc, leak, 1); break;
     }
 }
 
 /* All the directions with the source moments Q: the radiance moments into phi, the leaving power
- * into *leak (if not NULL). */
-static void sweep_all(do_work *W, const double *Q, double *phi, double *leak)
+ * into *leak (if not NULL). The packs in DO_GROUPS fixed groups, added in order. */
+static void sweep_all(do_work *W, const float *Q, double *phi, double *leak)
 {
     const size_t N = W->cells * W->K;
 #pragma omp parallel for schedule(static, 1) num_threads(W->P->threads)
     for (int g = 0; g < DO_GROUPS; g++) {
-        memset(W->acc[g], 0, sizeof(double) * N);
+        memset(W->acc[g], 0, sizeof(float) * N);
         W->leak[g] = 0;
-        for (int n = g; n < W->P->quad->n; n += DO_GROUPS) sweep_one(W, n, Q, W->psi[g], W->acc[g], &W->leak[g]);
+        for (int p = g; p < W->npack; p += DO_GROUPS) sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g]);
     }
     double l = 0;
     for (size_t i = 0; i < N; i++) {
         double s = 0;
-        for (int g = 0; g < DO_GROUPS; g++) s += W->acc[g][i];
+        for (int g = 0; g < DO_GROUPS; g++) s += (double)W->acc[g][i];
         phi[i] = s;
     }
     for (int g = 0; g < DO_GROUPS; g++) l += W->leak[g];
     if (leak) *leak = l;
 }
 
-/* The scattering source's moments, sig_s chi_l x_lm (plus q1 when add_q1). */
-static void scatter(const do_work *W, const double *x, double *Q, int add_q1)
+/* The scattering source's moments, sig_s chi_l x_lm (plus q1 when add_q1), into W->Q. */
+static void scatter(const do_work *W, const double *x, int add_q1)
 {
     const atmos__do_problem *P = W->P;
     const int K = W->K;
     for (size_t c = 0; c < W->cells; c++)
         for (int k = 0; k < K; k++) {
             const int l = atmos__sh_degree(k);
-            Q[c * K + k] = P->sig_s[c] * P->chi[l] * x[c * K + k] + (add_q1 ? P->q1[c * K + k] : 0);
+            W->Q[c * K + k] = (float)(P->sig_s[c] * P->chi[l] * x[c * K + k] + (add_q1 ? P->q1[c * K + k] : 0));
         }
 }
 
 /* y = (I - T S) x */
-static void apply(do_work *W, const double *x, double *y, double *tmp)
+static void apply(do_work *W, const double *x, double *y)
 {
-    scatter(W, x, tmp, 0);
-    sweep_all(W, tmp, y, NULL);
+    scatter(W, x, 0);
+    sweep_all(W, W->Q, y, NULL);
     for (size_t i = 0; i < W->cells * W->K; i++) y[i] = x[i] - y[i];
 }
 
@@ -209,9 +287,24 @@ static void axpy(double a, const double *x, double *y, size_t n, int threads)
     for (size_t i = 0; i < n; i++) y[i] += a * x[i];
 }
 
+/* The residual b - A x after a GMRES cycle of j columns, from its rotations (no sweep): V_{j+1} Q^T
+ * (0, ..., 0, g_j) (Saad 2003, Prop. 6.9), into r. */
+static void cycle_residual(const double *V, size_t N, int j, const double *g, const double *cs, const double *sn,
+                           double *r)
+{
+    double z[65] = {0};
+    z[j] = g[j];
+    for (int i = j - 1; i >= 0; i--) {
+        const double t = z[i], u = z[i + 1];
+        z[i] = cs[i] * t - sn[i] * u, z[i + 1] = sn[i] * t + cs[i] * u;
+    }
+    memset(r, 0, sizeof(double) * N);
+    for (int i = 0; i <= j; i++) axpy(z[i], V + (size_t)i * N, r, N, 1);
+}
+
 /* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
- * its first residual b itself, no sweep). */
-static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp, atmos__do_stats *st, int zero_start)
+ * its first residual b itself, no sweep). Returns 1 with the last residual b - A x in r, else 0. */
+static int gmres(do_work *W, const double *b, double *x, double *V, double *r, atmos__do_stats *st, int zero_start)
 {
     const atmos__do_problem *P = W->P;
     const int m = P->restart;
@@ -221,25 +314,28 @@ static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp
                         operation costs more in its barriers than it saves */
     const double bn = sqrt(dot(b, b, N, T));
     st->resid = 0;
-    if (!(bn > 0)) return;
+    if (!(bn > 0)) return 0;
     while (st->iters < P->max_iter) {
         if (zero_start)
             memcpy(V, b, sizeof(double) * N), zero_start = 0;
         else {
-            apply(W, x, V, tmp);
+            apply(W, x, V);
             st->sweeps++;
             for (size_t i = 0; i < N; i++) V[i] = b[i] - V[i];
         }
         const double beta = sqrt(dot(V, V, N, T));
         st->resid = beta / bn;
-        if (st->resid <= P->tol) return;
+        if (st->resid <= P->tol) {
+            memcpy(r, V, sizeof(double) * N);
+            return 1;
+        }
         for (size_t i = 0; i < N; i++) V[i] /= beta;
         memset(g, 0, sizeof g);
         g[0] = beta;
         int j = 0;
         for (; j < m && st->iters < P->max_iter; j++) {
             double *v = V + (size_t)(j + 1) * N;
-            apply(W, V + (size_t)j * N, v, tmp);
+            apply(W, V + (size_t)j * N, v);
             st->sweeps++, st->iters++;
             for (int i = 0; i <= j; i++) {
                 const double *vi = V + (size_t)i * N;
@@ -252,12 +348,12 @@ static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp
                 const double t = cs[i] * H[i][j] + sn[i] * H[i + 1][j];
                 H[i + 1][j] = -sn[i] * H[i][j] + cs[i] * H[i + 1][j], H[i][j] = t;
             }
-            const double r = hypot(H[j][j], H[j + 1][j]);
-            cs[j] = r > 0 ? H[j][j] / r : 1, sn[j] = r > 0 ? H[j + 1][j] / r : 0;
-            H[j][j] = r, H[j + 1][j] = 0;
+            const double rr = hypot(H[j][j], H[j + 1][j]);
+            cs[j] = rr > 0 ? H[j][j] / rr : 1, sn[j] = rr > 0 ? H[j + 1][j] / rr : 0;
+            H[j][j] = rr, H[j + 1][j] = 0;
             g[j + 1] = -sn[j] * g[j], g[j] = cs[j] * g[j];
             st->resid = fabs(g[j + 1]) / bn;
-            if (st->resid <= P->tol || !(r > 0)) {
+            if (st->resid <= P->tol || !(rr > 0)) {
                 j++;
                 break;
             }
@@ -268,8 +364,60 @@ static void gmres(do_work *W, const double *b, double *x, double *V, double *tmp
             y[i] = H[i][i] != 0 ? s / H[i][i] : 0;
         }
         for (int i = 0; i < j; i++) axpy(y[i], V + (size_t)i * N, x, N, T);
-        if (st->resid <= P->tol) return;
+        if (st->resid <= P->tol || st->iters >= P->max_iter) {
+            cycle_residual(V, N, j, g, cs, sn, r);
+            return 1;
+        }
     }
+    return 0;
+}
+
+struct atmos__do_ws {
+    void *mem;
+    size_t bytes;
+};
+
+atmos__do_ws *atmos__do_ws_create(void) { return calloc(1, sizeof(atmos__do_ws)); }
+
+void atmos__do_ws_free(atmos__do_ws *ws)
+{
+    if (ws) free(ws->mem), free(ws);
+}
+
+/* The next bytes of *at (rounded up to 64) when *at is not NULL; the running size into *total. */
+static void *carve(unsigned char **at, size_t bytes, size_t *total)
+{
+    bytes = (bytes + 63) & ~(size_t)63;
+    *total += bytes;
+    if (!*at) return NULL;
+    void *p = *at;
+    *at += bytes;
+    return p;
+}
+
+/* W's buffers and GMRES's (V, m + 1 vectors; b, tmp) from ws's memory, grown when too small (its
+ * pages then touched once for many solves). Returns 0 when out of memory. */
+static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp)
+{
+    const size_t N = W->cells * W->K;
+    for (int pass = 0; pass < 2; pass++) {
+        unsigned char *at = pass ? ws->mem : NULL;
+        size_t total = 0;
+        W->pack = carve(&at, sizeof *W->pack * ATMOS__DO_NMAX, &total);
+        *V = carve(&at, sizeof(double) * N * (m + 1), &total);
+        *b = carve(&at, sizeof(double) * N, &total), *tmp = carve(&at, sizeof(double) * N, &total);
+        W->live = carve(&at, W->cells, &total), W->need = carve(&at, W->cells, &total);
+        W->Q = carve(&at, sizeof(float) * N, &total), W->q1 = carve(&at, sizeof(float) * N, &total);
+        for (int g = 0; g < DO_GROUPS; g++)
+            W->acc[g] = carve(&at, sizeof(float) * N, &total),
+            W->psi[g] = carve(&at, sizeof(float) * W->cells * DO_PACK, &total);
+        if (!pass && ws->bytes < total) {
+            free(ws->mem);
+            ws->bytes = (ws->mem = malloc(total)) ? total : 0;
+            if (!ws->mem) return 0;
+        }
+    }
+    return 1;
 }
 
 int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st)
@@ -279,41 +427,36 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     memset(&W, 0, sizeof W);
     W.P = P, W.K = (P->L + 1) * (P->L + 1), W.cells = (size_t)P->c[0] * P->c[1] * P->c[2];
     const size_t N = W.cells * W.K;
-    const int m = P->restart < 1 ? 1 : P->restart > 64 ? 64 : P->restart, nd = P->quad->n;
+    const int m = P->restart < 1 ? 1 : P->restart > 64 ? 64 : P->restart;
     atmos__do_problem Pm = *P;
     Pm.restart = m, W.P = &Pm;
-    W.Y = malloc(sizeof *W.Y * nd), W.o = malloc(sizeof *W.o * nd);
-    double *V = malloc(sizeof(double) * N * (m + 1)), *b = malloc(sizeof(double) * N),
-           *tmp = malloc(sizeof(double) * N);
-    W.live = malloc(W.cells), W.need = malloc(W.cells);
-    int ok = W.Y && W.o && V && b && tmp && W.live && W.need;
-    for (int g = 0; g < DO_GROUPS; g++) {
-        W.acc[g] = malloc(sizeof(double) * N), W.psi[g] = malloc(sizeof(double) * W.cells);
-        ok = ok && W.acc[g] && W.psi[g];
-    }
+    atmos__do_ws own = {NULL, 0}, *ws = P->ws ? P->ws : &own;
+    double *V = NULL, *b = NULL, *tmp = NULL;
+    const int ok = take_buffers(&W, m, ws, &V, &b, &tmp);
     if (ok) {
         for (size_t c = 0; c < W.cells; c++) {
             W.live[c] = P->sig_s[c] != 0;
             for (int k = 0; k < W.K; k++) W.live[c] |= P->q1[c * W.K + k] != 0;
         }
         mark_needed(&W);
-        for (int n = 0; n < nd; n++) {
-            const double *d = P->quad->dir[n];
-            atmos__sh_eval(P->L, d, W.Y[n]);
-            for (int a = 0; a < 3; a++) W.o[n][a] = P->R[a][0] * d[0] + P->R[a][1] * d[1] + P->R[a][2] * d[2];
-        }
-        sweep_all(&W, P->q1, b, NULL);
+        W.npack = make_packs(P, W.pack);
+        for (size_t i = 0; i < N; i++) W.q1[i] = (float)P->q1[i];
+        sweep_all(&W, W.q1, b, NULL);
         st->sweeps++;
         int zero = 1;
         for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
-        gmres(&W, b, phi, V, tmp, st, zero);
-        scatter(&W, phi, tmp, 1);
-        sweep_all(&W, tmp, phi, &st->leak);
-        st->sweeps++;
+        /* the last source iteration, phi + (b - A phi) = T (S phi + q1): from GMRES's own residual
+           (tmp), or by a sweep that also gives the leaving power */
+        if (gmres(&W, b, phi, V, tmp, st, zero) && !P->leak)
+            for (size_t i = 0; i < N; i++) phi[i] += tmp[i];
+        else {
+            scatter(&W, phi, 1);
+            sweep_all(&W, W.Q, phi, &st->leak);
+            st->sweeps++;
+        }
         for (size_t c = 0; c < W.cells; c++) st->emitted += P->q1[c * W.K] * sqrt(4 * ATMOS_PI);
         st->emitted *= P->h * P->h * P->h;
     }
-    for (int g = 0; g < DO_GROUPS; g++) free(W.acc[g]), free(W.psi[g]);
-    free(W.Y), free(W.o), free(V), free(b), free(tmp), free(W.live), free(W.need);
+    free(own.mem);
     return ok;
 }

@@ -32,6 +32,11 @@ typedef struct {
  * degree <= min(2 nmu - 1, nphi - 1) / 2 in each. Returns 0 when nmu * nphi > ATMOS__DO_NMAX. */
 int atmos__do_quadrature(int nmu, int nphi, atmos__do_quad *q);
 
+/* Buffers kept between solves (the pages of a large one touched once, not per solve). */
+typedef struct atmos__do_ws atmos__do_ws;
+atmos__do_ws *atmos__do_ws_create(void);
+void atmos__do_ws_free(atmos__do_ws *ws);
+
 typedef struct {
     int c[3];                   /* cells, the first axis fastest */
     double h;                   /* cell edge, m */
@@ -43,12 +48,16 @@ typedef struct {
     double R[3][3];             /* a direction's components along the cells' axes: R d */
     double tol;                 /* GMRES: relative residual */
     int max_iter, restart, threads;
+    int leak;                   /* 1: the last source iteration by a sweep, which gives the leaving
+                                   power; 0: from GMRES's residual, no sweep (stats' leak 0) */
+    atmos__do_ws *ws;           /* the buffers to use (grown as needed); NULL: the solve's own */
 } atmos__do_problem;
 
 typedef struct {
     int iters, sweeps;    /* GMRES iterations; sweeps of all the directions */
     double resid;         /* the last relative residual */
-    double leak, emitted; /* power leaving the grid, power of the first-order emission (per 1 of q1 units m^3) */
+    double leak;          /* power leaving the grid (with the problem's leak, else 0) */
+    double emitted;       /* power of the first-order emission (per 1 of q1 units m^3) */
 } atmos__do_stats;
 
 /* The radiance moments phi[cell * K + k], K = (L + 1)^2, of the orders >= 1 (phi on entry: the

@@ -48,9 +48,11 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                                 t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w];
                                 tau += np->col[v + f] * np->mc_sig_ms[f][w];
                             }
+                            at += t, as += sc;
+                            if (!(sc != 0)) continue; /* an empty voxel: no exponentials */
                             /* the voxel's mean of e^-tau along the sun about its centre, sinh(d/2)/(d/2) */
                             const double d = fmin(t * len, 2 * tau), m = d > 1e-6 ? sinh(0.5 * d) / (0.5 * d) : 1;
-                            at += t, as += sc, aq += sc * exp(-tau) * m;
+                            aq += sc * exp(-tau) * m;
                         }
                 st[c] = (float)(at * inv), ss[c] = (float)(as * inv), src[c] = aq * inv;
             }
@@ -58,7 +60,7 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
 
 atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L, const double chi[][4],
                                     const double sun_w[3], const double *E, int threads, float *coef,
-                                    atmos__nishita_do_info *info)
+                                    double *phi_all, int warm, atmos__do_ws *ws, atmos__nishita_do_info *info)
 {
     atmos__nishita_plan *np = p->nishita;
     const int n = np->n, K = (L + 1) * (L + 1);
@@ -81,14 +83,14 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
     atmos__vol_dir_to_frame(&np->x, lt, ltg);
     atmos__sh_eval(L, lt, Ys);
     float *st = malloc(sizeof(float) * cells * 4); /* this wavelength's sigma_t, sigma_s; the last one's */
-    double *src = malloc(sizeof(double) * cells * 2), *q1 = malloc(sizeof(double) * cells * K),
-           *phi = malloc(sizeof(double) * cells * K);
-    int ok = st && src && q1 && phi;
+    double *src = malloc(sizeof(double) * cells * 2), *q1 = malloc(sizeof(double) * cells * K);
+    int ok = st && src && q1;
     P.c[0] = F->c[0], P.c[1] = F->c[1], P.c[2] = F->c[2], P.h = F->s / (double)np->g.sc, P.L = L;
     P.sig_t = st, P.sig_s = st + cells, P.q1 = q1, P.quad = &quad;
-    P.tol = DO_TOL, P.max_iter = DO_MAX_ITER, P.restart = DO_RESTART, P.threads = threads;
+    P.tol = DO_TOL, P.max_iter = DO_MAX_ITER, P.restart = DO_RESTART, P.threads = threads, P.ws = ws;
     int w_last = -1; /* the wavelength whose solution phi holds */
     for (int w = 0; w < n && ok; w++) {
+        double *phi = phi_all + (size_t)w * cells * K;
         cell_medium(np, F, w, ltg, st, st + cells, src, threads);
         /* a wavelength whose medium and phase are the last one's (a grey cloud): its field is the
          * last one's times the ratio of the sunlight */
@@ -97,6 +99,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
             for (size_t c = 0; c < cells; c++)
                 for (int k = 0; k < K; k++)
                     coef[(c * n + w) * K + k] = (float)(coef[(c * n + w - 1) * K + k] * (E[w] / E[w - 1]));
+            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] = phi[i - cells * K] * (E[w] / E[w - 1]);
             continue;
         }
         memcpy(st + 2 * cells, st, sizeof(float) * cells * 2), memcpy(src + cells, src, sizeof(double) * cells);
@@ -107,10 +110,12 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
                 q1[c * K + k] = E[w] * src[c] * chi[w][l] * Ys[k];
             }
         /* the start: the last wavelength's solution times the ratio of the sunlight (the clouds are
-         * nearly grey), else 0 */
-        if (w_last >= 0 && E[w_last] > 0)
-            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] *= E[w] / E[w_last];
-        else
+         * nearly grey; 2 GMRES iterations on the Disney cloud where the last sun's takes 3), else
+         * with warm this wavelength's solution for the last sun (phi as it is), else 0 */
+        if (w_last >= 0 && E[w_last] > 0) {
+            const double *last = phi_all + (size_t)w_last * cells * K;
+            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] = last[i] * (E[w] / E[w_last]);
+        } else if (!warm)
             memset(phi, 0, sizeof(double) * cells * K);
         atmos__do_stats S;
         ok = atmos__do_solve(&P, phi, &S);
@@ -123,7 +128,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
         info->iters += S.iters, info->sweeps += S.sweeps;
         info->resid = fmax(info->resid, S.resid);
     }
-    free(st), free(src), free(q1), free(phi);
+    free(st), free(src), free(q1);
     info->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
     info->directions = quad.n;
     return ok ? ATMOS_OK : atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");

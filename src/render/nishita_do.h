@@ -2,6 +2,7 @@
 #ifndef ATMOS_RENDER_NISHITA_DO_H
 #define ATMOS_RENDER_NISHITA_DO_H
 
+#include "light/lfield_do.h"
 #include "render/nishita_internal.h"
 
 typedef struct {
@@ -12,9 +13,12 @@ typedef struct {
 
 /* The field's coefficients coef[(cell * n + w) * K + k], K = (L + 1)^2, for the sun sun_w
  * (world; E the sunlight per wavelength) by discrete ordinates on F's cells, chi[w] the
- * scattering's normalised Legendre moments; the sunlight's columns (np->col) made for this sun. */
+ * scattering's normalised Legendre moments; the sunlight's columns (np->col) made for this sun.
+ * phi[(w * cells + cell) * K + k]: the radiance moments solved, per wavelength; on entry with warm
+ * the last sun's, each wavelength's start (a warm start after a sun move), else ignored. ws: the
+ * solver's buffers, kept between suns (NULL: its own). */
 atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L, const double chi[][4],
                                     const double sun_w[3], const double *E, int threads, float *coef,
-                                    atmos__nishita_do_info *info);
+                                    double *phi, int warm, atmos__do_ws *ws, atmos__nishita_do_info *info);
 
 #endif

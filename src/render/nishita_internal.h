@@ -68,11 +68,12 @@ struct atmos__nishita_plan {
 /* The Monte Carlo field (nishita_mc.c): made once per plan (the path tracer's medium and phase
  * tables, cut at 3 degrees), filled per sun (and, toward one direction, per out_w: the light's
  * direction toward the eye), turned toward the eye at eye_w per frame (E: the sunlight per
- * wavelength), read by the eye rays. */
+ * wavelength), read by the eye rays. warm: the discrete-ordinates field after a sun move starts
+ * from the last sun's (the frame's warm_field). */
 atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np);
 void atmos__nishita_mc_free(atmos__nishita_mc *mc);
 atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], const double out_w[3],
-                                      const double eye_w[3], const double *E, int threads);
+                                      const double eye_w[3], const double *E, int threads, int warm);
 const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np);
 /* 1 when the Monte Carlo field is delta-M scaled (its photons saw sig*, not sig') */
 int atmos__nishita_mc_delta_m(const atmos__nishita_plan *np);

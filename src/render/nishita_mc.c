@@ -48,6 +48,9 @@ struct atmos__nishita_mc {
     int clip;            /* with delta_m: their phase the clipped scaled phase (ph_dm) instead */
     path_phase ph_dm;
     float *coef;         /* [(cell * n + w) * K + k]: the emission of orders >= 2 per unit sigma_s' */
+    double *do_phi;      /* with "do": the radiance moments per wavelength of the last sun (nishita_do.c) */
+    int do_phi_valid;    /* do_phi holds a solve's: the start of the next sun's with a warm field */
+    atmos__do_ws *do_ws; /* with "do": the solver's buffers, kept between suns */
     atmos__lfield field; /* L: its radiance toward the eye (cells of s render voxels) */
     double sun[3], out[3], eye[3];
     int valid, view_valid;
@@ -60,7 +63,8 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc)
     atmos__path_phase_free(&mc->ph);
     atmos__path_phase_free(&mc->ph_dm);
     atmos__lfield_free(&mc->field);
-    free(mc->coef);
+    free(mc->coef), free(mc->do_phi);
+    atmos__do_ws_free(mc->do_ws);
     free(mc);
 }
 
@@ -359,7 +363,7 @@ static atmos_status trace(atmos_plan *p, const double sun_w[3], const double out
 
 /* The same coefficients by discrete ordinates (nishita_do.c): chi_l per wavelength, the cut or
  * scaled phase's normalised moments mc->pl weighted by the fields' scattering in the grid. */
-static atmos_status solve(atmos_plan *p, const double sun_w[3], const double *E, int threads)
+static atmos_status solve(atmos_plan *p, const double sun_w[3], const double *E, int threads, int warm)
 {
     atmos__nishita_plan *np = p->nishita;
     atmos__nishita_mc *mc = np->mc;
@@ -380,9 +384,14 @@ static atmos_status solve(atmos_plan *p, const double sun_w[3], const double *E,
         memset(mc->coef, 0, sizeof(float) * (size_t)mc->field.c[0] * mc->field.c[1] * mc->field.c[2] * n * mc->K);
         return ATMOS_OK;
     }
+    const size_t cells = (size_t)mc->field.c[0] * mc->field.c[1] * mc->field.c[2];
+    if (!mc->do_ws) mc->do_ws = atmos__do_ws_create(); /* NULL: each solve its own */
+    if (!mc->do_phi && !(mc->do_phi = malloc(sizeof(double) * cells * n * mc->K)))
+        return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's moments");
     atmos__nishita_do_info info;
     const atmos_status st = atmos__nishita_do_fill(p, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E,
-                                                   threads, mc->coef, &info);
+                                                   threads, mc->coef, mc->do_phi, warm && mc->do_phi_valid, mc->do_ws, &info);
+    mc->do_phi_valid = st == ATMOS_OK;
     np->do_iters = info.iters, np->do_sweeps = info.sweeps, np->do_dirs = info.directions;
     np->do_resid = info.resid, np->do_cpu = info.cpu_s;
     return st;
@@ -420,14 +429,14 @@ static void view(atmos__nishita_plan *np, const double eye_w[3], int threads)
 }
 
 atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], const double out_w[3],
-                                      const double eye_w[3], const double *E, int threads)
+                                      const double eye_w[3], const double *E, int threads, int warm)
 {
     atmos__nishita_plan *np = p->nishita;
     atmos__nishita_mc *mc = np->mc;
     const int same_out = mc->lmax >= 0 || !memcmp(mc->out, out_w, sizeof mc->out);
     if (!mc->valid || memcmp(mc->sun, sun_w, sizeof mc->sun) || !same_out) {
         const double t0 = atmos__now();
-        atmos_status st = p->scene.nishita.do_field ? solve(p, sun_w, E, threads < 1 ? 1 : threads)
+        atmos_status st = p->scene.nishita.do_field ? solve(p, sun_w, E, threads < 1 ? 1 : threads, warm)
                                                     : trace(p, sun_w, out_w, E, threads < 1 ? 1 : threads);
         if (st != ATMOS_OK) return st;
         memcpy(mc->sun, sun_w, sizeof mc->sun), memcpy(mc->out, out_w, sizeof mc->out);

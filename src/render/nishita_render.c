@@ -218,7 +218,7 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
         if (!atmos_camera_ray(&v->cam, 0.5 * out->width, 0.5 * out->height, dc))
             return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render nishita: no central view direction");
         for (int a = 0; a < 3; a++) ot[a] = -dc[a];
-        if ((st = atmos__nishita_mc_update(p, v->sun, ot, v->cam.position, J.E, threads)) != ATMOS_OK) return st;
+        if ((st = atmos__nishita_mc_update(p, v->sun, ot, v->cam.position, J.E, threads, v->warm_field)) != ATMOS_OK) return st;
         J.mc = atmos__nishita_mc_field(np);
         J.tms = atmos__nishita_mc_delta_m(np);
     }

@@ -66,7 +66,7 @@ static void make_cloud(cloud *C, double omega, int threads, int max_iter)
             }
     P->sig_t = C->st, P->sig_s = C->ss, P->q1 = C->q1, P->quad = &C->q;
     P->R[0][0] = P->R[1][1] = P->R[2][2] = 1;
-    P->tol = 1e-6, P->max_iter = max_iter, P->restart = 30, P->threads = threads;
+    P->tol = 1e-6, P->max_iter = max_iter, P->restart = 30, P->threads = threads, P->leak = 1;
 }
 
 static void check_balance(cloud *C)
@@ -107,7 +107,8 @@ static void check_threads(cloud *C)
 
 /* The moments of the cells more than one cell from the cloud are left 0 (no scattering and no
  * trilinear read of the field where there is a medium reads them), those next to it not; a start
- * at the solution needs no GMRES iteration and gives the same leaving power. */
+ * at the solution needs no GMRES iteration (at a tolerance above the single precision's rounding)
+ * and gives the same leaving power. */
 static void check_needed_and_start(cloud *C)
 {
     atmos__do_stats S, S2;
@@ -119,11 +120,39 @@ static void check_needed_and_start(cloud *C)
     printf("  moments 2 cells from the cloud %.1e, next to it %.3e\n", far, near);
     CHECK(far == 0);
     CHECK(near > 0);
+    C->P.tol = 1e-5; /* the sweeps are in single precision: at the solution, their rounding's residual */
     CHECK(atmos__do_solve(&C->P, C->phi, &S2));
-    printf("  started at the solution: %d GMRES iterations, leaving power %.6f of the first start's\n", S2.iters,
-           S2.leak / S.leak);
+    printf("  started at the solution: %d GMRES iterations (residual %.1e), leaving power %.6f of the first "
+           "start's\n",
+           S2.iters, S2.resid, S2.leak / S.leak);
     CHECK(S2.iters == 0);
     CHECK(fabs(S2.leak / S.leak - 1) < 1e-5);
+}
+
+/* The last source iteration from GMRES's own residual (no sweep, the problem's leak 0) gives the
+ * moments the last sweep gives (within the sweeps' single precision), one sweep fewer: after 20 iterations without restart, and after
+ * 400 (converged) with restarts of 30. */
+static void check_last_iteration(cloud *C)
+{
+    static double phi1[NC * NC * NC * 16];
+    for (int t = 0; t < 2; t++) {
+        const int max_iter = t ? 400 : 20;
+        atmos__do_stats S, S2;
+        make_cloud(C, 1.0, 2, max_iter);
+        CHECK(atmos__do_solve(&C->P, C->phi, &S));
+        memcpy(phi1, C->phi, sizeof phi1);
+        make_cloud(C, 1.0, 2, max_iter);
+        C->P.leak = 0;
+        CHECK(atmos__do_solve(&C->P, C->phi, &S2));
+        double worst = 0, big = 0;
+        for (size_t i = 0; i < NC * NC * NC * 16; i++)
+            worst = fmax(worst, fabs(C->phi[i] - phi1[i])), big = fmax(big, fabs(phi1[i]));
+        printf("  the last iteration without a sweep (%d iterations at most): %d sweeps instead of %d, largest "
+               "difference %.1e of the largest moment\n",
+               max_iter, S2.sweeps, S.sweeps, worst / big);
+        CHECK(big > 0 && worst <= 1e-6 * big); /* the sweeps' single precision */
+        CHECK(S2.iters == S.iters && S2.sweeps == S.sweeps - 1);
+    }
 }
 
 int main(void)
@@ -132,7 +161,7 @@ int main(void)
     check_quadrature(4, 8);
     cloud *C = malloc(sizeof *C);
     CHECK(C != NULL);
-    if (C) check_balance(C), check_threads(C), check_needed_and_start(C);
+    if (C) check_balance(C), check_threads(C), check_needed_and_start(C), check_last_iteration(C);
     free(C);
     return test_summary("test_lfield_do");
 }

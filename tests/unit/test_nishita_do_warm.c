@@ -1,0 +1,140 @@
+/* The Nishita renderer's discrete-ordinates field warm-started after a sun move (render/nishita_do.c,
+ * the frame's warm_field; docs/lightfield.md "A discrete-ordinates field"): a dense ball lit by a
+ * sun at 40 degrees, then the sun moved 2 degrees in azimuth in the same plan. Started from the
+ * last sun's moments the solve takes fewer GMRES iterations than a fresh plan's for the same sun
+ * and gives its image within the solver's tolerance, much closer than the first sun's image is
+ * (so that the check can fail). */
+#include "test.h"
+
+#define N 24       /* voxels per axis */
+#define VS 50.0    /* m */
+#define SIGMA 1e-9 /* m^2 */
+
+static void make_optics(atmos_context *ctx, atmos_phase_table **t, atmos_volume_optics *o)
+{
+    atmos_particle_desc p;
+    memset(&p, 0, sizeof p);
+    snprintf(p.name, sizeof p.name, "hg");
+    p.kind = ATMOS_PARTICLE_ANALYTIC;
+    p.analytic.count = 1;
+    p.analytic.kind[0] = ATMOS_PHASE_HG;
+    p.analytic.g[0] = 0.85;
+    p.analytic.weight[0] = 1;
+    p.sigma_ext_m2 = SIGMA;
+    p.albedo = 1.0;
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_phase_table_desc td = {1};
+    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, t));
+    memset(o, 0, sizeof *o);
+    o->count = 1;
+    o->phase[0] = *t;
+}
+
+/* A ball of radius 10 voxels, one optical depth per voxel (20 across), in a grid of N^3. */
+static atmos_volume *ball(atmos_context *ctx)
+{
+    float *buf = calloc(N * N * N, sizeof(float));
+    for (int k = 0; k < N; k++)
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                const double x = i + 0.5 - 0.5 * N, y = j + 0.5 - 0.5 * N, z = k + 0.5 - 0.5 * N;
+                if (x * x + y * y + z * z < 100) buf[((size_t)k * N + j) * N + i] = (float)(1 / (SIGMA * VS));
+            }
+    const int dims[3] = {N, N, N};
+    const double org[3] = {-0.5 * N * VS, 1000, -0.5 * N * VS};
+    atmos_volume *v = test_dense_volume(ctx, dims, VS, org, "cloud", "hg", buf);
+    free(buf);
+    return v;
+}
+
+static double mean(const atmos_image *img)
+{
+    double s = 0;
+    for (int i = 0; i < img->width * img->height * img->channels; i++) s += img->pixels[i];
+    return s / (img->width * img->height * img->channels);
+}
+
+/* The mean absolute difference of a and b over b's mean. */
+static double rel_diff(const atmos_image *a, const atmos_image *b)
+{
+    double s = 0;
+    for (int i = 0; i < a->width * a->height * a->channels; i++) s += fabs(a->pixels[i] - b->pixels[i]);
+    return s / (a->width * a->height * a->channels) / mean(b);
+}
+
+/* The GMRES iterations of the frame's field (the image's atmos:nishita metadata), -1 if none. */
+static int iterations(const atmos_image *img)
+{
+    const char *m = atmos_image_get_meta(img, "atmos:nishita"), *at = m ? strstr(m, "directions, ") : NULL;
+    int it = -1;
+    if (!at || sscanf(at, "directions, %d GMRES", &it) != 1) return -1;
+    return it;
+}
+
+/* Renders frame f (its sun sun_az degrees in azimuth) with plan p into a new image. */
+static atmos_image *frame(atmos_context *ctx, atmos_plan *p, const atmos_scene *s, double sun_az, int warm)
+{
+    atmos_scene t = *s;
+    t.sun.azimuth_deg = sun_az;
+    atmos_frame f;
+    atmos_image *img = NULL;
+    CHECK_OK(atmos_frame_from_scene(ctx, &t, &f));
+    f.warm_field = warm;
+    CHECK_OK(atmos_plan_image_create(p, &f, &img));
+    if (img) CHECK_MSG(atmos_plan_render(p, &f, NULL, img, NULL) == ATMOS_OK, "render: %s", atmos_context_error(ctx));
+    return img;
+}
+
+int main(void)
+{
+    atmos_context *ctx = NULL;
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    d.threads = 2;
+    CHECK_OK(atmos_context_create(&d, &ctx));
+    atmos_phase_table *t = NULL;
+    atmos_volume_optics o;
+    make_optics(ctx, &t, &o);
+    atmos_volume *v = ball(ctx);
+    atmos_scene s;
+    test_vacuum_scene(&s, 40, 0);
+    s.sun.irradiance_count = 1, s.sun.irradiance[0] = 1.0;
+    s.width = s.height = 32;
+    const double pos[3] = {0, 1000 + 0.5 * N * VS, 6000}, look[3] = {0, 1000 + 0.5 * N * VS, 0};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s.camera);
+    for (int a = 0; a < 3; a++) s.camera.look_at[a] = look[a];
+    s.camera.fov_deg = 15;
+    s.renderer = ATMOS_RENDERER_NISHITA;
+    s.nishita.orders = 1, s.nishita.sky = 0;
+    s.nishita.mc_kphotons = 0, s.nishita.do_field = 1, s.nishita.mc_delta_m = 1, s.nishita.mc_cell = 2;
+    s.nishita.mc_lmax = 3;
+    atmos_plan_desc pd;
+    memset(&pd, 0, sizeof pd);
+    pd.optics = &o, pd.offset_given = 1;
+    atmos_plan *p = NULL, *q = NULL;
+    CHECK_OK(atmos_plan_create(ctx, &s, v, &pd, &p));
+    CHECK_OK(atmos_plan_create(ctx, &s, v, &pd, &q));
+    if (p && q) {
+        atmos_image *first = frame(ctx, p, &s, 0, 1), *warm = frame(ctx, p, &s, 2, 1), *fresh = frame(ctx, q, &s, 2, 0);
+        if (first && warm && fresh) {
+            const int i0 = iterations(first), iw = iterations(warm), ifr = iterations(fresh);
+            const double dw = rel_diff(warm, fresh), d0 = rel_diff(first, fresh);
+            printf("  sun moved 2 degrees: GMRES iterations %d warm-started, %d afresh (the first sun %d); the "
+                   "image %.1e from the fresh one's (mean absolute difference over its mean), the first sun's "
+                   "%.1e\n",
+                   iw, ifr, i0, dw, d0);
+            CHECK(ifr > 0 && iw >= 0 && iw < ifr);
+            CHECK(mean(fresh) > 0);
+            CHECK(dw < 2e-4); /* measured 1.2e-5 */
+            CHECK(d0 > 5 * dw);
+        } else
+            CHECK(0);
+        atmos_image_destroy(first), atmos_image_destroy(warm), atmos_image_destroy(fresh);
+    }
+    atmos_plan_destroy(p), atmos_plan_destroy(q);
+    atmos_volume_destroy(v);
+    atmos_phase_table_destroy(t);
+    atmos_context_destroy(ctx);
+    return test_summary("test_nishita_do_warm");
+}
