@@ -137,10 +137,14 @@ static int reserve(void **p, size_t *cap, size_t want, size_t size)
 int atmos__beams_epi_build(atmos__beams_epi *e, const atmos__beams_sun *s, const double eye[3], size_t max_samples,
                            int threads)
 {
-    e->lines = 0;
-    if (!s->n) return 0;
-    e->ex = (atmos__dot3(eye, s->right) - s->u0) / s->texel - 0.5;
-    e->ey = (atmos__dot3(eye, s->up) - s->v0) / s->texel - 0.5;
+    if (!s->n) {
+        e->lines = 0;
+        return 0;
+    }
+    const double ex = (atmos__dot3(eye, s->right) - s->u0) / s->texel - 0.5;
+    const double ey = (atmos__dot3(eye, s->up) - s->v0) / s->texel - 0.5;
+    if (e->lines && e->sun == s && e->gen == s->gen && e->ex == ex && e->ey == ey) return 0; /* the same lines */
+    e->lines = 0, e->ex = ex, e->ey = ey, e->sun = s, e->gen = s->gen;
     double R = 1;
     for (int k = 0; k < 4; k++) R = fmax(R, hypot(s->box[k & 1] - e->ex, s->box[2 + (k >> 1)] - e->ey));
     const double lines = ceil(2 * ATMOS_PI * R);
