@@ -2,6 +2,7 @@
  * trees, built once a frame, and a ray's walk down one line's tree. */
 #include "render/beams_epipolar.h"
 #include "render/beams_sun.h"
+#include "core/clones.h"
 #include "core/internal.h"
 #include "core/vec.h"
 
@@ -16,23 +17,6 @@ void atmos__beams_epi_free(atmos__beams_epi *e)
 {
     free(e->at), free(e->m);
     memset(e, 0, sizeof *e);
-}
-
-/* The depth of the map at look-up coordinates (fx, fy): the four nearest texels' depths blended
- * when all four hold an object, else the nearest texel's; INFINITY beside the map. */
-static float depth_at(const atmos__beams_sun *s, double fx, double fy)
-{
-    const int n = s->n;
-    if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return INFINITY;
-    const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1;
-    const double ax = fx - x0, ay = fy - y0;
-    const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
-    const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
-    const float *ra = s->depth + (size_t)ya * n, *rb = s->depth + (size_t)yb * n;
-    const float d00 = ra[xa], d01 = ra[xb], d10 = rb[xa], d11 = rb[xb];
-    if (d00 < INFINITY && d01 < INFINITY && d10 < INFINITY && d11 < INFINITY)
-        return (float)((1 - ay) * ((1 - ax) * d00 + ax * d01) + ay * ((1 - ax) * d10 + ax * d11));
-    return ay < 0.5 ? (ax < 0.5 ? d00 : d01) : (ax < 0.5 ? d10 : d11);
 }
 
 /* The cells of a tree over nseg segments: level 0 holds ceil(nseg / LEAF) of them, each level
@@ -68,13 +52,60 @@ static void clip(const double box[4], double ex, double ey, double c, double sn,
     *r0 = a, *r1 = b;
 }
 
+/* Samples i0 .. i0 + cnt - 1 (cnt <= CHUNK) of the line from (ex, ey) along (c, sn), first at k0
+ * texels: the depth of the map at each sample's look-up coordinates, the four nearest texels'
+ * depths blended when all four hold an object, else the nearest texel's; INFINITY beside the
+ * map. Three loops, the first and the last vectorised in the AVX2 clone: the coordinates and
+ * weights, the four texels' loads, their blend or the nearest one (the same IEEE operations in
+ * the same order as one sample at a time, and ISO C contracts no products: the same bits). */
+#define CHUNK 128
+#if defined(__GNUC__) && !defined(__clang__)
+/* comparisons that cannot trap (no FP exception is enabled here): lets GCC if-convert the
+ * loops' selects; the values are the same */
+#  define NO_TRAPS __attribute__((optimize("no-trapping-math")))
+#else
+#  define NO_TRAPS
+#endif
+ATMOS_CLONES_NOINLINE NO_TRAPS static void samples(const atmos__beams_sun *s, double ex, double ey, double c, double sn, int k0,
+                                          int i0, int cnt, float *restrict out)
+{
+    const int n = s->n;
+    double ax[CHUNK], ay[CHUNK];
+    int xa[CHUNK], xb[CHUNK], ya[CHUNK], yb[CHUNK], in[CHUNK];
+    float d[4][CHUNK];
+#pragma omp simd
+    for (int i = 0; i < cnt; i++) {
+        const double r = k0 + i0 + i, fx0 = ex + r * c, fy0 = ey + r * sn;
+        const int inside = (fx0 > -1) & (fx0 < n) & (fy0 > -1) & (fy0 < n);
+        const double fx = inside ? fx0 : 0, fy = inside ? fy0 : 0;
+        const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1;
+        ax[i] = fx - x0, ay[i] = fy - y0, in[i] = inside;
+        xa[i] = x0 < 0 ? 0 : x0, xb[i] = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
+        ya[i] = y0 < 0 ? 0 : y0, yb[i] = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
+    }
+    const float *depth = s->depth;
+    for (int i = 0; i < cnt; i++) {
+        const float *ra = depth + (size_t)ya[i] * n, *rb = depth + (size_t)yb[i] * n;
+        d[0][i] = ra[xa[i]], d[1][i] = ra[xb[i]], d[2][i] = rb[xa[i]], d[3][i] = rb[xb[i]];
+    }
+#pragma omp simd
+    for (int i = 0; i < cnt; i++) {
+        const float d00 = d[0][i], d01 = d[1][i], d10 = d[2][i], d11 = d[3][i];
+        const double bx = ax[i], by = ay[i];
+        const float blend = (float)((1 - by) * ((1 - bx) * d00 + bx * d01) + by * ((1 - bx) * d10 + bx * d11));
+        const float top = bx < 0.5 ? d00 : d01, bottom = bx < 0.5 ? d10 : d11, near = by < 0.5 ? top : bottom;
+        const int all = (d00 < INFINITY) & (d01 < INFINITY) & (d10 < INFINITY) & (d11 < INFINITY);
+        out[i] = !in[i] ? INFINITY : all ? blend : near;
+    }
+}
+
 /* Line j's samples and its tree. */
 static void fill(atmos__beams_epi *e, const atmos__beams_sun *s, int j)
 {
     const double th = j * e->dth, c = cos(th), sn = sin(th);
     const int cnt = e->cnt[j], k0 = e->k0[j];
     float *m = e->m + e->at[j], *lh = e->lh + 2 * e->tat[j]; /* a cell's least depth, then its greatest */
-    for (int i = 0; i < cnt; i++) m[i] = depth_at(s, e->ex + (k0 + i) * c, e->ey + (k0 + i) * sn);
+    for (int i = 0; i < cnt; i += CHUNK) samples(s, e->ex, e->ey, c, sn, k0, i, cnt - i < CHUNK ? cnt - i : CHUNK, m + i);
     const int nseg = cnt - 1;
     int c0 = (nseg + LEAF - 1) / LEAF;
     for (int i = 0; i < c0; i++) {
@@ -106,10 +137,14 @@ static int reserve(void **p, size_t *cap, size_t want, size_t size)
 int atmos__beams_epi_build(atmos__beams_epi *e, const atmos__beams_sun *s, const double eye[3], size_t max_samples,
                            int threads)
 {
-    e->lines = 0;
-    if (!s->n) return 0;
-    e->ex = (atmos__dot3(eye, s->right) - s->u0) / s->texel - 0.5;
-    e->ey = (atmos__dot3(eye, s->up) - s->v0) / s->texel - 0.5;
+    if (!s->n) {
+        e->lines = 0;
+        return 0;
+    }
+    const double ex = (atmos__dot3(eye, s->right) - s->u0) / s->texel - 0.5;
+    const double ey = (atmos__dot3(eye, s->up) - s->v0) / s->texel - 0.5;
+    if (e->lines && e->sun == s && e->gen == s->gen && e->ex == ex && e->ey == ey) return 0; /* the same lines */
+    e->lines = 0, e->ex = ex, e->ey = ey, e->sun = s, e->gen = s->gen;
     double R = 1;
     for (int k = 0; k < 4; k++) R = fmax(R, hypot(s->box[k & 1] - e->ex, s->box[2 + (k >> 1)] - e->ey));
     const double lines = ceil(2 * ATMOS_PI * R);

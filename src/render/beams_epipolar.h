@@ -24,10 +24,14 @@ typedef struct atmos__beams_epi {
     float *m, *lh;      /* depths along the lines (INFINITY beside every object); per tree cell its
                          * least and greatest depth, side by side */
     size_t cap_lines, cap_floats; /* the blocks' sizes, kept from frame to frame */
+    const atmos__beams_sun *sun;  /* the map the lines were made of, and its build (gen) */
+    unsigned long gen;
 } atmos__beams_epi;
 
 /* The lines of the map s from the eye: their number such that neighbours lie at most a texel
  * apart where the map's objects end (their blocks kept from the last call where large enough).
+ * Lines made by the last call of the same build of the same map from the same point (the eye
+ * turning in place) are kept as they are: the same values.
  * 0 (e without lines when s has no map or they would take more than max_samples samples), or
  * -1 out of memory. Threads: threads lines at a time. */
 int atmos__beams_epi_build(atmos__beams_epi *e, const atmos__beams_sun *s, const double eye[3], size_t max_samples,

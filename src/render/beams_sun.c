@@ -48,6 +48,7 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
                                     int nmesh, int size)
 {
     atmos__beams_sun_free(s);
+    s->gen++;
     for (int a = 0; a < 3; a++) s->dir[a] = dir[a], s->fwd[a] = -dir[a];
     const double ref[3] = {fabs(s->fwd[1]) < 0.9 ? 0 : 1, fabs(s->fwd[1]) < 0.9 ? 1 : 0, 0};
     atmos__cross3(s->fwd, ref, s->right);

@@ -39,6 +39,7 @@ typedef struct atmos__beams_sun {
     int n;
     float *depth;
     atmos__beams_tiles tiles;           /* the map's min/max pyramid */
+    unsigned long gen;                  /* counts the builds: what was made from the map knows it */
 } atmos__beams_sun;
 
 /* The map of the meshes seen from the sun dir (unit); size texels a side. */

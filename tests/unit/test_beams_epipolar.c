@@ -13,12 +13,16 @@
  *     along it); walked along the next line, an eighth of the shadowed rays at least miss so;
  *   - the fog's sunlight from the lines (atmos__beams_sun_airlight_lines) against the map's
  *     own steps at epsilon 1e-4 (atmos__beams_sun_airlight) on rays across the fence's
- *     shadows: within 2 % of the unshadowed whole a ray. */
+ *     shadows: within 2 % of the unshadowed whole a ray;
+ *   - lines kept from one build to the next (the eye turning in place) are a fresh build's,
+ *     and are made again when the map is (a post moved: the same epipole) or the eye moves. */
 #include "atmos/atmos.h"
 #include "render/beams_sun.h"
 #include "render/beams_epipolar.h"
 #include "core/vec.h"
 #include "test.h"
+
+#include <string.h>
 
 static atmos_context *ctx;
 
@@ -43,6 +47,47 @@ static double map_depth(const atmos__beams_sun *s, double fx, double fy)
 }
 
 static void add_length(void *u, double ra, double rb) { *(double *)u += rb - ra; }
+
+/* 1 when a's lines are b's: the same epipole, lines and samples. */
+static int same_lines(const atmos__beams_epi *a, const atmos__beams_epi *b)
+{
+    if (a->lines != b->lines || a->ex != b->ex || a->ey != b->ey || a->lines <= 0) return 0;
+    const int L = a->lines;
+    if (memcmp(a->k0, b->k0, sizeof(int) * L) || memcmp(a->cnt, b->cnt, sizeof(int) * L) ||
+        memcmp(a->at, b->at, sizeof(size_t) * L) || memcmp(a->tat, b->tat, sizeof(size_t) * L))
+        return 0;
+    return !memcmp(a->m, b->m, sizeof(float) * (a->at[L - 1] + (size_t)a->cnt[L - 1])) &&
+           !memcmp(a->lh, b->lh, sizeof(float) * 2 * a->tat[L - 1]);
+}
+
+/* Lines kept from the last build (the eye turning in place) only while they are what a fresh
+ * build gives: the same eye and map; the map made again with a post moved (the same box, so the
+ * same epipole: only the map's build tells); the eye moved. */
+static void test_kept_lines(atmos_mesh *post[10], atmos__beams_sun *s, const double sun[3], const double eye[3])
+{
+    atmos__beams_epi kept = {0}, fresh = {0};
+    CHECK(atmos__beams_epi_build(&kept, s, eye, (size_t)1 << 24, 2) == 0);
+    CHECK(atmos__beams_epi_build(&kept, s, eye, (size_t)1 << 24, 1) == 0);
+    CHECK(atmos__beams_epi_build(&fresh, s, eye, (size_t)1 << 24, 1) == 0);
+    CHECK_MSG(same_lines(&kept, &fresh), "the same eye and map: not a fresh build's lines");
+    atmos__beams_epi_free(&fresh);
+    const double ex = kept.ex, ey = kept.ey;
+    atmos_mesh_transform t;
+    atmos_mesh_transform_identity(&t);
+    t.position_m[0] = 2.5;
+    CHECK_OK(atmos_mesh_apply_transform(ctx, post[4], &t));
+    CHECK_OK(atmos__beams_sun_build(ctx, s, sun, post, 10, 256));
+    CHECK(atmos__beams_epi_build(&kept, s, eye, (size_t)1 << 24, 2) == 0);
+    CHECK(atmos__beams_epi_build(&fresh, s, eye, (size_t)1 << 24, 1) == 0);
+    CHECK(fresh.ex == ex && fresh.ey == ey); /* the same epipole */
+    CHECK_MSG(same_lines(&kept, &fresh), "a post moved, the map made again: not a fresh build's lines");
+    atmos__beams_epi_free(&fresh);
+    const double moved[3] = {eye[0] + 0.5, eye[1], eye[2]};
+    CHECK(atmos__beams_epi_build(&kept, s, moved, (size_t)1 << 24, 2) == 0);
+    CHECK(atmos__beams_epi_build(&fresh, s, moved, (size_t)1 << 24, 1) == 0);
+    CHECK_MSG(same_lines(&kept, &fresh), "the eye moved: not a fresh build's lines");
+    atmos__beams_epi_free(&fresh), atmos__beams_epi_free(&kept);
+}
 
 /* Nine posts 1.5 m square and 30 m high, 6 m apart, 60 m away, on a slab 80 m by 40 (post[9]);
  * the sun's map of them. */
@@ -152,6 +197,7 @@ int main(void)
             test_airlight(&s, &e, eye);
         }
         atmos__beams_epi_free(&e);
+        test_kept_lines(post, &s, sun, eye); /* last: it moves a post */
     }
     atmos__beams_sun_free(&s);
     for (int i = 0; i < 10; i++) atmos_mesh_destroy(post[i]);
