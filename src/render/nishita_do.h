@@ -13,8 +13,8 @@ typedef struct {
 /* The field's coefficients coef[(cell * n + w) * K + k], K = (L + 1)^2, for the sun sun_w
  * (world; E the sunlight per wavelength) by discrete ordinates on F's cells, chi[w] the
  * scattering's normalised Legendre moments; the sunlight's columns (np->col) made for this sun. */
-atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L, const double chi[][4],
-                                    const double sun_w[3], const double *E, int threads, float *coef,
-                                    atmos__nishita_do_info *info);
+atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
+                                    const double chi[][4], const double sun_w[3], const double *E, int threads,
+                                    float *coef, atmos__nishita_do_info *info);
 
 #endif
