@@ -33,7 +33,7 @@ DM=$([ "${DELTA_M:-0}" = 1 ] && echo "--nishita-mc-delta-m" || echo "")
 DO=$([ "${DO:-0}" = 1 ] && echo "--nishita-do" || echo "")
 DMC=$([ -n "$DM" ] && [ "${DM_CLIP:-0}" = 1 ] && echo "--nishita-mc-dm-clip" || echo "")
 if [ "${SLICE_DO:-0}" = 1 ]; then
-    TAG=${TAG:-sdo$CELL$([ "${EYE_SCALE:-1}" = 2 ] && echo aa)}
+    TAG=${TAG:-sdo$CELL$([ "${EYE_SCALE:-1}" = 2 ] && echo aa || echo "")}
     R="--slice-do -D nishita.mc_cell=$CELL${EYE_SCALE:+ --eye-scale $EYE_SCALE}"
 else
     TAG=${TAG:-$([ -n "$DO" ] && echo do || echo mc)${CELL}_$LMAX${DM:+dm}${DMC:+c}}
