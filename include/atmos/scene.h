@@ -92,6 +92,8 @@ typedef struct atmos_scene_slice {
     double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1] or 2; 1 */
     int max_order;            /* Ams orders tabulated; 64 */
     int diffuse;              /* 1: add the diffuse light field (the light Eq. 24/25 drop, by diffusion) */
+    int do_field;             /* "do", 1: instead, the first order in the delta-M scaled medium plus the
+                                 orders >= 2 by discrete ordinates (docs/lightfield.md); 0 */
     int air_shadows;          /* 1 (default): the volume shadows the air's single scattering
                                  (light shafts, crepuscular rays); 0: the air is lit unshadowed */
 } atmos_scene_slice;

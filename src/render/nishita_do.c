@@ -58,11 +58,11 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
             }
 }
 
-atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L, const double chi[][4],
-                                    const double sun_w[3], const double *E, int threads, float *coef,
-                                    double *phi_all, int warm, atmos__do_ws *ws, atmos__nishita_do_info *info)
+atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
+                                    const double chi[][4], const double sun_w[3], const double *E, int threads,
+                                    float *coef, double *phi_all, int warm, atmos__do_ws *ws,
+                                    atmos__nishita_do_info *info)
 {
-    atmos__nishita_plan *np = p->nishita;
     const int n = np->n, K = (L + 1) * (L + 1);
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     const clock_t c0 = clock();
@@ -71,7 +71,7 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
     atmos__do_problem P;
     memset(&P, 0, sizeof P);
     if (!atmos__do_quadrature(DO_NMU, DO_NPHI, &quad))
-        return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render nishita: no quadrature");
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render nishita: no quadrature");
     for (int j = 0; j < 3; j++) {
         double e[3] = {0, 0, 0}, r[3];
         e[j] = 1;
@@ -131,5 +131,5 @@ atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L
     free(st), free(src), free(q1);
     info->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
     info->directions = quad.n;
-    return ok ? ATMOS_OK : atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");
+    return ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");
 }

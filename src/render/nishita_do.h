@@ -17,8 +17,9 @@ typedef struct {
  * phi[(w * cells + cell) * K + k]: the radiance moments solved, per wavelength; on entry with warm
  * the last sun's, each wavelength's start (a warm start after a sun move), else ignored. ws: the
  * solver's buffers, kept between suns (NULL: its own). */
-atmos_status atmos__nishita_do_fill(atmos_plan *p, const atmos__lfield *F, int L, const double chi[][4],
-                                    const double sun_w[3], const double *E, int threads, float *coef,
-                                    double *phi, int warm, atmos__do_ws *ws, atmos__nishita_do_info *info);
+atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
+                                    const double chi[][4], const double sun_w[3], const double *E, int threads,
+                                    float *coef, double *phi, int warm, atmos__do_ws *ws,
+                                    atmos__nishita_do_info *info);
 
 #endif

@@ -24,6 +24,7 @@
 typedef struct atmos__nishita_mc atmos__nishita_mc;
 
 struct atmos__nishita_plan {
+    atmos_scene_nishita opt; /* its settings: the scene's, or the slice renderer's field's (nishita_do_plan) */
     int nf, n;
     sgrid g;                 /* the volume box-filtered onto the render grid (slice_grid.c) */
     atmos__vol_xform x;      /* the volume's placement */
@@ -65,6 +66,12 @@ struct atmos__nishita_plan {
     double do_resid, do_cpu;
 };
 
+/* A plan of the discrete-ordinates field alone (nishita_plan.c), the field of the slice renderer's
+ * "do" (slice_do.c): the optics, the render grid of at most cap voxels per axis (the slice
+ * renderer's own grid: the same box filter, the same voxels), the sunlight's columns and the field
+ * (atmos__nishita_mc_create: degree 3, delta-M, discrete ordinates), none of the orders 2-3. */
+atmos_status atmos__nishita_do_plan_create(atmos_plan *p, int cap, atmos__nishita_plan **out);
+
 /* The Monte Carlo field (nishita_mc.c): made once per plan (the path tracer's medium and phase
  * tables, cut at 3 degrees), filled per sun (and, toward one direction, per out_w: the light's
  * direction toward the eye), turned toward the eye at eye_w per frame (E: the sunlight per
@@ -72,11 +79,16 @@ struct atmos__nishita_plan {
  * from the last sun's (the frame's warm_field). */
 atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np);
 void atmos__nishita_mc_free(atmos__nishita_mc *mc);
-atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], const double out_w[3],
-                                      const double eye_w[3], const double *E, int threads, int warm);
+atmos_status atmos__nishita_mc_update(atmos_plan *p, atmos__nishita_plan *np, const double sun_w[3],
+                                      const double out_w[3], const double eye_w[3], const double *E, int threads,
+                                      int warm);
 const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np);
 /* 1 when the Monte Carlo field is delta-M scaled (its photons saw sig*, not sig') */
 int atmos__nishita_mc_delta_m(const atmos__nishita_plan *np);
+
+/* Appends the discrete-ordinates field's last solve (directions, iterations, sweeps, residual,
+ * cells, times) to buf as "; discrete-ordinates field, ..." (nishita_mc.c). */
+void atmos__nishita_do_describe(const atmos__nishita_plan *np, char *buf, size_t cap);
 
 /* The forward-peak truncation of the orders 2-3 (nishita_light.c): trunc[] from the fields'
  * mean phase function, the field's medium scaled (sig_s (1 - f), sig_t - f sig_s). */

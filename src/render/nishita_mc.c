@@ -24,6 +24,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -124,17 +125,17 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
         st = atmos__path_medium_build(ctx, p->volume, p->scene.volume.density_scale, p->offset, p->optics, n, &mc->med);
     if (st != ATMOS_OK) return st;
     atmos__path_medium_truncate(&mc->med, n, (const float(*)[ATMOS_MAX_WAVELENGTHS])mc->ph.trunc);
-    mc->lmax = p->scene.nishita.mc_lmax < 0 && p->scene.nishita.do_field ? 3 : p->scene.nishita.mc_lmax;
+    mc->lmax = np->opt.mc_lmax < 0 && np->opt.do_field ? 3 : np->opt.mc_lmax;
     mc->K = mc->lmax < 0 ? 1 : (mc->lmax + 1) * (mc->lmax + 1);
     legendre_moments(mc, np->nf, n);
     for (int f = 0; f < np->nf; f++)
         for (int w = 0; w < n; w++) np->mc_sig[f][w] = mc->med.sig[f][w];
-    mc->delta_m = p->scene.nishita.mc_delta_m && mc->lmax >= 0;
-    mc->clip = mc->delta_m && p->scene.nishita.mc_dm_clip && !p->scene.nishita.do_field; /* do traces no photons */
+    mc->delta_m = np->opt.mc_delta_m && mc->lmax >= 0;
+    mc->clip = mc->delta_m && np->opt.mc_dm_clip && !np->opt.do_field; /* do traces no photons */
     if (mc->delta_m && (st = delta_m(ctx, mc, np->nf, n)) != ATMOS_OK) return st;
     for (int f = 0; f < np->nf; f++)
         for (int w = 0; w < n; w++) np->mc_sig_ms[f][w] = mc->med.sig[f][w], np->mc_sca[f][w] = mc->med.sca[f][w];
-    const int s = p->scene.nishita.mc_cell;
+    const int s = np->opt.mc_cell;
     const sgrid *g = &np->g;
     if (!atmos__lfield_alloc(&mc->field, ATMOS__LFIELD_NONE, (g->c[0] + s - 1) / s, (g->c[1] + s - 1) / s,
                              (g->c[2] + s - 1) / s, n, s) ||
@@ -146,6 +147,17 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
 const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np) { return &np->mc->field; }
 
 int atmos__nishita_mc_delta_m(const atmos__nishita_plan *np) { return np->mc->delta_m; }
+
+void atmos__nishita_do_describe(const atmos__nishita_plan *np, char *buf, size_t cap)
+{
+    const atmos__lfield *F = &np->mc->field;
+    const size_t l = strlen(buf);
+    snprintf(buf + l, cap - l,
+             "; discrete-ordinates field, %d directions, %d GMRES iterations, %d sweeps (residual %.1e), "
+             "%dx%dx%d cells of %d voxels, %.3f s, %.3f s CPU",
+             np->do_dirs, np->do_iters, np->do_sweeps, np->do_resid, F->c[0], F->c[1], F->c[2], F->s, np->mc_s,
+             np->do_cpu);
+}
 
 /* The occupied box's faces lit by the sunlight travelling along lt (grid frame): each face's
  * area across the beam (area3, m^2) and their sum. */
@@ -306,9 +318,9 @@ static int cell_scattering(const atmos__nishita_plan *np, const atmos__nishita_m
 }
 
 /* The photons of one sun (and, for lmax -1, one direction toward the eye) into mc->coef. */
-static atmos_status trace(atmos_plan *p, const double sun_w[3], const double out_w[3], const double *E, int threads)
+static atmos_status trace(atmos_plan *p, atmos__nishita_plan *np, const double sun_w[3], const double out_w[3],
+                          const double *E, int threads)
 {
-    atmos__nishita_plan *np = p->nishita;
     atmos__nishita_mc *mc = np->mc;
     const atmos__lfield *F = &mc->field;
     const int n = np->n, K = mc->K;
@@ -326,7 +338,7 @@ static atmos_status trace(atmos_plan *p, const double sun_w[3], const double out
     double ltg[3];
     atmos__vol_dir_to_frame(&mc->med.x, M.lt, ltg);
     M.A = mc->med.empty ? 0 : box_area(&mc->med, ltg, M.area3);
-    const long long N = (long long)p->scene.nishita.mc_kphotons * 1000;
+    const long long N = (long long)np->opt.mc_kphotons * 1000;
     const uint64_t seed = p->scene.path.seed;
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
     for (long long i = 0; i < N * n; i++) {
@@ -363,9 +375,9 @@ static atmos_status trace(atmos_plan *p, const double sun_w[3], const double out
 
 /* The same coefficients by discrete ordinates (nishita_do.c): chi_l per wavelength, the cut or
  * scaled phase's normalised moments mc->pl weighted by the fields' scattering in the grid. */
-static atmos_status solve(atmos_plan *p, const double sun_w[3], const double *E, int threads, int warm)
+static atmos_status solve(atmos_plan *p, atmos__nishita_plan *np, const double sun_w[3], const double *E, int threads,
+                          int warm)
 {
-    atmos__nishita_plan *np = p->nishita;
     atmos__nishita_mc *mc = np->mc;
     const int n = np->n, nf = np->nf;
     double chi[ATMOS_MAX_WAVELENGTHS][4] = {{0}}, dens[PATH_F] = {0};
@@ -389,8 +401,9 @@ static atmos_status solve(atmos_plan *p, const double sun_w[3], const double *E,
     if (!mc->do_phi && !(mc->do_phi = malloc(sizeof(double) * cells * n * mc->K)))
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's moments");
     atmos__nishita_do_info info;
-    const atmos_status st = atmos__nishita_do_fill(p, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E,
-                                                   threads, mc->coef, mc->do_phi, warm && mc->do_phi_valid, mc->do_ws, &info);
+    const atmos_status st =
+        atmos__nishita_do_fill(p->ctx, np, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E, threads, mc->coef,
+                               mc->do_phi, warm && mc->do_phi_valid, mc->do_ws, &info);
     mc->do_phi_valid = st == ATMOS_OK;
     np->do_iters = info.iters, np->do_sweeps = info.sweeps, np->do_dirs = info.directions;
     np->do_resid = info.resid, np->do_cpu = info.cpu_s;
@@ -428,16 +441,16 @@ static void view(atmos__nishita_plan *np, const double eye_w[3], int threads)
             }
 }
 
-atmos_status atmos__nishita_mc_update(atmos_plan *p, const double sun_w[3], const double out_w[3],
-                                      const double eye_w[3], const double *E, int threads, int warm)
+atmos_status atmos__nishita_mc_update(atmos_plan *p, atmos__nishita_plan *np, const double sun_w[3],
+                                      const double out_w[3], const double eye_w[3], const double *E, int threads,
+                                      int warm)
 {
-    atmos__nishita_plan *np = p->nishita;
     atmos__nishita_mc *mc = np->mc;
     const int same_out = mc->lmax >= 0 || !memcmp(mc->out, out_w, sizeof mc->out);
     if (!mc->valid || memcmp(mc->sun, sun_w, sizeof mc->sun) || !same_out) {
         const double t0 = atmos__now();
-        atmos_status st = p->scene.nishita.do_field ? solve(p, sun_w, E, threads < 1 ? 1 : threads, warm)
-                                                    : trace(p, sun_w, out_w, E, threads < 1 ? 1 : threads);
+        atmos_status st = np->opt.do_field ? solve(p, np, sun_w, E, threads < 1 ? 1 : threads, warm)
+                                           : trace(p, np, sun_w, out_w, E, threads < 1 ? 1 : threads);
         if (st != ATMOS_OK) return st;
         memcpy(mc->sun, sun_w, sizeof mc->sun), memcpy(mc->out, out_w, sizeof mc->out);
         mc->valid = 1, mc->view_valid = 0;

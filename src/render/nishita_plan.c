@@ -51,11 +51,16 @@ static void cell_medium(atmos__nishita_plan *np)
     }
 }
 
-atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out)
+/* What every use of the plan shares: its settings, the optics, the render grid (at most cap
+ * voxels per axis) and the storage of the sunlight's columns. *out is set whenever it was
+ * allocated (the caller destroys it on an error). */
+static atmos_status plan_base(atmos_plan *p, const atmos_scene_nishita *opt, int cap, atmos__nishita_plan **out)
 {
     atmos_context *ctx = p->ctx;
     atmos__nishita_plan *np = calloc(1, sizeof *np);
+    *out = np;
     if (!np) return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory");
+    np->opt = *opt;
     np->nf = atmos_volume_field_count(p->volume), np->n = p->wl.count;
     atmos__vol_xform_init(p->volume, p->offset, &np->x);
     for (int f = 0; f < np->nf; f++) {
@@ -66,7 +71,35 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
             np->sig[f][w] = (float)se, np->sca[f][w] = (float)ss;
         }
     }
-    atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, GRID_CAP, &np->g);
+    atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, cap, &np->g);
+    if (st == ATMOS_OK && np->g.v &&
+        !(np->col = malloc(sizeof(float) * (size_t)np->g.c[0] * np->g.c[1] * np->g.c[2] * np->nf)))
+        st = atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the sunlight");
+    return st;
+}
+
+atmos_status atmos__nishita_do_plan_create(atmos_plan *p, int cap, atmos__nishita_plan **out)
+{
+    atmos_scene_nishita o = p->scene.nishita;
+    o.orders = 1, o.sky = 0, o.diffuse = 0, o.mc_kphotons = 0, o.mc_lmax = 3, o.mc_delta_m = 1, o.do_field = 1;
+    o.mc_dm_clip = 0;
+    atmos__nishita_plan *np;
+    atmos_status st = plan_base(p, &o, cap, &np);
+    if (st == ATMOS_OK && np->g.v) st = atmos__nishita_mc_create(p, np);
+    if (st != ATMOS_OK) {
+        atmos__nishita_plan_destroy(np);
+        return st;
+    }
+    *out = np;
+    return ATMOS_OK;
+}
+
+atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out)
+{
+    atmos_context *ctx = p->ctx;
+    atmos__nishita_plan *np;
+    atmos_status st = plan_base(p, &p->scene.nishita, GRID_CAP, &np);
+    if (!np) return st;
     if (st == ATMOS_OK && np->g.v) {
         const sgrid *g = &np->g;
         int big = g->c[0] > g->c[1] ? g->c[0] : g->c[1];
@@ -75,10 +108,8 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
         np->s = (big + cap - 1) / cap;
         const int cx = (g->c[0] + np->s - 1) / np->s, cy = (g->c[1] + np->s - 1) / np->s,
                   cz = (g->c[2] + np->s - 1) / np->s;
-        const size_t vox = (size_t)g->c[0] * g->c[1] * g->c[2];
-        np->col = malloc(sizeof(float) * vox * np->nf);
         np->fdens = malloc(sizeof(float) * (size_t)cx * cy * cz * np->nf);
-        if (!np->col || !np->fdens || !atmos__lmedium_alloc(&np->med, cx, cy, cz, np->n, np->s / (double)g->sc))
+        if (!np->fdens || !atmos__lmedium_alloc(&np->med, cx, cy, cz, np->n, np->s / (double)g->sc))
             st = atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the light field");
         else
             cell_medium(np), atmos__nishita_truncate(np);

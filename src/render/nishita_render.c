@@ -218,7 +218,7 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
         if (!atmos_camera_ray(&v->cam, 0.5 * out->width, 0.5 * out->height, dc))
             return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render nishita: no central view direction");
         for (int a = 0; a < 3; a++) ot[a] = -dc[a];
-        if ((st = atmos__nishita_mc_update(p, v->sun, ot, v->cam.position, J.E, threads, v->warm_field)) != ATMOS_OK) return st;
+        if ((st = atmos__nishita_mc_update(p, np, v->sun, ot, v->cam.position, J.E, threads, v->warm_field)) != ATMOS_OK) return st;
         J.mc = atmos__nishita_mc_field(np);
         J.tms = atmos__nishita_mc_delta_m(np);
     }
@@ -241,11 +241,7 @@ void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap)
         const atmos__lfield *F = atmos__nishita_mc_field(np);
         const size_t l = strlen(buf);
         if (s->do_field)
-            snprintf(buf + l, cap - l,
-                     "; discrete-ordinates field, %d directions, %d GMRES iterations, %d sweeps (residual %.1e), "
-                     "%dx%dx%d cells of %d voxels, %.3f s, %.3f s CPU",
-                     np->do_dirs, np->do_iters, np->do_sweeps, np->do_resid, F->c[0], F->c[1], F->c[2], F->s,
-                     np->mc_s, np->do_cpu);
+            atmos__nishita_do_describe(np, buf, cap);
         else
             snprintf(buf + l, cap - l, "; Monte Carlo field of %d thousand photons, %dx%dx%d cells of %d voxels, %.3f s",
                      s->mc_kphotons, F->c[0], F->c[1], F->c[2], F->s, np->mc_s);

@@ -174,11 +174,12 @@ static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob
     j->ds = (smax - smin) / j->nslices;
     j->he = atmos__dot3(j->h, j->eye);
     j->u0 = lf->u0, j->v0 = lf->v0, j->du = lf->du, j->dv = lf->dv;
-    j->low_albedo = sp->low_albedo;
+    /* with "do" the passes are low albedo's in the delta-M scaled medium (slice_do.c) */
+    j->low_albedo = sp->low_albedo || sp->do_field;
     j->eq24 = sp->eq24;
-    j->xi = sp->xi;
+    j->xi = sp->do_field ? 0.0f : sp->xi;
     j->g = g;
-    j->t = &sp->tab;
+    j->t = sp->do_field ? &sp->tab_dm : &sp->tab;
 }
 
 /* Points the job's per-pixel planes and spans into the plan's buffers, growing them when

@@ -38,8 +38,7 @@ typedef struct {
     double hl;                   /* h . lt */
     const sgrid *g;
     const stables *t;
-    const atmos__lfield *field;  /* the diffuse light field, or NULL */
-    const float (*fg)[ATMOS_MAX_WAVELENGTHS]; /* the fields' asymmetry g per wavelength */
+    const atmos__lfield *field;  /* the diffuse light field (or the do field's cells, slice_do.c), or NULL */
     const float *fview;          /* the field toward the frame's eye as the fast eye pass reads it:
                                     [(cell * nf + f) * fvq + c] (atmos__dfield_view) */
     int fvq;                     /* floats per cell and field: 4 for RGB (the fourth 0), else n */
@@ -135,6 +134,16 @@ struct atmos__slice_plan {
     /* The diffuse light field (dfield.c; "diffuse"). */
     int diffuse;
     atmos__dfield df;
+    /* "do" (slice_do.c): the first order in the delta-M scaled medium (the passes read tab_dm, the
+     * tables with sigma_t*, as in low albedo and without xi) and the orders >= 2 from the
+     * discrete-ordinates field of dop (a Nishita plan of that field alone, on the same render
+     * grid), turned toward the eye into do_view (the layout of df.view) */
+    int do_field;
+    atmos__nishita_plan *dop;
+    stables tab_dm;          /* tab, its sig[][] sigma_t* (the pointers tab's: not freed) */
+    float *do_view;
+    double do_sun[3];
+    int do_valid;
     /* The volume's shadow on the air ("air_shadows"; slice_shadow.c): the map, kept per sun
      * direction, the per-frame aerial-perspective table over the shadowed pixels (storage kept)
      * and the per-pixel front part (sjob.air_front; grown to the largest image). */
@@ -157,17 +166,14 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
                                      double *secs);
 void atmos__slice_shadow_free(atmos__slice_plan *sp);
 
-/* The diffuse field at render-voxel point (u, v, w), toward the frame's eye: per wavelength
- * its mean radiance L[c] and A[c] = 3/(4 pi) J . d, d the unit direction to the eye (from the
- * field's cells, atmos__lfield_toward); a medium of asymmetry g scatters L + g A toward the eye
- * (Eddington's two terms). */
-static inline void atmos__slice_field_at(const atmos__lfield *f, float u, float v, float w, float *L, float *A)
-{
-    float o[2 * ATMOS_MAX_WAVELENGTHS];
-    const int n = f->n;
-    atmos__lfield_sample(f, f->LA, 2 * n, u, v, w, o);
-    for (int c = 0; c < n; c++) L[c] = o[c], A[c] = o[n + c];
-}
+/* The discrete-ordinates field (slice_do.c): prepare once per plan (after the tables), update
+ * per frame (a solve when the sun moved, its view toward the eye; sets j->field, j->fview,
+ * j->fvq and, when it solved, tm->field), free with the plan, and its metadata line. */
+atmos_status atmos__slice_do_prepare(atmos_plan *p, atmos__slice_plan *sp);
+atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const atmos__view *v, sjob *j,
+                                    atmos_slice_timing *tm);
+void atmos__slice_do_free(atmos__slice_plan *sp);
+void atmos__slice_do_describe(const atmos__slice_plan *sp, char *buf, size_t cap);
 
 /* Slice indices k whose plane s_k = s0 + (k + 0.5) ds lies in [sa, sb] (k0 > k1: none). */
 void atmos__slice_range(double sa, double sb, double s0, double ds, int nslices, int *k0, int *k1);

@@ -51,8 +51,9 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
         int oi = (int)(mm - 1.0f);
         if (oi > no - 2) oi = no - 2;
         const float fo = mm - 1.0f - (float)oi;
-        float Ld[ATMOS_MAX_WAVELENGTHS], Ad[ATMOS_MAX_WAVELENGTHS];
-        if (j->field) atmos__slice_field_at(j->field, u, v, w, Ld, Ad);
+        /* the field toward the eye as the fast pass reads it (atmos__dfield_view, slice_do.c) */
+        float fv[ATMOS_VOLUME_MAX_FIELDS * (ATMOS_MAX_WAVELENGTHS + 4)];
+        if (j->field) atmos__lfield_sample(j->field, j->fview, nf * j->fvq, u, v, w, fv);
         for (int c = 0; c < n; c++) {
             float bext = 0, src = 0, dsrc = 0;
             for (int f = 0; f < nf; f++) {
@@ -60,7 +61,7 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
                 bext += dens[f] * j->t->sig[f][c];
                 float bs = dens[f] * j->t->sca[f][c];
                 if (bs > 0.0f) {
-                    if (j->field) dsrc += bs * (Ld[c] + j->fg[f][c] * Ad[c]);
+                    if (j->field) dsrc += dens[f] * fv[f * j->fvq + c];
                     const float *q = j->t->ams[f] + ((size_t)j->pa[p * nf + f] + (size_t)oi * n + c);
                     const size_t an = (size_t)no * n; /* next angle; next order: + n */
                     float lo = q[0] + fo * (q[n] - q[0]);

@@ -19,6 +19,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
     atmos__aerial_free(&sp->aerial);
     atmos__dfield_free(&sp->df);
+    atmos__slice_do_free(sp);
     atmos__slice_shadow_free(sp);
     free(sp);
 }
@@ -62,7 +63,8 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     sp->low_albedo = ss->low_albedo;
     sp->eq24 = ss->eq24;
     sp->xi = (float)ss->xi;
-    sp->diffuse = ss->diffuse && !ss->low_albedo;
+    sp->do_field = ss->do_field && !ss->low_albedo;
+    sp->diffuse = ss->diffuse && !ss->low_albedo && !sp->do_field;
     sp->reference = p->reference;
     sp->air_shadows = ss->air_shadows;
     atmos__vol_xform_init(p->volume, p->offset, &sp->x);
@@ -72,6 +74,7 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the light buffer");
     if (st == ATMOS_OK && sp->g.v && sp->diffuse)
         st = atmos__dfield_prepare(ctx, &sp->df, &sp->g, &sp->tab, &sp->x, p->optics, "render slice");
+    if (st == ATMOS_OK && sp->g.v && sp->do_field) st = atmos__slice_do_prepare(p, sp);
     if (st != ATMOS_OK) {
         atmos__slice_plan_destroy(sp);
         return st;
@@ -97,9 +100,12 @@ void atmos__slice_describe(const atmos_plan *p, const atmos__view *v, char *buf,
     int w, h;
     eye_size(v, &w, &h);
     const int slices = v->slices > 0 ? v->slices : p->slice->slices_used;
+    const int dof = p->slice->do_field; /* "do": no xi, the delta-M direct beam (slice_do.c) */
     snprintf(buf, cap, "%d slices%s, light buffer %d, eye buffer %dx%d, xi %g, %s%s", slices,
-             v->slices > 0 ? "" : " (chosen)", ss->light_size, w, h,
-             ss->xi, ss->eq24 ? "eq24" : "eq25", ss->low_albedo ? ", low albedo" : (ss->diffuse ? ", diffuse field" : ""));
+             v->slices > 0 ? "" : " (chosen)", ss->light_size, w, h, dof ? 0.0 : ss->xi,
+             dof ? "delta-M beam" : (ss->eq24 ? "eq24" : "eq25"),
+             ss->low_albedo ? ", low albedo" : (dof ? "" : (ss->diffuse ? ", diffuse field" : "")));
+    atmos__slice_do_describe(p->slice, buf, cap);
 }
 
 atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out,
@@ -126,13 +132,13 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
                 (st = atmos__dfield_update(ctx, &sp->df, p->atm, v->sun, v->warm_field, 0, &built)) != ATMOS_OK)
                 return st;
             j.field = &sp->df.field;
-            j.fg = (const float(*)[ATMOS_MAX_WAVELENGTHS])sp->df.fg;
             double eu[3]; /* the eye in render-voxel coordinates */
             for (int a = 0; a < 3; a++) eu[a] = j.eye[a] * sp->g.sc + sp->g.off[a];
             atmos__dfield_view(&sp->df, eu, atmos__threads(ctx));
             j.fview = sp->df.view, j.fvq = sp->df.vq;
             if (built) tm->field = sp->df.field.build_s, tm->field_sweeps = sp->df.field.sweeps;
         }
+        if (sp->do_field && (st = atmos__slice_do_update(p, sp, v, &j, tm)) != ATMOS_OK) return st;
         tm->setup = atmos__now() - t_setup;
         tm->prepare = sp->prepare_s;
         tm->eye_dims[0] = j.W, tm->eye_dims[1] = j.H;

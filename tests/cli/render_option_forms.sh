@@ -47,6 +47,7 @@ cat >"$T/table" <<'EOF'
 --eye-scale 0.5|slice.eye_scale=0.5|slice|
 --max-order 1|slice.max_order=1|slice|same
 --no-diffuse|slice.diffuse=false|slice|
+--slice-do|slice.do=true|slice|
 --no-air-shadows|slice.air_shadows=false|slice|
 --spp 3|path.spp=3|path|
 --time-budget 1000|path.time_budget_s=1000|path|same
