@@ -1,5 +1,5 @@
 /* A frame's display path in one pass (atmos_image_display_into): radiance -> linear sRGB ->
- * gamut map -> tone map -> display values, a row at a time so that each row stays in the
+ * gamut map -> tone map -> display values, a chunk of a row at a time so that it stays in the
  * cache (three passes over a 1280 x 720 frame took a quarter of the viewer's frame). The
  * per-pixel steps are those of atmos_image_to_srgb_into, atmos_image_gamut_map and
  * atmos_tonemap_into, in the same order: the same bits. */
@@ -109,6 +109,29 @@ static void bytes_row(const float *d, int width, unsigned char *out)
     }
 }
 
+/* A row's pixels a chunk at a time, so that the chunk's linear values and display values stay in
+ * the first-level cache between the steps (a whole 1280-pixel row's were 40 KB). */
+#define DISPLAY_CHUNK 128
+
+/* Chunk src of width pixels (C channels) to display values: linear sRGB + alpha in buf, its
+ * display values in buf + 4 DISPLAY_CHUNK, then to disp (floats) and rgba8 (bytes) where not NULL.
+ * Returns the count of the chunk's values that are NaN or infinite. */
+static unsigned display_chunk(const float *src, int width, int C, int n, int has_alpha, const float (*w)[3],
+                              atmos_tone_curve curve, float scale, float *buf, float *disp, unsigned char *rgba8)
+{
+    float *out = buf + (size_t)4 * DISPLAY_CHUNK;
+    unsigned b;
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
+    if (n == 3 && has_alpha) b = linear_row3a(src, width, w, buf);
+    else
+#endif
+        b = linear_row(src, width, C, n, has_alpha, w, buf);
+    atmos__tonemap_row(curve, buf, out, (size_t)width, 4, scale);
+    if (disp) stream_row(out, disp, width);
+    if (rgba8) bytes_row(out, width, rgba8);
+    return b;
+}
+
 /* atmos_image_display_into, and with check atmos_image_display_checked: the count of the frame's
  * NaN and infinite values from the rows' own loads, and the first of them (y W C + i, the least
  * over the rows: the same for any thread count). */
@@ -137,7 +160,7 @@ static atmos_status display_pass(atmos_context *ctx, const atmos_image *spectral
     long long first = LLONG_MAX;
 #pragma omp parallel num_threads(atmos__threads(ctx)) reduction(+ : bad) reduction(min : first)
     {
-        float *buf = malloc(sizeof(float) * 8 * (size_t)W);
+        float *buf = malloc(sizeof(float) * 8 * DISPLAY_CHUNK);
         if (!buf) {
 #pragma omp atomic write
             nomem = 1;
@@ -145,22 +168,18 @@ static atmos_status display_pass(atmos_context *ctx, const atmos_image *spectral
 #pragma omp for schedule(static)
         for (int y = 0; y < spectral->height; y++) {
             if (!buf) continue;
-            float *out = buf + (size_t)4 * W;
             const float *row = spectral->pixels + (size_t)y * W * C;
-            unsigned b;
-#if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
-            if (n == 3 && has_alpha) b = linear_row3a(row, W, (const float(*)[3])w, buf);
-            else
-#endif
-                b = linear_row(row, W, C, n, has_alpha, (const float(*)[3])w, buf);
+            unsigned b = 0;
+            for (int x0 = 0; x0 < W; x0 += DISPLAY_CHUNK)
+                b += display_chunk(row + (size_t)x0 * C, W - x0 < DISPLAY_CHUNK ? W - x0 : DISPLAY_CHUNK, C, n, has_alpha,
+                                   (const float(*)[3])w, curve, scale, buf,
+                                   disp ? disp->pixels + ((size_t)y * W + x0) * 4 : NULL,
+                                   rgba8 ? rgba8 + ((size_t)y * W + x0) * 4 : NULL);
             if (b && check) {
                 bad += b;
                 const long long at = (long long)y * W * C + (long long)atmos__first_not_finite(row, (size_t)W * C);
                 first = first < at ? first : at;
             }
-            atmos__tonemap_row(curve, buf, out, (size_t)W, 4, scale);
-            if (disp) stream_row(out, disp->pixels + (size_t)y * W * 4, W);
-            if (rgba8) bytes_row(out, W, rgba8 + (size_t)y * W * 4);
         }
 #if defined(__SSE2__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
         _mm_sfence(); /* the streamed rows visible before the barrier closing the region */

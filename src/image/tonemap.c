@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -12,7 +13,12 @@
  * over log(eps + Y) so that black pixels do not send it to zero. 1e-4 cd/m^2 is
  * below anything a renderer of daylight scenes produces but keeps the log finite. */
 #define LOG_AVG_EPSILON 1e-4
-#define SRGB_LUT 16384 /* intervals of the tabulated sRGB transfer function */
+/* The tabulated sRGB transfer function: SRGB_SEGS intervals an octave over SRGB_OCTAVES octaves
+ * below 1 (under them the function is linear: 12.92 x). */
+#define SRGB_SEG_BITS 7
+#define SRGB_SEGS (1 << SRGB_SEG_BITS)
+#define SRGB_OCTAVES 13
+#define SRGB_LUT (SRGB_OCTAVES * SRGB_SEGS)
 /* Middle grey: the key value the log average is mapped to. */
 #define KEY_VALUE 0.18
 
@@ -109,9 +115,13 @@ double atmos_tonemap_scale(const atmos_image *img, const atmos_tonemap_desc *des
     return scale * pow(2.0, ev);
 }
 
-/* The sRGB transfer function tabulated over [0, 1] (a curve's output) in floats, read linearly:
- * within 3.3e-6 of atmos_srgb_encode, a fifth of a 16-bit PNG's level (a frame of the viewer spent
- * a third of its time in pow() without it). Made once, by the first call. */
+/* The sRGB transfer function tabulated over [2^-13, 1] (a curve's output) in floats, read linearly
+ * in intervals of 1/128 of an octave: entry i is the value at 2^(i / 128 - 13) (1 + (i mod 128) / 128),
+ * found from the float's bits (exponent and the mantissa's first 7), the fraction from the
+ * mantissa's other 16 bits. Within 1.5e-6 of atmos_srgb_encode (a tenth of a 16-bit PNG's
+ * level; test_image's tonemap precision), in 6.7 KB that stay in the first-level cache (a table
+ * of 16 385 even steps, 64 KB, was within 3.3e-6 and did not: a sixth of the viewer's display
+ * pass). Made once, by the first call. */
 static float srgb_lut[SRGB_LUT + 2];
 static _Atomic int srgb_lut_ready;
 
@@ -120,7 +130,8 @@ static const float *srgb_table(void)
     if (atomic_load_explicit(&srgb_lut_ready, memory_order_acquire)) return srgb_lut;
 #pragma omp critical(atmos_srgb_lut)
     if (!atomic_load_explicit(&srgb_lut_ready, memory_order_relaxed)) {
-        for (int i = 0; i <= SRGB_LUT; i++) srgb_lut[i] = (float)atmos_srgb_encode((double)i / SRGB_LUT);
+        for (int i = 0; i <= SRGB_LUT; i++)
+            srgb_lut[i] = (float)atmos_srgb_encode(ldexp(1.0 + (double)(i % SRGB_SEGS) / SRGB_SEGS, i / SRGB_SEGS - SRGB_OCTAVES));
         srgb_lut[SRGB_LUT + 1] = srgb_lut[SRGB_LUT];
         atomic_store_explicit(&srgb_lut_ready, 1, memory_order_release);
     }
@@ -146,29 +157,71 @@ static inline __attribute__((always_inline)) float curve_of(atmos_tone_curve cur
     return y < 1.0f ? y : 1.0f;
 }
 
+/* A value of src scaled and through the curve: NaN and negatives 0. */
+static inline __attribute__((always_inline)) float tone_of(atmos_tone_curve curve, float v, float scale)
+{
+    const float x = v * scale;
+    return curve_of(curve, x > 0 ? x : 0.0f);
+}
+
+/* A curve's output v in [0, 1] sRGB encoded from the table: the entry from the float's exponent
+ * and first mantissa bits (below 2^-13, clamped to the first: the linear part 12.92 v is taken
+ * there), read linearly by the other bits; at most 1. Both branches computed, so that GCC
+ * vectorises the loops (the table read a gather). */
+static inline __attribute__((always_inline)) float encode_of(float v, const float *restrict enc)
+{
+    const union { float f; uint32_t u; } bits = {v};
+    const uint32_t b = bits.u;
+    const int k = (int)(b >> (23 - SRGB_SEG_BITS)) - ((127 - SRGB_OCTAVES) << SRGB_SEG_BITS), i = k > 0 ? k : 0;
+    const float t = (float)(b & ((1u << (23 - SRGB_SEG_BITS)) - 1)) * (1.0f / (1u << (23 - SRGB_SEG_BITS)));
+    const float l = enc[i] + t * (enc[i + 1] - enc[i]), e = v < 0x1p-13f ? 12.92f * v : l;
+    return e < 1.0f ? e : 1.0f;
+}
+
 /* Values [0, n) of src to display values in dst: scale, the curve (per channel: it desaturates
  * very bright colours towards white, as film does the sun's disk), the sRGB transfer function.
- * Inlined per curve: no branch on the curve in the loop (alpha is mapped too and set right
- * afterwards). In chunks of two loops, the curve's and the table's: GCC 12 vectorises each (the
- * table read a gather, given restrict) but not the two as one loop. */
+ * Inlined per curve: no branch on the curve in the loop. In chunks of two loops, the curve's and
+ * the table's: GCC 12 vectorises each (the table read a gather, given restrict) but not the two
+ * as one loop. */
 static inline __attribute__((always_inline)) void map_values(atmos_tone_curve curve, const float *restrict src,
                                                              float *restrict dst, size_t n, float scale,
                                                              const float *restrict enc)
 {
     enum { CHUNK = 256 };
-    float vb[CHUNK];
+    float vb[CHUNK], ve[CHUNK];
     for (size_t j0 = 0; j0 < n; j0 += CHUNK) {
         const size_t m = n - j0 < CHUNK ? n - j0 : CHUNK;
-        for (size_t j = 0; j < m; j++) {
-            float x = src[j0 + j] * scale;
-            x = x > 0 ? x : 0.0f; /* NaN and negatives: 0 */
-            vb[j] = curve_of(curve, x) * SRGB_LUT;
+        for (size_t j = 0; j < m; j++) vb[j] = tone_of(curve, src[j0 + j], scale);
+        for (size_t j = 0; j < m; j++) ve[j] = encode_of(vb[j], enc);
+        memcpy(dst + j0, ve, sizeof(float) * m);
+    }
+}
+
+/* map_values for `width` RGBA pixels, alpha clamped to [0, 1] and not mapped: the colours of a
+ * chunk of pixels split into three planes, each plane's values through the table, the planes
+ * and alpha interleaved again (each a vector loop; mapping alpha with the colours and setting it
+ * afterwards took a third more time). */
+static inline __attribute__((always_inline)) void map_rgba(atmos_tone_curve curve, const float *restrict src,
+                                                           float *restrict dst, size_t width, float scale,
+                                                           const float *restrict enc)
+{
+    enum { CHUNK = 64 };
+    float pl[3][CHUNK], pe[3][CHUNK];
+    for (size_t p0 = 0; p0 < width; p0 += CHUNK) {
+        const size_t m = width - p0 < CHUNK ? width - p0 : CHUNK;
+        const float *s = src + 4 * p0;
+        float *d = dst + 4 * p0;
+        for (size_t p = 0; p < m; p++) {
+            pl[0][p] = tone_of(curve, s[4 * p], scale);
+            pl[1][p] = tone_of(curve, s[4 * p + 1], scale);
+            pl[2][p] = tone_of(curve, s[4 * p + 2], scale);
         }
-        for (size_t j = 0; j < m; j++) {
-            const float v = vb[j];
-            const int i = (int)v;
-            const float e = enc[i] + (v - (float)i) * (enc[i + 1] - enc[i]);
-            dst[j0 + j] = e < 1.0f ? e : 1.0f;
+        for (int c = 0; c < 3; c++)
+            for (size_t p = 0; p < m; p++) pe[c][p] = encode_of(pl[c][p], enc);
+        for (size_t p = 0; p < m; p++) {
+            const float a = s[4 * p + 3];
+            d[4 * p] = pe[0][p], d[4 * p + 1] = pe[1][p], d[4 * p + 2] = pe[2][p];
+            d[4 * p + 3] = a > 0 ? (a < 1 ? a : 1.0f) : 0.0f;
         }
     }
 }
@@ -179,14 +232,15 @@ ATMOS_CLONES
 static void map_row(atmos_tone_curve curve, const float *src, float *dst, size_t width, int C, float scale,
                     const float *enc)
 {
+    if (C == 4) {
+        if (curve == ATMOS_TONE_REINHARD) map_rgba(ATMOS_TONE_REINHARD, src, dst, width, scale, enc);
+        else if (curve == ATMOS_TONE_CLAMP) map_rgba(ATMOS_TONE_CLAMP, src, dst, width, scale, enc);
+        else map_rgba(ATMOS_TONE_FILMIC, src, dst, width, scale, enc);
+        return;
+    }
     if (curve == ATMOS_TONE_REINHARD) map_values(ATMOS_TONE_REINHARD, src, dst, width * C, scale, enc);
     else if (curve == ATMOS_TONE_CLAMP) map_values(ATMOS_TONE_CLAMP, src, dst, width * C, scale, enc);
     else map_values(ATMOS_TONE_FILMIC, src, dst, width * C, scale, enc);
-    if (C == 4)
-        for (size_t p = 0; p < width; p++) {
-            const float a = src[4 * p + 3];
-            dst[4 * p + 3] = a > 0 ? (a < 1 ? a : 1.0f) : 0.0f;
-        }
 }
 
 void atmos__tonemap_row(atmos_tone_curve curve, const float *src, float *dst, size_t width, int C, float scale)

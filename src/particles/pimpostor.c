@@ -99,35 +99,57 @@ atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, con
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* Pixel row y of the frame: the impostor over [x0, x1). The pixel's ray F + v U + u R meets
- * the impostor's plane (through c, normal nrm) at s = ce / (d . nrm) along it, and that point
- * seen from the impostor's camera is a quotient of functions linear in u: their coefficients
- * once per row. */
+/* A frame row's rays against an impostor: the point where pixel x's ray F + v U + u R meets the
+ * impostor's plane (through c, normal nrm), at s = ce / (d . nrm) along it, seen from the
+ * impostor's camera is a quotient of functions linear in u, these its coefficients. */
+typedef struct row_coef {
+    double W, H, t, R, fk, ce, bn, rn, px, py, pz, bx, by, bz, rx, ry, rz;
+} row_coef;
+
+enum { ROW_CHUNK = 128 };
+
+/* The texel coordinates (tx, ty) of pixels [x0, x0 + n) of the row (n <= ROW_CHUNK), and ok[i]
+ * 0 where the pixel's ray misses the texture (parallel to the plane, the plane behind the eye or
+ * behind the impostor's camera, outside the texels). Every pixel's values computed, then
+ * selected: one vector loop (4 pixels a vector in the AVX2 clone), the same operations in the
+ * same order, so the same bits, as a pixel at a time. */
+ATMOS_CLONES
+static void row_texels(const row_coef *k, int x0, int n, double *restrict tx, double *restrict ty, double *restrict ok)
+{
+    const double W = k->W, H = k->H, t = k->t, R = k->R, fk = k->fk, ce = k->ce, bn = k->bn, rn = k->rn;
+    const double px = k->px, py = k->py, pz = k->pz, bx = k->bx, by = k->by, bz = k->bz, rx = k->rx, ry = k->ry,
+                 rz = k->rz;
+    for (int i = 0; i < n; i++) {
+        const double u = (2.0 * (x0 + i + 0.5) - W) / H * t, dn = bn + u * rn;
+        const double s = ce / dn, Z = pz + s * (bz + u * rz), q = fk / Z;
+        const double a = 0.5 * R + q * (px + s * (bx + u * rx)) - 0.5, b = 0.5 * R - q * (py + s * (by + u * ry)) - 0.5;
+        const int in = fabs(dn) > 1e-12 && !(s <= 0) && Z > 0 && !(a < -0.5 || b < -0.5 || a > R - 0.5 || b > R - 0.5);
+        tx[i] = a, ty[i] = b, ok[i] = in ? 1.0 : 0.0;
+    }
+}
+
+/* Pixel row y of the frame: the impostor over [x0, x1), a chunk of pixels' texel coordinates at
+ * a time (row_texels), then each pixel that reads the texture composited. */
 static void draw_row(const atmos__pimpostor *im, const double c[3], const double nrm[3], const atmos_camera *cam, int y,
                      int x0, int x1, atmos_image *img)
 {
     const int C = img->channels, R = im->res;
     const atmos_camera *k = &im->cam;
-    const double W = cam->width, H = cam->height, t = cam->tan_half_fov, v = (H - 2.0 * (y + 0.5)) / H * t;
-    const double fk = k->height / (2.0 * k->tan_half_fov);
+    const double H = cam->height, t = cam->tan_half_fov, v = (H - 2.0 * (y + 0.5)) / H * t;
     double B[3], P[3], cr[3];
     for (int i = 0; i < 3; i++)
         B[i] = cam->forward[i] + v * cam->up[i], P[i] = cam->position[i] - k->position[i], cr[i] = c[i] - cam->position[i];
-    const double ce = dot3(cr, nrm), bn = dot3(B, nrm), rn = dot3(cam->right, nrm);
-    const double px = dot3(P, k->right), py = dot3(P, k->up), pz = dot3(P, k->forward);
-    const double bx = dot3(B, k->right), by = dot3(B, k->up), bz = dot3(B, k->forward);
-    const double rx = dot3(cam->right, k->right), ry = dot3(cam->right, k->up), rz = dot3(cam->right, k->forward);
-    for (int x = x0; x < x1; x++) {
-        const double u = (2.0 * (x + 0.5) - W) / H * t, dn = bn + u * rn;
-        if (!(fabs(dn) > 1e-12)) continue;
-        const double s = ce / dn;
-        if (s <= 0) continue;
-        const double Z = pz + s * (bz + u * rz);
-        if (!(Z > 0)) continue;
-        const double q = fk / Z, tx = 0.5 * R + q * (px + s * (bx + u * rx)) - 0.5,
-                     ty = 0.5 * R - q * (py + s * (by + u * ry)) - 0.5;
-        if (tx < -0.5 || ty < -0.5 || tx > R - 0.5 || ty > R - 0.5) continue;
-        atmos__pcloud_over(im->img->pixels, R, R, C, tx, ty, img->pixels + ((size_t)y * cam->width + x) * C);
+    const row_coef rc = {cam->width, H, t, R, k->height / (2.0 * k->tan_half_fov), dot3(cr, nrm), dot3(B, nrm),
+                         dot3(cam->right, nrm), dot3(P, k->right), dot3(P, k->up), dot3(P, k->forward),
+                         dot3(B, k->right), dot3(B, k->up), dot3(B, k->forward), dot3(cam->right, k->right),
+                         dot3(cam->right, k->up), dot3(cam->right, k->forward)};
+    double tx[ROW_CHUNK], ty[ROW_CHUNK], ok[ROW_CHUNK];
+    float *row = img->pixels + (size_t)y * cam->width * C;
+    for (int xa = x0; xa < x1; xa += ROW_CHUNK) {
+        const int n = x1 - xa < ROW_CHUNK ? x1 - xa : ROW_CHUNK;
+        row_texels(&rc, xa, n, tx, ty, ok);
+        for (int i = 0; i < n; i++)
+            if (ok[i] != 0.0) atmos__pcloud_over(im->img->pixels, R, R, C, tx[i], ty[i], row + (size_t)(xa + i) * C);
     }
 }
 

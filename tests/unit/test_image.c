@@ -735,8 +735,9 @@ static float tm_one(atmos_tone_curve curve, float v)
 }
 
 /* The tone map against the curves and the sRGB transfer function in double precision (the
- * formulas written out here): within 4e-6 over 1e-5 .. 1e5 times the exposure's scale, every
- * curve; atmos_tonemap_into gives the same pixels as atmos_tonemap. */
+ * formulas written out here): within 2e-6 (the sRGB table read linearly: 1.5e-6; its 16 385 even
+ * steps were 3.3e-6) over 1e-5 .. 1e5 times the exposure's scale, every curve; atmos_tonemap_into
+ * gives the same pixels as atmos_tonemap. */
 static double curve_ref(atmos_tone_curve curve, double x)
 {
     double y = curve == ATMOS_TONE_REINHARD ? x / (1 + x)
@@ -764,7 +765,7 @@ static void test_tonemap_precision(void)
             for (int c = 0; c < 3; c++)
                 worst = fmax(worst, fabs(out->pixels[4 * i + c] - curve_ref(curves[k], img->pixels[4 * i + c] * scale)));
         printf("tone curve %d: largest difference from double precision %.2g\n", k, worst);
-        CHECK_NEAR(worst, 0, 4e-6);
+        CHECK_NEAR(worst, 0, 2e-6);
         CHECK(out && !memcmp(out->pixels, into->pixels, sizeof(float) * 4 * (size_t)n));
         atmos_image_destroy(out);
     }
