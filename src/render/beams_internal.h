@@ -6,6 +6,7 @@
 #ifndef ATMOS_RENDER_BEAMS_INTERNAL_H
 #define ATMOS_RENDER_BEAMS_INTERNAL_H
 
+#include "core/vec.h"
 #include "light/lamp.h"
 #include "render/objects.h"
 #include "render/beams_kept.h"
@@ -32,7 +33,7 @@
 typedef struct atmos__beams_table {
     int nt, nx;
     double x_max;
-    double *w;               /* nx rows of nt values */
+    double *w;               /* nt nodes in s of nx values (one a row in x) */
 } atmos__beams_table;
 
 atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, const atmos__fog_optics *phase,
@@ -40,13 +41,24 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
 void atmos__beams_table_free(atmos__beams_table *t);
 
 /* The four rows and their weights for one x (a ray and a light): W at any theta is then
- * atmos__beams_table_at. */
+ * atmos__beams_table_at. The table is stored node by node in s (each node's nx values of x
+ * side by side), so a look-up reads its four rows' values at two nodes from two places. */
 typedef struct atmos__beams_column {
-    const double *row[4];
+    const double *col;       /* the first of the four rows' values at node 0 (node i: i nx further) */
     double wt[4];
 } atmos__beams_column;
 void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__beams_column *c);
-double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s);
+/* W at s for the column c (linear in s between the nodes, the column's cubic weights). */
+static inline double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s)
+{
+    const double f = atmos__clampd((s + 1) * (0.5 * (t->nt - 1)), 0, t->nt - 1);
+    int i = (int)f;
+    if (i > t->nt - 2) i = t->nt - 2;
+    const double a = f - i, *p = c->col + (size_t)i * (size_t)t->nx, *q = p + t->nx;
+    double v = 0;
+    for (int k = 0; k < 4; k++) v += c->wt[k] * (p[k] + a * (q[k] - p[k]));
+    return v;
+}
 /* The table's coordinate of the point u along a ray passing at v from the light. */
 static inline double atmos__beams_table_s(double u, double v) { return u / ((u < 0 ? -u : u) + v); }
 
