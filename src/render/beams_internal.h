@@ -33,7 +33,7 @@
 typedef struct atmos__beams_table {
     int nt, nx;
     double x_max;
-    double *w;               /* nt nodes in s of nx values (one a row in x) */
+    double *w;               /* nx rows of nt values */
 } atmos__beams_table;
 
 atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, const atmos__fog_optics *phase,
@@ -41,22 +41,21 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
 void atmos__beams_table_free(atmos__beams_table *t);
 
 /* The four rows and their weights for one x (a ray and a light): W at any theta is then
- * atmos__beams_table_at. The table is stored node by node in s (each node's nx values of x
- * side by side), so a look-up reads its four rows' values at two nodes from two places. */
+ * atmos__beams_table_at. */
 typedef struct atmos__beams_column {
-    const double *col;       /* the first of the four rows' values at node 0 (node i: i nx further) */
+    const double *row[4];
     double wt[4];
 } atmos__beams_column;
 void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__beams_column *c);
-/* W at s for the column c (linear in s between the nodes, the column's cubic weights). */
+/* W at s for the column c (linear in s between the nodes, the column's cubic weights); inline. */
 static inline double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s)
 {
     const double f = atmos__clampd((s + 1) * (0.5 * (t->nt - 1)), 0, t->nt - 1);
     int i = (int)f;
     if (i > t->nt - 2) i = t->nt - 2;
-    const double a = f - i, *p = c->col + (size_t)i * (size_t)t->nx, *q = p + t->nx;
+    const double a = f - i;
     double v = 0;
-    for (int k = 0; k < 4; k++) v += c->wt[k] * (p[k] + a * (q[k] - p[k]));
+    for (int k = 0; k < 4; k++) v += c->wt[k] * (c->row[k][i] + a * (c->row[k][i + 1] - c->row[k][i]));
     return v;
 }
 /* The table's coordinate of the point u along a ray passing at v from the light. */

@@ -46,14 +46,14 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
 #pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
     for (int j = 0; j < nx; j++) {
         const double w = (double)j / (nx - 1), x = t->x_max * w * w;
-        double *col = t->w + j, acc = 0; /* node i's value: col[i nx] */
+        double *row = t->w + (size_t)j * nt, acc = 0;
         double f0 = ph[0]; /* tan = 0 at theta = -pi/2 */
-        col[0] = 0;
+        row[0] = 0;
         for (int i = 0; i + 1 < nt; i++) {
             const double fm = ph[2 * i + 1] * exp(-x * tn[2 * i + 1]);
             const double f1 = x > 0 ? (isinf(tn[2 * i + 2]) ? 0 : ph[2 * i + 2] * exp(-x * tn[2 * i + 2])) : ph[2 * i + 2];
             acc += h[i] / 6 * (f0 + 4 * fm + f1);
-            col[(size_t)(i + 1) * nx] = acc;
+            row[i + 1] = acc;
             f0 = f1;
         }
     }
@@ -73,5 +73,5 @@ void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__bea
     c->wt[1] = s * (s - 2) * (s - 3) / 2;
     c->wt[2] = -s * (s - 1) * (s - 3) / 2;
     c->wt[3] = s * (s - 1) * (s - 2) / 6;
-    c->col = t->w + j0;
+    for (int k = 0; k < 4; k++) c->row[k] = t->w + (size_t)(j0 + k) * t->nt;
 }
