@@ -6,6 +6,7 @@
 #ifndef ATMOS_RENDER_BEAMS_INTERNAL_H
 #define ATMOS_RENDER_BEAMS_INTERNAL_H
 
+#include "core/vec.h"
 #include "light/lamp.h"
 #include "render/objects.h"
 #include "render/beams_kept.h"
@@ -46,7 +47,17 @@ typedef struct atmos__beams_column {
     double wt[4];
 } atmos__beams_column;
 void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__beams_column *c);
-double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s);
+/* W at s for the column c (linear in s between the nodes, the column's cubic weights); inline. */
+static inline double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s)
+{
+    const double f = atmos__clampd((s + 1) * (0.5 * (t->nt - 1)), 0, t->nt - 1);
+    int i = (int)f;
+    if (i > t->nt - 2) i = t->nt - 2;
+    const double a = f - i;
+    double v = 0;
+    for (int k = 0; k < 4; k++) v += c->wt[k] * (c->row[k][i] + a * (c->row[k][i + 1] - c->row[k][i]));
+    return v;
+}
 /* The table's coordinate of the point u along a ray passing at v from the light. */
 static inline double atmos__beams_table_s(double u, double v) { return u / ((u < 0 ? -u : u) + v); }
 

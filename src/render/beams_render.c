@@ -23,7 +23,8 @@
  * the planes sit at a pixel's own offset, and the airlight is filtered over N x N pixels.
  * With beams/screen_step k > 1 (beams_screen.h) the airlight (the lights' and the sun's) is
  * evaluated on a lattice of every k-th pixel and interpolated across the cells where that is
- * safe (a cell that a light's screen span crosses is always cut: the lit cones' hint), the surfaces
+ * safe (a cell that a light's screen span crosses is always cut, unless the span is many cells
+ * wide there: the lit cones' hint), the surfaces
  * still per pixel, the sky behind from the sky renderer's grid of every k-th pixel (at most 4).
  * Rows go to the threads; each pixel depends on nothing but its own ray (or its band of the
  * lattice), so the image does not depend on the thread count. */
@@ -595,6 +596,10 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
 #ifndef SCREEN_HINT
 #define SCREEN_HINT 1
 #endif
+/* A span this many cells' widths wide (or more) in every row of a cell is not its hint there. */
+#ifndef SCREEN_WIDE
+#define SCREEN_WIDE 8
+#endif
 
 /* The eye's ray through pixel (x, y) in a subsampled frame: kept from the first pass (J->dir) when
  * there is one, the same bits as eye_ray's. */
@@ -728,7 +733,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     J->dir = q.dir, J->dir_r = *r;
     const atmos__beams_screen s = {*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base,
                                    SCREEN_HINT ? J->span : NULL, SCREEN_HINT ? J->b->nlights : 0, J->cam->height,
-                                   air_pixel, J};
+                                   SCREEN_WIDE, air_pixel, J};
     long ev = 0;
 #pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev)
     {

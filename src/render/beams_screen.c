@@ -67,15 +67,22 @@ static int holds(const atmos__beams_screen *s, const int *sp, int y, int x0, int
 /* Whether a light's span touches the cell [x0, x1] x [y0, y1] without holding its corners'
  * rows a cell's width beyond it on either side (beams_screen.h): then its beam may lie between
  * the corners (a span is wider than its beam by a pixel or two each side), or its edge cross the
- * cell. */
+ * cell. A span wider than s->wide cells' widths in every row of the cell is left out: its beam's
+ * screen image is convex, so it cannot hide between the corners, and its edge across the cell
+ * leaves a corner or a tested point on each side, for the tests of agree() to find (a row where
+ * the span ends or is empty counts as narrow: its tip or its end may be in the cell). */
 static int crossed(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
 {
     const int m = x1 - x0 > y1 - y0 ? x1 - x0 : y1 - y0;
     for (int i = 0; i < s->nspan; i++) {
         const int *sp = s->span + 2 * (size_t)i * s->span_h;
         if (holds(s, sp, y0, x0, x1, m) && holds(s, sp, y1, x0, x1, m)) continue; /* well inside */
-        for (int y = y0; y <= y1; y++)
-            if (sp[2 * y] <= x1 && sp[2 * y + 1] > x0 && sp[2 * y + 1] > sp[2 * y]) return 1;
+        int touches = 0, narrow = !(s->wide > 0);
+        for (int y = y0; y <= y1; y++) {
+            touches |= sp[2 * y] <= x1 && sp[2 * y + 1] > x0 && sp[2 * y + 1] > sp[2 * y];
+            narrow |= sp[2 * y + 1] - sp[2 * y] < s->wide * m;
+        }
+        if (touches && narrow) return 1;
     }
     return 0;
 }

@@ -9,7 +9,10 @@
  * quarter by quarter from them (its quarters' centres not evaluated). A cell that a light's
  * span (the screen image of its lit cone) touches without holding its corners' rows a cell's
  * width beyond it on either side is always cut: a beam narrower than the cell, between its
- * corners, or an edge of a beam across it, is found without a node on it. The surfaces' direct
+ * corners, or an edge of a beam across it, is found without a node on it; unless the span is
+ * many cells wide in every row of the cell (wide): the screen image of a beam is convex, so a
+ * wide one cannot pass between the corners, and its edge leaves a tested point on each side
+ * for the other tests to find (a row where the span ends counts as narrow). The surfaces' direct
  * light stays per pixel (the caller's). Not part of the API. */
 #ifndef ATMOS_RENDER_BEAMS_SCREEN_H
 #define ATMOS_RENDER_BEAMS_SCREEN_H
@@ -38,6 +41,8 @@ typedef struct atmos__beams_screen {
      * is 0 (the screen image of a hull of its lit part, convex per row); NULL: none. */
     const int *span;
     int nspan, span_h;
+    int wide;                 /* a span at least this many cells' widths wide in each of a cell's
+                               * rows is not its hint there (0: every span) */
     atmos__beams_air_fn air;
     void *user;
 } atmos__beams_screen;

@@ -75,14 +75,3 @@ void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__bea
     c->wt[3] = s * (s - 1) * (s - 2) / 6;
     for (int k = 0; k < 4; k++) c->row[k] = t->w + (size_t)(j0 + k) * t->nt;
 }
-
-double atmos__beams_table_at(const atmos__beams_table *t, const atmos__beams_column *c, double s)
-{
-    const double f = atmos__clampd((s + 1) * (0.5 * (t->nt - 1)), 0, t->nt - 1);
-    int i = (int)f;
-    if (i > t->nt - 2) i = t->nt - 2;
-    const double a = f - i;
-    double v = 0;
-    for (int k = 0; k < 4; k++) v += c->wt[k] * (c->row[k][i] + a * (c->row[k][i + 1] - c->row[k][i]));
-    return v;
-}
