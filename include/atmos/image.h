@@ -170,10 +170,13 @@ ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmo
  * most 10 times the 99th percentile of the pixels'; the few above it are white too). */
 #define ATMOS_IMAGE_DIFF_MAX_CHANNELS 16
 /* Which channels to compare: pair c is channel image[c] of the image against channel
- * reference[c] of the reference. */
+ * reference[c] of the reference. exclude_above > 0 leaves out of every statistic, the worst
+ * region, the bins and the heat map (black) the pixels where a compared channel of either
+ * image exceeds it (the sun's disc, a lamp); 0 (as matched) keeps every pixel. */
 typedef struct atmos_channel_match {
     int count;
     int image[ATMOS_IMAGE_DIFF_MAX_CHANNELS], reference[ATMOS_IMAGE_DIFF_MAX_CHANNELS];
+    double exclude_above;
 } atmos_channel_match;
 /* Pairs channels by name ("A" and "<layer>.A" are coverage and never compared): R,G,B
  * when both images have all three (plain, or one layer's "<layer>.R", ...: the only layer
@@ -194,6 +197,7 @@ typedef struct atmos_image_diff {
     size_t nonfinite;                       /* compared samples skipped: either value NaN or infinite */
     double heat_scale;                      /* relative difference shown as white */
     size_t nonfinite_image, nonfinite_reference; /* of those, the non-finite values in each image */
+    size_t excluded;                        /* pixels left out by the match's exclude_above */
 } atmos_image_diff;
 ATMOS_API atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *image, const atmos_image *reference,
                                            atmos_image_diff *out, atmos_image **heatmap);

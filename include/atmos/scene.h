@@ -304,6 +304,10 @@ typedef struct atmos_scene {
     char file[ATMOS_SCENE_PATH_MAX];      /* the scene file atmos_scene_load read, whose folder its
                                              relative paths were taken from (messages name it);
                                              "" for a scene from text, standard input or code */
+    char origin[ATMOS_SCENE_PATH_MAX];    /* who set its file keys, for messages when file is "":
+                                             "standard input", else "" */
+    char volume_by[ATMOS_SCENE_PATH_MAX]; /* the override that set /volume/file ("-D volume.file=X
+                                             (on SOURCE)"), blamed for its load's errors; else "" */
 } atmos_scene;
 
 /* The built-in default scene (what `atmos render` renders with no scene file). */

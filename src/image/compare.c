@@ -21,9 +21,20 @@ static atmos_status positional_match(atmos_context *ctx, const atmos_image *a, c
     if (ca > ATMOS_IMAGE_DIFF_MAX_CHANNELS)
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "compare: at most %d colour channels, got %d",
                             ATMOS_IMAGE_DIFF_MAX_CHANNELS, ca);
+    memset(m, 0, sizeof *m);
     m->count = ca;
     for (int c = 0; c < ca; c++) m->image[c] = m->reference[c] = c;
     return ATMOS_OK;
+}
+
+/* Whether the pixel (pa of the image, pr of the reference) is left out: a compared channel
+ * of either above m->exclude_above (when that is > 0). */
+static int excluded(const atmos_channel_match *m, const float *pa, const float *pr)
+{
+    if (!(m->exclude_above > 0)) return 0;
+    for (int c = 0; c < m->count; c++)
+        if (pa[m->image[c]] > m->exclude_above || pr[m->reference[c]] > m->exclude_above) return 1;
+    return 0;
 }
 
 static atmos_status check_match(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
@@ -82,6 +93,10 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
     size_t bad = 0, bad_a = 0, bad_r = 0;
     for (size_t p = 0; p < npx; p++) {
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
+        if (excluded(m, pa, pr)) {
+            out->excluded++;
+            continue;
+        }
         for (int c = 0; c < ca; c++) {
             double va = pa[ia[c]], vr = pr[ir[c]];
             if (!isfinite(va) || !isfinite(vr)) {
@@ -127,7 +142,7 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
                 for (int x = tx; x < tx + COMPARE_TILE && x < a->width; x++) {
                     const float *pa = a->pixels + ((size_t)y * a->width + x) * a->channels,
                                 *pr = ref->pixels + ((size_t)y * ref->width + x) * ref->channels;
-                    for (int c = 0; c < ca; c++) {
+                    for (int c = 0; c < ca && !excluded(m, pa, pr); c++) {
                         double d = (double)pa[ia[c]] - pr[ir[c]];
                         if (isfinite(d)) s += d * d, n++;
                     }
@@ -150,7 +165,7 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
     for (size_t p = 0; p < npx; p++) {
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
         double d = 0;
-        for (int c = 0; c < ca; c++) d += fabs((double)pa[ia[c]] - pr[ir[c]]);
+        for (int c = 0; c < ca && !excluded(m, pa, pr); c++) d += fabs((double)pa[ia[c]] - pr[ir[c]]);
         d = mean_all > 0 ? d / ca / mean_all : 0;
         if (!isfinite(d)) d = 0;
         h->pixels[p * 3] = (float)d;
@@ -216,6 +231,7 @@ atmos_status atmos_image_compare_binned_matched(atmos_context *ctx, const atmos_
         int b = 0;
         while (b + 1 < out->bins && k >= edges[b + 1]) b++;
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
+        if (excluded(m, pa, pr)) continue;
         int counted = 0;
         for (int c = 0; c < ca; c++) {
             double va = pa[ia[c]], vr = pr[ir[c]];

@@ -312,13 +312,22 @@ static void work_free(water_work *w)
     free(w->mu), free(w->sw), free(w->slot), free(w->slot_q), free(w->acc);
 }
 
+/* Progress within a batch: a large drop's batch (rain: 32 sizes, one batch a wavelength) takes
+ * tens of seconds, so the calling thread (thread 0) reports after each size it sees done. */
+typedef struct {
+    atmos__phase_progress fn;
+    void *user;
+    int done, cancel;
+} batch_progress;
+
 /* Sizes b0 .. b0 + nb - 1 by Mie theory, in parallel, each into its slot. Returns
- * the worst status of any size. */
+ * the worst status of any size (ATMOS_E_CANCELLED when pr's callback asked to stop). */
 static atmos_status mie_batch(atmos_context *ctx, const atmos_particle_desc *p, const size_plan *sp, int b0, int nb,
-                              water_work *w)
+                              water_work *w, batch_progress *pr)
 {
     const int nsub = w->nsub, n_angles = w->n_angles;
     int bst = ATMOS_OK;
+    pr->done = 0;
 #pragma omp parallel num_threads(atmos__threads(ctx)) reduction(max : bst)
     {
         bst = ATMOS_OK; /* the private copy of a max reduction starts at INT_MIN */
@@ -327,7 +336,10 @@ static atmos_status mie_batch(atmos_context *ctx, const atmos_particle_desc *p, 
         if (!s1 || !s2 || !v) bst = ATMOS_E_NOMEM;
 #pragma omp for schedule(dynamic, 1)
         for (int j = 0; j < nb; j++) {
-            if (bst != ATMOS_OK) continue;
+            int stop;
+#pragma omp atomic read
+            stop = pr->cancel;
+            if (bst != ATMOS_OK || stop) continue;
             double x = sp->k * size_radius(p, sp, b0 + j);
             atmos_mie_result mr;
             atmos_status s = atmos_mie(NULL, sp->m, x, nsub, w->mu, s1, s2, &mr);
@@ -342,10 +354,18 @@ static atmos_status mie_batch(atmos_context *ctx, const atmos_particle_desc *p, 
             w->slot_q[3 * j] = mr.qext;
             w->slot_q[3 * j + 1] = mr.qsca;
             w->slot_q[3 * j + 2] = mr.g * mr.qsca;
+            int now;
+#pragma omp atomic capture
+            now = ++pr->done;
+            if (pr->fn && omp_get_thread_num() == 0 && now < nb &&
+                pr->fn(pr->user, (double)(b0 + now) / sp->n_sizes)) {
+#pragma omp atomic write
+                pr->cancel = 1;
+            }
         }
         free(s1), free(s2), free(v);
     }
-    return (atmos_status)bst;
+    return pr->cancel && bst == ATMOS_OK ? ATMOS_E_CANCELLED : (atmos_status)bst;
 }
 
 /* Adds a batch's slots to the sums: sizes in index order, independent of threads. */
@@ -364,9 +384,11 @@ static void accumulate(water_work *w, int nb)
 static atmos_status sum_sizes(atmos_context *ctx, const atmos_particle_desc *p, double nm, const size_plan *sp,
                               water_work *w, atmos__phase_progress progress, void *progress_user)
 {
+    batch_progress pr = {progress, progress_user, 0, 0};
     for (int b0 = 0; b0 < sp->n_sizes; b0 += w->batch) {
         int nb = sp->n_sizes - b0 < w->batch ? sp->n_sizes - b0 : w->batch;
-        atmos_status bst = mie_batch(ctx, p, sp, b0, nb, w);
+        atmos_status bst = mie_batch(ctx, p, sp, b0, nb, w, &pr);
+        if (bst == ATMOS_E_CANCELLED) return atmos__error(ctx, bst, "water phase: cancelled at %g nm", nm);
         if (bst != ATMOS_OK)
             return atmos__error(ctx, bst, "water phase: Mie computation failed at %g nm (%s)", nm,
                                 atmos_status_string(bst));

@@ -60,7 +60,7 @@ static atmos_status plan_volume(atmos_plan *p, const atmos_volume *volume, const
     if (p->optics->count != atmos_volume_field_count(p->volume))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "plan: optics for %d fields, the volume has %d", p->optics->count,
                             atmos_volume_field_count(p->volume));
-    atmos__scene_volume_warnings(ctx, &p->scene, p->volume, p->optics);
+    atmos__scene_volume_warnings(ctx, &p->scene, p->volume, p->optics, p->offset);
     return ATMOS_OK;
 }
 

@@ -248,7 +248,10 @@ atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t
             st = atmos__scene_from_json(ctx, source, root, &s);
             if (st != ATMOS_OK && count > 0) st = atmos__scene_blame_override(ctx, st, source, overrides, count);
         }
-        if (st == ATMOS_OK) *out = s;
+        if (st == ATMOS_OK) {
+            atmos__scene_override_blame(s.volume_by, sizeof s.volume_by, "/volume/file", source, overrides, count);
+            *out = s;
+        }
     }
     cJSON_Delete(root);
     free(copy);
@@ -331,6 +334,7 @@ atmos_status atmos_scene_parse_file(atmos_context *ctx, const char *json, size_t
     const char *slash = in ? NULL : strrchr(path, '/'); /* from standard input: the current folder */
     const size_t dir = slash ? (size_t)(slash - path) + 1 : 0;
     char key[64];
+    if (st == ATMOS_OK && in) snprintf(out->origin, sizeof out->origin, "standard input");
     if (st == ATMOS_OK && !in) { /* for messages only: a path too long kept as "..." and its end */
         const size_t len = strlen(path), cap = sizeof out->file;
         if (len < cap) snprintf(out->file, cap, "%s", path);

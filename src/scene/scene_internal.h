@@ -26,10 +26,11 @@
  * any ray across it) is below this is reported as nearly invisible. */
 #define ATMOS__SCENE_THIN_TAU 0.01
 /* The warnings about a scene's volume once its optics are known (a plan's): a VDB file read
- * as a 0..1 fraction and scaled by >= 1e3 (values meant as particles per m^3), and a volume
- * too thin to see (ATMOS__SCENE_THIN_TAU), naming the density unit and scale options. */
+ * as a 0..1 fraction and scaled by >= 1e3 (values meant as particles per m^3), a volume
+ * too thin to see (ATMOS__SCENE_THIN_TAU), naming the density unit and scale options, and a
+ * volume whose box placed at offset_m (the world's metres) lies wholly below the ground. */
 void atmos__scene_volume_warnings(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
-                                  const atmos_volume_optics *optics);
+                                  const atmos_volume_optics *optics, const double offset_m[3]);
 
 /* A closed, open or half-open interval. */
 typedef struct atmos__range {
@@ -91,6 +92,10 @@ atmos_status atmos__scene_apply_overrides(atmos_context *ctx, const char *source
  * rather than blaming the file, which may not have the key at all. Returns st. */
 atmos_status atmos__scene_blame_override(atmos_context *ctx, atmos_status st, const char *source,
                                          const char *const *overrides, int count);
+/* Writes into buf who set key (a JSON pointer): "-D PATH=VALUE (on SOURCE)" for the last
+ * override that sets it or an object holding it ("-D PATH=VALUE" when source is "-D"), else "". */
+void atmos__scene_override_blame(char *buf, size_t cap, const char *key, const char *source,
+                                 const char *const *overrides, int count);
 
 /* The view direction and up vector atmos_camera_init will use for cam, with
  * camera.h's zero-means-default rules for look_at and up applied. */

@@ -174,6 +174,18 @@ static int override_sets(const char *ov, const char *key)
     return !strncmp(key, ptr, n) && (key[n] == '\0' || key[n] == '/');
 }
 
+void atmos__scene_override_blame(char *buf, size_t cap, const char *key, const char *source,
+                                  const char *const *overrides, int count)
+{
+    buf[0] = '\0';
+    for (int i = count - 1; overrides && i >= 0; i--) /* the last override of a key is the one that holds */
+        if (overrides[i] && override_sets(overrides[i], key)) {
+            if (!strcmp(source, "-D")) snprintf(buf, cap, "-D %.300s", overrides[i]);
+            else snprintf(buf, cap, "-D %.300s (on %.300s)", overrides[i], source);
+            return;
+        }
+}
+
 atmos_status atmos__scene_blame_override(atmos_context *ctx, atmos_status st, const char *source,
                                          const char *const *overrides, int count)
 {
@@ -185,13 +197,9 @@ atmos_status atmos__scene_blame_override(atmos_context *ctx, atmos_status st, co
     if (!end || (size_t)(end - k) >= sizeof key) return st;
     memcpy(key, k, (size_t)(end - k));
     key[end - k] = '\0';
-    for (int i = count - 1; i >= 0; i--) /* the last override of a key is the one that holds */
-        if (overrides[i] && override_sets(overrides[i], key)) {
-            char rest[1024];
-            snprintf(rest, sizeof rest, "%s", k);
-            if (!strcmp(source, "-D")) /* atmos render's name for a scene of overrides alone */
-                return atmos__error(ctx, st, "-D %.300s: %s", overrides[i], rest);
-            return atmos__error(ctx, st, "-D %.300s (on %s): %s", overrides[i], source, rest);
-        }
-    return st;
+    char who[700], rest[1024];
+    atmos__scene_override_blame(who, sizeof who, key, source, overrides, count); /* "-D" alone: atmos render's */
+    if (!who[0]) return st;                                                       /* scene of overrides alone */
+    snprintf(rest, sizeof rest, "%s", k);
+    return atmos__error(ctx, st, "%s: %s", who, rest);
 }

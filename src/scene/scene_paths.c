@@ -55,6 +55,10 @@ atmos_status atmos__scene_file_error(atmos_context *ctx, atmos_status st, const 
     char why[1024], note[2 * ATMOS_SCENE_PATH_MAX + 80];
     snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
     const char *file = s && s->file[0] ? s->file : NULL;
+    const char *who = s && !strcmp(key, "/volume/file") && s->volume_by[0] ? s->volume_by
+                      : file                                               ? file
+                      : s && s->origin[0]                                  ? s->origin
+                                                                           : NULL;
     note[0] = '\0';
     if (where && path[0] && path[0] != '/' && !generated(path)) {
         const char *slash = file ? strrchr(file, '/') : NULL;
@@ -66,5 +70,5 @@ atmos_status atmos__scene_file_error(atmos_context *ctx, atmos_status st, const 
         else if (file) snprintf(note, sizeof note, " (a relative path: from the scene's folder, the current folder)");
         else snprintf(note, sizeof note, " (a relative path: from the current folder)");
     }
-    return atmos__error(ctx, st, "%s%s%s: %s%s", file ? file : "", file ? ": " : "", key, why, note);
+    return atmos__error(ctx, st, "%s%s%s: %s%s", who ? who : "", who ? ": " : "", key, why, note);
 }

@@ -189,11 +189,27 @@ static double peak_extinction(const atmos_scene *scene, const atmos_volume *vol,
     return scale * peak;
 }
 
+/* Below the ground (y = 0; none in a vacuum): the box's top at or under it, nothing of the
+ * volume is seen from above (a position in km for m, or a model's origin at sea level). */
+static void below_ground_warning(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
+                                 const double offset_m[3], const char *name)
+{
+    double lo[3], hi[3];
+    atmos_volume_bounds(vol, lo, hi);
+    if (!offset_m || scene->atmosphere.kind == ATMOS_ATMOSPHERE_VACUUM || !(hi[1] + offset_m[1] <= 0)) return;
+    atmos__log(ctx, ATMOS_LOG_WARN,
+               "%s: below the ground: its box spans %.0f to %.0f m in height (y), all under the ground at 0, so "
+               "the image will not show it; raise it (\"position_m\" in \"volume\", in metres, is where the "
+               "centre of the box's bottom face goes)",
+               name, lo[1] + offset_m[1], hi[1] + offset_m[1]);
+}
+
 void atmos__scene_volume_warnings(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *vol,
-                                  const atmos_volume_optics *optics)
+                                  const atmos_volume_optics *optics, const double offset_m[3])
 {
     const atmos_scene_volume *sv = &scene->volume;
     const char *name = sv->source[0] ? sv->source : "the volume";
+    below_ground_warning(ctx, scene, vol, offset_m, name);
     /* A scene written when VDB values were read as particles per m^3 scaled them by ~1e8;
      * read as a 0..1 fraction (1 = 1e8 m^-3) they would be that much denser again. */
     const char *fmt = atmos_volume_source_format(vol);

@@ -87,6 +87,23 @@ for name, v in ((sys.argv[1], [1.0] * 300), (sys.argv[2], [1.1] * 297 + [1000.0]
 out=$("$A" compare "$T/h_img.pfm" "$T/h_ref.pfm" --heatmap "$T/hh.png") || bad "compare with one far-off pixel"
 echo "$out" | grep -q "white = 1 relative" && ok || bad "the heat map's white with one far-off pixel: $out"
 
+# --exclude-above L: a sun's disc (one pixel of 1e9, 0.1 % off) would make the RMSE ~5.8e5;
+# left out, the other three pixels, each channel 0.1 above the reference, give an RMSE and a
+# bias of 0.1 exactly, and the count left out is printed. A bad value is a usage error.
+pfm "$T/sun_ref.pfm" '\n' 1 2 3 4 5 6 7 8 9 1e9 1e9 1e9
+pfm "$T/sun_img.pfm" '\n' 1.1 2.1 3.1 4.1 5.1 6.1 7.1 8.1 9.1 1.001e9 1.001e9 1.001e9
+out=$("$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --json) || bad "compare with a sun"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["rmse"] > 1e5 and "excluded" not in d, d' \
+    && ok || bad "without --exclude-above the sun is in the RMSE: $out"
+out=$("$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --exclude-above 1e5 --json) || bad "compare --exclude-above"
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin)
+assert abs(d["rmse"] - 0.1) < 1e-6 and all(abs(b - 0.1) < 1e-6 for b in d["bias"]) and d["excluded"] == 1, d
+assert d["worst_rmse"] < 0.11, d' && ok || bad "--exclude-above 1e5 leaves the sun out: $out"
+out=$("$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --exclude-above 1e5) || bad "compare --exclude-above (text)"
+echo "$out" | grep -q "excluded: 1 pixels above 100000 (--exclude-above)" && ok || bad "--exclude-above's line: $out"
+"$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --exclude-above -3 >/dev/null 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] && grep -q "exclude-above: expected a radiance > 0" "$T/err" && ok || bad "--exclude-above -3: exit $rc"
+
 rm -rf "$T"
 echo "compare: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

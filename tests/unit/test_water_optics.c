@@ -223,6 +223,50 @@ static void test_threads(void)
     free(a), free(b);
 }
 
+/* Progress within a batch: on the tables' grid rain affords a few dozen sizes a wavelength,
+ * one or two batches of 32 (tens of seconds of a batch job's silence in normal quality when
+ * reported only after each); the calling thread reports after each size, so no step between
+ * reports exceeds 1/8 of the wavelength's work, the fractions grow and the last is 1. A callback asking to stop cancels the computation. */
+typedef struct {
+    int calls, cancel_at;
+    double last, max_step;
+} water_progress;
+
+static int water_progress_fn(void *user, double f)
+{
+    water_progress *w = user;
+    CHECK(f >= w->last);
+    if (f - w->last > w->max_step) w->max_step = f - w->last;
+    w->last = f;
+    return ++w->calls == w->cancel_at;
+}
+
+static void test_progress(void)
+{
+    atmos_particle_desc p;
+    CHECK_OK(atmos_particle_preset(NULL, "rain", &p));
+    p.fast = 1;
+    /* the tables' whole grid: so many angles that the budget affords a few dozen sizes */
+    const double *th;
+    const int NB = atmos_phase_grid(&th);
+    double *ph = malloc((size_t)NB * sizeof *ph);
+    atmos__phase_result r;
+    atmos_context *c1;
+    atmos_context_desc d;
+    atmos_context_defaults(&d);
+    d.threads = 1;
+    CHECK_OK(atmos_context_create(&d, &c1));
+    water_progress w = {0, -1, 0, 0};
+    CHECK_OK(atmos__water_phase(c1, &p, 680.0, NB, th, ph, &r, water_progress_fn, &w));
+    printf("rain, fast, 680 nm: %d progress reports, largest step %.3f\n", w.calls, w.max_step);
+    CHECK(w.calls >= 8 && w.max_step <= 0.125 && w.last == 1.0);
+    water_progress c = {0, 2, 0, 0};
+    CHECK(atmos__water_phase(c1, &p, 680.0, NB, th, ph, &r, water_progress_fn, &c) == ATMOS_E_CANCELLED);
+    CHECK(c.calls == 2);
+    atmos_context_destroy(c1);
+    free(ph);
+}
+
 int main(void)
 {
     atmos_context *ctx;
@@ -233,6 +277,7 @@ int main(void)
     test_cloud(ctx);
     test_presets_and_errors(ctx);
     test_threads();
+    test_progress();
     atmos_context_destroy(ctx);
     return test_summary("test_water_optics");
 }

@@ -66,6 +66,16 @@ static int run_case(atmos_context *ctx, const atmos_scene *base, const beams_cas
     return rc;
 }
 
+/* A scene of the source tree not found (no --file): where they are read from, and the way out. */
+static int scene_error(atmos_context *ctx, atmos_status st, const char *file)
+{
+    const int rc = cli_runtime_error("bench", ctx, st);
+    if (!file && st == ATMOS_E_IO)
+        fprintf(stderr, "  (atmos bench beams reads the source tree's scenes/ folder: run it from the source tree, "
+                        "or pass --file SCENE)\n");
+    return rc;
+}
+
 int bench_beams(const char *file, int frames, int threads, const char *only)
 {
     const char *path = file ? file : "scenes/dobashi_fig04_spotlight.json";
@@ -75,7 +85,7 @@ int bench_beams(const char *file, int frames, int threads, const char *only)
     atmos_status st = atmos_scene_load(ctx, path, &s);
     if (st == ATMOS_OK && s.renderer != ATMOS_RENDERER_BEAMS)
         st = ATMOS_E_INVALID_ARG, fprintf(stderr, "atmos bench: %s: not a beams scene\n", path);
-    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error("bench", ctx, st);
+    int rc = st == ATMOS_OK ? CLI_EXIT_OK : scene_error(ctx, st, file);
     static const beams_case cases[] = {
         {"dobashi_fig04", 1, 1, 1, 0, 0, 0},
         {"dobashi_fig04_no_subplanes", 1, 1, 0, 0, 0, 0},
@@ -101,7 +111,7 @@ int bench_beams(const char *file, int frames, int threads, const char *only)
         const beams_case c = {table1[i][0], 0, 1, 1, 0, 0, 0};
         if (only && strcmp(only, c.name)) continue;
         ran++;
-        if ((st = atmos_scene_load(ctx, table1[i][1], &s)) != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
+        if ((st = atmos_scene_load(ctx, table1[i][1], &s)) != ATMOS_OK) rc = scene_error(ctx, st, file);
         else rc = run_case(ctx, &s, &c, frames, used);
     }
     atmos_context_destroy(ctx);

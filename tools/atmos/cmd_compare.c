@@ -9,7 +9,8 @@
 
 static void help(void)
 {
-    printf("Usage: atmos compare IMAGE REFERENCE [--heatmap OUT.png] [--by KEY.pfm [--edges E0,E1,...]] [--json]\n\n"
+    printf("Usage: atmos compare IMAGE REFERENCE [--heatmap OUT.png] [--by KEY.pfm [--edges E0,E1,...]]\n"
+           "                     [--exclude-above L] [--json]\n\n"
            "Compares two HDR images of the same size (OpenEXR .exr or portable float map .pfm)\n"
            "channel by channel, paired by name: R,G,B when both have them, otherwise the same\n"
            "set of names in both, otherwise the only channel of each (a PFM's are R,G,B or Y;\n"
@@ -34,7 +35,12 @@ static void help(void)
            "[E_i, E_i+1) form bin i (default edges 0.01,0.1,0.5,1,2,4,8,16,32,64,1e30). Per bin it\n"
            "prints the pixel count, rel_rmse and rel_bias (over the reference's mean in the bin;\n"
            "--edges without --by is warned of and does nothing);\n"
-           "--json adds \"bins\": [{\"lo\", \"hi\", \"pixels\", \"rel_rmse\", \"rel_bias\"}, ...].\n");
+           "--json adds \"bins\": [{\"lo\", \"hi\", \"pixels\", \"rel_rmse\", \"rel_bias\"}, ...].\n\n"
+           "--exclude-above L leaves out of every figure (the bins, the worst region; black in the heat\n"
+           "map) the pixels where a compared channel of either image exceeds L: the sun's disc, whose\n"
+           "radiance is ~10^5 times the sky's, otherwise dominates the RMSE of any image showing it\n"
+           "(e.g. 1e5 for a daylight sky in atmos render's units; the count left out is printed,\n"
+           "\"excluded\" in --json).\n");
     fputs(CLI_HELP_EXIT, stdout);
 }
 
@@ -123,6 +129,7 @@ static void print_json(const atmos_image_diff *d, const char *const *names, cons
     json_number(d->worst_rmse);
     printf(", \"nonfinite\": %zu, \"nonfinite_image\": %zu, \"nonfinite_reference\": %zu", d->nonfinite,
            d->nonfinite_image, d->nonfinite_reference);
+    if (m->exclude_above > 0) printf(", \"excluded\": %zu", d->excluded);
     if (bins) {
         printf(", \"bins\": [");
         for (int i = 0; i < bins->bins; i++) {
@@ -152,6 +159,8 @@ static void print_text(const char *const *files, const atmos_image *a, const atm
     printf("worst region: x %d..%d, y %d..%d, rmse %.6g\n", d->worst_x, d->worst_x + d->worst_w - 1, d->worst_y,
            d->worst_y + d->worst_h - 1, d->worst_rmse);
     if (heat) printf("heat map: %s (white = %.4g relative difference)\n", heat, d->heat_scale);
+    if (m->exclude_above > 0)
+        printf("excluded: %zu pixels above %g (--exclude-above)\n", d->excluded, m->exclude_above);
     if (bins) {
         printf("by %s:\n%12s %12s %10s %12s %12s\n", by, "from", "to", "pixels", "rel_rmse", "rel_bias");
         for (int i = 0; i < bins->bins; i++)
@@ -164,6 +173,7 @@ int cli_cmd_compare(int argc, char **argv)
 {
     const char *C = "compare", *files[2] = {NULL, NULL}, *heat = NULL, *by = NULL;
     int json = 0, nf = 0, n_edges = 11, edges_given = 0;
+    double exclude_above = 0;
     double edges[ATMOS_IMAGE_BINS_MAX + 1] = {0.01, 0.1, 0.5, 1, 2, 4, 8, 16, 32, 64, 1e30};
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
@@ -178,6 +188,11 @@ int cli_cmd_compare(int argc, char **argv)
         } else if (cli_take_value(argc, argv, &i, "--by", &v)) {
             if (!v || !*v) return cli_usage_error(C, "--by: missing key image");
             by = v;
+        } else if (cli_take_value(argc, argv, &i, "--exclude-above", &v)) {
+            char *end = NULL;
+            exclude_above = v ? strtod(v, &end) : 0;
+            if (!v || end == v || *end || !isfinite(exclude_above) || !(exclude_above > 0))
+                return cli_usage_error(C, "--exclude-above: expected a radiance > 0, got '%s'", v ? v : "");
         } else if (cli_take_value(argc, argv, &i, "--edges", &v)) {
             if (!v) return cli_usage_error(C, "--edges: missing list");
             n_edges = 0, edges_given = 1;
@@ -227,6 +242,7 @@ int cli_cmd_compare(int argc, char **argv)
     atmos_status st = read_hdr(ctx, files[0], &a);
     if (st == ATMOS_OK) st = read_hdr(ctx, files[1], &b);
     if (st == ATMOS_OK) st = atmos_image_match_channels(ctx, a.names, a.img->channels, b.names, b.img->channels, &m);
+    m.exclude_above = exclude_above;
     if (st == ATMOS_OK) st = atmos_image_compare_matched(ctx, a.img, b.img, &m, &d, heat ? &h : NULL);
     if (st == ATMOS_OK && by) st = read_hdr(ctx, by, &key);
     if (st == ATMOS_OK && by) st = atmos_image_compare_binned_matched(ctx, a.img, b.img, &m, key.img, edges, n_edges, &bins);

@@ -263,6 +263,7 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     } else {
         atmos_scene_defaults(scene);
     }
+    if (o->volume) scene->volume_by[0] = '\0'; /* --volume's file is the command line's, not a -D's */
     int rc = render_opts_apply(ctx, o, scene);
     if (rc != CLI_EXIT_OK) return rc;
     if ((st = atmos_scene_validate(ctx, scene, o->scene_path ? o->scene_path : "options")) != ATMOS_OK) {
