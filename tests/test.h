@@ -134,6 +134,14 @@ static inline atmos_volume *test_dense_volume(atmos_context *ctx, const int dims
     return v;
 }
 
+/* test_dense_volume's volume of one "cloud" field of type "hg", its base (dims[0] x dims[2]
+ * voxels of size vs) centred over the origin, 1000 m up. */
+static inline atmos_volume *test_cloud_volume(atmos_context *ctx, const int dims[3], double vs, const float *buf)
+{
+    const double org[3] = {-0.5 * dims[0] * vs, 1000, -0.5 * dims[2] * vs};
+    return test_dense_volume(ctx, dims, vs, org, "cloud", "hg", buf);
+}
+
 /* One frame of scene s (volume v, optics; the volume where its own coordinates put it, as
  * atmos_render_path does) through a plan made for it, checked; NULL on failure. */
 static inline atmos_image *test_plan_frame(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,

@@ -841,6 +841,39 @@ static atmos_image *render_counted_one_thread(const atmos_scene *s, long *evalua
     return img;
 }
 
+/* The images the screen_step tests compare: s at screen_step 1 (exact) and at step (sub; one, the
+ * same on a context of one thread), the renderer's counts for sub (ev of n pixels evaluated) and
+ * for one (ev1); nonzero if all three were made. */
+typedef struct {
+    atmos_image *exact, *sub, *one;
+    long ev, n, ev1;
+} stepped;
+
+static int render_stepped(atmos_scene *s, int step, stepped *r)
+{
+    r->ev = 0, r->n = 1, r->ev1 = 0;
+    s->beams.screen_step = 1;
+    r->exact = render_counted(ctx, s, &r->ev, &r->n);
+    s->beams.screen_step = step;
+    r->sub = render_counted(ctx, s, &r->ev, &r->n);
+    r->one = render_counted_one_thread(s, &r->ev1, &r->n);
+    return r->exact && r->sub && r->one;
+}
+
+/* 1 and 2 threads the same bytes and the same count of evaluated pixels (if all three images were
+ * made), then the images freed. */
+static void stepped_threads_free(stepped *r, int step)
+{
+    if (r->exact && r->sub && r->one) {
+        const size_t bytes = sizeof(float) * (size_t)r->sub->width * r->sub->height * r->sub->channels;
+        CHECK_MSG(r->ev1 == r->ev && !memcmp(r->one->pixels, r->sub->pixels, bytes),
+                  "1 and 2 threads differ (screen step %d)", step);
+    }
+    atmos_image_destroy(r->one);
+    atmos_image_destroy(r->exact);
+    atmos_image_destroy(r->sub);
+}
+
 /* A plan keeps its frame's per-pixel buffers for the next frame (beams_kept.h): frames whose
  * camera moves, a region smaller than the frame, then the whole frame again, each the same to
  * the byte as a fresh plan's; and a kept buffer grows when asked for more, stays when asked for
@@ -956,28 +989,19 @@ static void test_screen_step(void)
     atmos_image_destroy(img);
 
     spot_scene(&s, 192, 144);
-    s.beams.screen_step = 1;
-    atmos_image *exact = render_counted(ctx, &s, &ev, &n);
-    s.beams.screen_step = 4;
-    atmos_image *sub = render_counted(ctx, &s, &ev, &n);
-    long ev1 = 0;
-    atmos_image *one = render_counted_one_thread(&s, &ev1, &n);
-    if (exact && sub && one) {
-        const int W = s.width, C = exact->channels;
+    stepped r;
+    if (render_stepped(&s, 4, &r)) {
         double worst_edge, mean;
         long edges, lit;
-        exact_diff(exact, sub, W, s.height, &worst_edge, &edges, &mean, &lit);
+        exact_diff(r.exact, r.sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
         printf("screen step 4: a spot's beam and shadow, airlight evaluated at %ld of %ld pixels; %ld edge pixels, worst "
-               "relative difference there %.2e; mean over %ld lit pixels %.2e\n", ev, n, edges, worst_edge, lit, mean);
+               "relative difference there %.2e; mean over %ld lit pixels %.2e\n", r.ev, r.n, edges, worst_edge, lit,
+               mean);
         CHECK(edges > 100);
         CHECK_MSG(worst_edge <= 0.03, "an edge pixel is off the exact one by %.3g", worst_edge);
         CHECK_MSG(mean <= 1e-3, "the subsampled image is off the exact one by %.3g on average", mean);
-        CHECK_MSG(ev1 == ev && !memcmp(one->pixels, sub->pixels, sizeof(float) * (size_t)W * s.height * C),
-                  "1 and 2 threads differ (screen step 4)");
     }
-    atmos_image_destroy(one);
-    atmos_image_destroy(exact);
-    atmos_image_destroy(sub);
+    stepped_threads_free(&r, 4);
 }
 
 /* A spot's beam many cells wide (spot_scene's, screen_step 8): its span is no hint where it is
@@ -989,28 +1013,19 @@ static void test_wide_span(void)
 {
     atmos_scene s;
     spot_scene(&s, 192, 144);
-    s.beams.screen_step = 1;
-    long ev = 0, n = 1, ev1 = 0;
-    atmos_image *exact = render_counted(ctx, &s, &ev, &n);
-    s.beams.screen_step = 8;
-    atmos_image *sub = render_counted(ctx, &s, &ev, &n);
-    atmos_image *one = render_counted_one_thread(&s, &ev1, &n);
-    if (exact && sub && one) {
+    stepped r;
+    if (render_stepped(&s, 8, &r)) {
         double worst_edge, mean;
         long edges, lit;
-        exact_diff(exact, sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
+        exact_diff(r.exact, r.sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
         printf("a wide beam, screen step 8: airlight evaluated at %ld of %ld pixels (%.1f %%); %ld edge pixels, worst "
-               "relative difference there %.2e; mean over %ld lit pixels %.2e\n", ev, n, 100.0 * ev / n, edges, worst_edge,
-               lit, mean);
-        CHECK_MSG(ev < 0.27 * n, "the airlight was evaluated at %ld of %ld pixels", ev, n);
+               "relative difference there %.2e; mean over %ld lit pixels %.2e\n", r.ev, r.n, 100.0 * r.ev / r.n, edges,
+               worst_edge, lit, mean);
+        CHECK_MSG(r.ev < 0.27 * r.n, "the airlight was evaluated at %ld of %ld pixels", r.ev, r.n);
         CHECK_MSG(worst_edge <= 0.03, "an edge pixel is off the exact one by %.3g", worst_edge);
         CHECK_MSG(mean <= 1e-3, "the subsampled image is off the exact one by %.3g on average", mean);
-        CHECK_MSG(ev1 == ev && !memcmp(one->pixels, sub->pixels, sizeof(float) * (size_t)s.width * s.height * sub->channels),
-                  "1 and 2 threads differ (screen step 8)");
     }
-    atmos_image_destroy(one);
-    atmos_image_destroy(exact);
-    atmos_image_destroy(sub);
+    stepped_threads_free(&r, 8);
 }
 
 /* The lit cones' hint (beams_screen.h): a spot's beam about a pixel wide, upright on column 82 of
@@ -1028,12 +1043,9 @@ static void test_thin_beam_hint(void)
     l->direction[1] = 1;
     const double u = 82.5 - 80; /* the beam's column's centre, right of the image's centre */
     l->position_m[0] = u / 60 * 30 * tan(25 * ATMOS_PI / 180), l->position_m[1] = -20, l->position_m[2] = -30;
-    long ev = 0, n = 1, ev1 = 0;
-    atmos_image *exact = render_counted(ctx, &s, &ev, &n);
-    s.beams.screen_step = 8;
-    atmos_image *sub = render_counted(ctx, &s, &ev, &n);
-    atmos_image *one = render_counted_one_thread(&s, &ev1, &n);
-    if (exact && sub && one) {
+    stepped r;
+    if (render_stepped(&s, 8, &r)) {
+        const atmos_image *exact = r.exact, *sub = r.sub;
         const int W = s.width, C = exact->channels;
         double top = 0, worst = 0;
         long lit = 0, lo = W, hi = 0;
@@ -1047,15 +1059,11 @@ static void test_thin_beam_hint(void)
             }
         printf("screen step 8: a beam a pixel wide between the nodes, columns %ld-%ld, %ld pixels above 5 %% of the "
                "brightest, worst relative difference %.2e; airlight evaluated at %ld of %ld pixels\n",
-               lo, hi, lit, worst, ev, n);
+               lo, hi, lit, worst, r.ev, r.n);
         CHECK_MSG(lit > 100 && lo > 80 && hi < 84, "the beam is not where the test puts it (columns %ld-%ld)", lo, hi);
         CHECK_MSG(worst <= 0.05, "the thin beam is lost between the nodes (%.3g off)", worst);
-        CHECK_MSG(ev1 == ev && !memcmp(one->pixels, sub->pixels, sizeof(float) * (size_t)W * s.height * C),
-                  "1 and 2 threads differ (screen step 8)");
     }
-    atmos_image_destroy(one);
-    atmos_image_destroy(exact);
-    atmos_image_destroy(sub);
+    stepped_threads_free(&r, 8);
 }
 
 int main(void)

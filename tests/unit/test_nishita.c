@@ -60,8 +60,7 @@ static atmos_volume *ball(atmos_context *ctx, double tau)
                 buf[(k * N + j) * N + i] = q < 1 ? (float)(peak * (1 - q) * (1 - q)) : 0.0f;
             }
     const int dims[3] = {N, N, N};
-    const double org[3] = {-0.5 * N * VS, 1000, -0.5 * N * VS};
-    atmos_volume *v = test_dense_volume(ctx, dims, VS, org, "cloud", "hg", buf);
+    atmos_volume *v = test_cloud_volume(ctx, dims, VS, buf);
     free(buf);
     return v;
 }

@@ -7,17 +7,12 @@
  * (atmos__path_phase_clip): normalised, its removed fraction delta-M's f, its sampled moments its
  * tabulated ones; the same field of degree 3, delta-M, solved by discrete ordinates
  * (render/nishita_do.c) in slabs of optical depth 1, 4 and 16. */
-#include "path_ad.h"
 #include "render/path_phase.h"
 #include "test.h"
+#include "test_slab.h"
 
 #include <stdint.h>
 
-#define NX 96
-#define NY 16 /* the slab's 12 voxels and 2 empty ones above and below */
-#define NS 12
-#define VS 50.0
-#define SIGMA 1e-9
 #define TAU 4.0
 #define G 0.85
 
@@ -42,59 +37,17 @@ static void make_optics(atmos_context *ctx, atmos_phase_table **t, atmos_volume_
     o->phase[0] = *t;
 }
 
-/* A slab NX x NS x NX voxels, uniform, of optical depth TAU across its NS voxels, in a grid with
- * empty voxels above and below (so that its faces are where the renderers' grids put them). */
-static atmos_volume *slab_tau(atmos_context *ctx, double tau)
-{
-    float *buf = calloc(NX * NY * NX, sizeof(float));
-    for (int k = 0; k < NX; k++)
-        for (int j = (NY - NS) / 2; j < (NY + NS) / 2; j++)
-            for (int i = 0; i < NX; i++) buf[((size_t)k * NY + j) * NX + i] = (float)(tau / (SIGMA * VS * NS));
-    const int dims[3] = {NX, NY, NX};
-    const double org[3] = {-0.5 * NX * VS, 1000, -0.5 * NX * VS};
-    atmos_volume *v = test_dense_volume(ctx, dims, VS, org, "cloud", "hg", buf);
-    free(buf);
-    return v;
-}
+/* The slab (test_slab.h) of optical depth TAU. */
+static atmos_volume *slab(atmos_context *ctx) { return test_slab(ctx, TAU); }
 
-static atmos_volume *slab(atmos_context *ctx) { return slab_tau(ctx, TAU); }
-
-/* A vacuum, the sun at the zenith (irradiance 1), the camera 20 km from the slab's top centre
- * looking down at it from zenith angle acos(mu), a narrow view of the slab's middle. */
+/* The slab seen at mu (test_slab.h), the Nishita renderer with the first order and the Monte Carlo
+ * field of degree lmax. */
 static void scene(atmos_scene *s, double mu, int lmax)
 {
-    test_vacuum_scene(s, 90, 0);
-    s->sun.irradiance_count = 1, s->sun.irradiance[0] = 1.0;
-    s->width = s->height = 12;
-    const double top = 1000 + 0.5 * (NY + NS) * VS, D = 20000, st = sqrt(1 - mu * mu);
-    const double pos[3] = {0, top + D * mu, D * st};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s->camera);
-    s->camera.look_at[0] = 0, s->camera.look_at[1] = top, s->camera.look_at[2] = 0;
-    s->camera.fov_deg = 1.5;
+    test_slab_scene(s, mu);
     s->renderer = ATMOS_RENDERER_NISHITA;
     s->nishita.orders = 1, s->nishita.sky = 0;
     s->nishita.mc_kphotons = 100, s->nishita.mc_cell = 1, s->nishita.mc_lmax = lmax;
-}
-
-static double image_mean(const atmos_image *img)
-{
-    double s = 0;
-    for (int i = 0; i < img->width * img->height; i++)
-        for (int c = 0; c < 3; c++) s += img->pixels[i * img->channels + c];
-    return s / (3.0 * img->width * img->height);
-}
-
-/* The reflected radiance per unit irradiance at mu, linear between adding-doubling's nodes. */
-static double ad_up(const ad_result *r, double mu)
-{
-    int lo = -1, hi = -1;
-    for (int i = 1; i < r->D; i++) {
-        if (r->mu[i] <= mu && (lo < 0 || r->mu[i] > r->mu[lo])) lo = i;
-        if (r->mu[i] >= mu && (hi < 0 || r->mu[i] < r->mu[hi])) hi = i;
-    }
-    if (lo < 0 || hi < 0 || lo == hi) return r->radiance_up[lo < 0 ? hi : lo];
-    const double t = (mu - r->mu[lo]) / (r->mu[hi] - r->mu[lo]);
-    return (1 - t) * r->radiance_up[lo] + t * r->radiance_up[hi];
 }
 
 static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const atmos_volume *v)
@@ -119,8 +72,8 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
             atmos_image_destroy(one);
             return;
         }
-        const double ref = ad_up(&r, mus[a]), m = image_mean(img), md = image_mean(dm), me = image_mean(ex),
-                     m1 = image_mean(one), mc = image_mean(dc);
+        const double ref = test_ad_up(&r, mus[a]), m = test_image_mean(img), md = test_image_mean(dm),
+                     me = test_image_mean(ex), m1 = test_image_mean(one), mc = test_image_mean(dc);
         printf("  slab tau %g, view mu %.2f: adding-doubling %.4f; first order %.4f (%+.1f %%), + field toward the "
                "view's centre %.4f (%+.1f %%), + field of degree 3 %.4f (%+.1f %%), delta-M %.4f (%+.1f %%), "
                "clipped %.4f (%+.1f %%)\n",
@@ -161,7 +114,7 @@ static void check_do(atmos_context *ctx, const atmos_volume_optics *o)
 {
     const double taus[3] = {1, TAU, 16}, mus[2] = {0.9, 0.6};
     for (int t = 0; t < 3; t++) {
-        atmos_volume *v = slab_tau(ctx, taus[t]);
+        atmos_volume *v = test_slab(ctx, taus[t]);
         ad_result r;
         CHECK(ad_slab(taus[t], 1.0, G, 1.0, 32, &r));
         for (int a = 0; a < 2 && v; a++) {
@@ -173,7 +126,7 @@ static void check_do(atmos_context *ctx, const atmos_volume_optics *o)
             s.nishita.mc_kphotons = 0;
             atmos_image *one = test_plan_frame(ctx, &s, v, o);
             if (img && one) {
-                const double ref = ad_up(&r, mus[a]), m = image_mean(img), m1 = image_mean(one);
+                const double ref = test_ad_up(&r, mus[a]), m = test_image_mean(img), m1 = test_image_mean(one);
                 printf("  slab tau %g, view mu %.2f: adding-doubling %.4f; first order %.4f (%+.1f %%); discrete "
                        "ordinates, degree 3, delta-M, cells of 2 %.4f (%+.1f %%)\n",
                        taus[t], mus[a], ref, m1, 100 * (m1 / ref - 1), m, 100 * (m / ref - 1));
@@ -282,7 +235,7 @@ static void check_threads(const atmos_volume_optics *o, const atmos_volume *v, i
     }
     if (img[0] && img[1]) {
         const size_t bytes = sizeof(float) * img[0]->width * img[0]->height * img[0]->channels;
-        CHECK(image_mean(img[0]) > 0);
+        CHECK(test_image_mean(img[0]) > 0);
         CHECK(!memcmp(img[0]->pixels, img[1]->pixels, bytes));
     }
     atmos_image_destroy(img[0]), atmos_image_destroy(img[1]);

@@ -10,69 +10,21 @@
  *    within 3 % of adding-doubling.
  *  - The reference (scalar) eye pass reads the same field: its image within 0.1 % of the fast one's.
  *  - The same bytes with 1 and 2 threads. */
-#include "path_ad.h"
 #include "test.h"
 #include "test_optics.h"
+#include "test_slab.h"
 
-#define NX 96
-#define NY 16 /* the slab's 12 voxels and 2 empty ones above and below */
-#define NS 12
-#define VS 50.0
-#define SIGMA 1e-9
 #define G 0.85
 
-/* A slab NX x NS x NX voxels, uniform, of optical depth tau across its NS voxels. */
-static atmos_volume *slab(atmos_context *ctx, double tau)
-{
-    float *buf = calloc(NX * NY * NX, sizeof(float));
-    for (int k = 0; k < NX; k++)
-        for (int j = (NY - NS) / 2; j < (NY + NS) / 2; j++)
-            for (int i = 0; i < NX; i++) buf[((size_t)k * NY + j) * NX + i] = (float)(tau / (SIGMA * VS * NS));
-    const int dims[3] = {NX, NY, NX};
-    const double org[3] = {-0.5 * NX * VS, 1000, -0.5 * NX * VS};
-    atmos_volume *v = test_dense_volume(ctx, dims, VS, org, "cloud", "hg", buf);
-    free(buf);
-    return v;
-}
-
-/* A vacuum, the sun at the zenith (irradiance 1), the camera 20 km from the slab's top centre
- * looking down at it from zenith angle acos(mu), a narrow view of the slab's middle; the slice
- * renderer with "do" (or, do 0, low albedo without xi: the first order alone). */
+/* The slab (test_slab.h) seen at mu, the slice renderer with "do" (or, do 0, low albedo without
+ * xi: the first order alone). */
 static void scene(atmos_scene *s, double mu, int do_field)
 {
-    test_vacuum_scene(s, 90, 0);
-    s->sun.irradiance_count = 1, s->sun.irradiance[0] = 1.0;
-    s->width = s->height = 12;
-    const double top = 1000 + 0.5 * (NY + NS) * VS, D = 20000, st = sqrt(1 - mu * mu);
-    const double pos[3] = {0, top + D * mu, D * st};
-    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s->camera);
-    s->camera.look_at[0] = 0, s->camera.look_at[1] = top, s->camera.look_at[2] = 0;
-    s->camera.fov_deg = 1.5;
+    test_slab_scene(s, mu);
     s->renderer = ATMOS_RENDERER_SLICE;
     s->slice.do_field = do_field, s->slice.low_albedo = !do_field;
     s->slice.xi = 0; /* Riley's xi is not single scattering (and "do" does not use it) */
     s->nishita.mc_cell = 2;
-}
-
-static double image_mean(const atmos_image *img)
-{
-    double s = 0;
-    for (int i = 0; i < img->width * img->height; i++)
-        for (int c = 0; c < 3; c++) s += img->pixels[i * img->channels + c];
-    return s / (3.0 * img->width * img->height);
-}
-
-/* The reflected radiance per unit irradiance at mu, linear between adding-doubling's nodes. */
-static double ad_up(const ad_result *r, double mu)
-{
-    int lo = -1, hi = -1;
-    for (int i = 1; i < r->D; i++) {
-        if (r->mu[i] <= mu && (lo < 0 || r->mu[i] > r->mu[lo])) lo = i;
-        if (r->mu[i] >= mu && (hi < 0 || r->mu[i] < r->mu[hi])) hi = i;
-    }
-    if (lo < 0 || hi < 0 || lo == hi) return r->radiance_up[lo < 0 ? hi : lo];
-    const double t = (mu - r->mu[lo]) / (r->mu[hi] - r->mu[lo]);
-    return (1 - t) * r->radiance_up[lo] + t * r->radiance_up[hi];
 }
 
 /* The image of the slab of optical depth tau seen at mu, with "do" or the first order alone. */
@@ -82,7 +34,7 @@ static double mean_of(atmos_context *ctx, const test_optics *op, const atmos_vol
     scene(&s, mu, do_field);
     atmos_image *img = test_plan_frame(ctx, &s, v, &op->o);
     CHECK(img != NULL);
-    const double m = img ? image_mean(img) : 0;
+    const double m = img ? test_image_mean(img) : 0;
     atmos_image_destroy(img);
     return m;
 }
@@ -91,11 +43,12 @@ static void check_slabs(atmos_context *ctx, const test_optics *op)
 {
     const double taus[3] = {1, 4, 16}, mus[2] = {0.9, 0.6};
     for (int t = 0; t < 3; t++) {
-        atmos_volume *v = slab(ctx, taus[t]);
+        atmos_volume *v = test_slab(ctx, taus[t]);
         ad_result r;
         CHECK(ad_slab(taus[t], 1.0, G, 1.0, 32, &r));
         for (int a = 0; a < 2 && v; a++) {
-            const double ref = ad_up(&r, mus[a]), m = mean_of(ctx, op, v, mus[a], 1), m1 = mean_of(ctx, op, v, mus[a], 0);
+            const double ref = test_ad_up(&r, mus[a]), m = mean_of(ctx, op, v, mus[a], 1),
+                         m1 = mean_of(ctx, op, v, mus[a], 0);
             printf("  slab tau %g, view mu %.2f: adding-doubling %.4f; first order (low albedo) %.4f (%+.1f %%); "
                    "slice with do %.4f (%+.1f %%)\n",
                    taus[t], mus[a], ref, m1, 100 * (m1 / ref - 1), m, 100 * (m / ref - 1));
@@ -111,10 +64,10 @@ static void check_slabs(atmos_context *ctx, const test_optics *op)
  * view, HG 0.85 seen at 127 degrees from the sun's light). */
 static void check_thin(atmos_context *ctx, const test_optics *op)
 {
-    atmos_volume *v = slab(ctx, 0.02);
+    atmos_volume *v = test_slab(ctx, 0.02);
     ad_result r;
     CHECK(ad_slab(0.02, 1.0, G, 1.0, 32, &r));
-    const double ref = ad_up(&r, 0.6), m = mean_of(ctx, op, v, 0.6, 1), m1 = mean_of(ctx, op, v, 0.6, 0);
+    const double ref = test_ad_up(&r, 0.6), m = mean_of(ctx, op, v, 0.6, 1), m1 = mean_of(ctx, op, v, 0.6, 0);
     printf("  slab tau 0.02, view mu 0.60: adding-doubling %.6f; first order (low albedo) %.6f (%+.2f %%); slice with "
            "do %.6f (%+.2f %%)\n",
            ref, m1, 100 * (m1 / ref - 1), m, 100 * (m / ref - 1));
@@ -125,7 +78,7 @@ static void check_thin(atmos_context *ctx, const test_optics *op)
 /* The reference passes (atmos_plan_desc.reference) against the fast ones, the slab of depth 4. */
 static void check_reference(atmos_context *ctx, const test_optics *op)
 {
-    atmos_volume *v = slab(ctx, 4);
+    atmos_volume *v = test_slab(ctx, 4);
     atmos_scene s;
     scene(&s, 0.6, 1);
     atmos_image *img[2] = {NULL, NULL};
@@ -142,7 +95,7 @@ static void check_reference(atmos_context *ctx, const test_optics *op)
     }
     CHECK(img[0] && img[1]);
     if (img[0] && img[1]) {
-        const double a = image_mean(img[0]), b = image_mean(img[1]);
+        const double a = test_image_mean(img[0]), b = test_image_mean(img[1]);
         printf("  slab tau 4, view mu 0.60: fast passes %.5f, reference passes %.5f (%+.3f %%)\n", a, b,
                100 * (b / a - 1));
         CHECK(a > 0 && fabs(b / a - 1) < 1e-3);
@@ -161,7 +114,7 @@ static void check_threads(const test_optics *op)
         atmos_context_defaults(&d);
         d.threads = t + 1;
         CHECK_OK(atmos_context_create(&d, &ctx));
-        atmos_volume *v = slab(ctx, 4);
+        atmos_volume *v = test_slab(ctx, 4);
         atmos_scene s;
         scene(&s, 0.6, 1);
         img[t] = test_plan_frame(ctx, &s, v, &op->o);
@@ -171,7 +124,7 @@ static void check_threads(const test_optics *op)
     CHECK(img[0] && img[1]);
     if (img[0] && img[1]) {
         const size_t bytes = sizeof(float) * img[0]->width * img[0]->height * img[0]->channels;
-        CHECK(image_mean(img[0]) > 0);
+        CHECK(test_image_mean(img[0]) > 0);
         CHECK(!memcmp(img[0]->pixels, img[1]->pixels, bytes));
     }
     atmos_image_destroy(img[0]), atmos_image_destroy(img[1]);

@@ -1,0 +1,67 @@
+/* The wide uniform slab lit from the zenith that the tests of the fields of the orders >= 2 share
+ * (test_nishita_mc.c, test_slice_do.c): NX x NS x NX voxels of VS m, uniform, in a grid of NY
+ * voxels' height (empty voxels above and below, so that its faces are where the renderers' grids
+ * put them), seen from above in a vacuum with the sun at the zenith, and its reflected radiance
+ * per unit irradiance by the independent adding-doubling solver (path_ad.h). Header-only (static
+ * inline), included after test.h. */
+#ifndef ATMOS_TEST_SLAB_H
+#define ATMOS_TEST_SLAB_H
+#include "path_ad.h"
+
+#define NX 96
+#define NY 16 /* the slab's 12 voxels and 2 empty ones above and below */
+#define NS 12
+#define VS 50.0
+#define SIGMA 1e-9
+
+/* The slab, of optical depth tau across its NS voxels (particles of cross-section SIGMA). */
+static inline atmos_volume *test_slab(atmos_context *ctx, double tau)
+{
+    float *buf = calloc(NX * NY * NX, sizeof(float));
+    for (int k = 0; k < NX; k++)
+        for (int j = (NY - NS) / 2; j < (NY + NS) / 2; j++)
+            for (int i = 0; i < NX; i++) buf[((size_t)k * NY + j) * NX + i] = (float)(tau / (SIGMA * VS * NS));
+    const int dims[3] = {NX, NY, NX};
+    atmos_volume *v = test_cloud_volume(ctx, dims, VS, buf);
+    free(buf);
+    return v;
+}
+
+/* A vacuum, the sun at the zenith (irradiance 1), the camera 20 km from the slab's top centre
+ * looking down at it from zenith angle acos(mu), a narrow view (12 x 12 pixels) of the slab's
+ * middle; the caller sets the renderer. */
+static inline void test_slab_scene(atmos_scene *s, double mu)
+{
+    test_vacuum_scene(s, 90, 0);
+    s->sun.irradiance_count = 1, s->sun.irradiance[0] = 1.0;
+    s->width = s->height = 12;
+    const double top = 1000 + 0.5 * (NY + NS) * VS, D = 20000, st = sqrt(1 - mu * mu);
+    const double pos[3] = {0, top + D * mu, D * st};
+    atmos_camera_defaults(ATMOS_CAMERA_PINHOLE, pos, &s->camera);
+    s->camera.look_at[0] = 0, s->camera.look_at[1] = top, s->camera.look_at[2] = 0;
+    s->camera.fov_deg = 1.5;
+}
+
+/* The mean of img's first 3 channels over its pixels. */
+static inline double test_image_mean(const atmos_image *img)
+{
+    double s = 0;
+    for (int i = 0; i < img->width * img->height; i++)
+        for (int c = 0; c < 3; c++) s += img->pixels[i * img->channels + c];
+    return s / (3.0 * img->width * img->height);
+}
+
+/* The reflected radiance per unit irradiance at mu, linear between adding-doubling's nodes. */
+static inline double test_ad_up(const ad_result *r, double mu)
+{
+    int lo = -1, hi = -1;
+    for (int i = 1; i < r->D; i++) {
+        if (r->mu[i] <= mu && (lo < 0 || r->mu[i] > r->mu[lo])) lo = i;
+        if (r->mu[i] >= mu && (hi < 0 || r->mu[i] < r->mu[hi])) hi = i;
+    }
+    if (lo < 0 || hi < 0 || lo == hi) return r->radiance_up[lo < 0 ? hi : lo];
+    const double t = (mu - r->mu[lo]) / (r->mu[hi] - r->mu[lo]);
+    return (1 - t) * r->radiance_up[lo] + t * r->radiance_up[hi];
+}
+
+#endif
