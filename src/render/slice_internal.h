@@ -167,8 +167,9 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
 void atmos__slice_shadow_free(atmos__slice_plan *sp);
 
 /* The discrete-ordinates field (slice_do.c): prepare once per plan (after the tables), update
- * per frame (a solve when the sun moved, its view toward the eye; sets j->field, j->fview,
- * j->fvq and, when it solved, tm->field), free with the plan, and its metadata line. */
+ * per frame (a solve when the sun moved, none while held (hold_field), its view toward the eye;
+ * sets j->field, j->fview, j->fvq and, when it solved, tm->field), free with the plan, and its
+ * metadata line. */
 atmos_status atmos__slice_do_prepare(atmos_plan *p, atmos__slice_plan *sp);
 atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const atmos__view *v, sjob *j,
                                     atmos_slice_timing *tm);
