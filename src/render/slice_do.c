@@ -90,6 +90,7 @@ atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const 
     }
     atmos__nishita_plan *np = sp->dop;
     j->field = atmos__nishita_mc_field(np), j->fview = sp->do_view, j->fvq = sp->n == 3 ? 4 : sp->n;
+    j->fsca = np->mc_sca[0], j->fg = NULL;
     return ATMOS_OK;
 }
 

@@ -42,6 +42,10 @@ typedef struct {
     const float *fview;          /* the field toward the frame's eye as the fast eye pass reads it:
                                     [(cell * nf + f) * fvq + c] (atmos__dfield_view) */
     int fvq;                     /* floats per cell and field: 4 for RGB (the fourth 0), else n */
+    /* the same from the field itself, for the reference eye pass: per unit density field f
+     * scatters fsca_f (L + fg_f A) toward the eye (the field's L and A, atmos__lfield_toward; fg
+     * NULL: L alone, the do field); [f * ATMOS_MAX_WAVELENGTHS + c] */
+    const float *fsca, *fg;
     /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
      * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
      * coordinate (texel units, centres at integers) F0 + k dF. */
