@@ -172,7 +172,8 @@ ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmo
 /* Which channels to compare: pair c is channel image[c] of the image against channel
  * reference[c] of the reference. exclude_above > 0 leaves out of every statistic, the worst
  * region, the bins and the heat map (black) the pixels where a compared channel of either
- * image exceeds it (the sun's disc, a lamp); 0 (as matched) keeps every pixel. */
+ * image is finite and exceeds it (the sun's disc, a lamp), unless one is NaN or infinite (those
+ * count in nonfinite); 0 (as matched) keeps every pixel. */
 typedef struct atmos_channel_match {
     int count;
     int image[ATMOS_IMAGE_DIFF_MAX_CHANNELS], reference[ATMOS_IMAGE_DIFF_MAX_CHANNELS];

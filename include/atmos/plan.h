@@ -85,7 +85,7 @@ typedef struct atmos_frame {
                                    to the solver's tolerance: the viewer); 0 builds it afresh, so that a frame
                                    is the same however it was reached (renders, animations, MPI ranks). The
                                    Nishita renderer's discrete-ordinates field ("do") the same way */
-    int hold_field;             /* slice renderer: 1 keeps the diffuse field of the last sun it was solved for
+    int hold_field;             /* slice renderer: 1 keeps the diffuse (or "do") field of the last sun solved for
                                    when the sun moved (no solve this frame; solved when the plan has none):
                                    the viewer's preview while the sun moves. The next frame without it
                                    solves the field for its sun (warm_field decides how), so that frame is

@@ -28,13 +28,20 @@ static atmos_status positional_match(atmos_context *ctx, const atmos_image *a, c
 }
 
 /* Whether the pixel (pa of the image, pr of the reference) is left out: a compared channel
- * of either above m->exclude_above (when that is > 0). */
+ * of either finite and above m->exclude_above (when that is > 0), none NaN or infinite (those
+ * still count as nonfinite: an infinity is a broken image, not a bright sun). */
 static int excluded(const atmos_channel_match *m, const float *pa, const float *pr)
 {
     if (!(m->exclude_above > 0)) return 0;
-    for (int c = 0; c < m->count; c++)
-        if (pa[m->image[c]] > m->exclude_above || pr[m->reference[c]] > m->exclude_above) return 1;
-    return 0;
+    int above = 0;
+    for (int c = 0; c < m->count; c++) {
+        const float v[2] = {pa[m->image[c]], pr[m->reference[c]]};
+        for (int i = 0; i < 2; i++) {
+            if (!isfinite(v[i])) return 0;
+            above |= v[i] > m->exclude_above;
+        }
+    }
+    return above;
 }
 
 static atmos_status check_match(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,

@@ -303,7 +303,8 @@ static void cycle_residual(const double *V, size_t N, int j, const double *g, co
 }
 
 /* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
- * its first residual b itself, no sweep). Returns 1 with the last residual b - A x in r, else 0. */
+ * its first residual b itself, no sweep). Returns 1 with the last residual b - A x in r (b = 0: x = 0,
+ * r = 0), else 0. */
 static int gmres(do_work *W, const double *b, double *x, double *V, double *r, atmos__do_stats *st, int zero_start)
 {
     const atmos__do_problem *P = W->P;
@@ -314,7 +315,10 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
                         operation costs more in its barriers than it saves */
     const double bn = sqrt(dot(b, b, N, T));
     st->resid = 0;
-    if (!(bn > 0)) return 0;
+    if (!(bn > 0)) { /* no source: the solution is 0 whatever the start (a warm start's last sun) */
+        memset(x, 0, sizeof(double) * N), memset(r, 0, sizeof(double) * N);
+        return 1;
+    }
     while (st->iters < P->max_iter) {
         if (zero_start)
             memcpy(V, b, sizeof(double) * N), zero_start = 0;

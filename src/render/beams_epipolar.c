@@ -143,8 +143,9 @@ int atmos__beams_epi_build(atmos__beams_epi *e, const atmos__beams_sun *s, const
     }
     const double ex = (atmos__dot3(eye, s->right) - s->u0) / s->texel - 0.5;
     const double ey = (atmos__dot3(eye, s->up) - s->v0) / s->texel - 0.5;
-    if (e->lines && e->sun == s && e->gen == s->gen && e->ex == ex && e->ey == ey) return 0; /* the same lines */
-    e->lines = 0, e->ex = ex, e->ey = ey, e->sun = s, e->gen = s->gen;
+    if (e->lines && e->sun == s && e->gen == s->gen && e->ex == ex && e->ey == ey && e->max_samples == max_samples)
+        return 0; /* the same lines */
+    e->lines = 0, e->ex = ex, e->ey = ey, e->sun = s, e->gen = s->gen, e->max_samples = max_samples;
     double R = 1;
     for (int k = 0; k < 4; k++) R = fmax(R, hypot(s->box[k & 1] - e->ex, s->box[2 + (k >> 1)] - e->ey));
     const double lines = ceil(2 * ATMOS_PI * R);

@@ -26,6 +26,7 @@ typedef struct atmos__beams_epi {
     size_t cap_lines, cap_floats; /* the blocks' sizes, kept from frame to frame */
     const atmos__beams_sun *sun;  /* the map the lines were made of, and its build (gen) */
     unsigned long gen;
+    size_t max_samples;           /* the bound on the samples they were made under */
 } atmos__beams_epi;
 
 /* The lines of the map s from the eye: their number such that neighbours lie at most a texel

@@ -51,8 +51,8 @@ void atmos__slice_do_free(atmos__slice_plan *sp)
     sp->dop = NULL, sp->do_view = NULL;
 }
 
-atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const atmos__view *v, sjob *j,
-                                    atmos_slice_timing *tm)
+/* The field solved for the frame's sun (when it moved: tm->field) and its view. */
+static atmos_status do_solve(atmos_plan *p, atmos__slice_plan *sp, const atmos__view *v, atmos_slice_timing *tm)
 {
     atmos__nishita_plan *np = sp->dop;
     const int threads = atmos__threads(p->ctx), n = sp->n, nf = sp->nf, vq = n == 3 ? 4 : n;
@@ -69,13 +69,28 @@ atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const 
     if (st != ATMOS_OK) return st;
     memcpy(sp->do_sun, v->sun, sizeof sp->do_sun), sp->do_valid = 1;
     if (moved) tm->field = np->mc_s, tm->field_sweeps = np->do_sweeps;
-    /* what a unit density of field f scatters toward the eye: sigma_s* times the coefficients' sum */
+    /* what a unit density of field f scatters toward the eye: sigma_s* times the coefficients' sum
+       (of the field alone, not of the eye) */
     const atmos__lfield *F = atmos__nishita_mc_field(np);
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     for (size_t c = 0; c < cells; c++)
         for (int f = 0; f < nf; f++)
             for (int w = 0; w < n; w++) sp->do_view[(c * nf + f) * vq + w] = np->mc_sca[f][w] * F->L[c * n + w];
-    j->field = F, j->fview = sp->do_view, j->fvq = vq;
+    return ATMOS_OK;
+}
+
+atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const atmos__view *v, sjob *j,
+                                    atmos_slice_timing *tm)
+{
+    /* held (the viewer's preview while the sun moves), as the diffuse field: the last solved sun's
+     * field and its view, not solved again */
+    if (!(v->hold_field && sp->do_valid)) {
+        const atmos_status st = do_solve(p, sp, v, tm);
+        if (st != ATMOS_OK) return st;
+    }
+    atmos__nishita_plan *np = sp->dop;
+    j->field = atmos__nishita_mc_field(np), j->fview = sp->do_view, j->fvq = sp->n == 3 ? 4 : sp->n;
+    j->fsca = np->mc_sca[0], j->fg = NULL;
     return ATMOS_OK;
 }
 

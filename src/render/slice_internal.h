@@ -42,6 +42,10 @@ typedef struct {
     const float *fview;          /* the field toward the frame's eye as the fast eye pass reads it:
                                     [(cell * nf + f) * fvq + c] (atmos__dfield_view) */
     int fvq;                     /* floats per cell and field: 4 for RGB (the fourth 0), else n */
+    /* the same from the field itself, for the reference eye pass: per unit density field f
+     * scatters fsca_f (L + fg_f A) toward the eye (the field's L and A, atmos__lfield_toward; fg
+     * NULL: L alone, the do field); [f * ATMOS_MAX_WAVELENGTHS + c] */
+    const float *fsca, *fg;
     /* Per pixel. Slice planes are parallel, so the point where a pixel's ray meets
      * slice k is linear in k: render-voxel coordinate U0 + k dU, light-buffer
      * coordinate (texel units, centres at integers) F0 + k dF. */
@@ -167,8 +171,9 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
 void atmos__slice_shadow_free(atmos__slice_plan *sp);
 
 /* The discrete-ordinates field (slice_do.c): prepare once per plan (after the tables), update
- * per frame (a solve when the sun moved, its view toward the eye; sets j->field, j->fview,
- * j->fvq and, when it solved, tm->field), free with the plan, and its metadata line. */
+ * per frame (a solve when the sun moved, none while held (hold_field), its view toward the eye;
+ * sets j->field, j->fview, j->fvq and, when it solved, tm->field), free with the plan, and its
+ * metadata line. */
 atmos_status atmos__slice_do_prepare(atmos_plan *p, atmos__slice_plan *sp);
 atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const atmos__view *v, sjob *j,
                                     atmos_slice_timing *tm);

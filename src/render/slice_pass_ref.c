@@ -28,6 +28,23 @@ static inline void light_lookup(const sjob *j, const float *Ib, const float *nb,
     *n = w00 * nb[t00] + w10 * nb[t10] + w01 * nb[t01] + w11 * nb[t11];
 }
 
+/* What a unit density of each field scatters toward the eye at (u, v, w), out[f * n + c], from
+ * the field itself, not from the fast pass's per-cell view (which this checks): the diffuse
+ * field's L and A = 3/(4 pi) J . d (atmos__lfield_toward, d per cell) read here, the do field's L. */
+static void field_toward_eye(const sjob *j, float u, float v, float w, float *out)
+{
+    const atmos__lfield *F = j->field;
+    const int n = j->n;
+    float LA[2 * ATMOS_MAX_WAVELENGTHS];
+    atmos__lfield_sample(F, j->fg ? F->LA : F->L, j->fg ? 2 * n : n, u, v, w, LA);
+    const float *A = LA + n;
+    for (int f = 0; f < j->nf; f++)
+        for (int c = 0; c < n; c++) {
+            const int i = f * ATMOS_MAX_WAVELENGTHS + c;
+            out[f * n + c] = j->fsca[i] * (LA[c] + (j->fg ? j->fg[i] * A[c] : 0.0f));
+        }
+}
+
 /* Reference eye pass (see slice_internal.h). */
 long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb)
 {
@@ -51,9 +68,8 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
         int oi = (int)(mm - 1.0f);
         if (oi > no - 2) oi = no - 2;
         const float fo = mm - 1.0f - (float)oi;
-        /* the field toward the eye as the fast pass reads it (atmos__dfield_view, slice_do.c) */
-        float fv[ATMOS_VOLUME_MAX_FIELDS * (ATMOS_MAX_WAVELENGTHS + 4)];
-        if (j->field) atmos__lfield_sample(j->field, j->fview, nf * j->fvq, u, v, w, fv);
+        float fv[ATMOS_VOLUME_MAX_FIELDS * ATMOS_MAX_WAVELENGTHS];
+        if (j->field) field_toward_eye(j, u, v, w, fv);
         for (int c = 0; c < n; c++) {
             float bext = 0, src = 0, dsrc = 0;
             for (int f = 0; f < nf; f++) {
@@ -61,7 +77,7 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
                 bext += dens[f] * j->t->sig[f][c];
                 float bs = dens[f] * j->t->sca[f][c];
                 if (bs > 0.0f) {
-                    if (j->field) dsrc += dens[f] * fv[f * j->fvq + c];
+                    if (j->field) dsrc += dens[f] * fv[f * n + c];
                     const float *q = j->t->ams[f] + ((size_t)j->pa[p * nf + f] + (size_t)oi * n + c);
                     const size_t an = (size_t)no * n; /* next angle; next order: + n */
                     float lo = q[0] + fo * (q[n] - q[0]);

@@ -131,7 +131,7 @@ atmos_status atmos__slice_render(atmos_plan *p, const atmos__view *v, const atmo
             if ((!v->hold_field || !sp->df.field.valid) &&
                 (st = atmos__dfield_update(ctx, &sp->df, p->atm, v->sun, v->warm_field, 0, &built)) != ATMOS_OK)
                 return st;
-            j.field = &sp->df.field;
+            j.field = &sp->df.field, j.fsca = sp->df.tab->sca[0], j.fg = sp->df.fg[0];
             double eu[3]; /* the eye in render-voxel coordinates */
             for (int a = 0; a < 3; a++) eu[a] = j.eye[a] * sp->g.sc + sp->g.off[a];
             atmos__dfield_view(&sp->df, eu, atmos__threads(ctx));

@@ -44,7 +44,8 @@ static const atmos_setting slice_settings[] = {
      SLICE(diffuse)},
     {"do", "slice-do", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
      "instead of Eq. 24/25 and that field: the first order in the delta-M scaled medium and the orders >= 2 "
-     "by discrete ordinates (the Nishita renderer's do field; no sky light in it yet, docs/lightfield.md)",
+     "by discrete ordinates (the Nishita renderer's do field, its cells nishita.mc_cell render voxels: the "
+     "one nishita setting it takes; no sky light in it yet, docs/lightfield.md)",
      SLICE(do_field)},
     {"air_shadows", "no-air-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
      "the volume's shadow on the air's single scattering (light shafts, crepuscular rays); "

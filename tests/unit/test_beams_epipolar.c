@@ -62,7 +62,8 @@ static int same_lines(const atmos__beams_epi *a, const atmos__beams_epi *b)
 
 /* Lines kept from the last build (the eye turning in place) only while they are what a fresh
  * build gives: the same eye and map; the map made again with a post moved (the same box, so the
- * same epipole: only the map's build tells); the eye moved. */
+ * same epipole: only the map's build tells); the eye moved; the bound on the samples lowered below
+ * theirs (none, as a fresh build under it). */
 static void test_kept_lines(atmos_mesh *post[10], atmos__beams_sun *s, const double sun[3], const double eye[3])
 {
     atmos__beams_epi kept = {0}, fresh = {0};
@@ -86,6 +87,11 @@ static void test_kept_lines(atmos_mesh *post[10], atmos__beams_sun *s, const dou
     CHECK(atmos__beams_epi_build(&kept, s, moved, (size_t)1 << 24, 2) == 0);
     CHECK(atmos__beams_epi_build(&fresh, s, moved, (size_t)1 << 24, 1) == 0);
     CHECK_MSG(same_lines(&kept, &fresh), "the eye moved: not a fresh build's lines");
+    const size_t few = kept.lines > 0 ? kept.at[kept.lines - 1] + (size_t)kept.cnt[kept.lines - 1] - 1 : 0;
+    CHECK(atmos__beams_epi_build(&kept, s, moved, few, 2) == 0);
+    CHECK(atmos__beams_epi_build(&fresh, s, moved, few, 1) == 0);
+    CHECK_MSG(kept.lines == 0 && fresh.lines == 0, "max_samples lowered: %d lines kept, %d fresh", kept.lines,
+              fresh.lines);
     atmos__beams_epi_free(&fresh), atmos__beams_epi_free(&kept);
 }
 

@@ -9,7 +9,9 @@
  *  - Nothing counted twice in thin media: a slab of optical depth 0.02, mostly the first order,
  *    within 3 % of adding-doubling.
  *  - The reference (scalar) eye pass reads the same field: its image within 0.1 % of the fast one's.
- *  - The same bytes with 1 and 2 threads. */
+ *  - The same bytes with 1 and 2 threads.
+ *  - The viewer's preview (hold_field) while the sun moves keeps the last sun's field: no solve,
+ *    the image that of the last sun's field; the next frame without it solves for its sun. */
 #include "test.h"
 #include "test_optics.h"
 #include "test_slab.h"
@@ -130,6 +132,55 @@ static void check_threads(const test_optics *op)
     atmos_image_destroy(img[0]), atmos_image_destroy(img[1]);
 }
 
+/* Renders the frame of sun elevation el (hold: hold_field) with plan p; its field's sweeps into
+ * *sweeps, its mean into *mean. */
+static void held_frame(atmos_context *ctx, atmos_plan *p, const atmos_scene *s, double el, int hold, int *sweeps,
+                       double *mean)
+{
+    atmos_scene t = *s;
+    t.sun.elevation_deg = el;
+    atmos_frame f;
+    atmos_image *img = NULL;
+    atmos_plan_stats ps;
+    CHECK_OK(atmos_frame_from_scene(ctx, &t, &f));
+    f.hold_field = hold;
+    CHECK_OK(atmos_plan_image_create(p, &f, &img));
+    if (img) CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
+    atmos_plan_get_stats(p, &ps);
+    *sweeps = ps.slice.field_sweeps, *mean = img ? image_mean(img) : 0;
+    atmos_image_destroy(img);
+}
+
+/* hold_field: the sun at the zenith, then held previews at 60 degrees, then the frame at 60 without
+ * it: the held frames solve nothing, the last one does; the held image (the zenith's field) is
+ * the same twice and differs from the solved one's at 60 degrees. */
+static void check_hold(atmos_context *ctx, const test_optics *op)
+{
+    atmos_volume *v = test_slab(ctx, 4);
+    atmos_scene s;
+    scene(&s, 0.6, 1);
+    atmos_plan_desc d;
+    memset(&d, 0, sizeof d);
+    d.optics = &op->o, d.offset_given = 1;
+    atmos_plan *p = NULL;
+    CHECK_OK(atmos_plan_create(ctx, &s, v, &d, &p));
+    if (p) {
+        int s0, s1, s2, s3;
+        double m0, m1, m2, m3;
+        held_frame(ctx, p, &s, 90, 0, &s0, &m0);
+        held_frame(ctx, p, &s, 60, 1, &s1, &m1);
+        held_frame(ctx, p, &s, 60, 1, &s2, &m2);
+        held_frame(ctx, p, &s, 60, 0, &s3, &m3);
+        printf("  hold_field: sweeps %d at 90 degrees, %d and %d held at 60, %d at 60 after; means %.5f %.5f %.5f "
+               "%.5f\n",
+               s0, s1, s2, s3, m0, m1, m2, m3);
+        CHECK(s0 > 0 && s1 == 0 && s2 == 0 && s3 > 0);
+        CHECK(m1 == m2 && m1 != m3);
+    }
+    atmos_plan_destroy(p);
+    atmos_volume_destroy(v);
+}
+
 int main(void)
 {
     atmos_context *ctx = NULL;
@@ -143,6 +194,7 @@ int main(void)
     check_thin(ctx, &op);
     check_reference(ctx, &op);
     check_threads(&op);
+    check_hold(ctx, &op);
     test_optics_free(&op);
     atmos_context_destroy(ctx);
     return test_summary("test_slice_do");

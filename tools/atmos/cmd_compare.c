@@ -40,7 +40,8 @@ static void help(void)
            "map) the pixels where a compared channel of either image exceeds L: the sun's disc, whose\n"
            "radiance is ~10^5 times the sky's, otherwise dominates the RMSE of any image showing it\n"
            "(e.g. 1e5 for a daylight sky in atmos render's units; the count left out is printed,\n"
-           "\"excluded\" in --json).\n");
+           "\"excluded\" in --json). NaN and infinities are never left out; every pixel left out\n"
+           "fails the comparison (exit status 1).\n");
     fputs(CLI_HELP_EXIT, stdout);
 }
 
@@ -258,6 +259,11 @@ int cli_cmd_compare(int argc, char **argv)
         if (d.nonfinite) {
             fprintf(stderr, "atmos %s: %zu compared samples are NaN or infinite (%zu in %s, %zu in %s): the comparison fails\n",
                     C, d.nonfinite, d.nonfinite_image, files[0], d.nonfinite_reference, files[1]);
+            rc = CLI_EXIT_RUNTIME;
+        }
+        if (m.exclude_above > 0 && d.excluded == (size_t)a.img->width * a.img->height) {
+            fprintf(stderr, "atmos %s: every pixel is above %g (--exclude-above): nothing was compared\n", C,
+                    m.exclude_above);
             rc = CLI_EXIT_RUNTIME;
         }
     }
