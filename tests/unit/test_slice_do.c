@@ -147,7 +147,7 @@ static void held_frame(atmos_context *ctx, atmos_plan *p, const atmos_scene *s, 
     CHECK_OK(atmos_plan_image_create(p, &f, &img));
     if (img) CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
     atmos_plan_get_stats(p, &ps);
-    *sweeps = ps.slice.field_sweeps, *mean = img ? image_mean(img) : 0;
+    *sweeps = ps.slice.field_sweeps, *mean = img ? test_image_mean(img) : 0;
     atmos_image_destroy(img);
 }
 
