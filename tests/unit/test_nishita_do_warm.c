@@ -7,31 +7,11 @@
  * reaches the ball): the warm-started field is 0 as the fresh one, not the last sun's moments swept
  * once more (a ghost of the last sun). */
 #include "test.h"
+#include "test_optics.h"
 
 #define N 24       /* voxels per axis */
 #define VS 50.0    /* m */
 #define SIGMA 1e-9 /* m^2 */
-
-static void make_optics(atmos_context *ctx, atmos_phase_table **t, atmos_volume_optics *o)
-{
-    atmos_particle_desc p;
-    memset(&p, 0, sizeof p);
-    snprintf(p.name, sizeof p.name, "hg");
-    p.kind = ATMOS_PARTICLE_ANALYTIC;
-    p.analytic.count = 1;
-    p.analytic.kind[0] = ATMOS_PHASE_HG;
-    p.analytic.g[0] = 0.85;
-    p.analytic.weight[0] = 1;
-    p.sigma_ext_m2 = SIGMA;
-    p.albedo = 1.0;
-    atmos_wavelengths wl;
-    atmos_wavelengths_rgb(&wl);
-    atmos_phase_table_desc td = {1};
-    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, t));
-    memset(o, 0, sizeof *o);
-    o->count = 1;
-    o->phase[0] = *t;
-}
 
 /* A ball of radius 10 voxels, one optical depth per voxel (20 across), in a grid of N^3. */
 static atmos_volume *ball(atmos_context *ctx)
@@ -44,8 +24,7 @@ static atmos_volume *ball(atmos_context *ctx)
                 if (x * x + y * y + z * z < 100) buf[((size_t)k * N + j) * N + i] = (float)(1 / (SIGMA * VS));
             }
     const int dims[3] = {N, N, N};
-    const double org[3] = {-0.5 * N * VS, 1000, -0.5 * N * VS};
-    atmos_volume *v = test_dense_volume(ctx, dims, VS, org, "cloud", "hg", buf);
+    atmos_volume *v = test_cloud_volume(ctx, dims, VS, buf);
     free(buf);
     return v;
 }
@@ -131,9 +110,9 @@ int main(void)
     atmos_context_defaults(&d);
     d.threads = 2;
     CHECK_OK(atmos_context_create(&d, &ctx));
-    atmos_phase_table *t = NULL;
-    atmos_volume_optics o;
-    make_optics(ctx, &t, &o);
+    test_optics op;
+    test_hg_optics(ctx, "hg", 0.85, 1.0, 0, &op);
+    const atmos_volume_optics o = op.o;
     atmos_volume *v = ball(ctx);
     atmos_scene s;
     test_vacuum_scene(&s, 40, 0);
@@ -174,7 +153,7 @@ int main(void)
     atmos_plan_destroy(p), atmos_plan_destroy(q);
     sunset(ctx, &s, v, &pd);
     atmos_volume_destroy(v);
-    atmos_phase_table_destroy(t);
+    test_optics_free(&op);
     atmos_context_destroy(ctx);
     return test_summary("test_nishita_do_warm");
 }

@@ -9,33 +9,13 @@
  * (render/nishita_do.c) in slabs of optical depth 1, 4 and 16. */
 #include "render/path_phase.h"
 #include "test.h"
+#include "test_optics.h"
 #include "test_slab.h"
 
 #include <stdint.h>
 
 #define TAU 4.0
 #define G 0.85
-
-static void make_optics(atmos_context *ctx, atmos_phase_table **t, atmos_volume_optics *o)
-{
-    atmos_particle_desc p;
-    memset(&p, 0, sizeof p);
-    snprintf(p.name, sizeof p.name, "hg");
-    p.kind = ATMOS_PARTICLE_ANALYTIC;
-    p.analytic.count = 1;
-    p.analytic.kind[0] = ATMOS_PHASE_HG;
-    p.analytic.g[0] = G;
-    p.analytic.weight[0] = 1;
-    p.sigma_ext_m2 = SIGMA;
-    p.albedo = 1.0;
-    atmos_wavelengths wl;
-    atmos_wavelengths_rgb(&wl);
-    atmos_phase_table_desc td = {1};
-    CHECK_OK(atmos_phase_table_build(ctx, &p, &wl, &td, t));
-    memset(o, 0, sizeof *o);
-    o->count = 1;
-    o->phase[0] = *t;
-}
 
 /* The slab (test_slab.h) of optical depth TAU. */
 static atmos_volume *slab(atmos_context *ctx) { return test_slab(ctx, TAU); }
@@ -248,9 +228,9 @@ int main(void)
     atmos_context_defaults(&d);
     d.threads = 2;
     CHECK_OK(atmos_context_create(&d, &ctx));
-    atmos_phase_table *t = NULL;
-    atmos_volume_optics o;
-    make_optics(ctx, &t, &o);
+    test_optics op;
+    test_hg_optics(ctx, "hg", G, 1.0, 0, &op);
+    const atmos_volume_optics o = op.o;
     check_scaled_phase(ctx, &o);
     atmos_volume *v = slab(ctx);
     check_slab(ctx, &o, v);
@@ -260,7 +240,7 @@ int main(void)
     check_threads(&o, v, 1, 0, 1);
     check_do(ctx, &o);
     atmos_volume_destroy(v);
-    atmos_phase_table_destroy(t);
+    test_optics_free(&op);
     atmos_context_destroy(ctx);
     return test_summary("test_nishita_mc");
 }
