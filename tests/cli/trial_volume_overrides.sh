@@ -4,6 +4,7 @@
 #     file it applies to), not on the scene file, which has no such key (scene-format.md);
 #     the same without a scene file, and a scene from standard input keeps its
 #     "standard input:" prefix for a file key's error;
+#     a -D object's file key is from the current folder; two -D volume sources are refused;
 #  2. a volume placed wholly below the ground warns (as a too-thin one does); one above does not.
 . "$(dirname "$0")/common.inc"
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
@@ -22,6 +23,13 @@ hasnt "-D volume.file on a scene" "atmos render: s.json: /volume/file"
 has "-D volume.file alone" "nothere.vdb\": /volume/file: "
 printf '{"volume": {"file": "nothere.vdb"}}\n' | (cd "$T" && "$A" render - -o "$T/e.png") 2>"$T/err"
 has "a file key from standard input" "atmos render: standard input: /volume/file: nothere.vdb: cannot open"
+
+# a file key inside an object a -D sets is from the current folder too, and named as the -D
+(cd "$T" && "$A" render s.json -D 'volume={"file": "nothere.vdb"}' -o "$T/e.png") 2>"$T/err"
+has "-D volume={file} on a scene" "(on s.json): /volume/file: $(cd "$T" && pwd -P)/nothere.vdb: cannot open"
+# two -D naming volume sources of two kinds: refused, as in a scene file (not the last taken)
+(cd "$T" && "$A" render s.json -D volume.file=nothere.vdb -D volume.generate=cumulus -o "$T/e.png") 2>"$T/err"
+has "-D volume.file and -D volume.generate" "/volume: \"file\" and \"generate\" exclude each other"
 
 # --- 2. a volume wholly below the ground warns; above it, no such warning
 "$A" volume generate cumulus -o "$T/v.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"
