@@ -72,13 +72,15 @@ static cJSON *child(cJSON *node, const char *tok)
     return i < 0 ? NULL : cJSON_GetArrayItem(node, i);
 }
 
+/* The volume's sources, one bit each in the order given (file 1, generate 2, simulate 4). */
+static const char *const sources[] = {"file", "generate", "simulate"};
+
 /* The volume's source is one of "file", "generate" and "simulate": one set by an override
  * replaces the others the file had (as --volume replaces the scene's volume), with the keys
  * only the old kind takes (scene_json.c refuses them with the new one); overrides after it
  * may set them again. */
 static void drop_other_sources(cJSON *root, const cJSON *node, const char *tok)
 {
-    static const char *const sources[] = {"file", "generate", "simulate"};
     static const char *const file_only[] = {"grids", "time_index", "density_unit", "subgrid_detail", NULL},
                              *const gen_only[] = {"seed", NULL},
                              *const sim_bad[] = {"grids", "time_index", "density_unit", "subgrid_detail", "seed",
@@ -152,7 +154,6 @@ static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *roo
  * path is /volume/file, .generate or .simulate, or the whole "volume" holding them. */
 static unsigned override_sources(const char *ov)
 {
-    static const char *const sources[] = {"file", "generate", "simulate"};
     const char *eq = strchr(ov, '=');
     if (!eq) return 0;
     const char *p = ov + (ov[0] == '/');
@@ -161,7 +162,8 @@ static unsigned override_sources(const char *ov)
     unsigned bits = 0;
     if (n == 6) { /* the whole volume: the sources its object holds */
         cJSON *v = cJSON_Parse(eq + 1);
-        for (int i = 0; i < 3; i++) bits |= cJSON_IsObject(v) && cJSON_GetObjectItemCaseSensitive(v, sources[i]) ? 1u << i : 0;
+        for (int i = 0; i < 3; i++)
+            bits |= cJSON_IsObject(v) && cJSON_GetObjectItemCaseSensitive(v, sources[i]) ? 1u << i : 0;
         cJSON_Delete(v);
         return bits;
     }
@@ -175,7 +177,6 @@ static unsigned override_sources(const char *ov)
  * are refused, as the two keys in a scene file are; one replacing the file's source is not. */
 static atmos_status two_sources(atmos_context *ctx, const char *const *overrides, int count)
 {
-    static const char *const sources[] = {"file", "generate", "simulate"};
     unsigned seen = 0;
     int first = -1;
     for (int i = 0; i < count; i++) {

@@ -485,7 +485,8 @@ static int apply_volume_file(const render_opts *o, atmos_scene *s)
         return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit, --voxel-size and --volume-scale "
                                   "need a volume (--volume or a scene with one)");
     const int file_only = o->grids || o->time_index >= 0 || o->density_unit >= 0 || o->subgrid_detail > 0;
-    if ((file_only && !strncmp(s->volume.source, "generate:", 9)) || (given && !strncmp(s->volume.source, "simulate:", 9)))
+    const int generated = !strncmp(s->volume.source, "generate:", 9), simulated = !strncmp(s->volume.source, "simulate:", 9);
+    if ((file_only && generated) || (given && simulated))
         return cli_usage_error(C, "--grids, --time-index, --density-unit and --subgrid-detail apply to a volume file, "
                                   "not to a generated volume; --particle (its cloud droplets' type) not to a "
                                   "simulated one");

@@ -216,7 +216,8 @@ static const char *cwd_define(const char *def, char *buf, size_t cap)
         cJSON *tree = cJSON_Parse(v);
         char *text = tree && cwd_tree(tree) ? cJSON_PrintUnformatted(tree) : NULL;
         cJSON_Delete(tree);
-        if (text && (size_t)(eq - def) + 1 + strlen(text) < cap) snprintf(buf, cap, "%.*s=%s", (int)(eq - def), def, text);
+        if (text && (size_t)(eq - def) + 1 + strlen(text) < cap)
+            snprintf(buf, cap, "%.*s=%s", (int)(eq - def), def, text);
         const int done = text && buf[0];
         free(text);
         return done ? buf : def;
