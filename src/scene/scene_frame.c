@@ -18,6 +18,11 @@ atmos_status atmos_scene_frame_volume_file(atmos_context *ctx, atmos_scene *scen
     atmos_status st = atmos_scene_load_volume(ctx, scene, out, off);
     if (st != ATMOS_OK) return st;
     atmos_volume_bounds(*out, lo, hi);
+    /* Not placed by the scene: the box's centre over the origin at its own heights (the camera
+     * is framed around it, so nothing needs it in front of a camera). Three widths away, a
+     * model domain hundreds of km wide lay where a round planet's ground is tens of km under
+     * y = 0 (a 300 km domain 900 km away: 64 km), its clouds that far above the ground. */
+    if (!scene->volume.placed) off[0] = -0.5 * (lo[0] + hi[0]), off[2] = -0.5 * (lo[2] + hi[2]);
     /* The placement made explicit, so that a plan puts the volume where it was framed. */
     scene->volume.placed = 1;
     scene->volume.position_m[0] = off[0] + 0.5 * (lo[0] + hi[0]);

@@ -1057,11 +1057,11 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
         return ATMOS_OK;
     }
     /* The keys one kind of volume would ignore are refused with it. */
-    /* A generator sets its fields' particle types itself (a storm's cloud, rain and ice), so
-     * "particle", which names a file's one field's, is refused with it rather than ignored. */
-    static const int file_only[] = {K_GRIDS, K_TIME, K_UNIT, K_DETAIL, K_PARTICLE}, gen_only[] = {K_SEED};
+    /* "particle" applies to both: a file's one field's type, a generated volume's cloud
+     * droplets' (its "cloud" fields; a storm's rain and ice keep theirs: scene_optics.c). */
+    static const int file_only[] = {K_GRIDS, K_TIME, K_UNIT, K_DETAIL}, gen_only[] = {K_SEED};
     const int is_file = (it.seen & (1u << K_FILE)) != 0;
-    const int *bad = is_file ? gen_only : file_only, nbad = is_file ? 1 : 5;
+    const int *bad = is_file ? gen_only : file_only, nbad = is_file ? 1 : 4;
     for (int i = 0; i < nbad; i++)
         if (it.seen & (1u << bad[i]))
             return atmos__scene_fail(p->ctx, ATMOS_E_INVALID_ARG, p->source, path,

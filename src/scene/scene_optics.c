@@ -31,6 +31,11 @@ atmos_status atmos_volume_optics_build(atmos_context *ctx, const atmos_scene *sc
     for (int i = 0; i < nf; i++) {
         atmos_particle_desc pd;
         const char *name = atmos_volume_field_particle(volume, i);
+        /* a generated volume's cloud droplets take the scene's "particle" (a file's one field
+         * has it from the reader already; rain and ice keep their own) */
+        if (scene->volume.particle[0] && !strncmp(scene->volume.source, "generate:", 9) && name &&
+            !strcmp(name, "cloud"))
+            name = scene->volume.particle;
         if ((st = atmos_scene_particle(ctx, scene, name, &pd)) != ATMOS_OK) goto fail;
         atmos_phase_table *t = NULL;
         atmos_phase_table_desc td = {0};

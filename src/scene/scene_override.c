@@ -72,13 +72,15 @@ static cJSON *child(cJSON *node, const char *tok)
     return i < 0 ? NULL : cJSON_GetArrayItem(node, i);
 }
 
+/* The volume's sources, one bit each in the order given (file 1, generate 2, simulate 4). */
+static const char *const sources[] = {"file", "generate", "simulate"};
+
 /* The volume's source is one of "file", "generate" and "simulate": one set by an override
  * replaces the others the file had (as --volume replaces the scene's volume), with the keys
  * only the old kind takes (scene_json.c refuses them with the new one); overrides after it
  * may set them again. */
 static void drop_other_sources(cJSON *root, const cJSON *node, const char *tok)
 {
-    static const char *const sources[] = {"file", "generate", "simulate"};
     static const char *const file_only[] = {"grids", "time_index", "density_unit", "subgrid_detail", NULL},
                              *const gen_only[] = {"seed", NULL},
                              *const sim_bad[] = {"grids", "time_index", "density_unit", "subgrid_detail", "seed",
@@ -148,19 +150,67 @@ static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *roo
                         source, path);
 }
 
-atmos_status atmos__scene_apply_overrides(atmos_context *ctx, const char *source, struct cJSON *root,
-                                          const char *const *overrides, int count)
+/* The volume sources an override names, a bit each (file 1, generate 2, simulate 4): its
+ * path is /volume/file, .generate or .simulate, or the whole "volume" holding them. */
+static unsigned override_sources(const char *ov)
 {
+    const char *eq = strchr(ov, '=');
+    if (!eq) return 0;
+    const char *p = ov + (ov[0] == '/');
+    const size_t n = (size_t)(eq - p);
+    if (n < 6 || strncmp(p, "volume", 6)) return 0;
+    unsigned bits = 0;
+    if (n == 6) { /* the whole volume: the sources its object holds */
+        cJSON *v = cJSON_Parse(eq + 1);
+        for (int i = 0; i < 3; i++)
+            bits |= cJSON_IsObject(v) && cJSON_GetObjectItemCaseSensitive(v, sources[i]) ? 1u << i : 0;
+        cJSON_Delete(v);
+        return bits;
+    }
+    if (p[6] != (ov[0] == '/' ? '/' : '.')) return 0;
+    for (int i = 0; i < 3; i++)
+        if (n == 7 + strlen(sources[i]) && !strncmp(p + 7, sources[i], strlen(sources[i]))) bits |= 1u << i;
+    return bits;
+}
+
+/* Two overrides naming volume sources of two kinds (-D volume.file=x -D volume.generate=y)
+ * are refused, as the two keys in a scene file are; one replacing the file's source is not. */
+static atmos_status two_sources(atmos_context *ctx, const char *const *overrides, int count)
+{
+    unsigned seen = 0;
+    int first = -1;
     for (int i = 0; i < count; i++) {
-        if (!overrides || !overrides[i]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override %d is NULL", source, i);
-        atmos_status st = apply_one(ctx, source, root, overrides[i]);
-        if (st != ATMOS_OK) return st;
+        const unsigned b = override_sources(overrides[i]);
+        if (!b) continue;
+        const unsigned u = seen | b;
+        if (seen && (u & (u - 1))) { /* two kinds: name the first two */
+            int a = 0, c;
+            while (!(u >> a & 1u)) a++;
+            for (c = a + 1; c < 3 && !(u >> c & 1u); c++) {}
+            return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                                "-D %.300s and -D %.300s: /volume: \"%s\" and \"%s\" exclude each other (as in a "
+                                "scene file): give one",
+                                overrides[first], overrides[i], sources[a], sources[c < 3 ? c : a]);
+        }
+        seen |= b;
+        first = i;
     }
     return ATMOS_OK;
 }
 
+atmos_status atmos__scene_apply_overrides(atmos_context *ctx, const char *source, struct cJSON *root,
+                                          const char *const *overrides, int count)
+{
+    for (int i = 0; i < count; i++)
+        if (!overrides || !overrides[i]) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override %d is NULL", source, i);
+    atmos_status st = two_sources(ctx, overrides, count);
+    for (int i = 0; st == ATMOS_OK && i < count; i++) st = apply_one(ctx, source, root, overrides[i]);
+    return st;
+}
+
 /* Whether the override ov (PATH=VALUE, dotted or a JSON pointer) sets key (a JSON pointer,
- * "/a/b/0") or an object or array that holds it. */
+ * "/a/b/0") or an object or array that holds it; or, for one naming the volume's source
+ * (which replaces the file's), whether key is "/volume" (what the new source does not take). */
 static int override_sets(const char *ov, const char *key)
 {
     const char *eq = strchr(ov, '=');
@@ -171,6 +221,7 @@ static int override_sets(const char *ov, const char *key)
     if (*p != '/') ptr[n++] = '/';
     for (; p < eq && n + 1 < sizeof ptr; p++) ptr[n++] = *p == '.' && ov[0] != '/' ? '/' : *p;
     ptr[n] = '\0';
+    if (!strcmp(key, "/volume") && override_sources(ov)) return 1;
     return !strncmp(key, ptr, n) && (key[n] == '\0' || key[n] == '/');
 }
 

@@ -249,18 +249,18 @@ atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const
     return ATMOS_OK;
 }
 
-/* A volume's "particle": a file's (a generator sets its fields' own types), and a known
- * type (the scene's "particles" or a preset), as the fog's. */
+/* A volume's "particle": a file's or a generated volume's (a simulation sets its fields' own
+ * types), and a known type (the scene's "particles" or a preset), as the fog's. */
 static atmos_status validate_volume_particle(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
     const atmos_scene_volume *v = &s->volume;
     if (!v->particle[0]) return ATMOS_OK;
     if (!memchr(v->particle, '\0', sizeof v->particle))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/particle", "is not terminated");
-    if (!strncmp(v->source, "generate:", 9) || !strncmp(v->source, "simulate:", 9))
+    if (!strncmp(v->source, "simulate:", 9))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/particle",
-                                 "applies to volume files, not to a %s volume (its fields have their own types)",
-                                 v->source[0] == 'g' ? "generated" : "simulated");
+                                 "applies to volume files and generated volumes, not to a simulated volume (its "
+                                 "fields have their own types)");
     atmos_particle_desc pd;
     if (atmos_scene_particle(NULL, s, v->particle, &pd) != ATMOS_OK)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/volume/particle",

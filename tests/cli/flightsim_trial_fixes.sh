@@ -1,7 +1,8 @@
 #!/bin/sh
 # What a game/flight-sim developer's trial (scene files, the C API, time of day) ran into:
-#  1. "particle" on a generated volume is refused (it was ignored), and an unknown particle
-#     name on a volume file names /volume/particle, as /fog/particle does;
+#  1. "particle" on a generated volume names its cloud droplets' type (it was ignored, then
+#     refused: Fig. 4's glory scene did not render), on a simulated one it is refused, and an
+#     unknown particle name names /volume/particle, as /fog/particle does;
 #  2. a day animation with the locked exposure locks on the frame with the highest sun (a
 #     night first frame had burnt the day frames white), and an animation's automatic
 #     exposure stops at a camera's limit (animation.exposure_limit_ev, EV100 -2): a
@@ -19,12 +20,15 @@ hasnt() { grep -qF -- "$2" "$T/err" && { bad "$1: '$2' in:"; sed 's/^/  /' "$T/e
 scene() { printf '{"image": {"width": 16, "height": 9}, "volume": %s}\n' "$1" >"$T/s.json"; }
 scene '{"generate": "cumulus", "particle": "hail"}'
 "$A" render "$T/s.json" -o "$T/x.png" 2>"$T/err"; rc=$?
-[ $rc -eq 1 ] && ok "generate + particle refused" || bad "generate + particle: rc $rc"
-has "generate + particle" "/volume"
-has "generate + particle" "\"particle\""
-scene '{"generate": "cumulus", "particle": "ice"}'
+[ $rc -eq 1 ] && ok "generate + unknown particle refused" || bad "generate + unknown particle: rc $rc"
+has "generate + unknown particle" "/volume/particle: 'hail' is neither"
+scene '{"generate": "cumulus", "particle": "ice", "voxel_size_m": 400}'
+"$A" render "$T/s.json" -o "$T/x.png" -q 2>"$T/err"; rc=$?
+[ $rc -eq 0 ] && ok "generate + a known particle renders" || { bad "generate + particle ice: rc $rc"; cat "$T/err" >&2; }
+scene '{"simulate": {"preset": "stratocumulus"}, "particle": "ice"}'
 "$A" render "$T/s.json" -o "$T/x.png" 2>"$T/err"; rc=$?
-[ $rc -eq 1 ] && ok "generate + a known particle refused too" || bad "generate + particle ice: rc $rc"
+[ $rc -eq 1 ] && ok "simulate + particle refused" || bad "simulate + particle: rc $rc"
+has "simulate + particle" "\"particle\" does not apply to a simulated volume"
 "$A" volume generate cumulus -o "$T/v/v.json" --voxel-size 400 >/dev/null 2>"$T/err" || bad "volume generate"
 scene '{"file": "v/v.json", "particle": "hail"}'
 "$A" render "$T/s.json" -o "$T/x.png" 2>"$T/err"; rc=$?

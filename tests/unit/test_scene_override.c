@@ -48,6 +48,24 @@ int main(void)
     CHECK(fabs(s.fog.extinction_per_m - 0.01) < 1e-12 && s.fog.visibility_m == 391.2);
     CHECK_OK(parse("{\"fog\": {\"visibility_m\": 100}}", g, 1, &s));
     CHECK(s.fog.extinction_per_m == 0.02 && s.fog.visibility_m == 0);
+    /* two overrides naming volume sources of two kinds: refused, as the two keys in a file are
+     * (the last no longer drops the first without a word); one kind twice: the last holds */
+    const char *h[] = {"volume.file=x.vdb", "volume.generate=cumulus"},
+               *i[] = {"volume={\"file\": \"x.vdb\"}", "/volume/simulate={\"preset\": \"stratocumulus\"}"},
+               *j[] = {"volume.generate=cumulus", "volume.generate=storm"};
+    CHECK(parse("{}", h, 2, &s) == ATMOS_E_INVALID_ARG);
+    CHECK_MSG(strstr(atmos_context_error(ctx), "-D volume.file=x.vdb and -D volume.generate=cumulus: /volume: \"file\" "
+                                               "and \"generate\" exclude each other") != NULL,
+              "%s", atmos_context_error(ctx));
+    CHECK(parse("{}", i, 2, &s) == ATMOS_E_INVALID_ARG);
+    CHECK(strstr(atmos_context_error(ctx), "\"file\" and \"simulate\" exclude each other") != NULL);
+    CHECK_OK(parse("{\"volume\": {\"file\": \"d.vdb\"}}", j, 2, &s));
+    CHECK(!strcmp(s.volume.source, "generate:storm"));
+    /* an error at /volume that a source override causes names the override, not the file */
+    const char *k[] = {"volume.generate=cumulus", "volume.time_index=2"};
+    CHECK(parse("{\"volume\": {\"file\": \"d.vdb\"}}", k, 2, &s) == ATMOS_E_INVALID_ARG);
+    CHECK_MSG(!strncmp(atmos_context_error(ctx), "-D volume.generate=cumulus (on t.json): /volume: \"time_index\"", 60),
+              "%s", atmos_context_error(ctx));
     atmos_context_destroy(ctx);
     return test_summary("test_scene_override");
 }

@@ -484,9 +484,12 @@ static int apply_volume_file(const render_opts *o, atmos_scene *s)
     if (!s->volume.source[0])
         return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit, --voxel-size and --volume-scale "
                                   "need a volume (--volume or a scene with one)");
-    if (given && (!strncmp(s->volume.source, "generate:", 9) || !strncmp(s->volume.source, "simulate:", 9)))
-        return cli_usage_error(C, "--grids, --particle, --time-index, --density-unit and --subgrid-detail apply to a "
-                                  "volume file, not to a generated volume");
+    const int file_only = o->grids || o->time_index >= 0 || o->density_unit >= 0 || o->subgrid_detail > 0;
+    const int generated = !strncmp(s->volume.source, "generate:", 9), simulated = !strncmp(s->volume.source, "simulate:", 9);
+    if ((file_only && generated) || (given && simulated))
+        return cli_usage_error(C, "--grids, --time-index, --density-unit and --subgrid-detail apply to a volume file, "
+                                  "not to a generated volume; --particle (its cloud droplets' type) not to a "
+                                  "simulated one");
     if (o->grids) snprintf(s->volume.grids, sizeof s->volume.grids, "%s", o->grids);
     if (o->particle) snprintf(s->volume.particle, sizeof s->volume.particle, "%s", o->particle);
     if (o->time_index >= 0) s->volume.time_index = o->time_index;
@@ -785,7 +788,8 @@ void render_opts_help(void)
            "      --volume-scale S          generators: extent factor; VDB/raw files: multiplies their lengths\n"
            "                                (0.01: a file in centimetres)\n"
            "      --grids LIST              VDB grids or NetCDF variables to load (comma-separated)\n"
-           "      --particle NAME           particle type of a single-grid VDB/raw file (default cloud)\n"
+           "      --particle NAME           particle type of a single-grid VDB/raw file or of a generated\n"
+           "                                volume's cloud droplets (default cloud)\n"
            "      --time-index N            NetCDF time step (default 0)\n"
            "      --subgrid-detail A        NetCDF, for artists: a fractal texture below the model's grid,\n"
            "                                amplitude A in (0, 1] (not model data; default off)\n"

@@ -118,11 +118,14 @@ static void round_planet_from_orbit(const render_opts *o, atmos_scene *scene)
     if (atmosphere_given(o) || scene->atmosphere.kind != ATMOS_ATMOSPHERE_RILEY) return;
     if (!(scene->camera.position[1] > FLAT_EARTH_TOP_M)) return;
     scene->atmosphere.kind = ATMOS_ATMOSPHERE_SPHERICAL;
+    /* its height over the round planet (centre (0, -R, 0)), not its y */
+    const double R = scene->atmosphere.planet_radius_m > 0 ? scene->atmosphere.planet_radius_m : 6360e3,
+                 *p = scene->camera.position, up = hypot(hypot(p[0], p[2]), p[1] + R) - R;
     if (!o->quiet)
         fprintf(stderr,
                 "atmos %s: the camera is %.0f km up, above the flat-earth riley model's range: using the spherical "
                 "atmosphere model (--atmosphere riley keeps the flat one)\n",
-                o->cmd, scene->camera.position[1] / 1000.0);
+                o->cmd, up / 1000.0);
 }
 
 /* A volume file with no camera given: framed as atmos_scene_frame_volume_file frames it, and said. */
@@ -154,31 +157,74 @@ static void quoted_define(char *buf, size_t cap, const char *key, size_t klen, c
 }
 
 /* A -D that sets a file (volume.file, a light's image, an object's mesh or terrain, the Earth's
- * maps) to a relative path names it from the current folder, as a path typed on the command
+ * maps; or such a key inside an object it sets: -D 'volume={"file": ...}') to a relative path
+ * names it from the current folder, as a path typed on the command
  * line does everywhere, not from the scene file's folder: the path is made absolute here
  * (realpath when it exists). Others, "data:", "builtin:", "generate:" and "simulate:" values
  * are kept. Returns def itself or buf. */
+static const char *const cwd_keys[] = {"file", "image", "mesh", "terrain", "ground_map", "night_lights", "world_file"};
+
+static int is_path_key(const char *k, size_t n)
+{
+    for (size_t i = 0; i < sizeof cwd_keys / sizeof cwd_keys[0]; i++)
+        if (n == strlen(cwd_keys[i]) && !strncmp(k, cwd_keys[i], n)) return 1;
+    return 0;
+}
+
+/* value (n bytes) made absolute from the current folder into joined (realpath when it
+ * exists); 0 when it is kept: absolute, empty, too long, or "data:", "generate:" ... */
+static int cwd_path(const char *v, size_t n, char *joined, size_t cap)
+{
+    char value[ATMOS_SCENE_PATH_MAX], cwd[ATMOS_SCENE_PATH_MAX];
+    if (n == 0 || n >= sizeof value || v[0] == '/' || v[0] == '"' || memchr(v, ':', n)) return 0;
+    memcpy(value, v, n);
+    value[n] = 0;
+    char *abs = realpath(value, NULL);
+    if (!abs && getcwd(cwd, sizeof cwd)) snprintf(joined, cap, "%s/%s", cwd, value);
+    else snprintf(joined, cap, "%s", abs ? abs : value);
+    free(abs);
+    return 1;
+}
+
+/* The file keys inside a JSON value (-D 'volume={"file": "d.vdb"}', -D 'objects.0={...}'),
+ * made absolute as cwd_path does. Returns whether any changed. */
+static int cwd_tree(cJSON *node)
+{
+    int changed = 0;
+    for (cJSON *c = node ? node->child : NULL; c; c = c->next) {
+        char joined[2 * ATMOS_SCENE_PATH_MAX];
+        if (cJSON_IsString(c) && c->string && is_path_key(c->string, strlen(c->string)) &&
+            cwd_path(c->valuestring, strlen(c->valuestring), joined, sizeof joined)) {
+            changed |= cJSON_SetValuestring(c, joined) != NULL;
+        } else if (cJSON_IsObject(c) || cJSON_IsArray(c)) {
+            changed |= cwd_tree(c);
+        }
+    }
+    return changed;
+}
+
 static const char *cwd_define(const char *def, char *buf, size_t cap)
 {
-    static const char *const keys[] = {"file", "image", "mesh", "terrain", "ground_map", "night_lights", "world_file"};
     const char *eq = strchr(def, '=');
     if (!eq) return def;
     const char *last = eq;
     while (last > def && last[-1] != '.' && last[-1] != '/') last--;
-    int path_key = 0;
-    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
-        path_key |= (size_t)(eq - last) == strlen(keys[i]) && !strncmp(last, keys[i], strlen(keys[i]));
-    char value[ATMOS_SCENE_PATH_MAX];
     const char *v = eq + 1;
     size_t n = strlen(v);
+    if (v[0] == '{' || v[0] == '[') { /* an object or array holding file keys */
+        buf[0] = '\0';
+        cJSON *tree = cJSON_Parse(v);
+        char *text = tree && cwd_tree(tree) ? cJSON_PrintUnformatted(tree) : NULL;
+        cJSON_Delete(tree);
+        if (text && (size_t)(eq - def) + 1 + strlen(text) < cap)
+            snprintf(buf, cap, "%.*s=%s", (int)(eq - def), def, text);
+        const int done = text && buf[0];
+        free(text);
+        return done ? buf : def;
+    }
     if (n >= 2 && v[0] == '"' && v[n - 1] == '"' && !memchr(v + 1, '\\', n - 2)) v++, n -= 2;
-    if (!path_key || n == 0 || n >= sizeof value || v[0] == '/' || v[0] == '"' || strchr(v, ':')) return def;
-    memcpy(value, v, n);
-    value[n] = 0;
-    char *abs = realpath(value, NULL), cwd[ATMOS_SCENE_PATH_MAX], joined[2 * ATMOS_SCENE_PATH_MAX];
-    if (!abs && getcwd(cwd, sizeof cwd)) snprintf(joined, sizeof joined, "%s/%s", cwd, value);
-    else snprintf(joined, sizeof joined, "%s", abs ? abs : value);
-    free(abs);
+    char joined[2 * ATMOS_SCENE_PATH_MAX];
+    if (!is_path_key(last, (size_t)(eq - last)) || !cwd_path(v, n, joined, sizeof joined)) return def;
     quoted_define(buf, cap, def, (size_t)(eq - def), joined);
     return buf;
 }
