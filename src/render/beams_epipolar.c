@@ -21,7 +21,7 @@ void atmos__beams_epi_free(atmos__beams_epi *e)
 
 /* The cells of a tree over nseg segments: level 0 holds ceil(nseg / LEAF) of them, each level
  * above half as many, rounded up, down to one. */
-size_t atmos__beams_epi_cells(int nseg, int *levels)
+static size_t tree_cells(int nseg, int *levels)
 {
     size_t total = 0;
     int l = 0;
@@ -104,13 +104,8 @@ static void fill(atmos__beams_epi *e, const atmos__beams_sun *s, int j)
 {
     const double th = j * e->dth, c = cos(th), sn = sin(th);
     const int cnt = e->cnt[j], k0 = e->k0[j];
-    float *m = e->m + e->at[j], *lh = e->lh + 2 * e->tat[j];
+    float *m = e->m + e->at[j], *lh = e->lh + 2 * e->tat[j]; /* a cell's least depth, then its greatest */
     for (int i = 0; i < cnt; i += CHUNK) samples(s, e->ex, e->ey, c, sn, k0, i, cnt - i < CHUNK ? cnt - i : CHUNK, m + i);
-    atmos__beams_epi_tree(m, cnt, lh);
-}
-
-void atmos__beams_epi_tree(const float *m, int cnt, float *lh)
-{
     const int nseg = cnt - 1;
     int c0 = (nseg + LEAF - 1) / LEAF;
     for (int i = 0; i < c0; i++) {
@@ -169,7 +164,7 @@ int atmos__beams_epi_build(atmos__beams_epi *e, const atmos__beams_sun *s, const
         e->k0[j] = r1 > r0 ? (int)floor(r0) : 0;
         e->cnt[j] = r1 > r0 ? (int)ceil(r1) - e->k0[j] + 1 : 0;
         e->at[j] = samples, e->tat[j] = cells;
-        samples += (size_t)e->cnt[j], cells += atmos__beams_epi_cells(e->cnt[j] - 1, NULL);
+        samples += (size_t)e->cnt[j], cells += tree_cells(e->cnt[j] - 1, NULL);
     }
     if (samples > max_samples) return 0;
     if (reserve((void **)&e->m, &e->cap_floats, samples + 2 * cells + 1, sizeof(float))) {
@@ -257,25 +252,19 @@ void atmos__beams_epi_walk(const atmos__beams_epi *e, int j, double zc, double z
                            void (*lit)(void *u, double ra, double rb), void *u)
 {
     if (!(rT > 0)) return;
-    atmos__beams_epi_walk_line(e->m + e->at[j], e->lh + 2 * e->tat[j], e->cnt[j], e->k0[j], zc, zs, 0, rT, lit, u);
-}
-
-void atmos__beams_epi_walk_line(const float *m, const float *lh, int cnt, double k0, double zc, double zs, double r0,
-                                double r1, void (*lit)(void *u, double ra, double rb), void *u)
-{
-    if (!(r1 > r0)) return;
-    const int nseg = cnt - 1;
-    walk w = {.m = m, .lh = lh, .k0 = k0, .zc = zc, .zs = zs, .r0 = r0, .r1 = r1, .lit = lit, .u = u};
+    const int nseg = e->cnt[j] - 1;
+    walk w = {.m = e->m + e->at[j], .lh = e->lh + 2 * e->tat[j], .k0 = e->k0[j], .zc = zc, .zs = zs,
+              .r0 = 0, .r1 = rT, .lit = lit, .u = u};
     if (nseg <= 0) {
-        add(&w, r0, r1);
+        add(&w, 0, rT);
     } else {
         int levels;
-        atmos__beams_epi_cells(nseg, &levels);
+        tree_cells(nseg, &levels);
         size_t off = 0;
         for (int l = 0, c = (nseg + LEAF - 1) / LEAF; l < levels; l++, c = (c + 1) / 2) w.off[l] = off, off += (size_t)c;
-        if (w.k0 > r0) add(&w, r0, fmin(w.k0, r1));
+        if (w.k0 > 0) add(&w, 0, fmin(w.k0, rT));
         node(&w, levels - 1, 0, nseg);
-        if (r1 > w.k0 + nseg) add(&w, fmax(r0, w.k0 + nseg), r1);
+        if (rT > w.k0 + nseg) add(&w, w.k0 + nseg, rT);
     }
     if (w.open) lit(u, w.a, w.b);
 }

@@ -45,14 +45,4 @@ void atmos__beams_epi_free(atmos__beams_epi *e);
 void atmos__beams_epi_walk(const atmos__beams_epi *e, int j, double zc, double zs, double rT,
                            void (*lit)(void *u, double ra, double rb), void *u);
 
-/* The same walk over any line of cnt samples m at k0, k0 + 1, ... and its tree lh (as
- * atmos__beams_epi_tree makes it), over [r0, r1]; before k0 and beyond the last sample lit. */
-void atmos__beams_epi_walk_line(const float *m, const float *lh, int cnt, double k0, double zc, double zs, double r0,
-                                double r1, void (*lit)(void *u, double ra, double rb), void *u);
-/* The 1-D min/max tree of the cnt samples m into lh: its atmos__beams_epi_cells(cnt - 1) cells,
- * each its least value then its greatest (cells of 4 segments at the finest level, each level
- * above half as many, up to one). */
-void atmos__beams_epi_tree(const float *m, int cnt, float *lh);
-size_t atmos__beams_epi_cells(int nseg, int *levels);
-
 #endif

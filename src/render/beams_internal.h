@@ -9,7 +9,6 @@
 #include "core/vec.h"
 #include "light/lamp.h"
 #include "render/objects.h"
-#include "render/beams_epipoint.h"
 #include "render/beams_kept.h"
 #include "render/beams_sky.h"
 #include "render/beams_sun.h"
@@ -76,7 +75,6 @@ typedef struct atmos__beams_light {
     atmos__lamp L;               /* the light itself (light/lamp.h) */
     int nfaces;                  /* 0: no shadow casters; 1: a spot's frustum; 6: a cube map */
     atmos__beams_face face[6];
-    atmos__beams_pl pl;          /* a point light's cube map along epipolar lines from the eye (beams_epipoint.h) */
 } atmos__beams_light;
 
 /* The plan's progress over every light's shadow maps (stage "beams shadow maps"): faces done
@@ -100,10 +98,6 @@ double atmos__beams_visibility(const atmos__beams_light *l, const double p[3]);
  * bias that grows with the texels' size and the slope of the surface seen from the light: lit
  * when none of them holds a nearer surface, dark when all do (docs/beams.md *Surfaces' shadows*). */
 int atmos__beams_surface_visible(const atmos__beams_light *l, const double p[3], double cos_n);
-/* A cube map's nearest object toward the direction w (any length) as -1/x, x its distance in
- * units of w's length (the object at x w), from the texel holding w (a depth blended over texels
- * across a silhouette would be a surface that is not there); INFINITY when it holds none. */
-float atmos__beams_shadow_inverse(const atmos__beams_light *l, const double w[3]);
 
 /* One ray's view of one light, for the sub-planes: the point o + t d relative to the light,
  * its depth along the spot's axis and its coordinates in each shadow face, all linear in t

@@ -21,8 +21,7 @@ void atmos__beams_plan_destroy(atmos__beams_plan *b)
 {
     if (!b) return;
     atmos__objects_free(&b->obj);
-    for (int i = 0; i < b->nlights; i++)
-        atmos__beams_shadow_free(&b->lights[i]), atmos__beams_pl_free(&b->lights[i].pl), atmos__lamp_free(&b->lights[i].L);
+    for (int i = 0; i < b->nlights; i++) atmos__beams_shadow_free(&b->lights[i]), atmos__lamp_free(&b->lights[i].L);
     free(b->lights);
     atmos__beams_sun_free(&b->sun);
     atmos__beams_epi_free(&b->epi);

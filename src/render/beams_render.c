@@ -334,25 +334,6 @@ static int merged(job *J, const atmos__beams_ray *ray, const double *f, int k, i
     return e;
 }
 
-/* A point light's lit stretches along its epipolar lines (beams_epipoint.h): their length over
- * the ray, weighted as the walk blends its two half-planes. */
-static void stretch(void *u, double ta, double tb, double weight) { *(double *)u += weight * (tb - ta); }
-
-/* Light i (a point light with lines) over [t0, t1] of the ray d (its intervals' ends), its f_l
- * summing to S: when the lines find the ray lit all along (in both half-planes round it), the
- * unshadowed S, added to L; in shadow all along, nothing. Returns 0 when the lines cannot tell
- * or the ray crosses a shadow's edge: the caller samples the intervals then (the lines'
- * resampled edges, unfiltered, would streak away from the light where the map's texels step). */
-static int point_lines(const job *J, int i, const double d[3], double t0, double t1, double S, double *L)
-{
-    const atmos__beams_light *l = &J->b->lights[i];
-    double len = 0;
-    if (atmos__beams_pl_walk(&l->pl, d, t0, t1, stretch, &len)) return 0;
-    if (len >= (t1 - t0) * (1 - 1e-12))
-        for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * S;
-    return len == 0 || len >= (t1 - t0) * (1 - 1e-12);
-}
-
 /* Light i scattered toward the eye over its n intervals f (their f_l summing to S), added to
  * L: an interval whose f_l exceeds unit (epsilon of the pixel's airlight, in this light's
  * units) gets ceil(f_l / unit) sub-planes; the samples at offset o (0.5: the midpoints) of
@@ -365,7 +346,6 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * S;
         return;
     }
-    if (l->pl.lines && point_lines(J, i, d, f[0], f[2 * n], S, L)) return;
     atmos__beams_ray ray;
     atmos__beams_ray_init(l, J->eye, d, &ray);
     if (l->L.tex) {
@@ -813,24 +793,6 @@ static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const 
 /* A frame's own buffers (a job is zeroed first: the ones not made yet are NULL). */
 static void job_free(job *J) { free(J->z_lo), free(J->span), free(J->alb_pi), free(J->ru); }
 
-/* The most samples a point light's epipolar lines may take (4 bytes each, their trees about 2
- * more): beyond, its rays take the sub-planes. */
-#define PL_MAX_SAMPLES ((size_t)16 << 20)
-
-/* The point lights' shadow maps along epipolar lines from the eye (beams_epipoint.h): in fog, for
- * a point light with a cube map and no image. Returns 1 when out of memory. */
-static int point_planes(atmos_plan *p, const job *J)
-{
-    atmos__beams_plan *b = p->beams;
-    for (int i = 0; i < b->nlights; i++) {
-        atmos__beams_light *l = &b->lights[i];
-        if (l->L.type == ATMOS_LIGHT_POINT && !l->L.tex && l->nfaces == 6 && b->sigma_t > 0 &&
-            atmos__beams_pl_build(&l->pl, l, J->eye, PL_MAX_SAMPLES, atmos__threads(p->ctx)))
-            return 1;
-    }
-    return 0;
-}
-
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
 {
     atmos__beams_plan *b = p->beams;
@@ -846,7 +808,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
     J.cx = v->cam.width / 2, J.cy = v->cam.height / 2;
     J.epsilon = p->scene.beams.epsilon, J.max_sub = p->scene.beams.max_subplanes;
     if ((st = planes(p, &J)) != ATMOS_OK) return st;
-    if (eye_coordinates(&J) || point_planes(p, &J)) {
+    if (eye_coordinates(&J)) {
         job_free(&J);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     }

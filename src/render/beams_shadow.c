@@ -407,14 +407,3 @@ int atmos__beams_surface_visible(const atmos__beams_light *l, const double p[3],
     }
     return nearer == 0 ? 1 : nearer == 9 ? 0 : -1;
 }
-
-float atmos__beams_shadow_inverse(const atmos__beams_light *l, const double w[3])
-{
-    const atmos__beams_face *F = &l->face[cube_face(w)];
-    const double x = atmos__dot3(w, F->right), y = atmos__dot3(w, F->up), z = atmos__dot3(w, F->fwd);
-    const int n = F->n;
-    const double k = 0.5 * n / (z * F->tan_half);
-    const int cx = (int)(0.5 * n + x * k), cy = (int)(0.5 * n + y * k); /* the texel holding w: >= 0 within its face */
-    const float zs = F->depth[(size_t)(cy < 0 ? 0 : cy > n - 1 ? n - 1 : cy) * n + (cx < 0 ? 0 : cx > n - 1 ? n - 1 : cx)];
-    return zs < INFINITY ? (float)(-z / zs) : INFINITY;
-}
