@@ -27,6 +27,7 @@ struct atmos__nishita_plan {
     atmos_scene_nishita opt; /* its settings: the scene's, or the slice renderer's field's (nishita_do_plan) */
     int nf, n;
     sgrid g;                 /* the volume box-filtered onto the render grid (slice_grid.c) */
+    int g_borrowed;          /* g is the slice renderer's (nishita_do_plan): not freed here */
     atmos__vol_xform x;      /* the volume's placement */
     float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* extinction cross-section, m^2 */
     float sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* scattering cross-section, m^2 */
@@ -67,10 +68,10 @@ struct atmos__nishita_plan {
 };
 
 /* A plan of the discrete-ordinates field alone (nishita_plan.c), the field of the slice renderer's
- * "do" (slice_do.c): the optics, the render grid of at most cap voxels per axis (the slice
- * renderer's own grid: the same box filter, the same voxels), the sunlight's columns and the field
+ * "do" (slice_do.c): the optics, the render grid borrowed from the slice renderer (its own grid, not
+ * a copy: it must outlive the plan), the sunlight's columns and the field
  * (atmos__nishita_mc_create: degree 3, delta-M, discrete ordinates), none of the orders 2-3. */
-atmos_status atmos__nishita_do_plan_create(atmos_plan *p, int cap, atmos__nishita_plan **out);
+atmos_status atmos__nishita_do_plan_create(atmos_plan *p, const sgrid *grid, atmos__nishita_plan **out);
 
 /* The Monte Carlo field (nishita_mc.c): made once per plan (the path tracer's medium and phase
  * tables, cut at 3 degrees), filled per sun (and, toward one direction, per out_w: the light's

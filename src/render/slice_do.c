@@ -17,10 +17,15 @@
  * the multiple scattering it stood for). The same sum as the Nishita renderer's with "do"
  * (nishita_render.c), on the slice renderer's grid, slices and light buffer.
  *
- * The field is solved on the render grid the slice renderer builds (the same box filter and cap,
- * so the same voxels), from the sunlight's columns of the Nishita plan's sweep and the sunlight
+ * The field is solved on the slice renderer's render grid itself (borrowed by the field's plan, not
+ * copied), from the sunlight's columns of the Nishita plan's sweep and the sunlight
  * at the box's centre: the light buffer is made slice by slice during the eye pass, after the
- * field is needed. */
+ * field is needed.
+ *
+ * The background behind the volume is seen through sigma_t* too (T_eye): the delta-M peak's light
+ * passes as if not scattered. Through the true sigma_t it was measured worse (docs/lightfield.md,
+ * "The background behind the volume"): the first order does not draw the peak's light at the
+ * image's pixel size, so it was lost. */
 #include "render/nishita_internal.h"
 #include "render/slice_internal.h"
 
@@ -29,11 +34,10 @@
 
 atmos_status atmos__slice_do_prepare(atmos_plan *p, atmos__slice_plan *sp)
 {
-    atmos_status st = atmos__nishita_do_plan_create(p, p->scene.slice.grid_max_dim, &sp->dop);
+    /* the field on the render grid itself (borrowed, not copied: freed with the slice plan) */
+    atmos_status st = atmos__nishita_do_plan_create(p, &sp->g, &sp->dop);
     if (st != ATMOS_OK) return st;
     const atmos__nishita_plan *np = sp->dop;
-    if (!np->g.v || memcmp(np->g.c, sp->g.c, sizeof sp->g.c))
-        return atmos__error(p->ctx, ATMOS_E_INVALID_ARG, "render slice: the do field's grid is not the render grid");
     sp->tab_dm = sp->tab;
     for (int f = 0; f < sp->nf; f++)
         for (int w = 0; w < sp->n; w++) sp->tab_dm.sig[f][w] = np->mc_sig_ms[f][w];

@@ -605,17 +605,24 @@ SLICE_INLINE void light_wavelength(const sjob *j, int c, const echunk *e, const 
         const float idx = floorf(n0[q] + 1.0f + tq[q]);
         fi[q] = !(idx > 0.0f) ? 0 : (idx >= (float)SLICE_F_ORDERS ? SLICE_F_ORDERS : (int)idx);
     }
-    if (!j->low_albedo)
-        for (int f = 0; f < j->nf; f++) {
-            if (!e->live[f]) continue;
-            const float sa = t->sca[f][c];
-            const float *restrict Ft = t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1);
-            const float *restrict d = e->dens + f * CH;
-            for (int q = 0; q < e->mv; q++) {
-                const float fq = Ft[fi[q]], dq = d[q] > 0.0f ? d[q] : 0.0f;
-                aF[q] += dq * sa * fq;
-            }
+    if (j->low_albedo) { /* keep is 0: the light's plain attenuation (no log, no power) */
+        for (int q = 0; q < e->mv; q++) {
+            const float T = atmos__expf_poly(-tq[q]);
+            out[q] = be[q] > 0.0f ? Iq[q] * T : Iq[q]; /* T + (1 - T) 0: the same bits */
         }
+        for (int q = 0; q < e->m; q++) Io[(size_t)lane(e, q) * ns] = out[q];
+        return;
+    }
+    for (int f = 0; f < j->nf; f++) {
+        if (!e->live[f]) continue;
+        const float sa = t->sca[f][c];
+        const float *restrict Ft = t->F[f] + (size_t)c * (SLICE_F_ORDERS + 1);
+        const float *restrict d = e->dens + f * CH;
+        for (int q = 0; q < e->mv; q++) {
+            const float fq = Ft[fi[q]], dq = d[q] > 0.0f ? d[q] : 0.0f;
+            aF[q] += dq * sa * fq;
+        }
+    }
     for (int q = 0; q < e->mv; q++) {
         const float a = aF[q] / be[q];
         /* keep: the fraction of the scattered light (1 - T) still going forward,
