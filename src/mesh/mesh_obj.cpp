@@ -81,6 +81,11 @@ std::string check_statement(const std::string &line, long line_no)
                                         "bevel", "c_interp", "d_interp", "lod", "maplib", "usemap",
                                         "shadow_obj", "trace_obj", "ctech", "stech"};
     char buf[160];
+    if (line_no == 1 && !line.compare(0, 3, "\xEF\xBB\xBF")) { // the reader would drop the line's statement
+        if (line.find_first_not_of(" \t\r", 3) == std::string::npos) return std::string(); // a comment's line
+        return "line 1 starts with a UTF-8 byte-order mark, which the OBJ reader takes for a word: save the file "
+               "without it";
+    }
     std::snprintf(buf, sizeof buf, "not an OBJ file (line %ld holds binary data%s)", line_no,
                   line.compare(0, 4, "\x89PNG") ? "" : ": a PNG image");
     for (const unsigned char c : line)
