@@ -172,8 +172,8 @@ ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmo
 /* Which channels to compare: pair c is channel image[c] of the image against channel
  * reference[c] of the reference. exclude_above > 0 leaves out of every statistic, the worst
  * region, the bins and the heat map (black) the pixels where a compared channel of either
- * image is finite and exceeds it (the sun's disc, a lamp), unless one is NaN or infinite (those
- * count in nonfinite); 0 (as matched) keeps every pixel. */
+ * image is finite and exceeds it (the sun's disc, a lamp), every channel of them; their NaN or
+ * infinite samples still count in nonfinite; 0 (as matched) keeps every pixel. */
 typedef struct atmos_channel_match {
     int count;
     int image[ATMOS_IMAGE_DIFF_MAX_CHANNELS], reference[ATMOS_IMAGE_DIFF_MAX_CHANNELS];
@@ -193,8 +193,8 @@ typedef struct atmos_image_diff {
     double rmse[ATMOS_IMAGE_DIFF_MAX_CHANNELS], rel_rmse[ATMOS_IMAGE_DIFF_MAX_CHANNELS],
         bias[ATMOS_IMAGE_DIFF_MAX_CHANNELS];
     double rmse_all, rel_rmse_all;
-    int worst_x, worst_y, worst_w, worst_h; /* pixels */
-    double worst_rmse;
+    int worst_x, worst_y, worst_w, worst_h; /* pixels; w = h = 0 when no sample was compared */
+    double worst_rmse;                      /* NaN when no sample was compared */
     size_t nonfinite;                       /* compared samples skipped: either value NaN or infinite */
     double heat_scale;                      /* relative difference shown as white */
     size_t nonfinite_image, nonfinite_reference; /* of those, the non-finite values in each image */

@@ -27,21 +27,30 @@ static atmos_status positional_match(atmos_context *ctx, const atmos_image *a, c
     return ATMOS_OK;
 }
 
-/* Whether the pixel (pa of the image, pr of the reference) is left out: a compared channel
- * of either finite and above m->exclude_above (when that is > 0), none NaN or infinite (those
- * still count as nonfinite: an infinity is a broken image, not a bright sun). */
+/* Whether the pixel (pa of the image, pr of the reference) is left out of every figure: a
+ * compared channel of either is finite and above m->exclude_above (when that is > 0). Its
+ * NaN or infinite samples still count as nonfinite (an infinity is a broken image, not a
+ * bright sun): see count_nonfinite. */
 static int excluded(const atmos_channel_match *m, const float *pa, const float *pr)
 {
     if (!(m->exclude_above > 0)) return 0;
-    int above = 0;
     for (int c = 0; c < m->count; c++) {
         const float v[2] = {pa[m->image[c]], pr[m->reference[c]]};
-        for (int i = 0; i < 2; i++) {
-            if (!isfinite(v[i])) return 0;
-            above |= v[i] > m->exclude_above;
-        }
+        for (int i = 0; i < 2; i++)
+            if (isfinite(v[i]) && v[i] > m->exclude_above) return 1;
     }
-    return above;
+    return 0;
+}
+
+/* The non-finite samples of an excluded pixel, counted in out as those of a compared one. */
+static void count_nonfinite(const atmos_channel_match *m, const float *pa, const float *pr, atmos_image_diff *out)
+{
+    for (int c = 0; c < m->count; c++) {
+        const int a = !isfinite(pa[m->image[c]]), r = !isfinite(pr[m->reference[c]]);
+        out->nonfinite += a || r;
+        out->nonfinite_image += a;
+        out->nonfinite_reference += r;
+    }
 }
 
 static atmos_status check_match(atmos_context *ctx, const atmos_image *a, const atmos_image *ref,
@@ -102,6 +111,7 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
         const float *pa = a->pixels + p * a->channels, *pr = ref->pixels + p * ref->channels;
         if (excluded(m, pa, pr)) {
             out->excluded++;
+            count_nonfinite(m, pa, pr, out);
             continue;
         }
         for (int c = 0; c < ca; c++) {
@@ -136,10 +146,11 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
     out->rmse_all = sqrt(se_all / n_all);
     double mean_all = sr_all / n_all;
     out->rel_rmse_all = !(n_all >= 1) ? NAN : mean_all > 0 ? out->rmse_all / mean_all : (out->rmse_all > 0 ? INFINITY : 0.0);
-    out->nonfinite = bad;
-    out->nonfinite_image = bad_a;
-    out->nonfinite_reference = bad_r;
-    /* The worst region: the COMPARE_TILE^2 tile with the largest RMSE. */
+    out->nonfinite += bad;
+    out->nonfinite_image += bad_a;
+    out->nonfinite_reference += bad_r;
+    /* The worst region: the COMPARE_TILE^2 tile with the largest RMSE, of those with a compared
+     * sample (none: worst_w = worst_h = 0, worst_rmse NaN). */
     out->worst_rmse = -1;
     for (int ty = 0; ty < a->height; ty += COMPARE_TILE)
         for (int tx = 0; tx < a->width; tx += COMPARE_TILE) {
@@ -154,7 +165,7 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
                         if (isfinite(d)) s += d * d, n++;
                     }
                 }
-            double r = n ? sqrt(s / n) : 0;
+            double r = n ? sqrt(s / n) : -1;
             if (r > out->worst_rmse) {
                 out->worst_rmse = r;
                 out->worst_x = tx, out->worst_y = ty;
@@ -162,6 +173,7 @@ atmos_status atmos_image_compare_matched(atmos_context *ctx, const atmos_image *
                 out->worst_h = ty + COMPARE_TILE <= a->height ? COMPARE_TILE : a->height - ty;
             }
         }
+    if (out->worst_rmse < 0) out->worst_rmse = NAN;
     if (!heatmap) return ATMOS_OK;
     /* Heat map: per pixel the mean absolute difference over the channels relative to the
      * reference's mean value, 0 black -> red -> yellow -> white at out->heat_scale. */

@@ -70,6 +70,38 @@ std::string check_face(const std::string &rest, long line_no, long vertices, lon
     return std::string();
 }
 
+// A line's statement checked before its content: empty, or what is wrong. The first word must
+// be an OBJ statement (the reader skips any other line without a word, so a damaged or wrong
+// file would pass as a mesh of fewer faces); bytes no text holds mean another kind of file.
+std::string check_statement(const std::string &line, long line_no)
+{
+    static const char *const known[] = {"v", "vt", "vn", "vp", "vw", "f", "l", "p", "g", "o", "s", "t",
+                                        "usemtl", "mtllib", "cstype", "deg", "bmat", "step", "curv", "curv2",
+                                        "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "mg",
+                                        "bevel", "c_interp", "d_interp", "lod", "maplib", "usemap",
+                                        "shadow_obj", "trace_obj", "ctech", "stech"};
+    char buf[160];
+    if (line_no == 1 && !line.compare(0, 3, "\xEF\xBB\xBF")) { // the reader would drop the line's statement
+        if (line.find_first_not_of(" \t\r", 3) == std::string::npos) return std::string(); // a comment's line
+        return "line 1 starts with a UTF-8 byte-order mark, which the OBJ reader takes for a word: save the file "
+               "without it";
+    }
+    std::snprintf(buf, sizeof buf, "not an OBJ file (line %ld holds binary data%s)", line_no,
+                  line.compare(0, 4, "\x89PNG") ? "" : ": a PNG image");
+    for (const unsigned char c : line)
+        if ((c < 0x20 && c != '\t' && c != '\r' && c != '\v' && c != '\f') || c == 0x7f) return buf;
+    std::istringstream in(line);
+    std::string word;
+    if (!(in >> word)) return std::string();
+    for (const char *k : known)
+        if (word == k) return std::string();
+    for (const unsigned char c : word)
+        if (c >= 0x80) return buf;
+    std::snprintf(buf, sizeof buf, "line %ld: '%.40s' is not an OBJ statement (v, vt, vn, f, l, p, g, o, s, "
+                  "usemtl, mtllib, ...)", line_no, word.c_str());
+    return buf;
+}
+
 // The pass before the reader: the triangles the faces will give (every "f" line of n
 // vertices gives n - 2; stops counting past stop_after), and the first line that is wrong:
 // a vertex whose coordinates are not finite numbers (the reader would take "nan" or "inf"
@@ -92,17 +124,24 @@ long scan(const char *path, long stop_after, std::string *why, bool *trailing)
             *trailing = *trailing || line.find_first_not_of(" \t") < hash;
             line.erase(hash);
         }
-        if (line.size() < 2 || (line[1] != ' ' && line[1] != '\t')) continue;
+        if (!(*why = check_statement(line, line_no)).empty()) break;
+        if (line.size() < 1 || (line.size() > 1 && line[1] != ' ' && line[1] != '\t' && line[1] != '\r')) continue;
         if (line[0] == 'f') {
-            std::istringstream in(line.substr(2));
+            std::istringstream in(line.substr(1));
             std::string tok;
             long n = 0;
             while (in >> tok) n++;
             if (n > 2) tris += n - 2;
-            *why = check_face(line.substr(2), line_no, vertices, &max_pos, &max_line);
+            *why = check_face(line.substr(1), line_no, vertices, &max_pos, &max_line);
+            if (why->empty() && n < 3) {
+                char buf[128];
+                std::snprintf(buf, sizeof buf, "line %ld: a face needs 3 or more vertices, this one has %ld (a "
+                              "truncated file?)", line_no, n);
+                *why = buf;
+            }
         } else if (line[0] == 'v') {
             vertices++;
-            const char *p = line.c_str() + 2;
+            const char *p = line.c_str() + 1;
             for (int k = 0; k < 3; k++) {
                 char *end = nullptr;
                 const double x = std::strtod(p, &end);

@@ -188,9 +188,10 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
         atmos__lamp_tint(&l->L, P, tint);
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
-    if (sky) {
+    if (sky) { /* through a height-dependent fog's layer above P (J->sky is NULL in a uniform fog) */
+        static const double up[3] = {0, 1, 0};
         double E[ATMOS_MAX_WAVELENGTHS];
-        atmos__beams_sky_irradiance(J->sky, h->normal, E);
+        atmos__beams_sky_irradiance(J->sky, h->normal, atmos__beams_sun_fog_in(&b->fog, up, P), E);
         for (int k = 0; k < J->nw; k++) sum[k] += E[k];
         any = 1;
     }
@@ -812,9 +813,12 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         job_free(&J);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     }
-    /* the sky seen from the ground under the eye, kept while that stays within its quantum */
+    /* the sky seen from the ground under the eye, kept while that stays within its quantum; as
+     * the eye's sky behind, none through a uniform fog (it has no top: the sky is not seen) */
+    const int layered = b->fog.sigma0 > 0 && b->fog.height_m > 0, sky_seen = !(b->fog.sigma0 > 0) || layered;
     if ((b->sun_on && (st = atmos__beams_sun_frame(p, v)) != ATMOS_OK) ||
-        (b->obj.n > 0 && (st = atmos__beams_sky_keep(p->ctx, p->atm, J.eye, v->sun, J.nw, &b->sky)) != ATMOS_OK)) {
+        (b->obj.n > 0 && sky_seen &&
+         (st = atmos__beams_sky_keep(p->ctx, p->atm, J.eye, v->sun, J.nw, layered, &b->sky)) != ATMOS_OK)) {
         job_free(&J);
         return st;
     }
@@ -832,7 +836,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
             return st;
         }
         J.prim = &prim;
-        J.sky = &b->sky;
+        J.sky = sky_seen ? &b->sky : NULL;
     }
     const int step = p->scene.beams.screen_step;
     long evaluated = (long)(r->x1 - r->x0) * (r->y1 - r->y0);

@@ -3,9 +3,10 @@
  * atmosphere's radiance without the sun's disk (the sun is the beam renderer's own light).
  * Directions: BEAMS_SKY_MU rings of equal width in cos(zenith) by BEAMS_SKY_PHI azimuths,
  * cells of equal solid angle 2 pi / (MU PHI), each at its centre. The sky is that of one point
- * (the ground under the eye): what a surface sees below the horizon (the ground's light), the
- * sky hidden by other objects, and the scene's fog between the sky and the surface are left
- * out (docs/beams.md). */
+ * (the ground under the eye): what a surface sees below the horizon (the ground's light) and
+ * the sky hidden by other objects are left out (docs/beams.md). The scene's fog dims it as it
+ * dims the sky the eye sees: a height-dependent fog's layer above the surface by exp(-C / mu)
+ * (the table's layers of C); a uniform fog hides it (its caller adds none). */
 #include "render/beams_sky.h"
 #include "core/clones.h"
 #include "core/vec.h"
@@ -37,14 +38,46 @@ static void node_normal(int iy, int ia, double n[3])
     n[0] = s * cos(a), n[1] = y, n[2] = s * sin(a);
 }
 
+/* The layers C > 0 of the table (ic >= 1): per normal, the sky's irradiance ring by ring
+ * (rows of L as in atmos__beams_sky_build), each ring dimmed by exp(-C / mu) at its centre. */
+static int layers(const double *L, int nw, atmos__beams_sky *s)
+{
+    const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI, nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
+    double *R = malloc(sizeof(double) * (size_t)BEAMS_SKY_MU * nw);
+    if (!R) return 0;
+    const double dw = 2.0 * ATMOS_PI / nd;
+    for (int j = 0; j < nn; j++) {
+        double n[3];
+        node_normal(j / BEAMS_SKY_NA, j % BEAMS_SKY_NA, n);
+        for (int q = 0; q < BEAMS_SKY_MU * nw; q++) R[q] = 0;
+        for (int i = 0; i < nd; i++) {
+            const double *row = L + (size_t)i * (nw + 3), c = atmos__dot3(n, row);
+            if (c > 0)
+                for (int k = 0; k < nw; k++) R[(i / BEAMS_SKY_PHI) * nw + k] += row[3 + k] * c * dw;
+        }
+        for (int ic = 1; ic < s->nc; ic++) {
+            const double x = (double)ic / (BEAMS_SKY_NC - 1), C = BEAMS_SKY_CMAX * x * x;
+            double e[ATMOS_MAX_WAVELENGTHS] = {0};
+            for (int r = 0; r < BEAMS_SKY_MU; r++) {
+                const double t = exp(-C / ((r + 0.5) / BEAMS_SKY_MU));
+                for (int k = 0; k < nw; k++) e[k] += t * R[r * nw + k];
+            }
+            for (int k = 0; k < nw; k++) s->E[((size_t)ic * nn + j) * nw + k] = (float)e[k];
+        }
+    }
+    free(R);
+    return 1;
+}
+
 atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *atm, const double p[3],
-                                    const double sun_dir[3], int nw, atmos__beams_sky *s)
+                                    const double sun_dir[3], int nw, int layered, atmos__beams_sky *s)
 {
     memset(s, 0, sizeof *s);
     if (atmos_atmosphere_get_kind(atm) == ATMOS_ATMOSPHERE_VACUUM) return ATMOS_OK;
     const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI, nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
+    s->nc = layered ? BEAMS_SKY_NC : 1;
     double *L = malloc(sizeof(double) * (size_t)nd * (nw + 3));
-    s->E = calloc((size_t)nn * nw, sizeof *s->E);
+    s->E = calloc((size_t)s->nc * nn * nw, sizeof *s->E);
     if (!L || !s->E) {
         free(L), free(s->E), s->E = NULL;
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the sky's light");
@@ -68,17 +101,30 @@ atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *
         }
         for (int k = 0; k < nw; k++) s->E[(size_t)j * nw + k] = (float)e[k];
     }
+    const int ok = s->nc == 1 || layers(L, nw, s);
     free(L);
+    if (!ok) {
+        free(s->E), s->E = NULL;
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the sky's light");
+    }
     s->nw = nw;
     return ATMOS_OK;
 }
 
 /* The wavelengths' blend in one loop, vectorised in the AVX2 clone (the same operations in
  * the same order for each wavelength: the same bits). */
-ATMOS_CLONES void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const double n[3], double *E)
+ATMOS_CLONES void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const double n[3], double C, double *E)
 {
     const int nw = s->nw;
     if (!nw) return;
+    /* the layer: linear in x = sqrt(C / CMAX) between two of the table's values of C */
+    double tc = 0;
+    size_t c0 = 0, c1 = 0;
+    if (s->nc > 1 && C > 0) {
+        const double fc = fmin(1.0, sqrt(C / BEAMS_SKY_CMAX)) * (BEAMS_SKY_NC - 1);
+        c0 = (size_t)fc < BEAMS_SKY_NC - 1 ? (size_t)fc : BEAMS_SKY_NC - 2;
+        c1 = c0 + 1, tc = fc - (double)c0;
+    }
     const double fy = (fmin(1.0, fmax(-1.0, n[1])) + 1.0) * 0.5 * (BEAMS_SKY_NY - 1);
     double fa = atan2(n[2], n[0]) / (2.0 * ATMOS_PI) * BEAMS_SKY_NA;
     if (fa < 0) fa += BEAMS_SKY_NA;
@@ -87,12 +133,21 @@ ATMOS_CLONES void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const d
     if (ia > BEAMS_SKY_NA - 1) ia = BEAMS_SKY_NA - 1;
     const double ty = fy - iy, ta = fa - ia;
     const int ib = (ia + 1) % BEAMS_SKY_NA;
-    const float *e00 = s->E + ((size_t)iy * BEAMS_SKY_NA + ia) * nw, *e01 = s->E + ((size_t)iy * BEAMS_SKY_NA + ib) * nw;
-    const float *e10 = s->E + ((size_t)(iy + 1) * BEAMS_SKY_NA + ia) * nw;
-    const float *e11 = s->E + ((size_t)(iy + 1) * BEAMS_SKY_NA + ib) * nw;
+    const size_t layer = (size_t)BEAMS_SKY_NY * BEAMS_SKY_NA * nw;
+    const float *e00 = s->E + c0 * layer + ((size_t)iy * BEAMS_SKY_NA + ia) * nw;
+    const float *e01 = s->E + c0 * layer + ((size_t)iy * BEAMS_SKY_NA + ib) * nw;
+    const float *e10 = s->E + c0 * layer + ((size_t)(iy + 1) * BEAMS_SKY_NA + ia) * nw;
+    const float *e11 = s->E + c0 * layer + ((size_t)(iy + 1) * BEAMS_SKY_NA + ib) * nw;
 #pragma omp simd
     for (int k = 0; k < nw; k++)
         E[k] = (1 - ty) * ((1 - ta) * e00[k] + ta * e01[k]) + ty * ((1 - ta) * e10[k] + ta * e11[k]);
+    if (c1 == c0) return; /* no layer */
+    const size_t dl = (c1 - c0) * layer;
+#pragma omp simd
+    for (int k = 0; k < nw; k++) {
+        const double up = (1 - ty) * ((1 - ta) * e00[dl + k] + ta * e01[dl + k]) + ty * ((1 - ta) * e10[dl + k] + ta * e11[dl + k]);
+        E[k] = (1 - tc) * E[k] + tc * up;
+    }
 }
 
 void atmos__beams_sky_free(atmos__beams_sky *s)
@@ -101,17 +156,17 @@ void atmos__beams_sky_free(atmos__beams_sky *s)
 }
 
 atmos_status atmos__beams_sky_keep(atmos_context *ctx, const atmos_atmosphere *atm, const double eye[3],
-                                   const double sun_dir[3], int nw, atmos__beams_sky *s)
+                                   const double sun_dir[3], int nw, int layered, atmos__beams_sky *s)
 {
     const long key[2] = {lround(eye[0] / BEAMS_SKY_KEEP_M), lround(eye[2] / BEAMS_SKY_KEEP_M)};
     if (s->built && s->atm == atm && s->nw == nw && s->key[0] == key[0] && s->key[1] == key[1] &&
-        !memcmp(s->sun, sun_dir, sizeof s->sun))
+        s->layered == layered && !memcmp(s->sun, sun_dir, sizeof s->sun))
         return ATMOS_OK;
     const double under[3] = {key[0] * BEAMS_SKY_KEEP_M, 0, key[1] * BEAMS_SKY_KEEP_M};
     atmos__beams_sky_free(s);
-    const atmos_status st = atmos__beams_sky_build(ctx, atm, under, sun_dir, nw, s);
+    const atmos_status st = atmos__beams_sky_build(ctx, atm, under, sun_dir, nw, layered, s);
     if (st != ATMOS_OK) return st;
-    s->atm = atm, s->key[0] = key[0], s->key[1] = key[1], s->built = 1;
+    s->atm = atm, s->key[0] = key[0], s->key[1] = key[1], s->built = 1, s->layered = layered;
     memcpy(s->sun, sun_dir, sizeof s->sun);
     return ATMOS_OK;
 }

@@ -12,34 +12,46 @@
 #define BEAMS_SKY_NY 17
 #define BEAMS_SKY_NA 32
 
+/* A height-dependent fog's layer above a surface dims the sky toward it by exp(-C / mu), C the
+ * layer's vertical optical depth over the point and mu the direction's cos(zenith): the table
+ * has BEAMS_SKY_NC values of C = BEAMS_SKY_CMAX x^2, x even in [0, 1] (beyond: the last), one
+ * (C = 0) without such a fog. */
+#define BEAMS_SKY_NC 65
+#define BEAMS_SKY_CMAX 30.0
+
 /* The ground point under the eye is quantised to this many metres in x and z for the table
  * kept between frames (atmos__beams_sky_keep). */
 #define BEAMS_SKY_KEEP_M 100.0
 
 typedef struct atmos__beams_sky {
     int nw;   /* wavelengths; 0: no sky (a vacuum) */
-    float *E; /* [(iy * BEAMS_SKY_NA + ia) * nw + k]: W m^-2 nm^-1 */
+    int nc;   /* values of C: 1 (no height-dependent fog) or BEAMS_SKY_NC */
+    float *E; /* [((ic * BEAMS_SKY_NY + iy) * BEAMS_SKY_NA + ia) * nw + k]: W m^-2 nm^-1 */
     /* what a kept table was built for (atmos__beams_sky_keep): the atmosphere, the quantised
      * ground point (x, z in units of BEAMS_SKY_KEEP_M), the sun; built: 0 before the first */
     const atmos_atmosphere *atm;
     long key[2];
+    int layered;
     double sun[3];
     int built;
 } atmos__beams_sky;
 
 /* The table for the sun at sun_dir, the sky as seen from p (the ground under the eye): the
  * radiance of the atmosphere (atmos_atmosphere_radiance, without the sun's disk) over the
- * upper hemisphere on a grid of directions of equal solid angle, times max(0, n . w). */
+ * upper hemisphere on a grid of directions of equal solid angle, times max(0, n . w); layered:
+ * also dimmed by a fog layer of each tabulated C (nc = BEAMS_SKY_NC). */
 atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *atm, const double p[3],
-                                    const double sun_dir[3], int nw, atmos__beams_sky *s);
+                                    const double sun_dir[3], int nw, int layered, atmos__beams_sky *s);
 /* The table of the frame whose eye is at eye, kept in s between frames: the ground under the
  * eye quantised to BEAMS_SKY_KEEP_M metres in x and z (the point (kx Q, 0, kz Q)), so the
  * table is made again only when that point, the sun, the atmosphere or nw change, and a
  * frame's table is the same whatever frames came before it. s starts zeroed. */
 atmos_status atmos__beams_sky_keep(atmos_context *ctx, const atmos_atmosphere *atm, const double eye[3],
-                                   const double sun_dir[3], int nw, atmos__beams_sky *s);
-/* The sky's irradiance on a surface of unit normal n (bilinear in the table) into E[nw]. */
-void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const double n[3], double *E);
+                                   const double sun_dir[3], int nw, int layered, atmos__beams_sky *s);
+/* The sky's irradiance on a surface of unit normal n (bilinear in the table) under a fog layer
+ * of vertical optical depth C (0: none; linear in sqrt(C) between the table's values; a table
+ * without layers ignores it) into E[nw]. */
+void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const double n[3], double C, double *E);
 void atmos__beams_sky_free(atmos__beams_sky *s);
 
 #endif

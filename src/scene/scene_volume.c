@@ -199,8 +199,8 @@ static void below_ground_warning(atmos_context *ctx, const atmos_scene *scene, c
     if (!offset_m || scene->atmosphere.kind == ATMOS_ATMOSPHERE_VACUUM || !(hi[1] + offset_m[1] <= 0)) return;
     atmos__log(ctx, ATMOS_LOG_WARN,
                "%s: below the ground: its box spans %.0f to %.0f m in height (y), all under the ground at 0, so "
-               "the image will not show it; raise it (\"position_m\" in \"volume\", in metres, is where the "
-               "centre of the box's bottom face goes)",
+               "the image will not show it; raise it (\"position_m\" in \"volume\", or --volume-position on the "
+               "command line, in metres, is where the centre of the box's bottom face goes)",
                name, lo[1] + offset_m[1], hi[1] + offset_m[1]);
 }
 

@@ -214,6 +214,15 @@ static atmos_status parse_sidecar(atmos_context *ctx, const char *path, const cJ
     if (!cJSON_IsObject(root)) return atmos__error(ctx, ATMOS_E_FORMAT, "%s: top level: expected a JSON object", path);
     const cJSON *fields = cJSON_GetObjectItemCaseSensitive(root, "fields");
     int single = fields == NULL;
+    /* a scene file given where a volume is read: said as such, not as a sidecar's unknown key */
+    static const char *const scene_keys[] = {"camera", "sun", "image", "renderer", "volume", "atmosphere",
+                                             "objects", "lights", "fog", "background", "wavelengths", NULL};
+    for (int i = 0; scene_keys[i]; i++)
+        if (cJSON_HasObjectItem(root, scene_keys[i]))
+            return atmos__error(ctx, ATMOS_E_FORMAT,
+                                "%s: a scene file (it has \"%s\"), not a volume's JSON sidecar: a scene renders "
+                                "with atmos render SCENE; its volume is the file in its \"volume\"",
+                                path, scene_keys[i]);
     atmos_status st = check_keys(ctx, path, "top level", root, single ? single_keys : multi_keys);
     if (st != ATMOS_OK) return st;
     memset(sc, 0, sizeof *sc);

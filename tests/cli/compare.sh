@@ -104,16 +104,29 @@ echo "$out" | grep -q "excluded: 1 pixels above 100000 (--exclude-above)" && ok 
 "$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --exclude-above -3 >/dev/null 2>"$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q "exclude-above: expected a radiance > 0" "$T/err" && ok || bad "--exclude-above -3: exit $rc"
 
-# An infinity is not a bright sun: the pixel holding it is not left out (the comparison fails on
-# it), and every pixel left out fails the comparison (nothing was compared).
+# An infinity is not a bright sun: a pixel left out for its other channels' values still counts
+# it (the comparison fails on it), and every pixel left out fails the comparison (nothing was
+# compared).
 pfm "$T/inf_img.pfm" '\n' 1.1 2.1 3.1 4.1 5.1 6.1 7.1 8.1 9.1 inf 1.001e9 1.001e9
 out=$("$A" compare "$T/inf_img.pfm" "$T/sun_ref.pfm" --exclude-above 1e5 --json 2>"$T/err"); rc=$?
-echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["excluded"] == 0 and d["nonfinite_image"] == 1, d' \
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["excluded"] == 1 and d["nonfinite_image"] == 1, d' \
     && [ $rc -eq 1 ] && grep -q "1 compared samples are NaN or infinite" "$T/err" && ok ||
     bad "--exclude-above with an infinity: exit $rc, $out, $(cat "$T/err")"
-"$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --exclude-above 0.5 >/dev/null 2>"$T/err"; rc=$?
+"$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --exclude-above 0.5 >"$T/out" 2>"$T/err"; rc=$?
 [ $rc -eq 1 ] && grep -q "every pixel is above 0.5 (--exclude-above): nothing was compared" "$T/err" && ok ||
     bad "--exclude-above below every pixel: exit $rc, $(cat "$T/err")"
+# every pixel left out: no worst region (said so), null in --json
+grep -q "^worst region: none (every pixel was excluded by --exclude-above)$" "$T/out" && ok ||
+    bad "--exclude-above below every pixel: the worst region line: $(cat "$T/out")"
+out=$("$A" compare "$T/sun_img.pfm" "$T/sun_ref.pfm" --exclude-above 0.5 --json 2>/dev/null)
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["worst_region"] is None and d["worst_rmse"] is None, d' \
+    && ok || bad "--exclude-above below every pixel: --json $out"
+# a pixel left out for one channel (R above L) is out of every channel's figures, its NaN (G)
+# still counted: R's RMSE is the other pixels' 0.1, not the excluded pixel's 2e5
+pfm "$T/nan_g.pfm" '\n' 1.1 2.1 3.1 4.1 5.1 6.1 7.1 8.1 9.1 2e5 nan 12.1
+out=$("$A" compare "$T/nan_g.pfm" "$T/ref.pfm" --exclude-above 1e5 --json 2>"$T/err"); rc=$?
+echo "$out" | python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["excluded"] == 1 and d["nonfinite_image"] == 1 and max(d["rmse_per_channel"]) < 0.11 and d["worst_rmse"] < 0.11, d' \
+    && [ $rc -eq 1 ] && ok || bad "--exclude-above, a pixel above L in R with a NaN in G: exit $rc, $out"
 
 rm -rf "$T"
 echo "compare: $pass passed, $fail failed"

@@ -1,7 +1,9 @@
 #!/bin/sh
 # A mesh or terrain file that cannot be read is named by its scene key with the system's
 # reason and, for a relative path, where it was looked for (as a light's image is); an OBJ
-# file's wrong face says what is wrong, as written, and on which line; a folder is a folder; a comment after a face is a comment.
+# file's wrong face (or a face of fewer than 3 vertices, or a line that is no OBJ statement) says
+# what is wrong, as written, and on which line; another kind of file is not an OBJ file; a folder is
+# a folder; a comment after a face is a comment.
 . "$(dirname "$0")/common.inc"
 cd "$T" || exit 1
 mesh_scene() { # mesh_scene MESH TERRAIN
@@ -51,4 +53,16 @@ grep -q "stride" err9 && bad "max_triangles 1 spoken of as a stride: $(cat err9)
 printf '# a triangle\nv 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nf 1 2 3 # tri\nf 1 2 3#again\n' >comment.obj
 "$A" render s.json -D objects.0.mesh=comment.obj -o x.png -q 2>err10 && [ ! -s err10 ] &&
     ok "an OBJ file with comments after faces and vertices" || bad "comments after a face: $(cat err10)"
+# a truncated file (its last face cut to two vertices), a word that is no OBJ statement and an
+# image given as a mesh: errors naming the line, not a mesh of fewer faces or "no triangles"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 4 1' >cut.obj
+"$A" render s.json -D objects.0.mesh=cut.obj -o x.png -q 2>err11
+check "a face of two vertices (a truncated file)" err11 "/objects/0/mesh" "line 6" "3 or more vertices" "has 2"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nfx 1 2 3\nf 1 2 3\n' >word.obj
+"$A" render s.json -D objects.0.mesh=word.obj -o x.png -q 2>err12
+check "a line that is no OBJ statement" err12 "/objects/0/mesh" "line 4" "'fx' is not an OBJ statement"
+printf '\211PNG\r\n\032\n\000\000\000\rIHDR' >pic.obj
+"$A" render s.json -D objects.0.mesh=pic.obj -o x.png -q 2>err13
+check "a PNG given as a mesh" err13 "/objects/0/mesh" "not an OBJ file" "PNG"
+grep -q "no triangles" err13 && bad "a PNG spoken of as a mesh without triangles: $(cat err13)"
 exit $fail

@@ -57,6 +57,15 @@ has "--tone, --png-bits, no PNG" "no PNG is written"
 hasnt "-o PNG with --tone" "no PNG is written"
 "$A" render --width 8 --height 8 --exposure 12 --pfm "$T/z.pfm" -q 2>"$T/err" || bad "render --pfm --exposure"
 has "--exposure, no PNG" "--exposure"
+# --exr-half with no EXR written: said, as --tone is; with one, not
+"$A" render --width 8 --height 8 --exr-half --pfm "$T/z.pfm" -q 2>"$T/err" || bad "render --pfm --exr-half"
+has "--exr-half, no EXR" "--exr-half: it shapes the EXR image only"
+"$A" render --width 8 --height 8 --exr-half -o "$T/h.exr" -q 2>"$T/err" || bad "render -o EXR --exr-half"
+hasnt "--exr-half with -o FILE.exr" "--exr-half"
+# --exr-layers with no volume names the layers asked for only
+"$A" render --width 8 --height 8 --exr-layers tau --exr "$T/z.exr" -q 2>"$T/err" && bad "--exr-layers tau, no volume: exit 0"
+has "--exr-layers tau, no volume" "--exr-layers tau: it needs a volume"
+hasnt "--exr-layers tau, no volume" "transmittance"
 
 # --- 3. an output's format checked before the inputs are read: a missing volume is not
 # what is reported

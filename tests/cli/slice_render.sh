@@ -25,6 +25,21 @@ same = all(abs(px(a, x, y)[1] - px(b, x, y)[1]) <= 1e-3 * px(a, x, y)[1] for (x,
 assert changed > 10, "cloud not visible: %d pixels changed" % changed
 assert same, "corners changed"
 PY
+# with the do field (--slice-do) the settings it leaves without a use are refused, named by option
+# and key; xi 0 (what the field does) is taken
+for o in "--xi 0.5" --eq24 --low-albedo --no-diffuse; do
+    # shellcheck disable=SC2086
+    "$A" render -q --width 16 --height 9 --volume generate:cumulus --slice-do $o -o "$T/do.png" 2>"$T/do.txt"
+    st=$?
+    f=${o%% *}
+    [ $st -eq 2 ] && grep -q -- "($f) does nothing with the do field" "$T/do.txt" && [ ! -e "$T/do.png" ] &&
+        ok "--slice-do $o refused" || { bad "--slice-do $o: exit $st"; cat "$T/do.txt" >&2; }
+done
+printf '{"renderer": "slice", "volume": {"generate": "cumulus"}, "slice": {"do": true, "xi": 0.2}}\n' >"$T/do.json"
+"$A" render -q "$T/do.json" --width 16 --height 9 -o "$T/do.png" 2>"$T/do.txt"
+[ $? -eq 1 ] && grep -q "do.json: /slice/xi: (--xi) does nothing" "$T/do.txt" && ok "a scene's do with xi refused" ||
+    { bad "a scene's do with xi"; cat "$T/do.txt" >&2; }
+
 # --tau: the optical-depth key image, positive where the cloud is; compare --by splits by it
 "$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --eq24 --pfm "$T/eq24.pfm" \
     --tau "$T/tau.pfm" --threads 2 && ok || bad "render --eq24 --tau"

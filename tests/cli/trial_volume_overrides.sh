@@ -40,6 +40,11 @@ P='particles.cloud={"kind":"analytic","lobes":[{"type":"hg","g":0.8}],"sigma_ext
 "$A" render --volume "$T/v.json" -D "$P" -D 'volume.position_m=[0,-30000,-6000]' $small -q --pfm "$T/u.pfm" \
     2>"$T/err" || { bad "render below the ground"; cat "$T/err" >&2; }
 has "a volume below the ground" "below the ground: its box spans -30000 to"
+# placed by --volume-position, the warning names it as well as the scene's key
+# shellcheck disable=SC2086
+"$A" render --volume "$T/v.json" -D "$P" --volume-position 0,-30000,-6000 $small -q --pfm "$T/u.pfm" \
+    2>"$T/err" || { bad "render below the ground (--volume-position)"; cat "$T/err" >&2; }
+has "a volume below the ground, --volume-position" "or --volume-position on the command line"
 # shellcheck disable=SC2086
 "$A" render --volume "$T/v.json" -D "$P" -D 'volume.position_m=[0,1000,-6000]' $small -q --pfm "$T/a.pfm" \
     2>"$T/err" || { bad "render above the ground"; cat "$T/err" >&2; }

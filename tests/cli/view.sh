@@ -36,6 +36,24 @@ yaw = [float(r["yaw_deg"]) for r in rows]
 assert abs((yaw[1] - yaw[0]) % 360 - 120) < 1e-6 and abs((yaw[2] - yaw[1]) % 360 - 120) < 1e-6, yaw
 PY
 
+# -q: no "preparing the ... renderer" line (it is said without -q)
+"$A" view --headless --frames 1 --size 16x9 -q >"$T/q.txt" 2>&1 && ! grep -q "preparing" "$T/q.txt" &&
+    grep -q "preparing the sky renderer" "$T/out.txt" && ok "-q: no preparing line" ||
+    { bad "-q still says what it prepares"; cat "$T/q.txt" "$T/out.txt" >&2; }
+
+# a second recording into the same folder is refused (its 2 frames would leave the first run's
+# frame_00002.png among them), the earlier recording left as it was
+"$A" view --headless --frames 2 --size 64x36 --record "$T/rec" >"$T/again.txt" 2>&1
+st=$?
+[ $st -eq 2 ] && grep -q "record .*rec: the folder holds an earlier recording" "$T/again.txt" &&
+    [ "$(tail -n +2 "$T/rec/frames.csv" | wc -l)" -eq 3 ] && [ -s "$T/rec/frame_00002.png" ] &&
+    ok "--record into a folder with an earlier recording: refused (exit 2), the recording kept" ||
+    { bad "--record into an earlier recording: exit $st"; cat "$T/again.txt" >&2; }
+mkdir -p "$T/other" && : >"$T/other/notes.txt" && : >"$T/other/frame.png"
+"$A" view --headless --frames 1 --size 32x18 --record "$T/other" >"$T/other.txt" 2>&1 && [ -s "$T/other/frame_00000.png" ] &&
+    [ -f "$T/other/notes.txt" ] && ok "--record into a folder with other files: recorded, the files kept" ||
+    { bad "--record into a folder with other files"; cat "$T/other.txt" >&2; }
+
 # off a terminal the progress log speaks while a plan is made, not for each frame's renders (a log
 # line every interval: 0 logs every report)
 ATMOS_PROGRESS_INTERVAL=0 "$A" view --headless --frames 3 --size 32x18 >/dev/null 2>"$T/plog.txt"
@@ -64,6 +82,12 @@ ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
 xvfb-run -a "$A" view --frames 3 --size 96x54 --record "$T/win" --press I,W,F12 --save-base "$T/shot" >"$T/xout.txt" 2>&1
 st=$?
 [ $st -eq 0 ] && ok "window opens, renders 3 frames, closes (exit 0)" || { bad "xvfb run: exit $st"; cat "$T/xout.txt" >&2; }
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+xvfb-run -a "$A" view --frames 2 --size 96x54 --record "$T/win" >"$T/xagain.txt" 2>&1
+st=$?
+[ $st -eq 2 ] && grep -q "earlier recording (frame" "$T/xagain.txt" &&
+    [ "$(tail -n +2 "$T/win/frames.csv" | wc -l)" -eq 3 ] && ok "in a window too, --record into an earlier recording is refused" ||
+    { bad "xvfb: --record into an earlier recording: exit $st"; cat "$T/xagain.txt" >&2; }
 python3 - "$T/win/frames.csv" <<'PY' && ok "keys move the sun and the camera as documented" || bad "keys"
 import csv, math, sys
 r = list(csv.DictReader(open(sys.argv[1])))

@@ -47,6 +47,10 @@ done
 "$A" volume info "$T/does_not_exist.json"; [ $? -eq 1 ] || fail "missing file exit"
 "$A" volume info "$ATMOS_SOURCE_DIR/tests/crashers/volume/truncated_raw.json" 2> "$T/err.txt"; [ $? -eq 1 ] || fail "crasher exit"
 grep -q "truncated" "$T/err.txt" || fail "crasher message"
+# a scene file given as a volume: said to be a scene, not a sidecar with an unknown key
+"$A" volume info "$ATMOS_SOURCE_DIR/scenes/disney_cloud_sunset.json" 2> "$T/err.txt"; [ $? -eq 1 ] || fail "scene as a volume exit"
+grep -q "disney_cloud_sunset.json: a scene file (it has \"" "$T/err.txt" || fail "scene as a volume message: $(cat "$T/err.txt")"
+grep -q "unknown key" "$T/err.txt" && fail "scene as a volume: an unknown key: $(cat "$T/err.txt")"
 "$A" volume slice "$T/rs.json" --axis z --field snow -o "$T/s.png" 2>/dev/null; [ $? -eq 1 ] || fail "missing field exit"
 # damaged OpenVDB files: refused with exit 1 and a message naming the file (when the reader is built)
 C="$ATMOS_SOURCE_DIR/tests/crashers/volume"

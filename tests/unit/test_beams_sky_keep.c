@@ -51,25 +51,25 @@ int main(void)
         atmos_direction_from_angles(e ? 30 : 8, 266, sun);
         atmos__beams_sky keep = {0}, fresh = {0}, exact = {0};
         const double eye1[3] = {0.3 * Q, 200, -0.2 * Q}, eye2[3] = {0.1 * Q, 250, 0.4 * Q}, q0[3] = {0, 0, 0};
-        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye1, sun, nw, &keep));
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye1, sun, nw, 0, &keep));
         const float mark = keep.E[0];
         keep.E[0] = -1; /* a table made again would not keep this */
-        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye2, sun, nw, &keep));
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye2, sun, nw, 0, &keep));
         CHECK_MSG(keep.E[0] == -1, "an eye moved within its quantum: the table was made again");
         keep.E[0] = mark;
-        CHECK_OK(atmos__beams_sky_build(ctx, atm, q0, sun, nw, &fresh));
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, q0, sun, nw, 0, &fresh));
         CHECK_MSG(same(&keep, &fresh), "the kept table differs from a fresh one at the quantised point");
         atmos__beams_sky_free(&fresh);
         /* another quantum */
         const double eye3[3] = {3.6 * Q, 200, -1.7 * Q}, q3[3] = {4 * Q, 0, -2 * Q};
-        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye3, sun, nw, &keep));
-        CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun, nw, &fresh));
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye3, sun, nw, 0, &keep));
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun, nw, 0, &fresh));
         CHECK_MSG(same(&keep, &fresh), "after the eye left its quantum: not the fresh table of the new one");
         atmos__beams_sky_free(&fresh);
         /* the quantisation's cost: half a quantum in x and z away */
         const double eye4[3] = {4.5 * Q - 1e-6, 10, -2.5 * Q + 1e-6}, p4[3] = {eye4[0], 0, eye4[2]};
-        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun, nw, &keep));
-        CHECK_OK(atmos__beams_sky_build(ctx, atm, p4, sun, nw, &exact));
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun, nw, 0, &keep));
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, p4, sun, nw, 0, &exact));
         const double w = worst(&keep, &exact);
         printf("sun %g deg up: the table half a quantum (%g m in x and z) from the true point: worst relative "
                "difference %.3g\n", e ? 30.0 : 8.0, 0.5 * Q, w);
@@ -78,8 +78,8 @@ int main(void)
         /* another sun */
         double sun2[3];
         atmos_direction_from_angles(e ? 31 : 9, 266, sun2);
-        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun2, nw, &keep));
-        CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun2, nw, &fresh));
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun2, nw, 0, &keep));
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun2, nw, 0, &fresh));
         CHECK_MSG(same(&keep, &fresh), "after the sun moved: not the fresh table");
         atmos__beams_sky_free(&fresh);
         atmos__beams_sky_free(&keep);

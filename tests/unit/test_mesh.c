@@ -230,6 +230,10 @@ static void test_obj(void)
     expect_fail("garbage.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x y\n", 0, ATMOS_E_FORMAT, "garbage.obj");
     expect_fail("nofaces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", 0, ATMOS_E_FORMAT, "no triangles");
     expect_fail("empty.obj", "", 0, ATMOS_E_FORMAT, "no triangles");
+    /* a truncated file (its last face cut to two vertices): the line, not a mesh of fewer faces */
+    expect_fail("cut.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 4 1", 0, ATMOS_E_FORMAT, "line 6");
+    expect_fail("png.obj", "\211PNG\r\n\032\n", 0, ATMOS_E_FORMAT, "not an OBJ file");
+    expect_fail("bom.obj", "\357\273\277v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 0, ATMOS_E_FORMAT, "byte-order mark");
     expect_fail("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", 0, ATMOS_E_FORMAT, "line 2");
     expect_fail("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 1 2 4\n", 2, ATMOS_E_LIMIT,
                 "more than 2 triangles");

@@ -39,9 +39,10 @@ static void help(void)
            "--exclude-above L leaves out of every figure (the bins, the worst region; black in the heat\n"
            "map) the pixels where a compared channel of either image exceeds L: the sun's disc, whose\n"
            "radiance is ~10^5 times the sky's, otherwise dominates the RMSE of any image showing it\n"
-           "(e.g. 1e5 for a daylight sky in atmos render's units; the count left out is printed,\n"
-           "\"excluded\" in --json). NaN and infinities are never left out; every pixel left out\n"
-           "fails the comparison (exit status 1).\n");
+           "(e.g. 1e5 for a daylight sky in atmos render's units: it also leaves out a path tracer's\n"
+           "fireflies, ~1e5 inside thick clouds; the count left out is printed, \"excluded\" in\n"
+           "--json). A pixel left out is out for every channel; its NaN and infinities still count\n"
+           "and fail the comparison, as does every pixel left out (exit status 1; no worst region).\n");
     fputs(CLI_HELP_EXIT, stdout);
 }
 
@@ -126,7 +127,9 @@ static void print_json(const atmos_image_diff *d, const char *const *names, cons
         if (c) printf(", ");
         json_string(names[m->image[c]]);
     }
-    printf("], \"worst_region\": [%d, %d, %d, %d], \"worst_rmse\": ", d->worst_x, d->worst_y, d->worst_w, d->worst_h);
+    if (d->worst_w > 0)
+        printf("], \"worst_region\": [%d, %d, %d, %d], \"worst_rmse\": ", d->worst_x, d->worst_y, d->worst_w, d->worst_h);
+    else printf("], \"worst_region\": null, \"worst_rmse\": "); /* no sample compared */
     json_number(d->worst_rmse);
     printf(", \"nonfinite\": %zu, \"nonfinite_image\": %zu, \"nonfinite_reference\": %zu", d->nonfinite,
            d->nonfinite_image, d->nonfinite_reference);
@@ -157,8 +160,12 @@ static void print_text(const char *const *files, const atmos_image *a, const atm
     for (int c = 0; c < d->channels; c++)
         printf("%10s %14.6g %14.6g %14.6g\n", names[m->image[c]], d->rmse[c], d->rel_rmse[c], d->bias[c]);
     printf("%10s %14.6g %14.6g\n", "all", d->rmse_all, d->rel_rmse_all);
-    printf("worst region: x %d..%d, y %d..%d, rmse %.6g\n", d->worst_x, d->worst_x + d->worst_w - 1, d->worst_y,
-           d->worst_y + d->worst_h - 1, d->worst_rmse);
+    if (d->worst_w > 0)
+        printf("worst region: x %d..%d, y %d..%d, rmse %.6g\n", d->worst_x, d->worst_x + d->worst_w - 1, d->worst_y,
+               d->worst_y + d->worst_h - 1, d->worst_rmse);
+    else if (m->exclude_above > 0 && d->excluded == (size_t)a->width * a->height)
+        printf("worst region: none (every pixel was excluded by --exclude-above)\n");
+    else printf("worst region: none (no finite sample was compared)\n");
     if (heat) printf("heat map: %s (white = %.4g relative difference)\n", heat, d->heat_scale);
     if (m->exclude_above > 0)
         printf("excluded: %zu pixels above %g (--exclude-above)\n", d->excluded, m->exclude_above);

@@ -417,6 +417,9 @@ static int check_output_names(const render_opts *o)
     if (list[0])
         fprintf(stderr, "atmos render: warning: %s: these shape the PNG only (-o FILE.png), and no PNG is written; the "
                         "EXR and PFM outputs are linear, untouched by them\n", list);
+    if (o->exr_half && !o->exr && !(o->png && cli_file_kind_of(o->png) == CLI_FILE_EXR))
+        fprintf(stderr, "atmos render: warning: --exr-half: it shapes the EXR image only (--exr FILE or -o FILE.exr), and "
+                        "none is written%s\n", o->variance ? " (--variance's EXR is always 32-bit)" : "");
     return CLI_EXIT_OK;
 }
 

@@ -575,8 +575,11 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
     if (o->density_scale > 0)
         s->volume.density_scale = (s->volume.density_scale > 0 ? s->volume.density_scale : 1.0) * o->density_scale;
     if (o->tau && !s->volume.source[0]) return cli_usage_error(C, "--tau needs a volume (--volume or a scene with one)");
-    if ((o->exr_layers & (RENDER_LAYER_TAU | RENDER_LAYER_TRANSMITTANCE)) && !s->volume.source[0])
-        return cli_usage_error(C, "--exr-layers tau, transmittance: they need a volume (--volume or a scene with one)");
+    const int vl = o->exr_layers & (RENDER_LAYER_TAU | RENDER_LAYER_TRANSMITTANCE);
+    if (vl && !s->volume.source[0])
+        return cli_usage_error(C, "--exr-layers %s: %s a volume (--volume or a scene with one)",
+                               vl == RENDER_LAYER_TAU ? "tau" : vl == RENDER_LAYER_TRANSMITTANCE ? "transmittance" : "tau, transmittance",
+                               vl == (RENDER_LAYER_TAU | RENDER_LAYER_TRANSMITTANCE) ? "they need" : "it needs");
     if ((o->exr_layers & (RENDER_LAYER_ORDER | RENDER_LAYER_VARIANCE)) && s->renderer != ATMOS_RENDERER_PATH)
         return cli_usage_error(C, "--exr-layers order, variance: they are the path tracer's (--renderer path)");
     if (!o->scene_path && (r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_NISHITA || r == ATMOS_RENDERER_HARRIS) &&

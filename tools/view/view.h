@@ -189,6 +189,7 @@ typedef struct view_opts {
     const char *script, *record, *save_base;
     const char *press;   /* --press: keys pressed at the second frame (window: through its event
                             queue; headless: view_state_tap) */
+    int quiet;           /* -q (atmos render's): no "preparing" lines nor progress, warnings kept */
     int passed;          /* arguments left for atmos render's parser */
     char **pass;
 } view_opts;

@@ -46,7 +46,8 @@ static void help(void)
            "                     point it looks at), its pitch kept: frame 0 is atmos render's view\n"
            "  --record DIR       write every frame as DIR/frame_NNNNN.png and DIR/frames.csv (frame, ms =\n"
            "                     the frame's wall time including presentation, renderer, impostor_updates,\n"
-           "                     camera, sun (empty when lamps alone light it), preview, impostors_coarse)\n"
+           "                     camera, sun (empty when lamps alone light it), preview, impostors_coarse);\n"
+           "                     a DIR holding frames.csv or frame_*.png of an earlier run is refused\n"
            "  --headless         no window (with --frames or --script: render and record only)\n"
            "  --press KEYS       press these keys (key or script names as below, comma-separated) at the\n"
            "                     second frame (so --frames 2 at least): through the window's event queue\n"
@@ -145,6 +146,7 @@ int cli_cmd_view(int argc, char **argv)
         render_opts_free(&ro);
         return cli_usage_error("view", "--press: unknown key in '%s' (atmos view --help lists the keys)", vo.press);
     }
+    vo.quiet = ro.quiet;
     atmos_context *ctx = cli_context(ro.threads, 0); /* -q keeps warnings */
     atmos_scene sc;
     atmos_volume *vol = NULL;

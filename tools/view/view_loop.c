@@ -26,6 +26,7 @@ typedef struct loop {
     double screen_layer_px;      /* view_opts's */
     int said_pinhole;            /* the stand-in pinhole for the scene's camera was announced */
     int progress_log;            /* off a terminal: the progress log, kept for the plans' making */
+    int quiet;                   /* -q: nothing said but warnings and errors */
 } loop;
 
 /* What a frame's camera and sun are made of, as numbers: a frame whose pose equals the last
@@ -76,8 +77,8 @@ static atmos_status get_plan(loop *L, const view_state *s, atmos_plan **out)
             sc.camera = f.camera;
         }
         if (sc.renderer == ATMOS_RENDERER_SKY) sc.volume.source[0] = 0; /* the sky alone, the volume left out */
-        fprintf(stderr, "atmos view: preparing the %s renderer...\n", atmos_renderer_name(s->renderer));
-        cli_shared_progress()->log = L->progress_log; /* a plan's making may be long: logged */
+        if (!L->quiet) fprintf(stderr, "atmos view: preparing the %s renderer...\n", atmos_renderer_name(s->renderer));
+        cli_shared_progress()->log = L->quiet ? 0 : L->progress_log; /* a plan's making may be long: logged */
         atmos_status st = atmos_plan_create(L->ctx, &sc, sc.renderer == ATMOS_RENDERER_SKY ? NULL : L->vol, NULL, &L->plan[k]);
         cli_shared_progress()->log = 0; /* the frames' renders are not: a frame is short */
         if (st != ATMOS_OK) return st;
@@ -340,6 +341,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     memset(&L, 0, sizeof L);
     L.ctx = ctx, L.sc = sc, L.vol = vol, L.spectral = sc->wavelengths == ATMOS_WAVELENGTHS_SPECTRAL;
     L.impostor_budget = o->impostor_budget, L.screen_layer_px = o->screen_layer_px;
+    L.quiet = o->quiet;
     L.progress_log = cli_shared_progress()->log;
     cli_shared_progress()->log = 0;
     view_state s;
@@ -348,8 +350,8 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     /* the window first: without a display the viewer stops at once, before any work */
     int rc = CLI_EXIT_OK;
     if (!o->headless && !(win = view_window_open(o->width, o->height, "atmos view"))) rc = CLI_EXIT_RUNTIME;
+    if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record); /* before preparing the renderer */
     if (rc == CLI_EXIT_OK) rc = start(&L, o, &s, script);
-    if (rc == CLI_EXIT_OK) rc = view_record_open(&rec, o->record);
     const int scripted = o->frames > 0 || script;
     /* a flight without --frames: until its last key frame (a window closes then too) */
     const int frames = o->frames > 0 ? o->frames : view_script_frames(script);

@@ -7,10 +7,28 @@
 #include "view.h"
 
 #include <cjson/cJSON.h>
+#include <dirent.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+
+/* The first file of an earlier recording in DIR (frames.csv or a frame_*.png) into NAME, or 0:
+ * a new recording into it would leave the earlier run's later frames among its own. */
+static int earlier_recording(const char *dir, char *name, size_t size)
+{
+    DIR *d = opendir(dir);
+    if (!d) return 0;
+    int found = 0;
+    for (struct dirent *e; !found && (e = readdir(d));) {
+        const size_t n = strlen(e->d_name);
+        found = !strcmp(e->d_name, "frames.csv") ||
+                (!strncmp(e->d_name, "frame_", 6) && n > 10 && !strcmp(e->d_name + n - 4, ".png"));
+        if (found) snprintf(name, size, "%s", e->d_name);
+    }
+    closedir(d);
+    return found;
+}
 
 int view_record_open(view_recorder *r, const char *dir)
 {
@@ -20,6 +38,14 @@ int view_record_open(view_recorder *r, const char *dir)
     if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "atmos view: --record %s: %s\n", dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
+    }
+    char name[256];
+    if (earlier_recording(dir, name, sizeof name)) {
+        fprintf(stderr,
+                "atmos view: --record %s: the folder holds an earlier recording (%s): a new one would mix its\n"
+                "frames with the earlier ones; remove them (frames.csv, frame_*.png) or record into another folder\n",
+                dir, name);
+        return CLI_EXIT_USAGE;
     }
     return CLI_EXIT_OK;
 }
