@@ -104,36 +104,46 @@ typedef struct lanes {
 } lanes;
 
 /* The batch's columns and transmittances (vector loops over its lanes rounded up to 8; the
- * lanes past n hold the centre), then each row's pixels within the cut composited; empties
- * the batch. */
+ * lanes past n hold the centre; a lane beyond the cut gets transmittance 1, which leaves its
+ * pixel as it is: v 1 + c 0 = v), then each row's pixels composited; empties the batch. */
 static inline __attribute__((always_inline)) void flush(lanes *L, const sp *q, int nw, int x0, double rc2, double k2,
                                                         int width, atmos_image *img)
 {
     const int nn = (L->n + 7) & ~7, C = img->channels;
     const float *tc = q->tc, *col = q->col;
     for (int i = L->n; i < nn; i++) L->b2[i] = 0.0;
-    for (int i = 0; i < nn; i++) L->g[i] = atmos__pcloud_column((float)(L->b2[i] * k2));
+    for (int i = 0; i < nn; i++) L->g[i] = L->b2[i] > rc2 ? -1.0f : atmos__pcloud_column((float)(L->b2[i] * k2));
     for (int k = 0; k < nw; k++)
-        for (int i = 0; i < nn; i++) L->T[k][i] = atmos__expf_fast(-tc[k] * L->g[i]);
-    for (int r = 0; r < L->rows; r++) {
-        const int n = L->len[r], o = L->off[r];
-        const double *b2 = L->b2 + o;
-        float *row = img->pixels + ((size_t)L->y[r] * width + x0 + L->ja[r]) * C;
-        if (nw == 3 && C == 4) {
-            /* three wavelengths and coverage: every value v of a pixel within the cut becomes
-             * v t + c (1 - t), the coverage's t the mean transmittance and c = 1 */
+        for (int i = 0; i < nn; i++) {
+            const float T = atmos__expf_fast(-tc[k] * L->g[i]);
+            L->T[k][i] = L->g[i] < 0.0f ? 1.0f : T;
+        }
+    if (nw == 3 && C == 4) {
+        /* three wavelengths and coverage: every value v of a pixel becomes v t + c (1 - t), the
+         * coverage's t the mean transmittance and c = 1; a pixel as one vector of four */
+        typedef float v4 __attribute__((vector_size(16)));
+        const v4 c = {col[0], col[1], col[2], 1.0f}, one = {1.0f, 1.0f, 1.0f, 1.0f};
+        for (int r = 0; r < L->rows; r++) {
+            const int n = L->len[r], o = L->off[r];
+            float *row = img->pixels + ((size_t)L->y[r] * width + x0 + L->ja[r]) * C;
             const float *T0 = L->T[0] + o, *T1 = L->T[1] + o, *T2 = L->T[2] + o;
             for (int j = 0; j < n; j++) {
-                if (b2[j] > rc2) continue;
-                float *px = row + 4 * j;
-                const float t0 = T0[j], t1 = T1[j], t2 = T2[j], tm = (t0 + t1 + t2) / 3.0f;
-                px[0] = px[0] * t0 + col[0] * (1.0f - t0), px[1] = px[1] * t1 + col[1] * (1.0f - t1);
-                px[2] = px[2] * t2 + col[2] * (1.0f - t2), px[3] = px[3] * tm + 1.0f * (1.0f - tm);
+                const float t0 = T0[j], t1 = T1[j], t2 = T2[j];
+                const v4 t = {t0, t1, t2, (t0 + t1 + t2) / 3.0f};
+                v4 px;
+                memcpy(&px, row + 4 * j, sizeof px);
+                px = px * t + c * (one - t);
+                memcpy(row + 4 * j, &px, sizeof px);
             }
-            continue;
         }
+        L->n = L->rows = 0;
+        return;
+    }
+    for (int r = 0; r < L->rows; r++) {
+        const int n = L->len[r], o = L->off[r];
+        float *row = img->pixels + ((size_t)L->y[r] * width + x0 + L->ja[r]) * C;
         for (int j = 0; j < n; j++) {
-            if (b2[j] > rc2) continue;
+            if (L->g[o + j] < 0.0f) continue; /* beyond the cut (tm / nw need not be 1 exactly) */
             float *px = row + (size_t)j * C, tm = 0;
             for (int k = 0; k < nw; k++) {
                 px[k] = px[k] * L->T[k][o + j] + col[k] * (1.0f - L->T[k][o + j]);
@@ -148,8 +158,9 @@ static inline __attribute__((always_inline)) void flush(lanes *L, const sp *q, i
 /* Composites splat q over the pixels of its box inside tile (tx, ty). Pixel (x, y)'s ray is
  * d = F + u R + v U (u, v: the pixel's place on the image plane at unit distance); its squared
  * distance from the centre is b^2 = |rel x d|^2 / |d|^2, and along a row both are quadratics in
- * u: b^2 = (a0 + a1 u + a2 u^2) / (e0 + e1 u + e2 u^2), the coefficients once per row (double:
- * a0 is |rel|^2 |d|^2, b^2 a small difference). Only the row's columns that may lie within the
+ * u: b^2 = (a0 + a1 u + a2 u^2) / (e0 + e1 u + e2 u^2), the coefficients once per row from
+ * polynomials in v made once per splat (double: a0 is |rel|^2 |d|^2, b^2 a small difference;
+ * the rows' recorded frames the same as with the cross products made per row). Only the row's columns that may lie within the
  * cut are visited (row_span: a small splat's box is mostly outside its cut), their b^2 laid in
  * a batch of lanes (flush) with the next rows'. A pixel beyond the cut is left as it is, so
  * the spans change no value. */
@@ -161,20 +172,20 @@ ATMOS_CLONES static void draw(const sp *q, int nw, const atmos_camera *cam, int 
     const double W = cam->width, H = cam->height, t = cam->tan_half_fov, k2 = 1.0 / (q->s * q->s);
     const double rc2 = ATMOS__PCLOUD_CUT * ATMOS__PCLOUD_CUT * q->s * q->s;
     const double *F = cam->forward, *R = cam->right, *U = cam->up;
-    double rel[3], Q[3];
+    double rel[3], Q[3], PF[3], PU[3];
     for (int i = 0; i < 3; i++) rel[i] = q->c[i] - cam->position[i];
-    cross(rel, R, Q);
-    const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, u0 = (2.0 * x0 + 1.0 - W) / H * t;
+    cross(rel, R, Q), cross(rel, F, PF), cross(rel, U, PU);
+    const double a2 = dot(Q, Q), e2 = dot(R, R), du = 2.0 * t / H, idu = 1.0 / du, u0 = (2.0 * x0 + 1.0 - W) / H * t;
+    /* the rows' coefficients as polynomials in v (D = F + v U, P = rel x D = PF + v PU) */
+    const double a00 = dot(PF, PF), a01 = 2.0 * dot(PF, PU), a02 = dot(PU, PU), a10 = 2.0 * dot(PF, Q), a11 = 2.0 * dot(PU, Q);
+    const double e00 = dot(F, F), e01 = 2.0 * dot(F, U), e02 = dot(U, U), e10 = 2.0 * dot(F, R), e11 = 2.0 * dot(U, R);
     lanes L;
     L.n = L.rows = 0;
     for (int y = y0; y < y1; y++) {
         const double v = (H - 2.0 * (y + 0.5)) / H * t;
-        double D[3], P[3];
-        for (int i = 0; i < 3; i++) D[i] = F[i] + v * U[i];
-        cross(rel, D, P);
-        const double a0 = dot(P, P), a1 = 2.0 * dot(P, Q), e0 = dot(D, D), e1 = 2.0 * dot(D, R);
+        const double a0 = a00 + v * (a01 + v * a02), a1 = a10 + v * a11, e0 = e00 + v * (e01 + v * e02), e1 = e10 + v * e11;
         int ja, jb;
-        row_span(a0, a1, a2, e0, e1, e2, rc2, u0, 1.0 / du, x1 - x0, &ja, &jb);
+        row_span(a0, a1, a2, e0, e1, e2, rc2, u0, idu, x1 - x0, &ja, &jb);
         if (ja >= jb) continue;
         if (L.n + (jb - ja) > LANES) flush(&L, q, nw, x0, rc2, k2, cam->width, img);
         /* whole vectors of 4 (the lanes past the span are the next row's or unused) */
