@@ -4,7 +4,9 @@
  * (positive, the cell's balance exact); the emission s toward the direction is the degree <= L
  * series of the scattering source, sig_s chi_l phi_lm + q1_lm. The moments phi solve
  * phi = T (S phi + q1) (T: the sweeps and the projection; S: the scattering), by restarted
- * GMRES on (I - T S) phi = T q1, then one last sweep that gives the leaving power. The
+ * GMRES on (I - T S) phi = T q1 + T_in (T_in: the sweeps of the radiance entering through the
+ * grid's faces, the problem's inflow, with no source inside; T and S linear, without it), then
+ * one last source iteration (a sweep when the leaving power is asked for). The
  * directions are swept in a fixed number of groups, each summed into its own moments, the
  * groups added in order: the same numbers whatever the threads. */
 #include "light/lfield_do.h"
@@ -80,6 +82,7 @@ typedef struct {
     v4f Y[ATMOS__DO_KMAX];             /* the harmonics, per coefficient (the directions in a vector) */
     float wY[DO_PACK][ATMOS__DO_KMAX]; /* times the weight, per direction and coefficient */
     v4f a[3], as;                      /* |the components| along the axes; their sum */
+    v4f in;                            /* the radiance entering through the grid's faces */
     double w[DO_PACK];                 /* the weight */
 } do_pack;
 
@@ -146,6 +149,7 @@ static int make_packs(const atmos__do_problem *P, do_pack *pack)
                 for (int m = 0; m < ATMOS__DO_KMAX; m++) p->Y[m][e] = (float)Y[m], p->wY[e][m] = (float)(w * Y[m]);
                 for (int a = 0; a < 3; a++) p->a[a][e] = (float)fabs(o[a]);
                 p->as[e] = p->a[0][e] + p->a[1][e] + p->a[2][e], p->w[e] = w;
+                p->in[e] = P->inflow ? (float)P->inflow[n] : 0.0f;
             }
             d++;
         }
@@ -154,15 +158,16 @@ static int make_packs(const atmos__do_problem *P, do_pack *pack)
 }
 
 /* One pack's sweep with the source moments Q (per cell, K each), its radiance into psi (per cell,
- * DO_PACK), its moments added to acc, the power leaving through the grid's faces to *leak. In
+ * DO_PACK), its moments added to acc, the power leaving through the grid's faces to *leak; with_in:
+ * the inflow entering through the grid's faces (else nothing: the linear part). In
  * single precision but the leaving power (the directions of a pack in one vector). */
 static inline __attribute__((always_inline)) void sweep_k(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc,
-                           double *leak, const int K)
+                           double *leak, const int K, const int with_in)
 {
     const atmos__do_problem *P = W->P;
     const int nx = P->c[0], ny = P->c[1], nz = P->c[2], sx = pk->s[0], sy = pk->s[1], sz = pk->s[2];
     const float h = (float)P->h;
-    const v4f zero = {0, 0, 0, 0};
+    const v4f zero = {0, 0, 0, 0}, bnd = with_in ? pk->in : zero;
     const size_t sxy = (size_t)nx * ny;
     double out[DO_PACK] = {0};
     for (int kk = 0; kk < nz; kk++) {
@@ -177,9 +182,9 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
                     const float *q = Q + c * K;
                     for (int m = 0; m < K; m++) src += q[m] * pk->Y[m];
                 }
-                const v4f px = ii ? load4(psi + (c - sx) * DO_PACK) : zero,
-                          py = jj ? load4(psi + (c - (ptrdiff_t)sy * nx) * DO_PACK) : zero,
-                          pz = kk ? load4(psi + (c - (ptrdiff_t)sz * (ptrdiff_t)sxy) * DO_PACK) : zero;
+                const v4f px = ii ? load4(psi + (c - sx) * DO_PACK) : bnd,
+                          py = jj ? load4(psi + (c - (ptrdiff_t)sy * nx) * DO_PACK) : bnd,
+                          pz = kk ? load4(psi + (c - (ptrdiff_t)sz * (ptrdiff_t)sxy) * DO_PACK) : bnd;
                 const float th = P->sig_t[c] * h;
                 const v4f v = (src * h + pk->a[0] * px + pk->a[1] * py + pk->a[2] * pz) / (th + pk->as);
                 memcpy(psi + c * DO_PACK, &v, sizeof v);
@@ -214,26 +219,28 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
 /* The same with K a constant the compiler can unroll (and vectorise, for AVX2 too: the same
  * operations in the same order, no contraction). */
 ATMOS_CLONES
-static void sweep_one(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc, double *leak)
+static void sweep_one(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc, double *leak,
+                      int with_in)
 {
     switch (W->K) {
-    case 16: sweep_k(W, pk, Q, psi, acc, leak, 16); break;
-    case 9: sweep_k(W, pk, Q, psi, acc, leak, 9); break;
-    case 4: sweep_k(W, pk, Q, psi, acc, leak, 4); break;
-    default: sweep_k(W, pk, Q, psi, acc, leak, 1); break;
+    case 16: sweep_k(W, pk, Q, psi, acc, leak, 16, with_in); break;
+    case 9: sweep_k(W, pk, Q, psi, acc, leak, 9, with_in); break;
+    case 4: sweep_k(W, pk, Q, psi, acc, leak, 4, with_in); break;
+    default: sweep_k(W, pk, Q, psi, acc, leak, 1, with_in); break;
     }
 }
 
-/* All the directions with the source moments Q: the radiance moments into phi, the leaving power
- * into *leak (if not NULL). The packs in DO_GROUPS fixed groups, added in order. */
-static void sweep_all(do_work *W, const float *Q, double *phi, double *leak)
+/* All the directions with the source moments Q (and the inflow when with_in): the radiance moments
+ * into phi, the leaving power into *leak (if not NULL). The packs in DO_GROUPS fixed groups, added
+ * in order. */
+static void sweep_all(do_work *W, const float *Q, double *phi, double *leak, int with_in)
 {
     const size_t N = W->cells * W->K;
 #pragma omp parallel for schedule(static, 1) num_threads(W->P->threads)
     for (int g = 0; g < DO_GROUPS; g++) {
         memset(W->acc[g], 0, sizeof(float) * N);
         W->leak[g] = 0;
-        for (int p = g; p < W->npack; p += DO_GROUPS) sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g]);
+        for (int p = g; p < W->npack; p += DO_GROUPS) sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in);
     }
     double l = 0;
     for (size_t i = 0; i < N; i++) {
@@ -261,7 +268,7 @@ static void scatter(const do_work *W, const double *x, int add_q1)
 static void apply(do_work *W, const double *x, double *y)
 {
     scatter(W, x, 0);
-    sweep_all(W, W->Q, y, NULL);
+    sweep_all(W, W->Q, y, NULL, 0);
     for (size_t i = 0; i < W->cells * W->K; i++) y[i] = x[i] - y[i];
 }
 
@@ -424,6 +431,23 @@ static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double 
     return 1;
 }
 
+/* The power the inflow brings through the grid's faces: per direction its radiance times the
+ * faces' areas projected across it, times its weight. */
+static double entering(const atmos__do_problem *P)
+{
+    double e = 0;
+    for (int n = 0; P->inflow && n < P->quad->n; n++) {
+        const double *d = P->quad->dir[n];
+        double proj = 0;
+        for (int a = 0; a < 3; a++) {
+            const double o = fabs(P->R[a][0] * d[0] + P->R[a][1] * d[1] + P->R[a][2] * d[2]);
+            proj += o * P->c[(a + 1) % 3] * P->c[(a + 2) % 3];
+        }
+        e += P->quad->w[n] * P->inflow[n] * proj;
+    }
+    return e * P->h * P->h;
+}
+
 int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st)
 {
     memset(st, 0, sizeof *st);
@@ -445,7 +469,7 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         mark_needed(&W);
         W.npack = make_packs(P, W.pack);
         for (size_t i = 0; i < N; i++) W.q1[i] = (float)P->q1[i];
-        sweep_all(&W, W.q1, b, NULL);
+        sweep_all(&W, W.q1, b, NULL, P->inflow != NULL);
         st->sweeps++;
         int zero = 1;
         for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
@@ -455,11 +479,12 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
             for (size_t i = 0; i < N; i++) phi[i] += tmp[i];
         else {
             scatter(&W, phi, 1);
-            sweep_all(&W, W.Q, phi, &st->leak);
+            sweep_all(&W, W.Q, phi, &st->leak, P->inflow != NULL);
             st->sweeps++;
         }
         for (size_t c = 0; c < W.cells; c++) st->emitted += P->q1[c * W.K] * sqrt(4 * ATMOS_PI);
         st->emitted *= P->h * P->h * P->h;
+        st->entering = entering(P);
     }
     free(own.mem);
     return ok;

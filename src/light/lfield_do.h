@@ -44,6 +44,8 @@ typedef struct {
     double chi[4];              /* the phase function's normalised Legendre moments, chi[0] = 1 */
     const float *sig_t, *sig_s; /* per cell, 1/m */
     const double *q1;           /* per cell and coefficient: the first-order emission's moments per m^3 */
+    const double *inflow;       /* per direction of quad: the radiance entering through the grid's faces
+                                   travelling along it (the same over the faces); NULL: none */
     const atmos__do_quad *quad; /* directions in the frame of the spherical harmonics */
     double R[3][3];             /* a direction's components along the cells' axes: R d */
     double tol;                 /* GMRES: relative residual */
@@ -58,10 +60,12 @@ typedef struct {
     double resid;         /* the last relative residual */
     double leak;          /* power leaving the grid (with the problem's leak, else 0) */
     double emitted;       /* power of the first-order emission (per 1 of q1 units m^3) */
+    double entering;      /* power entering through the grid's faces (the inflow's) */
 } atmos__do_stats;
 
-/* The radiance moments phi[cell * K + k], K = (L + 1)^2, of the orders >= 1 (phi on entry: the
- * start, 0 if nothing better). Returns 0 when out of memory. */
+/* The radiance moments phi[cell * K + k], K = (L + 1)^2, of the orders >= 1 and of the inflow
+ * (its uncollided part too; phi on entry: the start, 0 if nothing better). Returns 0 when out of
+ * memory. */
 int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st);
 
 #endif

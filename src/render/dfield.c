@@ -8,7 +8,7 @@
  * thin (field_fade). */
 #include "render/dfield.h"
 
-#include "atmosphere/atmosphere_check.h"
+#include "render/sky_inflow.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -238,8 +238,8 @@ void atmos__dfield_view(atmos__dfield *df, const double eye[3], int threads)
 /* The sky's and the ground's light coming in through each face of the field's box: the
  * inward partial current J_in = int L(d) max(0, d . n) dOmega over the directions d looking
  * out through the face (normal n), L what a view ray from the box's centre cw sees
- * (atmos_atmosphere_radiance: the sky, the lit ground; the sun's disk left out, the sun is
- * the forward beam's), on SKY_NMU x SKY_NPHI cells of equal solid angle. */
+ * (sky_inflow.h: the sky, the lit ground; the sun's disk left out, the sun is the forward
+ * beam's), on SKY_NMU x SKY_NPHI cells of equal solid angle. */
 #define SKY_NMU 16
 #define SKY_NPHI 32
 static void field_sky(atmos__dfield *df, const atmos_atmosphere *atm, const double cw[3], const double sun_w[3])
@@ -255,9 +255,7 @@ static void field_sky(atmos__dfield *df, const atmos_atmosphere *atm, const doub
                          ph = 2.0 * 3.14159265358979323846 * (b + 0.5) / SKY_NPHI;
             const double d[3] = {sn * cos(ph), mu, sn * sin(ph)};
             double L[ATMOS_MAX_WAVELENGTHS], dg[3];
-            atmos_atmosphere_hit info;
-            atmos_atmosphere_radiance(atm, cw, d, sun_w, L, &info);
-            if (info.in_sun_disk) continue;
+            if (!atmos__sky_seen(atm, cw, d, sun_w, L)) continue;
             atmos__vol_dir_to_frame(df->x, d, dg);
             for (int f = 0; f < 6; f++) {
                 const double c = (f & 1 ? 1.0 : -1.0) * dg[f / 2];
@@ -311,8 +309,7 @@ atmos_status atmos__dfield_update(atmos_context *ctx, atmos__dfield *df, const a
     for (int a = 0; a < 3; a++) lt[a] = -sun_g[a], cen[a] = 0.5 * (g->box_lo[a] + g->box_hi[a]);
     /* the sunlight at the box's centre (the light buffer's per-texel entry points would
      * differ by the air's attenuation across the box) */
-    atmos__vol_frame_to_point(df->x, cen, cw);
-    atmos__atm_onto_ground(atm, cw, cw); /* the sky seen from above the ground */
+    atmos__sky_inflow_point(atm, df->x, cen, cw);
     atmos_atmosphere_sunlight(atm, cw, sun_w, sl);
     atmos__lfield_sun_source(&df->med, lt, sl, field_keep, df, Q, Q1, Ib, threads);
     const atmos__lsource src = {Q, Q1};

@@ -7,10 +7,19 @@
  * along the sun), the quadrature's directions about the world's axes (the harmonics' frame),
  * swept along the cells' axes, each wavelength after the first started from the last one's
  * solution; the moments times chi_l are the field's coefficients (the
- * emission of orders >= 2 per unit sigma_s). */
+ * emission of orders >= 2 per unit sigma_s).
+ *
+ * The sky's and the ground's light (with atm) enter as the sweeps' inflow through the grid's
+ * faces: per direction the mean over its patch of the sphere of what a view ray from the box's
+ * centre sees the other way (sky_inflow.c, the P1 field's source; the sun's disk left out), the
+ * same over the faces. The moments then hold that light too, its uncollided part included, so the
+ * coefficients are also the sky's and the ground's light of the orders >= 1 per unit sigma_s (the
+ * eye pass adds no other sky light in the volume; the sky seen straight through the volume is
+ * the eye pass's background, attenuated). */
 #include "core/vec.h"
 #include "light/lfield_do.h"
 #include "render/nishita_do.h"
+#include "render/sky_inflow.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -22,6 +31,31 @@
 #define DO_TOL 1e-3 /* GMRES's relative residual */
 #define DO_RESTART 20
 #define DO_MAX_ITER 200
+#define SKY_NS 4 /* the sky's samples per direction's patch: SKY_NS x SKY_NS */
+
+/* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
+ * DO_NPHI, atmos__do_quadrature's order: the cosines descending), the mean over the direction's
+ * patch (its Gauss-Legendre weight's band of cosines, its azimuth's sector), per wavelength:
+ * in[dir * n + w]. Returns 1 when any is not 0. */
+static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np, const atmos__do_quad *q,
+                      const double sun_w[3], double *in)
+{
+    double cen[3], cw[3], top = 1;
+    for (int a = 0; a < 3; a++) cen[a] = 0.5 * (np->g.box_lo[a] + np->g.box_hi[a]);
+    atmos__sky_inflow_point(atm, &np->x, cen, cw);
+    int any = 0;
+    for (int i = 0; i < DO_NMU; i++) {
+        const double wmu = q->w[i * DO_NPHI] * DO_NPHI / (2 * ATMOS_PI), bot = i == DO_NMU - 1 ? -1 : top - wmu;
+        for (int j = 0; j < DO_NPHI; j++) {
+            double *L = in + (size_t)(i * DO_NPHI + j) * np->n;
+            atmos__sky_patch_inflow(atm, cw, sun_w, np->n, bot, top, 2 * ATMOS_PI * j / DO_NPHI,
+                                    2 * ATMOS_PI * (j + 1) / DO_NPHI, SKY_NS, L);
+            for (int w = 0; w < np->n; w++) any |= L[w] != 0;
+        }
+        top = bot;
+    }
+    return any;
+}
 
 /* Per cell the mean sigma_t, sigma_s (1/m) and the mean of sigma_s E T_sun over its render voxels,
  * wavelength w. */
@@ -59,9 +93,9 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
 }
 
 atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
-                                    const double chi[][4], const double sun_w[3], const double *E, int threads,
-                                    float *coef, double *phi_all, int warm, atmos__do_ws *ws,
-                                    atmos__nishita_do_info *info)
+                                    const double chi[][4], const double sun_w[3], const double *E,
+                                    const atmos_atmosphere *atm, int threads, float *coef, double *phi_all, int warm,
+                                    atmos__do_ws *ws, atmos__nishita_do_info *info)
 {
     const int n = np->n, K = (L + 1) * (L + 1);
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
@@ -82,6 +116,12 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     for (int a = 0; a < 3; a++) lt[a] = -sun_w[a];
     atmos__vol_dir_to_frame(&np->x, lt, ltg);
     atmos__sh_eval(L, lt, Ys);
+    double inw[ATMOS__DO_NMAX], skymean[ATMOS_MAX_WAVELENGTHS] = {0};
+    double *sky = atm ? malloc(sizeof(double) * quad.n * n) : NULL;
+    if (atm && !sky) return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");
+    const int sky_on = sky && sky_inflow(atm, np, &quad, sun_w, sky);
+    for (int d = 0; sky_on && d < quad.n; d++)
+        for (int w = 0; w < n; w++) skymean[w] += sky[d * n + w] * quad.w[d];
     float *st = malloc(sizeof(float) * cells * 4); /* this wavelength's sigma_t, sigma_s; the last one's */
     double *src = malloc(sizeof(double) * cells * 2), *q1 = malloc(sizeof(double) * cells * K);
     int ok = st && src && q1;
@@ -94,7 +134,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
         cell_medium(np, F, w, ltg, st, st + cells, src, threads);
         /* a wavelength whose medium and phase are the last one's (a grey cloud): its field is the
          * last one's times the ratio of the sunlight */
-        if (w > 0 && E[w - 1] > 0 && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&
+        if (w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&
             !memcmp(st, st + 2 * cells, sizeof(float) * cells * 2) && !memcmp(src, src + cells, sizeof(double) * cells)) {
             for (size_t c = 0; c < cells; c++)
                 for (int k = 0; k < K; k++)
@@ -109,12 +149,19 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
                 const int l = atmos__sh_degree(k);
                 q1[c * K + k] = E[w] * src[c] * chi[w][l] * Ys[k];
             }
+        for (int d = 0; sky_on && d < quad.n; d++) inw[d] = sky[d * n + w];
+        P.inflow = sky_on ? inw : NULL;
         /* the start: the last wavelength's solution times the ratio of the sunlight (the clouds are
-         * nearly grey; 2 GMRES iterations on the Disney cloud where the last sun's takes 3), else
-         * with warm this wavelength's solution for the last sun (phi as it is), else 0 */
-        if (w_last >= 0 && E[w_last] > 0) {
+         * nearly grey; 2 GMRES iterations on the Disney cloud where the last sun's takes 3; with the
+         * sun off, of the sky's light), else with warm this wavelength's solution for the last sun
+         * (phi as it is), else 0. Only a start: the solve reaches its tolerance from any. */
+        const double ratio = w_last < 0          ? 0
+                             : E[w_last] > 0     ? E[w] / E[w_last]
+                             : skymean[w_last] > 0 ? skymean[w] / skymean[w_last]
+                                                   : 0;
+        if (ratio > 0) {
             const double *last = phi_all + (size_t)w_last * cells * K;
-            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] = last[i] * (E[w] / E[w_last]);
+            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] = last[i] * ratio;
         } else if (!warm)
             memset(phi, 0, sizeof(double) * cells * K);
         atmos__do_stats S;
@@ -128,7 +175,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
         info->iters += S.iters, info->sweeps += S.sweeps;
         info->resid = fmax(info->resid, S.resid);
     }
-    free(st), free(src), free(q1);
+    free(st), free(src), free(q1), free(sky);
     info->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
     info->directions = quad.n;
     return ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");

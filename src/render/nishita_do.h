@@ -12,14 +12,15 @@ typedef struct {
 } atmos__nishita_do_info;
 
 /* The field's coefficients coef[(cell * n + w) * K + k], K = (L + 1)^2, for the sun sun_w
- * (world; E the sunlight per wavelength) by discrete ordinates on F's cells, chi[w] the
+ * (world; E the sunlight per wavelength) and, with atm (else NULL), the sky's and the ground's
+ * light entering through the grid's faces, by discrete ordinates on F's cells, chi[w] the
  * scattering's normalised Legendre moments; the sunlight's columns (np->col) made for this sun.
  * phi[(w * cells + cell) * K + k]: the radiance moments solved, per wavelength; on entry with warm
  * the last sun's, each wavelength's start (a warm start after a sun move), else ignored. ws: the
  * solver's buffers, kept between suns (NULL: its own). */
 atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
-                                    const double chi[][4], const double sun_w[3], const double *E, int threads,
-                                    float *coef, double *phi, int warm, atmos__do_ws *ws,
-                                    atmos__nishita_do_info *info);
+                                    const double chi[][4], const double sun_w[3], const double *E,
+                                    const atmos_atmosphere *atm, int threads, float *coef, double *phi, int warm,
+                                    atmos__do_ws *ws, atmos__nishita_do_info *info);
 
 #endif

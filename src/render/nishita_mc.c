@@ -402,8 +402,9 @@ static atmos_status solve(atmos_plan *p, atmos__nishita_plan *np, const double s
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's moments");
     atmos__nishita_do_info info;
     const atmos_status st =
-        atmos__nishita_do_fill(p->ctx, np, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E, threads, mc->coef,
-                               mc->do_phi, warm && mc->do_phi_valid, mc->do_ws, &info);
+        atmos__nishita_do_fill(p->ctx, np, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E,
+                               np->opt.sky ? p->atm : NULL, threads, mc->coef, mc->do_phi,
+                               warm && mc->do_phi_valid, mc->do_ws, &info);
     mc->do_phi_valid = st == ATMOS_OK;
     np->do_iters = info.iters, np->do_sweeps = info.sweeps, np->do_dirs = info.directions;
     np->do_resid = info.resid, np->do_cpu = info.cpu_s;

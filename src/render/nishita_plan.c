@@ -87,7 +87,8 @@ static atmos_status plan_base(atmos_plan *p, const atmos_scene_nishita *opt, int
 atmos_status atmos__nishita_do_plan_create(atmos_plan *p, const sgrid *grid, atmos__nishita_plan **out)
 {
     atmos_scene_nishita o = p->scene.nishita;
-    o.orders = 1, o.sky = 0, o.diffuse = 0, o.mc_kphotons = 0, o.mc_lmax = 3, o.mc_delta_m = 1, o.do_field = 1;
+    /* sky 1: the sky's and the ground's light enter the field's solve (no sky elements here) */
+    o.orders = 1, o.sky = 1, o.diffuse = 0, o.mc_kphotons = 0, o.mc_lmax = 3, o.mc_delta_m = 1, o.do_field = 1;
     o.mc_dm_clip = 0;
     atmos__nishita_plan *np;
     atmos_status st = plan_base(p, &o, 0, grid, &np);

@@ -88,8 +88,9 @@ static void grid_at(const sgrid *g, const float *arr, int m, double u, double v,
     }
 }
 
-/* The volume's radiance L and transmittance T along direction d (world) from the eye, and the
- * distance th of its light's centre (the transmittance-weighted mean). 0 if the ray misses. */
+/* The volume's radiance L and transmittance T along direction d (world) from the eye (delta-M
+ * scaled with the field's tms), and the distance th of its light's centre (the
+ * transmittance-weighted mean). 0 if the ray misses. */
 static int march(const rjob *J, const double dw[3], double *L, double *T, double *th)
 {
     const atmos__nishita_plan *np = J->np;
@@ -161,6 +162,9 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         if (Tmax < 1e-5) break;
     }
     *th = wsum > 0 ? tsum / wsum : 0.5 * (t0 + t1);
+    /* delta-M: what lies behind is seen through sig*, the peak's share passing straight on (as the
+     * field's sweeps carry the sky's light, and the slice renderer's background with "do") */
+    if (J->tms) memcpy(T, Tm, sizeof(double) * n);
     return 1;
 }
 
@@ -192,8 +196,9 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
     atmos__vol_dir_to_frame(&np->x, v->sun, sun_g);
     atmos__nishita_columns(np, sun_g, threads);
     if (!np->col_valid) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the sunlight");
-    /* the Monte Carlo field holds every order above the first of the sunlight: it replaces the orders
-     * 2-3, the sky elements and the diffuse field (counted twice otherwise) */
+    /* the Monte Carlo field holds every order above the first of the sunlight (by discrete ordinates,
+     * with the sky on, the sky's and the ground's light of every order too, nishita_do.c): it
+     * replaces the orders 2-3, the sky elements and the diffuse field (counted twice otherwise) */
     const int use_field = !np->mc && (p->scene.nishita.orders > 1 || p->scene.nishita.sky);
     if (use_field && (st = atmos__nishita_field_update(p, v->sun, v->cam.position)) != ATMOS_OK) return st;
     rjob J;

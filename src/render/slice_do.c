@@ -17,6 +17,12 @@
  * the multiple scattering it stood for). The same sum as the Nishita renderer's with "do"
  * (nishita_render.c), on the slice renderer's grid, slices and light buffer.
  *
+ * The sky's and the ground's light enter the field's sweeps through the grid's faces (nishita_do.c,
+ * from the atmosphere interface as the P1 field's boundary, sky_inflow.c): the field then holds
+ * their scattered light of every order (the first included: the eye pass's first order is the
+ * sun's alone), and the sky seen straight through the volume is the eye pass's background,
+ * attenuated by sigma_t* (the delta-M peak's share counts as passing straight on).
+ *
  * The field is solved on the slice renderer's render grid itself (borrowed by the field's plan, not
  * copied), from the sunlight's columns of the Nishita plan's sweep and the sunlight
  * at the box's centre: the light buffer is made slice by slice during the eye pass, after the

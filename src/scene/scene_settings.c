@@ -88,7 +88,7 @@ static const atmos_setting nishita_settings[] = {
     {"cells", "nishita-cells", ATMOS_SETTING_INT, "", 4, 96, 0, 0, 32, NULL, 0,
      "the light field's grid: at most this many cells per axis", NISHITA(cells)},
     {"sky", "no-nishita-sky", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
-     "the sky's and the ground's light through sky elements (off: the sunlight alone)", NISHITA(sky)},
+     "the sky's and the ground's light, by sky elements or the do field's inflow (off: none)", NISHITA(sky)},
     {"step_pct", "nishita-step", ATMOS_SETTING_INT, "%", 5, 400, 0, 0, 50, NULL, 0,
      "eye-ray step, per cent of a render voxel", NISHITA(step_scale_pct)},
     {"diffuse", "nishita-diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,

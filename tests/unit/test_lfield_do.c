@@ -3,7 +3,7 @@
  * <= 3 exactly; in a closed conservative cloud the power leaving the grid is the power the first
  * order emitted (nothing is absorbed; one sweep alone, the first order's transport without the
  * scattering, falls far short, so the check can fail); an absorbing cloud loses some; the same
- * bytes with 1 and 2 threads. */
+ * bytes with 1 and 2 threads; light entering through the grid's faces (the sky's). */
 #include "light/lfield_do.h"
 #include "test.h"
 
@@ -155,13 +155,65 @@ static void check_last_iteration(cloud *C)
     }
 }
 
+/* Light entering through the grid's faces (the sky's and the ground's, the problem's inflow), no
+ * source inside. A conservative cloud under a uniform radiance L from every direction: the
+ * radiance is L everywhere, inside the cloud too (its degree-0 moment sqrt(4 pi) L, the others 0;
+ * the step scheme's fixed point exactly), and the power leaving is the power entering; without
+ * the inflow the moments are 0. The same cloud lit from above alone (a black ground): all that
+ * enters leaves (nothing is absorbed), the cloud's bottom darker than its top; albedo 0.9 keeps
+ * some. */
+static void check_inflow(cloud *C)
+{
+    double in[ATMOS__DO_NMAX];
+    const double L = 2.0, sq = sqrt(4 * 3.14159265358979323846);
+    atmos__do_stats S;
+    make_cloud(C, 1.0, 2, 400);
+    memset(C->q1, 0, sizeof C->q1);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    double none = 0;
+    for (size_t i = 0; i < NC * NC * NC * 16; i++) none = fmax(none, fabs(C->phi[i]));
+    for (int n = 0; n < C->q.n; n++) in[n] = L;
+    C->P.inflow = in;
+    memset(C->phi, 0, sizeof C->phi);
+    CHECK(atmos__do_solve(&C->P, C->phi, &S));
+    double worst0 = 0, worst = 0;
+    /* the cells the solve keeps the moments of: within one cell of the cloud */
+    for (int k = LO - 1; k <= HI; k++)
+        for (int j = LO - 1; j <= HI; j++)
+            for (int i = LO - 1; i <= HI; i++) {
+                const size_t c = ((size_t)k * NC + j) * NC + i;
+                worst0 = fmax(worst0, fabs(C->phi[c * 16] / (sq * L) - 1));
+                for (int m = 1; m < 16; m++) worst = fmax(worst, fabs(C->phi[c * 16 + m]) / (sq * L));
+            }
+    printf("  a uniform inflow on a conservative cloud: radiance / L - 1 at worst %.1e, the other moments %.1e; "
+           "leaving / entering %.6f (%d iterations); without the inflow the moments %.1e\n",
+           worst0, worst, S.leak / S.entering, S.iters, none);
+    CHECK(none == 0);
+    CHECK(worst0 < 1e-4 && worst < 1e-4);
+    CHECK(S.entering > 0 && fabs(S.leak / S.entering - 1) < 1e-4);
+    for (int n = 0; n < C->q.n; n++) in[n] = C->q.dir[n][2] < 0 ? L : 0; /* travelling down: the sky */
+    for (int t = 0; t < 2; t++) {
+        make_cloud(C, t ? 0.9 : 1.0, 2, 400);
+        memset(C->q1, 0, sizeof C->q1);
+        C->P.inflow = in;
+        CHECK(atmos__do_solve(&C->P, C->phi, &S));
+        const size_t top = ((size_t)(HI - 1) * NC + NC / 2) * NC + NC / 2, bot = ((size_t)LO * NC + NC / 2) * NC + NC / 2;
+        printf("  lit from above, albedo %.1f: leaving / entering %.6f; radiance in the bottom / top layer %.3f\n",
+               t ? 0.9 : 1.0, S.leak / S.entering, C->phi[bot * 16] / C->phi[top * 16]);
+        CHECK(S.entering > 0);
+        if (!t) CHECK(fabs(S.leak / S.entering - 1) < 1e-3);
+        else CHECK(S.leak / S.entering < 0.9);
+        CHECK(C->phi[bot * 16] < 0.5 * C->phi[top * 16] && C->phi[bot * 16] > 0);
+    }
+}
+
 int main(void)
 {
     check_quadrature(8, 16);
     check_quadrature(4, 8);
     cloud *C = malloc(sizeof *C);
     CHECK(C != NULL);
-    if (C) check_balance(C), check_threads(C), check_needed_and_start(C), check_last_iteration(C);
+    if (C) check_balance(C), check_threads(C), check_needed_and_start(C), check_last_iteration(C), check_inflow(C);
     free(C);
     return test_summary("test_lfield_do");
 }
