@@ -45,7 +45,8 @@ static const atmos_setting slice_settings[] = {
     {"do", "slice-do", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
      "instead of Eq. 24/25 and that field: the first order in the delta-M scaled medium and the orders >= 2 "
      "by discrete ordinates (the Nishita renderer's do field, its cells nishita.mc_cell render voxels: the "
-     "one nishita setting it takes; no sky light in it yet, docs/lightfield.md)",
+     "one nishita setting it takes; the sky's and the ground's light enter it through its faces, "
+     "docs/lightfield.md)",
      SLICE(do_field)},
     {"air_shadows", "no-air-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
      "the volume's shadow on the air's single scattering (light shafts, crepuscular rays); "
