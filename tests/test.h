@@ -12,6 +12,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* 1 in the sanitizer copies of the tests (asan.*): they are there for memory errors, the numbers
+ * are checked by the plain copy (unit.*), so a slow test may run fewer of its cases there. */
+#if defined(__SANITIZE_ADDRESS__)
+#define TEST_SANITIZED 1
+#else
+#define TEST_SANITIZED 0
+#endif
+
 static int test_passed_, test_failed_;
 
 #define CHECK(cond)                                                                   \

@@ -419,7 +419,7 @@ static void test_fast_vs_reference(void)
     double worst = 0;
     for (int i = 0; i < 2; i++)
         for (int mode = 0; mode < 4; mode++)
-            for (int thick = 0; thick < 2; thick++) {
+            for (int thick = TEST_SANITIZED; thick < 2; thick++) { /* the sanitizer copy: thick alone */
                 atmos_scene s;
                 scene_for(&s, suns[i][0], suns[i][1]);
                 sopts ss = {0};
@@ -467,7 +467,7 @@ static void test_eye_scale(void)
     make_optics(c2, &op);
     atmos_volume *v = blob(c2, 3e6f);
     const double suns[][2] = {{35, 200}, {20, 10}};
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < 2 - TEST_SANITIZED; i++) { /* the sanitizer copy: front-to-back alone */
         atmos_scene s;
         scene_for(&s, suns[i][0], suns[i][1]);
         s.width = s.height = 128;

@@ -44,7 +44,7 @@ static double mean_of(atmos_context *ctx, const test_optics *op, const atmos_vol
 static void check_slabs(atmos_context *ctx, const test_optics *op)
 {
     const double taus[3] = {1, 4, 16}, mus[2] = {0.9, 0.6};
-    for (int t = 0; t < 3; t++) {
+    for (int t = TEST_SANITIZED; t < 3 - TEST_SANITIZED; t++) { /* the sanitizer copy: depth 4 alone */
         atmos_volume *v = test_slab(ctx, taus[t]);
         ad_result r;
         CHECK(ad_slab(taus[t], 1.0, G, 1.0, 32, &r));
