@@ -353,41 +353,42 @@ static int cell_fine(const coarse *g, int j, int i)
     return g->bent[c[0]] | g->bent[c[1]] | g->bent[c[2]] | g->bent[c[3]];
 }
 
-/* Row y from the grid: cells read bilinearly, fine cells' pixels evaluated. */
+/* Row y from the grid: cells read bilinearly, fine cells' pixels evaluated. The grid's two rows
+ * about y are first read at y once a node (lrow, nx n values: a cell's left and right edges), a
+ * cell's pixels then along x at the offsets fx[p] = p / step (a cell read bilinearly is a whole
+ * step wide; the last column's takes one pixel more, at fx 1). */
 static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t, const coarse *g,
                        const atmos__rect *r, int y, row_buffers *rb, int *xs, float *val, float *dst, int C)
 {
     const int n = job->n, j = (y - r->y0) / g->step < g->ny - 1 ? (y - r->y0) / g->step : g->ny - 2;
-    const float fy = (float)(y - g->cy[j]) / (float)(g->cy[j + 1] - g->cy[j]);
+    const float fy = (float)(y - g->cy[j]) / (float)(g->cy[j + 1] - g->cy[j]), inv = 1.0f / (float)g->step;
+    const unsigned char *fine = g->fine + (size_t)j * g->nx;
+    float *lrow = rb->acc, fx[16 + 1]; /* sky_step is at most 16; rb->acc is free until eval_cols below */
+    for (int p = 0; p <= g->step; p++) fx[p] = (float)p * inv;
+    const float *a = g->val + (size_t)j * g->nx * n, *b = a + (size_t)g->nx * n;
+    for (int q = 0; q < g->nx * n; q++) lrow[q] = (1 - fy) * a[q] + fy * b[q];
     int m = 0;
     for (int i = 0; i < g->nx - 1; i++) {
         const int xa = g->cx[i], xb = i == g->nx - 2 ? g->cx[i + 1] + 1 : g->cx[i + 1];
-        if (g->fine[j * g->nx + i]) {
+        if (fine[i]) {
             for (int x = xa; x < xb; x++) xs[m++] = x, dst[(size_t)x * C + n] = 1.0f;
             continue;
         }
-        const float *a = g->val + ((size_t)j * g->nx + i) * n, *b = a + (size_t)g->nx * n, inv = 1.0f / (float)(g->cx[i + 1] - xa);
-        float r0[ATMOS_MAX_WAVELENGTHS], dif[ATMOS_MAX_WAVELENGTHS], l0[ATMOS_MAX_WAVELENGTHS];
-        for (int k = 0; k < n; k++) {
-            l0[k] = (1 - fy) * a[k] + fy * b[k];
-            r0[k] = (1 - fy) * a[n + k] + fy * b[n + k];
-            dif[k] = r0[k] - l0[k]; /* the cell's left and right edges at row y */
-        }
+        const float *l0 = lrow + (size_t)i * n, *r0 = l0 + n;
+        float *px = dst + (size_t)xa * C;
 #if defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
         if (n == 3 && C == 4) { /* RGB + alpha: a pixel as one vector of four (alpha 1 + fx 0) */
             typedef float v4f __attribute__((vector_size(16)));
-            const v4f lv = {l0[0], l0[1], l0[2], 1.0f}, dv = {dif[0], dif[1], dif[2], 0.0f};
-            for (int x = xa; x < xb; x++) {
-                const v4f o = lv + (float)(x - xa) * inv * dv;
-                memcpy(dst + (size_t)x * 4, &o, sizeof o);
+            const v4f lv = {l0[0], l0[1], l0[2], 1.0f}, dv = {r0[0] - l0[0], r0[1] - l0[1], r0[2] - l0[2], 0.0f};
+            for (int p = 0; p < xb - xa; p++) {
+                const v4f o = lv + fx[p] * dv;
+                memcpy(px + (size_t)p * 4, &o, sizeof o);
             }
             continue;
         }
 #endif
-        for (int x = xa; x < xb; x++) {
-            const float fx = (float)(x - xa) * inv;
-            float *px = dst + (size_t)x * C;
-            for (int k = 0; k < n; k++) px[k] = l0[k] + fx * dif[k];
+        for (int p = 0; p < xb - xa; p++, px += C) {
+            for (int k = 0; k < n; k++) px[k] = l0[k] + fx[p] * (r0[k] - l0[k]);
             px[n] = 1.0f;
         }
     }
