@@ -34,8 +34,9 @@ csv="$OUT/results.csv"
 # reference's mean there; tau_bins, order_bins: [bin start, pixels, rel_rmse, rel_bias] per bin
 echo "case,sun,variant,seconds,rel_rmse,bias_rel,tau_bins,order_bins" > "$csv"
 
-# Seconds from atmos render's own timing line ("..., 1.234 s").
-secs() { if [ -f "$1" ]; then sed -n 's/.*, \([0-9.]*\) s$/\1/p' "$1" | tail -1; fi; }
+# Seconds rendering and writing, from atmos render's own timing line
+# ("atmos render: ... s in all: ... s for the scene, ..., 1.234 s rendering and writing").
+secs() { if [ -f "$1" ]; then sed -n 's/.*, \([0-9.]*\) s rendering and writing$/\1/p' "$1" | tail -1; fi; }
 
 for c in $CASES; do
     scene="$here/$c.json"
