@@ -53,6 +53,10 @@ struct atmos__nishita_mc {
     int do_phi_valid;    /* do_phi holds a solve's: the start of the next sun's with a warm field */
     atmos__do_ws *do_ws; /* with "do": the solver's buffers, kept between suns */
     atmos__lfield field; /* L: its radiance toward the eye (cells of s render voxels) */
+    /* per cell and wavelength the kernel-weighted sigma_s' (cell_ss()): the medium's alone, the
+     * same for every sun, so made at the plan's first trace and kept (ss_done; NULL: no scattering) */
+    double *ss;
+    int ss_done;
     double sun[3], out[3], eye[3];
     int valid, view_valid;
 };
@@ -64,7 +68,7 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc)
     atmos__path_phase_free(&mc->ph);
     atmos__path_phase_free(&mc->ph_dm);
     atmos__lfield_free(&mc->field);
-    free(mc->coef), free(mc->do_phi);
+    free(mc->coef), free(mc->do_phi), free(mc->ss);
     atmos__do_ws_free(mc->do_ws);
     free(mc);
 }
@@ -192,27 +196,42 @@ typedef struct {
     double area3[3], A;
 } mc_job;
 
-/* Adds v[0..K) times the trilinear read's weights at render-voxel point u (atmos__lfield_sample's)
- * to the 8 cells' acc[((cell * n + w) * K + k]: reading the cells at x then returns the kernel
- * estimate, sum_c W_c(x) (sum of v W_c) / (integral of sigma_s' W_c). Fixed point, atomic: the
- * same integers whatever the threads' order. */
-static void splat(const atmos__lfield *F, const float u[3], const double *v, int K, int w, int64_t *acc)
+/* The trilinear read's 8 corners at render-voxel point u (atmos__lfield_sample's): each one's cell
+ * indices ci and weight wt, in the order c = 0..7. */
+static void corners(const atmos__lfield *F, const float u[3], int ci[8][3], double wt[8])
 {
     int i[3];
     float f[3];
     for (int a = 0; a < 3; a++) atmos__lfield_axis(u[a], F->s, F->c[a], &i[a], &f[a]);
     for (int c = 0; c < 8; c++) {
-        double wt = 1;
-        size_t cell = 0;
+        wt[c] = 1;
         for (int a = 2; a >= 0; a--) {
-            const int hi = (c >> a) & 1, ia = i[a] + hi < F->c[a] ? i[a] + hi : i[a];
-            wt *= hi ? f[a] : 1.0f - f[a];
-            cell = cell * F->c[a] + ia;
+            const int hi = (c >> a) & 1;
+            ci[c][a] = i[a] + hi < F->c[a] ? i[a] + hi : i[a];
+            wt[c] *= hi ? f[a] : 1.0f - f[a];
         }
-        if (!(wt > 0)) continue;
-        const size_t o = (cell * F->n + w) * K;
+    }
+}
+
+static size_t cell_of(const atmos__lfield *F, const int ci[3])
+{
+    return ((size_t)ci[2] * F->c[1] + ci[1]) * F->c[0] + ci[0];
+}
+
+/* Adds v[0..K) times the trilinear read's weights at render-voxel point u to the 8 cells'
+ * acc[((cell * n + w) * K + k]: reading the cells at x then returns the kernel estimate,
+ * sum_c W_c(x) (sum of v W_c) / (integral of sigma_s' W_c). Fixed point, atomic: the same
+ * integers whatever the threads' order. */
+static void splat(const atmos__lfield *F, const float u[3], const double *v, int K, int w, int64_t *acc)
+{
+    int ci[8][3];
+    double wt[8];
+    corners(F, u, ci, wt);
+    for (int c = 0; c < 8; c++) {
+        if (!(wt[c] > 0)) continue;
+        const size_t o = (cell_of(F, ci[c]) * F->n + w) * K;
         for (int k = 0; k < K; k++) {
-            const int64_t x = (int64_t)llrint(wt * v[k] * MC_FIX);
+            const int64_t x = (int64_t)llrint(wt[c] * v[k] * MC_FIX);
 #pragma omp atomic
             acc[o + k] += x;
         }
@@ -279,6 +298,69 @@ static void photon(const mc_job *M, int k, atmos__stream *r, int64_t *acc)
     }
 }
 
+/* One render voxel's SUB^3 points into cell_scattering()'s acc: their fixed-point terms summed
+ * first in the 3 x 3 x 3 cells from the first point's (a voxel's points span at most 3 per axis),
+ * then added atomically, 27 adds a wavelength instead of 8 SUB^3; the integer sums are exact, so
+ * the same whatever the grouping. */
+static void voxel_scattering(const atmos__nishita_plan *np, const path_medium *m, const atmos__lfield *F,
+                             const int v[3], int sub, double unit, int64_t *acc)
+{
+    const sgrid *g = &np->g;
+    const int nf = np->nf, n = np->n;
+    int64_t loc[27][ATMOS_MAX_WAVELENGTHS];
+    int base[3], used[27] = {0};
+    for (int a = 0; a < 3; a++) { /* the cells of the voxel's first point, the lowest on every axis */
+        float f;
+        atmos__lfield_axis(v[a] + 0.5f / sub - 0.5f, F->s, F->c[a], &base[a], &f);
+    }
+    for (int l = 0; l < 27; l++) memset(loc[l], 0, sizeof(int64_t) * n);
+    for (int c = 0; c < sub * sub * sub; c++) {
+        const float u[3] = {v[0] + (c % sub + 0.5f) / sub - 0.5f, v[1] + (c / sub % sub + 0.5f) / sub - 0.5f,
+                            v[2] + (c / (sub * sub) + 0.5f) / sub - 0.5f};
+        double q[3];
+        for (int a = 0; a < 3; a++) q[a] = (u[a] - g->off[a]) / g->sc * m->inv_vs;
+        float dens[PATH_F];
+        atmos__path_density(m, q[0], q[1], q[2], dens);
+        double sums[ATMOS_MAX_WAVELENGTHS];
+        int any = 0;
+        for (int w = 0; w < n; w++) {
+            double sum = 0;
+            for (int f = 0; f < nf; f++) sum += (double)dens[f] * np->mc_sca[f][w];
+            sums[w] = sum * unit, any |= sums[w] > 0;
+        }
+        if (!any) continue; /* the empty points, most of a cloud's box: no corners */
+        int ci[8][3];
+        double wt[8];
+        corners(F, u, ci, wt);
+        for (int w = 0; w < n; w++) {
+            const double sum = sums[w];
+            if (!(sum > 0)) continue;
+            for (int k = 0; k < 8; k++) {
+                if (!(wt[k] > 0)) continue;
+                const int64_t x = (int64_t)llrint(wt[k] * sum * MC_FIX);
+                int d[3], inside = 1;
+                for (int a = 0; a < 3; a++) d[a] = ci[k][a] - base[a], inside &= d[a] >= 0 && d[a] < 3;
+                if (inside) {
+                    const int l = (d[2] * 3 + d[1]) * 3 + d[0];
+                    loc[l][w] += x, used[l] = 1;
+                } else { /* not expected; the same sum either way */
+#pragma omp atomic
+                    acc[cell_of(F, ci[k]) * n + w] += x;
+                }
+            }
+        }
+    }
+    for (int l = 0; l < 27; l++) {
+        if (!used[l]) continue;
+        const int ci[3] = {base[0] + l % 3, base[1] + l / 3 % 3, base[2] + l / 9};
+        const size_t o = cell_of(F, ci) * n;
+        for (int w = 0; w < n; w++) {
+#pragma omp atomic
+            acc[o + w] += loc[l][w];
+        }
+    }
+}
+
 /* Per cell and wavelength the integral of sigma_s' times the cell's trilinear weight (into ss,
  * in units of sig_max times a render voxel's volume), by the midpoint rule on SUB^3 points per
  * render voxel of the medium the photons see (the path tracer's: its density next to the
@@ -288,32 +370,45 @@ static int cell_scattering(const atmos__nishita_plan *np, const atmos__nishita_m
 {
     const sgrid *g = &np->g;
     const atmos__lfield *F = &mc->field;
-    const path_medium *m = &mc->med;
-    const int nf = np->nf, n = np->n, sub = F->s >= 2 ? 2 : 4;
-    const size_t vals = (size_t)F->c[0] * F->c[1] * F->c[2] * n;
+    const int sub = F->s >= 2 ? 2 : 4;
+    const size_t vals = (size_t)F->c[0] * F->c[1] * F->c[2] * np->n;
     int64_t *acc = calloc(vals, sizeof(int64_t));
     if (!acc) return 0;
     const double unit = 1.0 / (sig_max * sub * sub * sub);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int k = 0; k < g->c[2]; k++)
         for (int j = 0; j < g->c[1]; j++)
-            for (int i = 0; i < g->c[0]; i++)
-                for (int c = 0; c < sub * sub * sub; c++) {
-                    const float u[3] = {i + (c % sub + 0.5f) / sub - 0.5f, j + (c / sub % sub + 0.5f) / sub - 0.5f,
-                                        k + (c / (sub * sub) + 0.5f) / sub - 0.5f};
-                    double q[3];
-                    for (int a = 0; a < 3; a++) q[a] = (u[a] - g->off[a]) / g->sc * m->inv_vs;
-                    float dens[PATH_F];
-                    atmos__path_density(m, q[0], q[1], q[2], dens);
-                    for (int w = 0; w < n; w++) {
-                        double sum = 0;
-                        for (int f = 0; f < nf; f++) sum += (double)dens[f] * np->mc_sca[f][w];
-                        sum *= unit;
-                        if (sum > 0) splat(F, u, &sum, 1, w, acc);
-                    }
-                }
+            for (int i = 0; i < g->c[0]; i++) {
+                const int v[3] = {i, j, k};
+                voxel_scattering(np, &mc->med, F, v, sub, unit, acc);
+            }
     for (size_t c = 0; c < vals; c++) ss[c] = acc[c] / MC_FIX;
     free(acc);
+    return 1;
+}
+
+/* The kernel-weighted sigma_s' of the cells (m^3 / m): cell_scattering() scaled back from units of
+ * sig_max (twice the grid's largest sigma_s') and render voxels. Made once per plan into mc->ss:
+ * it depends on the plan's medium and cells only, not on the sun. 0: out of memory. */
+static int cell_ss(const atmos__nishita_plan *np, atmos__nishita_mc *mc, int threads)
+{
+    if (mc->ss_done) return 1;
+    const int n = np->n;
+    const size_t vals = (size_t)mc->field.c[0] * mc->field.c[1] * mc->field.c[2] * n;
+    const double h = 1.0 / np->g.sc;
+    double sig_max = 0;
+    for (size_t v = 0; v < (size_t)np->g.c[0] * np->g.c[1] * np->g.c[2]; v++)
+        for (int f = 0; f < np->nf; f++)
+            for (int w = 0; w < n; w++) sig_max = fmax(sig_max, 2.0 * np->g.v[v * np->nf + f] * np->mc_sca[f][w]);
+    if (sig_max > 0) {
+        if (!(mc->ss = calloc(vals, sizeof(double)))) return 0;
+        if (!cell_scattering(np, mc, sig_max, mc->ss, threads)) {
+            free(mc->ss), mc->ss = NULL;
+            return 0;
+        }
+        for (size_t c = 0; c < vals; c++) mc->ss[c] *= sig_max * h * h * h;
+    }
+    mc->ss_done = 1;
     return 1;
 }
 
@@ -326,9 +421,8 @@ static atmos_status trace(atmos_plan *p, atmos__nishita_plan *np, const double s
     const int n = np->n, K = mc->K;
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2], vals = cells * n;
     int64_t *acc = calloc(vals * K, sizeof(int64_t));
-    double *ss = calloc(vals, sizeof(double));
-    if (!acc || !ss) {
-        free(acc), free(ss);
+    if (!acc || !cell_ss(np, mc, threads)) {
+        free(acc);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the photons");
     }
     mc_job M;
@@ -350,17 +444,11 @@ static atmos_status trace(atmos_plan *p, atmos__nishita_plan *np, const double s
      * kernel holds almost no scattering (the cloud's fringe) divided by at least MC_SS_FLOOR of
      * the largest cell's: one collision there would otherwise make a radiance that the trilinear
      * read carries into the dense neighbours */
-    const double h = 1.0 / np->g.sc;
-    double sig_max = 0;
-    for (size_t v = 0; v < (size_t)np->g.c[0] * np->g.c[1] * np->g.c[2]; v++)
-        for (int f = 0; f < np->nf; f++)
-            for (int w = 0; w < n; w++) sig_max = fmax(sig_max, 2.0 * np->g.v[v * np->nf + f] * np->mc_sca[f][w]);
-    if (!(sig_max > 0) || !cell_scattering(np, mc, sig_max, ss, threads)) {
-        free(acc), free(ss);
-        return sig_max > 0 ? atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the photons")
-                           : ATMOS_OK;
+    const double *ss = mc->ss;
+    if (!ss) { /* no scattering in the grid */
+        free(acc);
+        return ATMOS_OK;
     }
-    for (size_t c = 0; c < vals; c++) ss[c] *= sig_max * h * h * h;
     double smax[ATMOS_MAX_WAVELENGTHS] = {0};
     for (size_t c = 0; c < vals; c++)
         if (ss[c] > smax[c % n]) smax[c % n] = ss[c];
@@ -369,7 +457,7 @@ static atmos_status trace(atmos_plan *p, atmos__nishita_plan *np, const double s
         const double d = fmax(ss[c], MC_SS_FLOOR * smax[w]), sc = N > 0 && d > 0 ? E[w] * M.A / ((double)N * d) : 0;
         for (int k = 0; k < K; k++) mc->coef[c * K + k] = (float)(acc[c * K + k] / MC_FIX * sc);
     }
-    free(acc), free(ss);
+    free(acc);
     return ATMOS_OK;
 }
 
