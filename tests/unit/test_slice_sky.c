@@ -48,7 +48,7 @@ static atmos_image *slice(atmos_context *ctx, const atmos_scene *scene, const at
     ss.optics = o;
     s.slice.light_size = 96;
     s.slice.xi = 0; /* no ambient term: the sky's light is the field's alone */
-    s.slice.diffuse = field == 1, s.slice.do_field = field == 2;
+    s.slice.diffuse = field != 0, s.slice.do_field = field == 2; /* "diffuse" left on with do: its default */
     atmos_image *img = NULL;
     CHECK_MSG(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_OK, "slice: %s", atmos_context_error(ctx));
     return img;
