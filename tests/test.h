@@ -14,7 +14,12 @@
 
 /* 1 in the sanitizer copies of the tests (asan.*): they are there for memory errors, the numbers
  * are checked by the plain copy (unit.*), so a slow test may run fewer of its cases there. */
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__has_feature) /* clang says it so; GCC defines __SANITIZE_ADDRESS__ */
+#if __has_feature(address_sanitizer)
+#define TEST_ASAN_ 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(TEST_ASAN_)
 #define TEST_SANITIZED 1
 #else
 #define TEST_SANITIZED 0

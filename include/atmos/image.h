@@ -199,6 +199,7 @@ typedef struct atmos_image_diff {
     double heat_scale;                      /* relative difference shown as white */
     size_t nonfinite_image, nonfinite_reference; /* of those, the non-finite values in each image */
     size_t excluded;                        /* pixels left out by the match's exclude_above */
+    size_t nonfinite_excluded;              /* of nonfinite, those in the excluded pixels (not compared) */
 } atmos_image_diff;
 ATMOS_API atmos_status atmos_image_compare(atmos_context *ctx, const atmos_image *image, const atmos_image *reference,
                                            atmos_image_diff *out, atmos_image **heatmap);

@@ -48,6 +48,7 @@ static void count_nonfinite(const atmos_channel_match *m, const float *pa, const
     for (int c = 0; c < m->count; c++) {
         const int a = !isfinite(pa[m->image[c]]), r = !isfinite(pr[m->reference[c]]);
         out->nonfinite += a || r;
+        out->nonfinite_excluded += a || r;
         out->nonfinite_image += a;
         out->nonfinite_reference += r;
     }

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <algorithm>
 #include <new>
 #include <sstream>
 #include <string>
@@ -72,33 +73,38 @@ std::string check_face(const std::string &rest, long line_no, long vertices, lon
 
 // A line's statement checked before its content: empty, or what is wrong. The first word must
 // be an OBJ statement (the reader skips any other line without a word, so a damaged or wrong
-// file would pass as a mesh of fewer faces); bytes no text holds mean another kind of file.
+// file would pass as a mesh of fewer faces); bytes no text holds mean another kind of file. The
+// message is made only for a wrong line (this runs on every line of the file).
 std::string check_statement(const std::string &line, long line_no)
 {
     static const char *const known[] = {"v", "vt", "vn", "vp", "vw", "f", "l", "p", "g", "o", "s", "t",
                                         "usemtl", "mtllib", "cstype", "deg", "bmat", "step", "curv", "curv2",
                                         "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "mg",
                                         "bevel", "c_interp", "d_interp", "lod", "maplib", "usemap",
-                                        "shadow_obj", "trace_obj", "ctech", "stech"};
+                                        "shadow_obj", "trace_obj", "ctech", "stech", "call", "csh"};
+    static const char *const space = " \t\n\v\f\r";
     char buf[160];
     if (line_no == 1 && !line.compare(0, 3, "\xEF\xBB\xBF")) { // the reader would drop the line's statement
         if (line.find_first_not_of(" \t\r", 3) == std::string::npos) return std::string(); // a comment's line
         return "line 1 starts with a UTF-8 byte-order mark, which the OBJ reader takes for a word: save the file "
                "without it";
     }
-    std::snprintf(buf, sizeof buf, "not an OBJ file (line %ld holds binary data%s)", line_no,
-                  line.compare(0, 4, "\x89PNG") ? "" : ": a PNG image");
+    bool binary = false;
     for (const unsigned char c : line)
-        if ((c < 0x20 && c != '\t' && c != '\r' && c != '\v' && c != '\f') || c == 0x7f) return buf;
-    std::istringstream in(line);
-    std::string word;
-    if (!(in >> word)) return std::string();
+        if ((c < 0x20 && c != '\t' && c != '\r' && c != '\v' && c != '\f') || c == 0x7f) binary = true;
+    const size_t b = line.find_first_not_of(space);
+    if (!binary && b == std::string::npos) return std::string();
+    const size_t n = binary ? 0 : std::min(line.find_first_of(space, b), line.size()) - b;
     for (const char *k : known)
-        if (word == k) return std::string();
-    for (const unsigned char c : word)
-        if (c >= 0x80) return buf;
-    std::snprintf(buf, sizeof buf, "line %ld: '%.40s' is not an OBJ statement (v, vt, vn, f, l, p, g, o, s, "
-                  "usemtl, mtllib, ...)", line_no, word.c_str());
+        if (!binary && !line.compare(b, n, k)) return std::string();
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)line[b + i] >= 0x80) binary = true;
+    if (binary)
+        std::snprintf(buf, sizeof buf, "not an OBJ file (line %ld holds binary data%s)", line_no,
+                      line.compare(0, 4, "\x89PNG") ? "" : ": a PNG image");
+    else
+        std::snprintf(buf, sizeof buf, "line %ld: '%.40s' is not an OBJ statement (v, vt, vn, f, l, p, g, o, s, "
+                      "usemtl, mtllib, ...)", line_no, line.substr(b, n).c_str());
     return buf;
 }
 
@@ -124,6 +130,8 @@ long scan(const char *path, long stop_after, std::string *why, bool *trailing)
             *trailing = *trailing || line.find_first_not_of(" \t") < hash;
             line.erase(hash);
         }
+        if (!line.empty() && line.back() == '\x1a' && f.peek() == EOF) line.pop_back(); // a DOS end of file
+        line.erase(0, line.find_first_not_of(" \t")); // an indented statement is one
         if (!(*why = check_statement(line, line_no)).empty()) break;
         if (line.size() < 1 || (line.size() > 1 && line[1] != ' ' && line[1] != '\t' && line[1] != '\r')) continue;
         if (line[0] == 'f') {

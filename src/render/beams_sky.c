@@ -8,6 +8,7 @@
  * dims the sky the eye sees: a height-dependent fog's layer above the surface by exp(-C / mu)
  * (the table's layers of C); a uniform fog hides it (its caller adds none). */
 #include "render/beams_sky.h"
+#include "render/sky_inflow.h"
 #include "core/clones.h"
 #include "core/vec.h"
 
@@ -17,19 +18,6 @@
 #define BEAMS_SKY_MU 24
 #define BEAMS_SKY_PHI 48
 
-/* The radiance of the sky at p along d without the sun's disk (into L[nw]). */
-static void sky_radiance(const atmos_atmosphere *atm, const double p[3], const double d[3], const double sun[3],
-                         int nw, double *L)
-{
-    atmos_atmosphere_hit info;
-    atmos_atmosphere_radiance(atm, p, d, sun, L, &info);
-    if (info.in_sun_disk) {
-        double D[ATMOS_MAX_WAVELENGTHS];
-        atmos_atmosphere_sun_radiance(atm, p, sun, D);
-        for (int k = 0; k < nw; k++) L[k] = fmax(0.0, L[k] - D[k]);
-    }
-}
-
 /* The table's normal at node (iy, ia). */
 static void node_normal(int iy, int ia, double n[3])
 {
@@ -38,35 +26,34 @@ static void node_normal(int iy, int ia, double n[3])
     n[0] = s * cos(a), n[1] = y, n[2] = s * sin(a);
 }
 
-/* The layers C > 0 of the table (ic >= 1): per normal, the sky's irradiance ring by ring
- * (rows of L as in atmos__beams_sky_build), each ring dimmed by exp(-C / mu) at its centre. */
-static int layers(const double *L, int nw, atmos__beams_sky *s)
+/* The sky's irradiance on a surface of normal n ring by ring of the directions (the rows of L
+ * as in atmos__beams_sky_build): R[r * nw + k]. */
+static void ring_irradiance(const double *L, int nw, const double n[3], double *R)
 {
-    const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI, nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
-    double *R = malloc(sizeof(double) * (size_t)BEAMS_SKY_MU * nw);
-    if (!R) return 0;
+    const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI;
     const double dw = 2.0 * ATMOS_PI / nd;
-    for (int j = 0; j < nn; j++) {
-        double n[3];
-        node_normal(j / BEAMS_SKY_NA, j % BEAMS_SKY_NA, n);
-        for (int q = 0; q < BEAMS_SKY_MU * nw; q++) R[q] = 0;
-        for (int i = 0; i < nd; i++) {
-            const double *row = L + (size_t)i * (nw + 3), c = atmos__dot3(n, row);
-            if (c > 0)
-                for (int k = 0; k < nw; k++) R[(i / BEAMS_SKY_PHI) * nw + k] += row[3 + k] * c * dw;
-        }
-        for (int ic = 1; ic < s->nc; ic++) {
-            const double x = (double)ic / (BEAMS_SKY_NC - 1), C = BEAMS_SKY_CMAX * x * x;
-            double e[ATMOS_MAX_WAVELENGTHS] = {0};
-            for (int r = 0; r < BEAMS_SKY_MU; r++) {
-                const double t = exp(-C / ((r + 0.5) / BEAMS_SKY_MU));
-                for (int k = 0; k < nw; k++) e[k] += t * R[r * nw + k];
-            }
-            for (int k = 0; k < nw; k++) s->E[((size_t)ic * nn + j) * nw + k] = (float)e[k];
-        }
+    for (int q = 0; q < BEAMS_SKY_MU * nw; q++) R[q] = 0;
+    for (int i = 0; i < nd; i++) {
+        const double *row = L + (size_t)i * (nw + 3), c = atmos__dot3(n, row);
+        if (c > 0)
+            for (int k = 0; k < nw; k++) R[(i / BEAMS_SKY_PHI) * nw + k] += row[3 + k] * c * dw;
     }
-    free(R);
-    return 1;
+}
+
+/* The table's values of normal j: its rings' irradiance R summed, for each layer ic of C, each
+ * ring dimmed by exp(-C / mu) at its centre (ic = 0: C = 0, undimmed). */
+static void node_values(const double *R, int nw, int j, atmos__beams_sky *s)
+{
+    const int nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
+    for (int ic = 0; ic < s->nc; ic++) {
+        const double x = (double)ic / (BEAMS_SKY_NC - 1), C = BEAMS_SKY_CMAX * x * x;
+        double e[ATMOS_MAX_WAVELENGTHS] = {0};
+        for (int r = 0; r < BEAMS_SKY_MU; r++) {
+            const double t = ic ? exp(-C / ((r + 0.5) / BEAMS_SKY_MU)) : 1.0;
+            for (int k = 0; k < nw; k++) e[k] += t * R[r * nw + k];
+        }
+        for (int k = 0; k < nw; k++) s->E[((size_t)ic * nn + j) * nw + k] = (float)e[k];
+    }
 }
 
 atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *atm, const double p[3],
@@ -76,37 +63,27 @@ atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *
     if (atmos_atmosphere_get_kind(atm) == ATMOS_ATMOSPHERE_VACUUM) return ATMOS_OK;
     const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI, nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
     s->nc = layered ? BEAMS_SKY_NC : 1;
-    double *L = malloc(sizeof(double) * (size_t)nd * (nw + 3));
+    double *L = malloc(sizeof(double) * (size_t)nd * (nw + 3)), *R = malloc(sizeof(double) * BEAMS_SKY_MU * nw);
     s->E = calloc((size_t)s->nc * nn * nw, sizeof *s->E);
-    if (!L || !s->E) {
-        free(L), free(s->E), s->E = NULL;
+    if (!L || !R || !s->E) {
+        free(L), free(R), free(s->E), s->E = NULL;
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the sky's light");
     }
-    const double dw = 2.0 * ATMOS_PI / nd;
 #pragma omp parallel for schedule(dynamic, 8) num_threads(atmos__threads(ctx))
     for (int i = 0; i < nd; i++) {
         const double mu = ((i / BEAMS_SKY_PHI) + 0.5) / BEAMS_SKY_MU, phi = 2.0 * ATMOS_PI * ((i % BEAMS_SKY_PHI) + 0.5) / BEAMS_SKY_PHI;
         const double st = sqrt(fmax(0.0, 1.0 - mu * mu));
         double *row = L + (size_t)i * (nw + 3);
         row[0] = st * cos(phi), row[1] = mu, row[2] = st * sin(phi);
-        sky_radiance(atm, p, row, sun_dir, nw, row + 3);
+        atmos__sky_seen(atm, p, row, sun_dir, nw, row + 3); /* without the sun's disk */
     }
     for (int j = 0; j < nn; j++) {
-        double n[3], e[ATMOS_MAX_WAVELENGTHS] = {0};
+        double n[3];
         node_normal(j / BEAMS_SKY_NA, j % BEAMS_SKY_NA, n);
-        for (int i = 0; i < nd; i++) {
-            const double *row = L + (size_t)i * (nw + 3), c = atmos__dot3(n, row);
-            if (c > 0)
-                for (int k = 0; k < nw; k++) e[k] += row[3 + k] * c * dw;
-        }
-        for (int k = 0; k < nw; k++) s->E[(size_t)j * nw + k] = (float)e[k];
+        ring_irradiance(L, nw, n, R);
+        node_values(R, nw, j, s);
     }
-    const int ok = s->nc == 1 || layers(L, nw, s);
-    free(L);
-    if (!ok) {
-        free(s->E), s->E = NULL;
-        return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the sky's light");
-    }
+    free(L), free(R);
     s->nw = nw;
     return ATMOS_OK;
 }

@@ -255,7 +255,7 @@ static void field_sky(atmos__dfield *df, const atmos_atmosphere *atm, const doub
                          ph = 2.0 * 3.14159265358979323846 * (b + 0.5) / SKY_NPHI;
             const double d[3] = {sn * cos(ph), mu, sn * sin(ph)};
             double L[ATMOS_MAX_WAVELENGTHS], dg[3];
-            if (!atmos__sky_seen(atm, cw, d, sun_w, L)) continue;
+            atmos__sky_seen(atm, cw, d, sun_w, n, L);
             atmos__vol_dir_to_frame(df->x, d, dg);
             for (int f = 0; f < 6; f++) {
                 const double c = (f & 1 ? 1.0 : -1.0) * dg[f / 2];

@@ -162,8 +162,13 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         if (Tmax < 1e-5) break;
     }
     *th = wsum > 0 ? tsum / wsum : 0.5 * (t0 + t1);
-    /* delta-M: what lies behind is seen through sig*, the peak's share passing straight on (as the
-     * field's sweeps carry the sky's light, and the slice renderer's background with "do") */
+    /* delta-M: what lies behind is seen through sig*, the peak's share passing straight on. This
+     * holds for any delta-M field, the photons' (--nishita-mc-delta-m) as the do sweeps': the
+     * field is built counting the peak's share f of each scattering as not scattered, so none of
+     * its radiance is that share; seen through the full sig_t the background would lose that
+     * share, and the field would not give it back. Whether the field also carries the sky's light
+     * (the do sweeps do, the photons do not) changes what it adds, not this transmittance (as
+     * the slice renderer's background with "do"). */
     if (J->tms) memcpy(T, Tm, sizeof(double) * n);
     return 1;
 }

@@ -3,7 +3,6 @@
 #include "atmosphere/atmosphere_check.h"
 
 #include <math.h>
-#include <string.h>
 
 void atmos__sky_inflow_point(const atmos_atmosphere *atm, const atmos__vol_xform *x, const double cen[3],
                              double cw[3])
@@ -12,14 +11,15 @@ void atmos__sky_inflow_point(const atmos_atmosphere *atm, const atmos__vol_xform
     atmos__atm_onto_ground(atm, cw, cw); /* the sky seen from above the ground */
 }
 
-int atmos__sky_seen(const atmos_atmosphere *atm, const double cw[3], const double d[3], const double sun_w[3],
-                    double *L)
+void atmos__sky_seen(const atmos_atmosphere *atm, const double cw[3], const double d[3], const double sun_w[3], int n,
+                     double *L)
 {
     atmos_atmosphere_hit info;
     atmos_atmosphere_radiance(atm, cw, d, sun_w, L, &info);
-    if (!info.in_sun_disk) return 1;
-    memset(L, 0, sizeof(double) * ATMOS_MAX_WAVELENGTHS);
-    return 0;
+    if (!info.in_sun_disk) return;
+    double D[ATMOS_MAX_WAVELENGTHS]; /* the disk alone: the circumsolar sky behind it stays */
+    atmos_atmosphere_sun_radiance(atm, cw, sun_w, D);
+    for (int w = 0; w < n; w++) L[w] = fmax(0.0, L[w] - D[w]);
 }
 
 void atmos__sky_patch_inflow(const atmos_atmosphere *atm, const double cw[3], const double sun_w[3], int n, double mu0,
@@ -33,7 +33,7 @@ void atmos__sky_patch_inflow(const atmos_atmosphere *atm, const double cw[3], co
             /* the view ray looks against the light's direction */
             const double d[3] = {-st * cos(ph), -st * sin(ph), -mu};
             double s[ATMOS_MAX_WAVELENGTHS];
-            atmos__sky_seen(atm, cw, d, sun_w, s);
+            atmos__sky_seen(atm, cw, d, sun_w, n, s);
             for (int w = 0; w < n; w++) L[w] += s[w] / ((double)ns * ns);
         }
 }

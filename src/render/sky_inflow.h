@@ -1,6 +1,6 @@
 /* The sky's and the ground's light arriving at a volume (sky_inflow.c): what a view ray from
  * the box's centre sees (atmos_atmosphere_radiance: the air and the lit ground; the sun's disk
- * left out, the sun is the renderers' direct beam). The one source of both light fields'
+ * taken off, the sun is the renderers' direct beam). The one source of both light fields'
  * boundaries: the P1 field's inward currents per face (dfield.c) and the discrete-ordinates
  * field's inflow per direction (nishita_do.c). Not part of the API. */
 #ifndef ATMOS_RENDER_SKY_INFLOW_H
@@ -14,10 +14,11 @@
 void atmos__sky_inflow_point(const atmos_atmosphere *atm, const atmos__vol_xform *x, const double cen[3],
                              double cw[3]);
 
-/* What a view ray from cw along the world direction d sees, into L (per wavelength); 0 and L
- * zero when d looks into the sun's disk. */
-int atmos__sky_seen(const atmos_atmosphere *atm, const double cw[3], const double d[3], const double sun_w[3],
-                    double *L);
+/* What a view ray from cw along the world direction d sees, into L (n wavelengths): the sky
+ * without the sun's disk (atmos_atmosphere_sun_radiance taken off where d looks into it, so the
+ * circumsolar sky around and behind the disk stays; the beam renderer's sky table too). */
+void atmos__sky_seen(const atmos_atmosphere *atm, const double cw[3], const double d[3], const double sun_w[3], int n,
+                     double *L);
 
 /* The mean radiance travelling along the directions of a patch of the sphere, mu in [mu0, mu1]
  * (the cosine to the world's z axis) and azimuth in [ph0, ph1) about it, arriving at cw: what the

@@ -77,12 +77,13 @@ static const char *const sources[] = {"file", "generate", "simulate"};
 
 /* The volume's source is one of "file", "generate" and "simulate": one set by an override
  * replaces the others the file had (as --volume replaces the scene's volume), with the keys
- * only the old kind takes (scene_json.c refuses them with the new one); overrides after it
- * may set them again. */
+ * only the old kind takes (scene_json.c refuses them with the new one) and "particle" (a
+ * file's one field's type is not a generated cloud's droplets); overrides after it may set
+ * them again. */
 static void drop_other_sources(cJSON *root, const cJSON *node, const char *tok)
 {
-    static const char *const file_only[] = {"grids", "time_index", "density_unit", "subgrid_detail", NULL},
-                             *const gen_only[] = {"seed", NULL},
+    static const char *const file_only[] = {"grids", "time_index", "density_unit", "subgrid_detail", "particle", NULL},
+                             *const gen_only[] = {"seed", "particle", NULL},
                              *const sim_bad[] = {"grids", "time_index", "density_unit", "subgrid_detail", "seed",
                                                  "voxel_size_m", "scale", "particle", NULL};
     cJSON *vol = cJSON_GetObjectItemCaseSensitive(root, "volume");

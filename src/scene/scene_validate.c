@@ -222,7 +222,8 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
 /* Every row of the renderers' settings tables within its range (atmos_renderer_settings). */
 /* With the slice renderer's do field ("do", --slice-do) these settings would do nothing: set
  * away from their default (xi also 0, which is what the field does) they are refused, naming
- * the key and the flag. */
+ * the key and the flag, when the slice renderer is the scene's (another renderer reads none of
+ * them; the viewer switched to slice leaves them unused, as the field does). */
 static atmos_status slice_do_check(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
     static const struct {
@@ -233,7 +234,7 @@ static atmos_status slice_do_check(atmos_context *ctx, const char *source, const
         {"low_albedo", "low albedo is single scattering alone: it and the field exclude each other"},
         {"diffuse", "the field takes the place of the diffuse light field: there is none to leave out"},
     };
-    if (!s->slice.do_field) return ATMOS_OK;
+    if (!s->slice.do_field || s->renderer != ATMOS_RENDERER_SLICE) return ATMOS_OK;
     int n;
     const atmos_setting *t = atmos_renderer_settings(ATMOS_RENDERER_SLICE, &n);
     for (int i = 0; i < n; i++)

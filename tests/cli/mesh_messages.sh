@@ -3,7 +3,7 @@
 # reason and, for a relative path, where it was looked for (as a light's image is); an OBJ
 # file's wrong face (or a face of fewer than 3 vertices, or a line that is no OBJ statement) says
 # what is wrong, as written, and on which line; another kind of file is not an OBJ file; a folder is
-# a folder; a comment after a face is a comment.
+# a folder; a comment after a face is a comment; call, csh, indents and a final ^Z are OBJ's.
 . "$(dirname "$0")/common.inc"
 cd "$T" || exit 1
 mesh_scene() { # mesh_scene MESH TERRAIN
@@ -61,6 +61,14 @@ check "a face of two vertices (a truncated file)" err11 "/objects/0/mesh" "line 
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nfx 1 2 3\nf 1 2 3\n' >word.obj
 "$A" render s.json -D objects.0.mesh=word.obj -o x.png -q 2>err12
 check "a line that is no OBJ statement" err12 "/objects/0/mesh" "line 4" "'fx' is not an OBJ statement"
+# the spec's call and csh statements, indented lines and a DOS end-of-file mark (^Z) after the
+# last line are a valid file's; an indented face is checked as any other
+printf 'v 0 0 0\r\nv 1 0 0\r\n  v 0 1 0\r\ncsh echo\r\ncall other.obj\r\n\tf 1 2 3\r\n\032' >dos.obj
+"$A" render s.json -D objects.0.mesh=dos.obj -o x.png -q 2>err14 && [ ! -s err14 ] &&
+    ok "call, csh, indented lines and a final ^Z: read" || bad "call, csh, indents, ^Z: $(cat err14)"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n  f 3 1\n' >icut.obj
+"$A" render s.json -D objects.0.mesh=icut.obj -o x.png -q 2>err15
+check "an indented face of two vertices" err15 "line 5" "3 or more vertices" "has 2"
 printf '\211PNG\r\n\032\n\000\000\000\rIHDR' >pic.obj
 "$A" render s.json -D objects.0.mesh=pic.obj -o x.png -q 2>err13
 check "a PNG given as a mesh" err13 "/objects/0/mesh" "not an OBJ file" "PNG"

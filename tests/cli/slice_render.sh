@@ -39,6 +39,10 @@ printf '{"renderer": "slice", "volume": {"generate": "cumulus"}, "slice": {"do":
 "$A" render -q "$T/do.json" --width 16 --height 9 -o "$T/do.png" 2>"$T/do.txt"
 [ $? -eq 1 ] && grep -q "do.json: /slice/xi: (--xi) does nothing" "$T/do.txt" && ok "a scene's do with xi refused" ||
     { bad "a scene's do with xi"; cat "$T/do.txt" >&2; }
+# another renderer reads none of the slice settings: a leftover do with xi is no error there
+printf '{"renderer": "nishita", "volume": {"generate": "cumulus"}, "slice": {"do": true, "xi": 0.2}}\n' >"$T/don.json"
+"$A" render -q "$T/don.json" --width 16 --height 9 -o "$T/don.png" 2>"$T/don.txt" && ok "do with xi under nishita: renders" ||
+    { bad "do with xi under nishita refused"; cat "$T/don.txt" >&2; }
 
 # --tau: the optical-depth key image, positive where the cloud is; compare --by splits by it
 "$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --eq24 --pfm "$T/eq24.pfm" \

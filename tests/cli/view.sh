@@ -50,6 +50,13 @@ st=$?
     ok "--record into a folder with an earlier recording: refused (exit 2), the recording kept" ||
     { bad "--record into an earlier recording: exit $st"; cat "$T/again.txt" >&2; }
 mkdir -p "$T/other" && : >"$T/other/notes.txt" && : >"$T/other/frame.png"
+# --record naming a file is refused before the renderer is prepared (no frame tried)
+: >"$T/afile"
+"$A" view --headless --frames 1 --size 32x18 --record "$T/afile" >"$T/file.txt" 2>&1
+st=$?
+[ $st -eq 2 ] && grep -q "record .*afile: not a folder" "$T/file.txt" && ! grep -q "frames.csv\|preparing" "$T/file.txt" &&
+    [ ! -s "$T/afile" ] && ok "--record FILE: refused (exit 2) before a frame" ||
+    { bad "--record FILE: exit $st"; cat "$T/file.txt" >&2; }
 "$A" view --headless --frames 1 --size 32x18 --record "$T/other" >"$T/other.txt" 2>&1 && [ -s "$T/other/frame_00000.png" ] &&
     [ -f "$T/other/notes.txt" ] && ok "--record into a folder with other files: recorded, the files kept" ||
     { bad "--record into a folder with other files"; cat "$T/other.txt" >&2; }

@@ -4,7 +4,9 @@
 #  - a volume too thin to see (its peak extinction times its box's diagonal, a bound on any
 #    ray's optical depth across it, under 0.01) renders with a warning that names the peak
 #    extinction and optical depth and the density unit / scale options; a visible one
-#    gets no such warning.
+#    gets no such warning;
+#  - a scene's "particle" (a volume file's field type) does not carry over to the cloud
+#    droplets of a volume --volume generate:… puts in its place (the same image as without it).
 . "$(dirname "$0")/common.inc"
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
 
@@ -35,4 +37,18 @@ has "thin volume" "--density-scale"
 # shellcheck disable=SC2086
 "$A" render $common -D "$P" --pfm "$T/thick.pfm" >/dev/null 2>"$T/err"
 grep -q "peak extinction" "$T/err" && bad "a visible volume got the warning" || ok "no warning for a visible volume"
+# a file source's particle type does not become a generated cloud's droplets: the same image as
+# with no particle given; --particle given again is used
+printf '{"volume": {"file": "%s", "particle": "ice"}}\n' "$T/v.json" >"$T/ps.json"
+printf '{"volume": {"file": "%s"}}\n' "$T/v.json" >"$T/p0.json"
+gen="--volume generate:cumulus --voxel-size 400 --width 16 --height 9 --renderer path --spp 1 --threads 1"
+for s in ps p0; do
+    # shellcheck disable=SC2086
+    "$A" render "$T/$s.json" $gen -D "$P" --pfm "$T/$s.pfm" >/dev/null 2>"$T/err" || { bad "$s.json:"; cat "$T/err" >&2; }
+done
+cmp -s "$T/ps.pfm" "$T/p0.pfm" && ok "--volume generate: the file's particle dropped (the same image)" ||
+    bad "--volume generate kept the file's particle (another image)"
+# shellcheck disable=SC2086
+"$A" render "$T/ps.json" $gen -D "$P" --particle no_such_particle --pfm "$T/ps2.pfm" >/dev/null 2>"$T/err" &&
+    bad "--particle given again was not used" || has "--particle given again" "no_such_particle"
 exit $fail

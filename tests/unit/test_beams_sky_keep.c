@@ -4,7 +4,8 @@
  *   - an eye moved within its quantum keeps the very table (not made again: a value written
  *     into it stays), and it equals, value
  *     for value, a fresh atmos__beams_sky_build at the quantised point;
- *   - an eye moved into another quantum, or another sun, gets a new table equal to a fresh one;
+ *   - an eye moved into another quantum, another sun, or a fog's layers asked or no longer
+ *     asked, gets a new table equal to a fresh one;
  *   - the quantisation's cost: the table at the quantised point against the table at the true
  *     point half a quantum away in x and z (the spherical model, the sun 8 and 30 degrees up),
  *     within a relative 10^-3 at every node with light above 10^-3 of the brightest. */
@@ -82,6 +83,14 @@ int main(void)
         CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun2, nw, 0, &fresh));
         CHECK_MSG(same(&keep, &fresh), "after the sun moved: not the fresh table");
         atmos__beams_sky_free(&fresh);
+        /* the same eye and sun with a height-dependent fog: the table made again with its layers */
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun2, nw, 1, &keep));
+        CHECK_MSG(keep.nc == BEAMS_SKY_NC, "layered after unlayered: %d values of C kept", keep.nc);
+        CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun2, nw, 1, &fresh));
+        CHECK_MSG(keep.nc == fresh.nc && same(&keep, &fresh), "layered: not the fresh table");
+        atmos__beams_sky_free(&fresh);
+        CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun2, nw, 0, &keep));
+        CHECK_MSG(keep.nc == 1, "unlayered after layered: %d values of C kept", keep.nc);
         atmos__beams_sky_free(&keep);
     }
     atmos_atmosphere_destroy(atm);

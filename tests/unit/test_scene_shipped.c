@@ -89,6 +89,7 @@ static void generated_particle(void)
     CHECK_OK(atmos_scene_particle(ctx, &s, "glory_droplets", &pd));
     CHECK_OK(atmos_scene_wavelengths(ctx, &s, &wl));
     CHECK_OK(atmos_phase_table_build(ctx, &pd, &wl, &td, &t));
+    CHECK(with.count == 1 && without.count == 1 && t);
     if (with.count == 1 && without.count == 1 && t) {
         CHECK_REL(sigma_ext(with.phase[0]), sigma_ext(t), 1e-9);
         CHECK_MSG(fabs(sigma_ext(without.phase[0]) / sigma_ext(t) - 1) > 0.05, "cloud %g, glory droplets %g",
@@ -98,11 +99,20 @@ static void generated_particle(void)
     atmos_volume_optics_free(&with);
     atmos_volume_optics_free(&without);
     atmos_volume_destroy(v);
-    /* -D volume.generate over a file source whose "particle" is the default: allowed, kept */
-    const char *ov[] = {"volume.generate=cumulus"};
-    const char *json = "{\"volume\": {\"file\": \"d.vdb\", \"particle\": \"cloud\", \"grids\": [\"density\"]}}";
+    /* -D volume.generate over a file source: the file's "particle" (its field's type) goes with
+     * it, not to the generated cloud's droplets; one set after the source is kept */
+    const char *ov[] = {"volume.generate=cumulus", "volume.particle=snow"};
+    const char *json = "{\"volume\": {\"file\": \"d.vdb\", \"particle\": \"ice\", \"grids\": [\"density\"]}}";
     CHECK_OK(atmos_scene_parse_with(ctx, json, strlen(json), "t.json", ov, 1, &s));
-    CHECK(!strcmp(s.volume.source, "generate:cumulus") && !strcmp(s.volume.particle, "cloud"));
+    CHECK_MSG(!strcmp(s.volume.source, "generate:cumulus") && !s.volume.particle[0], "particle '%s'",
+              s.volume.particle);
+    CHECK_OK(atmos_scene_parse_with(ctx, json, strlen(json), "t.json", ov, 2, &s));
+    CHECK(!strcmp(s.volume.particle, "snow"));
+    /* and back: -D volume.file over a generated cloud with its own droplets */
+    const char *ovf[] = {"volume.file=d.vdb"};
+    const char *gen = "{\"volume\": {\"generate\": \"cumulus\", \"particle\": \"ice\"}}";
+    CHECK_OK(atmos_scene_parse_with(ctx, gen, strlen(gen), "t.json", ovf, 1, &s));
+    CHECK_MSG(!s.volume.particle[0], "particle '%s'", s.volume.particle);
 }
 
 static void framed_over_the_ground(void)

@@ -24,7 +24,8 @@ static void help(void)
            "yellow, white = the largest, at most 10 x the 99th percentile of the pixels' differences:\n"
            "one far-off pixel such as a lamp saturates instead of leaving the rest black). --json prints\n"
            "  {\"rmse\": ..., \"rel_rmse\": ..., \"bias\": [...], \"rmse_per_channel\": [...],\n"
-           "   \"rel_rmse_per_channel\": [...], \"channels\": [names], \"worst_region\": [x, y, w, h],\n"
+           "   \"rel_rmse_per_channel\": [...], \"channels\": [names],\n"
+           "   \"worst_region\": [x, y, w, h] or null (nothing compared),\n"
            "   \"worst_rmse\": ..., \"nonfinite\": N, \"nonfinite_image\": N1, \"nonfinite_reference\": N2}\n"
            "(numbers without a finite value are null: the relative ones of an all-zero reference,\n"
            "printed inf or nan as text). NaN or infinite samples in either image\n"
@@ -264,8 +265,11 @@ int cli_cmd_compare(int argc, char **argv)
         /* A comparison is a test: a NaN or infinity in either image fails it, whatever
          * the statistics over the finite samples say. */
         if (d.nonfinite) {
-            fprintf(stderr, "atmos %s: %zu compared samples are NaN or infinite (%zu in %s, %zu in %s): the comparison fails\n",
-                    C, d.nonfinite, d.nonfinite_image, files[0], d.nonfinite_reference, files[1]);
+            char left[96] = ""; /* those of pixels --exclude-above left out were not compared, yet count */
+            if (d.nonfinite_excluded)
+                snprintf(left, sizeof left, "; %zu of them in pixels left out by --exclude-above", d.nonfinite_excluded);
+            fprintf(stderr, "atmos %s: %zu samples are NaN or infinite (%zu in %s, %zu in %s%s): the comparison fails\n",
+                    C, d.nonfinite, d.nonfinite_image, files[0], d.nonfinite_reference, files[1], left);
             rc = CLI_EXIT_RUNTIME;
         }
         if (m.exclude_above > 0 && d.excluded == (size_t)a.img->width * a.img->height) {

@@ -540,11 +540,20 @@ static int apply_view(const render_opts *o, atmos_scene *s)
     return CLI_EXIT_OK;
 }
 
+/* A volume source's kind: 0 a file, 1 generated, 2 simulated. */
+static int source_kind(const char *src)
+{
+    return !strncmp(src, "generate:", 9) ? 1 : !strncmp(src, "simulate:", 9) ? 2 : 0;
+}
+
 /* The renderer, the volume and the renderers' settings. */
 static int apply_renderer(const render_opts *o, atmos_scene *s)
 {
     const char *C = o->cmd;
     if (o->volume) {
+        /* a file's "particle" is its one field's type, not a generated cloud's droplets: it goes
+         * with the source it was given for (--particle sets it again) */
+        if (source_kind(o->volume) != source_kind(s->volume.source)) s->volume.particle[0] = '\0';
         snprintf(s->volume.source, sizeof s->volume.source, "%s", o->volume);
         if (s->renderer == ATMOS_RENDERER_SKY) s->renderer = ATMOS_RENDERER_SLICE;
     }

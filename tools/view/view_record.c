@@ -39,6 +39,11 @@ int view_record_open(view_recorder *r, const char *dir)
         fprintf(stderr, "atmos view: --record %s: %s\n", dir, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
+    struct stat st; /* mkdir's EEXIST is also that of a file of that name */
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "atmos view: --record %s: not a folder (--record takes the folder to record into)\n", dir);
+        return CLI_EXIT_USAGE;
+    }
     char name[256];
     if (earlier_recording(dir, name, sizeof name)) {
         fprintf(stderr,
