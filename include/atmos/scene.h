@@ -91,7 +91,7 @@ typedef struct atmos_scene_slice {
     int grid_max_dim;         /* 256 */
     double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1] or 2; 1 */
     int max_order;            /* Ams orders tabulated; 64 */
-    int diffuse;              /* 1: add the diffuse light field (the light Eq. 24/25 drop, by diffusion) */
+    int diffuse;              /* 0: the same as field ATMOS_SLICE_FIELD_NONE (the key kept); 1 (default) */
     int do_field;             /* "do", 1: the same as field ATMOS_SLICE_FIELD_DO (the key kept); 0 */
     int air_shadows;          /* 1 (default): the volume shadows the air's single scattering
                                  (light shafts, crepuscular rays); 0: the air is lit unshadowed */
