@@ -42,7 +42,8 @@ for c in $CASES; do
             opts=""
             case $V in
             eq25) opts="--no-diffuse" ;;
-            diffuse_xi0) opts="--xi 0" ;;
+            diffuse) opts="--slice-p1" ;;
+            diffuse_xi0) opts="--slice-p1 --xi 0" ;;
             esac
             "$A" render "$scene" $TH --sun-azimuth $az $opts --width "$w" --height "$h" \
                 --pfm "$base.$V.ss$SS.pfm" -o "$base.$V.ss$SS.png" 2> "$base.$V.ss$SS.log"

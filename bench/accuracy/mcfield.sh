@@ -56,7 +56,7 @@ for c in $CASES; do
             fi
         done
         if [ ! -s "$b.p1.pfm" ]; then
-            $V --pfm "$b.p1.pfm" -o "$b.p1.png" 2> "$b.p1.log"
+            $V --slice-p1 --pfm "$b.p1.pfm" -o "$b.p1.png" 2> "$b.p1.log"
             python3 "$here/breakdown.py" "$b.p1.pfm" "$b.vpath.pfm" "$b.tau.pfm" "$b.vpath2.pfm" > "$b.p1.bd.txt"
         fi
         /usr/bin/time -f %U+%S -o "$b.$TAG.cpu" $V $R --pfm "$b.$TAG.pfm" -o "$b.$TAG.png" 2> "$b.$TAG.log"

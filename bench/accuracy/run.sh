@@ -12,9 +12,9 @@
 # CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
 # VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer, "harris",
 # "harris_sun": Harris's, and the same with the diffuse light field, "nishita_diffuse",
-# "harris_diffuse", "harris_sun_diffuse"; "diffuse_aa": the default with four eye rays per pixel,
-# antialiased; "slice_do", "slice_do_aa": the slice renderer with the discrete-ordinates field,
-# --slice-do, one and four eye rays per pixel; "nishita_do": the Nishita renderer with that field,
+# "harris_diffuse", "harris_sun_diffuse"; "diffuse": the P1 field, --slice-p1; "diffuse_aa": the
+# same with four eye rays per pixel, antialiased; "slice_do", "slice_do_aa": the slice renderer with
+# the discrete-ordinates field (the default), one and four eye rays per pixel; "nishita_do": the Nishita renderer with that field,
 # its sky's light the field's inflow, "nishita_do_nosky" the same without: not in the default list), THREADS, REUSE (1: keep the reference images
 # already in OUT_DIR, e.g. to compare a new build's variants against the same references).
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
@@ -60,9 +60,9 @@ for c in $CASES; do
             eq25_xi4) opts="--no-diffuse --xi 0.0318" ;;
             eq24) opts="--no-diffuse --eq24" ;;
             low_albedo) opts="--low-albedo" ;;
-            diffuse) opts="" ;;
-            diffuse_xi0) opts="--xi 0" ;;
-            diffuse_aa) opts="--eye-scale 2" ;;
+            diffuse) opts="--slice-p1" ;;
+            diffuse_xi0) opts="--slice-p1 --xi 0" ;;
+            diffuse_aa) opts="--slice-p1 --eye-scale 2" ;;
             slice_do) opts="--slice-do" ;;
             slice_do_aa) opts="--slice-do --eye-scale 2" ;;
             nishita_do) opts="--renderer nishita --nishita-orders 1 --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do" ;;

@@ -91,12 +91,25 @@ typedef struct atmos_scene_slice {
     int grid_max_dim;         /* 256 */
     double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1] or 2; 1 */
     int max_order;            /* Ams orders tabulated; 64 */
-    int diffuse;              /* 1: add the diffuse light field (the light Eq. 24/25 drop, by diffusion) */
-    int do_field;             /* "do", 1: instead, the first order in the delta-M scaled medium plus the
-                                 orders >= 2 by discrete ordinates (docs/lightfield.md); 0 */
+    int diffuse;              /* 0: the same as field ATMOS_SLICE_FIELD_NONE (the key kept); 1 (default) */
+    int do_field;             /* "do", 1: the same as field ATMOS_SLICE_FIELD_DO (the key kept); 0 */
     int air_shadows;          /* 1 (default): the volume shadows the air's single scattering
                                  (light shafts, crepuscular rays); 0: the air is lit unshadowed */
+    int field;                /* "field": the light scattered more than once, atmos_slice_field;
+                                 ATMOS_SLICE_FIELD_AUTO (default), see atmos_scene_slice_field */
 } atmos_scene_slice;
+
+/* The slice renderer's field of the light scattered more than once ("field"). */
+typedef enum atmos_slice_field {
+    ATMOS_SLICE_FIELD_AUTO = 0, /* "auto": do, unless a setting of Riley's path asks for that path:
+                                   p1 when xi is set away from its default or update is eq24,
+                                   none when diffuse is false or low_albedo is set */
+    ATMOS_SLICE_FIELD_DO = 1,   /* "do": the first order in the delta-M scaled medium plus the orders
+                                   >= 2 by discrete ordinates (docs/lightfield.md) */
+    ATMOS_SLICE_FIELD_P1 = 2,   /* "p1": Riley's Eq. 24/25, Ams and xi plus the diffusion (P1) field of
+                                   the light they drop */
+    ATMOS_SLICE_FIELD_NONE = 3  /* "none": Riley's Eq. 24/25, Ams and xi alone */
+} atmos_slice_field;
 
 /* Settings of the path tracer ("path" in the file); the table is
  * atmos_renderer_settings(ATMOS_RENDERER_PATH). */
@@ -478,6 +491,10 @@ ATMOS_API const atmos_setting *atmos_renderer_settings(atmos_renderer_kind rende
  * is not checked: atmos_scene_validate does that). */
 ATMOS_API double atmos_scene_setting_get(const atmos_scene *scene, const atmos_setting *setting);
 ATMOS_API void atmos_scene_setting_set(atmos_scene *scene, const atmos_setting *setting, double value);
+/* The field the slice renderer draws for these settings: "field" when set, else the old keys
+ * ("do": true, "diffuse": false) and the settings of Riley's path (ATMOS_SLICE_FIELD_AUTO);
+ * never ATMOS_SLICE_FIELD_AUTO. With low_albedo the field is not drawn whatever this says. */
+ATMOS_API atmos_slice_field atmos_scene_slice_field(const atmos_scene_slice *slice);
 /* "sky", "slice", "path", "nishita", "harris", "beams"; NULL for an unknown kind. */
 ATMOS_API const char *atmos_renderer_name(atmos_renderer_kind renderer);
 

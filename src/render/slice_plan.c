@@ -63,8 +63,9 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     sp->low_albedo = ss->low_albedo;
     sp->eq24 = ss->eq24;
     sp->xi = (float)ss->xi;
-    sp->do_field = ss->do_field && !ss->low_albedo;
-    sp->diffuse = ss->diffuse && !ss->low_albedo && !sp->do_field;
+    const atmos_slice_field field = atmos_scene_slice_field(ss); /* "field" (scene_slice_field.c) */
+    sp->do_field = field == ATMOS_SLICE_FIELD_DO && !ss->low_albedo;
+    sp->diffuse = field == ATMOS_SLICE_FIELD_P1 && !ss->low_albedo;
     sp->reference = p->reference;
     sp->air_shadows = ss->air_shadows;
     atmos__vol_xform_init(p->volume, p->offset, &sp->x);
@@ -104,7 +105,7 @@ void atmos__slice_describe(const atmos_plan *p, const atmos__view *v, char *buf,
     snprintf(buf, cap, "%d slices%s, light buffer %d, eye buffer %dx%d, xi %g, %s%s", slices,
              v->slices > 0 ? "" : " (chosen)", ss->light_size, w, h, dof ? 0.0 : ss->xi,
              dof ? "delta-M beam" : (ss->eq24 ? "eq24" : "eq25"),
-             ss->low_albedo ? ", low albedo" : (dof ? "" : (ss->diffuse ? ", diffuse field" : "")));
+             ss->low_albedo ? ", low albedo" : (dof ? "" : (p->slice->diffuse ? ", diffuse field" : "")));
     atmos__slice_do_describe(p->slice, buf, cap);
 }
 

@@ -105,6 +105,9 @@ void atmos__scene_camera_effective(const atmos_camera_desc *cam, double fwd[3], 
  * range check of every row (scene_validate.c). */
 void atmos__settings_defaults(atmos_scene *s);
 atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s);
+/* The slice renderer's "field" against "do", "diffuse" and the settings the do field leaves
+ * without a use (scene_slice_field.c). */
+atmos_status atmos__slice_field_check(atmos_context *ctx, const char *source, const atmos_scene *s);
 
 /* Robust vector helpers (scaled so huge components never overflow). */
 double atmos__scene_norm3(const double v[3]);

@@ -15,6 +15,8 @@
 #define BEAMS(field) offsetof(atmos_scene, beams.field)
 
 static const char *const update_names[] = {"eq25", "eq24", NULL};
+/* indexed by atmos_slice_field */
+static const char *const field_names[] = {"auto", "do", "p1", "none", NULL};
 
 static const atmos_setting slice_settings[] = {
     {"slices", "slices", ATMOS_SETTING_INT, "", 0, 8192, 0, 0, 0, NULL, 0,
@@ -37,16 +39,19 @@ static const atmos_setting slice_settings[] = {
      SLICE(eye_scale)},
     {"max_order", "max-order", ATMOS_SETTING_INT, "", 1, 1000, 0, 0, 64, NULL, 0,
      "orders of Ams tabulated (higher scattering orders use the last)", SLICE(max_order)},
+    {"field", "slice-p1", ATMOS_SETTING_CHOICE, "", 0, 0, 0, 0, 0, field_names, ATMOS_SLICE_FIELD_P1,
+     "the light scattered more than once: p1 (the flag: Riley's Eq. 24/25, Ams and xi plus a diffusion field of "
+     "the light they drop), do (the first order in the delta-M scaled medium, the orders >= 2 by discrete "
+     "ordinates, the sky's and the ground's light through its faces), none (Eq. 24/25 alone); auto, the default: "
+     "do, but p1 when xi or update is set, none when diffuse is false or low_albedo is set (docs/lightfield.md)",
+     SLICE(field)},
     {"diffuse", "no-diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
-     "the diffuse light of all orders that Eq. 24/25 drop, from a diffusion solve on a coarse grid once "
-     "per sun direction (docs/lightfield.md); off: Riley's Eq. 24/25 alone, which lose most of the light "
-     "of dense clouds",
+     "a field of the light scattered more than once, as field chooses; false: field none, Riley's Eq. 24/25 "
+     "alone, which lose most of the light of dense clouds",
      SLICE(diffuse)},
     {"do", "slice-do", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
-     "instead of Eq. 24/25 and that field: the first order in the delta-M scaled medium and the orders >= 2 "
-     "by discrete ordinates (the Nishita renderer's do field, its cells nishita.mc_cell render voxels: the "
-     "one nishita setting it takes; the sky's and the ground's light enter it through its faces, "
-     "docs/lightfield.md)",
+     "the same as field do, the default (its cells nishita.mc_cell render voxels: the one nishita setting it "
+     "takes)",
      SLICE(do_field)},
     {"air_shadows", "no-air-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
      "the volume's shadow on the air's single scattering (light shafts, crepuscular rays); "

@@ -220,36 +220,6 @@ static atmos_status validate_atmosphere(atmos_context *ctx, const char *source,
 }
 
 /* Every row of the renderers' settings tables within its range (atmos_renderer_settings). */
-/* With the slice renderer's do field ("do", --slice-do) these settings would do nothing: set
- * away from their default (xi also 0, which is what the field does) they are refused, naming
- * the key and the flag, when the slice renderer is the scene's (another renderer reads none of
- * them; the viewer switched to slice leaves them unused, as the field does). */
-static atmos_status slice_do_check(atmos_context *ctx, const char *source, const atmos_scene *s)
-{
-    static const struct {
-        const char *key, *why;
-    } unused[] = {
-        {"xi", "the field holds the multiple scattering that Riley's xi term stands in for"},
-        {"update", "its light pass is the delta-M direct beam, without Eq. 24/25's update"},
-        {"low_albedo", "low albedo is single scattering alone: it and the field exclude each other"},
-        {"diffuse", "the field takes the place of the diffuse light field: there is none to leave out"},
-    };
-    if (!s->slice.do_field || s->renderer != ATMOS_RENDERER_SLICE) return ATMOS_OK;
-    int n;
-    const atmos_setting *t = atmos_renderer_settings(ATMOS_RENDERER_SLICE, &n);
-    for (int i = 0; i < n; i++)
-        for (size_t k = 0; k < sizeof unused / sizeof unused[0]; k++) {
-            const double v = atmos_scene_setting_get(s, &t[i]);
-            if (strcmp(t[i].key, unused[k].key) || v == t[i].def || (!strcmp(t[i].key, "xi") && v == 0)) continue;
-            char path[64];
-            snprintf(path, sizeof path, "/slice/%s", t[i].key);
-            return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path,
-                                     "(--%s) does nothing with the do field (\"do\": true, --slice-do): %s; leave "
-                                     "it out", t[i].flag, unused[k].why);
-        }
-    return ATMOS_OK;
-}
-
 atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const atmos_scene *s)
 {
     for (int r = ATMOS_RENDERER_SLICE; r <= ATMOS_RENDERER_LAST; r++) {
@@ -276,7 +246,7 @@ atmos_status atmos__settings_check(atmos_context *ctx, const char *source, const
             }
         }
     }
-    return slice_do_check(ctx, source, s);
+    return atmos__slice_field_check(ctx, source, s);
 }
 
 /* A volume's "particle": a file's or a generated volume's (a simulation sets its fields' own

@@ -36,7 +36,8 @@ base() {
 
 # flag (with its argument) | the -D form | renderer | "same" if a tiny image may not show it
 # (a budget never reached, orders beyond what a thin ball scatters, order-3 paths with orders
-# 2, impostors smaller anyway, a diffuse field faded out in a thin ball)
+# 2, impostors smaller anyway, a diffuse field faded out in a thin ball, the slice renderer's
+# default field chosen again)
 cat >"$T/table" <<'EOF'
 --slices 16|slice.slices=16|slice|
 --light-size 16|slice.light_size=16|slice|
@@ -46,8 +47,9 @@ cat >"$T/table" <<'EOF'
 --grid-max-dim 8|slice.grid_max_dim=8|slice|
 --eye-scale 0.5|slice.eye_scale=0.5|slice|
 --max-order 1|slice.max_order=1|slice|same
+--slice-p1|slice.field=p1|slice|
 --no-diffuse|slice.diffuse=false|slice|
---slice-do|slice.do=true|slice|
+--slice-do|slice.do=true|slice|same
 --no-air-shadows|slice.air_shadows=false|slice|
 --spp 3|path.spp=3|path|
 --time-budget 1000|path.time_budget_s=1000|path|same

@@ -39,6 +39,46 @@ printf '{"renderer": "slice", "volume": {"generate": "cumulus"}, "slice": {"do":
 "$A" render -q "$T/do.json" --width 16 --height 9 -o "$T/do.png" 2>"$T/do.txt"
 [ $? -eq 1 ] && grep -q "do.json: /slice/xi: (--xi) does nothing" "$T/do.txt" && ok "a scene's do with xi refused" ||
     { bad "a scene's do with xi"; cat "$T/do.txt" >&2; }
+# the field: do by default (the image's atmos:slice metadata names its delta-M beam), p1 with
+# --slice-p1 or a setting of Riley's path (xi, update), none with --no-diffuse; contradictions
+# refused. The do field and the P1 field draw different images.
+meta() { # the PNG's atmos:slice text
+    python3 -c '
+import struct, sys
+d = open(sys.argv[1], "rb").read()
+i = 8
+while i < len(d):
+    n, = struct.unpack(">I", d[i:i + 4])
+    if d[i + 4:i + 8] == b"tEXt" and d[i + 8:i + 8 + n].startswith(b"atmos:slice\0"):
+        print(d[i + 8:i + 8 + n].split(b"\0")[1].decode())
+    i += 12 + n' "$1"
+}
+for f in "do:" "p1:--slice-p1" "p1:--xi 0.02" "p1:--eq24" "none:--no-diffuse" "do:--slice-do"; do
+    o=${f#*:}
+    # shellcheck disable=SC2086
+    "$A" render -q --width 16 --height 9 --volume generate:cumulus --slices 32 $o -o "$T/f.png" 2>"$T/f.txt" ||
+        { bad "render $o"; cat "$T/f.txt" >&2; continue; }
+    m=$(meta "$T/f.png")
+    case ${f%%:*} in
+    do) echo "$m" | grep -q "delta-M beam" ;;
+    p1) echo "$m" | grep -q "diffuse field" && ! echo "$m" | grep -q "delta-M" ;;
+    none) ! echo "$m" | grep -q "diffuse field\|delta-M" ;;
+    esac && ok "field ${f%%:*} for '$o'" || bad "field for '$o': $m"
+done
+for o in "--slice-do --slice-p1" "--no-diffuse --slice-p1" "--slice-do -D slice.field=none"; do
+    # shellcheck disable=SC2086
+    "$A" render -q --width 16 --height 9 --volume generate:cumulus $o -o "$T/c.png" 2>"$T/c.txt"
+    st=$?
+    [ $st -eq 2 ] && grep -q "contradicts \"field\"" "$T/c.txt" && [ ! -e "$T/c.png" ] && ok "$o refused" ||
+        { bad "$o: exit $st"; cat "$T/c.txt" >&2; }
+done
+printf '{"renderer": "slice", "volume": {"generate": "cumulus"}, "slice": {"field": "p1", "diffuse": false}}\n' >"$T/pf.json"
+"$A" render -q "$T/pf.json" --width 16 --height 9 -o "$T/pf.png" 2>"$T/pf.txt"
+[ $? -eq 1 ] && grep -q "pf.json: /slice/diffuse: (--no-diffuse) contradicts" "$T/pf.txt" && ok "a scene's p1 without diffuse refused" ||
+    { bad "a scene's p1 without diffuse"; cat "$T/pf.txt" >&2; }
+"$A" render -q --width 32 --height 18 --volume generate:cumulus --slices 32 --pfm "$T/fdo.pfm" || bad "render do"
+"$A" render -q --width 32 --height 18 --volume generate:cumulus --slices 32 --slice-p1 --pfm "$T/fp1.pfm" || bad "render p1"
+cmp -s "$T/fdo.pfm" "$T/fp1.pfm" && bad "the do and the p1 field draw the same image" || ok "do and p1 differ"
 # another renderer reads none of the slice settings: a leftover do with xi is no error there
 printf '{"renderer": "nishita", "volume": {"generate": "cumulus"}, "slice": {"do": true, "xi": 0.2}}\n' >"$T/don.json"
 "$A" render -q "$T/don.json" --width 16 --height 9 -o "$T/don.png" 2>"$T/don.txt" && ok "do with xi under nishita: renders" ||

@@ -118,6 +118,62 @@ static void check_help(void)
     free(text);
 }
 
+/* The slice renderer's "field": what each scene section selects (atmos_scene_slice_field), and
+ * the contradictions the parser refuses naming the key, the flag and the field. */
+static void check_slice_field(atmos_context *ctx)
+{
+    static const struct {
+        const char *slice; /* the "slice" section's members */
+        int field;         /* the field selected, or -1: refused */
+        const char *msg;   /* with -1: in the message */
+    } cases[] = {
+        {"", ATMOS_SLICE_FIELD_DO, NULL},
+        {"\"field\": \"auto\"", ATMOS_SLICE_FIELD_DO, NULL},
+        {"\"diffuse\": true", ATMOS_SLICE_FIELD_DO, NULL},
+        {"\"do\": true", ATMOS_SLICE_FIELD_DO, NULL},
+        {"\"do\": false", ATMOS_SLICE_FIELD_DO, NULL},
+        {"\"field\": \"p1\"", ATMOS_SLICE_FIELD_P1, NULL},
+        {"\"field\": \"none\"", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"field\": \"none\", \"diffuse\": false", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"diffuse\": false", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"low_albedo\": true", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"xi\": 0.02", ATMOS_SLICE_FIELD_P1, NULL},
+        {"\"xi\": 0", ATMOS_SLICE_FIELD_P1, NULL},
+        {"\"update\": \"eq24\"", ATMOS_SLICE_FIELD_P1, NULL},
+        {"\"xi\": 0.02, \"diffuse\": false", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"field\": \"do\", \"xi\": 0", ATMOS_SLICE_FIELD_DO, NULL},
+        {"\"field\": \"p1\", \"xi\": 0.02, \"update\": \"eq24\"", ATMOS_SLICE_FIELD_P1, NULL},
+        {"\"field\": \"none\", \"xi\": 0.02", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"field\": \"do\", \"xi\": 0.02", -1, "/slice/xi: (--xi) does nothing with the do field"},
+        {"\"do\": true, \"update\": \"eq24\"", -1, "/slice/update: (--eq24) does nothing with the do field"},
+        {"\"field\": \"do\", \"diffuse\": false", -1, "/slice/diffuse: (--no-diffuse) does nothing with the do"},
+        {"\"field\": \"p1\", \"do\": true", -1, "/slice/do: (--slice-do) contradicts \"field\": \"p1\" (--slice-p1)"},
+        {"\"field\": \"none\", \"do\": true", -1, "/slice/do: (--slice-do) contradicts \"field\": \"none\""},
+        {"\"field\": \"p1\", \"diffuse\": false", -1, "/slice/diffuse: (--no-diffuse) contradicts \"field\": \"p1\""},
+        {"\"field\": \"p2\"", -1, "/slice/field: must be one of auto, do, p1, none"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char json[512];
+        snprintf(json, sizeof json, "{\"renderer\": \"slice\", \"volume\": {\"generate\": \"storm\"}, \"slice\": {%s}}",
+                 cases[i].slice);
+        atmos_scene s;
+        atmos_scene_defaults(&s);
+        const atmos_status st = atmos_scene_parse(ctx, json, strlen(json), "t.json", &s);
+        if (cases[i].field < 0)
+            CHECK_MSG(st == ATMOS_E_INVALID_ARG && strstr(atmos_context_error(ctx), cases[i].msg),
+                      "{%s}: %s (wanted %s)", cases[i].slice, st ? atmos_context_error(ctx) : "accepted", cases[i].msg);
+        else
+            CHECK_MSG(st == ATMOS_OK && (int)atmos_scene_slice_field(&s.slice) == cases[i].field, "{%s}: %s, field %d",
+                      cases[i].slice, st ? atmos_context_error(ctx) : "ok", (int)atmos_scene_slice_field(&s.slice));
+    }
+    /* another renderer reads none of them: a leftover contradiction is no error there */
+    const char *nish = "{\"renderer\": \"nishita\", \"volume\": {\"generate\": \"storm\"}, \"slice\": {\"field\": "
+                       "\"p1\", \"do\": true}}";
+    atmos_scene s;
+    atmos_scene_defaults(&s);
+    CHECK_OK(atmos_scene_parse(ctx, nish, strlen(nish), "t.json", &s));
+}
+
 int main(void)
 {
     atmos_context *ctx = NULL;
@@ -133,6 +189,7 @@ int main(void)
     printf("%d settings checked\n", total);
     CHECK(atmos_renderer_name((atmos_renderer_kind)9) == NULL);
     check_help();
+    check_slice_field(ctx);
     atmos_context_destroy(ctx);
     return test_summary("test_settings");
 }

@@ -100,7 +100,8 @@ static atmos_status render_st(atmos_context *ctx, const atmos_scene *scene, cons
         if (o->xi != 0) s.slice.xi = o->xi < 0 ? 0 : o->xi;
         s.slice.eq24 = o->eq24;
         s.slice.low_albedo = o->low_albedo;
-        s.slice.diffuse = o->diffuse;
+        s.slice.diffuse = o->diffuse; /* these tests are Riley's path's: with or without the P1 field */
+        s.slice.field = o->diffuse ? ATMOS_SLICE_FIELD_P1 : ATMOS_SLICE_FIELD_NONE;
         if (o->density_scale != 0) s.volume.density_scale = o->density_scale;
         if (o->eye_scale != 0) s.slice.eye_scale = o->eye_scale;
     }

@@ -57,7 +57,7 @@ static double side_bias(atmos_context *ctx, const atmos_volume *v, const test_op
     ss.optics = &op->o;
     s.slice.light_size = 96;
     s.slice.xi = 0;
-    s.slice.diffuse = 1;
+    s.slice.field = ATMOS_SLICE_FIELD_P1; /* the P1 field's shape toward the eye, tested here */
     CHECK_MSG(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_OK, "slice: %s", atmos_context_error(ctx));
     double top = 0;
     for (int p = 0; p < W * W; p++) top = ref->pixels[p * 4 + 1] > top ? ref->pixels[p * 4 + 1] : top;

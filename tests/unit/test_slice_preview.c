@@ -1,7 +1,8 @@
 /* The slice renderer's preview frames (atmos_frame.light_size, .hold_field, with .slices,
  * .eye_scale and .no_air_shadows: docs/viewer.md, the viewer's preview while the sun moves).
  *
- * A generated cumulus, its diffuse field and its shadow on the air on, 24 x 16 pixels. One plan
+ * A generated cumulus, its field (the P1 field, then the do field) and its shadow on the air on,
+ * 24 x 16 pixels. One plan
  * renders a full frame at sun A, previews at two suns between A and B (the light buffer at half
  * its side, the field held from A), then the full frame at B: its bytes must be those of a fresh
  * plan's frame at B (nothing of the previews stays in it). The last preview, at B, is compared
@@ -37,7 +38,6 @@ static void scene_for(atmos_scene *s)
     s->wavelengths = ATMOS_WAVELENGTHS_RGB;
     s->slice.slices = 48;
     s->slice.light_size = 64;
-    s->slice.diffuse = 1;
     s->slice.air_shadows = 1;
     s->volume.placed = 1; /* the bottom face's centre 1.2 km up, 4 km ahead */
     s->volume.position_m[0] = 0, s->volume.position_m[1] = 1200, s->volume.position_m[2] = -4000;
@@ -109,23 +109,19 @@ static void error_of(const atmos_image *p, const atmos_image *full, double *mean
     *mean = d / sum, *worst = m / (sum / (W * H));
 }
 
-int main(void)
+/* The checks above for one field (its solve held in the previews, solved again for the full frame). */
+static void check_field(const atmos_scene *scene, const atmos_volume *v, const test_optics *op, int field,
+                        const char *name)
 {
-    test_tmp_path(cache_dir, sizeof cache_dir, "cache");
-    atmos_scene s;
-    scene_for(&s);
-    atmos_context *gctx = test_context(2, cache_dir);
-    atmos_volume *v = test_generate(gctx, "cumulus", 1, 150);
-    test_optics op;
-    test_hg_optics(gctx, "cloud", 0.85, 0.999, 1, &op);
-
+    atmos_scene sc = *scene, *s = &sc;
+    s->slice.field = field;
     rig fresh, r1, r2;
-    rig_open(&fresh, 2, &s, v, &op);
+    rig_open(&fresh, 2, s, v, op);
     atmos_image *ref = frame(&fresh, 170, 0, 0); /* a fresh plan's full frame at B */
     rig_close(&fresh);
 
-    rig_open(&r2, 2, &s, v, &op);
-    rig_open(&r1, 1, &s, v, &op);
+    rig_open(&r2, 2, s, v, op);
+    rig_open(&r1, 1, s, v, op);
     atmos_image *a2 = frame(&r2, 150, 0, 0), *a1 = frame(&r1, 150, 0, 0);
     atmos_image *p2 = frame(&r2, 160, 1, 32), *p1 = frame(&r1, 160, 1, 32);
     atmos_image *q2 = frame(&r2, 170, 1, 32), *q1 = frame(&r1, 170, 1, 32);
@@ -142,8 +138,8 @@ int main(void)
     double mean, worst, mean1, worst1;
     error_of(q2, full, &mean, &worst);
     error_of(sharp, full, &mean1, &worst1);
-    printf("preview at B against the full frame, relative to its mean green: mean |difference| %.4f, largest %.3f; "
-           "at the image's resolution %.4f, %.3f\n", mean, worst, mean1, worst1);
+    printf("%s field: preview at B against the full frame, relative to its mean green: mean |difference| %.4f, "
+           "largest %.3f; at the image's resolution %.4f, %.3f\n", name, mean, worst, mean1, worst1);
     CHECK_MSG(mean < 0.15, "the preview's error: mean %.4f of the mean (bound 0.15)", mean);
     CHECK_MSG(mean1 < 0.05 && worst1 < 1.5,
               "the preview's error at the image's resolution: mean %.4f (bound 0.05), largest %.3f (bound 1.5)", mean1,
@@ -158,6 +154,20 @@ int main(void)
     atmos_image *imgs[] = {ref, a2, a1, p2, p1, q2, q1, big, zero, same_l, q2b, sharp, full, bad};
     for (size_t i = 0; i < sizeof imgs / sizeof *imgs; i++) atmos_image_destroy(imgs[i]);
     rig_close(&r1), rig_close(&r2);
+}
+
+int main(void)
+{
+    test_tmp_path(cache_dir, sizeof cache_dir, "cache");
+    atmos_scene s;
+    scene_for(&s);
+    atmos_context *gctx = test_context(2, cache_dir);
+    atmos_volume *v = test_generate(gctx, "cumulus", 1, 150);
+    test_optics op;
+    test_hg_optics(gctx, "cloud", 0.85, 0.999, 1, &op);
+
+    check_field(&s, v, &op, ATMOS_SLICE_FIELD_P1, "p1");
+    check_field(&s, v, &op, ATMOS_SLICE_FIELD_DO, "do"); /* the default */
     test_optics_free(&op);
     atmos_volume_destroy(v);
     atmos_context_destroy(gctx);

@@ -48,7 +48,7 @@ static atmos_image *slice(atmos_context *ctx, const atmos_scene *scene, const at
     ss.optics = o;
     s.slice.light_size = 96;
     s.slice.xi = 0; /* no ambient term: the sky's light is the field's alone */
-    s.slice.diffuse = field != 0, s.slice.do_field = field == 2; /* "do" refuses diffuse off */
+    s.slice.field = field == 0 ? ATMOS_SLICE_FIELD_NONE : field == 1 ? ATMOS_SLICE_FIELD_P1 : ATMOS_SLICE_FIELD_DO;
     atmos_image *img = NULL;
     CHECK_MSG(atmos_render_slice(ctx, &s, v, &ss, &img, NULL) == ATMOS_OK, "slice: %s", atmos_context_error(ctx));
     return img;

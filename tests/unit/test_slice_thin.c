@@ -1,4 +1,4 @@
-/* The slice renderer's diffuse light field in a thin sheet and in a dense one (issue 15: the
+/* The slice renderer's light fields (the P1 field, "field": "p1", and the do field) in a thin sheet and in a dense one (issue 15: the
  * thin cirrus of the accuracy bench got +25 % too bright with the field, where Eq. 25 alone,
  * `--no-diffuse`, is within a few per cent of the path tracer; docs/lightfield.md, "Thin
  * media"). A sheet of HG 0.85 particles, 2.4 km wide and 240 m thick, under Riley's sky with
@@ -7,7 +7,8 @@
  * sheet's light. Dense (optical depth 25 across): the field must still add light (without it
  * the sheet is far too dark, docs/accuracy.md). Measured, the sum over the sheet's pixels
  * with the field over without: before the fade of the field in thin media (dfield.c,
- * field_fade) thin 1.157, dense 4.548; with it thin 1.000, dense 4.548. Small sizes (a 48 x 6
+ * field_fade) thin 1.157, dense 4.548; with it thin 1.000, dense 4.548 (2026-12-06: 4.580). The
+ * do field (the default since 2026-12-06, no fade) the same way: thin 1.003, dense 2.799. Small sizes (a 48 x 6
  * x 48 grid, 32 x 32 pixels) keep it fast (2 s of CPU). */
 #include "atmos/atmos.h"
 #include "test.h"
@@ -51,7 +52,7 @@ static atmos_volume *sheet(atmos_context *ctx, double tau)
     return v;
 }
 
-static atmos_image *render(atmos_context *ctx, const atmos_volume *v, const test_optics *op, int diffuse)
+static atmos_image *render(atmos_context *ctx, const atmos_volume *v, const test_optics *op, int field)
 {
     atmos_scene s;
     atmos_scene_defaults(&s);
@@ -65,7 +66,7 @@ static atmos_image *render(atmos_context *ctx, const atmos_volume *v, const test
     s.wavelengths = ATMOS_WAVELENGTHS_RGB;
     s.samples_per_pixel = 1;
     s.slice.light_size = 96;
-    s.slice.diffuse = diffuse;
+    s.slice.field = field; /* an atmos_slice_field: p1 (its fade), do, or none */
     atmos_slice_settings ss;
     atmos_slice_defaults(&ss);
     ss.optics = &op->o;
@@ -76,10 +77,11 @@ static atmos_image *render(atmos_context *ctx, const atmos_volume *v, const test
 
 /* The sum of the green channel over the sheet's pixels with the field over the same without
  * it; the sheet's pixels: where it changes the image without the field from the sky alone. */
-static double ratio(atmos_context *ctx, const test_optics *op, double tau, const char *name)
+static double ratio(atmos_context *ctx, const test_optics *op, double tau, int field, const char *name)
 {
     atmos_volume *v = sheet(ctx, tau), *none = sheet(ctx, 1e-6); /* the sky alone, to the digits that matter */
-    atmos_image *with = render(ctx, v, op, 1), *without = render(ctx, v, op, 0), *sky = render(ctx, none, op, 0);
+    atmos_image *with = render(ctx, v, op, field), *without = render(ctx, v, op, ATMOS_SLICE_FIELD_NONE),
+                *sky = render(ctx, none, op, ATMOS_SLICE_FIELD_NONE);
     double sw = 0, so = 0;
     int cnt = 0;
     for (int p = 0; p < W * W; p++) {
@@ -88,7 +90,8 @@ static double ratio(atmos_context *ctx, const test_optics *op, double tau, const
         sw += a, so += b, cnt++;
     }
     const double r = so > 0 ? sw / so : 0;
-    printf("%s (optical depth %.2f across): %d pixels, with the field / without %.3f\n", name, tau, cnt, r);
+    printf("%s (optical depth %.2f across): %d pixels, with the %s field / without %.3f\n", name, tau, cnt,
+           field == ATMOS_SLICE_FIELD_DO ? "do" : "p1", r);
     CHECK(cnt > 200);
     atmos_image_destroy(with), atmos_image_destroy(without), atmos_image_destroy(sky);
     atmos_volume_destroy(v), atmos_volume_destroy(none);
@@ -101,9 +104,16 @@ int main(void)
     atmos_context *ctx = test_context(2, cache_dir);
     test_optics op;
     test_hg_optics(ctx, "hg085t", 0.85, 1.0, 1, &op);
-    const double thin = ratio(ctx, &op, 0.25, "thin sheet"), dense = ratio(ctx, &op, 25.0, "dense sheet");
+    const double thin = ratio(ctx, &op, 0.25, ATMOS_SLICE_FIELD_P1, "thin sheet"),
+                 dense = ratio(ctx, &op, 25.0, ATMOS_SLICE_FIELD_P1, "dense sheet");
     CHECK(fabs(thin - 1) < 0.03);
     CHECK(dense > 1.2);
+    /* the do field (the default) has no fade: its first order is exact, the field of the orders >= 2
+     * small in a thin sheet, and Riley's xi (left out with it) adds little there */
+    const double thin_do = ratio(ctx, &op, 0.25, ATMOS_SLICE_FIELD_DO, "thin sheet"),
+                 dense_do = ratio(ctx, &op, 25.0, ATMOS_SLICE_FIELD_DO, "dense sheet");
+    CHECK_MSG(fabs(thin_do - 1) < 0.03, "thin sheet: the do field over Eq. 25 alone %.3f", thin_do);
+    CHECK(dense_do > 1.2);
     test_optics_free(&op);
     atmos_context_destroy(ctx);
     return test_summary("test_slice_thin");

@@ -83,7 +83,7 @@ static atmos_status bench_plan(atmos_context *ctx, atmos_volume *v, const atmos_
 
 static void print_slice(const char *name, int size, int threads, const double fps[3], const double cpu[3],
                         const atmos_plan_stats *s,
-                        const atmos_slice_timing *first, double prepare_s, int diffuse, int air_shadows, int json)
+                        const atmos_slice_timing *first, double prepare_s, const char *field, int air_shadows, int json)
 {
     const atmos_slice_timing *t = &s->slice;
     const long long samples = t->eye_samples + t->light_samples;
@@ -92,24 +92,24 @@ static void print_slice(const char *name, int size, int threads, const double fp
                              "\"fps_camera_moving\":%.3f,\"fps_sun_moving\":%.3f,\"fps_static\":%.3f,"
                              "\"ms_per_frame\":%.2f,\"ns_per_sample\":%.2f,\"setup_ms\":%.2f,\"light_ms\":%.2f,"
                              "\"eye_ms\":%.2f,\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"eye_samples\":%lld,"
-                             "\"light_samples\":%lld,\"grid\":[%d,%d,%d],\"diffuse\":%d,\"field_ms\":%.2f,"
+                             "\"light_samples\":%lld,\"grid\":[%d,%d,%d],\"field\":\"%s\",\"field_ms\":%.2f,"
                              "\"field_sweeps\":%d,\"field_cold_ms\":%.2f,\"field_cold_sweeps\":%d,\"cpu_ms_camera_moving\":%.2f,"
                              "\"cpu_ms_sun_moving\":%.2f,\"air_shadows\":%d,\"air_shadow_ms\":%.2f}\n"
                            : "bench=slice case=%s size=%d threads=%d eye=%dx%d fps_camera_moving=%.3f fps_sun_moving=%.3f "
                              "fps_static=%.3f ms_per_frame=%.2f ns_per_sample=%.2f setup_ms=%.2f light_ms=%.2f eye_ms=%.2f "
-                             "sky_ms=%.2f prepare_ms=%.2f eye_samples=%lld light_samples=%lld grid=%dx%dx%d diffuse=%d "
+                             "sky_ms=%.2f prepare_ms=%.2f eye_samples=%lld light_samples=%lld grid=%dx%dx%d field=%s "
                              "field_ms=%.2f field_sweeps=%d field_cold_ms=%.2f field_cold_sweeps=%d cpu_ms_camera_moving=%.2f cpu_ms_sun_moving=%.2f "
                              "air_shadows=%d air_shadow_ms=%.2f\n";
     printf(fmt, name, size, threads, t->eye_dims[0], t->eye_dims[1], fps[MOVE_CAMERA], fps[MOVE_SUN], fps[MOVE_NOTHING],
            1e3 / fps[MOVE_SUN], ns, 1e3 * t->setup, 1e3 * t->light, 1e3 * t->eye, 1e3 * t->sky, 1e3 * prepare_s,
-           t->eye_samples, t->light_samples, t->grid_dims[0], t->grid_dims[1], t->grid_dims[2], diffuse, 1e3 * t->field,
+           t->eye_samples, t->light_samples, t->grid_dims[0], t->grid_dims[1], t->grid_dims[2], field, 1e3 * t->field,
            t->field_sweeps, 1e3 * first->field, first->field_sweeps, 1e3 * cpu[MOVE_CAMERA], 1e3 * cpu[MOVE_SUN],
            air_shadows, 1e3 * t->air_shadow);
     fflush(stdout);
 }
 
 int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
-                     int diffuse, int air_shadows, int json)
+                     int field, int air_shadows, int json)
 {
     atmos_scene scene;
     atmos_plan *plan = NULL;
@@ -120,7 +120,7 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     double offset[3];
     bench_view(&scene, v, size, offset);
     scene.renderer = ATMOS_RENDERER_SLICE;
-    scene.slice.diffuse = diffuse;
+    scene.slice.field = field; /* atmos_slice_field: auto (the default, do), p1 or none */
     scene.slice.air_shadows = air_shadows;
     atmos_status st = bench_plan(ctx, v, &scene, &plan, &prepare);
     if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
@@ -136,7 +136,8 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     atmos_plan_destroy(plan);
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
-    print_slice(name, size, atmos_context_threads(ctx), fps, cpu, &stats[MOVE_SUN], &first.slice, prepare, diffuse, air_shadows, json);
+    print_slice(name, size, atmos_context_threads(ctx), fps, cpu, &stats[MOVE_SUN], &first.slice, prepare,
+                (const char *[]){"auto", "do", "p1", "none"}[atmos_scene_slice_field(&scene.slice)], air_shadows, json);
     return CLI_EXIT_OK;
 }
 

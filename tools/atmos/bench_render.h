@@ -5,10 +5,10 @@
 #include "cli.h"
 
 /* The slice renderer on v at size^2 (Riley et al. 2004 Fig. 14: 256 slices): frames per mode
- * (camera moving, sun moving, static), eye_scale > 0 overriding the scene's; diffuse and
- * air_shadows the scene's "slice" settings. */
+ * (camera moving, sun moving, static), eye_scale > 0 overriding the scene's; field (an
+ * atmos_slice_field) and air_shadows the scene's "slice" settings. */
 int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
-                     int diffuse, int air_shadows, int json);
+                     int field, int air_shadows, int json);
 
 /* The aerial-perspective case: the slice renderer on v (densities times density_scale) under
  * each atmosphere model of the comma-separated list (riley, dobashi, spherical; NULL:

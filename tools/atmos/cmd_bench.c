@@ -23,7 +23,7 @@ static void help(void)
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S]\n"
-           "                         [--no-diffuse] [--no-air-shadows] [--json]\n"
+           "                         [--no-diffuse | --slice-p1] [--no-air-shadows] [--json]\n"
            "       atmos bench slice --aerial [--file FILE] [--models LIST] [--density-scale S] [--size N]\n"
            "                         [--repeat R] [--threads T] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
@@ -85,9 +85,10 @@ static void help(void)
            "          prepare_ms: making the plan (render grid, tables; the optics included).\n"
            "          --eye-scale S renders the eye passes on a buffer S times the image per axis, S in\n"
            "          (0, 1] or 2 (2: four rays per pixel, averaged).\n"
-           "          --no-diffuse leaves out the diffuse light field (\"diffuse\", on by default); field_ms:\n"
-           "          its build (source and diffusion solve, warm-started) after the sun's last move,\n"
-           "          field_sweeps its sweeps;\n"
+           "          field: the light scattered more than once, do (the default), p1 (--slice-p1: the\n"
+           "          diffusion field) or none (--no-diffuse: Eq. 24/25 alone); field_ms: its build\n"
+           "          (the source and the solve, warm-started) after the sun's last move, field_sweeps its\n"
+           "          sweeps;\n"
            "          field_cold_ms, field_cold_sweeps: the plan's first frame's (no warm start).\n"
            "          --no-air-shadows leaves out the volume's shadow on the air (\"air_shadows\", on by\n"
            "          default); air_shadow_ms: its share of the last sun-moving frame (part of sky_ms).\n"
@@ -490,7 +491,7 @@ static int bench_aerial(const char *file, int size, int frames, int threads, con
 }
 
 /* The slice renderer's cases: the generated storm and, with FILE, that volume. */
-static int bench_slice(const char *file, int size, int frames, int threads, double eye_scale, int diffuse,
+static int bench_slice(const char *file, int size, int frames, int threads, double eye_scale, int field,
                        int air_shadows, int json)
 {
     atmos_context *ctx = cli_context(threads, 1);
@@ -500,14 +501,14 @@ static int bench_slice(const char *file, int size, int frames, int threads, doub
     atmos_volume *v = NULL;
     atmos_status st = atmos_volume_generate(ctx, "storm", &g, &v);
     if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-    else rc = bench_slice_case(ctx, "generated_storm", v, size, frames, eye_scale, diffuse, air_shadows, json);
+    else rc = bench_slice_case(ctx, "generated_storm", v, size, frames, eye_scale, field, air_shadows, json);
     atmos_volume_destroy(v);
     v = NULL;
     if (rc == CLI_EXIT_OK && file) {
         st = atmos_volume_load(ctx, file, &bench_load, &v);
         const char *base = strrchr(file, '/');
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, frames, eye_scale, diffuse, air_shadows,
+        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, frames, eye_scale, field, air_shadows,
                                    json);
         atmos_volume_destroy(v);
     }
@@ -536,7 +537,7 @@ int cli_cmd_bench(int argc, char **argv)
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16, aerial = 0;
     double dscale = 0, eye_scale = 0, budget = 2;
-    int diffuse = 1, air_shadows = 1;
+    int field = ATMOS_SLICE_FIELD_AUTO, air_shadows = 1;
     const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL, *beams_case = NULL;
     if (argc > 1 && !strcmp(argv[1], "sky-accuracy")) return bench_sky_accuracy_main(argc - 1, argv + 1);
     bench_path_opts pflags;
@@ -569,7 +570,9 @@ int cli_cmd_bench(int argc, char **argv)
         } else if (!strcmp(argv[i], "--aerial")) {
             aerial = 1;
         } else if (!strcmp(argv[i], "--diffuse") || !strcmp(argv[i], "--no-diffuse")) {
-            diffuse = argv[i][2] == 'd';
+            field = argv[i][2] == 'd' ? ATMOS_SLICE_FIELD_AUTO : ATMOS_SLICE_FIELD_NONE;
+        } else if (!strcmp(argv[i], "--slice-p1") || !strcmp(argv[i], "--slice-do")) {
+            field = argv[i][8] == 'p' ? ATMOS_SLICE_FIELD_P1 : ATMOS_SLICE_FIELD_DO;
         } else if (!strcmp(argv[i], "--no-air-shadows")) {
             air_shadows = 0;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
@@ -609,7 +612,7 @@ int cli_cmd_bench(int argc, char **argv)
     if (!strcmp(what, "slice") && aerial)
         return bench_aerial(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, models, dscale, json);
     if (!strcmp(what, "slice"))
-        return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, diffuse, air_shadows,
+        return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, field, air_shadows,
                            json);
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads, models, budget);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
