@@ -386,13 +386,27 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
 struct atmos__do_ws {
     void *mem;
     size_t bytes;
+    atmos__do_ws *next; /* the next concurrent solve's */
 };
 
 atmos__do_ws *atmos__do_ws_create(void) { return calloc(1, sizeof(atmos__do_ws)); }
 
+atmos__do_ws *atmos__do_ws_at(atmos__do_ws *ws, int i)
+{
+    for (; ws && i > 0; i--) {
+        if (!ws->next) ws->next = atmos__do_ws_create();
+        ws = ws->next;
+    }
+    return ws;
+}
+
 void atmos__do_ws_free(atmos__do_ws *ws)
 {
-    if (ws) free(ws->mem), free(ws);
+    while (ws) {
+        atmos__do_ws *next = ws->next;
+        free(ws->mem), free(ws);
+        ws = next;
+    }
 }
 
 /* The next bytes of *at (rounded up to 64) when *at is not NULL; the running size into *total. */
@@ -458,7 +472,7 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     const int m = P->restart < 1 ? 1 : P->restart > 64 ? 64 : P->restart;
     atmos__do_problem Pm = *P;
     Pm.restart = m, W.P = &Pm;
-    atmos__do_ws own = {NULL, 0}, *ws = P->ws ? P->ws : &own;
+    atmos__do_ws own = {NULL, 0, NULL}, *ws = P->ws ? P->ws : &own;
     double *V = NULL, *b = NULL, *tmp = NULL;
     const int ok = take_buffers(&W, m, ws, &V, &b, &tmp);
     if (ok) {
