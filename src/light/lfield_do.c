@@ -158,11 +158,11 @@ static int make_packs(const atmos__do_problem *P, do_pack *pack)
 }
 
 /* One pack's sweep with the source moments Q (per cell, K each), its radiance into psi (per cell,
- * DO_PACK), its moments added to acc, the power leaving through the grid's faces to *leak; with_in:
+ * DO_PACK), its moments added to acc (first: set, at the cells needed), the power leaving through the grid's faces to *leak; with_in:
  * the inflow entering through the grid's faces (else nothing: the linear part). In
  * single precision but the leaving power (the directions of a pack in one vector). */
 static inline __attribute__((always_inline)) void sweep_k(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc,
-                           double *leak, const int K, const int with_in)
+                           double *leak, const int K, const int with_in, const int first)
 {
     const atmos__do_problem *P = W->P;
     const int nx = P->c[0], ny = P->c[1], nz = P->c[2], sx = pk->s[0], sy = pk->s[1], sz = pk->s[2];
@@ -188,20 +188,21 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
                 const float th = P->sig_t[c] * h;
                 const v4f v = (src * h + pk->a[0] * px + pk->a[1] * py + pk->a[2] * pz) / (th + pk->as);
                 memcpy(psi + c * DO_PACK, &v, sizeof v);
-                if ((v[0] != 0 || v[1] != 0 || v[2] != 0 || v[3] != 0) && W->need[c]) {
-                    /* a vector over the coefficients */
+                if (W->need[c] && (first || v[0] != 0 || v[1] != 0 || v[2] != 0 || v[3] != 0)) {
+                    /* a vector over the coefficients; the group's first pack sets them (no memset of
+                       the sums each sweep: 0 + t = t, the cells not needed never written) */
                     float *a = acc + c * K;
                     int m = 0;
                     for (; m + 4 <= K; m += 4) {
                         v4f t = load4(&pk->wY[0][m]) * v[0];
                         for (int d = 1; d < DO_PACK; d++) t += load4(&pk->wY[d][m]) * v[d];
-                        t = load4(a + m) + t;
+                        if (!first) t = load4(a + m) + t;
                         memcpy(a + m, &t, sizeof t);
                     }
                     for (; m < K; m++) {
                         float t = pk->wY[0][m] * v[0];
                         for (int d = 1; d < DO_PACK; d++) t += pk->wY[d][m] * v[d];
-                        a[m] += t;
+                        a[m] = first ? t : a[m] + t;
                     }
                 }
                 const int ex = ii == nx - 1, ey = jj == ny - 1, ez = kk == nz - 1;
@@ -220,13 +221,13 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
  * operations in the same order, no contraction). */
 ATMOS_CLONES
 static void sweep_one(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc, double *leak,
-                      int with_in)
+                      int with_in, int first)
 {
     switch (W->K) {
-    case 16: sweep_k(W, pk, Q, psi, acc, leak, 16, with_in); break;
-    case 9: sweep_k(W, pk, Q, psi, acc, leak, 9, with_in); break;
-    case 4: sweep_k(W, pk, Q, psi, acc, leak, 4, with_in); break;
-    default: sweep_k(W, pk, Q, psi, acc, leak, 1, with_in); break;
+    case 16: sweep_k(W, pk, Q, psi, acc, leak, 16, with_in, first); break;
+    case 9: sweep_k(W, pk, Q, psi, acc, leak, 9, with_in, first); break;
+    case 4: sweep_k(W, pk, Q, psi, acc, leak, 4, with_in, first); break;
+    default: sweep_k(W, pk, Q, psi, acc, leak, 1, with_in, first); break;
     }
 }
 
@@ -238,9 +239,9 @@ static void sweep_all(do_work *W, const float *Q, double *phi, double *leak, int
     const size_t N = W->cells * W->K;
 #pragma omp parallel for schedule(static, 1) num_threads(W->P->threads)
     for (int g = 0; g < DO_GROUPS; g++) {
-        memset(W->acc[g], 0, sizeof(float) * N);
         W->leak[g] = 0;
-        for (int p = g; p < W->npack; p += DO_GROUPS) sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in);
+        for (int p = g; p < W->npack; p += DO_GROUPS)
+            sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in, p == g);
     }
     double l = 0;
     for (size_t i = 0; i < N; i++) {
@@ -481,6 +482,7 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
             for (int k = 0; k < W.K; k++) W.live[c] |= P->q1[c * W.K + k] != 0;
         }
         mark_needed(&W);
+        for (int g = 0; g < DO_GROUPS; g++) memset(W.acc[g], 0, sizeof(float) * N); /* the cells not needed */
         W.npack = make_packs(P, W.pack);
         for (size_t i = 0; i < N; i++) W.q1[i] = (float)P->q1[i];
         sweep_all(&W, W.q1, b, NULL, P->inflow != NULL);
