@@ -98,6 +98,8 @@ typedef struct {
     unsigned char *need; /* per cell: it or one of its 26 neighbours has a medium or a source (else
                             its moments are left 0: no scattering reads them, nor a trilinear read
                             of the field where there is a medium) */
+    size_t *idx, n;      /* the cells needed, in order, and their count: GMRES's vectors hold their
+                            moments alone (idx[i] * K + k at i * K + k), the others 0 */
 } do_work;
 
 /* W->need from W->live and the cells' extinction: the cells within one cell (26 neighbours) of a
@@ -232,11 +234,11 @@ static void sweep_one(const do_work *W, const do_pack *pk, const float *Q, float
 }
 
 /* All the directions with the source moments Q (and the inflow when with_in): the radiance moments
- * into phi, the leaving power into *leak (if not NULL). The packs in DO_GROUPS fixed groups, added
+ * of the cells needed into phi (W->idx's order), or x - them when x is not NULL; the leaving power into *leak (if not NULL). The packs in DO_GROUPS fixed groups, added
  * in order. */
-static void sweep_all(do_work *W, const float *Q, double *phi, double *leak, int with_in)
+static void sweep_all(do_work *W, const float *Q, double *phi, const double *x, double *leak, int with_in)
 {
-    const size_t N = W->cells * W->K;
+    const int K = W->K;
 #pragma omp parallel for schedule(static, 1) num_threads(W->P->threads)
     for (int g = 0; g < DO_GROUPS; g++) {
         W->leak[g] = 0;
@@ -244,33 +246,38 @@ static void sweep_all(do_work *W, const float *Q, double *phi, double *leak, int
             sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in, p == g);
     }
     double l = 0;
-    for (size_t i = 0; i < N; i++) {
-        double s = 0;
-        for (int g = 0; g < DO_GROUPS; g++) s += (double)W->acc[g][i];
-        phi[i] = s;
-    }
+    for (size_t i = 0; i < W->n; i++)
+        for (int k = 0; k < K; k++) {
+            const size_t a = W->idx[i] * K + k, e = i * K + k;
+            double s = 0;
+            for (int g = 0; g < DO_GROUPS; g++) s += (double)W->acc[g][a];
+            phi[e] = x ? x[e] - s : s;
+        }
     for (int g = 0; g < DO_GROUPS; g++) l += W->leak[g];
     if (leak) *leak = l;
 }
 
-/* The scattering source's moments, sig_s chi_l x_lm (plus q1 when add_q1), into W->Q. */
+/* The scattering source's moments, sig_s chi_l x_lm (plus q1 when add_q1), into W->Q at the cells
+ * needed (x in W->idx's order; the sweeps read Q only where a cell scatters or emits, which is
+ * needed). */
 static void scatter(const do_work *W, const double *x, int add_q1)
 {
     const atmos__do_problem *P = W->P;
     const int K = W->K;
-    for (size_t c = 0; c < W->cells; c++)
+    for (size_t i = 0; i < W->n; i++) {
+        const size_t c = W->idx[i];
         for (int k = 0; k < K; k++) {
             const int l = atmos__sh_degree(k);
-            W->Q[c * K + k] = (float)(P->sig_s[c] * P->chi[l] * x[c * K + k] + (add_q1 ? P->q1[c * K + k] : 0));
+            W->Q[c * K + k] = (float)(P->sig_s[c] * P->chi[l] * x[i * K + k] + (add_q1 ? P->q1[c * K + k] : 0));
         }
+    }
 }
 
 /* y = (I - T S) x */
 static void apply(do_work *W, const double *x, double *y)
 {
     scatter(W, x, 0);
-    sweep_all(W, W->Q, y, NULL, 0);
-    for (size_t i = 0; i < W->cells * W->K; i++) y[i] = x[i] - y[i];
+    sweep_all(W, W->Q, y, x, NULL, 0);
 }
 
 /* In DOT_CHUNKS fixed pieces added in order: the same sum whatever the threads. */
@@ -317,7 +324,7 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
 {
     const atmos__do_problem *P = W->P;
     const int m = P->restart;
-    const size_t N = W->cells * W->K;
+    const size_t N = W->n * W->K;
     double H[65][64], cs[64], sn[64], g[65], y[64];
     const int T = 1; /* the vector operations in one thread: on a loaded machine a parallel region per
                         operation costs more in its barriers than it saves */
@@ -421,9 +428,9 @@ static void *carve(unsigned char **at, size_t bytes, size_t *total)
     return p;
 }
 
-/* W's buffers and GMRES's (V, m + 1 vectors; b, tmp) from ws's memory, grown when too small (its
+/* W's buffers and GMRES's (V, m + 1 vectors; b, tmp, x) from ws's memory, grown when too small (its
  * pages then touched once for many solves). Returns 0 when out of memory. */
-static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp)
+static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp, double **x)
 {
     const size_t N = W->cells * W->K;
     for (int pass = 0; pass < 2; pass++) {
@@ -432,6 +439,7 @@ static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double 
         W->pack = carve(&at, sizeof *W->pack * ATMOS__DO_NMAX, &total);
         *V = carve(&at, sizeof(double) * N * (m + 1), &total);
         *b = carve(&at, sizeof(double) * N, &total), *tmp = carve(&at, sizeof(double) * N, &total);
+        *x = carve(&at, sizeof(double) * N, &total), W->idx = carve(&at, sizeof(size_t) * W->cells, &total);
         W->live = carve(&at, W->cells, &total), W->need = carve(&at, W->cells, &total);
         W->Q = carve(&at, sizeof(float) * N, &total), W->q1 = carve(&at, sizeof(float) * N, &total);
         for (int g = 0; g < DO_GROUPS; g++)
@@ -474,30 +482,37 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     atmos__do_problem Pm = *P;
     Pm.restart = m, W.P = &Pm;
     atmos__do_ws own = {NULL, 0, NULL}, *ws = P->ws ? P->ws : &own;
-    double *V = NULL, *b = NULL, *tmp = NULL;
-    const int ok = take_buffers(&W, m, ws, &V, &b, &tmp);
+    double *V = NULL, *b = NULL, *tmp = NULL, *x = NULL;
+    const int ok = take_buffers(&W, m, ws, &V, &b, &tmp, &x);
     if (ok) {
         for (size_t c = 0; c < W.cells; c++) {
             W.live[c] = P->sig_s[c] != 0;
             for (int k = 0; k < W.K; k++) W.live[c] |= P->q1[c * W.K + k] != 0;
         }
         mark_needed(&W);
+        for (size_t c = 0; c < W.cells; c++)
+            if (W.need[c]) W.idx[W.n++] = c;
+        const size_t Nn = W.n * W.K;
         for (int g = 0; g < DO_GROUPS; g++) memset(W.acc[g], 0, sizeof(float) * N); /* the cells not needed */
         W.npack = make_packs(P, W.pack);
         for (size_t i = 0; i < N; i++) W.q1[i] = (float)P->q1[i];
-        sweep_all(&W, W.q1, b, NULL, P->inflow != NULL);
+        sweep_all(&W, W.q1, b, NULL, NULL, P->inflow != NULL);
         st->sweeps++;
         int zero = 1;
         for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
-        /* the last source iteration, phi + (b - A phi) = T (S phi + q1): from GMRES's own residual
+        for (size_t i = 0; i < W.n; i++) memcpy(x + i * W.K, phi + W.idx[i] * W.K, sizeof(double) * W.K);
+        /* the last source iteration, x + (b - A x) = T (S x + q1): from GMRES's own residual
            (tmp), or by a sweep that also gives the leaving power */
-        if (gmres(&W, b, phi, V, tmp, st, zero) && !P->leak)
-            for (size_t i = 0; i < N; i++) phi[i] += tmp[i];
+        if (gmres(&W, b, x, V, tmp, st, zero) && !P->leak)
+            for (size_t i = 0; i < Nn; i++) x[i] += tmp[i];
         else {
-            scatter(&W, phi, 1);
-            sweep_all(&W, W.Q, phi, &st->leak, P->inflow != NULL);
+            scatter(&W, x, 1);
+            sweep_all(&W, W.Q, x, NULL, &st->leak, P->inflow != NULL);
             st->sweeps++;
         }
+        /* the cells not needed 0 (as the sweeps leave them) */
+        memset(phi, 0, sizeof(double) * N);
+        for (size_t i = 0; i < W.n; i++) memcpy(phi + W.idx[i] * W.K, x + i * W.K, sizeof(double) * W.K);
         for (size_t c = 0; c < W.cells; c++) st->emitted += P->q1[c * W.K] * sqrt(4 * ATMOS_PI);
         st->emitted *= P->h * P->h * P->h;
         st->entering = entering(P);
