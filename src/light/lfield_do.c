@@ -8,7 +8,8 @@
  * grid's faces, the problem's inflow, with no source inside; T and S linear, without it), then
  * one last source iteration (a sweep when the leaving power is asked for). The
  * directions are swept in a fixed number of groups, each summed into its own moments, the
- * groups added in order: the same numbers whatever the threads. */
+ * groups added in order: the same numbers whatever the threads. GMRES's vectors hold the cells
+ * needed alone (a medium or a source within one cell), the others' moments 0. */
 #include "light/lfield_do.h"
 #include "core/clones.h"
 #include "core/internal.h"

@@ -5,9 +5,9 @@
  * (sig' cut at 3 degrees, or delta-M scaled sig*), the first order's emission per cell from the
  * sunlight's columns per render voxel (nishita_plan.c's sweep, its voxel's mean transmittance
  * along the sun), the quadrature's directions about the world's axes (the harmonics' frame),
- * swept along the cells' axes, each wavelength after the first started from the last one's
- * solution; the moments times chi_l are the field's coefficients (the
- * emission of orders >= 2 per unit sigma_s).
+ * swept along the cells' axes; the first wavelength solved on all the threads, the others in
+ * parallel, one a thread, each started from the first one's solution (solve_all); the moments
+ * times chi_l are the field's coefficients (the emission of orders >= 2 per unit sigma_s).
  *
  * The sky's and the ground's light (with atm) enter as the sweeps' inflow through the grid's
  * faces: per direction the mean over its patch of the sphere of what a view ray from the box's
