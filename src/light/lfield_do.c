@@ -265,12 +265,15 @@ static void scatter(const do_work *W, const double *x, int add_q1)
 {
     const atmos__do_problem *P = W->P;
     const int K = W->K;
+    double chi[ATMOS__DO_KMAX];
+    for (int k = 0; k < K; k++) chi[k] = P->chi[atmos__sh_degree(k)];
     for (size_t i = 0; i < W->n; i++) {
         const size_t c = W->idx[i];
-        for (int k = 0; k < K; k++) {
-            const int l = atmos__sh_degree(k);
-            W->Q[c * K + k] = (float)(P->sig_s[c] * P->chi[l] * x[i * K + k] + (add_q1 ? P->q1[c * K + k] : 0));
-        }
+        const double ss = P->sig_s[c];
+        if (add_q1)
+            for (int k = 0; k < K; k++) W->Q[c * K + k] = (float)(ss * chi[k] * x[i * K + k] + P->q1[c * K + k]);
+        else
+            for (int k = 0; k < K; k++) W->Q[c * K + k] = (float)(ss * chi[k] * x[i * K + k] + 0);
     }
 }
 

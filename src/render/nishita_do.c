@@ -138,14 +138,18 @@ static int solve_w(const do_fill *D, int w, double *q1, int threads, atmos__do_w
     atmos__do_problem P = D->P;
     double inw[ATMOS__DO_NMAX];
     P.sig_t = D->st + 2 * cells * w, P.sig_s = P.sig_t + cells, P.q1 = q1, P.threads = threads, P.ws = ws;
+    double chik[ATMOS__DO_KMAX]; /* chi_l of each coefficient */
     for (int l = 0; l <= P.L; l++) P.chi[l] = D->chi[w][l];
-    for (size_t c = 0; c < cells; c++)
-        for (int k = 0; k < K; k++) q1[c * K + k] = D->E[w] * D->src[cells * w + c] * D->chi[w][atmos__sh_degree(k)] * D->Ys[k];
+    for (int k = 0; k < K; k++) chik[k] = D->chi[w][atmos__sh_degree(k)];
+    for (size_t c = 0; c < cells; c++) {
+        const double e = D->E[w] * D->src[cells * w + c];
+        for (int k = 0; k < K; k++) q1[c * K + k] = e * chik[k] * D->Ys[k];
+    }
     for (int d = 0; D->sky && d < P.quad->n; d++) inw[d] = D->sky[d * n + w];
     P.inflow = D->sky ? inw : NULL;
     const int ok = atmos__do_solve(&P, phi, S);
     for (size_t c = 0; c < cells && ok; c++)
-        for (int k = 0; k < K; k++) D->coef[(c * n + w) * K + k] = (float)(D->chi[w][atmos__sh_degree(k)] * phi[c * K + k]);
+        for (int k = 0; k < K; k++) D->coef[(c * n + w) * K + k] = (float)(chik[k] * phi[c * K + k]);
     return ok;
 }
 
