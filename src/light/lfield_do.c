@@ -8,7 +8,8 @@
  * grid's faces, the problem's inflow, with no source inside; T and S linear, without it), then
  * one last source iteration (a sweep when the leaving power is asked for). The
  * directions are swept in a fixed number of groups, each summed into its own moments, the
- * groups added in order: the same numbers whatever the threads. */
+ * groups added in order: the same numbers whatever the threads. GMRES's vectors hold the cells
+ * needed alone (a medium or a source within one cell), the others' moments 0. */
 #include "light/lfield_do.h"
 #include "core/clones.h"
 #include "core/internal.h"
@@ -98,6 +99,8 @@ typedef struct {
     unsigned char *need; /* per cell: it or one of its 26 neighbours has a medium or a source (else
                             its moments are left 0: no scattering reads them, nor a trilinear read
                             of the field where there is a medium) */
+    size_t *idx, n;      /* the cells needed, in order, and their count: GMRES's vectors hold their
+                            moments alone (idx[i] * K + k at i * K + k), the others 0 */
 } do_work;
 
 /* W->need from W->live and the cells' extinction: the cells within one cell (26 neighbours) of a
@@ -158,11 +161,11 @@ static int make_packs(const atmos__do_problem *P, do_pack *pack)
 }
 
 /* One pack's sweep with the source moments Q (per cell, K each), its radiance into psi (per cell,
- * DO_PACK), its moments added to acc, the power leaving through the grid's faces to *leak; with_in:
+ * DO_PACK), its moments added to acc (first: set, at the cells needed), the power leaving through the grid's faces to *leak; with_in:
  * the inflow entering through the grid's faces (else nothing: the linear part). In
  * single precision but the leaving power (the directions of a pack in one vector). */
 static inline __attribute__((always_inline)) void sweep_k(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc,
-                           double *leak, const int K, const int with_in)
+                           double *leak, const int K, const int with_in, const int first)
 {
     const atmos__do_problem *P = W->P;
     const int nx = P->c[0], ny = P->c[1], nz = P->c[2], sx = pk->s[0], sy = pk->s[1], sz = pk->s[2];
@@ -188,20 +191,21 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
                 const float th = P->sig_t[c] * h;
                 const v4f v = (src * h + pk->a[0] * px + pk->a[1] * py + pk->a[2] * pz) / (th + pk->as);
                 memcpy(psi + c * DO_PACK, &v, sizeof v);
-                if ((v[0] != 0 || v[1] != 0 || v[2] != 0 || v[3] != 0) && W->need[c]) {
-                    /* a vector over the coefficients */
+                if (W->need[c] && (first || v[0] != 0 || v[1] != 0 || v[2] != 0 || v[3] != 0)) {
+                    /* a vector over the coefficients; the group's first pack sets them (no memset of
+                       the sums each sweep: 0 + t = t, the cells not needed never written) */
                     float *a = acc + c * K;
                     int m = 0;
                     for (; m + 4 <= K; m += 4) {
                         v4f t = load4(&pk->wY[0][m]) * v[0];
                         for (int d = 1; d < DO_PACK; d++) t += load4(&pk->wY[d][m]) * v[d];
-                        t = load4(a + m) + t;
+                        if (!first) t = load4(a + m) + t;
                         memcpy(a + m, &t, sizeof t);
                     }
                     for (; m < K; m++) {
                         float t = pk->wY[0][m] * v[0];
                         for (int d = 1; d < DO_PACK; d++) t += pk->wY[d][m] * v[d];
-                        a[m] += t;
+                        a[m] = first ? t : a[m] + t;
                     }
                 }
                 const int ex = ii == nx - 1, ey = jj == ny - 1, ez = kk == nz - 1;
@@ -220,56 +224,64 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
  * operations in the same order, no contraction). */
 ATMOS_CLONES
 static void sweep_one(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc, double *leak,
-                      int with_in)
+                      int with_in, int first)
 {
     switch (W->K) {
-    case 16: sweep_k(W, pk, Q, psi, acc, leak, 16, with_in); break;
-    case 9: sweep_k(W, pk, Q, psi, acc, leak, 9, with_in); break;
-    case 4: sweep_k(W, pk, Q, psi, acc, leak, 4, with_in); break;
-    default: sweep_k(W, pk, Q, psi, acc, leak, 1, with_in); break;
+    case 16: sweep_k(W, pk, Q, psi, acc, leak, 16, with_in, first); break;
+    case 9: sweep_k(W, pk, Q, psi, acc, leak, 9, with_in, first); break;
+    case 4: sweep_k(W, pk, Q, psi, acc, leak, 4, with_in, first); break;
+    default: sweep_k(W, pk, Q, psi, acc, leak, 1, with_in, first); break;
     }
 }
 
 /* All the directions with the source moments Q (and the inflow when with_in): the radiance moments
- * into phi, the leaving power into *leak (if not NULL). The packs in DO_GROUPS fixed groups, added
+ * of the cells needed into phi (W->idx's order), or x - them when x is not NULL; the leaving power into *leak (if not NULL). The packs in DO_GROUPS fixed groups, added
  * in order. */
-static void sweep_all(do_work *W, const float *Q, double *phi, double *leak, int with_in)
+static void sweep_all(do_work *W, const float *Q, double *phi, const double *x, double *leak, int with_in)
 {
-    const size_t N = W->cells * W->K;
+    const int K = W->K;
 #pragma omp parallel for schedule(static, 1) num_threads(W->P->threads)
     for (int g = 0; g < DO_GROUPS; g++) {
-        memset(W->acc[g], 0, sizeof(float) * N);
         W->leak[g] = 0;
-        for (int p = g; p < W->npack; p += DO_GROUPS) sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in);
+        for (int p = g; p < W->npack; p += DO_GROUPS)
+            sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in, p == g);
     }
     double l = 0;
-    for (size_t i = 0; i < N; i++) {
-        double s = 0;
-        for (int g = 0; g < DO_GROUPS; g++) s += (double)W->acc[g][i];
-        phi[i] = s;
-    }
+    for (size_t i = 0; i < W->n; i++)
+        for (int k = 0; k < K; k++) {
+            const size_t a = W->idx[i] * K + k, e = i * K + k;
+            double s = 0;
+            for (int g = 0; g < DO_GROUPS; g++) s += (double)W->acc[g][a];
+            phi[e] = x ? x[e] - s : s;
+        }
     for (int g = 0; g < DO_GROUPS; g++) l += W->leak[g];
     if (leak) *leak = l;
 }
 
-/* The scattering source's moments, sig_s chi_l x_lm (plus q1 when add_q1), into W->Q. */
+/* The scattering source's moments, sig_s chi_l x_lm (plus q1 when add_q1), into W->Q at the cells
+ * needed (x in W->idx's order; the sweeps read Q only where a cell scatters or emits, which is
+ * needed). */
 static void scatter(const do_work *W, const double *x, int add_q1)
 {
     const atmos__do_problem *P = W->P;
     const int K = W->K;
-    for (size_t c = 0; c < W->cells; c++)
-        for (int k = 0; k < K; k++) {
-            const int l = atmos__sh_degree(k);
-            W->Q[c * K + k] = (float)(P->sig_s[c] * P->chi[l] * x[c * K + k] + (add_q1 ? P->q1[c * K + k] : 0));
-        }
+    double chi[ATMOS__DO_KMAX];
+    for (int k = 0; k < K; k++) chi[k] = P->chi[atmos__sh_degree(k)];
+    for (size_t i = 0; i < W->n; i++) {
+        const size_t c = W->idx[i];
+        const double ss = P->sig_s[c];
+        if (add_q1)
+            for (int k = 0; k < K; k++) W->Q[c * K + k] = (float)(ss * chi[k] * x[i * K + k] + P->q1[c * K + k]);
+        else
+            for (int k = 0; k < K; k++) W->Q[c * K + k] = (float)(ss * chi[k] * x[i * K + k] + 0);
+    }
 }
 
 /* y = (I - T S) x */
 static void apply(do_work *W, const double *x, double *y)
 {
     scatter(W, x, 0);
-    sweep_all(W, W->Q, y, NULL, 0);
-    for (size_t i = 0; i < W->cells * W->K; i++) y[i] = x[i] - y[i];
+    sweep_all(W, W->Q, y, x, NULL, 0);
 }
 
 /* In DOT_CHUNKS fixed pieces added in order: the same sum whatever the threads. */
@@ -316,7 +328,7 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
 {
     const atmos__do_problem *P = W->P;
     const int m = P->restart;
-    const size_t N = W->cells * W->K;
+    const size_t N = W->n * W->K;
     double H[65][64], cs[64], sn[64], g[65], y[64];
     const int T = 1; /* the vector operations in one thread: on a loaded machine a parallel region per
                         operation costs more in its barriers than it saves */
@@ -386,13 +398,27 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
 struct atmos__do_ws {
     void *mem;
     size_t bytes;
+    atmos__do_ws *next; /* the next concurrent solve's */
 };
 
 atmos__do_ws *atmos__do_ws_create(void) { return calloc(1, sizeof(atmos__do_ws)); }
 
+atmos__do_ws *atmos__do_ws_at(atmos__do_ws *ws, int i)
+{
+    for (; ws && i > 0; i--) {
+        if (!ws->next) ws->next = atmos__do_ws_create();
+        ws = ws->next;
+    }
+    return ws;
+}
+
 void atmos__do_ws_free(atmos__do_ws *ws)
 {
-    if (ws) free(ws->mem), free(ws);
+    while (ws) {
+        atmos__do_ws *next = ws->next;
+        free(ws->mem), free(ws);
+        ws = next;
+    }
 }
 
 /* The next bytes of *at (rounded up to 64) when *at is not NULL; the running size into *total. */
@@ -406,9 +432,9 @@ static void *carve(unsigned char **at, size_t bytes, size_t *total)
     return p;
 }
 
-/* W's buffers and GMRES's (V, m + 1 vectors; b, tmp) from ws's memory, grown when too small (its
+/* W's buffers and GMRES's (V, m + 1 vectors; b, tmp, x) from ws's memory, grown when too small (its
  * pages then touched once for many solves). Returns 0 when out of memory. */
-static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp)
+static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp, double **x)
 {
     const size_t N = W->cells * W->K;
     for (int pass = 0; pass < 2; pass++) {
@@ -417,6 +443,7 @@ static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double 
         W->pack = carve(&at, sizeof *W->pack * ATMOS__DO_NMAX, &total);
         *V = carve(&at, sizeof(double) * N * (m + 1), &total);
         *b = carve(&at, sizeof(double) * N, &total), *tmp = carve(&at, sizeof(double) * N, &total);
+        *x = carve(&at, sizeof(double) * N, &total), W->idx = carve(&at, sizeof(size_t) * W->cells, &total);
         W->live = carve(&at, W->cells, &total), W->need = carve(&at, W->cells, &total);
         W->Q = carve(&at, sizeof(float) * N, &total), W->q1 = carve(&at, sizeof(float) * N, &total);
         for (int g = 0; g < DO_GROUPS; g++)
@@ -458,30 +485,38 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     const int m = P->restart < 1 ? 1 : P->restart > 64 ? 64 : P->restart;
     atmos__do_problem Pm = *P;
     Pm.restart = m, W.P = &Pm;
-    atmos__do_ws own = {NULL, 0}, *ws = P->ws ? P->ws : &own;
-    double *V = NULL, *b = NULL, *tmp = NULL;
-    const int ok = take_buffers(&W, m, ws, &V, &b, &tmp);
+    atmos__do_ws own = {NULL, 0, NULL}, *ws = P->ws ? P->ws : &own;
+    double *V = NULL, *b = NULL, *tmp = NULL, *x = NULL;
+    const int ok = take_buffers(&W, m, ws, &V, &b, &tmp, &x);
     if (ok) {
         for (size_t c = 0; c < W.cells; c++) {
             W.live[c] = P->sig_s[c] != 0;
             for (int k = 0; k < W.K; k++) W.live[c] |= P->q1[c * W.K + k] != 0;
         }
         mark_needed(&W);
+        for (size_t c = 0; c < W.cells; c++)
+            if (W.need[c]) W.idx[W.n++] = c;
+        const size_t Nn = W.n * W.K;
+        for (int g = 0; g < DO_GROUPS; g++) memset(W.acc[g], 0, sizeof(float) * N); /* the cells not needed */
         W.npack = make_packs(P, W.pack);
         for (size_t i = 0; i < N; i++) W.q1[i] = (float)P->q1[i];
-        sweep_all(&W, W.q1, b, NULL, P->inflow != NULL);
+        sweep_all(&W, W.q1, b, NULL, NULL, P->inflow != NULL);
         st->sweeps++;
         int zero = 1;
         for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
-        /* the last source iteration, phi + (b - A phi) = T (S phi + q1): from GMRES's own residual
+        for (size_t i = 0; i < W.n; i++) memcpy(x + i * W.K, phi + W.idx[i] * W.K, sizeof(double) * W.K);
+        /* the last source iteration, x + (b - A x) = T (S x + q1): from GMRES's own residual
            (tmp), or by a sweep that also gives the leaving power */
-        if (gmres(&W, b, phi, V, tmp, st, zero) && !P->leak)
-            for (size_t i = 0; i < N; i++) phi[i] += tmp[i];
+        if (gmres(&W, b, x, V, tmp, st, zero) && !P->leak)
+            for (size_t i = 0; i < Nn; i++) x[i] += tmp[i];
         else {
-            scatter(&W, phi, 1);
-            sweep_all(&W, W.Q, phi, &st->leak, P->inflow != NULL);
+            scatter(&W, x, 1);
+            sweep_all(&W, W.Q, x, NULL, &st->leak, P->inflow != NULL);
             st->sweeps++;
         }
+        /* the cells not needed 0 (as the sweeps leave them) */
+        memset(phi, 0, sizeof(double) * N);
+        for (size_t i = 0; i < W.n; i++) memcpy(phi + W.idx[i] * W.K, x + i * W.K, sizeof(double) * W.K);
         for (size_t c = 0; c < W.cells; c++) st->emitted += P->q1[c * W.K] * sqrt(4 * ATMOS_PI);
         st->emitted *= P->h * P->h * P->h;
         st->entering = entering(P);

@@ -35,6 +35,9 @@ int atmos__do_quadrature(int nmu, int nphi, atmos__do_quad *q);
 /* Buffers kept between solves (the pages of a large one touched once, not per solve). */
 typedef struct atmos__do_ws atmos__do_ws;
 atmos__do_ws *atmos__do_ws_create(void);
+/* The buffers of the i-th of concurrent solves (i = 0: ws itself), made when first asked for, freed
+ * with ws; NULL when ws is or when out of memory (the solve then uses its own). Not thread-safe. */
+atmos__do_ws *atmos__do_ws_at(atmos__do_ws *ws, int i);
 void atmos__do_ws_free(atmos__do_ws *ws);
 
 typedef struct {

@@ -5,9 +5,9 @@
  * (sig' cut at 3 degrees, or delta-M scaled sig*), the first order's emission per cell from the
  * sunlight's columns per render voxel (nishita_plan.c's sweep, its voxel's mean transmittance
  * along the sun), the quadrature's directions about the world's axes (the harmonics' frame),
- * swept along the cells' axes, each wavelength after the first started from the last one's
- * solution; the moments times chi_l are the field's coefficients (the
- * emission of orders >= 2 per unit sigma_s).
+ * swept along the cells' axes; the first wavelength solved on all the threads, the others in
+ * parallel, one a thread, each started from the first one's solution (solve_all); the moments
+ * times chi_l are the field's coefficients (the emission of orders >= 2 per unit sigma_s).
  *
  * The sky's and the ground's light (with atm) enter as the sweeps' inflow through the grid's
  * faces: per direction the mean over its patch of the sphere of what a view ray from the box's
@@ -16,12 +16,14 @@
  * coefficients are also the sky's and the ground's light of the orders >= 1 per unit sigma_s (the
  * eye pass adds no other sky light in the volume; the sky seen straight through the volume is
  * the eye pass's background, attenuated). */
+#include "core/fastmath.h"
 #include "core/vec.h"
 #include "light/lfield_do.h"
 #include "render/nishita_do.h"
 #include "render/sky_inflow.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -57,13 +59,28 @@ static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np
     return any;
 }
 
-/* Per cell the mean sigma_t, sigma_s (1/m) and the mean of sigma_s E T_sun over its render voxels,
- * wavelength w. */
-static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, int w, const double sun_g[3],
-                        float *st, float *ss, double *src, int threads)
+/* The voxel's mean of e^-tau along the sun about its centre, e^-tau sinh(h) / h (h: half the
+ * optical depth across it along the sun, h <= tau), in single precision's polynomial exponential
+ * (relative error < 1e-6; the library's exp and sinh took half the cells' set-up): below h 0.5 by
+ * the series of sinh(h) / h, else as (e^(h - tau) - e^(-h - tau)) / 2h, no exponent above 0. */
+static inline double mean_transmittance(double tau, double h)
+{
+    if (h < 0.5) {
+        const double h2 = h * h;
+        return atmos__expf_fast((float)-tau) * (1 + h2 * (1.0 / 6 + h2 * (1.0 / 120 + h2 * (1.0 / 5040))));
+    }
+    return (atmos__expf_fast((float)(h - tau)) - atmos__expf_fast((float)(-h - tau))) / (2 * h);
+}
+
+/* Per cell and wavelength w < n the mean sigma_t, sigma_s (1/m: st + 2 cells w, the cells' sigma_t
+ * then their sigma_s) and the mean of sigma_s E T_sun over its render voxels (src + cells w): the
+ * wavelengths in one pass over the voxels, an empty voxel (no field's density) skipped once. */
+static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, int n, const double sun_g[3], float *st,
+                        double *src, int threads)
 {
     const sgrid *g = &np->g;
     const int s = F->s, nf = np->nf;
+    const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     double amax = 0;
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
     const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s);
@@ -72,24 +89,107 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
-                double at = 0, as = 0, aq = 0;
+                double at[ATMOS_MAX_WAVELENGTHS], as[ATMOS_MAX_WAVELENGTHS], aq[ATMOS_MAX_WAVELENGTHS];
+                for (int w = 0; w < n; w++) at[w] = as[w] = aq[w] = 0;
                 for (int z = k * s; z < (k + 1) * s && z < g->c[2]; z++)
                     for (int y = j * s; y < (j + 1) * s && y < g->c[1]; y++)
                         for (int x = i * s; x < (i + 1) * s && x < g->c[0]; x++) {
                             const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
-                            double t = 0, sc = 0, tau = 0;
-                            for (int f = 0; f < nf; f++) {
-                                t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w];
-                                tau += np->col[v + f] * np->mc_sig_ms[f][w];
+                            int any = 0;
+                            for (int f = 0; f < nf; f++) any |= g->v[v + f] != 0;
+                            if (!any) continue; /* adds 0 to every sum */
+                            for (int w = 0; w < n; w++) {
+                                double t = 0, sc = 0, tau = 0;
+                                for (int f = 0; f < nf; f++) {
+                                    t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w];
+                                    tau += np->col[v + f] * np->mc_sig_ms[f][w];
+                                }
+                                at[w] += t, as[w] += sc;
+                                if (!(sc != 0)) continue; /* no exponentials */
+                                aq[w] += sc * mean_transmittance(tau, 0.5 * fmin(t * len, 2 * tau));
                             }
-                            at += t, as += sc;
-                            if (!(sc != 0)) continue; /* an empty voxel: no exponentials */
-                            /* the voxel's mean of e^-tau along the sun about its centre, sinh(d/2)/(d/2) */
-                            const double d = fmin(t * len, 2 * tau), m = d > 1e-6 ? sinh(0.5 * d) / (0.5 * d) : 1;
-                            aq += sc * exp(-tau) * m;
                         }
-                st[c] = (float)(at * inv), ss[c] = (float)(as * inv), src[c] = aq * inv;
+                for (int w = 0; w < n; w++)
+                    st[2 * cells * w + c] = (float)(at[w] * inv), st[2 * cells * w + cells + c] = (float)(as[w] * inv),
+                                       src[cells * w + c] = aq[w] * inv;
             }
+}
+
+/* What the wavelengths' solves share: the problem but for the wavelength's medium, emission and
+ * inflow; per wavelength the cells' sigma_t and sigma_s (st, 2 cells each) and the mean of
+ * sigma_s E T_sun (src, cells each). */
+typedef struct {
+    atmos__do_problem P;
+    int n, K;
+    size_t cells;
+    const float *st;
+    const double *src, *Ys, *E, *sky; /* sky: per direction and wavelength, NULL: none */
+    const double (*chi)[4];
+    float *coef;
+} do_fill;
+
+/* Wavelength w's solve from phi as it is (its start) on threads threads with ws's buffers and q1
+ * (cells * K) for the emission: its moments into phi, its coefficients into D->coef. */
+static int solve_w(const do_fill *D, int w, double *q1, int threads, atmos__do_ws *ws, double *phi,
+                   atmos__do_stats *S)
+{
+    const size_t cells = D->cells;
+    const int n = D->n, K = D->K;
+    atmos__do_problem P = D->P;
+    double inw[ATMOS__DO_NMAX];
+    P.sig_t = D->st + 2 * cells * w, P.sig_s = P.sig_t + cells, P.q1 = q1, P.threads = threads, P.ws = ws;
+    double chik[ATMOS__DO_KMAX]; /* chi_l of each coefficient */
+    for (int l = 0; l <= P.L; l++) P.chi[l] = D->chi[w][l];
+    for (int k = 0; k < K; k++) chik[k] = D->chi[w][atmos__sh_degree(k)];
+    for (size_t c = 0; c < cells; c++) {
+        const double e = D->E[w] * D->src[cells * w + c];
+        for (int k = 0; k < K; k++) q1[c * K + k] = e * chik[k] * D->Ys[k];
+    }
+    for (int d = 0; D->sky && d < P.quad->n; d++) inw[d] = D->sky[d * n + w];
+    P.inflow = D->sky ? inw : NULL;
+    const int ok = atmos__do_solve(&P, phi, S);
+    for (size_t c = 0; c < cells && ok; c++)
+        for (int k = 0; k < K; k++) D->coef[(c * n + w) * K + k] = (float)(chik[k] * phi[c * K + k]);
+    return ok;
+}
+
+/* The wavelengths to solve, wl[0 .. ns - 1] (the first on all the threads, from phi_all's start
+ * with warm, else 0; the others each on one thread, in parallel, from the first one's solution
+ * times the ratio of the sunlight, or of the sky's mean radiance with the sun off: the clouds are
+ * nearly grey, 2 GMRES iterations on the Disney cloud where the last sun's start takes 3). Which
+ * thread solves which wavelength changes no number. Returns 0 when out of memory. */
+static int solve_all(const do_fill *D, const int *wl, int ns, const double *skymean, double *phi_all, int warm,
+                     int threads, atmos__do_ws *ws, atmos__nishita_do_info *info)
+{
+    const size_t NK = D->cells * D->K;
+    const int nt = threads < 1 ? 1 : threads, w0 = wl[0];
+    double *q1 = malloc(sizeof(double) * NK * nt), *phi0 = phi_all + (size_t)w0 * NK;
+    atmos__do_ws *wss[64];
+    int oks[ATMOS_MAX_WAVELENGTHS];
+    atmos__do_stats S[ATMOS_MAX_WAVELENGTHS];
+    if (!q1 || nt > 64) return free(q1), 0;
+    for (int t = 0; t < nt; t++) wss[t] = atmos__do_ws_at(ws, t);
+    if (!warm) memset(phi0, 0, sizeof(double) * NK);
+    oks[0] = solve_w(D, w0, q1, threads, ws, phi0, &S[0]);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+    for (int i = 1; i < ns; i++) {
+        const int w = wl[i], t = omp_get_thread_num();
+        const double ratio = !oks[0]            ? 0
+                             : D->E[w0] > 0     ? D->E[w] / D->E[w0]
+                             : skymean[w0] > 0 ? skymean[w] / skymean[w0]
+                                                : 0;
+        double *phi = phi_all + (size_t)w * NK;
+        for (size_t j = 0; j < NK; j++) phi[j] = ratio > 0 ? phi0[j] * ratio : warm ? phi[j] : 0;
+        oks[i] = solve_w(D, w, q1 + NK * t, 1, wss[t], phi, &S[i]);
+    }
+    int ok = 1;
+    for (int i = 0; i < ns; i++) {
+        ok &= oks[i];
+        info->iters += S[i].iters, info->sweeps += S[i].sweeps;
+        info->resid = fmax(info->resid, S[i].resid);
+    }
+    free(q1);
+    return ok;
 }
 
 atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
@@ -98,84 +198,59 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
                                     atmos__do_ws *ws, atmos__nishita_do_info *info)
 {
     const int n = np->n, K = (L + 1) * (L + 1);
-    const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
+    const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2], NK = cells * K;
     const clock_t c0 = clock();
     memset(info, 0, sizeof *info);
     atmos__do_quad quad;
-    atmos__do_problem P;
-    memset(&P, 0, sizeof P);
+    do_fill D;
+    memset(&D, 0, sizeof D);
+    atmos__do_problem *P = &D.P;
     if (!atmos__do_quadrature(DO_NMU, DO_NPHI, &quad))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "render nishita: no quadrature");
     for (int j = 0; j < 3; j++) {
         double e[3] = {0, 0, 0}, r[3];
         e[j] = 1;
         atmos__vol_dir_to_frame(&np->x, e, r);
-        for (int a = 0; a < 3; a++) P.R[a][j] = r[a];
+        for (int a = 0; a < 3; a++) P->R[a][j] = r[a];
     }
     double lt[3], ltg[3], Ys[ATMOS__DO_KMAX];
     for (int a = 0; a < 3; a++) lt[a] = -sun_w[a];
     atmos__vol_dir_to_frame(&np->x, lt, ltg);
     atmos__sh_eval(L, lt, Ys);
-    double inw[ATMOS__DO_NMAX], skymean[ATMOS_MAX_WAVELENGTHS] = {0};
+    double skymean[ATMOS_MAX_WAVELENGTHS] = {0};
     double *sky = atm ? malloc(sizeof(double) * quad.n * n) : NULL;
     if (atm && !sky) return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");
     const int sky_on = sky && sky_inflow(atm, np, &quad, sun_w, sky);
     for (int d = 0; sky_on && d < quad.n; d++)
         for (int w = 0; w < n; w++) skymean[w] += sky[d * n + w] * quad.w[d];
-    float *st = malloc(sizeof(float) * cells * 4); /* this wavelength's sigma_t, sigma_s; the last one's */
-    double *src = malloc(sizeof(double) * cells * 2), *q1 = malloc(sizeof(double) * cells * K);
-    int ok = st && src && q1;
-    P.c[0] = F->c[0], P.c[1] = F->c[1], P.c[2] = F->c[2], P.h = F->s / (double)np->g.sc, P.L = L;
-    P.sig_t = st, P.sig_s = st + cells, P.q1 = q1, P.quad = &quad;
-    P.tol = DO_TOL, P.max_iter = DO_MAX_ITER, P.restart = DO_RESTART, P.threads = threads, P.ws = ws;
-    int w_last = -1; /* the wavelength whose solution phi holds */
+    float *st = malloc(sizeof(float) * cells * 2 * n); /* per wavelength sigma_t, sigma_s */
+    double *src = malloc(sizeof(double) * cells * n);
+    int ok = st && src;
+    P->c[0] = F->c[0], P->c[1] = F->c[1], P->c[2] = F->c[2], P->h = F->s / (double)np->g.sc, P->L = L, P->quad = &quad;
+    P->tol = DO_TOL, P->max_iter = DO_MAX_ITER, P->restart = DO_RESTART;
+    D.n = n, D.K = K, D.cells = cells, D.st = st, D.src = src, D.Ys = Ys, D.E = E, D.sky = sky_on ? sky : NULL;
+    D.chi = chi, D.coef = coef;
+    /* a wavelength whose medium and phase are the last one's (a grey cloud, no sky): its field is
+     * the last one's times the ratio of the sunlight; the others solved */
+    int copy[ATMOS_MAX_WAVELENGTHS] = {0}, wl[ATMOS_MAX_WAVELENGTHS], ns = 0;
+    if (ok) cell_medium(np, F, n, ltg, st, src, threads);
     for (int w = 0; w < n && ok; w++) {
-        double *phi = phi_all + (size_t)w * cells * K;
-        cell_medium(np, F, w, ltg, st, st + cells, src, threads);
-        /* a wavelength whose medium and phase are the last one's (a grey cloud): its field is the
-         * last one's times the ratio of the sunlight */
-        if (w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&
-            !memcmp(st, st + 2 * cells, sizeof(float) * cells * 2) && !memcmp(src, src + cells, sizeof(double) * cells)) {
-            for (size_t c = 0; c < cells; c++)
-                for (int k = 0; k < K; k++)
-                    coef[(c * n + w) * K + k] = (float)(coef[(c * n + w - 1) * K + k] * (E[w] / E[w - 1]));
-            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] = phi[i - cells * K] * (E[w] / E[w - 1]);
-            continue;
-        }
-        memcpy(st + 2 * cells, st, sizeof(float) * cells * 2), memcpy(src + cells, src, sizeof(double) * cells);
-        for (int l = 0; l <= L; l++) P.chi[l] = chi[w][l];
-        for (size_t c = 0; c < cells; c++)
-            for (int k = 0; k < K; k++) {
-                const int l = atmos__sh_degree(k);
-                q1[c * K + k] = E[w] * src[c] * chi[w][l] * Ys[k];
-            }
-        for (int d = 0; sky_on && d < quad.n; d++) inw[d] = sky[d * n + w];
-        P.inflow = sky_on ? inw : NULL;
-        /* the start: the last wavelength's solution times the ratio of the sunlight (the clouds are
-         * nearly grey; 2 GMRES iterations on the Disney cloud where the last sun's takes 3; with the
-         * sun off, of the sky's light), else with warm this wavelength's solution for the last sun
-         * (phi as it is), else 0. Only a start: the solve reaches its tolerance from any. */
-        const double ratio = w_last < 0          ? 0
-                             : E[w_last] > 0     ? E[w] / E[w_last]
-                             : skymean[w_last] > 0 ? skymean[w] / skymean[w_last]
-                                                   : 0;
-        if (ratio > 0) {
-            const double *last = phi_all + (size_t)w_last * cells * K;
-            for (size_t i = 0; i < cells * (size_t)K; i++) phi[i] = last[i] * ratio;
-        } else if (!warm)
-            memset(phi, 0, sizeof(double) * cells * K);
-        atmos__do_stats S;
-        ok = atmos__do_solve(&P, phi, &S);
-        for (size_t c = 0; c < cells && ok; c++)
-            for (int k = 0; k < K; k++) {
-                const int l = atmos__sh_degree(k);
-                coef[(c * n + w) * K + k] = (float)(chi[w][l] * phi[c * K + k]);
-            }
-        w_last = ok ? w : -1;
-        info->iters += S.iters, info->sweeps += S.sweeps;
-        info->resid = fmax(info->resid, S.resid);
+        const float *sw = st + 2 * cells * w;
+        copy[w] = w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&
+                  !memcmp(sw, sw - 2 * cells, sizeof(float) * cells * 2) &&
+                  !memcmp(src + cells * w, src + cells * (w - 1), sizeof(double) * cells);
+        if (!copy[w]) wl[ns++] = w;
     }
-    free(st), free(src), free(q1), free(sky);
+    ok = ok && solve_all(&D, wl, ns, skymean, phi_all, warm, threads, ws, info);
+    for (int w = 1; w < n && ok; w++) {
+        if (!copy[w]) continue;
+        double *phi = phi_all + (size_t)w * NK;
+        for (size_t c = 0; c < cells; c++)
+            for (int k = 0; k < K; k++)
+                coef[(c * n + w) * K + k] = (float)(coef[(c * n + w - 1) * K + k] * (E[w] / E[w - 1]));
+        for (size_t i = 0; i < NK; i++) phi[i] = phi[i - NK] * (E[w] / E[w - 1]);
+    }
+    free(st), free(src), free(sky);
     info->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
     info->directions = quad.n;
     return ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");

@@ -124,6 +124,15 @@ int main(void)
     CHECK(bd < -0.15); /* without the sky's inflow as dark as without a field */
     CHECK(fabs(bs) < 0.05 && fabs(bn) < 0.05);
     CHECK(rs < 0.08 && rn < 0.08);
+    /* with the sky every wavelength is solved (the first on both threads, the others one a thread,
+       in parallel): the same bytes on one thread */
+    atmos_context *ctx1 = test_context(1, cache_dir);
+    atmos_image *sdo1 = slice(ctx1, &s, v, &op.o, 2);
+    CHECK(sdo1 && sdo1->width == sdo->width && sdo1->height == sdo->height && sdo1->channels == sdo->channels);
+    if (sdo1 && sdo1->width == sdo->width && sdo1->height == sdo->height && sdo1->channels == sdo->channels)
+        CHECK(!memcmp(sdo1->pixels, sdo->pixels, sizeof(float) * sdo->width * sdo->height * sdo->channels));
+    atmos_image_destroy(sdo1);
+    atmos_context_destroy(ctx1);
     atmos_image_destroy(sdo), atmos_image_destroy(ndo), atmos_image_destroy(ndo_dark);
     atmos_image_destroy(ref), atmos_image_destroy(with), atmos_image_destroy(without);
     atmos_volume_destroy(v);
