@@ -1,13 +1,14 @@
 /* Discrete ordinates on a coarse grid (lfield_do.h; docs/lightfield.md, "A discrete-ordinates
- * field"). Per direction one upwind sweep with the step scheme: a cell's radiance psi =
- * (s h + sum_a |O_a| psi_in,a) / (sig_t h + sum_a |O_a|), its outgoing faces carrying psi
- * (positive, the cell's balance exact); the emission s toward the direction is the degree <= L
- * series of the scattering source, sig_s chi_l phi_lm + q1_lm. The moments phi solve
- * phi = T (S phi + q1) (T: the sweeps and the projection; S: the scattering), by restarted
- * GMRES on (I - T S) phi = T q1 + T_in (T_in: the sweeps of the radiance entering through the
- * grid's faces, the problem's inflow, with no source inside; T and S linear, without it), then
- * one last source iteration (a sweep when the leaving power is asked for). The
- * directions are swept in a fixed number of groups, each summed into its own moments, the
+ * field"). Per direction one upwind sweep with the weighted diamond scheme (cell_faces(); theta 1,
+ * the step scheme: a cell's radiance psi = (s h + sum_a |O_a| psi_in,a) / (sig_t h + sum_a |O_a|),
+ * its outgoing faces carrying psi, positive; with theta < 1 in thick cells, less numerical
+ * diffusion, a face may leave negative; the cell's balance exact either way); the emission s
+ * toward the direction is the degree <= L series of the scattering source, sig_s chi_l phi_lm +
+ * q1_lm. The moments phi solve phi = T (S phi + q1) (T: the sweeps and the projection; S: the
+ * scattering), by restarted GMRES on (I - T S) phi = T q1 + T_in (T_in: the sweeps of the
+ * radiance entering through the grid's faces, the problem's inflow, with no source inside; T and
+ * S linear, without it), then one last source iteration (a sweep when the leaving power is asked
+ * for). The directions are swept in a fixed number of groups, each summed into its own moments, the
  * groups added in order: the same numbers whatever the threads. GMRES's vectors hold the cells
  * needed alone (a medium or a source within one cell), the others' moments 0. */
 #include "light/lfield_do.h"
@@ -92,9 +93,10 @@ typedef struct {
     int K, npack;
     size_t cells;
     do_pack *pack;
-    float *acc[DO_GROUPS], *psi[DO_GROUPS]; /* in single precision; psi per cell, DO_PACK */
+    float *acc[DO_GROUPS], *psi[DO_GROUPS]; /* in single precision; psi per cell, 3 faces of DO_PACK */
     float *Q, *q1;                          /* the sweeps' source moments; q1 in single precision */
     double leak[DO_GROUPS];
+    float *theta;        /* per cell: the weighted diamond's weight (cell_faces()) */
     unsigned char *live; /* per cell: it scatters or emits (else its source is 0) */
     unsigned char *need; /* per cell: it or one of its 26 neighbours has a medium or a source (else
                             its moments are left 0: no scattering reads them, nor a trilinear read
@@ -160,10 +162,31 @@ static int make_packs(const atmos__do_problem *P, do_pack *pack)
     return np;
 }
 
-/* One pack's sweep with the source moments Q (per cell, K each), its radiance into psi (per cell,
- * DO_PACK), its moments added to acc (first: set, at the cells needed), the power leaving through the grid's faces to *leak; with_in:
- * the inflow entering through the grid's faces (else nothing: the linear part). In
- * single precision but the leaving power (the directions of a pack in one vector). */
+/* A cell's radiance psi_c and its outgoing faces' o[a] from its entering faces' in[a] (a pack's 4
+ * directions in a vector), by the weighted diamond scheme (theta 1: the step scheme, o[a] = psi_c;
+ * 1/2: diamond difference): psi_c = (s theta h + sum_a |O_a| in_a) / (sig_t theta h + sum_a
+ * |O_a|), o[a] = (psi_c - (1 - theta) in_a) / theta. Linear (no fixup of negative faces: the
+ * sweeps are GMRES's operator, applied to vectors of any sign), so with theta < 1 a face may leave
+ * negative. */
+static inline __attribute__((always_inline)) v4f cell_faces(const do_pack *pk, v4f src, float st, float h, float theta,
+                                                          const v4f in[3], v4f o[3])
+{
+    const float th = theta * h;
+    v4f v = (src * th + pk->a[0] * in[0] + pk->a[1] * in[1] + pk->a[2] * in[2]) / (st * th + pk->as);
+    if (theta >= 1.0f) {
+        o[0] = o[1] = o[2] = v;
+        return v;
+    }
+    const float r = 1.0f / theta, q = (1.0f - theta) / theta;
+    for (int a = 0; a < 3; a++) o[a] = v * r - in[a] * q;
+    return v;
+}
+
+/* One pack's sweep with the source moments Q (per cell, K each), its radiance's outgoing faces into
+ * psi (per cell, 3 faces of DO_PACK), its moments added to acc (first: set, at the cells needed), the power leaving through the
+ * grid's faces to *leak; with_in: the inflow entering through the grid's faces (else nothing: the
+ * linear part). In single precision but the leaving power (the directions of a pack in one
+ * vector). */
 static inline __attribute__((always_inline)) void sweep_k(const do_work *W, const do_pack *pk, const float *Q, float *psi, float *acc,
                            double *leak, const int K, const int with_in, const int first)
 {
@@ -185,12 +208,12 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
                     const float *q = Q + c * K;
                     for (int m = 0; m < K; m++) src += q[m] * pk->Y[m];
                 }
-                const v4f px = ii ? load4(psi + (c - sx) * DO_PACK) : bnd,
-                          py = jj ? load4(psi + (c - (ptrdiff_t)sy * nx) * DO_PACK) : bnd,
-                          pz = kk ? load4(psi + (c - (ptrdiff_t)sz * (ptrdiff_t)sxy) * DO_PACK) : bnd;
-                const float th = P->sig_t[c] * h;
-                const v4f v = (src * h + pk->a[0] * px + pk->a[1] * py + pk->a[2] * pz) / (th + pk->as);
-                memcpy(psi + c * DO_PACK, &v, sizeof v);
+                const v4f in[3] = {ii ? load4(psi + ((c - sx) * 3 + 0) * DO_PACK) : bnd,
+                                   jj ? load4(psi + ((c - (ptrdiff_t)sy * nx) * 3 + 1) * DO_PACK) : bnd,
+                                   kk ? load4(psi + ((c - (ptrdiff_t)sz * (ptrdiff_t)sxy) * 3 + 2) * DO_PACK) : bnd};
+                v4f o[3];
+                const v4f v = cell_faces(pk, src, P->sig_t[c], h, W->theta[c], in, o);
+                memcpy(psi + c * 3 * DO_PACK, o, sizeof o);
                 if (W->need[c] && (first || v[0] != 0 || v[1] != 0 || v[2] != 0 || v[3] != 0)) {
                     /* a vector over the coefficients; the group's first pack sets them (no memset of
                        the sums each sweep: 0 + t = t, the cells not needed never written) */
@@ -211,7 +234,8 @@ static inline __attribute__((always_inline)) void sweep_k(const do_work *W, cons
                 const int ex = ii == nx - 1, ey = jj == ny - 1, ez = kk == nz - 1;
                 if (ex | ey | ez)
                     for (int d = 0; d < DO_PACK; d++)
-                        out[d] += (double)v[d] * (ex * pk->a[0][d] + ey * pk->a[1][d] + ez * pk->a[2][d]);
+                        out[d] += (double)ex * o[0][d] * pk->a[0][d] + (double)ey * o[1][d] * pk->a[1][d] +
+                                  (double)ez * o[2][d] * pk->a[2][d];
             }
         }
     }
@@ -445,10 +469,11 @@ static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double 
         *b = carve(&at, sizeof(double) * N, &total), *tmp = carve(&at, sizeof(double) * N, &total);
         *x = carve(&at, sizeof(double) * N, &total), W->idx = carve(&at, sizeof(size_t) * W->cells, &total);
         W->live = carve(&at, W->cells, &total), W->need = carve(&at, W->cells, &total);
+        W->theta = carve(&at, sizeof(float) * W->cells, &total);
         W->Q = carve(&at, sizeof(float) * N, &total), W->q1 = carve(&at, sizeof(float) * N, &total);
         for (int g = 0; g < DO_GROUPS; g++)
             W->acc[g] = carve(&at, sizeof(float) * N, &total),
-            W->psi[g] = carve(&at, sizeof(float) * W->cells * DO_PACK, &total);
+            W->psi[g] = carve(&at, sizeof(float) * W->cells * 3 * DO_PACK, &total);
         if (!pass && ws->bytes < total) {
             free(ws->mem);
             ws->bytes = (ws->mem = malloc(total)) ? total : 0;
@@ -498,6 +523,13 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
             if (W.need[c]) W.idx[W.n++] = c;
         const size_t Nn = W.n * W.K;
         for (int g = 0; g < DO_GROUPS; g++) memset(W.acc[g], 0, sizeof(float) * N); /* the cells not needed */
+        /* the weighted diamond's weight per cell: theta (P's, in (0, 1), else 1: the step scheme)
+           in optically thick cells, toward 1 in thin ones, 1 - (1 - theta) (1 - e^(-tau / tau0)) */
+        const double th = P->theta > 0 && P->theta < 1 ? P->theta : 1;
+        for (size_t c = 0; c < W.cells; c++) {
+            const double tau = P->sig_t[c] * P->h;
+            W.theta[c] = (float)(P->theta_tau > 0 ? 1 - (1 - th) * (1 - exp(-tau / P->theta_tau)) : th);
+        }
         W.npack = make_packs(P, W.pack);
         for (size_t i = 0; i < N; i++) W.q1[i] = (float)P->q1[i];
         sweep_all(&W, W.q1, b, NULL, NULL, P->inflow != NULL);

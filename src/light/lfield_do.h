@@ -56,6 +56,10 @@ typedef struct {
     int leak;                   /* 1: the last source iteration by a sweep, which gives the leaving
                                    power; 0: from GMRES's residual, no sweep (stats' leak 0) */
     atmos__do_ws *ws;           /* the buffers to use (grown as needed); NULL: the solve's own */
+    double theta;               /* the sweep's weighted diamond: 1 (or 0, unset) the step scheme,
+                                   1/2 diamond difference (lfield_do.c, cell_faces()) */
+    double theta_tau;           /* > 0: theta in optically thick cells only, a cell of optical depth
+                                   tau 1 - (1 - theta) (1 - exp(-tau / theta_tau)); 0: in every cell */
 } atmos__do_problem;
 
 typedef struct {
