@@ -190,7 +190,9 @@ int main(void)
     d.threads = 2;
     CHECK_OK(atmos_context_create(&d, &ctx));
     check_orders(ctx, 30, 90);
-    check_orders(ctx, 20, 0);
+    /* the sanitizer copy (TEST_SANITIZED, test.h: there for memory errors, the plain copy checks
+     * the numbers) leaves out the sun behind the ball: the same code at other angles */
+    if (!TEST_SANITIZED) check_orders(ctx, 20, 0);
     check_sky(ctx);
     atmos_context_destroy(ctx);
     return test_summary("test_nishita");

@@ -59,26 +59,30 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
     ad_result r;
     CHECK(ad_slab(TAU, 1.0, G, 1.0, 32, &r));
     const double mus[NA] = {0.9, 0.6};
-    atmos_image *img[NA], *dm[NA], *dc[NA];
+    atmos_image *img[NA], *dm[NA] = {NULL, NULL}, *dc[NA] = {NULL, NULL};
     atmos_scene s;
     scene(&s, mus[0], 3);
     views(ctx, &s, v, o, mus, img);
+    /* the sanitizer copy (TEST_SANITIZED, test.h: there for memory errors, the plain copy checks
+     * the numbers) leaves out the delta-M fields (600 of the 700 thousand photons a wavelength):
+     * check_threads runs their code, delta-M and clipped, at 5 thousand */
     s.nishita.mc_delta_m = 1, s.nishita.mc_kphotons = 300;
-    views(ctx, &s, v, o, mus, dm);
+    if (!TEST_SANITIZED) views(ctx, &s, v, o, mus, dm);
     s.nishita.mc_dm_clip = 1;
-    views(ctx, &s, v, o, mus, dc);
+    if (!TEST_SANITIZED) views(ctx, &s, v, o, mus, dc);
     for (int a = 0; a < NA; a++) {
         scene(&s, mus[a], -1);
         atmos_image *ex = test_plan_frame(ctx, &s, v, o);
         s.nishita.mc_kphotons = 0;
         atmos_image *one = test_plan_frame(ctx, &s, v, o);
-        if (!img[a] || !dm[a] || !dc[a] || !ex || !one) {
+        if (!img[a] || (!TEST_SANITIZED && (!dm[a] || !dc[a])) || !ex || !one) {
             CHECK(0);
             atmos_image_destroy(ex), atmos_image_destroy(one);
             continue;
         }
-        const double ref = test_ad_up(&r, mus[a]), m = test_image_mean(img[a]), md = test_image_mean(dm[a]),
-                     me = test_image_mean(ex), m1 = test_image_mean(one), mc = test_image_mean(dc[a]);
+        const double ref = test_ad_up(&r, mus[a]), m = test_image_mean(img[a]), me = test_image_mean(ex),
+                     m1 = test_image_mean(one), md = dm[a] ? test_image_mean(dm[a]) : NAN,
+                     mc = dc[a] ? test_image_mean(dc[a]) : NAN;
         printf("  slab tau %g, view mu %.2f: adding-doubling %.4f; first order %.4f (%+.1f %%), + field toward the "
                "view's centre %.4f (%+.1f %%), + field of degree 3 %.4f (%+.1f %%), delta-M %.4f (%+.1f %%), "
                "clipped %.4f (%+.1f %%)\n",
@@ -101,13 +105,13 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
          * (+9.9 and +7.8 % with 100 thousand: the photons' noise), within the field toward the
          * view's centre's error. Held within 10 % (the unscaled degree 3, above, is outside it at
          * both angles) and closer than the unscaled degree 3, so the check can fail */
-        CHECK(fabs(md / ref - 1) < 0.1);
-        CHECK(fabs(md / ref - 1) < fabs(m / ref - 1));
+        if (!TEST_SANITIZED) CHECK(fabs(md / ref - 1) < 0.1);
+        if (!TEST_SANITIZED) CHECK(fabs(md / ref - 1) < fabs(m / ref - 1));
         /* delta-M with the photons sampling the clipped scaled phase exactly (mc_dm_clip, the
          * projection on delta-M's moments): measured -5.0 % and -5.2 % with 300 thousand photons
          * (its table's own moments in the projection instead: -9.5 and -2.8 %); held as delta-M */
-        CHECK(fabs(mc / ref - 1) < 0.1);
-        CHECK(fabs(mc / ref - 1) < fabs(m / ref - 1));
+        if (!TEST_SANITIZED) CHECK(fabs(mc / ref - 1) < 0.1);
+        if (!TEST_SANITIZED) CHECK(fabs(mc / ref - 1) < fabs(m / ref - 1));
         atmos_image_destroy(ex), atmos_image_destroy(one);
     }
     for (int a = 0; a < NA; a++) atmos_image_destroy(img[a]), atmos_image_destroy(dm[a]), atmos_image_destroy(dc[a]);

@@ -22,6 +22,16 @@
 static char cache_dir[1024];
 static int long_run;
 
+/* The sanitizer copy (TEST_SANITIZED, test.h) is there for memory errors; the plain copy checks
+ * the numbers. Its slabs (truncated or with the ordinary phase) and the camera in the cloud take
+ * an eighth of the samples: the checks against the references, in standard errors, stay as they
+ * are; those that the noise is small enough (the test has teeth) allow TEETH = sqrt(8) times the
+ * plain copy's relative standard error. Not where a check is per pixel or a variance ratio
+ * (their noise at an eighth fails them), nor the exact droplet slab's reflectance (the aureole
+ * estimate's rare large values: -5 % at an eighth). */
+#define SAN_SPP(n) (TEST_SANITIZED ? ((n) + 7) / 8 : (n))
+#define TEETH (TEST_SANITIZED ? 2.83 : 1.0)
+
 static atmos_context *make_ctx(int threads)
 {
     return test_context(threads, cache_dir);
@@ -321,13 +331,13 @@ static void test_slab(atmos_context *ctx)
         double E = sun_e(ctx, &s, 1);
         for (int side = 0; side < 2; side++) {
             double f, se;
-            slab_flux(ctx, &s, v, &op, side, spp[i], E, &f, &se);
+            slab_flux(ctx, &s, v, &op, side, SAN_SPP(spp[i]), E, &f, &se);
             double ref = side == 0 ? ad.refl : ad.trans;
             double z = (f - ref) / se;
             printf("slab g=0.85 tau=%g %s: path %.5f +- %.5f, adding-doubling %.5f (%+.2f sigma, rel SE %.2f%%)\n",
                    taus[i], side == 0 ? "R" : "T", f, se, ref, z, 100 * se / ref);
             CHECK_MSG(fabs(z) < 3.0, "tau %g %s: %.5f vs %.5f (%.2f standard errors)", taus[i], side ? "T" : "R", f, ref, z);
-            CHECK(se < 0.02 * ref); /* the test has teeth */
+            CHECK(se < 0.02 * TEETH * ref); /* the test has teeth */
         }
         atmos_volume_destroy(v);
     }
@@ -362,12 +372,12 @@ static void test_big_sun(atmos_context *ctx)
     double E = sun_e(ctx, &s, 1);
     for (int side = 0; side < 2; side++) {
         double f, se;
-        slab_flux(ctx, &s, v, &op, side, side == 0 ? 2048 : 256, E, &f, &se);
+        slab_flux(ctx, &s, v, &op, side, SAN_SPP(side == 0 ? 2048 : 256), E, &f, &se);
         double z = (f - ref[side]) / se;
         printf("slab g=0.9 tau=1 sun 20 deg %s: path %.5f +- %.5f, adding-doubling over the disk %.5f (%+.2f sigma)\n",
                side == 0 ? "R" : "T", f, se, ref[side], z);
         CHECK_MSG(fabs(z) < 3.0, "big sun %s: %.5f vs %.5f (%.2f standard errors)", side ? "T" : "R", f, ref[side], z);
-        CHECK(se < 0.025 * ref[side]);
+        CHECK(se < 0.025 * TEETH * ref[side]);
     }
     atmos_volume_destroy(v);
     atmos_phase_table_destroy(op.t);
@@ -413,7 +423,7 @@ static void slab_vs_ad(atmos_context *ctx, double w1, double g1, double g2, doub
     const double E = sun_e(ctx, &s, 1);
     double val[2], se[2];
     for (int side = 0; side < 2; side++) {
-        slab_flux(ctx, &s, v, &op, side, spp[side], E, &val[side], &se[side]);
+        slab_flux(ctx, &s, v, &op, side, tc > 0 ? SAN_SPP(spp[side]) : spp[side], E, &val[side], &se[side]);
         if (side == 1) val[1] += direct;
         /* allowance for the approximation: 1.5 % of R, 0.5 % of T_total (measured: docs/path.md) */
         const double z = (val[side] - ref[side]) / se[side];
@@ -424,7 +434,7 @@ static void slab_vs_ad(atmos_context *ctx, double w1, double g1, double g2, doub
                side == 0 ? "R" : "T total", val[side], se[side], ref[side], 100 * (val[side] / ref[side] - 1), z, f);
         CHECK_MSG(fabs(val[side] - ref[side]) < 3 * se[side] + allow, "%s: %.5f vs %.5f", side ? "T" : "R", val[side],
                   ref[side]);
-        CHECK(se[side] < 0.02 * ref[side]);
+        CHECK(se[side] < 0.02 * TEETH * ref[side]);
     }
     /* energy: nothing is absorbed */
     const double sum = val[0] + val[1], sse = sqrt(se[0] * se[0] + se[1] * se[1]);
@@ -480,8 +490,10 @@ static void test_truncate(atmos_context *ctx)
         double w1, g1, g2, tau;
         int spp[2]; /* R, T */
     } cases[] = {
-        {0.5, 0.99, 0.85, 2, {2048, 256}}, /* a droplet-like diffraction peak (P(0) = 800 sr^-1) on a g = 0.85 body */
-        {0.5, 0.99, 0.85, 8, {768, 192}},
+        /* R's samples halved 2026-12-06 (the test's longest renders): its relative standard error
+         * 0.38 -> 0.53 % and 0.58 -> 0.83 %, within the 2 % the check asks with margin */
+        {0.5, 0.99, 0.85, 2, {1024, 256}}, /* a droplet-like diffraction peak (P(0) = 800 sr^-1) on a g = 0.85 body */
+        {0.5, 0.99, 0.85, 8, {384, 192}},
         {1.0, 0.95, 0.0, 2, {4096, 256}},  /* one HG lobe, g = 0.95 (P(0) = 62 sr^-1) */
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
@@ -1012,7 +1024,7 @@ static void test_air_inside(atmos_context *ctx)
     int low = 0;
     for (int k = 0; k < 2; k++) {
         no_sky_nee = no_forced = k;
-        atmos_image *var = NULL, *img = render(ctx, &s, v, &op, 128, 0, &var);
+        atmos_image *var = NULL, *img = render(ctx, &s, v, &op, SAN_SPP(64), 0, &var);
         for (int p = 0; p < n; p++) {
             const double y = img->pixels[p * 4 + 1], se = sqrt(var->pixels[p * 4 + 1]);
             low += y < -3 * se;
@@ -1023,11 +1035,13 @@ static void test_air_inside(atmos_context *ctx)
     }
     no_sky_nee = no_forced = 0;
     const double z = (mean[0] - mean[1]) / sqrt(mvar[0] + mvar[1]);
-    printf("  128 spp: image mean %.4g +- %.2g, without sky NEE and forced %.4g +- %.2g (%+.2f sigma); "
-           "%d pixels below -3 standard errors\n", mean[0], sqrt(mvar[0]), mean[1], sqrt(mvar[1]), z, low);
+    printf("  %d spp: image mean %.4g +- %.2g, without sky NEE and forced %.4g +- %.2g (%+.2f sigma); "
+           "%d pixels below -3 standard errors\n", SAN_SPP(64), mean[0], sqrt(mvar[0]), mean[1], sqrt(mvar[1]), z, low);
     CHECK(low == 0);
     CHECK(fabs(z) < 4);
-    CHECK(mean[0] > 10 * sqrt(mvar[0])); /* the test has teeth: the light is resolved */
+    /* the test has teeth: the light is resolved (at 128 spp 44 standard errors, 31 at 64; the
+     * sanitizer copy's 8 spp: 9 and 12 of the two air models, against 10 / TEETH) */
+    CHECK(mean[0] > 10 / TEETH * sqrt(mvar[0]));
     atmos_volume_destroy(v);
     atmos_phase_table_destroy(op.t);
 }
