@@ -44,4 +44,9 @@ rc=$?
 [ $rc -eq 0 ] && [ -s "$T/new/deep/s.json" ] && [ -s "$T/new/deep/s.cloud.raw" ] && [ -s "$T/new/deep/s.rain.raw" ] &&
     [ "$(ls -A "$T/new/deep" | wc -l)" -eq 3 ] && ok "-o into missing folders: made, the volume there, no staging file left" ||
     { bad "-o into missing folders: exit $rc, files: $(ls -A "$T/new/deep" 2>&1 | tr '\n' ' ')"; cat "$T/err" >&2; }
+# a run that fails after the check (the voxel limit, found when the simulation is made) leaves no
+# folder of those it made
+"$A" simulate cumulonimbus --grid 512 --refine 4 -o "$T/gone/a/x.json" -q 2>"$T/err"
+rc=$?
+[ $rc -eq 1 ] && [ ! -e "$T/gone" ] && ok "a failed run removes the folders it made" || bad "failed run: exit $rc, $(ls -R "$T/gone" 2>&1)"
 exit $fail
