@@ -131,6 +131,8 @@ class Plan(Owned):
                 f.camera.fov_deg = number(f"{w}: camera fov_deg", camera["fov_deg"])
         if sun is not None:
             el, az = _vector(f"{w}: sun (elevation_deg, azimuth_deg)", sun, 2)
+            if not -90.0 <= el <= 90.0:  # as the scene's sun.elevation_deg (else wrapped past a pole)
+                raise ValueError(f"atmos: {w}: sun elevation_deg: {el:g} is not in [-90, 90]")
             lib.atmos_direction_from_angles(el, az, f.sun_dir)
         if size is not None:
             f.width, f.height = _vector(f"{w}: size (width, height)", size, 2, integer=True)

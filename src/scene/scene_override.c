@@ -112,6 +112,11 @@ static void drop_other_density(cJSON *root, const cJSON *node, const char *tok)
     else if (!strcmp(tok, "extinction_per_m")) cJSON_DeleteItemFromObjectCaseSensitive(fog, "visibility_m");
 }
 
+/* An override's VALUE as JSON when the whole of it is JSON (white space after it allowed), as a
+ * scene file's text is read; NULL otherwise. cJSON_Parse alone stops after the first value and
+ * ignores the rest, so 30abc read as 30 and 2026-06-21T12:00:00Z as the number 2026. */
+static cJSON *whole_json(const char *text) { return cJSON_ParseWithOpts(text, NULL, 1); }
+
 static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *root, const char *ov)
 {
     const char *eq = strchr(ov, '=');
@@ -123,8 +128,8 @@ static atmos_status apply_one(atmos_context *ctx, const char *source, cJSON *roo
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: override '%.60s...': the path is too long", source, ov);
     memcpy(path, ov, plen);
     path[plen] = '\0';
-    /* The value: JSON text, or a bare word (not JSON) taken as a string. */
-    cJSON *value = cJSON_Parse(eq + 1);
+    /* The value: JSON text, or a bare word (not JSON, in whole) taken as a string. */
+    cJSON *value = whole_json(eq + 1);
     if (!value) value = cJSON_CreateString(eq + 1);
     if (!value) return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory", source);
     const int pointer = path[0] == '/';
@@ -162,7 +167,7 @@ static unsigned override_sources(const char *ov)
     if (n < 6 || strncmp(p, "volume", 6)) return 0;
     unsigned bits = 0;
     if (n == 6) { /* the whole volume: the sources its object holds */
-        cJSON *v = cJSON_Parse(eq + 1);
+        cJSON *v = whole_json(eq + 1);
         for (int i = 0; i < 3; i++)
             bits |= cJSON_IsObject(v) && cJSON_GetObjectItemCaseSensitive(v, sources[i]) ? 1u << i : 0;
         cJSON_Delete(v);

@@ -36,4 +36,17 @@ python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["dims"] ==
     "$T/s.JSON" && ok "stratocumulus at grid 16: 16 x 8 x 16 cells of 400 m" || bad "stratocumulus at grid 16: $(cat "$T/s.JSON")"
 "$A" simulate --help | grep -A4 -- "--grid N" | grep -q "at least 8 levels" && ok "--help states the 8 levels" ||
     bad "--help silent on the 8 levels"
+# a missing folder is made and kept for the volume (README: atmos simulate cumulus_field -o
+# sim/cf.json); it used to be made for the check and removed again before the run, whose
+# write then failed after the whole simulation ("sim/cf.cloud.raw.staged: cannot create")
+"$A" simulate stratocumulus --grid 16 --minutes 0.5 -o "$T/new/deep/s.json" -q 2>"$T/err"
+rc=$?
+[ $rc -eq 0 ] && [ -s "$T/new/deep/s.json" ] && [ -s "$T/new/deep/s.cloud.raw" ] && [ -s "$T/new/deep/s.rain.raw" ] &&
+    [ "$(ls -A "$T/new/deep" | wc -l)" -eq 3 ] && ok "-o into missing folders: made, the volume there, no staging file left" ||
+    { bad "-o into missing folders: exit $rc, files: $(ls -A "$T/new/deep" 2>&1 | tr '\n' ' ')"; cat "$T/err" >&2; }
+# a run that fails after the check (the voxel limit, found when the simulation is made) leaves no
+# folder of those it made
+"$A" simulate cumulonimbus --grid 512 --refine 4 -o "$T/gone/a/x.json" -q 2>"$T/err"
+rc=$?
+[ $rc -eq 1 ] && [ ! -e "$T/gone" ] && ok "a failed run removes the folders it made" || bad "failed run: exit $rc, $(ls -R "$T/gone" 2>&1)"
 exit $fail

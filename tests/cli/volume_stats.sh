@@ -71,6 +71,14 @@ head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "
 # no cloud above the threshold: said, not NaN and an inverted size range
 "$A" volume stats "$T/d.json" --threshold 1e9 >"$T/o" 2>&1 && grep -q "nothing to fit" "$T/o" && ! grep -q nan "$T/o" &&
     ok "no clouds: nothing to fit, no NaN" || bad "no clouds: $(cat "$T/o")"
+# one cloud to fit (--min-pixels 300 keeps the largest disc), a size range with one cloud: too few
+# clouds said in words, no NaN (both printed "nan +- nan")
+"$A" volume stats "$T/d.json" --min-pixels 300 >"$T/o" 2>&1 && grep -q "dimension: too few clouds to fit (1 of" "$T/o" &&
+    grep -q "size distribution: too few clouds to fit (0 in" "$T/o" && ! grep -qi nan "$T/o" &&
+    ok "one cloud to fit: too few clouds, no NaN" || bad "one cloud to fit: $(cat "$T/o")"
+"$A" volume stats "$T/d.json" --size-range 2000,2500 >"$T/o" 2>&1 && grep -q "size distribution: too few clouds to fit (1 in" "$T/o" &&
+    grep -q "dimension D = 1.0" "$T/o" && ! grep -qi nan "$T/o" && ok "one cloud in the size range: too few, no NaN" ||
+    bad "one cloud in the size range: $(cat "$T/o")"
 "$A" volume stats "$T/d.json" --threshold 1e9 --kv >"$T/o" 2>&1 && grep -q "^size_min_m=nan" "$T/o" && grep -q "^size_clouds=0" "$T/o" &&
     ok "no clouds: --kv size range nan" || bad "no clouds --kv: $(grep size_m "$T/o")"
 # reading options reach the file: --scale 0.5 halves every optical depth (the discs have tau between 10 and 20:

@@ -66,6 +66,21 @@ int main(void)
     CHECK(parse("{\"volume\": {\"file\": \"d.vdb\"}}", k, 2, &s) == ATMOS_E_INVALID_ARG);
     CHECK_MSG(!strncmp(atmos_context_error(ctx), "-D volume.generate=cumulus (on t.json): /volume: \"time_index\"", 60),
               "%s", atmos_context_error(ctx));
+    /* the whole value is JSON or it is a bare word: text after a JSON value makes the value a
+     * string, not the JSON before it (a time is not the number 2026, 30abc is not 30) */
+    const char *l[] = {"sun.time=2026-06-21T12:00:00Z", "sun.latitude_deg=40 ", "sun.longitude_deg=-105"};
+    CHECK_MSG(parse("{}", l, 3, &s) == ATMOS_OK, "%s", atmos_context_error(ctx));
+    CHECK(s.sun.from_time && s.sun.latitude_deg == 40 && s.sun.longitude_deg == -105);
+    const char *m[] = {"name=2026abc"};
+    CHECK_OK(parse("{}", m, 1, &s));
+    CHECK(!strcmp(s.name, "2026abc"));
+    const char *bad_numbers[] = {"camera.fov_deg=30abc", "camera.fov_deg=30, 50", "/image/width=64 px"};
+    for (int q = 0; q < 3; q++) {
+        CHECK_MSG(parse("{}", &bad_numbers[q], 1, &s) == ATMOS_E_INVALID_ARG, "override %s", bad_numbers[q]);
+        CHECK_MSG(strstr(atmos_context_error(ctx), "expected") != NULL, "%s", atmos_context_error(ctx));
+    }
+    const char *v[] = {"volume={\"generate\": \"cumulus\"} x"};
+    CHECK(parse("{}", v, 1, &s) == ATMOS_E_INVALID_ARG);
     atmos_context_destroy(ctx);
     return test_summary("test_scene_override");
 }

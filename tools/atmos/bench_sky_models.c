@@ -121,8 +121,14 @@ static atmos_status time_frames(atmos_context *ctx, const atmos_scene *sc, int f
     return st;
 }
 
+/* Frames timed at each size while the image grows: the best of 4, as a plan's first two frames
+ * carry one-off work (space_clouds at 12x8: 47-60 and 55-230 ms of CPU, then 16-21 ms); with the
+ * best of 2 that second frame's cost at 12x8, against a 1x1 frame without it, was taken for a
+ * cost per pixel and stopped the growth at 12x8 (fps 0.001 extrapolated instead of about 3). */
+enum { GROW_FRAMES = 4 };
+
 /* One view of one model. A frame costs a fixed part (tables that depend on the camera or
- * the sun) plus a part per pixel. Starting from frames of 1x1 and 12x8 pixels (best of 2),
+ * the sun) plus a part per pixel. Starting from frames of 1x1 and 12x8 pixels (GROW_FRAMES),
  * the image grows through 45x30, 90x60, 180x120, 360x240 to 720x480 while the cost the last
  * two sizes predict for the next one (fixed + per pixel) fits budget_s for `repeat` frames;
  * the last size is measured with `repeat` frames when they fit (slow models: smaller). */
@@ -133,10 +139,10 @@ static atmos_status bench_view(atmos_context *ctx, const char *name, atmos_atmos
     atmos_scene sc;
     double t_prev, t, cpu;
     view_scene(&sc, kind, space, 1, 1, clouds);
-    atmos_status st = time_frames(ctx, &sc, 2, climb, &t_prev, &cpu);
+    atmos_status st = time_frames(ctx, &sc, GROW_FRAMES, climb, &t_prev, &cpu);
     double px_prev = 1, px = (double)(FULL_W / divs[0]) * (FULL_H / divs[0]);
     view_scene(&sc, kind, space, FULL_W / divs[0], FULL_H / divs[0], clouds);
-    if (st == ATMOS_OK) st = time_frames(ctx, &sc, 2, climb, &t, &cpu);
+    if (st == ATMOS_OK) st = time_frames(ctx, &sc, GROW_FRAMES, climb, &t, &cpu);
     int i = 0;
     while (st == ATMOS_OK && i < 5) {
         const double per_px = fmax((t - t_prev) / (px - px_prev), 0.0), fixed = fmax(t - per_px * px, 0.0);
@@ -145,7 +151,7 @@ static atmos_status bench_view(atmos_context *ctx, const char *name, atmos_atmos
         i++;
         view_scene(&sc, kind, space, FULL_W / divs[i], FULL_H / divs[i], clouds);
         t_prev = t, px_prev = px, px = px_next;
-        st = time_frames(ctx, &sc, 2, climb, &t, &cpu);
+        st = time_frames(ctx, &sc, GROW_FRAMES, climb, &t, &cpu);
     }
     if (st == ATMOS_OK && repeat > 2 && t * repeat <= budget_s) st = time_frames(ctx, &sc, repeat, climb, &t, &cpu);
     if (st != ATMOS_OK) return st;

@@ -223,13 +223,23 @@ static void print_fit(const opts *o, const atmos_cloud_fit *f, int sources, doub
                o->sd.fit_min_pixels > 0 ? o->sd.fit_min_pixels : 10);
         return;
     }
-    printf("  perimeter-area dimension D = %.3f +- %.3f (crack perimeter %.3f +- %.3f) over %d clouds of %.3g..%.3g km^2 "
-           "(the %d of at least %g pixels away from the edge)\n",
-           f->d, f->d_se, f->d_crack, f->d_crack_se, f->fitted, f->fit_area_min_m2 * 1e-6, f->fit_area_max_m2 * 1e-6,
-           f->fitted, o->sd.fit_min_pixels > 0 ? o->sd.fit_min_pixels : 10);
-    printf("  size distribution n(d) ~ d^-b: b = %.2f +- %.2f (max. likelihood), %.2f +- %.2f (histogram) over %d clouds of "
-           "%.0f..%.0f m\n",
-           f->size_slope, f->size_slope_se, f->size_slope_hist, f->size_slope_hist_se, f->size_n, f->size_min_m, f->size_max_m);
+    /* A fit with too few clouds (one cloud's D, an empty size range) is NaN: said in words, as
+     * "nothing to fit" is (--kv keeps the NaN). */
+    if (isfinite(f->d) && isfinite(f->d_se))
+        printf("  perimeter-area dimension D = %.3f +- %.3f (crack perimeter %.3f +- %.3f) over %d clouds of %.3g..%.3g "
+               "km^2 (the %d of at least %g pixels away from the edge)\n",
+               f->d, f->d_se, f->d_crack, f->d_crack_se, f->fitted, f->fit_area_min_m2 * 1e-6, f->fit_area_max_m2 * 1e-6,
+               f->fitted, o->sd.fit_min_pixels > 0 ? o->sd.fit_min_pixels : 10);
+    else
+        printf("  perimeter-area dimension: too few clouds to fit (%d of at least %g pixels away from the edge)\n", f->fitted,
+               o->sd.fit_min_pixels > 0 ? o->sd.fit_min_pixels : 10);
+    if (isfinite(f->size_slope) && isfinite(f->size_slope_hist))
+        printf("  size distribution n(d) ~ d^-b: b = %.2f +- %.2f (max. likelihood), %.2f +- %.2f (histogram) over %d clouds "
+               "of %.0f..%.0f m\n",
+               f->size_slope, f->size_slope_se, f->size_slope_hist, f->size_slope_hist_se, f->size_n, f->size_min_m,
+               f->size_max_m);
+    else
+        printf("  size distribution: too few clouds to fit (%d in the size range; --size-range sets it)\n", f->size_n);
     printf("  base flatness (sd of base / depth): median %.3f, area-weighted mean %.3f over %d clouds\n", f->flatness_median,
            f->flatness_mean, f->flatness_n);
 }

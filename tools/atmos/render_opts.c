@@ -164,6 +164,17 @@ static int parse_vec3(const char *C, const char *opt, const char *arg, double v[
     return *given = 1, 1;
 }
 
+/* --lat, --lon: degrees in [-limit, limit], as the scene's latitude_deg/longitude_deg and atmos
+ * sun take them (over a round planet they set the atmosphere's place, checked by no scene rule
+ * on the way: --lon 200 was taken, --lat 95 failed in the library with exit 1). */
+static int parse_place(const char *C, const char *opt, const char *arg, double limit, double *out)
+{
+    if (!cli_parse_double(C, opt, arg, out)) return 0;
+    if (fabs(*out) <= limit) return 1;
+    cli_usage_error(C, "%s: expected degrees in [%g, %g], got %s", opt, -limit, limit, arg);
+    return 0;
+}
+
 /* The options that name files or pick from words. Returns 1, 0 (usage error printed) or -1
  * (not one of these). */
 static int parse_named(int c, const char *arg, render_opts *o)
@@ -223,8 +234,8 @@ static int parse_number(int c, const char *arg, render_opts *o)
     case O_ALT: return cli_parse_double(C, "--altitude", arg, &o->altitude);
     case O_SEL: return cli_parse_double(C, "--sun-elevation", arg, &o->sun_el);
     case O_SAZ: return cli_parse_double(C, "--sun-azimuth", arg, &o->sun_az);
-    case O_LAT: return cli_parse_double(C, "--lat", arg, &o->lat);
-    case O_LON: return cli_parse_double(C, "--lon", arg, &o->lon);
+    case O_LAT: return parse_place(C, "--lat", arg, 90.0, &o->lat);
+    case O_LON: return parse_place(C, "--lon", arg, 180.0, &o->lon);
     case O_EXPCOMP: return cli_parse_double(C, "--exposure-comp", arg, &o->ev_comp);
     case O_SEL_END: return cli_parse_double(C, "--sun-elevation-end", arg, &o->sun_el_end);
     case O_SAZ_END: return cli_parse_double(C, "--sun-azimuth-end", arg, &o->sun_az_end);

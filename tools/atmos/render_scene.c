@@ -213,7 +213,7 @@ static const char *cwd_define(const char *def, char *buf, size_t cap)
     size_t n = strlen(v);
     if (v[0] == '{' || v[0] == '[') { /* an object or array holding file keys */
         buf[0] = '\0';
-        cJSON *tree = cJSON_Parse(v);
+        cJSON *tree = cJSON_ParseWithOpts(v, NULL, 1); /* the whole value, as the library reads it */
         char *text = tree && cwd_tree(tree) ? cJSON_PrintUnformatted(tree) : NULL;
         cJSON_Delete(tree);
         if (text && (size_t)(eq - def) + 1 + strlen(text) < cap)
