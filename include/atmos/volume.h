@@ -156,9 +156,12 @@ ATMOS_API atmos_status atmos_volume_write_raw(atmos_context *ctx, const atmos_vo
 typedef struct atmos_volume_generate_desc {
     uint64_t seed;            /* same seed, same volume */
     double voxel_size_m;      /* 0 = the preset's default */
-    double scale;             /* multiplies the preset's extent (1 = default); 0 = 1 */
+    double scale;             /* multiplies the preset's extent (1 = default); 0 = 1; else in
+                                 [ATMOS_GENERATE_SCALE_MIN, ATMOS_GENERATE_SCALE_MAX] */
     uint64_t max_memory;      /* 0 = default */
 } atmos_volume_generate_desc;
+#define ATMOS_GENERATE_SCALE_MIN 0.05
+#define ATMOS_GENERATE_SCALE_MAX 20.0
 
 /* Presets: "cumulus", "cumulonimbus", "cumulus_field", "cirrus", "rain_shaft", "storm",
  * "stratocumulus", "virga" (docs/volumes.md). Unknown names list the known ones. */

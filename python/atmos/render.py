@@ -133,6 +133,8 @@ class Plan(Owned):
             el, az = _vector(f"{w}: sun (elevation_deg, azimuth_deg)", sun, 2)
             if not -90.0 <= el <= 90.0:  # as the scene's sun.elevation_deg (else wrapped past a pole)
                 raise ValueError(f"atmos: {w}: sun elevation_deg: {el:g} is not in [-90, 90]")
+            if not 0.0 <= az < 360.0:  # as the scene's sun.azimuth_deg and the CLI's azimuths
+                raise ValueError(f"atmos: {w}: sun azimuth_deg: {az:g} is not in [0, 360)")
             lib.atmos_direction_from_angles(el, az, f.sun_dir)
         if size is not None:
             f.width, f.height = _vector(f"{w}: size (width, height)", size, 2, integer=True)

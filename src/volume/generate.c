@@ -60,8 +60,9 @@ atmos_status atmos_volume_generate(atmos_context *ctx, const char *preset, const
                             preset ? preset : "(null)", list);
     }
     double scale = desc->scale == 0 ? 1 : desc->scale;
-    if (!isfinite(scale) || scale < 0.05 || scale > 20)
-        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate %s: scale must be in [0.05, 20], got %g", preset, scale);
+    if (!isfinite(scale) || scale < ATMOS_GENERATE_SCALE_MIN || scale > ATMOS_GENERATE_SCALE_MAX)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate %s: scale must be in [%g, %g], got %g", preset,
+                            ATMOS_GENERATE_SCALE_MIN, ATMOS_GENERATE_SCALE_MAX, scale);
     if (desc->voxel_size_m != 0 && !(isfinite(desc->voxel_size_m) && desc->voxel_size_m > 0))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "generate %s: voxel_size_m must be > 0, got %g", preset,
                             desc->voxel_size_m);

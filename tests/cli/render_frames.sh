@@ -52,7 +52,7 @@ cmp -s "$T/b/ov_0002.pfm" "$T/b/one.pfm" && ok || bad "--time-end 14:00: last fr
 # 3. Errors.
 "$A" render -q --time-end 2026-06-21T14:00:00Z -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--time-end without --frames should exit 2"
 "$A" render -q --frames 2 --time-end 2026-06-21T14:00:00Z -o "$T/x.png" 2> "$T/err"; rc=$?
-[ $rc -eq 2 ] && grep -q "time_end: needs a sun given by time" "$T/err" && ok || bad "--time-end with an angle sun: rc $rc, $(cat "$T/err")"
+[ $rc -eq 2 ] && grep -q -- "--time-end: needs a sun given by time" "$T/err" && ok || bad "--time-end with an angle sun: rc $rc, $(cat "$T/err")"
 "$A" render -q --frames 2 -o "$T/x.png" 2> "$T/err"; rc=$?
 [ $rc -eq 2 ] && grep -q "need an end" "$T/err" && ok || bad "--frames 2 without an end: rc $rc, $(cat "$T/err")"
 "$A" render -q --frames 0 -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--frames 0 should exit 2"

@@ -81,6 +81,8 @@ head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "
     bad "one cloud in the size range: $(cat "$T/o")"
 "$A" volume stats "$T/d.json" --threshold 1e9 --kv >"$T/o" 2>&1 && grep -q "^size_min_m=nan" "$T/o" && grep -q "^size_clouds=0" "$T/o" &&
     ok "no clouds: --kv size range nan" || bad "no clouds --kv: $(grep size_m "$T/o")"
+"$A" volume --help | grep -q -- "--kv prints key=value lines" && "$A" volume --help | grep -q "nan where a fit has too few clouds" &&
+    ok "volume --help says --kv's nan" || bad "volume --help does not say when --kv prints nan"
 # reading options reach the file: --scale 0.5 halves every optical depth (the discs have tau between 10 and 20:
 # clouds at --threshold 10 read as they are, none read at half)
 "$A" volume stats "$T/d.json" --threshold 10 --kv >"$T/o" 2>&1 && [ "$(sed -n 's/^clouds=//p' "$T/o")" = 3 ] &&

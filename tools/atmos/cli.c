@@ -26,6 +26,14 @@ int cli_parse_double(const char *cmd, const char *opt, const char *text, double 
     return 1;
 }
 
+int cli_parse_azimuth(const char *cmd, const char *opt, const char *text, double *out)
+{
+    if (!cli_parse_double(cmd, opt, text, out)) return 0;
+    if (*out >= 0.0 && *out < 360.0) return 1;
+    cli_usage_error(cmd, "%s: expected degrees in [0, 360) (clockwise from north), got %s", opt, text);
+    return 0;
+}
+
 int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, long hi, int *out)
 {
     char *end = NULL;

@@ -14,6 +14,9 @@ enum { CLI_EXIT_OK = 0, CLI_EXIT_RUNTIME = 1, CLI_EXIT_USAGE = 2 };
 /* Parses a finite number; on failure prints "atmos CMD: OPT: expected a number, got 'TEXT'"
  * to stderr and returns 0. */
 int cli_parse_double(const char *cmd, const char *opt, const char *text, double *out);
+/* Parses an azimuth in degrees, [0, 360) as the scene file's azimuth keys: another value is a
+ * usage error naming OPT and the range (the same rule for every azimuth option). */
+int cli_parse_azimuth(const char *cmd, const char *opt, const char *text, double *out);
 /* Parses an integer in [lo, hi]; prints a message naming OPT and the range on failure. */
 int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, long hi, int *out);
 /* Prints "atmos CMD: message" and "Try 'atmos CMD --help'." to stderr; returns CLI_EXIT_USAGE. */

@@ -151,10 +151,18 @@ static int run_write(const atmos_sim_desc *d, int threads, int quiet, const char
     atmos_volume *v = NULL;
     const double t0 = cli_now_s();
     atmos_status st = atmos_sim_create(ctx, d, &s);
+    int rc = CLI_EXIT_OK;
+    if (st == ATMOS_E_LIMIT) { /* the options' voxels, refused before the run: a usage error */
+        const char *msg = atmos_context_error(ctx);
+        if (!strncmp(msg, "simulate: ", 10)) msg += 10;
+        const int g = d->grid ? d->grid : 64;
+        rc = d->refine > 1 ? cli_usage_error(C, "--grid %d --refine %d: %s", g, d->refine, msg)
+                           : cli_usage_error(C, "--grid %d: %s", g, msg);
+    }
     if (st == ATMOS_OK) st = atmos_sim_run(ctx, s, minutes * 60.0);
     if (st == ATMOS_OK) st = atmos_sim_to_volume(ctx, s, &v);
     if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
-    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    if (rc == CLI_EXIT_OK) rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
     if (rc == CLI_EXIT_OK) warn_if_empty(s, d, minutes);
     if (rc == CLI_EXIT_OK && !quiet)
         fprintf(stderr, "atmos simulate: %s, %g min on a %d grid in %.1f s: wrote %s\n", d->preset, minutes,

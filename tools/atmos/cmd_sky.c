@@ -19,9 +19,9 @@ static void help(void)
            "corrected; Eq. 11, 12); homogeneous: closed forms too; dobashi: single scattering by\n"
            "Dobashi et al. 2002's tables; spherical: every order of scattering (docs/sky.md).\n\n"
            "  --sun-elevation E    sun elevation, degrees above the horizon [-90, 90]\n"
-           "  --sun-azimuth A      sun azimuth, degrees clockwise from north (default 180)\n"
+           "  --sun-azimuth A      sun azimuth, degrees [0, 360) clockwise from north (default 180)\n"
            "  --view-elevation e   view elevation, degrees [-90, 90]\n"
-           "  --view-azimuth a     view azimuth, degrees clockwise from north\n"
+           "  --view-azimuth a     view azimuth, degrees [0, 360) clockwise from north\n"
            "  --altitude h         observer altitude, metres in [0, 1e8] (default 0)\n"
            "  --distance K         path length, metres > 0 (default: to the ground or to space)\n"
            "  --spectral N         N spectral samples in 380-780 nm (default: rgb = 680, 550, 440 nm)\n"
@@ -179,9 +179,9 @@ int cli_cmd_sky(int argc, char **argv)
         if (!view_opt && c > 0 && strchr("EAeazKj", c) && li >= 0) view_opt = opts[li].name;
         switch (c) {
         case 'E': if (!cli_parse_double(C, "--sun-elevation", optarg, &o.sun_el)) return CLI_EXIT_USAGE; break;
-        case 'A': if (!cli_parse_double(C, "--sun-azimuth", optarg, &o.sun_az)) return CLI_EXIT_USAGE; break;
+        case 'A': if (!cli_parse_azimuth(C, "--sun-azimuth", optarg, &o.sun_az)) return CLI_EXIT_USAGE; break;
         case 'e': if (!cli_parse_double(C, "--view-elevation", optarg, &o.view_el)) return CLI_EXIT_USAGE; break;
-        case 'a': if (!cli_parse_double(C, "--view-azimuth", optarg, &o.view_az)) return CLI_EXIT_USAGE; break;
+        case 'a': if (!cli_parse_azimuth(C, "--view-azimuth", optarg, &o.view_az)) return CLI_EXIT_USAGE; break;
         case 'z': if (!cli_parse_double(C, "--altitude", optarg, &o.alt)) return CLI_EXIT_USAGE; break;
         case 'K': if (!cli_parse_double(C, "--distance", optarg, &o.dist)) return CLI_EXIT_USAGE; break;
         case 'r': if (!cli_parse_double(C, "--albedo", optarg, &o.albedo)) return CLI_EXIT_USAGE; break;

@@ -37,8 +37,8 @@ void cli_volume_help(void)
         if (n[1] && col + (int)strlen(n[1]) + 3 <= 100) col += printf(" ");
     }
     printf("            --seed (default 1) picks the random shape; --voxel-size overrides the preset's\n"
-           "            voxel edge in metres; --scale (or atmos render's --volume-scale) multiplies its extent\n"
-           "            (default 1).\n"
+           "            voxel edge in metres; --scale S, in [0.05, 20] (or atmos render's --volume-scale),\n"
+           "            multiplies its extent (default 1).\n"
            "  slice     writes a grey PNG of one field's density in the plane at fraction F (default 0.5)\n"
            "            of the grid along AXIS, normalised by the slice's maximum; y is up in the image (a\n"
            "            missing folder is made).\n"
@@ -198,7 +198,9 @@ static int cmd_generate(int argc, char **argv)
         } else if ((!strcmp(argv[i], "--scale") || !strcmp(argv[i], "--volume-scale")) && i + 1 < argc) {
             if (!cli_parse_double(C, argv[i], argv[i + 1], &g.scale)) return CLI_EXIT_USAGE; /* render's name too */
             i++;
-            if (g.scale <= 0) return cli_usage_error(C, "%s: must be > 0", argv[i - 1]);
+            if (!(g.scale >= ATMOS_GENERATE_SCALE_MIN && g.scale <= ATMOS_GENERATE_SCALE_MAX))
+                return cli_usage_error(C, "%s: expected a factor in [%g, %g], got %s", argv[i - 1],
+                                       ATMOS_GENERATE_SCALE_MIN, ATMOS_GENERATE_SCALE_MAX, argv[i]);
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
         } else if (argv[i][0] == '-') {

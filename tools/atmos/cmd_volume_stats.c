@@ -50,9 +50,9 @@ void cli_volume_stats_help(void)
            "            histogram; the bases' flatness, per cloud the standard deviation of the base height\n"
            "            (where the optical depth from below reaches --base-tau, default 0.1) over its columns\n"
            "            divided by its depth (median and area-weighted mean). --kv prints key=value lines\n"
-           "            instead of the summary; --csv writes one line per cloud; --mask-png the first source's\n"
-           "            mask (white clouds, grey edge clouds, dark grey thinner cloud, black clear; rows\n"
-           "            along z).\n"
+           "            instead of the summary (nan where a fit has too few clouds, the summary saying so in\n"
+           "            words); --csv writes one line per cloud; --mask-png the first source's mask (white\n"
+           "            clouds, grey edge clouds, dark grey thinner cloud, black clear; rows along z).\n"
            "            Files are read with the reading options below; each source is measured once.\n");
 }
 

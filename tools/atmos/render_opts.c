@@ -233,12 +233,12 @@ static int parse_number(int c, const char *arg, render_opts *o)
     case O_FRAMES: return cli_parse_int(C, "--frames", arg, 1, ATMOS_SCENE_MAX_FRAMES, &o->frames);
     case O_ALT: return cli_parse_double(C, "--altitude", arg, &o->altitude);
     case O_SEL: return cli_parse_double(C, "--sun-elevation", arg, &o->sun_el);
-    case O_SAZ: return cli_parse_double(C, "--sun-azimuth", arg, &o->sun_az);
+    case O_SAZ: return cli_parse_azimuth(C, "--sun-azimuth", arg, &o->sun_az);
     case O_LAT: return parse_place(C, "--lat", arg, 90.0, &o->lat);
     case O_LON: return parse_place(C, "--lon", arg, 180.0, &o->lon);
     case O_EXPCOMP: return cli_parse_double(C, "--exposure-comp", arg, &o->ev_comp);
     case O_SEL_END: return cli_parse_double(C, "--sun-elevation-end", arg, &o->sun_el_end);
-    case O_SAZ_END: return cli_parse_double(C, "--sun-azimuth-end", arg, &o->sun_az_end);
+    case O_SAZ_END: return cli_parse_azimuth(C, "--sun-azimuth-end", arg, &o->sun_az_end);
     case O_THICKNESS:
         if (!cli_parse_double(C, "--thickness", arg, &o->thickness) || !(o->thickness >= 1 && o->thickness <= 1e6))
             return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]"), 0;
@@ -266,7 +266,7 @@ static int parse_number(int c, const char *arg, render_opts *o)
         if (!cli_parse_double(C, "--view-elevation", arg, &o->view_el) || !(fabs(o->view_el) <= 90))
             return cli_usage_error(C, "--view-elevation: expected degrees in [-90, 90]"), 0;
         return 1;
-    case O_VIEW_AZ: return cli_parse_double(C, "--view-azimuth", arg, &o->view_az);
+    case O_VIEW_AZ: return cli_parse_azimuth(C, "--view-azimuth", arg, &o->view_az);
     case O_DSCALE:
         if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) || !(o->density_scale > 0))
             return cli_usage_error(C, "--density-scale: expected a factor > 0"), 0;
@@ -439,6 +439,12 @@ static int apply_sun(atmos_context *ctx, const render_opts *o, atmos_scene *s)
     }
     if (!isnan(o->sun_el_end)) s->animation.elevation_end_deg = o->sun_el_end, s->animation.elevation_end_set = 1;
     if (!isnan(o->sun_az_end)) s->animation.azimuth_end_deg = o->sun_az_end, s->animation.azimuth_end_set = 1;
+    if (o->time_end && !s->sun.from_time)
+        return cli_usage_error(C, "--time-end: needs a sun given by time (--time, or a scene's \"sun\": {\"time\", ...}); "
+                                  "a sun given by angles moves with --sun-elevation-end/--sun-azimuth-end");
+    if ((!isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->sun.from_time)
+        return cli_usage_error(C, "--sun-elevation-end/--sun-azimuth-end: need a sun given by angles (--sun-elevation/"
+                                  "--sun-azimuth, or a scene's); a sun given by time moves with --time-end");
     if ((o->time_end || !isnan(o->sun_el_end) || !isnan(o->sun_az_end)) && s->animation.frames < 1)
         return cli_usage_error(C, "--time-end, --sun-elevation-end and --sun-azimuth-end need --frames N "
                                          "or a scene with an \"animation\"");
@@ -501,6 +507,10 @@ static int apply_volume_file(const render_opts *o, atmos_scene *s)
         return cli_usage_error(C, "--grids, --time-index, --density-unit and --subgrid-detail apply to a volume file, "
                                   "not to a generated volume; --particle (its cloud droplets' type) not to a "
                                   "simulated one");
+    if (generated && o->volume_scale > 0 &&
+        !(o->volume_scale >= ATMOS_GENERATE_SCALE_MIN && o->volume_scale <= ATMOS_GENERATE_SCALE_MAX))
+        return cli_usage_error(C, "--volume-scale: expected a factor in [%g, %g] for a generated volume, got %g",
+                               ATMOS_GENERATE_SCALE_MIN, ATMOS_GENERATE_SCALE_MAX, o->volume_scale);
     if (o->grids) snprintf(s->volume.grids, sizeof s->volume.grids, "%s", o->grids);
     if (o->particle) snprintf(s->volume.particle, sizeof s->volume.particle, "%s", o->particle);
     if (o->time_index >= 0) s->volume.time_index = o->time_index;
@@ -751,12 +761,13 @@ static void help_head(void)
            "      --look-at X,Y,Z           the point the camera looks at, metres\n"
            "      --view-elevation E        the view direction's elevation, degrees in [-90, 90] (negative:\n"
            "                                down; at -90 the image's top faces the view azimuth)\n"
-           "      --view-azimuth A          the view direction's azimuth, degrees clockwise from north\n"
+           "      --view-azimuth A          the view direction's azimuth, degrees in [0, 360) clockwise from\n"
+           "                                north\n"
            "      --fov DEG                 field of view: pinhole vertical, fisheye across the circle\n"
            "                                (a volume file with no camera given is framed: placed, and the\n"
            "                                camera pointed at it from where the whole box shows)\n"
-           "      --sun-elevation E         sun elevation, degrees\n"
-           "      --sun-azimuth A           sun azimuth, degrees clockwise from north\n"
+           "      --sun-elevation E         sun elevation, degrees in [-90, 90]\n"
+           "      --sun-azimuth A           sun azimuth, degrees in [0, 360) clockwise from north\n"
            "      --time T --lat L --lon L  sun from a time (2026-06-21T12:00:00Z, or an offset +HH:MM/-HH:MM;\n"
            "                                years 1800-2200) and a place: L in degrees north and degrees\n"
            "                                east (south and west negative); --time alone keeps a scene's\n"
@@ -808,8 +819,8 @@ void render_opts_help(void)
            "                                NetCDF its mixing ratios)\n"
            "      --voxel-size M            NetCDF: the resampling voxel (default: the model's mean layer depth,\n"
            "                                or DX if finer); VDB/raw: the voxel edge replacing the file's\n"
-           "      --volume-scale S          generators: extent factor; VDB/raw files: multiplies their lengths\n"
-           "                                (0.01: a file in centimetres)\n"
+           "      --volume-scale S          generators: extent factor in [0.05, 20]; VDB/raw files: multiplies\n"
+           "                                their lengths, (0, 100] (0.01: a file in centimetres)\n"
            "      --grids LIST              VDB grids or NetCDF variables to load (comma-separated)\n"
            "      --particle NAME           particle type of a single-grid VDB/raw file or of a generated\n"
            "                                volume's cloud droplets (default cloud)\n"
@@ -849,7 +860,7 @@ void render_opts_help(void)
            "      --time-end T              the last frame's UTC time (a sun given by time); frames are\n"
            "                                spaced evenly in time from the scene's (or --time's) time\n"
            "      --sun-elevation-end E     the last frame's sun elevation (a sun given by angles)\n"
-           "      --sun-azimuth-end A       the last frame's sun azimuth (the shorter way round)\n"
+           "      --sun-azimuth-end A       the last frame's sun azimuth, [0, 360) (the shorter way round)\n"
            "  -q, --quiet                   no progress bar or status lines (warnings and errors are\n"
            "                                still printed)\n"
            "  -h, --help                    show this help\n\n"
