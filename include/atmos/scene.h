@@ -495,6 +495,8 @@ ATMOS_API void atmos_scene_setting_set(atmos_scene *scene, const atmos_setting *
  * ("do": true, "diffuse": false) and the settings of Riley's path (ATMOS_SLICE_FIELD_AUTO);
  * never ATMOS_SLICE_FIELD_AUTO. With low_albedo the field is not drawn whatever this says. */
 ATMOS_API atmos_slice_field atmos_scene_slice_field(const atmos_scene_slice *slice);
+/* "auto", "do", "p1", "none" (the "field" key's names, the settings table's); NULL for another value. */
+ATMOS_API const char *atmos_slice_field_name(atmos_slice_field field);
 /* "sky", "slice", "path", "nishita", "harris", "beams"; NULL for an unknown kind. */
 ATMOS_API const char *atmos_renderer_name(atmos_renderer_kind renderer);
 

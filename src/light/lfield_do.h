@@ -3,7 +3,8 @@
  * first-order emission starts, in a medium of per-cell extinction and scattering whose phase
  * function is given by its normalised Legendre moments up to degree L <= 3; the answer is the
  * radiance's real spherical harmonics of degree <= L per cell (the orthonormal ones of
- * atmos__sh_eval). Upwind step sweeps (positive), the scattering source re-projected on degree
+ * atmos__sh_eval). Upwind sweeps (the step scheme, positive, or the weighted diamond: theta,
+ * not positive), the scattering source re-projected on degree
  * <= L after every sweep, and restarted GMRES on the moments (the source iteration's fixed point).
  * The same numbers whatever the threads. Not part of the API. */
 #ifndef ATMOS_LIGHT_LFIELD_DO_H
@@ -11,6 +12,15 @@
 
 #define ATMOS__DO_KMAX 16  /* coefficients per cell at most: degree 3 */
 #define ATMOS__DO_NMAX 512 /* directions at most */
+
+/* The renderers' sweeps' weighted diamond (atmos__do_problem's theta, theta_tau): 1/2, diamond
+ * difference, in optically thick cells, toward the step scheme (1) in thin ones, over an optical
+ * depth ATMOS__DO_THETA_TAU a cell. The step scheme alone diffuses too much across thick cells:
+ * the rain's cumulus (cells of 4 voxels) too dark with the sun behind and too bright toward it;
+ * the diamond leaves a slightly negative mean radiance deep inside thick clouds
+ * (docs/lightfield.md, "The step scheme in thick cells"). */
+#define ATMOS__DO_THETA 0.5
+#define ATMOS__DO_THETA_TAU 1.0
 
 /* The degree l of coefficient k of the real spherical harmonics (k = l^2 ... (l + 1)^2 - 1), k < 16. */
 static inline int atmos__sh_degree(int k)

@@ -34,13 +34,7 @@
 #define DO_RESTART 20
 #define DO_MAX_ITER 200
 #define SKY_NS 4 /* the sky's samples per direction's patch: SKY_NS x SKY_NS */
-/* The sweeps' weighted diamond (lfield_do.h): 1/2, diamond difference, in optically thick cells,
- * toward the step scheme (1) in thin ones, over an optical depth DO_THETA_TAU a cell. The step
- * scheme alone diffuses too much across thick cells: the rain's cumulus (cells of 4 voxels) too
- * dark with the sun behind and too bright toward it (docs/lightfield.md, "The step scheme in
- * thick cells"). */
-#define DO_THETA 0.5
-#define DO_THETA_TAU 1.0
+#define WS_MAX 64 /* the wavelengths solved in parallel at most (their buffers) */
 
 /* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
  * DO_NPHI, atmos__do_quadrature's order: the cosines descending), the mean over the direction's
@@ -169,12 +163,15 @@ static int solve_all(const do_fill *D, const int *wl, int ns, const double *skym
                      int threads, atmos__do_ws *ws, atmos__nishita_do_info *info)
 {
     const size_t NK = D->cells * D->K;
-    const int nt = threads < 1 ? 1 : threads, w0 = wl[0];
+    /* the other wavelengths' threads: no more than there are wavelengths or buffers */
+    int nt = threads < ns - 1 ? threads : ns - 1;
+    nt = nt > WS_MAX ? WS_MAX : nt < 1 ? 1 : nt;
+    const int w0 = wl[0];
     double *q1 = malloc(sizeof(double) * NK * nt), *phi0 = phi_all + (size_t)w0 * NK;
-    atmos__do_ws *wss[64];
+    atmos__do_ws *wss[WS_MAX];
     int oks[ATMOS_MAX_WAVELENGTHS];
     atmos__do_stats S[ATMOS_MAX_WAVELENGTHS];
-    if (!q1 || nt > 64) return free(q1), 0;
+    if (!q1) return 0;
     for (int t = 0; t < nt; t++) wss[t] = atmos__do_ws_at(ws, t);
     if (!warm) memset(phi0, 0, sizeof(double) * NK);
     oks[0] = solve_w(D, w0, q1, threads, ws, phi0, &S[0]);
@@ -234,7 +231,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     double *src = malloc(sizeof(double) * cells * n);
     int ok = st && src;
     P->c[0] = F->c[0], P->c[1] = F->c[1], P->c[2] = F->c[2], P->h = F->s / (double)np->g.sc, P->L = L, P->quad = &quad;
-    P->theta = DO_THETA, P->theta_tau = DO_THETA_TAU;
+    P->theta = ATMOS__DO_THETA, P->theta_tau = ATMOS__DO_THETA_TAU; /* the weighted diamond (lfield_do.h) */
     P->tol = DO_TOL, P->max_iter = DO_MAX_ITER, P->restart = DO_RESTART;
     D.n = n, D.K = K, D.cells = cells, D.st = st, D.src = src, D.Ys = Ys, D.E = E, D.sky = sky_on ? sky : NULL;
     D.chi = chi, D.coef = coef;

@@ -9,6 +9,7 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -1071,6 +1072,17 @@ static atmos_status parse_volume(const jp *p, const cJSON *j, const char *path, 
     return ATMOS_OK;
 }
 
+/* The slice's "do": false in a file, "field" left out: the P1 field, what it meant when the P1 field
+ * was the default (before 2026-12-06), unless "diffuse": false or "low_albedo" ask for none
+ * (auto's choice then). A file's key only: the scene struct's do_field 0 says nothing. */
+static atmos_status old_do_false(const atmos_setting *t, int n, unsigned seen, atmos_scene *s)
+{
+    for (int i = 0; i < n && i < 32; i++)
+        if (t[i].offset == offsetof(atmos_scene, slice.field) && (seen & (1u << i))) return ATMOS_OK;
+    if (s->slice.diffuse && !s->slice.low_albedo) s->slice.field = ATMOS_SLICE_FIELD_P1;
+    return ATMOS_OK;
+}
+
 /* A renderer's section ("slice", "path"): every key is a row of its settings table
  * (atmos_renderer_settings), which gives its type and range. */
 static atmos_status parse_settings(const jp *p, const cJSON *j, const char *path, atmos_renderer_kind r, atmos_scene *s)
@@ -1084,9 +1096,10 @@ static atmos_status parse_settings(const jp *p, const cJSON *j, const char *path
     const cJSON *v;
     int k;
     TRY(iter_begin(p, j, path, keys, n < 32 ? n : 32, &it));
+    int do_false = 0; /* the slice's "do": false */
     for (;;) {
         TRY(iter_next(p, &it, &k, &v, ip));
-        if (k < 0) return ATMOS_OK;
+        if (k < 0) return do_false ? old_do_false(t, n, it.seen, s) : ATMOS_OK;
         const atmos_setting *st = &t[k];
         const atmos__range range = {st->min, st->max, st->min_open, st->max_open};
         double value = 0;
@@ -1104,6 +1117,7 @@ static atmos_status parse_settings(const jp *p, const cJSON *j, const char *path
         case ATMOS_SETTING_SEED: TRY(get_u64(p, v, ip, &range, &u)); value = (double)u; break;
         }
         atmos_scene_setting_set(s, st, value);
+        do_false |= r == ATMOS_RENDERER_SLICE && st->offset == offsetof(atmos_scene, slice.do_field) && value == 0;
     }
 }
 

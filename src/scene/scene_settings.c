@@ -51,7 +51,7 @@ static const atmos_setting slice_settings[] = {
      SLICE(diffuse)},
     {"do", "slice-do", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
      "the same as field do, the default (its cells nishita.mc_cell render voxels: the one nishita setting it "
-     "takes)",
+     "takes); false in a file without field: p1, what it meant before 2026-12-06",
      SLICE(do_field)},
     {"air_shadows", "no-air-shadows", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
      "the volume's shadow on the air's single scattering (light shafts, crepuscular rays); "
@@ -198,6 +198,11 @@ const char *atmos_renderer_name(atmos_renderer_kind renderer)
 {
     static const char *const names[] = {"sky", "slice", "path", "nishita", "harris", "beams"};
     return renderer >= ATMOS_RENDERER_SKY && renderer <= ATMOS_RENDERER_LAST ? names[renderer] : NULL;
+}
+
+const char *atmos_slice_field_name(atmos_slice_field field)
+{
+    return field >= ATMOS_SLICE_FIELD_AUTO && field <= ATMOS_SLICE_FIELD_NONE ? field_names[field] : NULL;
 }
 
 double atmos_scene_setting_get(const atmos_scene *s, const atmos_setting *st)

@@ -1,14 +1,16 @@
 /* The slice renderer's field of the light scattered more than once ("field", scene.h
  * atmos_slice_field): which one a scene's settings select, and the settings that contradict
- * the one chosen. The old keys stay: "do": true is field do, "diffuse": false is field none;
- * with field auto (the default) a setting of Riley's path (xi, update, low_albedo) selects
- * that path, so a scene file written before do was the default renders as it did. */
+ * the one chosen. The old keys stay: "do": true is field do, "diffuse": false is field none
+ * (a file's "do": false without "field" is field p1: scene_json.c); with field auto (the
+ * default) a setting of Riley's path (xi, update, low_albedo) selects that path. So a scene file
+ * written before do was the default renders as it did when it set one of these; one that set
+ * none of them renders with the do field. */
 #include "scene/scene_internal.h"
 
 #include <stdio.h>
 #include <string.h>
 
-static const char *const field_name[] = {"auto", "do", "p1", "none"};
+/* indexed by atmos_slice_field; the names: atmos_slice_field_name (the settings table's) */
 static const char *const field_flag[] = {"", "--slice-do", "--slice-p1", "--no-diffuse"};
 
 /* xi's default (the settings table's). */
@@ -66,7 +68,8 @@ atmos_status atmos__slice_field_check(atmos_context *ctx, const char *source, co
     const int f = ss->field;
     if (ss->do_field && (f == ATMOS_SLICE_FIELD_P1 || f == ATMOS_SLICE_FIELD_NONE))
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/slice/do",
-                                 "(--slice-do) contradicts \"field\": \"%s\" (%s): leave one out", field_name[f],
+                                 "(--slice-do) contradicts \"field\": \"%s\" (%s): leave one out",
+                                 atmos_slice_field_name((atmos_slice_field)f),
                                  field_flag[f]);
     if (!ss->diffuse && f == ATMOS_SLICE_FIELD_P1)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/slice/diffuse",

@@ -10,6 +10,10 @@ set -u
 "$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --pfm "$T/cloud1.pfm" --threads 1 \
     && ok || bad "slice render, 1 thread"
 cmp -s "$T/cloud.pfm" "$T/cloud1.pfm" && ok || bad "1 and 2 threads differ"
+# more threads than the do field solves wavelengths in parallel (64 at most): the same bytes
+"$A" render -q --width 16 --height 9 --volume generate:cumulus --pfm "$T/t65.pfm" --threads 65 &&
+    "$A" render -q --width 16 --height 9 --volume generate:cumulus --pfm "$T/t1.pfm" --threads 1 &&
+    cmp -s "$T/t65.pfm" "$T/t1.pfm" && ok "65 threads" || bad "65 threads: failed or not 1 thread's bytes"
 python3 - "$T/sky.pfm" "$T/cloud.pfm" <<'PY' && ok || bad "cloud image check"
 import sys, pfm
 def rgb(p):

@@ -131,7 +131,12 @@ static void check_slice_field(atmos_context *ctx)
         {"\"field\": \"auto\"", ATMOS_SLICE_FIELD_DO, NULL},
         {"\"diffuse\": true", ATMOS_SLICE_FIELD_DO, NULL},
         {"\"do\": true", ATMOS_SLICE_FIELD_DO, NULL},
-        {"\"do\": false", ATMOS_SLICE_FIELD_DO, NULL},
+        /* a file's "do": false without "field": the P1 field, its meaning before the do field was the default */
+        {"\"do\": false", ATMOS_SLICE_FIELD_P1, NULL},
+        {"\"do\": false, \"diffuse\": false", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"low_albedo\": true, \"do\": false", ATMOS_SLICE_FIELD_NONE, NULL},
+        {"\"do\": false, \"field\": \"auto\"", ATMOS_SLICE_FIELD_DO, NULL},
+        {"\"do\": false, \"field\": \"do\"", ATMOS_SLICE_FIELD_DO, NULL},
         {"\"field\": \"p1\"", ATMOS_SLICE_FIELD_P1, NULL},
         {"\"field\": \"none\"", ATMOS_SLICE_FIELD_NONE, NULL},
         {"\"field\": \"none\", \"diffuse\": false", ATMOS_SLICE_FIELD_NONE, NULL},
@@ -188,6 +193,15 @@ int main(void)
     }
     printf("%d settings checked\n", total);
     CHECK(atmos_renderer_name((atmos_renderer_kind)9) == NULL);
+    /* the field's names: the "field" row's choices */
+    int ns = 0;
+    const atmos_setting *sl = atmos_renderer_settings(ATMOS_RENDERER_SLICE, &ns);
+    for (int i = 0; i < ns; i++)
+        if (!strcmp(sl[i].key, "field"))
+            for (int f = 0; f <= ATMOS_SLICE_FIELD_NONE + 1; f++) {
+                const char *name = atmos_slice_field_name((atmos_slice_field)f);
+                CHECK(f > ATMOS_SLICE_FIELD_NONE ? !name && !sl[i].choices[f] : name && !strcmp(name, sl[i].choices[f]));
+            }
     check_help();
     check_slice_field(ctx);
     atmos_context_destroy(ctx);

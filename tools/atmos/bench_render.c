@@ -137,7 +137,7 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
     print_slice(name, size, atmos_context_threads(ctx), fps, cpu, &stats[MOVE_SUN], &first.slice, prepare,
-                (const char *[]){"auto", "do", "p1", "none"}[atmos_scene_slice_field(&scene.slice)], air_shadows, json);
+                atmos_slice_field_name(atmos_scene_slice_field(&scene.slice)), air_shadows, json);
     return CLI_EXIT_OK;
 }
 
