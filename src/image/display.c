@@ -117,7 +117,8 @@ static void bytes_row(const float *d, int width, unsigned char *out)
  * display values in buf + 4 DISPLAY_CHUNK, then to disp (floats) and rgba8 (bytes) where not NULL.
  * Returns the count of the chunk's values that are NaN or infinite. */
 static unsigned display_chunk(const float *src, int width, int C, int n, int has_alpha, const float (*w)[3],
-                              atmos_tone_curve curve, float scale, float *buf, float *disp, unsigned char *rgba8)
+                              atmos_tone_curve curve, float scale, const uint32_t *bytes_lut, float *buf, float *disp,
+                              unsigned char *rgba8)
 {
     float *out = buf + (size_t)4 * DISPLAY_CHUNK;
     unsigned b;
@@ -126,6 +127,10 @@ static unsigned display_chunk(const float *src, int width, int C, int n, int has
     else
 #endif
         b = linear_row(src, width, C, n, has_alpha, w, buf);
+    if (!disp && bytes_lut) { /* the bytes alone: from the curve's table over the scaled value */
+        atmos__tonemap_bytes_row(curve, bytes_lut, buf, rgba8, (size_t)width, scale);
+        return b;
+    }
     atmos__tonemap_row(curve, buf, out, (size_t)width, 4, scale);
     if (disp) stream_row(out, disp, width);
     if (rgba8) bytes_row(out, width, rgba8);
@@ -155,6 +160,7 @@ static atmos_status display_pass(atmos_context *ctx, const atmos_image *spectral
         for (int c = 0; c < 3; c++) w[i][c] = (float)wl->to_srgb[i][c];
     const float scale = (float)atmos_tonemap_scale(NULL, desc);
     const int has_alpha = C == n + 1;
+    const uint32_t *bytes_lut = disp ? NULL : atmos__tonemap_byte_table(curve);
     int nomem = 0;
     size_t bad = 0;
     long long first = LLONG_MAX;
@@ -172,7 +178,7 @@ static atmos_status display_pass(atmos_context *ctx, const atmos_image *spectral
             unsigned b = 0;
             for (int x0 = 0; x0 < W; x0 += DISPLAY_CHUNK)
                 b += display_chunk(row + (size_t)x0 * C, W - x0 < DISPLAY_CHUNK ? W - x0 : DISPLAY_CHUNK, C, n, has_alpha,
-                                   (const float(*)[3])w, curve, scale, buf,
+                                   (const float(*)[3])w, curve, scale, bytes_lut, buf,
                                    disp ? disp->pixels + ((size_t)y * W + x0) * 4 : NULL,
                                    rgba8 ? rgba8 + ((size_t)y * W + x0) * 4 : NULL);
             if (b && check) {

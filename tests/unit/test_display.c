@@ -3,7 +3,8 @@
  * atmos_image_gamut_map, atmos_tonemap_into): the same display values to the bit, for RGB and
  * spectral images with out-of-gamut colours, negatives, NaN, infinities and the sun's
  * radiance, on one thread and on three; its 8-bit RGBA equal to what atmos_write_png writes of
- * those values (read back with atmos_read_png); atmos_image_display_checked refusing a frame with
+ * those values (read back with atmos_read_png), the bytes alone (from the curve's table) equal to
+ * them over every 5th float of the table's range; atmos_image_display_checked refusing a frame with
  * a NaN or an infinity, naming the first. */
 #include "test.h"
 
@@ -111,6 +112,41 @@ static void check_refusal(atmos_context *ctx, const atmos_wavelengths *wl, int W
     atmos_image_destroy(img), atmos_image_destroy(a), atmos_image_destroy(b);
 }
 
+/* The bytes alone (atmos_image_display_into without display values: the curve's table over the
+ * scaled value, tonemap_bytes.c) against the bytes made with the display values (the curve and
+ * the sRGB table, then rounded): every 5th float from 2^-17 to 2^11 through each curve, the same
+ * bytes. */
+static void check_dense_bytes(atmos_context *ctx, const atmos_wavelengths *rgb, atmos_tone_curve curve)
+{
+    enum { W = 1024, H = 512 };
+    atmos_image *img = NULL, *disp = NULL;
+    CHECK_OK(atmos_image_create(NULL, W, H, 4, &img));
+    CHECK_OK(atmos_image_create(NULL, W, H, 4, &disp));
+    unsigned char *a = malloc((size_t)W * H * 4), *b = malloc((size_t)W * H * 4);
+    if (!img || !disp || !a || !b) return;
+    const atmos_tonemap_desc td = {1, 0.0, curve};
+    const uint32_t first = (127u - 17u) << 23, last = (127u + 11u) << 23;
+    size_t bad = 0, seen = 0;
+    for (uint32_t u = first; u < last;) {
+        for (size_t i = 0; i < (size_t)W * H * 4; i++) {
+            if (i % 4 == 3) {
+                img->pixels[i] = 1.0f;
+                continue;
+            }
+            memcpy(&img->pixels[i], &u, sizeof u);
+            u = u < last ? u + 5 : u;
+        }
+        CHECK_OK(atmos_image_display_into(ctx, img, rgb, &td, disp, a));
+        CHECK_OK(atmos_image_display_into(ctx, img, rgb, &td, NULL, b));
+        for (size_t i = 0; i < (size_t)W * H * 4; i++) bad += a[i] != b[i];
+        seen += (size_t)W * H * 3;
+    }
+    CHECK_MSG(bad == 0, "curve %d: %zu of %zu bytes from the table differ from the display values' bytes", (int)curve, bad,
+              seen);
+    free(a), free(b);
+    atmos_image_destroy(img), atmos_image_destroy(disp);
+}
+
 int main(void)
 {
     atmos_context *one = NULL, *three = NULL;
@@ -133,6 +169,7 @@ int main(void)
     check(one, &spec, 53, 29, ATMOS_TONE_FILMIC, 12.0);
     check(one, &three_bands, 97, 31, ATMOS_TONE_FILMIC, 9.0);
     check(three, &three_bands, 61, 23, ATMOS_TONE_CLAMP, 2.0);
+    for (int c = 0; c < 3; c++) check_dense_bytes(three, &rgb, (atmos_tone_curve)c);
     check_refusal(one, &rgb, 37, 9);
     check_refusal(three, &rgb, 37, 9);
     check_refusal(three, &spec, 21, 7);

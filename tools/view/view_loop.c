@@ -145,28 +145,42 @@ static atmos_status display(loop *L, const atmos_plan *p, view_state *s, int sna
     return st;
 }
 
-/* A frame's display values in one pass (atmos_image_display_checked: the same values as display's
- * steps, a NaN or an infinity in the frame refused in the same pass, the plan not checking it:
- * atmos_frame.no_check): L->disp when recording, L->rgba for the window, and for a headless run
- * that records nothing (the window's work, not float values nothing reads). */
-static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, int snap, int floats, int bytes)
+/* A frame's 8-bit display values in one pass (atmos_image_display_checked: the bytes of the
+ * values display's steps give, from the curve's table over the scaled value; a NaN or an
+ * infinity in the frame refused in the same pass, the plan not checking it: atmos_frame.no_check),
+ * L->rgba: the window's, and a headless run's whether it records or not (the window's work). */
+static atmos_status display_frame(loop *L, const atmos_plan *p, view_state *s, int snap)
 {
     const int W = L->img->width, H = L->img->height;
-    atmos_status st = ATMOS_OK;
-    if (floats && (!L->disp || L->disp->width != W || L->disp->height != H)) {
-        atmos_image_destroy(L->disp), L->disp = NULL;
-        st = atmos_image_create(L->ctx, W, H, 4, &L->disp);
-    }
-    if (bytes && st == ATMOS_OK && (size_t)W * H * 4 > L->rgba_cap) {
+    if ((size_t)W * H * 4 > L->rgba_cap) {
         free(L->rgba), L->rgba_cap = 0;
         if (!(L->rgba = malloc((size_t)W * H * 4))) return ATMOS_E_NOMEM;
         L->rgba_cap = (size_t)W * H * 4;
     }
-    if (st != ATMOS_OK) return st;
     const atmos_tonemap_desc td = frame_tonemap(L, p, s, snap);
-    st = atmos_image_display_checked(L->ctx, L->img, atmos_plan_wavelengths(p), &td, floats ? L->disp : NULL,
-                                     bytes ? L->rgba : NULL);
-    return st;
+    return atmos_image_display_checked(L->ctx, L->img, atmos_plan_wavelengths(p), &td, NULL, L->rgba);
+}
+
+/* A recorded frame's display values (L->disp, for its PNG) from its bytes, after the frame's
+ * time is taken: b / 255 (the PNG's rounding gives b back), alpha the frame's clamped to [0, 1]
+ * as the display pass takes it (1 for a frame without alpha): the PNG the display values made
+ * in the frame gave. */
+static atmos_status record_values(loop *L, const atmos_plan *p)
+{
+    const int W = L->img->width, H = L->img->height, C = L->img->channels;
+    const int alpha = C == atmos_plan_wavelengths(p)->count + 1;
+    if (!L->disp || L->disp->width != W || L->disp->height != H) {
+        atmos_image_destroy(L->disp), L->disp = NULL;
+        const atmos_status st = atmos_image_create(L->ctx, W, H, 4, &L->disp);
+        if (st != ATMOS_OK) return st;
+    }
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        float *d = L->disp->pixels + 4 * i;
+        const float a = alpha ? L->img->pixels[i * C + C - 1] : 1.0f;
+        for (int c = 0; c < 3; c++) d[c] = (float)L->rgba[4 * i + c] / 255.0f;
+        d[3] = a > 0 ? (a < 1 ? a : 1.0f) : 0.0f;
+    }
+    return ATMOS_OK;
 }
 
 /* The viewer's frames take the sky behind the volume every VIEW_SKY_STEP pixels and read it
@@ -370,7 +384,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
         atmos_plan *p = NULL;
         const view_quality q = scripted && !o->preview ? VIEW_SCRIPTED : moving ? VIEW_PREVIEW : VIEW_STILL;
         atmos_status st = render(&L, &s, q, &p);
-        if (st == ATMOS_OK) st = display_frame(&L, p, &s, i == 0 || scripted, o->record != NULL, win != NULL || !o->record);
+        if (st == ATMOS_OK) st = display_frame(&L, p, &s, i == 0 || scripted);
         if (st != ATMOS_OK) {
             rc = cli_runtime_error("view", ctx, st);
             break;
@@ -380,6 +394,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
         overlay(&s, last_ms, lines);
         if (win && view_window_present(win, L.rgba, L.img->width, L.img->height, s.overlay ? lp : NULL, 4) != 0) rc = CLI_EXIT_RUNTIME;
         last_ms = 1000.0 * (cli_now_s() - t0);
+        if (rc == CLI_EXIT_OK && o->record && (st = record_values(&L, p)) != ATMOS_OK) rc = cli_runtime_error("view", ctx, st);
         if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates,
                                                       L.impostors_coarse, q == VIEW_PREVIEW,
                                                       cli_lit_without_sun(sc, s.renderer), &s);
