@@ -73,7 +73,6 @@ static void do_kappa(atmos__slice_plan *sp)
     sp->do_share = a > 0 ? (float)(1 - b / a) : 0.0f;
 }
 
-
 /* Row r (0: the first order) of tab's Ams for field f, wavelength w at theta (degrees). */
 static double ams_at(const stables *t, int f, int w, int n, int r, double theta)
 {
@@ -88,7 +87,7 @@ static double ams_at(const stables *t, int f, int w, int n, int r, double theta)
 /* The smooth phase's half-width for field f, wavelength w: the median angle of the light in the
  * forward peak that delta-M counts as not scattered (the share 1 - sigma_s* / sigma_s of the
  * scattering), where the phase table's integral from 0 reaches half that share; 0.05-20 degrees.
- * About 1-3 degrees for cloud droplets (their diffraction peak), hundredths for raindrops. */
+ * About 1 degree for cloud droplets (their diffraction peak), 0.05 (the floor) for raindrops. */
 static double blur_deg(const atmos__slice_plan *sp, int f, int w)
 {
     const stables *t = &sp->tab;
@@ -113,9 +112,8 @@ static double blur_deg(const atmos__slice_plan *sp, int f, int w)
  * smooth phase, the first order averaged over theta +- blur_deg (reflected at 0 and 180 degrees):
  * the light that the particles' forward peak turns before or after its scattering toward the eye
  * sees the phase smeared by about that much (the cloud droplets' glory rings gone, the raindrops'
- * bows kept). The eye pass blends the two
- * rows by the share of the first order's light that the delta-M peak has turned on its way to
- * the eye (sjob.sharp_eye). */
+ * bows kept). The eye pass blends the two rows by the share of the first order's light that the
+ * delta-M peak has turned (sjob.sharp_eye). */
 static int do_ams(atmos__slice_plan *sp)
 {
     const stables *t = &sp->tab;
@@ -138,7 +136,7 @@ static int do_ams(atmos__slice_plan *sp)
                 }
                 a0[((size_t)a * no + 1) * n + w] = (float)(sum / (K + 1));
             }
-            }
+        }
         sp->tab_dm.ams[f] = a0, a0 += sz;
     }
     return 1;
