@@ -17,6 +17,18 @@
  * the multiple scattering it stood for). The same sum as the Nishita renderer's with "do"
  * (nishita_render.c), on the slice renderer's grid, slices and light buffer.
  *
+ * The first order split in a sharp and a smooth part (since 2026-12-06; docs/lightfield.md, "The
+ * phenomena"): the delta-M direct beam E exp(-tau*) holds light that the particles' forward peak
+ * has turned (for cloud droplets by a degree or more), and so does the light leaving a scattering
+ * toward the eye seen through sigma_t*; drawn with the full phase table, both put the glory's
+ * rings on it, twice as strong as the path tracer's. So front to back (the sun behind the eye:
+ * the glory, the bows) the eye pass draws the share w = exp(-(tau - tau*)) of the sun's side times
+ * the same of the eye's side with the full table and the rest, 1 - w, with the smooth phase (the
+ * table averaged over +- the forward peak's median angle, do_ams' order-2 rows, blended as the
+ * orders are): w = exp(-share n) T_eye^(kap - 1), n the light buffer's scattering depth from the
+ * sun (sjob.sharp_eye). Back to front (the sun ahead: the halos) T_eye is not known ahead of a
+ * sample and the first order stays the full table's.
+ *
  * The sky's and the ground's light enter the field's sweeps through the grid's faces (nishita_do.c,
  * from the atmosphere interface as the P1 field's boundary, sky_inflow.c): the field then holds
  * their scattered light of every order (the first included: the eye pass's first order is the
@@ -37,6 +49,98 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
+
+/* sigma_t / sigma_t* per wavelength, the fields weighted by their share of the grid's extinction
+ * (sigma_t* times the density summed over the grid), and delta-M's share of the scattering counted
+ * as not scattered, 1 - sigma_s* / sigma_s (the middle wavelength's, weighted by sigma_s): the eye
+ * pass's sharp first order (sjob.sharp_eye). */
+static void do_kappa(atmos__slice_plan *sp)
+{
+    const sgrid *g = &sp->g;
+    const size_t cells = (size_t)g->c[0] * g->c[1] * g->c[2];
+    double dsum[ATMOS_VOLUME_MAX_FIELDS] = {0};
+    for (size_t v = 0; v < cells; v++)
+        for (int f = 0; f < sp->nf; f++) dsum[f] += g->v[v * sp->nf + f];
+    for (int w = 0; w < sp->n; w++) {
+        double a = 0, b = 0;
+        for (int f = 0; f < sp->nf; f++) a += dsum[f] * sp->tab.sig[f][w], b += dsum[f] * sp->tab_dm.sig[f][w];
+        sp->do_kap[w] = b > 0 ? (float)(a / b) : 1.0f;
+    }
+    const int w = sp->n / 2;
+    double a = 0, b = 0;
+    for (int f = 0; f < sp->nf; f++) a += dsum[f] * sp->tab.sca[f][w], b += dsum[f] * sp->dop->mc_sca[f][w];
+    sp->do_share = a > 0 ? (float)(1 - b / a) : 0.0f;
+}
+
+/* Row r (0: the first order) of tab's Ams for field f, wavelength w at theta (degrees). */
+static double ams_at(const stables *t, int f, int w, int n, int r, double theta)
+{
+    int a = 0;
+    float wt;
+    atmos__angle_locate(t->grid[f], t->ng[f], theta, &a, &wt);
+    const float *A = t->ams[f];
+    const size_t i0 = ((size_t)a * t->no + r) * n + w, i1 = i0 + (size_t)t->no * n;
+    return A[i0] + wt * (A[i1] - A[i0]);
+}
+
+/* The smooth phase's half-width for field f, wavelength w: the median angle of the light in the
+ * forward peak that delta-M counts as not scattered (the share 1 - sigma_s* / sigma_s of the
+ * scattering), where the phase table's integral from 0 reaches half that share; 0.05-20 degrees.
+ * About 1 degree for cloud droplets (their diffraction peak), 0.05 (the floor) for raindrops. */
+static double blur_deg(const atmos__slice_plan *sp, int f, int w)
+{
+    const stables *t = &sp->tab;
+    const double sh = t->sca[f][w] > 0 ? 1 - sp->dop->mc_sca[f][w] / t->sca[f][w] : 0;
+    const int n = sp->n, no = t->no;
+    const double *g = t->grid[f];
+    double cum = 0, th = g[t->ng[f] - 1];
+    for (int a = 0; a + 1 < t->ng[f]; a++) {
+        const double p0 = t->ams[f][(size_t)a * no * n + w], p1 = t->ams[f][(size_t)(a + 1) * no * n + w];
+        const double c0 = cos(g[a] * ATMOS_DEG2RAD), c1 = cos(g[a + 1] * ATMOS_DEG2RAD);
+        const double d = 2 * ATMOS_PI * 0.5 * (p0 + p1) * (c0 - c1);
+        if (cum + d >= 0.5 * sh) {
+            th = g[a] + (g[a + 1] - g[a]) * (d > 0 ? (0.5 * sh - cum) / d : 0);
+            break;
+        }
+        cum += d;
+    }
+    return th < 0.05 ? 0.05 : th > 20 ? 20 : th;
+}
+
+/* tab_dm's Ams tables: tab's first order (the full phase table, sharp) and in the order-2 rows the
+ * smooth phase, the first order averaged over theta +- blur_deg (reflected at 0 and 180 degrees):
+ * the light that the particles' forward peak turns before or after its scattering toward the eye
+ * sees the phase smeared by about that much (the cloud droplets' glory rings gone, the raindrops'
+ * bows kept). The eye pass blends the two rows by the share of the first order's light that the
+ * delta-M peak has turned (sjob.sharp_eye). */
+static int do_ams(atmos__slice_plan *sp)
+{
+    const stables *t = &sp->tab;
+    const int n = sp->n, no = t->no, K = 40;
+    size_t tot = 0;
+    for (int f = 0; f < sp->nf; f++) tot += (size_t)n * t->ng[f] * no + 4;
+    if (!(sp->do_ams = malloc(tot * sizeof(float)))) return 0;
+    float *a0 = sp->do_ams;
+    for (int f = 0; f < sp->nf; f++) {
+        const size_t sz = (size_t)n * t->ng[f] * no + 4;
+        memcpy(a0, t->ams[f], sz * sizeof(float));
+        for (int w = 0; w < n; w++) {
+            const double W = blur_deg(sp, f, w);
+            for (int a = 0; a < t->ng[f]; a++) {
+                double sum = 0;
+                for (int i = 0; i <= K; i++) {
+                    double th = t->grid[f][a] + W * (2.0 * i / K - 1);
+                    th = th < 0 ? -th : th > 180 ? 360 - th : th;
+                    sum += ams_at(t, f, w, n, 0, th);
+                }
+                a0[((size_t)a * no + 1) * n + w] = (float)(sum / (K + 1));
+            }
+        }
+        sp->tab_dm.ams[f] = a0, a0 += sz;
+    }
+    return 1;
+}
 
 atmos_status atmos__slice_do_prepare(atmos_plan *p, atmos__slice_plan *sp)
 {
@@ -47,6 +151,8 @@ atmos_status atmos__slice_do_prepare(atmos_plan *p, atmos__slice_plan *sp)
     sp->tab_dm = sp->tab;
     for (int f = 0; f < sp->nf; f++)
         for (int w = 0; w < sp->n; w++) sp->tab_dm.sig[f][w] = np->mc_sig_ms[f][w];
+    do_kappa(sp);
+    if (!do_ams(sp)) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render slice: out of memory for the do field");
     const atmos__lfield *F = atmos__nishita_mc_field(np);
     const int vq = sp->n == 3 ? 4 : sp->n;
     sp->do_view = calloc((size_t)F->c[0] * F->c[1] * F->c[2] * sp->nf * vq, sizeof(float));
@@ -57,8 +163,8 @@ atmos_status atmos__slice_do_prepare(atmos_plan *p, atmos__slice_plan *sp)
 void atmos__slice_do_free(atmos__slice_plan *sp)
 {
     atmos__nishita_plan_destroy(sp->dop);
-    free(sp->do_view);
-    sp->dop = NULL, sp->do_view = NULL;
+    free(sp->do_view), free(sp->do_ams);
+    sp->dop = NULL, sp->do_view = NULL, sp->do_ams = NULL;
 }
 
 /* The field solved for the frame's sun (when it moved: tm->field) and its view. */
@@ -101,6 +207,10 @@ atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const 
     atmos__nishita_plan *np = sp->dop;
     j->field = atmos__nishita_mc_field(np), j->fview = sp->do_view, j->fvq = sp->n == 3 ? 4 : sp->n;
     j->fsca = np->mc_sca[0], j->fg = NULL;
+    /* the first order's sharp share: T_eye is known ahead of a sample only front to back (the sun
+       behind the eye: the glory, the bows) */
+    j->sharp_eye = !j->btf;
+    memcpy(j->kap, sp->do_kap, sizeof j->kap), j->share = sp->do_share;
     return ATMOS_OK;
 }
 

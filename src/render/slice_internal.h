@@ -38,6 +38,12 @@ typedef struct {
     double hl;                   /* h . lt */
     const sgrid *g;
     const stables *t;
+    /* with the do field, front to back (slice_do.c): the share of the first order's light that is
+     * sharp, T_eye^(kap - 1) exp(-share n) (kap = sigma_t / sigma_t*, share = 1 - sigma_s* / sigma_s,
+     * n the light's scattering depth from the sun), drawn with the full phase table, the rest with
+     * the smooth phase (tab_dm's Ams order-2 rows, blended by the order weight) */
+    int sharp_eye;
+    float kap[ATMOS_MAX_WAVELENGTHS], share;
     const atmos__lfield *field;  /* the diffuse light field (or the do field's cells, slice_do.c), or NULL */
     const float *fview;          /* the field toward the frame's eye as the fast eye pass reads it:
                                     [(cell * nf + f) * fvq + c] (atmos__dfield_view) */
@@ -146,6 +152,8 @@ struct atmos__slice_plan {
     atmos__nishita_plan *dop;
     stables tab_dm;          /* tab, its sig[][] sigma_t* (the pointers tab's: not freed) */
     float *do_view;
+    float *do_ams;           /* tab_dm's Ams: tab's, the order-2 rows the smooth phase (slice_do.c) */
+    float do_kap[ATMOS_MAX_WAVELENGTHS], do_share; /* sjob's kap and share (slice_do.c) */
     double do_sun[3];
     int do_valid;
     /* The volume's shadow on the air ("air_shadows"; slice_shadow.c): the map, kept per sun

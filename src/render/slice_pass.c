@@ -277,6 +277,12 @@ SLICE_INLINE void eye_orders(const sjob *j, size_t p0, echunk *e)
         e->oi[q] = o;
         e->fo[q] = mm - 1.0f - (float)o;
     }
+    if (j->sharp_eye) { /* the do field: its first order's smooth share (slice_do.c) */
+        const int c = j->n / 2;
+        const float km = j->kap[c] - 1.0f, sh = j->share, *restrict T0 = j->T_eye + c * j->pst + p0;
+        for (int q = 0; q < e->mv; q++)
+            e->fo[q] = 1.0f - atmos__expf_poly(km * log_pos(T0[lane(e, q)]) - sh * e->nsc[q]);
+    }
     for (int f = 0; f < nf; f++) {
         if (!e->live[f]) continue;
         const int32_t *restrict pa = j->pa + p0 * nf + f;

@@ -67,7 +67,11 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
         const float mm = m < 1.0f ? 1.0f : (m > (float)no ? (float)no : m);
         int oi = (int)(mm - 1.0f);
         if (oi > no - 2) oi = no - 2;
-        const float fo = mm - 1.0f - (float)oi;
+        float fo = mm - 1.0f - (float)oi;
+        if (j->sharp_eye) { /* the do field: its first order's smooth share (slice_do.c) */
+            const float Tg = j->T_eye[(size_t)(n / 2) * j->pst + p];
+            fo = 1.0f - expf((j->kap[n / 2] - 1.0f) * logf(Tg > 1e-30f ? Tg : 1e-30f) - j->share * nsc);
+        }
         float fv[ATMOS_VOLUME_MAX_FIELDS * ATMOS_MAX_WAVELENGTHS];
         if (j->field) field_toward_eye(j, u, v, w, fv);
         for (int c = 0; c < n; c++) {
