@@ -34,7 +34,7 @@ static _Atomic int byte_lut_state[3]; /* 0 not made, 1 made, 2 not usable (the p
 #define BYTE_WINDOW 256 /* floats checked at each end of an interval and about its step */
 static void bytes_at(atmos_tone_curve curve, uint32_t bits, int n, int *out)
 {
-    float x[2 * BYTE_WINDOW], v[2 * BYTE_WINDOW];
+    float x[2 * BYTE_WINDOW] = {0}, v[2 * BYTE_WINDOW];
     for (int i = 0; i < n; i++) {
         const uint32_t u = bits + (uint32_t)i;
         memcpy(&x[i], &u, sizeof x[i]);
