@@ -2,7 +2,7 @@
 import json
 import os
 
-from atmos._core import check, context, ffi, json_value, lib
+from atmos._core import AtmosError, check, context, ffi, json_value, lib
 
 # Keyword arguments with a name of their own (as the CLI's options); any other keyword is a
 # path into the scene with "__" between keys: camera__fov_deg=35 is -D camera.fov_deg=35.
@@ -28,6 +28,18 @@ def _override(key: str, value) -> str:
     return f"{path}={_dumps(path, value)}"
 
 
+def _as_keywords(e: AtmosError, said: dict) -> AtmosError:
+    """e with a keyword argument named as the caller wrote it: the library blames a mistake at a
+    key an override set on the CLI's spelling, "-D image.width=-1 (on default): ..."."""
+    msg = e.message
+    for ov, kw in said.items():
+        prefix = f"-D {ov} (on "
+        if msg.startswith(prefix):
+            msg = f"keyword argument {kw} (on " + msg[len(prefix):]
+            break
+    return type(e)(e.status, msg)
+
+
 class Scene:
     """A scene as atmos reads it: a JSON document (docs/scene-format.md) from a file, a dict
     or the built-in default, plus overrides. It is parsed and validated by the library, so
@@ -37,11 +49,12 @@ class Scene:
     >>> s2 = s.with_(width=320, height=200, camera__fov_deg=35)
     """
 
-    def __init__(self, text: str = "{}", path: str | None = None, overrides=(), source: str = "scene"):
+    def __init__(self, text: str = "{}", path: str | None = None, overrides=(), source: str = "scene", said=None):
         self._text = text
         self._path = path
         self._overrides = tuple(overrides)
         self._source = source
+        self._said = dict(said or {})  # override -> the keyword argument that made it, for messages
         self._struct()  # validate now: errors belong to the line that made the scene
 
     @classmethod
@@ -71,7 +84,8 @@ class Scene:
         sun_azimuth_deg, samples_per_pixel by name; any other key as a path with "__"
         between its parts (camera__position_m=[0, 900, 0])."""
         extra = tuple(_override(k, v) for k, v in kw.items())
-        return Scene(self._text, self._path, self._overrides + extra, self._source)
+        said = {**self._said, **{o: f"{k}={v!r}" for o, (k, v) in zip(extra, kw.items())}}
+        return Scene(self._text, self._path, self._overrides + extra, self._source, said)
 
     def _struct(self):
         """The validated C scene (a new atmos_scene each call)."""
@@ -84,7 +98,10 @@ class Scene:
         else:
             raw = self._text.encode()
             st = lib.atmos_scene_parse_with(ctx, raw, len(raw), self._source.encode(), arr, len(keep), out)
-        check(st, ctx, types=True)
+        try:
+            check(st, ctx, types=True)
+        except AtmosError as e:
+            raise _as_keywords(e, self._said) from None
         return out
 
     @property

@@ -8,6 +8,7 @@
 #include "core/vec.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,13 +24,16 @@ static void sph_destroy(void *model)
     free(m);
 }
 
+/* The key sums the air's description: the planet's members before its geographic frame. The
+ * frame, the ground's maps and the cloud spheres (pointers: other addresses every run) do not
+ * enter the tables, and summing them made every run of an Earth scene build them again. */
 static void cache_key(const atmos__planet *pl, const atmos__sph_model *m, char *key, size_t cap)
 {
     snprintf(key, cap,
              "spherical-sky v%d tau %dx%d psi %dx%d esky %d j %dx%dx%dx%d it %d steps %d floats %zu planet %016llx",
              SPH_TABLE_VERSION, ATMOS__SPH_T_R, ATMOS__SPH_T_MU, ATMOS__SPH_M_R, ATMOS__SPH_M_MU, ATMOS__SPH_E_MU,
              ATMOS__SPH_J_R, ATMOS__SPH_J_MUS, ATMOS__SPH_J_G, ATMOS__SPH_J_P, ATMOS__SPH_J_ITER,
-             ATMOS__SPH_STEPS_TABLE, m->block_floats, (unsigned long long)atmos__cache_checksum(pl, sizeof *pl));
+             ATMOS__SPH_STEPS_TABLE, m->block_floats, (unsigned long long)atmos__cache_checksum(pl, offsetof(atmos__planet, geo_east)));
 }
 
 static atmos_status sph_create(atmos_context *ctx, atmos_atmosphere *a)

@@ -81,7 +81,7 @@ static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
     int n = 0;
     if (s->fog.enabled) in_list[n++] = "fog";
     if (s->light_count > 0) in_list[n++] = "lights";
-    if (s->object_count > 0) in_list[n++] = "objects";
+    if (s->object_count > 0 && s->renderer != ATMOS_RENDERER_HARRIS) in_list[n++] = "objects"; /* Harris draws them */
     char list[64];
     join_names(in_list, n, list, sizeof list);
     if (list[0])

@@ -5,7 +5,8 @@
 #  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
 #    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3);
 #  - --volume with a -D naming another volume source: refused, both named, nothing written;
-#  - fog or lights given to the slice renderer: a warning that it does not draw them;
+#  - fog or lights given to the slice renderer: a warning that it does not draw them; objects
+#    too, but not to Harris's renderer, which draws them;
 #  - a beam scene without a sun: the status line names its lights, not an unused sun;
 #  - an all-zero volume: said to be empty, not told to raise --density-scale.
 . "$(dirname "$0")/common.inc"
@@ -66,6 +67,14 @@ has "two volume sources" "give one of them"
 has "fog on the slice renderer" "slice renderer does not draw the scene's fog"
 "$A" render --volume "$T/v.json" --width 8 --height 8 -o "$T/nofog.png" >/dev/null 2>"$T/err"
 grep -q "does not draw" "$T/err" && bad "a warning without fog or lights" || ok "no warning without fog or lights"
+# objects: Harris's renderer draws them (its impostors split at them), the slice renderer does not
+O='objects=[{"mesh":"builtin:sphere","position_m":[0,1500,0],"scale":100}]'
+"$A" render --volume "$T/v.json" -D "$O" --renderer harris --width 8 --height 8 -o "$T/ho.png" >/dev/null 2>"$T/err" ||
+    { bad "harris render with objects"; cat "$T/err" >&2; }
+grep -q "does not draw" "$T/err" && bad "harris is told it does not draw its objects" || ok "no warning: harris draws objects"
+"$A" render --volume "$T/v.json" -D "$O" --width 8 --height 8 -o "$T/so.png" >/dev/null 2>"$T/err" ||
+    { bad "slice render with objects"; cat "$T/err" >&2; }
+has "objects on the slice renderer" "slice renderer does not draw the scene's objects"
 
 # --- a beam scene without a sun says what lights it, not where the unused sun stands
 "$A" render "$S/scenes/searchlights_fog.json" --width 24 --height 16 -o "$T/sl.png" >/dev/null 2>"$T/err" ||

@@ -83,6 +83,22 @@ def test_errors_are_exceptions_with_status_and_message(tmp_path):
         atmos.phase_table("no-such-particle")
 
 
+def test_keyword_mistakes_are_named_as_keywords():
+    """A mistake in a keyword argument is named as the caller wrote it, not as the CLI's -D."""
+    with pytest.raises(atmos.AtmosError) as e:
+        atmos.Scene.default().with_(width=-1)
+    assert e.value.message.startswith("keyword argument width=-1 (on default): /image/width: must be in")
+    with pytest.raises(atmos.AtmosError) as e:
+        atmos.Scene.default().with_(height=9).with_(camera__fov_deg=500)
+    assert e.value.message.startswith("keyword argument camera__fov_deg=500 (on default): /camera/fov_deg:")
+    with pytest.raises(atmos.AtmosTypeError) as e:
+        atmos.Scene.default().with_(renderer=3)
+    assert e.value.message.startswith("keyword argument renderer=3 (on default): /renderer:")
+    with pytest.raises(atmos.AtmosError) as e:
+        atmos.render(atmos.Scene.default(), width=0)
+    assert "keyword argument width=0" in e.value.message and "-D" not in e.value.message
+
+
 def test_volume_round_trip_and_render():
     rng = np.random.default_rng(7)
     a = (rng.random((6, 5, 4)) * 2e8).astype(np.float32)

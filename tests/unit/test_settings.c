@@ -2,7 +2,7 @@
  * setting: the scene's defaults are the rows' defaults, the parser accepts each row's range
  * and refuses beyond it naming the key, the validator says the same of a scene set in code,
  * and atmos render has each row's option (it sets the value the parser would) and lists it
- * in --help. */
+ * in --help; docs/scene-format.md has a row for each. */
 #define _GNU_SOURCE /* memmem */
 #include "atmos/atmos.h"
 #include "test.h"
@@ -118,6 +118,34 @@ static void check_help(void)
     free(text);
 }
 
+/* docs/scene-format.md has a row for every setting, in its renderer's section ("## `harris`"
+ * up to the next "## "): the page says its tables are these. */
+static void check_docs(void)
+{
+    const char *root = getenv("ATMOS_SOURCE_DIR");
+    if (!root || !*root) return;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/docs/scene-format.md", root);
+    size_t n = 0;
+    char *text = (char *)test_slurp(path, &n);
+    CHECK_MSG(text != NULL, "cannot read %s", path);
+    for (int r = ATMOS_RENDERER_SLICE; text && r <= ATMOS_RENDERER_LAST; r++) {
+        char head[64], row[96];
+        snprintf(head, sizeof head, "\n## `%s`", atmos_renderer_name((atmos_renderer_kind)r));
+        const char *sec = memmem(text, n, head, strlen(head));
+        const char *end = sec ? memmem(sec + 1, n - (size_t)(sec + 1 - text), "\n## ", 4) : NULL;
+        const size_t len = sec ? (size_t)((end ? end : text + n) - sec) : 0;
+        CHECK_MSG(sec != NULL, "scene-format.md has no section %s", head + 1);
+        int count;
+        const atmos_setting *t = atmos_renderer_settings((atmos_renderer_kind)r, &count);
+        for (int i = 0; sec && i < count; i++) {
+            snprintf(row, sizeof row, "\n| `%s` |", t[i].key);
+            CHECK_MSG(memmem(sec, len, row, strlen(row)), "scene-format.md's %s table lacks %s", head + 1, t[i].key);
+        }
+    }
+    free(text);
+}
+
 /* The slice renderer's "field": what each scene section selects (atmos_scene_slice_field), and
  * the contradictions the parser refuses naming the key, the flag and the field. */
 static void check_slice_field(atmos_context *ctx)
@@ -203,6 +231,7 @@ int main(void)
                 CHECK(f > ATMOS_SLICE_FIELD_NONE ? !name && !sl[i].choices[f] : name && !strcmp(name, sl[i].choices[f]));
             }
     check_help();
+    check_docs();
     check_slice_field(ctx);
     atmos_context_destroy(ctx);
     return test_summary("test_settings");
