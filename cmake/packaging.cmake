@@ -8,6 +8,12 @@ install(TARGETS atmos_shared atmos_static EXPORT atmosTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(TARGETS atmos RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The modules opened at run time (src/core/module.h), beside the library.
+foreach(_m atmos_openvdb atmos_gdal)
+  if(TARGET ${_m})
+    install(TARGETS ${_m} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  endif()
+endforeach()
 install(DIRECTORY include/atmos DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT atmosTargets NAMESPACE atmos:: DESTINATION ${ATMOS_CMAKE_DIR})
 configure_package_config_file(${CMAKE_SOURCE_DIR}/cmake/atmos-config.cmake.in
@@ -23,14 +29,13 @@ set(ATMOS_PC_LIBS_PRIVATE "-fopenmp -lm")
 if(ATMOS_HAVE_NETCDF)
   string(APPEND ATMOS_PC_REQUIRES_PRIVATE " netcdf")
 endif()
-if(GDAL_FOUND)
-  string(APPEND ATMOS_PC_REQUIRES_PRIVATE " gdal")
+# The OpenVDB and GDAL readers are modules beside the library, opened when a .vdb or a height
+# map file is read (src/core/module.h): a static link needs neither, only dlopen.
+if(CMAKE_DL_LIBS)
+  string(APPEND ATMOS_PC_LIBS_PRIVATE " -l${CMAKE_DL_LIBS}")
 endif()
-if(ATMOS_HAVE_OPENVDB)
-  get_filename_component(_imath ${OPENVDB_IMATH_LIB} NAME_WE)
-  string(REGEX REPLACE "^lib" "" _imath ${_imath})
-  string(APPEND ATMOS_PC_LIBS_PRIVATE " -lopenvdb -ltbb -l${_imath} -lstdc++")
-endif()
+# the C++ runtime of the OBJ reader's shim (src/mesh/mesh_obj.cpp)
+string(APPEND ATMOS_PC_LIBS_PRIVATE " -lstdc++")
 # The prefix is found from the file's own place, so the package can be installed anywhere
 # (cmake --install --prefix, DESTDIR) and moved.
 file(RELATIVE_PATH ATMOS_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)

@@ -21,13 +21,17 @@ typedef struct atmos__heights {
     double *h;
 } atmos__heights;
 
-/* The least stride that keeps 2 (nx - 1)(nz - 1) triangles of a w x h grid within max. */
-int atmos__terrain_stride(long w, long h, long max_triangles); /* mesh_gdal.c */
-
-/* Band 1 of a raster file through GDAL, every stride-th row and column (stride 0: the
- * automatic one), no-data pixels set to the lowest valid value (mesh_gdal.c).
- * ATMOS_E_UNSUPPORTED without GDAL. */
+/* Band 1 of a raster file through GDAL, every stride-th row and column (stride 0: the least
+ * that keeps 2 (nx - 1)(nz - 1) triangles within max_triangles), no-data pixels set to the
+ * lowest valid value (mesh_gdal.c). ATMOS_E_UNSUPPORTED without GDAL or its module. */
 atmos_status atmos__terrain_read(atmos_context *ctx, const char *path, int stride, long max_triangles,
                                  atmos__heights *out);
+
+/* The GDAL module (terrain_gdal.c, libatmos_gdal.so) and its one export: atmos__terrain_read's
+ * work on a file that opens, the message of a failure in msg (cap bytes). */
+#define ATMOS__GDAL_MODULE "libatmos_gdal.so"
+#define ATMOS__GDAL_MODULE_ENTRY "atmos_gdal_module_v1"
+typedef atmos_status (*atmos__gdal_module_entry)(const char *path, int stride, long max_triangles,
+                                                 atmos__heights *out, char *msg, size_t cap);
 
 #endif

@@ -1,4 +1,4 @@
-// The OpenVDB shim: the only C++ in libatmos (see openvdb_shim.h). OpenVDB does the
+// The OpenVDB shim, built as the module libatmos_openvdb.so (see openvdb_shim.h). OpenVDB does the
 // parsing, decompression (zip, blosc) and tree walking; this file only copies what
 // atmos needs into plain C structures. Every entry point catches everything: an
 // exception escaping into C would be undefined behaviour.
@@ -7,7 +7,7 @@
 // libatmos builds with -fvisibility=hidden, but OpenVDB's headers must see
 // default visibility: its registries and type-name singletons live in template
 // statics shared with libopenvdb.so, and hidden copies of them in a PIC object
-// crash openvdb::initialize() (null registry). Our own entry points stay hidden.
+// crash openvdb::initialize() (null registry). Our own entry points stay hidden but one.
 #pragma GCC visibility push(default)
 #include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>
@@ -94,9 +94,11 @@ const char *stats_disagree(const openvdb::GridBase &grid, const atmos__vdb_grid_
 
 } // namespace
 
-extern "C" const char *atmos__vdb_library_version(void) { return OPENVDB_LIBRARY_VERSION_STRING; }
+static const char *shim_library_version(void) { return OPENVDB_LIBRARY_VERSION_STRING; }
 
-extern "C" int atmos__vdb_open(const char *path, atmos__vdb **out, char *msg, size_t cap)
+static void shim_close(atmos__vdb *f);
+
+static int shim_open(const char *path, atmos__vdb **out, char *msg, size_t cap)
 {
     *out = nullptr;
     atmos__vdb *f = nullptr;
@@ -129,12 +131,12 @@ extern "C" int atmos__vdb_open(const char *path, atmos__vdb **out, char *msg, si
         return ATMOS__VDB_OK;
     } catch (...) {
         int rc = from_exception(msg, cap, "OpenVDB");
-        atmos__vdb_close(f);
+        shim_close(f);
         return rc;
     }
 }
 
-extern "C" void atmos__vdb_close(atmos__vdb *f)
+static void shim_close(atmos__vdb *f)
 {
     if (!f) return;
     try {
@@ -149,9 +151,9 @@ extern "C" void atmos__vdb_close(atmos__vdb *f)
     }
 }
 
-extern "C" int atmos__vdb_grid_count(const atmos__vdb *f) { return f ? (int)f->names.size() : 0; }
+static int shim_grid_count(const atmos__vdb *f) { return f ? (int)f->names.size() : 0; }
 
-extern "C" int atmos__vdb_get_grid_info(const atmos__vdb *f, int index, atmos__vdb_grid_info *info)
+static int shim_get_grid_info(const atmos__vdb *f, int index, atmos__vdb_grid_info *info)
 {
     std::memset(info, 0, sizeof *info);
     if (!f || index < 0 || (size_t)index >= f->names.size()) return ATMOS__VDB_E_FORMAT;
@@ -161,7 +163,7 @@ extern "C" int atmos__vdb_get_grid_info(const atmos__vdb *f, int index, atmos__v
     return ATMOS__VDB_OK;
 }
 
-extern "C" int atmos__vdb_load_grid(atmos__vdb *f, int index, atmos__vdb_grid_stats *st, char *msg, size_t cap)
+static int shim_load_grid(atmos__vdb *f, int index, atmos__vdb_grid_stats *st, char *msg, size_t cap)
 {
     std::memset(st, 0, sizeof *st);
     if (!f || index < 0 || (size_t)index >= f->names.size()) {
@@ -227,7 +229,7 @@ extern "C" int atmos__vdb_load_grid(atmos__vdb *f, int index, atmos__vdb_grid_st
     }
 }
 
-extern "C" int atmos__vdb_visit(atmos__vdb *f, int index, atmos__vdb_block_fn fn, void *user, char *msg, size_t cap)
+static int shim_visit(atmos__vdb *f, int index, atmos__vdb_block_fn fn, void *user, char *msg, size_t cap)
 {
     if (!f || index < 0 || (size_t)index >= f->grids.size() || !f->grids[index]) {
         set_msg(msg, cap, "grid not loaded");
@@ -268,4 +270,12 @@ extern "C" int atmos__vdb_visit(atmos__vdb *f, int index, atmos__vdb_block_fn fn
     } catch (...) {
         return from_exception(msg, cap, ("OpenVDB: grid '" + f->names[index] + "'").c_str());
     }
+}
+
+// The module's one export (openvdb_shim.h): the table of the entry points above.
+extern "C" __attribute__((visibility("default"))) const atmos__vdb_api *atmos_openvdb_module_v1(void)
+{
+    static const atmos__vdb_api api = {shim_open, shim_close, shim_grid_count, shim_get_grid_info,
+                                       shim_load_grid, shim_visit, shim_library_version};
+    return &api;
 }

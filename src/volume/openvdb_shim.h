@@ -1,5 +1,5 @@
-/* A thin C interface to the OpenVDB library (src/volume/openvdb_shim.cpp), the only
- * C++ in libatmos. It is compiled only when CMake finds OpenVDB (ATMOS_HAVE_OPENVDB).
+/* A thin C interface to the OpenVDB library (src/volume/openvdb_shim.cpp, built as the module
+ * libatmos_openvdb.so). It is compiled only when CMake finds OpenVDB (ATMOS_HAVE_OPENVDB).
  *
  * Every function catches all C++ exceptions and turns them into a nonzero return
  * code plus a message in msg (cap bytes, always NUL-terminated), so no exception
@@ -57,17 +57,38 @@ typedef struct atmos__vdb_grid_stats {
 typedef int (*atmos__vdb_block_fn)(void *user, const int origin[3], const int size[3], const float *values,
                                    float constant);
 
+/* The shim's entry points. They live in the module libatmos_openvdb.so, opened on the first
+ * use (volume/openvdb_module.c, core/module.h), so that only a program reading a .vdb file
+ * loads OpenVDB and its libraries; the module's one export is ATMOS__VDB_MODULE_ENTRY, a
+ * function returning this table. */
+typedef struct atmos__vdb_api {
+    int (*open)(const char *path, atmos__vdb **out, char *msg, size_t cap);
+    void (*close)(atmos__vdb *f);
+    int (*grid_count)(const atmos__vdb *f);
+    int (*get_grid_info)(const atmos__vdb *f, int index, atmos__vdb_grid_info *info);
+    /* Reads grid `index` (a float grid) from the file and measures it. */
+    int (*load_grid)(atmos__vdb *f, int index, atmos__vdb_grid_stats *stats, char *msg, size_t cap);
+    /* Walks the loaded grid `index`: every leaf as an 8^3 block (inactive voxels 0) and
+     * every active tile as a constant block. */
+    int (*visit)(atmos__vdb *f, int index, atmos__vdb_block_fn fn, void *user, char *msg, size_t cap);
+    /* The library's version string ("10.0.1"), for messages. */
+    const char *(*library_version)(void);
+} atmos__vdb_api;
+
+#define ATMOS__VDB_MODULE "libatmos_openvdb.so"
+#define ATMOS__VDB_MODULE_ENTRY "atmos_openvdb_module_v1"
+typedef const atmos__vdb_api *(*atmos__vdb_module_entry)(void);
+
+/* The library's side (openvdb_module.c). atmos__vdb_module_load opens the module once per
+ * process (thread-safe): 0 and why in msg when it cannot. The calls below go to the
+ * module's table; atmos__vdb_open answers ATMOS__VDB_E_IO with that message without it. */
+int atmos__vdb_module_load(char *msg, size_t cap);
 int atmos__vdb_open(const char *path, atmos__vdb **out, char *msg, size_t cap);
 void atmos__vdb_close(atmos__vdb *f);
 int atmos__vdb_grid_count(const atmos__vdb *f);
 int atmos__vdb_get_grid_info(const atmos__vdb *f, int index, atmos__vdb_grid_info *info);
-/* Reads grid `index` (a float grid) from the file and measures it. */
 int atmos__vdb_load_grid(atmos__vdb *f, int index, atmos__vdb_grid_stats *stats, char *msg, size_t cap);
-/* Walks the loaded grid `index`: every leaf as an 8^3 block (inactive voxels 0) and
- * every active tile as a constant block. */
 int atmos__vdb_visit(atmos__vdb *f, int index, atmos__vdb_block_fn fn, void *user, char *msg, size_t cap);
-/* The library's version string ("10.0.1"), for messages and `atmos --version`. */
-const char *atmos__vdb_library_version(void);
 
 #ifdef __cplusplus
 }

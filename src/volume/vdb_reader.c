@@ -1,6 +1,7 @@
 /* OpenVDB .vdb reader: picks the float grids, checks their values and transform,
  * and copies leaves and active tiles into an atmos volume. The file itself is
- * parsed by the OpenVDB library through openvdb_shim.cpp; without it (the library
+ * parsed by the OpenVDB library through openvdb_shim.cpp (the module libatmos_openvdb.so,
+ * opened on the first .vdb file: openvdb_module.c); without it (the library
  * was not found at configure time) the reader says which package to install. */
 #include "core/internal.h"
 #include "volume/reader_common.h"
@@ -317,6 +318,9 @@ atmos_status atmos__volume_load_openvdb(atmos_context *ctx, const char *path, co
     int ngrids = 0;
     if (atmos__vdb_check_header(path, &ngrids, why, sizeof why) != 0)
         return atmos__error(ctx, ATMOS_E_FORMAT, "%s: %s", path, why);
+    /* the library's module, opened here so the fence's children inherit it */
+    if (!atmos__vdb_module_load(why, sizeof why))
+        return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "%s: %s (install it next to libatmos)", path, why);
     return atmos__reader_fenced(ctx, path, desc, "OpenVDB", load_direct, out);
 }
 

@@ -114,6 +114,25 @@ check "pkg-config slice_volume runs" "$T/pc/slice_volume" --size 32 20 -o "$T/sl
 [ -s "$T/slice.png" ] && ok "slice_volume wrote its image" || bad "slice_volume wrote no image"
 "$T/cm/sky" --size 0 5 >/dev/null 2>&1; [ $? -eq 2 ] && ok "bad --size is a usage error" || bad "sky --size 0 5 did not exit 2"
 
+# The OpenVDB and GDAL readers are modules beside the library, opened on the first file they
+# read (src/core/module.h): the installed CLI finds the OpenVDB one from bin/ (no
+# LD_LIBRARY_PATH), and without it says what is missing.
+vdb=$build/tests/fixtures/volume/small.vdb
+if [ -f "$build/libatmos_gdal.so" ]; then
+    [ -s "$libdir/libatmos_gdal.so" ] && ok "installed libatmos_gdal.so" || bad "no libatmos_gdal.so beside libatmos.so"
+fi
+if [ -f "$build/libatmos_openvdb.so" ]; then
+    [ -s "$libdir/libatmos_openvdb.so" ] && ok "installed libatmos_openvdb.so" || bad "no libatmos_openvdb.so beside libatmos.so"
+    if [ -f "$vdb" ]; then
+        check "installed atmos reads a .vdb through the module" env LD_LIBRARY_PATH= "$P/bin/atmos" volume info "$vdb"
+        mv "$libdir/libatmos_openvdb.so" "$T/moved.so"
+        env LD_LIBRARY_PATH= "$P/bin/atmos" volume info "$vdb" >"$T/log" 2>&1
+        grep -q "libatmos_openvdb.so not found" "$T/log" && ok "without the module: not found, said" ||
+            bad "without the module: $(cat "$T/log")"
+        mv "$T/moved.so" "$libdir/libatmos_openvdb.so"
+    else bad "no $vdb (the test fixtures.vdb makes it)"; fi
+fi
+
 # The Python package installed by pip against the installed library (a copy of python/, so the
 # checkout stays clean; --target: the system's site-packages are left alone).
 py=${ATMOS_PYTHON:-python3}

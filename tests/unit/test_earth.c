@@ -34,12 +34,17 @@ static float halves(double lon, double lat, int c)
 static float white(double lon, double lat, int c) { (void)lon, (void)lat, (void)c; return 1.0f; }
 static float grey_cloud(double lon, double lat, int c) { (void)lon, (void)lat, (void)c; return 0.6f; }
 
-static atmos_atmosphere *make(double lat0, double lon0, const atmos_image *ground, const atmos_image *night,
-                              const atmos_image *clouds, int spheres)
+/* The spherical sky (SPHERICAL) where a check reads the sky (radiance, transmittance); where it
+ * reads only the planet (the maps' look-ups, the geographic frame, the cloud spheres), DOBASHI:
+ * the same planet (atmosphere_create.c's create_planet, whatever the kind) without the spherical
+ * sky's multiple-scattering tables, which took most of this test's time (docs/architecture.md,
+ * "The test suite's time"). */
+static atmos_atmosphere *make_kind(atmos_atmosphere_kind kind, double lat0, double lon0, const atmos_image *ground,
+                                   const atmos_image *night, const atmos_image *clouds, int spheres)
 {
     atmos_atmosphere_desc d;
     atmos_atmosphere_defaults(&d);
-    d.kind = ATMOS_ATMOSPHERE_SPHERICAL;
+    d.kind = kind;
     d.latitude_deg = lat0, d.longitude_deg = lon0;
     d.ground_map = ground, d.night_map = night;
     d.clouds.image = clouds;
@@ -49,6 +54,16 @@ static atmos_atmosphere *make(double lat0, double lon0, const atmos_image *groun
     atmos_atmosphere *a = NULL;
     CHECK_OK(atmos_atmosphere_create(NULL, &d, &wl, &a));
     return a;
+}
+static atmos_atmosphere *make(double lat0, double lon0, const atmos_image *ground, const atmos_image *night,
+                              const atmos_image *clouds, int spheres)
+{
+    return make_kind(ATMOS_ATMOSPHERE_SPHERICAL, lat0, lon0, ground, night, clouds, spheres);
+}
+static atmos_atmosphere *make_planet(double lat0, double lon0, const atmos_image *ground, const atmos_image *night,
+                                     const atmos_image *clouds, int spheres)
+{
+    return make_kind(ATMOS_ATMOSPHERE_DOBASHI, lat0, lon0, ground, night, clouds, spheres);
 }
 
 /* The ground point at angular distance arc_deg from the origin's ground point toward the
@@ -64,7 +79,7 @@ static void test_map_lookup(void)
     atmos_image *map = make_map(360, 180, 3, halves);
     double g[3], lat, lon;
     /* the origin at 30 N 100 E: north-east quadrant; 40 degrees north (-z): 70 N */
-    atmos_atmosphere *a = make(30, 100, map, NULL, NULL, 0);
+    atmos_atmosphere *a = make_planet(30, 100, map, NULL, NULL, 0);
     const atmos__planet *pl = a->planet;
     ground_at(0, 1, 0, g);
     atmos__planet_latlon(pl, g, &lat, &lon);
@@ -84,7 +99,7 @@ static void test_map_lookup(void)
     CHECK_NEAR(atmos__planet_ground_albedo(pl, g, 1), 0.0, 1e-6);
     atmos_atmosphere_destroy(a);
     /* on the equator at 5 W: 10 degrees east (+x) is 5 E, 10 west is 15 W */
-    a = make(0, -5, map, NULL, NULL, 0);
+    a = make_planet(0, -5, map, NULL, NULL, 0);
     pl = a->planet;
     ground_at(10, 1, 0, g);
     atmos__planet_latlon(pl, g, &lat, &lon);
@@ -94,7 +109,7 @@ static void test_map_lookup(void)
     CHECK_NEAR(atmos__planet_ground_albedo(pl, g, 0), 0.0, 1e-6);
     atmos_atmosphere_destroy(a);
     /* across the date line: 175 E + 10 degrees east is 175 W */
-    a = make(0, 175, map, NULL, NULL, 0);
+    a = make_planet(0, 175, map, NULL, NULL, 0);
     ground_at(10, 1, 0, g);
     atmos__planet_latlon(a->planet, g, &lat, &lon);
     CHECK_NEAR(lon, -175, 1e-9);
@@ -105,10 +120,10 @@ static void test_map_lookup(void)
     atmos_image_destroy(map);
 }
 
-static void test_night_lights(void)
+/* a: the clear sky over 10 N 20 E with white night lights (shared with test_cloud_attenuation:
+ * one spherical sky's tables fewer to build; the lights' look-ups here do not depend on where) */
+static void test_night_lights(const atmos_atmosphere *a)
 {
-    atmos_image *night = make_map(36, 18, 1, white);
-    atmos_atmosphere *a = make(0, 0, NULL, night, NULL, 0);
     const atmos__planet *pl = a->planet;
     const double g[3] = {0, 0, 0}, Ln = 5e-6; /* the default night_radiance */
     double sun[3];
@@ -127,8 +142,6 @@ static void test_night_lights(void)
     atmos_atmosphere_transmittance(a, eye, down, 500e3, T);
     /* (the production sky's view march and its segment transmittance agree to ~1e-3) */
     for (int k = 0; k < 3; k++) CHECK_REL(L[k], Ln * T[k], 2e-3);
-    atmos_atmosphere_destroy(a);
-    atmos_image_destroy(night);
 }
 
 /* The brightness mapping inverts the two-stream reflectance R = (1-g) tau / (2 + (1-g) tau),
@@ -148,11 +161,10 @@ static void test_brightness_mapping(void)
 /* One uniform cloud sphere: the sunlight reaching the ground passes it with transmittance
  * exp(-tau / mu), mu the sun's cosine where the ray crosses the sphere (r sin = R sin:
  * the same ray); a view ray straight down sees the night lights dimmed by exp(-tau). */
-static void test_cloud_attenuation(void)
+static void test_cloud_attenuation(const atmos_atmosphere *clear, const atmos_image *night)
 {
-    atmos_image *cloud = make_map(72, 36, 1, grey_cloud), *night = make_map(36, 18, 1, white);
+    atmos_image *cloud = make_map(72, 36, 1, grey_cloud);
     atmos_atmosphere *a = make(10, 20, NULL, night, cloud, 1);
-    atmos_atmosphere *clear = make(10, 20, NULL, night, NULL, 0);
     const atmos__planet *pl = a->planet;
     const double lin = pow((0.6 + 0.055) / 1.055, 2.4);
     const double tau = atmos__clouds_tau_from_brightness(lin, 0.04, 100);
@@ -187,14 +199,12 @@ static void test_cloud_attenuation(void)
     atmos_atmosphere_radiance(a, ground, up, sun, Ls, NULL);
     for (int k = 0; k < 3; k++) CHECK_REL(Ls[k], Lsun[k] * exp(-tau), 0.02);
     atmos_atmosphere_destroy(a);
-    atmos_atmosphere_destroy(clear);
     /* five spheres carry the same column: the ground's shadow is the same */
-    a = make(10, 20, NULL, night, cloud, 5);
+    a = make_planet(10, 20, NULL, night, cloud, 5);
     atmos_direction_from_angles(90, 0, sun);
     CHECK_NEAR(atmos__clouds_sun_attenuation(a->planet, g, sun, -1), exp(-tau), 1e-6 * exp(-tau));
     atmos_atmosphere_destroy(a);
     atmos_image_destroy(cloud);
-    atmos_image_destroy(night);
 }
 
 static void write_text(const char *path, const char *text)
@@ -286,7 +296,7 @@ static void test_regional_edges(void)
     atmos_image *img = make_map(100, 200, 1, grey_cloud);
     atmos_atmosphere_desc d;
     atmos_atmosphere_defaults(&d);
-    d.kind = ATMOS_ATMOSPHERE_SPHERICAL;
+    d.kind = ATMOS_ATMOSPHERE_DOBASHI; /* the planet's cloud spheres alone (make_kind) */
     d.clouds.image = img;
     d.clouds.lon_west_deg = 0, d.clouds.lon_east_deg = 10, d.clouds.lat_south_deg = 0, d.clouds.lat_north_deg = 20;
     atmos_wavelengths wl;
@@ -317,7 +327,7 @@ static void test_latlon_fast(void)
     double worst = 0.0;
     unsigned s = 12345u;
     for (int o = 0; o < 3; o++) {
-        atmos_atmosphere *a = make(origins[o][0], origins[o][1], NULL, NULL, NULL, 0);
+        atmos_atmosphere *a = make_planet(origins[o][0], origins[o][1], NULL, NULL, NULL, 0);
         const atmos__planet *pl = a->planet;
         for (int i = 0; i < 20000; i++) {
             double x[3];
@@ -344,9 +354,13 @@ int main(void)
     test_regional_edges();
     test_scene_keys();
     test_map_lookup();
-    test_night_lights();
+    atmos_image *night = make_map(36, 18, 1, white);
+    atmos_atmosphere *clear = make(10, 20, NULL, night, NULL, 0);
+    test_night_lights(clear);
     test_brightness_mapping();
-    test_cloud_attenuation();
+    test_cloud_attenuation(clear, night);
+    atmos_atmosphere_destroy(clear);
+    atmos_image_destroy(night);
     test_latlon_fast();
     return test_summary("test_earth");
 }

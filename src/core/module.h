@@ -1,0 +1,23 @@
+/* The library's optional parts kept in shared objects of their own (modules), opened with
+ * dlopen on their first use, so that a program pays for loading their dependencies only
+ * when it uses them (docs/architecture.md, "Each atmos process's start"): the OpenVDB
+ * reader (libatmos_openvdb.so, volume/openvdb_module.c) drags in OpenVDB, TBB and Imath,
+ * whose symbol bindings were more than half of every `atmos` process's start. */
+#ifndef ATMOS_CORE_MODULE_H
+#define ATMOS_CORE_MODULE_H
+
+#include <stddef.h>
+
+/* dlopen's handle of the module `file` (a file name, no directory), looked for in order:
+ *  0. in the folder ATMOS_MODULE_DIR names, when it is set (the sanitizer tests: under
+ *     AddressSanitizer dlopen is called from its interceptor, whose RUNPATH is not the program's);
+ *  1. next to the object holding the library's code (libatmos.so where it is installed or
+ *     built; a program linked with libatmos.a: the program's folder);
+ *  2. ATMOS_MODULE_FROM_BIN relative to that folder (an installed program in bin/, the
+ *     modules in the library folder beside it);
+ *  3. by the dynamic loader's own search (the program's RUNPATH, LD_LIBRARY_PATH, the
+ *     system's folders).
+ * NULL when none opens, with the places tried and the loader's last message in msg. */
+void *atmos__module_open(const char *file, char *msg, size_t cap);
+
+#endif
