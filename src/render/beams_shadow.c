@@ -328,35 +328,9 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
     }
 }
 
-/* H of the n samples (at most RUN_READ) at texel coordinates fx, fy and depths z on face F, into
- * H: first what the tiles settle, lane by lane without branches (the near plane, the frustum's
- * outside and the tile's bounds selected; -1 where they do not settle), a loop that vectorises
- * and reads only the small tiles; then the texels of the samples left, as texels() reads them.
- * The same values as texels(). */
-BEAMS_CLONES static void run_visibility(const atmos__beams_face *F, const double *restrict fx, const double *restrict fy,
-                                        const double *restrict z, int n, double *restrict H)
-{
-    const int N = F->n, T = F->tiles.tiles;
-    const float *lo = F->tiles.min, *hi = F->tiles.max;
-    int left = 0;
-    for (int s = 0; s < n; s++) {
-        const double zs = z[s];
-        const int in = (zs > NEAR_M) & (fx[s] > -1) & (fx[s] < N) & (fy[s] > -1) & (fy[s] < N);
-        const int x0 = (int)((in ? fx[s] : 0) + 1) - 1, y0 = (int)((in ? fy[s] : 0) + 1) - 1; /* floor: > -1 */
-        const int tile = (y0 < 0 ? 0 : y0 / ATMOS__BEAMS_TILE) * T + (x0 < 0 ? 0 : x0 / ATMOS__BEAMS_TILE);
-        const float near = lo[tile], far = hi[tile];
-        const double v = zs < near ? 1 : zs >= far ? 0 : -1;
-        H[s] = in ? v : 1;
-        left += H[s] < 0;
-    }
-    for (int s = 0; s < n && left; s++)
-        if (H[s] < 0) H[s] = texels(F, fx[s], fy[s], z[s]);
-}
-
 /* The samples [s0, s1) (at most RUN_READ) of atmos__beams_ray_light_sum read one by one: when
  * they all lie in one face of the map (each sample's face as atmos__beams_ray_light finds it),
- * their texels projected together (run_texels) and read together (run_visibility), else each
- * alone. The same sum, in order. */
+ * their texels projected together (run_texels), else each alone. The same sum, in order. */
 static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
@@ -372,16 +346,11 @@ static double read_run(const atmos__beams_ray *r, double ta, double step, double
         for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
         return h;
     }
-    double fx[RUN_READ], fy[RUN_READ], z[RUN_READ], H[RUN_READ];
+    double fx[RUN_READ], fy[RUN_READ], z[RUN_READ];
     run_texels(r, f, ta, step, o, s0, s1, fx, fy, z);
-    run_visibility(&l->face[f], fx, fy, z, s1 - s0, H);
-    if (l->L.type != ATMOS_LIGHT_SPOT) {
-        for (int s = 0; s < s1 - s0; s++) h += H[s];
-        return h;
-    }
     for (int s = s0; s < s1; s++) {
         const double fall = atmos__beams_ray_falloff(r, ta + (s + o) * step);
-        h += fall == 0 ? 0 : fall * H[s - s0];
+        h += fall == 0 ? 0 : fall * texels(&l->face[f], fx[s - s0], fy[s - s0], z[s - s0]);
     }
     return h;
 }
