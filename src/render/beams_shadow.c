@@ -329,18 +329,20 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
 }
 
 /* The samples [s0, s1) (at most RUN_READ) of atmos__beams_ray_light_sum read one by one: when
- * they all lie in one face of the map (each sample's face as atmos__beams_ray_light finds it),
- * their texels projected together (run_texels), else each alone. The same sum, in order. */
+ * they all lie in one face of the map (the first's and the last's, each as
+ * atmos__beams_ray_light finds it), their texels projected together (run_texels), else each
+ * alone. The same sum, in order. */
 static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
     double h = 0;
     int f = 0;
-    for (int s = s0; s < s1 && l->nfaces == 6 && f >= 0; s++) {
-        const double t = ta + (s + o) * step;
-        const double w[3] = {r->w0[0] + t * r->d[0], r->w0[1] + t * r->d[1], r->w0[2] + t * r->d[2]};
-        const int g = cube_face(w);
-        f = s == s0 || g == f ? g : -1;
+    if (l->nfaces == 6) { /* a face's pyramid is convex: the first and the last sample's face is the run's */
+        const double t0 = ta + (s0 + o) * step, t1 = ta + (s1 - 1 + o) * step;
+        const double w0[3] = {r->w0[0] + t0 * r->d[0], r->w0[1] + t0 * r->d[1], r->w0[2] + t0 * r->d[2]};
+        const double w1[3] = {r->w0[0] + t1 * r->d[0], r->w0[1] + t1 * r->d[1], r->w0[2] + t1 * r->d[2]};
+        f = cube_face(w0);
+        if (s1 - s0 > 1 && cube_face(w1) != f) f = -1;
     }
     if (!l->nfaces || f < 0) {
         for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
