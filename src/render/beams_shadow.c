@@ -112,7 +112,7 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     for (int f = 0; f < nf; f++) {
         if (atmos__cancelled(&pr->cancelled)) continue;
         raster_face(&l->face[f], l->L.pos, mesh, nmesh);
-        if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n)) {
+        if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n, ATMOS__BEAMS_LIGHT_TILE_SHIFT)) {
 #pragma omp atomic write
             failed = 1;
         }
@@ -133,7 +133,7 @@ static inline double texels(const atmos__beams_face *F, double fx, double fy, do
     const int n = F->n;
     if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
     const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1; /* floor: fx, fy > -1 */
-    const int tile = atmos__beams_tiles_at(&F->tiles, x0, y0);
+    const int tile = atmos__beams_tiles_at(&F->tiles, x0, y0, ATMOS__BEAMS_LIGHT_TILE_SHIFT);
     if (z < F->tiles.min[tile]) return 1;
     if (z >= F->tiles.max[tile]) return 0;
     const double ax = fx - x0, ay = fy - y0;
