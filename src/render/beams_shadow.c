@@ -112,7 +112,7 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     for (int f = 0; f < nf; f++) {
         if (atmos__cancelled(&pr->cancelled)) continue;
         raster_face(&l->face[f], l->L.pos, mesh, nmesh);
-        if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n)) {
+        if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n, ATMOS__BEAMS_LIGHT_TILE_SHIFT)) {
 #pragma omp atomic write
             failed = 1;
         }
@@ -133,7 +133,7 @@ static inline double texels(const atmos__beams_face *F, double fx, double fy, do
     const int n = F->n;
     if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
     const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1; /* floor: fx, fy > -1 */
-    const int tile = atmos__beams_tiles_at(&F->tiles, x0, y0);
+    const int tile = atmos__beams_tiles_at(&F->tiles, x0, y0, ATMOS__BEAMS_LIGHT_TILE_SHIFT);
     if (z < F->tiles.min[tile]) return 1;
     if (z >= F->tiles.max[tile]) return 0;
     const double ax = fx - x0, ay = fy - y0;
@@ -329,18 +329,20 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
 }
 
 /* The samples [s0, s1) (at most RUN_READ) of atmos__beams_ray_light_sum read one by one: when
- * they all lie in one face of the map (each sample's face as atmos__beams_ray_light finds it),
- * their texels projected together (run_texels), else each alone. The same sum, in order. */
+ * they all lie in one face of the map (the first's and the last's, each as
+ * atmos__beams_ray_light finds it), their texels projected together (run_texels), else each
+ * alone. The same sum, in order. */
 static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
     double h = 0;
     int f = 0;
-    for (int s = s0; s < s1 && l->nfaces == 6 && f >= 0; s++) {
-        const double t = ta + (s + o) * step;
-        const double w[3] = {r->w0[0] + t * r->d[0], r->w0[1] + t * r->d[1], r->w0[2] + t * r->d[2]};
-        const int g = cube_face(w);
-        f = s == s0 || g == f ? g : -1;
+    if (l->nfaces == 6) { /* a face's pyramid is convex: the first and the last sample's face is the run's */
+        const double t0 = ta + (s0 + o) * step, t1 = ta + (s1 - 1 + o) * step;
+        const double w0[3] = {r->w0[0] + t0 * r->d[0], r->w0[1] + t0 * r->d[1], r->w0[2] + t0 * r->d[2]};
+        const double w1[3] = {r->w0[0] + t1 * r->d[0], r->w0[1] + t1 * r->d[1], r->w0[2] + t1 * r->d[2]};
+        f = cube_face(w0);
+        if (s1 - s0 > 1 && cube_face(w1) != f) f = -1;
     }
     if (!l->nfaces || f < 0) {
         for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);

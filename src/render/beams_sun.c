@@ -86,7 +86,7 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
             }
             draw(s, v);
         }
-    if (atmos__beams_tiles_build(&s->tiles, s->depth, size)) {
+    if (atmos__beams_tiles_build(&s->tiles, s->depth, size, ATMOS__BEAMS_SUN_TILE_SHIFT)) {
         atmos__beams_sun_free(s);
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d sun shadow map's tiles", size, size);
     }
@@ -120,7 +120,8 @@ int atmos__beams_sun_dark(const atmos__beams_sun *s, const double p[3])
     if (!s->n) return 0;
     const double fx = (atmos__dot3(p, s->right) - s->u0) / s->texel - 0.5, fy = (atmos__dot3(p, s->up) - s->v0) / s->texel - 0.5;
     if (!(fx >= 0 && fx < s->n - 1 && fy >= 0 && fy < s->n - 1)) return 0; /* beside the map: it cannot tell */
-    const int tile = atmos__beams_tiles_at(&s->tiles, (int)fx, (int)fy); /* its ring holds the texels round p */
+    /* its ring holds the texels round p */
+    const int tile = atmos__beams_tiles_at(&s->tiles, (int)fx, (int)fy, ATMOS__BEAMS_SUN_TILE_SHIFT);
     return s->tiles.max[tile] < atmos__dot3(p, s->fwd) - 2 * s->texel;
 }
 

@@ -4,12 +4,10 @@
 #include <math.h>
 #include <stdlib.h>
 
-#define TILE ATMOS__BEAMS_TILE
-
 void atmos__beams_tiles_free(atmos__beams_tiles *t)
 {
     free(t->min);
-    t->min = t->max = NULL, t->tiles = t->levels = 0;
+    t->min = t->max = NULL, t->tiles = t->levels = t->shift = 0;
 }
 
 /* The levels' sizes and offsets; the cells of all levels. */
@@ -30,7 +28,7 @@ static size_t plan_levels(atmos__beams_tiles *t)
 /* Level 0: each tile over its texels and a ring of one around. */
 static void finest(atmos__beams_tiles *t, const float *depth, int n)
 {
-    const int T = t->tiles;
+    const int T = t->tiles, TILE = 1 << t->shift;
     for (int ty = 0; ty < T; ty++)
         for (int tx = 0; tx < T; tx++) {
             float lo = INFINITY, hi = -INFINITY;
@@ -45,9 +43,10 @@ static void finest(atmos__beams_tiles *t, const float *depth, int n)
         }
 }
 
-int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n)
+int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, int shift)
 {
-    t->tiles = (n + TILE - 1) / TILE;
+    t->shift = shift;
+    t->tiles = (n + (1 << shift) - 1) >> shift;
     const size_t cells = plan_levels(t);
     if (!(t->min = malloc(sizeof(float) * 2 * cells))) {
         t->max = NULL, t->tiles = t->levels = 0;
@@ -74,8 +73,8 @@ int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n)
 
 void atmos__beams_tiles_range(const atmos__beams_tiles *t, int x0, int x1, int y0, int y1, float *lo, float *hi)
 {
-    const int tx0 = x0 < 0 ? 0 : x0 / TILE, tx1 = x1 < 0 ? 0 : x1 / TILE, ty0 = y0 < 0 ? 0 : y0 / TILE,
-              ty1 = y1 < 0 ? 0 : y1 / TILE;
+    const int sh = t->shift, tx0 = x0 < 0 ? 0 : x0 >> sh, tx1 = x1 < 0 ? 0 : x1 >> sh, ty0 = y0 < 0 ? 0 : y0 >> sh,
+              ty1 = y1 < 0 ? 0 : y1 >> sh;
     int k = 0; /* the finest level where the tiles' box spans at most 2 x 2 cells */
     while (k + 1 < t->levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
     const float *cmin = t->min + t->level_at[k], *cmax = t->max + t->level_at[k];

@@ -1,32 +1,38 @@
 /* The min/max pyramid of a beam renderer's depth map (the spotlights' faces, beams_shadow.c,
- * and the sun's orthographic map, beams_sun.c): per tile of ATMOS__BEAMS_TILE x
- * ATMOS__BEAMS_TILE texels, the least and the greatest depth over the tile and a ring of one
- * texel around it (what a 2x2 filtered look-up in the tile may read), then the same over 2x2,
- * 4x4, ... tiles up to the whole map. A point nearer than the least depth of its tile is lit,
- * one at or beyond the greatest in shadow, without reading the map; a segment whose depths
- * lie all below (or all beyond) the bounds of every tile it crosses is lit (or dark) all
- * along. Not part of the API. */
+ * and the sun's orthographic map, beams_sun.c): per tile of 2^shift x 2^shift texels, the
+ * least and the greatest depth over the tile and a ring of one texel around it (what a 2x2
+ * filtered look-up in the tile may read), then the same over 2x2, 4x4, ... tiles up to the
+ * whole map. A point nearer than the least depth of its tile is lit, one at or beyond the
+ * greatest in shadow, without reading the map; a segment whose depths lie all below (or all
+ * beyond) the bounds of every tile it crosses is lit (or dark) all along. Not part of the API. */
 #ifndef ATMOS_RENDER_BEAMS_TILES_H
 #define ATMOS_RENDER_BEAMS_TILES_H
 
 #include <stddef.h>
 
-#define ATMOS__BEAMS_TILE 8
+/* The tiles' sizes: 2 x 2 texels for the lights' faces (docs/beams.md, *Twentieth round*:
+ * a point light's samples read four texels less than half as often as with 8 x 8), 8 x 8 for
+ * the sun's. */
+#define ATMOS__BEAMS_LIGHT_TILE_SHIFT 1
+#define ATMOS__BEAMS_SUN_TILE_SHIFT 3
 
 typedef struct atmos__beams_tiles {
+    int shift;               /* a tile is 2^shift texels a side */
     int tiles, levels;       /* tiles a side at level 0; levels down to one cell */
     int level_n[24];         /* level k: level_n[k] cells a side at offset level_at[k] */
     size_t level_at[24];
     float *min, *max;        /* every level's cells, one allocation (min) */
 } atmos__beams_tiles;
 
-/* The pyramid of the n x n map depth; 0, or -1 out of memory (t then empty). */
-int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n);
+/* The pyramid of the n x n map depth, tiles of 2^shift texels a side; 0, or -1 out of memory
+ * (t then empty). */
+int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, int shift);
 void atmos__beams_tiles_free(atmos__beams_tiles *t);
-/* The tile of the texel x, y (a look-up's floor; -1 is clamped to 0) at level 0. */
-static inline int atmos__beams_tiles_at(const atmos__beams_tiles *t, int x, int y)
+/* The tile of the texel x, y (a look-up's floor; -1 is clamped to 0) at level 0; shift the
+ * pyramid's own (t->shift), given by the caller as a constant for a shift rather than a load. */
+static inline int atmos__beams_tiles_at(const atmos__beams_tiles *t, int x, int y, int shift)
 {
-    return (y < 0 ? 0 : y / ATMOS__BEAMS_TILE) * t->tiles + (x < 0 ? 0 : x / ATMOS__BEAMS_TILE);
+    return (y < 0 ? 0 : y >> shift) * t->tiles + (x < 0 ? 0 : x >> shift);
 }
 /* The least and greatest depth over the tiles of the texels [x0, x1] x [y0, y1] (floors of
  * look-up coordinates, each >= -1 and < n), read at the finest level where they span at most

@@ -619,6 +619,58 @@ static void test_light_sum(void)
     atmos_mesh_destroy(mesh);
 }
 
+/* A point light's runs of at most 8 samples (read without the tiles' test, each run's cube face
+ * from its first and last sample) against every sample read alone, on rays that cross the edge
+ * between two faces of the cube (x + y = 10 here) inside a sphere's shadow, which straddles it:
+ * a run across the edge read on one face would be wrong on the other side. */
+static void test_runs_across_faces(void)
+{
+    atmos_mesh *mesh = NULL;
+    atmos_mesh_transform tr;
+    atmos_mesh_transform_identity(&tr);
+    tr.position_m[0] = 3.5, tr.position_m[1] = 6.5;
+    CHECK_OK(atmos_mesh_load(ctx, "builtin:sphere", 0, &mesh));
+    if (!mesh) return;
+    CHECK_OK(atmos_mesh_apply_transform(ctx, mesh, &tr));
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_scene s;
+    base_scene(&s, 8, 8);
+    atmos_scene_light sl = s.lights[0];
+    sl.type = ATMOS_LIGHT_POINT, sl.position_m[0] = 0, sl.position_m[1] = 10, sl.position_m[2] = 0;
+    atmos__beams_light l;
+    memset(&l, 0, sizeof l);
+    atmos__lamp_make(&sl, &wl, &l.L);
+    atmos__beams_progress pr = {0, 6, 0};
+    CHECK_OK(atmos__beams_shadow_build(ctx, &l, &mesh, 1, 256, &pr));
+    double worst = 0;
+    long runs = 0, shadowed = 0;
+    for (int r = 0; r < 25; r++) {
+        double d[3] = {0.3, 0.3, 1};
+        const double n = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; a++) d[a] /= n;
+        const double P[3] = {6.36 + 0.12 * (r % 5 - 2), 3.64 + 0.12 * (r / 5 - 2), 0}; /* in the shadow, on the edge */
+        const double o[3] = {P[0] - 6 * d[0], P[1] - 6 * d[1], P[2] - 6 * d[2]};
+        atmos__beams_ray ray;
+        atmos__beams_ray_init(&l, o, d, &ray);
+        const int m = 400;
+        const double step = 12.0 / m;
+        for (int k = 2; k <= 8; k++)
+            for (int s0 = 0; s0 + k <= m; s0 += 3) {
+                double want = 0;
+                for (int q = s0; q < s0 + k; q++) want += atmos__beams_ray_light(&ray, (q + 0.5) * step);
+                const double got = atmos__beams_ray_light_sum(&ray, 0, step, 0.5, s0, s0 + k);
+                worst = fmax(worst, fabs(got - want)), runs++, shadowed += want < k - 0.5;
+            }
+    }
+    printf("runs of 2-8 samples across a cube map's edge: %ld runs, %ld in the shadow, worst difference %.2e\n", runs,
+           shadowed, worst);
+    CHECK(shadowed > 100);
+    CHECK_MSG(worst < 1e-12, "a run across the cube's faces differs from its samples by %.3g", worst);
+    atmos__beams_shadow_free(&l);
+    atmos_mesh_destroy(mesh);
+}
+
 /* Spots seen from several places: every pixel whose ray meets the cone within its reach is lit. */
 static void test_screen_spans(void)
 {
@@ -1073,6 +1125,7 @@ int main(void)
     test_airlight();
     test_shadow();
     test_light_sum();
+    test_runs_across_faces();
     test_screen_spans();
     test_surface_spans();
     test_surface_closed_form();
