@@ -344,6 +344,9 @@ ATMOS_API atmos_status atmos_scene_atmosphere_create(atmos_context *ctx, const a
  * from the cloud layer's base (where the curved layer is lowest in the box) to its top, of
  * voxel_size_m voxels whose densities give the layer's extinction (docs/sky.md). The ground
  * truth for the cloud spheres with the slice renderer and the path tracer. */
+/* The most voxels atmos_scene_cloud_volume puts across its box (2 half_width_m / voxel_size_m,
+ * rounded up): more is ATMOS_E_INVALID_ARG. */
+#define ATMOS_CLOUD_VOLUME_MAX_ACROSS 8192
 ATMOS_API atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *scene, const double centre_xz[2],
                                                 double half_width_m, double voxel_size_m, atmos_volume **out);
 

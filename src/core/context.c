@@ -202,6 +202,11 @@ atmos_status atmos__write_atomic_unique(atmos_context *ctx, const char *path, at
     return write_atomic(ctx, path, fn, user, 1);
 }
 
+atmos_status atmos__temp_create_error(atmos_context *ctx, const char *path, int err)
+{
+    return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create a temporary file beside it: %s", path, strerror(err));
+}
+
 typedef struct {
     const char *src;
     const char *dst;
@@ -216,7 +221,7 @@ static atmos_status copy_fn(atmos_context *ctx, const char *tmp, void *user)
     if (!out) {
         int e = errno;
         fclose(in);
-        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file: %s", j->dst, strerror(e));
+        return atmos__temp_create_error(ctx, j->dst, e);
     }
     char buf[65536];
     size_t n;

@@ -57,6 +57,9 @@ atmos_status atmos__write_atomic(atmos_context *ctx, const char *path, atmos__wr
 /* The same with a temporary name unique to this write within the process
  * (PATH.tmpPID + 6-digit counter): for files that several threads may write. */
 atmos_status atmos__write_atomic_unique(atmos_context *ctx, const char *path, atmos__write_fn fn, void *user);
+/* A write_fn's error when its temporary cannot be created (err: errno): named by path only,
+ * the temporary's name being the final one with a suffix that messages do not show. */
+atmos_status atmos__temp_create_error(atmos_context *ctx, const char *path, int err);
 
 #define ATMOS_PI 3.14159265358979323846
 #define ATMOS_DEG2RAD (ATMOS_PI / 180.0)

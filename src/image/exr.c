@@ -198,7 +198,7 @@ static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *us
     int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) {
         tls_errbuf = saved;
-        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file %s: %s", job->path, tmp, strerror(errno));
+        return atmos__temp_create_error(ctx, job->path, errno);
     }
 
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;

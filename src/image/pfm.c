@@ -50,7 +50,7 @@ static atmos_status pfm_write_file(atmos_context *ctx, const char *tmp, void *us
     const atmos_image *img = job->img;
     const int oc = job->out_channels;
     FILE *f = fopen(tmp, "wb");
-    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file %s: %s", job->path, tmp, strerror(errno));
+    if (!f) return atmos__temp_create_error(ctx, job->path, errno);
     size_t row_bytes = (size_t)img->width * (size_t)oc * 4;
     unsigned char *row = malloc(row_bytes);
     if (!row) {

@@ -69,7 +69,7 @@ static atmos_status png_write_file(atmos_context *ctx, const char *tmp, void *us
 
     /* All resources acquired before setjmp and not reassigned after it. */
     FILE *f = fopen(tmp, "wb");
-    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot create temporary file %s: %s", job->path, tmp, strerror(errno));
+    if (!f) return atmos__temp_create_error(ctx, job->path, errno);
     unsigned char *row = malloc(row_bytes);
     png_text *texts = img->meta_count > 0 ? calloc((size_t)img->meta_count, sizeof *texts) : NULL;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, png_error_cb, png_warning_cb);

@@ -19,9 +19,12 @@ atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *sce
     *out = NULL;
     if (!scene->earth.cloud_image[0])
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud volume: the scene's atmosphere has no \"clouds\"");
-    if (!(half_width_m > 0 && voxel_size_m > 0 && half_width_m / voxel_size_m <= 4096))
+    if (!(half_width_m > 0 && voxel_size_m > 0))
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud volume: need a half width > 0 and a voxel size > 0");
+    if (!(ceil(2.0 * half_width_m / voxel_size_m) <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
-                            "cloud volume: need a half width > 0 and at most 4096 voxels of size > 0 across it");
+                            "cloud volume: a half width of %g m in voxels of %g m gives %.0f voxels across (allowed 1..%d)",
+                            half_width_m, voxel_size_m, ceil(2.0 * half_width_m / voxel_size_m), ATMOS_CLOUD_VOLUME_MAX_ACROSS);
     atmos_particle_desc cloud;
     atmos_status st = atmos_particle_preset(ctx, "cloud", &cloud);
     if (st) return st;

@@ -50,4 +50,10 @@ set +e
 grep -q "ground_map" "$T/err.txt" || fail "missing map message"
 "$A" volume clouds "$T/bad.json" -o "$T/x.json" 2> /dev/null; [ $? -eq 1 ] || fail "volume clouds on a bad scene"
 "$A" volume clouds; [ $? -eq 2 ] || fail "usage exit"
+# too many voxels across: an option's mistake (exit 2, before the scene is read), with the count
+# it would give and the bound, as volume generate's; the bound is in volume --help
+"$A" volume clouds "$T/earth.json" -o "$T/x.json" --voxel-size 1 2> "$T/err.txt"; [ $? -eq 2 ] || fail "voxel count exit"
+grep -qF "atmos volume: clouds: --half-width 20000 m in voxels of --voxel-size 1 m gives 40000 voxels across (allowed 1..8192)" \
+    "$T/err.txt" || { cat "$T/err.txt" >&2; fail "voxel count message"; }
+"$A" volume --help | grep -q "at most 8192 across" || fail "volume --help: the voxel bound"
 exit 0

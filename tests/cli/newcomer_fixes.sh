@@ -66,6 +66,17 @@ hasnt "--exr-half with -o FILE.exr" "--exr-half"
 "$A" render --width 8 --height 8 --exr-layers tau --exr "$T/z.exr" -q 2>"$T/err" && bad "--exr-layers tau, no volume: exit 0"
 has "--exr-layers tau, no volume" "--exr-layers tau: it needs a volume"
 hasnt "--exr-layers tau, no volume" "transmittance"
+# --exr-layers variance without the path tracer names the layer asked for only
+"$A" render --width 8 --height 8 --exr-layers variance --exr "$T/z.exr" -q 2>"$T/err" && bad "--exr-layers variance, sky: exit 0"
+has "--exr-layers variance, sky" "--exr-layers variance: it is the path tracer's (--renderer path)"
+hasnt "--exr-layers variance, sky" "order"
+# a word for an integer setting names the range, as a number outside it does
+"$A" render --nishita-orders x --width 8 --height 8 -o "$T/n.png" -q 2>"$T/err" && bad "--nishita-orders x: exit 0"
+has "--nishita-orders x" "--nishita-orders: expected an integer in [1, 3], got 'x'"
+# an output whose temporary cannot be made: said of the output, not naming the output as the temporary
+"$A" volume slice "$T/cu.json" --axis x -o /proc/atmos_slice.png 2>"$T/err" && bad "volume slice into /proc: exit 0"
+has "volume slice into /proc" "/proc/atmos_slice.png: cannot create a temporary file beside it"
+hasnt "volume slice into /proc" "temporary file /proc"
 
 # --- 3. an output's format checked before the inputs are read: a missing volume is not
 # what is reported

@@ -104,6 +104,9 @@ col=$(python3 -c 'import sys; l = open(sys.argv[1]).read().split("\n")[0]; print
 check syntax.json "syntax.json:1:$col: malformed JSON near '\"position_m\""
 head -c 60 plain.json >cut.json
 check cut.json "cut.json:1:61: malformed JSON: unexpected end of input"
+# a key whose camera looks at its own position: refused as the scene reader refuses it
+printf '{"keys": [{"t": 0, "position_m": [0, 1000, 0], "look_at_m": [0, 1500, -4000]},\n {"t": 0.5, "position_m": [0, 5, 0], "look_at_m": [0, 5, 0]}]}\n' >same.json
+check same.json "same.json: /keys/1/look_at_m: must differ from position_m"
 # a negative time: refused (frame i is at t = i / fps >= 0; such a flight would never end)
 printf '{"keys": [{"t": -5, "position_m": [0, 1000, 0], "look_at_m": [0, 1500, -4000]}]}\n' >neg.json
 check neg.json "/keys/0/t: must be >= 0, got -5"
@@ -112,6 +115,22 @@ check neg.json "/keys/0/t: must be >= 0, got -5"
 [ $? -eq 1 ] && grep -q "atmos view: --script nope.json: cannot open: No such file or directory" e_nope.txt &&
     ! grep -q preparing e_nope.txt && ok "a missing flight: its reason, before any work (exit 1)" ||
     { bad "a missing flight"; cat e_nope.txt >&2; }
+
+# keys without "sun" between keys with one: the sun interpolated between the keys that give one
+# (the azimuth along the shorter arc, through north), held before the first and after the last
+printf '{"fps": 4, "keys": [{"t": 0, "position_m": [0, 1000, 0], "look_at_m": [0, 1500, -4000]},
+ {"t": 0.25, "position_m": [0, 1000, 0], "look_at_m": [0, 1500, -4000], "sun": {"elevation_deg": 10, "azimuth_deg": 350}},
+ {"t": 0.5, "position_m": [0, 1000, 0], "look_at_m": [0, 1500, -4000]},
+ {"t": 0.75, "position_m": [0, 1000, 0], "look_at_m": [0, 1500, -4000], "sun": {"elevation_deg": 30, "azimuth_deg": 30}},
+ {"t": 1, "position_m": [0, 1000, 0], "look_at_m": [0, 1500, -4000]}]}\n' >mixed.json
+"$A" view --headless --script mixed.json --size 16x9 --record mx >o_mx.txt 2>&1 &&
+python3 - mx/frames.csv <<'PY' && ok "keys without a sun: interpolated between the keys with one, held outside" ||
+import csv, sys
+r = [(float(x["sun_elevation_deg"]), float(x["sun_azimuth_deg"])) for x in csv.DictReader(open(sys.argv[1]))]
+want = [(10, 350), (10, 350), (20, 10), (30, 30), (30, 30)]
+assert len(r) == 5 and all(abs(a - c) < 1e-3 and abs(b - d) < 1e-3 for (a, b), (c, d) in zip(r, want)), r
+PY
+    { bad "keys without a sun among keys with one"; cat o_mx.txt mx/frames.csv >&2; }
 
 # without --frames a flight stops at its last key frame: 1 s at 2 fps is 3 frames (t = 0, 0.5, 1),
 # the last at the last key's camera; 1.2 s at 2 fps is 4 (t = 1.5 holds the last key)

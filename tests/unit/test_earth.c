@@ -260,6 +260,11 @@ static void test_scene_keys(void)
     atmos_volume *v = NULL;
     const double centre[2] = {0, 0};
     CHECK_OK(atmos_scene_cloud_volume(ctx, &sc, centre, 5000, 500, &v));
+    {   /* too many voxels across: refused with the count and the bound (8192 across: allowed) */
+        atmos_volume *big = NULL;
+        CHECK(atmos_scene_cloud_volume(ctx, &sc, centre, 5000, 1, &big) == ATMOS_E_INVALID_ARG && !big);
+        CHECK(strstr(atmos_context_error(ctx), "gives 10000 voxels across (allowed 1..8192)") != NULL);
+    }
     if (v && a) {
         atmos_particle_desc pd;
         CHECK_OK(atmos_particle_preset(NULL, "cloud", &pd));

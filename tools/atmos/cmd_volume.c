@@ -46,7 +46,7 @@ void cli_volume_help(void)
            "            a raw + JSON volume of \"cloud\" particles with the same optical depths, in the\n"
            "            world frame (x east, y up, z south at the scene's latitude/longitude): a box\n"
            "            2 M wide around (X, Z) (default 0,0; half width 20000 m) from the layer's base to\n"
-           "            its top, voxels of --voxel-size metres (default 500).\n");
+           "            its top, voxels of --voxel-size metres (default 500; at most 8192 across the box).\n");
     cli_volume_stats_help();
     printf("\n"
            "Reading options (info, slice, stats):\n"
@@ -376,6 +376,9 @@ static int cmd_clouds(int argc, char **argv)
     if (!scene_path) return cli_usage_error(C, "clouds: which scene?");
     if (!out) return cli_usage_error(C, "clouds: missing -o NAME.json");
     if (!(half > 0 && voxel > 0)) return cli_usage_error(C, "clouds: --half-width and --voxel-size must be > 0");
+    if (!(ceil(2.0 * half / voxel) <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
+        return cli_usage_error(C, "clouds: --half-width %g m in voxels of --voxel-size %g m gives %.0f voxels across (allowed 1..%d)",
+                               half, voxel, ceil(2.0 * half / voxel), ATMOS_CLOUD_VOLUME_MAX_ACROSS);
     if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 1);

@@ -120,9 +120,14 @@ static int parse_setting(const char *C, const atmos_setting *s, const char *text
         return 1;
     }
     double v;
-    if (!cli_parse_double(C, opt, text, &v)) return 0;
+    if (s->type == ATMOS_SETTING_INT) { /* a word: the integer range said, as for a number outside it */
+        char *end = NULL;
+        v = strtod(text, &end);
+        if (end == text || *end || !isfinite(v)) v = NAN;
+    } else if (!cli_parse_double(C, opt, text, &v))
+        return 0;
     const int low = s->min_open ? v <= s->min : v < s->min, high = s->max_open ? v >= s->max : v > s->max;
-    if (low || high || (s->type == ATMOS_SETTING_INT && v != floor(v))) {
+    if (low || high || (s->type == ATMOS_SETTING_INT && !(v == floor(v)))) {
         cli_usage_error(C, "%s: expected %s in %c%g, %g%c%s%s, got '%s'", opt,
                         s->type == ATMOS_SETTING_INT ? "an integer" : "a value", s->min_open ? '(' : '[', s->min, s->max,
                         s->max_open ? ')' : ']', s->unit[0] ? " " : "", s->unit, text);
@@ -610,8 +615,11 @@ static int apply_renderer(const render_opts *o, atmos_scene *s)
         return cli_usage_error(C, "--exr-layers %s: %s a volume (--volume or a scene with one)",
                                vl == RENDER_LAYER_TAU ? "tau" : vl == RENDER_LAYER_TRANSMITTANCE ? "transmittance" : "tau, transmittance",
                                vl == (RENDER_LAYER_TAU | RENDER_LAYER_TRANSMITTANCE) ? "they need" : "it needs");
-    if ((o->exr_layers & (RENDER_LAYER_ORDER | RENDER_LAYER_VARIANCE)) && s->renderer != ATMOS_RENDERER_PATH)
-        return cli_usage_error(C, "--exr-layers order, variance: they are the path tracer's (--renderer path)");
+    const int pl = o->exr_layers & (RENDER_LAYER_ORDER | RENDER_LAYER_VARIANCE);
+    if (pl && s->renderer != ATMOS_RENDERER_PATH)
+        return cli_usage_error(C, "--exr-layers %s: %s the path tracer's (--renderer path)",
+                               pl == RENDER_LAYER_ORDER ? "order" : pl == RENDER_LAYER_VARIANCE ? "variance" : "order, variance",
+                               pl == (RENDER_LAYER_ORDER | RENDER_LAYER_VARIANCE) ? "they are" : "it is");
     if (!o->scene_path && (r == ATMOS_RENDERER_SLICE || r == ATMOS_RENDERER_NISHITA || r == ATMOS_RENDERER_HARRIS) &&
         !s->volume.source[0])
         return cli_usage_error(C, "--renderer %s needs --volume SOURCE (a file, generate:NAME or simulate:PRESET)",

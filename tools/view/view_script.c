@@ -103,6 +103,10 @@ static int key_frame(const char *file, const cJSON *o, int i, double t_prev, int
     if (t->valuedouble < 0) return fail(file, sub, "must be >= 0, got %g", t->valuedouble);
     k->t = t->valuedouble;
     if ((rc = vec3(file, o, ptr, "position_m", k->pos)) || (rc = vec3(file, o, ptr, "look_at_m", k->look_at))) return rc;
+    if (k->pos[0] == k->look_at[0] && k->pos[1] == k->look_at[1] && k->pos[2] == k->look_at[2]) {
+        snprintf(sub, sizeof sub, "%s/look_at_m", ptr); /* no direction to look in: the scene reader's verdict */
+        return fail(file, sub, "must differ from position_m");
+    }
     const cJSON *sun = cJSON_GetObjectItemCaseSensitive(o, "sun");
     if (sun) {
         snprintf(sub, sizeof sub, "%s/sun", ptr);
@@ -138,6 +142,34 @@ static char *flight_text(atmos_context *ctx, const char *file, int *rc)
     return text;
 }
 
+/* The sun at fraction f of the way from key frame a's to b's (the azimuth along the shorter arc). */
+static void sun_between(const view_key_frame *a, const view_key_frame *b, double f, double *el, double *az)
+{
+    const double daz = fmod(b->sun_az - a->sun_az + 540.0, 360.0) - 180.0;
+    *el = a->sun_el + f * (b->sun_el - a->sun_el);
+    *az = fmod(a->sun_az + f * daz + 360.0, 360.0);
+}
+
+/* When some key frames set the sun, each key frame without one is given the sun interpolated
+ * in time between the key frames around it that set one (held before the first and after the
+ * last): the flight's sun is then linear between the keys that give it, as the camera is. */
+static void fill_sun(view_script *s)
+{
+    int prev = -1;
+    for (int i = 0; i < s->n; i++) {
+        if (s->k[i].has_sun) {
+            prev = i;
+            continue;
+        }
+        int next = i + 1;
+        while (next < s->n && !s->k[next].has_sun) next++;
+        const view_key_frame *a = &s->k[prev >= 0 ? prev : next], *b = &s->k[next < s->n ? next : prev];
+        const double span = b->t - a->t, f = span > 0 ? (s->k[i].t - a->t) / span : 0.0;
+        sun_between(a, b, f, &s->k[i].sun_el, &s->k[i].sun_az);
+        s->k[i].has_sun = 1;
+    }
+}
+
 int view_script_load(atmos_context *ctx, const char *path, view_script *out)
 {
     static const char *const allowed[] = {"fps", "keys"};
@@ -163,6 +195,7 @@ int view_script_load(atmos_context *ctx, const char *path, view_script *out)
         for (const cJSON *k = keys->child; k; k = k->next) sun_keyed |= cJSON_GetObjectItemCaseSensitive(k, "sun") != NULL;
         for (int i = 0; i < out->n && rc == CLI_EXIT_OK; i++)
             rc = key_frame(path, cJSON_GetArrayItem(keys, i), i, i ? out->k[i - 1].t : -INFINITY, sun_keyed, &out->k[i]);
+        if (rc == CLI_EXIT_OK && sun_keyed) fill_sun(out);
     }
     cJSON_Delete(root);
     if (rc != CLI_EXIT_OK) view_script_free(out);
@@ -247,10 +280,8 @@ void view_script_step(const view_script *s, view_state *st, double t_prev, doubl
         look[c] = a->look_at[c] + f * (b->look_at[c] - a->look_at[c]);
     }
     place(st, pos, look);
-    if (a->has_sun) {
-        const double el = b->has_sun ? a->sun_el + f * (b->sun_el - a->sun_el) : a->sun_el;
-        double daz = b->has_sun ? fmod(b->sun_az - a->sun_az + 540.0, 360.0) - 180.0 : 0.0; /* the shorter arc */
-        st->sun_el = el, st->sun_az = fmod(a->sun_az + f * daz + 360.0, 360.0), st->sun_from_time = 0;
-        st->changes |= VIEW_CHANGED_SUN;
+    if (a->has_sun) { /* every key frame's, or none's (fill_sun) */
+        sun_between(a, b, f, &st->sun_el, &st->sun_az);
+        st->sun_from_time = 0, st->changes |= VIEW_CHANGED_SUN;
     }
 }
