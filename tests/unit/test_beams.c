@@ -557,19 +557,26 @@ static void test_interleave(void)
     atmos_image_destroy(inter);
 }
 
+/* The built-in unit sphere moved to (x, y, 0); NULL (a failed check) if it cannot be made. */
+static atmos_mesh *sphere_at(double x, double y)
+{
+    atmos_mesh *mesh = NULL;
+    atmos_mesh_transform tr;
+    atmos_mesh_transform_identity(&tr);
+    tr.position_m[0] = x, tr.position_m[1] = y;
+    CHECK_OK(atmos_mesh_load(ctx, "builtin:sphere", 0, &mesh));
+    if (mesh) CHECK_OK(atmos_mesh_apply_transform(ctx, mesh, &tr));
+    return mesh;
+}
+
 /* atmos__beams_ray_light_sum against atmos__beams_ray_light at every sample, on rays across a
  * sphere's shadow, for a point light (a cube map) and a spot (one face); and
  * atmos__beams_ray_light_sum_split (halved without its own test) on parts of the rays, the same
  * as the tested sum to the bit for the point light. */
 static void test_light_sum(void)
 {
-    atmos_mesh *mesh = NULL;
-    atmos_mesh_transform tr;
-    atmos_mesh_transform_identity(&tr);
-    tr.position_m[1] = 5;
-    CHECK_OK(atmos_mesh_load(ctx, "builtin:sphere", 0, &mesh));
+    atmos_mesh *mesh = sphere_at(0, 5);
     if (!mesh) return;
-    CHECK_OK(atmos_mesh_apply_transform(ctx, mesh, &tr));
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
     atmos_scene s;
@@ -625,13 +632,8 @@ static void test_light_sum(void)
  * a run across the edge read on one face would be wrong on the other side. */
 static void test_runs_across_faces(void)
 {
-    atmos_mesh *mesh = NULL;
-    atmos_mesh_transform tr;
-    atmos_mesh_transform_identity(&tr);
-    tr.position_m[0] = 3.5, tr.position_m[1] = 6.5;
-    CHECK_OK(atmos_mesh_load(ctx, "builtin:sphere", 0, &mesh));
+    atmos_mesh *mesh = sphere_at(3.5, 6.5);
     if (!mesh) return;
-    CHECK_OK(atmos_mesh_apply_transform(ctx, mesh, &tr));
     atmos_wavelengths wl;
     atmos_wavelengths_rgb(&wl);
     atmos_scene s;

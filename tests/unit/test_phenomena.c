@@ -406,10 +406,9 @@ static double first_ring(const profile *p, int k, double lo, double hi)
     return (b + 0.5 + (den < 0 ? 0.5 * (ym - yp) / den : 0)) * p->bin_deg;
 }
 
-static void test_glory(atmos_context *ctx)
+/* A narrow droplet distribution (8 um, sigma 0.1, as in thin altocumulus): the glory's rings. */
+static void build_narrow_droplets(atmos_context *ctx, optics *op)
 {
-    /* A narrow droplet distribution (as in thin altocumulus): the broad cloud preset
-     * keeps the central glory maximum but washes out the rings. */
     atmos_particle_desc p;
     memset(&p, 0, sizeof p);
     snprintf(p.name, sizeof p.name, "droplets");
@@ -418,8 +417,15 @@ static void test_glory(atmos_context *ctx)
     p.size.r_m = 8e-6;
     p.size.sigma = 0.1;
     p.fast = 1;
+    build_optics(ctx, &p, op);
+}
+
+static void test_glory(atmos_context *ctx)
+{
+    /* A narrow droplet distribution (as in thin altocumulus): the broad cloud preset
+     * keeps the central glory maximum but washes out the rings. */
     optics op;
-    build_optics(ctx, &p, &op);
+    build_narrow_droplets(ctx, &op);
     setup u;
     make_setup(ctx, 0, 24, atmos_phase_table_sigma_ext(op.t, 1), &u);
     atmos_image *img = render(ctx, &u, &op);
@@ -462,16 +468,8 @@ static double ring_swing(const profile *im)
 
 static void test_glory_dense(atmos_context *ctx)
 {
-    atmos_particle_desc p;
-    memset(&p, 0, sizeof p);
-    snprintf(p.name, sizeof p.name, "droplets");
-    p.kind = ATMOS_PARTICLE_WATER;
-    p.size.kind = ATMOS_SIZE_LOGNORMAL;
-    p.size.r_m = 8e-6;
-    p.size.sigma = 0.1;
-    p.fast = 1;
     optics op;
-    build_optics(ctx, &p, &op);
+    build_narrow_droplets(ctx, &op);
     slab_tau = 10;
     setup u;
     make_setup(ctx, 0, 24, atmos_phase_table_sigma_ext(op.t, 1), &u);
