@@ -29,7 +29,7 @@ static const atmos_setting slice_settings[] = {
      "light-buffer update: eq25 (the paper's) or eq24 (the exact product of F_i; the flag selects it)",
      SLICE(eq24)},
     {"low_albedo", "low-albedo", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
-     "single scattering with the plain phase function, light attenuated by T only (Riley Fig. 13)",
+     "single scattering with the plain phase function, light attenuated by T only, plus xi's ambient (xi 0: the first order alone; Riley Fig. 13)",
      SLICE(low_albedo)},
     {"grid_max_dim", "grid-max-dim", ATMOS_SETTING_INT, "voxels", 8, 2048, 0, 0, 256, NULL, 0,
      "the volume is box-filtered onto a grid of at most this many voxels per axis", SLICE(grid_max_dim)},
