@@ -347,6 +347,9 @@ ATMOS_API atmos_status atmos_scene_atmosphere_create(atmos_context *ctx, const a
 /* The most voxels atmos_scene_cloud_volume puts across its box (2 half_width_m / voxel_size_m,
  * rounded up): more is ATMOS_E_INVALID_ARG. */
 #define ATMOS_CLOUD_VOLUME_MAX_ACROSS 8192
+/* The voxels across that box, 2 half_width_m / voxel_size_m rounded up; 0 unless both are > 0.
+ * The box is allowed when it is 1..ATMOS_CLOUD_VOLUME_MAX_ACROSS. */
+ATMOS_API double atmos_scene_cloud_volume_across(double half_width_m, double voxel_size_m);
 ATMOS_API atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *scene, const double centre_xz[2],
                                                 double half_width_m, double voxel_size_m, atmos_volume **out);
 

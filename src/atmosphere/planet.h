@@ -37,7 +37,7 @@ typedef struct atmos__planet {
     float mie_cdf[ATMOS_MAX_WAVELENGTHS][ATMOS__PLANET_PHASE_N];
     double mie_g[ATMOS_MAX_WAVELENGTHS];  /* asymmetry parameter */
     /* The members above are the air's description, the spherical sky's cache key
-     * (spherical.c); what follows does not enter its tables. */
+     * (spherical.c, whose asserts pin the tail); what follows does not enter its tables. */
     /* the geographic frame (planet_surface.c): the Earth-centred axes (x to latitude 0,
      * longitude 0; y to longitude 90 E; z north) of the world's x (east at the origin),
      * y (up there) and -z (north there) */

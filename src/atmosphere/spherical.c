@@ -1,7 +1,7 @@
 /* The production sky over a spherical earth with all orders of scattering (Hillaire 2020):
  * the solver table of the SPHERICAL kind over the tables and the march of spherical.h,
- * the tables cached on disk (src/core/cache.h) under a key naming the whole planet
- * description. docs/sky.md, "The production sky". */
+ * the tables cached on disk (src/core/cache.h) under a key naming the air's description
+ * (the planet's members before its geographic frame). docs/sky.md, "The production sky". */
 #include "atmosphere/spherical.h"
 
 #include "core/cache.h"
@@ -27,6 +27,17 @@ static void sph_destroy(void *model)
 /* The key sums the air's description: the planet's members before its geographic frame. The
  * frame, the ground's maps and the cloud spheres (pointers: other addresses every run) do not
  * enter the tables, and summing them made every run of an Earth scene build them again. */
+/* The key sums the bytes before geo_east, so it relies on the members' order: the tail after
+ * the air (frame, maps, clouds) is pinned here, and a member added to it, or between the air and
+ * it, stops the build instead of silently dropping out of the key. A new member of the air goes
+ * before geo_east. */
+_Static_assert(offsetof(atmos__planet, geo_east) == offsetof(atmos__planet, mie_g) + sizeof(((atmos__planet *)0)->mie_g),
+               "atmos__planet: the air's description must end with mie_g, just before geo_east");
+_Static_assert(offsetof(atmos__planet, surface) == offsetof(atmos__planet, geo_east) + 9 * sizeof(double) &&
+                   offsetof(atmos__planet, clouds) == offsetof(atmos__planet, surface) + sizeof(void *) &&
+                   sizeof(atmos__planet) == offsetof(atmos__planet, clouds) + sizeof(void *),
+               "atmos__planet: a member after geo_east does not enter the cache key; put the air's before it");
+
 static void cache_key(const atmos__planet *pl, const atmos__sph_model *m, char *key, size_t cap)
 {
     snprintf(key, cap,

@@ -52,8 +52,27 @@ void *atmos__module_open(const char *file, char *msg, size_t cap)
     }
     void *h = dlopen(file, RTLD_NOW | RTLD_LOCAL);
     if (!h && msg && cap)
-        snprintf(msg, cap, "%s not found (looked in %s, %s/%s and the loader's folders): %s", file,
+        snprintf(msg, cap, "%s not found (looked in %s%s%s, %s/%s and the loader's folders): %s", file,
+                 base[0] ? base[0] : "", base[0] ? " (ATMOS_MODULE_DIR), " : "",
                  have_dir ? dir : "(the library's folder unknown)", have_dir ? dir : "", ATMOS_MODULE_FROM_BIN,
                  dlerror());
     return h;
+}
+
+void *atmos__module_symbol(const char *file, const char *sym, const atmos__module_stamp *want, char *why,
+                           size_t cap)
+{
+    void *h = atmos__module_open(file, why, cap);
+    if (!h) return NULL;
+    const atmos__module_stamp *got = (const atmos__module_stamp *)dlsym(h, ATMOS__MODULE_STAMP);
+    if (!got || strncmp(got->version, want->version, sizeof got->version) != 0 || got->abi != want->abi ||
+        memcmp(got->sizes, want->sizes, sizeof got->sizes) != 0) {
+        snprintf(why, cap, "%s was built for another libatmos (%.24s, interface %u; this one is %s, interface %u)",
+                 file, got ? got->version : "no stamp", got ? got->abi : 0u, want->version, want->abi);
+        dlclose(h);
+        return NULL;
+    }
+    void *p = dlsym(h, sym);
+    if (!p) snprintf(why, cap, "%s: no %s in it", file, sym);
+    return p;
 }

@@ -2,7 +2,8 @@
  * dlopen on their first use, so that a program pays for loading their dependencies only
  * when it uses them (docs/architecture.md, "Each atmos process's start"): the OpenVDB
  * reader (libatmos_openvdb.so, volume/openvdb_module.c) drags in OpenVDB, TBB and Imath,
- * whose symbol bindings were more than half of every `atmos` process's start. */
+ * whose symbol bindings were more than half of every `atmos` process's start; the height map
+ * reader (libatmos_gdal.so, mesh/mesh_gdal.c) drags in GDAL and its hundred libraries. */
 #ifndef ATMOS_CORE_MODULE_H
 #define ATMOS_CORE_MODULE_H
 
@@ -19,5 +20,23 @@
  *     system's folders).
  * NULL when none opens, with the places tried and the loader's last message in msg. */
 void *atmos__module_open(const char *file, char *msg, size_t cap);
+
+/* What a module was built for, its export ATMOS__MODULE_STAMP: the library's version, the
+ * interface's revision (bump ATMOS__MODULE_ABI when a structure crossing it changes without
+ * changing size) and the sizes of the structures crossing it (0 for the unused). A module of
+ * another build (an older install, a second atmos on the system) is refused, not called. */
+#define ATMOS__MODULE_ABI 1u
+#define ATMOS__MODULE_STAMP "atmos_module_stamp"
+typedef struct atmos__module_stamp {
+    char version[24];
+    unsigned abi;
+    size_t sizes[3];
+} atmos__module_stamp;
+
+/* The symbol `sym` of the module `file` (atmos__module_open), once its stamp matches `want`
+ * (version and abi: the library's own; sizes: the caller's). NULL with why (cap bytes) when
+ * the module is missing, stale ("built for another libatmos") or lacks the symbol. */
+void *atmos__module_symbol(const char *file, const char *sym, const atmos__module_stamp *want, char *why,
+                           size_t cap);
 
 #endif

@@ -8,8 +8,8 @@
  * table. The table is made by evaluating that very path (each interval's ends and a bisection
  * between them); where the path's roundings step back and forth about a step (v 255 + 1/2 within
  * a few ulps of a whole number), its interval is marked and its values take the path itself. The
- * same bytes as the path (test_display compares the two over every 5th float of the table's
- * range; every float of it, for the three curves, on 2026-12-06). */
+ * same bytes as the path (test_display compares the two over every 5th float from 2^-17 to 2^11,
+ * the table's range and an octave either side; every float of it with ATMOS_TEST_EXHAUSTIVE=1). */
 #include "core/internal.h"
 #include "image/display_internal.h"
 

@@ -4,7 +4,6 @@
 
 #include "core/module.h"
 
-#include <dlfcn.h>
 #include <errno.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -18,10 +17,9 @@ static pthread_once_t gdal_once = PTHREAD_ONCE_INIT;
 
 static void load_once(void)
 {
-    void *h = atmos__module_open(ATMOS__GDAL_MODULE, gdal_why, sizeof gdal_why);
-    if (h) *(void **)&gdal_read = dlsym(h, ATMOS__GDAL_MODULE_ENTRY);
-    if (h && !gdal_read)
-        snprintf(gdal_why, sizeof gdal_why, "%s: no %s in it", ATMOS__GDAL_MODULE, ATMOS__GDAL_MODULE_ENTRY);
+    const atmos__module_stamp want = ATMOS__GDAL_MODULE_STAMP;
+    *(void **)&gdal_read =
+        atmos__module_symbol(ATMOS__GDAL_MODULE, ATMOS__GDAL_MODULE_ENTRY, &want, gdal_why, sizeof gdal_why);
 }
 
 atmos_status atmos__terrain_read(atmos_context *ctx, const char *path, int stride, long max_triangles,

@@ -3,6 +3,7 @@
 #define ATMOS_MESH_INTERNAL_H
 
 #include "core/internal.h"
+#include "core/module.h"
 
 /* A mesh with room for nv vertices and nt triangles (contents zero), normals per vertex when
  * vertex_normals, else per triangle. */
@@ -27,10 +28,11 @@ typedef struct atmos__heights {
 atmos_status atmos__terrain_read(atmos_context *ctx, const char *path, int stride, long max_triangles,
                                  atmos__heights *out);
 
-/* The GDAL module (terrain_gdal.c, libatmos_gdal.so) and its one export: atmos__terrain_read's
- * work on a file that opens, the message of a failure in msg (cap bytes). */
+/* The GDAL module (terrain_gdal.c, libatmos_gdal.so), its stamp (core/module.h) and its entry:
+ * atmos__terrain_read's work on a file that opens, the message of a failure in msg (cap bytes). */
 #define ATMOS__GDAL_MODULE "libatmos_gdal.so"
 #define ATMOS__GDAL_MODULE_ENTRY "atmos_gdal_module_v1"
+#define ATMOS__GDAL_MODULE_STAMP {ATMOS_VERSION_STRING, ATMOS__MODULE_ABI, {sizeof(atmos__heights), 0, 0}}
 typedef atmos_status (*atmos__gdal_module_entry)(const char *path, int stride, long max_triangles,
                                                  atmos__heights *out, char *msg, size_t cap);
 

@@ -73,7 +73,11 @@ static atmos_status read_rows(char *msg, size_t cap, const char *path, GDALRaste
     return ATMOS_OK;
 }
 
-/* The module's one export (mesh_internal.h's atmos__gdal_module_entry). */
+/* What the module was built for (core/module.h): the library checks it before the entry. */
+extern const atmos__module_stamp atmos_module_stamp;
+__attribute__((visibility("default"))) const atmos__module_stamp atmos_module_stamp = ATMOS__GDAL_MODULE_STAMP;
+
+/* The module's entry (mesh_internal.h's atmos__gdal_module_entry). */
 atmos_status atmos_gdal_module_v1(const char *path, int stride, long max_triangles, atmos__heights *out, char *msg,
                                   size_t cap);
 __attribute__((visibility("default"))) atmos_status

@@ -11,11 +11,13 @@
  * Ams_{n+1} toward the eye light that the field already holds as orders >= 2. So with "do" the
  * light pass is the delta-M direct beam alone, I = E exp(-tau*) (low albedo's plain attenuation
  * with sigma_t*: F and the scattering count n play no part), and the eye pass is TMS's first
- * order (Nakajima & Tanaka 1988), sigma_s p(theta) I with the full phase table (Ams_1: the
- * rainbows, halos and glories as sharp as in low albedo), plus sigma_s* times the field's
- * coefficients toward the eye, both attenuated toward the eye by sigma_t*; xi is 0 (the field is
- * the multiple scattering it stood for). The same sum as the Nishita renderer's with "do"
- * (nishita_render.c), on the slice renderer's grid, slices and light buffer.
+ * order (Nakajima & Tanaka 1988), sigma_s p(theta) I (front to back the share
+ * exp(-(tau - tau*)) with the full phase table, Ams_1, the rest smoothed over the forward peak:
+ * below; back to front the full table alone), plus sigma_s* times the field's coefficients toward
+ * the eye, both attenuated toward the eye by sigma_t*; xi is 0 (the field is the multiple
+ * scattering it stood for). The Nishita renderer's sum with "do" (nishita_render.c) is the same
+ * but for that split: its first order is the full table's whole, on its own grid; this one is on
+ * the slice renderer's grid, slices and light buffer.
  *
  * The first order split in a sharp and a smooth part (since 2026-12-06; docs/lightfield.md, "The
  * phenomena"): the delta-M direct beam E exp(-tau*) holds light that the particles' forward peak

@@ -12,6 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+double atmos_scene_cloud_volume_across(double half_width_m, double voxel_size_m)
+{
+    return half_width_m > 0 && voxel_size_m > 0 ? ceil(2.0 * half_width_m / voxel_size_m) : 0;
+}
+
 atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *scene, const double centre_xz[2],
                                       double half_width_m, double voxel_size_m, atmos_volume **out)
 {
@@ -21,10 +26,11 @@ atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *sce
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud volume: the scene's atmosphere has no \"clouds\"");
     if (!(half_width_m > 0 && voxel_size_m > 0))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "cloud volume: need a half width > 0 and a voxel size > 0");
-    if (!(ceil(2.0 * half_width_m / voxel_size_m) <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
+    const double across = atmos_scene_cloud_volume_across(half_width_m, voxel_size_m);
+    if (!(across <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
                             "cloud volume: a half width of %g m in voxels of %g m gives %.0f voxels across (allowed 1..%d)",
-                            half_width_m, voxel_size_m, ceil(2.0 * half_width_m / voxel_size_m), ATMOS_CLOUD_VOLUME_MAX_ACROSS);
+                            half_width_m, voxel_size_m, across, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
     atmos_particle_desc cloud;
     atmos_status st = atmos_particle_preset(ctx, "cloud", &cloud);
     if (st) return st;
@@ -40,7 +46,7 @@ atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *sce
     const double y0 = floor((base - far2 / (2.0 * R)) / voxel_size_m) * voxel_size_m;
     atmos_volume_desc vd;
     memset(&vd, 0, sizeof vd);
-    vd.dims[0] = vd.dims[2] = (int)ceil(2.0 * half_width_m / voxel_size_m);
+    vd.dims[0] = vd.dims[2] = (int)across;
     vd.dims[1] = (int)ceil((top - y0) / voxel_size_m);
     vd.voxel_size_m = voxel_size_m;
     vd.origin_m[0] = cx - half_width_m, vd.origin_m[1] = y0, vd.origin_m[2] = cz - half_width_m;

@@ -4,7 +4,6 @@
 
 #include "core/module.h"
 
-#include <dlfcn.h>
 #include <pthread.h>
 #include <stdio.h>
 
@@ -14,12 +13,10 @@ static pthread_once_t vdb_once = PTHREAD_ONCE_INIT;
 
 static void load_once(void)
 {
-    void *h = atmos__module_open(ATMOS__VDB_MODULE, vdb_why, sizeof vdb_why);
-    if (!h) return;
+    const atmos__module_stamp want = ATMOS__VDB_MODULE_STAMP;
     atmos__vdb_module_entry entry;
-    *(void **)&entry = dlsym(h, ATMOS__VDB_MODULE_ENTRY);
+    *(void **)&entry = atmos__module_symbol(ATMOS__VDB_MODULE, ATMOS__VDB_MODULE_ENTRY, &want, vdb_why, sizeof vdb_why);
     if (entry) vdb_api = entry();
-    if (!vdb_api) snprintf(vdb_why, sizeof vdb_why, "%s: no %s in it", ATMOS__VDB_MODULE, ATMOS__VDB_MODULE_ENTRY);
 }
 
 int atmos__vdb_module_load(char *msg, size_t cap)

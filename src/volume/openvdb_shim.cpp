@@ -94,8 +94,6 @@ const char *stats_disagree(const openvdb::GridBase &grid, const atmos__vdb_grid_
 
 } // namespace
 
-static const char *shim_library_version(void) { return OPENVDB_LIBRARY_VERSION_STRING; }
-
 static void shim_close(atmos__vdb *f);
 
 static int shim_open(const char *path, atmos__vdb **out, char *msg, size_t cap)
@@ -276,6 +274,10 @@ static int shim_visit(atmos__vdb *f, int index, atmos__vdb_block_fn fn, void *us
 extern "C" __attribute__((visibility("default"))) const atmos__vdb_api *atmos_openvdb_module_v1(void)
 {
     static const atmos__vdb_api api = {shim_open, shim_close, shim_grid_count, shim_get_grid_info,
-                                       shim_load_grid, shim_visit, shim_library_version};
+                                       shim_load_grid, shim_visit};
     return &api;
 }
+
+// What it was built for (core/module.h): the library checks it before calling the entry.
+extern "C" __attribute__((visibility("default"))) const atmos__module_stamp atmos_module_stamp;
+const atmos__module_stamp atmos_module_stamp = ATMOS__VDB_MODULE_STAMP;

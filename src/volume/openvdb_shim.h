@@ -9,6 +9,8 @@
 #ifndef ATMOS_OPENVDB_SHIM_H
 #define ATMOS_OPENVDB_SHIM_H
 
+#include "core/module.h"
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -59,8 +61,8 @@ typedef int (*atmos__vdb_block_fn)(void *user, const int origin[3], const int si
 
 /* The shim's entry points. They live in the module libatmos_openvdb.so, opened on the first
  * use (volume/openvdb_module.c, core/module.h), so that only a program reading a .vdb file
- * loads OpenVDB and its libraries; the module's one export is ATMOS__VDB_MODULE_ENTRY, a
- * function returning this table. */
+ * loads OpenVDB and its libraries; the module's exports are its stamp (ATMOS__VDB_MODULE_STAMP,
+ * core/module.h) and ATMOS__VDB_MODULE_ENTRY, a function returning this table. */
 typedef struct atmos__vdb_api {
     int (*open)(const char *path, atmos__vdb **out, char *msg, size_t cap);
     void (*close)(atmos__vdb *f);
@@ -71,12 +73,14 @@ typedef struct atmos__vdb_api {
     /* Walks the loaded grid `index`: every leaf as an 8^3 block (inactive voxels 0) and
      * every active tile as a constant block. */
     int (*visit)(atmos__vdb *f, int index, atmos__vdb_block_fn fn, void *user, char *msg, size_t cap);
-    /* The library's version string ("10.0.1"), for messages. */
-    const char *(*library_version)(void);
 } atmos__vdb_api;
 
 #define ATMOS__VDB_MODULE "libatmos_openvdb.so"
 #define ATMOS__VDB_MODULE_ENTRY "atmos_openvdb_module_v1"
+#define ATMOS__VDB_MODULE_STAMP                                                                                     \
+    {ATMOS_VERSION_STRING,                                                                                          \
+     ATMOS__MODULE_ABI,                                                                                             \
+     {sizeof(atmos__vdb_api), sizeof(atmos__vdb_grid_info), sizeof(atmos__vdb_grid_stats)}}
 typedef const atmos__vdb_api *(*atmos__vdb_module_entry)(void);
 
 /* The library's side (openvdb_module.c). atmos__vdb_module_load opens the module once per

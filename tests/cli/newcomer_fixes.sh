@@ -73,6 +73,9 @@ hasnt "--exr-layers variance, sky" "order"
 # a word for an integer setting names the range, as a number outside it does
 "$A" render --nishita-orders x --width 8 --height 8 -o "$T/n.png" -q 2>"$T/err" && bad "--nishita-orders x: exit 0"
 has "--nishita-orders x" "--nishita-orders: expected an integer in [1, 3], got 'x'"
+# and so does one for a real-valued setting
+"$A" render --xi x --width 8 --height 8 -o "$T/n.png" -q 2>"$T/err" && bad "--xi x: exit 0"
+has "--xi x" "--xi: expected a value in [0, 100] sr^-1, got 'x'"
 # an output whose temporary cannot be made: said of the output, not naming the output as the temporary
 "$A" volume slice "$T/cu.json" --axis x -o /proc/atmos_slice.png 2>"$T/err" && bad "volume slice into /proc: exit 0"
 has "volume slice into /proc" "/proc/atmos_slice.png: cannot create a temporary file beside it"

@@ -3,6 +3,7 @@
  * with a stride), the generated ridges are deterministic by seed and span [0, height_m], and
  * broken, missing, non-raster, absurdly sized, NaN and flat inputs are clear errors. */
 #include "atmos/atmos.h"
+#include "mesh/mesh_internal.h"
 #include "test.h"
 
 #ifdef ATMOS_HAVE_GDAL
@@ -184,6 +185,25 @@ static void test_files(void)
     CHECK(write_raster("GTiff", path, 4, 4, GDT_Float32, 5));
     expect_fail(path, ATMOS_E_FORMAT, "pixel (1, 1) is not finite");
 }
+
+/* The module's stamp (core/module.h): a module built for another libatmos is refused with a
+ * message saying so, never called; the right one gives its entry. */
+static void test_module_stamp(void)
+{
+    atmos__module_stamp want = {"", ATMOS__MODULE_ABI, {sizeof(atmos__heights), 0, 0}};
+    snprintf(want.version, sizeof want.version, "%s", atmos_version());
+    char why[512] = "";
+    CHECK(atmos__module_symbol(ATMOS__GDAL_MODULE, ATMOS__GDAL_MODULE_ENTRY, &want, why, sizeof why) != NULL);
+    atmos__module_stamp stale = want;
+    stale.abi = ATMOS__MODULE_ABI + 1;
+    CHECK(atmos__module_symbol(ATMOS__GDAL_MODULE, ATMOS__GDAL_MODULE_ENTRY, &stale, why, sizeof why) == NULL);
+    CHECK(strstr(why, "built for another libatmos") != NULL);
+    stale = want, stale.sizes[0] += 8; /* atmos__heights grown on one side */
+    CHECK(atmos__module_symbol(ATMOS__GDAL_MODULE, ATMOS__GDAL_MODULE_ENTRY, &stale, why, sizeof why) == NULL);
+    snprintf(stale.version, sizeof stale.version, "0.0.1"), stale.sizes[0] = want.sizes[0];
+    CHECK(atmos__module_symbol(ATMOS__GDAL_MODULE, ATMOS__GDAL_MODULE_ENTRY, &stale, why, sizeof why) == NULL);
+    CHECK(strstr(why, "0.0.1") != NULL);
+}
 #endif
 
 int main(void)
@@ -192,6 +212,7 @@ int main(void)
     test_generated();
 #ifdef ATMOS_HAVE_GDAL
     test_files();
+    test_module_stamp();
 #else
     atmos_mesh *m = NULL;
     CHECK(load("x.tif", 10, 0, 0, 0, 0, &m) == ATMOS_E_UNSUPPORTED);

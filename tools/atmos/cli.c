@@ -12,12 +12,20 @@
 #include <time.h>
 #include <unistd.h>
 
-int cli_parse_double(const char *cmd, const char *opt, const char *text, double *out)
+int cli_strtod(const char *text, double *out)
 {
     char *end = NULL;
     errno = 0;
-    double v = text ? strtod(text, &end) : 0.0;
-    if (!text || end == text || *end != '\0' || errno == ERANGE || !isfinite(v)) {
+    const double v = text ? strtod(text, &end) : 0.0;
+    if (!text || end == text || *end != '\0' || errno == ERANGE || !isfinite(v)) return 0;
+    *out = v;
+    return 1;
+}
+
+int cli_parse_double(const char *cmd, const char *opt, const char *text, double *out)
+{
+    double v = 0.0;
+    if (!cli_strtod(text, &v)) {
         fprintf(stderr, "atmos %s: %s: expected a finite number, got '%s'\nTry 'atmos %s --help'.\n", cmd, opt,
                 text ? text : "", cmd);
         return 0;

@@ -376,9 +376,10 @@ static int cmd_clouds(int argc, char **argv)
     if (!scene_path) return cli_usage_error(C, "clouds: which scene?");
     if (!out) return cli_usage_error(C, "clouds: missing -o NAME.json");
     if (!(half > 0 && voxel > 0)) return cli_usage_error(C, "clouds: --half-width and --voxel-size must be > 0");
-    if (!(ceil(2.0 * half / voxel) <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
+    const double across = atmos_scene_cloud_volume_across(half, voxel);
+    if (!(across <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
         return cli_usage_error(C, "clouds: --half-width %g m in voxels of --voxel-size %g m gives %.0f voxels across (allowed 1..%d)",
-                               half, voxel, ceil(2.0 * half / voxel), ATMOS_CLOUD_VOLUME_MAX_ACROSS);
+                               half, voxel, across, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
     if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 1);

@@ -119,15 +119,10 @@ static int parse_setting(const char *C, const atmos_setting *s, const char *text
         *out = (double)v;
         return 1;
     }
-    double v;
-    if (s->type == ATMOS_SETTING_INT) { /* a word: the integer range said, as for a number outside it */
-        char *end = NULL;
-        v = strtod(text, &end);
-        if (end == text || *end || !isfinite(v)) v = NAN;
-    } else if (!cli_parse_double(C, opt, text, &v))
-        return 0;
+    double v = NAN; /* a word: the range said, as for a number outside it */
+    cli_strtod(text, &v);
     const int low = s->min_open ? v <= s->min : v < s->min, high = s->max_open ? v >= s->max : v > s->max;
-    if (low || high || (s->type == ATMOS_SETTING_INT && !(v == floor(v)))) {
+    if (low || high || isnan(v) || (s->type == ATMOS_SETTING_INT && !(v == floor(v)))) {
         cli_usage_error(C, "%s: expected %s in %c%g, %g%c%s%s, got '%s'", opt,
                         s->type == ATMOS_SETTING_INT ? "an integer" : "a value", s->min_open ? '(' : '[', s->min, s->max,
                         s->max_open ? ')' : ']', s->unit[0] ? " " : "", s->unit, text);
