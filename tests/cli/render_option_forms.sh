@@ -124,15 +124,7 @@ done <"$T/table"
 # --exposure auto on a scene with a manual EV: the -D form's exposure, not that EV taken as
 # a compensation of +9 stops (which turned Fig. 4's beam white).
 png_scale() { # the exposure scale a PNG's metadata records
-    python3 -c '
-import struct, sys
-d = open(sys.argv[1], "rb").read()
-i = 8
-while i < len(d):
-    n, = struct.unpack(">I", d[i:i + 4])
-    if d[i + 4:i + 8] == b"tEXt" and d[i + 8:i + 8 + n].startswith(b"atmos:exposure_scale\0"):
-        print(d[i + 8:i + 8 + n].split(b"\0")[1].decode())
-    i += 12 + n' "$1"
+    png_text "$1" atmos:exposure_scale
 }
 # shellcheck disable=SC2046
 "$A" render $(base beams) --exposure auto -q -o "$T/auto_opt.png" || bad "render --exposure auto"

@@ -47,15 +47,7 @@ printf '{"renderer": "slice", "volume": {"generate": "cumulus"}, "slice": {"do":
 # --slice-p1 or a setting of Riley's path (xi, update), none with --no-diffuse; contradictions
 # refused. The do field and the P1 field draw different images.
 meta() { # the PNG's atmos:slice text
-    python3 -c '
-import struct, sys
-d = open(sys.argv[1], "rb").read()
-i = 8
-while i < len(d):
-    n, = struct.unpack(">I", d[i:i + 4])
-    if d[i + 4:i + 8] == b"tEXt" and d[i + 8:i + 8 + n].startswith(b"atmos:slice\0"):
-        print(d[i + 8:i + 8 + n].split(b"\0")[1].decode())
-    i += 12 + n' "$1"
+    png_text "$1" atmos:slice
 }
 for f in "do:" "p1:--slice-p1" "p1:--xi 0.02" "p1:--eq24" "none:--no-diffuse" "do:--slice-do"; do
     o=${f#*:}
