@@ -158,7 +158,8 @@ struct atmos__beams_plan {
     /* the last frame, along the ray through the image's centre: Dobashi Fig. 5's counts */
     int centre_planes, centre_subplanes;
     /* the last frame's pixels, and how many of them had their airlight evaluated (the others
-     * interpolated: beams/screen_step, beams_screen.h; evaluations counted again where two bands meet) */
+     * interpolated: beams/screen_step, beams_screen.h; evaluations counted again where two bands meet,
+     * and in each of a frame's two layers, the spots' and the other lights', when it has both) */
     long air_pixels, air_evaluated;
     /* a frame's per-pixel buffers, kept for the next frame (beams_kept.h): the primary
      * visibility's two, then the subsampled frame's (beams_render.c) */

@@ -24,7 +24,8 @@
  * With beams/screen_step k > 1 (beams_screen.h) the airlight (the lights' and the sun's) is
  * evaluated on a lattice of every k-th pixel and interpolated across the cells where that is
  * safe (a cell that a light's screen span crosses is always cut, unless the span is many cells
- * wide there: the lit cones' hint), the surfaces
+ * wide there: the lit cones' hint; the spots on a lattice of their own when there are other lights
+ * or the sun, air_layers), the surfaces
  * still per pixel, the sky behind from the sky renderer's grid of every k-th pixel (at most 4).
  * Rows go to the threads; each pixel depends on nothing but its own ray (or its band of the
  * lattice), so the image does not depend on the thread count. */
@@ -53,6 +54,9 @@
 #ifndef POINT_READ_MAX
 #define POINT_READ_MAX 3
 #endif
+
+/* Every light (lights()' mask). */
+#define ALL_LIGHTS 0xffffffffu
 
 /* A point light's neighbouring intervals whose f_l sum to less than this share of a sub-plane's
  * (epsilon of the pixel's airlight) share one sample (merged()). */
@@ -404,17 +408,24 @@ static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights :
  * interval gets a sub-plane for every epsilon of the pixel's unshadowed airlight from all its
  * lights (each light's f_l sum weighted by its mean intensity) that it could add, so a light
  * whose airlight is a small share of the pixel's gets few; with one light, epsilon of its own. */
-static void lights(job *J, int x, int y, const double d[3], double T, double *f, double *L, int centre, double o)
+static void lights(job *J, int x, int y, const double d[3], double T, double *f, double *L, int centre, double o,
+                   uint32_t mask)
 {
     const int nl = J->b->nlights;
     double *S = f + (size_t)nl * LIGHT_STRIDE, *cnt = S + nl, tot = 0;
-    int lit = 0;
-    for (int i = 0; i < nl; i++) {
-        cnt[i] = in_span(J, i, x, y) ? intervals(J, i, d, T, f + (size_t)i * LIGHT_STRIDE, &S[i], centre) : 0;
-        if (cnt[i] > 0) tot += J->weight[i] * S[i], lit++;
+    int lit = 0, any = 0;
+    for (int pass = 0; pass < 2; pass++) { /* the lights of mask, then (if any of them adds) the others */
+        for (int i = 0; i < nl; i++)
+            if ((mask >> i & 1) == !pass) {
+                cnt[i] = in_span(J, i, x, y) ? intervals(J, i, d, T, f + (size_t)i * LIGHT_STRIDE, &S[i], centre) : 0;
+                any |= cnt[i] > 0;
+            }
+        if (!any) return;
     }
     for (int i = 0; i < nl; i++)
-        if (cnt[i] > 0) {
+        if (cnt[i] > 0) tot += J->weight[i] * S[i], lit++;
+    for (int i = 0; i < nl; i++)
+        if (cnt[i] > 0 && mask >> i & 1) {
             const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
             airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o);
         }
@@ -439,7 +450,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
         const double fog_t = base_light(J, x, y, d, hit ? &h : NULL, m, cones, px, b->sun_on, L);
         if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         if (!il) {
-            if (b->sigma_t > 0) lights(J, x, y, d, T, f, L, x == J->cx && y == J->cy, 0.5);
+            if (b->sigma_t > 0) lights(J, x, y, d, T, f, L, x == J->cx && y == J->cy, 0.5, ALL_LIGHTS);
             if (b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         }
         for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
@@ -448,7 +459,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     const long q = atmos__beams_il_index(il, x, y);
     const double o = atmos__beams_il_offset(il->n, x, y);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
-    if (b->sigma_t > 0) lights(J, x, y, d, T, f, A, px && x == J->cx && y == J->cy, o);
+    if (b->sigma_t > 0) lights(J, x, y, d, T, f, A, px && x == J->cx && y == J->cy, o, ALL_LIGHTS);
     for (int k = 0; k < J->nw; k++) il->air[(size_t)q * J->nw + k] = (float)A[k];
     il->depth[q] = (float)T, il->object[q] = hit ? m : -1;
 }
@@ -597,6 +608,10 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
 #ifndef SCREEN_HINT
 #define SCREEN_HINT 1
 #endif
+/* 1: a subsampled frame's spots on a lattice of their own (air_layers). */
+#ifndef SCREEN_LAYERS
+#define SCREEN_LAYERS 1
+#endif
 /* A span this many cells' widths wide (or more) in every row of a cell is not its hint there. */
 #ifndef SCREEN_WIDE
 #define SCREEN_WIDE 8
@@ -661,15 +676,42 @@ static void surface_row(const job *J, const atmos__rect *r, int y, const screen_
     }
 }
 
-/* The airlight of pixel (x, y) (atmos__beams_air_fn): the lights' and the sun's. */
+/* One layer of a subsampled frame's airlight: the lights of mask (light i: bit i), and the sun's
+ * if sun; each layer has its own lattice, its own cuts and its own hints (those of its lights). */
+typedef struct air_layer {
+    job *J;
+    uint32_t mask;
+    int sun;
+} air_layer;
+
+/* The airlight of pixel (x, y) (atmos__beams_air_fn) of the layer user: its lights' and the sun's. */
 static void air_pixel(void *user, double *f, int x, int y, double T, double *A)
 {
-    job *J = user;
+    const air_layer *a = user;
+    job *J = a->J;
     double d[3];
     kept_ray(J, x, y, d);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
-    if (J->b->sigma_t > 0) lights(J, x, y, d, T, f, A, J->centre_now, 0.5);
-    if (J->b->sun_on) sun_air(J, d, T, A);
+    if (J->b->sigma_t > 0) lights(J, x, y, d, T, f, A, J->centre_now, 0.5, a->mask);
+    if (a->sun && J->b->sun_on) sun_air(J, d, T, A);
+}
+
+/* A subsampled frame's layers into a (at most 2; returns how many): the spots apart from the
+ * other lights and the sun when there are both, so that a spot's span, a hint that cuts the
+ * cells along its beam down to single pixels, cuts only the spots' lattice, and the others'
+ * airlight (a point light's glow, the sun's) is still interpolated there where it is smooth;
+ * else one layer of everything. Either way a pixel evaluated in every layer gets the light it
+ * would get in one (the sub-planes per light as before: lights() weighs all the pixel's lights). */
+static int air_layers(job *J, air_layer a[2])
+{
+    uint32_t spots = 0;
+    for (int i = 0; i < J->b->nlights; i++)
+        if (J->b->lights[i].L.type == ATMOS_LIGHT_SPOT) spots |= (uint32_t)1 << i;
+    const uint32_t all = J->b->nlights >= 32 ? ALL_LIGHTS : ((uint32_t)1 << J->b->nlights) - 1, rest = all & ~spots;
+    a[0] = (air_layer){J, ALL_LIGHTS, 1};
+    if (!SCREEN_LAYERS || !spots || (!rest && !J->b->sun_on)) return 1;
+    a[0].mask = rest, a[1] = (air_layer){J, spots, 0};
+    return 2;
 }
 
 
@@ -678,28 +720,37 @@ static void screen_buf_free(screen_buf *q) /* the others are the plan's, kept fo
     free(q->X), free(q->Y);
 }
 
-/* Band j of a subsampled frame (atmos__beams_screen_band) from the lattice's nodes, added to the
- * pixels' light (its last row only in the last band: the next band's first). Returns the pixels
- * evaluated. */
-static long screen_band(const atmos__beams_screen *s, const screen_buf *q, int nx, int ny, int j, double *f,
-                        double *band, unsigned char *state, atmos_image *out)
+/* Band j of a subsampled frame (atmos__beams_screen_band) from the lattice's nodes, each of the
+ * nl layers s[l] in its own band[l] and state[l], their sum added to the pixels' light (its last
+ * row only in the last band: the next band's first). Returns the pixels evaluated (in each
+ * layer: a pixel evaluated in two counts twice). */
+static long screen_band(const atmos__beams_screen *s, int nl, const screen_buf *q, int nx, int ny, int j, double *f,
+                        double *const *band, unsigned char *const *state, atmos_image *out)
 {
     const atmos__rect *r = &s->r;
     const int W = r->x1 - r->x0, nw = s->nw, y0 = q->Y[j], y1 = ny > 1 ? q->Y[j + 1] : y0;
-    memset(state, 0, (size_t)W * (size_t)(y1 - y0 + 1));
-    for (int e = 0; e < (ny > 1 ? 2 : 1); e++)
-        for (int i = 0; i < nx; i++) {
-            const size_t at = (size_t)(e ? y1 - y0 : 0) * W + (size_t)(q->X[i] - r->x0);
-            memcpy(band + at * nw, q->node + ((size_t)(j + e) * nx + i) * nw, sizeof(double) * nw);
-            state[at] = 2;
-        }
-    const long ev = atmos__beams_screen_band(s, f, q->X, nx, y0, y1, band, state);
+    const size_t layer = (size_t)nx * ny * nw; /* the nodes of a layer */
+    long ev = 0;
+    for (int l = 0; l < nl; l++) {
+        memset(state[l], 0, (size_t)W * (size_t)(y1 - y0 + 1));
+        for (int e = 0; e < (ny > 1 ? 2 : 1); e++)
+            for (int i = 0; i < nx; i++) {
+                const size_t at = (size_t)(e ? y1 - y0 : 0) * W + (size_t)(q->X[i] - r->x0);
+                memcpy(band[l] + at * nw, q->node + l * layer + ((size_t)(j + e) * nx + i) * nw, sizeof(double) * nw);
+                state[l][at] = 2;
+            }
+        ev += atmos__beams_screen_band(&s[l], f, q->X, nx, y0, y1, band[l], state[l]);
+    }
     const int last = j + 2 >= ny ? y1 : y1 - 1;
     for (int y = y0; y <= last; y++)
         for (int x = r->x0; x < r->x1; x++) {
             const size_t a = (size_t)(y - y0) * W + (size_t)(x - r->x0), p = (size_t)(y - r->y0) * W + (size_t)(x - r->x0);
             float *px = out->pixels + ((size_t)y * out->width + x) * out->channels;
-            for (int k = 0; k < nw; k++) px[k] = (float)((double)q->base[p * nw + k] + band[a * nw + k]);
+            for (int k = 0; k < nw; k++) {
+                double v = (double)q->base[p * nw + k] + band[0][a * nw + k];
+                if (nl > 1) v += band[1][a * nw + k];
+                px[k] = (float)v;
+            }
         }
     return ev;
 }
@@ -723,8 +774,10 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     int failed = !q.X || !q.Y || !q.obj || !q.T || !q.base, done = 0;
     const int nx = failed ? 0 : atmos__beams_screen_nodes(r->x0, r->x1, k, q.X);
     const int ny = failed ? 0 : atmos__beams_screen_nodes(r->y0, r->y1, k, q.Y), nb = ny > 1 ? ny - 1 : 1;
-    if (!failed)
-        failed = !(q.node = atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_NODE], sizeof(double) * (size_t)nx * ny * nw));
+    air_layer a[2];
+    const int nl = air_layers(J, a);
+    const size_t layer = (size_t)nx * ny * nw; /* the nodes of a layer */
+    if (!failed) failed = !(q.node = atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_NODE], sizeof(double) * nl * layer));
     if (failed) {
         screen_buf_free(&q);
         return 1;
@@ -732,17 +785,22 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     /* none: each pass makes its rays */
     q.dir = J->ru ? atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_DIR], sizeof(double) * 3 * n) : NULL;
     J->dir = q.dir, J->dir_r = *r;
-    const atmos__beams_screen s = {*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base,
-                                   SCREEN_HINT ? J->span : NULL, SCREEN_HINT ? J->b->nlights : 0, J->cam->height,
-                                   SCREEN_WIDE, air_pixel, J};
+    atmos__beams_screen s[2];
+    for (int l = 0; l < nl; l++)
+        s[l] = (atmos__beams_screen){*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base,
+                                     SCREEN_HINT ? J->span : NULL, SCREEN_HINT ? J->b->nlights : 0, J->cam->height,
+                                     a[l].mask, !(a[l].sun && J->b->sun_on), SCREEN_WIDE, air_pixel, &a[l]};
     long ev = 0;
 #pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev)
     {
-        double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), *band = malloc(sizeof(double) * W * (k + 1) * nw);
-        unsigned char *state = malloc((size_t)W * (k + 1));
+        const size_t bw = (size_t)W * (k + 1); /* a band's pixels */
+        double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), *band = malloc(sizeof(double) * bw * nw * nl);
+        unsigned char *state = malloc(bw * nl);
         atmos_mesh_hit *hits = malloc(sizeof *hits * (size_t)W);
         uint32_t *cones = malloc(sizeof *cones * (size_t)W);
         const int ok = f && band && state && hits && cones;
+        double *const bands[2] = {band, band ? band + bw * nw : NULL};
+        unsigned char *const states[2] = {state, state ? state + bw : NULL};
         if (!ok) {
 #pragma omp atomic write
             failed = 1;
@@ -758,21 +816,23 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
         any_failed = failed;
 #pragma omp for schedule(dynamic, 1)
         for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx && ok && !any_failed && !atmos__cancelled(cancelled); i++, ev++)
-                air_pixel(J, f, q.X[i], q.Y[j], q.T[(size_t)(q.Y[j] - r->y0) * W + (size_t)(q.X[i] - r->x0)],
-                          q.node + ((size_t)j * nx + i) * nw);
+            for (int i = 0; i < nx && ok && !any_failed && !atmos__cancelled(cancelled); i++)
+                for (int l = 0; l < nl; l++, ev++)
+                    air_pixel(&a[l], f, q.X[i], q.Y[j], q.T[(size_t)(q.Y[j] - r->y0) * W + (size_t)(q.X[i] - r->x0)],
+                              q.node + l * layer + ((size_t)j * nx + i) * nw);
 #pragma omp for schedule(dynamic, 1)
         for (int j = 0; j < nb; j++) {
             if (!ok || atmos__cancelled(cancelled)) continue;
-            ev += screen_band(&s, &q, nx, ny, j, f, band, state, out);
+            ev += screen_band(s, nl, &q, nx, ny, j, f, bands, states, out);
             atmos__progress_step(p->ctx, "render beams", &done, nb, cancelled);
         }
         free(f), free(band), free(state), free(hits), free(cones);
     }
     if (!failed && J->cx >= r->x0 && J->cx < r->x1 && J->cy >= r->y0 && J->cy < r->y1) { /* the centre ray's counts */
         double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), A[ATMOS_MAX_WAVELENGTHS];
+        air_layer every = {J, ALL_LIGHTS, 1};
         J->centre_now = 1;
-        if (f) air_pixel(J, f, J->cx, J->cy, q.T[(size_t)(J->cy - r->y0) * W + (size_t)(J->cx - r->x0)], A);
+        if (f) air_pixel(&every, f, J->cx, J->cy, q.T[(size_t)(J->cy - r->y0) * W + (size_t)(J->cx - r->x0)], A);
         J->centre_now = 0;
         free(f);
     }

@@ -75,6 +75,7 @@ static int crossed(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
 {
     const int m = x1 - x0 > y1 - y0 ? x1 - x0 : y1 - y0;
     for (int i = 0; i < s->nspan; i++) {
+        if (!(s->span_mask >> i & 1)) continue;
         const int *sp = s->span + 2 * (size_t)i * s->span_h;
         if (holds(s, sp, y0, x0, x1, m) && holds(s, sp, y1, x0, x1, m)) continue; /* well inside */
         int touches = 0, narrow = !(s->wide > 0);
@@ -83,6 +84,18 @@ static int crossed(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
             narrow |= sp[2 * y + 1] - sp[2 * y] < s->wide * m;
         }
         if (touches && narrow) return 1;
+    }
+    return 0;
+}
+
+/* Whether any light's span touches the cell [x0, x1] x [y0, y1] (its airlight may be other than 0). */
+static int touched(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
+{
+    for (int i = 0; i < s->nspan; i++) {
+        if (!(s->span_mask >> i & 1)) continue;
+        const int *sp = s->span + 2 * (size_t)i * s->span_h;
+        for (int y = y0; y <= y1; y++)
+            if (sp[2 * y] <= x1 && sp[2 * y + 1] > x0 && sp[2 * y + 1] > sp[2 * y]) return 1;
     }
     return 0;
 }
@@ -155,6 +168,10 @@ static void cell(band *b, int x0, int y0, int x1, int y1)
     const double *c[4] = {b->out + at(b, x0, y0) * nw, b->out + at(b, x1, y0) * nw, b->out + at(b, x0, y1) * nw,
                           b->out + at(b, x1, y1) * nw};
     const int px[3] = {x0, xm, x1}, py[3] = {y0, ym, y1};
+    if (s->bound && s->span && !touched(s, x0, y0, x1, y1)) { /* its corners 0, and every pixel */
+        fill(b, x0, y0, x1, y1);
+        return;
+    }
     const int cut = crossed(s, x0, y0, x1, y1);
     if (large) {
         for (int j = 0; j < 3; j++)

@@ -12,13 +12,17 @@
  * corners, or an edge of a beam across it, is found without a node on it; unless the span is
  * many cells wide in every row of the cell (wide): the screen image of a beam is convex, so a
  * wide one cannot pass between the corners, and its edge leaves a tested point on each side
- * for the other tests to find (a row where the span ends counts as narrow). The surfaces' direct
+ * for the other tests to find (a row where the span ends counts as narrow). Where the airlight is
+ * 0 outside the spans (no sun), a cell that no span touches is filled with its corners' zeros
+ * without its tests (a dark cell across a silhouette is not cut). The surfaces' direct
  * light stays per pixel (the caller's). Not part of the API. */
 #ifndef ATMOS_RENDER_BEAMS_SCREEN_H
 #define ATMOS_RENDER_BEAMS_SCREEN_H
 
 #include "render/view.h"
 #include "atmos/spectrum.h"
+
+#include <stdint.h>
 
 /* The most values a pixel. */
 #define ATMOS__BEAMS_SCREEN_MAX_NW ATMOS_MAX_WAVELENGTHS
@@ -41,6 +45,9 @@ typedef struct atmos__beams_screen {
      * is 0 (the screen image of a hull of its lit part, convex per row); NULL: none. */
     const int *span;
     int nspan, span_h;
+    uint32_t span_mask;       /* the lights whose spans are hints here (light i: bit i) */
+    int bound;                /* 1: the airlight is 0 outside those spans (no sun): a cell that no
+                               * span touches is 0, filled without its tests */
     int wide;                 /* a span at least this many cells' widths wide in each of a cell's
                                * rows is not its hint there (0: every span) */
     atmos__beams_air_fn air;
