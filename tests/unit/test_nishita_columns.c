@@ -41,10 +41,10 @@ static double trilinear(const double p[3])
     return s;
 }
 
-/* The column from voxel (x, y, z)'s centre toward the sun by steps of 1/64 voxel (midpoints). */
+/* The column from voxel (x, y, z)'s centre toward the sun by steps of 1/16 voxel (midpoints). */
 static double exact_column(int x, int y, int z, const double sun[3])
 {
-    const double ds = 1.0 / 64;
+    const double ds = 1.0 / 16;
     double c = 0;
     for (int it = 0;; it++) {
         const double p[3] = {x + (it + 0.5) * ds * sun[0], y + (it + 0.5) * ds * sun[1], z + (it + 0.5) * ds * sun[2]};
