@@ -146,10 +146,12 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     return ATMOS_OK;
 }
 
-/* Bilinear value of plane array a (nx x ny, m floats per point, member f) at (x, y); 0 outside. */
+/* The bilinear interpolant of field f of a plane of nx x ny values (m a point) at (x, y), the
+ * point clamped to the plane. */
 static float plane_at(const float *a, int nx, int ny, int m, int f, double x, double y)
 {
-    if (!(x >= 0 && y >= 0 && x <= nx - 1 && y <= ny - 1)) return 0.0f;
+    x = x < 0 ? 0 : x > nx - 1 ? nx - 1 : x;
+    y = y < 0 ? 0 : y > ny - 1 ? ny - 1 : y;
     int i = (int)x, j = (int)y;
     if (i > nx - 2) i = nx - 2 < 0 ? 0 : nx - 2;
     if (j > ny - 2) j = ny - 2 < 0 ? 0 : ny - 2;
@@ -159,10 +161,16 @@ static float plane_at(const float *a, int nx, int ny, int m, int f, double x, do
                    (1 - u) * v * a[((size_t)j1 * nx + i) * m + f] + u * v * a[((size_t)j1 * nx + i1) * m + f]);
 }
 
-/* The column density toward the sun at every render voxel, by one sweep across the grid
- * along the axis nearest to the sun's direction: a voxel's column is the column one plane
- * nearer the sun (bilinear there) plus the trapezoid of the densities over the step between
- * them. Planes one after another, the rows of a plane in parallel. */
+/* The column density toward the sun at every render voxel, by rays along the sun: one ray per
+ * point of a lattice of the plane's spacing, the planes across the axis nearest to the sun's
+ * direction one after another from the sun's side. Between two planes each ray moves by the
+ * sun's slope, so the lattice is the last one shifted by a whole number of points and a
+ * fraction: a ray's column is its own (the trapezoid of the densities, bilinear at its points,
+ * over the step), carried without interpolation, and a voxel's column is interpolated once
+ * from the four rays about its centre. (Interpolating the last plane's columns at every plane
+ * instead blurred them sideways, more with every plane: in a cloud textured at the voxel's scale
+ * the sunlight through the thin gaps was lost, the field's source too shallow; docs/lightfield.md,
+ * "The sun's columns".) The rows of a plane in parallel. */
 void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int threads)
 {
     if (np->col_valid && !memcmp(np->col_sun, sun_g, sizeof np->col_sun)) return;
@@ -176,34 +184,52 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
     const double db = sun_g[b] / fabs(sun_g[a]), dc = sun_g[c] / fabs(sun_g[a]);
     const double len = 1.0 / fabs(sun_g[a]) / g->sc; /* metres per plane along the sun */
     const int step = sun_g[a] > 0 ? -1 : 1;           /* from the sun's side */
-    size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf};
-    float *plane = malloc(sizeof(float) * (size_t)nb * nc * nf * 4);
-    if (!plane) return;
-    float *pc = plane, *pd = plane + (size_t)nb * nc * nf, *qc = pd + (size_t)nb * nc * nf,
-          *qd = qc + (size_t)nb * nc * nf; /* previous: columns, densities; current: same */
-    memset(plane, 0, sizeof(float) * (size_t)nb * nc * nf * 2);
+    const size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf}, pl = (size_t)nb * nc * nf;
+    float *buf = malloc(sizeof(float) * pl * 5);
+    if (!buf) return;
+    /* the plane's densities; the rays' columns and densities, the last plane's and this one's */
+    float *dens = buf, *rc = buf + pl, *rd = rc + pl, *qc = rd + pl, *qd = qc + pl;
+    memset(rc, 0, sizeof(float) * pl * 2);
+    /* plane k's rays at lattice point (m, n) lie at (m + fb, n + fc): fb, fc the fractions of the
+       offsets -k db, -k dc (the rays move away from the sun, the last plane's points at +db, +dc) */
+    double ob = 0, oc = 0;
     /* a plane of the Disney cloud's grid (128 x 88 x 156) is 0.1-0.2 ms of work: split in two
        threads its parallel region per plane cost more CPU in the waiting thread's spinning than it
        saved (the same numbers either way) */
-    const int par = (size_t)nb * nc * nf >= COL_PAR_MIN ? threads : 1;
-    for (int ia = step > 0 ? 0 : na - 1; ia >= 0 && ia < na; ia += step) {
+    const int par = pl >= COL_PAR_MIN ? threads : 1;
+    for (int k = 0; k < na; k++) {
+        const int ia = step > 0 ? k : na - 1 - k;
+        const double nb_ = -k * db, nc_ = -k * dc;
+        const int sb = (int)(floor(nb_) - floor(ob)), sc = (int)(floor(nc_) - floor(oc));
+        const double fb = nb_ - floor(nb_), fc = nc_ - floor(nc_);
+        ob = nb_, oc = nc_;
 #pragma omp parallel for schedule(static) num_threads(par)
         for (int jc = 0; jc < nc; jc++)
-            for (int jb = 0; jb < nb; jb++) {
-                const size_t v = ia * str[a] + jb * str[b] + jc * str[c], e = ((size_t)jc * nb + jb) * nf;
+            for (int jb = 0; jb < nb; jb++)
+                for (int f = 0; f < nf; f++)
+                    dens[((size_t)jc * nb + jb) * nf + f] = g->v[ia * str[a] + jb * str[b] + jc * str[c] + f];
+#pragma omp parallel for schedule(static) num_threads(par)
+        for (int n = 0; n < nc; n++)
+            for (int m = 0; m < nb; m++) {
+                const int pm = m - sb, pn = n - sc, in = k > 0 && pm >= 0 && pm < nb && pn >= 0 && pn < nc;
+                const size_t e = ((size_t)n * nb + m) * nf, pe = in ? ((size_t)pn * nb + pm) * nf : 0;
                 for (int f = 0; f < nf; f++) {
-                    const float d = g->v[v + f];
-                    const float up = plane_at(pd, nb, nc, nf, f, jb + db, jc + dc);
+                    const float d = plane_at(dens, nb, nc, nf, f, m + fb, n + fc);
                     qd[e + f] = d;
-                    qc[e + f] = plane_at(pc, nb, nc, nf, f, jb + db, jc + dc) + (float)(0.5 * len * (d + up));
-                    np->col[v + f] = qc[e + f];
+                    qc[e + f] = in ? rc[pe + f] + (float)(0.5 * len * (d + rd[pe + f])) : (float)(0.5 * len * d);
                 }
             }
-        float *t = pc;
-        pc = qc, qc = t;
-        t = pd, pd = qd, qd = t;
+#pragma omp parallel for schedule(static) num_threads(par)
+        for (int jc = 0; jc < nc; jc++)
+            for (int jb = 0; jb < nb; jb++)
+                for (int f = 0; f < nf; f++)
+                    np->col[ia * str[a] + jb * str[b] + jc * str[c] + f] =
+                        plane_at(qc, nb, nc, nf, f, jb - fb, jc - fc);
+        float *t = rc;
+        rc = qc, qc = t;
+        t = rd, rd = qd, qd = t;
     }
-    free(plane);
+    free(buf);
     memcpy(np->col_sun, sun_g, sizeof np->col_sun);
     np->col_valid = 1;
     np->col_s = atmos__now() - t0;
