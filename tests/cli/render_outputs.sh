@@ -76,13 +76,27 @@ echo "$out" | grep -q '"nonfinite": 0[,}]' && ok || bad "--exr-half wrote non-fi
 # carries the chromaticities and numbers as numbers.
 "$A" render -q $P --rgb --exr "$T/p.exr" --variance "$T/v.exr" && ok || bad "path render --variance"
 exr_header "$T/v.exr" > "$T/vh" || bad "variance EXR unreadable"
-grep -q "^channels chlist var_440.0nm,var_550.0nm,var_680.0nm,var_Y$" "$T/vh" && ok || bad "variance channels: $(grep chlist "$T/vh")"
+grep -q "^channels chlist variance.440nm,variance.550nm,variance.680nm,variance.Y$" "$T/vh" && ok || bad "variance channels: $(grep chlist "$T/vh")"
+# no chromaticities: they describe R, G and B, which a variance file has not
+grep -q "^chromaticities" "$T/vh" && bad "variance EXR has chromaticities" || ok
+# one spelling: the --exr-layers variance layers are the --variance file's channels, spectral
+# wavelengths as they are (386.25 nm, not 386 or 386.2), with OpenEXR's comma so that the
+# layer stays "variance"
+"$A" render -q $P --spectral 32 --exr "$T/ps.exr" --exr-layers variance --variance "$T/vs.exr" && ok || bad "spectral variance"
+vs=$(exr_header "$T/vs.exr" | grep '^channels' | cut -d' ' -f3)
+ls=$(exr_header "$T/ps.exr" | grep '^channels' | cut -d' ' -f3 | sed 's/^A,B,G,R,//')
+[ -n "$vs" ] && [ "$vs" = "$ls" ] && ok || bad "variance names differ: file '$vs', layers '$ls'"
+echo "$vs" | grep -q "variance.386,25nm,variance.398,75nm" && ok || bad "spectral variance names: $vs"
+exr_header "$T/vs.exr" | grep -q '^atmos:units string variance of the mean.*W m^-2 sr^-1 nm^-1.*variance.Y in (cd/m^2)^2' \
+    && ok || bad "variance file: units $(exr_header "$T/vs.exr" | grep '^atmos:units')"
+exr_header "$T/ps.exr" | grep -q '^atmos:units string linear sRGB.*; variance.\*: variance of the mean' \
+    && ok || bad "layered file: units $(exr_header "$T/ps.exr" | grep '^atmos:units')"
 for key in "atmos:scene string" "atmos:renderer string path" "atmos:sun_elevation_deg double 22.0" \
     "atmos:sun_azimuth_deg double 235.0" "atmos:threads int" "atmos:version string" "atmos:wavelengths_nm string 680.0 550.0 440.0" \
     "atmos:atmosphere string"; do
     grep -q "^$key" "$T/vh" && ok || bad "variance EXR lacks '$key'"
 done
-for f in o.exr f.exr h.exr p.exr v.exr; do
+for f in o.exr f.exr h.exr p.exr ps.exr; do
     exr_header "$T/$f" > "$T/hdr"
     grep -q "^chromaticities chromaticities 0.6400,0.3300,0.3000,0.6000,0.1500,0.0600,0.3127,0.3290$" "$T/hdr" \
         && ok || bad "$f: no Rec. 709 / D65 chromaticities"
