@@ -77,6 +77,29 @@ grep -q 'homogeneous.*no tables' "$T/list" "$T/err" && grep -q 'spherical' "$T/l
 "$cli" sky --model dobashi --table sun_attenuation -o "$T/new/sub/t.pfm" >"$T/out" 2>"$T/err" && [ -s "$T/new/sub/t.pfm" ] &&
     ok "--table -o into a new folder" || bad "--table -o into a new folder: $(cat "$T/err")"
 
+# a table as EXR: channels "<table>.<nm>nm" (not "440.00nm", which OpenEXR reads as channel
+# "00nm" of layer "440"), its units in atmos:units, no chromaticities (it is not an RGB image)
+"$cli" sky --model dobashi --table sun_attenuation -o "$T/gl.exr" >"$T/out" 2>"$T/err" &&
+    python3 - "$T/gl.exr" >"$T/hdr" <<'PY' || bad "--table -o x.exr: $(cat "$T/err")"
+import struct, sys
+b = open(sys.argv[1], "rb").read()
+i = 8
+while b[i] != 0:
+    j = b.index(b"\0", i); name = b[i:j].decode()
+    k = b.index(b"\0", j + 1); typ = b[j + 1:k].decode()
+    n = struct.unpack("<i", b[k + 1:k + 5])[0]; v = b[k + 5:k + 5 + n]; i = k + 5 + n
+    if typ == "chlist":
+        names, p = [], 0
+        while v[p] != 0:
+            e = v.index(b"\0", p); names.append(v[p:e].decode()); p = e + 1 + 16
+        v = ",".join(names).encode()
+    print(name, typ, v.decode(errors="replace") if typ in ("string", "chlist") else "-")
+PY
+grep -q '^channels chlist sun_attenuation.440nm,sun_attenuation.550nm,sun_attenuation.680nm$' "$T/hdr" &&
+    ok "--table EXR: channels named <table>.<nm>nm" || bad "--table EXR channels: $(grep '^channels' "$T/hdr")"
+grep -q '^atmos:units string 1: g_l' "$T/hdr" && ok "--table EXR: units" || bad "--table EXR units: $(grep -c units "$T/hdr")"
+grep -q '^chromaticities' "$T/hdr" && bad "--table EXR has chromaticities" || ok "--table EXR: no chromaticities"
+
 # the help says what --table list does
 "$cli" sky --help >"$T/help" 2>&1
 grep -q 'table list' "$T/help" && grep -q 'goes with' "$T/help" && ok "help" || bad "help: $(cat "$T/help")"
