@@ -1,7 +1,8 @@
 #!/bin/sh
 # Inputs a new user gets wrong, and the messages that tell them what to do:
 #  - a file that is not an image given as an Earth map: the message names the scene key, the
-#    path and the formats read (PNG, JPEG), not the image library's "Read Error";
+#    path and the formats read (PNG, JPEG), not the image library's "Read Error"; a scene file's
+#    cloud image that cannot be read: the scene file too;
 #  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
 #    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3);
 #  - --volume with a -D naming another volume source: refused, both named, nothing written;
@@ -29,6 +30,19 @@ printf '\211PNG\r\n\032\n' >"$T/cut.png"
     -o "$T/g.png" >/dev/null 2>"$T/err"
 [ $? -ne 0 ] && ok "a truncated PNG map is refused" || bad "a truncated PNG map was accepted"
 has "truncated PNG map" "/atmosphere/night_lights"
+# a scene file's cloud image or world file that cannot be read: the message names the scene file
+# too, as it does for a missing one (a truncated JPEG, a PNG cut short, a folder, a bad world file)
+printf '\377\330\377\340\000\020JFIF\000' >"$T/cut.jpg"
+mkdir -p "$T/sc/folder.png"
+cp "$T/cut.png" "$T/sc/cut.png"; cp "$T/cut.jpg" "$T/sc/cut.jpg"
+for img in cut.jpg cut.png folder.png; do
+    printf '{"atmosphere": {"model": "spherical", "clouds": {"image": "%s", "base_m": 2000, "top_m": 8000}},
+ "image": {"width": 8, "height": 8}}\n' "$img" >"$T/sc/clouds.json"
+    "$A" render "$T/sc/clouds.json" -o "$T/g.png" >/dev/null 2>"$T/err"
+    [ $? -eq 1 ] && ok "cloud image $img refused (exit 1)" || bad "cloud image $img: not exit 1"
+    has "cloud image $img" "sc/clouds.json: /atmosphere/clouds/image: "
+    has "cloud image $img" "$img"
+done
 
 # --- -D volume.* with --volume FILE
 "$A" volume generate cumulus -o "$T/v.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"
