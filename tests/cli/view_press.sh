@@ -59,4 +59,26 @@ for x in r:
     yaws.add(round(float(x["yaw_deg"])))
 assert len(yaws) == 5, yaws   # it does go round
 PY
+
+# a sun key on a scene the renderer lights by its lamps only (Dobashi's spotlight, the beam
+# renderer without a sun): said, naming the key and why, not taken in silence
+S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
+"$A" view "$S/scenes/dobashi_fig04_spotlight.json" --headless --frames 2 --size 16x9 --press sun_up,forward \
+    --record r_lamp >o_lamp.txt 2>&1
+st=$?
+[ $st -eq 0 ] && grep -q -- "--press sun_up: changes nothing: the beams renderer lights this scene without the sun" o_lamp.txt &&
+    ! grep -q -- "--press forward" o_lamp.txt && ok "--press sun_up on a lamp-only scene: said why (exit $st)" ||
+    { bad "--press sun_up on a lamp-only scene (exit $st)"; cat o_lamp.txt >&2; }
+
+# atmos render's outputs, its image size and --mpi are refused, not ignored (the viewer writes
+# with F12 and --record, its size is --size)
+n=0
+for opt in "-o x.png" "--exr x.exr" "--pfm x.pfm" "--width 100" "--height 50"; do
+    n=$((n + 1))
+    # shellcheck disable=SC2086
+    "$A" view --headless --frames 2 --size 16x9 --record "r_opt$n" $opt >o_opt.txt 2>&1
+    st=$?
+    [ $st -eq 2 ] && grep -q "atmos render's; the viewer's frame is --size WxH" o_opt.txt && [ ! -e x.png ] && [ ! -e x.exr ] &&
+        ok "view $opt refused (exit 2)" || { bad "view $opt: exit $st"; cat o_opt.txt >&2; }
+done
 exit $fail

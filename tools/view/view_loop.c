@@ -337,14 +337,23 @@ static int start(loop *L, const view_opts *o, view_state *s, const view_script *
 }
 
 /* --press's keys: through the window's event queue, as a user's; headless, tapped on the state
- * (view_state_tap: what the window does with a key pressed and released at once). */
-static void press(view_window *win, view_state *s, const char *keys)
+ * (view_state_tap: what the window does with a key pressed and released at once). A key that
+ * moves the sun or the clock where the renderer lights the scene by its lamps only is said to
+ * change nothing, and why, rather than taken in silence. */
+static void press(view_window *win, view_state *s, const atmos_scene *sc, const char *keys)
 {
     int codes[16];
     const int n = view_key_codes(keys, codes, 16);
     for (int k = 0; k < n; k++) {
+        const view_action a = view_key_action(codes[k]);
+        if (a >= VA_SUN_UP && a <= VA_TIME_FORWARD && cli_lit_without_sun(sc, s->renderer))
+            fprintf(stderr,
+                    "atmos view: --press %s: changes nothing: the %s renderer lights this scene without the sun "
+                    "(by its %d lamp%s)\n",
+                    view_action_name(a), atmos_renderer_name(s->renderer), sc->light_count,
+                    sc->light_count == 1 ? "" : "s");
         if (win) view_window_push_key(win, codes[k]);
-        else view_state_tap(s, view_key_action(codes[k]));
+        else view_state_tap(s, a);
     }
 }
 
@@ -376,7 +385,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!frames || i < frames); i++) {
         const double t0 = cli_now_s();
         if (scripted) view_script_step(script, &s, (i - 1) / fps, i / fps, i, frames);
-        if (i == 1 && o->press) press(win, &s, o->press), pressed = 1;
+        if (i == 1 && o->press) press(win, &s, sc, o->press), pressed = 1;
         if (win) view_window_events(win, &s, last_ms > 0 ? last_ms / 1000.0 : 1.0 / 30.0);
         const int moving = i > 0 && (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && view_moved(&pose, &s);
         s.changes = 0;
