@@ -1,7 +1,8 @@
 #!/bin/sh
 # Inputs a new user gets wrong, and the messages that tell them what to do:
 #  - a file that is not an image given as an Earth map: the message names the scene key, the
-#    path and the formats read (PNG, JPEG), not the image library's "Read Error"; a scene file's
+#    path and the formats read (PNG, JPEG), not the image library's "Read Error" (a PNG cut
+#    short: "truncated"); a scene file's
 #    cloud image that cannot be read: the scene file too;
 #  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
 #    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3);
@@ -30,6 +31,7 @@ printf '\211PNG\r\n\032\n' >"$T/cut.png"
     -o "$T/g.png" >/dev/null 2>"$T/err"
 [ $? -ne 0 ] && ok "a truncated PNG map is refused" || bad "a truncated PNG map was accepted"
 has "truncated PNG map" "/atmosphere/night_lights"
+has "truncated PNG map" "truncated: the PNG file ends before its image does"
 # a scene file's cloud image or world file that cannot be read: the message names the scene file
 # too, as it does for a missing one (a truncated JPEG, a PNG cut short, a folder, a bad world file)
 printf '\377\330\377\340\000\020JFIF\000' >"$T/cut.jpg"
