@@ -3,7 +3,7 @@
 #  - a file that is not an image given as an Earth map: the message names the scene key, the
 #    path and the formats read (PNG, JPEG), not the image library's "Read Error" (a PNG cut
 #    short: "truncated"); a scene file's
-#    cloud image that cannot be read: the scene file too;
+#    cloud image that cannot be read: the scene file too; an image given as the scene: said so;
 #  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
 #    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3);
 #  - --volume with a -D naming another volume source: refused, both named, nothing written;
@@ -45,6 +45,17 @@ for img in cut.jpg cut.png folder.png; do
     has "cloud image $img" "sc/clouds.json: /atmosphere/clouds/image: "
     has "cloud image $img" "$img"
 done
+
+# --- an image given as the scene: said what it is (not "malformed JSON: control character"),
+# exit 2, no output
+"$A" render -q --width 8 --height 8 --exr "$T/img.exr" -o "$T/img.png" 2>/dev/null || bad "render img.exr"
+for img in img.exr img.png; do
+    "$A" render "$T/$img" -o "$T/as_scene.png" >/dev/null 2>"$T/err"
+    st=$?
+    [ $st -eq 2 ] && [ ! -e "$T/as_scene.png" ] && ok "$img as the scene refused (exit 2)" || bad "$img as the scene: exit $st"
+    has "$img as the scene" "image, not a scene"
+done
+has "img.png as the scene" "is a PNG image"
 
 # --- -D volume.* with --volume FILE
 "$A" volume generate cumulus -o "$T/v.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"
