@@ -81,4 +81,13 @@ for opt in "-o x.png" "--exr x.exr" "--pfm x.pfm" "--width 100" "--height 50"; d
     [ $st -eq 2 ] && grep -q "atmos render's; the viewer's frame is --size WxH" o_opt.txt && [ ! -e x.png ] && [ ! -e x.exr ] &&
         ok "view $opt refused (exit 2)" || { bad "view $opt: exit $st"; cat o_opt.txt >&2; }
 done
+
+# --record into missing folders: made, as atmos render's outputs' folders; one that cannot be
+# made: said, naming the folder
+"$A" view --headless --frames 2 --size 16x9 --record new/sub/rec >o_rec.txt 2>&1 && [ -s new/sub/rec/frames.csv ] &&
+    ok "--record new/sub/rec: the folders made" || { bad "--record new/sub/rec"; cat o_rec.txt >&2; }
+"$A" view --headless --frames 2 --size 16x9 --record /proc/no/rec >o_rec.txt 2>&1
+st=$?
+[ $st -eq 1 ] && grep -q "record /proc/no/rec/frames.csv: cannot create the folder /proc/no" o_rec.txt &&
+    ok "--record in a folder that cannot be made: said (exit 1)" || { bad "--record /proc/no/rec: exit $st"; cat o_rec.txt >&2; }
 exit $fail
