@@ -90,4 +90,16 @@ done
 st=$?
 [ $st -eq 1 ] && grep -q "record /proc/no/rec/frames.csv: cannot create the folder /proc/no" o_rec.txt &&
     ok "--record in a folder that cannot be made: said (exit 1)" || { bad "--record /proc/no/rec: exit $st"; cat o_rec.txt >&2; }
+
+# a flight that moves the sun over such a scene: said once
+cat >lamp_flight.json <<'EOF2'
+{"fps": 24, "keys": [{"t": 0, "position_m": [0, 7, 32], "look_at_m": [0, 3, 0]},
+                     {"t": 0.05, "position_m": [0, 7, 30], "look_at_m": [0, 3, 0], "sun": {"elevation_deg": 30, "azimuth_deg": 90}}]}
+EOF2
+"$A" view "$S/scenes/dobashi_fig04_spotlight.json" --headless --script lamp_flight.json --size 16x9 --record r_lampfl \
+    >o_lampfl.txt 2>&1
+st=$?
+[ $st -eq 0 ] && [ "$(grep -c 'changes nothing' o_lampfl.txt)" -eq 1 ] &&
+    grep -q -- "--script lamp_flight.json: the flight's sun: changes nothing: the beams renderer" o_lampfl.txt &&
+    ok "a flight's sun on a lamp-only scene: said once (exit $st)" || { bad "a flight's sun on a lamp-only scene (exit $st)"; cat o_lampfl.txt >&2; }
 exit $fail

@@ -321,6 +321,30 @@ static int volume_centre(const atmos_plan *p, double c[3])
     return 1;
 }
 
+/* A sun or clock move (what: the option or the flight's key that asks for it) where the
+ * renderer lights the scene without the sun: said to change nothing, and why. */
+static void say_sunless(const char *what, const atmos_scene *sc, atmos_renderer_kind r)
+{
+    fprintf(stderr, "atmos view: %s: changes nothing: the %s renderer lights this scene without the sun (by its %d lamp%s)\n",
+            what, atmos_renderer_name(r), sc->light_count, sc->light_count == 1 ? "" : "s");
+}
+
+/* A flight's sun (key frames that set it, sun or clock keys pressed) on such a scene: said
+ * once (a pressed key by its key frame). */
+static void flight_sunless(const view_script *script, const char *path, const atmos_scene *sc, atmos_renderer_kind r)
+{
+    for (int i = 0; script && i < script->n && cli_lit_without_sun(sc, r); i++) {
+        const view_action a = script->k[i].press;
+        if (script->k[i].has_sun || (a >= VA_SUN_UP && a <= VA_TIME_FORWARD)) {
+            char what[ATMOS_SCENE_PATH_MAX + 64];
+            if (script->k[i].has_sun) snprintf(what, sizeof what, "--script %s: the flight's sun", path);
+            else snprintf(what, sizeof what, "--script %s: /keys/%d/press", path, i);
+            say_sunless(what, sc, r);
+            return;
+        }
+    }
+}
+
 static int start(loop *L, const view_opts *o, view_state *s, const view_script *script)
 {
     atmos_frame f;
@@ -328,6 +352,7 @@ static int start(loop *L, const view_opts *o, view_state *s, const view_script *
     view_state_init(s, L->sc, &f, NULL);
     const int rc = view_script_check(script, s, o->script); /* before the plan's work */
     if (rc != CLI_EXIT_OK) return rc;
+    flight_sunless(script, o->script, L->sc, s->renderer);
     atmos_plan *p = NULL;
     if (st == ATMOS_OK) st = get_plan(L, s, &p);
     if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
@@ -346,12 +371,11 @@ static void press(view_window *win, view_state *s, const atmos_scene *sc, const 
     const int n = view_key_codes(keys, codes, 16);
     for (int k = 0; k < n; k++) {
         const view_action a = view_key_action(codes[k]);
-        if (a >= VA_SUN_UP && a <= VA_TIME_FORWARD && cli_lit_without_sun(sc, s->renderer))
-            fprintf(stderr,
-                    "atmos view: --press %s: changes nothing: the %s renderer lights this scene without the sun "
-                    "(by its %d lamp%s)\n",
-                    view_action_name(a), atmos_renderer_name(s->renderer), sc->light_count,
-                    sc->light_count == 1 ? "" : "s");
+        if (a >= VA_SUN_UP && a <= VA_TIME_FORWARD && cli_lit_without_sun(sc, s->renderer)) {
+            char what[64];
+            snprintf(what, sizeof what, "--press %s", view_action_name(a));
+            say_sunless(what, sc, s->renderer);
+        }
         if (win) view_window_push_key(win, codes[k]);
         else view_state_tap(s, a);
     }
