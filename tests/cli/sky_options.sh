@@ -80,21 +80,7 @@ grep -q 'homogeneous.*no tables' "$T/list" "$T/err" && grep -q 'spherical' "$T/l
 # a table as EXR: channels "<table>.<nm>nm" (not "440.00nm", which OpenEXR reads as channel
 # "00nm" of layer "440"), its units in atmos:units, no chromaticities (it is not an RGB image)
 "$cli" sky --model dobashi --table sun_attenuation -o "$T/gl.exr" >"$T/out" 2>"$T/err" &&
-    python3 - "$T/gl.exr" >"$T/hdr" <<'PY' || bad "--table -o x.exr: $(cat "$T/err")"
-import struct, sys
-b = open(sys.argv[1], "rb").read()
-i = 8
-while b[i] != 0:
-    j = b.index(b"\0", i); name = b[i:j].decode()
-    k = b.index(b"\0", j + 1); typ = b[j + 1:k].decode()
-    n = struct.unpack("<i", b[k + 1:k + 5])[0]; v = b[k + 5:k + 5 + n]; i = k + 5 + n
-    if typ == "chlist":
-        names, p = [], 0
-        while v[p] != 0:
-            e = v.index(b"\0", p); names.append(v[p:e].decode()); p = e + 1 + 16
-        v = ",".join(names).encode()
-    print(name, typ, v.decode(errors="replace") if typ in ("string", "chlist") else "-")
-PY
+    python3 "$(dirname "$0")/exr_header.py" "$T/gl.exr" >"$T/hdr" || bad "--table -o x.exr: $(cat "$T/err")"
 grep -q '^channels chlist sun_attenuation.440nm,sun_attenuation.550nm,sun_attenuation.680nm$' "$T/hdr" &&
     ok "--table EXR: channels named <table>.<nm>nm" || bad "--table EXR channels: $(grep '^channels' "$T/hdr")"
 grep -q '^atmos:units string 1: g_l' "$T/hdr" && ok "--table EXR: units" || bad "--table EXR units: $(grep -c units "$T/hdr")"
