@@ -33,7 +33,7 @@ printf '\211PNG\r\n\032\n' >"$T/cut.png"
 has "truncated PNG map" "/atmosphere/night_lights"
 has "truncated PNG map" "truncated: the PNG file ends before its image does"
 # a scene file's cloud image or world file that cannot be read: the message names the scene file
-# too, as it does for a missing one (a truncated JPEG, a PNG cut short, a folder, a bad world file)
+# too, as it does for a missing one (a truncated JPEG, a PNG cut short, a folder)
 printf '\377\330\377\340\000\020JFIF\000' >"$T/cut.jpg"
 mkdir -p "$T/sc/folder.png"
 cp "$T/cut.png" "$T/sc/cut.png"; cp "$T/cut.jpg" "$T/sc/cut.jpg"
