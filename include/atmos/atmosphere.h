@@ -207,7 +207,8 @@ ATMOS_API double atmos_atmosphere_phase(const atmos_atmosphere *atm, const doubl
 
 /* The look-up tables of a spherical kind, to print or plot: names (NULL-terminated; an empty
  * list for kinds without tables) and one table as an image with one channel per wavelength
- * of the set, its metadata "atmos:table" (the name) and "atmos:axes" (what x and y are).
+ * of the set, its metadata "atmos:table" (the name), "atmos:axes" (what x and y are) and
+ * "atmos:units" (what a value is and its units: "1: the transmittance to the top of the air").
  * SPHERICAL: "transmittance", "multiple_scattering", "f_ms", "sky_irradiance",
  * "higher_orders_air", "higher_orders_aerosols"; DOBASHI: "sun_attenuation", "plane_rayleigh",
  * "plane_mie", "plane_attenuation" (docs/sky.md). atmos_atmosphere_kind_table_names gives a

@@ -97,9 +97,10 @@ ATMOS_API double atmos_srgb_decode(double encoded);
  * images and "C0".."Cn" otherwise. half: nonzero for 16-bit half floats, else 32-bit;
  * finite values beyond the largest half (+-65504) are written as +-65504, with a
  * warning (ATMOS_LOG_WARN) that counts them, instead of becoming infinite (infinities
- * and NaN are stored as they are). Every file carries the standard "chromaticities"
- * attribute of linear sRGB (Rec. 709 primaries, D65 white) unless the metadata has that
- * key. Every metadata entry becomes an attribute: a value that is a decimal number as a
+ * and NaN are stored as they are). Every file with R, G and B channels (plain, or one
+ * layer's "<layer>.R", ...) carries the standard "chromaticities" attribute of linear sRGB
+ * (Rec. 709 primaries, D65 white) unless the metadata has that key; a file without them (a
+ * variance per wavelength, a table) has none: the attribute describes R, G and B. Every metadata entry becomes an attribute: a value that is a decimal number as a
  * whole an int (integers that fit 32 bits, without a leading zero or '+') or a double
  * attribute, anything else a string; keys that are standard attributes of another type
  * ("channels", ...) or the structural "type"/"name" give ATMOS_E_INVALID_ARG. */

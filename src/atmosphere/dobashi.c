@@ -59,10 +59,14 @@ static atmos_status dob_table(atmos_context *ctx, const atmos_atmosphere *a, int
         return atmos__planet_table_image(ctx, m->gl, ATMOS__DOB_NS, ATMOS__DOB_NH, n, (size_t)n,
                                          (size_t)ATMOS__DOB_NS * n, 1, 1, dob_table_names[0],
                                          "x: the sun's cosine at the point; y: height (dobashi_tables.c); g_l",
-                                         out);
+                                         "1: g_l, the sunlight's transmittance to the top of the air", out);
     return atmos__planet_table_image(ctx, m->plane + (i - 1), ATMOS__DOB_NV, ATMOS__DOB_NH, n, (size_t)n * 3,
                                      (size_t)ATMOS__DOB_NV * n * 3, 3, 0, dob_table_names[i],
-                                     "x: the view's cosine; y: height (dobashi_tables.c); one sub-segment", out);
+                                     "x: the view's cosine; y: height (dobashi_tables.c); one sub-segment",
+                                     i == 3 ? "1: dg_v, the sub-segment's transmittance"
+                                            : "1: the scattering coefficient times the transmittance from the start, "
+                                              "integrated over the sub-segment",
+                                     out);
 }
 
 const atmos__planet_solver atmos__dobashi_solver = {

@@ -41,7 +41,7 @@ atmos_status atmos_atmosphere_table(atmos_context *ctx, const atmos_atmosphere *
 
 atmos_status atmos__planet_table_image(atmos_context *ctx, const float *src, int w, int h, int n, size_t xs,
                                        size_t ys, size_t ks, int neg_exp, const char *name, const char *axes,
-                                       atmos_image **out)
+                                       const char *units, atmos_image **out)
 {
     atmos_status st = atmos_image_create(ctx, w, h, n, out);
     if (st != ATMOS_OK) return st;
@@ -54,6 +54,7 @@ atmos_status atmos__planet_table_image(atmos_context *ctx, const float *src, int
             }
     if ((st = atmos_image_set_meta(img, "atmos:table", name)) == ATMOS_OK)
         st = atmos_image_set_meta(img, "atmos:axes", axes);
+    if (st == ATMOS_OK) st = atmos_image_set_meta(img, "atmos:units", units);
     if (st != ATMOS_OK) {
         atmos_image_destroy(img);
         *out = NULL;

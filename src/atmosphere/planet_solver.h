@@ -52,10 +52,11 @@ typedef struct atmos__planet_solver {
 
 /* An image of w x h pixels and n channels whose pixel (x, y), channel k is
  * src[k * ks + y * ys + x * xs] (times scale; exp(-value) when neg_exp), with the metadata
- * atmos:table = name and atmos:axes = axes (planet_ask.c). */
+ * atmos:table = name, atmos:axes = axes and atmos:units = units (what a value is, in what
+ * units; planet_ask.c). */
 atmos_status atmos__planet_table_image(atmos_context *ctx, const float *src, int w, int h, int n, size_t xs,
                                        size_t ys, size_t ks, int neg_exp, const char *name, const char *axes,
-                                       atmos_image **out);
+                                       const char *units, atmos_image **out);
 
 /* The solvers: dobashi.c, spherical.c; planet_numeric.c's brute-force quadrature (single
  * scattering, a test reference). */

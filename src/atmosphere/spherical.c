@@ -193,7 +193,7 @@ static atmos_status j_table(atmos_context *ctx, const atmos__sph_model *m, int p
         "(J_G - 1); psi, the azimuth about the sun, (1 - cos psi) / 2 = node / (J_P - 1)); y: altitude row * "
         "J_MUS + sun column (rows sqrt(altitude / top); columns uniform in u, the sun's elevation (pi / 2) u |u|, from asin(-0.3) to the zenith); "
         "sr^-1 per unit irradiance and scattering coefficient",
-        out);
+        "J_ms: sr^-1 per unit irradiance of the sun and scattering coefficient", out);
     free(v);
     return st;
 }
@@ -208,19 +208,23 @@ static atmos_status sph_table(atmos_context *ctx, const atmos_atmosphere *a, int
                                          (size_t)ATMOS__SPH_T_R * ATMOS__SPH_T_MU, 1, sph_table_names[i],
                                          "x: (d - d_min) / (d_max - d_min) of the distance d to the top; "
                                          "y: rho / H (Bruneton 2017); exp(-depth to the top)",
-                                         out);
+                                         "1: the transmittance to the top of the air", out);
     case 1:
     case 2:
         return atmos__planet_table_image(ctx, i == 1 ? m->psi : m->fms, ATMOS__SPH_M_MU, ATMOS__SPH_M_R, n, 1,
                                          ATMOS__SPH_M_MU, (size_t)ATMOS__SPH_M_R * ATMOS__SPH_M_MU, 0,
                                          sph_table_names[i],
-                                         "x: mu_s = x'|x'|, x' in [-1, 1]; y: sqrt(altitude / top)", out);
+                                         "x: mu_s = x'|x'|, x' in [-1, 1]; y: sqrt(altitude / top)",
+                                         i == 1 ? "Psi_ms: sr^-1 per unit irradiance of the sun and scattering coefficient"
+                                                : "1: f_ms, the share of isotropic light scattered again",
+                                         out);
     case 4:
     case 5:
         return j_table(ctx, m, i - 4, sph_table_names[i], out);
     default:
         return atmos__planet_table_image(ctx, m->esky, ATMOS__SPH_E_MU, 1, n, 1, 0, ATMOS__SPH_E_MU, 0,
-                                         sph_table_names[i], "x: mu_s = x'|x'|, x' in [-1, 1] (the ground)", out);
+                                         sph_table_names[i], "x: mu_s = x'|x'|, x' in [-1, 1] (the ground)",
+                                         "1: the sky's irradiance of the ground per unit irradiance of the sun", out);
     }
 }
 

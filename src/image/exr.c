@@ -155,13 +155,16 @@ static int meta_number(const char *v, int32_t *iv, double *dv)
 }
 
 /* The header's attributes: the standard "chromaticities" (linear sRGB / Rec. 709
- * primaries, D65 white) and the image's metadata, numbers as int or double attributes
- * and everything else as strings. */
+ * primaries, D65 white) when the image has R, G and B channels (names: its channels' names;
+ * they describe those, so a file of other quantities, as a variance per wavelength or a
+ * table, has none), and the image's metadata, numbers as int or double attributes and
+ * everything else as strings. */
 static atmos_status write_attributes(atmos_context *ctx, const char *path, exr_context_t ex, int part,
-                                     const atmos_image *img, exr_errbuf *eb)
+                                     const atmos_image *img, const char *const *names, exr_errbuf *eb)
 {
     exr_result_t rv;
-    if (!atmos_image_get_meta(img, "chromaticities")) {
+    int rgb[4];
+    if (atmos__rgb_channels(names, img->channels, rgb) && !atmos_image_get_meta(img, "chromaticities")) {
         const exr_attr_chromaticities_t rec709 = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
         if ((rv = exr_attr_set_chromaticities(ex, part, "chromaticities", &rec709)) != EXR_ERR_SUCCESS)
             return atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: chromaticities: %s", path, exr_message(eb, rv));
@@ -233,7 +236,7 @@ static atmos_status exr_write_file(atmos_context *ctx, const char *tmp, void *us
             goto done;
         }
     }
-    if ((st = write_attributes(ctx, job->path, ex, part, img, &eb)) != ATMOS_OK) goto done;
+    if ((st = write_attributes(ctx, job->path, ex, part, img, job->names, &eb)) != ATMOS_OK) goto done;
     rv = exr_write_header(ex);
     if (rv != EXR_ERR_SUCCESS) {
         st = atmos__error(ctx, ATMOS_E_IO, "%s: OpenEXR: cannot write header: %s", job->path, exr_message(&eb, rv));

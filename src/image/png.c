@@ -195,10 +195,14 @@ atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmos_image **
 
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_read_struct(&png, &info, NULL);
+        const int ended = feof(f); /* libpng's "Read Error": the file ended before the image did */
         fclose(f);
         free(rows);
         free(buf);
         atmos_image_destroy(img);
+        if (st == ATMOS_E_FORMAT && ended)
+            return atmos__error(ctx, ATMOS_E_FORMAT, "%s: truncated: the PNG file ends before its image does (libpng: %s)",
+                                path, err.msg);
         if (st == ATMOS_E_FORMAT)
             return atmos__error(ctx, ATMOS_E_FORMAT, "%s: not a valid PNG file: %s", path, err.msg);
         return st; /* already reported */

@@ -8,6 +8,7 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #ifdef ATMOS_HAVE_GDAL
 
@@ -26,7 +27,10 @@ atmos_status atmos__terrain_read(atmos_context *ctx, const char *path, int strid
                                  atmos__heights *out)
 {
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(path, "rb"); /* GDAL's own message for a missing file is vaguer */
+    struct stat sb; /* GDAL's own messages for a missing file or a folder are vaguer */
+    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return atmos__error(ctx, ATMOS_E_IO, "terrain %s: cannot open: it is a folder, not a file", path);
+    FILE *f = fopen(path, "rb");
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "terrain %s: cannot open: %s", path, strerror(errno));
     fclose(f);
     pthread_once(&gdal_once, load_once);

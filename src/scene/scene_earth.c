@@ -31,29 +31,34 @@ atmos_status atmos__scene_earth_paths(atmos_context *ctx, const char *path, size
     return st;
 }
 
-/* A JPEG (FF D8 FF) or a PNG (its 8-byte signature) by the file's first bytes; key: the
- * scene key that names it, in every message. */
-static atmos_status read_map(atmos_context *ctx, const char *key, const char *path, int reduce, atmos_image **out)
+/* A JPEG (FF D8 FF) or a PNG (its 8-byte signature) by the file's first bytes; the messages
+ * name the file (map_error puts the scene and its key in front). */
+static atmos_status read_map(atmos_context *ctx, const char *path, int reduce, atmos_image **out)
 {
     unsigned char m[8] = {0};
     FILE *f = fopen(path, "rb");
-    if (!f) return atmos__error(ctx, ATMOS_E_IO, "/atmosphere/%s: %s: cannot open: %s", key, path, strerror(errno));
+    if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
     const size_t n = fread(m, 1, sizeof m, f);
     fclose(f);
     const int jpeg = n >= 3 && m[0] == 0xFF && m[1] == 0xD8 && m[2] == 0xFF;
     const int png = n == 8 && !memcmp(m, "\x89PNG\r\n\x1a\n", 8);
     if (!jpeg && !png)
         return atmos__error(ctx, ATMOS_E_FORMAT,
-                            "/atmosphere/%s: %s is not an image atmos reads: the Earth's maps are PNG or JPEG files "
+                            "%s is not an image atmos reads: the Earth's maps are PNG or JPEG files "
                             "(known by their first bytes)",
-                            key, path);
-    atmos_status st = jpeg ? atmos_read_jpeg_scaled(ctx, path, reduce ? reduce : 1, out) : atmos_read_png(ctx, path, out);
-    if (st != ATMOS_OK) { /* the reader's message, with the key in front */
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", atmos_context_error(ctx));
-        return atmos__error(ctx, st, "/atmosphere/%s: %s", key, msg);
-    }
-    return ATMOS_OK;
+                            path);
+    return jpeg ? atmos_read_jpeg_scaled(ctx, path, reduce ? reduce : 1, out) : atmos_read_png(ctx, path, out);
+}
+
+/* A failure st of reading the file at path, named by the scene's key /atmosphere/KEY: said as
+ * every file a scene names is (the scene file, the key, the reader's message). */
+static atmos_status map_error(atmos_context *ctx, atmos_status st, const atmos_scene *scene, const char *key,
+                              const char *path)
+{
+    if (st == ATMOS_OK) return st;
+    char k[64];
+    snprintf(k, sizeof k, "/atmosphere/%s", key);
+    return atmos__scene_file_error(ctx, st, scene, path, k, 1);
 }
 
 /* An ESRI world file (six numbers: x size of a pixel, two rotations, y size, and the
@@ -89,11 +94,16 @@ atmos_status atmos_scene_atmosphere_create(atmos_context *ctx, const atmos_scene
     atmos_atmosphere_desc d = scene->atmosphere;
     atmos_image *ground = NULL, *night = NULL, *clouds = NULL;
     atmos_status st = ATMOS_OK;
-    if (spherical && e->ground_map[0]) st = read_map(ctx, "ground_map", e->ground_map, e->map_reduce, &ground);
-    if (!st && spherical && e->night_lights[0]) st = read_map(ctx, "night_lights", e->night_lights, e->map_reduce, &night);
-    if (!st && spherical && e->cloud_image[0]) st = read_map(ctx, "clouds/image", e->cloud_image, 1, &clouds);
+    if (spherical && e->ground_map[0])
+        st = map_error(ctx, read_map(ctx, e->ground_map, e->map_reduce, &ground), scene, "ground_map", e->ground_map);
+    if (!st && spherical && e->night_lights[0])
+        st = map_error(ctx, read_map(ctx, e->night_lights, e->map_reduce, &night), scene, "night_lights",
+                       e->night_lights);
+    if (!st && spherical && e->cloud_image[0])
+        st = map_error(ctx, read_map(ctx, e->cloud_image, 1, &clouds), scene, "clouds/image", e->cloud_image);
     if (!st && clouds && e->cloud_world_file[0])
-        st = world_file(ctx, e->cloud_world_file, clouds->width, clouds->height, &d.clouds);
+        st = map_error(ctx, world_file(ctx, e->cloud_world_file, clouds->width, clouds->height, &d.clouds), scene,
+                       "clouds/world_file", e->cloud_world_file);
     if (!st) {
         /* the files named in the scene, else the images the scene's desc holds (a scene built
          * in code) */

@@ -20,7 +20,10 @@ python3 -c 'import sys; assert open(sys.argv[1],"rb").read(8) == b"\x89PNG\r\n\x
 "$A" compare "$T/b.pfm" "$T/a.pfm" --heatmap "$T/new/sub/h.png" >/dev/null 2>"$T/err" && [ -s "$T/new/sub/h.png" ] && ok ||
     bad "--heatmap into a new folder: $(cat "$T/err")"
 "$A" render -q --width 8 --height 8 --pfm "$T/small.pfm" || bad "render small"
-"$A" compare "$T/small.pfm" "$T/a.pfm" 2>/dev/null; [ $? -eq 1 ] && ok || bad "size mismatch should exit 1"
+"$A" compare "$T/small.pfm" "$T/a.pfm" 2>"$T/err"; [ $? -eq 1 ] && ok || bad "size mismatch should exit 1"
+# the message names both files and their sizes
+grep -q "small.pfm is 8x8, .*a.pfm [0-9]*x[0-9]*: the image and the reference must be the same size" "$T/err" && ok ||
+    bad "size mismatch message: $(cat "$T/err")"
 "$A" compare "$T/a.pfm" 2>/dev/null; [ $? -eq 2 ] && ok || bad "one file should exit 2"
 "$A" compare "$T/nope.exr" "$T/a.pfm" 2>/dev/null; [ $? -eq 1 ] && ok || bad "missing file should exit 1"
 

@@ -1,7 +1,9 @@
 #!/bin/sh
 # Inputs a new user gets wrong, and the messages that tell them what to do:
 #  - a file that is not an image given as an Earth map: the message names the scene key, the
-#    path and the formats read (PNG, JPEG), not the image library's "Read Error";
+#    path and the formats read (PNG, JPEG), not the image library's "Read Error" (a PNG cut
+#    short: "truncated"); a scene file's
+#    cloud image that cannot be read: the scene file too; an image given as the scene: said so;
 #  - -D volume.KEY=VALUE together with --volume FILE: applies to that file, as the option of
 #    the same meaning does (-D volume.density_unit=per_m3 == --density-unit per_m3);
 #  - --volume with a -D naming another volume source: refused, both named, nothing written;
@@ -29,6 +31,31 @@ printf '\211PNG\r\n\032\n' >"$T/cut.png"
     -o "$T/g.png" >/dev/null 2>"$T/err"
 [ $? -ne 0 ] && ok "a truncated PNG map is refused" || bad "a truncated PNG map was accepted"
 has "truncated PNG map" "/atmosphere/night_lights"
+has "truncated PNG map" "truncated: the PNG file ends before its image does"
+# a scene file's cloud image or world file that cannot be read: the message names the scene file
+# too, as it does for a missing one (a truncated JPEG, a PNG cut short, a folder)
+printf '\377\330\377\340\000\020JFIF\000' >"$T/cut.jpg"
+mkdir -p "$T/sc/folder.png"
+cp "$T/cut.png" "$T/sc/cut.png"; cp "$T/cut.jpg" "$T/sc/cut.jpg"
+for img in cut.jpg cut.png folder.png; do
+    printf '{"atmosphere": {"model": "spherical", "clouds": {"image": "%s", "base_m": 2000, "top_m": 8000}},
+ "image": {"width": 8, "height": 8}}\n' "$img" >"$T/sc/clouds.json"
+    "$A" render "$T/sc/clouds.json" -o "$T/g.png" >/dev/null 2>"$T/err"
+    [ $? -eq 1 ] && ok "cloud image $img refused (exit 1)" || bad "cloud image $img: not exit 1"
+    has "cloud image $img" "sc/clouds.json: /atmosphere/clouds/image: "
+    has "cloud image $img" "$img"
+done
+
+# --- an image given as the scene: said what it is (not "malformed JSON: control character"),
+# exit 2, no output
+"$A" render -q --width 8 --height 8 --exr "$T/img.exr" -o "$T/img.png" 2>/dev/null || bad "render img.exr"
+for img in img.exr img.png; do
+    "$A" render "$T/$img" -o "$T/as_scene.png" >/dev/null 2>"$T/err"
+    st=$?
+    [ $st -eq 2 ] && [ ! -e "$T/as_scene.png" ] && ok "$img as the scene refused (exit 2)" || bad "$img as the scene: exit $st"
+    has "$img as the scene" "image, not a scene"
+done
+has "img.png as the scene" "is a PNG image"
 
 # --- -D volume.* with --volume FILE
 "$A" volume generate cumulus -o "$T/v.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"

@@ -3,7 +3,7 @@
 # reason and, for a relative path, where it was looked for (as a light's image is); an OBJ
 # file's wrong face (or a face of fewer than 3 vertices, or a line that is no OBJ statement) says
 # what is wrong, as written, and on which line; another kind of file is not an OBJ file; a folder is
-# a folder; a comment after a face is a comment; call, csh, indents and a final ^Z are OBJ's.
+# a folder (a mesh's or a terrain's); a comment after a face is a comment; call, csh, indents and a final ^Z are OBJ's.
 . "$(dirname "$0")/common.inc"
 cd "$T" || exit 1
 mesh_scene() { # mesh_scene MESH TERRAIN
@@ -43,6 +43,9 @@ check "vertex 0" err6 "line 4" "vertex 0"
 mkdir dir.obj
 "$A" render s.json -D objects.0.mesh=dir.obj -o x.png -q 2>err7
 check "a folder" err7 "/objects/0/mesh" "folder"
+mkdir dir.tif
+"$A" render s.json -D objects.1.terrain=dir.tif -o x.png -q 2>err7t
+check "a folder as the terrain" err7t "/objects/1/terrain" "dir.tif" "it is a folder, not a file"
 # a terrain whose max_triangles leaves no cell: said of max_triangles, not of a stride never set
 "$A" render --width 33 --height 33 -o h.png -q 2>/dev/null || bad "a height map"
 "$A" render s.json -D objects.1.terrain=h.png -D objects.1.max_triangles=1 -o x.png -q 2>err9

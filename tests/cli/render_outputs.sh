@@ -26,31 +26,8 @@ cat > "$T/path.json" <<'EOF'
 EOF
 P="$T/path.json"
 
-# The header of an EXR as lines "name type value" (string, int, double, chromaticities,
-# and the channel list as "channels chlist A,B,G,R").
-exr_header() {
-    python3 - "$1" <<'PY'
-import struct, sys
-b = open(sys.argv[1], "rb").read()
-assert b[:4] == b"\x76\x2f\x31\x01", "not an EXR"
-i = 8
-while b[i] != 0:
-    j = b.index(b"\0", i); name = b[i:j].decode()
-    k = b.index(b"\0", j + 1); typ = b[j + 1:k].decode()
-    n = struct.unpack("<i", b[k + 1:k + 5])[0]; v = b[k + 5:k + 5 + n]; i = k + 5 + n
-    if typ == "string": v = v.decode()
-    elif typ == "int": v = struct.unpack("<i", v)[0]
-    elif typ == "double": v = repr(struct.unpack("<d", v)[0])
-    elif typ == "chromaticities": v = ",".join("%.4f" % x for x in struct.unpack("<8f", v))
-    elif typ == "chlist":
-        names, p = [], 0
-        while v[p] != 0:
-            e = v.index(b"\0", p); names.append(v[p:e].decode()); p = e + 1 + 16
-        v = ",".join(names)
-    else: v = "-"
-    print(name, typ, v)
-PY
-}
+# The header of an EXR as lines "name type value" (exr_header.py).
+exr_header() { python3 "$(dirname "$0")/exr_header.py" "$1"; }
 
 # 1. The writer by the extension; other extensions refused before rendering.
 "$A" render -q $S -o "$T/o.exr" && ok || bad "-o x.exr"
@@ -76,13 +53,27 @@ echo "$out" | grep -q '"nonfinite": 0[,}]' && ok || bad "--exr-half wrote non-fi
 # carries the chromaticities and numbers as numbers.
 "$A" render -q $P --rgb --exr "$T/p.exr" --variance "$T/v.exr" && ok || bad "path render --variance"
 exr_header "$T/v.exr" > "$T/vh" || bad "variance EXR unreadable"
-grep -q "^channels chlist var_440.0nm,var_550.0nm,var_680.0nm,var_Y$" "$T/vh" && ok || bad "variance channels: $(grep chlist "$T/vh")"
+grep -q "^channels chlist variance.440nm,variance.550nm,variance.680nm,variance.Y$" "$T/vh" && ok || bad "variance channels: $(grep chlist "$T/vh")"
+# no chromaticities: they describe R, G and B, which a variance file has not
+grep -q "^chromaticities" "$T/vh" && bad "variance EXR has chromaticities" || ok
+# one spelling: the --exr-layers variance layers are the --variance file's channels, spectral
+# wavelengths as they are (386.25 nm, not 386 or 386.2), with OpenEXR's comma so that the
+# layer stays "variance"
+"$A" render -q $P --spectral 32 --exr "$T/ps.exr" --exr-layers variance --variance "$T/vs.exr" && ok || bad "spectral variance"
+vs=$(exr_header "$T/vs.exr" | grep '^channels' | cut -d' ' -f3)
+ls=$(exr_header "$T/ps.exr" | grep '^channels' | cut -d' ' -f3 | sed 's/^A,B,G,R,//')
+[ -n "$vs" ] && [ "$vs" = "$ls" ] && ok || bad "variance names differ: file '$vs', layers '$ls'"
+echo "$vs" | grep -q "variance.386,25nm,variance.398,75nm" && ok || bad "spectral variance names: $vs"
+exr_header "$T/vs.exr" | grep -q '^atmos:units string variance of the mean.*W m^-2 sr^-1 nm^-1.*variance.Y in (cd/m^2)^2' \
+    && ok || bad "variance file: units $(exr_header "$T/vs.exr" | grep '^atmos:units')"
+exr_header "$T/ps.exr" | grep -q '^atmos:units string linear sRGB.*; variance.\*: variance of the mean' \
+    && ok || bad "layered file: units $(exr_header "$T/ps.exr" | grep '^atmos:units')"
 for key in "atmos:scene string" "atmos:renderer string path" "atmos:sun_elevation_deg double 22.0" \
     "atmos:sun_azimuth_deg double 235.0" "atmos:threads int" "atmos:version string" "atmos:wavelengths_nm string 680.0 550.0 440.0" \
     "atmos:atmosphere string"; do
     grep -q "^$key" "$T/vh" && ok || bad "variance EXR lacks '$key'"
 done
-for f in o.exr f.exr h.exr p.exr v.exr; do
+for f in o.exr f.exr h.exr p.exr ps.exr; do
     exr_header "$T/$f" > "$T/hdr"
     grep -q "^chromaticities chromaticities 0.6400,0.3300,0.3000,0.6000,0.1500,0.0600,0.3127,0.3290$" "$T/hdr" \
         && ok || bad "$f: no Rec. 709 / D65 chromaticities"

@@ -77,6 +77,15 @@ grep -q 'homogeneous.*no tables' "$T/list" "$T/err" && grep -q 'spherical' "$T/l
 "$cli" sky --model dobashi --table sun_attenuation -o "$T/new/sub/t.pfm" >"$T/out" 2>"$T/err" && [ -s "$T/new/sub/t.pfm" ] &&
     ok "--table -o into a new folder" || bad "--table -o into a new folder: $(cat "$T/err")"
 
+# a table as EXR: channels "<table>.<nm>nm" (not "440.00nm", which OpenEXR reads as channel
+# "00nm" of layer "440"), its units in atmos:units, no chromaticities (it is not an RGB image)
+"$cli" sky --model dobashi --table sun_attenuation -o "$T/gl.exr" >"$T/out" 2>"$T/err" &&
+    python3 "$(dirname "$0")/exr_header.py" "$T/gl.exr" >"$T/hdr" || bad "--table -o x.exr: $(cat "$T/err")"
+grep -q '^channels chlist sun_attenuation.440nm,sun_attenuation.550nm,sun_attenuation.680nm$' "$T/hdr" &&
+    ok "--table EXR: channels named <table>.<nm>nm" || bad "--table EXR channels: $(grep '^channels' "$T/hdr")"
+grep -q '^atmos:units string 1: g_l' "$T/hdr" && ok "--table EXR: units" || bad "--table EXR units: $(grep -c units "$T/hdr")"
+grep -q '^chromaticities' "$T/hdr" && bad "--table EXR has chromaticities" || ok "--table EXR: no chromaticities"
+
 # the help says what --table list does
 "$cli" sky --help >"$T/help" 2>&1
 grep -q 'table list' "$T/help" && grep -q 'goes with' "$T/help" && ok "help" || bad "help: $(cat "$T/help")"

@@ -59,4 +59,47 @@ for x in r:
     yaws.add(round(float(x["yaw_deg"])))
 assert len(yaws) == 5, yaws   # it does go round
 PY
+
+# a sun key on a scene the renderer lights by its lamps only (Dobashi's spotlight, the beam
+# renderer without a sun): said, naming the key and why, not taken in silence
+S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
+"$A" view "$S/scenes/dobashi_fig04_spotlight.json" --headless --frames 2 --size 16x9 --press sun_up,forward \
+    --record r_lamp >o_lamp.txt 2>&1
+st=$?
+[ $st -eq 0 ] && grep -q -- "--press sun_up: changes nothing: the beams renderer lights this scene without the sun" o_lamp.txt &&
+    ! grep -q -- "--press forward" o_lamp.txt && ok "--press sun_up on a lamp-only scene: said why (exit $st)" ||
+    { bad "--press sun_up on a lamp-only scene (exit $st)"; cat o_lamp.txt >&2; }
+
+# atmos render's outputs, its image size and --mpi are refused, not ignored (the viewer writes
+# with F12 and --record, its size is --size)
+n=0
+for opt in "-o x.png" "--exr x.exr" "--pfm x.pfm" "--width 100" "--height 50"; do
+    n=$((n + 1))
+    # shellcheck disable=SC2086
+    "$A" view --headless --frames 2 --size 16x9 --record "r_opt$n" $opt >o_opt.txt 2>&1
+    st=$?
+    [ $st -eq 2 ] && grep -q "atmos render's; the viewer's frame is --size WxH" o_opt.txt && [ ! -e x.png ] && [ ! -e x.exr ] &&
+        ok "view $opt refused (exit 2)" || { bad "view $opt: exit $st"; cat o_opt.txt >&2; }
+done
+
+# --record into missing folders: made, as atmos render's outputs' folders; one that cannot be
+# made: said, naming the folder
+"$A" view --headless --frames 2 --size 16x9 --record new/sub/rec >o_rec.txt 2>&1 && [ -s new/sub/rec/frames.csv ] &&
+    ok "--record new/sub/rec: the folders made" || { bad "--record new/sub/rec"; cat o_rec.txt >&2; }
+"$A" view --headless --frames 2 --size 16x9 --record /proc/no/rec >o_rec.txt 2>&1
+st=$?
+[ $st -eq 1 ] && grep -q "record /proc/no/rec/frames.csv: cannot create the folder /proc/no" o_rec.txt &&
+    ok "--record in a folder that cannot be made: said (exit 1)" || { bad "--record /proc/no/rec: exit $st"; cat o_rec.txt >&2; }
+
+# a flight that moves the sun over such a scene: said once
+cat >lamp_flight.json <<'EOF2'
+{"fps": 24, "keys": [{"t": 0, "position_m": [0, 7, 32], "look_at_m": [0, 3, 0]},
+                     {"t": 0.05, "position_m": [0, 7, 30], "look_at_m": [0, 3, 0], "sun": {"elevation_deg": 30, "azimuth_deg": 90}}]}
+EOF2
+"$A" view "$S/scenes/dobashi_fig04_spotlight.json" --headless --script lamp_flight.json --size 16x9 --record r_lampfl \
+    >o_lampfl.txt 2>&1
+st=$?
+[ $st -eq 0 ] && [ "$(grep -c 'changes nothing' o_lampfl.txt)" -eq 1 ] &&
+    grep -q -- "--script lamp_flight.json: the flight's sun: changes nothing: the beams renderer" o_lampfl.txt &&
+    ok "a flight's sun on a lamp-only scene: said once (exit $st)" || { bad "a flight's sun on a lamp-only scene (exit $st)"; cat o_lampfl.txt >&2; }
 exit $fail

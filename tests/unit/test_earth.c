@@ -237,6 +237,17 @@ static void test_scene_keys(void)
     CHECK_OK(atmos_write_png(NULL, img, map, 8));
     atmos_image_destroy(img);
     CHECK(atmos_scene_load(ctx, scene, &sc) == ATMOS_E_IO); /* the world file is missing */
+    /* one that is there but wrong (a rotation): refused when the atmosphere is made, naming the
+     * scene file, the key and the world file */
+    write_text(jgw, "0.5\n0.1\n0\n-0.25\n-119.75\n29.875\n");
+    CHECK_OK(atmos_scene_load(ctx, scene, &sc));
+    atmos_wavelengths wl0;
+    atmos_wavelengths_rgb(&wl0);
+    atmos_atmosphere *a0 = NULL;
+    CHECK(atmos_scene_atmosphere_create(ctx, &sc, &wl0, &a0) == ATMOS_E_FORMAT && a0 == NULL);
+    CHECK_MSG(strstr(atmos_context_error(ctx), scene) && strstr(atmos_context_error(ctx), "/atmosphere/clouds/world_file: ") &&
+                  strstr(atmos_context_error(ctx), jgw),
+              "%s", atmos_context_error(ctx));
     write_text(jgw, "0.5\n0\n0\n-0.25\n-119.75\n29.875\n");
     CHECK_OK(atmos_scene_load(ctx, scene, &sc));
     CHECK(strcmp(sc.earth.cloud_image, map) == 0); /* resolved against the scene's folder */

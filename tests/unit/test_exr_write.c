@@ -39,11 +39,23 @@ static atmos_image *ramp(atmos_context *ctx, int w, int h, int nc)
     return img;
 }
 
-/* Names given for a 4-channel image are the file's channels (sorted by OpenEXR). */
+/* 1 if the file at path has the "chromaticities" attribute. */
+static int has_chromaticities(const char *path)
+{
+    exr_context_t ex = NULL;
+    const exr_attribute_t *a = NULL;
+    if (exr_start_read(&ex, path, NULL) != EXR_ERR_SUCCESS) return -1;
+    const int has = exr_get_attribute_by_name(ex, 0, "chromaticities", &a) == EXR_ERR_SUCCESS;
+    exr_finish(&ex);
+    return has;
+}
+
+/* Names given for a 4-channel image are the file's channels (sorted by OpenEXR); the
+ * chromaticities (of R, G and B) only on a file that has R, G and B, plain or in a layer. */
 static void test_names(atmos_context *ctx, const char *path)
 {
     atmos_image *img = ramp(ctx, 6, 5, 4), *back = NULL;
-    static const char *const names[4] = {"var_680.0nm", "var_550.0nm", "var_440.0nm", "var_Y"};
+    static const char *const names[4] = {"variance.680nm", "variance.550nm", "variance.386,25nm", "variance.Y"};
     atmos_exr_desc d = {0, names};
     CHECK_OK(atmos_write_exr(ctx, img, path, &d));
     exr_context_t ex = NULL;
@@ -52,8 +64,13 @@ static void test_names(atmos_context *ctx, const char *path)
     char got[256] = "";
     for (int i = 0; cl && i < cl->num_channels; i++)
         snprintf(got + strlen(got), sizeof got - strlen(got), "%s%s", i ? "," : "", cl->entries[i].name.str);
-    CHECK_MSG(strcmp(got, "var_440.0nm,var_550.0nm,var_680.0nm,var_Y") == 0, "channels %s", got);
+    CHECK_MSG(strcmp(got, "variance.386,25nm,variance.550nm,variance.680nm,variance.Y") == 0, "channels %s", got);
     exr_finish(&ex);
+    CHECK_MSG(has_chromaticities(path) == 0, "a file without R, G, B has chromaticities");
+    static const char *const layered[4] = {"beauty.B", "beauty.G", "beauty.R", "beauty.A"};
+    d.channel_names = layered;
+    CHECK_OK(atmos_write_exr(ctx, img, path, &d));
+    CHECK_MSG(has_chromaticities(path) == 1, "one layer's R, G, B without chromaticities");
     /* RGBA images without names keep R,G,B,A */
     CHECK_OK(atmos_write_exr(ctx, img, path, NULL));
     CHECK(exr_start_read(&ex, path, NULL) == EXR_ERR_SUCCESS && exr_get_channels(ex, 0, &cl) == EXR_ERR_SUCCESS);

@@ -317,7 +317,7 @@ static void test_grid(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 /* The tables as images (atmos_atmosphere_table): each kind lists some, each is finite and
  * as wide as a wavelength set; the production sky's transmittance at its first node (the
  * ground, straight up) is the interface's vertical transmittance; Dobashi's sun attenuation
- * lies in [0, 1]; an unknown name is refused. */
+ * lies in [0, 1]; each says its units (atmos:units); an unknown name is refused. */
 static void test_tables(const atmos_atmosphere *a, const atmos_wavelengths *wl)
 {
     const char *const *names = atmos_atmosphere_table_names(a);
@@ -330,6 +330,8 @@ static void test_tables(const atmos_atmosphere *a, const atmos_wavelengths *wl)
         int bad = 0;
         for (size_t j = 0; j < (size_t)t->width * t->height * t->channels; j++) bad += !isfinite(t->pixels[j]);
         CHECK_MSG(bad == 0, "table %s: %d values not finite", names[i], bad);
+        const char *units = atmos_image_get_meta(t, "atmos:units"); /* what a value is, in what units */
+        CHECK_MSG(units && strlen(units) > 3, "table %s: no atmos:units", names[i]);
         if (!strcmp(names[i], "transmittance")) {
             const double p[3] = {0, 0, 0}, up[3] = {0, 1, 0};
             double T[ATMOS_MAX_WAVELENGTHS];

@@ -250,6 +250,12 @@ int cli_cmd_compare(int argc, char **argv)
     atmos_channel_match m;
     atmos_status st = read_hdr(ctx, files[0], &a);
     if (st == ATMOS_OK) st = read_hdr(ctx, files[1], &b);
+    int said = 0; /* a message printed here, not the context's */
+    if (st == ATMOS_OK && (a.img->width != b.img->width || a.img->height != b.img->height)) {
+        fprintf(stderr, "atmos %s: %s is %dx%d, %s %dx%d: the image and the reference must be the same size\n", C,
+                files[0], a.img->width, a.img->height, files[1], b.img->width, b.img->height);
+        st = ATMOS_E_INVALID_ARG, said = 1;
+    }
     if (st == ATMOS_OK) st = atmos_image_match_channels(ctx, a.names, a.img->channels, b.names, b.img->channels, &m);
     m.exclude_above = exclude_above;
     if (st == ATMOS_OK) st = atmos_image_compare_matched(ctx, a.img, b.img, &m, &d, heat ? &h : NULL);
@@ -258,7 +264,7 @@ int cli_cmd_compare(int argc, char **argv)
     if (st == ATMOS_OK && heat) st = atmos_write_png(ctx, h, heat, 8);
     int rc = CLI_EXIT_OK;
     if (st != ATMOS_OK) {
-        rc = cli_runtime_error(C, ctx, st);
+        rc = said ? CLI_EXIT_RUNTIME : cli_runtime_error(C, ctx, st);
     } else {
         if (json) print_json(&d, a.names, &m, by ? &bins : NULL);
         else print_text(files, a.img, &d, a.names, &m, heat, by, by ? &bins : NULL);

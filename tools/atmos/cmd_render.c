@@ -125,24 +125,20 @@ static void copy_meta(atmos_image *img, const atmos_image *lin)
         if (strcmp(lin->meta[i].key, "atmos:units")) atmos_image_set_meta(img, lin->meta[i].key, lin->meta[i].value);
 }
 
-/* The path tracer's variance (channels var_<nm>nm, then var_Y) and order images, with the
- * render's metadata (lin's). */
+/* The path tracer's variance (channels variance.<nm>nm, then variance.Y: as the variance
+ * layers of --exr-layers) and order images, with the render's metadata (lin's). */
 static atmos_status write_path_aux(atmos_context *ctx, const atmos_plan *plan, const frame_files *ff, const atmos_image *lin)
 {
     const atmos_wavelengths *wl = atmos_plan_wavelengths(plan);
     atmos_image *img = NULL;
     atmos_status st = ATMOS_OK;
     if (ff->var && (st = atmos_plan_path_variance(plan, &img)) == ATMOS_OK) {
-        static char names[ATMOS_MAX_WAVELENGTHS + 1][24];
+        static char names[ATMOS_MAX_WAVELENGTHS + 1][40];
         const char *np[ATMOS_MAX_WAVELENGTHS + 1];
-        for (int k = 0; k < wl->count; k++) {
-            snprintf(names[k], sizeof names[k], "var_%.1fnm", wl->nm[k]);
-            np[k] = names[k];
-        }
-        np[wl->count] = "var_Y";
+        render_layers_variance_names(wl, img->channels, names, np);
         atmos_exr_desc ed = {0, np};
         copy_meta(img, lin);
-        atmos_image_set_meta(img, "atmos:units", "variance of the mean of each channel: the channel's units squared");
+        atmos_image_set_meta(img, "atmos:units", RENDER_VARIANCE_UNITS);
         st = atmos_write_exr(ctx, img, ff->var, &ed);
         atmos_image_destroy(img);
         img = NULL;

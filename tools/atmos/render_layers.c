@@ -1,6 +1,7 @@
 /* atmos render --exr-layers (render_layers.h). */
 #include "render_layers.h"
 #include "cli.h"
+#include "exr_names.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -66,6 +67,27 @@ static atmos_status layer_sources(atmos_context *ctx, const atmos_plan *plan, co
     return st;
 }
 
+/* atmos:units of the layered image: lin's, then each layer's. */
+static void layer_units(atmos_image *img, const atmos_image *lin, int mask)
+{
+    const char *u = atmos_image_get_meta(lin, "atmos:units");
+    char buf[512];
+    snprintf(buf, sizeof buf, "%s%s%s%s%s", u ? u : "", mask & RENDER_LAYER_TAU ? "; tau.Y: optical depth (1)" : "",
+             mask & RENDER_LAYER_TRANSMITTANCE ? "; transmittance.Y: (1)" : "",
+             mask & RENDER_LAYER_ORDER ? "; order.Y: mean number of scattering events" : "",
+             mask & RENDER_LAYER_VARIANCE ? "; variance.*: " RENDER_VARIANCE_UNITS : "");
+    atmos_image_set_meta(img, "atmos:units", buf);
+}
+
+void render_layers_variance_names(const atmos_wavelengths *wl, int channels, char (*buf)[40], const char **names)
+{
+    for (int k = 0; k < channels; k++) {
+        if (k < wl->count) cli_exr_wavelength_name(buf[k], sizeof buf[k], "variance", wl->nm[k]);
+        else snprintf(buf[k], sizeof buf[k], "variance.Y");
+        names[k] = buf[k];
+    }
+}
+
 atmos_status render_layers_build(atmos_context *ctx, const atmos_plan *plan, const atmos_scene *scene,
                                  const atmos_image *lin, int mask, atmos_image **out, const char *const **names)
 {
@@ -87,12 +109,10 @@ atmos_status render_layers_build(atmos_context *ctx, const atmos_plan *plan, con
         if (src[2]) {
             const atmos_wavelengths *wl = atmos_plan_wavelengths(plan);
             put_channels(*out, c, src[2], 0);
-            for (int k = 0; k < src[2]->channels; k++, c++) {
-                if (k < wl->count) snprintf(buf[c], sizeof buf[c], "variance.%.0fnm", wl->nm[k]);
-                else snprintf(buf[c], sizeof buf[c], "variance.Y");
-                np[c] = buf[c];
-            }
+            render_layers_variance_names(wl, src[2]->channels, buf + c, np + c);
+            c += src[2]->channels;
         }
+        layer_units(*out, lin, mask);
         *names = np;
     }
     for (int i = 0; i < 3; i++) atmos_image_destroy(src[i]);

@@ -97,6 +97,30 @@ static int refuse_volume_file(const render_opts *o)
     return 1;
 }
 
+/* An image given where a scene goes (known by its first bytes): refused, saying what it is,
+ * rather than read as malformed JSON. 1 if refused (message printed). */
+static int refuse_image_file(const render_opts *o)
+{
+    const char *p = o->scene_path;
+    if (!strcmp(p, "-")) return 0;
+    unsigned char b[8] = {0};
+    FILE *f = fopen(p, "rb");
+    if (!f) return 0;
+    const size_t n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    const char *kind = n >= 4 && !memcmp(b, "\x76\x2f\x31\x01", 4)                   ? "an OpenEXR image"
+                       : n == 8 && !memcmp(b, "\x89PNG\r\n\x1a\n", 8)                 ? "a PNG image"
+                       : n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF          ? "a JPEG image"
+                       : n >= 3 && b[0] == 'P' && (b[1] == 'F' || b[1] == 'f') && b[2] == '\n' ? "a PFM image"
+                                                                                         : NULL;
+    if (!kind) return 0;
+    fprintf(stderr,
+            "atmos %s: %s is %s, not a scene: a scene is a JSON file (docs/scene-format.md), which names the "
+            "images it uses; atmos compare reads rendered images\n",
+            o->cmd, p, kind);
+    return 1;
+}
+
 /* Whether the user chose the atmosphere: a scene file, --atmosphere or a -D atmosphere.*. */
 static int atmosphere_given(const render_opts *o)
 {
@@ -287,7 +311,7 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
     }
     const int ndefs = volume_defines(o, defs, source_def, sizeof source_def, paths);
     if (o->scene_path) {
-        if (refuse_volume_file(o)) return CLI_EXIT_USAGE;
+        if (refuse_volume_file(o) || refuse_image_file(o)) return CLI_EXIT_USAGE;
         if (!strcmp(o->scene_path, "-")) {
             if (!o->scene_text) {
                 fprintf(stderr, "atmos %s: standard input: cannot read the scene (larger than 16 MiB, the limit "

@@ -1,7 +1,9 @@
 /* atmos sky --table: the models' look-up tables listed, or one written as an image
- * (EXR: every wavelength, channels named by it; PFM: the first three; PNG: a plot, the
- * first three channels each scaled to its own maximum). */
+ * (EXR: every wavelength, channels "<table>.<nm>nm" (exr_names.h), the table's atmos:axes and
+ * atmos:units, no chromaticities; PFM: the first three; PNG: a plot, the first three channels
+ * each scaled to its own maximum). */
 #include "cli.h"
+#include "exr_names.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -37,14 +39,16 @@ static atmos_status write_table(atmos_context *ctx, const atmos_image *t, const 
 {
     if (ends_with(path, ".png")) return write_plot(ctx, t, path);
     if (ends_with(path, ".pfm")) return atmos_write_pfm(ctx, t, path);
-    char **names = malloc(sizeof(char *) * (size_t)t->channels), *buf = malloc((size_t)t->channels * 24);
+    enum { CAP = 64 };
+    char **names = malloc(sizeof(char *) * (size_t)t->channels), *buf = malloc((size_t)t->channels * CAP);
     if (!names || !buf) {
         free(names), free(buf);
         return ATMOS_E_NOMEM;
     }
-    for (int k = 0; k < t->channels; k++) {
-        names[k] = buf + (size_t)k * 24;
-        snprintf(names[k], 24, "%.2fnm", wl->nm[k]);
+    const char *table = atmos_image_get_meta(t, "atmos:table");
+    for (int k = 0; k < t->channels; k++) { /* "transmittance.440nm": the table's layer */
+        names[k] = buf + (size_t)k * CAP;
+        cli_exr_wavelength_name(names[k], CAP, table ? table : "table", wl->nm[k]);
     }
     atmos_exr_desc d = {0, (const char *const *)names};
     atmos_status st = atmos_write_exr(ctx, t, path, &d);

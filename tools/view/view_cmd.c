@@ -68,7 +68,8 @@ static void help(void)
            "                     draw them at)\n"
            "  -h, --help         show this help\n"
            "Scene options are atmos render's (atmos render --help): --renderer, --volume, --sun-elevation,\n"
-           "--time, --spp, -D KEY=VALUE, --threads, ...\n\n");
+           "--time, --spp, -D KEY=VALUE, --threads, ...; not its outputs (-o, --exr, ...), --width/--height\n"
+           "or --mpi: refused (the frame is --size's; F12 and --record write files)\n\n");
     view_keys_help(stdout);
     fputs(CLI_HELP_EXIT, stdout);
 }
@@ -127,6 +128,24 @@ static int parse(int argc, char **argv, view_opts *o)
     return CLI_EXIT_OK;
 }
 
+/* The first of atmos render's options that the viewer takes but would not use (its outputs,
+ * the image size, --mpi), as the user wrote it, or NULL: refused rather than ignored. */
+static const char *render_only(const render_opts *ro)
+{
+    return ro->png        ? "-o"
+           : ro->exr      ? "--exr"
+           : ro->pfm      ? "--pfm"
+           : ro->variance ? "--variance"
+           : ro->order    ? "--order"
+           : ro->tau      ? "--tau"
+           : ro->exr_layers ? "--exr-layers"
+           : ro->png_bits ? "--png-bits"
+           : ro->exr_half ? "--exr-half"
+           : ro->width > 0 || ro->height > 0 ? "--width/--height"
+           : ro->mpi ? "--mpi"
+                     : NULL;
+}
+
 int cli_cmd_view(int argc, char **argv)
 {
     view_opts vo;
@@ -140,6 +159,13 @@ int cli_cmd_view(int argc, char **argv)
         free(vo.pass);
         render_opts_free(&ro);
         return rc == -1 ? CLI_EXIT_OK : rc;
+    }
+    const char *unused = render_only(&ro);
+    if (unused) {
+        free(vo.pass);
+        render_opts_free(&ro);
+        return cli_usage_error("view", "%s: atmos render's; the viewer's frame is --size WxH, F12 saves it as EXR and PNG "
+                                       "(--save-base BASE), --record DIR writes every frame", unused);
     }
     int codes[16];
     if (vo.press && view_key_codes(vo.press, codes, 16) < 0) {

@@ -321,6 +321,30 @@ static int volume_centre(const atmos_plan *p, double c[3])
     return 1;
 }
 
+/* A sun or clock move (what: the option or the flight's key that asks for it) where the
+ * renderer lights the scene without the sun: said to change nothing, and why. */
+static void say_sunless(const char *what, const atmos_scene *sc, atmos_renderer_kind r)
+{
+    fprintf(stderr, "atmos view: %s: changes nothing: the %s renderer lights this scene without the sun (by its %d lamp%s)\n",
+            what, atmos_renderer_name(r), sc->light_count, sc->light_count == 1 ? "" : "s");
+}
+
+/* A flight's sun (key frames that set it, sun or clock keys pressed) on such a scene: said
+ * once (a pressed key by its key frame). */
+static void flight_sunless(const view_script *script, const char *path, const atmos_scene *sc, atmos_renderer_kind r)
+{
+    for (int i = 0; script && i < script->n && cli_lit_without_sun(sc, r); i++) {
+        const view_action a = script->k[i].press;
+        if (script->k[i].has_sun || (a >= VA_SUN_UP && a <= VA_TIME_FORWARD)) {
+            char what[ATMOS_SCENE_PATH_MAX + 64];
+            if (script->k[i].has_sun) snprintf(what, sizeof what, "--script %s: the flight's sun", path);
+            else snprintf(what, sizeof what, "--script %s: /keys/%d/press", path, i);
+            say_sunless(what, sc, r);
+            return;
+        }
+    }
+}
+
 static int start(loop *L, const view_opts *o, view_state *s, const view_script *script)
 {
     atmos_frame f;
@@ -328,6 +352,7 @@ static int start(loop *L, const view_opts *o, view_state *s, const view_script *
     view_state_init(s, L->sc, &f, NULL);
     const int rc = view_script_check(script, s, o->script); /* before the plan's work */
     if (rc != CLI_EXIT_OK) return rc;
+    flight_sunless(script, o->script, L->sc, s->renderer);
     atmos_plan *p = NULL;
     if (st == ATMOS_OK) st = get_plan(L, s, &p);
     if (st != ATMOS_OK) return cli_runtime_error("view", L->ctx, st);
@@ -337,14 +362,22 @@ static int start(loop *L, const view_opts *o, view_state *s, const view_script *
 }
 
 /* --press's keys: through the window's event queue, as a user's; headless, tapped on the state
- * (view_state_tap: what the window does with a key pressed and released at once). */
-static void press(view_window *win, view_state *s, const char *keys)
+ * (view_state_tap: what the window does with a key pressed and released at once). A key that
+ * moves the sun or the clock where the renderer lights the scene by its lamps only is said to
+ * change nothing, and why, rather than taken in silence. */
+static void press(view_window *win, view_state *s, const atmos_scene *sc, const char *keys)
 {
     int codes[16];
     const int n = view_key_codes(keys, codes, 16);
     for (int k = 0; k < n; k++) {
+        const view_action a = view_key_action(codes[k]);
+        if (a >= VA_SUN_UP && a <= VA_TIME_FORWARD && cli_lit_without_sun(sc, s->renderer)) {
+            char what[64];
+            snprintf(what, sizeof what, "--press %s", view_action_name(a));
+            say_sunless(what, sc, s->renderer);
+        }
         if (win) view_window_push_key(win, codes[k]);
-        else view_state_tap(s, view_key_action(codes[k]));
+        else view_state_tap(s, a);
     }
 }
 
@@ -376,7 +409,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!frames || i < frames); i++) {
         const double t0 = cli_now_s();
         if (scripted) view_script_step(script, &s, (i - 1) / fps, i / fps, i, frames);
-        if (i == 1 && o->press) press(win, &s, o->press), pressed = 1;
+        if (i == 1 && o->press) press(win, &s, sc, o->press), pressed = 1;
         if (win) view_window_events(win, &s, last_ms > 0 ? last_ms / 1000.0 : 1.0 / 30.0);
         const int moving = i > 0 && (s.changes & (VIEW_CHANGED_CAMERA | VIEW_CHANGED_SUN)) && view_moved(&pose, &s);
         s.changes = 0;

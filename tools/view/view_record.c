@@ -4,6 +4,7 @@
  * exposure (and the volume's absolute path and its placement), so every other setting stays
  * as written. */
 #define _XOPEN_SOURCE 700 /* realpath */
+#include "outputs.h"
 #include "view.h"
 
 #include <cjson/cJSON.h>
@@ -35,11 +36,12 @@ int view_record_open(view_recorder *r, const char *dir)
     memset(r, 0, sizeof *r);
     if (!dir) return CLI_EXIT_OK;
     r->dir = dir;
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "atmos view: --record %s: %s\n", dir, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
-    struct stat st; /* mkdir's EEXIST is also that of a file of that name */
+    struct stat st;
+    char csv[4096];
+    snprintf(csv, sizeof csv, "%s/frames.csv", dir);
+    /* the folder made with its missing parents, as atmos render's outputs' (a file of that
+     * name: said below) */
+    if (stat(dir, &st) != 0 && cli_output_folder("view", "--record", csv)) return CLI_EXIT_RUNTIME;
     if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
         fprintf(stderr, "atmos view: --record %s: not a folder (--record takes the folder to record into)\n", dir);
         return CLI_EXIT_USAGE;
