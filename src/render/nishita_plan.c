@@ -146,17 +146,39 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     return ATMOS_OK;
 }
 
-/* Bilinear value of plane array a (nx x ny, m floats per point, member f) at (x, y); 0 outside. */
-static float plane_at(const float *a, int nx, int ny, int m, int f, double x, double y)
+/* One axis of a bilinear tap at x on points 0..nx-1: the lower and upper points, the weight of
+ * the upper, and whether x lies on the axis (a tap outside reads 0). */
+typedef struct {
+    int i, i1, in;
+    double u;
+} plane_tap;
+
+static plane_tap tap_at(int nx, double x)
 {
-    if (!(x >= 0 && y >= 0 && x <= nx - 1 && y <= ny - 1)) return 0.0f;
-    int i = (int)x, j = (int)y;
-    if (i > nx - 2) i = nx - 2 < 0 ? 0 : nx - 2;
-    if (j > ny - 2) j = ny - 2 < 0 ? 0 : ny - 2;
-    const double u = x - i, v = y - j;
-    const int i1 = i + 1 < nx ? i + 1 : i, j1 = j + 1 < ny ? j + 1 : j;
-    return (float)((1 - u) * (1 - v) * a[((size_t)j * nx + i) * m + f] + u * (1 - v) * a[((size_t)j * nx + i1) * m + f] +
-                   (1 - u) * v * a[((size_t)j1 * nx + i) * m + f] + u * v * a[((size_t)j1 * nx + i1) * m + f]);
+    plane_tap t = {0, 0, x >= 0 && x <= nx - 1, 0};
+    if (!t.in) return t;
+    t.i = (int)x;
+    if (t.i > nx - 2) t.i = nx - 2 < 0 ? 0 : nx - 2;
+    t.u = x - t.i;
+    t.i1 = t.i + 1 < nx ? t.i + 1 : t.i;
+    return t;
+}
+
+/* Bilinear values of the plane arrays a and b (nx points a row, m floats per point, member f) at
+ * the taps tx, ty into *va and *vb, 0 outside. */
+static inline void plane_at2(const float *a, const float *b, int nx, int m, int f, const plane_tap *tx,
+                             const plane_tap *ty, float *va, float *vb)
+{
+    if (!(tx->in && ty->in)) {
+        *va = *vb = 0.0f;
+        return;
+    }
+    const double u = tx->u, v = ty->u;
+    const double w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
+    const size_t o00 = ((size_t)ty->i * nx + tx->i) * m + f, o10 = ((size_t)ty->i * nx + tx->i1) * m + f,
+                 o01 = ((size_t)ty->i1 * nx + tx->i) * m + f, o11 = ((size_t)ty->i1 * nx + tx->i1) * m + f;
+    *va = (float)(w00 * a[o00] + w10 * a[o10] + w01 * a[o01] + w11 * a[o11]);
+    *vb = (float)(w00 * b[o00] + w10 * b[o10] + w01 * b[o01] + w11 * b[o11]);
 }
 
 /* The column density toward the sun at every render voxel, by one sweep across the grid
@@ -178,7 +200,14 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
     const int step = sun_g[a] > 0 ? -1 : 1;           /* from the sun's side */
     size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf};
     float *plane = malloc(sizeof(float) * (size_t)nb * nc * nf * 4);
-    if (!plane) return;
+    /* the taps one plane nearer the sun: the same offsets (db, dc) on every plane */
+    plane_tap *tb = malloc(sizeof(plane_tap) * ((size_t)nb + nc)), *tc = tb ? tb + nb : NULL;
+    if (!plane || !tb) {
+        free(plane), free(tb);
+        return;
+    }
+    for (int jb = 0; jb < nb; jb++) tb[jb] = tap_at(nb, jb + db);
+    for (int jc = 0; jc < nc; jc++) tc[jc] = tap_at(nc, jc + dc);
     float *pc = plane, *pd = plane + (size_t)nb * nc * nf, *qc = pd + (size_t)nb * nc * nf,
           *qd = qc + (size_t)nb * nc * nf; /* previous: columns, densities; current: same */
     memset(plane, 0, sizeof(float) * (size_t)nb * nc * nf * 2);
@@ -193,9 +222,10 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
                 const size_t v = ia * str[a] + jb * str[b] + jc * str[c], e = ((size_t)jc * nb + jb) * nf;
                 for (int f = 0; f < nf; f++) {
                     const float d = g->v[v + f];
-                    const float up = plane_at(pd, nb, nc, nf, f, jb + db, jc + dc);
+                    float up, col;
+                    plane_at2(pd, pc, nb, nf, f, &tb[jb], &tc[jc], &up, &col);
                     qd[e + f] = d;
-                    qc[e + f] = plane_at(pc, nb, nc, nf, f, jb + db, jc + dc) + (float)(0.5 * len * (d + up));
+                    qc[e + f] = col + (float)(0.5 * len * (d + up));
                     np->col[v + f] = qc[e + f];
                 }
             }
@@ -203,7 +233,7 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
         pc = qc, qc = t;
         t = pd, pd = qd, qd = t;
     }
-    free(plane);
+    free(plane), free(tb);
     memcpy(np->col_sun, sun_g, sizeof np->col_sun);
     np->col_valid = 1;
     np->col_s = atmos__now() - t0;
