@@ -401,7 +401,8 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
         for (; j < m && st->iters < P->max_iter; j++) {
             double *v = V + (size_t)(j + 1) * N;
             if (W->dsa) {
-                precondition(W, V + (size_t)j * N, W->dz + (size_t)j * W->n * atmos__dsa_moments(W->dsa), r, st);
+                const size_t at = (size_t)j * W->n * atmos__dsa_moments(W->dsa);
+                precondition(W, V + (size_t)j * N, W->dz + at, r, st);
                 apply(W, r, v);
             } else
                 apply(W, V + (size_t)j * N, v);
@@ -484,8 +485,9 @@ static void *carve(unsigned char **at, size_t bytes, size_t *total)
     return p;
 }
 
-/* W's buffers (the preconditioner's corrections with P's dsa) and GMRES's (V, m + 1 vectors; b, tmp, x) from ws's memory, grown when too small (its
- * pages then touched once for many solves). Returns 0 when out of memory. */
+/* W's buffers (with P's dsa the preconditioner's corrections) and GMRES's (V, m + 1 vectors; b,
+ * tmp, x) from ws's memory, grown when too small (its pages then touched once for many solves).
+ * Returns 0 when out of memory. */
 static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp, double **x)
 {
     const size_t N = W->cells * W->K;
