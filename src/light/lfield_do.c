@@ -13,6 +13,7 @@
  * needed alone (a medium or a source within one cell), the others' moments 0. */
 #include "light/lfield_do.h"
 #include "core/clones.h"
+#include "light/lfield_dsa.h"
 #include "core/internal.h"
 
 #include <math.h>
@@ -103,6 +104,9 @@ typedef struct {
                             of the field where there is a medium) */
     size_t *idx, n;      /* the cells needed, in order, and their count: GMRES's vectors hold their
                             moments alone (idx[i] * K + k at i * K + k), the others 0 */
+    atmos__dsa *dsa;     /* the diffusion preconditioner (P->dsa), else NULL */
+    double *dz;          /* per GMRES column: its preconditioner's correction (n cells of
+                            atmos__dsa_moments() values) */
 } do_work;
 
 /* W->need from W->live and the cells' extinction: the cells within one cell (26 neighbours) of a
@@ -345,8 +349,22 @@ static void cycle_residual(const double *V, size_t N, int j, const double *g, co
     for (int i = 0; i <= j; i++) axpy(z[i], V + (size_t)i * N, r, N, 1);
 }
 
+/* z = M^-1 v = v + C S v (C S: the P1 solve of v's scattering, its moments of degree <= 1 alone,
+ * lfield_dsa.h), the correction into dz (nm values a cell). */
+static void precondition(do_work *W, const double *v, double *dz, double *z, atmos__do_stats *st)
+{
+    const int K = W->K, nm = atmos__dsa_moments(W->dsa);
+    st->dsa_iters += atmos__dsa_apply(W->dsa, v, K, dz);
+    memcpy(z, v, sizeof(double) * W->n * K);
+    for (size_t i = 0; i < W->n; i++)
+        for (int k = 0; k < nm; k++) z[i * K + k] += dz[i * nm + k];
+}
+
 /* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
- * its first residual b itself, no sweep). Returns 1 with the last residual b - A x in r (b = 0: x = 0,
+ * its first residual b itself, no sweep); with W->dsa flexible GMRES (Saad 1993) right-preconditioned
+ * by it: the columns' z_j = M^-1 v_j differ from v_j in their moments of degree <= 1 alone
+ * (W->dz), the residual the true one (the same tolerance), r the z's room within a cycle.
+ * Returns 1 with the last residual b - A x in r (b = 0: x = 0,
  * r = 0), else 0. */
 static int gmres(do_work *W, const double *b, double *x, double *V, double *r, atmos__do_stats *st, int zero_start)
 {
@@ -382,7 +400,12 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
         int j = 0;
         for (; j < m && st->iters < P->max_iter; j++) {
             double *v = V + (size_t)(j + 1) * N;
-            apply(W, V + (size_t)j * N, v);
+            if (W->dsa) {
+                const size_t at = (size_t)j * W->n * atmos__dsa_moments(W->dsa);
+                precondition(W, V + (size_t)j * N, W->dz + at, r, st);
+                apply(W, r, v);
+            } else
+                apply(W, V + (size_t)j * N, v);
             st->sweeps++, st->iters++;
             for (int i = 0; i <= j; i++) {
                 const double *vi = V + (size_t)i * N;
@@ -411,6 +434,12 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
             y[i] = H[i][i] != 0 ? s / H[i][i] : 0;
         }
         for (int i = 0; i < j; i++) axpy(y[i], V + (size_t)i * N, x, N, T);
+        for (int i = 0; i < j && W->dsa; i++) {
+            const int nm = atmos__dsa_moments(W->dsa);
+            const double *dz = W->dz + (size_t)i * W->n * nm;
+            for (size_t c = 0; c < W->n; c++)
+                for (int k = 0; k < nm; k++) x[c * W->K + k] += y[i] * dz[c * nm + k];
+        }
         if (st->resid <= P->tol || st->iters >= P->max_iter) {
             cycle_residual(V, N, j, g, cs, sn, r);
             return 1;
@@ -456,8 +485,9 @@ static void *carve(unsigned char **at, size_t bytes, size_t *total)
     return p;
 }
 
-/* W's buffers and GMRES's (V, m + 1 vectors; b, tmp, x) from ws's memory, grown when too small (its
- * pages then touched once for many solves). Returns 0 when out of memory. */
+/* W's buffers (with P's dsa the preconditioner's corrections) and GMRES's (V, m + 1 vectors; b,
+ * tmp, x) from ws's memory, grown when too small (its pages then touched once for many solves).
+ * Returns 0 when out of memory. */
 static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double **b, double **tmp, double **x)
 {
     const size_t N = W->cells * W->K;
@@ -470,6 +500,7 @@ static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double 
         *x = carve(&at, sizeof(double) * N, &total), W->idx = carve(&at, sizeof(size_t) * W->cells, &total);
         W->live = carve(&at, W->cells, &total), W->need = carve(&at, W->cells, &total);
         W->theta = carve(&at, sizeof(float) * W->cells, &total);
+        W->dz = carve(&at, W->P->dsa ? sizeof(double) * W->cells * 4 * m : 0, &total); /* 4 moments at most */
         W->Q = carve(&at, sizeof(float) * N, &total), W->q1 = carve(&at, sizeof(float) * N, &total);
         for (int g = 0; g < DO_GROUPS; g++)
             W->acc[g] = carve(&at, sizeof(float) * N, &total),
@@ -522,6 +553,7 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         for (size_t c = 0; c < W.cells; c++)
             if (W.need[c]) W.idx[W.n++] = c;
         const size_t Nn = W.n * W.K;
+        if (P->dsa) W.dsa = atmos__dsa_create(P, W.idx, W.n); /* NULL (out of memory): plain GMRES */
         for (int g = 0; g < DO_GROUPS; g++) memset(W.acc[g], 0, sizeof(float) * N); /* the cells not needed */
         /* the weighted diamond's weight per cell: theta (P's, in (0, 1), else 1: the step scheme)
            in optically thick cells, toward 1 in thin ones, 1 - (1 - theta) (1 - e^(-tau / tau0)) */
@@ -552,6 +584,7 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         for (size_t c = 0; c < W.cells; c++) st->emitted += P->q1[c * W.K] * sqrt(4 * ATMOS_PI);
         st->emitted *= P->h * P->h * P->h;
         st->entering = entering(P);
+        atmos__dsa_free(W.dsa);
     }
     free(own.mem);
     return ok;

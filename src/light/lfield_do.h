@@ -70,6 +70,8 @@ typedef struct {
                                    1/2 diamond difference (lfield_do.c, cell_faces()) */
     double theta_tau;           /* > 0: theta in optically thick cells only, a cell of optical depth
                                    tau 1 - (1 - theta) (1 - exp(-tau / theta_tau)); 0: in every cell */
+    int dsa;                    /* 1: GMRES right-preconditioned by a diffusion solve of the degree-0
+                                   moments (flexible GMRES; lfield_dsa.h); 0: plain */
 } atmos__do_problem;
 
 typedef struct {
@@ -78,6 +80,7 @@ typedef struct {
     double leak;          /* power leaving the grid (with the problem's leak, else 0) */
     double emitted;       /* power of the first-order emission (per 1 of q1 units m^3) */
     double entering;      /* power entering through the grid's faces (the inflow's) */
+    int dsa_iters;        /* the diffusion preconditioner's conjugate-gradient iterations, all */
 } atmos__do_stats;
 
 /* The radiance moments phi[cell * K + k], K = (L + 1)^2, of the orders >= 1 and of the inflow

@@ -226,6 +226,44 @@ static void check_inflow(cloud *C)
     }
 }
 
+/* The diffusion preconditioner (lfield_dsa.h): on the closed cube of 50 optical depths, conservative
+ * and at albedo 0.99, with the sky's inflow too, the preconditioned solve reaches the plain one's
+ * moments (both to a residual of 1e-6) in fewer than half its sweeps; the same bytes with 1 and 2
+ * threads. */
+static void check_dsa(cloud *C)
+{
+    static double plain[NC * NC * NC * 16], one[NC * NC * NC * 16];
+    double in[ATMOS__DO_NMAX];
+    for (int n = 0; n < C->q.n; n++) in[n] = C->q.dir[n][2] < 0 ? 1.0 : 0; /* q's: make_cloud's */
+    for (int t = 0; t < 3; t++) {
+        const double omega = t == 1 ? 0.99 : 1.0;
+        atmos__do_stats S, S2;
+        make_cloud(C, omega, 2, 2000);
+        C->P.inflow = t == 2 ? in : NULL;
+        CHECK(atmos__do_solve(&C->P, C->phi, &S));
+        memcpy(plain, C->phi, sizeof plain);
+        for (int th = 1; th <= 2; th++) {
+            make_cloud(C, omega, th, 2000);
+            C->P.inflow = t == 2 ? in : NULL, C->P.dsa = 1;
+            CHECK(atmos__do_solve(&C->P, C->phi, &S2));
+            if (th == 1) memcpy(one, C->phi, sizeof one);
+        }
+        CHECK(!memcmp(one, C->phi, sizeof one));
+        double worst = 0, big = 0;
+        for (size_t i = 0; i < NC * NC * NC * 16; i++)
+            worst = fmax(worst, fabs(C->phi[i] - plain[i])), big = fmax(big, fabs(plain[i]));
+        printf("  the diffusion preconditioner, albedo %.2f%s: %d sweeps (%d GMRES iterations, %d of the "
+               "diffusion's) against %d plain, largest difference %.1e of the largest moment, leaving power "
+               "%.6f of the plain one's\n",
+               omega, t == 2 ? ", the sky's inflow" : "", S2.sweeps, S2.iters, S2.dsa_iters, S.sweeps, worst / big,
+               S2.leak / S.leak);
+        CHECK(S2.resid <= 1e-6 && S.resid <= 1e-6);
+        CHECK(big > 0 && worst <= 1e-4 * big);
+        CHECK(fabs(S2.leak / S.leak - 1) < 1e-5);
+        CHECK(2 * S2.sweeps < S.sweeps);
+    }
+}
+
 int main(void)
 {
     check_quadrature(8, 16);
@@ -235,6 +273,7 @@ int main(void)
     for (diamond = 0; diamond < 2 && C; diamond++) {
         printf("%s\n", diamond ? "the renderers' weighted diamond:" : "the step scheme:");
         check_balance(C), check_threads(C), check_needed_and_start(C), check_last_iteration(C), check_inflow(C);
+        check_dsa(C);
     }
     free(C);
     return test_summary("test_lfield_do");
