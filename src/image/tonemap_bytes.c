@@ -29,9 +29,13 @@
 static uint32_t byte_lut[3][BYTE_LUT];
 static _Atomic int byte_lut_state[3]; /* 0 not made, 1 made, 2 not usable (the path steps by more) */
 
+/* The byte of a display value v (the PNG's rounding). */
+static int byte_of(float v) { return !(v > 0) ? 0 : v >= 1 ? 255 : (int)(unsigned char)(v * 255.0f + 0.5f); }
+
 /* The bytes of the float display path at the floats with bits from `bits`, n of them (scale 1:
  * x 1 = x). */
 #define BYTE_WINDOW 256 /* floats checked at each end of an interval and about its step */
+
 static void bytes_at(atmos_tone_curve curve, uint32_t bits, int n, int *out)
 {
     float x[2 * BYTE_WINDOW] = {0}, v[2 * BYTE_WINDOW];
@@ -40,14 +44,17 @@ static void bytes_at(atmos_tone_curve curve, uint32_t bits, int n, int *out)
         memcpy(&x[i], &u, sizeof x[i]);
     }
     atmos__tonemap_row(curve, x, v, (size_t)n, 1, 1.0f);
-    for (int i = 0; i < n; i++) out[i] = !(v[i] > 0) ? 0 : v[i] >= 1 ? 255 : (int)(unsigned char)(v[i] * 255.0f + 0.5f);
+    for (int i = 0; i < n; i++) out[i] = byte_of(v[i]);
 }
 
+/* The byte of one float (a marked interval's value, every frame: without bytes_at's window, whose
+ * 2 KB zeroing a value cost more than the path itself). */
 static int byte_at(atmos_tone_curve curve, uint32_t bits)
 {
-    int b;
-    bytes_at(curve, bits, 1, &b);
-    return b;
+    float x, v;
+    memcpy(&x, &bits, sizeof x);
+    atmos__tonemap_row(curve, &x, &v, 1, 1, 1.0f);
+    return byte_of(v);
 }
 
 /* 1 when the floats [from, from + n) of interval lo's give the bytes entry e says (the path's
