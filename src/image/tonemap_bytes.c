@@ -47,8 +47,7 @@ static void bytes_at(atmos_tone_curve curve, uint32_t bits, int n, int *out)
     for (int i = 0; i < n; i++) out[i] = byte_of(v[i]);
 }
 
-/* The byte of one float (a marked interval's value, every frame: without bytes_at's window, whose
- * 2 KB zeroing a value cost more than the path itself). */
+/* The byte of one float (without bytes_at's window and its 2 KB zeroing). */
 static int byte_at(atmos_tone_curve curve, uint32_t bits)
 {
     float x, v;
@@ -191,15 +190,17 @@ ATMOS_CLONES void atmos__tonemap_bytes_row(atmos_tone_curve curve, const uint32_
             q[j] = (e & BYTE_EXACT) | (((e >> 16) & 0xffu) + ((u & (BYTE_NEVER - 1)) >= (e & 0xffffu)));
             exact |= (j & 3) == 3 ? 0u : q[j];
         }
-        if (exact & BYTE_EXACT)
+        if (exact & BYTE_EXACT) { /* the marked values through the float path, the chunk's at once */
+            float x[CHUNK], v[CHUNK];
+            int at[CHUNK], ne = 0;
             for (j = 0; j < m; j++)
                 if ((j & 3) != 3 && (q[j] & BYTE_EXACT)) {
-                    float x = s[j] * scale;
-                    x = x > 0 ? x : 0.0f;
-                    uint32_t u;
-                    memcpy(&u, &x, sizeof u);
-                    q[j] = (uint32_t)byte_at(curve, u);
+                    const float y = s[j] * scale;
+                    x[ne] = y > 0 ? y : 0.0f, at[ne++] = j;
                 }
+            atmos__tonemap_row(curve, x, v, (size_t)ne, 1, 1.0f);
+            for (int i = 0; i < ne; i++) q[at[i]] = (uint32_t)byte_of(v[i]);
+        }
         for (j = 0; j < m; j++) d[j] = (j & 3) == 3 ? 255 : (unsigned char)q[j];
     }
 }
