@@ -29,9 +29,13 @@
 static uint32_t byte_lut[3][BYTE_LUT];
 static _Atomic int byte_lut_state[3]; /* 0 not made, 1 made, 2 not usable (the path steps by more) */
 
+/* The byte of a display value v (the PNG's rounding). */
+static int byte_of(float v) { return !(v > 0) ? 0 : v >= 1 ? 255 : (int)(unsigned char)(v * 255.0f + 0.5f); }
+
 /* The bytes of the float display path at the floats with bits from `bits`, n of them (scale 1:
  * x 1 = x). */
 #define BYTE_WINDOW 256 /* floats checked at each end of an interval and about its step */
+
 static void bytes_at(atmos_tone_curve curve, uint32_t bits, int n, int *out)
 {
     float x[2 * BYTE_WINDOW] = {0}, v[2 * BYTE_WINDOW];
@@ -40,14 +44,16 @@ static void bytes_at(atmos_tone_curve curve, uint32_t bits, int n, int *out)
         memcpy(&x[i], &u, sizeof x[i]);
     }
     atmos__tonemap_row(curve, x, v, (size_t)n, 1, 1.0f);
-    for (int i = 0; i < n; i++) out[i] = !(v[i] > 0) ? 0 : v[i] >= 1 ? 255 : (int)(unsigned char)(v[i] * 255.0f + 0.5f);
+    for (int i = 0; i < n; i++) out[i] = byte_of(v[i]);
 }
 
+/* The byte of one float (without bytes_at's window and its 2 KB zeroing). */
 static int byte_at(atmos_tone_curve curve, uint32_t bits)
 {
-    int b;
-    bytes_at(curve, bits, 1, &b);
-    return b;
+    float x, v;
+    memcpy(&x, &bits, sizeof x);
+    atmos__tonemap_row(curve, &x, &v, 1, 1, 1.0f);
+    return byte_of(v);
 }
 
 /* 1 when the floats [from, from + n) of interval lo's give the bytes entry e says (the path's
@@ -184,15 +190,17 @@ ATMOS_CLONES void atmos__tonemap_bytes_row(atmos_tone_curve curve, const uint32_
             q[j] = (e & BYTE_EXACT) | (((e >> 16) & 0xffu) + ((u & (BYTE_NEVER - 1)) >= (e & 0xffffu)));
             exact |= (j & 3) == 3 ? 0u : q[j];
         }
-        if (exact & BYTE_EXACT)
+        if (exact & BYTE_EXACT) { /* the marked values through the float path, the chunk's at once */
+            float x[CHUNK], v[CHUNK];
+            int at[CHUNK], ne = 0;
             for (j = 0; j < m; j++)
                 if ((j & 3) != 3 && (q[j] & BYTE_EXACT)) {
-                    float x = s[j] * scale;
-                    x = x > 0 ? x : 0.0f;
-                    uint32_t u;
-                    memcpy(&u, &x, sizeof u);
-                    q[j] = (uint32_t)byte_at(curve, u);
+                    const float y = s[j] * scale;
+                    x[ne] = y > 0 ? y : 0.0f, at[ne++] = j;
                 }
+            atmos__tonemap_row(curve, x, v, (size_t)ne, 1, 1.0f);
+            for (int i = 0; i < ne; i++) q[at[i]] = (uint32_t)byte_of(v[i]);
+        }
         for (j = 0; j < m; j++) d[j] = (j & 3) == 3 ? 255 : (unsigned char)q[j];
     }
 }
