@@ -854,14 +854,28 @@ static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const 
 /* A frame's own buffers (a job is zeroed first: the ones not made yet are NULL). */
 static void job_free(job *J) { free(J->z_lo), free(J->span), free(J->alb_pi), free(J->ru); }
 
+/* The sky behind into out over r, on the airlight's lattice too (the sky renderer's grid:
+ * sky_render.c); where prim (may be NULL) holds a triangle for a pixel, its surface hides the
+ * sky, which is then read from the grid rather than evaluated (the sky renderer's hidden). */
+static atmos_status sky_behind(atmos_plan *p, const atmos__view *v, const atmos__rect *r, const atmos__beams_primary *prim,
+                               atmos_image *out)
+{
+    atmos__view sv = *v;
+    const int sky_step = p->scene.beams.screen_step < SKY_STEP_MAX ? p->scene.beams.screen_step : SKY_STEP_MAX;
+    if (p->scene.beams.interleave <= 1 && sky_step > sv.sky_step) sv.sky_step = sky_step;
+    const size_t n = (size_t)(r->x1 - r->x0) * (size_t)(r->y1 - r->y0);
+    unsigned char *hidden = NULL;
+    if (prim && prim->mesh && !memcmp(&prim->r, r, sizeof *r) && (hidden = malloc(n)) != NULL)
+        for (size_t i = 0; i < n; i++) hidden[i] = prim->mesh[i] >= 0;
+    const atmos_status st = atmos__sky_render_hidden(p->ctx, p->atm, &sv, r, out, p->sky_keep, hidden);
+    free(hidden);
+    return st;
+}
+
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
 {
     atmos__beams_plan *b = p->beams;
-    atmos__view sv = *v; /* the sky behind on the airlight's lattice too (the sky renderer's grid: sky_render.c) */
-    const int sky_step = p->scene.beams.screen_step < SKY_STEP_MAX ? p->scene.beams.screen_step : SKY_STEP_MAX;
-    if (p->scene.beams.interleave <= 1 && sky_step > sv.sky_step) sv.sky_step = sky_step;
-    atmos_status st = atmos__sky_render(p->ctx, p->atm, &sv, r, out, p->sky_keep);
-    if (st != ATMOS_OK) return st;
+    atmos_status st;
     job J;
     memset(&J, 0, sizeof J);
     J.b = b, J.cam = &v->cam, J.eye = v->cam.position, J.nw = p->wl.count;
@@ -897,6 +911,10 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         }
         J.prim = &prim;
         J.sky = sky_seen ? &b->sky : NULL;
+    }
+    if (!failed && (st = sky_behind(p, v, r, ilp ? NULL : J.prim, out)) != ATMOS_OK) {
+        atmos__beams_primary_free(&prim), atmos__beams_il_free(&il), job_free(&J);
+        return st;
     }
     const int step = p->scene.beams.screen_step;
     long evaluated = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
