@@ -865,12 +865,11 @@ static atmos_status sky_behind(atmos_plan *p, const atmos__view *v, const atmos_
     const int sky_step = p->scene.beams.screen_step < SKY_STEP_MAX ? p->scene.beams.screen_step : SKY_STEP_MAX;
     if (p->scene.beams.interleave <= 1 && sky_step > sv.sky_step) sv.sky_step = sky_step;
     const size_t n = (size_t)(r->x1 - r->x0) * (size_t)(r->y1 - r->y0);
-    unsigned char *hidden = NULL;
-    if (prim && prim->mesh && !memcmp(&prim->r, r, sizeof *r) && (hidden = malloc(n)) != NULL)
+    unsigned char *hidden = NULL; /* none when out of memory: every pixel's sky evaluated */
+    if (prim && prim->mesh && !memcmp(&prim->r, r, sizeof *r) &&
+        (hidden = atmos__beams_kept_get(&p->beams->kept[ATMOS__BEAMS_KEPT_HIDDEN], n)) != NULL)
         for (size_t i = 0; i < n; i++) hidden[i] = prim->mesh[i] >= 0;
-    const atmos_status st = atmos__sky_render_hidden(p->ctx, p->atm, &sv, r, out, p->sky_keep, hidden);
-    free(hidden);
-    return st;
+    return atmos__sky_render_hidden(p->ctx, p->atm, &sv, r, out, p->sky_keep, hidden);
 }
 
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
