@@ -139,6 +139,7 @@ enum {
     ATMOS__BEAMS_KEPT_BASE,
     ATMOS__BEAMS_KEPT_NODE,
     ATMOS__BEAMS_KEPT_DIR,
+    ATMOS__BEAMS_KEPT_HIDDEN, /* the sky behind's mask (sky_behind) */
     ATMOS__BEAMS_KEPT_COUNT
 };
 

@@ -153,7 +153,7 @@ ATMOS_CLONES static void row_cones(const job *J, const double *dx, const double 
  * is a light not in cones (row_cones: a spot whose cone surely leaves the point out). Returns
  * 0 when no light and no sky reach the point (L all zeros: the fog need not be evaluated). */
 static int shade_surface(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int m, uint32_t cones,
-                         double *L)
+                         double *L, atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
     const int sky = J->sky && J->sky->nw;
@@ -195,7 +195,7 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
     if (sky) { /* through a height-dependent fog's layer above P (J->sky is NULL in a uniform fog) */
         static const double up[3] = {0, 1, 0};
         double E[ATMOS_MAX_WAVELENGTHS];
-        atmos__beams_sky_irradiance(J->sky, h->normal, atmos__beams_sun_fog_in(&b->fog, up, P), E);
+        atmos__beams_sky_irradiance_memo(J->sky, h->normal, atmos__beams_sun_fog_in(&b->fog, up, P), E, memo);
         for (int k = 0; k < J->nw; k++) sum[k] += E[k];
         any = 1;
     }
@@ -208,9 +208,9 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
  * eye. Returns the fog's transmittance to the hit, which is evaluated only where something is
  * lit or when fog_needed (an unlit surface is 0 whatever it is: the same bits; then 1). */
 static double base_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int m, uint32_t cones,
-                         const float *bg, int fog_needed, double *L)
+                         const float *bg, int fog_needed, double *L, atmos__beams_sky_memo *memo)
 {
-    if (h && !shade_surface(J, x, y, d, h, m, cones, L) && !fog_needed) return 1;
+    if (h && !shade_surface(J, x, y, d, h, m, cones, L, memo) && !fog_needed) return 1;
     /* 0 to the sky behind endless fog */
     const double fog_t = exp(-atmos__beams_fog_tau(&J->b->fog, J->eye, d, h ? h->t : INFINITY));
     if (h)
@@ -447,7 +447,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     uint32_t cones = 0;
     if (hit) row_cones(J, &d[0], &d[1], &d[2], &T, 1, &cones);
     if (px) {
-        const double fog_t = base_light(J, x, y, d, hit ? &h : NULL, m, cones, px, b->sun_on, L);
+        const double fog_t = base_light(J, x, y, d, hit ? &h : NULL, m, cones, px, b->sun_on, L, NULL);
         if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         if (!il) {
             if (b->sigma_t > 0) lights(J, x, y, d, T, f, L, x == J->cx && y == J->cy, 0.5, ALL_LIGHTS);
@@ -641,12 +641,12 @@ typedef struct screen_buf {
 /* Subsampling's first pass, pixel (x, y) seeing h of object obj along the eye's ray d (-1: the
  * sky behind, bg), lit by the lights in cones (row_cones): its light without the airlight into B. */
 static void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
-                          uint32_t cones, const float *bg, float *B)
+                          uint32_t cones, const float *bg, float *B, atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
     double L[ATMOS_MAX_WAVELENGTHS];
     const int hit = obj >= 0;
-    const double fog_t = base_light(J, x, y, d, hit ? h : NULL, obj, cones, bg, hit && b->sun_on, L);
+    const double fog_t = base_light(J, x, y, d, hit ? h : NULL, obj, cones, bg, hit && b->sun_on, L, memo);
     if (hit && b->sun_on) sun_surface(J, d, h, obj, fog_t, L);
     for (int k = 0; k < J->nw; k++) B[k] = (float)L[k];
 }
@@ -669,10 +669,11 @@ static void surface_row(const job *J, const atmos__rect *r, int y, const screen_
         if (!q->dir) row_cones(J, &d[0], &d[1], &d[2], &T[i], 1, &cones[i]);
     }
     if (q->dir) row_cones(J, q->dir + row, q->dir + n + row, q->dir + 2 * n + row, T, W, cones);
+    atmos__beams_sky_memo memo = {{0, 0, 0}, 0, 0, {0}}; /* the row's last sky irradiance (a flat ground's) */
     for (int x = r->x0, i = 0; x < r->x1; x++, i++) {
         kept_ray(J, x, y, d);
         float *px = out->pixels + ((size_t)y * out->width + x) * out->channels;
-        surface_light(J, x, y, d, &hits[i], obj[i], cones[i], px, q->base + (row + i) * J->nw);
+        surface_light(J, x, y, d, &hits[i], obj[i], cones[i], px, q->base + (row + i) * J->nw, &memo);
     }
 }
 
@@ -854,14 +855,27 @@ static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const 
 /* A frame's own buffers (a job is zeroed first: the ones not made yet are NULL). */
 static void job_free(job *J) { free(J->z_lo), free(J->span), free(J->alb_pi), free(J->ru); }
 
+/* The sky behind into out over r, on the airlight's lattice too (the sky renderer's grid:
+ * sky_render.c); where prim (may be NULL) holds a triangle for a pixel, its surface hides the
+ * sky, which is then read from the grid rather than evaluated (the sky renderer's hidden). */
+static atmos_status sky_behind(atmos_plan *p, const atmos__view *v, const atmos__rect *r, const atmos__beams_primary *prim,
+                               atmos_image *out)
+{
+    atmos__view sv = *v;
+    const int sky_step = p->scene.beams.screen_step < SKY_STEP_MAX ? p->scene.beams.screen_step : SKY_STEP_MAX;
+    if (p->scene.beams.interleave <= 1 && sky_step > sv.sky_step) sv.sky_step = sky_step;
+    const size_t n = (size_t)(r->x1 - r->x0) * (size_t)(r->y1 - r->y0);
+    unsigned char *hidden = NULL; /* none when out of memory: every pixel's sky evaluated */
+    if (prim && prim->mesh && !memcmp(&prim->r, r, sizeof *r) &&
+        (hidden = atmos__beams_kept_get(&p->beams->kept[ATMOS__BEAMS_KEPT_HIDDEN], n)) != NULL)
+        for (size_t i = 0; i < n; i++) hidden[i] = prim->mesh[i] >= 0;
+    return atmos__sky_render_hidden(p->ctx, p->atm, &sv, r, out, p->sky_keep, hidden);
+}
+
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
 {
     atmos__beams_plan *b = p->beams;
-    atmos__view sv = *v; /* the sky behind on the airlight's lattice too (the sky renderer's grid: sky_render.c) */
-    const int sky_step = p->scene.beams.screen_step < SKY_STEP_MAX ? p->scene.beams.screen_step : SKY_STEP_MAX;
-    if (p->scene.beams.interleave <= 1 && sky_step > sv.sky_step) sv.sky_step = sky_step;
-    atmos_status st = atmos__sky_render(p->ctx, p->atm, &sv, r, out, p->sky_keep);
-    if (st != ATMOS_OK) return st;
+    atmos_status st;
     job J;
     memset(&J, 0, sizeof J);
     J.b = b, J.cam = &v->cam, J.eye = v->cam.position, J.nw = p->wl.count;
@@ -897,6 +911,10 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         }
         J.prim = &prim;
         J.sky = sky_seen ? &b->sky : NULL;
+    }
+    if (!failed && (st = sky_behind(p, v, r, ilp ? NULL : J.prim, out)) != ATMOS_OK) {
+        atmos__beams_primary_free(&prim), atmos__beams_il_free(&il), job_free(&J);
+        return st;
     }
     const int step = p->scene.beams.screen_step;
     long evaluated = (long)(r->x1 - r->x0) * (r->y1 - r->y0);

@@ -28,28 +28,40 @@ static void node_normal(int iy, int ia, double n[3])
 
 /* The sky's irradiance on a surface of normal n ring by ring of the directions (the rows of L
  * as in atmos__beams_sky_build): R[r * nw + k]. */
-static void ring_irradiance(const double *L, int nw, const double n[3], double *R)
+ATMOS_CLONES static void ring_irradiance(const double *L, int nw, const double n[3], double *R)
 {
     const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI;
     const double dw = 2.0 * ATMOS_PI / nd;
     for (int q = 0; q < BEAMS_SKY_MU * nw; q++) R[q] = 0;
     for (int i = 0; i < nd; i++) {
         const double *row = L + (size_t)i * (nw + 3), c = atmos__dot3(n, row);
-        if (c > 0)
-            for (int k = 0; k < nw; k++) R[(i / BEAMS_SKY_PHI) * nw + k] += row[3 + k] * c * dw;
+        if (!(c > 0)) continue;
+        double *Rr = R + (i / BEAMS_SKY_PHI) * nw;
+#pragma omp simd
+        for (int k = 0; k < nw; k++) Rr[k] += row[3 + k] * c * dw;
+    }
+}
+
+/* Each layer's dimming of each ring, exp(-C / mu) at the ring's centre (ic = 0: C = 0,
+ * undimmed): T[ic * BEAMS_SKY_MU + r], the same for every normal, so made once a table. */
+static void ring_dimming(int nc, double *T)
+{
+    for (int ic = 0; ic < nc; ic++) {
+        const double x = (double)ic / (BEAMS_SKY_NC - 1), C = BEAMS_SKY_CMAX * x * x;
+        for (int r = 0; r < BEAMS_SKY_MU; r++) T[ic * BEAMS_SKY_MU + r] = ic ? exp(-C / ((r + 0.5) / BEAMS_SKY_MU)) : 1.0;
     }
 }
 
 /* The table's values of normal j: its rings' irradiance R summed, for each layer ic of C, each
- * ring dimmed by exp(-C / mu) at its centre (ic = 0: C = 0, undimmed). */
-static void node_values(const double *R, int nw, int j, atmos__beams_sky *s)
+ * ring dimmed by T (ring_dimming). */
+ATMOS_CLONES static void node_values(const double *R, const double *T, int nw, int j, atmos__beams_sky *s)
 {
     const int nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
     for (int ic = 0; ic < s->nc; ic++) {
-        const double x = (double)ic / (BEAMS_SKY_NC - 1), C = BEAMS_SKY_CMAX * x * x;
         double e[ATMOS_MAX_WAVELENGTHS] = {0};
         for (int r = 0; r < BEAMS_SKY_MU; r++) {
-            const double t = ic ? exp(-C / ((r + 0.5) / BEAMS_SKY_MU)) : 1.0;
+            const double t = T[ic * BEAMS_SKY_MU + r];
+#pragma omp simd
             for (int k = 0; k < nw; k++) e[k] += t * R[r * nw + k];
         }
         for (int k = 0; k < nw; k++) s->E[((size_t)ic * nn + j) * nw + k] = (float)e[k];
@@ -77,11 +89,13 @@ atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *
         row[0] = st * cos(phi), row[1] = mu, row[2] = st * sin(phi);
         atmos__sky_seen(atm, p, row, sun_dir, nw, row + 3); /* without the sun's disk */
     }
+    double T[BEAMS_SKY_NC * BEAMS_SKY_MU];
+    ring_dimming(s->nc, T);
     for (int j = 0; j < nn; j++) {
         double n[3];
         node_normal(j / BEAMS_SKY_NA, j % BEAMS_SKY_NA, n);
         ring_irradiance(L, nw, n, R);
-        node_values(R, nw, j, s);
+        node_values(R, T, nw, j, s);
     }
     free(L), free(R);
     s->nw = nw;
@@ -125,6 +139,20 @@ ATMOS_CLONES void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const d
         const double up = (1 - ty) * ((1 - ta) * e00[dl + k] + ta * e01[dl + k]) + ty * ((1 - ta) * e10[dl + k] + ta * e11[dl + k]);
         E[k] = (1 - tc) * E[k] + tc * up;
     }
+}
+
+void atmos__beams_sky_irradiance_memo(const atmos__beams_sky *s, const double n[3], double C, double *E,
+                                      atmos__beams_sky_memo *memo)
+{
+    if (!memo) {
+        atmos__beams_sky_irradiance(s, n, C, E);
+        return;
+    }
+    if (!memo->valid || memcmp(memo->n, n, sizeof memo->n) || memcmp(&memo->C, &C, sizeof C)) {
+        atmos__beams_sky_irradiance(s, n, C, memo->E);
+        memcpy(memo->n, n, sizeof memo->n), memo->C = C, memo->valid = 1;
+    }
+    memcpy(E, memo->E, sizeof(double) * (size_t)s->nw);
 }
 
 void atmos__beams_sky_free(atmos__beams_sky *s)

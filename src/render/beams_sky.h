@@ -52,6 +52,18 @@ atmos_status atmos__beams_sky_keep(atmos_context *ctx, const atmos_atmosphere *a
  * of vertical optical depth C (0: none; linear in sqrt(C) between the table's values; a table
  * without layers ignores it) into E[nw]. */
 void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const double n[3], double C, double *E);
+/* The last irradiance a caller asked of a table (atmos__beams_sky_irradiance_memo): its normal
+ * and C, bit for bit, and E; valid 0 before the first. A caller's own, within one table's use. */
+typedef struct atmos__beams_sky_memo {
+    double n[3], C;
+    int valid;
+    double E[ATMOS_MAX_WAVELENGTHS];
+} atmos__beams_sky_memo;
+/* As atmos__beams_sky_irradiance, E copied from memo (NULL: none) when n and C are those of its
+ * last call, bit for bit (a flat ground under a fog of one height: the same normal and layer at
+ * every pixel), so the same bits as a call. */
+void atmos__beams_sky_irradiance_memo(const atmos__beams_sky *s, const double n[3], double C, double *E,
+                                      atmos__beams_sky_memo *memo);
 void atmos__beams_sky_free(atmos__beams_sky *s);
 
 #endif

@@ -358,7 +358,8 @@ static int cell_fine(const coarse *g, int j, int i)
  * cell's pixels then along x at the offsets fx[p] = p / step (a cell read bilinearly is a whole
  * step wide; the last column's takes one pixel more, at fx 1). */
 static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t, const coarse *g,
-                       const atmos__rect *r, int y, row_buffers *rb, int *xs, float *val, float *dst, int C)
+                       const atmos__rect *r, int y, row_buffers *rb, int *xs, float *val, float *dst, int C,
+                       const unsigned char *hidden)
 {
     const int n = job->n, j = (y - r->y0) / g->step < g->ny - 1 ? (y - r->y0) / g->step : g->ny - 2;
     const float fy = (float)(y - g->cy[j]) / (float)(g->cy[j + 1] - g->cy[j]), inv = 1.0f / (float)g->step;
@@ -370,11 +371,17 @@ static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const 
     int m = 0;
     for (int i = 0; i < g->nx - 1; i++) {
         const int xa = g->cx[i], xb = i == g->nx - 2 ? g->cx[i + 1] + 1 : g->cx[i + 1];
+        const float *l0 = lrow + (size_t)i * n, *r0 = l0 + n;
         if (fine[i]) {
-            for (int x = xa; x < xb; x++) xs[m++] = x, dst[(size_t)x * C + n] = 1.0f;
+            for (int x = xa; x < xb; x++) {
+                float *px = dst + (size_t)x * C;
+                px[n] = 1.0f;
+                if (!hidden || !hidden[x - r->x0]) xs[m++] = x;
+                else /* not shown: read bilinearly (x - xa < step, so fx[x - xa] is within the cell) */
+                    for (int k = 0; k < n; k++) px[k] = l0[k] + fx[x - xa] * (r0[k] - l0[k]);
+            }
             continue;
         }
-        const float *l0 = lrow + (size_t)i * n, *r0 = l0 + n;
         float *px = dst + (size_t)xa * C;
 #if defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__)
         if (n == 3 && C == 4) { /* RGB + alpha: a pixel as one vector of four (alpha 1 + fx 0) */
@@ -401,7 +408,8 @@ static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const 
 /* The sky of rect r every v->sky_step pixels (coarse_row), the values from the sky-view table t
  * when not NULL; 1 when it cannot (too small a rect: the caller renders every pixel). */
 static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t,
-                         const atmos__view *v, const atmos__rect *r, atmos_image *out, int *nomem)
+                         const atmos__view *v, const atmos__rect *r, atmos_image *out, int *nomem,
+                         const unsigned char *hidden)
 {
     const int F = v->sky_step > 1 ? v->sky_step : 1, n = job->n, count = r->x1 - r->x0, rows = r->y1 - r->y0, C = out->channels;
     if (count < 2 || rows < 2) return 1;
@@ -446,7 +454,8 @@ static int render_coarse(atmos_context *ctx, const sky_job *job, const atmos__at
 #pragma omp for schedule(dynamic, 1)
         for (int b = 0; b < nbands; b++)
             for (int y = r->y0 + b * band; mem && xs && tmem && y < r->y1 && y < r->y0 + (b + 1) * band; y++)
-                coarse_row(job, batch, t, &g, r, y, &rb, xs, val, out->pixels + (size_t)y * v->cam.width * C, C);
+                coarse_row(job, batch, t, &g, r, y, &rb, xs, val, out->pixels + (size_t)y * v->cam.width * C, C,
+                           hidden ? hidden + (size_t)(y - r->y0) * count : NULL);
         free(mem), free(xs), free(tmem);
     }
     free(g.cx), free(g.val), free(g.flags);
@@ -490,6 +499,13 @@ static int black_vacuum(atmos_context *ctx, const atmos_atmosphere *atm, const a
 atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
                                const atmos__rect *r, atmos_image *out, atmos__sky_keep *keep)
 {
+    return atmos__sky_render_hidden(ctx, atm, v, r, out, keep, NULL);
+}
+
+atmos_status atmos__sky_render_hidden(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
+                                      const atmos__rect *r, atmos_image *out, atmos__sky_keep *keep,
+                                      const unsigned char *hidden)
+{
     sky_job job;
     job_init(&job, atm, v);
     const int W = v->cam.width, C = out->channels, count = r->x1 - r->x0;
@@ -514,7 +530,7 @@ atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, 
         table = &keep->table;
     }
     if ((v->sky_step > 1 || table) && v->cam.type == ATMOS_CAMERA_PINHOLE && job.spp == 1 &&
-        !render_coarse(ctx, &job, batch, table, v, r, out, &nomem)) {
+        !render_coarse(ctx, &job, batch, table, v, r, out, &nomem, hidden)) {
         if (!keep) atmos__atm_batch_release(&own);
         if (nomem) return atmos__error(ctx, ATMOS_E_NOMEM, "render: out of memory for the sky's grid");
         atmos__progress(ctx, "render sky", 1.0);

@@ -40,5 +40,12 @@ void atmos__sky_keep_destroy(atmos__sky_keep *k);
  * keep: the plan's (NULL: the per-eye tables are built for this frame alone). */
 atmos_status atmos__sky_render(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
                                const atmos__rect *r, atmos_image *out, atmos__sky_keep *keep);
+/* The same, where hidden (NULL: nowhere) marks the pixels of r (row by row, non-zero: hidden
+ * by a caller's surface) whose sky the caller will not show: on the grid of every sky_step
+ * pixels those are read bilinearly instead of being evaluated one by one (the grid itself and
+ * every other pixel as atmos__sky_render makes them, so the same bits there). */
+atmos_status atmos__sky_render_hidden(atmos_context *ctx, const atmos_atmosphere *atm, const atmos__view *v,
+                                      const atmos__rect *r, atmos_image *out, atmos__sky_keep *keep,
+                                      const unsigned char *hidden);
 
 #endif

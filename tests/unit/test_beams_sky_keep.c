@@ -8,7 +8,8 @@
  *     asked, gets a new table equal to a fresh one;
  *   - the quantisation's cost: the table at the quantised point against the table at the true
  *     point half a quantum away in x and z (the spherical model, the sun 8 and 30 degrees up),
- *     within a relative 10^-3 at every node with light above 10^-3 of the brightest. */
+ *     within a relative 10^-3 at every node with light above 10^-3 of the brightest;
+ *   - atmos__beams_sky_irradiance_memo gives the bits of the call it stands for. */
 #include "atmos/atmos.h"
 #include "render/beams_sky.h"
 #include "test.h"
@@ -33,6 +34,24 @@ static int same(const atmos__beams_sky *a, const atmos__beams_sky *b)
 {
     if (a->nw != b->nw || !a->E || !b->E) return 0;
     return !memcmp(a->E, b->E, sizeof(float) * (size_t)nodes(a));
+}
+
+/* atmos__beams_sky_irradiance_memo against the call it stands for, bit for bit, over a run of
+ * normals and layers that repeat, differ in C alone (a memo keyed on the normal alone fails
+ * here) or in a zero's sign alone; counts the mismatches. */
+static int memo_mismatches(const atmos__beams_sky *s)
+{
+    const double C[] = {0.3, 0.3, 0.31, 0.31, 0.31, 2.0, 2.0, 0.0};
+    const double n[][3] = {{0, 1, 0}, {0, 1, 0}, {0, 1, 0}, {-0.0, 1, 0}, {-0.0, 1, -0.0}, {0.6, 0, 0.8}, {0.6, 0, 0.8}, {0, -1, 0}};
+    atmos__beams_sky_memo memo = {{0, 0, 0}, 0, 0, {0}};
+    int bad = 0;
+    for (int i = 0; i < 8; i++) {
+        double a[ATMOS_MAX_WAVELENGTHS], b[ATMOS_MAX_WAVELENGTHS];
+        atmos__beams_sky_irradiance(s, n[i], C[i], a);
+        atmos__beams_sky_irradiance_memo(s, n[i], C[i], b, &memo);
+        bad += memcmp(a, b, sizeof(double) * (size_t)s->nw) != 0;
+    }
+    return bad;
 }
 
 int main(void)
@@ -88,6 +107,7 @@ int main(void)
         CHECK_MSG(keep.nc == BEAMS_SKY_NC, "layered after unlayered: %d values of C kept", keep.nc);
         CHECK_OK(atmos__beams_sky_build(ctx, atm, q3, sun2, nw, 1, &fresh));
         CHECK_MSG(keep.nc == fresh.nc && same(&keep, &fresh), "layered: not the fresh table");
+        CHECK_MSG(memo_mismatches(&keep) == 0, "the memo's irradiance differs from the call's");
         atmos__beams_sky_free(&fresh);
         CHECK_OK(atmos__beams_sky_keep(ctx, atm, eye4, sun2, nw, 0, &keep));
         CHECK_MSG(keep.nc == 1, "unlayered after layered: %d values of C kept", keep.nc);
