@@ -157,8 +157,8 @@ wait $pid; rc=$?
 "$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/pk/s.png" -D animation.frames=5 \
     -D animation.elevation_end_deg=-1 -D animation.exposure=per_frame && ok || bad "animation, the scene's exposure per_frame"
 "$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/one.png" && ok || bad "single render"
-PYTHONPATH=$(cd "$(dirname "$0")" && pwd) python3 - "$T/an" "$T/pf" "$T/one.png" "$T/pk" <<'PY' && ok ||
-    bad "exposure over the animation"
+# (the here-document's text starts on the line after the one with <<: bad on that line too)
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd) python3 - "$T/an" "$T/pf" "$T/one.png" "$T/pk" <<'PY' && ok || bad "exposure over the animation"
 import os, sys
 from png import mean  # tests/cli/png.py
 locked = [mean(os.path.join(sys.argv[1], "s_%04d.png" % k)) for k in range(1, 6)]
