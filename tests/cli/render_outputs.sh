@@ -2,8 +2,8 @@
 # atmos render's outputs are what their names say and are written all or none: the format
 # by the extension, half-float EXRs without overflow, the variance EXR's channel names, the
 # EXR header (render metadata, chromaticities, numbers as numbers), folders created, every
-# output checked before rendering, no output written twice or over an input, no temporary
-# left by SIGTERM, and one exposure over an animation.
+# output checked before rendering (and before a volume is read), no output written twice or
+# over an input, no temporary left by SIGTERM, and one exposure over an animation.
 set -u
 A=${ATMOS_CLI:?ATMOS_CLI not set}
 T=${ATMOS_TEST_TMP:-/tmp}/cli_outputs.$$
@@ -94,6 +94,15 @@ t1=$(date +%s)
 [ $rc -eq 1 ] && grep -q "plain" "$T/err" && ok || bad "an unwritable output: rc $rc, $(cat "$T/err")"
 [ $((t1 - t0)) -le 5 ] && ok || bad "an unwritable output was found after $((t1 - t0)) s of rendering"
 cmp -s "$T/keep.exr" "$T/f.exr" && ok || bad "the other output was replaced though the command failed"
+# ... and before the scene and its volume are read: no framing line (a volume file without a
+# camera is read and framed first), and the folders the check made are gone again.
+"$A" volume generate cumulus -o "$T/cu.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"
+"$A" render $S --volume "$T/cu.json" -o "$T/gone/sub/a.png" --pfm "$T/plain/x.pfm" 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] && grep -q "plain" "$T/err" && ! grep -q "framing" "$T/err" && [ ! -e "$T/gone" ] && ok \
+    || bad "an unwritable output beside a volume file: rc $rc, $(cat "$T/err"), $(ls -d "$T/gone" 2>&1)"
+"$A" render $S --volume "$T/missing.vdb" --exr "$T/plain/x.exr" 2>"$T/err"; rc=$?
+[ $rc -eq 1 ] && grep -q "plain" "$T/err" && ! grep -q "missing" "$T/err" && ok \
+    || bad "an unwritable output told after a missing volume: rc $rc, $(cat "$T/err")"
 mkdir "$T/adir.pfm"
 "$A" render -q $S --pfm "$T/adir.pfm" --exr "$T/keep.exr" 2>/dev/null; [ $? -ne 0 ] && cmp -s "$T/keep.exr" "$T/f.exr" \
     && ok || bad "an output that is a folder"
@@ -148,8 +157,8 @@ wait $pid; rc=$?
 "$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/pk/s.png" -D animation.frames=5 \
     -D animation.elevation_end_deg=-1 -D animation.exposure=per_frame && ok || bad "animation, the scene's exposure per_frame"
 "$A" render -q --width 48 --height 27 --sun-elevation 12 -o "$T/one.png" && ok || bad "single render"
-PYTHONPATH=$(cd "$(dirname "$0")" && pwd) python3 - "$T/an" "$T/pf" "$T/one.png" "$T/pk" <<'PY' && ok ||
-    bad "exposure over the animation"
+# (the here-document's text starts on the line after the one with <<: bad on that line too)
+PYTHONPATH=$(cd "$(dirname "$0")" && pwd) python3 - "$T/an" "$T/pf" "$T/one.png" "$T/pk" <<'PY' && ok || bad "exposure over the animation"
 import os, sys
 from png import mean  # tests/cli/png.py
 locked = [mean(os.path.join(sys.argv[1], "s_%04d.png" % k)) for k in range(1, 6)]

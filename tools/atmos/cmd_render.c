@@ -421,12 +421,17 @@ static int check_output_names(const render_opts *o)
 
 /* No two outputs are the same file and none is an input (the scene file, the volume file).
  * CLI_EXIT_OK or CLI_EXIT_USAGE. */
-static int check_outputs(const render_opts *o, const atmos_scene *scene, const char *png)
+static void add_outputs(const render_opts *o, const char *png, cli_outputs *set)
 {
     const char *names[6] = {png, o->exr, o->pfm, o->variance, o->order, o->tau};
-    cli_outputs set = {0};
     for (int i = 0; i < 6; i++)
-        if (names[i]) cli_outputs_add(&set, out_option[i], names[i]);
+        if (names[i]) cli_outputs_add(set, out_option[i], names[i]);
+}
+
+static int check_outputs(const render_opts *o, const atmos_scene *scene, const char *png)
+{
+    cli_outputs set = {0};
+    add_outputs(o, png, &set);
     const char *vol = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) &&
                               strncmp(scene->volume.source, "simulate:", 9)
                           ? scene->volume.source
@@ -509,6 +514,14 @@ int cli_cmd_render(int argc, char **argv)
     /* the outputs' names first: a wrong one is told before a volume is read */
     if ((rc = check_output_names(&o)) != CLI_EXIT_OK) return render_opts_free(&o), rc;
     if ((rc = cli_dist_start(o.mpi, &d)) != CLI_EXIT_OK) return render_opts_free(&o), rc;
+    /* and whether they can be written, before the scene and its volume are read (the default
+     * PNG's folder is the current one; the names are checked again, and staged, after) */
+    cli_outputs probe = {0};
+    if (d.rank == 0) add_outputs(&o, o.png, &probe);
+    const char *scene_file[1] = {o.scene_path};
+    if (probe.n && (rc = cli_outputs_check("render", &probe, scene_file, 1)) == CLI_EXIT_OK)
+        rc = cli_outputs_probe("render", &probe) != 0 ? CLI_EXIT_RUNTIME : CLI_EXIT_OK;
+    if ((rc = cli_dist_max(&d, rc)) != CLI_EXIT_OK) return cli_dist_stop(&d), render_opts_free(&o), rc;
     o.scene_text = render_scene_text(o.scene_path);
     if (d.rank != 0) o.quiet = 1; /* rank 0 reports; the others speak only of their failures */
     cli_progress prog;

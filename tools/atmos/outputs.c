@@ -325,6 +325,15 @@ int cli_outputs_prepare(const char *cmd, cli_outputs *set)
     return 0;
 }
 
+int cli_outputs_probe(const char *cmd, cli_outputs *set)
+{
+    const int made0 = made_n;
+    const int rc = cli_outputs_prepare(cmd, set);
+    cli_outputs_discard(set);
+    made_n = made0; /* the folders it made are gone again (they were left empty) */
+    return rc;
+}
+
 /* 0 when every staging file of set is written (not empty); else 1, the message printed and
  * the staging files removed. */
 static int all_written(const char *cmd, cli_outputs *set)

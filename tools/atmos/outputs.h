@@ -58,6 +58,10 @@ int cli_outputs_check(const char *cmd, const cli_outputs *set, const char *const
  * and creates the staging files. Returns 0 or 1 (CLI_EXIT_RUNTIME) with a message on
  * stderr; on failure no staging file is left. */
 int cli_outputs_prepare(const char *cmd, cli_outputs *set);
+/* cli_outputs_prepare, then its staging files and the folders it made removed again: an
+ * output that cannot be written is told before a long read of the inputs (whose names the
+ * outputs may still depend on), and no trace is left. 0 or 1 (message printed). */
+int cli_outputs_probe(const char *cmd, cli_outputs *set);
 /* Before work whose output the library writes itself (a raw volume and its sidecar): the
  * folder of path made (mkdir -p) and writable. 0, or 1 with the reason printed. */
 int cli_output_folder(const char *cmd, const char *option, const char *path);
