@@ -420,7 +420,7 @@ static void test_budget_whole_passes(void)
 /* ------------------------------------------------------------------ the noise figures */
 
 /* The slab (optical depth 2) fills the middle of the view, a black vacuum around it: the
- * volume's pixels are those lit, and the median and 90th percentile of sqrt(var_Y) / Y
+ * volume's pixels are those lit, and the median and 90th percentile of sqrt(variance.Y) / Y
  * recomputed here from the variance image over the lit pixels must be the stats'. */
 static void test_noise_figures(void)
 {
