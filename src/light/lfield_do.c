@@ -104,7 +104,8 @@ typedef struct {
                             of the field where there is a medium) */
     size_t *idx, n;      /* the cells needed, in order, and their count: GMRES's vectors hold their
                             moments alone (idx[i] * K + k at i * K + k), the others 0 */
-    atmos__dsa *dsa;     /* the diffusion preconditioner (P->dsa), else NULL */
+    atmos__dsa *dsa;     /* the diffusion preconditioner (P->dsa), else NULL (or not yet on) */
+    double hist[4];      /* ATMOS__DO_DSA_AUTO: the relative residuals after the last 4 iterations */
     double *dz;          /* per GMRES column: its preconditioner's correction (n cells of
                             atmos__dsa_moments() values) */
 } do_work;
@@ -360,6 +361,22 @@ static void precondition(do_work *W, const double *v, double *dz, double *z, atm
         for (int k = 0; k < nm; k++) z[i * K + k] += dz[i * nm + k];
 }
 
+/* ATMOS__DO_DSA_AUTO: after GMRES's iteration it (0: the start) with the relative residual resid,
+ * the rate of the last three iterations (plain ones) predicts the iterations to the tolerance; more
+ * than ATMOS__DO_DSA_AFTER in all: the preconditioner on from the next column. A fast start (a thin
+ * medium, a warm start near the solution) stays plain and pays nothing for it. */
+static void dsa_switch(do_work *W, int it, double resid, atmos__do_stats *st)
+{
+    W->hist[it % 4] = resid;
+    if (W->dsa || W->P->dsa != ATMOS__DO_DSA_AUTO || it < 3 || !(resid > W->P->tol)) return;
+    const double rho = pow(resid / W->hist[(it - 3) % 4], 1.0 / 3);
+    const double left = rho < 1 ? log(W->P->tol / resid) / log(rho) : 1e9;
+    if (it + left > ATMOS__DO_DSA_AFTER) {
+        W->dsa = atmos__dsa_create(W->P, W->idx, W->n); /* NULL (out of memory): plain on */
+        if (W->dsa) st->dsa_at = it;
+    }
+}
+
 /* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
  * its first residual b itself, no sweep); with W->dsa flexible GMRES (Saad 1993) right-preconditioned
  * by it: the columns' z_j = M^-1 v_j differ from v_j in their moments of degree <= 1 alone
@@ -372,6 +389,7 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
     const int m = P->restart;
     const size_t N = W->n * W->K;
     double H[65][64], cs[64], sn[64], g[65], y[64];
+    unsigned char pre[64] = {0}; /* column j preconditioned */
     const int T = 1; /* the vector operations in one thread: on a loaded machine a parallel region per
                         operation costs more in its barriers than it saves */
     const double bn = sqrt(dot(b, b, N, T));
@@ -390,6 +408,7 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
         }
         const double beta = sqrt(dot(V, V, N, T));
         st->resid = beta / bn;
+        dsa_switch(W, st->iters, st->resid, st);
         if (st->resid <= P->tol) {
             memcpy(r, V, sizeof(double) * N);
             return 1;
@@ -400,7 +419,7 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
         int j = 0;
         for (; j < m && st->iters < P->max_iter; j++) {
             double *v = V + (size_t)(j + 1) * N;
-            if (W->dsa) {
+            if ((pre[j] = W->dsa != NULL)) {
                 const size_t at = (size_t)j * W->n * atmos__dsa_moments(W->dsa);
                 precondition(W, V + (size_t)j * N, W->dz + at, r, st);
                 apply(W, r, v);
@@ -423,6 +442,7 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
             H[j][j] = rr, H[j + 1][j] = 0;
             g[j + 1] = -sn[j] * g[j], g[j] = cs[j] * g[j];
             st->resid = fabs(g[j + 1]) / bn;
+            dsa_switch(W, st->iters, st->resid, st);
             if (st->resid <= P->tol || !(rr > 0)) {
                 j++;
                 break;
@@ -434,7 +454,8 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
             y[i] = H[i][i] != 0 ? s / H[i][i] : 0;
         }
         for (int i = 0; i < j; i++) axpy(y[i], V + (size_t)i * N, x, N, T);
-        for (int i = 0; i < j && W->dsa; i++) {
+        for (int i = 0; i < j; i++) {
+            if (!pre[i]) continue;
             const int nm = atmos__dsa_moments(W->dsa);
             const double *dz = W->dz + (size_t)i * W->n * nm;
             for (size_t c = 0; c < W->n; c++)
@@ -553,7 +574,8 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         for (size_t c = 0; c < W.cells; c++)
             if (W.need[c]) W.idx[W.n++] = c;
         const size_t Nn = W.n * W.K;
-        if (P->dsa) W.dsa = atmos__dsa_create(P, W.idx, W.n); /* NULL (out of memory): plain GMRES */
+        if (P->dsa == ATMOS__DO_DSA_ON) W.dsa = atmos__dsa_create(P, W.idx, W.n); /* NULL (no memory): plain */
+        st->dsa_at = W.dsa ? 0 : -1;
         for (int g = 0; g < DO_GROUPS; g++) memset(W.acc[g], 0, sizeof(float) * N); /* the cells not needed */
         /* the weighted diamond's weight per cell: theta (P's, in (0, 1), else 1: the step scheme)
            in optically thick cells, toward 1 in thin ones, 1 - (1 - theta) (1 - e^(-tau / tau0)) */

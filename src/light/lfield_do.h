@@ -70,8 +70,10 @@ typedef struct {
                                    1/2 diamond difference (lfield_do.c, cell_faces()) */
     double theta_tau;           /* > 0: theta in optically thick cells only, a cell of optical depth
                                    tau 1 - (1 - theta) (1 - exp(-tau / theta_tau)); 0: in every cell */
-    int dsa;                    /* 1: GMRES right-preconditioned by a diffusion solve of the degree-0
-                                   moments (flexible GMRES; lfield_dsa.h); 0: plain */
+    int dsa;                    /* ATMOS__DO_DSA_ON: GMRES right-preconditioned by a diffusion solve of
+                                   the low moments (flexible GMRES; lfield_dsa.h); ATMOS__DO_DSA_AUTO:
+                                   plain until its rate predicts more than ATMOS__DO_DSA_AFTER
+                                   iterations, then preconditioned; 0: plain */
 } atmos__do_problem;
 
 typedef struct {
@@ -81,7 +83,13 @@ typedef struct {
     double emitted;       /* power of the first-order emission (per 1 of q1 units m^3) */
     double entering;      /* power entering through the grid's faces (the inflow's) */
     int dsa_iters;        /* the diffusion preconditioner's conjugate-gradient iterations, all */
+    int dsa_at;           /* the GMRES iterations before the preconditioner came on (0: from the
+                             first); -1: it did not */
 } atmos__do_stats;
+
+#define ATMOS__DO_DSA_ON 1
+#define ATMOS__DO_DSA_AUTO 2
+#define ATMOS__DO_DSA_AFTER 12
 
 /* The radiance moments phi[cell * K + k], K = (L + 1)^2, of the orders >= 1 and of the inflow
  * (its uncollided part too; phi on entry: the start, 0 if nothing better). Returns 0 when out of

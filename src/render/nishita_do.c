@@ -233,7 +233,8 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     P->c[0] = F->c[0], P->c[1] = F->c[1], P->c[2] = F->c[2], P->h = F->s / (double)np->g.sc, P->L = L, P->quad = &quad;
     P->theta = ATMOS__DO_THETA, P->theta_tau = ATMOS__DO_THETA_TAU; /* the weighted diamond (lfield_do.h) */
     P->tol = DO_TOL, P->max_iter = DO_MAX_ITER, P->restart = DO_RESTART;
-    P->dsa = 1; /* GMRES preconditioned by the P1 solve of the low moments (lfield_dsa.h) */
+    P->dsa = ATMOS__DO_DSA_AUTO; /* GMRES preconditioned by the P1 solve of the low moments where it pays
+                                   (lfield_dsa.h, lfield_do.h) */
     D.n = n, D.K = K, D.cells = cells, D.st = st, D.src = src, D.Ys = Ys, D.E = E, D.sky = sky_on ? sky : NULL;
     D.chi = chi, D.coef = coef;
     /* a wavelength whose medium and phase are the last one's (a grey cloud, no sky): its field is

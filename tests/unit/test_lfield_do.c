@@ -261,6 +261,40 @@ static void check_dsa(cloud *C)
         CHECK(big > 0 && worst <= 1e-4 * big);
         CHECK(fabs(S2.leak / S.leak - 1) < 1e-5);
         CHECK(2 * S2.sweeps < S.sweeps);
+        CHECK(S.dsa_at == -1 && S2.dsa_at == 0);
+    }
+}
+
+/* The preconditioner's switch (ATMOS__DO_DSA_AUTO): on the thick cube (conservative) plain GMRES's
+ * rate soon predicts more than ATMOS__DO_DSA_AFTER iterations, the preconditioner comes on and the
+ * solve takes fewer sweeps than the plain one, to its moments; the cube 100 times thinner converges
+ * fast, the switch stays off and the bytes are the plain solve's. The same bytes with 1 and 2 threads. */
+static void check_dsa_switch(cloud *C)
+{
+    static double plain[NC * NC * NC * 16];
+    for (int t = 0; t < 2; t++) {
+        atmos__do_stats S, S2;
+        make_cloud(C, 1.0, 2, 2000);
+        for (size_t c = 0; c < NC * NC * NC && t; c++) C->st[c] *= 0.01f, C->ss[c] *= 0.01f;
+        CHECK(atmos__do_solve(&C->P, C->phi, &S));
+        memcpy(plain, C->phi, sizeof plain);
+        memset(C->phi, 0, sizeof plain);
+        C->P.dsa = ATMOS__DO_DSA_AUTO;
+        CHECK(atmos__do_solve(&C->P, C->phi, &S2));
+        double worst = 0, big = 0;
+        for (size_t i = 0; i < NC * NC * NC * 16; i++)
+            worst = fmax(worst, fabs(C->phi[i] - plain[i])), big = fmax(big, fabs(plain[i]));
+        printf("  the preconditioner's switch, %s cube: on after %d GMRES iterations, %d sweeps against %d "
+               "plain, largest difference %.1e of the largest moment\n",
+               t ? "the thin" : "the thick", S2.dsa_at, S2.sweeps, S.sweeps, worst / big);
+        CHECK(S2.resid <= 1e-6 && big > 0);
+        if (t) CHECK(S2.dsa_at == -1 && S2.dsa_iters == 0 && !memcmp(plain, C->phi, sizeof plain));
+        else CHECK(S2.dsa_at >= 3 && S2.sweeps < S.sweeps && worst <= 1e-4 * big);
+        if (t) continue;
+        memcpy(plain, C->phi, sizeof plain); /* one thread: the same switch, the same bytes */
+        make_cloud(C, 1.0, 1, 2000);
+        C->P.dsa = ATMOS__DO_DSA_AUTO;
+        CHECK(atmos__do_solve(&C->P, C->phi, &S) && S.dsa_at == S2.dsa_at && !memcmp(plain, C->phi, sizeof plain));
     }
 }
 
@@ -273,7 +307,7 @@ int main(void)
     for (diamond = 0; diamond < 2 && C; diamond++) {
         printf("%s\n", diamond ? "the renderers' weighted diamond:" : "the step scheme:");
         check_balance(C), check_threads(C), check_needed_and_start(C), check_last_iteration(C), check_inflow(C);
-        check_dsa(C);
+        check_dsa(C), check_dsa_switch(C);
     }
     free(C);
     return test_summary("test_lfield_do");
