@@ -521,7 +521,8 @@ static int take_buffers(do_work *W, int m, atmos__do_ws *ws, double **V, double 
         *x = carve(&at, sizeof(double) * N, &total), W->idx = carve(&at, sizeof(size_t) * W->cells, &total);
         W->live = carve(&at, W->cells, &total), W->need = carve(&at, W->cells, &total);
         W->theta = carve(&at, sizeof(float) * W->cells, &total);
-        W->dz = carve(&at, W->P->dsa ? sizeof(double) * W->cells * 4 * m : 0, &total); /* 4 moments at most */
+        W->dz = carve(&at, W->P->dsa ? sizeof(double) * W->cells * (W->K >= 4 ? 4 : 1) * m : 0,
+                      &total); /* the moments of degree <= 1 (lfield_dsa.c) */
         W->Q = carve(&at, sizeof(float) * N, &total), W->q1 = carve(&at, sizeof(float) * N, &total);
         for (int g = 0; g < DO_GROUPS; g++)
             W->acc[g] = carve(&at, sizeof(float) * N, &total),

@@ -1,8 +1,8 @@
 /* The diffusion preconditioner of the discrete-ordinates solve (lfield_dsa.h). Cell-centred finite
- * volumes on the cells of edge h: between two cells of the medium the face's conductance 1 / (h^2
- * (1 / (2 D_a / h) + 1 / (2 D_b / h))), the harmonic mean of D; a face toward vacuum (the grid's
- * edge, a cell without medium) the Marshak condition, outgoing flux phi_b / 2 at the face, 1 /
- * (h^2 (h / (2 D) + 2)) (diffusion.c's). h / (2 D) = 3/2 sig_tr h floored at DSA_TAU_MIN: the
+ * volumes on the cells of edge h, r = h / (2 D) a half cell's resistance: between two cells of the
+ * medium the face's conductance 1 / (h (r_a + r_b)), the harmonic mean of D over h^2; a face toward
+ * vacuum (the grid's edge, a cell without medium) the Marshak condition, outgoing flux phi_b / 2 at
+ * the face, 1 / (h (r + 2)) (diffusion.c's). h / (2 D) = 3/2 sig_tr h floored at DSA_TAU_MIN: the
  * conductance of optically thin cells bounded (the diffusion overshoots there: with the floor at 0.05
  * the Disney cloud took 10 GMRES iterations after a sun move instead of 7, with 0.5 7, with 2 11). The operator is
  * symmetric positive definite: conjugate gradients. */
