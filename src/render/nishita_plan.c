@@ -146,19 +146,43 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     return ATMOS_OK;
 }
 
-/* The bilinear interpolant of field f of a plane of nx x ny values (m a point) at (x, y), the
- * point clamped to the plane. */
-static float plane_at(const float *a, int nx, int ny, int m, int f, double x, double y)
+/* One axis's bilinear taps at the points m + off, m = 0 .. n - 1, each clamped to the axis: the
+ * lower and upper index and the upper's weight, as a per-point bilinear read finds them (the
+ * same bits: m + off rounded as a double before the fraction is taken). */
+static void axis_taps(int n, double off, int *lo, int *hi, double *u)
 {
-    x = x < 0 ? 0 : x > nx - 1 ? nx - 1 : x;
-    y = y < 0 ? 0 : y > ny - 1 ? ny - 1 : y;
-    int i = (int)x, j = (int)y;
-    if (i > nx - 2) i = nx - 2 < 0 ? 0 : nx - 2;
-    if (j > ny - 2) j = ny - 2 < 0 ? 0 : ny - 2;
-    const double u = x - i, v = y - j;
-    const int i1 = i + 1 < nx ? i + 1 : i, j1 = j + 1 < ny ? j + 1 : j;
-    return (float)((1 - u) * (1 - v) * a[((size_t)j * nx + i) * m + f] + u * (1 - v) * a[((size_t)j * nx + i1) * m + f] +
-                   (1 - u) * v * a[((size_t)j1 * nx + i) * m + f] + u * v * a[((size_t)j1 * nx + i1) * m + f]);
+    for (int m = 0; m < n; m++) {
+        double x = m + off;
+        x = x < 0 ? 0 : x > n - 1 ? n - 1 : x;
+        int i = (int)x;
+        if (i > n - 2) i = n - 2 < 0 ? 0 : n - 2;
+        lo[m] = i, hi[m] = i + 1 < n ? i + 1 : i, u[m] = x - i;
+    }
+}
+
+/* The bilinear interpolant of a plane a of nb x nc points of nf fields at every lattice point
+ * (m + ob, n + oc), written to out at out_b and out_c floats per step along the two axes (its
+ * fields contiguous). tap holds 3 (nb + nc) slots of scratch. The rows in parallel. */
+static void plane_lerp(const float *a, int nb, int nc, int nf, double ob, double oc, float *out, size_t out_b,
+                       size_t out_c, int par, double *tap)
+{
+    double *ub = tap, *uc = ub + nb;
+    int *lb = (int *)(uc + nc), *hb = lb + nb, *lc = hb + nb, *hc = lc + nc;
+    axis_taps(nb, ob, lb, hb, ub);
+    axis_taps(nc, oc, lc, hc, uc);
+#pragma omp parallel for schedule(static) num_threads(par)
+    for (int n = 0; n < nc; n++) {
+        const double v = uc[n];
+        const float *r0 = a + (size_t)lc[n] * nb * nf, *r1 = a + (size_t)hc[n] * nb * nf;
+        for (int m = 0; m < nb; m++) {
+            const double u = ub[m], w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
+            const float *p00 = r0 + (size_t)lb[m] * nf, *p10 = r0 + (size_t)hb[m] * nf, *p01 = r1 + (size_t)lb[m] * nf,
+                        *p11 = r1 + (size_t)hb[m] * nf;
+            float *o = out + n * out_c + m * out_b;
+            for (int f = 0; f < nf; f++)
+                o[f] = (float)(w00 * p00[f] + w10 * p10[f] + w01 * p01[f] + w11 * p11[f]);
+        }
+    }
 }
 
 /* The column density toward the sun at every render voxel, by rays along the sun: one ray per
@@ -186,7 +210,11 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
     const int step = sun_g[a] > 0 ? -1 : 1;           /* from the sun's side */
     const size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf}, pl = (size_t)nb * nc * nf;
     float *buf = malloc(sizeof(float) * pl * 5);
-    if (!buf) return;
+    double *tap = malloc((sizeof(double) + 2 * sizeof(int)) * (size_t)(nb + nc));
+    if (!buf || !tap) {
+        free(buf), free(tap);
+        return;
+    }
     /* the plane's densities; the rays' columns and densities, the last plane's and this one's */
     float *dens = buf, *rc = buf + pl, *rd = rc + pl, *qc = rd + pl, *qd = qc + pl;
     memset(rc, 0, sizeof(float) * pl * 2);
@@ -208,28 +236,23 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
             for (int jb = 0; jb < nb; jb++)
                 for (int f = 0; f < nf; f++)
                     dens[((size_t)jc * nb + jb) * nf + f] = g->v[ia * str[a] + jb * str[b] + jc * str[c] + f];
+        plane_lerp(dens, nb, nc, nf, fb, fc, qd, (size_t)nf, (size_t)nb * nf, par, tap);
 #pragma omp parallel for schedule(static) num_threads(par)
         for (int n = 0; n < nc; n++)
             for (int m = 0; m < nb; m++) {
                 const int pm = m - sb, pn = n - sc, in = k > 0 && pm >= 0 && pm < nb && pn >= 0 && pn < nc;
                 const size_t e = ((size_t)n * nb + m) * nf, pe = in ? ((size_t)pn * nb + pm) * nf : 0;
                 for (int f = 0; f < nf; f++) {
-                    const float d = plane_at(dens, nb, nc, nf, f, m + fb, n + fc);
-                    qd[e + f] = d;
+                    const float d = qd[e + f];
                     qc[e + f] = in ? rc[pe + f] + (float)(0.5 * len * (d + rd[pe + f])) : (float)(0.5 * len * d);
                 }
             }
-#pragma omp parallel for schedule(static) num_threads(par)
-        for (int jc = 0; jc < nc; jc++)
-            for (int jb = 0; jb < nb; jb++)
-                for (int f = 0; f < nf; f++)
-                    np->col[ia * str[a] + jb * str[b] + jc * str[c] + f] =
-                        plane_at(qc, nb, nc, nf, f, jb - fb, jc - fc);
+        plane_lerp(qc, nb, nc, nf, -fb, -fc, np->col + ia * str[a], str[b], str[c], par, tap);
         float *t = rc;
         rc = qc, qc = t;
         t = rd, rd = qd, qd = t;
     }
-    free(buf);
+    free(buf), free(tap);
     memcpy(np->col_sun, sun_g, sizeof np->col_sun);
     np->col_valid = 1;
     np->col_s = atmos__now() - t0;
