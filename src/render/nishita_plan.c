@@ -147,41 +147,50 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
 }
 
 /* One axis's bilinear taps at the points m + off, m = 0 .. n - 1, each clamped to the axis: the
- * lower and upper index and the upper's weight, as a per-point bilinear read finds them (the
- * same bits: m + off rounded as a double before the fraction is taken). */
-static void axis_taps(int n, double off, int *lo, int *hi, double *u)
+ * offsets (stride floats a point) of the lower and upper point and the upper's weight, as a
+ * per-point bilinear read finds them (the same bits: m + off rounded as a double before the
+ * fraction is taken). */
+static void axis_taps(int n, double off, size_t stride, size_t *lo, size_t *hi, double *u)
 {
     for (int m = 0; m < n; m++) {
         double x = m + off;
         x = x < 0 ? 0 : x > n - 1 ? n - 1 : x;
         int i = (int)x;
         if (i > n - 2) i = n - 2 < 0 ? 0 : n - 2;
-        lo[m] = i, hi[m] = i + 1 < n ? i + 1 : i, u[m] = x - i;
+        lo[m] = (size_t)i * stride, hi[m] = (size_t)(i + 1 < n ? i + 1 : i) * stride, u[m] = x - i;
     }
 }
 
-/* The bilinear interpolant of a plane a of nb x nc points of nf fields at every lattice point
- * (m + ob, n + oc), written to out at out_b and out_c floats per step along the two axes (its
- * fields contiguous). tap holds 3 (nb + nc) slots of scratch. The rows in parallel. */
-static void plane_lerp(const float *a, int nb, int nc, int nf, double ob, double oc, float *out, size_t out_b,
-                       size_t out_c, int par, double *tap)
+/* Row n's points of plane_lerp (its taps lb, hb, ub along the row, the row's r0, r1 and v),
+ * nf a constant where inlined. */
+static inline __attribute__((always_inline)) void lerp_row(const float *r0, const float *r1, double v, int nb,
+                                                            int nf, const size_t *lb, const size_t *hb,
+                                                            const double *ub, float *o, size_t ob)
+{
+    for (int m = 0; m < nb; m++, o += ob) {
+        const double u = ub[m], w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
+        const float *p00 = r0 + lb[m], *p10 = r0 + hb[m], *p01 = r1 + lb[m], *p11 = r1 + hb[m];
+        for (int f = 0; f < nf; f++) o[f] = (float)(w00 * p00[f] + w10 * p10[f] + w01 * p01[f] + w11 * p11[f]);
+    }
+}
+
+/* The bilinear interpolant of nf fields on a plane of nb x nc points, a's point (m, n) at
+ * a + m in[0] + n in[1] (its fields contiguous), at every lattice point (m + ob, n + oc),
+ * written to out + m on[0] + n on[1]. tap: 3 (nb + nc) slots of scratch. The rows in parallel,
+ * one field's rows unrolled. */
+static void plane_lerp(const float *a, const size_t in[2], int nb, int nc, int nf, double ob, double oc, float *out,
+                       const size_t on[2], int par, double *tap)
 {
     double *ub = tap, *uc = ub + nb;
-    int *lb = (int *)(uc + nc), *hb = lb + nb, *lc = hb + nb, *hc = lc + nc;
-    axis_taps(nb, ob, lb, hb, ub);
-    axis_taps(nc, oc, lc, hc, uc);
+    size_t *lb = (size_t *)(uc + nc), *hb = lb + nb, *lc = hb + nb, *hc = lc + nc;
+    axis_taps(nb, ob, in[0], lb, hb, ub);
+    axis_taps(nc, oc, in[1], lc, hc, uc);
 #pragma omp parallel for schedule(static) num_threads(par)
     for (int n = 0; n < nc; n++) {
-        const double v = uc[n];
-        const float *r0 = a + (size_t)lc[n] * nb * nf, *r1 = a + (size_t)hc[n] * nb * nf;
-        for (int m = 0; m < nb; m++) {
-            const double u = ub[m], w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
-            const float *p00 = r0 + (size_t)lb[m] * nf, *p10 = r0 + (size_t)hb[m] * nf, *p01 = r1 + (size_t)lb[m] * nf,
-                        *p11 = r1 + (size_t)hb[m] * nf;
-            float *o = out + n * out_c + m * out_b;
-            for (int f = 0; f < nf; f++)
-                o[f] = (float)(w00 * p00[f] + w10 * p10[f] + w01 * p01[f] + w11 * p11[f]);
-        }
+        if (nf == 1)
+            lerp_row(a + lc[n], a + hc[n], uc[n], nb, 1, lb, hb, ub, out + n * on[1], on[0]);
+        else
+            lerp_row(a + lc[n], a + hc[n], uc[n], nb, nf, lb, hb, ub, out + n * on[1], on[0]);
     }
 }
 
@@ -209,14 +218,16 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
     const double len = 1.0 / fabs(sun_g[a]) / g->sc; /* metres per plane along the sun */
     const int step = sun_g[a] > 0 ? -1 : 1;           /* from the sun's side */
     const size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf}, pl = (size_t)nb * nc * nf;
-    float *buf = malloc(sizeof(float) * pl * 5);
-    double *tap = malloc((sizeof(double) + 2 * sizeof(int)) * (size_t)(nb + nc));
+    /* the grid's strides along the plane's axes and the rays' planes' */
+    const size_t sv[2] = {str[b], str[c]}, sq[2] = {(size_t)nf, (size_t)nb * nf};
+    float *buf = malloc(sizeof(float) * pl * 4);
+    double *tap = malloc((sizeof(double) + 2 * sizeof(size_t)) * (size_t)(nb + nc));
     if (!buf || !tap) {
         free(buf), free(tap);
         return;
     }
-    /* the plane's densities; the rays' columns and densities, the last plane's and this one's */
-    float *dens = buf, *rc = buf + pl, *rd = rc + pl, *qc = rd + pl, *qd = qc + pl;
+    /* the rays' columns and densities, the last plane's and this one's */
+    float *rc = buf, *rd = rc + pl, *qc = rd + pl, *qd = qc + pl;
     memset(rc, 0, sizeof(float) * pl * 2);
     /* plane k's rays at lattice point (m, n) lie at (m + fb, n + fc): fb, fc the fractions of the
        offsets -k db, -k dc (the rays move away from the sun, the last plane's points at +db, +dc) */
@@ -231,12 +242,7 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
         const int sb = (int)(floor(nb_) - floor(ob)), sc = (int)(floor(nc_) - floor(oc));
         const double fb = nb_ - floor(nb_), fc = nc_ - floor(nc_);
         ob = nb_, oc = nc_;
-#pragma omp parallel for schedule(static) num_threads(par)
-        for (int jc = 0; jc < nc; jc++)
-            for (int jb = 0; jb < nb; jb++)
-                for (int f = 0; f < nf; f++)
-                    dens[((size_t)jc * nb + jb) * nf + f] = g->v[ia * str[a] + jb * str[b] + jc * str[c] + f];
-        plane_lerp(dens, nb, nc, nf, fb, fc, qd, (size_t)nf, (size_t)nb * nf, par, tap);
+        plane_lerp(g->v + ia * str[a], sv, nb, nc, nf, fb, fc, qd, sq, par, tap);
 #pragma omp parallel for schedule(static) num_threads(par)
         for (int n = 0; n < nc; n++)
             for (int m = 0; m < nb; m++) {
@@ -247,7 +253,7 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
                     qc[e + f] = in ? rc[pe + f] + (float)(0.5 * len * (d + rd[pe + f])) : (float)(0.5 * len * d);
                 }
             }
-        plane_lerp(qc, nb, nc, nf, -fb, -fc, np->col + ia * str[a], str[b], str[c], par, tap);
+        plane_lerp(qc, sq, nb, nc, nf, -fb, -fc, np->col + ia * str[a], sv, par, tap);
         float *t = rc;
         rc = qc, qc = t;
         t = rd, rd = qd, qd = t;
