@@ -7,6 +7,7 @@
 #include "render/nishita_internal.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -194,6 +195,12 @@ static void plane_lerp(const float *a, const size_t in[2], int nb, int nc, int n
     }
 }
 
+/* A ray's first step's column, qc[e] for e in [from, to): the trapezoid from 0 at the grid's face. */
+static inline void first_step(float *qc, const float *qd, size_t from, size_t to, double len)
+{
+    for (size_t e = from; e < to; e++) qc[e] = (float)(0.5 * len * qd[e]);
+}
+
 /* The column density toward the sun at every render voxel, by rays along the sun: one ray per
  * point of a lattice of the plane's spacing, the planes across the axis nearest to the sun's
  * direction one after another from the sun's side. Between two planes each ray moves by the
@@ -244,15 +251,17 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
         ob = nb_, oc = nc_;
         plane_lerp(g->v + ia * str[a], sv, nb, nc, nf, fb, fc, qd, sq, par, tap);
 #pragma omp parallel for schedule(static) num_threads(par)
-        for (int n = 0; n < nc; n++)
-            for (int m = 0; m < nb; m++) {
-                const int pm = m - sb, pn = n - sc, in = k > 0 && pm >= 0 && pm < nb && pn >= 0 && pn < nc;
-                const size_t e = ((size_t)n * nb + m) * nf, pe = in ? ((size_t)pn * nb + pm) * nf : 0;
-                for (int f = 0; f < nf; f++) {
-                    const float d = qd[e + f];
-                    qc[e + f] = in ? rc[pe + f] + (float)(0.5 * len * (d + rd[pe + f])) : (float)(0.5 * len * d);
-                }
-            }
+        for (int n = 0; n < nc; n++) {
+            /* the row's rays whose last point (m - sb, n - sc) was on the plane: m in [m0, m1) */
+            const int pn = n - sc, row = k > 0 && pn >= 0 && pn < nc;
+            int m0 = sb > 0 ? sb : 0, m1 = sb < 0 ? nb + sb : nb;
+            m0 = !row || m0 > nb ? nb : m0, m1 = m1 < m0 ? m0 : m1;
+            const size_t e0 = (size_t)n * nb * nf, e1 = e0 + (size_t)m0 * nf, e2 = e0 + (size_t)m1 * nf;
+            const ptrdiff_t pe = -((ptrdiff_t)sc * nb + sb) * nf; /* the last point's offset */
+            first_step(qc, qd, e0, e1, len);
+            for (size_t e = e1; e < e2; e++) qc[e] = rc[e + pe] + (float)(0.5 * len * (qd[e] + rd[e + pe]));
+            first_step(qc, qd, e2, e0 + (size_t)nb * nf, len);
+        }
         plane_lerp(qc, sq, nb, nc, nf, -fb, -fc, np->col + ia * str[a], sv, par, tap);
         float *t = rc;
         rc = qc, qc = t;
