@@ -7,6 +7,7 @@
 #include "render/nishita_internal.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -146,19 +147,58 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     return ATMOS_OK;
 }
 
-/* The bilinear interpolant of field f of a plane of nx x ny values (m a point) at (x, y), the
- * point clamped to the plane. */
-static float plane_at(const float *a, int nx, int ny, int m, int f, double x, double y)
+/* One axis's bilinear taps at the points m + off, m = 0 .. n - 1, each clamped to the axis: the
+ * offsets (stride floats a point) of the lower and upper point and the upper's weight, as a
+ * per-point bilinear read finds them (the same bits: m + off rounded as a double before the
+ * fraction is taken). */
+static void axis_taps(int n, double off, size_t stride, size_t *lo, size_t *hi, double *u)
 {
-    x = x < 0 ? 0 : x > nx - 1 ? nx - 1 : x;
-    y = y < 0 ? 0 : y > ny - 1 ? ny - 1 : y;
-    int i = (int)x, j = (int)y;
-    if (i > nx - 2) i = nx - 2 < 0 ? 0 : nx - 2;
-    if (j > ny - 2) j = ny - 2 < 0 ? 0 : ny - 2;
-    const double u = x - i, v = y - j;
-    const int i1 = i + 1 < nx ? i + 1 : i, j1 = j + 1 < ny ? j + 1 : j;
-    return (float)((1 - u) * (1 - v) * a[((size_t)j * nx + i) * m + f] + u * (1 - v) * a[((size_t)j * nx + i1) * m + f] +
-                   (1 - u) * v * a[((size_t)j1 * nx + i) * m + f] + u * v * a[((size_t)j1 * nx + i1) * m + f]);
+    for (int m = 0; m < n; m++) {
+        double x = m + off;
+        x = x < 0 ? 0 : x > n - 1 ? n - 1 : x;
+        int i = (int)x;
+        if (i > n - 2) i = n - 2 < 0 ? 0 : n - 2;
+        lo[m] = (size_t)i * stride, hi[m] = (size_t)(i + 1 < n ? i + 1 : i) * stride, u[m] = x - i;
+    }
+}
+
+/* Row n's points of plane_lerp (its taps lb, hb, ub along the row, the row's r0, r1 and v),
+ * nf a constant where inlined. */
+static inline __attribute__((always_inline)) void lerp_row(const float *r0, const float *r1, double v, int nb,
+                                                            int nf, const size_t *lb, const size_t *hb,
+                                                            const double *ub, float *o, size_t ob)
+{
+    for (int m = 0; m < nb; m++, o += ob) {
+        const double u = ub[m], w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;
+        const float *p00 = r0 + lb[m], *p10 = r0 + hb[m], *p01 = r1 + lb[m], *p11 = r1 + hb[m];
+        for (int f = 0; f < nf; f++) o[f] = (float)(w00 * p00[f] + w10 * p10[f] + w01 * p01[f] + w11 * p11[f]);
+    }
+}
+
+/* The bilinear interpolant of nf fields on a plane of nb x nc points, a's point (m, n) at
+ * a + m in[0] + n in[1] (its fields contiguous), at every lattice point (m + ob, n + oc),
+ * written to out + m on[0] + n on[1]. tap: 3 (nb + nc) slots of scratch. The rows in parallel,
+ * one field's rows unrolled. */
+static void plane_lerp(const float *a, const size_t in[2], int nb, int nc, int nf, double ob, double oc, float *out,
+                       const size_t on[2], int par, double *tap)
+{
+    double *ub = tap, *uc = ub + nb;
+    size_t *lb = (size_t *)(uc + nc), *hb = lb + nb, *lc = hb + nb, *hc = lc + nc;
+    axis_taps(nb, ob, in[0], lb, hb, ub);
+    axis_taps(nc, oc, in[1], lc, hc, uc);
+#pragma omp parallel for schedule(static) num_threads(par)
+    for (int n = 0; n < nc; n++) {
+        if (nf == 1)
+            lerp_row(a + lc[n], a + hc[n], uc[n], nb, 1, lb, hb, ub, out + n * on[1], on[0]);
+        else
+            lerp_row(a + lc[n], a + hc[n], uc[n], nb, nf, lb, hb, ub, out + n * on[1], on[0]);
+    }
+}
+
+/* A ray's first step's column, qc[e] for e in [from, to): the trapezoid from 0 at the grid's face. */
+static inline void first_step(float *qc, const float *qd, size_t from, size_t to, double len)
+{
+    for (size_t e = from; e < to; e++) qc[e] = (float)(0.5 * len * qd[e]);
 }
 
 /* The column density toward the sun at every render voxel, by rays along the sun: one ray per
@@ -185,10 +225,16 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
     const double len = 1.0 / fabs(sun_g[a]) / g->sc; /* metres per plane along the sun */
     const int step = sun_g[a] > 0 ? -1 : 1;           /* from the sun's side */
     const size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf}, pl = (size_t)nb * nc * nf;
-    float *buf = malloc(sizeof(float) * pl * 5);
-    if (!buf) return;
-    /* the plane's densities; the rays' columns and densities, the last plane's and this one's */
-    float *dens = buf, *rc = buf + pl, *rd = rc + pl, *qc = rd + pl, *qd = qc + pl;
+    /* the grid's strides along the plane's axes and the rays' planes' */
+    const size_t sv[2] = {str[b], str[c]}, sq[2] = {(size_t)nf, (size_t)nb * nf};
+    float *buf = malloc(sizeof(float) * pl * 4);
+    double *tap = malloc((sizeof(double) + 2 * sizeof(size_t)) * (size_t)(nb + nc));
+    if (!buf || !tap) {
+        free(buf), free(tap);
+        return;
+    }
+    /* the rays' columns and densities, the last plane's and this one's */
+    float *rc = buf, *rd = rc + pl, *qc = rd + pl, *qd = qc + pl;
     memset(rc, 0, sizeof(float) * pl * 2);
     /* plane k's rays at lattice point (m, n) lie at (m + fb, n + fc): fb, fc the fractions of the
        offsets -k db, -k dc (the rays move away from the sun, the last plane's points at +db, +dc) */
@@ -203,33 +249,25 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
         const int sb = (int)(floor(nb_) - floor(ob)), sc = (int)(floor(nc_) - floor(oc));
         const double fb = nb_ - floor(nb_), fc = nc_ - floor(nc_);
         ob = nb_, oc = nc_;
+        plane_lerp(g->v + ia * str[a], sv, nb, nc, nf, fb, fc, qd, sq, par, tap);
 #pragma omp parallel for schedule(static) num_threads(par)
-        for (int jc = 0; jc < nc; jc++)
-            for (int jb = 0; jb < nb; jb++)
-                for (int f = 0; f < nf; f++)
-                    dens[((size_t)jc * nb + jb) * nf + f] = g->v[ia * str[a] + jb * str[b] + jc * str[c] + f];
-#pragma omp parallel for schedule(static) num_threads(par)
-        for (int n = 0; n < nc; n++)
-            for (int m = 0; m < nb; m++) {
-                const int pm = m - sb, pn = n - sc, in = k > 0 && pm >= 0 && pm < nb && pn >= 0 && pn < nc;
-                const size_t e = ((size_t)n * nb + m) * nf, pe = in ? ((size_t)pn * nb + pm) * nf : 0;
-                for (int f = 0; f < nf; f++) {
-                    const float d = plane_at(dens, nb, nc, nf, f, m + fb, n + fc);
-                    qd[e + f] = d;
-                    qc[e + f] = in ? rc[pe + f] + (float)(0.5 * len * (d + rd[pe + f])) : (float)(0.5 * len * d);
-                }
-            }
-#pragma omp parallel for schedule(static) num_threads(par)
-        for (int jc = 0; jc < nc; jc++)
-            for (int jb = 0; jb < nb; jb++)
-                for (int f = 0; f < nf; f++)
-                    np->col[ia * str[a] + jb * str[b] + jc * str[c] + f] =
-                        plane_at(qc, nb, nc, nf, f, jb - fb, jc - fc);
+        for (int n = 0; n < nc; n++) {
+            /* the row's rays whose last point (m - sb, n - sc) was on the plane: m in [m0, m1) */
+            const int pn = n - sc, row = k > 0 && pn >= 0 && pn < nc;
+            int m0 = sb > 0 ? sb : 0, m1 = sb < 0 ? nb + sb : nb;
+            m0 = !row || m0 > nb ? nb : m0, m1 = m1 < m0 ? m0 : m1;
+            const size_t e0 = (size_t)n * nb * nf, e1 = e0 + (size_t)m0 * nf, e2 = e0 + (size_t)m1 * nf;
+            const ptrdiff_t pe = -((ptrdiff_t)sc * nb + sb) * nf; /* the last point's offset */
+            first_step(qc, qd, e0, e1, len);
+            for (size_t e = e1; e < e2; e++) qc[e] = rc[e + pe] + (float)(0.5 * len * (qd[e] + rd[e + pe]));
+            first_step(qc, qd, e2, e0 + (size_t)nb * nf, len);
+        }
+        plane_lerp(qc, sq, nb, nc, nf, -fb, -fc, np->col + ia * str[a], sv, par, tap);
         float *t = rc;
         rc = qc, qc = t;
         t = rd, rd = qd, qd = t;
     }
-    free(buf);
+    free(buf), free(tap);
     memcpy(np->col_sun, sun_g, sizeof np->col_sun);
     np->col_valid = 1;
     np->col_s = atmos__now() - t0;
