@@ -90,6 +90,14 @@ done
 st=$?
 [ $st -eq 1 ] && grep -q "record /proc/no/rec/frames.csv: cannot create the folder /proc/no" o_rec.txt &&
     ok "--record in a folder that cannot be made: said (exit 1)" || { bad "--record /proc/no/rec: exit $st"; cat o_rec.txt >&2; }
+# a --record path too long for its frames' names: refused (exit 2), no folder made (it used to be
+# cut short, and a folder other than the one named made)
+long=long; for i in 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16; do long="$long/$(printf '%0250d' "$i")"; done
+long="$long/$(printf '%060d' 17)" # 4081 bytes: its frame_00000.png 4097
+"$A" view --headless --frames 2 --size 16x9 --record "$long" >o_long.txt 2>&1
+st=$?
+[ $st -eq 2 ] && grep -q "record long/0*\.\.\.: the path is too long" o_long.txt && [ ! -e long ] &&
+    ok "--record with a path too long: refused (exit 2), nothing made" || { bad "--record too long: exit $st"; head -c 600 o_long.txt >&2; }
 
 # a flight that moves the sun over such a scene: said once
 cat >lamp_flight.json <<'EOF2'
