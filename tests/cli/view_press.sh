@@ -110,4 +110,15 @@ st=$?
 [ $st -eq 0 ] && [ "$(grep -c 'changes nothing' o_lampfl.txt)" -eq 1 ] &&
     grep -q -- "--script lamp_flight.json: the flight's sun: changes nothing: the beams renderer" o_lampfl.txt &&
     ok "a flight's sun on a lamp-only scene: said once (exit $st)" || { bad "a flight's sun on a lamp-only scene (exit $st)"; cat o_lampfl.txt >&2; }
+# ... but not when the flight presses R first (the path renderer, lit by the lamp alone, then the
+# sky renderer, lit by the sun)
+cat >r_flight.json <<'EOF2'
+{"fps": 24, "keys": [{"t": 0, "position_m": [0, 7, 32], "look_at_m": [0, 3, 0], "press": "renderer"},
+                     {"t": 0.05, "position_m": [0, 7, 30], "look_at_m": [0, 3, 0], "sun": {"elevation_deg": 30, "azimuth_deg": 90}}]}
+EOF2
+"$A" view "$S/scenes/dobashi_fig04_spotlight.json" --renderer path --spp 1 --headless --script r_flight.json --size 16x9 \
+    >o_rfl.txt 2>&1
+st=$?
+[ $st -eq 0 ] && ! grep -q 'changes nothing' o_rfl.txt && ok "a flight's sun after its R key: not said (exit $st)" ||
+    { bad "a flight's sun after its R key (exit $st)"; cat o_rfl.txt >&2; }
 exit $fail
