@@ -160,6 +160,13 @@ ATMOS_API atmos_status atmos_read_jpeg_scaled(atmos_context *ctx, const char *pa
 ATMOS_API atmos_status atmos_write_pfm(atmos_context *ctx, const atmos_image *img, const char *path);
 ATMOS_API atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **out);
 
+/* An image's format by its first n bytes: "OpenEXR" (76 2F 31 01), "PNG" (its 8-byte
+ * signature), "JPEG" (FF D8 FF) or "PFM" ("PF" or "Pf" and a space, tab, CR or LF, as
+ * atmos_read_pfm takes it), else NULL. atmos_image_file_kind: the same for a file's first 8
+ * bytes (NULL also when it cannot be read). */
+ATMOS_API const char *atmos_image_kind(const void *bytes, size_t n);
+ATMOS_API const char *atmos_image_file_kind(const char *path);
+
 /* Error statistics of an image against a reference (same size and colour channels;
  * the 4th channel of RGBA images is coverage and is ignored). rmse, rel_rmse (RMSE over
  * the reference's mean absolute value) and bias (mean of image - reference) per channel

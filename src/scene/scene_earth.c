@@ -40,8 +40,8 @@ static atmos_status read_map(atmos_context *ctx, const char *path, int reduce, a
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
     const size_t n = fread(m, 1, sizeof m, f);
     fclose(f);
-    const int jpeg = n >= 3 && m[0] == 0xFF && m[1] == 0xD8 && m[2] == 0xFF;
-    const int png = n == 8 && !memcmp(m, "\x89PNG\r\n\x1a\n", 8);
+    const char *kind = atmos_image_kind(m, n);
+    const int jpeg = kind && !strcmp(kind, "JPEG"), png = kind && !strcmp(kind, "PNG");
     if (!jpeg && !png)
         return atmos__error(ctx, ATMOS_E_FORMAT,
                             "%s is not an image atmos reads: the Earth's maps are PNG or JPEG files "

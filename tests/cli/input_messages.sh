@@ -54,8 +54,20 @@ for img in img.exr img.png; do
     st=$?
     [ $st -eq 2 ] && [ ! -e "$T/as_scene.png" ] && ok "$img as the scene refused (exit 2)" || bad "$img as the scene: exit $st"
     has "$img as the scene" "image, not a scene"
+    [ "$img" = img.exr ] && has "$img as the scene" "is an OpenEXR image"
 done
 has "img.png as the scene" "is a PNG image"
+# PFM files with each header the PFM reader takes (LF, CRLF, a space after the magic)
+printf 'PF\n1 1\n-1\n\0\0\0\0\0\0\0\0\0\0\0\0' >"$T/lf.pfm"
+printf 'PF\r\n1 1\r\n-1\n\0\0\0\0\0\0\0\0\0\0\0\0' >"$T/crlf.pfm"
+printf 'Pf 1 1 -1\n\0\0\0\0' >"$T/sp.pfm"
+for img in lf.pfm crlf.pfm sp.pfm; do
+    "$A" compare "$T/$img" "$T/$img" >/dev/null 2>"$T/err" || { bad "$img: not a PFM the reader takes"; cat "$T/err" >&2; }
+    "$A" render "$T/$img" -o "$T/as_scene.png" >/dev/null 2>"$T/err"
+    st=$?
+    [ $st -eq 2 ] && [ ! -e "$T/as_scene.png" ] && ok "$img as the scene refused (exit 2)" || bad "$img as the scene: exit $st"
+    has "$img as the scene" "is a PFM image, not a scene"
+done
 
 # --- -D volume.* with --volume FILE
 "$A" volume generate cumulus -o "$T/v.json" --voxel-size 200 >/dev/null 2>&1 || bad "volume generate"

@@ -158,4 +158,18 @@ if [ -f "$T/in_001.json" ] && [ -f "$T/in_001.exr" ]; then
 else
     bad "inside a cumulus: F12 saved no EXR and JSON"
 fi
+
+# a sun key after R, in a window (where --press only queues the keys): judged by the renderer R
+# gives, not the one at the start (the spotlight scene without a volume: the path renderer, lit
+# by its lamp without the sun, then R: the sky renderer, lit by the sun); before R it is said
+S="$ATMOS_SOURCE_DIR/scenes/dobashi_fig04_spotlight.json"
+for keys in R,sun_up sun_up,R; do
+    ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+    xvfb-run -a "$A" view "$S" --renderer path --spp 1 --frames 2 --size 16x9 --press "$keys" >"$T/rk.txt" 2>&1 ||
+        { bad "--press $keys in a window: exit $?"; cat "$T/rk.txt" >&2; }
+    n=$(grep -c -- "--press sun_up: changes nothing: the path renderer" "$T/rk.txt")
+    [ "$keys" = R,sun_up ] && want=0 || want=1
+    [ "$n" -eq "$want" ] && ok "--press $keys in a window: 'changes nothing' said $want time(s)" ||
+        { bad "--press $keys in a window: 'changes nothing' said $n times"; cat "$T/rk.txt" >&2; }
+done
 exit $fail

@@ -90,6 +90,14 @@ done
 st=$?
 [ $st -eq 1 ] && grep -q "record /proc/no/rec/frames.csv: cannot create the folder /proc/no" o_rec.txt &&
     ok "--record in a folder that cannot be made: said (exit 1)" || { bad "--record /proc/no/rec: exit $st"; cat o_rec.txt >&2; }
+# a --record path too long for its frames' names: refused (exit 2), no folder made (it used to be
+# cut short, and a folder other than the one named made)
+long=long; for i in 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16; do long="$long/$(printf '%0250d' "$i")"; done
+long="$long/$(printf '%060d' 17)" # 4081 bytes: its frame_00000.png 4097
+"$A" view --headless --frames 2 --size 16x9 --record "$long" >o_long.txt 2>&1
+st=$?
+[ $st -eq 2 ] && grep -q "record long/0*\.\.\.: the path is too long" o_long.txt && [ ! -e long ] &&
+    ok "--record with a path too long: refused (exit 2), nothing made" || { bad "--record too long: exit $st"; head -c 600 o_long.txt >&2; }
 
 # a flight that moves the sun over such a scene: said once
 cat >lamp_flight.json <<'EOF2'
@@ -102,4 +110,15 @@ st=$?
 [ $st -eq 0 ] && [ "$(grep -c 'changes nothing' o_lampfl.txt)" -eq 1 ] &&
     grep -q -- "--script lamp_flight.json: the flight's sun: changes nothing: the beams renderer" o_lampfl.txt &&
     ok "a flight's sun on a lamp-only scene: said once (exit $st)" || { bad "a flight's sun on a lamp-only scene (exit $st)"; cat o_lampfl.txt >&2; }
+# ... but not when the flight presses R first (the path renderer, lit by the lamp alone, then the
+# sky renderer, lit by the sun)
+cat >r_flight.json <<'EOF2'
+{"fps": 24, "keys": [{"t": 0, "position_m": [0, 7, 32], "look_at_m": [0, 3, 0], "press": "renderer"},
+                     {"t": 0.05, "position_m": [0, 7, 30], "look_at_m": [0, 3, 0], "sun": {"elevation_deg": 30, "azimuth_deg": 90}}]}
+EOF2
+"$A" view "$S/scenes/dobashi_fig04_spotlight.json" --renderer path --spp 1 --headless --script r_flight.json --size 16x9 \
+    >o_rfl.txt 2>&1
+st=$?
+[ $st -eq 0 ] && ! grep -q 'changes nothing' o_rfl.txt && ok "a flight's sun after its R key: not said (exit $st)" ||
+    { bad "a flight's sun after its R key (exit $st)"; cat o_rfl.txt >&2; }
 exit $fail

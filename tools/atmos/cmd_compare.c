@@ -71,14 +71,8 @@ static atmos_status read_hdr(atmos_context *ctx, const char *path, named_image *
 /* An 8-bit image given where an HDR one goes: "PNG" or "JPEG" by its first bytes, else NULL. */
 static const char *ldr_kind(const char *path)
 {
-    unsigned char b[4] = {0};
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    size_t n = fread(b, 1, sizeof b, f);
-    fclose(f);
-    if (n == 4 && !memcmp(b, "\x89PNG", 4)) return "PNG";
-    if (n >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff) return "JPEG";
-    return NULL;
+    const char *kind = atmos_image_file_kind(path);
+    return kind && (!strcmp(kind, "PNG") || !strcmp(kind, "JPEG")) ? kind : NULL;
 }
 
 /* JSON has no NaN or infinity: such numbers are null. */

@@ -102,22 +102,12 @@ static int refuse_volume_file(const render_opts *o)
 static int refuse_image_file(const render_opts *o)
 {
     const char *p = o->scene_path;
-    if (!strcmp(p, "-")) return 0;
-    unsigned char b[8] = {0};
-    FILE *f = fopen(p, "rb");
-    if (!f) return 0;
-    const size_t n = fread(b, 1, sizeof b, f);
-    fclose(f);
-    const char *kind = n >= 4 && !memcmp(b, "\x76\x2f\x31\x01", 4)                   ? "an OpenEXR image"
-                       : n == 8 && !memcmp(b, "\x89PNG\r\n\x1a\n", 8)                 ? "a PNG image"
-                       : n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF          ? "a JPEG image"
-                       : n >= 3 && b[0] == 'P' && (b[1] == 'F' || b[1] == 'f') && b[2] == '\n' ? "a PFM image"
-                                                                                         : NULL;
+    const char *kind = strcmp(p, "-") ? atmos_image_file_kind(p) : NULL;
     if (!kind) return 0;
     fprintf(stderr,
-            "atmos %s: %s is %s, not a scene: a scene is a JSON file (docs/scene-format.md), which names the "
-            "images it uses; atmos compare reads rendered images\n",
-            o->cmd, p, kind);
+            "atmos %s: %s is %s %s image, not a scene: a scene is a JSON file (docs/scene-format.md), which names "
+            "the images it uses; atmos compare reads rendered images\n",
+            o->cmd, p, kind[0] == 'O' ? "an" : "a", kind);
     return 1;
 }
 

@@ -64,6 +64,9 @@ void view_state_apply(view_state *s, view_action a, double dt, int fast, int slo
  * and released at once does in the window; headless --press acts so on the state). */
 #define VIEW_TAP_S (1.0 / 30.0)
 void view_state_tap(view_state *s, view_action a);
+/* The renderer key R gives after r: slice -> harris -> nishita -> path -> sky -> slice with a
+ * volume; without one, sky after path and r unchanged otherwise. */
+atmos_renderer_kind view_next_renderer(atmos_renderer_kind r, int has_volume);
 /* Mouse motion of (dx, dy) pixels: turns the view (or, orbiting, moves about the target). */
 void view_state_look(view_state *s, double dx, double dy);
 /* Scroll: the field of view narrows (clicks > 0) or widens. */

@@ -330,11 +330,13 @@ static void say_sunless(const char *what, const atmos_scene *sc, atmos_renderer_
 }
 
 /* A flight's sun (key frames that set it, sun or clock keys pressed) on such a scene: said
- * once (a pressed key by its key frame). */
+ * once (a pressed key by its key frame). Up to its first renderer key only: after it another
+ * renderer lights the scene. */
 static void flight_sunless(const view_script *script, const char *path, const atmos_scene *sc, atmos_renderer_kind r)
 {
     for (int i = 0; script && i < script->n && cli_lit_without_sun(sc, r); i++) {
         const view_action a = script->k[i].press;
+        if (a == VA_RENDERER) return;
         if (script->k[i].has_sun || (a >= VA_SUN_UP && a <= VA_TIME_FORWARD)) {
             char what[ATMOS_SCENE_PATH_MAX + 64];
             if (script->k[i].has_sun) snprintf(what, sizeof what, "--script %s: the flight's sun", path);
@@ -364,17 +366,20 @@ static int start(loop *L, const view_opts *o, view_state *s, const view_script *
 /* --press's keys: through the window's event queue, as a user's; headless, tapped on the state
  * (view_state_tap: what the window does with a key pressed and released at once). A key that
  * moves the sun or the clock where the renderer lights the scene by its lamps only is said to
- * change nothing, and why, rather than taken in silence. */
+ * change nothing, and why, rather than taken in silence: judged by the renderer the keys
+ * before it give (in a window they are only queued here). */
 static void press(view_window *win, view_state *s, const atmos_scene *sc, const char *keys)
 {
     int codes[16];
     const int n = view_key_codes(keys, codes, 16);
+    atmos_renderer_kind r = s->renderer;
     for (int k = 0; k < n; k++) {
         const view_action a = view_key_action(codes[k]);
-        if (a >= VA_SUN_UP && a <= VA_TIME_FORWARD && cli_lit_without_sun(sc, s->renderer)) {
+        if (a == VA_RENDERER) r = view_next_renderer(r, s->has_volume);
+        if (a >= VA_SUN_UP && a <= VA_TIME_FORWARD && cli_lit_without_sun(sc, r)) {
             char what[64];
             snprintf(what, sizeof what, "--press %s", view_action_name(a));
-            say_sunless(what, sc, s->renderer);
+            say_sunless(what, sc, r);
         }
         if (win) view_window_push_key(win, codes[k]);
         else view_state_tap(s, a);

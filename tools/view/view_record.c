@@ -37,7 +37,13 @@ int view_record_open(view_recorder *r, const char *dir)
     if (!dir) return CLI_EXIT_OK;
     r->dir = dir;
     struct stat st;
-    char csv[4096];
+    char csv[CLI_OUTPUT_PATH_MAX];
+    /* room for the longest name written into it (frame_NNNNN.png, its frame number any int):
+     * a longer path would be cut, and another folder than DIR made */
+    if (strlen(dir) + sizeof "/frame_2147483647.png" > sizeof csv) {
+        fprintf(stderr, "atmos view: --record %.40s...: the path is too long\n", dir);
+        return CLI_EXIT_USAGE;
+    }
     snprintf(csv, sizeof csv, "%s/frames.csv", dir);
     /* the folder made with its missing parents, as atmos render's outputs' (a file of that
      * name: said below) */
@@ -61,7 +67,7 @@ int view_record_open(view_recorder *r, const char *dir)
  * no header-only file behind). */
 static int open_csv(view_recorder *r)
 {
-    char path[4096];
+    char path[CLI_OUTPUT_PATH_MAX];
     snprintf(path, sizeof path, "%s/frames.csv", r->dir);
     if (!(r->csv = fopen(path, "w"))) {
         fprintf(stderr, "atmos view: --record: cannot write %s: %s\n", path, strerror(errno));
@@ -77,7 +83,7 @@ int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *d
 {
     if (!r->dir) return CLI_EXIT_OK;
     if (!r->csv && open_csv(r) != CLI_EXIT_OK) return CLI_EXIT_RUNTIME;
-    char path[4096];
+    char path[CLI_OUTPUT_PATH_MAX];
     snprintf(path, sizeof path, "%s/frame_%05d.png", r->dir, r->frames);
     /* zlib's fastest level: at the default, writing a 1280 x 720 frame took more CPU than
      * rendering it */

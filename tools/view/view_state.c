@@ -174,6 +174,17 @@ static void add_minutes(view_state *s, double minutes)
     s->changes |= VIEW_CHANGED_SUN;
 }
 
+atmos_renderer_kind view_next_renderer(atmos_renderer_kind r, int has_volume)
+{
+    /* slice -> harris -> nishita -> path -> sky -> slice with a volume; sky alone without */
+    const atmos_renderer_kind next = r == ATMOS_RENDERER_SLICE     ? ATMOS_RENDERER_HARRIS
+                                     : r == ATMOS_RENDERER_HARRIS  ? ATMOS_RENDERER_NISHITA
+                                     : r == ATMOS_RENDERER_NISHITA ? ATMOS_RENDERER_PATH
+                                     : r == ATMOS_RENDERER_PATH    ? ATMOS_RENDERER_SKY
+                                                                   : ATMOS_RENDERER_SLICE;
+    return has_volume || next == ATMOS_RENDERER_SKY ? next : r;
+}
+
 void view_state_apply(view_state *s, view_action a, double dt, int fast, int slow)
 {
     const double mult = fast ? 10.0 : (slow ? 0.1 : 1.0);
@@ -200,17 +211,10 @@ void view_state_apply(view_state *s, view_action a, double dt, int fast, int slo
     case VA_EXPOSURE_UP: s->ev += s->manual_exposure ? -0.5 : 0.5; s->changes |= VIEW_CHANGED_LOOK; break;
     case VA_EXPOSURE_DOWN: s->ev -= s->manual_exposure ? -0.5 : 0.5; s->changes |= VIEW_CHANGED_LOOK; break;
     case VA_ORBIT: s->orbit = !s->orbit; break;
-    case VA_RENDERER: {
-        /* slice -> harris -> nishita -> path -> sky -> slice with a volume; sky alone without */
-        const atmos_renderer_kind next = s->renderer == ATMOS_RENDERER_SLICE     ? ATMOS_RENDERER_HARRIS
-                                         : s->renderer == ATMOS_RENDERER_HARRIS  ? ATMOS_RENDERER_NISHITA
-                                         : s->renderer == ATMOS_RENDERER_NISHITA ? ATMOS_RENDERER_PATH
-                                         : s->renderer == ATMOS_RENDERER_PATH   ? ATMOS_RENDERER_SKY
-                                                                                : ATMOS_RENDERER_SLICE;
-        if (s->has_volume || next == ATMOS_RENDERER_SKY) s->renderer = s->has_volume ? next : ATMOS_RENDERER_SKY;
+    case VA_RENDERER:
+        s->renderer = view_next_renderer(s->renderer, s->has_volume);
         s->changes |= VIEW_CHANGED_PLAN;
         break;
-    }
     case VA_SPECTRAL: s->spectral = !s->spectral; s->changes |= VIEW_CHANGED_PLAN; break;
     case VA_OVERLAY: s->overlay = !s->overlay; s->changes |= VIEW_CHANGED_LOOK; break;
     case VA_SAVE: s->save = 1; break;
