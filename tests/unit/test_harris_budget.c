@@ -4,7 +4,7 @@
  * not seen yet), the out-of-date ones are drawn as they were; the next frames make both in
  * full. Once caught up, the image is the same, byte for byte, as that of a plan that made them
  * all at once (those one a thread, a frame's two one after the other, each on both threads),
- * and as that of the same frames on one thread. A frame's full makes also keep within the
+ * and as that of the same frames on one thread. A frame's remakes also keep within the
  * budget's units of texels: through a narrow lens, fewer than 2 a frame. */
 #include "atmos/atmos.h"
 #include "test.h"
@@ -117,9 +117,10 @@ int main(void)
     const int differ = memcmp(b->pixels, c->pixels, sizeof(float) * (size_t)W * H * (size_t)b->channels) != 0;
     printf("one thread against two, budget 2, 60 m east: %s\n", differ ? "differ" : "the same bytes");
     CHECK(!differ);
-    /* through a 4 degree lens the clouds ahead need up to their particles' texels: a frame's full
-     * makes keep within 2 units of 32 x 32 texels (the first always), so the budget of 2 takes
-     * more frames than 2 a frame would, and ends at the same image */
+    /* through a 4 degree lens the clouds ahead need up to their particles' texels: a frame's
+     * remakes keep within 2 units of 32 x 32 texels (a larger one alone, at twice the tolerance
+     * or when nothing else is left), so the budget of 2 takes more frames than 2 a frame would,
+     * and ends at the same image */
     fov = 4;
     const int tele = render(all, 60, 0, a);
     sum = catch_up(held, 60, b, &frames);
