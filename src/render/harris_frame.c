@@ -259,8 +259,12 @@ static int needed_res(const atmos_plan *p, const atmos__harris_plan *h, int k, c
  * screen first; then those out of date by the most pixels (the error over the tolerance times
  * the texels the view needs); B in all are made. The out-of-date ones left are drawn as they
  * are (how 3), the never-made ones left are made at a quarter of their resolution (a coarse
- * stand-in, out of date by its texels, so a later frame makes it in full). Reorders stale: the
- * full makes first; returns their count, the coarse ones after them (*ncoarse). */
+ * stand-in, out of date by its texels, so a later frame makes it in full). The out-of-date
+ * ones also keep within B units of (max(H / 8, 32))^2 texels (H: the frame's height), the full
+ * makes before them counted: one that would pass it is held unless nothing was taken yet and
+ * it is out of date by twice the tolerance, or nothing else is made (a still view catches up).
+ * So a large impostor is made again less often and alone. Reorders stale: the full makes
+ * first; returns their count, the coarse ones after them (*ncoarse). */
 static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how, int *stale,
                           int n, atmos__keyed *key, int *ncoarse)
 {
@@ -280,12 +284,20 @@ static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmo
     }
     atmos__keyed_sort(first, (size_t)nfirst, 1);
     atmos__keyed_sort(key, (size_t)m, 1);
-    int taken = 0; /* never-made ones made in full: the first of first[] */
-    for (; taken < nfirst && kept < v->impostor_budget; taken++) stale[kept++] = first[taken].index;
+    const double side = fmax(v->cam.height / 8.0, 32.0), cap = v->impostor_budget * side * side;
+    double texels = 0;
+    int taken = 0; /* never-made ones made in full: the first of first[] (their texels counted) */
+    for (; taken < nfirst && kept < v->impostor_budget; taken++)
+        stale[kept++] = first[taken].index, texels += first[taken].key * first[taken].key;
     for (int q = 0; q < m; q++) {
-        if (kept < v->impostor_budget) stale[kept++] = key[q].index;
+        const int res = needed_res(p, h, key[q].index / 3, e, f);
+        const double t = (double)res * res, late = key[q].key / res; /* its error over the tolerance */
+        if (kept < v->impostor_budget && ((kept == 0 && late >= 2) || texels + t <= cap))
+            stale[kept++] = key[q].index, texels += t;
         else how[key[q].index / 3] = 3, h->held++;
     }
+    if (kept == 0 && m > 0) /* nothing else to make: the most out of date, so a still view catches up */
+        stale[kept++] = key[0].index, how[key[0].index / 3] = 4, h->held--;
     for (int q = taken; q < nfirst; q++) stale[kept + q - taken] = first[q].index; /* the coarse ones */
     *ncoarse = nfirst - taken;
     return kept;
