@@ -80,7 +80,8 @@ if command -v script >/dev/null 2>&1; then
 import sys
 d = open(sys.argv[1], "rb").read()
 i = d.find(b"atmos render: interrupted")
-sys.exit(0 if i > 0 and d[i - 1:i] == b"\n" and b"ETA" in d[:i] else 1)
+# (timeout signals the process, then its group: two threads' handlers once wrote "atmos atmos")
+sys.exit(0 if i > 0 and d[i - 1:i] == b"\n" and b"ETA" in d[:i] and d.count(b"interrupted") == 1 else 1)
 PY
 else
     echo "skip: script(1) not installed"

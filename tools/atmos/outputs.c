@@ -83,26 +83,33 @@ static volatile sig_atomic_t deferred;    /* the signal that came meanwhile (any
 
 void cli_outputs_line_open(int open) { line_open = open; }
 
-static void put(const char *s) { (void)!write(2, s, strlen(s)); }
+/* s appended to the buffer b of n bytes at *len, cut at its end (async-signal-safe) */
+static void put(char *b, size_t n, size_t *len, const char *s)
+{
+    while (*s && *len + 1 < n) b[(*len)++] = *s++;
+}
 
-/* "interrupted" on a line of its own (async-signal-safe: write, strlen, no stdio) */
+/* "interrupted" on a line of its own, in one write (async-signal-safe: no stdio) */
 static void say_interrupted(void)
 {
-    if (line_open) put("\n");
-    put("atmos ");
-    put(signal_cmd);
-    put(": interrupted");
+    char b[512];
+    size_t n = 0;
+    if (line_open) put(b, sizeof b, &n, "\n");
+    put(b, sizeof b, &n, "atmos ");
+    put(b, sizeof b, &n, signal_cmd);
+    put(b, sizeof b, &n, ": interrupted");
     if (animation) {
         char num[24], *q = num + sizeof num;
         unsigned v = (unsigned)frames_held;
         *--q = '\0';
         do *--q = (char)('0' + v % 10); while ((v /= 10) && q > num);
-        put(": no frame written (");
-        put(q);
-        put(frames_held == 1 ? " finished frame discarded" : " finished frames discarded");
-        put(": an animation's frames are moved into place together, after the last one)");
+        put(b, sizeof b, &n, ": no frame written (");
+        put(b, sizeof b, &n, q);
+        put(b, sizeof b, &n, frames_held == 1 ? " finished frame discarded" : " finished frames discarded");
+        put(b, sizeof b, &n, ": an animation's frames are moved into place together, after the last one)");
     }
-    put("\n");
+    put(b, sizeof b, &n, "\n");
+    (void)!write(2, b, n);
 }
 
 /* The folders this run made, removed where still empty (rmdir fails otherwise: kept); safe in
@@ -118,6 +125,10 @@ static void on_signal(int sig)
         deferred = sig;
         return;
     }
+    /* timeout(1) signals the process and then its group: the same signal may come twice, to
+     * two threads at once; the first handler cleans up, says so and ends the process */
+    static atomic_flag handling = ATOMIC_FLAG_INIT;
+    if (atomic_flag_test_and_set(&handling)) return;
     for (int i = 0; i < SLOTS; i++)
         if (slot_used[i]) unlink(slot_name[i]);
     for (int i = 0; i < held_n; i++) unlink(held[i].stage);
