@@ -76,4 +76,14 @@ printf '\211PNG\r\n\032\n\000\000\000\rIHDR' >pic.obj
 "$A" render s.json -D objects.0.mesh=pic.obj -o x.png -q 2>err13
 check "a PNG given as a mesh" err13 "/objects/0/mesh" "not an OBJ file" "PNG"
 grep -q "no triangles" err13 && bad "a PNG spoken of as a mesh without triangles: $(cat err13)"
+# a bad terrain set by -D is the define's, not the scene file's; one the file sets is the file's
+printf 'garbage' >bad.png
+"$A" render s.json -D objects.1.terrain=bad.png -o x.png -q 2>errd1
+check "a bad terrain set by -D" errd1 "/objects/1/terrain" "(set by -D objects.1.terrain=" "not by the scene file"
+"$A" render s.json -D '/objects/1={"terrain": "bad.png", "size_m": 60, "height_m": 3}' -o x.png -q 2>errd2
+check "a bad terrain in an object set by -D" errd2 "/objects/1/terrain" "(set by -D /objects/1={"
+mesh_scene ok.obj bad.png >sbad.json
+"$A" render sbad.json -D objects.1.albedo=0.3 -o x.png -q 2>errd3
+check "a bad terrain in the scene file, -D elsewhere" errd3 "/objects/1/terrain"
+grep -q "set by -D" errd3 && bad "the scene file's bad terrain blamed on a -D: $(cat errd3)" || ok "the scene file's terrain not blamed on -D"
 exit $fail

@@ -496,7 +496,11 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         if (d->size > 1) fprintf(stderr, "atmos render: rank %d of %d:\n", d->rank, d->size);
         if (nframes > 1 && failed >= 1) fprintf(stderr, "atmos render: frame %d/%d failed\n", failed, nframes);
         if (st == ATMOS_E_IO && !atmos_context_error(ctx)[0]) rc = CLI_EXIT_RUNTIME; /* an output's message printed */
-        else rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
+        else {
+            const char *def = o->scene_path ? render_scene_define_in(o, atmos_context_error(ctx)) : NULL;
+            rc = st == ATMOS_E_INVALID_ARG && !atmos_context_error(ctx)[0] ? CLI_EXIT_USAGE : cli_runtime_error("render", ctx, st);
+            if (def) fprintf(stderr, "  (set by -D %s, not by the scene file)\n", def);
+        }
     } else if (st == ATMOS_E_CANCELLED)
         rc = CLI_EXIT_RUNTIME; /* another rank failed and said why */
     atmos_plan_destroy(plan);

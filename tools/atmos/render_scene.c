@@ -170,6 +170,24 @@ static void quoted_define(char *buf, size_t cap, const char *key, size_t klen, c
     snprintf(buf + k, cap - k, "\"");
 }
 
+/* The -D whose key (a.b.0 or /a/b/0) is, or holds, the JSON pointer after the scene file's name
+ * in msg ("scene.json: /objects/0/terrain: ..."): the error is the define's, not the file's. */
+const char *render_scene_define_in(const render_opts *o, const char *msg)
+{
+    for (int i = 0; i < o->ndefines; i++) {
+        const char *d = o->defines[i], *eq = strchr(d, '=');
+        char ptr[256];
+        size_t n = 0;
+        if (!eq || eq == d) continue;
+        if (d[0] != '/') ptr[n++] = '/';
+        for (const char *c = d; c < eq && n + 1 < sizeof ptr; c++) ptr[n++] = *c == '.' ? '/' : *c;
+        ptr[n] = '\0';
+        for (const char *at = strstr(msg, ptr); at; at = strstr(at + 1, ptr))
+            if (at - msg >= 2 && at[-2] == ':' && at[-1] == ' ' && (at[n] == ':' || at[n] == '/')) return d;
+    }
+    return NULL;
+}
+
 /* A -D that sets a file (volume.file, a light's image, an object's mesh or terrain, the Earth's
  * maps; or such a key inside an object it sets: -D 'volume={"file": ...}') to a relative path
  * names it from the current folder, as a path typed on the command
@@ -313,7 +331,13 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         } else {
             st = atmos_scene_load_with(ctx, o->scene_path, defs, ndefs, scene);
         }
-        if (st != ATMOS_OK) return cli_runtime_error(o->cmd, ctx, st);
+        if (st != ATMOS_OK) {
+            const char *msg = atmos_context_error(ctx);
+            const char *def = o->scene_path ? render_scene_define_in(o, msg) : NULL;
+            const int rc = cli_runtime_error(o->cmd, ctx, st);
+            if (def) fprintf(stderr, "  (set by -D %s, not by the scene file)\n", def);
+            return rc;
+        }
     } else if (ndefs) {
         /* the built-in default scene is the parse of an empty one */
         if ((st = atmos_scene_parse_with(ctx, "{}", 2, "-D", defs, ndefs, scene)) != ATMOS_OK) {
