@@ -126,12 +126,11 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     return ATMOS_OK;
 }
 
-/* H at depth z and texel coordinates (fx, fy) of face F: the four nearest comparisons, blended. */
-static inline double texels(const atmos__beams_face *F, double fx, double fy, double z)
+/* texels() at coordinates inside the map (fx, fy in (-1, n)). */
+static inline double texels_in(const atmos__beams_face *F, double fx, double fy, double z)
 {
     if (z <= NEAR_M) return 1;
     const int n = F->n;
-    if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
     const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1; /* floor: fx, fy > -1 */
     const int tile = atmos__beams_tiles_at(&F->tiles, x0, y0, ATMOS__BEAMS_LIGHT_TILE_SHIFT);
     if (z < F->tiles.min[tile]) return 1;
@@ -142,6 +141,14 @@ static inline double texels(const atmos__beams_face *F, double fx, double fy, do
     const float *ra = F->depth + (size_t)ya * n, *rb = F->depth + (size_t)yb * n;
     const double top = (1 - ax) * (z < ra[xa]) + ax * (z < ra[xb]), bottom = (1 - ax) * (z < rb[xa]) + ax * (z < rb[xb]);
     return (1 - ay) * top + ay * bottom;
+}
+
+/* H at depth z and texel coordinates (fx, fy) of face F: the four nearest comparisons, blended. */
+static inline double texels(const atmos__beams_face *F, double fx, double fy, double z)
+{
+    const int n = F->n;
+    if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
+    return texels_in(F, fx, fy, z);
 }
 
 /* H at the point (x, y, z) of face F's frame. */
@@ -175,11 +182,20 @@ void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const
     for (int a = 0; a < 3; a++) r->w0[a] = o[a] - l->L.pos[a], r->d[a] = d[a];
     r->ww0 = atmos__dot3(r->w0, r->w0), r->wd = atmos__dot3(r->w0, d);
     r->a0 = atmos__dot3(r->w0, l->L.axis), r->a1 = atmos__dot3(d, l->L.axis);
-    for (int f = 0; f < l->nfaces; f++) {
+    /* a cube's faces 2a and 2a + 1 look along +-axis a: the odd one's right and fwd are the even
+     * one's negated, its up the same (set_face: the cross products' signs flip exactly), so its
+     * coordinates are the even one's with two signs flipped, the same bits */
+    const int cube = l->nfaces == 6;
+    for (int f = 0; f < l->nfaces; f += 1 + cube) {
         const atmos__beams_face *F = &l->face[f];
         r->f0[f][0] = atmos__dot3(r->w0, F->right), r->f1[f][0] = atmos__dot3(d, F->right);
         r->f0[f][1] = atmos__dot3(r->w0, F->up), r->f1[f][1] = atmos__dot3(d, F->up);
         r->f0[f][2] = atmos__dot3(r->w0, F->fwd), r->f1[f][2] = atmos__dot3(d, F->fwd);
+        if (cube) {
+            r->f0[f + 1][0] = -r->f0[f][0], r->f1[f + 1][0] = -r->f1[f][0];
+            r->f0[f + 1][1] = r->f0[f][1], r->f1[f + 1][1] = r->f1[f][1];
+            r->f0[f + 1][2] = -r->f0[f][2], r->f1[f + 1][2] = -r->f1[f][2];
+        }
     }
 }
 
@@ -350,6 +366,11 @@ static double read_run(const atmos__beams_ray *r, double ta, double step, double
     }
     double fx[RUN_READ], fy[RUN_READ], z[RUN_READ];
     run_texels(r, f, ta, step, o, s0, s1, fx, fy, z);
+    if (l->L.type != ATMOS_LIGHT_SPOT) { /* no falloff: each sample's is 1; the samples in the cube's face f
+                                           * (its pyramid), at most half a texel past its edge by rounding */
+        for (int s = s0; s < s1; s++) h += texels_in(&l->face[f], fx[s - s0], fy[s - s0], z[s - s0]);
+        return h;
+    }
     for (int s = s0; s < s1; s++) {
         const double fall = atmos__beams_ray_falloff(r, ta + (s + o) * step);
         h += fall == 0 ? 0 : fall * texels(&l->face[f], fx[s - s0], fy[s - s0], z[s - s0]);

@@ -75,7 +75,12 @@ void atmos__beams_tiles_range(const atmos__beams_tiles *t, int x0, int x1, int y
 {
     const int sh = t->shift, tx0 = x0 < 0 ? 0 : x0 >> sh, tx1 = x1 < 0 ? 0 : x1 >> sh, ty0 = y0 < 0 ? 0 : y0 >> sh,
               ty1 = y1 < 0 ? 0 : y1 >> sh;
-    int k = 0; /* the finest level where the tiles' box spans at most 2 x 2 cells */
+    /* the finest level where the tiles' box spans at most 2 x 2 cells: none below the one where
+     * the larger side d (2^(B-1) <= d < 2^B) is halved to 1, since at level k the box spans at
+     * least floor(d / 2^k) + 1 cells */
+    const unsigned d = (unsigned)(tx1 - tx0 > ty1 - ty0 ? tx1 - tx0 : ty1 - ty0);
+    int k = d > 1 ? 31 - __builtin_clz(d) : 0;
+    if (k > t->levels - 1) k = t->levels - 1;
     while (k + 1 < t->levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
     const float *cmin = t->min + t->level_at[k], *cmax = t->max + t->level_at[k];
     const int m = t->level_n[k];

@@ -673,6 +673,88 @@ static void test_runs_across_faces(void)
     atmos_mesh_destroy(mesh);
 }
 
+/* atmos__beams_tiles_range's level found from the box's larger side against the search from level
+ * 0 (the same cells, so the same bounds to the bit), and its bounds holding every texel the box's
+ * tiles cover, on maps of 100 and 512 texels with tiles of 2 x 2 and 8 x 8. */
+static void test_tiles_range(void)
+{
+    const int sizes[2] = {100, 512}, shifts[2] = {1, 3};
+    long boxes = 0, differ = 0, loose = 0;
+    for (int c = 0; c < 4; c++) {
+        const int n = sizes[c / 2], sh = shifts[c % 2];
+        float *depth = malloc(sizeof(float) * (size_t)n * n);
+        if (!depth) continue;
+        for (int i = 0; i < n * n; i++) depth[i] = (float)(1 + (i * 7919 % 1009) + (i / n) % 13);
+        atmos__beams_tiles t;
+        CHECK(atmos__beams_tiles_build(&t, depth, n, sh) == 0);
+        for (int b = 0; b < 4000 && t.min; b++, boxes++) {
+            int x0 = (b * 37) % (n + 1) - 1, x1 = x0 + (b * 13) % (b % 3 ? 9 : n), y0 = (b * 53) % (n + 1) - 1;
+            int y1 = y0 + (b * 29) % (b % 5 ? 40 : n);
+            x1 = x1 > n - 1 ? n - 1 : x1, y1 = y1 > n - 1 ? n - 1 : y1;
+            float lo, hi, rlo = INFINITY, rhi = -INFINITY;
+            atmos__beams_tiles_range(&t, x0, x1, y0, y1, &lo, &hi);
+            const int tx0 = x0 < 0 ? 0 : x0 >> sh, tx1 = x1 < 0 ? 0 : x1 >> sh, ty0 = y0 < 0 ? 0 : y0 >> sh;
+            const int ty1 = y1 < 0 ? 0 : y1 >> sh;
+            int k = 0;
+            while (k + 1 < t.levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
+            for (int ty = ty0 >> k; ty <= ty1 >> k; ty++)
+                for (int tx = tx0 >> k; tx <= tx1 >> k; tx++) {
+                    const size_t i = t.level_at[k] + (size_t)ty * t.level_n[k] + tx;
+                    rlo = fminf(rlo, t.min[i]), rhi = fmaxf(rhi, t.max[i]);
+                }
+            differ += lo != rlo || hi != rhi;
+            for (int y = y0 < 0 ? 0 : y0; y <= y1; y++)
+                for (int x = x0 < 0 ? 0 : x0; x <= x1; x++) loose += depth[(size_t)y * n + x] < lo || depth[(size_t)y * n + x] > hi;
+        }
+        atmos__beams_tiles_free(&t);
+        free(depth);
+    }
+    printf("tiles' ranges: %ld boxes, %ld differ from the search from level 0, %ld texels outside\n", boxes, differ, loose);
+    CHECK(boxes == 16000);
+    CHECK_MSG(differ == 0 && loose == 0, "tiles' ranges: %ld differ, %ld texels outside", differ, loose);
+}
+
+/* A point light's ray in its cube map's six faces (atmos__beams_ray_init: the odd faces from the
+ * even ones, two signs flipped) against each face's own dot products, to the bit. */
+static void test_ray_faces(void)
+{
+    atmos_mesh *mesh = sphere_at(3.5, 6.5);
+    if (!mesh) return;
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_scene s;
+    base_scene(&s, 8, 8);
+    atmos_scene_light sl = s.lights[0];
+    sl.type = ATMOS_LIGHT_POINT, sl.position_m[0] = 0.3, sl.position_m[1] = 10, sl.position_m[2] = -0.7;
+    atmos__beams_light l;
+    memset(&l, 0, sizeof l);
+    atmos__lamp_make(&sl, &wl, &l.L);
+    atmos__beams_progress pr = {0, 6, 0};
+    CHECK_OK(atmos__beams_shadow_build(ctx, &l, &mesh, 1, 64, &pr));
+    CHECK(l.nfaces == 6);
+    int differ = 0;
+    for (int r = 0; r < 50; r++) {
+        double d[3] = {sin(0.7 * r), cos(1.3 * r), 0.2 * r - 5};
+        const double nn = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; a++) d[a] /= nn;
+        const double o[3] = {0.37 * r - 9, 1.1 * (r % 7), 4 - 0.3 * r};
+        atmos__beams_ray ray;
+        atmos__beams_ray_init(&l, o, d, &ray);
+        double w0[3];
+        for (int a = 0; a < 3; a++) w0[a] = o[a] - l.L.pos[a];
+        for (int f = 0; f < l.nfaces; f++) {
+            const double *ax[3] = {l.face[f].right, l.face[f].up, l.face[f].fwd};
+            for (int a = 0; a < 3; a++)
+                differ += ray.f0[f][a] != w0[0] * ax[a][0] + w0[1] * ax[a][1] + w0[2] * ax[a][2] ||
+                          ray.f1[f][a] != d[0] * ax[a][0] + d[1] * ax[a][1] + d[2] * ax[a][2];
+        }
+    }
+    printf("a point light's ray in its six faces: %d of 900 coordinates differ\n", differ);
+    CHECK_MSG(differ == 0, "a point light's ray in its faces: %d coordinates differ", differ);
+    atmos__beams_shadow_free(&l);
+    atmos_mesh_destroy(mesh);
+}
+
 /* Spots seen from several places: every pixel whose ray meets the cone within its reach is lit. */
 static void test_screen_spans(void)
 {
@@ -1172,6 +1254,8 @@ int main(void)
     test_shadow();
     test_light_sum();
     test_runs_across_faces();
+    test_tiles_range();
+    test_ray_faces();
     test_screen_spans();
     test_surface_spans();
     test_surface_closed_form();
