@@ -170,7 +170,10 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     int ex[2];
                     float wx;
                     eye_taps((x + 0.5) / j->sx - 0.5, j->W, ex, &wx);
-                    const float wt[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+                    /* edge_aa outside the edges: eye pixel (2x, 2y) alone, the image pixel's centre ray */
+                    const int one = j->edge && !j->edge[(size_t)y * W + x];
+                    const float vx = one ? 0.0f : wx, vy = one ? 0.0f : wy;
+                    const float wt[4] = {(1 - vx) * (1 - vy), vx * (1 - vy), (1 - vx) * vy, vx * vy};
                     float Lv[ATMOS_MAX_WAVELENGTHS], Tv[ATMOS_MAX_WAVELENGTHS];
                     for (int c = 0; c < j->n; c++) Lv[c] = 0.0f, Tv[c] = 0.0f;
                     int touched = 0;
@@ -190,6 +193,10 @@ void atmos__slice_composite(const sjob *j, const atmos_atmosphere *atm, const at
                     atmos__vol_dir_to_frame(xf, dw, d);
                     const double hd = atmos__dot3(j->h, d);
                     double th = fabs(hd) >= SLICE_HD_EPS ? (hc - j->he) / hd : 0.0;
+                    if (one) { /* as the full-size eye buffer meets the halfway plane */
+                        const float pv = j->pinv[(size_t)ey[0] * j->W + ex[0]];
+                        th = pv != 0.0f ? (hc - j->he) * pv : 0.0;
+                    }
                     const size_t q = (size_t)y * W + x;
                     composite_pixel(atm, ap, cam, dw, th, sun_w, j->n, Lv, Tv, j->air_front ? j->air_front + q * j->n : NULL,
                                     img->pixels + q * C);

@@ -168,6 +168,9 @@ static void job_geometry(const atmos__slice_plan *sp, const atmos__view *v, sjob
             j->sx = (double)cam->width / we, j->sy = (double)cam->height / he;
             j->W = we, j->H = he;
         }
+    } else if (atmos__slice_edge_mode(sp, v)) { /* edge_aa: four rays at the edges (slice_edges.c) */
+        j->W = 2 * cam->width, j->H = 2 * cam->height;
+        j->sx = j->sy = 0.5;
     }
     j->nslices = v->slices > 0 ? v->slices : auto_slices(g, j->h, j->hl, smax - smin, needed);
     j->s0 = smin;
@@ -238,8 +241,13 @@ static void setup_pixels(const atmos__slice_plan *sp, const atmos_atmosphere *at
         for (int x = j->erow[y].x0; x <= j->erow[y].x1; x++) {
             size_t p = (size_t)y * j->W + x;
             for (int c = 0; c < j->n; c++) j->L_eye[c * j->pst + p] = 0.0f, j->T_eye[c * j->pst + p] = 1.0f;
+            /* edge_aa: outside the edges eye pixel (2x, 2y) takes the image pixel's centre ray
+             * and its three neighbours none */
+            double ix = (x + 0.5) * j->sx, iy = (y + 0.5) * j->sy;
+            const int one = j->edge && !j->edge[(size_t)(y >> 1) * cam->width + (x >> 1)];
+            if (one) ix = (x >> 1) + 0.5, iy = (y >> 1) + 0.5;
             double dw[3], d[3];
-            atmos_camera_ray(cam, (x + 0.5) * j->sx, (y + 0.5) * j->sy, dw);
+            atmos_camera_ray(cam, ix, iy, dw);
             atmos__vol_dir_to_frame(&sp->x, dw, d);
             double hd = atmos__dot3(j->h, d);
             j->pk0[p] = 1, j->pk1[p] = 0;
@@ -248,6 +256,7 @@ static void setup_pixels(const atmos__slice_plan *sp, const atmos_atmosphere *at
             for (int a = 0; a < 2; a++) j->pF0[a][p] = j->pdF[a][p] = 0;
             j->pdelta[p] = 0;
             for (int f = 0; f < j->nf; f++) j->pa[p * j->nf + f] = 0, j->pw[p * j->nf + f] = 0;
+            if (one && ((x | y) & 1)) continue;
             double ta, tb;
             int ok = j->btf ? hd <= -SLICE_HD_EPS : hd >= SLICE_HD_EPS;
             if (!ok || !atmos__ray_box(j->eye, d, g->box_lo, g->box_hi, &ta, &tb)) continue;
@@ -372,6 +381,8 @@ atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp,
     atmos__vol_dir_to_frame(&sp->x, v->cam.up, cu);
     if (!atmos__slice_build_spans(j, &v->cam, cf, cr, cu, threads))
         return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the spans");
+    if (atmos__slice_edge_mode(sp, v) && !atmos__slice_edges(sp, atm, v, j, threads))
+        return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the edge pixels");
     if (r->x0 > 0 || r->y0 > 0 || r->x1 < v->cam.width || r->y1 < v->cam.height) {
         int e[4];
         eye_rect(j, r, e);

@@ -83,6 +83,10 @@ typedef struct {
      * ([pixel * n + c], image width; slice_shadow.c), taken from the air in front in the
      * composite; NULL: none (the option off, or no air). */
     const float *air_front;
+    /* edge_aa (slice_edges.c): per image pixel 1 where its four eye rays (the eye buffer twice
+     * the image per axis) are traced and averaged, 0 where one ray through its centre (eye pixel
+     * (2x, 2y)) stands for the four; NULL: every eye pixel is traced */
+    const unsigned char *edge;
 } sjob;
 
 /* The light frame of one sun direction (everything of the light buffer that does not depend
@@ -127,6 +131,9 @@ struct atmos__slice_plan {
     int n, nf, L;
     int low_albedo, eq24, reference;
     float xi;
+    double edge_aa;          /* the transmittance step between neighbours that marks an edge; 0 = off */
+    unsigned char *edge;     /* sjob.edge's storage (grown to the largest image) */
+    size_t edge_cap;
     atmos__vol_xform x;      /* the volume's transform, placed: world = org + R g in the grid frame */
     double prepare_s;        /* building the grid and the tables */
     int slices_used;         /* the last frame's slice count (the rule's when "slices" is 0) */
@@ -177,6 +184,16 @@ atmos_status atmos__slice_air_shadow(atmos_context *ctx, atmos__slice_plan *sp, 
                                      const atmos__view *v, const atmos__rect *r, sjob *j, atmos_image *img,
                                      double *secs);
 void atmos__slice_shadow_free(atmos__slice_plan *sp);
+
+/* edge_aa (slice_edges.c): 1 when the view takes four eye rays at the volume's edges only
+ * (edge_aa > 0 with eye_scale 1: the eye buffer is then twice the image per axis). */
+int atmos__slice_edge_mode(const atmos__slice_plan *sp, const atmos__view *v);
+/* The edge pixels of the view (sets j->edge; sp->edge's storage): a pixel is an edge when the
+ * volume's transmittance along its centre ray, exp(-tau) (tau at the middle wavelength),
+ * differs by more than edge_aa from that of one of its eight neighbours. Depends only on the
+ * view, not on the region rendered or the thread count: called after the spans are built,
+ * before they are clipped to the region (it reads erow). 0 if out of memory. */
+int atmos__slice_edges(atmos__slice_plan *sp, const atmos_atmosphere *atm, const atmos__view *v, sjob *j, int threads);
 
 /* The discrete-ordinates field (slice_do.c): prepare once per plan (after the tables), update
  * per frame (a solve when the sun moved, none while held (hold_field), its view toward the eye;

@@ -17,6 +17,7 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
     atmos__stables_free(&sp->tab);
     free(sp->pixblock), free(sp->spans), free(sp->lk), free(sp->ring), free(sp->I), free(sp->nsc);
     free(sp->light.ta), free(sp->light.tb), free(sp->light.hit), free(sp->light.sl);
+    free(sp->edge);
     atmos__aerial_free(&sp->aerial);
     atmos__dfield_free(&sp->df);
     atmos__slice_do_free(sp);
@@ -63,6 +64,7 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     sp->low_albedo = ss->low_albedo;
     sp->eq24 = ss->eq24;
     sp->xi = (float)ss->xi;
+    sp->edge_aa = ss->edge_aa;
     const atmos_slice_field field = atmos_scene_slice_field(ss); /* "field" (scene_slice_field.c) */
     sp->do_field = field == ATMOS_SLICE_FIELD_DO && !ss->low_albedo;
     sp->diffuse = field == ATMOS_SLICE_FIELD_P1 && !ss->low_albedo;
@@ -102,8 +104,10 @@ void atmos__slice_describe(const atmos_plan *p, const atmos__view *v, char *buf,
     eye_size(v, &w, &h);
     const int slices = v->slices > 0 ? v->slices : p->slice->slices_used;
     const int dof = p->slice->do_field; /* "do": no xi, the delta-M direct beam (slice_do.c) */
-    snprintf(buf, cap, "%d slices%s, light buffer %d, eye buffer %dx%d, xi %g, %s%s", slices,
-             v->slices > 0 ? "" : " (chosen)", ss->light_size, w, h, dof ? 0.0 : ss->xi,
+    const int edges = atmos__slice_edge_mode(p->slice, v);
+    snprintf(buf, cap, "%d slices%s, light buffer %d, eye buffer %dx%d%s, xi %g, %s%s", slices,
+             v->slices > 0 ? "" : " (chosen)", ss->light_size, edges ? 2 * w : w, edges ? 2 * h : h,
+             edges ? " (four rays at the volume's edges, one elsewhere)" : "", dof ? 0.0 : ss->xi,
              dof ? "delta-M beam" : (ss->eq24 ? "eq24" : "eq25"),
              ss->low_albedo ? ", low albedo" : (dof ? "" : (p->slice->diffuse ? ", diffuse field" : "")));
     atmos__slice_do_describe(p->slice, buf, cap);

@@ -37,6 +37,10 @@ static const atmos_setting slice_settings[] = {
      "eye buffer resolution relative to the image, per axis, in (0, 1] or 2 (0.5: a quarter of the "
      "rays, upsampled; 2: four rays per pixel, averaged: antialiased)",
      SLICE(eye_scale)},
+    {"edge_aa", "edge-aa", ATMOS_SETTING_REAL, "", 0, 1, 0, 0, 0, NULL, 0,
+     "with eye scale 1: four rays, averaged, in the pixels whose transmittance through the volume "
+     "differs from a neighbour's by more than this (the silhouette); 0 = off",
+     SLICE(edge_aa)},
     {"max_order", "max-order", ATMOS_SETTING_INT, "", 1, 1000, 0, 0, 64, NULL, 0,
      "orders of Ams tabulated (higher scattering orders use the last)", SLICE(max_order)},
     {"field", "slice-p1", ATMOS_SETTING_CHOICE, "", 0, 0, 0, 0, 0, field_names, ATMOS_SLICE_FIELD_P1,
