@@ -64,7 +64,7 @@ for c in $CASES; do
             diffuse) opts="--slice-p1" ;;
             diffuse_xi0) opts="--slice-p1 --xi 0" ;;
             diffuse_aa) opts="--slice-p1 --eye-scale 2" ;;
-            slice_do) opts="--slice-do" ;;
+            slice_do) opts="--slice-do --edge-aa 0" ;;
             slice_do_aa) opts="--slice-do --eye-scale 2" ;;
             slice_do_edge) opts="--slice-do --edge-aa ${EDGE_AA:-0.05}" ;;
             nishita_do) opts="--renderer nishita --nishita-orders 1 --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do" ;;

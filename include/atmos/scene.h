@@ -90,7 +90,7 @@ typedef struct atmos_scene_slice {
     int low_albedo;           /* 0 */
     int grid_max_dim;         /* 256 */
     double eye_scale;         /* eye buffer resolution relative to the image, per axis, (0, 1] or 2; 1 */
-    double edge_aa;           /* with eye_scale 1: four eye rays in the pixels where the volume's
+    double edge_aa;           /* 0.05; with eye_scale 1: four eye rays in the pixels where the volume's
                                  transmittance differs from a neighbour's by more than this; 0 = off */
     int max_order;            /* Ams orders tabulated; 64 */
     int diffuse;              /* 0: the same as field ATMOS_SLICE_FIELD_NONE (the key kept); 1 (default) */

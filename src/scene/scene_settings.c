@@ -37,7 +37,7 @@ static const atmos_setting slice_settings[] = {
      "eye buffer resolution relative to the image, per axis, in (0, 1] or 2 (0.5: a quarter of the "
      "rays, upsampled; 2: four rays per pixel, averaged: antialiased)",
      SLICE(eye_scale)},
-    {"edge_aa", "edge-aa", ATMOS_SETTING_REAL, "", 0, 1, 0, 0, 0, NULL, 0,
+    {"edge_aa", "edge-aa", ATMOS_SETTING_REAL, "", 0, 1, 0, 0, 0.05, NULL, 0,
      "with eye scale 1: four rays, averaged, in the pixels whose transmittance through the volume "
      "differs from a neighbour's by more than this (the silhouette); 0 = off",
      SLICE(edge_aa)},

@@ -46,7 +46,7 @@ cat >"$T/table" <<'EOF'
 --low-albedo|slice.low_albedo=true|slice|
 --grid-max-dim 8|slice.grid_max_dim=8|slice|
 --eye-scale 0.5|slice.eye_scale=0.5|slice|
---edge-aa 0.05|slice.edge_aa=0.05|slice|
+--edge-aa 0|slice.edge_aa=0|slice|
 --max-order 1|slice.max_order=1|slice|same
 --slice-p1|slice.field=p1|slice|
 --no-diffuse|slice.diffuse=false|slice|

@@ -81,9 +81,12 @@ printf '{"renderer": "nishita", "volume": {"generate": "cumulus"}, "slice": {"do
     { bad "do with xi under nishita refused"; cat "$T/don.txt" >&2; }
 
 # --tau: the optical-depth key image, positive where the cloud is; compare --by splits by it
+# (one eye ray per pixel: with --edge-aa a pixel whose centre ray misses the volume may hold it)
 "$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --eq24 --pfm "$T/eq24.pfm" \
-    --tau "$T/tau.pfm" --threads 2 && ok || bad "render --eq24 --tau"
-"$A" compare "$T/eq24.pfm" "$T/cloud.pfm" --by "$T/tau.pfm" --edges 0,0.001,1,1000 --json > "$T/bins.json" && ok || bad "compare --by"
+    --tau "$T/tau.pfm" --edge-aa 0 --threads 2 && ok || bad "render --eq24 --tau"
+"$A" render -q --width 64 --height 36 --volume generate:cumulus --slices 64 --pfm "$T/cloud0.pfm" --edge-aa 0 \
+    --threads 2 && ok || bad "render --edge-aa 0"
+"$A" compare "$T/eq24.pfm" "$T/cloud0.pfm" --by "$T/tau.pfm" --edges 0,0.001,1,1000 --json > "$T/bins.json" && ok || bad "compare --by"
 python3 - "$T/bins.json" "$T/tau.pfm" <<'PY' && ok || bad "tau image / bins check"
 import json, sys, pfm
 j = json.load(open(sys.argv[1]))

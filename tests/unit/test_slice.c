@@ -83,6 +83,7 @@ typedef struct {
     const atmos_volume_optics *optics;
     int slices, light_size, eq24, low_albedo, reference, diffuse;
     double xi, density_scale, eye_scale;
+    double edge_aa; /* these tests take one eye ray per pixel unless this is set */
 } sopts;
 
 static atmos_status render_st(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *v, const sopts *o,
@@ -104,6 +105,7 @@ static atmos_status render_st(atmos_context *ctx, const atmos_scene *scene, cons
         s.slice.field = o->diffuse ? ATMOS_SLICE_FIELD_P1 : ATMOS_SLICE_FIELD_NONE;
         if (o->density_scale != 0) s.volume.density_scale = o->density_scale;
         if (o->eye_scale != 0) s.slice.eye_scale = o->eye_scale;
+        s.slice.edge_aa = o->edge_aa;
     }
     return atmos_render_slice(ctx, &s, v, &ss, img, NULL);
 }
