@@ -238,6 +238,60 @@ static void draw_wide(const sp *q, int nw, const atmos_camera *cam, int tx, int 
         }
 }
 
+/* The splats' order cut into this many pieces for binning them on the threads. */
+#define BIN_PIECES 8
+
+/* The tiles (tx0..tx1, ty0..ty1, inclusive) that splat a's box covers. */
+static void tile_range(const sp *a, const int rect[4], int t[4])
+{
+    t[0] = (a->bb[0] - rect[0]) / TILE, t[1] = (a->bb[1] - 1 - rect[0]) / TILE;
+    t[2] = (a->bb[2] - rect[1]) / TILE, t[3] = (a->bb[3] - 1 - rect[1]) / TILE;
+}
+
+/* One pass over the pieces of the order on the threads: each piece counts its splats over each
+ * tile into its row of at (list NULL), or puts them into list from its row's places. */
+static void bin_pass(atmos_context *ctx, const sp *s, const atmos__keyed *ord, int n, const int rect[4], int ntx, int nt,
+                     int *at, int *list)
+{
+#pragma omp parallel for schedule(static, 1) num_threads(atmos__threads(ctx)) if (n >= 4096)
+    for (int c = 0; c < BIN_PIECES; c++) {
+        int *k = at + (size_t)c * nt, t[4];
+        for (int q = (int)((long long)n * c / BIN_PIECES); q < (int)((long long)n * (c + 1) / BIN_PIECES); q++) {
+            tile_range(&s[ord[q].index], rect, t);
+            for (int ty = t[2]; ty <= t[3]; ty++)
+                for (int tx = t[0]; tx <= t[1]; tx++) {
+                    if (list) list[k[ty * ntx + tx]] = ord[q].index;
+                    k[ty * ntx + tx]++;
+                }
+        }
+    }
+}
+
+/* The tile lists: list[cnt[t] .. cnt[t + 1]) the splats over tile t in the order of ord (far to
+ * near). The order is cut into BIN_PIECES pieces, counted and then put in place on the threads,
+ * each piece's entries in a tile's list after those of the pieces before it: the lists of one
+ * pass in order, whatever the threads. Returns the list (NULL: no memory). */
+static int *bin_tiles(atmos_context *ctx, const sp *s, const atmos__keyed *ord, int n, const int rect[4], int ntx,
+                      int nty, int *cnt)
+{
+    const int nt = ntx * nty;
+    int *at = calloc((size_t)BIN_PIECES * nt, sizeof(int)), *list = NULL;
+    if (!at) return NULL;
+    bin_pass(ctx, s, ord, n, rect, ntx, nt, at, NULL);
+    int total = 0; /* each piece's start in each tile's list */
+    for (int t = 0; t < nt; t++) {
+        cnt[t] = total;
+        for (int c = 0; c < BIN_PIECES; c++) {
+            const int m = at[(size_t)c * nt + t];
+            at[(size_t)c * nt + t] = total, total += m;
+        }
+    }
+    cnt[nt] = total;
+    if ((list = malloc(sizeof(int) * (size_t)(total ? total : 1)))) bin_pass(ctx, s, ord, n, rect, ntx, nt, at, list);
+    free(at);
+    return list;
+}
+
 atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, const atmos__poptics *o,
                                  const atmos__plights *L, const int *idx, int nidx, const atmos_camera *cam,
                                  const int rect[4], atmos_image *img, int *drawn)
@@ -263,24 +317,8 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
         if (kept[q]) ord[n].key = s[q].z, ord[n].index = q, n++;
     free(kept), kept = NULL;
     atmos__keyed_sort(ord, (size_t)n, 1);
-    /* tile lists: counts, offsets, then the splats in far-to-near order */
-    for (int q = 0; q < n; q++) {
-        const sp *a = &s[ord[q].index];
-        for (int ty = (a->bb[2] - rect[1]) / TILE; ty <= (a->bb[3] - 1 - rect[1]) / TILE; ty++)
-            for (int tx = (a->bb[0] - rect[0]) / TILE; tx <= (a->bb[1] - 1 - rect[0]) / TILE; tx++) cnt[ty * ntx + tx + 1]++;
-    }
-    for (int t = 0; t < ntx * nty; t++) cnt[t + 1] += cnt[t];
-    int *list = malloc(sizeof(int) * (size_t)(cnt[ntx * nty] ? cnt[ntx * nty] : 1)), *fill = calloc((size_t)ntx * nty, sizeof(int));
-    if (!list || !fill) {
-        free(list), free(fill);
-        goto nomem;
-    }
-    for (int q = 0; q < n; q++) {
-        const sp *a = &s[ord[q].index];
-        for (int ty = (a->bb[2] - rect[1]) / TILE; ty <= (a->bb[3] - 1 - rect[1]) / TILE; ty++)
-            for (int tx = (a->bb[0] - rect[0]) / TILE; tx <= (a->bb[1] - 1 - rect[0]) / TILE; tx++)
-                list[cnt[ty * ntx + tx] + fill[ty * ntx + tx]++] = ord[q].index;
-    }
+    int *list = bin_tiles(ctx, s, ord, n, rect, ntx, nty, cnt);
+    if (!list) goto nomem;
     const int wide = cam->type != ATMOS_CAMERA_PINHOLE;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(atmos__threads(ctx))
     for (int t = 0; t < ntx * nty; t++) {
@@ -292,7 +330,7 @@ atmos_status atmos__pcloud_splat(atmos_context *ctx, const atmos__pcloud *pc, co
             else draw(&s[list[q]], o->nw, cam, tx, ty, img);
         }
     }
-    free(list), free(fill), free(s), free(ord), free(cnt), free(pool);
+    free(list), free(s), free(ord), free(cnt), free(pool);
     if (drawn) *drawn = n;
     return ATMOS_OK;
 nomem:
