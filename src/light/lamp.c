@@ -30,6 +30,18 @@ double atmos__lamp_spectrum(const atmos_scene_light *l, const atmos_wavelengths 
     return l->intensity_w_sr * c / 400.0;
 }
 
+double atmos__lamp_auto_range(double sigma_t)
+{
+    const double s = sigma_t > 0 ? sigma_t : 0, goal = log(1000.0) + s;
+    double lo = 1, hi = 1000; /* g(r) = s r + ln r rises with r: g(1) = s < goal <= g(1000) */
+    for (int i = 0; i < 60; i++) {
+        const double m = 0.5 * (lo + hi);
+        if (s * m + log(m) < goal) lo = m;
+        else hi = m;
+    }
+    return hi;
+}
+
 void atmos__lamp_make(const atmos_scene_light *s, const atmos_wavelengths *wl, atmos__lamp *l)
 {
     memset(l, 0, sizeof *l);

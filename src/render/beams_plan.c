@@ -14,6 +14,12 @@ static atmos_status make_light(atmos_context *ctx, const atmos_scene *s, int ind
 {
     memset(l, 0, sizeof *l);
     atmos__lamp_make(&s->lights[index], wl, &l->L);
+    if (!(l->L.range > 0)) { /* auto: from the fog's extinction where the light is */
+        const atmos_scene_fog *f = &s->fog;
+        const double above = fmax(0, l->L.pos[1] - f->base_m);
+        const double sig = !f->enabled ? 0 : f->height_m > 0 ? f->extinction_per_m * exp(-above / f->height_m) : f->extinction_per_m;
+        l->L.range = atmos__lamp_auto_range(sig);
+    }
     return atmos__lamp_load_image(ctx, s, index, &l->L);
 }
 
