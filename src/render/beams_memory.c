@@ -4,7 +4,6 @@
 #define _DEFAULT_SOURCE /* sysconf's _SC_PHYS_PAGES */
 #include "render/plan_internal.h"
 
-#include <stdint.h>
 #include <unistd.h>
 
 /* Bytes a pixel: 88 + 12 per wavelength (measured: the largest resident set of `atmos render`,
