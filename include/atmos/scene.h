@@ -203,7 +203,9 @@ typedef struct atmos_scene_light {
     double colour_temperature_k; /* > 0: the spectrum of a black body at this temperature, [1000, 40000];
                                     0: colour */
     double colour[3];         /* rgb weights in [0, 1e3] (rgb wavelengths only), with no temperature; 1, 1, 1 */
-    double range_m;           /* the light's reach: the beam renderer samples the air within it; (0, 1e6]; 100 */
+    double range_m;           /* the light's reach: the beam renderer samples the air within it, a hard cut;
+                                 [0, 1e6]; 0 (the default): where the airlight falls to 1e-3 of its value
+                                 1 m from the light (docs/beams.md, "A light's reach") */
     char image[ATMOS_SCENE_PATH_MAX]; /* spot, rgb wavelengths: a PNG projected through the cone (stained glass):
                                          the light toward a direction is tinted by the image's texel there
                                          (docs/scene-format.md); relative paths against the scene's folder; "" none */

@@ -30,6 +30,18 @@ double atmos__lamp_spectrum(const atmos_scene_light *l, const atmos_wavelengths 
     return l->intensity_w_sr * c / 400.0;
 }
 
+double atmos__lamp_auto_range(double sigma_t)
+{
+    const double s = sigma_t > 0 ? sigma_t : 0, goal = log(1000.0) + s;
+    double lo = 1, hi = 1000; /* g(r) = s r + ln r rises with r: g(1) = s < goal <= g(1000) */
+    for (int i = 0; i < 60; i++) {
+        const double m = 0.5 * (lo + hi);
+        if (s * m + log(m) < goal) lo = m;
+        else hi = m;
+    }
+    return hi;
+}
+
 void atmos__lamp_make(const atmos_scene_light *s, const atmos_wavelengths *wl, atmos__lamp *l)
 {
     memset(l, 0, sizeof *l);
@@ -137,14 +149,26 @@ int atmos__lamp_clip(const atmos__lamp *l, const double e[3], const double d[3],
     const double w[3] = {e[0] - l->pos[0], e[1] - l->pos[1], e[2] - l->pos[2]}, c2 = l->cos_outer * l->cos_outer;
     const double wa = atmos__dot3(w, l->axis), da = atmos__dot3(d, l->axis);
     const double A = da * da - c2, B = 2 * (wa * da - c2 * atmos__dot3(w, d)), C = wa * wa - c2 * atmos__dot3(w, w);
-    double cut[4] = {*t0, *t0, *t1, *t1};
+    /* the cuts: the quadric's two roots and where the ray crosses the light's plane (w.a = 0,
+     * which parts the quadric's two nappes: a cone of 90 deg is the plane itself, its quadric
+     * the plane counted twice, whose roots are rounding noise) */
+    double cut[5] = {*t0, *t0, *t0, *t1, *t1};
     const double disc = B * B - 4 * A * C;
     if (disc > 0 && A != 0) {
         const double q = -0.5 * (B + copysign(sqrt(disc), B)), r1 = q / A, r2 = C / q;
-        cut[1] = atmos__clampd(fmin(r1, r2), *t0, *t1), cut[2] = atmos__clampd(fmax(r1, r2), *t0, *t1);
+        cut[1] = atmos__clampd(fmin(r1, r2), *t0, *t1), cut[3] = atmos__clampd(fmax(r1, r2), *t0, *t1);
+    }
+    cut[2] = da != 0 ? atmos__clampd(-wa / da, *t0, *t1) : *t0;
+    for (int k = 2; k > 0 && cut[k] < cut[k - 1]; k--) { /* in order */
+        const double x = cut[k];
+        cut[k] = cut[k - 1], cut[k - 1] = x;
+    }
+    if (cut[2] > cut[3]) {
+        const double x = cut[2];
+        cut[2] = cut[3], cut[3] = x;
     }
     double lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 4; k++) {
         if (!(cut[k + 1] > cut[k])) continue;
         const double tm = 0.5 * (cut[k] + cut[k + 1]);
         const double P[3] = {e[0] + tm * d[0], e[1] + tm * d[1], e[2] + tm * d[2]};

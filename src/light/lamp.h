@@ -28,7 +28,14 @@ typedef struct atmos__lamp {
  * or for an rgb colour a flat 1/400 nm^-1 per channel times the channel's weight. */
 double atmos__lamp_spectrum(const atmos_scene_light *l, const atmos_wavelengths *wl, int k);
 
-/* The lamp of a scene light for the wavelength set. */
+/* The reach of a light with no range_m (0) in a fog of extinction sigma_t (per m) about the
+ * light: the distance r at which the airlight of a ray passing the light at r, about
+ * exp(-sigma_t r) / r, falls to 1e-3 of that of a ray passing at 1 m (sigma_t r + ln r =
+ * ln 1000 + sigma_t); 1000 m without fog, less in a denser one, at least 1 m. */
+double atmos__lamp_auto_range(double sigma_t);
+
+/* The lamp of a scene light for the wavelength set (range: range_m, 0 when auto: the caller
+ * sets it from the fog with atmos__lamp_auto_range). */
 void atmos__lamp_make(const atmos_scene_light *s, const atmos_wavelengths *wl, atmos__lamp *l);
 
 /* The spot's smooth falloff for a point whose offset from the light has cosine c with the

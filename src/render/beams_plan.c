@@ -14,6 +14,12 @@ static atmos_status make_light(atmos_context *ctx, const atmos_scene *s, int ind
 {
     memset(l, 0, sizeof *l);
     atmos__lamp_make(&s->lights[index], wl, &l->L);
+    if (!(l->L.range > 0)) { /* auto: from the fog's extinction where the light is */
+        const atmos_scene_fog *f = &s->fog;
+        const double above = fmax(0, l->L.pos[1] - f->base_m);
+        const double sig = !f->enabled ? 0 : f->height_m > 0 ? f->extinction_per_m * exp(-above / f->height_m) : f->extinction_per_m;
+        l->L.range = atmos__lamp_auto_range(sig);
+    }
     return atmos__lamp_load_image(ctx, s, index, &l->L);
 }
 
@@ -48,9 +54,11 @@ static atmos_status shadow_maps(atmos_plan *p, atmos__beams_plan *b, atmos__beam
 atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
 {
     const atmos_scene *s = &p->scene;
+    atmos_status st = atmos__beams_memory_check(p->ctx, s->width, s->height, p->wl.count);
+    if (st != ATMOS_OK) return st;
     atmos__beams_plan *b = calloc(1, sizeof *b);
     if (!b) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
-    atmos_status st = atmos__objects_load(p->ctx, s, &p->wl, &b->obj);
+    st = atmos__objects_load(p->ctx, s, &p->wl, &b->obj);
     if (st == ATMOS_OK) atmos__objects_warn_enclosed_lights(p->ctx, s, &b->obj);
     if (st == ATMOS_OK && !(b->lights = calloc((size_t)s->light_count, sizeof *b->lights)))
         st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
@@ -96,6 +104,7 @@ atmos_status atmos__beams_sun_frame(atmos_plan *p, const atmos__view *v)
     atmos_status st = ATMOS_OK;
     if (!(sun->depth && !memcmp(sun->dir, v->sun, sizeof sun->dir)))
         st = atmos__beams_sun_build(p->ctx, sun, v->sun, b->obj.mesh, b->obj.n, p->scene.beams.shadow_size);
+    if (st == ATMOS_OK && !sun->warned) atmos__beams_sun_warn_texel(p->ctx, sun, b->obj.mesh, b->obj.n), sun->warned = 1;
     /* the map along epipolar lines from the eye, for the fog's sunlight (none without fog) */
     if (st == ATMOS_OK && b->fog.sigma0 > 0 &&
         atmos__beams_epi_build(&b->epi, sun, v->cam.position, EPI_MAX_SAMPLES, atmos__threads(p->ctx)))

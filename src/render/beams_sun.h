@@ -40,12 +40,16 @@ typedef struct atmos__beams_sun {
     float *depth;
     atmos__beams_tiles tiles;           /* the map's min/max pyramid */
     unsigned long gen;                  /* counts the builds: what was made from the map knows it */
+    int warned;                         /* atmos__beams_sun_warn_texel has spoken */
 } atmos__beams_sun;
 
 /* The map of the meshes seen from the sun dir (unit); size texels a side. */
 atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, const double dir[3], atmos_mesh *const *mesh,
                                     int nmesh, int size);
 void atmos__beams_sun_free(atmos__beams_sun *s);
+/* Warns when the built map's texels exceed 16 times the median size of the meshes'
+ * triangles, naming the object whose bounds set the map's extent (beams_sun_warn.c). */
+void atmos__beams_sun_warn_texel(atmos_context *ctx, const atmos__beams_sun *s, atmos_mesh *const *mesh, int nmesh);
 /* H at p: the share of sunlight reaching p past the meshes, in [0, 1] (2x2 filtered). */
 double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3]);
 /* 1 when p is surely in the meshes' shadow by the map: the depths over p's finest tile (8 x 8

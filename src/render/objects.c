@@ -17,11 +17,18 @@ static atmos_status load_terrain(atmos_context *ctx, const atmos_scene_object *o
 }
 
 /* A failed mesh or terrain's message with the scene file and its key in front, and for a
- * relative path where it was looked for, as a light's image says (lamp.c). */
-static atmos_status name_key(atmos_context *ctx, atmos_status st, const atmos_scene *s, int i)
+ * relative path where it was looked for, as a light's image says (lamp.c); placed: the mesh was
+ * read and failed once placed (a vertex beyond 1e8 m after position and scale), which the
+ * message says with the file's name. */
+static atmos_status name_key(atmos_context *ctx, atmos_status st, const atmos_scene *s, int i, int placed)
 {
     const atmos_scene_object *o = &s->objects[i];
     const char *path = o->terrain[0] ? o->terrain : o->mesh;
+    if (placed) {
+        char why[1024];
+        snprintf(why, sizeof why, "%s", atmos_context_error(ctx));
+        atmos__error(ctx, st, "%s after position and scale (%s)", why, path);
+    }
     char key[48];
     snprintf(key, sizeof key, "/objects/%d/%s", i, o->terrain[0] ? "terrain" : "mesh");
     return atmos__scene_file_error(ctx, st, s, path, key, st == ATMOS_E_IO);
@@ -38,13 +45,13 @@ atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const
     for (int i = 0; i < s->object_count; i++) {
         const atmos_scene_object *o = &s->objects[i];
         atmos_status st = o->terrain[0] ? load_terrain(ctx, o, &ob->mesh[i]) : atmos_mesh_load(ctx, o->mesh, 0, &ob->mesh[i]);
-        if (st != ATMOS_OK) return name_key(ctx, st, s, i);
+        if (st != ATMOS_OK) return name_key(ctx, st, s, i, 0);
         ob->n = i + 1;
         atmos_mesh_transform t;
         memcpy(t.position_m, o->position_m, sizeof t.position_m);
         memcpy(t.scale, o->scale, sizeof t.scale);
         memcpy(t.rotation_deg, o->rotation_deg, sizeof t.rotation_deg);
-        if ((st = atmos_mesh_apply_transform(ctx, ob->mesh[i], &t)) != ATMOS_OK) return st;
+        if ((st = atmos_mesh_apply_transform(ctx, ob->mesh[i], &t)) != ATMOS_OK) return name_key(ctx, st, s, i, 1);
         for (int k = 0; k < wl->count; k++)
             ob->albedo[i][k] = wl->mode == ATMOS_WAVELENGTHS_RGB ? o->albedo[k < 3 ? k : 2]
                                                                : (o->albedo[0] + o->albedo[1] + o->albedo[2]) / 3;

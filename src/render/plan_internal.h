@@ -85,6 +85,11 @@ void atmos__harris_describe(const atmos_plan *p, char *buf, size_t cap);
 /* The beam renderer (beams_plan.c, beams_render.c; Dobashi et al. 2002 §4): the scene's
  * objects, lights with their shadow maps, the fog's scattering table. */
 atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out);
+/* The beam renderer's memory for a width x height image of that many wavelengths, in bytes
+ * (beams_memory.c); the check refuses (ATMOS_E_LIMIT) an image needing more than the machine's
+ * physical memory, with the estimate and what lowers it, and warns above half of it. */
+double atmos__beams_memory_estimate(int width, int height, int wavelengths);
+atmos_status atmos__beams_memory_check(atmos_context *ctx, int width, int height, int wavelengths);
 void atmos__beams_plan_destroy(atmos__beams_plan *b);
 /* The sky, then the objects and the light the fog scatters, over the pixels of r. */
 atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out);

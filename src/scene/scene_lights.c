@@ -15,7 +15,7 @@ void atmos__scene_light_defaults(atmos_scene_light *l)
     l->cone_deg = 30, l->edge_deg = 5;
     l->intensity_w_sr = 100;
     l->colour[0] = l->colour[1] = l->colour[2] = 1;
-    l->range_m = 100;
+    l->range_m = 0; /* auto: atmos__lamp_auto_range */
 }
 
 void atmos__scene_object_defaults(atmos_scene_object *o)
@@ -50,7 +50,7 @@ static atmos_status check1(atmos_context *ctx, const char *source, const char *p
 static atmos_status check_light(atmos_context *ctx, const char *source, const atmos_scene *s, int i)
 {
     static const atmos__range r_cone = {0, 89, 0, 0}, r_edge = {0, 90, 0, 0}, r_intensity = {0, 1e9, 1, 0},
-                              r_temp = {1000, 40000, 0, 0}, r_colour = {0, 1e3, 0, 0}, r_range = {0, 1e6, 1, 0};
+                              r_temp = {1000, 40000, 0, 0}, r_colour = {0, 1e3, 0, 0}, r_range = {0, 1e6, 0, 0};
     const atmos_scene_light *l = &s->lights[i];
     char at[48];
     snprintf(at, sizeof at, "/lights/%d", i);

@@ -86,4 +86,11 @@ mesh_scene ok.obj bad.png >sbad.json
 "$A" render sbad.json -D objects.1.albedo=0.3 -o x.png -q 2>errd3
 check "a bad terrain in the scene file, -D elsewhere" errd3 "/objects/1/terrain"
 grep -q "set by -D" errd3 && bad "the scene file's bad terrain blamed on a -D: $(cat errd3)" || ok "the scene file's terrain not blamed on -D"
+# a mesh whose vertices pass 1e8 m only once placed (position, scale): the object, the file and
+# "after position and scale"; the same in the path tracer
+"$A" render s.json -D objects.0.position_m=[0,0,9.99e7] -D objects.0.scale=1e6 -D objects.0.mesh=builtin:sphere \
+    -o x.png -q 2>errp1
+check "a built-in sphere placed beyond 1e8 m" errp1 "/objects/0/mesh" "builtin:sphere" "after position and scale"
+"$A" render s.json -D objects.0.scale=1e6 -D objects.0.position_m=[9.99e7,0,0] --renderer path --spp 1 -o x.png -q 2>errp2
+check "an OBJ scaled beyond 1e8 m, the path tracer" errp2 "/objects/0/mesh" "ok.obj" "after position and scale"
 exit $fail

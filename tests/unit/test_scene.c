@@ -282,7 +282,7 @@ static const bad_case bad_lights[] = {
     {"{\"lights\": [{\"type\": \"spot\", \"direction\": [0, 0, 0]}]}", ATMOS_E_INVALID_ARG, "/lights/0/direction: must be a nonzero finite vector", NULL},
     {"{\"lights\": [{\"colour_temperature_k\": 100}]}", ATMOS_E_INVALID_ARG, "/lights/0/colour_temperature_k: must be in [1000, 40000] (0: colour)", NULL},
     {"{\"lights\": [{\"position_m\": [0, 1e300, 0]}]}", ATMOS_E_INVALID_ARG, "/lights/0/position_m/1: must be in", NULL},
-    {"{\"lights\": [{\"range_m\": 0}]}", ATMOS_E_INVALID_ARG, "/lights/0/range_m: must be in (0, 1000000]", NULL},
+    {"{\"lights\": [{\"range_m\": -1}]}", ATMOS_E_INVALID_ARG, "/lights/0/range_m: must be in [0, 1000000]", NULL},
     {"{\"wavelengths\": {\"mode\": \"spectral\"}, \"lights\": [{\"colour\": [1, 0.5, 0.2]}]}", ATMOS_E_INVALID_ARG, "/lights/0/colour: rgb colours need rgb wavelengths", NULL},
     {"{\"lights\": {\"type\": \"spot\"}}", ATMOS_E_INVALID_ARG, "/lights: expected an array of objects, got an object", NULL},
     {"{\"lights\": [{\"cone\": 5}]}", ATMOS_E_INVALID_ARG, "/lights/0/cone: unknown key", NULL},
@@ -495,7 +495,7 @@ static void test_lights(void)
     const atmos_scene_light *a = &s.lights[0], *b = &s.lights[1];
     CHECK(a->type == ATMOS_LIGHT_SPOT && a->position_m[1] == 20 && a->direction[1] == -1 && a->cone_deg == 15 &&
           a->edge_deg == 3 && a->intensity_w_sr == 5000 && a->colour_temperature_k == 3200 && a->range_m == 40);
-    CHECK(b->type == ATMOS_LIGHT_POINT && b->intensity_w_sr == 100 && b->range_m == 100 && b->colour[1] == 0.5 &&
+    CHECK(b->type == ATMOS_LIGHT_POINT && b->intensity_w_sr == 100 && b->range_m == 0 && b->colour[1] == 0.5 &&
           b->colour_temperature_k == 0);
     CHECK(s.fog.enabled && s.fog.extinction_per_m == 0.05 && s.fog.scattering_per_m == 0.05 && s.fog.g == 0.3);
     /* visibility (Koschmieder: 3.912 / V at 550 nm) and a fog of a particle type */

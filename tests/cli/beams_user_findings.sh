@@ -1,0 +1,76 @@
+#!/bin/sh
+# A new user's findings in the beam renderer mended (docs/beams.md):
+#  - a hemispherical spot (cone_deg + edge_deg = 90, a ceiling lamp) lights the fog smoothly
+#    above and below the light's plane: no pixel of the fog it lights is black, and the beam
+#    renderer's image agrees with the path tracer's single scattering (--max-depth 1);
+#  - one far vertex stretching the sun's shadow map is warned of, naming the object and the
+#    texel size; the same scene without it is not;
+#  - an image whose estimated memory exceeds the machine's is refused at once with the estimate
+#    and the options that lower it (16384 x 16384 of 128 wavelengths: ~440 GB); a small one is not
+#    warned of;
+#  - a point light without range_m reaches where its airlight falls to 1e-3 of its value 1 m from
+#    it: no glowing ball with a hard edge, the image within 5 % of the path tracer's single
+#    scattering (the former default, 100 m, gave 0.45 of it, 0.1 at the image's edges).
+. "$(dirname "$0")/common.inc"
+cd "$T" || exit 1
+cat >hemi.json <<'JSON'
+{"image": {"width": 40, "height": 30}, "camera": {"type": "pinhole", "position_m": [8, 2, 8], "look_at_m": [0, 3, 0], "fov_deg": 60},
+ "wavelengths": {"mode": "rgb"}, "background": "black", "renderer": "beams",
+ "fog": {"extinction_per_m": 0.04, "scattering_per_m": 0.036, "g": 0.5},
+ "lights": [{"type": "spot", "position_m": [0, 12, 0], "direction": [0, -1, 0], "cone_deg": 85, "edge_deg": 5,
+             "intensity_w_sr": 20000, "range_m": 50}],
+ "objects": [{"mesh": "builtin:plane", "position_m": [0, 0, 0], "scale": 15, "albedo": 0.6}]}
+JSON
+"$A" render hemi.json -o b.pfm -q 2>e1 || bad "beams, cone 85 + edge 5: $(cat e1)"
+"$A" render hemi.json --renderer path --max-depth 1 --spp 64 --seed 3 -o p.pfm -q 2>e2 || bad "path: $(cat e2)"
+python3 - b.pfm p.pfm <<'PY' && ok "cone 85 + edge 5: no black pixel, beams within 10 % of the path tracer" || bad "cone 85 + edge 5"
+import sys, pfm
+b, p = pfm.read(sys.argv[1]), pfm.read(sys.argv[2])
+zeros = sum(1 for v in b.v[1::3] if v <= 0)
+sb, sp = sum(b.v[1::3]), sum(p.v[1::3])
+print("beams black pixels %d, beams / path (green mean) %.4f" % (zeros, sb / sp))
+sys.exit(0 if zeros == 0 and abs(sb / sp - 1) < 0.10 else 1)
+PY
+# the sun's map: a terrain and a box; the box with one far triangle (x = 1e7 m)
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n' >near.obj
+cp near.obj far.obj
+printf 'v 1e7 0 0\nv 1e7 1 0\nv 1e7 0 1\nf -3 -2 -1\n' >>far.obj
+sun_scene() {
+    cat <<JSON
+{"image": {"width": 24, "height": 16}, "camera": {"type": "pinhole", "position_m": [0, 1500, 2500], "look_at_m": [0, 600, 0], "fov_deg": 55},
+ "sun": {"elevation_deg": 12, "azimuth_deg": 250}, "renderer": "beams", "beams": {"sun": true, "shadow_size": 512},
+ "fog": {"visibility_m": 6000, "height_m": 800},
+ "objects": [{"terrain": "generate:ridges", "size_m": 6000, "height_m": 1200, "samples": 65}, {"mesh": "$1", "position_m": [0, 900, 0], "scale": 6}]}
+JSON
+}
+sun_scene far.obj | "$A" render - -o x.png 2>w1 || bad "the far triangle: $(cat w1)"
+grep -q "warning: the sun's 512x512 shadow map has texels of .* set by the bounds of /objects/1" w1 &&
+    ok "a far vertex: the sun's map warned of, naming /objects/1" || bad "no warning of the far vertex: $(cat w1)"
+sun_scene near.obj | "$A" render - -o x.png 2>w2 || bad "near: $(cat w2)"
+grep -q "shadow map" w2 && bad "warned without the far vertex: $(cat w2)" || ok "no warning without it"
+# the memory: refused before anything is allocated (a second, not the minutes of swapping)
+"$A" render hemi.json -D 'wavelengths={"mode":"spectral","samples":128}' --width 16384 --height 16384 -o big.png -q 2>m1 &&
+    bad "a 16384^2 image of 128 wavelengths rendered" || true
+grep -q "needs about .* GB (1624 bytes a pixel), more than the machine's .* GB of memory: .*--width" m1 &&
+    ok "a 16384^2 image of 128 wavelengths refused with its estimate" || bad "no refusal: $(cat m1)"
+[ -e big.png ] && bad "the refused image was written"
+"$A" render hemi.json --width 64 --height 48 -o small.png 2>m2 || bad "a small image: $(cat m2)"
+grep -q "needs about" m2 && bad "a small image warned of: $(cat m2)" || ok "a small image: no word of memory"
+# a point light's default reach: 1e5 W/sr, fog 0.002 /m, seen from 400 m
+cat >pt.json <<'JSON'
+{"image": {"width": 64, "height": 40}, "camera": {"type": "pinhole", "position_m": [0, 30, 400], "look_at_m": [0, 30, 0], "fov_deg": 60},
+ "background": "black", "renderer": "beams", "wavelengths": {"mode": "rgb"}, "fog": {"extinction_per_m": 0.002},
+ "lights": [{"type": "point", "position_m": [0, 30, 0], "intensity_w_sr": 100000}], "objects": [{"mesh": "builtin:plane", "scale": 1000}]}
+JSON
+"$A" render pt.json -o ptb.pfm -q 2>r1 || bad "beams, a point light's default reach: $(cat r1)"
+"$A" render pt.json --renderer path --max-depth 1 --spp 32 --seed 5 -o ptp.pfm -q 2>r2 || bad "path: $(cat r2)"
+python3 - ptb.pfm ptp.pfm <<'PY' && ok "a point light's default reach: beams within 5 % of the path tracer, 15 % at the edges" || bad "default reach"
+import sys, pfm
+b, p = pfm.read(sys.argv[1]), pfm.read(sys.argv[2])
+g, r, w = b.v[1::3], p.v[1::3], b.w
+edge = lambda v: sum(v[i] for i in range(len(v)) if i % w < w // 8 or i % w >= w - w // 8)
+m, e = sum(g) / sum(r), edge(g) / edge(r)
+print("beams / path: mean %.4f, the outer eighths %.4f" % (m, e))
+sys.exit(0 if abs(m - 1) < 0.05 and abs(e - 1) < 0.15 else 1)
+PY
+exit $fail
