@@ -33,6 +33,8 @@ atmos_status atmos__terrain_read(atmos_context *ctx, const char *path, int strid
     FILE *f = fopen(path, "rb");
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "terrain %s: cannot open: %s", path, strerror(errno));
     fclose(f);
+    if (stat(path, &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size == 0) /* GDAL: "unknown format" */
+        return atmos__error(ctx, ATMOS_E_FORMAT, "terrain %s: empty file (0 bytes)", path);
     pthread_once(&gdal_once, load_once);
     if (!gdal_read)
         return atmos__error(ctx, ATMOS_E_UNSUPPORTED, "terrain %s: the GDAL module: %s (install it next to libatmos)",

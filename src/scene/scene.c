@@ -121,6 +121,8 @@ static atmos_status scan_text(atmos_context *ctx, const char *source, const char
     const unsigned char *s = (const unsigned char *)text;
     int in_string = 0, escape = 0, content = 0;
     size_t depth = 0;
+    if (n >= 2 && ((s[0] == 0xFF && s[1] == 0xFE) || (s[0] == 0xFE && s[1] == 0xFF))) /* a UTF-16 byte order mark */
+        return text_error(ctx, ATMOS_E_FORMAT, source, text, 0, "malformed JSON: UTF-16: save the scene as UTF-8");
     for (size_t i = 0; i < n; i++) {
         unsigned c = s[i];
         if (c == 0) return text_error(ctx, ATMOS_E_FORMAT, source, text, i, "malformed JSON: NUL byte");

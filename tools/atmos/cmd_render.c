@@ -470,6 +470,9 @@ static int render_run(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         fprintf(stderr, "atmos render: warning: the animation moves the sun, but the sun lights nothing here (lamps "
                         "only%s, a vacuum behind): every frame is the same image\n",
                 scene->renderer == ATMOS_RENDERER_BEAMS ? ": no \"beams\": {\"sun\"}" : "");
+    if (d->rank == 0 && nframes < 2 && o->exposure_per_frame)
+        fprintf(stderr, "atmos render: warning: --exposure-per-frame: changes nothing: the scene is one frame, not an "
+                        "animation (\"animation\": {\"frames\": N} makes one)\n");
     atmos_plan *plan = NULL;
     int failed = 0;
     /* a time-lapse: the first frame's volume from the simulation the frames carry on */

@@ -138,7 +138,8 @@ static void on_signal(int sig)
     raise(sig);
 }
 
-static void register_stage(int i, const char *stage)
+/* The handler installed on the ending signals, once. */
+static void install_handlers(void)
 {
     static int installed;
     if (!installed) {
@@ -157,6 +158,17 @@ static void register_stage(int i, const char *stage)
         }
         installed = 1;
     }
+}
+
+void cli_outputs_catch(const char *cmd)
+{
+    signal_cmd = cmd;
+    install_handlers();
+}
+
+static void register_stage(int i, const char *stage)
+{
+    install_handlers();
     slot_used[2 * i] = slot_used[2 * i + 1] = 0;
     snprintf(slot_name[2 * i], sizeof slot_name[0], "%s", stage);
     snprintf(slot_name[2 * i + 1], sizeof slot_name[0], "%s.tmp%ld", stage, (long)getpid());
@@ -393,9 +405,6 @@ int cli_outputs_hold(const char *cmd, cli_outputs *set)
     return 0;
 }
 
-/* The held files renamed into place with the ending signals blocked, so that a signal cannot
- * remove the frames not yet renamed once the first is (it is taken after the loop, when every
- * frame is in place). A rename that fails part way leaves the frames before it new: said. */
 /* The end of a commit: signals act again, one that came during it (to another thread) now. */
 static void commit_end(const sigset_t *old)
 {
@@ -406,14 +415,32 @@ static void commit_end(const sigset_t *old)
     if (deferred) raise(deferred);
 }
 
-int cli_outputs_held_commit(const char *cmd)
+/* The start of a commit: the ending signals blocked in this thread, other threads' handlers
+ * defer theirs to commit_end. */
+static void commit_begin(sigset_t *old)
 {
-    sigset_t block, old;
+    sigset_t block;
     sigemptyset(&block);
     for (size_t k = 0; k < sizeof ENDING / sizeof ENDING[0]; k++) sigaddset(&block, ENDING[k]);
-    sigprocmask(SIG_BLOCK, &block, &old); /* this thread; other threads' handlers defer */
+    sigprocmask(SIG_BLOCK, &block, old);
     committing = 1;
     atomic_signal_fence(memory_order_seq_cst);
+}
+
+void cli_outputs_defer_signals(int on)
+{
+    static sigset_t old;
+    if (on) commit_begin(&old);
+    else commit_end(&old);
+}
+
+/* The held files renamed into place with the ending signals blocked, so that a signal cannot
+ * remove the frames not yet renamed once the first is (it is taken after the loop, when every
+ * frame is in place). A rename that fails part way leaves the frames before it new: said. */
+int cli_outputs_held_commit(const char *cmd)
+{
+    sigset_t old;
+    commit_begin(&old);
     for (int i = 0; i < held_n; i++)
         if (rename(held[i].stage, held[i].path) != 0) {
             fprintf(stderr, "atmos %s: %s: cannot rename %s into place: %s (%d of %d files renamed before it)\n",

@@ -83,6 +83,14 @@ void cli_outputs_discard(cli_outputs *set);
 /* Whether a progress bar's line on the terminal is open (not ended): a signal's
  * "interrupted" line starts on a new line then. */
 void cli_outputs_line_open(int open);
+/* A command that writes its files as it goes (atmos view --record, its saves): the ending
+ * signals caught as for the staging files, a signal saying "atmos CMD: interrupted" and ending
+ * the process by the signal. */
+void cli_outputs_catch(const char *cmd);
+/* on = 1 .. on = 0 around writing a set of files that must not be cut (a recorded frame's PNG
+ * and its csv line): an ending signal that comes meanwhile acts at on = 0, so that no file is
+ * left half written and no writer's temporary is left. Not nested. */
+void cli_outputs_defer_signals(int on);
 /* A message with the staging suffix (".tmpPID") taken out of the names it holds, so
  * that the library's messages about a staging file name the output. */
 void cli_outputs_final_names(const char *msg, char *out, size_t cap);

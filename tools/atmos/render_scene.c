@@ -334,9 +334,13 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         if (st != ATMOS_OK) {
             const char *msg = atmos_context_error(ctx);
             const char *def = o->scene_path ? render_scene_define_in(o, msg) : NULL;
+            /* a value a -D gave that the scene reader refuses (the message blames the -D): the
+             * options alone made it, a usage error as without a scene file; the scene file's
+             * own content, or a file that cannot be read, is a runtime error */
+            const int by_define = st == ATMOS_E_INVALID_ARG && !strncmp(msg, "-D ", 3);
             const int rc = cli_runtime_error(o->cmd, ctx, st);
             if (def) fprintf(stderr, "  (set by -D %s, not by the scene file)\n", def);
-            return rc;
+            return by_define ? CLI_EXIT_USAGE : rc;
         }
     } else if (ndefs) {
         /* the built-in default scene is the parse of an empty one */
@@ -354,7 +358,7 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         const char *flag = render_opts_flag_in(atmos_context_error(ctx));
         fprintf(stderr, "atmos %s: %s\n", o->cmd, atmos_context_error(ctx));
         if (flag) fprintf(stderr, "  (the option --%s sets it)\n", flag);
-        return o->scene_path ? CLI_EXIT_RUNTIME : CLI_EXIT_USAGE;
+        return CLI_EXIT_USAGE; /* the scene file was valid as read: the options made it invalid */
     }
     if (!render_opts_camera_given(o) && (st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK)
         return cli_runtime_error(o->cmd, ctx, st);

@@ -130,8 +130,12 @@ typedef struct view_script {
  * when its key frames set the sun, the sun's and the time's. Returns 0 or an exit status with
  * a message. */
 int view_script_load(atmos_context *ctx, const char *path, view_script *out);
+/* The most frames a session plays (--frames's cap; frame names are frame_NNNNN.png, wider
+ * past 99999). */
+#define VIEW_FRAMES_MAX 10000000
 /* The frames a flight plays without --frames: frame i is at t = i / fps, so the last one is
- * the first at or after its last key frame (t = T: T fps + 1 frames when T fps is whole). */
+ * the first at or after its last key frame (t = T: T fps + 1 frames when T fps is whole);
+ * VIEW_FRAMES_MAX + 1 for a flight longer than VIEW_FRAMES_MAX frames. */
 int view_script_frames(const view_script *s);
 /* What a flight presses that the scene cannot act on (the time's keys without a date, time and
  * place): 0 or a usage error with a message (path: the flight file). */

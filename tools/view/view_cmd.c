@@ -101,7 +101,7 @@ static int parse(int argc, char **argv, view_opts *o)
         else if (cli_take_value(argc, argv, &i, "--size", &v)) {
             if (!size(v, o)) return CLI_EXIT_USAGE;
         } else if (cli_take_value(argc, argv, &i, "--frames", &v)) {
-            if (!v || !cli_parse_int("view", "--frames", v, 1, 10000000, &o->frames)) return CLI_EXIT_USAGE;
+            if (!v || !cli_parse_int("view", "--frames", v, 1, VIEW_FRAMES_MAX, &o->frames)) return CLI_EXIT_USAGE;
         } else if (cli_take_value(argc, argv, &i, "--impostor-budget", &v)) {
             if (!v || !cli_parse_int("view", "--impostor-budget", v, 0, 1000000, &o->impostor_budget)) return CLI_EXIT_USAGE;
         } else if (cli_take_value(argc, argv, &i, "--screen-layer-px", &v)) {
@@ -182,6 +182,10 @@ int cli_cmd_view(int argc, char **argv)
     if (!ctx) rc = CLI_EXIT_RUNTIME;
     /* the flight read first: its mistakes said before any work on the scene */
     if (rc == CLI_EXIT_OK && vo.script) rc = view_script_load(ctx, vo.script, &script);
+    if (rc == CLI_EXIT_OK && vo.script && !vo.frames && view_script_frames(&script) > VIEW_FRAMES_MAX)
+        rc = cli_usage_error("view", "--script %s: the flight lasts %g s: at %g fps more than the %d frames a session "
+                                     "plays (--frames's cap); shorten it, lower its fps or give --frames N",
+                             vo.script, script.k[script.n - 1].t, script.fps, VIEW_FRAMES_MAX);
     if (rc == CLI_EXIT_OK) rc = render_scene_make(ctx, &ro, &sc, &vol);
     if (rc == CLI_EXIT_OK && ro.scene_path && strcmp(ro.scene_path, "-")) text = cli_read_text(ro.scene_path, CLI_TEXT_MAX);
     if (rc == CLI_EXIT_OK) {

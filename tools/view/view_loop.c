@@ -288,7 +288,10 @@ static int save(loop *L, const view_opts *o, view_state *s, const char *text)
     snprintf(base, sizeof base, "%s_%03d", o->save_base ? o->save_base : "view", ++L->saves);
     /* its folder made as atmos render makes its outputs' */
     if (cli_output_folder("view", "--save-base", base) != 0) return CLI_EXIT_RUNTIME;
-    return view_save(L->ctx, base, text, &sc, &saved, L->lin, L->disp);
+    cli_outputs_defer_signals(1); /* a signal meanwhile acts after the save's files are whole */
+    const int rc = view_save(L->ctx, base, text, &sc, &saved, L->lin, L->disp);
+    cli_outputs_defer_signals(0);
+    return rc;
 }
 
 static void overlay(const view_state *s, double ms, char lines[4][160])
@@ -399,6 +402,10 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     view_state s;
     view_recorder rec = {0};
     view_window *win = NULL;
+    /* Ctrl-C, SIGTERM: "atmos view: interrupted", the process ended by the signal; a recorded
+     * frame or a save being written is finished first (view_record_frame, save). Before the
+     * window: SDL then keeps it rather than installing its own. */
+    cli_outputs_catch("view");
     /* the window first: without a display the viewer stops at once, before any work */
     int rc = CLI_EXIT_OK;
     if (!o->headless && !(win = view_window_open(o->width, o->height, "atmos view"))) rc = CLI_EXIT_RUNTIME;
@@ -409,7 +416,7 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
     const int frames = o->frames > 0 ? o->frames : view_script_frames(script);
     const double fps = script ? script->fps : 24;
     double last_ms = 0.0;
-    int pressed = 0;
+    int pressed = 0, unsaved = 0;
     view_pose pose = view_pose_of(&s);
     for (int i = 0; rc == CLI_EXIT_OK && !s.quit && (!frames || i < frames); i++) {
         const double t0 = cli_now_s();
@@ -436,11 +443,16 @@ int view_loop(atmos_context *ctx, const view_opts *o, const view_script *script,
         if (rc == CLI_EXIT_OK) rc = view_record_frame(&rec, ctx, L.disp, last_ms, atmos_renderer_name(s.renderer), L.impostor_updates,
                                                       L.impostors_coarse, q == VIEW_PREVIEW,
                                                       cli_lit_without_sun(sc, s.renderer), &s);
-        /* a save that fails is said (save prints why) and the session goes on */
-        if (rc == CLI_EXIT_OK && s.save && save(&L, o, &s, text) != CLI_EXIT_OK)
-            fprintf(stderr, "atmos view: the frame was not saved; the session goes on\n");
+        /* a save that fails is said (save prints why) and the session goes on; headless, where
+         * no one sees the message, the session's exit status then says it (1) */
+        if (rc == CLI_EXIT_OK && s.save && save(&L, o, &s, text) != CLI_EXIT_OK) {
+            fprintf(stderr, "atmos view: the frame was not saved; the session goes on%s\n",
+                    o->headless ? " (its exit status will be 1)" : "");
+            unsaved++;
+        }
         s.save = 0;
     }
+    if (o->headless && unsaved && rc == CLI_EXIT_OK) rc = CLI_EXIT_RUNTIME;
     if (o->press && !pressed && rc == CLI_EXIT_OK) /* the session ended before its second frame */
         fprintf(stderr, "atmos view: --press %s: not pressed: the session ended before its second frame\n", o->press);
     if (view_record_close(&rec) != CLI_EXIT_OK && rc == CLI_EXIT_OK) rc = CLI_EXIT_RUNTIME;

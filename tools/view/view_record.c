@@ -1,8 +1,8 @@
 /* Recording a flight and saving a view (view.h). A saved view is the frame's linear EXR,
  * the PNG as shown, and a scene file that renders the same image offline: the scene file
  * the viewer opened, edited with cJSON to hold the viewer's camera, sun, size, renderer and
- * exposure (and the volume's absolute path and its placement), so every other setting stays
- * as written. */
+ * exposure (and the absolute paths of the volume, meshes, terrains, lights' images and Earth
+ * maps, and the volume's placement), so every other setting stays as written. */
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "outputs.h"
 #include "view.h"
@@ -85,15 +85,27 @@ int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *d
     if (!r->csv && open_csv(r) != CLI_EXIT_OK) return CLI_EXIT_RUNTIME;
     char path[CLI_OUTPUT_PATH_MAX];
     snprintf(path, sizeof path, "%s/frame_%05d.png", r->dir, r->frames);
-    /* zlib's fastest level: at the default, writing a 1280 x 720 frame took more CPU than
-     * rendering it */
-    atmos_status st = atmos_write_png_level(ctx, disp, path, 8, 1);
-    if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
     char sun[64] = ""; /* empty without a sun (lit by lamps only) */
     if (!sunless) snprintf(sun, sizeof sun, "%.4f,%.4f", s->sun_el, s->sun_az);
     else snprintf(sun, sizeof sun, ",");
-    fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%s,%d,%d\n", r->frames, ms, renderer, impostor_updates,
-            s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, sun, preview, impostors_coarse);
+    /* the frame's PNG and its csv line, flushed, both or neither: a signal meanwhile (Ctrl-C)
+     * acts after them, and the recording ends with whole frames and whole lines */
+    cli_outputs_defer_signals(1);
+    /* zlib's fastest level: at the default, writing a 1280 x 720 frame took more CPU than
+     * rendering it */
+    atmos_status st = atmos_write_png_level(ctx, disp, path, 8, 1);
+    int ok = st == ATMOS_OK;
+    if (ok) {
+        fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%s,%d,%d\n", r->frames, ms, renderer, impostor_updates,
+                s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, sun, preview, impostors_coarse);
+        ok = fflush(r->csv) == 0;
+    }
+    cli_outputs_defer_signals(0);
+    if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
+    if (!ok) {
+        fprintf(stderr, "atmos view: --record: writing %s/frames.csv failed: %s\n", r->dir, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
     r->frames++;
     return CLI_EXIT_OK;
 }
@@ -134,6 +146,46 @@ static void clear(cJSON *o, const char *const *names, int n)
     for (int i = 0; i < n; i++) cJSON_DeleteItemFromObjectCaseSensitive(o, names[i]);
 }
 
+/* o's file key made absolute in the saved scene, which lies in another folder than the one its
+ * relative paths were relative to: the path the scene reader resolved (joined to the scene's
+ * folder) through realpath. Kept as written: absolute paths, "builtin:", "generate:",
+ * "simulate:", "data:" (the data folder's), and a value the scene's (resolved) does not end
+ * with (a -D replaced it). */
+static void absolute_file(cJSON *o, const char *key, const char *resolved)
+{
+    static const char *const kept[] = {"builtin:", "generate:", "simulate:", "data:"};
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!cJSON_IsString(v) || !v->valuestring[0] || v->valuestring[0] == '/') return;
+    const char *p = v->valuestring;
+    for (size_t k = 0; k < sizeof kept / sizeof kept[0]; k++)
+        if (!strncmp(p, kept[k], strlen(kept[k]))) return;
+    const size_t n = strlen(p), m = strlen(resolved);
+    if (m < n || strcmp(resolved + m - n, p)) return;
+    char *abs = realpath(resolved, NULL);
+    if (abs) set(o, key, cJSON_CreateString(abs));
+    free(abs);
+}
+
+/* The scene's files besides the volume made absolute: the lights' images, the objects' meshes
+ * and terrains, the Earth's maps. */
+static void files_absolute(cJSON *root, const atmos_scene *sc)
+{
+    cJSON *lights = cJSON_GetObjectItemCaseSensitive(root, "lights");
+    cJSON *objects = cJSON_GetObjectItemCaseSensitive(root, "objects");
+    cJSON *atm = cJSON_GetObjectItemCaseSensitive(root, "atmosphere");
+    cJSON *clouds = cJSON_GetObjectItemCaseSensitive(atm, "clouds");
+    for (int i = 0; cJSON_IsArray(lights) && i < sc->light_count; i++)
+        absolute_file(cJSON_GetArrayItem(lights, i), "image", sc->lights[i].image);
+    for (int i = 0; cJSON_IsArray(objects) && i < sc->object_count; i++) {
+        absolute_file(cJSON_GetArrayItem(objects, i), "mesh", sc->objects[i].mesh);
+        absolute_file(cJSON_GetArrayItem(objects, i), "terrain", sc->objects[i].terrain);
+    }
+    absolute_file(atm, "ground_map", sc->earth.ground_map);
+    absolute_file(atm, "night_lights", sc->earth.night_lights);
+    absolute_file(clouds, "image", sc->earth.cloud_image);
+    absolute_file(clouds, "world_file", sc->earth.cloud_world_file);
+}
+
 char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_state *s)
 {
     cJSON *root = cJSON_Parse(scene_json && *scene_json ? scene_json : "{}");
@@ -170,6 +222,7 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
     cJSON *wl = object(root, "wavelengths");
     set(wl, "mode", cJSON_CreateString(s->spectral ? "spectral" : "rgb"));
     cJSON_DeleteItemFromObjectCaseSensitive(root, "animation");
+    files_absolute(root, sc);
     if (s->renderer == ATMOS_RENDERER_SKY) {
         cJSON_DeleteItemFromObjectCaseSensitive(root, "volume"); /* the sky renderer's frame is without it */
     } else if (sc->volume.source[0]) {

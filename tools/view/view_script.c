@@ -207,7 +207,7 @@ int view_script_frames(const view_script *s)
     if (!s || s->n == 0) return 0;
     /* frame i at t = i / fps: the first frame at or after the last key frame's time */
     const double f = ceil(s->k[s->n - 1].t * s->fps - 1e-9);
-    return !(f > 0) ? 1 : f < 10000000 ? (int)f + 1 : 10000000;
+    return !(f > 0) ? 1 : f < VIEW_FRAMES_MAX ? (int)f + 1 : VIEW_FRAMES_MAX + 1;
 }
 
 int view_script_check(const view_script *s, const view_state *st, const char *path)
