@@ -37,6 +37,10 @@
 #define DO_MAX_ITER 200
 #define SKY_NS 4 /* the sky's samples per direction's patch: SKY_NS x SKY_NS */
 #define WS_MAX 64 /* the wavelengths solved in parallel at most (their buffers) */
+/* the face neighbours' first scattering in a voxel's local radiance, per neighbour, in voxel
+ * sizes: the largest that keeps the smooth clouds within about a point of their images without
+ * the sub-cell term (docs/lightfield.md, "The cells' averaging: a sub-cell term") */
+#define SUB_NB 0.4
 
 /* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
  * DO_NPHI, atmos__do_quadrature's order: the cosines descending), the mean over the direction's
@@ -82,16 +86,32 @@ static inline double escape(double x)
     return x < 1e-3 ? 1 - 0.5 * x : (1 - atmos__expf_fast((float)-x)) / x;
 }
 
+/* The densities of the voxel (x, y, z)'s six face neighbours in the grid, summed per field (nb). */
+static void neighbours(const sgrid *g, int nf, int x, int y, int z, double *nb)
+{
+    const int xyz[3] = {x, y, z};
+    for (int a = 0; a < 3; a++)
+        for (int d = -1; d <= 1; d += 2) {
+            int q[3] = {xyz[0], xyz[1], xyz[2]};
+            q[a] += d;
+            if (q[a] < 0 || q[a] >= g->c[a]) continue;
+            const size_t u = (((size_t)q[2] * g->c[1] + q[1]) * g->c[0] + q[0]) * nf;
+            for (int f = 0; f < nf; f++) nb[f] += g->v[u + f];
+        }
+}
+
 /* Per cell and wavelength w < n the mean sigma_t, sigma_s (1/m: st + 2 cells w, the cells' sigma_t
  * then their sigma_s) and the mean of sigma_s E T_sun over its render voxels (src + cells w): the
  * wavelengths in one pass over the voxels, an empty voxel (no field's density) skipped once.
  * And the cell's sub-cell term (dsrc + cells w, per unit E; 0 for cells of 1 voxel): the eye pass
  * multiplies the cell's one radiance by each voxel's sigma_s, where it should read the voxels'
  * radiance weighted by their sigma_s, and a dense sunlit voxel sees its own first scattering
- * (docs/lightfield.md, "The cells' averaging"). Each voxel's share of it is taken as its first
- * order's emission s1 = sigma_s T_sun over the voxel's size, at most its mean free path
- * (h escape(sigma_t h)); the term is the mean of that weighted by sigma_s less its plain mean, the
- * covariance of sigma_s and the local radiance over sigma_s's mean: 0 in a uniform cell. */
+ * (docs/lightfield.md, "The cells' averaging"). A voxel's local radiance is taken as its first
+ * order's emission sigma_s T_sun over the voxel's size, at most its mean free path
+ * (h escape(sigma_t h)), plus SUB_NB h times its six face neighbours' sigma_s seen with its own
+ * T_sun (their first scattering, in a texture whose dense voxels sit together); the term is the
+ * mean of that weighted by sigma_s less its plain mean, the covariance of sigma_s and the local
+ * radiance over sigma_s's mean: 0 in a uniform cell. */
 static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, int n, const double sun_g[3], float *st,
                         double *src, double *dsrc, int threads)
 {
@@ -116,6 +136,8 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                             int any = 0;
                             for (int f = 0; f < nf; f++) any |= g->v[v + f] != 0;
                             if (!any) continue; /* adds 0 to every sum */
+                            double nb[ATMOS_VOLUME_MAX_FIELDS] = {0};
+                            if (s > 1) neighbours(g, nf, x, y, z, nb);
                             for (int w = 0; w < n; w++) {
                                 double t = 0, sc = 0, tau = 0;
                                 for (int f = 0; f < nf; f++) {
@@ -124,10 +146,12 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                                 }
                                 at[w] += t, as[w] += sc;
                                 if (!(sc != 0)) continue; /* no exponentials */
-                                const double s1 = sc * mean_transmittance(tau, 0.5 * fmin(t * len, 2 * tau));
-                                aq[w] += s1;
+                                const double tr = mean_transmittance(tau, 0.5 * fmin(t * len, 2 * tau));
+                                aq[w] += sc * tr;
                                 if (s == 1) continue; /* a voxel's cell: no spread */
-                                const double l1 = s1 * hv * escape(t * hv);
+                                double scn = 0;
+                                for (int f = 0; f < nf; f++) scn += nb[f] * np->mc_sca[f][w];
+                                const double l1 = hv * tr * (sc * escape(t * hv) + SUB_NB * scn);
                                 la[w] += l1, lw[w] += sc * l1;
                             }
                         }
