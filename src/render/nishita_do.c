@@ -38,8 +38,8 @@
 #define SKY_NS 4 /* the sky's samples per direction's patch: SKY_NS x SKY_NS */
 #define WS_MAX 64 /* the wavelengths solved in parallel at most (their buffers) */
 /* the face neighbours' first scattering in a voxel's local radiance, per neighbour, in voxel
- * sizes: the largest that keeps the smooth clouds within about a point of their images without
- * the sub-cell term (docs/lightfield.md, "The cells' averaging: a sub-cell term") */
+ * sizes: fitted on a textured crop against its field on cells of 1 voxel (docs/lightfield.md,
+ * "The cells' averaging: a sub-cell term") */
 #define SUB_NB 0.4
 
 /* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
@@ -108,10 +108,13 @@ static void neighbours(const sgrid *g, int nf, int x, int y, int z, double *nb)
  * radiance weighted by their sigma_s, and a dense sunlit voxel sees its own first scattering
  * (docs/lightfield.md, "The cells' averaging"). A voxel's local radiance is taken as its first
  * order's emission sigma_s T_sun over the voxel's size, at most its mean free path
- * (h escape(sigma_t h)), plus SUB_NB h times its six face neighbours' sigma_s seen with its own
- * T_sun (their first scattering, in a texture whose dense voxels sit together); the term is the
- * mean of that weighted by sigma_s less its plain mean, the covariance of sigma_s and the local
- * radiance over sigma_s's mean: 0 in a uniform cell. */
+ * (h escape(sigma_t h)), plus SUB_NB h times its six face neighbours' sigma_s seen with the
+ * sunlight at its sunward face (their first scattering, in a texture whose dense voxels sit
+ * together; with the voxel's own mean T_sun a dense voxel's neighbours looked dark); the term is the
+ * mean of that weighted by sigma_s less its plain mean over the scattering voxels (an empty
+ * voxel's radiance is its neighbours', not 0: counted as 0 a uniform slab's edge cells got a
+ * term), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
+ * scattering voxels are uniform. */
 static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, int n, const double sun_g[3], float *st,
                         double *src, double *dsrc, int threads)
 {
@@ -128,7 +131,8 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
                 double at[ATMOS_MAX_WAVELENGTHS], as[ATMOS_MAX_WAVELENGTHS], aq[ATMOS_MAX_WAVELENGTHS];
                 double la[ATMOS_MAX_WAVELENGTHS], lw[ATMOS_MAX_WAVELENGTHS];
-                for (int w = 0; w < n; w++) at[w] = as[w] = aq[w] = la[w] = lw[w] = 0;
+                int nv[ATMOS_MAX_WAVELENGTHS];
+                for (int w = 0; w < n; w++) at[w] = as[w] = aq[w] = la[w] = lw[w] = 0, nv[w] = 0;
                 for (int z = k * s; z < (k + 1) * s && z < g->c[2]; z++)
                     for (int y = j * s; y < (j + 1) * s && y < g->c[1]; y++)
                         for (int x = i * s; x < (i + 1) * s && x < g->c[0]; x++) {
@@ -146,19 +150,21 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                                 }
                                 at[w] += t, as[w] += sc;
                                 if (!(sc != 0)) continue; /* no exponentials */
-                                const double tr = mean_transmittance(tau, 0.5 * fmin(t * len, 2 * tau));
+                                const double hs = 0.5 * fmin(t * len, 2 * tau);
+                                const double tr = mean_transmittance(tau, hs);
                                 aq[w] += sc * tr;
                                 if (s == 1) continue; /* a voxel's cell: no spread */
                                 double scn = 0;
                                 for (int f = 0; f < nf; f++) scn += nb[f] * np->mc_sca[f][w];
-                                const double l1 = hv * tr * (sc * escape(t * hv) + SUB_NB * scn);
-                                la[w] += l1, lw[w] += sc * l1;
+                                const double l1 = hv * (tr * sc * escape(t * hv) +
+                                                        SUB_NB * scn * atmos__expf_fast((float)(hs - tau)));
+                                la[w] += l1, lw[w] += sc * l1, nv[w]++;
                             }
                         }
                 for (int w = 0; w < n; w++)
                     st[2 * cells * w + c] = (float)(at[w] * inv), st[2 * cells * w + cells + c] = (float)(as[w] * inv),
                                        src[cells * w + c] = aq[w] * inv,
-                                       dsrc[cells * w + c] = as[w] > 0 ? lw[w] / as[w] - la[w] * inv : 0;
+                                       dsrc[cells * w + c] = nv[w] > 0 ? lw[w] / as[w] - la[w] / nv[w] : 0;
             }
 }
 
