@@ -7,7 +7,9 @@
  * along the sun), the quadrature's directions about the world's axes (the harmonics' frame),
  * swept along the cells' axes; the first wavelength solved on all the threads, the others in
  * parallel, one a thread, each started from the first one's solution (solve_all); the moments
- * times chi_l are the field's coefficients (the emission of orders >= 2 per unit sigma_s).
+ * times chi_l are the field's coefficients (the emission of orders >= 2 per unit sigma_s), plus
+ * per cell the sub-cell term that gives the eye the voxels' sigma_s-weighted radiance
+ * (cell_medium).
  *
  * The sky's and the ground's light (with atm) enter as the sweeps' inflow through the grid's
  * faces: per direction the mean over its patch of the sphere of what a view ray from the box's
@@ -35,6 +37,10 @@
 #define DO_MAX_ITER 200
 #define SKY_NS 4 /* the sky's samples per direction's patch: SKY_NS x SKY_NS */
 #define WS_MAX 64 /* the wavelengths solved in parallel at most (their buffers) */
+/* the face neighbours' first scattering in a voxel's local radiance, per neighbour, in voxel
+ * sizes: fitted on a textured crop against its field on cells of 1 voxel (docs/lightfield.md,
+ * "The cells' averaging: a sub-cell term") */
+#define SUB_NB 0.4
 
 /* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
  * DO_NPHI, atmos__do_quadrature's order: the cosines descending), the mean over the direction's
@@ -73,25 +79,60 @@ static inline double mean_transmittance(double tau, double h)
     return (atmos__expf_fast((float)(h - tau)) - atmos__expf_fast((float)(-h - tau))) / (2 * h);
 }
 
+/* (1 - e^-x) / x: the mean of e^-tau over [0, x], the share of a voxel's own emission that its
+ * optical size x lets reach a point of it (as a length: the voxel's size times this). */
+static inline double escape(double x)
+{
+    return x < 1e-3 ? 1 - 0.5 * x : (1 - atmos__expf_fast((float)-x)) / x;
+}
+
+/* The densities of the voxel (x, y, z)'s six face neighbours in the grid, summed per field (nb). */
+static void neighbours(const sgrid *g, int nf, int x, int y, int z, double *nb)
+{
+    const int xyz[3] = {x, y, z};
+    for (int a = 0; a < 3; a++)
+        for (int d = -1; d <= 1; d += 2) {
+            int q[3] = {xyz[0], xyz[1], xyz[2]};
+            q[a] += d;
+            if (q[a] < 0 || q[a] >= g->c[a]) continue;
+            const size_t u = (((size_t)q[2] * g->c[1] + q[1]) * g->c[0] + q[0]) * nf;
+            for (int f = 0; f < nf; f++) nb[f] += g->v[u + f];
+        }
+}
+
 /* Per cell and wavelength w < n the mean sigma_t, sigma_s (1/m: st + 2 cells w, the cells' sigma_t
  * then their sigma_s) and the mean of sigma_s E T_sun over its render voxels (src + cells w): the
- * wavelengths in one pass over the voxels, an empty voxel (no field's density) skipped once. */
+ * wavelengths in one pass over the voxels, an empty voxel (no field's density) skipped once.
+ * And the cell's sub-cell term (dsrc + cells w, per unit E; 0 for cells of 1 voxel): the eye pass
+ * multiplies the cell's one radiance by each voxel's sigma_s, where it should read the voxels'
+ * radiance weighted by their sigma_s, and a dense sunlit voxel sees its own first scattering
+ * (docs/lightfield.md, "The cells' averaging"). A voxel's local radiance is taken as its first
+ * order's emission sigma_s T_sun over the voxel's size, at most its mean free path
+ * (h escape(sigma_t h)), plus SUB_NB h times its six face neighbours' sigma_s seen with the
+ * sunlight at its sunward face (their first scattering, in a texture whose dense voxels sit
+ * together; with the voxel's own mean T_sun a dense voxel's neighbours looked dark); the term is the
+ * mean of that weighted by sigma_s less its plain mean over the scattering voxels (an empty
+ * voxel's radiance is its neighbours', not 0: counted as 0 a uniform slab's edge cells got a
+ * term), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
+ * scattering voxels are uniform. */
 static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, int n, const double sun_g[3], float *st,
-                        double *src, int threads)
+                        double *src, double *dsrc, int threads)
 {
     const sgrid *g = &np->g;
     const int s = F->s, nf = np->nf;
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     double amax = 0;
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
-    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s);
+    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s), hv = 1.0 / g->sc;
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int k = 0; k < F->c[2]; k++)
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
                 double at[ATMOS_MAX_WAVELENGTHS], as[ATMOS_MAX_WAVELENGTHS], aq[ATMOS_MAX_WAVELENGTHS];
-                for (int w = 0; w < n; w++) at[w] = as[w] = aq[w] = 0;
+                double la[ATMOS_MAX_WAVELENGTHS], lw[ATMOS_MAX_WAVELENGTHS];
+                int nv[ATMOS_MAX_WAVELENGTHS];
+                for (int w = 0; w < n; w++) at[w] = as[w] = aq[w] = la[w] = lw[w] = 0, nv[w] = 0;
                 for (int z = k * s; z < (k + 1) * s && z < g->c[2]; z++)
                     for (int y = j * s; y < (j + 1) * s && y < g->c[1]; y++)
                         for (int x = i * s; x < (i + 1) * s && x < g->c[0]; x++) {
@@ -99,6 +140,8 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                             int any = 0;
                             for (int f = 0; f < nf; f++) any |= g->v[v + f] != 0;
                             if (!any) continue; /* adds 0 to every sum */
+                            double nb[ATMOS_VOLUME_MAX_FIELDS] = {0};
+                            if (s > 1) neighbours(g, nf, x, y, z, nb);
                             for (int w = 0; w < n; w++) {
                                 double t = 0, sc = 0, tau = 0;
                                 for (int f = 0; f < nf; f++) {
@@ -107,12 +150,21 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
                                 }
                                 at[w] += t, as[w] += sc;
                                 if (!(sc != 0)) continue; /* no exponentials */
-                                aq[w] += sc * mean_transmittance(tau, 0.5 * fmin(t * len, 2 * tau));
+                                const double hs = 0.5 * fmin(t * len, 2 * tau);
+                                const double tr = mean_transmittance(tau, hs);
+                                aq[w] += sc * tr;
+                                if (s == 1) continue; /* a voxel's cell: no spread */
+                                double scn = 0;
+                                for (int f = 0; f < nf; f++) scn += nb[f] * np->mc_sca[f][w];
+                                const double l1 = hv * (tr * sc * escape(t * hv) +
+                                                        SUB_NB * scn * atmos__expf_fast((float)(hs - tau)));
+                                la[w] += l1, lw[w] += sc * l1, nv[w]++;
                             }
                         }
                 for (int w = 0; w < n; w++)
                     st[2 * cells * w + c] = (float)(at[w] * inv), st[2 * cells * w + cells + c] = (float)(as[w] * inv),
-                                       src[cells * w + c] = aq[w] * inv;
+                                       src[cells * w + c] = aq[w] * inv,
+                                       dsrc[cells * w + c] = nv[w] > 0 ? lw[w] / as[w] - la[w] / nv[w] : 0;
             }
 }
 
@@ -124,7 +176,7 @@ typedef struct {
     int n, K;
     size_t cells;
     const float *st;
-    const double *src, *Ys, *E, *sky; /* sky: per direction and wavelength, NULL: none */
+    const double *src, *dsrc, *Ys, *E, *sky; /* sky: per direction and wavelength, NULL: none */
     const double (*chi)[4];
     float *coef;
 } do_fill;
@@ -149,8 +201,13 @@ static int solve_w(const do_fill *D, int w, double *q1, int threads, atmos__do_w
     for (int d = 0; D->sky && d < P.quad->n; d++) inw[d] = D->sky[d * n + w];
     P.inflow = D->sky ? inw : NULL;
     const int ok = atmos__do_solve(&P, phi, S);
-    for (size_t c = 0; c < cells && ok; c++)
-        for (int k = 0; k < K; k++) D->coef[(c * n + w) * K + k] = (float)(chik[k] * phi[c * K + k]);
+    for (size_t c = 0; c < cells && ok; c++) {
+        /* the sub-cell term as radiance moments of the first order's emission over a length:
+           q1's harmonics times the term, into the coefficients only (phi stays the solve's) */
+        const double e = D->E[w] * D->dsrc[cells * w + c];
+        for (int k = 0; k < K; k++)
+            D->coef[(c * n + w) * K + k] = (float)(chik[k] * (phi[c * K + k] + e * chik[k] * D->Ys[k]));
+    }
     return ok;
 }
 
@@ -228,24 +285,25 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     for (int d = 0; sky_on && d < quad.n; d++)
         for (int w = 0; w < n; w++) skymean[w] += sky[d * n + w] * quad.w[d];
     float *st = malloc(sizeof(float) * cells * 2 * n); /* per wavelength sigma_t, sigma_s */
-    double *src = malloc(sizeof(double) * cells * n);
+    double *src = malloc(sizeof(double) * cells * n * 2), *dsrc = src ? src + cells * n : NULL;
     int ok = st && src;
     P->c[0] = F->c[0], P->c[1] = F->c[1], P->c[2] = F->c[2], P->h = F->s / (double)np->g.sc, P->L = L, P->quad = &quad;
     P->theta = ATMOS__DO_THETA, P->theta_tau = ATMOS__DO_THETA_TAU; /* the weighted diamond (lfield_do.h) */
     P->tol = DO_TOL, P->max_iter = DO_MAX_ITER, P->restart = DO_RESTART;
     P->dsa = ATMOS__DO_DSA_AUTO; /* GMRES preconditioned by the P1 solve of the low moments where it pays
                                    (lfield_dsa.h, lfield_do.h) */
-    D.n = n, D.K = K, D.cells = cells, D.st = st, D.src = src, D.Ys = Ys, D.E = E, D.sky = sky_on ? sky : NULL;
-    D.chi = chi, D.coef = coef;
+    D.n = n, D.K = K, D.cells = cells, D.st = st, D.src = src, D.dsrc = dsrc, D.Ys = Ys, D.E = E;
+    D.sky = sky_on ? sky : NULL, D.chi = chi, D.coef = coef;
     /* a wavelength whose medium and phase are the last one's (a grey cloud, no sky): its field is
      * the last one's times the ratio of the sunlight; the others solved */
     int copy[ATMOS_MAX_WAVELENGTHS] = {0}, wl[ATMOS_MAX_WAVELENGTHS], ns = 0;
-    if (ok) cell_medium(np, F, n, ltg, st, src, threads);
+    if (ok) cell_medium(np, F, n, ltg, st, src, dsrc, threads);
     for (int w = 0; w < n && ok; w++) {
         const float *sw = st + 2 * cells * w;
         copy[w] = w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&
                   !memcmp(sw, sw - 2 * cells, sizeof(float) * cells * 2) &&
-                  !memcmp(src + cells * w, src + cells * (w - 1), sizeof(double) * cells);
+                  !memcmp(src + cells * w, src + cells * (w - 1), sizeof(double) * cells) &&
+                  !memcmp(dsrc + cells * w, dsrc + cells * (w - 1), sizeof(double) * cells);
         if (!copy[w]) wl[ns++] = w;
     }
     ok = ok && solve_all(&D, wl, ns, skymean, phi_all, warm, threads, ws, info);
