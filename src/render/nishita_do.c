@@ -9,7 +9,7 @@
  * parallel, one a thread, each started from the first one's solution (solve_all); the moments
  * times chi_l are the field's coefficients (the emission of orders >= 2 per unit sigma_s), plus
  * per cell the sub-cell term that gives the eye the voxels' sigma_s-weighted radiance
- * (cell_medium).
+ * (cell_source).
  *
  * The sky's and the ground's light (with atm) enter as the sweeps' inflow through the grid's
  * faces: per direction the mean over its patch of the sphere of what a view ray from the box's
@@ -26,6 +26,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -100,9 +101,90 @@ static void neighbours(const sgrid *g, int nf, int x, int y, int z, double *nb)
         }
 }
 
-/* Per cell and wavelength w < n the mean sigma_t, sigma_s (1/m: st + 2 cells w, the cells' sigma_t
- * then their sigma_s) and the mean of sigma_s E T_sun over its render voxels (src + cells w): the
- * wavelengths in one pass over the voxels, an empty voxel (no field's density) skipped once.
+/* The cells' medium, the same for every sun: per wavelength the cells' mean sigma_t and sigma_s
+ * (1/m; st + 2 cells w, the cells' sigma_t then their sigma_s), and the render voxels holding a
+ * field's density, cell by cell in the order z, y, x (vox[first[c] .. first[c + 1]): each one's
+ * place in its cell, x | y << 4 | z << 8, the cells' edge at most 16 voxels). An empty voxel adds
+ * 0 to every sum: a sun's source (cell_source) visits the others alone. */
+struct atmos__do_cells {
+    float *st;
+    uint16_t *vox;
+    size_t *first;
+};
+
+void atmos__do_cells_free(atmos__do_cells *dc)
+{
+    if (dc) free(dc->st), free(dc->vox), free(dc->first), free(dc);
+}
+
+/* Cell (i, j, k)'s voxels holding a field's density: their count, with vox (else NULL) their
+ * places into vox, with at, as (else NULL) their sums of sigma_t and sigma_s per wavelength. */
+static size_t cell_voxels(const atmos__nishita_plan *np, int s, int n, int i, int j, int k, uint16_t *vox, double *at,
+                          double *as)
+{
+    const sgrid *g = &np->g;
+    const int nf = np->nf;
+    size_t m = 0;
+    for (int z = k * s; z < (k + 1) * s && z < g->c[2]; z++)
+        for (int y = j * s; y < (j + 1) * s && y < g->c[1]; y++)
+            for (int x = i * s; x < (i + 1) * s && x < g->c[0]; x++) {
+                const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
+                int any = 0;
+                for (int f = 0; f < nf; f++) any |= g->v[v + f] != 0;
+                if (!any) continue;
+                if (vox) vox[m] = (uint16_t)((x - i * s) | (y - j * s) << 4 | (z - k * s) << 8);
+                m++;
+                for (int w = 0; at && w < n; w++) {
+                    double t = 0, sc = 0;
+                    for (int f = 0; f < nf; f++)
+                        t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w];
+                    at[w] += t, as[w] += sc;
+                }
+            }
+    return m;
+}
+
+/* The cells' medium of np on F's cells (struct atmos__do_cells); NULL when out of memory. */
+static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__lfield *F, int n, int threads)
+{
+    const int s = F->s;
+    const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
+    const double inv = 1.0 / ((double)s * s * s);
+    atmos__do_cells *dc = calloc(1, sizeof *dc);
+    if (!dc || !(dc->st = malloc(sizeof(float) * cells * 2 * n)) ||
+        !(dc->first = malloc(sizeof(size_t) * (cells + 1)))) {
+        atmos__do_cells_free(dc);
+        return NULL;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int k = 0; k < F->c[2]; k++)
+        for (int j = 0; j < F->c[1]; j++)
+            for (int i = 0; i < F->c[0]; i++) {
+                const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
+                double at[ATMOS_MAX_WAVELENGTHS] = {0}, as[ATMOS_MAX_WAVELENGTHS] = {0};
+                dc->first[c + 1] = cell_voxels(np, s, n, i, j, k, NULL, at, as);
+                for (int w = 0; w < n; w++)
+                    dc->st[2 * cells * w + c] = (float)(at[w] * inv),
+                                           dc->st[2 * cells * w + cells + c] = (float)(as[w] * inv);
+            }
+    dc->first[0] = 0;
+    for (size_t c = 0; c < cells; c++) dc->first[c + 1] += dc->first[c];
+    if (!(dc->vox = malloc(sizeof(uint16_t) * (dc->first[cells] + 1)))) {
+        atmos__do_cells_free(dc);
+        return NULL;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int k = 0; k < F->c[2]; k++)
+        for (int j = 0; j < F->c[1]; j++)
+            for (int i = 0; i < F->c[0]; i++) {
+                const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
+                cell_voxels(np, s, n, i, j, k, dc->vox + dc->first[c], NULL, NULL);
+            }
+    return dc;
+}
+
+/* Per cell and wavelength w < n the mean of sigma_s E T_sun over its render voxels (src + cells w)
+ * for the sun along sun_g (grid frame), over the voxels holding a field's density (dc).
  * And the cell's sub-cell term (dsrc + cells w, per unit E; 0 for cells of 1 voxel): the eye pass
  * multiplies the cell's one radiance by each voxel's sigma_s, where it should read the voxels'
  * radiance weighted by their sigma_s, and a dense sunlit voxel sees its own first scattering
@@ -115,8 +197,8 @@ static void neighbours(const sgrid *g, int nf, int x, int y, int z, double *nb)
  * voxel's radiance is its neighbours', not 0: counted as 0 a uniform slab's edge cells got a
  * term), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
  * scattering voxels are uniform. */
-static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, int n, const double sun_g[3], float *st,
-                        double *src, double *dsrc, int threads)
+static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, const atmos__do_cells *dc, int n,
+                        const double sun_g[3], double *src, double *dsrc, int threads)
 {
     const sgrid *g = &np->g;
     const int s = F->s, nf = np->nf;
@@ -124,47 +206,43 @@ static void cell_medium(const atmos__nishita_plan *np, const atmos__lfield *F, i
     double amax = 0;
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
     const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s), hv = 1.0 / g->sc;
+    float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS], sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    for (int f = 0; f < nf; f++)
+        for (int w = 0; w < n; w++) sig[f][w] = np->mc_sig_ms[f][w], sca[f][w] = np->mc_sca[f][w];
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int k = 0; k < F->c[2]; k++)
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
-                double at[ATMOS_MAX_WAVELENGTHS], as[ATMOS_MAX_WAVELENGTHS], aq[ATMOS_MAX_WAVELENGTHS];
-                double la[ATMOS_MAX_WAVELENGTHS], lw[ATMOS_MAX_WAVELENGTHS];
-                int nv[ATMOS_MAX_WAVELENGTHS];
-                for (int w = 0; w < n; w++) at[w] = as[w] = aq[w] = la[w] = lw[w] = 0, nv[w] = 0;
-                for (int z = k * s; z < (k + 1) * s && z < g->c[2]; z++)
-                    for (int y = j * s; y < (j + 1) * s && y < g->c[1]; y++)
-                        for (int x = i * s; x < (i + 1) * s && x < g->c[0]; x++) {
-                            const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
-                            int any = 0;
-                            for (int f = 0; f < nf; f++) any |= g->v[v + f] != 0;
-                            if (!any) continue; /* adds 0 to every sum */
-                            double nb[ATMOS_VOLUME_MAX_FIELDS] = {0};
-                            if (s > 1) neighbours(g, nf, x, y, z, nb);
-                            for (int w = 0; w < n; w++) {
-                                double t = 0, sc = 0, tau = 0;
-                                for (int f = 0; f < nf; f++) {
-                                    t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w];
-                                    tau += np->col[v + f] * np->mc_sig_ms[f][w];
-                                }
-                                at[w] += t, as[w] += sc;
-                                if (!(sc != 0)) continue; /* no exponentials */
-                                const double hs = 0.5 * fmin(t * len, 2 * tau);
-                                const double tr = mean_transmittance(tau, hs);
-                                aq[w] += sc * tr;
-                                if (s == 1) continue; /* a voxel's cell: no spread */
-                                double scn = 0;
-                                for (int f = 0; f < nf; f++) scn += nb[f] * np->mc_sca[f][w];
-                                const double l1 = hv * (tr * sc * escape(t * hv) +
-                                                        SUB_NB * scn * atmos__expf_fast((float)(hs - tau)));
-                                la[w] += l1, lw[w] += sc * l1, nv[w]++;
-                            }
+                double aq[ATMOS_MAX_WAVELENGTHS] = {0}, as[ATMOS_MAX_WAVELENGTHS] = {0};
+                double la[ATMOS_MAX_WAVELENGTHS] = {0}, lw[ATMOS_MAX_WAVELENGTHS] = {0};
+                int nv[ATMOS_MAX_WAVELENGTHS] = {0};
+                for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
+                    const int p = dc->vox[e], x = i * s + (p & 15), y = j * s + (p >> 4 & 15), z = k * s + (p >> 8);
+                    const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
+                    double nb[ATMOS_VOLUME_MAX_FIELDS] = {0};
+                    if (s > 1) neighbours(g, nf, x, y, z, nb);
+                    for (int w = 0; w < n; w++) {
+                        double t = 0, sc = 0, tau = 0;
+                        for (int f = 0; f < nf; f++) {
+                            t += g->v[v + f] * sig[f][w], sc += g->v[v + f] * sca[f][w];
+                            tau += np->col[v + f] * sig[f][w];
                         }
+                        as[w] += sc;
+                        if (!(sc != 0)) continue; /* no exponentials */
+                        const double tl = t * len; /* fmin's value, no call: neither is NaN */
+                        const double hs = 0.5 * (tl < 2 * tau ? tl : 2 * tau), tr = mean_transmittance(tau, hs);
+                        aq[w] += sc * tr;
+                        if (s == 1) continue; /* a voxel's cell: no spread */
+                        double scn = 0;
+                        for (int f = 0; f < nf; f++) scn += nb[f] * sca[f][w];
+                        const double l1 =
+                            hv * (tr * sc * escape(t * hv) + SUB_NB * scn * atmos__expf_fast((float)(hs - tau)));
+                        la[w] += l1, lw[w] += sc * l1, nv[w]++;
+                    }
+                }
                 for (int w = 0; w < n; w++)
-                    st[2 * cells * w + c] = (float)(at[w] * inv), st[2 * cells * w + cells + c] = (float)(as[w] * inv),
-                                       src[cells * w + c] = aq[w] * inv,
-                                       dsrc[cells * w + c] = nv[w] > 0 ? lw[w] / as[w] - la[w] / nv[w] : 0;
+                    src[cells * w + c] = aq[w] * inv, dsrc[cells * w + c] = nv[w] > 0 ? lw[w] / as[w] - la[w] / nv[w] : 0;
             }
 }
 
@@ -183,7 +261,7 @@ typedef struct {
 
 /* Wavelength w's solve from phi as it is (its start) on threads threads with ws's buffers and q1
  * (cells * K) for the emission: its moments into phi, its coefficients into D->coef. */
-static int solve_w(const do_fill *D, int w, double *q1, int threads, atmos__do_ws *ws, double *phi,
+static int solve_w(const do_fill *D, int w, double *q1, int threads, int dsa, atmos__do_ws *ws, double *phi,
                    atmos__do_stats *S)
 {
     const size_t cells = D->cells;
@@ -191,6 +269,7 @@ static int solve_w(const do_fill *D, int w, double *q1, int threads, atmos__do_w
     atmos__do_problem P = D->P;
     double inw[ATMOS__DO_NMAX];
     P.sig_t = D->st + 2 * cells * w, P.sig_s = P.sig_t + cells, P.q1 = q1, P.threads = threads, P.ws = ws;
+    P.dsa = dsa;
     double chik[ATMOS__DO_KMAX]; /* chi_l of each coefficient */
     for (int l = 0; l <= P.L; l++) P.chi[l] = D->chi[w][l];
     for (int k = 0; k < K; k++) chik[k] = D->chi[w][atmos__sh_degree(k)];
@@ -214,8 +293,17 @@ static int solve_w(const do_fill *D, int w, double *q1, int threads, atmos__do_w
 /* The wavelengths to solve, wl[0 .. ns - 1] (the first on all the threads, from phi_all's start
  * with warm, else 0; the others each on one thread, in parallel, from the first one's solution
  * times the ratio of the sunlight, or of the sky's mean radiance with the sun off: the clouds are
- * nearly grey, 2 GMRES iterations on the Disney cloud where the last sun's start takes 3). Which
- * thread solves which wavelength changes no number. Returns 0 when out of memory. */
+ * nearly grey, 2 GMRES iterations on the Disney cloud where the last sun's start takes 3). When
+ * the first one's solve switched the diffusion preconditioner on (ATMOS__DO_DSA_AUTO), the others
+ * have it from their first iteration: their media are nearly the first one's, and their rates
+ * would switch it on later anyway (the generated storm: the third wavelength 12 GMRES iterations
+ * instead of 16, the fill -1.1 % instructions; the second's 10 either way). But
+ * when the first, started from 0, took one GMRES iteration or none (an optically thin medium:
+ * its first order, the sweep of the source, is nearly the whole), the others start from 0 too:
+ * one iteration each, where the ratio's start pays a sweep for its residual and then mostly
+ * still that iteration (the Disney cloud in `atmos bench slice`, at its file's densities: 2
+ * sweeps a wavelength instead of 3). Which thread solves which wavelength changes no number.
+ * Returns 0 when out of memory. */
 static int solve_all(const do_fill *D, const int *wl, int ns, const double *skymean, double *phi_all, int warm,
                      int threads, atmos__do_ws *ws, atmos__nishita_do_info *info)
 {
@@ -231,17 +319,19 @@ static int solve_all(const do_fill *D, const int *wl, int ns, const double *skym
     if (!q1) return 0;
     for (int t = 0; t < nt; t++) wss[t] = atmos__do_ws_at(ws, t);
     if (!warm) memset(phi0, 0, sizeof(double) * NK);
-    oks[0] = solve_w(D, w0, q1, threads, ws, phi0, &S[0]);
+    oks[0] = solve_w(D, w0, q1, threads, D->P.dsa, ws, phi0, &S[0]);
+    const int thin = !warm && S[0].iters <= 1;
+    const int dsa = S[0].dsa_at >= 0 ? ATMOS__DO_DSA_ON : D->P.dsa;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
     for (int i = 1; i < ns; i++) {
         const int w = wl[i], t = omp_get_thread_num();
-        const double ratio = !oks[0]            ? 0
+        const double ratio = !oks[0] || thin    ? 0
                              : D->E[w0] > 0     ? D->E[w] / D->E[w0]
                              : skymean[w0] > 0 ? skymean[w] / skymean[w0]
                                                 : 0;
         double *phi = phi_all + (size_t)w * NK;
         for (size_t j = 0; j < NK; j++) phi[j] = ratio > 0 ? phi0[j] * ratio : warm ? phi[j] : 0;
-        oks[i] = solve_w(D, w, q1 + NK * t, 1, wss[t], phi, &S[i]);
+        oks[i] = solve_w(D, w, q1 + NK * t, 1, dsa, wss[t], phi, &S[i]);
     }
     int ok = 1;
     for (int i = 0; i < ns; i++) {
@@ -256,7 +346,7 @@ static int solve_all(const do_fill *D, const int *wl, int ns, const double *skym
 atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
                                     const double chi[][4], const double sun_w[3], const double *E,
                                     const atmos_atmosphere *atm, int threads, float *coef, double *phi_all, int warm,
-                                    atmos__do_ws *ws, atmos__nishita_do_info *info)
+                                    atmos__do_ws *ws, atmos__do_cells **dc, atmos__nishita_do_info *info)
 {
     const int n = np->n, K = (L + 1) * (L + 1);
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2], NK = cells * K;
@@ -284,7 +374,8 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     const int sky_on = sky && sky_inflow(atm, np, &quad, sun_w, sky);
     for (int d = 0; sky_on && d < quad.n; d++)
         for (int w = 0; w < n; w++) skymean[w] += sky[d * n + w] * quad.w[d];
-    float *st = malloc(sizeof(float) * cells * 2 * n); /* per wavelength sigma_t, sigma_s */
+    if (!*dc) *dc = cells_make(np, F, n, threads);
+    const float *st = *dc ? (*dc)->st : NULL; /* per wavelength sigma_t, sigma_s */
     double *src = malloc(sizeof(double) * cells * n * 2), *dsrc = src ? src + cells * n : NULL;
     int ok = st && src;
     P->c[0] = F->c[0], P->c[1] = F->c[1], P->c[2] = F->c[2], P->h = F->s / (double)np->g.sc, P->L = L, P->quad = &quad;
@@ -297,7 +388,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     /* a wavelength whose medium and phase are the last one's (a grey cloud, no sky): its field is
      * the last one's times the ratio of the sunlight; the others solved */
     int copy[ATMOS_MAX_WAVELENGTHS] = {0}, wl[ATMOS_MAX_WAVELENGTHS], ns = 0;
-    if (ok) cell_medium(np, F, n, ltg, st, src, dsrc, threads);
+    if (ok) cell_source(np, F, *dc, n, ltg, src, dsrc, threads);
     for (int w = 0; w < n && ok; w++) {
         const float *sw = st + 2 * cells * w;
         copy[w] = w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&
@@ -315,7 +406,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
                 coef[(c * n + w) * K + k] = (float)(coef[(c * n + w - 1) * K + k] * (E[w] / E[w - 1]));
         for (size_t i = 0; i < NK; i++) phi[i] = phi[i - NK] * (E[w] / E[w - 1]);
     }
-    free(st), free(src), free(sky);
+    free(src), free(sky);
     info->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
     info->directions = quad.n;
     return ok ? ATMOS_OK : atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");

@@ -52,6 +52,9 @@ struct atmos__nishita_mc {
     double *do_phi;      /* with "do": the radiance moments per wavelength of the last sun (nishita_do.c) */
     int do_phi_valid;    /* do_phi holds a solve's: the start of the next sun's with a warm field */
     atmos__do_ws *do_ws; /* with "do": the solver's buffers, kept between suns */
+    atmos__do_cells *do_cells; /* with "do": the cells' medium, kept between suns */
+    double do_dens[PATH_F];    /* with "do": each field's density summed over the grid (do_dens_done) */
+    int do_dens_done;
     atmos__lfield field; /* L: its radiance toward the eye (cells of s render voxels) */
     /* per cell and wavelength the kernel-weighted sigma_s' (cell_ss()): the medium's alone, the
      * same for every sun, so made at the plan's first trace and kept (ss_done; NULL: no scattering) */
@@ -70,6 +73,7 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc)
     atmos__lfield_free(&mc->field);
     free(mc->coef), free(mc->do_phi), free(mc->ss);
     atmos__do_ws_free(mc->do_ws);
+    atmos__do_cells_free(mc->do_cells);
     free(mc);
 }
 
@@ -468,9 +472,11 @@ static atmos_status solve(atmos_plan *p, atmos__nishita_plan *np, const double s
 {
     atmos__nishita_mc *mc = np->mc;
     const int n = np->n, nf = np->nf;
-    double chi[ATMOS_MAX_WAVELENGTHS][4] = {{0}}, dens[PATH_F] = {0};
-    for (size_t v = 0; v < (size_t)np->g.c[0] * np->g.c[1] * np->g.c[2]; v++)
+    double chi[ATMOS_MAX_WAVELENGTHS][4] = {{0}};
+    double *dens = mc->do_dens; /* the medium's alone: summed at the plan's first solve */
+    for (size_t v = 0; !mc->do_dens_done && v < (size_t)np->g.c[0] * np->g.c[1] * np->g.c[2]; v++)
         for (int f = 0; f < nf; f++) dens[f] += np->g.v[v * nf + f];
+    mc->do_dens_done = 1;
     for (int w = 0; w < n; w++) {
         double S = 0;
         for (int f = 0; f < nf; f++) {
@@ -492,7 +498,7 @@ static atmos_status solve(atmos_plan *p, atmos__nishita_plan *np, const double s
     const atmos_status st =
         atmos__nishita_do_fill(p->ctx, np, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E,
                                np->opt.sky ? p->atm : NULL, threads, mc->coef, mc->do_phi,
-                               warm && mc->do_phi_valid, mc->do_ws, &info);
+                               warm && mc->do_phi_valid, mc->do_ws, &mc->do_cells, &info);
     mc->do_phi_valid = st == ATMOS_OK;
     np->do_iters = info.iters, np->do_sweeps = info.sweeps, np->do_dirs = info.directions;
     np->do_resid = info.resid, np->do_cpu = info.cpu_s;
