@@ -79,7 +79,8 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
                                       fmin(b->sigma_t * range, ATMOS__BEAMS_MAX_OPTICAL_RANGE), &b->table);
     }
     if (st == ATMOS_OK && s->fog.enabled) {
-        const atmos__beams_fog f = {o->sigma_t, o->sigma_s / o->sigma_t, o->g, s->fog.base_m, s->fog.height_m, o};
+        const atmos__beams_fog f = {.sigma0 = o->sigma_t, .albedo = o->sigma_s / o->sigma_t, .g = o->g,
+                                     .base_m = s->fog.base_m, .height_m = s->fog.height_m, .phase = o};
         b->fog = f;
     }
     b->sun_on = s->beams.sun;

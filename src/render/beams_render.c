@@ -371,7 +371,7 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
 
 /* The sun's light on the surface hit (beams_sun.h): where a ray toward the sun is free (not
  * cast where the sun's map proves the point in shadow, atmos__beams_sun_dark), dimmed by a
- * height-dependent fog above it on the way in and by fog_t on the way out. */
+ * height-dependent fog above it on the way in (its exp only where lit) and by fog_t on the way out. */
 static void sun_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
 {
     const atmos__beams_plan *b = J->b;
@@ -379,8 +379,11 @@ static void sun_surface(const job *J, const double d[3], const atmos_mesh_hit *h
     const double c = atmos__dot3(h->normal, s->dir), off = 1e-4 * (1 + h->t);
     const double o[3] = {J->eye[0] + h->t * d[0] + off * h->normal[0], J->eye[1] + h->t * d[1] + off * h->normal[1],
                          J->eye[2] + h->t * d[2] + off * h->normal[2]};
-    const double in = c > 0 ? exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)) : 0; /* dimmed on its way in */
-    if (c > 0 && in > 0 && !atmos__beams_sun_dark(s, o) && !atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
+    const int set = b->fog.height_m > 0 && !(s->dir[1] > 0); /* a layered fog's sun set: none in */
+    if (!(c > 0) || set || atmos__beams_sun_dark(s, o) || atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
+        return;
+    const double in = exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)); /* dimmed on its way in */
+    if (in > 0)
         for (int k = 0; k < J->nw; k++) L[k] += J->alb_pi[m][k] * s->E[k] * c * in * fog_t;
 }
 
@@ -897,6 +900,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         job_free(&J);
         return st;
     }
+    atmos__beams_fog_eye(&b->fog, J.eye, b->sun.dir); /* the eye's factors, once a frame, after the sun's */
     atmos__beams_il il = {0}, *ilp = NULL;
     atmos__beams_primary prim = {{0, 0, 0, 0}, NULL, NULL, 0, 0};
     int failed = 0, cancelled = 0;

@@ -9,10 +9,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* exp(-(y - base) / H), the eye's kept where y is its height (the same value). */
+static double density_factor(const atmos__beams_fog *f, double y)
+{
+    return f->eye_set && y == f->eye_y ? f->eye_e : exp(-(y - f->base_m) / f->height_m);
+}
+
 /* Along o + t d the fog is A exp(-k t): A at the eye, k = d_y / H (0 for uniform fog). */
 static void fog_line(const atmos__beams_fog *f, const double o[3], const double d[3], double *A, double *k)
 {
-    *A = f->height_m > 0 ? f->sigma0 * exp(-(o[1] - f->base_m) / f->height_m) : f->sigma0;
+    *A = f->height_m > 0 ? f->sigma0 * density_factor(f, o[1]) : f->sigma0;
     *k = f->height_m > 0 ? d[1] / f->height_m : 0;
 }
 
@@ -129,7 +135,15 @@ double atmos__beams_sun_fog_in(const atmos__beams_fog *f, const double sun[3], c
 {
     if (!(f->height_m > 0)) return 0; /* a uniform fog has no top: lit as it is */
     if (!(sun[1] > 0)) return INFINITY;
-    return f->sigma0 * exp(-(p[1] - f->base_m) / f->height_m) * f->height_m / sun[1];
+    return f->sigma0 * density_factor(f, p[1]) * f->height_m / sun[1];
+}
+
+void atmos__beams_fog_eye(atmos__beams_fog *f, const double o[3], const double sun[3])
+{
+    f->eye_set = 0;
+    const double e = f->height_m > 0 ? exp(-(o[1] - f->base_m) / f->height_m) : 1;
+    const double C = atmos__beams_sun_fog_in(f, sun, o);
+    f->eye_y = o[1], f->eye_e = e, f->eye_C = C, f->eye_expC = exp(-C), f->eye_set = 1;
 }
 
 /* One ray's steps (atmos__beams_sun_airlight): sample i at t(i), the map's coordinates and
@@ -219,7 +233,8 @@ static double sun_fog_ray(const atmos__beams_sun *s, const atmos__beams_fog *f, 
 static double sun_fog_light(const atmos__beams_sun *s, const atmos__beams_fog *f, const double d[3], double C)
 {
     const double c = atmos__dot3(s->dir, d);
-    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * exp(-C);
+    const double in = f->eye_set && C == f->eye_C ? f->eye_expC : exp(-C); /* the eye's kept */
+    return f->albedo * (f->phase ? atmos__fog_phase(f->phase, c) : atmos_phase_hg(c, f->g)) * in;
 }
 
 double atmos__beams_sun_airlight(const atmos__beams_sun *s, const atmos__beams_fog *f, const double o[3],

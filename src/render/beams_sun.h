@@ -23,7 +23,15 @@ typedef struct atmos__beams_fog {
     double sigma0, albedo, g;
     double base_m, height_m;
     const atmos__fog_optics *phase; /* the phase function; NULL: Henyey-Greenstein with g */
+    /* the frame's eye (atmos__beams_fog_eye; eye_set 0: none): the density's factor
+     * exp(-(y - base) / H) at its height eye_y, and the sunlight's dimming exp(-C) on its way in
+     * to it, kept so that its rays do not compute them again (the same values: the same bits) */
+    int eye_set;
+    double eye_y, eye_e, eye_C, eye_expC;
 } atmos__beams_fog;
+
+/* Keeps in f the eye's factors (above) for the eye at o, the sun (unit, toward it) at sun. */
+void atmos__beams_fog_eye(atmos__beams_fog *f, const double o[3], const double sun[3]);
 
 /* The optical depth from the eye o to o + t d (t may be INFINITY). */
 double atmos__beams_fog_tau(const atmos__beams_fog *f, const double o[3], const double d[3], double t);

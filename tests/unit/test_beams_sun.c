@@ -11,6 +11,8 @@
  *   - the steps' visibility read through the map's min/max tiles (runs proven lit or dark not
  *     read) against every step's middle read one by one (atmos__beams_sun_visibility), on rays
  *     crossing a wall's shadow, starting inside it, leaving the map and endless: to 1e-9;
+ *   - the eye's factors kept once a frame (atmos__beams_fog_eye): the same bits from the eye,
+ *     another point's own values;
  *   - the steps' placement's ln(1 + x) (atmos__log1p_fast, core/fastmath.h) against the
  *     library's log1p over x in (-1, 10], tiny arguments of both signs included: within
  *     1e-15 of it, relative;
@@ -62,7 +64,8 @@ static void test_no_shadow(void)
     double sun[3] = {0.3, 0.5, -0.8};
     unit(sun);
     CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, NULL, 0, 64));
-    const atmos__beams_fog uniform = {2e-3, 0.9, 0.6, 0, 0, NULL}, layer = {5e-3, 0.8, 0.3, 100, 250, NULL};
+    const atmos__beams_fog uniform = {.sigma0 = 2e-3, .albedo = 0.9, .g = 0.6},
+                           layer = {.sigma0 = 5e-3, .albedo = 0.8, .g = 0.3, .base_m = 100, .height_m = 250};
     const atmos__beams_fog *fogs[2] = {&uniform, &layer};
     const double o[3] = {0, 20, 0};
     double worst = 0;
@@ -116,7 +119,8 @@ static void test_shadow(void)
     atmos_mesh *wall = wall_and_sun(&s, sun, 2048);
     if (!wall) return;
     /* a uniform fog, and a layer thinning upward (the sunlight dimmed on its way in) */
-    const atmos__beams_fog fogs[2] = {{4e-3, 1, 0.2, 0, 0, NULL}, {4e-3, 1, 0.2, 60, 0, NULL}};
+    const atmos__beams_fog fogs[2] = {{.sigma0 = 4e-3, .albedo = 1, .g = 0.2},
+                                      {.sigma0 = 4e-3, .albedo = 1, .g = 0.2, .base_m = 60}};
     const double o[3] = {0, 5, 0};
     for (int fi = 0; fi < 2; fi++) {
         const atmos__beams_fog *fog = &fogs[fi];
@@ -165,7 +169,7 @@ static void test_skipped_runs(void)
     double sun[3];
     atmos_mesh *wall = wall_and_sun(&s, sun, 256);
     if (!wall) return;
-    const atmos__beams_fog fog = {4e-3, 1, 0.2, 0, 0, NULL};
+    const atmos__beams_fog fog = {.sigma0 = 4e-3, .albedo = 1, .g = 0.2};
     /* below the wall looking across its shadow, inside the shadow looking along it (away from
      * the sun), far off looking away from it */
     const double eyes[3][3] = {{0, 5, 0}, {-15, 5, -104}, {-300, 60, 100}};
@@ -214,6 +218,37 @@ static atmos_image *render_file(const char *path, int w, int h, int threads)
 
 /* atmos__log1p_fast against log1p: x from -1 + 2^-40 to 10 on a grid, and +-10^-k (k 1..300)
  * times a spread of mantissas, where 1 + x loses the most of x. */
+/* The eye's factors kept once a frame (atmos__beams_fog_eye): the optical depths, the sunlight's
+ * dimming and the airlight from the eye the same bits as computed ray by ray, and from a point
+ * at another height (or with no eye kept) the values of that point, not the eye's. */
+static void test_eye_kept(void)
+{
+    atmos__beams_sun s;
+    memset(&s, 0, sizeof s);
+    double sun[3] = {0.3, 0.2, -0.8};
+    unit(sun);
+    CHECK_OK(atmos__beams_sun_build(ctx, &s, sun, NULL, 0, 64));
+    atmos__beams_fog f = {.sigma0 = 5e-3, .albedo = 0.8, .g = 0.3, .base_m = 100, .height_m = 250};
+    const double o[3] = {3, 20, -7}, q[3] = {40, 70, 5};
+    double want[4][5], got[4][5];
+    for (int kept = 0; kept < 2; kept++) {
+        if (kept) atmos__beams_fog_eye(&f, o, s.dir);
+        CHECK(f.eye_set == kept);
+        for (int r = 0; r < 4; r++) {
+            double d[3] = {cos(r), 0.3 * sin(1.3 * r), sin(r)};
+            unit(d);
+            double *v = kept ? got[r] : want[r];
+            v[0] = atmos__beams_fog_tau(&f, o, d, 500 + 300 * r), v[1] = atmos__beams_fog_tau(&f, q, d, INFINITY);
+            v[2] = atmos__beams_sun_airlight(&s, &f, o, d, 800, 0.01, 1000);
+            v[3] = atmos__beams_sun_airlight(&s, &f, q, d, 800, 0.01, 1000);
+            v[4] = atmos__beams_sun_fog_in(&f, s.dir, r & 1 ? o : q);
+        }
+    }
+    CHECK(!memcmp(want, got, sizeof want));
+    CHECK(f.eye_e == exp(-(o[1] - f.base_m) / f.height_m) && f.eye_expC == exp(-atmos__beams_sun_fog_in(&f, s.dir, o)));
+    atmos__beams_sun_free(&s);
+}
+
 static void test_log1p(void)
 {
     double worst = 0, at = 0;
@@ -263,6 +298,7 @@ int main(void)
     test_no_shadow();
     test_shadow();
     test_skipped_runs();
+    test_eye_kept();
     test_log1p();
     test_scene();
     atmos_context_destroy(ctx);
