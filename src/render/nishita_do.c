@@ -105,16 +105,20 @@ static void neighbours(const sgrid *g, int nf, int x, int y, int z, double *nb)
  * (1/m; st + 2 cells w, the cells' sigma_t then their sigma_s), and the render voxels holding a
  * field's density, cell by cell in the order z, y, x (vox[first[c] .. first[c + 1]): each one's
  * place in its cell, x | y << 4 | z << 8, the cells' edge at most 16 voxels). An empty voxel adds
- * 0 to every sum: a sun's source (cell_source) visits the others alone. */
+ * 0 to every sum: a sun's source (cell_source) visits the others alone. With cells of more than
+ * one voxel, per listed voxel e and wavelength w the sun-free parts of its local radiance
+ * (cell_source's sub-cell term): sub[2 (e n + w)] = h sigma_s escape(sigma_t h), and
+ * sub[2 (e n + w) + 1] = SUB_NB h times its six face neighbours' sigma_s. */
+#define DO_CELL_MAX 16 /* the packing's bound on a cell's edge (nishita.mc_cell's cap) */
 struct atmos__do_cells {
-    float *st;
+    float *st, *sub;
     uint16_t *vox;
     size_t *first;
 };
 
 void atmos__do_cells_free(atmos__do_cells *dc)
 {
-    if (dc) free(dc->st), free(dc->vox), free(dc->first), free(dc);
+    if (dc) free(dc->st), free(dc->sub), free(dc->vox), free(dc->first), free(dc);
 }
 
 /* Cell (i, j, k)'s voxels holding a field's density: their count, with vox (else NULL) their
@@ -144,12 +148,42 @@ static size_t cell_voxels(const atmos__nishita_plan *np, int s, int n, int i, in
     return m;
 }
 
-/* The cells' medium of np on F's cells (struct atmos__do_cells); NULL when out of memory. */
+/* dc->sub (struct atmos__do_cells) for the voxels listed in dc. */
+static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atmos__do_cells *dc, int n, int threads)
+{
+    const sgrid *g = &np->g;
+    const int s = F->s, nf = np->nf;
+    const double hv = 1.0 / g->sc;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int k = 0; k < F->c[2]; k++)
+        for (int j = 0; j < F->c[1]; j++)
+            for (int i = 0; i < F->c[0]; i++) {
+                const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
+                for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
+                    const int p = dc->vox[e], x = i * s + (p & 15), y = j * s + (p >> 4 & 15), z = k * s + (p >> 8);
+                    const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
+                    double nb[ATMOS_VOLUME_MAX_FIELDS] = {0};
+                    neighbours(g, nf, x, y, z, nb);
+                    for (int w = 0; w < n; w++) {
+                        double t = 0, sc = 0, scn = 0;
+                        for (int f = 0; f < nf; f++)
+                            t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w],
+                                scn += nb[f] * np->mc_sca[f][w];
+                        dc->sub[2 * (e * n + w)] = (float)(hv * sc * escape(t * hv));
+                        dc->sub[2 * (e * n + w) + 1] = (float)(hv * SUB_NB * scn);
+                    }
+                }
+            }
+}
+
+/* The cells' medium of np on F's cells (struct atmos__do_cells); NULL when out of memory or
+ * when a cell's edge is outside [1, DO_CELL_MAX]. */
 static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__lfield *F, int n, int threads)
 {
     const int s = F->s;
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     const double inv = 1.0 / ((double)s * s * s);
+    if (s < 1 || s > DO_CELL_MAX) return NULL;
     atmos__do_cells *dc = calloc(1, sizeof *dc);
     if (!dc || !(dc->st = malloc(sizeof(float) * cells * 2 * n)) ||
         !(dc->first = malloc(sizeof(size_t) * (cells + 1)))) {
@@ -180,6 +214,11 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
                 cell_voxels(np, s, n, i, j, k, dc->vox + dc->first[c], NULL, NULL);
             }
+    if (s > 1 && !(dc->sub = malloc(sizeof(float) * 2 * n * (dc->first[cells] + 1)))) {
+        atmos__do_cells_free(dc);
+        return NULL;
+    }
+    if (s > 1) sub_terms(np, F, dc, n, threads);
     return dc;
 }
 
@@ -205,7 +244,7 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     double amax = 0;
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
-    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s), hv = 1.0 / g->sc;
+    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s);
     float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS], sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     for (int f = 0; f < nf; f++)
         for (int w = 0; w < n; w++) sig[f][w] = np->mc_sig_ms[f][w], sca[f][w] = np->mc_sca[f][w];
@@ -220,8 +259,6 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                 for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
                     const int p = dc->vox[e], x = i * s + (p & 15), y = j * s + (p >> 4 & 15), z = k * s + (p >> 8);
                     const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
-                    double nb[ATMOS_VOLUME_MAX_FIELDS] = {0};
-                    if (s > 1) neighbours(g, nf, x, y, z, nb);
                     for (int w = 0; w < n; w++) {
                         double t = 0, sc = 0, tau = 0;
                         for (int f = 0; f < nf; f++) {
@@ -234,10 +271,8 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                         const double hs = 0.5 * (tl < 2 * tau ? tl : 2 * tau), tr = mean_transmittance(tau, hs);
                         aq[w] += sc * tr;
                         if (s == 1) continue; /* a voxel's cell: no spread */
-                        double scn = 0;
-                        for (int f = 0; f < nf; f++) scn += nb[f] * sca[f][w];
-                        const double l1 =
-                            hv * (tr * sc * escape(t * hv) + SUB_NB * scn * atmos__expf_fast((float)(hs - tau)));
+                        const float *ab = dc->sub + 2 * (e * n + w);
+                        const double l1 = tr * ab[0] + ab[1] * atmos__expf_fast((float)(hs - tau));
                         la[w] += l1, lw[w] += sc * l1, nv[w]++;
                     }
                 }
