@@ -67,4 +67,10 @@ check "--exposure-per-frame on one frame" 0 "--exposure-per-frame: changes nothi
 check "a failed save, headless" 1 "the frame was not saved" \
     view --headless --frames 3 --size 16x9 --renderer sky --press save --save-base blocker/v --record rec
 [ -s rec/frame_00002.png ] && ok "all 3 frames recorded after the failed save" || bad "the session stopped after the failed save"
+# a save whose scene file cannot be written (a folder of its name) leaves none of its three files
+mkdir -p part/v_001.json
+check "a save whose scene cannot be written" 1 "cannot write part/v_001.json" \
+    view --headless --frames 2 --size 16x9 --renderer sky --press save --save-base part/v
+[ ! -e part/v_001.exr ] && [ ! -e part/v_001.png ] && ok "no image left of the failed save" \
+    || bad "the failed save left $(ls part)"
 exit $fail

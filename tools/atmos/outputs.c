@@ -3,6 +3,7 @@
 #include "outputs.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -411,7 +412,7 @@ static void commit_end(const sigset_t *old)
     atomic_signal_fence(memory_order_seq_cst);
     committing = 0;
     atomic_signal_fence(memory_order_seq_cst);
-    sigprocmask(SIG_SETMASK, old, NULL);
+    pthread_sigmask(SIG_SETMASK, old, NULL); /* this thread's mask (the process has others) */
     if (deferred) raise(deferred);
 }
 
@@ -422,7 +423,7 @@ static void commit_begin(sigset_t *old)
     sigset_t block;
     sigemptyset(&block);
     for (size_t k = 0; k < sizeof ENDING / sizeof ENDING[0]; k++) sigaddset(&block, ENDING[k]);
-    sigprocmask(SIG_BLOCK, &block, old);
+    pthread_sigmask(SIG_BLOCK, &block, old);
     committing = 1;
     atomic_signal_fence(memory_order_seq_cst);
 }
@@ -430,8 +431,9 @@ static void commit_begin(sigset_t *old)
 void cli_outputs_defer_signals(int on)
 {
     static sigset_t old;
-    if (on) commit_begin(&old);
-    else commit_end(&old);
+    static int depth; /* nested calls: the outermost pair blocks and unblocks */
+    if (on && depth++ == 0) commit_begin(&old);
+    else if (!on && depth > 0 && --depth == 0) commit_end(&old);
 }
 
 /* The held files renamed into place with the ending signals blocked, so that a signal cannot

@@ -89,7 +89,7 @@ void cli_outputs_line_open(int open);
 void cli_outputs_catch(const char *cmd);
 /* on = 1 .. on = 0 around writing a set of files that must not be cut (a recorded frame's PNG
  * and its csv line): an ending signal that comes meanwhile acts at on = 0, so that no file is
- * left half written and no writer's temporary is left. Not nested. */
+ * left half written and no writer's temporary is left. Nested pairs: the outermost acts. */
 void cli_outputs_defer_signals(int on);
 /* A message with the staging suffix (".tmpPID") taken out of the names it holds, so
  * that the library's messages about a staging file name the output. */

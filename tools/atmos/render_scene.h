@@ -13,13 +13,14 @@
  * printed). */
 int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume);
 
-/* The name of the default output (NAME.png when no output is given): the scene file's name
- * without its folder and extension (as pbrt and Mitsuba do), or the scene's "name" for the
- * default scene and a scene from standard input. Returns buf or scene->name. */
 /* The -D (its whole text) whose key is, or holds, the JSON pointer that follows the scene file's
  * name in the error msg ("scene.json: /objects/0/terrain: ..."), or NULL: the error is the
  * define's, not the file's. */
 const char *render_scene_define_in(const render_opts *o, const char *msg);
+
+/* The name of the default output (NAME.png when no output is given): the scene file's name
+ * without its folder and extension (as pbrt and Mitsuba do), or the scene's "name" for the
+ * default scene and a scene from standard input. Returns buf or scene->name. */
 const char *render_scene_output_name(const render_opts *o, const atmos_scene *scene, char *buf, size_t cap);
 
 /* The scene file's text for the outputs' metadata (atmos:scene_json): NULL for the default

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* The first file of an earlier recording in DIR (frames.csv or a frame_*.png) into NAME, or 0:
  * a new recording into it would leave the earlier run's later frames among its own. */
@@ -99,6 +100,7 @@ int view_record_frame(view_recorder *r, atmos_context *ctx, const atmos_image *d
         fprintf(r->csv, "%d,%.3f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%s,%d,%d\n", r->frames, ms, renderer, impostor_updates,
                 s->pos[0], s->pos[1], s->pos[2], s->yaw_deg, s->pitch_deg, sun, preview, impostors_coarse);
         ok = fflush(r->csv) == 0;
+        if (!ok) unlink(path); /* no line for it: nor its PNG */
     }
     cli_outputs_defer_signals(0);
     if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
@@ -160,7 +162,7 @@ static void absolute_file(cJSON *o, const char *key, const char *resolved)
     for (size_t k = 0; k < sizeof kept / sizeof kept[0]; k++)
         if (!strncmp(p, kept[k], strlen(kept[k]))) return;
     const size_t n = strlen(p), m = strlen(resolved);
-    if (m < n || strcmp(resolved + m - n, p)) return;
+    if (m < n || strcmp(resolved + m - n, p) || (m > n && resolved[m - n - 1] != '/')) return;
     char *abs = realpath(resolved, NULL);
     if (abs) set(o, key, cJSON_CreateString(abs));
     free(abs);
@@ -254,27 +256,33 @@ char *view_scene_json(const char *scene_json, const atmos_scene *sc, const view_
     return text;
 }
 
+/* base + ext into buf */
+static const char *save_name(char *buf, size_t cap, const char *base, const char *ext)
+{
+    snprintf(buf, cap, "%s%s", base, ext);
+    return buf;
+}
+
+/* A saved view: BASE.exr, BASE.png and BASE.json, all three or none (a failure removes the ones
+ * written before it). */
 int view_save(atmos_context *ctx, const char *base, const char *scene_json, const atmos_scene *sc,
               const view_state *s, const atmos_image *lin, const atmos_image *disp)
 {
-    char path[4096];
-    snprintf(path, sizeof path, "%s.exr", base);
-    atmos_status st = atmos_write_exr(ctx, lin, path, NULL);
-    if (st == ATMOS_OK) {
-        snprintf(path, sizeof path, "%s.png", base);
-        st = atmos_write_png(ctx, disp, path, 8);
-    }
+    char exr[4096], png[4096], json[4096];
+    atmos_status st = atmos_write_exr(ctx, lin, save_name(exr, sizeof exr, base, ".exr"), NULL);
+    if (st == ATMOS_OK && (st = atmos_write_png(ctx, disp, save_name(png, sizeof png, base, ".png"), 8)) != ATMOS_OK)
+        unlink(exr);
     if (st != ATMOS_OK) return cli_runtime_error("view", ctx, st);
     char *text = view_scene_json(scene_json, sc, s);
-    snprintf(path, sizeof path, "%s.json", base);
-    FILE *f = text ? fopen(path, "w") : NULL;
+    FILE *f = text ? fopen(save_name(json, sizeof json, base, ".json"), "w") : NULL;
     const int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    free(text);
     if ((f && fclose(f) != 0) || !ok) {
-        fprintf(stderr, "atmos view: cannot write %s\n", path);
-        free(text);
+        fprintf(stderr, "atmos view: cannot write %s.json: the view was not saved\n", base);
+        if (f) unlink(json);
+        unlink(exr), unlink(png);
         return CLI_EXIT_RUNTIME;
     }
-    free(text);
     fprintf(stderr, "atmos view: saved %s.exr, %s.png and %s.json\n", base, base, base);
     return CLI_EXIT_OK;
 }
