@@ -14,8 +14,8 @@
 # "harris_sun": Harris's, and the same with the diffuse light field, "nishita_diffuse",
 # "harris_diffuse", "harris_sun_diffuse"; "diffuse": the P1 field, --slice-p1; "diffuse_aa": the
 # same with four eye rays per pixel, antialiased; "slice_do", "slice_do_aa": the slice renderer with
-# the discrete-ordinates field (the default), one and four eye rays per pixel; "slice_do_edge": the
-# same with four rays only at the volume's edges, --edge-aa $EDGE_AA (default 0.05); "nishita_do": the Nishita renderer with that field,
+# the discrete-ordinates field, one (--edge-aa 0) and four eye rays per pixel; "slice_do_edge": the
+# same with four rays only at the volume's edges, --edge-aa $EDGE_AA (0.05: the default renderer); "nishita_do": the Nishita renderer with that field,
 # its sky's light the field's inflow, "nishita_do_nosky" the same without: not in the default list), THREADS, REUSE (1: keep the reference images
 # already in OUT_DIR, e.g. to compare a new build's variants against the same references).
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
