@@ -51,9 +51,15 @@ grep -q "shadow map" w2 && bad "warned without the far vertex: $(cat w2)" || ok 
 # the memory: refused before anything is allocated (a second, not the minutes of swapping)
 "$A" render hemi.json -D 'wavelengths={"mode":"spectral","samples":128}' --width 16384 --height 16384 -o big.png -q 2>m1 &&
     bad "a 16384^2 image of 128 wavelengths rendered" || true
-grep -q "needs about .* GB (1624 bytes a pixel), more than the machine's .* GB of memory: .*--width" m1 &&
+grep -q "needs about .* GB (1624 bytes a pixel), more than the .* GB of memory it may have, .*--width" m1 &&
     ok "a 16384^2 image of 128 wavelengths refused with its estimate" || bad "no refusal: $(cat m1)"
 [ -e big.png ] && bad "the refused image was written"
+# the same bound from the address-space limit (ulimit -v, 3 GB): 2048^2 of 128 wavelengths (6.8 GB)
+# refused whatever the machine has
+(ulimit -v 3000000 && "$A" render hemi.json -D 'wavelengths={"mode":"spectral","samples":128}' --width 2048 \
+    --height 2048 -o big2.png -q) 2>m3 && bad "a 2048^2 image of 128 wavelengths rendered under ulimit -v 3 GB" || true
+grep -q "more than the 3.1 GB of memory it may have, the process's address-space limit (ulimit -v)" m3 &&
+    ok "the address-space limit bounds the estimate" || bad "no refusal under ulimit -v: $(cat m3)"
 "$A" render hemi.json --width 64 --height 48 -o small.png 2>m2 || bad "a small image: $(cat m2)"
 grep -q "needs about" m2 && bad "a small image warned of: $(cat m2)" || ok "a small image: no word of memory"
 # a point light's default reach: 1e5 W/sr, fog 0.002 /m, seen from 400 m
