@@ -148,6 +148,38 @@ static size_t cell_voxels(const atmos__nishita_plan *np, int s, int n, int i, in
     return m;
 }
 
+/* One pass of cells_make over the cells: list 0, their voxels counted into first[c + 1] and their
+ * mean sigma_t and sigma_s into st; list 1, their voxels' places into vox from first[c]. */
+static void cells_pass(const atmos__nishita_plan *np, const atmos__lfield *F, atmos__do_cells *dc, int n, int threads,
+                       int list)
+{
+    const int s = F->s;
+    const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
+    const double inv = 1.0 / ((double)s * s * s);
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (int k = 0; k < F->c[2]; k++)
+        for (int j = 0; j < F->c[1]; j++)
+            for (int i = 0; i < F->c[0]; i++) {
+                const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
+                if (list) {
+                    cell_voxels(np, s, n, i, j, k, dc->vox + dc->first[c], NULL, NULL);
+                    continue;
+                }
+                double at[ATMOS_MAX_WAVELENGTHS] = {0}, as[ATMOS_MAX_WAVELENGTHS] = {0};
+                dc->first[c + 1] = cell_voxels(np, s, n, i, j, k, NULL, at, as);
+                for (int w = 0; w < n; w++)
+                    dc->st[2 * cells * w + c] = (float)(at[w] * inv),
+                                           dc->st[2 * cells * w + cells + c] = (float)(as[w] * inv);
+            }
+}
+
+/* The grid index (times nf) of the kept voxel packed as p in cell (i, j, k) of edge s. */
+static inline size_t kept_voxel(const sgrid *g, int nf, int s, int i, int j, int k, int p, int *x, int *y, int *z)
+{
+    *x = i * s + (p & 15), *y = j * s + (p >> 4 & 15), *z = k * s + (p >> 8);
+    return (((size_t)*z * g->c[1] + *y) * g->c[0] + *x) * nf;
+}
+
 /* dc->sub (struct atmos__do_cells) for the voxels listed in dc. */
 static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atmos__do_cells *dc, int n, int threads)
 {
@@ -160,8 +192,8 @@ static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atm
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
                 for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
-                    const int p = dc->vox[e], x = i * s + (p & 15), y = j * s + (p >> 4 & 15), z = k * s + (p >> 8);
-                    const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
+                    int x, y, z;
+                    const size_t v = kept_voxel(g, nf, s, i, j, k, dc->vox[e], &x, &y, &z);
                     double nb[ATMOS_VOLUME_MAX_FIELDS] = {0};
                     neighbours(g, nf, x, y, z, nb);
                     for (int w = 0; w < n; w++) {
@@ -182,7 +214,6 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
 {
     const int s = F->s;
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
-    const double inv = 1.0 / ((double)s * s * s);
     if (s < 1 || s > DO_CELL_MAX) return NULL;
     atmos__do_cells *dc = calloc(1, sizeof *dc);
     if (!dc || !(dc->st = malloc(sizeof(float) * cells * 2 * n)) ||
@@ -190,30 +221,14 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
         atmos__do_cells_free(dc);
         return NULL;
     }
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int k = 0; k < F->c[2]; k++)
-        for (int j = 0; j < F->c[1]; j++)
-            for (int i = 0; i < F->c[0]; i++) {
-                const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
-                double at[ATMOS_MAX_WAVELENGTHS] = {0}, as[ATMOS_MAX_WAVELENGTHS] = {0};
-                dc->first[c + 1] = cell_voxels(np, s, n, i, j, k, NULL, at, as);
-                for (int w = 0; w < n; w++)
-                    dc->st[2 * cells * w + c] = (float)(at[w] * inv),
-                                           dc->st[2 * cells * w + cells + c] = (float)(as[w] * inv);
-            }
+    cells_pass(np, F, dc, n, threads, 0);
     dc->first[0] = 0;
     for (size_t c = 0; c < cells; c++) dc->first[c + 1] += dc->first[c];
     if (!(dc->vox = malloc(sizeof(uint16_t) * (dc->first[cells] + 1)))) {
         atmos__do_cells_free(dc);
         return NULL;
     }
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int k = 0; k < F->c[2]; k++)
-        for (int j = 0; j < F->c[1]; j++)
-            for (int i = 0; i < F->c[0]; i++) {
-                const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
-                cell_voxels(np, s, n, i, j, k, dc->vox + dc->first[c], NULL, NULL);
-            }
+    cells_pass(np, F, dc, n, threads, 1);
     if (s > 1 && !(dc->sub = malloc(sizeof(float) * 2 * n * (dc->first[cells] + 1)))) {
         atmos__do_cells_free(dc);
         return NULL;
@@ -257,8 +272,8 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                 double la[ATMOS_MAX_WAVELENGTHS] = {0}, lw[ATMOS_MAX_WAVELENGTHS] = {0};
                 int nv[ATMOS_MAX_WAVELENGTHS] = {0};
                 for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
-                    const int p = dc->vox[e], x = i * s + (p & 15), y = j * s + (p >> 4 & 15), z = k * s + (p >> 8);
-                    const size_t v = (((size_t)z * g->c[1] + y) * g->c[0] + x) * nf;
+                    int x, y, z;
+                    const size_t v = kept_voxel(g, nf, s, i, j, k, dc->vox[e], &x, &y, &z);
                     for (int w = 0; w < n; w++) {
                         double t = 0, sc = 0, tau = 0;
                         for (int f = 0; f < nf; f++) {
