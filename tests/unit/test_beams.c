@@ -626,6 +626,22 @@ static void test_light_sum(void)
     atmos_mesh_destroy(mesh);
 }
 
+/* l: the base scene's light made a point light at (x, y, z) with its shadow maps of mesh, size
+ * texels a face. */
+static void point_light(atmos_mesh **mesh, double x, double y, double z, int size, atmos__beams_light *l)
+{
+    atmos_wavelengths wl;
+    atmos_wavelengths_rgb(&wl);
+    atmos_scene s;
+    base_scene(&s, 8, 8);
+    atmos_scene_light sl = s.lights[0];
+    sl.type = ATMOS_LIGHT_POINT, sl.position_m[0] = x, sl.position_m[1] = y, sl.position_m[2] = z;
+    memset(l, 0, sizeof *l);
+    atmos__lamp_make(&sl, &wl, &l->L);
+    atmos__beams_progress pr = {0, 6, 0};
+    CHECK_OK(atmos__beams_shadow_build(ctx, l, mesh, 1, size, &pr));
+}
+
 /* A point light's runs of at most 8 samples (read without the tiles' test, each run's cube face
  * from its first and last sample) against every sample read alone, on rays that cross the edge
  * between two faces of the cube (x + y = 10 here) inside a sphere's shadow, which straddles it:
@@ -634,17 +650,8 @@ static void test_runs_across_faces(void)
 {
     atmos_mesh *mesh = sphere_at(3.5, 6.5);
     if (!mesh) return;
-    atmos_wavelengths wl;
-    atmos_wavelengths_rgb(&wl);
-    atmos_scene s;
-    base_scene(&s, 8, 8);
-    atmos_scene_light sl = s.lights[0];
-    sl.type = ATMOS_LIGHT_POINT, sl.position_m[0] = 0, sl.position_m[1] = 10, sl.position_m[2] = 0;
     atmos__beams_light l;
-    memset(&l, 0, sizeof l);
-    atmos__lamp_make(&sl, &wl, &l.L);
-    atmos__beams_progress pr = {0, 6, 0};
-    CHECK_OK(atmos__beams_shadow_build(ctx, &l, &mesh, 1, 256, &pr));
+    point_light(&mesh, 0, 10, 0, 256, &l);
     double worst = 0;
     long runs = 0, shadowed = 0;
     for (int r = 0; r < 25; r++) {
@@ -720,17 +727,8 @@ static void test_ray_faces(void)
 {
     atmos_mesh *mesh = sphere_at(3.5, 6.5);
     if (!mesh) return;
-    atmos_wavelengths wl;
-    atmos_wavelengths_rgb(&wl);
-    atmos_scene s;
-    base_scene(&s, 8, 8);
-    atmos_scene_light sl = s.lights[0];
-    sl.type = ATMOS_LIGHT_POINT, sl.position_m[0] = 0.3, sl.position_m[1] = 10, sl.position_m[2] = -0.7;
     atmos__beams_light l;
-    memset(&l, 0, sizeof l);
-    atmos__lamp_make(&sl, &wl, &l.L);
-    atmos__beams_progress pr = {0, 6, 0};
-    CHECK_OK(atmos__beams_shadow_build(ctx, &l, &mesh, 1, 64, &pr));
+    point_light(&mesh, 0.3, 10, -0.7, 64, &l);
     CHECK(l.nfaces == 6);
     int differ = 0;
     for (int r = 0; r < 50; r++) {
