@@ -75,10 +75,10 @@ atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *
     if (atmos_atmosphere_get_kind(atm) == ATMOS_ATMOSPHERE_VACUUM) return ATMOS_OK;
     const int nd = BEAMS_SKY_MU * BEAMS_SKY_PHI, nn = BEAMS_SKY_NY * BEAMS_SKY_NA;
     s->nc = layered ? BEAMS_SKY_NC : 1;
-    double *L = malloc(sizeof(double) * (size_t)nd * (nw + 3)), *R = malloc(sizeof(double) * BEAMS_SKY_MU * nw);
+    double *L = malloc(sizeof(double) * (size_t)nd * (nw + 3));
     s->E = calloc((size_t)s->nc * nn * nw, sizeof *s->E);
-    if (!L || !R || !s->E) {
-        free(L), free(R), free(s->E), s->E = NULL;
+    if (!L || !s->E) {
+        free(L), free(s->E), s->E = NULL;
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the sky's light");
     }
 #pragma omp parallel for schedule(dynamic, 8) num_threads(atmos__threads(ctx))
@@ -91,13 +91,15 @@ atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *
     }
     double T[BEAMS_SKY_NC * BEAMS_SKY_MU];
     ring_dimming(s->nc, T);
+    /* each normal's values on their own (the same bits with any number of threads) */
+#pragma omp parallel for schedule(dynamic, 8) num_threads(atmos__threads(ctx))
     for (int j = 0; j < nn; j++) {
-        double n[3];
+        double n[3], R[BEAMS_SKY_MU * ATMOS_MAX_WAVELENGTHS];
         node_normal(j / BEAMS_SKY_NA, j % BEAMS_SKY_NA, n);
         ring_irradiance(L, nw, n, R);
         node_values(R, T, nw, j, s);
     }
-    free(L), free(R);
+    free(L);
     s->nw = nw;
     return ATMOS_OK;
 }
@@ -160,14 +162,24 @@ void atmos__beams_sky_free(atmos__beams_sky *s)
     if (s) free(s->E), memset(s, 0, sizeof *s);
 }
 
+void atmos__beams_sky_axes(const double sun_dir[3], double u[2])
+{
+    const double h = hypot(sun_dir[0], sun_dir[2]);
+    u[0] = h > 1e-9 ? sun_dir[0] / h : 1.0, u[1] = h > 1e-9 ? sun_dir[2] / h : 0.0;
+}
+
 atmos_status atmos__beams_sky_keep(atmos_context *ctx, const atmos_atmosphere *atm, const double eye[3],
                                    const double sun_dir[3], int nw, int layered, atmos__beams_sky *s)
 {
-    const long key[2] = {lround(eye[0] / BEAMS_SKY_KEEP_M), lround(eye[2] / BEAMS_SKY_KEEP_M)};
+    double u[2]; /* along the sun's azimuth (x, z); across it: (-u[1], u[0]) */
+    atmos__beams_sky_axes(sun_dir, u);
+    const long key[2] = {lround((eye[0] * u[0] + eye[2] * u[1]) / BEAMS_SKY_KEEP_M),
+                         lround((eye[2] * u[0] - eye[0] * u[1]) / BEAMS_SKY_KEEP_ACROSS_M)};
     if (s->built && s->atm == atm && s->nw == nw && s->key[0] == key[0] && s->key[1] == key[1] &&
         s->layered == layered && !memcmp(s->sun, sun_dir, sizeof s->sun))
         return ATMOS_OK;
-    const double under[3] = {key[0] * BEAMS_SKY_KEEP_M, 0, key[1] * BEAMS_SKY_KEEP_M};
+    const double a = (double)key[0] * BEAMS_SKY_KEEP_M, c = (double)key[1] * BEAMS_SKY_KEEP_ACROSS_M;
+    const double under[3] = {a * u[0] - c * u[1] + 0.0, 0, a * u[1] + c * u[0] + 0.0}; /* + 0: no -0 */
     atmos__beams_sky_free(s);
     const atmos_status st = atmos__beams_sky_build(ctx, atm, under, sun_dir, nw, layered, s);
     if (st != ATMOS_OK) return st;

@@ -19,16 +19,22 @@
 #define BEAMS_SKY_NC 65
 #define BEAMS_SKY_CMAX 30.0
 
-/* The ground point under the eye is quantised to this many metres in x and z for the table
- * kept between frames (atmos__beams_sky_keep). */
+/* The ground point under the eye is quantised for the table kept between frames
+ * (atmos__beams_sky_keep) on axes along and across the sun's azimuth: BEAMS_SKY_KEEP_M metres
+ * along it, where the sun's height over the local horizon changes (the table half a quantum
+ * off by 8e-5 relative with the sun 8 degrees up, 5.6e-4 at 3 degrees below), and
+ * BEAMS_SKY_KEEP_ACROSS_M across it, where only the local vertical turns (2.5e-4 half a
+ * quantum off, the sun between -3 and 30 degrees up): docs/beams.md, "The sky's light". */
 #define BEAMS_SKY_KEEP_M 100.0
+#define BEAMS_SKY_KEEP_ACROSS_M 1000.0
 
 typedef struct atmos__beams_sky {
     int nw;   /* wavelengths; 0: no sky (a vacuum) */
     int nc;   /* values of C: 1 (no height-dependent fog) or BEAMS_SKY_NC */
     float *E; /* [((ic * BEAMS_SKY_NY + iy) * BEAMS_SKY_NA + ia) * nw + k]: W m^-2 nm^-1 */
     /* what a kept table was built for (atmos__beams_sky_keep): the atmosphere, the quantised
-     * ground point (x, z in units of BEAMS_SKY_KEEP_M), the sun; built: 0 before the first */
+     * ground point (along the sun's azimuth in units of BEAMS_SKY_KEEP_M, across it in units of
+     * BEAMS_SKY_KEEP_ACROSS_M), the sun; built: 0 before the first */
     const atmos_atmosphere *atm;
     long key[2];
     int layered;
@@ -42,10 +48,14 @@ typedef struct atmos__beams_sky {
  * also dimmed by a fog layer of each tabulated C (nc = BEAMS_SKY_NC). */
 atmos_status atmos__beams_sky_build(atmos_context *ctx, const atmos_atmosphere *atm, const double p[3],
                                     const double sun_dir[3], int nw, int layered, atmos__beams_sky *s);
+/* The sun's azimuth as a unit vector u in (x, z) ((1, 0) for a sun at the zenith): the axes
+ * of atmos__beams_sky_keep's quantum, u along and (-u[1], u[0]) across. */
+void atmos__beams_sky_axes(const double sun_dir[3], double u[2]);
 /* The table of the frame whose eye is at eye, kept in s between frames: the ground under the
- * eye quantised to BEAMS_SKY_KEEP_M metres in x and z (the point (kx Q, 0, kz Q)), so the
- * table is made again only when that point, the sun, the atmosphere or nw change, and a
- * frame's table is the same whatever frames came before it. s starts zeroed. */
+ * eye quantised to BEAMS_SKY_KEEP_M metres along the sun's azimuth and BEAMS_SKY_KEEP_ACROSS_M
+ * across it (the point ka Q u + kc Q' u_perp on the ground plane y = 0), so the table is made
+ * again only when that point, the sun, the atmosphere or nw change, and a frame's table is the
+ * same whatever frames came before it. s starts zeroed. */
 atmos_status atmos__beams_sky_keep(atmos_context *ctx, const atmos_atmosphere *atm, const double eye[3],
                                    const double sun_dir[3], int nw, int layered, atmos__beams_sky *s);
 /* The sky's irradiance on a surface of unit normal n (bilinear in the table) under a fog layer
