@@ -1,4 +1,6 @@
-"""Images: an atmos image seen by NumPy without a copy."""
+"""Images: an atmos image seen by NumPy without a copy, and an image file's kind."""
+import os
+
 import numpy as np
 
 from atmos._core import Owned, check, context, ffi, lib
@@ -78,3 +80,22 @@ def read_exr(path) -> Image:
     chans = [ffi.string(names[0][i]).decode() for i in range(n)]
     lib.free(names[0])
     return Image(out[0], channels=chans)
+
+
+def _kind(p) -> str | None:
+    return None if p == ffi.NULL else ffi.string(p).decode()
+
+
+def image_kind(data) -> str | None:
+    """An image's format by its first bytes (``bytes``, ``bytearray`` or ``memoryview``), as the
+    readers tell it: "OpenEXR", "PNG", "JPEG" or "PFM", else None (``atmos_image_kind``)."""
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        raise TypeError(f"atmos: image_kind: expected bytes, got {type(data).__name__}")
+    b = bytes(data)
+    return _kind(lib.atmos_image_kind(ffi.from_buffer(b), len(b)))
+
+
+def image_file_kind(path) -> str | None:
+    """A file's image format by its first 8 bytes, as ``image_kind`` tells it; None also when
+    the file cannot be read (``atmos_image_file_kind``)."""
+    return _kind(lib.atmos_image_file_kind(os.fsencode(path)))
