@@ -1,6 +1,7 @@
 """atmos.image_kind and atmos.image_file_kind: an image's format by its first bytes, as the
 library's atmos_image_kind and atmos_image_file_kind (atmos/image.h) tell it, the magic numbers
-spelt out here independently of the library; and of the files the package itself writes."""
+spelt out here independently of the library; and of the files the package itself writes. The
+image functions that take a file name refuse what is not one."""
 import pytest
 
 import atmos
@@ -40,3 +41,14 @@ def test_image_file_kind_of_written_files(tmp_path):
     assert atmos.image_file_kind(tmp_path / "missing.exr") is None
     with open(tmp_path / "a.exr", "rb") as f:
         assert atmos.image_kind(f.read(8)) == "OpenEXR"
+
+
+def test_a_file_name_that_is_not_one_is_a_type_error(tmp_path):
+    """None was taken as the file "None" (read_exr: "None: cannot open")."""
+    img = atmos.render(atmos.Scene.default(), width=4, height=3)
+    for call, where in ((lambda: atmos.read_exr(None), "read_exr"), (lambda: img.write_exr(None), "Image.write_exr"),
+                        (lambda: img.write_pfm(3), "Image.write_pfm"), (lambda: atmos.image_file_kind(None), "image_file_kind")):
+        with pytest.raises(TypeError, match=f"atmos: {where}: expected a file name"):
+            call()
+    img.write_exr(str(tmp_path / "b.EXR").encode())
+    assert atmos.read_exr(tmp_path / "b.EXR").shape == (3, 4, 4)
