@@ -62,8 +62,9 @@ typedef struct atmos_frame {
     atmos_camera_desc camera;
     int width, height;          /* pixels, 1..ATMOS_SCENE_MAX_DIM */
     double sun_dir[3];          /* unit vector toward the sun, world frame */
-    int samples_per_pixel;      /* sky and slice renderers: stratified samples of the sky, 1..256 */
-    int spp;                    /* path tracer: samples per pixel to reach (progressive), 1..ATMOS_PATH_MAX_SPP */
+    int samples_per_pixel;      /* sky and slice renderers: stratified samples of the sky, 1..256, 0 = the scene's */
+    int spp;                    /* path tracer: samples per pixel to reach (progressive), 1..ATMOS_PATH_MAX_SPP,
+                                   0 = the scene's */
     int slices;                 /* slice renderer: sampling planes, 0 = the scene's */
     double eye_scale;           /* slice renderer: eye buffer scale in (0, 1] or 2, 0 = the scene's */
     int light_size;             /* slice renderer: the light buffer's side in texels for this frame, at most

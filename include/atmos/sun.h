@@ -39,9 +39,16 @@ ATMOS_API atmos_status atmos_parse_utc_time(atmos_context *ctx, const char *text
 ATMOS_API double atmos_utc_time_seconds(const atmos_utc_time *t);
 ATMOS_API void atmos_utc_time_from_seconds(double seconds, atmos_utc_time *out);
 
+/* The years (UTC) atmos_sun_position_compute takes: the algorithm's polynomials are fits
+ * around J2000, within 0.01 degree over these. A scene's sun time and its animation's
+ * time_end outside them are refused when the scene is read or validated. */
+#define ATMOS_SUN_YEAR_MIN 1800
+#define ATMOS_SUN_YEAR_MAX 2200
+
 /* Sun position for latitude (degrees north, [-90, 90]) and longitude (degrees
- * east, [-180, 180]). refraction: nonzero to include standard atmospheric
- * refraction in elevation_deg. Errors name the offending value. */
+ * east, [-180, 180]) at a time of the years ATMOS_SUN_YEAR_MIN..ATMOS_SUN_YEAR_MAX.
+ * refraction: nonzero to include standard atmospheric refraction in elevation_deg.
+ * Errors name the offending value. */
 ATMOS_API atmos_status atmos_sun_position_compute(atmos_context *ctx, const atmos_utc_time *t,
                                                   double latitude_deg, double longitude_deg,
                                                   int refraction, atmos_sun_position *out);

@@ -13,7 +13,7 @@ return arrays. Errors raise ``AtmosError`` with atmos's status code and message.
 has its own context, and the GIL is released while the library works. docs/python.md.
 """
 from atmos._core import AtmosError, AtmosTypeError, version
-from atmos.image import Image, read_exr
+from atmos.image import Image, image_file_kind, image_kind, read_exr
 from atmos.optics import mie, phase_table, refractive_index
 from atmos.render import Plan, render
 from atmos.scene import Scene
@@ -21,5 +21,5 @@ from atmos.sky import directions, sky_radiance
 from atmos.volume import Volume
 
 __version__ = version()
-__all__ = ["AtmosError", "AtmosTypeError", "Image", "Plan", "Scene", "Volume", "directions", "mie", "phase_table",
-           "read_exr", "refractive_index", "render", "sky_radiance", "version"]
+__all__ = ["AtmosError", "AtmosTypeError", "Image", "Plan", "Scene", "Volume", "directions", "image_file_kind",
+           "image_kind", "mie", "phase_table", "read_exr", "refractive_index", "render", "sky_radiance", "version"]

@@ -45,6 +45,8 @@ atmos_status atmos_image_to_srgb(atmos_context *ctx, const atmos_image *spectral
 atmos_status atmos_write_exr(atmos_context *ctx, const atmos_image *img, const char *path, const void *desc);
 atmos_status atmos_write_pfm(atmos_context *ctx, const atmos_image *img, const char *path);
 atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **out);
+const char *atmos_image_kind(const void *bytes, size_t n);
+const char *atmos_image_file_kind(const char *path);
 
 typedef struct atmos_camera_desc { double position[3]; double look_at[3]; double up[3]; double fov_deg; ...; }
     atmos_camera_desc;

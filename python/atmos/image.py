@@ -1,7 +1,18 @@
-"""Images: an atmos image seen by NumPy without a copy."""
+"""Images: an atmos image seen by NumPy without a copy, and an image file's kind."""
+import os
+
 import numpy as np
 
 from atmos._core import Owned, check, context, ffi, lib
+
+
+def _path(where: str, path) -> bytes:
+    """A file name (str, bytes or os.PathLike) as the library takes it; anything else (None) a
+    TypeError naming `where` (str(path) made None the file "None")."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"atmos: {where}: expected a file name (str, bytes or os.PathLike), "
+                        f"got {type(path).__name__}")
+    return os.fsencode(path)
 
 
 class Image(Owned):
@@ -49,15 +60,17 @@ class Image(Owned):
 
     def write_exr(self, path: str) -> None:
         """Writes the image as OpenEXR (linear, atomically); the name must end in .exr."""
-        if not str(path).lower().endswith(".exr"):
+        name = _path("Image.write_exr", path)
+        if not name.lower().endswith(b".exr"):
             raise ValueError(f"atmos.Image.write_exr: {path}: an OpenEXR file's name ends in .exr")
-        check(lib.atmos_write_exr(context(), self._live(), str(path).encode(), ffi.NULL))
+        check(lib.atmos_write_exr(context(), self._live(), name, ffi.NULL))
 
     def write_pfm(self, path: str) -> None:
         """Writes the first three channels as a portable float map (atomically); the name must end in .pfm."""
-        if not str(path).lower().endswith(".pfm"):
+        name = _path("Image.write_pfm", path)
+        if not name.lower().endswith(b".pfm"):
             raise ValueError(f"atmos.Image.write_pfm: {path}: a portable float map's name ends in .pfm")
-        check(lib.atmos_write_pfm(context(), self._live(), str(path).encode()))
+        check(lib.atmos_write_pfm(context(), self._live(), name))
 
     def __repr__(self):
         if self._ptr is None:
@@ -73,8 +86,27 @@ def read_exr(path) -> Image:
     ctx = context()
     out = ffi.new("atmos_image **")
     names = ffi.new("char ***")
-    check(lib.atmos_read_exr_named(ctx, str(path).encode(), out, names), ctx)
+    check(lib.atmos_read_exr_named(ctx, _path("read_exr", path), out, names), ctx)
     n = out[0].channels
     chans = [ffi.string(names[0][i]).decode() for i in range(n)]
     lib.free(names[0])
     return Image(out[0], channels=chans)
+
+
+def _kind(p) -> str | None:
+    return None if p == ffi.NULL else ffi.string(p).decode()
+
+
+def image_kind(data) -> str | None:
+    """An image's format by its first bytes (``bytes``, ``bytearray`` or ``memoryview``), as the
+    readers tell it: "OpenEXR", "PNG", "JPEG" or "PFM", else None (``atmos_image_kind``)."""
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        raise TypeError(f"atmos: image_kind: expected bytes, got {type(data).__name__}")
+    b = bytes(data)
+    return _kind(lib.atmos_image_kind(ffi.from_buffer(b), len(b)))
+
+
+def image_file_kind(path) -> str | None:
+    """A file's image format by its first 8 bytes, as ``image_kind`` tells it; None also when
+    the file cannot be read (``atmos_image_file_kind``)."""
+    return _kind(lib.atmos_image_file_kind(_path("image_file_kind", path)))

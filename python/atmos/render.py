@@ -114,10 +114,14 @@ class Plan(Owned):
     def render(self, camera: dict | None = None, sun=None, size=None, spp=None) -> Image:
         """Renders a frame. camera: {"position_m": [x, y, z], "look_at_m": [...], "fov_deg": f}
         (any subset); sun: (elevation_deg, azimuth_deg); size: (width, height); spp: the path
-        tracer's samples per pixel. What is not given stays as in the last frame."""
+        tracer's samples per pixel. What is not given stays as in the last frame rendered: a call
+        that fails changes nothing."""
         if self._ptr is None:
             raise ValueError("atmos.Plan: the plan was closed")
-        f = self._frame
+        # the changes go to a copy, kept as the plan's frame once the render succeeded: a call
+        # that fails leaves the next one the frame before it
+        f = ffi.new("atmos_frame *")
+        ffi.memmove(f, self._frame, ffi.sizeof("atmos_frame"))
         w = "Plan.render"
         if camera:
             unknown = sorted(str(k) for k in camera if k not in _CAMERA_KEYS)
@@ -149,6 +153,7 @@ class Plan(Owned):
         wl = lib.atmos_plan_wavelengths(self._ptr)
         rgb = _to_srgb(ctx, spec, wl)
         ffi.release(spec)
+        self._frame = f
         return Image(rgb, _info(info, wl))
 
     def __repr__(self):

@@ -23,8 +23,8 @@
  * feeding UT for TD (see above) costs more than the 0.01 degree budget once
  * |Delta T| grows past ~15 minutes, i.e. centuries away from now. 1800-2200
  * keeps us well inside both. */
-#define SUNPOS_YEAR_MIN 1800
-#define SUNPOS_YEAR_MAX 2200
+#define SUNPOS_YEAR_MIN ATMOS_SUN_YEAR_MIN
+#define SUNPOS_YEAR_MAX ATMOS_SUN_YEAR_MAX
 
 static int is_leap_year(int y)
 {

@@ -461,11 +461,14 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     ok = ok && solve_all(&D, wl, ns, skymean, phi_all, warm, threads, ws, info);
     for (int w = 1; w < n && ok; w++) {
         if (!copy[w]) continue;
+        /* the last wavelength's moments, just before this one's in phi_all (w >= 1); indexed from
+           their own start, as phi[i - NK] wrapped round as an unsigned index for every i < NK */
         double *phi = phi_all + (size_t)w * NK;
+        const double *prev = phi_all + (size_t)(w - 1) * NK;
         for (size_t c = 0; c < cells; c++)
             for (int k = 0; k < K; k++)
                 coef[(c * n + w) * K + k] = (float)(coef[(c * n + w - 1) * K + k] * (E[w] / E[w - 1]));
-        for (size_t i = 0; i < NK; i++) phi[i] = phi[i - NK] * (E[w] / E[w - 1]);
+        for (size_t i = 0; i < NK; i++) phi[i] = prev[i] * (E[w] / E[w - 1]);
     }
     free(src), free(sky);
     info->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;

@@ -114,6 +114,16 @@ int atmos__scene_valid_time(const atmos_utc_time *t)
              t->minute < 0 || t->minute > 59 || !(t->second >= 0 && t->second < 61));
 }
 
+/* A sun time's year outside the solar position algorithm's (atmos_sun_position_compute refuses it,
+ * the render would fail naming neither the scene nor the key). */
+static atmos_status sun_year(atmos_context *ctx, const char *source, const char *key, const atmos_utc_time *t)
+{
+    if (t->year >= ATMOS_SUN_YEAR_MIN && t->year <= ATMOS_SUN_YEAR_MAX) return ATMOS_OK;
+    return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, key,
+                             "year %d out of range [%d, %d] of the solar position algorithm (NOAA/Meeus)", t->year,
+                             ATMOS_SUN_YEAR_MIN, ATMOS_SUN_YEAR_MAX);
+}
+
 atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
                                        const atmos_scene_sun *sun)
 {
@@ -131,6 +141,7 @@ atmos_status atmos__scene_validate_sun(atmos_context *ctx, const char *source,
                                  "not a valid UTC date-time (%04d-%02d-%02dT%02d:%02d:%06.3f)",
                                  t->year, t->month, t->day, t->hour, t->minute,
                                  isfinite(t->second) ? t->second : -1.0);
+    if ((st = sun_year(ctx, source, "/sun/time", t))) return st;
     if ((st = atmos__scene_check_range(ctx, source, "/sun/latitude_deg", sun->latitude_deg,
                                        &atmos__r_latitude, NULL)))
         return st;
@@ -347,6 +358,7 @@ atmos_status atmos__scene_validate_animation(atmos_context *ctx, const char *sou
                                      "\"longitude_deg\"}); a sun given by angles moves with elevation_end_deg/azimuth_end_deg");
         if (!atmos__scene_valid_time(&a->time_end))
             return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, "/animation/time_end", "not a valid UTC date-time");
+        if ((st = sun_year(ctx, source, "/animation/time_end", &a->time_end))) return st;
     }
     if (angle_end && scene->sun.from_time)
         return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source,

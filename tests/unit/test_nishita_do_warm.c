@@ -7,7 +7,11 @@
  * reaches the ball): the warm-started field is 0 as the fresh one, not the last sun's moments swept
  * once more (a ghost of the last sun). Solved afresh after more moves (each plan's cells' medium
  * kept from its first sun) the image does not depend on the frames before it, to the bit. An optically thin ball
- * under the sky: 2 sweeps a wavelength (thin()). */
+ * under the sky: 2 sweeps a wavelength (thin()). The grey ball in a vacuum with the sky off takes the
+ * fill's copy of the last wavelength's moments (nishita_do.c): its index phi[i - NK] wrapped round
+ * as an unsigned for every i until 2026-12-06, which Clang's -fsanitize=pointer-overflow reports on
+ * this test ("addition of unsigned offset ... overflowed") and GCC's sanitizer, the asan twin's, does
+ * not. */
 #include "test.h"
 #include "test_optics.h"
 
