@@ -175,7 +175,7 @@ static const atmos_setting beams_settings[] = {
      "interleaved sampling (Keller and Heidrich 2001): the pixels of each N x N block sample between the planes at N^2 "
      "different offsets, their airlight averaged over N x N pixels of similar depth (1: off)",
      BEAMS(interleave)},
-    {"screen_step", "screen-step", ATMOS_SETTING_INT, "pixels", 1, 16, 0, 0, 8, NULL, 0,
+    {"screen_step", "screen-step", ATMOS_SETTING_INT, "pixels", 1, 16, 0, 0, 16, NULL, 0,
      "the airlight evaluated every N pixels and interpolated across the cells whose corners agree, per pixel "
      "elsewhere, the sky behind on the sky's grid of every N pixels, at most 4 (1: every pixel; with interleave 1)",
      BEAMS(screen_step)},
