@@ -99,8 +99,11 @@ static int ad_solve(int n, int m, double *A, double *B)
 
 /* Slab of optical thickness tau, single-scattering albedo a, phase function the sum of two
  * HG lobes w1 HG(g1) + (1 - w1) HG(g2) (Legendre moments w1 g1^l + (1 - w1) g2^l), collimated
- * beam at cosine mu0 (0 < mu0 <= 1) on top; N Gauss points per hemisphere (<= 64). */
-static int ad_slab2(double tau, double a, double w1, double g1, double g2, double mu0, int N, ad_result *res)
+ * beam at cosine mu0 (0 < mu0 <= 1) on top; N Gauss points per hemisphere (<= 64); lt >= 0:
+ * delta-M of degree lt instead (f = chi_{lt+1}, the scaled moments above lt 0: a field that
+ * keeps the phase's degrees <= lt alone, solved exactly in angle and depth), else of 2N - 1. */
+static int ad_slab_lt(double tau, double a, double w1, double g1, double g2, double mu0, int N, int lt,
+                      ad_result *res)
 {
     const double PI = 3.14159265358979323846, eps = 1e-12;
     const int D = N + 1, L = 2 * N; /* Legendre terms kept: 0..L-1 */
@@ -109,10 +112,11 @@ static int ad_slab2(double tau, double a, double w1, double g1, double g2, doubl
     res->mu[0] = mu0, res->w[0] = eps;
     ad_gauss01(N, res->mu + 1, res->w + 1);
     /* delta-M */
-    const double f = w1 * pow(g1, L) + (1 - w1) * pow(g2, L);
+    const int lf = lt >= 0 && lt + 1 < L ? lt + 1 : L;
+    const double f = w1 * pow(g1, lf) + (1 - w1) * pow(g2, lf);
     const double ts = (1 - a * f) * tau, as = a * (1 - f) / (1 - a * f);
     double chi[2 * AD_MAXN];
-    for (int l = 0; l < L; l++) chi[l] = (w1 * pow(g1, l) + (1 - w1) * pow(g2, l) - f) / (1 - f);
+    for (int l = 0; l < L; l++) chi[l] = l < lf ? (w1 * pow(g1, l) + (1 - w1) * pow(g2, l) - f) / (1 - f) : 0;
     /* Legendre polynomials at the directions */
     static double P[AD_MAXN][2 * AD_MAXN];
     for (int i = 0; i < D; i++) {
@@ -199,6 +203,11 @@ static int ad_slab2(double tau, double a, double w1, double g1, double g2, doubl
     res->radiance_up[0] = res->R[0] * I0;
     free(Pt), free(Pr), free(A), free(B), free(tmp), free(tmp2), free(E);
     return 1;
+}
+
+static int ad_slab2(double tau, double a, double w1, double g1, double g2, double mu0, int N, ad_result *res)
+{
+    return ad_slab_lt(tau, a, w1, g1, g2, mu0, N, -1, res);
 }
 
 /* One HG lobe of asymmetry g. */

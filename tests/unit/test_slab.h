@@ -64,4 +64,26 @@ static inline double test_ad_up(const ad_result *r, double mu)
     return (1 - t) * r->radiance_up[lo] + t * r->radiance_up[hi];
 }
 
+/* The reflected radiance per unit irradiance at mu of the slab of optical depth tau (HG g,
+ * albedo 1, the sun at the zenith) as the discrete-ordinates field's own approximation would give
+ * it if solved exactly in angle and depth: delta-M of degree lt (adding-doubling with the scaled
+ * moments above lt dropped) with its first order replaced by the full phase's (TMS, Nakajima &
+ * Tanaka 1988, J. Quant. Spectrosc. Radiat. Transfer 40, 51), as the slice renderer's eye pass
+ * draws it. Its difference from the full solution is the degree's truncation alone. */
+static inline double test_ad_tms_up(double tau, double g, int lt, double mu)
+{
+    ad_result r;
+    if (!ad_slab_lt(tau, 1.0, 1.0, g, 0.0, 1.0, 32, lt, &r)) return 0;
+    const double PI = 3.14159265358979323846, c = -mu, f = pow(g, lt + 1), ts = (1 - f) * tau;
+    double ps = 0, p0 = 1, p1 = c; /* the scaled phase of degree lt at the scattering angle */
+    for (int l = 0; l <= lt; l++) {
+        const double pl = l == 0 ? 1 : l == 1 ? c : ((2 * l - 1) * c * p1 - (l - 1) * p0) / l;
+        if (l >= 2) p0 = p1, p1 = pl;
+        ps += (2 * l + 1) * (pow(g, l) - f) / (1 - f) * pl;
+    }
+    const double pf = (1 - g * g) / pow(1 + g * g - 2 * g * c, 1.5); /* 4 pi HG */
+    const double geo = (1 - exp(-ts * (1 + 1 / mu))) / (4 * PI * (1 + mu));
+    return test_ad_up(&r, mu) - ps * geo + pf / (1 - f) * geo;
+}
+
 #endif
