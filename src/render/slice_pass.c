@@ -405,17 +405,22 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
     /* the in-scattering; the field's added by a loop of its own: a test of ds inside the loop
      * became a masked load from the null pointer, whose every lane masked off still cost a
      * microcode assist per vector (a quarter of the eye pass without the field) */
-    for (int q = 0; q < e->mv; q++) Sq[q] = Ic[q] * src[q];
+    for (int q = 0; q < e->mv; q++) Sq[q] = 0.0f;
     if (ds)
-        for (int q = 0; q < e->mv; q++) Sq[q] += ds[q];
+        for (int q = 0; q < e->mv; q++) Sq[q] = ds[q];
+    /* the light buffer's beam also attenuated across the slab where the light pass takes all
+       its extinction (atmos__slice_beam_len) */
+    const float lk = j->low_albedo ? j->ldelta : 0.0f;
+    const int btf = j->btf;
     for (int q = 0; q < e->mv; q++) {
         const float be = bext[q], tau = be * e->del[q];
         const float T = atmos__expf_poly(-tau);
         /* beta_sca Delta of Eq. 26, integrated over the slab with its own attenuation:
          * (1 - T)/beta_ext (-> Delta when thin). */
         const float len = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
+        const float lenI = atmos__slice_beam_len(e->del[q], tau, be * lk, btf, atmos__expf_poly);
         Tq[q] = be > 0.0f ? T : 1.0f;
-        Cq[q] = be > 0.0f ? Sq[q] * len : 0.0f;
+        Cq[q] = be > 0.0f ? Sq[q] * len + Ic[q] * src[q] * lenI : 0.0f;
     }
     float *restrict Lb = j->L_eye + c * j->pst + p0, *restrict Tb = j->T_eye + c * j->pst + p0;
     const int m = e->m;

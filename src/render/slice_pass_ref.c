@@ -95,8 +95,11 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
             /* beta_sca Delta of Eq. 26, integrated over the slab with its own
              * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
             float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
+            /* the light buffer's beam also attenuated across the slab where the light pass
+               takes all its extinction (atmos__slice_beam_len) */
+            const float lenI = atmos__slice_beam_len(delta, tau, j->low_albedo ? bext * j->ldelta : 0.0f, j->btf, expf);
             /* the diffuse field scattered toward the eye: beta_sca (L + g A), not below 0 */
-            float contrib = (j->field ? I[c] * src + (dsrc > 0.0f ? dsrc : 0.0f) : I[c] * src) * len;
+            float contrib = I[c] * src * lenI + (j->field && dsrc > 0.0f ? dsrc * len : 0.0f);
             float *Lp = j->L_eye + c * j->pst + p, *Tp = j->T_eye + c * j->pst + p;
             if (j->btf) *Lp = *Lp * Tslab + contrib; /* back-to-front: over */
             else *Lp += *Tp * contrib;               /* front-to-back: under */
