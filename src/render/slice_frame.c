@@ -404,7 +404,7 @@ atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp,
  * light span of slices k - B..k covers can differ, and only those are copied or updated. */
 atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp, sjob *j, atmos_slice_timing *tm)
 {
-    long long (*const eye_pass)(const sjob *, int, int, int, int, const float *, const float *) =
+    long long (*const eye_pass)(const sjob *, int, int, int, int, const float *, const float *, const float *) =
         sp->reference ? atmos__slice_eye_span_ref : atmos__slice_eye_span;
     long long (*const light_pass)(const sjob *, int, int, int, int, int, int, const float *, const float *, float *,
                                   float *) = sp->reference ? atmos__slice_light_span_ref : atmos__slice_light_span;
@@ -439,7 +439,7 @@ atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp
             for (int q = 0; q < nb; q++) {
                 const int k = k0 + q;
                 const sspan es = j->espan[(size_t)k * j->H + y];
-                if (es.x0 <= es.x1) eye_samples += eye_pass(j, k, y, es.x0, es.x1, j->I[q], j->nsc[q]);
+                if (es.x0 <= es.x1) eye_samples += eye_pass(j, k, y, es.x0, es.x1, j->I[q], j->nsc[q], j->I[q + 1]);
             }
 #pragma omp master
         {

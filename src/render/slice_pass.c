@@ -397,25 +397,35 @@ SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, fl
 
 /* Eq. 26 for wavelength c: the slab's transmittance and in-scattered light, composited
  * into the eye buffer over (back to front) or under (front to back); ds (or NULL): the
- * diffuse field's in-scattering added to the beam's. */
+ * diffuse field's in-scattering added to the beam's; I1 (or NULL): the light leaving the slab
+ * at the samples, Ic's attenuation across it (atmos__slice_beam_len). */
 SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
-                             const float *restrict bext, const float *restrict src, const float *restrict ds)
+                             const float *restrict bext, const float *restrict src, const float *restrict ds,
+                             const float *restrict I1)
 {
     float Tq[CH], Cq[CH], Sq[CH];
     /* the in-scattering; the field's added by a loop of its own: a test of ds inside the loop
      * became a masked load from the null pointer, whose every lane masked off still cost a
      * microcode assist per vector (a quarter of the eye pass without the field) */
-    for (int q = 0; q < e->mv; q++) Sq[q] = Ic[q] * src[q];
+    float tl[CH];
+    for (int q = 0; q < e->mv; q++) Sq[q] = 0.0f, tl[q] = 0.0f;
     if (ds)
-        for (int q = 0; q < e->mv; q++) Sq[q] += ds[q];
+        for (int q = 0; q < e->mv; q++) Sq[q] = ds[q];
+    if (I1) /* the beam's optical depth across the slab, as the light pass took it */
+        for (int q = 0; q < e->mv; q++) {
+            const float r = Ic[q] > 0.0f ? I1[q] / Ic[q] : 1.0f;
+            tl[q] = r < 1.0f ? -log_pos(r) : 0.0f;
+        }
+    const int btf = j->btf;
     for (int q = 0; q < e->mv; q++) {
         const float be = bext[q], tau = be * e->del[q];
         const float T = atmos__expf_poly(-tau);
         /* beta_sca Delta of Eq. 26, integrated over the slab with its own attenuation:
          * (1 - T)/beta_ext (-> Delta when thin). */
         const float len = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
+        const float lenI = atmos__slice_beam_len(e->del[q], tau, tl[q], btf, atmos__expf_poly);
         Tq[q] = be > 0.0f ? T : 1.0f;
-        Cq[q] = be > 0.0f ? Sq[q] * len : 0.0f;
+        Cq[q] = be > 0.0f ? Sq[q] * len + Ic[q] * src[q] * lenI : 0.0f;
     }
     float *restrict Lb = j->L_eye + c * j->pst + p0, *restrict Tb = j->T_eye + c * j->pst + p0;
     const int m = e->m;
@@ -540,26 +550,29 @@ SLICE_INLINE void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e
 }
 
 /* The light, the optics and the blend of an RGB chunk. */
-SLICE_INLINE void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib)
+SLICE_INLINE void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib, const float *In)
 {
-    float I3[4][CH], be3[3][CH], src3[3][CH], ds3[4][CH];
+    float I3[4][CH], be3[3][CH], src3[3][CH], ds3[4][CH], J3[4][CH];
+    if (j->low_albedo) eye_rgb_light(j, e, In, J3); /* the light leaving the slab (its n overwritten next) */
     eye_rgb_light(j, e, Ib, I3);
     eye_orders(j, p0, e);
     eye_rgb_optics(j, e, be3, src3);
     if (j->field) eye_rgb_field(j, k, p0, e, ds3);
-    for (int c = 0; c < 3; c++) eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], j->field ? ds3[c] : NULL);
+    for (int c = 0; c < 3; c++)
+        eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], j->field ? ds3[c] : NULL, j->low_albedo ? J3[c] : NULL);
 }
 #else
 #define SLICE_RGB 0
 #endif
 
 SLICE_CLONES
-long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb)
+long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb,
+                                const float *In)
 {
     const int n = j->n;
     const int32_t ns = n + 1, LN = j->L * ns; /* texels interleave I per wavelength and n */
     echunk e;
-    float Ic[CH], bext[CH], src[CH];
+    float Ic[CH], I1[CH], bext[CH], src[CH];
     float ds[CH * ATMOS_MAX_WAVELENGTHS]; /* the diffuse field's in-scattering at the samples */
     long long count = 0;
     for (int xs = x0; xs <= x1; xs += CH) {
@@ -570,7 +583,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
         eye_texels(j, k, p0, &e);
 #if SLICE_RGB
         if (n == 3) {
-            eye_rgb(j, k, p0, &e, Ib);
+            eye_rgb(j, k, p0, &e, Ib, In);
             continue;
         }
 #endif
@@ -579,8 +592,9 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
         if (j->field) eye_field(j, k, p0, &e, ds);
         for (int c = 0; c < n; c++) {
             eye_bilinear(&e, Ib + c, ns, LN, Ic);
+            if (j->low_albedo) eye_bilinear(&e, In + c, ns, LN, I1);
             eye_optics(j, &e, c, bext, src);
-            eye_blend(j, p0, &e, c, Ic, bext, src, j->field ? ds + c * CH : NULL);
+            eye_blend(j, p0, &e, c, Ic, bext, src, j->field ? ds + c * CH : NULL, j->low_albedo ? I1 : NULL);
         }
     }
     return count;

@@ -46,11 +46,12 @@ static void field_toward_eye(const sjob *j, float u, float v, float w, float *ou
 }
 
 /* Reference eye pass (see slice_internal.h). */
-long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb)
+long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1, const float *Ib, const float *nb,
+                                    const float *In)
 {
     const int n = j->n, nf = j->nf, no = j->t->no;
     const float kf = (float)k;
-    float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], nsc;
+    float dens[ATMOS_VOLUME_MAX_FIELDS], I[ATMOS_MAX_WAVELENGTHS], I1[ATMOS_MAX_WAVELENGTHS], nsc, n1;
     long long count = 0;
     for (int x = x0; x <= x1; x++) {
         size_t p = (size_t)y * j->W + x;
@@ -59,7 +60,9 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
               w = j->pU0[2][p] + kf * j->pdU[2][p];
         if (!sgrid_sample_u(j->g, u, v, w, dens)) continue;
         count++;
-        light_lookup(j, Ib, nb, j->pF0[0][p] + kf * j->pdF[0][p], j->pF0[1][p] + kf * j->pdF[1][p], I, &nsc);
+        const float lu = j->pF0[0][p] + kf * j->pdF[0][p], lv = j->pF0[1][p] + kf * j->pdF[1][p];
+        light_lookup(j, Ib, nb, lu, lv, I, &nsc);
+        if (j->low_albedo) light_lookup(j, In, In + n, lu, lv, I1, &n1); /* the light leaving the slab */
         const float delta = j->pdelta[p];
         /* One more scattering than the light has had turns it to the eye (Eq. 26):
          * Ams at fractional order m, linear between orders (and angles). */
@@ -95,8 +98,12 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
             /* beta_sca Delta of Eq. 26, integrated over the slab with its own
              * attenuation: (1 - T)/beta_ext (-> Delta when thin). */
             float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
+            /* the light buffer's beam also attenuated across the slab where the light pass
+               takes all its extinction (atmos__slice_beam_len) */
+            const float r = j->low_albedo && I[c] > 0.0f ? I1[c] / I[c] : 1.0f;
+            const float lenI = atmos__slice_beam_len(delta, tau, r < 1.0f ? -logf(r > 1e-30f ? r : 1e-30f) : 0.0f, j->btf, expf);
             /* the diffuse field scattered toward the eye: beta_sca (L + g A), not below 0 */
-            float contrib = (j->field ? I[c] * src + (dsrc > 0.0f ? dsrc : 0.0f) : I[c] * src) * len;
+            float contrib = I[c] * src * lenI + (j->field && dsrc > 0.0f ? dsrc * len : 0.0f);
             float *Lp = j->L_eye + c * j->pst + p, *Tp = j->T_eye + c * j->pst + p;
             if (j->btf) *Lp = *Lp * Tslab + contrib; /* back-to-front: over */
             else *Lp += *Tp * contrib;               /* front-to-back: under */

@@ -131,7 +131,9 @@ int main(void)
         const char *used = atmos_image_get_meta(chosen, "atmos:slice");
         printf("wide flat slab, relative rms difference to 2048 slices: 256 slices %.5f, renderer's choice %.5f (%s)\n",
                e256, eauto, used ? used : "?");
-        CHECK(e256 > 0.004); /* the banding (measured 0.0090), so that the test can fail */
+        /* the banding, so that the test can fail: measured 0.0090, 0.0033 since the beam's own
+           attenuation across a slab is integrated (atmos__slice_beam_len) */
+        CHECK(e256 > 0.002);
         CHECK(eauto < 0.001);
     }
     test_low_view(ctx, v, &op);
