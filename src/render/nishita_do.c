@@ -18,6 +18,7 @@
  * coefficients are also the sky's and the ground's light of the orders >= 1 per unit sigma_s (the
  * eye pass adds no other sky light in the volume; the sky seen straight through the volume is
  * the eye pass's background, attenuated). */
+#include "core/clones.h"
 #include "core/fastmath.h"
 #include "core/vec.h"
 #include "light/lfield_do.h"
@@ -47,6 +48,13 @@
  * voxel's own share: -17 %) */
 #define SUB_NB_TAU 16.0
 
+/* a helper of a cloned function (ATMOS_CLONES) inlined into each clone */
+#if defined(__GNUC__)
+#define DO_INLINE static inline __attribute__((always_inline))
+#else
+#define DO_INLINE static inline
+#endif
+
 /* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
  * DO_NPHI, atmos__do_quadrature's order: the cosines descending), the mean over the direction's
  * patch (its Gauss-Legendre weight's band of cosines, its azimuth's sector), per wavelength:
@@ -75,7 +83,7 @@ static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np
  * optical depth across it along the sun, h <= tau), in single precision's polynomial exponential
  * (relative error < 1e-6; the library's exp and sinh took half the cells' set-up): below h 0.5 by
  * the series of sinh(h) / h, else as (e^(h - tau) - e^(-h - tau)) / 2h, no exponent above 0. */
-static inline double mean_transmittance(double tau, double h)
+DO_INLINE double mean_transmittance(double tau, double h)
 {
     if (h < 0.5) {
         const double h2 = h * h;
@@ -248,6 +256,46 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
     return dc;
 }
 
+#define CS_BLOCK 64 /* cell_source's voxels a block: its arrays stay in L1 */
+
+/* cell_source's sums over a block of m listed voxels (their grid indices times nf vi, their first
+ * list entry e0) for wavelength w: acc[0 .. 3] += the voxels' sigma_s T_sun, sigma_s, local
+ * radiance and sigma_s times it, *nv += the scattering voxels (sub: the sub-cell term's, cells of
+ * more than one voxel). The same operations in the same order per wavelength as one voxel at a
+ * time, in three loops: the medium gathered, the exponentials of every voxel in one vector loop
+ * (both sides of mean_transmittance's branch, the one kept chosen per voxel: the same values), the
+ * sums in the voxels' order (the same bits as the voxel-at-a-time loop; built for AVX2 as well as
+ * the baseline, chosen at run time). */
+ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos__do_cells *dc, int n, int w,
+                                      const size_t *vi, size_t e0, int m, const float *sig, const float *sca,
+                                      double len, int sub, double acc[4], int *nv)
+{
+    const float *gv = np->g.v, *col = np->col;
+    const int nf = np->nf;
+    double t[CS_BLOCK], sc[CS_BLOCK], tau[CS_BLOCK], tr[CS_BLOCK], l1[CS_BLOCK];
+    float a0[CS_BLOCK], a1[CS_BLOCK];
+    for (int e = 0; e < m; e++) {
+        double tt = 0, ss = 0, ta = 0;
+        for (int f = 0; f < nf; f++)
+            tt += gv[vi[e] + f] * sig[f], ss += gv[vi[e] + f] * sca[f], ta += col[vi[e] + f] * sig[f];
+        t[e] = tt, sc[e] = ss, tau[e] = ta;
+    }
+    for (int e = 0; sub && e < m; e++) a0[e] = dc->sub[2 * ((e0 + e) * n + w)], a1[e] = dc->sub[2 * ((e0 + e) * n + w) + 1];
+    for (int e = 0; e < m; e++) {
+        const double tl = t[e] * len, ta = tau[e]; /* fmin's value, no call: neither is NaN */
+        const double hs = 0.5 * (tl < 2 * ta ? tl : 2 * ta), r = mean_transmittance(ta, hs);
+        tr[e] = r;
+        l1[e] = sub ? r * a0[e] + a1[e] * atmos__expf_fast((float)(hs - ta)) : 0;
+    }
+    for (int e = 0; e < m; e++) {
+        acc[1] += sc[e];
+        if (!(sc[e] != 0)) continue;
+        acc[0] += sc[e] * tr[e];
+        if (!sub) continue; /* a voxel's cell: no spread */
+        acc[2] += l1[e], acc[3] += sc[e] * l1[e], (*nv)++;
+    }
+}
+
 /* Per cell and wavelength w < n the mean of sigma_s E T_sun over its render voxels (src + cells w)
  * for the sun along sun_g (grid frame), over the voxels holding a field's density (dc).
  * And the cell's sub-cell term (dsrc + cells w, per unit E; 0 for cells of 1 voxel): the eye pass
@@ -261,7 +309,7 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
  * mean of that weighted by sigma_s less its plain mean over the scattering voxels (an empty
  * voxel's radiance is its neighbours', not 0: counted as 0 a uniform slab's edge cells got a
  * term), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
- * scattering voxels are uniform. */
+ * scattering voxels are uniform. The voxels in blocks (source_block). */
 static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, const atmos__do_cells *dc, int n,
                         const double sun_g[3], double *src, double *dsrc, int threads)
 {
@@ -271,39 +319,30 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
     double amax = 0;
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
     const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s);
-    float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS], sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
+    float sig[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS], sca[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS];
     for (int f = 0; f < nf; f++)
-        for (int w = 0; w < n; w++) sig[f][w] = np->mc_sig_ms[f][w], sca[f][w] = np->mc_sca[f][w];
+        for (int w = 0; w < n; w++) sig[w][f] = np->mc_sig_ms[f][w], sca[w][f] = np->mc_sca[f][w];
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int k = 0; k < F->c[2]; k++)
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
-                double aq[ATMOS_MAX_WAVELENGTHS] = {0}, as[ATMOS_MAX_WAVELENGTHS] = {0};
-                double la[ATMOS_MAX_WAVELENGTHS] = {0}, lw[ATMOS_MAX_WAVELENGTHS] = {0};
-                int nv[ATMOS_MAX_WAVELENGTHS] = {0};
-                for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
-                    int x, y, z;
-                    const size_t v = kept_voxel(g, nf, s, i, j, k, dc->vox[e], &x, &y, &z);
-                    for (int w = 0; w < n; w++) {
-                        double t = 0, sc = 0, tau = 0;
-                        for (int f = 0; f < nf; f++) {
-                            t += g->v[v + f] * sig[f][w], sc += g->v[v + f] * sca[f][w];
-                            tau += np->col[v + f] * sig[f][w];
-                        }
-                        as[w] += sc;
-                        if (!(sc != 0)) continue; /* no exponentials */
-                        const double tl = t * len; /* fmin's value, no call: neither is NaN */
-                        const double hs = 0.5 * (tl < 2 * tau ? tl : 2 * tau), tr = mean_transmittance(tau, hs);
-                        aq[w] += sc * tr;
-                        if (s == 1) continue; /* a voxel's cell: no spread */
-                        const float *ab = dc->sub + 2 * (e * n + w);
-                        const double l1 = tr * ab[0] + ab[1] * atmos__expf_fast((float)(hs - tau));
-                        la[w] += l1, lw[w] += sc * l1, nv[w]++;
+                double acc[ATMOS_MAX_WAVELENGTHS][4];
+                int nv[ATMOS_MAX_WAVELENGTHS];
+                for (int w = 0; w < n; w++) acc[w][0] = acc[w][1] = acc[w][2] = acc[w][3] = 0, nv[w] = 0;
+                for (size_t e0 = dc->first[c]; e0 < dc->first[c + 1]; e0 += CS_BLOCK) {
+                    const int m = dc->first[c + 1] - e0 < CS_BLOCK ? (int)(dc->first[c + 1] - e0) : CS_BLOCK;
+                    size_t vi[CS_BLOCK];
+                    for (int e = 0; e < m; e++) {
+                        int x, y, z;
+                        vi[e] = kept_voxel(g, nf, s, i, j, k, dc->vox[e0 + e], &x, &y, &z);
                     }
+                    for (int w = 0; w < n; w++)
+                        source_block(np, dc, n, w, vi, e0, m, sig[w], sca[w], len, s > 1, acc[w], &nv[w]);
                 }
                 for (int w = 0; w < n; w++)
-                    src[cells * w + c] = aq[w] * inv, dsrc[cells * w + c] = nv[w] > 0 ? lw[w] / as[w] - la[w] / nv[w] : 0;
+                    src[cells * w + c] = acc[w][0] * inv,
+                               dsrc[cells * w + c] = nv[w] > 0 ? acc[w][3] / acc[w][1] - acc[w][2] / nv[w] : 0;
             }
 }
 
