@@ -12,7 +12,10 @@ def _path(where: str, path) -> bytes:
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise TypeError(f"atmos: {where}: expected a file name (str, bytes or os.PathLike), "
                         f"got {type(path).__name__}")
-    return os.fsencode(path)
+    name = os.fsencode(path)
+    if b"\0" in name:  # the library would read the name only up to it, past the suffix's check
+        raise ValueError(f"atmos: {where}: a file name with a NUL byte: {path!r}")
+    return name
 
 
 class Image(Owned):
@@ -102,7 +105,7 @@ def image_kind(data) -> str | None:
     readers tell it: "OpenEXR", "PNG", "JPEG" or "PFM", else None (``atmos_image_kind``)."""
     if not isinstance(data, (bytes, bytearray, memoryview)):
         raise TypeError(f"atmos: image_kind: expected bytes, got {type(data).__name__}")
-    b = bytes(data)
+    b = bytes(data[:8])  # the longest magic number the readers test (PNG's)
     return _kind(lib.atmos_image_kind(ffi.from_buffer(b), len(b)))
 
 

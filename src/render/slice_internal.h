@@ -227,6 +227,16 @@ atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp,
  * progress callback asks to stop. */
 atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp, sjob *j, atmos_slice_timing *tm);
 
+/* The beam's transmittance across a slab from the light arriving (i0) and leaving (i1) it, as the
+ * light pass took it: i1 / i0, 1 where no light arrives or none is lost, at least e^-80 (a beam put
+ * out within the slab): its -ln, the beam's optical depth, is then at most 80 in both eye passes,
+ * the fast one's logarithm and the reference's libm one alike. */
+static inline float atmos__slice_beam_ratio(float i0, float i1)
+{
+    const float r = i0 > 0.0f ? i1 / i0 : 1.0f;
+    return !(r < 1.0f) ? 1.0f : r > 1.80485e-35f ? r : 1.80485e-35f; /* e^-80 */
+}
+
 /* The eye-ray length by which the light arriving at a slab, I, times the slab's in-scattering
  * coefficient makes its in-scattered light: the integral over the slab of the light's own
  * attenuation in it (tl, the optical depth across the slab that the light pass took from that
@@ -235,8 +245,9 @@ atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp
  * ray, del its length). Front to back the light and the eye enter the slab by the same face:
  * del (1 - e^-(te + tl)) / (te + tl); back to front the light enters by the far one: del (e^-tl -
  * e^-te) / (te - tl). With tl = 0 both are the plain (1 - e^-te) del / te; with tl left out a
- * homogeneous medium's beam was counted (e^tl - 1) / tl too bright (+37 % at tl = te = 0.6 a
- * slab: a dense cloud's 256 slices). ex: the exponential (libm's or the vectorisable one). */
+ * homogeneous medium's beam was counted too bright (back to front by (e^tl - 1) / tl: +37 % at
+ * tl = te = 0.6 a slab, a dense cloud's 256 slices; front to back +29 % there). ex: the
+ * exponential (libm's or the vectorisable one). */
 static inline float atmos__slice_beam_len(float del, float te, float tl, int btf, float (*ex)(float))
 {
     const float y = btf ? te - tl : te + tl;

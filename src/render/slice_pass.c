@@ -412,10 +412,7 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
     if (ds)
         for (int q = 0; q < e->mv; q++) Sq[q] = ds[q];
     if (I1) /* the beam's optical depth across the slab, as the light pass took it */
-        for (int q = 0; q < e->mv; q++) {
-            const float r = Ic[q] > 0.0f ? I1[q] / Ic[q] : 1.0f;
-            tl[q] = r < 1.0f ? -log_pos(r) : 0.0f;
-        }
+        for (int q = 0; q < e->mv; q++) tl[q] = -log_pos(atmos__slice_beam_ratio(Ic[q], I1[q]));
     const int btf = j->btf;
     for (int q = 0; q < e->mv; q++) {
         const float be = bext[q], tau = be * e->del[q];
@@ -423,7 +420,7 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
         /* beta_sca Delta of Eq. 26, integrated over the slab with its own attenuation:
          * (1 - T)/beta_ext (-> Delta when thin). */
         const float len = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
-        const float lenI = atmos__slice_beam_len(e->del[q], tau, tl[q], btf, atmos__expf_poly);
+        const float lenI = I1 ? atmos__slice_beam_len(e->del[q], tau, tl[q], btf, atmos__expf_poly) : len;
         Tq[q] = be > 0.0f ? T : 1.0f;
         Cq[q] = be > 0.0f ? Sq[q] * len + Ic[q] * src[q] * lenI : 0.0f;
     }

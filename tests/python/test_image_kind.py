@@ -52,3 +52,11 @@ def test_a_file_name_that_is_not_one_is_a_type_error(tmp_path):
             call()
     img.write_exr(str(tmp_path / "b.EXR").encode())
     assert atmos.read_exr(tmp_path / "b.EXR").shape == (3, 4, 4)
+
+
+def test_a_file_name_with_a_nul_byte_is_refused(tmp_path):
+    """The library reads a name up to its NUL: "x\\0.exr" passed the suffix's check and wrote "x"."""
+    img = atmos.render(atmos.Scene.default(), width=4, height=3)
+    with pytest.raises(ValueError, match="atmos: Image.write_exr: a file name with a NUL byte"):
+        img.write_exr(str(tmp_path / "x") + "\0.exr")
+    assert not (tmp_path / "x").exists()

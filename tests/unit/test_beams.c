@@ -1263,7 +1263,7 @@ int main(void)
     test_threads();
     test_interleave();
     test_screen_step();
-    for (int step = 8; step <= 16; step *= 2) { /* 16: the default since issue 17's twenty-fifth round */
+    for (int step = 8; step <= 16; step *= 2) { /* 16: the default since issue 17's twenty-sixth round */
         test_thin_beam_hint(step);
         test_wide_span(step);
         test_layers(step);

@@ -134,7 +134,9 @@ int main(void)
         /* the banding, so that the test can fail: measured 0.0090, 0.0033 since the beam's own
            attenuation across a slab is integrated (atmos__slice_beam_len) */
         CHECK(e256 > 0.002);
-        CHECK(eauto < 0.001);
+        /* the renderer's choice (1847 slices here) within a tenth of 256's banding: measured 7e-5;
+           fails for a count below about 1250 */
+        CHECK(eauto < 0.1 * e256);
     }
     test_low_view(ctx, v, &op);
     /* A compact volume (32 x 24 x 32 voxels) keeps the former fixed count, 256. */

@@ -70,7 +70,9 @@ static void check_slabs(atmos_context *ctx, const test_optics *op)
             if (t > 0) CHECK(fabs(m1 / ref - 1) > 0.5);
             /* the field's own error (its sweeps, quadrature and grid) beside its degree's at depths
                1 and 4: within 5 points (measured +3.6 / +1.6 and -0.5 / -0.4; the diamond in every
-               cell -3.5 / -4.3 and -5.6 / -4.9, the field of degree 2 -6.2 / -1.2 at depth 1) */
+               cell -3.5 / -4.3 and -5.6 / -4.9, the field of degree 2 -6.2 / -1.2 at depth 1); not
+               checked at 16 and 64, where the thick cells' sweeps themselves differ from it by more
+               (-6.5 / -3.1 points at 16): there only the bound against adding-doubling above holds */
             if (t < 2) CHECK(fabs(m / m3 - 1) < 0.05);
         }
         atmos_volume_destroy(v);
