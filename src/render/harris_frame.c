@@ -300,12 +300,12 @@ static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmo
     const double cap = texel_cap(v);
     double texels = texels0;
     int taken = 0; /* never-made ones made in full: the first of first[] (their texels counted) */
-    for (; taken < nfirst && kept + used < v->impostor_budget; taken++)
+    for (; taken < nfirst && kept < v->impostor_budget; taken++)
         stale[kept++] = first[taken].index, texels += first[taken].key * first[taken].key;
     for (int q = 0; q < m; q++) {
         const int res = needed_res(p, h, key[q].index / 3, e, f);
         const double t = (double)res * res, late = key[q].key / res; /* its error over the tolerance */
-        if (kept + used < v->impostor_budget && ((kept + used == 0 && late >= 2) || texels + t <= cap))
+        if (kept < v->impostor_budget && ((kept + used == 0 && late >= 2) || texels + t <= cap))
             stale[kept++] = key[q].index, texels += t;
         else how[key[q].index / 3] = 3, h->held++;
     }
@@ -358,7 +358,7 @@ static void spread_start(const atmos_plan *p, atmos__harris_plan *h, const atmos
     const double f = v->cam.height / (2.0 * v->cam.tan_half_fov), cap = texel_cap(v);
     for (int q = 0; q < *nfull; q++) {
         const int k = stale[q] / 3, res = needed_res(p, h, k, v->cam.position, f);
-        if (stale[q] % 3 || !h->imp[k].valid || (double)res * res <= cap) continue;
+        if (stale[q] % 3 || !h->imp[k].valid || 2 * h->imp[k].res < res || (double)res * res <= cap) continue;
         const int pieces = (int)ceil((double)res * res / cap);
         h->spread_pieces = pieces < ATMOS__HARRIS_SPREAD_MAX ? pieces : ATMOS__HARRIS_SPREAD_MAX;
         if (!spread_cuts(h, &h->imp[k], res)) return;
