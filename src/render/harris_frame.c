@@ -276,7 +276,7 @@ static double texel_cap(const atmos__view *v)
  * makes before them counted: one that would pass it is held unless nothing was taken yet and
  * it is out of date by twice the tolerance, or nothing else is made (a still view catches up).
  * So a large impostor is made again less often and alone. A make spread over frames (used 1,
- * its rows' texels0 this frame) takes one of the B and its texels first. Reorders stale: the
+ * its piece's texels0 this frame) takes its texels first, and no other is then made alone. Reorders stale: the
  * full makes first; returns their count, the coarse ones after them (*ncoarse). */
 static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how, int *stale,
                           int n, atmos__keyed *key, int *ncoarse, int used, double texels0)
@@ -300,12 +300,12 @@ static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmo
     const double cap = texel_cap(v);
     double texels = texels0;
     int taken = 0; /* never-made ones made in full: the first of first[] (their texels counted) */
-    for (; taken < nfirst && kept < v->impostor_budget; taken++)
+    for (; taken < nfirst && kept + used < v->impostor_budget; taken++)
         stale[kept++] = first[taken].index, texels += first[taken].key * first[taken].key;
     for (int q = 0; q < m; q++) {
         const int res = needed_res(p, h, key[q].index / 3, e, f);
         const double t = (double)res * res, late = key[q].key / res; /* its error over the tolerance */
-        if (kept < v->impostor_budget && ((kept + used == 0 && late >= 2) || texels + t <= cap))
+        if (kept + used < v->impostor_budget && ((kept + used == 0 && late >= 2) || texels + t <= cap))
             stale[kept++] = key[q].index, texels += t;
         else how[key[q].index / 3] = 3, h->held++;
     }
@@ -343,8 +343,9 @@ static int spread_cuts(atmos__harris_plan *h, const atmos__pimpostor *old, int r
     return 1;
 }
 
-/* A whole-cloud impostor to make in full (stale[0..*nfull)) that has an old one to show and
- * more texels than the frame's cap is made over frames instead: the fewest pieces of rows of at
+/* A whole-cloud impostor to make in full (stale[0..*nfull)) that has an old one to show, at
+ * least half as fine as the view needs (not a coarse stand-in), and more texels than the
+ * frame's cap is made over frames instead: the fewest pieces of rows of at
  * most the cap's texels each (at least 2, at most ATMOS__HARRIS_SPREAD_MAX), cut where the old
  * one's coverage says the work is alike (spread_cuts), a piece a frame, its old one drawn until
  * it is done. The first such one is taken out of stale (shifting the coarse ones after it)
