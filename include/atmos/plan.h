@@ -161,9 +161,11 @@ typedef struct atmos_plan_stats {
     int sun_changed, camera_changed;
     atmos_slice_timing slice;   /* slice renderer */
     atmos_path_stats path;      /* path tracer */
-    int impostor_updates;       /* Harris's renderer: impostors made again this frame */
+    int impostor_updates;       /* Harris's renderer: impostors made again this frame (one made over several
+                                   frames counted in its first) */
     int impostors_held;         /* Harris's renderer: out-of-date impostors the frame's budget left as they
-                                   were (the same frame rendered again makes them; not reused meanwhile) */
+                                   were, and one drawn as it was while its new one is made over frames (the
+                                   same frame rendered again makes them; not reused meanwhile) */
     int impostors_coarse;       /* Harris's renderer: impostors never made before that the frame's budget made
                                    at a quarter of their resolution (made in full by a later frame; not
                                    counted in impostor_updates) */

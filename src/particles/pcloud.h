@@ -262,6 +262,12 @@ double atmos__pimpostor_error(const atmos__pimpostor *im, const double c[3], dou
 atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
                                    const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
                                    const double c[3], double r, const double e[3], int res);
+/* Makes rows [y0, y1) of im's image as atmos__pimpostor_make makes them (the same values): the
+ * first piece (y0 0) sets im's camera and clears its image, im valid once the last (y1 res) is
+ * made; the pieces in order from the same eye e, so a make can be spread over several calls. */
+atmos_status atmos__pimpostor_make_rows(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
+                                        const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
+                                        const double c[3], double r, const double e[3], int res, int y0, int y1);
 /* Draws the impostors ims[0..n) in that order (far to near; cloud q's centre c[q], radius r[q])
  * over img seen by cam within rect: each pixel's ray meets an impostor's plane (through its
  * cloud's centre, facing its view), the texture is read there (bilinear), and the pixel

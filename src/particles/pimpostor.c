@@ -67,34 +67,46 @@ static void texel_box(atmos__pimpostor *im)
     im->box[0] = x0 < x1 ? x0 : 0, im->box[1] = x0 < x1 ? x1 : 0, im->box[2] = y0, im->box[3] = y1;
 }
 
-atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
-                                   const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
-                                   const double c[3], double r, const double e[3], int res)
+atmos_status atmos__pimpostor_make_rows(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
+                                        const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
+                                        const double c[3], double r, const double e[3], int res, int y0, int y1)
 {
-    double d = 0;
-    for (int i = 0; i < 3; i++) d += (c[i] - e[i]) * (c[i] - e[i]);
-    d = sqrt(d);
-    if (!(d > r)) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "particles: an impostor seen from inside its cloud");
-    atmos_camera_desc cd;
-    memset(&cd, 0, sizeof cd);
-    cd.type = ATMOS_CAMERA_PINHOLE;
-    memcpy(cd.position, e, sizeof cd.position), memcpy(cd.look_at, c, sizeof cd.look_at);
-    const double fwd_y = (c[1] - e[1]) / d;
-    cd.up[0] = 0, cd.up[1] = fabs(fwd_y) > 0.99 ? 0 : 1, cd.up[2] = fabs(fwd_y) > 0.99 ? -1 : 0;
-    cd.fov_deg = 2.0 * asin(r / d) * 180.0 / ATMOS_PI;
-    atmos_status st = atmos_camera_init(ctx, &cd, res, res, &im->cam);
-    if (st == ATMOS_OK && (!im->img || im->img->width != res)) {
-        atmos_image_destroy(im->img), im->img = NULL;
-        st = atmos_image_create(ctx, res, res, o->nw + 1, &im->img);
+    atmos_status st = ATMOS_OK;
+    if (y0 == 0) {
+        double d = 0;
+        for (int i = 0; i < 3; i++) d += (c[i] - e[i]) * (c[i] - e[i]);
+        d = sqrt(d);
+        if (!(d > r)) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "particles: an impostor seen from inside its cloud");
+        atmos_camera_desc cd;
+        memset(&cd, 0, sizeof cd);
+        cd.type = ATMOS_CAMERA_PINHOLE;
+        memcpy(cd.position, e, sizeof cd.position), memcpy(cd.look_at, c, sizeof cd.look_at);
+        const double fwd_y = (c[1] - e[1]) / d;
+        cd.up[0] = 0, cd.up[1] = fabs(fwd_y) > 0.99 ? 0 : 1, cd.up[2] = fabs(fwd_y) > 0.99 ? -1 : 0;
+        cd.fov_deg = 2.0 * asin(r / d) * 180.0 / ATMOS_PI;
+        im->valid = 0;
+        st = atmos_camera_init(ctx, &cd, res, res, &im->cam);
+        if (st == ATMOS_OK && (!im->img || im->img->width != res)) {
+            atmos_image_destroy(im->img), im->img = NULL;
+            st = atmos_image_create(ctx, res, res, o->nw + 1, &im->img);
+        }
+        if (st != ATMOS_OK) return st;
+        memset(im->img->pixels, 0, sizeof(float) * (size_t)res * res * (o->nw + 1));
     }
-    if (st != ATMOS_OK) return st;
-    memset(im->img->pixels, 0, sizeof(float) * (size_t)res * res * (o->nw + 1));
-    const int rect[4] = {0, 0, res, res};
+    const int rect[4] = {0, y0, res, y1};
     if ((st = atmos__pcloud_splat(ctx, pc, o, L, idx, nidx, &im->cam, rect, im->img, NULL)) != ATMOS_OK) return st;
+    if (y1 < res) return ATMOS_OK;
     memcpy(im->view, e, sizeof im->view);
     im->res = res, im->valid = 1;
     texel_box(im);
     return ATMOS_OK;
+}
+
+atmos_status atmos__pimpostor_make(atmos_context *ctx, atmos__pimpostor *im, const atmos__pcloud *pc,
+                                   const atmos__poptics *o, const atmos__plights *L, const int *idx, int nidx,
+                                   const double c[3], double r, const double e[3], int res)
+{
+    return atmos__pimpostor_make_rows(ctx, im, pc, o, L, idx, nidx, c, r, e, res, 0, res);
 }
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

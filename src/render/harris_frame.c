@@ -118,6 +118,15 @@ static int part_mode(const atmos_plan *p, const atmos__harris_plan *h, const atm
                                           max_res(p, h, k)) ? 3 : 4;
 }
 
+/* The particles' lights and air for the splats. */
+static atmos__plights plights(const atmos__harris_plan *h)
+{
+    const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
+                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
+                              h->diffuse ? h->dview : NULL};
+    return L;
+}
+
 /* Above this many impostors to make a thread, remake makes one on each thread. */
 #define REMAKE_ONE_A_THREAD 4
 
@@ -153,9 +162,7 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
 {
     const int n = nfull + nc;
     const atmos__pclusters *c = &h->clouds;
-    const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
-                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
-                              h->diffuse ? h->dview : NULL};
+    const atmos__plights L = plights(h);
     /* the air to all their clouds' particles in one pass on the threads (a cloud's parts follow
      * each other in list) */
     int total = 0;
@@ -189,9 +196,7 @@ static atmos_status remake(const atmos_plan *p, atmos__harris_plan *h, const atm
 static atmos_status draw(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
                          const int *idx, int n, int how, const int rect[4], atmos_image *out)
 {
-    const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
-                              (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
-                              h->diffuse ? h->dview : NULL};
+    const atmos__plights L = plights(h);
     if (how == 1) {
         air(p, h, v, ap, idx, n);
         int drawn = 0;
@@ -254,6 +259,13 @@ static int needed_res(const atmos_plan *p, const atmos__harris_plan *h, int k, c
     return atmos__pimpostor_res(h->clouds.radius[k], sqrt(d2), f, max_res(p, h, k));
 }
 
+/* The frame's units of texels for the remakes (hold_to_budget's cap). */
+static double texel_cap(const atmos__view *v)
+{
+    const double side = fmax(v->cam.height / 8.0, 32.0);
+    return v->impostor_budget * side * side;
+}
+
 /* Holds the impostors to make (stale[0..n), entries 3 k + part) to the frame's budget B: split
  * clouds' parts are always made; then the whole-cloud impostors never made, the largest on the
  * screen first; then those out of date by the most pixels (the error over the tolerance times
@@ -263,10 +275,11 @@ static int needed_res(const atmos_plan *p, const atmos__harris_plan *h, int k, c
  * ones also keep within B units of (max(H / 8, 32))^2 texels (H: the frame's height), the full
  * makes before them counted: one that would pass it is held unless nothing was taken yet and
  * it is out of date by twice the tolerance, or nothing else is made (a still view catches up).
- * So a large impostor is made again less often and alone. Reorders stale: the full makes
- * first; returns their count, the coarse ones after them (*ncoarse). */
+ * So a large impostor is made again less often and alone. A make spread over frames (used 1,
+ * its piece's texels0 this frame) takes its texels first, and no other is then made alone. Reorders stale: the
+ * full makes first; returns their count, the coarse ones after them (*ncoarse). */
 static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how, int *stale,
-                          int n, atmos__keyed *key, int *ncoarse)
+                          int n, atmos__keyed *key, int *ncoarse, int used, double texels0)
 {
     const atmos_scene_harris *hs = &p->scene.harris;
     const double *e = v->cam.position, f = v->cam.height / (2.0 * v->cam.tan_half_fov);
@@ -284,27 +297,106 @@ static int hold_to_budget(const atmos_plan *p, atmos__harris_plan *h, const atmo
     }
     atmos__keyed_sort(first, (size_t)nfirst, 1);
     atmos__keyed_sort(key, (size_t)m, 1);
-    const double side = fmax(v->cam.height / 8.0, 32.0), cap = v->impostor_budget * side * side;
-    double texels = 0;
+    const double cap = texel_cap(v);
+    double texels = texels0;
     int taken = 0; /* never-made ones made in full: the first of first[] (their texels counted) */
-    for (; taken < nfirst && kept < v->impostor_budget; taken++)
+    for (; taken < nfirst && kept + used < v->impostor_budget; taken++)
         stale[kept++] = first[taken].index, texels += first[taken].key * first[taken].key;
     for (int q = 0; q < m; q++) {
         const int res = needed_res(p, h, key[q].index / 3, e, f);
         const double t = (double)res * res, late = key[q].key / res; /* its error over the tolerance */
-        if (kept < v->impostor_budget && ((kept == 0 && late >= 2) || texels + t <= cap))
+        if (kept + used < v->impostor_budget && ((kept + used == 0 && late >= 2) || texels + t <= cap))
             stale[kept++] = key[q].index, texels += t;
         else how[key[q].index / 3] = 3, h->held++;
     }
-    if (kept == 0 && m > 0) /* nothing else to make: the most out of date, so a still view catches up */
+    if (kept + used == 0 && m > 0) /* nothing else to make: the most out of date, so a still view catches up */
         stale[kept++] = key[0].index, how[key[0].index / 3] = 4, h->held--;
     for (int q = taken; q < nfirst; q++) stale[kept + q - taken] = first[q].index; /* the coarse ones */
     *ncoarse = nfirst - taken;
     return kept;
 }
 
+/* Cuts the rows of a res-texel make of the cloud whose impostor is old into h->spread_pieces
+ * pieces of about the same work (h->spread_cut): old's coverage summed over its rows (and a
+ * little a row), the new rows at the same place on the plane. Returns 0 without memory. */
+static int spread_cuts(atmos__harris_plan *h, const atmos__pimpostor *old, int res)
+{
+    const int R = old->res, C = old->img->channels, n = h->spread_pieces;
+    double *cum = malloc(sizeof(double) * (size_t)(R + 1));
+    if (!cum) return 0;
+    cum[0] = 0;
+    for (int y = 0; y < R; y++) {
+        const float *row = old->img->pixels + (size_t)y * R * C;
+        double a = 1e-3 * R;
+        for (int x = 0; x < R; x++) a += row[(size_t)x * C + C - 1];
+        cum[y + 1] = cum[y] + a;
+    }
+    h->spread_cut[0] = 0, h->spread_cut[n] = res;
+    for (int j = 1, y = 0; j < n; j++) {
+        const double want = cum[R] * j / n;
+        while (y < R && cum[y + 1] < want) y++;
+        const double oy = y + (want - cum[y]) / (cum[y + 1] - cum[y]); /* old rows, within row y */
+        const int c = (int)lround(oy * res / R), lo = h->spread_cut[j - 1] + 1, hi = res - (n - j);
+        h->spread_cut[j] = c < lo ? lo : (c > hi ? hi : c);
+    }
+    free(cum);
+    return 1;
+}
+
+/* A whole-cloud impostor to make in full (stale[0..*nfull)) that has an old one to show, at
+ * least half as fine as the view needs (not a coarse stand-in), and more texels than the
+ * frame's cap is made over frames instead: the fewest pieces of rows of at
+ * most the cap's texels each (at least 2, at most ATMOS__HARRIS_SPREAD_MAX), cut where the old
+ * one's coverage says the work is alike (spread_cuts), a piece a frame, its old one drawn until
+ * it is done. The first such one is taken out of stale (shifting the coarse ones after it)
+ * unless a make is spread already; not with the diffuse field or objects (what a particle shows
+ * then depends on more of the frame's eye than its air, which the first frame computes for all
+ * the rows). */
+static void spread_start(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how, int *stale,
+                         int *nfull, int ncoarse)
+{
+    if (h->spreading || h->diffuse || h->obj || v->impostor_budget <= 0) return;
+    const double f = v->cam.height / (2.0 * v->cam.tan_half_fov), cap = texel_cap(v);
+    for (int q = 0; q < *nfull; q++) {
+        const int k = stale[q] / 3, res = needed_res(p, h, k, v->cam.position, f);
+        if (stale[q] % 3 || !h->imp[k].valid || 2 * h->imp[k].res < res || (double)res * res <= cap) continue;
+        const int pieces = (int)ceil((double)res * res / cap);
+        h->spread_pieces = pieces < ATMOS__HARRIS_SPREAD_MAX ? pieces : ATMOS__HARRIS_SPREAD_MAX;
+        if (!spread_cuts(h, &h->imp[k], res)) return;
+        h->spreading = 1, h->spread_k = k, h->spread_res = res, h->spread_at = 0;
+        memcpy(h->spread_eye, v->cam.position, sizeof h->spread_eye);
+        memmove(stale + q, stale + q + 1, sizeof *stale * (size_t)(*nfull + ncoarse - q - 1));
+        --*nfull, how[k] = 3, h->updates++;
+        return;
+    }
+}
+
+/* The next piece of the make spread over frames (its first frame: the air to its particles from
+ * this frame's eye, the eye it is made from); once its last rows are made it replaces the
+ * cloud's impostor. */
+static atmos_status spread_step(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap)
+{
+    const int k = h->spread_k, j = h->spread_at, res = h->spread_res;
+    const atmos__pimpostor *cim;
+    const int *idx;
+    int m;
+    atmos__harris_piece(h, k, 1, 3, ATMOS__HARRIS_NEAR, &cim, &idx, &m);
+    if (j == 0) air(p, h, v, ap, idx, m);
+    const atmos__plights L = plights(h);
+    const atmos_status st = atmos__pimpostor_make_rows(p->ctx, &h->spread, &h->pc, &h->o, &L, idx, m, h->clouds.centre[k],
+                                                       h->clouds.radius[k], h->spread_eye, res, h->spread_cut[j],
+                                                       h->spread_cut[j + 1]);
+    if (st != ATMOS_OK) return h->spreading = 0, st;
+    if (++h->spread_at < h->spread_pieces) return ATMOS_OK;
+    const atmos__pimpostor done = h->spread; /* the old image kept for the next spread make */
+    h->spread = h->imp[k], h->imp[k] = done;
+    h->imp[k].split = 0, h->spread.valid = 0, h->spreading = 0;
+    return ATMOS_OK;
+}
+
 /* The modes of the clouds (how), the split (side, hp) and the impostors to make (stale: the
- * full makes, returned, then *ncoarse coarse ones). */
+ * full makes, returned, then *ncoarse coarse ones). A make spread over frames goes on while its
+ * cloud is drawn whole from an impostor (its old one meanwhile, how 3), within the budget. */
 static int modes(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const int rect[4], int *how,
                  int *side, int *hp, int *stale, int *ncoarse)
 {
@@ -321,10 +413,19 @@ static int modes(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *
         for (int pass = 0; pass < 2; pass++)
             if ((hp[2 * k + pass] = part_mode(p, h, v, k, pass)) == 4) stale[nstale++] = 3 * k + 1 + pass;
     }
-    if (v->impostor_budget <= 0 || nstale <= v->impostor_budget) return nstale;
-    atmos__keyed *key = malloc(sizeof *key * 2 * (size_t)nstale);
+    const int k = h->spread_k;
+    if (h->spreading && (v->impostor_budget <= 0 || how[k] < 3 || side[k] == ATMOS__HARRIS_SPLIT)) h->spreading = 0;
+    if (h->spreading) { /* its old impostor drawn as it is */
+        int q = 0;
+        while (q < nstale && stale[q] != 3 * k) q++;
+        if (q < nstale) memmove(stale + q, stale + q + 1, sizeof *stale * (size_t)(--nstale - q));
+        how[k] = 3;
+    }
+    if (v->impostor_budget <= 0 || (!h->spreading && nstale <= v->impostor_budget)) return nstale;
+    atmos__keyed *key = malloc(sizeof *key * 2 * (size_t)(nstale ? nstale : 1));
     if (!key) return nstale; /* no room to choose: every stale one made */
-    nstale = hold_to_budget(p, h, v, how, stale, nstale, key, ncoarse);
+    nstale = hold_to_budget(p, h, v, how, stale, nstale, key, ncoarse, h->spreading,
+                            h->spreading ? (double)h->spread_res * h->spread_res / h->spread_pieces : 0.0);
     free(key);
     return nstale;
 }
@@ -363,8 +464,10 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     const frame_plan fp = {how, side, hp};
     if (st == ATMOS_OK) {
         int ncoarse = 0;
-        const int nfull = modes(p, h, v, rect, how, side, hp, stale, &ncoarse);
+        int nfull = modes(p, h, v, rect, how, side, hp, stale, &ncoarse);
+        spread_start(p, h, v, how, stale, &nfull, ncoarse);
         st = remake(p, h, v, ap, stale, nfull, ncoarse);
+        if (st == ATMOS_OK && h->spreading) st = spread_step(p, h, v, ap);
     }
     /* far to near: the far layer, the objects, the near layer (without objects: the near alone) */
     if (st == ATMOS_OK && h->split_m < INFINITY) st = draw_pass(p, h, v, ap, ord, &fp, 0, rect, out, ims, cs, rs);
@@ -372,6 +475,7 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
     if (st == ATMOS_OK) st = draw_pass(p, h, v, ap, ord, &fp, 1, rect, out, ims, cs, rs);
     free(how), free(ims), free(cs), free(rs);
     free(ord);
+    h->held += h->spreading; /* an old impostor drawn while its new one is being made */
     p->stats.impostor_updates = h->updates, p->stats.impostors_held = h->held;
     p->stats.impostors_coarse = h->coarse;
     return st;

@@ -38,6 +38,9 @@ atmos_status atmos__harris_objects_frame(const atmos_plan *p, const atmos__harri
 void atmos__harris_objects_over(atmos_context *ctx, const atmos__harris_objects *ob, int nw, const atmos_camera *cam,
                                 atmos_image *img);
 
+/* The most frames a large impostor's make is spread over. */
+#define ATMOS__HARRIS_SPREAD_MAX 8
+
 struct atmos__harris_plan {
     atmos__pcloud pc;
     atmos__poptics o;
@@ -57,6 +60,13 @@ struct atmos__harris_plan {
     float *light[ATMOS__HARRIS_MAX_LIGHTS], *order[ATMOS__HARRIS_MAX_LIGHTS];
     float *air_t, *air_l;                /* the air from the eye to each particle, this frame */
     atmos__aerial aerial;
+    /* a large impostor made over frames (harris_frame.c): while spreading, cloud spread_k's
+     * whole impostor made into spread from the eye of its first frame, piece spread_at of
+     * spread_pieces (rows [spread_cut[j], spread_cut[j + 1])) a frame, its old one drawn until
+     * it is done */
+    atmos__pimpostor spread;
+    int spreading, spread_k, spread_res, spread_at, spread_pieces, spread_cut[ATMOS__HARRIS_SPREAD_MAX + 1];
+    double spread_eye[3];
     double sun[3];
     int have_sun, drawn, updates, direct, held, coarse;
     double shade_s;

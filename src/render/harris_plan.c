@@ -98,6 +98,7 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
     h->have_sun = 1;
     for (int k = 0; k < h->clouds.n; k++) h->imp[k].valid = 0; /* lit anew */
     for (int k = 0; h->split && k < 2 * h->clouds.n; k++) h->split[k].valid = 0;
+    h->spreading = 0; /* a make spread over frames was lit by the old sun */
     return ATMOS_OK;
 }
 
@@ -214,6 +215,7 @@ void atmos__harris_plan_destroy(atmos__harris_plan *h)
     if (!h) return;
     for (int k = 0; h->imp && k < h->clouds.n; k++) atmos__pimpostor_free(&h->imp[k]);
     free(h->imp);
+    atmos__pimpostor_free(&h->spread);
     for (int k = 0; h->split && k < 2 * h->clouds.n; k++) atmos__pimpostor_free(&h->split[k]);
     free(h->split), free(h->part), free(h->nfar), free(h->offset), free(h->smin);
     atmos__harris_objects_destroy(h->obj);

@@ -47,7 +47,7 @@ static atmos_frame frame(double x, int b)
     return f;
 }
 
-static int coarse; /* the last render's impostors made coarse */
+static int coarse, kept_old; /* the last render's impostors made coarse, and held (drawn as they were) */
 
 /* Renders frame(x, b) into img; returns the impostors made in full. */
 static int render(atmos_plan *p, double x, int b, atmos_image *img)
@@ -56,19 +56,23 @@ static int render(atmos_plan *p, double x, int b, atmos_image *img)
     CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
     atmos_plan_stats st;
     atmos_plan_get_stats(p, &st);
-    coarse = st.impostors_coarse;
+    coarse = st.impostors_coarse, kept_old = st.impostors_held;
     return st.impostor_updates;
 }
 
-/* Renders frame(x, 2) into img until a frame makes nothing; each makes at most 2 in full and
- * none coarse. Returns the impostors made; *frames the frames that made some. */
+static int spread; /* catch_up's frames that went on with a make spread over frames and began none */
+
+/* Renders frame(x, 2) into img until a frame makes nothing and holds nothing (a large make
+ * spread over frames holds its old impostor until it is done); each makes at most 2 in full
+ * and none coarse. Returns the impostors made (a spread one counted in its first frame);
+ * *frames the frames that made or held some. */
 static int catch_up(atmos_plan *p, double x, atmos_image *img, int *frames)
 {
     int sum = 0, n;
-    *frames = 0;
-    while ((n = render(p, x, 2, img)) > 0 && *frames < 100) {
+    *frames = spread = 0;
+    while (((n = render(p, x, 2, img)) > 0 || kept_old > 0) && *frames < 100) {
         CHECK(n <= 2 && coarse == 0);
-        sum += n, ++*frames;
+        sum += n, ++*frames, spread += n == 0;
     }
     return sum;
 }
@@ -126,6 +130,16 @@ int main(void)
     sum = catch_up(held, 60, b, &frames);
     printf("4 degree lens: %d impostors made at once; with a budget of 2, %d over %d frames\n", tele, sum, frames);
     CHECK(sum == tele && frames > (tele + 1) / 2);
+    CHECK(memcmp(a->pixels, b->pixels, sizeof(float) * (size_t)W * H * (size_t)a->channels) == 0);
+    /* then 120 m further east: impostors of more than the 2 units go out of date by the angle
+     * (their old ones as fine as the view needs) and are made over frames, a piece of their rows
+     * a frame, the old one drawn meanwhile; the image ends the same, byte for byte (a make
+     * spread over frames gives the same values as one made at once) */
+    const int moved = render(all, 180, 0, a);
+    sum = catch_up(held, 180, b, &frames);
+    printf("4 degree lens, 180 m east: %d impostors made at once; with a budget of 2, %d over %d frames (%d going "
+           "on with a make spread over frames)\n", moved, sum, frames, spread);
+    CHECK(sum == moved && spread > 0);
     CHECK(memcmp(a->pixels, b->pixels, sizeof(float) * (size_t)W * H * (size_t)a->channels) == 0);
     atmos_image_destroy(c), atmos_plan_destroy(one), atmos_context_destroy(ctx1);
     atmos_image_destroy(a), atmos_image_destroy(b);
