@@ -155,3 +155,29 @@ def test_a_callback_returning_false_cancels_and_one_raising_cancels_with_its_exc
     assert np.array_equal(rgb(atmos.render(scene)), full)  # nothing left behind in the thread's context
     with pytest.raises(TypeError, match="callable"):
         atmos.render(scene, progress="yes")
+
+
+def test_each_thread_gets_its_own_calls_reports():
+    """The callback is the calling thread's: two threads rendering at once, one with a callback
+    and one without, and two with their own callbacks, each callback hears its own thread only."""
+    import threading
+    scene = atmos.Scene.from_json(SLICE)
+    heard, errors = {0: set(), 1: set()}, []
+
+    def work(i, with_callback):
+        try:
+            me = threading.get_ident()
+            cb = (lambda stage, f: heard[i].add(threading.get_ident() == me)) if with_callback else None
+            atmos.render(scene, progress=cb)
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    for second in (False, True):
+        heard[0].clear(), heard[1].clear()
+        ts = [threading.Thread(target=work, args=(0, True)), threading.Thread(target=work, args=(1, second))]
+        for t in ts:
+            t.start()
+        for t in ts:
+            t.join()
+        assert not errors
+        assert heard[0] == {True} and heard[1] == ({True} if second else set())
