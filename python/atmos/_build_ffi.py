@@ -20,7 +20,11 @@ typedef enum { ATMOS_OK = 0, ATMOS_E_INVALID_ARG, ATMOS_E_NOMEM, ATMOS_E_IO, ATM
                ATMOS_E_UNSUPPORTED, ATMOS_E_LIMIT, ATMOS_E_CANCELLED } atmos_status;
 typedef struct atmos_context atmos_context;
 typedef struct atmos_volume atmos_volume;
+typedef int (*atmos_progress_fn)(void *user, const char *stage, double fraction);
 typedef struct atmos_context_desc { int threads; const char *cache_dir; ...; } atmos_context_desc;
+extern "Python" int atmos_py_progress(void *user, const char *stage, double fraction);
+atmos_status atmos_py_context_create(atmos_context **out);
+int atmos_py_progress_swap(int on);
 const char *atmos_version(void);
 const char *atmos_status_string(atmos_status status);
 void atmos_context_defaults(atmos_context_desc *desc);
@@ -48,13 +52,29 @@ atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **
 const char *atmos_image_kind(const void *bytes, size_t n);
 const char *atmos_image_file_kind(const char *path);
 
+typedef struct atmos_utc_time { int year, month, day; int hour, minute; double second; } atmos_utc_time;
+typedef struct atmos_sun_position { double elevation_deg; double azimuth_deg; ...; } atmos_sun_position;
+atmos_status atmos_parse_utc_time(atmos_context *ctx, const char *text, atmos_utc_time *out);
+atmos_status atmos_sun_position_compute(atmos_context *ctx, const atmos_utc_time *t, double latitude_deg,
+                                        double longitude_deg, int refraction, atmos_sun_position *out);
+
 typedef struct atmos_camera_desc { double position[3]; double look_at[3]; double up[3]; double fov_deg; ...; }
     atmos_camera_desc;
 void atmos_direction_from_angles(double elevation_deg, double azimuth_deg, double dir[3]);
 typedef struct atmos_scene_volume { char source[...]; ...; } atmos_scene_volume;
 typedef enum { ATMOS_RENDERER_SKY = 0, ... } atmos_renderer_kind;
+typedef struct atmos_scene_sun { int from_time; atmos_utc_time time; double latitude_deg, longitude_deg; ...; }
+    atmos_scene_sun;
+typedef enum { ATMOS_ATMOSPHERE_RILEY = 0, ATMOS_ATMOSPHERE_VACUUM, ATMOS_ATMOSPHERE_HOMOGENEOUS,
+               ATMOS_ATMOSPHERE_DOBASHI, ATMOS_ATMOSPHERE_SPHERICAL } atmos_atmosphere_kind;
+typedef struct atmos_atmosphere_desc { atmos_atmosphere_kind kind; double latitude_deg, longitude_deg; ...; }
+    atmos_atmosphere_desc;
+typedef struct atmos_scene_animation { int frames; int elevation_end_set; int azimuth_end_set; int minutes_end_set;
+                                       ...; } atmos_scene_animation;
 typedef struct atmos_scene { char name[128]; int width, height; atmos_camera_desc camera; atmos_renderer_kind renderer;
-                             atmos_scene_volume volume; ...; } atmos_scene;
+                             atmos_scene_sun sun; atmos_atmosphere_desc atmosphere; atmos_scene_volume volume;
+                             atmos_scene_animation animation; ...; } atmos_scene;
+atmos_status atmos_scene_animation_frame(atmos_context *ctx, const atmos_scene *scene, int index, atmos_scene *out);
 atmos_status atmos_scene_parse_with(atmos_context *ctx, const char *json, size_t length, const char *source,
                                     const char *const *overrides, int count, atmos_scene *out);
 atmos_status atmos_scene_load_with(atmos_context *ctx, const char *path, const char *const *overrides, int count,
@@ -129,6 +149,33 @@ void atmos_py_volume_dense(const atmos_volume *vol, int field, float *out);
 SOURCE = r"""
 #include <atmos/atmos.h>
 #include <stdlib.h>
+
+/* Progress: every context's sink passes reports on to Python (atmos_py_progress) only while
+ * the calling thread's current call has a callback (atmos_py_progress_swap), so that a call
+ * without one never waits for the GIL. The library reports from the calling thread only. */
+static int atmos_py_progress(void *user, const char *stage, double fraction); /* cffi defines it */
+static _Thread_local int atmos_py_progress_on;
+
+static int atmos_py_progress_sink(void *user, const char *stage, double fraction)
+{
+    return atmos_py_progress_on ? atmos_py_progress(user, stage, fraction) : 0;
+}
+
+/* Sets whether this thread's calls report to Python; returns what it was. */
+static int atmos_py_progress_swap(int on)
+{
+    const int was = atmos_py_progress_on;
+    atmos_py_progress_on = on;
+    return was;
+}
+
+/* A context as atmos_context_create(NULL, out) makes it, with the progress sink. */
+static atmos_status atmos_py_context_create(atmos_context **out)
+{
+    atmos_context_desc desc = {0};
+    desc.progress = atmos_py_progress_sink;
+    return atmos_context_create(&desc, out);
+}
 
 /* A particle preset, with its fast (coarser) optics if asked. */
 static atmos_status atmos_py_particle_fast(atmos_context *ctx, const char *name, int fast, atmos_particle_desc *out)

@@ -65,6 +65,11 @@ class AtmosError(RuntimeError):
         super().__init__(f"{message} ({STATUS_NAMES.get(self.status, 'error')}, status {self.status})")
 
 
+class Cancelled(AtmosError):
+    """An AtmosError for a render stopped by its progress callback (status 7, cancelled): the
+    callback returned False. A callback that raised stops the render with its own exception."""
+
+
 class AtmosTypeError(AtmosError, TypeError):
     """An AtmosError for a scene value of the wrong type ("expected a number, got a string"):
     also a TypeError, as the package's own checks of arguments raise."""
@@ -73,13 +78,69 @@ class AtmosTypeError(AtmosError, TypeError):
 _local = threading.local()
 
 
+@ffi.def_extern()
+def atmos_py_progress(user, stage, fraction):
+    """Every context's progress reports, while the calling thread's current call has a
+    callback (the C sink passes them on only then): to that callback."""
+    rep = getattr(_local, "progress", None)
+    return rep.report(stage, fraction) if rep is not None else 0
+
+
+class Progress:
+    """The progress callback of one call into the library (``with Progress(callback, where) as
+    p: status = lib.atmos_...; p.check(status, ctx)``): the callback receives (stage, fraction);
+    returning False, or raising, cancels the call, which then raises Cancelled, or the
+    callback's own exception."""
+
+    def __init__(self, callback, where: str):
+        if callback is not None and not callable(callback):
+            raise TypeError(f"atmos: {where}: progress: expected a callable (stage, fraction), "
+                            f"got {type(callback).__name__}")
+        self._callback, self._where = callback, where
+        self._prev, self._was_on, self.error, self.stopped = None, 0, None, False
+
+    def __enter__(self):
+        self._prev = getattr(_local, "progress", None)
+        _local.progress = self if self._callback is not None else None
+        self._was_on = lib.atmos_py_progress_swap(self._callback is not None)
+        return self
+
+    def __exit__(self, *exc):
+        lib.atmos_py_progress_swap(self._was_on)
+        _local.progress = self._prev
+
+    def report(self, stage, fraction) -> int:
+        if self.stopped:  # asked once: every later report asks again
+            return 1
+        try:
+            said = self._callback(ffi.string(stage).decode(errors="replace"), float(fraction))
+        except BaseException as e:  # noqa: BLE001 - raised again once the library has returned
+            self.error = e
+            said = False
+        self.stopped = said is not None and not said
+        return 1 if self.stopped else 0
+
+    def check(self, status: int, ctx=None) -> None:
+        """check(status, ctx), the callback's exception first: raised when the callback raised,
+        even if the library finished anyway."""
+        if self.error is not None:
+            e, self.error = self.error, None
+            raise e
+        if status == lib.ATMOS_E_CANCELLED and self.stopped:
+            ctx = ctx if ctx is not None else context()
+            msg = ffi.string(lib.atmos_context_error(ctx)).decode(errors="replace")
+            raise Cancelled(status, f"{self._where}: {msg} (the progress callback returned False)")
+        check(status, ctx)
+
+
 def context():
-    """This thread's atmos context (created on first use, all cores, the default cache).
-    A context is not shared between threads, so several threads may render at once."""
+    """This thread's atmos context (created on first use, all cores, the default cache), with
+    the package's progress sink (Progress). A context is not shared between threads, so
+    several threads may render at once."""
     ctx = getattr(_local, "ctx", None)
     if ctx is None:
         p = ffi.new("atmos_context **")
-        st = lib.atmos_context_create(ffi.NULL, p)
+        st = lib.atmos_py_context_create(p)  # the defaults, with the progress sink
         if st != lib.ATMOS_OK:
             raise AtmosError(st, ffi.string(lib.atmos_status_string(st)).decode())
         ctx = ffi.gc(p[0], lib.atmos_context_destroy)
@@ -94,6 +155,8 @@ def check(status: int, ctx=None, types: bool = False) -> None:
     if status != lib.ATMOS_OK:
         ctx = ctx if ctx is not None else context()
         msg = ffi.string(lib.atmos_context_error(ctx)).decode(errors="replace")
+        if status == lib.ATMOS_E_CANCELLED:
+            raise Cancelled(status, msg)
         if types and status == lib.ATMOS_E_INVALID_ARG and re.search(r": expected an? [^,]+, got an? [a-z ]+$", msg):
             raise AtmosTypeError(status, msg)
         raise AtmosError(status, msg)

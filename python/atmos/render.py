@@ -1,5 +1,5 @@
 """Rendering: one call for one image, a plan for many frames of one scene."""
-from atmos._core import Owned, check, context, ffi, lib, number
+from atmos._core import AtmosError, Owned, Progress, check, context, ffi, lib, number
 from atmos.image import Image
 from atmos.scene import Scene
 
@@ -26,27 +26,89 @@ def _info(info, wl):
             "sun_azimuth_deg": info.sun_azimuth_deg, "wavelengths_nm": [wl.nm[k] for k in range(wl.count)]}
 
 
-def render(scene: Scene | None = None, volume=None, **kw) -> Image:
+def _time_text(where: str, time) -> str:
+    """An ISO 8601 time as the CLI's --time takes it, from a string or an aware datetime."""
+    import datetime
+    if isinstance(time, datetime.datetime):
+        if time.tzinfo is None or time.utcoffset() is None:
+            raise ValueError(f"atmos: {where}: time: a datetime without a time zone ({time.isoformat()}): "
+                             "give tzinfo (datetime.timezone.utc) or a string ending in Z or +HH:MM")
+        return time.astimezone(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%S.%f")[:-3] + "Z"
+    if not isinstance(time, str):
+        raise TypeError(f"atmos: {where}: time: expected a string (\"2026-06-21T19:00Z\") or a datetime, "
+                        f"got {type(time).__name__} {time!r}")
+    return time
+
+
+def _set_time(ctx, s, time, where: str) -> None:
+    """Puts the sun of the scene s (a C scene, changed in place) where `time` puts it, as
+    `atmos render --time` does: at the scene's place (its sun's latitude_deg and longitude_deg
+    when the sun is given by time; over a round planet, the atmosphere's), with the scene's
+    refraction; an animation by angles is dropped."""
+    text = _time_text(where, time)
+    t = ffi.new("atmos_utc_time *")
+    pos = ffi.new("atmos_sun_position *")
+    st = lib.atmos_parse_utc_time(ctx, text.encode(), t)
+    if st == lib.ATMOS_OK:  # the years the solar position takes, as the CLI checks them
+        st = lib.atmos_sun_position_compute(ctx, t, 0.0, 0.0, 0, pos)
+    if st != lib.ATMOS_OK:
+        raise AtmosError(st, f"atmos: {where}: time: " + ffi.string(lib.atmos_context_error(ctx)).decode(errors="replace"))
+    if not s.sun.from_time:
+        if s.atmosphere.kind not in (lib.ATMOS_ATMOSPHERE_DOBASHI, lib.ATMOS_ATMOSPHERE_SPHERICAL):
+            raise ValueError(f"atmos: {where}: time {text!r}: the scene gives no place for the sun (a sun by angles "
+                             "over a flat atmosphere): give it one, sun={\"time\": ..., \"latitude_deg\": ..., "
+                             "\"longitude_deg\": ...}, as the CLI's --time needs --lat and --lon")
+        s.sun.latitude_deg, s.sun.longitude_deg = s.atmosphere.latitude_deg, s.atmosphere.longitude_deg
+    s.sun.time = t[0]
+    s.sun.from_time = 1
+    s.animation.elevation_end_set = s.animation.azimuth_end_set = 0
+
+
+def _scene_at(ctx, s, time, frame, where: str):
+    """The C scene s with the sun at `time` (_set_time) and then at frame `frame` of its
+    animation (atmos_scene_animation_frame); s itself when neither is given."""
+    if time is None and frame is None:
+        return s
+    out = ffi.new("atmos_scene *")
+    ffi.memmove(out, s, ffi.sizeof("atmos_scene"))
+    if time is not None:
+        _set_time(ctx, out, time, where)
+    if frame is not None:
+        i = number(f"{where}: frame", frame, integer=True)
+        fs = ffi.new("atmos_scene *")
+        check(lib.atmos_scene_animation_frame(ctx, out, i, fs), ctx)
+        out = fs
+    return out
+
+
+def render(scene: Scene | None = None, volume=None, *, time=None, frame=None, progress=None, **kw) -> Image:
     """Renders a scene as `atmos render` does (its renderer, settings, volume, atmosphere) and
     returns linear sRGB + alpha as an Image (``numpy.asarray`` gives ``(H, W, 4)`` float32,
     channels 0-2 equal to what ``atmos render --pfm`` writes). Keywords override the scene
     (``Scene.with_``). ``volume``: an ``atmos.Volume`` drawn instead of the scene's own, where
     its origin puts it (see ``Plan``); name a renderer for it here (``renderer="path"``), as a
-    scene without a volume of its own cannot name a volume renderer. The GIL is released while the library renders."""
+    scene without a volume of its own cannot name a volume renderer. ``time``: the sun where
+    this UTC time ("2026-06-21T19:00Z", or an aware datetime) puts it at the scene's place, as
+    ``atmos render --time``; ``frame``: frame i (from 0) of the scene's animation, as ``atmos
+    render --frames`` writes it; ``progress``: a callable(stage, fraction) called while the library
+    works; returning False cancels (``atmos.Cancelled``), raising cancels with that exception.
+    The GIL is released while the library renders."""
     scene = _as_scene(scene)
     if volume is not None:
         scene = _scene_for_volume(scene)
     if kw:
         scene = scene.with_(**kw)
     if volume is not None:
-        with Plan(scene, volume) as plan:
-            return plan.render()
+        with Plan(scene, volume, progress=progress) as plan:
+            return plan.render(time=time, frame=frame, progress=progress)
     ctx = context()
-    s = scene._struct()
-    framed = _frame(ctx, s)
+    s = _scene_at(ctx, scene._struct(), time, frame, "render")
     spec = ffi.new("atmos_image **")
     info = ffi.new("atmos_render_info *")
-    check(lib.atmos_render_scene(ctx, s, framed if framed is not None else ffi.NULL, spec, info), ctx)
+    with Progress(progress, "render") as rep:
+        framed = _frame(ctx, s, rep)
+        st = lib.atmos_render_scene(ctx, s, framed if framed is not None else ffi.NULL, spec, info)
+    rep.check(st, ctx)
     spec_img = ffi.gc(spec[0], lib.atmos_image_destroy)
     wl = ffi.new("atmos_wavelengths *")
     check(lib.atmos_scene_wavelengths(ctx, s, wl), ctx)
@@ -63,11 +125,12 @@ def _as_scene(scene) -> Scene:
     return scene
 
 
-def _frame(ctx, s):
+def _frame(ctx, s, rep):
     """A scene naming a volume file and no camera is framed as `atmos render` frames it
-    (atmos_scene_frame_volume_file): the loaded volume, or None when there was nothing to frame."""
+    (atmos_scene_frame_volume_file): the loaded volume, or None when there was nothing to frame.
+    rep: the call's Progress."""
     vol = ffi.new("atmos_volume **")
-    check(lib.atmos_scene_frame_volume_file(ctx, s, float("nan"), vol), ctx)
+    rep.check(lib.atmos_scene_frame_volume_file(ctx, s, float("nan"), vol), ctx)
     return ffi.gc(vol[0], lib.atmos_volume_destroy) if vol[0] != ffi.NULL else None
 
 
@@ -87,14 +150,16 @@ class Plan(Owned):
     ``atmos.Volume`` drawn instead of the scene's own, at the place its origin gives (not
     moved by the scene's placement rules); the scene's "volume" settings (particle, density
     scale) still apply, and a scene without one renders it with the slice renderer unless it
-    names another.
+    names another. ``progress``: as ``render``'s, for the plan's making (tables, the volume).
 
     >>> with atmos.Plan(scene) as plan:
     ...     for az in range(0, 360, 10):
     ...         img = plan.render(sun=(20, az))
+    ...     for img in plan.frames():   # the scene's animation, as atmos render --frames
+    ...         ...
     """
 
-    def __init__(self, scene: Scene, volume=None):
+    def __init__(self, scene: Scene, volume=None, progress=None):
         scene = _as_scene(scene)
         ctx = context()
         desc = ffi.NULL
@@ -103,19 +168,36 @@ class Plan(Owned):
             desc = ffi.new("atmos_plan_desc *")
             desc.offset_given = 1  # the volume stays where its origin puts it
         self._scene = scene._struct()
-        vptr = volume._ptr if volume is not None else _frame(ctx, self._scene)
-        self._volume = vptr  # borrowed by the plan: kept alive with it
         p = ffi.new("atmos_plan **")
-        check(lib.atmos_plan_create(ctx, self._scene, vptr if vptr is not None else ffi.NULL, desc, p), ctx)
+        with Progress(progress, "Plan") as rep:
+            vptr = volume._ptr if volume is not None else _frame(ctx, self._scene, rep)
+            self._volume = vptr  # borrowed by the plan: kept alive with it
+            st = lib.atmos_plan_create(ctx, self._scene, vptr if vptr is not None else ffi.NULL, desc, p)
+        rep.check(st, ctx)
         self._ptr = ffi.gc(p[0], lib.atmos_plan_destroy)
         self._frame = ffi.new("atmos_frame *")
         check(lib.atmos_frame_from_scene(ctx, self._scene, self._frame), ctx)
 
-    def render(self, camera: dict | None = None, sun=None, size=None, spp=None) -> Image:
+    @property
+    def frame_count(self) -> int:
+        """The frames of the scene's animation (1 without one)."""
+        return max(1, self._scene.animation.frames)
+
+    def frames(self, progress=None):
+        """The scene's animation, frame after frame (``render(frame=i)`` for each i): the images
+        ``atmos render --frames`` writes."""
+        for i in range(self.frame_count):
+            yield self.render(frame=i, progress=progress)
+
+    def render(self, camera: dict | None = None, sun=None, size=None, spp=None, *, time=None, frame=None,
+               progress=None) -> Image:
         """Renders a frame. camera: {"position_m": [x, y, z], "look_at_m": [...], "fov_deg": f}
-        (any subset); sun: (elevation_deg, azimuth_deg); size: (width, height); spp: the path
-        tracer's samples per pixel. What is not given stays as in the last frame rendered: a call
-        that fails changes nothing."""
+        (any subset); sun: (elevation_deg, azimuth_deg); time: the sun where this UTC time
+        ("2026-06-21T19:00Z", or an aware datetime) puts it at the scene's place (as ``atmos render
+        --time``); frame: the sun of frame i (from 0) of the scene's animation (from ``time`` if
+        given too); size: (width, height); spp: the path tracer's samples per pixel; progress: as
+        ``atmos.render``'s. What is not given stays as in the last frame rendered: a call that
+        fails changes nothing."""
         if self._ptr is None:
             raise ValueError("atmos.Plan: the plan was closed")
         # the changes go to a copy, kept as the plan's frame once the render succeeded: a call
@@ -140,16 +222,26 @@ class Plan(Owned):
             if not 0.0 <= az < 360.0:  # as the scene's sun.azimuth_deg and the CLI's azimuths
                 raise ValueError(f"atmos: {w}: sun azimuth_deg: {az:g} is not in [0, 360)")
             lib.atmos_direction_from_angles(el, az, f.sun_dir)
+        ctx = context()
+        if time is not None or frame is not None:
+            if sun is not None:
+                raise ValueError(f"atmos: {w}: sun (angles) and time or frame exclude each other")
+            if frame is not None and self._scene.animation.minutes_end_set:
+                raise ValueError(f"atmos: {w}: frame: the scene's animation is a time-lapse (a volume a frame, "
+                                 "\"minutes_end\"), which one plan does not render: atmos.render(scene, frame=i)")
+            fs = _scene_at(ctx, self._scene, time, frame, w)
+            check(lib.atmos_scene_sun_direction(ctx, fs, f.sun_dir, ffi.NULL, ffi.NULL), ctx)
         if size is not None:
             f.width, f.height = _vector(f"{w}: size (width, height)", size, 2, integer=True)
         if spp is not None:
             f.spp = number(f"{w}: spp", spp, integer=True)
-        ctx = context()
         img = ffi.new("atmos_image **")
         check(lib.atmos_plan_image_create(self._ptr, f, img), ctx)
         spec = ffi.gc(img[0], lib.atmos_image_destroy)
         info = ffi.new("atmos_render_info *")
-        check(lib.atmos_plan_render(self._ptr, f, ffi.NULL, spec, info), ctx)
+        with Progress(progress, w) as rep:
+            st = lib.atmos_plan_render(self._ptr, f, ffi.NULL, spec, info)
+        rep.check(st, ctx)
         wl = lib.atmos_plan_wavelengths(self._ptr)
         rgb = _to_srgb(ctx, spec, wl)
         ffi.release(spec)
