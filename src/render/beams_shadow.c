@@ -329,7 +329,7 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
 /* The texel coordinates and depths on face f of the samples t = ta + (s + o) step, s in [s0, s1)
  * (at most RUN_READ of them), as lookup() computes them: one loop that vectorises (the divisions
  * four at a time in the AVX2 clone, each lane the same IEEE operations: the same bits). */
-#define RUN_READ 8
+#define RUN_READ 32
 BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1,
                                     double *fx, double *fy, double *z)
 {
@@ -378,9 +378,16 @@ static double read_run(const atmos__beams_ray *r, double ta, double step, double
     return h;
 }
 
+/* The longest run of samples atmos__beams_ray_light_sum reads without asking the tiles: a
+ * spot's 8 (the inner cone's run and the tiles spare its falloff's evaluations), a point
+ * light's RUN_READ (the tiles' test of a run inside an interval they did not settle costs
+ * about 400 instructions and settles about half: reading the run costs less; docs/beams.md,
+ * issue 17's twenty-seventh round). */
+static int run_max(const atmos__beams_ray *r) { return r->l->L.type == ATMOS_LIGHT_SPOT ? 8 : RUN_READ; }
+
 double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
-    if (s1 - s0 > 8) { /* what is the same along the run's samples, from the tiles */
+    if (s1 - s0 > run_max(r)) { /* what is the same along the run's samples, from the tiles */
         double same;
         int full;
         if (atmos__beams_ray_uniform(r, ta + (s0 + o) * step, ta + (s1 - 1 + o) * step, &same, &full)) {
@@ -395,7 +402,7 @@ double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double s
 
 double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
-    if (s1 - s0 <= 8) return atmos__beams_ray_light_sum(r, ta, step, o, s0, s1);
+    if (s1 - s0 <= run_max(r)) return atmos__beams_ray_light_sum(r, ta, step, o, s0, s1);
     const int mid = s0 + (s1 - s0) / 2;
     return atmos__beams_ray_light_sum(r, ta, step, o, s0, mid) + atmos__beams_ray_light_sum(r, ta, step, o, mid, s1);
 }
