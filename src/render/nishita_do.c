@@ -4,7 +4,7 @@
  * wavelength: the cells' mean sigma_t and sigma_s of the medium the field's photons would see
  * (sig' cut at 3 degrees, or delta-M scaled sig*), the first order's emission per cell from the
  * sunlight's columns per render voxel (nishita_plan.c's sweep, its voxel's mean transmittance
- * along the sun), the quadrature's directions about the world's axes (the harmonics' frame),
+ * along the sun, or through its sunward faces where that is larger), the quadrature's directions about the world's axes (the harmonics' frame),
  * swept along the cells' axes; the first wavelength solved on all the threads, the others in
  * parallel, one a thread, each started from the first one's solution (solve_all); the moments
  * times chi_l are the field's coefficients (the emission of orders >= 2 per unit sigma_s), plus
@@ -111,6 +111,36 @@ static void neighbours(const atmos__nishita_plan *np, int n, int x, int y, int z
                 if (sc != 0) out[w] += sc * escape(t * hv / SUB_NB_TAU);
             }
         }
+}
+
+/* The sunlight at a voxel's sunward faces (per unit sunlight; lt: the light's travel, a unit
+ * vector in the grid's frame; hv: the voxel's size, m): per axis a whose face the light enters,
+ * that face's share of the light entering, |lt_a| / M (M = sum |lt_a|), times e^-tau at the
+ * face. tau at a face: the column at the sunward neighbour's centre plus that neighbour's
+ * sigma_t over the light's part of the half voxel between them, |lt_a| h / 2 (0 outside the
+ * grid). Times escape(sigma_t h / M) (h / M: the voxel's mean chord along the light) it is the
+ * voxel's mean sunlight through its faces (cell_source): in a voxel of many optical depths the
+ * light entering its faces over sigma_t h, sum |lt_a| T_a / (sigma_t h). */
+static double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, const double lt[3],
+                        float sig[][ATMOS_MAX_WAVELENGTHS], int w, double hv)
+{
+    const sgrid *g = &np->g;
+    const int nf = np->nf, xyz[3] = {x, y, z};
+    const double M = fabs(lt[0]) + fabs(lt[1]) + fabs(lt[2]);
+    double T = 0;
+    for (int a = 0; a < 3; a++) {
+        if (lt[a] == 0) continue;
+        int q[3] = {xyz[0], xyz[1], xyz[2]};
+        q[a] += lt[a] > 0 ? -1 : 1;
+        double tau = 0;
+        if (q[a] >= 0 && q[a] < g->c[a]) {
+            const size_t u = (((size_t)q[2] * g->c[1] + q[1]) * g->c[0] + q[0]) * nf;
+            const double half = 0.5 * hv * fabs(lt[a]);
+            for (int f = 0; f < nf; f++) tau += (np->col[u + f] + g->v[u + f] * half) * sig[f][w];
+        }
+        T += fabs(lt[a]) * atmos__expf_fast((float)-tau);
+    }
+    return T / M;
 }
 
 /* The cells' medium, the same for every sun: per wavelength the cells' mean sigma_t and sigma_s
@@ -261,7 +291,15 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
  * mean of that weighted by sigma_s less its plain mean over the scattering voxels (an empty
  * voxel's radiance is its neighbours', not 0: counted as 0 a uniform slab's edge cells got a
  * term), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
- * scattering voxels are uniform. */
+ * scattering voxels are uniform.
+ * A voxel's mean sunlight is the larger of two estimates: along the chord through its centre
+ * along the sun's dominant axis (the column at the centre, mean_transmittance), and through its
+ * sunward faces (sun_faces). The chord's is the right one in a voxel of a few optical depths at
+ * most; in a thick one it takes the light through the neighbours along that axis only: a
+ * horizontal deck one voxel (tens of optical depths) thick at a low sun is lit through the deck
+ * (about 130 optical depths to its voxel's centre), not through its top face, and the sunlit
+ * skin the voxel holds, the light entering its faces, was lost (docs/slice.md, "Why the deck is
+ * dark"). The faces' estimate alone was darker in thin clouds (its face columns are cruder). */
 static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, const atmos__do_cells *dc, int n,
                         const double sun_g[3], double *src, double *dsrc, int threads)
 {
@@ -270,7 +308,8 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     double amax = 0;
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
-    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s);
+    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s), hv = 1.0 / g->sc;
+    const double lbar = hv / (fabs(sun_g[0]) + fabs(sun_g[1]) + fabs(sun_g[2])); /* the mean chord */
     float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS], sca[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     for (int f = 0; f < nf; f++)
         for (int w = 0; w < n; w++) sig[f][w] = np->mc_sig_ms[f][w], sca[f][w] = np->mc_sca[f][w];
@@ -294,11 +333,15 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                         as[w] += sc;
                         if (!(sc != 0)) continue; /* no exponentials */
                         const double tl = t * len; /* fmin's value, no call: neither is NaN */
-                        const double hs = 0.5 * (tl < 2 * tau ? tl : 2 * tau), tr = mean_transmittance(tau, hs);
+                        const double hs = 0.5 * (tl < 2 * tau ? tl : 2 * tau);
+                        double tr = mean_transmittance(tau, hs), tf = atmos__expf_fast((float)(hs - tau));
+                        /* the faces' estimate where it is the larger: a voxel thick along the chord */
+                        const double tff = sun_faces(np, x, y, z, sun_g, sig, w, hv), trf = tff * escape(t * lbar);
+                        if (trf > tr) tr = trf, tf = tff;
                         aq[w] += sc * tr;
                         if (s == 1) continue; /* a voxel's cell: no spread */
                         const float *ab = dc->sub + 2 * (e * n + w);
-                        const double l1 = tr * ab[0] + ab[1] * atmos__expf_fast((float)(hs - tau));
+                        const double l1 = tr * ab[0] + ab[1] * tf;
                         la[w] += l1, lw[w] += sc * l1, nv[w]++;
                     }
                 }
