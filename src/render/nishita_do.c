@@ -256,6 +256,36 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
     return dc;
 }
 
+/* The sunlight at a voxel's sunward faces (per unit sunlight; lt: the light's travel, a unit
+ * vector in the grid's frame; hv: the voxel's size, m): per axis a whose face the light enters,
+ * that face's share of the light entering, |lt_a| / M (M = sum |lt_a|), times e^-tau at the
+ * face. tau at a face: the column at the sunward neighbour's centre plus that neighbour's
+ * sigma_t over the light's part of the half voxel between them, |lt_a| h / 2 (0 outside the
+ * grid). Times escape(sigma_t h / M) (h / M: the voxel's mean chord along the light) it is the
+ * voxel's mean sunlight through its faces (cell_source): in a voxel of many optical depths the
+ * light entering its faces over sigma_t h, sum |lt_a| T_a / (sigma_t h). */
+static double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, const double lt[3],
+                        const float *sig, double hv)
+{
+    const sgrid *g = &np->g;
+    const int nf = np->nf, xyz[3] = {x, y, z};
+    const double M = fabs(lt[0]) + fabs(lt[1]) + fabs(lt[2]);
+    double T = 0;
+    for (int a = 0; a < 3; a++) {
+        if (lt[a] == 0) continue;
+        int q[3] = {xyz[0], xyz[1], xyz[2]};
+        q[a] += lt[a] > 0 ? -1 : 1;
+        double tau = 0;
+        if (q[a] >= 0 && q[a] < g->c[a]) {
+            const size_t u = (((size_t)q[2] * g->c[1] + q[1]) * g->c[0] + q[0]) * nf;
+            const double half = 0.5 * hv * fabs(lt[a]);
+            for (int f = 0; f < nf; f++) tau += (np->col[u + f] + g->v[u + f] * half) * sig[f];
+        }
+        T += fabs(lt[a]) * atmos__expf_fast((float)-tau);
+    }
+    return T / M;
+}
+
 #define CS_BLOCK 64 /* cell_source's voxels a block: its arrays stay in L1 */
 
 /* cell_source's sums over a block of m listed voxels (their grid indices times nf vi, their first
@@ -267,12 +297,13 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
  * sums in the voxels' order (the same bits as the voxel-at-a-time loop; built for AVX2 as well as
  * the baseline, chosen at run time). */
 ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos__do_cells *dc, int n, int w,
-                                      const size_t *vi, size_t e0, int m, const float *sig, const float *sca,
-                                      double len, int sub, double acc[4], int *nv)
+                                      const size_t *vi, const int (*xyz)[3], size_t e0, int m, const float *sig,
+                                      const float *sca, const double geo[6], int sub, double acc[4], int *nv)
 {
+    const double len = geo[0], hv = geo[1], lbar = geo[2], lt[3] = {geo[3], geo[4], geo[5]};
     const float *gv = np->g.v, *col = np->col;
     const int nf = np->nf;
-    double t[CS_BLOCK], sc[CS_BLOCK], tau[CS_BLOCK], tr[CS_BLOCK], l1[CS_BLOCK];
+    double t[CS_BLOCK], sc[CS_BLOCK], tau[CS_BLOCK], tr[CS_BLOCK], tf[CS_BLOCK];
     float a0[CS_BLOCK], a1[CS_BLOCK];
     for (int e = 0; e < m; e++) {
         double tt = 0, ss = 0, ta = 0;
@@ -284,15 +315,20 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
     for (int e = 0; e < m; e++) {
         const double tl = t[e] * len, ta = tau[e]; /* fmin's value, no call: neither is NaN */
         const double hs = 0.5 * (tl < 2 * ta ? tl : 2 * ta), r = mean_transmittance(ta, hs);
-        tr[e] = r;
-        l1[e] = sub ? r * a0[e] + a1[e] * atmos__expf_fast((float)(hs - ta)) : 0;
+        tr[e] = r, tf[e] = atmos__expf_fast((float)(hs - ta));
+    }
+    for (int e = 0; e < m; e++) { /* the faces' estimate where it is the larger: a voxel thick along the chord */
+        if (!(sc[e] != 0)) continue;
+        const double tff = sun_faces(np, xyz[e][0], xyz[e][1], xyz[e][2], lt, sig, hv), trf = tff * escape(t[e] * lbar);
+        if (trf > tr[e]) tr[e] = trf, tf[e] = tff;
     }
     for (int e = 0; e < m; e++) {
         acc[1] += sc[e];
         if (!(sc[e] != 0)) continue;
         acc[0] += sc[e] * tr[e];
         if (!sub) continue; /* a voxel's cell: no spread */
-        acc[2] += l1[e], acc[3] += sc[e] * l1[e], (*nv)++;
+        const double l1 = tr[e] * a0[e] + a1[e] * tf[e];
+        acc[2] += l1, acc[3] += sc[e] * l1, (*nv)++;
     }
 }
 
@@ -309,7 +345,15 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
  * mean of that weighted by sigma_s less its plain mean over the scattering voxels (an empty
  * voxel's radiance is its neighbours', not 0: counted as 0 a uniform slab's edge cells got a
  * term), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
- * scattering voxels are uniform. The voxels in blocks (source_block). */
+ * scattering voxels are uniform. The voxels in blocks (source_block).
+ * A voxel's mean sunlight is the larger of two estimates: along the chord through its centre
+ * along the sun's dominant axis (the column at the centre, mean_transmittance), and through its
+ * sunward faces (sun_faces). The chord's is the right one in a voxel of a few optical depths at
+ * most; in a thick one it takes the light through the neighbours along that axis only: a
+ * horizontal deck one voxel (tens of optical depths) thick at a low sun is lit through the deck
+ * (about 130 optical depths to its voxel's centre), not through its top face, and the sunlit
+ * skin the voxel holds, the light entering its faces, was lost (docs/slice.md, "Why the deck is
+ * dark"). The faces' estimate alone was darker in thin clouds (its face columns are cruder). */
 static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, const atmos__do_cells *dc, int n,
                         const double sun_g[3], double *src, double *dsrc, int threads)
 {
@@ -318,7 +362,9 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
     double amax = 0;
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
-    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s);
+    const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s), hv = 1.0 / g->sc;
+    const double lbar = hv / (fabs(sun_g[0]) + fabs(sun_g[1]) + fabs(sun_g[2])); /* the mean chord */
+    const double geo[6] = {len, hv, lbar, sun_g[0], sun_g[1], sun_g[2]};
     float sig[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS], sca[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS];
     for (int f = 0; f < nf; f++)
         for (int w = 0; w < n; w++) sig[w][f] = np->mc_sig_ms[f][w], sca[w][f] = np->mc_sca[f][w];
@@ -333,12 +379,12 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                 for (size_t e0 = dc->first[c]; e0 < dc->first[c + 1]; e0 += CS_BLOCK) {
                     const int m = dc->first[c + 1] - e0 < CS_BLOCK ? (int)(dc->first[c + 1] - e0) : CS_BLOCK;
                     size_t vi[CS_BLOCK];
-                    for (int e = 0; e < m; e++) {
-                        int x, y, z;
-                        vi[e] = kept_voxel(g, nf, s, i, j, k, dc->vox[e0 + e], &x, &y, &z);
-                    }
+                    int xyz[CS_BLOCK][3];
+                    for (int e = 0; e < m; e++)
+                        vi[e] = kept_voxel(g, nf, s, i, j, k, dc->vox[e0 + e], &xyz[e][0], &xyz[e][1], &xyz[e][2]);
                     for (int w = 0; w < n; w++)
-                        source_block(np, dc, n, w, vi, e0, m, sig[w], sca[w], len, s > 1, acc[w], &nv[w]);
+                        source_block(np, dc, n, w, vi, (const int(*)[3])xyz, e0, m, sig[w], sca[w], geo, s > 1, acc[w],
+                                     &nv[w]);
                 }
                 for (int w = 0; w < n; w++)
                     src[cells * w + c] = acc[w][0] * inv,
