@@ -264,7 +264,7 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
  * grid). Times escape(sigma_t h / M) (h / M: the voxel's mean chord along the light) it is the
  * voxel's mean sunlight through its faces (cell_source): in a voxel of many optical depths the
  * light entering its faces over sigma_t h, sum |lt_a| T_a / (sigma_t h). */
-static double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, const double lt[3],
+DO_INLINE double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, const double lt[3],
                         const float *sig, double hv)
 {
     const sgrid *g = &np->g;

@@ -231,10 +231,11 @@ atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp
  * light pass took it: i1 / i0, 1 where no light arrives or none is lost, at least e^-80 (a beam put
  * out within the slab): its -ln, the beam's optical depth, is then at most 80 in both eye passes,
  * the fast one's logarithm and the reference's libm one alike. */
+#define ATMOS__SLICE_BEAM_MIN 1.80485e-35f /* e^-80 */
 static inline float atmos__slice_beam_ratio(float i0, float i1)
 {
     const float r = i0 > 0.0f ? i1 / i0 : 1.0f;
-    return !(r < 1.0f) ? 1.0f : r > 1.80485e-35f ? r : 1.80485e-35f; /* e^-80 */
+    return !(r < 1.0f) ? 1.0f : r > ATMOS__SLICE_BEAM_MIN ? r : ATMOS__SLICE_BEAM_MIN;
 }
 
 /* The eye-ray length by which the light arriving at a slab, I, times the slab's in-scattering

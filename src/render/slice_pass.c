@@ -403,27 +403,32 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
                              const float *restrict bext, const float *restrict src, const float *restrict ds,
                              const float *restrict I1)
 {
-    float Tq[CH], Cq[CH], Sq[CH];
+    float Tq[CH], Cq[CH], Sq[CH], Lq[CH];
     /* the in-scattering; the field's added by a loop of its own: a test of ds inside the loop
      * became a masked load from the null pointer, whose every lane masked off still cost a
      * microcode assist per vector (a quarter of the eye pass without the field) */
-    float tl[CH];
-    for (int q = 0; q < e->mv; q++) Sq[q] = 0.0f, tl[q] = 0.0f;
+    for (int q = 0; q < e->mv; q++) Sq[q] = 0.0f;
     if (ds)
         for (int q = 0; q < e->mv; q++) Sq[q] = ds[q];
-    if (I1) /* the beam's optical depth across the slab, as the light pass took it */
-        for (int q = 0; q < e->mv; q++) tl[q] = -log_pos(atmos__slice_beam_ratio(Ic[q], I1[q]));
-    const int btf = j->btf;
     for (int q = 0; q < e->mv; q++) {
         const float be = bext[q], tau = be * e->del[q];
         const float T = atmos__expf_poly(-tau);
         /* beta_sca Delta of Eq. 26, integrated over the slab with its own attenuation:
          * (1 - T)/beta_ext (-> Delta when thin). */
-        const float len = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
-        const float lenI = I1 ? atmos__slice_beam_len(e->del[q], tau, tl[q], btf, atmos__expf_poly) : len;
+        Lq[q] = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
         Tq[q] = be > 0.0f ? T : 1.0f;
-        Cq[q] = be > 0.0f ? Sq[q] * len + Ic[q] * src[q] * lenI : 0.0f;
     }
+    float Bq[CH]; /* the beam's length: Lq, or with I1 its attenuation across the slab too */
+    if (I1) {
+        const int btf = j->btf;
+        for (int q = 0; q < e->mv; q++) {
+            const float r = Ic[q] > 0.0f ? I1[q] / Ic[q] : 1.0f; /* atmos__slice_beam_ratio's, in a vector loop */
+            const float tl = r < 1.0f ? -log_pos(r > ATMOS__SLICE_BEAM_MIN ? r : ATMOS__SLICE_BEAM_MIN) : 0.0f;
+            Bq[q] = atmos__slice_beam_len(e->del[q], bext[q] * e->del[q], tl, btf, atmos__expf_poly);
+        }
+    } else
+        for (int q = 0; q < e->mv; q++) Bq[q] = Lq[q];
+    for (int q = 0; q < e->mv; q++) Cq[q] = bext[q] > 0.0f ? Sq[q] * Lq[q] + Ic[q] * src[q] * Bq[q] : 0.0f;
     float *restrict Lb = j->L_eye + c * j->pst + p0, *restrict Tb = j->T_eye + c * j->pst + p0;
     const int m = e->m;
     if (e->contig && j->btf)
