@@ -22,9 +22,7 @@
 /* Accepted years: the polynomials of Meeus ch. 25 are fits around J2000, and
  * feeding UT for TD (see above) costs more than the 0.01 degree budget once
  * |Delta T| grows past ~15 minutes, i.e. centuries away from now. 1800-2200
- * keeps us well inside both. */
-#define SUNPOS_YEAR_MIN ATMOS_SUN_YEAR_MIN
-#define SUNPOS_YEAR_MAX ATMOS_SUN_YEAR_MAX
+ * keeps us well inside both (ATMOS_SUN_YEAR_MIN, ATMOS_SUN_YEAR_MAX in atmos/sun.h). */
 
 static int is_leap_year(int y)
 {
@@ -185,10 +183,10 @@ static double julian_day_0h(int year, int month, int day)
 
 static atmos_status validate_time(atmos_context *ctx, const atmos_utc_time *t)
 {
-    if (t->year < SUNPOS_YEAR_MIN || t->year > SUNPOS_YEAR_MAX)
+    if (t->year < ATMOS_SUN_YEAR_MIN || t->year > ATMOS_SUN_YEAR_MAX)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
                             "sun position: year %d out of range [%d, %d] of the NOAA/Meeus algorithm",
-                            t->year, SUNPOS_YEAR_MIN, SUNPOS_YEAR_MAX);
+                            t->year, ATMOS_SUN_YEAR_MIN, ATMOS_SUN_YEAR_MAX);
     if (t->month < 1 || t->month > 12)
         return atmos__error(ctx, ATMOS_E_INVALID_ARG, "sun position: month %d out of range [1, 12]",
                             t->month);

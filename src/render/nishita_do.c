@@ -264,8 +264,8 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
  * grid). Times escape(sigma_t h / M) (h / M: the voxel's mean chord along the light) it is the
  * voxel's mean sunlight through its faces (cell_source): in a voxel of many optical depths the
  * light entering its faces over sigma_t h, sum |lt_a| T_a / (sigma_t h). */
-DO_INLINE double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, const double lt[3],
-                        const float *sig, double hv)
+DO_INLINE double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, const double lt[3], const float *sig,
+                           double hv)
 {
     const sgrid *g = &np->g;
     const int nf = np->nf, xyz[3] = {x, y, z};
@@ -288,19 +288,27 @@ DO_INLINE double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, c
 
 #define CS_BLOCK 64 /* cell_source's voxels a block: its arrays stay in L1 */
 
+/* The sun seen from the render grid, for cell_source: len the chord per unit sigma_t along the
+ * dominant axis (m), hv a voxel's size (m), lbar its mean chord along the light (m), lt the
+ * light's travel (a unit vector in the grid's frame). */
+typedef struct {
+    double len, hv, lbar, lt[3];
+} sun_geom;
+
 /* cell_source's sums over a block of m listed voxels (their grid indices times nf vi, their first
  * list entry e0) for wavelength w: acc[0 .. 3] += the voxels' sigma_s T_sun, sigma_s, local
  * radiance and sigma_s times it, *nv += the scattering voxels (sub: the sub-cell term's, cells of
- * more than one voxel). The same operations in the same order per wavelength as one voxel at a
- * time, in three loops: the medium gathered, the exponentials of every voxel in one vector loop
- * (both sides of mean_transmittance's branch, the one kept chosen per voxel: the same values), the
- * sums in the voxels' order (the same bits as the voxel-at-a-time loop; built for AVX2 as well as
- * the baseline, chosen at run time). */
+ * more than one voxel; sg: the sun's geometry). The same operations in the same order per
+ * wavelength as one voxel at a time, in four loops: the medium gathered, the exponentials of
+ * every voxel in one vector loop (both sides of mean_transmittance's branch, the one kept chosen
+ * per voxel: the same values), the faces' estimate where it is the larger (sun_faces, scalar),
+ * the sums in the voxels' order (the same bits as the voxel-at-a-time loop; built for AVX2 as
+ * well as the baseline, chosen at run time). */
 ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos__do_cells *dc, int n, int w,
                                       const size_t *vi, const int (*xyz)[3], size_t e0, int m, const float *sig,
-                                      const float *sca, const double geo[6], int sub, double acc[4], int *nv)
+                                      const float *sca, const sun_geom *sg, int sub, double acc[4], int *nv)
 {
-    const double len = geo[0], hv = geo[1], lbar = geo[2], lt[3] = {geo[3], geo[4], geo[5]};
+    const double len = sg->len;
     const float *gv = np->g.v, *col = np->col;
     const int nf = np->nf;
     double t[CS_BLOCK], sc[CS_BLOCK], tau[CS_BLOCK], tr[CS_BLOCK], tf[CS_BLOCK];
@@ -319,7 +327,8 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
     }
     for (int e = 0; e < m; e++) { /* the faces' estimate where it is the larger: a voxel thick along the chord */
         if (!(sc[e] != 0)) continue;
-        const double tff = sun_faces(np, xyz[e][0], xyz[e][1], xyz[e][2], lt, sig, hv), trf = tff * escape(t[e] * lbar);
+        const double tff = sun_faces(np, xyz[e][0], xyz[e][1], xyz[e][2], sg->lt, sig, sg->hv),
+                     trf = tff * escape(t[e] * sg->lbar);
         if (trf > tr[e]) tr[e] = trf, tf[e] = tff;
     }
     for (int e = 0; e < m; e++) {
@@ -364,7 +373,7 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
     for (int a = 0; a < 3; a++) amax = fmax(amax, fabs(sun_g[a]));
     const double len = 1.0 / amax / g->sc, inv = 1.0 / ((double)s * s * s), hv = 1.0 / g->sc;
     const double lbar = hv / (fabs(sun_g[0]) + fabs(sun_g[1]) + fabs(sun_g[2])); /* the mean chord */
-    const double geo[6] = {len, hv, lbar, sun_g[0], sun_g[1], sun_g[2]};
+    const sun_geom sg = {len, hv, lbar, {sun_g[0], sun_g[1], sun_g[2]}};
     float sig[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS], sca[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS];
     for (int f = 0; f < nf; f++)
         for (int w = 0; w < n; w++) sig[w][f] = np->mc_sig_ms[f][w], sca[w][f] = np->mc_sca[f][w];
@@ -383,7 +392,7 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                     for (int e = 0; e < m; e++)
                         vi[e] = kept_voxel(g, nf, s, i, j, k, dc->vox[e0 + e], &xyz[e][0], &xyz[e][1], &xyz[e][2]);
                     for (int w = 0; w < n; w++)
-                        source_block(np, dc, n, w, vi, (const int(*)[3])xyz, e0, m, sig[w], sca[w], geo, s > 1, acc[w],
+                        source_block(np, dc, n, w, vi, (const int(*)[3])xyz, e0, m, sig[w], sca[w], &sg, s > 1, acc[w],
                                      &nv[w]);
                 }
                 for (int w = 0; w < n; w++)
