@@ -18,6 +18,10 @@
 # same with four rays only at the volume's edges, --edge-aa $EDGE_AA (0.05: the default renderer); "nishita_do": the Nishita renderer with that field,
 # its sky's light the field's inflow, "nishita_do_nosky" the same without: not in the default list), THREADS, REUSE (1: keep the reference images
 # already in OUT_DIR, e.g. to compare a new build's variants against the same references).
+# Where the sun's disk is seen (the cirrus in front) the truncated reference has no aureole within
+# TRUNCATE degrees of it (sun_cone.py): those pixels, the disk's and its cone's, are left out of
+# every figure and reported apart (cone_bins), against OUT_DIR/<case>_<sun>.path_exact.pfm, an
+# untruncated reference (--truncate 0), when there is one.
 # The Disney case reads ../shared/data/real/wdas_cloud_sixteenth.vdb beside the checkout.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -33,7 +37,8 @@ mkdir -p "$OUT"
 csv="$OUT/results.csv"
 # rel_rmse, bias_rel: over the volume's pixels (optical depth >= 0.01), relative to the
 # reference's mean there; tau_bins, order_bins: [bin start, pixels, rel_rmse, rel_bias] per bin
-echo "case,sun,variant,seconds,rel_rmse,bias_rel,tau_bins,order_bins" > "$csv"
+# cone_bins: the same for the sun's disk's pixels and the rest of its cone ([] when the disk is not seen)
+echo "case,sun,variant,seconds,rel_rmse,bias_rel,tau_bins,order_bins,cone_bins" > "$csv"
 
 # Seconds rendering and writing, from atmos render's own timing line
 # ("atmos render: ... s in all: ... s for the scene, ..., 1.234 s rendering and writing").
@@ -53,7 +58,12 @@ for c in $CASES; do
                 --variance "$base.path.var.exr" --order "$base.order.pfm" --tau "$base.tau.pfm" -o "$base.path.png" \
                 2> "$base.path.log"
         fi
-        echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[],[]" >> "$csv"
+        echo "$c,$sun,path,$(secs "$base.path.log"),0,0,[],[],[]" >> "$csv"
+        # the keys without the sun's cone (unchanged when the disk is not seen), the cone's own key
+        python3 "$here/sun_cone.py" "$scene" "$base.path.pfm" "$TRUNCATE" "$base.cone.pfm" \
+            "$base.tau.pfm" "$base.tau_nosun.pfm" "$base.order.pfm" "$base.order_nosun.pfm" >&2
+        cref="$base.path.pfm"
+        if [ -s "$base.path_exact.pfm" ]; then cref="$base.path_exact.pfm"; fi
         for v in $VARIANTS; do
             case $v in
             eq25) opts="--no-diffuse" ;;
@@ -78,23 +88,25 @@ for c in $CASES; do
             harris_sun_diffuse) opts="--renderer harris --sky-lights 0 --harris-diffuse" ;;
             esac
             "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
-            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \
+            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau_nosun.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \
                 --heatmap "$base.$v.diff.png" --json > "$base.$v.json"
-            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.order.pfm" --edges 0.5,1.5,3,6,12,25,50,1000 \
+            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.order_nosun.pfm" --edges 0.5,1.5,3,6,12,25,50,1000 \
                 --json > "$base.$v.order.json"
             # the volume's pixels only (optical depth >= 0.01): the sky and the sun's disk are not the question
-            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau.pfm" --edges 0.01,1e30 \
+            "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau_nosun.pfm" --edges 0.01,1e30 \
                 --json > "$base.$v.vol.json"
+            "$A" compare "$base.$v.pfm" "$cref" --by "$base.cone.pfm" --edges 0,0.5,1.5 --json > "$base.$v.cone.json"
             python3 - "$base.$v.json" "$base.$v.order.json" "$base.$v.vol.json" "$c" "$sun" "$v" "$(secs "$base.$v.log")" \
+                "$base.$v.cone.json" \
                 >> "$csv" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
 o = json.load(open(sys.argv[2]))
 v = json.load(open(sys.argv[3]))["bins"][0]
-tb = [[b["lo"], b["pixels"], b["rel_rmse"], b["rel_bias"]] for b in j["bins"]]
-ob = [[b["lo"], b["pixels"], b["rel_rmse"], b["rel_bias"]] for b in o["bins"]]
-print("%s,%s,%s,%s,%.5g,%.5g,\"%s\",\"%s\"" % (sys.argv[4], sys.argv[5], sys.argv[6], sys.argv[7], v["rel_rmse"],
-      v["rel_bias"], json.dumps(tb), json.dumps(ob)))
+bins = lambda d: [[b["lo"], b["pixels"], b["rel_rmse"], b["rel_bias"]] for b in d["bins"]]
+cb = [b for b in bins(json.load(open(sys.argv[8]))) if b[1]]
+print("%s,%s,%s,%s,%.5g,%.5g,\"%s\",\"%s\",\"%s\"" % (sys.argv[4], sys.argv[5], sys.argv[6], sys.argv[7], v["rel_rmse"],
+      v["rel_bias"], json.dumps(bins(j)), json.dumps(bins(o)), json.dumps(cb)))
 PY
         done
     done
