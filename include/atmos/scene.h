@@ -152,6 +152,9 @@ typedef struct atmos_scene_nishita {
     int mc_dm_clip;           /* 1 (with mc_delta_m): the photons sample the scaled phase exactly, the cut
                                  phase with its peak clipped until delta-M's fraction is gone, instead of
                                  Henyey-Greenstein of its g*; 0 */
+    double edge_aa;           /* four eye rays, averaged, in the pixels whose transmittance through the volume
+                                 differs from a neighbour's by more than this (its silhouette; the slice
+                                 renderer's edge_aa); 0 = one ray a pixel; 0.05 */
 } atmos_scene_nishita;
 
 /* Settings of Harris's particle renderer ("harris" in the file); the table is

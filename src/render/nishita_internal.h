@@ -6,7 +6,8 @@
  *   nishita_plan.c    the render grid, the optics, the sunlight's attenuation per voxel (one
  *                     sweep across the grid per sun direction), the light field per sun and
  *                     eye direction, its sky elements
- *   nishita_render.c  the eye rays and the composite over the sky
+ *   nishita_render.c  the eye rays (four in the pixels at the volume's edges, edge_aa.c) and
+ *                     the composite over the sky
  *   dfield.c          with "diffuse": the slice renderer's diffuse light field, shared
  *   nishita_mc.c      with "mc_kphotons": the Monte Carlo field of the orders >= 2
  *   nishita_do.c      with "do": the same field by discrete ordinates (light/lfield_do.c)
@@ -65,6 +66,9 @@ struct atmos__nishita_plan {
      * wavelengths), largest relative residual, CPU time */
     int do_dirs, do_iters, do_sweeps;
     double do_resid, do_cpu;
+    /* edge_aa (nishita_render.c, edge_aa.c): the edge pixels' transmittances and flags */
+    unsigned char *edge;
+    size_t edge_cap;
 };
 
 /* A plan of the discrete-ordinates field alone (nishita_plan.c), the field of the slice renderer's

@@ -19,7 +19,7 @@ void atmos__nishita_plan_destroy(atmos__nishita_plan *s)
 {
     if (!s) return;
     if (!s->g_borrowed) atmos__sgrid_free(&s->g);
-    free(s->col), free(s->fdens);
+    free(s->col), free(s->fdens), free(s->edge);
     atmos__lmedium_free(&s->med);
     atmos__lfield_free(&s->field);
     atmos__dfield_free(&s->df);

@@ -4,9 +4,11 @@
  * sun, the sunlight attenuated by the column density stored per render voxel) and the
  * light field's orders 2-3 and sky light (per unit scattering coefficient) interpolated and
  * multiplied by the sample's scattering coefficient; the sky behind attenuated by the volume
- * and the air in front of the volume added as the slice renderer's composite does. */
+ * and the air in front of the volume added as the slice renderer's composite does. With edge_aa
+ * the pixels at the volume's edges (edge_aa.c, as the slice renderer's) take four rays. */
 #include "atmosphere/atmosphere_ops.h"
 #include "core/vec.h"
+#include "render/edge_aa.h"
 #include "render/nishita_internal.h"
 
 #include <math.h>
@@ -173,13 +175,15 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
     return 1;
 }
 
-/* Pixel (x, y): the volume over the sky image's value px (B = front + T_front back): front +
- * T_front L + T (B - front), the air's part "front" in front of the volume's light. */
-static void shade(const rjob *J, int x, int y, float *px)
+/* The ray through image point (x, y): the volume over the sky image's value px (B = front +
+ * T_front back) into out: front + T_front L + T (B - front), the air's part "front" in front of
+ * the volume's light; px itself where the ray misses the volume. */
+static void shade_ray(const rjob *J, double x, double y, const float *px, double *out)
 {
     double d[3], L[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS], th;
     const int n = J->np->n;
-    if (!atmos_camera_ray(J->cam, x + 0.5, y + 0.5, d) || !march(J, d, L, T, &th)) return;
+    for (int c = 0; c < n; c++) out[c] = px[c];
+    if (!atmos_camera_ray(J->cam, x, y, d) || !march(J, d, L, T, &th)) return;
     double front[ATMOS_MAX_WAVELENGTHS], Tf[ATMOS_MAX_WAVELENGTHS];
     const double tg = atmos_atmosphere_ground_distance(J->atm, J->cam->position, d);
     if (th > tg) th = tg;
@@ -187,8 +191,39 @@ static void shade(const rjob *J, int x, int y, float *px)
     atmos_atmosphere_transmittance(J->atm, J->cam->position, d, th, Tf);
     for (int c = 0; c < n; c++) {
         const double r = front[c] + Tf[c] * L[c] + T[c] * (px[c] - front[c]);
-        px[c] = (float)(isfinite(r) && r > 0 ? r : 0.0);
+        out[c] = isfinite(r) && r > 0 ? r : 0.0;
     }
+}
+
+/* Pixel (x, y): one ray through its centre, or at the volume's edges (edge set) the mean of four
+ * through the centres of its quarters, each over the sky image's value at the pixel (as the
+ * slice renderer's edge_aa; the sky is smooth across a pixel). */
+static void shade(const rjob *J, int x, int y, int edge, float *px)
+{
+    const int n = J->np->n;
+    double o[ATMOS_MAX_WAVELENGTHS], sum[ATMOS_MAX_WAVELENGTHS] = {0};
+    if (!edge) {
+        shade_ray(J, x + 0.5, y + 0.5, px, o);
+        for (int c = 0; c < n; c++) px[c] = (float)o[c];
+        return;
+    }
+    for (int q = 0; q < 4; q++) {
+        shade_ray(J, x + 0.25 + 0.5 * (q & 1), y + 0.25 + 0.5 * (q >> 1), px, o);
+        for (int c = 0; c < n; c++) sum[c] += o[c];
+    }
+    for (int c = 0; c < n; c++) px[c] = (float)(0.25 * sum[c]);
+}
+
+/* The edge pixels of region r (edge_aa.c; NULL: edge_aa off), from the plain cross-sections at
+ * the middle wavelength along the centre rays. */
+static const unsigned char *edges(atmos__nishita_plan *np, const rjob *J, double lim, const atmos__rect *r,
+                                  int threads)
+{
+    if (!(lim > 0)) return NULL;
+    atmos__edge_desc e = {&np->g, &np->x, J->atm, J->cam, {J->eye_g[0], J->eye_g[1], J->eye_g[2]}, {0}, lim,
+                          NULL, NULL};
+    for (int f = 0; f < np->nf; f++) e.sig[f] = np->sig[f][np->n / 2];
+    return atmos__edge_flags(&e, r, &np->edge, &np->edge_cap, threads);
 }
 
 atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const atmos__rect *r, atmos_image *out)
@@ -232,10 +267,14 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
         J.mc = atmos__nishita_mc_field(np);
         J.tms = atmos__nishita_mc_delta_m(np);
     }
+    const double lim = p->scene.nishita.edge_aa;
+    const unsigned char *edge = edges(np, &J, lim, r, threads);
+    if (lim > 0 && !edge) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the edge pixels");
     const int W = out->width, C = out->channels;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int y = r->y0; y < r->y1; y++)
-        for (int x = r->x0; x < r->x1; x++) shade(&J, x, y, out->pixels + ((size_t)y * W + x) * C);
+        for (int x = r->x0; x < r->x1; x++)
+            shade(&J, x, y, edge && edge[(size_t)y * W + x], out->pixels + ((size_t)y * W + x) * C);
     return ATMOS_OK;
 }
 
@@ -256,4 +295,6 @@ void atmos__nishita_describe(const atmos_plan *p, char *buf, size_t cap)
             snprintf(buf + l, cap - l, "; Monte Carlo field of %d thousand photons, %dx%dx%d cells of %d voxels, %.3f s",
                      s->mc_kphotons, F->c[0], F->c[1], F->c[2], F->s, np->mc_s);
     }
+    const size_t l = strlen(buf);
+    if (s->edge_aa > 0) snprintf(buf + l, cap - l, "; four eye rays at the volume's edges (edge_aa %g)", s->edge_aa);
 }

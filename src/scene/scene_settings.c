@@ -128,6 +128,10 @@ static const atmos_setting nishita_settings[] = {
      "with mc_delta_m: the photons sample the scaled phase exactly (the cut phase, its peak clipped until "
      "delta-M's fraction is gone) instead of Henyey-Greenstein of its g*",
      NISHITA(mc_dm_clip)},
+    {"edge_aa", "nishita-edge-aa", ATMOS_SETTING_REAL, "", 0, 1, 0, 0, 0.05, NULL, 0,
+     "four eye rays, averaged, in the pixels whose transmittance through the volume differs from a "
+     "neighbour's by more than this (the silhouette); 0 = one ray a pixel",
+     NISHITA(edge_aa)},
 };
 
 static const atmos_setting harris_settings[] = {

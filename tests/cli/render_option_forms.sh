@@ -74,6 +74,7 @@ cat >"$T/table" <<'EOF'
 --nishita-mc-delta-m|nishita.mc_delta_m=true|nishita|same
 --nishita-do|nishita.do=true|nishita|
 --nishita-mc-dm-clip|nishita.mc_dm_clip=true|nishita|same
+--nishita-edge-aa 0|nishita.edge_aa=0|nishita|
 --spacing 100|harris.spacing_m=100|harris|
 --max-particles 10|harris.max_particles=10|harris|
 --sky-lights 0|harris.sky_lights=0|harris|
