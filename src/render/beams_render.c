@@ -158,14 +158,17 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
 {
     const atmos__beams_plan *b = J->b;
     const int sky = J->sky && J->sky->nw;
-    if (!cones && !sky) { /* no light can reach it: the sums' zeros, as the loops below would leave them */
-        for (int k = 0; k < J->nw; k++) L[k] = J->alb_pi[m][k] * 0.0;
-        return 0;
+    static const double up[3] = {0, 1, 0};
+    double P[3], sum[ATMOS_MAX_WAVELENGTHS], E[ATMOS_MAX_WAVELENGTHS];
+    for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
+    if (!cones) { /* no light can reach it: the sky alone (0 + E: the sums' bits), else zeros */
+        const double *e = sky ? atmos__beams_sky_irradiance_memo(J->sky, h->normal, atmos__beams_sun_fog_in(&b->fog, up, P), E, memo)
+                              : NULL;
+        for (int k = 0; k < J->nw; k++) L[k] = J->alb_pi[m][k] * (e ? 0.0 + e[k] : 0.0);
+        return sky;
     }
-    double P[3], sum[ATMOS_MAX_WAVELENGTHS];
     int any = 0;
     for (int k = 0; k < J->nw; k++) sum[k] = 0; /* the wavelengths in use only: not 1 kB a pixel */
-    for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
     const double off = 1e-4 * (1 + h->t);
     for (int i = 0; i < b->nlights; i++) {
         if (!(cones >> i & 1)) continue;
@@ -194,10 +197,8 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
     if (sky) { /* through a height-dependent fog's layer above P (J->sky is NULL in a uniform fog) */
-        static const double up[3] = {0, 1, 0};
-        double E[ATMOS_MAX_WAVELENGTHS];
-        atmos__beams_sky_irradiance_memo(J->sky, h->normal, atmos__beams_sun_fog_in(&b->fog, up, P), E, memo);
-        for (int k = 0; k < J->nw; k++) sum[k] += E[k];
+        const double *e = atmos__beams_sky_irradiance_memo(J->sky, h->normal, atmos__beams_sun_fog_in(&b->fog, up, P), E, memo);
+        for (int k = 0; k < J->nw; k++) sum[k] += e[k];
         any = 1;
     }
     for (int k = 0; k < J->nw; k++) L[k] = J->alb_pi[m][k] * sum[k];
