@@ -216,6 +216,9 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
     return any;
 }
 
+/* The fog's transmittance from the eye along d to t (INFINITY: the sky behind). */
+static double fog_to(const job *J, const double d[3], double t) { return exp(-atmos__beams_fog_tau(&J->b->fog, J->eye, d, t)); }
+
 /* The light of pixel (x, y) without the airlight, into L: the surface hit h (of object m) lit
  * by the lights and the sky, or (h NULL) the sky behind bg, dimmed by the fog on the way to the
  * eye. Returns the fog's transmittance to the hit, which is evaluated only where something is
@@ -225,7 +228,7 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
 {
     if (h && !shade_surface(J, x, y, d, h, m, cones, L, memo) && !fog_needed) return 1;
     /* 0 to the sky behind endless fog */
-    const double fog_t = exp(-atmos__beams_fog_tau(&J->b->fog, J->eye, d, h ? h->t : INFINITY));
+    const double fog_t = fog_to(J, d, h ? h->t : INFINITY);
     if (h)
         for (int k = 0; k < J->nw; k++) L[k] *= fog_t;
     else
@@ -676,7 +679,7 @@ static void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit 
         for (int k = 0; k < nw; k++) B[k] = (float)(a[k] * 0.0);
         return;
     }
-    const double fog_t = exp(-atmos__beams_fog_tau(&b->fog, J->eye, d, h->t));
+    const double fog_t = fog_to(J, d, h->t);
     const int sun = b->sun_on && sun_reaches(J, d, h, &c, &in);
     if (e && sun)
         for (int k = 0; k < nw; k++) B[k] = (float)(a[k] * (0.0 + e[k]) * fog_t + a[k] * sE[k] * c * in * fog_t);
@@ -698,6 +701,11 @@ static void surface_light(const job *J, int x, int y, const double d[3], const a
     const int hit = obj >= 0;
     if (hit && !cones) {
         unlit_surface(J, d, h, obj, B, memo);
+        return;
+    }
+    if (!hit) { /* the sky behind through the fog (base_light's, in one loop) */
+        const double fog_t = fog_to(J, d, INFINITY);
+        for (int k = 0; k < J->nw; k++) B[k] = (float)(bg[k] * fog_t);
         return;
     }
     const double fog_t = base_light(J, x, y, d, hit ? h : NULL, obj, cones, bg, hit && b->sun_on, L, memo);
