@@ -24,7 +24,7 @@
 #define NEAR_M 1e-3
 #define EDGE_PX 1e-3
 #define DEPTH_TOL 1e-6
-#define TILE 32
+#define TILE 64
 /* A box is hidden when every pixel centre it may cover has a surface nearer than its nearest
  * corner by more than DEPTH_TOL and this much more (rounding of the drawn depths). */
 #define HIDDEN_MARGIN 1e-9

@@ -144,6 +144,17 @@ ATMOS_CLONES static void row_cones(const job *J, const double *dx, const double 
     }
 }
 
+/* The sky's irradiance on the surface hit along d (memo's or E), through a height-dependent
+ * fog's layer above the point; NULL when no sky lights surfaces (J->sky NULL in a uniform fog). */
+static const double *sky_light(const job *J, const double d[3], const atmos_mesh_hit *h, double *E,
+                               atmos__beams_sky_memo *memo)
+{
+    static const double up[3] = {0, 1, 0};
+    if (!(J->sky && J->sky->nw)) return NULL;
+    const double P[3] = {0, J->eye[1] + h->t * d[1], 0}; /* the fog's depth above reads the height alone */
+    return atmos__beams_sky_irradiance_memo(J->sky, h->normal, atmos__beams_sun_fog_in(&J->b->fog, up, P), E, memo);
+}
+
 /* The object's surface at the eye's ray's hit through pixel (x, y), lit by the lights and the
  * sky, into L before the fog on the way to the eye (the caller's factor, the last of the
  * product). Each light's shadow there from its shadow map where the map settles it
@@ -157,15 +168,18 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
                          double *L, atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
-    const int sky = J->sky && J->sky->nw;
-    if (!cones && !sky) { /* no light can reach it: the sums' zeros, as the loops below would leave them */
-        for (int k = 0; k < J->nw; k++) L[k] = J->alb_pi[m][k] * 0.0;
-        return 0;
+    double P[3], sum[ATMOS_MAX_WAVELENGTHS], E[ATMOS_MAX_WAVELENGTHS];
+    if (!cones) { /* no light can reach it: the sky alone (0 + E: the sums' bits), else zeros */
+        const double *e = sky_light(J, d, h, E, memo), *a = J->alb_pi[m];
+        if (e)
+            for (int k = 0; k < J->nw; k++) L[k] = a[k] * (0.0 + e[k]);
+        else
+            for (int k = 0; k < J->nw; k++) L[k] = a[k] * 0.0;
+        return e != NULL;
     }
-    double P[3], sum[ATMOS_MAX_WAVELENGTHS];
+    for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
     int any = 0;
     for (int k = 0; k < J->nw; k++) sum[k] = 0; /* the wavelengths in use only: not 1 kB a pixel */
-    for (int a = 0; a < 3; a++) P[a] = J->eye[a] + h->t * d[a];
     const double off = 1e-4 * (1 + h->t);
     for (int i = 0; i < b->nlights; i++) {
         if (!(cones >> i & 1)) continue;
@@ -193,16 +207,17 @@ static int shade_surface(const job *J, int x, int y, const double d[3], const at
         atmos__lamp_tint(&l->L, P, tint);
         for (int k = 0; k < J->nw; k++) sum[k] += l->L.I[k] * e * tint[k < 3 ? k : 2];
     }
-    if (sky) { /* through a height-dependent fog's layer above P (J->sky is NULL in a uniform fog) */
-        static const double up[3] = {0, 1, 0};
-        double E[ATMOS_MAX_WAVELENGTHS];
-        atmos__beams_sky_irradiance_memo(J->sky, h->normal, atmos__beams_sun_fog_in(&b->fog, up, P), E, memo);
-        for (int k = 0; k < J->nw; k++) sum[k] += E[k];
+    const double *e = sky_light(J, d, h, E, memo);
+    if (e) {
+        for (int k = 0; k < J->nw; k++) sum[k] += e[k];
         any = 1;
     }
     for (int k = 0; k < J->nw; k++) L[k] = J->alb_pi[m][k] * sum[k];
     return any;
 }
+
+/* The fog's transmittance from the eye along d to t (INFINITY: the sky behind). */
+static double fog_to(const job *J, const double d[3], double t) { return exp(-atmos__beams_fog_tau(&J->b->fog, J->eye, d, t)); }
 
 /* The light of pixel (x, y) without the airlight, into L: the surface hit h (of object m) lit
  * by the lights and the sky, or (h NULL) the sky behind bg, dimmed by the fog on the way to the
@@ -213,7 +228,7 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
 {
     if (h && !shade_surface(J, x, y, d, h, m, cones, L, memo) && !fog_needed) return 1;
     /* 0 to the sky behind endless fog */
-    const double fog_t = exp(-atmos__beams_fog_tau(&J->b->fog, J->eye, d, h ? h->t : INFINITY));
+    const double fog_t = fog_to(J, d, h ? h->t : INFINITY);
     if (h)
         for (int k = 0; k < J->nw; k++) L[k] *= fog_t;
     else
@@ -371,20 +386,28 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
 
 /* The sun's light on the surface hit (beams_sun.h): where a ray toward the sun is free (not
  * cast where the sun's map proves the point in shadow, atmos__beams_sun_dark), dimmed by a
- * height-dependent fog above it on the way in (its exp only where lit) and by fog_t on the way out. */
-static void sun_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
+ * height-dependent fog above it on the way in (its exp only where lit) and by fog_t on the way
+ * out. sun_reaches: whether it adds, with the cosine c and the dimming in. */
+static int sun_reaches(const job *J, const double d[3], const atmos_mesh_hit *h, double *c, double *in)
 {
     const atmos__beams_plan *b = J->b;
     const atmos__beams_sun *s = &b->sun;
-    const double c = atmos__dot3(h->normal, s->dir), off = 1e-4 * (1 + h->t);
+    const double off = 1e-4 * (1 + h->t);
     const double o[3] = {J->eye[0] + h->t * d[0] + off * h->normal[0], J->eye[1] + h->t * d[1] + off * h->normal[1],
                          J->eye[2] + h->t * d[2] + off * h->normal[2]};
     const int set = b->fog.height_m > 0 && !(s->dir[1] > 0); /* a layered fog's sun set: none in */
-    if (!(c > 0) || set || atmos__beams_sun_dark(s, o) || atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
-        return;
-    const double in = exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)); /* dimmed on its way in */
-    if (in > 0)
-        for (int k = 0; k < J->nw; k++) L[k] += J->alb_pi[m][k] * s->E[k] * c * in * fog_t;
+    *c = atmos__dot3(h->normal, s->dir);
+    if (!(*c > 0) || set || atmos__beams_sun_dark(s, o) || atmos__objects_hit(&b->obj, o, s->dir, 0, INFINITY, NULL, NULL))
+        return 0;
+    *in = exp(-atmos__beams_sun_fog_in(&b->fog, s->dir, o)); /* dimmed on its way in */
+    return *in > 0;
+}
+
+static void sun_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, double fog_t, double *L)
+{
+    double c, in;
+    if (sun_reaches(J, d, h, &c, &in))
+        for (int k = 0; k < J->nw; k++) L[k] += J->alb_pi[m][k] * J->b->sun.E[k] * c * in * fog_t;
 }
 
 /* The fog's scattering of sunlight along [0, T) of the ray d. */
@@ -642,6 +665,32 @@ typedef struct screen_buf {
     double *dir; /* the eye's rays (a pinhole camera; else NULL) */
 } screen_buf;
 
+/* Subsampling's first pass for a surface that no light reaches (no cones): the sky's light and
+ * the sun's, dimmed by the fog to the eye, into B in one loop a pixel (the same operations in
+ * the same order as shade_surface, base_light and sun_surface one after the other: the same bits). */
+static void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, float *B,
+                          atmos__beams_sky_memo *memo)
+{
+    const atmos__beams_plan *b = J->b;
+    double E[ATMOS_MAX_WAVELENGTHS], c = 0, in = 0;
+    const double *e = sky_light(J, d, h, E, memo), *a = J->alb_pi[m], *sE = b->sun.E;
+    const int nw = J->nw;
+    if (!e && !b->sun_on) { /* nothing reaches it: the zeros, no fog */
+        for (int k = 0; k < nw; k++) B[k] = (float)(a[k] * 0.0);
+        return;
+    }
+    const double fog_t = fog_to(J, d, h->t);
+    const int sun = b->sun_on && sun_reaches(J, d, h, &c, &in);
+    if (e && sun)
+        for (int k = 0; k < nw; k++) B[k] = (float)(a[k] * (0.0 + e[k]) * fog_t + a[k] * sE[k] * c * in * fog_t);
+    else if (e)
+        for (int k = 0; k < nw; k++) B[k] = (float)(a[k] * (0.0 + e[k]) * fog_t);
+    else if (sun)
+        for (int k = 0; k < nw; k++) B[k] = (float)(a[k] * 0.0 * fog_t + a[k] * sE[k] * c * in * fog_t);
+    else
+        for (int k = 0; k < nw; k++) B[k] = (float)(a[k] * 0.0 * fog_t);
+}
+
 /* Subsampling's first pass, pixel (x, y) seeing h of object obj along the eye's ray d (-1: the
  * sky behind, bg), lit by the lights in cones (row_cones): its light without the airlight into B. */
 static void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
@@ -650,6 +699,15 @@ static void surface_light(const job *J, int x, int y, const double d[3], const a
     const atmos__beams_plan *b = J->b;
     double L[ATMOS_MAX_WAVELENGTHS];
     const int hit = obj >= 0;
+    if (hit && !cones) {
+        unlit_surface(J, d, h, obj, B, memo);
+        return;
+    }
+    if (!hit) { /* the sky behind through the fog (base_light's, in one loop) */
+        const double fog_t = fog_to(J, d, INFINITY);
+        for (int k = 0; k < J->nw; k++) B[k] = (float)(bg[k] * fog_t);
+        return;
+    }
     const double fog_t = base_light(J, x, y, d, hit ? h : NULL, obj, cones, bg, hit && b->sun_on, L, memo);
     if (hit && b->sun_on) sun_surface(J, d, h, obj, fog_t, L);
     for (int k = 0; k < J->nw; k++) B[k] = (float)L[k];

@@ -42,19 +42,32 @@ static void eval(band *b, int x, int y)
 /* Whether every pixel of [x0, x1] x [y0, y1] sees the same object at depths within the ratio
  * 1 + s->depth of each other (or all the sky); dim[k]: the least light without the airlight of
  * its pixels, per wavelength. */
+/* dim[k]: the least of base[i nw + k] over the pixels i of [x0, x1] x [y0, y1] (each row's
+ * values one block; the minima exact, so the same values in the AVX2 clone). */
+ATMOS_CLONES_NOINLINE static void least_base(const atmos__beams_screen *s, int x0, int y0, int x1, int y1, double *dim)
+{
+    const int nw = s->nw, n = (x1 - x0 + 1) * nw;
+    for (int k = 0; k < nw; k++) dim[k] = INFINITY;
+    for (int y = y0; y <= y1; y++) {
+        const float *row = s->base + pix(s, x0, y) * nw;
+        for (int j = 0; j < n; j += nw)
+            for (int k = 0; k < nw; k++) dim[k] = atmos__mind(row[j + k], dim[k]);
+    }
+}
+
 static int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1, double *dim)
 {
-    const int m = s->object[pix(s, x0, y0)], nw = s->nw;
+    const int m = s->object[pix(s, x0, y0)];
     double lo = INFINITY, hi = 0;
-    for (int k = 0; k < nw; k++) dim[k] = INFINITY;
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
             const size_t i = pix(s, x, y);
             if (s->object[i] != m) return 0;
             lo = atmos__mind(s->T[i], lo), hi = atmos__maxd(s->T[i], hi); /* fmin, fmax: no NaN here */
-            for (int k = 0; k < nw; k++) dim[k] = atmos__mind(s->base[i * nw + k], dim[k]);
         }
-    return isinf(lo) || hi <= lo * (1 + s->depth);
+    if (!(isinf(lo) || hi <= lo * (1 + s->depth))) return 0;
+    least_base(s, x0, y0, x1, y1, dim); /* only for a cell that passes: dim is read then alone */
+    return 1;
 }
 
 /* Whether row y of span sp holds [x0 - m, x1 + m] (or to the region's edge). */

@@ -143,18 +143,18 @@ ATMOS_CLONES void atmos__beams_sky_irradiance(const atmos__beams_sky *s, const d
     }
 }
 
-void atmos__beams_sky_irradiance_memo(const atmos__beams_sky *s, const double n[3], double C, double *E,
-                                      atmos__beams_sky_memo *memo)
+const double *atmos__beams_sky_irradiance_memo(const atmos__beams_sky *s, const double n[3], double C, double *E,
+                                               atmos__beams_sky_memo *memo)
 {
     if (!memo) {
         atmos__beams_sky_irradiance(s, n, C, E);
-        return;
+        return E;
     }
     if (!memo->valid || memcmp(memo->n, n, sizeof memo->n) || memcmp(&memo->C, &C, sizeof C)) {
         atmos__beams_sky_irradiance(s, n, C, memo->E);
         memcpy(memo->n, n, sizeof memo->n), memo->C = C, memo->valid = 1;
     }
-    memcpy(E, memo->E, sizeof(double) * (size_t)s->nw);
+    return memo->E;
 }
 
 void atmos__beams_sky_free(atmos__beams_sky *s)

@@ -69,11 +69,11 @@ typedef struct atmos__beams_sky_memo {
     int valid;
     double E[ATMOS_MAX_WAVELENGTHS];
 } atmos__beams_sky_memo;
-/* As atmos__beams_sky_irradiance, E copied from memo (NULL: none) when n and C are those of its
- * last call, bit for bit (a flat ground under a fog of one height: the same normal and layer at
- * every pixel), so the same bits as a call. */
-void atmos__beams_sky_irradiance_memo(const atmos__beams_sky *s, const double n[3], double C, double *E,
-                                      atmos__beams_sky_memo *memo);
+/* As atmos__beams_sky_irradiance: returns the irradiance, memo's E (the same bits as a call),
+ * evaluated again only when n or C differ from its last call's, bit for bit (a flat ground
+ * under a fog of one height: the same normal and layer at every pixel); memo NULL: into E. */
+const double *atmos__beams_sky_irradiance_memo(const atmos__beams_sky *s, const double n[3], double C, double *E,
+                                               atmos__beams_sky_memo *memo);
 void atmos__beams_sky_free(atmos__beams_sky *s);
 
 #endif
