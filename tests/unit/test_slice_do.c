@@ -9,8 +9,8 @@
  *    give it solved exactly (adding-doubling with delta-M of degree 3 and the full phase's first
  *    order, test_ad_tms): at depths 1 and 4 the field within 5 points of that, so that what the
  *    bounds allow is its degree's truncation (-5.5 / -13.3 % at depth 1) and not its sweeps'.
- *  - The forward lobe: the slab of depth 4 seen from below near the sun, the renderer within 3 points
- *    of its approximation solved exactly (which is +94 % at 10 degrees from the sun: a known limit).
+ *  - The forward lobe: the slab of depth 4 seen from below 10-25 degrees from the sun, within 15 %
+ *    of adding-doubling (TMS's first order, the renderer's before 2026-12-06, +94 % at 10 degrees).
  *  - Optically thick cells (a slab of depth 64, the field's cells of 2 and 6 voxels) against
  *    adding-doubling: the sweeps' step scheme alone was 10-29 % dark there.
  *  - Nothing counted twice in thin media: a slab of optical depth 0.02, mostly the first order,
@@ -118,12 +118,11 @@ static double mean_below(atmos_context *ctx, const test_optics *op, const atmos_
 
 /* The forward lobe, toward the sun (the accuracy bench's cumulus with the sun in front: its
  * silver lining): the slab of optical depth 4 seen from below at 10, 15 and 25 degrees from the
- * sun, against adding-doubling and against the field's own approximation solved exactly (delta-M
- * of degree 3, TMS's first order: test_ad_tms). The renderer is its approximation's to 0.2 point
- * (measured +0.1, +0.1, -0.2; the bound 3), and that approximation is itself far too bright near
- * the sun: +94, +37, -4 % against adding-doubling (a known limit, docs/accuracy.md, "The cumulus
- * in front: where the RMSE is": the light delta-M keeps in the beam, drawn with the full phase's
- * forward lobe). Printed, not bounded: a mend of the approximation moves those figures. */
+ * sun, against adding-doubling, within 15 % (measured +6.4, -10.1, -13.7 %). The field's own
+ * approximation solved exactly (delta-M of degree 3 and TMS's first order: test_ad_tms), which
+ * the renderer drew before 2026-12-06 to 0.2 point, is +94, +37, -4 %: the full phase times the
+ * whole delta-M beam counted the peak's light twice; now the light the peak has turned scatters
+ * with delta-M's scaled phase (slice_do.c, sjob.two_pop). */
 static void check_forward(atmos_context *ctx, const test_optics *op)
 {
     const double mus[3] = {0.985, 0.966, 0.906}, tau = 4;
@@ -136,7 +135,7 @@ static void check_forward(atmos_context *ctx, const test_optics *op)
         printf("  slab tau 4 seen from below at %.0f deg from the sun: adding-doubling %.5f; slice with do %.5f "
                "(%+.1f %%); degree 3 solved exactly %.5f (%+.1f %%)\n",
                acos(mus[a]) * 57.29577951308232, ref, m, 100 * (m / ref - 1), m3, 100 * (m3 / ref - 1));
-        CHECK(fabs(m / m3 - 1) < 0.03);
+        CHECK(fabs(m / ref - 1) < 0.15);
     }
     atmos_volume_destroy(v);
 }
