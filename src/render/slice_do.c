@@ -28,8 +28,15 @@
  * the same of the eye's side with the full table and the rest, 1 - w, with the smooth phase (the
  * table averaged over +- the forward peak's median angle, do_ams' order-2 rows, blended as the
  * orders are): w = exp(-share n) T_eye^(kap - 1), n the light buffer's scattering depth from the
- * sun (sjob.sharp_eye). Back to front (the sun ahead: the halos) T_eye is not known ahead of a
- * sample and the first order stays the full table's.
+ * sun (sjob.sharp_eye). Back to front (the sun ahead: the halos, the silver lining) T_eye is not
+ * known ahead of a sample, and there the first order is that of two populations (since 2026-12-06,
+ * sjob.two_pop; docs/accuracy.md, "The cumulus in front: where the RMSE is"): TMS's full table
+ * times the whole delta-M beam counted the peak's light twice, kept in the beam and sent toward
+ * the eye by the phase's forward lobe, +94 % on a slab of depth 4 seen 10 degrees from the sun.
+ * The light the delta-M peak has not turned, the share exp(-share_dm n) of the beam (share_dm:
+ * delta-M's part of the scattering, the 3-degree cut's left out as the path tracer's references
+ * leave it; n the scattering depth from the sun), scatters with the full table; the rest with
+ * delta-M's scaled phase p* of degree 3 times sigma_s* / sigma_s (do_ams' rows 2 and 3).
  *
  * The sky's and the ground's light enter the field's sweeps through the grid's faces (nishita_do.c,
  * from the atmosphere interface as the P1 field's boundary, sky_inflow.c): the field then holds
@@ -53,6 +60,63 @@
 #include <string.h>
 #include <math.h>
 
+/* The phase table's share above its value at SLICE_DO_CUT_DEG within that angle: the forward
+ * peak's part that the 3-degree cut counts as not scattered (the path tracer's --truncate 3, the
+ * field's cut), for field f, wavelength w (n wavelengths). */
+#define SLICE_DO_CUT_DEG 3.0
+static double cut_share(const stables *t, int f, int w, int n)
+{
+    const double *g = t->grid[f];
+    const float *A = t->ams[f];
+    const size_t st = (size_t)t->no * n;
+    double pc = 0, cut = 0, all = 0;
+    for (int a = 0; a + 1 < t->ng[f]; a++)
+        if (g[a] <= SLICE_DO_CUT_DEG && g[a + 1] > SLICE_DO_CUT_DEG) pc = A[a * st + w];
+    for (int a = 0; a + 1 < t->ng[f]; a++) {
+        const double p0 = A[a * st + w], p1 = A[(a + 1) * st + w];
+        const double dm = cos(g[a] * ATMOS_DEG2RAD) - cos(g[a + 1] * ATMOS_DEG2RAD);
+        all += 2 * ATMOS_PI * 0.5 * (p0 + p1) * dm;
+        if (g[a + 1] <= SLICE_DO_CUT_DEG) cut += 2 * ATMOS_PI * 0.5 * (p0 + p1 - 2 * pc) * dm;
+    }
+    return all > 0 && cut > 0 ? cut / all : 0;
+}
+
+/* The Legendre polynomials P_0..P_3 at mu. */
+static void legendre3(double mu, double P[4])
+{
+    P[0] = 1, P[1] = mu, P[2] = 0.5 * (3 * mu * mu - 1), P[3] = 0.5 * (5 * mu * mu - 3) * mu;
+}
+
+/* Rows 2 and 3 of field f's Ams in a (do_ams' copy of tab's, stride no): the full table again and
+ * sigma_s* / sigma_s times delta-M's scaled phase of degree 3, p* = sum (2l + 1) / (4 pi) chi*_l P_l
+ * with chi*_l = (chi_l - share) / (1 - share) (the cut and delta-M together: 1 - share = sigma_s* /
+ * sigma_s), chi_l the table's moments; not below 0. The eye pass back to front blends them
+ * (sjob.two_pop). */
+static void two_pop_rows(const atmos__slice_plan *sp, int f, float *a0)
+{
+    const stables *t = &sp->tab;
+    const int n = sp->n, no = t->no, ng = t->ng[f];
+    const double *g = t->grid[f];
+    for (int w = 0; w < n; w++) {
+        const double sh = t->sca[f][w] > 0 ? 1 - sp->dop->mc_sca[f][w] / t->sca[f][w] : 0;
+        double chi[4] = {0}, P0[4], P1[4];
+        for (int a = 0; a + 1 < ng; a++) {
+            const double m0 = cos(g[a] * ATMOS_DEG2RAD), m1 = cos(g[a + 1] * ATMOS_DEG2RAD);
+            const double p0 = t->ams[f][(size_t)a * no * n + w], p1 = t->ams[f][(size_t)(a + 1) * no * n + w];
+            legendre3(m0, P0), legendre3(m1, P1);
+            for (int l = 0; l < 4; l++) chi[l] += 2 * ATMOS_PI * 0.5 * (p0 * P0[l] + p1 * P1[l]) * (m0 - m1);
+        }
+        for (int l = 3; l >= 0; l--) chi[l] = chi[0] > 0 ? chi[l] / chi[0] : l == 0;
+        for (int a = 0; a < ng; a++) {
+            legendre3(cos(g[a] * ATMOS_DEG2RAD), P0);
+            double v = 0;
+            for (int l = 0; l < 4; l++) v += (2 * l + 1) / (4 * ATMOS_PI) * (chi[l] - sh) * P0[l];
+            a0[((size_t)a * no + 2) * n + w] = t->ams[f][(size_t)a * no * n + w];
+            a0[((size_t)a * no + 3) * n + w] = (float)(v > 0 ? v : 0);
+        }
+    }
+}
+
 /* sigma_t / sigma_t* per wavelength, the fields weighted by their share of the grid's extinction
  * (sigma_t* times the density summed over the grid), and delta-M's share of the scattering counted
  * as not scattered, 1 - sigma_s* / sigma_s (the middle wavelength's, weighted by sigma_s): the eye
@@ -70,9 +134,13 @@ static void do_kappa(atmos__slice_plan *sp)
         sp->do_kap[w] = b > 0 ? (float)(a / b) : 1.0f;
     }
     const int w = sp->n / 2;
-    double a = 0, b = 0;
-    for (int f = 0; f < sp->nf; f++) a += dsum[f] * sp->tab.sca[f][w], b += dsum[f] * sp->dop->mc_sca[f][w];
+    double a = 0, b = 0, c = 0;
+    for (int f = 0; f < sp->nf; f++) {
+        a += dsum[f] * sp->tab.sca[f][w], b += dsum[f] * sp->dop->mc_sca[f][w];
+        c += dsum[f] * sp->tab.sca[f][w] * cut_share(&sp->tab, f, w, sp->n);
+    }
     sp->do_share = a > 0 ? (float)(1 - b / a) : 0.0f;
+    sp->do_share_dm = a > 0 && a - b - c > 0 ? (float)((a - b - c) / a) : 0.0f;
 }
 
 /* Row r (0: the first order) of tab's Ams for field f, wavelength w at theta (degrees). */
@@ -139,6 +207,7 @@ static int do_ams(atmos__slice_plan *sp)
                 a0[((size_t)a * no + 1) * n + w] = (float)(sum / (K + 1));
             }
         }
+        if (no >= 4) two_pop_rows(sp, f, a0);
         sp->tab_dm.ams[f] = a0, a0 += sz;
     }
     return 1;
@@ -212,7 +281,8 @@ atmos_status atmos__slice_do_update(atmos_plan *p, atmos__slice_plan *sp, const 
     /* the first order's sharp share: T_eye is known ahead of a sample only front to back (the sun
        behind the eye: the glory, the bows) */
     j->sharp_eye = !j->btf;
-    memcpy(j->kap, sp->do_kap, sizeof j->kap), j->share = sp->do_share;
+    j->two_pop = j->btf && sp->tab.no >= 4; /* back to front: the first order's two populations */
+    memcpy(j->kap, sp->do_kap, sizeof j->kap), j->share = sp->do_share, j->share_dm = sp->do_share_dm;
     return ATMOS_OK;
 }
 

@@ -44,6 +44,11 @@ typedef struct {
      * the smooth phase (tab_dm's Ams order-2 rows, blended by the order weight) */
     int sharp_eye;
     float kap[ATMOS_MAX_WAVELENGTHS], share;
+    /* with the do field, back to front (slice_do.c): the first order of two populations, the light
+     * the delta-M peak has not turned (the share exp(-share_dm n)) with the full phase table (Ams
+     * row 2), the rest with delta-M's scaled phase (row 3) */
+    int two_pop;
+    float share_dm;
     const atmos__lfield *field;  /* the diffuse light field (or the do field's cells, slice_do.c), or NULL */
     const float *fview;          /* the field toward the frame's eye as the fast eye pass reads it:
                                     [(cell * nf + f) * fvq + c] (atmos__dfield_view) */
@@ -160,7 +165,7 @@ struct atmos__slice_plan {
     stables tab_dm;          /* tab, its sig[][] sigma_t* (the pointers tab's: not freed) */
     float *do_view;
     float *do_ams;           /* tab_dm's Ams: tab's, the order-2 rows the smooth phase (slice_do.c) */
-    float do_kap[ATMOS_MAX_WAVELENGTHS], do_share; /* sjob's kap and share (slice_do.c) */
+    float do_kap[ATMOS_MAX_WAVELENGTHS], do_share, do_share_dm; /* sjob's kap, share, share_dm (slice_do.c) */
     double do_sun[3];
     int do_valid;
     /* The volume's shadow on the air ("air_shadows"; slice_shadow.c): the map, kept per sun

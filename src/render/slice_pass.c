@@ -277,6 +277,8 @@ SLICE_INLINE void eye_orders(const sjob *j, size_t p0, echunk *e)
         e->oi[q] = o;
         e->fo[q] = mm - 1.0f - (float)o;
     }
+    if (j->two_pop) /* the do field back to front: the turned light's share (slice_do.c) */
+        for (int q = 0; q < e->mv; q++) e->oi[q] = 2, e->fo[q] = 1.0f - atmos__expf_poly(-j->share_dm * e->nsc[q]);
     if (j->sharp_eye) { /* the do field: its first order's smooth share (slice_do.c) */
         const int c = j->n / 2;
         const float km = j->kap[c] - 1.0f, sh = j->share, *restrict T0 = j->T_eye + c * j->pst + p0;

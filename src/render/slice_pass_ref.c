@@ -71,6 +71,7 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
         int oi = (int)(mm - 1.0f);
         if (oi > no - 2) oi = no - 2;
         float fo = mm - 1.0f - (float)oi;
+        if (j->two_pop) oi = 2, fo = 1.0f - expf(-j->share_dm * nsc); /* the do field back to front */
         if (j->sharp_eye) { /* the do field: its first order's smooth share (slice_do.c) */
             const float Tg = j->T_eye[(size_t)(n / 2) * j->pst + p];
             fo = 1.0f - expf((j->kap[n / 2] - 1.0f) * logf(Tg > 1e-30f ? Tg : 1e-30f) - j->share * nsc);

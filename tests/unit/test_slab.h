@@ -51,30 +51,38 @@ static inline double test_image_mean(const atmos_image *img)
     return s / (3.0 * img->width * img->height);
 }
 
-/* The reflected radiance per unit irradiance at mu, linear between adding-doubling's nodes. */
-static inline double test_ad_up(const ad_result *r, double mu)
+/* The radiance rad[] per unit irradiance (adding-doubling's radiance_up or radiance_down) at mu,
+ * linear between its nodes. */
+static inline double test_ad_at(const ad_result *r, const double *rad, double mu)
 {
     int lo = -1, hi = -1;
     for (int i = 1; i < r->D; i++) {
         if (r->mu[i] <= mu && (lo < 0 || r->mu[i] > r->mu[lo])) lo = i;
         if (r->mu[i] >= mu && (hi < 0 || r->mu[i] < r->mu[hi])) hi = i;
     }
-    if (lo < 0 || hi < 0 || lo == hi) return r->radiance_up[lo < 0 ? hi : lo];
+    if (lo < 0 || hi < 0 || lo == hi) return rad[lo < 0 ? hi : lo];
     const double t = (mu - r->mu[lo]) / (r->mu[hi] - r->mu[lo]);
-    return (1 - t) * r->radiance_up[lo] + t * r->radiance_up[hi];
+    return (1 - t) * rad[lo] + t * rad[hi];
 }
 
-/* The reflected radiance per unit irradiance at mu of the slab of optical depth tau (HG g,
- * albedo 1, the sun at the zenith) as the discrete-ordinates field's own approximation would give
- * it if solved exactly in angle and depth: delta-M of degree lt (adding-doubling with the scaled
- * moments above lt dropped) with its first order replaced by the full phase's (TMS, Nakajima &
- * Tanaka 1988, J. Quant. Spectrosc. Radiat. Transfer 40, 51), as the slice renderer's eye pass
- * draws it. Its difference from the full solution is the degree's truncation alone. */
-static inline double test_ad_tms_up(double tau, double g, int lt, double mu)
+/* The reflected radiance per unit irradiance at mu. */
+static inline double test_ad_up(const ad_result *r, double mu) { return test_ad_at(r, r->radiance_up, mu); }
+
+/* The diffusely transmitted radiance per unit irradiance at mu (below the slab, mu from the nadir). */
+static inline double test_ad_down(const ad_result *r, double mu) { return test_ad_at(r, r->radiance_down, mu); }
+
+/* The radiance per unit irradiance at mu of the slab of optical depth tau (HG g, albedo 1, the
+ * sun at the zenith), reflected (down 0) or diffusely transmitted (down 1; mu < 1), as the
+ * discrete-ordinates field's own approximation would give it if solved exactly in angle and
+ * depth: delta-M of degree lt (adding-doubling with the scaled moments above lt dropped) with its
+ * first order replaced by the full phase's (TMS, Nakajima & Tanaka 1988, J. Quant. Spectrosc.
+ * Radiat. Transfer 40, 51), as the slice renderer's eye pass draws it. Its difference from the
+ * full solution is the degree's truncation alone. */
+static inline double test_ad_tms(double tau, double g, int lt, double mu, int down)
 {
     ad_result r;
     if (!ad_slab_lt(tau, 1.0, 1.0, g, 0.0, 1.0, 32, lt, &r)) return 0;
-    const double PI = 3.14159265358979323846, c = -mu, f = pow(g, lt + 1), ts = (1 - f) * tau;
+    const double PI = 3.14159265358979323846, c = down ? mu : -mu, f = pow(g, lt + 1), ts = (1 - f) * tau;
     double ps = 0, p0 = 1, p1 = c; /* the scaled phase of degree lt at the scattering angle */
     for (int l = 0; l <= lt; l++) {
         const double pl = l == 0 ? 1 : l == 1 ? c : ((2 * l - 1) * c * p1 - (l - 1) * p0) / l;
@@ -82,8 +90,10 @@ static inline double test_ad_tms_up(double tau, double g, int lt, double mu)
         ps += (2 * l + 1) * (pow(g, l) - f) / (1 - f) * pl;
     }
     const double pf = (1 - g * g) / pow(1 + g * g - 2 * g * c, 1.5); /* 4 pi HG */
-    const double geo = (1 - exp(-ts * (1 + 1 / mu))) / (4 * PI * (1 + mu));
-    return test_ad_up(&r, mu) - ps * geo + pf / (1 - f) * geo;
+    /* the first order per unit phase (4 pi normalised) in the scaled slab, seen at mu */
+    const double geo = down ? (exp(-ts) - exp(-ts / mu)) / (4 * PI * (1 - mu))
+                            : (1 - exp(-ts * (1 + 1 / mu))) / (4 * PI * (1 + mu));
+    return (down ? test_ad_down(&r, mu) : test_ad_up(&r, mu)) - ps * geo + pf / (1 - f) * geo;
 }
 
 #endif
