@@ -11,8 +11,9 @@
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
 # CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
 # VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer, "harris",
-# "harris_sun": Harris's, and the same with the diffuse light field, "nishita_diffuse",
-# "harris_diffuse", "harris_sun_diffuse"; "diffuse": the P1 field, --slice-p1; "diffuse_aa": the
+# "harris_sun": Harris's (with the diffuse light field, its default since 2026-12-06), the
+# Nishita renderer with that field, "nishita_diffuse", Harris's forward shading alone (Harris
+# 2002, its default before), "harris_forward", "harris_sun_forward"; "diffuse": the P1 field, --slice-p1; "diffuse_aa": the
 # same with four eye rays per pixel, antialiased; "slice_do", "slice_do_aa": the slice renderer with
 # the discrete-ordinates field, one (--edge-aa 0) and four eye rays per pixel; "slice_do_edge": the
 # same with four rays only at the volume's edges, --edge-aa $EDGE_AA (0.05: the default renderer); "nishita_do": the Nishita renderer with that field,
@@ -84,8 +85,8 @@ for c in $CASES; do
             harris) opts="--renderer harris" ;;
             harris_sun) opts="--renderer harris --sky-lights 0" ;;
             nishita_diffuse) opts="--renderer nishita --nishita-diffuse" ;;
-            harris_diffuse) opts="--renderer harris --harris-diffuse" ;;
-            harris_sun_diffuse) opts="--renderer harris --sky-lights 0 --harris-diffuse" ;;
+            harris_forward) opts="--renderer harris --no-harris-diffuse" ;;
+            harris_sun_forward) opts="--renderer harris --sky-lights 0 --no-harris-diffuse" ;;
             esac
             "$A" render "$scene" $TH --sun-azimuth $az $opts --pfm "$base.$v.pfm" -o "$base.$v.png" 2> "$base.$v.log"
             "$A" compare "$base.$v.pfm" "$base.path.pfm" --by "$base.tau_nosun.pfm" --edges 0.01,0.3,1,3,10,30,100,1e30 \

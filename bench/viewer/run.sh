@@ -54,6 +54,11 @@
 # 28.9 fps (1 % low 17.6 / 15.4 -> 22.4 / 21.7); field_snap the same CPU.
 # A splat's rows only within its cut (docs/viewer.md), the same images: one thread's CPU a
 # field200k frame 38 / 39 -> 30 / 31 ms (bench/viewer/cpu.sh, load 5); wall times at load 4-8 scatter.
+# Harris's diffuse light field the default (2026-12-06, docs/viewer.md, "Harris's diffuse light
+# field in the viewer"): in turns old / new at load 12-20, --frames 120 (million 48), the same
+# fps within the noise (field 1.4 / 1.4, field200k 1.6 / 1.7, inside 1.5 / 1.8, million 3.0 /
+# 1.9); the first frame takes the field's cold solve (inside 0.7 -> 2.3 s); bench/viewer/cpu.sh
+# field200k 93, 96 -> 101, 89 ms a frame, million 113, 126, 118 -> 138, 128, 100.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)

@@ -85,12 +85,15 @@ typedef struct atmos_frame {
                                    sun's (2-3 times faster, but the image then depends on the frames before it
                                    to the solver's tolerance: the viewer); 0 builds it afresh, so that a frame
                                    is the same however it was reached (renders, animations, MPI ranks). The
-                                   Nishita renderer's discrete-ordinates field ("do") the same way */
+                                   Nishita renderer's discrete-ordinates field ("do") and Harris's diffuse
+                                   field the same way */
     int hold_field;             /* slice renderer: 1 keeps the diffuse (or "do") field of the last sun solved for
                                    when the sun moved (no solve this frame; solved when the plan has none):
                                    the viewer's preview while the sun moves. The next frame without it
                                    solves the field for its sun (warm_field decides how), so that frame is
-                                   the one it would have been without the held frames before it; 0 */
+                                   the one it would have been without the held frames before it. Harris's
+                                   renderer the same with its diffuse field (none solved yet: its forward
+                                   shading alone until a frame without it); 0 */
     int impostor_budget;        /* Harris's renderer: at most this many impostors made again this frame, the
                                    most out of date first, the others drawn as they are until a later frame
                                    (the viewer's frames: the updates spread over frames); impostors never

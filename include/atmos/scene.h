@@ -169,7 +169,7 @@ typedef struct atmos_scene_harris {
     double impostor_tolerance_deg; /* the translation error that makes an impostor again; 0.15 */
     int impostor_max_res;     /* an impostor's texels per side at most; 512 */
     int diffuse;              /* 1: each particle also scatters the slice renderer's diffuse light field
-                                 toward the eye (docs/particles.md); 0 */
+                                 toward the eye (docs/particles.md); 1 */
 } atmos_scene_harris;
 
 /* Settings of the beam renderer ("beams" in the file); the table is

@@ -38,36 +38,55 @@ void atmos__harris_diffuse_free(atmos__harris_plan *h)
     free(h->dview);
 }
 
-atmos_status atmos__harris_diffuse_sun(atmos_plan *p, atmos__harris_plan *h, const double sun[3])
+atmos_status atmos__harris_diffuse_sun(atmos_plan *p, atmos__harris_plan *h, const atmos__view *v)
 {
-    if (!h->diffuse) return ATMOS_OK;
-    int built;
-    return atmos__dfield_update(p->ctx, &h->df, p->atm, sun, 0, 0, &built);
+    if (!h->diffuse || (h->field_ok && !memcmp(h->field_sun, v->sun, sizeof h->field_sun))) return ATMOS_OK;
+    const int was = h->field_ok;
+    if (v->hold_field) { /* the viewer's moving sun: the last sun's field, or the forward shading alone */
+        if (h->df.field.valid == was) return ATMOS_OK;
+        h->field_ok = h->df.field.valid;
+    } else {
+        int built; /* warm: from the last sun's field (2-3 times fewer sweeps), the viewer's frames */
+        atmos_status st = atmos__dfield_update(p->ctx, &h->df, p->atm, v->sun, v->warm_field, 0, &built);
+        if (st != ATMOS_OK) return st;
+        memcpy(h->field_sun, v->sun, sizeof h->field_sun);
+        h->field_ok = 1;
+        if (!built && was) return ATMOS_OK; /* the same field as drawn */
+    }
+    for (int k = 0; k < h->clouds.n; k++) h->imp[k].valid = 0; /* what the particles show has changed */
+    for (int k = 0; h->split && k < 2 * h->clouds.n; k++) h->split[k].valid = 0;
+    h->spreading = 0;
+    return ATMOS_OK;
 }
 
-void atmos__harris_diffuse_view(const atmos_plan *p, atmos__harris_plan *h, const double eye_w[3])
+int atmos__harris_diffuse_eye(const atmos_plan *p, atmos__harris_plan *h, const double eye_w[3])
 {
-    if (!h->diffuse) return;
-    const int threads = atmos__threads(p->ctx), nw = h->o.nw;
+    if (!h->diffuse || !h->field_ok) return 0;
+    if (h->eye_done) return 1;
     const sgrid *g = &h->g;
     double rel[3], eg[3], eu[3];
     for (int a = 0; a < 3; a++) rel[a] = eye_w[a] - h->x.org[a];
     atmos__vol_dir_to_frame(&h->x, rel, eg);
     for (int a = 0; a < 3; a++) eu[a] = eg[a] * g->sc + g->off[a];
-    atmos__dfield_view(&h->df, eu, threads); /* the field's L and A toward the eye */
+    atmos__dfield_view(&h->df, eu, atmos__threads(p->ctx)); /* the field's L and A toward the eye */
+    h->eye_done = 1;
+    return 1;
+}
+
+void atmos__harris_diffuse_at(atmos__harris_plan *h, int i)
+{
+    const int nw = h->o.nw;
+    const sgrid *g = &h->g;
     const atmos__lfield *fl = &h->df.field;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int i = 0; i < h->pc.n; i++) {
-        const double d[3] = {h->pc.x[i] - h->x.org[0], h->pc.y[i] - h->x.org[1], h->pc.z[i] - h->x.org[2]};
-        double q[3];
-        atmos__vol_dir_to_frame(&h->x, d, q);
-        float la[2 * ATMOS_MAX_WAVELENGTHS];
-        atmos__lfield_sample(fl, fl->LA, 2 * nw, (float)(q[0] * g->sc + g->off[0]), (float)(q[1] * g->sc + g->off[1]),
-                             (float)(q[2] * g->sc + g->off[2]), la);
-        const int f = h->pc.field[i];
-        for (int k = 0; k < nw; k++) {
-            const float s = la[k] + h->df.fg[f][k] * la[nw + k];
-            h->dview[(size_t)i * nw + k] = s > 0.0f ? (float)(h->o.albedo[f][k] * s) : 0.0f;
-        }
+    const double d[3] = {h->pc.x[i] - h->x.org[0], h->pc.y[i] - h->x.org[1], h->pc.z[i] - h->x.org[2]};
+    double q[3];
+    atmos__vol_dir_to_frame(&h->x, d, q);
+    float la[2 * ATMOS_MAX_WAVELENGTHS];
+    atmos__lfield_sample(fl, fl->LA, 2 * nw, (float)(q[0] * g->sc + g->off[0]), (float)(q[1] * g->sc + g->off[1]),
+                         (float)(q[2] * g->sc + g->off[2]), la);
+    const int f = h->pc.field[i];
+    for (int k = 0; k < nw; k++) {
+        const float s = la[k] + h->df.fg[f][k] * la[nw + k];
+        h->dview[(size_t)i * nw + k] = s > 0.0f ? (float)(h->o.albedo[f][k] * s) : 0.0f;
     }
 }

@@ -37,14 +37,15 @@ static const atmos__aerial *frame_aerial(const atmos_plan *p, atmos__harris_plan
 }
 
 /* The air from the eye to the centres of particles idx[0..n) (ap: the frame's volume, or
- * NULL: ask the atmosphere). */
+ * NULL: ask the atmosphere), and the diffuse field's light toward the eye there. */
 static void air(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, const atmos__aerial *ap,
                 const int *idx, int n)
 {
-    const int nw = h->o.nw;
+    const int nw = h->o.nw, dv = atmos__harris_diffuse_eye(p, h, v->cam.position);
 #pragma omp parallel for schedule(dynamic, 256) num_threads(atmos__threads(p->ctx))
     for (int q = 0; q < n; q++) {
         const int i = idx[q];
+        if (dv) atmos__harris_diffuse_at(h, i); /* the diffuse field's light toward the eye */
         double d[3] = {h->pc.x[i] - v->cam.position[0], h->pc.y[i] - v->cam.position[1], h->pc.z[i] - v->cam.position[2]};
         const double t = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         for (int a = 0; a < 3; a++) d[a] /= t > 0 ? t : 1.0;
@@ -123,7 +124,7 @@ static atmos__plights plights(const atmos__harris_plan *h)
 {
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
                               (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
-                              h->diffuse ? h->dview : NULL};
+                              h->diffuse && h->field_ok ? h->dview : NULL};
     return L;
 }
 
@@ -349,13 +350,13 @@ static int spread_cuts(atmos__harris_plan *h, const atmos__pimpostor *old, int r
  * most the cap's texels each (at least 2, at most ATMOS__HARRIS_SPREAD_MAX), cut where the old
  * one's coverage says the work is alike (spread_cuts), a piece a frame, its old one drawn until
  * it is done. The first such one is taken out of stale (shifting the coarse ones after it)
- * unless a make is spread already; not with the diffuse field or objects (what a particle shows
- * then depends on more of the frame's eye than its air, which the first frame computes for all
- * the rows). */
+ * unless a make is spread already; not with objects (what a particle shows then depends on more
+ * of the frame's eye than its air and diffuse light, which the first frame computes for all the
+ * rows). */
 static void spread_start(const atmos_plan *p, atmos__harris_plan *h, const atmos__view *v, int *how, int *stale,
                          int *nfull, int ncoarse)
 {
-    if (h->spreading || h->diffuse || h->obj || v->impostor_budget <= 0) return;
+    if (h->spreading || h->obj || v->impostor_budget <= 0) return;
     const double f = v->cam.height / (2.0 * v->cam.tan_half_fov), cap = texel_cap(v);
     for (int q = 0; q < *nfull; q++) {
         const int k = stale[q] / 3, res = needed_res(p, h, k, v->cam.position, f);
@@ -440,7 +441,8 @@ atmos_status atmos__harris_render(atmos_plan *p, const atmos__view *v, const atm
         if ((st = atmos__harris_lights(p, h, v->sun)) != ATMOS_OK) return st;
         h->shade_s = atmos__now() - t0;
     }
-    atmos__harris_diffuse_view(p, h, v->cam.position);
+    if ((st = atmos__harris_diffuse_sun(p, h, v)) != ATMOS_OK) return st;
+    h->eye_done = 0; /* the field turned toward this eye when a particle is splatted (air) */
     const int rect[4] = {r->x0, r->y0, r->x1, r->y1};
     const atmos__aerial *ap = frame_aerial(p, h, v);
     if (h->obj && (st = atmos__harris_objects_frame(p, h, h->obj, v, ap, rect)) != ATMOS_OK) return st;

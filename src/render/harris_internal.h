@@ -73,6 +73,9 @@ struct atmos__harris_plan {
     /* "diffuse" (harris_diffuse.c): the diffuse light field on the volume's grid, and per particle
      * what it scatters toward this frame's eye ([p * nw + k]; the splats' atmos__plights.diffuse) */
     int diffuse;
+    int field_ok;                        /* the field is drawn this frame (0: Harris's forward shading alone) */
+    int eye_done;                        /* the field turned toward this frame's eye (0 at a frame's start) */
+    double field_sun[3];                 /* the sun the field was solved for (field_ok) */
     sgrid g;
     stables tab;
     atmos__vol_xform x;
@@ -98,12 +101,16 @@ int atmos__harris_piece(const atmos__harris_plan *h, int k, int pass, int how, i
 atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const double sun[3]);
 
 /* The diffuse light field (harris_diffuse.c): its grid and medium once per plan (nothing
- * unless the scene's "diffuse"), the field per sun direction, per frame its light at each
- * particle toward the eye eye_w (h->dview). */
+ * unless the scene's "diffuse"), the field per sun direction (view v's sun, warm-started with
+ * v->warm_field; with v->hold_field the last sun's field kept, or none drawn before the first
+ * solve; the impostors made stale when the field drawn changes); per frame, only when particles
+ * are splatted, the field turned toward the eye eye_w once (_eye: 0 when no field is drawn) and
+ * its light toward it at each particle splatted (_at: h->dview[i]). */
 atmos_status atmos__harris_diffuse_prepare(atmos_plan *p, atmos__harris_plan *h);
 void atmos__harris_diffuse_free(atmos__harris_plan *h);
-atmos_status atmos__harris_diffuse_sun(atmos_plan *p, atmos__harris_plan *h, const double sun[3]);
-void atmos__harris_diffuse_view(const atmos_plan *p, atmos__harris_plan *h, const double eye_w[3]);
+atmos_status atmos__harris_diffuse_sun(atmos_plan *p, atmos__harris_plan *h, const atmos__view *v);
+int atmos__harris_diffuse_eye(const atmos_plan *p, atmos__harris_plan *h, const double eye_w[3]);
+void atmos__harris_diffuse_at(atmos__harris_plan *h, int i);
 
 /* The bytes a particle type's phase table (particles/pphase.h) may take in a plan:
  * ATMOS__PPHASE_MAX_BYTES; a test lowers it to see the exact look-up past the cap. */

@@ -92,7 +92,6 @@ atmos_status atmos__harris_lights(atmos_plan *p, atmos__harris_plan *h, const do
             for (size_t i = 0; i < per; i++) h->obj->light[q / cl->n][i] *= probe[(size_t)(q - q0) * per + i];
     }
     free(probe);
-    if (st == ATMOS_OK) st = atmos__harris_diffuse_sun(p, h, sun);
     if (st != ATMOS_OK) return st;
     memcpy(h->sun, sun, sizeof h->sun);
     h->have_sun = 1;

@@ -156,9 +156,10 @@ static const atmos_setting harris_settings[] = {
      HARRIS(impostor_tolerance_deg)},
     {"impostor_max_res", "impostor-max-res", ATMOS_SETTING_INT, "texels", 16, 4096, 0, 0, 512, NULL, 0,
      "an impostor's texels per side at most", HARRIS(impostor_max_res)},
-    {"diffuse", "harris-diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
+    {"diffuse", "no-harris-diffuse", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 0,
      "each particle also scatters the diffuse light field of all orders (the light the forward passes drop, "
-     "by the slice renderer's diffusion solve on the volume's grid) toward the eye (docs/particles.md)",
+     "by the slice renderer's diffusion solve on the volume's grid) toward the eye; off: Harris's forward "
+     "shading alone, dense clouds far too dark (docs/particles.md)",
      HARRIS(diffuse)},
 };
 

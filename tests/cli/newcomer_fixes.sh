@@ -41,10 +41,12 @@ if [ -s "$T/pin.pfm" ] && [ -s "$T/fish.pfm" ] && [ -s "$T/eq.pfm" ] && [ -s "$T
         ok "fisheye: the cloud is drawn (centre $f, the sky alone $s)"
     # the same ray through the same splats: the wide cameras composite them in the order of
     # their distance from the eye, a pinhole in that of their depth along its axis (the axis
-    # ray's own order), which puts some overlapping splats the other way round: 1.3 % here
-    # (both in the distance order: the same value to all digits)
+    # ray's own order), which puts some overlapping splats the other way round: 3.0 % here with
+    # the diffuse light field (the default since 2026-12-06: the particles' colours differ more
+    # from one to the next), 1.3 % without it (both in the distance order: the same value to all
+    # digits)
     within "$f" "$e" 1e-6 && ok "fisheye's axis = equirect's north ($f, $e)" || bad "fisheye's axis $f, equirect's north $e"
-    within "$f" "$p" 0.02 && ok "fisheye's axis = pinhole's within 2 % ($f, $p)" || bad "fisheye's axis $f, pinhole's $p"
+    within "$f" "$p" 0.04 && ok "fisheye's axis = pinhole's within 4 % ($f, $p)" || bad "fisheye's axis $f, pinhole's $p"
 fi
 
 # --- 2. options that shape the PNG only, with no PNG written

@@ -82,7 +82,7 @@ cat >"$T/table" <<'EOF'
 --no-impostors|harris.impostors=false|harris|same
 --impostor-tolerance 5|harris.impostor_tolerance_deg=5|harris|same
 --impostor-max-res 16|harris.impostor_max_res=16|harris|same
---harris-diffuse|harris.diffuse=true|harris|same
+--no-harris-diffuse|harris.diffuse=false|harris|same
 --plane-spacing 0.5|beams.plane_spacing_m=0.5|beams|
 --beams-epsilon 0.1|beams.epsilon=0.1|beams|
 --max-subplanes 1|beams.max_subplanes=1|beams|

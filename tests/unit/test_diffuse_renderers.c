@@ -3,7 +3,8 @@
  * ("nishita": {"diffuse": true}): the field of all orders and Riley's scattered beam added to
  * the exact first order where the medium is thick, the orders 2-3 and the sky elements kept
  * where it is thin. Harris ("harris": {"diffuse": true}): the field read at each particle's
- * centre and scattered toward the eye besides the light passes' forward-scattered light.
+ * centre and scattered toward the eye besides the light passes' forward-scattered light; on by
+ * default (issue 16): the default render of the dense blob is the one with the field.
  *  - A dense blob (optical depth ~20 through its centre, HG 0.85, albedo 1, a vacuum: the
  *    sun's light alone), the sun behind the camera and in front of it: with the field the
  *    mean over the cloud's pixels within a bound of the path tracer's, without it far darker
@@ -53,7 +54,7 @@ static atmos_image *render(atmos_context *ctx, const atmos_scene *sc, const atmo
 {
     atmos_scene s = *sc;
     s.renderer = renderer;
-    s.nishita.diffuse = s.harris.diffuse = diffuse;
+    if (diffuse >= 0) s.nishita.diffuse = s.harris.diffuse = diffuse; /* -1: the scene's default */
     return test_plan_frame(ctx, &s, v, &op->o);
 }
 
@@ -96,6 +97,14 @@ static void dense_side(atmos_context *ctx, const atmos_volume *v, const test_opt
     printf("%s, %s: %d cloud pixels; against the path tracer, with the field %+.1f %%, without %+.1f %%\n",
            atmos_renderer_name(renderer), name, cnt, 100 * *with_bias, 100 * *without_bias);
     CHECK(cnt > 150);
+    if (renderer == ATMOS_RENDERER_HARRIS) { /* the field is Harris's default: the same image */
+        atmos_image *def = render(ctx, &s, v, op, renderer, -1);
+        const double d = cloud_sum(ref, def, &cnt) / r - 1;
+        printf("%s, %s: the default %+.1f %%\n", atmos_renderer_name(renderer), name, 100 * d);
+        CHECK(fabs(d) < (sun_azimuth == 0 ? BOUND_FRONT : BOUND_BEHIND));
+        CHECK(fabs(d - *with_bias) < 1e-6);
+        atmos_image_destroy(def);
+    }
     atmos_image_destroy(with), atmos_image_destroy(without);
 }
 
@@ -134,6 +143,53 @@ static void check(atmos_context *ctx, const atmos_volume *dense, const test_opti
     CHECK(fabs(thin_ratio(ctx, op, renderer) - 1) < 0.01);
 }
 
+/* Harris's field through one plan's frames as the viewer asks for them (atmos_frame.hold_field,
+ * warm_field): before any solve a held frame is the forward shading alone (the same bytes as
+ * "diffuse": false); a frame without hold the field's (the same bytes as a plan's first frame);
+ * the sun moved 10 degrees and held, the old sun's field still drawn (far brighter than the
+ * forward shading there); then solved warm-started, within 1 % of the cold solve's image. */
+static void harris_viewer_frames(atmos_context *ctx, const atmos_volume *v, const test_optics *op, const atmos_image *ref)
+{
+    atmos_scene s;
+    scene_for(&s, 180, 1);
+    s.renderer = ATMOS_RENDERER_HARRIS;
+    atmos_plan_desc d;
+    memset(&d, 0, sizeof d);
+    d.optics = &op->o, d.offset_given = 1;
+    atmos_plan *p = NULL;
+    atmos_frame f;
+    atmos_image *img = NULL;
+    CHECK_OK(atmos_plan_create(ctx, &s, v, &d, &p));
+    CHECK_OK(atmos_frame_from_scene(ctx, &s, &f));
+    CHECK_OK(atmos_plan_image_create(p, &f, &img));
+    const size_t bytes = sizeof(float) * W * W * 4;
+    atmos_image *fwd = render(ctx, &s, v, op, ATMOS_RENDERER_HARRIS, 0), *with = render(ctx, &s, v, op, ATMOS_RENDERER_HARRIS, 1);
+    f.hold_field = 1, f.warm_field = 1;
+    CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
+    CHECK(!memcmp(img->pixels, fwd->pixels, bytes)); /* no field yet: the forward shading alone */
+    f.hold_field = 0;
+    CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
+    CHECK(!memcmp(img->pixels, with->pixels, bytes)); /* solved: the field's */
+    atmos_image_destroy(fwd), atmos_image_destroy(with);
+    scene_for(&s, 190, 1);
+    s.renderer = ATMOS_RENDERER_HARRIS;
+    fwd = render(ctx, &s, v, op, ATMOS_RENDERER_HARRIS, 0), with = render(ctx, &s, v, op, ATMOS_RENDERER_HARRIS, 1);
+    atmos_direction_from_angles(30, 190, f.sun_dir);
+    f.hold_field = 1;
+    CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
+    int cnt;
+    const double sf = cloud_sum(ref, fwd, &cnt), sw = cloud_sum(ref, with, &cnt), held = cloud_sum(ref, img, &cnt);
+    f.hold_field = 0; /* the sun still: solved from the last sun's field */
+    CHECK_OK(atmos_plan_render(p, &f, NULL, img, NULL));
+    const double warm = cloud_sum(ref, img, &cnt);
+    printf("harris, the sun 10 degrees on: forward %.4g, the old field held %.4g, warm-started %.4g, cold %.4g\n", sf,
+           held, warm, sw);
+    CHECK(held > 1.5 * sf);
+    CHECK(fabs(warm / sw - 1) < 0.01);
+    atmos_image_destroy(fwd), atmos_image_destroy(with), atmos_image_destroy(img);
+    atmos_plan_destroy(p);
+}
+
 int main(void)
 {
     test_tmp_path(cache_dir, sizeof cache_dir, "cache");
@@ -144,6 +200,7 @@ int main(void)
     atmos_image *refs[2] = {reference(ctx, v, &op, 180), reference(ctx, v, &op, 0)};
     check(ctx, v, &op, ATMOS_RENDERER_NISHITA, refs);
     check(ctx, v, &op, ATMOS_RENDERER_HARRIS, refs);
+    harris_viewer_frames(ctx, v, &op, refs[0]);
     atmos_image_destroy(refs[0]), atmos_image_destroy(refs[1]);
     atmos_volume_destroy(v);
     test_optics_free(&op);

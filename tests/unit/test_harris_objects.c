@@ -165,7 +165,7 @@ int main(void)
     /* the near particles alone and all of them, splatted over black with the plan's light */
     const atmos__plights L = {h->nlights, (const float *const *)h->light, (const float *const *)h->order,
                               (const double(*)[3])h->dir, (const double(*)[ATMOS_MAX_WAVELENGTHS])h->e, h->air_t, h->air_l,
-                              NULL};
+                              h->diffuse && h->field_ok ? h->dview : NULL}; /* the field: the default */
     atmos_image *nearimg = NULL, *allimg = NULL;
     CHECK_OK(atmos_image_create(c2, W, H, C, &nearimg));
     CHECK_OK(atmos_image_create(c2, W, H, C, &allimg));

@@ -249,6 +249,9 @@ static atmos_status render(loop *L, view_state *s, view_quality q, atmos_plan **
     f.no_keep = q == VIEW_PREVIEW || q == VIEW_SCRIPTED;
     f.no_check = !saving; /* display_frame's pass checks the frame; a save's, by the plan */
     if (s->renderer == ATMOS_RENDERER_SLICE) slice_quality(&f, L->sc, q);
+    /* Harris's preview: the diffuse field of the sun before the move (none yet: the forward
+     * shading alone), solved, warm-started, when the view is still (docs/viewer.md) */
+    if (s->renderer == ATMOS_RENDERER_HARRIS && preview) f.hold_field = 1;
     if (s->renderer == ATMOS_RENDERER_PATH) {
         const int full = L->sc->path.spp > 0 ? L->sc->path.spp : 64;
         L->spp = preview ? 1 : (L->spp < full ? L->spp + 1 : full);
