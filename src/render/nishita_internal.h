@@ -88,8 +88,12 @@ atmos_status atmos__nishita_mc_update(atmos_plan *p, atmos__nishita_plan *np, co
                                       const double out_w[3], const double eye_w[3], const double *E, int threads,
                                       int warm);
 const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np);
-/* 1 when the Monte Carlo field is delta-M scaled (its photons saw sig*, not sig') */
-int atmos__nishita_mc_delta_m(const atmos__nishita_plan *np);
+/* With a delta-M scaled field (its photons saw sig*, not sig'): per field and wavelength the
+ * moments chi*_0..3 of its scaled phase (0 above its degree) and sigma_s' - sigma_s*, the
+ * scattering its peak turns (the eye rays' first order of two populations, dm_two_pop.c); returns
+ * 1 then, 0 (nothing set) without delta-M. */
+int atmos__nishita_mc_dm_phase(const atmos__nishita_plan *np, double chi[][ATMOS_MAX_WAVELENGTHS][4],
+                               float turn[][ATMOS_MAX_WAVELENGTHS]);
 
 /* Appends the discrete-ordinates field's last solve (directions, iterations, sweeps, residual,
  * cells, times) to buf as "; discrete-ordinates field, ..." (nishita_mc.c). */

@@ -45,6 +45,7 @@ struct atmos__nishita_mc {
      * scaled phase p* (ph_dm's table), l <= lmax, normalised */
     double pl[PATH_F][ATMOS_MAX_WAVELENGTHS][5];
     int delta_m;         /* the photons in the delta-M scaled medium, their phase HG of g* (hg) */
+    float dm_f[PATH_F][ATMOS_MAX_WAVELENGTHS]; /* with delta_m: its share f of sigma_s' */
     atmos_phase_mixture hg[PATH_F][ATMOS_MAX_WAVELENGTHS];
     int clip;            /* with delta_m: their phase the clipped scaled phase (ph_dm) instead */
     path_phase ph_dm;
@@ -106,7 +107,7 @@ static atmos_status delta_m(atmos_context *ctx, atmos__nishita_mc *mc, int nf, i
         for (int k = 0; k < n; k++) {
             double *pl = mc->pl[i][k];
             const double p0 = pl[0], c = pl[L + 1] / p0, fk = c > 0 && c < 1 ? c : 0;
-            f[i][k] = (float)fk;
+            f[i][k] = (float)fk, mc->dm_f[i][k] = (float)fk;
             for (int l = 0; l <= L; l++) pl[l] = (pl[l] / p0 - fk) / (1 - fk);
             atmos_phase_mixture *h = &mc->hg[i][k];
             memset(h, 0, sizeof *h);
@@ -154,7 +155,19 @@ atmos_status atmos__nishita_mc_create(atmos_plan *p, atmos__nishita_plan *np)
 
 const atmos__lfield *atmos__nishita_mc_field(const atmos__nishita_plan *np) { return &np->mc->field; }
 
-int atmos__nishita_mc_delta_m(const atmos__nishita_plan *np) { return np->mc->delta_m; }
+int atmos__nishita_mc_dm_phase(const atmos__nishita_plan *np, double chi[][ATMOS_MAX_WAVELENGTHS][4],
+                               float turn[][ATMOS_MAX_WAVELENGTHS])
+{
+    const atmos__nishita_mc *mc = np->mc;
+    if (!mc || !mc->delta_m) return 0;
+    for (int f = 0; f < np->nf; f++)
+        for (int w = 0; w < np->n; w++) {
+            for (int l = 0; l < 4; l++) chi[f][w][l] = l <= mc->lmax ? mc->pl[f][w][l] : 0;
+            const double fk = mc->dm_f[f][w];
+            turn[f][w] = fk < 1 ? (float)(np->mc_sca[f][w] * fk / (1 - fk)) : 0.0f; /* sigma_s' - sigma_s* */
+        }
+    return 1;
+}
 
 void atmos__nishita_do_describe(const atmos__nishita_plan *np, char *buf, size_t cap)
 {

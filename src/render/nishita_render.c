@@ -8,6 +8,7 @@
  * the pixels at the volume's edges (edge_aa.c, as the slice renderer's) take four rays. */
 #include "atmosphere/atmosphere_ops.h"
 #include "core/vec.h"
+#include "render/dm_two_pop.h"
 #include "render/edge_aa.h"
 #include "render/nishita_internal.h"
 
@@ -30,6 +31,11 @@ typedef struct {
                 medium too: sigma_s p E exp(-tau*_sun), attenuated toward the eye by sigma_t* */
     float sig[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* extinction of the first order and the eye
                                                                   rays (truncated with mc) */
+    /* with tms, the first order of two populations (dm_two_pop.c): the beam's share exp(-sum col
+     * turn) the delta-M peak has not turned scatters with the full phase, the rest with sigma_s*
+     * times the scaled phase p* of moments chi */
+    double chi[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS][4];
+    float turn[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
 } rjob;
 
 /* Ams_2 of each field at scattering angle acos(mu) (the beam's scattered light, once scattered
@@ -104,8 +110,12 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
     if (t0 < 0) t0 = 0;
     double pf[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     const double mu = atmos__dot3(dw, J->sun_w); /* cos of the angle between the sunlight's and the ray's travel */
+    double ps[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS]; /* with tms: sigma_s* p*(mu) */
     for (int f = 0; f < nf; f++)
-        for (int w = 0; w < n; w++) pf[f][w] = atmos_phase_table_eval(np->phase[f], w, mu);
+        for (int w = 0; w < n; w++) {
+            pf[f][w] = atmos_phase_table_eval(np->phase[f], w, mu);
+            ps[f][w] = J->tms ? np->mc_sca[f][w] * atmos__dm_phase3(J->chi[f][w], 0, mu) : 0;
+        }
     double ams2[ATMOS_VOLUME_MAX_FIELDS][ATMOS_MAX_WAVELENGTHS];
     if (J->diffuse) ams2_at(&np->tab, mu, ams2);
     double Tm[ATMOS_MAX_WAVELENGTHS]; /* the Monte Carlo field's transmittance (sig_ms) */
@@ -135,13 +145,18 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         }
         double Tmax = 0;
         for (int w = 0; w < n; w++) {
-            double st = 0, ss = 0, s1 = 0, tau = 0, sm = 0, Sm = 0;
+            double st = 0, ss = 0, s1 = 0, s1t = 0, nt = 0, tau = 0, sm = 0, Sm = 0;
             for (int f = 0; f < nf; f++) {
                 st += dens[f] * J->sig[f][w], ss += dens[f] * np->sca[f][w];
                 s1 += dens[f] * np->sca[f][w] * pf[f][w];
+                if (J->tms) s1t += dens[f] * ps[f][w], nt += col[f] * J->turn[f][w];
                 tau += col[f] * (J->tms ? np->mc_sig_ms[f][w] : J->sig[f][w]);
                 if (J->mc)
                     sm += dens[f] * np->mc_sig_ms[f][w], Sm += dens[f] * np->mc_sca[f][w] * (Lmc[w] > 0 ? Lmc[w] : 0);
+            }
+            if (J->tms) { /* the two populations: the unturned share e^-nt, the turned one */
+                const double wu = exp(-nt);
+                s1 = wu * s1 + (1 - wu) * s1t;
             }
             /* the field's radiance is per unit truncated scattering, sig_s (1 - f); where the
              * diffuse field is on (fade > 0) it takes the place of the orders 2-3 and the sky */
@@ -265,7 +280,7 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
         for (int a = 0; a < 3; a++) ot[a] = -dc[a];
         if ((st = atmos__nishita_mc_update(p, np, v->sun, ot, v->cam.position, J.E, threads, v->warm_field)) != ATMOS_OK) return st;
         J.mc = atmos__nishita_mc_field(np);
-        J.tms = atmos__nishita_mc_delta_m(np);
+        J.tms = atmos__nishita_mc_dm_phase(np, J.chi, J.turn);
     }
     const double lim = p->scene.nishita.edge_aa;
     const unsigned char *edge = edges(np, &J, lim, r, threads);

@@ -53,39 +53,13 @@
  * passes as if not scattered. Through the true sigma_t it was measured worse (docs/lightfield.md,
  * "The background behind the volume"): the first order does not draw the peak's light at the
  * image's pixel size, so it was lost. */
+#include "render/dm_two_pop.h"
 #include "render/nishita_internal.h"
 #include "render/slice_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
-
-/* The phase table's share above its value at SLICE_DO_CUT_DEG within that angle: the forward
- * peak's part that the 3-degree cut counts as not scattered (the path tracer's --truncate 3, the
- * field's cut), for field f, wavelength w (n wavelengths). */
-#define SLICE_DO_CUT_DEG 3.0
-static double cut_share(const stables *t, int f, int w, int n)
-{
-    const double *g = t->grid[f];
-    const float *A = t->ams[f];
-    const size_t st = (size_t)t->no * n;
-    double pc = 0, cut = 0, all = 0;
-    for (int a = 0; a + 1 < t->ng[f]; a++)
-        if (g[a] <= SLICE_DO_CUT_DEG && g[a + 1] > SLICE_DO_CUT_DEG) pc = A[a * st + w];
-    for (int a = 0; a + 1 < t->ng[f]; a++) {
-        const double p0 = A[a * st + w], p1 = A[(a + 1) * st + w];
-        const double dm = cos(g[a] * ATMOS_DEG2RAD) - cos(g[a + 1] * ATMOS_DEG2RAD);
-        all += 2 * ATMOS_PI * 0.5 * (p0 + p1) * dm;
-        if (g[a + 1] <= SLICE_DO_CUT_DEG) cut += 2 * ATMOS_PI * 0.5 * (p0 + p1 - 2 * pc) * dm;
-    }
-    return all > 0 && cut > 0 ? cut / all : 0;
-}
-
-/* The Legendre polynomials P_0..P_3 at mu. */
-static void legendre3(double mu, double P[4])
-{
-    P[0] = 1, P[1] = mu, P[2] = 0.5 * (3 * mu * mu - 1), P[3] = 0.5 * (5 * mu * mu - 3) * mu;
-}
 
 /* Rows 2 and 3 of field f's Ams in a (do_ams' copy of tab's, stride no): the full table again and
  * sigma_s* / sigma_s times delta-M's scaled phase of degree 3, p* = sum (2l + 1) / (4 pi) chi*_l P_l
@@ -99,20 +73,11 @@ static void two_pop_rows(const atmos__slice_plan *sp, int f, float *a0)
     const double *g = t->grid[f];
     for (int w = 0; w < n; w++) {
         const double sh = t->sca[f][w] > 0 ? 1 - sp->dop->mc_sca[f][w] / t->sca[f][w] : 0;
-        double chi[4] = {0}, P0[4], P1[4];
-        for (int a = 0; a + 1 < ng; a++) {
-            const double m0 = cos(g[a] * ATMOS_DEG2RAD), m1 = cos(g[a + 1] * ATMOS_DEG2RAD);
-            const double p0 = t->ams[f][(size_t)a * no * n + w], p1 = t->ams[f][(size_t)(a + 1) * no * n + w];
-            legendre3(m0, P0), legendre3(m1, P1);
-            for (int l = 0; l < 4; l++) chi[l] += 2 * ATMOS_PI * 0.5 * (p0 * P0[l] + p1 * P1[l]) * (m0 - m1);
-        }
-        for (int l = 3; l >= 0; l--) chi[l] = chi[0] > 0 ? chi[l] / chi[0] : l == 0;
+        double chi[4];
+        atmos__dm_moments3(t, f, w, n, chi);
         for (int a = 0; a < ng; a++) {
-            legendre3(cos(g[a] * ATMOS_DEG2RAD), P0);
-            double v = 0;
-            for (int l = 0; l < 4; l++) v += (2 * l + 1) / (4 * ATMOS_PI) * (chi[l] - sh) * P0[l];
             a0[((size_t)a * no + 2) * n + w] = t->ams[f][(size_t)a * no * n + w];
-            a0[((size_t)a * no + 3) * n + w] = (float)(v > 0 ? v : 0);
+            a0[((size_t)a * no + 3) * n + w] = (float)atmos__dm_phase3(chi, sh, cos(g[a] * ATMOS_DEG2RAD));
         }
     }
 }
@@ -137,7 +102,7 @@ static void do_kappa(atmos__slice_plan *sp)
     double a = 0, b = 0, c = 0;
     for (int f = 0; f < sp->nf; f++) {
         a += dsum[f] * sp->tab.sca[f][w], b += dsum[f] * sp->dop->mc_sca[f][w];
-        c += dsum[f] * sp->tab.sca[f][w] * cut_share(&sp->tab, f, w, sp->n);
+        c += dsum[f] * sp->tab.sca[f][w] * atmos__dm_cut_share(&sp->tab, f, w, sp->n);
     }
     sp->do_share = a > 0 ? (float)(1 - b / a) : 0.0f;
     sp->do_share_dm = a > 0 && a - b - c > 0 ? (float)((a - b - c) / a) : 0.0f;
