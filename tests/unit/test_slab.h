@@ -51,18 +51,25 @@ static inline double test_image_mean(const atmos_image *img)
     return s / (3.0 * img->width * img->height);
 }
 
-/* The reflected radiance per unit irradiance at mu, linear between adding-doubling's nodes. */
-static inline double test_ad_up(const ad_result *r, double mu)
+/* Adding-doubling's radiance per unit irradiance at mu (rad: radiance_up, reflected, or
+ * radiance_down, diffusely transmitted), linear between its nodes. */
+static inline double test_ad_at(const ad_result *r, const double *rad, double mu)
 {
     int lo = -1, hi = -1;
     for (int i = 1; i < r->D; i++) {
         if (r->mu[i] <= mu && (lo < 0 || r->mu[i] > r->mu[lo])) lo = i;
         if (r->mu[i] >= mu && (hi < 0 || r->mu[i] < r->mu[hi])) hi = i;
     }
-    if (lo < 0 || hi < 0 || lo == hi) return r->radiance_up[lo < 0 ? hi : lo];
+    if (lo < 0 || hi < 0 || lo == hi) return rad[lo < 0 ? hi : lo];
     const double t = (mu - r->mu[lo]) / (r->mu[hi] - r->mu[lo]);
-    return (1 - t) * r->radiance_up[lo] + t * r->radiance_up[hi];
+    return (1 - t) * rad[lo] + t * rad[hi];
 }
+
+/* The reflected radiance per unit irradiance at mu. */
+static inline double test_ad_up(const ad_result *r, double mu) { return test_ad_at(r, r->radiance_up, mu); }
+
+/* The diffusely transmitted radiance per unit irradiance at mu (the slab seen from below). */
+static inline double test_ad_down(const ad_result *r, double mu) { return test_ad_at(r, r->radiance_down, mu); }
 
 /* The reflected radiance per unit irradiance at mu of the slab of optical depth tau (HG g,
  * albedo 1, the sun at the zenith) as the discrete-ordinates field's own approximation would give
