@@ -182,12 +182,12 @@ static void check_thick_cells(atmos_context *ctx, const test_optics *op)
 /* Lit from behind (the clouds and the rain with the sun in front): the slab of optical depth 4,
  * 16 and 64 seen from below, the sun at the zenith above it, at view cosines 0.98 (11.5 degrees
  * from the sun), 0.9 and 0.6 looking up, its diffusely transmitted radiance against
- * adding-doubling (cells of 2 voxels). Measured 2026-12-06: depths 4 and 16 within -5.3 ... +2.8 %
- * but for two known excesses, bounded here so that they cannot grow unseen: depth 4 at 0.98,
- * +73 % (likely the first order's full phase on the delta-M direct beam, which holds light the
- * forward peak has turned; sharp_eye's split is front to back only, and its smooth phase given
- * back to front on the sun's side made it +98 %), and depth 64, +23 ... +31 % (cells of 10.7
- * optical depths; cells of 1 voxel +9 / +11 %, of 4 +120 / +145 %; not diagnosed further). */
+ * adding-doubling (cells of 2 voxels). Measured 2026-12-06 with the first order's two
+ * populations (check_forward): depths 4 and 16 within -12.8 ... +3.2 % (depth 4 at 0.9, 26 degrees
+ * from the sun, -12.8 %: the turned light's lost forward lobe, as check_forward's -10 ... -14 %;
+ * before the two populations, depth 4 at 0.98 was +73 %), bounded at 15 % as check_forward is;
+ * depth 64 +23 ... +31 %, a known excess bounded here so that it cannot grow unseen (cells of
+ * 10.7 optical depths; cells of 1 voxel +9 / +11 %, of 4 +120 / +145 %; not diagnosed further). */
 static void check_transmitted(atmos_context *ctx, const test_optics *op)
 {
     const double taus[3] = {4, 16, 64}, mus[3] = {0.98, 0.9, 0.6}, bottom = 1000 + 0.5 * (NY - NS) * VS, D = 1000;
@@ -208,8 +208,7 @@ static void check_transmitted(atmos_context *ctx, const test_optics *op)
             atmos_image_destroy(img);
             printf("  slab tau %g seen from below, view mu %.2f: adding-doubling %.5f; slice with do %.5f (%+.1f %%)\n",
                    taus[t], mus[a], ref, m, 100 * e);
-            const int near_sun = t == 0 && a == 0, thick = t == 2;
-            CHECK(near_sun ? e > 0.3 && e < 0.85 : thick ? e > 0 && e < 0.35 : fabs(e) < 0.07);
+            CHECK(t == 2 ? e > 0 && e < 0.35 : fabs(e) < 0.15);
         }
         atmos_volume_destroy(v);
     }
