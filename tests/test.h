@@ -156,9 +156,10 @@ static inline atmos_volume *test_cloud_volume(atmos_context *ctx, const int dims
 }
 
 /* One frame of scene s (volume v, optics; the volume where its own coordinates put it, as
- * atmos_render_path does) through a plan made for it, checked; NULL on failure. */
-static inline atmos_image *test_plan_frame(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,
-                                           const atmos_volume_optics *optics)
+ * atmos_render_path does) through a plan made for it, checked; NULL on failure. Rows [y0, y1)
+ * alone when y1 > y0 (the rest of the image left as created), else the whole frame. */
+static inline atmos_image *test_plan_frame_rows(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,
+                                                const atmos_volume_optics *optics, int y0, int y1)
 {
     atmos_plan_desc d;
     memset(&d, 0, sizeof d);
@@ -168,10 +169,35 @@ static inline atmos_image *test_plan_frame(atmos_context *ctx, const atmos_scene
     atmos_frame f;
     atmos_image *img = NULL;
     CHECK_OK(atmos_plan_create(ctx, s, v, &d, &p));
-    if (p && atmos_frame_from_scene(ctx, s, &f) == ATMOS_OK && atmos_plan_image_create(p, &f, &img) == ATMOS_OK)
-        CHECK_MSG(atmos_plan_render(p, &f, NULL, img, NULL) == ATMOS_OK, "render: %s", atmos_context_error(ctx));
+    if (p && atmos_frame_from_scene(ctx, s, &f) == ATMOS_OK && atmos_plan_image_create(p, &f, &img) == ATMOS_OK) {
+        const atmos_region r = {0, y0, s->width, y1};
+        CHECK_MSG(atmos_plan_render(p, &f, y1 > y0 ? &r : NULL, img, NULL) == ATMOS_OK, "render: %s",
+                  atmos_context_error(ctx));
+    }
     atmos_plan_destroy(p);
     return img;
+}
+
+/* test_plan_frame_rows' whole frame. */
+static inline atmos_image *test_plan_frame(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,
+                                           const atmos_volume_optics *optics)
+{
+    return test_plan_frame_rows(ctx, s, v, optics, 0, 0);
+}
+
+/* The fraction of pixel (x, y) of a w x w pinhole image (vertical field fov_deg) inside the disk
+ * of a sphere on the optical axis whose angular radius has the sine s: 32 x 32 rays over the
+ * pixel's area (the pixel's rays are symmetric about the axis). */
+static inline double test_disk_coverage(int x, int y, int w, double fov_deg, double s)
+{
+    const double th = tan(0.5 * fov_deg * 3.14159265358979323846 / 180.0);
+    int in = 0;
+    for (int b = 0; b < 32; b++)
+        for (int a = 0; a < 32; a++) {
+            const double u = (2.0 * (x + (a + 0.5) / 32) / w - 1.0) * th, v = (2.0 * (y + (b + 0.5) / 32) / w - 1.0) * th;
+            in += (u * u + v * v) / (1.0 + u * u + v * v) < s * s; /* sin^2 of the angle to the axis */
+        }
+    return in / 1024.0;
 }
 
 /* Scratch path for a test's output files: $ATMOS_TEST_TMP/name (or /tmp). */

@@ -55,35 +55,12 @@ static atmos_image *frame(atmos_context *ctx, double edge_aa, const atmos_volume
 {
     atmos_scene s;
     scene_for(&s, edge_aa);
-    atmos_plan_desc pd;
-    memset(&pd, 0, sizeof pd);
-    pd.optics = o;
-    pd.offset_given = 1;
-    atmos_plan *plan = NULL;
-    atmos_frame f;
-    atmos_image *img = NULL;
-    CHECK_OK(atmos_plan_create(ctx, &s, v, &pd, &plan));
-    CHECK_OK(atmos_frame_from_scene(ctx, &s, &f));
-    CHECK_OK(atmos_plan_image_create(plan, &f, &img));
-    const atmos_region r = {0, y0, W, y1};
-    if (plan && img && atmos_plan_render(plan, &f, &r, img, NULL) != ATMOS_OK) atmos_image_destroy(img), img = NULL;
-    atmos_plan_destroy(plan);
-    return img;
+    return test_plan_frame_rows(ctx, &s, v, o, y0, y1);
 }
 
-/* The fraction of pixel (x, y) inside the sphere's disk: 32 x 32 pinhole rays over its area
- * (the sphere on the optical axis). The voxelised sphere's edge is taken half a voxel out. */
-static double coverage(int x, int y)
-{
-    const double th = tan(30.0 * 3.14159265358979323846 / 180.0), s = (R + 0.5 * VOX) / D;
-    int in = 0;
-    for (int b = 0; b < 32; b++)
-        for (int a = 0; a < 32; a++) {
-            const double u = (2.0 * (x + (a + 0.5) / 32) / W - 1.0) * th, v = (2.0 * (y + (b + 0.5) / 32) / W - 1.0) * th;
-            in += (u * u + v * v) / (1.0 + u * u + v * v) < s * s;
-        }
-    return in / 1024.0;
-}
+/* The fraction of pixel (x, y) inside the sphere's disk (the voxelised sphere's edge taken half
+ * a voxel out). */
+static double coverage(int x, int y) { return test_disk_coverage(x, y, W, 60, (R + 0.5 * VOX) / D); }
 
 /* 1 when pixel (x, y) and its eight neighbours are all clear or all covered. */
 static int away(const double *cov, int x, int y)

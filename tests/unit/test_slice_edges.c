@@ -80,28 +80,15 @@ static atmos_image *render(atmos_context *ctx, const atmos_scene *scene, const a
     return img;
 }
 
-/* The frame through a plan with edge_aa 0.05, rows [y0, y1) alone (region) or whole. */
+/* The frame through a plan with edge_aa 0.05, rows [y0, y1) alone (region) or whole (the volume
+ * where its own origin puts it, as atmos_render_slice does). */
 static atmos_image *plan_frame(atmos_context *ctx, const atmos_scene *scene, const atmos_volume *v,
                                const atmos_volume_optics *o, int y0, int y1)
 {
     atmos_scene s = *scene;
     s.renderer = ATMOS_RENDERER_SLICE;
     s.slice.edge_aa = 0.05;
-    s.volume.placed = 1; /* where the volume's own origin puts it, as atmos_render_slice does */
-    s.volume.position_m[0] = 0, s.volume.position_m[1] = 1500 - N * VOX / 2, s.volume.position_m[2] = -D;
-    atmos_plan_desc pd;
-    memset(&pd, 0, sizeof pd);
-    pd.optics = o;
-    atmos_plan *plan = NULL;
-    atmos_frame f;
-    atmos_image *img = NULL;
-    CHECK_OK(atmos_plan_create(ctx, &s, v, &pd, &plan));
-    CHECK_OK(atmos_frame_from_scene(ctx, &s, &f));
-    CHECK_OK(atmos_plan_image_create(plan, &f, &img));
-    const atmos_region r = {0, y0, W, y1};
-    if (plan && img && atmos_plan_render(plan, &f, &r, img, NULL) != ATMOS_OK) atmos_image_destroy(img), img = NULL;
-    atmos_plan_destroy(plan);
-    return img;
+    return test_plan_frame_rows(ctx, &s, v, o, y0, y1);
 }
 
 /* Rows [y0, y1) rendered alone are the whole frame's bit for bit. */
@@ -117,21 +104,9 @@ static int region_same(atmos_context *ctx, const atmos_scene *s, const atmos_vol
     return same;
 }
 
-/* The fraction of pixel (x, y) inside the sphere's disk: 32 x 32 pinhole rays over its area
- * (the sphere on the optical axis; the pixel's rays, tan_half = tan(30 degrees) at the
- * image's edge, are symmetric about it). The voxelised sphere's edge is taken half a voxel out. */
-static double coverage(int x, int y)
-{
-    const double th = tan(30.0 * 3.14159265358979323846 / 180.0), s = (R + 0.5 * VOX) / D;
-    int in = 0;
-    for (int b = 0; b < 32; b++)
-        for (int a = 0; a < 32; a++) {
-            const double u = (2.0 * (x + (a + 0.5) / 32) / W - 1.0) * th, v = (2.0 * (y + (b + 0.5) / 32) / W - 1.0) * th;
-            /* sin^2 of the angle to the axis against (R / D)^2 */
-            in += (u * u + v * v) / (1.0 + u * u + v * v) < s * s;
-        }
-    return in / 1024.0;
-}
+/* The fraction of pixel (x, y) inside the sphere's disk (the voxelised sphere's edge taken half
+ * a voxel out). */
+static double coverage(int x, int y) { return test_disk_coverage(x, y, W, 60, (R + 0.5 * VOX) / D); }
 
 /* The volume's coverage of pixel p in img: (sky - img) / (sky - full), full the image of the
  * opaque box around the sphere (the air in front of the same halfway plane alone), the channels
