@@ -339,7 +339,12 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
      * escape(sigma_t lbar) (its faces' share at most 1): the voxels below that alone listed */
     double esc[CS_BLOCK], tff[CS_BLOCK];
     int id[CS_BLOCK], k = 0;
-    for (int e = 0; e < m; e++) esc[e] = escape(t[e] * sg->lbar);
+    double xmax = 0; /* a block of optically thin voxels: escape's series alone, no exponential */
+    for (int e = 0; e < m; e++) xmax = t[e] * sg->lbar > xmax ? t[e] * sg->lbar : xmax;
+    if (xmax < 1e-3)
+        for (int e = 0; e < m; e++) esc[e] = 1 - 0.5 * (t[e] * sg->lbar); /* escape's own, below 1e-3 */
+    else
+        for (int e = 0; e < m; e++) esc[e] = escape(t[e] * sg->lbar);
     for (int e = 0; e < m; e++) id[k] = e, k += sc[e] != 0 && tr[e] < esc[e];
     if (k) sun_faces(np, vi, xyz, id, k, sg, sig, tff);
     for (int q = 0; q < k; q++) {
