@@ -27,6 +27,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -256,36 +257,6 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
     return dc;
 }
 
-/* The sunlight at a voxel's sunward faces (per unit sunlight; lt: the light's travel, a unit
- * vector in the grid's frame; hv: the voxel's size, m): per axis a whose face the light enters,
- * that face's share of the light entering, |lt_a| / M (M = sum |lt_a|), times e^-tau at the
- * face. tau at a face: the column at the sunward neighbour's centre plus that neighbour's
- * sigma_t over the light's part of the half voxel between them, |lt_a| h / 2 (0 outside the
- * grid). Times escape(sigma_t h / M) (h / M: the voxel's mean chord along the light) it is the
- * voxel's mean sunlight through its faces (cell_source): in a voxel of many optical depths the
- * light entering its faces over sigma_t h, sum |lt_a| T_a / (sigma_t h). */
-DO_INLINE double sun_faces(const atmos__nishita_plan *np, int x, int y, int z, const double lt[3], const float *sig,
-                           double hv)
-{
-    const sgrid *g = &np->g;
-    const int nf = np->nf, xyz[3] = {x, y, z};
-    const double M = fabs(lt[0]) + fabs(lt[1]) + fabs(lt[2]);
-    double T = 0;
-    for (int a = 0; a < 3; a++) {
-        if (lt[a] == 0) continue;
-        int q[3] = {xyz[0], xyz[1], xyz[2]};
-        q[a] += lt[a] > 0 ? -1 : 1;
-        double tau = 0;
-        if (q[a] >= 0 && q[a] < g->c[a]) {
-            const size_t u = (((size_t)q[2] * g->c[1] + q[1]) * g->c[0] + q[0]) * nf;
-            const double half = 0.5 * hv * fabs(lt[a]);
-            for (int f = 0; f < nf; f++) tau += (np->col[u + f] + g->v[u + f] * half) * sig[f];
-        }
-        T += fabs(lt[a]) * atmos__expf_fast((float)-tau);
-    }
-    return T / M;
-}
-
 #define CS_BLOCK 64 /* cell_source's voxels a block: its arrays stay in L1 */
 
 /* The sun seen from the render grid, for cell_source: len the chord per unit sigma_t along the
@@ -295,13 +266,52 @@ typedef struct {
     double len, hv, lbar, lt[3];
 } sun_geom;
 
+/* The sunlight at the sunward faces of voxels id[0 .. k) of a block (per unit sunlight; their
+ * grid indices times nf vi, their coordinates xyz; sig: a wavelength's sigma_t per field) into
+ * tff[0 .. k): per axis a whose face the light enters (lt, the light's travel in sg), that face's
+ * share of the light entering, |lt_a| / M (M = sum |lt_a|), times e^-tau at the face. tau at a
+ * face: the column at the sunward neighbour's centre plus that neighbour's sigma_t over the
+ * light's part of the half voxel between them, |lt_a| h / 2 (0 outside the grid). Times
+ * escape(sigma_t h / M) (h / M: the voxel's mean chord along the light) it is the voxel's mean
+ * sunlight through its faces (source_block): in a voxel of many optical depths the light
+ * entering its faces over sigma_t h, sum |lt_a| T_a / (sigma_t h). The columns gathered, then
+ * each face's exponentials in a vector loop (the same operations in the same order as one voxel
+ * at a time). */
+DO_INLINE void sun_faces(const atmos__nishita_plan *np, const size_t *vi, const int (*xyz)[3], const int *id, int k,
+                         const sun_geom *sg, const float *sig, double *tff)
+{
+    const sgrid *g = &np->g;
+    const int nf = np->nf;
+    const double *lt = sg->lt, M = fabs(lt[0]) + fabs(lt[1]) + fabs(lt[2]);
+    const ptrdiff_t stride[3] = {nf, (ptrdiff_t)g->c[0] * nf, (ptrdiff_t)g->c[0] * g->c[1] * nf};
+    double tau[CS_BLOCK];
+    for (int q = 0; q < k; q++) tff[q] = 0;
+    for (int a = 0; a < 3; a++) {
+        if (lt[a] == 0) continue;
+        const int d = lt[a] > 0 ? -1 : 1;
+        const double half = 0.5 * sg->hv * fabs(lt[a]), la = fabs(lt[a]);
+        for (int q = 0; q < k; q++) {
+            const int e = id[q], qa = xyz[e][a] + d;
+            double ta = 0;
+            if (qa >= 0 && qa < g->c[a]) {
+                const size_t u = (size_t)((ptrdiff_t)vi[e] + d * stride[a]);
+                for (int f = 0; f < nf; f++) ta += (np->col[u + f] + g->v[u + f] * half) * sig[f];
+            }
+            tau[q] = ta;
+        }
+        for (int q = 0; q < k; q++) tff[q] += la * atmos__expf_fast((float)-tau[q]);
+    }
+    for (int q = 0; q < k; q++) tff[q] /= M;
+}
+
 /* cell_source's sums over a block of m listed voxels (their grid indices times nf vi, their first
  * list entry e0) for wavelength w: acc[0 .. 3] += the voxels' sigma_s T_sun, sigma_s, local
  * radiance and sigma_s times it, *nv += the scattering voxels (sub: the sub-cell term's, cells of
  * more than one voxel; sg: the sun's geometry). The same operations in the same order per
  * wavelength as one voxel at a time, in four loops: the medium gathered, the exponentials of
  * every voxel in one vector loop (both sides of mean_transmittance's branch, the one kept chosen
- * per voxel: the same values), the faces' estimate where it is the larger (sun_faces, scalar),
+ * per voxel: the same values), the faces' estimate where it is the larger (sun_faces, vectorised
+ * over the voxels it may win),
  * the sums in the voxels' order (the same bits as the voxel-at-a-time loop; built for AVX2 as
  * well as the baseline, chosen at run time). */
 ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos__do_cells *dc, int n, int w,
@@ -325,11 +335,22 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
         const double hs = 0.5 * (tl < 2 * ta ? tl : 2 * ta), r = mean_transmittance(ta, hs);
         tr[e] = r, tf[e] = atmos__expf_fast((float)(hs - ta));
     }
-    for (int e = 0; e < m; e++) { /* the faces' estimate where it is the larger: a voxel thick along the chord */
-        if (!(sc[e] != 0)) continue;
-        const double tff = sun_faces(np, xyz[e][0], xyz[e][1], xyz[e][2], sg->lt, sig, sg->hv),
-                     trf = tff * escape(t[e] * sg->lbar);
-        if (trf > tr[e]) tr[e] = trf, tf[e] = tff;
+    /* the faces' estimate where it is the larger: a voxel thick along the chord. It is at most
+     * escape(sigma_t lbar) (its faces' share at most 1): the voxels below that alone listed */
+    double esc[CS_BLOCK], tff[CS_BLOCK];
+    int id[CS_BLOCK], k = 0;
+    double xmax = 0; /* a block of optically thin voxels: escape's series alone, no exponential */
+    for (int e = 0; e < m; e++) xmax = t[e] * sg->lbar > xmax ? t[e] * sg->lbar : xmax;
+    if (xmax < 1e-3)
+        for (int e = 0; e < m; e++) esc[e] = 1 - 0.5 * (t[e] * sg->lbar); /* escape's own, below 1e-3 */
+    else
+        for (int e = 0; e < m; e++) esc[e] = escape(t[e] * sg->lbar);
+    for (int e = 0; e < m; e++) id[k] = e, k += sc[e] != 0 && tr[e] < esc[e];
+    if (k) sun_faces(np, vi, xyz, id, k, sg, sig, tff);
+    for (int q = 0; q < k; q++) {
+        const int e = id[q];
+        const double trf = tff[q] * esc[e];
+        if (trf > tr[e]) tr[e] = trf, tf[e] = tff[q];
     }
     for (int e = 0; e < m; e++) {
         acc[1] += sc[e];

@@ -405,7 +405,7 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
                              const float *restrict bext, const float *restrict src, const float *restrict ds,
                              const float *restrict I1)
 {
-    float Tq[CH], Cq[CH], Sq[CH], Lq[CH];
+    float Tq[CH], Cq[CH], Sq[CH], Lq[CH], Eq[CH];
     /* the in-scattering; the field's added by a loop of its own: a test of ds inside the loop
      * became a masked load from the null pointer, whose every lane masked off still cost a
      * microcode assist per vector (a quarter of the eye pass without the field) */
@@ -418,15 +418,16 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
         /* beta_sca Delta of Eq. 26, integrated over the slab with its own attenuation:
          * (1 - T)/beta_ext (-> Delta when thin). */
         Lq[q] = tau < 1e-4f ? e->del[q] * (1.0f - 0.5f * tau) : (1.0f - T) / be;
-        Tq[q] = be > 0.0f ? T : 1.0f;
+        Tq[q] = be > 0.0f ? T : 1.0f, Eq[q] = T;
     }
     float Bq[CH]; /* the beam's length: Lq, or with I1 its attenuation across the slab too */
     if (I1) {
+        /* the beam's exponentials are the slab's T and the light's ratio r themselves: a
+         * logarithm a sample, no exponential (two were taken here) */
         const int btf = j->btf;
         for (int q = 0; q < e->mv; q++) {
-            const float r = Ic[q] > 0.0f ? I1[q] / Ic[q] : 1.0f; /* atmos__slice_beam_ratio's, in a vector loop */
-            const float tl = r < 1.0f ? -log_pos(r > ATMOS__SLICE_BEAM_MIN ? r : ATMOS__SLICE_BEAM_MIN) : 0.0f;
-            Bq[q] = atmos__slice_beam_len(e->del[q], bext[q] * e->del[q], tl, btf, atmos__expf_poly);
+            const float r = atmos__slice_beam_ratio(Ic[q], I1[q]);
+            Bq[q] = atmos__slice_beam_len(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r, btf);
         }
     } else
         for (int q = 0; q < e->mv; q++) Bq[q] = Lq[q];

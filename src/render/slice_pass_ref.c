@@ -101,9 +101,8 @@ long long atmos__slice_eye_span_ref(const sjob *j, int k, int y, int x0, int x1,
             float len = tau < 1e-4f ? delta * (1.0f - 0.5f * tau) : (1.0f - Tslab) / bext;
             /* the light buffer's beam also attenuated across the slab where the light pass
                takes all its extinction (atmos__slice_beam_len) */
-            const float lenI = j->low_albedo
-                                   ? atmos__slice_beam_len(delta, tau, -logf(atmos__slice_beam_ratio(I[c], I1[c])), j->btf, expf)
-                                   : len;
+            const float rI = j->low_albedo ? atmos__slice_beam_ratio(I[c], I1[c]) : 1.0f;
+            const float lenI = j->low_albedo ? atmos__slice_beam_len(delta, tau, Tslab, -logf(rI), rI, j->btf) : len;
             /* the diffuse field scattered toward the eye: beta_sca (L + g A), not below 0 */
             float contrib = I[c] * src * lenI + (j->field && dsrc > 0.0f ? dsrc * len : 0.0f);
             float *Lp = j->L_eye + c * j->pst + p, *Tp = j->T_eye + c * j->pst + p;
