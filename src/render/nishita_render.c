@@ -4,7 +4,8 @@
  * sun, the sunlight attenuated by the column density stored per render voxel) and the
  * light field's orders 2-3 and sky light (per unit scattering coefficient) interpolated and
  * multiplied by the sample's scattering coefficient; the sky behind attenuated by the volume
- * and the air in front of the volume added as the slice renderer's composite does. With edge_aa
+ * and the air in front of the volume added as the slice renderer's composite does, less what the
+ * volume's shadow takes from the air's single scattering (nishita_air.c). With edge_aa
  * the pixels at the volume's edges (edge_aa.c, as the slice renderer's) take four rays. */
 #include "atmosphere/atmosphere_ops.h"
 #include "core/vec.h"
@@ -21,7 +22,8 @@ typedef struct {
     const atmos__nishita_plan *np;
     const atmos_atmosphere *atm;
     const atmos_camera *cam;
-    double sun_w[3], eye_g[3];
+    double sun_w[3], eye_g[3], sun_g[3];
+    int air_shadow; /* the volume's shadow on the air (the scene's "air_shadows"; nishita_air.c) */
     double E[ATMOS_MAX_WAVELENGTHS]; /* the sunlight at the box's centre */
     double dt;                       /* step, m */
     int use_field;
@@ -72,9 +74,7 @@ static void diffuse_at(const atmos__nishita_plan *np, const float *u, const floa
     }
 }
 
-/* Trilinear value of m floats per voxel of a render-grid array at render-voxel coordinate
- * (u, v, w) (voxel centres at integers; clamped into the grid). */
-static void grid_at(const sgrid *g, const float *arr, int m, double u, double v, double w, float *out)
+void atmos__nishita_grid_at(const sgrid *g, const float *arr, int m, double u, double v, double w, float *out)
 {
     const double x[3] = {u, v, w};
     int i[3];
@@ -128,11 +128,11 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         double u[3];
         for (int a = 0; a < 3; a++) u[a] = (J->eye_g[a] + t * dg[a]) * g->sc + g->off[a];
         float dens[ATMOS_VOLUME_MAX_FIELDS], col[ATMOS_VOLUME_MAX_FIELDS], Lf[ATMOS_MAX_WAVELENGTHS];
-        grid_at(g, g->v, nf, u[0], u[1], u[2], dens);
+        atmos__nishita_grid_at(g, g->v, nf, u[0], u[1], u[2], dens);
         float any = 0;
         for (int f = 0; f < nf; f++) any += dens[f];
         if (!(any > 0)) continue;
-        grid_at(g, np->col, nf, u[0], u[1], u[2], col);
+        atmos__nishita_grid_at(g, np->col, nf, u[0], u[1], u[2], col);
         if (J->use_field) atmos__lfield_sample(&np->field, np->field.L, n, (float)u[0], (float)u[1], (float)u[2], Lf);
         float Lmc[ATMOS_MAX_WAVELENGTHS];
         if (J->mc) atmos__lfield_sample(J->mc, J->mc->L, n, (float)u[0], (float)u[1], (float)u[2], Lmc);
@@ -190,6 +190,27 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
     return 1;
 }
 
+/* The volume's shadow on the air along the ray d (world) taken from the air in front of the
+ * volume's light (front, the eye to th) and from the sky image's value B (the whole ray to the
+ * volume's far side or the ground at tg), as the slice renderer's composite over its shadowed
+ * sky image (slice_shadow.c): with the sun ahead the air between the eye and a cloud lies in
+ * its shadow, and unshadowed it lit the cloud's deep pixels (docs/lightfield.md). */
+static void air_shadow(const rjob *J, const double d[3], double th, double tg, double *front, double *B)
+{
+    const atmos__nishita_plan *np = J->np;
+    const float(*sig)[ATMOS_MAX_WAVELENGTHS] = J->tms ? np->mc_sig_ms : J->sig;
+    double dg[3], t0, t1, Df[ATMOS_MAX_WAVELENGTHS], Db[ATMOS_MAX_WAVELENGTHS];
+    atmos__vol_dir_to_frame(&np->x, d, dg);
+    if (!atmos__ray_box(J->eye_g, dg, np->g.box_lo, np->g.box_hi, &t0, &t1)) return;
+    const double tb = t1 < tg ? t1 : tg;
+    atmos__nishita_air_shadow(np, J->atm, J->cam->position, d, J->eye_g, dg, J->sun_w, J->sun_g, sig, 0, th, Df);
+    atmos__nishita_air_shadow(np, J->atm, J->cam->position, d, J->eye_g, dg, J->sun_w, J->sun_g, sig, th, tb, Db);
+    for (int c = 0; c < np->n; c++) {
+        front[c] = front[c] > Df[c] ? front[c] - Df[c] : 0;
+        B[c] = B[c] > Df[c] + Db[c] ? B[c] - Df[c] - Db[c] : 0;
+    }
+}
+
 /* The ray through image point (x, y): the volume over the sky image's value px (B = front +
  * T_front back) into out: front + T_front L + T (B - front), the air's part "front" in front of
  * the volume's light; px itself where the ray misses the volume. */
@@ -204,8 +225,11 @@ static void shade_ray(const rjob *J, double x, double y, const float *px, double
     if (th > tg) th = tg;
     atmos_atmosphere_inscatter(J->atm, J->cam->position, d, th, J->sun_w, front);
     atmos_atmosphere_transmittance(J->atm, J->cam->position, d, th, Tf);
+    double B[ATMOS_MAX_WAVELENGTHS];
+    for (int c = 0; c < n; c++) B[c] = px[c];
+    if (J->air_shadow) air_shadow(J, d, th, tg, front, B);
     for (int c = 0; c < n; c++) {
-        const double r = front[c] + Tf[c] * L[c] + T[c] * (px[c] - front[c]);
+        const double r = front[c] + Tf[c] * L[c] + T[c] * (B[c] - front[c]);
         out[c] = isfinite(r) && r > 0 ? r : 0.0;
     }
 }
@@ -259,7 +283,9 @@ atmos_status atmos__nishita_render(atmos_plan *p, const atmos__view *v, const at
     rjob J;
     memset(&J, 0, sizeof J);
     J.np = np, J.atm = p->atm, J.cam = &v->cam, J.use_field = use_field, J.diffuse = np->diffuse && !np->mc;
-    memcpy(J.sun_w, v->sun, sizeof J.sun_w);
+    memcpy(J.sun_w, v->sun, sizeof J.sun_w), memcpy(J.sun_g, sun_g, sizeof J.sun_g);
+    J.air_shadow = p->scene.slice.air_shadows && !v->no_air_shadows &&
+                   atmos_atmosphere_get_kind(p->atm) != ATMOS_ATMOSPHERE_VACUUM;
     for (int a = 0; a < 3; a++) rel[a] = v->cam.position[a] - np->x.org[a], cen[a] = 0.5 * (np->g.box_lo[a] + np->g.box_hi[a]);
     atmos__vol_dir_to_frame(&np->x, rel, J.eye_g);
     if (J.diffuse) {
