@@ -9,7 +9,7 @@
 /* The angle of the forward peak's cut (the path tracer's --truncate 3, the field's cut), degrees. */
 #define ATMOS_DM_CUT_DEG 3.0
 
-/* The share of field f's phase table (Ams row 1 of t, n wavelengths) above its value at
+/* The share of field f's phase table (Ams_1, row 0 of t, n wavelengths) above its value at
  * ATMOS_DM_CUT_DEG within that angle, at wavelength w: the part the cut counts as not scattered. */
 double atmos__dm_cut_share(const stables *t, int f, int w, int n);
 

@@ -194,8 +194,12 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
  * volume's light (front, the eye to th) and from the sky image's value B (the whole ray to the
  * volume's far side or the ground at tg), as the slice renderer's composite over its shadowed
  * sky image (slice_shadow.c): with the sun ahead the air between the eye and a cloud lies in
- * its shadow, and unshadowed it lit the cloud's deep pixels (docs/lightfield.md). */
-static void air_shadow(const rjob *J, const double d[3], double th, double tg, double *front, double *B)
+ * its shadow, and unshadowed it lit the cloud's deep pixels (docs/lightfield.md). Taken in
+ * proportion to the volume's opacity 1 - T along the ray: the rays that miss the volume keep
+ * the sky image's unshadowed air, so those that graze it join them without a seam (the shafts
+ * beside a cloud are not drawn). */
+static void air_shadow(const rjob *J, const double d[3], double th, double tg, const double *T, double *front,
+                       double *B)
 {
     const atmos__nishita_plan *np = J->np;
     const float(*sig)[ATMOS_MAX_WAVELENGTHS] = J->tms ? np->mc_sig_ms : J->sig;
@@ -206,8 +210,9 @@ static void air_shadow(const rjob *J, const double d[3], double th, double tg, d
     atmos__nishita_air_shadow(np, J->atm, J->cam->position, d, J->eye_g, dg, J->sun_w, J->sun_g, sig, 0, th, Df);
     atmos__nishita_air_shadow(np, J->atm, J->cam->position, d, J->eye_g, dg, J->sun_w, J->sun_g, sig, th, tb, Db);
     for (int c = 0; c < np->n; c++) {
-        front[c] = front[c] > Df[c] ? front[c] - Df[c] : 0;
-        B[c] = B[c] > Df[c] + Db[c] ? B[c] - Df[c] - Db[c] : 0;
+        const double o = T[c] < 1 ? 1 - T[c] : 0, f = o * Df[c], b = o * (Df[c] + Db[c]);
+        front[c] = front[c] > f ? front[c] - f : 0;
+        B[c] = B[c] > b ? B[c] - b : 0;
     }
 }
 
@@ -227,7 +232,7 @@ static void shade_ray(const rjob *J, double x, double y, const float *px, double
     atmos_atmosphere_transmittance(J->atm, J->cam->position, d, th, Tf);
     double B[ATMOS_MAX_WAVELENGTHS];
     for (int c = 0; c < n; c++) B[c] = px[c];
-    if (J->air_shadow) air_shadow(J, d, th, tg, front, B);
+    if (J->air_shadow) air_shadow(J, d, th, tg, T, front, B);
     for (int c = 0; c < n; c++) {
         const double r = front[c] + Tf[c] * L[c] + T[c] * (B[c] - front[c]);
         out[c] = isfinite(r) && r > 0 ? r : 0.0;

@@ -13,7 +13,9 @@
  * with sigma_t*: F and the scattering count n play no part), and the eye pass is TMS's first
  * order (Nakajima & Tanaka 1988), sigma_s p(theta) I (front to back the share
  * exp(-(tau - tau*)) with the full phase table, Ams_1, the rest smoothed over the forward peak:
- * below; back to front the full table alone), plus sigma_s* times the field's coefficients toward
+ * below; back to front, the sun ahead, two populations: the share the peak has not turned with
+ * the full table, the rest with delta-M's smoothed phase, sjob.two_pop), plus sigma_s* times the
+ * field's coefficients toward
  * the eye, both attenuated toward the eye by sigma_t*; xi is 0 (the field is the multiple
  * scattering it stood for). The Nishita renderer's sum with "do" (nishita_render.c) is the same
  * but for that split: its first order is the full table's whole, on its own grid; this one is on
