@@ -84,9 +84,10 @@ typedef struct atmos_frame {
     int warm_field;             /* slice renderer: 1 starts the diffuse field after a sun move from the last
                                    sun's (2-3 times faster, but the image then depends on the frames before it
                                    to the solver's tolerance: the viewer); 0 builds it afresh, so that a frame
-                                   is the same however it was reached (renders, animations, MPI ranks). The
-                                   Nishita renderer's discrete-ordinates field ("do") and Harris's diffuse
-                                   field the same way */
+                                   is the same however it was reached (renders, animations, MPI ranks; a
+                                   field solved warm is solved again at the same sun for such a frame: the
+                                   viewer's save). The Nishita renderer's discrete-ordinates field ("do") and
+                                   Harris's diffuse field the same way */
     int hold_field;             /* slice renderer: 1 keeps the diffuse (or "do") field of the last sun solved for
                                    when the sun moved (no solve this frame; solved when the plan has none):
                                    the viewer's preview while the sun moves. The next frame without it

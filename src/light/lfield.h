@@ -61,6 +61,8 @@ typedef struct {
     /* what it was computed for */
     int valid;
     double sun[3];
+    int warm; /* 1: solved from an earlier sun's field (the viewer's frames); a frame that asks for
+                 no warm start (a save: atmos render's image) solves it afresh */
     /* the last solve */
     int sweeps;
     double build_s, source_s, solve_s;

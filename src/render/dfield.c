@@ -285,13 +285,14 @@ atmos_status atmos__dfield_update(atmos_context *ctx, atmos__dfield *df, const a
 {
     atmos__lfield *fl = &df->field;
     *built = 0;
-    if (fl->valid && memcmp(fl->sun, sun_w, sizeof fl->sun) == 0 && (!want_beam || df->beam)) return ATMOS_OK;
+    if (fl->valid && memcmp(fl->sun, sun_w, sizeof fl->sun) == 0 && (!want_beam || df->beam) && !(fl->warm && !warm))
+        return ATMOS_OK;
     const int n = df->n;
     const size_t cnt = atmos__lmedium_cells(&df->med) * (size_t)n;
     if (!df->fade_any) {
         /* thin everywhere: the field is faded out in every cell and stays zero, no solve */
         memcpy(fl->sun, sun_w, sizeof fl->sun);
-        fl->valid = 1, fl->sweeps = 0, fl->build_s = fl->source_s = fl->solve_s = 0;
+        fl->valid = 1, fl->warm = 0, fl->sweeps = 0, fl->build_s = fl->source_s = fl->solve_s = 0;
         if (want_beam && !df->beam && !(df->beam = calloc(cnt, sizeof(float))))
             return atmos__error(ctx, ATMOS_E_NOMEM, "%s: out of memory for the diffuse light field", df->who);
         *built = 1;
@@ -318,6 +319,7 @@ atmos_status atmos__dfield_update(atmos_context *ctx, atmos__dfield *df, const a
     atmos__ldiffusion_opts o = {0};
     o.limiter = 1; /* measured better than without (docs/lightfield.md) */
     o.cascade = fl->valid && warm ? 0 : 2; /* a cold start from coarser grids' solutions; else the last sun's field */
+    fl->warm = o.cascade == 0;
     fl->sweeps = atmos__lfield_diffuse(&df->med, &src, fl->phi, &o, threads);
     if (fl->sweeps < 0) {
         free(Q);

@@ -40,7 +40,9 @@ void atmos__harris_diffuse_free(atmos__harris_plan *h)
 
 atmos_status atmos__harris_diffuse_sun(atmos_plan *p, atmos__harris_plan *h, const atmos__view *v)
 {
-    if (!h->diffuse || (h->field_ok && !memcmp(h->field_sun, v->sun, sizeof h->field_sun))) return ATMOS_OK;
+    const int cold_asked = !v->warm_field && h->df.field.warm && !v->hold_field; /* a save after warm starts */
+    if (!h->diffuse || (h->field_ok && !memcmp(h->field_sun, v->sun, sizeof h->field_sun) && !cold_asked))
+        return ATMOS_OK;
     const int was = h->field_ok;
     if (v->hold_field) { /* the viewer's moving sun: the last sun's field, or the forward shading alone */
         if (h->df.field.valid == was) return ATMOS_OK;

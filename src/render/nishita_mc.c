@@ -63,6 +63,8 @@ struct atmos__nishita_mc {
     int ss_done;
     double sun[3], out[3], eye[3];
     int valid, view_valid;
+    int warm; /* 1: the field solved from an earlier sun's (the viewer's frames); a frame that asks
+                 for no warm start (a save: atmos render's image) solves it afresh */
 };
 
 void atmos__nishita_mc_free(atmos__nishita_mc *mc)
@@ -555,13 +557,14 @@ atmos_status atmos__nishita_mc_update(atmos_plan *p, atmos__nishita_plan *np, co
 {
     atmos__nishita_mc *mc = np->mc;
     const int same_out = mc->lmax >= 0 || !memcmp(mc->out, out_w, sizeof mc->out);
-    if (!mc->valid || memcmp(mc->sun, sun_w, sizeof mc->sun) || !same_out) {
+    if (!mc->valid || memcmp(mc->sun, sun_w, sizeof mc->sun) || !same_out || (mc->warm && !warm)) {
         const double t0 = atmos__now();
+        const int warm_start = np->opt.do_field && warm && mc->do_phi_valid;
         atmos_status st = np->opt.do_field ? solve(p, np, sun_w, E, threads < 1 ? 1 : threads, warm)
                                            : trace(p, np, sun_w, out_w, E, threads < 1 ? 1 : threads);
         if (st != ATMOS_OK) return st;
         memcpy(mc->sun, sun_w, sizeof mc->sun), memcpy(mc->out, out_w, sizeof mc->out);
-        mc->valid = 1, mc->view_valid = 0;
+        mc->valid = 1, mc->view_valid = 0, mc->warm = warm_start;
         np->mc_s = atmos__now() - t0;
     }
     if (!mc->view_valid || memcmp(mc->eye, eye_w, sizeof mc->eye)) {

@@ -335,7 +335,7 @@ static int same_view(const atmos__view *a, const atmos__view *b)
            a->samples_per_pixel == b->samples_per_pixel && a->slices == b->slices && a->eye_scale == b->eye_scale &&
            a->light_size == b->light_size &&
            a->sky_step == b->sky_step && a->sky_table == b->sky_table && a->no_air_shadows == b->no_air_shadows &&
-           a->hold_field == b->hold_field && a->screen_layer_px == b->screen_layer_px;
+           a->hold_field == b->hold_field && a->warm_field == b->warm_field && a->screen_layer_px == b->screen_layer_px;
 }
 
 static int rect_inside(const atmos__rect *a, const atmos__rect *b)
