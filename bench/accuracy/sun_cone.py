@@ -24,22 +24,19 @@ ring. Prints the sun's pixel and the cone's pixel counts; exit status 0 either w
 """
 import json
 import math
+import os
 import struct
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "shafts"))
+import compare as shafts_compare  # noqa: E402  (the PFM reader of the light-shaft bench)
 
 SUN_RADIUS_DEG = 0.2665  # the sun's angular radius (atmos's disk)
 
 
 def read_pfm(path):
-    """(w, h, channels, values, little-endian scale line) in the file's own row order."""
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = f.read()
-    n = 3 if kind == b"PF" else 1
-    end = "<" if scale < 0 else ">"
-    return w, h, n, list(struct.unpack(end + "%df" % (w * h * n), data[: 4 * w * h * n]))
+    """(w, h, channels, values) in the file's own row order (the keys are written back in it)."""
+    return shafts_compare.read_pfm(path, top_down=False)
 
 
 def write_pfm(path, w, h, n, vals):

@@ -15,7 +15,9 @@ import struct
 import sys
 
 
-def read_pfm(path):
+def read_pfm(path, top_down=True):
+    """(w, h, channels, values): rows top to bottom, or in the file's own order (bottom to top)
+    with top_down False."""
     with open(path, "rb") as f:
         kind = f.readline().strip()
         w, h = map(int, f.readline().split())
@@ -24,6 +26,8 @@ def read_pfm(path):
         data = f.read()
     end = "<" if scale < 0 else ">"
     vals = struct.unpack(end + "%df" % (w * h * n), data[: 4 * w * h * n])
+    if not top_down:
+        return w, h, n, list(vals)
     # PFM rows run bottom to top: turn them top to bottom
     rows = [vals[(h - 1 - y) * w * n:(h - y) * w * n] for y in range(h)]
     return w, h, n, [v for r in rows for v in r]
