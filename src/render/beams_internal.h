@@ -162,6 +162,7 @@ struct atmos__beams_plan {
      * interpolated: beams/screen_step, beams_screen.h; evaluations counted again where two bands meet,
      * and in each of a frame's two layers, the spots' and the other lights', when it has both) */
     long air_pixels, air_evaluated;
+    long air_shared; /* of the evaluated, those handed their cell's corners' agreement (beams_screen.h) */
     /* a frame's per-pixel buffers, kept for the next frame (beams_kept.h): the primary
      * visibility's two, then the subsampled frame's (beams_render.c) */
     atmos__beams_kept kept[ATMOS__BEAMS_KEPT_COUNT];

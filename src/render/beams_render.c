@@ -25,7 +25,8 @@
  * evaluated on a lattice of every k-th pixel and interpolated across the cells where that is
  * safe (a cell that a light's screen span crosses is always cut, unless the span is many cells
  * wide there: the lit cones' hint; the spots on a lattice of their own when there are other lights
- * or the sun, air_layers), the surfaces
+ * or the sun, air_layers; a point light's stretches between two planes taken as lit or dark where
+ * all four corners of a cut cell saw them so, shared_interval), the surfaces
  * still per pixel, the sky behind from the sky renderer's grid of every k-th pixel (at most 4).
  * Rows go to the threads; each pixel depends on nothing but its own ray (or its band of the
  * lattice), so the image does not depend on the thread count. */
@@ -303,8 +304,9 @@ static int intervals(job *J, int i, const double d[3], double T, double *f, doub
 }
 
 /* Interval k of the intervals f (its f_l > 0) scattered toward the eye, added to *sum: ceil(f_l /
- * unit) sub-planes, the samples at offset o of their parts. */
-static void interval(job *J, const atmos__beams_ray *ray, const double *f, int k, double unit, double *sum, int centre,
+ * unit) sub-planes, the samples at offset o of their parts. Returns 1 when every sample (or the
+ * tiles' proof) gave H = 1 with no falloff, 0 when each gave 0, else -1. */
+static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k, double unit, double *sum, int centre,
                      double o)
 {
     const double fl = f[2 * k + 1];
@@ -319,7 +321,7 @@ static void interval(job *J, const atmos__beams_ray *ray, const double *f, int k
     const int uniform = tested && atmos__beams_ray_uniform(ray, ta, f[2 * k + 2], &same, &full);
     if (uniform && (full || same == 0)) { /* what every sample would say */
         *sum += same * fl;
-        return;
+        return same == 0 ? 0 : same == 1 ? 1 : -1;
     }
     if (uniform) /* lit all along: the falloff alone varies */
         h = atmos__beams_ray_falloff_sum(ray, ta, step, o, m);
@@ -329,6 +331,38 @@ static void interval(job *J, const atmos__beams_ray *ray, const double *f, int k
         h = atmos__beams_ray_light_sum(ray, ta, step, o, 0, m);
     *sum += h / m * fl;
     if (centre) J->centre_subplanes += m;
+    return h == 0 ? 0 : h == m && !uniform && ray->l->L.type == ATMOS_LIGHT_POINT ? 1 : -1;
+}
+
+/* A subsampled frame's point light whose rays share what the corners of a cut cell saw
+ * (beams_screen.h's known): per stretch j of a ray between its planes j and j + 1 (j < 64),
+ * bit j of known[0] where every corner's was lit all along, of known[1] where dark; seen, the
+ * ray's own, for the cells it is a corner of (the stretches whole between two planes). */
+typedef struct shared_ray {
+    int light;             /* the light (-1: none) */
+    const uint64_t *known; /* NULL: nothing agreed */
+    uint64_t *seen;
+} shared_ray;
+
+/* Interval k of n of the shared light i (interval()'s), taken from the corners where they agree
+ * on its stretch (the planes are the same for every pixel: a pixel's stretch between two planes
+ * lies within the hull of its cell's corners' stretches there), else sampled. */
+static void shared_interval(job *J, int i, const atmos__beams_ray *ray, const double *f, int k, int n, double unit,
+                            double *sum, int centre, double o, double cosf, const shared_ray *sh)
+{
+    const double j = floor((0.5 * (f[2 * k] + f[2 * k + 2]) * cosf - J->z_lo[i]) / J->dz[i]);
+    const uint64_t bit = j >= 0 && j < 64 ? (uint64_t)1 << (int)j : 0;
+    if (sh->known && bit & sh->known[0]) {
+        *sum += f[2 * k + 1], sh->seen[0] |= bit;
+        return;
+    }
+    if (sh->known && bit & sh->known[1]) {
+        sh->seen[1] |= bit;
+        return;
+    }
+    const int lit = interval(J, ray, f, k, unit, sum, centre, o);
+    if (k == 0 || k == n - 1 || lit < 0) return; /* a stretch cut by the reach or the surface tells nothing */
+    sh->seen[lit ? 0 : 1] |= bit;
 }
 
 /* A point light's intervals from k on (the first's f_l below POINT_MERGE unit) while their f_l
@@ -360,7 +394,7 @@ static int merged(job *J, const atmos__beams_ray *ray, const double *f, int k, i
  * units) gets ceil(f_l / unit) sub-planes; the samples at offset o (0.5: the midpoints) of
  * their parts. */
 static void airlight(job *J, int i, const double d[3], const double *f, int n, double S, double unit, double *L,
-                     int centre, double o)
+                     int centre, double o, const shared_ray *sh)
 {
     const atmos__beams_light *l = &J->b->lights[i];
     if (!l->nfaces && l->L.type == ATMOS_LIGHT_POINT) { /* H = 1 and no falloff: the sum is exact */
@@ -374,11 +408,14 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         return;
     }
     double sum = 0;
+    const double cosf = atmos__dot3(d, J->fwd);
     for (int k = 0; k < n;)
         if (!(f[2 * k + 1] > 0))
             k++;
         else if (l->L.type == ATMOS_LIGHT_POINT && f[2 * k + 1] < POINT_MERGE * unit)
             k = merged(J, &ray, f, k, n, unit, &sum, centre, o);
+        else if (sh)
+            shared_interval(J, i, &ray, f, k++, n, unit, &sum, centre, o, cosf, sh);
         else
             interval(J, &ray, f, k++, unit, &sum, centre, o);
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum;
@@ -436,7 +473,7 @@ static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights :
  * lights (each light's f_l sum weighted by its mean intensity) that it could add, so a light
  * whose airlight is a small share of the pixel's gets few; with one light, epsilon of its own. */
 static void lights(job *J, int x, int y, const double d[3], double T, double *f, double *L, int centre, double o,
-                   uint32_t mask)
+                   uint32_t mask, const shared_ray *sh)
 {
     const int nl = J->b->nlights;
     double *S = f + (size_t)nl * LIGHT_STRIDE, *cnt = S + nl, tot = 0;
@@ -454,7 +491,8 @@ static void lights(job *J, int x, int y, const double d[3], double T, double *f,
     for (int i = 0; i < nl; i++)
         if (cnt[i] > 0 && mask >> i & 1) {
             const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
-            airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o);
+            airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o,
+                     sh && sh->light == i ? sh : NULL);
         }
 }
 
@@ -477,7 +515,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
         const double fog_t = base_light(J, x, y, d, hit ? &h : NULL, m, cones, px, b->sun_on, L, NULL);
         if (il && b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         if (!il) {
-            if (b->sigma_t > 0) lights(J, x, y, d, T, f, L, x == J->cx && y == J->cy, 0.5, ALL_LIGHTS);
+            if (b->sigma_t > 0) lights(J, x, y, d, T, f, L, x == J->cx && y == J->cy, 0.5, ALL_LIGHTS, NULL);
             if (b->sun_on) sunlight(J, d, hit ? &h : NULL, m, T, fog_t, L);
         }
         for (int k = 0; k < J->nw; k++) px[k] = (float)L[k];
@@ -486,7 +524,7 @@ static void pixel(job *J, int x, int y, float *px, double *f, atmos__beams_il *i
     const long q = atmos__beams_il_index(il, x, y);
     const double o = atmos__beams_il_offset(il->n, x, y);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
-    if (b->sigma_t > 0) lights(J, x, y, d, T, f, A, px && x == J->cx && y == J->cy, o, ALL_LIGHTS);
+    if (b->sigma_t > 0) lights(J, x, y, d, T, f, A, px && x == J->cx && y == J->cy, o, ALL_LIGHTS, NULL);
     for (int k = 0; k < J->nw; k++) il->air[(size_t)q * J->nw + k] = (float)A[k];
     il->depth[q] = (float)T, il->object[q] = hit ? m : -1;
 }
@@ -643,6 +681,11 @@ static int rows(atmos_plan *p, job *J, const atmos__rect *r, const atmos__rect *
 #ifndef SCREEN_WIDE
 #define SCREEN_WIDE 8
 #endif
+/* A cut cell at most this many pixels wide and tall hands its corners' agreement on a point
+ * light's stretches to the rays evaluated in it (shared_ray; 0: none). */
+#ifndef SCREEN_SHARE
+#define SCREEN_SHARE 16
+#endif
 
 /* The eye's ray through pixel (x, y) in a subsampled frame: kept from the first pass (J->dir) when
  * there is one, the same bits as eye_ray's. */
@@ -662,7 +705,8 @@ typedef struct screen_buf {
     int *X, *Y, *obj;
     double *T, *node;
     float *base;
-    double *dir; /* the eye's rays (a pinhole camera; else NULL) */
+    double *dir;      /* the eye's rays (a pinhole camera; else NULL) */
+    uint64_t *seen;   /* per layer and node: what its evaluation saw (two masks, air_pixel) */
 } screen_buf;
 
 /* Subsampling's first pass for a surface that no light reaches (no cones): the sky's light and
@@ -745,17 +789,20 @@ typedef struct air_layer {
     job *J;
     uint32_t mask;
     int sun;
+    int shared; /* its point light whose rays share their corners' (shared_ray; -1: none) */
 } air_layer;
 
 /* The airlight of pixel (x, y) (atmos__beams_air_fn) of the layer user: its lights' and the sun's. */
-static void air_pixel(void *user, double *f, int x, int y, double T, double *A)
+static void air_pixel(void *user, double *f, int x, int y, double T, const uint64_t *known, uint64_t seen[2], double *A)
 {
     const air_layer *a = user;
     job *J = a->J;
     double d[3];
+    const shared_ray sh = {a->shared, known, seen};
     kept_ray(J, x, y, d);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
-    if (J->b->sigma_t > 0) lights(J, x, y, d, T, f, A, J->centre_now, 0.5, a->mask);
+    seen[0] = seen[1] = 0;
+    if (J->b->sigma_t > 0) lights(J, x, y, d, T, f, A, J->centre_now, 0.5, a->mask, a->shared >= 0 ? &sh : NULL);
     if (a->sun && J->b->sun_on) sun_air(J, d, T, A);
 }
 
@@ -768,19 +815,24 @@ static void air_pixel(void *user, double *f, int x, int y, double T, double *A)
 static int air_layers(job *J, air_layer a[2])
 {
     uint32_t spots = 0;
-    for (int i = 0; i < J->b->nlights; i++)
-        if (J->b->lights[i].L.type == ATMOS_LIGHT_SPOT) spots |= (uint32_t)1 << i;
+    int points = 0, shared = -1; /* a layer's rays share their corners' view of its one shadowed point light */
+    for (int i = 0; i < J->b->nlights; i++) {
+        const atmos__beams_light *l = &J->b->lights[i];
+        if (l->L.type == ATMOS_LIGHT_SPOT) spots |= (uint32_t)1 << i;
+        else if (l->L.type == ATMOS_LIGHT_POINT && points++ == 0 && l->nfaces && !l->L.tex) shared = i;
+    }
+    if (points != 1 || !(SCREEN_SHARE > 0)) shared = -1;
     const uint32_t all = J->b->nlights >= 32 ? ALL_LIGHTS : ((uint32_t)1 << J->b->nlights) - 1, rest = all & ~spots;
-    a[0] = (air_layer){J, ALL_LIGHTS, 1};
+    a[0] = (air_layer){J, ALL_LIGHTS, 1, shared};
     if (!SCREEN_LAYERS || !spots || (!rest && !J->b->sun_on)) return 1;
-    a[0].mask = rest, a[1] = (air_layer){J, spots, 0};
+    a[0].mask = rest, a[1] = (air_layer){J, spots, 0, -1};
     return 2;
 }
 
 
 static void screen_buf_free(screen_buf *q) /* the others are the plan's, kept for the next frame */
 {
-    free(q->X), free(q->Y);
+    free(q->X), free(q->Y), free(q->seen);
 }
 
 /* Band j of a subsampled frame (atmos__beams_screen_band) from the lattice's nodes, each of the
@@ -788,21 +840,23 @@ static void screen_buf_free(screen_buf *q) /* the others are the plan's, kept fo
  * row only in the last band: the next band's first). Returns the pixels evaluated (in each
  * layer: a pixel evaluated in two counts twice). */
 static long screen_band(const atmos__beams_screen *s, int nl, const screen_buf *q, int nx, int ny, int j, double *f,
-                        double *const *band, unsigned char *const *state, atmos_image *out)
+                        double *const *band, unsigned char *const *state, uint64_t *seen, long *shared,
+                        atmos_image *out)
 {
     const atmos__rect *r = &s->r;
     const int W = r->x1 - r->x0, nw = s->nw, y0 = q->Y[j], y1 = ny > 1 ? q->Y[j + 1] : y0;
-    const size_t layer = (size_t)nx * ny * nw; /* the nodes of a layer */
     long ev = 0;
     for (int l = 0; l < nl; l++) {
         memset(state[l], 0, (size_t)W * (size_t)(y1 - y0 + 1));
         for (int e = 0; e < (ny > 1 ? 2 : 1); e++)
             for (int i = 0; i < nx; i++) {
                 const size_t at = (size_t)(e ? y1 - y0 : 0) * W + (size_t)(q->X[i] - r->x0);
-                memcpy(band[l] + at * nw, q->node + l * layer + ((size_t)(j + e) * nx + i) * nw, sizeof(double) * nw);
+                const size_t node = l * (size_t)nx * ny + (size_t)(j + e) * nx + i;
+                memcpy(band[l] + at * nw, q->node + node * nw, sizeof(double) * nw);
+                memcpy(seen + 2 * at, q->seen + 2 * node, sizeof(uint64_t) * 2);
                 state[l][at] = 2;
             }
-        ev += atmos__beams_screen_band(&s[l], f, q->X, nx, y0, y1, band[l], state[l]);
+        ev += atmos__beams_screen_band(&s[l], f, q->X, nx, y0, y1, band[l], state[l], seen, shared);
     }
     const int last = j + 2 >= ny ? y1 : y1 - 1;
     for (int y = y0; y <= last; y++)
@@ -833,7 +887,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     screen_buf q = {malloc(sizeof(int) * (size_t)((W - 1) / k + 2)), malloc(sizeof(int) * (size_t)((H - 1) / k + 2)),
                     atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_OBJECT], sizeof(int) * n),
                     atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_DEPTH], sizeof(double) * n), NULL,
-                    atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_BASE], sizeof(float) * n * nw), NULL};
+                    atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_BASE], sizeof(float) * n * nw), NULL, NULL};
     int failed = !q.X || !q.Y || !q.obj || !q.T || !q.base, done = 0;
     const int nx = failed ? 0 : atmos__beams_screen_nodes(r->x0, r->x1, k, q.X);
     const int ny = failed ? 0 : atmos__beams_screen_nodes(r->y0, r->y1, k, q.Y), nb = ny > 1 ? ny - 1 : 1;
@@ -841,6 +895,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     const int nl = air_layers(J, a);
     const size_t layer = (size_t)nx * ny * nw; /* the nodes of a layer */
     if (!failed) failed = !(q.node = atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_NODE], sizeof(double) * nl * layer));
+    if (!failed) failed = !(q.seen = malloc(sizeof(uint64_t) * 2 * (size_t)nl * nx * ny));
     if (failed) {
         screen_buf_free(&q);
         return 1;
@@ -852,16 +907,18 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     for (int l = 0; l < nl; l++)
         s[l] = (atmos__beams_screen){*r, k, nw, SCREEN_SPREAD, SCREEN_CURVE, SCREEN_DEPTH, q.T, q.obj, q.base,
                                      SCREEN_HINT ? J->span : NULL, SCREEN_HINT ? J->b->nlights : 0, J->cam->height,
-                                     a[l].mask, !(a[l].sun && J->b->sun_on), SCREEN_WIDE, air_pixel, &a[l]};
-    long ev = 0;
-#pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev)
+                                     a[l].mask, !(a[l].sun && J->b->sun_on), SCREEN_WIDE,
+                                     a[l].shared >= 0 ? SCREEN_SHARE : 0, air_pixel, &a[l]};
+    long ev = 0, sh = 0;
+#pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev, sh)
     {
         const size_t bw = (size_t)W * (k + 1); /* a band's pixels */
         double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), *band = malloc(sizeof(double) * bw * nw * nl);
         unsigned char *state = malloc(bw * nl);
+        uint64_t *seen = malloc(sizeof(uint64_t) * 2 * bw); /* a layer's band at a time */
         atmos_mesh_hit *hits = malloc(sizeof *hits * (size_t)W);
         uint32_t *cones = malloc(sizeof *cones * (size_t)W);
-        const int ok = f && band && state && hits && cones;
+        const int ok = f && band && state && seen && hits && cones;
         double *const bands[2] = {band, band ? band + bw * nw : NULL};
         unsigned char *const states[2] = {state, state ? state + bw : NULL};
         if (!ok) {
@@ -880,28 +937,31 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
 #pragma omp for schedule(dynamic, 1)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx && ok && !any_failed && !atmos__cancelled(cancelled); i++)
-                for (int l = 0; l < nl; l++, ev++)
+                for (int l = 0; l < nl; l++, ev++) {
+                    const size_t node = l * (size_t)nx * ny + (size_t)j * nx + i;
                     air_pixel(&a[l], f, q.X[i], q.Y[j], q.T[(size_t)(q.Y[j] - r->y0) * W + (size_t)(q.X[i] - r->x0)],
-                              q.node + l * layer + ((size_t)j * nx + i) * nw);
+                              NULL, q.seen + 2 * node, q.node + node * nw);
+                }
 #pragma omp for schedule(dynamic, 1)
         for (int j = 0; j < nb; j++) {
             if (!ok || atmos__cancelled(cancelled)) continue;
-            ev += screen_band(s, nl, &q, nx, ny, j, f, bands, states, out);
+            ev += screen_band(s, nl, &q, nx, ny, j, f, bands, states, seen, &sh, out);
             atmos__progress_step(p->ctx, "render beams", &done, nb, cancelled);
         }
-        free(f), free(band), free(state), free(hits), free(cones);
+        free(f), free(band), free(state), free(seen), free(hits), free(cones);
     }
     if (!failed && J->cx >= r->x0 && J->cx < r->x1 && J->cy >= r->y0 && J->cy < r->y1) { /* the centre ray's counts */
         double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), A[ATMOS_MAX_WAVELENGTHS];
-        air_layer every = {J, ALL_LIGHTS, 1};
+        air_layer every = {J, ALL_LIGHTS, 1, -1};
+        uint64_t seen[2];
         J->centre_now = 1;
-        if (f) air_pixel(&every, f, J->cx, J->cy, q.T[(size_t)(J->cy - r->y0) * W + (size_t)(J->cx - r->x0)], A);
+        if (f) air_pixel(&every, f, J->cx, J->cy, q.T[(size_t)(J->cy - r->y0) * W + (size_t)(J->cx - r->x0)], NULL, seen, A);
         J->centre_now = 0;
         free(f);
     }
     J->dir = NULL;
     screen_buf_free(&q);
-    *evaluated = ev;
+    *evaluated = ev, p->beams->air_shared = sh;
     return failed;
 }
 
@@ -980,6 +1040,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         return st;
     }
     const int step = p->scene.beams.screen_step;
+    b->air_shared = 0; /* set by a subsampled frame */
     long evaluated = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
     if (!failed && step > 1 && !ilp) failed = subsampled(p, &J, r, out, step, &cancelled, &evaluated);
     else if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);

@@ -12,7 +12,8 @@ typedef struct band {
     int y0, w;       /* the band's first row, its width (the screen's) */
     double *out;
     unsigned char *state;
-    long evaluated;
+    uint64_t *seen; /* per pixel: what its evaluation saw (atmos__beams_air_fn), two masks */
+    long evaluated, shared;
 } band;
 
 static size_t at(const band *b, int x, int y) { return (size_t)(y - b->y0) * b->w + (size_t)(x - b->s->r.x0); }
@@ -29,14 +30,26 @@ int atmos__beams_screen_nodes(int a, int b, int k, int *X)
     return n;
 }
 
-/* Pixel (x, y) evaluated exactly, unless it was. */
-static void eval(band *b, int x, int y)
+/* Pixel (x, y) evaluated, unless it was; known (NULL: none): what the corners of the cell it
+ * lies in agree on (corners()). */
+static void eval(band *b, int x, int y, const uint64_t *known)
 {
     const size_t i = at(b, x, y);
     if (b->state[i] == 2) return;
     const atmos__beams_screen *s = b->s;
-    s->air(s->user, b->scratch, x, y, s->T[pix(s, x, y)], b->out + i * s->nw);
-    b->state[i] = 2, b->evaluated++;
+    s->air(s->user, b->scratch, x, y, s->T[pix(s, x, y)], known, b->seen + 2 * i, b->out + i * s->nw);
+    b->state[i] = 2, b->evaluated++, b->shared += known != NULL;
+}
+
+/* What the four corners of the cell [x0, x1] x [y0, y1] (evaluated) all saw, into known; NULL
+ * when the cell is too large to share it (s->share) or they agree on nothing. */
+static const uint64_t *corners(const band *b, int x0, int y0, int x1, int y1, uint64_t known[2])
+{
+    if (x1 - x0 > b->s->share || y1 - y0 > b->s->share) return NULL;
+    const uint64_t *c[4] = {b->seen + 2 * at(b, x0, y0), b->seen + 2 * at(b, x1, y0), b->seen + 2 * at(b, x0, y1),
+                            b->seen + 2 * at(b, x1, y1)};
+    for (int m = 0; m < 2; m++) known[m] = c[0][m] & c[1][m] & c[2][m] & c[3][m];
+    return known[0] | known[1] ? known : NULL;
 }
 
 /* Whether every pixel of [x0, x1] x [y0, y1] sees the same object at depths within the ratio
@@ -181,6 +194,8 @@ static void cell(band *b, int x0, int y0, int x1, int y1)
     const double *c[4] = {b->out + at(b, x0, y0) * nw, b->out + at(b, x1, y0) * nw, b->out + at(b, x0, y1) * nw,
                           b->out + at(b, x1, y1) * nw};
     const int px[3] = {x0, xm, x1}, py[3] = {y0, ym, y1};
+    uint64_t agreed[2];
+    const uint64_t *known = corners(b, x0, y0, x1, y1, agreed);
     if (s->bound && s->span && !touched(s, x0, y0, x1, y1)) { /* its corners 0, and every pixel */
         fill(b, x0, y0, x1, y1);
         return;
@@ -188,7 +203,7 @@ static void cell(band *b, int x0, int y0, int x1, int y1)
     const int cut = crossed(s, x0, y0, x1, y1);
     if (large) {
         for (int j = 0; j < 3; j++)
-            for (int i = 0; i < 3; i++) eval(b, px[i], py[j]);
+            for (int i = 0; i < 3; i++) eval(b, px[i], py[j], known);
         const int mx[5] = {xm, xm, xm, x0, x1}, my[5] = {ym, y0, y1, ym, ym}; /* the centre, the edges' midpoints */
         if (!cut && agree(b, c, x0, y0, x1, y1, mx, my, 5, 0.5 * s->curve)) {
             for (int j = 0; j < 2; j++)
@@ -196,13 +211,13 @@ static void cell(band *b, int x0, int y0, int x1, int y1)
             return;
         }
     } else {
-        if (big) eval(b, xm, ym);
+        if (big) eval(b, xm, ym, known);
         if (!cut && agree(b, c, x0, y0, x1, y1, &xm, &ym, big, s->curve)) {
             fill(b, x0, y0, x1, y1);
             return;
         }
         for (int j = 0; j < 3; j++)
-            for (int i = 0; i < 3; i++) eval(b, px[i], py[j]);
+            for (int i = 0; i < 3; i++) eval(b, px[i], py[j], known);
     }
     for (int j = 0; j < 2; j++)
         for (int i = 0; i < 2; i++)
@@ -210,10 +225,11 @@ static void cell(band *b, int x0, int y0, int x1, int y1)
 }
 
 long atmos__beams_screen_band(const atmos__beams_screen *s, double *scratch, const int *X, int nx, int y0, int y1,
-                              double *out, unsigned char *state)
+                              double *out, unsigned char *state, uint64_t *seen, long *shared)
 {
-    band b = {s, scratch, y0, s->r.x1 - s->r.x0, out, state, 0};
+    band b = {s, scratch, y0, s->r.x1 - s->r.x0, out, state, seen, 0, 0};
     for (int i = 0; i + 1 < nx; i++) cell(&b, X[i], y0, X[i + 1], y1);
     if (nx == 1 && y1 > y0) cell(&b, X[0], y0, X[0], y1); /* a single column */
+    *shared += b.shared;
     return b.evaluated;
 }

@@ -14,7 +14,9 @@
  * wide one cannot pass between the corners, and its edge leaves a tested point on each side
  * for the other tests to find (a row where the span ends counts as narrow). Where the airlight is
  * 0 outside the spans (no sun), a cell that no span touches is filled with its corners' zeros
- * without its tests (a dark cell across a silhouette is not cut). The surfaces' direct
+ * without its tests (a dark cell across a silhouette is not cut). Each evaluation hands back
+ * what it saw (two masks, the caller's meaning), and a pixel evaluated in a cut cell of at most
+ * `share` pixels is handed what all four of the cell's corners saw alike. The surfaces' direct
  * light stays per pixel (the caller's). Not part of the API. */
 #ifndef ATMOS_RENDER_BEAMS_SCREEN_H
 #define ATMOS_RENDER_BEAMS_SCREEN_H
@@ -28,8 +30,12 @@
 #define ATMOS__BEAMS_SCREEN_MAX_NW ATMOS_MAX_WAVELENGTHS
 
 /* The airlight of pixel (x, y), whose ray ends at depth T (INFINITY: none), into A[0 .. nw);
- * scratch is the calling thread's own buffer. */
-typedef void (*atmos__beams_air_fn)(void *user, double *scratch, int x, int y, double T, double *A);
+ * scratch is the calling thread's own buffer. known (NULL: none): what the corners of the cell
+ * being cut agree on (the caller's meaning: bit j of known[0] / known[1], the stretch j of a
+ * shared light's ray lit / dark in every corner), which the pixel may take rather than sample;
+ * seen: the pixel's own, for the cells it is a corner of. */
+typedef void (*atmos__beams_air_fn)(void *user, double *scratch, int x, int y, double T, const uint64_t *known,
+                                    uint64_t seen[2], double *A);
 
 typedef struct atmos__beams_screen {
     atmos__rect r;            /* the pixels */
@@ -50,6 +56,8 @@ typedef struct atmos__beams_screen {
                                * span touches is 0, filled without its tests */
     int wide;                 /* a span at least this many cells' widths wide in each of a cell's
                                * rows is not its hint there (0: every span) */
+    int share;                /* a cell at most this many pixels wide and tall hands its corners'
+                               * agreement (known) to the pixels evaluated in it (0: none) */
     atmos__beams_air_fn air;
     void *user;
 } atmos__beams_screen;
@@ -60,10 +68,11 @@ int atmos__beams_screen_nodes(int a, int b, int k, int *X);
 
 /* The airlight of a band of the image: the pixels [r.x0, r.x1) x [y0, y1] (y1 included) into
  * out (nw values a pixel, row by row over the band), of which the lattice's nodes on rows y0
- * and y1 (columns X[0 .. nx)) are given (state 2 there, 0 elsewhere); each cell between them
- * filled from left to right, state 1 where interpolated, 2 where evaluated. Returns the
- * pixels evaluated. */
+ * and y1 (columns X[0 .. nx)) are given (state 2 there, 0 elsewhere, and their seen masks in
+ * seen, two a pixel like out's values); each cell between them filled from left to right,
+ * state 1 where interpolated, 2 where evaluated. Returns the pixels evaluated, of which those
+ * handed their cell's corners' agreement (known) are added to *shared. */
 long atmos__beams_screen_band(const atmos__beams_screen *s, double *scratch, const int *X, int nx, int y0, int y1,
-                              double *out, unsigned char *state);
+                              double *out, unsigned char *state, uint64_t *seen, long *shared);
 
 #endif
