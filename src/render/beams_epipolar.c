@@ -55,9 +55,9 @@ static void clip(const double box[4], double ex, double ey, double c, double sn,
 /* Samples i0 .. i0 + cnt - 1 (cnt <= CHUNK) of the line from (ex, ey) along (c, sn), first at k0
  * texels: the depth of the map at each sample's look-up coordinates, the four nearest texels'
  * depths blended when all four hold an object, else the nearest texel's; INFINITY beside the
- * map. Three loops, vectorised in the AVX2 clone: the coordinates, weights and the four texels'
- * indices, the four texels' loads (hardware gathers with this file's tuning, CMakeLists.txt),
- * their blend or the nearest one (the same IEEE operations in the same order as one sample at a
+ * map. Three steps, vectorised in the AVX2 clone: the coordinates, weights and the four texels'
+ * indices; the loads, a loop for each of the four texels (hardware gathers with this file's
+ * tuning, CMakeLists.txt); their blend or the nearest one (the same IEEE operations in the same order as one sample at a
  * time, and ISO C contracts no products: the same bits). */
 #define CHUNK 128
 #if defined(__GNUC__) && !defined(__clang__)
