@@ -55,9 +55,10 @@ static void clip(const double box[4], double ex, double ey, double c, double sn,
 /* Samples i0 .. i0 + cnt - 1 (cnt <= CHUNK) of the line from (ex, ey) along (c, sn), first at k0
  * texels: the depth of the map at each sample's look-up coordinates, the four nearest texels'
  * depths blended when all four hold an object, else the nearest texel's; INFINITY beside the
- * map. Three loops, the first and the last vectorised in the AVX2 clone: the coordinates and
- * weights, the four texels' loads, their blend or the nearest one (the same IEEE operations in
- * the same order as one sample at a time, and ISO C contracts no products: the same bits). */
+ * map. Three steps, vectorised in the AVX2 clone: the coordinates, weights and the four texels'
+ * indices; the loads, a loop for each of the four texels (hardware gathers with this file's
+ * tuning, CMakeLists.txt); their blend or the nearest one (the same IEEE operations in the same order as one sample at a
+ * time, and ISO C contracts no products: the same bits). */
 #define CHUNK 128
 #if defined(__GNUC__) && !defined(__clang__)
 /* comparisons that cannot trap (no FP exception is enabled here): lets GCC if-convert the
@@ -71,7 +72,7 @@ ATMOS_CLONES_NOINLINE NO_TRAPS static void samples(const atmos__beams_sun *s, do
 {
     const int n = s->n;
     double ax[CHUNK], ay[CHUNK];
-    int xa[CHUNK], xb[CHUNK], ya[CHUNK], yb[CHUNK], in[CHUNK];
+    int at[4][CHUNK], in[CHUNK];
     float d[4][CHUNK];
 #pragma omp simd
     for (int i = 0; i < cnt; i++) {
@@ -80,13 +81,16 @@ ATMOS_CLONES_NOINLINE NO_TRAPS static void samples(const atmos__beams_sun *s, do
         const double fx = inside ? fx0 : 0, fy = inside ? fy0 : 0;
         const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1;
         ax[i] = fx - x0, ay[i] = fy - y0, in[i] = inside;
-        xa[i] = x0 < 0 ? 0 : x0, xb[i] = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
-        ya[i] = y0 < 0 ? 0 : y0, yb[i] = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
+        const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
+        const int ya = (y0 < 0 ? 0 : y0) * n, yb = (y0 + 1 > n - 1 ? n - 1 : y0 + 1) * n; /* n <= 8192 (shadow_size): n^2 < 2^31 */
+        at[0][i] = ya + xa, at[1][i] = ya + xb, at[2][i] = yb + xa, at[3][i] = yb + xb;
     }
-    const float *depth = s->depth;
-    for (int i = 0; i < cnt; i++) {
-        const float *ra = depth + (size_t)ya[i] * n, *rb = depth + (size_t)yb[i] * n;
-        d[0][i] = ra[xa[i]], d[1][i] = ra[xb[i]], d[2][i] = rb[xa[i]], d[3][i] = rb[xb[i]];
+    const float *restrict depth = s->depth;
+    for (int q = 0; q < 4; q++) {
+        const int *restrict a = at[q];
+        float *restrict dq = d[q];
+#pragma omp simd
+        for (int i = 0; i < cnt; i++) dq[i] = depth[a[i]];
     }
 #pragma omp simd
     for (int i = 0; i < cnt; i++) {
@@ -108,7 +112,14 @@ static void fill(atmos__beams_epi *e, const atmos__beams_sun *s, int j)
     for (int i = 0; i < cnt; i += CHUNK) samples(s, e->ex, e->ey, c, sn, k0, i, cnt - i < CHUNK ? cnt - i : CHUNK, m + i);
     const int nseg = cnt - 1;
     int c0 = (nseg + LEAF - 1) / LEAF;
-    for (int i = 0; i < c0; i++) {
+    const int whole = nseg / LEAF; /* the cells of LEAF segments each: unrolled, in the same order */
+    for (int i = 0; i < whole; i++) {
+        const float *mi = m + LEAF * i;
+        float lo = mi[0], hi = lo;
+        for (int k = 1; k <= LEAF; k++) lo = mi[k] < lo ? mi[k] : lo, hi = mi[k] > hi ? mi[k] : hi;
+        lh[2 * i] = lo, lh[2 * i + 1] = hi;
+    }
+    for (int i = whole; i < c0; i++) {
         float lo = m[LEAF * i], hi = lo;
         for (int k = LEAF * i + 1; k <= LEAF * (i + 1) && k <= nseg; k++) lo = m[k] < lo ? m[k] : lo, hi = m[k] > hi ? m[k] : hi;
         lh[2 * i] = lo, lh[2 * i + 1] = hi;

@@ -47,6 +47,13 @@ typedef struct tile {
     int *mm, *tri;
 } tile;
 
+/* The least and the greatest of three. Here atmos__mind / atmos__maxd stand for fmin / fmax,
+ * which are calls into the maths library: the same values, since no operand is a NaN (and a
+ * running bound's new value comes first, so that a NaN would be skipped as fmin skips it), and
+ * a zero's sign does not change the bounds' ceil, floor and comparisons. */
+#define MIN3(v) atmos__mind((v)[0], atmos__mind((v)[1], (v)[2]))
+#define MAX3(v) atmos__maxd((v)[0], atmos__maxd((v)[1], (v)[2]))
+
 static size_t at(const tile *T, int px, int py) { return (size_t)(py - T->y0) * (size_t)(T->x1 - T->x0) + (size_t)(px - T->x0); }
 
 /* A point's camera frame (x right, y up, z forward). */
@@ -69,11 +76,11 @@ static int setup(const tile *T, const double v[3][3], int tri, stri *s)
         s->iz[k] = 1.0 / v[k][2];
         to_pixel(T->cam, v[k], s->iz[k], &s->x[k], &s->y[k]);
     }
-    const double x0 = fmin(s->x[0], fmin(s->x[1], s->x[2])) - EDGE_PX, x1 = fmax(s->x[0], fmax(s->x[1], s->x[2])) + EDGE_PX;
-    const double y0 = fmin(s->y[0], fmin(s->y[1], s->y[2])) - EDGE_PX, y1 = fmax(s->y[0], fmax(s->y[1], s->y[2])) + EDGE_PX;
+    const double x0 = MIN3(s->x) - EDGE_PX, x1 = MAX3(s->x) + EDGE_PX;
+    const double y0 = MIN3(s->y) - EDGE_PX, y1 = MAX3(s->y) + EDGE_PX;
     /* the pixel centres (p + 0.5) within the box, clamped to the tile before the conversion */
-    const double bx0 = fmax(T->x0, ceil(x0 - 0.5)), bx1 = fmin(T->x1 - 1, floor(x1 - 0.5));
-    const double by0 = fmax(T->y0, ceil(y0 - 0.5)), by1 = fmin(T->y1 - 1, floor(y1 - 0.5));
+    const double bx0 = atmos__maxd(ceil(x0 - 0.5), T->x0), bx1 = atmos__mind(floor(x1 - 0.5), T->x1 - 1);
+    const double by0 = atmos__maxd(ceil(y0 - 0.5), T->y0), by1 = atmos__mind(floor(y1 - 0.5), T->y1 - 1);
     if (!(bx0 <= bx1 && by0 <= by1)) return 0;
     s->px0 = (int)bx0, s->px1 = (int)bx1, s->py0 = (int)by0, s->py1 = (int)by1, s->mesh = T->mesh, s->tri = tri;
     return 1;
@@ -117,7 +124,7 @@ static void draw(tile *T, const stri *s)
 {
     const double *x = s->x, *y = s->y;
     const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
-    const double znear = 1.0 / fmax(s->iz[0], fmax(s->iz[1], s->iz[2]));
+    const double znear = 1.0 / MAX3(s->iz);
     double len[3];
     for (int k = 0; k < 3; k++) {
         const double ex = x[(k + 2) % 3] - x[(k + 1) % 3], ey = y[(k + 2) % 3] - y[(k + 1) % 3];
@@ -146,7 +153,7 @@ static void draw(tile *T, const stri *s)
             if (dmin < -EDGE_PX) continue;
             const double z = 1.0 / ((e[0] * s->iz[0] + e[1] * s->iz[1] + e[2] * s->iz[2]) * inv);
             if (dmin >= EDGE_PX) cover(T, at(T, px, py), z, s);
-            else rival(T, at(T, px, py), fmax(z, znear));
+            else rival(T, at(T, px, py), atmos__maxd(z, znear));
         }
     }
 }
@@ -192,19 +199,19 @@ static int enter(void *user, const float lo[3], const float hi[3])
         const double p[3] = {(k & 1 ? hi : lo)[0], (k & 2 ? hi : lo)[1], (k & 4 ? hi : lo)[2]};
         double v[3], x, y;
         view(T->cam, p, v);
-        zmin = fmin(zmin, v[2]);
+        zmin = atmos__mind(v[2], zmin);
         if (v[2] < NEAR_M) {
             behind++;
             continue;
         }
         to_pixel(T->cam, v, 1.0 / v[2], &x, &y);
-        xa = fmin(xa, x), xb = fmax(xb, x), ya = fmin(ya, y), yb = fmax(yb, y);
+        xa = atmos__mind(x, xa), xb = atmos__maxd(x, xb), ya = atmos__mind(y, ya), yb = atmos__maxd(y, yb);
     }
     if (behind == 8) return 0;
     int px0 = T->x0, px1 = T->x1 - 1, py0 = T->y0, py1 = T->y1 - 1;
     if (!behind) { /* the box's projection is the hull of its corners'; a pixel of slack */
-        const double bx0 = fmax(T->x0, ceil(xa - 1.5)), bx1 = fmin(T->x1 - 1, floor(xb + 0.5));
-        const double by0 = fmax(T->y0, ceil(ya - 1.5)), by1 = fmin(T->y1 - 1, floor(yb + 0.5));
+        const double bx0 = atmos__maxd(ceil(xa - 1.5), T->x0), bx1 = atmos__mind(floor(xb + 0.5), T->x1 - 1);
+        const double by0 = atmos__maxd(ceil(ya - 1.5), T->y0), by1 = atmos__mind(floor(yb + 0.5), T->y1 - 1);
         if (!(bx0 <= bx1 && by0 <= by1)) return 0;
         px0 = (int)bx0, px1 = (int)bx1, py0 = (int)by0, py1 = (int)by1;
     }

@@ -709,11 +709,14 @@ typedef struct screen_buf {
     uint64_t *seen;   /* per layer and node: what its evaluation saw (two masks, air_pixel) */
 } screen_buf;
 
+/* The first pass's helpers, inlined into each clone of surface_row (its AVX2 clone's loops). */
+#define FIRST_PASS static inline __attribute__((always_inline))
+
 /* Subsampling's first pass for a surface that no light reaches (no cones): the sky's light and
  * the sun's, dimmed by the fog to the eye, into B in one loop a pixel (the same operations in
  * the same order as shade_surface, base_light and sun_surface one after the other: the same bits). */
-static void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, float *B,
-                          atmos__beams_sky_memo *memo)
+FIRST_PASS void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, float *B,
+                              atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
     double E[ATMOS_MAX_WAVELENGTHS], c = 0, in = 0;
@@ -737,8 +740,8 @@ static void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit 
 
 /* Subsampling's first pass, pixel (x, y) seeing h of object obj along the eye's ray d (-1: the
  * sky behind, bg), lit by the lights in cones (row_cones): its light without the airlight into B. */
-static void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
-                          uint32_t cones, const float *bg, float *B, atmos__beams_sky_memo *memo)
+FIRST_PASS void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
+                              uint32_t cones, const float *bg, float *B, atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
     double L[ATMOS_MAX_WAVELENGTHS];
@@ -759,9 +762,10 @@ static void surface_light(const job *J, int x, int y, const double d[3], const a
 
 /* Subsampling's first pass over row y (its rays made when kept): what each pixel sees (into T,
  * obj and hits), the lights that may reach it (cones: a row at a time where the rays are kept),
- * its light without the airlight (into base). */
-static void surface_row(const job *J, const atmos__rect *r, int y, const screen_buf *q, atmos_mesh_hit *hits,
-                        uint32_t *cones, atmos_image *out)
+ * its light without the airlight (into base). Its wavelengths' loops (unlit_surface's, the sky
+ * behind's) in vectors of four in the AVX2 clone: the same operations lane by lane, the same bits. */
+ATMOS_CLONES static void surface_row(const job *J, const atmos__rect *r, int y, const screen_buf *q,
+                                     atmos_mesh_hit *hits, uint32_t *cones, atmos_image *out)
 {
     const int W = r->x1 - r->x0;
     const size_t n = (size_t)W * (size_t)(r->y1 - r->y0), row = (size_t)(y - r->y0) * W;

@@ -115,6 +115,33 @@ static int fence(atmos_mesh *post[10], atmos__beams_sun *s, const double sun[3])
     return s->n == 256;
 }
 
+/* Each line's tree: a cell of the finest level holds the least and the greatest of its 4
+ * segments' samples (the line's last cell fewer), a cell above those of the one or two cells
+ * below it; lines of every length mod 4 are among them. */
+static void test_trees(const atmos__beams_epi *e)
+{
+    int bad = 0, mods = 0;
+    for (int j = 0; j < e->lines; j++) {
+        const int nseg = e->cnt[j] - 1;
+        if (nseg <= 0) continue;
+        mods |= 1 << (nseg % 4);
+        const float *m = e->m + e->at[j], *lh = e->lh + 2 * e->tat[j];
+        int c = (nseg + 3) / 4;
+        for (int i = 0; i < c; i++) {
+            float lo = INFINITY, hi = -INFINITY;
+            for (int k = 4 * i; k <= 4 * i + 4 && k <= nseg; k++) lo = fminf(lo, m[k]), hi = fmaxf(hi, m[k]);
+            bad += lh[2 * i] != lo || lh[2 * i + 1] != hi;
+        }
+        for (; c > 1; lh += 2 * c, c = (c + 1) / 2)
+            for (int i = 0; 2 * i < c; i++) {
+                const float *a = lh + 4 * i, *b = 2 * i + 1 < c ? a + 2 : a, *up = lh + 2 * c + 2 * i;
+                bad += up[0] != fminf(a[0], b[0]) || up[1] != fmaxf(a[1], b[1]);
+            }
+    }
+    CHECK_MSG(bad == 0, "%d cells of the lines' trees not the least and greatest below them", bad);
+    CHECK_MSG(mods == 15, "lines of lengths %#x mod 4 only", (unsigned)mods);
+}
+
 static void test_lit_length(const atmos__beams_sun *s, const atmos__beams_epi *e, const double eye[3])
 {
     int rays = 0, shadowed = 0, fails = 0, off_fails = 0, samples = 0, samples_off = 0, sampled = 0;
@@ -199,6 +226,7 @@ int main(void)
         CHECK(atmos__beams_epi_build(&e, &s, eye, (size_t)1 << 24, 2) == 0);
         CHECK(e.lines > 0);
         if (e.lines > 0) {
+            test_trees(&e);
             test_lit_length(&s, &e, eye);
             test_airlight(&s, &e, eye);
         }
