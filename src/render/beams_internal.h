@@ -163,6 +163,7 @@ struct atmos__beams_plan {
      * and in each of a frame's two layers, the spots' and the other lights', when it has both) */
     long air_pixels, air_evaluated;
     long air_shared; /* of the evaluated, those handed their cell's corners' agreement (beams_screen.h) */
+    long air_unread; /* the stretches of their rays taken within a run of agreed ones, no W looked up */
     /* a frame's per-pixel buffers, kept for the next frame (beams_kept.h): the primary
      * visibility's two, then the subsampled frame's (beams_render.c) */
     atmos__beams_kept kept[ATMOS__BEAMS_KEPT_COUNT];

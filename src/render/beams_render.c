@@ -264,11 +264,26 @@ static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum[k < 3 ? k : 2];
 }
 
-/* Light i's intervals along [0, T) of the ray d between the planes crossing it: f[2k] where
- * interval k starts, f[2k + 1] its f_l (an unshadowed light of unit intensity), f[2n] where the
- * last ends (f holds room for 2 MAX_INTERVALS + 1 values). Returns n (0: none), *sum the sum of
- * the f_l. */
-static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre)
+/* A subsampled frame's point light whose rays share what the corners of a cut cell saw
+ * (beams_screen.h's known): per stretch j of a ray between its planes j and j + 1 (j < 64),
+ * bit j of known[0] where every corner's was lit all along, of known[1] where dark; seen, the
+ * ray's own, for the cells it is a corner of (the stretches whole between two planes). */
+typedef struct shared_ray {
+    int light;             /* the light (-1: none) */
+    const uint64_t *known; /* NULL: nothing agreed */
+    uint64_t *seen;
+    double *unread; /* the count of stretches that a run took without their W looked up */
+} shared_ray;
+
+/* Light i's part of the ray d within its reach and before T: [t0, t1), the table's column, the
+ * factor of its W differences and the ray's nearest point to the light tQ at distance v.
+ * Returns 0 where the ray misses it. */
+typedef struct reach_part {
+    double t0, t1, tQ, v, scale, cosf;
+    atmos__beams_column col;
+} reach_part;
+
+static int reach_part_of(const job *J, int i, const double d[3], double T, reach_part *r)
 {
     const atmos__beams_plan *b = J->b;
     const atmos__beams_light *l = &b->lights[i];
@@ -277,30 +292,120 @@ static int intervals(job *J, int i, const double d[3], double T, double *f, doub
     const double tQ = atmos__dot3(Lp, d);
     const double q[3] = {Lp[0] - tQ * d[0], Lp[1] - tQ * d[1], Lp[2] - tQ * d[2]};
     const double v = atmos__maxd(sqrt(atmos__dot3(q, q)), 1e-6 * R);
-    *sum = 0;
     if (v >= R) return 0;
     const double hh = sqrt(R * R - v * v);
-    double t0 = atmos__maxd(0, tQ - hh), t1 = atmos__mind(T, tQ + hh);
-    if (!(t0 < t1) || !atmos__lamp_clip(&l->L, J->eye, d, &t0, &t1)) return 0;
-    atmos__beams_column col;
-    atmos__beams_table_column(&b->table, sig * v, &col);
-    const double scale = exp(-sig * tQ) / v, cosf = atmos__dot3(d, J->fwd), dz = J->dz[i], zl = J->z_lo[i];
+    r->t0 = atmos__maxd(0, tQ - hh), r->t1 = atmos__mind(T, tQ + hh);
+    if (!(r->t0 < r->t1) || !atmos__lamp_clip(&l->L, J->eye, d, &r->t0, &r->t1)) return 0;
+    atmos__beams_table_column(&b->table, sig * v, &r->col);
+    r->tQ = tQ, r->v = v, r->scale = exp(-sig * tQ) / v, r->cosf = atmos__dot3(d, J->fwd);
+    return 1;
+}
+
+/* W (the table's) at t along the part r. */
+static inline double W_at(const job *J, const reach_part *r, double t)
+{
+    return atmos__beams_table_at(&J->b->table, &r->col, atmos__beams_table_s(t - r->tQ, r->v));
+}
+
+/* The bit of the stretch of [a, e) between two of light i's planes (0: past the 64th). */
+static uint64_t stretch_bit(const job *J, int i, double a, double e, double cosf)
+{
+    const double j = floor((0.5 * (a + e) * cosf - J->z_lo[i]) / J->dz[i]);
+    return j >= 0 && j < 64 ? (uint64_t)1 << (int)j : 0;
+}
+
+/* The run of stretches from stretch b on (its bit set in m) whose bits are all set in m, up to
+ * where the part r ends: its end *e, the stretches it crosses, returned (at least 1). */
+static int agreed_run(const job *J, int i, const reach_part *r, long b, uint64_t m, double *e)
+{
+    const uint64_t rest = ~(m >> b);
+    const int len = rest ? __builtin_ctzll(rest) : 64 - (int)b;
+    const double zl = J->z_lo[i], dz = J->dz[i], plane = (zl + (double)(b + len) * dz) / r->cosf;
+    if (plane < r->t1) {
+        *e = plane;
+        return len;
+    }
+    *e = r->t1;
+    const long last = (long)floor((r->t1 * r->cosf - zl) / dz);
+    return last < b ? 1 : last - b + 1 < len ? (int)(last - b + 1) : len;
+}
+
+/* intervals() with sh->known: a run of stretches that the corners all saw lit or all dark is one
+ * interval of f_l -1 (its W looked up at its end alone), the lit runs' f_l summed into f[2n + 1]
+ * and their bits into sh->seen. The stretch between the planes j - 1 and j is bit j - 1. */
+static int agreed_intervals(job *J, int i, const reach_part *r, double *f, double *sum, const shared_ray *sh)
+{
+    const double t1 = r->t1, cosf = r->cosf, dz = J->dz[i], zl = J->z_lo[i], W0 = W_at(J, r, r->t0);
+    const uint64_t kl = sh->known[0], kd = sh->known[1];
+    double a = r->t0, Wa = W0, S = 0, lit = 0;
+    long j = (long)floor((a * cosf - zl) / dz) + 1;
+    int n = 0, c = 0;
+    while (a < t1) {
+        const long b = j - 1;
+        const uint64_t bit = b >= 0 && b < 64 && c < MAX_INTERVALS - 65 ? (uint64_t)1 << b : 0;
+        if (bit & (kl | kd)) { /* a run the corners agree on */
+            double e;
+            const int len = agreed_run(J, i, r, b, bit & kl ? kl : kd, &e);
+            const double We = W_at(J, r, e);
+            if (bit & kl) lit += atmos__maxd(0, We - Wa) * r->scale;
+            sh->seen[bit & kl ? 0 : 1] |= (len >= 64 ? ~(uint64_t)0 : ((uint64_t)1 << len) - 1) << b;
+            *sh->unread += len - 1;
+            f[2 * n] = a, f[2 * n + 1] = -1, n++;
+            a = e, Wa = We, j += len, c += len;
+            continue;
+        }
+        double e = c == MAX_INTERVALS - 1 ? t1 : atmos__mind(t1, (zl + j * dz) / cosf);
+        if (e <= a) e = atmos__mind(t1, a + 1e-9 * (1 + a)); /* a plane at a itself */
+        const double We = W_at(J, r, e);
+        f[2 * n] = a, f[2 * n + 1] = atmos__maxd(0, We - Wa) * r->scale;
+        a = e, Wa = We, j++, n++, c++;
+    }
+    f[2 * n] = t1, f[2 * n + 1] = lit;
+    *sum = S = atmos__maxd(0, Wa - W0) * r->scale; /* what the f_l add up to */
+    return S > 0 ? n : 0;
+}
+
+/* Light i's intervals along [0, T) of the ray d between the planes crossing it: f[2k] where
+ * interval k starts, f[2k + 1] its f_l (an unshadowed light of unit intensity), f[2n] where the
+ * last ends (f holds room for 2 MAX_INTERVALS + 2 values). Returns n (0: none), *sum the sum of
+ * the f_l. With sh (its known not NULL), agreed_intervals(): *sum is then the W difference over
+ * the whole part, and f[2n + 1] the lit runs' f_l. */
+static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre,
+                     const shared_ray *sh)
+{
+    reach_part r;
+    *sum = 0;
+    if (!reach_part_of(J, i, d, T, &r)) return 0;
+    if (sh && sh->known && (sh->known[0] | sh->known[1])) return agreed_intervals(J, i, &r, f, sum, sh);
+    const double t1 = r.t1, cosf = r.cosf, dz = J->dz[i], zl = J->z_lo[i];
     /* the intervals between the planes crossing [t0, t1], and their f_l */
-    double a = t0, Wa = atmos__beams_table_at(&b->table, &col, atmos__beams_table_s(t0 - tQ, v)), S = 0;
-    long j = (long)floor((t0 * cosf - zl) / dz) + 1;
+    double a = r.t0, Wa = W_at(J, &r, a), S = 0;
+    long j = (long)floor((a * cosf - zl) / dz) + 1;
     int n = 0;
     while (a < t1) {
         double e = n == MAX_INTERVALS - 1 ? t1 : atmos__mind(t1, (zl + j * dz) / cosf);
         if (e <= a) e = atmos__mind(t1, a + 1e-9 * (1 + a)); /* a plane at a itself */
-        const double We = atmos__beams_table_at(&b->table, &col, atmos__beams_table_s(e - tQ, v));
-        f[2 * n] = a, f[2 * n + 1] = atmos__maxd(0, We - Wa) * scale;
+        const double We = W_at(J, &r, e);
+        f[2 * n] = a, f[2 * n + 1] = atmos__maxd(0, We - Wa) * r.scale;
         S += f[2 * n + 1];
         a = e, Wa = We, j++, n++;
     }
-    f[2 * n] = t1;
+    f[2 * n] = t1, f[2 * n + 1] = 0;
     if (centre) J->centre_planes += n;
     *sum = S;
     return S > 0 ? n : 0;
+}
+
+/* The sum of light i's f_l along [0, T) of the ray d (intervals()'s *sum, from the W of the
+ * part's two ends), for the criterion's weights of a light not evaluated here: 1 when it adds. */
+static int interval_sum(job *J, int i, const double d[3], double T, double *f, double *sum, int centre)
+{
+    if (centre) return intervals(J, i, d, T, f, sum, centre, NULL) > 0; /* its planes counted */
+    reach_part r;
+    *sum = 0;
+    if (!reach_part_of(J, i, d, T, &r)) return 0;
+    *sum = atmos__maxd(0, W_at(J, &r, r.t1) - W_at(J, &r, r.t0)) * r.scale;
+    return *sum > 0;
 }
 
 /* Interval k of the intervals f (its f_l > 0) scattered toward the eye, added to *sum: ceil(f_l /
@@ -334,39 +439,20 @@ static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k,
     return h == 0 ? 0 : h == m && !uniform && ray->l->L.type == ATMOS_LIGHT_POINT ? 1 : -1;
 }
 
-/* A subsampled frame's point light whose rays share what the corners of a cut cell saw
- * (beams_screen.h's known): per stretch j of a ray between its planes j and j + 1 (j < 64),
- * bit j of known[0] where every corner's was lit all along, of known[1] where dark; seen, the
- * ray's own, for the cells it is a corner of (the stretches whole between two planes). */
-typedef struct shared_ray {
-    int light;             /* the light (-1: none) */
-    const uint64_t *known; /* NULL: nothing agreed */
-    uint64_t *seen;
-} shared_ray;
-
-/* Interval k of n of the shared light i (interval()'s), taken from the corners where they agree
- * on its stretch (the planes are the same for every pixel: a pixel's stretch between two planes
- * lies within the hull of its cell's corners' stretches there), else sampled. */
+/* Interval k of n of the shared light i (interval()'s) sampled, what it saw kept in sh->seen
+ * (the stretches the corners agree on are taken by intervals() already: the planes are the same
+ * for every pixel, and a pixel's stretch between two planes lies within the hull of its cell's
+ * corners' stretches there). */
 static void shared_interval(job *J, int i, const atmos__beams_ray *ray, const double *f, int k, int n, double unit,
                             double *sum, int centre, double o, double cosf, const shared_ray *sh)
 {
-    const double j = floor((0.5 * (f[2 * k] + f[2 * k + 2]) * cosf - J->z_lo[i]) / J->dz[i]);
-    const uint64_t bit = j >= 0 && j < 64 ? (uint64_t)1 << (int)j : 0;
-    if (sh->known && bit & sh->known[0]) {
-        *sum += f[2 * k + 1], sh->seen[0] |= bit;
-        return;
-    }
-    if (sh->known && bit & sh->known[1]) {
-        sh->seen[1] |= bit;
-        return;
-    }
     const int lit = interval(J, ray, f, k, unit, sum, centre, o);
     if (k == 0 || k == n - 1 || lit < 0) return; /* a stretch cut by the reach or the surface tells nothing */
-    sh->seen[lit ? 0 : 1] |= bit;
+    sh->seen[lit ? 0 : 1] |= stretch_bit(J, i, f[2 * k], f[2 * k + 2], cosf);
 }
 
 /* A point light's intervals from k on (the first's f_l below POINT_MERGE unit) while their f_l
- * sum stays below POINT_MERGE unit, added to *sum as one sample: the visibility at the point
+ * sum stays below POINT_MERGE unit (up to a run the corners agreed on, f_l -1), added to *sum as one sample: the visibility at the point
  * where the sum reaches o of itself (interpolated within its interval) times the sum. A sample
  * so carries at most POINT_MERGE epsilon of the pixel's airlight, where a sub-plane carries up to
  * epsilon (docs/beams.md, *Eleventh round*). Returns the interval after the last taken. */
@@ -375,7 +461,7 @@ static int merged(job *J, const atmos__beams_ray *ray, const double *f, int k, i
 {
     double acc = 0;
     int e = k;
-    while (e < n && acc + f[2 * e + 1] < POINT_MERGE * unit) acc += f[2 * e + 1], e++;
+    while (e < n && f[2 * e + 1] >= 0 && acc + f[2 * e + 1] < POINT_MERGE * unit) acc += f[2 * e + 1], e++;
     double c = o * acc, t = f[2 * e];
     for (int q = k; q < e; q++) {
         if (c <= f[2 * q + 1]) {
@@ -407,7 +493,7 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         tinted(J, l, &ray, d, f, n, unit, L, centre, o);
         return;
     }
-    double sum = 0;
+    double sum = f[2 * n + 1]; /* the lit runs the corners agreed on (else 0) */
     const double cosf = atmos__dot3(d, J->fwd);
     for (int k = 0; k < n;)
         if (!(f[2 * k + 1] > 0))
@@ -463,9 +549,12 @@ static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, i
     sun_air(J, d, T, L);
 }
 
-/* The doubles of a thread's buffer for lights(): each light's intervals, then their sums and counts. */
+/* The doubles of a thread's buffer for lights(): each light's intervals, then their sums and counts, then
+ * the thread's count of unread stretches. */
 #define LIGHT_STRIDE (2 * MAX_INTERVALS + 2)
-static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights : 1) * (LIGHT_STRIDE + 2); }
+static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights : 1) * (LIGHT_STRIDE + 2) + 1; }
+/* The last double of a thread's buffer: its count of stretches unread (shared_ray's). */
+static double *unread_count(double *f, int nlights) { return f + buffer_size(nlights) - 1; }
 
 /* Every light's airlight along [0, T) of the ray d through pixel (x, y) (the lights whose span
  * holds it), added to L, with Dobashi's criterion over all the lights of the pixel (§4.2.2): an
@@ -481,7 +570,10 @@ static void lights(job *J, int x, int y, const double d[3], double T, double *f,
     for (int pass = 0; pass < 2; pass++) { /* the lights of mask, then (if any of them adds) the others */
         for (int i = 0; i < nl; i++)
             if ((mask >> i & 1) == !pass) {
-                cnt[i] = in_span(J, i, x, y) ? intervals(J, i, d, T, f + (size_t)i * LIGHT_STRIDE, &S[i], centre) : 0;
+                double *fi = f + (size_t)i * LIGHT_STRIDE;
+                cnt[i] = !in_span(J, i, x, y) ? 0
+                         : pass ? interval_sum(J, i, d, T, fi, &S[i], centre) /* its weight alone */
+                                : intervals(J, i, d, T, fi, &S[i], centre, sh && sh->light == i ? sh : NULL);
                 any |= cnt[i] > 0;
             }
         if (!any) return;
@@ -802,7 +894,7 @@ static void air_pixel(void *user, double *f, int x, int y, double T, const uint6
     const air_layer *a = user;
     job *J = a->J;
     double d[3];
-    const shared_ray sh = {a->shared, known, seen};
+    const shared_ray sh = {a->shared, known, seen, unread_count(f, J->b->nlights)};
     kept_ray(J, x, y, d);
     for (int k = 0; k < J->nw; k++) A[k] = 0;
     seen[0] = seen[1] = 0;
@@ -913,8 +1005,8 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
                                      SCREEN_HINT ? J->span : NULL, SCREEN_HINT ? J->b->nlights : 0, J->cam->height,
                                      a[l].mask, !(a[l].sun && J->b->sun_on), SCREEN_WIDE,
                                      a[l].shared >= 0 ? SCREEN_SHARE : 0, air_pixel, &a[l]};
-    long ev = 0, sh = 0;
-#pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev, sh)
+    long ev = 0, sh = 0, un = 0;
+#pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev, sh, un)
     {
         const size_t bw = (size_t)W * (k + 1); /* a band's pixels */
         double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), *band = malloc(sizeof(double) * bw * nw * nl);
@@ -923,6 +1015,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
         atmos_mesh_hit *hits = malloc(sizeof *hits * (size_t)W);
         uint32_t *cones = malloc(sizeof *cones * (size_t)W);
         const int ok = f && band && state && seen && hits && cones;
+        if (f) *unread_count(f, J->b->nlights) = 0;
         double *const bands[2] = {band, band ? band + bw * nw : NULL};
         unsigned char *const states[2] = {state, state ? state + bw : NULL};
         if (!ok) {
@@ -952,6 +1045,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
             ev += screen_band(s, nl, &q, nx, ny, j, f, bands, states, seen, &sh, out);
             atmos__progress_step(p->ctx, "render beams", &done, nb, cancelled);
         }
+        if (f) un += (long)*unread_count(f, J->b->nlights);
         free(f), free(band), free(state), free(seen), free(hits), free(cones);
     }
     if (!failed && J->cx >= r->x0 && J->cx < r->x1 && J->cy >= r->y0 && J->cy < r->y1) { /* the centre ray's counts */
@@ -965,7 +1059,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     }
     J->dir = NULL;
     screen_buf_free(&q);
-    *evaluated = ev, p->beams->air_shared = sh;
+    *evaluated = ev, p->beams->air_shared = sh, p->beams->air_unread = un;
     return failed;
 }
 
@@ -1044,7 +1138,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         return st;
     }
     const int step = p->scene.beams.screen_step;
-    b->air_shared = 0; /* set by a subsampled frame */
+    b->air_shared = b->air_unread = 0; /* set by a subsampled frame */
     long evaluated = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
     if (!failed && step > 1 && !ilp) failed = subsampled(p, &J, r, out, step, &cancelled, &evaluated);
     else if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);
