@@ -236,6 +236,14 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
     return fog_t;
 }
 
+/* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
+ * the scene's max_subplanes. */
+static int subplanes(const job *J, double fl, double unit)
+{
+    const double need = ceil(fl / unit);
+    return need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+}
+
 /* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
  * image's tint at every sample (atmos__beams_ray_tinted_sum: where it is one colour along a run
  * of them, that colour times the light's sum), so no interval is taken as uniform by its f_l
@@ -248,11 +256,13 @@ static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
         if (fl <= 0) continue;
-        const double need = ceil(fl / unit);
-        const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+        if (!some || f[2 * k + 2] < p0 || f[2 * k] > p1) { /* black all along: counted, not sampled */
+            if (centre) J->centre_subplanes += subplanes(J, fl, unit);
+            continue;
+        }
+        const int m = subplanes(J, fl, unit);
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
         if (centre) J->centre_subplanes += m;
-        if (!some || f[2 * k + 2] < p0 || ta > p1) continue;
         /* the samples within [p0, p1], and one more each side for the rounding */
         const double a = ceil((p0 - ta) / step - o) - 1, b = floor((p1 - ta) / step - o) + 2;
         const int s0 = a > 0 ? (int)a : 0, s1 = b < m ? (int)b : m;
@@ -308,8 +318,7 @@ static void interval(job *J, const atmos__beams_ray *ray, const double *f, int k
                      double o)
 {
     const double fl = f[2 * k + 1];
-    const double need = ceil(fl / unit);
-    const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+    const int m = subplanes(J, fl, unit);
     const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
     double h = 0, same = 0;
     int full = 0;
