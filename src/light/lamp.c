@@ -79,15 +79,13 @@ double atmos__lamp_toward(const atmos__lamp *l, const double p[3], int m, const 
 
 static double srgb_linear(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
 
-static const float *texel(const atmos__lamp *l, int x, int y) { return atmos__lamp_texel(l, x, y); }
-
 /* The box of the image's texels that are not black (atmos__lamp's box). */
 static void lit_box(atmos__lamp *l)
 {
     int x0 = l->tw, x1 = -1, y0 = l->th, y1 = -1;
     for (int y = 0; y < l->th; y++)
         for (int x = 0; x < l->tw; x++) {
-            const float *t = texel(l, x, y);
+            const float *t = atmos__lamp_texel(l, x, y);
             if (t[0] != 0 || t[1] != 0 || t[2] != 0)
                 x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1, y0 = y < y0 ? y : y0, y1 = y > y1 ? y : y1;
         }
@@ -108,7 +106,7 @@ static void edge_sums(const atmos__lamp *l, int dx, int dy, int *S)
         for (int x = 0; x < l->tw; x++) {
             int e = 0;
             if (x + dx < l->tw && y + dy < l->th) {
-                const float *a = texel(l, x, y), *b = texel(l, x + dx, y + dy);
+                const float *a = atmos__lamp_texel(l, x, y), *b = atmos__lamp_texel(l, x + dx, y + dy);
                 e = a[0] != b[0] || a[1] != b[1] || a[2] != b[2];
             }
             S[(y + 1) * W + x + 1] = e + S[y * W + x + 1] + S[(y + 1) * W + x] - S[y * W + x];
@@ -202,7 +200,7 @@ int atmos__lamp_tint_same(const atmos__lamp *l, double fx0, double fx1, double f
     const int ca = x0 < 0 ? 0 : x0, cb = x1 >= l->tw ? l->tw - 1 : x1, ra = y0 < 0 ? 0 : y0, rb = y1 >= l->th ? l->th - 1 : y1;
     const int cells = (l->tw + 1) * (l->th + 1);
     if (edges_in(l, l->edges, ca, cb - 1, ra, rb) || edges_in(l, l->edges + cells, ca, cb, ra, rb - 1)) return 0;
-    const float *t = texel(l, ca, ra);
+    const float *t = atmos__lamp_texel(l, ca, ra);
     for (int c = 0; c < 3; c++) rgb[c] = t[c];
     return 1;
 }

@@ -265,7 +265,7 @@ static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *
         if (centre) J->centre_subplanes += m;
         /* the samples within [p0, p1], and one more each side for the rounding */
         const double a = ceil((p0 - ta) / step - o) - 1, b = floor((p1 - ta) / step - o) + 2;
-        const int s0 = a > 0 ? (int)a : 0, s1 = b < m ? (int)b : m;
+        const int s0 = a > 0 ? (a < m ? (int)a : m) : 0, s1 = b < m ? (b > 0 ? (int)b : 0) : m;
         double h[3] = {0, 0, 0};
         atmos__beams_ray_tinted_sum(ray, ta, step, o, s0, s1, h);
         for (int c = 0; c < 3; c++) sum[c] += h[c] / m * fl;
