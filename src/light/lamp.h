@@ -89,7 +89,8 @@ static inline void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double f
     const int x0 = (int)floor(fx), y0 = (int)floor(fy); /* in [-1, tw - 1], [-1, th - 1] */
     const double ax = fx - x0, ay = fy - y0;
     const double w00 = (1 - ax) * (1 - ay), w01 = ax * (1 - ay), w10 = (1 - ax) * ay, w11 = ax * ay;
-    const float *t00 = atmos__lamp_texel(l, x0, y0), *t10 = atmos__lamp_texel(l, x0, y0 + 1); /* the border: the clamped edge */
+    /* the border stands for the clamped edge */
+    const float *t00 = atmos__lamp_texel(l, x0, y0), *t10 = atmos__lamp_texel(l, x0, y0 + 1);
     for (int c = 0; c < 3; c++) {
         double v = 0;
         v += w00 * t00[c], v += w01 * t00[c + 3], v += w10 * t10[c], v += w11 * t10[c + 3];

@@ -9,20 +9,19 @@
 
 #include <math.h>
 
-#ifndef TEST_MIN
-#define TEST_MIN 4
-#endif
-
 /* What the runs know of atmos__beams_ray_light along them. */
 enum { LIGHT_UNKNOWN, LIGHT_FULL /* 1 all along */, LIGHT_FALLOFF /* H = 1: the falloff alone */ };
 
-/* The texel coordinates of the image toward the ray's point at t; 0 behind the light. */
-static int coords(const atmos__beams_ray *r, double t, double *fx, double *fy)
+/* The texel coordinates of the image toward the ray's point at t; 0 behind the light (inlined:
+ * a call cost 1.7 % of a frame's instructions). */
+static inline __attribute__((always_inline)) int coords(const atmos__beams_ray *r, double t, double *fx,
+                                                        double *fy)
 {
     const double z = r->a0 + t * r->a1;
     if (!(z > 0)) return 0;
     const double iz = 1 / z;
-    *fx = (r->u0 + t * r->u1) * iz + (0.5 * r->l->L.tw - 0.5), *fy = (r->v0 + t * r->v1) * iz + (0.5 * r->l->L.th - 0.5);
+    *fx = (r->u0 + t * r->u1) * iz + (0.5 * r->l->L.tw - 0.5);
+    *fy = (r->v0 + t * r->v1) * iz + (0.5 * r->l->L.th - 0.5);
     return 1;
 }
 
@@ -59,7 +58,8 @@ static void tinted_sum(const atmos__beams_ray *r, double ta, double step, double
     const double t0 = ta + (s0 + o) * step, t1 = ta + (s1 - 1 + o) * step;
     double xa, ya, xb, yb, tint[3];
     if (s1 - s0 > 1 && coords(r, t0, &xa, &ya) && coords(r, t1, &xb, &yb) &&
-        atmos__lamp_tint_same(&r->l->L, atmos__mind(xa, xb), atmos__maxd(xa, xb), atmos__mind(ya, yb), atmos__maxd(ya, yb), tint)) {
+        atmos__lamp_tint_same(&r->l->L, atmos__mind(xa, xb), atmos__maxd(xa, xb), atmos__mind(ya, yb),
+                              atmos__maxd(ya, yb), tint)) {
         if (tint[0] == 0 && tint[1] == 0 && tint[2] == 0) return; /* lead, or outside the window */
         const double v = light_sum(r, ta, step, o, s0, s1, known);
         for (int c = 0; c < 3; c++) h[c] += v * tint[c];
@@ -105,7 +105,8 @@ int atmos__beams_ray_tint_span(const atmos__beams_ray *r, double *t0, double *t1
     return *t0 < *t1;
 }
 
-void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, double h[3])
+void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1,
+                                 double h[3])
 {
     tinted_sum(r, ta, step, o, s0, s1, LIGHT_UNKNOWN, h);
 }
