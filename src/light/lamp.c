@@ -79,6 +79,41 @@ double atmos__lamp_toward(const atmos__lamp *l, const double p[3], int m, const 
 
 static double srgb_linear(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
 
+/* The box of the image's texels that are not black (atmos__lamp's box). */
+static void lit_box(atmos__lamp *l)
+{
+    int x0 = l->tw, x1 = -1, y0 = l->th, y1 = -1;
+    for (int y = 0; y < l->th; y++)
+        for (int x = 0; x < l->tw; x++) {
+            const float *t = atmos__lamp_texel(l, x, y);
+            if (t[0] != 0 || t[1] != 0 || t[2] != 0)
+                x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1, y0 = y < y0 ? y : y0, y1 = y > y1 ? y : y1;
+        }
+    /* a look-up at fx reads the texels floor(fx) and floor(fx) + 1 (the border repeats the edges') */
+    l->box[0] = x0 == 0 ? -1 : x0 - 1, l->box[1] = x1 == l->tw - 1 ? l->tw : x1 + 1;
+    l->box[2] = y0 == 0 ? -1 : y0 - 1, l->box[3] = y1 == l->th - 1 ? l->th : y1 + 1;
+    if (x1 < 0) l->box[0] = l->box[2] = 1, l->box[1] = l->box[3] = 0;
+}
+
+/* The running sums of the image's edges (atmos__lamp's edges): texel (x, y) differs from its
+ * neighbour (x + dx, y + dy). */
+static void edge_sums(const atmos__lamp *l, int dx, int dy, int *S)
+{
+    const int W = l->tw + 1;
+    for (int x = 0; x < W; x++) S[x] = 0;
+    for (int y = 0; y < l->th; y++) {
+        S[(y + 1) * W] = 0;
+        for (int x = 0; x < l->tw; x++) {
+            int e = 0;
+            if (x + dx < l->tw && y + dy < l->th) {
+                const float *a = atmos__lamp_texel(l, x, y), *b = atmos__lamp_texel(l, x + dx, y + dy);
+                e = a[0] != b[0] || a[1] != b[1] || a[2] != b[2];
+            }
+            S[(y + 1) * W + x + 1] = e + S[y * W + x + 1] + S[(y + 1) * W + x] - S[y * W + x];
+        }
+    }
+}
+
 atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene, int index, atmos__lamp *l)
 {
     const atmos_scene_light *s = &scene->lights[index];
@@ -92,16 +127,21 @@ atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene
         snprintf(key, sizeof key, "/lights/%d/image", index);
         return atmos__scene_file_error(ctx, st, scene, s->image, key, 1);
     }
-    const size_t n = (size_t)img->width * img->height;
-    l->tex = malloc(sizeof(float) * 3 * n);
+    const int W = img->width + 2, H = img->height + 2; /* a border of the edges' texels */
+    l->tex = malloc(sizeof(float) * 3 * (size_t)W * H);
     if (!l->tex) {
         atmos_image_destroy(img);
         return atmos__error(ctx, ATMOS_E_NOMEM, "/lights/%d/image: %s: out of memory for a light's image", index, s->image);
     }
-    for (size_t i = 0; i < n; i++)
-        for (int c = 0; c < 3; c++) {
-            const int ch = img->channels < 3 ? 0 : c;
-            l->tex[3 * i + c] = (float)srgb_linear(img->pixels[i * img->channels + ch]);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const int xi = x < 1 ? 0 : x > img->width ? img->width - 1 : x - 1;
+            const int yi = y < 1 ? 0 : y > img->height ? img->height - 1 : y - 1;
+            const size_t i = (size_t)yi * img->width + xi;
+            for (int c = 0; c < 3; c++) {
+                const int ch = img->channels < 3 ? 0 : c;
+                l->tex[3 * ((size_t)y * W + x) + c] = (float)srgb_linear(img->pixels[i * img->channels + ch]);
+            }
         }
     l->tw = img->width, l->th = img->height;
     atmos_image_destroy(img);
@@ -111,13 +151,22 @@ atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene
     atmos__normalize3(l->right);
     atmos__cross3(l->right, l->axis, l->up);
     l->tan_max = tan(acos(atmos__clampd(l->cos_outer, -1, 1)));
+    const size_t cells = (size_t)(l->tw + 1) * (l->th + 1);
+    if (!(l->edges = malloc(sizeof(int) * 2 * cells))) {
+        atmos__lamp_free(l);
+        return atmos__error(ctx, ATMOS_E_NOMEM, "/lights/%d/image: %s: out of memory for a light's image", index, s->image);
+    }
+    lit_box(l);
+    edge_sums(l, 1, 0, l->edges);
+    edge_sums(l, 0, 1, l->edges + cells);
     return ATMOS_OK;
 }
 
 void atmos__lamp_free(atmos__lamp *l)
 {
     free(l->tex);
-    l->tex = NULL;
+    free(l->edges);
+    l->tex = NULL, l->edges = NULL;
 }
 
 void atmos__lamp_tint(const atmos__lamp *l, const double p[3], double rgb[3])
@@ -128,19 +177,32 @@ void atmos__lamp_tint(const atmos__lamp *l, const double p[3], double rgb[3])
     const double z = atmos__dot3(w, l->axis);
     rgb[0] = rgb[1] = rgb[2] = 0;
     if (!(z > 0)) return;
-    const double x = atmos__dot3(w, l->right) / (z * l->tan_max), y = atmos__dot3(w, l->up) / (z * l->tan_max);
-    const double fx = 0.5 * (x + 1) * l->tw - 0.5, fy = 0.5 * (1 - y) * l->th - 0.5;
-    if (!(fx > -1 && fx < l->tw && fy > -1 && fy < l->th)) return;
-    const int x0 = (int)floor(fx), y0 = (int)floor(fy);
-    const double ax = fx - x0, ay = fy - y0;
-    for (int j = 0; j < 2; j++)
-        for (int i = 0; i < 2; i++) {
-            const int xi = x0 + i < 0 ? 0 : x0 + i >= l->tw ? l->tw - 1 : x0 + i;
-            const int yj = y0 + j < 0 ? 0 : y0 + j >= l->th ? l->th - 1 : y0 + j;
-            const double wt = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
-            const float *t = l->tex + 3 * ((size_t)yj * l->tw + xi);
-            for (int c = 0; c < 3; c++) rgb[c] += wt * t[c];
-        }
+    double fx, fy;
+    atmos__lamp_tint_coords(l, atmos__dot3(w, l->right), atmos__dot3(w, l->up), z, &fx, &fy);
+    atmos__lamp_tint_at(l, fx, fy, rgb);
+}
+
+/* The edges counted in columns [x0, x1], rows [y0, y1] of the running sums S. */
+static int edges_in(const atmos__lamp *l, const int *S, int x0, int x1, int y0, int y1)
+{
+    if (x1 < x0 || y1 < y0) return 0;
+    const int W = l->tw + 1;
+    return S[(y1 + 1) * W + x1 + 1] - S[y0 * W + x1 + 1] - S[(y1 + 1) * W + x0] + S[y0 * W + x0];
+}
+
+int atmos__lamp_tint_same(const atmos__lamp *l, double fx0, double fx1, double fy0, double fy1, double rgb[3])
+{
+    const double m = 1e-6; /* texels: the coordinates' rounding along a run is far smaller */
+    rgb[0] = rgb[1] = rgb[2] = 0;
+    if (!l->tex || fx1 < -1 - m || fx0 > l->tw + m || fy1 < -1 - m || fy0 > l->th + m) return l->tex != NULL;
+    if (!(fx0 > -1 + m && fx1 < l->tw - m && fy0 > -1 + m && fy1 < l->th - m)) return 0; /* across the image's edge */
+    const int x0 = (int)floor(fx0 - m), x1 = (int)floor(fx1 + m) + 1, y0 = (int)floor(fy0 - m), y1 = (int)floor(fy1 + m) + 1;
+    const int ca = x0 < 0 ? 0 : x0, cb = x1 >= l->tw ? l->tw - 1 : x1, ra = y0 < 0 ? 0 : y0, rb = y1 >= l->th ? l->th - 1 : y1;
+    const int cells = (l->tw + 1) * (l->th + 1);
+    if (edges_in(l, l->edges, ca, cb - 1, ra, rb) || edges_in(l, l->edges + cells, ca, cb, ra, rb - 1)) return 0;
+    const float *t = atmos__lamp_texel(l, ca, ra);
+    for (int c = 0; c < 3; c++) rgb[c] = t[c];
+    return 1;
 }
 
 int atmos__lamp_clip(const atmos__lamp *l, const double e[3], const double d[3], double *t0, double *t1)

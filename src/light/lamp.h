@@ -8,6 +8,8 @@
 #include "core/internal.h"
 #include "atmos/scene.h"
 
+#include <math.h>
+
 typedef struct atmos__lamp {
     atmos_light_type type;
     double pos[3], axis[3];
@@ -17,10 +19,19 @@ typedef struct atmos__lamp {
     double I_max;                /* the largest of I */
     /* a spot's projected image (stained glass; NULL: none): tw x th linear rgb texels, row 0
      * at the top, spanning [-tan_max, tan_max]^2 of the plane at unit distance along the axis
-     * (right, up: the image's axes there) */
+     * (right, up: the image's axes there), in a border of a texel that repeats the edges' (so
+     * that a bilinear look-up need not clamp: atmos__lamp_texel) */
     float *tex;
     int tw, th;
     double tan_max, right[3], up[3];
+    /* the image's edges, for atmos__lamp_tint_same: (th + 1) x (tw + 1) running sums over the
+     * texels above and left of each of those differing from their right neighbour (one table),
+     * then from the one below (the next) */
+    int *edges;
+    /* the texel coordinates outside which the tint is 0 (the image's non-black texels' box,
+     * a texel wider each side for the bilinear look-ups): fx in (box[0], box[1]), fy in
+     * (box[2], box[3]); an empty box when the image is all black */
+    double box[4];
 } atmos__lamp;
 
 /* The intensity at wavelength k of a scene light (W sr^-1 nm^-1): intensity_w_sr is the
@@ -58,6 +69,39 @@ void atmos__lamp_free(atmos__lamp *l);
 /* The image's tint toward point p (rgb, bilinear; 0 outside the image; 1, 1, 1 without an
  * image). */
 void atmos__lamp_tint(const atmos__lamp *l, const double p[3], double rgb[3]);
+/* The image's texel coordinates toward a point at (x, y, z) in the light's (right, up, axis)
+ * frame, z > 0 (those atmos__lamp_tint_at reads). */
+static inline void atmos__lamp_tint_coords(const atmos__lamp *l, double x, double y, double z, double *fx, double *fy)
+{
+    x /= z * l->tan_max, y /= z * l->tan_max;
+    *fx = 0.5 * (x + 1) * l->tw - 0.5, *fy = 0.5 * (1 - y) * l->th - 0.5;
+}
+/* Texel (x, y) of the image, x in [-1, tw], y in [-1, th] (the border: the edges' texels). */
+static inline const float *atmos__lamp_texel(const atmos__lamp *l, int x, int y)
+{
+    return l->tex + 3 * ((size_t)(y + 1) * (l->tw + 2) + x + 1);
+}
+/* The tint at texel coordinates (fx, fy) of the image (bilinear; 0 outside it). */
+static inline void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0;
+    if (!(fx > -1 && fx < l->tw && fy > -1 && fy < l->th)) return;
+    const int x0 = (int)floor(fx), y0 = (int)floor(fy); /* in [-1, tw - 1], [-1, th - 1] */
+    const double ax = fx - x0, ay = fy - y0;
+    const double w00 = (1 - ax) * (1 - ay), w01 = ax * (1 - ay), w10 = (1 - ax) * ay, w11 = ax * ay;
+    /* the border stands for the clamped edge */
+    const float *t00 = atmos__lamp_texel(l, x0, y0), *t10 = atmos__lamp_texel(l, x0, y0 + 1);
+    for (int c = 0; c < 3; c++) {
+        double v = 0;
+        v += w00 * t00[c], v += w01 * t00[c + 3], v += w10 * t10[c], v += w11 * t10[c + 3];
+        rgb[c] = v;
+    }
+}
+/* Whether the tint is the same all over the box [fx0, fx1] x [fy0, fy1] of texel coordinates
+ * (every texel the bilinear look-ups there read alike, or the box wholly outside the image:
+ * 0), with a margin for the rounding of the coordinates; that tint into rgb (the texel's, to
+ * which the look-ups' weights add up within rounding). */
+int atmos__lamp_tint_same(const atmos__lamp *l, double fx0, double fx1, double fy0, double fy1, double rgb[3]);
 
 /* The falloff toward point p (1 at the light itself). */
 double atmos__lamp_falloff(const atmos__lamp *l, const double p[3]);

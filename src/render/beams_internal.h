@@ -108,6 +108,7 @@ typedef struct atmos__beams_ray {
     double w0[3], d[3];      /* w(t) = w0 + t d */
     double a0, a1;           /* the depth along the axis: a0 + t a1 */
     double f0[6][3], f1[6][3]; /* per face: (right, up, fwd) coordinates a0 + t a1 */
+    double u0, u1, v0, v1;   /* a spot with an image: w(t)'s along its right and down, in texels at unit depth */
 } atmos__beams_ray;
 void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r);
 /* The spot's falloff times the visibility H at o + t d (as the two functions above). */
@@ -130,6 +131,17 @@ double atmos__beams_ray_light_sum(const atmos__beams_ray *r, double ta, double s
  * test would have passed passes too, the pyramid's ranges being nested, so for a point light
  * the sum is the same to the bit; for a spot the falloff's runs may be added in another order). */
 double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1);
+
+/* A spot with an image (stained glass, beams_tint.c): the sum of atmos__beams_ray_light times
+ * the image's tint at the samples t = ta + (s + o) step, s = s0 .. s1 - 1, added to h (rgb).
+ * Runs of them whose image the tint proves the same (atmos__lamp_tint_same) are that tint
+ * times atmos__beams_ray_light_sum, runs the shadow map's tiles prove dark nothing; the rest
+ * halved, down to 8 samples read one by one. */
+void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, double h[3]);
+/* Narrows [*t0, *t1] of the ray to where the spot's image may tint it (its non-black texels'
+ * pyramid, atmos__lamp's box, with a margin for rounding): outside, the tint is 0. Returns 0
+ * when no part is left. */
+int atmos__beams_ray_tint_span(const atmos__beams_ray *r, double *t0, double *t1);
 
 /* The plan's kept buffers (struct atmos__beams_plan's kept). */
 enum {

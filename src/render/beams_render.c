@@ -237,29 +237,39 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
     return fog_t;
 }
 
-/* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
- * image's tint at every sample (so no interval is taken as uniform: its colour varies). */
-static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *ray, const double d[3], const double *f,
-                   int n, double unit, double *L, int centre, double o)
+/* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
+ * the scene's max_subplanes. */
+static int subplanes(const job *J, double fl, double unit)
 {
-    double sum[3] = {0, 0, 0};
+    const double need = ceil(fl / unit);
+    return need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+}
+
+/* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
+ * image's tint at every sample (atmos__beams_ray_tinted_sum: where it is one colour along a run
+ * of them, that colour times the light's sum), so no interval is taken as uniform by its f_l
+ * alone: its colour varies. */
+static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *ray, const double *f, int n, double unit,
+                   double *L, int centre, double o)
+{
+    double sum[3] = {0, 0, 0}, p0 = f[0], p1 = f[2 * n];
+    const int some = atmos__beams_ray_tint_span(ray, &p0, &p1); /* outside [p0, p1] the image is black */
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
         if (fl <= 0) continue;
-        const double need = ceil(fl / unit);
-        const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
-        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
-        double h[3] = {0, 0, 0};
-        for (int s = 0; s < m; s++) {
-            const double t = ta + (s + o) * step, v = atmos__beams_ray_light(ray, t);
-            if (!(v > 0)) continue;
-            const double P[3] = {J->eye[0] + t * d[0], J->eye[1] + t * d[1], J->eye[2] + t * d[2]};
-            double tint[3];
-            atmos__lamp_tint(&l->L, P, tint);
-            for (int c = 0; c < 3; c++) h[c] += v * tint[c];
+        if (!some || f[2 * k + 2] < p0 || f[2 * k] > p1) { /* black all along: counted, not sampled */
+            if (centre) J->centre_subplanes += subplanes(J, fl, unit);
+            continue;
         }
-        for (int c = 0; c < 3; c++) sum[c] += h[c] / m * fl;
+        const int m = subplanes(J, fl, unit);
+        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
         if (centre) J->centre_subplanes += m;
+        /* the samples within [p0, p1], and one more each side for the rounding */
+        const double a = ceil((p0 - ta) / step - o) - 1, b = floor((p1 - ta) / step - o) + 2;
+        const int s0 = a > 0 ? (a < m ? (int)a : m) : 0, s1 = b < m ? (b > 0 ? (int)b : 0) : m;
+        double h[3] = {0, 0, 0};
+        atmos__beams_ray_tinted_sum(ray, ta, step, o, s0, s1, h);
+        for (int c = 0; c < 3; c++) sum[c] += h[c] / m * fl;
     }
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum[k < 3 ? k : 2];
 }
@@ -415,8 +425,7 @@ static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k,
                      double o)
 {
     const double fl = f[2 * k + 1];
-    const double need = ceil(fl / unit);
-    const int m = need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
+    const int m = subplanes(J, fl, unit);
     const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
     double h = 0, same = 0;
     int full = 0;
@@ -490,7 +499,7 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
     atmos__beams_ray ray;
     atmos__beams_ray_init(l, J->eye, d, &ray);
     if (l->L.tex) {
-        tinted(J, l, &ray, d, f, n, unit, L, centre, o);
+        tinted(J, l, &ray, f, n, unit, L, centre, o);
         return;
     }
     double sum = f[2 * n + 1]; /* the lit runs the corners agreed on (else 0) */

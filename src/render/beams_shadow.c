@@ -182,6 +182,11 @@ void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const
     for (int a = 0; a < 3; a++) r->w0[a] = o[a] - l->L.pos[a], r->d[a] = d[a];
     r->ww0 = atmos__dot3(r->w0, r->w0), r->wd = atmos__dot3(r->w0, d);
     r->a0 = atmos__dot3(r->w0, l->L.axis), r->a1 = atmos__dot3(d, l->L.axis);
+    if (l->L.tex) { /* in texels at unit depth, the image's rows downward */
+        const double kx = 0.5 * l->L.tw / l->L.tan_max, ky = -0.5 * l->L.th / l->L.tan_max;
+        r->u0 = kx * atmos__dot3(r->w0, l->L.right), r->u1 = kx * atmos__dot3(d, l->L.right);
+        r->v0 = ky * atmos__dot3(r->w0, l->L.up), r->v1 = ky * atmos__dot3(d, l->L.up);
+    }
     /* a cube's faces 2a and 2a + 1 look along +-axis a: the odd one's right and fwd are the even
      * one's negated, its up the same (set_face: the cross products' signs flip exactly), so its
      * coordinates are the even one's with two signs flipped, the same bits */

@@ -3,7 +3,7 @@
  * sub-planes (at the scene's plane spacing, 0.3 m and 0.1 m), with a coarser epsilon, with
  * interleaved sampling instead of sub-planes (Keller and Heidrich 2001: 2x2 and 3x3), with two
  * and four lights (the spot copied around the first), and at twice the size; then the studio
- * of Fig. 9(a), the searchlights and the mountains of Fig. 10(a) at Table 1's 720x480. Each case makes one plan (objects, shadow maps, the scattering table) and renders
+ * of Fig. 9(a), the stained glass of Fig. 9(b), the searchlights and the mountains of Fig. 10(a) at Table 1's 720x480. Each case makes one plan (objects, shadow maps, the scattering table) and renders
  * frames with the camera moving round the sphere (a degree a frame): what interactive use
  * pays per frame. */
 #include "bench_beams.h"
@@ -105,6 +105,7 @@ int bench_beams(const char *file, int frames, int threads, const char *only)
         if (!only || !strcmp(only, cases[i].name)) rc = run_case(ctx, &s, &cases[i], frames, used), ran++;
     /* without a file: the other scenes as they are (Table 1's size, 720x480) */
     static const char *const table1[][2] = {{"dobashi_fig09a_studio", "scenes/dobashi_fig09a_studio.json"},
+                                            {"dobashi_fig09b_stained_glass", "scenes/dobashi_fig09b_stained_glass.json"},
                                             {"searchlights_fog", "scenes/searchlights_fog.json"},
                                             {"dobashi_fig10a_mountain_shafts", "scenes/dobashi_fig10a_mountain_shafts.json"}};
     for (size_t i = 0; !file && rc == CLI_EXIT_OK && i < sizeof table1 / sizeof *table1; i++) {
