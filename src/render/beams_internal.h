@@ -176,6 +176,7 @@ struct atmos__beams_plan {
     long air_pixels, air_evaluated;
     long air_shared; /* of the evaluated, those handed their cell's corners' agreement (beams_screen.h) */
     long air_unread; /* the stretches of their rays taken within a run of agreed ones, no W looked up */
+    long air_told;   /* the stretches a merged sample told lit or dark to the cells around (merged) */
     /* a frame's per-pixel buffers, kept for the next frame (beams_kept.h): the primary
      * visibility's two, then the subsampled frame's (beams_render.c) */
     atmos__beams_kept kept[ATMOS__BEAMS_KEPT_COUNT];

@@ -282,7 +282,8 @@ typedef struct shared_ray {
     int light;             /* the light (-1: none) */
     const uint64_t *known; /* NULL: nothing agreed */
     uint64_t *seen;
-    double *unread; /* the count of stretches that a run took without their W looked up */
+    double *unread; /* the count of stretches that a run took without their W looked up, then
+                     * that of the stretches a merged sample told lit or dark */
 } shared_ray;
 
 /* Light i's part of the ray d within its reach and before T: [t0, t1), the table's column, the
@@ -464,23 +465,31 @@ static void shared_interval(job *J, int i, const atmos__beams_ray *ray, const do
  * sum stays below POINT_MERGE unit (up to a run the corners agreed on, f_l -1), added to *sum as one sample: the visibility at the point
  * where the sum reaches o of itself (interpolated within its interval) times the sum. A sample
  * so carries at most POINT_MERGE epsilon of the pixel's airlight, where a sub-plane carries up to
- * epsilon (docs/beams.md, *Eleventh round*). Returns the interval after the last taken. */
-static int merged(job *J, const atmos__beams_ray *ray, const double *f, int k, int n, double unit, double *sum,
-                  int centre, double o)
+ * epsilon (docs/beams.md, *Eleventh round*). With sh, a sample of a single interval (its
+ * midpoint, as an interval of one sub-plane takes) tells its stretch lit or dark as
+ * shared_interval does (not the first or the last interval, cut by the reach or the surface; a
+ * sample placed by the sum of several is not its stretch's evidence: docs/beams.md, *Thirty-sixth
+ * round*). Returns the interval after the last taken. */
+static int merged(job *J, int i, const atmos__beams_ray *ray, const double *f, int k, int n, double unit, double *sum,
+                  int centre, double o, double cosf, const shared_ray *sh)
 {
     double acc = 0;
-    int e = k;
+    int e = k, in = -1;
     while (e < n && f[2 * e + 1] >= 0 && acc + f[2 * e + 1] < POINT_MERGE * unit) acc += f[2 * e + 1], e++;
     double c = o * acc, t = f[2 * e];
     for (int q = k; q < e; q++) {
         if (c <= f[2 * q + 1]) {
             t = f[2 * q] + (f[2 * q + 1] > 0 ? c / f[2 * q + 1] : o) * (f[2 * q + 2] - f[2 * q]);
+            in = q;
             break;
         }
         c -= f[2 * q + 1];
     }
-    *sum += atmos__beams_ray_light(ray, t) * acc;
+    const double v = atmos__beams_ray_light(ray, t);
+    *sum += v * acc;
     if (centre) J->centre_subplanes++;
+    if (sh && e == k + 1 && in > 0 && in < n - 1 && (v == 0 || v == 1))
+        sh->seen[v == 1 ? 0 : 1] |= stretch_bit(J, i, f[2 * in], f[2 * in + 2], cosf), sh->unread[1]++;
     return e;
 }
 
@@ -508,7 +517,7 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         if (!(f[2 * k + 1] > 0))
             k++;
         else if (l->L.type == ATMOS_LIGHT_POINT && f[2 * k + 1] < POINT_MERGE * unit)
-            k = merged(J, &ray, f, k, n, unit, &sum, centre, o);
+            k = merged(J, i, &ray, f, k, n, unit, &sum, centre, o, cosf, sh);
         else if (sh)
             shared_interval(J, i, &ray, f, k++, n, unit, &sum, centre, o, cosf, sh);
         else
@@ -559,11 +568,12 @@ static void sunlight(const job *J, const double d[3], const atmos_mesh_hit *h, i
 }
 
 /* The doubles of a thread's buffer for lights(): each light's intervals, then their sums and counts, then
- * the thread's count of unread stretches. */
+ * the thread's counts of unread stretches and of merged samples' stretches told. */
 #define LIGHT_STRIDE (2 * MAX_INTERVALS + 2)
-static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights : 1) * (LIGHT_STRIDE + 2) + 1; }
-/* The last double of a thread's buffer: its count of stretches unread (shared_ray's). */
-static double *unread_count(double *f, int nlights) { return f + buffer_size(nlights) - 1; }
+static size_t buffer_size(int nlights) { return (size_t)(nlights > 0 ? nlights : 1) * (LIGHT_STRIDE + 2) + 2; }
+/* The last two doubles of a thread's buffer: its counts of stretches unread and told by a merged
+ * sample (shared_ray's). */
+static double *unread_count(double *f, int nlights) { return f + buffer_size(nlights) - 2; }
 
 /* Every light's airlight along [0, T) of the ray d through pixel (x, y) (the lights whose span
  * holds it), added to L, with Dobashi's criterion over all the lights of the pixel (§4.2.2): an
@@ -851,7 +861,15 @@ FIRST_PASS void surface_light(const job *J, int x, int y, const double d[3], con
         unlit_surface(J, d, h, obj, B, memo);
         return;
     }
-    if (!hit) { /* the sky behind through the fog (base_light's, in one loop) */
+    if (!hit) { /* the sky behind through the fog (base_light's, in one loop); a black sky (every
+                 * wavelength +-0) stays so with no fog evaluated: +-0 times a transmittance in [0, 1]
+                 * is the same zero, the same bits */
+        int black = 1;
+        for (int k = 0; k < J->nw; k++) black &= bg[k] == 0;
+        if (black) {
+            for (int k = 0; k < J->nw; k++) B[k] = bg[k];
+            return;
+        }
         const double fog_t = fog_to(J, d, INFINITY);
         for (int k = 0; k < J->nw; k++) B[k] = (float)(bg[k] * fog_t);
         return;
@@ -1014,8 +1032,8 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
                                      SCREEN_HINT ? J->span : NULL, SCREEN_HINT ? J->b->nlights : 0, J->cam->height,
                                      a[l].mask, !(a[l].sun && J->b->sun_on), SCREEN_WIDE,
                                      a[l].shared >= 0 ? SCREEN_SHARE : 0, air_pixel, &a[l]};
-    long ev = 0, sh = 0, un = 0;
-#pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev, sh, un)
+    long ev = 0, sh = 0, un = 0, told = 0;
+#pragma omp parallel num_threads(atmos__threads(p->ctx)) reduction(+ : ev, sh, un, told)
     {
         const size_t bw = (size_t)W * (k + 1); /* a band's pixels */
         double *f = malloc(sizeof(double) * buffer_size(J->b->nlights)), *band = malloc(sizeof(double) * bw * nw * nl);
@@ -1024,7 +1042,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
         atmos_mesh_hit *hits = malloc(sizeof *hits * (size_t)W);
         uint32_t *cones = malloc(sizeof *cones * (size_t)W);
         const int ok = f && band && state && seen && hits && cones;
-        if (f) *unread_count(f, J->b->nlights) = 0;
+        if (f) unread_count(f, J->b->nlights)[0] = unread_count(f, J->b->nlights)[1] = 0;
         double *const bands[2] = {band, band ? band + bw * nw : NULL};
         unsigned char *const states[2] = {state, state ? state + bw : NULL};
         if (!ok) {
@@ -1054,7 +1072,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
             ev += screen_band(s, nl, &q, nx, ny, j, f, bands, states, seen, &sh, out);
             atmos__progress_step(p->ctx, "render beams", &done, nb, cancelled);
         }
-        if (f) un += (long)*unread_count(f, J->b->nlights);
+        if (f) un += (long)unread_count(f, J->b->nlights)[0], told += (long)unread_count(f, J->b->nlights)[1];
         free(f), free(band), free(state), free(seen), free(hits), free(cones);
     }
     if (!failed && J->cx >= r->x0 && J->cx < r->x1 && J->cy >= r->y0 && J->cy < r->y1) { /* the centre ray's counts */
@@ -1068,7 +1086,7 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     }
     J->dir = NULL;
     screen_buf_free(&q);
-    *evaluated = ev, p->beams->air_shared = sh, p->beams->air_unread = un;
+    *evaluated = ev, p->beams->air_shared = sh, p->beams->air_unread = un, p->beams->air_told = told;
     return failed;
 }
 
@@ -1147,7 +1165,7 @@ atmos_status atmos__beams_render(atmos_plan *p, const atmos__view *v, const atmo
         return st;
     }
     const int step = p->scene.beams.screen_step;
-    b->air_shared = b->air_unread = 0; /* set by a subsampled frame */
+    b->air_shared = b->air_unread = b->air_told = 0; /* set by a subsampled frame */
     long evaluated = (long)(r->x1 - r->x0) * (r->y1 - r->y0);
     if (!failed && step > 1 && !ilp) failed = subsampled(p, &J, r, out, step, &cancelled, &evaluated);
     else if (!failed) failed = rows(p, &J, r, ilp ? &il.e : r, out, ilp, &cancelled);

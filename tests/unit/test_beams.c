@@ -946,8 +946,9 @@ static void test_sky_on_lattice(void)
 }
 
 /* The last render_counted's count of the evaluations handed their cell's corners' agreement, and
- * of their rays' stretches taken within a run of agreed ones (no W looked up). */
-static long last_shared, last_unread;
+ * of their rays' stretches taken within a run of agreed ones (no W looked up), and of the stretches
+ * a merged sample told lit or dark to the cells around. */
+static long last_shared, last_unread, last_told;
 
 /* One frame of s by a plan (on context c); *evaluated, *pixels: the renderer's count of the
  * pixels whose airlight it evaluated rather than interpolated, of all. */
@@ -962,7 +963,7 @@ static atmos_image *render_counted(atmos_context *c, const atmos_scene *s, long 
     CHECK_OK(atmos_plan_image_create(plan, &f, &img));
     if (img) CHECK_OK(atmos_plan_render(plan, &f, NULL, img, NULL));
     *evaluated = plan->beams->air_evaluated, *pixels = plan->beams->air_pixels, last_shared = plan->beams->air_shared;
-    last_unread = plan->beams->air_unread;
+    last_unread = plan->beams->air_unread, last_told = plan->beams->air_told;
     atmos_plan_destroy(plan);
     return img;
 }
@@ -987,16 +988,17 @@ typedef struct {
     atmos_image *exact, *sub, *one;
     long ev, n, ev1, shared; /* shared: of sub's evaluations, those handed their cell's corners' agreement */
     long unread;             /* sub's stretches taken within a run of agreed ones */
+    long told;               /* sub's stretches a merged sample told lit or dark */
 } stepped;
 
 static int render_stepped(atmos_scene *s, int step, stepped *r)
 {
-    r->ev = 0, r->n = 1, r->ev1 = 0, r->shared = 0, r->unread = 0;
+    r->ev = 0, r->n = 1, r->ev1 = 0, r->shared = 0, r->unread = 0, r->told = 0;
     s->beams.screen_step = 1;
     r->exact = render_counted(ctx, s, &r->ev, &r->n);
     s->beams.screen_step = step;
     r->sub = render_counted(ctx, s, &r->ev, &r->n);
-    r->shared = last_shared, r->unread = last_unread;
+    r->shared = last_shared, r->unread = last_unread, r->told = last_told;
     r->one = render_counted_one_thread(s, &r->ev1, &r->n);
     return r->exact && r->sub && r->one;
 }
@@ -1263,8 +1265,10 @@ static void test_layers(int step)
  * makes it (its pixels at the edges within 3.23 % at 8 and 16, the mean 0.304 % and 0.334 %; the
  * bounds 4 % and 0.4 %; a stretch taken where any one corner saw it so: 7.6 % and 12.9 %, 0.91 %
  * and 2.4 %); a run of stretches they agree on is taken in one step, so more stretches than shared
- * evaluations are taken without their W looked up (14 670 at 8 over 4 421, 13 250 at 16 over
- * 4 054; none without the runs); 1 and 2 threads the same bytes. */
+ * evaluations are taken without their W looked up (16 194 at 8 over 4 421, 14 814 at 16 over
+ * 4 054; none without the runs); a point light's merged sample of a single interval tells its
+ * stretch to the cells around (668 at 8, 584 at 16; none before merged() told them); 1 and 2
+ * threads the same bytes. */
 static void test_shared_corners(int step)
 {
     atmos_scene s;
@@ -1289,12 +1293,13 @@ static void test_shared_corners(int step)
         exact_diff(r.exact, r.sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
         printf("a point light's streaks, screen step %d: airlight evaluated at %ld of %ld pixels, %ld of them handed "
                "their corners' agreement; %ld edge pixels, worst relative difference there %.2e; mean over %ld lit "
-               "pixels %.2e; %ld stretches taken within runs, no W looked up\n", step, r.ev, r.n, r.shared, edges,
-               worst_edge, lit, mean, r.unread);
+               "pixels %.2e; %ld stretches taken within runs, no W looked up; %ld told by merged samples\n", step,
+               r.ev, r.n, r.shared, edges, worst_edge, lit, mean, r.unread, r.told);
         CHECK(edges > 500);
         CHECK_MSG(r.shared > r.ev / 2, "only %ld of %ld evaluations shared their corners'", r.shared, r.ev);
         CHECK_MSG(r.unread > 2 * r.shared, "only %ld stretches of %ld shared evaluations were taken in runs", r.unread,
                   r.shared);
+        CHECK_MSG(r.told > 0, "no merged sample told its stretch to the cells around");
         CHECK_MSG(worst_edge <= 0.04, "an edge pixel is off the exact one by %.3g", worst_edge);
         CHECK_MSG(mean <= 4e-3, "the subsampled image is off the exact one by %.3g on average", mean);
     }
