@@ -24,4 +24,9 @@ static inline size_t atmos__first_not_finite(const float *row, size_t n)
     return i;
 }
 
+/* The number of NaNs and infinities among src[0 .. n); with dst, src copied there in the same
+ * pass (the plan's kept frame). One load a value: the row's greatest |bits| against the
+ * exponent's, counted value by value only in a row that holds one (finite.c). */
+size_t atmos__copy_not_finite(float *restrict dst, const float *restrict src, size_t n);
+
 #endif

@@ -354,9 +354,11 @@ static void copy_rect(float *dst, const float *src, int W, int C, const atmos__r
 /* No valid scene may give a NaN or an infinity (DESIGN §5): a renderer that does has a
  * bug, and an image holding one is refused here, whatever the renderer, rather than
  * written with exit status 0. With keep (a sky, slice, Nishita, Harris or beams frame, not
- * atmos_frame.no_keep), the rendered pixels are kept for the next call in the same pass: rows on
- * the threads (one pass over a 1280 x 720 frame instead of two serial ones; the count and the
- * first bad pixel do not depend on the thread count). A frame not kept with no_check is not read
+ * atmos_frame.no_keep), the rendered pixels are kept for the next call in the same pass
+ * (atmos__copy_not_finite: one load a value, the copy streamed from it; a copy, not a reference:
+ * the caller may write into its image before the next call): rows on the threads (one pass
+ * over a 1280 x 720 frame instead of two serial ones; the count and the first bad pixel do not
+ * depend on the thread count). A frame not kept with no_check is not read
  * here: the caller checks it (atmos_frame.no_check). The view is remembered either way (what
  * the next frame changed). */
 static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const atmos__rect *r, const atmos_image *out,
@@ -379,15 +381,12 @@ static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const at
 #pragma omp parallel for schedule(static) reduction(+ : bad) reduction(min : first) num_threads(atmos__threads(p->ctx))
     for (int y = r->y0; y < r->y1; y++) {
         const float *row = out->pixels + ((size_t)y * W + r->x0) * C;
-        unsigned b = 0;
-#pragma omp simd reduction(+ : b)
-        for (size_t i = 0; i < n; i++) b += atmos__not_finite(row[i]);
+        const size_t b = atmos__copy_not_finite(keep ? p->last_pixels + ((size_t)y * W + r->x0) * C : NULL, row, n);
         if (b) {
             const long long at = (long long)y * W * C + (long long)atmos__first_not_finite(row, n);
             first = first < at ? first : at;
             bad += b;
         }
-        if (keep) memcpy(p->last_pixels + ((size_t)y * W + r->x0) * C, row, sizeof(float) * n);
     }
     if (bad)
         return atmos__error(p->ctx, ATMOS_E_UNSUPPORTED,
