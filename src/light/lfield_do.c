@@ -111,22 +111,29 @@ typedef struct {
 } do_work;
 
 /* W->need from W->live and the cells' extinction: the cells within one cell (26 neighbours) of a
- * live cell or of one with sigma_t > 0. */
+ * live cell or of one with sigma_t > 0. The box's dilation axis by axis, each pass's result in a
+ * bit of its own (bit 0 the seeds, then 1, 2 and 3 after x, y and z). */
 static void mark_needed(do_work *W)
 {
     const atmos__do_problem *P = W->P;
-    const int nx = P->c[0], ny = P->c[1], nz = P->c[2];
-    memset(W->need, 0, W->cells);
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                const size_t c = ((size_t)k * ny + j) * nx + i;
-                if (!W->live[c] && !(P->sig_t[c] != 0)) continue;
-                for (int z = k > 0 ? k - 1 : 0; z <= k + 1 && z < nz; z++)
-                    for (int y = j > 0 ? j - 1 : 0; y <= j + 1 && y < ny; y++)
-                        for (int x = i > 0 ? i - 1 : 0; x <= i + 1 && x < nx; x++)
-                            W->need[((size_t)z * ny + y) * nx + x] = 1;
-            }
+    const int c[3] = {P->c[0], P->c[1], P->c[2]};
+    const size_t stride[3] = {1, (size_t)c[0], (size_t)c[0] * c[1]};
+    unsigned char *m = W->need;
+    for (size_t i = 0; i < W->cells; i++) m[i] = W->live[i] || P->sig_t[i] != 0;
+    for (int a = 0; a < 3; a++) {
+        const unsigned char from = (unsigned char)(1u << a), to = (unsigned char)(2u << a);
+        for (int k = 0; k < c[2]; k++)
+            for (int j = 0; j < c[1]; j++)
+                for (int i = 0; i < c[0]; i++) {
+                    const int at[3] = {i, j, k};
+                    const size_t q = k * stride[2] + j * stride[1] + i;
+                    int any = m[q] & from;
+                    if (at[a] > 0) any |= m[q - stride[a]] & from;
+                    if (at[a] + 1 < c[a]) any |= m[q + stride[a]] & from;
+                    if (any) m[q] |= to;
+                }
+    }
+    for (size_t i = 0; i < W->cells; i++) m[i] = m[i] >> 3 & 1;
 }
 
 /* The packs: the directions by octant (in a fixed order), DO_PACK at a time. Returns their count;
@@ -553,13 +560,44 @@ static double entering(const atmos__do_problem *P)
     return e * P->h * P->h;
 }
 
+/* GMRES on W's needed cells from x (phi's start in W->idx's order; phi all 0: from 0), the source's
+ * sweep into b, then the last source iteration, x + (b - A x) = T (S x + q1): from GMRES's own
+ * residual (tmp), or by a sweep that also gives the leaving power. */
+static void solve_gmres(do_work *W, const double *phi, double *b, double *x, double *V, double *tmp,
+                        atmos__do_stats *st)
+{
+    const atmos__do_problem *P = W->P;
+    const size_t N = W->cells * W->K, Nn = W->n * W->K;
+    for (size_t i = 0; i < N; i++) W->q1[i] = (float)P->q1[i];
+    sweep_all(W, W->q1, b, NULL, NULL, P->inflow != NULL);
+    st->sweeps++;
+    int zero = 1;
+    for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
+    if (gmres(W, b, x, V, tmp, st, zero) && !P->leak)
+        for (size_t i = 0; i < Nn; i++) x[i] += tmp[i];
+    else {
+        scatter(W, x, 1);
+        sweep_all(W, W->Q, x, NULL, &st->leak, P->inflow != NULL);
+        st->sweeps++;
+    }
+}
+
+double atmos__do_rho(const atmos__do_problem *P)
+{
+    const size_t cells = (size_t)P->c[0] * P->c[1] * P->c[2];
+    float smax = 0;
+    for (size_t c = 0; c < cells; c++) smax = P->sig_s[c] > smax ? P->sig_s[c] : smax;
+    double C = 0;
+    for (int l = 0; l <= P->L; l++) C += (2 * l + 1) * fabs(P->chi[l]);
+    return C * smax * sqrt(3.0) * P->h * (P->c[0] + P->c[1] + P->c[2]);
+}
+
 int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st)
 {
     memset(st, 0, sizeof *st);
     do_work W;
     memset(&W, 0, sizeof W);
     W.P = P, W.K = (P->L + 1) * (P->L + 1), W.cells = (size_t)P->c[0] * P->c[1] * P->c[2];
-    const size_t N = W.cells * W.K;
     const int m = P->restart < 1 ? 1 : P->restart > 64 ? 64 : P->restart;
     atmos__do_problem Pm = *P;
     Pm.restart = m, W.P = &Pm;
@@ -574,8 +612,8 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         mark_needed(&W);
         for (size_t c = 0; c < W.cells; c++)
             if (W.need[c]) W.idx[W.n++] = c;
-        const size_t Nn = W.n * W.K;
-        if (P->dsa == ATMOS__DO_DSA_ON) W.dsa = atmos__dsa_create(P, W.idx, W.n); /* NULL (no memory): plain */
+        if (P->dsa == ATMOS__DO_DSA_ON && P->richardson <= 0)
+            W.dsa = atmos__dsa_create(P, W.idx, W.n); /* NULL (no memory): plain */
         st->dsa_at = W.dsa ? 0 : -1;
         /* W.acc not cleared: its cells not needed are never read, each sweep's group's first pack
            sets the needed ones (sweep_k; the clearing was 7 MB a wavelength on the Disney cloud) */
@@ -587,21 +625,15 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
             W.theta[c] = (float)(P->theta_tau > 0 ? 1 - (1 - th) * (1 - exp(-tau / P->theta_tau)) : th);
         }
         W.npack = make_packs(P, W.pack);
-        for (size_t i = 0; i < N; i++) W.q1[i] = (float)P->q1[i];
-        sweep_all(&W, W.q1, b, NULL, NULL, P->inflow != NULL);
-        st->sweeps++;
-        int zero = 1;
-        for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
         for (size_t i = 0; i < W.n; i++) memcpy(x + i * W.K, phi + W.idx[i] * W.K, sizeof(double) * W.K);
-        /* the last source iteration, x + (b - A x) = T (S x + q1): from GMRES's own residual
-           (tmp), or by a sweep that also gives the leaving power */
-        if (gmres(&W, b, x, V, tmp, st, zero) && !P->leak)
-            for (size_t i = 0; i < Nn; i++) x[i] += tmp[i];
-        else {
-            scatter(&W, x, 1);
-            sweep_all(&W, W.Q, x, NULL, &st->leak, P->inflow != NULL);
-            st->sweeps++;
-        }
+        if (P->richardson > 0)
+            for (int it = 0; it < P->richardson; it++) { /* x <- T (S x + q1), the inflow's too */
+                scatter(&W, x, 1);
+                sweep_all(&W, W.Q, x, NULL, &st->leak, P->inflow != NULL);
+                st->sweeps++;
+            }
+        else
+            solve_gmres(&W, phi, b, x, V, tmp, st);
         /* the cells not needed 0 (as the sweeps leave them), the others x: each cell written once */
         for (size_t c = 0; c < W.cells; c++)
             if (!W.need[c]) memset(phi + c * W.K, 0, sizeof(double) * W.K);

@@ -74,6 +74,9 @@ typedef struct {
                                    the low moments (flexible GMRES; lfield_dsa.h); ATMOS__DO_DSA_AUTO:
                                    plain until its rate predicts more than ATMOS__DO_DSA_AFTER
                                    iterations, then preconditioned; 0: plain */
+    int richardson;             /* > 0: that many source iterations from phi instead of GMRES (no
+                                   residual: the caller knows them converged, the scattering
+                                   operator's norm small; nishita_do.c's thin media); 0: GMRES */
 } atmos__do_problem;
 
 typedef struct {
@@ -90,6 +93,13 @@ typedef struct {
 #define ATMOS__DO_DSA_ON 1
 #define ATMOS__DO_DSA_AUTO 2
 #define ATMOS__DO_DSA_AFTER 12
+
+/* A bound on the norm of P's scattering operator T S (a sweep of the scattering source, the
+ * maximum norm), so that a source iteration multiplies a start's error by at most it: C tau, tau
+ * the largest optical depth of scattering a ray can cross (the cells' largest sigma_s times a
+ * cell's longest chord sqrt(3) h times the c[0] + c[1] + c[2] cells a ray crosses at most), C =
+ * sum (2l + 1) |chi_l| (l <= L), the largest integral over the sphere of |the phase function|. */
+double atmos__do_rho(const atmos__do_problem *P);
 
 /* The radiance moments phi[cell * K + k], K = (L + 1)^2, of the orders >= 1 and of the inflow
  * (its uncollided part too; phi on entry: the start, 0 if nothing better). Returns 0 when out of

@@ -5,7 +5,8 @@
  * (sig' cut at 3 degrees, or delta-M scaled sig*), the first order's emission per cell from the
  * sunlight's columns per render voxel (nishita_plan.c's sweep, its voxel's mean transmittance
  * along the sun), the quadrature's directions about the world's axes (the harmonics' frame),
- * swept along the cells' axes; the first wavelength solved on all the threads, the others in
+ * swept along the cells' axes (GMRES, or in an optically thin medium one or two source
+ * iterations: thin_sweeps); the first wavelength solved on all the threads, the others in
  * parallel, one a thread, each started from the first one's solution (solve_all); the moments
  * times chi_l are the field's coefficients (the emission of orders >= 2 per unit sigma_s), plus
  * per cell the sub-cell term that gives the eye the voxels' sigma_s-weighted radiance
@@ -84,12 +85,15 @@ static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np
  * optical depth across it along the sun, h <= tau), in single precision's polynomial exponential
  * (relative error < 1e-6; the library's exp and sinh took half the cells' set-up): below h 0.5 by
  * the series of sinh(h) / h, else as (e^(h - tau) - e^(-h - tau)) / 2h, no exponent above 0. */
+DO_INLINE double mean_transmittance_series(double tau, double h)
+{
+    const double h2 = h * h;
+    return atmos__expf_fast((float)-tau) * (1 + h2 * (1.0 / 6 + h2 * (1.0 / 120 + h2 * (1.0 / 5040))));
+}
+
 DO_INLINE double mean_transmittance(double tau, double h)
 {
-    if (h < 0.5) {
-        const double h2 = h * h;
-        return atmos__expf_fast((float)-tau) * (1 + h2 * (1.0 / 6 + h2 * (1.0 / 120 + h2 * (1.0 / 5040))));
-    }
+    if (h < 0.5) return mean_transmittance_series(tau, h);
     return (atmos__expf_fast((float)(h - tau)) - atmos__expf_fast((float)(-h - tau))) / (2 * h);
 }
 
@@ -310,7 +314,8 @@ DO_INLINE void sun_faces(const atmos__nishita_plan *np, const size_t *vi, const 
  * more than one voxel; sg: the sun's geometry). The same operations in the same order per
  * wavelength as one voxel at a time, in four loops: the medium gathered, the exponentials of
  * every voxel in one vector loop (both sides of mean_transmittance's branch, the one kept chosen
- * per voxel: the same values), the faces' estimate where it is the larger (sun_faces, vectorised
+ * per voxel: the same values; a block whose voxels all take the series side, the optically thin
+ * ones, that side alone), the faces' estimate where it is the larger (sun_faces, vectorised
  * over the voxels it may win),
  * the sums in the voxels' order (the same bits as the voxel-at-a-time loop; built for AVX2 as
  * well as the baseline, chosen at run time). */
@@ -330,11 +335,17 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
         t[e] = tt, sc[e] = ss, tau[e] = ta;
     }
     for (int e = 0; sub && e < m; e++) a0[e] = dc->sub[2 * ((e0 + e) * n + w)], a1[e] = dc->sub[2 * ((e0 + e) * n + w) + 1];
+    double hs[CS_BLOCK], hmax = 0;
     for (int e = 0; e < m; e++) {
         const double tl = t[e] * len, ta = tau[e]; /* fmin's value, no call: neither is NaN */
-        const double hs = 0.5 * (tl < 2 * ta ? tl : 2 * ta), r = mean_transmittance(ta, hs);
-        tr[e] = r, tf[e] = atmos__expf_fast((float)(hs - ta));
+        hs[e] = 0.5 * (tl < 2 * ta ? tl : 2 * ta), hmax = hs[e] > hmax ? hs[e] : hmax;
     }
+    if (hmax < 0.5) /* a block thin along the chord: mean_transmittance's series side alone */
+        for (int e = 0; e < m; e++)
+            tr[e] = mean_transmittance_series(tau[e], hs[e]), tf[e] = atmos__expf_fast((float)(hs[e] - tau[e]));
+    else
+        for (int e = 0; e < m; e++)
+            tr[e] = mean_transmittance(tau[e], hs[e]), tf[e] = atmos__expf_fast((float)(hs[e] - tau[e]));
     /* the faces' estimate where it is the larger: a voxel thick along the chord. It is at most
      * escape(sigma_t lbar) (its faces' share at most 1): the voxels below that alone listed */
     double esc[CS_BLOCK], tff[CS_BLOCK];
@@ -420,6 +431,25 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                     src[cells * w + c] = acc[w][0] * inv,
                                dsrc[cells * w + c] = nv[w] > 0 ? acc[w][3] / acc[w][1] - acc[w][2] / nv[w] : 0;
             }
+}
+
+/* The source iterations that replace GMRES in an optically thin medium (atmos__do_rho's bound
+ * rho on the scattering operator of every wavelength's problem; P's medium and phase set per
+ * wavelength): one where rho <= DO_TOL (its error at most rho times the start's: from 0 rho times
+ * the field, where GMRES from 0 took two sweeps: the source's and one iteration's); with a warm
+ * start (the viewer's sun moving: the start's error the field's change since the last sun) two
+ * where rho^2 <= DO_TOL, GMRES from it taking three; else 0 (GMRES). */
+static int thin_sweeps(const atmos__do_problem *P0, const float *st, size_t cells, int n, const double chi[][4],
+                       int warm)
+{
+    atmos__do_problem P = *P0;
+    double rho = 0;
+    for (int w = 0; w < n; w++) {
+        P.sig_s = st + 2 * cells * w + cells;
+        for (int l = 0; l <= P.L; l++) P.chi[l] = chi[w][l];
+        rho = fmax(rho, atmos__do_rho(&P));
+    }
+    return rho <= DO_TOL ? 1 : warm && rho * rho <= DO_TOL ? 2 : 0;
 }
 
 /* What the wavelengths' solves share: the problem but for the wavelength's medium, emission and
@@ -565,6 +595,8 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
      * the last one's times the ratio of the sunlight; the others solved */
     int copy[ATMOS_MAX_WAVELENGTHS] = {0}, wl[ATMOS_MAX_WAVELENGTHS], ns = 0;
     if (ok) cell_source(np, F, *dc, n, ltg, src, dsrc, threads);
+    /* an optically thin medium: source iterations alone */
+    P->richardson = ok ? thin_sweeps(P, st, cells, n, chi, warm) : 0;
     for (int w = 0; w < n && ok; w++) {
         const float *sw = st + 2 * cells * w;
         copy[w] = w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&

@@ -63,6 +63,10 @@ struct atmos__nishita_mc {
     int ss_done;
     double sun[3], out[3], eye[3];
     int valid, view_valid;
+    /* with lmax >= 0: per cell the harmonics toward the eye at vy_eye (view(); NULL: none yet, or
+     * no memory), the same while the eye stays and only the sun moves */
+    double *vy, vy_eye[3];
+    int vy_valid;
     int warm; /* 1: the field solved from an earlier sun's (the viewer's frames); a frame that asks
                  for no warm start (a save: atmos render's image) solves it afresh */
 };
@@ -74,7 +78,7 @@ void atmos__nishita_mc_free(atmos__nishita_mc *mc)
     atmos__path_phase_free(&mc->ph);
     atmos__path_phase_free(&mc->ph_dm);
     atmos__lfield_free(&mc->field);
-    free(mc->coef), free(mc->do_phi), free(mc->ss);
+    free(mc->coef), free(mc->do_phi), free(mc->ss), free(mc->vy);
     atmos__do_ws_free(mc->do_ws);
     atmos__do_cells_free(mc->do_cells);
     free(mc);
@@ -520,28 +524,39 @@ static atmos_status solve(atmos_plan *p, atmos__nishita_plan *np, const double s
     return st;
 }
 
+/* The harmonics of degree lmax at the direction from cell (i, j, k)'s centre to the eye at eye_w
+ * (world) into Y. */
+static void cell_eye_harmonics(const atmos__nishita_plan *np, const double eye_w[3], int i, int j, int k, double *Y)
+{
+    const atmos__lfield *F = &np->mc->field;
+    const sgrid *g = &np->g;
+    const int ijk[3] = {i, j, k};
+    double gc[3], pw[3], d[3];
+    for (int a = 0; a < 3; a++) gc[a] = (ijk[a] * F->s + 0.5 * (F->s - 1) - g->off[a]) / g->sc;
+    atmos__vol_frame_to_point(&np->x, gc, pw);
+    for (int a = 0; a < 3; a++) d[a] = eye_w[a] - pw[a];
+    atmos__normalize3(d);
+    atmos__sh_eval(np->mc->lmax, d, Y);
+}
+
 /* The field toward the eye at eye_w (world): per cell its coefficients at the direction from
- * the cell's centre to the eye, not below 0. */
+ * the cell's centre to the eye, not below 0. The directions' harmonics kept (mc->vy) for the
+ * frames whose sun alone moved. */
 static void view(atmos__nishita_plan *np, const double eye_w[3], int threads)
 {
     atmos__nishita_mc *mc = np->mc;
     atmos__lfield *F = &mc->field;
-    const sgrid *g = &np->g;
     const int n = np->n, K = mc->K;
+    const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2];
+    if (mc->lmax >= 0 && !mc->vy) mc->vy = malloc(sizeof(double) * cells * K); /* NULL: not kept */
+    const int kept = mc->vy && mc->vy_valid && !memcmp(mc->vy_eye, eye_w, sizeof mc->vy_eye);
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int k = 0; k < F->c[2]; k++)
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t cell = ((size_t)k * F->c[1] + j) * F->c[0] + i;
-                double Y[MC_KMAX] = {1}, gc[3], pw[3], d[3];
-                const int ijk[3] = {i, j, k};
-                if (mc->lmax >= 0) {
-                    for (int a = 0; a < 3; a++) gc[a] = (ijk[a] * F->s + 0.5 * (F->s - 1) - g->off[a]) / g->sc;
-                    atmos__vol_frame_to_point(&np->x, gc, pw);
-                    for (int a = 0; a < 3; a++) d[a] = eye_w[a] - pw[a];
-                    atmos__normalize3(d);
-                    atmos__sh_eval(mc->lmax, d, Y);
-                }
+                double own[MC_KMAX] = {1}, *Y = mc->vy ? mc->vy + cell * K : own;
+                if (mc->lmax >= 0 && !kept) cell_eye_harmonics(np, eye_w, i, j, k, Y);
                 for (int w = 0; w < n; w++) {
                     const float *c = mc->coef + (cell * n + w) * K;
                     double v = 0;
@@ -549,6 +564,7 @@ static void view(atmos__nishita_plan *np, const double eye_w[3], int threads)
                     F->L[cell * n + w] = v > 0 ? (float)v : 0.0f;
                 }
             }
+    if (mc->vy) memcpy(mc->vy_eye, eye_w, sizeof mc->vy_eye), mc->vy_valid = 1;
 }
 
 atmos_status atmos__nishita_mc_update(atmos_plan *p, atmos__nishita_plan *np, const double sun_w[3],
