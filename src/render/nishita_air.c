@@ -14,7 +14,8 @@
 
 #define AIR_CELLS 24 /* the span's cells (the air's single scattering at their centres) */
 
-void atmos__nishita_sun_transmittance(const atmos__nishita_plan *np, const double x[3], const double sun_g[3],
+/* The volume's transmittance toward the sun from grid-frame point x, per wavelength, into T. */
+static void sun_transmittance(const atmos__nishita_plan *np, const double x[3], const double sun_g[3],
                               const float sig[][ATMOS_MAX_WAVELENGTHS], double *T)
 {
     const sgrid *g = &np->g;
@@ -45,7 +46,7 @@ void atmos__nishita_air_shadow(const atmos__nishita_plan *np, const atmos_atmosp
     const double dt = (s1 - s0) / AIR_CELLS;
     for (int c = 0; c < AIR_CELLS; c++) {
         const double t = s0 + (c + 0.5) * dt, x[3] = {eye_g[0] + t * dg[0], eye_g[1] + t * dg[1], eye_g[2] + t * dg[2]};
-        atmos__nishita_sun_transmittance(np, x, sun_g, sig, T);
+        sun_transmittance(np, x, sun_g, sig, T);
         for (int w = 0; w < n; w++) D[w] += S[(size_t)c * n + w] * (1 - T[w]);
     }
 }

@@ -56,9 +56,9 @@
 #define DO_INLINE static inline
 #endif
 
-/* The volume's shadow on the sky's inflow (sky_inflow.h), by the sun's columns (made for sun_g
- * before the solve) in the medium the first order and the photons see (mc_sig: the forward peak
- * cut), as the path tracer's shadow rays: on the ground and on the air out to reach metres. */
+/* The volume's shadow on the air of the sky's inflow (sky_inflow.h), by the sun's columns (made
+ * for sun_g before the solve) in the medium the first order and the photons see (mc_sig: the
+ * forward peak cut), as the path tracer's shadow rays, out to reach metres along a sample's ray. */
 typedef struct {
     const atmos__nishita_plan *np;
     const atmos_atmosphere *atm;
@@ -82,20 +82,11 @@ static void shade_air(const void *u, const double cw[3], const double d[3], doub
                               (const float(*)[ATMOS_MAX_WAVELENGTHS])sh->np->mc_sig, 0, fmin(K, sh->reach), D);
 }
 
-/* the volume's transmittance toward the sun from the ground point gw */
-static void shade_ground(const void *u, const double gw[3], double *T)
-{
-    const inflow_shade *sh = u;
-    double q[3];
-    world_to_frame(sh->np, gw, q);
-    atmos__nishita_sun_transmittance(sh->np, q, sh->sun_g, (const float(*)[ATMOS_MAX_WAVELENGTHS])sh->np->mc_sig, T);
-}
-
 /* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
  * DO_NPHI, atmos__do_quadrature's order: the cosines descending), the mean over the direction's
  * patch (its Gauss-Legendre weight's band of cosines, its azimuth's sector), per wavelength:
- * in[dir * n + w]; the ground and the air in the volume's shadow lit by the sky alone. Returns 1
- * when any is not 0. */
+ * in[dir * n + w]; the air in the volume's shadow lit by the sky alone (the ground's shadow is
+ * not in it: docs/accuracy.md). Returns 1 when any is not 0. */
 static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np, const atmos__do_quad *q,
                       const double sun_w[3], double *in)
 {
@@ -106,14 +97,14 @@ static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np
     for (int a = 0; a < 3; a++) sh.reach += (np->g.box_hi[a] - np->g.box_lo[a]) * (np->g.box_hi[a] - np->g.box_lo[a]);
     sh.reach = 4 * sqrt(sh.reach); /* 4 box diagonals */
     atmos__vol_dir_to_frame(&np->x, sun_w, sh.sun_g);
-    const atmos__sky_ground_shade gs = {shade_ground, shade_air, &sh};
+    const atmos__sky_air_shade air = {shade_air, &sh};
     int any = 0;
     for (int i = 0; i < DO_NMU; i++) {
         const double wmu = q->w[i * DO_NPHI] * DO_NPHI / (2 * ATMOS_PI), bot = i == DO_NMU - 1 ? -1 : top - wmu;
         for (int j = 0; j < DO_NPHI; j++) {
             double *L = in + (size_t)(i * DO_NPHI + j) * np->n;
             atmos__sky_patch_inflow(atm, cw, sun_w, np->n, bot, top, 2 * ATMOS_PI * j / DO_NPHI,
-                                    2 * ATMOS_PI * (j + 1) / DO_NPHI, SKY_NS, np->col_valid ? &gs : NULL, L);
+                                    2 * ATMOS_PI * (j + 1) / DO_NPHI, SKY_NS, np->col_valid ? &air : NULL, L);
             for (int w = 0; w < np->n; w++) any |= L[w] != 0;
         }
         top = bot;

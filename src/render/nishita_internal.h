@@ -112,11 +112,6 @@ atmos_status atmos__nishita_field_update(atmos_plan *p, const double sun_w[3], c
 /* Trilinear value of m floats per voxel of a render-grid array at render-voxel coordinate
  * (u, v, w) (voxel centres at integers; clamped into the grid; nishita_render.c). */
 void atmos__nishita_grid_at(const sgrid *g, const float *arr, int m, double u, double v, double w, float *out);
-/* The volume's transmittance toward the sun sun_g from grid-frame point x (inside the box or not),
- * per wavelength into T: the column density where the way to the sun enters the box (the columns
- * made for sun_g) times sig (nishita_air.c). */
-void atmos__nishita_sun_transmittance(const atmos__nishita_plan *np, const double x[3], const double sun_g[3],
-                                      const float sig[][ATMOS_MAX_WAVELENGTHS], double *T);
 /* What the volume's shadow takes from the air's single scattering along the eye ray cam + t d
  * (world; eye_g + t dg in the grid frame), t in [s0, s1], per wavelength into D; the sun sun_w
  * (world), sun_g (grid frame), the volume's transmittance toward it by the columns (made for

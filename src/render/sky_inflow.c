@@ -1,7 +1,6 @@
 /* The sky's and the ground's light arriving at a volume (sky_inflow.h). */
 #include "render/sky_inflow.h"
 #include "atmosphere/atmosphere_check.h"
-#include "atmosphere/atmosphere_ops.h"
 
 #include <math.h>
 
@@ -23,26 +22,17 @@ void atmos__sky_seen(const atmos_atmosphere *atm, const double cw[3], const doub
     for (int w = 0; w < n; w++) L[w] = fmax(0.0, L[w] - D[w]);
 }
 
-/* The ground's sunlit part that the volume's shadow takes from s (gs, the ground seen along d). */
-static void ground_shadow(const atmos_atmosphere *atm, const double cw[3], const double d[3], const double sun_w[3],
-                          int n, const atmos__sky_ground_shade *gs, double *s)
+/* What the volume's shadow takes from the air's light that s holds (sh, the view ray along d). */
+static void air_shadow(const atmos_atmosphere *atm, const double cw[3], const double d[3], int n,
+                       const atmos__sky_air_shade *sh, double *s)
 {
-    const double K = atmos_atmosphere_ground_distance(atm, cw, d);
-    if (gs->air) {
-        double D[ATMOS_MAX_WAVELENGTHS];
-        gs->air(gs->u, cw, d, K, D);
-        for (int w = 0; w < n; w++) s[w] = fmax(0.0, s[w] - D[w]);
-    }
-    if (!(K < INFINITY)) return;
-    double G[ATMOS_MAX_WAVELENGTHS], T[ATMOS_MAX_WAVELENGTHS];
-    const double gw[3] = {cw[0] + K * d[0], cw[1] + K * d[1], cw[2] + K * d[2]};
-    atmos__atm_ground_sunlit(atm, cw, d, K, sun_w, G);
-    gs->T(gs->u, gw, T);
-    for (int w = 0; w < n; w++) s[w] = fmax(0.0, s[w] - (1 - T[w]) * G[w]);
+    double D[ATMOS_MAX_WAVELENGTHS];
+    sh->take(sh->u, cw, d, atmos_atmosphere_ground_distance(atm, cw, d), D);
+    for (int w = 0; w < n; w++) s[w] = fmax(0.0, s[w] - D[w]);
 }
 
 void atmos__sky_patch_inflow(const atmos_atmosphere *atm, const double cw[3], const double sun_w[3], int n, double mu0,
-                             double mu1, double ph0, double ph1, int ns, const atmos__sky_ground_shade *gs, double *L)
+                             double mu1, double ph0, double ph1, int ns, const atmos__sky_air_shade *sh, double *L)
 {
     for (int w = 0; w < n; w++) L[w] = 0;
     for (int a = 0; a < ns; a++)
@@ -53,7 +43,7 @@ void atmos__sky_patch_inflow(const atmos_atmosphere *atm, const double cw[3], co
             const double d[3] = {-st * cos(ph), -st * sin(ph), -mu};
             double s[ATMOS_MAX_WAVELENGTHS];
             atmos__sky_seen(atm, cw, d, sun_w, n, s);
-            if (gs) ground_shadow(atm, cw, d, sun_w, n, gs, s);
+            if (sh) air_shadow(atm, cw, d, n, sh, s);
             for (int w = 0; w < n; w++) L[w] += s[w] / ((double)ns * ns);
         }
 }
