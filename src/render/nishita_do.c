@@ -57,23 +57,55 @@
 #define DO_INLINE static inline
 #endif
 
+/* The volume's shadow on the air of the sky's inflow (sky_inflow.h), by the sun's columns (made
+ * for sun_g before the solve) in the medium the first order and the photons see (mc_sig: the
+ * forward peak cut), as the path tracer's shadow rays, out to reach metres along a sample's ray. */
+typedef struct {
+    const atmos__nishita_plan *np;
+    const atmos_atmosphere *atm;
+    double sun_g[3], sun_w[3], reach;
+} inflow_shade;
+
+static void world_to_frame(const atmos__nishita_plan *np, const double p[3], double q[3])
+{
+    atmos__vol_point_to_index(&np->x, p, q);
+    for (int a = 0; a < 3; a++) q[a] *= np->x.vs;
+}
+
+/* what the volume's shadow takes from the air's light along cw + t d, t in [0, min(K, reach)] */
+static void shade_air(const void *u, const double cw[3], const double d[3], double K, double *D)
+{
+    const inflow_shade *sh = u;
+    double q[3], dg[3];
+    world_to_frame(sh->np, cw, q);
+    atmos__vol_dir_to_frame(&sh->np->x, d, dg);
+    atmos__nishita_air_shadow(sh->np, sh->atm, cw, d, q, dg, sh->sun_w, sh->sun_g,
+                              (const float(*)[ATMOS_MAX_WAVELENGTHS])sh->np->mc_sig, 0, fmin(K, sh->reach), D);
+}
+
 /* The sky's and the ground's radiance entering the grid along each direction of q (DO_NMU x
  * DO_NPHI, atmos__do_quadrature's order: the cosines descending), the mean over the direction's
  * patch (its Gauss-Legendre weight's band of cosines, its azimuth's sector), per wavelength:
- * in[dir * n + w]. Returns 1 when any is not 0. */
+ * in[dir * n + w]; the air in the volume's shadow lit by the sky alone (the ground's shadow is
+ * not in it: docs/accuracy.md). Returns 1 when any is not 0. */
 static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np, const atmos__do_quad *q,
                       const double sun_w[3], double *in)
 {
     double cen[3], cw[3], top = 1;
     for (int a = 0; a < 3; a++) cen[a] = 0.5 * (np->g.box_lo[a] + np->g.box_hi[a]);
     atmos__sky_inflow_point(atm, &np->x, cen, cw);
+    inflow_shade sh = {np, atm, {0, 0, 0}, {sun_w[0], sun_w[1], sun_w[2]}, 0};
+    for (int a = 0; a < 3; a++) sh.reach += (np->g.box_hi[a] - np->g.box_lo[a]) * (np->g.box_hi[a] - np->g.box_lo[a]);
+    sh.reach = 4 * sqrt(sh.reach); /* 4 box diagonals */
+    atmos__vol_dir_to_frame(&np->x, sun_w, sh.sun_g);
+    const atmos__sky_air_shade air = {shade_air, &sh};
     int any = 0;
     for (int i = 0; i < DO_NMU; i++) {
         const double wmu = q->w[i * DO_NPHI] * DO_NPHI / (2 * ATMOS_PI), bot = i == DO_NMU - 1 ? -1 : top - wmu;
         for (int j = 0; j < DO_NPHI; j++) {
             double *L = in + (size_t)(i * DO_NPHI + j) * np->n;
             atmos__sky_patch_inflow(atm, cw, sun_w, np->n, bot, top, 2 * ATMOS_PI * j / DO_NPHI,
-                                    2 * ATMOS_PI * (j + 1) / DO_NPHI, SKY_NS, L);
+                                    2 * ATMOS_PI * (j + 1) / DO_NPHI, SKY_NS, np->col_valid ? &air : NULL, L);
             for (int w = 0; w < np->n; w++) any |= L[w] != 0;
         }
         top = bot;

@@ -22,8 +22,17 @@ void atmos__sky_seen(const atmos_atmosphere *atm, const double cw[3], const doub
     for (int w = 0; w < n; w++) L[w] = fmax(0.0, L[w] - D[w]);
 }
 
+/* What the volume's shadow takes from the air's light that s holds (sh, the view ray along d). */
+static void air_shadow(const atmos_atmosphere *atm, const double cw[3], const double d[3], int n,
+                       const atmos__sky_air_shade *sh, double *s)
+{
+    double D[ATMOS_MAX_WAVELENGTHS];
+    sh->take(sh->u, cw, d, atmos_atmosphere_ground_distance(atm, cw, d), D);
+    for (int w = 0; w < n; w++) s[w] = fmax(0.0, s[w] - D[w]);
+}
+
 void atmos__sky_patch_inflow(const atmos_atmosphere *atm, const double cw[3], const double sun_w[3], int n, double mu0,
-                             double mu1, double ph0, double ph1, int ns, double *L)
+                             double mu1, double ph0, double ph1, int ns, const atmos__sky_air_shade *sh, double *L)
 {
     for (int w = 0; w < n; w++) L[w] = 0;
     for (int a = 0; a < ns; a++)
@@ -34,6 +43,7 @@ void atmos__sky_patch_inflow(const atmos_atmosphere *atm, const double cw[3], co
             const double d[3] = {-st * cos(ph), -st * sin(ph), -mu};
             double s[ATMOS_MAX_WAVELENGTHS];
             atmos__sky_seen(atm, cw, d, sun_w, n, s);
+            if (sh) air_shadow(atm, cw, d, n, sh, s);
             for (int w = 0; w < n; w++) L[w] += s[w] / ((double)ns * ns);
         }
 }

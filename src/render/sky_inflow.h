@@ -20,10 +20,19 @@ void atmos__sky_inflow_point(const atmos_atmosphere *atm, const atmos__vol_xform
 void atmos__sky_seen(const atmos_atmosphere *atm, const double cw[3], const double d[3], const double sun_w[3], int n,
                      double *L);
 
+/* The volume's shadow on the air: what it takes from the air's light along the view ray
+ * cw + t d, t in [0, K] (K: the ground's distance, or infinite), into D (u: the caller's). */
+typedef struct {
+    void (*take)(const void *u, const double cw[3], const double d[3], double K, double *D);
+    const void *u;
+} atmos__sky_air_shade;
+
 /* The mean radiance travelling along the directions of a patch of the sphere, mu in [mu0, mu1]
  * (the cosine to the world's z axis) and azimuth in [ph0, ph1) about it, arriving at cw: what the
- * view rays along the opposite directions see, over ns x ns cells of equal solid angle, into L. */
+ * view rays along the opposite directions see, over ns x ns cells of equal solid angle, into L.
+ * With sh, what the volume's shadow takes from the air's light is taken off each sample (the
+ * path tracer's sky light is the air's in the volume's shadow). */
 void atmos__sky_patch_inflow(const atmos_atmosphere *atm, const double cw[3], const double sun_w[3], int n, double mu0,
-                             double mu1, double ph0, double ph1, int ns, double *L);
+                             double mu1, double ph0, double ph1, int ns, const atmos__sky_air_shade *sh, double *L);
 
 #endif

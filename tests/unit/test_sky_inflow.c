@@ -4,10 +4,37 @@
  *   - looking at the sun's centre, what is left is the sky just beside the disk (half a degree
  *     from the centre, outside the disk), within a factor 2, for every wavelength; and it is
  *     not the disk (under 1 % of the disk's radiance);
- *   - beside the disk, the same as atmos_atmosphere_radiance. */
+ *   - beside the disk, the same as atmos_atmosphere_radiance.
+ * And atmos__sky_patch_inflow's air in the volume's shadow: what the shade takes comes off every
+ * sample, and nothing else (the path tracer's sky light is the air's less the volume's shadow on
+ * it; the field's inflow had the air lit everywhere). */
 #include "atmos/atmos.h"
 #include "render/sky_inflow.h"
 #include "test.h"
+
+static void take_air(const void *u, const double cw[3], const double d[3], double K, double *D)
+{
+    (void)cw, (void)d, (void)K;
+    for (int w = 0; w < ATMOS_MAX_WAVELENGTHS; w++) D[w] = *(const double *)u;
+}
+
+/* The whole sphere's mean inflow at p, with no shade, a shade that takes nothing and one that
+ * takes 1e-4 from each sample (less than any sample holds): the same, and 1e-4 less. */
+static void check_air_shade(const atmos_atmosphere *atm, const double p[3], const double sun[3], int n)
+{
+    enum { NS = 8 };
+    const double zero = 0, tiny = 1e-4;
+    const atmos__sky_air_shade s0 = {take_air, &zero}, s1 = {take_air, &tiny};
+    double L[ATMOS_MAX_WAVELENGTHS], L0[ATMOS_MAX_WAVELENGTHS], L1[ATMOS_MAX_WAVELENGTHS];
+    atmos__sky_patch_inflow(atm, p, sun, n, -1, 1, 0, 2 * ATMOS_PI, NS, NULL, L);
+    atmos__sky_patch_inflow(atm, p, sun, n, -1, 1, 0, 2 * ATMOS_PI, NS, &s0, L0);
+    atmos__sky_patch_inflow(atm, p, sun, n, -1, 1, 0, 2 * ATMOS_PI, NS, &s1, L1);
+    for (int w = 0; w < n; w++) {
+        printf("inflow %d: %.4g, the air shaded by 1e-4 %.6g\n", w, L[w], L1[w]);
+        CHECK_REL(L0[w], L[w], 1e-12);
+        CHECK_REL(L1[w], L[w] - tiny, 1e-9);
+    }
+}
 
 int main(void)
 {
@@ -43,6 +70,10 @@ int main(void)
         CHECK_MSG(at[k] < 0.01 * disk[k], "%.0f nm: the disk left in (%g, the disk %g)", wl.nm[k], at[k], disk[k]);
         CHECK_REL(off[k], raw[k], 1e-12);
     }
+    atmos_atmosphere_destroy(atm);
+    atmos_atmosphere_defaults(&desc); /* Riley's flat earth */
+    CHECK_OK(atmos_atmosphere_create(ctx, &desc, &wl, &atm));
+    check_air_shade(atm, p, sun, n);
     atmos_atmosphere_destroy(atm);
     atmos_context_destroy(ctx);
     return test_summary("test_sky_inflow");
