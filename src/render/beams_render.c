@@ -452,7 +452,9 @@ static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k,
 /* Interval k of n of the shared light i (interval()'s) sampled, what it saw kept in sh->seen
  * (the stretches the corners agree on are taken by intervals() already: the planes are the same
  * for every pixel, and a pixel's stretch between two planes lies within the hull of its cell's
- * corners' stretches there). */
+ * corners' stretches there: a heuristic, not a proof, since a shadow narrower than the cell can
+ * pass between the corners, the blind spot the lattice's interpolation has too; measured in
+ * docs/beams.md, the thirty-third round). */
 static void shared_interval(job *J, int i, const atmos__beams_ray *ray, const double *f, int k, int n, double unit,
                             double *sum, int centre, double o, double cosf, const shared_ray *sh)
 {

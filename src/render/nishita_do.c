@@ -467,12 +467,11 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
 
 /* The source iterations that replace GMRES in an optically thin medium (atmos__do_rho's bound
  * rho on the scattering operator of every wavelength's problem; P's medium and phase set per
- * wavelength): one where rho <= DO_TOL (its error at most rho times the start's: from 0 rho times
- * the field, where GMRES from 0 took two sweeps: the source's and one iteration's); with a warm
- * start (the viewer's sun moving: the start's error the field's change since the last sun) two
- * where rho^2 <= DO_TOL, GMRES from it taking three; else 0 (GMRES). */
-static int thin_sweeps(const atmos__do_problem *P0, const float *st, size_t cells, int n, const double chi[][4],
-                       int warm)
+ * wavelength), always from 0, so that the error is at most rho^k times the field itself whatever
+ * came before (from a warm start it would be rho^k times the field's change since the last sun,
+ * which need not be small against a field that fell, e.g. at sunset): one where rho <= DO_TOL (GMRES from 0 took
+ * two sweeps: the source's and one iteration's), two where rho^2 <= DO_TOL; else 0 (GMRES). */
+static int thin_sweeps(const atmos__do_problem *P0, const float *st, size_t cells, int n, const double chi[][4])
 {
     atmos__do_problem P = *P0;
     double rho = 0;
@@ -481,7 +480,7 @@ static int thin_sweeps(const atmos__do_problem *P0, const float *st, size_t cell
         for (int l = 0; l <= P.L; l++) P.chi[l] = chi[w][l];
         rho = fmax(rho, atmos__do_rho(&P));
     }
-    return rho <= DO_TOL ? 1 : warm && rho * rho <= DO_TOL ? 2 : 0;
+    return rho <= DO_TOL ? 1 : rho * rho <= DO_TOL ? 2 : 0;
 }
 
 /* What the wavelengths' solves share: the problem but for the wavelength's medium, emission and
@@ -628,7 +627,8 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     int copy[ATMOS_MAX_WAVELENGTHS] = {0}, wl[ATMOS_MAX_WAVELENGTHS], ns = 0;
     if (ok) cell_source(np, F, *dc, n, ltg, src, dsrc, threads);
     /* an optically thin medium: source iterations alone */
-    P->richardson = ok ? thin_sweeps(P, st, cells, n, chi, warm) : 0;
+    P->richardson = ok ? thin_sweeps(P, st, cells, n, chi) : 0;
+    if (P->richardson) warm = 0; /* thin_sweeps: from 0 */
     for (int w = 0; w < n && ok; w++) {
         const float *sw = st + 2 * cells * w;
         copy[w] = w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&

@@ -1,7 +1,8 @@
 /* The plan's one pass over a rendered frame (atmos__copy_not_finite, core/finite.c): over rows of
  * every length from 0 to 40 and a frame's row (720 pixels of 17 channels), with one NaN, one
  * infinity of either sign or none at each position, among finite values that come nearest
- * (the largest float, a subnormal, -0): the count of NaNs and infinities is the count value by
+ * (the largest float, a subnormal, -0), each row and its copy at every offset from a 16-byte
+ * boundary: the count of NaNs and infinities is the count value by
  * value, with and without the copy, and the copy holds the row's bits. */
 #include "core/finite.h"
 #include "test.h"
@@ -41,12 +42,17 @@ int main(void)
 {
     const float bads[] = {NAN, -NAN, INFINITY, -INFINITY};
     const size_t frame_row = 720 * 17;
-    float *row = malloc(sizeof(float) * (frame_row + 1)), *dst = malloc(sizeof(float) * (frame_row + 1));
+    float *row = malloc(sizeof(float) * (frame_row + 4)), *dst = malloc(sizeof(float) * (frame_row + 4));
     if (!row || !dst) return 1;
     int failed = 0, rows = 0;
-    for (size_t n = 0; n <= 40; n++)
-        for (int b = 0; b < 4; b++)
-            for (size_t at = 0; at <= n; at++) failed += !check_row(row, dst, n, at, bads[b]), rows++;
+    /* the rows and their copies at every offset from a 16-byte boundary (the kept frame's rows
+       start anywhere: the copy's first values go one by one up to the boundary) */
+    for (size_t so = 0; so < 4; so++)
+        for (size_t doff = 0; doff < 4; doff++)
+            for (size_t n = 0; n <= 40; n++)
+                for (int b = 0; b < 4; b++)
+                    for (size_t at = 0; at <= n; at++)
+                        failed += !check_row(row + so, dst + doff, n, at, bads[b]), rows++;
     for (int b = 0; b < 4; b++)
         for (size_t at = 0; at <= frame_row; at += at < 64 || at > frame_row - 64 ? 1 : 97)
             failed += !check_row(row, dst, frame_row, at, bads[b]), rows++;
