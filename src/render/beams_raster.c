@@ -8,13 +8,19 @@
 
 void atmos__beams_raster(float *depth, int n, const double x[3], const double y[3], const double z[3], int perspective)
 {
+    atmos__beams_raster_rows(depth, n, x, y, z, perspective, 0, n - 1);
+}
+
+void atmos__beams_raster_rows(float *depth, int n, const double x[3], const double y[3], const double z[3],
+                              int perspective, int row0, int row1)
+{
     const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
     if (area == 0 || !isfinite(area)) return;
     /* the bounding box within the map, clamped before the conversion to int (a vertex near a
      * light's plane projects far out); a box beside the map costs nothing, not a pass over
      * its rows (most of a city's triangles lie outside a narrow spot's map) */
     const double bx0 = fmax(0, floor(fmin(x[0], fmin(x[1], x[2])))), bx1 = fmin(n - 1, ceil(fmax(x[0], fmax(x[1], x[2]))));
-    const double by0 = fmax(0, floor(fmin(y[0], fmin(y[1], y[2])))), by1 = fmin(n - 1, ceil(fmax(y[0], fmax(y[1], y[2]))));
+    const double by0 = fmax(row0, floor(fmin(y[0], fmin(y[1], y[2])))), by1 = fmin(row1, ceil(fmax(y[0], fmax(y[1], y[2]))));
     if (!(bx0 <= bx1 && by0 <= by1)) return;
     const int x0 = (int)bx0, x1 = (int)bx1, y0 = (int)by0, y1 = (int)by1;
     for (int py = y0; py <= y1; py++)

@@ -8,6 +8,11 @@
  * the depth is affine across the map, an orthographic view) or its reciprocal (perspective 1:
  * 1/depth is affine, a pinhole view). */
 void atmos__beams_raster(float *depth, int n, const double x[3], const double y[3], const double z[3], int perspective);
+/* The same, its texels in rows row0..row1 alone (0 <= row0, row1 <= n - 1): each texel the
+ * value and the order of comparisons of the whole triangle's, so a map drawn band by band,
+ * every triangle in the same order into each band, has the same bits. */
+void atmos__beams_raster_rows(float *depth, int n, const double x[3], const double y[3], const double z[3],
+                              int perspective, int row0, int row1);
 
 /* Clips a triangle (a view's frame, z forward) at z = near (Sutherland-Hodgman) into poly;
  * returns its vertex count, 0 or 3..4 (a fan from poly[0]). */

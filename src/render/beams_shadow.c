@@ -112,7 +112,7 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     for (int f = 0; f < nf; f++) {
         if (atmos__cancelled(&pr->cancelled)) continue;
         raster_face(&l->face[f], l->L.pos, mesh, nmesh);
-        if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n, ATMOS__BEAMS_LIGHT_TILE_SHIFT)) {
+        if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n, ATMOS__BEAMS_LIGHT_TILE_SHIFT, 1)) {
 #pragma omp atomic write
             failed = 1;
         }

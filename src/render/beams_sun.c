@@ -43,11 +43,103 @@ void atmos__beams_sun_free(atmos__beams_sun *s)
     s->depth = NULL, s->n = 0;
 }
 
-/* One triangle (u, v in texels, depth) into the map: depth is linear in an orthographic view. */
-static void draw(atmos__beams_sun *s, const double v[3][3])
+#define SUN_BANDS 32 /* the map drawn in bands of rows, one thread a band */
+
+/* The vertices of the meshes in the map's frame: u, v in texels, the depth (one array, each
+ * mesh's from at[m]); NULL out of memory. */
+static double *map_vertices(const atmos__beams_sun *s, atmos_mesh *const *mesh, int nmesh, size_t *at)
 {
-    const double x[3] = {v[0][0], v[1][0], v[2][0]}, y[3] = {v[0][1], v[1][1], v[2][1]}, z[3] = {v[0][2], v[1][2], v[2][2]};
-    atmos__beams_raster(s->depth, s->n, x, y, z, 0);
+    size_t total = 0;
+    for (int m = 0; m < nmesh; m++) at[m] = total, total += (size_t)mesh[m]->vertex_count;
+    double *w = malloc(sizeof(double) * 3 * (total ? total : 1));
+    if (!w) return NULL;
+    for (int m = 0; m < nmesh; m++)
+        for (int i = 0; i < mesh[m]->vertex_count; i++) {
+            const float *p = mesh[m]->positions + 3 * i;
+            const double q[3] = {p[0], p[1], p[2]};
+            double *o = w + 3 * (at[m] + (size_t)i);
+            o[0] = (atmos__dot3(q, s->right) - s->u0) / s->texel;
+            o[1] = (atmos__dot3(q, s->up) - s->v0) / s->texel;
+            o[2] = atmos__dot3(q, s->fwd);
+        }
+    return w;
+}
+
+/* The first row of band b of an n-row map. */
+static int band_row(int n, int b) { return (int)((long)n * b / SUN_BANDS); }
+
+/* The band of row y (0 <= y < n). */
+static int row_band(int n, int y)
+{
+    int b = (int)((long)y * SUN_BANDS / n);
+    while (b + 1 < SUN_BANDS && band_row(n, b + 1) <= y) b++;
+    while (b > 0 && band_row(n, b) > y) b--;
+    return b;
+}
+
+/* The triangles in the map's bands: each triangle (numbered over the meshes one after the
+ * other) listed in every band its rows meet, in order: band b's in list[at[b] .. at[b + 1]).
+ * A triangle whose rows lie beside the map or are not finite draws nothing (the rasteriser's
+ * own rule) and is left out. w, vat: map_vertices'. Returns the list, NULL out of memory. */
+static size_t *band_lists(const atmos__beams_sun *s, atmos_mesh *const *mesh, int nmesh, const double *w,
+                       const size_t *vat, size_t *at, int threads)
+{
+    size_t total = 0;
+    for (int m = 0; m < nmesh; m++) total += (size_t)mesh[m]->triangle_count;
+    unsigned char *span = malloc(2 * (total ? total : 1));
+    if (!span) return NULL;
+    const int n = s->n;
+    size_t t0 = 0;
+    for (int m = 0; m < nmesh; m++) {
+        const atmos_mesh *M = mesh[m];
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (int t = 0; t < M->triangle_count; t++) {
+            double lo = INFINITY, hi = -INFINITY;
+            for (int k = 0; k < 3; k++) {
+                const double y = w[3 * (vat[m] + (size_t)M->indices[3 * t + k]) + 1];
+                lo = fmin(lo, y), hi = fmax(hi, y);
+            }
+            unsigned char *sp = span + 2 * (t0 + (size_t)t);
+            if (!(isfinite(lo) && isfinite(hi)) || ceil(hi) < 0 || floor(lo) > n - 1) sp[0] = 1, sp[1] = 0;
+            else sp[0] = (unsigned char)row_band(n, (int)fmax(0, floor(lo))),
+            sp[1] = (unsigned char)row_band(n, (int)fmin(n - 1, ceil(hi)));
+        }
+        t0 += (size_t)M->triangle_count;
+    }
+    for (int b = 0; b <= SUN_BANDS; b++) at[b] = 0;
+    for (size_t t = 0; t < total; t++)
+        for (int b = span[2 * t]; b <= span[2 * t + 1]; b++) at[b + 1]++;
+    for (int b = 0; b < SUN_BANDS; b++) at[b + 1] += at[b];
+    size_t fill[SUN_BANDS];
+    for (int b = 0; b < SUN_BANDS; b++) fill[b] = at[b];
+    size_t *list = malloc(sizeof(size_t) * (at[SUN_BANDS] ? at[SUN_BANDS] : 1));
+    if (list)
+        for (size_t t = 0; t < total; t++)
+            for (int b = span[2 * t]; b <= span[2 * t + 1]; b++) list[fill[b]++] = t;
+    free(span);
+    return list;
+}
+
+/* Band b of the map: cleared, then its triangles, in order (depth is linear in an
+ * orthographic view). */
+static void draw_band(atmos__beams_sun *s, atmos_mesh *const *mesh, int nmesh, const double *w, const size_t *vat,
+                      const size_t *list, const size_t *at, int b)
+{
+    const size_t n = (size_t)s->n;
+    const int row0 = band_row(s->n, b), row1 = band_row(s->n, b + 1) - 1;
+    for (size_t i = (size_t)row0 * n; i < (size_t)(row1 + 1) * n; i++) s->depth[i] = INFINITY;
+    int m = 0;
+    size_t t0 = 0; /* the first triangle of mesh m */
+    for (size_t i = at[b]; i < at[b + 1]; i++) {
+        while (m + 1 < nmesh && list[i] >= t0 + (size_t)mesh[m]->triangle_count) t0 += (size_t)mesh[m++]->triangle_count;
+        const size_t t = list[i] - t0;
+        double x[3], y[3], z[3];
+        for (int k = 0; k < 3; k++) {
+            const double *o = w + 3 * (vat[m] + (size_t)mesh[m]->indices[3 * t + k]);
+            x[k] = o[0], y[k] = o[1], z[k] = o[2];
+        }
+        atmos__beams_raster_rows(s->depth, s->n, x, y, z, 0, row0, row1);
+    }
 }
 
 atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, const double dir[3], atmos_mesh *const *mesh,
@@ -75,24 +167,21 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
     /* the objects lie within [1, 1 + (hi - lo) / texel] texels, [0.5, ...] in look-up coordinates */
     s->box[0] = -1, s->box[1] = fmin(size, 2 + (hi[0] - lo[0]) / s->texel);
     s->box[2] = -1, s->box[3] = fmin(size, 2 + (hi[1] - lo[1]) / s->texel);
-    if (!(s->depth = malloc(sizeof(float) * (size_t)size * size))) {
+    const int threads = atmos__threads(ctx);
+    size_t *vat = malloc(sizeof(size_t) * (size_t)nmesh), at[SUN_BANDS + 1];
+    double *w = vat ? map_vertices(s, mesh, nmesh, vat) : NULL;
+    size_t *list = w ? band_lists(s, mesh, nmesh, w, vat, at, threads) : NULL;
+    if (!list || !(s->depth = malloc(sizeof(float) * (size_t)size * size))) {
+        free(vat), free(w), free(list);
         s->n = 0;
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d sun shadow map", size, size);
     }
-    for (size_t i = 0; i < (size_t)size * size; i++) s->depth[i] = INFINITY;
-    for (int m = 0; m < nmesh; m++)
-        for (int t = 0; t < mesh[m]->triangle_count; t++) {
-            double v[3][3];
-            for (int k = 0; k < 3; k++) {
-                const float *p = mesh[m]->positions + 3 * mesh[m]->indices[3 * t + k];
-                const double q[3] = {p[0], p[1], p[2]};
-                v[k][0] = (atmos__dot3(q, s->right) - s->u0) / s->texel;
-                v[k][1] = (atmos__dot3(q, s->up) - s->v0) / s->texel;
-                v[k][2] = atmos__dot3(q, s->fwd);
-            }
-            draw(s, v);
-        }
-    if (atmos__beams_tiles_build(&s->tiles, s->depth, size, ATMOS__BEAMS_SUN_TILE_SHIFT)) {
+    /* each band of rows on its own, its triangles in the meshes' order: the same bits with
+     * any number of threads */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int b = 0; b < SUN_BANDS; b++) draw_band(s, mesh, nmesh, w, vat, list, at, b);
+    free(vat), free(w), free(list);
+    if (atmos__beams_tiles_build(&s->tiles, s->depth, size, ATMOS__BEAMS_SUN_TILE_SHIFT, threads)) {
         atmos__beams_sun_free(s);
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d sun shadow map's tiles", size, size);
     }

@@ -19,6 +19,8 @@ void atmos__beams_sun_warn_texel(atmos_context *ctx, const atmos__beams_sun *s, 
     double wide = -1;
     for (int m = 0; m < nmesh; m++) {
         const atmos_mesh *M = mesh[m];
+        long ms = 0; /* the mesh's small triangles: a count, the same with any number of threads */
+#pragma omp parallel for schedule(static) reduction(+ : ms) num_threads(atmos__threads(ctx))
         for (int t = 0; t < M->triangle_count; t++) {
             double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
             for (int k = 0; k < 3; k++)
@@ -27,8 +29,9 @@ void atmos__beams_sun_warn_texel(atmos_context *ctx, const atmos__beams_sun *s, 
                     lo[a] = fmin(lo[a], x), hi[a] = fmax(hi[a], x);
                 }
             const double size = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
-            small += size * TEXEL_PER_TRIANGLE < s->texel, all++;
+            ms += size * TEXEL_PER_TRIANGLE < s->texel;
         }
+        small += ms, all += M->triangle_count;
         /* the object whose bounds across the sun's rays are the widest sets the map's extent */
         double u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
         for (int i = 0; i < M->vertex_count; i++) {

@@ -26,9 +26,10 @@ static size_t plan_levels(atmos__beams_tiles *t)
 }
 
 /* Level 0: each tile over its texels and a ring of one around. */
-static void finest(atmos__beams_tiles *t, const float *depth, int n)
+static void finest(atmos__beams_tiles *t, const float *depth, int n, int threads)
 {
     const int T = t->tiles, TILE = 1 << t->shift;
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
     for (int ty = 0; ty < T; ty++)
         for (int tx = 0; tx < T; tx++) {
             float lo = INFINITY, hi = -INFINITY;
@@ -43,7 +44,7 @@ static void finest(atmos__beams_tiles *t, const float *depth, int n)
         }
 }
 
-int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, int shift)
+int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, int shift, int threads)
 {
     t->shift = shift;
     t->tiles = (n + (1 << shift) - 1) >> shift;
@@ -53,10 +54,11 @@ int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, i
         return -1;
     }
     t->max = t->min + cells;
-    finest(t, depth, n);
+    finest(t, depth, n, threads);
     for (int k = 1; k < t->levels; k++) {
         const int m = t->level_n[k], c = t->level_n[k - 1];
         const float *cmin = t->min + t->level_at[k - 1], *cmax = t->max + t->level_at[k - 1];
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && m >= 64)
         for (int j = 0; j < m; j++)
             for (int i = 0; i < m; i++) {
                 float lo = INFINITY, hi = -INFINITY;

@@ -24,9 +24,10 @@ typedef struct atmos__beams_tiles {
     float *min, *max;        /* every level's cells, one allocation (min) */
 } atmos__beams_tiles;
 
-/* The pyramid of the n x n map depth, tiles of 2^shift texels a side; 0, or -1 out of memory
- * (t then empty). */
-int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, int shift);
+/* The pyramid of the n x n map depth, tiles of 2^shift texels a side, its rows of tiles on
+ * up to threads threads (each cell on its own: the same bits with any number); 0, or -1 out
+ * of memory (t then empty). */
+int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, int shift, int threads);
 void atmos__beams_tiles_free(atmos__beams_tiles *t);
 /* The tile of the texel x, y (a look-up's floor; -1 is clamped to 0) at level 0; shift the
  * pyramid's own (t->shift), given by the caller as a constant for a shift rather than a load. */

@@ -693,7 +693,7 @@ static void test_tiles_range(void)
         if (!depth) continue;
         for (int i = 0; i < n * n; i++) depth[i] = (float)(1 + (i * 7919 % 1009) + (i / n) % 13);
         atmos__beams_tiles t;
-        CHECK(atmos__beams_tiles_build(&t, depth, n, sh) == 0);
+        CHECK(atmos__beams_tiles_build(&t, depth, n, sh, 1 + (c / 2 + c) % 2) == 0);
         for (int b = 0; b < 4000 && t.min; b++, boxes++) {
             int x0 = (b * 37) % (n + 1) - 1, x1 = x0 + (b * 13) % (b % 3 ? 9 : n), y0 = (b * 53) % (n + 1) - 1;
             int y1 = y0 + (b * 29) % (b % 5 ? 40 : n);

@@ -15,13 +15,17 @@
  *     own steps at epsilon 1e-4 (atmos__beams_sun_airlight) on rays across the fence's
  *     shadows: within 2 % of the unshadowed whole a ray;
  *   - lines kept from one build to the next (the eye turning in place) are a fresh build's,
- *     and are made again when the map is (a post moved: the same epipole) or the eye moves. */
+ *     and are made again when the map is (a post moved: the same epipole) or the eye moves;
+ *   - the map, drawn band by band on 1, 2 and 3 threads, has the bits of every triangle drawn
+ *     in order over the whole map, and so have its tiles. */
 #include "atmos/atmos.h"
 #include "render/beams_sun.h"
 #include "render/beams_epipolar.h"
+#include "render/beams_raster.h"
 #include "core/vec.h"
 #include "test.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 static atmos_context *ctx;
@@ -113,6 +117,48 @@ static int fence(atmos_mesh *post[10], atmos__beams_sun *s, const double sun[3])
     memset(s, 0, sizeof *s);
     CHECK_OK(atmos__beams_sun_build(ctx, s, sun, post, 10, 256));
     return s->n == 256;
+}
+
+/* The map of s built again with 1, 2 and 3 threads against the fence's triangles drawn one
+ * after the other into the whole map (the rasteriser alone), and its tiles. */
+static void test_bands(atmos_mesh *post[10], const atmos__beams_sun *s, const double sun[3])
+{
+    const size_t nn = (size_t)s->n * s->n;
+    float *ref = malloc(sizeof(float) * nn);
+    if (!ref) return;
+    for (size_t i = 0; i < nn; i++) ref[i] = INFINITY;
+    for (int m = 0; m < 10; m++)
+        for (int t = 0; t < post[m]->triangle_count; t++) {
+            double x[3], y[3], z[3];
+            for (int k = 0; k < 3; k++) {
+                const float *p = post[m]->positions + 3 * post[m]->indices[3 * t + k];
+                const double q[3] = {p[0], p[1], p[2]};
+                x[k] = (atmos__dot3(q, s->right) - s->u0) / s->texel;
+                y[k] = (atmos__dot3(q, s->up) - s->v0) / s->texel;
+                z[k] = atmos__dot3(q, s->fwd);
+            }
+            atmos__beams_raster(ref, s->n, x, y, z, 0);
+        }
+    long lit = 0;
+    for (size_t i = 0; i < nn; i++) lit += !isinf(ref[i]);
+    CHECK(lit > (long)nn / 20); /* the fence covers the map, not a corner of it */
+    for (int th = 1; th <= 3; th++) {
+        atmos_context_desc d;
+        memset(&d, 0, sizeof d);
+        d.threads = th;
+        atmos_context *c = NULL;
+        CHECK_OK(atmos_context_create(&d, &c));
+        atmos__beams_sun b;
+        memset(&b, 0, sizeof b);
+        CHECK_OK(atmos__beams_sun_build(c, &b, sun, post, 10, s->n));
+        CHECK(b.n == s->n && b.depth && !memcmp(b.depth, ref, sizeof(float) * nn));
+        CHECK(b.tiles.levels == s->tiles.levels && b.tiles.min &&
+              !memcmp(b.tiles.min, s->tiles.min,
+                      sizeof(float) * 2 * (s->tiles.level_at[s->tiles.levels - 1] + 1)));
+        atmos__beams_sun_free(&b);
+        atmos_context_destroy(c);
+    }
+    free(ref);
 }
 
 /* Each line's tree: a cell of the finest level holds the least and the greatest of its 4
@@ -231,6 +277,7 @@ int main(void)
             test_airlight(&s, &e, eye);
         }
         atmos__beams_epi_free(&e);
+        test_bands(post, &s, sun);
         test_kept_lines(post, &s, sun, eye); /* last: it moves a post */
     }
     atmos__beams_sun_free(&s);
