@@ -441,7 +441,9 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
     float sig[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS], sca[ATMOS_MAX_WAVELENGTHS][ATMOS_VOLUME_MAX_FIELDS];
     for (int f = 0; f < nf; f++)
         for (int w = 0; w < n; w++) sig[w][f] = np->mc_sig_ms[f][w], sca[w][f] = np->mc_sca[f][w];
-#pragma omp parallel for schedule(static) num_threads(threads)
+    /* planes of cells handed out one at a time: the Disney cloud's voxels are 46 % in the lower
+       half of its planes and 54 % in the upper (each cell's sums alone: the same bits) */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int k = 0; k < F->c[2]; k++)
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
