@@ -48,9 +48,9 @@ typedef struct tile {
 } tile;
 
 /* The least and the greatest of three. Here atmos__mind / atmos__maxd stand for fmin / fmax,
- * which are calls into the maths library: the same values, since no operand is a NaN (and a
- * running bound's new value comes first, so that a NaN would be skipped as fmin skips it), and
- * a zero's sign does not change the bounds' ceil, floor and comparisons. */
+ * which are calls into the maths library: the same values, since no operand is a NaN (the
+ * projected vertices are finite; unlike fmin, a NaN here would not always be skipped), and a
+ * zero's sign does not change the bounds' ceil, floor and comparisons. */
 #define MIN3(v) atmos__mind((v)[0], atmos__mind((v)[1], (v)[2]))
 #define MAX3(v) atmos__maxd((v)[0], atmos__maxd((v)[1], (v)[2]))
 

@@ -29,10 +29,7 @@ static void make_window(atmos__beams_light *bl)
     snprintf(l->image, sizeof l->image, "%s/scenes/dobashi_fig09b_window.png", src && *src ? src : ".");
     s.light_count = 1;
     atmos_wavelengths wl;
-    memset(&wl, 0, sizeof wl);
-    wl.mode = ATMOS_WAVELENGTHS_RGB;
-    wl.count = 3;
-    wl.nm[0] = 600, wl.nm[1] = 550, wl.nm[2] = 450;
+    atmos_wavelengths_rgb(&wl);
     memset(bl, 0, sizeof *bl);
     atmos__lamp_make(l, &wl, &bl->L);
     CHECK_OK(atmos__lamp_load_image(ctx, &s, 0, &bl->L));
