@@ -152,6 +152,9 @@ enum {
     ATMOS__BEAMS_KEPT_NODE,
     ATMOS__BEAMS_KEPT_DIR,
     ATMOS__BEAMS_KEPT_HIDDEN, /* the sky behind's mask (sky_behind) */
+    ATMOS__BEAMS_KEPT_NODE_X, /* the lattice's columns and rows, its nodes' masks (subsampled) */
+    ATMOS__BEAMS_KEPT_NODE_Y,
+    ATMOS__BEAMS_KEPT_SEEN,
     ATMOS__BEAMS_KEPT_COUNT
 };
 

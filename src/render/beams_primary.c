@@ -117,6 +117,23 @@ static int row_span(const stri *s, double sg, const double len[3], double cy, in
     return *pa <= *pb;
 }
 
+/* Whether draw() may skip the pixels whose drawn surface is nearer than the triangle's nearest
+ * vertex (znear) by more than DEPTH_TOL and HIDE_SLACK: its depth at a pixel centre is then
+ * beyond that surface's DEPTH_TOL, so it is neither a nearer cover nor a rival that could count
+ * (a rival's depth matters only within DEPTH_TOL of the pixel's final surface, which is never
+ * farther than the one drawn now). A covered pixel's depth is at least znear but for the
+ * rounding of its edge functions against the area: with the vertices within HIDE_COORD pixels
+ * of the origin (their products below 2^27, each edge function's error below 1e-7) and an area
+ * of at least a pixel, its depth is within 1e-6 of at least znear, well inside HIDE_SLACK. */
+#define HIDE_COORD 4096
+#define HIDE_SLACK 1e-5
+static int hides(const stri *s, double area)
+{
+    for (int k = 0; k < 3; k++)
+        if (!(fabs(s->x[k]) < HIDE_COORD && fabs(s->y[k]) < HIDE_COORD)) return 0;
+    return fabs(area) >= 1;
+}
+
 /* A rival's depth is at least the nearest vertex's (the depth extrapolated past a thin
  * triangle's edge can be far nearer than any point of it), so a triangle is never nearer than
  * its box: what makes hiding a box exact. */
@@ -137,11 +154,15 @@ static void draw(tile *T, const stri *s)
         return;
     }
     const double sg = area > 0 ? 1 : -1, inv = 1.0 / fabs(area), ilen[3] = {1 / len[0], 1 / len[1], 1 / len[2]};
+    /* a pixel whose surface drawn already is nearer than znear by more than DEPTH_TOL and
+     * HIDE_SLACK is skipped: nothing drawn here changes its entry (see hides) */
+    const double zhide = hides(s, area) ? znear / ((1 + DEPTH_TOL) * (1 + HIDE_SLACK)) : 0;
     for (int py = s->py0; py <= s->py1; py++) {
         const double cy = py + 0.5;
         int pa, pb;
         if (!row_span(s, sg, len, cy, &pa, &pb)) continue;
         for (int px = pa; px <= pb; px++) {
+            if (T->z[at(T, px, py)] < zhide) continue;
             const double cx = px + 0.5;
             double e[3], dmin = INFINITY;
             for (int k = 0; k < 3; k++) {

@@ -813,7 +813,8 @@ static inline void kept_ray(const job *J, int x, int y, double d[3])
     d[0] = J->dir[i], d[1] = J->dir[n + i], d[2] = J->dir[2 * n + i];
 }
 
-/* The buffers of a subsampled frame over r (each NULL until made). */
+/* The buffers of a subsampled frame over r (each NULL until made), the plan's (beams_kept.h), kept
+ * for the next frame. */
 typedef struct screen_buf {
     int *X, *Y, *obj;
     double *T, *node;
@@ -955,11 +956,6 @@ static int air_layers(job *J, air_layer a[2])
 }
 
 
-static void screen_buf_free(screen_buf *q) /* the others are the plan's, kept for the next frame */
-{
-    free(q->X), free(q->Y), free(q->seen);
-}
-
 /* Band j of a subsampled frame (atmos__beams_screen_band) from the lattice's nodes, each of the
  * nl layers s[l] in its own band[l] and state[l], their sum added to the pixels' light (its last
  * row only in the last band: the next band's first). Returns the pixels evaluated (in each
@@ -1009,7 +1005,8 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     *evaluated = 0;
     if (W <= 0 || H <= 0) return 0;
     atmos__beams_kept *kept = p->beams->kept; /* the plan's, for the next frame too */
-    screen_buf q = {malloc(sizeof(int) * (size_t)((W - 1) / k + 2)), malloc(sizeof(int) * (size_t)((H - 1) / k + 2)),
+    screen_buf q = {atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_NODE_X], sizeof(int) * (size_t)((W - 1) / k + 2)),
+                    atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_NODE_Y], sizeof(int) * (size_t)((H - 1) / k + 2)),
                     atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_OBJECT], sizeof(int) * n),
                     atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_DEPTH], sizeof(double) * n), NULL,
                     atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_BASE], sizeof(float) * n * nw), NULL, NULL};
@@ -1020,11 +1017,9 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
     const int nl = air_layers(J, a);
     const size_t layer = (size_t)nx * ny * nw; /* the nodes of a layer */
     if (!failed) failed = !(q.node = atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_NODE], sizeof(double) * nl * layer));
-    if (!failed) failed = !(q.seen = malloc(sizeof(uint64_t) * 2 * (size_t)nl * nx * ny));
-    if (failed) {
-        screen_buf_free(&q);
-        return 1;
-    }
+    if (!failed)
+        failed = !(q.seen = atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_SEEN], sizeof(uint64_t) * 2 * (size_t)nl * nx * ny));
+    if (failed) return 1;
     /* none: each pass makes its rays */
     q.dir = J->ru ? atmos__beams_kept_get(&kept[ATMOS__BEAMS_KEPT_DIR], sizeof(double) * 3 * n) : NULL;
     J->dir = q.dir, J->dir_r = *r;
@@ -1087,7 +1082,6 @@ static int subsampled(atmos_plan *p, job *J, const atmos__rect *r, atmos_image *
         free(f);
     }
     J->dir = NULL;
-    screen_buf_free(&q);
     *evaluated = ev, p->beams->air_shared = sh, p->beams->air_unread = un, p->beams->air_told = told;
     return failed;
 }

@@ -52,9 +52,6 @@ static const uint64_t *corners(const band *b, int x0, int y0, int x1, int y1, ui
     return known[0] | known[1] ? known : NULL;
 }
 
-/* Whether every pixel of [x0, x1] x [y0, y1] sees the same object at depths within the ratio
- * 1 + s->depth of each other (or all the sky); dim[k]: the least light without the airlight of
- * its pixels, per wavelength. */
 /* dim[k]: the least of base[i nw + k] over the pixels i of [x0, x1] x [y0, y1] (each row's
  * values one block; the minima exact, so the same values in the AVX2 clone). */
 ATMOS_CLONES_NOINLINE static void least_base(const atmos__beams_screen *s, int x0, int y0, int x1, int y1, double *dim)
@@ -68,7 +65,9 @@ ATMOS_CLONES_NOINLINE static void least_base(const atmos__beams_screen *s, int x
     }
 }
 
-static int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1, double *dim)
+/* Whether every pixel of [x0, x1] x [y0, y1] sees the same object at depths within the ratio
+ * 1 + s->depth of each other (or all the sky). */
+static int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
 {
     const int m = s->object[pix(s, x0, y0)];
     double lo = INFINITY, hi = 0;
@@ -78,9 +77,7 @@ static int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, in
             if (s->object[i] != m) return 0;
             lo = atmos__mind(s->T[i], lo), hi = atmos__maxd(s->T[i], hi); /* fmin, fmax: no NaN here */
         }
-    if (!(isinf(lo) || hi <= lo * (1 + s->depth))) return 0;
-    least_base(s, x0, y0, x1, y1, dim); /* only for a cell that passes: dim is read then alone */
-    return 1;
+    return isinf(lo) || hi <= lo * (1 + s->depth);
 }
 
 /* Whether row y of span sp holds [x0 - m, x1 + m] (or to the region's edge). */
@@ -133,19 +130,14 @@ static void weights(int x0, int y0, int x1, int y1, int x, int y, double w[4])
     w[0] = (1 - u) * (1 - v), w[1] = u * (1 - v), w[2] = (1 - u) * v, w[3] = u * v;
 }
 
-/* Whether the cell's corners c agree (beams_screen.h), and each of its points (px[j], py[j]),
- * j < np, evaluated, lies within curve of the light it may have of their interpolation. */
-static int agree(const band *b, const double *c[4], int x0, int y0, int x1, int y1, const int *px, const int *py, int np,
-                 double curve)
+/* agree()'s test with dim[k] the least light without the airlight of the cell's pixels: the
+ * corners c's spread and each point cm[j] (weights w[j]) against their interpolation, within
+ * s->spread and curve of the least light a pixel of the cell may have. A dim[k] lower than the
+ * cell's least passes only where that passes (the sums and products below are monotone in it),
+ * a higher one fails only where that fails. */
+static int within(const atmos__beams_screen *s, const double *const c[4], const double *const *cm, const double (*w)[4],
+                  int np, double curve, const double *dim)
 {
-    const atmos__beams_screen *s = b->s;
-    double dim[ATMOS__BEAMS_SCREEN_MAX_NW], w[5][4];
-    const double *cm[5];
-    if (!same_surface(s, x0, y0, x1, y1, dim)) return 0;
-    for (int j = 0; j < np; j++) {
-        weights(x0, y0, x1, y1, px[j], py[j], w[j]);
-        cm[j] = b->out + at(b, px[j], py[j]) * s->nw;
-    }
     for (int k = 0; k < s->nw; k++) {
         const double lo = atmos__mind(atmos__mind(c[0][k], c[1][k]), atmos__mind(c[2][k], c[3][k]));
         const double hi = atmos__maxd(atmos__maxd(c[0][k], c[1][k]), atmos__maxd(c[2][k], c[3][k]));
@@ -159,25 +151,67 @@ static int agree(const band *b, const double *c[4], int x0, int y0, int x1, int 
     return 1;
 }
 
-/* The cell [x0, x1] x [y0, y1], its corners c evaluated, filled by bilinear interpolation
- * (the pixels not evaluated; the wavelengths in one loop, vectorised in the AVX2 clone: the
- * same bits). */
-ATMOS_CLONES_NOINLINE static void fill(band *b, int x0, int y0, int x1, int y1)
+/* Whether the cell's corners c agree (beams_screen.h), and each of its points (px[j], py[j]),
+ * j < np, evaluated, lies within curve of the light it may have of their interpolation. The
+ * least light without the airlight over the cell's pixels (least_base) is read only where two
+ * bounds of it do not settle the test: 0 below (that light is never negative: albedos within
+ * [0, 1], the lights' and the sky's light not negative), the least of the four corners' above
+ * (they are pixels of the cell); the same answer as the least itself gives. */
+static int agree(const band *b, const double *c[4], int x0, int y0, int x1, int y1, const int *px, const int *py, int np,
+                 double curve)
 {
-    const int nw = b->s->nw;
-    const double *c[4] = {b->out + at(b, x0, y0) * nw, b->out + at(b, x1, y0) * nw, b->out + at(b, x0, y1) * nw,
-                          b->out + at(b, x1, y1) * nw};
+    const atmos__beams_screen *s = b->s;
+    const int nw = s->nw;
+    double dim[ATMOS__BEAMS_SCREEN_MAX_NW], w[5][4];
+    const double *cm[5];
+    if (!same_surface(s, x0, y0, x1, y1)) return 0;
+    for (int j = 0; j < np; j++) {
+        weights(x0, y0, x1, y1, px[j], py[j], w[j]);
+        cm[j] = b->out + at(b, px[j], py[j]) * nw;
+    }
+    for (int k = 0; k < nw; k++) dim[k] = 0;
+    if (within(s, c, cm, (const double (*)[4])w, np, curve, dim)) return 1;
+    const float *q[4] = {s->base + pix(s, x0, y0) * nw, s->base + pix(s, x1, y0) * nw, s->base + pix(s, x0, y1) * nw,
+                         s->base + pix(s, x1, y1) * nw};
+    for (int k = 0; k < nw; k++) /* the corners' least, as least_base takes it */
+        dim[k] = atmos__mind(q[3][k], atmos__mind(q[2][k], atmos__mind(q[1][k], atmos__mind(q[0][k], INFINITY))));
+    if (!within(s, c, cm, (const double (*)[4])w, np, curve, dim)) return 0;
+    least_base(s, x0, y0, x1, y1, dim);
+    return within(s, c, cm, (const double (*)[4])w, np, curve, dim);
+}
+
+/* fill()'s pixels with nw wavelengths (inlined into fill: a constant nw unrolls the loop over
+ * them). The band's fields are read once: the state's byte stores may alias them. */
+static inline __attribute__((always_inline)) void fill_nw(const band *b, int x0, int y0, int x1, int y1, const int nw)
+{
+    double *const out = b->out;
+    unsigned char *const state = b->state;
+    const size_t bw = (size_t)b->w;
+    const int by0 = b->y0, rx0 = b->s->r.x0;
+    const double *c[4] = {out + at(b, x0, y0) * nw, out + at(b, x1, y0) * nw, out + at(b, x0, y1) * nw,
+                          out + at(b, x1, y1) * nw};
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
-            const size_t i = at(b, x, y);
-            if (b->state[i]) continue;
+            const size_t i = (size_t)(y - by0) * bw + (size_t)(x - rx0); /* at(b, x, y) */
+            if (state[i]) continue;
             double w[4];
             weights(x0, y0, x1, y1, x, y, w);
 #pragma omp simd /* the corners are evaluated (state set): pixel i is none of them */
             for (int k = 0; k < nw; k++)
-                b->out[i * nw + k] = w[0] * c[0][k] + w[1] * c[1][k] + w[2] * c[2][k] + w[3] * c[3][k];
-            b->state[i] = 1;
+                out[i * nw + k] = w[0] * c[0][k] + w[1] * c[1][k] + w[2] * c[2][k] + w[3] * c[3][k];
+            state[i] = 1;
         }
+}
+
+/* The cell [x0, x1] x [y0, y1], its corners c evaluated, filled by bilinear interpolation
+ * (the pixels not evaluated; the wavelengths in one loop, vectorised in the AVX2 clone, and
+ * unrolled for three, the rgb mode's: the same bits). */
+ATMOS_CLONES_NOINLINE static void fill(band *b, int x0, int y0, int x1, int y1)
+{
+    if (b->s->nw == 3)
+        fill_nw(b, x0, y0, x1, y1, 3);
+    else
+        fill_nw(b, x0, y0, x1, y1, b->s->nw);
 }
 
 /* The cell [x0, x1] x [y0, y1], its corners evaluated: interpolated, or cut into four. A cell
