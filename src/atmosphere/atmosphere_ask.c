@@ -233,10 +233,12 @@ void atmos_atmosphere_radiance(const atmos_atmosphere *atm, const double p[3], c
 
 /* ------------------------------------------------------------------ many view rays at once */
 
-void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3])
+void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3],
+                           int threads)
 {
     memset(b, 0, sizeof *b);
     b->atm = a;
+    b->threads = threads > 0 ? threads : atmos__threads(NULL);
     b->kind = a->desc.kind;
     memcpy(b->eye, eye, sizeof b->eye);
     memcpy(b->sun, sun, sizeof b->sun);
@@ -245,7 +247,8 @@ void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const
     if (a->solver && a->solver->batch_init) a->solver->batch_init(b);
 }
 
-int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3])
+int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3],
+                            int threads)
 {
     if (b->atm == a && a->solver && a->solver->batch_keep && a->solver->batch_keep(b, eye, sun)) {
         memcpy(b->eye, eye, sizeof b->eye);
@@ -253,7 +256,7 @@ int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, cons
         return 1;
     }
     if (b->atm) atmos__atm_batch_release(b);
-    atmos__atm_batch_init(b, a, eye, sun);
+    atmos__atm_batch_init(b, a, eye, sun, threads);
     return 0;
 }
 

@@ -79,9 +79,13 @@ typedef struct atmos__atm_batch {
     float background;
     atmos__sky_batch riley;
     void *state;           /* a spherical kind's per-eye tables (its solver's batch_init) */
+    int threads;           /* the threads that make those tables (the caller's context's) */
 } atmos__atm_batch;
 #define ATMOS__ATM_BATCH_SCRATCH ATMOS__SKY_BATCH_SCRATCH
-void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3]);
+/* threads: how many threads make the per-eye tables (the caller's atmos__threads(ctx); 0: the
+ * default count, atmos__threads(NULL)); the tables are the same for any count. */
+void atmos__atm_batch_init(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3],
+                           int threads);
 /* Frees what atmos__atm_batch_init allocated (a spherical kind's per-eye tables). */
 void atmos__atm_batch_release(atmos__atm_batch *b);
 /* b (zeroed, or initialised before) made to answer for atmosphere a, eye and sun: its per-eye
@@ -89,7 +93,8 @@ void atmos__atm_batch_release(atmos__atm_batch *b);
  * rays' values are those of atmos__atm_batch_init's either way, but for cloud spheres seen
  * from above the air: from the second frame with the same sun on, their attenuation comes
  * from textures (planet_clouds.h), within the textures' error of the first frame's. */
-int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3]);
+int atmos__atm_batch_update(atmos__atm_batch *b, const atmos_atmosphere *a, const double eye[3], const double sun[3],
+                            int threads);
 void atmos__atm_batch_eval(const atmos__atm_batch *b, int count, const float *dx, const float *dy, const float *dz,
                            const float *weight, float *out, float *scratch);
 

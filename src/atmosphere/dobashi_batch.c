@@ -76,13 +76,13 @@ static void direction(const dob_eye *e, double mu, double c, double d[3])
  * marched exactly, differs from the corners' mean by more than TOL (of the table's largest
  * value / 1000 at least) at some wavelength, or the corners differ by more than a factor
  * ROUGH (a terminator or a shadow's edge inside the cell). */
-static void mark_rough(dob_eye *e, const atmos_atmosphere *a, const double eye[3], const double sun[3])
+static void mark_rough(dob_eye *e, const atmos_atmosphere *a, const double eye[3], const double sun[3], int threads)
 {
     const int n = e->n, n3 = 3 * n;
     float top[ATMOS_MAX_WAVELENGTHS] = {0};
     for (size_t c = 0; c < (size_t)2 * NM * NPHI; c++)
         for (int k = 0; k < n; k++) top[k] = fmaxf(top[k], e->tab[c * n3 + 3 * k] + e->tab[c * n3 + 3 * k + 1]);
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int bi = 0; bi < 2 * NM; bi++)
         for (int j = 0; j < NPHI; j++) {
             unsigned char x = 0;
@@ -141,7 +141,7 @@ void atmos__dobashi_batch_init(atmos__atm_batch *b)
         free(e);
         return;
     }
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(b->threads > 0 ? b->threads : 1)
     for (int bi = 0; bi < 2 * NM; bi++) {
         const int block = bi / NM, i = bi % NM;
         const double mu = row_mu(e, block, i);
@@ -151,7 +151,7 @@ void atmos__dobashi_batch_init(atmos__atm_batch *b)
             entry(a, b->eye, b->sun, d, e->tab + (size_t)bi * row + (size_t)j * 3 * e->n);
         }
     }
-    mark_rough(e, a, b->eye, b->sun);
+    mark_rough(e, a, b->eye, b->sun, b->threads > 0 ? b->threads : 1);
     b->state = e;
 }
 

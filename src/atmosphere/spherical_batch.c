@@ -191,7 +191,7 @@ void atmos__sph_batch_init(atmos__atm_batch *b)
     }
     s->mie = s->tab + (size_t)s->n * 3 * PLANE;
     atmos__planet_mie_phase_table(pl, s->n, NPH, s->mie);
-#pragma omp parallel for schedule(dynamic)
+#pragma omp parallel for schedule(dynamic) num_threads(b->threads > 0 ? b->threads : 1)
     for (int e = 0; e < 2 * NV * NA; e++) fill_node(a, s, eye, sun, e / NA, e % NA);
     frame(s, pl, b->eye, b->sun);
 }

@@ -3,6 +3,7 @@
  * mappings of its coordinates, and the quadrilinear interpolation of its logarithm that the
  * march reads at every step. */
 #include "atmosphere/spherical.h"
+#include "core/clones.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -57,8 +58,8 @@ void atmos__sph_j_gamma(double nu, atmos__sph_jg *g)
     g->cg = nu, g->sg = sin(gm);
 }
 
-void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, const atmos__sph_jg *g, int cnt,
-                  const int *k, double *jr, double *jm)
+ATMOS_CLONES void atmos__sph_j(const atmos__sph_model *m, double r, double mu, double mus, const atmos__sph_jg *g,
+                               int cnt, const int *k, double *jr, double *jm)
 {
     const int n = m->n;
     const double xr = sqrt(atmos__clampd((r - m->R) / (m->Rt - m->R), 0.0, 1.0)) * (JR - 1);

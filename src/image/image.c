@@ -31,7 +31,10 @@ atmos_status atmos_image_create(atmos_context *ctx, int width, int height, int c
 
     atmos_image *img = calloc(1, sizeof *img);
     if (!img) return atmos__error(ctx, ATMOS_E_NOMEM, "image %d x %d: out of memory", width, height);
-    img->pixels = calloc(n, sizeof(float));
+    /* on 2 MB pages where large (a renderer's first frame then faults a few pages in, not one
+     * a 4 KB page), zeroed as calloc's */
+    img->pixels = atmos__big_alloc(n * sizeof(float));
+    if (img->pixels) memset(img->pixels, 0, n * sizeof(float));
     if (!img->pixels) {
         free(img);
         return atmos__error(ctx, ATMOS_E_NOMEM, "image %d x %d x %d: cannot allocate %zu bytes", width,

@@ -140,7 +140,7 @@ static int reserve(void **p, size_t *cap, size_t want, size_t size)
     if (want <= *cap) return 0;
     free(*p);
     *cap = 0;
-    if (!(*p = malloc(size * want))) return -1;
+    if (!(*p = atmos__big_alloc(size * want))) return -1; /* on 2 MB pages where large */
     *cap = want;
     return 0;
 }

@@ -171,7 +171,7 @@ atmos_status atmos__beams_sun_build(atmos_context *ctx, atmos__beams_sun *s, con
     size_t *vat = malloc(sizeof(size_t) * (size_t)nmesh), at[SUN_BANDS + 1];
     double *w = vat ? map_vertices(s, mesh, nmesh, vat) : NULL;
     size_t *list = w ? band_lists(s, mesh, nmesh, w, vat, at, threads) : NULL;
-    if (!list || !(s->depth = malloc(sizeof(float) * (size_t)size * size))) {
+    if (!list || !(s->depth = atmos__big_alloc(sizeof(float) * (size_t)size * size))) {
         free(vat), free(w), free(list);
         s->n = 0;
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d sun shadow map", size, size);

@@ -371,10 +371,11 @@ static atmos_status check_and_keep(atmos_plan *p, const atmos__view *v, const at
         p->last_view = *v, p->have_last = 1;
         return ATMOS_OK;
     }
-    if (keep && need > p->last_cap) {
-        float *b = realloc(p->last_pixels, sizeof(float) * need);
-        if (b) p->last_pixels = b, p->last_cap = need;
-        else keep = 0; /* no cache: the next frame is rendered again */
+    if (keep && need > p->last_cap) { /* the old contents are not needed: have_pixels is 0 */
+        free(p->last_pixels);
+        p->last_pixels = atmos__big_alloc(sizeof(float) * need); /* on 2 MB pages where large */
+        p->last_cap = p->last_pixels ? need : 0;
+        if (!p->last_pixels) keep = 0; /* no cache: the next frame is rendered again */
     }
     size_t bad = 0;
     long long first = LLONG_MAX; /* y W C + i of the first bad value */

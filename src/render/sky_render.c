@@ -514,8 +514,8 @@ atmos_status atmos__sky_render_hidden(atmos_context *ctx, const atmos_atmosphere
     const int nbands = (r->y1 - r->y0 + band - 1) / band;
     int done = 0, cancelled = 0, nomem = 0;
     atmos__atm_batch own, *bp = keep ? &keep->batch : &own;
-    if (keep) atmos__atm_batch_update(bp, atm, v->cam.position, job.sun);
-    else atmos__atm_batch_init(bp, atm, v->cam.position, job.sun);
+    if (keep) atmos__atm_batch_update(bp, atm, v->cam.position, job.sun, atmos__threads(ctx));
+    else atmos__atm_batch_init(bp, atm, v->cam.position, job.sun, atmos__threads(ctx));
     const atmos__atm_batch *batch = bp;
     if (black_vacuum(ctx, atm, v, &job, r, out)) {
         if (!keep) atmos__atm_batch_release(&own);

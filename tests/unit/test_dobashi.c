@@ -194,7 +194,7 @@ static void test_batch(const atmos_atmosphere *a)
             for (int v = 0; v < nv; v++) dx[v] = (float)d[v][0], dy[v] = (float)d[v][1], dz[v] = (float)d[v][2], w[v] = 1;
             memset(out, 0, sizeof out);
             atmos__atm_batch b;
-            atmos__atm_batch_init(&b, a, eye, sun);
+            atmos__atm_batch_init(&b, a, eye, sun, 0);
             atmos__atm_batch_eval(&b, nv, dx, dy, dz, w, out, scratch);
             atmos__atm_batch_release(&b);
             double top = 0, ref[64][3];

@@ -45,8 +45,8 @@ static void batch_at_eye(const atmos_atmosphere *a, const double eye[3], double 
     const double se = sun_elev_deg * PI / 180, az = 240 * PI / 180;
     sun[0] = cos(se) * sin(az), sun[1] = sin(se), sun[2] = -cos(se) * cos(az);
     const double before[3] = {eye[0] - 1.0, eye[1], eye[2]};
-    atmos__atm_batch_init(b, a, before, sun);
-    CHECK(atmos__atm_batch_update(b, a, eye, sun) == 1);
+    atmos__atm_batch_init(b, a, before, sun, 0);
+    CHECK(atmos__atm_batch_update(b, a, eye, sun, 0) == 1);
 }
 
 /* One view: the eye 12 000 km up, looking down with a 46 degree field (the disk, the limb

@@ -26,7 +26,7 @@ static void compare(atmos_atmosphere_kind kind, const atmos_wavelengths *wl, dou
         double sun[3], eye[3] = {0, eye_y, 0};
         atmos_direction_from_angles(sun_el[s], 250, sun);
         atmos__atm_batch b;
-        atmos__atm_batch_init(&b, sky, eye, sun);
+        atmos__atm_batch_init(&b, sky, eye, sun, 0);
         for (int i = 0; i < N; i++) {
             double d[3];
             /* Elevations cluster near the horizon, where the closed form is most delicate. */

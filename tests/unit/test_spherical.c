@@ -328,7 +328,7 @@ static void batch(atmos_atmosphere *a)
                 dx[i] = (float)d[0], dy[i] = (float)d[1], dz[i] = (float)d[2], w[i] = 1;
             }
             atmos__atm_batch b;
-            atmos__atm_batch_init(&b, a, eye, sun);
+            atmos__atm_batch_init(&b, a, eye, sun, 0);
             memset(out, 0, sizeof out);
             atmos__atm_batch_eval(&b, N, dx, dy, dz, w, out, scratch);
             atmos__atm_batch_release(&b);

@@ -59,7 +59,7 @@ static atmos_atmosphere *make(void)
 static void eval_batch(const atmos_atmosphere *a, const double eye[3], const double sun[3], int n, float *o)
 {
     atmos__atm_batch b;
-    atmos__atm_batch_init(&b, a, eye, sun);
+    atmos__atm_batch_init(&b, a, eye, sun, 0);
     memset(o, 0, sizeof(float) * 3 * (size_t)n);
     atmos__atm_batch_eval(&b, n, dx, dy, dz, w, o, scratch);
     atmos__atm_batch_release(&b);
@@ -208,17 +208,17 @@ static void kept_table(const atmos_atmosphere *uniform, const atmos_atmosphere *
     const double e0[3] = {0, 1000, 0}, e1[3] = {40, 1000, 0}, up[3] = {40, 1030, 0};
     atmos__atm_batch b;
     memset(&b, 0, sizeof b);
-    CHECK(atmos__atm_batch_update(&b, uniform, e0, sun) == 0);
-    CHECK(atmos__atm_batch_update(&b, uniform, e1, sun) == 1); /* 40 m level flight across the sun's vertical */
+    CHECK(atmos__atm_batch_update(&b, uniform, e0, sun, 0) == 0);
+    CHECK(atmos__atm_batch_update(&b, uniform, e1, sun, 0) == 1); /* 40 m level flight across the sun's vertical */
     memset(out, 0, sizeof(float) * 3 * (size_t)n);
     atmos__atm_batch_eval(&b, n, dx, dy, dz, w, out, scratch);
     eval_batch(uniform, e1, sun, n, out2);
     CHECK(memcmp(out, out2, sizeof(float) * 3 * (size_t)n) == 0);
-    CHECK(atmos__atm_batch_update(&b, uniform, up, sun) == 0);  /* 30 m higher */
-    CHECK(atmos__atm_batch_update(&b, uniform, up, sun2) == 0); /* the sun 0.1 degree higher */
-    CHECK(atmos__atm_batch_update(&b, uniform, up, sun2) == 1);
-    CHECK(atmos__atm_batch_update(&b, mapped, up, sun2) == 0);  /* another atmosphere, with maps */
-    CHECK(atmos__atm_batch_update(&b, mapped, up, sun2) == 0);
+    CHECK(atmos__atm_batch_update(&b, uniform, up, sun, 0) == 0);  /* 30 m higher */
+    CHECK(atmos__atm_batch_update(&b, uniform, up, sun2, 0) == 0); /* the sun 0.1 degree higher */
+    CHECK(atmos__atm_batch_update(&b, uniform, up, sun2, 0) == 1);
+    CHECK(atmos__atm_batch_update(&b, mapped, up, sun2, 0) == 0);  /* another atmosphere, with maps */
+    CHECK(atmos__atm_batch_update(&b, mapped, up, sun2, 0) == 0);
     atmos__atm_batch_release(&b);
 }
 
