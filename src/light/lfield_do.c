@@ -276,20 +276,25 @@ static void sweep_one(const do_work *W, const do_pack *pk, const float *Q, float
 static void sweep_all(do_work *W, const float *Q, double *phi, const double *x, double *leak, int with_in)
 {
     const int K = W->K;
-#pragma omp parallel for schedule(static, 1) num_threads(W->P->threads)
-    for (int g = 0; g < DO_GROUPS; g++) {
-        W->leak[g] = 0;
-        for (int p = g; p < W->npack; p += DO_GROUPS)
-            sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in, p == g);
+    /* the groups' sums per cell in the same region, after the sweeps (each cell's its own) */
+#pragma omp parallel num_threads(W->P->threads)
+    {
+#pragma omp for schedule(static, 1)
+        for (int g = 0; g < DO_GROUPS; g++) {
+            W->leak[g] = 0;
+            for (int p = g; p < W->npack; p += DO_GROUPS)
+                sweep_one(W, &W->pack[p], Q, W->psi[g], W->acc[g], &W->leak[g], with_in, p == g);
+        }
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < W->n; i++)
+            for (int k = 0; k < K; k++) {
+                const size_t a = W->idx[i] * K + k, e = i * K + k;
+                double s = 0;
+                for (int g = 0; g < DO_GROUPS; g++) s += (double)W->acc[g][a];
+                phi[e] = x ? x[e] - s : s;
+            }
     }
     double l = 0;
-    for (size_t i = 0; i < W->n; i++)
-        for (int k = 0; k < K; k++) {
-            const size_t a = W->idx[i] * K + k, e = i * K + k;
-            double s = 0;
-            for (int g = 0; g < DO_GROUPS; g++) s += (double)W->acc[g][a];
-            phi[e] = x ? x[e] - s : s;
-        }
     for (int g = 0; g < DO_GROUPS; g++) l += W->leak[g];
     if (leak) *leak = l;
 }
@@ -303,6 +308,7 @@ static void scatter(const do_work *W, const double *x, int add_q1)
     const int K = W->K;
     double chi[ATMOS__DO_KMAX];
     for (int k = 0; k < K; k++) chi[k] = P->chi[atmos__sh_degree(k)];
+#pragma omp parallel for schedule(static) num_threads(P->threads) if (P->threads > 1)
     for (size_t i = 0; i < W->n; i++) {
         const size_t c = W->idx[i];
         const double ss = P->sig_s[c];
@@ -605,9 +611,16 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     double *V = NULL, *b = NULL, *tmp = NULL, *x = NULL;
     const int ok = take_buffers(&W, m, ws, &V, &b, &tmp, &x);
     if (ok) {
+        /* the loops over the cells on the solve's threads (each cell its own) */
+        const double th = P->theta > 0 && P->theta < 1 ? P->theta : 1;
+#pragma omp parallel for schedule(static) num_threads(P->threads) if (P->threads > 1)
         for (size_t c = 0; c < W.cells; c++) {
             W.live[c] = P->sig_s[c] != 0;
             for (int k = 0; k < W.K; k++) W.live[c] |= P->q1[c * W.K + k] != 0;
+            /* the weighted diamond's weight: theta (P's, in (0, 1), else 1: the step scheme) in
+               optically thick cells, toward 1 in thin ones, 1 - (1 - theta) (1 - e^(-tau / tau0)) */
+            const double tau = P->sig_t[c] * P->h;
+            W.theta[c] = (float)(P->theta_tau > 0 ? 1 - (1 - th) * (1 - exp(-tau / P->theta_tau)) : th);
         }
         mark_needed(&W);
         for (size_t c = 0; c < W.cells; c++)
@@ -617,13 +630,6 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         st->dsa_at = W.dsa ? 0 : -1;
         /* W.acc not cleared: its cells not needed are never read, each sweep's group's first pack
            sets the needed ones (sweep_k; the clearing was 7 MB a wavelength on the Disney cloud) */
-        /* the weighted diamond's weight per cell: theta (P's, in (0, 1), else 1: the step scheme)
-           in optically thick cells, toward 1 in thin ones, 1 - (1 - theta) (1 - e^(-tau / tau0)) */
-        const double th = P->theta > 0 && P->theta < 1 ? P->theta : 1;
-        for (size_t c = 0; c < W.cells; c++) {
-            const double tau = P->sig_t[c] * P->h;
-            W.theta[c] = (float)(P->theta_tau > 0 ? 1 - (1 - th) * (1 - exp(-tau / P->theta_tau)) : th);
-        }
         W.npack = make_packs(P, W.pack);
         for (size_t i = 0; i < W.n; i++) memcpy(x + i * W.K, phi + W.idx[i] * W.K, sizeof(double) * W.K);
         if (P->richardson > 0)
@@ -635,9 +641,14 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
         else
             solve_gmres(&W, phi, b, x, V, tmp, st);
         /* the cells not needed 0 (as the sweeps leave them), the others x: each cell written once */
-        for (size_t c = 0; c < W.cells; c++)
-            if (!W.need[c]) memset(phi + c * W.K, 0, sizeof(double) * W.K);
-        for (size_t i = 0; i < W.n; i++) memcpy(phi + W.idx[i] * W.K, x + i * W.K, sizeof(double) * W.K);
+#pragma omp parallel num_threads(P->threads) if (P->threads > 1)
+        {
+#pragma omp for schedule(static) nowait
+            for (size_t c = 0; c < W.cells; c++)
+                if (!W.need[c]) memset(phi + c * W.K, 0, sizeof(double) * W.K);
+#pragma omp for schedule(static)
+            for (size_t i = 0; i < W.n; i++) memcpy(phi + W.idx[i] * W.K, x + i * W.K, sizeof(double) * W.K);
+        }
         for (size_t c = 0; c < W.cells; c++) st->emitted += P->q1[c * W.K] * sqrt(4 * ATMOS_PI);
         st->emitted *= P->h * P->h * P->h;
         st->entering = entering(P);

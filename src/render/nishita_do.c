@@ -89,9 +89,9 @@ static void shade_air(const void *u, const double cw[3], const double d[3], doub
  * in[dir * n + w]; the air in the volume's shadow lit by the sky alone (the ground's shadow is
  * not in it: docs/accuracy.md). Returns 1 when any is not 0. */
 static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np, const atmos__do_quad *q,
-                      const double sun_w[3], double *in)
+                      const double sun_w[3], double *in, int threads)
 {
-    double cen[3], cw[3], top = 1;
+    double cen[3], cw[3], top[DO_NMU + 1] = {1};
     for (int a = 0; a < 3; a++) cen[a] = 0.5 * (np->g.box_lo[a] + np->g.box_hi[a]);
     atmos__sky_inflow_point(atm, &np->x, cen, cw);
     inflow_shade sh = {np, atm, {0, 0, 0}, {sun_w[0], sun_w[1], sun_w[2]}, 0};
@@ -99,16 +99,18 @@ static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np
     sh.reach = 4 * sqrt(sh.reach); /* 4 box diagonals */
     atmos__vol_dir_to_frame(&np->x, sun_w, sh.sun_g);
     const atmos__sky_air_shade air = {shade_air, &sh};
+    /* the bands of cosines: band i from top[i] down to top[i + 1] */
+    for (int i = 0; i < DO_NMU; i++)
+        top[i + 1] = i == DO_NMU - 1 ? -1 : top[i] - q->w[i * DO_NPHI] * DO_NPHI / (2 * ATMOS_PI);
     int any = 0;
-    for (int i = 0; i < DO_NMU; i++) {
-        const double wmu = q->w[i * DO_NPHI] * DO_NPHI / (2 * ATMOS_PI), bot = i == DO_NMU - 1 ? -1 : top - wmu;
-        for (int j = 0; j < DO_NPHI; j++) {
-            double *L = in + (size_t)(i * DO_NPHI + j) * np->n;
-            atmos__sky_patch_inflow(atm, cw, sun_w, np->n, bot, top, 2 * ATMOS_PI * j / DO_NPHI,
-                                    2 * ATMOS_PI * (j + 1) / DO_NPHI, SKY_NS, np->col_valid ? &air : NULL, L);
-            for (int w = 0; w < np->n; w++) any |= L[w] != 0;
-        }
-        top = bot;
+    /* the patches, each its own sums, on the threads (the same numbers) */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(| : any)
+    for (int d = 0; d < DO_NMU * DO_NPHI; d++) {
+        const int i = d / DO_NPHI, j = d % DO_NPHI;
+        double *L = in + (size_t)d * np->n;
+        atmos__sky_patch_inflow(atm, cw, sun_w, np->n, top[i + 1], top[i], 2 * ATMOS_PI * j / DO_NPHI,
+                                2 * ATMOS_PI * (j + 1) / DO_NPHI, SKY_NS, np->col_valid ? &air : NULL, L);
+        for (int w = 0; w < np->n; w++) any |= L[w] != 0;
     }
     return any;
 }
@@ -512,6 +514,7 @@ static int solve_w(const do_fill *D, int w, double *q1, int threads, int dsa, at
     double chik[ATMOS__DO_KMAX]; /* chi_l of each coefficient */
     for (int l = 0; l <= P.L; l++) P.chi[l] = D->chi[w][l];
     for (int k = 0; k < K; k++) chik[k] = D->chi[w][atmos__sh_degree(k)];
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
     for (size_t c = 0; c < cells; c++) {
         const double e = D->E[w] * D->src[cells * w + c];
         for (int k = 0; k < K; k++) q1[c * K + k] = e * chik[k] * D->Ys[k];
@@ -519,14 +522,16 @@ static int solve_w(const do_fill *D, int w, double *q1, int threads, int dsa, at
     for (int d = 0; D->sky && d < P.quad->n; d++) inw[d] = D->sky[d * n + w];
     P.inflow = D->sky ? inw : NULL;
     const int ok = atmos__do_solve(&P, phi, S);
-    for (size_t c = 0; c < cells && ok; c++) {
+    if (!ok) return 0;
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+    for (size_t c = 0; c < cells; c++) {
         /* the sub-cell term as radiance moments of the first order's emission over a length:
            q1's harmonics times the term, into the coefficients only (phi stays the solve's) */
         const double e = D->E[w] * D->dsrc[cells * w + c];
         for (int k = 0; k < K; k++)
             D->coef[(c * n + w) * K + k] = (float)(chik[k] * (phi[c * K + k] + e * chik[k] * D->Ys[k]));
     }
-    return ok;
+    return 1;
 }
 
 /* The wavelengths to solve, wl[0 .. ns - 1] (the first on all the threads, from phi_all's start
@@ -610,7 +615,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     double skymean[ATMOS_MAX_WAVELENGTHS] = {0};
     double *sky = atm ? malloc(sizeof(double) * quad.n * n) : NULL;
     if (atm && !sky) return atmos__error(ctx, ATMOS_E_NOMEM, "render nishita: out of memory for the field's solve");
-    const int sky_on = sky && sky_inflow(atm, np, &quad, sun_w, sky);
+    const int sky_on = sky && sky_inflow(atm, np, &quad, sun_w, sky, threads);
     for (int d = 0; sky_on && d < quad.n; d++)
         for (int w = 0; w < n; w++) skymean[w] += sky[d * n + w] * quad.w[d];
     if (!*dc) *dc = cells_make(np, F, n, threads);

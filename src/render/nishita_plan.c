@@ -7,13 +7,15 @@
 #include "core/vec.h"
 #include "render/nishita_internal.h"
 
+#include <limits.h>
 #include <math.h>
+#include <omp.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define GRID_CAP 256 /* render voxels per axis at most */
-#define COL_PAR_MIN 65536 /* a plane of the columns' sweep with fewer values: one thread */
+#define COL_PAR_MIN 65536 /* a columns' sweep of fewer values (all its planes): one thread */
 
 void atmos__nishita_plan_destroy(atmos__nishita_plan *s)
 {
@@ -208,28 +210,78 @@ ATMOS_CLONES static void lerp_rows(const float *a, int n0, int n1, int nb, int n
 }
 
 /* The bilinear interpolant of nf fields on a plane of nb x nc points, a's point (m, n) at
- * a + m in[0] + n in[1] (its fields contiguous), at every lattice point (m + ob, n + oc),
- * written to out + m on[0] + n on[1]. tap: 3 (nb + nc) slots of scratch. The rows in parallel
- * when par > 1. */
+ * a + m in[0] + n in[1] (its fields contiguous), at the lattice points (m + ob, n + oc) of the
+ * rows n0 <= n < n1, written to out + m on[0] + n on[1]. tap: 3 (nb + nc) slots of scratch. */
 static void plane_lerp(const float *a, const size_t in[2], int nb, int nc, int nf, double ob, double oc, float *out,
-                       const size_t on[2], int par, double *tap)
+                       const size_t on[2], int n0, int n1, double *tap)
 {
     double *ub = tap, *uc = ub + nb;
     size_t *lb = (size_t *)(uc + nc), *hb = lb + nb, *lc = hb + nb, *hc = lc + nc;
     axis_taps(nb, ob, in[0], lb, hb, ub);
     axis_taps(nc, oc, in[1], lc, hc, uc);
-    if (par <= 1) {
-        lerp_rows(a, 0, nc, nb, nf, lb, hb, ub, lc, hc, uc, out, on);
-        return;
-    }
-#pragma omp parallel for schedule(static) num_threads(par)
-    for (int n = 0; n < nc; n++) lerp_rows(a, n, n + 1, nb, nf, lb, hb, ub, lc, hc, uc, out, on);
+    lerp_rows(a, n0, n1, nb, nf, lb, hb, ub, lc, hc, uc, out, on);
 }
 
 /* A ray's first step's column, qc[e] for e in [from, to): the trapezoid from 0 at the grid's face. */
 static inline void first_step(float *qc, const float *qd, size_t from, size_t to, double len)
 {
     for (size_t e = from; e < to; e++) qc[e] = (float)(0.5 * len * qd[e]);
+}
+
+/* The columns' sweep (atmos__nishita_columns): the planes across axis a, na of nb x nc points,
+ * from the sun's side (step), db, dc the sun's slope, len the metres a plane; the grid's and the
+ * rays' strides. */
+typedef struct {
+    const float *v;
+    float *col;
+    int nf, a, na, nb, nc, step;
+    double db, dc, len;
+    size_t str[3], sv[2], sq[2], pl;
+} col_sweep;
+
+static inline int clampi(long x, int lo, int hi) { return x < lo ? lo : x > hi ? hi : (int)x; }
+
+/* The rays of the lattice lines r0 <= r < r1 through every plane, and the voxels' columns of
+ * the rows they own (buf: 4 pl floats, tap: plane_lerp's scratch, both this caller's own). A ray
+ * moves by whole rows between planes (plane k's row n continues the last plane's row n - sc),
+ * so lattice line r is row r + C(k) of plane k, C(k) = floor(-k dc), and its column depends on
+ * its own points alone: the lines of one call are swept without the others'. A voxel's column
+ * reads the rays of its row and the rows either side, so the rays of one line more each side are
+ * swept too (again, by the neighbour's call), and the voxels' rows are those of [r0, r1); r0, r1
+ * beyond the lattice (INT_MIN, INT_MAX) take every line entering on that side. */
+static void sweep_lines(const col_sweep *S, long r0, long r1, float *buf, double *tap)
+{
+    const int nf = S->nf, nb = S->nb, nc = S->nc;
+    float *rc = buf, *rd = rc + S->pl, *qc = rd + S->pl, *qd = qc + S->pl;
+    /* plane k's rays at lattice point (m, n) lie at (m + fb, n + fc): fb, fc the fractions of the
+       offsets -k db, -k dc (the rays move away from the sun, the last plane's points at +db, +dc) */
+    double ob = 0, oc = 0;
+    for (int k = 0; k < S->na; k++) {
+        const int ia = S->step > 0 ? k : S->na - 1 - k;
+        const double nb_ = -k * S->db, nc_ = -k * S->dc;
+        const int sb = (int)(floor(nb_) - floor(ob)), sc = (int)(floor(nc_) - floor(oc)), C = (int)floor(nc_);
+        const double fb = nb_ - floor(nb_), fc = nc_ - floor(nc_);
+        ob = nb_, oc = nc_;
+        /* the rays' rows [n0, n1) and the voxels' [v0, v1) */
+        const int v0 = clampi(r0 + C, 0, nc), v1 = clampi(r1 + C, 0, nc);
+        const int n0 = v0 > 0 ? v0 - 1 : 0, n1 = v1 < nc ? v1 + 1 : nc;
+        plane_lerp(S->v + ia * S->str[S->a], S->sv, nb, nc, nf, fb, fc, qd, S->sq, n0, n1, tap);
+        for (int n = n0; n < n1; n++) {
+            /* the row's rays whose last point (m - sb, n - sc) was on the plane: m in [m0, m1) */
+            const int pn = n - sc, row = k > 0 && pn >= 0 && pn < nc;
+            int m0 = sb > 0 ? sb : 0, m1 = sb < 0 ? nb + sb : nb;
+            m0 = !row || m0 > nb ? nb : m0, m1 = m1 < m0 ? m0 : m1;
+            const size_t e0 = (size_t)n * nb * nf, e1 = e0 + (size_t)m0 * nf, e2 = e0 + (size_t)m1 * nf;
+            const ptrdiff_t pe = -((ptrdiff_t)sc * nb + sb) * nf; /* the last point's offset */
+            first_step(qc, qd, e0, e1, S->len);
+            for (size_t e = e1; e < e2; e++) qc[e] = rc[e + pe] + (float)(0.5 * S->len * (qd[e] + rd[e + pe]));
+            first_step(qc, qd, e2, e0 + (size_t)nb * nf, S->len);
+        }
+        plane_lerp(qc, S->sq, nb, nc, nf, -fb, -fc, S->col + ia * S->str[S->a], S->sv, v0, v1, tap);
+        float *t = rc;
+        rc = qc, qc = t;
+        t = rd, rd = qd, qd = t;
+    }
 }
 
 /* The column density toward the sun at every render voxel, by rays along the sun: one ray per
@@ -241,7 +293,7 @@ static inline void first_step(float *qc, const float *qd, size_t from, size_t to
  * from the four rays about its centre. (Interpolating the last plane's columns at every plane
  * instead blurred them sideways, more with every plane: in a cloud textured at the voxel's scale
  * the sunlight through the thin gaps was lost, the field's source too shallow; docs/lightfield.md,
- * "The sun's columns".) The rows of a plane in parallel. */
+ * "The sun's columns".) The threads each sweep a band of the rays (sweep_lines). */
 void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int threads)
 {
     if (np->col_valid && !memcmp(np->col_sun, sun_g, sizeof np->col_sun)) return;
@@ -251,52 +303,37 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
     int a = 0;
     for (int q = 1; q < 3; q++)
         if (fabs(sun_g[q]) > fabs(sun_g[a])) a = q;
-    const int b = (a + 1) % 3, c = (a + 2) % 3, na = g->c[a], nb = g->c[b], nc = g->c[c];
-    const double db = sun_g[b] / fabs(sun_g[a]), dc = sun_g[c] / fabs(sun_g[a]);
-    const double len = 1.0 / fabs(sun_g[a]) / g->sc; /* metres per plane along the sun */
-    const int step = sun_g[a] > 0 ? -1 : 1;           /* from the sun's side */
-    const size_t str[3] = {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf}, pl = (size_t)nb * nc * nf;
-    /* the grid's strides along the plane's axes and the rays' planes' */
-    const size_t sv[2] = {str[b], str[c]}, sq[2] = {(size_t)nf, (size_t)nb * nf};
-    float *buf = malloc(sizeof(float) * pl * 4);
-    double *tap = malloc((sizeof(double) + 2 * sizeof(size_t)) * (size_t)(nb + nc));
+    const int b = (a + 1) % 3, c = (a + 2) % 3, nb = g->c[b], nc = g->c[c];
+    col_sweep S = {g->v, np->col, nf, a, g->c[a], nb, nc, sun_g[a] > 0 ? -1 : 1, /* from the sun's side */
+                   sun_g[b] / fabs(sun_g[a]), sun_g[c] / fabs(sun_g[a]),
+                   1.0 / fabs(sun_g[a]) / g->sc, /* metres per plane along the sun */
+                   {(size_t)nf, (size_t)g->c[0] * nf, (size_t)g->c[0] * g->c[1] * nf},
+                   {0, 0}, {(size_t)nf, (size_t)nb * nf}, (size_t)nb * nc * nf};
+    /* the grid's strides along the plane's axes */
+    S.sv[0] = S.str[b], S.sv[1] = S.str[c];
+    /* each thread its band of lattice lines through all the planes, with no meeting: a plane of
+       the Disney cloud's grid (128 x 88 x 156) is 0.1-0.2 ms of work, and a parallel region a
+       plane cost more CPU in the waiting thread's spinning than it saved (the same numbers either
+       way); the bands split the middle plane's rows */
+    int par = S.pl * S.na >= COL_PAR_MIN ? threads : 1;
+    par = par > nc / 4 ? nc / 4 : par;
+    par = par < 1 ? 1 : par; /* a band of 4 rows at least */
+    /* plane_lerp's scratch, a thread's: its doubles, rounded up */
+    const size_t ntap =
+        ((sizeof(double) + 2 * sizeof(size_t)) * (size_t)(nb + nc) + sizeof(double) - 1) / sizeof(double);
+    float *buf = malloc(sizeof(float) * S.pl * 4 * par);
+    double *tap = malloc(sizeof(double) * ntap * par);
     if (!buf || !tap) {
         free(buf), free(tap);
         return;
     }
-    /* the rays' columns and densities, the last plane's and this one's */
-    float *rc = buf, *rd = rc + pl, *qc = rd + pl, *qd = qc + pl;
-    memset(rc, 0, sizeof(float) * pl * 2);
-    /* plane k's rays at lattice point (m, n) lie at (m + fb, n + fc): fb, fc the fractions of the
-       offsets -k db, -k dc (the rays move away from the sun, the last plane's points at +db, +dc) */
-    double ob = 0, oc = 0;
-    /* a plane of the Disney cloud's grid (128 x 88 x 156) is 0.1-0.2 ms of work: split in two
-       threads its parallel region per plane cost more CPU in the waiting thread's spinning than it
-       saved (the same numbers either way) */
-    const int par = pl >= COL_PAR_MIN ? threads : 1;
-    for (int k = 0; k < na; k++) {
-        const int ia = step > 0 ? k : na - 1 - k;
-        const double nb_ = -k * db, nc_ = -k * dc;
-        const int sb = (int)(floor(nb_) - floor(ob)), sc = (int)(floor(nc_) - floor(oc));
-        const double fb = nb_ - floor(nb_), fc = nc_ - floor(nc_);
-        ob = nb_, oc = nc_;
-        plane_lerp(g->v + ia * str[a], sv, nb, nc, nf, fb, fc, qd, sq, par, tap);
-#pragma omp parallel for schedule(static) num_threads(par)
-        for (int n = 0; n < nc; n++) {
-            /* the row's rays whose last point (m - sb, n - sc) was on the plane: m in [m0, m1) */
-            const int pn = n - sc, row = k > 0 && pn >= 0 && pn < nc;
-            int m0 = sb > 0 ? sb : 0, m1 = sb < 0 ? nb + sb : nb;
-            m0 = !row || m0 > nb ? nb : m0, m1 = m1 < m0 ? m0 : m1;
-            const size_t e0 = (size_t)n * nb * nf, e1 = e0 + (size_t)m0 * nf, e2 = e0 + (size_t)m1 * nf;
-            const ptrdiff_t pe = -((ptrdiff_t)sc * nb + sb) * nf; /* the last point's offset */
-            first_step(qc, qd, e0, e1, len);
-            for (size_t e = e1; e < e2; e++) qc[e] = rc[e + pe] + (float)(0.5 * len * (qd[e] + rd[e + pe]));
-            first_step(qc, qd, e2, e0 + (size_t)nb * nf, len);
-        }
-        plane_lerp(qc, sq, nb, nc, nf, -fb, -fc, np->col + ia * str[a], sv, par, tap);
-        float *t = rc;
-        rc = qc, qc = t;
-        t = rd, rd = qd, qd = t;
+    const long mid = (long)floor(-(S.na / 2) * S.dc); /* the middle plane's C (sweep_lines) */
+#pragma omp parallel num_threads(par)
+    {
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        const long r0 = t == 0 ? INT_MIN : (long)nc * t / nt - mid,
+                   r1 = t == nt - 1 ? INT_MAX : (long)nc * (t + 1) / nt - mid;
+        sweep_lines(&S, r0, r1, buf + S.pl * 4 * t, tap + ntap * t);
     }
     free(buf), free(tap);
     memcpy(np->col_sun, sun_g, sizeof np->col_sun);
