@@ -81,21 +81,26 @@ static inline const float *atmos__lamp_texel(const atmos__lamp *l, int x, int y)
 {
     return l->tex + 3 * ((size_t)(y + 1) * (l->tw + 2) + x + 1);
 }
+/* floor(x) for x in (-2, INT_MAX) (the texel coordinates inside the image and its border):
+ * the truncation toward zero, one less below it (floor's own value, in fewer instructions). */
+static inline int atmos__lamp_floor(double x)
+{
+    const int i = (int)x;
+    return i - (x < i);
+}
 /* The tint at texel coordinates (fx, fy) of the image (bilinear; 0 outside it). */
 static inline void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0;
     if (!(fx > -1 && fx < l->tw && fy > -1 && fy < l->th)) return;
-    const int x0 = (int)floor(fx), y0 = (int)floor(fy); /* in [-1, tw - 1], [-1, th - 1] */
+    const int x0 = atmos__lamp_floor(fx), y0 = atmos__lamp_floor(fy); /* in [-1, tw - 1], [-1, th - 1] */
     const double ax = fx - x0, ay = fy - y0;
     const double w00 = (1 - ax) * (1 - ay), w01 = ax * (1 - ay), w10 = (1 - ax) * ay, w11 = ax * ay;
     /* the border stands for the clamped edge */
     const float *t00 = atmos__lamp_texel(l, x0, y0), *t10 = atmos__lamp_texel(l, x0, y0 + 1);
-    for (int c = 0; c < 3; c++) {
-        double v = 0;
-        v += w00 * t00[c], v += w01 * t00[c + 3], v += w10 * t10[c], v += w11 * t10[c + 3];
-        rgb[c] = v;
-    }
+    rgb[0] = w00 * t00[0] + w01 * t00[3] + w10 * t10[0] + w11 * t10[3]; /* in this order, left to right */
+    rgb[1] = w00 * t00[1] + w01 * t00[4] + w10 * t10[1] + w11 * t10[4];
+    rgb[2] = w00 * t00[2] + w01 * t00[5] + w10 * t10[2] + w11 * t10[5];
 }
 /* Whether the tint is the same all over the box [fx0, fx1] x [fy0, fy1] of texel coordinates
  * (every texel the bilinear look-ups there read alike, or the box wholly outside the image:

@@ -134,9 +134,9 @@ double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, do
 
 /* A spot with an image (stained glass, beams_tint.c): the sum of atmos__beams_ray_light times
  * the image's tint at the samples t = ta + (s + o) step, s = s0 .. s1 - 1, added to h (rgb).
- * Runs of them whose image the tint proves the same (atmos__lamp_tint_same) are that tint
- * times atmos__beams_ray_light_sum, runs the shadow map's tiles prove dark nothing; the rest
- * halved, down to 8 samples read one by one. */
+ * Runs of more than 8 of them whose image the tint proves the same (atmos__lamp_tint_same)
+ * are that tint times atmos__beams_ray_light_sum, runs the shadow map's tiles prove dark
+ * nothing; the rest halved, down to 8 samples read one by one. */
 void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, double h[3]);
 /* Narrows [*t0, *t1] of the ray to where the spot's image may tint it (its non-black texels'
  * pyramid, atmos__lamp's box, with a margin for rounding): outside, the tint is 0. Returns 0
