@@ -375,8 +375,8 @@ static double read_point(const atmos__beams_ray *r, int f, double ta, double ste
 
 /* The samples [s0, s1) (at most RUN_READ) of atmos__beams_ray_light_sum read one by one: when
  * they all lie in one face of the map (the first's and the last's, each as
- * atmos__beams_ray_light finds it), their texels projected together (run_texels), else each
- * alone. The same sum, in order. */
+ * atmos__beams_ray_light finds it), a point light's by read_point, a spot's texels projected
+ * together (run_texels), else each alone. The same sum, in order. */
 static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
