@@ -349,10 +349,34 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
     }
 }
 
+/* A point light's samples [s0, s1) in the cube's face f (its pyramid; at most half a texel past
+ * its edge by rounding), summed: no falloff, each sample's is 1. Projected one by one as
+ * run_texels projects them, the same operations (the runs are short, about 8 samples on
+ * average: the vectorised loop's call and setup cost more than it saves), and the division
+ * skipped where texels_in returns 1 before it reads the coordinates. */
+static double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
+{
+    const atmos__beams_face *F = &r->l->face[f];
+    const int n = F->n;
+    const double x0 = r->f0[f][0], x1 = r->f1[f][0], y0 = r->f0[f][1], y1 = r->f1[f][1];
+    const double z0 = r->f0[f][2], z1 = r->f1[f][2], th = F->tan_half;
+    double h = 0;
+    for (int s = s0; s < s1; s++) {
+        const double t = ta + (s + o) * step, zs = z0 + t * z1;
+        if (zs <= NEAR_M) {
+            h += 1;
+            continue;
+        }
+        const double k = 0.5 * n / (zs * th);
+        h += texels_in(F, 0.5 * n + (x0 + t * x1) * k - 0.5, 0.5 * n + (y0 + t * y1) * k - 0.5, zs);
+    }
+    return h;
+}
+
 /* The samples [s0, s1) (at most RUN_READ) of atmos__beams_ray_light_sum read one by one: when
  * they all lie in one face of the map (the first's and the last's, each as
- * atmos__beams_ray_light finds it), their texels projected together (run_texels), else each
- * alone. The same sum, in order. */
+ * atmos__beams_ray_light finds it), a point light's by read_point, a spot's texels projected
+ * together (run_texels), else each alone. The same sum, in order. */
 static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
@@ -369,13 +393,9 @@ static double read_run(const atmos__beams_ray *r, double ta, double step, double
         for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
         return h;
     }
+    if (l->L.type != ATMOS_LIGHT_SPOT) return read_point(r, f, ta, step, o, s0, s1);
     double fx[RUN_READ], fy[RUN_READ], z[RUN_READ];
     run_texels(r, f, ta, step, o, s0, s1, fx, fy, z);
-    if (l->L.type != ATMOS_LIGHT_SPOT) { /* no falloff: each sample's is 1; the samples in the cube's face f
-                                           * (its pyramid), at most half a texel past its edge by rounding */
-        for (int s = s0; s < s1; s++) h += texels_in(&l->face[f], fx[s - s0], fy[s - s0], z[s - s0]);
-        return h;
-    }
     for (int s = s0; s < s1; s++) {
         const double fall = atmos__beams_ray_falloff(r, ta + (s + o) * step);
         h += fall == 0 ? 0 : fall * texels(&l->face[f], fx[s - s0], fy[s - s0], z[s - s0]);
