@@ -1096,6 +1096,23 @@ static void exact_diff(const atmos_image *exact, const atmos_image *sub, int W, 
     *mean = *lit ? sum / *lit : 0;
 }
 
+/* The subsampled image of r against its exact one (exact_diff) printed under the label what, and
+ * checked: more than min_edges pixels at the edges, the worst of them within edge_max, the mean
+ * over the lit pixels within mean_max. */
+static void check_exact_diff(const stepped *r, int W, int H, const char *what, long min_edges, double edge_max,
+                             double mean_max)
+{
+    double worst_edge, mean;
+    long edges, lit;
+    exact_diff(r->exact, r->sub, W, H, &worst_edge, &edges, &mean, &lit);
+    printf("%s: airlight evaluated %ld times over %ld pixels (%.1f %%); %ld edge pixels, worst relative difference "
+           "there %.2e; mean over %ld lit pixels %.2e\n", what, r->ev, r->n, 100.0 * r->ev / r->n, edges, worst_edge,
+           lit, mean);
+    CHECK_MSG(edges > min_edges, "%s: %ld edge pixels", what, edges);
+    CHECK_MSG(worst_edge <= edge_max, "%s: an edge pixel is off the exact one by %.3g", what, worst_edge);
+    CHECK_MSG(mean <= mean_max, "%s: the subsampled image is off the exact one by %.3g on average", what, mean);
+}
+
 /* The airlight subsampled on a lattice of every 4th pixel (beams/screen_step 4): a point
  * light's smooth glow is interpolated over most pixels (the renderer's count of those it
  * evaluated at most half), within 1 % of Sun et al.'s closed form at the pixels between the
@@ -1134,15 +1151,7 @@ static void test_screen_step(void)
     spot_scene(&s, 192, 144);
     stepped r;
     if (render_stepped(&s, 4, &r)) {
-        double worst_edge, mean;
-        long edges, lit;
-        exact_diff(r.exact, r.sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
-        printf("screen step 4: a spot's beam and shadow, airlight evaluated at %ld of %ld pixels; %ld edge pixels, worst "
-               "relative difference there %.2e; mean over %ld lit pixels %.2e\n", r.ev, r.n, edges, worst_edge, lit,
-               mean);
-        CHECK(edges > 100);
-        CHECK_MSG(worst_edge <= 0.03, "an edge pixel is off the exact one by %.3g", worst_edge);
-        CHECK_MSG(mean <= 1e-3, "the subsampled image is off the exact one by %.3g on average", mean);
+        check_exact_diff(&r, s.width, s.height, "screen step 4, a spot's beam and shadow", 100, 0.03, 1e-3);
     }
     stepped_threads_free(&r, 4);
 }
@@ -1158,15 +1167,10 @@ static void test_wide_span(int step)
     spot_scene(&s, 192, 144);
     stepped r;
     if (render_stepped(&s, step, &r)) {
-        double worst_edge, mean;
-        long edges, lit;
-        exact_diff(r.exact, r.sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
-        printf("a wide beam, screen step %d: airlight evaluated at %ld of %ld pixels (%.1f %%); %ld edge pixels, "
-               "worst relative difference there %.2e; mean over %ld lit pixels %.2e\n", step, r.ev, r.n,
-               100.0 * r.ev / r.n, edges, worst_edge, lit, mean);
+        char what[64];
+        snprintf(what, sizeof what, "a wide beam, screen step %d", step);
+        check_exact_diff(&r, s.width, s.height, what, 0, 0.03, 1e-3);
         CHECK_MSG(r.ev < 0.27 * r.n, "the airlight was evaluated at %ld of %ld pixels", r.ev, r.n);
-        CHECK_MSG(worst_edge <= 0.03, "an edge pixel is off the exact one by %.3g", worst_edge);
-        CHECK_MSG(mean <= 1e-3, "the subsampled image is off the exact one by %.3g on average", mean);
     }
     stepped_threads_free(&r, step);
 }
@@ -1233,12 +1237,9 @@ static void test_layers(int step)
     glow->position_m[0] = 3, glow->position_m[1] = 3, glow->position_m[2] = 3;
     stepped r;
     if (render_stepped(&s, step, &r)) {
-        double worst_edge, mean;
-        long edges, lit;
-        exact_diff(r.exact, r.sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
-        printf("a glow with spots, screen step %d: airlight evaluated %ld times over %ld pixels (%.1f %%); %ld edge "
-               "pixels, worst relative difference there %.2e; mean over %ld lit pixels %.2e\n", step, r.ev, r.n,
-               100.0 * r.ev / r.n, edges, worst_edge, lit, mean);
+        char what[64];
+        snprintf(what, sizeof what, "a glow with spots, screen step %d", step);
+        check_exact_diff(&r, s.width, s.height, what, 100, 0.03, 1e-3);
         const int C = r.exact->channels;
         double top = 0, worst = 0;
         for (size_t i = 0; i < (size_t)r.n; i++) top = fmax(top, r.exact->pixels[i * C + 1]);
@@ -1246,11 +1247,8 @@ static void test_layers(int step)
             if (r.exact->pixels[i * C + 1] > 0.05 * top)
                 worst = fmax(worst, fabs(r.sub->pixels[i * C + 1] / r.exact->pixels[i * C + 1] - 1));
         printf("  the pixels above 5 %% of the brightest within %.2e of the exact ones\n", worst);
-        CHECK(edges > 100);
         CHECK_MSG(worst <= 0.05, "a bright pixel (the thin beam?) is off the exact one by %.3g", worst);
         CHECK_MSG(r.ev < LAYERS_MAX * r.n, "the airlight was evaluated %ld times over %ld pixels", r.ev, r.n);
-        CHECK_MSG(worst_edge <= 0.03, "an edge pixel is off the exact one by %.3g", worst_edge);
-        CHECK_MSG(mean <= 1e-3, "the subsampled image is off the exact one by %.3g on average", mean);
     }
     stepped_threads_free(&r, step);
 }
@@ -1288,20 +1286,15 @@ static void test_shared_corners(int step)
     }
     stepped r;
     if (render_stepped(&s, step, &r)) {
-        double worst_edge, mean;
-        long edges, lit;
-        exact_diff(r.exact, r.sub, s.width, s.height, &worst_edge, &edges, &mean, &lit);
-        printf("a point light's streaks, screen step %d: airlight evaluated at %ld of %ld pixels, %ld of them handed "
-               "their corners' agreement; %ld edge pixels, worst relative difference there %.2e; mean over %ld lit "
-               "pixels %.2e; %ld stretches taken within runs, no W looked up; %ld told by merged samples\n", step,
-               r.ev, r.n, r.shared, edges, worst_edge, lit, mean, r.unread, r.told);
-        CHECK(edges > 500);
+        char what[64];
+        snprintf(what, sizeof what, "a point light's streaks, screen step %d", step);
+        check_exact_diff(&r, s.width, s.height, what, 500, 0.04, 4e-3);
+        printf("  %ld evaluations handed their corners' agreement; %ld stretches taken within runs, no W looked up; "
+               "%ld told by merged samples\n", r.shared, r.unread, r.told);
         CHECK_MSG(r.shared > r.ev / 2, "only %ld of %ld evaluations shared their corners'", r.shared, r.ev);
         CHECK_MSG(r.unread > 2 * r.shared, "only %ld stretches of %ld shared evaluations were taken in runs", r.unread,
                   r.shared);
         CHECK_MSG(r.told > 0, "no merged sample told its stretch to the cells around");
-        CHECK_MSG(worst_edge <= 0.04, "an edge pixel is off the exact one by %.3g", worst_edge);
-        CHECK_MSG(mean <= 4e-3, "the subsampled image is off the exact one by %.3g on average", mean);
     }
     stepped_threads_free(&r, step);
 }
