@@ -205,7 +205,8 @@ void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const
 }
 
 /* Face f's texel coordinates and depth of the ray at t (0 if behind the near plane). */
-static int project(const atmos__beams_ray *r, int f, double t, double *fx, double *fy, double *z)
+static inline __attribute__((always_inline)) int project(const atmos__beams_ray *r, int f, double t, double *fx,
+                                                         double *fy, double *z)
 {
     const atmos__beams_face *F = &r->l->face[f];
     *z = r->f0[f][2] + t * r->f1[f][2];
@@ -350,25 +351,18 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
 }
 
 /* A point light's samples [s0, s1) in the cube's face f (its pyramid; at most half a texel past
- * its edge by rounding), summed: no falloff, each sample's is 1. Projected one by one as
- * run_texels projects them, the same operations (the runs are short, about 8 samples on
- * average: the vectorised loop's call and setup cost more than it saves), and the division
- * skipped where texels_in returns 1 before it reads the coordinates. */
+ * its edge by rounding), summed: no falloff, each sample's is 1. Projected one by one (project:
+ * the same operations as run_texels; the runs are short, about 8 samples on average: the
+ * vectorised loop's call and setup cost more than it saves), no division where the sample is
+ * behind the near plane (texels_in's 1 there). */
 static double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_face *F = &r->l->face[f];
-    const int n = F->n;
-    const double x0 = r->f0[f][0], x1 = r->f1[f][0], y0 = r->f0[f][1], y1 = r->f1[f][1];
-    const double z0 = r->f0[f][2], z1 = r->f1[f][2], th = F->tan_half;
     double h = 0;
     for (int s = s0; s < s1; s++) {
-        const double t = ta + (s + o) * step, zs = z0 + t * z1;
-        if (zs <= NEAR_M) {
-            h += 1;
-            continue;
-        }
-        const double k = 0.5 * n / (zs * th);
-        h += texels_in(F, 0.5 * n + (x0 + t * x1) * k - 0.5, 0.5 * n + (y0 + t * y1) * k - 0.5, zs);
+        double fx, fy, z;
+        project(r, f, ta + (s + o) * step, &fx, &fy, &z); /* its frustum test not needed: texels_in's */
+        h += z <= NEAR_M ? 1 : texels_in(F, fx, fy, z);
     }
     return h;
 }

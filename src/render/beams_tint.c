@@ -25,21 +25,16 @@ static inline __attribute__((always_inline)) int coords(const atmos__beams_ray *
     return 1;
 }
 
-/* The samples [s0, s1) one by one, added to h (as coords() and atmos__lamp_tint_at find each,
- * the image's sizes and the sums held in locals). */
+/* The samples [s0, s1) one by one, added to h (the sums held in locals). */
 static void read_tinted(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
                         double h[3])
 {
-    const atmos__lamp *L = &r->l->L;
-    const double cx = 0.5 * L->tw - 0.5, cy = 0.5 * L->th - 0.5, tw = L->tw, th = L->th;
     double h0 = h[0], h1 = h[1], h2 = h[2];
     for (int s = s0; s < s1; s++) {
-        const double t = ta + (s + o) * step, z = r->a0 + t * r->a1;
-        if (!(z > 0)) continue;
-        const double iz = 1 / z, fx = (r->u0 + t * r->u1) * iz + cx, fy = (r->v0 + t * r->v1) * iz + cy;
-        if (!(fx > -1 && fx < tw && fy > -1 && fy < th)) continue; /* outside the image: 0 */
-        double tint[3];
-        atmos__lamp_tint_at(L, fx, fy, tint); /* first: a black texel spares the shadow map's */
+        const double t = ta + (s + o) * step;
+        double fx, fy, tint[3];
+        if (!coords(r, t, &fx, &fy)) continue;
+        atmos__lamp_tint_at(&r->l->L, fx, fy, tint); /* first: a black texel spares the shadow map's */
         if (tint[0] == 0 && tint[1] == 0 && tint[2] == 0) continue;
         const double v = known == LIGHT_FULL      ? 1
                          : known == LIGHT_FALLOFF ? atmos__beams_ray_falloff(r, t)
