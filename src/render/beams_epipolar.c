@@ -10,6 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* a helper of a cloned function (ATMOS_CLONES) inlined into each clone */
+#define CLONED_HELPER static inline __attribute__((always_inline))
+
 #define MAX_LEVELS 32
 #define LEAF 4 /* segments a cell of the trees' finest level covers */
 
@@ -199,7 +202,7 @@ typedef struct walk {
     void *u;
 } walk;
 
-static void add(walk *w, double ra, double rb)
+CLONED_HELPER void add(walk *w, double ra, double rb)
 {
     if (w->open && ra <= w->b) {
         w->b = rb;
@@ -211,7 +214,7 @@ static void add(walk *w, double ra, double rb)
 
 /* [ra, rb] where the map's depth runs linearly from da to db (finite): lit up to or from where
  * the ray's depth crosses it. */
-static void linear(walk *w, double ra, double rb, double da, double db)
+CLONED_HELPER void linear(walk *w, double ra, double rb, double da, double db)
 {
     const double fa = da - (w->zc + ra * w->zs), fb = db - (w->zc + rb * w->zs);
     if (fa > 0 && fb > 0) add(w, ra, rb);
@@ -221,7 +224,7 @@ static void linear(walk *w, double ra, double rb, double da, double db)
 
 /* Segment i (samples i and i + 1) over [ra, rb]: the depth linear between the samples; where a
  * sample holds no object, each sample's depth over its nearer half. */
-static void leaf(walk *w, int i, double ra, double rb)
+CLONED_HELPER void leaf(walk *w, int i, double ra, double rb)
 {
     const double mi = w->m[i], mj = w->m[i + 1], ri = w->k0 + i;
     if (mi < INFINITY && mj < INFINITY) {
@@ -241,7 +244,7 @@ static void leaf(walk *w, int i, double ra, double rb)
     }
 }
 
-static void node(walk *w, int l, int q, int nseg)
+ATMOS_CLONES static void node(walk *w, int l, int q, int nseg)
 {
     const int s0 = (q << l) * LEAF, s1 = ((q + 1) << l) * LEAF < nseg ? ((q + 1) << l) * LEAF : nseg;
     const double a = w->k0 + s0, b = w->k0 + s1, ra = a > w->r0 ? a : w->r0, rb = b < w->r1 ? b : w->r1;

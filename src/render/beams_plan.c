@@ -51,6 +51,21 @@ static atmos_status shadow_maps(atmos_plan *p, atmos__beams_plan *b, atmos__beam
     return ATMOS_OK;
 }
 
+/* The sun's map for the scene's own sun, made with the lights' maps (it depends on the scene
+ * alone): a frame whose sun is the same (the bits of a frame from the scene, atmos_frame_from_scene,
+ * as the frame resolves it) keeps it (atmos__beams_sun_frame), another makes its own as before. */
+static atmos_status scene_sun_map(atmos_plan *p, atmos__beams_plan *b)
+{
+    double d[3];
+    atmos_status st = atmos_scene_sun_direction(p->ctx, &p->scene, d, NULL, NULL);
+    const double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (st != ATMOS_OK || !(l > 0.5 && l < 2.0)) return st; /* a frame's own sun is checked there */
+    for (int a = 0; a < 3; a++) d[a] = l == 1.0 ? d[a] : d[a] / l;
+    st = atmos__beams_sun_build(p->ctx, &b->sun, d, b->obj.mesh, b->obj.n, p->scene.beams.shadow_size);
+    if (st == ATMOS_OK) atmos__beams_sun_warn_texel(p->ctx, &b->sun, b->obj.mesh, b->obj.n), b->sun.warned = 1;
+    return st;
+}
+
 atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
 {
     const atmos_scene *s = &p->scene;
@@ -85,6 +100,7 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
     }
     b->sun_on = s->beams.sun;
     b->exact_shadows = s->beams.exact_shadows;
+    if (st == ATMOS_OK && b->sun_on && b->obj.n > 0) st = scene_sun_map(p, b);
     if (st != ATMOS_OK) {
         atmos__beams_plan_destroy(b);
         return st;
