@@ -16,6 +16,7 @@
 #include "render/beams_raster.h"
 #include "mesh/mesh_walk.h"
 #include "core/vec.h"
+#include "core/clones.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -28,6 +29,8 @@
 /* A box is hidden when every pixel centre it may cover has a surface nearer than its nearest
  * corner by more than DEPTH_TOL and this much more (rounding of the drawn depths). */
 #define HIDDEN_MARGIN 1e-9
+/* A helper of a cloned function, inlined into each clone (core/clones.h). */
+#define IN_CLONE static inline __attribute__((always_inline))
 
 /* A triangle (or a clipped part of one) on the image: pixel coordinates, 1 / view depth, the
  * rows and columns of the tile's pixel centres its box (widened by EDGE_PX) holds. */
@@ -100,7 +103,7 @@ static void cover(tile *T, size_t i, double z, const stri *s)
 /* The columns [*pa, *pb] of the triangle's box whose centres on the row at cy may lie within
  * EDGE_PX of it: each edge's function is linear along the row (a pixel of slack each end: the
  * pixels themselves are then classified exactly). 0 when none. */
-static int row_span(const stri *s, double sg, const double len[3], double cy, int *pa, int *pb)
+IN_CLONE int row_span(const stri *s, double sg, const double len[3], double cy, int *pa, int *pb)
 {
     double lo = s->px0, hi = s->px1;
     for (int k = 0; k < 3; k++) {
@@ -136,8 +139,9 @@ static int hides(const stri *s, double area)
 
 /* A rival's depth is at least the nearest vertex's (the depth extrapolated past a thin
  * triangle's edge can be far nearer than any point of it), so a triangle is never nearer than
- * its box: what makes hiding a box exact. */
-static void draw(tile *T, const stri *s)
+ * its box: what makes hiding a box exact. An AVX2 clone where the processor has it (row_span
+ * inlined into it: the same IEEE operations, the same bits). */
+ATMOS_CLONES static void draw(tile *T, const stri *s)
 {
     const double *x = s->x, *y = s->y;
     const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);

@@ -60,6 +60,9 @@
 /* Every light (lights()' mask). */
 #define ALL_LIGHTS 0xffffffffu
 
+/* A helper of a cloned function, inlined into each clone (core/clones.h). */
+#define IN_CLONE static inline __attribute__((always_inline))
+
 /* A point light's neighbouring intervals whose f_l sum to less than this share of a sub-plane's
  * (epsilon of the pixel's airlight) share one sample (merged()). */
 #ifndef POINT_MERGE
@@ -344,7 +347,7 @@ static int agreed_run(const job *J, int i, const reach_part *r, long b, uint64_t
 /* intervals() with sh->known: a run of stretches that the corners all saw lit or all dark is one
  * interval of f_l -1 (its W looked up at its end alone), the lit runs' f_l summed into f[2n + 1]
  * and their bits into sh->seen. The stretch between the planes j - 1 and j is bit j - 1. */
-static int agreed_intervals(job *J, int i, const reach_part *r, double *f, double *sum, const shared_ray *sh)
+IN_CLONE int agreed_intervals(job *J, int i, const reach_part *r, double *f, double *sum, const shared_ray *sh)
 {
     const double t1 = r->t1, cosf = r->cosf, dz = J->dz[i], zl = J->z_lo[i], W0 = W_at(J, r, r->t0);
     const uint64_t kl = sh->known[0], kd = sh->known[1];
@@ -380,8 +383,9 @@ static int agreed_intervals(job *J, int i, const reach_part *r, double *f, doubl
  * interval k starts, f[2k + 1] its f_l (an unshadowed light of unit intensity), f[2n] where the
  * last ends (f holds room for 2 MAX_INTERVALS + 2 values). Returns n (0: none), *sum the sum of
  * the f_l. With sh (its known not NULL), agreed_intervals(): *sum is then the W difference over
- * the whole part, and f[2n + 1] the lit runs' f_l. */
-static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre,
+ * the whole part, and f[2n + 1] the lit runs' f_l. An AVX2 clone where the processor has it
+ * (agreed_intervals and W_at inlined into it: the same IEEE operations, the same bits). */
+ATMOS_CLONES static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre,
                      const shared_ray *sh)
 {
     reach_part r;

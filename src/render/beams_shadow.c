@@ -14,6 +14,8 @@
 
 #define NEAR_M 1e-3
 #define BEAMS_CLONES ATMOS_CLONES
+/* A helper of a cloned function, inlined into each clone (core/clones.h). */
+#define IN_CLONE static inline __attribute__((always_inline))
 #define SPOT_FRUSTUM_MAX_DEG 60.0
 
 void atmos__beams_shadow_free(atmos__beams_light *l)
@@ -355,7 +357,7 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
  * the same operations as run_texels; the runs are short, about 8 samples on average: the
  * vectorised loop's call and setup cost more than it saves), no division where the sample is
  * behind the near plane (texels_in's 1 there). */
-static double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
+IN_CLONE double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_face *F = &r->l->face[f];
     double h = 0;
@@ -370,8 +372,9 @@ static double read_point(const atmos__beams_ray *r, int f, double ta, double ste
 /* The samples [s0, s1) (at most RUN_READ) of atmos__beams_ray_light_sum read one by one: when
  * they all lie in one face of the map (the first's and the last's, each as
  * atmos__beams_ray_light finds it), a point light's by read_point, a spot's texels projected
- * together (run_texels), else each alone. The same sum, in order. */
-static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
+ * together (run_texels), else each alone. The same sum, in order. An AVX2 clone where the
+ * processor has it (read_point inlined into it: the same IEEE operations, the same bits). */
+BEAMS_CLONES static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
     double h = 0;
