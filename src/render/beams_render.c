@@ -242,7 +242,7 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
 
 /* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
  * the scene's max_subplanes. */
-static int subplanes(const job *J, double fl, double unit)
+IN_CLONE int subplanes(const job *J, double fl, double unit)
 {
     const double need = ceil(fl / unit);
     return need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
@@ -425,9 +425,10 @@ static int interval_sum(job *J, int i, const double d[3], double T, double *f, d
 
 /* Interval k of the intervals f (its f_l > 0) scattered toward the eye, added to *sum: ceil(f_l /
  * unit) sub-planes, the samples at offset o of their parts. Returns 1 when every sample (or the
- * tiles' proof) gave H = 1 with no falloff, 0 when each gave 0, else -1. */
-static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k, double unit, double *sum, int centre,
-                     double o)
+ * tiles' proof) gave H = 1 with no falloff, 0 when each gave 0, else -1. An AVX2 clone where the
+ * processor has it (subplanes inlined into it: the same bits). */
+ATMOS_CLONES static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k, double unit, double *sum,
+                                 int centre, double o)
 {
     const double fl = f[2 * k + 1];
     const int m = subplanes(J, fl, unit);
