@@ -112,10 +112,12 @@ static int eye_coordinates(job *J)
     return 0;
 }
 
+/* Whether x is within the columns [r[0], r[1]) of a light's span on a row. */
+static int in_columns(const int *r, int x) { return x >= r[0] && x < r[1]; }
+
 static int in_span(const job *J, int i, int x, int y)
 {
-    const int *r = J->span + 2 * ((size_t)i * J->cam->height + y);
-    return x >= r[0] && x < r[1];
+    return in_columns(J->span + 2 * ((size_t)i * J->cam->height + y), x);
 }
 
 /* Per pixel x of a row of n (its rays (dx, dy, dz)[x], the distances T[x] to the surfaces they
@@ -592,26 +594,32 @@ static void lights(job *J, int x, int y, const double d[3], double T, double *f,
 {
     const int nl = J->b->nlights;
     double *S = f + (size_t)nl * LIGHT_STRIDE, *cnt = S + nl, tot = 0;
-    int lit = 0, any = 0;
+    int lit = 0;
+    uint32_t adds = 0; /* the lights whose cnt > 0 */
+    const uint32_t all = nl >= 32 ? ALL_LIGHTS : ((uint32_t)1 << nl) - 1;
+    const int *span = J->span + 2 * (size_t)y; /* light i's on row y at i stride (in_span's) */
+    const size_t stride = 2 * (size_t)J->cam->height;
     for (int pass = 0; pass < 2; pass++) { /* the lights of mask, then (if any of them adds) the others */
-        for (int i = 0; i < nl; i++)
-            if ((mask >> i & 1) == !pass) {
-                double *fi = f + (size_t)i * LIGHT_STRIDE;
-                cnt[i] = !in_span(J, i, x, y) ? 0
-                         : pass ? interval_sum(J, i, d, T, fi, &S[i], centre) /* its weight alone */
-                                : intervals(J, i, d, T, fi, &S[i], centre, sh && sh->light == i ? sh : NULL);
-                any |= cnt[i] > 0;
-            }
-        if (!any) return;
-    }
-    for (int i = 0; i < nl; i++)
-        if (cnt[i] > 0) tot += J->weight[i] * S[i], lit++;
-    for (int i = 0; i < nl; i++)
-        if (cnt[i] > 0 && mask >> i & 1) {
-            const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
-            airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o,
-                     sh && sh->light == i ? sh : NULL);
+        for (uint32_t todo = (pass ? ~mask : mask) & all; todo; todo &= todo - 1) { /* their bits, lowest first */
+            const int i = __builtin_ctz(todo);
+            double *fi = f + (size_t)i * LIGHT_STRIDE;
+            cnt[i] = !in_columns(span + i * stride, x) ? 0
+                     : pass ? interval_sum(J, i, d, T, fi, &S[i], centre) /* its weight alone */
+                            : intervals(J, i, d, T, fi, &S[i], centre, sh && sh->light == i ? sh : NULL);
+            adds |= cnt[i] > 0 ? (uint32_t)1 << i : 0;
         }
+        if (!adds) return;
+    }
+    for (uint32_t todo = adds; todo; todo &= todo - 1) { /* in the lights' order */
+        const int i = __builtin_ctz(todo);
+        tot += J->weight[i] * S[i], lit++;
+    }
+    for (uint32_t todo = adds & mask; todo; todo &= todo - 1) {
+        const int i = __builtin_ctz(todo);
+        const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
+        airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o,
+                 sh && sh->light == i ? sh : NULL);
+    }
 }
 
 /* Pixel (x, y): the surface or the sky behind, the lights' airlight and the sun's, into px.

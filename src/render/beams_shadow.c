@@ -182,7 +182,7 @@ static inline double texels(const atmos__beams_face *F, double fx, double fy, do
 }
 
 /* H at the point (x, y, z) of face F's frame. */
-static double lookup(const atmos__beams_face *F, double x, double y, double z)
+IN_CLONE double lookup(const atmos__beams_face *F, double x, double y, double z)
 {
     if (z <= NEAR_M) return 1;
     const int n = F->n;
@@ -281,7 +281,8 @@ BEAMS_CLONES int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, 
     return 0;
 }
 
-double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
+/* atmos__beams_ray_falloff, inlined into ray_light. */
+IN_CLONE double ray_falloff(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
     if (l->L.type != ATMOS_LIGHT_SPOT) return 1;
@@ -291,6 +292,8 @@ double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
     const double s = (z / sqrt(w2) - l->L.cos_outer) / (l->L.cos_inner - l->L.cos_outer);
     return s * s * (3 - 2 * s);
 }
+
+double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t) { return ray_falloff(r, t); }
 
 /* The samples t = ta + (s + o) step, s in [*ka, *kb), inside the spot's inner cone (falloff 1):
  * the cone is convex, so they are one run, between the roots of (z(t))^2 = cos^2 |w(t)|^2 on
@@ -352,10 +355,11 @@ double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double
     return falloff_run(r, ta, step, o, 0, ka) + (kb - ka) + falloff_run(r, ta, step, o, kb, m);
 }
 
-double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
+/* atmos__beams_ray_light, inlined into read_run's clones. */
+IN_CLONE double ray_light(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
-    const double fall = atmos__beams_ray_falloff(r, t);
+    const double fall = ray_falloff(r, t);
     if (!l->nfaces || fall == 0) return fall;
     int f = 0;
     if (l->nfaces == 6) {
@@ -365,6 +369,8 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
     return fall * lookup(&l->face[f], r->f0[f][0] + t * r->f1[f][0], r->f0[f][1] + t * r->f1[f][1],
                          r->f0[f][2] + t * r->f1[f][2]);
 }
+
+double atmos__beams_ray_light(const atmos__beams_ray *r, double t) { return ray_light(r, t); }
 
 /* The texel coordinates and depths on face f of the samples t = ta + (s + o) step, s in [s0, s1)
  * (at most RUN_READ of them), as lookup() computes them: one loop that vectorises (the divisions
@@ -419,14 +425,14 @@ BEAMS_CLONES static double read_run(const atmos__beams_ray *r, double ta, double
         if (s1 - s0 > 1 && cube_face(w1) != f) f = -1;
     }
     if (!l->nfaces || f < 0) {
-        for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
+        for (int s = s0; s < s1; s++) h += ray_light(r, ta + (s + o) * step);
         return h;
     }
     if (l->L.type != ATMOS_LIGHT_SPOT) return read_point(r, f, ta, step, o, s0, s1);
     double fx[RUN_READ], fy[RUN_READ], z[RUN_READ];
     run_texels(r, f, ta, step, o, s0, s1, fx, fy, z);
     for (int s = s0; s < s1; s++) {
-        const double fall = atmos__beams_ray_falloff(r, ta + (s + o) * step);
+        const double fall = ray_falloff(r, ta + (s + o) * step);
         h += fall == 0 ? 0 : fall * texels(&l->face[f], fx[s - s0], fy[s - s0], z[s - s0]);
     }
     return h;
