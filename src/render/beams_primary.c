@@ -214,8 +214,9 @@ static void leaf(void *user, const int *tri, int n)
 }
 
 /* Whether to draw what a node's box holds: not when the box lies wholly behind the near plane,
- * beside the tile, or behind the surfaces already drawn at every pixel centre it may cover. */
-static int enter(void *user, const float lo[3], const float hi[3])
+ * beside the tile, or behind the surfaces already drawn at every pixel centre it may cover. An
+ * AVX2 clone where the processor has it (the same IEEE operations: the same answers). */
+ATMOS_CLONES static int enter(void *user, const float lo[3], const float hi[3])
 {
     const tile *T = user;
     double zmin = INFINITY, xa = INFINITY, xb = -INFINITY, ya = INFINITY, yb = -INFINITY;
