@@ -69,6 +69,8 @@ typedef struct atmos__beams_face {
     int n;
     float *depth;
     atmos__beams_tiles tiles;   /* its min/max pyramid (beams_tiles.h) */
+    int *tile_x, *tile_y;       /* per floor + 1 of a look-up's coordinate (0 .. n + 1): its tile's
+                                 * column, and its tile's row times the tiles a side (one block) */
 } atmos__beams_face;
 
 typedef struct atmos__beams_light {

@@ -60,6 +60,9 @@
 /* Every light (lights()' mask). */
 #define ALL_LIGHTS 0xffffffffu
 
+/* A helper of a cloned function, inlined into each clone (core/clones.h). */
+#define IN_CLONE static inline __attribute__((always_inline))
+
 /* A point light's neighbouring intervals whose f_l sum to less than this share of a sub-plane's
  * (epsilon of the pixel's airlight) share one sample (merged()). */
 #ifndef POINT_MERGE
@@ -109,10 +112,12 @@ static int eye_coordinates(job *J)
     return 0;
 }
 
+/* Whether x is within the columns [r[0], r[1]) of a light's span on a row. */
+static int in_columns(const int *r, int x) { return x >= r[0] && x < r[1]; }
+
 static int in_span(const job *J, int i, int x, int y)
 {
-    const int *r = J->span + 2 * ((size_t)i * J->cam->height + y);
-    return x >= r[0] && x < r[1];
+    return in_columns(J->span + 2 * ((size_t)i * J->cam->height + y), x);
 }
 
 /* Per pixel x of a row of n (its rays (dx, dy, dz)[x], the distances T[x] to the surfaces they
@@ -239,7 +244,7 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
 
 /* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
  * the scene's max_subplanes. */
-static int subplanes(const job *J, double fl, double unit)
+IN_CLONE int subplanes(const job *J, double fl, double unit)
 {
     const double need = ceil(fl / unit);
     return need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
@@ -344,7 +349,7 @@ static int agreed_run(const job *J, int i, const reach_part *r, long b, uint64_t
 /* intervals() with sh->known: a run of stretches that the corners all saw lit or all dark is one
  * interval of f_l -1 (its W looked up at its end alone), the lit runs' f_l summed into f[2n + 1]
  * and their bits into sh->seen. The stretch between the planes j - 1 and j is bit j - 1. */
-static int agreed_intervals(job *J, int i, const reach_part *r, double *f, double *sum, const shared_ray *sh)
+IN_CLONE int agreed_intervals(job *J, int i, const reach_part *r, double *f, double *sum, const shared_ray *sh)
 {
     const double t1 = r->t1, cosf = r->cosf, dz = J->dz[i], zl = J->z_lo[i], W0 = W_at(J, r, r->t0);
     const uint64_t kl = sh->known[0], kd = sh->known[1];
@@ -380,8 +385,9 @@ static int agreed_intervals(job *J, int i, const reach_part *r, double *f, doubl
  * interval k starts, f[2k + 1] its f_l (an unshadowed light of unit intensity), f[2n] where the
  * last ends (f holds room for 2 MAX_INTERVALS + 2 values). Returns n (0: none), *sum the sum of
  * the f_l. With sh (its known not NULL), agreed_intervals(): *sum is then the W difference over
- * the whole part, and f[2n + 1] the lit runs' f_l. */
-static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre,
+ * the whole part, and f[2n + 1] the lit runs' f_l. An AVX2 clone where the processor has it
+ * (agreed_intervals and W_at inlined into it: the same IEEE operations, the same bits). */
+ATMOS_CLONES static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre,
                      const shared_ray *sh)
 {
     reach_part r;
@@ -421,9 +427,10 @@ static int interval_sum(job *J, int i, const double d[3], double T, double *f, d
 
 /* Interval k of the intervals f (its f_l > 0) scattered toward the eye, added to *sum: ceil(f_l /
  * unit) sub-planes, the samples at offset o of their parts. Returns 1 when every sample (or the
- * tiles' proof) gave H = 1 with no falloff, 0 when each gave 0, else -1. */
-static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k, double unit, double *sum, int centre,
-                     double o)
+ * tiles' proof) gave H = 1 with no falloff, 0 when each gave 0, else -1. An AVX2 clone where the
+ * processor has it (subplanes inlined into it: the same bits). */
+ATMOS_CLONES static int interval(job *J, const atmos__beams_ray *ray, const double *f, int k, double unit, double *sum,
+                                 int centre, double o)
 {
     const double fl = f[2 * k + 1];
     const int m = subplanes(J, fl, unit);
@@ -587,26 +594,32 @@ static void lights(job *J, int x, int y, const double d[3], double T, double *f,
 {
     const int nl = J->b->nlights;
     double *S = f + (size_t)nl * LIGHT_STRIDE, *cnt = S + nl, tot = 0;
-    int lit = 0, any = 0;
+    int lit = 0;
+    uint32_t adds = 0; /* the lights whose cnt > 0 */
+    const uint32_t all = nl >= 32 ? ALL_LIGHTS : ((uint32_t)1 << nl) - 1;
+    const int *span = J->span + 2 * (size_t)y; /* light i's on row y at i stride (in_span's) */
+    const size_t stride = 2 * (size_t)J->cam->height;
     for (int pass = 0; pass < 2; pass++) { /* the lights of mask, then (if any of them adds) the others */
-        for (int i = 0; i < nl; i++)
-            if ((mask >> i & 1) == !pass) {
-                double *fi = f + (size_t)i * LIGHT_STRIDE;
-                cnt[i] = !in_span(J, i, x, y) ? 0
-                         : pass ? interval_sum(J, i, d, T, fi, &S[i], centre) /* its weight alone */
-                                : intervals(J, i, d, T, fi, &S[i], centre, sh && sh->light == i ? sh : NULL);
-                any |= cnt[i] > 0;
-            }
-        if (!any) return;
-    }
-    for (int i = 0; i < nl; i++)
-        if (cnt[i] > 0) tot += J->weight[i] * S[i], lit++;
-    for (int i = 0; i < nl; i++)
-        if (cnt[i] > 0 && mask >> i & 1) {
-            const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
-            airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o,
-                     sh && sh->light == i ? sh : NULL);
+        for (uint32_t todo = (pass ? ~mask : mask) & all; todo; todo &= todo - 1) { /* their bits, lowest first */
+            const int i = __builtin_ctz(todo);
+            double *fi = f + (size_t)i * LIGHT_STRIDE;
+            cnt[i] = !in_columns(span + i * stride, x) ? 0
+                     : pass ? interval_sum(J, i, d, T, fi, &S[i], centre) /* its weight alone */
+                            : intervals(J, i, d, T, fi, &S[i], centre, sh && sh->light == i ? sh : NULL);
+            adds |= cnt[i] > 0 ? (uint32_t)1 << i : 0;
         }
+        if (!adds) return;
+    }
+    for (uint32_t todo = adds; todo; todo &= todo - 1) { /* in the lights' order */
+        const int i = __builtin_ctz(todo);
+        tot += J->weight[i] * S[i], lit++;
+    }
+    for (uint32_t todo = adds & mask; todo; todo &= todo - 1) {
+        const int i = __builtin_ctz(todo);
+        const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
+        airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o,
+                 sh && sh->light == i ? sh : NULL);
+    }
 }
 
 /* Pixel (x, y): the surface or the sky behind, the lights' airlight and the sun's, into px.

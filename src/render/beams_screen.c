@@ -52,6 +52,9 @@ static const uint64_t *corners(const band *b, int x0, int y0, int x1, int y1, ui
     return known[0] | known[1] ? known : NULL;
 }
 
+/* A helper of a cloned function, inlined into each clone (core/clones.h). */
+#define IN_CLONE static inline __attribute__((always_inline))
+
 /* dim[k]: the least of base[i nw + k] over the pixels i of [x0, x1] x [y0, y1] (each row's
  * values one block; the minima exact, so the same values in the AVX2 clone). */
 ATMOS_CLONES_NOINLINE static void least_base(const atmos__beams_screen *s, int x0, int y0, int x1, int y1, double *dim)
@@ -67,7 +70,7 @@ ATMOS_CLONES_NOINLINE static void least_base(const atmos__beams_screen *s, int x
 
 /* Whether every pixel of [x0, x1] x [y0, y1] sees the same object at depths within the ratio
  * 1 + s->depth of each other (or all the sky). */
-static int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
+IN_CLONE int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
 {
     const int m = s->object[pix(s, x0, y0)];
     double lo = INFINITY, hi = 0;
@@ -135,8 +138,8 @@ static void weights(int x0, int y0, int x1, int y1, int x, int y, double w[4])
  * s->spread and curve of the least light a pixel of the cell may have. A dim[k] lower than the
  * cell's least passes only where that passes (the sums and products below are monotone in it),
  * a higher one fails only where that fails. */
-static int within(const atmos__beams_screen *s, const double *const c[4], const double *const *cm, const double (*w)[4],
-                  int np, double curve, const double *dim)
+IN_CLONE int within(const atmos__beams_screen *s, const double *const c[4], const double *const *cm,
+                    const double (*w)[4], int np, double curve, const double *dim)
 {
     for (int k = 0; k < s->nw; k++) {
         const double lo = atmos__mind(atmos__mind(c[0][k], c[1][k]), atmos__mind(c[2][k], c[3][k]));
@@ -156,9 +159,11 @@ static int within(const atmos__beams_screen *s, const double *const c[4], const 
  * least light without the airlight over the cell's pixels (least_base) is read only where two
  * bounds of it do not settle the test: 0 below (that light is never negative: albedos within
  * [0, 1], the lights' and the sky's light not negative), the least of the four corners' above
- * (they are pixels of the cell); the same answer as the least itself gives. */
-static int agree(const band *b, const double *c[4], int x0, int y0, int x1, int y1, const int *px, const int *py, int np,
-                 double curve)
+ * (they are pixels of the cell); the same answer as the least itself gives. An AVX2 clone where
+ * the processor has it (same_surface and within inlined into it: the same IEEE operations, the
+ * same answers). */
+ATMOS_CLONES static int agree(const band *b, const double *c[4], int x0, int y0, int x1, int y1, const int *px,
+                              const int *py, int np, double curve)
 {
     const atmos__beams_screen *s = b->s;
     const int nw = s->nw;

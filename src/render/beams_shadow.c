@@ -14,13 +14,15 @@
 
 #define NEAR_M 1e-3
 #define BEAMS_CLONES ATMOS_CLONES
+/* A helper of a cloned function, inlined into each clone (core/clones.h). */
+#define IN_CLONE static inline __attribute__((always_inline))
 #define SPOT_FRUSTUM_MAX_DEG 60.0
 
 void atmos__beams_shadow_free(atmos__beams_light *l)
 {
     for (int f = 0; f < l->nfaces; f++) {
-        free(l->face[f].depth), atmos__beams_tiles_free(&l->face[f].tiles);
-        l->face[f].depth = NULL;
+        free(l->face[f].depth), free(l->face[f].tile_x), atmos__beams_tiles_free(&l->face[f].tiles);
+        l->face[f].depth = NULL, l->face[f].tile_x = l->face[f].tile_y = NULL;
     }
     l->nfaces = 0;
 }
@@ -77,6 +79,16 @@ static void raster_face(atmos__beams_face *F, const double pos[3], atmos_mesh *c
         }
 }
 
+/* The face's tile_x and tile_y: atmos__beams_tiles_at's two terms for each floor x0 = i - 1 of a
+ * look-up's coordinate (-1 .. n), so that a look-up's tile is two loads and an add. */
+static void tile_index(atmos__beams_face *F)
+{
+    for (int i = 0; i < F->n + 2; i++) {
+        F->tile_x[i] = atmos__beams_tiles_at(&F->tiles, i - 1, -1, ATMOS__BEAMS_LIGHT_TILE_SHIFT);
+        F->tile_y[i] = atmos__beams_tiles_at(&F->tiles, -1, i - 1, ATMOS__BEAMS_LIGHT_TILE_SHIFT);
+    }
+}
+
 int atmos__beams_shadow_faces(const atmos__lamp *L, int nmesh)
 {
     if (nmesh == 0) return 0;
@@ -99,8 +111,9 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
         }
         F->n = size;
         F->depth = malloc(sizeof(float) * (size_t)size * size);
+        F->tile_x = malloc(sizeof(int) * 2 * ((size_t)size + 2)), F->tile_y = F->tile_x ? F->tile_x + size + 2 : NULL;
         memset(&F->tiles, 0, sizeof F->tiles);
-        if (!F->depth) {
+        if (!F->depth || !F->tile_x) {
             l->nfaces = f + 1;
             atmos__beams_shadow_free(l);
             return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for a %dx%d shadow map", size, size);
@@ -115,7 +128,8 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
         if (atmos__beams_tiles_build(&l->face[f].tiles, l->face[f].depth, l->face[f].n, ATMOS__BEAMS_LIGHT_TILE_SHIFT, 1)) {
 #pragma omp atomic write
             failed = 1;
-        }
+        } else
+            tile_index(&l->face[f]);
         atmos__progress_step(ctx, "beams shadow maps", &pr->done, pr->total, &pr->cancelled);
     }
     if (failed) {
@@ -126,15 +140,30 @@ atmos_status atmos__beams_shadow_build(atmos_context *ctx, atmos__beams_light *l
     return ATMOS_OK;
 }
 
+/* What a look-up reads of a face, in locals: a run's loop (read_point) takes them once, where
+ * the fields read after a branch in the loop would be loaded again at every sample (the compiler
+ * does not hoist a load that the loop may not reach). */
+typedef struct face_at {
+    int n;
+    double hn, tan_half; /* 0.5 n, the same bits as 0.5 * F->n */
+    const float *depth, *min, *max;
+    const int *tile_x, *tile_y;
+} face_at;
+
+static inline face_at face_of(const atmos__beams_face *F)
+{
+    return (face_at){F->n, 0.5 * F->n, F->tan_half, F->depth, F->tiles.min, F->tiles.max, F->tile_x, F->tile_y};
+}
+
 /* texels() at coordinates inside the map (fx, fy in (-1, n)). */
-static inline double texels_in(const atmos__beams_face *F, double fx, double fy, double z)
+static inline double texels_in(const face_at *F, double fx, double fy, double z)
 {
     if (z <= NEAR_M) return 1;
     const int n = F->n;
-    const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1; /* floor: fx, fy > -1 */
-    const int tile = atmos__beams_tiles_at(&F->tiles, x0, y0, ATMOS__BEAMS_LIGHT_TILE_SHIFT);
-    if (z < F->tiles.min[tile]) return 1;
-    if (z >= F->tiles.max[tile]) return 0;
+    const int xi = (int)(fx + 1), yi = (int)(fy + 1), x0 = xi - 1, y0 = yi - 1; /* floor: fx, fy > -1 */
+    const int tile = F->tile_y[yi] + F->tile_x[xi]; /* atmos__beams_tiles_at(&tiles, x0, y0, shift) */
+    if (z < F->min[tile]) return 1;
+    if (z >= F->max[tile]) return 0;
     const double ax = fx - x0, ay = fy - y0;
     const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
     const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
@@ -148,11 +177,12 @@ static inline double texels(const atmos__beams_face *F, double fx, double fy, do
 {
     const int n = F->n;
     if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* outside the spot's frustum: its falloff is zero there */
-    return texels_in(F, fx, fy, z);
+    const face_at a = face_of(F);
+    return texels_in(&a, fx, fy, z);
 }
 
 /* H at the point (x, y, z) of face F's frame. */
-static double lookup(const atmos__beams_face *F, double x, double y, double z)
+IN_CLONE double lookup(const atmos__beams_face *F, double x, double y, double z)
 {
     if (z <= NEAR_M) return 1;
     const int n = F->n;
@@ -161,7 +191,7 @@ static double lookup(const atmos__beams_face *F, double x, double y, double z)
 }
 
 /* The cube face of w's largest component. */
-static int cube_face(const double w[3])
+IN_CLONE int cube_face(const double w[3])
 {
     const double ax = fabs(w[0]), ay = fabs(w[1]), az = fabs(w[2]);
     const int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
@@ -176,7 +206,10 @@ double atmos__beams_visibility(const atmos__beams_light *l, const double p[3])
     return lookup(F, atmos__dot3(d, F->right), atmos__dot3(d, F->up), atmos__dot3(d, F->fwd));
 }
 
-void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r)
+/* An AVX2 clone where the processor has it (the same IEEE operations: the same bits), as
+ * atmos__beams_ray_uniform below. */
+BEAMS_CLONES void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3],
+                                        atmos__beams_ray *r)
 {
     r->l = l;
     for (int a = 0; a < 3; a++) r->w0[a] = o[a] - l->L.pos[a], r->d[a] = d[a];
@@ -204,26 +237,26 @@ void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const
     }
 }
 
-/* Face f's texel coordinates and depth of the ray at t (0 if behind the near plane). */
-static inline __attribute__((always_inline)) int project(const atmos__beams_ray *r, int f, double t, double *fx,
-                                                         double *fy, double *z)
+/* Face f's (F, face_of(&r->l->face[f])) texel coordinates and depth of the ray at t (0 if behind
+ * the near plane). */
+static inline __attribute__((always_inline)) int project(const atmos__beams_ray *r, int f, const face_at *F, double t,
+                                                         double *fx, double *fy, double *z)
 {
-    const atmos__beams_face *F = &r->l->face[f];
     *z = r->f0[f][2] + t * r->f1[f][2];
     if (*z <= NEAR_M) return 0;
-    const double k = 0.5 * F->n / (*z * F->tan_half);
-    *fx = 0.5 * F->n + (r->f0[f][0] + t * r->f1[f][0]) * k - 0.5;
-    *fy = 0.5 * F->n + (r->f0[f][1] + t * r->f1[f][1]) * k - 0.5;
+    const double k = F->hn / (*z * F->tan_half);
+    *fx = F->hn + (r->f0[f][0] + t * r->f1[f][0]) * k - 0.5;
+    *fy = F->hn + (r->f0[f][1] + t * r->f1[f][1]) * k - 0.5;
     return *fx > -1 && *fx < F->n && *fy > -1 && *fy < F->n;
 }
 
-static int inside_inner(const atmos__beams_ray *r, double t)
+IN_CLONE int inside_inner(const atmos__beams_ray *r, double t)
 {
     const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
     return z > 0 && z * z >= r->l->L.cos_inner * r->l->L.cos_inner * w2;
 }
 
-int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full)
+BEAMS_CLONES int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full)
 {
     const atmos__beams_light *l = r->l;
     *full = l->L.type != ATMOS_LIGHT_SPOT || (inside_inner(r, ta) && inside_inner(r, tb)); /* the cone is convex */
@@ -236,8 +269,9 @@ int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, do
         if ((f = cube_face(wa)) != cube_face(wb)) return 0;
     }
     double xa, ya, za, xb, yb, zb; /* depth is linear along the segment, its image a straight line */
-    if (!project(r, f, ta, &xa, &ya, &za) || !project(r, f, tb, &xb, &yb, &zb)) return 0;
     const atmos__beams_face *F = &l->face[f];
+    const face_at a = face_of(F);
+    if (!project(r, f, &a, ta, &xa, &ya, &za) || !project(r, f, &a, tb, &xb, &yb, &zb)) return 0;
     const int x0 = (int)(atmos__mind(xa, xb) + 1) - 1, x1 = (int)(atmos__maxd(xa, xb) + 1) - 1;
     const int y0 = (int)(atmos__mind(ya, yb) + 1) - 1, y1 = (int)(atmos__maxd(ya, yb) + 1) - 1;
     float lo, hi;
@@ -247,7 +281,8 @@ int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, do
     return 0;
 }
 
-double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
+/* atmos__beams_ray_falloff, inlined into ray_light. */
+IN_CLONE double ray_falloff(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
     if (l->L.type != ATMOS_LIGHT_SPOT) return 1;
@@ -257,6 +292,8 @@ double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t)
     const double s = (z / sqrt(w2) - l->L.cos_outer) / (l->L.cos_inner - l->L.cos_outer);
     return s * s * (3 - 2 * s);
 }
+
+double atmos__beams_ray_falloff(const atmos__beams_ray *r, double t) { return ray_falloff(r, t); }
 
 /* The samples t = ta + (s + o) step, s in [*ka, *kb), inside the spot's inner cone (falloff 1):
  * the cone is convex, so they are one run, between the roots of (z(t))^2 = cos^2 |w(t)|^2 on
@@ -318,10 +355,11 @@ double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double
     return falloff_run(r, ta, step, o, 0, ka) + (kb - ka) + falloff_run(r, ta, step, o, kb, m);
 }
 
-double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
+/* atmos__beams_ray_light, inlined into read_run's clones. */
+IN_CLONE double ray_light(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
-    const double fall = atmos__beams_ray_falloff(r, t);
+    const double fall = ray_falloff(r, t);
     if (!l->nfaces || fall == 0) return fall;
     int f = 0;
     if (l->nfaces == 6) {
@@ -331,6 +369,8 @@ double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
     return fall * lookup(&l->face[f], r->f0[f][0] + t * r->f1[f][0], r->f0[f][1] + t * r->f1[f][1],
                          r->f0[f][2] + t * r->f1[f][2]);
 }
+
+double atmos__beams_ray_light(const atmos__beams_ray *r, double t) { return ray_light(r, t); }
 
 /* The texel coordinates and depths on face f of the samples t = ta + (s + o) step, s in [s0, s1)
  * (at most RUN_READ of them), as lookup() computes them: one loop that vectorises (the divisions
@@ -355,14 +395,14 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
  * the same operations as run_texels; the runs are short, about 8 samples on average: the
  * vectorised loop's call and setup cost more than it saves), no division where the sample is
  * behind the near plane (texels_in's 1 there). */
-static double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
+IN_CLONE double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
 {
-    const atmos__beams_face *F = &r->l->face[f];
+    const face_at F = face_of(&r->l->face[f]);
     double h = 0;
     for (int s = s0; s < s1; s++) {
         double fx, fy, z;
-        project(r, f, ta + (s + o) * step, &fx, &fy, &z); /* its frustum test not needed: texels_in's */
-        h += z <= NEAR_M ? 1 : texels_in(F, fx, fy, z);
+        project(r, f, &F, ta + (s + o) * step, &fx, &fy, &z); /* its frustum test not needed: texels_in's */
+        h += z <= NEAR_M ? 1 : texels_in(&F, fx, fy, z);
     }
     return h;
 }
@@ -370,8 +410,9 @@ static double read_point(const atmos__beams_ray *r, int f, double ta, double ste
 /* The samples [s0, s1) (at most RUN_READ) of atmos__beams_ray_light_sum read one by one: when
  * they all lie in one face of the map (the first's and the last's, each as
  * atmos__beams_ray_light finds it), a point light's by read_point, a spot's texels projected
- * together (run_texels), else each alone. The same sum, in order. */
-static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
+ * together (run_texels), else each alone. The same sum, in order. An AVX2 clone where the
+ * processor has it (read_point inlined into it: the same IEEE operations, the same bits). */
+BEAMS_CLONES static double read_run(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1)
 {
     const atmos__beams_light *l = r->l;
     double h = 0;
@@ -384,14 +425,14 @@ static double read_run(const atmos__beams_ray *r, double ta, double step, double
         if (s1 - s0 > 1 && cube_face(w1) != f) f = -1;
     }
     if (!l->nfaces || f < 0) {
-        for (int s = s0; s < s1; s++) h += atmos__beams_ray_light(r, ta + (s + o) * step);
+        for (int s = s0; s < s1; s++) h += ray_light(r, ta + (s + o) * step);
         return h;
     }
     if (l->L.type != ATMOS_LIGHT_SPOT) return read_point(r, f, ta, step, o, s0, s1);
     double fx[RUN_READ], fy[RUN_READ], z[RUN_READ];
     run_texels(r, f, ta, step, o, s0, s1, fx, fy, z);
     for (int s = s0; s < s1; s++) {
-        const double fall = atmos__beams_ray_falloff(r, ta + (s + o) * step);
+        const double fall = ray_falloff(r, ta + (s + o) * step);
         h += fall == 0 ? 0 : fall * texels(&l->face[f], fx[s - s0], fy[s - s0], z[s - s0]);
     }
     return h;

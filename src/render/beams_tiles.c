@@ -1,5 +1,6 @@
 /* The min/max pyramid of a depth map (beams_tiles.h). */
 #include "render/beams_tiles.h"
+#include "core/clones.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -73,7 +74,9 @@ int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, i
     return 0;
 }
 
-void atmos__beams_tiles_range(const atmos__beams_tiles *t, int x0, int x1, int y0, int y1, float *lo, float *hi)
+/* An AVX2 clone where the processor has it (the same comparisons: the same bounds). */
+ATMOS_CLONES void atmos__beams_tiles_range(const atmos__beams_tiles *t, int x0, int x1, int y0, int y1, float *lo,
+                                           float *hi)
 {
     const int sh = t->shift, tx0 = x0 < 0 ? 0 : x0 >> sh, tx1 = x1 < 0 ? 0 : x1 >> sh, ty0 = y0 < 0 ? 0 : y0 >> sh,
               ty1 = y1 < 0 ? 0 : y1 >> sh;
