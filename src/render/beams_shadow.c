@@ -223,7 +223,7 @@ static int inside_inner(const atmos__beams_ray *r, double t)
     return z > 0 && z * z >= r->l->L.cos_inner * r->l->L.cos_inner * w2;
 }
 
-int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full)
+BEAMS_CLONES int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full)
 {
     const atmos__beams_light *l = r->l;
     *full = l->L.type != ATMOS_LIGHT_SPOT || (inside_inner(r, ta) && inside_inner(r, tb)); /* the cone is convex */
@@ -318,7 +318,7 @@ double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double
     return falloff_run(r, ta, step, o, 0, ka) + (kb - ka) + falloff_run(r, ta, step, o, kb, m);
 }
 
-double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
+BEAMS_CLONES double atmos__beams_ray_light(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
     const double fall = atmos__beams_ray_falloff(r, t);
