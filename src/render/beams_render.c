@@ -381,7 +381,7 @@ static int agreed_intervals(job *J, int i, const reach_part *r, double *f, doubl
  * last ends (f holds room for 2 MAX_INTERVALS + 2 values). Returns n (0: none), *sum the sum of
  * the f_l. With sh (its known not NULL), agreed_intervals(): *sum is then the W difference over
  * the whole part, and f[2n + 1] the lit runs' f_l. */
-static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre,
+ATMOS_CLONES static int intervals(job *J, int i, const double d[3], double T, double *f, double *sum, int centre,
                      const shared_ray *sh)
 {
     reach_part r;
