@@ -56,7 +56,10 @@ static double light_sum(const atmos__beams_ray *r, double ta, double step, doubl
 /* atmos__beams_ray_tinted_sum over [s0, s1), knowing what known says of the light there. A run
  * of 8 samples or fewer is read without its box's colour test: its segment spans less than 3 of
  * the stained glass's texels, whose panes are about 4 across, and the test settled 6 % of them
- * for about 230 instructions each (docs/beams.md *Forty-first round*). */
+ * for about 230 instructions each (docs/beams.md *Forty-first round*). An AVX2 clone: the same
+ * operations (C11 contracts none into FMAs), fewer instructions; read_tinted and the look-up
+ * always inlined, else the clone calls the baseline's copies (docs/beams.md *Forty-seventh
+ * round*). */
 ATMOS_CLONES static void tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
                        double h[3])
 {
