@@ -85,7 +85,7 @@ static void lit_box(atmos__lamp *l)
     int x0 = l->tw, x1 = -1, y0 = l->th, y1 = -1;
     for (int y = 0; y < l->th; y++)
         for (int x = 0; x < l->tw; x++) {
-            const float *t = atmos__lamp_texel(l, x, y);
+            const double *t = atmos__lamp_texel(l, x, y);
             if (t[0] != 0 || t[1] != 0 || t[2] != 0)
                 x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1, y0 = y < y0 ? y : y0, y1 = y > y1 ? y : y1;
         }
@@ -106,7 +106,7 @@ static void edge_sums(const atmos__lamp *l, int dx, int dy, int *S)
         for (int x = 0; x < l->tw; x++) {
             int e = 0;
             if (x + dx < l->tw && y + dy < l->th) {
-                const float *a = atmos__lamp_texel(l, x, y), *b = atmos__lamp_texel(l, x + dx, y + dy);
+                const double *a = atmos__lamp_texel(l, x, y), *b = atmos__lamp_texel(l, x + dx, y + dy);
                 e = a[0] != b[0] || a[1] != b[1] || a[2] != b[2];
             }
             S[(y + 1) * W + x + 1] = e + S[y * W + x + 1] + S[(y + 1) * W + x] - S[y * W + x];
@@ -128,7 +128,7 @@ atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene
         return atmos__scene_file_error(ctx, st, scene, s->image, key, 1);
     }
     const int W = img->width + 2, H = img->height + 2; /* a border of the edges' texels */
-    l->tex = malloc(sizeof(float) * 3 * (size_t)W * H);
+    l->tex = malloc(sizeof(double) * 3 * (size_t)W * H);
     if (!l->tex) {
         atmos_image_destroy(img);
         return atmos__error(ctx, ATMOS_E_NOMEM, "/lights/%d/image: %s: out of memory for a light's image", index, s->image);
@@ -200,7 +200,7 @@ int atmos__lamp_tint_same(const atmos__lamp *l, double fx0, double fx1, double f
     const int ca = x0 < 0 ? 0 : x0, cb = x1 >= l->tw ? l->tw - 1 : x1, ra = y0 < 0 ? 0 : y0, rb = y1 >= l->th ? l->th - 1 : y1;
     const int cells = (l->tw + 1) * (l->th + 1);
     if (edges_in(l, l->edges, ca, cb - 1, ra, rb) || edges_in(l, l->edges + cells, ca, cb, ra, rb - 1)) return 0;
-    const float *t = atmos__lamp_texel(l, ca, ra);
+    const double *t = atmos__lamp_texel(l, ca, ra);
     for (int c = 0; c < 3; c++) rgb[c] = t[c];
     return 1;
 }

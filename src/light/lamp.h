@@ -20,8 +20,9 @@ typedef struct atmos__lamp {
     /* a spot's projected image (stained glass; NULL: none): tw x th linear rgb texels, row 0
      * at the top, spanning [-tan_max, tan_max]^2 of the plane at unit distance along the axis
      * (right, up: the image's axes there), in a border of a texel that repeats the edges' (so
-     * that a bilinear look-up need not clamp: atmos__lamp_texel) */
-    float *tex;
+     * that a bilinear look-up need not clamp: atmos__lamp_texel); each the float of the linear
+     * value, kept as a double (a look-up's products then read it without a conversion) */
+    double *tex;
     int tw, th;
     double tan_max, right[3], up[3];
     /* the image's edges, for atmos__lamp_tint_same: (th + 1) x (tw + 1) running sums over the
@@ -77,7 +78,7 @@ static inline void atmos__lamp_tint_coords(const atmos__lamp *l, double x, doubl
     *fx = 0.5 * (x + 1) * l->tw - 0.5, *fy = 0.5 * (1 - y) * l->th - 0.5;
 }
 /* Texel (x, y) of the image, x in [-1, tw], y in [-1, th] (the border: the edges' texels). */
-static inline const float *atmos__lamp_texel(const atmos__lamp *l, int x, int y)
+static inline const double *atmos__lamp_texel(const atmos__lamp *l, int x, int y)
 {
     return l->tex + 3 * ((size_t)(y + 1) * (l->tw + 2) + x + 1);
 }
@@ -89,7 +90,7 @@ static inline int atmos__lamp_floor(double x)
     return i - (x < i);
 }
 /* The tint at texel coordinates (fx, fy) of the image (bilinear; 0 outside it). */
-static inline void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
+static inline __attribute__((always_inline)) void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0;
     if (!(fx > -1 && fx < l->tw && fy > -1 && fy < l->th)) return;
@@ -97,7 +98,7 @@ static inline void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double f
     const double ax = fx - x0, ay = fy - y0;
     const double w00 = (1 - ax) * (1 - ay), w01 = ax * (1 - ay), w10 = (1 - ax) * ay, w11 = ax * ay;
     /* the border stands for the clamped edge */
-    const float *t00 = atmos__lamp_texel(l, x0, y0), *t10 = atmos__lamp_texel(l, x0, y0 + 1);
+    const double *t00 = atmos__lamp_texel(l, x0, y0), *t10 = atmos__lamp_texel(l, x0, y0 + 1);
     rgb[0] = w00 * t00[0] + w01 * t00[3] + w10 * t10[0] + w11 * t10[3]; /* in this order, left to right */
     rgb[1] = w00 * t00[1] + w01 * t00[4] + w10 * t10[1] + w11 * t10[4];
     rgb[2] = w00 * t00[2] + w01 * t00[5] + w10 * t10[2] + w11 * t10[5];

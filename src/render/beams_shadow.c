@@ -370,7 +370,7 @@ IN_CLONE double ray_light(const atmos__beams_ray *r, double t)
                          r->f0[f][2] + t * r->f1[f][2]);
 }
 
-double atmos__beams_ray_light(const atmos__beams_ray *r, double t) { return ray_light(r, t); }
+BEAMS_CLONES double atmos__beams_ray_light(const atmos__beams_ray *r, double t) { return ray_light(r, t); }
 
 /* The texel coordinates and depths on face f of the samples t = ta + (s + o) step, s in [s0, s1)
  * (at most RUN_READ of them), as lookup() computes them: one loop that vectorises (the divisions

@@ -87,13 +87,18 @@ ATMOS_CLONES void atmos__beams_tiles_range(const atmos__beams_tiles *t, int x0, 
     int k = d > 1 ? 31 - __builtin_clz(d) : 0;
     if (k > t->levels - 1) k = t->levels - 1;
     while (k + 1 < t->levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
-    const float *cmin = t->min + t->level_at[k], *cmax = t->max + t->level_at[k];
-    const int m = t->level_n[k];
-    float a = INFINITY, b = -INFINITY;
-    for (int ty = ty0 >> k; ty <= ty1 >> k; ty++)
-        for (int tx = tx0 >> k; tx <= tx1 >> k; tx++) {
-            const float u = cmin[ty * m + tx], v = cmax[ty * m + tx];
-            a = u < a ? u : a, b = v > b ? v : b;
-        }
+    /* at most 2 x 2 cells there: the four corners' read (a corner twice where the box is one
+     * cell wide; the least and the greatest are the same whatever the order: no NaN depths) */
+    const int xa = tx0 >> k, xb = tx1 >> k, ya = ty0 >> k, yb = ty1 >> k;
+    if (xb < xa || yb < ya) { /* an empty box (the texels' ends out of order) */
+        *lo = INFINITY, *hi = -INFINITY;
+        return;
+    }
+    const size_t m = (size_t)t->level_n[k], ra = t->level_at[k] + ya * m, rb = t->level_at[k] + yb * m;
+    const float *cmin = t->min, *cmax = t->max;
+    float a = cmin[ra + xa], b = cmax[ra + xa], u, v;
+    u = cmin[ra + xb], v = cmax[ra + xb], a = u < a ? u : a, b = v > b ? v : b;
+    u = cmin[rb + xa], v = cmax[rb + xa], a = u < a ? u : a, b = v > b ? v : b;
+    u = cmin[rb + xb], v = cmax[rb + xb], a = u < a ? u : a, b = v > b ? v : b;
     *lo = a, *hi = b;
 }

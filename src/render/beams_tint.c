@@ -5,6 +5,7 @@
  * light's own sum (its tiles' tests, its falloff's runs); a run in a black part of the image, or
  * outside it, adds nothing. */
 #include "render/beams_internal.h"
+#include "core/clones.h"
 #include "core/vec.h"
 
 #include <math.h>
@@ -26,7 +27,7 @@ static inline __attribute__((always_inline)) int coords(const atmos__beams_ray *
 }
 
 /* The samples [s0, s1) one by one, added to h (the sums held in locals). */
-static void read_tinted(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
+static inline __attribute__((always_inline)) void read_tinted(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
                         double h[3])
 {
     double h0 = h[0], h1 = h[1], h2 = h[2];
@@ -55,8 +56,11 @@ static double light_sum(const atmos__beams_ray *r, double ta, double step, doubl
 /* atmos__beams_ray_tinted_sum over [s0, s1), knowing what known says of the light there. A run
  * of 8 samples or fewer is read without its box's colour test: its segment spans less than 3 of
  * the stained glass's texels, whose panes are about 4 across, and the test settled 6 % of them
- * for about 230 instructions each (docs/beams.md *Forty-first round*). */
-static void tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
+ * for about 230 instructions each (docs/beams.md *Forty-first round*). An AVX2 clone: the same
+ * operations (C11 contracts none into FMAs), fewer instructions; read_tinted and the look-up
+ * always inlined, else the clone calls the baseline's copies (docs/beams.md *Forty-seventh
+ * round*). */
+ATMOS_CLONES static void tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
                        double h[3])
 {
     const double t0 = ta + (s0 + o) * step, t1 = ta + (s1 - 1 + o) * step;
