@@ -1,25 +1,41 @@
-/* Branch-free float exponential for the renderers' vectorised loops; ln(1 + x) without
- * the library's log1p; atan2 without the library's. */
+/* Branch-free float exponential and select for the renderers' vectorised loops; ln(1 + x)
+ * without the library's log1p; atan2 without the library's. */
 #ifndef ATMOS_FASTMATH_H
 #define ATMOS_FASTMATH_H
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
+
+/* c ? a : b (c 0 or 1) by the bits: a and b are both computed by the caller, so that GCC's
+ * vectoriser sees no branch. Written as c ? a : b, an operation on one side (a division, a
+ * product) is moved into a branch that, floating point operations being allowed to trap, the
+ * loop cannot be vectorised with; the bits chosen are the same. */
+static inline float atmos__select_f(int c, float a, float b)
+{
+    int32_t ia, ib;
+    memcpy(&ia, &a, sizeof ia), memcpy(&ib, &b, sizeof ib);
+    const int32_t mk = -(int32_t)c, r = (ia & mk) | (ib & ~mk);
+    float f;
+    memcpy(&f, &r, sizeof f);
+    return f;
+}
 
 /* e^x by range reduction x = n ln2 + r, |r| <= ln2/2, and a degree-6 Taylor polynomial
  * for e^r (truncation error < 2e-8), 2^n assembled in the exponent bits; x is clamped to
  * [-87, 88] (e^-87 < 2e-38 stands for anything smaller). No branches or calls, so loops
- * over it vectorise. */
+ * over it vectorise (its clamps by atmos__select_f: written as c ? a : b, GCC 12 at -O2 without
+ * -fno-trapping-math left such loops scalar). */
 static inline float atmos__expf_poly(float x)
 {
-    x = x < -87.0f ? -87.0f : x;
-    x = x > 88.0f ? 88.0f : x;
+    x = atmos__select_f(x < -87.0f, -87.0f, x);
+    x = atmos__select_f(x > 88.0f, 88.0f, x);
     float t = x * 1.44269504088896341f;
     float nf = (t + 12582912.0f) - 12582912.0f; /* round to nearest by the 1.5*2^23 trick */
     /* nf is in [-126, 127] for any number; a NaN argument (which the clamps above let
      * through) becomes -126 here so that the conversion and shift below stay defined,
      * while p, and so the result, stays NaN for the caller's checks to see. */
-    nf = nf > -126.0f ? nf : -126.0f;
+    nf = atmos__select_f(nf > -126.0f, nf, -126.0f);
     float r = x - nf * 0.693145751953125f;      /* ln2 split: hi exactly representable */
     r = r - nf * 1.428606765330187045e-06f;     /* ln2 lo */
     float p = 1.0f / 720.0f;

@@ -30,7 +30,7 @@
  * are taken as FLT_MIN. Branch-free for vectorisation. */
 SLICE_INLINE float log_pos(float x)
 {
-    x = x < 1.17549435e-38f ? 1.17549435e-38f : x;
+    x = atmos__select_f(x < 1.17549435e-38f, 1.17549435e-38f, x);
     union {
         int32_t i;
         float f;
@@ -39,7 +39,7 @@ SLICE_INLINE float log_pos(float x)
     b.i = (b.i & 0x007fffff) | 0x3f800000; /* m in [1, 2) */
     float m = b.f;
     const int big = m > 1.41421356f;
-    m = big ? 0.5f * m : m;
+    m = atmos__select_f(big, 0.5f * m, m);
     e += big;
     const float s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
     float p = 1.0f / 9.0f;
@@ -277,13 +277,19 @@ SLICE_INLINE void eye_orders(const sjob *j, size_t p0, echunk *e)
         e->oi[q] = o;
         e->fo[q] = mm - 1.0f - (float)o;
     }
-    if (j->two_pop) /* the do field back to front: the turned light's share (slice_do.c) */
-        for (int q = 0; q < e->mv; q++) e->oi[q] = 2, e->fo[q] = 1.0f - atmos__expf_poly(-j->share_dm * e->nsc[q]);
+    /* the do field's loops: the count and the constants in locals and the eye's transmittance
+       gathered first, so that each is one vector loop */
+    const int mv = e->mv & ~7; /* e->mv itself: whole vectors */
+    if (j->two_pop) { /* the do field back to front: the turned light's share (slice_do.c) */
+        const float sd = j->share_dm;
+        for (int q = 0; q < mv; q++) e->oi[q] = 2, e->fo[q] = 1.0f - atmos__expf_poly(-sd * e->nsc[q]);
+    }
     if (j->sharp_eye) { /* the do field: its first order's smooth share (slice_do.c) */
         const int c = j->n / 2;
         const float km = j->kap[c] - 1.0f, sh = j->share, *restrict T0 = j->T_eye + c * j->pst + p0;
-        for (int q = 0; q < e->mv; q++)
-            e->fo[q] = 1.0f - atmos__expf_poly(km * log_pos(T0[lane(e, q)]) - sh * e->nsc[q]);
+        float t0[CH];
+        for (int q = 0; q < mv; q++) t0[q] = T0[lane(e, q)];
+        for (int q = 0; q < mv; q++) e->fo[q] = 1.0f - atmos__expf_poly(km * log_pos(t0[q]) - sh * e->nsc[q]);
     }
     for (int f = 0; f < nf; f++) {
         if (!e->live[f]) continue;
@@ -333,14 +339,24 @@ typedef struct {
     int32_t st[3]; /* the view's strides to the next cell along each axis (0: an axis of one cell) */
 } fchunk;
 
-SLICE_INLINE void field_axis(float x, int c, int32_t *i, float *t)
+/* One axis of the field's cells for mv samples (a multiple of 8) at render-voxel coordinate x:
+ * the lower cell i and the fraction t. Written without a branch, so that it is one vector loop
+ * (the fraction is taken whatever c; an axis of one cell sets it to 0 afterwards). */
+SLICE_INLINE void field_axis(int mv, const float *restrict x, float off, float is, int c, int32_t *restrict i,
+                             float *restrict t)
 {
-    const float lim = (float)(c - 1);
-    x = x < 0.0f ? 0.0f : (x > lim ? lim : x);
-    int a = (int)x;
-    a = a > c - 2 ? c - 2 : a;
-    a = a < 0 ? 0 : a;
-    *i = a, *t = c > 1 ? x - (float)a : 0.0f;
+    const float lim = (float)(c - 1); /* >= 0: the two clamps one after the other clamp alike */
+    for (int q = 0; q < mv; q++) {
+        float y = (x[q] - off) * is;
+        y = y < 0.0f ? 0.0f : y;
+        y = y > lim ? lim : y;
+        int a = (int)y;
+        a = a > c - 2 ? c - 2 : a;
+        a = a < 0 ? 0 : a;
+        i[q] = a, t[q] = y - (float)a;
+    }
+    if (c <= 1)
+        for (int q = 0; q < mv; q++) t[q] = 0.0f;
 }
 
 SLICE_INLINE void eye_field_cells(const sjob *j, int k, size_t p0, const echunk *e, fchunk *fc)
@@ -350,15 +366,21 @@ SLICE_INLINE void eye_field_cells(const sjob *j, int k, size_t p0, const echunk 
     const int32_t m = j->nf * j->fvq;
     const float kf = (float)k, off = 0.5f * (float)(f->s - 1), is = 1.0f / (float)f->s;
     fc->st[0] = cx > 1 ? m : 0, fc->st[1] = cy > 1 ? cx * m : 0, fc->st[2] = cz > 1 ? cx * cy * m : 0;
-    for (int q = 0; q < e->mv; q++) {
+    /* the samples' points gathered first, then the cells and weights in vector loops (the
+       gather and the clamps in one loop took more instructions: docs/lightfield.md) */
+    const int mv = e->mv & ~7; /* e->mv itself: whole vectors */
+    float pt[3][CH], ft[3][CH];
+    int32_t it[3][CH];
+    for (int q = 0; q < mv; q++) {
         const size_t p = p0 + (size_t)lane(e, q);
-        const float u = j->pU0[0][p] + kf * j->pdU[0][p], v = j->pU0[1][p] + kf * j->pdU[1][p],
-                    w = j->pU0[2][p] + kf * j->pdU[2][p];
-        int32_t i, jj, kk;
-        float a, b, c;
-        field_axis((u - off) * is, cx, &i, &a);
-        field_axis((v - off) * is, cy, &jj, &b);
-        field_axis((w - off) * is, cz, &kk, &c);
+        for (int a = 0; a < 3; a++) pt[a][q] = j->pU0[a][p] + kf * j->pdU[a][p];
+    }
+    field_axis(mv, pt[0], off, is, cx, it[0], ft[0]);
+    field_axis(mv, pt[1], off, is, cy, it[1], ft[1]);
+    field_axis(mv, pt[2], off, is, cz, it[2], ft[2]);
+    for (int q = 0; q < mv; q++) {
+        const int32_t i = it[0][q], jj = it[1][q], kk = it[2][q];
+        const float a = ft[0][q], b = ft[1][q], c = ft[2][q];
         fc->cell[q] = ((kk * cy + jj) * cx + i) * m;
         fc->w[0][q] = (1 - a) * (1 - b) * (1 - c), fc->w[1][q] = a * (1 - b) * (1 - c);
         fc->w[2][q] = (1 - a) * b * (1 - c), fc->w[3][q] = a * b * (1 - c);
@@ -397,6 +419,33 @@ SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, fl
         for (int q = 0; q < e->mv; q++) ds[c * CH + q] = ds[c * CH + q] > 0.0f ? ds[c * CH + q] : 0.0f;
 }
 
+/* atmos__slice_beam_ratio and atmos__slice_beam_len (slice_internal.h) with every operation
+ * taken and the result selected by atmos__select_f (the same bits): the beam's loop in fewer
+ * instructions than with their branches (docs/lightfield.md, "Where a sun-moving frame's extra
+ * work is"). A division by 0 on the side not taken gives an infinity or a NaN, not selected. */
+SLICE_INLINE float beam_ratio(float i0, float i1)
+{
+    float r = atmos__select_f(i0 > 0.0f, i1 / i0, 1.0f);
+    r = atmos__select_f(r < 1.0f, r, 1.0f); /* NaN: 1 */
+    return atmos__select_f(r > ATMOS__SLICE_BEAM_MIN, r, ATMOS__SLICE_BEAM_MIN);
+}
+
+/* back to front: the light enters by the far face */
+SLICE_INLINE float beam_len_btf(float del, float te, float T, float tl, float r)
+{
+    const float y = te - tl;
+    const float near = del * r * (1.0f - 0.5f * y), far = del * (r - T) / y;
+    return atmos__select_f((y < 1e-3f) & (y > -1e-3f), near, far);
+}
+
+/* front to back: the light and the eye enter by the same face */
+SLICE_INLINE float beam_len_ftb(float del, float te, float T, float tl, float r)
+{
+    const float y = te + tl;
+    const float near = del * 1.0f * (1.0f - 0.5f * y), far = del * (1.0f - T * r) / y;
+    return atmos__select_f((y < 1e-3f) & (y > -1e-3f), near, far);
+}
+
 /* Eq. 26 for wavelength c: the slab's transmittance and in-scattered light, composited
  * into the eye buffer over (back to front) or under (front to back); ds (or NULL): the
  * diffuse field's in-scattering added to the beam's; I1 (or NULL): the light leaving the slab
@@ -424,11 +473,17 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
     if (I1) {
         /* the beam's exponentials are the slab's T and the light's ratio r themselves: a
          * logarithm a sample, no exponential (two were taken here) */
-        const int btf = j->btf;
-        for (int q = 0; q < e->mv; q++) {
-            const float r = atmos__slice_beam_ratio(Ic[q], I1[q]);
-            Bq[q] = atmos__slice_beam_len(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r, btf);
-        }
+        const int mv = e->mv & ~7; /* e->mv itself: whole vectors */
+        if (j->btf)
+            for (int q = 0; q < mv; q++) {
+                const float r = beam_ratio(Ic[q], I1[q]);
+                Bq[q] = beam_len_btf(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r);
+            }
+        else
+            for (int q = 0; q < mv; q++) {
+                const float r = beam_ratio(Ic[q], I1[q]);
+                Bq[q] = beam_len_ftb(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r);
+            }
     } else
         for (int q = 0; q < e->mv; q++) Bq[q] = Lq[q];
     for (int q = 0; q < e->mv; q++) Cq[q] = bext[q] > 0.0f ? Sq[q] * Lq[q] + Ic[q] * src[q] * Bq[q] : 0.0f;
@@ -534,21 +589,23 @@ SLICE_INLINE void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e
     const int32_t sx = fc.st[0], sy = fc.st[1], sz = fc.st[2];
     const int32_t o8[8] = {0, sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz};
     const __m128 zero = _mm_setzero_ps();
+    /* the fields outside, the samples inside: a field's test once a chunk (each sample's sum over
+       the fields in the same order) */
+    __m128 acc[CH];
+    for (int q = 0; q < e->mv; q++) acc[q] = zero;
+    for (int f = 0; f < nf; f++) {
+        if (!e->live[f]) continue;
+        const float *restrict V = j->fview + f * 4, *restrict d = e->dens + f * CH;
+        for (int q = 0; q < e->mv; q++) {
+            const float *p = V + fc.cell[q];
+            __m128 v = _mm_mul_ps(_mm_set1_ps(fc.w[0][q]), _mm_loadu_ps(p));
+            for (int x = 1; x < 8; x++) v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(fc.w[x][q]), _mm_loadu_ps(p + o8[x])));
+            acc[q] = _mm_add_ps(acc[q], _mm_mul_ps(_mm_set1_ps(d[q] > 0.0f ? d[q] : 0.0f), v));
+        }
+    }
     for (int q0 = 0; q0 < e->mv; q0 += 4) {
         __m128 r[4];
-        for (int i = 0; i < 4; i++) {
-            const int q = q0 + i;
-            __m128 acc = zero;
-            for (int f = 0; f < nf; f++) {
-                if (!e->live[f]) continue;
-                const float *p = j->fview + fc.cell[q] + f * 4;
-                __m128 v = _mm_mul_ps(_mm_set1_ps(fc.w[0][q]), _mm_loadu_ps(p));
-                for (int x = 1; x < 8; x++) v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(fc.w[x][q]), _mm_loadu_ps(p + o8[x])));
-                const float d = e->dens[f * CH + q];
-                acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(d > 0.0f ? d : 0.0f), v));
-            }
-            r[i] = _mm_max_ps(acc, zero);
-        }
+        for (int i = 0; i < 4; i++) r[i] = _mm_max_ps(acc[q0 + i], zero);
         _MM_TRANSPOSE4_PS(r[0], r[1], r[2], r[3]);
         for (int c = 0; c < 3; c++) _mm_storeu_ps(ds3[c] + q0, r[c]);
     }
