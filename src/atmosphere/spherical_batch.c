@@ -38,13 +38,7 @@
 #define KEEP_HS 10000.0 /* the altitude's quantum: HS DH near the ground (m) */
 #define KEEP_DH 1e-4
 #define KEEP_DMU 1e-5 /* the sun's zenith cosine's quantum */
-/* The look-up's helpers are inlined into each clone of eval_table (a helper left out of line
- * would be compiled for the baseline only). */
-#if defined(__GNUC__)
-#define SV_INLINE static inline __attribute__((always_inline))
-#else
-#define SV_INLINE static inline
-#endif
+/* The look-up's helpers (ATMOS_CLONE_HELPER) are inlined into each clone of eval_table. */
 
 typedef struct sv_state {
     int march, n;
@@ -209,7 +203,7 @@ void atmos__sph_batch_release(atmos__atm_batch *b)
 }
 
 /* The azimuth in [0, pi] of (x, y) with y >= 0. */
-SV_INLINE float azimuth(float x, float y)
+ATMOS_CLONE_HELPER float azimuth(float x, float y)
 {
     const float ax = fabsf(x);
     const int swap = y > ax;
@@ -242,7 +236,7 @@ static void eval_rays(const atmos__atm_batch *b, int count, const float *dx, con
  * table's of every ray (vectorises), the look-ups of the table's logarithms, their
  * exponentials (vectorises), the phase functions applied. */
 #define BLK 16
-SV_INLINE void eval_block(const sv_state *s, const float *ra, const float *rb, int i0, int m, int count,
+ATMOS_CLONE_HELPER void eval_block(const sv_state *s, const float *ra, const float *rb, int i0, int m, int count,
                        const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
     const int n = s->n, S = 3 * n;

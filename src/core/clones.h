@@ -50,4 +50,12 @@
 #  define ATMOS_CLONES_NOINLINE
 #endif
 
+/* ATMOS_CLONE_HELPER: a static helper of a cloned function, always inlined, so that each clone
+ * holds its own copy built for the clone's instructions (a call would reach the baseline copy). */
+#if defined(__GNUC__)
+#  define ATMOS_CLONE_HELPER static inline __attribute__((always_inline))
+#else
+#  define ATMOS_CLONE_HELPER static inline
+#endif
+
 #endif

@@ -140,7 +140,7 @@ static const float *srgb_table(void)
 
 /* A tone curve of x >= 0 (finite or +Inf), in [0, 1]. Each curve reaches 1 below its clamp
  * (the filmic curve at x = 7.24), so clamping first keeps +Inf out of the arithmetic. */
-static inline __attribute__((always_inline)) float curve_of(atmos_tone_curve curve, float x)
+ATMOS_CLONE_HELPER float curve_of(atmos_tone_curve curve, float x)
 {
     float y;
     if (curve == ATMOS_TONE_REINHARD) {
@@ -158,7 +158,7 @@ static inline __attribute__((always_inline)) float curve_of(atmos_tone_curve cur
 }
 
 /* A value of src scaled and through the curve: NaN and negatives 0. */
-static inline __attribute__((always_inline)) float tone_of(atmos_tone_curve curve, float v, float scale)
+ATMOS_CLONE_HELPER float tone_of(atmos_tone_curve curve, float v, float scale)
 {
     const float x = v * scale;
     return curve_of(curve, x > 0 ? x : 0.0f);
@@ -168,7 +168,7 @@ static inline __attribute__((always_inline)) float tone_of(atmos_tone_curve curv
  * and first mantissa bits (below 2^-13, clamped to the first: the linear part 12.92 v is taken
  * there), read linearly by the other bits; at most 1. Both branches computed, so that GCC
  * vectorises the loops (the table read a gather). */
-static inline __attribute__((always_inline)) float encode_of(float v, const float *restrict enc)
+ATMOS_CLONE_HELPER float encode_of(float v, const float *restrict enc)
 {
     const union { float f; uint32_t u; } bits = {v};
     const uint32_t b = bits.u;
@@ -183,7 +183,7 @@ static inline __attribute__((always_inline)) float encode_of(float v, const floa
  * Inlined per curve: no branch on the curve in the loop. In chunks of two loops, the curve's and
  * the table's: GCC 12 vectorises each (the table read a gather, given restrict) but not the two
  * as one loop. */
-static inline __attribute__((always_inline)) void map_values(atmos_tone_curve curve, const float *restrict src,
+ATMOS_CLONE_HELPER void map_values(atmos_tone_curve curve, const float *restrict src,
                                                              float *restrict dst, size_t n, float scale,
                                                              const float *restrict enc)
 {
@@ -201,7 +201,7 @@ static inline __attribute__((always_inline)) void map_values(atmos_tone_curve cu
  * chunk of pixels split into three planes, each plane's values through the table, the planes
  * and alpha interleaved again (each a vector loop; mapping alpha with the colours and setting it
  * afterwards took a third more time). */
-static inline __attribute__((always_inline)) void map_rgba(atmos_tone_curve curve, const float *restrict src,
+ATMOS_CLONE_HELPER void map_rgba(atmos_tone_curve curve, const float *restrict src,
                                                            float *restrict dst, size_t width, float scale,
                                                            const float *restrict enc)
 {

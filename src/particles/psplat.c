@@ -74,7 +74,7 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
  * rounding (far below a pixel in double precision; the pixels' own test decides); none when
  * g has no root by far more than its terms' rounding; the whole row when g is not a parabola
  * open upwards (the eye within the cut's reach). */
-static inline __attribute__((always_inline)) void row_span(double a0, double a1, double a2, double e0, double e1,
+ATMOS_CLONE_HELPER void row_span(double a0, double a1, double a2, double e0, double e1,
                                                            double e2, double rc2, double u0, double idu, int n, int *ja,
                                                            int *jb)
 {
@@ -106,7 +106,7 @@ typedef struct lanes {
 /* The batch's columns and transmittances (vector loops over its lanes rounded up to 8; the
  * lanes past n hold the centre; a lane beyond the cut gets transmittance 1, which leaves its
  * pixel as it is: v 1 + c 0 = v), then each row's pixels composited; empties the batch. */
-static inline __attribute__((always_inline)) void flush(lanes *L, const sp *q, int nw, int x0, double rc2, double k2,
+ATMOS_CLONE_HELPER void flush(lanes *L, const sp *q, int nw, int x0, double rc2, double k2,
                                                         int width, atmos_image *img)
 {
     const int nn = (L->n + 7) & ~7, C = img->channels;

@@ -10,8 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* a helper of a cloned function (ATMOS_CLONES) inlined into each clone */
-#define CLONED_HELPER static inline __attribute__((always_inline))
 
 #define MAX_LEVELS 32
 #define LEAF 4 /* segments a cell of the trees' finest level covers */
@@ -202,7 +200,7 @@ typedef struct walk {
     void *u;
 } walk;
 
-CLONED_HELPER void add(walk *w, double ra, double rb)
+ATMOS_CLONE_HELPER void add(walk *w, double ra, double rb)
 {
     if (w->open && ra <= w->b) {
         w->b = rb;
@@ -214,7 +212,7 @@ CLONED_HELPER void add(walk *w, double ra, double rb)
 
 /* [ra, rb] where the map's depth runs linearly from da to db (finite): lit up to or from where
  * the ray's depth crosses it. */
-CLONED_HELPER void linear(walk *w, double ra, double rb, double da, double db)
+ATMOS_CLONE_HELPER void linear(walk *w, double ra, double rb, double da, double db)
 {
     const double fa = da - (w->zc + ra * w->zs), fb = db - (w->zc + rb * w->zs);
     if (fa > 0 && fb > 0) add(w, ra, rb);
@@ -224,7 +222,7 @@ CLONED_HELPER void linear(walk *w, double ra, double rb, double da, double db)
 
 /* Segment i (samples i and i + 1) over [ra, rb]: the depth linear between the samples; where a
  * sample holds no object, each sample's depth over its nearer half. */
-CLONED_HELPER void leaf(walk *w, int i, double ra, double rb)
+ATMOS_CLONE_HELPER void leaf(walk *w, int i, double ra, double rb)
 {
     const double mi = w->m[i], mj = w->m[i + 1], ri = w->k0 + i;
     if (mi < INFINITY && mj < INFINITY) {

@@ -22,8 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* a helper of a cloned function (ATMOS_CLONES) inlined into each clone */
-#define CLONED_HELPER static inline __attribute__((always_inline))
 
 #define NEAR_M 1e-3
 #define EDGE_PX 1e-3
@@ -74,7 +72,7 @@ static void to_pixel(const atmos_camera *c, const double v[3], double iz, double
 }
 
 /* The triangle on the image and the tile's pixel centres within its box; 0 when none. */
-CLONED_HELPER int setup(const tile *T, const double v[3][3], int tri, stri *s)
+ATMOS_CLONE_HELPER int setup(const tile *T, const double v[3][3], int tri, stri *s)
 {
     for (int k = 0; k < 3; k++) {
         s->iz[k] = 1.0 / v[k][2];
@@ -104,7 +102,7 @@ static void cover(tile *T, size_t i, double z, const stri *s)
 /* The columns [*pa, *pb] of the triangle's box whose centres on the row at cy may lie within
  * EDGE_PX of it: each edge's function is linear along the row (a pixel of slack each end: the
  * pixels themselves are then classified exactly). 0 when none. */
-CLONED_HELPER int row_span(const stri *s, double sg, const double len[3], double cy, int *pa, int *pb)
+ATMOS_CLONE_HELPER int row_span(const stri *s, double sg, const double len[3], double cy, int *pa, int *pb)
 {
     double lo = s->px0, hi = s->px1;
     for (int k = 0; k < 3; k++) {
@@ -141,7 +139,7 @@ static int hides(const stri *s, double area)
 /* A rival's depth is at least the nearest vertex's (the depth extrapolated past a thin
  * triangle's edge can be far nearer than any point of it), so a triangle is never nearer than
  * its box: what makes hiding a box exact. */
-CLONED_HELPER void draw(tile *T, const stri *s)
+ATMOS_CLONE_HELPER void draw(tile *T, const stri *s)
 {
     const double *x = s->x, *y = s->y;
     const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);

@@ -60,8 +60,6 @@
 /* Every light (lights()' mask). */
 #define ALL_LIGHTS 0xffffffffu
 
-/* A helper of a cloned function, inlined into each clone (core/clones.h). */
-#define IN_CLONE static inline __attribute__((always_inline))
 
 /* A point light's neighbouring intervals whose f_l sum to less than this share of a sub-plane's
  * (epsilon of the pixel's airlight) share one sample (merged()). */
@@ -244,7 +242,7 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
 
 /* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
  * the scene's max_subplanes. */
-IN_CLONE int subplanes(const job *J, double fl, double unit)
+ATMOS_CLONE_HELPER int subplanes(const job *J, double fl, double unit)
 {
     const double need = ceil(fl / unit);
     return need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
@@ -349,7 +347,7 @@ static int agreed_run(const job *J, int i, const reach_part *r, long b, uint64_t
 /* intervals() with sh->known: a run of stretches that the corners all saw lit or all dark is one
  * interval of f_l -1 (its W looked up at its end alone), the lit runs' f_l summed into f[2n + 1]
  * and their bits into sh->seen. The stretch between the planes j - 1 and j is bit j - 1. */
-IN_CLONE int agreed_intervals(job *J, int i, const reach_part *r, double *f, double *sum, const shared_ray *sh)
+ATMOS_CLONE_HELPER int agreed_intervals(job *J, int i, const reach_part *r, double *f, double *sum, const shared_ray *sh)
 {
     const double t1 = r->t1, cosf = r->cosf, dz = J->dz[i], zl = J->z_lo[i], W0 = W_at(J, r, r->t0);
     const uint64_t kl = sh->known[0], kd = sh->known[1];
@@ -836,13 +834,11 @@ typedef struct screen_buf {
     uint64_t *seen;   /* per layer and node: what its evaluation saw (two masks, air_pixel) */
 } screen_buf;
 
-/* The first pass's helpers, inlined into each clone of surface_row (its AVX2 clone's loops). */
-#define FIRST_PASS static inline __attribute__((always_inline))
 
 /* Subsampling's first pass for a surface that no light reaches (no cones): the sky's light and
  * the sun's, dimmed by the fog to the eye, into B in one loop a pixel (the same operations in
  * the same order as shade_surface, base_light and sun_surface one after the other: the same bits). */
-FIRST_PASS void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, float *B,
+ATMOS_CLONE_HELPER void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, float *B,
                               atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
@@ -867,7 +863,7 @@ FIRST_PASS void unlit_surface(const job *J, const double d[3], const atmos_mesh_
 
 /* Subsampling's first pass, pixel (x, y) seeing h of object obj along the eye's ray d (-1: the
  * sky behind, bg), lit by the lights in cones (row_cones): its light without the airlight into B. */
-FIRST_PASS void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
+ATMOS_CLONE_HELPER void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
                               uint32_t cones, const float *bg, float *B, atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;

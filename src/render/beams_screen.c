@@ -52,8 +52,6 @@ static const uint64_t *corners(const band *b, int x0, int y0, int x1, int y1, ui
     return known[0] | known[1] ? known : NULL;
 }
 
-/* A helper of a cloned function, inlined into each clone (core/clones.h). */
-#define IN_CLONE static inline __attribute__((always_inline))
 
 /* dim[k]: the least of base[i nw + k] over the pixels i of [x0, x1] x [y0, y1] (each row's
  * values one block; the minima exact, so the same values in the AVX2 clone). */
@@ -70,7 +68,7 @@ ATMOS_CLONES_NOINLINE static void least_base(const atmos__beams_screen *s, int x
 
 /* Whether every pixel of [x0, x1] x [y0, y1] sees the same object at depths within the ratio
  * 1 + s->depth of each other (or all the sky). */
-IN_CLONE int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
+ATMOS_CLONE_HELPER int same_surface(const atmos__beams_screen *s, int x0, int y0, int x1, int y1)
 {
     const int m = s->object[pix(s, x0, y0)];
     double lo = INFINITY, hi = 0;
@@ -138,7 +136,7 @@ static void weights(int x0, int y0, int x1, int y1, int x, int y, double w[4])
  * s->spread and curve of the least light a pixel of the cell may have. A dim[k] lower than the
  * cell's least passes only where that passes (the sums and products below are monotone in it),
  * a higher one fails only where that fails. */
-IN_CLONE int within(const atmos__beams_screen *s, const double *const c[4], const double *const *cm,
+ATMOS_CLONE_HELPER int within(const atmos__beams_screen *s, const double *const c[4], const double *const *cm,
                     const double (*w)[4], int np, double curve, const double *dim)
 {
     for (int k = 0; k < s->nw; k++) {
@@ -187,7 +185,7 @@ ATMOS_CLONES static int agree(const band *b, const double *c[4], int x0, int y0,
 
 /* fill()'s pixels with nw wavelengths (inlined into fill: a constant nw unrolls the loop over
  * them). The band's fields are read once: the state's byte stores may alias them. */
-static inline __attribute__((always_inline)) void fill_nw(const band *b, int x0, int y0, int x1, int y1, const int nw)
+ATMOS_CLONE_HELPER void fill_nw(const band *b, int x0, int y0, int x1, int y1, const int nw)
 {
     double *const out = b->out;
     unsigned char *const state = b->state;

@@ -14,8 +14,6 @@
 
 #define NEAR_M 1e-3
 #define BEAMS_CLONES ATMOS_CLONES
-/* A helper of a cloned function, inlined into each clone (core/clones.h). */
-#define IN_CLONE static inline __attribute__((always_inline))
 #define SPOT_FRUSTUM_MAX_DEG 60.0
 
 void atmos__beams_shadow_free(atmos__beams_light *l)
@@ -182,7 +180,7 @@ static inline double texels(const atmos__beams_face *F, double fx, double fy, do
 }
 
 /* H at the point (x, y, z) of face F's frame. */
-IN_CLONE double lookup(const atmos__beams_face *F, double x, double y, double z)
+ATMOS_CLONE_HELPER double lookup(const atmos__beams_face *F, double x, double y, double z)
 {
     if (z <= NEAR_M) return 1;
     const int n = F->n;
@@ -191,7 +189,7 @@ IN_CLONE double lookup(const atmos__beams_face *F, double x, double y, double z)
 }
 
 /* The cube face of w's largest component. */
-IN_CLONE int cube_face(const double w[3])
+ATMOS_CLONE_HELPER int cube_face(const double w[3])
 {
     const double ax = fabs(w[0]), ay = fabs(w[1]), az = fabs(w[2]);
     const int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
@@ -239,7 +237,7 @@ BEAMS_CLONES void atmos__beams_ray_init(const atmos__beams_light *l, const doubl
 
 /* Face f's (F, face_of(&r->l->face[f])) texel coordinates and depth of the ray at t (0 if behind
  * the near plane). */
-static inline __attribute__((always_inline)) int project(const atmos__beams_ray *r, int f, const face_at *F, double t,
+ATMOS_CLONE_HELPER int project(const atmos__beams_ray *r, int f, const face_at *F, double t,
                                                          double *fx, double *fy, double *z)
 {
     *z = r->f0[f][2] + t * r->f1[f][2];
@@ -250,7 +248,7 @@ static inline __attribute__((always_inline)) int project(const atmos__beams_ray 
     return *fx > -1 && *fx < F->n && *fy > -1 && *fy < F->n;
 }
 
-IN_CLONE int inside_inner(const atmos__beams_ray *r, double t)
+ATMOS_CLONE_HELPER int inside_inner(const atmos__beams_ray *r, double t)
 {
     const double z = r->a0 + t * r->a1, w2 = r->ww0 + t * (2 * r->wd + t);
     return z > 0 && z * z >= r->l->L.cos_inner * r->l->L.cos_inner * w2;
@@ -282,7 +280,7 @@ BEAMS_CLONES int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, 
 }
 
 /* atmos__beams_ray_falloff, inlined into ray_light. */
-IN_CLONE double ray_falloff(const atmos__beams_ray *r, double t)
+ATMOS_CLONE_HELPER double ray_falloff(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
     if (l->L.type != ATMOS_LIGHT_SPOT) return 1;
@@ -356,7 +354,7 @@ double atmos__beams_ray_falloff_sum(const atmos__beams_ray *r, double ta, double
 }
 
 /* atmos__beams_ray_light, inlined into read_run's clones. */
-IN_CLONE double ray_light(const atmos__beams_ray *r, double t)
+ATMOS_CLONE_HELPER double ray_light(const atmos__beams_ray *r, double t)
 {
     const atmos__beams_light *l = r->l;
     const double fall = ray_falloff(r, t);
@@ -395,7 +393,7 @@ BEAMS_CLONES static void run_texels(const atmos__beams_ray *r, int f, double ta,
  * the same operations as run_texels; the runs are short, about 8 samples on average: the
  * vectorised loop's call and setup cost more than it saves), no division where the sample is
  * behind the near plane (texels_in's 1 there). */
-IN_CLONE double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
+ATMOS_CLONE_HELPER double read_point(const atmos__beams_ray *r, int f, double ta, double step, double o, int s0, int s1)
 {
     const face_at F = face_of(&r->l->face[f]);
     double h = 0;

@@ -50,13 +50,6 @@
  * voxel's own share: -17 %) */
 #define SUB_NB_TAU 16.0
 
-/* a helper of a cloned function (ATMOS_CLONES) inlined into each clone */
-#if defined(__GNUC__)
-#define DO_INLINE static inline __attribute__((always_inline))
-#else
-#define DO_INLINE static inline
-#endif
-
 /* The volume's shadow on the air of the sky's inflow (sky_inflow.h), by the sun's columns (made
  * for sun_g before the solve) in the medium the first order and the photons see (mc_sig: the
  * forward peak cut), as the path tracer's shadow rays, out to reach metres along a sample's ray. */
@@ -119,13 +112,13 @@ static int sky_inflow(const atmos_atmosphere *atm, const atmos__nishita_plan *np
  * optical depth across it along the sun, h <= tau), in single precision's polynomial exponential
  * (relative error < 1e-6; the library's exp and sinh took half the cells' set-up): below h 0.5 by
  * the series of sinh(h) / h, else as (e^(h - tau) - e^(-h - tau)) / 2h, no exponent above 0. */
-DO_INLINE double mean_transmittance_series(double tau, double h)
+ATMOS_CLONE_HELPER double mean_transmittance_series(double tau, double h)
 {
     const double h2 = h * h;
     return atmos__expf_fast((float)-tau) * (1 + h2 * (1.0 / 6 + h2 * (1.0 / 120 + h2 * (1.0 / 5040))));
 }
 
-DO_INLINE double mean_transmittance(double tau, double h)
+ATMOS_CLONE_HELPER double mean_transmittance(double tau, double h)
 {
     if (h < 0.5) return mean_transmittance_series(tau, h);
     return (atmos__expf_fast((float)(h - tau)) - atmos__expf_fast((float)(-h - tau))) / (2 * h);
@@ -315,7 +308,7 @@ typedef struct {
  * entering its faces over sigma_t h, sum |lt_a| T_a / (sigma_t h). The columns gathered, then
  * each face's exponentials in a vector loop (the same operations in the same order as one voxel
  * at a time). */
-DO_INLINE void sun_faces(const atmos__nishita_plan *np, const size_t *vi, const int (*xyz)[3], const int *id, int k,
+ATMOS_CLONE_HELPER void sun_faces(const atmos__nishita_plan *np, const size_t *vi, const int (*xyz)[3], const int *id, int k,
                          const sun_geom *sg, const float *sig, double *tff)
 {
     const sgrid *g = &np->g;

@@ -16,19 +16,12 @@
 #define CH 64 /* samples per chunk: the SoA scratch stays in L1 */
 
 #define SLICE_CLONES ATMOS_CLONES
-/* The helpers below are inlined into each clone (a helper left out of line would be
- * compiled for the baseline only). */
-#if defined(__GNUC__)
-#define SLICE_INLINE static inline __attribute__((always_inline))
-#else
-#define SLICE_INLINE static inline
-#endif
 
 
 /* ln x for x > 0: x = 2^e m with m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s),
  * s = (m - 1)/(m + 1), |s| < 0.172, by its series to s^9 (error < 1e-9). Subnormal x
  * are taken as FLT_MIN. Branch-free for vectorisation. */
-SLICE_INLINE float log_pos(float x)
+ATMOS_CLONE_HELPER float log_pos(float x)
 {
     x = atmos__select_f(x < 1.17549435e-38f, 1.17549435e-38f, x);
     union {
@@ -53,7 +46,7 @@ SLICE_INLINE float log_pos(float x)
 /* Trilinear densities of the compacted samples: vox[q] is the grid index of the lower
  * corner (times nf), (fu, fv, fw) the fractions. SoA out: dens[f * CH + q]. The grid
  * holds at most 2 GB, so 32-bit indices suffice. */
-SLICE_INLINE void trilinear_soa(const sgrid *g, int m, const int32_t *restrict vox, const float *restrict fu,
+ATMOS_CLONE_HELPER void trilinear_soa(const sgrid *g, int m, const int32_t *restrict vox, const float *restrict fu,
                                  const float *restrict fv, const float *restrict fw, float *restrict dens)
 {
     const int nf = g->nf;
@@ -75,7 +68,7 @@ SLICE_INLINE void trilinear_soa(const sgrid *g, int m, const int32_t *restrict v
 
 /* live[f]: whether field f is non-zero at any of the m samples. A field that is zero
  * everywhere in a chunk adds exact zeros to every sum, so its lookups are skipped. */
-SLICE_INLINE void fields_live(int nf, int m, const float *dens, int *live)
+ATMOS_CLONE_HELPER void fields_live(int nf, int m, const float *dens, int *live)
 {
     for (int f = 0; f < nf; f++) {
         const float *d = dens + f * CH;
@@ -90,7 +83,7 @@ SLICE_INLINE void fields_live(int nf, int m, const float *dens, int *live)
  * without changing a bit: when more than a quarter of the m samples are empty they are
  * dropped (branch-free packing), otherwise kept (computing them costs less than packing).
  * Returns the new count (0: all empty). */
-SLICE_INLINE int drop_empty(int nf, int m, float *dens, int *id)
+ATMOS_CLONE_HELPER int drop_empty(int nf, int m, float *dens, int *id)
 {
     int nz[CH], live = 0;
     for (int q = 0; q < m; q++) nz[q] = 0;
@@ -110,7 +103,7 @@ SLICE_INLINE int drop_empty(int nf, int m, float *dens, int *id)
 /* Pads the compacted samples m..mv-1 (mv: m rounded up to 8) with copies of the last,
  * so that the vector loops run whole vectors only; results of the copies are never
  * stored. */
-SLICE_INLINE int pad_samples(int m, int *id, int32_t *vox, float *fu, float *fv, float *fw)
+ATMOS_CLONE_HELPER int pad_samples(int m, int *id, int32_t *vox, float *fu, float *fv, float *fw)
 {
     const int mv = (m + 7) & ~7;
     for (int q = m; q < mv; q++)
@@ -118,7 +111,7 @@ SLICE_INLINE int pad_samples(int m, int *id, int32_t *vox, float *fu, float *fv,
     return mv;
 }
 
-SLICE_INLINE int pad_dens(int nf, int m, float *dens, int *id)
+ATMOS_CLONE_HELPER int pad_dens(int nf, int m, float *dens, int *id)
 {
     const int mv = (m + 7) & ~7;
     for (int q = m; q < mv; q++) {
@@ -134,7 +127,7 @@ SLICE_INLINE int pad_dens(int nf, int m, float *dens, int *id)
  * id[] holds their chunk positions. The tests, lower corners and fractions run as one
  * vector loop over all points (rejected ones clamped to voxel 0, so that the occupancy
  * gather stays inside the grid); a branch-free scalar loop then packs the kept ones. */
-SLICE_INLINE int compact(const sgrid *g, int cnt, const float *restrict u, const float *restrict v,
+ATMOS_CLONE_HELPER int compact(const sgrid *g, int cnt, const float *restrict u, const float *restrict v,
                           const float *restrict w, const int32_t *restrict ok, int *restrict id,
                           int32_t *restrict vox, float *restrict fu, float *restrict fv, float *restrict fw)
 {
@@ -193,7 +186,7 @@ typedef struct {
 /* Of a chunk's cnt candidate points (render-voxel coordinates u, v, w; ok[q] = 0 for
  * points already rejected), the ones that meet occupied blocks and a non-zero density, with
  * their densities. Returns the number of points looked up in the grid (e->m: kept). */
-SLICE_INLINE int chunk_lookup(const sgrid *g, int cnt, const float *u, const float *v, const float *w,
+ATMOS_CLONE_HELPER int chunk_lookup(const sgrid *g, int cnt, const float *u, const float *v, const float *w,
                                const int32_t *ok, echunk *e)
 {
     e->m = compact(g, cnt, u, v, w, ok, e->id, e->vox, e->fu, e->fv, e->fw);
@@ -212,10 +205,10 @@ SLICE_INLINE int chunk_lookup(const sgrid *g, int cnt, const float *u, const flo
 /* The chunk point of sample q: id[q], which for a contiguous chunk is q itself, or for its
  * padded lanes (q >= m) the last sample's, as pad_samples made them (so a computed index
  * lets the loops read the per-point arrays without the indirection). */
-SLICE_INLINE int lane(const echunk *e, int q) { return e->contig ? (q < e->m ? q : e->m - 1) : e->id[q]; }
+ATMOS_CLONE_HELPER int lane(const echunk *e, int q) { return e->contig ? (q < e->m ? q : e->m - 1) : e->id[q]; }
 
 /* The chunk of pixels p0.. (cnt of them) on slice k: chunk_lookup of their samples. */
-SLICE_INLINE int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e)
+ATMOS_CLONE_HELPER int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e)
 {
     const float kf = (float)k;
     float u[CH], v[CH], w[CH];
@@ -234,7 +227,7 @@ SLICE_INLINE int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e
 
 /* The samples' light-buffer texel (lt, the row-major offset of the lower-left one) and
  * bilinear weights, and their slab lengths. */
-SLICE_INLINE void eye_texels(const sjob *j, int k, size_t p0, echunk *e)
+ATMOS_CLONE_HELPER void eye_texels(const sjob *j, int k, size_t p0, echunk *e)
 {
     const int L = j->L;
     const int32_t ns = j->n + 1;
@@ -255,7 +248,7 @@ SLICE_INLINE void eye_texels(const sjob *j, int k, size_t p0, echunk *e)
 }
 
 /* Bilinear light-buffer value at the samples: component c of the texels ([texel + c]). */
-SLICE_INLINE void eye_bilinear(const echunk *e, const float *restrict B, int32_t ns, int32_t LN, float *restrict out)
+ATMOS_CLONE_HELPER void eye_bilinear(const echunk *e, const float *restrict B, int32_t ns, int32_t LN, float *restrict out)
 {
     for (int q = 0; q < e->mv; q++) {
         const int32_t t00 = e->lt[q];
@@ -265,7 +258,7 @@ SLICE_INLINE void eye_bilinear(const echunk *e, const float *restrict B, int32_t
 
 /* The Ams order (one more scattering than the light has had turns it to the eye, Eq. 26)
  * and each live field's Ams row and angle weight. */
-SLICE_INLINE void eye_orders(const sjob *j, size_t p0, echunk *e)
+ATMOS_CLONE_HELPER void eye_orders(const sjob *j, size_t p0, echunk *e)
 {
     const int n = j->n, nf = j->nf, no = j->t->no;
     const float fno = (float)no;
@@ -304,7 +297,7 @@ SLICE_INLINE void eye_orders(const sjob *j, size_t p0, echunk *e)
 }
 
 /* Extinction and source (sum over fields of beta_sca (Ams + xi)) of wavelength c. */
-SLICE_INLINE void eye_optics(const sjob *j, const echunk *e, int c, float *restrict bext, float *restrict src)
+ATMOS_CLONE_HELPER void eye_optics(const sjob *j, const echunk *e, int c, float *restrict bext, float *restrict src)
 {
     const stables *t = j->t;
     const int n = j->n;
@@ -342,7 +335,7 @@ typedef struct {
 /* One axis of the field's cells for mv samples (a multiple of 8) at render-voxel coordinate x:
  * the lower cell i and the fraction t. Written without a branch, so that it is one vector loop
  * (the fraction is taken whatever c; an axis of one cell sets it to 0 afterwards). */
-SLICE_INLINE void field_axis(int mv, const float *restrict x, float off, float is, int c, int32_t *restrict i,
+ATMOS_CLONE_HELPER void field_axis(int mv, const float *restrict x, float off, float is, int c, int32_t *restrict i,
                              float *restrict t)
 {
     const float lim = (float)(c - 1); /* >= 0: the two clamps one after the other clamp alike */
@@ -359,7 +352,7 @@ SLICE_INLINE void field_axis(int mv, const float *restrict x, float off, float i
         for (int q = 0; q < mv; q++) t[q] = 0.0f;
 }
 
-SLICE_INLINE void eye_field_cells(const sjob *j, int k, size_t p0, const echunk *e, fchunk *fc)
+ATMOS_CLONE_HELPER void eye_field_cells(const sjob *j, int k, size_t p0, const echunk *e, fchunk *fc)
 {
     const atmos__lfield *f = j->field;
     const int cx = f->c[0], cy = f->c[1], cz = f->c[2];
@@ -392,7 +385,7 @@ SLICE_INLINE void eye_field_cells(const sjob *j, int k, size_t p0, const echunk 
 /* The diffuse field scattered toward the eye at the chunk's samples, wavelength c in
  * ds[c * CH + q]: sum over the live fields of density times the view's sca (L + g A)
  * (trilinear), not below 0. */
-SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict ds)
+ATMOS_CLONE_HELPER void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict ds)
 {
     fchunk fc;
     eye_field_cells(j, k, p0, e, &fc);
@@ -423,7 +416,7 @@ SLICE_INLINE void eye_field(const sjob *j, int k, size_t p0, const echunk *e, fl
  * taken and the result selected by atmos__select_f (the same bits): the beam's loop in fewer
  * instructions than with their branches (docs/lightfield.md, "Where a sun-moving frame's extra
  * work is"). A division by 0 on the side not taken gives an infinity or a NaN, not selected. */
-SLICE_INLINE float beam_ratio(float i0, float i1)
+ATMOS_CLONE_HELPER float beam_ratio(float i0, float i1)
 {
     float r = atmos__select_f(i0 > 0.0f, i1 / i0, 1.0f);
     r = atmos__select_f(r < 1.0f, r, 1.0f); /* NaN: 1 */
@@ -431,7 +424,7 @@ SLICE_INLINE float beam_ratio(float i0, float i1)
 }
 
 /* back to front: the light enters by the far face */
-SLICE_INLINE float beam_len_btf(float del, float te, float T, float tl, float r)
+ATMOS_CLONE_HELPER float beam_len_btf(float del, float te, float T, float tl, float r)
 {
     const float y = te - tl;
     const float near = del * r * (1.0f - 0.5f * y), far = del * (r - T) / y;
@@ -439,7 +432,7 @@ SLICE_INLINE float beam_len_btf(float del, float te, float T, float tl, float r)
 }
 
 /* front to back: the light and the eye enter by the same face */
-SLICE_INLINE float beam_len_ftb(float del, float te, float T, float tl, float r)
+ATMOS_CLONE_HELPER float beam_len_ftb(float del, float te, float T, float tl, float r)
 {
     const float y = te + tl;
     const float near = del * 1.0f * (1.0f - 0.5f * y), far = del * (1.0f - T * r) / y;
@@ -450,7 +443,7 @@ SLICE_INLINE float beam_len_ftb(float del, float te, float T, float tl, float r)
  * into the eye buffer over (back to front) or under (front to back); ds (or NULL): the
  * diffuse field's in-scattering added to the beam's; I1 (or NULL): the light leaving the slab
  * at the samples, Ic's attenuation across it (atmos__slice_beam_len). */
-SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
+ATMOS_CLONE_HELPER void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
                              const float *restrict bext, const float *restrict src, const float *restrict ds,
                              const float *restrict I1)
 {
@@ -517,7 +510,7 @@ SLICE_INLINE void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, co
  * Lane c computes what eye_bilinear and eye_optics compute for wavelength c, with the same
  * operations in the same order (the same bits); four samples' vectors are transposed into
  * the per-wavelength arrays. I3[c]: the light of wavelength c (c = 3: n, also in nsc). */
-SLICE_INLINE void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float (*restrict I3)[CH])
+ATMOS_CLONE_HELPER void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float (*restrict I3)[CH])
 {
     const int32_t LN = j->L * 4;
     for (int q0 = 0; q0 < e->mv; q0 += 4) {
@@ -537,7 +530,7 @@ SLICE_INLINE void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float
 }
 
 /* One sample's extinction and source vectors (lane c: wavelength c) over the live fields. */
-SLICE_INLINE void eye_rgb_sample(const sjob *j, const echunk *e, int q, const __m128 *sg, const __m128 *sa,
+ATMOS_CLONE_HELPER void eye_rgb_sample(const sjob *j, const echunk *e, int q, const __m128 *sg, const __m128 *sa,
                                  __m128 *bext, __m128 *src)
 {
     const stables *t = j->t;
@@ -562,7 +555,7 @@ SLICE_INLINE void eye_rgb_sample(const sjob *j, const echunk *e, int q, const __
     *bext = be, *src = sr;
 }
 
-SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float (*restrict be3)[CH], float (*restrict src3)[CH])
+ATMOS_CLONE_HELPER void eye_rgb_optics(const sjob *j, const echunk *e, float (*restrict be3)[CH], float (*restrict src3)[CH])
 {
     const stables *t = j->t;
     __m128 sg[ATMOS_VOLUME_MAX_FIELDS], sa[ATMOS_VOLUME_MAX_FIELDS];
@@ -581,7 +574,7 @@ SLICE_INLINE void eye_rgb_optics(const sjob *j, const echunk *e, float (*restric
 
 /* eye_field for RGB: a cell's view of a field is one 16-byte vector (fvq 4), so a sample's
  * three wavelengths are 8 vector loads per live field. */
-SLICE_INLINE void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e, float (*restrict ds3)[CH])
+ATMOS_CLONE_HELPER void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e, float (*restrict ds3)[CH])
 {
     fchunk fc;
     eye_field_cells(j, k, p0, e, &fc);
@@ -612,7 +605,7 @@ SLICE_INLINE void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e
 }
 
 /* The light, the optics and the blend of an RGB chunk. */
-SLICE_INLINE void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib, const float *In)
+ATMOS_CLONE_HELPER void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib, const float *In)
 {
     float I3[4][CH], be3[3][CH], src3[3][CH], ds3[4][CH], J3[4][CH];
     if (j->low_albedo) eye_rgb_light(j, e, In, J3); /* the light leaving the slab (its n overwritten next) */
@@ -664,7 +657,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
 
 /* The light of wavelength c leaving the chunk's samples (Eq. 25; the light pass's
  * per-wavelength part): I' = I (T + (1 - T) keep). Accumulates beta_sca Delta into dn. */
-SLICE_INLINE void light_wavelength(const sjob *j, int c, const echunk *e, const float *restrict Iw,
+ATMOS_CLONE_HELPER void light_wavelength(const sjob *j, int c, const echunk *e, const float *restrict Iw,
                                     const float *restrict n0, float *restrict dn, float *restrict Io)
 {
     const stables *t = j->t;

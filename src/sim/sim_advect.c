@@ -10,15 +10,13 @@
 #include <string.h>
 
 #define ADV_CLONES ATMOS_CLONES
-/* Inlined into each clone (a helper left out of line would be built for the baseline only). The
- * loops over a row run i = 1 .. nx - 2 with i - 1 and i + 1 as they are (so that the compiler
- * vectorises them) and the row's ends wrapped apart. */
-#define ADV_INLINE static inline __attribute__((always_inline))
-
+/* The helpers (ATMOS_CLONE_HELPER) are inlined into each clone. The loops over a row run
+ * i = 1 .. nx - 2 with i - 1 and i + 1 as they are (so that the compiler vectorises them) and the
+ * row's ends wrapped apart. */
 /* Level k packed for the scalars' trace (s->pack): the velocity at the cell centres (u, v, w, 0)
  * and the scalars (theta, q_v, q_c, q_r), 4 floats a cell each; and the level's water before
  * the advection: q_v into part[k], q_c + q_r into part[nz + 1 + k]. */
-ADV_INLINE void pack_cell(const atmos_sim *s, size_t n, size_t xp, size_t yp, size_t lev, float *restrict p,
+ATMOS_CLONE_HELPER void pack_cell(const atmos_sim *s, size_t n, size_t xp, size_t yp, size_t lev, float *restrict p,
                           float *restrict q)
 {
     p[0] = 0.5f * (s->u[n] + s->u[xp]);
@@ -76,7 +74,7 @@ ADV_CLONES static void scalars(atmos_sim *s, int k, float c)
 
 /* The departure points of the faces of a row: u's, v's and w's (the velocity's components
  * other than the face's own averaged from its four nearest faces). */
-ADV_INLINE void pos_u(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
+ATMOS_CLONE_HELPER void pos_u(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
                       size_t lev, int i, int im, float fj, float fk, float c, float *restrict x, float *restrict y,
                       float *restrict z)
 {
@@ -85,7 +83,7 @@ ADV_INLINE void pos_u(const float *restrict u, const float *restrict v, const fl
     x[i] = (float)i - c * u[r + i], y[i] = fj - c * vu, z[i] = fk - c * wu;
 }
 
-ADV_INLINE void pos_v(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rm,
+ATMOS_CLONE_HELPER void pos_v(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rm,
                       size_t lev, int i, int ip, float fj, float fk, float c, float *restrict x, float *restrict y,
                       float *restrict z)
 {
@@ -94,7 +92,7 @@ ADV_INLINE void pos_v(const float *restrict u, const float *restrict v, const fl
     x[i] = (float)i - c * uv, y[i] = fj - c * v[r + i], z[i] = fk - c * wv;
 }
 
-ADV_INLINE void pos_w(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
+ATMOS_CLONE_HELPER void pos_w(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
                       size_t lev, int i, int ip, float fj, float fk, float c, float *restrict x, float *restrict y,
                       float *restrict z)
 {

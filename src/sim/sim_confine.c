@@ -9,8 +9,6 @@
 #include <math.h>
 
 #define CONF_CLONES ATMOS_CLONES
-/* Inlined into each clone (a helper left out of line would be built for the baseline only). */
-#define CONF_INLINE static inline __attribute__((always_inline))
 
 /* The rows of a cell's neighbours: j - 1 and j + 1 wrapped, level k - 1 and k + 1 clamped (as
  * offsets from the cell's own row). The loops over a row run i = 1 .. nx - 2 with i - 1 and
@@ -57,7 +55,7 @@ typedef struct {
     float x, y, z;
 } vec3f;
 
-CONF_INLINE vec3f vort_at(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float inv2, float zf,
+ATMOS_CLONE_HELPER vec3f vort_at(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float inv2, float zf,
                           const float *restrict uc, const float *restrict vc, const float *restrict wc)
 {
     const size_t yp = o->yp + i, ym = o->ym + i, zp = n + o->zp, zm = n + o->zm;
@@ -68,7 +66,7 @@ CONF_INLINE vec3f vort_at(const rows *o, size_t n, size_t i, size_t xm, size_t x
     return w;
 }
 
-CONF_INLINE float len(vec3f w)
+ATMOS_CLONE_HELPER float len(vec3f w)
 {
     return sqrtf(w.x * w.x + w.y * w.y + w.z * w.z);
 }
@@ -100,7 +98,7 @@ CONF_CLONES static void vorticity(atmos_sim *s, int k, float *const f[7])
 #define FORCE_ARGS                                                                                                   \
     const float *restrict uc, const float *restrict vc, const float *restrict wc, const float *restrict om,           \
         float *restrict fx, float *restrict fy, float *restrict fz
-CONF_INLINE void force_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float a, float inv2, float zf,
+ATMOS_CLONE_HELPER void force_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float a, float inv2, float zf,
                             FORCE_ARGS)
 {
     const vec3f w = vort_at(o, n, i, xm, xp, inv2, zf, uc, vc, wc);
