@@ -6,6 +6,8 @@
 #define ATMOS_RENDER_SLICE_INTERNAL_H
 
 #include "atmosphere/atmosphere_ops.h"
+#include "core/clones.h"
+#include "core/fastmath.h"
 #include "core/internal.h"
 #include "light/lfield.h"
 #include "render/dfield.h"
@@ -237,10 +239,11 @@ atmos_status atmos__slice_passes(atmos_context *ctx, const atmos__slice_plan *sp
  * out within the slab): its -ln, the beam's optical depth, is then at most 80 in both eye passes,
  * the fast one's logarithm and the reference's libm one alike. */
 #define ATMOS__SLICE_BEAM_MIN 1.80485e-35f /* e^-80 */
-static inline float atmos__slice_beam_ratio(float i0, float i1)
+ATMOS_CLONE_HELPER float atmos__slice_beam_ratio(float i0, float i1)
 {
-    const float r = i0 > 0.0f ? i1 / i0 : 1.0f;
-    return !(r < 1.0f) ? 1.0f : r > ATMOS__SLICE_BEAM_MIN ? r : ATMOS__SLICE_BEAM_MIN;
+    float r = atmos__select_f(i0 > 0.0f, i1 / i0, 1.0f);
+    r = atmos__select_f(r < 1.0f, r, 1.0f); /* NaN: 1 */
+    return atmos__select_f(r > ATMOS__SLICE_BEAM_MIN, r, ATMOS__SLICE_BEAM_MIN);
 }
 
 /* The eye-ray length by which the light arriving at a slab, I, times the slab's in-scattering
@@ -254,13 +257,15 @@ static inline float atmos__slice_beam_ratio(float i0, float i1)
  * homogeneous medium's beam was counted too bright (back to front by (e^tl - 1) / tl: +37 % at
  * tl = te = 0.6 a slab, a dense cloud's 256 slices; front to back +29 % there). The exponentials
  * are the caller's: T = e^-te, the slab's transmittance along the eye, which Eq. 26 needs anyway,
- * and r = e^-tl, the ratio tl was taken from (atmos__slice_beam_ratio); e^-(te + tl) is T r. */
-static inline float atmos__slice_beam_len(float del, float te, float T, float tl, float r, int btf)
+ * and r = e^-tl, the ratio tl was taken from (atmos__slice_beam_ratio); e^-(te + tl) is T r. Both
+ * sides are computed and one selected by its bits (atmos__select_f: a loop over it vectorises; a
+ * division by 0 on the side not taken is not selected), as in atmos__slice_beam_ratio. */
+ATMOS_CLONE_HELPER float atmos__slice_beam_len(float del, float te, float T, float tl, float r, int btf)
 {
     const float y = btf ? te - tl : te + tl;
     const float e0 = btf ? r : 1.0f, e1 = btf ? T : T * r; /* the integrand at the two faces */
-    if (y < 1e-3f && y > -1e-3f) return del * e0 * (1.0f - 0.5f * y);
-    return del * (e0 - e1) / y;
+    const float near = del * e0 * (1.0f - 0.5f * y), far = del * (e0 - e1) / y;
+    return atmos__select_f((y < 1e-3f) & (y > -1e-3f), near, far);
 }
 
 /* Eye pass of slice k over pixels x0..x1 of image row y (Eq. 26); light pass of slice k

@@ -412,33 +412,6 @@ ATMOS_CLONE_HELPER void eye_field(const sjob *j, int k, size_t p0, const echunk 
         for (int q = 0; q < e->mv; q++) ds[c * CH + q] = ds[c * CH + q] > 0.0f ? ds[c * CH + q] : 0.0f;
 }
 
-/* atmos__slice_beam_ratio and atmos__slice_beam_len (slice_internal.h) with every operation
- * taken and the result selected by atmos__select_f (the same bits): the beam's loop in fewer
- * instructions than with their branches (docs/lightfield.md, "Where a sun-moving frame's extra
- * work is"). A division by 0 on the side not taken gives an infinity or a NaN, not selected. */
-ATMOS_CLONE_HELPER float beam_ratio(float i0, float i1)
-{
-    float r = atmos__select_f(i0 > 0.0f, i1 / i0, 1.0f);
-    r = atmos__select_f(r < 1.0f, r, 1.0f); /* NaN: 1 */
-    return atmos__select_f(r > ATMOS__SLICE_BEAM_MIN, r, ATMOS__SLICE_BEAM_MIN);
-}
-
-/* back to front: the light enters by the far face */
-ATMOS_CLONE_HELPER float beam_len_btf(float del, float te, float T, float tl, float r)
-{
-    const float y = te - tl;
-    const float near = del * r * (1.0f - 0.5f * y), far = del * (r - T) / y;
-    return atmos__select_f((y < 1e-3f) & (y > -1e-3f), near, far);
-}
-
-/* front to back: the light and the eye enter by the same face */
-ATMOS_CLONE_HELPER float beam_len_ftb(float del, float te, float T, float tl, float r)
-{
-    const float y = te + tl;
-    const float near = del * 1.0f * (1.0f - 0.5f * y), far = del * (1.0f - T * r) / y;
-    return atmos__select_f((y < 1e-3f) & (y > -1e-3f), near, far);
-}
-
 /* Eq. 26 for wavelength c: the slab's transmittance and in-scattered light, composited
  * into the eye buffer over (back to front) or under (front to back); ds (or NULL): the
  * diffuse field's in-scattering added to the beam's; I1 (or NULL): the light leaving the slab
@@ -469,13 +442,13 @@ ATMOS_CLONE_HELPER void eye_blend(const sjob *j, size_t p0, const echunk *e, int
         const int mv = e->mv & ~7; /* e->mv itself: whole vectors */
         if (j->btf)
             for (int q = 0; q < mv; q++) {
-                const float r = beam_ratio(Ic[q], I1[q]);
-                Bq[q] = beam_len_btf(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r);
+                const float r = atmos__slice_beam_ratio(Ic[q], I1[q]);
+                Bq[q] = atmos__slice_beam_len(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r, 1);
             }
         else
             for (int q = 0; q < mv; q++) {
-                const float r = beam_ratio(Ic[q], I1[q]);
-                Bq[q] = beam_len_ftb(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r);
+                const float r = atmos__slice_beam_ratio(Ic[q], I1[q]);
+                Bq[q] = atmos__slice_beam_len(e->del[q], bext[q] * e->del[q], Eq[q], -log_pos(r), r, 0);
             }
     } else
         for (int q = 0; q < e->mv; q++) Bq[q] = Lq[q];
