@@ -237,7 +237,7 @@ static void eval_rays(const atmos__atm_batch *b, int count, const float *dx, con
  * exponentials (vectorises), the phase functions applied. */
 #define BLK 16
 ATMOS_CLONE_HELPER void eval_block(const sv_state *s, const float *ra, const float *rb, int i0, int m, int count,
-                       const float *dx, const float *dy, const float *dz, const float *weight, float *out)
+                                   const float *dx, const float *dy, const float *dz, const float *weight, float *out)
 {
     const int n = s->n, S = 3 * n;
     const float muh = s->muh, kr = 3.0f / (16.0f * 3.14159265359f);

@@ -184,8 +184,8 @@ ATMOS_CLONE_HELPER float encode_of(float v, const float *restrict enc)
  * the table's: GCC 12 vectorises each (the table read a gather, given restrict) but not the two
  * as one loop. */
 ATMOS_CLONE_HELPER void map_values(atmos_tone_curve curve, const float *restrict src,
-                                                             float *restrict dst, size_t n, float scale,
-                                                             const float *restrict enc)
+                                   float *restrict dst, size_t n, float scale,
+                                   const float *restrict enc)
 {
     enum { CHUNK = 256 };
     float vb[CHUNK], ve[CHUNK];
@@ -202,8 +202,8 @@ ATMOS_CLONE_HELPER void map_values(atmos_tone_curve curve, const float *restrict
  * and alpha interleaved again (each a vector loop; mapping alpha with the colours and setting it
  * afterwards took a third more time). */
 ATMOS_CLONE_HELPER void map_rgba(atmos_tone_curve curve, const float *restrict src,
-                                                           float *restrict dst, size_t width, float scale,
-                                                           const float *restrict enc)
+                                 float *restrict dst, size_t width, float scale,
+                                 const float *restrict enc)
 {
     enum { CHUNK = 64 };
     float pl[3][CHUNK], pe[3][CHUNK];

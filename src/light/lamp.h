@@ -5,6 +5,7 @@
 #ifndef ATMOS_LIGHT_LAMP_H
 #define ATMOS_LIGHT_LAMP_H
 
+#include "core/clones.h"
 #include "core/internal.h"
 #include "atmos/scene.h"
 
@@ -90,7 +91,7 @@ static inline int atmos__lamp_floor(double x)
     return i - (x < i);
 }
 /* The tint at texel coordinates (fx, fy) of the image (bilinear; 0 outside it). */
-static inline __attribute__((always_inline)) void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
+ATMOS_CLONE_HELPER void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0;
     if (!(fx > -1 && fx < l->tw && fy > -1 && fy < l->th)) return;

@@ -75,8 +75,8 @@ static int prepare(const atmos__pcloud *pc, int p, const atmos__poptics *o, cons
  * g has no root by far more than its terms' rounding; the whole row when g is not a parabola
  * open upwards (the eye within the cut's reach). */
 ATMOS_CLONE_HELPER void row_span(double a0, double a1, double a2, double e0, double e1,
-                                                           double e2, double rc2, double u0, double idu, int n, int *ja,
-                                                           int *jb)
+                                 double e2, double rc2, double u0, double idu, int n, int *ja,
+                                 int *jb)
 {
     const double A = a2 - rc2 * e2, B = a1 - rc2 * e1, C = a0 - rc2 * e0, disc = B * B - 4.0 * A * C;
     *ja = 0, *jb = n;
@@ -107,7 +107,7 @@ typedef struct lanes {
  * lanes past n hold the centre; a lane beyond the cut gets transmittance 1, which leaves its
  * pixel as it is: v 1 + c 0 = v), then each row's pixels composited; empties the batch. */
 ATMOS_CLONE_HELPER void flush(lanes *L, const sp *q, int nw, int x0, double rc2, double k2,
-                                                        int width, atmos_image *img)
+                              int width, atmos_image *img)
 {
     const int nn = (L->n + 7) & ~7, C = img->channels;
     const float *tc = q->tc, *col = q->col;

@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 #define MAX_LEVELS 32
 #define LEAF 4 /* segments a cell of the trees' finest level covers */
 

@@ -22,7 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 #define NEAR_M 1e-3
 #define EDGE_PX 1e-3
 #define DEPTH_TOL 1e-6

@@ -60,7 +60,6 @@
 /* Every light (lights()' mask). */
 #define ALL_LIGHTS 0xffffffffu
 
-
 /* A point light's neighbouring intervals whose f_l sum to less than this share of a sub-plane's
  * (epsilon of the pixel's airlight) share one sample (merged()). */
 #ifndef POINT_MERGE
@@ -834,12 +833,11 @@ typedef struct screen_buf {
     uint64_t *seen;   /* per layer and node: what its evaluation saw (two masks, air_pixel) */
 } screen_buf;
 
-
 /* Subsampling's first pass for a surface that no light reaches (no cones): the sky's light and
  * the sun's, dimmed by the fog to the eye, into B in one loop a pixel (the same operations in
  * the same order as shade_surface, base_light and sun_surface one after the other: the same bits). */
 ATMOS_CLONE_HELPER void unlit_surface(const job *J, const double d[3], const atmos_mesh_hit *h, int m, float *B,
-                              atmos__beams_sky_memo *memo)
+                                      atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
     double E[ATMOS_MAX_WAVELENGTHS], c = 0, in = 0;
@@ -864,7 +862,7 @@ ATMOS_CLONE_HELPER void unlit_surface(const job *J, const double d[3], const atm
 /* Subsampling's first pass, pixel (x, y) seeing h of object obj along the eye's ray d (-1: the
  * sky behind, bg), lit by the lights in cones (row_cones): its light without the airlight into B. */
 ATMOS_CLONE_HELPER void surface_light(const job *J, int x, int y, const double d[3], const atmos_mesh_hit *h, int obj,
-                              uint32_t cones, const float *bg, float *B, atmos__beams_sky_memo *memo)
+                                      uint32_t cones, const float *bg, float *B, atmos__beams_sky_memo *memo)
 {
     const atmos__beams_plan *b = J->b;
     double L[ATMOS_MAX_WAVELENGTHS];

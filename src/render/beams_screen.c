@@ -52,7 +52,6 @@ static const uint64_t *corners(const band *b, int x0, int y0, int x1, int y1, ui
     return known[0] | known[1] ? known : NULL;
 }
 
-
 /* dim[k]: the least of base[i nw + k] over the pixels i of [x0, x1] x [y0, y1] (each row's
  * values one block; the minima exact, so the same values in the AVX2 clone). */
 ATMOS_CLONES_NOINLINE static void least_base(const atmos__beams_screen *s, int x0, int y0, int x1, int y1, double *dim)
@@ -137,7 +136,7 @@ static void weights(int x0, int y0, int x1, int y1, int x, int y, double w[4])
  * cell's least passes only where that passes (the sums and products below are monotone in it),
  * a higher one fails only where that fails. */
 ATMOS_CLONE_HELPER int within(const atmos__beams_screen *s, const double *const c[4], const double *const *cm,
-                    const double (*w)[4], int np, double curve, const double *dim)
+                              const double (*w)[4], int np, double curve, const double *dim)
 {
     for (int k = 0; k < s->nw; k++) {
         const double lo = atmos__mind(atmos__mind(c[0][k], c[1][k]), atmos__mind(c[2][k], c[3][k]));

@@ -238,7 +238,7 @@ BEAMS_CLONES void atmos__beams_ray_init(const atmos__beams_light *l, const doubl
 /* Face f's (F, face_of(&r->l->face[f])) texel coordinates and depth of the ray at t (0 if behind
  * the near plane). */
 ATMOS_CLONE_HELPER int project(const atmos__beams_ray *r, int f, const face_at *F, double t, double *fx,
-                              double *fy, double *z)
+                               double *fy, double *z)
 {
     *z = r->f0[f][2] + t * r->f1[f][2];
     if (*z <= NEAR_M) return 0;

@@ -15,8 +15,8 @@ enum { LIGHT_UNKNOWN, LIGHT_FULL /* 1 all along */, LIGHT_FALLOFF /* H = 1: the 
 
 /* The texel coordinates of the image toward the ray's point at t; 0 behind the light (inlined:
  * a call cost 1.7 % of a frame's instructions). */
-static inline __attribute__((always_inline)) int coords(const atmos__beams_ray *r, double t, double *fx,
-                                                        double *fy)
+ATMOS_CLONE_HELPER int coords(const atmos__beams_ray *r, double t, double *fx,
+                              double *fy)
 {
     const double z = r->a0 + t * r->a1;
     if (!(z > 0)) return 0;
@@ -27,8 +27,8 @@ static inline __attribute__((always_inline)) int coords(const atmos__beams_ray *
 }
 
 /* The samples [s0, s1) one by one, added to h (the sums held in locals). */
-static inline __attribute__((always_inline)) void read_tinted(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
-                        double h[3])
+ATMOS_CLONE_HELPER void read_tinted(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1,
+                                    int known, double h[3])
 {
     double h0 = h[0], h1 = h[1], h2 = h[2];
     for (int s = s0; s < s1; s++) {
@@ -60,8 +60,8 @@ static double light_sum(const atmos__beams_ray *r, double ta, double step, doubl
  * operations (C11 contracts none into FMAs), fewer instructions; read_tinted and the look-up
  * always inlined, else the clone calls the baseline's copies (docs/beams.md *Forty-seventh
  * round*). */
-ATMOS_CLONES static void tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, int known,
-                       double h[3])
+ATMOS_CLONES static void tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1,
+                                    int known, double h[3])
 {
     const double t0 = ta + (s0 + o) * step, t1 = ta + (s1 - 1 + o) * step;
     double xa, ya, xb, yb, tint[3];

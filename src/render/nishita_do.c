@@ -309,7 +309,7 @@ typedef struct {
  * each face's exponentials in a vector loop (the same operations in the same order as one voxel
  * at a time). */
 ATMOS_CLONE_HELPER void sun_faces(const atmos__nishita_plan *np, const size_t *vi, const int (*xyz)[3], const int *id, int k,
-                         const sun_geom *sg, const float *sig, double *tff)
+                                  const sun_geom *sg, const float *sig, double *tff)
 {
     const sgrid *g = &np->g;
     const int nf = np->nf;

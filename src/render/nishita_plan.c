@@ -168,8 +168,8 @@ static void axis_taps(int n, double off, size_t stride, size_t *lo, size_t *hi, 
 /* Row n's points of plane_lerp (its taps lb, hb, ub along the row, the row's r0, r1 and v),
  * nf a constant where inlined. */
 ATMOS_CLONE_HELPER void lerp_row(const float *r0, const float *r1, double v, int nb,
-                                                            int nf, const size_t *lb, const size_t *hb,
-                                                            const double *ub, float *o, size_t ob)
+                                 int nf, const size_t *lb, const size_t *hb,
+                                 const double *ub, float *o, size_t ob)
 {
     for (int m = 0; m < nb; m++, o += ob) {
         const double u = ub[m], w00 = (1 - u) * (1 - v), w10 = u * (1 - v), w01 = (1 - u) * v, w11 = u * v;

@@ -357,9 +357,9 @@ static int cell_fine(const coarse *g, int j, int i)
  * about y are first read at y once a node (lrow, nx n values: a cell's left and right edges), a
  * cell's pixels then along x at the offsets fx[p] = p / step (a cell read bilinearly is a whole
  * step wide; the last column's takes one pixel more, at fx 1). */
-ATMOS_CLONES static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t, const coarse *g,
-                       const atmos__rect *r, int y, row_buffers *rb, int *xs, float *val, float *dst, int C,
-                       const unsigned char *hidden)
+ATMOS_CLONES static void coarse_row(const sky_job *job, const atmos__atm_batch *batch, const atmos__sky_view *t,
+                                    const coarse *g, const atmos__rect *r, int y, row_buffers *rb, int *xs, float *val,
+                                    float *dst, int C, const unsigned char *hidden)
 {
     const int n = job->n, j = (y - r->y0) / g->step < g->ny - 1 ? (y - r->y0) / g->step : g->ny - 2;
     const float fy = (float)(y - g->cy[j]) / (float)(g->cy[j + 1] - g->cy[j]), inv = 1.0f / (float)g->step;

@@ -47,7 +47,7 @@ ATMOS_CLONE_HELPER float log_pos(float x)
  * corner (times nf), (fu, fv, fw) the fractions. SoA out: dens[f * CH + q]. The grid
  * holds at most 2 GB, so 32-bit indices suffice. */
 ATMOS_CLONE_HELPER void trilinear_soa(const sgrid *g, int m, const int32_t *restrict vox, const float *restrict fu,
-                                 const float *restrict fv, const float *restrict fw, float *restrict dens)
+                                      const float *restrict fv, const float *restrict fw, float *restrict dens)
 {
     const int nf = g->nf;
     const int32_t sx = nf, sy = g->c[0] * nf, sz = g->c[0] * g->c[1] * nf;
@@ -128,8 +128,8 @@ ATMOS_CLONE_HELPER int pad_dens(int nf, int m, float *dens, int *id)
  * vector loop over all points (rejected ones clamped to voxel 0, so that the occupancy
  * gather stays inside the grid); a branch-free scalar loop then packs the kept ones. */
 ATMOS_CLONE_HELPER int compact(const sgrid *g, int cnt, const float *restrict u, const float *restrict v,
-                          const float *restrict w, const int32_t *restrict ok, int *restrict id,
-                          int32_t *restrict vox, float *restrict fu, float *restrict fv, float *restrict fw)
+                               const float *restrict w, const int32_t *restrict ok, int *restrict id,
+                               int32_t *restrict vox, float *restrict fu, float *restrict fv, float *restrict fw)
 {
     const int c0 = g->c[0], c1 = g->c[1], ob0 = g->ob[0], ob1 = g->ob[1], nf = g->nf;
     const float u1 = (float)(c0 - 1), v1 = (float)(c1 - 1), w1 = (float)(g->c[2] - 1);
@@ -187,7 +187,7 @@ typedef struct {
  * points already rejected), the ones that meet occupied blocks and a non-zero density, with
  * their densities. Returns the number of points looked up in the grid (e->m: kept). */
 ATMOS_CLONE_HELPER int chunk_lookup(const sgrid *g, int cnt, const float *u, const float *v, const float *w,
-                               const int32_t *ok, echunk *e)
+                                    const int32_t *ok, echunk *e)
 {
     e->m = compact(g, cnt, u, v, w, ok, e->id, e->vox, e->fu, e->fv, e->fw);
     const int looked = e->m;
@@ -336,7 +336,7 @@ typedef struct {
  * the lower cell i and the fraction t. Written without a branch, so that it is one vector loop
  * (the fraction is taken whatever c; an axis of one cell sets it to 0 afterwards). */
 ATMOS_CLONE_HELPER void field_axis(int mv, const float *restrict x, float off, float is, int c, int32_t *restrict i,
-                             float *restrict t)
+                                   float *restrict t)
 {
     const float lim = (float)(c - 1); /* >= 0: the two clamps one after the other clamp alike */
     for (int q = 0; q < mv; q++) {
@@ -417,8 +417,8 @@ ATMOS_CLONE_HELPER void eye_field(const sjob *j, int k, size_t p0, const echunk 
  * diffuse field's in-scattering added to the beam's; I1 (or NULL): the light leaving the slab
  * at the samples, Ic's attenuation across it (atmos__slice_beam_len). */
 ATMOS_CLONE_HELPER void eye_blend(const sjob *j, size_t p0, const echunk *e, int c, const float *restrict Ic,
-                             const float *restrict bext, const float *restrict src, const float *restrict ds,
-                             const float *restrict I1)
+                                  const float *restrict bext, const float *restrict src, const float *restrict ds,
+                                  const float *restrict I1)
 {
     float Tq[CH], Cq[CH], Sq[CH], Lq[CH], Eq[CH];
     /* the in-scattering; the field's added by a loop of its own: a test of ds inside the loop
@@ -504,7 +504,7 @@ ATMOS_CLONE_HELPER void eye_rgb_light(const sjob *j, echunk *e, const float *Ib,
 
 /* One sample's extinction and source vectors (lane c: wavelength c) over the live fields. */
 ATMOS_CLONE_HELPER void eye_rgb_sample(const sjob *j, const echunk *e, int q, const __m128 *sg, const __m128 *sa,
-                                 __m128 *bext, __m128 *src)
+                                       __m128 *bext, __m128 *src)
 {
     const stables *t = j->t;
     const int32_t an = t->no * 3;
@@ -631,7 +631,7 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
 /* The light of wavelength c leaving the chunk's samples (Eq. 25; the light pass's
  * per-wavelength part): I' = I (T + (1 - T) keep). Accumulates beta_sca Delta into dn. */
 ATMOS_CLONE_HELPER void light_wavelength(const sjob *j, int c, const echunk *e, const float *restrict Iw,
-                                    const float *restrict n0, float *restrict dn, float *restrict Io)
+                                         const float *restrict n0, float *restrict dn, float *restrict Io)
 {
     const stables *t = j->t;
     const size_t ns = (size_t)j->n + 1;

@@ -17,7 +17,7 @@
  * and the scalars (theta, q_v, q_c, q_r), 4 floats a cell each; and the level's water before
  * the advection: q_v into part[k], q_c + q_r into part[nz + 1 + k]. */
 ATMOS_CLONE_HELPER void pack_cell(const atmos_sim *s, size_t n, size_t xp, size_t yp, size_t lev, float *restrict p,
-                          float *restrict q)
+                                  float *restrict q)
 {
     p[0] = 0.5f * (s->u[n] + s->u[xp]);
     p[1] = 0.5f * (s->v[n] + s->v[yp]);
@@ -76,7 +76,7 @@ ADV_CLONES static void scalars(atmos_sim *s, int k, float c)
  * other than the face's own averaged from its four nearest faces). */
 ATMOS_CLONE_HELPER void pos_u(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
                       size_t lev, int i, int im, float fj, float fk, float c, float *restrict x, float *restrict y,
-                      float *restrict z)
+                              float *restrict z)
 {
     const float vu = 0.25f * (v[r + im] + v[r + i] + v[rp + im] + v[rp + i]);
     const float wu = 0.25f * (w[r + im] + w[r + i] + w[r + lev + im] + w[r + lev + i]);
@@ -85,7 +85,7 @@ ATMOS_CLONE_HELPER void pos_u(const float *restrict u, const float *restrict v, 
 
 ATMOS_CLONE_HELPER void pos_v(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rm,
                       size_t lev, int i, int ip, float fj, float fk, float c, float *restrict x, float *restrict y,
-                      float *restrict z)
+                              float *restrict z)
 {
     const float uv = 0.25f * (u[rm + i] + u[rm + ip] + u[r + i] + u[r + ip]);
     const float wv = 0.25f * (w[rm + i] + w[r + i] + w[rm + lev + i] + w[r + lev + i]);
@@ -94,7 +94,7 @@ ATMOS_CLONE_HELPER void pos_v(const float *restrict u, const float *restrict v, 
 
 ATMOS_CLONE_HELPER void pos_w(const float *restrict u, const float *restrict v, const float *restrict w, size_t r, size_t rp,
                       size_t lev, int i, int ip, float fj, float fk, float c, float *restrict x, float *restrict y,
-                      float *restrict z)
+                              float *restrict z)
 {
     const float uw = 0.25f * (u[r - lev + i] + u[r - lev + ip] + u[r + i] + u[r + ip]);
     const float vw = 0.25f * (v[r - lev + i] + v[rp - lev + i] + v[r + i] + v[rp + i]);

@@ -56,7 +56,7 @@ typedef struct {
 } vec3f;
 
 ATMOS_CLONE_HELPER vec3f vort_at(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float inv2, float zf,
-                          const float *restrict uc, const float *restrict vc, const float *restrict wc)
+                                 const float *restrict uc, const float *restrict vc, const float *restrict wc)
 {
     const size_t yp = o->yp + i, ym = o->ym + i, zp = n + o->zp, zm = n + o->zm;
     vec3f w;
@@ -99,7 +99,7 @@ CONF_CLONES static void vorticity(atmos_sim *s, int k, float *const f[7])
     const float *restrict uc, const float *restrict vc, const float *restrict wc, const float *restrict om,           \
         float *restrict fx, float *restrict fy, float *restrict fz
 ATMOS_CLONE_HELPER void force_cell(const rows *o, size_t n, size_t i, size_t xm, size_t xp, float a, float inv2, float zf,
-                            FORCE_ARGS)
+                                   FORCE_ARGS)
 {
     const vec3f w = vort_at(o, n, i, xm, xp, inv2, zf, uc, vc, wc);
     float gx = om[xp] - om[xm];
