@@ -597,8 +597,8 @@ static void lights(job *J, int x, int y, const double d[3], double T, double *f,
     const int *span = J->span + 2 * (size_t)y; /* light i's on row y at i stride (in_span's) */
     const size_t stride = 2 * (size_t)J->cam->height;
     for (int pass = 0; pass < 2; pass++) { /* the lights of mask, then (if any of them adds) the others */
-        for (uint32_t todo = (pass ? ~mask : mask) & all; todo; todo &= todo - 1) { /* their bits, lowest first */
-            const int i = __builtin_ctz(todo);
+        for (uint32_t left = (pass ? ~mask : mask) & all; left; left &= left - 1) { /* their bits, lowest first */
+            const int i = __builtin_ctz(left);
             double *fi = f + (size_t)i * LIGHT_STRIDE;
             cnt[i] = !in_columns(span + i * stride, x) ? 0
                      : pass ? interval_sum(J, i, d, T, fi, &S[i], centre) /* its weight alone */
@@ -607,12 +607,12 @@ static void lights(job *J, int x, int y, const double d[3], double T, double *f,
         }
         if (!adds) return;
     }
-    for (uint32_t todo = adds; todo; todo &= todo - 1) { /* in the lights' order */
-        const int i = __builtin_ctz(todo);
+    for (uint32_t left = adds; left; left &= left - 1) { /* in the lights' order */
+        const int i = __builtin_ctz(left);
         tot += J->weight[i] * S[i], lit++;
     }
-    for (uint32_t todo = adds & mask; todo; todo &= todo - 1) {
-        const int i = __builtin_ctz(todo);
+    for (uint32_t left = adds & mask; left; left &= left - 1) {
+        const int i = __builtin_ctz(left);
         const double unit = J->epsilon * (lit == 1 || !(J->weight[i] > 0) ? S[i] : tot / J->weight[i]);
         airlight(J, i, d, f + (size_t)i * LIGHT_STRIDE, (int)cnt[i], S[i], unit, L, centre, o,
                  sh && sh->light == i ? sh : NULL);
