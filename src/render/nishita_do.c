@@ -468,7 +468,8 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
  * came before (from a warm start it would be rho^k times the field's change since the last sun,
  * which need not be small against a field that fell, e.g. at sunset): one where rho <= DO_TOL (GMRES from 0 took
  * two sweeps: the source's and one iteration's), two where rho^2 <= DO_TOL; else 0 (GMRES). */
-static int thin_sweeps(const atmos__do_problem *P0, const float *st, size_t cells, int n, const double chi[][4])
+static int thin_sweeps(const atmos__do_problem *P0, const float *st, size_t cells, int n, const double chi[][4],
+                       double *bound)
 {
     atmos__do_problem P = *P0;
     double rho = 0;
@@ -477,7 +478,9 @@ static int thin_sweeps(const atmos__do_problem *P0, const float *st, size_t cell
         for (int l = 0; l <= P.L; l++) P.chi[l] = chi[w][l];
         rho = fmax(rho, atmos__do_rho(&P));
     }
-    return rho <= DO_TOL ? 1 : rho * rho <= DO_TOL ? 2 : 0;
+    const int k = rho <= DO_TOL ? 1 : rho * rho <= DO_TOL ? 2 : 0;
+    *bound = k == 1 ? rho : rho * rho;
+    return k;
 }
 
 /* What the wavelengths' solves share: the problem but for the wavelength's medium, emission and
@@ -627,7 +630,8 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     int copy[ATMOS_MAX_WAVELENGTHS] = {0}, wl[ATMOS_MAX_WAVELENGTHS], ns = 0;
     if (ok) cell_source(np, F, *dc, n, ltg, src, dsrc, threads);
     /* an optically thin medium: source iterations alone */
-    P->richardson = ok ? thin_sweeps(P, st, cells, n, chi) : 0;
+    double bound = 0;
+    P->richardson = ok ? thin_sweeps(P, st, cells, n, chi, &bound) : 0;
     if (P->richardson) warm = 0; /* thin_sweeps: from 0 */
     for (int w = 0; w < n && ok; w++) {
         const float *sw = st + 2 * cells * w;
@@ -638,6 +642,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
         if (!copy[w]) wl[ns++] = w;
     }
     ok = ok && solve_all(&D, wl, ns, skymean, phi_all, warm, threads, ws, info);
+    if (P->richardson) info->source_its = P->richardson, info->resid = bound; /* no residual computed */
     for (int w = 1; w < n && ok; w++) {
         if (!copy[w]) continue;
         /* the last wavelength's moments, just before this one's in phi_all (w >= 1); indexed from

@@ -7,7 +7,9 @@
 
 typedef struct {
     int directions, iters, sweeps; /* GMRES iterations and sweeps, summed over the wavelengths */
-    double resid;                  /* the largest relative residual left */
+    double resid;                  /* the largest relative residual left; with source iterations
+                                      (source_its > 0) not computed: the bound rho^k on the error */
+    int source_its;                /* > 0: the source iterations that replaced GMRES (thin media) */
     double cpu_s;                  /* the process's CPU time during the solve */
 } atmos__nishita_do_info;
 

@@ -64,7 +64,7 @@ struct atmos__nishita_plan {
     double mc_s;             /* the last field's time */
     /* with "do" (nishita_do.c): the last solve's directions, GMRES iterations and sweeps (over the
      * wavelengths), largest relative residual, CPU time */
-    int do_dirs, do_iters, do_sweeps;
+    int do_dirs, do_iters, do_sweeps, do_source_its; /* do_source_its > 0: do_resid is rho^k's bound */
     double do_resid, do_cpu;
     /* edge_aa (nishita_render.c, edge_aa.c): the edge pixels' transmittances and flags */
     unsigned char *edge;

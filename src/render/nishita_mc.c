@@ -179,11 +179,17 @@ void atmos__nishita_do_describe(const atmos__nishita_plan *np, char *buf, size_t
 {
     const atmos__lfield *F = &np->mc->field;
     const size_t l = strlen(buf);
+    /* an optically thin medium is solved by source iterations alone (no GMRES): no residual is
+       computed then; the bound on the error is given instead */
+    char res[64];
+    if (np->do_source_its > 0)
+        snprintf(res, sizeof res, "%d source iterations, relative error at most %.1e", np->do_source_its, np->do_resid);
+    else
+        snprintf(res, sizeof res, "residual %.1e", np->do_resid);
     snprintf(buf + l, cap - l,
-             "; discrete-ordinates field, %d directions, %d GMRES iterations, %d sweeps (residual %.1e), "
+             "; discrete-ordinates field, %d directions, %d GMRES iterations, %d sweeps (%s), "
              "%dx%dx%d cells of %d voxels, %.3f s, %.3f s CPU",
-             np->do_dirs, np->do_iters, np->do_sweeps, np->do_resid, F->c[0], F->c[1], F->c[2], F->s, np->mc_s,
-             np->do_cpu);
+             np->do_dirs, np->do_iters, np->do_sweeps, res, F->c[0], F->c[1], F->c[2], F->s, np->mc_s, np->do_cpu);
 }
 
 /* The occupied box's faces lit by the sunlight travelling along lt (grid frame): each face's
@@ -520,7 +526,7 @@ static atmos_status solve(atmos_plan *p, atmos__nishita_plan *np, const double s
                                warm && mc->do_phi_valid, mc->do_ws, &mc->do_cells, &info);
     mc->do_phi_valid = st == ATMOS_OK;
     np->do_iters = info.iters, np->do_sweeps = info.sweeps, np->do_dirs = info.directions;
-    np->do_resid = info.resid, np->do_cpu = info.cpu_s;
+    np->do_resid = info.resid, np->do_cpu = info.cpu_s, np->do_source_its = info.source_its;
     return st;
 }
 
