@@ -5,6 +5,7 @@
  * light's own sum (its tiles' tests, its falloff's runs); a run in a black part of the image, or
  * outside it, adds nothing. */
 #include "render/beams_internal.h"
+#include "render/beams_lookup.h"
 #include "core/clones.h"
 #include "core/vec.h"
 
@@ -39,7 +40,7 @@ ATMOS_CLONE_HELPER void read_tinted(const atmos__beams_ray *r, double ta, double
         if (tint[0] == 0 && tint[1] == 0 && tint[2] == 0) continue;
         const double v = known == LIGHT_FULL      ? 1
                          : known == LIGHT_FALLOFF ? atmos__beams_ray_falloff(r, t)
-                                                  : atmos__beams_ray_light(r, t);
+                                                  : ray_light(r, t);
         if (v > 0) h0 += v * tint[0], h1 += v * tint[1], h2 += v * tint[2];
     }
     h[0] = h0, h[1] = h1, h[2] = h2;
@@ -76,7 +77,7 @@ ATMOS_CLONES static void tinted_sum(const atmos__beams_ray *r, double ta, double
     if (known == LIGHT_UNKNOWN && s1 - s0 > 1) { /* the shadow map's tiles: a run in a wall's shadow adds nothing */
         double same;
         int full;
-        if (atmos__beams_ray_uniform(r, t0, t1, &same, &full)) {
+        if (ray_uniform(r, t0, t1, &same, &full)) {
             if (same == 0) return; /* in shadow all along */
             known = full ? LIGHT_FULL : LIGHT_FALLOFF;
         }
