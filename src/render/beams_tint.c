@@ -153,7 +153,7 @@ ATMOS_CLONES int atmos__beams_ray_tinted(const atmos__beams_ray *r, const double
         const int s0 = a > 0 ? (a < m ? (int)a : m) : 0, s1 = b < m ? (b > 0 ? (int)b : 0) : m;
         double h[3] = {0, 0, 0};
         tinted_sum(r, ta, step, o, s0, s1, LIGHT_UNKNOWN, h);
-        for (int c = 0; c < 3; c++) sum[c] += h[c] / m * fl;
+        sum[0] += h[0] / m * fl, sum[1] += h[1] / m * fl, sum[2] += h[2] / m * fl; /* written out: not a loop */
     }
     return count;
 }
