@@ -90,19 +90,36 @@ static inline int atmos__lamp_floor(double x)
     const int i = (int)x;
     return i - (x < i);
 }
-/* The tint at texel coordinates (fx, fy) of the image (bilinear; 0 outside it). */
-ATMOS_CLONE_HELPER void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
+/* What a look-up reads of the image, in locals: a loop's look-ups take them once (the lamp's
+ * fields, read through a pointer, would be loaded and converted again at every look-up). */
+typedef struct atmos__lamp_image {
+    const double *tex; /* atmos__lamp's, with its border */
+    int stride;        /* tw + 2 */
+    double w, h;       /* tw, th */
+} atmos__lamp_image;
+static inline atmos__lamp_image atmos__lamp_image_of(const atmos__lamp *l)
+{
+    return (atmos__lamp_image){l->tex, l->tw + 2, l->tw, l->th};
+}
+/* atmos__lamp_tint_at from the image's locals. */
+ATMOS_CLONE_HELPER void atmos__lamp_image_tint(const atmos__lamp_image *m, double fx, double fy, double rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0;
-    if (!(fx > -1 && fx < l->tw && fy > -1 && fy < l->th)) return;
+    if (!(fx > -1 && fx < m->w && fy > -1 && fy < m->h)) return;
     const int x0 = atmos__lamp_floor(fx), y0 = atmos__lamp_floor(fy); /* in [-1, tw - 1], [-1, th - 1] */
     const double ax = fx - x0, ay = fy - y0;
     const double w00 = (1 - ax) * (1 - ay), w01 = ax * (1 - ay), w10 = (1 - ax) * ay, w11 = ax * ay;
-    /* the border stands for the clamped edge */
-    const double *t00 = atmos__lamp_texel(l, x0, y0), *t10 = atmos__lamp_texel(l, x0, y0 + 1);
+    /* the border stands for the clamped edge (atmos__lamp_texel) */
+    const double *t00 = m->tex + 3 * ((size_t)(y0 + 1) * m->stride + x0 + 1), *t10 = t00 + 3 * (size_t)m->stride;
     rgb[0] = w00 * t00[0] + w01 * t00[3] + w10 * t10[0] + w11 * t10[3]; /* in this order, left to right */
     rgb[1] = w00 * t00[1] + w01 * t00[4] + w10 * t10[1] + w11 * t10[4];
     rgb[2] = w00 * t00[2] + w01 * t00[5] + w10 * t10[2] + w11 * t10[5];
+}
+/* The tint at texel coordinates (fx, fy) of the image (bilinear; 0 outside it). */
+ATMOS_CLONE_HELPER void atmos__lamp_tint_at(const atmos__lamp *l, double fx, double fy, double rgb[3])
+{
+    const atmos__lamp_image m = atmos__lamp_image_of(l);
+    atmos__lamp_image_tint(&m, fx, fy, rgb);
 }
 /* Whether the tint is the same all over the box [fx0, fx1] x [fy0, fy1] of texel coordinates
  * (every texel the bilinear look-ups there read alike, or the box wholly outside the image:

@@ -140,6 +140,13 @@ double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, do
  * are that tint times atmos__beams_ray_light_sum, runs the shadow map's tiles prove dark
  * nothing; the rest halved, down to 8 samples read one by one. */
 void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, double h[3]);
+/* A spot with an image (stained glass) over the ray's n intervals f (beams_render.c's layout:
+ * f[2k], f[2k + 2] the ends of interval k, f[2k + 1] its f_l): each interval whose f_l > 0 gets
+ * ceil(f_l / unit) sub-planes (at most max_sub), their samples at offset o, whose tinted sum
+ * (atmos__beams_ray_tinted_sum) over the sub-planes times f_l is added into sum (rgb, set);
+ * returns the sub-planes counted, those of the intervals the image leaves black included. */
+int atmos__beams_ray_tinted(const atmos__beams_ray *r, const double *f, int n, double unit, int max_sub, double o,
+                            double sum[3]);
 /* Narrows [*t0, *t1] of the ray to where the spot's image may tint it (its non-black texels'
  * pyramid, atmos__lamp's box, with a margin for rounding): outside, the tint is 0. Returns 0
  * when no part is left. */

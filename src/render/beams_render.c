@@ -248,31 +248,15 @@ ATMOS_CLONE_HELPER int subplanes(const job *J, double fl, double unit)
 }
 
 /* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
- * image's tint at every sample (atmos__beams_ray_tinted_sum: where it is one colour along a run
- * of them, that colour times the light's sum), so no interval is taken as uniform by its f_l
- * alone: its colour varies. */
+ * image's tint at every sample (atmos__beams_ray_tinted, beams_tint.c: where it is one colour
+ * along a run of them, that colour times the light's sum), so no interval is taken as uniform by
+ * its f_l alone: its colour varies. */
 static void tinted(job *J, const atmos__beams_light *l, const atmos__beams_ray *ray, const double *f, int n, double unit,
                    double *L, int centre, double o)
 {
-    double sum[3] = {0, 0, 0}, p0 = f[0], p1 = f[2 * n];
-    const int some = atmos__beams_ray_tint_span(ray, &p0, &p1); /* outside [p0, p1] the image is black */
-    for (int k = 0; k < n; k++) {
-        const double fl = f[2 * k + 1];
-        if (fl <= 0) continue;
-        if (!some || f[2 * k + 2] < p0 || f[2 * k] > p1) { /* black all along: counted, not sampled */
-            if (centre) J->centre_subplanes += subplanes(J, fl, unit);
-            continue;
-        }
-        const int m = subplanes(J, fl, unit);
-        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
-        if (centre) J->centre_subplanes += m;
-        /* the samples within [p0, p1], and one more each side for the rounding */
-        const double a = ceil((p0 - ta) / step - o) - 1, b = floor((p1 - ta) / step - o) + 2;
-        const int s0 = a > 0 ? (a < m ? (int)a : m) : 0, s1 = b < m ? (b > 0 ? (int)b : 0) : m;
-        double h[3] = {0, 0, 0};
-        atmos__beams_ray_tinted_sum(ray, ta, step, o, s0, s1, h);
-        for (int c = 0; c < 3; c++) sum[c] += h[c] / m * fl;
-    }
+    double sum[3];
+    const int m = atmos__beams_ray_tinted(ray, f, n, unit, J->max_sub, o, sum);
+    if (centre) J->centre_subplanes += m;
     for (int k = 0; k < J->nw; k++) L[k] += l->L.I[k] * sum[k < 3 ? k : 2];
 }
 

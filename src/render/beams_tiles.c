@@ -78,27 +78,5 @@ int atmos__beams_tiles_build(atmos__beams_tiles *t, const float *depth, int n, i
 ATMOS_CLONES void atmos__beams_tiles_range(const atmos__beams_tiles *t, int x0, int x1, int y0, int y1, float *lo,
                                            float *hi)
 {
-    const int sh = t->shift, tx0 = x0 < 0 ? 0 : x0 >> sh, tx1 = x1 < 0 ? 0 : x1 >> sh, ty0 = y0 < 0 ? 0 : y0 >> sh,
-              ty1 = y1 < 0 ? 0 : y1 >> sh;
-    /* the finest level where the tiles' box spans at most 2 x 2 cells: none below the one where
-     * the larger side d (2^(B-1) <= d < 2^B) is halved to 1, since at level k the box spans at
-     * least floor(d / 2^k) + 1 cells */
-    const unsigned d = (unsigned)(tx1 - tx0 > ty1 - ty0 ? tx1 - tx0 : ty1 - ty0);
-    int k = d > 1 ? 31 - __builtin_clz(d) : 0;
-    if (k > t->levels - 1) k = t->levels - 1;
-    while (k + 1 < t->levels && ((tx1 >> k) - (tx0 >> k) > 1 || (ty1 >> k) - (ty0 >> k) > 1)) k++;
-    /* at most 2 x 2 cells there: the four corners' read (a corner twice where the box is one
-     * cell wide; the least and the greatest are the same whatever the order: no NaN depths) */
-    const int xa = tx0 >> k, xb = tx1 >> k, ya = ty0 >> k, yb = ty1 >> k;
-    if (xb < xa || yb < ya) { /* an empty box (the texels' ends out of order) */
-        *lo = INFINITY, *hi = -INFINITY;
-        return;
-    }
-    const size_t m = (size_t)t->level_n[k], ra = t->level_at[k] + ya * m, rb = t->level_at[k] + yb * m;
-    const float *cmin = t->min, *cmax = t->max;
-    float a = cmin[ra + xa], b = cmax[ra + xa], u, v;
-    u = cmin[ra + xb], v = cmax[ra + xb], a = u < a ? u : a, b = v > b ? v : b;
-    u = cmin[rb + xa], v = cmax[rb + xa], a = u < a ? u : a, b = v > b ? v : b;
-    u = cmin[rb + xb], v = cmax[rb + xb], a = u < a ? u : a, b = v > b ? v : b;
-    *lo = a, *hi = b;
+    atmos__beams_tiles_range_in(t, x0, x1, y0, y1, lo, hi);
 }

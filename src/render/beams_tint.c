@@ -5,6 +5,7 @@
  * light's own sum (its tiles' tests, its falloff's runs); a run in a black part of the image, or
  * outside it, adds nothing. */
 #include "render/beams_internal.h"
+#include "render/beams_lookup.h"
 #include "core/clones.h"
 #include "core/vec.h"
 
@@ -26,20 +27,24 @@ ATMOS_CLONE_HELPER int coords(const atmos__beams_ray *r, double t, double *fx,
     return 1;
 }
 
-/* The samples [s0, s1) one by one, added to h (the sums held in locals). */
+/* The samples [s0, s1) one by one, added to h (the sums, the image's fields and its centre held
+ * in locals: coords() computes the same). */
 ATMOS_CLONE_HELPER void read_tinted(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1,
                                     int known, double h[3])
 {
+    const atmos__lamp_image m = atmos__lamp_image_of(&r->l->L);
+    const double u0 = r->u0, u1 = r->u1, v0 = r->v0, v1 = r->v1, a0 = r->a0, a1 = r->a1;
+    const double cx = 0.5 * r->l->L.tw - 0.5, cy = 0.5 * r->l->L.th - 0.5;
     double h0 = h[0], h1 = h[1], h2 = h[2];
     for (int s = s0; s < s1; s++) {
-        const double t = ta + (s + o) * step;
-        double fx, fy, tint[3];
-        if (!coords(r, t, &fx, &fy)) continue;
-        atmos__lamp_tint_at(&r->l->L, fx, fy, tint); /* first: a black texel spares the shadow map's */
+        const double t = ta + (s + o) * step, z = a0 + t * a1;
+        if (!(z > 0)) continue; /* behind the light */
+        const double iz = 1 / z;
+        double tint[3];
+        atmos__lamp_image_tint(&m, (u0 + t * u1) * iz + cx, (v0 + t * v1) * iz + cy, tint); /* first: a black
+                                                                  * texel spares the shadow map's */
         if (tint[0] == 0 && tint[1] == 0 && tint[2] == 0) continue;
-        const double v = known == LIGHT_FULL      ? 1
-                         : known == LIGHT_FALLOFF ? atmos__beams_ray_falloff(r, t)
-                                                  : atmos__beams_ray_light(r, t);
+        const double v = known == LIGHT_FULL ? 1 : known == LIGHT_FALLOFF ? ray_falloff(r, t) : ray_light(r, t);
         if (v > 0) h0 += v * tint[0], h1 += v * tint[1], h2 += v * tint[2];
     }
     h[0] = h0, h[1] = h1, h[2] = h2;
@@ -76,7 +81,7 @@ ATMOS_CLONES static void tinted_sum(const atmos__beams_ray *r, double ta, double
     if (known == LIGHT_UNKNOWN && s1 - s0 > 1) { /* the shadow map's tiles: a run in a wall's shadow adds nothing */
         double same;
         int full;
-        if (atmos__beams_ray_uniform(r, t0, t1, &same, &full)) {
+        if (ray_uniform(r, t0, t1, &same, &full)) {
             if (same == 0) return; /* in shadow all along */
             known = full ? LIGHT_FULL : LIGHT_FALLOFF;
         }
@@ -117,4 +122,38 @@ void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double st
                                  double h[3])
 {
     tinted_sum(r, ta, step, o, s0, s1, LIGHT_UNKNOWN, h);
+}
+
+/* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
+ * max_sub (beams_render.c's subplanes(), the same value). */
+ATMOS_CLONE_HELPER int tinted_subplanes(double fl, double unit, int max_sub)
+{
+    const double need = ceil(fl / unit);
+    return need < 1 ? 1 : need > max_sub ? max_sub : (int)need;
+}
+
+/* An AVX2 clone (the same operations: ceil and floor a rounding instruction each there, where the
+ * baseline spells them out; the call to tinted_sum a direct one). */
+ATMOS_CLONES int atmos__beams_ray_tinted(const atmos__beams_ray *r, const double *f, int n, double unit, int max_sub,
+                                         double o, double sum[3])
+{
+    double p0 = f[0], p1 = f[2 * n];
+    const int some = atmos__beams_ray_tint_span(r, &p0, &p1); /* outside [p0, p1] the image is black */
+    int count = 0;
+    sum[0] = sum[1] = sum[2] = 0;
+    for (int k = 0; k < n; k++) {
+        const double fl = f[2 * k + 1];
+        if (fl <= 0) continue;
+        const int m = tinted_subplanes(fl, unit, max_sub);
+        count += m;
+        if (!some || f[2 * k + 2] < p0 || f[2 * k] > p1) continue; /* black all along: counted, not sampled */
+        const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
+        /* the samples within [p0, p1], and one more each side for the rounding */
+        const double a = ceil((p0 - ta) / step - o) - 1, b = floor((p1 - ta) / step - o) + 2;
+        const int s0 = a > 0 ? (a < m ? (int)a : m) : 0, s1 = b < m ? (b > 0 ? (int)b : 0) : m;
+        double h[3] = {0, 0, 0};
+        tinted_sum(r, ta, step, o, s0, s1, LIGHT_UNKNOWN, h);
+        sum[0] += h[0] / m * fl, sum[1] += h[1] / m * fl, sum[2] += h[2] / m * fl; /* written out: not a loop */
+    }
+    return count;
 }
