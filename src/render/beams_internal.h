@@ -7,8 +7,6 @@
 #define ATMOS_RENDER_BEAMS_INTERNAL_H
 
 #include "core/vec.h"
-
-#include <string.h>
 #include "light/lamp.h"
 #include "render/objects.h"
 #include "render/beams_kept.h"
@@ -16,6 +14,8 @@
 #include "render/beams_sun.h"
 #include "render/beams_tiles.h"
 #include "render/plan_internal.h"
+
+#include <string.h>
 
 /* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
  * substitution of Sun et al. 2005). For a ray passing at distance v from the light, with u
