@@ -15,6 +15,8 @@
 #include "render/beams_tiles.h"
 #include "render/plan_internal.h"
 
+#include <string.h>
+
 /* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
  * substitution of Sun et al. 2005). For a ray passing at distance v from the light, with u
  * the signed distance along the ray from Q (the ray's point nearest the light) and
@@ -33,7 +35,7 @@
 typedef struct atmos__beams_table {
     int nt, nx;
     double x_max;
-    double *w;               /* nx rows of nt values */
+    double *w;               /* nx rows of nt values, stored by node: row j's node i at i nx + j */
 } atmos__beams_table;
 
 atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double sigma_s, const atmos__fog_optics *phase,
@@ -43,7 +45,7 @@ void atmos__beams_table_free(atmos__beams_table *t);
 /* The four rows and their weights for one x (a ray and a light): W at any theta is then
  * atmos__beams_table_at. */
 typedef struct atmos__beams_column {
-    const double *row[4];
+    const double *rows; /* the first row's node 0: node i of the four at rows + i nx, side by side */
     double wt[4];
 } atmos__beams_column;
 void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__beams_column *c);
@@ -53,9 +55,14 @@ static inline double atmos__beams_table_at(const atmos__beams_table *t, const at
     const double f = atmos__clampd((s + 1) * (0.5 * (t->nt - 1)), 0, t->nt - 1);
     int i = (int)f;
     if (i > t->nt - 2) i = t->nt - 2;
-    const double a = f - i;
+    /* the four rows' terms as one vector (each lane the scalar's operations), summed in order */
+    typedef double v4d __attribute__((vector_size(32)));
+    v4d p, q, w;
+    memcpy(&p, c->rows + (size_t)i * t->nx, sizeof p), memcpy(&q, c->rows + (size_t)(i + 1) * t->nx, sizeof q);
+    memcpy(&w, c->wt, sizeof w);
+    const v4d u = w * (p + (f - i) * (q - p));
     double v = 0;
-    for (int k = 0; k < 4; k++) v += c->wt[k] * (c->row[k][i] + a * (c->row[k][i + 1] - c->row[k][i]));
+    for (int k = 0; k < 4; k++) v += u[k];
     return v;
 }
 /* The table's coordinate of the point u along a ray passing at v from the light. */
@@ -113,6 +120,11 @@ typedef struct atmos__beams_ray {
     double u0, u1, v0, v1;   /* a spot with an image: w(t)'s along its right and down, in texels at unit depth */
 } atmos__beams_ray;
 void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r);
+/* atmos__beams_ray_init in two steps, for many rays from one eye o: the part of a ray's view
+ * that depends on o alone (l, w0, ww0, a0, u0, v0, f0), set once a frame and light into e, then
+ * per ray d the rest (atmos__beams_ray_from: the same bits as atmos__beams_ray_init). */
+void atmos__beams_ray_eye(const atmos__beams_light *l, const double o[3], atmos__beams_ray *e);
+void atmos__beams_ray_from(const atmos__beams_ray *e, const double d[3], atmos__beams_ray *r);
 /* The spot's falloff times the visibility H at o + t d (as the two functions above). */
 double atmos__beams_ray_light(const atmos__beams_ray *r, double t);
 /* What is the same all along [ta, tb] of the ray: 1 if H is (*h: 0 or 1; the segment nearer

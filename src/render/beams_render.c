@@ -74,6 +74,7 @@ typedef struct job {
     int nw, cx, cy;
     double *z_lo, *dz, *reach; /* per light: the first plane's depth, the spacing, the sampled radius */
     double *weight;            /* per light: its mean intensity over the wavelengths */
+    atmos__beams_ray *from_eye; /* per light: the eye's part of its rays' views (atmos__beams_ray_eye) */
     int *span;                 /* per light and row: the columns [x0, x1) outside which its airlight is 0 */
     double epsilon;
     int max_sub;
@@ -496,7 +497,7 @@ static void airlight(job *J, int i, const double d[3], const double *f, int n, d
         return;
     }
     atmos__beams_ray ray;
-    atmos__beams_ray_init(l, J->eye, d, &ray);
+    atmos__beams_ray_from(&J->from_eye[i], d, &ray);
     if (l->L.tex) {
         tinted(J, l, &ray, f, n, unit, L, centre, o);
         return;
@@ -709,8 +710,9 @@ static atmos_status planes(atmos_plan *p, job *J)
     J->z_lo = malloc(sizeof(double) * 4 * (size_t)(b->nlights ? b->nlights : 1));
     J->span = malloc(sizeof(int) * 2 * (size_t)J->cam->height * (size_t)(b->nlights ? b->nlights : 1));
     J->alb_pi = malloc(sizeof *J->alb_pi * (size_t)(b->obj.n > 0 ? b->obj.n : 1));
-    if (!J->z_lo || !J->span || !J->alb_pi) {
-        free(J->z_lo), free(J->span), free(J->alb_pi);
+    J->from_eye = malloc(sizeof *J->from_eye * (size_t)(b->nlights ? b->nlights : 1));
+    if (!J->z_lo || !J->span || !J->alb_pi || !J->from_eye) {
+        free(J->z_lo), free(J->span), free(J->alb_pi), free(J->from_eye);
         return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     }
     for (int m = 0; m < b->obj.n; m++)
@@ -726,6 +728,7 @@ static atmos_status planes(atmos_plan *p, job *J)
         J->z_lo[i] = atmos__dot3(Lp, J->fwd) - R;
         J->dz[i] = fmax(given > 0 ? given : 2 * R / 40, 2 * R / (MAX_INTERVALS - 8));
         screen_spans(J, l, R, J->span + 2 * (size_t)i * J->cam->height);
+        atmos__beams_ray_eye(l, J->eye, &J->from_eye[i]);
     }
     return ATMOS_OK;
 }
@@ -1087,7 +1090,10 @@ static void filter(atmos_plan *p, const atmos__rect *r, atmos_image *out, const 
 }
 
 /* A frame's own buffers (a job is zeroed first: the ones not made yet are NULL). */
-static void job_free(job *J) { free(J->z_lo), free(J->span), free(J->alb_pi), free(J->ru); }
+static void job_free(job *J)
+{
+    free(J->z_lo), free(J->span), free(J->alb_pi), free(J->from_eye), free(J->ru);
+}
 
 /* The sky behind into out over r, on the airlight's lattice too (the sky renderer's grid:
  * sky_render.c); where prim (may be NULL) holds a triangle for a pixel, its surface hides the

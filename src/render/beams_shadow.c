@@ -147,19 +147,14 @@ double atmos__beams_visibility(const atmos__beams_light *l, const double p[3])
     return lookup(F, atmos__dot3(d, F->right), atmos__dot3(d, F->up), atmos__dot3(d, F->fwd));
 }
 
-/* An AVX2 clone where the processor has it (the same IEEE operations: the same bits), as
- * atmos__beams_ray_uniform below. */
-BEAMS_CLONES void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3],
-                                        atmos__beams_ray *r)
+void atmos__beams_ray_eye(const atmos__beams_light *l, const double o[3], atmos__beams_ray *e)
 {
-    r->l = l;
-    for (int a = 0; a < 3; a++) r->w0[a] = o[a] - l->L.pos[a], r->d[a] = d[a];
-    r->ww0 = atmos__dot3(r->w0, r->w0), r->wd = atmos__dot3(r->w0, d);
-    r->a0 = atmos__dot3(r->w0, l->L.axis), r->a1 = atmos__dot3(d, l->L.axis);
+    e->l = l;
+    for (int a = 0; a < 3; a++) e->w0[a] = o[a] - l->L.pos[a];
+    e->ww0 = atmos__dot3(e->w0, e->w0), e->a0 = atmos__dot3(e->w0, l->L.axis);
     if (l->L.tex) { /* in texels at unit depth, the image's rows downward */
         const double kx = 0.5 * l->L.tw / l->L.tan_max, ky = -0.5 * l->L.th / l->L.tan_max;
-        r->u0 = kx * atmos__dot3(r->w0, l->L.right), r->u1 = kx * atmos__dot3(d, l->L.right);
-        r->v0 = ky * atmos__dot3(r->w0, l->L.up), r->v1 = ky * atmos__dot3(d, l->L.up);
+        e->u0 = kx * atmos__dot3(e->w0, l->L.right), e->v0 = ky * atmos__dot3(e->w0, l->L.up);
     }
     /* a cube's faces 2a and 2a + 1 look along +-axis a: the odd one's right and fwd are the even
      * one's negated, its up the same (set_face: the cross products' signs flip exactly), so its
@@ -167,15 +162,44 @@ BEAMS_CLONES void atmos__beams_ray_init(const atmos__beams_light *l, const doubl
     const int cube = l->nfaces == 6;
     for (int f = 0; f < l->nfaces; f += 1 + cube) {
         const atmos__beams_face *F = &l->face[f];
-        r->f0[f][0] = atmos__dot3(r->w0, F->right), r->f1[f][0] = atmos__dot3(d, F->right);
-        r->f0[f][1] = atmos__dot3(r->w0, F->up), r->f1[f][1] = atmos__dot3(d, F->up);
-        r->f0[f][2] = atmos__dot3(r->w0, F->fwd), r->f1[f][2] = atmos__dot3(d, F->fwd);
+        e->f0[f][0] = atmos__dot3(e->w0, F->right), e->f0[f][1] = atmos__dot3(e->w0, F->up);
+        e->f0[f][2] = atmos__dot3(e->w0, F->fwd);
+        if (cube) e->f0[f + 1][0] = -e->f0[f][0], e->f0[f + 1][1] = e->f0[f][1], e->f0[f + 1][2] = -e->f0[f][2];
+    }
+}
+
+/* An AVX2 clone where the processor has it (the same IEEE operations: the same bits), as
+ * atmos__beams_ray_uniform below. */
+BEAMS_CLONES void atmos__beams_ray_from(const atmos__beams_ray *e, const double d[3], atmos__beams_ray *r)
+{
+    const atmos__beams_light *l = e->l;
+    r->l = l, r->ww0 = e->ww0, r->a0 = e->a0;
+    for (int a = 0; a < 3; a++) r->w0[a] = e->w0[a], r->d[a] = d[a];
+    r->wd = atmos__dot3(r->w0, d), r->a1 = atmos__dot3(d, l->L.axis);
+    if (l->L.tex) {
+        const double kx = 0.5 * l->L.tw / l->L.tan_max, ky = -0.5 * l->L.th / l->L.tan_max;
+        r->u0 = e->u0, r->u1 = kx * atmos__dot3(d, l->L.right);
+        r->v0 = e->v0, r->v1 = ky * atmos__dot3(d, l->L.up);
+    }
+    const int cube = l->nfaces == 6;
+    for (int f = 0; f < l->nfaces; f += 1 + cube) {
+        const atmos__beams_face *F = &l->face[f];
+        r->f0[f][0] = e->f0[f][0], r->f1[f][0] = atmos__dot3(d, F->right);
+        r->f0[f][1] = e->f0[f][1], r->f1[f][1] = atmos__dot3(d, F->up);
+        r->f0[f][2] = e->f0[f][2], r->f1[f][2] = atmos__dot3(d, F->fwd);
         if (cube) {
-            r->f0[f + 1][0] = -r->f0[f][0], r->f1[f + 1][0] = -r->f1[f][0];
-            r->f0[f + 1][1] = r->f0[f][1], r->f1[f + 1][1] = r->f1[f][1];
-            r->f0[f + 1][2] = -r->f0[f][2], r->f1[f + 1][2] = -r->f1[f][2];
+            r->f0[f + 1][0] = e->f0[f + 1][0], r->f1[f + 1][0] = -r->f1[f][0];
+            r->f0[f + 1][1] = e->f0[f + 1][1], r->f1[f + 1][1] = r->f1[f][1];
+            r->f0[f + 1][2] = e->f0[f + 1][2], r->f1[f + 1][2] = -r->f1[f][2];
         }
     }
+}
+
+void atmos__beams_ray_init(const atmos__beams_light *l, const double o[3], const double d[3], atmos__beams_ray *r)
+{
+    atmos__beams_ray e;
+    atmos__beams_ray_eye(l, o, &e);
+    atmos__beams_ray_from(&e, d, r);
 }
 
 BEAMS_CLONES int atmos__beams_ray_uniform(const atmos__beams_ray *r, double ta, double tb, double *h, int *full)

@@ -32,8 +32,9 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
     t->nt = nt, t->nx = nx, t->x_max = x_max > 0 ? x_max : 1e-9;
     t->w = malloc(sizeof(double) * (size_t)nt * nx);
     double *ph = malloc(sizeof(double) * ns), *tn = malloc(sizeof(double) * ns), *h = malloc(sizeof(double) * nt);
-    if (!t->w || !ph || !tn || !h) {
-        free(ph), free(tn), free(h), atmos__beams_table_free(t);
+    double *rows = malloc(sizeof(double) * (size_t)nt * nx); /* row j at j nt, then stored by node */
+    if (!t->w || !ph || !tn || !h || !rows) {
+        free(ph), free(tn), free(h), free(rows), atmos__beams_table_free(t);
         return atmos__error(ctx, ATMOS_E_NOMEM, "render beams: out of memory for the scattering table");
     }
     for (int i = 0; i < ns; i++) {
@@ -46,7 +47,7 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
 #pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
     for (int j = 0; j < nx; j++) {
         const double w = (double)j / (nx - 1), x = t->x_max * w * w;
-        double *row = t->w + (size_t)j * nt, acc = 0;
+        double *row = rows + (size_t)j * nt, acc = 0;
         double f0 = ph[0]; /* tan = 0 at theta = -pi/2 */
         row[0] = 0;
         for (int i = 0; i + 1 < nt; i++) {
@@ -57,7 +58,11 @@ atmos_status atmos__beams_table_build(atmos_context *ctx, double sigma_t, double
             f0 = f1;
         }
     }
-    free(ph), free(tn), free(h);
+    /* by node: a look-up's four rows side by side (atmos__beams_table_at) */
+#pragma omp parallel for schedule(static) num_threads(atmos__threads(ctx))
+    for (int i = 0; i < nt; i++)
+        for (int j = 0; j < nx; j++) t->w[(size_t)i * nx + j] = rows[(size_t)j * nt + i];
+    free(ph), free(tn), free(h), free(rows);
     return ATMOS_OK;
 }
 
@@ -73,5 +78,5 @@ void atmos__beams_table_column(const atmos__beams_table *t, double x, atmos__bea
     c->wt[1] = s * (s - 2) * (s - 3) / 2;
     c->wt[2] = -s * (s - 1) * (s - 3) / 2;
     c->wt[3] = s * (s - 1) * (s - 2) / 6;
-    for (int k = 0; k < 4; k++) c->row[k] = t->w + (size_t)(j0 + k) * t->nt;
+    c->rows = t->w + j0;
 }
