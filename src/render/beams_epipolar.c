@@ -103,8 +103,8 @@ ATMOS_CLONES_NOINLINE NO_TRAPS static void samples(const atmos__beams_sun *s, do
     }
 }
 
-/* Line j's samples and its tree. */
-static void fill(atmos__beams_epi *e, const atmos__beams_sun *s, int j)
+/* Line j's samples and its tree; built for AVX2 as well (the same operations, the same bits). */
+ATMOS_CLONES static void fill(atmos__beams_epi *e, const atmos__beams_sun *s, int j)
 {
     const double th = j * e->dth, c = cos(th), sn = sin(th);
     const int cnt = e->cnt[j], k0 = e->k0[j];

@@ -207,11 +207,13 @@ ATMOS_CLONE_HELPER void fill_nw(const band *b, int x0, int y0, int x1, int y1, c
 
 /* The cell [x0, x1] x [y0, y1], its corners c evaluated, filled by bilinear interpolation
  * (the pixels not evaluated; the wavelengths in one loop, vectorised in the AVX2 clone, and
- * unrolled for three, the rgb mode's: the same bits). */
+ * unrolled for three, the rgb mode's, and 16, the spectral mode's: the same bits). */
 ATMOS_CLONES_NOINLINE static void fill(band *b, int x0, int y0, int x1, int y1)
 {
     if (b->s->nw == 3)
         fill_nw(b, x0, y0, x1, y1, 3);
+    else if (b->s->nw == 16)
+        fill_nw(b, x0, y0, x1, y1, 16);
     else
         fill_nw(b, x0, y0, x1, y1, b->s->nw);
 }
