@@ -39,12 +39,7 @@ ATMOS_CLONE_HELPER double texels_in(const face_at *F, double fx, double fy, doub
     const int tile = F->tile_y[yi] + F->tile_x[xi]; /* atmos__beams_tiles_at(&tiles, x0, y0, shift) */
     if (z < F->min[tile]) return 1;
     if (z >= F->max[tile]) return 0;
-    const double ax = fx - x0, ay = fy - y0;
-    const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
-    const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
-    const float *ra = F->depth + (size_t)ya * n, *rb = F->depth + (size_t)yb * n;
-    const double top = (1 - ax) * (z < ra[xa]) + ax * (z < ra[xb]), bottom = (1 - ax) * (z < rb[xa]) + ax * (z < rb[xb]);
-    return (1 - ay) * top + ay * bottom;
+    return atmos__beams_depth_blend(F->depth, n, fx, fy, x0, y0, z);
 }
 
 /* H at depth z and texel coordinates (fx, fy) of face F: the four nearest comparisons, blended. */

@@ -194,13 +194,7 @@ static double lookup(const atmos__beams_sun *s, double fx, double fy, double z)
 {
     const int n = s->n;
     if (!(fx > -1 && fx < n && fy > -1 && fy < n)) return 1; /* beside every object */
-    const int x0 = (int)(fx + 1) - 1, y0 = (int)(fy + 1) - 1;
-    const double ax = fx - x0, ay = fy - y0;
-    const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
-    const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
-    const float *ra = s->depth + (size_t)ya * n, *rb = s->depth + (size_t)yb * n;
-    const double top = (1 - ax) * (z < ra[xa]) + ax * (z < ra[xb]), bottom = (1 - ax) * (z < rb[xa]) + ax * (z < rb[xb]);
-    return (1 - ay) * top + ay * bottom;
+    return atmos__beams_depth_blend(s->depth, n, fx, fy, (int)(fx + 1) - 1, (int)(fy + 1) - 1, z);
 }
 
 double atmos__beams_sun_visibility(const atmos__beams_sun *s, const double p[3])

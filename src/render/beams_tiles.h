@@ -72,4 +72,18 @@ ATMOS_CLONE_HELPER void atmos__beams_tiles_range_in(const atmos__beams_tiles *t,
     *lo = a, *hi = b;
 }
 
+/* The 2x2 filtered look-up that the tiles bound: H at depth z and texel coordinates (fx, fy) of
+ * an n x n depth map, (x0, y0) = (floor(fx), floor(fy)) with fx, fy in (-1, n): the four nearest
+ * comparisons, blended (the texels beyond the edge are the edge's). */
+ATMOS_CLONE_HELPER double atmos__beams_depth_blend(const float *depth, int n, double fx, double fy, int x0, int y0,
+                                                   double z)
+{
+    const double ax = fx - x0, ay = fy - y0;
+    const int xa = x0 < 0 ? 0 : x0, xb = x0 + 1 > n - 1 ? n - 1 : x0 + 1;
+    const int ya = y0 < 0 ? 0 : y0, yb = y0 + 1 > n - 1 ? n - 1 : y0 + 1;
+    const float *ra = depth + (size_t)ya * n, *rb = depth + (size_t)yb * n;
+    const double top = (1 - ax) * (z < ra[xa]) + ax * (z < ra[xb]), bottom = (1 - ax) * (z < rb[xa]) + ax * (z < rb[xb]);
+    return (1 - ay) * top + ay * bottom;
+}
+
 #endif
