@@ -384,7 +384,10 @@ ATMOS_CLONE_HELPER void eye_field_cells(const sjob *j, int k, size_t p0, const e
 
 /* The diffuse field scattered toward the eye at the chunk's samples, wavelength c in
  * ds[c * CH + q]: sum over the live fields of density times the view's sca (L + g A)
- * (trilinear), not below 0. */
+ * (trilinear), not below 0. For RGB too: a vector loop over the samples, each corner one
+ * gather a wavelength in the AVX2 clone, took fewer instructions than a sample's three
+ * wavelengths as one 16-byte vector (8 loads and 8 broadcast weights a sample), with the
+ * same sums in the same order (docs/lightfield.md). */
 ATMOS_CLONE_HELPER void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict ds)
 {
     fchunk fc;
@@ -420,13 +423,15 @@ ATMOS_CLONE_HELPER void eye_blend(const sjob *j, size_t p0, const echunk *e, int
                                   const float *restrict bext, const float *restrict src, const float *restrict ds,
                                   const float *restrict I1)
 {
-    float Tq[CH], Cq[CH], Sq[CH], Lq[CH], Eq[CH];
-    /* the in-scattering; the field's added by a loop of its own: a test of ds inside the loop
-     * became a masked load from the null pointer, whose every lane masked off still cost a
-     * microcode assist per vector (a quarter of the eye pass without the field) */
-    for (int q = 0; q < e->mv; q++) Sq[q] = 0.0f;
-    if (ds)
-        for (int q = 0; q < e->mv; q++) Sq[q] = ds[q];
+    float Tq[CH], Cq[CH], S0[CH], Lq[CH], Eq[CH];
+    /* the in-scattering: the field's, or zeros chosen before the loop (a test of ds inside the
+     * loop became a masked load from the null pointer, whose every lane masked off still cost a
+     * microcode assist per vector: a quarter of the eye pass without the field) */
+    const float *restrict Sq = ds;
+    if (!ds) {
+        for (int q = 0; q < e->mv; q++) S0[q] = 0.0f;
+        Sq = S0;
+    }
     for (int q = 0; q < e->mv; q++) {
         const float be = bext[q], tau = be * e->del[q];
         const float T = atmos__expf_poly(-tau);
@@ -483,22 +488,36 @@ ATMOS_CLONE_HELPER void eye_blend(const sjob *j, size_t p0, const echunk *e, int
  * Lane c computes what eye_bilinear and eye_optics compute for wavelength c, with the same
  * operations in the same order (the same bits); four samples' vectors are transposed into
  * the per-wavelength arrays. I3[c]: the light of wavelength c (c = 3: n, also in nsc). */
-ATMOS_CLONE_HELPER void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float (*restrict I3)[CH])
+ATMOS_CLONE_HELPER __m128 texel_rgb(const float *p, int32_t LN, __m128 w00, __m128 w10, __m128 w01, __m128 w11)
+{
+    __m128 v = _mm_mul_ps(w00, _mm_loadu_ps(p));
+    v = _mm_add_ps(v, _mm_mul_ps(w10, _mm_loadu_ps(p + 4)));
+    v = _mm_add_ps(v, _mm_mul_ps(w01, _mm_loadu_ps(p + LN)));
+    return _mm_add_ps(v, _mm_mul_ps(w11, _mm_loadu_ps(p + LN + 4)));
+}
+
+/* Jb (or NULL): a second buffer read at the same texels with the same weights (the light
+ * leaving the slab), its three wavelengths into J3 (its n is not stored). */
+ATMOS_CLONE_HELPER void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float (*restrict I3)[CH],
+                                      const float *Jb, float (*restrict J3)[CH])
 {
     const int32_t LN = j->L * 4;
     for (int q0 = 0; q0 < e->mv; q0 += 4) {
-        __m128 r[4];
+        __m128 r[4], s[4];
         for (int i = 0; i < 4; i++) {
             const int q = q0 + i;
-            const float *p = Ib + e->lt[q];
-            __m128 v = _mm_mul_ps(_mm_set1_ps(e->w00[q]), _mm_loadu_ps(p));
-            v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(e->w10[q]), _mm_loadu_ps(p + 4)));
-            v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(e->w01[q]), _mm_loadu_ps(p + LN)));
-            r[i] = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(e->w11[q]), _mm_loadu_ps(p + LN + 4)));
+            const __m128 w00 = _mm_set1_ps(e->w00[q]), w10 = _mm_set1_ps(e->w10[q]);
+            const __m128 w01 = _mm_set1_ps(e->w01[q]), w11 = _mm_set1_ps(e->w11[q]);
+            r[i] = texel_rgb(Ib + e->lt[q], LN, w00, w10, w01, w11);
+            if (Jb) s[i] = texel_rgb(Jb + e->lt[q], LN, w00, w10, w01, w11);
         }
         _MM_TRANSPOSE4_PS(r[0], r[1], r[2], r[3]);
         for (int c = 0; c < 3; c++) _mm_storeu_ps(I3[c] + q0, r[c]);
         _mm_storeu_ps(e->nsc + q0, r[3]);
+        if (Jb) {
+            _MM_TRANSPOSE4_PS(s[0], s[1], s[2], s[3]);
+            for (int c = 0; c < 3; c++) _mm_storeu_ps(J3[c] + q0, s[c]);
+        }
     }
 }
 
@@ -545,47 +564,17 @@ ATMOS_CLONE_HELPER void eye_rgb_optics(const sjob *j, const echunk *e, float (*r
     }
 }
 
-/* eye_field for RGB: a cell's view of a field is one 16-byte vector (fvq 4), so a sample's
- * three wavelengths are 8 vector loads per live field. */
-ATMOS_CLONE_HELPER void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e, float (*restrict ds3)[CH])
-{
-    fchunk fc;
-    eye_field_cells(j, k, p0, e, &fc);
-    const int nf = j->nf;
-    const int32_t sx = fc.st[0], sy = fc.st[1], sz = fc.st[2];
-    const int32_t o8[8] = {0, sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz};
-    const __m128 zero = _mm_setzero_ps();
-    /* the fields outside, the samples inside: a field's test once a chunk (each sample's sum over
-       the fields in the same order) */
-    __m128 acc[CH];
-    for (int q = 0; q < e->mv; q++) acc[q] = zero;
-    for (int f = 0; f < nf; f++) {
-        if (!e->live[f]) continue;
-        const float *restrict V = j->fview + f * 4, *restrict d = e->dens + f * CH;
-        for (int q = 0; q < e->mv; q++) {
-            const float *p = V + fc.cell[q];
-            __m128 v = _mm_mul_ps(_mm_set1_ps(fc.w[0][q]), _mm_loadu_ps(p));
-            for (int x = 1; x < 8; x++) v = _mm_add_ps(v, _mm_mul_ps(_mm_set1_ps(fc.w[x][q]), _mm_loadu_ps(p + o8[x])));
-            acc[q] = _mm_add_ps(acc[q], _mm_mul_ps(_mm_set1_ps(d[q] > 0.0f ? d[q] : 0.0f), v));
-        }
-    }
-    for (int q0 = 0; q0 < e->mv; q0 += 4) {
-        __m128 r[4];
-        for (int i = 0; i < 4; i++) r[i] = _mm_max_ps(acc[q0 + i], zero);
-        _MM_TRANSPOSE4_PS(r[0], r[1], r[2], r[3]);
-        for (int c = 0; c < 3; c++) _mm_storeu_ps(ds3[c] + q0, r[c]);
-    }
-}
-
 /* The light, the optics and the blend of an RGB chunk. */
 ATMOS_CLONE_HELPER void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib, const float *In)
 {
-    float I3[4][CH], be3[3][CH], src3[3][CH], ds3[4][CH], J3[4][CH];
-    if (j->low_albedo) eye_rgb_light(j, e, In, J3); /* the light leaving the slab (its n overwritten next) */
-    eye_rgb_light(j, e, Ib, I3);
+    float I3[4][CH], be3[3][CH], src3[3][CH], ds3[3][CH], J3[3][CH];
+    if (j->low_albedo) /* and the light leaving the slab, read at the same texels */
+        eye_rgb_light(j, e, Ib, I3, In, J3);
+    else
+        eye_rgb_light(j, e, Ib, I3, NULL, J3);
     eye_orders(j, p0, e);
     eye_rgb_optics(j, e, be3, src3);
-    if (j->field) eye_rgb_field(j, k, p0, e, ds3);
+    if (j->field) eye_field(j, k, p0, e, &ds3[0][0]);
     for (int c = 0; c < 3; c++)
         eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], j->field ? ds3[c] : NULL, j->low_albedo ? J3[c] : NULL);
 }
