@@ -110,7 +110,7 @@ void atmos__nishita_columns(atmos__nishita_plan *np, const double sun_g[3], int 
 atmos_status atmos__nishita_field_update(atmos_plan *p, const double sun_w[3], const double eye_w[3]);
 
 /* Trilinear value of m floats per voxel of a render-grid array at render-voxel coordinate
- * (u, v, w) (voxel centres at integers; clamped into the grid; nishita_render.c). */
+ * (u, v, w) (voxel centres at integers; clamped into the grid; nishita_grid.c). */
 void atmos__nishita_grid_at(const sgrid *g, const float *arr, int m, double u, double v, double w, float *out);
 /* What the volume's shadow takes from the air's single scattering along the eye ray cam + t d
  * (world; eye_g + t dg in the grid frame), t in [s0, s1], per wavelength into D; the sun sun_w
