@@ -15,6 +15,7 @@
 #include "render/beams_tiles.h"
 #include "render/plan_internal.h"
 
+#include <math.h>
 #include <string.h>
 
 /* The pre-integrated scattering of a point light toward the eye (Dobashi Eq. 8-9, with the
@@ -152,6 +153,13 @@ double atmos__beams_ray_light_sum_split(const atmos__beams_ray *r, double ta, do
  * are that tint times atmos__beams_ray_light_sum, runs the shadow map's tiles prove dark
  * nothing; the rest halved, down to 8 samples read one by one. */
 void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double step, double o, int s0, int s1, double h[3]);
+/* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
+ * max_sub (the renderer's and the stained glass's intervals alike). */
+ATMOS_CLONE_HELPER int atmos__beams_subplanes(double fl, double unit, int max_sub)
+{
+    const double need = ceil(fl / unit);
+    return need < 1 ? 1 : need > max_sub ? max_sub : (int)need;
+}
 /* A spot with an image (stained glass) over the ray's n intervals f (beams_render.c's layout:
  * f[2k], f[2k + 2] the ends of interval k, f[2k + 1] its f_l): each interval whose f_l > 0 gets
  * ceil(f_l / unit) sub-planes (at most max_sub), their samples at offset o, whose tinted sum

@@ -240,14 +240,6 @@ static double base_light(const job *J, int x, int y, const double d[3], const at
     return fog_t;
 }
 
-/* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
- * the scene's max_subplanes. */
-ATMOS_CLONE_HELPER int subplanes(const job *J, double fl, double unit)
-{
-    const double need = ceil(fl / unit);
-    return need < 1 ? 1 : need > J->max_sub ? J->max_sub : (int)need;
-}
-
 /* The sub-planes of a light with an image (stained glass): as in airlight() below, with the
  * image's tint at every sample (atmos__beams_ray_tinted, beams_tint.c: where it is one colour
  * along a run of them, that colour times the light's sum), so no interval is taken as uniform by
@@ -415,7 +407,7 @@ ATMOS_CLONES static int interval(job *J, const atmos__beams_ray *ray, const doub
                                  int centre, double o)
 {
     const double fl = f[2 * k + 1];
-    const int m = subplanes(J, fl, unit);
+    const int m = atmos__beams_subplanes(fl, unit, J->max_sub);
     const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
     double h = 0, same = 0;
     int full = 0;

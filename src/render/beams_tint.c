@@ -124,14 +124,6 @@ void atmos__beams_ray_tinted_sum(const atmos__beams_ray *r, double ta, double st
     tinted_sum(r, ta, step, o, s0, s1, LIGHT_UNKNOWN, h);
 }
 
-/* Dobashi's sub-planes of an interval whose f_l is fl: ceil(fl / unit), at least 1, at most
- * max_sub (beams_render.c's subplanes(), the same value). */
-ATMOS_CLONE_HELPER int tinted_subplanes(double fl, double unit, int max_sub)
-{
-    const double need = ceil(fl / unit);
-    return need < 1 ? 1 : need > max_sub ? max_sub : (int)need;
-}
-
 /* An AVX2 clone (the same operations: ceil and floor a rounding instruction each there, where the
  * baseline spells them out; the call to tinted_sum a direct one). */
 ATMOS_CLONES int atmos__beams_ray_tinted(const atmos__beams_ray *r, const double *f, int n, double unit, int max_sub,
@@ -144,7 +136,7 @@ ATMOS_CLONES int atmos__beams_ray_tinted(const atmos__beams_ray *r, const double
     for (int k = 0; k < n; k++) {
         const double fl = f[2 * k + 1];
         if (fl <= 0) continue;
-        const int m = tinted_subplanes(fl, unit, max_sub);
+        const int m = atmos__beams_subplanes(fl, unit, max_sub);
         count += m;
         if (!some || f[2 * k + 2] < p0 || f[2 * k] > p1) continue; /* black all along: counted, not sampled */
         const double ta = f[2 * k], step = (f[2 * k + 2] - ta) / m;
