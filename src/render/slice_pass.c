@@ -484,7 +484,10 @@ ATMOS_CLONE_HELPER void eye_blend(const sjob *j, size_t p0, const echunk *e, int
  * Ams tables are read by whole-vector loads rather than one gathered lane per wavelength.
  * Lane c computes what eye_bilinear and eye_optics compute for wavelength c, with the same
  * operations in the same order (the same bits); four samples' vectors are transposed into
- * the per-wavelength arrays. I3[c]: the light of wavelength c (c = 3: n, also in nsc). */
+ * the per-wavelength arrays. */
+
+/* A sample's bilinear read of a light buffer: the four texels at p, p + 4, p + LN, p + LN + 4
+ * (each I_r, I_g, I_b, n), weighted and summed in that order. */
 ATMOS_CLONE_HELPER __m128 texel_rgb(const float *p, int32_t LN, __m128 w00, __m128 w10, __m128 w01, __m128 w11)
 {
     __m128 v = _mm_mul_ps(w00, _mm_loadu_ps(p));
@@ -493,8 +496,9 @@ ATMOS_CLONE_HELPER __m128 texel_rgb(const float *p, int32_t LN, __m128 w00, __m1
     return _mm_add_ps(v, _mm_mul_ps(w11, _mm_loadu_ps(p + LN + 4)));
 }
 
-/* Jb (or NULL): a second buffer read at the same texels with the same weights (the light
- * leaving the slab), its three wavelengths into J3 (its n is not stored). */
+/* I3[c]: the light of wavelength c of buffer Ib (c = 3: n, also in nsc); Jb (or NULL): a second
+ * buffer read at the same texels with the same weights (the light leaving the slab), its three
+ * wavelengths into J3 (its n is not stored). */
 ATMOS_CLONE_HELPER void eye_rgb_light(const sjob *j, echunk *e, const float *Ib, float (*restrict I3)[CH],
                                       const float *Jb, float (*restrict J3)[CH])
 {
