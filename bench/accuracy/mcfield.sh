@@ -31,6 +31,7 @@ CELL=${CELL:-4}
 LMAX=${LMAX:--1}
 DM=$([ "${DELTA_M:-0}" = 1 ] && echo "--nishita-mc-delta-m" || echo "")
 DO=$([ "${DO:-0}" = 1 ] && echo "--nishita-do" || echo "")
+OFF="$([ -z "$DM" ] && echo "-D nishita.mc_delta_m=false") $([ -z "$DO" ] && echo "-D nishita.do=false")" # both on by default
 DMC=$([ -n "$DM" ] && [ "${DM_CLIP:-0}" = 1 ] && echo "--nishita-mc-dm-clip" || echo "")
 if [ "${SLICE_DO:-0}" = 1 ]; then
     TAG=${TAG:-sdo$CELL$([ "${EYE_SCALE:-1}" = 2 ] && echo aa || echo "")}
@@ -38,7 +39,7 @@ if [ "${SLICE_DO:-0}" = 1 ]; then
 else
     TAG=${TAG:-$([ -n "$DO" ] && echo do || echo mc)${CELL}_$LMAX${DM:+dm}${DMC:+c}}
     R="--renderer nishita --nishita-orders 1 --no-nishita-sky --nishita-mc $K --nishita-mc-cell $CELL \
---nishita-mc-lmax $LMAX $DM $DMC $DO"
+--nishita-mc-lmax $LMAX $DM $DMC $DO $OFF"
 fi
 TH=${THREADS:+--threads $THREADS}
 mkdir -p "$OUT"

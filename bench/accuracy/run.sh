@@ -10,7 +10,8 @@
 # Environment: ATMOS (the binary, default build/atmos), SPP (path samples per pixel,
 # default 1024), TRUNCATE (the path tracer's forward-peak cut, degrees, default 3; 0 = exact),
 # CASES (default "cumulus cirrus rain disney"; also harris_cumulus, Harris's particle cumulus),
-# VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer, "harris",
+# VARIANTS (default all of the slice variants below; "nishita": the Nishita renderer as the paper
+# wrote it (its do field, the default since 2026-12-07, off), "harris",
 # "harris_sun": Harris's (with the diffuse light field, its default since 2026-12-06), the
 # Nishita renderer with that field, "nishita_diffuse", Harris's forward shading alone (Harris
 # 2002, its default before), "harris_forward", "harris_sun_forward"; "diffuse": the P1 field, --slice-p1; "diffuse_aa": the
@@ -81,10 +82,10 @@ for c in $CASES; do
             nishita_do) opts="--renderer nishita --nishita-orders 1 --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do" ;;
             nishita_do_nosky) opts="--renderer nishita --nishita-orders 1 --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do \
 --no-nishita-sky" ;;
-            nishita) opts="--renderer nishita" ;;
+            nishita) opts="--renderer nishita -D nishita.do=false -D nishita.mc_delta_m=false" ;; # as written
             harris) opts="--renderer harris" ;;
             harris_sun) opts="--renderer harris --sky-lights 0" ;;
-            nishita_diffuse) opts="--renderer nishita --nishita-diffuse" ;;
+            nishita_diffuse) opts="--renderer nishita --nishita-diffuse -D nishita.do=false -D nishita.mc_delta_m=false" ;;
             harris_forward) opts="--renderer harris --no-harris-diffuse" ;;
             harris_sun_forward) opts="--renderer harris --sky-lights 0 --no-harris-diffuse" ;;
             esac

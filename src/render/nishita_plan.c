@@ -133,9 +133,10 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     }
     const atmos_scene_nishita *sn = &p->scene.nishita;
     if (st == ATMOS_OK && np->g.v && (sn->mc_kphotons > 0 || sn->do_field)) st = atmos__nishita_mc_create(p, np);
-    if (sn->mc_delta_m && ((sn->mc_kphotons <= 0 && !sn->do_field) || (sn->mc_lmax < 0 && !sn->do_field)))
-        atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_delta_m does nothing without a Monte Carlo field in spherical "
-                                        "harmonics (mc_kphotons > 0 and mc_lmax >= 0)");
+    /* (on by default for the do field: without any field, as the paper's method, it is not used) */
+    if (sn->mc_delta_m && sn->mc_kphotons > 0 && sn->mc_lmax < 0 && !sn->do_field)
+        atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_delta_m does nothing with a Monte Carlo field toward the view "
+                                        "alone (mc_lmax -1): it needs spherical harmonics (mc_lmax >= 0)");
     if (sn->mc_dm_clip && !sn->mc_delta_m)
         atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_dm_clip does nothing without mc_delta_m (it clips the photons' "
                                         "delta-M scaled phase)");

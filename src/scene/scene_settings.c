@@ -89,7 +89,8 @@ static const atmos_setting path_settings[] = {
 
 static const atmos_setting nishita_settings[] = {
     {"orders", "nishita-orders", ATMOS_SETTING_INT, "", 1, 3, 0, 0, 3, NULL, 0,
-     "highest scattering order of the sunlight (1: single scattering; 2, 3: by reference patterns)",
+     "with do off, the highest scattering order of the sunlight (1: single scattering; 2, 3: by reference "
+     "patterns)",
      NISHITA(orders)},
     {"ratio", "nishita-ratio", ATMOS_SETTING_REAL, "", 0, 1, 1, 0, 0.95, NULL, 0,
      "the share r of the sample space's contribution the reference patterns keep", NISHITA(ratio)},
@@ -116,13 +117,15 @@ static const atmos_setting nishita_settings[] = {
     {"mc_lmax", "nishita-mc-lmax", ATMOS_SETTING_INT, "", -1, 3, 0, 0, -1, NULL, 0,
      "the Monte Carlo field's angles: -1 = toward the view's centre only; 0-3 = spherical harmonics "
      "of this degree", NISHITA(mc_lmax)},
-    {"mc_delta_m", "nishita-mc-delta-m", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
-     "with mc_lmax >= 0: the photons and the field's part of the eye rays in the delta-M scaled medium "
-     "of that degree (its forward peak above the degree counted as not scattered)",
+    {"mc_delta_m", "nishita-mc-delta-m", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 1,
+     "on by default; with mc_lmax >= 0: the photons and the field's part of the eye rays in the delta-M "
+     "scaled medium of that degree (its forward peak above the degree counted as not scattered)",
      NISHITA(mc_delta_m)},
-    {"do", "nishita-do", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
-     "the field of the orders >= 2 in spherical harmonics (degree mc_lmax, 3 if -1) solved by discrete "
-     "ordinates on its cells, not by photons (docs/lightfield.md)",
+    {"do", "nishita-do", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 1, NULL, 1,
+     "on by default: the field of every order >= 2 and the sky's light in spherical harmonics (degree "
+     "mc_lmax, 3 if -1) solved by discrete ordinates on its cells, not by photons (docs/lightfield.md); "
+     "-D nishita.do=false -D nishita.mc_delta_m=false: Nishita 1996 as written, orders 2-3 by reference "
+     "patterns and sky elements, which lose most of a dense cloud's light",
      NISHITA(do_field)},
     {"mc_dm_clip", "nishita-mc-dm-clip", ATMOS_SETTING_BOOL, "", 0, 1, 0, 0, 0, NULL, 1,
      "with mc_delta_m: the photons sample the scaled phase exactly (the cut phase, its peak clipped until "

@@ -10,7 +10,10 @@
 #    warned of;
 #  - a point light without range_m reaches where its airlight falls to 1e-3 of its value 1 m from
 #    it: no glowing ball with a hard edge, the image within 5 % of the path tracer's single
-#    scattering (the former default, 100 m, gave 0.45 of it, 0.1 at the image's edges).
+#    scattering (the former default, 100 m, gave 0.45 of it, 0.1 at the image's edges);
+#  - the example scene of docs/scene-format.md's `beams` section (its camera was missing, so
+#    it rendered black) shows the beam: light in the image's top third (the cone below the lamp)
+#    and in its bottom third (the lit floor), over 5 % of the pixels in all (about 11 %).
 . "$(dirname "$0")/common.inc"
 cd "$T" || exit 1
 cat >hemi.json <<'JSON'
@@ -78,5 +81,25 @@ edge = lambda v: sum(v[i] for i in range(len(v)) if i % w < w // 8 or i % w >= w
 m, e = sum(g) / sum(r), edge(g) / edge(r)
 print("beams / path: mean %.4f, the outer eighths %.4f" % (m, e))
 sys.exit(0 if abs(m - 1) < 0.05 and abs(e - 1) < 0.15 else 1)
+PY
+S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
+python3 - "$S/docs/scene-format.md" >doc.json <<'PY' || bad "no json block in scene-format.md's beams section"
+import sys, re
+text = open(sys.argv[1], encoding="utf-8").read()
+sec = text.split("\n## `beams`", 1)[1].split("\n## ", 1)[0]
+m = re.search(r"```json\n(.*?)```", sec, re.S)
+sys.exit(1) if not m else print(m.group(1))
+PY
+"$A" render doc.json --width 48 --height 32 -o doc.pfm -q 2>d1 || bad "the docs' beams example: $(cat d1)"
+python3 - doc.pfm <<'PY' && ok "the docs' beams example shows its beam and the floor" || bad "the docs' beams example"
+import sys, pfm
+b = pfm.read(sys.argv[1])
+g, w, h = b.v[1::3], b.w, b.h
+lit = sum(1 for v in g if v > 0) / len(g)
+band = lambda y0, y1: sum(1 for i in range(y0 * w, y1 * w) if g[i] > 0)
+# pfm rows run bottom to top
+top, bottom = band(h - h // 3, h), band(0, h // 3)
+print("pixels with light: %.3f; in the top third %d, the bottom third %d" % (lit, top, bottom))
+sys.exit(0 if lit > 0.05 and top > 0 and bottom > 0 else 1)
 PY
 exit $fail

@@ -24,12 +24,12 @@ open(sys.argv[1] + "/v.raw", "wb").write(struct.pack("<%df" % len(vals), *vals))
 open(sys.argv[1] + "/v.json", "w").write('{"file": "v.raw", "dims": [12, 12, 12], "voxel_size_m": 40, "particle": "air"}')
 PY
 
-# The base command of each renderer: tiny images, one thread (Nishita's: orders 1-2 on a coarse
-# light field, a tenth of the time).
+# The base command of each renderer: tiny images, one thread (Nishita's: the paper's method, its
+# default do field off, orders 1-2 on a coarse light field, a tenth of the time).
 base() {
     case $1 in
     beams) echo "$S/scenes/dobashi_fig04_spotlight.json --width 24 --height 36" ;;
-    nishita) echo "--volume $T/v.json --renderer nishita --width 10 --height 8 -D nishita.orders=2 -D nishita.cells=4 -D nishita.paths=4" ;;
+    nishita) echo "--volume $T/v.json --renderer nishita --width 10 --height 8 -D nishita.orders=2 -D nishita.cells=4 -D nishita.paths=4 -D nishita.do=false -D nishita.mc_delta_m=false" ;;
     *) echo "--volume $T/v.json --renderer $1 --width 10 --height 8" ;;
     esac
 }
@@ -136,8 +136,9 @@ a=$(png_scale "$T/auto_opt.png") b=$(png_scale "$T/auto_def.png")
 if [ -n "$a" ] && [ "$a" = "$b" ]; then ok "--exposure auto = -D output.exposure=auto (scale $a)"; else bad "--exposure auto scale $a, -D form $b"; fi
 # an option that does nothing on its own says so
 # shellcheck disable=SC2046
-"$A" render $(base nishita) -q --nishita-mc-delta-m -o "$T/dm.png" 2>"$T/dm.err" || bad "render --nishita-mc-delta-m"
-grep -q "mc_delta_m does nothing" "$T/dm.err" && ok "--nishita-mc-delta-m without a field warns" || bad "no warning: $(cat "$T/dm.err")"
+"$A" render $(base nishita) -q --nishita-mc 1 --nishita-mc-delta-m -o "$T/dm.png" 2>"$T/dm.err" || bad "render --nishita-mc-delta-m"
+grep -q "mc_delta_m does nothing" "$T/dm.err" && ok "--nishita-mc-delta-m with photons toward the view alone warns" ||
+    bad "no warning: $(cat "$T/dm.err")"
 # shellcheck disable=SC2046
 "$A" render $(base nishita) -q --nishita-mc-dm-clip -o "$T/clip.png" 2>"$T/clip.err" || bad "render --nishita-mc-dm-clip"
 grep -q "mc_dm_clip does nothing without mc_delta_m" "$T/clip.err" && ok "--nishita-mc-dm-clip without delta-M warns" ||

@@ -8,7 +8,9 @@
  *  - A dense blob (optical depth ~20 through its centre, HG 0.85, albedo 1, a vacuum: the
  *    sun's light alone), the sun behind the camera and in front of it: with the field the
  *    mean over the cloud's pixels within a bound of the path tracer's, without it far darker
- *    (orders 1-3 lose most of a dense cloud's light, docs/accuracy.md).
+ *    (orders 1-3 lose most of a dense cloud's light, docs/accuracy.md). Nishita's default render
+ *    (since 2026-12-07 its discrete-ordinates field of every order, not this option) within 15 %
+ *    of the path tracer's: -13.7 % / -11.8 % (sun behind / in front) on this blob.
  *  - A thin blob under Riley's sky (optical depth ~0.2 through its centre): the field is
  *    faded out, the image with the option equals the image without it to 1 %.
  * Measured (the sun behind the camera / in front, relative bias over the cloud's pixels): Nishita
@@ -27,6 +29,9 @@
  * tracer's noise at 64 paths is about 1 % of the mean over the cloud. */
 #define BOUND_BEHIND 0.3
 #define BOUND_FRONT 0.1
+/* Nishita's default, its discrete-ordinates field, on this blob's few cells (the cells of 4
+ * voxels over a 32^3 blob; on the accuracy bench's clouds within 5 %, docs/accuracy.md) */
+#define BOUND_NISHITA_DEFAULT 0.15
 
 static char cache_dir[1024];
 
@@ -54,7 +59,10 @@ static atmos_image *render(atmos_context *ctx, const atmos_scene *sc, const atmo
 {
     atmos_scene s = *sc;
     s.renderer = renderer;
-    if (diffuse >= 0) s.nishita.diffuse = s.harris.diffuse = diffuse; /* -1: the scene's default */
+    if (diffuse >= 0) { /* -1: the scene's default; else Nishita's orders 1-3 (its do field off), the option on or off */
+        s.nishita.diffuse = s.harris.diffuse = diffuse;
+        s.nishita.do_field = 0, s.nishita.mc_delta_m = 0;
+    }
     return test_plan_frame(ctx, &s, v, &op->o);
 }
 
@@ -97,14 +105,19 @@ static void dense_side(atmos_context *ctx, const atmos_volume *v, const test_opt
     printf("%s, %s: %d cloud pixels; against the path tracer, with the field %+.1f %%, without %+.1f %%\n",
            atmos_renderer_name(renderer), name, cnt, 100 * *with_bias, 100 * *without_bias);
     CHECK(cnt > 150);
-    if (renderer == ATMOS_RENDERER_HARRIS) { /* the field is Harris's default: the same image */
-        atmos_image *def = render(ctx, &s, v, op, renderer, -1);
-        const double d = cloud_sum(ref, def, &cnt) / r - 1;
-        printf("%s, %s: the default %+.1f %%\n", atmos_renderer_name(renderer), name, 100 * d);
+    /* the default render: Harris's is the one with the field (the same image); Nishita's is its
+     * discrete-ordinates field of every order (not this option), within the same bounds */
+    atmos_image *def = render(ctx, &s, v, op, renderer, -1);
+    const double d = cloud_sum(ref, def, &cnt) / r - 1;
+    printf("%s, %s: the default %+.1f %%\n", atmos_renderer_name(renderer), name, 100 * d);
+    if (renderer == ATMOS_RENDERER_HARRIS) {
         CHECK(fabs(d) < (sun_azimuth == 0 ? BOUND_FRONT : BOUND_BEHIND));
         CHECK(fabs(d - *with_bias) < 1e-6);
-        atmos_image_destroy(def);
+    } else {
+        CHECK(fabs(d) < BOUND_NISHITA_DEFAULT);
+        CHECK(fabs(d) < fabs(*without_bias) / 3); /* not the paper's orders 1-3, which lose most of it */
     }
+    atmos_image_destroy(def);
     atmos_image_destroy(with), atmos_image_destroy(without);
 }
 
