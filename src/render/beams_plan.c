@@ -74,7 +74,7 @@ atmos_status atmos__beams_plan_create(atmos_plan *p, atmos__beams_plan **out)
     atmos__beams_plan *b = calloc(1, sizeof *b);
     if (!b) return atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     st = atmos__objects_load(p->ctx, s, &p->wl, &b->obj);
-    if (st == ATMOS_OK) atmos__objects_warn_enclosed_lights(p->ctx, s, &b->obj);
+    if (st == ATMOS_OK) atmos__objects_warn_dark_lights(p->ctx, s, &b->obj);
     if (st == ATMOS_OK && !(b->lights = calloc((size_t)s->light_count, sizeof *b->lights)))
         st = atmos__error(p->ctx, ATMOS_E_NOMEM, "render beams: out of memory");
     double range = 0;

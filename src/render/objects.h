@@ -18,9 +18,9 @@ typedef struct atmos__objects {
 atmos_status atmos__objects_load(atmos_context *ctx, const atmos_scene *s, const atmos_wavelengths *wl,
                                  atmos__objects *o);
 void atmos__objects_free(atmos__objects *o);
-/* Warns (once a light) of each of the scene's lights inside a closed mesh (objects_lights.c);
- * called by the renderers that draw the scene's lights. */
-void atmos__objects_warn_enclosed_lights(atmos_context *ctx, const atmos_scene *s, const atmos__objects *o);
+/* Warns of each of the scene's lights that lights nothing: inside a closed mesh, or a spot of no
+ * angle (objects_lights.c); called by the renderers that draw the scene's lights. */
+void atmos__objects_warn_dark_lights(atmos_context *ctx, const atmos_scene *s, const atmos__objects *o);
 
 /* The nearest hit of the ray o + t d, t in (tmin, tmax), over all the meshes: 1 and *hit,
  * *which (the mesh) if any; with hit NULL, 1 at the first hit found (a shadow ray). */

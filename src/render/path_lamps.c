@@ -36,7 +36,7 @@ atmos_status atmos__path_lamps_build(atmos_context *ctx, const atmos_scene *s, c
     memset(L, 0, sizeof *L);
     atmos_status st = atmos__objects_load(ctx, s, wl, &L->obj);
     if (st != ATMOS_OK) return st;
-    atmos__objects_warn_enclosed_lights(ctx, s, &L->obj);
+    atmos__objects_warn_dark_lights(ctx, s, &L->obj);
     L->lamp = calloc((size_t)(s->light_count ? s->light_count : 1), sizeof *L->lamp);
     if (!L->lamp) return atmos__error(ctx, ATMOS_E_NOMEM, "render path: out of memory for the lights");
     L->nlamps = s->light_count;

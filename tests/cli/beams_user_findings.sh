@@ -14,6 +14,7 @@
 #  - the example scene of docs/scene-format.md's `beams` section (its camera was missing, so
 #    it rendered black) shows the beam: light in the image's top third (the cone below the lamp)
 #    and in its bottom third (the lit floor), over 5 % of the pixels in all (about 11 %).
+#  - a spot of cone_deg 0 and edge_deg 0 (a valid value: its image is black) is warned of.
 . "$(dirname "$0")/common.inc"
 cd "$T" || exit 1
 cat >hemi.json <<'JSON'
@@ -102,4 +103,8 @@ top, bottom = band(h - h // 3, h), band(0, h // 3)
 print("pixels with light: %.3f; in the top third %d, the bottom third %d" % (lit, top, bottom))
 sys.exit(0 if lit > 0.05 and top > 0 and bottom > 0 else 1)
 PY
+"$A" render "$S/scenes/dobashi_fig04_spotlight.json" --width 12 --height 18 -D lights.0.cone_deg=0 \
+    -D lights.0.edge_deg=0 -o z.pfm -q 2>z.err || bad "a spot of no angle: $(cat z.err)"
+grep -q "/lights/0: a spot of cone_deg 0 and edge_deg 0 lights nothing" z.err && ok "a spot of no angle is warned of" ||
+    bad "a spot of no angle: no warning ($(cat z.err))"
 exit $fail
