@@ -178,6 +178,13 @@ static inline atmos_image *test_plan_frame_rows(atmos_context *ctx, const atmos_
     return img;
 }
 
+/* The Nishita renderer as Nishita et al. 1996 wrote it (orders 2-3 by reference patterns, sky
+ * elements): its default since 2026-12-07 is the discrete-ordinates field (do, delta-M). */
+static inline void test_nishita_paper(atmos_scene *s)
+{
+    s->nishita.do_field = 0, s->nishita.mc_delta_m = 0;
+}
+
 /* test_plan_frame_rows' whole frame. */
 static inline atmos_image *test_plan_frame(atmos_context *ctx, const atmos_scene *s, const atmos_volume *v,
                                            const atmos_volume_optics *optics)

@@ -95,7 +95,7 @@ static atmos_image *nishita(atmos_context *ctx, const atmos_scene *sc, const atm
     atmos_scene s = *sc;
     s.renderer = ATMOS_RENDERER_NISHITA;
     s.nishita.orders = orders, s.nishita.sky = sky;
-    s.nishita.do_field = 0, s.nishita.mc_delta_m = 0; /* the paper's method (the default: the do field) */
+    test_nishita_paper(&s);
     s.nishita.ratio = ratio;
     return test_plan_frame(ctx, &s, v, &op->o);
 }

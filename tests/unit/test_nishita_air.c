@@ -76,7 +76,7 @@ static void scene_for(atmos_scene *s, int air_shadows)
     s->camera.fov_deg = FOV;
     s->renderer = ATMOS_RENDERER_NISHITA;
     s->nishita.orders = 1, s->nishita.sky = 0;
-    s->nishita.do_field = 0, s->nishita.mc_delta_m = 0; /* the paper's method (the default: the do field) */
+    test_nishita_paper(s);
     s->slice.air_shadows = air_shadows;
 }
 

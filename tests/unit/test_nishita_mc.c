@@ -27,7 +27,7 @@ static void scene(atmos_scene *s, double mu, int lmax)
     test_slab_scene(s, mu);
     s->renderer = ATMOS_RENDERER_NISHITA;
     s->nishita.orders = 1, s->nishita.sky = 0;
-    s->nishita.do_field = 0, s->nishita.mc_delta_m = 0; /* the paper's method (the default: the do field) */
+    test_nishita_paper(s);
     s->nishita.mc_kphotons = 100, s->nishita.mc_cell = 1, s->nishita.mc_lmax = lmax;
 }
 
