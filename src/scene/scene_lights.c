@@ -146,10 +146,11 @@ static atmos_status check_object(atmos_context *ctx, const char *source, const a
     }
     if ((st = check3(ctx, source, at, "position_m", o->position_m, &atmos__r_pos))) return st;
     if ((st = check3(ctx, source, at, "scale", o->scale, &r_scale))) return st;
+    const int uniform = o->scale[0] == o->scale[1] && o->scale[1] == o->scale[2]; /* one number, or three alike */
     for (int a = 0; a < 3; a++)
         if (o->scale[a] == 0) {
             char path[96];
-            snprintf(path, sizeof path, "%s/scale/%d", at, a);
+            snprintf(path, sizeof path, uniform ? "%s/scale" : "%s/scale/%d", at, a);
             return atmos__scene_fail(ctx, ATMOS_E_INVALID_ARG, source, path, "must not be zero");
         }
     if ((st = check3(ctx, source, at, "rotation_deg", o->rotation_deg, &r_rot))) return st;

@@ -300,6 +300,7 @@ static const bad_case bad_lights[] = {
     {"{\"objects\": [{\"position_m\": [0, 0, 0]}]}", ATMOS_E_INVALID_ARG, "/objects/0: needs \"mesh\" or \"terrain\"", NULL},
     {"{\"objects\": [{\"mesh\": \"builtin:teapot\"}]}", ATMOS_E_INVALID_ARG, "/objects/0: mesh \"builtin:teapot\" is no built-in", NULL},
     {"{\"objects\": [{\"mesh\": \"builtin:box\", \"scale\": [1, 0, 1]}]}", ATMOS_E_INVALID_ARG, "/objects/0/scale/1: must not be zero", NULL},
+    {"{\"objects\": [{\"mesh\": \"builtin:box\", \"scale\": 0}]}", ATMOS_E_INVALID_ARG, "/objects/0/scale: must not be zero", NULL},
     {"{\"objects\": [{\"mesh\": \"builtin:box\", \"albedo\": 1.5}]}", ATMOS_E_INVALID_ARG, "/objects/0/albedo/0: must be in [0, 1]", NULL},
     {"{\"objects\": [{\"mesh\": \"builtin:box\", \"terrain\": \"generate:ridges\"}]}", ATMOS_E_INVALID_ARG, "/objects/0: needs either \"mesh\"", NULL},
     {"{\"objects\": [{\"terrain\": \"generate:dunes\", \"height_m\": 10}]}", ATMOS_E_INVALID_ARG, "terrain \"generate:dunes\" is no generator", NULL},
