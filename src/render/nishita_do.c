@@ -49,6 +49,12 @@
  * simulated cumulus -3.2 -> -6.9 %, a dense tower's brightest cell 1.6 times dimmer; 1 as the
  * voxel's own share: -17 %) */
 #define SUB_NB_TAU 16.0
+/* the share of its cell's densest sigma_s below which a voxel counts in the sub-cell term's plain
+ * mean in proportion to its sigma_s: dust, nearly empty (counted in full, voxels of less than
+ * 10^-6 of it gave a deck's cells a term by how many of them each held, a checkerboard of cells;
+ * docs/slice.md, "The deck's checkerboard"). 10^-5: the simulated cumulus moves 0.05 points,
+ * 10^-3 moved it 0.8 (within the path tracer's noise either way) */
+#define SUB_DUST 1e-5
 
 /* The volume's shadow on the air of the sky's inflow (sky_inflow.h), by the sun's columns (made
  * for sun_g before the solve) in the medium the first order and the photons see (mc_sig: the
@@ -160,17 +166,18 @@ static void neighbours(const atmos__nishita_plan *np, int n, int x, int y, int z
  * 0 to every sum: a sun's source (cell_source) visits the others alone. With cells of more than
  * one voxel, per listed voxel e and wavelength w the sun-free parts of its local radiance
  * (cell_source's sub-cell term): sub[2 (e n + w)] = h sigma_s escape(sigma_t h), and
- * sub[2 (e n + w) + 1] = SUB_NB h times its six face neighbours' sigma_s. */
+ * sub[2 (e n + w) + 1] = SUB_NB h times its six face neighbours' sigma_s; and per cell c and
+ * wavelength w dust[c n + w], SUB_DUST times the largest sigma_s of its voxels. */
 #define DO_CELL_MAX 16 /* the packing's bound on a cell's edge (nishita.mc_cell's cap) */
 struct atmos__do_cells {
-    float *st, *sub;
+    float *st, *sub, *dust;
     uint16_t *vox;
     size_t *first;
 };
 
 void atmos__do_cells_free(atmos__do_cells *dc)
 {
-    if (dc) free(dc->st), free(dc->sub), free(dc->vox), free(dc->first), free(dc);
+    if (dc) free(dc->st), free(dc->sub), free(dc->dust), free(dc->vox), free(dc->first), free(dc);
 }
 
 /* Cell (i, j, k)'s voxels holding a field's density: their count, with vox (else NULL) their
@@ -232,7 +239,7 @@ static inline size_t kept_voxel(const sgrid *g, int nf, int s, int i, int j, int
     return (((size_t)*z * g->c[1] + *y) * g->c[0] + *x) * nf;
 }
 
-/* dc->sub (struct atmos__do_cells) for the voxels listed in dc. */
+/* dc->sub and dc->dust (struct atmos__do_cells) for the voxels listed in dc. */
 static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atmos__do_cells *dc, int n, int threads)
 {
     const sgrid *g = &np->g;
@@ -243,6 +250,7 @@ static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atm
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
+                double scmax[ATMOS_MAX_WAVELENGTHS] = {0};
                 for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
                     int x, y, z;
                     const size_t v = kept_voxel(g, nf, s, i, j, k, dc->vox[e], &x, &y, &z);
@@ -254,8 +262,10 @@ static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atm
                             t += g->v[v + f] * np->mc_sig_ms[f][w], sc += g->v[v + f] * np->mc_sca[f][w];
                         dc->sub[2 * (e * n + w)] = (float)(hv * sc * escape(t * hv));
                         dc->sub[2 * (e * n + w) + 1] = (float)(hv * SUB_NB * scn[w]);
+                        scmax[w] = sc > scmax[w] ? sc : scmax[w];
                     }
                 }
+                for (int w = 0; w < n; w++) dc->dust[c * n + w] = (float)(SUB_DUST * scmax[w]);
             }
 }
 
@@ -280,7 +290,8 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
         return NULL;
     }
     cells_pass(np, F, dc, n, threads, 1);
-    if (s > 1 && !(dc->sub = malloc(sizeof(float) * 2 * n * (dc->first[cells] + 1)))) {
+    if (s > 1 && (!(dc->sub = malloc(sizeof(float) * 2 * n * (dc->first[cells] + 1))) ||
+                  !(dc->dust = malloc(sizeof(float) * n * cells)))) {
         atmos__do_cells_free(dc);
         return NULL;
     }
@@ -337,8 +348,9 @@ ATMOS_CLONE_HELPER void sun_faces(const atmos__nishita_plan *np, const size_t *v
 
 /* cell_source's sums over a block of m listed voxels (their grid indices times nf vi, their first
  * list entry e0) for wavelength w: acc[0 .. 3] += the voxels' sigma_s T_sun, sigma_s, local
- * radiance and sigma_s times it, *nv += the scattering voxels (sub: the sub-cell term's, cells of
- * more than one voxel; sg: the sun's geometry). The same operations in the same order per
+ * radiance and sigma_s times it, *nv += the scattering voxels, one of dust (sigma_s below dust) as
+ * its sigma_s / dust (sub: the sub-cell term's, cells of more than one voxel; sg: the sun's
+ * geometry). The same operations in the same order per
  * wavelength as one voxel at a time, in four loops: the medium gathered, the exponentials of
  * every voxel in one vector loop (both sides of mean_transmittance's branch, the one kept chosen
  * per voxel: the same values; a block whose voxels all take the series side, the optically thin
@@ -348,7 +360,7 @@ ATMOS_CLONE_HELPER void sun_faces(const atmos__nishita_plan *np, const size_t *v
  * well as the baseline, chosen at run time). */
 ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos__do_cells *dc, int n, int w,
                                       const size_t *vi, const int (*xyz)[3], size_t e0, int m, const float *sig,
-                                      const float *sca, const sun_geom *sg, int sub, double acc[4], int *nv)
+                                      const float *sca, const sun_geom *sg, int sub, double dust, double acc[4], double *nv)
 {
     const double len = sg->len;
     const float *gv = np->g.v, *col = np->col;
@@ -396,7 +408,8 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
         acc[0] += sc[e] * tr[e];
         if (!sub) continue; /* a voxel's cell: no spread */
         const double l1 = tr[e] * a0[e] + a1[e] * tf[e];
-        acc[2] += l1, acc[3] += sc[e] * l1, (*nv)++;
+        const double u = sc[e] < dust ? sc[e] / dust : 1; /* a voxel of dust: in proportion */
+        acc[2] += u * l1, acc[3] += sc[e] * l1, *nv += u;
     }
 }
 
@@ -412,7 +425,8 @@ ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos
  * together; with the voxel's own mean T_sun a dense voxel's neighbours looked dark); the term is the
  * mean of that weighted by sigma_s less its plain mean over the scattering voxels (an empty
  * voxel's radiance is its neighbours', not 0: counted as 0 a uniform slab's edge cells got a
- * term), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
+ * term; a voxel of dust, below SUB_DUST of the cell's densest, is nearly empty and counts in
+ * proportion), the covariance of sigma_s and the local radiance over sigma_s's mean: 0 where the
  * scattering voxels are uniform. The voxels in blocks (source_block).
  * A voxel's mean sunlight is the larger of two estimates: along the chord through its centre
  * along the sun's dominant axis (the column at the centre, mean_transmittance), and through its
@@ -444,7 +458,7 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
                 double acc[ATMOS_MAX_WAVELENGTHS][4];
-                int nv[ATMOS_MAX_WAVELENGTHS];
+                double nv[ATMOS_MAX_WAVELENGTHS];
                 for (int w = 0; w < n; w++) acc[w][0] = acc[w][1] = acc[w][2] = acc[w][3] = 0, nv[w] = 0;
                 for (size_t e0 = dc->first[c]; e0 < dc->first[c + 1]; e0 += CS_BLOCK) {
                     const int m = dc->first[c + 1] - e0 < CS_BLOCK ? (int)(dc->first[c + 1] - e0) : CS_BLOCK;
@@ -453,7 +467,8 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                     for (int e = 0; e < m; e++)
                         vi[e] = kept_voxel(g, nf, s, i, j, k, dc->vox[e0 + e], &xyz[e][0], &xyz[e][1], &xyz[e][2]);
                     for (int w = 0; w < n; w++)
-                        source_block(np, dc, n, w, vi, (const int(*)[3])xyz, e0, m, sig[w], sca[w], &sg, s > 1, acc[w],
+                        source_block(np, dc, n, w, vi, (const int(*)[3])xyz, e0, m, sig[w], sca[w], &sg, s > 1,
+                                     s > 1 ? dc->dust[c * n + w] : 0, acc[w],
                                      &nv[w]);
                 }
                 for (int w = 0; w < n; w++)

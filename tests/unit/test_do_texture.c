@@ -11,7 +11,13 @@
  * within 3 %, cells of 2 within 5 %. A random texture has no dense neighbours to speak of: what
  * it checks is the voxel's own share and that the neighbours' share adds nothing there (seen
  * with the voxel's own mean transmittance it took 5-10 % off at depth 16).
- * The uniform slabs of test_slice_do.c get no term (no spread inside a cell). */
+ * The uniform slabs of test_slice_do.c get no term (no spread inside a cell).
+ * Dust: the uniform slab with the empty voxels above and below it filled with 10^-7 of its
+ * density, which changes no radiance to speak of. Counted in full in the term's plain mean, those
+ * voxels made the image 1.4 and 1.7 % brighter (depth 4 and 16; the cells the dust shares with the
+ * slab's faces hold two of its four rows; a deck one voxel thick took tens of per cent, a
+ * checkerboard of cells, docs/slice.md); counted in proportion to their density below SUB_DUST
+ * of the cell's densest, the image is within 0.02 and 0.03 % of the clean slab's (bound 0.5 %). */
 #include "test.h"
 #include "test_optics.h"
 #include "test_slab.h"
@@ -33,6 +39,25 @@ static atmos_volume *textured_slab(atmos_context *ctx, double tau)
                 r = r * 1664525u + 1013904223u;
                 const double u = (r >> 8) / 16777216.0;
                 buf[((size_t)k * NY + j) * NX + i] = (float)(u < DENSE ? thin * RATIO : thin);
+            }
+    const int dims[3] = {NX, NY, NX};
+    atmos_volume *v = test_cloud_volume(ctx, dims, VS, buf);
+    free(buf);
+    return v;
+}
+
+/* The uniform slab of test_slab.h, of optical depth tau, its empty voxels filled with dust times
+ * its density. */
+static atmos_volume *dusty_slab(atmos_context *ctx, double tau, double dust)
+{
+    float *buf = calloc(NX * NY * NX, sizeof(float));
+    if (!buf) return NULL;
+    const float rho = (float)(tau / (SIGMA * VS * NS));
+    for (int k = 0; k < NX; k++)
+        for (int j = 0; j < NY; j++)
+            for (int i = 0; i < NX; i++) {
+                const int in = j >= (NY - NS) / 2 && j < (NY + NS) / 2;
+                buf[((size_t)k * NY + j) * NX + i] = in ? rho : (float)(dust * rho);
             }
     const int dims[3] = {NX, NY, NX};
     atmos_volume *v = test_cloud_volume(ctx, dims, VS, buf);
@@ -67,6 +92,16 @@ int main(void)
     test_hg_optics(ctx, "hg", G, 1.0, 1, &op);
     const double taus[2] = {4, 16}, mus[2] = {0.9, 0.6};
     for (int t = 0; t < 2 - TEST_SANITIZED; t++) { /* the sanitizer copy: depth 4 alone */
+        atmos_volume *vc = dusty_slab(ctx, taus[t], 0), *vd = dusty_slab(ctx, taus[t], 1e-7);
+        CHECK(vc != NULL && vd != NULL);
+        if (vc && vd) {
+            const double mc = mean_cell(ctx, &op, vc, mus[0], 4), md = mean_cell(ctx, &op, vd, mus[0], 4);
+            printf("  uniform slab tau %g, view mu %.2f, cells of 4: clean %.5f, with dust %.5f (%+.2f %%)\n", taus[t],
+                   mus[0], mc, md, 100 * (md / mc - 1));
+            CHECK(mc > 0 && fabs(md / mc - 1) < 0.005);
+        }
+        atmos_volume_destroy(vc), atmos_volume_destroy(vd);
+
         atmos_volume *v = textured_slab(ctx, taus[t]);
         CHECK(v != NULL);
         for (int a = 0; a < 2 && v; a++) {
