@@ -25,6 +25,9 @@ def ratio(p):
     return sum(v[2::3]) / sum(v[0::3])
 assert ratio(sys.argv[1]) > 1.2 * ratio(sys.argv[2]), (ratio(sys.argv[1]), ratio(sys.argv[2]))
 PY
+# --position names the altitude too: with --altitude it is refused, not silently one of the two
+"$A" render $S --altitude 5000 --position 0,500,0 -o "$T/x.png" 2> "$T/err.txt"; [ $? -eq 2 ] \
+    && grep -q "exclude each other" "$T/err.txt" && ok || bad "--altitude with --position not refused"
 # --fov and -D camera.fov_deg (dotted) and -D /camera/fov_deg (pointer) are the same
 "$A" render $S --fov 30 --pfm "$T/f1.pfm" && "$A" render $S -D camera.fov_deg=30 --pfm "$T/f2.pfm" \
     && "$A" render $S -D /camera/fov_deg=30 --pfm "$T/f3.pfm" && ok || bad "--fov / -D"

@@ -172,6 +172,9 @@ fi
 sed 's/g[12]\.json//' "$T/own" >"$T/own2"; sed 's/g[12]\.json//' "$T/render" >"$T/render2"
 [ -s "$T/own2" ] && cmp -s "$T/own2" "$T/render2" && ok "render's names read as volume's own" \
     || { bad "render's names differ:"; diff "$T/own" "$T/render" >&2; }
+# render's name keeps render's bound (0, 100]: a factor that render refuses is refused here too
+"$A" volume info "$T/g1.json" --volume-scale 500 >/dev/null 2>"$T/err"; [ $? -eq 2 ] \
+    && ok "info --volume-scale 500 refused as render refuses it" || bad "info --volume-scale 500 accepted"
 # the help texts
 "$A" render --help >"$T/err"
 hasnt "render --help" "[> 0, 2]"

@@ -308,6 +308,8 @@ static int check_options(const render_opts *o)
         return cli_usage_error(C, "--particle: expected a particle type's name");
     if (o->look_at_given && (!isnan(o->view_el) || !isnan(o->view_az)))
         return cli_usage_error(C, "--look-at and --view-elevation/--view-azimuth exclude each other");
+    if (o->position_given && !isnan(o->altitude))
+        return cli_usage_error(C, "--position (its y is the altitude) and --altitude exclude each other");
     return CLI_EXIT_OK;
 }
 
@@ -758,7 +760,7 @@ static void help_head(void)
            "                                n x n rays a pixel, n = round(sqrt(N)) (antialiasing; 1 default)\n"
            "      --camera TYPE             pinhole | fisheye (180 deg, looking up) | equirect (360x180 map);\n"
            "                                the slice and beams renderers take pinhole only, the others all\n"
-           "      --altitude M              camera altitude above sea level, metres\n"
+           "      --altitude M              camera altitude above sea level, metres (not with --position)\n"
            "      --position X,Y,Z          camera position, metres (x east, y up, z south); keeps the view\n"
            "                                direction unless --look-at is given\n"
            "      --look-at X,Y,Z           the point the camera looks at, metres\n"

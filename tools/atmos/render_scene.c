@@ -337,9 +337,10 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
             /* a value a -D gave that the scene reader refuses (the message blames the -D): the
              * options alone made it, a usage error as without a scene file; the scene file's
              * own content, or a file that cannot be read, is a runtime error */
-            const int by_define = st == ATMOS_E_INVALID_ARG && !strncmp(msg, "-D ", 3);
+            const int named = !strncmp(msg, "-D ", 3), by_define = st == ATMOS_E_INVALID_ARG && named;
             const int rc = cli_runtime_error(o->cmd, ctx, st);
-            if (def) fprintf(stderr, "  (set by -D %s, not by the scene file)\n", def);
+            /* the message names the -D already when it starts with it */
+            if (def && !named) fprintf(stderr, "  (set by -D %s, not by the scene file)\n", def);
             return by_define ? CLI_EXIT_USAGE : rc;
         }
     } else if (ndefs) {

@@ -39,9 +39,12 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
             return -1;
         }
         d->density_unit = (atmos_density_unit)k;
-    } else if (!strcmp(a, "--length-scale") || !strcmp(a, "--volume-scale")) { /* --volume-scale: render's */
-        if (!cli_parse_double(C, a, argv[++*i], &d->length_scale) || !(d->length_scale > 0 && d->length_scale <= 1e6)) {
-            cli_usage_error(C, "%s: expected a factor in (0, 1e6]", a);
+    } else if (!strcmp(a, "--length-scale") || !strcmp(a, "--volume-scale")) {
+        /* --volume-scale: render's name, with its bound (the scene's volume "scale"); --length-scale
+           the library's */
+        const double top = strcmp(a, "--volume-scale") ? 1e6 : 100;
+        if (!cli_parse_double(C, a, argv[++*i], &d->length_scale) || !(d->length_scale > 0 && d->length_scale <= top)) {
+            cli_usage_error(C, "%s: expected a factor in (0, %g]", a, top);
             return -1;
         }
     } else if (!strcmp(a, "--max-memory")) {

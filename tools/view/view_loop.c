@@ -201,7 +201,7 @@ static void say_pinhole(loop *L, const view_state *s)
     if (L->said_pinhole || view_state_camera(s, &fov) == s->camera) return;
     fprintf(stderr,
             "atmos view: the %s renderer draws pinhole cameras only: the scene's %s camera is shown as a "
-            "%.0f-degree pinhole looking the same way (the sky, nishita and path renderers show it as it is)\n",
+            "%.0f-degree pinhole looking the same way (the sky, nishita, harris and path renderers show it as it is)\n",
             atmos_renderer_name(s->renderer), camera_name(s->camera), fov);
     L->said_pinhole = 1;
 }
