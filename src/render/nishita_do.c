@@ -360,7 +360,8 @@ ATMOS_CLONE_HELPER void sun_faces(const atmos__nishita_plan *np, const size_t *v
  * well as the baseline, chosen at run time). */
 ATMOS_CLONES static void source_block(const atmos__nishita_plan *np, const atmos__do_cells *dc, int n, int w,
                                       const size_t *vi, const int (*xyz)[3], size_t e0, int m, const float *sig,
-                                      const float *sca, const sun_geom *sg, int sub, double dust, double acc[4], double *nv)
+                                      const float *sca, const sun_geom *sg, int sub, double dust, double acc[4],
+                                      double *nv)
 {
     const double len = sg->len;
     const float *gv = np->g.v, *col = np->col;
@@ -468,8 +469,7 @@ static void cell_source(const atmos__nishita_plan *np, const atmos__lfield *F, c
                         vi[e] = kept_voxel(g, nf, s, i, j, k, dc->vox[e0 + e], &xyz[e][0], &xyz[e][1], &xyz[e][2]);
                     for (int w = 0; w < n; w++)
                         source_block(np, dc, n, w, vi, (const int(*)[3])xyz, e0, m, sig[w], sca[w], &sg, s > 1,
-                                     s > 1 ? dc->dust[c * n + w] : 0, acc[w],
-                                     &nv[w]);
+                                     s > 1 ? dc->dust[c * n + w] : 0, acc[w], &nv[w]);
                 }
                 for (int w = 0; w < n; w++)
                     src[cells * w + c] = acc[w][0] * inv,
