@@ -35,6 +35,9 @@ int atmos__threads(const atmos_context *ctx);
  * it, so that samples do not pay a page walk per access. Freed with free(); NULL when
  * out of memory. */
 void *atmos__big_alloc(size_t bytes);
+/* The bytes atmos__big_alloc(bytes) holds (whole 2 MB pages where large): a buffer that grows
+ * may use them all before it is made again. */
+size_t atmos__big_size(size_t bytes);
 /* Monotonic wall-clock time in seconds (for timings and time budgets only). */
 double atmos__now(void);
 /* The k-th smallest (0: the least) of n floats, none NaN (select.c); reorders v. k < n. */
