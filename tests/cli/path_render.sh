@@ -44,7 +44,7 @@ PY
 "$A" render $P --spp 1000000 --time-budget 0.2 --threads 2 --pfm "$T/t.pfm" 2> "$T/t.log" && ok || bad "--time-budget"
 grep -q "path: [0-9]* spp" "$T/t.log" && ! grep -q "path: 1000000 spp" "$T/t.log" && ok || bad "--time-budget did not stop early"
 # bad values: usage errors exit 2
-for args in "--spp 0" "--spp 1000001" "--time-budget -1" "--seed x" "--threads 0" "--truncate 21" "--truncate -1"; do
+for args in "--spp 0" "--spp 1000001" "--time-budget -1" "--seed x" "--seed 9007199254740993" "--threads 0" "--truncate 21" "--truncate -1"; do
     "$A" render -q $P $args -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "'$args' should exit 2"
 done
 "$A" render -q --order "$T/o.pfm" -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--order without --renderer path should exit 2"

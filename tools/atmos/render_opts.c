@@ -112,7 +112,7 @@ static int parse_setting(const char *C, const atmos_setting *s, const char *text
     if (s->type == ATMOS_SETTING_SEED) {
         char *end = NULL;
         unsigned long long v = strtoull(text, &end, 10);
-        if (!*text || *end || text[0] == '-' || (double)v > s->max) {
+        if (!*text || *end || text[0] == '-' || v > (unsigned long long)s->max) { /* compared as integers: 2^53 + 1 is not 2^53 */
             cli_usage_error(C, "%s: expected an integer in [0, %.0f], got '%s'", opt, s->max, text);
             return 0;
         }
