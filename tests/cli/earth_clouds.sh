@@ -50,6 +50,10 @@ set +e
 grep -q "ground_map" "$T/err.txt" || fail "missing map message"
 "$A" volume clouds "$T/bad.json" -o "$T/x.json" 2> /dev/null; [ $? -eq 1 ] || fail "volume clouds on a bad scene"
 "$A" volume clouds; [ $? -eq 2 ] || fail "usage exit"
+# -o naming the scene itself: refused before anything is written, the scene kept
+cp "$T/earth.json" "$T/self.json"
+"$A" volume clouds "$T/self.json" -o "$T/self.json" 2> "$T/err.txt"; [ $? -eq 2 ] || fail "-o over the scene: exit"
+grep -q "refusing to overwrite an input" "$T/err.txt" && cmp -s "$T/self.json" "$T/earth.json" || fail "-o over the scene: $(cat "$T/err.txt")"
 # too many voxels across: an option's mistake (exit 2, before the scene is read), with the count
 # it would give and the bound, as volume generate's; the bound is in volume --help
 "$A" volume clouds "$T/earth.json" -o "$T/x.json" --voxel-size 1 2> "$T/err.txt"; [ $? -eq 2 ] || fail "voxel count exit"

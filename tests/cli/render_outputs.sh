@@ -123,6 +123,16 @@ cmp -s "$T/fs/keep.exr" "$T/fs/keep0.exr" && ok || bad "the EXR was replaced tho
 [ $rc -eq 2 ] && grep -q "same file" "$T/err" && [ ! -e "$T/d.pfm" ] && ok || bad "the same PFM twice: rc $rc"
 "$A" render -q $P --pfm "$T/d.pfm" --tau "$T/d.pfm" 2>/dev/null; [ $? -eq 2 ] && [ ! -e "$T/d.pfm" ] && ok || bad "--pfm X --tau X"
 "$A" render -q $S -o "$T/d.exr" --exr "$T/d.exr" 2>/dev/null; [ $? -eq 2 ] && ok || bad "-o X.exr --exr X.exr"
+# the files a scene reads are inputs too: a light's image and a height map (the beams scenes)
+SRC=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
+cp "$SRC/scenes/dobashi_fig09b_window.png" "$T/win.png"; cp "$T/win.png" "$T/win0.png"; cp "$T/win.png" "$T/hm.png"
+"$A" render -q "$SRC/scenes/dobashi_fig09b_stained_glass.json" $S -D "lights.0.image=$T/win.png" -o "$T/win.png" 2>"$T/err"
+[ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/err" && cmp -s "$T/win.png" "$T/win0.png" && ok ||
+    bad "-o over the light's image: $(cat "$T/err")"
+"$A" render -q "$SRC/scenes/dobashi_fig04_spotlight.json" $S -D "objects.1={\"terrain\": \"$T/hm.png\", \"size_m\": 30, \"height_m\": 3}" \
+    --pfm "$T/x.pfm" -o "$T/hm.png" 2>"$T/err"
+[ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/err" && cmp -s "$T/hm.png" "$T/win0.png" && [ ! -e "$T/x.pfm" ] && ok ||
+    bad "-o over the height map: $(cat "$T/err")"
 ln -s "$T/f.exr" "$T/link.exr"
 "$A" render -q $S --exr "$T/link.exr" -o "$T/f.exr" 2>/dev/null; [ $? -eq 2 ] && ok || bad "an output and a link to it"
 cp "$T/f.exr" "$T/ref.exr"

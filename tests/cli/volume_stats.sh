@@ -93,4 +93,15 @@ head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "
 "$A" volume stats "$T/d.json" --minutes 3 >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q -- "--minutes" "$T/e" && ok "--minutes on a file" || bad "--minutes on a file"
 "$A" volume stats "$T/d.json" --seeds 3 >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q -- "--seeds" "$T/e" && ok "--seeds on a file" || bad "--seeds on a file"
 "$A" volume stats generate:cumulus --time 2 >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q "reading options" "$T/e" && ok "--time on a generator" || bad "--time on a generator"
+# outputs written all or none, never over an input: --csv naming the volume is refused and the
+# volume kept; a failing second source leaves neither the csv nor the mask behind
+cp "$T/d.json" "$T/keep.json"
+"$A" volume stats "$T/d.json" --csv "$T/d.json" >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/e" &&
+    cmp -s "$T/d.json" "$T/keep.json" && ok "--csv over the input refused, the input kept" || bad "--csv over the input: $(cat "$T/e")"
+printf 'not a volume' >"$T/junk.vdb"
+"$A" volume stats "$T/d.json" "$T/junk.vdb" --csv "$T/part.csv" --mask-png "$T/part.png" >/dev/null 2>"$T/e"; [ $? -eq 1 ] &&
+    [ ! -e "$T/part.csv" ] && [ ! -e "$T/part.png" ] && [ -z "$(ls "$T" | grep -F .tmp)" ] && ok "a failed source: no output left" ||
+    bad "a failed source left: $(ls "$T")"
+"$A" volume stats "$T/d.json" --csv "$T/out/s.csv" --mask-png "$T/out/s.png" >/dev/null 2>"$T/e" && [ -s "$T/out/s.csv" ] &&
+    [ -s "$T/out/s.png" ] && ok "--csv and --mask-png written" || bad "--csv and --mask-png: $(cat "$T/e")"
 exit $fail

@@ -419,8 +419,7 @@ static int check_output_names(const render_opts *o)
     return CLI_EXIT_OK;
 }
 
-/* No two outputs are the same file and none is an input (the scene file, the volume file).
- * CLI_EXIT_OK or CLI_EXIT_USAGE. */
+/* The outputs the command line names (check_outputs: no two the same file, none an input). */
 static void add_outputs(const render_opts *o, const char *png, cli_outputs *set)
 {
     const char *names[6] = {png, o->exr, o->pfm, o->variance, o->order, o->tau};
@@ -428,16 +427,32 @@ static void add_outputs(const render_opts *o, const char *png, cli_outputs *set)
         if (names[i]) cli_outputs_add(set, out_option[i], names[i]);
 }
 
+/* The files a scene reads (paths resolved by atmos_scene_load; "" and generated sources
+ * NULL): the scene, its volume, the lights' images, the objects' meshes and height maps, the
+ * Earth's maps. Returns how many of cap entries it wrote. */
+#define SCENE_INPUTS_MAX (2 + ATMOS_SCENE_MAX_LIGHTS + 2 * ATMOS_SCENE_MAX_OBJECTS + 4)
+static int scene_inputs(const render_opts *o, const atmos_scene *scene, const char **in)
+{
+    int n = 0;
+    in[n++] = o->scene_path;
+    in[n++] = scene->volume.source;
+    for (int i = 0; i < scene->light_count; i++) in[n++] = scene->lights[i].image;
+    for (int i = 0; i < scene->object_count; i++) in[n++] = scene->objects[i].mesh, in[n++] = scene->objects[i].terrain;
+    const atmos_scene_earth *e = &scene->earth;
+    in[n++] = e->ground_map, in[n++] = e->night_lights, in[n++] = e->cloud_image, in[n++] = e->cloud_world_file;
+    for (int k = 0; k < n; k++)
+        if (in[k] && (!in[k][0] || !strncmp(in[k], "generate:", 9) || !strncmp(in[k], "simulate:", 9) ||
+                      !strncmp(in[k], "builtin:", 8)))
+            in[k] = NULL;
+    return n;
+}
+
 static int check_outputs(const render_opts *o, const atmos_scene *scene, const char *png)
 {
     cli_outputs set = {0};
     add_outputs(o, png, &set);
-    const char *vol = scene->volume.source[0] && strncmp(scene->volume.source, "generate:", 9) &&
-                              strncmp(scene->volume.source, "simulate:", 9)
-                          ? scene->volume.source
-                          : NULL;
-    const char *inputs[2] = {o->scene_path, vol};
-    return cli_outputs_check("render", &set, inputs, 2);
+    const char *inputs[SCENE_INPUTS_MAX];
+    return cli_outputs_check("render", &set, inputs, scene_inputs(o, scene, inputs));
 }
 
 /* The render after the scene is made: outputs checked and staged (rank 0), the plan, the

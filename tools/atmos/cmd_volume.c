@@ -381,6 +381,10 @@ static int cmd_clouds(int argc, char **argv)
         return cli_usage_error(C, "clouds: --half-width %g m in voxels of --voxel-size %g m gives %.0f voxels across (allowed 1..%d)",
                                half, voxel, across, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
     if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
+    cli_outputs set = {0};
+    cli_outputs_add(&set, "-o", out);
+    const char *inputs[1] = {scene_path};
+    if (cli_outputs_check(C, &set, inputs, 1)) return CLI_EXIT_USAGE; /* -o naming the scene: refused */
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;

@@ -301,15 +301,24 @@ int cli_cmd_volume_stats(int argc, char **argv)
     int rc = parse(argc, argv, &o);
     if (rc != CLI_EXIT_OK) return rc;
     if (o.png && cli_png_output("volume", "--mask-png", o.png)) return CLI_EXIT_USAGE;
-    /* the outputs' folders made as atmos render makes them */
-    if ((o.csv && cli_output_folder("volume", "--csv", o.csv)) || (o.png && cli_output_folder("volume", "--mask-png", o.png)))
-        return CLI_EXIT_RUNTIME;
+    /* the outputs as atmos render has them: none an input, their folders made and staging files
+       written, renamed into place only when every source was measured */
+    cli_outputs set = {0};
+    const int icsv = cli_outputs_add(&set, "--csv", o.csv), ipng = cli_outputs_add(&set, "--mask-png", o.png);
+    const char *inputs[32];
+    for (int s = 0; s < o.nsources; s++)
+        inputs[s] = strncmp(o.sources[s], "generate:", 9) && strncmp(o.sources[s], "simulate:", 9) ? o.sources[s] : NULL;
+    if ((rc = cli_outputs_check(C, &set, inputs, o.nsources)) != CLI_EXIT_OK) return rc;
+    if (cli_outputs_prepare(C, &set)) return CLI_EXIT_RUNTIME;
+    const char *csv_name = o.csv;
+    if (icsv >= 0) o.csv = cli_outputs_stage(&set, icsv);
+    if (ipng >= 0) o.png = cli_outputs_stage(&set, ipng);
     atmos_context *ctx = cli_context(o.threads, 1);
-    if (!ctx) return CLI_EXIT_RUNTIME;
     FILE *csv = NULL;
-    if (o.csv && !(csv = fopen(o.csv, "w"))) {
-        fprintf(stderr, "atmos volume: %s: cannot write\n", o.csv);
+    if (!ctx || (o.csv && !(csv = fopen(o.csv, "w")))) {
+        if (ctx) fprintf(stderr, "atmos volume: %s: cannot write\n", csv_name);
         atmos_context_destroy(ctx);
+        cli_outputs_discard(&set);
         return CLI_EXIT_RUNTIME;
     }
     if (csv) fprintf(csv, "source,seed,cloud,pixels,area_m2,perimeter_m,crack_perimeter_m,diameter_m,base_m,base_sd_m,depth_m,edge\n");
@@ -323,9 +332,11 @@ int cli_cmd_volume_stats(int argc, char **argv)
             rc = measure(ctx, &o, o.sources[s], o.seed + (uint64_t)k, runs == 0, &all, &nall, &cloudy, &pixels, &dx, csv);
     }
     if (csv && fclose(csv) != 0 && rc == CLI_EXIT_OK) {
-        fprintf(stderr, "atmos volume: %s: write failed\n", o.csv);
+        fprintf(stderr, "atmos volume: %s: write failed\n", csv_name);
         rc = CLI_EXIT_RUNTIME;
     }
+    if (rc == CLI_EXIT_OK && cli_outputs_commit(C, &set)) rc = CLI_EXIT_RUNTIME;
+    if (rc != CLI_EXIT_OK) cli_outputs_discard(&set); /* no output half written */
     if (rc == CLI_EXIT_OK) {
         atmos_cloud_fit f;
         atmos_cloud_stats_fit(all, nall, cloudy, pixels, dx, &o.sd, &f);
