@@ -6,6 +6,7 @@
  * (C11 7.13.2.1p3). */
 #define _POSIX_C_SOURCE 200809L
 #include "core/internal.h"
+#include "image/png_size.h"
 
 #include <png.h>
 #include <sys/stat.h>
@@ -170,6 +171,25 @@ atmos_status atmos_write_png_level(atmos_context *ctx, const atmos_image *displa
 }
 
 /* ---------------------------------------------------------------- reading ---- */
+
+int atmos__png_size(const char *path, uint32_t *w, uint32_t *h)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    png_errctx err = {{0}};
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &err, png_error_cb, png_warning_cb);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    int ok = 0;
+    if (png && info && !setjmp(png_jmpbuf(png))) {
+        png_init_io(png, f);
+        png_read_info(png, info);
+        *w = png_get_image_width(png, info), *h = png_get_image_height(png, info);
+        ok = 1;
+    }
+    png_destroy_read_struct(png ? &png : NULL, info ? &info : NULL, NULL);
+    fclose(f);
+    return ok;
+}
 
 atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmos_image **out)
 {

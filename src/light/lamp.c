@@ -3,15 +3,21 @@
 #include "light/lamp.h"
 #include "scene/scene_internal.h"
 #include "core/vec.h"
+#include "image/png_size.h"
 
 #include "atmos/image.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
 /* Planck's law up to constants: the spectral radiance of a black body at T (K), nm. */
+/* A light's image at most this many texels: held as doubles with a border, its edges' counts
+ * and the decoded floats, about 36 bytes a texel; and the counts stay within an int. */
+#define LAMP_IMAGE_MAX_TEXELS (4096 * 4096)
+
 static double planck(double nm, double T)
 {
     const double c2 = 1.438776877e7; /* h c / k, nm K */
@@ -118,6 +124,12 @@ atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene
 {
     const atmos_scene_light *s = &scene->lights[index];
     if (!s->image[0]) return ATMOS_OK;
+    uint32_t w = 0, h = 0;
+    if (atmos__png_size(s->image, &w, &h) && (uint64_t)w * h > LAMP_IMAGE_MAX_TEXELS)
+        return atmos__error(ctx, ATMOS_E_LIMIT,
+                            "/lights/%d/image: %s: %u x %u texels; a light's image may have at most %d (4096 x 4096, "
+                            "about 0.6 GB as the renderers hold it): scale it down",
+                            index, s->image, (unsigned)w, (unsigned)h, LAMP_IMAGE_MAX_TEXELS);
     atmos_image *img = NULL;
     atmos_status st = atmos_read_png(ctx, s->image, &img);
     if (st != ATMOS_OK) {

@@ -14,7 +14,9 @@
 #  - the example scene of docs/scene-format.md's `beams` section (its camera was missing, so
 #    it rendered black) shows the beam: light in the image's top third (the cone below the lamp)
 #    and in its bottom third (the lit floor), over 5 % of the pixels in all (about 11 %).
-#  - a spot of cone_deg 0 and edge_deg 0 (a valid value: its image is black) is warned of.
+#  - a spot of cone_deg 0 and edge_deg 0 (a valid value: its image is black) is warned of;
+#  - a light's image of more than 4096 x 4096 texels (a small file that inflates to gigabytes)
+#    is refused from its header, naming its size, before it is decoded.
 . "$(dirname "$0")/common.inc"
 cd "$T" || exit 1
 cat >hemi.json <<'JSON'
@@ -107,4 +109,16 @@ PY
     -D lights.0.edge_deg=0 -o z.pfm -q 2>z.err || bad "a spot of no angle: $(cat z.err)"
 grep -q "/lights/0: a spot of cone_deg 0 and edge_deg 0 lights nothing" z.err && ok "a spot of no angle is warned of" ||
     bad "a spot of no angle: no warning ($(cat z.err))"
+# a 4097 x 4096 image, 50 kB of zeros: refused from its header in well under a second
+"${ATMOS_PYTHON:-python3}" - <<'PY' || bad "writing the big image"
+import struct, zlib
+w, h = 4097, 4096
+raw = (b'\x00' * (1 + 3 * w)) * h
+chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+open('huge.png', 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 2, 0, 0, 0)) +
+                             chunk(b'IDAT', zlib.compress(raw, 9)) + chunk(b'IEND', b''))
+PY
+"$A" render "$S/scenes/dobashi_fig09b_stained_glass.json" --width 12 --height 8 -D lights.0.image="$T/huge.png" -o h.png -q 2>h.err
+[ $? -eq 1 ] && grep -q "4097 x 4096 texels; a light's image may have at most" h.err && [ ! -e h.png ] &&
+    ok "a huge light image refused" || bad "a huge light image: $(cat h.err)"
 exit $fail
