@@ -10,7 +10,10 @@
 #  - fog or lights given to the slice renderer: a warning that it does not draw them; objects
 #    too, but not to Harris's renderer, which draws them;
 #  - a beam scene without a sun: the status line names its lights, not an unused sun;
-#  - an all-zero volume: said to be empty, not told to raise --density-scale.
+#  - an all-zero volume: said to be empty, not told to raise --density-scale;
+#  - a -D that leaves a valid scene file invalid through another key (fog.extinction_per_m below
+#    the file's scattering) or that cannot be placed (lights.1 in a scene of one light): a usage
+#    error (exit 2) saying the file alone is valid; a broken file with a harmless -D stays exit 1.
 . "$(dirname "$0")/common.inc"
 S=${ATMOS_SOURCE_DIR:?ATMOS_SOURCE_DIR not set}
 has() { grep -qF -- "$2" "$T/err" && ok "$1: names '$2'" || { bad "$1: no '$2' in:"; sed 's/^/  /' "$T/err" >&2; }; }
@@ -133,4 +136,13 @@ json.dump({'dims': [8, 8, 8], 'voxel_size_m': 100, 'origin_m': [0, 0, 0],
 has "empty volume" "empty: every value is 0"
 grep -q "raise --density-scale" "$T/err" && bad "an empty volume is told to raise --density-scale" ||
     ok "an empty volume is not told to raise --density-scale"
+F4="$S/scenes/dobashi_fig04_spotlight.json"
+for d in fog.extinction_per_m=0.01 lights.1.cone_deg=5; do
+    "$A" render "$F4" --width 8 --height 8 -q -D "$d" -o "$T/d.png" 2>"$T/err"; st=$?
+    [ $st -eq 2 ] && grep -q "the scene file alone is valid: the -D override -D $d made it so" "$T/err" && [ ! -e "$T/d.png" ] &&
+        ok "-D $d: a usage error" || bad "-D $d: exit $st, $(cat "$T/err")"
+done
+printf '{"renderer": "beams", "fog": {"extinction_per_m": 0.01, "scattering_per_m": 0.02}}' >"$T/broken.json"
+"$A" render "$T/broken.json" --width 8 --height 8 -q -D fog.g=0.5 -o "$T/d.png" 2>"$T/err"; st=$?
+[ $st -eq 1 ] && ! grep -q "alone is valid" "$T/err" && ok "a broken file with a -D: exit 1" || bad "a broken file with a -D: exit $st"
 exit $fail

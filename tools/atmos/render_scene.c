@@ -170,6 +170,28 @@ static void quoted_define(char *buf, size_t cap, const char *key, size_t klen, c
     snprintf(buf + k, cap - k, "\"");
 }
 
+/* Whether a scene file that failed to load with the user's -D (status st) loads without them: a
+ * value one of them gave that another key of the file no longer agrees with (-D
+ * fog.extinction_per_m below the file's scattering), or a -D the reader cannot place (-D
+ * lights.1.cone_deg in a scene of one light). Then the options made the error, a usage error.
+ * Called after the error was printed: the context's message is replaced. */
+static int defines_broke_it(atmos_context *ctx, const render_opts *o, atmos_status st)
+{
+    if (o->ndefines == 0 || st == ATMOS_E_IO || st == ATMOS_E_NOMEM || !strcmp(o->scene_path, "-")) return 0;
+    atmos_scene *alone = malloc(sizeof *alone);
+    const int ok = alone && atmos_scene_load_with(ctx, o->scene_path, NULL, 0, alone) == ATMOS_OK;
+    free(alone);
+    atmos_context_clear_error(ctx);
+    return ok;
+}
+
+static void say_defines(const render_opts *o)
+{
+    fprintf(stderr, "  (the scene file alone is valid: the -D override%s", o->ndefines > 1 ? "s" : "");
+    for (int i = 0; i < o->ndefines; i++) fprintf(stderr, "%s -D %s", i ? "," : "", o->defines[i]);
+    fprintf(stderr, " made it so)\n");
+}
+
 /* The -D whose key (a.b.0 or /a/b/0) is, or holds, the JSON pointer after the scene file's name
  * in msg ("scene.json: /objects/0/terrain: ..."): the error is the define's, not the file's. */
 const char *render_scene_define_in(const render_opts *o, const char *msg)
@@ -337,10 +359,12 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
             /* a value a -D gave that the scene reader refuses (the message blames the -D): the
              * options alone made it, a usage error as without a scene file; the scene file's
              * own content, or a file that cannot be read, is a runtime error */
-            const int named = !strncmp(msg, "-D ", 3), by_define = st == ATMOS_E_INVALID_ARG && named;
-            const int rc = cli_runtime_error(o->cmd, ctx, st);
+            const int named = !strncmp(msg, "-D ", 3);
+            const int rc = cli_runtime_error(o->cmd, ctx, st); /* the message printed: the context is free */
+            const int by_define = (st == ATMOS_E_INVALID_ARG && named) || (!def && !named && defines_broke_it(ctx, o, st));
             /* the message names the -D already when it starts with it */
             if (def && !named) fprintf(stderr, "  (set by -D %s, not by the scene file)\n", def);
+            else if (by_define && !named) say_defines(o);
             return by_define ? CLI_EXIT_USAGE : rc;
         }
     } else if (ndefs) {
