@@ -131,6 +131,14 @@ long scan(const char *path, long stop_after, std::string *why, bool *trailing)
             line.erase(hash);
         }
         if (!line.empty() && line.back() == '\x1a' && f.peek() == EOF) line.pop_back(); // a DOS end of file
+        const size_t cr = line.find('\r');
+        if (cr != std::string::npos && cr + 1 < line.size()) { // the reader would split it where this pass cannot
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "line %ld: a carriage return without a line feed (old Mac line endings): "
+                          "save the file with LF or CRLF line endings", line_no);
+            *why = buf;
+            break;
+        }
         line.erase(0, line.find_first_not_of(" \t")); // an indented statement is one
         if (!(*why = check_statement(line, line_no)).empty()) break;
         if (line.size() < 1 || (line.size() > 1 && line[1] != ' ' && line[1] != '\t' && line[1] != '\r')) continue;
@@ -153,9 +161,11 @@ long scan(const char *path, long stop_after, std::string *why, bool *trailing)
             for (int k = 0; k < 3; k++) {
                 char *end = nullptr;
                 const double x = std::strtod(p, &end);
-                if (end == p || !std::isfinite(x)) {
-                    char buf[96];
-                    std::snprintf(buf, sizeof buf, "line %ld: a vertex needs three finite numbers", line_no);
+                bool hex = false; // strtod reads 0x10 as 16, the reader as 0
+                for (const char *c = p; c < end; c++) hex = hex || *c == 'x' || *c == 'X';
+                if (end == p || !std::isfinite(x) || hex) {
+                    char buf[112];
+                    std::snprintf(buf, sizeof buf, "line %ld: a vertex needs three finite decimal numbers", line_no);
                     *why = buf;
                     break;
                 }

@@ -93,4 +93,14 @@ grep -q "set by -D" errd3 && bad "the scene file's bad terrain blamed on a -D: $
 check "a built-in sphere placed beyond 1e8 m" errp1 "/objects/0/mesh" "builtin:sphere" "after position and scale"
 "$A" render s.json -D objects.0.scale=1e6 -D objects.0.position_m=[9.99e7,0,0] --renderer path --spp 1 -o x.png -q 2>errp2
 check "an OBJ scaled beyond 1e8 m, the path tracer" errp2 "/objects/0/mesh" "ok.obj" "after position and scale"
+# old Mac line endings (CR alone: the reader splits them, the first pass did not, so a cut last
+# face passed) and a hexadecimal coordinate (strtod reads 0x10 as 16, the reader as 0): refused
+printf 'v 0 0 0\rv 1 0 0\rv 0 1 0\rv 0 0 1\rf 1 2 3\rf 4 1' >cr.obj
+"$A" render s.json -D objects.0.mesh=cr.obj -o x.png -q 2>errcr
+check "old Mac line endings" errcr "/objects/0/mesh" "line 1" "carriage return without a line feed"
+printf 'v 0x10 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >hex.obj
+"$A" render s.json -D objects.0.mesh=hex.obj -o x.png -q 2>errhex
+check "a hexadecimal coordinate" errhex "/objects/0/mesh" "line 1" "three finite decimal numbers"
+printf 'v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n' >crlf.obj
+"$A" render s.json -D objects.0.mesh=crlf.obj -o x.png -q 2>errcrlf && ok "CRLF line endings read" || bad "CRLF: $(cat errcrlf)"
 exit $fail
