@@ -113,7 +113,11 @@ static atmos_status scale_heights(atmos_context *ctx, const atmos_terrain_desc *
         for (size_t i = 0; i < n; i++) g->h[i] = (g->h[i] - lo) / (hi - lo) * d->height_m;
     } else {
         const double s = d->height_scale != 0 ? d->height_scale : 1;
-        for (size_t i = 0; i < n; i++) g->h[i] *= s;
+        for (size_t i = 0; i < n; i++)
+            if (!(fabs(g->h[i] *= s) <= 1e8)) /* a mesh's bound: said of the height map, not of a vertex */
+                return atmos__error(ctx, ATMOS_E_FORMAT, "terrain %s: the height %g m at sample (%zu, %zu) of its grid "
+                                    "(the value times height_scale %g) is beyond 1e8 m: set height_m, or a smaller "
+                                    "height_scale", d->source, g->h[i], i % (size_t)g->nx, i / (size_t)g->nx, s);
     }
     return ATMOS_OK;
 }

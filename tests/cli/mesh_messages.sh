@@ -51,6 +51,10 @@ check "a folder as the terrain" err7t "/objects/1/terrain" "dir.tif" "it is a fo
 "$A" render s.json -D objects.1.terrain=h.png -D objects.1.max_triangles=1 -o x.png -q 2>err9
 check "max_triangles 1" err9 "/objects/1/terrain" "max_triangles 1"
 grep -q "stride" err9 && bad "max_triangles 1 spoken of as a stride: $(cat err9)"
+# a height map scaled beyond 1e8 m: said of the terrain and its height_scale, not of "mesh: vertex N"
+"$A" render --width 9 --height 9 --png-bits 16 --exposure 20 -o h16.png -q 2>/dev/null || bad "a 16-bit height map"
+"$A" render s.json -D objects.1.terrain=h16.png -D objects.1.height_m=0 -D objects.1.height_scale=1e5 -o x.png -q 2>err9b
+check "a height map scaled beyond 1e8 m" err9b "/objects/1/terrain" "h16.png" "height_scale 100000" "beyond 1e8 m"
 "$A" render s.json -o x.png -q 2>err8 && ok "the good mesh renders" || bad "the good mesh: $(cat err8)"
 # comments after a line's content are comments ('#' to the end of the line), not vertex indices
 printf '# a triangle\nv 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nf 1 2 3 # tri\nf 1 2 3#again\n' >comment.obj
