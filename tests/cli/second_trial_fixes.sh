@@ -175,6 +175,10 @@ sed 's/g[12]\.json//' "$T/own" >"$T/own2"; sed 's/g[12]\.json//' "$T/render" >"$
 # render's name keeps render's bound (0, 100]: a factor that render refuses is refused here too
 "$A" volume info "$T/g1.json" --volume-scale 500 >/dev/null 2>"$T/err"; [ $? -eq 2 ] \
     && ok "info --volume-scale 500 refused as render refuses it" || bad "info --volume-scale 500 accepted"
+# a density factor beyond the scene's bound: a usage error naming the option, not the library's
+# "set_dense: scale ... got inf"
+"$A" volume info "$T/g1.json" --scale 1e300 >/dev/null 2>"$T/err"; [ $? -eq 2 ] && grep -q -- "--scale: expected a factor in (0, 1e30]" "$T/err" \
+    && ok "info --scale 1e300 refused" || bad "info --scale 1e300: $(cat "$T/err")"
 # the help texts
 "$A" render --help >"$T/err"
 hasnt "render --help" "[> 0, 2]"

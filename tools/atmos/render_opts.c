@@ -268,8 +268,8 @@ static int parse_number(int c, const char *arg, render_opts *o)
         return 1;
     case O_VIEW_AZ: return cli_parse_azimuth(C, "--view-azimuth", arg, &o->view_az);
     case O_DSCALE:
-        if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) || !(o->density_scale > 0))
-            return cli_usage_error(C, "--density-scale: expected a factor > 0"), 0;
+        if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) || !(o->density_scale > 0 && o->density_scale <= 1e30))
+            return cli_usage_error(C, "--density-scale: expected a factor in (0, 1e30] (volume.density_scale's bound)"), 0;
         return 1;
     default: return -1;
     }

@@ -25,8 +25,8 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
             return -1;
         }
     } else if (!strcmp(a, "--scale") || !strcmp(a, "--density-scale")) { /* --density-scale: render's */
-        if (!cli_parse_double(C, a, argv[++*i], &d->density_scale) || !(d->density_scale > 0)) {
-            cli_usage_error(C, "%s: expected a factor > 0", a);
+        if (!cli_parse_double(C, a, argv[++*i], &d->density_scale) || !(d->density_scale > 0 && d->density_scale <= 1e30)) {
+            cli_usage_error(C, "%s: expected a factor in (0, 1e30] (a scene's volume.density_scale's bound)", a);
             return -1;
         }
     } else if (!strcmp(a, "--density-unit")) {
