@@ -116,6 +116,17 @@ static atmos_status load_format(atmos_context *ctx, const char *path, vol_format
     return ATMOS_OK;
 }
 
+/* A name the comma-separated list of grids holds twice (its first character in list), or NULL. */
+static const char *grid_twice(const char *list, size_t *len)
+{
+    for (const char *a = list; a && *a; a = strchr(a, ',') ? strchr(a, ',') + 1 : NULL) {
+        const size_t n = strcspn(a, ",");
+        for (const char *b = strchr(a, ','); b; b = strchr(b + 1, ','))
+            if (strcspn(b + 1, ",") == n && n && !strncmp(a, b + 1, n)) return *len = n, a;
+    }
+    return NULL;
+}
+
 atmos_status atmos_volume_load(atmos_context *ctx, const char *path, const atmos_volume_load_desc *desc,
                                atmos_volume **out)
 {
@@ -127,6 +138,10 @@ atmos_status atmos_volume_load(atmos_context *ctx, const char *path, const atmos
         memset(&zero, 0, sizeof zero);
         desc = &zero;
     }
+    size_t twice_n = 0;
+    const char *twice = grid_twice(desc->grids, &twice_n);
+    if (twice)
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG, "%s: grids: '%.*s' is named twice", path, (int)twice_n, twice);
     struct stat sb;
     if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
         return atmos__error(ctx, ATMOS_E_IO, "%s: is a directory, not a volume file", path);

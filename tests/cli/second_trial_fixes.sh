@@ -179,6 +179,8 @@ sed 's/g[12]\.json//' "$T/own" >"$T/own2"; sed 's/g[12]\.json//' "$T/render" >"$
 # "set_dense: scale ... got inf"
 "$A" volume info "$T/g1.json" --scale 1e300 >/dev/null 2>"$T/err"; [ $? -eq 2 ] && grep -q -- "--scale: expected a factor in (0, 1e30]" "$T/err" \
     && ok "info --scale 1e300 refused" || bad "info --scale 1e300: $(cat "$T/err")"
+"$A" volume info "$T/g1.json" --grids density,density >/dev/null 2>"$T/err"; [ $? -eq 1 ] && grep -q "grids: 'density' is named twice" "$T/err" \
+    && ok "a grid named twice said so" || bad "--grids density,density: $(cat "$T/err")"
 # the help texts
 "$A" render --help >"$T/err"
 hasnt "render --help" "[> 0, 2]"
