@@ -270,6 +270,7 @@ static int cmd_slice(int argc, char **argv)
         } else if (!strcmp(argv[i], "--at") && i + 1 < argc) {
             if (!cli_parse_double(C, "--at", argv[++i], &at)) return CLI_EXIT_USAGE;
             if (at < 0 || at > 1) return cli_usage_error(C, "--at: expected a fraction in [0, 1], got %g", at);
+            at += 0.0; /* -0 is 0: said so ("the slice at 0") */
         } else if (argv[i][0] == '-') {
             return cli_usage_error(C, "slice: unknown or incomplete option '%s'", argv[i]);
         } else if (!file) {
