@@ -55,6 +55,19 @@ grep -q "stride" err9 && bad "max_triangles 1 spoken of as a stride: $(cat err9)
 "$A" render --width 9 --height 9 --png-bits 16 --exposure 20 -o h16.png -q 2>/dev/null || bad "a 16-bit height map"
 "$A" render s.json -D objects.1.terrain=h16.png -D objects.1.height_m=0 -D objects.1.height_scale=1e5 -o x.png -q 2>err9b
 check "a height map scaled beyond 1e8 m" err9b "/objects/1/terrain" "h16.png" "height_scale 100000" "beyond 1e8 m"
+# a height map cut short in rows a stride passes over: its last row is read too, so the cut is said
+"${ATMOS_PYTHON:-python3}" - <<'PY' || bad "writing the cut height map"
+import random, struct, zlib
+random.seed(7)
+w, h = 4000, 50  # max_triangles 1000: a stride of 18, rows 0, 18, 36 kept, the last (49) passed over
+z = zlib.compressobj()  # each row flushed, so that the rows before a cut decode
+data = b''.join(z.compress(b'\x00' + random.randbytes(2 * w)) + z.flush(zlib.Z_SYNC_FLUSH) for _ in range(h)) + z.flush()
+chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+png = b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, 16, 0, 0, 0, 0)) + chunk(b'IDAT', data)
+open('cut.png', 'wb').write(png[:len(png) * 90 // 100])  # rows 45 on cut
+PY
+"$A" render s.json -D objects.1.terrain=cut.png -D objects.1.max_triangles=1000 -o x.png -q 2>err9c
+check "a height map cut in its last rows" err9c "/objects/1/terrain" "cut.png" "the last"
 "$A" render s.json -o x.png -q 2>err8 && ok "the good mesh renders" || bad "the good mesh: $(cat err8)"
 # comments after a line's content are comments ('#' to the end of the line), not vertex indices
 printf '# a triangle\nv 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nf 1 2 3 # tri\nf 1 2 3#again\n' >comment.obj
