@@ -146,6 +146,20 @@ ln -s a.pfm "$T/heat.png"
 cp "$T/f.exr" "$T/f2.exr"
 "$A" compare "$T/f.exr" "$T/f2.exr" --heatmap "$T/fine.png" >/dev/null && [ -s "$T/fine.png" ] && ok || bad "compare --heatmap"
 
+# 6b. An output that another user owns in a sticky folder (as /tmp) cannot be renamed onto: said
+# before the render, nothing written (it had failed after the render, the other outputs renamed).
+# Only as root, where another user can be taken on (setpriv).
+if [ "$(id -u)" = 0 ] && command -v setpriv >/dev/null 2>&1; then
+    mkdir "$T/sticky" && chmod 1777 "$T/sticky" && echo old >"$T/sticky/b.pfm"
+    chmod o+x "$T" 2>/dev/null
+    as_nobody() { setpriv --reuid=65534 --regid=65534 --clear-groups "$@"; }
+    if as_nobody "$A" --version >/dev/null 2>&1 && as_nobody test -w "$T/sticky"; then
+        as_nobody "$A" render -q $S -o "$T/sticky/a.png" --pfm "$T/sticky/b.pfm" 2>"$T/err"; rc=$?
+        [ $rc -eq 1 ] && grep -q "another user" "$T/err" && [ ! -e "$T/sticky/a.png" ] && [ "$(cat "$T/sticky/b.pfm")" = old ] &&
+            ok || bad "another user's output in a sticky folder: rc $rc, $(cat "$T/err"), left: $(ls "$T/sticky")"
+    fi
+fi
+
 # 7. SIGTERM while the outputs are written leaves no temporary and no partial output.
 mkdir "$T/sig"
 "$A" render -q $P --width 512 --height 512 --spp 1 --spectral 16 \

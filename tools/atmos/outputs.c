@@ -316,6 +316,19 @@ int cli_output_folder(const char *cmd, const char *option, const char *path)
     return 0;
 }
 
+/* Whether path exists in a folder with the sticky bit (such as /tmp) and belongs neither to
+ * this user nor to the folder's owner: the final rename onto it would fail (EPERM) only after
+ * all the work, and after the set's other outputs were renamed. Root may (CAP_FOWNER). */
+static int sticky_foreign(const char *path)
+{
+    struct stat f, d;
+    if (lstat(path, &f) != 0 || geteuid() == 0) return 0;
+    char dir[CLI_OUTPUT_PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + 1 : 1, slash ? path : ".");
+    return stat(dir, &d) == 0 && (d.st_mode & S_ISVTX) && f.st_uid != geteuid() && d.st_uid != geteuid();
+}
+
 int cli_outputs_prepare(const char *cmd, cli_outputs *set)
 {
     signal_cmd = cmd;
@@ -330,6 +343,10 @@ int cli_outputs_prepare(const char *cmd, cli_outputs *set)
         } else if (lstat(o->path, &sb) == 0 && !S_ISREG(sb.st_mode)) {
             why = S_ISLNK(sb.st_mode) ? "a symbolic link" : S_ISDIR(sb.st_mode) ? "a folder" : "a device or FIFO";
             fprintf(stderr, "atmos %s: %s %s: exists and is %s; refusing to replace it\n", cmd, o->option, o->path, why);
+            e = 1;
+        } else if (sticky_foreign(o->path)) {
+            fprintf(stderr, "atmos %s: %s %s: exists, belongs to another user, and its folder has the sticky bit (as "
+                            "/tmp has): it cannot be replaced; choose another name\n", cmd, o->option, o->path);
             e = 1;
         } else {
             snprintf(o->stage, sizeof o->stage, "%s.tmp%ld", o->path, (long)getpid());
