@@ -199,9 +199,21 @@ atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmos_image **
     FILE *f = fopen(path, "rb");
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
     struct stat whole; /* an empty file: libpng would say "truncated" */
+    if (fstat(fileno(f), &whole) == 0 && S_ISDIR(whole.st_mode)) {
+        fclose(f);
+        return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: it is a folder, not a file", path);
+    }
     if (fstat(fileno(f), &whole) == 0 && S_ISREG(whole.st_mode) && whole.st_size == 0) {
         fclose(f);
         return atmos__error(ctx, ATMOS_E_FORMAT, "%s: empty file (0 bytes): not a PNG image", path);
+    }
+    png_byte sig[8]; /* a file that does not start as a PNG: said so, not "truncated" when it is short */
+    const size_t got = fread(sig, 1, sizeof sig, f);
+    if (png_sig_cmp(sig, 0, got) != 0 || got < sizeof sig) {
+        fclose(f);
+        return atmos__error(ctx, ATMOS_E_FORMAT, "%s: not a PNG file (%s)", path,
+                            png_sig_cmp(sig, 0, got) != 0 ? "it does not start with PNG's signature"
+                                                          : "it ends within PNG's signature");
     }
 
     png_errctx err = {{0}};
@@ -234,6 +246,7 @@ atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmos_image **
     }
 
     png_init_io(png, f);
+    png_set_sig_bytes(png, 8); /* read above */
     /* Reject huge images in the header, before any row is allocated. */
     png_set_user_limits(png, ATMOS_IMAGE_MAX_DIM, ATMOS_IMAGE_MAX_DIM);
     png_read_info(png, info);

@@ -125,16 +125,17 @@ atmos_status atmos__lamp_load_image(atmos_context *ctx, const atmos_scene *scene
     const atmos_scene_light *s = &scene->lights[index];
     if (!s->image[0]) return ATMOS_OK;
     uint32_t w = 0, h = 0;
-    if (atmos__png_size(s->image, &w, &h) && (uint64_t)w * h > LAMP_IMAGE_MAX_TEXELS)
-        return atmos__error(ctx, ATMOS_E_LIMIT,
-                            "/lights/%d/image: %s: %u x %u texels; a light's image may have at most %d (4096 x 4096, "
-                            "about 0.6 GB as the renderers hold it): scale it down",
-                            index, s->image, (unsigned)w, (unsigned)h, LAMP_IMAGE_MAX_TEXELS);
     atmos_image *img = NULL;
-    atmos_status st = atmos_read_png(ctx, s->image, &img);
+    atmos_status st = ATMOS_OK;
+    if (atmos__png_size(s->image, &w, &h) && (uint64_t)w * h > LAMP_IMAGE_MAX_TEXELS)
+        st = atmos__error(ctx, ATMOS_E_LIMIT,
+                          "%s: %u x %u texels; a light's image may have at most %d (4096 x 4096, about 0.6 GB as the "
+                          "renderers hold it): scale it down", s->image, (unsigned)w, (unsigned)h, LAMP_IMAGE_MAX_TEXELS);
+    else
+        st = atmos_read_png(ctx, s->image, &img);
     if (st != ATMOS_OK) {
-        /* the reader's message names the file; the scene file and its key go in front, and a
-         * relative path says where it was looked for */
+        /* the message names the file; the scene file and its key go in front, and a relative
+         * path says where it was looked for */
         char key[48];
         snprintf(key, sizeof key, "/lights/%d/image", index);
         return atmos__scene_file_error(ctx, st, scene, s->image, key, 1);

@@ -568,6 +568,21 @@ static void test_malformed(void)
     test_tmp_path(path, sizeof path, "does-not-exist.exr");
     CHECK(atmos_read_exr(NULL, path, &out) == ATMOS_E_IO);
     CHECK(atmos_read_png(NULL, path, &out) == ATMOS_E_IO);
+    /* a short text file and a folder given as a PNG: said as what they are, not "truncated" or
+       libpng's "Read Error" */
+    atmos_context *ctx = NULL;
+    CHECK_OK(atmos_context_create(NULL, &ctx));
+    test_tmp_path(path, sizeof path, "text.png");
+    spit(path, "hello", 5);
+    CHECK(atmos_read_png(ctx, path, &out) == ATMOS_E_FORMAT && !out);
+    CHECK(strstr(atmos_context_error(ctx), "not a PNG file") != NULL);
+    spit(path, png_magic, 5);
+    CHECK(atmos_read_png(ctx, path, &out) == ATMOS_E_FORMAT && strstr(atmos_context_error(ctx), "within PNG's signature"));
+    test_tmp_path(path, sizeof path, "folder.png");
+    (void)mkdir(path, 0700);
+    CHECK(atmos_read_png(ctx, path, &out) == ATMOS_E_IO && strstr(atmos_context_error(ctx), "it is a folder"));
+    rmdir(path);
+    atmos_context_destroy(ctx);
 }
 
 /* Every file in tests/crashers/ must be rejected cleanly by the reader its
