@@ -28,18 +28,20 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >ok.obj
 mesh_scene ok.obj nohills.png | "$A" render - -o x.png -q 2>err2
 check "a missing terrain" err2 "/objects/1/terrain" "nohills.png" "No such file" "relative path"
 mesh_scene ok.obj generate:ridges >s.json
-printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 abc\n' >junk.obj
-"$A" render s.json -D objects.0.mesh=junk.obj -o x.png -q 2>err3
-check "a face vertex that is not a number" err3 "/objects/0/mesh" "line 4" "'abc'" "not a number"
-printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -5\n' >neg.obj
-"$A" render s.json -D objects.0.mesh=neg.obj -o x.png -q 2>err4
-check "a negative index out of range, as written" err4 "line 4" "vertex -5" "3 vertices"
-printf 'v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\nf 1 2 9\n' >big.obj
-"$A" render s.json -D objects.0.mesh=big.obj -o x.png -q 2>err5
-check "a positive index past the file's vertices" err5 "line 5" "vertex 9" "has 3"
-printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n' >zero.obj
-"$A" render s.json -D objects.0.mesh=zero.obj -o x.png -q 2>err6
-check "vertex 0" err6 "line 4" "vertex 0"
+# obj_check NAME TEXT LABEL PATTERN...: TEXT (printf's escapes) as NAME.obj, the scene's mesh;
+# the render's message must hold every PATTERN
+obj_check() {
+    n=$1 text=$2 label=$3
+    shift 3
+    printf "$text" >"$n.obj"
+    "$A" render s.json -D objects.0.mesh="$n.obj" -o x.png -q 2>"err_$n"
+    check "$label" "err_$n" "$@"
+}
+obj_check junk 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 abc\n' "a face vertex that is not a number" "/objects/0/mesh" "line 4" "'abc'" \
+    "not a number"
+obj_check neg 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -5\n' "a negative index out of range, as written" "line 4" "vertex -5" "3 vertices"
+obj_check big 'v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\nf 1 2 9\n' "a positive index past the file's vertices" "line 5" "vertex 9" "has 3"
+obj_check zero 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n' "vertex 0" "line 4" "vertex 0"
 mkdir dir.obj
 "$A" render s.json -D objects.0.mesh=dir.obj -o x.png -q 2>err7
 check "a folder" err7 "/objects/0/mesh" "folder"
@@ -112,12 +114,10 @@ check "a built-in sphere placed beyond 1e8 m" errp1 "/objects/0/mesh" "builtin:s
 check "an OBJ scaled beyond 1e8 m, the path tracer" errp2 "/objects/0/mesh" "ok.obj" "after position and scale"
 # old Mac line endings (CR alone: the reader splits them, the first pass did not, so a cut last
 # face passed) and a hexadecimal coordinate (strtod reads 0x10 as 16, the reader as 0): refused
-printf 'v 0 0 0\rv 1 0 0\rv 0 1 0\rv 0 0 1\rf 1 2 3\rf 4 1' >cr.obj
-"$A" render s.json -D objects.0.mesh=cr.obj -o x.png -q 2>errcr
-check "old Mac line endings" errcr "/objects/0/mesh" "line 1" "carriage return without a line feed"
-printf 'v 0x10 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >hex.obj
-"$A" render s.json -D objects.0.mesh=hex.obj -o x.png -q 2>errhex
-check "a hexadecimal coordinate" errhex "/objects/0/mesh" "line 1" "three finite decimal numbers"
+obj_check cr 'v 0 0 0\rv 1 0 0\rv 0 1 0\rv 0 0 1\rf 1 2 3\rf 4 1' "old Mac line endings" "/objects/0/mesh" "line 1" \
+    "carriage return without a line feed"
+obj_check hex 'v 0x10 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' "a hexadecimal coordinate" "/objects/0/mesh" "line 1" \
+    "three finite decimal numbers"
 printf 'v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n' >crlf.obj
 "$A" render s.json -D objects.0.mesh=crlf.obj -o x.png -q 2>errcrlf && ok "CRLF line endings read" || bad "CRLF: $(cat errcrlf)"
 exit $fail
