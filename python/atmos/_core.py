@@ -114,10 +114,10 @@ class Progress:
             return 1
         try:
             said = self._callback(ffi.string(stage).decode(errors="replace"), float(fraction))
+            self.stopped = said is not None and not said  # its truth may raise too (a NumPy array)
         except BaseException as e:  # noqa: BLE001 - raised again once the library has returned
             self.error = e
-            said = False
-        self.stopped = said is not None and not said
+            self.stopped = True
         return 1 if self.stopped else 0
 
     def check(self, status: int, ctx=None) -> None:

@@ -9,7 +9,10 @@ def refractive_index(material: str, nm: float) -> complex:
     f = {"water": lib.atmos_refractive_index_water, "ice": lib.atmos_refractive_index_ice}.get(material)
     if f is None:
         raise ValueError(f"atmos.refractive_index: material must be 'water' or 'ice', got {material!r}")
-    m = f(number("refractive_index: nm", nm))
+    wl = number("refractive_index: nm", nm)
+    if not wl > 0:  # the tables' ends stand for wavelengths beyond them (clamped), not for these
+        raise ValueError(f"atmos: refractive_index: nm: a wavelength must be > 0, got {wl:g}")
+    m = f(wl)
     return complex(m.re, m.im)
 
 
@@ -42,12 +45,17 @@ def phase_table(preset: str = "cloud", wavelengths_nm=None, fast: bool = False) 
     the disk cache."""
     ctx = context()
     part = ffi.new("atmos_particle_desc *")
+    if not isinstance(preset, str) or "\0" in preset:
+        raise TypeError(f"atmos: phase_table: preset: expected a name, got {preset!r}")
     check(lib.atmos_py_particle_fast(ctx, preset.encode(), 1 if fast else 0, part), ctx)
     wl = ffi.new("atmos_wavelengths *")
     if wavelengths_nm is None:
         lib.atmos_wavelengths_rgb(wl)
     else:
-        check(lib.atmos_wavelengths_spectral(int(wavelengths_nm), wl), ctx)
+        n = number("phase_table: wavelengths_nm (a count of spectral samples)", wavelengths_nm, integer=True)
+        if not 1 <= n <= 128:  # ATMOS_MAX_WAVELENGTHS; the call takes no context to say so
+            raise ValueError(f"atmos: phase_table: wavelengths_nm: expected a count in [1, 128], got {n}")
+        lib.atmos_wavelengths_spectral(n, wl)
     p = ffi.new("atmos_phase_table **")
     check(lib.atmos_phase_table_build(ctx, part, wl, ffi.NULL, p), ctx)
     t = ffi.gc(p[0], lib.atmos_phase_table_destroy)

@@ -1,4 +1,6 @@
 """Rendering: one call for one image, a plan for many frames of one scene."""
+import threading
+
 from atmos._core import AtmosError, Owned, Progress, check, context, ffi, lib, number
 from atmos.image import Image
 from atmos.scene import Scene
@@ -95,8 +97,8 @@ def render(scene: Scene | None = None, volume=None, *, time=None, frame=None, pr
     The GIL is released while the library renders."""
     scene = _as_scene(scene)
     if volume is not None:
-        scene = _scene_for_volume(scene)
-    if kw:
+        scene = _scene_for_volume(scene, kw)
+    elif kw:
         scene = scene.with_(**kw)
     if volume is not None:
         with Plan(scene, volume, progress=progress) as plan:
@@ -134,13 +136,17 @@ def _frame(ctx, s, rep):
     return ffi.gc(vol[0], lib.atmos_volume_destroy) if vol[0] != ffi.NULL else None
 
 
-def _scene_for_volume(scene: Scene) -> Scene:
-    """A scene that renders a volume given in code: one without a "volume" of its own is given
-    a stand-in source (never read: the given volume is used), so that it is validated, and
-    drawn by default, as a scene with a volume."""
-    if ffi.string(scene._struct().volume.source):
-        return scene
-    return scene.with_(volume__generate="cumulus")
+def _scene_for_volume(scene: Scene, kw=None) -> Scene:
+    """A scene that renders a volume given in code, with the keywords kw: one without a
+    "volume" of its own is given a stand-in source (never read: the given volume is used), so
+    that it is validated, and drawn by default, as a scene with a volume."""
+    try:
+        if not ffi.string(scene._struct().volume.source):
+            scene = scene.with_(volume__generate="cumulus")
+        return scene.with_(**kw) if kw else scene
+    except AtmosError as e:  # said of the volume given, not of the stand-in's keyword
+        msg = e.message.split(": ", 2)[-1] if "volume__generate" in e.message else e.message
+        raise AtmosError(e.status, f"the volume given: {msg}") from None
 
 
 class Plan(Owned):
@@ -170,13 +176,28 @@ class Plan(Owned):
         self._scene = scene._struct()
         p = ffi.new("atmos_plan **")
         with Progress(progress, "Plan") as rep:
-            vptr = volume._ptr if volume is not None else _frame(ctx, self._scene, rep)
+            vptr = volume._live() if volume is not None else _frame(ctx, self._scene, rep)
             self._volume = vptr  # borrowed by the plan: kept alive with it
             st = lib.atmos_plan_create(ctx, self._scene, vptr if vptr is not None else ffi.NULL, desc, p)
         rep.check(st, ctx)
         self._ptr = ffi.gc(p[0], lib.atmos_plan_destroy)
+        if volume is not None:
+            volume._plans.add(self)  # its close() refused while this plan is open
+        self._ctx = ctx  # the plan's own: its errors are told there, whichever thread renders
+        # one render at a time (a plan is not for two at once), and close() waits for it, or, from
+        # within it (a progress callback), takes effect when it returns
+        self._lock, self._busy, self._close_pending = threading.RLock(), 0, False
         self._frame = ffi.new("atmos_frame *")
         check(lib.atmos_frame_from_scene(ctx, self._scene, self._frame), ctx)
+
+    def close(self) -> None:
+        """Frees the plan now; from another thread while it renders, once that render is done;
+        from within a render (its progress callback), when the render returns."""
+        with self._lock:
+            if self._busy:
+                self._close_pending = True
+            else:
+                Owned.close(self)
 
     @property
     def frame_count(self) -> int:
@@ -197,9 +218,19 @@ class Plan(Owned):
         --time``); frame: the sun of frame i (from 0) of the scene's animation (from ``time`` if
         given too); size: (width, height); spp: the path tracer's samples per pixel; progress: as
         ``atmos.render``'s. What is not given stays as in the last frame rendered: a call that
-        fails changes nothing."""
-        if self._ptr is None:
-            raise ValueError("atmos.Plan: the plan was closed")
+        fails changes nothing. Calls from several threads take turns."""
+        with self._lock:
+            if self._ptr is None or self._close_pending:
+                raise ValueError("atmos.Plan: the plan was closed")
+            self._busy += 1
+            try:
+                return self._render(camera, sun, size, spp, time, frame, progress)
+            finally:
+                self._busy -= 1
+                if self._close_pending and not self._busy:
+                    Owned.close(self)
+
+    def _render(self, camera, sun, size, spp, time, frame, progress) -> Image:
         # the changes go to a copy, kept as the plan's frame once the render succeeded: a call
         # that fails leaves the next one the frame before it
         f = ffi.new("atmos_frame *")
@@ -213,8 +244,12 @@ class Plan(Owned):
             for key, field in (("position_m", "position"), ("look_at_m", "look_at"), ("up", "up")):
                 if key in camera:
                     setattr(f.camera, field, _vector(f"{w}: camera {key}", camera[key], 3))
+            if "up" in camera and not any(f.camera.up[i] for i in range(3)):  # 0 would keep the last frame's
+                raise ValueError(f"atmos: {w}: camera up: must not be zero")
             if "fov_deg" in camera:
                 f.camera.fov_deg = number(f"{w}: camera fov_deg", camera["fov_deg"])
+                if not f.camera.fov_deg > 0:  # 0 would keep the last frame's
+                    raise ValueError(f"atmos: {w}: camera fov_deg: must be > 0, got {f.camera.fov_deg:g}")
         if sun is not None:
             el, az = _vector(f"{w}: sun (elevation_deg, azimuth_deg)", sun, 2)
             if not -90.0 <= el <= 90.0:  # as the scene's sun.elevation_deg (else wrapped past a pole)
@@ -222,7 +257,7 @@ class Plan(Owned):
             if not 0.0 <= az < 360.0:  # as the scene's sun.azimuth_deg and the CLI's azimuths
                 raise ValueError(f"atmos: {w}: sun azimuth_deg: {az:g} is not in [0, 360)")
             lib.atmos_direction_from_angles(el, az, f.sun_dir)
-        ctx = context()
+        ctx = self._ctx
         if time is not None or frame is not None:
             if sun is not None:
                 raise ValueError(f"atmos: {w}: sun (angles) and time or frame exclude each other")
@@ -235,6 +270,8 @@ class Plan(Owned):
             f.width, f.height = _vector(f"{w}: size (width, height)", size, 2, integer=True)
         if spp is not None:
             f.spp = number(f"{w}: spp", spp, integer=True)
+            if not 1 <= f.spp <= 1000000:  # 0 would keep the last frame's
+                raise ValueError(f"atmos: {w}: spp: must be in [1, 1000000], got {spp}")
         img = ffi.new("atmos_image **")
         check(lib.atmos_plan_image_create(self._ptr, f, img), ctx)
         spec = ffi.gc(img[0], lib.atmos_image_destroy)

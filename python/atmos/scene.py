@@ -66,6 +66,8 @@ class Scene:
     def load(cls, path) -> "Scene":
         """Reads a scene file; relative volume paths are taken from the file's folder."""
         path = os.fspath(path)
+        if not isinstance(path, str) or "\0" in path:  # C would read the path up to the NUL
+            raise ValueError(f"atmos: Scene.load: path: expected a file name without NUL, got {path!r}")
         return cls(path=path, source=path)
 
     @classmethod

@@ -27,6 +27,9 @@ def sky_radiance(scene: Scene, dirs, position_m=None) -> np.ndarray:
         raise ValueError("atmos.sky_radiance: a direction has zero length")
     d = np.ascontiguousarray(d / norm)
     s = scene._struct()
+    if position_m is not None and (isinstance(position_m, (str, bytes)) or not hasattr(position_m, "__len__")
+                                   or len(position_m) != 3):
+        raise TypeError(f"atmos: sky_radiance: position_m: expected 3 numbers (x, y, z m), got {position_m!r}")
     pos = list(position_m) if position_m is not None else list(s.camera.position)
     n = d.size // 3
     ctx = context()

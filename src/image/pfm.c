@@ -195,6 +195,12 @@ atmos_status atmos_read_pfm(atmos_context *ctx, const char *path, atmos_image **
                           (unsigned long long)(sb.st_size > (off_t)pos ? (uint64_t)sb.st_size - pos : 0));
         goto done;
     }
+    if ((uint64_t)sb.st_size - (uint64_t)pos > data_bytes) { /* a header whose size is not the data's */
+        st = atmos__error(ctx, ATMOS_E_FORMAT,
+                          "%s: %llu bytes after the PFM's data (%ld x %ld x %d floats): its header's size is not its data's",
+                          path, (unsigned long long)((uint64_t)sb.st_size - pos - data_bytes), w, h, channels);
+        goto done;
+    }
     if (fseek(f, (long)pos, SEEK_SET) != 0) {
         st = atmos__error(ctx, ATMOS_E_IO, "%s: seek failed: %s", path, strerror(errno));
         goto done;
