@@ -462,6 +462,7 @@ static void test_pfm(void)
         {"PF\n2 2\n-1.0", ATMOS_E_FORMAT},
         {"PF\n12345678901 2\n-1.0\n", ATMOS_E_FORMAT},
         {"PF\n2 2\n-1.0\n\x01\x02\x03", ATMOS_E_FORMAT},       /* truncated data */
+        {"Pf\n1 1\n-1.0\n\x01\x02\x03\x04junk", ATMOS_E_FORMAT}, /* bytes after the data: a header's size not the data's */
         {"PF\n60000 60000\n-1.0\n", ATMOS_E_FORMAT},           /* claims 40 GB, has none */
         {"PF\n70000 2\n-1.0\n", ATMOS_E_LIMIT},
         {"Pf\n2 999999999\n-1.0\n", ATMOS_E_LIMIT},
