@@ -241,4 +241,11 @@ has "--thickness with spherical" "homogeneous"
 "$A" render --atmosphere homogeneous --thickness 200 --width 8 --height 6 -o "$T/f.png" -q 2>"$T/err" \
     && ok "--thickness with homogeneous" || bad "--thickness with homogeneous: $(cat "$T/err")"
 
+# volume generate: a folder where one of its raw files goes is refused before anything is
+# written (it had left the other fields' raw files and a staged one, no sidecar)
+mkdir -p "$T/gen/g.ice.raw"
+"$A" volume generate storm --voxel-size 600 -o "$T/gen/g.json" 2>"$T/err"; st=$?
+[ $st -eq 1 ] && grep -q "g.ice.raw: exists and is a folder" "$T/err" && [ "$(ls "$T/gen")" = g.ice.raw ] \
+    && ok "generate: a folder in the way" || bad "generate: a folder in the way: exit $st, left $(ls "$T/gen"), $(cat "$T/err")"
+
 exit $fail

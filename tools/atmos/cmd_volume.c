@@ -172,6 +172,24 @@ static int cmd_info(int argc, char **argv)
     return CLI_EXIT_OK;
 }
 
+/* Every file atmos_volume_write_raw(v, out) will write (the sidecar out = NAME.json and
+ * NAME.FIELD.raw for each of v's fields) checked before it writes any: none in the way (a
+ * folder, a link), each creatable (a staging file made, discarded by the caller after the
+ * write), as atmos simulate checks its own. CLI_EXIT_OK or the exit status (the message said). */
+static int raw_outputs(const char *out, const atmos_volume *v, cli_outputs *set)
+{
+    static char raw[CLI_OUTPUTS_MAX][CLI_OUTPUT_PATH_MAX];
+    const int stem = (int)strlen(out) - 5; /* without .json (cli_volume_output) */
+    cli_outputs_add(set, "-o", out);
+    for (int f = 0; f < atmos_volume_field_count(v) && f + 1 < CLI_OUTPUTS_MAX; f++) {
+        const int n = snprintf(raw[f], sizeof raw[f], "%.*s.%s.raw", stem, out, atmos_volume_field_name(v, f));
+        if (n < 0 || n >= (int)sizeof raw[f]) return cli_usage_error(C, "-o %s: the path is too long", out);
+        cli_outputs_add(set, "-o", raw[f]);
+    }
+    const int rc = cli_outputs_check(C, set, NULL, 0);
+    return rc == CLI_EXIT_OK ? cli_outputs_prepare(C, set) : rc;
+}
+
 static int cmd_generate(int argc, char **argv)
 {
     const char *preset = NULL, *out = NULL;
@@ -222,8 +240,11 @@ static int cmd_generate(int argc, char **argv)
     if (!ctx) return CLI_EXIT_RUNTIME;
     atmos_volume *v = NULL;
     atmos_status st = atmos_scene_generate_volume(ctx, preset, &g, &v);
-    if (st == ATMOS_OK) st = atmos_volume_write_raw(ctx, v, out);
-    int rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    cli_outputs set = {0};
+    int rc = st == ATMOS_OK ? raw_outputs(out, v, &set) : CLI_EXIT_OK;
+    if (st == ATMOS_OK && rc == CLI_EXIT_OK) st = atmos_volume_write_raw(ctx, v, out);
+    if (rc == CLI_EXIT_OK) rc = st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
+    cli_outputs_discard(&set); /* the staging files; the library wrote the files themselves */
     atmos_volume_destroy(v);
     atmos_context_destroy(ctx);
     return rc;
