@@ -98,6 +98,9 @@ head -c 8 "$T/d.png" | od -An -c | grep -q "P   N   G" && ok "mask PNG" || bad "
 cp "$T/d.json" "$T/keep.json"
 "$A" volume stats "$T/d.json" --csv "$T/d.json" >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/e" &&
     cmp -s "$T/d.json" "$T/keep.json" && ok "--csv over the input refused, the input kept" || bad "--csv over the input: $(cat "$T/e")"
+cp "$T/d.cloud.raw" "$T/keep.raw"
+"$A" volume stats "$T/d.json" --csv "$T/d.cloud.raw" >/dev/null 2>"$T/e"; [ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/e" &&
+    cmp -s "$T/d.cloud.raw" "$T/keep.raw" && ok "--csv over the sidecar's data file refused" || bad "--csv over the data file: $(cat "$T/e")"
 printf 'not a volume' >"$T/junk.vdb"
 "$A" volume stats "$T/d.json" "$T/junk.vdb" --csv "$T/part.csv" --mask-png "$T/part.png" >/dev/null 2>"$T/e"; [ $? -eq 1 ] &&
     [ ! -e "$T/part.csv" ] && [ ! -e "$T/part.png" ] && [ -z "$(ls "$T" | grep -F .tmp)" ] && ok "a failed source: no output left" ||
