@@ -96,6 +96,9 @@ static void test_errors(void)
         {"{\"particles\": {\"x\": {\"kind\": \"analytic\", \"lobes\": [{\"type\": \"hg\", \"weight\": 0}]}}}", "at least one lobe with weight > 0"},
         {"{\"particles\": {\"x\": {\"preset\": \"hail\"}}}", "/particles/x/preset: unknown preset"},
         {"{\"particles\": {\"x\": {\"kind\": \"ice\", \"albedo\": 2}}}", "/particles/x/albedo: must be in [0, 1]"},
+        /* the ranges the crystal tables take, told when the scene is read, not when its table is built */
+        {"{\"particles\": {\"x\": {\"kind\": \"snow\", \"distortion\": 1.2}}}", "/particles/x/distortion: must be in [0, 1]"},
+        {"{\"particles\": {\"x\": {\"kind\": \"ice\", \"aspect_ratio\": 0.005}}}", "/particles/x/aspect_ratio: must be in [0.01, 100]"},
         {"{\"particles\": {\"x\": {\"kind\": \"air\"}, \"x\": {\"kind\": \"air\"}}}", "/particles/x: duplicate key"},
         {"{\"particles\": {\"a\": {\"kind\": \"air\"}, \"b\": {\"kind\": \"air\"}, \"c\": {\"kind\": \"air\"}, \"d\": {\"kind\": \"air\"},"
          " \"e\": {\"kind\": \"air\"}, \"f\": {\"kind\": \"air\"}, \"g\": {\"kind\": \"air\"}, \"h\": {\"kind\": \"air\"}, \"i\": {\"kind\": \"air\"}}}",
