@@ -44,10 +44,19 @@ atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *sce
     const double far2 = (fabs(cx) + half_width_m) * (fabs(cx) + half_width_m) +
                         (fabs(cz) + half_width_m) * (fabs(cz) + half_width_m);
     const double y0 = floor((base - far2 / (2.0 * R)) / voxel_size_m) * voxel_size_m;
+    const double tall = ceil((top - y0) / voxel_size_m); /* the curved layer's depth below the box's top */
+    if (!(tall <= ATMOS_CLOUD_VOLUME_MAX_ACROSS)) {
+        atmos_atmosphere_destroy(atm);
+        return atmos__error(ctx, ATMOS_E_INVALID_ARG,
+                            "cloud volume: a box of half width %g m centred at (%g, %g) m reaches so far round the Earth "
+                            "that the cloud layer falls %.3g m across it: %.3g voxels of %g m tall (allowed 1..%d); "
+                            "centre it nearer the origin or make it smaller",
+                            half_width_m, cx, cz, top - y0, tall, voxel_size_m, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
+    }
     atmos_volume_desc vd;
     memset(&vd, 0, sizeof vd);
     vd.dims[0] = vd.dims[2] = (int)across;
-    vd.dims[1] = (int)ceil((top - y0) / voxel_size_m);
+    vd.dims[1] = (int)tall;
     vd.voxel_size_m = voxel_size_m;
     vd.origin_m[0] = cx - half_width_m, vd.origin_m[1] = y0, vd.origin_m[2] = cz - half_width_m;
     atmos_volume *v = NULL;

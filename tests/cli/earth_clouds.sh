@@ -50,6 +50,9 @@ set +e
 grep -q "ground_map" "$T/err.txt" || fail "missing map message"
 "$A" volume clouds "$T/bad.json" -o "$T/x.json" 2> /dev/null; [ $? -eq 1 ] || fail "volume clouds on a bad scene"
 "$A" volume clouds; [ $? -eq 2 ] || fail "usage exit"
+# a centre so far that the curved layer is too tall for a box: said so, not an int's overflow
+"$A" volume clouds "$T/earth.json" -o "$T/far.json" --centre 1e12,0 --voxel-size 4000 2> "$T/err.txt"; [ $? -eq 1 ] || fail "far centre: exit"
+grep -q "reaches so far round the Earth" "$T/err.txt" && ! grep -q -- "-2147483648" "$T/err.txt" || fail "far centre: $(cat "$T/err.txt")"
 # -o naming the scene itself: refused before anything is written, the scene kept
 cp "$T/earth.json" "$T/self.json"
 "$A" volume clouds "$T/self.json" -o "$T/self.json" 2> "$T/err.txt"; [ $? -eq 2 ] || fail "-o over the scene: exit"
