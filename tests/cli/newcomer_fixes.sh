@@ -248,4 +248,11 @@ mkdir -p "$T/gen/g.ice.raw"
 [ $st -eq 1 ] && grep -q "g.ice.raw: exists and is a folder" "$T/err" && [ "$(ls "$T/gen")" = g.ice.raw ] \
     && ok "generate: a folder in the way" || bad "generate: a folder in the way: exit $st, left $(ls "$T/gen"), $(cat "$T/err")"
 
+# a seed past 2^64 - 1 refused (it had been clamped to 2^64 - 1 without a word)
+for c in "simulate stratocumulus --grid 16 --minutes 1" "volume generate cumulus"; do
+    "$A" $c --seed 18446744073709551616 -o "$T/seed.json" 2>"$T/err"; st=$?
+    [ $st -eq 2 ] && grep -q -- "--seed: expected an integer in \[0, 18446744073709551615\]" "$T/err" && [ ! -e "$T/seed.json" ] \
+        && ok "$c --seed 2^64" || bad "$c --seed 2^64: exit $st, $(cat "$T/err")"
+done
+
 exit $fail

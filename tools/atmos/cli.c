@@ -56,6 +56,19 @@ int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, l
     return 1;
 }
 
+int cli_parse_seed(const char *cmd, const char *text, unsigned long long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    const unsigned long long v = text ? strtoull(text, &end, 10) : 0;
+    if (!text || !*text || *end || text[0] == '-' || errno == ERANGE) {
+        cli_usage_error(cmd, "--seed: expected an integer in [0, 18446744073709551615], got '%s'", text ? text : "");
+        return 0;
+    }
+    *out = v;
+    return 1;
+}
+
 int cli_usage_error(const char *cmd, const char *fmt, ...)
 {
     va_list ap;

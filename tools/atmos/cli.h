@@ -21,6 +21,9 @@ int cli_parse_double(const char *cmd, const char *opt, const char *text, double 
 int cli_parse_azimuth(const char *cmd, const char *opt, const char *text, double *out);
 /* Parses an integer in [lo, hi]; prints a message naming OPT and the range on failure. */
 int cli_parse_int(const char *cmd, const char *opt, const char *text, long lo, long hi, int *out);
+/* Parses a seed: a decimal integer in [0, 2^64 - 1] (a larger one refused, not clamped); on
+ * failure prints a usage message naming --seed and returns 0. */
+int cli_parse_seed(const char *cmd, const char *text, unsigned long long *out);
 /* Prints "atmos CMD: message" and "Try 'atmos CMD --help'." to stderr; returns CLI_EXIT_USAGE. */
 int cli_usage_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints "atmos CMD: <ctx error or status string>" to stderr; returns CLI_EXIT_RUNTIME. */

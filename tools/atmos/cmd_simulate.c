@@ -198,10 +198,8 @@ int cli_cmd_simulate(int argc, char **argv)
             if (!cli_parse_int(C, "--grid", argv[++i], ATMOS_SIM_MIN_GRID, ATMOS_SIM_MAX_GRID, &d.grid))
                 return CLI_EXIT_USAGE;
         } else if (!strcmp(a, "--seed") && i + 1 < argc) {
-            char *end = NULL;
-            const char *t = argv[++i];
-            unsigned long long s = strtoull(t, &end, 10);
-            if (!*t || *end || t[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", t);
+            unsigned long long s = 0;
+            if (!cli_parse_seed(C, argv[++i], &s)) return CLI_EXIT_USAGE;
             d.seed = s;
         } else if (!strcmp(a, "--refine") && i + 1 < argc) {
             if (!cli_parse_int(C, "--refine", argv[++i], 1, ATMOS_SIM_MAX_REFINE, &d.refine)) return CLI_EXIT_USAGE;

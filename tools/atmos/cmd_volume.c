@@ -205,10 +205,8 @@ static int cmd_generate(int argc, char **argv)
             out = argv[++i];
             if (!*out) return cli_usage_error(C, "-o: expected a file name");
         } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
-            char *end = NULL;
-            const char *t = argv[++i];
-            unsigned long long s = strtoull(t, &end, 10);
-            if (!*t || *end || t[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", t);
+            unsigned long long s = 0;
+            if (!cli_parse_seed(C, argv[++i], &s)) return CLI_EXIT_USAGE;
             g.seed = s;
         } else if (!strcmp(argv[i], "--voxel-size") && i + 1 < argc) {
             if (!cli_parse_double(C, "--voxel-size", argv[++i], &g.voxel_size_m)) return CLI_EXIT_USAGE;

@@ -129,9 +129,8 @@ static int parse(int argc, char **argv, opts *o)
             else if (!strcmp(a, "--csv")) o->csv = v;
             else if (!strcmp(a, "--mask-png")) o->png = v;
             else if (!strcmp(a, "--seed")) {
-                char *end = NULL;
-                unsigned long long s = strtoull(v, &end, 10);
-                if (!*v || *end || v[0] == '-') return cli_usage_error(C, "--seed: expected a non-negative integer, got '%s'", v);
+                unsigned long long s = 0;
+                if (!cli_parse_seed(C, v, &s)) return CLI_EXIT_USAGE;
                 o->seed = s, o->seed_given = 1;
             } else if (!strcmp(a, "--seeds")) ok = cli_parse_int(C, a, v, 1, 1000, &o->seeds);
             else if (!strcmp(a, "--minutes")) {
