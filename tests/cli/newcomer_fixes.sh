@@ -255,4 +255,19 @@ for c in "simulate stratocumulus --grid 16 --minutes 1" "volume generate cumulus
         && ok "$c --seed 2^64" || bad "$c --seed 2^64: exit $st, $(cat "$T/err")"
 done
 
+# volume generate interrupted while it writes: its staged raw files go with it (they had been
+# left, hundreds of MB); the signal is sent once the first staged file shows (no signal, and no
+# check, when the write is over before it is seen)
+mkdir -p "$T/int"
+"$A" volume generate storm --voxel-size 40 -o "$T/int/v.json" 2>/dev/null &
+pid=$!
+n=0
+while [ $n -lt 600 ] && kill -0 $pid 2>/dev/null && [ -z "$(ls "$T/int" | grep -F .staged)" ]; do sleep 0.02; n=$((n + 1)); done
+if [ -n "$(ls "$T/int" | grep -F .staged)" ] && kill -INT $pid 2>/dev/null; then
+    wait $pid
+    [ -z "$(ls "$T/int" | grep -F .staged)" ] && ok "generate interrupted: no staged file left" || bad "generate interrupted left: $(ls "$T/int")"
+else
+    wait $pid
+fi
+
 exit $fail

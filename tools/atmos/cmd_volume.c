@@ -186,8 +186,10 @@ static int raw_outputs(const char *out, const atmos_volume *v, cli_outputs *set)
         if (n < 0 || n >= (int)sizeof raw[f]) return cli_usage_error(C, "-o %s: the path is too long", out);
         cli_outputs_add(set, "-o", raw[f]);
     }
-    const int rc = cli_outputs_check(C, set, NULL, 0);
-    return rc == CLI_EXIT_OK ? cli_outputs_prepare(C, set) : rc;
+    int rc = cli_outputs_check(C, set, NULL, 0);
+    if (rc == CLI_EXIT_OK && (rc = cli_outputs_prepare(C, set)) == CLI_EXIT_OK)
+        cli_outputs_also_remove(set, ".staged"); /* atmos_volume_write_raw's names until all are written */
+    return rc;
 }
 
 static int cmd_generate(int argc, char **argv)

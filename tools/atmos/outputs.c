@@ -51,7 +51,7 @@ int cli_png_output(const char *cmd, const char *option, const char *path)
 /* Every staging file and the writer's temporary next to it (STAGE.tmpPID, as the
  * library's atomic writes name them). A slot is filled before its flag is set, so the
  * handler reads only whole names; unlink is async-signal-safe. */
-#define SLOTS (2 * CLI_OUTPUTS_MAX)
+#define SLOTS (4 * CLI_OUTPUTS_MAX) /* per output: its staging file and a writer's own (cli_outputs_also_remove) */
 static char slot_name[SLOTS][CLI_OUTPUT_PATH_MAX + 64];
 static volatile sig_atomic_t slot_used[SLOTS];
 
@@ -167,16 +167,32 @@ void cli_outputs_catch(const char *cmd)
     install_handlers();
 }
 
-static void register_stage(int i, const char *stage)
+/* Slots k and k + 1: name and the writer's temporary next to it. */
+static void register_pair(int k, const char *name)
 {
     install_handlers();
-    slot_used[2 * i] = slot_used[2 * i + 1] = 0;
-    snprintf(slot_name[2 * i], sizeof slot_name[0], "%s", stage);
-    snprintf(slot_name[2 * i + 1], sizeof slot_name[0], "%s.tmp%ld", stage, (long)getpid());
-    slot_used[2 * i] = slot_used[2 * i + 1] = 1;
+    slot_used[k] = slot_used[k + 1] = 0;
+    snprintf(slot_name[k], sizeof slot_name[0], "%s", name);
+    snprintf(slot_name[k + 1], sizeof slot_name[0], "%s.tmp%ld", name, (long)getpid());
+    slot_used[k] = slot_used[k + 1] = 1;
 }
 
-static void unregister_stage(int i) { slot_used[2 * i] = slot_used[2 * i + 1] = 0; }
+static void register_stage(int i, const char *stage) { register_pair(2 * i, stage); }
+
+static void unregister_stage(int i)
+{
+    slot_used[2 * i] = slot_used[2 * i + 1] = 0;
+    slot_used[2 * (CLI_OUTPUTS_MAX + i)] = slot_used[2 * (CLI_OUTPUTS_MAX + i) + 1] = 0;
+}
+
+void cli_outputs_also_remove(const cli_outputs *set, const char *suffix)
+{
+    char name[CLI_OUTPUT_PATH_MAX + 32];
+    for (int i = 0; i < set->n; i++) {
+        snprintf(name, sizeof name, "%s%s", set->f[i].path, suffix);
+        register_pair(2 * (CLI_OUTPUTS_MAX + i), name);
+    }
+}
 
 /* ------------------------------------------------------------------ the set ---- */
 

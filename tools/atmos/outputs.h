@@ -65,6 +65,10 @@ int cli_outputs_probe(const char *cmd, cli_outputs *set);
 /* Before work whose output the library writes itself (a raw volume and its sidecar): the
  * folder of path made (mkdir -p) and writable. 0, or 1 with the reason printed. */
 int cli_output_folder(const char *cmd, const char *option, const char *path);
+/* After cli_outputs_prepare, for outputs the library writes itself under names of its own
+ * (a raw volume's PATH.staged until the whole set is written): PATH + suffix, and its writer's
+ * temporary, removed too on the ending signals, until the set is discarded. */
+void cli_outputs_also_remove(const cli_outputs *set, const char *suffix);
 /* Renames every staging file onto its final name. Returns 0 or 1 (message printed). */
 int cli_outputs_commit(const char *cmd, cli_outputs *set);
 /* An animation's frames, all or none: room for frames * per_frame held files (0 or 1: out
