@@ -135,8 +135,10 @@ static int check_outputs(const char *out, int ice, sim_outputs *o)
         if (n < 0 || n >= (int)sizeof o->raw[f]) return cli_usage_error(C, "-o %s: the path is too long", out);
         cli_outputs_add(&o->set, "-o", o->raw[f]);
     }
-    const int rc = cli_outputs_check(C, &o->set, NULL, 0);
-    return rc == CLI_EXIT_OK ? cli_outputs_prepare(C, &o->set) : rc;
+    int rc = cli_outputs_check(C, &o->set, NULL, 0);
+    if (rc == CLI_EXIT_OK && (rc = cli_outputs_prepare(C, &o->set)) == CLI_EXIT_OK)
+        cli_outputs_also_remove(&o->set, ".staged"); /* atmos_volume_write_raw's names until all are written */
+    return rc;
 }
 
 /* The run and the volume written as NAME.json + raw files. */
