@@ -21,6 +21,10 @@ def mie(m: complex, x: float, cos_theta=None) -> dict:
     relative refractive index m (imaginary part <= 0): the efficiencies qext, qsca, qback, the
     asymmetry parameter g, and with cos_theta (an array of cosines) the amplitudes s1, s2 as
     complex arrays of its shape."""
+    import numbers
+    if isinstance(m, bool) or not isinstance(m, numbers.Complex):
+        raise TypeError(f"atmos: mie: m: expected a (complex) refractive index, got {type(m).__name__} {m!r}")
+    m = complex(m)
     mu = np.ascontiguousarray(np.atleast_1d(cos_theta if cos_theta is not None else []), dtype=np.float64)
     n = mu.size
     s1 = ffi.new("atmos_complex[]", max(n, 1))

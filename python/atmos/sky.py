@@ -17,6 +17,8 @@ def sky_radiance(scene: Scene, dirs, position_m=None) -> np.ndarray:
     along each direction of dirs (..., 3), seen from position_m (default: the scene's camera),
     under the scene's sun: radiance (..., K) in W m^-2 sr^-1 nm^-1 at the scene's K
     wavelengths. Clouds of a volume are not included (render for those)."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"atmos: sky_radiance: expected an atmos.Scene, got {type(scene).__name__}")
     d = np.ascontiguousarray(dirs, dtype=np.float64)
     if d.shape[-1] != 3:
         raise ValueError(f"atmos.sky_radiance: directions must have shape (..., 3), got {d.shape}")

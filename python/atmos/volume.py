@@ -105,6 +105,8 @@ class Volume(Owned):
     def to_array(self, field: str | int = 0) -> np.ndarray:
         """A field's densities at the voxel centres as a new (nz, ny, nx) float32 array."""
         names = list(self.fields)
+        if isinstance(field, bool) or not isinstance(field, (str, int, np.integer)):
+            raise TypeError(f"atmos: Volume.to_array: field: expected a name or an index, got {type(field).__name__} {field!r}")
         i = names.index(field) if isinstance(field, str) and field in names else (-1 if isinstance(field, str) else int(field))
         if not 0 <= i < len(names):
             raise KeyError(f"atmos.Volume: no field {field!r}; fields: {names}")

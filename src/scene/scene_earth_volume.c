@@ -29,8 +29,8 @@ atmos_status atmos_scene_cloud_volume(atmos_context *ctx, const atmos_scene *sce
     const double across = atmos_scene_cloud_volume_across(half_width_m, voxel_size_m);
     if (!(across <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
         return atmos__error(ctx, ATMOS_E_INVALID_ARG,
-                            "cloud volume: a half width of %g m in voxels of %g m gives %.0f voxels across (allowed 1..%d)",
-                            half_width_m, voxel_size_m, across, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
+                            "cloud volume: a half width of %g m in voxels of %g m gives %.*g voxels across (allowed 1..%d)",
+                            half_width_m, voxel_size_m, across < 1e9 ? 10 : 3, across, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
     atmos_particle_desc cloud;
     atmos_status st = atmos_particle_preset(ctx, "cloud", &cloud);
     if (st) return st;

@@ -14,8 +14,8 @@ atmos_status atmos__gen_grid_init(gen_job *job, const double lo[3], const double
         double n = ceil((hi[a] - lo[a]) / job->voxel);
         if (!(n >= 1 && n <= ATMOS_VOLUME_MAX_DIM))
             return atmos__error(job->ctx, ATMOS_E_INVALID_ARG,
-                                "generate %s: voxel_size_m %g m gives %.0f voxels along %c (allowed 1..%d)", job->preset,
-                                job->voxel, n, axis[a], ATMOS_VOLUME_MAX_DIM);
+                                "generate %s: voxel_size_m %g m gives %.*g voxels along %c (allowed 1..%d)", job->preset,
+                                job->voxel, n < 1e9 ? 10 : 3, n, axis[a], ATMOS_VOLUME_MAX_DIM);
         job->dims[a] = (int)n;
         job->origin[a] = lo[a];
         total *= (uint64_t)n;

@@ -772,9 +772,9 @@ static atmos_status output_grid(loader *L)
         if (n < 1) n = 1;
         if (n > ATMOS_VOLUME_MAX_DIM)
             return atmos__error(s->ctx, ATMOS_E_LIMIT,
-                                "%s: %.0f voxels of %g m along %s exceed the limit of %d; choose a larger voxel size "
+                                "%s: %.*g voxels of %g m along %s exceed the limit of %d; choose a larger voxel size "
                                 "or a smaller region",
-                                s->path, n, vs, a == 0 ? "x" : a == 1 ? "y" : "z", ATMOS_VOLUME_MAX_DIM);
+                                s->path, n < 1e9 ? 10 : 3, n, vs, a == 0 ? "x" : a == 1 ? "y" : "z", ATMOS_VOLUME_MAX_DIM);
         vd->dims[a] = (int)n;
     }
     vd->voxel_size_m = vs;

@@ -96,6 +96,11 @@ def test_a_callback_whose_answer_cannot_be_told_true_or_false_stops_the_render()
     (lambda: atmos.Plan(SMALL).render(camera={"fov_deg": 0}), ValueError, "fov_deg: must be > 0"),
     (lambda: atmos.Plan(SMALL).render(camera={"up": [0, 0, 0]}), ValueError, "must not be zero"),
     (lambda: atmos.Plan(SMALL).render(spp=0), ValueError, r"\[1, 1000000\]"),
+    (lambda: atmos.mie(None, 10), TypeError, "refractive index"),
+    (lambda: atmos.mie("1.33", 10), TypeError, "refractive index"),
+    (lambda: atmos.sky_radiance(None, [0, 1, 0]), TypeError, "atmos.Scene"),
+    (lambda: atmos.Volume.from_array(np.ones((2, 2, 2)), 1.0).to_array(True), TypeError, "a name or an index"),
+    (lambda: atmos.Volume.from_array(np.ones((2, 2, 2)), 1.0).to_array(1.7), TypeError, "a name or an index"),
 ])
 def test_arguments_the_library_would_misread_are_refused(call, kind, words):
     with pytest.raises(kind, match=words):

@@ -400,8 +400,8 @@ static int cmd_clouds(int argc, char **argv)
     if (!(half > 0 && voxel > 0)) return cli_usage_error(C, "clouds: --half-width and --voxel-size must be > 0");
     const double across = atmos_scene_cloud_volume_across(half, voxel);
     if (!(across <= ATMOS_CLOUD_VOLUME_MAX_ACROSS))
-        return cli_usage_error(C, "clouds: --half-width %g m in voxels of --voxel-size %g m gives %.0f voxels across (allowed 1..%d)",
-                               half, voxel, across, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
+        return cli_usage_error(C, "clouds: --half-width %g m in voxels of --voxel-size %g m gives %.*g voxels across (allowed 1..%d)",
+                               half, voxel, across < 1e9 ? 10 : 3, across, ATMOS_CLOUD_VOLUME_MAX_ACROSS);
     if (cli_volume_output(C, "-o", out)) return CLI_EXIT_USAGE;
     cli_outputs set = {0};
     cli_outputs_add(&set, "-o", out);
