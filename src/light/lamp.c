@@ -13,11 +13,11 @@
 #include <stdio.h>
 #include <string.h>
 
-/* Planck's law up to constants: the spectral radiance of a black body at T (K), nm. */
 /* A light's image at most this many texels: held as doubles with a border, its edges' counts
  * and the decoded floats, about 36 bytes a texel; and the counts stay within an int. */
 #define LAMP_IMAGE_MAX_TEXELS (4096 * 4096)
 
+/* Planck's law up to constants: the spectral radiance of a black body at T (K), nm. */
 static double planck(double nm, double T)
 {
     const double c2 = 1.438776877e7; /* h c / k, nm K */

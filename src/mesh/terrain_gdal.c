@@ -72,7 +72,8 @@ static atmos_status read_rows(char *msg, size_t cap, const char *path, GDALRaste
     /* the file's last row too, where the stride passes it: a file cut short there would
        otherwise be read without a word */
     const int last = GDALGetRasterBandYSize(band) - 1;
-    if ((out->nz - 1) * stride < last && GDALRasterIO(band, GF_Read, 0, last, w, 1, row, w, 1, GDT_Float64, 0, 0) != CE_None) {
+    if ((out->nz - 1) * stride < last &&
+        GDALRasterIO(band, GF_Read, 0, last, w, 1, row, w, 1, GDT_Float64, 0, 0) != CE_None) {
         free(row);
         return fail(msg, cap, ATMOS_E_IO, "terrain %s: reading row %d (the last): %s", path, last,
                     gdal_message("read error"));

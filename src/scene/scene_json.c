@@ -682,8 +682,9 @@ static atmos_status parse_output(const jp *p, const cJSON *j, const char *path, 
 /* ---- user-defined particle types: "particles": {NAME: {...}, ...} ---- */
 
 static const atmos__range r_radius = {0, 0.005, 1, 0}, r_sigma = {0, 2, 1, 0}, r_alpha = {0, 100, 1, 0},
-                          r_gamma = {0, 10, 1, 0}, r_rbound = {0, 0.02, 0, 0}, r_aspect = {0.01, 100, 0, 0},
-                          r_distortion = {0, 1, 0, 0}, /* the crystal tables' own bounds (crystal.c) */ r_rays = {1000, 1e9, 0, 0}, r_g = {-1, 1, 1, 1},
+                          r_gamma = {0, 10, 1, 0}, r_rbound = {0, 0.02, 0, 0},
+                          r_aspect = {0.01, 100, 0, 0}, r_distortion = {0, 1, 0, 0}, /* the crystal tables' (crystal.c) */
+                          r_rays = {1000, 1e9, 0, 0}, r_g = {-1, 1, 1, 1},
                           r_weight = {0, 1e6, 0, 0}, r_sigma_ext = {0, 1, 0, 0}, r_unit = {0, 1, 0, 0};
 
 static atmos_status parse_size(const jp *p, const cJSON *j, const char *path, atmos_size_distribution *d)

@@ -112,7 +112,8 @@ static int parse_setting(const char *C, const atmos_setting *s, const char *text
     if (s->type == ATMOS_SETTING_SEED) {
         char *end = NULL;
         unsigned long long v = strtoull(text, &end, 10);
-        if (!*text || *end || text[0] == '-' || v > (unsigned long long)s->max) { /* compared as integers: 2^53 + 1 is not 2^53 */
+        /* compared as integers: 2^53 + 1 is not 2^53 */
+        if (!*text || *end || text[0] == '-' || v > (unsigned long long)s->max) {
             cli_usage_error(C, "%s: expected an integer in [0, %.0f], got '%s'", opt, s->max, text);
             return 0;
         }
@@ -268,7 +269,8 @@ static int parse_number(int c, const char *arg, render_opts *o)
         return 1;
     case O_VIEW_AZ: return cli_parse_azimuth(C, "--view-azimuth", arg, &o->view_az);
     case O_DSCALE:
-        if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) || !(o->density_scale > 0 && o->density_scale <= 1e30))
+        if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) ||
+            !(o->density_scale > 0 && o->density_scale <= 1e30))
             return cli_usage_error(C, "--density-scale: expected a factor in (0, 1e30] (volume.density_scale's bound)"), 0;
         return 1;
     default: return -1;
