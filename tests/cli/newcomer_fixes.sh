@@ -244,7 +244,7 @@ has "--thickness with spherical" "homogeneous"
 # volume generate: a folder where one of its raw files goes is refused before anything is
 # written (it had left the other fields' raw files and a staged one, no sidecar)
 mkdir -p "$T/gen/g.ice.raw"
-"$A" volume generate storm --voxel-size 600 -o "$T/gen/g.json" 2>"$T/err"; st=$?
+"$A" volume generate storm --voxel-size 600 -q -o "$T/gen/g.json" 2>"$T/err"; st=$?  # -q as every command takes it
 [ $st -eq 1 ] && grep -q "g.ice.raw: exists and is a folder" "$T/err" && [ "$(ls "$T/gen")" = g.ice.raw ] \
     && ok "generate: a folder in the way" || bad "generate: a folder in the way: exit $st, left $(ls "$T/gen"), $(cat "$T/err")"
 
@@ -269,5 +269,10 @@ if [ -n "$(ls "$T/int" | grep -F .staged)" ] && kill -INT $pid 2>/dev/null; then
 else
     wait $pid
 fi
+
+# a hexadecimal number for a real option refused, as for an integer option (it had been read as 16)
+"$A" render --sun-elevation 0x10 --width 8 --height 8 -o "$T/hex.png" 2>"$T/err"; st=$?
+[ $st -eq 2 ] && grep -q -- "--sun-elevation: expected a finite number, got '0x10'" "$T/err" && ok "--sun-elevation 0x10" ||
+    bad "--sun-elevation 0x10: exit $st, $(cat "$T/err")"
 
 exit $fail

@@ -18,6 +18,7 @@ int cli_strtod(const char *text, double *out)
     errno = 0;
     const double v = text ? strtod(text, &end) : 0.0;
     if (!text || end == text || *end != '\0' || errno == ERANGE || !isfinite(v)) return 0;
+    if (strpbrk(text, "xX")) return 0; /* decimal only, as the integer options are (strtod reads 0x10 as 16) */
     *out = v;
     return 1;
 }

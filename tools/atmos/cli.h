@@ -11,7 +11,8 @@
 #define CLI_HELP_EXIT "\nExit status: 0 success, 1 runtime error, 2 usage error.\n"
 enum { CLI_EXIT_OK = 0, CLI_EXIT_RUNTIME = 1, CLI_EXIT_USAGE = 2 };
 
-/* text as a finite number (all of it, in range) into *out: 1; else 0, *out untouched, nothing said. */
+/* text as a finite decimal number (all of it, in range; no hexadecimal) into *out: 1; else 0, *out
+ * untouched, nothing said. */
 int cli_strtod(const char *text, double *out);
 /* Parses a finite number; on failure prints "atmos CMD: OPT: expected a finite number, got
  * 'TEXT'" to stderr and returns 0. */

@@ -15,7 +15,7 @@ void cli_volume_help(void)
 {
     printf("Usage: atmos volume info FILE [--json] [reading options]\n"
            "       atmos volume generate PRESET -o NAME.json [--seed N] [--voxel-size M] [--scale S]\n"
-           "                 [--threads T]\n"
+           "                 [--threads T] [-q]\n"
            "       atmos volume slice FILE --axis x|y|z [--at F] [--field NAME] -o SLICE.png [reading options]\n"
            "       atmos volume clouds SCENE.json -o NAME.json [--centre X,Z] [--half-width M] [--voxel-size M]\n");
     cli_volume_stats_usage();
@@ -206,6 +206,8 @@ static int cmd_generate(int argc, char **argv)
         } else if (!strcmp(argv[i], "-o") && i + 1 < argc) {
             out = argv[++i];
             if (!*out) return cli_usage_error(C, "-o: expected a file name");
+        } else if (!strcmp(argv[i], "-q") || !strcmp(argv[i], "--quiet")) {
+            /* as every command takes it: generate prints nothing but errors anyway */
         } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
             unsigned long long s = 0;
             if (!cli_parse_seed(C, argv[++i], &s)) return CLI_EXIT_USAGE;
