@@ -198,12 +198,13 @@ atmos_status atmos_read_png(atmos_context *ctx, const char *path, atmos_image **
     if (!path) return atmos__error(ctx, ATMOS_E_INVALID_ARG, "atmos_read_png: path is NULL");
     FILE *f = fopen(path, "rb");
     if (!f) return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat whole; /* an empty file: libpng would say "truncated" */
-    if (fstat(fileno(f), &whole) == 0 && S_ISDIR(whole.st_mode)) {
+    struct stat whole; /* a folder, or an empty file: libpng would say "Read Error", "truncated" */
+    const int known = fstat(fileno(f), &whole) == 0;
+    if (known && S_ISDIR(whole.st_mode)) {
         fclose(f);
         return atmos__error(ctx, ATMOS_E_IO, "%s: cannot open: it is a folder, not a file", path);
     }
-    if (fstat(fileno(f), &whole) == 0 && S_ISREG(whole.st_mode) && whole.st_size == 0) {
+    if (known && S_ISREG(whole.st_mode) && whole.st_size == 0) {
         fclose(f);
         return atmos__error(ctx, ATMOS_E_FORMAT, "%s: empty file (0 bytes): not a PNG image", path);
     }

@@ -111,34 +111,18 @@ static void warn_if_empty(const atmos_sim *s, const atmos_sim_desc *d, double mi
             minutes, 1e3 * st.max_qc, d->preset, first, first > 0 ? 2 * first : 1);
 }
 
-/* The files one run writes: the sidecar out = NAME.json and NAME.FIELD.raw for each of the
- * simulation's fields (cloud, rain and with --ice ice, as atmos_volume_write_raw names them). */
+/* The files one run writes (cli_raw_outputs): the sidecar and a raw file for each of the
+ * simulation's fields, cloud, rain and with --ice ice. */
 typedef struct {
     char raw[3][CLI_OUTPUT_PATH_MAX];
     cli_outputs set;
 } sim_outputs;
 
-/* Every file the run will write, checked before the run: the folders made, no existing folder or
- * link in the way, each file creatable (a staging file made). The set stays prepared through the
- * run, so the folders it made are there for the library to write into (and a signal removes the
- * staging files and those folders); the caller discards it after the run, which removes the
- * staging files and the folders made only where the run left them empty. CLI_EXIT_OK or the exit
- * status (the set then holds nothing to discard). */
 static int check_outputs(const char *out, int ice, sim_outputs *o)
 {
     static const char *const fields[3] = {"cloud", "rain", "ice"};
-    const int stem = (int)strlen(out) - 5; /* without .json (cli_volume_output) */
     memset(&o->set, 0, sizeof o->set);
-    cli_outputs_add(&o->set, "-o", out);
-    for (int f = 0; f < 2 + (ice != 0); f++) {
-        const int n = snprintf(o->raw[f], sizeof o->raw[f], "%.*s.%s.raw", stem, out, fields[f]);
-        if (n < 0 || n >= (int)sizeof o->raw[f]) return cli_usage_error(C, "-o %s: the path is too long", out);
-        cli_outputs_add(&o->set, "-o", o->raw[f]);
-    }
-    int rc = cli_outputs_check(C, &o->set, NULL, 0);
-    if (rc == CLI_EXIT_OK && (rc = cli_outputs_prepare(C, &o->set)) == CLI_EXIT_OK)
-        cli_outputs_also_remove(&o->set, ".staged"); /* atmos_volume_write_raw's names until all are written */
-    return rc;
+    return cli_raw_outputs(C, out, fields, 2 + (ice != 0), o->raw, &o->set);
 }
 
 /* The run and the volume written as NAME.json + raw files. */

@@ -172,24 +172,15 @@ static int cmd_info(int argc, char **argv)
     return CLI_EXIT_OK;
 }
 
-/* Every file atmos_volume_write_raw(v, out) will write (the sidecar out = NAME.json and
- * NAME.FIELD.raw for each of v's fields) checked before it writes any: none in the way (a
- * folder, a link), each creatable (a staging file made, discarded by the caller after the
- * write), as atmos simulate checks its own. CLI_EXIT_OK or the exit status (the message said). */
+/* The files atmos_volume_write_raw(v, out) will write, checked before it writes any
+ * (cli_raw_outputs, as atmos simulate checks its own). */
 static int raw_outputs(const char *out, const atmos_volume *v, cli_outputs *set)
 {
     static char raw[CLI_OUTPUTS_MAX][CLI_OUTPUT_PATH_MAX];
-    const int stem = (int)strlen(out) - 5; /* without .json (cli_volume_output) */
-    cli_outputs_add(set, "-o", out);
-    for (int f = 0; f < atmos_volume_field_count(v) && f + 1 < CLI_OUTPUTS_MAX; f++) {
-        const int n = snprintf(raw[f], sizeof raw[f], "%.*s.%s.raw", stem, out, atmos_volume_field_name(v, f));
-        if (n < 0 || n >= (int)sizeof raw[f]) return cli_usage_error(C, "-o %s: the path is too long", out);
-        cli_outputs_add(set, "-o", raw[f]);
-    }
-    int rc = cli_outputs_check(C, set, NULL, 0);
-    if (rc == CLI_EXIT_OK && (rc = cli_outputs_prepare(C, set)) == CLI_EXIT_OK)
-        cli_outputs_also_remove(set, ".staged"); /* atmos_volume_write_raw's names until all are written */
-    return rc;
+    const char *fields[CLI_OUTPUTS_MAX];
+    int n = 0;
+    for (; n < atmos_volume_field_count(v) && n + 1 < CLI_OUTPUTS_MAX; n++) fields[n] = atmos_volume_field_name(v, n);
+    return cli_raw_outputs(C, out, fields, n, raw, set);
 }
 
 static int cmd_generate(int argc, char **argv)

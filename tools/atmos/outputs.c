@@ -382,6 +382,22 @@ int cli_outputs_prepare(const char *cmd, cli_outputs *set)
     return 0;
 }
 
+int cli_raw_outputs(const char *cmd, const char *out, const char *const *fields, int n,
+                    char (*raw)[CLI_OUTPUT_PATH_MAX], cli_outputs *set)
+{
+    const int stem = (int)strlen(out) - 5; /* without .json */
+    cli_outputs_add(set, "-o", out);
+    for (int f = 0; f < n && f + 1 < CLI_OUTPUTS_MAX; f++) {
+        const int k = snprintf(raw[f], CLI_OUTPUT_PATH_MAX, "%.*s.%s.raw", stem, out, fields[f]);
+        if (k < 0 || k >= CLI_OUTPUT_PATH_MAX) return fprintf(stderr, "atmos %s: -o %s: the path is too long\n", cmd, out), 2;
+        cli_outputs_add(set, "-o", raw[f]);
+    }
+    int rc = cli_outputs_check(cmd, set, NULL, 0);
+    if (rc == 0 && (rc = cli_outputs_prepare(cmd, set)) == 0)
+        cli_outputs_also_remove(set, ".staged"); /* atmos_volume_write_raw's names until all are written */
+    return rc;
+}
+
 int cli_outputs_probe(const char *cmd, cli_outputs *set)
 {
     const int made0 = made_n;

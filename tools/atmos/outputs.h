@@ -69,6 +69,14 @@ int cli_output_folder(const char *cmd, const char *option, const char *path);
  * (a raw volume's PATH.staged until the whole set is written): PATH + suffix, and its writer's
  * temporary, removed too on the ending signals, until the set is discarded. */
 void cli_outputs_also_remove(const cli_outputs *set, const char *suffix);
+/* The files atmos_volume_write_raw writes for out = NAME.json: the sidecar and NAME.FIELD.raw for
+ * each of the n fields (at most CLI_OUTPUTS_MAX - 1; their names kept in raw), added to the empty
+ * set, checked and prepared before any is written (none in the way, each creatable), their
+ * PATH.staged names removed too on the ending signals. The set stays prepared through the write,
+ * so the folders it made are there for the library; the caller discards it afterwards. 0, or
+ * the exit status with the message printed (the set then holds nothing to discard). */
+int cli_raw_outputs(const char *cmd, const char *out, const char *const *fields, int n,
+                    char (*raw)[CLI_OUTPUT_PATH_MAX], cli_outputs *set);
 /* Renames every staging file onto its final name. Returns 0 or 1 (message printed). */
 int cli_outputs_commit(const char *cmd, cli_outputs *set);
 /* An animation's frames, all or none: room for frames * per_frame held files (0 or 1: out
