@@ -56,7 +56,7 @@ static atmos_status run_mode(atmos_plan *plan, const atmos_frame *start, int mod
     const double t0 = cli_now_s();
     const clock_t c0 = clock();
     for (int i = 1; i <= n && st == ATMOS_OK; i++) {
-        step_frame(plan, start, mode, i, &f);
+        step_frame(plan, start, mode, i, &f); /* the start's warm_field kept */
         if (mode == MOVE_NOTHING) f.spp = start->spp + i; /* the path tracer adds a sample a frame */
         st = atmos_plan_render(plan, &f, NULL, img, NULL);
     }
@@ -81,10 +81,11 @@ static atmos_status bench_plan(atmos_context *ctx, atmos_volume *v, const atmos_
     return st;
 }
 
-static void print_slice(const char *name, int size, int threads, const double fps[3], const double cpu[3],
-                        const atmos_plan_stats *s,
-                        const atmos_slice_timing *first, double prepare_s, const char *field, int air_shadows, int json)
+static void print_slice(const char *name, const bench_slice_opts *o, double density_scale, int threads,
+                        const double fps[3], const double cpu[3], const atmos_plan_stats *s,
+                        const atmos_slice_timing *first, double prepare_s, const char *field)
 {
+    const int size = o->size, air_shadows = o->air_shadows, json = o->json;
     const atmos_slice_timing *t = &s->slice;
     const long long samples = t->eye_samples + t->light_samples;
     const double ns = samples > 0 ? 1e9 * (t->light + t->eye) / (double)samples : 0;
@@ -94,22 +95,23 @@ static void print_slice(const char *name, int size, int threads, const double fp
                              "\"eye_ms\":%.2f,\"sky_ms\":%.2f,\"prepare_ms\":%.2f,\"eye_samples\":%lld,"
                              "\"light_samples\":%lld,\"grid\":[%d,%d,%d],\"field\":\"%s\",\"field_ms\":%.2f,"
                              "\"field_sweeps\":%d,\"field_cold_ms\":%.2f,\"field_cold_sweeps\":%d,\"cpu_ms_camera_moving\":%.2f,"
-                             "\"cpu_ms_sun_moving\":%.2f,\"air_shadows\":%d,\"air_shadow_ms\":%.2f}\n"
+                             "\"cpu_ms_sun_moving\":%.2f,\"air_shadows\":%d,\"air_shadow_ms\":%.2f,"
+                             "\"density_scale\":%g,\"warm_field\":%d}\n"
                            : "bench=slice case=%s size=%d threads=%d eye=%dx%d fps_camera_moving=%.3f fps_sun_moving=%.3f "
                              "fps_static=%.3f ms_per_frame=%.2f ns_per_sample=%.2f setup_ms=%.2f light_ms=%.2f eye_ms=%.2f "
                              "sky_ms=%.2f prepare_ms=%.2f eye_samples=%lld light_samples=%lld grid=%dx%dx%d field=%s "
                              "field_ms=%.2f field_sweeps=%d field_cold_ms=%.2f field_cold_sweeps=%d cpu_ms_camera_moving=%.2f cpu_ms_sun_moving=%.2f "
-                             "air_shadows=%d air_shadow_ms=%.2f\n";
+                             "air_shadows=%d air_shadow_ms=%.2f density_scale=%g warm_field=%d\n";
     printf(fmt, name, size, threads, t->eye_dims[0], t->eye_dims[1], fps[MOVE_CAMERA], fps[MOVE_SUN], fps[MOVE_NOTHING],
            1e3 / fps[MOVE_SUN], ns, 1e3 * t->setup, 1e3 * t->light, 1e3 * t->eye, 1e3 * t->sky, 1e3 * prepare_s,
            t->eye_samples, t->light_samples, t->grid_dims[0], t->grid_dims[1], t->grid_dims[2], field, 1e3 * t->field,
            t->field_sweeps, 1e3 * first->field, first->field_sweeps, 1e3 * cpu[MOVE_CAMERA], 1e3 * cpu[MOVE_SUN],
-           air_shadows, 1e3 * t->air_shadow);
+           air_shadows, 1e3 * t->air_shadow, density_scale, !o->cold_field);
     fflush(stdout);
 }
 
-int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
-                     int field, int air_shadows, int json)
+int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, double density_scale,
+                     const bench_slice_opts *o)
 {
     atmos_scene scene;
     atmos_plan *plan = NULL;
@@ -118,26 +120,29 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int 
     atmos_plan_stats stats[3];
     atmos_frame start;
     double offset[3];
-    bench_view(&scene, v, size, offset);
+    bench_view(&scene, v, o->size, offset);
     scene.renderer = ATMOS_RENDERER_SLICE;
-    scene.slice.field = field; /* atmos_slice_field: auto (the default, do), p1 or none */
-    scene.slice.air_shadows = air_shadows;
+    scene.slice.field = o->field; /* atmos_slice_field: auto (the default, do), p1 or none */
+    scene.slice.air_shadows = o->air_shadows;
+    scene.volume.density_scale = density_scale;
     atmos_status st = bench_plan(ctx, v, &scene, &plan, &prepare);
     if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
-    if (eye_scale > 0) start.eye_scale = eye_scale;
+    if (o->eye_scale > 0) start.eye_scale = o->eye_scale;
     if (st == ATMOS_OK) st = atmos_plan_image_create(plan, &start, &img);
     /* the plan's first frame: the field's cold build (no warm start) */
     atmos_plan_stats first;
     memset(&first, 0, sizeof first);
     if (st == ATMOS_OK) st = atmos_plan_render(plan, &start, NULL, img, NULL);
     if (st == ATMOS_OK) atmos_plan_get_stats(plan, &first);
-    for (int m = 0; m < 3 && st == ATMOS_OK; m++) st = run_mode(plan, &start, m, frames, img, &sec[m], &cpu[m], &stats[m]);
+    start.warm_field = !o->cold_field; /* a sun move's field from the last sun's, as in the viewer */
+    for (int m = 0; m < 3 && st == ATMOS_OK; m++)
+        st = run_mode(plan, &start, m, o->frames, img, &sec[m], &cpu[m], &stats[m]);
     atmos_image_destroy(img);
     atmos_plan_destroy(plan);
     if (st != ATMOS_OK) return cli_runtime_error("bench", ctx, st);
     for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
-    print_slice(name, size, atmos_context_threads(ctx), fps, cpu, &stats[MOVE_SUN], &first.slice, prepare,
-                atmos_slice_field_name(atmos_scene_slice_field(&scene.slice)), air_shadows, json);
+    print_slice(name, o, density_scale, atmos_context_threads(ctx), fps, cpu, &stats[MOVE_SUN], &first.slice, prepare,
+                atmos_slice_field_name(atmos_scene_slice_field(&scene.slice)));
     return CLI_EXIT_OK;
 }
 

@@ -4,11 +4,19 @@
 
 #include "cli.h"
 
-/* The slice renderer on v at size^2 (Riley et al. 2004 Fig. 14: 256 slices): frames per mode
- * (camera moving, sun moving, static), eye_scale > 0 overriding the scene's; field (an
- * atmos_slice_field) and air_shadows the scene's "slice" settings. */
-int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, int size, int frames, double eye_scale,
-                     int field, int air_shadows, int json);
+typedef struct {
+    int size, frames;  /* the image is size^2; frames per mode */
+    double eye_scale;  /* > 0: overriding the scene's */
+    int field;         /* an atmos_slice_field: the scene's "slice" setting */
+    int air_shadows;   /* the scene's "slice" setting */
+    int cold_field;    /* 1: the sun-moving frames solve the field afresh; 0: warm-started, as the viewer's */
+    int json;
+} bench_slice_opts;
+
+/* The slice renderer on v (densities times density_scale) at size^2 (Riley et al. 2004 Fig. 14:
+ * 256 slices): frames per mode (camera moving, sun moving, static). */
+int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, double density_scale,
+                     const bench_slice_opts *o);
 
 /* The aerial-perspective case: the slice renderer on v (densities times density_scale) under
  * each atmosphere model of the comma-separated list (riley, dobashi, spherical; NULL:

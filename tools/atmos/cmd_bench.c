@@ -23,7 +23,8 @@ static void help(void)
            "       atmos bench optics [--fast] [--presets rain,cloud,...] [--threads T]\n"
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S]\n"
-           "                         [--no-diffuse | --slice-p1] [--no-air-shadows] [--json]\n"
+           "                         [--no-diffuse | --slice-p1] [--no-air-shadows] [--cold-field]\n"
+           "                         [--density-scale S] [--file-only] [--json]\n"
            "       atmos bench slice --aerial [--file FILE] [--models LIST] [--density-scale S] [--size N]\n"
            "                         [--repeat R] [--threads T] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
@@ -78,6 +79,9 @@ static void help(void)
            "            bench=volume case=generated_cumulus load_s=1.2 active_voxels=605554 ...\n"
            "  slice   the half-angle slicing renderer (Riley et al. 2004 Fig. 14: NxN, default 512, 256\n"
            "          slices) on the generated storm and, with --file, on that volume (the Disney cloud),\n"
+           "          its densities times --density-scale S (default 1e8 m^-3 per unit of the file's values,\n"
+           "          as the Disney cloud's scenes; the storm is in physical units; --file-only leaves the\n"
+           "          storm out),\n"
            "          from one plan as an interactive session renders: 8 R frames (default R 3) with the\n"
            "          camera orbiting 3 degrees a frame, then with the sun turning 3 degrees a frame, then\n"
            "          with nothing moving; frames per second of each, end to end (the sky and the\n"
@@ -88,8 +92,9 @@ static void help(void)
            "          (0, 1] or 2 (2: four rays per pixel, averaged).\n"
            "          field: the light scattered more than once, do (the default), p1 (--slice-p1: the\n"
            "          diffusion field) or none (--no-diffuse: Eq. 24/25 alone); field_ms: its build\n"
-           "          (the source and the solve, afresh: these frames are not warm-started) after the\n"
-           "          sun's last move, field_sweeps its sweeps;\n"
+           "          (the source and the solve) after the sun's last move, field_sweeps its sweeps;\n"
+           "          the solve starts from the last sun's field, as the viewer's frames do\n"
+           "          (warm_field=1), or afresh with --cold-field (warm_field=0);\n"
            "          field_cold_ms, field_cold_sweeps: the plan's first frame's (no warm start).\n"
            "          --no-air-shadows leaves out the volume's shadow on the air (\"air_shadows\", on by\n"
            "          default); air_shadow_ms: its share of the last sun-moving frame (part of sky_ms).\n"
@@ -492,26 +497,27 @@ static int bench_aerial(const char *file, int size, int frames, int threads, con
     return rc;
 }
 
-/* The slice renderer's cases: the generated storm and, with FILE, that volume. */
-static int bench_slice(const char *file, int size, int frames, int threads, double eye_scale, int field,
-                       int air_shadows, int json)
+/* The slice renderer's cases: the generated storm (unless file_only) and, with FILE, that volume. */
+static int bench_slice(const char *file, int file_only, const bench_slice_opts *o, int threads, double dscale)
 {
     atmos_context *ctx = cli_context(threads, 1);
     if (!ctx) return CLI_EXIT_RUNTIME;
     int rc = CLI_EXIT_OK;
     atmos_volume_generate_desc g = {.seed = 1};
     atmos_volume *v = NULL;
-    atmos_status st = atmos_volume_generate(ctx, "storm", &g, &v);
-    if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-    else rc = bench_slice_case(ctx, "generated_storm", v, size, frames, eye_scale, field, air_shadows, json);
-    atmos_volume_destroy(v);
-    v = NULL;
+    atmos_status st = ATMOS_OK;
+    if (!file_only) {
+        st = atmos_volume_generate(ctx, "storm", &g, &v);
+        if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
+        else rc = bench_slice_case(ctx, "generated_storm", v, 1, o);
+        atmos_volume_destroy(v);
+        v = NULL;
+    }
     if (rc == CLI_EXIT_OK && file) {
         st = atmos_volume_load(ctx, file, &bench_load, &v);
         const char *base = strrchr(file, '/');
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, size, frames, eye_scale, field, air_shadows,
-                                   json);
+        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, dscale > 0 ? dscale : 1e8, o);
         atmos_volume_destroy(v);
     }
     atmos_context_destroy(ctx);
@@ -539,7 +545,7 @@ int cli_cmd_bench(int argc, char **argv)
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16, aerial = 0;
     double dscale = 0, eye_scale = 0, budget = 2;
-    int field = ATMOS_SLICE_FIELD_AUTO, air_shadows = 1;
+    int field = ATMOS_SLICE_FIELD_AUTO, air_shadows = 1, cold_field = 0, file_only = 0;
     const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL, *beams_case = NULL;
     if (argc > 1 && !strcmp(argv[1], "sky-accuracy")) return bench_sky_accuracy_main(argc - 1, argv + 1);
     bench_path_opts pflags;
@@ -577,6 +583,10 @@ int cli_cmd_bench(int argc, char **argv)
             field = argv[i][8] == 'p' ? ATMOS_SLICE_FIELD_P1 : ATMOS_SLICE_FIELD_DO;
         } else if (!strcmp(argv[i], "--no-air-shadows")) {
             air_shadows = 0;
+        } else if (!strcmp(argv[i], "--cold-field")) {
+            cold_field = 1;
+        } else if (!strcmp(argv[i], "--file-only")) {
+            file_only = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "--fast")) {
@@ -613,9 +623,13 @@ int cli_cmd_bench(int argc, char **argv)
     if (!strcmp(what, "path")) return bench_path(file, &pflags, threads);
     if (!strcmp(what, "slice") && aerial)
         return bench_aerial(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, models, dscale, json);
-    if (!strcmp(what, "slice"))
-        return bench_slice(file, size ? size : 512, 8 * (repeat_set ? repeat : 3), threads, eye_scale, field, air_shadows,
-                           json);
+    if (!strcmp(what, "slice")) {
+        const bench_slice_opts so = {.size = size ? size : 512, .frames = 8 * (repeat_set ? repeat : 3),
+                                     .eye_scale = eye_scale, .field = field, .air_shadows = air_shadows,
+                                     .cold_field = cold_field, .json = json};
+        if (file_only && !file) return cli_usage_error(C, "--file-only: give the volume with --file");
+        return bench_slice(file, file_only, &so, threads, dscale);
+    }
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads, models, budget);
     if (!strcmp(what, "optics")) return bench_optics(threads, fast, presets);
     if (!strcmp(what, "volume")) return bench_volume(file, repeat < 3 ? repeat : 3, threads);

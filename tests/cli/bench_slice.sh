@@ -1,0 +1,51 @@
+#!/bin/sh
+# atmos bench slice (docs/performance.md, "The slice renderer"): a small generated cumulus from
+# its file alone (--file-only: the generated storm left out), --json. Checked (python3): one
+# object, for the file, with the density scale asked for and the discrete-ordinates field; the
+# sun-moving frames warm-started by default (warm_field 1) take fewer of the field's sweeps than
+# the plan's first, cold frame, and with --cold-field (warm_field 0) as many as it; without
+# --density-scale a file's values are taken as 1e8 m^-3 a unit (the Disney cloud's scenes);
+# --file-only without --file is a usage error.
+set -u
+A=${ATMOS_CLI:?ATMOS_CLI not set}
+T=${ATMOS_TEST_TMP:-/tmp}/bench_slice.$$
+rm -rf "$T"
+mkdir -p "$T" || exit 1
+trap 'rm -rf "$T"' EXIT
+export XDG_CACHE_HOME="$T/cache"
+fail=0
+ok() { printf 'ok: %s\n' "$1"; }
+bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+
+"$A" volume generate cumulus -o "$T/cu.json" --voxel-size 100 >/dev/null || bad "volume generate"
+run() { # OUT ARGS...: the bench on the cumulus, its JSON into OUT
+    out=$1
+    shift
+    "$A" bench slice --file "$T/cu.json" --file-only --size 32 --repeat 1 --threads 2 --json "$@" >"$out" 2>"$T/err.txt"
+    st=$?
+    [ $st -eq 0 ] && ok "bench slice $* exits 0" || { bad "bench slice $*: exit $st"; cat "$T/err.txt" >&2; }
+}
+run "$T/warm.json" --density-scale 1
+run "$T/cold.json" --density-scale 1 --cold-field
+run "$T/default.json" --no-diffuse
+python3 - "$T/warm.json" "$T/cold.json" "$T/default.json" <<'PY' && ok "bench slice figures" || bad "bench slice figures"
+import json, math, sys
+def one(path):
+    rows = [json.loads(l) for l in open(path) if l.strip()]
+    assert len(rows) == 1, rows  # the storm left out
+    r = rows[0]
+    assert r["bench"] == "slice" and r["case"] == "cu.json" and r["size"] == 32, r
+    for k in ("fps_camera_moving", "fps_sun_moving", "cpu_ms_camera_moving", "cpu_ms_sun_moving", "field_ms"):
+        assert math.isfinite(r[k]) and r[k] >= 0, (k, r)
+    return r
+warm, cold, default = (one(p) for p in sys.argv[1:])
+assert warm["density_scale"] == 1 and warm["warm_field"] == 1 and warm["field"] == "do", warm
+assert cold["density_scale"] == 1 and cold["warm_field"] == 0, cold
+assert 0 < warm["field_sweeps"] < warm["field_cold_sweeps"], warm
+assert cold["field_sweeps"] == cold["field_cold_sweeps"] > 0, cold
+assert default["density_scale"] == 1e8 and default["field"] == "none" and default["field_sweeps"] == 0, default
+PY
+"$A" bench slice --file-only >/dev/null 2>"$T/bad.err"
+[ $? -eq 2 ] && grep -q -- "--file" "$T/bad.err" && ok "--file-only without --file is a usage error" ||
+    bad "--file-only without --file should exit 2"
+exit $fail
