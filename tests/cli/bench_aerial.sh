@@ -7,16 +7,7 @@
 # (< 1e-5), the spherical sky's through its aerial-perspective volume within 1 % of the
 # per-pixel air (and not identical to it: the volume is in use); an unknown model is a
 # usage error.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/bench_aerial.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 
 "$A" volume generate cumulus -o "$T/cu.json" --voxel-size 100 >/dev/null || bad "volume generate"
 "$A" bench slice --aerial --file "$T/cu.json" --density-scale 1 --size 48 --repeat 1 --threads 2 --json \

@@ -6,16 +6,7 @@
 # the plan's first, cold frame, and with --cold-field (warm_field 0) as many as it; without
 # --density-scale a file's values are taken as 1e8 m^-3 a unit (the Disney cloud's scenes);
 # --file-only without --file is a usage error.
-set -u
-A=${ATMOS_CLI:?ATMOS_CLI not set}
-T=${ATMOS_TEST_TMP:-/tmp}/bench_slice.$$
-rm -rf "$T"
-mkdir -p "$T" || exit 1
-trap 'rm -rf "$T"' EXIT
-export XDG_CACHE_HOME="$T/cache"
-fail=0
-ok() { printf 'ok: %s\n' "$1"; }
-bad() { printf 'FAIL: %s\n' "$1" >&2; fail=1; }
+. "$(dirname "$0")/common.inc"
 
 "$A" volume generate cumulus -o "$T/cu.json" --voxel-size 100 >/dev/null || bad "volume generate"
 run() { # OUT ARGS...: the bench on the cumulus, its JSON into OUT
