@@ -133,6 +133,19 @@ cp "$SRC/scenes/dobashi_fig09b_window.png" "$T/win.png"; cp "$T/win.png" "$T/win
     --pfm "$T/x.pfm" -o "$T/hm.png" 2>"$T/err"
 [ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/err" && cmp -s "$T/hm.png" "$T/win0.png" && [ ! -e "$T/x.pfm" ] && ok ||
     bad "-o over the height map: $(cat "$T/err")"
+# a raw volume's data file, which its sidecar names (here data.exr), is an input too: render and
+# volume slice refuse it as an output and leave it whole
+"$A" volume generate cumulus -o "$T/cu.json" --voxel-size 200 >/dev/null || bad "volume generate"
+rawf=$(python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d["fields"][0]["file"])' "$T/cu.json")
+cp "$T/$rawf" "$T/data.exr"; cp "$T/data.exr" "$T/data0.exr"; cp "$T/data.exr" "$T/slice.png"
+sed "s|\"$rawf\"|\"data.exr\"|" "$T/cu.json" >"$T/side.json"
+sed "s|\"$rawf\"|\"slice.png\"|" "$T/cu.json" >"$T/side2.json"
+"$A" render -q --volume "$T/side.json" $S --exr "$T/data.exr" 2>"$T/err"
+[ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/err" && cmp -s "$T/data.exr" "$T/data0.exr" && ok ||
+    bad "--exr over the volume's raw data: $(cat "$T/err")"
+"$A" volume slice "$T/side2.json" --axis z -o "$T/slice.png" 2>"$T/err"
+[ $? -eq 2 ] && grep -q "refusing to overwrite an input" "$T/err" && cmp -s "$T/slice.png" "$T/data0.exr" && ok ||
+    bad "volume slice -o over the volume's raw data: $(cat "$T/err")"
 ln -s "$T/f.exr" "$T/link.exr"
 "$A" render -q $S --exr "$T/link.exr" -o "$T/f.exr" 2>/dev/null; [ $? -eq 2 ] && ok || bad "an output and a link to it"
 cp "$T/f.exr" "$T/ref.exr"

@@ -3,6 +3,7 @@
  * is rendered from that plan (atmos_plan_render, the same call atmos_render_scene makes). */
 #define _POSIX_C_SOURCE 200809L /* access */
 #include "outputs.h"
+#include "sidecar_inputs.h"
 #include "render_opts.h"
 #include "dist.h"
 #include "render_exposure.h"
@@ -451,8 +452,12 @@ static int check_outputs(const render_opts *o, const atmos_scene *scene, const c
 {
     cli_outputs set = {0};
     add_outputs(o, png, &set);
-    const char *inputs[SCENE_INPUTS_MAX];
-    return cli_outputs_check("render", &set, inputs, scene_inputs(o, scene, inputs));
+    const char *inputs[SCENE_INPUTS_MAX + 64];
+    static char data[64][CLI_OUTPUT_PATH_MAX]; /* a raw volume's data files, which its sidecar names */
+    int n = scene_inputs(o, scene, inputs), ndata = 0;
+    if (inputs[1]) cli_sidecar_files(inputs[1], data, 64, &ndata); /* inputs[1]: the volume's file */
+    for (int k = 0; k < ndata; k++) inputs[n++] = data[k];
+    return cli_outputs_check("render", &set, inputs, n);
 }
 
 /* The render after the scene is made: outputs checked and staged (rank 0), the plan, the

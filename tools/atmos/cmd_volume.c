@@ -1,6 +1,7 @@
 /* atmos volume: inspect, generate and slice volumes. No physics here. */
 #include "cli.h"
 #include "outputs.h"
+#include "sidecar_inputs.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -297,6 +298,14 @@ static int cmd_slice(int argc, char **argv)
     if (axis < 0) return cli_usage_error(C, "slice: missing --axis x|y|z");
     if (!out) return cli_usage_error(C, "slice: missing -o SLICE.png");
     if (cli_png_output(C, "-o", out)) return CLI_EXIT_USAGE;
+    cli_outputs set = {0};
+    cli_outputs_add(&set, "-o", out);
+    static char data[64][CLI_OUTPUT_PATH_MAX]; /* a raw volume's data files */
+    const char *inputs[1 + 64] = {file};
+    int ninputs = 1, ndata = 0;
+    cli_sidecar_files(file, data, 64, &ndata);
+    for (int k = 0; k < ndata; k++) inputs[ninputs++] = data[k];
+    if (cli_outputs_check(C, &set, inputs, ninputs)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */
     if (!ctx) return CLI_EXIT_RUNTIME;

@@ -2,8 +2,8 @@
  * (include/atmos/cloudstats.h, docs/clouds.md "Shape statistics"). No physics here. */
 #include "cli.h"
 #include "outputs.h"
+#include "sidecar_inputs.h"
 
-#include <cjson/cJSON.h>
 
 #include <math.h>
 #include <stdint.h>
@@ -286,33 +286,6 @@ static int measure(atmos_context *ctx, const opts *o, const char *src, uint64_t 
     return st == ATMOS_OK ? CLI_EXIT_OK : cli_runtime_error(C, ctx, st);
 }
 
-/* The data files a raw volume's sidecar (a source NAME.json) names, its "file" and each field's,
- * against the sidecar's folder as the reader takes them, added to names from *n on (at most
- * cap): inputs too, which no output may replace. A file that is no such sidecar adds none. */
-static void sidecar_files(const char *path, char (*names)[CLI_OUTPUT_PATH_MAX], int cap, int *n)
-{
-    const size_t len = strlen(path);
-    FILE *f = len > 5 && !strcmp(path + len - 5, ".json") ? fopen(path, "rb") : NULL;
-    if (!f) return;
-    static char text[1 << 20];
-    const size_t got = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    text[got] = '\0';
-    cJSON *root = cJSON_Parse(text), *fields = cJSON_GetObjectItemCaseSensitive(root, "fields"), *it;
-    const char *slash = strrchr(path, '/');
-    const int dir = slash ? (int)(slash - path) + 1 : 0;
-    const cJSON *files[64];
-    int k = 0;
-    files[k++] = cJSON_GetObjectItemCaseSensitive(root, "file");
-    if (!cJSON_IsArray(fields)) fields = NULL;
-    cJSON_ArrayForEach(it, fields) if (k < 64) files[k++] = cJSON_GetObjectItemCaseSensitive(it, "file");
-    for (int i = 0; i < k && *n < cap; i++)
-        if (cJSON_IsString(files[i]) && files[i]->valuestring[0])
-            snprintf(names[(*n)++], CLI_OUTPUT_PATH_MAX, "%.*s%s", files[i]->valuestring[0] == '/' ? 0 : dir, path,
-                     files[i]->valuestring);
-    cJSON_Delete(root);
-}
-
 int cli_cmd_volume_stats(int argc, char **argv)
 {
     opts o;
@@ -339,7 +312,7 @@ int cli_cmd_volume_stats(int argc, char **argv)
     for (int s = 0; s < o.nsources; s++) {
         const int file = strncmp(o.sources[s], "generate:", 9) && strncmp(o.sources[s], "simulate:", 9);
         inputs[s] = file ? o.sources[s] : NULL;
-        if (file) sidecar_files(o.sources[s], data, 64, &ndata);
+        if (file) cli_sidecar_files(o.sources[s], data, 64, &ndata);
     }
     for (int k = 0; k < ndata; k++) inputs[ninputs++] = data[k];
     if ((rc = cli_outputs_check(C, &set, inputs, ninputs)) != CLI_EXIT_OK) return rc;
