@@ -79,8 +79,8 @@ for c in $CASES; do
             slice_do) opts="--slice-do --edge-aa 0" ;;
             slice_do_aa) opts="--slice-do --eye-scale 2" ;;
             slice_do_edge) opts="--slice-do --edge-aa ${EDGE_AA:-0.05}" ;;
-            nishita_do) opts="--renderer nishita --nishita-orders 1 --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do" ;;
-            nishita_do_nosky) opts="--renderer nishita --nishita-orders 1 --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do \
+            nishita_do) opts="--renderer nishita --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do" ;;
+            nishita_do_nosky) opts="--renderer nishita --nishita-mc-lmax 3 --nishita-mc-delta-m --nishita-do \
 --no-nishita-sky" ;;
             nishita) opts="--renderer nishita -D nishita.do=false -D nishita.mc_delta_m=false" ;; # as written
             harris) opts="--renderer harris" ;;

@@ -105,6 +105,28 @@ atmos_status atmos__nishita_do_plan_create(atmos_plan *p, const sgrid *grid, atm
     return ATMOS_OK;
 }
 
+/* The settings a field of every order leaves without a use (the discrete-ordinates field, do, or
+ * photons, mc_kphotons: nishita_render.c then draws neither the orders 2-3 by reference patterns
+ * nor the diffuse field), warned of when they differ from their defaults (the scene cannot tell a
+ * default given from one left out). */
+static void warn_unused(atmos_context *ctx, const atmos_scene_nishita *sn)
+{
+    atmos_scene d;
+    atmos_scene_defaults(&d);
+    const atmos_scene_nishita *dn = &d.nishita;
+    const char *field = sn->do_field ? "do (the discrete-ordinates field gives every order >= 2; "
+                                       "\"do\": false for the paper's method)"
+                                     : "mc_kphotons (the photons' field gives every order >= 2)";
+    if (!sn->do_field && sn->mc_kphotons <= 0) return;
+    if (sn->do_field && sn->mc_kphotons > 0)
+        atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_kphotons does nothing with do (the discrete-ordinates field "
+                                        "takes the photons' place; \"do\": false to trace them)");
+    if (sn->orders != dn->orders || sn->ratio != dn->ratio || sn->paths != dn->paths)
+        atmos__log(ctx, ATMOS_LOG_WARN, "nishita: orders, ratio and paths (the orders 2-3 by reference patterns) "
+                                        "do nothing with %s", field);
+    if (sn->diffuse) atmos__log(ctx, ATMOS_LOG_WARN, "nishita: diffuse does nothing with %s", field);
+}
+
 atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out)
 {
     atmos_context *ctx = p->ctx;
@@ -125,7 +147,8 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
         else
             cell_medium(np), atmos__nishita_truncate(np);
     }
-    np->diffuse = p->scene.nishita.diffuse;
+    /* the diffuse field is drawn only without a field of every order (nishita_render.c) */
+    np->diffuse = p->scene.nishita.diffuse && !p->scene.nishita.do_field && p->scene.nishita.mc_kphotons <= 0;
     if (st == ATMOS_OK && np->g.v && np->diffuse) {
         /* Ams_2 for the scattered beam (nishita_render.c); F_n and B_n for the field's source */
         st = atmos__stables_build(ctx, p->optics, np->n, 2, &np->tab);
@@ -143,6 +166,7 @@ atmos_status atmos__nishita_plan_create(atmos_plan *p, atmos__nishita_plan **out
     else if (sn->mc_dm_clip && sn->do_field)
         atmos__log(ctx, ATMOS_LOG_WARN, "nishita: mc_dm_clip does nothing with do (discrete ordinates trace no "
                                         "photons)");
+    warn_unused(ctx, sn);
     if (st != ATMOS_OK) {
         atmos__nishita_plan_destroy(np);
         return st;
