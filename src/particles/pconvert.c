@@ -97,6 +97,14 @@ atmos_status atmos__pcloud_from_volume(atmos_context *ctx, const atmos_volume *v
             atmos__pcloud_free(out);
             return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the particles of a volume");
         }
+    double peak = 0;
+    for (int fi = 0; fi < nf; fi++) peak = fmax(peak, thr[fi]);
+    if (out->n < 8 && peak > 0) /* a volume with a cloud in it, next to none of it made into particles */
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "particles: the volume made %d particle%s (cells of %g m%s): %s; a smaller spacing, or a larger "
+                   "max_particles, makes more", out->n, out->n == 1 ? "" : "s", m * f.vs,
+                   h > 0 ? ", the spacing's" : ", as coarse as max_particles asks",
+                   out->n ? "the cloud is drawn as a few blobs" : "nothing of it is drawn");
     return ATMOS_OK;
 }
 

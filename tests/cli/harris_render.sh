@@ -2,7 +2,8 @@
 # atmos render --renderer harris (docs/particles.md): a generated cumulus renders, the image
 # does not depend on the thread count (same EXR pixels on 1 and 2 threads), the cloud covers
 # pixels and is brighter on its sunlit side than the air beside it, the "harris" section's
-# settings are read and checked, and the renderer refuses a scene without a volume.
+# settings are read and checked, the renderer refuses a scene without a volume, and a volume
+# made into next to no particles (a huge spacing, max_particles 2) is warned of.
 set -u
 . "$(dirname "$0")/common.inc"
 
@@ -44,4 +45,16 @@ printf '{"renderer": "harris", "harris": {"sky_lights": 40}, "volume": {"generat
 [ $st -ne 0 ] && grep -q "sky_lights" "$T/eb.txt" && ok "sky_lights out of range refused" || bad "sky_lights 40 accepted (exit $st)"
 "$A" render --renderer harris -o "$T/nv.png" 2>"$T/en.txt"; st=$?
 [ $st -eq 2 ] && grep -q "needs --volume" "$T/en.txt" && ok "harris without a volume: usage error" || bad "harris without a volume (exit $st)"
+# a volume made into next to no particles says so: none at a spacing wider than the cloud, two
+# when max_particles asks for two (the default's render: no such warning, above's e1.txt)
+! grep -q "particles: the volume made" "$T/e1.txt" && ok "no particle warning by default" ||
+    bad "particle warning by default: $(cat "$T/e1.txt")"
+"$A" render --volume generate:cumulus --voxel-size 120 --renderer harris --width 24 --height 16 --spacing 100000 \
+    -o "$T/sp.png" -q 2>"$T/esp.txt"
+grep -q "the volume made 0 particles .*nothing of it is drawn" "$T/esp.txt" && ok "--spacing wider than the cloud: warned" ||
+    bad "--spacing 100000: $(cat "$T/esp.txt")"
+"$A" render --volume generate:cumulus --voxel-size 120 --renderer harris --width 24 --height 16 --max-particles 2 \
+    -o "$T/mp.png" -q 2>"$T/emp.txt"
+grep -q "the volume made [12] particles\? .*as coarse as max_particles asks" "$T/emp.txt" && ok "--max-particles 2: warned" ||
+    bad "--max-particles 2: $(cat "$T/emp.txt")"
 exit $fail
