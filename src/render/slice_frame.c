@@ -373,6 +373,11 @@ atmos_status atmos__slice_frame_setup(atmos_context *ctx, atmos__slice_plan *sp,
                    "render slice: this view of the volume would need %d slices to sample its thinnest extent "
                    "without banding; using %d (set \"slices\" / --slices to choose)",
                    needed, j->nslices);
+    if (v->eye_scale < 1 && (j->W < 16 || j->H < 16) && (j->W < v->cam.width || j->H < v->cam.height))
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "render slice: eye_scale %g makes an eye buffer of %d x %d for the %d x %d image, which is that "
+                   "buffer's few pixels enlarged (eye_scale 1: a ray for every pixel)",
+                   v->eye_scale, j->W, j->H, v->cam.width, v->cam.height);
     sp->slices_used = j->nslices;
     if (!job_buffers(sp, j)) return atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the buffers");
     double cf[3], cr[3], cu[3];

@@ -110,6 +110,12 @@ PY
     --pfm "$T/eh1.pfm" --threads 1 --eye-scale 0.5 && cmp -s "$T/eh1.pfm" "$T/eh2.pfm" && ok || bad "--eye-scale 0.5"
 "$A" render -q --volume generate:cumulus --eye-scale 1.5 -o "$T/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--eye-scale 1.5 should exit 2"
 "$A" render -q --volume generate:nope -o "$T/x.png" 2>/dev/null; [ $? -eq 1 ] && ok || bad "unknown generator should exit 1"
+# an eye_scale that leaves a buffer of a pixel or two for the image says so; a half-size one does not
+"$A" render -q --volume generate:cumulus --voxel-size 120 --width 48 --height 32 --eye-scale 0.01 -o "$T/es.png" \
+    2>"$T/es.err" && grep -q "eye_scale 0.01 makes an eye buffer of 1 x 1 for the 48 x 32 image" "$T/es.err" && ok ||
+    bad "--eye-scale 0.01: $(cat "$T/es.err")"
+"$A" render -q --volume generate:cumulus --voxel-size 120 --width 48 --height 32 --eye-scale 0.5 -o "$T/es.png" \
+    2>"$T/es.err" && ! grep -q "eye buffer" "$T/es.err" && ok || bad "--eye-scale 0.5: $(cat "$T/es.err")"
 rm -rf "$T"
 echo "slice_render: $pass passed"
 [ "$fail" -eq 0 ]
