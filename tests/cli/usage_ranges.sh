@@ -61,4 +61,20 @@ usage "--volume-scale: expected a factor in \[0.05, 20\] for a generated volume,
 # simulate past the voxel limit: refused before the run, no folder or file left
 usage "--grid 512 --refine 4: refine 4 makes" simulate cumulus_field --grid 512 --refine 4 -q -o "$T/sim/c.json"
 [ ! -e "$T/sim" ] && ok "simulate: no folder left" || bad "simulate: $T/sim left"
+# a number that is none (nan, a word) is one usage error, said once: the range's message came after
+# the parse's as a second error
+once() { # the option's name, then the command
+    name=$1
+    shift
+    "$A" "$@" 2>"$T/err" >/dev/null
+    rc=$?
+    [ $rc -eq 2 ] && [ "$(grep -c "^atmos .*: $name: " "$T/err")" -eq 1 ] && grep -q -- "$name: expected a finite number" "$T/err" &&
+        ok "$*: one message" || { bad "$*: exit $rc, not one message"; cat "$T/err" >&2; }
+}
+once --density-scale render --volume generate:cumulus --density-scale nan $R
+once --fov render --fov inf $R
+once --thickness render --thickness abc $R
+once --voxel-size volume info --voxel-size q "$S/scenes/simulated_cumulus.json"
+once --thickness sky --thickness zz -o "$T/x.png"
+once --budget bench sky --budget nan
 exit $fail

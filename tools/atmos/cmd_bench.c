@@ -562,10 +562,12 @@ int cli_cmd_bench(int argc, char **argv)
         } else if (!strcmp(argv[i], "--spp") && i + 1 < argc) {
             if (!cli_parse_int(C, "--spp", argv[++i], 1, ATMOS_PATH_MAX_SPP, &spp)) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "--density-scale") && i + 1 < argc) {
-            if (!cli_parse_double(C, "--density-scale", argv[++i], &dscale) || !(dscale > 0))
+            if (!cli_parse_double(C, "--density-scale", argv[++i], &dscale)) return CLI_EXIT_USAGE; /* its message given */
+            if (!(dscale > 0))
                 return cli_usage_error(C, "--density-scale: expected a factor > 0");
         } else if (!strcmp(argv[i], "--eye-scale") && i + 1 < argc) {
-            if (!cli_parse_double(C, "--eye-scale", argv[++i], &eye_scale) || !(eye_scale > 0 && (eye_scale <= 1 || eye_scale == 2)))
+            if (!cli_parse_double(C, "--eye-scale", argv[++i], &eye_scale)) return CLI_EXIT_USAGE; /* its message given */
+            if (!(eye_scale > 0 && (eye_scale <= 1 || eye_scale == 2)))
                 return cli_usage_error(C, "--eye-scale: expected a value in (0, 1] or 2");
         } else if (!strcmp(argv[i], "--no-forced")) {
             pflags.no_forced = 1;
@@ -599,7 +601,8 @@ int cli_cmd_bench(int argc, char **argv)
             if (!model_list_ok(models))
                 return cli_usage_error(C, "--models: expected a list of riley, dobashi, spherical, got '%s'", models);
         } else if (!strcmp(argv[i], "--budget") && i + 1 < argc) {
-            if (!cli_parse_double(C, "--budget", argv[++i], &budget) || !(budget > 0))
+            if (!cli_parse_double(C, "--budget", argv[++i], &budget)) return CLI_EXIT_USAGE; /* its message given */
+            if (!(budget > 0))
                 return cli_usage_error(C, "--budget: expected seconds > 0");
         } else if (!strcmp(argv[i], "--case") && i + 1 < argc) {
             beams_case = argv[++i];

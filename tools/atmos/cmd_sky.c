@@ -195,7 +195,8 @@ int cli_cmd_sky(int argc, char **argv)
                                        optarg);
             break;
         case 't':
-            if (!cli_parse_double(C, "--thickness", optarg, &o.top) || !(o.top >= 1 && o.top <= 1e6))
+            if (!cli_parse_double(C, "--thickness", optarg, &o.top)) return CLI_EXIT_USAGE; /* its message given */
+            if (!(o.top >= 1 && o.top <= 1e6))
                 return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]");
             thickness = 1;
             break;

@@ -241,36 +241,40 @@ static int parse_number(int c, const char *arg, render_opts *o)
     case O_SEL_END: return cli_parse_double(C, "--sun-elevation-end", arg, &o->sun_el_end);
     case O_SAZ_END: return cli_parse_azimuth(C, "--sun-azimuth-end", arg, &o->sun_az_end);
     case O_THICKNESS:
-        if (!cli_parse_double(C, "--thickness", arg, &o->thickness) || !(o->thickness >= 1 && o->thickness <= 1e6))
+        if (!cli_parse_double(C, "--thickness", arg, &o->thickness)) return 0; /* its message given */
+        if (!(o->thickness >= 1 && o->thickness <= 1e6))
             return cli_usage_error(C, "--thickness: expected metres in [1, 1000000]"), 0;
         return 1;
     case O_TINDEX: return cli_parse_int(C, "--time-index", arg, 0, 1000000, &o->time_index);
     case O_VOXEL:
-        if (!cli_parse_double(C, "--voxel-size", arg, &o->voxel_size) || !(o->voxel_size > 0 && o->voxel_size <= 1e5))
+        if (!cli_parse_double(C, "--voxel-size", arg, &o->voxel_size)) return 0; /* its message given */
+        if (!(o->voxel_size > 0 && o->voxel_size <= 1e5))
             return cli_usage_error(C, "--voxel-size: expected metres in (0, 100000]"), 0;
         return 1;
     case O_VSCALE:
-        if (!cli_parse_double(C, "--volume-scale", arg, &o->volume_scale) ||
-            !(o->volume_scale > 0 && o->volume_scale <= 100))
+        if (!cli_parse_double(C, "--volume-scale", arg, &o->volume_scale)) return 0; /* its message given */
+        if (!(o->volume_scale > 0 && o->volume_scale <= 100))
             return cli_usage_error(C, "--volume-scale: expected a factor in (0, 100]"), 0;
         return 1;
     case O_DETAIL:
-        if (!cli_parse_double(C, "--subgrid-detail", arg, &o->subgrid_detail) ||
-            !(o->subgrid_detail > 0 && o->subgrid_detail <= 1))
+        if (!cli_parse_double(C, "--subgrid-detail", arg, &o->subgrid_detail)) return 0; /* its message given */
+        if (!(o->subgrid_detail > 0 && o->subgrid_detail <= 1))
             return cli_usage_error(C, "--subgrid-detail: expected an amplitude in (0, 1]"), 0;
         return 1;
     case O_FOV:
-        if (!cli_parse_double(C, "--fov", arg, &o->fov) || !(o->fov > 0 && o->fov <= 360))
+        if (!cli_parse_double(C, "--fov", arg, &o->fov)) return 0; /* its message given */
+        if (!(o->fov > 0 && o->fov <= 360))
             return cli_usage_error(C, "--fov: expected degrees in (0, 360]"), 0;
         return 1;
     case O_VIEW_EL:
-        if (!cli_parse_double(C, "--view-elevation", arg, &o->view_el) || !(fabs(o->view_el) <= 90))
+        if (!cli_parse_double(C, "--view-elevation", arg, &o->view_el)) return 0; /* its message given */
+        if (!(fabs(o->view_el) <= 90))
             return cli_usage_error(C, "--view-elevation: expected degrees in [-90, 90]"), 0;
         return 1;
     case O_VIEW_AZ: return cli_parse_azimuth(C, "--view-azimuth", arg, &o->view_az);
     case O_DSCALE:
-        if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale) ||
-            !(o->density_scale > 0 && o->density_scale <= 1e30))
+        if (!cli_parse_double(C, "--density-scale", arg, &o->density_scale)) return 0; /* its message given */
+        if (!(o->density_scale > 0 && o->density_scale <= 1e30))
             return cli_usage_error(C, "--density-scale: expected a factor in (0, 1e30] (volume.density_scale's bound)"), 0;
         return 1;
     default: return -1;

@@ -20,12 +20,14 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
     } else if (!strcmp(a, "--time") || !strcmp(a, "--time-index")) { /* --time-index: as atmos render's */
         if (!cli_parse_int(C, a, argv[++*i], 0, 1000000, &d->time_index)) return -1;
     } else if (!strcmp(a, "--voxel-size")) {
-        if (!cli_parse_double(C, "--voxel-size", argv[++*i], &d->voxel_size_m) || !(d->voxel_size_m > 0)) {
+        if (!cli_parse_double(C, "--voxel-size", argv[++*i], &d->voxel_size_m)) return -1; /* its message given */
+        if (!(d->voxel_size_m > 0)) {
             cli_usage_error(C, "--voxel-size: expected metres > 0");
             return -1;
         }
     } else if (!strcmp(a, "--scale") || !strcmp(a, "--density-scale")) { /* --density-scale: render's */
-        if (!cli_parse_double(C, a, argv[++*i], &d->density_scale) || !(d->density_scale > 0 && d->density_scale <= 1e30)) {
+        if (!cli_parse_double(C, a, argv[++*i], &d->density_scale)) return -1; /* its message given */
+        if (!(d->density_scale > 0 && d->density_scale <= 1e30)) {
             cli_usage_error(C, "%s: expected a factor in (0, 1e30] (a scene's volume.density_scale's bound)", a);
             return -1;
         }
@@ -43,13 +45,15 @@ int cli_volume_load_option(int argc, char **argv, int *i, atmos_volume_load_desc
         /* --volume-scale: render's name, with its bound (the scene's volume "scale"); --length-scale
            the library's */
         const double top = strcmp(a, "--volume-scale") ? 1e6 : 100;
-        if (!cli_parse_double(C, a, argv[++*i], &d->length_scale) || !(d->length_scale > 0 && d->length_scale <= top)) {
+        if (!cli_parse_double(C, a, argv[++*i], &d->length_scale)) return -1; /* its message given */
+        if (!(d->length_scale > 0 && d->length_scale <= top)) {
             cli_usage_error(C, "%s: expected a factor in (0, %g]", a, top);
             return -1;
         }
     } else if (!strcmp(a, "--max-memory")) {
         double mb = 0;
-        if (!cli_parse_double(C, "--max-memory", argv[++*i], &mb) || mb <= 0) {
+        if (!cli_parse_double(C, "--max-memory", argv[++*i], &mb)) return -1; /* its message given */
+        if (mb <= 0) {
             cli_usage_error(C, "--max-memory: expected megabytes > 0");
             return -1;
         }
