@@ -77,4 +77,9 @@ once --thickness render --thickness abc $R
 once --voxel-size volume info --voxel-size q "$S/scenes/simulated_cumulus.json"
 once --thickness sky --thickness zz -o "$T/x.png"
 once --budget bench sky --budget nan
+# a volume framed with no camera in a field of view so narrow that the camera would stand beyond the
+# scene's 1e8 m: a usage error naming --fov, not the position the framing made
+"$A" volume generate cumulus -o "$T/vol/cu.json" --voxel-size 200 >/dev/null || bad "volume generate"
+usage "a field of view of 1e-09 degrees puts the camera" render --volume "$T/vol/cu.json" --fov 1e-9 $R
+grep -q -- "wider --fov" "$T/err" && ! grep -q "position_m" "$T/err" && ok || bad "--fov 1e-9: $(cat "$T/err")"
 exit $fail

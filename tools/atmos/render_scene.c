@@ -142,21 +142,29 @@ static void round_planet_from_orbit(const render_opts *o, atmos_scene *scene)
                 o->cmd, up / 1000.0);
 }
 
-/* A volume file with no camera given: framed as atmos_scene_frame_volume_file frames it, and said. */
-static atmos_status frame_volume(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
+/* A volume file with no camera given: framed as atmos_scene_frame_volume_file frames it, and said.
+ * Returns the exit status: a field of view so narrow that the framing camera stands beyond the
+ * scene's positions (1e8 m) is a usage error naming --fov, not the position it made. */
+static int frame_volume(atmos_context *ctx, const render_opts *o, atmos_scene *scene, atmos_volume **volume)
 {
     atmos_status st = atmos_scene_frame_volume_file(ctx, scene, o->view_el, volume);
-    if (st != ATMOS_OK || !*volume) return st;
-    if (o->quiet) return round_planet_from_orbit(o, scene), ATMOS_OK;
+    if (st != ATMOS_OK) return cli_runtime_error(o->cmd, ctx, st);
+    if (!*volume) return CLI_EXIT_OK;
+    const double *p = scene->camera.position, *l = scene->camera.look_at;
+    const double far = fmax(fabs(p[0]), fmax(fabs(p[1]), fabs(p[2])));
+    if (!(far <= 1e8))
+        return cli_usage_error(o->cmd, "no camera given: framing the volume in a field of view of %g degrees puts the "
+                               "camera %.3g m away, beyond the scene's 1e8 m; give a wider --fov, or the camera's "
+                               "--position and --look-at", scene->camera.fov_deg, far);
+    if (o->quiet) return round_planet_from_orbit(o, scene), CLI_EXIT_OK;
     double lo[3], hi[3];
     atmos_volume_bounds(*volume, lo, hi);
-    const double *p = scene->camera.position, *l = scene->camera.look_at;
     fprintf(stderr,
             "atmos %s: no camera given: framing the volume (%.0f x %.0f x %.0f m) from (%.0f, %.0f, %.0f) m "
             "looking at (%.0f, %.0f, %.0f) m\n",
             o->cmd, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], p[0], p[1], p[2], l[0], l[1], l[2]);
     round_planet_from_orbit(o, scene);
-    return ATMOS_OK;
+    return CLI_EXIT_OK;
 }
 
 /* Writes "KEY=\"VALUE\"" into buf with VALUE's quotes and backslashes escaped for JSON. */
@@ -385,9 +393,7 @@ int render_scene_make(atmos_context *ctx, const render_opts *o, atmos_scene *sce
         if (flag) fprintf(stderr, "  (the option --%s sets it)\n", flag);
         return CLI_EXIT_USAGE; /* the scene file was valid as read: the options made it invalid */
     }
-    if (!render_opts_camera_given(o) && (st = frame_volume(ctx, o, scene, volume)) != ATMOS_OK)
-        return cli_runtime_error(o->cmd, ctx, st);
-    return CLI_EXIT_OK;
+    return render_opts_camera_given(o) ? CLI_EXIT_OK : frame_volume(ctx, o, scene, volume);
 }
 
 const char *render_scene_output_name(const render_opts *o, const atmos_scene *scene, char *buf, size_t cap)
