@@ -205,6 +205,12 @@ atmos_status atmos__harris_plan_create(atmos_plan *p, atmos__harris_plan **out)
         return st;
     }
     atmos__log(p->ctx, ATMOS_LOG_INFO, "render harris: %d particles in %d clouds", h->pc.n, h->clouds.n);
+    if (hs->light_size > 1024) /* its own choice is at most 1024; the time grows as the texels */
+        atmos__log(p->ctx, ATMOS_LOG_WARN,
+                   "render harris: light_size %d: each of the %d lights' passes over %d cloud%s fills %d x %d "
+                   "texels, %.0f times 1024's; expect minutes where 1024 takes seconds",
+                   hs->light_size, hs->sky_lights + 1, h->clouds.n, h->clouds.n == 1 ? "" : "s", hs->light_size,
+                   hs->light_size, (double)hs->light_size * hs->light_size / (1024.0 * 1024.0));
     *out = h;
     return ATMOS_OK;
 }

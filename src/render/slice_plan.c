@@ -29,11 +29,17 @@ void atmos__slice_plan_destroy(atmos__slice_plan *sp)
  * cache line serves all of a texel), B up to 16 within 32 MB. Slots are padded by three
  * cache lines so that they do not alias in the caches. Also the texels' slice ranges and the
  * light frame's per-texel arrays. */
-static int light_buffers(atmos__slice_plan *sp)
+static int light_buffers(atmos_context *ctx, atmos__slice_plan *sp)
 {
     const size_t LL = (size_t)sp->L * sp->L, slotf = LL * (size_t)(sp->n + 1) + 48, slot = sizeof(float) * slotf;
     const size_t fit = ((size_t)32 << 20) / slot;
     sp->batch = fit > 17 ? 16 : (fit > 2 ? (int)fit - 1 : 1);
+    const double bytes = (double)slot * (sp->batch + 1) + (double)LL * (2 * sizeof(int) + 2 * sizeof(double) + 1 +
+                                                                        sizeof(float) * (size_t)sp->n);
+    if (bytes > (double)(1u << 30)) /* a large light_size's cost, before it is paid */
+        atmos__log(ctx, ATMOS_LOG_WARN,
+                   "render slice: light_size %d takes about %.1f GB for the light buffers (%.0f bytes a texel) and time "
+                   "in proportion; 256 (the default) to 2048 are the usual sizes", sp->L, bytes / 1e9, bytes / (double)LL);
     sp->ring = atmos__big_alloc(slot * (size_t)(sp->batch + 1));
     sp->I = malloc(sizeof(float *) * (size_t)(sp->batch + 1));
     sp->nsc = malloc(sizeof(float *) * (size_t)(sp->batch + 1));
@@ -73,7 +79,7 @@ atmos_status atmos__slice_plan_create(atmos_plan *p, atmos__slice_plan **out)
     atmos__vol_xform_init(p->volume, p->offset, &sp->x);
     atmos_status st = atmos__sgrid_build(ctx, p->volume, p->scene.volume.density_scale, ss->grid_max_dim, &sp->g);
     if (st == ATMOS_OK && sp->g.v) st = atmos__stables_build(ctx, p->optics, sp->n, ss->max_order, &sp->tab);
-    if (st == ATMOS_OK && sp->g.v && !light_buffers(sp))
+    if (st == ATMOS_OK && sp->g.v && !light_buffers(ctx, sp))
         st = atmos__error(ctx, ATMOS_E_NOMEM, "render slice: out of memory for the light buffer");
     if (st == ATMOS_OK && sp->g.v && sp->diffuse)
         st = atmos__dfield_prepare(ctx, &sp->df, &sp->g, &sp->tab, &sp->x, p->optics, "render slice");

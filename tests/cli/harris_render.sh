@@ -57,4 +57,9 @@ grep -q "the volume made 0 particles .*nothing of it is drawn" "$T/esp.txt" && o
     -o "$T/mp.png" -q 2>"$T/emp.txt"
 grep -q "the volume made [12] particles\? .*as coarse as max_particles asks" "$T/emp.txt" && ok "--max-particles 2: warned" ||
     bad "--max-particles 2: $(cat "$T/emp.txt")"
+# a light_size past the renderer's own choice (1024) is warned of before the work (interrupted then)
+timeout -s INT 4 "$A" render --volume generate:cumulus --voxel-size 120 --renderer harris --width 24 --height 16 \
+    -D harris.light_size=2048 -o "$T/ls.png" -q 2>"$T/els.txt"
+grep -q "light_size 2048: each of the .* lights' passes .* fills 2048 x 2048 texels, 4 times 1024's" "$T/els.txt" &&
+    ok "harris light_size 2048: warned" || bad "harris light_size 2048: $(cat "$T/els.txt")"
 exit $fail

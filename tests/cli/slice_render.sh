@@ -116,6 +116,10 @@ PY
     bad "--eye-scale 0.01: $(cat "$T/es.err")"
 "$A" render -q --volume generate:cumulus --voxel-size 120 --width 48 --height 32 --eye-scale 0.5 -o "$T/es.png" \
     2>"$T/es.err" && ! grep -q "eye buffer" "$T/es.err" && ok || bad "--eye-scale 0.5: $(cat "$T/es.err")"
+# a light buffer that costs more than a gigabyte is warned of before the work (interrupted then)
+timeout -s INT 4 "$A" render -q --volume generate:cumulus --voxel-size 200 --width 16 --height 16 --light-size 4096 \
+    -o "$T/ls.png" 2>"$T/ls.err"
+grep -q "light_size 4096 takes about 1.2 GB for the light buffers" "$T/ls.err" && ok || bad "--light-size 4096: $(cat "$T/ls.err")"
 rm -rf "$T"
 echo "slice_render: $pass passed"
 [ "$fail" -eq 0 ]
