@@ -84,11 +84,16 @@ static void warn_unused_parts(atmos_context *ctx, const atmos_scene *s)
     if (s->object_count > 0 && s->renderer != ATMOS_RENDERER_HARRIS) in_list[n++] = "objects"; /* Harris draws them */
     char list[64];
     join_names(in_list, n, list, sizeof list);
-    if (list[0])
-        atmos__log(ctx, ATMOS_LOG_WARN,
-                   "the %s renderer does not draw the scene's %s (the beam renderer and the path tracer do: "
-                   "\"renderer\": \"beams\" or \"path\")",
-                   atmos_renderer_name(s->renderer), list);
+    if (!list[0]) return;
+    /* with a cloud volume neither the beam renderer nor the path tracer draws them (docs/path.md) */
+    const int volume = s->volume.source[0] != '\0';
+    const char *who = !volume ? "the beam renderer and the path tracer do: \"renderer\": \"beams\" or \"path\""
+                      : n == 1 && s->object_count > 0
+                          ? "the harris renderer draws objects among its clouds: \"renderer\": \"harris\"; the "
+                            "beam renderer and the path tracer draw them without a cloud volume"
+                          : "the beam renderer and the path tracer draw them, but not with a cloud volume yet";
+    atmos__log(ctx, ATMOS_LOG_WARN, "the %s renderer does not draw the scene's %s (%s)",
+               atmos_renderer_name(s->renderer), list, who);
 }
 
 /* A round model without aerosols ("aerosol": "none") reads none of the keys that set their
