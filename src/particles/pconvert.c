@@ -97,9 +97,9 @@ atmos_status atmos__pcloud_from_volume(atmos_context *ctx, const atmos_volume *v
             atmos__pcloud_free(out);
             return atmos__error(ctx, ATMOS_E_NOMEM, "particles: out of memory for the particles of a volume");
         }
-    double peak = 0;
-    for (int fi = 0; fi < nf; fi++) peak = fmax(peak, thr[fi]);
-    if (out->n < 8 && peak > 0) /* a volume with a cloud in it, next to none of it made into particles */
+    int cloudy = 0; /* a field with any density (its threshold above 0) */
+    for (int fi = 0; fi < nf; fi++) cloudy |= thr[fi] > 0;
+    if (out->n < 8 && cloudy) /* a volume with a cloud in it, next to none of it made into particles */
         atmos__log(ctx, ATMOS_LOG_WARN,
                    "particles: the volume made %d particle%s (cells of %g m%s): %s; a smaller spacing, or a larger "
                    "max_particles, makes more", out->n, out->n == 1 ? "" : "s", m * f.vs,

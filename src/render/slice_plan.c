@@ -34,20 +34,22 @@ static int light_buffers(atmos_context *ctx, atmos__slice_plan *sp)
     const size_t LL = (size_t)sp->L * sp->L, slotf = LL * (size_t)(sp->n + 1) + 48, slot = sizeof(float) * slotf;
     const size_t fit = ((size_t)32 << 20) / slot;
     sp->batch = fit > 17 ? 16 : (fit > 2 ? (int)fit - 1 : 1);
-    const double bytes = (double)slot * (sp->batch + 1) + (double)LL * (2 * sizeof(int) + 2 * sizeof(double) + 1 +
-                                                                        sizeof(float) * (size_t)sp->n);
+    /* the per-texel arrays' sizes, each allocated and counted from the same figure */
+    const size_t ring_b = slot * (size_t)(sp->batch + 1), lk_b = sizeof(int) * LL * 2, t_b = sizeof(double) * LL,
+                 sl_b = sizeof(float) * LL * (size_t)sp->n;
+    const double bytes = (double)ring_b + lk_b + 2.0 * t_b + LL + sl_b;
     if (bytes > (double)(1u << 30)) /* a large light_size's cost, before it is paid */
         atmos__log(ctx, ATMOS_LOG_WARN,
                    "render slice: light_size %d takes about %.1f GB for the light buffers (%.0f bytes a texel) and time "
                    "in proportion; 256 (the default) to 2048 are the usual sizes", sp->L, bytes / 1e9, bytes / (double)LL);
-    sp->ring = atmos__big_alloc(slot * (size_t)(sp->batch + 1));
+    sp->ring = atmos__big_alloc(ring_b);
     sp->I = malloc(sizeof(float *) * (size_t)(sp->batch + 1));
     sp->nsc = malloc(sizeof(float *) * (size_t)(sp->batch + 1));
-    sp->lk = malloc(sizeof(int) * LL * 2);
-    sp->light.ta = malloc(sizeof(double) * LL);
-    sp->light.tb = malloc(sizeof(double) * LL);
+    sp->lk = malloc(lk_b);
+    sp->light.ta = malloc(t_b);
+    sp->light.tb = malloc(t_b);
     sp->light.hit = malloc(LL);
-    sp->light.sl = malloc(sizeof(float) * LL * (size_t)sp->n);
+    sp->light.sl = malloc(sl_b);
     if (!sp->ring || !sp->I || !sp->nsc || !sp->lk || !sp->light.ta || !sp->light.tb || !sp->light.hit || !sp->light.sl)
         return 0;
     for (int q = 0; q <= sp->batch; q++) {

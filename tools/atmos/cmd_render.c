@@ -455,8 +455,7 @@ static int check_outputs(const render_opts *o, const atmos_scene *scene, const c
     const char *inputs[SCENE_INPUTS_MAX + 64];
     static char data[64][CLI_OUTPUT_PATH_MAX]; /* a raw volume's data files, which its sidecar names */
     int n = scene_inputs(o, scene, inputs), ndata = 0;
-    if (inputs[1]) cli_sidecar_files(inputs[1], data, 64, &ndata); /* inputs[1]: the volume's file */
-    for (int k = 0; k < ndata; k++) inputs[n++] = data[k];
+    if (inputs[1]) cli_sidecar_inputs(inputs[1], data, 64, &ndata, inputs, &n); /* inputs[1]: the volume's file */
     return cli_outputs_check("render", &set, inputs, n);
 }
 

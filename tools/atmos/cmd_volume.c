@@ -303,8 +303,7 @@ static int cmd_slice(int argc, char **argv)
     static char data[64][CLI_OUTPUT_PATH_MAX]; /* a raw volume's data files */
     const char *inputs[1 + 64] = {file};
     int ninputs = 1, ndata = 0;
-    cli_sidecar_files(file, data, 64, &ndata);
-    for (int k = 0; k < ndata; k++) inputs[ninputs++] = data[k];
+    cli_sidecar_inputs(file, data, 64, &ndata, inputs, &ninputs);
     if (cli_outputs_check(C, &set, inputs, ninputs)) return CLI_EXIT_USAGE;
     if (cli_output_folder(C, "-o", out)) return CLI_EXIT_RUNTIME;
     atmos_context *ctx = cli_context(0, 0); /* warnings (e.g. a coarse NetCDF voxel) reach the user */

@@ -308,13 +308,12 @@ int cli_cmd_volume_stats(int argc, char **argv)
     const int icsv = cli_outputs_add(&set, "--csv", o.csv), ipng = cli_outputs_add(&set, "--mask-png", o.png);
     const char *inputs[32 + 64];
     static char data[64][CLI_OUTPUT_PATH_MAX]; /* the raw sidecars' data files */
-    int ninputs = o.nsources, ndata = 0;
-    for (int s = 0; s < o.nsources; s++) {
-        const int file = strncmp(o.sources[s], "generate:", 9) && strncmp(o.sources[s], "simulate:", 9);
-        inputs[s] = file ? o.sources[s] : NULL;
-        if (file) cli_sidecar_files(o.sources[s], data, 64, &ndata);
-    }
-    for (int k = 0; k < ndata; k++) inputs[ninputs++] = data[k];
+    int ninputs = 0, ndata = 0;
+    for (int s = 0; s < o.nsources; s++)
+        if (strncmp(o.sources[s], "generate:", 9) && strncmp(o.sources[s], "simulate:", 9)) { /* a file */
+            inputs[ninputs++] = o.sources[s];
+            cli_sidecar_inputs(o.sources[s], data, 64, &ndata, inputs, &ninputs);
+        }
     if ((rc = cli_outputs_check(C, &set, inputs, ninputs)) != CLI_EXIT_OK) return rc;
     if (cli_outputs_prepare(C, &set)) return CLI_EXIT_RUNTIME;
     const char *csv_name = o.csv;

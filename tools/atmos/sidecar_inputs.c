@@ -5,7 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
-void cli_sidecar_files(const char *path, char (*names)[CLI_OUTPUT_PATH_MAX], int cap, int *n)
+/* The files into names (cli_sidecar_inputs). */
+static void sidecar_files(const char *path, char (*names)[CLI_OUTPUT_PATH_MAX], int cap, int *n)
 {
     const size_t len = strlen(path);
     FILE *f = len > 5 && !strcmp(path + len - 5, ".json") ? fopen(path, "rb") : NULL;
@@ -27,4 +28,12 @@ void cli_sidecar_files(const char *path, char (*names)[CLI_OUTPUT_PATH_MAX], int
             snprintf(names[(*n)++], CLI_OUTPUT_PATH_MAX, "%.*s%s", files[i]->valuestring[0] == '/' ? 0 : dir, path,
                      files[i]->valuestring);
     cJSON_Delete(root);
+}
+
+void cli_sidecar_inputs(const char *path, char (*names)[CLI_OUTPUT_PATH_MAX], int cap, int *n, const char **inputs,
+                        int *ninputs)
+{
+    const int from = *n;
+    sidecar_files(path, names, cap, n);
+    for (int k = from; k < *n; k++) inputs[(*ninputs)++] = names[k];
 }
