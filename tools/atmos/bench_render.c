@@ -110,6 +110,17 @@ static void print_slice(const char *name, const bench_slice_opts *o, double dens
     fflush(stdout);
 }
 
+/* The bench view's scene of v for the slice renderer with o's settings. */
+static void slice_scene(atmos_scene *scene, atmos_volume *v, double density_scale, const bench_slice_opts *o)
+{
+    double offset[3];
+    bench_view(scene, v, o->size, offset);
+    scene->renderer = ATMOS_RENDERER_SLICE;
+    scene->slice.field = o->field; /* atmos_slice_field: auto (the default, do), p1 or none */
+    scene->slice.air_shadows = o->air_shadows;
+    scene->volume.density_scale = density_scale;
+}
+
 int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, double density_scale,
                      const bench_slice_opts *o)
 {
@@ -119,12 +130,7 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, doub
     double prepare = 0, sec[3] = {0, 0, 0}, cpu[3] = {0, 0, 0}, fps[3];
     atmos_plan_stats stats[3];
     atmos_frame start;
-    double offset[3];
-    bench_view(&scene, v, o->size, offset);
-    scene.renderer = ATMOS_RENDERER_SLICE;
-    scene.slice.field = o->field; /* atmos_slice_field: auto (the default, do), p1 or none */
-    scene.slice.air_shadows = o->air_shadows;
-    scene.volume.density_scale = density_scale;
+    slice_scene(&scene, v, density_scale, o);
     atmos_status st = bench_plan(ctx, v, &scene, &plan, &prepare);
     if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
     if (o->eye_scale > 0) start.eye_scale = o->eye_scale;
@@ -143,6 +149,75 @@ int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, doub
     for (int m = 0; m < 3; m++) fps[m] = sec[m] > 0 ? 1.0 / sec[m] : 0;
     print_slice(name, o, density_scale, atmos_context_threads(ctx), fps, cpu, &stats[MOVE_SUN], &first.slice, prepare,
                 atmos_slice_field_name(atmos_scene_slice_field(&scene.slice)));
+    return CLI_EXIT_OK;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Frame i of the sun-moving run of both plans (the field's first on even i, none's on odd: neither
+ * always follows the other), each frame's CPU seconds added to cpu[p]; the frame's ratio in *r. */
+static atmos_status ratio_frame(atmos_plan *const plan[2], const atmos_frame *start, int i, atmos_image *img,
+                                double cpu[2], double *r)
+{
+    double c[2] = {0, 0};
+    atmos_status st = ATMOS_OK;
+    for (int t = 0; t < 2 && st == ATMOS_OK; t++) {
+        const int p = (i + t) % 2;
+        atmos_frame f;
+        step_frame(plan[p], start, MOVE_SUN, i, &f);
+        const clock_t c0 = clock();
+        st = atmos_plan_render(plan[p], &f, NULL, img, NULL);
+        c[p] = (double)(clock() - c0) / CLOCKS_PER_SEC;
+        cpu[p] += c[p];
+    }
+    *r = c[1] > 0 ? c[0] / c[1] : 0;
+    return st;
+}
+
+int bench_slice_ratio(atmos_context *ctx, const char *name, atmos_volume *v, double density_scale,
+                      const bench_slice_opts *o)
+{
+    atmos_scene scene;
+    atmos_plan *plan[2] = {NULL, NULL};
+    atmos_image *img = NULL;
+    atmos_frame start;
+    double prepare = 0, cpu[2] = {0, 0};
+    double *r = malloc(sizeof(double) * (size_t)o->frames);
+    slice_scene(&scene, v, density_scale, o);
+    atmos_status st = r ? ATMOS_OK : ATMOS_E_NOMEM;
+    const char *field = atmos_slice_field_name(atmos_scene_slice_field(&scene.slice));
+    for (int p = 0; p < 2 && st == ATMOS_OK; p++) {
+        scene.slice.field = p == 0 ? o->field : ATMOS_SLICE_FIELD_NONE;
+        st = bench_plan(ctx, v, &scene, &plan[p], &prepare);
+    }
+    if (st == ATMOS_OK) st = atmos_frame_from_scene(ctx, &scene, &start);
+    if (o->eye_scale > 0) start.eye_scale = o->eye_scale;
+    if (st == ATMOS_OK) st = atmos_plan_image_create(plan[0], &start, &img);
+    for (int p = 0; p < 2 && st == ATMOS_OK; p++) st = atmos_plan_render(plan[p], &start, NULL, img, NULL); /* untimed */
+    start.warm_field = !o->cold_field;
+    for (int i = 1; i <= o->frames && st == ATMOS_OK; i++) st = ratio_frame(plan, &start, i, img, cpu, &r[i - 1]);
+    atmos_image_destroy(img);
+    for (int p = 0; p < 2; p++) atmos_plan_destroy(plan[p]);
+    if (st != ATMOS_OK) {
+        free(r);
+        return cli_runtime_error("bench", ctx, st);
+    }
+    qsort(r, (size_t)o->frames, sizeof *r, cmp_double);
+    const double med = o->frames % 2 ? r[o->frames / 2] : 0.5 * (r[o->frames / 2 - 1] + r[o->frames / 2]);
+    const double mf = 1e3 * cpu[0] / o->frames, mn = 1e3 * cpu[1] / o->frames;
+    free(r);
+    printf(o->json ? "{\"bench\":\"slice_field_ratio\",\"case\":\"%s\",\"size\":%d,\"threads\":%d,\"frames\":%d,"
+                     "\"field\":\"%s\",\"cpu_ms_field\":%.2f,\"cpu_ms_none\":%.2f,\"ratio\":%.4f,"
+                     "\"ratio_median\":%.4f,\"density_scale\":%g,\"warm_field\":%d}\n"
+                   : "bench=slice_field_ratio case=%s size=%d threads=%d frames=%d field=%s cpu_ms_field=%.2f "
+                     "cpu_ms_none=%.2f ratio=%.4f ratio_median=%.4f density_scale=%g warm_field=%d\n",
+           name, o->size, atmos_context_threads(ctx), o->frames, field, mf, mn,
+           mn > 0 ? mf / mn : 0, med, density_scale, !o->cold_field);
+    fflush(stdout);
     return CLI_EXIT_OK;
 }
 

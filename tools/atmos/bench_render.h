@@ -10,6 +10,7 @@ typedef struct {
     int field;         /* an atmos_slice_field: the scene's "slice" setting */
     int air_shadows;   /* the scene's "slice" setting */
     int cold_field;    /* 1: the sun-moving frames solve the field afresh; 0: warm-started, as the viewer's */
+    int field_ratio;   /* 1: the field's cost against none, frames in turns (bench_slice_ratio) */
     int json;
 } bench_slice_opts;
 
@@ -17,6 +18,12 @@ typedef struct {
  * 256 slices): frames per mode (camera moving, sun moving, static). */
 int bench_slice_case(atmos_context *ctx, const char *name, atmos_volume *v, double density_scale,
                      const bench_slice_opts *o);
+
+/* The field's cost (--field-ratio): two plans of the bench view of v, the field's (o->field) and
+ * none, their sun-moving frames in turns, each frame's CPU time by itself; the ratio of the means
+ * and the median of the frames' ratios. */
+int bench_slice_ratio(atmos_context *ctx, const char *name, atmos_volume *v, double density_scale,
+                      const bench_slice_opts *o);
 
 /* The aerial-perspective case: the slice renderer on v (densities times density_scale) under
  * each atmosphere model of the comma-separated list (riley, dobashi, spherical; NULL:

@@ -24,7 +24,7 @@ static void help(void)
            "       atmos bench volume [--file FILE] [--repeat R] [--threads T]\n"
            "       atmos bench slice [--file FILE] [--size N] [--repeat R] [--threads T] [--eye-scale S]\n"
            "                         [--no-diffuse | --slice-p1] [--no-air-shadows] [--cold-field]\n"
-           "                         [--density-scale S] [--file-only] [--json]\n"
+           "                         [--density-scale S] [--file-only] [--field-ratio] [--json]\n"
            "       atmos bench slice --aerial [--file FILE] [--models LIST] [--density-scale S] [--size N]\n"
            "                         [--repeat R] [--threads T] [--json]\n"
            "       atmos bench path [--file FILE] [--size N] [--spp N] [--density-scale S] [--threads T]\n"
@@ -100,6 +100,11 @@ static void help(void)
            "          default); air_shadow_ms: its share of the last sun-moving frame (part of sky_ms).\n"
            "          cpu_ms_camera_moving, cpu_ms_sun_moving: the process's CPU time per frame (with\n"
            "          OMP_WAIT_POLICY=passive the work done; steadier than fps on a shared machine).\n"
+           "          --field-ratio: instead, the field's cost: two plans of the view, with the field\n"
+           "          and without (none), their 8 R sun-moving frames in turns, each frame's CPU time\n"
+           "          on its own (bench=slice_field_ratio): cpu_ms_field, cpu_ms_none, ratio (of the\n"
+           "          means) and ratio_median (of the frames' ratios: a change of the machine's load\n"
+           "          falls on both frames of a pair).\n"
            "          --json prints one JSON object per case.\n"
            "          --aerial: instead, the cost of the atmosphere around a sliced volume: FILE (default\n"
            "          the generated storm) under each model of --models (default riley,spherical), 8 R\n"
@@ -509,7 +514,7 @@ static int bench_slice(const char *file, int file_only, const bench_slice_opts *
     if (!file_only) {
         st = atmos_volume_generate(ctx, "storm", &g, &v);
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = bench_slice_case(ctx, "generated_storm", v, 1, o);
+        else rc = (o->field_ratio ? bench_slice_ratio : bench_slice_case)(ctx, "generated_storm", v, 1, o);
         atmos_volume_destroy(v);
         v = NULL;
     }
@@ -517,7 +522,9 @@ static int bench_slice(const char *file, int file_only, const bench_slice_opts *
         st = atmos_volume_load(ctx, file, &bench_load, &v);
         const char *base = strrchr(file, '/');
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = bench_slice_case(ctx, base ? base + 1 : file, v, dscale > 0 ? dscale : 1e8, o);
+        else
+            rc = (o->field_ratio ? bench_slice_ratio : bench_slice_case)(ctx, base ? base + 1 : file, v,
+                                                                        dscale > 0 ? dscale : 1e8, o);
         atmos_volume_destroy(v);
     }
     atmos_context_destroy(ctx);
@@ -545,7 +552,7 @@ int cli_cmd_bench(int argc, char **argv)
     const char *C = "bench";
     int size = 0, repeat = 5, threads = 0, fast = 0, json = 0, repeat_set = 0, spp = 16, aerial = 0;
     double dscale = 0, eye_scale = 0, budget = 2;
-    int field = ATMOS_SLICE_FIELD_AUTO, air_shadows = 1, cold_field = 0, file_only = 0;
+    int field = ATMOS_SLICE_FIELD_AUTO, air_shadows = 1, cold_field = 0, file_only = 0, field_ratio = 0;
     const char *what = NULL, *presets = NULL, *file = NULL, *models = NULL, *beams_case = NULL;
     if (argc > 1 && !strcmp(argv[1], "sky-accuracy")) return bench_sky_accuracy_main(argc - 1, argv + 1);
     bench_path_opts pflags;
@@ -589,6 +596,8 @@ int cli_cmd_bench(int argc, char **argv)
             cold_field = 1;
         } else if (!strcmp(argv[i], "--file-only")) {
             file_only = 1;
+        } else if (!strcmp(argv[i], "--field-ratio")) {
+            field_ratio = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             if (!cli_parse_int(C, "--threads", argv[++i], 1, 1024, &threads)) return CLI_EXIT_USAGE;
         } else if (!strcmp(argv[i], "--fast")) {
@@ -629,8 +638,10 @@ int cli_cmd_bench(int argc, char **argv)
     if (!strcmp(what, "slice")) {
         const bench_slice_opts so = {.size = size ? size : 512, .frames = 8 * (repeat_set ? repeat : 3),
                                      .eye_scale = eye_scale, .field = field, .air_shadows = air_shadows,
-                                     .cold_field = cold_field, .json = json};
+                                     .cold_field = cold_field, .field_ratio = field_ratio, .json = json};
         if (file_only && !file) return cli_usage_error(C, "--file-only: give the volume with --file");
+        if (field_ratio && field == ATMOS_SLICE_FIELD_NONE)
+            return cli_usage_error(C, "--field-ratio: a field to weigh against none (not with --no-diffuse)");
         return bench_slice(file, file_only, &so, threads, dscale);
     }
     if (!strcmp(what, "sky")) return bench_sky(size ? size : 1024, repeat, threads, models, budget);
