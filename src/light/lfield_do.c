@@ -396,7 +396,34 @@ static void dsa_switch(do_work *W, int it, double resid, atmos__do_stats *st)
  * (W->dz), the residual the true one (the same tolerance), r the z's room within a cycle.
  * Returns 1 with the last residual b - A x in r (b = 0: x = 0,
  * r = 0), else 0. */
-static int gmres(do_work *W, const double *b, double *x, double *V, double *r, atmos__do_stats *st, int zero_start)
+/* The residual b - A x into V at a GMRES cycle's start: b itself from 0 (zero_start), else by a
+ * sweep: with b, A x's (apply); with b NULL (not swept: atmos__do_problem's kappa), the source's
+ * and the scattering's together, V = T (S x + q1) - x, and *bn, when not known yet (0), taken as
+ * kappa ||T (S x + q1)||. */
+static void cycle_start(do_work *W, const double *b, const double *x, double *V, int zero_start, double *bn,
+                        atmos__do_stats *st)
+{
+    const size_t N = W->n * W->K;
+    if (zero_start) {
+        memcpy(V, b, sizeof(double) * N);
+        return;
+    }
+    st->sweeps++;
+    if (b) {
+        apply(W, x, V);
+        for (size_t i = 0; i < N; i++) V[i] = b[i] - V[i];
+        return;
+    }
+    scatter(W, x, 1);
+    sweep_all(W, W->Q, V, NULL, NULL, W->P->inflow != NULL);
+    if (!(*bn > 0)) *bn = *W->P->kappa * sqrt(dot(V, V, N, 1));
+    for (size_t i = 0; i < N; i++) V[i] -= x[i];
+}
+
+/* GMRES from x (zero_start: x is 0) for the source's sweep b, bn = ||b||; b NULL with bn 0: not
+ * swept, bn estimated at the first cycle's start (cycle_start). The last residual into r. */
+static int gmres(do_work *W, const double *b, double bn, double *x, double *V, double *r, atmos__do_stats *st,
+                 int zero_start)
 {
     const atmos__do_problem *P = W->P;
     const int m = P->restart;
@@ -405,19 +432,13 @@ static int gmres(do_work *W, const double *b, double *x, double *V, double *r, a
     unsigned char pre[64] = {0}; /* column j preconditioned */
     const int T = 1; /* the vector operations in one thread: on a loaded machine a parallel region per
                         operation costs more in its barriers than it saves */
-    const double bn = sqrt(dot(b, b, N, T));
     st->resid = 0;
-    if (!(bn > 0)) { /* no source: the solution is 0 whatever the start (a warm start's last sun) */
-        memset(x, 0, sizeof(double) * N), memset(r, 0, sizeof(double) * N);
-        return 1;
-    }
-    while (st->iters < P->max_iter) {
-        if (zero_start)
-            memcpy(V, b, sizeof(double) * N), zero_start = 0;
-        else {
-            apply(W, x, V);
-            st->sweeps++;
-            for (size_t i = 0; i < N; i++) V[i] = b[i] - V[i];
+    for (int cyc = 0; st->iters < P->max_iter; cyc++) {
+        if (!b || cyc > 0 || bn > 0) cycle_start(W, b, x, V, zero_start, &bn, st);
+        zero_start = 0;
+        if (!(bn > 0)) { /* no source: the solution is 0 whatever the start (a warm start's last sun) */
+            memset(x, 0, sizeof(double) * N), memset(r, 0, sizeof(double) * N);
+            return 1;
         }
         const double beta = sqrt(dot(V, V, N, T));
         st->resid = beta / bn;
@@ -567,24 +588,34 @@ static double entering(const atmos__do_problem *P)
 }
 
 /* GMRES on W's needed cells from x (phi's start in W->idx's order; phi all 0: from 0), the source's
- * sweep into b, then the last source iteration, x + (b - A x) = T (S x + q1): from GMRES's own
+ * sweep into b (unless its norm is estimated: atmos__do_problem's kappa), then the last source
+ * iteration, x + (b - A x) = T (S x + q1): from GMRES's own
  * residual (tmp), or by a sweep that also gives the leaving power. */
 static void solve_gmres(do_work *W, const double *phi, double *b, double *x, double *V, double *tmp,
                         atmos__do_stats *st)
 {
     const atmos__do_problem *P = W->P;
     const size_t N = W->cells * W->K, Nn = W->n * W->K;
-    for (size_t i = 0; i < N; i++) W->q1[i] = (float)P->q1[i];
-    sweep_all(W, W->q1, b, NULL, NULL, P->inflow != NULL);
-    st->sweeps++;
     int zero = 1;
     for (size_t i = 0; i < N && zero; i++) zero = phi[i] == 0;
-    if (gmres(W, b, x, V, tmp, st, zero) && !P->leak)
+    const int est = !zero && P->kappa && *P->kappa > 0; /* ||b|| estimated, b not swept */
+    double bn = 0;
+    if (!est) {
+        for (size_t i = 0; i < N; i++) W->q1[i] = (float)P->q1[i];
+        sweep_all(W, W->q1, b, NULL, NULL, P->inflow != NULL);
+        st->sweeps++;
+        bn = sqrt(dot(b, b, Nn, 1));
+    }
+    if (gmres(W, est ? NULL : b, bn, x, V, tmp, st, zero) && !P->leak)
         for (size_t i = 0; i < Nn; i++) x[i] += tmp[i];
     else {
         scatter(W, x, 1);
         sweep_all(W, W->Q, x, NULL, &st->leak, P->inflow != NULL);
         st->sweeps++;
+    }
+    if (!est && P->kappa) { /* x is T (S x + q1) now */
+        const double xn = sqrt(dot(x, x, Nn, 1));
+        *P->kappa = xn > 0 ? bn / xn : 0;
     }
 }
 

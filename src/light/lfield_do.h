@@ -77,6 +77,12 @@ typedef struct {
     int richardson;             /* > 0: that many source iterations from phi instead of GMRES (no
                                    residual: the caller knows them converged, the scattering
                                    operator's norm small; nishita_do.c's thin media); 0: GMRES */
+    double *kappa;              /* in/out, or NULL: ||b|| / ||T (S x + q1)|| at the end of a solve that
+                                   swept its source b (x its solution; the inflow's in both). A start
+                                   from phi not 0 with *kappa > 0 takes ||b|| (GMRES's scale) as
+                                   *kappa ||T (S x0 + q1)||, whose sweep is its first residual's, and
+                                   leaves b's own sweep out: a warm start after a small change of
+                                   the source (a sun move), one sweep fewer */
 } atmos__do_problem;
 
 typedef struct {

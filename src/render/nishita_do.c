@@ -39,6 +39,7 @@
 #define DO_TOL 1e-3 /* GMRES's relative residual */
 #define DO_RESTART 20
 #define DO_MAX_ITER 200
+#define KAPPA_E 0.2 /* a warm start estimates its source's norm within this change of the sunlight (do_fill) */
 #define SKY_NS 4 /* the sky's samples per direction's patch: SKY_NS x SKY_NS */
 #define WS_MAX 64 /* the wavelengths solved in parallel at most (their buffers) */
 /* the face neighbours' first scattering in a voxel's local radiance, per neighbour, in voxel
@@ -509,6 +510,7 @@ typedef struct {
     const double *src, *dsrc, *Ys, *E, *sky; /* sky: per direction and wavelength, NULL: none */
     const double (*chi)[4];
     float *coef;
+    double *kappa; /* per wavelength (atmos__do_problem's), or NULL */
 } do_fill;
 
 /* Wavelength w's solve from phi as it is (its start) on threads threads with ws's buffers and q1
@@ -521,7 +523,7 @@ static int solve_w(const do_fill *D, int w, double *q1, int threads, int dsa, at
     atmos__do_problem P = D->P;
     double inw[ATMOS__DO_NMAX];
     P.sig_t = D->st + 2 * cells * w, P.sig_s = P.sig_t + cells, P.q1 = q1, P.threads = threads, P.ws = ws;
-    P.dsa = dsa;
+    P.dsa = dsa, P.kappa = D->kappa ? D->kappa + w : NULL;
     double chik[ATMOS__DO_KMAX]; /* chi_l of each coefficient */
     for (int l = 0; l <= P.L; l++) P.chi[l] = D->chi[w][l];
     for (int k = 0; k < K; k++) chik[k] = D->chi[w][atmos__sh_degree(k)];
@@ -609,7 +611,8 @@ static int solve_all(const do_fill *D, const int *wl, int ns, const double *skym
 atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
                                     const double chi[][4], const double sun_w[3], const double *E,
                                     const atmos_atmosphere *atm, int threads, float *coef, double *phi_all, int warm,
-                                    atmos__do_ws *ws, atmos__do_cells **dc, atmos__nishita_do_info *info)
+                                    double *kappa, atmos__do_ws *ws, atmos__do_cells **dc,
+                                    atmos__nishita_do_info *info)
 {
     const int n = np->n, K = (L + 1) * (L + 1);
     const size_t cells = (size_t)F->c[0] * F->c[1] * F->c[2], NK = cells * K;
@@ -647,7 +650,7 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     P->dsa = ATMOS__DO_DSA_AUTO; /* GMRES preconditioned by the P1 solve of the low moments where it pays
                                    (lfield_dsa.h, lfield_do.h) */
     D.n = n, D.K = K, D.cells = cells, D.st = st, D.src = src, D.dsrc = dsrc, D.Ys = Ys, D.E = E;
-    D.sky = sky_on ? sky : NULL, D.chi = chi, D.coef = coef;
+    D.sky = sky_on ? sky : NULL, D.chi = chi, D.coef = coef, D.kappa = kappa;
     /* a wavelength whose medium and phase are the last one's (a grey cloud, no sky): its field is
      * the last one's times the ratio of the sunlight; the others solved */
     int copy[ATMOS_MAX_WAVELENGTHS] = {0}, wl[ATMOS_MAX_WAVELENGTHS], ns = 0;
@@ -656,6 +659,12 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
     double bound = 0;
     P->richardson = ok ? thin_sweeps(P, st, cells, n, chi, &bound) : 0;
     if (P->richardson) warm = 0; /* thin_sweeps: from 0 */
+    /* kappa's ratio kept only for a sunlight within KAPPA_E of its own (kappa[n + w]): after a
+       larger change (the sun setting, the sky alone) the source's shape is not the last one's */
+    for (int w = 0; kappa && w < n; w++)
+        if (!warm || !(E[w] > 0) || !(kappa[n + w] > 0) || fabs(E[w] / kappa[n + w] - 1) > KAPPA_E) kappa[w] = 0;
+    double kappa0[ATMOS_MAX_WAVELENGTHS];
+    for (int w = 0; kappa && w < n; w++) kappa0[w] = kappa[w];
     for (int w = 0; w < n && ok; w++) {
         const float *sw = st + 2 * cells * w;
         copy[w] = w > 0 && E[w - 1] > 0 && !sky_on && !memcmp(chi[w], chi[w - 1], sizeof chi[w]) &&
@@ -665,6 +674,8 @@ atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_pla
         if (!copy[w]) wl[ns++] = w;
     }
     ok = ok && solve_all(&D, wl, ns, skymean, phi_all, warm, threads, ws, info);
+    for (int w = 0; kappa && w < n; w++)
+        if (kappa0[w] == 0) kappa[n + w] = E[w]; /* measured by this solve (0 where not solved) */
     if (P->richardson) info->source_its = P->richardson, info->resid = bound; /* no residual computed */
     for (int w = 1; w < n && ok; w++) {
         if (!copy[w]) continue;

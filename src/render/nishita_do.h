@@ -23,12 +23,16 @@ void atmos__do_cells_free(atmos__do_cells *dc);
  * light entering through the grid's faces, by discrete ordinates on F's cells, chi[w] the
  * scattering's normalised Legendre moments; the sunlight's columns (np->col) made for this sun.
  * phi[(w * cells + cell) * K + k]: the radiance moments solved, per wavelength; on entry with warm
- * the last sun's, each wavelength's start (a warm start after a sun move), else ignored. ws: the
+ * the last sun's, each wavelength's start (a warm start after a sun move), else ignored. kappa (or
+ * NULL): per wavelength the ratio that lets a warm start leave its source's sweep out
+ * (atmos__do_problem's) and, at kappa + n, the sunlight it was measured at, kept with phi; set
+ * by a solve that sweeps its source. ws: the
  * solver's buffers, kept between suns (NULL: its own). *dc: the cells' medium, made when NULL and
  * kept for the next call (the caller frees it with atmos__do_cells_free). */
 atmos_status atmos__nishita_do_fill(atmos_context *ctx, const atmos__nishita_plan *np, const atmos__lfield *F, int L,
                                     const double chi[][4], const double sun_w[3], const double *E,
                                     const atmos_atmosphere *atm, int threads, float *coef, double *phi, int warm,
-                                    atmos__do_ws *ws, atmos__do_cells **dc, atmos__nishita_do_info *info);
+                                    double *kappa, atmos__do_ws *ws, atmos__do_cells **dc,
+                                    atmos__nishita_do_info *info);
 
 #endif

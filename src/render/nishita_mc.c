@@ -52,6 +52,8 @@ struct atmos__nishita_mc {
     float *coef;         /* [(cell * n + w) * K + k]: the emission of orders >= 2 per unit sigma_s' */
     double *do_phi;      /* with "do": the radiance moments per wavelength of the last sun (nishita_do.c) */
     int do_phi_valid;    /* do_phi holds a solve's: the start of the next sun's with a warm field */
+    double do_kappa[2 * ATMOS_MAX_WAVELENGTHS]; /* with do_phi: the warm start's ratio (atmos__do_problem)
+                                                   and the sunlight it was measured at */
     atmos__do_ws *do_ws; /* with "do": the solver's buffers, kept between suns */
     atmos__do_cells *do_cells; /* with "do": the cells' medium, kept between suns */
     double do_dens[PATH_F];    /* with "do": each field's density summed over the grid (do_dens_done) */
@@ -523,7 +525,7 @@ static atmos_status solve(atmos_plan *p, atmos__nishita_plan *np, const double s
     const atmos_status st =
         atmos__nishita_do_fill(p->ctx, np, &mc->field, mc->lmax, (const double(*)[4])chi, sun_w, E,
                                np->opt.sky ? p->atm : NULL, threads, mc->coef, mc->do_phi,
-                               warm && mc->do_phi_valid, mc->do_ws, &mc->do_cells, &info);
+                               warm && mc->do_phi_valid, mc->do_kappa, mc->do_ws, &mc->do_cells, &info);
     mc->do_phi_valid = st == ATMOS_OK;
     np->do_iters = info.iters, np->do_sweeps = info.sweeps, np->do_dirs = info.directions;
     np->do_resid = info.resid, np->do_cpu = info.cpu_s, np->do_source_its = info.source_its;

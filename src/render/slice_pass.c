@@ -180,6 +180,7 @@ typedef struct {
     int32_t vox[CH], lt[CH], oi[CH], ai[ATMOS_VOLUME_MAX_FIELDS][CH];
     float fu[CH], fv[CH], fw[CH], dens[ATMOS_VOLUME_MAX_FIELDS * CH];
     float w00[CH], w10[CH], w01[CH], w11[CH], fo[CH], del[CH], nsc[CH], aw[ATMOS_VOLUME_MAX_FIELDS][CH];
+    float pt[3][CH]; /* eye chunks: the points' render-voxel coordinates, by chunk position */
     int live[ATMOS_VOLUME_MAX_FIELDS];
 } echunk;
 
@@ -211,7 +212,7 @@ ATMOS_CLONE_HELPER int lane(const echunk *e, int q) { return e->contig ? (q < e-
 ATMOS_CLONE_HELPER int eye_samples(const sjob *j, int k, size_t p0, int cnt, echunk *e)
 {
     const float kf = (float)k;
-    float u[CH], v[CH], w[CH];
+    float *restrict u = e->pt[0], *restrict v = e->pt[1], *restrict w = e->pt[2];
     int32_t ok[CH];
     const float *restrict U0 = j->pU0[0] + p0, *restrict V0 = j->pU0[1] + p0, *restrict W0 = j->pU0[2] + p0;
     const float *restrict dU = j->pdU[0] + p0, *restrict dV = j->pdU[1] + p0, *restrict dW = j->pdU[2] + p0;
@@ -322,7 +323,7 @@ ATMOS_CLONE_HELPER void eye_optics(const sjob *j, const echunk *e, int c, float 
     }
 }
 
-/* The diffuse field's cells at the samples of slice k: per sample the offset of the lower
+/* The diffuse field's cells at a chunk's samples: per sample the offset of the lower
  * corner cell in the per-frame view (j->fview) and the trilinear weights, as
  * atmos__lfield_sample finds them (the cells' centres at render voxel (i + 1/2) s - 1/2,
  * clamped to the outer ones). One vector loop over the chunk. */
@@ -352,21 +353,22 @@ ATMOS_CLONE_HELPER void field_axis(int mv, const float *restrict x, float off, f
         for (int q = 0; q < mv; q++) t[q] = 0.0f;
 }
 
-ATMOS_CLONE_HELPER void eye_field_cells(const sjob *j, int k, size_t p0, const echunk *e, fchunk *fc)
+ATMOS_CLONE_HELPER void eye_field_cells(const sjob *j, const echunk *e, fchunk *fc)
 {
     const atmos__lfield *f = j->field;
     const int cx = f->c[0], cy = f->c[1], cz = f->c[2];
     const int32_t m = j->nf * j->fvq;
-    const float kf = (float)k, off = 0.5f * (float)(f->s - 1), is = 1.0f / (float)f->s;
+    const float off = 0.5f * (float)(f->s - 1), is = 1.0f / (float)f->s;
     fc->st[0] = cx > 1 ? m : 0, fc->st[1] = cy > 1 ? cx * m : 0, fc->st[2] = cz > 1 ? cx * cy * m : 0;
-    /* the samples' points gathered first, then the cells and weights in vector loops (the
-       gather and the clamps in one loop took more instructions: docs/lightfield.md) */
+    /* the samples' points gathered first (eye_samples' own, by chunk position), then the cells and
+       weights in vector loops (the gather and the clamps in one loop took more instructions:
+       docs/lightfield.md) */
     const int mv = e->mv & ~7; /* e->mv itself: whole vectors */
     float pt[3][CH], ft[3][CH];
     int32_t it[3][CH];
     for (int q = 0; q < mv; q++) {
-        const size_t p = p0 + (size_t)lane(e, q);
-        for (int a = 0; a < 3; a++) pt[a][q] = j->pU0[a][p] + kf * j->pdU[a][p];
+        const int x = lane(e, q);
+        for (int a = 0; a < 3; a++) pt[a][q] = e->pt[a][x];
     }
     field_axis(mv, pt[0], off, is, cx, it[0], ft[0]);
     field_axis(mv, pt[1], off, is, cy, it[1], ft[1]);
@@ -385,10 +387,10 @@ ATMOS_CLONE_HELPER void eye_field_cells(const sjob *j, int k, size_t p0, const e
 /* The diffuse field scattered toward the eye at the chunk's samples, wavelength c in
  * ds[c * CH + q]: sum over the live fields of density times the view's sca (L + g A)
  * (trilinear), not below 0. */
-ATMOS_CLONE_HELPER void eye_field(const sjob *j, int k, size_t p0, const echunk *e, float *restrict ds)
+ATMOS_CLONE_HELPER void eye_field(const sjob *j, const echunk *e, float *restrict ds)
 {
     fchunk fc;
-    eye_field_cells(j, k, p0, e, &fc);
+    eye_field_cells(j, e, &fc);
     const int n = j->n, nf = j->nf, fq = j->fvq;
     const int32_t sx = fc.st[0], sy = fc.st[1], sz = fc.st[2];
     const int32_t o8[8] = {0, sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz};
@@ -569,10 +571,10 @@ ATMOS_CLONE_HELPER void eye_rgb_optics(const sjob *j, const echunk *e, float (*r
  * three wavelengths are 8 vector loads per live field. (eye_field's vector loop, a gather per
  * corner in the AVX2 clone, took 4 % fewer instructions in the eye pass but 5-10 % more CPU a
  * frame where measured: docs/lightfield.md.) */
-ATMOS_CLONE_HELPER void eye_rgb_field(const sjob *j, int k, size_t p0, const echunk *e, float (*restrict ds3)[CH])
+ATMOS_CLONE_HELPER void eye_rgb_field(const sjob *j, const echunk *e, float (*restrict ds3)[CH])
 {
     fchunk fc;
-    eye_field_cells(j, k, p0, e, &fc);
+    eye_field_cells(j, e, &fc);
     const int nf = j->nf;
     const int32_t sx = fc.st[0], sy = fc.st[1], sz = fc.st[2];
     const int32_t o8[8] = {0, sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz};
@@ -600,7 +602,7 @@ ATMOS_CLONE_HELPER void eye_rgb_field(const sjob *j, int k, size_t p0, const ech
 }
 
 /* The light, the optics and the blend of an RGB chunk. */
-ATMOS_CLONE_HELPER void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, const float *Ib, const float *In)
+ATMOS_CLONE_HELPER void eye_rgb(const sjob *j, size_t p0, echunk *e, const float *Ib, const float *In)
 {
     float I3[4][CH], be3[3][CH], src3[3][CH], ds3[3][CH], J3[3][CH];
     if (j->low_albedo) /* and the light leaving the slab, read at the same texels */
@@ -609,7 +611,7 @@ ATMOS_CLONE_HELPER void eye_rgb(const sjob *j, int k, size_t p0, echunk *e, cons
         eye_rgb_light(j, e, Ib, I3, NULL, J3);
     eye_orders(j, p0, e);
     eye_rgb_optics(j, e, be3, src3);
-    if (j->field) eye_rgb_field(j, k, p0, e, ds3);
+    if (j->field) eye_rgb_field(j, e, ds3);
     for (int c = 0; c < 3; c++)
         eye_blend(j, p0, e, c, I3[c], be3[c], src3[c], j->field ? ds3[c] : NULL, j->low_albedo ? J3[c] : NULL);
 }
@@ -635,13 +637,13 @@ long long atmos__slice_eye_span(const sjob *j, int k, int y, int x0, int x1, con
         eye_texels(j, k, p0, &e);
 #if SLICE_RGB
         if (n == 3) {
-            eye_rgb(j, k, p0, &e, Ib, In);
+            eye_rgb(j, p0, &e, Ib, In);
             continue;
         }
 #endif
         eye_bilinear(&e, nb, ns, LN, e.nsc);
         eye_orders(j, p0, &e);
-        if (j->field) eye_field(j, k, p0, &e, ds);
+        if (j->field) eye_field(j, &e, ds);
         for (int c = 0; c < n; c++) {
             eye_bilinear(&e, Ib + c, ns, LN, Ic);
             if (j->low_albedo) eye_bilinear(&e, In + c, ns, LN, I1);

@@ -199,7 +199,10 @@ static void thinner(atmos_context *ctx, const atmos_scene *s, const atmos_plan_d
  * the ratio of the light times the first one's change, and take one GMRES iteration each (from the
  * first one's new field times the ratio, as before 2026-12-07, they took as many as afresh: the
  * clouds are nearly but not quite grey, and that start carries the whole difference). The image
- * within the solver's tolerance of a fresh plan's. */
+ * within the solver's tolerance of a fresh plan's. Warm, each wavelength's source is not swept on its
+ * own (its norm estimated from the last solve's ratio, atmos__do_problem's kappa): a sweep an
+ * iteration and one a wavelength for the first residual (the build before, one more a wavelength:
+ * 12 sweeps for 6 iterations); afresh the source's sweep is the first residual. */
 static void dense_sky(atmos_context *ctx, const atmos_scene *s, atmos_volume *v, const atmos_plan_desc *pd)
 {
     atmos_scene t = *s, d0;
@@ -217,6 +220,9 @@ static void dense_sky(atmos_context *ctx, const atmos_scene *s, atmos_volume *v,
                "warm-started, %d (%d) afresh; the image %.1e from the fresh one's, the first sun's %.1e\n",
                iw, sweeps(warm), ifr, sweeps(fresh), dw, d0f);
         CHECK(ifr >= 9 && iw >= 1 && iw <= ifr / 2);
+        /* afresh the second and third wavelengths start from the first's field times the ratio: their
+           sources swept, and their first residuals */
+        CHECK(sweeps(warm) == iw + 3 && sweeps(fresh) == ifr + 3 + 2);
         CHECK(mean(fresh) > 0 && dw < 2e-4 && d0f > 5 * dw);
     } else
         CHECK(0);
