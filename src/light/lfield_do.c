@@ -390,12 +390,6 @@ static void dsa_switch(do_work *W, int it, double resid, atmos__do_stats *st)
     }
 }
 
-/* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
- * its first residual b itself, no sweep); with W->dsa flexible GMRES (Saad 1993) right-preconditioned
- * by it: the columns' z_j = M^-1 v_j differ from v_j in their moments of degree <= 1 alone
- * (W->dz), the residual the true one (the same tolerance), r the z's room within a cycle.
- * Returns 1 with the last residual b - A x in r (b = 0: x = 0,
- * r = 0), else 0. */
 /* The residual b - A x into V at a GMRES cycle's start: b itself from 0 (zero_start), else by a
  * sweep: with b, A x's (apply); with b NULL (not swept: atmos__do_problem's kappa), the source's
  * and the scattering's together, V = T (S x + q1) - x, and *bn, when not known yet (0), taken as
@@ -420,8 +414,12 @@ static void cycle_start(do_work *W, const double *b, const double *x, double *V,
     for (size_t i = 0; i < N; i++) V[i] -= x[i];
 }
 
-/* GMRES from x (zero_start: x is 0) for the source's sweep b, bn = ||b||; b NULL with bn 0: not
- * swept, bn estimated at the first cycle's start (cycle_start). The last residual into r. */
+/* Restarted GMRES (Saad & Schultz 1986) on (I - T S) x = b, x holding the start (zero_start: x is 0,
+ * its first residual b itself, no sweep); with W->dsa flexible GMRES (Saad 1993) right-preconditioned
+ * by it: the columns' z_j = M^-1 v_j differ from v_j in their moments of degree <= 1 alone
+ * (W->dz), the residual the true one (the same tolerance), r the z's room within a cycle. bn =
+ * ||b||; b NULL with bn 0: b not swept, bn estimated at the first cycle's start (cycle_start).
+ * Returns 1 with the last residual b - A x in r (no source: x = 0, r = 0), else 0. */
 static int gmres(do_work *W, const double *b, double bn, double *x, double *V, double *r, atmos__do_stats *st,
                  int zero_start)
 {
