@@ -511,10 +511,12 @@ static int bench_slice(const char *file, int file_only, const bench_slice_opts *
     atmos_volume_generate_desc g = {.seed = 1};
     atmos_volume *v = NULL;
     atmos_status st = ATMOS_OK;
+    int (*const run)(atmos_context *, const char *, atmos_volume *, double, const bench_slice_opts *) =
+        o->field_ratio ? bench_slice_ratio : bench_slice_case;
     if (!file_only) {
         st = atmos_volume_generate(ctx, "storm", &g, &v);
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else rc = (o->field_ratio ? bench_slice_ratio : bench_slice_case)(ctx, "generated_storm", v, 1, o);
+        else rc = run(ctx, "generated_storm", v, 1, o);
         atmos_volume_destroy(v);
         v = NULL;
     }
@@ -522,9 +524,7 @@ static int bench_slice(const char *file, int file_only, const bench_slice_opts *
         st = atmos_volume_load(ctx, file, &bench_load, &v);
         const char *base = strrchr(file, '/');
         if (st != ATMOS_OK) rc = cli_runtime_error("bench", ctx, st);
-        else
-            rc = (o->field_ratio ? bench_slice_ratio : bench_slice_case)(ctx, base ? base + 1 : file, v,
-                                                                        dscale > 0 ? dscale : 1e8, o);
+        else rc = run(ctx, base ? base + 1 : file, v, dscale > 0 ? dscale : 1e8, o);
         atmos_volume_destroy(v);
     }
     atmos_context_destroy(ctx);
