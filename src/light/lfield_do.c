@@ -502,8 +502,8 @@ static int gmres(do_work *W, const double *b, double bn, double *x, double *V, d
 }
 
 struct atmos__do_ws {
-    void *mem;
-    size_t bytes;
+    void *mem, *aux;
+    size_t bytes, aux_bytes;
     atmos__do_ws *next; /* the next concurrent solve's */
 };
 
@@ -522,9 +522,18 @@ void atmos__do_ws_free(atmos__do_ws *ws)
 {
     while (ws) {
         atmos__do_ws *next = ws->next;
-        free(ws->mem), free(ws);
+        free(ws->mem), free(ws->aux), free(ws);
         ws = next;
     }
+}
+
+void *atmos__do_ws_aux(atmos__do_ws *ws, size_t bytes)
+{
+    if (ws->aux_bytes < bytes) {
+        free(ws->aux);
+        ws->aux_bytes = (ws->aux = malloc(bytes)) ? bytes : 0;
+    }
+    return ws->aux;
 }
 
 /* The next bytes of *at (rounded up to 64) when *at is not NULL; the running size into *total. */
@@ -636,7 +645,7 @@ int atmos__do_solve(const atmos__do_problem *P, double *phi, atmos__do_stats *st
     const int m = P->restart < 1 ? 1 : P->restart > 64 ? 64 : P->restart;
     atmos__do_problem Pm = *P;
     Pm.restart = m, W.P = &Pm;
-    atmos__do_ws own = {NULL, 0, NULL}, *ws = P->ws ? P->ws : &own;
+    atmos__do_ws own = {NULL, NULL, 0, 0, NULL}, *ws = P->ws ? P->ws : &own;
     double *V = NULL, *b = NULL, *tmp = NULL, *x = NULL;
     const int ok = take_buffers(&W, m, ws, &V, &b, &tmp, &x);
     if (ok) {

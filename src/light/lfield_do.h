@@ -10,6 +10,8 @@
 #ifndef ATMOS_LIGHT_LFIELD_DO_H
 #define ATMOS_LIGHT_LFIELD_DO_H
 
+#include <stddef.h>
+
 #define ATMOS__DO_KMAX 16  /* coefficients per cell at most: degree 3 */
 #define ATMOS__DO_NMAX 512 /* directions at most */
 
@@ -49,6 +51,9 @@ atmos__do_ws *atmos__do_ws_create(void);
  * with ws; NULL when ws is or when out of memory (the solve then uses its own). Not thread-safe. */
 atmos__do_ws *atmos__do_ws_at(atmos__do_ws *ws, int i);
 void atmos__do_ws_free(atmos__do_ws *ws);
+/* A second buffer of ws of at least bytes, for its owner's own arrays of each solve (kept, grown as
+ * needed); NULL when out of memory. Not thread-safe. */
+void *atmos__do_ws_aux(atmos__do_ws *ws, size_t bytes);
 
 typedef struct {
     int c[3];                   /* cells, the first axis fastest */

@@ -198,11 +198,12 @@ static int job_buffers(atmos__slice_plan *sp, sjob *j)
         sp->pix_cap = pst * nplanes;
     }
     const size_t K = (size_t)j->nslices, nspan = K * j->H + 2 * K * j->L + j->H + j->L;
-    if (nspan > sp->span_cap) {
+    if (nspan > sp->span_cap) { /* a quarter more: the slices' count changes as the sun moves */
+        const size_t cap = nspan + nspan / 4;
         free(sp->spans);
         sp->span_cap = 0;
-        if (!(sp->spans = malloc(sizeof(sspan) * nspan))) return 0;
-        sp->span_cap = nspan;
+        if (!(sp->spans = malloc(sizeof(sspan) * cap))) return 0;
+        sp->span_cap = cap;
     }
     j->pst = pst;
     float *b = sp->pixblock;
