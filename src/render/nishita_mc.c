@@ -360,21 +360,24 @@ static void voxel_scattering(const atmos__nishita_plan *np, const path_medium *m
             sums[w] = sum * unit, any |= sums[w] > 0;
         }
         if (!any) continue; /* the empty points, most of a cloud's box: no corners */
-        int ci[8][3];
+        int ci[8][3], lk[8]; /* lk: the corner's local cell, -1 outside them, -2 weight 0 */
         double wt[8];
         corners(F, u, ci, wt);
+        for (int k = 0; k < 8; k++) {
+            int d[3], inside = 1;
+            for (int a = 0; a < 3; a++) d[a] = ci[k][a] - base[a], inside &= d[a] >= 0 && d[a] < 3;
+            lk[k] = !(wt[k] > 0) ? -2 : inside ? (d[2] * 3 + d[1]) * 3 + d[0] : -1;
+            if (lk[k] >= 0) used[lk[k]] = 1;
+        }
         for (int w = 0; w < n; w++) {
             const double sum = sums[w];
             if (!(sum > 0)) continue;
             for (int k = 0; k < 8; k++) {
-                if (!(wt[k] > 0)) continue;
+                if (lk[k] == -2) continue;
                 const int64_t x = (int64_t)llrint(wt[k] * sum * MC_FIX);
-                int d[3], inside = 1;
-                for (int a = 0; a < 3; a++) d[a] = ci[k][a] - base[a], inside &= d[a] >= 0 && d[a] < 3;
-                if (inside) {
-                    const int l = (d[2] * 3 + d[1]) * 3 + d[0];
-                    loc[l][w] += x, used[l] = 1;
-                } else { /* not expected; the same sum either way */
+                if (lk[k] >= 0)
+                    loc[lk[k]][w] += x;
+                else { /* not expected; the same sum either way */
 #pragma omp atomic
                     acc[cell_of(F, ci[k]) * n + w] += x;
                 }

@@ -14,18 +14,22 @@
 #define VS 50.0
 #define SIGMA 1e-9
 
-/* The slab, of optical depth tau across its NS voxels (particles of cross-section SIGMA). */
-static inline atmos_volume *test_slab(atmos_context *ctx, double tau)
+/* A slab nx voxels wide each way, of optical depth tau across its NS voxels (particles of
+ * cross-section SIGMA). */
+static inline atmos_volume *test_slab_nx(atmos_context *ctx, double tau, int nx)
 {
-    float *buf = calloc(NX * NY * NX, sizeof(float));
-    for (int k = 0; k < NX; k++)
+    float *buf = calloc((size_t)nx * NY * nx, sizeof(float));
+    for (int k = 0; buf && k < nx; k++)
         for (int j = (NY - NS) / 2; j < (NY + NS) / 2; j++)
-            for (int i = 0; i < NX; i++) buf[((size_t)k * NY + j) * NX + i] = (float)(tau / (SIGMA * VS * NS));
-    const int dims[3] = {NX, NY, NX};
-    atmos_volume *v = test_cloud_volume(ctx, dims, VS, buf);
+            for (int i = 0; i < nx; i++) buf[((size_t)k * NY + j) * nx + i] = (float)(tau / (SIGMA * VS * NS));
+    const int dims[3] = {nx, NY, nx};
+    atmos_volume *v = buf ? test_cloud_volume(ctx, dims, VS, buf) : NULL;
     free(buf);
     return v;
 }
+
+/* The wide slab (NX voxels each way). */
+static inline atmos_volume *test_slab(atmos_context *ctx, double tau) { return test_slab_nx(ctx, tau, NX); }
 
 /* A vacuum, the sun at the zenith (irradiance 1), the camera 20 km from the slab's top centre
  * looking down at it from zenith angle acos(mu), a narrow view (12 x 12 pixels) of the slab's
