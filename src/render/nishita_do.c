@@ -138,25 +138,48 @@ static inline double escape(double x)
     return x < 1e-3 ? 1 - 0.5 * x : (1 - atmos__expf_fast((float)-x)) / x;
 }
 
-/* The first scattering the voxel (x, y, z)'s six face neighbours send it, per wavelength w < n
- * (out, 1/m): each one's sigma_s escape(sigma_t h / SUB_NB_TAU), its sigma_s bounded where its
- * optical size passes SUB_NB_TAU (its sigma_s alone grew without bound and drew a cell of a dense
- * tower 1.5 times as bright as the cloud about it, the path tracer 0.9 times). */
-static void neighbours(const atmos__nishita_plan *np, int n, int x, int y, int z, double hv, double *out)
+/* What a voxel sends its face neighbours as their first scattering (sub_terms), per wavelength
+ * w < n (o, 1/m): its sigma_s escape(sigma_t h / SUB_NB_TAU), 0 where its sigma_s is 0 (u: its grid
+ * index times nf); its sigma_s bounded where its optical size passes SUB_NB_TAU (its sigma_s alone
+ * grew without bound and drew a cell of a dense tower 1.5 times as bright as the cloud about it,
+ * the path tracer 0.9 times). */
+static inline void nb_value(const atmos__nishita_plan *np, int n, size_t u, double hv, double *o)
 {
     const sgrid *g = &np->g;
-    const int nf = np->nf, xyz[3] = {x, y, z};
+    const int nf = np->nf;
+    for (int w = 0; w < n; w++) {
+        double t = 0, sc = 0;
+        for (int f = 0; f < nf; f++) t += g->v[u + f] * np->mc_sig_ms[f][w], sc += g->v[u + f] * np->mc_sca[f][w];
+        o[w] = sc != 0 ? sc * escape(t * hv / SUB_NB_TAU) : 0;
+    }
+}
+
+/* nb_value of the voxels of planes z0 .. z0 + nz - 1 (those inside the grid) into nb, plane
+ * z - z0's voxel (x, y) at ((z - z0) c[1] + y) c[0] + x, n each. */
+static void nb_planes(const atmos__nishita_plan *np, int n, int z0, int nz, double hv, double *nb)
+{
+    const sgrid *g = &np->g;
+    const size_t plane = (size_t)g->c[0] * g->c[1];
+    for (int z = z0 < 0 ? 0 : z0; z < z0 + nz && z < g->c[2]; z++)
+        for (size_t p = 0; p < plane; p++)
+            nb_value(np, n, ((size_t)z * plane + p) * np->nf, hv, nb + ((size_t)(z - z0) * plane + p) * n);
+}
+
+/* The first scattering the voxel (x, y, z)'s six face neighbours send it, per wavelength w < n
+ * (out, 1/m, added in the order -x, +x, -y, +y, -z, +z): their nb_value, from nb (nb_planes from
+ * plane z0, which holds z - 1 .. z + 1 where they are inside the grid). */
+static void neighbours(const atmos__nishita_plan *np, int n, int x, int y, int z, const double *nb, int z0,
+                       double *out)
+{
+    const sgrid *g = &np->g;
+    const int xyz[3] = {x, y, z};
     for (int a = 0; a < 3; a++)
         for (int d = -1; d <= 1; d += 2) {
             int q[3] = {xyz[0], xyz[1], xyz[2]};
             q[a] += d;
             if (q[a] < 0 || q[a] >= g->c[a]) continue;
-            const size_t u = (((size_t)q[2] * g->c[1] + q[1]) * g->c[0] + q[0]) * nf;
-            for (int w = 0; w < n; w++) {
-                double t = 0, sc = 0;
-                for (int f = 0; f < nf; f++) t += g->v[u + f] * np->mc_sig_ms[f][w], sc += g->v[u + f] * np->mc_sca[f][w];
-                if (sc != 0) out[w] += sc * escape(t * hv / SUB_NB_TAU);
-            }
+            const double *v = nb + (((size_t)(q[2] - z0) * g->c[1] + q[1]) * g->c[0] + q[0]) * n;
+            for (int w = 0; w < n; w++) out[w] += v[w];
         }
 }
 
@@ -240,14 +263,24 @@ static inline size_t kept_voxel(const sgrid *g, int nf, int s, int i, int j, int
     return (((size_t)*z * g->c[1] + *y) * g->c[0] + *x) * nf;
 }
 
-/* dc->sub and dc->dust (struct atmos__do_cells) for the voxels listed in dc. */
-static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atmos__do_cells *dc, int n, int threads)
+/* dc->sub and dc->dust (struct atmos__do_cells) for the voxels listed in dc. Each plane of cells
+ * with the neighbours' values of its voxels' planes and the one either side made once (nb_planes,
+ * a buffer a thread: each voxel's value was made again for each of its six neighbours). 0: out of
+ * memory. */
+static int sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atmos__do_cells *dc, int n, int threads)
 {
     const sgrid *g = &np->g;
     const int s = F->s, nf = np->nf;
     const double hv = 1.0 / g->sc;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int k = 0; k < F->c[2]; k++)
+    const size_t span = (size_t)(s + 2) * g->c[0] * g->c[1] * n; /* a thread's planes */
+    const int nt = threads < 1 ? 1 : threads;
+    double *buf = malloc(sizeof(double) * span * nt);
+    if (!buf) return 0;
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (int k = 0; k < F->c[2]; k++) {
+        double *nb = buf + span * omp_get_thread_num();
+        const int z0 = k * s - 1;
+        nb_planes(np, n, z0, s + 2, hv, nb);
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
@@ -256,7 +289,7 @@ static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atm
                     int x, y, z;
                     const size_t v = kept_voxel(g, nf, s, i, j, k, dc->vox[e], &x, &y, &z);
                     double scn[ATMOS_MAX_WAVELENGTHS] = {0};
-                    neighbours(np, n, x, y, z, hv, scn);
+                    neighbours(np, n, x, y, z, nb, z0, scn);
                     for (int w = 0; w < n; w++) {
                         double t = 0, sc = 0;
                         for (int f = 0; f < nf; f++)
@@ -268,6 +301,9 @@ static void sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atm
                 }
                 for (int w = 0; w < n; w++) dc->dust[c * n + w] = (float)(SUB_DUST * scmax[w]);
             }
+    }
+    free(buf);
+    return 1;
 }
 
 /* The cells' medium of np on F's cells (struct atmos__do_cells); NULL when out of memory or
@@ -296,7 +332,10 @@ static atmos__do_cells *cells_make(const atmos__nishita_plan *np, const atmos__l
         atmos__do_cells_free(dc);
         return NULL;
     }
-    if (s > 1) sub_terms(np, F, dc, n, threads);
+    if (s > 1 && !sub_terms(np, F, dc, n, threads)) {
+        atmos__do_cells_free(dc);
+        return NULL;
+    }
     return dc;
 }
 
