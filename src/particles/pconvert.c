@@ -1,6 +1,7 @@
 /* Particle clouds from volumes and back (pcloud.h). */
 #include "particles/pcloud.h"
 #include "core/internal.h"
+#include "volume/volume_access.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -33,7 +34,10 @@ static void to_world(const vframe *f, double i, double j, double k, double w[3])
 }
 
 /* One sweep over the cells of m^3 voxels of a field: counts the cells above thr and, with
- * pc, adds their particles. Returns the count (-1: out of memory). */
+ * pc, adds their particles. Returns the count (-1: out of memory). Each voxel's value read
+ * as it is stored (the trilinear sample at its centre through the public sampler, from world
+ * coordinates and back, was most of a Harris plan of the Disney cloud; it differed from the
+ * voxel's value by rounding alone). */
 static long sweep(const atmos_volume *vol, const vframe *f, int field, int m, double thr, const double off[3],
                   atmos__pcloud *pc)
 {
@@ -49,7 +53,7 @@ static long sweep(const atmos_volume *vol, const vframe *f, int field, int m, do
                         for (int i = ci * m; i < (ci + 1) * m && i < f->dims[0]; i++) {
                             double w[3];
                             to_world(f, i + 0.5, j + 0.5, k + 0.5, w);
-                            const double v = atmos_volume_sample(vol, field, w);
+                            const double v = atmos__vol_voxel(vol, field, i, j, k);
                             sum += v;
                             for (int a = 0; a < 3; a++) cen[a] += v * w[a];
                         }
