@@ -273,7 +273,8 @@ static int sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atmo
     const int s = F->s, nf = np->nf;
     const double hv = 1.0 / g->sc;
     const size_t span = (size_t)(s + 2) * g->c[0] * g->c[1] * n; /* a thread's planes */
-    const int nt = threads < 1 ? 1 : threads;
+    int nt = threads > F->c[2] ? F->c[2] : threads; /* no more than planes */
+    nt = nt < 1 ? 1 : nt;
     double *buf = malloc(sizeof(double) * span * nt);
     if (!buf) return 0;
 #pragma omp parallel for schedule(static) num_threads(nt)
