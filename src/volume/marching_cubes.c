@@ -57,15 +57,43 @@ static int push(gen_mesh *m, const gen_tri *t, size_t max_tris)
     return 1;
 }
 
-int atmos__gen_marching_cubes(const gen_grid *g, int stride, float iso, int floor_j, size_t max_tris, gen_mesh *out)
+/* Each grid row's (j, k) largest value into rmax[k n1 + j], at least 0 (the value outside the grid)
+ * and 0 below floor_j: a row of cubes whose four grid rows are at most iso has no corner inside,
+ * so none of its cubes makes a polygon (most rows of a cloud's box). */
+static void row_max(const gen_grid *g, int floor_j, float *rmax)
 {
-    memset(out, 0, sizeof *out);
+    for (int k = 0; k < g->n[2]; k++)
+        for (int j = 0; j < g->n[1]; j++) {
+            const float *r = g->v + ((size_t)k * g->n[1] + j) * g->n[0];
+            float m = 0;
+            for (int i = 0; j >= floor_j && i < g->n[0]; i++) m = r[i] > m ? r[i] : m;
+            rmax[(size_t)k * g->n[1] + j] = m;
+        }
+}
+
+/* The largest of row_max's values over the grid rows that the row of cubes (j, k) reads. */
+static float cube_row_max(const gen_grid *g, const float *rmax, int stride, int j, int k)
+{
+    float m = 0;
+    for (int dk = 0; dk <= stride; dk += stride)
+        for (int dj = 0; dj <= stride; dj += stride) {
+            const int cj = j + dj, ck = k + dk;
+            if (cj >= 0 && ck >= 0 && cj < g->n[1] && ck < g->n[2] && rmax[(size_t)ck * g->n[1] + cj] > m)
+                m = rmax[(size_t)ck * g->n[1] + cj];
+        }
+    return m;
+}
+
+static int march(const gen_grid *g, const float *rmax, int stride, float iso, int floor_j, size_t max_tris,
+                 gen_mesh *out)
+{
     int edge_tab[8][8];
     for (int a = 0; a < 8; a++)
         for (int b = 0; b < 8; b++) edge_tab[a][b] = edge_between(a, b);
     const double s = g->voxel;
     for (int k = -stride; k < g->n[2]; k += stride)
-        for (int j = -stride; j < g->n[1]; j += stride)
+        for (int j = -stride; j < g->n[1]; j += stride) {
+            if (!(cube_row_max(g, rmax, stride, j, k) > iso)) continue; /* no corner inside */
             for (int i = -stride; i < g->n[0]; i += stride) {
                 /* Samples outside the grid read as 0 so the surface closes at the borders. */
                 float v[8];
@@ -166,5 +194,17 @@ int atmos__gen_marching_cubes(const gen_grid *g, int stride, float iso, int floo
                     }
                 }
             }
+        }
     return 1;
+}
+
+int atmos__gen_marching_cubes(const gen_grid *g, int stride, float iso, int floor_j, size_t max_tris, gen_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    float *rmax = malloc(sizeof(float) * (size_t)g->n[1] * g->n[2]);
+    if (!rmax) return 0;
+    row_max(g, floor_j, rmax);
+    const int ok = march(g, rmax, stride, iso, floor_j, max_tris, out);
+    free(rmax);
+    return ok;
 }
