@@ -248,7 +248,8 @@ static void cells_pass(const atmos__nishita_plan *np, const atmos__lfield *F, at
                     cell_voxels(np, s, n, i, j, k, dc->vox + dc->first[c], NULL, NULL);
                     continue;
                 }
-                double at[ATMOS_MAX_WAVELENGTHS] = {0}, as[ATMOS_MAX_WAVELENGTHS] = {0};
+                double at[ATMOS_MAX_WAVELENGTHS], as[ATMOS_MAX_WAVELENGTHS]; /* n of them set */
+                for (int w = 0; w < n; w++) at[w] = as[w] = 0;
                 dc->first[c + 1] = cell_voxels(np, s, n, i, j, k, NULL, at, as);
                 for (int w = 0; w < n; w++)
                     dc->st[2 * cells * w + c] = (float)(at[w] * inv),
@@ -285,11 +286,13 @@ static int sub_terms(const atmos__nishita_plan *np, const atmos__lfield *F, atmo
         for (int j = 0; j < F->c[1]; j++)
             for (int i = 0; i < F->c[0]; i++) {
                 const size_t c = ((size_t)k * F->c[1] + j) * F->c[0] + i;
-                double scmax[ATMOS_MAX_WAVELENGTHS] = {0};
+                double scmax[ATMOS_MAX_WAVELENGTHS];
+                for (int w = 0; w < n; w++) scmax[w] = 0;
                 for (size_t e = dc->first[c]; e < dc->first[c + 1]; e++) {
                     int x, y, z;
                     const size_t v = kept_voxel(g, nf, s, i, j, k, dc->vox[e], &x, &y, &z);
-                    double scn[ATMOS_MAX_WAVELENGTHS] = {0};
+                    double scn[ATMOS_MAX_WAVELENGTHS]; /* n of them: not all 128 set each voxel */
+                    for (int w = 0; w < n; w++) scn[w] = 0;
                     neighbours(np, n, x, y, z, nb, z0, scn);
                     for (int w = 0; w < n; w++) {
                         double t = 0, sc = 0;
