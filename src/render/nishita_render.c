@@ -114,9 +114,9 @@ static int march(const rjob *J, const double dw[3], double *L, double *T, double
         if (J->use_field) atmos__lfield_sample(&np->field, np->field.L, n, (float)u[0], (float)u[1], (float)u[2], Lf);
         float Lmc[ATMOS_MAX_WAVELENGTHS];
         if (J->mc) atmos__lfield_sample(J->mc, J->mc->L, n, (float)u[0], (float)u[1], (float)u[2], Lmc);
-        double Sd[ATMOS_MAX_WAVELENGTHS] = {0};
+        double Sd[ATMOS_MAX_WAVELENGTHS]; /* n of them set a sample, not all 128 */
         float fade[ATMOS_MAX_WAVELENGTHS];
-        for (int w = 0; w < n; w++) fade[w] = 0.0f;
+        for (int w = 0; w < n; w++) Sd[w] = 0, fade[w] = 0.0f;
         if (J->diffuse) {
             const float uf[3] = {(float)u[0], (float)u[1], (float)u[2]};
             diffuse_at(np, uf, dens, ams2, Sd, fade);
