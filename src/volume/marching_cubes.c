@@ -84,6 +84,8 @@ static float cube_row_max(const gen_grid *g, const float *rmax, int stride, int 
     return m;
 }
 
+/* atmos__gen_marching_cubes's triangles into out (emptied by the caller), the rows of cubes with no
+ * corner above iso skipped (rmax: row_max). 0: out of memory. */
 static int march(const gen_grid *g, const float *rmax, int stride, float iso, int floor_j, size_t max_tris,
                  gen_mesh *out)
 {
