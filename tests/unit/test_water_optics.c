@@ -60,7 +60,9 @@ static void test_rain(atmos_context *ctx)
     const double nms[3] = {680.0, 550.0, 440.0};
     double bow1[3], bow2[3];
     for (int w = 0; w < 3; w++) {
-        if (SANITIZED && w == 1) continue;
+        /* a wavelength's cost is fixed by the size budget (6 s under the sanitizers): one
+         * there, the colour order below without them */
+        if (SANITIZED && w != 0) continue;
         atmos__phase_result r;
         CHECK_OK(atmos__water_phase(ctx, &p, nms[w], NB, th, ph, &r, NULL, NULL));
         double n = atmos_refractive_index_water(nms[w]).re;
@@ -90,8 +92,10 @@ static void test_rain(atmos_context *ctx)
     }
     /* colour order: red outside in the primary (larger radius 180 - theta, i.e. smaller
      * scattering angle), inside in the secondary */
-    CHECK_MSG(bow1[0] < bow1[2], "primary: 680 nm at %.3f°, 440 nm at %.3f°", bow1[0], bow1[2]);
-    CHECK_MSG(bow2[0] > bow2[2], "secondary: 680 nm at %.3f°, 440 nm at %.3f°", bow2[0], bow2[2]);
+    if (!SANITIZED) {
+        CHECK_MSG(bow1[0] < bow1[2], "primary: 680 nm at %.3f°, 440 nm at %.3f°", bow1[0], bow1[2]);
+        CHECK_MSG(bow2[0] > bow2[2], "secondary: 680 nm at %.3f°, 440 nm at %.3f°", bow2[0], bow2[2]);
+    }
 
 }
 
@@ -256,10 +260,14 @@ static void test_progress(void)
     atmos_context_defaults(&d);
     d.threads = 1;
     CHECK_OK(atmos_context_create(&d, &c1));
-    water_progress w = {0, -1, 0, 0};
-    CHECK_OK(atmos__water_phase(c1, &p, 680.0, NB, th, ph, &r, water_progress_fn, &w));
-    printf("rain, fast, 680 nm: %d progress reports, largest step %.3f\n", w.calls, w.max_step);
-    CHECK(w.calls >= 8 && w.max_step <= 0.125 && w.last == 1.0);
+    /* the whole computation is reported on without the sanitizers (7 s with them); the
+     * cancelled one below runs the same calls in both builds */
+    if (!SANITIZED) {
+        water_progress w = {0, -1, 0, 0};
+        CHECK_OK(atmos__water_phase(c1, &p, 680.0, NB, th, ph, &r, water_progress_fn, &w));
+        printf("rain, fast, 680 nm: %d progress reports, largest step %.3f\n", w.calls, w.max_step);
+        CHECK(w.calls >= 8 && w.max_step <= 0.125 && w.last == 1.0);
+    }
     water_progress c = {0, 2, 0, 0};
     CHECK(atmos__water_phase(c1, &p, 680.0, NB, th, ph, &r, water_progress_fn, &c) == ATMOS_E_CANCELLED);
     CHECK(c.calls == 2);
