@@ -25,7 +25,8 @@ static const char *scene_json =
     " \"sigma_ext_m2\": 2e-9, \"albedo\": 0.98}},"
     " \"volume\": {\"generate\": \"cumulus\", \"seed\": 3, \"scale\": 0.3, \"position_m\": [0, 1000, -4000]},"
     " \"sun\": {\"elevation_deg\": 30, \"azimuth_deg\": 160},"
-    " \"slice\": {\"slices\": 48, \"light_size\": 64}, \"path\": {\"spp\": 4}}";
+    " \"slice\": {\"slices\": 48, \"light_size\": 64}, \"path\": {\"spp\": 4}, \"nishita\": {\"mc_cell\": 8},"
+    " \"harris\": {\"max_particles\": 4000, \"sky_lights\": 2}}";
 
 static atmos_context *make_ctx(int threads)
 {
