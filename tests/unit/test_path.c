@@ -498,9 +498,11 @@ static void test_truncate(atmos_context *ctx)
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
         slab_vs_ad(ctx, cases[c].w1, cases[c].g1, cases[c].g2, cases[c].tau, cases[c].spp, 3.0);
-    /* Exact, with the droplet-like peak: the aureole estimate is on (P(0) > 100 sr^-1) */
+    /* Exact, with the droplet-like peak: the aureole estimate is on (P(0) > 100 sr^-1). Not in
+     * the sanitizer copy: its samples cannot be cut (above) and it was that copy's longest part
+     * (14 s); the estimate's code runs there in test_truncate_aureole. */
     static const int spp[2] = {2048, 256};
-    slab_vs_ad(ctx, 0.5, 0.99, 0.85, 2, spp, 0.0);
+    if (!TEST_SANITIZED) slab_vs_ad(ctx, 0.5, 0.99, 0.85, 2, spp, 0.0);
 }
 
 /* ------------------------------------------------------------------ single scattering */
