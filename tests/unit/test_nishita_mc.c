@@ -17,6 +17,12 @@
 #define TAU 4.0
 #define G 0.85
 
+/* The sanitizer copy (TEST_SANITIZED, test.h) is there for memory errors, the plain copy checks
+ * the numbers: the slab's fields there trace an eighth of the photons on cells of 2 voxels (the
+ * same code; the cells' scattering on 4^3 points a voxel, for cells of 1, was 84 % of that copy's
+ * time), and the checks their noise and cells would fail are left out. */
+#define SAN_KPHOTONS(k) (TEST_SANITIZED ? ((k) + 7) / 8 : (k))
+
 /* The slab (test_slab.h) of optical depth TAU. */
 static atmos_volume *slab(atmos_context *ctx) { return test_slab(ctx, TAU); }
 
@@ -28,7 +34,7 @@ static void scene(atmos_scene *s, double mu, int lmax)
     s->renderer = ATMOS_RENDERER_NISHITA;
     s->nishita.orders = 1, s->nishita.sky = 0;
     test_nishita_paper(s);
-    s->nishita.mc_kphotons = 100, s->nishita.mc_cell = 1, s->nishita.mc_lmax = lmax;
+    s->nishita.mc_kphotons = SAN_KPHOTONS(100), s->nishita.mc_cell = TEST_SANITIZED ? 2 : 1, s->nishita.mc_lmax = lmax;
 }
 
 /* The views of scene s (seen at mus[0]) at the NA view cosines mus through one plan: a field
@@ -93,13 +99,13 @@ static void check_slab(atmos_context *ctx, const atmos_volume_optics *o, const a
          * thousand photons per wavelength, cells of 1 voxel; -1.4 and -7.8 % with 300 thousand,
          * -4.9 and -12.7 % with cells of 2: the photons' noise over the few cells the view sees,
          * and the slab's top voxel); the first order alone is -96 %, so the check can fail */
-        CHECK(fabs(me / ref - 1) < 0.15);
+        if (!TEST_SANITIZED) CHECK(fabs(me / ref - 1) < 0.15);
         CHECK(fabs(m1 / ref - 1) > 0.5);
         /* degree 3 (the spherical harmonics of each collision's phase function, HG 0.85: g^l does
          * not fall off by degree 3) is far off in the slab lit from the zenith: measured -18 % and
          * +19 % (cells of 1 voxel; -35 and +20 % with cells of 2). Held within 30 % either way, so
          * a better field passes and one that loses the light (the first order's -96 %) fails */
-        CHECK(fabs(m / ref - 1) < 0.3);
+        if (!TEST_SANITIZED) CHECK(fabs(m / ref - 1) < 0.3);
         /* degree 3 in the delta-M scaled medium (f = g^4 = 0.52 of the scattering counted as not
          * scattered, the rest's moments falling off by degree 3), its first order in the scaled
          * medium too (TMS): measured +1.4 % and +1.3 % with 300 thousand photons per wavelength
