@@ -134,8 +134,10 @@ static void check_orders(atmos_context *ctx, double sun_el, double sun_az)
     atmos_scene s;
     scene(&s, sun_el, sun_az);
     atmos_image *p1 = path(ctx, &s, v, &op, 1, 256), *p2 = path(ctx, &s, v, &op, 2, 1024);
-    atmos_image *n1 = nishita(ctx, &s, v, &op, 1, 0, 0.8), *n2 = nishita(ctx, &s, v, &op, 2, 0, 0.99),
-                *n2p = nishita(ctx, &s, v, &op, 2, 0, 0.8);
+    /* the sanitizer copy runs the patterns at the paper's r = 0.8 alone: the nearly whole ones
+     * (r = 0.99) were most of its time, the same code */
+    atmos_image *n1 = nishita(ctx, &s, v, &op, 1, 0, 0.8), *n2p = nishita(ctx, &s, v, &op, 2, 0, 0.8),
+                *n2 = TEST_SANITIZED ? n2p : nishita(ctx, &s, v, &op, 2, 0, 0.99);
     unsigned char *m = cloud_mask(p1);
     const double r1 = masked_mean(p1, NULL, m), m1 = masked_mean(n1, NULL, m);
     const double r2 = masked_mean(p2, p1, m), m2 = masked_mean(n2, n1, m), m2p = masked_mean(n2p, n1, m);
@@ -148,9 +150,10 @@ static void check_orders(atmos_context *ctx, double sun_el, double sun_az)
     /* order 2 with the patterns nearly whole (r = 0.99): the difference of two path images
      * (1024 and 256 spp) is good to 1-2 % over the cloud; the patterns' cells (3 voxels) and
      * the one eye direction of the field add a few per cent: measured +3 % */
-    CHECK(fabs(m2 / r2 - 1) < 0.08);
+    if (!TEST_SANITIZED) CHECK(fabs(m2 / r2 - 1) < 0.08);
     free(m);
-    atmos_image_destroy(p1), atmos_image_destroy(p2), atmos_image_destroy(n1), atmos_image_destroy(n2), atmos_image_destroy(n2p);
+    if (n2 != n2p) atmos_image_destroy(n2);
+    atmos_image_destroy(p1), atmos_image_destroy(p2), atmos_image_destroy(n1), atmos_image_destroy(n2p);
     atmos_volume_destroy(v);
     atmos_phase_table_destroy(op.t);
 }
